@@ -1,0 +1,1 @@
+//! Code generation from traced `Sym` graphs (issue 4).

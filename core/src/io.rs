@@ -1,0 +1,1 @@
+//! Model readers (URDF, TOML) — STUB being written.

@@ -1,0 +1,1 @@
+//! The counting symbolic scalar — STUB being written.

@@ -1,0 +1,1 @@
+//! Proc-macros of kanegen (issue 4).

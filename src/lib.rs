@@ -1,0 +1,8 @@
+//! # kanegen
+//!
+//! Equations of motion of space manipulators `A(q) q̈ = b(q, q̇)`: the paper's recurrent O(N²)
+//! algorithm and its baselines, generic over the scalar; a counting symbolic tracer; and (later)
+//! code generation and simulation. This crate is the user-facing facade and the `kanegen` CLI.
+#![warn(missing_docs)]
+
+pub use kanegen_core::*;
