@@ -12,6 +12,7 @@ pub mod algorithms;
 pub mod io;
 pub mod linalg;
 pub mod model;
+pub mod random;
 pub mod scalar;
 pub mod sym;
 
