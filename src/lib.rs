@@ -5,4 +5,9 @@
 //! code generation and simulation. This crate is the user-facing facade and the `kanegen` CLI.
 #![warn(missing_docs)]
 
+pub mod commands;
+pub mod poly;
+pub mod states;
+pub mod table1;
+
 pub use kanegen_core::*;

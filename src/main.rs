@@ -1,1 +1,128 @@
-fn main() {}
+//! The `kanegen` command line.
+
+use anyhow::{Context, Result};
+use clap::{Parser, Subcommand};
+use kanegen::commands;
+use kanegen::Algorithm;
+use std::path::PathBuf;
+
+#[derive(Parser)]
+#[command(name = "kanegen", version, about = "Equations of motion of space manipulators: evaluate, count, reproduce the paper's Table 1")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+fn parse_algorithm(s: &str) -> Result<Algorithm, String> {
+    Algorithm::from_name(s).ok_or_else(|| {
+        let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+        format!("unknown algorithm `{s}`; known: {}", names.join(", "))
+    })
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Evaluate A(q) and b(q, q̇) at the states of a JSON file.
+    Eval {
+        /// Model file (.urdf or .toml).
+        model: PathBuf,
+        /// States file: {"states":[{"q":[…],"qd":[…],"tau":[…]}]}.
+        #[arg(long)]
+        states: PathBuf,
+        /// Algorithm: recurrent, recurrent-r1, kane-direct, crba-base, spatial.
+        #[arg(long, default_value = "recurrent", value_parser = parse_algorithm)]
+        algorithm: Algorithm,
+        /// Gravity X,Y,Z in the base frame, m/s² (zero unless given).
+        #[arg(long, allow_hyphen_values = true)]
+        gravity: Option<String>,
+        /// Print JSON: {"results":[{"A":[[…]],"b":[…]}]}.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Reproduce the paper's Table 1 by tracing; print it, or write table1.md, table1.json and
+    /// fig2.svg into --out.
+    Table1 {
+        /// Print the JSON report.
+        #[arg(long)]
+        json: bool,
+        /// Write table1.md, table1.json and fig2.svg into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
+    /// Operation counts of A and b for a model, per algorithm and convention.
+    Count {
+        /// Model file (.urdf or .toml).
+        model: PathBuf,
+        /// Only this algorithm (default: all).
+        #[arg(long, value_parser = parse_algorithm)]
+        algorithm: Option<Algorithm>,
+        /// Include gravity X,Y,Z in b.
+        #[arg(long, allow_hyphen_values = true)]
+        gravity: Option<String>,
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+fn load(model: &PathBuf) -> Result<kanegen::Chain> {
+    kanegen::io::load_model(model).with_context(|| format!("model `{}`", model.display()))
+}
+
+fn main() -> Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Command::Eval {
+            model,
+            states,
+            algorithm,
+            gravity,
+            json,
+        } => {
+            let chain = load(&model)?;
+            let text = std::fs::read_to_string(&states)
+                .with_context(|| format!("cannot read states file `{}`", states.display()))?;
+            let g = gravity
+                .map(|s| kanegen::states::parse_vec3(&s).context("--gravity"))
+                .transpose()?;
+            let results = commands::eval::eval_states(&chain, &text, algorithm, g)
+                .with_context(|| format!("states file `{}`", states.display()))?;
+            if json {
+                println!("{}", serde_json::json!({ "results": results }));
+            } else {
+                print!("{}", commands::eval::render_text(&chain, algorithm, &results));
+            }
+        }
+        Command::Table1 { json, out } => {
+            let t = kanegen::table1::build(&kanegen::table1::trace_all());
+            if let Some(dir) = &out {
+                commands::table1::write_all(&t, dir)?;
+                eprintln!("wrote table1.md, table1.json, fig2.svg to {}", dir.display());
+            }
+            if json {
+                println!("{}", serde_json::to_string_pretty(&t)?);
+            } else if out.is_none() {
+                print!("{}", commands::table1::render_markdown(&t)?);
+            }
+        }
+        Command::Count {
+            model,
+            algorithm,
+            gravity,
+            json,
+        } => {
+            let chain = load(&model)?;
+            let g = gravity
+                .map(|s| kanegen::states::parse_vec3(&s).context("--gravity"))
+                .transpose()?;
+            let algs: Vec<Algorithm> = algorithm.map_or(Algorithm::ALL.to_vec(), |a| vec![a]);
+            let r = commands::count::count(&chain, &algs, g);
+            if json {
+                println!("{}", serde_json::to_string_pretty(&r)?);
+            } else {
+                print!("{}", commands::count::render_text(&r));
+            }
+        }
+    }
+    Ok(())
+}

@@ -10,6 +10,7 @@
 
 pub mod algorithms;
 pub mod io;
+pub mod ldlt;
 pub mod linalg;
 pub mod model;
 pub mod random;

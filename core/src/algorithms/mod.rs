@@ -148,6 +148,46 @@ impl Algorithm {
     }
 }
 
+impl Algorithm {
+    /// Forward dynamics `q̈ = A⁻¹ b`, by the branch-free LDLᵀ of [`crate::ldlt`].
+    pub fn forward_dynamics<S: Scalar>(
+        self,
+        p: &ChainParams<S>,
+        q: &[S],
+        qd: &[S],
+        loads: &Loads<S>,
+    ) -> Vec<S> {
+        let d = self.dynamics(p, q, qd, loads);
+        crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+    }
+
+    /// Inverse dynamics: the joint drives `τ` for which `A q̈ = b(q, q̇, τ)` holds, i.e.
+    /// `τ = A q̈ − b(q, q̇, τ = 0)`; `loads.tau` is ignored.
+    pub fn inverse_dynamics<S: Scalar>(
+        self,
+        p: &ChainParams<S>,
+        q: &[S],
+        qd: &[S],
+        qdd: &[S],
+        loads: &Loads<S>,
+    ) -> Vec<S> {
+        let passive = Loads {
+            tau: None,
+            ..loads.clone()
+        };
+        let d = self.dynamics(p, q, qd, &passive);
+        d.a.iter()
+            .zip(d.b)
+            .map(|(row, bi)| {
+                row.iter()
+                    .zip(qdd)
+                    .fold(S::zero(), |acc, (aij, x)| acc + aij.clone() * x.clone())
+                    - bi
+            })
+            .collect()
+    }
+}
+
 impl core::fmt::Display for Algorithm {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         f.write_str(self.name())

@@ -1,0 +1,5 @@
+//! The CLI's commands, as library functions the tests call directly.
+
+pub mod count;
+pub mod eval;
+pub mod table1;
