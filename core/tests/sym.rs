@@ -1,0 +1,483 @@
+//! Tests of the counting symbolic scalar `Sym`: folding, hash-consing, sign normalisation,
+//! the three counting conventions on the primitives of `opcount_findings.md` §1, sections,
+//! evaluation and misuse panics.
+
+use kanegen_core::linalg::{Mat3, Vec3};
+use kanegen_core::scalar::Scalar;
+use kanegen_core::sym::{trace, Convention, Counts, Node, Sym, Tracer};
+
+fn c(x: f64) -> Sym {
+    Sym::constant(x)
+}
+
+fn vec_in(t: &Tracer, name: &str) -> Vec3<Sym> {
+    Vec3(core::array::from_fn(|i| t.input(format!("{name}{i}"))))
+}
+
+fn mat_in(t: &Tracer, name: &str) -> Mat3<Sym> {
+    Mat3(core::array::from_fn(|r| {
+        core::array::from_fn(|k| t.input(format!("{name}{r}{k}")))
+    }))
+}
+
+fn mat_out(m: Mat3<Sym>) -> Vec<Sym> {
+    m.into_array().into_iter().flatten().collect()
+}
+
+/// (mul, add) under each convention: [paper, folded, emitted].
+fn ma(t: &kanegen_core::sym::Trace) -> [(u64, u64); 3] {
+    Convention::ALL.map(|cv| {
+        let k = t.counts(cv);
+        (k.mul, k.add)
+    })
+}
+
+// ------------------------------------------------------------------------------------------
+// Folding identities.
+
+#[test]
+fn folding_identities() {
+    let t = Tracer::new();
+    let x = t.input("x");
+    let y = t.input("y");
+    // Constants fold.
+    assert_eq!((c(2.0) * c(3.0)).const_value(), Some(6.0));
+    assert_eq!((c(2.0) + c(3.0)).const_value(), Some(5.0));
+    assert_eq!((c(2.0) - c(3.0)).const_value(), Some(-1.0));
+    assert_eq!((c(3.0) / c(2.0)).const_value(), Some(1.5));
+    assert_eq!(c(4.0).sqrt().const_value(), Some(2.0));
+    assert_eq!(c(0.0).sin().const_value(), Some(0.0));
+    assert_eq!(c(0.0).cos().const_value(), Some(1.0));
+    // Zeros and ones.
+    assert_eq!((x * c(0.0)).const_value(), Some(0.0));
+    assert_eq!((c(0.0) * x).const_value(), Some(0.0));
+    assert_eq!(x * c(1.0), x);
+    assert_eq!(c(1.0) * x, x);
+    assert_eq!(x * c(-1.0), -x);
+    assert_eq!(c(-1.0) * x, -x);
+    assert_eq!(x + c(0.0), x);
+    assert_eq!(c(0.0) + x, x);
+    assert_eq!(x - c(0.0), x);
+    assert_eq!(c(0.0) - x, -x);
+    assert_eq!((x - x).const_value(), Some(0.0));
+    assert_eq!(x / c(1.0), x);
+    assert_eq!((c(0.0) / x).const_value(), Some(0.0));
+    assert_eq!(-(-x), x);
+    assert_eq!((-c(2.0)).const_value(), Some(-2.0));
+    // -0.0 and 0.0 are the same constant.
+    assert_eq!(c(-0.0), c(0.0));
+    // Non-foldable things stay.
+    assert_eq!((x + y).const_value(), None);
+    assert_ne!(x + x, x);
+    let tr = t.finish(&[]);
+    // Only the user's negations and x + y, x + x survived folding (-x made once per call).
+    let f = tr.counts(Convention::Folded);
+    assert_eq!(
+        (f.mul, f.add, f.div, f.sqrt, f.sin, f.cos),
+        (0, 2, 0, 0, 0, 0)
+    );
+    // Every call counts in the paper convention.
+    let p = tr.counts(Convention::Paper);
+    assert_eq!(
+        (p.mul, p.add, p.div, p.sqrt, p.sin, p.cos),
+        (7, 9, 3, 1, 1, 1)
+    );
+    // Nothing is reachable.
+    assert_eq!(tr.counts(Convention::Emitted), Counts::default());
+}
+
+#[test]
+fn folded_count_excludes_folded_calls_but_includes_cse_hits() {
+    let tr = trace(|t| {
+        let x = t.input("x");
+        let y = t.input("y");
+        let a = x * y;
+        let b = y * x; // hash-cons hit: still one folded operation
+        let _ = x * c(0.0) + c(0.0); // fully folded
+        vec![a, b]
+    });
+    assert_eq!(ma(&tr), [(3, 1), (2, 0), (1, 0)]);
+}
+
+// ------------------------------------------------------------------------------------------
+// Hash-consing and sign normalisation.
+
+#[test]
+fn hash_consing() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        assert_eq!(a * b, b * a);
+        assert_eq!(a + b, b + a);
+        assert_ne!(a - b, b - a);
+        assert_eq!(a / b, a / b);
+        assert_ne!(a / b, b / a);
+        assert_eq!(a.sin(), a.sin());
+        assert_eq!(c(1.5), c(1.5));
+        // Inputs are distinct per call, even with the same name.
+        let a2 = t.input("a");
+        assert_ne!(a, a2);
+        assert_ne!(a * b, a2 * b);
+        vec![a * b]
+    });
+    assert_eq!(tr.input_names(), ["a", "b", "a"]);
+}
+
+#[test]
+fn sign_normalisation() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        assert_eq!((-a) * b, -(a * b));
+        assert_eq!(a * (-b), -(a * b));
+        assert_eq!((-a) * (-b), a * b);
+        assert_eq!(a + (-b), a - b);
+        assert_eq!((-a) + b, b - a);
+        assert_eq!((-a) + (-b), -(a + b));
+        assert_eq!(a - (-b), a + b);
+        assert_eq!((-a) - b, -(a + b));
+        assert_eq!((-a) - (-b), b - a);
+        assert_eq!((-a) / b, -(a / b));
+        assert_eq!(a / (-b), -(a / b));
+        assert_eq!((-a) + a, c(0.0));
+        assert_eq!(a + (-a), c(0.0));
+        vec![]
+    });
+    // Negations never nest and never wrap another negation.
+    for (_, n) in tr.schedule() {
+        if let Node::Neg(inner) = n {
+            assert!(!matches!(tr.node(inner), Node::Neg(_)));
+        }
+    }
+    // (-a)*(-b): one multiplication after folding, no negation left.
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        vec![(-a) * (-b)]
+    });
+    let f = tr.counts(Convention::Folded);
+    assert_eq!(f.mul, 1);
+    assert_eq!(tr.counts(Convention::Emitted).neg, 0);
+    assert_eq!(tr.counts(Convention::Paper).neg, 2);
+    assert!(matches!(tr.node(tr.outputs()[0]), Node::Mul(..)));
+}
+
+// ------------------------------------------------------------------------------------------
+// The primitives of opcount_findings.md §1.
+
+#[test]
+fn skew_skew_product() {
+    let tr = trace(|t| {
+        let x = vec_in(t, "x");
+        let y = vec_in(t, "y");
+        mat_out(Mat3::skew(&x).mul_mat(&Mat3::skew(&y).transpose()))
+    });
+    assert_eq!(ma(&tr), [(27, 27), (12, 3), (9, 3)]);
+}
+
+#[test]
+fn scaled_skew_skew_product() {
+    let tr = trace(|t| {
+        let m = t.input("m");
+        let x = vec_in(t, "x");
+        let y = vec_in(t, "y");
+        mat_out(
+            Mat3::skew(&x)
+                .mul_mat(&Mat3::skew(&y).transpose())
+                .scale(&m),
+        )
+    });
+    assert_eq!(ma(&tr), [(36, 27), (21, 3), (18, 3)]);
+}
+
+#[test]
+fn bilinear_form() {
+    let tr = trace(|t| {
+        let a = vec_in(t, "a");
+        let m = mat_in(t, "M");
+        let b = vec_in(t, "b");
+        vec![a.dot(&m.mul_vec(&b))]
+    });
+    assert_eq!(ma(&tr), [(12, 12), (12, 8), (12, 8)]);
+}
+
+#[test]
+fn cross_product() {
+    let tr = trace(|t| {
+        let x = vec_in(t, "x");
+        let f = vec_in(t, "f");
+        Mat3::skew(&x).mul_vec(&f).into_array().to_vec()
+    });
+    assert_eq!(ma(&tr), [(9, 9), (6, 3), (6, 3)]);
+}
+
+// ------------------------------------------------------------------------------------------
+// Evaluation.
+
+/// A generic function exercising every operation, folding and sign normalisation.
+fn mixed<S: Scalar>(v: &[S]) -> Vec<S> {
+    let x = Vec3::new(v[0].clone(), v[1].clone(), v[2].clone());
+    let y = Vec3::new(v[3].clone(), v[4].clone(), v[5].clone());
+    let (s, co) = v[6].clone().sin_cos();
+    let u = Vec3::new(S::constant(0.6), S::zero(), S::constant(0.8));
+    let r = kanegen_core::linalg::axis_rotation(&u, &s, &co);
+    let p = Mat3::skew(&x).mul_mat(&Mat3::skew(&y).transpose());
+    let q = r.mul_mat(&p).mul_mat(&r.transpose());
+    let n = x.dot(&x).sqrt();
+    let w = (-x.cross(&y)).scale(&(S::one() / n.clone()));
+    let z = (-(v[0].clone()) - v[1].clone()) / (-(v[2].clone()) + S::constant(3.5))
+        + v[6].clone().sin() * v[5].clone().cos()
+        - (S::zero() - v[3].clone()) * S::constant(-1.0);
+    let mut out: Vec<S> = q.into_array().into_iter().flatten().collect();
+    out.extend(w.into_array());
+    out.push(z);
+    out.push(n);
+    out
+}
+
+#[test]
+fn eval_matches_f64() {
+    let inputs = [0.3, -1.2, 2.5, 1.1, 0.7, -0.4, 0.9];
+    let tr = trace(|t| {
+        let v: Vec<Sym> = (0..inputs.len())
+            .map(|i| t.input(format!("v{i}")))
+            .collect();
+        mixed(&v)
+    });
+    let want = mixed(&inputs);
+    let got = tr.eval(&inputs);
+    assert_eq!(got.len(), want.len());
+    for (g, w) in got.iter().zip(&want) {
+        assert!((g - w).abs() <= 1e-14 * w.abs().max(1.0), "{g} vs {w}");
+    }
+    // A second point, to make sure nothing is baked in.
+    let inputs2 = [-0.7, 0.2, 1.9, -2.1, 0.4, 1.3, -2.2];
+    let want2 = mixed(&inputs2);
+    for (g, w) in tr.eval(&inputs2).iter().zip(&want2) {
+        assert!((g - w).abs() <= 1e-14 * w.abs().max(1.0), "{g} vs {w}");
+    }
+}
+
+#[test]
+#[should_panic(expected = "expected 2 input values")]
+fn eval_with_missing_inputs_panics() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        vec![a + b]
+    });
+    let _ = tr.eval(&[1.0]);
+}
+
+#[test]
+fn schedule_is_topological_and_minimal() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        let _dead = a / b + c(3.0);
+        let s = (a * b).sin();
+        vec![s + a, s]
+    });
+    let sched = tr.schedule();
+    let ids: Vec<u32> = sched.iter().map(|(i, _)| *i).collect();
+    // a, b, a*b, sin, s + a — the division and the constant 3 are dead.
+    assert_eq!(sched.len(), 5);
+    assert!(ids.windows(2).all(|w| w[0] < w[1]));
+    for (id, n) in &sched {
+        let deps: Vec<Sym> = match *n {
+            Node::Add(x, y) | Node::Sub(x, y) | Node::Mul(x, y) | Node::Div(x, y) => vec![x, y],
+            Node::Neg(x) | Node::Sin(x) | Node::Cos(x) | Node::Sqrt(x) => vec![x],
+            Node::Const(_) | Node::Input(_) => vec![],
+        };
+        for d in deps {
+            assert!(ids.contains(&d.id()), "operand {} not scheduled", d.id());
+            assert!(d.id() < *id, "operand {} after its user {id}", d.id());
+        }
+    }
+    let kinds: Vec<&str> = sched
+        .iter()
+        .map(|(_, n)| match n {
+            Node::Input(_) => "in",
+            Node::Mul(..) => "mul",
+            Node::Sin(_) => "sin",
+            Node::Add(..) => "add",
+            _ => "other",
+        })
+        .collect();
+    assert_eq!(kinds, ["in", "in", "mul", "sin", "add"]);
+    match tr.node(tr.outputs()[1]) {
+        Node::Sin(arg) => assert_eq!(arg.id(), sched[2].0),
+        n => panic!("expected a sine, got {n:?}"),
+    }
+}
+
+// ------------------------------------------------------------------------------------------
+// Dead code, trig counting, sections.
+
+#[test]
+fn dead_code_not_emitted() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        let _unused = a * b + b / a;
+        let used = a - b;
+        vec![used, -used]
+    });
+    let p = tr.counts(Convention::Paper);
+    let e = tr.counts(Convention::Emitted);
+    assert_eq!((p.mul, p.add, p.div, p.neg), (1, 2, 1, 1));
+    assert_eq!((e.mul, e.add, e.div, e.neg), (0, 1, 0, 1));
+}
+
+#[test]
+fn trig_counts() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        let (sa, ca) = a.sin_cos();
+        let sb = b.sin();
+        let cb = b.cos();
+        let _dead = (a + b).cos();
+        let _folded = c(1.0).sin_cos();
+        vec![sa, ca, sb, cb]
+    });
+    let k = |cv| {
+        let k: Counts = tr.counts(cv);
+        (k.sin, k.cos, k.sincos)
+    };
+    assert_eq!(k(Convention::Paper), (3, 4, 5));
+    assert_eq!(k(Convention::Folded), (2, 3, 4));
+    assert_eq!(k(Convention::Emitted), (2, 2, 2));
+}
+
+#[test]
+fn sections_attribute_counts() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        let b = t.input("b");
+        let pre = a + b; // unlabelled
+        <Sym as Scalar>::section("A");
+        let _p = a * b; // emitted here, in A
+        let _dead = a * c(0.0);
+        <Sym as Scalar>::section("B");
+        let q = b * a; // CSE hit: emitted in A
+        let r = q - pre;
+        <Sym as Scalar>::section("A");
+        let s = r / a;
+        vec![s]
+    });
+    let by = |cv| tr.counts_by_section(cv);
+    let names: Vec<String> = by(Convention::Paper).into_iter().map(|(n, _)| n).collect();
+    assert_eq!(names, ["", "A", "B"]);
+    let get = |cv, i: usize| {
+        let k = by(cv)[i].1;
+        (k.mul, k.add, k.div)
+    };
+    assert_eq!(get(Convention::Paper, 0), (0, 1, 0));
+    assert_eq!(get(Convention::Paper, 1), (2, 0, 1));
+    assert_eq!(get(Convention::Paper, 2), (1, 1, 0));
+    assert_eq!(get(Convention::Folded, 1), (1, 0, 1));
+    assert_eq!(get(Convention::Folded, 2), (1, 1, 0));
+    assert_eq!(get(Convention::Emitted, 0), (0, 1, 0));
+    assert_eq!(get(Convention::Emitted, 1), (1, 0, 1));
+    assert_eq!(get(Convention::Emitted, 2), (0, 1, 0));
+    for cv in Convention::ALL {
+        let sum = by(cv)
+            .into_iter()
+            .fold(Counts::default(), |acc, (_, k)| acc + k);
+        assert_eq!(sum, tr.counts(cv));
+    }
+}
+
+#[test]
+fn unlabelled_section_listed_only_when_used() {
+    let tr = trace(|t| {
+        let a = t.input("a");
+        <Sym as Scalar>::section("only");
+        vec![a * a]
+    });
+    let by = tr.counts_by_section(Convention::Emitted);
+    assert_eq!(by.len(), 1);
+    assert_eq!(by[0].0, "only");
+    assert_eq!(by[0].1.mul, 1);
+}
+
+#[test]
+fn counts_arithmetic_and_names() {
+    let a = Counts {
+        mul: 2,
+        add: 3,
+        neg: 7,
+        ..Counts::default()
+    };
+    let mut b = Counts {
+        mul: 1,
+        div: 4,
+        ..Counts::default()
+    };
+    b += a;
+    assert_eq!(
+        b,
+        Counts {
+            mul: 3,
+            add: 3,
+            div: 4,
+            neg: 7,
+            ..Counts::default()
+        }
+    );
+    assert_eq!((a + a).total(), 10);
+    let names: Vec<_> = Convention::ALL.iter().map(|c| c.name()).collect();
+    assert_eq!(names, ["paper", "folded", "emitted"]);
+}
+
+// ------------------------------------------------------------------------------------------
+// Misuse.
+
+#[test]
+#[should_panic(expected = "no active Tracer on this thread")]
+fn no_tracer_panics() {
+    let _ = Sym::constant(1.0);
+}
+
+#[test]
+#[should_panic(expected = "no active Tracer on this thread")]
+fn sym_after_drop_panics() {
+    let x = {
+        let t = Tracer::new();
+        t.input("x")
+    };
+    let _ = x + x;
+}
+
+#[test]
+#[should_panic(expected = "no active Tracer on this thread")]
+fn sym_from_dropped_tracer_under_new_tracer_panics() {
+    let x = {
+        let t = Tracer::new();
+        t.input("x")
+    };
+    let t = Tracer::new();
+    let y = t.input("y");
+    let _ = x + y;
+}
+
+#[test]
+#[should_panic(expected = "already active")]
+fn two_tracers_panic() {
+    let _a = Tracer::new();
+    let _b = Tracer::new();
+}
+
+#[test]
+fn tracer_is_reusable_after_finish_and_drop() {
+    let t1 = trace(|t| vec![t.input("a") * c(2.0)]);
+    {
+        let t = Tracer::new();
+        let _ = t.input("z") + c(1.0);
+    }
+    let t2 = trace(|t| vec![t.input("b") + c(2.0)]);
+    assert_eq!(t1.eval(&[3.0]), [6.0]);
+    assert_eq!(t2.eval(&[3.0]), [5.0]);
+    assert_eq!(t2.counts(Convention::Paper).mul, 0);
+}
