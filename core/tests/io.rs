@@ -404,6 +404,16 @@ fn urdf_moving_body_without_mass_is_rejected() {
 }
 
 #[test]
+fn urdf_negative_mass_names_the_joint_and_link() {
+    let text = MERGE_URDF.replace(r#"<mass value="2"/>"#, r#"<mass value="-2"/>"#);
+    let e = parse_urdf(&text).unwrap_err().to_string();
+    assert!(
+        e.contains("`j1`") && e.contains("inertial.mass") && e.contains("link1"),
+        "{e}"
+    );
+}
+
+#[test]
 fn urdf_syntax_errors_are_parse_errors() {
     assert!(matches!(
         parse_urdf("<robot name="),

@@ -109,7 +109,7 @@ pub fn parse_urdf(text: &str) -> Result<Chain, ModelError> {
     // current body frame to the current link frame.
     let mut acc = MassAcc::default();
     let mut offset = Tf::identity();
-    add_link(&mut acc, &offset, links[root])?;
+    add_link(&mut acc, &offset, links[root], root)?;
     let mut base_inertial: Option<Inertial> = None;
     let mut joints: Vec<Joint> = Vec::new();
     let mut link = root;
@@ -138,7 +138,7 @@ pub fn parse_urdf(text: &str) -> Result<Chain, ModelError> {
         match kind {
             None => {
                 offset = offset.then(&origin);
-                add_link(&mut acc, &offset, child)?;
+                add_link(&mut acc, &offset, child, &j.name)?;
             }
             Some(kind) => {
                 let done = inertial_of(&acc);
@@ -160,7 +160,7 @@ pub fn parse_urdf(text: &str) -> Result<Chain, ModelError> {
                 });
                 acc = MassAcc::default();
                 offset = Tf::identity();
-                add_link(&mut acc, &offset, child)?;
+                add_link(&mut acc, &offset, child, &j.name)?;
             }
         }
         link = j.child.link.as_str();
@@ -186,13 +186,19 @@ fn inertial_of(acc: &MassAcc) -> Inertial {
 }
 
 /// Adds a link's `<inertial>` (placed at `offset` in the body frame) to the body.
-fn add_link(acc: &mut MassAcc, offset: &Tf, link: &urdf_rs::Link) -> Result<(), ModelError> {
+/// Errors name `owner` (the joint whose child the link is, or the root link) and the link.
+fn add_link(
+    acc: &mut MassAcc,
+    offset: &Tf,
+    link: &urdf_rs::Link,
+    owner: &str,
+) -> Result<(), ModelError> {
     let inl = &link.inertial;
     let m = inl.mass.value;
     if !m.is_finite() || m < 0.0 {
         return Err(ModelError::invalid(
-            &link.name,
-            "inertial.mass",
+            owner,
+            &format!("inertial.mass (link `{}`)", link.name),
             format!("link mass must be finite and ≥ 0, got {m}"),
         ));
     }
@@ -205,8 +211,8 @@ fn add_link(acc: &mut MassAcc, offset: &Tf, link: &urdf_rs::Link) -> Result<(), 
     if m == 0.0 {
         if inertia.iter().flatten().any(|x| *x != 0.0) {
             return Err(ModelError::invalid(
-                &link.name,
-                "inertial.inertia",
+                owner,
+                &format!("inertial.inertia (link `{}`)", link.name),
                 "a massless link must have zero inertia",
             ));
         }
