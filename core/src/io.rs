@@ -1,1 +1,0 @@
-//! Model readers (URDF, TOML) — STUB being written.
