@@ -508,3 +508,149 @@ fn gravity_external_wrenches_and_drives_enter_b_correctly() {
         }
     }
 }
+
+/// A scalar that counts operations in the paper's convention (every `+ − × ÷` counts, sign
+/// changes and constants are free), per section label.
+mod count {
+    use kanegen_core::scalar::Scalar;
+    use std::cell::RefCell;
+    use std::collections::BTreeMap;
+
+    thread_local! {
+        static SECTION: RefCell<&'static str> = const { RefCell::new("") };
+        static COUNTS: RefCell<BTreeMap<&'static str, (u64, u64)>> = RefCell::new(BTreeMap::new());
+    }
+
+    fn tick(mul: bool) {
+        let s = SECTION.with(|s| *s.borrow());
+        COUNTS.with(|c| {
+            let mut c = c.borrow_mut();
+            let e = c.entry(s).or_default();
+            if mul {
+                e.0 += 1;
+            } else {
+                e.1 += 1;
+            }
+        });
+    }
+
+    /// Resets the counters.
+    pub fn reset() {
+        COUNTS.with(|c| c.borrow_mut().clear());
+    }
+
+    /// (mult, add) per section since the last reset.
+    pub fn take() -> BTreeMap<&'static str, (u64, u64)> {
+        COUNTS.with(|c| std::mem::take(&mut *c.borrow_mut()))
+    }
+
+    #[derive(Clone, Debug)]
+    pub struct C(pub f64);
+
+    impl core::ops::Add for C {
+        type Output = C;
+        fn add(self, o: C) -> C {
+            tick(false);
+            C(self.0 + o.0)
+        }
+    }
+    impl core::ops::Sub for C {
+        type Output = C;
+        fn sub(self, o: C) -> C {
+            tick(false);
+            C(self.0 - o.0)
+        }
+    }
+    impl core::ops::Mul for C {
+        type Output = C;
+        fn mul(self, o: C) -> C {
+            tick(true);
+            C(self.0 * o.0)
+        }
+    }
+    impl core::ops::Div for C {
+        type Output = C;
+        fn div(self, o: C) -> C {
+            tick(true);
+            C(self.0 / o.0)
+        }
+    }
+    impl core::ops::Neg for C {
+        type Output = C;
+        fn neg(self) -> C {
+            C(-self.0)
+        }
+    }
+    impl Scalar for C {
+        fn constant(x: f64) -> Self {
+            C(x)
+        }
+        fn sin(self) -> Self {
+            C(self.0.sin())
+        }
+        fn cos(self) -> Self {
+            C(self.0.cos())
+        }
+        fn sqrt(self) -> Self {
+            C(self.0.sqrt())
+        }
+        fn section(label: &'static str) {
+            SECTION.with(|s| *s.borrow_mut() = label);
+        }
+    }
+}
+
+/// Raw counts (paper convention) of `A` from base-frame inputs equal the exact polynomial fits of
+/// `opcount_findings.md` §2 and §5 (revolute chains).
+#[test]
+fn paper_convention_counts_match_opcount_findings() {
+    use count::C;
+    for n in 2..=10_i64 {
+        let ch = chain(n as usize, 0.0, 3);
+        let (q, _) = state(n as usize, 3);
+        let qc: Vec<C> = q.iter().map(|&x| C(x)).collect();
+        let kin = base_frame(&ch.params::<C>(), &qc);
+        let total = |f: &dyn Fn() -> Vec<Vec<C>>| {
+            count::reset();
+            f();
+            let per = count::take();
+            let t = per.values().fold((0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
+            (t, per)
+        };
+        let n2 = n * n;
+        let ((pm, pa), _) = total(&|| recurrent::mass_matrix_base(&kin, Variant::P));
+        assert_eq!(
+            (2 * pm as i64, 2 * pa as i64),
+            (78 * n2 - 54 * n, 117 * n2 - 97 * n + 6),
+            "P, N = {n}"
+        );
+        let ((rm, ra), _) = total(&|| recurrent::mass_matrix_base(&kin, Variant::R2));
+        assert_eq!(
+            (rm as i64, ra as i64),
+            (36 * n2 - 24 * n, 60 * n2 - 53 * n + 6),
+            "R2, N = {n}"
+        );
+        let ((cm, ca), _) = total(&|| crba_base::mass_matrix_base(&kin));
+        assert_eq!(
+            (2 * cm as i64, 2 * ca as i64),
+            (12 * n2 + 144 * n - 114, 15 * n2 + 203 * n - 176),
+            "crba-base, N = {n}"
+        );
+        let ((m1, a1), per) = total(&|| recurrent::mass_matrix_base(&kin, Variant::R1));
+        let corr = per.get("R1-corr").copied().unwrap_or((0, 0));
+        if n >= 3 {
+            assert_eq!(
+                (corr.0 as i64, corr.1 as i64),
+                (30 * n - 60, 48 * n - 108),
+                "R1-corr, N = {n}"
+            );
+            assert_eq!(
+                (2 * m1 as i64, 2 * a1 as i64),
+                (78 * n2 + 6 * n - 120, 117 * n2 - n - 210),
+                "R1, N = {n}"
+            );
+        } else {
+            assert_eq!(corr, (0, 0));
+        }
+    }
+}
