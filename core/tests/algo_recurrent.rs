@@ -518,7 +518,7 @@ mod count {
 
     thread_local! {
         static SECTION: RefCell<&'static str> = const { RefCell::new("") };
-        static COUNTS: RefCell<BTreeMap<&'static str, (u64, u64)>> = RefCell::new(BTreeMap::new());
+        static COUNTS: RefCell<BTreeMap<&'static str, (u64, u64)>> = const { RefCell::new(BTreeMap::new()) };
     }
 
     fn tick(mul: bool) {
