@@ -14,6 +14,9 @@
 //!
 //! Errors are relative: `max|x − y| / max|y|`. Run with `--nocapture` to see the measured maxima.
 
+// Matrix identities read best with explicit indices.
+#![allow(clippy::needless_range_loop)]
+
 use kanegen_core::algorithms::{kane_direct, spatial, ExternalWrench, LoadFrame, Loads};
 use kanegen_core::dual::Dual;
 use kanegen_core::linalg::{axis_rotation, Mat3, Vec3};

@@ -102,18 +102,19 @@ pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
                 (u, w)
             })
             .unzip();
-        for i in 0..pvj.t.len() {
-            for l in i..pvj.t.len() {
+        for (i, (ti, ri)) in pvj.t.iter().zip(&pvj.r).enumerate() {
+            for (l, (ul, wl)) in u.iter().zip(&w).enumerate().skip(i) {
                 // (9) upper triangle i ≤ l ≤ j
-                let term = pvj.t[i].dot(&u[l]) + pvj.r[i].dot(&w[l]);
+                let term = ti.dot(ul) + ri.dot(wl);
                 a[i][l] = a[i][l].clone() + term;
             }
         }
     }
     // (9) A is symmetric: mirror the upper triangle.
-    for i in 0..n {
-        for l in 0..i {
-            a[i][l] = a[l][i].clone();
+    let upper = a.clone();
+    for (i, row) in a.iter_mut().enumerate() {
+        for (l, x) in row.iter_mut().enumerate().take(i) {
+            *x = upper[l][i].clone();
         }
     }
     a
