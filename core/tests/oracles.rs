@@ -296,9 +296,16 @@ fn no_loads() -> Loads<f64> {
 #[test]
 fn lagrange_oracle_matches_spatial_a_and_b() {
     let (mut worst_a, mut worst_b) = (0.0f64, 0.0f64);
+    let (mut prismatic, mut joints) = (0usize, 0usize);
     for n in 1..=10 {
         for seed in 0..3u64 {
             let c = chain(n, 100 * n as u64 + seed);
+            joints += n;
+            prismatic += c
+                .joints()
+                .iter()
+                .filter(|j| j.kind == JointKind::Prismatic)
+                .count();
             let p = c.params::<f64>();
             let s = state(&mut rng(seed + 7 * n as u64), n);
             let a_ref = lagrange_mass_matrix(&c, &s.q, &s.qd);
@@ -329,7 +336,14 @@ fn lagrange_oracle_matches_spatial_a_and_b() {
             worst_b = worst_b.max(e0);
         }
     }
-    eprintln!("Lagrange vs spatial: max rel err A {worst_a:.2e}, b {worst_b:.2e}");
+    assert!(
+        prismatic > 0 && prismatic < joints,
+        "both joint kinds must be exercised"
+    );
+    eprintln!(
+        "Lagrange vs spatial ({prismatic} prismatic of {joints} joints): \
+         max rel err A {worst_a:.2e}, b {worst_b:.2e}"
+    );
 }
 
 #[test]
