@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod algorithms;
+pub mod dual;
 pub mod io;
 pub mod ldlt;
 pub mod linalg;
