@@ -65,7 +65,8 @@ use std::sync::atomic::{AtomicU32, Ordering};
 ///
 /// All arithmetic on `Sym` is recorded (and counted) in the thread's graph. Using a `Sym` after its
 /// tracer was dropped or finished, or with no tracer active, panics. There is deliberately no
-/// comparison of values.
+/// comparison of values: `==` on `Sym` is node identity (after folding and hash-consing, so
+/// `a * b == b * a`), never a numeric comparison, and there is no ordering.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub struct Sym {
     id: u32,

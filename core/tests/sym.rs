@@ -481,3 +481,116 @@ fn tracer_is_reusable_after_finish_and_drop() {
     assert_eq!(t2.eval(&[3.0]), [5.0]);
     assert_eq!(t2.counts(Convention::Paper).mul, 0);
 }
+
+#[test]
+fn large_trace_evaluates() {
+    // A long recurrence with many shared subexpressions: x_{k+1} = x_k·c_k + s_k, where the
+    // c_k, s_k are sin/cos of inputs; checks eval and the counting scale linearly.
+    let n = 20_000;
+    let vals: Vec<f64> = (0..n).map(|i| 0.001 * i as f64).collect();
+    let tr = trace(|t| {
+        let qs: Vec<Sym> = (0..n).map(|i| t.input(format!("q{i}"))).collect();
+        let mut x = Sym::one();
+        for q in &qs {
+            let (s, co) = q.sin_cos();
+            x = x * co + s * c(0.5) - Sym::zero();
+        }
+        vec![x]
+    });
+    let mut want = 1.0f64;
+    for q in &vals {
+        let (s, c) = q.sin_cos();
+        want = want * c + s * 0.5 - 0.0;
+    }
+    let got = tr.eval(&vals)[0];
+    assert!(
+        (got - want).abs() <= 1e-12 * want.abs().max(1.0),
+        "{got} vs {want}"
+    );
+    let e = tr.counts(Convention::Emitted);
+    let n = n as u64;
+    // The first step folds 1·c; every later step costs 2 m + 1 a.
+    assert_eq!((e.mul, e.add, e.sincos), (2 * n - 1, n, n));
+    assert_eq!(tr.counts(Convention::Paper).add, 2 * n);
+}
+
+/// One step of a random straight-line program over registers (operands index earlier registers).
+#[derive(Clone, Debug)]
+enum Step {
+    Const(f64),
+    Bin(u8, usize, usize),
+    Un(u8, usize),
+}
+
+fn run<S: Scalar>(inputs: &[S], prog: &[Step]) -> Vec<S> {
+    let mut r: Vec<S> = inputs.to_vec();
+    for st in prog {
+        let n = r.len();
+        let v = match *st {
+            Step::Const(x) => S::constant(x),
+            Step::Bin(op, i, j) => {
+                let (a, b) = (r[i % n].clone(), r[j % n].clone());
+                match op % 4 {
+                    0 => a + b,
+                    1 => a - b,
+                    2 => a * b,
+                    _ => a / b,
+                }
+            }
+            Step::Un(op, i) => {
+                let a = r[i % n].clone();
+                match op % 5 {
+                    0 => -a,
+                    1 => a.sin(),
+                    2 => a.cos(),
+                    3 => a.sqrt(),
+                    _ => a.sin_cos().1,
+                }
+            }
+        };
+        r.push(v);
+    }
+    r
+}
+
+mod random_programs {
+    use super::*;
+    use proptest::prelude::*;
+
+    fn step() -> impl Strategy<Value = Step> {
+        prop_oneof![
+            prop::sample::select(vec![0.0, 1.0, -1.0, 2.5, -0.0]).prop_map(Step::Const),
+            (0u8..4, 0usize..64, 0usize..64).prop_map(|(o, i, j)| Step::Bin(o, i, j)),
+            (0u8..5, 0usize..64).prop_map(|(o, i)| Step::Un(o, i)),
+        ]
+    }
+
+    proptest! {
+        /// Folding and sign normalisation are exact in IEEE arithmetic, so every finite value of a
+        /// random program is reproduced bit for bit (up to the sign of zero) by the trace.
+        #[test]
+        fn eval_equals_f64(
+            xs in prop::collection::vec(-3.0f64..3.0, 1..4),
+            prog in prop::collection::vec(step(), 1..40),
+        ) {
+            let want = run(&xs, &prog);
+            let tr = trace(|t| {
+                let ins: Vec<Sym> = (0..xs.len()).map(|i| t.input(format!("x{i}"))).collect();
+                run(&ins, &prog)
+            });
+            let got = tr.eval(&xs);
+            for (g, w) in got.iter().zip(&want) {
+                if w.is_finite() {
+                    prop_assert!(g == w, "{} vs {}", g, w);
+                }
+            }
+            // Folding never increases a count; CSE and DCE never increase it further.
+            let [p, f, e] = Convention::ALL.map(|c| tr.counts(c));
+            for (a, b) in [(p, f), (f, e)] {
+                prop_assert!(a.mul >= b.mul && a.add >= b.add && a.div >= b.div);
+                prop_assert!(a.sin >= b.sin && a.cos >= b.cos && a.sqrt >= b.sqrt);
+                prop_assert!(a.sincos >= b.sincos);
+            }
+        }
+    }
+}
