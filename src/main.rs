@@ -7,7 +7,11 @@ use kanegen::Algorithm;
 use std::path::PathBuf;
 
 #[derive(Parser)]
-#[command(name = "kanegen", version, about = "Equations of motion of space manipulators: evaluate, count, reproduce the paper's Table 1")]
+#[command(
+    name = "kanegen",
+    version,
+    about = "Equations of motion of space manipulators: evaluate, count, reproduce the paper's Table 1"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -38,6 +42,10 @@ enum Command {
         /// Print JSON: {"results":[{"A":[[…]],"b":[…]}]}.
         #[arg(long)]
         json: bool,
+        /// Accept inertia tensors that violate the triangle inequality (published but not
+        /// physically realisable parameter sets); other checks stay.
+        #[arg(long)]
+        allow_nonphysical: bool,
     },
     /// Reproduce the paper's Table 1 by tracing; print it, or write table1.md, table1.json and
     /// fig2.svg into --out.
@@ -62,11 +70,17 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
+        /// Accept inertia tensors that violate the triangle inequality.
+        #[arg(long)]
+        allow_nonphysical: bool,
     },
 }
 
-fn load(model: &PathBuf) -> Result<kanegen::Chain> {
-    kanegen::io::load_model(model).with_context(|| format!("model `{}`", model.display()))
+fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<kanegen::Chain> {
+    let v = kanegen::Validation {
+        allow_nonphysical_inertia: allow_nonphysical,
+    };
+    kanegen::io::load_model_with(model, v).with_context(|| format!("model `{}`", model.display()))
 }
 
 fn main() -> Result<()> {
@@ -78,8 +92,9 @@ fn main() -> Result<()> {
             algorithm,
             gravity,
             json,
+            allow_nonphysical,
         } => {
-            let chain = load(&model)?;
+            let chain = load(&model, allow_nonphysical)?;
             let text = std::fs::read_to_string(&states)
                 .with_context(|| format!("cannot read states file `{}`", states.display()))?;
             let g = gravity
@@ -90,14 +105,20 @@ fn main() -> Result<()> {
             if json {
                 println!("{}", serde_json::json!({ "results": results }));
             } else {
-                print!("{}", commands::eval::render_text(&chain, algorithm, &results));
+                print!(
+                    "{}",
+                    commands::eval::render_text(&chain, algorithm, &results)
+                );
             }
         }
         Command::Table1 { json, out } => {
             let t = kanegen::table1::build(&kanegen::table1::trace_all());
             if let Some(dir) = &out {
                 commands::table1::write_all(&t, dir)?;
-                eprintln!("wrote table1.md, table1.json, fig2.svg to {}", dir.display());
+                eprintln!(
+                    "wrote table1.md, table1.json, fig2.svg to {}",
+                    dir.display()
+                );
             }
             if json {
                 println!("{}", serde_json::to_string_pretty(&t)?);
@@ -110,8 +131,9 @@ fn main() -> Result<()> {
             algorithm,
             gravity,
             json,
+            allow_nonphysical,
         } => {
-            let chain = load(&model)?;
+            let chain = load(&model, allow_nonphysical)?;
             let g = gravity
                 .map(|s| kanegen::states::parse_vec3(&s).context("--gravity"))
                 .transpose()?;

@@ -27,7 +27,10 @@ impl Poly {
             c.iter()
                 .map(|&x| {
                     let scaled = (x * 6.0).round() as i128;
-                    assert!(((scaled as f64) / 6.0 - x).abs() < 1e-12, "coefficient {x} is not a multiple of 1/6");
+                    assert!(
+                        ((scaled as f64) / 6.0 - x).abs() < 1e-12,
+                        "coefficient {x} is not a multiple of 1/6"
+                    );
                     Q::new(scaled, 6)
                 })
                 .collect(),
@@ -46,18 +49,27 @@ impl Poly {
     }
     /// Value at `n`.
     pub fn eval(&self, n: i64) -> Q {
-        self.0.iter().rev().fold(Q::zero(), |acc, c| acc * Q::from(n as i128) + c)
+        self.0
+            .iter()
+            .rev()
+            .fold(Q::zero(), |acc, c| acc * Q::from(n as i128) + c)
     }
     /// Value at a real `x`.
     pub fn eval_f64(&self, x: f64) -> f64 {
-        self.0.iter().rev().fold(0.0, |acc, c| acc * x + c.to_f64().unwrap_or(f64::NAN))
+        self.0
+            .iter()
+            .rev()
+            .fold(0.0, |acc, c| acc * x + c.to_f64().unwrap_or(f64::NAN))
     }
     /// Coefficients as decimals, lowest degree first (the JSON contract).
     pub fn coeffs_f64(&self) -> Vec<f64> {
         if self.0.is_empty() {
             return vec![0.0];
         }
-        self.0.iter().map(|c| c.to_f64().unwrap_or(f64::NAN)).collect()
+        self.0
+            .iter()
+            .map(|c| c.to_f64().unwrap_or(f64::NAN))
+            .collect()
     }
     /// Sum.
     pub fn add(&self, o: &Poly) -> Poly {
@@ -191,7 +203,9 @@ fn interpolate(pts: &[(i64, i64)]) -> Poly {
             let lin = Poly(vec![Q::from(-(xj as i128)) / d, Q::from(1) / d]);
             basis = mul(&basis, &lin);
         }
-        acc = acc.add(&Poly(basis.0.iter().map(|c| c * Q::from(yi as i128)).collect()));
+        acc = acc.add(&Poly(
+            basis.0.iter().map(|c| c * Q::from(yi as i128)).collect(),
+        ));
     }
     acc.trimmed()
 }
@@ -260,7 +274,7 @@ mod tests {
         pts[1].1 -= 2;
         let fit = fit_exact(&pts, 3).unwrap();
         assert_eq!(fit.valid_from, 3);
-        assert_eq!(fit.poly.to_string(), "4.666667N³ + 37N² − 1.666667N + 3");
+        assert_eq!(fit.poly.to_string(), "(14/3)N³ + 37N² − (5/3)N + 3");
         assert!(fit.check_points.contains(&12) && fit.check_points.contains(&3));
         assert_eq!(fit.poly.eval(7), Q::from(f(7) as i128));
     }
@@ -273,7 +287,10 @@ mod tests {
 
     #[test]
     fn formats_like_the_paper() {
-        assert_eq!(Poly::from_f64(&[39.0, -136.5, 91.5]).to_string(), "91.5N² − 136.5N + 39");
+        assert_eq!(
+            Poly::from_f64(&[39.0, -136.5, 91.5]).to_string(),
+            "91.5N² − 136.5N + 39"
+        );
         assert_eq!(Poly::from_f64(&[0.0, 0.0]).to_string(), "0");
         assert_eq!(Poly::from_f64(&[-9.0, 9.0]).to_string(), "9N − 9");
         let r = Poly::from_f64(&[39.0, -136.5, 91.5]).sub(&Poly::from_f64(&[0.0, 69.0, 69.0]));

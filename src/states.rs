@@ -26,8 +26,11 @@ struct StatesFile {
 pub fn parse_states(text: &str, n: usize) -> Result<Vec<State>> {
     let f: StatesFile = serde_json::from_str(text).context("malformed states file")?;
     for (i, s) in f.states.iter().enumerate() {
-        let fields: [(&str, Option<&Vec<f64>>); 3] =
-            [("q", Some(&s.q)), ("qd", Some(&s.qd)), ("tau", s.tau.as_ref())];
+        let fields: [(&str, Option<&Vec<f64>>); 3] = [
+            ("q", Some(&s.q)),
+            ("qd", Some(&s.qd)),
+            ("tau", s.tau.as_ref()),
+        ];
         for (name, v) in fields {
             let Some(v) = v else { continue };
             if v.len() != n {
@@ -50,7 +53,7 @@ pub fn parse_vec3(s: &str) -> Result<[f64; 3]> {
     if parts.len() != 3 {
         bail!("expected three comma-separated numbers X,Y,Z, got `{s}`");
     }
-    let mut out = [0.0; 3];
+    let mut out = [0.0f64; 3];
     for (o, p) in out.iter_mut().zip(&parts) {
         *o = p
             .parse()

@@ -65,7 +65,13 @@ impl Traced {
 /// Independent symbolic base-frame inputs for `n` revolute bodies (general geometry and inertia;
 /// inertia tensors are symmetric, so 6 inputs each).
 pub fn general_base_inputs(t: &Tracer, n: usize) -> Vec<BodyKinematics<Sym>> {
-    let v = |name: String| Vec3::new(t.input(format!("{name}x")), t.input(format!("{name}y")), t.input(format!("{name}z")));
+    let v = |name: String| {
+        Vec3::new(
+            t.input(format!("{name}x")),
+            t.input(format!("{name}y")),
+            t.input(format!("{name}z")),
+        )
+    };
     (0..n)
         .map(|j| {
             let r = v(format!("r{j}_"));
@@ -90,13 +96,24 @@ pub fn general_base_inputs(t: &Tracer, n: usize) -> Vec<BodyKinematics<Sym>> {
 
 /// A chain whose every parameter is a symbolic input (all revolute), for the `spatial` trace.
 pub fn general_params(t: &Tracer, n: usize) -> ChainParams<Sym> {
-    let v = |name: String| Vec3::new(t.input(format!("{name}x")), t.input(format!("{name}y")), t.input(format!("{name}z")));
-    let m3 = |name: String| Mat3(std::array::from_fn(|r| std::array::from_fn(|c| t.input(format!("{name}{r}{c}")))));
+    let v = |name: String| {
+        Vec3::new(
+            t.input(format!("{name}x")),
+            t.input(format!("{name}y")),
+            t.input(format!("{name}z")),
+        )
+    };
+    let m3 = |name: String| {
+        Mat3(std::array::from_fn(|r| {
+            std::array::from_fn(|c| t.input(format!("{name}{r}{c}")))
+        }))
+    };
     ChainParams {
         joints: (0..n)
             .map(|j| {
                 let i = |s: &str| t.input(format!("Ic{j}_{s}"));
-                let (xx, yy, zz, xy, xz, yz) = (i("xx"), i("yy"), i("zz"), i("xy"), i("xz"), i("yz"));
+                let (xx, yy, zz, xy, xz, yz) =
+                    (i("xx"), i("yy"), i("zz"), i("xy"), i("xz"), i("yz"));
                 JointParams {
                     kind: JointKind::Revolute,
                     l: v(format!("l{j}_")),
@@ -325,7 +342,14 @@ pub struct Crossover {
 pub fn trace_all() -> BTreeMap<Traced, Vec<TraceCounts>> {
     Traced::ALL
         .iter()
-        .map(|&alg| (alg, (1..=N_MAX).map(|n| counts_of(&trace_mass_matrix(alg, n))).collect()))
+        .map(|&alg| {
+            (
+                alg,
+                (1..=N_MAX)
+                    .map(|n| counts_of(&trace_mass_matrix(alg, n)))
+                    .collect(),
+            )
+        })
         .collect()
 }
 
@@ -340,12 +364,17 @@ fn section_sum(tc: &TraceCounts, conv: &str, sections: &[&str]) -> Counts {
 }
 
 fn fit_series(values: &[(i64, i64)]) -> Fit {
-    fit_exact(values, 3).unwrap_or_else(|| panic!("traced counts are not a polynomial of degree ≤ 3: {values:?}"))
+    fit_exact(values, 3)
+        .unwrap_or_else(|| panic!("traced counts are not a polynomial of degree ≤ 3: {values:?}"))
 }
 
 fn fit_mul_add(per_n: &[Counts], part: Part) -> (Fit, Fit) {
     let pts = |f: &dyn Fn(&Counts) -> u64| -> Vec<(i64, i64)> {
-        per_n.iter().enumerate().map(|(k, c)| (k as i64 + 1, f(c) as i64)).collect()
+        per_n
+            .iter()
+            .enumerate()
+            .map(|(k, c)| (k as i64 + 1, f(c) as i64))
+            .collect()
     };
     let mul = pts(&|c| if part == Part::AddOnly { 0 } else { c.mul });
     let add = pts(&|c| if part == Part::MulOnly { 0 } else { c.add });
@@ -354,9 +383,7 @@ fn fit_mul_add(per_n: &[Counts], part: Part) -> (Fit, Fit) {
 
 fn diff_note(row: &str, printed: &Poly, traced: &Poly, what: &str) -> Option<String> {
     let d = traced.sub(printed);
-    if d.degree().is_none() {
-        return None;
-    }
+    d.degree()?;
     Some(format!(
         "row {row} {what}: traced − printed = {d} ({} at N = 6)",
         fmt_num(d.eval_f64(6.0))
@@ -364,31 +391,38 @@ fn diff_note(row: &str, printed: &Poly, traced: &Poly, what: &str) -> Option<Str
 }
 
 fn fmt_num(x: f64) -> String {
-    if x.fract() == 0.0 {
+    let s = if x.fract() == 0.0 {
         format!("{x:+}")
     } else {
         format!("{x:+.1}")
-    }
+    };
+    s.replace('-', "−")
 }
 
 /// Builds the reproduction from traces.
 pub fn build(traces: &BTreeMap<Traced, Vec<TraceCounts>>) -> Table1 {
     let r1 = &traces[&Traced::RecurrentR1];
     let mut rows = Vec::new();
-    let per_section = |secs: &[&str], conv: &str| -> Vec<Counts> { r1.iter().map(|tc| section_sum(tc, conv, secs)).collect() };
+    let per_section = |secs: &[&str], conv: &str| -> Vec<Counts> {
+        r1.iter().map(|tc| section_sum(tc, conv, secs)).collect()
+    };
     let mut sum_printed = (Poly::zero(), Poly::zero());
     let mut sum_traced = (Poly::zero(), Poly::zero());
     for spec in ROWS {
-        let [t, f, e] = ["paper", "folded", "emitted"].map(|c| fit_mul_add(&per_section(spec.sections, c), spec.part));
+        let [t, f, e] = ["paper", "folded", "emitted"]
+            .map(|c| fit_mul_add(&per_section(spec.sections, c), spec.part));
         let pm = Poly::from_f64(spec.paper_mul);
         let pa = Poly::from_f64(spec.paper_add);
         sum_printed = (sum_printed.0.add(&pm), sum_printed.1.add(&pa));
         sum_traced = (sum_traced.0.add(&t.0.poly), sum_traced.1.add(&t.1.poly));
         let agree = pm == t.0.poly && pa == t.1.poly;
-        let mut notes: Vec<String> = [diff_note(spec.row, &pm, &t.0.poly, "mult"), diff_note(spec.row, &pa, &t.1.poly, "add")]
-            .into_iter()
-            .flatten()
-            .collect();
+        let mut notes: Vec<String> = [
+            diff_note(spec.row, &pm, &t.0.poly, "mult"),
+            diff_note(spec.row, &pa, &t.1.poly, "add"),
+        ]
+        .into_iter()
+        .flatten()
+        .collect();
         if !agree && !spec.explain.is_empty() {
             notes.push(spec.explain.to_string());
         }
@@ -406,7 +440,8 @@ pub fn build(traces: &BTreeMap<Traced, Vec<TraceCounts>>) -> Table1 {
     }
     // The R1 correction row (exactness costs this much on top of the paper's structure).
     {
-        let [t, f, e] = ["paper", "folded", "emitted"].map(|c| fit_mul_add(&per_section(R1_CORRECTION, c), Part::Both));
+        let [t, f, e] = ["paper", "folded", "emitted"]
+            .map(|c| fit_mul_add(&per_section(R1_CORRECTION, c), Part::Both));
         rows.push(RowReport {
             row: "R1".into(),
             quantity: "correction Q_j of (14b) folded into M^rr,1 (not in the paper)".into(),
@@ -440,7 +475,10 @@ pub fn build(traces: &BTreeMap<Traced, Vec<TraceCounts>>) -> Table1 {
     }
 
     // Row 11 printed, and what rows 1–10 of the paper actually add up to.
-    let row11 = (Poly::from_f64(&[9.0, -39.0, 36.0]), Poly::from_f64(&[30.0, -97.5, 55.5]));
+    let row11 = (
+        Poly::from_f64(&[9.0, -39.0, 36.0]),
+        Poly::from_f64(&[30.0, -97.5, 55.5]),
+    );
     let mut derivations = derivation_rows(r1);
     derivations.push(RowReport {
         row: "11".into(),
@@ -465,33 +503,94 @@ pub fn build(traces: &BTreeMap<Traced, Vec<TraceCounts>>) -> Table1 {
     let printed_totals = printed_totals();
     let ssrms_n6 = ssrms(&totals, &printed_totals);
     let crossovers = crossovers(&totals, &printed_totals);
-    Table1 { rows, totals, derivations, printed_totals, ssrms_n6, crossovers }
+    Table1 {
+        rows,
+        totals,
+        derivations,
+        printed_totals,
+        ssrms_n6,
+        crossovers,
+    }
 }
 
 /// The text's per-step derivations (printed next to each formula) against the trace.
 fn derivation_rows(r1: &[TraceCounts]) -> Vec<RowReport> {
-    let steps: &[(&str, &[&str], &[f64], &[f64], &str)] = &[
+    // (label, sections, printed mult, printed add, the text's derivation)
+    type Step = (
+        &'static str,
+        &'static [&'static str],
+        &'static [f64],
+        &'static [f64],
+        &'static str,
+    );
+    let steps: &[Step] = &[
         ("(13)", &["(13)"], &[0.0], &[-9.0, 9.0], "9(N − 1) a"),
-        ("(14a)", &["(14a)"], &[-36.0, 36.0], &[-27.0, 27.0], "N − 1 matrices × (36 m + 27 a)"),
-        ("(14b)", &["(14b)"], &[36.0, -54.0, 18.0], &[36.0, -54.0, 18.0], "(N² − 3N + 2)/2 matrices × (36 m + 36 a)"),
-        ("(14) total", &["(14a)", "(14b)"], &[-18.0, 0.0, 18.0], &[9.0, -27.0, 18.0], "the text's \"in total for M^rr,2\" line"),
-        ("(15a)", &["(15a)"], &[-27.0, 27.0], &[-27.0, 27.0], "N − 1 matrices × (27 m + 27 a)"),
-        ("(15b)", &["(15b)"], &[27.0, -40.5, 13.5], &[36.0, -54.0, 18.0], "(N² − 3N + 2)/2 matrices × (27 m + 36 a)"),
-        ("(16)", &["(16)"], &[0.0], &[-9.0, -4.5, 13.5], "(27N − 27) + (9N − 9) + (13.5N² − 40.5N + 27) a"),
-        ("(20)", &["(20)"], &[0.0, 3.0, 3.0], &[0.0, 3.0, 3.0], "(N² + N)/2 elements × (3 m + 3 a)·2"),
+        (
+            "(14a)",
+            &["(14a)"],
+            &[-36.0, 36.0],
+            &[-27.0, 27.0],
+            "N − 1 matrices × (36 m + 27 a)",
+        ),
+        (
+            "(14b)",
+            &["(14b)"],
+            &[36.0, -54.0, 18.0],
+            &[36.0, -54.0, 18.0],
+            "(N² − 3N + 2)/2 matrices × (36 m + 36 a)",
+        ),
+        (
+            "(14) total",
+            &["(14a)", "(14b)"],
+            &[-18.0, 0.0, 18.0],
+            &[9.0, -27.0, 18.0],
+            "the text's \"in total for M^rr,2\" line",
+        ),
+        (
+            "(15a)",
+            &["(15a)"],
+            &[-27.0, 27.0],
+            &[-27.0, 27.0],
+            "N − 1 matrices × (27 m + 27 a)",
+        ),
+        (
+            "(15b)",
+            &["(15b)"],
+            &[27.0, -40.5, 13.5],
+            &[36.0, -54.0, 18.0],
+            "(N² − 3N + 2)/2 matrices × (27 m + 36 a)",
+        ),
+        (
+            "(16)",
+            &["(16)"],
+            &[0.0],
+            &[-9.0, -4.5, 13.5],
+            "(27N − 27) + (9N − 9) + (13.5N² − 40.5N + 27) a",
+        ),
+        (
+            "(20)",
+            &["(20)"],
+            &[0.0, 3.0, 3.0],
+            &[0.0, 3.0, 3.0],
+            "(N² + N)/2 elements × (3 m + 3 a)·2",
+        ),
     ];
     steps
         .iter()
         .map(|(label, secs, pm, pa, text)| {
-            let per: [Vec<Counts>; 3] = ["paper", "folded", "emitted"].map(|c| r1.iter().map(|tc| section_sum(tc, c, secs)).collect());
+            let per: [Vec<Counts>; 3] = ["paper", "folded", "emitted"]
+                .map(|c| r1.iter().map(|tc| section_sum(tc, c, secs)).collect());
             let [t, f, e] = per.map(|p| fit_mul_add(&p, Part::Both));
             let (pm, pa) = (Poly::from_f64(pm), Poly::from_f64(pa));
             let agree = pm == t.0.poly && pa == t.1.poly;
-            let note = [diff_note(label, &pm, &t.0.poly, "mult"), diff_note(label, &pa, &t.1.poly, "add")]
-                .into_iter()
-                .flatten()
-                .collect::<Vec<_>>()
-                .join("; ");
+            let note = [
+                diff_note(label, &pm, &t.0.poly, "mult"),
+                diff_note(label, &pa, &t.1.poly, "add"),
+            ]
+            .into_iter()
+            .flatten()
+            .collect::<Vec<_>>()
+            .join("; ");
             RowReport {
                 row: label.to_string(),
                 quantity: text.to_string(),
@@ -511,20 +610,66 @@ fn printed_totals() -> Vec<PrintedTotal> {
     let both = |row: &str, name: &str, m: &[f64], a: &[f64]| {
         let (pm, pa) = (Poly::from_f64(m), Poly::from_f64(a));
         let t = pm.add(&pa);
-        PrintedTotal { row: row.into(), name: name.into(), mul: pm.coeffs_f64(), add: pa.coeffs_f64(), total: t.coeffs_f64(), text: t.to_string() }
+        PrintedTotal {
+            row: row.into(),
+            name: name.into(),
+            mul: pm.coeffs_f64(),
+            add: pa.coeffs_f64(),
+            total: t.coeffs_f64(),
+            text: t.to_string(),
+        }
     };
     let total = |row: &str, name: &str, t: &[f64]| {
         let t = Poly::from_f64(t);
-        PrintedTotal { row: row.into(), name: name.into(), mul: vec![], add: vec![], total: t.coeffs_f64(), text: t.to_string() }
+        PrintedTotal {
+            row: row.into(),
+            name: name.into(),
+            mul: vec![],
+            add: vec![],
+            total: t.coeffs_f64(),
+            text: t.to_string(),
+        }
     };
     vec![
-        both("11", "Recurrent algorithm", &[9.0, -39.0, 36.0], &[30.0, -97.5, 55.5]),
-        both("12", "«Kosynka» algorithm", &[0.0, -9.0, 24.0, 3.0], &[0.0, -50.0, 105.0, 11.0]),
-        both("13", "Stepanenko's algorithm", &[0.0, 38.0, 38.0], &[0.0, 31.0, 31.0]),
-        total("14", "Recurrent algorithm, total operations", &[39.0, -136.5, 91.5]),
-        total("15", "«Kosynka» algorithm, total", &[0.0, -59.0, 129.0, 14.0]),
-        total("16", "Stepanenko's algorithm, total operations", &[0.0, 69.0, 69.0]),
-        both("—", "Featherstone CRBA (RBDA 2008, Table 10.1), incl. frame transforms", &[-32.0, 22.0, 10.0], &[-43.0, 37.0, 6.0]),
+        both(
+            "11",
+            "Recurrent algorithm",
+            &[9.0, -39.0, 36.0],
+            &[30.0, -97.5, 55.5],
+        ),
+        both(
+            "12",
+            "«Kosynka» algorithm",
+            &[0.0, -9.0, 24.0, 3.0],
+            &[0.0, -50.0, 105.0, 11.0],
+        ),
+        both(
+            "13",
+            "Stepanenko's algorithm",
+            &[0.0, 38.0, 38.0],
+            &[0.0, 31.0, 31.0],
+        ),
+        total(
+            "14",
+            "Recurrent algorithm, total operations",
+            &[39.0, -136.5, 91.5],
+        ),
+        total(
+            "15",
+            "«Kosynka» algorithm, total",
+            &[0.0, -59.0, 129.0, 14.0],
+        ),
+        total(
+            "16",
+            "Stepanenko's algorithm, total operations",
+            &[0.0, 69.0, 69.0],
+        ),
+        both(
+            "—",
+            "Featherstone CRBA (RBDA 2008, Table 10.1), incl. frame transforms",
+            &[-32.0, 22.0, 10.0],
+            &[-43.0, 37.0, 6.0],
+        ),
     ]
 }
 
@@ -535,10 +680,13 @@ fn poly_of(c: &[f64]) -> Poly {
 fn ssrms(totals: &[TotalReport], printed: &[PrintedTotal]) -> serde_json::Value {
     let at6 = |c: &[f64]| poly_of(c).eval_f64(6.0);
     let mut printed_map = serde_json::Map::new();
-    for p in printed.iter().filter(|p| ["11", "12", "13"].contains(&p.row.as_str())) {
+    for p in printed
+        .iter()
+        .filter(|p| ["11", "12", "13"].contains(&p.row.as_str()))
+    {
         printed_map.insert(
             p.name.clone(),
-            serde_json::json!({"mul": at6(&p.mul), "add": at6(&p.add), "total": at6(&p.total)}),
+            serde_json::json!({"mul": at6(&p.mul) as i64, "add": at6(&p.add) as i64, "total": at6(&p.total) as i64}),
         );
     }
     let traced: Vec<serde_json::Value> = totals
@@ -554,16 +702,30 @@ fn ssrms(totals: &[TotalReport], printed: &[PrintedTotal]) -> serde_json::Value 
 fn crossovers(totals: &[TotalReport], printed: &[PrintedTotal]) -> Vec<Crossover> {
     let step = poly_of(&printed.iter().find(|p| p.row == "16").unwrap().total);
     let mut curves: Vec<(String, Poly)> = vec![
-        ("printed recurrent (row 14)".into(), poly_of(&printed.iter().find(|p| p.row == "14").unwrap().total)),
-        ("printed «Kosynka» (row 15)".into(), poly_of(&printed.iter().find(|p| p.row == "15").unwrap().total)),
+        (
+            "printed recurrent (row 14)".into(),
+            poly_of(&printed.iter().find(|p| p.row == "14").unwrap().total),
+        ),
+        (
+            "printed «Kosynka» (row 15)".into(),
+            poly_of(&printed.iter().find(|p| p.row == "15").unwrap().total),
+        ),
     ];
     for t in totals.iter().filter(|t| t.convention == "paper") {
-        curves.push((format!("traced {} (paper convention)", t.algorithm), poly_of(&t.mul).add(&poly_of(&t.add))));
+        curves.push((
+            format!("traced {} (paper convention)", t.algorithm),
+            poly_of(&t.mul).add(&poly_of(&t.add)),
+        ));
     }
     curves
         .into_iter()
         .map(|(curve, p)| Crossover {
-            at_n: p.sub(&step).real_roots(1.0, 40.0).into_iter().map(|x| (x * 100.0).round() / 100.0).collect(),
+            at_n: p
+                .sub(&step)
+                .real_roots(1.0, 40.0)
+                .into_iter()
+                .map(|x| (x * 100.0).round() / 100.0)
+                .collect(),
             total: p.coeffs_f64(),
             curve,
         })

@@ -8,7 +8,11 @@ use kanegen::{Algorithm, ExternalWrench, LoadFrame, Loads};
 use proptest::prelude::*;
 
 fn rel_err(x: &[f64], y: &[f64]) -> f64 {
-    let num = x.iter().zip(y).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    let num = x
+        .iter()
+        .zip(y)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
     let den = y.iter().map(|b| b.abs()).fold(f64::MIN_POSITIVE, f64::max);
     num / den
 }
@@ -25,7 +29,11 @@ fn random_loads(n: usize, seed: u64, with_gravity: bool) -> Loads<f64> {
             let v = random_vec(&mut r, 6, 50.0);
             external.push(ExternalWrench {
                 body,
-                frame: if body % 2 == 0 { LoadFrame::Body } else { LoadFrame::Base },
+                frame: if body % 2 == 0 {
+                    LoadFrame::Body
+                } else {
+                    LoadFrame::Base
+                },
                 force: Vec3([v[0], v[1], v[2]]),
                 moment: Vec3([v[3], v[4], v[5]]),
             });
@@ -39,7 +47,14 @@ fn random_loads(n: usize, seed: u64, with_gravity: bool) -> Loads<f64> {
 }
 
 fn check(n: usize, seed: u64, prismatic: f64, with_gravity: bool) -> Result<(), TestCaseError> {
-    let chain = random_chain(&ChainSpec { n, prismatic_fraction: prismatic, ..Default::default() }, seed);
+    let chain = random_chain(
+        &ChainSpec {
+            n,
+            prismatic_fraction: prismatic,
+            ..Default::default()
+        },
+        seed,
+    );
     let p = chain.params::<f64>();
     let mut r = rng(seed);
     let q = random_vec(&mut r, n, 3.0);
@@ -50,8 +65,14 @@ fn check(n: usize, seed: u64, prismatic: f64, with_gravity: bool) -> Result<(), 
         let d = alg.dynamics(&p, &q, &qd, &loads);
         let ea = rel_err(&flat(&d.a), &flat(&reference.a));
         let eb = rel_err(&d.b, &reference.b);
-        prop_assert!(ea < 1e-12, "{alg} vs spatial: A rel. error {ea:.3e} (N = {n}, seed {seed})");
-        prop_assert!(eb < 1e-12, "{alg} vs spatial: b rel. error {eb:.3e} (N = {n}, seed {seed})");
+        prop_assert!(
+            ea < 1e-12,
+            "{alg} vs spatial: A rel. error {ea:.3e} (N = {n}, seed {seed})"
+        );
+        prop_assert!(
+            eb < 1e-12,
+            "{alg} vs spatial: b rel. error {eb:.3e} (N = {n}, seed {seed})"
+        );
     }
     Ok(())
 }
@@ -84,7 +105,13 @@ fn every_small_chain_agrees() {
     // Deterministic sweep of the smallest chains, where index edge cases live (N = 1, 2, 3).
     for n in 1..=4 {
         for seed in 0..8 {
-            check(n, seed, if seed % 2 == 0 { 0.0 } else { 0.5 }, seed % 3 == 0).unwrap();
+            check(
+                n,
+                seed,
+                if seed % 2 == 0 { 0.0 } else { 0.5 },
+                seed % 3 == 0,
+            )
+            .unwrap();
         }
     }
 }

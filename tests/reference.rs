@@ -7,13 +7,21 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
+/// Models whose data flags inertias violating the triangle inequality (`space_arms.json`,
+/// `physical_checks[].triangle_margin < 0`).
+const NONPHYSICAL: [&str; 3] = ["ets7_vyas_urdf", "ets7_bmsd", "bmsd_7dof_free_floating"];
+
 fn data_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/reference")
 }
 
 fn rel_err(x: &[f64], y: &[f64]) -> f64 {
     assert_eq!(x.len(), y.len());
-    let num = x.iter().zip(y).map(|(a, b)| (a - b).abs()).fold(0.0, f64::max);
+    let num = x
+        .iter()
+        .zip(y)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
     let den = y.iter().map(|b| b.abs()).fold(0.0, f64::max);
     if den == 0.0 {
         num
@@ -30,10 +38,19 @@ fn flat(v: &Value) -> Vec<f64> {
     }
 }
 
-fn run_eval(urdf: &Path, states: &Path, algorithm: &str, gravity: Option<&str>) -> Value {
+fn run_eval(
+    urdf: &Path,
+    states: &Path,
+    algorithm: &str,
+    gravity: Option<&str>,
+    lenient: bool,
+) -> Value {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_kanegen"));
-    cmd.arg("eval")
-        .arg(urdf)
+    cmd.arg("eval");
+    if lenient {
+        cmd.arg("--allow-nonphysical");
+    }
+    cmd.arg(urdf)
         .arg("--states")
         .arg(states)
         .arg("--algorithm")
@@ -57,19 +74,45 @@ fn eval_matches_pinocchio_references() {
     let index: Value =
         serde_json::from_str(&std::fs::read_to_string(dir.join("index.json")).unwrap()).unwrap();
     let models = index["models"].as_array().unwrap();
-    assert!(models.len() >= 10, "reference index lists {} models", models.len());
+    assert!(
+        models.len() >= 10,
+        "reference index lists {} models",
+        models.len()
+    );
     let mut worst: f64 = 0.0;
     let mut checked = 0;
     for m in models {
         let id = m["id"].as_str().unwrap();
         let urdf = dir.join(format!("{id}.urdf"));
+        // Three published sets have link inertias that violate the triangle inequality (the
+        // shared data flags them). kanegen rejects them by default, naming the joint; they are
+        // evaluated with the explicit opt-in, and only they may need it.
+        let strict = kanegen::io::load_model(&urdf);
+        let lenient = match &strict {
+            Ok(_) => false,
+            Err(e) => {
+                assert!(e.to_string().contains("triangle inequality"), "{id}: {e}");
+                assert!(NONPHYSICAL.contains(&id), "{id} unexpectedly rejected: {e}");
+                true
+            }
+        };
         let states = dir.join(format!("{id}.states.json"));
-        let expected: Value =
-            serde_json::from_str(&std::fs::read_to_string(dir.join(format!("{id}.expected.json"))).unwrap())
-                .unwrap();
-        for algorithm in ["recurrent", "recurrent-r1", "kane-direct", "crba-base", "spatial"] {
-            for (key, gravity) in [("gravity_zero", None), ("gravity_minus_z_9.81", Some("0,0,-9.81"))] {
-                let got = run_eval(&urdf, &states, algorithm, gravity);
+        let expected: Value = serde_json::from_str(
+            &std::fs::read_to_string(dir.join(format!("{id}.expected.json"))).unwrap(),
+        )
+        .unwrap();
+        for algorithm in [
+            "recurrent",
+            "recurrent-r1",
+            "kane-direct",
+            "crba-base",
+            "spatial",
+        ] {
+            for (key, gravity) in [
+                ("gravity_zero", None),
+                ("gravity_minus_z_9.81", Some("0,0,-9.81")),
+            ] {
+                let got = run_eval(&urdf, &states, algorithm, gravity, lenient);
                 let got = got["results"].as_array().unwrap();
                 let want = expected[key].as_array().unwrap();
                 assert_eq!(got.len(), want.len(), "{id}: number of results");
@@ -87,7 +130,9 @@ fn eval_matches_pinocchio_references() {
             }
         }
     }
-    eprintln!("checked {checked} matrices/vectors against Pinocchio; worst relative error {worst:.3e}");
+    eprintln!(
+        "checked {checked} matrices/vectors against Pinocchio; worst relative error {worst:.3e}"
+    );
 }
 
 #[test]

@@ -2,7 +2,7 @@
 //! agreeing, rows 7, 8, 10 and the totals disagreeing with their arithmetic, and the committed
 //! `docs/table1.md` / `docs/fig2.svg` not stale.
 
-use kanegen::poly::Poly;
+use kanegen::poly::{Poly, Q};
 use kanegen::table1::{build, trace_all, trace_mass_matrix, Table1, Traced};
 use kanegen_core::sym::Convention;
 use std::sync::OnceLock;
@@ -13,7 +13,10 @@ fn table() -> &'static Table1 {
 }
 
 fn row<'a>(t: &'a Table1, r: &str) -> &'a kanegen::table1::RowReport {
-    t.rows.iter().find(|x| x.row == r).unwrap_or_else(|| panic!("row {r} missing"))
+    t.rows
+        .iter()
+        .find(|x| x.row == r)
+        .unwrap_or_else(|| panic!("row {r} missing"))
 }
 
 #[test]
@@ -25,7 +28,11 @@ fn sound_rows_agree_and_rows_7_8_10_do_not() {
     for r in ["7", "8", "10"] {
         let x = row(t, r);
         assert_eq!(x.agree, Some(false), "row {r} should disagree");
-        assert!(x.note.contains("traced − printed"), "row {r} note: {}", x.note);
+        assert!(
+            x.note.contains("traced − printed"),
+            "row {r} note: {}",
+            x.note
+        );
     }
     // The text's per-step derivations all agree except its own summations.
     for d in &t.derivations {
@@ -41,8 +48,14 @@ fn traced_rows_have_the_findings_values() {
     let t = table();
     let p = |c: &[f64]| Poly::from_f64(c).to_string();
     assert_eq!(row(t, "7").traced.text[0], p(&[0.0, -18.0, 18.0]));
-    assert_eq!(row(t, "8").traced.text, [p(&[0.0, -13.5, 13.5]), p(&[9.0, -27.0, 18.0])]);
-    assert_eq!(row(t, "10").traced.text, [p(&[0.0, 6.0, 6.0]), p(&[0.0, 6.0, 6.0])]);
+    assert_eq!(
+        row(t, "8").traced.text,
+        [p(&[0.0, -13.5, 13.5]), p(&[9.0, -27.0, 18.0])]
+    );
+    assert_eq!(
+        row(t, "10").traced.text,
+        [p(&[0.0, 6.0, 6.0]), p(&[0.0, 6.0, 6.0])]
+    );
     let total = |alg: &str, conv: &str| {
         t.totals
             .iter()
@@ -51,14 +64,22 @@ fn traced_rows_have_the_findings_values() {
             .text
             .clone()
     };
-    assert_eq!(total("recurrent-p", "paper"), [p(&[0.0, -27.0, 39.0]), p(&[3.0, -48.5, 58.5])]);
+    assert_eq!(
+        total("recurrent-p", "paper"),
+        [p(&[0.0, -27.0, 39.0]), p(&[3.0, -48.5, 58.5])]
+    );
 }
 
 #[test]
 fn fitted_totals_predict_a_fresh_trace_at_n_13() {
     // N = 13 is outside the traced range 1..=12 used for every fit.
     let t = table();
-    for alg in [Traced::RecurrentR1, Traced::Recurrent, Traced::CrbaBase, Traced::KaneDirect] {
+    for alg in [
+        Traced::RecurrentR1,
+        Traced::Recurrent,
+        Traced::CrbaBase,
+        Traced::KaneDirect,
+    ] {
         let trace = trace_mass_matrix(alg, 13);
         for conv in Convention::ALL {
             let fit = t
@@ -67,9 +88,15 @@ fn fitted_totals_predict_a_fresh_trace_at_n_13() {
                 .find(|x| x.algorithm == alg.name() && x.convention == conv.name())
                 .unwrap();
             let c = trace.counts(conv);
-            let m = Poly::from_f64(&fit.mul).eval_f64(13.0);
-            let a = Poly::from_f64(&fit.add).eval_f64(13.0);
-            assert_eq!((c.mul as f64, c.add as f64), (m, a), "{} {}", alg.name(), conv.name());
+            let m = Poly::from_f64(&fit.mul).eval(13);
+            let a = Poly::from_f64(&fit.add).eval(13);
+            assert_eq!(
+                (Q::from(c.mul as i128), Q::from(c.add as i128)),
+                (m, a),
+                "{} {}",
+                alg.name(),
+                conv.name()
+            );
         }
     }
 }
@@ -77,16 +104,30 @@ fn fitted_totals_predict_a_fresh_trace_at_n_13() {
 #[test]
 fn ssrms_line_and_crossover_are_reported() {
     let t = table();
-    let printed = t.ssrms_n6["printed"]["Recurrent algorithm"]["total"].as_f64().unwrap();
+    let printed = t.ssrms_n6["printed"]["Recurrent algorithm"]["total"]
+        .as_f64()
+        .unwrap();
     assert_eq!(printed, 2514.0);
     let traced: Vec<&serde_json::Value> = t.ssrms_n6["traced"].as_array().unwrap().iter().collect();
     let p = traced
         .iter()
         .find(|v| v["algorithm"] == "recurrent-p" && v["convention"] == "paper")
         .unwrap();
-    assert_eq!(p["total"].as_u64().unwrap(), 3060, "corrected total of the paper's structure at N = 6");
-    let c = t.crossovers.iter().find(|c| c.curve.starts_with("printed recurrent")).unwrap();
-    assert!(c.at_n.iter().any(|x| (x - 8.94).abs() < 0.01), "{:?}", c.at_n);
+    assert_eq!(
+        p["total"].as_u64().unwrap(),
+        3060,
+        "corrected total of the paper's structure at N = 6"
+    );
+    let c = t
+        .crossovers
+        .iter()
+        .find(|c| c.curve.starts_with("printed recurrent"))
+        .unwrap();
+    assert!(
+        c.at_n.iter().any(|x| (x - 8.94).abs() < 0.01),
+        "{:?}",
+        c.at_n
+    );
 }
 
 #[test]

@@ -6,11 +6,14 @@
 //!
 //! ```
 //! use kanegen_core::ldlt::{ldlt, solve};
-//! let a = vec![vec![4.0, 2.0], vec![2.0, 3.0]];
+//! let a: Vec<Vec<f64>> = vec![vec![4.0, 2.0], vec![2.0, 3.0]];
 //! let f = ldlt(&a);
 //! let x = solve(&f, &[2.0, 1.0]);
 //! assert!((4.0 * x[0] + 2.0 * x[1] - 2.0).abs() < 1e-15 && (2.0 * x[0] + 3.0 * x[1] - 1.0).abs() < 1e-15);
 //! ```
+
+// Index loops mirror the formulas (L_ik, y_k) and keep the trace order explicit.
+#![allow(clippy::needless_range_loop)]
 
 use crate::scalar::Scalar;
 
@@ -70,7 +73,11 @@ pub fn solve<S: Scalar>(f: &Ldlt<S>, b: &[S]) -> Vec<S> {
         y.push(s);
     }
     // D z = y, Lᵀ x = z
-    let mut x: Vec<S> = y.into_iter().zip(&f.d_inv).map(|(yi, di)| yi * di.clone()).collect();
+    let mut x: Vec<S> = y
+        .into_iter()
+        .zip(&f.d_inv)
+        .map(|(yi, di)| yi * di.clone())
+        .collect();
     for i in (0..n).rev() {
         for k in (i + 1)..n {
             let t = f.l[k][i].clone() * x[k].clone();
@@ -92,13 +99,22 @@ mod tests {
             let m = DMatrix::from_vec(n, n, crate::random::random_vec(&mut rng, n * n, 1.0));
             let a = &m * m.transpose() + DMatrix::identity(n, n) * 0.5;
             let b = crate::random::random_vec(&mut rng, n, 1.0);
-            let rows: Vec<Vec<f64>> = (0..n).map(|i| (0..n).map(|j| a[(i, j)]).collect()).collect();
+            let rows: Vec<Vec<f64>> = (0..n)
+                .map(|i| (0..n).map(|j| a[(i, j)]).collect())
+                .collect();
             let f = ldlt(&rows);
             assert!(f.d.iter().all(|&d| d > 0.0));
             let x = solve(&f, &b);
-            let want = a.clone().cholesky().unwrap().solve(&nalgebra::DVector::from_vec(b.clone()));
+            let want = a
+                .clone()
+                .cholesky()
+                .unwrap()
+                .solve(&nalgebra::DVector::from_vec(b.clone()));
             for i in 0..n {
-                assert!((x[i] - want[i]).abs() < 1e-10 * (1.0 + want[i].abs()), "n={n} i={i}");
+                assert!(
+                    (x[i] - want[i]).abs() < 1e-10 * (1.0 + want[i].abs()),
+                    "n={n} i={i}"
+                );
             }
         }
     }

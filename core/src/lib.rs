@@ -19,5 +19,7 @@ pub mod scalar;
 pub mod sym;
 
 pub use algorithms::{Algorithm, Dynamics, ExternalWrench, LoadFrame, Loads};
-pub use model::{Chain, ChainParams, Inertial, Joint, JointKind, ModelError, Placement};
+pub use model::{
+    Chain, ChainParams, Inertial, Joint, JointKind, ModelError, Placement, Validation,
+};
 pub use scalar::Scalar;

@@ -61,7 +61,9 @@ impl<S: Scalar> Vec3<S> {
     /// Outer product `self oᵀ` (9 m).
     #[must_use]
     pub fn outer(&self, o: &Self) -> Mat3<S> {
-        Mat3(core::array::from_fn(|r| core::array::from_fn(|c| self.at(r) * o.at(c))))
+        Mat3(core::array::from_fn(|r| {
+            core::array::from_fn(|c| self.at(r) * o.at(c))
+        }))
     }
     /// Components as an array.
     pub fn into_array(self) -> [S; 3] {
@@ -72,7 +74,9 @@ impl<S: Scalar> Vec3<S> {
 impl<S: Scalar> Mat3<S> {
     /// The zero matrix.
     pub fn zero() -> Self {
-        Mat3(core::array::from_fn(|_| core::array::from_fn(|_| S::zero())))
+        Mat3(core::array::from_fn(|_| {
+            core::array::from_fn(|_| S::zero())
+        }))
     }
     /// The identity.
     pub fn identity() -> Self {
@@ -101,7 +105,9 @@ impl<S: Scalar> Mat3<S> {
     /// Transpose (free).
     #[must_use]
     pub fn transpose(&self) -> Self {
-        Mat3(core::array::from_fn(|r| core::array::from_fn(|c| self.at(c, r))))
+        Mat3(core::array::from_fn(|r| {
+            core::array::from_fn(|c| self.at(c, r))
+        }))
     }
     /// Row `r` as a vector.
     #[must_use]
@@ -248,6 +254,7 @@ pub fn rpy_to_matrix(rpy: [f64; 3]) -> [[f64; 3]; 3] {
 }
 
 #[cfg(test)]
+#[allow(clippy::needless_range_loop)]
 mod tests {
     use super::*;
 
@@ -295,7 +302,9 @@ mod tests {
         let ey = Vec3::new(0.0, 1.0, 0.0);
         let ez = Vec3::new(0.0, 0.0, 1.0);
         let rot = |u: &Vec3<f64>, a: f64| axis_rotation(u, &a.sin(), &a.cos());
-        let r = rot(&ez, rpy[2]).mul_mat(&rot(&ey, rpy[1])).mul_mat(&rot(&ex, rpy[0]));
+        let r = rot(&ez, rpy[2])
+            .mul_mat(&rot(&ey, rpy[1]))
+            .mul_mat(&rot(&ex, rpy[0]));
         for i in 0..3 {
             for j in 0..3 {
                 assert!((r.at(i, j) - m[i][j]).abs() < 1e-14);

@@ -132,16 +132,35 @@ impl ModelError {
     }
 }
 
+/// How strictly [`Chain::new_with`] validates mass properties.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Validation {
+    /// Accept inertia tensors that are positive definite but violate the triangle inequality
+    /// (not physically realisable, yet present in some published parameter sets). Off by default.
+    pub allow_nonphysical_inertia: bool,
+}
+
 impl Chain {
-    /// Builds and validates a chain. Checks, each reported with the joint and field: finite
-    /// numbers; mass > 0; inertia symmetric, positive definite and satisfying the triangle
-    /// inequality; non-zero axis (normalized here); orthonormal right-handed origin rotation;
-    /// unique joint and body names; at least one joint.
+    /// Builds and validates a chain with the default (strict) [`Validation`].
     pub fn new(
         name: impl Into<String>,
         base: impl Into<String>,
         base_inertial: Option<Inertial>,
         joints: Vec<Joint>,
+    ) -> Result<Self, ModelError> {
+        Self::new_with(name, base, base_inertial, joints, Validation::default())
+    }
+
+    /// Builds and validates a chain. Checks, each reported with the joint and field: finite
+    /// numbers; mass > 0; inertia symmetric, positive definite and satisfying the triangle
+    /// inequality; non-zero axis (normalized here); orthonormal right-handed origin rotation;
+    /// unique joint and body names; at least one joint.
+    pub fn new_with(
+        name: impl Into<String>,
+        base: impl Into<String>,
+        base_inertial: Option<Inertial>,
+        joints: Vec<Joint>,
+        validation: Validation,
     ) -> Result<Self, ModelError> {
         let name = name.into();
         let base = base.into();
@@ -166,10 +185,10 @@ impl Chain {
             }
             validate_placement(&j.name, "origin", &j.origin)?;
             j.axis = validate_axis(&j.name, &j.axis)?;
-            validate_inertial(&j.name, "inertial", &j.inertial)?;
+            validate_inertial_with(&j.name, "inertial", &j.inertial, validation)?;
         }
         if let Some(b) = &base_inertial {
-            validate_inertial(&base, "base.inertial", b)?;
+            validate_inertial_with(&base, "base.inertial", b, validation)?;
         }
         Ok(Chain {
             name,
@@ -311,8 +330,18 @@ fn validate_axis(joint: &str, a: &[f64; 3]) -> Result<[f64; 3], ModelError> {
     Ok([a[0] / n, a[1] / n, a[2] / n])
 }
 
-/// Checks a body's mass properties; `owner` names the joint (or body) in the message.
+/// Checks a body's mass properties strictly; `owner` names the joint (or body) in the message.
 pub fn validate_inertial(owner: &str, field: &str, b: &Inertial) -> Result<(), ModelError> {
+    validate_inertial_with(owner, field, b, Validation::default())
+}
+
+/// Checks a body's mass properties under the given [`Validation`].
+pub fn validate_inertial_with(
+    owner: &str,
+    field: &str,
+    b: &Inertial,
+    validation: Validation,
+) -> Result<(), ModelError> {
     finite(owner, &format!("{field}.mass"), &[b.mass])?;
     if b.mass <= 0.0 {
         return Err(ModelError::invalid(
@@ -325,13 +354,19 @@ pub fn validate_inertial(owner: &str, field: &str, b: &Inertial) -> Result<(), M
     let i = &b.inertia;
     let flat: Vec<f64> = i.iter().flatten().copied().collect();
     finite(owner, &format!("{field}.inertia"), &flat)?;
-    let scale = flat.iter().fold(0.0f64, |m, x| m.max(x.abs())).max(f64::MIN_POSITIVE);
+    let scale = flat
+        .iter()
+        .fold(0.0f64, |m, x| m.max(x.abs()))
+        .max(f64::MIN_POSITIVE);
     for (r, c) in [(0, 1), (0, 2), (1, 2)] {
         if (i[r][c] - i[c][r]).abs() > 1e-9 * scale {
             return Err(ModelError::invalid(
                 owner,
                 &format!("{field}.inertia"),
-                format!("not symmetric: I[{r}][{c}] = {} but I[{c}][{r}] = {}", i[r][c], i[c][r]),
+                format!(
+                    "not symmetric: I[{r}][{c}] = {} but I[{c}][{r}] = {}",
+                    i[r][c], i[c][r]
+                ),
             ));
         }
     }
@@ -355,12 +390,12 @@ pub fn validate_inertial(owner: &str, field: &str, b: &Inertial) -> Result<(), M
     let tol = 1e-9 * (ev[0] + ev[1] + ev[2]);
     for k in 0..3 {
         let (a, b2, c) = (ev[k], ev[(k + 1) % 3], ev[(k + 2) % 3]);
-        if a > b2 + c + tol {
+        if a > b2 + c + tol && !validation.allow_nonphysical_inertia {
             return Err(ModelError::invalid(
                 owner,
                 &format!("{field}.inertia"),
                 format!(
-                    "violates the triangle inequality: principal moments {:.6e}, {:.6e}, {:.6e}",
+                    "violates the triangle inequality: principal moments {:.6e}, {:.6e}, {:.6e} (not physically realisable; --allow-nonphysical accepts it)",
                     ev[0], ev[1], ev[2]
                 ),
             ));

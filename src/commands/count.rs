@@ -44,9 +44,17 @@ pub struct CountReport {
 pub fn trace_mass_matrix(chain: &Chain, alg: Algorithm) -> Trace {
     let t = Tracer::new();
     let p = chain.params::<Sym>();
-    let q: Vec<Sym> = chain.joints().iter().map(|j| t.input(format!("q_{}", j.name))).collect();
+    let q: Vec<Sym> = chain
+        .joints()
+        .iter()
+        .map(|j| t.input(format!("q_{}", j.name)))
+        .collect();
     let a = alg.mass_matrix(&p, &q);
-    let out: Vec<Sym> = a.iter().enumerate().flat_map(|(i, r)| r[i..].to_vec()).collect();
+    let out: Vec<Sym> = a
+        .iter()
+        .enumerate()
+        .flat_map(|(i, r)| r[i..].to_vec())
+        .collect();
     t.finish(&out)
 }
 

@@ -24,7 +24,13 @@ pub fn render_markdown(t: &Table1) -> Result<String> {
     let mut ssrms_rows: Vec<(String, String, String, String, String)> = Vec::new();
     if let Some(p) = t.ssrms_n6["printed"].as_object() {
         for (name, v) in p {
-            ssrms_rows.push((name.clone(), "printed".into(), v["mul"].to_string(), v["add"].to_string(), v["total"].to_string()));
+            ssrms_rows.push((
+                name.clone(),
+                "printed".into(),
+                v["mul"].to_string(),
+                v["add"].to_string(),
+                v["total"].to_string(),
+            ));
         }
     }
     for v in t.ssrms_n6["traced"].as_array().into_iter().flatten() {
@@ -53,7 +59,10 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
         let root = SVGBackend::with_string(&mut svg, (900, 600)).into_drawing_area();
         root.fill(&WHITE)?;
         let mut chart = ChartBuilder::on(&root)
-            .caption("Operations for A(q) against N (Fig. 2, printed and traced)", ("sans-serif", 20))
+            .caption(
+                "Operations for A(q) against N (Fig. 2, printed and traced)",
+                ("sans-serif", 20),
+            )
             .margin(15)
             .x_label_area_size(40)
             .y_label_area_size(70)
@@ -64,25 +73,83 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
             .y_desc("multiplications + additions")
             .y_labels(18)
             .draw()?;
-        let xs: Vec<f64> = (0..=((N_MAX - 1) * 10)).map(|k| 1.0 + k as f64 / 10.0).collect();
-        let printed = |row: &str| Poly::from_f64(&t.printed_totals.iter().find(|p| p.row == row).unwrap().total);
+        let xs: Vec<f64> = (0..=((N_MAX - 1) * 10))
+            .map(|k| 1.0 + k as f64 / 10.0)
+            .collect();
+        let printed = |row: &str| {
+            Poly::from_f64(
+                &t.printed_totals
+                    .iter()
+                    .find(|p| p.row == row)
+                    .unwrap()
+                    .total,
+            )
+        };
         let total_of = |alg: Traced, conv: &str| {
-            let r = t.totals.iter().find(|x| x.algorithm == alg.name() && x.convention == conv).unwrap();
+            let r = t
+                .totals
+                .iter()
+                .find(|x| x.algorithm == alg.name() && x.convention == conv)
+                .unwrap();
             Poly::from_f64(&r.mul).add(&Poly::from_f64(&r.add))
         };
         let curves: Vec<(String, Poly, RGBColor, u8)> = vec![
-            ("f: recurrent, printed 91.5N² − 136.5N + 39".into(), printed("14"), RED, 1),
+            (
+                "f: recurrent, printed 91.5N² − 136.5N + 39".into(),
+                printed("14"),
+                RED,
+                1,
+            ),
             ("g: «Kosynka», printed".into(), printed("15"), MAGENTA, 1),
-            ("h: Stepanenko, printed 69N² + 69N".into(), printed("16"), BLUE, 1),
-            ("recurrent-r1, traced (paper conv.)".into(), total_of(Traced::RecurrentR1, "paper"), RED, 0),
-            ("recurrent (R2), traced (paper conv.)".into(), total_of(Traced::Recurrent, "paper"), RGBColor(200, 120, 0), 0),
-            ("crba-base, traced (paper conv.)".into(), total_of(Traced::CrbaBase, "paper"), BLUE, 0),
-            ("recurrent (R2), emitted".into(), total_of(Traced::Recurrent, "emitted"), RGBColor(120, 60, 0), 0),
-            ("crba-base, emitted".into(), total_of(Traced::CrbaBase, "emitted"), RGBColor(0, 120, 160), 0),
-            ("Featherstone CRBA (RBDA Table 10.1)".into(), printed("—"), BLACK, 2),
+            (
+                "h: Stepanenko, printed 69N² + 69N".into(),
+                printed("16"),
+                BLUE,
+                1,
+            ),
+            (
+                "recurrent-r1, traced (paper conv.)".into(),
+                total_of(Traced::RecurrentR1, "paper"),
+                RED,
+                0,
+            ),
+            (
+                "recurrent (R2), traced (paper conv.)".into(),
+                total_of(Traced::Recurrent, "paper"),
+                RGBColor(200, 120, 0),
+                0,
+            ),
+            (
+                "crba-base, traced (paper conv.)".into(),
+                total_of(Traced::CrbaBase, "paper"),
+                BLUE,
+                0,
+            ),
+            (
+                "recurrent (R2), emitted".into(),
+                total_of(Traced::Recurrent, "emitted"),
+                RGBColor(120, 60, 0),
+                0,
+            ),
+            (
+                "crba-base, emitted".into(),
+                total_of(Traced::CrbaBase, "emitted"),
+                RGBColor(0, 120, 160),
+                0,
+            ),
+            (
+                "Featherstone CRBA (RBDA Table 10.1)".into(),
+                printed("—"),
+                BLACK,
+                2,
+            ),
         ];
         for (label, p, color, style) in curves {
-            let pts: Vec<(f64, f64)> = xs.iter().map(|&x| (x, p.eval_f64(x))).filter(|(_, y)| *y <= 17000.0).collect();
+            let pts: Vec<(f64, f64)> = xs
+                .iter()
+                .map(|&x| (x, p.eval_f64(x)))
+                .filter(|(_, y)| *y <= 17000.0)
+                .collect();
             let s = ShapeStyle::from(&color).stroke_width(2);
             let series: Vec<(f64, f64)> = pts;
             match style {
@@ -91,7 +158,9 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
                 _ => chart.draw_series(DashedLineSeries::new(series, 2, 4, s))?,
             }
             .label(label)
-            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2)));
+            .legend(move |(x, y)| {
+                PathElement::new(vec![(x, y), (x + 20, y)], color.stroke_width(2))
+            });
         }
         chart
             .configure_series_labels()
@@ -109,6 +178,9 @@ pub fn write_all(t: &Table1, dir: &std::path::Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("create {}", dir.display()))?;
     std::fs::write(dir.join("table1.md"), render_markdown(t)?)?;
     std::fs::write(dir.join("fig2.svg"), render_fig2(t)?)?;
-    std::fs::write(dir.join("table1.json"), serde_json::to_string_pretty(t)? + "\n")?;
+    std::fs::write(
+        dir.join("table1.json"),
+        serde_json::to_string_pretty(t)? + "\n",
+    )?;
     Ok(())
 }

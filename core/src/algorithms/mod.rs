@@ -124,7 +124,13 @@ impl Algorithm {
     }
 
     /// The generalized forces `b(q, q̇, loads) = Q − h`.
-    pub fn bias<S: Scalar>(self, p: &ChainParams<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    pub fn bias<S: Scalar>(
+        self,
+        p: &ChainParams<S>,
+        q: &[S],
+        qd: &[S],
+        loads: &Loads<S>,
+    ) -> Vec<S> {
         match self {
             Algorithm::Recurrent | Algorithm::RecurrentR1 => recurrent::bias(p, q, qd, loads),
             Algorithm::KaneDirect => kane_direct::bias(p, q, qd, loads),

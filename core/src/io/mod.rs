@@ -21,15 +21,20 @@ mod frames;
 mod toml_model;
 mod urdf;
 
-use crate::model::{Chain, ModelError};
+use crate::model::{Chain, ModelError, Validation};
 use std::path::Path;
 
 pub use toml_model::parse_toml;
-pub use urdf::parse_urdf;
+pub use urdf::{parse_urdf, parse_urdf_with};
 
 /// Reads a model file, choosing the reader by extension: `.urdf` ([`parse_urdf`]) or `.toml`
 /// ([`parse_toml`]). Parse errors are prefixed with the file name.
 pub fn load_model(path: &Path) -> Result<Chain, ModelError> {
+    load_model_with(path, Validation::default())
+}
+
+/// [`load_model`] under the given [`Validation`].
+pub fn load_model_with(path: &Path, validation: Validation) -> Result<Chain, ModelError> {
     let ext = path
         .extension()
         .and_then(|e| e.to_str())
@@ -42,8 +47,10 @@ pub fn load_model(path: &Path) -> Result<Chain, ModelError> {
         })
     };
     match ext.as_deref() {
-        Some("urdf") => urdf::parse_urdf(&read()?).map_err(|e| prefix(&display, e)),
-        Some("toml") => toml_model::parse_toml_named(&read()?, Some(&display)),
+        Some("urdf") => {
+            urdf::parse_urdf_with(&read()?, validation).map_err(|e| prefix(&display, e))
+        }
+        Some("toml") => toml_model::parse_toml_named(&read()?, Some(&display), validation),
         Some(other) => Err(ModelError::Parse(format!(
             "{display}: unsupported model file extension `.{other}` (expected `.urdf` or `.toml`)"
         ))),

@@ -2,7 +2,9 @@
 
 use super::frames::{rotate_inertia, Tf, M3, V3};
 use crate::linalg::rpy_to_matrix;
-use crate::model::{validate_inertial, Chain, Inertial, Joint, JointKind, ModelError};
+use crate::model::{
+    validate_inertial_with, Chain, Inertial, Joint, JointKind, ModelError, Validation,
+};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use std::fmt;
@@ -162,17 +164,21 @@ impl<'de> Deserialize<'de> for InertiaSpec {
 ///
 /// `base_xyz` and `base_rpy`/`base_rotation` in `[dh]` place DH frame 0 in the base body frame.
 pub fn parse_toml(text: &str) -> Result<Chain, ModelError> {
-    parse_toml_named(text, None)
+    parse_toml_named(text, None, Validation::default())
 }
 
-pub(crate) fn parse_toml_named(text: &str, file: Option<&str>) -> Result<Chain, ModelError> {
+pub(crate) fn parse_toml_named(
+    text: &str,
+    file: Option<&str>,
+    validation: Validation,
+) -> Result<Chain, ModelError> {
     let spec: ModelSpec = toml::from_str(text).map_err(|e| {
         ModelError::Parse(match file {
             Some(f) => format!("{f}: {e}"),
             None => e.to_string(),
         })
     })?;
-    build(spec)
+    build(spec, validation)
 }
 
 fn finite(label: &str, field: &str, xs: &[f64]) -> Result<(), ModelError> {
@@ -216,22 +222,23 @@ fn inertial_of(
     mass: f64,
     com: Option<V3>,
     inertia: &InertiaSpec,
+    validation: Validation,
 ) -> Result<Inertial, ModelError> {
     let b = Inertial {
         mass,
         com: com.unwrap_or([0.0; 3]),
         inertia: inertia.0,
     };
-    validate_inertial(label, field, &b)?;
+    validate_inertial_with(label, field, &b, validation)?;
     Ok(b)
 }
 
-fn build(spec: ModelSpec) -> Result<Chain, ModelError> {
+fn build(spec: ModelSpec, validation: Validation) -> Result<Chain, ModelError> {
     let base = spec.base.map(|b| b.0).unwrap_or_default();
     let base_name = base.name.clone().unwrap_or_else(|| "base".to_string());
     let base_inertial = match (base.mass, &base.inertia) {
         (None, None) if base.com.is_none() => None,
-        (Some(m), Some(i)) => Some(inertial_of(&base_name, "base", m, base.com, i)?),
+        (Some(m), Some(i)) => Some(inertial_of(&base_name, "base", m, base.com, i, validation)?),
         (None, _) => {
             return Err(ModelError::invalid(
                 &base_name,
@@ -278,8 +285,14 @@ fn build(spec: ModelSpec) -> Result<Chain, ModelError> {
             KindSpec::Revolute => JointKind::Revolute,
             KindSpec::Prismatic => JointKind::Prismatic,
         };
-        let mut inertial =
-            inertial_of(&label, "body", js.body.mass, js.body.com, &js.body.inertia)?;
+        let mut inertial = inertial_of(
+            &label,
+            "body",
+            js.body.mass,
+            js.body.com,
+            &js.body.inertia,
+            validation,
+        )?;
         let (origin, axis) = match &spec.dh {
             None => {
                 for (field, present) in [
@@ -364,7 +377,7 @@ fn build(spec: ModelSpec) -> Result<Chain, ModelError> {
         });
     }
     let is_dh = spec.dh.is_some();
-    Chain::new(spec.name, base_name, base_inertial, joints).map_err(|e| match e {
+    Chain::new_with(spec.name, base_name, base_inertial, joints, validation).map_err(|e| match e {
         ModelError::Invalid {
             joint,
             field,

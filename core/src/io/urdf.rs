@@ -5,7 +5,7 @@
 //! moving body that ends up massless is rejected by [`Chain::new`] (mass must be > 0).
 
 use super::frames::{MassAcc, Tf, M3};
-use crate::model::{Chain, Inertial, Joint, JointKind, ModelError};
+use crate::model::{Chain, Inertial, Joint, JointKind, ModelError, Validation};
 use std::collections::{HashMap, HashSet};
 use urdf_rs::JointType;
 
@@ -26,6 +26,11 @@ use urdf_rs::JointType;
 /// The chain is named after the robot; the base after the root link, whose (merged) inertial
 /// becomes the base inertial when its mass is non-zero.
 pub fn parse_urdf(text: &str) -> Result<Chain, ModelError> {
+    parse_urdf_with(text, Validation::default())
+}
+
+/// [`parse_urdf`] under the given [`Validation`].
+pub fn parse_urdf_with(text: &str, validation: Validation) -> Result<Chain, ModelError> {
     let robot =
         urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse(format!("URDF: {e}")))?;
 
@@ -177,7 +182,7 @@ pub fn parse_urdf(text: &str) -> Result<Chain, ModelError> {
             robot.links.len() - visited
         )));
     }
-    Chain::new(robot.name.clone(), root, base_inertial, joints)
+    Chain::new_with(robot.name.clone(), root, base_inertial, joints, validation)
 }
 
 fn inertial_of(acc: &MassAcc) -> Inertial {
