@@ -115,3 +115,34 @@ fn every_small_chain_agrees() {
         }
     }
 }
+
+#[test]
+fn algorithms_run_on_f32() {
+    // The same source on f32: agreement with f64 to single-precision accuracy.
+    for seed in 0..6 {
+        let n = 7;
+        let chain = random_chain(
+            &ChainSpec {
+                n,
+                prismatic_fraction: 0.2,
+                ..Default::default()
+            },
+            seed,
+        );
+        let mut r = rng(seed);
+        let q = random_vec(&mut r, n, 3.0);
+        let qd = random_vec(&mut r, n, 2.0);
+        let p64 = chain.params::<f64>();
+        let p32 = chain.params::<f32>();
+        let q32: Vec<f32> = q.iter().map(|&x| x as f32).collect();
+        let qd32: Vec<f32> = qd.iter().map(|&x| x as f32).collect();
+        for alg in Algorithm::ALL {
+            let d64 = alg.dynamics(&p64, &q, &qd, &Loads::default());
+            let d32 = alg.dynamics(&p32, &q32, &qd32, &Loads::default());
+            let a32: Vec<f64> = d32.a.iter().flatten().map(|&x| x as f64).collect();
+            let b32: Vec<f64> = d32.b.iter().map(|&x| x as f64).collect();
+            let (ea, eb) = (rel_err(&a32, &flat(&d64.a)), rel_err(&b32, &d64.b));
+            assert!(ea < 1e-4 && eb < 1e-3, "{alg} f32: A {ea:.2e}, b {eb:.2e}");
+        }
+    }
+}

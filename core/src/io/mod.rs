@@ -1,5 +1,5 @@
 //! Model readers: URDF ([`parse_urdf`]) and kanegen's TOML format ([`parse_toml`], documented in
-//! `docs/model-format.md`), both producing a validated [`Chain`].
+//! README.md, "Model files"), both producing a validated [`Chain`].
 //!
 //! ```
 //! let chain = kanegen_core::io::parse_toml(r#"

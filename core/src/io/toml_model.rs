@@ -1,4 +1,4 @@
-//! kanegen's TOML model format (see `docs/model-format.md`), with optional DH geometry.
+//! kanegen's TOML model format (see README.md, "Model files"), with optional DH geometry.
 
 use super::frames::{rotate_inertia, Tf, M3, V3};
 use crate::linalg::rpy_to_matrix;
@@ -146,7 +146,7 @@ impl<'de> Deserialize<'de> for InertiaSpec {
     }
 }
 
-/// Parses kanegen's TOML model format (documented in `docs/model-format.md`) into a [`Chain`].
+/// Parses kanegen's TOML model format (documented in README.md, "Model files") into a [`Chain`].
 ///
 /// Unknown keys and syntax errors are reported by the `toml` crate (naming the key and line) as
 /// [`ModelError::Parse`]; every value error names the joint (by name, or `joint #k`, 1-based,

@@ -1,0 +1,120 @@
+//! `kanegen count` on URDF and TOML models: the JSON contract, the same counts for the same arm
+//! in both formats, and the ordering paper ≥ folded ≥ emitted.
+
+use serde_json::Value;
+use std::path::Path;
+use std::process::Command;
+
+fn count_json(model: &Path) -> Value {
+    let out = Command::new(env!("CARGO_BIN_EXE_kanegen"))
+        .arg("count")
+        .arg(model)
+        .arg("--json")
+        .output()
+        .expect("run kanegen");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+#[test]
+fn count_reports_every_algorithm_function_and_convention() {
+    let urdf = count_json(&root().join("tests/data/reference/ssrms_nguyen_hughes_1994.urdf"));
+    let toml = count_json(&root().join("models/ssrms.toml"));
+    assert_eq!(urdf["n"], 7);
+    let lines = urdf["counts"].as_array().unwrap();
+    assert_eq!(
+        lines.len(),
+        5 * 2 * 3,
+        "5 algorithms × 2 functions × 3 conventions"
+    );
+    for key in [
+        "algorithm",
+        "function",
+        "convention",
+        "mul",
+        "add",
+        "div",
+        "sqrt",
+        "sincos",
+    ] {
+        assert!(lines.iter().all(|l| l.get(key).is_some()), "missing {key}");
+    }
+    // The same arm in two formats costs the same.
+    assert_eq!(urdf["counts"], toml["counts"]);
+    // Folding and CSE never add operations; sin/cos once per joint in emitted code.
+    for alg in [
+        "recurrent",
+        "recurrent-r1",
+        "kane-direct",
+        "crba-base",
+        "spatial",
+    ] {
+        for f in ["mass_matrix", "bias"] {
+            let get = |conv: &str| {
+                lines
+                    .iter()
+                    .find(|l| {
+                        l["algorithm"] == alg && l["function"] == f && l["convention"] == conv
+                    })
+                    .unwrap()
+            };
+            let tot = |l: &Value| l["mul"].as_u64().unwrap() + l["add"].as_u64().unwrap();
+            let (p, fo, e) = (get("paper"), get("folded"), get("emitted"));
+            assert!(
+                tot(p) >= tot(fo) && tot(fo) >= tot(e),
+                "{alg} {f}: {} {} {}",
+                tot(p),
+                tot(fo),
+                tot(e)
+            );
+            assert!(tot(e) > 0);
+            // At most one sin/cos pair per joint. The local-frame `spatial` algorithm needs none for
+            // joint 1 without gravity (A and h are invariant to rotating the whole arm about the
+            // fixed first axis), so its emitted code drops it; the base-frame ones keep all 7.
+            let sc = e["sincos"].as_u64().unwrap();
+            let want = if alg == "spatial" { 6 } else { 7 };
+            assert_eq!(sc, want, "{alg} {f}: sin/cos pairs");
+        }
+    }
+}
+
+#[test]
+fn count_rejects_a_bad_model_naming_the_field() {
+    let dir = std::env::temp_dir().join(format!("kanegen-count-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad = dir.join("bad.toml");
+    std::fs::write(
+        &bad,
+        r#"name = "bad"
+[[joint]]
+name = "elbow"
+type = "revolute"
+axis = [0.0, 0.0, 0.0]
+[joint.body]
+mass = 1.0
+com = [0.0, 0.0, 0.0]
+inertia = { ixx = 1.0, iyy = 1.0, izz = 1.0 }
+"#,
+    )
+    .unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_kanegen"))
+        .arg("count")
+        .arg(&bad)
+        .output()
+        .unwrap();
+    let _ = std::fs::remove_dir_all(&dir);
+    assert!(!out.status.success());
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("elbow") && err.contains("axis"),
+        "stderr: {err}"
+    );
+}
