@@ -72,6 +72,8 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
             .x_desc("N (number of links)")
             .y_desc("multiplications + additions")
             .y_labels(18)
+            .x_label_formatter(&|x| format!("{x:.0}"))
+            .y_label_formatter(&|y| format!("{y:.0}"))
             .draw()?;
         let xs: Vec<f64> = (0..=((N_MAX - 1) * 10))
             .map(|k| 1.0 + k as f64 / 10.0)
