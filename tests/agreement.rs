@@ -3,23 +3,10 @@
 //! forward / inverse dynamics are consistent.
 
 use kanegen::linalg::Vec3;
+use kanegen::metrics::{flatten as flat, rel_err};
 use kanegen::random::{random_chain, random_vec, rng, ChainSpec};
 use kanegen::{Algorithm, ExternalWrench, LoadFrame, Loads};
 use proptest::prelude::*;
-
-fn rel_err(x: &[f64], y: &[f64]) -> f64 {
-    let num = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let den = y.iter().map(|b| b.abs()).fold(f64::MIN_POSITIVE, f64::max);
-    num / den
-}
-
-fn flat(a: &[Vec<f64>]) -> Vec<f64> {
-    a.iter().flatten().copied().collect()
-}
 
 fn random_loads(n: usize, seed: u64, with_gravity: bool) -> Loads<f64> {
     let mut r = rng(seed ^ 0x5eed);

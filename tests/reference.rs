@@ -3,6 +3,7 @@
 //! model, every state, every algorithm, gravity zero and −9.81 along the root z axis, to 1e-9
 //! relative (max |x − y| / max |y| over each matrix or vector).
 
+use kanegen::metrics::rel_err;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -13,21 +14,6 @@ const NONPHYSICAL: [&str; 3] = ["ets7_vyas_urdf", "ets7_bmsd", "bmsd_7dof_free_f
 
 fn data_dir() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/reference")
-}
-
-fn rel_err(x: &[f64], y: &[f64]) -> f64 {
-    assert_eq!(x.len(), y.len());
-    let num = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let den = y.iter().map(|b| b.abs()).fold(0.0, f64::max);
-    if den == 0.0 {
-        num
-    } else {
-        num / den
-    }
 }
 
 fn flat(v: &Value) -> Vec<f64> {

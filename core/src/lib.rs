@@ -13,6 +13,7 @@ pub mod dual;
 pub mod io;
 pub mod ldlt;
 pub mod linalg;
+pub mod metrics;
 pub mod model;
 pub mod random;
 pub mod scalar;

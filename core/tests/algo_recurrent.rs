@@ -10,25 +10,12 @@ use kanegen_core::algorithms::kinematics::{base_frame, motion};
 use kanegen_core::algorithms::recurrent::{self, Variant};
 use kanegen_core::algorithms::{crba_base, Algorithm, ExternalWrench, LoadFrame, Loads};
 use kanegen_core::linalg::Vec3;
+use kanegen_core::metrics::rel_err_mat as rel_err;
 use kanegen_core::model::{Chain, JointKind};
 use kanegen_core::random::{random_chain, random_vec, rng, ChainSpec};
 use nalgebra::{DMatrix, Matrix3, Vector3};
 
 type Mat = Vec<Vec<f64>>;
-
-/// max |x − y| / max |y| over all entries.
-fn rel_err(x: &[Vec<f64>], y: &[Vec<f64>]) -> f64 {
-    let mut num: f64 = 0.0;
-    let mut den: f64 = 0.0;
-    for (rx, ry) in x.iter().zip(y) {
-        assert_eq!(rx.len(), ry.len());
-        for (a, b) in rx.iter().zip(ry) {
-            num = num.max((a - b).abs());
-            den = den.max(b.abs());
-        }
-    }
-    num / den
-}
 
 /// max |x − y| / max(max |y|, 1): `b` vanishes identically for some chains (one body, no loads),
 /// where a purely relative error would compare rounding noise; typical entries here are 10–1000.

@@ -20,6 +20,7 @@
 use kanegen_core::algorithms::{kane_direct, spatial, ExternalWrench, LoadFrame, Loads};
 use kanegen_core::dual::Dual;
 use kanegen_core::linalg::{axis_rotation, Mat3, Vec3};
+use kanegen_core::metrics::{flatten as flat, rel_err};
 use kanegen_core::model::{Chain, ChainParams, JointKind};
 use kanegen_core::random::{random_chain, random_vec, rng, ChainSpec};
 use kanegen_core::Scalar;
@@ -217,21 +218,6 @@ fn virtual_power_forces(chain: &Chain, q: &[f64], ext: &[ExternalWrench<f64>]) -
 // ---------------------------------------------------------------------------------------------
 // Helpers.
 // ---------------------------------------------------------------------------------------------
-
-fn rel_err(x: &[f64], y: &[f64]) -> f64 {
-    assert_eq!(x.len(), y.len());
-    let num = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let den = y.iter().map(|b| b.abs()).fold(0.0, f64::max);
-    num / den
-}
-
-fn flat(a: &[Vec<f64>]) -> Vec<f64> {
-    a.iter().flatten().copied().collect()
-}
 
 fn chain(n: usize, seed: u64) -> Chain {
     random_chain(
