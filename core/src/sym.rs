@@ -65,9 +65,10 @@ use std::sync::atomic::{AtomicU32, Ordering};
 ///
 /// All arithmetic on `Sym` is recorded (and counted) in the thread's graph. Using a `Sym` after its
 /// tracer was dropped or finished, or with no tracer active, panics. There is deliberately no
-/// comparison of values: `==` on `Sym` is node identity (after folding and hash-consing, so
-/// `a * b == b * a`), never a numeric comparison, and there is no ordering.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// comparison at all (no `PartialEq`, no ordering), so a traced computation cannot branch on its
+/// values; tools that need node identity (after folding and hash-consing `a * b` and `b * a` are
+/// the same node) compare [`Sym::id`].
+#[derive(Clone, Copy, Debug)]
 pub struct Sym {
     id: u32,
     gen: u32,
@@ -93,7 +94,7 @@ impl Sym {
 }
 
 /// One node of a frozen graph, as seen by a code emitter.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug)]
 pub enum Node {
     /// A constant.
     Const(f64),
