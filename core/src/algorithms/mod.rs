@@ -201,6 +201,7 @@ impl core::fmt::Display for Algorithm {
 }
 
 pub mod crba_base;
+pub mod floating;
 pub mod kane_direct;
 pub mod kinematics;
 pub mod recurrent;
