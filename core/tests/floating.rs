@@ -569,3 +569,144 @@ fn generalized_jacobian_gives_the_end_effector_motion_at_zero_momentum() {
     }
     println!("J* q̇ vs end-effector motion at zero momentum: {worst:.2e}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Gravity, and tracing on `Sym`.
+// ---------------------------------------------------------------------------------------------
+
+#[test]
+fn uniform_gravity_is_a_base_acceleration() {
+    // A uniform field g is indistinguishable from accelerating the base by g: the generalized
+    // gravity force is b(g) − b(0) = A[:, 0..3] R₀ᵀ g in every state, so at rest
+    // ν̇ = [R₀ᵀ g; 0; 0].
+    for n in [1, 3, 8] {
+        let c = random_case(n, 2000 + n as u64, 0.3, false);
+        let g = Vec3::new(0.3, -1.2, -9.81);
+        let with_g = Loads {
+            gravity: Some(g.clone()),
+            ..Loads::default()
+        };
+        let gb = c.state.rotation.tr_mul_vec(&g);
+        for alg in ALGS {
+            let d0 = floating_dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &c.loads);
+            let d1 = floating_dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &with_g);
+            let diff: Vec<f64> = d1.b.iter().zip(&d0.b).map(|(x, y)| x - y).collect();
+            let want: Vec<f64> =
+                d0.a.iter()
+                    .map(|row| (0..3).map(|m| row[m] * gb.at(m)).sum())
+                    .collect();
+            let e = rel_vec(&diff, &want);
+            assert!(e < 1e-12, "n={n} {alg}: {e:e}");
+            let rest = FloatingState {
+                v_b: Vec3::zero(),
+                omega_b: Vec3::zero(),
+                ..c.state.clone()
+            };
+            let zeros = vec![0.0; n];
+            let acc = floating_forward_dynamics(alg, &c.p, &c.base, &rest, &c.q, &zeros, &with_g);
+            let mut want = gb.0.to_vec();
+            want.extend(vec![0.0; 3 + n]);
+            let e = acc
+                .iter()
+                .zip(&want)
+                .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()));
+            assert!(e < 1e-11, "n={n} {alg}: at rest {e:e}");
+        }
+    }
+}
+
+#[test]
+fn floating_dynamics_traces_on_sym() {
+    use kanegen_core::sym::{trace, Convention, Sym};
+    use kanegen_core::Scalar;
+    let n = 6;
+    let c = random_case(n, 31, 0.0, true);
+    let (a_num, b_num) = dynamics(Algorithm::Recurrent, &c);
+    for alg in ALGS {
+        let mut inputs: Vec<f64> = Vec::new();
+        let t = trace(|t| {
+            let mut inp = |name: String, x: f64| {
+                inputs.push(x);
+                t.input(name)
+            };
+            let q: Vec<Sym> = (0..n).map(|i| inp(format!("q{i}"), c.q[i])).collect();
+            let qd: Vec<Sym> = (0..n).map(|i| inp(format!("qd{i}"), c.qd[i])).collect();
+            let vec_in = |name: &str, v: &Vec3<f64>, inp: &mut dyn FnMut(String, f64) -> Sym| {
+                Vec3(core::array::from_fn(|i| inp(format!("{name}{i}"), v.at(i))))
+            };
+            let position = vec_in("p", &c.state.position, &mut inp);
+            let v_b = vec_in("v", &c.state.v_b, &mut inp);
+            let omega_b = vec_in("w", &c.state.omega_b, &mut inp);
+            let rotation = Mat3(core::array::from_fn(|r| {
+                core::array::from_fn(|k| inp(format!("R{r}{k}"), c.state.rotation.at(r, k)))
+            }));
+            let state = FloatingState {
+                position,
+                rotation,
+                v_b,
+                omega_b,
+            };
+            let base = FloatingBase {
+                mass: Sym::constant(c.base.mass),
+                com: Vec3(c.base.com.0.map(Sym::constant)),
+                inertia_com: Mat3(c.base.inertia_com.0.map(|r| r.map(Sym::constant))),
+            };
+            let p = ChainParams {
+                joints: c
+                    .p
+                    .joints
+                    .iter()
+                    .map(|j| kanegen_core::model::JointParams {
+                        kind: j.kind,
+                        l: Vec3(j.l.0.map(Sym::constant)),
+                        upsilon: Mat3(j.upsilon.0.map(|r| r.map(Sym::constant))),
+                        axis: Vec3(j.axis.0.map(Sym::constant)),
+                        mass: Sym::constant(j.mass),
+                        com: Vec3(j.com.0.map(Sym::constant)),
+                        inertia_com: Mat3(j.inertia_com.0.map(|r| r.map(Sym::constant))),
+                    })
+                    .collect(),
+            };
+            let loads = Loads {
+                tau: c
+                    .loads
+                    .tau
+                    .as_ref()
+                    .map(|t| t.iter().map(|x| Sym::constant(*x)).collect()),
+                gravity: c
+                    .loads
+                    .gravity
+                    .as_ref()
+                    .map(|g| Vec3(g.0.map(Sym::constant))),
+                external: c
+                    .loads
+                    .external
+                    .iter()
+                    .map(|e| ExternalWrench {
+                        body: e.body,
+                        frame: e.frame,
+                        force: Vec3(e.force.0.map(Sym::constant)),
+                        moment: Vec3(e.moment.0.map(Sym::constant)),
+                    })
+                    .collect(),
+            };
+            let d = floating_dynamics(alg, &p, &base, &state, &q, &qd, &loads);
+            d.a.into_iter().flatten().chain(d.b).collect()
+        });
+        let out = t.eval(&inputs);
+        let m = 6 + n;
+        let a: Vec<Vec<f64>> = (0..m).map(|i| out[i * m..(i + 1) * m].to_vec()).collect();
+        let b = &out[m * m..];
+        assert!(
+            rel_mat(&a, &a_num) < 1e-12 && rel_vec(b, &b_num) < 1e-12,
+            "{alg}"
+        );
+        let k = t.counts(Convention::ALL[1]);
+        println!(
+            "N = {n} floating, {alg:13}: {} m + {} a ({})",
+            k.mul,
+            k.add,
+            Convention::ALL[1].name()
+        );
+    }
+}
