@@ -710,3 +710,38 @@ fn floating_dynamics_traces_on_sym() {
         );
     }
 }
+
+#[test]
+fn wrench_on_the_last_body_is_its_jacobian_transpose() {
+    // Virtual power: a wrench (f at a point of the last body, moment m), inertial frame, adds
+    // Jᵀ [f; m] to b, J the point's (6+N)-column Jacobian.
+    use kanegen_core::algorithms::floating::point_jacobian;
+    for n in [1, 2, 5, 9] {
+        let c = random_case(n, 3000 + n as u64, 0.3, false);
+        let mut r = rng(n as u64 + 11);
+        let f = v3(&random_vec(&mut r, 3, 10.0));
+        let m = v3(&random_vec(&mut r, 3, 10.0));
+        // Force at O_last (point 0).
+        let j = point_jacobian(&c.p, &c.base, &c.state, &c.q, &Vec3::zero());
+        let w: Vec<f64> = f.0.iter().chain(m.0.iter()).copied().collect();
+        let want: Vec<f64> = (0..6 + n)
+            .map(|col| (0..6).map(|row| j[row][col] * w[row]).sum())
+            .collect();
+        let loads = Loads {
+            external: vec![ExternalWrench {
+                body: n - 1,
+                frame: LoadFrame::Base,
+                force: f.clone(),
+                moment: m.clone(),
+            }],
+            ..Loads::default()
+        };
+        for alg in ALGS {
+            let d0 = floating_dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &c.loads);
+            let d1 = floating_dynamics(alg, &c.p, &c.base, &c.state, &c.q, &c.qd, &loads);
+            let diff: Vec<f64> = d1.b.iter().zip(&d0.b).map(|(x, y)| x - y).collect();
+            let e = rel_vec(&diff, &want);
+            assert!(e < 1e-11, "n={n} {alg}: {e:e}");
+        }
+    }
+}
