@@ -136,16 +136,32 @@ pub fn bias<S: Scalar>(p: &ChainParams<S>, q: &[S], qd: &[S], loads: &Loads<S>) 
     let kin = kinematics::base_frame(p, q);
     let mot = kinematics::motion(&kin, qd);
     let fie = kinematics::inertial_external(&kin, &mot, loads);
-    let pv = partial_velocities(&kin);
+    bias_base(&kin, &fie, loads.tau.as_deref())
+}
+
+/// The direct sum (10) from base-frame inputs: the kinematics `kin` of eq. (1), (2), (6), the
+/// resultants `fie[j] = (f^IE_j, m^IE_j)` of eq. (11) and the joint drives `tau` (added when
+/// present). Section `"(10)"` (the partial velocities are traced under `"(3)"`).
+pub fn bias_base<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    fie: &[(Vec3<S>, Vec3<S>)],
+    tau: Option<&[S]>,
+) -> Vec<S> {
+    let n = kin.len();
+    assert_eq!(fie.len(), n, "fie has the wrong length");
+    if let Some(tau) = tau {
+        assert_eq!(tau.len(), n, "tau has the wrong length");
+    }
+    let pv = partial_velocities(kin);
     S::section("(10)");
     let mut b = vec![S::zero(); n];
-    for (pvj, (f, m)) in pv.iter().zip(&fie) {
+    for (pvj, (f, m)) in pv.iter().zip(fie) {
         for (l, (tl, rl)) in pvj.t.iter().zip(&pvj.r).enumerate() {
             // (10) b += T_jᵀ f^IE_j + R_jᵀ m^IE_j   (columns l ≤ j)
             b[l] = b[l].clone() + tl.dot(f) + rl.dot(m);
         }
     }
-    if let Some(tau) = &loads.tau {
+    if let Some(tau) = tau {
         for (bj, tj) in b.iter_mut().zip(tau) {
             // (10) + T^rel(j)ᵀ f^J(j) + R^rel(j)ᵀ m^J(j): the drive along the unit joint axis.
             *bj = bj.clone() + tj.clone();

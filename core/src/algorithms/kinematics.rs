@@ -12,6 +12,7 @@
 //! | `m_j`, `c_j`, `I_j` (eq. 6, about `O_j`) | `m`, `c`, `inertia` |
 //! | `ω_j`, `v_j`, `ε_j`, `w_j` (eq. 3–5) | [`BodyMotion`] |
 
+use crate::algorithms::floating::{FloatingBase, FloatingState};
 use crate::algorithms::{LoadFrame, Loads};
 use crate::linalg::{axis_rotation, Mat3, Vec3};
 use crate::model::{ChainParams, JointKind};
@@ -67,9 +68,22 @@ pub fn body_inertia_about_origin<S: Scalar>(
 /// Eq. (1), (2), (6): orientations, joint-to-joint vectors, axes and inertial quantities of every
 /// body in the base frame.
 pub fn base_frame<S: Scalar>(p: &ChainParams<S>, q: &[S]) -> Vec<BodyKinematics<S>> {
+    base_frame_from(p, q, None)
+}
+
+/// [`base_frame`] with the base body's orientation `τ_{-1}` given: `None` is the fixed base
+/// (`τ_{-1} = 1`, the base frame is the reference frame); `Some(R₀)` expresses every quantity in
+/// the frame in which the base frame has orientation `R₀` (the inertial frame of a free-floating
+/// base, see [`crate::algorithms::floating`]). Vectors `r_{j-1,j}` stay relative, so `r_{-1,0}`
+/// starts at the base-frame origin.
+pub fn base_frame_from<S: Scalar>(
+    p: &ChainParams<S>,
+    q: &[S],
+    tau_base: Option<&Mat3<S>>,
+) -> Vec<BodyKinematics<S>> {
     assert_eq!(q.len(), p.dof(), "q has the wrong length");
     let mut out: Vec<BodyKinematics<S>> = Vec::with_capacity(p.dof());
-    let mut tau_prev = Mat3::identity();
+    let mut tau_prev = tau_base.cloned().unwrap_or_else(Mat3::identity);
     S::section("(1)-(2)");
     for (jp, qj) in p.joints.iter().zip(q) {
         // (1) τ̂_j = τ_{j-1} Υ_{j-1}
@@ -109,13 +123,27 @@ pub fn e_matrix<S: Scalar>(m: &BodyMotion<S>) -> Mat3<S> {
     Mat3::skew(&m.eps) + wt.mul_mat(&wt)
 }
 
-/// Eq. (3)–(5): velocities and the velocity-product accelerations, fixed base.
+/// Eq. (3)–(5): velocities and the velocity-product accelerations, fixed base
+/// (`motion_from(kin, qd, None)`).
 pub fn motion<S: Scalar>(kin: &[BodyKinematics<S>], qd: &[S]) -> Vec<BodyMotion<S>> {
+    motion_from(kin, qd, None)
+}
+
+/// Eq. (3)–(5) starting from the motion of the base body ("body −1"): `None` is the fixed base
+/// (`ω_{-1} = v_{-1} = ε_{-1} = w_{-1} = 0`, not traced at all, so the fixed-base operation count
+/// is unchanged); `Some(m)` a moving base whose `m.v` is the velocity of the base-frame origin,
+/// `m.eps`, `m.w` the parts of its angular and linear acceleration not proportional to the
+/// generalized accelerations (for a free-floating base: [`floating_base_motion`]).
+pub fn motion_from<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    qd: &[S],
+    initial: Option<&BodyMotion<S>>,
+) -> Vec<BodyMotion<S>> {
     assert_eq!(qd.len(), kin.len(), "qd has the wrong length");
     S::section("(3)-(5)");
     let mut out: Vec<BodyMotion<S>> = Vec::with_capacity(kin.len());
     for (j, (k, qdj)) in kin.iter().zip(qd).enumerate() {
-        let prev = if j == 0 { None } else { Some(&out[j - 1]) };
+        let prev = if j == 0 { initial } else { Some(&out[j - 1]) };
         let rel = k.a.scale(qdj);
         let (w_rel, v_rel) = match k.kind {
             JointKind::Revolute => (Some(rel), None),
@@ -189,4 +217,100 @@ pub fn inertial_external<S: Scalar>(
             (f, n)
         })
         .collect()
+}
+
+/// Number of generalized speeds of a free-floating base (3 linear, then 3 angular).
+pub const FLOATING_BASE_DOF: usize = 6;
+
+/// Eq. (1), (2), (6) for a free-floating base, in the inertial frame: the base as six virtual
+/// joints in front of the arm, then the arm's bodies (indices `6..6+N`).
+///
+/// The base's generalized speeds `ν_b = [v_b; ω_b]` (base coordinates) give every body `k` the
+/// partial velocities (linear `T`, angular `R` columns, inertial frame, `e_m` the unit vectors):
+/// for `v_b,m`: `T = R₀e_m`, `R = 0` — a prismatic joint with axis `R₀e_m`; for `ω_b,m`:
+/// `R = R₀e_m`, `T = (R₀e_m) × r_{base,k}` — a revolute joint with axis `R₀e_m` through the base
+/// origin `p₀`. Virtual joints `0..3` are those prismatic joints, `3..6` those revolute joints,
+/// all at `q = 0` with `r = 0` between them (virtual body 0 stores `r = p₀`, its position from
+/// the inertial origin, which no recursion reads). All six virtual bodies have the base's
+/// orientation `τ = R₀`; bodies `0..5` are massless and body 5 carries the base body's inertia,
+/// so the base-frame algorithms' prismatic/revolute formulas give the `(6+N)×(6+N)` matrix `A`
+/// with no change. Because each virtual axis is `R₀e_m`, a row `a·F` of an inertial-frame
+/// vector `F` is directly its base-coordinate component `(R₀ᵀF)_m`.
+pub fn floating_base_frame<S: Scalar>(
+    p: &ChainParams<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+) -> Vec<BodyKinematics<S>> {
+    S::section("floating:base");
+    let r0 = &state.rotation;
+    let mut out: Vec<BodyKinematics<S>> = Vec::with_capacity(FLOATING_BASE_DOF + p.dof());
+    let (c_local, i_local) = body_inertia_about_origin(&base.mass, &base.com, &base.inertia_com);
+    for m in 0..FLOATING_BASE_DOF {
+        let carries = m == FLOATING_BASE_DOF - 1;
+        out.push(BodyKinematics {
+            kind: if m < 3 {
+                JointKind::Prismatic
+            } else {
+                JointKind::Revolute
+            },
+            tau: r0.clone(),
+            r: if m == 0 {
+                state.position.clone()
+            } else {
+                Vec3::zero()
+            },
+            a: r0.col(m % 3),
+            m: if carries {
+                base.mass.clone()
+            } else {
+                S::zero()
+            },
+            c: if carries {
+                r0.mul_vec(&c_local)
+            } else {
+                Vec3::zero()
+            },
+            inertia: if carries {
+                r0.congruence(&i_local)
+            } else {
+                Mat3::zero()
+            },
+        });
+    }
+    out.extend(base_frame_from(p, q, Some(r0)));
+    out
+}
+
+/// The true motion of a free-floating base body, inertial frame: `ω₀ = R₀ω_b`, `v₀ = R₀v_b`,
+/// `ε₀ = 0` (because `d/dt(R₀ω_b) = R₀ω̇_b + R₀(ω_b × ω_b) = R₀ω̇_b`) and `w₀ = ω₀ × v₀`
+/// (because `d/dt(R₀v_b) = R₀v̇_b + ω₀ × v₀`). This — not the composition of the virtual joints'
+/// rates, which would add spurious `ω × ω^rel` terms — starts the recursion (3)–(5) of the arm.
+pub fn floating_base_motion<S: Scalar>(state: &FloatingState<S>) -> BodyMotion<S> {
+    let omega = state.rotation.mul_vec(&state.omega_b);
+    let v = state.rotation.mul_vec(&state.v_b);
+    let w = omega.cross(&v);
+    BodyMotion {
+        omega,
+        v,
+        eps: Vec3::zero(),
+        w,
+    }
+}
+
+/// Eq. (3)–(5) for the extended bodies of [`floating_base_frame`]: the six virtual bodies move
+/// with the base body ([`floating_base_motion`]), the arm's bodies follow by [`motion_from`].
+pub fn floating_motion<S: Scalar>(
+    kin: &[BodyKinematics<S>],
+    state: &FloatingState<S>,
+    qd: &[S],
+) -> Vec<BodyMotion<S>> {
+    assert!(
+        kin.len() >= FLOATING_BASE_DOF,
+        "not a floating-base body list"
+    );
+    let m0 = floating_base_motion(state);
+    let mut out = vec![m0.clone(); FLOATING_BASE_DOF];
+    out.extend(motion_from(&kin[FLOATING_BASE_DOF..], qd, Some(&m0)));
+    out
 }

@@ -11,6 +11,10 @@
 //! | `kane-direct`   | `kane_direct.rs`   | the direct sums (9)–(11), O(N³)                           |
 //! | `crba-base`     | `crba_base.rs`     | composite-rigid-body algorithm in base-frame notation     |
 //! | `spatial`       | `spatial.rs`       | Featherstone's local-frame spatial CRBA + RNEA            |
+//!
+//! A free-floating base (6 + N speeds, issue #5) is in [`floating`]: the first four algorithms run
+//! on the base-as-six-virtual-joints extension of their base-frame inputs, `spatial` has its own
+//! floating-base CRBA + RNEA ([`spatial::floating_dynamics`]).
 
 use crate::linalg::Vec3;
 use crate::model::ChainParams;
@@ -201,6 +205,7 @@ impl core::fmt::Display for Algorithm {
 }
 
 pub mod crba_base;
+pub mod floating;
 pub mod kane_direct;
 pub mod kinematics;
 pub mod recurrent;

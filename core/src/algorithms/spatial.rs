@@ -364,3 +364,197 @@ pub fn bias<S: Scalar>(p: &ChainParams<S>, q: &[S], qd: &[S], loads: &Loads<S>) 
     }
     b
 }
+
+/// Featherstone's floating-base dynamics (RBDA §9.3, Table 9.6 / spatial_v2 `HandC` with a
+/// floating base), an implementation independent of the virtual-joint extension of
+/// [`crate::algorithms::floating`], with that module's conventions.
+///
+/// The base is body 0 with a 6-dof joint whose motion subspace is `1₆` in base coordinates: its
+/// spatial velocity in base coordinates is `[ω_b; v_b]` and, as `v × v = 0`, its spatial
+/// acceleration in base coordinates is the derivative of those components, `[ω̇_b; v̇_b]` — so
+/// the base speeds of `ν = [v_b; ω_b; q̇]` are the base joint's speeds reordered.
+///
+/// - `A`: composite inertias `IC_j` of the arm (RBDA Table 6.2); the base block is the composite
+///   inertia of the whole tree `IC_0 = I_base + Xup_0ᵀ IC_arm,0 Xup_0` applied to unit motions;
+///   the arm columns `F = IC_i S_i` are carried down to the base, `A_bi = F` (rows `[f; n]`).
+/// - `b`: RNEA with `ν̇ = 0`: base `v_0 = [ω_b; v_b]`, `a_0 = [0; −R₀ᵀ g]` (gravity as a
+///   fictitious base acceleration, RBDA §5.3), `fvp_0 = I_0 a_0 + v_0 ×* I_0 v_0 − f^x_0`, the arm
+///   as in [`bias`], `fvp_0 += Xup_0ᵀ fvp_arm,0`; then `b_base = −[fvp_0.f; fvp_0.n]`,
+///   `b_arm,j = τ_j − S_jᵀ fvp_j`. Inertial-frame wrenches are rotated into body coordinates
+///   with `E_{0j} R₀ᵀ`. Section `"spatial:floating"`.
+pub fn floating_dynamics<S: Scalar>(
+    p: &ChainParams<S>,
+    base: &crate::algorithms::floating::FloatingBase<S>,
+    state: &crate::algorithms::floating::FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+) -> crate::algorithms::Dynamics<S> {
+    use crate::algorithms::floating::BASE_BODY;
+    let n = p.dof();
+    assert_eq!(q.len(), n, "q has the wrong length");
+    assert_eq!(qd.len(), n, "qd has the wrong length");
+    if let Some(tau) = &loads.tau {
+        assert_eq!(tau.len(), n, "loads.tau has the wrong length");
+    }
+    assert!(
+        loads
+            .external
+            .iter()
+            .all(|e| e.body < n || e.body == BASE_BODY),
+        "an external wrench names a body past the end of the chain"
+    );
+    S::section("spatial:floating");
+    let nb = 6;
+    let xup: Vec<Xform<S>> = p.joints.iter().zip(q).map(|(jp, qj)| xup(jp, qj)).collect();
+    let ct = Mat3::skew(&base.com);
+    let i_base = RbInertia {
+        m: base.mass.clone(),
+        h: base.com.scale(&base.mass),
+        ibar: base.inertia_com.clone() + ct.mul_mat(&ct.transpose()).scale(&base.mass),
+    };
+
+    // ---- A ----
+    let mut ic: Vec<RbInertia<S>> = p.joints.iter().map(RbInertia::mci).collect();
+    for i in (1..n).rev() {
+        let carried = xup[i].tr_inertia(&ic[i]);
+        let parent = ic[i - 1].clone();
+        ic[i - 1] = parent.add(carried);
+    }
+    let ic0 = if n > 0 {
+        i_base.clone().add(xup[0].tr_inertia(&ic[0]))
+    } else {
+        i_base.clone()
+    };
+    let mut a = vec![vec![S::zero(); nb + n]; nb + n];
+    // Base block: column m of ν_b is the unit motion [0; e_m] (m < 3) or [e_{m−3}; 0].
+    let unit = |m: usize| {
+        let mut e = Vec3::zero();
+        e.0[m % 3] = S::one();
+        if m < 3 {
+            Motion {
+                ang: Vec3::zero(),
+                lin: e,
+            }
+        } else {
+            Motion {
+                ang: e,
+                lin: Vec3::zero(),
+            }
+        }
+    };
+    let rows = |f: &Force<S>| -> [S; 6] {
+        [
+            f.lin.at(0),
+            f.lin.at(1),
+            f.lin.at(2),
+            f.ang.at(0),
+            f.ang.at(1),
+            f.ang.at(2),
+        ]
+    };
+    #[allow(clippy::needless_range_loop)] // a[i][m] and a[m][i] are both written
+    for m in 0..nb {
+        let col = rows(&ic0.mul(&unit(m)));
+        // Upper triangle, mirrored (IC_0 is symmetric; mirroring makes A exactly so).
+        for (i, x) in col.into_iter().enumerate().take(m + 1) {
+            a[m][i] = x.clone();
+            a[i][m] = x;
+        }
+    }
+    for i in 0..n {
+        let mut f = inertia_s(&ic[i], &p.joints[i]);
+        a[nb + i][nb + i] = s_tr(&p.joints[i], &f);
+        let mut j = i;
+        loop {
+            f = xup[j].tr_apply(&f);
+            if j == 0 {
+                break;
+            }
+            j -= 1;
+            let hij = s_tr(&p.joints[j], &f);
+            a[nb + j][nb + i] = hij.clone();
+            a[nb + i][nb + j] = hij;
+        }
+        for (r, x) in rows(&f).into_iter().enumerate() {
+            a[r][nb + i] = x.clone();
+            a[nb + i][r] = x;
+        }
+    }
+
+    // ---- b ----
+    let r0t = state.rotation.transpose();
+    let v0 = Motion {
+        ang: state.omega_b.clone(),
+        lin: state.v_b.clone(),
+    };
+    let a0 = match &loads.gravity {
+        Some(g) => Motion {
+            ang: Vec3::zero(),
+            lin: -r0t.mul_vec(g),
+        },
+        None => Motion::zero(),
+    };
+    let ext_force = |body: usize, e0: &Mat3<S>| {
+        let mut f: Option<Force<S>> = None;
+        for ext in loads.external.iter().filter(|e| e.body == body) {
+            let fx = match ext.frame {
+                LoadFrame::Body => Force {
+                    ang: ext.moment.clone(),
+                    lin: ext.force.clone(),
+                },
+                LoadFrame::Base => Force {
+                    ang: e0.mul_vec(&ext.moment),
+                    lin: e0.mul_vec(&ext.force),
+                },
+            };
+            f = Some(match f {
+                None => fx,
+                Some(acc) => acc + fx,
+            });
+        }
+        f
+    };
+    let mut f0 = i_base.mul(&a0) + v0.crf(&i_base.mul(&v0));
+    if let Some(fx) = ext_force(BASE_BODY, &r0t) {
+        f0 = f0 - fx;
+    }
+    let mut v_prev = v0;
+    let mut a_prev = a0;
+    let mut e0_prev = r0t;
+    let mut fvp: Vec<Force<S>> = Vec::with_capacity(n);
+    for (j, (jp, qdj)) in p.joints.iter().zip(qd).enumerate() {
+        let x = &xup[j];
+        let vj = s_times(jp, qdj);
+        let v = x.apply(&v_prev) + vj.clone();
+        let avp = x.apply(&a_prev) + v.crm(&vj);
+        let inertia = RbInertia::mci(jp);
+        let mut f = inertia.mul(&avp) + v.crf(&inertia.mul(&v));
+        e0_prev = x.e.mul_mat(&e0_prev);
+        if let Some(fx) = ext_force(j, &e0_prev) {
+            f = f - fx;
+        }
+        fvp.push(f);
+        v_prev = v;
+        a_prev = avp;
+    }
+    let mut b = vec![S::zero(); nb + n];
+    for j in (0..n).rev() {
+        let c = s_tr(&p.joints[j], &fvp[j]);
+        b[nb + j] = match &loads.tau {
+            Some(tau) => tau[j].clone() - c,
+            None => -c,
+        };
+        let carried = xup[j].tr_apply(&fvp[j]);
+        if j > 0 {
+            let parent = fvp[j - 1].clone();
+            fvp[j - 1] = parent + carried;
+        } else {
+            f0 = f0 + carried;
+        }
+    }
+    for (bi, x) in b.iter_mut().zip(rows(&f0)) {
+        *bi = -x;
+    }
+    crate::algorithms::Dynamics { a, b }
+}
