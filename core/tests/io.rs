@@ -765,3 +765,21 @@ fn random_dh_arms_agree_across_conventions() {
         assert_same_dynamics(&x, &s, 1e-12);
     }
 }
+
+#[test]
+fn to_toml_round_trips_random_chains_exactly() {
+    use kanegen_core::random::{random_chain, ChainSpec};
+    for seed in 0..20 {
+        let spec = ChainSpec { n: 1 + seed as usize % 9, prismatic_fraction: 0.3, ..Default::default() };
+        let chain = random_chain(&spec, seed);
+        let text = kanegen_core::io::to_toml(&chain);
+        let back = kanegen_core::io::parse_toml(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(back, chain, "seed {seed}");
+    }
+    let ssrms = kanegen_core::io::load_model(std::path::Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../models/ssrms.toml"
+    )))
+    .unwrap();
+    assert_eq!(kanegen_core::io::parse_toml(&kanegen_core::io::to_toml(&ssrms)).unwrap(), ssrms);
+}

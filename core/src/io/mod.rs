@@ -20,12 +20,14 @@
 mod frames;
 mod toml_model;
 mod urdf;
+mod write;
 
 use crate::model::{Chain, ModelError, Validation};
 use std::path::Path;
 
 pub use toml_model::parse_toml;
 pub use urdf::{parse_urdf, parse_urdf_with};
+pub use write::to_toml;
 
 /// Reads a model file, choosing the reader by extension: `.urdf` ([`parse_urdf`]) or `.toml`
 /// ([`parse_toml`]). Parse errors are prefixed with the file name.
