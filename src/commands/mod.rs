@@ -2,4 +2,5 @@
 
 pub mod count;
 pub mod eval;
+pub mod generate;
 pub mod table1;
