@@ -18,6 +18,10 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+// The files are written by prettyplease; rustfmt leaves them as generated.
+#[rustfmt::skip]
 pub mod srms;
+#[rustfmt::skip]
 pub mod ssrms;
+#[rustfmt::skip]
 pub mod ssrms6;
