@@ -790,3 +790,6 @@ pub fn generate_file(chain: &Chain, opts: &Options) -> Result<String, Error> {
         syn::parse2(file).map_err(|e| Error(format!("generated code does not parse: {e}")))?;
     Ok(prettyplease::unparse(&parsed))
 }
+
+/// The core crate, re-exported for the proc-macro (models, readers, validation).
+pub use kanegen_core;
