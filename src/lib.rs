@@ -11,3 +11,20 @@ pub mod states;
 pub mod table1;
 
 pub use kanegen_core::*;
+
+/// Unrolled, allocation-free dynamics of a fixed model, generated at compile time; see
+/// [`kanegen_macros::dynamics!`] and the README section "Code generation".
+///
+/// ```
+/// kanegen::dynamics!(TwoLink, "models/two_link.toml");
+/// let a = TwoLink::mass_matrix(&[0.1, 0.2]);
+/// assert_eq!(TwoLink::N, 2);
+/// assert_eq!(a[0][1], a[1][0]);
+/// ```
+pub use kanegen_macros::dynamics;
+
+/// Support for the code emitted by [`dynamics!`]; not a public API.
+#[doc(hidden)]
+pub mod __private {
+    pub use libm;
+}

@@ -74,6 +74,29 @@ enum Command {
         #[arg(long)]
         allow_nonphysical: bool,
     },
+    /// Emit unrolled, allocation-free, no_std Rust for a model (stdout, or -o FILE).
+    Generate {
+        /// Model file (.urdf or .toml).
+        model: PathBuf,
+        /// Output file (stdout when absent).
+        #[arg(short, long)]
+        output: Option<PathBuf>,
+        /// Gravity X,Y,Z in the base frame, m/s² (none: space, no gravity code).
+        #[arg(long, allow_hyphen_values = true)]
+        gravity: Option<String>,
+        /// Make the last body's mass, centre of mass and inertia a runtime `payload` argument.
+        #[arg(long)]
+        runtime_payload: bool,
+        /// Name of the generated struct (default: from the model name, in CamelCase).
+        #[arg(long)]
+        name: Option<String>,
+        /// Lock joint INDEX at VALUE (rad or m) before generating: `--lock 1=0`.
+        #[arg(long)]
+        lock: Vec<String>,
+        /// Accept inertia tensors that violate the triangle inequality.
+        #[arg(long)]
+        allow_nonphysical: bool,
+    },
 }
 
 fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<kanegen::Chain> {
@@ -143,6 +166,35 @@ fn main() -> Result<()> {
                 println!("{}", serde_json::to_string_pretty(&r)?);
             } else {
                 print!("{}", commands::count::render_text(&r));
+            }
+        }
+        Command::Generate {
+            model,
+            output,
+            gravity,
+            runtime_payload,
+            name,
+            lock,
+            allow_nonphysical,
+        } => {
+            let mut chain = load(&model, allow_nonphysical)?;
+            for l in &lock {
+                let (i, v) = l
+                    .split_once('=')
+                    .with_context(|| format!("--lock `{l}`: expected INDEX=VALUE"))?;
+                let i: usize = i.trim().parse().with_context(|| format!("--lock `{l}`"))?;
+                let v: f64 = v.trim().parse().with_context(|| format!("--lock `{l}`"))?;
+                chain = chain.lock_joint(i, v)?;
+            }
+            let g = gravity
+                .map(|s| kanegen::states::parse_vec3(&s).context("--gravity"))
+                .transpose()?;
+            let name = name.unwrap_or_else(|| commands::generate::type_name(chain.name()));
+            let code = commands::generate::generate(&chain, &name, g, runtime_payload)?;
+            match output {
+                Some(path) => std::fs::write(&path, code)
+                    .with_context(|| format!("cannot write `{}`", path.display()))?,
+                None => print!("{code}"),
             }
         }
     }

@@ -1,1 +1,795 @@
-//! Code generation from traced `Sym` graphs (issue 4).
+//! # kanegen-codegen
+//!
+//! Unrolled, allocation-free Rust emitted from simplified [`Sym`] graphs, for one fixed chain.
+//!
+//! For every generated function ([`FUNCTIONS`]), every algorithm of [`Algorithm::ALL`] is traced
+//! on [`Sym`] with the model's numbers as constants; the trace with the fewest emitted
+//! operations (`mul + add`, [`Convention::Emitted`]) wins and is emitted:
+//!
+//! * one `let` per shared subexpression (a node used more than once), per expensive node
+//!   (division, square root, sine/cosine) and per output; single-use nodes are inlined into their
+//!   user's expression with the parentheses that keep the graph's evaluation order, so the
+//!   emitted code performs exactly the emitted operation count of the trace;
+//! * sine and cosine of one argument come from one `libm::sincos` call (the path of the `libm`
+//!   crate is an [`Options::libm_path`]), square roots from `libm::sqrt`: the code is `no_std`;
+//! * inputs are fixed-size arrays `&[f64; N]` (`q`, `qd`, `tau`, `qdd`) indexed by constants, and
+//!   with [`Options::runtime_payload`] a `payload: &Payload` (last argument);
+//! * outputs are `[[f64; N]; N]` (the symmetric `A`: upper triangle computed, both written) or
+//!   `[f64; N]`.
+//!
+//! The output is a unit struct with associated constants and functions ([`generate_items`]);
+//! [`generate_file`] wraps it into a formatted module file with a doc header (model, N, joints,
+//! chosen algorithm per function, the op counts of every candidate, generator version).
+#![warn(missing_docs)]
+
+use kanegen_core::linalg::{Mat3, Vec3};
+use kanegen_core::sym::{Convention, Counts, Node, Sym, Trace, Tracer};
+use kanegen_core::{Algorithm, Chain, JointKind, Loads, Scalar};
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+use std::collections::{HashMap, HashSet};
+
+/// Version of the generator, written into every generated header.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Generator options.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Name of the generated unit struct (a Rust identifier, e.g. `Ssrms`).
+    pub type_name: String,
+    /// Uniform gravity in the base frame, m/s². `None` (default): space, no gravity code at all
+    /// and no `gravity` function.
+    pub gravity: Option<[f64; 3]>,
+    /// Make the last body's (the payload's) mass, centre of mass and inertia runtime inputs: every
+    /// function then takes a last argument `payload: &Payload`.
+    pub runtime_payload: bool,
+    /// Path of the `libm` crate in the generated code: `libm` for a crate depending on `libm`,
+    /// `::kanegen::__private::libm` for the output of the `dynamics!` macro.
+    pub libm_path: String,
+    /// Name of the generated payload struct (used with [`Options::runtime_payload`]).
+    pub payload_name: String,
+}
+
+impl Options {
+    /// Defaults: space (no gravity), constant payload, `libm` path `libm`, payload struct
+    /// `Payload`.
+    pub fn new(type_name: impl Into<String>) -> Self {
+        Options {
+            type_name: type_name.into(),
+            gravity: None,
+            runtime_payload: false,
+            libm_path: "libm".into(),
+            payload_name: "Payload".into(),
+        }
+    }
+}
+
+/// An error of the generator.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Error(pub String);
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Error {}
+
+/// An argument of a generated function.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Arg {
+    /// Joint positions `q` (rad or m).
+    Q,
+    /// Joint velocities `q̇`.
+    Qd,
+    /// Joint drives `τ` (N·m or N).
+    Tau,
+    /// Joint accelerations `q̈`.
+    Qdd,
+}
+
+impl Arg {
+    /// The argument's name in generated code.
+    pub fn name(self) -> &'static str {
+        match self {
+            Arg::Q => "q",
+            Arg::Qd => "qd",
+            Arg::Tau => "tau",
+            Arg::Qdd => "qdd",
+        }
+    }
+}
+
+/// A generated function.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Function {
+    /// Its name.
+    pub name: &'static str,
+    /// Its arguments, in order (then `payload` with [`Options::runtime_payload`]).
+    pub args: &'static [Arg],
+    /// Whether it returns the symmetric `N×N` matrix (else an `N`-vector).
+    pub matrix: bool,
+    /// Only generated when the model has gravity.
+    pub needs_gravity: bool,
+    /// Its documentation (first line).
+    pub doc: &'static str,
+}
+
+/// The generated functions, in emission order.
+pub const FUNCTIONS: [Function; 6] = [
+    Function {
+        name: "mass_matrix",
+        args: &[Arg::Q],
+        matrix: true,
+        needs_gravity: false,
+        doc: "The generalized inertia matrix `A(q)` (symmetric, both triangles written).",
+    },
+    Function {
+        name: "bias",
+        args: &[Arg::Q, Arg::Qd, Arg::Tau],
+        matrix: false,
+        needs_gravity: false,
+        doc:
+            "The generalized forces `b = Q − h` of `A q̈ = b`: joint drives `tau` (and gravity when \
+              the model has it) minus the velocity-product terms.",
+    },
+    Function {
+        name: "bias_velocity",
+        args: &[Arg::Q, Arg::Qd],
+        matrix: false,
+        needs_gravity: false,
+        doc: "The velocity part of `b` only: `−h(q, q̇)` (no drives, no gravity).",
+    },
+    Function {
+        name: "gravity",
+        args: &[Arg::Q],
+        matrix: false,
+        needs_gravity: true,
+        doc: "The generalized gravity force only (the gravity part of `Q`).",
+    },
+    Function {
+        name: "inverse_dynamics",
+        args: &[Arg::Q, Arg::Qd, Arg::Qdd],
+        matrix: false,
+        needs_gravity: false,
+        doc: "Inverse dynamics: the drives `τ = A q̈ − b(q, q̇, τ = 0)`.",
+    },
+    Function {
+        name: "forward_dynamics",
+        args: &[Arg::Q, Arg::Qd, Arg::Tau],
+        matrix: false,
+        needs_gravity: false,
+        doc: "Forward dynamics `q̈ = A⁻¹ b(q, q̇, τ)`, by an unrolled branch-free LDLᵀ.",
+    },
+];
+
+/// The functions generated for the given options.
+pub fn functions(opts: &Options) -> impl Iterator<Item = &'static Function> + '_ {
+    FUNCTIONS
+        .iter()
+        .filter(move |f| !f.needs_gravity || opts.gravity.is_some())
+}
+
+/// A traced function: the trace and, per trace input, the Rust expression that reads it.
+pub struct Traced {
+    /// The frozen graph; outputs are the upper triangle (row-major) for matrices.
+    pub trace: Trace,
+    /// `inputs[i]` reads input `i` (e.g. `q[3]`, `payload.com[0]`).
+    pub inputs: Vec<TokenStream>,
+}
+
+/// Traces `f` of `alg` for `chain` under `opts`.
+#[allow(clippy::needless_range_loop)] // the symmetric fill reads best with indices
+pub fn trace_function(chain: &Chain, f: &Function, alg: Algorithm, opts: &Options) -> Traced {
+    let n = chain.dof();
+    let t = Tracer::new();
+    let mut inputs: Vec<TokenStream> = Vec::new();
+    let mut input = |tokens: TokenStream| {
+        let name = tokens.to_string().replace(' ', "");
+        inputs.push(tokens);
+        t.input(name)
+    };
+    let mut p = chain.params::<Sym>();
+    if opts.runtime_payload {
+        let last = p.joints.last_mut().expect("a chain has at least one joint");
+        last.mass = input(quote!(payload.mass));
+        let com: [Sym; 3] = core::array::from_fn(|k| {
+            let k = Literal::usize_unsuffixed(k);
+            input(quote!(payload.com[#k]))
+        });
+        last.com = Vec3(com);
+        // Upper triangle read, mirrored: the tensor is symmetric.
+        let mut i = [[Sym::zero(); 3]; 3];
+        for r in 0..3 {
+            for c in r..3 {
+                let (lr, lc) = (Literal::usize_unsuffixed(r), Literal::usize_unsuffixed(c));
+                let s = input(quote!(payload.inertia[#lr][#lc]));
+                i[r][c] = s;
+                i[c][r] = s;
+            }
+        }
+        last.inertia_com = Mat3(i);
+    }
+    let mut vecs: HashMap<&str, Vec<Sym>> = HashMap::new();
+    for a in f.args {
+        let name = format_ident!("{}", a.name());
+        let v: Vec<Sym> = (0..n)
+            .map(|i| {
+                let i = Literal::usize_unsuffixed(i);
+                input(quote!(#name[#i]))
+            })
+            .collect();
+        vecs.insert(a.name(), v);
+    }
+    let gravity = opts.gravity.map(Vec3::from_f64);
+    let q = &vecs["q"];
+    let out: Vec<Sym> = match f.name {
+        "mass_matrix" => {
+            let a = alg.mass_matrix(&p, q);
+            a.iter()
+                .enumerate()
+                .flat_map(|(i, r)| r[i..].to_vec())
+                .collect()
+        }
+        "bias" => {
+            let loads = Loads {
+                tau: Some(vecs["tau"].clone()),
+                gravity,
+                external: Vec::new(),
+            };
+            alg.bias(&p, q, &vecs["qd"], &loads)
+        }
+        "bias_velocity" => alg.bias(&p, q, &vecs["qd"], &Loads::default()),
+        "gravity" => {
+            let zeros = vec![Sym::zero(); n];
+            let loads = Loads {
+                tau: None,
+                gravity,
+                external: Vec::new(),
+            };
+            alg.bias(&p, q, &zeros, &loads)
+        }
+        "inverse_dynamics" => {
+            let loads = Loads {
+                tau: None,
+                gravity,
+                external: Vec::new(),
+            };
+            alg.inverse_dynamics(&p, q, &vecs["qd"], &vecs["qdd"], &loads)
+        }
+        "forward_dynamics" => {
+            let loads = Loads {
+                tau: Some(vecs["tau"].clone()),
+                gravity,
+                external: Vec::new(),
+            };
+            alg.forward_dynamics(&p, q, &vecs["qd"], &loads)
+        }
+        other => unreachable!("unknown generated function {other}"),
+    };
+    let trace = t.finish(&out);
+    Traced { trace, inputs }
+}
+
+/// The emitted counts of every candidate algorithm for one function, and the winner.
+#[derive(Clone, Debug)]
+pub struct Choice {
+    /// The function.
+    pub function: &'static Function,
+    /// `(algorithm, emitted counts)` for every algorithm of [`Algorithm::ALL`].
+    pub candidates: Vec<(Algorithm, Counts)>,
+    /// The algorithm with the fewest emitted `mul + add` (the first in [`Algorithm::ALL`] order
+    /// on ties).
+    pub chosen: Algorithm,
+}
+
+impl Choice {
+    /// Emitted counts of the chosen algorithm.
+    pub fn counts(&self) -> Counts {
+        self.candidates
+            .iter()
+            .find(|(a, _)| *a == self.chosen)
+            .map(|(_, c)| *c)
+            .unwrap_or_default()
+    }
+}
+
+/// Traces every algorithm for `f` and keeps the cheapest.
+pub fn choose(chain: &Chain, f: &'static Function, opts: &Options) -> (Choice, Traced) {
+    let mut best: Option<(u64, Algorithm, Traced)> = None;
+    let mut candidates = Vec::new();
+    for alg in Algorithm::ALL {
+        let t = trace_function(chain, f, alg, opts);
+        let c = t.trace.counts(Convention::Emitted);
+        candidates.push((alg, c));
+        let better = match &best {
+            None => true,
+            Some((b, _, _)) => c.total() < *b,
+        };
+        if better {
+            best = Some((c.total(), alg, t));
+        }
+    }
+    let (_, chosen, traced) = best.expect("Algorithm::ALL is not empty");
+    (
+        Choice {
+            function: f,
+            candidates,
+            chosen,
+        },
+        traced,
+    )
+}
+
+// ---------------------------------------------------------------------------------------------
+// Emission of one graph.
+
+/// Operator precedence of an emitted expression (higher binds tighter).
+const P_ADD: u8 = 1;
+const P_MUL: u8 = 2;
+const P_NEG: u8 = 3;
+const P_ATOM: u8 = 4;
+
+#[derive(Clone)]
+struct Expr {
+    tokens: TokenStream,
+    prec: u8,
+}
+
+impl Expr {
+    fn atom(tokens: TokenStream) -> Self {
+        Expr {
+            tokens,
+            prec: P_ATOM,
+        }
+    }
+    /// The expression, parenthesized unless it binds at least as tightly as `min`.
+    fn at(&self, min: u8) -> TokenStream {
+        let t = &self.tokens;
+        if self.prec >= min {
+            t.clone()
+        } else {
+            quote!((#t))
+        }
+    }
+}
+
+fn constant(x: f64) -> Expr {
+    if x.is_nan() {
+        return Expr::atom(quote!(f64::NAN));
+    }
+    if x.is_infinite() {
+        return if x > 0.0 {
+            Expr::atom(quote!(f64::INFINITY))
+        } else {
+            Expr::atom(quote!(f64::NEG_INFINITY))
+        };
+    }
+    let lit = Literal::f64_unsuffixed(x.abs());
+    if x.is_sign_negative() && x != 0.0 {
+        Expr {
+            tokens: quote!(-#lit),
+            prec: P_NEG,
+        }
+    } else {
+        Expr::atom(quote!(#lit))
+    }
+}
+
+/// The statements and result expression of one traced function. `matrix`: the outputs are the
+/// upper triangle of a symmetric `n×n` matrix.
+pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> TokenStream {
+    let trace = &t.trace;
+    let sched = trace.schedule();
+    let outputs: HashSet<u32> = trace.outputs().iter().map(|s| s.id()).collect();
+    let nodes: HashMap<u32, Node> = sched.iter().copied().collect();
+    let mut uses: HashMap<u32, usize> = HashMap::new();
+    // Sine and cosine nodes per argument.
+    let mut trig: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
+    for (id, node) in &sched {
+        match *node {
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
+                *uses.entry(a.id()).or_default() += 1;
+                *uses.entry(b.id()).or_default() += 1;
+            }
+            Node::Neg(a) | Node::Sqrt(a) => *uses.entry(a.id()).or_default() += 1,
+            Node::Sin(a) => {
+                *uses.entry(a.id()).or_default() += 1;
+                trig.entry(a.id()).or_default().0 = Some(*id);
+            }
+            Node::Cos(a) => {
+                *uses.entry(a.id()).or_default() += 1;
+                trig.entry(a.id()).or_default().1 = Some(*id);
+            }
+            Node::Const(_) | Node::Input(_) => {}
+        }
+    }
+    let mut exprs: HashMap<u32, Expr> = HashMap::new();
+    let mut stmts: Vec<TokenStream> = Vec::new();
+    let mut counter = 0usize;
+    // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
+    let trig_base = |arg: u32, counter: usize| -> String {
+        match nodes[&arg] {
+            Node::Input(i) => t.inputs[i as usize]
+                .to_string()
+                .chars()
+                .filter(char::is_ascii_alphanumeric)
+                .collect(),
+            _ => format!("{counter}"),
+        }
+    };
+    for (id, node) in &sched {
+        let id = *id;
+        let get = |s: Sym| exprs[&s.id()].clone();
+        let expr = match node {
+            Node::Const(x) => {
+                exprs.insert(id, constant(*x));
+                continue;
+            }
+            Node::Input(i) => {
+                exprs.insert(id, Expr::atom(t.inputs[*i as usize].clone()));
+                continue;
+            }
+            Node::Sin(a) | Node::Cos(a) => {
+                if exprs.contains_key(&id) {
+                    continue; // bound together with its partner by one sincos
+                }
+                let arg = get(*a).tokens;
+                let base = trig_base(a.id(), counter);
+                counter += 1;
+                match trig[&a.id()] {
+                    (Some(s), Some(c)) => {
+                        let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
+                        stmts.push(quote!(let (#sn, #cn) = #libm::sincos(#arg);));
+                        exprs.insert(s, Expr::atom(quote!(#sn)));
+                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                    }
+                    (Some(s), None) => {
+                        let sn = format_ident!("s_{}", base);
+                        stmts.push(quote!(let #sn = #libm::sin(#arg);));
+                        exprs.insert(s, Expr::atom(quote!(#sn)));
+                    }
+                    (None, Some(c)) => {
+                        let cn = format_ident!("c_{}", base);
+                        stmts.push(quote!(let #cn = #libm::cos(#arg);));
+                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                    }
+                    (None, None) => unreachable!("trig node without entry"),
+                }
+                continue;
+            }
+            Node::Add(a, b) => {
+                let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
+                Expr {
+                    tokens: quote!(#a + #b),
+                    prec: P_ADD,
+                }
+            }
+            Node::Sub(a, b) => {
+                let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
+                Expr {
+                    tokens: quote!(#a - #b),
+                    prec: P_ADD,
+                }
+            }
+            Node::Mul(a, b) => {
+                let (a, b) = (get(*a).at(P_MUL), get(*b).at(P_NEG));
+                Expr {
+                    tokens: quote!(#a * #b),
+                    prec: P_MUL,
+                }
+            }
+            Node::Div(a, b) => {
+                let (a, b) = (get(*a).at(P_MUL), get(*b).at(P_NEG));
+                Expr {
+                    tokens: quote!(#a / #b),
+                    prec: P_MUL,
+                }
+            }
+            Node::Neg(a) => {
+                let a = get(*a).at(P_NEG);
+                Expr {
+                    tokens: quote!(-#a),
+                    prec: P_NEG,
+                }
+            }
+            Node::Sqrt(a) => {
+                let a = get(*a).tokens;
+                Expr::atom(quote!(#libm::sqrt(#a)))
+            }
+        };
+        let bind = outputs.contains(&id)
+            || uses.get(&id).copied().unwrap_or(0) > 1
+            || matches!(node, Node::Div(..) | Node::Sqrt(..));
+        if bind {
+            let name = format_ident!("x{}", counter);
+            counter += 1;
+            let e = expr.tokens;
+            stmts.push(quote!(let #name = #e;));
+            exprs.insert(id, Expr::atom(quote!(#name)));
+        } else {
+            exprs.insert(id, expr);
+        }
+    }
+    let out: Vec<TokenStream> = trace
+        .outputs()
+        .iter()
+        .map(|s| exprs[&s.id()].at(P_NEG))
+        .collect();
+    let result = if matrix {
+        // Upper triangle, row-major: index of (i, j), i ≤ j.
+        let idx = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
+        let rows = (0..n).map(|i| {
+            let row = (0..n).map(|j| &out[idx(i.min(j), i.max(j))]);
+            quote!([#(#row),*])
+        });
+        quote!([#(#rows),*])
+    } else {
+        quote!([#(#out),*])
+    };
+    quote!(#(#stmts)* #result)
+}
+
+// ---------------------------------------------------------------------------------------------
+// Whole model.
+
+/// Everything generated for one model.
+pub struct Generated {
+    /// The items: the unit struct, its `impl`, and the payload struct when asked.
+    pub items: TokenStream,
+    /// The doc header lines (without comment markers).
+    pub header: Vec<String>,
+    /// One choice per generated function.
+    pub choices: Vec<Choice>,
+}
+
+fn joint_list(chain: &Chain) -> String {
+    chain
+        .joints()
+        .iter()
+        .map(|j| {
+            let k = match j.kind {
+                JointKind::Revolute => "revolute",
+                JointKind::Prismatic => "prismatic",
+            };
+            format!("`{}` ({k})", j.name)
+        })
+        .collect::<Vec<_>>()
+        .join(", ")
+}
+
+/// Generates the items for `chain`.
+///
+/// # Errors
+/// If an option is not a valid Rust identifier or path.
+pub fn generate_items(chain: &Chain, opts: &Options) -> Result<Generated, Error> {
+    generate_items_with(chain, opts, true)
+}
+
+/// [`generate_items`]; `header_on_struct`: document the struct with the full header (else one
+/// line, for files whose module docs carry the header).
+fn generate_items_with(
+    chain: &Chain,
+    opts: &Options,
+    header_on_struct: bool,
+) -> Result<Generated, Error> {
+    let n = chain.dof();
+    let nl = Literal::usize_unsuffixed(n);
+    let ty: syn::Ident = syn::parse_str(&opts.type_name)
+        .map_err(|e| Error(format!("type name `{}`: {e}", opts.type_name)))?;
+    let payload_ty: syn::Ident = syn::parse_str(&opts.payload_name)
+        .map_err(|e| Error(format!("payload name `{}`: {e}", opts.payload_name)))?;
+    let libm: syn::Path = syn::parse_str(&opts.libm_path)
+        .map_err(|e| Error(format!("libm path `{}`: {e}", opts.libm_path)))?;
+    let libm = quote!(#libm);
+
+    let mut fns = Vec::new();
+    let mut choices = Vec::new();
+    for f in functions(opts) {
+        let (choice, traced) = choose(chain, f, opts);
+        let body = emit_body(&traced, &libm, f.matrix, n);
+        let name = format_ident!("{}", f.name);
+        let args = f.args.iter().map(|a| {
+            let a = format_ident!("{}", a.name());
+            quote!(#a: &[f64; #nl])
+        });
+        let payload_arg = opts
+            .runtime_payload
+            .then(|| quote!(, payload: &#payload_ty));
+        let ret = if f.matrix {
+            quote!([[f64; #nl]; #nl])
+        } else {
+            quote!([f64; #nl])
+        };
+        let c = choice.counts();
+        let doc1 = format!(" {}", f.doc);
+        let doc2 = format!(
+            " Algorithm `{}`: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted).",
+            choice.chosen, c.mul, c.add, c.div, c.sqrt, c.sincos
+        );
+        fns.push(quote! {
+            #[doc = #doc1]
+            #[doc = ""]
+            #[doc = #doc2]
+            #[must_use]
+            pub fn #name(#(#args),* #payload_arg) -> #ret {
+                #body
+            }
+        });
+        choices.push(choice);
+    }
+
+    let mut rows = Vec::new();
+    let mut chosen_rows = Vec::new();
+    for ch in &choices {
+        let fname = ch.function.name;
+        let alg = ch.chosen.name();
+        chosen_rows.push(quote!((#fname, #alg)));
+        for (a, c) in &ch.candidates {
+            let (aname, m, ad) = (a.name(), c.mul, c.add);
+            rows.push(quote!((#fname, #aname, #m, #ad)));
+        }
+    }
+
+    let header = header_lines(chain, opts, &choices);
+    let short = [format!(
+        "Dynamics of `{}` (N = {n}); see the module documentation.",
+        chain.name()
+    )];
+    let struct_header: &[String] = if header_on_struct { &header } else { &short };
+    let struct_docs = struct_header.iter().map(|l| {
+        let l = format!(" {l}");
+        quote!(#[doc = #l])
+    });
+    let joint_names = chain.joints().iter().map(|j| j.name.as_str());
+
+    let payload_item = if opts.runtime_payload {
+        let last = &chain.joints()[n - 1];
+        let m = last.inertial.mass;
+        let com = last.inertial.com;
+        let i = last.inertial.inertia;
+        let doc = format!(
+            " Mass properties of the payload, the last body (`{}`, moved by joint `{}`): mass (kg), \
+             centre of mass in the body frame (m) and inertia about the centre of mass in body \
+             axes (kg·m²; only the upper triangle is read).",
+            last.body, last.name
+        );
+        let rows3 = i.iter().map(|r| quote!([#(#r),*]));
+        quote! {
+            #[doc = #doc]
+            #[derive(Clone, Copy, Debug, PartialEq)]
+            pub struct #payload_ty {
+                /// Mass, kg.
+                pub mass: f64,
+                /// Centre of mass in the body frame, m.
+                pub com: [f64; 3],
+                /// Inertia tensor about the centre of mass, body axes, kg·m².
+                pub inertia: [[f64; 3]; 3],
+            }
+
+            impl #payload_ty {
+                /// The payload of the model file.
+                pub const NOMINAL: #payload_ty = #payload_ty {
+                    mass: #m,
+                    com: [#(#com),*],
+                    inertia: [#(#rows3),*],
+                };
+            }
+        }
+    } else {
+        quote!()
+    };
+
+    let items = quote! {
+        #(#struct_docs)*
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct #ty;
+
+        #payload_item
+
+        #[allow(
+            clippy::approx_constant,
+            clippy::excessive_precision,
+            clippy::unreadable_literal,
+            clippy::neg_multiply,
+            clippy::too_many_lines,
+            clippy::many_single_char_names,
+            clippy::similar_names,
+            unused_parens
+        )]
+        impl #ty {
+            /// Degrees of freedom.
+            pub const N: usize = #nl;
+            /// Joint names, from the base.
+            pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
+            /// Emitted operation counts of every candidate algorithm:
+            /// `(function, algorithm, mul, add)`.
+            pub const OP_COUNTS: &'static [(&'static str, &'static str, u64, u64)] = &[#(#rows),*];
+            /// The algorithm emitted for each function: `(function, algorithm)`.
+            pub const ALGORITHMS: &'static [(&'static str, &'static str)] = &[#(#chosen_rows),*];
+
+            #(#fns)*
+        }
+    };
+    Ok(Generated {
+        items,
+        header,
+        choices,
+    })
+}
+
+fn header_lines(chain: &Chain, opts: &Options, choices: &[Choice]) -> Vec<String> {
+    let mut h = vec![
+        format!(
+            "Dynamics of `{}` (N = {}), generated by kanegen-codegen {VERSION}. Do not edit.",
+            chain.name(),
+            chain.dof()
+        ),
+        String::new(),
+        format!("Joints: {}.", joint_list(chain)),
+        String::new(),
+        match opts.gravity {
+            Some(g) => format!("Gravity: [{}, {}, {}] m/s² in the base frame.", g[0], g[1], g[2]),
+            None => "Gravity: none (space).".into(),
+        },
+        if opts.runtime_payload {
+            format!(
+                "Runtime payload: the last body's mass properties are the argument `payload: &{}`.",
+                opts.payload_name
+            )
+        } else {
+            "Runtime payload: no (every model number is a constant).".into()
+        },
+        String::new(),
+        "Emitted operation counts per candidate algorithm (the cheapest in mul + add is emitted, *):"
+            .into(),
+        String::new(),
+        "| function | algorithm | mul | add | div | sqrt | sincos | mul + add |".into(),
+        "|---|---|---:|---:|---:|---:|---:|---:|".into(),
+    ];
+    for ch in choices {
+        for (a, c) in &ch.candidates {
+            let star = if *a == ch.chosen { " *" } else { "" };
+            h.push(format!(
+                "| `{}` | `{}`{star} | {} | {} | {} | {} | {} | {} |",
+                ch.function.name,
+                a.name(),
+                c.mul,
+                c.add,
+                c.div,
+                c.sqrt,
+                c.sincos,
+                c.total()
+            ));
+        }
+    }
+    h
+}
+
+/// A formatted module file for `chain`: the doc header as inner doc comments, then the items.
+///
+/// # Errors
+/// As [`generate_items`].
+pub fn generate_file(chain: &Chain, opts: &Options) -> Result<String, Error> {
+    let g = generate_items_with(chain, opts, false)?;
+    let docs = g.header.iter().map(|l| {
+        let l = if l.is_empty() {
+            String::new()
+        } else {
+            format!(" {l}")
+        };
+        quote!(#![doc = #l])
+    });
+    let items = g.items;
+    let file = quote! {
+        #(#docs)*
+        #items
+    };
+    let parsed: syn::File =
+        syn::parse2(file).map_err(|e| Error(format!("generated code does not parse: {e}")))?;
+    Ok(prettyplease::unparse(&parsed))
+}
+
+/// The core crate, re-exported for the proc-macro (models, readers, validation).
+pub use kanegen_core;

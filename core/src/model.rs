@@ -223,6 +223,81 @@ impl Chain {
     pub fn dof(&self) -> usize {
         self.joints.len()
     }
+    /// The chain with joint `index` locked at `value` (rad or m): the joint becomes a fixed
+    /// placement and its body is merged into its parent (the previous body, or the base when
+    /// `index == 0`), mass, centre of mass and inertia combined; the next joint's origin is
+    /// re-expressed in the parent frame. The result has `N − 1` joints and the same dynamics as
+    /// the original with `q[index] = value` and `q̇[index] = 0` (rows and columns of the locked
+    /// joint removed). The merged inertia is not re-checked for the triangle inequality (it holds
+    /// when it held for the parts).
+    ///
+    /// # Errors
+    /// If `index` is out of range or the chain would become empty.
+    pub fn lock_joint(&self, index: usize, value: f64) -> Result<Chain, ModelError> {
+        use crate::linalg::axis_rotation;
+        let n = self.joints.len();
+        if index >= n {
+            return Err(ModelError::invalid(
+                &format!("#{index}"),
+                "lock_joint",
+                format!("joint index {index} out of range (N = {n})"),
+            ));
+        }
+        let j = &self.joints[index];
+        // Placement of body `index` in its parent frame at q = value.
+        let ups = Mat3::from_f64(j.origin.rotation);
+        let axis = Vec3::from_f64(j.axis);
+        let (rot, trans) = match j.kind {
+            JointKind::Revolute => {
+                let (s, c) = value.sin_cos();
+                (
+                    ups.mul_mat(&axis_rotation(&axis, &s, &c)),
+                    Vec3::from_f64(j.origin.translation),
+                )
+            }
+            JointKind::Prismatic => (
+                ups.clone(),
+                Vec3::from_f64(j.origin.translation) + ups.mul_vec(&axis.scale(&value)),
+            ),
+        };
+        // The locked body's mass properties in the parent frame.
+        let moved = Inertial {
+            mass: j.inertial.mass,
+            com: (&trans + &rot.mul_vec(&Vec3::from_f64(j.inertial.com))).into_array(),
+            inertia: rot
+                .mul_mat(&Mat3::from_f64(j.inertial.inertia))
+                .mul_mat(&rot.transpose())
+                .into_array(),
+        };
+        let mut joints = self.joints.clone();
+        let mut base_inertial = self.base_inertial.clone();
+        if index == 0 {
+            base_inertial = base_inertial.map(|b| merge_inertials(&b, &moved));
+        } else {
+            let parent = &mut joints[index - 1].inertial;
+            *parent = merge_inertials(parent, &moved);
+        }
+        if let Some(next) = joints.get_mut(index + 1) {
+            let l = Vec3::from_f64(next.origin.translation);
+            next.origin = Placement {
+                translation: (&trans + &rot.mul_vec(&l)).into_array(),
+                rotation: rot
+                    .mul_mat(&Mat3::from_f64(next.origin.rotation))
+                    .into_array(),
+            };
+        }
+        joints.remove(index);
+        Chain::new_with(
+            self.name.clone(),
+            self.base.clone(),
+            base_inertial,
+            joints,
+            Validation {
+                allow_nonphysical_inertia: true,
+            },
+        )
+    }
+
     /// The model's numbers as constants of the scalar type `S` (see [`ChainParams`]).
     pub fn params<S: Scalar>(&self) -> ChainParams<S> {
         ChainParams {
@@ -402,6 +477,28 @@ pub fn validate_inertial_with(
         }
     }
     Ok(())
+}
+
+/// Two bodies' mass properties, given in the same frame, combined into one (parallel-axis theorem).
+fn merge_inertials(a: &Inertial, b: &Inertial) -> Inertial {
+    let m = a.mass + b.mass;
+    let c: [f64; 3] = core::array::from_fn(|k| (a.mass * a.com[k] + b.mass * b.com[k]) / m);
+    let mut inertia = [[0.0; 3]; 3];
+    for part in [a, b] {
+        let d: [f64; 3] = core::array::from_fn(|k| part.com[k] - c[k]);
+        let d2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
+        for r in 0..3 {
+            for s in 0..3 {
+                let e = if r == s { d2 } else { 0.0 };
+                inertia[r][s] += part.inertia[r][s] + part.mass * (e - d[r] * d[s]);
+            }
+        }
+    }
+    Inertial {
+        mass: m,
+        com: c,
+        inertia,
+    }
 }
 
 /// Eigenvalues of a symmetric 3×3 matrix.

@@ -1,1 +1,127 @@
-//! Proc-macros of kanegen (issue 4).
+//! # kanegen-macros
+//!
+//! The `dynamics!` proc-macro: unrolled, allocation-free dynamics code for a fixed model, emitted
+//! at compile time by [`kanegen_codegen`]. Use it through the `kanegen` facade
+//! (`kanegen::dynamics!`), which provides the `libm` the generated code calls.
+#![warn(missing_docs)]
+
+use proc_macro::TokenStream;
+use proc_macro2::Span;
+use quote::quote;
+use syn::parse::{Parse, ParseStream};
+use syn::{Expr, ExprArray, ExprLit, ExprUnary, Ident, Lit, LitBool, LitStr, Token, UnOp};
+
+struct Input {
+    name: Ident,
+    path: LitStr,
+    gravity: Option<[f64; 3]>,
+    allow_nonphysical: bool,
+    runtime_payload: bool,
+}
+
+fn float(e: &Expr) -> syn::Result<f64> {
+    match e {
+        Expr::Lit(ExprLit {
+            lit: Lit::Float(f), ..
+        }) => f.base10_parse(),
+        Expr::Lit(ExprLit {
+            lit: Lit::Int(i), ..
+        }) => i.base10_parse::<i64>().map(|x| x as f64),
+        Expr::Unary(ExprUnary {
+            op: UnOp::Neg(_),
+            expr,
+            ..
+        }) => float(expr).map(|x| -x),
+        other => Err(syn::Error::new_spanned(other, "expected a number literal")),
+    }
+}
+
+impl Parse for Input {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let name: Ident = input.parse()?;
+        input.parse::<Token![,]>()?;
+        let path: LitStr = input.parse()?;
+        let mut out = Input {
+            name,
+            path,
+            gravity: None,
+            allow_nonphysical: false,
+            runtime_payload: false,
+        };
+        while input.parse::<Option<Token![,]>>()?.is_some() {
+            if input.is_empty() {
+                break;
+            }
+            let key: Ident = input.parse()?;
+            input.parse::<Token![=]>()?;
+            match key.to_string().as_str() {
+                "gravity" => {
+                    let arr: ExprArray = input.parse()?;
+                    let v: Vec<f64> = arr.elems.iter().map(float).collect::<syn::Result<_>>()?;
+                    let g: [f64; 3] = v.try_into().map_err(|_| {
+                        syn::Error::new_spanned(&arr, "gravity must have three components")
+                    })?;
+                    out.gravity = Some(g);
+                }
+                "allow_nonphysical" => out.allow_nonphysical = input.parse::<LitBool>()?.value,
+                "runtime_payload" => out.runtime_payload = input.parse::<LitBool>()?.value,
+                other => {
+                    return Err(syn::Error::new(
+                        key.span(),
+                        format!(
+                            "unknown option `{other}` (expected gravity, allow_nonphysical, \
+                             runtime_payload)"
+                        ),
+                    ))
+                }
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// `dynamics!(Name, "path/to/model.urdf" [, gravity = [x, y, z]] [, allow_nonphysical = true]
+/// [, runtime_payload = true])`: defines `pub struct Name;` with the associated constants `N`,
+/// `JOINTS`, `OP_COUNTS`, `ALGORITHMS` and the functions `mass_matrix(q)`, `bias(q, qd, tau)`,
+/// `bias_velocity(q, qd)`, `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)` (and
+/// `gravity(q)` with gravity) on `&[f64; N]` arrays. With `runtime_payload = true`, every
+/// function takes a last argument `payload: &NamePayload` (the last body's mass properties).
+///
+/// The path is relative to the calling crate's `CARGO_MANIFEST_DIR`; the crate is rebuilt when
+/// the file changes. A missing, malformed or non-physical model is a compile error at the path.
+#[proc_macro]
+pub fn dynamics(input: TokenStream) -> TokenStream {
+    let input = syn::parse_macro_input!(input as Input);
+    match expand(&input) {
+        Ok(ts) => ts.into(),
+        Err(msg) => syn::Error::new(input.path.span(), msg)
+            .to_compile_error()
+            .into(),
+    }
+}
+
+fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
+    let rel = input.path.value();
+    let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
+    let path = std::path::Path::new(&dir).join(&rel);
+    let abs = path.display().to_string();
+    let v = kanegen_codegen::kanegen_core::Validation {
+        allow_nonphysical_inertia: input.allow_nonphysical,
+    };
+    // Messages name the path as written, not the machine's absolute path.
+    let chain = kanegen_codegen::kanegen_core::io::load_model_with(&path, v)
+        .map_err(|e| e.to_string().replace(&abs, &rel))?;
+    let name = input.name.to_string();
+    let mut opts = kanegen_codegen::Options::new(name.clone());
+    opts.gravity = input.gravity;
+    opts.runtime_payload = input.runtime_payload;
+    opts.libm_path = "::kanegen::__private::libm".into();
+    opts.payload_name = format!("{name}Payload");
+    let g = kanegen_codegen::generate_items(&chain, &opts).map_err(|e| e.to_string())?;
+    let items = g.items;
+    let abs_lit = LitStr::new(&abs, Span::call_site());
+    Ok(quote! {
+        const _: &[u8] = include_bytes!(#abs_lit);
+        #items
+    })
+}

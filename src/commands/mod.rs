@@ -3,4 +3,5 @@
 pub mod bench;
 pub mod count;
 pub mod eval;
+pub mod generate;
 pub mod table1;
