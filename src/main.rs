@@ -97,6 +97,19 @@ enum Command {
         #[arg(long)]
         allow_nonphysical: bool,
     },
+    /// ns per call of the generated SSRMS code against the interpreted algorithms, measured side
+    /// by side in one run (report ratios: the machine is shared and noisy).
+    Bench {
+        /// Print JSON.
+        #[arg(long)]
+        json: bool,
+        /// Measurement rounds per candidate (the median is reported).
+        #[arg(long, default_value_t = 31)]
+        rounds: usize,
+        /// Calls per round.
+        #[arg(long, default_value_t = 2000)]
+        calls: usize,
+    },
 }
 
 fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<kanegen::Chain> {
@@ -195,6 +208,18 @@ fn main() -> Result<()> {
                 Some(path) => std::fs::write(&path, code)
                     .with_context(|| format!("cannot write `{}`", path.display()))?,
                 None => print!("{code}"),
+            }
+        }
+        Command::Bench {
+            json,
+            rounds,
+            calls,
+        } => {
+            let r = commands::bench::bench_ssrms(rounds, calls)?;
+            if json {
+                println!("{}", serde_json::to_string_pretty(&r)?);
+            } else {
+                print!("{}", commands::bench::render_text(&r));
             }
         }
     }

@@ -770,7 +770,11 @@ fn random_dh_arms_agree_across_conventions() {
 fn to_toml_round_trips_random_chains_exactly() {
     use kanegen_core::random::{random_chain, ChainSpec};
     for seed in 0..20 {
-        let spec = ChainSpec { n: 1 + seed as usize % 9, prismatic_fraction: 0.3, ..Default::default() };
+        let spec = ChainSpec {
+            n: 1 + seed as usize % 9,
+            prismatic_fraction: 0.3,
+            ..Default::default()
+        };
         let chain = random_chain(&spec, seed);
         let text = kanegen_core::io::to_toml(&chain);
         let back = kanegen_core::io::parse_toml(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
@@ -781,5 +785,8 @@ fn to_toml_round_trips_random_chains_exactly() {
         "/../models/ssrms.toml"
     )))
     .unwrap();
-    assert_eq!(kanegen_core::io::parse_toml(&kanegen_core::io::to_toml(&ssrms)).unwrap(), ssrms);
+    assert_eq!(
+        kanegen_core::io::parse_toml(&kanegen_core::io::to_toml(&ssrms)).unwrap(),
+        ssrms
+    );
 }

@@ -126,3 +126,81 @@ pub fn render_text(r: &BenchReport) -> String {
     }
     s
 }
+
+/// The SSRMS model the generated code was emitted from (embedded, so the command runs anywhere).
+const SSRMS_URDF: &str = include_str!("../../tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
+
+/// Generated SSRMS code against the interpreted f64 algorithms, side by side.
+pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
+    use kanegen_core::{Algorithm, Loads};
+    use kanegen_generated::ssrms::Ssrms;
+    let chain = kanegen_core::io::parse_urdf(SSRMS_URDF)?;
+    let p = chain.params::<f64>();
+    let n = chain.dof();
+    let arr = |x: &[f64]| -> [f64; 7] { core::array::from_fn(|i| x[i]) };
+    let zero = [0.0; 7];
+    let mut c: Vec<Candidate<'_>> = Vec::new();
+    let sum2 = |a: [[f64; 7]; 7], b: [f64; 7]| a[0][0] + a[6][6] + b[0] + b[6];
+    c.push((
+        "generated".into(),
+        "A+b".into(),
+        Box::new(move |q, qd| {
+            sum2(
+                Ssrms::mass_matrix(&arr(q)),
+                Ssrms::bias(&arr(q), &arr(qd), &zero),
+            )
+        }),
+    ));
+    for alg in Algorithm::ALL {
+        let p = &p;
+        c.push((
+            format!("interpreted {alg}"),
+            "A+b".into(),
+            Box::new(move |q, qd| {
+                let d = alg.dynamics(p, q, qd, &Loads::default());
+                d.a[0][0] + d.a[6][6] + d.b[0] + d.b[6]
+            }),
+        ));
+    }
+    c.push((
+        "generated".into(),
+        "forward_dynamics".into(),
+        Box::new(move |q, qd| Ssrms::forward_dynamics(&arr(q), &arr(qd), &zero)[6]),
+    ));
+    for alg in [
+        Algorithm::Recurrent,
+        Algorithm::CrbaBase,
+        Algorithm::Spatial,
+    ] {
+        let p = &p;
+        c.push((
+            format!("interpreted {alg}"),
+            "forward_dynamics".into(),
+            Box::new(move |q, qd| alg.forward_dynamics(p, q, qd, &Loads::default())[6]),
+        ));
+    }
+    c.push((
+        "generated".into(),
+        "inverse_dynamics".into(),
+        Box::new(move |q, qd| Ssrms::inverse_dynamics(&arr(q), &arr(qd), &arr(qd))[6]),
+    ));
+    for alg in [
+        Algorithm::Recurrent,
+        Algorithm::CrbaBase,
+        Algorithm::Spatial,
+    ] {
+        let p = &p;
+        c.push((
+            format!("interpreted {alg}"),
+            "inverse_dynamics".into(),
+            Box::new(move |q, qd| alg.inverse_dynamics(p, q, qd, qd, &Loads::default())[6]),
+        ));
+    }
+    Ok(BenchReport {
+        model: chain.name().into(),
+        n,
+        rounds,
+        calls_per_round: calls,
+        results: measure(n, c, rounds, calls),
+    })
+}
