@@ -74,7 +74,7 @@ fn main() {
         }
         t += dt;
         step += 1;
-        if step % 1000 == 0 {
+        if step.is_multiple_of(1000) {
             let (q_d, _, _) = desired(t);
             let err = (0..N).map(|j| (q_d[j] - q[j]).abs()).fold(0.0, f64::max);
             let tmax = max_tau.iter().copied().fold(0.0, f64::max);
