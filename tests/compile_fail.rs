@@ -1,0 +1,23 @@
+//! `dynamics!` rejects bad models at compile time with the reader's message at the path literal.
+//!
+//! trybuild compiles each case in its own project, `<target>/tests/trybuild/kanegen`, whose
+//! `CARGO_MANIFEST_DIR` is that directory: the bad models of `tests/data/codegen/bad/` are copied
+//! there first, and the cases name them relative to it (`bad/…`).
+
+use std::path::Path;
+
+#[test]
+fn dynamics_macro_errors() {
+    let target = Path::new(env!("CARGO_TARGET_TMPDIR"))
+        .parent()
+        .expect("the target tmp dir has a parent");
+    let project = target.join("tests/trybuild/kanegen/bad");
+    std::fs::create_dir_all(&project).unwrap();
+    let src = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/codegen/bad");
+    for e in std::fs::read_dir(&src).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), project.join(e.file_name())).unwrap();
+    }
+    let t = trybuild::TestCases::new();
+    t.compile_fail("tests/ui/*.rs");
+}

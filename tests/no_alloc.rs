@@ -1,0 +1,77 @@
+//! The generated functions allocate nothing: a counting global allocator is read before and
+//! after many calls of every function (generated crate and `dynamics!` output).
+
+use std::alloc::{GlobalAlloc, Layout, System};
+use std::sync::atomic::{AtomicUsize, Ordering};
+
+struct Counting;
+
+static ALLOCATIONS: AtomicUsize = AtomicUsize::new(0);
+
+// SAFETY: forwards to `System`; only counts.
+unsafe impl GlobalAlloc for Counting {
+    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        // SAFETY: the caller upholds `alloc`'s contract.
+        unsafe { System.alloc(layout) }
+    }
+    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
+        // SAFETY: the caller upholds `dealloc`'s contract.
+        unsafe { System.dealloc(ptr, layout) }
+    }
+    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
+        ALLOCATIONS.fetch_add(1, Ordering::SeqCst);
+        // SAFETY: the caller upholds `realloc`'s contract.
+        unsafe { System.realloc(ptr, layout, new_size) }
+    }
+}
+
+#[global_allocator]
+static GLOBAL: Counting = Counting;
+
+kanegen::dynamics!(
+    Random5,
+    "tests/data/codegen/random5.toml",
+    gravity = [0.0, 0.0, -9.81],
+    runtime_payload = true
+);
+
+use kanegen_generated::ssrms::Ssrms;
+
+#[test]
+fn generated_functions_do_not_allocate() {
+    // The counter itself works: a Vec allocates.
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let v = std::hint::black_box(vec![1.0f64; 16]);
+    assert!(ALLOCATIONS.load(Ordering::SeqCst) > before);
+    drop(v);
+
+    let payload = Random5Payload::NOMINAL;
+    let mut acc = 0.0;
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    for k in 0..1000 {
+        let x = f64::from(k) * 1e-3;
+        let q7 = std::hint::black_box([x, 0.1, -0.2, 0.3, x, 0.5, -x]);
+        let a = Ssrms::mass_matrix(&q7);
+        let b = Ssrms::bias(&q7, &q7, &q7);
+        let h = Ssrms::bias_velocity(&q7, &q7);
+        let t = Ssrms::inverse_dynamics(&q7, &q7, &q7);
+        let f = Ssrms::forward_dynamics(&q7, &q7, &q7);
+        acc += a[6][6] + b[0] + h[1] + t[2] + f[3];
+        let q5 = std::hint::black_box([x, 0.1, -0.2, 0.3, x]);
+        let a = Random5::mass_matrix(&q5, &payload);
+        let b = Random5::bias(&q5, &q5, &q5, &payload);
+        let g = Random5::gravity(&q5, &payload);
+        let t = Random5::inverse_dynamics(&q5, &q5, &q5, &payload);
+        let f = Random5::forward_dynamics(&q5, &q5, &q5, &payload);
+        acc += a[4][4] + b[0] + g[1] + t[2] + f[3];
+    }
+    let after = ALLOCATIONS.load(Ordering::SeqCst);
+    assert!(acc.is_finite());
+    assert_eq!(
+        after - before,
+        0,
+        "generated code allocated {} times",
+        after - before
+    );
+}

@@ -1,0 +1,3 @@
+kanegen::dynamics!(Arm, "bad/no_such_model.urdf");
+
+fn main() {}

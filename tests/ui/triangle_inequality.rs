@@ -1,0 +1,3 @@
+kanegen::dynamics!(Arm, "bad/triangle.toml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+kanegen::dynamics!(Arm, "bad/unknown_key.toml");
+
+fn main() {}
