@@ -793,3 +793,96 @@ pub fn generate_file(chain: &Chain, opts: &Options) -> Result<String, Error> {
 
 /// The core crate, re-exported for the proc-macro (models, readers, validation).
 pub use kanegen_core;
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use kanegen_core::random::{random_chain, ChainSpec};
+    use syn::visit::Visit;
+
+    /// Binary `*`, `/`, `+`, `-` and libm calls in a function body.
+    #[derive(Default)]
+    struct OpCounter {
+        mul: u64,
+        add: u64,
+        div: u64,
+        sqrt: u64,
+        sincos: u64,
+    }
+
+    impl<'a> Visit<'a> for OpCounter {
+        fn visit_expr_binary(&mut self, e: &'a syn::ExprBinary) {
+            match e.op {
+                syn::BinOp::Mul(_) => self.mul += 1,
+                syn::BinOp::Div(_) => self.div += 1,
+                syn::BinOp::Add(_) | syn::BinOp::Sub(_) => self.add += 1,
+                _ => {}
+            }
+            syn::visit::visit_expr_binary(self, e);
+        }
+        fn visit_expr_call(&mut self, e: &'a syn::ExprCall) {
+            let f = quote!(#e).to_string();
+            if f.contains(":: sqrt") {
+                self.sqrt += 1;
+            } else if f.contains(":: sincos") || f.contains(":: sin (") || f.contains(":: cos") {
+                self.sincos += 1;
+            }
+            syn::visit::visit_expr_call(self, e);
+        }
+    }
+
+    /// The emitted code performs exactly the trace's emitted operation counts, function by
+    /// function, for random chains with prismatic joints, gravity and a runtime payload.
+    #[test]
+    fn emitted_code_has_the_traced_op_counts() {
+        for (seed, n, payload) in [(1, 3, false), (2, 5, true), (3, 7, false)] {
+            let chain = random_chain(
+                &ChainSpec {
+                    n,
+                    prismatic_fraction: 0.3,
+                    ..Default::default()
+                },
+                seed,
+            );
+            let mut opts = Options::new("Arm");
+            opts.gravity = Some([0.1, 0.2, -9.81]);
+            opts.runtime_payload = payload;
+            let g = generate_items(&chain, &opts).unwrap();
+            let file: syn::File = syn::parse2(g.items).unwrap();
+            let mut fns = HashMap::new();
+            for item in &file.items {
+                if let syn::Item::Impl(imp) = item {
+                    for it in &imp.items {
+                        if let syn::ImplItem::Fn(f) = it {
+                            let mut c = OpCounter::default();
+                            c.visit_block(&f.block);
+                            fns.insert(f.sig.ident.to_string(), c);
+                        }
+                    }
+                }
+            }
+            assert_eq!(fns.len(), 6, "all functions, gravity included");
+            for ch in &g.choices {
+                let want = ch.counts();
+                let have = &fns[ch.function.name];
+                assert_eq!(
+                    (have.mul, have.add, have.div, have.sqrt, have.sincos),
+                    (want.mul, want.add, want.div, want.sqrt, want.sincos),
+                    "{} (N = {n})",
+                    ch.function.name
+                );
+                let best = ch.candidates.iter().map(|(_, c)| c.total()).min();
+                assert_eq!(Some(want.total()), best);
+            }
+        }
+    }
+
+    #[test]
+    fn bad_options_are_errors() {
+        let chain = random_chain(&ChainSpec::default(), 1);
+        assert!(generate_items(&chain, &Options::new("not an ident")).is_err());
+        let mut o = Options::new("Arm");
+        o.libm_path = "::".into();
+        assert!(generate_items(&chain, &o).is_err());
+    }
+}
