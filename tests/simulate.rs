@@ -385,3 +385,17 @@ fn cli_simulate_writes_trajectory_and_summary() {
     assert!(Path::new(&out.join("joints.svg")).exists());
     std::fs::remove_dir_all(&out).ok();
 }
+
+#[test]
+fn dopri5_rejects_a_too_large_first_step_and_recovers() {
+    let opts = Dopri5Options {
+        tolerance: 1e-10,
+        max_step: 2.0,
+        initial_step: 2.0,
+        output_interval: 0.5,
+    };
+    let mut x = vec![1.0, 0.0];
+    let stats = dopri5(&mut Oscillator, 0.0, 5.0, &opts, &mut x, |_, _| {}).unwrap();
+    assert!(stats.rejected_steps > 0, "{stats:?}");
+    assert!((x[0] - 5f64.cos()).abs() < 1e-8 && (x[1] + 5f64.sin()).abs() < 1e-8);
+}
