@@ -6,7 +6,11 @@
 #![warn(missing_docs)]
 
 pub mod commands;
+pub mod integrate;
 pub mod poly;
+pub mod scene;
+pub mod simulate;
+pub mod simulate_plot;
 pub mod states;
 pub mod table1;
 

@@ -110,6 +110,18 @@ enum Command {
         #[arg(long, default_value_t = 2000)]
         calls: usize,
     },
+    /// Simulate a scene file (TOML, README.md "Simulation scenes"): write trajectory.csv,
+    /// summary.json and SVG plots into --out, print a summary.
+    Simulate {
+        /// Scene file (.toml).
+        scene: PathBuf,
+        /// Write trajectory.csv, summary.json, joints.svg, drift.svg into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print the JSON summary to stdout (and no progress bar).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<kanegen::Chain> {
@@ -220,6 +232,30 @@ fn main() -> Result<()> {
                 println!("{}", serde_json::to_string_pretty(&r)?);
             } else {
                 print!("{}", commands::bench::render_text(&r));
+            }
+        }
+        Command::Simulate { scene, out, json } => {
+            let sc = kanegen::scene::Scene::load(&scene)?;
+            let pb = if json {
+                indicatif::ProgressBar::hidden()
+            } else {
+                indicatif::ProgressBar::new((sc.simulation.duration * 1000.0) as u64)
+            };
+            let run = kanegen::simulate::simulate(&sc, Some(&pb))?;
+            pb.finish_and_clear();
+            if let Some(dir) = &out {
+                kanegen::simulate::write_outputs(&sc, &run, dir)?;
+            }
+            if json {
+                println!("{}", serde_json::to_string_pretty(&run.summary)?);
+            } else {
+                println!("{}", kanegen::simulate::render_text(&run.summary));
+                if let Some(dir) = &out {
+                    eprintln!(
+                        "wrote trajectory.csv, summary.json, plots to {}",
+                        dir.display()
+                    );
+                }
             }
         }
     }

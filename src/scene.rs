@@ -1,0 +1,628 @@
+//! Simulation scenes (issue #5): a TOML file naming a model, the base (fixed or free-floating),
+//! an optional payload, the effects (gravity, joint damping, constant wrenches), the joint
+//! drives, the initial state and the integrator. See README.md, "Simulation scenes".
+//!
+//! Every table rejects unknown keys, and every validation error names its key
+//! (`simulation.tolerance: must be > 0`). "Effects decide the code": only the effects a scene
+//! names end up in the [`Loads`](crate::Loads) of the simulation.
+//!
+//! ```
+//! let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+//! let scene = kanegen::scene::Scene::parse(r#"
+//!     model = "models/two_link.toml"
+//!     [simulation]
+//!     duration = 1.0
+//! "#, dir).unwrap();
+//! assert_eq!(scene.q0.len(), scene.chain.dof());
+//! ```
+
+use crate::{Chain, ExternalWrench, Inertial, LoadFrame, Validation};
+use anyhow::{anyhow, bail, Context, Result};
+use kanegen_core::algorithms::floating::BASE_BODY;
+use kanegen_core::linalg::Vec3;
+use kanegen_core::Algorithm;
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    model: String,
+    #[serde(default)]
+    allow_nonphysical: bool,
+    base: Option<RawBase>,
+    payload: Option<RawPayload>,
+    #[serde(default)]
+    effects: RawEffects,
+    drives: Option<RawDrives>,
+    #[serde(default)]
+    initial: RawInitial,
+    simulation: RawSimulation,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBase {
+    #[serde(rename = "type")]
+    kind: String,
+    mass: Option<f64>,
+    com: Option<[f64; 3]>,
+    inertia: Option<RawInertia>,
+    position: Option<[f64; 3]>,
+    quaternion: Option<[f64; 4]>,
+    v: Option<[f64; 3]>,
+    omega: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize, Clone, Copy)]
+#[serde(deny_unknown_fields)]
+struct RawInertia {
+    ixx: f64,
+    iyy: f64,
+    izz: f64,
+    #[serde(default)]
+    ixy: f64,
+    #[serde(default)]
+    ixz: f64,
+    #[serde(default)]
+    iyz: f64,
+}
+
+impl RawInertia {
+    fn matrix(&self) -> [[f64; 3]; 3] {
+        [
+            [self.ixx, self.ixy, self.ixz],
+            [self.ixy, self.iyy, self.iyz],
+            [self.ixz, self.iyz, self.izz],
+        ]
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPayload {
+    mass: f64,
+    com: [f64; 3],
+    inertia: RawInertia,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawEffects {
+    gravity: Option<[f64; 3]>,
+    damping: Option<Vec<f64>>,
+    #[serde(default)]
+    wrench: Vec<RawWrench>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWrench {
+    body: String,
+    frame: String,
+    #[serde(default)]
+    force: [f64; 3],
+    #[serde(default)]
+    moment: [f64; 3],
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawGain {
+    Scalar(f64),
+    Vector(Vec<f64>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDrives {
+    #[serde(rename = "type")]
+    kind: String,
+    kp: Option<RawGain>,
+    kd: Option<RawGain>,
+    target: Option<Vec<f64>>,
+    duration_s: Option<f64>,
+    tau: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawInitial {
+    q: Option<Vec<f64>>,
+    qd: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSimulation {
+    duration: f64,
+    integrator: Option<String>,
+    step: Option<f64>,
+    tolerance: Option<f64>,
+    max_step: Option<f64>,
+    output_every: Option<usize>,
+    algorithm: Option<String>,
+}
+
+/// The base of a scene.
+// One value per scene: the size difference of the variants does not matter.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum BaseSpec {
+    /// Fixed to the inertial frame.
+    Fixed,
+    /// Free-floating (see [`kanegen_core::algorithms::floating`] for the conventions).
+    FreeFloating {
+        /// Mass properties of the base body (base frame).
+        inertial: Inertial,
+        /// Initial `p₀`.
+        position: [f64; 3],
+        /// Initial attitude, unit quaternion `[x, y, z, w]`.
+        quaternion: [f64; 4],
+        /// Initial `v_b` (base coordinates).
+        v: [f64; 3],
+        /// Initial `ω_b` (base coordinates).
+        omega: [f64; 3],
+    },
+}
+
+/// Joint drives.
+#[derive(Clone, Debug)]
+pub enum Drives {
+    /// No drive torques.
+    None,
+    /// Constant joint torques/forces `τ`.
+    Constant {
+        /// The `N` drive values.
+        tau: Vec<f64>,
+    },
+    /// `τ = kp (q_target − q) − kd q̇`.
+    Pd {
+        /// Proportional gains (`N`).
+        kp: Vec<f64>,
+        /// Derivative gains (`N`).
+        kd: Vec<f64>,
+        /// Target positions (`N`).
+        target: Vec<f64>,
+    },
+    /// Computed torque along a quintic from the initial `q` to `target` over `duration`:
+    /// `τ = ID(q, q̇, q̈_d + kd (q̇_d − q̇) + kp (q_d − q))` (fixed base only).
+    ComputedTorque {
+        /// Proportional gains (`N`).
+        kp: Vec<f64>,
+        /// Derivative gains (`N`).
+        kd: Vec<f64>,
+        /// Final positions (`N`).
+        target: Vec<f64>,
+        /// Duration of the quintic, s.
+        duration: f64,
+    },
+}
+
+/// The integrator of a scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    /// Fixed-step RK4 with the scene's `step`.
+    Rk4,
+    /// Adaptive Dormand–Prince 5(4) with `rtol = atol = tolerance`.
+    Dopri5,
+}
+
+/// The `[simulation]` table, validated.
+#[derive(Clone, Debug)]
+pub struct SimulationSpec {
+    /// End time, s.
+    pub duration: f64,
+    /// The integrator.
+    pub integrator: Integrator,
+    /// RK4 step; for dopri5 the first step tried (default 0.01 s).
+    pub step: f64,
+    /// dopri5 tolerance (default 1e-8).
+    pub tolerance: f64,
+    /// dopri5 largest step (default: the duration).
+    pub max_step: f64,
+    /// Output every k-th RK4 step; dopri5 samples its dense output every `output_every · step`
+    /// seconds (default 10).
+    pub output_every: usize,
+    /// The dynamics algorithm evaluating `A`, `b` (default `recurrent`).
+    pub algorithm: Algorithm,
+}
+
+/// A validated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The arm, with the payload (if any) merged into the last body.
+    pub chain: Chain,
+    /// Fixed or free-floating base.
+    pub base: BaseSpec,
+    /// Uniform gravity (base frame for a fixed base, inertial frame for a free-floating one).
+    pub gravity: Option<[f64; 3]>,
+    /// Joint viscous damping coefficients: `τ_d = −c q̇`.
+    pub damping: Option<Vec<f64>>,
+    /// Constant external wrenches ([`BASE_BODY`] for the free-floating base body).
+    pub wrenches: Vec<ExternalWrench<f64>>,
+    /// The joint drives.
+    pub drives: Drives,
+    /// Initial joint positions.
+    pub q0: Vec<f64>,
+    /// Initial joint rates.
+    pub qd0: Vec<f64>,
+    /// Integrator settings.
+    pub simulation: SimulationSpec,
+}
+
+fn check_len(key: &str, v: &[f64], n: usize) -> Result<()> {
+    if v.len() != n {
+        bail!(
+            "{key}: expected {n} values (the model's degrees of freedom), got {}",
+            v.len()
+        );
+    }
+    check_finite(key, v)
+}
+
+fn check_finite(key: &str, v: &[f64]) -> Result<()> {
+    if v.iter().any(|x| !x.is_finite()) {
+        bail!("{key}: values must be finite");
+    }
+    Ok(())
+}
+
+fn gain(key: &str, g: Option<RawGain>, n: usize) -> Result<Vec<f64>> {
+    let v = match g.ok_or_else(|| anyhow!("{key}: required by this drive type"))? {
+        RawGain::Scalar(x) => vec![x; n],
+        RawGain::Vector(v) => {
+            check_len(key, &v, n)?;
+            v
+        }
+    };
+    if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        bail!("{key}: gains must be finite and >= 0");
+    }
+    Ok(v)
+}
+
+/// `m (|c|² 1 − c cᵀ)`: the parallel-axis term.
+fn steiner(m: f64, c: &[f64; 3]) -> [[f64; 3]; 3] {
+    let n2 = c.iter().map(|x| x * x).sum::<f64>();
+    let mut s = [[0.0; 3]; 3];
+    for (i, row) in s.iter_mut().enumerate() {
+        for (j, x) in row.iter_mut().enumerate() {
+            *x = m * (if i == j { n2 } else { 0.0 } - c[i] * c[j]);
+        }
+    }
+    s
+}
+
+/// Two rigid bodies welded together, all quantities in one frame: total mass, combined centre of
+/// mass, and the inertia about it by the parallel-axis theorem.
+#[must_use]
+pub fn combine_inertials(a: &Inertial, b: &Inertial) -> Inertial {
+    let mass = a.mass + b.mass;
+    let com = [0, 1, 2].map(|i| (a.mass * a.com[i] + b.mass * b.com[i]) / mass);
+    let da = [0, 1, 2].map(|i| a.com[i] - com[i]);
+    let db = [0, 1, 2].map(|i| b.com[i] - com[i]);
+    let (sa, sb) = (steiner(a.mass, &da), steiner(b.mass, &db));
+    let inertia = [0, 1, 2]
+        .map(|i| [0, 1, 2].map(|j| a.inertia[i][j] + sa[i][j] + b.inertia[i][j] + sb[i][j]));
+    Inertial { mass, com, inertia }
+}
+
+impl Scene {
+    /// Reads and validates a scene file; the model path is relative to the file's directory.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scene `{}`", path.display()))?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Scene::parse(&text, dir).with_context(|| format!("scene `{}`", path.display()))
+    }
+
+    /// Parses and validates scene text; `dir` is the directory the model path is relative to.
+    pub fn parse(text: &str, dir: &Path) -> Result<Scene> {
+        let raw: RawScene = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        let model_path = dir.join(&raw.model);
+        let validation = Validation {
+            allow_nonphysical_inertia: raw.allow_nonphysical,
+        };
+        let chain = kanegen_core::io::load_model_with(&model_path, validation)
+            .map_err(|e| anyhow!("model: `{}`: {e}", model_path.display()))?;
+        let n = chain.dof();
+
+        let chain = match raw.payload {
+            None => chain,
+            Some(p) => {
+                if !(p.mass.is_finite() && p.mass > 0.0) {
+                    bail!("payload.mass: must be > 0");
+                }
+                check_finite("payload.com", &p.com)?;
+                let pay = Inertial {
+                    mass: p.mass,
+                    com: p.com,
+                    inertia: p.inertia.matrix(),
+                };
+                kanegen_core::model::validate_inertial_with("payload", "inertia", &pay, validation)
+                    .map_err(|e| anyhow!("payload.inertia: {e}"))?;
+                let mut joints = chain.joints().to_vec();
+                let last = joints.last_mut().expect("a chain has a joint");
+                last.inertial = combine_inertials(&last.inertial, &pay);
+                Chain::new_with(
+                    chain.name(),
+                    chain.base(),
+                    chain.base_inertial().cloned(),
+                    joints,
+                    validation,
+                )
+                .map_err(|e| anyhow!("payload: {e}"))?
+            }
+        };
+
+        let base = match raw.base {
+            None => BaseSpec::Fixed,
+            Some(b) => match b.kind.as_str() {
+                "fixed" => {
+                    let given = [
+                        ("mass", b.mass.is_some()),
+                        ("com", b.com.is_some()),
+                        ("inertia", b.inertia.is_some()),
+                        ("position", b.position.is_some()),
+                        ("quaternion", b.quaternion.is_some()),
+                        ("v", b.v.is_some()),
+                        ("omega", b.omega.is_some()),
+                    ];
+                    if let Some((k, _)) = given.iter().find(|(_, g)| *g) {
+                        bail!("base.{k}: only for type = \"free-floating\"");
+                    }
+                    BaseSpec::Fixed
+                }
+                "free-floating" => {
+                    let model = chain.base_inertial();
+                    let mass = b.mass.or(model.map(|i| i.mass)).ok_or_else(|| {
+                        anyhow!("base.mass: the model has no base inertial; give mass, com, inertia")
+                    })?;
+                    let com = b.com.or(model.map(|i| i.com)).unwrap_or([0.0; 3]);
+                    let inertia = b
+                        .inertia
+                        .map(|i| i.matrix())
+                        .or(model.map(|i| i.inertia))
+                        .ok_or_else(|| anyhow!("base.inertia: the model has no base inertial"))?;
+                    if !(mass.is_finite() && mass > 0.0) {
+                        bail!("base.mass: must be > 0");
+                    }
+                    check_finite("base.com", &com)?;
+                    let inertial = Inertial { mass, com, inertia };
+                    kanegen_core::model::validate_inertial_with(
+                        "base",
+                        "inertia",
+                        &inertial,
+                        validation,
+                    )
+                    .map_err(|e| anyhow!("base.inertia: {e}"))?;
+                    let quat = b.quaternion.unwrap_or([0.0, 0.0, 0.0, 1.0]);
+                    check_finite("base.quaternion", &quat)?;
+                    let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if norm < 1e-12 {
+                        bail!("base.quaternion: must be non-zero");
+                    }
+                    let position = b.position.unwrap_or([0.0; 3]);
+                    let v = b.v.unwrap_or([0.0; 3]);
+                    let omega = b.omega.unwrap_or([0.0; 3]);
+                    check_finite("base.position", &position)?;
+                    check_finite("base.v", &v)?;
+                    check_finite("base.omega", &omega)?;
+                    BaseSpec::FreeFloating {
+                        inertial,
+                        position,
+                        quaternion: quat.map(|x| x / norm),
+                        v,
+                        omega,
+                    }
+                }
+                other => bail!(
+                    "base.type: unknown base type `{other}` (expected \"fixed\" or \"free-floating\")"
+                ),
+            },
+        };
+        let floating = matches!(base, BaseSpec::FreeFloating { .. });
+
+        let e = raw.effects;
+        if let Some(g) = &e.gravity {
+            check_finite("effects.gravity", g)?;
+        }
+        if let Some(c) = &e.damping {
+            check_len("effects.damping", c, n)?;
+            if c.iter().any(|x| *x < 0.0) {
+                bail!("effects.damping: coefficients must be >= 0");
+            }
+        }
+        let mut wrenches = Vec::new();
+        for (k, w) in e.wrench.iter().enumerate() {
+            let key = format!("effects.wrench[{k}]");
+            let body = if w.body == "base" || w.body == chain.base() {
+                if !floating {
+                    bail!("{key}.body: a wrench on a fixed base has no effect");
+                }
+                BASE_BODY
+            } else {
+                chain
+                    .joints()
+                    .iter()
+                    .position(|j| j.body == w.body)
+                    .ok_or_else(|| {
+                        let names: Vec<&str> =
+                            chain.joints().iter().map(|j| j.body.as_str()).collect();
+                        anyhow!(
+                            "{key}.body: unknown body `{}` (known: base, {})",
+                            w.body,
+                            names.join(", ")
+                        )
+                    })?
+            };
+            let frame = match w.frame.as_str() {
+                "body" => LoadFrame::Body,
+                "inertial" => LoadFrame::Base,
+                other => bail!("{key}.frame: unknown frame `{other}` (expected body or inertial)"),
+            };
+            check_finite(&format!("{key}.force"), &w.force)?;
+            check_finite(&format!("{key}.moment"), &w.moment)?;
+            wrenches.push(ExternalWrench {
+                body,
+                frame,
+                force: Vec3::from_f64(w.force),
+                moment: Vec3::from_f64(w.moment),
+            });
+        }
+
+        let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
+        check_len("initial.q", &q0, n)?;
+        let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
+        check_len("initial.qd", &qd0, n)?;
+
+        let drives = match raw.drives {
+            None => Drives::None,
+            Some(d) => {
+                let extra = |keys: &[(&str, bool)]| -> Result<()> {
+                    if let Some((k, _)) = keys.iter().find(|(_, g)| *g) {
+                        bail!("drives.{k}: not used by drives.type = \"{}\"", d.kind);
+                    }
+                    Ok(())
+                };
+                match d.kind.as_str() {
+                    "none" => {
+                        extra(&[
+                            ("kp", d.kp.is_some()),
+                            ("kd", d.kd.is_some()),
+                            ("target", d.target.is_some()),
+                            ("duration_s", d.duration_s.is_some()),
+                            ("tau", d.tau.is_some()),
+                        ])?;
+                        Drives::None
+                    }
+                    "constant" => {
+                        extra(&[
+                            ("kp", d.kp.is_some()),
+                            ("kd", d.kd.is_some()),
+                            ("target", d.target.is_some()),
+                            ("duration_s", d.duration_s.is_some()),
+                        ])?;
+                        let tau = d
+                            .tau
+                            .ok_or_else(|| anyhow!("drives.tau: required by type = \"constant\""))?;
+                        check_len("drives.tau", &tau, n)?;
+                        Drives::Constant { tau }
+                    }
+                    "pd" => {
+                        extra(&[("duration_s", d.duration_s.is_some()), ("tau", d.tau.is_some())])?;
+                        let target = d
+                            .target
+                            .ok_or_else(|| anyhow!("drives.target: required by type = \"pd\""))?;
+                        check_len("drives.target", &target, n)?;
+                        Drives::Pd {
+                            kp: gain("drives.kp", d.kp, n)?,
+                            kd: gain("drives.kd", d.kd, n)?,
+                            target,
+                        }
+                    }
+                    "computed-torque" => {
+                        extra(&[("tau", d.tau.is_some())])?;
+                        if floating {
+                            bail!("drives.type: computed-torque needs a fixed base");
+                        }
+                        let target = d.target.ok_or_else(|| {
+                            anyhow!("drives.target: required by type = \"computed-torque\"")
+                        })?;
+                        check_len("drives.target", &target, n)?;
+                        let duration = d.duration_s.ok_or_else(|| {
+                            anyhow!("drives.duration_s: required by type = \"computed-torque\"")
+                        })?;
+                        if !(duration.is_finite() && duration > 0.0) {
+                            bail!("drives.duration_s: must be > 0");
+                        }
+                        Drives::ComputedTorque {
+                            kp: gain("drives.kp", d.kp, n)?,
+                            kd: gain("drives.kd", d.kd, n)?,
+                            target,
+                            duration,
+                        }
+                    }
+                    other => bail!(
+                        "drives.type: unknown drive type `{other}` (expected none, constant, pd or computed-torque)"
+                    ),
+                }
+            }
+        };
+
+        let s = raw.simulation;
+        if !(s.duration.is_finite() && s.duration > 0.0) {
+            bail!("simulation.duration: must be > 0");
+        }
+        let integrator = match s.integrator.as_deref().unwrap_or("rk4") {
+            "rk4" => Integrator::Rk4,
+            "dopri5" => Integrator::Dopri5,
+            other => {
+                bail!(
+                    "simulation.integrator: unknown integrator `{other}` (expected rk4 or dopri5)"
+                )
+            }
+        };
+        let step = s.step.unwrap_or(0.01);
+        if !(step.is_finite() && step > 0.0) {
+            bail!("simulation.step: must be > 0");
+        }
+        let tolerance = s.tolerance.unwrap_or(1e-8);
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            bail!("simulation.tolerance: must be > 0");
+        }
+        let max_step = s.max_step.unwrap_or(s.duration);
+        if !(max_step.is_finite() && max_step > 0.0) {
+            bail!("simulation.max_step: must be > 0");
+        }
+        let output_every = s.output_every.unwrap_or(10);
+        if output_every == 0 {
+            bail!("simulation.output_every: must be >= 1");
+        }
+        let algorithm = match s.algorithm {
+            None => Algorithm::Recurrent,
+            Some(a) => Algorithm::from_name(&a).ok_or_else(|| {
+                let names: Vec<&str> = Algorithm::ALL.iter().map(|a| a.name()).collect();
+                anyhow!(
+                    "simulation.algorithm: unknown algorithm `{a}` (known: {})",
+                    names.join(", ")
+                )
+            })?,
+        };
+        if integrator == Integrator::Rk4 {
+            if s.tolerance.is_some() {
+                bail!("simulation.tolerance: only for integrator = \"dopri5\"");
+            }
+            if s.max_step.is_some() {
+                bail!("simulation.max_step: only for integrator = \"dopri5\"");
+            }
+        }
+
+        Ok(Scene {
+            chain,
+            base,
+            gravity: e.gravity,
+            damping: e.damping,
+            wrenches,
+            drives,
+            q0,
+            qd0,
+            simulation: SimulationSpec {
+                duration: s.duration,
+                integrator,
+                step,
+                tolerance,
+                max_step,
+                output_every,
+                algorithm,
+            },
+        })
+    }
+
+    /// Whether the base is free-floating.
+    #[must_use]
+    pub fn is_floating(&self) -> bool {
+        matches!(self.base, BaseSpec::FreeFloating { .. })
+    }
+}
