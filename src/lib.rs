@@ -6,6 +6,7 @@
 #![warn(missing_docs)]
 
 pub mod commands;
+pub mod convert;
 pub mod integrate;
 pub mod poly;
 pub mod scene;
