@@ -2,6 +2,7 @@
 //! the interpreted f64 algorithms, and cheaper than Featherstone's generic CRBA for SSRMS.
 
 use kanegen::commands::generate::GENERATED;
+use kanegen::metrics::rel_err;
 use kanegen::random::{random_vec, rng};
 use kanegen::{Algorithm, Chain, Loads};
 use kanegen_generated::{srms::Srms, ssrms::Ssrms, ssrms6::Ssrms6};
@@ -9,17 +10,6 @@ use std::path::Path;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn rel_err(x: &[f64], y: &[f64]) -> f64 {
-    assert_eq!(x.len(), y.len());
-    let num = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let den = y.iter().map(|b| b.abs()).fold(f64::MIN_POSITIVE, f64::max);
-    num / den
 }
 
 #[test]

@@ -1,6 +1,7 @@
 //! `kanegen::dynamics!` on random-geometry models (prismatic joints, gravity, a runtime payload):
 //! the emitted functions equal the interpreted f64 algorithms.
 
+use kanegen::metrics::rel_err;
 use kanegen::random::{random_vec, rng};
 use kanegen::{Algorithm, Chain, Inertial, Loads};
 use std::path::Path;
@@ -18,17 +19,6 @@ const G: [f64; 3] = [0.3, -1.2, -9.81];
 
 fn load(rel: &str) -> Chain {
     kanegen::io::load_model(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
-}
-
-fn rel_err(x: &[f64], y: &[f64]) -> f64 {
-    assert_eq!(x.len(), y.len());
-    let num = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (a - b).abs())
-        .fold(0.0, f64::max);
-    let den = y.iter().map(|b| b.abs()).fold(f64::MIN_POSITIVE, f64::max);
-    num / den
 }
 
 fn flat<const N: usize>(a: [[f64; N]; N]) -> Vec<f64> {
