@@ -19,6 +19,7 @@
 use crate::{Chain, ExternalWrench, Inertial, LoadFrame, Validation};
 use anyhow::{anyhow, bail, Context, Result};
 use kanegen_core::algorithms::floating::BASE_BODY;
+use kanegen_core::io::InertiaSpec;
 use kanegen_core::linalg::Vec3;
 use kanegen_core::Algorithm;
 use serde::Deserialize;
@@ -47,35 +48,11 @@ struct RawBase {
     kind: String,
     mass: Option<f64>,
     com: Option<[f64; 3]>,
-    inertia: Option<RawInertia>,
+    inertia: Option<InertiaSpec>,
     position: Option<[f64; 3]>,
     quaternion: Option<[f64; 4]>,
     v: Option<[f64; 3]>,
     omega: Option<[f64; 3]>,
-}
-
-#[derive(Deserialize, Clone, Copy)]
-#[serde(deny_unknown_fields)]
-struct RawInertia {
-    ixx: f64,
-    iyy: f64,
-    izz: f64,
-    #[serde(default)]
-    ixy: f64,
-    #[serde(default)]
-    ixz: f64,
-    #[serde(default)]
-    iyz: f64,
-}
-
-impl RawInertia {
-    fn matrix(&self) -> [[f64; 3]; 3] {
-        [
-            [self.ixx, self.ixy, self.ixz],
-            [self.ixy, self.iyy, self.iyz],
-            [self.ixz, self.iyz, self.izz],
-        ]
-    }
 }
 
 #[derive(Deserialize)]
@@ -83,7 +60,7 @@ impl RawInertia {
 struct RawPayload {
     mass: f64,
     com: [f64; 3],
-    inertia: RawInertia,
+    inertia: InertiaSpec,
 }
 
 #[derive(Deserialize, Default)]
@@ -338,7 +315,7 @@ impl Scene {
                 let pay = Inertial {
                     mass: p.mass,
                     com: p.com,
-                    inertia: p.inertia.matrix(),
+                    inertia: p.inertia.0,
                 };
                 kanegen_core::model::validate_inertial_with("payload", "inertia", &pay, validation)
                     .map_err(|e| anyhow!("payload.inertia: {e}"))?;
@@ -382,7 +359,7 @@ impl Scene {
                     let com = b.com.or(model.map(|i| i.com)).unwrap_or([0.0; 3]);
                     let inertia = b
                         .inertia
-                        .map(|i| i.matrix())
+                        .map(|i| i.0)
                         .or(model.map(|i| i.inertia))
                         .ok_or_else(|| anyhow!("base.inertia: the model has no base inertial"))?;
                     if !(mass.is_finite() && mass > 0.0) {

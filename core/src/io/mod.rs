@@ -25,7 +25,7 @@ mod write;
 use crate::model::{Chain, ModelError, Validation};
 use std::path::Path;
 
-pub use toml_model::parse_toml;
+pub use toml_model::{parse_toml, InertiaSpec};
 pub use urdf::{parse_urdf, parse_urdf_with};
 pub use write::to_toml;
 

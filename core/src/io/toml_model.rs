@@ -105,8 +105,11 @@ struct BodySpec {
     inertia: InertiaSpec,
 }
 
-/// `{ ixx, iyy, izz, ixy, ixz, iyz }` (off-diagonals default 0) or a 3×3 matrix.
-struct InertiaSpec(M3);
+/// An inertia tensor as written in kanegen's TOML files (models and scenes):
+/// `{ ixx, iyy, izz, ixy, ixz, iyz }` (off-diagonals default 0, URDF sign convention) or a
+/// row-major 3×3 matrix. Deserializes with serde; `.0` is the matrix.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct InertiaSpec(pub M3);
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
