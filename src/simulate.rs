@@ -526,8 +526,9 @@ pub fn trajectory_csv(scene: &Scene, run: &Run) -> String {
     out
 }
 
-/// Writes `trajectory.csv`, `summary.json`, `joints.svg` and (when anything is monitored)
-/// `drift.svg` into `dir` (created if needed).
+/// Writes `trajectory.csv`, `summary.json`, `joints.svg`, `end_effector.svg`, (free-floating)
+/// `base_attitude.svg` and (when anything is monitored) `drift.svg` into `dir` (created if
+/// needed).
 pub fn write_outputs(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create `{}`", dir.display()))?;
     let w = |name: &str, text: &str| -> Result<()> {
