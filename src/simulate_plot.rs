@@ -1,13 +1,17 @@
-//! SVG plots of a simulation run: joint angles, and energy/momentum drift, against time.
+//! SVG plots of a simulation run against time: joint angles, energy/momentum drift, the
+//! end-effector position and (free-floating) the base attitude.
 
 use crate::scene::Scene;
 use crate::simulate::Run;
 use anyhow::{Context, Result};
+use kanegen_core::algorithms::floating::quat_to_matrix;
+use kanegen_core::algorithms::kinematics::base_frame;
+use kanegen_core::linalg::Vec3;
 use plotters::prelude::*;
 use std::path::Path;
 
 /// A named polyline.
-type Series = (String, Vec<(f64, f64)>);
+pub type Series = (String, Vec<(f64, f64)>);
 
 /// Renders `series` as an SVG line chart.
 pub fn line_chart(title: &str, y_desc: &str, series: &[Series]) -> Result<String> {
@@ -63,7 +67,68 @@ pub fn line_chart(title: &str, y_desc: &str, series: &[Series]) -> Result<String
     Ok(svg)
 }
 
-/// Writes `joints.svg` (joint positions) and, when the scene monitors any conserved quantity,
+/// The inertial-frame origin of the last body at every sample (`x`, `y`, `z` series).
+#[must_use]
+pub fn end_effector_series(scene: &Scene, run: &Run) -> Vec<Series> {
+    let n = scene.chain.dof();
+    let params = scene.chain.params();
+    let mut out: Vec<Series> = ["x", "y", "z"]
+        .iter()
+        .map(|c| ((*c).to_string(), Vec::with_capacity(run.samples.len())))
+        .collect();
+    for s in &run.samples {
+        let x = &s.x;
+        let q = if scene.is_floating() {
+            &x[7..7 + n]
+        } else {
+            &x[..n]
+        };
+        let mut o = Vec3::<f64>::zero();
+        for k in base_frame(&params, q) {
+            o = &o + &k.r;
+        }
+        let p = if scene.is_floating() {
+            let quat: [f64; 4] = x[3..7].try_into().expect("4 entries");
+            &quat_to_matrix(&quat).mul_vec(&o) + &Vec3::new(x[0], x[1], x[2])
+        } else {
+            o
+        };
+        for (i, series) in out.iter_mut().enumerate() {
+            series.1.push((s.t, p.0[i]));
+        }
+    }
+    out
+}
+
+/// Roll, pitch, yaw (Z–Y–X Euler angles, rad) of the base quaternion `[x, y, z, w]` at every
+/// sample of a free-floating run, unwrapped (multiples of 2π added) to stay continuous.
+#[must_use]
+pub fn base_attitude_series(run: &Run) -> Vec<Series> {
+    let mut out: Vec<Series> = ["roll", "pitch", "yaw"]
+        .iter()
+        .map(|c| ((*c).to_string(), Vec::with_capacity(run.samples.len())))
+        .collect();
+    for s in &run.samples {
+        let [x, y, z, w] = [s.x[3], s.x[4], s.x[5], s.x[6]];
+        let roll = (2.0 * (w * x + y * z)).atan2(1.0 - 2.0 * (x * x + y * y));
+        let pitch = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0).asin();
+        let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
+        for (series, v) in out.iter_mut().zip([roll, pitch, yaw]) {
+            // Unwrap the ±π jumps of roll and yaw so the curves stay continuous.
+            let v = match series.1.last() {
+                Some(&(_, prev)) => {
+                    v + (std::f64::consts::TAU * ((prev - v) / std::f64::consts::TAU).round())
+                }
+                None => v,
+            };
+            series.1.push((s.t, v));
+        }
+    }
+    out
+}
+
+/// Writes `joints.svg` (joint positions), `end_effector.svg` (inertial position of the last
+/// body's origin), for a free-floating base `base_attitude.svg` (roll/pitch/yaw) and, when the scene monitors any conserved quantity,
 /// `drift.svg` (relative energy and momentum drift) into `dir`.
 pub fn write_plots(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
     let n = scene.chain.dof();
@@ -89,6 +154,24 @@ pub fn write_plots(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
         "joints.svg",
         line_chart("Joint positions", "q (rad or m)", &joints)?,
     )?;
+    write(
+        "end_effector.svg",
+        line_chart(
+            "End-effector (last body origin), inertial frame",
+            "position (m)",
+            &end_effector_series(scene, run),
+        )?,
+    )?;
+    if scene.is_floating() {
+        write(
+            "base_attitude.svg",
+            line_chart(
+                "Base attitude (Z-Y-X Euler angles)",
+                "angle (rad)",
+                &base_attitude_series(run),
+            )?,
+        )?;
+    }
     let mut drift: Vec<Series> = Vec::new();
     let pick = |f: &dyn Fn(&crate::simulate::Sample) -> Option<f64>| -> Option<Vec<(f64, f64)>> {
         run.samples.iter().map(|s| f(s).map(|v| (s.t, v))).collect()
