@@ -59,7 +59,7 @@ enum Command {
     },
     /// Operation counts of A and b for a model, per algorithm and convention.
     Count {
-        /// Model file (.urdf or .toml).
+        /// Model file (.urdf or .toml), or a scene file (.toml with a `model` key).
         model: PathBuf,
         /// Only this algorithm (default: all).
         #[arg(long, value_parser = parse_algorithm)]
@@ -181,11 +181,22 @@ fn main() -> Result<()> {
             json,
             allow_nonphysical,
         } => {
+            let algs: Vec<Algorithm> = algorithm.map_or(Algorithm::ALL.to_vec(), |a| vec![a]);
+            if commands::count::is_scene_file(&model) {
+                anyhow::ensure!(gravity.is_none(), "--gravity: a scene's [effects] decide");
+                let scene = kanegen::scene::Scene::load(&model)?;
+                let r = commands::count::count_scene(&scene, &model.display().to_string(), &algs);
+                if json {
+                    println!("{}", serde_json::to_string_pretty(&r)?);
+                } else {
+                    print!("{}", commands::count::render_scene_text(&r));
+                }
+                return Ok(());
+            }
             let chain = load(&model, allow_nonphysical)?;
             let g = gravity
                 .map(|s| kanegen::states::parse_vec3(&s).context("--gravity"))
                 .transpose()?;
-            let algs: Vec<Algorithm> = algorithm.map_or(Algorithm::ALL.to_vec(), |a| vec![a]);
             let r = commands::count::count(&chain, &algs, g);
             if json {
                 println!("{}", serde_json::to_string_pretty(&r)?);
