@@ -58,6 +58,8 @@ struct RawBase {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawPayload {
+    /// Name of the body (link) that holds the payload; default the last body.
+    body: Option<String>,
     mass: f64,
     com: [f64; 3],
     inertia: InertiaSpec,
@@ -211,7 +213,7 @@ pub struct SimulationSpec {
 /// A validated scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
-    /// The arm, with the payload (if any) merged into the last body.
+    /// The arm, with the payload (if any) merged into the body that holds it (default the last).
     pub chain: Chain,
     /// Fixed or free-floating base.
     pub base: BaseSpec,
@@ -323,8 +325,19 @@ impl Scene {
                 kanegen_core::model::validate_inertial_with("payload", "inertia", &pay, validation)
                     .map_err(|e| anyhow!("payload.inertia: {e}"))?;
                 let mut joints = chain.joints().to_vec();
-                let last = joints.last_mut().expect("a chain has a joint");
-                last.inertial = combine_inertials(&last.inertial, &pay);
+                let holder = match &p.body {
+                    None => joints.last_mut().expect("a chain has a joint"),
+                    Some(name) => {
+                        let names: Vec<String> = joints.iter().map(|j| j.body.clone()).collect();
+                        joints.iter_mut().find(|j| &j.body == name).ok_or_else(|| {
+                            anyhow!(
+                                "payload.body: unknown body `{name}` (moving bodies: {})",
+                                names.join(", ")
+                            )
+                        })?
+                    }
+                };
+                holder.inertial = combine_inertials(&holder.inertial, &pay);
                 Chain::new_with(
                     chain.name(),
                     chain.base(),

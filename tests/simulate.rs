@@ -399,3 +399,41 @@ fn dopri5_rejects_a_too_large_first_step_and_recovers() {
     assert!(stats.rejected_steps > 0, "{stats:?}");
     assert!((x[0] - 5f64.cos()).abs() < 1e-8 && (x[1] + 5f64.sin()).abs() < 1e-8);
 }
+
+#[test]
+fn payload_is_welded_to_the_named_body() {
+    let text = || {
+        String::from(
+            r#"model = "tests/data/reference/srms_nguyen_hughes_1994.urdf"
+[payload]
+mass = 500.0
+com = [0.2, 0.0, 0.0]
+inertia = { ixx = 10.0, iyy = 12.0, izz = 14.0 }
+[initial]
+q = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+qd = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]
+[simulation]
+duration = 0.1
+integrator = "rk4"
+step = 0.01
+"#,
+        )
+    };
+    let plain =
+        kanegen::io::load_model(&root().join("tests/data/reference/srms_nguyen_hughes_1994.urdf"))
+            .unwrap();
+    let third = plain.joints()[2].body.clone();
+    let named = Scene::parse(
+        &text().replace("[payload]", &format!("[payload]\nbody = \"{third}\"")),
+        &root(),
+    )
+    .unwrap_or_else(|e| panic!("{e:#}"));
+    let default = Scene::parse(&text(), &root()).unwrap();
+    let m = |s: &Scene, j: usize| s.chain.joints()[j].inertial.mass;
+    assert_eq!(m(&named, 2), plain.joints()[2].inertial.mass + 500.0);
+    assert_eq!(m(&named, 5), plain.joints()[5].inertial.mass);
+    assert_eq!(m(&default, 5), plain.joints()[5].inertial.mass + 500.0);
+    let bad = text().replace("[payload]", "[payload]\nbody = \"nope\"");
+    let e = format!("{:#}", Scene::parse(&bad, &root()).unwrap_err());
+    assert!(e.contains("payload.body") && e.contains("nope"), "{e}");
+}
