@@ -109,25 +109,15 @@ pub fn count(chain: &Chain, algorithms: &[Algorithm], gravity: Option<[f64; 3]>)
     }
 }
 
-/// Human-readable table.
-pub fn render_text(r: &CountReport) -> String {
+/// Appends the table of count lines (header and one row per line) to `s`.
+fn write_count_table(s: &mut String, counts: &[CountLine]) {
     use std::fmt::Write;
-    let mut s = format!(
-        "model {} (N = {}), gravity {}\n\n{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}\n",
-        r.model,
-        r.n,
-        if r.gravity { "on" } else { "off" },
-        "algorithm",
-        "function",
-        "conv.",
-        "mul",
-        "add",
-        "m+a",
-        "div",
-        "sqrt",
-        "sincos"
+    let _ = writeln!(
+        s,
+        "{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}",
+        "algorithm", "function", "conv.", "mul", "add", "m+a", "div", "sqrt", "sincos"
     );
-    for c in &r.counts {
+    for c in counts {
         let _ = writeln!(
             s,
             "{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}",
@@ -142,6 +132,17 @@ pub fn render_text(r: &CountReport) -> String {
             c.sincos
         );
     }
+}
+
+/// Human-readable table.
+pub fn render_text(r: &CountReport) -> String {
+    let mut s = format!(
+        "model {} (N = {}), gravity {}\n\n",
+        r.model,
+        r.n,
+        if r.gravity { "on" } else { "off" }
+    );
+    write_count_table(&mut s, &r.counts);
     s
 }
 
@@ -412,26 +413,7 @@ pub fn render_scene_text(r: &SceneCountReport) -> String {
             names.join(", ")
         }
     );
-    let _ = writeln!(
-        s,
-        "{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}",
-        "algorithm", "function", "conv.", "mul", "add", "m+a", "div", "sqrt", "sincos"
-    );
-    for c in &r.counts {
-        let _ = writeln!(
-            s,
-            "{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}",
-            c.algorithm,
-            c.function,
-            c.convention,
-            c.mul,
-            c.add,
-            c.mul + c.add,
-            c.div,
-            c.sqrt,
-            c.sincos
-        );
-    }
+    write_count_table(&mut s, &r.counts);
     if !r.effects.is_empty() {
         let _ = writeln!(
             s,
