@@ -1,5 +1,5 @@
 //! Simulation scenes (issue #5): a TOML file naming a model, the base (fixed or free-floating),
-//! an optional payload, the effects (gravity, joint damping, constant wrenches), the joint
+//! an optional payload, the effects (gravity, joint damping, constant or tabulated wrenches), the joint
 //! drives, the initial state and the integrator. See README.md, "Simulation scenes".
 //!
 //! Every table rejects unknown keys, and every validation error names its key
@@ -79,10 +79,18 @@ struct RawEffects {
 struct RawWrench {
     body: String,
     frame: String,
-    #[serde(default)]
-    force: [f64; 3],
-    #[serde(default)]
-    moment: [f64; 3],
+    /// Sample times of a tabulated wrench (strictly increasing, s); absent for a constant one.
+    time: Option<Vec<f64>>,
+    force: Option<RawProfile>,
+    moment: Option<RawProfile>,
+}
+
+/// One vector (constant wrench) or one row per sample time (tabulated wrench).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawProfile {
+    Constant([f64; 3]),
+    Table(Vec<[f64; 3]>),
 }
 
 #[derive(Deserialize)]
@@ -210,6 +218,152 @@ pub struct SimulationSpec {
     pub algorithm: Algorithm,
 }
 
+/// How an external wrench varies in time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WrenchProfile {
+    /// The same force and moment at all times.
+    Constant {
+        /// Force, N.
+        force: [f64; 3],
+        /// Moment, N·m.
+        moment: [f64; 3],
+    },
+    /// Samples `(time[k], force[k], moment[k])`, interpolated linearly between samples and held
+    /// at the first (last) sample before (after) the table.
+    Table {
+        /// Strictly increasing sample times, s (at least two).
+        time: Vec<f64>,
+        /// Force at each sample time, N.
+        force: Vec<[f64; 3]>,
+        /// Moment at each sample time, N·m.
+        moment: Vec<[f64; 3]>,
+    },
+}
+
+/// An external wrench of a scene: where it acts, in which frame, and its time profile.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneWrench {
+    /// Body index (joint index of the body's inboard joint), or [`BASE_BODY`].
+    pub body: usize,
+    /// Frame of the force and moment vectors.
+    pub frame: LoadFrame,
+    /// Constant or tabulated.
+    pub profile: WrenchProfile,
+}
+
+impl SceneWrench {
+    /// Whether the wrench varies in time (a runtime input of the dynamics, not a constant).
+    #[must_use]
+    pub fn is_tabulated(&self) -> bool {
+        matches!(self.profile, WrenchProfile::Table { .. })
+    }
+
+    /// Force and moment at time `t`.
+    #[must_use]
+    pub fn value_at(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        match &self.profile {
+            WrenchProfile::Constant { force, moment } => (*force, *moment),
+            WrenchProfile::Table {
+                time,
+                force,
+                moment,
+            } => {
+                // First sample strictly after t (time is strictly increasing, at least 2 long).
+                let k = time.partition_point(|&tk| tk <= t);
+                if k == 0 {
+                    return (force[0], moment[0]);
+                }
+                if k == time.len() {
+                    return (force[k - 1], moment[k - 1]);
+                }
+                let s = (t - time[k - 1]) / (time[k] - time[k - 1]);
+                let lerp =
+                    |v: &[[f64; 3]]| [0, 1, 2].map(|i| v[k - 1][i] + s * (v[k][i] - v[k - 1][i]));
+                (lerp(force), lerp(moment))
+            }
+        }
+    }
+
+    /// The wrench at time `t` as a load of the dynamics.
+    #[must_use]
+    pub fn at(&self, t: f64) -> ExternalWrench<f64> {
+        let (force, moment) = self.value_at(t);
+        ExternalWrench {
+            body: self.body,
+            frame: self.frame,
+            force: Vec3::from_f64(force),
+            moment: Vec3::from_f64(moment),
+        }
+    }
+}
+
+/// Validates `[[effects.wrench]]` number `key`'s force/moment profiles against its `time`.
+fn wrench_profile(
+    key: &str,
+    time: Option<Vec<f64>>,
+    force: Option<RawProfile>,
+    moment: Option<RawProfile>,
+) -> Result<WrenchProfile> {
+    let Some(time) = time else {
+        let constant = |name: &str, p: Option<RawProfile>| match p {
+            None => Ok([0.0; 3]),
+            Some(RawProfile::Constant(v)) => {
+                check_finite(&format!("{key}.{name}"), &v)?;
+                Ok(v)
+            }
+            Some(RawProfile::Table(_)) => Err(anyhow!(
+                "{key}.{name}: one row per sample needs `{key}.time` (or give one vector [x, y, z])"
+            )),
+        };
+        return Ok(WrenchProfile::Constant {
+            force: constant("force", force)?,
+            moment: constant("moment", moment)?,
+        });
+    };
+    let tkey = format!("{key}.time");
+    if time.len() < 2 {
+        bail!("{tkey}: a table needs at least 2 sample times");
+    }
+    check_finite(&tkey, &time)?;
+    if let Some(k) = time.windows(2).position(|w| w[1] <= w[0]) {
+        bail!(
+            "{tkey}: sample times must be strictly increasing (time[{}] = {} after {})",
+            k + 1,
+            time[k + 1],
+            time[k]
+        );
+    }
+    let rows = |name: &str, p: Option<RawProfile>| -> Result<Vec<[f64; 3]>> {
+        let k = format!("{key}.{name}");
+        match p {
+            None => Ok(vec![[0.0; 3]; time.len()]),
+            Some(RawProfile::Constant(_)) => Err(anyhow!(
+                "{k}: with `{tkey}` give one [x, y, z] row per sample time ({} rows)",
+                time.len()
+            )),
+            Some(RawProfile::Table(v)) => {
+                if v.len() != time.len() {
+                    bail!(
+                        "{k}: expected {} rows (one per sample time), got {}",
+                        time.len(),
+                        v.len()
+                    );
+                }
+                check_finite(&k, v.as_flattened())?;
+                Ok(v)
+            }
+        }
+    };
+    if force.is_none() && moment.is_none() {
+        bail!("{key}: a tabulated wrench needs `force` or `moment` rows");
+    }
+    Ok(WrenchProfile::Table {
+        force: rows("force", force)?,
+        moment: rows("moment", moment)?,
+        time,
+    })
+}
+
 /// A validated scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -221,8 +375,9 @@ pub struct Scene {
     pub gravity: Option<[f64; 3]>,
     /// Joint viscous damping coefficients: `τ_d = −c q̇`.
     pub damping: Option<Vec<f64>>,
-    /// Constant external wrenches ([`BASE_BODY`] for the free-floating base body).
-    pub wrenches: Vec<ExternalWrench<f64>>,
+    /// External wrenches, constant or tabulated in time ([`BASE_BODY`] for the free-floating base
+    /// body).
+    pub wrenches: Vec<SceneWrench>,
     /// The joint drives.
     pub drives: Drives,
     /// Initial joint positions.
@@ -428,7 +583,7 @@ impl Scene {
             }
         }
         let mut wrenches = Vec::new();
-        for (k, w) in e.wrench.iter().enumerate() {
+        for (k, w) in e.wrench.into_iter().enumerate() {
             let key = format!("effects.wrench[{k}]");
             let body = if w.body == "base" || w.body == chain.base() {
                 if !floating {
@@ -455,13 +610,10 @@ impl Scene {
                 "inertial" => LoadFrame::Base,
                 other => bail!("{key}.frame: unknown frame `{other}` (expected body or inertial)"),
             };
-            check_finite(&format!("{key}.force"), &w.force)?;
-            check_finite(&format!("{key}.moment"), &w.moment)?;
-            wrenches.push(ExternalWrench {
+            wrenches.push(SceneWrench {
                 body,
                 frame,
-                force: Vec3::from_f64(w.force),
-                moment: Vec3::from_f64(w.moment),
+                profile: wrench_profile(&key, w.time, w.force, w.moment)?,
             });
         }
 

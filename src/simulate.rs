@@ -8,7 +8,7 @@
 //! exponential map ([`System::advance`]) and needs no projection.
 
 use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, Stats, System};
-use crate::scene::{BaseSpec, Drives, Integrator, Scene};
+use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench};
 use anyhow::{Context, Result};
 use kanegen_core::algorithms::floating::{
     floating_forward_dynamics, kinetic_energy, momentum, quat_to_matrix, FloatingBase,
@@ -25,8 +25,10 @@ pub struct SceneSystem<'a> {
     scene: &'a Scene,
     params: ChainParams<f64>,
     base: Option<FloatingBase<f64>>,
-    /// Loads without `tau` (gravity and wrenches, as the scene names them).
+    /// Loads without `tau` (gravity and constant wrenches, as the scene names them).
     passive: Loads<f64>,
+    /// Whether some wrench is tabulated in time (then `deriv` evaluates the wrenches at `t`).
+    time_varying: bool,
     n: usize,
 }
 
@@ -76,8 +78,9 @@ impl<'a> SceneSystem<'a> {
             passive: Loads {
                 tau: None,
                 gravity: scene.gravity.map(Vec3::from_f64),
-                external: scene.wrenches.clone(),
+                external: scene.wrenches.iter().map(|w| w.at(0.0)).collect(),
             },
+            time_varying: scene.wrenches.iter().any(SceneWrench::is_tabulated),
             n: scene.chain.dof(),
         }
     }
@@ -214,10 +217,13 @@ impl System for SceneSystem<'_> {
     fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
         let n = self.n;
         let (q, qd, st) = self.split(x);
-        let loads = Loads {
+        let mut loads = Loads {
             tau: self.torques(t, q, qd),
             ..self.passive.clone()
         };
+        if self.time_varying {
+            loads.external = self.scene.wrenches.iter().map(|w| w.at(t)).collect();
+        }
         let alg = self.scene.simulation.algorithm;
         match (&self.base, st) {
             (Some(b), Some(st)) => {

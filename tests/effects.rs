@@ -144,7 +144,27 @@ fn count_scene_reports_the_cost_of_each_enabled_effect() {
         2 * 3,
         "A and b, three conventions"
     );
-    assert_eq!(effect_names(&r), ["gravity", "wrench[0]", "damping"]);
+    assert_eq!(
+        effect_names(&r),
+        ["gravity", "wrench[0]", "wrench[1]", "damping"]
+    );
+    // The same wrench on the same body, constant (folded into the code: its zero components
+    // vanish) and tabulated (six runtime inputs): the tabulated one cannot cost less.
+    let emitted = |name: &str| {
+        let e = r["effects"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|e| e["effect"] == name && e["convention"] == "emitted")
+            .unwrap();
+        (e["mul"].as_i64().unwrap(), e["add"].as_i64().unwrap())
+    };
+    let (constant, tabulated) = (emitted("wrench[0]"), emitted("wrench[1]"));
+    println!("wrench on B8, emitted: constant {constant:?}, tabulated {tabulated:?}");
+    assert!(
+        tabulated.0 > constant.0 && tabulated.1 >= constant.1,
+        "constant {constant:?} tabulated {tabulated:?}"
+    );
     for e in r["effects"].as_array().unwrap() {
         let (m, a) = (e["mul"].as_i64().unwrap(), e["add"].as_i64().unwrap());
         println!("{} {}: {m} mul, {a} add", e["effect"], e["convention"]);

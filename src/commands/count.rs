@@ -149,7 +149,7 @@ pub fn render_text(r: &CountReport) -> String {
 // ---------------------------------------------------------------------------------------------
 // `kanegen count SCENE`: the scene's dynamics and the operations each effect adds.
 
-use crate::scene::{BaseSpec, Scene};
+use crate::scene::{BaseSpec, Scene, SceneWrench};
 use kanegen_core::algorithms::floating::{
     floating_dynamics, quat_to_matrix, FloatingBase, FloatingState,
 };
@@ -174,7 +174,7 @@ pub fn is_scene_file(path: &Path) -> bool {
 pub enum Effect {
     /// Uniform gravity.
     Gravity,
-    /// The i-th constant external wrench.
+    /// The i-th external wrench (constant: folded in; tabulated: six runtime inputs).
     Wrench(usize),
     /// Joint viscous damping `−c q̇`, traced as part of the generalized force.
     Damping,
@@ -206,12 +206,27 @@ pub fn scene_effects(scene: &Scene) -> Vec<Effect> {
     v
 }
 
-fn sym_wrench(w: &ExternalWrench<f64>) -> ExternalWrench<Sym> {
+/// The `i`-th wrench of a scene on the tracer: a constant wrench is folded into the code; a
+/// tabulated one becomes the runtime inputs `f{i}_x … m{i}_z` (its value changes with time).
+fn sym_wrench(t: &Tracer, i: usize, w: &SceneWrench) -> ExternalWrench<Sym> {
+    let (force, moment) = if w.is_tabulated() {
+        let v3 = |p: &str| {
+            Vec3::new(
+                t.input(format!("{p}{i}_x")),
+                t.input(format!("{p}{i}_y")),
+                t.input(format!("{p}{i}_z")),
+            )
+        };
+        (v3("f"), v3("m"))
+    } else {
+        let (f, m) = w.value_at(0.0);
+        (Vec3::from_f64(f), Vec3::from_f64(m))
+    };
     ExternalWrench {
         body: w.body,
         frame: w.frame,
-        force: Vec3::from_f64(w.force.clone().into_array()),
-        moment: Vec3::from_f64(w.moment.clone().into_array()),
+        force,
+        moment,
     }
 }
 
@@ -263,7 +278,7 @@ pub fn trace_scene_bias(scene: &Scene, alg: Algorithm, effects: &[Effect]) -> Tr
             .iter()
             .enumerate()
             .filter(|(i, _)| effects.contains(&Effect::Wrench(*i)))
-            .map(|(_, w)| sym_wrench(w))
+            .map(|(i, w)| sym_wrench(&t, i, w))
             .collect(),
     };
     let b = match &scene.base {
