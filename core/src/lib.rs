@@ -10,6 +10,7 @@
 
 pub mod algorithms;
 pub mod dual;
+pub mod exact;
 pub mod io;
 pub mod ldlt;
 pub mod linalg;
@@ -18,9 +19,10 @@ pub mod model;
 pub mod random;
 pub mod scalar;
 pub mod sym;
+pub mod wide;
 
 pub use algorithms::{Algorithm, Dynamics, ExternalWrench, LoadFrame, Loads};
 pub use model::{
     Chain, ChainParams, Inertial, Joint, JointKind, ModelError, Placement, Validation,
 };
-pub use scalar::Scalar;
+pub use scalar::{Real, Scalar};

@@ -95,3 +95,21 @@ impl_float_scalar!(f32);
 pub fn constants<S: Scalar>(xs: &[f64]) -> Vec<S> {
     xs.iter().map(|&x| S::constant(x)).collect()
 }
+
+/// A numeric scalar whose values can be read back as `f64` (every [`Scalar`] except the tracer).
+pub trait Real: Scalar {
+    /// The nearest `f64` (for `f64` itself, the value; for wider types, rounded).
+    fn to_f64(&self) -> f64;
+}
+
+impl Real for f64 {
+    fn to_f64(&self) -> f64 {
+        *self
+    }
+}
+
+impl Real for f32 {
+    fn to_f64(&self) -> f64 {
+        f64::from(*self)
+    }
+}
