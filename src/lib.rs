@@ -5,6 +5,7 @@
 //! code generation and simulation. This crate is the user-facing facade and the `kanegen` CLI.
 #![warn(missing_docs)]
 
+pub mod accuracy;
 pub mod commands;
 pub mod convert;
 pub mod integrate;

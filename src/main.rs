@@ -110,6 +110,22 @@ enum Command {
         #[arg(long, default_value_t = 2000)]
         calls: usize,
     },
+    /// What accuracy costs in time: errors of A, b, q̈ per precision against a double-double
+    /// reference with ns per call; integrators' work–precision; each scene effect's cost and
+    /// trajectory change. Without inputs: the four subjects of docs/accuracy.md.
+    Accuracy {
+        /// Model (.urdf/.toml) or scene files (default: SSRMS model and three example scenes).
+        inputs: Vec<PathBuf>,
+        /// Write accuracy.md, accuracy.json and work-precision SVGs into this directory.
+        #[arg(long)]
+        out: Option<PathBuf>,
+        /// Print JSON (one input: the report; several: {"subjects": [...]}).
+        #[arg(long)]
+        json: bool,
+        /// Accept inertia tensors that violate the triangle inequality (models only).
+        #[arg(long)]
+        allow_nonphysical: bool,
+    },
     /// Simulate a scene file (TOML, README.md "Simulation scenes"): write trajectory.csv,
     /// summary.json and SVG plots into --out, print a summary.
     Simulate {
@@ -243,6 +259,38 @@ fn main() -> Result<()> {
                 println!("{}", serde_json::to_string_pretty(&r)?);
             } else {
                 print!("{}", commands::bench::render_text(&r));
+            }
+        }
+        Command::Accuracy {
+            inputs,
+            out,
+            json,
+            allow_nonphysical,
+        } => {
+            let inputs: Vec<PathBuf> = if inputs.is_empty() {
+                commands::accuracy::DEFAULT_INPUTS
+                    .iter()
+                    .map(PathBuf::from)
+                    .collect()
+            } else {
+                inputs
+            };
+            let opts = kanegen::accuracy::Options { timing: true };
+            let reports = commands::accuracy::run(&inputs, allow_nonphysical, opts)?;
+            if let Some(dir) = &out {
+                commands::accuracy::write_all(&reports, dir)?;
+                eprintln!(
+                    "wrote accuracy.md, accuracy.json, work-precision SVGs to {}",
+                    dir.display()
+                );
+            }
+            if json {
+                println!(
+                    "{}",
+                    serde_json::to_string_pretty(&commands::accuracy::to_json(&reports))?
+                );
+            } else if out.is_none() {
+                print!("{}", commands::accuracy::render_markdown(&reports, true)?);
             }
         }
         Command::Simulate { scene, out, json } => {

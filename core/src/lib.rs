@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod algorithms;
+pub mod compensated;
 pub mod dual;
 pub mod exact;
 pub mod io;

@@ -17,7 +17,7 @@ use kanegen_core::algorithms::floating::{
 use kanegen_core::exact::Exact;
 use kanegen_core::ldlt::{ldlt, solve};
 use kanegen_core::linalg::Vec3;
-use kanegen_core::metrics::{rel_err, rel_err_mat};
+use kanegen_core::metrics::{rel_err, rel_err_mat, rel_err_wide};
 use kanegen_core::random::{random_chain, ChainSpec};
 use kanegen_core::wide::Wide;
 use kanegen_core::{
@@ -106,16 +106,10 @@ fn to_f64_vec<S: Real>(b: &[S]) -> Vec<f64> {
     b.iter().map(Real::to_f64).collect()
 }
 
-/// Error of a `Wide` or `f64` result against the exact one, measured in double-double so that
-/// errors far below `f64`'s resolution are seen: `max |x − y| / max |y|`.
+/// Error of a `Wide` result against the exact one, in double-double.
 fn wide_rel(x: &[Wide], y: &[Exact]) -> f64 {
-    let num = x
-        .iter()
-        .zip(y)
-        .map(|(a, b)| (*a - b.to_wide()).to_f64().abs())
-        .fold(0.0, f64::max);
-    let den = y.iter().map(|b| b.to_f64().abs()).fold(0.0, f64::max);
-    num / den
+    let y: Vec<Wide> = y.iter().map(Exact::to_wide).collect();
+    rel_err_wide(x, &y)
 }
 
 fn all_exact(d: &Dynamics<Exact>) -> bool {

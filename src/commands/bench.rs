@@ -128,7 +128,8 @@ pub fn render_text(r: &BenchReport) -> String {
 }
 
 /// The SSRMS model the generated code was emitted from (embedded, so the command runs anywhere).
-const SSRMS_URDF: &str = include_str!("../../tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
+pub const SSRMS_URDF: &str =
+    include_str!("../../tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
 
 /// Generated SSRMS code against the interpreted f64 algorithms, side by side.
 pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {

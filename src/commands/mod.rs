@@ -1,5 +1,6 @@
 //! The CLI's commands, as library functions the tests call directly.
 
+pub mod accuracy;
 pub mod bench;
 pub mod count;
 pub mod eval;

@@ -1,0 +1,223 @@
+//! `kanegen accuracy` (issue #6): the committed docs/accuracy.md is the rendering of the
+//! committed docs/accuracy.json, and that JSON's deterministic parts (errors, steps, operation
+//! counts, trajectory changes) agree with a fresh run; the rows say what they should (f32 loses
+//! digits that f64 keeps, fixed-step errors fall with the step at the integrator's order,
+//! leaving an effect out moves the trajectory).
+//!
+//! Times are not compared: they come from a shared, noisy machine.
+
+use kanegen::accuracy::{AccuracyReport, Options};
+use kanegen::commands::accuracy::{figure_name, render_markdown, run, Cost, DEFAULT_INPUTS};
+use std::path::PathBuf;
+
+fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn committed() -> Vec<AccuracyReport> {
+    let text = std::fs::read_to_string(root().join("docs/accuracy.json")).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    serde_json::from_value(v["subjects"].clone()).unwrap()
+}
+
+fn fresh() -> Vec<AccuracyReport> {
+    let inputs: Vec<PathBuf> = DEFAULT_INPUTS.iter().map(|p| root().join(p)).collect();
+    let mut r = run(&inputs, false, Options { timing: false }).unwrap();
+    for (x, name) in r.iter_mut().zip(DEFAULT_INPUTS) {
+        x.subject = name.into();
+    }
+    r
+}
+
+/// `a` and `b` agree to a factor `f` (both finite and positive), or are both zero / both NaN.
+fn close(a: f64, b: f64, f: f64) -> bool {
+    (a.is_nan() && b.is_nan()) || a == b || (a > 0.0 && b > 0.0 && a / b < f && b / a < f)
+}
+
+#[test]
+fn docs_accuracy_md_renders_docs_accuracy_json() {
+    let reports = committed();
+    let md = std::fs::read_to_string(root().join("docs/accuracy.md")).unwrap();
+    assert!(
+        md == render_markdown(&reports, true).unwrap(),
+        "docs/accuracy.md is not the rendering of docs/accuracy.json: run \
+         `cargo run --release -- accuracy --out docs`"
+    );
+    for r in &reports {
+        if !r.integration.is_empty() {
+            for cost in [Cost::Wall, Cost::Evals] {
+                let svg = root().join("docs").join(figure_name(r, cost));
+                assert!(svg.exists(), "{} missing", svg.display());
+            }
+        }
+    }
+}
+
+#[test]
+fn docs_accuracy_json_is_fresh() {
+    let (old, new) = (committed(), fresh());
+    let stale = "docs/accuracy.json is stale: run `cargo run --release -- accuracy --out docs`";
+    assert_eq!(old.len(), new.len(), "{stale}");
+    for (o, n) in old.iter().zip(&new) {
+        assert_eq!(
+            (&o.subject, o.n, &o.base),
+            (&n.subject, n.n, &n.base),
+            "{stale}"
+        );
+        assert!(
+            close(o.cond_a, n.cond_a, 1.001),
+            "{}: cond {} vs {}; {stale}",
+            o.subject,
+            o.cond_a,
+            n.cond_a
+        );
+        assert_eq!(o.evaluation.len(), n.evaluation.len(), "{stale}");
+        for (a, b) in o.evaluation.iter().zip(&n.evaluation) {
+            // Round-off errors may move a little with the machine's libm; a factor 2 is a change.
+            for (x, y) in [
+                (a.rel_err_a, b.rel_err_a),
+                (a.rel_err_b, b.rel_err_b),
+                (a.rel_err_qdd, b.rel_err_qdd),
+            ] {
+                assert!(
+                    close(x, y, 2.0),
+                    "{} {} {}: {x:e} vs {y:e}; {stale}",
+                    o.subject,
+                    a.precision,
+                    a.path
+                );
+            }
+        }
+        assert_eq!(o.integration.len(), n.integration.len(), "{stale}");
+        for (a, b) in o.integration.iter().zip(&n.integration) {
+            assert_eq!(
+                (&a.integrator, &a.setting),
+                (&b.integrator, &b.setting),
+                "{stale}"
+            );
+            match (a.final_error, b.final_error) {
+                (Some(x), Some(y)) => assert!(
+                    close(x, y, 2.0) || x.max(y) < 1e-12,
+                    "{} {} {}: {x:e} vs {y:e}; {stale}",
+                    o.subject,
+                    a.integrator,
+                    a.setting
+                ),
+                (x, y) => assert_eq!(x.is_none(), y.is_none(), "{stale}"),
+            }
+            let (s, t) = (a.steps as f64, b.steps as f64);
+            assert!(
+                (s - t).abs() <= 0.02 * s.max(t) + 2.0,
+                "{} steps {s} vs {t}; {stale}",
+                a.setting
+            );
+        }
+        assert_eq!(o.effects.len(), n.effects.len(), "{stale}");
+        for (a, b) in o.effects.iter().zip(&n.effects) {
+            assert_eq!((&a.effect, a.ops), (&b.effect, b.ops), "{stale}");
+            assert!(
+                close(a.trajectory_change, b.trajectory_change, 1.01),
+                "{stale}"
+            );
+        }
+    }
+}
+
+#[test]
+fn the_rows_say_what_they_should() {
+    for r in committed() {
+        let row = |p: &str, path: &str| {
+            r.evaluation
+                .iter()
+                .find(|e| e.precision == p && e.path == path)
+                .unwrap_or_else(|| panic!("{}: no {p} {path} row", r.subject))
+        };
+        let (f32r, f64r) = (row("f32", "interpreted"), row("f64", "interpreted"));
+        // f64 keeps about 16 − log10 cond(A) digits of q̈, f32 about 7 − log10 cond(A): at least
+        // 6 digits apart, and f64 within 10·cond(A)·ε of the reference.
+        assert!(f32r.rel_err_qdd > 1e6 * f64r.rel_err_qdd, "{}", r.subject);
+        assert!(
+            f64r.rel_err_qdd < 10.0 * r.cond_a * f64::EPSILON,
+            "{}: {:e}",
+            r.subject,
+            f64r.rel_err_qdd
+        );
+        assert!(
+            f64r.rel_err_a < 1e-14 && f64r.rel_err_b < 1e-13,
+            "{}",
+            r.subject
+        );
+        // Compensated f64 is as good as computing in twice the precision: delivered in f64 it
+        // is within an ulp or two of the reference; double-double is itself within 1e-28 of
+        // exact rationals (measured ≤ 7.1e-30 for the 116 t payload, cond 1.2e5).
+        let comp = row("compensated", "interpreted");
+        assert!(
+            comp.rel_err_qdd <= 2.0 * f64::EPSILON,
+            "{}: {:e}",
+            r.subject,
+            comp.rel_err_qdd
+        );
+        let wide = row("wide", "interpreted");
+        assert!(
+            wide.rel_err_qdd < 1e-28 && wide.rel_err_a < 1e-30,
+            "{}",
+            r.subject
+        );
+        // Generated code, where there is any: f64 (plain and fused) as good as interpreted f64,
+        // f32 six digits worse.
+        let generated: Vec<_> = r
+            .evaluation
+            .iter()
+            .filter(|e| e.path == "generated")
+            .collect();
+        for g in &generated {
+            let bound = if g.precision == "f32" {
+                10.0 * r.cond_a * f64::from(f32::EPSILON)
+            } else {
+                10.0 * r.cond_a * f64::EPSILON
+            };
+            assert!(
+                g.rel_err_qdd < bound,
+                "{} generated {}: {:e}",
+                r.subject,
+                g.precision,
+                g.rel_err_qdd
+            );
+        }
+        if let (Some(g32), Some(g64)) = (
+            generated.iter().find(|g| g.precision == "f32"),
+            generated.iter().find(|g| g.precision == "f64"),
+        ) {
+            assert!(g32.rel_err_qdd > 1e6 * g64.rel_err_qdd, "{}", r.subject);
+        }
+        // Fixed-step integrators: halving the step divides the error by about 2^p while above
+        // the reference's floor (RK4 p = 4, midpoint p = 2); checked on the two finest steps.
+        for (name, p) in [("rk4", 4.0), ("midpoint", 2.0)] {
+            let errs: Vec<f64> = r
+                .integration
+                .iter()
+                .filter(|i| i.integrator == name)
+                .filter_map(|i| i.final_error)
+                .collect();
+            if let [.., a, b] = errs[..] {
+                if b > 1e3 * r.integration_reference_error.unwrap() {
+                    let order = (a / b).log2();
+                    assert!(
+                        (order - p).abs() < 0.5,
+                        "{} {name}: order {order:.2}",
+                        r.subject
+                    );
+                }
+            }
+        }
+        for e in &r.effects {
+            assert!(e.ops > 0, "{}: {} costs nothing", r.subject, e.effect);
+            assert!(
+                e.trajectory_change > 1e-8,
+                "{}: {} changes nothing",
+                r.subject,
+                e.effect
+            );
+        }
+    }
+}
