@@ -218,3 +218,94 @@ fn ssrms_mass_matrix_beats_generic_crba() {
     let c = choice.counts();
     assert_eq!((c.mul, c.add), (m, a));
 }
+
+/// Per-function counts of the header line `Fused multiply-adds: T (`f` k, …)`, and `T`.
+fn header_fmas(src: &str) -> (u64, Vec<(String, u64)>) {
+    let line = src
+        .lines()
+        .find_map(|l| l.strip_prefix("//! Fused multiply-adds: "))
+        .expect("the fma header line");
+    let (total, rest) = line.split_once(" (").unwrap();
+    let per = rest
+        .split_once(')')
+        .unwrap()
+        .0
+        .split(", ")
+        .map(|p| {
+            let (f, k) = p.split_once(' ').unwrap();
+            (f.trim_matches('`').to_string(), k.parse().unwrap())
+        })
+        .collect();
+    (total.parse().unwrap(), per)
+}
+
+/// Calls of `call` per generated function (`pub fn NAME(` up to the next function), comments
+/// excluded.
+fn calls_per_function(src: &str, call: &str) -> Vec<(String, u64)> {
+    let mut out: Vec<(String, u64)> = Vec::new();
+    for line in src.lines() {
+        let code = line.trim_start();
+        if code.starts_with("//") {
+            continue;
+        }
+        if let Some(rest) = code.strip_prefix("pub fn ") {
+            out.push((rest.split('(').next().unwrap().to_string(), 0));
+        } else if let Some(last) = out.last_mut() {
+            last.1 += line.matches(call).count() as u64;
+        }
+    }
+    out
+}
+
+/// `fma = true` on SSRMS: every function fuses, the source has exactly the fused calls its
+/// header and its per-function docs state, the op-count table is that of the plain code, and
+/// the plain (default) file has no precision lines (it is the checked-in file, see
+/// `generated_files_are_up_to_date`).
+#[test]
+fn fma_source_has_the_fused_calls_its_header_states() {
+    let chain = GENERATED[0].chain(root()).unwrap();
+    let plain =
+        kanegen_codegen::generate_file(&chain, &kanegen_codegen::Options::new("Ssrms")).unwrap();
+    assert!(!plain.contains("Fused multiply-adds") && !plain.contains("fma("));
+    for path in [None, Some("f64::mul_add")] {
+        let mut o = kanegen_codegen::Options::new("Ssrms");
+        o.fma = true;
+        o.fma_path = path.map(String::from);
+        let src = kanegen_codegen::generate_file(&chain, &o).unwrap();
+        let call = format!("{}(", path.unwrap_or("libm::fma"));
+        let (total, per) = header_fmas(&src);
+        let have = calls_per_function(&src, &call);
+        eprintln!("SSRMS fma ({call}): {total} in all, {per:?}");
+        assert_eq!(have, per, "{call}");
+        assert_eq!(have.iter().map(|(_, k)| k).sum::<u64>(), total);
+        assert!(per.iter().all(|(_, k)| *k > 0), "every function fuses");
+        for (f, k) in &per {
+            let doc = format!("of which {k} fused multiply-adds");
+            assert!(src.contains(&doc), "{f}: {doc}");
+        }
+        assert!(src.contains("//! Precision: `f64`."));
+        // Same table of counts: an fma is one mul and one add.
+        let table = |s: &str| -> Vec<String> {
+            s.lines()
+                .filter(|l| l.starts_with("//! | `"))
+                .map(String::from)
+                .collect()
+        };
+        assert_eq!(table(&src), table(&plain));
+        assert!(!src.contains("unsafe"));
+    }
+}
+
+/// `float = F32` on SSRMS: no `f64` anywhere in the file, f32 libm calls, the header says so.
+#[test]
+fn f32_source_is_f32_throughout() {
+    let chain = GENERATED[0].chain(root()).unwrap();
+    let mut o = kanegen_codegen::Options::new("SsrmsF32");
+    o.float = kanegen_codegen::Float::F32;
+    let src = kanegen_codegen::generate_file(&chain, &o).unwrap();
+    assert!(!src.contains("f64"));
+    assert!(src.contains("//! Precision: `f32`"));
+    assert!(src.contains("pub fn mass_matrix(q: &[f32; 7]) -> [[f32; 7]; 7]"));
+    assert!(src.contains("libm::sincosf("));
+    assert!(!src.contains("libm::sincos("));
+}

@@ -1,5 +1,7 @@
 //! `kanegen::dynamics!` on random-geometry models (prismatic joints, gravity, a runtime payload):
-//! the emitted functions equal the interpreted f64 algorithms.
+//! the emitted functions equal the interpreted f64 algorithms. The precision variants of the
+//! SSRMS code (`scalar = f32`, `fma = true`) agree with the checked-in f64 code to their
+//! precision.
 
 use kanegen::metrics::rel_err;
 use kanegen::random::{random_vec, rng};
@@ -169,4 +171,198 @@ fn runtime_payload_and_gravity_equal_interpreted_with_modified_chain() {
         Random5Gravity::mass_matrix(&q, &nominal),
         Random5Gravity::mass_matrix(&q, &heavy)
     );
+}
+
+// ---------------------------------------------------------------------------------------------
+// Precision variants of the SSRMS code: `scalar = f32`, `fma = true`.
+
+kanegen::dynamics!(
+    SsrmsF64,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    scalar = f64,
+);
+kanegen::dynamics!(
+    SsrmsF32,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    scalar = f32,
+);
+kanegen::dynamics!(
+    SsrmsFma,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    fma = true,
+);
+kanegen::dynamics!(
+    SsrmsMulAdd,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    fma = true,
+    fma_path = f64::mul_add,
+);
+kanegen::dynamics!(
+    Random5F32Fma,
+    "tests/data/codegen/random5.toml",
+    gravity = [0.3, -1.2, -9.81],
+    runtime_payload = true,
+    scalar = f32,
+    fma = true,
+);
+
+use kanegen_generated::ssrms::Ssrms;
+
+/// Random SSRMS states `(q, qd, tau, qdd)`, exactly representable in `f32` (so the `f32` code
+/// and the `f64` reference see the same numbers and the error is the arithmetic's alone).
+fn ssrms_states(count: u64) -> Vec<[[f64; 7]; 4]> {
+    (0..count)
+        .map(|seed| state::<7>(1000 + seed).map(|v| v.map(|x| f64::from(x as f32))))
+        .collect()
+}
+
+fn to_f32<const N: usize>(x: &[f64; N]) -> [f32; N] {
+    x.map(|v| v as f32)
+}
+
+fn widen(x: &[f32]) -> Vec<f64> {
+    x.iter().map(|&v| f64::from(v)).collect()
+}
+
+/// `scalar = f32` agrees with the f64 code to f32 precision, and is clearly worse than it.
+///
+/// Measured over these 200 states (max of `rel_err`, the max-norm relative error): `A` 2.1e-7,
+/// `b` 1.3e-6, `q̈` 5.3e-5 (the f32 unit roundoff is 6e-8; `q̈` loses the condition number of
+/// `A` on top). The bounds are about 10× those: `A` 2e-6, `b` 1.5e-5, `q̈` 5e-4. The floor:
+/// every state's `A` error is above 1e-9 (measured min 2.1e-8, 20× above it), where f64 code
+/// gives ~1e-16 — the test fails if the f32 code silently computed in f64.
+#[test]
+fn f32_code_agrees_to_f32_precision() {
+    let (mut ea, mut eb, mut efd, mut min_a) = (0.0_f64, 0.0_f64, 0.0_f64, f64::INFINITY);
+    for [q, qd, tau, _] in ssrms_states(200) {
+        let a: [[f32; 7]; 7] = SsrmsF32::mass_matrix(&to_f32(&q));
+        let a = flat_v(a.iter().map(|r| widen(r)).collect());
+        let e = rel_err(&a, &flat(Ssrms::mass_matrix(&q)));
+        ea = ea.max(e);
+        min_a = min_a.min(e);
+        let b = SsrmsF32::bias(&to_f32(&q), &to_f32(&qd), &to_f32(&tau));
+        eb = eb.max(rel_err(&widen(&b), &Ssrms::bias(&q, &qd, &tau)));
+        let fd = SsrmsF32::forward_dynamics(&to_f32(&q), &to_f32(&qd), &to_f32(&tau));
+        efd = efd.max(rel_err(
+            &widen(&fd),
+            &Ssrms::forward_dynamics(&q, &qd, &tau),
+        ));
+    }
+    eprintln!("f32 vs f64: A {ea:.2e} (min {min_a:.2e}), b {eb:.2e}, q̈ {efd:.2e}");
+    assert!(ea < 2e-6, "A: {ea:e}");
+    assert!(eb < 1.5e-5, "b: {eb:e}");
+    assert!(efd < 5e-4, "q̈: {efd:e}");
+    assert!(min_a > 1e-9, "A is as accurate as f64: {min_a:e}");
+}
+
+/// `scalar = f64` is the default: bit for bit the checked-in code.
+#[test]
+fn explicit_f64_is_the_default() {
+    for [q, qd, tau, qdd] in ssrms_states(20) {
+        assert_eq!(SsrmsF64::mass_matrix(&q), Ssrms::mass_matrix(&q));
+        assert_eq!(
+            SsrmsF64::forward_dynamics(&q, &qd, &tau),
+            Ssrms::forward_dynamics(&q, &qd, &tau)
+        );
+        assert_eq!(
+            SsrmsF64::inverse_dynamics(&q, &qd, &qdd),
+            Ssrms::inverse_dynamics(&q, &qd, &qdd)
+        );
+    }
+}
+
+/// `fma = true` agrees with the plain f64 code to rounding level, differs from it in the last
+/// bits (the products are really fused), and `libm::fma` and `f64::mul_add` (both correctly
+/// rounded) give the same bits.
+///
+/// Measured over these 200 states (max-norm relative): `A` 3.3e-16, `b` 3.2e-15, `τ` 1.4e-15,
+/// `q̈` 1.4e-13 (`q̈` carries the condition number of `A`). Bounds about 10× those: 3e-14 for
+/// `A`, `b`, `τ` and 1.5e-12 for `q̈`. Every one of the 200 `q̈` differs from the plain code's
+/// in some bit (measured 200/200; required > 100).
+#[test]
+fn fma_code_agrees_with_plain_f64() {
+    let (mut ea, mut eb, mut eid, mut efd) = (0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64);
+    let mut differs = 0;
+    for [q, qd, tau, qdd] in ssrms_states(200) {
+        let a = SsrmsFma::mass_matrix(&q);
+        assert_eq!(a, SsrmsMulAdd::mass_matrix(&q));
+        ea = ea.max(rel_err(&flat(a), &flat(Ssrms::mass_matrix(&q))));
+        let b = SsrmsFma::bias(&q, &qd, &tau);
+        assert_eq!(b, SsrmsMulAdd::bias(&q, &qd, &tau));
+        eb = eb.max(rel_err(&b, &Ssrms::bias(&q, &qd, &tau)));
+        let id = SsrmsFma::inverse_dynamics(&q, &qd, &qdd);
+        assert_eq!(id, SsrmsMulAdd::inverse_dynamics(&q, &qd, &qdd));
+        eid = eid.max(rel_err(&id, &Ssrms::inverse_dynamics(&q, &qd, &qdd)));
+        let fd = SsrmsFma::forward_dynamics(&q, &qd, &tau);
+        assert_eq!(fd, SsrmsMulAdd::forward_dynamics(&q, &qd, &tau));
+        let plain = Ssrms::forward_dynamics(&q, &qd, &tau);
+        efd = efd.max(rel_err(&fd, &plain));
+        differs += usize::from(fd != plain);
+    }
+    eprintln!(
+        "fma vs plain: A {ea:.2e}, b {eb:.2e}, τ {eid:.2e}, q̈ {efd:.2e}; {differs}/200 differ"
+    );
+    assert!(ea < 3e-14, "A: {ea:e}");
+    assert!(eb < 3e-14, "b: {eb:e}");
+    assert!(eid < 3e-14, "τ: {eid:e}");
+    assert!(efd < 1.5e-12, "q̈: {efd:e}");
+    assert!(
+        differs > 100,
+        "fused code gives the plain code's bits: {differs}/200 differ"
+    );
+}
+
+/// The `FMA_COUNTS` of the macro's code are those the generator's header states.
+#[test]
+fn fma_counts_match_the_header() {
+    let chain = load("tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
+    let mut o = kanegen_codegen::Options::new("SsrmsFma");
+    o.fma = true;
+    let src = kanegen_codegen::generate_file(&chain, &o).unwrap();
+    let total: u64 = SsrmsFma::FMA_COUNTS.iter().map(|(_, k)| k).sum();
+    let per = SsrmsFma::FMA_COUNTS
+        .iter()
+        .map(|(f, k)| format!("`{f}` {k}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    let line = format!("//! Fused multiply-adds: {total} ({per}), ");
+    assert!(src.contains(&line), "{line}");
+    assert!(total > 0);
+    assert_eq!(SsrmsFma::FMA_COUNTS, SsrmsMulAdd::FMA_COUNTS);
+}
+
+/// f32 with fma, gravity and a runtime payload (f32 fields) on a random model: the same
+/// dynamics as the interpreted f64 algorithm, to f32 precision (measured over these 50 states
+/// `A` 2.8e-7, `q̈` 1.7e-6; bounds about 10×: 3e-6 and 2e-5; floor 1e-9 as for SSRMS).
+#[test]
+fn f32_fma_payload_gravity_through_the_macro() {
+    let chain = load("tests/data/codegen/random5.toml");
+    let p = chain.params::<f64>();
+    let nominal: Random5F32FmaPayload = Random5F32FmaPayload::NOMINAL;
+    assert_eq!(nominal.mass, chain.joints()[4].inertial.mass as f32);
+    let (mut ea, mut efd) = (0.0_f64, 0.0_f64);
+    for seed in 0..50 {
+        let [q, qd, tau, _] = state::<5>(300 + seed).map(|v| v.map(|x| f64::from(x as f32)));
+        let loads = Loads {
+            tau: Some(tau.to_vec()),
+            gravity: Some(kanegen::linalg::Vec3(G)),
+            external: Vec::new(),
+        };
+        let a = Random5F32Fma::mass_matrix(&to_f32(&q), &nominal);
+        let a = flat_v(a.iter().map(|r| widen(r)).collect());
+        ea = ea.max(rel_err(
+            &a,
+            &flat_v(Algorithm::Recurrent.mass_matrix(&p, &q)),
+        ));
+        let fd =
+            Random5F32Fma::forward_dynamics(&to_f32(&q), &to_f32(&qd), &to_f32(&tau), &nominal);
+        efd = efd.max(rel_err(
+            &widen(&fd),
+            &Algorithm::Recurrent.forward_dynamics(&p, &q, &qd, &loads),
+        ));
+    }
+    eprintln!("random5 f32 + fma: A {ea:.2e}, q̈ {efd:.2e}");
+    assert!(ea < 3e-6 && ea > 1e-9, "A: {ea:e}");
+    assert!(efd < 2e-5 && efd > 1e-9, "q̈: {efd:e}");
+    assert!(Random5F32Fma::FMA_COUNTS.iter().all(|(_, k)| *k > 0));
 }

@@ -15,7 +15,12 @@
 //! * inputs are fixed-size arrays `&[f64; N]` (`q`, `qd`, `tau`, `qdd`) indexed by constants, and
 //!   with [`Options::runtime_payload`] a `payload: &Payload` (last argument);
 //! * outputs are `[[f64; N]; N]` (the symmetric `A`: upper triangle computed, both written) or
-//!   `[f64; N]`.
+//!   `[f64; N]`;
+//! * with [`Options::float`] = [`Float::F32`] every type is `f32` instead, the constants are the
+//!   model's numbers rounded to `f32` and the libm calls are the `f32` ones (`sincosf`, `sqrtf`);
+//! * with [`Options::fma`] an addition or subtraction of a single-use product becomes one fused
+//!   multiply-add `fma(a, b, c)` = `a·b + c` ([`Options::fma_path`]), which still counts as one
+//!   multiplication and one addition.
 //!
 //! The output is a unit struct with associated constants and functions ([`generate_items`]);
 //! [`generate_file`] wraps it into a formatted module file with a doc header (model, N, joints,
@@ -48,11 +53,72 @@ pub struct Options {
     pub libm_path: String,
     /// Name of the generated payload struct (used with [`Options::runtime_payload`]).
     pub payload_name: String,
+    /// Floating-point type of the emitted code (default [`Float::F64`]).
+    pub float: Float,
+    /// Fuse single-use products into their sum or difference: `c + a·b`, `a·b + c` become
+    /// `fma(a, b, c)`, `c − a·b` becomes `fma(−a, b, c)` and `a·b − c` becomes `fma(a, b, −c)`
+    /// (one rounding instead of two). Default `false`.
+    pub fma: bool,
+    /// The function called for a fused multiply-add, as `path(a, b, c)` = `a·b + c`. `None`
+    /// (default): `fma` (f64) or `fmaf` (f32) of [`Options::libm_path`]. `f64::mul_add` /
+    /// `f32::mul_add` (UFCS of the std method; not `no_std`) work as well.
+    pub fma_path: Option<String>,
+}
+
+/// Floating-point type of the emitted code.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Float {
+    /// `f64` (default).
+    #[default]
+    F64,
+    /// `f32`: inputs, outputs, constants and libm calls.
+    F32,
+}
+
+impl Float {
+    /// The Rust type name, `f64` or `f32`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Float::F64 => "f64",
+            Float::F32 => "f32",
+        }
+    }
+
+    /// `f64` or `f32` from its name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "f64" => Some(Float::F64),
+            "f32" => Some(Float::F32),
+            _ => None,
+        }
+    }
+
+    fn ty(self) -> TokenStream {
+        let t = format_ident!("{}", self.name());
+        quote!(#t)
+    }
+
+    /// The libm function `base` for this type: `sin` or `sinf`.
+    fn libm_fn(self, base: &str) -> proc_macro2::Ident {
+        match self {
+            Float::F64 => format_ident!("{}", base),
+            Float::F32 => format_ident!("{}f", base),
+        }
+    }
+
+    /// A literal of this type with the value `x` (rounded for `f32`), suffixed like `quote!`
+    /// suffixes an `f64`.
+    fn suffixed(self, x: f64) -> Literal {
+        match self {
+            Float::F64 => Literal::f64_suffixed(x),
+            Float::F32 => Literal::f32_suffixed(x as f32),
+        }
+    }
 }
 
 impl Options {
     /// Defaults: space (no gravity), constant payload, `libm` path `libm`, payload struct
-    /// `Payload`.
+    /// `Payload`, `f64`, no fused multiply-adds.
     pub fn new(type_name: impl Into<String>) -> Self {
         Options {
             type_name: type_name.into(),
@@ -60,6 +126,9 @@ impl Options {
             runtime_payload: false,
             libm_path: "libm".into(),
             payload_name: "Payload".into(),
+            float: Float::F64,
+            fma: false,
+            fma_path: None,
         }
     }
 }
@@ -355,18 +424,27 @@ impl Expr {
     }
 }
 
-fn constant(x: f64) -> Expr {
+/// A constant of type `float`: the f64 value, rounded for `f32`.
+fn constant(x: f64, float: Float) -> Expr {
+    let ty = float.ty();
+    let x = match float {
+        Float::F64 => x,
+        Float::F32 => f64::from(x as f32),
+    };
     if x.is_nan() {
-        return Expr::atom(quote!(f64::NAN));
+        return Expr::atom(quote!(#ty::NAN));
     }
     if x.is_infinite() {
         return if x > 0.0 {
-            Expr::atom(quote!(f64::INFINITY))
+            Expr::atom(quote!(#ty::INFINITY))
         } else {
-            Expr::atom(quote!(f64::NEG_INFINITY))
+            Expr::atom(quote!(#ty::NEG_INFINITY))
         };
     }
-    let lit = Literal::f64_unsuffixed(x.abs());
+    let lit = match float {
+        Float::F64 => Literal::f64_unsuffixed(x.abs()),
+        Float::F32 => Literal::f32_unsuffixed((x as f32).abs()),
+    };
     if x.is_sign_negative() && x != 0.0 {
         Expr {
             tokens: quote!(-#lit),
@@ -377,9 +455,60 @@ fn constant(x: f64) -> Expr {
     }
 }
 
+/// How one graph is emitted: the libm path, the floating-point type and the fused multiply-add
+/// function (none: no fusion). Built from [`Options`] by [`Emitter::new`].
+#[derive(Clone, Debug)]
+pub struct Emitter {
+    libm: TokenStream,
+    float: Float,
+    fma: Option<TokenStream>,
+}
+
+impl Emitter {
+    /// The emitter of `opts`.
+    ///
+    /// # Errors
+    /// If [`Options::libm_path`] or [`Options::fma_path`] is not a Rust path.
+    pub fn new(opts: &Options) -> Result<Self, Error> {
+        let libm: syn::Path = syn::parse_str(&opts.libm_path)
+            .map_err(|e| Error(format!("libm path `{}`: {e}", opts.libm_path)))?;
+        let libm = quote!(#libm);
+        let fma = if opts.fma {
+            Some(match &opts.fma_path {
+                Some(p) => {
+                    let path: syn::Path =
+                        syn::parse_str(p).map_err(|e| Error(format!("fma path `{p}`: {e}")))?;
+                    quote!(#path)
+                }
+                None => {
+                    let f = opts.float.libm_fn("fma");
+                    quote!(#libm::#f)
+                }
+            })
+        } else {
+            None
+        };
+        Ok(Emitter {
+            libm,
+            float: opts.float,
+            fma,
+        })
+    }
+}
+
+/// The emitted body of one function.
+pub struct Body {
+    /// The statements and the result expression.
+    pub tokens: TokenStream,
+    /// Fused multiply-adds formed (0 without [`Options::fma`]).
+    pub fmas: u64,
+}
+
 /// The statements and result expression of one traced function. `matrix`: the outputs are the
 /// upper triangle of a symmetric `n×n` matrix.
-pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> TokenStream {
+pub fn emit_body(t: &Traced, emitter: &Emitter, matrix: bool, n: usize) -> Body {
+    let Emitter { libm, float, fma } = emitter;
+    let float = *float;
     let trace = &t.trace;
     let sched = trace.schedule();
     let outputs: HashSet<u32> = trace.outputs().iter().map(|s| s.id()).collect();
@@ -405,9 +534,18 @@ pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> Toke
             Node::Const(_) | Node::Input(_) => {}
         }
     }
+    // Inlined (single-use, not an output): its expression appears once, in its user's.
+    let inlined = |s: Sym| !outputs.contains(&s.id()) && uses.get(&s.id()).copied() == Some(1);
+    // The factors of a product that fuses into its user: an inlined multiplication.
+    let product = |s: Sym| match nodes.get(&s.id()) {
+        Some(Node::Mul(a, b)) if fma.is_some() && inlined(s) => Some((*a, *b)),
+        _ => None,
+    };
+    let is_const = |s: Sym| matches!(nodes.get(&s.id()), Some(Node::Const(_)));
     let mut exprs: HashMap<u32, Expr> = HashMap::new();
     let mut stmts: Vec<TokenStream> = Vec::new();
     let mut counter = 0usize;
+    let mut fmas = 0u64;
     // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
     let trig_base = |arg: u32, counter: usize| -> String {
         match nodes[&arg] {
@@ -422,9 +560,26 @@ pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> Toke
     for (id, node) in &sched {
         let id = *id;
         let get = |s: Sym| exprs[&s.id()].clone();
+        // `−s` as a call argument: constants negated, an inlined negation unwrapped.
+        let neg = |s: Sym| -> TokenStream {
+            match nodes.get(&s.id()) {
+                Some(Node::Const(x)) => constant(-x, float).tokens,
+                Some(Node::Neg(z)) if inlined(s) => get(*z).tokens,
+                _ => {
+                    let e = get(s).at(P_NEG);
+                    quote!(-#e)
+                }
+            }
+        };
+        let call = |a: TokenStream, b: TokenStream, c: TokenStream| {
+            let f = fma
+                .as_ref()
+                .expect("products fuse only with an fma function");
+            Expr::atom(quote!(#f(#a, #b, #c)))
+        };
         let expr = match node {
             Node::Const(x) => {
-                exprs.insert(id, constant(*x));
+                exprs.insert(id, constant(*x, float));
                 continue;
             }
             Node::Input(i) => {
@@ -441,23 +596,54 @@ pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> Toke
                 match trig[&a.id()] {
                     (Some(s), Some(c)) => {
                         let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
-                        stmts.push(quote!(let (#sn, #cn) = #libm::sincos(#arg);));
+                        let f = float.libm_fn("sincos");
+                        stmts.push(quote!(let (#sn, #cn) = #libm::#f(#arg);));
                         exprs.insert(s, Expr::atom(quote!(#sn)));
                         exprs.insert(c, Expr::atom(quote!(#cn)));
                     }
                     (Some(s), None) => {
                         let sn = format_ident!("s_{}", base);
-                        stmts.push(quote!(let #sn = #libm::sin(#arg);));
+                        let f = float.libm_fn("sin");
+                        stmts.push(quote!(let #sn = #libm::#f(#arg);));
                         exprs.insert(s, Expr::atom(quote!(#sn)));
                     }
                     (None, Some(c)) => {
                         let cn = format_ident!("c_{}", base);
-                        stmts.push(quote!(let #cn = #libm::cos(#arg);));
+                        let f = float.libm_fn("cos");
+                        stmts.push(quote!(let #cn = #libm::#f(#arg);));
                         exprs.insert(c, Expr::atom(quote!(#cn)));
                     }
                     (None, None) => unreachable!("trig node without entry"),
                 }
                 continue;
+            }
+            // x + a·b, a·b + x: fma(a, b, x) (the right product first: sums accumulate
+            // from the left, so the left operand is the running sum).
+            Node::Add(x, y) if product(*y).is_some() || product(*x).is_some() => {
+                fmas += 1;
+                let (m, c) = if product(*y).is_some() {
+                    (*y, *x)
+                } else {
+                    (*x, *y)
+                };
+                let (a, b) = product(m).expect("checked");
+                call(get(a).tokens, get(b).tokens, get(c).tokens)
+            }
+            // x − a·b: fma(−a, b, x) (the constant factor negated when there is one).
+            Node::Sub(x, y) if product(*y).is_some() => {
+                fmas += 1;
+                let (a, b) = product(*y).expect("checked");
+                if is_const(b) && !is_const(a) {
+                    call(get(a).tokens, neg(b), get(*x).tokens)
+                } else {
+                    call(neg(a), get(b).tokens, get(*x).tokens)
+                }
+            }
+            // a·b − y: fma(a, b, −y).
+            Node::Sub(x, y) if product(*x).is_some() => {
+                fmas += 1;
+                let (a, b) = product(*x).expect("checked");
+                call(get(a).tokens, get(b).tokens, neg(*y))
             }
             Node::Add(a, b) => {
                 let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
@@ -496,7 +682,8 @@ pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> Toke
             }
             Node::Sqrt(a) => {
                 let a = get(*a).tokens;
-                Expr::atom(quote!(#libm::sqrt(#a)))
+                let f = float.libm_fn("sqrt");
+                Expr::atom(quote!(#libm::#f(#a)))
             }
         };
         let bind = outputs.contains(&id)
@@ -528,7 +715,10 @@ pub fn emit_body(t: &Traced, libm: &TokenStream, matrix: bool, n: usize) -> Toke
     } else {
         quote!([#(#out),*])
     };
-    quote!(#(#stmts)* #result)
+    Body {
+        tokens: quote!(#(#stmts)* #result),
+        fmas,
+    }
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -580,34 +770,43 @@ fn generate_items_with(
         .map_err(|e| Error(format!("type name `{}`: {e}", opts.type_name)))?;
     let payload_ty: syn::Ident = syn::parse_str(&opts.payload_name)
         .map_err(|e| Error(format!("payload name `{}`: {e}", opts.payload_name)))?;
-    let libm: syn::Path = syn::parse_str(&opts.libm_path)
-        .map_err(|e| Error(format!("libm path `{}`: {e}", opts.libm_path)))?;
-    let libm = quote!(#libm);
+    let emitter = Emitter::new(opts)?;
+    let fl = opts.float.ty();
 
     let mut fns = Vec::new();
     let mut choices = Vec::new();
+    let mut fmas = Vec::new();
     for f in functions(opts) {
         let (choice, traced) = choose(chain, f, opts);
-        let body = emit_body(&traced, &libm, f.matrix, n);
+        let Body {
+            tokens: body,
+            fmas: k,
+        } = emit_body(&traced, &emitter, f.matrix, n);
         let name = format_ident!("{}", f.name);
         let args = f.args.iter().map(|a| {
             let a = format_ident!("{}", a.name());
-            quote!(#a: &[f64; #nl])
+            quote!(#a: &[#fl; #nl])
         });
         let payload_arg = opts
             .runtime_payload
             .then(|| quote!(, payload: &#payload_ty));
         let ret = if f.matrix {
-            quote!([[f64; #nl]; #nl])
+            quote!([[#fl; #nl]; #nl])
         } else {
-            quote!([f64; #nl])
+            quote!([#fl; #nl])
         };
         let c = choice.counts();
         let doc1 = format!(" {}", f.doc);
+        let fused = if opts.fma {
+            format!(", of which {k} fused multiply-adds")
+        } else {
+            String::new()
+        };
         let doc2 = format!(
-            " Algorithm `{}`: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted).",
+            " Algorithm `{}`: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted){fused}.",
             choice.chosen, c.mul, c.add, c.div, c.sqrt, c.sincos
         );
+        fmas.push((f.name, k));
         fns.push(quote! {
             #[doc = #doc1]
             #[doc = ""]
@@ -632,7 +831,7 @@ fn generate_items_with(
         }
     }
 
-    let header = header_lines(chain, opts, &choices);
+    let header = header_lines(chain, opts, &choices, &fmas);
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         chain.name()
@@ -655,17 +854,23 @@ fn generate_items_with(
              axes (kg·m²; only the upper triangle is read).",
             last.body, last.name
         );
-        let rows3 = i.iter().map(|r| quote!([#(#r),*]));
+        let lit = |x: f64| opts.float.suffixed(x);
+        let m = lit(m);
+        let com = com.map(lit);
+        let rows3 = i.iter().map(|r| {
+            let r = r.map(lit);
+            quote!([#(#r),*])
+        });
         quote! {
             #[doc = #doc]
             #[derive(Clone, Copy, Debug, PartialEq)]
             pub struct #payload_ty {
                 /// Mass, kg.
-                pub mass: f64,
+                pub mass: #fl,
                 /// Centre of mass in the body frame, m.
-                pub com: [f64; 3],
+                pub com: [#fl; 3],
                 /// Inertia tensor about the centre of mass, body axes, kg·m².
-                pub inertia: [[f64; 3]; 3],
+                pub inertia: [[#fl; 3]; 3],
             }
 
             impl #payload_ty {
@@ -676,6 +881,17 @@ fn generate_items_with(
                     inertia: [#(#rows3),*],
                 };
             }
+        }
+    } else {
+        quote!()
+    };
+
+    let fma_const = if opts.fma {
+        let rows = fmas.iter().map(|(f, k)| quote!((#f, #k)));
+        quote! {
+            /// Fused multiply-adds in each function: `(function, count)` (each also counts as one
+            /// mul and one add in [`Self::OP_COUNTS`]).
+            pub const FMA_COUNTS: &'static [(&'static str, u64)] = &[#(#rows),*];
         }
     } else {
         quote!()
@@ -708,6 +924,7 @@ fn generate_items_with(
             pub const OP_COUNTS: &'static [(&'static str, &'static str, u64, u64)] = &[#(#rows),*];
             /// The algorithm emitted for each function: `(function, algorithm)`.
             pub const ALGORITHMS: &'static [(&'static str, &'static str)] = &[#(#chosen_rows),*];
+            #fma_const
 
             #(#fns)*
         }
@@ -719,7 +936,12 @@ fn generate_items_with(
     })
 }
 
-fn header_lines(chain: &Chain, opts: &Options, choices: &[Choice]) -> Vec<String> {
+fn header_lines(
+    chain: &Chain,
+    opts: &Options,
+    choices: &[Choice],
+    fmas: &[(&str, u64)],
+) -> Vec<String> {
     let mut h = vec![
         format!(
             "Dynamics of `{}` (N = {}), generated by kanegen-codegen {VERSION}. Do not edit.",
@@ -730,7 +952,10 @@ fn header_lines(chain: &Chain, opts: &Options, choices: &[Choice]) -> Vec<String
         format!("Joints: {}.", joint_list(chain)),
         String::new(),
         match opts.gravity {
-            Some(g) => format!("Gravity: [{}, {}, {}] m/s² in the base frame.", g[0], g[1], g[2]),
+            Some(g) => format!(
+                "Gravity: [{}, {}, {}] m/s² in the base frame.",
+                g[0], g[1], g[2]
+            ),
             None => "Gravity: none (space).".into(),
         },
         if opts.runtime_payload {
@@ -741,13 +966,43 @@ fn header_lines(chain: &Chain, opts: &Options, choices: &[Choice]) -> Vec<String
         } else {
             "Runtime payload: no (every model number is a constant).".into()
         },
+    ];
+    // Precision lines only for a non-default precision: the default f64 header is unchanged.
+    if opts.float != Float::F64 || opts.fma {
+        h.push(match opts.float {
+            Float::F64 => "Precision: `f64`.".into(),
+            Float::F32 => "Precision: `f32`: inputs, outputs and every intermediate; the model's \
+                           numbers rounded to `f32` constants; libm's `sincosf`, `sinf`, `cosf`, \
+                           `sqrtf`."
+                .into(),
+        });
+        h.push(if opts.fma {
+            let total: u64 = fmas.iter().map(|(_, k)| k).sum();
+            let per = fmas
+                .iter()
+                .map(|(f, k)| format!("`{f}` {k}"))
+                .collect::<Vec<_>>()
+                .join(", ");
+            let path = opts
+                .fma_path
+                .clone()
+                .unwrap_or_else(|| format!("{}::{}", opts.libm_path, opts.float.libm_fn("fma")));
+            format!(
+                "Fused multiply-adds: {total} ({per}), each `{path}(a, b, c)` = a·b + c rounded \
+                 once; the counts below count each as 1 mul + 1 add."
+            )
+        } else {
+            "Fused multiply-adds: none.".into()
+        });
+    }
+    h.extend([
         String::new(),
         "Emitted operation counts per candidate algorithm (the cheapest in mul + add is emitted, *):"
             .into(),
         String::new(),
         "| function | algorithm | mul | add | div | sqrt | sincos | mul + add |".into(),
         "|---|---|---:|---:|---:|---:|---:|---:|".into(),
-    ];
+    ]);
     for ch in choices {
         for (a, c) in &ch.candidates {
             let star = if *a == ch.chosen { " *" } else { "" };
@@ -808,6 +1063,7 @@ mod tests {
         div: u64,
         sqrt: u64,
         sincos: u64,
+        fma: u64,
     }
 
     impl<'a> Visit<'a> for OpCounter {
@@ -821,21 +1077,56 @@ mod tests {
             syn::visit::visit_expr_binary(self, e);
         }
         fn visit_expr_call(&mut self, e: &'a syn::ExprCall) {
-            let f = quote!(#e).to_string();
-            if f.contains(":: sqrt") {
-                self.sqrt += 1;
-            } else if f.contains(":: sincos") || f.contains(":: sin (") || f.contains(":: cos") {
-                self.sincos += 1;
+            let name = match &*e.func {
+                syn::Expr::Path(p) => p.path.segments.last().map(|s| s.ident.to_string()),
+                _ => None,
+            };
+            match name.as_deref() {
+                Some("sqrt" | "sqrtf") => self.sqrt += 1,
+                Some("sincos" | "sincosf" | "sin" | "sinf" | "cos" | "cosf") => self.sincos += 1,
+                Some("fma" | "fmaf" | "mul_add") => {
+                    self.fma += 1;
+                    self.mul += 1;
+                    self.add += 1;
+                }
+                _ => {}
             }
             syn::visit::visit_expr_call(self, e);
         }
     }
 
+    /// The operations of every generated function: `name → counts`.
+    fn count_ops(items: TokenStream) -> HashMap<String, OpCounter> {
+        let file: syn::File = syn::parse2(items).unwrap();
+        let mut fns = HashMap::new();
+        for item in &file.items {
+            if let syn::Item::Impl(imp) = item {
+                for it in &imp.items {
+                    if let syn::ImplItem::Fn(f) = it {
+                        let mut c = OpCounter::default();
+                        c.visit_block(&f.block);
+                        fns.insert(f.sig.ident.to_string(), c);
+                    }
+                }
+            }
+        }
+        fns
+    }
+
     /// The emitted code performs exactly the trace's emitted operation counts, function by
-    /// function, for random chains with prismatic joints, gravity and a runtime payload.
+    /// function, for random chains with prismatic joints, gravity and a runtime payload, in
+    /// every precision (an fma counts as one mul and one add).
     #[test]
     fn emitted_code_has_the_traced_op_counts() {
-        for (seed, n, payload) in [(1, 3, false), (2, 5, true), (3, 7, false)] {
+        let variants = [
+            (1, 3, false, Float::F64, false),
+            (2, 5, true, Float::F64, false),
+            (3, 7, false, Float::F64, false),
+            (2, 5, true, Float::F32, false),
+            (3, 7, false, Float::F64, true),
+            (2, 5, true, Float::F32, true),
+        ];
+        for (seed, n, payload, float, fma) in variants {
             let chain = random_chain(
                 &ChainSpec {
                     n,
@@ -847,21 +1138,16 @@ mod tests {
             let mut opts = Options::new("Arm");
             opts.gravity = Some([0.1, 0.2, -9.81]);
             opts.runtime_payload = payload;
+            opts.float = float;
+            opts.fma = fma;
             let g = generate_items(&chain, &opts).unwrap();
-            let file: syn::File = syn::parse2(g.items).unwrap();
-            let mut fns = HashMap::new();
-            for item in &file.items {
-                if let syn::Item::Impl(imp) = item {
-                    for it in &imp.items {
-                        if let syn::ImplItem::Fn(f) = it {
-                            let mut c = OpCounter::default();
-                            c.visit_block(&f.block);
-                            fns.insert(f.sig.ident.to_string(), c);
-                        }
-                    }
-                }
-            }
+            let fns = count_ops(g.items);
             assert_eq!(fns.len(), 6, "all functions, gravity included");
+            if fma {
+                assert!(fns.values().all(|c| c.fma > 0), "every function fuses");
+            } else {
+                assert!(fns.values().all(|c| c.fma == 0));
+            }
             for ch in &g.choices {
                 let want = ch.counts();
                 let have = &fns[ch.function.name];
@@ -884,5 +1170,54 @@ mod tests {
         let mut o = Options::new("Arm");
         o.libm_path = "::".into();
         assert!(generate_items(&chain, &o).is_err());
+        let mut o = Options::new("Arm");
+        o.fma = true;
+        o.fma_path = Some("f64::".into());
+        assert!(generate_items(&chain, &o).is_err());
+        // Not used without fma.
+        o.fma = false;
+        assert!(generate_items(&chain, &o).is_ok());
+    }
+
+    /// The f32 code names no f64 anywhere; the fma code calls the fma path and says how many it
+    /// formed; the defaults have neither the precision lines nor `FMA_COUNTS`.
+    #[test]
+    fn precision_variants_in_the_source() {
+        let chain = random_chain(
+            &ChainSpec {
+                n: 4,
+                prismatic_fraction: 0.3,
+                ..Default::default()
+            },
+            7,
+        );
+        let mut o = Options::new("Arm");
+        o.runtime_payload = true;
+        o.gravity = Some([0.0, 0.0, -9.81]);
+        let plain = generate_file(&chain, &o).unwrap();
+        assert!(!plain.contains("f32") && !plain.contains("Precision") && !plain.contains("fma"));
+
+        o.float = Float::F32;
+        let f32_src = generate_file(&chain, &o).unwrap();
+        assert!(!f32_src.contains("f64"), "{f32_src}");
+        assert!(f32_src.contains("Precision: `f32`"));
+        assert!(f32_src.contains("libm::sincosf("));
+        assert!(f32_src.contains("Fused multiply-adds: none."));
+
+        o.float = Float::F64;
+        o.fma = true;
+        o.fma_path = Some("f64::mul_add".into());
+        let g = generate_items(&chain, &o).unwrap();
+        let fma_src = generate_file(&chain, &o).unwrap();
+        let calls = fma_src
+            .lines()
+            .filter(|l| !l.trim_start().starts_with("//"))
+            .map(|l| l.matches("f64::mul_add(").count() as u64)
+            .sum::<u64>();
+        let total: u64 = count_ops(g.items).values().map(|c| c.fma).sum();
+        assert!(calls > 0);
+        assert_eq!(calls, total);
+        assert!(fma_src.contains(&format!("Fused multiply-adds: {total} (")));
+        assert!(fma_src.contains("FMA_COUNTS"));
     }
 }

@@ -17,6 +17,9 @@ struct Input {
     gravity: Option<[f64; 3]>,
     allow_nonphysical: bool,
     runtime_payload: bool,
+    float: kanegen_codegen::Float,
+    fma: bool,
+    fma_path: Option<syn::Path>,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -47,7 +50,11 @@ impl Parse for Input {
             gravity: None,
             allow_nonphysical: false,
             runtime_payload: false,
+            float: kanegen_codegen::Float::F64,
+            fma: false,
+            fma_path: None,
         };
+        let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
             if input.is_empty() {
                 break;
@@ -65,27 +72,54 @@ impl Parse for Input {
                 }
                 "allow_nonphysical" => out.allow_nonphysical = input.parse::<LitBool>()?.value,
                 "runtime_payload" => out.runtime_payload = input.parse::<LitBool>()?.value,
+                "scalar" => {
+                    let ty: Ident = input.parse().map_err(|e| {
+                        syn::Error::new(e.span(), "expected `f32` or `f64` (scalar = f32)")
+                    })?;
+                    out.float =
+                        kanegen_codegen::Float::from_name(&ty.to_string()).ok_or_else(|| {
+                            syn::Error::new(
+                                ty.span(),
+                                format!("unsupported scalar `{ty}`: expected `f32` or `f64`"),
+                            )
+                        })?;
+                }
+                "fma" => out.fma = input.parse::<LitBool>()?.value,
+                "fma_path" => {
+                    out.fma_path = Some(input.parse::<syn::Path>()?);
+                    fma_path_key = Some(key);
+                }
                 other => {
                     return Err(syn::Error::new(
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, allow_nonphysical, \
-                             runtime_payload)"
+                             runtime_payload, scalar, fma, fma_path)"
                         ),
                     ))
                 }
             }
+        }
+        if let (Some(key), false) = (fma_path_key, out.fma) {
+            return Err(syn::Error::new(key.span(), "`fma_path` needs `fma = true`"));
         }
         Ok(out)
     }
 }
 
 /// `dynamics!(Name, "path/to/model.urdf" [, gravity = [x, y, z]] [, allow_nonphysical = true]
-/// [, runtime_payload = true])`: defines `pub struct Name;` with the associated constants `N`,
-/// `JOINTS`, `OP_COUNTS`, `ALGORITHMS` and the functions `mass_matrix(q)`, `bias(q, qd, tau)`,
-/// `bias_velocity(q, qd)`, `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)` (and
-/// `gravity(q)` with gravity) on `&[f64; N]` arrays. With `runtime_payload = true`, every
-/// function takes a last argument `payload: &NamePayload` (the last body's mass properties).
+/// [, runtime_payload = true] [, scalar = f32] [, fma = true] [, fma_path = f64::mul_add])`:
+/// defines `pub struct Name;` with the associated constants `N`, `JOINTS`, `OP_COUNTS`,
+/// `ALGORITHMS` and the functions `mass_matrix(q)`, `bias(q, qd, tau)`, `bias_velocity(q, qd)`,
+/// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)` (and `gravity(q)` with
+/// gravity) on `&[f64; N]` arrays. With `runtime_payload = true`, every function takes a last
+/// argument `payload: &NamePayload` (the last body's mass properties).
+///
+/// `scalar = f32` (default `f64`) emits `f32` code: arrays, payload fields, constants (the
+/// model's numbers rounded) and libm calls. `fma = true` fuses each single-use product into its
+/// sum or difference as one call `fma(a, b, c)` = `a·b + c`, by default libm's `fma` / `fmaf`;
+/// `fma_path = PATH` calls `PATH(a, b, c)` instead (e.g. `f64::mul_add`, which needs `std`), and
+/// `Name::FMA_COUNTS` lists the fused operations per function.
 ///
 /// The path is relative to the calling crate's `CARGO_MANIFEST_DIR`; the crate is rebuilt when
 /// the file changes. A missing, malformed or non-physical model is a compile error at the path.
@@ -117,6 +151,12 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.runtime_payload = input.runtime_payload;
     opts.libm_path = "::kanegen::__private::libm".into();
     opts.payload_name = format!("{name}Payload");
+    opts.float = input.float;
+    opts.fma = input.fma;
+    opts.fma_path = input
+        .fma_path
+        .as_ref()
+        .map(|p| quote!(#p).to_string().replace(' ', ""));
     let g = kanegen_codegen::generate_items(&chain, &opts).map_err(|e| e.to_string())?;
     let items = g.items;
     let abs_lit = LitStr::new(&abs, Span::call_site());

@@ -1,0 +1,3 @@
+kanegen::dynamics!(Arm, "bad/negative_mass.toml", scalar = f16);
+
+fn main() {}
