@@ -5,6 +5,9 @@
 //! code generation and simulation. This crate is the user-facing facade and the `kanegen` CLI.
 #![warn(missing_docs)]
 
+// `::kanegen::…` paths emitted by `dynamics!` resolve inside this crate too (src/accuracy/generated.rs).
+extern crate self as kanegen;
+
 pub mod accuracy;
 pub mod commands;
 pub mod convert;
