@@ -23,6 +23,7 @@
 //! assert!(!Exact::constant(2.0).sqrt().is_exact());
 //! ```
 
+use crate::model::{Chain, JointKind};
 use crate::scalar::{Real, Scalar};
 use crate::wide::Wide;
 use core::ops::{Add, Div, Mul, Neg, Sub};
@@ -124,6 +125,29 @@ impl Exact {
             trig: None,
         }
     }
+}
+
+/// The `k`-th exact test state of `chain` (`q`, `q̇`, `τ`): revolute angles `2 atan(m/n)` with
+/// small integers (rational sine and cosine), prismatic positions, rates and torques dyadic, so
+/// the state is exact in every scalar type. Used by the exact oracles and `kanegen accuracy`.
+#[must_use]
+pub fn rational_state(chain: &Chain, k: i64) -> (Vec<Exact>, Vec<Exact>, Vec<Exact>) {
+    let n = chain.dof() as i64;
+    let q = chain
+        .joints()
+        .iter()
+        .zip(0..n)
+        .map(|(joint, j)| match joint.kind {
+            JointKind::Revolute => Exact::pythagorean((j * 7 + k) % 11 - 5, 3 + (j + k) % 4),
+            JointKind::Prismatic => Exact::constant(((j + k) % 5) as f64 * 0.125 - 0.25),
+        })
+        .collect();
+    let dyadic = |j: i64, a: i64, m: i64, scale: f64| {
+        Exact::constant(((j * a + k) % m - m / 2) as f64 * scale)
+    };
+    let qd = (0..n).map(|j| dyadic(j, 3, 9, 0.125)).collect();
+    let tau = (0..n).map(|j| dyadic(j, 5, 7, 12.5)).collect();
+    (q, qd, tau)
 }
 
 fn rational_to_wide(r: &BigRational) -> Wide {

@@ -14,15 +14,13 @@
 use kanegen_core::algorithms::floating::{
     floating_dynamics, kinetic_energy, quat_to_matrix, FloatingBase, FloatingState,
 };
-use kanegen_core::exact::Exact;
+use kanegen_core::exact::{rational_state, Exact};
 use kanegen_core::ldlt::{ldlt, solve};
 use kanegen_core::linalg::Vec3;
 use kanegen_core::metrics::{rel_err, rel_err_mat, rel_err_wide};
 use kanegen_core::random::{random_chain, ChainSpec};
 use kanegen_core::wide::Wide;
-use kanegen_core::{
-    Algorithm, Chain, Dynamics, ExternalWrench, JointKind, LoadFrame, Loads, Real, Scalar,
-};
+use kanegen_core::{Algorithm, Chain, Dynamics, ExternalWrench, LoadFrame, Loads, Real, Scalar};
 use std::path::PathBuf;
 
 /// A random chain whose joint frames and axes are exactly orthonormal in rational arithmetic:
@@ -63,24 +61,6 @@ fn ssrms() -> Chain {
     let p = PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
     kanegen_core::io::load_model(&p).unwrap()
-}
-
-/// Half-angle tangents `m/n` of the test angles, rates `k/8` rad/s, torques `k·5/4`.
-fn exact_state(chain: &Chain, seed: i64) -> (Vec<Exact>, Vec<Exact>, Vec<Exact>) {
-    let n = chain.dof();
-    let q = (0..n as i64)
-        .map(|j| match chain.joints()[j as usize].kind {
-            JointKind::Revolute => Exact::pythagorean((j * 7 + seed) % 11 - 5, 3 + (j + seed) % 4),
-            JointKind::Prismatic => Exact::constant(((j + seed) % 5) as f64 * 0.125 - 0.25),
-        })
-        .collect();
-    let qd = (0..n as i64)
-        .map(|j| Exact::constant(((j * 3 + seed) % 9 - 4) as f64 * 0.125))
-        .collect();
-    let tau = (0..n as i64)
-        .map(|j| Exact::constant(((j * 5 + seed) % 7 - 3) as f64 * 1.25))
-        .collect();
-    (q, qd, tau)
 }
 
 fn loads<S: Scalar>(tau: Vec<S>, n: usize) -> Loads<S> {
@@ -124,7 +104,7 @@ fn all_algorithms_agree_exactly_and_wide_is_within_1e_30() {
     ];
     for (name, chain) in &chains {
         let n = chain.dof();
-        let (q, qd, tau) = exact_state(chain, 3);
+        let (q, qd, tau) = rational_state(chain, 3);
         let pe = chain.params::<Exact>();
         let le = loads(tau.clone(), n);
         let reference = Algorithm::Recurrent.dynamics(&pe, &q, &qd, &le);
@@ -222,7 +202,7 @@ fn free_floating_energy_is_exactly_half_nu_a_nu() {
         v_b: Vec3::from_f64([0.125, 0.25, -0.5]),
         omega_b: Vec3::from_f64([0.0625, -0.125, 0.25]),
     };
-    let (q, qd, _) = exact_state(&chain, 1);
+    let (q, qd, _) = rational_state(&chain, 1);
     let p = chain.params::<Exact>();
     let nu: Vec<Exact> = state
         .v_b

@@ -13,11 +13,11 @@ use kanegen_core::algorithms::floating::{
     floating_dynamics, quat_to_matrix, FloatingBase, FloatingState,
 };
 use kanegen_core::compensated::Compensated;
-use kanegen_core::exact::Exact;
+use kanegen_core::exact::{rational_state, Exact};
 use kanegen_core::linalg::Vec3;
 use kanegen_core::metrics::{rel_err, rel_err_mat, rel_err_wide};
 use kanegen_core::random::{random_vec, rng};
-use kanegen_core::{Algorithm, Chain, ExternalWrench, JointKind, Loads, Real, Scalar};
+use kanegen_core::{Algorithm, Chain, ExternalWrench, Loads, Real, Scalar};
 use serde::{Deserialize, Serialize};
 
 pub use kanegen_core::wide::Wide;
@@ -173,27 +173,6 @@ fn wide_rel_err(x: &[Wide], y: &[Exact]) -> f64 {
     rel_err_wide(x, &y)
 }
 
-/// The `k`-th exact test state: revolute angles `2 atan(m/n)` with small integers (rational
-/// sine and cosine), prismatic positions, rates and torques dyadic (exact in every type).
-fn exact_state(chain: &Chain, k: i64) -> (Vec<Exact>, Vec<Exact>, Vec<Exact>) {
-    let n = chain.dof() as i64;
-    let q = chain
-        .joints()
-        .iter()
-        .zip(0..n)
-        .map(|(joint, j)| match joint.kind {
-            JointKind::Revolute => Exact::pythagorean((j * 7 + k) % 11 - 5, 3 + (j + k) % 4),
-            JointKind::Prismatic => Exact::constant(((j + k) % 5) as f64 * 0.125 - 0.25),
-        })
-        .collect();
-    let dyadic = |j: i64, a: i64, m: i64, scale: f64| {
-        Exact::constant(((j * a + k) % m - m / 2) as f64 * scale)
-    };
-    let qd = (0..n).map(|j| dyadic(j, 3, 9, 0.125)).collect();
-    let tau = (0..n).map(|j| dyadic(j, 5, 7, 12.5)).collect();
-    (q, qd, tau)
-}
-
 /// Number of exact states [`wide_vs_exact`] checks.
 pub const EXACT_STATES: i64 = 2;
 
@@ -205,7 +184,7 @@ pub const EXACT_STATES: i64 = 2;
 pub fn wide_vs_exact(subject: &Subject, alg: Algorithm) -> Option<[f64; 3]> {
     let mut worst = [0.0_f64; 3];
     for k in 0..EXACT_STATES {
-        let (q, qd, tau) = exact_state(&subject.chain, k);
+        let (q, qd, tau) = rational_state(&subject.chain, k);
         let (a, b, qdd) = dynamics_on(subject, alg, &q, &qd, tau.clone());
         if !a
             .iter()
