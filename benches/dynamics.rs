@@ -5,8 +5,10 @@
 //! Run: `cargo bench --bench dynamics`. Compare ratios within one run; the machines are shared.
 
 use criterion::{black_box, criterion_group, criterion_main, BenchmarkId, Criterion};
-use kanegen::random::{random_vec, rng};
-use kanegen::{Algorithm, Chain, Loads};
+use kanegen::dynamics::Params;
+use kanegen::dynamics::{Loads, Methods};
+use kanegen::model::random::{random_vec, rng};
+use kanegen::model::Model;
 use kanegen_generated::ssrms::Ssrms;
 
 kanegen::dynamics!(Rand2, "benches/data/random_n2.toml");
@@ -15,14 +17,11 @@ kanegen::dynamics!(Rand8, "benches/data/random_n8.toml");
 kanegen::dynamics!(Rand16, "benches/data/random_n16.toml");
 kanegen::dynamics!(Rand32, "benches/data/random_n32.toml");
 
-const INTERPRETED: [Algorithm; 3] = [
-    Algorithm::Recurrent,
-    Algorithm::CrbaBase,
-    Algorithm::Spatial,
-];
+const INTERPRETED: [Methods; 3] = [Methods::RECURRENT, Methods::CRBA_BASE, Methods::SPATIAL];
 
-fn load(path: &str) -> Chain {
-    kanegen::io::load_model(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).unwrap()
+fn load(path: &str) -> Model {
+    kanegen::model::io::load_model(&std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join(path))
+        .unwrap()
 }
 
 fn state<const N: usize>(seed: u64) -> ([f64; N], [f64; N]) {
@@ -35,8 +34,8 @@ fn state<const N: usize>(seed: u64) -> ([f64; N], [f64; N]) {
     )
 }
 
-fn interpreted(c: &mut Criterion, group: &str, chain: &Chain, q: &[f64], qd: &[f64]) {
-    let p = chain.params::<f64>();
+fn interpreted(c: &mut Criterion, group: &str, chain: &Model, q: &[f64], qd: &[f64]) {
+    let p = Params::<f64>::new(chain);
     let mut g = c.benchmark_group(group);
     for alg in INTERPRETED {
         g.bench_function(BenchmarkId::new("interpreted", alg.name()), |b| {
@@ -49,16 +48,10 @@ fn interpreted(c: &mut Criterion, group: &str, chain: &Chain, q: &[f64], qd: &[f
 fn ssrms(c: &mut Criterion) {
     let chain = load("tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
     let (q, qd) = state::<7>(7);
-    let tau = [0.0; 7];
-    c.bench_function("ssrms A+b/generated", |b| {
-        b.iter(|| {
-            (
-                Ssrms::mass_matrix(black_box(&q)),
-                Ssrms::bias(black_box(&q), black_box(&qd), &tau),
-            )
-        })
+    c.bench_function("ssrms M+c/generated", |b| {
+        b.iter(|| Ssrms::mass_matrix_and_nonlinear_effects(black_box(&q), black_box(&qd)))
     });
-    interpreted(c, "ssrms A+b", &chain, &q, &qd);
+    interpreted(c, "ssrms M+c", &chain, &q, &qd);
 }
 
 macro_rules! random_chain_bench {
@@ -66,17 +59,11 @@ macro_rules! random_chain_bench {
         fn $fn(c: &mut Criterion) {
             let chain = load(concat!("benches/data/random_n", stringify!($n), ".toml"));
             let (q, qd) = state::<$n>($n);
-            let tau = [0.0; $n];
-            let group = concat!("random N=", stringify!($n), " A+b");
+            let group = concat!("random N=", stringify!($n), " M+c");
             c.bench_function(
-                concat!("random N=", stringify!($n), " A+b/generated"),
+                concat!("random N=", stringify!($n), " M+c/generated"),
                 |b| {
-                    b.iter(|| {
-                        (
-                            $ty::mass_matrix(black_box(&q)),
-                            $ty::bias(black_box(&q), black_box(&qd), &tau),
-                        )
-                    })
+                    b.iter(|| $ty::mass_matrix_and_nonlinear_effects(black_box(&q), black_box(&qd)))
                 },
             );
             interpreted(c, group, &chain, &q, &qd);

@@ -1,39 +1,81 @@
 //! # kanegen
 //!
-//! Equations of motion of space manipulators `A(q) q̈ = b(q, q̇)`: the paper's recurrent O(N²)
-//! algorithm and its baselines, generic over the scalar; a counting symbolic tracer; and (later)
-//! code generation and simulation. This crate is the user-facing facade and the `kanegen` CLI.
+//! Equations of motion of space manipulators, `M(q) q̈ + c(q, q̇) = τ`, as unrolled,
+//! allocation-free, `no_std` Rust generated at compile time for one fixed robot
+//! ([`dynamics!`]), and — behind features — the whole pipeline that produces and checks it.
+//!
+//! | feature | what it adds |
+//! |---|---|
+//! | (none) | [`dynamics!`] and its runtime support (`libm`): builds for `#![no_std]` targets |
+//! | `std` | the library crates: [`model`] (robots as plain data, URDF/TOML readers), [`dynamics`] (algorithms generic over the scalar), [`trace`] (the counting tracer, Table 1), [`codegen`] (the emitter), [`sim`] (scenes, integrators) |
+//! | `nalgebra` | [`nalgebra`](crate::nalgebra) conversions of generated arrays (f64 and f32) |
+//! | `cli` (default) | the `kanegen` command line, and [`cli`] |
+//!
+//! A `#![no_std]` controller depends on `kanegen = { version = "…", default-features = false }`.
+#![no_std]
 #![warn(missing_docs)]
 
-// `::kanegen::…` paths emitted by `dynamics!` resolve inside this crate too (src/accuracy/generated.rs).
-extern crate self as kanegen;
+#[cfg(feature = "std")]
+extern crate std;
 
-pub mod accuracy;
-pub mod commands;
-pub mod convert;
-pub mod integrate;
-pub mod poly;
-pub mod scene;
-pub mod simulate;
-pub mod simulate_plot;
-pub mod states;
-pub mod table1;
-
-pub use kanegen_core::*;
-
-/// Unrolled, allocation-free dynamics of a fixed model, generated at compile time; see
-/// [`kanegen_macros::dynamics!`] and the README section "Code generation".
+/// Unrolled, allocation-free, `no_std` dynamics of a fixed model, generated at compile time.
+///
+/// `dynamics!(Name, "path/to/model.urdf" [, gravity = [x, y, z]] [, allow_nonphysical = true]
+/// [, runtime_payload = true] [, scalar = f32] [, fma = true] [, fma_path = f64::mul_add])`
+/// defines `pub struct Name;` with the associated constants `N`, `JOINTS`, `OP_COUNTS`,
+/// `CANDIDATES` and, on `&[f64; N]` arrays, the functions of `M(q) q̈ + c(q, q̇) = τ`:
+/// `mass_matrix(q)`, `nonlinear_effects(q, qd)`, `inverse_dynamics(q, qd, qdd)`,
+/// `forward_dynamics(q, qd, tau)`, `mass_matrix_and_nonlinear_effects(q, qd)`, and `gravity(q)`
+/// with gravity (README, "Generated API"). It also defines `NameOpCount` (the entries of
+/// `OP_COUNTS`) and, with `runtime_payload = true`, `NamePayload`, the last body's mass
+/// properties, taken by every function as a last argument `payload: &NamePayload`.
+///
+/// `scalar = f32` (default `f64`) emits `f32` code: arrays, payload fields, constants (the
+/// model's numbers rounded) and libm calls. `fma = true` fuses each single-use product into its
+/// sum or difference as one call `fma(a, b, c)` = `a·b + c`, by default libm's `fma` / `fmaf`;
+/// `fma_path = PATH` calls `PATH(a, b, c)` instead (e.g. `f64::mul_add`, which needs `std`).
+///
+/// The path is relative to the calling crate's `CARGO_MANIFEST_DIR`; the crate is rebuilt when
+/// the file changes. A missing, malformed or non-physical model is a compile error at the path.
 ///
 /// ```
 /// kanegen::dynamics!(TwoLink, "models/two_link.toml");
-/// let a = TwoLink::mass_matrix(&[0.1, 0.2]);
+/// let q = [0.1, 0.2];
+/// let m = TwoLink::mass_matrix(&q);
 /// assert_eq!(TwoLink::N, 2);
-/// assert_eq!(a[0][1], a[1][0]);
+/// assert_eq!(m[0][1], m[1][0]);
+/// // M q̈ + c = τ, with c = τ at q̈ = 0.
+/// let qd = [0.3, -0.4];
+/// let c = TwoLink::nonlinear_effects(&q, &qd);
+/// assert_eq!(TwoLink::inverse_dynamics(&q, &qd, &[0.0; 2]), c);
 /// ```
-pub use kanegen_macros::dynamics;
+#[macro_export]
+macro_rules! dynamics {
+    ($($input:tt)*) => {
+        $crate::__private::dynamics!($crate; $($input)*);
+    };
+}
 
 /// Support for the code emitted by [`dynamics!`]; not a public API.
 #[doc(hidden)]
 pub mod __private {
+    pub use kanegen_macros::dynamics;
     pub use libm;
 }
+
+#[cfg(feature = "std")]
+pub use kanegen_codegen as codegen;
+#[cfg(feature = "std")]
+pub use kanegen_dynamics as dynamics;
+#[cfg(feature = "std")]
+pub use kanegen_model as model;
+#[cfg(feature = "std")]
+pub use kanegen_sim as sim;
+#[cfg(feature = "std")]
+pub use kanegen_trace as trace;
+
+#[cfg(feature = "cli")]
+pub use kanegen_cli as cli;
+
+#[cfg(feature = "nalgebra")]
+pub mod nalgebra;

@@ -6,8 +6,8 @@
 //!
 //! Times are not compared: they come from a shared, noisy machine.
 
-use kanegen::accuracy::{AccuracyReport, Options};
-use kanegen::commands::accuracy::{figure_name, render_markdown, run, Cost, DEFAULT_INPUTS};
+use kanegen::cli::commands::accuracy::{figure_name, render_markdown, run, Cost, DEFAULT_INPUTS};
+use kanegen::cli::reports::accuracy::{AccuracyReport, Options};
 use std::path::PathBuf;
 
 fn root() -> PathBuf {

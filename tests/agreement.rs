@@ -2,10 +2,11 @@
 //! N = 1..32 with prismatic joints, external loads in both frames, joint drives and gravity; and
 //! forward / inverse dynamics are consistent.
 
-use kanegen::linalg::Vec3;
-use kanegen::metrics::{flatten as flat, rel_err};
-use kanegen::random::{random_chain, random_vec, rng, ChainSpec};
-use kanegen::{Algorithm, ExternalWrench, LoadFrame, Loads};
+use kanegen::dynamics::linalg::Vec3;
+use kanegen::dynamics::metrics::{flatten as flat, rel_err};
+use kanegen::dynamics::Params;
+use kanegen::dynamics::{ExternalWrench, LoadFrame, Loads, Methods};
+use kanegen::model::random::{random_chain, random_vec, rng, ChainSpec};
 use proptest::prelude::*;
 
 fn random_loads(n: usize, seed: u64, with_gravity: bool) -> Loads<f64> {
@@ -42,13 +43,13 @@ fn check(n: usize, seed: u64, prismatic: f64, with_gravity: bool) -> Result<(), 
         },
         seed,
     );
-    let p = chain.params::<f64>();
+    let p = Params::<f64>::new(&chain);
     let mut r = rng(seed);
     let q = random_vec(&mut r, n, 3.0);
     let qd = random_vec(&mut r, n, 2.0);
     let loads = random_loads(n, seed, with_gravity);
-    let reference = Algorithm::Spatial.dynamics(&p, &q, &qd, &loads);
-    for alg in Algorithm::ALL {
+    let reference = Methods::SPATIAL.dynamics(&p, &q, &qd, &loads);
+    for alg in Methods::ALL {
         let d = alg.dynamics(&p, &q, &qd, &loads);
         let ea = rel_err(&flat(&d.a), &flat(&reference.a));
         let eb = rel_err(&d.b, &reference.b);
@@ -75,13 +76,13 @@ proptest! {
     #[test]
     fn forward_and_inverse_dynamics_are_consistent(n in 1usize..=16, seed in any::<u64>()) {
         let chain = random_chain(&ChainSpec { n, prismatic_fraction: 0.2, ..Default::default() }, seed);
-        let p = chain.params::<f64>();
+        let p = Params::<f64>::new(&chain);
         let mut r = rng(seed);
         let q = random_vec(&mut r, n, 3.0);
         let qd = random_vec(&mut r, n, 2.0);
         let loads = random_loads(n, seed, true);
-        let qdd = Algorithm::Recurrent.forward_dynamics(&p, &q, &qd, &loads);
-        let tau = Algorithm::Spatial.inverse_dynamics(&p, &q, &qd, &qdd, &loads);
+        let qdd = Methods::RECURRENT.forward_dynamics(&p, &q, &qd, &loads);
+        let tau = Methods::SPATIAL.inverse_dynamics(&p, &q, &qd, &qdd, &loads);
         let e = rel_err(&tau, loads.tau.as_ref().unwrap());
         prop_assert!(e < 1e-8, "inverse(forward(τ)) ≠ τ: rel. error {e:.3e}");
     }
@@ -119,11 +120,11 @@ fn algorithms_run_on_f32() {
         let mut r = rng(seed);
         let q = random_vec(&mut r, n, 3.0);
         let qd = random_vec(&mut r, n, 2.0);
-        let p64 = chain.params::<f64>();
-        let p32 = chain.params::<f32>();
+        let p64 = Params::<f64>::new(&chain);
+        let p32 = Params::<f32>::new(&chain);
         let q32: Vec<f32> = q.iter().map(|&x| x as f32).collect();
         let qd32: Vec<f32> = qd.iter().map(|&x| x as f32).collect();
-        for alg in Algorithm::ALL {
+        for alg in Methods::ALL {
             let d64 = alg.dynamics(&p64, &q, &qd, &Loads::default());
             let d32 = alg.dynamics(&p32, &q32, &qd32, &Loads::default());
             let a32: Vec<f64> = d32.a.iter().flatten().map(|&x| x as f64).collect();

@@ -2,8 +2,8 @@
 //! committed files; this test regenerates them from `random_chain` and fails when they are stale
 //! (`KANEGEN_BLESS=1 cargo test --release --test bench_models` rewrites them).
 
-use kanegen::io::to_toml;
-use kanegen::random::{random_chain, ChainSpec};
+use kanegen::model::io::to_toml;
+use kanegen::model::random::{random_chain, ChainSpec};
 
 /// Sizes of the benchmarked random chains.
 pub const SIZES: [usize; 5] = [2, 4, 8, 16, 32];

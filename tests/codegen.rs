@@ -1,10 +1,12 @@
 //! The checked-in generated code (`generated/`): byte-identical to a fresh generation, equal to
 //! the interpreted f64 algorithms, and cheaper than Featherstone's generic CRBA for SSRMS.
 
-use kanegen::commands::generate::GENERATED;
-use kanegen::metrics::rel_err;
-use kanegen::random::{random_vec, rng};
-use kanegen::{Algorithm, Chain, Loads};
+use kanegen::cli::commands::generate::GENERATED;
+use kanegen::dynamics::metrics::rel_err;
+use kanegen::dynamics::Params;
+use kanegen::dynamics::{BiasMethod, Loads, MassMatrixMethod, Methods};
+use kanegen::model::random::{random_vec, rng};
+use kanegen::model::Model;
 use kanegen_generated::{srms::Srms, ssrms::Ssrms, ssrms6::Ssrms6};
 use std::path::Path;
 
@@ -19,13 +21,19 @@ fn generated_files_are_up_to_date() {
         let have = std::fs::read_to_string(root().join(g.file)).unwrap();
         assert!(
             have == want,
-            "{} is stale: regenerate with `kanegen generate {} --name {}{} -o {}`",
+            "{} is stale: regenerate with `kanegen generate {} --name {}{}{}{} -o {}`",
             g.file,
             g.model,
             g.type_name,
             g.lock
                 .map(|(i, v)| format!(" --lock {i}={v}"))
                 .unwrap_or_default(),
+            if g.float == kanegen::codegen::Float::F32 {
+                " --scalar f32"
+            } else {
+                ""
+            },
+            if g.fma { " --fma" } else { "" },
             g.file
         );
     }
@@ -34,14 +42,30 @@ fn generated_files_are_up_to_date() {
 /// `(q, qd, x) -> y` on slices.
 type Fn3 = fn(&[f64], &[f64], &[f64]) -> Vec<f64>;
 
+/// `(q, qd) -> (M, c)` on slices.
+type Pair = fn(&[f64], &[f64]) -> (Vec<Vec<f64>>, Vec<f64>);
+
+/// `(methods, mul + add)` of one emitted function, from `OP_COUNTS`.
+type Chosen = fn(&str) -> (Methods, u64);
+
 /// The generated functions of one struct, as slices, for the comparison.
 struct Fns {
     mass_matrix: fn(&[f64]) -> Vec<Vec<f64>>,
-    bias: Fn3,
-    bias_velocity: fn(&[f64], &[f64]) -> Vec<f64>,
+    nonlinear_effects: fn(&[f64], &[f64]) -> Vec<f64>,
+    mass_matrix_and_nonlinear_effects: Pair,
     inverse_dynamics: Fn3,
     forward_dynamics: Fn3,
-    algorithms: &'static [(&'static str, &'static str)],
+    chosen: Chosen,
+}
+
+/// The methods of an `OP_COUNTS` entry (an unused method is reported as the CRBA / RNEA).
+fn methods_of(mass: Option<&str>, bias: Option<&str>) -> Methods {
+    Methods {
+        mass_matrix: mass.map_or(MassMatrixMethod::Crba, |m| {
+            MassMatrixMethod::from_name(m).unwrap()
+        }),
+        bias: bias.map_or(BiasMethod::Rnea, |b| BiasMethod::from_name(b).unwrap()),
+    }
 }
 
 macro_rules! fns {
@@ -53,16 +77,15 @@ macro_rules! fns {
                     .map(|r| r.to_vec())
                     .collect()
             },
-            bias: |q, qd, tau| {
-                <$t>::bias(
+            nonlinear_effects: |q, qd| {
+                <$t>::nonlinear_effects(q.try_into().unwrap(), qd.try_into().unwrap()).to_vec()
+            },
+            mass_matrix_and_nonlinear_effects: |q, qd| {
+                let (m, c) = <$t>::mass_matrix_and_nonlinear_effects(
                     q.try_into().unwrap(),
                     qd.try_into().unwrap(),
-                    tau.try_into().unwrap(),
-                )
-                .to_vec()
-            },
-            bias_velocity: |q, qd| {
-                <$t>::bias_velocity(q.try_into().unwrap(), qd.try_into().unwrap()).to_vec()
+                );
+                (m.iter().map(|r| r.to_vec()).collect(), c.to_vec())
             },
             inverse_dynamics: |q, qd, qdd| {
                 <$t>::inverse_dynamics(
@@ -80,19 +103,24 @@ macro_rules! fns {
                 )
                 .to_vec()
             },
-            algorithms: <$t>::ALGORITHMS,
+            chosen: |name| {
+                let c = <$t>::OP_COUNTS.iter().find(|c| c.function == name).unwrap();
+                (
+                    methods_of(c.mass_matrix_method, c.bias_method),
+                    c.mul + c.add,
+                )
+            },
         }
     };
 }
 
-fn chosen(f: &Fns, name: &str) -> Algorithm {
-    let a = f.algorithms.iter().find(|(n, _)| *n == name).unwrap().1;
-    Algorithm::from_name(a).unwrap()
+fn chosen(f: &Fns, name: &str) -> Methods {
+    (f.chosen)(name).0
 }
 
-fn compare(chain: &Chain, f: &Fns, seed: u64) {
+fn compare(chain: &Model, f: &Fns, seed: u64) {
     let n = chain.dof();
-    let p = chain.params::<f64>();
+    let p = Params::<f64>::new(chain);
     let mut r = rng(seed);
     for _ in 0..20 {
         let q = random_vec(&mut r, n, 3.0);
@@ -104,20 +132,32 @@ fn compare(chain: &Chain, f: &Fns, seed: u64) {
             ..Loads::default()
         };
         let flat = |a: Vec<Vec<f64>>| a.into_iter().flatten().collect::<Vec<_>>();
-        let a_want = flat(chosen(f, "mass_matrix").mass_matrix(&p, &q));
+        let a_want = flat(chosen(f, "mass_matrix").mass_matrix.mass_matrix(&p, &q));
         let a_have = flat((f.mass_matrix)(&q));
         assert!(rel_err(&a_have, &a_want) < 1e-12, "{}: A", chain.name());
         // Against every algorithm: the generated code is the model's dynamics, not one method's.
-        for alg in Algorithm::ALL {
-            let e = rel_err(&a_have, &flat(alg.mass_matrix(&p, &q)));
+        for alg in Methods::ALL {
+            let e = rel_err(&a_have, &flat(alg.mass_matrix.mass_matrix(&p, &q)));
             assert!(e < 1e-12, "{}: A vs {alg}: {e:e}", chain.name());
-            let b = alg.bias(&p, &q, &qd, &loads);
-            let e = rel_err(&(f.bias)(&q, &qd, &tau), &b);
-            assert!(e < 1e-12, "{}: b vs {alg}: {e:e}", chain.name());
-            let h = alg.bias(&p, &q, &qd, &Loads::default());
-            let e = rel_err(&(f.bias_velocity)(&q, &qd), &h);
-            assert!(e < 1e-12, "{}: -h vs {alg}: {e:e}", chain.name());
+            // c = −b(τ = 0), and b = τ − c.
+            let b = alg.bias.bias(&p, &q, &qd, &loads);
+            let c = (f.nonlinear_effects)(&q, &qd);
+            let tau_minus_c: Vec<f64> = tau.iter().zip(&c).map(|(t, c)| t - c).collect();
+            let e = rel_err(&tau_minus_c, &b);
+            assert!(e < 1e-12, "{}: τ − c vs b of {alg}: {e:e}", chain.name());
+            let h = alg.bias.bias(&p, &q, &qd, &Loads::default());
+            let minus_h: Vec<f64> = c.iter().map(|c| -c).collect();
+            let e = rel_err(&minus_h, &h);
+            assert!(e < 1e-12, "{}: −c vs −h of {alg}: {e:e}", chain.name());
         }
+        let (m2, c2) = (f.mass_matrix_and_nonlinear_effects)(&q, &qd);
+        assert!(
+            rel_err(&flat(m2), &a_have) < 1e-15,
+            "{}: (M, c).0",
+            chain.name()
+        );
+        let e = rel_err(&c2, &(f.nonlinear_effects)(&q, &qd));
+        assert!(e < 1e-13, "{}: (M, c).1 {e:e}", chain.name());
         let id = chosen(f, "inverse_dynamics").inverse_dynamics(&p, &q, &qd, &qdd, &loads);
         let e = rel_err(&(f.inverse_dynamics)(&q, &qd, &qdd), &id);
         assert!(e < 1e-12, "{}: inverse dynamics {e:e}", chain.name());
@@ -135,8 +175,8 @@ fn compare(chain: &Chain, f: &Fns, seed: u64) {
 fn generated_code_equals_interpreted_algorithms() {
     let fns = [fns!(Ssrms), fns!(Ssrms6), fns!(Srms)];
     for (g, f) in GENERATED.iter().zip(&fns) {
-        let chain = g.chain(root()).unwrap();
-        compare(&chain, f, 11);
+        let model = g.model(root()).unwrap();
+        compare(&model, f, 11);
     }
     assert_eq!((Ssrms::N, Ssrms6::N, Srms::N), (7, 6, 6));
 }
@@ -145,12 +185,12 @@ fn generated_code_equals_interpreted_algorithms() {
 /// 7-dof model at `q[0] = v`, `q̇[0] = 0`, with row and column 0 removed.
 #[test]
 fn locked_joint_matches_full_model() {
-    let full = kanegen::io::load_model(&root().join(GENERATED[0].model)).unwrap();
-    let pf = full.params::<f64>();
+    let full = kanegen::model::io::load_model(&root().join(GENERATED[0].model)).unwrap();
+    let pf = Params::<f64>::new(&full);
     for (index, v) in [(0, 0.0), (0, 0.7), (3, -1.1), (6, 0.4)] {
         let locked = full.lock_joint(index, v).unwrap();
         assert_eq!(locked.dof(), 6);
-        let pl = locked.params::<f64>();
+        let pl = Params::<f64>::new(&locked);
         let mut r = rng(5 + index as u64);
         for _ in 0..5 {
             let q6 = random_vec(&mut r, 6, 3.0);
@@ -162,8 +202,8 @@ fn locked_joint_matches_full_model() {
                 y
             };
             let (q, qd, tau) = (ins(&q6, v), ins(&qd6, 0.0), ins(&tau6, 0.0));
-            let a7 = Algorithm::Recurrent.mass_matrix(&pf, &q);
-            let a6 = Algorithm::Spatial.mass_matrix(&pl, &q6);
+            let a7 = Methods::RECURRENT.mass_matrix.mass_matrix(&pf, &q);
+            let a6 = Methods::SPATIAL.mass_matrix.mass_matrix(&pl, &q6);
             let a7r: Vec<f64> = (0..7)
                 .filter(|&i| i != index)
                 .flat_map(|i| {
@@ -181,9 +221,9 @@ fn locked_joint_matches_full_model() {
                 tau: Some(tau6),
                 ..Loads::default()
             };
-            let mut b7 = Algorithm::Recurrent.bias(&pf, &q, &qd, &l7);
+            let mut b7 = Methods::RECURRENT.bias.bias(&pf, &q, &qd, &l7);
             b7.remove(index);
-            let b6 = Algorithm::Spatial.bias(&pl, &q6, &qd6, &l6);
+            let b6 = Methods::SPATIAL.bias.bias(&pl, &q6, &qd6, &l6);
             assert!(rel_err(&b6, &b7) < 1e-12, "b, lock {index}={v}");
         }
     }
@@ -191,32 +231,42 @@ fn locked_joint_matches_full_model() {
 }
 
 /// Featherstone's CRBA costs 612 m + 510 a at n = 7 (generic, from q including kinematics); the
-/// emitted SSRMS mass matrix must be cheaper.
+/// emitted SSRMS mass matrix must be cheaper; `OP_COUNTS` agrees with a fresh trace, and the
+/// inverse dynamics is the O(N) Newton–Euler pass, cheaper than the mass matrix.
 #[test]
 fn ssrms_mass_matrix_beats_generic_crba() {
-    let count = |f: &str| {
-        let alg = Ssrms::ALGORITHMS.iter().find(|(n, _)| *n == f).unwrap().1;
-        let (_, _, m, a) = *Ssrms::OP_COUNTS
-            .iter()
-            .find(|(n, al, _, _)| *n == f && *al == alg)
-            .unwrap();
-        (alg, m, a)
+    for c in Ssrms::OP_COUNTS {
+        eprintln!(
+            "SSRMS {:<34} {:?} {:?} {} m + {} a = {}",
+            c.function,
+            c.mass_matrix_method,
+            c.bias_method,
+            c.mul,
+            c.add,
+            c.mul + c.add
+        );
+    }
+    let m = Ssrms::OP_COUNTS[0];
+    assert_eq!(m.function, "mass_matrix");
+    assert!(m.mul + m.add < 612 + 510, "M: {} m + {} a", m.mul, m.add);
+    let total = |f: &str| {
+        let c = Ssrms::OP_COUNTS.iter().find(|c| c.function == f).unwrap();
+        c.mul + c.add
     };
-    for f in ["mass_matrix", "bias", "forward_dynamics"] {
-        let (alg, m, a) = count(f);
-        eprintln!("SSRMS {f}: {alg}, {m} m + {a} a = {}", m + a);
-    }
-    for (f, alg, m, a) in Ssrms::OP_COUNTS {
-        eprintln!("  {f:<17} {alg:<13} {m:>5} m {a:>5} a {:>6}", m + a);
-    }
-    let (_, m, a) = count("mass_matrix");
-    assert!(m + a < 612 + 510, "A: {m} m + {a} a");
+    // One Newton–Euler pass costs less than forming M q̈ + c.
+    assert!(total("inverse_dynamics") < total("mass_matrix") + total("nonlinear_effects"));
     // OP_COUNTS agrees with a fresh trace.
-    let chain = GENERATED[0].chain(root()).unwrap();
-    let opts = kanegen_codegen::Options::new("Ssrms");
-    let (choice, _) = kanegen_codegen::choose(&chain, &kanegen_codegen::FUNCTIONS[0], &opts);
+    let model = GENERATED[0].model(root()).unwrap();
+    let opts = kanegen::codegen::Options::new("Ssrms");
+    let (choice, _) = kanegen::codegen::choose::choose(
+        &model,
+        kanegen::trace::Function::MassMatrix,
+        MassMatrixMethod::Crba,
+        &opts,
+    )
+    .unwrap();
     let c = choice.counts();
-    assert_eq!((c.mul, c.add), (m, a));
+    assert_eq!((c.mul, c.add), (m.mul, m.add));
 }
 
 /// Per-function counts of the header line `Fused multiply-adds: T (`f` k, …)`, and `T`.
@@ -263,15 +313,15 @@ fn calls_per_function(src: &str, call: &str) -> Vec<(String, u64)> {
 /// `generated_files_are_up_to_date`).
 #[test]
 fn fma_source_has_the_fused_calls_its_header_states() {
-    let chain = GENERATED[0].chain(root()).unwrap();
+    let chain = GENERATED[0].model(root()).unwrap();
     let plain =
-        kanegen_codegen::generate_file(&chain, &kanegen_codegen::Options::new("Ssrms")).unwrap();
-    assert!(!plain.contains("Fused multiply-adds") && !plain.contains("fma("));
+        kanegen::codegen::generate_file(&chain, &kanegen::codegen::Options::new("Ssrms")).unwrap();
+    assert!(!plain.contains("//! Fused multiply-adds") && !plain.contains("fma("));
     for path in [None, Some("f64::mul_add")] {
-        let mut o = kanegen_codegen::Options::new("Ssrms");
+        let mut o = kanegen::codegen::Options::new("Ssrms");
         o.fma = true;
         o.fma_path = path.map(String::from);
-        let src = kanegen_codegen::generate_file(&chain, &o).unwrap();
+        let src = kanegen::codegen::generate_file(&chain, &o).unwrap();
         let call = format!("{}(", path.unwrap_or("libm::fma"));
         let (total, per) = header_fmas(&src);
         let have = calls_per_function(&src, &call);
@@ -299,10 +349,10 @@ fn fma_source_has_the_fused_calls_its_header_states() {
 /// `float = F32` on SSRMS: no `f64` anywhere in the file, f32 libm calls, the header says so.
 #[test]
 fn f32_source_is_f32_throughout() {
-    let chain = GENERATED[0].chain(root()).unwrap();
-    let mut o = kanegen_codegen::Options::new("SsrmsF32");
-    o.float = kanegen_codegen::Float::F32;
-    let src = kanegen_codegen::generate_file(&chain, &o).unwrap();
+    let chain = GENERATED[0].model(root()).unwrap();
+    let mut o = kanegen::codegen::Options::new("SsrmsF32");
+    o.float = kanegen::codegen::Float::F32;
+    let src = kanegen::codegen::generate_file(&chain, &o).unwrap();
     assert!(!src.contains("f64"));
     assert!(src.contains("//! Precision: `f32`"));
     assert!(src.contains("pub fn mass_matrix(q: &[f32; 7]) -> [[f32; 7]; 7]"));

@@ -4,16 +4,18 @@
 //!
 //! Run with `--nocapture` to see the measured numbers.
 
-use kanegen::integrate::{dopri5, Dopri5Options};
-use kanegen::scene::{BaseSpec, Scene};
-use kanegen::simulate::SceneSystem;
-use kanegen_core::algorithms::floating::{
-    floating_dynamics, generalized_jacobian, quat_to_matrix, FloatingBase, FloatingState,
-};
-use kanegen_core::algorithms::kinematics::{floating_base_frame, FLOATING_BASE_DOF};
-use kanegen_core::linalg::Vec3;
-use kanegen_core::sym::{Convention, Sym, Tracer};
-use kanegen_core::{Algorithm, Chain, Loads};
+use kanegen::dynamics::algorithms::floating::{self, generalized_jacobian};
+use kanegen::dynamics::algorithms::kinematics::floating_base_frame;
+use kanegen::dynamics::base::FLOATING_BASE_DOF;
+use kanegen::dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen::dynamics::linalg::Vec3;
+use kanegen::dynamics::Params;
+use kanegen::dynamics::{Loads, Methods};
+use kanegen::model::Model;
+use kanegen::sim::integrate::{dopri5, Dopri5Options};
+use kanegen::sim::scene::{BaseSpec, Scene};
+use kanegen::sim::simulate::SceneSystem;
+use kanegen::trace::sym::{Convention, Sym, Tracer};
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 
@@ -21,15 +23,17 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn ssrms() -> Chain {
-    kanegen::io::load_model(&root().join("tests/data/reference/ssrms_nguyen_hughes_1994.urdf"))
-        .unwrap()
+fn ssrms() -> Model {
+    kanegen::model::io::load_model(
+        &root().join("tests/data/reference/ssrms_nguyen_hughes_1994.urdf"),
+    )
+    .unwrap()
 }
 
 /// Traces `b` of `alg` for `chain`; gravity (when on) is the symbolic input `g_x, g_y, g_z`.
-fn trace_b(chain: &Chain, alg: Algorithm, gravity: bool) -> kanegen_core::sym::Trace {
+fn trace_b(chain: &Model, alg: Methods, gravity: bool) -> kanegen::trace::sym::Trace {
     let t = Tracer::new();
-    let p = chain.params::<Sym>();
+    let p = Params::<Sym>::new(chain);
     let n = chain.dof();
     let q: Vec<Sym> = (0..n).map(|i| t.input(format!("q{i}"))).collect();
     let qd: Vec<Sym> = (0..n).map(|i| t.input(format!("qd{i}"))).collect();
@@ -40,7 +44,7 @@ fn trace_b(chain: &Chain, alg: Algorithm, gravity: bool) -> kanegen_core::sym::T
         gravity: g,
         external: Vec::new(),
     };
-    let b = alg.bias(&p, &q, &qd, &loads);
+    let b = alg.bias.bias(&p, &q, &qd, &loads);
     t.finish(&b)
 }
 
@@ -48,7 +52,7 @@ fn trace_b(chain: &Chain, alg: Algorithm, gravity: bool) -> kanegen_core::sym::T
 fn a_trace_without_gravity_has_no_gravity_term() {
     let chain = ssrms();
     let n = chain.dof();
-    for alg in Algorithm::ALL {
+    for alg in Methods::ALL {
         let off = trace_b(&chain, alg, false);
         let on = trace_b(&chain, alg, true);
         assert!(
@@ -94,18 +98,21 @@ fn a_trace_without_gravity_has_no_gravity_term() {
 #[test]
 fn generated_code_has_gravity_only_when_asked() {
     let chain = ssrms();
-    let mut opts = kanegen_codegen::Options::new("Ssrms");
-    let space = kanegen_codegen::generate_file(&chain, &opts).unwrap();
+    let mut opts = kanegen::codegen::Options::new("Ssrms");
+    let space = kanegen::codegen::generate_file(&chain, &opts).unwrap();
     opts.gravity = Some([0.0, 0.0, -9.81]);
-    let earth = kanegen_codegen::generate_file(&chain, &opts).unwrap();
+    let earth = kanegen::codegen::generate_file(&chain, &opts).unwrap();
     assert!(!space.contains("fn gravity"));
     assert!(earth.contains("fn gravity"));
-    // The gravity function is only in the gravity file, and the bias differs (g enters b).
+    // The gravity function is only in the gravity file, and c differs (g enters c).
     let body = |src: &str, f: &str| {
         let i = src.find(&format!("fn {f}(")).unwrap();
         src[i..i + src[i..].find("\n    }").unwrap()].to_string()
     };
-    assert_ne!(body(&space, "bias"), body(&earth, "bias"));
+    assert_ne!(
+        body(&space, "nonlinear_effects"),
+        body(&earth, "nonlinear_effects")
+    );
     assert_eq!(body(&space, "mass_matrix"), body(&earth, "mass_matrix"));
 }
 
@@ -191,8 +198,8 @@ fn count_scene_reports_the_cost_of_each_enabled_effect() {
 }
 
 /// Origin of the last arm body (inertial frame).
-fn tip(chain: &Chain, base: &FloatingBase<f64>, st: &FloatingState<f64>, q: &[f64]) -> [f64; 3] {
-    let kin = floating_base_frame(&chain.params(), base, st, q);
+fn tip(chain: &Model, base: &FloatingBase<f64>, st: &FloatingState<f64>, q: &[f64]) -> [f64; 3] {
+    let kin = floating_base_frame(&Params::new(chain), base, st, q);
     let mut x = st.position.clone();
     for k in &kin[FLOATING_BASE_DOF..] {
         x = &x + &k.r;
@@ -237,9 +244,9 @@ integrator = "dopri5"
         omega_b: Vec3::zero(),
     };
     // Zero momentum: ν_b = −A_bb⁻¹ A_bm q̇.
-    let p = scene.chain.params::<f64>();
-    let a = floating_dynamics(
-        Algorithm::Recurrent,
+    let p = Params::<f64>::new(&scene.model);
+    let a = floating::dynamics(
+        Methods::RECURRENT,
         &p,
         &base,
         &st0,
@@ -253,19 +260,26 @@ integrator = "dopri5"
     let rhs: Vec<f64> = (0..nb)
         .map(|i| -(0..n).map(|j| a[i][nb + j] * qd[j]).sum::<f64>())
         .collect();
-    let nu_b = kanegen_core::ldlt::solve(&kanegen_core::ldlt::ldlt(&a_bb), &rhs);
+    let nu_b = kanegen::dynamics::ldlt::solve(&kanegen::dynamics::ldlt::ldlt(&a_bb), &rhs);
     let v_b = [nu_b[0], nu_b[1], nu_b[2]];
     if let BaseSpec::FreeFloating { v, omega, .. } = &mut scene.base {
         *v = v_b;
         *omega = [nu_b[3], nu_b[4], nu_b[5]];
     }
     // Predictions: tip velocity J* q̇, base origin velocity R₀ v_b (inertial frame).
-    let js = generalized_jacobian(Algorithm::Recurrent, &p, &base, &st0, &q, &Vec3::zero());
+    let js = generalized_jacobian(
+        Methods::RECURRENT.mass_matrix,
+        &p,
+        &base,
+        &st0,
+        &q,
+        &Vec3::zero(),
+    );
     let tip_rate: Vec<f64> = (0..3)
         .map(|r| (0..n).map(|j| js[r][j] * qd[j]).sum())
         .collect();
     let base_rate = rot.mul_vec(&Vec3::from_f64(v_b)).into_array();
-    let tip0 = tip(&scene.chain, &base, &st0, &q);
+    let tip0 = tip(&scene.model, &base, &st0, &q);
 
     let mut sys = SceneSystem::new(&scene);
     let x0 = sys.initial_state();
@@ -287,7 +301,7 @@ integrator = "dopri5"
         dopri5(&mut sys, 0.0, h, &opts, &mut x, |_, _| {}).unwrap();
         let (qh, _, sth) = sys.split(&x);
         let sth = sth.unwrap();
-        let tiph = tip(&scene.chain, &base, &sth, qh);
+        let tiph = tip(&scene.model, &base, &sth, qh);
         let rel = |moved: [f64; 3], pred: &[f64]| {
             let e: Vec<f64> = (0..3).map(|k| moved[k] / h - pred[k]).collect();
             norm(&e) / norm(pred)

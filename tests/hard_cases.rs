@@ -35,17 +35,19 @@
 //!   |ΔE|/E in the first quarter is 9.1e-7 and in the last 3.2e-6. RK4 at the same step is
 //!   7000× more accurate here: the motion is slow, and RK4's error is O(h⁴).
 
-use kanegen::integrate::{midpoint, rk4};
-use kanegen::scene::Scene;
-use kanegen::simulate::SceneSystem;
-use kanegen_core::ldlt::{ldlt, solve};
-use kanegen_core::linalg::rpy_to_matrix;
-use kanegen_core::metrics::{rel_err, rel_err_mat, rel_err_wide};
-use kanegen_core::random::{
+use kanegen::dynamics::ldlt::{ldlt, solve};
+use kanegen::dynamics::metrics::{rel_err, rel_err_mat, rel_err_wide};
+use kanegen::dynamics::scalars::wide::Wide;
+use kanegen::dynamics::Params;
+use kanegen::dynamics::{Loads, Methods, Real, Scalar};
+use kanegen::model::placement::rpy_to_matrix;
+use kanegen::model::random::{
     random_chain, random_inertial, random_rotation, random_vec, rng, ChainSpec,
 };
-use kanegen_core::wide::Wide;
-use kanegen_core::{Algorithm, Chain, Inertial, Joint, JointKind, Loads, Placement, Real, Scalar};
+use kanegen::model::{Inertial, Joint, JointKind, Model, Placement};
+use kanegen::sim::integrate::{midpoint, rk4};
+use kanegen::sim::scene::Scene;
+use kanegen::sim::simulate::SceneSystem;
 use nalgebra::{DMatrix, SymmetricEigen};
 use std::path::PathBuf;
 use std::time::Instant;
@@ -64,17 +66,19 @@ fn root() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn ssrms() -> Chain {
-    kanegen_core::io::load_model(&root().join("tests/data/reference/ssrms_nguyen_hughes_1994.urdf"))
-        .unwrap()
+fn ssrms() -> Model {
+    kanegen::model::io::load_model(
+        &root().join("tests/data/reference/ssrms_nguyen_hughes_1994.urdf"),
+    )
+    .unwrap()
 }
 
 /// SSRMS with the 116 t payload of `scenes/ssrms_payload_fixed.toml`, merged into the last body
-/// by the scene reader ([`kanegen::scene::combine_inertials`], parallel-axis theorem).
-fn ssrms_payload() -> Chain {
+/// by the scene reader ([`kanegen::sim::scene::combine_inertials`], parallel-axis theorem).
+fn ssrms_payload() -> Model {
     Scene::load(&root().join("scenes/ssrms_payload_fixed.toml"))
         .unwrap_or_else(|e| panic!("{e:#}"))
-        .chain
+        .model
 }
 
 fn to_f64_vec<S: Real>(x: &[S]) -> Vec<f64> {
@@ -141,10 +145,10 @@ impl Measured {
 }
 
 /// `A`, `b` and `q̈ = A⁻¹ b` by `recurrent` (LDLᵀ) in `Wide`, `f64` and `f32`, at `(q, q̇, τ)`.
-fn measure(chain: &Chain, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
-    let alg = Algorithm::Recurrent;
+fn measure(chain: &Model, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
+    let alg = Methods::RECURRENT;
     let dw = alg.dynamics(
-        &chain.params::<Wide>(),
+        &Params::<Wide>::new(chain),
         &consts::<Wide>(q),
         &consts(qd),
         &drives(tau),
@@ -159,7 +163,7 @@ fn measure(chain: &Chain, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
     }));
     let diag = (0..n).fold(0.0_f64, |m, i| m.max(aw[i][i]));
 
-    let p = chain.params::<f64>();
+    let p = Params::<f64>::new(chain);
     let d = alg.dynamics(&p, q, qd, &drives(tau));
     let f = ldlt(&d.a);
     let x = solve(&f, &d.b);
@@ -172,12 +176,12 @@ fn measure(chain: &Chain, q: &[f64], qd: &[f64], tau: &[f64]) -> Measured {
         b2 += d.b[i].powi(2);
     }
     let x32 = alg.forward_dynamics(
-        &chain.params::<f32>(),
+        &Params::<f32>::new(chain),
         &consts::<f32>(q),
         &consts(qd),
         &drives(tau),
     );
-    let xs = Algorithm::Spatial.forward_dynamics(&p, q, qd, &drives(tau));
+    let xs = Methods::SPATIAL.forward_dynamics(&p, q, qd, &drives(tau));
     Measured {
         cond,
         cond_s,
@@ -419,7 +423,7 @@ fn scaled(mut i: Inertial, mass: f64) -> Inertial {
     i
 }
 
-fn with_masses(chain: &Chain, masses: &[f64]) -> Chain {
+fn with_masses(chain: &Model, masses: &[f64]) -> Model {
     let joints = chain
         .joints()
         .iter()
@@ -429,7 +433,7 @@ fn with_masses(chain: &Chain, masses: &[f64]) -> Chain {
             ..j.clone()
         })
         .collect();
-    Chain::new("mass_ratio", "base", None, joints).unwrap()
+    Model::new("mass_ratio", "base", None, joints).unwrap()
 }
 
 /// Case 3: mass ratio 1e8. Random 8-link geometry (6 seeds), either alternating 1e5 / 1e-3 kg,
@@ -490,7 +494,7 @@ fn case3_mass_ratio() {
 /// paired axes and the distance between them are the same at every `q`. Between pairs the
 /// placements are random. Body `2k`, the one between the paired axes, has mass `inner_mass`,
 /// with its random inertia scaled along.
-fn pair_chain(pairs: usize, theta: f64, at: [f64; 3], inner_mass: f64, seed: u64) -> Chain {
+fn pair_chain(pairs: usize, theta: f64, at: [f64; 3], inner_mass: f64, seed: u64) -> Model {
     let mut r = rng(seed);
     let joints = (0..2 * pairs)
         .map(|k| {
@@ -520,7 +524,7 @@ fn pair_chain(pairs: usize, theta: f64, at: [f64; 3], inner_mass: f64, seed: u64
             }
         })
         .collect();
-    Chain::new("pairs", "base", None, joints).unwrap()
+    Model::new("pairs", "base", None, joints).unwrap()
 }
 
 /// Case 4: degenerate joint geometry. 6-dof chains (three pairs, 4 seeds) whose paired axes are
@@ -631,9 +635,9 @@ fn case5_fast_joints() {
     ] {
         let n = chain.dof();
         let (p, pw, p32) = (
-            chain.params::<f64>(),
-            chain.params::<Wide>(),
-            chain.params::<f32>(),
+            Params::<f64>::new(chain),
+            Params::<Wide>::new(chain),
+            Params::<f32>::new(chain),
         );
         let mut worst = [0.0_f64; 5];
         for seed in 0..6u64 {
@@ -650,12 +654,12 @@ fn case5_fast_joints() {
             assert_spd_and_bounded(&label, &m);
 
             let (qw, qdw) = (consts::<Wide>(&q), consts::<Wide>(&qd));
-            let bwr = Algorithm::Recurrent.bias(&pw, &qw, &qdw, &drives(&tau));
-            let bws = Algorithm::Spatial.bias(&pw, &qw, &qdw, &drives(&tau));
+            let bwr = Methods::RECURRENT.bias.bias(&pw, &qw, &qdw, &drives(&tau));
+            let bws = Methods::SPATIAL.bias.bias(&pw, &qw, &qdw, &drives(&tau));
             let reference = to_f64_vec(&bwr);
-            let br = Algorithm::Recurrent.bias(&p, &q, &qd, &drives(&tau));
-            let bs = Algorithm::Spatial.bias(&p, &q, &qd, &drives(&tau));
-            let b32 = Algorithm::Recurrent.bias(
+            let br = Methods::RECURRENT.bias.bias(&p, &q, &qd, &drives(&tau));
+            let bs = Methods::SPATIAL.bias.bias(&p, &q, &qd, &drives(&tau));
+            let b32 = Methods::RECURRENT.bias.bias(
                 &p32,
                 &consts::<f32>(&q),
                 &consts::<f32>(&qd),

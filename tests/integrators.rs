@@ -9,9 +9,9 @@
 //! first to the last quarter (ratio 40.7 at h = 0.002, 3.1 at h = 0.001; RK4 at h = 0.002: 2417) —
 //! bounded energy error of symmetric non-symplectic methods is a near-integrable result.
 
-use kanegen::integrate::{midpoint, rk4};
-use kanegen::scene::Scene;
-use kanegen::simulate::{simulate, SceneSystem};
+use kanegen::sim::integrate::{midpoint, rk4};
+use kanegen::sim::scene::Scene;
+use kanegen::sim::simulate::{simulate, SceneSystem};
 use std::path::PathBuf;
 
 fn scene(text: &str) -> Scene {
@@ -203,7 +203,7 @@ fn outputs_include_end_effector_and_base_attitude_plots() {
     let s = floating("midpoint", 0.01, 20.0);
     let run = simulate(&s, None).unwrap();
     let dir = std::env::temp_dir().join(format!("kanegen-integ-plots-{}", std::process::id()));
-    kanegen::simulate::write_outputs(&s, &run, &dir).unwrap();
+    kanegen::cli::commands::simulate::write_outputs(&s, &run, &dir).unwrap();
     for f in [
         "joints.svg",
         "end_effector.svg",
@@ -214,13 +214,13 @@ fn outputs_include_end_effector_and_base_attitude_plots() {
         assert!(text.contains("<svg") && text.contains("polyline"), "{f}");
     }
     // Roll/pitch/yaw of the initial quaternion, and the end effector moves.
-    let att = kanegen::simulate_plot::base_attitude_series(&run);
+    let att = kanegen::cli::plots::simulate::base_attitude_series(&run);
     let [x, y, z, w] = [0.1_f64, -0.2, 0.3, 0.9];
     let n = (x * x + y * y + z * z + w * w).sqrt();
     let (x, y, z, w) = (x / n, y / n, z / n, w / n);
     let yaw = (2.0 * (w * z + x * y)).atan2(1.0 - 2.0 * (y * y + z * z));
     assert!((att[2].1[0].1 - yaw).abs() < 1e-12);
-    let ee = kanegen::simulate_plot::end_effector_series(&s, &run);
+    let ee = kanegen::cli::plots::simulate::end_effector_series(&s, &run);
     let moved = ee[0].1.iter().map(|p| p.1).fold(f64::MIN, f64::max)
         - ee[0].1.iter().map(|p| p.1).fold(f64::MAX, f64::min);
     assert!(moved > 0.05, "end effector x range {moved}");

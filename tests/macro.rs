@@ -3,9 +3,11 @@
 //! SSRMS code (`scalar = f32`, `fma = true`) agree with the checked-in f64 code to their
 //! precision.
 
-use kanegen::metrics::rel_err;
-use kanegen::random::{random_vec, rng};
-use kanegen::{Algorithm, Chain, Inertial, Loads};
+use kanegen::dynamics::metrics::rel_err;
+use kanegen::dynamics::Params;
+use kanegen::dynamics::{Loads, Methods};
+use kanegen::model::random::{random_vec, rng};
+use kanegen::model::{Inertial, Model};
 use std::path::Path;
 
 kanegen::dynamics!(Random3, "tests/data/codegen/random3_prismatic.toml");
@@ -19,8 +21,8 @@ kanegen::dynamics!(
 
 const G: [f64; 3] = [0.3, -1.2, -9.81];
 
-fn load(rel: &str) -> Chain {
-    kanegen::io::load_model(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
+fn load(rel: &str) -> Model {
+    kanegen::model::io::load_model(&Path::new(env!("CARGO_MANIFEST_DIR")).join(rel)).unwrap()
 }
 
 fn flat<const N: usize>(a: [[f64; N]; N]) -> Vec<f64> {
@@ -41,7 +43,7 @@ fn state<const N: usize>(seed: u64) -> [[f64; N]; 4] {
 macro_rules! check_constant_model {
     ($t:ident, $n:literal, $file:literal) => {{
         let chain = load($file);
-        let p = chain.params::<f64>();
+        let p = Params::<f64>::new(&chain);
         assert_eq!($t::N, $n);
         assert_eq!($t::JOINTS.len(), chain.dof());
         for seed in 0..20 {
@@ -50,14 +52,22 @@ macro_rules! check_constant_model {
                 tau: Some(tau.to_vec()),
                 ..Loads::default()
             };
-            for alg in Algorithm::ALL {
-                let e = rel_err(&flat($t::mass_matrix(&q)), &flat_v(alg.mass_matrix(&p, &q)));
-                assert!(e < 1e-12, "{}: A vs {alg}: {e:e}", $file);
-                let e = rel_err(&$t::bias(&q, &qd, &tau), &alg.bias(&p, &q, &qd, &loads));
-                assert!(e < 1e-12, "{}: b vs {alg}: {e:e}", $file);
-                let h = alg.bias(&p, &q, &qd, &Loads::default());
-                let e = rel_err(&$t::bias_velocity(&q, &qd), &h);
-                assert!(e < 1e-12, "{}: -h vs {alg}: {e:e}", $file);
+            for alg in Methods::ALL {
+                let m = flat($t::mass_matrix(&q));
+                let e = rel_err(&m, &flat_v(alg.mass_matrix.mass_matrix(&p, &q)));
+                assert!(e < 1e-12, "{}: M vs {alg}: {e:e}", $file);
+                // c = −b(τ = 0): the field's sign.
+                let c: Vec<f64> = alg
+                    .bias
+                    .bias(&p, &q, &qd, &Loads::default())
+                    .iter()
+                    .map(|b| -b)
+                    .collect();
+                let e = rel_err(&$t::nonlinear_effects(&q, &qd), &c);
+                assert!(e < 1e-12, "{}: c vs {alg}: {e:e}", $file);
+                let (m2, c2) = $t::mass_matrix_and_nonlinear_effects(&q, &qd);
+                assert!(rel_err(&flat(m2), &m) < 1e-15, "{}: (M, c).0", $file);
+                assert!(rel_err(&c2, &c) < 1e-12, "{}: (M, c).1", $file);
                 let id = alg.inverse_dynamics(&p, &q, &qd, &qdd, &loads);
                 let e = rel_err(&$t::inverse_dynamics(&q, &qd, &qdd), &id);
                 assert!(e < 1e-11, "{}: ID vs {alg}: {e:e}", $file);
@@ -73,32 +83,42 @@ macro_rules! check_constant_model {
 fn random_models_through_the_macro_equal_interpreted() {
     check_constant_model!(Random3, 3, "tests/data/codegen/random3_prismatic.toml");
     check_constant_model!(Random5, 5, "tests/data/codegen/random5.toml");
-    // The op-count table lists every algorithm for every function and names the emitted one.
-    assert_eq!(Random5::OP_COUNTS.len(), 5 * Algorithm::ALL.len());
-    for (f, alg) in Random5::ALGORITHMS {
-        let best = Random5::OP_COUNTS
+    // One OP_COUNTS entry per generated function, each the cheapest of its candidates.
+    let names: Vec<&str> = Random5::OP_COUNTS.iter().map(|c| c.function).collect();
+    assert_eq!(
+        names,
+        [
+            "mass_matrix",
+            "nonlinear_effects",
+            "inverse_dynamics",
+            "forward_dynamics",
+            "mass_matrix_and_nonlinear_effects"
+        ]
+    );
+    for chosen in Random5::OP_COUNTS {
+        let candidates: Vec<_> = Random5::CANDIDATES
             .iter()
-            .filter(|r| r.0 == *f)
-            .map(|r| r.2 + r.3)
-            .min()
-            .unwrap();
-        let chosen = Random5::OP_COUNTS
+            .filter(|c| c.function == chosen.function)
+            .collect();
+        assert!(candidates.len() >= 3, "{}", chosen.function);
+        let best = candidates.iter().map(|c| c.mul + c.add).min().unwrap();
+        assert_eq!(chosen.mul + chosen.add, best, "{}", chosen.function);
+        assert!(candidates
             .iter()
-            .find(|r| r.0 == *f && r.1 == *alg)
-            .unwrap();
-        assert_eq!(chosen.2 + chosen.3, best, "{f}");
+            .any(|c| c.mass_matrix_method == chosen.mass_matrix_method
+                && c.bias_method == chosen.bias_method));
     }
 }
 
 /// The chain with its last body's mass properties replaced.
-fn with_payload(chain: &Chain, p: &Random5GravityPayload) -> Chain {
+fn with_payload(chain: &Model, p: &Random5GravityPayload) -> Model {
     let mut joints = chain.joints().to_vec();
     joints.last_mut().unwrap().inertial = Inertial {
         mass: p.mass,
         com: p.com,
         inertia: p.inertia,
     };
-    Chain::new(
+    Model::new(
         chain.name(),
         chain.base(),
         chain.base_inertial().cloned(),
@@ -119,8 +139,8 @@ fn runtime_payload_and_gravity_equal_interpreted_with_modified_chain() {
     };
     for payload in [nominal, heavy] {
         let modified = with_payload(&chain, &payload);
-        let p = modified.params::<f64>();
-        let g = Some(kanegen::linalg::Vec3(G));
+        let p = Params::<f64>::new(&modified);
+        let g = Some(kanegen::dynamics::linalg::Vec3(G));
         for seed in 0..10 {
             let [q, qd, tau, qdd] = state::<5>(100 + seed);
             let loads = Loads {
@@ -128,31 +148,28 @@ fn runtime_payload_and_gravity_equal_interpreted_with_modified_chain() {
                 gravity: g.clone(),
                 external: Vec::new(),
             };
-            let alg = Algorithm::Recurrent;
+            let alg = Methods::RECURRENT;
             let e = rel_err(
                 &flat(Random5Gravity::mass_matrix(&q, &payload)),
-                &flat_v(alg.mass_matrix(&p, &q)),
+                &flat_v(alg.mass_matrix.mass_matrix(&p, &q)),
             );
             assert!(e < 1e-12, "A: {e:e}");
-            let e = rel_err(
-                &Random5Gravity::bias(&q, &qd, &tau, &payload),
-                &alg.bias(&p, &q, &qd, &loads),
-            );
-            assert!(e < 1e-12, "b: {e:e}");
+            // c = −b(τ = 0) with gravity; g = c(q̇ = 0).
             let grav = Loads {
                 gravity: g.clone(),
                 ..Loads::default()
             };
+            let neg = |v: Vec<f64>| -> Vec<f64> { v.iter().map(|x| -x).collect() };
+            let e = rel_err(
+                &Random5Gravity::nonlinear_effects(&q, &qd, &payload),
+                &neg(alg.bias.bias(&p, &q, &qd, &grav)),
+            );
+            assert!(e < 1e-12, "c: {e:e}");
             let e = rel_err(
                 &Random5Gravity::gravity(&q, &payload),
-                &alg.bias(&p, &q, &[0.0; 5], &grav),
+                &neg(alg.bias.bias(&p, &q, &[0.0; 5], &grav)),
             );
             assert!(e < 1e-12, "gravity: {e:e}");
-            let e = rel_err(
-                &Random5Gravity::bias_velocity(&q, &qd, &payload),
-                &alg.bias(&p, &q, &qd, &Loads::default()),
-            );
-            assert!(e < 1e-12, "-h: {e:e}");
             let e = rel_err(
                 &Random5Gravity::inverse_dynamics(&q, &qd, &qdd, &payload),
                 &alg.inverse_dynamics(&p, &q, &qd, &qdd, &loads),
@@ -240,17 +257,17 @@ fn f32_code_agrees_to_f32_precision() {
         let e = rel_err(&a, &flat(Ssrms::mass_matrix(&q)));
         ea = ea.max(e);
         min_a = min_a.min(e);
-        let b = SsrmsF32::bias(&to_f32(&q), &to_f32(&qd), &to_f32(&tau));
-        eb = eb.max(rel_err(&widen(&b), &Ssrms::bias(&q, &qd, &tau)));
+        let c = SsrmsF32::nonlinear_effects(&to_f32(&q), &to_f32(&qd));
+        eb = eb.max(rel_err(&widen(&c), &Ssrms::nonlinear_effects(&q, &qd)));
         let fd = SsrmsF32::forward_dynamics(&to_f32(&q), &to_f32(&qd), &to_f32(&tau));
         efd = efd.max(rel_err(
             &widen(&fd),
             &Ssrms::forward_dynamics(&q, &qd, &tau),
         ));
     }
-    eprintln!("f32 vs f64: A {ea:.2e} (min {min_a:.2e}), b {eb:.2e}, q̈ {efd:.2e}");
+    eprintln!("f32 vs f64: A {ea:.2e} (min {min_a:.2e}), c {eb:.2e}, q̈ {efd:.2e}");
     assert!(ea < 2e-6, "A: {ea:e}");
-    assert!(eb < 1.5e-5, "b: {eb:e}");
+    assert!(eb < 1.5e-5, "c: {eb:e}");
     assert!(efd < 5e-4, "q̈: {efd:e}");
     assert!(min_a > 1e-9, "A is as accurate as f64: {min_a:e}");
 }
@@ -287,9 +304,9 @@ fn fma_code_agrees_with_plain_f64() {
         let a = SsrmsFma::mass_matrix(&q);
         assert_eq!(a, SsrmsMulAdd::mass_matrix(&q));
         ea = ea.max(rel_err(&flat(a), &flat(Ssrms::mass_matrix(&q))));
-        let b = SsrmsFma::bias(&q, &qd, &tau);
-        assert_eq!(b, SsrmsMulAdd::bias(&q, &qd, &tau));
-        eb = eb.max(rel_err(&b, &Ssrms::bias(&q, &qd, &tau)));
+        let c = SsrmsFma::nonlinear_effects(&q, &qd);
+        assert_eq!(c, SsrmsMulAdd::nonlinear_effects(&q, &qd));
+        eb = eb.max(rel_err(&c, &Ssrms::nonlinear_effects(&q, &qd)));
         let id = SsrmsFma::inverse_dynamics(&q, &qd, &qdd);
         assert_eq!(id, SsrmsMulAdd::inverse_dynamics(&q, &qd, &qdd));
         eid = eid.max(rel_err(&id, &Ssrms::inverse_dynamics(&q, &qd, &qdd)));
@@ -300,10 +317,10 @@ fn fma_code_agrees_with_plain_f64() {
         differs += usize::from(fd != plain);
     }
     eprintln!(
-        "fma vs plain: A {ea:.2e}, b {eb:.2e}, τ {eid:.2e}, q̈ {efd:.2e}; {differs}/200 differ"
+        "fma vs plain: A {ea:.2e}, c {eb:.2e}, τ {eid:.2e}, q̈ {efd:.2e}; {differs}/200 differ"
     );
     assert!(ea < 3e-14, "A: {ea:e}");
-    assert!(eb < 3e-14, "b: {eb:e}");
+    assert!(eb < 3e-14, "c: {eb:e}");
     assert!(eid < 3e-14, "τ: {eid:e}");
     assert!(efd < 1.5e-12, "q̈: {efd:e}");
     assert!(
@@ -312,23 +329,25 @@ fn fma_code_agrees_with_plain_f64() {
     );
 }
 
-/// The `FMA_COUNTS` of the macro's code are those the generator's header states.
+/// The `fma` counts in `OP_COUNTS` of the macro's code are those the generator's header states.
 #[test]
 fn fma_counts_match_the_header() {
     let chain = load("tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
-    let mut o = kanegen_codegen::Options::new("SsrmsFma");
+    let mut o = kanegen::codegen::Options::new("SsrmsFma");
     o.fma = true;
-    let src = kanegen_codegen::generate_file(&chain, &o).unwrap();
-    let total: u64 = SsrmsFma::FMA_COUNTS.iter().map(|(_, k)| k).sum();
-    let per = SsrmsFma::FMA_COUNTS
+    let src = kanegen::codegen::generate_file(&chain, &o).unwrap();
+    let total: u64 = SsrmsFma::OP_COUNTS.iter().map(|c| c.fma).sum();
+    let per = SsrmsFma::OP_COUNTS
         .iter()
-        .map(|(f, k)| format!("`{f}` {k}"))
+        .map(|c| format!("`{}` {}", c.function, c.fma))
         .collect::<Vec<_>>()
         .join(", ");
     let line = format!("//! Fused multiply-adds: {total} ({per}), ");
     assert!(src.contains(&line), "{line}");
     assert!(total > 0);
-    assert_eq!(SsrmsFma::FMA_COUNTS, SsrmsMulAdd::FMA_COUNTS);
+    let fmas = |c: &[SsrmsFmaOpCount]| c.iter().map(|c| c.fma).collect::<Vec<_>>();
+    let fmas2 = |c: &[SsrmsMulAddOpCount]| c.iter().map(|c| c.fma).collect::<Vec<_>>();
+    assert_eq!(fmas(&SsrmsFma::OP_COUNTS), fmas2(&SsrmsMulAdd::OP_COUNTS));
 }
 
 /// f32 with fma, gravity and a runtime payload (f32 fields) on a random model: the same
@@ -337,7 +356,7 @@ fn fma_counts_match_the_header() {
 #[test]
 fn f32_fma_payload_gravity_through_the_macro() {
     let chain = load("tests/data/codegen/random5.toml");
-    let p = chain.params::<f64>();
+    let p = Params::<f64>::new(&chain);
     let nominal: Random5F32FmaPayload = Random5F32FmaPayload::NOMINAL;
     assert_eq!(nominal.mass, chain.joints()[4].inertial.mass as f32);
     let (mut ea, mut efd) = (0.0_f64, 0.0_f64);
@@ -345,24 +364,24 @@ fn f32_fma_payload_gravity_through_the_macro() {
         let [q, qd, tau, _] = state::<5>(300 + seed).map(|v| v.map(|x| f64::from(x as f32)));
         let loads = Loads {
             tau: Some(tau.to_vec()),
-            gravity: Some(kanegen::linalg::Vec3(G)),
+            gravity: Some(kanegen::dynamics::linalg::Vec3(G)),
             external: Vec::new(),
         };
         let a = Random5F32Fma::mass_matrix(&to_f32(&q), &nominal);
         let a = flat_v(a.iter().map(|r| widen(r)).collect());
         ea = ea.max(rel_err(
             &a,
-            &flat_v(Algorithm::Recurrent.mass_matrix(&p, &q)),
+            &flat_v(Methods::RECURRENT.mass_matrix.mass_matrix(&p, &q)),
         ));
         let fd =
             Random5F32Fma::forward_dynamics(&to_f32(&q), &to_f32(&qd), &to_f32(&tau), &nominal);
         efd = efd.max(rel_err(
             &widen(&fd),
-            &Algorithm::Recurrent.forward_dynamics(&p, &q, &qd, &loads),
+            &Methods::RECURRENT.forward_dynamics(&p, &q, &qd, &loads),
         ));
     }
     eprintln!("random5 f32 + fma: A {ea:.2e}, q̈ {efd:.2e}");
     assert!(ea < 3e-6 && ea > 1e-9, "A: {ea:e}");
     assert!(efd < 2e-5 && efd > 1e-9, "q̈: {efd:e}");
-    assert!(Random5F32Fma::FMA_COUNTS.iter().all(|(_, k)| *k > 0));
+    assert!(Random5F32Fma::OP_COUNTS.iter().all(|c| c.fma > 0));
 }

@@ -53,18 +53,19 @@ fn generated_functions_do_not_allocate() {
         let x = f64::from(k) * 1e-3;
         let q7 = std::hint::black_box([x, 0.1, -0.2, 0.3, x, 0.5, -x]);
         let a = Ssrms::mass_matrix(&q7);
-        let b = Ssrms::bias(&q7, &q7, &q7);
-        let h = Ssrms::bias_velocity(&q7, &q7);
+        let c = Ssrms::nonlinear_effects(&q7, &q7);
+        let (m, h) = Ssrms::mass_matrix_and_nonlinear_effects(&q7, &q7);
         let t = Ssrms::inverse_dynamics(&q7, &q7, &q7);
         let f = Ssrms::forward_dynamics(&q7, &q7, &q7);
-        acc += a[6][6] + b[0] + h[1] + t[2] + f[3];
+        acc += a[6][6] + c[0] + m[0][1] + h[1] + t[2] + f[3];
         let q5 = std::hint::black_box([x, 0.1, -0.2, 0.3, x]);
         let a = Random5::mass_matrix(&q5, &payload);
-        let b = Random5::bias(&q5, &q5, &q5, &payload);
+        let c = Random5::nonlinear_effects(&q5, &q5, &payload);
         let g = Random5::gravity(&q5, &payload);
+        let (m, h) = Random5::mass_matrix_and_nonlinear_effects(&q5, &q5, &payload);
         let t = Random5::inverse_dynamics(&q5, &q5, &q5, &payload);
         let f = Random5::forward_dynamics(&q5, &q5, &q5, &payload);
-        acc += a[4][4] + b[0] + g[1] + t[2] + f[3];
+        acc += a[4][4] + c[0] + g[1] + m[1][0] + h[2] + t[2] + f[3];
     }
     let after = ALLOCATIONS.load(Ordering::SeqCst);
     assert!(acc.is_finite());

@@ -3,7 +3,7 @@
 //! model, every state, every algorithm, gravity zero and −9.81 along the root z axis, to 1e-9
 //! relative (max |x − y| / max |y| over each matrix or vector).
 
-use kanegen::metrics::rel_err;
+use kanegen::dynamics::metrics::rel_err;
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -73,7 +73,7 @@ fn eval_matches_pinocchio_references() {
         // Three published sets have link inertias that violate the triangle inequality (the
         // shared data flags them). kanegen rejects them by default, naming the joint; they are
         // evaluated with the explicit opt-in, and only they may need it.
-        let strict = kanegen::io::load_model(&urdf);
+        let strict = kanegen::model::io::load_model(&urdf);
         let lenient = match &strict {
             Ok(_) => false,
             Err(e) => {

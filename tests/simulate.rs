@@ -4,10 +4,10 @@
 //!
 //! Run with `--nocapture` to see the measured numbers.
 
-use kanegen::integrate::{dopri5, rk4, Dopri5Options, System};
-use kanegen::scene::{combine_inertials, Scene};
-use kanegen::simulate::{simulate, SceneSystem};
-use kanegen::Inertial;
+use kanegen::model::Inertial;
+use kanegen::sim::integrate::{dopri5, rk4, Dopri5Options, System};
+use kanegen::sim::scene::Scene;
+use kanegen::sim::simulate::{simulate, SceneSystem};
 use std::path::{Path, PathBuf};
 
 fn root() -> PathBuf {
@@ -196,7 +196,7 @@ tolerance = 1e-10
     let sys = SceneSystem::new(&s);
     let kinetic = |x: &[f64]| {
         let mut x = x.to_vec();
-        let n = s.chain.dof();
+        let n = s.model.dof();
         let free = Scene {
             gravity: None,
             ..s.clone()
@@ -330,7 +330,7 @@ fn every_example_scene_parses_and_runs() {
 fn computed_torque_tracks_the_quintic_with_the_payload() {
     let s = Scene::load(&root().join("scenes/ssrms_payload_fixed.toml")).unwrap();
     // The payload is merged into the last body.
-    let last = s.chain.joints().last().unwrap();
+    let last = s.model.joints().last().unwrap();
     assert!((last.inertial.mass - (243.66 + 116000.0)).abs() < 1e-6);
     let run = simulate(&s, None).unwrap();
     let target = [0.3, 0.4, -0.5, 0.2, 0.1, -0.2, 0.3];
@@ -338,7 +338,7 @@ fn computed_torque_tracks_the_quintic_with_the_payload() {
     assert!(err < 1e-6, "final error {err:e}");
     // On the way, q follows q_d (the model is exact, the initial error zero).
     for sm in &run.samples {
-        let (qd, _, _) = kanegen::simulate::quintic_reference(&s.q0, &target, 25.0, sm.t);
+        let (qd, _, _) = kanegen::sim::simulate::quintic_reference(&s.q0, &target, 25.0, sm.t);
         assert!(max_abs_diff(&sm.x[..7], &qd) < 1e-6, "at t = {}", sm.t);
     }
 }
@@ -351,7 +351,7 @@ fn combine_inertials_is_the_parallel_axis_theorem() {
         inertia: [[0.0; 3]; 3],
     };
     // Two point masses 1 kg at x = 0 and 3 kg at x = 4: CoM at 3, Iyy = 1·9 + 3·1 = 12.
-    let c = combine_inertials(&point(1.0, 0.0), &point(3.0, 4.0));
+    let c = point(1.0, 0.0).merge(&point(3.0, 4.0));
     assert_eq!(c.mass, 4.0);
     assert!((c.com[0] - 3.0).abs() < 1e-12);
     assert!((c.inertia[1][1] - 12.0).abs() < 1e-12 && (c.inertia[2][2] - 12.0).abs() < 1e-12);
@@ -498,9 +498,10 @@ step = 0.01
 "#,
         )
     };
-    let plain =
-        kanegen::io::load_model(&root().join("tests/data/reference/srms_nguyen_hughes_1994.urdf"))
-            .unwrap();
+    let plain = kanegen::model::io::load_model(
+        &root().join("tests/data/reference/srms_nguyen_hughes_1994.urdf"),
+    )
+    .unwrap();
     let third = plain.joints()[2].body.clone();
     let named = Scene::parse(
         &text().replace("[payload]", &format!("[payload]\nbody = \"{third}\"")),
@@ -508,7 +509,7 @@ step = 0.01
     )
     .unwrap_or_else(|e| panic!("{e:#}"));
     let default = Scene::parse(&text(), &root()).unwrap();
-    let m = |s: &Scene, j: usize| s.chain.joints()[j].inertial.mass;
+    let m = |s: &Scene, j: usize| s.model.joints()[j].inertial.mass;
     assert_eq!(m(&named, 2), plain.joints()[2].inertial.mass + 500.0);
     assert_eq!(m(&named, 5), plain.joints()[5].inertial.mass);
     assert_eq!(m(&default, 5), plain.joints()[5].inertial.mass + 500.0);

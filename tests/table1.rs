@@ -2,9 +2,9 @@
 //! agreeing, rows 7, 8, 10 and the totals disagreeing with their arithmetic, and the committed
 //! `docs/table1.md` / `docs/fig2.svg` not stale.
 
-use kanegen::poly::{Poly, Q};
-use kanegen::table1::{build, trace_all, trace_mass_matrix, Table1, Traced};
-use kanegen_core::sym::Convention;
+use kanegen::trace::poly::{Poly, Q};
+use kanegen::trace::sym::Convention;
+use kanegen::trace::table1::{build, trace_all, trace_mass_matrix, Table1, TableAlgorithm};
 use std::sync::OnceLock;
 
 fn table() -> &'static Table1 {
@@ -12,7 +12,7 @@ fn table() -> &'static Table1 {
     T.get_or_init(|| build(&trace_all()))
 }
 
-fn row<'a>(t: &'a Table1, r: &str) -> &'a kanegen::table1::RowReport {
+fn row<'a>(t: &'a Table1, r: &str) -> &'a kanegen::trace::table1::RowReport {
     t.rows
         .iter()
         .find(|x| x.row == r)
@@ -75,10 +75,10 @@ fn fitted_totals_predict_a_fresh_trace_at_n_13() {
     // N = 13 is outside the traced range 1..=12 used for every fit.
     let t = table();
     for alg in [
-        Traced::RecurrentR1,
-        Traced::Recurrent,
-        Traced::CrbaBase,
-        Traced::KaneDirect,
+        TableAlgorithm::RecurrentR1,
+        TableAlgorithm::Recurrent,
+        TableAlgorithm::CrbaBase,
+        TableAlgorithm::KaneDirect,
     ] {
         let trace = trace_mass_matrix(alg, 13);
         for conv in Convention::ALL {
@@ -133,7 +133,7 @@ fn ssrms_line_and_crossover_are_reported() {
 #[test]
 fn committed_docs_are_not_stale() {
     let dir = std::env::temp_dir().join(format!("kanegen-table1-{}", std::process::id()));
-    kanegen::commands::table1::write_all(table(), &dir).unwrap();
+    kanegen::cli::commands::table1::write_all(table(), &dir).unwrap();
     let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("docs");
     for f in ["table1.md", "fig2.svg"] {
         let fresh = std::fs::read_to_string(dir.join(f)).unwrap();

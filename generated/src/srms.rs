@@ -2,41 +2,56 @@
 //!
 //! Joints: `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
+//! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //!
-//! Emitted operation counts per candidate algorithm (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
-//! | function | algorithm | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | 488 | 406 | 0 | 0 | 6 | 894 |
-//! | `mass_matrix` | `recurrent-r1` | 539 | 436 | 0 | 0 | 6 | 975 |
-//! | `mass_matrix` | `kane-direct` | 629 | 413 | 0 | 0 | 6 | 1042 |
-//! | `mass_matrix` | `crba-base` | 470 | 353 | 0 | 0 | 6 | 823 |
-//! | `mass_matrix` | `spatial` * | 214 | 152 | 0 | 0 | 5 | 366 |
-//! | `bias` | `recurrent` | 551 | 404 | 0 | 0 | 6 | 955 |
-//! | `bias` | `recurrent-r1` | 551 | 404 | 0 | 0 | 6 | 955 |
-//! | `bias` | `kane-direct` | 628 | 458 | 0 | 0 | 6 | 1086 |
-//! | `bias` | `crba-base` | 551 | 404 | 0 | 0 | 6 | 955 |
-//! | `bias` | `spatial` * | 326 | 232 | 0 | 0 | 5 | 558 |
-//! | `bias_velocity` | `recurrent` | 551 | 398 | 0 | 0 | 6 | 949 |
-//! | `bias_velocity` | `recurrent-r1` | 551 | 398 | 0 | 0 | 6 | 949 |
-//! | `bias_velocity` | `kane-direct` | 628 | 452 | 0 | 0 | 6 | 1080 |
-//! | `bias_velocity` | `crba-base` | 551 | 398 | 0 | 0 | 6 | 949 |
-//! | `bias_velocity` | `spatial` * | 326 | 226 | 0 | 0 | 5 | 552 |
-//! | `inverse_dynamics` | `recurrent` | 789 | 679 | 0 | 0 | 6 | 1468 |
-//! | `inverse_dynamics` | `recurrent-r1` | 840 | 709 | 0 | 0 | 6 | 1549 |
-//! | `inverse_dynamics` | `kane-direct` | 965 | 704 | 0 | 0 | 6 | 1669 |
-//! | `inverse_dynamics` | `crba-base` | 771 | 626 | 0 | 0 | 6 | 1397 |
-//! | `inverse_dynamics` | `spatial` * | 576 | 406 | 0 | 0 | 5 | 982 |
-//! | `forward_dynamics` | `recurrent` | 839 | 714 | 6 | 0 | 6 | 1553 |
-//! | `forward_dynamics` | `recurrent-r1` | 890 | 744 | 6 | 0 | 6 | 1634 |
-//! | `forward_dynamics` | `kane-direct` | 1015 | 739 | 6 | 0 | 6 | 1754 |
-//! | `forward_dynamics` | `crba-base` | 821 | 661 | 6 | 0 | 6 | 1482 |
-//! | `forward_dynamics` | `spatial` * | 626 | 441 | 6 | 0 | 5 | 1067 |
+//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | 488 | 406 | 0 | 0 | 6 | 894 |
+//! | `mass_matrix` | `recurrent-r1` | — | 539 | 436 | 0 | 0 | 6 | 975 |
+//! | `mass_matrix` | `kane-direct` | — | 629 | 413 | 0 | 0 | 6 | 1042 |
+//! | `mass_matrix` | `crba-base` | — | 470 | 353 | 0 | 0 | 6 | 823 |
+//! | `mass_matrix` * | `crba` | — | 214 | 152 | 0 | 0 | 5 | 366 |
+//! | `nonlinear_effects` | — | `recurrent` | 551 | 398 | 0 | 0 | 6 | 949 |
+//! | `nonlinear_effects` | — | `kane-direct` | 628 | 452 | 0 | 0 | 6 | 1080 |
+//! | `nonlinear_effects` * | — | `rnea` | 326 | 226 | 0 | 0 | 5 | 552 |
+//! | `inverse_dynamics` | — | `recurrent` | 801 | 578 | 0 | 0 | 6 | 1379 |
+//! | `inverse_dynamics` | — | `kane-direct` | 878 | 632 | 0 | 0 | 6 | 1510 |
+//! | `inverse_dynamics` * | — | `rnea` | 349 | 249 | 0 | 0 | 5 | 598 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 851 | 613 | 6 | 0 | 6 | 1464 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 928 | 667 | 6 | 0 | 6 | 1595 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 626 | 441 | 6 | 0 | 5 | 1067 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 765 | 542 | 0 | 0 | 6 | 1307 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 842 | 596 | 0 | 0 | 6 | 1438 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 540 | 370 | 0 | 0 | 5 | 910 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
+/// Emitted operation counts of one function of [`Srms`] (`None`: the function uses no such method; `fma`: fused multiply-adds formed, each also counted as one `mul` and one `add`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpCount {
+    /// The generated function.
+    pub function: &'static str,
+    /// Its mass-matrix method.
+    pub mass_matrix_method: Option<&'static str>,
+    /// Its bias method.
+    pub bias_method: Option<&'static str>,
+    /// Multiplications.
+    pub mul: u64,
+    /// Additions and subtractions.
+    pub add: u64,
+    /// Divisions.
+    pub div: u64,
+    /// Square roots.
+    pub sqrt: u64,
+    /// Angles whose sine and cosine are taken.
+    pub sincos: u64,
+    /// Fused multiply-adds.
+    pub fma: u64,
+}
 #[allow(
     clippy::approx_constant,
     clippy::excessive_precision,
@@ -45,12 +60,13 @@ pub struct Srms;
     clippy::too_many_lines,
     clippy::many_single_char_names,
     clippy::similar_names,
+    clippy::type_complexity,
     unused_parens
 )]
 impl Srms {
     /// Degrees of freedom.
     pub const N: usize = 6;
-    /// Joint names, from the base.
+    /// Joint names, from the base, in the order of `q`.
     pub const JOINTS: [&'static str; 6] = [
         "shoulder_yaw",
         "shoulder_pitch",
@@ -59,46 +75,257 @@ impl Srms {
         "wrist_yaw",
         "wrist_roll",
     ];
-    /// Emitted operation counts of every candidate algorithm:
-    /// `(function, algorithm, mul, add)`.
-    pub const OP_COUNTS: &'static [(&'static str, &'static str, u64, u64)] = &[
-        ("mass_matrix", "recurrent", 488u64, 406u64),
-        ("mass_matrix", "recurrent-r1", 539u64, 436u64),
-        ("mass_matrix", "kane-direct", 629u64, 413u64),
-        ("mass_matrix", "crba-base", 470u64, 353u64),
-        ("mass_matrix", "spatial", 214u64, 152u64),
-        ("bias", "recurrent", 551u64, 404u64),
-        ("bias", "recurrent-r1", 551u64, 404u64),
-        ("bias", "kane-direct", 628u64, 458u64),
-        ("bias", "crba-base", 551u64, 404u64),
-        ("bias", "spatial", 326u64, 232u64),
-        ("bias_velocity", "recurrent", 551u64, 398u64),
-        ("bias_velocity", "recurrent-r1", 551u64, 398u64),
-        ("bias_velocity", "kane-direct", 628u64, 452u64),
-        ("bias_velocity", "crba-base", 551u64, 398u64),
-        ("bias_velocity", "spatial", 326u64, 226u64),
-        ("inverse_dynamics", "recurrent", 789u64, 679u64),
-        ("inverse_dynamics", "recurrent-r1", 840u64, 709u64),
-        ("inverse_dynamics", "kane-direct", 965u64, 704u64),
-        ("inverse_dynamics", "crba-base", 771u64, 626u64),
-        ("inverse_dynamics", "spatial", 576u64, 406u64),
-        ("forward_dynamics", "recurrent", 839u64, 714u64),
-        ("forward_dynamics", "recurrent-r1", 890u64, 744u64),
-        ("forward_dynamics", "kane-direct", 1015u64, 739u64),
-        ("forward_dynamics", "crba-base", 821u64, 661u64),
-        ("forward_dynamics", "spatial", 626u64, 441u64),
+    /// Emitted operation counts of each generated function, in emission order.
+    pub const OP_COUNTS: [OpCount; 5] = [
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            mul: 214u64,
+            add: 152u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 326u64,
+            add: 226u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 349u64,
+            add: 249u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 626u64,
+            add: 441u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 540u64,
+            add: 370u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
     ];
-    /// The algorithm emitted for each function: `(function, algorithm)`.
-    pub const ALGORITHMS: &'static [(&'static str, &'static str)] = &[
-        ("mass_matrix", "spatial"),
-        ("bias", "spatial"),
-        ("bias_velocity", "spatial"),
-        ("inverse_dynamics", "spatial"),
-        ("forward_dynamics", "spatial"),
+    /// Emitted operation counts of every candidate traced (the cheapest is emitted).
+    pub const CANDIDATES: &'static [OpCount] = &[
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            mul: 488u64,
+            add: 406u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            mul: 539u64,
+            add: 436u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            mul: 629u64,
+            add: 413u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            mul: 470u64,
+            add: 353u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            mul: 214u64,
+            add: 152u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            mul: 551u64,
+            add: 398u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            mul: 628u64,
+            add: 452u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 326u64,
+            add: 226u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            mul: 801u64,
+            add: 578u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            mul: 878u64,
+            add: 632u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 349u64,
+            add: 249u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 851u64,
+            add: 613u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 928u64,
+            add: 667u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 626u64,
+            add: 441u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 765u64,
+            add: 542u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 842u64,
+            add: 596u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 540u64,
+            add: 370u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
     ];
-    /// The generalized inertia matrix `A(q)` (symmetric, both triangles written).
+    /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Algorithm `spatial`: 214 mul, 152 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`: 214 mul, 152 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -236,11 +463,11 @@ impl Srms {
             [x104, x103, x101, x98, x17, 1.903],
         ]
     }
-    /// The generalized forces `b = Q − h` of `A q̈ = b`: joint drives `tau` (and gravity when the model has it) minus the velocity-product terms.
+    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Algorithm `spatial`: 326 mul, 232 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 326 mul, 226 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
-    pub fn bias(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
+    pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * s_q1;
         let x2 = qd[0] * c_q1;
@@ -344,517 +571,220 @@ impl Srms {
             + (x75 * x90 - x81 * x92);
         let x97 = 45.21 * (c_q5 * x84 - s_q5 * x83 - qd[5] * x79)
             + (x81 * x91 - x74 * x90);
-        let x98 = tau[5] - x93;
-        let x99 = c_q5 * x96 - s_q5 * x97;
-        let x100 = s_q5 * x96 + c_q5 * x97;
-        let x101 = 0.408 * x62 + (x53 * x68 - x58 * x67 + (x57 * x70 - x56 * x71))
+        let x98 = c_q5 * x96 - s_q5 * x97;
+        let x99 = s_q5 * x96 + c_q5 * x97;
+        let x100 = 0.408 * x62 + (x53 * x68 - x58 * x67 + (x57 * x70 - x56 * x71))
             + x73 * x93;
-        let x102 = x58 * x66 - x52 * x68 + (x57 * x69 - x55 * x71) - 4.68 * x63
-            + (c_q5 * x94 - s_q5 * x95 + -0.762 * x100);
-        let x103 = 4.68 * x59 + (x52 * x67 - x53 * x66 + (x56 * x69 - x55 * x70))
-            + (s_q5 * x94 + c_q5 * x95 + 0.762 * x99);
-        let x104 = 45.94 * x64 + (x58 * x70 + x53 * x71)
+        let x101 = x58 * x66 - x52 * x68 + (x57 * x69 - x55 * x71) - 4.68 * x63
+            + (c_q5 * x94 - s_q5 * x95 + -0.762 * x99);
+        let x102 = 4.68 * x59 + (x52 * x67 - x53 * x66 + (x56 * x69 - x55 * x70))
+            + (s_q5 * x94 + c_q5 * x95 + 0.762 * x98);
+        let x103 = 45.94 * x64 + (x58 * x70 + x53 * x71)
             + x73 * (45.21 * (x64 * x73) + (x74 * x92 - x75 * x91));
-        let x105 = 45.94 * x65 + (x58 * x69 - x52 * x71) + x99;
-        let x106 = tau[4] - x103;
-        let x107 = s_q4 * x104 + c_q4 * x105;
-        let x108 = x51 * (45.94 * x61 - (x53 * x69 + x52 * x70) + x100);
-        let x109 = 0.0893 * x40 + (x38 * x46 - x32 * x45 + (x37 * x48 - x36 * x49))
-            + (c_q4 * x101 - s_q4 * x102);
-        let x110 = x31 * x46 - x32 * x44 + (x37 * x47 - x35 * x49)
-            + (s_q4 * x101 + c_q4 * x102 + -0.4572 * x108);
-        let x111 = 0.402 * x41 + (x38 * x44 - x31 * x45 + (x36 * x47 - x35 * x48))
-            + (x51 * x103 + 0.4572 * x107);
-        let x112 = 8.48 * x42 + (x32 * x48 + x38 * x49) + (c_q4 * x104 - s_q4 * x105);
-        let x113 = 8.48 * x43 + (x31 * x48 - x38 * x47) + x108;
-        let x114 = tau[3] - x110;
-        let x115 = c_q3 * x112 + s_q3 * x113;
-        let x116 = x30 * (8.48 * x39 + (x32 * x47 + x31 * x49) + x107);
-        let x117 = c_q3 * x113 - s_q3 * x112;
-        let x118 = 1.59 * x21 - -3.786 * x22
+        let x104 = 45.94 * x65 + (x58 * x69 - x52 * x71) + x98;
+        let x105 = s_q4 * x103 + c_q4 * x104;
+        let x106 = x51 * (45.94 * x61 - (x53 * x69 + x52 * x70) + x99);
+        let x107 = 0.0893 * x40 + (x38 * x46 - x32 * x45 + (x37 * x48 - x36 * x49))
+            + (c_q4 * x100 - s_q4 * x101);
+        let x108 = x31 * x46 - x32 * x44 + (x37 * x47 - x35 * x49)
+            + (s_q4 * x100 + c_q4 * x101 + -0.4572 * x106);
+        let x109 = 0.402 * x41 + (x38 * x44 - x31 * x45 + (x36 * x47 - x35 * x48))
+            + (x51 * x102 + 0.4572 * x105);
+        let x110 = 8.48 * x42 + (x32 * x48 + x38 * x49) + (c_q4 * x103 - s_q4 * x104);
+        let x111 = 8.48 * x43 + (x31 * x48 - x38 * x47) + x106;
+        let x112 = c_q3 * x110 + s_q3 * x111;
+        let x113 = x30 * (8.48 * x39 + (x32 * x47 + x31 * x49) + x105);
+        let x114 = c_q3 * x111 - s_q3 * x110;
+        let x115 = 1.59 * x21 - -3.786 * x22
             + (x17 * x25 - x11 * x24 + (x15 * x28 - x16 * x27))
-            + (c_q3 * x109 + s_q3 * x111 + 0.1524 * x116);
-        let x119 = 0.8021 * x21 - -0.08 * x22
+            + (c_q3 * x107 + s_q3 * x109 + 0.1524 * x113);
+        let x116 = 0.8021 * x21 - -0.08 * x22
             + (x11 * x23 + x10 * x25 + (x14 * x28 - x16 * x26))
-            + (x30 * x110 + (-0.1524 * x115 + -7.06 * x117));
-        let x120 = -3.786 * x21 - 632.51 * x22
+            + (x30 * x108 + (-0.1524 * x112 + -7.06 * x114));
+        let x117 = -3.786 * x21 - 632.51 * x22
             + (x15 * x26 - x14 * x27 - (x17 * x23 + x10 * x24))
-            + (c_q3 * x111 - s_q3 * x109 + 7.06 * x116);
-        let x121 = 87.42 * x19 + (x11 * x27 - x17 * x28) + x115;
-        let x122 = 87.42 * x20 + (x10 * x27 - x17 * x26) + x117;
-        let x123 = tau[2] - x119;
-        let x124 = x9 * (87.42 * x18 + (x11 * x26 - x10 * x28) + x116);
-        let x125 = tau[1]
-            - (x2 * x5 + x1 * x7 - (-1.928 * x3 + -0.0302 * x4)
-                + (x9 * x119
-                    + (-0.1524 * (c_q2 * x121 + s_q2 * x122)
-                        + -6.377 * (c_q2 * x122 - s_q2 * x121))));
-        let x126 = tau[0]
-            - (c_q1
-                * (c_q2 * x120 - s_q2 * x118 + 6.377 * x124
-                    - (9.185 * x3 + 997.18 * x4 + (qd[1] * x5 + x1 * x6)))
-                - s_q1
-                    * (qd[1] * x7 - x2 * x6 - (3.225 * x3 + 9.185 * x4)
-                        + (c_q2 * x118 + s_q2 * x120 + 0.1524 * x124)));
-        [x126, x125, x123, x114, x106, x98]
-    }
-    /// The velocity part of `b` only: `−h(q, q̇)` (no drives, no gravity).
-    ///
-    /// Algorithm `spatial`: 326 mul, 226 add, 0 div, 0 sqrt, 5 sincos (emitted).
-    #[must_use]
-    pub fn bias_velocity(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let x1 = qd[0] * s_q1;
-        let x2 = qd[0] * c_q1;
-        let x3 = qd[1] * x2;
-        let x4 = qd[1] * x1;
-        let x5 = -1.928 * qd[1] - 3.225 * x1 + 9.185 * x2;
-        let x6 = 998.63 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x7 = -0.0302 * qd[1] - 9.185 * x1 + 997.18 * x2;
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x9 = c_q2 + (1.0 - c_q2);
-        let x10 = x1 * c_q2 + x2 * s_q2;
-        let x11 = x2 * c_q2 - x1 * s_q2;
-        let x12 = qd[1] * 0.1524;
-        let x13 = 6.377 * qd[1];
-        let x14 = s_q2 * x13 - c_q2 * x12;
-        let x15 = x9 * (x2 * -6.377 - -0.1524 * x1);
-        let x16 = s_q2 * x12 + c_q2 * x13;
-        let x17 = qd[2] + qd[1] * x9;
-        let x18 = x9 * (-0.1524 * x3 + x4 * -6.377);
-        let x19 = qd[2] * x16;
-        let x20 = qd[2] * x14;
-        let x21 = x4 * s_q2 - x3 * c_q2 - qd[2] * x11;
-        let x22 = x3 * s_q2 + x4 * c_q2 + qd[2] * x10;
-        let x23 = 0.8021 * x17 - 1.59 * x10 + -3.786 * x11;
-        let x24 = 632.9 * x17 - 0.8021 * x10 + -0.08 * x11;
-        let x25 = -0.08 * x17 - -3.786 * x10 + 632.51 * x11;
-        let x26 = 87.42 * x14;
-        let x27 = 87.42 * x15;
-        let x28 = 87.42 * x16;
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x30 = c_q3 + (1.0 - c_q3);
-        let x31 = x10 * c_q3 + x11 * s_q3;
-        let x32 = x11 * c_q3 - x10 * s_q3;
-        let x33 = x14 - 0.1524 * x17;
-        let x34 = x16 + 7.06 * x17;
-        let x35 = c_q3 * x33 + s_q3 * x34;
-        let x36 = x30 * (x15 + (x11 * -7.06 - -0.1524 * x10));
-        let x37 = s_q3 * x33 - c_q3 * x34;
-        let x38 = qd[3] + x17 * x30;
-        let x39 = x30 * (x18 - (-0.1524 * x21 - x22 * -7.06));
-        let x40 = x21 * c_q3 + x22 * s_q3 - qd[3] * x32;
-        let x41 = x21 * s_q3 - x22 * c_q3 - qd[3] * x31;
-        let x42 = x19 * c_q3 - x20 * s_q3 - qd[3] * x37;
-        let x43 = x19 * s_q3 + x20 * c_q3 + qd[3] * x35;
-        let x44 = 0.0893 * x31;
-        let x45 = 0.402 * x38;
-        let x46 = 0.402 * x32;
-        let x47 = 8.48 * x35;
-        let x48 = 8.48 * x36;
-        let x49 = 8.48 * x37;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x51 = c_q4 + (1.0 - c_q4);
-        let x52 = x38 * s_q4 - x31 * c_q4;
-        let x53 = x31 * s_q4 + x38 * c_q4;
-        let x54 = x36 + x32 * -0.4572;
-        let x55 = x35 * c_q4 - s_q4 * x54;
-        let x56 = x35 * s_q4 + c_q4 * x54;
-        let x57 = x51 * (x37 - 0.4572 * x38);
-        let x58 = qd[4] + x32 * x51;
-        let x59 = x41 * x51;
-        let x60 = x39 - x41 * -0.4572;
-        let x61 = x43 * x51;
-        let x62 = x40 * c_q4 + qd[4] * x53;
-        let x63 = x40 * s_q4 + qd[4] * x52;
-        let x64 = x42 * c_q4 + s_q4 * x60 - qd[4] * x56;
-        let x65 = c_q4 * x60 - x42 * s_q4 - qd[4] * x55;
-        let x66 = 0.408 * x52;
-        let x67 = 4.68 * x53;
-        let x68 = 4.68 * x58;
-        let x69 = 45.94 * x55;
-        let x70 = 45.94 * x56;
-        let x71 = 45.94 * x57;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x73 = c_q5 + (1.0 - c_q5);
-        let x74 = x53 * c_q5 + x58 * s_q5;
-        let x75 = x58 * c_q5 - x53 * s_q5;
-        let x76 = x56 + x58 * -0.762;
-        let x77 = x57 - 0.762 * x53;
-        let x78 = x55 * x73;
-        let x79 = s_q5 * x77 - c_q5 * x76;
-        let x80 = s_q5 * x76 + c_q5 * x77;
-        let x81 = qd[5] + x52 * x73;
-        let x82 = x62 * x73;
-        let x83 = x65 - x59 * -0.762;
-        let x84 = x61 + 0.762 * x63;
-        let x85 = x59 * s_q5 - x63 * c_q5 + qd[5] * x75;
-        let x86 = x63 * s_q5 + x59 * c_q5 - qd[5] * x74;
-        let x87 = 1.903 * x81 + 0.385 * x74 + 0.966 * x75;
-        let x88 = 0.385 * x81 + 3.816 * x74 + 0.353 * x75;
-        let x89 = 0.966 * x81 + 0.353 * x74 + 2.823 * x75;
-        let x90 = 45.21 * x78;
-        let x91 = 45.21 * x79;
-        let x92 = 45.21 * x80;
-        let x93 = 1.903 * x82 + 0.385 * x85 + 0.966 * x86
-            + (x74 * x89 - x75 * x88 + (x79 * x92 - x80 * x91));
-        let x94 = 0.385 * x82 + 3.816 * x85 + 0.353 * x86
-            + (x75 * x87 - x81 * x89 + (x80 * x90 - x78 * x92));
-        let x95 = 0.966 * x82 + 0.353 * x85 + 2.823 * x86
-            + (x81 * x88 - x74 * x87 + (x78 * x91 - x79 * x90));
-        let x96 = 45.21 * (c_q5 * x83 + s_q5 * x84 + qd[5] * x80)
-            + (x75 * x90 - x81 * x92);
-        let x97 = 45.21 * (c_q5 * x84 - s_q5 * x83 - qd[5] * x79)
-            + (x81 * x91 - x74 * x90);
-        let x98 = -x93;
-        let x99 = c_q5 * x96 - s_q5 * x97;
-        let x100 = s_q5 * x96 + c_q5 * x97;
-        let x101 = 0.408 * x62 + (x53 * x68 - x58 * x67 + (x57 * x70 - x56 * x71))
-            + x73 * x93;
-        let x102 = x58 * x66 - x52 * x68 + (x57 * x69 - x55 * x71) - 4.68 * x63
-            + (c_q5 * x94 - s_q5 * x95 + -0.762 * x100);
-        let x103 = 4.68 * x59 + (x52 * x67 - x53 * x66 + (x56 * x69 - x55 * x70))
-            + (s_q5 * x94 + c_q5 * x95 + 0.762 * x99);
-        let x104 = 45.94 * x64 + (x58 * x70 + x53 * x71)
-            + x73 * (45.21 * (x64 * x73) + (x74 * x92 - x75 * x91));
-        let x105 = 45.94 * x65 + (x58 * x69 - x52 * x71) + x99;
-        let x106 = -x103;
-        let x107 = s_q4 * x104 + c_q4 * x105;
-        let x108 = x51 * (45.94 * x61 - (x53 * x69 + x52 * x70) + x100);
-        let x109 = 0.0893 * x40 + (x38 * x46 - x32 * x45 + (x37 * x48 - x36 * x49))
-            + (c_q4 * x101 - s_q4 * x102);
-        let x110 = x31 * x46 - x32 * x44 + (x37 * x47 - x35 * x49)
-            + (s_q4 * x101 + c_q4 * x102 + -0.4572 * x108);
-        let x111 = 0.402 * x41 + (x38 * x44 - x31 * x45 + (x36 * x47 - x35 * x48))
-            + (x51 * x103 + 0.4572 * x107);
-        let x112 = 8.48 * x42 + (x32 * x48 + x38 * x49) + (c_q4 * x104 - s_q4 * x105);
-        let x113 = 8.48 * x43 + (x31 * x48 - x38 * x47) + x108;
-        let x114 = -x110;
-        let x115 = c_q3 * x112 + s_q3 * x113;
-        let x116 = x30 * (8.48 * x39 + (x32 * x47 + x31 * x49) + x107);
-        let x117 = c_q3 * x113 - s_q3 * x112;
-        let x118 = 1.59 * x21 - -3.786 * x22
-            + (x17 * x25 - x11 * x24 + (x15 * x28 - x16 * x27))
-            + (c_q3 * x109 + s_q3 * x111 + 0.1524 * x116);
-        let x119 = 0.8021 * x21 - -0.08 * x22
-            + (x11 * x23 + x10 * x25 + (x14 * x28 - x16 * x26))
-            + (x30 * x110 + (-0.1524 * x115 + -7.06 * x117));
-        let x120 = -3.786 * x21 - 632.51 * x22
-            + (x15 * x26 - x14 * x27 - (x17 * x23 + x10 * x24))
-            + (c_q3 * x111 - s_q3 * x109 + 7.06 * x116);
-        let x121 = 87.42 * x19 + (x11 * x27 - x17 * x28) + x115;
-        let x122 = 87.42 * x20 + (x10 * x27 - x17 * x26) + x117;
-        let x123 = -x119;
-        let x124 = x9 * (87.42 * x18 + (x11 * x26 - x10 * x28) + x116);
-        let x125 = -(x2 * x5 + x1 * x7 - (-1.928 * x3 + -0.0302 * x4)
-            + (x9 * x119
-                + (-0.1524 * (c_q2 * x121 + s_q2 * x122)
-                    + -6.377 * (c_q2 * x122 - s_q2 * x121))));
-        let x126 = -(c_q1
-            * (c_q2 * x120 - s_q2 * x118 + 6.377 * x124
+            + (c_q3 * x109 - s_q3 * x107 + 7.06 * x113);
+        let x118 = 87.42 * x19 + (x11 * x27 - x17 * x28) + x112;
+        let x119 = 87.42 * x20 + (x10 * x27 - x17 * x26) + x114;
+        let x120 = x9 * (87.42 * x18 + (x11 * x26 - x10 * x28) + x113);
+        let x121 = x2 * x5 + x1 * x7 - (-1.928 * x3 + -0.0302 * x4)
+            + (x9 * x116
+                + (-0.1524 * (c_q2 * x118 + s_q2 * x119)
+                    + -6.377 * (c_q2 * x119 - s_q2 * x118)));
+        let x122 = c_q1
+            * (c_q2 * x117 - s_q2 * x115 + 6.377 * x120
                 - (9.185 * x3 + 997.18 * x4 + (qd[1] * x5 + x1 * x6)))
             - s_q1
                 * (qd[1] * x7 - x2 * x6 - (3.225 * x3 + 9.185 * x4)
-                    + (c_q2 * x118 + s_q2 * x120 + 0.1524 * x124)));
-        [x126, x125, x123, x114, x106, x98]
+                    + (c_q2 * x115 + s_q2 * x117 + 0.1524 * x120));
+        [x122, x121, x116, x108, x102, x93]
     }
-    /// Inverse dynamics: the drives `τ = A q̈ − b(q, q̇, τ = 0)`.
+    /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Algorithm `spatial`: 576 mul, 406 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 349 mul, 249 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
+        let x1 = qd[0] * s_q1;
+        let x2 = qd[0] * c_q1;
+        let x3 = qdd[0] * s_q1 + qd[1] * x2;
+        let x4 = qdd[0] * c_q1 - qd[1] * x1;
+        let x5 = -1.928 * qd[1] - 3.225 * x1 + 9.185 * x2;
+        let x6 = 998.63 * qd[1] - -1.928 * x1 + -0.0302 * x2;
+        let x7 = -0.0302 * qd[1] - 9.185 * x1 + 997.18 * x2;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
+        let x9 = c_q2 + (1.0 - c_q2);
+        let x10 = x1 * c_q2 + x2 * s_q2;
+        let x11 = x2 * c_q2 - x1 * s_q2;
+        let x12 = qd[1] * 0.1524;
+        let x13 = 6.377 * qd[1];
+        let x14 = s_q2 * x13 - c_q2 * x12;
+        let x15 = x9 * (x2 * -6.377 - -0.1524 * x1);
+        let x16 = s_q2 * x12 + c_q2 * x13;
+        let x17 = qd[2] + qd[1] * x9;
+        let x18 = qdd[1] * 0.1524;
+        let x19 = 6.377 * qdd[1];
+        let x20 = x9 * (x4 * -6.377 - -0.1524 * x3);
+        let x21 = qdd[2] + qdd[1] * x9;
+        let x22 = x3 * c_q2 + x4 * s_q2 + qd[2] * x11;
+        let x23 = x4 * c_q2 - x3 * s_q2 - qd[2] * x10;
+        let x24 = s_q2 * x19 - c_q2 * x18 + qd[2] * x16;
+        let x25 = qd[2] * x14 - (s_q2 * x18 + c_q2 * x19);
+        let x26 = 0.8021 * x17 - 1.59 * x10 + -3.786 * x11;
+        let x27 = 632.9 * x17 - 0.8021 * x10 + -0.08 * x11;
+        let x28 = -0.08 * x17 - -3.786 * x10 + 632.51 * x11;
+        let x29 = 87.42 * x14;
+        let x30 = 87.42 * x15;
+        let x31 = 87.42 * x16;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
+        let x33 = c_q3 + (1.0 - c_q3);
+        let x34 = x10 * c_q3 + x11 * s_q3;
+        let x35 = x11 * c_q3 - x10 * s_q3;
+        let x36 = x14 - 0.1524 * x17;
+        let x37 = x16 + 7.06 * x17;
+        let x38 = c_q3 * x36 + s_q3 * x37;
+        let x39 = x33 * (x15 + (x11 * -7.06 - -0.1524 * x10));
+        let x40 = s_q3 * x36 - c_q3 * x37;
+        let x41 = qd[3] + x17 * x33;
+        let x42 = x24 - 0.1524 * x21;
+        let x43 = x25 - 7.06 * x21;
+        let x44 = x33 * (x20 + (x23 * -7.06 - -0.1524 * x22));
+        let x45 = qdd[3] + x21 * x33;
+        let x46 = x22 * c_q3 + x23 * s_q3 + qd[3] * x35;
+        let x47 = x23 * c_q3 - x22 * s_q3 - qd[3] * x34;
+        let x48 = c_q3 * x42 - s_q3 * x43 - qd[3] * x40;
+        let x49 = s_q3 * x42 + c_q3 * x43 + qd[3] * x38;
+        let x50 = 0.0893 * x34;
+        let x51 = 0.402 * x41;
+        let x52 = 0.402 * x35;
+        let x53 = 8.48 * x38;
+        let x54 = 8.48 * x39;
+        let x55 = 8.48 * x40;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
+        let x57 = c_q4 + (1.0 - c_q4);
+        let x58 = x41 * s_q4 - x34 * c_q4;
+        let x59 = x34 * s_q4 + x41 * c_q4;
+        let x60 = x39 + x35 * -0.4572;
+        let x61 = x38 * c_q4 - s_q4 * x60;
+        let x62 = x38 * s_q4 + c_q4 * x60;
+        let x63 = x57 * (x40 - 0.4572 * x41);
+        let x64 = qd[4] + x35 * x57;
+        let x65 = x44 + x47 * -0.4572;
+        let x66 = x57 * (x49 - 0.4572 * x45);
+        let x67 = qdd[4] + x47 * x57;
+        let x68 = x45 * s_q4 - x46 * c_q4 + qd[4] * x59;
+        let x69 = x46 * s_q4 + x45 * c_q4 - qd[4] * x58;
+        let x70 = x48 * c_q4 - s_q4 * x65 - qd[4] * x62;
+        let x71 = x48 * s_q4 + c_q4 * x65 + qd[4] * x61;
+        let x72 = 0.408 * x58;
+        let x73 = 4.68 * x59;
+        let x74 = 4.68 * x64;
+        let x75 = 45.94 * x61;
+        let x76 = 45.94 * x62;
+        let x77 = 45.94 * x63;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 1.903 * x8;
-        let x10 = 0.385 * x8;
-        let x11 = 0.966 * x8;
-        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
-        let x13 = 0.353 * s_q5;
-        let x14 = 3.816 * c_q5 - x13;
-        let x15 = 0.353 * c_q5;
-        let x16 = x15 - 2.823 * s_q5;
-        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x18 = x15 + 3.816 * s_q5;
-        let x19 = x13 + 2.823 * c_q5;
-        let x20 = c_q5 * x10 - s_q5 * x11;
-        let x21 = s_q5 * x10 + c_q5 * x11;
-        let x22 = x8 * x12;
-        let x23 = s_q5 * x14 + c_q5 * x16;
-        let x24 = 0.408 + x8 * x9;
-        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
-        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
-        let x27 = c_q4 * 34.45002;
-        let x28 = s_q4 * 34.45002;
-        let x29 = x27 + 41.67378;
-        let x30 = c_q4 * x24 - s_q4 * x22;
-        let x31 = c_q4 * x20 - s_q4 * x25;
-        let x32 = c_q4 * x21 - s_q4 * x23;
-        let x33 = s_q4 * x21 + c_q4 * x23;
-        let x34 = x6 * (x8 * x17);
-        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
-        let x36 = x6 * x26;
-        let x37 = x6 * x32;
-        let x38 = c_q4 * x34 - s_q4 * x35;
-        let x39 = s_q4 * x34 + c_q4 * x35;
-        let x40 = 0.4572 * x27;
-        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
-        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
-        let x43 = 0.402
-            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
-                - x27 * -0.4572 + 0.4572 * x29);
-        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
-        let x45 = c_q3 * x29;
-        let x46 = x4 * x28;
-        let x47 = s_q3 * x29;
-        let x48 = x45 + 703.3878000000001;
-        let x49 = -15.183612000000002 - x47;
-        let x50 = c_q3 * x42 + s_q3 * x38;
-        let x51 = c_q3 * x41 + s_q3 * x39;
-        let x52 = c_q3 * x37 + s_q3 * x44;
-        let x53 = x4 * x43;
-        let x54 = c_q3 * x38 - s_q3 * x42;
-        let x55 = c_q3 * x39 - s_q3 * x41;
-        let x56 = c_q3 * x44 - s_q3 * x37;
-        let x57 = -0.1524 * x47 + x45 * -7.06;
-        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
-        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
-        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
-        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
-        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
-        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
-        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
-        let x65 = c_q2 * x48 + s_q2 * x49;
-        let x66 = x2 * x46;
-        let x67 = c_q2 * x49 - s_q2 * x48;
-        let x68 = x65 + 1192.8178500000001;
-        let x69 = x67 + -28.506420000000002;
-        let x70 = c_q2 * x58 + s_q2 * x62;
-        let x71 = c_q2 * x59 + s_q2 * x63;
-        let x72 = c_q2 * x60 + s_q2 * x64;
-        let x73 = x2 * x61;
-        let x74 = c_q2 * x62 - s_q2 * x58;
-        let x75 = c_q2 * x63 - s_q2 * x59;
-        let x76 = c_q2 * x64 - s_q2 * x60;
-        let x77 = -0.1524 * x67;
-        let x78 = x65 * -6.377;
-        let x79 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
-            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
-        let x80 = x73 + (x77 - x78);
-        let x81 = c_q1 * x75 - s_q1 * x71;
-        let x82 = x53 - x57;
-        let x83 = x2 * x82
-            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45));
-        let x84 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
-        let x85 = x36 + x40;
-        let x86 = c_q3 * x28;
-        let x87 = x4 * x27;
-        let x88 = s_q3 * x28;
-        let x89 = c_q3 * x32 + s_q3 * x85 + 0.1524 * x87;
-        let x90 = x4 * x33 + (-7.06 * x88 - -0.1524 * x86);
-        let x91 = c_q3 * x85 - s_q3 * x32 + 7.06 * x87;
-        let x92 = x2 * x87;
-        let x93 = x2 * x90
-            + (-0.1524 * (s_q2 * x88 - c_q2 * x86) + -6.377 * (s_q2 * x86 + c_q2 * x88));
-        let x94 = c_q1 * (c_q2 * x91 - s_q2 * x89 + 6.377 * x92)
-            - s_q1 * (c_q2 * x89 + s_q2 * x91 + 0.1524 * x92);
-        let x95 = c_q4 * x9 - s_q4 * x12;
-        let x96 = s_q4 * x9 + c_q4 * x12;
-        let x97 = x6 * x17;
-        let x98 = c_q3 * x95 + s_q3 * x97;
-        let x99 = x4 * x96;
-        let x100 = c_q3 * x97 - s_q3 * x95;
-        let x101 = x2 * x99;
-        let x102 = c_q1 * (c_q2 * x100 - s_q2 * x98) - s_q1 * (c_q2 * x98 + s_q2 * x100);
-        let x103 = qd[0] * s_q1;
-        let x104 = qd[0] * c_q1;
-        let x105 = qd[1] * x104;
-        let x106 = qd[1] * x103;
-        let x107 = -1.928 * qd[1] - 3.225 * x103 + 9.185 * x104;
-        let x108 = 998.63 * qd[1] - -1.928 * x103 + -0.0302 * x104;
-        let x109 = -0.0302 * qd[1] - 9.185 * x103 + 997.18 * x104;
-        let x110 = c_q2 * x103 + s_q2 * x104;
-        let x111 = c_q2 * x104 - s_q2 * x103;
-        let x112 = qd[1] * 0.1524;
-        let x113 = 6.377 * qd[1];
-        let x114 = s_q2 * x113 - c_q2 * x112;
-        let x115 = x2 * (-6.377 * x104 - -0.1524 * x103);
-        let x116 = s_q2 * x112 + c_q2 * x113;
-        let x117 = qd[2] + qd[1] * x2;
-        let x118 = x2 * (-0.1524 * x105 + -6.377 * x106);
-        let x119 = qd[2] * x116;
-        let x120 = qd[2] * x114;
-        let x121 = s_q2 * x106 - c_q2 * x105 - qd[2] * x111;
-        let x122 = s_q2 * x105 + c_q2 * x106 + qd[2] * x110;
-        let x123 = 0.8021 * x117 - 1.59 * x110 + -3.786 * x111;
-        let x124 = 632.9 * x117 - 0.8021 * x110 + -0.08 * x111;
-        let x125 = -0.08 * x117 - -3.786 * x110 + 632.51 * x111;
-        let x126 = 87.42 * x114;
-        let x127 = 87.42 * x115;
-        let x128 = 87.42 * x116;
-        let x129 = c_q3 * x110 + s_q3 * x111;
-        let x130 = c_q3 * x111 - s_q3 * x110;
-        let x131 = x114 - 0.1524 * x117;
-        let x132 = x116 + 7.06 * x117;
-        let x133 = c_q3 * x131 + s_q3 * x132;
-        let x134 = x4 * (x115 + (-7.06 * x111 - -0.1524 * x110));
-        let x135 = s_q3 * x131 - c_q3 * x132;
-        let x136 = qd[3] + x4 * x117;
-        let x137 = x4 * (x118 - (-0.1524 * x121 - -7.06 * x122));
-        let x138 = c_q3 * x121 + s_q3 * x122 - qd[3] * x130;
-        let x139 = s_q3 * x121 - c_q3 * x122 - qd[3] * x129;
-        let x140 = c_q3 * x119 - s_q3 * x120 - qd[3] * x135;
-        let x141 = s_q3 * x119 + c_q3 * x120 + qd[3] * x133;
-        let x142 = 0.0893 * x129;
-        let x143 = 0.402 * x136;
-        let x144 = 0.402 * x130;
-        let x145 = 8.48 * x133;
-        let x146 = 8.48 * x134;
-        let x147 = 8.48 * x135;
-        let x148 = s_q4 * x136 - c_q4 * x129;
-        let x149 = s_q4 * x129 + c_q4 * x136;
-        let x150 = x134 + -0.4572 * x130;
-        let x151 = c_q4 * x133 - s_q4 * x150;
-        let x152 = s_q4 * x133 + c_q4 * x150;
-        let x153 = x6 * (x135 - 0.4572 * x136);
-        let x154 = qd[4] + x6 * x130;
-        let x155 = x6 * x139;
-        let x156 = x137 - -0.4572 * x139;
-        let x157 = x6 * x141;
-        let x158 = c_q4 * x138 + qd[4] * x149;
-        let x159 = s_q4 * x138 + qd[4] * x148;
-        let x160 = c_q4 * x140 + s_q4 * x156 - qd[4] * x152;
-        let x161 = c_q4 * x156 - s_q4 * x140 - qd[4] * x151;
-        let x162 = 0.408 * x148;
-        let x163 = 4.68 * x149;
-        let x164 = 4.68 * x154;
-        let x165 = 45.94 * x151;
-        let x166 = 45.94 * x152;
-        let x167 = 45.94 * x153;
-        let x168 = c_q5 * x149 + s_q5 * x154;
-        let x169 = c_q5 * x154 - s_q5 * x149;
-        let x170 = x152 + -0.762 * x154;
-        let x171 = x153 - 0.762 * x149;
-        let x172 = x8 * x151;
-        let x173 = s_q5 * x171 - c_q5 * x170;
-        let x174 = s_q5 * x170 + c_q5 * x171;
-        let x175 = qd[5] + x8 * x148;
-        let x176 = x8 * x158;
-        let x177 = x161 - -0.762 * x155;
-        let x178 = x157 + 0.762 * x159;
-        let x179 = s_q5 * x155 - c_q5 * x159 + qd[5] * x169;
-        let x180 = s_q5 * x159 + c_q5 * x155 - qd[5] * x168;
-        let x181 = 1.903 * x175 + 0.385 * x168 + 0.966 * x169;
-        let x182 = 0.385 * x175 + 3.816 * x168 + 0.353 * x169;
-        let x183 = 0.966 * x175 + 0.353 * x168 + 2.823 * x169;
-        let x184 = 45.21 * x172;
-        let x185 = 45.21 * x173;
-        let x186 = 45.21 * x174;
-        let x187 = 1.903 * x176 + 0.385 * x179 + 0.966 * x180
-            + (x168 * x183 - x169 * x182 + (x173 * x186 - x174 * x185));
-        let x188 = 0.385 * x176 + 3.816 * x179 + 0.353 * x180
-            + (x169 * x181 - x175 * x183 + (x174 * x184 - x172 * x186));
-        let x189 = 0.966 * x176 + 0.353 * x179 + 2.823 * x180
-            + (x175 * x182 - x168 * x181 + (x172 * x185 - x173 * x184));
-        let x190 = 45.21 * (c_q5 * x177 + s_q5 * x178 + qd[5] * x174)
-            + (x169 * x184 - x175 * x186);
-        let x191 = 45.21 * (c_q5 * x178 - s_q5 * x177 - qd[5] * x173)
-            + (x175 * x185 - x168 * x184);
-        let x192 = c_q5 * x190 - s_q5 * x191;
-        let x193 = s_q5 * x190 + c_q5 * x191;
-        let x194 = 0.408 * x158
-            + (x149 * x164 - x154 * x163 + (x153 * x166 - x152 * x167)) + x8 * x187;
-        let x195 = x154 * x162 - x148 * x164 + (x153 * x165 - x151 * x167) - 4.68 * x159
-            + (c_q5 * x188 - s_q5 * x189 + -0.762 * x193);
-        let x196 = 4.68 * x155
-            + (x148 * x163 - x149 * x162 + (x152 * x165 - x151 * x166))
-            + (s_q5 * x188 + c_q5 * x189 + 0.762 * x192);
-        let x197 = 45.94 * x160 + (x154 * x166 + x149 * x167)
-            + x8 * (45.21 * (x8 * x160) + (x168 * x186 - x169 * x185));
-        let x198 = 45.94 * x161 + (x154 * x165 - x148 * x167) + x192;
-        let x199 = s_q4 * x197 + c_q4 * x198;
-        let x200 = x6 * (45.94 * x157 - (x149 * x165 + x148 * x166) + x193);
-        let x201 = 0.0893 * x138
-            + (x136 * x144 - x130 * x143 + (x135 * x146 - x134 * x147))
-            + (c_q4 * x194 - s_q4 * x195);
-        let x202 = x129 * x144 - x130 * x142 + (x135 * x145 - x133 * x147)
-            + (s_q4 * x194 + c_q4 * x195 + -0.4572 * x200);
-        let x203 = 0.402 * x139
-            + (x136 * x142 - x129 * x143 + (x134 * x145 - x133 * x146))
-            + (x6 * x196 + 0.4572 * x199);
-        let x204 = 8.48 * x140 + (x130 * x146 + x136 * x147)
-            + (c_q4 * x197 - s_q4 * x198);
-        let x205 = 8.48 * x141 + (x129 * x146 - x136 * x145) + x200;
-        let x206 = c_q3 * x204 + s_q3 * x205;
-        let x207 = x4 * (8.48 * x137 + (x130 * x145 + x129 * x147) + x199);
-        let x208 = c_q3 * x205 - s_q3 * x204;
-        let x209 = 1.59 * x121 - -3.786 * x122
-            + (x117 * x125 - x111 * x124 + (x115 * x128 - x116 * x127))
-            + (c_q3 * x201 + s_q3 * x203 + 0.1524 * x207);
-        let x210 = 0.8021 * x121 - -0.08 * x122
-            + (x111 * x123 + x110 * x125 + (x114 * x128 - x116 * x126))
-            + (x4 * x202 + (-0.1524 * x206 + -7.06 * x208));
-        let x211 = -3.786 * x121 - 632.51 * x122
-            + (x115 * x126 - x114 * x127 - (x117 * x123 + x110 * x124))
-            + (c_q3 * x203 - s_q3 * x201 + 7.06 * x207);
-        let x212 = 87.42 * x119 + (x111 * x127 - x117 * x128) + x206;
-        let x213 = 87.42 * x120 + (x110 * x127 - x117 * x126) + x208;
-        let x214 = x2 * (87.42 * x118 + (x111 * x126 - x110 * x128) + x207);
-        let x215 = c_q1
-            * (c_q2 * x211 - s_q2 * x209 + 6.377 * x214
-                - (9.185 * x105 + 997.18 * x106 + (qd[1] * x107 + x103 * x108)))
-            - s_q1
-                * (qd[1] * x109 - x104 * x108 - (3.225 * x105 + 9.185 * x106)
-                    + (c_q2 * x209 + s_q2 * x211 + 0.1524 * x214))
-            + (qdd[0]
-                * (0.595
-                    + (c_q1
-                        * (c_q1
-                            * (997.18
-                                + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
-                            - s_q1
-                                * (9.185
-                                    + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
-                        - s_q1
-                            * (c_q1
-                                * (9.185
-                                    + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
-                                - s_q1
-                                    * (3.225
-                                        + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
-                                            + -0.1524 * x69))))) + qdd[1] * x79 + qdd[2] * x81
-                + qdd[3] * x84 + qdd[4] * x94 + qdd[5] * x102);
-        let x216 = x104 * x107 + x103 * x109 - (-1.928 * x105 + -0.0302 * x106)
-            + (x2 * x210
-                + (-0.1524 * (c_q2 * x212 + s_q2 * x213)
-                    + -6.377 * (c_q2 * x213 - s_q2 * x212)))
-            + (qdd[0] * x79
-                + qdd[1]
-                    * (998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68)))
-                + qdd[2] * x80 + qdd[3] * x83 + qdd[4] * x93 + qdd[5] * x101);
-        let x217 = x210
-            + (qdd[0] * x81 + qdd[1] * x80 + qdd[2] * x61 + qdd[3] * x82 + qdd[4] * x90
-                + qdd[5] * x99);
-        let x218 = x202
-            + (qdd[0] * x84 + qdd[1] * x83 + qdd[2] * x82 + qdd[3] * x43 + qdd[4] * x33
-                + qdd[5] * x96);
-        let x219 = x196
-            + (qdd[0] * x94 + qdd[1] * x93 + qdd[2] * x90 + qdd[3] * x33 + qdd[4] * x26
-                + qdd[5] * x17);
-        let x220 = x187
-            + (qdd[0] * x102 + qdd[1] * x101 + qdd[2] * x99 + qdd[3] * x96 + qdd[4] * x17
-                + 1.903 * qdd[5]);
-        [x215, x216, x217, x218, x219, x220]
+        let x79 = c_q5 + (1.0 - c_q5);
+        let x80 = x59 * c_q5 + x64 * s_q5;
+        let x81 = x64 * c_q5 - x59 * s_q5;
+        let x82 = x62 + x64 * -0.762;
+        let x83 = x63 - 0.762 * x59;
+        let x84 = x61 * x79;
+        let x85 = s_q5 * x83 - c_q5 * x82;
+        let x86 = s_q5 * x82 + c_q5 * x83;
+        let x87 = qd[5] + x58 * x79;
+        let x88 = x71 + x67 * -0.762;
+        let x89 = x66 - 0.762 * x69;
+        let x90 = qdd[5] + x68 * x79;
+        let x91 = x69 * c_q5 + x67 * s_q5 + qd[5] * x81;
+        let x92 = x67 * c_q5 - x69 * s_q5 - qd[5] * x80;
+        let x93 = 1.903 * x87 + 0.385 * x80 + 0.966 * x81;
+        let x94 = 0.385 * x87 + 3.816 * x80 + 0.353 * x81;
+        let x95 = 0.966 * x87 + 0.353 * x80 + 2.823 * x81;
+        let x96 = 45.21 * x84;
+        let x97 = 45.21 * x85;
+        let x98 = 45.21 * x86;
+        let x99 = 1.903 * x90 + 0.385 * x91 + 0.966 * x92
+            + (x80 * x95 - x81 * x94 + (x85 * x98 - x86 * x97));
+        let x100 = 0.385 * x90 + 3.816 * x91 + 0.353 * x92
+            + (x81 * x93 - x87 * x95 + (x86 * x96 - x84 * x98));
+        let x101 = 0.966 * x90 + 0.353 * x91 + 2.823 * x92
+            + (x87 * x94 - x80 * x93 + (x84 * x97 - x85 * x96));
+        let x102 = 45.21 * (s_q5 * x89 - c_q5 * x88 + qd[5] * x86)
+            + (x81 * x96 - x87 * x98);
+        let x103 = 45.21 * (s_q5 * x88 + c_q5 * x89 - qd[5] * x85)
+            + (x87 * x97 - x80 * x96);
+        let x104 = c_q5 * x102 - s_q5 * x103;
+        let x105 = s_q5 * x102 + c_q5 * x103;
+        let x106 = 0.408 * x68 + (x59 * x74 - x64 * x73 + (x63 * x76 - x62 * x77))
+            + x79 * x99;
+        let x107 = 4.68 * x69 + (x64 * x72 - x58 * x74 + (x63 * x75 - x61 * x77))
+            + (c_q5 * x100 - s_q5 * x101 + -0.762 * x105);
+        let x108 = 4.68 * x67 + (x58 * x73 - x59 * x72 + (x62 * x75 - x61 * x76))
+            + (s_q5 * x100 + c_q5 * x101 + 0.762 * x104);
+        let x109 = 45.94 * x70 + (x64 * x76 + x59 * x77)
+            + x79 * (45.21 * (x70 * x79) + (x80 * x98 - x81 * x97));
+        let x110 = x64 * x75 - x58 * x77 - 45.94 * x71 + x104;
+        let x111 = s_q4 * x109 + c_q4 * x110;
+        let x112 = x57 * (45.94 * x66 - (x59 * x75 + x58 * x76) + x105);
+        let x113 = x41 * x52 - x35 * x51 + (x40 * x54 - x39 * x55) - 0.0893 * x46
+            + (c_q4 * x106 - s_q4 * x107);
+        let x114 = 0.402 * x45 + (x34 * x52 - x35 * x50 + (x40 * x53 - x38 * x55))
+            + (s_q4 * x106 + c_q4 * x107 + -0.4572 * x112);
+        let x115 = 0.402 * x47 + (x41 * x50 - x34 * x51 + (x39 * x53 - x38 * x54))
+            + (x57 * x108 + 0.4572 * x111);
+        let x116 = 8.48 * x48 + (x35 * x54 + x41 * x55) + (c_q4 * x109 - s_q4 * x110);
+        let x117 = 8.48 * x49 + (x34 * x54 - x41 * x53) + x112;
+        let x118 = c_q3 * x116 + s_q3 * x117;
+        let x119 = x33 * (x35 * x53 + x34 * x55 - 8.48 * x44 + x111);
+        let x120 = c_q3 * x117 - s_q3 * x116;
+        let x121 = 0.8021 * x21 - 1.59 * x22 + -3.786 * x23
+            + (x17 * x28 - x11 * x27 + (x15 * x31 - x16 * x30))
+            + (c_q3 * x113 + s_q3 * x115 + 0.1524 * x119);
+        let x122 = 632.9 * x21 - 0.8021 * x22 + -0.08 * x23
+            + (x11 * x26 + x10 * x28 + (x14 * x31 - x16 * x29))
+            + (x33 * x114 + (-0.1524 * x118 + -7.06 * x120));
+        let x123 = -0.08 * x21 - -3.786 * x22 + 632.51 * x23
+            + (x15 * x29 - x14 * x30 - (x17 * x26 + x10 * x27))
+            + (c_q3 * x115 - s_q3 * x113 + 7.06 * x119);
+        let x124 = 87.42 * x24 + (x11 * x30 - x17 * x31) + x118;
+        let x125 = 87.42 * x25 + (x10 * x30 - x17 * x29) + x120;
+        let x126 = x9 * (x11 * x29 - x10 * x31 - 87.42 * x20 + x119);
+        let x127 = 998.63 * qdd[1] - -1.928 * x3 + -0.0302 * x4 + (x2 * x5 + x1 * x7)
+            + (x9 * x122
+                + (-0.1524 * (c_q2 * x124 + s_q2 * x125)
+                    + -6.377 * (c_q2 * x125 - s_q2 * x124)));
+        let x128 = 0.595 * qdd[0]
+            + (c_q1
+                * (-0.0302 * qdd[1] - 9.185 * x3 + 997.18 * x4 - (qd[1] * x5 + x1 * x6)
+                    + (c_q2 * x123 - s_q2 * x121 + 6.377 * x126))
+                - s_q1
+                    * (-1.928 * qdd[1] - 3.225 * x3 + 9.185 * x4 + (qd[1] * x7 - x2 * x6)
+                        + (c_q2 * x121 + s_q2 * x123 + 0.1524 * x126)));
+        [x128, x127, x122, x114, x108, x99]
     }
-    /// Forward dynamics `q̈ = A⁻¹ b(q, q̇, τ)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Algorithm `spatial`: 626 mul, 441 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 626 mul, 441 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1174,5 +1104,295 @@ impl Srms {
         let x252 = x211 * x212 - x213 * x251 - x214 * x250 - x215 * x249 - x216 * x248
             - x217 * x247;
         [x252, x251, x250, x249, x248, x247]
+    }
+    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 540 mul, 370 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects(
+        q: &[f64; 6],
+        qd: &[f64; 6],
+    ) -> ([[f64; 6]; 6], [f64; 6]) {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let x9 = 1.903 * x8;
+        let x10 = 0.385 * x8;
+        let x11 = 0.966 * x8;
+        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x13 = 0.353 * s_q5;
+        let x14 = 3.816 * c_q5 - x13;
+        let x15 = 0.353 * c_q5;
+        let x16 = x15 - 2.823 * s_q5;
+        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
+        let x18 = x15 + 3.816 * s_q5;
+        let x19 = x13 + 2.823 * c_q5;
+        let x20 = c_q5 * x10 - s_q5 * x11;
+        let x21 = s_q5 * x10 + c_q5 * x11;
+        let x22 = x8 * x12;
+        let x23 = s_q5 * x14 + c_q5 * x16;
+        let x24 = 0.408 + x8 * x9;
+        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
+        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
+        let x27 = c_q4 * 34.45002;
+        let x28 = s_q4 * 34.45002;
+        let x29 = x27 + 41.67378;
+        let x30 = c_q4 * x24 - s_q4 * x22;
+        let x31 = c_q4 * x20 - s_q4 * x25;
+        let x32 = c_q4 * x21 - s_q4 * x23;
+        let x33 = s_q4 * x21 + c_q4 * x23;
+        let x34 = x6 * (x8 * x17);
+        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
+        let x36 = x6 * x26;
+        let x37 = x6 * x32;
+        let x38 = c_q4 * x34 - s_q4 * x35;
+        let x39 = s_q4 * x34 + c_q4 * x35;
+        let x40 = 0.4572 * x27;
+        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
+        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
+        let x43 = 0.402
+            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
+                - x27 * -0.4572 + 0.4572 * x29);
+        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
+        let x45 = c_q3 * x29;
+        let x46 = x4 * x28;
+        let x47 = s_q3 * x29;
+        let x48 = x45 + 703.3878000000001;
+        let x49 = -15.183612000000002 - x47;
+        let x50 = c_q3 * x42 + s_q3 * x38;
+        let x51 = c_q3 * x41 + s_q3 * x39;
+        let x52 = c_q3 * x37 + s_q3 * x44;
+        let x53 = x4 * x43;
+        let x54 = c_q3 * x38 - s_q3 * x42;
+        let x55 = c_q3 * x39 - s_q3 * x41;
+        let x56 = c_q3 * x44 - s_q3 * x37;
+        let x57 = -0.1524 * x47 + x45 * -7.06;
+        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
+        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
+        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
+        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
+        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
+        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
+        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
+        let x65 = c_q2 * x48 + s_q2 * x49;
+        let x66 = x2 * x46;
+        let x67 = c_q2 * x49 - s_q2 * x48;
+        let x68 = x65 + 1192.8178500000001;
+        let x69 = x67 + -28.506420000000002;
+        let x70 = c_q2 * x58 + s_q2 * x62;
+        let x71 = c_q2 * x59 + s_q2 * x63;
+        let x72 = c_q2 * x60 + s_q2 * x64;
+        let x73 = x2 * x61;
+        let x74 = c_q2 * x62 - s_q2 * x58;
+        let x75 = c_q2 * x63 - s_q2 * x59;
+        let x76 = c_q2 * x64 - s_q2 * x60;
+        let x77 = -0.1524 * x67;
+        let x78 = x65 * -6.377;
+        let x79 = 998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68));
+        let x80 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
+            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
+        let x81 = 0.595
+            + (c_q1
+                * (c_q1
+                    * (997.18 + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
+                    - s_q1
+                        * (9.185
+                            + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
+                - s_q1
+                    * (c_q1
+                        * (9.185
+                            + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
+                        - s_q1
+                            * (3.225
+                                + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
+                                    + -0.1524 * x69))));
+        let x82 = x73 + (x77 - x78);
+        let x83 = c_q1 * x75 - s_q1 * x71;
+        let x84 = x53 - x57;
+        let x85 = x2 * x84
+            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45));
+        let x86 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
+        let x87 = x36 + x40;
+        let x88 = c_q3 * x28;
+        let x89 = x4 * x27;
+        let x90 = s_q3 * x28;
+        let x91 = c_q3 * x32 + s_q3 * x87 + 0.1524 * x89;
+        let x92 = x4 * x33 + (-7.06 * x90 - -0.1524 * x88);
+        let x93 = c_q3 * x87 - s_q3 * x32 + 7.06 * x89;
+        let x94 = x2 * x89;
+        let x95 = x2 * x92
+            + (-0.1524 * (s_q2 * x90 - c_q2 * x88) + -6.377 * (s_q2 * x88 + c_q2 * x90));
+        let x96 = c_q1 * (c_q2 * x93 - s_q2 * x91 + 6.377 * x94)
+            - s_q1 * (c_q2 * x91 + s_q2 * x93 + 0.1524 * x94);
+        let x97 = c_q4 * x9 - s_q4 * x12;
+        let x98 = s_q4 * x9 + c_q4 * x12;
+        let x99 = x6 * x17;
+        let x100 = c_q3 * x97 + s_q3 * x99;
+        let x101 = x4 * x98;
+        let x102 = c_q3 * x99 - s_q3 * x97;
+        let x103 = x2 * x101;
+        let x104 = c_q1 * (c_q2 * x102 - s_q2 * x100)
+            - s_q1 * (c_q2 * x100 + s_q2 * x102);
+        let x105 = qd[0] * s_q1;
+        let x106 = qd[0] * c_q1;
+        let x107 = qd[1] * x106;
+        let x108 = qd[1] * x105;
+        let x109 = -1.928 * qd[1] - 3.225 * x105 + 9.185 * x106;
+        let x110 = 998.63 * qd[1] - -1.928 * x105 + -0.0302 * x106;
+        let x111 = -0.0302 * qd[1] - 9.185 * x105 + 997.18 * x106;
+        let x112 = c_q2 * x105 + s_q2 * x106;
+        let x113 = c_q2 * x106 - s_q2 * x105;
+        let x114 = qd[1] * 0.1524;
+        let x115 = 6.377 * qd[1];
+        let x116 = s_q2 * x115 - c_q2 * x114;
+        let x117 = x2 * (-6.377 * x106 - -0.1524 * x105);
+        let x118 = s_q2 * x114 + c_q2 * x115;
+        let x119 = qd[2] + qd[1] * x2;
+        let x120 = x2 * (-0.1524 * x107 + -6.377 * x108);
+        let x121 = qd[2] * x118;
+        let x122 = qd[2] * x116;
+        let x123 = s_q2 * x108 - c_q2 * x107 - qd[2] * x113;
+        let x124 = s_q2 * x107 + c_q2 * x108 + qd[2] * x112;
+        let x125 = 0.8021 * x119 - 1.59 * x112 + -3.786 * x113;
+        let x126 = 632.9 * x119 - 0.8021 * x112 + -0.08 * x113;
+        let x127 = -0.08 * x119 - -3.786 * x112 + 632.51 * x113;
+        let x128 = 87.42 * x116;
+        let x129 = 87.42 * x117;
+        let x130 = 87.42 * x118;
+        let x131 = c_q3 * x112 + s_q3 * x113;
+        let x132 = c_q3 * x113 - s_q3 * x112;
+        let x133 = x116 - 0.1524 * x119;
+        let x134 = x118 + 7.06 * x119;
+        let x135 = c_q3 * x133 + s_q3 * x134;
+        let x136 = x4 * (x117 + (-7.06 * x113 - -0.1524 * x112));
+        let x137 = s_q3 * x133 - c_q3 * x134;
+        let x138 = qd[3] + x4 * x119;
+        let x139 = x4 * (x120 - (-0.1524 * x123 - -7.06 * x124));
+        let x140 = c_q3 * x123 + s_q3 * x124 - qd[3] * x132;
+        let x141 = s_q3 * x123 - c_q3 * x124 - qd[3] * x131;
+        let x142 = c_q3 * x121 - s_q3 * x122 - qd[3] * x137;
+        let x143 = s_q3 * x121 + c_q3 * x122 + qd[3] * x135;
+        let x144 = 0.0893 * x131;
+        let x145 = 0.402 * x138;
+        let x146 = 0.402 * x132;
+        let x147 = 8.48 * x135;
+        let x148 = 8.48 * x136;
+        let x149 = 8.48 * x137;
+        let x150 = s_q4 * x138 - c_q4 * x131;
+        let x151 = s_q4 * x131 + c_q4 * x138;
+        let x152 = x136 + -0.4572 * x132;
+        let x153 = c_q4 * x135 - s_q4 * x152;
+        let x154 = s_q4 * x135 + c_q4 * x152;
+        let x155 = x6 * (x137 - 0.4572 * x138);
+        let x156 = qd[4] + x6 * x132;
+        let x157 = x6 * x141;
+        let x158 = x139 - -0.4572 * x141;
+        let x159 = x6 * x143;
+        let x160 = c_q4 * x140 + qd[4] * x151;
+        let x161 = s_q4 * x140 + qd[4] * x150;
+        let x162 = c_q4 * x142 + s_q4 * x158 - qd[4] * x154;
+        let x163 = c_q4 * x158 - s_q4 * x142 - qd[4] * x153;
+        let x164 = 0.408 * x150;
+        let x165 = 4.68 * x151;
+        let x166 = 4.68 * x156;
+        let x167 = 45.94 * x153;
+        let x168 = 45.94 * x154;
+        let x169 = 45.94 * x155;
+        let x170 = c_q5 * x151 + s_q5 * x156;
+        let x171 = c_q5 * x156 - s_q5 * x151;
+        let x172 = x154 + -0.762 * x156;
+        let x173 = x155 - 0.762 * x151;
+        let x174 = x8 * x153;
+        let x175 = s_q5 * x173 - c_q5 * x172;
+        let x176 = s_q5 * x172 + c_q5 * x173;
+        let x177 = qd[5] + x8 * x150;
+        let x178 = x8 * x160;
+        let x179 = x163 - -0.762 * x157;
+        let x180 = x159 + 0.762 * x161;
+        let x181 = s_q5 * x157 - c_q5 * x161 + qd[5] * x171;
+        let x182 = s_q5 * x161 + c_q5 * x157 - qd[5] * x170;
+        let x183 = 1.903 * x177 + 0.385 * x170 + 0.966 * x171;
+        let x184 = 0.385 * x177 + 3.816 * x170 + 0.353 * x171;
+        let x185 = 0.966 * x177 + 0.353 * x170 + 2.823 * x171;
+        let x186 = 45.21 * x174;
+        let x187 = 45.21 * x175;
+        let x188 = 45.21 * x176;
+        let x189 = 1.903 * x178 + 0.385 * x181 + 0.966 * x182
+            + (x170 * x185 - x171 * x184 + (x175 * x188 - x176 * x187));
+        let x190 = 0.385 * x178 + 3.816 * x181 + 0.353 * x182
+            + (x171 * x183 - x177 * x185 + (x176 * x186 - x174 * x188));
+        let x191 = 0.966 * x178 + 0.353 * x181 + 2.823 * x182
+            + (x177 * x184 - x170 * x183 + (x174 * x187 - x175 * x186));
+        let x192 = 45.21 * (c_q5 * x179 + s_q5 * x180 + qd[5] * x176)
+            + (x171 * x186 - x177 * x188);
+        let x193 = 45.21 * (c_q5 * x180 - s_q5 * x179 - qd[5] * x175)
+            + (x177 * x187 - x170 * x186);
+        let x194 = c_q5 * x192 - s_q5 * x193;
+        let x195 = s_q5 * x192 + c_q5 * x193;
+        let x196 = 0.408 * x160
+            + (x151 * x166 - x156 * x165 + (x155 * x168 - x154 * x169)) + x8 * x189;
+        let x197 = x156 * x164 - x150 * x166 + (x155 * x167 - x153 * x169) - 4.68 * x161
+            + (c_q5 * x190 - s_q5 * x191 + -0.762 * x195);
+        let x198 = 4.68 * x157
+            + (x150 * x165 - x151 * x164 + (x154 * x167 - x153 * x168))
+            + (s_q5 * x190 + c_q5 * x191 + 0.762 * x194);
+        let x199 = 45.94 * x162 + (x156 * x168 + x151 * x169)
+            + x8 * (45.21 * (x8 * x162) + (x170 * x188 - x171 * x187));
+        let x200 = 45.94 * x163 + (x156 * x167 - x150 * x169) + x194;
+        let x201 = s_q4 * x199 + c_q4 * x200;
+        let x202 = x6 * (45.94 * x159 - (x151 * x167 + x150 * x168) + x195);
+        let x203 = 0.0893 * x140
+            + (x138 * x146 - x132 * x145 + (x137 * x148 - x136 * x149))
+            + (c_q4 * x196 - s_q4 * x197);
+        let x204 = x131 * x146 - x132 * x144 + (x137 * x147 - x135 * x149)
+            + (s_q4 * x196 + c_q4 * x197 + -0.4572 * x202);
+        let x205 = 0.402 * x141
+            + (x138 * x144 - x131 * x145 + (x136 * x147 - x135 * x148))
+            + (x6 * x198 + 0.4572 * x201);
+        let x206 = 8.48 * x142 + (x132 * x148 + x138 * x149)
+            + (c_q4 * x199 - s_q4 * x200);
+        let x207 = 8.48 * x143 + (x131 * x148 - x138 * x147) + x202;
+        let x208 = c_q3 * x206 + s_q3 * x207;
+        let x209 = x4 * (8.48 * x139 + (x132 * x147 + x131 * x149) + x201);
+        let x210 = c_q3 * x207 - s_q3 * x206;
+        let x211 = 1.59 * x123 - -3.786 * x124
+            + (x119 * x127 - x113 * x126 + (x117 * x130 - x118 * x129))
+            + (c_q3 * x203 + s_q3 * x205 + 0.1524 * x209);
+        let x212 = 0.8021 * x123 - -0.08 * x124
+            + (x113 * x125 + x112 * x127 + (x116 * x130 - x118 * x128))
+            + (x4 * x204 + (-0.1524 * x208 + -7.06 * x210));
+        let x213 = -3.786 * x123 - 632.51 * x124
+            + (x117 * x128 - x116 * x129 - (x119 * x125 + x112 * x126))
+            + (c_q3 * x205 - s_q3 * x203 + 7.06 * x209);
+        let x214 = 87.42 * x121 + (x113 * x129 - x119 * x130) + x208;
+        let x215 = 87.42 * x122 + (x112 * x129 - x119 * x128) + x210;
+        let x216 = x2 * (87.42 * x120 + (x113 * x128 - x112 * x130) + x209);
+        let x217 = x106 * x109 + x105 * x111 - (-1.928 * x107 + -0.0302 * x108)
+            + (x2 * x212
+                + (-0.1524 * (c_q2 * x214 + s_q2 * x215)
+                    + -6.377 * (c_q2 * x215 - s_q2 * x214)));
+        let x218 = c_q1
+            * (c_q2 * x213 - s_q2 * x211 + 6.377 * x216
+                - (9.185 * x107 + 997.18 * x108 + (qd[1] * x109 + x105 * x110)))
+            - s_q1
+                * (qd[1] * x111 - x106 * x110 - (3.225 * x107 + 9.185 * x108)
+                    + (c_q2 * x211 + s_q2 * x213 + 0.1524 * x216));
+        (
+            [
+                [x81, x80, x83, x86, x96, x104],
+                [x80, x79, x82, x85, x95, x103],
+                [x83, x82, x61, x84, x92, x101],
+                [x86, x85, x84, x43, x33, x98],
+                [x96, x95, x92, x33, x26, x17],
+                [x104, x103, x101, x98, x17, 1.903],
+            ],
+            [x218, x217, x212, x204, x198, x189],
+        )
     }
 }

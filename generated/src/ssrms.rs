@@ -2,41 +2,56 @@
 //!
 //! Joints: `shoulder_roll` (revolute), `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
+//! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //!
-//! Emitted operation counts per candidate algorithm (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
-//! | function | algorithm | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | 721 | 679 | 0 | 0 | 7 | 1400 |
-//! | `mass_matrix` | `recurrent-r1` | 822 | 723 | 0 | 0 | 7 | 1545 |
-//! | `mass_matrix` | `kane-direct` | 923 | 635 | 0 | 0 | 7 | 1558 |
-//! | `mass_matrix` | `crba-base` | 623 | 475 | 0 | 0 | 7 | 1098 |
-//! | `mass_matrix` | `spatial` * | 254 | 171 | 0 | 0 | 6 | 425 |
-//! | `bias` | `recurrent` | 652 | 471 | 0 | 0 | 7 | 1123 |
-//! | `bias` | `recurrent-r1` | 652 | 471 | 0 | 0 | 7 | 1123 |
-//! | `bias` | `kane-direct` | 797 | 587 | 0 | 0 | 7 | 1384 |
-//! | `bias` | `crba-base` | 652 | 471 | 0 | 0 | 7 | 1123 |
-//! | `bias` | `spatial` * | 394 | 272 | 0 | 0 | 6 | 666 |
-//! | `bias_velocity` | `recurrent` | 652 | 464 | 0 | 0 | 7 | 1116 |
-//! | `bias_velocity` | `recurrent-r1` | 652 | 464 | 0 | 0 | 7 | 1116 |
-//! | `bias_velocity` | `kane-direct` | 797 | 580 | 0 | 0 | 7 | 1377 |
-//! | `bias_velocity` | `crba-base` | 652 | 464 | 0 | 0 | 7 | 1116 |
-//! | `bias_velocity` | `spatial` * | 394 | 265 | 0 | 0 | 6 | 659 |
-//! | `inverse_dynamics` | `recurrent` | 1103 | 1034 | 0 | 0 | 7 | 2137 |
-//! | `inverse_dynamics` | `recurrent-r1` | 1204 | 1078 | 0 | 0 | 7 | 2282 |
-//! | `inverse_dynamics` | `kane-direct` | 1370 | 1031 | 0 | 0 | 7 | 2401 |
-//! | `inverse_dynamics` | `crba-base` | 1005 | 830 | 0 | 0 | 7 | 1835 |
-//! | `inverse_dynamics` | `spatial` * | 695 | 473 | 0 | 0 | 6 | 1168 |
-//! | `forward_dynamics` | `recurrent` | 1180 | 1090 | 7 | 0 | 7 | 2270 |
-//! | `forward_dynamics` | `recurrent-r1` | 1281 | 1134 | 7 | 0 | 7 | 2415 |
-//! | `forward_dynamics` | `kane-direct` | 1447 | 1087 | 7 | 0 | 7 | 2534 |
-//! | `forward_dynamics` | `crba-base` | 1082 | 886 | 7 | 0 | 7 | 1968 |
-//! | `forward_dynamics` | `spatial` * | 774 | 530 | 7 | 0 | 6 | 1304 |
+//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | 721 | 679 | 0 | 0 | 7 | 1400 |
+//! | `mass_matrix` | `recurrent-r1` | — | 822 | 723 | 0 | 0 | 7 | 1545 |
+//! | `mass_matrix` | `kane-direct` | — | 923 | 635 | 0 | 0 | 7 | 1558 |
+//! | `mass_matrix` | `crba-base` | — | 623 | 475 | 0 | 0 | 7 | 1098 |
+//! | `mass_matrix` * | `crba` | — | 254 | 171 | 0 | 0 | 6 | 425 |
+//! | `nonlinear_effects` | — | `recurrent` | 652 | 464 | 0 | 0 | 7 | 1116 |
+//! | `nonlinear_effects` | — | `kane-direct` | 797 | 580 | 0 | 0 | 7 | 1377 |
+//! | `nonlinear_effects` * | — | `rnea` | 394 | 265 | 0 | 0 | 6 | 659 |
+//! | `inverse_dynamics` | — | `recurrent` | 953 | 670 | 0 | 0 | 7 | 1623 |
+//! | `inverse_dynamics` | — | `kane-direct` | 1098 | 786 | 0 | 0 | 7 | 1884 |
+//! | `inverse_dynamics` * | — | `rnea` | 404 | 279 | 0 | 0 | 6 | 683 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 1032 | 727 | 7 | 0 | 7 | 1759 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 1177 | 843 | 7 | 0 | 7 | 2020 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 774 | 530 | 7 | 0 | 6 | 1304 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 906 | 623 | 0 | 0 | 7 | 1529 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 1051 | 739 | 0 | 0 | 7 | 1790 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 648 | 426 | 0 | 0 | 6 | 1074 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms;
+/// Emitted operation counts of one function of [`Ssrms`] (`None`: the function uses no such method; `fma`: fused multiply-adds formed, each also counted as one `mul` and one `add`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpCount {
+    /// The generated function.
+    pub function: &'static str,
+    /// Its mass-matrix method.
+    pub mass_matrix_method: Option<&'static str>,
+    /// Its bias method.
+    pub bias_method: Option<&'static str>,
+    /// Multiplications.
+    pub mul: u64,
+    /// Additions and subtractions.
+    pub add: u64,
+    /// Divisions.
+    pub div: u64,
+    /// Square roots.
+    pub sqrt: u64,
+    /// Angles whose sine and cosine are taken.
+    pub sincos: u64,
+    /// Fused multiply-adds.
+    pub fma: u64,
+}
 #[allow(
     clippy::approx_constant,
     clippy::excessive_precision,
@@ -45,12 +60,13 @@ pub struct Ssrms;
     clippy::too_many_lines,
     clippy::many_single_char_names,
     clippy::similar_names,
+    clippy::type_complexity,
     unused_parens
 )]
 impl Ssrms {
     /// Degrees of freedom.
     pub const N: usize = 7;
-    /// Joint names, from the base.
+    /// Joint names, from the base, in the order of `q`.
     pub const JOINTS: [&'static str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
@@ -60,46 +76,257 @@ impl Ssrms {
         "wrist_yaw",
         "wrist_roll",
     ];
-    /// Emitted operation counts of every candidate algorithm:
-    /// `(function, algorithm, mul, add)`.
-    pub const OP_COUNTS: &'static [(&'static str, &'static str, u64, u64)] = &[
-        ("mass_matrix", "recurrent", 721u64, 679u64),
-        ("mass_matrix", "recurrent-r1", 822u64, 723u64),
-        ("mass_matrix", "kane-direct", 923u64, 635u64),
-        ("mass_matrix", "crba-base", 623u64, 475u64),
-        ("mass_matrix", "spatial", 254u64, 171u64),
-        ("bias", "recurrent", 652u64, 471u64),
-        ("bias", "recurrent-r1", 652u64, 471u64),
-        ("bias", "kane-direct", 797u64, 587u64),
-        ("bias", "crba-base", 652u64, 471u64),
-        ("bias", "spatial", 394u64, 272u64),
-        ("bias_velocity", "recurrent", 652u64, 464u64),
-        ("bias_velocity", "recurrent-r1", 652u64, 464u64),
-        ("bias_velocity", "kane-direct", 797u64, 580u64),
-        ("bias_velocity", "crba-base", 652u64, 464u64),
-        ("bias_velocity", "spatial", 394u64, 265u64),
-        ("inverse_dynamics", "recurrent", 1103u64, 1034u64),
-        ("inverse_dynamics", "recurrent-r1", 1204u64, 1078u64),
-        ("inverse_dynamics", "kane-direct", 1370u64, 1031u64),
-        ("inverse_dynamics", "crba-base", 1005u64, 830u64),
-        ("inverse_dynamics", "spatial", 695u64, 473u64),
-        ("forward_dynamics", "recurrent", 1180u64, 1090u64),
-        ("forward_dynamics", "recurrent-r1", 1281u64, 1134u64),
-        ("forward_dynamics", "kane-direct", 1447u64, 1087u64),
-        ("forward_dynamics", "crba-base", 1082u64, 886u64),
-        ("forward_dynamics", "spatial", 774u64, 530u64),
+    /// Emitted operation counts of each generated function, in emission order.
+    pub const OP_COUNTS: [OpCount; 5] = [
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            mul: 254u64,
+            add: 171u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 394u64,
+            add: 265u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 404u64,
+            add: 279u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 774u64,
+            add: 530u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 648u64,
+            add: 426u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
     ];
-    /// The algorithm emitted for each function: `(function, algorithm)`.
-    pub const ALGORITHMS: &'static [(&'static str, &'static str)] = &[
-        ("mass_matrix", "spatial"),
-        ("bias", "spatial"),
-        ("bias_velocity", "spatial"),
-        ("inverse_dynamics", "spatial"),
-        ("forward_dynamics", "spatial"),
+    /// Emitted operation counts of every candidate traced (the cheapest is emitted).
+    pub const CANDIDATES: &'static [OpCount] = &[
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            mul: 721u64,
+            add: 679u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            mul: 822u64,
+            add: 723u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            mul: 923u64,
+            add: 635u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            mul: 623u64,
+            add: 475u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            mul: 254u64,
+            add: 171u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            mul: 652u64,
+            add: 464u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            mul: 797u64,
+            add: 580u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 394u64,
+            add: 265u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            mul: 953u64,
+            add: 670u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            mul: 1098u64,
+            add: 786u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 404u64,
+            add: 279u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 1032u64,
+            add: 727u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1177u64,
+            add: 843u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 774u64,
+            add: 530u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 906u64,
+            add: 623u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1051u64,
+            add: 739u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 648u64,
+            add: 426u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
     ];
-    /// The generalized inertia matrix `A(q)` (symmetric, both triangles written).
+    /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Algorithm `spatial`: 254 mul, 171 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`: 254 mul, 171 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -263,11 +490,11 @@ impl Ssrms {
             [x135, x134, x132, x129, x127, 0.0, 9.336],
         ]
     }
-    /// The generalized forces `b = Q − h` of `A q̈ = b`: joint drives `tau` (and gravity when the model has it) minus the velocity-product terms.
+    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Algorithm `spatial`: 394 mul, 272 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `rnea`: 394 mul, 265 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
-    pub fn bias(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
+    pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
@@ -400,643 +627,270 @@ impl Ssrms {
             + (x109 * x119 - x114 * x121);
         let x126 = 243.66 * (x95 * c_q6 - s_q6 * x115 - qd[6] * x112)
             + (x114 * x120 - x108 * x119);
-        let x127 = tau[6] - x122;
-        let x128 = x107
+        let x127 = x107
             * (243.66 * (x107 * (x98 - 0.7026 * x97)) + (x108 * x121 - x109 * x120));
-        let x129 = c_q6 * x125 - s_q6 * x126;
-        let x130 = 12.13 * x96 + (x87 * x102 - x92 * x101 + (x91 * x104 - x90 * x105))
-            + (x107 * x122 + 0.7026 * x129);
-        let x131 = 12.13 * x97 + (x92 * x100 - x86 * x102 + (x91 * x103 - x89 * x105))
-            + (c_q6 * x123 - s_q6 * x124 + -0.7026 * x128);
-        let x132 = 3.061 * x93 + (x86 * x101 - x87 * x100 + (x90 * x103 - x89 * x104))
+        let x128 = c_q6 * x125 - s_q6 * x126;
+        let x129 = 12.13 * x96 + (x87 * x102 - x92 * x101 + (x91 * x104 - x90 * x105))
+            + (x107 * x122 + 0.7026 * x128);
+        let x130 = 12.13 * x97 + (x92 * x100 - x86 * x102 + (x91 * x103 - x89 * x105))
+            + (c_q6 * x123 - s_q6 * x124 + -0.7026 * x127);
+        let x131 = 3.061 * x93 + (x86 * x101 - x87 * x100 + (x90 * x103 - x89 * x104))
             + (s_q6 * x123 + c_q6 * x124);
-        let x133 = 105.98 * x98 + (x92 * x104 + x87 * x105) + x128;
-        let x134 = 105.98 * x99 + (x92 * x103 - x86 * x105) + x129;
-        let x135 = tau[5] - x132;
-        let x136 = c_q5 * x133 - s_q5 * x134;
-        let x137 = x85
+        let x132 = 105.98 * x98 + (x92 * x104 + x87 * x105) + x127;
+        let x133 = 105.98 * x99 + (x92 * x103 - x86 * x105) + x128;
+        let x134 = c_q5 * x132 - s_q5 * x133;
+        let x135 = x85
             * (105.98 * x95 - (x87 * x103 + x86 * x104) + (s_q6 * x125 + c_q6 * x126));
-        let x138 = x70 * x80 - x65 * x79 + (x69 * x82 - x68 * x83) - 8.305 * x74
-            + (c_q5 * x130 - s_q5 * x131 + -0.5692 * x137);
-        let x139 = x65 * x78 - x64 * x80 + (x69 * x81 - x67 * x83) - 3.061 * x71
-            + (s_q5 * x130 + c_q5 * x131);
-        let x140 = 8.0386 * x75 + (x64 * x79 - x70 * x78 + (x68 * x81 - x67 * x82))
-            + (x85 * x132 + 0.5692 * x136);
-        let x141 = 105.98 * x76 + (x65 * x82 + x70 * x83) + x136;
-        let x142 = 105.98 * x77 - (x70 * x81 + x64 * x82) + x137;
-        let x143 = tau[4] - x139;
-        let x144 = x63
-            * (105.98 * x73 + (x65 * x81 - x64 * x83) + (s_q5 * x133 + c_q5 * x134));
-        let x145 = c_q4 * x142 - s_q4 * x141;
-        let x146 = x47 * x58 - x41 * x57 + (x46 * x60 - x45 * x61)
-            - (9.522 * x52 + -39.95 * x48) + (c_q4 * x138 + s_q4 * x140);
-        let x147 = x41 * x56 - x40 * x58 + (x46 * x59 - x44 * x61)
-            - (-39.95 * x52 + 1966.28 * x48) + (x63 * x139 + -7.11 * x145);
-        let x148 = 1966.28 * x53 + (x40 * x57 - x47 * x56 + (x45 * x59 - x44 * x60))
-            + (c_q4 * x140 - s_q4 * x138 + 7.11 * x144);
-        let x149 = 279.2 * x54 + (x41 * x60 + x47 * x61) + (c_q4 * x141 + s_q4 * x142);
-        let x150 = 279.2 * x55 - (x47 * x59 + x40 * x60) + x145;
-        let x151 = tau[3] - x147;
-        let x152 = c_q3 * x149 + s_q3 * x150;
-        let x153 = x39 * (279.2 * x51 + (x41 * x59 - x40 * x61) + x144);
-        let x154 = c_q3 * x150 - s_q3 * x149;
-        let x155 = x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36)
-            - (15.41 * x28 + 49.52 * x25) + (c_q3 * x146 + s_q3 * x148 + -0.475 * x154);
-        let x156 = x18 * x32 - x17 * x34 + (x21 * x37 - x23 * x35)
-            - (49.52 * x28 + 2094.71 * x25) + (x39 * x147 + -7.11 * x154);
-        let x157 = 2103.19 * x29 + (x17 * x33 - x24 * x32 + (x22 * x35 - x21 * x36))
-            + (c_q3 * x148 - s_q3 * x146 + (0.475 * x152 + 7.11 * x153));
-        let x158 = 314.88 * x30 + (x18 * x36 - x24 * x37) + x152;
-        let x159 = 314.88 * x31 - (x24 * x35 + x17 * x36) + x154;
-        let x160 = tau[2] - x156;
-        let x161 = c_q2 * x158 + s_q2 * x159;
-        let x162 = tau[1]
-            - (x2 * x10 - x1 * x11 + (x4 * x14 - x5 * x13)
-                + (c_q2 * x157 - s_q2 * x155 + 0.5692 * x161));
-        let x163 = tau[0]
-            - (c_q1
-                * (qd[1] * x11 - x2 * x12 - 8.088 * x6
-                    + (c_q2 * x155 + s_q2 * x157
-                        + -0.5692 * (c_q2 * x159 - s_q2 * x158)))
-                - s_q1 * (qd[1] * x10 - x1 * x12 - 3.061 * x7 + x16 * x156)
-                + -0.7026
-                    * (s_q1 * (qd[1] * x14 - 105.98 * x8 + x161)
-                        + c_q1
-                            * (105.98 * x9 - qd[1] * x13
-                                + x16 * (314.88 * x27 + (x18 * x35 + x17 * x37) + x153))));
-        [x163, x162, x160, x151, x143, x135, x127]
-    }
-    /// The velocity part of `b` only: `−h(q, q̇)` (no drives, no gravity).
-    ///
-    /// Algorithm `spatial`: 394 mul, 265 add, 0 div, 0 sqrt, 6 sincos (emitted).
-    #[must_use]
-    pub fn bias_velocity(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let x1 = qd[0] * c_q1;
-        let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * qd[0];
-        let x4 = s_q1 * x3;
-        let x5 = c_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = qd[1] * x1;
-        let x8 = qd[1] * x5;
-        let x9 = qd[1] * x4;
-        let x10 = 8.088 * x1;
-        let x11 = 3.061 * x2;
-        let x12 = 8.446 * qd[1];
-        let x13 = 105.98 * x4;
-        let x14 = 105.98 * x5;
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = c_q2 + (1.0 - c_q2);
-        let x17 = x1 * c_q2 - qd[1] * s_q2;
-        let x18 = x1 * s_q2 + qd[1] * c_q2;
-        let x19 = x1 * 0.5692;
-        let x20 = x4 + -0.5692 * qd[1];
-        let x21 = s_q2 * x19 - c_q2 * x20;
-        let x22 = x5 * x16;
-        let x23 = s_q2 * x20 + c_q2 * x19;
-        let x24 = qd[2] - x2 * x16;
-        let x25 = x7 * x16;
-        let x26 = x6 * 0.5692;
-        let x27 = x9 * x16;
-        let x28 = x6 * c_q2 + qd[2] * x18;
-        let x29 = qd[2] * x17 - x6 * s_q2;
-        let x30 = qd[2] * x23 - (x8 * c_q2 + s_q2 * x26);
-        let x31 = c_q2 * x26 - x8 * s_q2 + qd[2] * x21;
-        let x32 = 15.41 * x17 + 49.52 * x24;
-        let x33 = 49.52 * x17 + 2094.71 * x24;
-        let x34 = 2103.19 * x18;
-        let x35 = 314.88 * x21;
-        let x36 = 314.88 * x22;
-        let x37 = 314.88 * x23;
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x39 = c_q3 + (1.0 - c_q3);
-        let x40 = x17 * c_q3 - x18 * s_q3;
-        let x41 = x17 * s_q3 + x18 * c_q3;
-        let x42 = x21 - -0.475 * x18;
-        let x43 = x23 + (x17 * 0.475 + 7.11 * x24);
-        let x44 = c_q3 * x42 + s_q3 * x43;
-        let x45 = x39 * (x22 + x18 * -7.11);
-        let x46 = s_q3 * x42 - c_q3 * x43;
-        let x47 = qd[3] + x24 * x39;
-        let x48 = x25 * x39;
-        let x49 = x30 - -0.475 * x29;
-        let x50 = x31 + (x28 * 0.475 + 7.11 * x25);
-        let x51 = x39 * (x27 - x29 * -7.11);
-        let x52 = x28 * c_q3 + x29 * s_q3 + qd[3] * x41;
-        let x53 = x29 * c_q3 - x28 * s_q3 + qd[3] * x40;
-        let x54 = c_q3 * x49 - s_q3 * x50 - qd[3] * x46;
-        let x55 = s_q3 * x49 + c_q3 * x50 + qd[3] * x44;
-        let x56 = 9.522 * x40 + -39.95 * x47;
-        let x57 = -39.95 * x40 + 1966.28 * x47;
-        let x58 = 1966.28 * x41;
-        let x59 = 279.2 * x44;
-        let x60 = 279.2 * x45;
-        let x61 = 279.2 * x46;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x63 = c_q4 + (1.0 - c_q4);
-        let x64 = x40 * c_q4 - x41 * s_q4;
-        let x65 = x40 * s_q4 + x41 * c_q4;
-        let x66 = x46 - 7.11 * x47;
-        let x67 = x44 * c_q4 - s_q4 * x66;
-        let x68 = x63 * (x45 + x41 * -7.11);
-        let x69 = x44 * s_q4 + c_q4 * x66;
-        let x70 = qd[4] + x47 * x63;
-        let x71 = x48 * x63;
-        let x72 = x55 + 7.11 * x48;
-        let x73 = x63 * (x51 - -7.11 * x53);
-        let x74 = x52 * c_q4 + x53 * s_q4 + qd[4] * x65;
-        let x75 = x53 * c_q4 - x52 * s_q4 + qd[4] * x64;
-        let x76 = x54 * c_q4 - s_q4 * x72 - qd[4] * x69;
-        let x77 = x54 * s_q4 + c_q4 * x72 + qd[4] * x67;
-        let x78 = 8.305 * x64;
-        let x79 = 3.061 * x70;
-        let x80 = 8.0386 * x65;
-        let x81 = 105.98 * x67;
-        let x82 = 105.98 * x68;
-        let x83 = 105.98 * x69;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x85 = c_q5 + (1.0 - c_q5);
-        let x86 = x64 * c_q5 + x70 * s_q5;
-        let x87 = x70 * c_q5 - x64 * s_q5;
-        let x88 = x67 - -0.5692 * x65;
-        let x89 = c_q5 * x88 - x68 * s_q5;
-        let x90 = s_q5 * x88 + x68 * c_q5;
-        let x91 = x85 * (x69 - 0.5692 * x64);
-        let x92 = qd[5] + x65 * x85;
-        let x93 = x75 * x85;
-        let x94 = x76 - -0.5692 * x75;
-        let x95 = x85 * (x77 + 0.5692 * x74);
-        let x96 = qd[5] * x87 - (x74 * c_q5 + x71 * s_q5);
-        let x97 = x74 * s_q5 - x71 * c_q5 - qd[5] * x86;
-        let x98 = c_q5 * x94 + x73 * s_q5 - qd[5] * x90;
-        let x99 = x73 * c_q5 - s_q5 * x94 - qd[5] * x89;
-        let x100 = 12.13 * x86;
-        let x101 = 12.13 * x87;
-        let x102 = 3.061 * x92;
-        let x103 = 105.98 * x89;
-        let x104 = 105.98 * x90;
-        let x105 = 105.98 * x91;
-        let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x107 = c_q6 + (1.0 - c_q6);
-        let x108 = x87 * c_q6 + x92 * s_q6;
-        let x109 = x92 * c_q6 - x87 * s_q6;
-        let x110 = x90 + -0.7026 * x86;
-        let x111 = x107 * (x89 - 0.7026 * x87);
-        let x112 = x91 * s_q6 - c_q6 * x110;
-        let x113 = s_q6 * x110 + x91 * c_q6;
-        let x114 = qd[6] + x86 * x107;
-        let x115 = x99 - -0.7026 * x96;
-        let x116 = 9.336 * x114;
-        let x117 = 44.41 * x108;
-        let x118 = 44.41 * x109;
-        let x119 = 243.66 * x111;
-        let x120 = 243.66 * x112;
-        let x121 = 243.66 * x113;
-        let x122 = 9.336 * (x96 * x107)
-            + (x108 * x118 - x109 * x117 + (x112 * x121 - x113 * x120));
-        let x123 = 44.41 * (x97 * c_q6 + x93 * s_q6 + qd[6] * x109)
-            + (x109 * x116 - x114 * x118 + (x113 * x119 - x111 * x121));
-        let x124 = 44.41 * (x93 * c_q6 - x97 * s_q6 - qd[6] * x108)
-            + (x114 * x117 - x108 * x116 + (x111 * x120 - x112 * x119));
-        let x125 = 243.66 * (c_q6 * x115 + x95 * s_q6 + qd[6] * x113)
-            + (x109 * x119 - x114 * x121);
-        let x126 = 243.66 * (x95 * c_q6 - s_q6 * x115 - qd[6] * x112)
-            + (x114 * x120 - x108 * x119);
-        let x127 = -x122;
-        let x128 = x107
-            * (243.66 * (x107 * (x98 - 0.7026 * x97)) + (x108 * x121 - x109 * x120));
-        let x129 = c_q6 * x125 - s_q6 * x126;
-        let x130 = 12.13 * x96 + (x87 * x102 - x92 * x101 + (x91 * x104 - x90 * x105))
-            + (x107 * x122 + 0.7026 * x129);
-        let x131 = 12.13 * x97 + (x92 * x100 - x86 * x102 + (x91 * x103 - x89 * x105))
-            + (c_q6 * x123 - s_q6 * x124 + -0.7026 * x128);
-        let x132 = 3.061 * x93 + (x86 * x101 - x87 * x100 + (x90 * x103 - x89 * x104))
-            + (s_q6 * x123 + c_q6 * x124);
-        let x133 = 105.98 * x98 + (x92 * x104 + x87 * x105) + x128;
-        let x134 = 105.98 * x99 + (x92 * x103 - x86 * x105) + x129;
-        let x135 = -x132;
-        let x136 = c_q5 * x133 - s_q5 * x134;
-        let x137 = x85
-            * (105.98 * x95 - (x87 * x103 + x86 * x104) + (s_q6 * x125 + c_q6 * x126));
-        let x138 = x70 * x80 - x65 * x79 + (x69 * x82 - x68 * x83) - 8.305 * x74
-            + (c_q5 * x130 - s_q5 * x131 + -0.5692 * x137);
-        let x139 = x65 * x78 - x64 * x80 + (x69 * x81 - x67 * x83) - 3.061 * x71
-            + (s_q5 * x130 + c_q5 * x131);
-        let x140 = 8.0386 * x75 + (x64 * x79 - x70 * x78 + (x68 * x81 - x67 * x82))
-            + (x85 * x132 + 0.5692 * x136);
-        let x141 = 105.98 * x76 + (x65 * x82 + x70 * x83) + x136;
-        let x142 = 105.98 * x77 - (x70 * x81 + x64 * x82) + x137;
-        let x143 = -x139;
-        let x144 = x63
-            * (105.98 * x73 + (x65 * x81 - x64 * x83) + (s_q5 * x133 + c_q5 * x134));
-        let x145 = c_q4 * x142 - s_q4 * x141;
-        let x146 = x47 * x58 - x41 * x57 + (x46 * x60 - x45 * x61)
-            - (9.522 * x52 + -39.95 * x48) + (c_q4 * x138 + s_q4 * x140);
-        let x147 = x41 * x56 - x40 * x58 + (x46 * x59 - x44 * x61)
-            - (-39.95 * x52 + 1966.28 * x48) + (x63 * x139 + -7.11 * x145);
-        let x148 = 1966.28 * x53 + (x40 * x57 - x47 * x56 + (x45 * x59 - x44 * x60))
-            + (c_q4 * x140 - s_q4 * x138 + 7.11 * x144);
-        let x149 = 279.2 * x54 + (x41 * x60 + x47 * x61) + (c_q4 * x141 + s_q4 * x142);
-        let x150 = 279.2 * x55 - (x47 * x59 + x40 * x60) + x145;
-        let x151 = -x147;
-        let x152 = c_q3 * x149 + s_q3 * x150;
-        let x153 = x39 * (279.2 * x51 + (x41 * x59 - x40 * x61) + x144);
-        let x154 = c_q3 * x150 - s_q3 * x149;
-        let x155 = x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36)
-            - (15.41 * x28 + 49.52 * x25) + (c_q3 * x146 + s_q3 * x148 + -0.475 * x154);
-        let x156 = x18 * x32 - x17 * x34 + (x21 * x37 - x23 * x35)
-            - (49.52 * x28 + 2094.71 * x25) + (x39 * x147 + -7.11 * x154);
-        let x157 = 2103.19 * x29 + (x17 * x33 - x24 * x32 + (x22 * x35 - x21 * x36))
-            + (c_q3 * x148 - s_q3 * x146 + (0.475 * x152 + 7.11 * x153));
-        let x158 = 314.88 * x30 + (x18 * x36 - x24 * x37) + x152;
-        let x159 = 314.88 * x31 - (x24 * x35 + x17 * x36) + x154;
-        let x160 = -x156;
-        let x161 = c_q2 * x158 + s_q2 * x159;
-        let x162 = -(x2 * x10 - x1 * x11 + (x4 * x14 - x5 * x13)
-            + (c_q2 * x157 - s_q2 * x155 + 0.5692 * x161));
-        let x163 = -(c_q1
+        let x136 = x70 * x80 - x65 * x79 + (x69 * x82 - x68 * x83) - 8.305 * x74
+            + (c_q5 * x129 - s_q5 * x130 + -0.5692 * x135);
+        let x137 = x65 * x78 - x64 * x80 + (x69 * x81 - x67 * x83) - 3.061 * x71
+            + (s_q5 * x129 + c_q5 * x130);
+        let x138 = 8.0386 * x75 + (x64 * x79 - x70 * x78 + (x68 * x81 - x67 * x82))
+            + (x85 * x131 + 0.5692 * x134);
+        let x139 = 105.98 * x76 + (x65 * x82 + x70 * x83) + x134;
+        let x140 = 105.98 * x77 - (x70 * x81 + x64 * x82) + x135;
+        let x141 = x63
+            * (105.98 * x73 + (x65 * x81 - x64 * x83) + (s_q5 * x132 + c_q5 * x133));
+        let x142 = c_q4 * x140 - s_q4 * x139;
+        let x143 = x47 * x58 - x41 * x57 + (x46 * x60 - x45 * x61)
+            - (9.522 * x52 + -39.95 * x48) + (c_q4 * x136 + s_q4 * x138);
+        let x144 = x41 * x56 - x40 * x58 + (x46 * x59 - x44 * x61)
+            - (-39.95 * x52 + 1966.28 * x48) + (x63 * x137 + -7.11 * x142);
+        let x145 = 1966.28 * x53 + (x40 * x57 - x47 * x56 + (x45 * x59 - x44 * x60))
+            + (c_q4 * x138 - s_q4 * x136 + 7.11 * x141);
+        let x146 = 279.2 * x54 + (x41 * x60 + x47 * x61) + (c_q4 * x139 + s_q4 * x140);
+        let x147 = 279.2 * x55 - (x47 * x59 + x40 * x60) + x142;
+        let x148 = c_q3 * x146 + s_q3 * x147;
+        let x149 = x39 * (279.2 * x51 + (x41 * x59 - x40 * x61) + x141);
+        let x150 = c_q3 * x147 - s_q3 * x146;
+        let x151 = x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36)
+            - (15.41 * x28 + 49.52 * x25) + (c_q3 * x143 + s_q3 * x145 + -0.475 * x150);
+        let x152 = x18 * x32 - x17 * x34 + (x21 * x37 - x23 * x35)
+            - (49.52 * x28 + 2094.71 * x25) + (x39 * x144 + -7.11 * x150);
+        let x153 = 2103.19 * x29 + (x17 * x33 - x24 * x32 + (x22 * x35 - x21 * x36))
+            + (c_q3 * x145 - s_q3 * x143 + (0.475 * x148 + 7.11 * x149));
+        let x154 = 314.88 * x30 + (x18 * x36 - x24 * x37) + x148;
+        let x155 = 314.88 * x31 - (x24 * x35 + x17 * x36) + x150;
+        let x156 = c_q2 * x154 + s_q2 * x155;
+        let x157 = x2 * x10 - x1 * x11 + (x4 * x14 - x5 * x13)
+            + (c_q2 * x153 - s_q2 * x151 + 0.5692 * x156);
+        let x158 = c_q1
             * (qd[1] * x11 - x2 * x12 - 8.088 * x6
-                + (c_q2 * x155 + s_q2 * x157 + -0.5692 * (c_q2 * x159 - s_q2 * x158)))
-            - s_q1 * (qd[1] * x10 - x1 * x12 - 3.061 * x7 + x16 * x156)
+                + (c_q2 * x151 + s_q2 * x153 + -0.5692 * (c_q2 * x155 - s_q2 * x154)))
+            - s_q1 * (qd[1] * x10 - x1 * x12 - 3.061 * x7 + x16 * x152)
             + -0.7026
-                * (s_q1 * (qd[1] * x14 - 105.98 * x8 + x161)
+                * (s_q1 * (qd[1] * x14 - 105.98 * x8 + x156)
                     + c_q1
                         * (105.98 * x9 - qd[1] * x13
-                            + x16 * (314.88 * x27 + (x18 * x35 + x17 * x37) + x153))));
-        [x163, x162, x160, x151, x143, x135, x127]
+                            + x16 * (314.88 * x27 + (x18 * x35 + x17 * x37) + x149)));
+        [x158, x157, x152, x144, x137, x131, x122]
     }
-    /// Inverse dynamics: the drives `τ = A q̈ − b(q, q̇, τ = 0)`.
+    /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Algorithm `spatial`: 695 mul, 473 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `rnea`: 404 mul, 279 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
+        let x1 = qd[0] * c_q1;
+        let x2 = qd[0] * s_q1;
+        let x3 = 0.7026 * qd[0];
+        let x4 = s_q1 * x3;
+        let x5 = c_q1 * x3;
+        let x6 = 0.7026 * qdd[0];
+        let x7 = qdd[0] * c_q1 - qd[1] * x2;
+        let x8 = qdd[0] * s_q1 + qd[1] * x1;
+        let x9 = s_q1 * x6 + qd[1] * x5;
+        let x10 = qd[1] * x4 - c_q1 * x6;
+        let x11 = 8.088 * x1;
+        let x12 = 3.061 * x2;
+        let x13 = 8.446 * qd[1];
+        let x14 = 105.98 * x4;
+        let x15 = 105.98 * x5;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
+        let x17 = c_q2 + (1.0 - c_q2);
+        let x18 = x1 * c_q2 - qd[1] * s_q2;
+        let x19 = x1 * s_q2 + qd[1] * c_q2;
+        let x20 = x1 * 0.5692;
+        let x21 = x4 + -0.5692 * qd[1];
+        let x22 = s_q2 * x20 - c_q2 * x21;
+        let x23 = x5 * x17;
+        let x24 = s_q2 * x21 + c_q2 * x20;
+        let x25 = qd[2] - x2 * x17;
+        let x26 = x7 * 0.5692;
+        let x27 = x9 + -0.5692 * qdd[1];
+        let x28 = x10 * x17;
+        let x29 = qdd[2] - x8 * x17;
+        let x30 = x7 * c_q2 - qdd[1] * s_q2 - qd[2] * x19;
+        let x31 = x7 * s_q2 + qdd[1] * c_q2 + qd[2] * x18;
+        let x32 = s_q2 * x26 - c_q2 * x27 + qd[2] * x24;
+        let x33 = qd[2] * x22 - (s_q2 * x27 + c_q2 * x26);
+        let x34 = 15.41 * x18 + 49.52 * x25;
+        let x35 = 49.52 * x18 + 2094.71 * x25;
+        let x36 = 2103.19 * x19;
+        let x37 = 314.88 * x22;
+        let x38 = 314.88 * x23;
+        let x39 = 314.88 * x24;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
+        let x41 = c_q3 + (1.0 - c_q3);
+        let x42 = x18 * c_q3 - x19 * s_q3;
+        let x43 = x18 * s_q3 + x19 * c_q3;
+        let x44 = x22 - -0.475 * x19;
+        let x45 = x24 + (x18 * 0.475 + 7.11 * x25);
+        let x46 = c_q3 * x44 + s_q3 * x45;
+        let x47 = x41 * (x23 + x19 * -7.11);
+        let x48 = s_q3 * x44 - c_q3 * x45;
+        let x49 = qd[3] + x25 * x41;
+        let x50 = x32 - -0.475 * x31;
+        let x51 = x33 - (x30 * 0.475 + 7.11 * x29);
+        let x52 = x41 * (x28 - x31 * -7.11);
+        let x53 = qdd[3] + x29 * x41;
+        let x54 = x30 * c_q3 - x31 * s_q3 - qd[3] * x43;
+        let x55 = x30 * s_q3 + x31 * c_q3 + qd[3] * x42;
+        let x56 = c_q3 * x50 - s_q3 * x51 - qd[3] * x48;
+        let x57 = s_q3 * x50 + c_q3 * x51 + qd[3] * x46;
+        let x58 = 9.522 * x42 + -39.95 * x49;
+        let x59 = -39.95 * x42 + 1966.28 * x49;
+        let x60 = 1966.28 * x43;
+        let x61 = 279.2 * x46;
+        let x62 = 279.2 * x47;
+        let x63 = 279.2 * x48;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
+        let x65 = c_q4 + (1.0 - c_q4);
+        let x66 = x42 * c_q4 - x43 * s_q4;
+        let x67 = x42 * s_q4 + x43 * c_q4;
+        let x68 = x48 - 7.11 * x49;
+        let x69 = x46 * c_q4 - s_q4 * x68;
+        let x70 = x65 * (x47 + x43 * -7.11);
+        let x71 = x46 * s_q4 + c_q4 * x68;
+        let x72 = qd[4] + x49 * x65;
+        let x73 = x57 - 7.11 * x53;
+        let x74 = x65 * (x52 - -7.11 * x55);
+        let x75 = qdd[4] + x53 * x65;
+        let x76 = x54 * c_q4 - x55 * s_q4 - qd[4] * x67;
+        let x77 = x54 * s_q4 + x55 * c_q4 + qd[4] * x66;
+        let x78 = x56 * c_q4 - s_q4 * x73 - qd[4] * x71;
+        let x79 = x56 * s_q4 + c_q4 * x73 + qd[4] * x69;
+        let x80 = 8.305 * x66;
+        let x81 = 3.061 * x72;
+        let x82 = 8.0386 * x67;
+        let x83 = 105.98 * x69;
+        let x84 = 105.98 * x70;
+        let x85 = 105.98 * x71;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
+        let x87 = c_q5 + (1.0 - c_q5);
+        let x88 = x66 * c_q5 + x72 * s_q5;
+        let x89 = x72 * c_q5 - x66 * s_q5;
+        let x90 = x69 - -0.5692 * x67;
+        let x91 = c_q5 * x90 - x70 * s_q5;
+        let x92 = s_q5 * x90 + x70 * c_q5;
+        let x93 = x87 * (x71 - 0.5692 * x66);
+        let x94 = qd[5] + x67 * x87;
+        let x95 = x78 - -0.5692 * x77;
+        let x96 = x87 * (x79 - 0.5692 * x76);
+        let x97 = qdd[5] + x77 * x87;
+        let x98 = x76 * c_q5 + x75 * s_q5 + qd[5] * x89;
+        let x99 = x75 * c_q5 - x76 * s_q5 - qd[5] * x88;
+        let x100 = c_q5 * x95 + x74 * s_q5 - qd[5] * x92;
+        let x101 = x74 * c_q5 - s_q5 * x95 - qd[5] * x91;
+        let x102 = 12.13 * x88;
+        let x103 = 12.13 * x89;
+        let x104 = 3.061 * x94;
+        let x105 = 105.98 * x91;
+        let x106 = 105.98 * x92;
+        let x107 = 105.98 * x93;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = c_q6 * x12 + s_q6 * x13;
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + (x10 * x11 + 120.2819695416);
-        let x19 = 12.13 + (x14 + 120.2819695416);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.195516;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = s_q5 * x22 - c_q5 * x23;
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = c_q5 * x28 + x21 * 0.5692;
-        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27938808960002);
-        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
-        let x36 = 8.0386 + (x8 * x29 + 113.27938808960002);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01508800000002;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4582;
-        let x41 = c_q4 * x34 - s_q4 * x32;
-        let x42 = c_q4 * x30 + s_q4 * x33;
-        let x43 = s_q4 * x36 - c_q4 * x31;
-        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
-        let x45 = x6 * x35;
-        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
-        let x47 = s_q4 * x34 + c_q4 * x32;
-        let x48 = c_q4 * x33 - s_q4 * x30;
-        let x49 = s_q4 * x31 + c_q4 * x36;
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
-        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
-        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
-        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
-        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
-        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
-        let x58 = s_q3 * x39;
-        let x59 = c_q3 * x40 + x58;
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = x61 - s_q3 * x40;
-        let x63 = x59 + 5224.5702;
-        let x64 = x60 + -349.0395;
-        let x65 = c_q3 * x54 + s_q3 * x52;
-        let x66 = c_q3 * x55 + s_q3 * x50;
-        let x67 = c_q3 * x53 + s_q3 * x57;
-        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
-        let x69 = x4 * x56;
-        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
-        let x71 = c_q3 * x52 - s_q3 * x54;
-        let x72 = c_q3 * x50 - s_q3 * x55;
-        let x73 = c_q3 * x57 - s_q3 * x53;
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
-        let x78 = x4 * x72 + x76;
-        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
-        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
-        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
-        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
-        let x83 = 2103.19
-            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
-                - (-7.11 * x63 - -0.475 * x64));
-        let x84 = s_q2 * x62;
-        let x85 = c_q2 * x63 + x84;
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = x87 - s_q2 * x63;
-        let x89 = x86 + -597.4892399999999;
-        let x90 = c_q2 * x80 + s_q2 * x77;
-        let x91 = c_q2 * x81 + s_q2 * x78;
-        let x92 = c_q2 * x79 + s_q2 * x83;
-        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
-        let x94 = x2 * x82;
-        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
-        let x96 = -0.5692 * x85;
-        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x98 = c_q1 * (c_q2 * x92 - s_q2 * x90)
-            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
-            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
-        let x99 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88;
-        let x100 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
-        let x101 = x66 - x74;
-        let x102 = x69 - x75;
-        let x103 = x72 + x76;
-        let x104 = x87 - s_q2 * x59;
-        let x105 = c_q2 * x103 - s_q2 * x101 + 0.5692 * x104;
-        let x106 = c_q1 * (c_q2 * x101 + s_q2 * x103 - -0.5692 * (x84 + c_q2 * x59))
-            - s_q1 * (x2 * x102) + -0.7026 * (s_q1 * x104);
-        let x107 = x45 - x51;
-        let x108 = x61 - s_q3 * x37;
-        let x109 = x58 + c_q3 * x37;
-        let x110 = c_q3 * x42 + s_q3 * x48 - -0.475 * x109;
-        let x111 = x4 * x107 - -7.11 * x109;
-        let x112 = c_q3 * x48 - s_q3 * x42 + 0.475 * x108;
-        let x113 = c_q2 * x108 - s_q2 * x109;
-        let x114 = c_q2 * x112 - s_q2 * x110 + 0.5692 * x113;
-        let x115 = c_q1
-            * (c_q2 * x110 + s_q2 * x112 - -0.5692 * (s_q2 * x108 + c_q2 * x109))
-            - s_q1 * (x2 * x111) + -0.7026 * (s_q1 * x113);
-        let x116 = s_q4 * x29 - c_q4 * x24;
-        let x117 = x6 * x27;
-        let x118 = s_q4 * x24 + c_q4 * x29;
-        let x119 = c_q3 * x116 + s_q3 * x118;
-        let x120 = x4 * x117;
-        let x121 = c_q3 * x118 - s_q3 * x116;
-        let x122 = c_q2 * x121 - s_q2 * x119;
-        let x123 = c_q1 * (c_q2 * x119 + s_q2 * x121) - s_q1 * (x2 * x120);
-        let x124 = c_q5 * x11;
-        let x125 = s_q5 * x11;
-        let x126 = c_q4 * x124;
-        let x127 = x6 * x125;
-        let x128 = s_q4 * x124;
-        let x129 = c_q3 * x126 - s_q3 * x128;
-        let x130 = x4 * x127;
-        let x131 = s_q3 * x126 + c_q3 * x128;
-        let x132 = s_q2 * x129 + c_q2 * x131;
-        let x133 = c_q1 * (c_q2 * x129 - s_q2 * x131) - s_q1 * (x2 * x130);
-        let x134 = qd[0] * c_q1;
-        let x135 = qd[0] * s_q1;
-        let x136 = 0.7026 * qd[0];
-        let x137 = s_q1 * x136;
-        let x138 = c_q1 * x136;
-        let x139 = qd[1] * x135;
-        let x140 = qd[1] * x134;
-        let x141 = qd[1] * x138;
-        let x142 = qd[1] * x137;
-        let x143 = 8.088 * x134;
-        let x144 = 3.061 * x135;
-        let x145 = 8.446 * qd[1];
-        let x146 = 105.98 * x137;
-        let x147 = 105.98 * x138;
-        let x148 = c_q2 * x134 - qd[1] * s_q2;
-        let x149 = s_q2 * x134 + qd[1] * c_q2;
-        let x150 = 0.5692 * x134;
-        let x151 = x137 + -0.5692 * qd[1];
-        let x152 = s_q2 * x150 - c_q2 * x151;
-        let x153 = x2 * x138;
-        let x154 = s_q2 * x151 + c_q2 * x150;
-        let x155 = qd[2] - x2 * x135;
-        let x156 = x2 * x140;
-        let x157 = 0.5692 * x139;
-        let x158 = x2 * x142;
-        let x159 = c_q2 * x139 + qd[2] * x149;
-        let x160 = qd[2] * x148 - s_q2 * x139;
-        let x161 = qd[2] * x154 - (c_q2 * x141 + s_q2 * x157);
-        let x162 = c_q2 * x157 - s_q2 * x141 + qd[2] * x152;
-        let x163 = 15.41 * x148 + 49.52 * x155;
-        let x164 = 49.52 * x148 + 2094.71 * x155;
-        let x165 = 2103.19 * x149;
-        let x166 = 314.88 * x152;
-        let x167 = 314.88 * x153;
-        let x168 = 314.88 * x154;
-        let x169 = c_q3 * x148 - s_q3 * x149;
-        let x170 = s_q3 * x148 + c_q3 * x149;
-        let x171 = x152 - -0.475 * x149;
-        let x172 = x154 + (0.475 * x148 + 7.11 * x155);
-        let x173 = c_q3 * x171 + s_q3 * x172;
-        let x174 = x4 * (x153 + -7.11 * x149);
-        let x175 = s_q3 * x171 - c_q3 * x172;
-        let x176 = qd[3] + x4 * x155;
-        let x177 = x4 * x156;
-        let x178 = x161 - -0.475 * x160;
-        let x179 = x162 + (0.475 * x159 + 7.11 * x156);
-        let x180 = x4 * (x158 - -7.11 * x160);
-        let x181 = c_q3 * x159 + s_q3 * x160 + qd[3] * x170;
-        let x182 = c_q3 * x160 - s_q3 * x159 + qd[3] * x169;
-        let x183 = c_q3 * x178 - s_q3 * x179 - qd[3] * x175;
-        let x184 = s_q3 * x178 + c_q3 * x179 + qd[3] * x173;
-        let x185 = 9.522 * x169 + -39.95 * x176;
-        let x186 = -39.95 * x169 + 1966.28 * x176;
-        let x187 = 1966.28 * x170;
-        let x188 = 279.2 * x173;
-        let x189 = 279.2 * x174;
-        let x190 = 279.2 * x175;
-        let x191 = c_q4 * x169 - s_q4 * x170;
-        let x192 = s_q4 * x169 + c_q4 * x170;
-        let x193 = x175 - 7.11 * x176;
-        let x194 = c_q4 * x173 - s_q4 * x193;
-        let x195 = x6 * (x174 + -7.11 * x170);
-        let x196 = s_q4 * x173 + c_q4 * x193;
-        let x197 = qd[4] + x6 * x176;
-        let x198 = x6 * x177;
-        let x199 = x184 + 7.11 * x177;
-        let x200 = x6 * (x180 - -7.11 * x182);
-        let x201 = c_q4 * x181 + s_q4 * x182 + qd[4] * x192;
-        let x202 = c_q4 * x182 - s_q4 * x181 + qd[4] * x191;
-        let x203 = c_q4 * x183 - s_q4 * x199 - qd[4] * x196;
-        let x204 = s_q4 * x183 + c_q4 * x199 + qd[4] * x194;
-        let x205 = 8.305 * x191;
-        let x206 = 3.061 * x197;
-        let x207 = 8.0386 * x192;
-        let x208 = 105.98 * x194;
-        let x209 = 105.98 * x195;
-        let x210 = 105.98 * x196;
-        let x211 = c_q5 * x191 + s_q5 * x197;
-        let x212 = c_q5 * x197 - s_q5 * x191;
-        let x213 = x194 - -0.5692 * x192;
-        let x214 = c_q5 * x213 - s_q5 * x195;
-        let x215 = s_q5 * x213 + c_q5 * x195;
-        let x216 = x8 * (x196 - 0.5692 * x191);
-        let x217 = qd[5] + x8 * x192;
-        let x218 = x8 * x202;
-        let x219 = x203 - -0.5692 * x202;
-        let x220 = x8 * (x204 + 0.5692 * x201);
-        let x221 = qd[5] * x212 - (c_q5 * x201 + s_q5 * x198);
-        let x222 = s_q5 * x201 - c_q5 * x198 - qd[5] * x211;
-        let x223 = c_q5 * x219 + s_q5 * x200 - qd[5] * x215;
-        let x224 = c_q5 * x200 - s_q5 * x219 - qd[5] * x214;
-        let x225 = 12.13 * x211;
-        let x226 = 12.13 * x212;
-        let x227 = 3.061 * x217;
-        let x228 = 105.98 * x214;
-        let x229 = 105.98 * x215;
-        let x230 = 105.98 * x216;
-        let x231 = c_q6 * x212 + s_q6 * x217;
-        let x232 = c_q6 * x217 - s_q6 * x212;
-        let x233 = x215 + -0.7026 * x211;
-        let x234 = x10 * (x214 - 0.7026 * x212);
-        let x235 = s_q6 * x216 - c_q6 * x233;
-        let x236 = s_q6 * x233 + c_q6 * x216;
-        let x237 = qd[6] + x10 * x211;
-        let x238 = x224 - -0.7026 * x221;
-        let x239 = 9.336 * x237;
-        let x240 = 44.41 * x231;
-        let x241 = 44.41 * x232;
-        let x242 = 243.66 * x234;
-        let x243 = 243.66 * x235;
-        let x244 = 243.66 * x236;
-        let x245 = 9.336 * (x10 * x221)
-            + (x231 * x241 - x232 * x240 + (x235 * x244 - x236 * x243));
-        let x246 = 44.41 * (c_q6 * x222 + s_q6 * x218 + qd[6] * x232)
-            + (x232 * x239 - x237 * x241 + (x236 * x242 - x234 * x244));
-        let x247 = 44.41 * (c_q6 * x218 - s_q6 * x222 - qd[6] * x231)
-            + (x237 * x240 - x231 * x239 + (x234 * x243 - x235 * x242));
-        let x248 = 243.66 * (c_q6 * x238 + s_q6 * x220 + qd[6] * x236)
-            + (x232 * x242 - x237 * x244);
-        let x249 = 243.66 * (c_q6 * x220 - s_q6 * x238 - qd[6] * x235)
-            + (x237 * x243 - x231 * x242);
-        let x250 = x10
-            * (243.66 * (x10 * (x223 - 0.7026 * x222)) + (x231 * x244 - x232 * x243));
-        let x251 = c_q6 * x248 - s_q6 * x249;
-        let x252 = 12.13 * x221
-            + (x212 * x227 - x217 * x226 + (x216 * x229 - x215 * x230))
-            + (x10 * x245 + 0.7026 * x251);
-        let x253 = 12.13 * x222
-            + (x217 * x225 - x211 * x227 + (x216 * x228 - x214 * x230))
-            + (c_q6 * x246 - s_q6 * x247 + -0.7026 * x250);
-        let x254 = 3.061 * x218
-            + (x211 * x226 - x212 * x225 + (x215 * x228 - x214 * x229))
-            + (s_q6 * x246 + c_q6 * x247);
-        let x255 = 105.98 * x223 + (x217 * x229 + x212 * x230) + x250;
-        let x256 = 105.98 * x224 + (x217 * x228 - x211 * x230) + x251;
-        let x257 = c_q5 * x255 - s_q5 * x256;
-        let x258 = x8
-            * (105.98 * x220 - (x212 * x228 + x211 * x229)
-                + (s_q6 * x248 + c_q6 * x249));
-        let x259 = x197 * x207 - x192 * x206 + (x196 * x209 - x195 * x210) - 8.305 * x201
-            + (c_q5 * x252 - s_q5 * x253 + -0.5692 * x258);
-        let x260 = x192 * x205 - x191 * x207 + (x196 * x208 - x194 * x210) - 3.061 * x198
-            + (s_q5 * x252 + c_q5 * x253);
-        let x261 = 8.0386 * x202
-            + (x191 * x206 - x197 * x205 + (x195 * x208 - x194 * x209))
-            + (x8 * x254 + 0.5692 * x257);
-        let x262 = 105.98 * x203 + (x192 * x209 + x197 * x210) + x257;
-        let x263 = 105.98 * x204 - (x197 * x208 + x191 * x209) + x258;
-        let x264 = x6
-            * (105.98 * x200 + (x192 * x208 - x191 * x210)
-                + (s_q5 * x255 + c_q5 * x256));
-        let x265 = c_q4 * x263 - s_q4 * x262;
-        let x266 = x176 * x187 - x170 * x186 + (x175 * x189 - x174 * x190)
-            - (9.522 * x181 + -39.95 * x177) + (c_q4 * x259 + s_q4 * x261);
-        let x267 = x170 * x185 - x169 * x187 + (x175 * x188 - x173 * x190)
-            - (-39.95 * x181 + 1966.28 * x177) + (x6 * x260 + -7.11 * x265);
-        let x268 = 1966.28 * x182
-            + (x169 * x186 - x176 * x185 + (x174 * x188 - x173 * x189))
-            + (c_q4 * x261 - s_q4 * x259 + 7.11 * x264);
-        let x269 = 279.2 * x183 + (x170 * x189 + x176 * x190)
-            + (c_q4 * x262 + s_q4 * x263);
-        let x270 = 279.2 * x184 - (x176 * x188 + x169 * x189) + x265;
-        let x271 = c_q3 * x269 + s_q3 * x270;
-        let x272 = x4 * (279.2 * x180 + (x170 * x188 - x169 * x190) + x264);
-        let x273 = c_q3 * x270 - s_q3 * x269;
-        let x274 = x155 * x165 - x149 * x164 + (x153 * x168 - x154 * x167)
-            - (15.41 * x159 + 49.52 * x156)
-            + (c_q3 * x266 + s_q3 * x268 + -0.475 * x273);
-        let x275 = x149 * x163 - x148 * x165 + (x152 * x168 - x154 * x166)
-            - (49.52 * x159 + 2094.71 * x156) + (x4 * x267 + -7.11 * x273);
-        let x276 = 2103.19 * x160
-            + (x148 * x164 - x155 * x163 + (x153 * x166 - x152 * x167))
-            + (c_q3 * x268 - s_q3 * x266 + (0.475 * x271 + 7.11 * x272));
-        let x277 = 314.88 * x161 + (x149 * x167 - x155 * x168) + x271;
-        let x278 = 314.88 * x162 - (x155 * x166 + x148 * x167) + x273;
-        let x279 = c_q2 * x277 + s_q2 * x278;
-        let x280 = c_q1
-            * (qd[1] * x144 - x135 * x145 - 8.088 * x139
-                + (c_q2 * x274 + s_q2 * x276 + -0.5692 * (c_q2 * x278 - s_q2 * x277)))
-            - s_q1 * (qd[1] * x143 - x134 * x145 - 3.061 * x140 + x2 * x275)
-            + -0.7026
-                * (s_q1 * (qd[1] * x147 - 105.98 * x141 + x279)
-                    + c_q1
-                        * (105.98 * x142 - qd[1] * x146
-                            + x2 * (314.88 * x158 + (x149 * x166 + x148 * x168) + x272)))
-            + (qdd[0]
-                * (12.19
-                    + (c_q1
-                        * (c_q1
-                            * (8.088
-                                + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
-                            - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
-                        - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
-                        - -0.7026 * x97 + 0.7026 * (x97 + 811.9807679999999)))
-                + qdd[1] * x98 + qdd[2] * x100 + qdd[3] * x106 + qdd[4] * x115
-                + qdd[5] * x123 + qdd[6] * x133);
-        let x281 = x135 * x143 - x134 * x144 + (x137 * x147 - x138 * x146)
-            + (c_q2 * x276 - s_q2 * x274 + 0.5692 * x279)
-            + (qdd[0] * x98
-                + qdd[1]
-                    * (8.446
-                        + (c_q2 * (c_q2 * x83 - s_q2 * x79)
-                            - s_q2 * (c_q2 * x77 - s_q2 * x80) - 0.5692 * x86
-                            + -0.5692 * x89)) + qdd[2] * x99 + qdd[3] * x105
-                + qdd[4] * x114 + qdd[5] * x122 - qdd[6] * x132);
-        let x282 = x275
-            + (qdd[0] * x100 + qdd[1] * x99 + qdd[2] * x82 + qdd[3] * x102
-                + qdd[4] * x111 + qdd[5] * x120 + qdd[6] * x130);
-        let x283 = x267
-            + (qdd[0] * x106 + qdd[1] * x105 + qdd[2] * x102 + qdd[3] * x56
-                + qdd[4] * x107 + qdd[5] * x117 + qdd[6] * x127);
-        let x284 = x260
-            + (qdd[0] * x115 + qdd[1] * x114 + qdd[2] * x111 + qdd[3] * x107
-                + qdd[4] * x35 + qdd[5] * x27 + qdd[6] * x125);
-        let x285 = x254
-            + (qdd[0] * x123 + qdd[1] * x122 + qdd[2] * x120 + qdd[3] * x117
-                + qdd[4] * x27 + qdd[5] * x20);
-        let x286 = x245
-            + (qdd[0] * x133 - qdd[1] * x132 + qdd[2] * x130 + qdd[3] * x127
-                + qdd[4] * x125 + 9.336 * qdd[6]);
-        [x280, x281, x282, x283, x284, x285, x286]
+        let x109 = c_q6 + (1.0 - c_q6);
+        let x110 = x89 * c_q6 + x94 * s_q6;
+        let x111 = x94 * c_q6 - x89 * s_q6;
+        let x112 = x92 + -0.7026 * x88;
+        let x113 = x109 * (x91 - 0.7026 * x89);
+        let x114 = x93 * s_q6 - c_q6 * x112;
+        let x115 = s_q6 * x112 + x93 * c_q6;
+        let x116 = qd[6] + x88 * x109;
+        let x117 = x101 - -0.7026 * x98;
+        let x118 = 9.336 * x116;
+        let x119 = 44.41 * x110;
+        let x120 = 44.41 * x111;
+        let x121 = 243.66 * x113;
+        let x122 = 243.66 * x114;
+        let x123 = 243.66 * x115;
+        let x124 = 9.336 * (qdd[6] + x98 * x109)
+            + (x110 * x120 - x111 * x119 + (x114 * x123 - x115 * x122));
+        let x125 = 44.41 * (x99 * c_q6 + x97 * s_q6 + qd[6] * x111)
+            + (x111 * x118 - x116 * x120 + (x115 * x121 - x113 * x123));
+        let x126 = 44.41 * (x97 * c_q6 - x99 * s_q6 - qd[6] * x110)
+            + (x116 * x119 - x110 * x118 + (x113 * x122 - x114 * x121));
+        let x127 = 243.66 * (c_q6 * x117 + x96 * s_q6 + qd[6] * x115)
+            + (x111 * x121 - x116 * x123);
+        let x128 = 243.66 * (x96 * c_q6 - s_q6 * x117 - qd[6] * x114)
+            + (x116 * x122 - x110 * x121);
+        let x129 = x109
+            * (243.66 * (x109 * (x100 - 0.7026 * x99)) + (x110 * x123 - x111 * x122));
+        let x130 = c_q6 * x127 - s_q6 * x128;
+        let x131 = 12.13 * x98 + (x89 * x104 - x94 * x103 + (x93 * x106 - x92 * x107))
+            + (x109 * x124 + 0.7026 * x130);
+        let x132 = 12.13 * x99 + (x94 * x102 - x88 * x104 + (x93 * x105 - x91 * x107))
+            + (c_q6 * x125 - s_q6 * x126 + -0.7026 * x129);
+        let x133 = 3.061 * x97 + (x88 * x103 - x89 * x102 + (x92 * x105 - x91 * x106))
+            + (s_q6 * x125 + c_q6 * x126);
+        let x134 = 105.98 * x100 + (x94 * x106 + x89 * x107) + x129;
+        let x135 = 105.98 * x101 + (x94 * x105 - x88 * x107) + x130;
+        let x136 = c_q5 * x134 - s_q5 * x135;
+        let x137 = x87
+            * (105.98 * x96 - (x89 * x105 + x88 * x106) + (s_q6 * x127 + c_q6 * x128));
+        let x138 = 8.305 * x76 + (x72 * x82 - x67 * x81 + (x71 * x84 - x70 * x85))
+            + (c_q5 * x131 - s_q5 * x132 + -0.5692 * x137);
+        let x139 = 3.061 * x75 + (x67 * x80 - x66 * x82 + (x71 * x83 - x69 * x85))
+            + (s_q5 * x131 + c_q5 * x132);
+        let x140 = 8.0386 * x77 + (x66 * x81 - x72 * x80 + (x70 * x83 - x69 * x84))
+            + (x87 * x133 + 0.5692 * x136);
+        let x141 = 105.98 * x78 + (x67 * x84 + x72 * x85) + x136;
+        let x142 = 105.98 * x79 - (x72 * x83 + x66 * x84) + x137;
+        let x143 = x65
+            * (105.98 * x74 + (x67 * x83 - x66 * x85) + (s_q5 * x134 + c_q5 * x135));
+        let x144 = c_q4 * x142 - s_q4 * x141;
+        let x145 = 9.522 * x54 + -39.95 * x53
+            + (x49 * x60 - x43 * x59 + (x48 * x62 - x47 * x63))
+            + (c_q4 * x138 + s_q4 * x140);
+        let x146 = -39.95 * x54 + 1966.28 * x53
+            + (x43 * x58 - x42 * x60 + (x48 * x61 - x46 * x63))
+            + (x65 * x139 + -7.11 * x144);
+        let x147 = 1966.28 * x55 + (x42 * x59 - x49 * x58 + (x47 * x61 - x46 * x62))
+            + (c_q4 * x140 - s_q4 * x138 + 7.11 * x143);
+        let x148 = 279.2 * x56 + (x43 * x62 + x49 * x63) + (c_q4 * x141 + s_q4 * x142);
+        let x149 = 279.2 * x57 - (x49 * x61 + x42 * x62) + x144;
+        let x150 = c_q3 * x148 + s_q3 * x149;
+        let x151 = x41 * (279.2 * x52 + (x43 * x61 - x42 * x63) + x143);
+        let x152 = c_q3 * x149 - s_q3 * x148;
+        let x153 = 15.41 * x30 + 49.52 * x29
+            + (x25 * x36 - x19 * x35 + (x23 * x39 - x24 * x38))
+            + (c_q3 * x145 + s_q3 * x147 + -0.475 * x152);
+        let x154 = 49.52 * x30 + 2094.71 * x29
+            + (x19 * x34 - x18 * x36 + (x22 * x39 - x24 * x37))
+            + (x41 * x146 + -7.11 * x152);
+        let x155 = 2103.19 * x31 + (x18 * x35 - x25 * x34 + (x23 * x37 - x22 * x38))
+            + (c_q3 * x147 - s_q3 * x145 + (0.475 * x150 + 7.11 * x151));
+        let x156 = 314.88 * x32 + (x19 * x38 - x25 * x39) + x150;
+        let x157 = 314.88 * x33 - (x25 * x37 + x18 * x38) + x152;
+        let x158 = c_q2 * x156 + s_q2 * x157;
+        let x159 = 8.446 * qdd[1] + (x2 * x11 - x1 * x12 + (x4 * x15 - x5 * x14))
+            + (c_q2 * x155 - s_q2 * x153 + 0.5692 * x158);
+        let x160 = 12.19 * qdd[0]
+            + (c_q1
+                * (8.088 * x7 + (qd[1] * x12 - x2 * x13)
+                    + (c_q2 * x153 + s_q2 * x155
+                        + -0.5692 * (c_q2 * x157 - s_q2 * x156)))
+                - s_q1 * (qd[1] * x11 - x1 * x13 - 3.061 * x8 + x17 * x154)
+                + -0.7026
+                    * (s_q1 * (qd[1] * x15 - 105.98 * x9 + x158)
+                        + c_q1
+                            * (105.98 * x10 - qd[1] * x14
+                                + x17 * (314.88 * x28 + (x19 * x37 + x18 * x39) + x151))));
+        [x160, x159, x154, x146, x139, x133, x124]
     }
-    /// Forward dynamics `q̈ = A⁻¹ b(q, q̇, τ)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Algorithm `spatial`: 774 mul, 530 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 530 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1441,5 +1295,365 @@ impl Ssrms {
         let x330 = x275 * x276 - x277 * x329 - x278 * x328 - x279 * x327 - x280 * x326
             - x281 * x325 - x282 * x324;
         [x330, x329, x328, x327, x326, x325, x324]
+    }
+    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 648 mul, 426 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects(
+        q: &[f64; 7],
+        qd: &[f64; 7],
+    ) -> ([[f64; 7]; 7], [f64; 7]) {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let x10 = c_q6 + (1.0 - c_q6);
+        let x11 = 9.336 * x10;
+        let x12 = 44.41 * c_q6;
+        let x13 = 44.41 * s_q6;
+        let x14 = c_q6 * x12 + s_q6 * x13;
+        let x15 = s_q6 * x12;
+        let x16 = c_q6 * x13;
+        let x17 = x15 - x16;
+        let x18 = 12.13 + (x10 * x11 + 120.2819695416);
+        let x19 = 12.13 + (x14 + 120.2819695416);
+        let x20 = 3.061 + x14;
+        let x21 = x8 * -171.195516;
+        let x22 = c_q5 * x18;
+        let x23 = s_q5 * x19;
+        let x24 = s_q5 * x17;
+        let x25 = s_q5 * x18;
+        let x26 = c_q5 * x19;
+        let x27 = c_q5 * x17;
+        let x28 = x8 * (x16 - x15);
+        let x29 = x8 * x20;
+        let x30 = s_q5 * x22 - c_q5 * x23;
+        let x31 = x8 * x24;
+        let x32 = s_q5 * x28;
+        let x33 = c_q5 * x28 + x21 * 0.5692;
+        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27938808960002);
+        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
+        let x36 = 8.0386 + (x8 * x29 + 113.27938808960002);
+        let x37 = s_q4 * x21;
+        let x38 = x6 * -199.01508800000002;
+        let x39 = c_q4 * x21;
+        let x40 = x37 + 3239.4582;
+        let x41 = c_q4 * x34 - s_q4 * x32;
+        let x42 = c_q4 * x30 + s_q4 * x33;
+        let x43 = s_q4 * x36 - c_q4 * x31;
+        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
+        let x45 = x6 * x35;
+        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
+        let x47 = s_q4 * x34 + c_q4 * x32;
+        let x48 = c_q4 * x33 - s_q4 * x30;
+        let x49 = s_q4 * x31 + c_q4 * x36;
+        let x50 = x6 * x48;
+        let x51 = x37 * -7.11;
+        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
+        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
+        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
+        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
+        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
+        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
+        let x58 = s_q3 * x39;
+        let x59 = c_q3 * x40 + x58;
+        let x60 = x4 * x38;
+        let x61 = c_q3 * x39;
+        let x62 = x61 - s_q3 * x40;
+        let x63 = x59 + 5224.5702;
+        let x64 = x60 + -349.0395;
+        let x65 = c_q3 * x54 + s_q3 * x52;
+        let x66 = c_q3 * x55 + s_q3 * x50;
+        let x67 = c_q3 * x53 + s_q3 * x57;
+        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
+        let x69 = x4 * x56;
+        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
+        let x71 = c_q3 * x52 - s_q3 * x54;
+        let x72 = c_q3 * x50 - s_q3 * x55;
+        let x73 = c_q3 * x57 - s_q3 * x53;
+        let x74 = -0.475 * x59;
+        let x75 = -7.11 * x59;
+        let x76 = x62 * 0.475;
+        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
+        let x78 = x4 * x72 + x76;
+        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
+        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
+        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
+        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
+        let x83 = 2103.19
+            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
+                - (-7.11 * x63 - -0.475 * x64));
+        let x84 = s_q2 * x62;
+        let x85 = c_q2 * x63 + x84;
+        let x86 = x2 * x64;
+        let x87 = c_q2 * x62;
+        let x88 = x87 - s_q2 * x63;
+        let x89 = x86 + -597.4892399999999;
+        let x90 = c_q2 * x80 + s_q2 * x77;
+        let x91 = c_q2 * x81 + s_q2 * x78;
+        let x92 = c_q2 * x79 + s_q2 * x83;
+        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
+        let x94 = x2 * x82;
+        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
+        let x96 = -0.5692 * x85;
+        let x97 = 8.446
+            + (c_q2 * (c_q2 * x83 - s_q2 * x79) - s_q2 * (c_q2 * x77 - s_q2 * x80)
+                - 0.5692 * x86 + -0.5692 * x89);
+        let x98 = (c_q1 + (1.0 - c_q1)) * x88;
+        let x99 = 12.19
+            + (c_q1
+                * (c_q1
+                    * (8.088 + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
+                    - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
+                - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
+                - -0.7026 * x98 + 0.7026 * (x98 + 811.9807679999999));
+        let x100 = c_q1 * (c_q2 * x92 - s_q2 * x90)
+            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
+            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
+        let x101 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88;
+        let x102 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
+        let x103 = x66 - x74;
+        let x104 = x69 - x75;
+        let x105 = x72 + x76;
+        let x106 = x87 - s_q2 * x59;
+        let x107 = c_q2 * x105 - s_q2 * x103 + 0.5692 * x106;
+        let x108 = c_q1 * (c_q2 * x103 + s_q2 * x105 - -0.5692 * (x84 + c_q2 * x59))
+            - s_q1 * (x2 * x104) + -0.7026 * (s_q1 * x106);
+        let x109 = x45 - x51;
+        let x110 = x61 - s_q3 * x37;
+        let x111 = x58 + c_q3 * x37;
+        let x112 = c_q3 * x42 + s_q3 * x48 - -0.475 * x111;
+        let x113 = x4 * x109 - -7.11 * x111;
+        let x114 = c_q3 * x48 - s_q3 * x42 + 0.475 * x110;
+        let x115 = c_q2 * x110 - s_q2 * x111;
+        let x116 = c_q2 * x114 - s_q2 * x112 + 0.5692 * x115;
+        let x117 = c_q1
+            * (c_q2 * x112 + s_q2 * x114 - -0.5692 * (s_q2 * x110 + c_q2 * x111))
+            - s_q1 * (x2 * x113) + -0.7026 * (s_q1 * x115);
+        let x118 = s_q4 * x29 - c_q4 * x24;
+        let x119 = x6 * x27;
+        let x120 = s_q4 * x24 + c_q4 * x29;
+        let x121 = c_q3 * x118 + s_q3 * x120;
+        let x122 = x4 * x119;
+        let x123 = c_q3 * x120 - s_q3 * x118;
+        let x124 = c_q2 * x123 - s_q2 * x121;
+        let x125 = c_q1 * (c_q2 * x121 + s_q2 * x123) - s_q1 * (x2 * x122);
+        let x126 = c_q5 * x11;
+        let x127 = s_q5 * x11;
+        let x128 = c_q4 * x126;
+        let x129 = x6 * x127;
+        let x130 = s_q4 * x126;
+        let x131 = c_q3 * x128 - s_q3 * x130;
+        let x132 = x4 * x129;
+        let x133 = s_q3 * x128 + c_q3 * x130;
+        let x134 = -(s_q2 * x131 + c_q2 * x133);
+        let x135 = c_q1 * (c_q2 * x131 - s_q2 * x133) - s_q1 * (x2 * x132);
+        let x136 = qd[0] * c_q1;
+        let x137 = qd[0] * s_q1;
+        let x138 = 0.7026 * qd[0];
+        let x139 = s_q1 * x138;
+        let x140 = c_q1 * x138;
+        let x141 = qd[1] * x137;
+        let x142 = qd[1] * x136;
+        let x143 = qd[1] * x140;
+        let x144 = qd[1] * x139;
+        let x145 = 8.088 * x136;
+        let x146 = 3.061 * x137;
+        let x147 = 8.446 * qd[1];
+        let x148 = 105.98 * x139;
+        let x149 = 105.98 * x140;
+        let x150 = c_q2 * x136 - qd[1] * s_q2;
+        let x151 = s_q2 * x136 + qd[1] * c_q2;
+        let x152 = 0.5692 * x136;
+        let x153 = x139 + -0.5692 * qd[1];
+        let x154 = s_q2 * x152 - c_q2 * x153;
+        let x155 = x2 * x140;
+        let x156 = s_q2 * x153 + c_q2 * x152;
+        let x157 = qd[2] - x2 * x137;
+        let x158 = x2 * x142;
+        let x159 = 0.5692 * x141;
+        let x160 = x2 * x144;
+        let x161 = c_q2 * x141 + qd[2] * x151;
+        let x162 = qd[2] * x150 - s_q2 * x141;
+        let x163 = qd[2] * x156 - (c_q2 * x143 + s_q2 * x159);
+        let x164 = c_q2 * x159 - s_q2 * x143 + qd[2] * x154;
+        let x165 = 15.41 * x150 + 49.52 * x157;
+        let x166 = 49.52 * x150 + 2094.71 * x157;
+        let x167 = 2103.19 * x151;
+        let x168 = 314.88 * x154;
+        let x169 = 314.88 * x155;
+        let x170 = 314.88 * x156;
+        let x171 = c_q3 * x150 - s_q3 * x151;
+        let x172 = s_q3 * x150 + c_q3 * x151;
+        let x173 = x154 - -0.475 * x151;
+        let x174 = x156 + (0.475 * x150 + 7.11 * x157);
+        let x175 = c_q3 * x173 + s_q3 * x174;
+        let x176 = x4 * (x155 + -7.11 * x151);
+        let x177 = s_q3 * x173 - c_q3 * x174;
+        let x178 = qd[3] + x4 * x157;
+        let x179 = x4 * x158;
+        let x180 = x163 - -0.475 * x162;
+        let x181 = x164 + (0.475 * x161 + 7.11 * x158);
+        let x182 = x4 * (x160 - -7.11 * x162);
+        let x183 = c_q3 * x161 + s_q3 * x162 + qd[3] * x172;
+        let x184 = c_q3 * x162 - s_q3 * x161 + qd[3] * x171;
+        let x185 = c_q3 * x180 - s_q3 * x181 - qd[3] * x177;
+        let x186 = s_q3 * x180 + c_q3 * x181 + qd[3] * x175;
+        let x187 = 9.522 * x171 + -39.95 * x178;
+        let x188 = -39.95 * x171 + 1966.28 * x178;
+        let x189 = 1966.28 * x172;
+        let x190 = 279.2 * x175;
+        let x191 = 279.2 * x176;
+        let x192 = 279.2 * x177;
+        let x193 = c_q4 * x171 - s_q4 * x172;
+        let x194 = s_q4 * x171 + c_q4 * x172;
+        let x195 = x177 - 7.11 * x178;
+        let x196 = c_q4 * x175 - s_q4 * x195;
+        let x197 = x6 * (x176 + -7.11 * x172);
+        let x198 = s_q4 * x175 + c_q4 * x195;
+        let x199 = qd[4] + x6 * x178;
+        let x200 = x6 * x179;
+        let x201 = x186 + 7.11 * x179;
+        let x202 = x6 * (x182 - -7.11 * x184);
+        let x203 = c_q4 * x183 + s_q4 * x184 + qd[4] * x194;
+        let x204 = c_q4 * x184 - s_q4 * x183 + qd[4] * x193;
+        let x205 = c_q4 * x185 - s_q4 * x201 - qd[4] * x198;
+        let x206 = s_q4 * x185 + c_q4 * x201 + qd[4] * x196;
+        let x207 = 8.305 * x193;
+        let x208 = 3.061 * x199;
+        let x209 = 8.0386 * x194;
+        let x210 = 105.98 * x196;
+        let x211 = 105.98 * x197;
+        let x212 = 105.98 * x198;
+        let x213 = c_q5 * x193 + s_q5 * x199;
+        let x214 = c_q5 * x199 - s_q5 * x193;
+        let x215 = x196 - -0.5692 * x194;
+        let x216 = c_q5 * x215 - s_q5 * x197;
+        let x217 = s_q5 * x215 + c_q5 * x197;
+        let x218 = x8 * (x198 - 0.5692 * x193);
+        let x219 = qd[5] + x8 * x194;
+        let x220 = x8 * x204;
+        let x221 = x205 - -0.5692 * x204;
+        let x222 = x8 * (x206 + 0.5692 * x203);
+        let x223 = qd[5] * x214 - (c_q5 * x203 + s_q5 * x200);
+        let x224 = s_q5 * x203 - c_q5 * x200 - qd[5] * x213;
+        let x225 = c_q5 * x221 + s_q5 * x202 - qd[5] * x217;
+        let x226 = c_q5 * x202 - s_q5 * x221 - qd[5] * x216;
+        let x227 = 12.13 * x213;
+        let x228 = 12.13 * x214;
+        let x229 = 3.061 * x219;
+        let x230 = 105.98 * x216;
+        let x231 = 105.98 * x217;
+        let x232 = 105.98 * x218;
+        let x233 = c_q6 * x214 + s_q6 * x219;
+        let x234 = c_q6 * x219 - s_q6 * x214;
+        let x235 = x217 + -0.7026 * x213;
+        let x236 = x10 * (x216 - 0.7026 * x214);
+        let x237 = s_q6 * x218 - c_q6 * x235;
+        let x238 = s_q6 * x235 + c_q6 * x218;
+        let x239 = qd[6] + x10 * x213;
+        let x240 = x226 - -0.7026 * x223;
+        let x241 = 9.336 * x239;
+        let x242 = 44.41 * x233;
+        let x243 = 44.41 * x234;
+        let x244 = 243.66 * x236;
+        let x245 = 243.66 * x237;
+        let x246 = 243.66 * x238;
+        let x247 = 9.336 * (x10 * x223)
+            + (x233 * x243 - x234 * x242 + (x237 * x246 - x238 * x245));
+        let x248 = 44.41 * (c_q6 * x224 + s_q6 * x220 + qd[6] * x234)
+            + (x234 * x241 - x239 * x243 + (x238 * x244 - x236 * x246));
+        let x249 = 44.41 * (c_q6 * x220 - s_q6 * x224 - qd[6] * x233)
+            + (x239 * x242 - x233 * x241 + (x236 * x245 - x237 * x244));
+        let x250 = 243.66 * (c_q6 * x240 + s_q6 * x222 + qd[6] * x238)
+            + (x234 * x244 - x239 * x246);
+        let x251 = 243.66 * (c_q6 * x222 - s_q6 * x240 - qd[6] * x237)
+            + (x239 * x245 - x233 * x244);
+        let x252 = x10
+            * (243.66 * (x10 * (x225 - 0.7026 * x224)) + (x233 * x246 - x234 * x245));
+        let x253 = c_q6 * x250 - s_q6 * x251;
+        let x254 = 12.13 * x223
+            + (x214 * x229 - x219 * x228 + (x218 * x231 - x217 * x232))
+            + (x10 * x247 + 0.7026 * x253);
+        let x255 = 12.13 * x224
+            + (x219 * x227 - x213 * x229 + (x218 * x230 - x216 * x232))
+            + (c_q6 * x248 - s_q6 * x249 + -0.7026 * x252);
+        let x256 = 3.061 * x220
+            + (x213 * x228 - x214 * x227 + (x217 * x230 - x216 * x231))
+            + (s_q6 * x248 + c_q6 * x249);
+        let x257 = 105.98 * x225 + (x219 * x231 + x214 * x232) + x252;
+        let x258 = 105.98 * x226 + (x219 * x230 - x213 * x232) + x253;
+        let x259 = c_q5 * x257 - s_q5 * x258;
+        let x260 = x8
+            * (105.98 * x222 - (x214 * x230 + x213 * x231)
+                + (s_q6 * x250 + c_q6 * x251));
+        let x261 = x199 * x209 - x194 * x208 + (x198 * x211 - x197 * x212) - 8.305 * x203
+            + (c_q5 * x254 - s_q5 * x255 + -0.5692 * x260);
+        let x262 = x194 * x207 - x193 * x209 + (x198 * x210 - x196 * x212) - 3.061 * x200
+            + (s_q5 * x254 + c_q5 * x255);
+        let x263 = 8.0386 * x204
+            + (x193 * x208 - x199 * x207 + (x197 * x210 - x196 * x211))
+            + (x8 * x256 + 0.5692 * x259);
+        let x264 = 105.98 * x205 + (x194 * x211 + x199 * x212) + x259;
+        let x265 = 105.98 * x206 - (x199 * x210 + x193 * x211) + x260;
+        let x266 = x6
+            * (105.98 * x202 + (x194 * x210 - x193 * x212)
+                + (s_q5 * x257 + c_q5 * x258));
+        let x267 = c_q4 * x265 - s_q4 * x264;
+        let x268 = x178 * x189 - x172 * x188 + (x177 * x191 - x176 * x192)
+            - (9.522 * x183 + -39.95 * x179) + (c_q4 * x261 + s_q4 * x263);
+        let x269 = x172 * x187 - x171 * x189 + (x177 * x190 - x175 * x192)
+            - (-39.95 * x183 + 1966.28 * x179) + (x6 * x262 + -7.11 * x267);
+        let x270 = 1966.28 * x184
+            + (x171 * x188 - x178 * x187 + (x176 * x190 - x175 * x191))
+            + (c_q4 * x263 - s_q4 * x261 + 7.11 * x266);
+        let x271 = 279.2 * x185 + (x172 * x191 + x178 * x192)
+            + (c_q4 * x264 + s_q4 * x265);
+        let x272 = 279.2 * x186 - (x178 * x190 + x171 * x191) + x267;
+        let x273 = c_q3 * x271 + s_q3 * x272;
+        let x274 = x4 * (279.2 * x182 + (x172 * x190 - x171 * x192) + x266);
+        let x275 = c_q3 * x272 - s_q3 * x271;
+        let x276 = x157 * x167 - x151 * x166 + (x155 * x170 - x156 * x169)
+            - (15.41 * x161 + 49.52 * x158)
+            + (c_q3 * x268 + s_q3 * x270 + -0.475 * x275);
+        let x277 = x151 * x165 - x150 * x167 + (x154 * x170 - x156 * x168)
+            - (49.52 * x161 + 2094.71 * x158) + (x4 * x269 + -7.11 * x275);
+        let x278 = 2103.19 * x162
+            + (x150 * x166 - x157 * x165 + (x155 * x168 - x154 * x169))
+            + (c_q3 * x270 - s_q3 * x268 + (0.475 * x273 + 7.11 * x274));
+        let x279 = 314.88 * x163 + (x151 * x169 - x157 * x170) + x273;
+        let x280 = 314.88 * x164 - (x157 * x168 + x150 * x169) + x275;
+        let x281 = c_q2 * x279 + s_q2 * x280;
+        let x282 = x137 * x145 - x136 * x146 + (x139 * x149 - x140 * x148)
+            + (c_q2 * x278 - s_q2 * x276 + 0.5692 * x281);
+        let x283 = c_q1
+            * (qd[1] * x146 - x137 * x147 - 8.088 * x141
+                + (c_q2 * x276 + s_q2 * x278 + -0.5692 * (c_q2 * x280 - s_q2 * x279)))
+            - s_q1 * (qd[1] * x145 - x136 * x147 - 3.061 * x142 + x2 * x277)
+            + -0.7026
+                * (s_q1 * (qd[1] * x149 - 105.98 * x143 + x281)
+                    + c_q1
+                        * (105.98 * x144 - qd[1] * x148
+                            + x2
+                                * (314.88 * x160 + (x151 * x168 + x150 * x170) + x274)));
+        (
+            [
+                [x99, x100, x102, x108, x117, x125, x135],
+                [x100, x97, x101, x107, x116, x124, x134],
+                [x102, x101, x82, x104, x113, x122, x132],
+                [x108, x107, x104, x56, x109, x119, x129],
+                [x117, x116, x113, x109, x35, x27, x127],
+                [x125, x124, x122, x119, x27, x20, 0.0],
+                [x135, x134, x132, x129, x127, 0.0, 9.336],
+            ],
+            [x283, x282, x277, x269, x262, x256, x247],
+        )
     }
 }

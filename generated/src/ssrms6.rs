@@ -2,41 +2,56 @@
 //!
 //! Joints: `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
+//! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //!
-//! Emitted operation counts per candidate algorithm (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
-//! | function | algorithm | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | 451 | 366 | 0 | 0 | 6 | 817 |
-//! | `mass_matrix` | `recurrent-r1` | 493 | 386 | 0 | 0 | 6 | 879 |
-//! | `mass_matrix` | `kane-direct` | 564 | 356 | 0 | 0 | 6 | 920 |
-//! | `mass_matrix` | `crba-base` | 436 | 314 | 0 | 0 | 6 | 750 |
-//! | `mass_matrix` | `spatial` * | 161 | 115 | 0 | 0 | 5 | 276 |
-//! | `bias` | `recurrent` | 509 | 358 | 0 | 0 | 6 | 867 |
-//! | `bias` | `recurrent-r1` | 509 | 358 | 0 | 0 | 6 | 867 |
-//! | `bias` | `kane-direct` | 580 | 406 | 0 | 0 | 6 | 986 |
-//! | `bias` | `crba-base` | 509 | 358 | 0 | 0 | 6 | 867 |
-//! | `bias` | `spatial` * | 317 | 217 | 0 | 0 | 5 | 534 |
-//! | `bias_velocity` | `recurrent` | 509 | 352 | 0 | 0 | 6 | 861 |
-//! | `bias_velocity` | `recurrent-r1` | 509 | 352 | 0 | 0 | 6 | 861 |
-//! | `bias_velocity` | `kane-direct` | 580 | 400 | 0 | 0 | 6 | 980 |
-//! | `bias_velocity` | `crba-base` | 509 | 352 | 0 | 0 | 6 | 861 |
-//! | `bias_velocity` | `spatial` * | 317 | 211 | 0 | 0 | 5 | 528 |
-//! | `inverse_dynamics` | `recurrent` | 753 | 637 | 0 | 0 | 6 | 1390 |
-//! | `inverse_dynamics` | `recurrent-r1` | 795 | 657 | 0 | 0 | 6 | 1452 |
-//! | `inverse_dynamics` | `kane-direct` | 901 | 643 | 0 | 0 | 6 | 1544 |
-//! | `inverse_dynamics` | `crba-base` | 738 | 585 | 0 | 0 | 6 | 1323 |
-//! | `inverse_dynamics` | `spatial` * | 512 | 352 | 0 | 0 | 5 | 864 |
-//! | `forward_dynamics` | `recurrent` | 803 | 672 | 6 | 0 | 6 | 1475 |
-//! | `forward_dynamics` | `recurrent-r1` | 845 | 692 | 6 | 0 | 6 | 1537 |
-//! | `forward_dynamics` | `kane-direct` | 951 | 678 | 6 | 0 | 6 | 1629 |
-//! | `forward_dynamics` | `crba-base` | 788 | 620 | 6 | 0 | 6 | 1408 |
-//! | `forward_dynamics` | `spatial` * | 564 | 388 | 6 | 0 | 5 | 952 |
+//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | 451 | 366 | 0 | 0 | 6 | 817 |
+//! | `mass_matrix` | `recurrent-r1` | — | 493 | 386 | 0 | 0 | 6 | 879 |
+//! | `mass_matrix` | `kane-direct` | — | 564 | 356 | 0 | 0 | 6 | 920 |
+//! | `mass_matrix` | `crba-base` | — | 436 | 314 | 0 | 0 | 6 | 750 |
+//! | `mass_matrix` * | `crba` | — | 161 | 115 | 0 | 0 | 5 | 276 |
+//! | `nonlinear_effects` | — | `recurrent` | 509 | 352 | 0 | 0 | 6 | 861 |
+//! | `nonlinear_effects` | — | `kane-direct` | 580 | 400 | 0 | 0 | 6 | 980 |
+//! | `nonlinear_effects` * | — | `rnea` | 317 | 211 | 0 | 0 | 5 | 528 |
+//! | `inverse_dynamics` | — | `recurrent` | 704 | 491 | 0 | 0 | 6 | 1195 |
+//! | `inverse_dynamics` | — | `kane-direct` | 775 | 539 | 0 | 0 | 6 | 1314 |
+//! | `inverse_dynamics` * | — | `rnea` | 334 | 229 | 0 | 0 | 5 | 563 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 756 | 527 | 6 | 0 | 6 | 1283 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 827 | 575 | 6 | 0 | 6 | 1402 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 564 | 388 | 6 | 0 | 5 | 952 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 670 | 457 | 0 | 0 | 6 | 1127 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 741 | 505 | 0 | 0 | 6 | 1246 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 478 | 318 | 0 | 0 | 5 | 796 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
+/// Emitted operation counts of one function of [`Ssrms6`] (`None`: the function uses no such method; `fma`: fused multiply-adds formed, each also counted as one `mul` and one `add`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct OpCount {
+    /// The generated function.
+    pub function: &'static str,
+    /// Its mass-matrix method.
+    pub mass_matrix_method: Option<&'static str>,
+    /// Its bias method.
+    pub bias_method: Option<&'static str>,
+    /// Multiplications.
+    pub mul: u64,
+    /// Additions and subtractions.
+    pub add: u64,
+    /// Divisions.
+    pub div: u64,
+    /// Square roots.
+    pub sqrt: u64,
+    /// Angles whose sine and cosine are taken.
+    pub sincos: u64,
+    /// Fused multiply-adds.
+    pub fma: u64,
+}
 #[allow(
     clippy::approx_constant,
     clippy::excessive_precision,
@@ -45,12 +60,13 @@ pub struct Ssrms6;
     clippy::too_many_lines,
     clippy::many_single_char_names,
     clippy::similar_names,
+    clippy::type_complexity,
     unused_parens
 )]
 impl Ssrms6 {
     /// Degrees of freedom.
     pub const N: usize = 6;
-    /// Joint names, from the base.
+    /// Joint names, from the base, in the order of `q`.
     pub const JOINTS: [&'static str; 6] = [
         "shoulder_yaw",
         "shoulder_pitch",
@@ -59,46 +75,257 @@ impl Ssrms6 {
         "wrist_yaw",
         "wrist_roll",
     ];
-    /// Emitted operation counts of every candidate algorithm:
-    /// `(function, algorithm, mul, add)`.
-    pub const OP_COUNTS: &'static [(&'static str, &'static str, u64, u64)] = &[
-        ("mass_matrix", "recurrent", 451u64, 366u64),
-        ("mass_matrix", "recurrent-r1", 493u64, 386u64),
-        ("mass_matrix", "kane-direct", 564u64, 356u64),
-        ("mass_matrix", "crba-base", 436u64, 314u64),
-        ("mass_matrix", "spatial", 161u64, 115u64),
-        ("bias", "recurrent", 509u64, 358u64),
-        ("bias", "recurrent-r1", 509u64, 358u64),
-        ("bias", "kane-direct", 580u64, 406u64),
-        ("bias", "crba-base", 509u64, 358u64),
-        ("bias", "spatial", 317u64, 217u64),
-        ("bias_velocity", "recurrent", 509u64, 352u64),
-        ("bias_velocity", "recurrent-r1", 509u64, 352u64),
-        ("bias_velocity", "kane-direct", 580u64, 400u64),
-        ("bias_velocity", "crba-base", 509u64, 352u64),
-        ("bias_velocity", "spatial", 317u64, 211u64),
-        ("inverse_dynamics", "recurrent", 753u64, 637u64),
-        ("inverse_dynamics", "recurrent-r1", 795u64, 657u64),
-        ("inverse_dynamics", "kane-direct", 901u64, 643u64),
-        ("inverse_dynamics", "crba-base", 738u64, 585u64),
-        ("inverse_dynamics", "spatial", 512u64, 352u64),
-        ("forward_dynamics", "recurrent", 803u64, 672u64),
-        ("forward_dynamics", "recurrent-r1", 845u64, 692u64),
-        ("forward_dynamics", "kane-direct", 951u64, 678u64),
-        ("forward_dynamics", "crba-base", 788u64, 620u64),
-        ("forward_dynamics", "spatial", 564u64, 388u64),
+    /// Emitted operation counts of each generated function, in emission order.
+    pub const OP_COUNTS: [OpCount; 5] = [
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            mul: 161u64,
+            add: 115u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 317u64,
+            add: 211u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 334u64,
+            add: 229u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 564u64,
+            add: 388u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 478u64,
+            add: 318u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
     ];
-    /// The algorithm emitted for each function: `(function, algorithm)`.
-    pub const ALGORITHMS: &'static [(&'static str, &'static str)] = &[
-        ("mass_matrix", "spatial"),
-        ("bias", "spatial"),
-        ("bias_velocity", "spatial"),
-        ("inverse_dynamics", "spatial"),
-        ("forward_dynamics", "spatial"),
+    /// Emitted operation counts of every candidate traced (the cheapest is emitted).
+    pub const CANDIDATES: &'static [OpCount] = &[
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            mul: 451u64,
+            add: 366u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            mul: 493u64,
+            add: 386u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            mul: 564u64,
+            add: 356u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            mul: 436u64,
+            add: 314u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            mul: 161u64,
+            add: 115u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            mul: 509u64,
+            add: 352u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            mul: 580u64,
+            add: 400u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 317u64,
+            add: 211u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            mul: 704u64,
+            add: 491u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            mul: 775u64,
+            add: 539u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            mul: 334u64,
+            add: 229u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 756u64,
+            add: 527u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 827u64,
+            add: 575u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 564u64,
+            add: 388u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 670u64,
+            add: 457u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 741u64,
+            add: 505u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 478u64,
+            add: 318u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
     ];
-    /// The generalized inertia matrix `A(q)` (symmetric, both triangles written).
+    /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Algorithm `spatial`: 161 mul, 115 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`: 161 mul, 115 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -219,11 +446,11 @@ impl Ssrms6 {
             [x92, x91, x89, x87, 0.0, 9.336],
         ]
     }
-    /// The generalized forces `b = Q − h` of `A q̈ = b`: joint drives `tau` (and gravity when the model has it) minus the velocity-product terms.
+    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Algorithm `spatial`: 317 mul, 217 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 317 mul, 211 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
-    pub fn bias(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
+    pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * s_q1;
         let x2 = qd[0] * c_q1;
@@ -330,515 +557,229 @@ impl Ssrms6 {
             + (x83 * x93 - x88 * x95);
         let x100 = 243.66 * (x69 * c_q5 - s_q5 * x89 - qd[5] * x86)
             + (x88 * x94 - x82 * x93);
-        let x101 = tau[5] - x96;
-        let x102 = x81
+        let x101 = x81
             * (243.66 * (x81 * (x72 + 0.7026 * x71)) + (x82 * x95 - x83 * x94));
-        let x103 = c_q5 * x99 - s_q5 * x100;
-        let x104 = 12.13 * x70 + (x61 * x76 - x66 * x75 + (x65 * x78 - x64 * x79))
-            + (x81 * x96 + 0.7026 * x103);
-        let x105 = x66 * x74 - x60 * x76 + (x65 * x77 - x63 * x79) - 12.13 * x71
-            + (c_q5 * x97 - s_q5 * x98 + -0.7026 * x102);
-        let x106 = 3.061 * x67 + (x60 * x75 - x61 * x74 + (x64 * x77 - x63 * x78))
+        let x102 = c_q5 * x99 - s_q5 * x100;
+        let x103 = 12.13 * x70 + (x61 * x76 - x66 * x75 + (x65 * x78 - x64 * x79))
+            + (x81 * x96 + 0.7026 * x102);
+        let x104 = x66 * x74 - x60 * x76 + (x65 * x77 - x63 * x79) - 12.13 * x71
+            + (c_q5 * x97 - s_q5 * x98 + -0.7026 * x101);
+        let x105 = 3.061 * x67 + (x60 * x75 - x61 * x74 + (x64 * x77 - x63 * x78))
             + (s_q5 * x97 + c_q5 * x98);
-        let x107 = 105.98 * x72 + (x66 * x78 + x61 * x79) + x102;
-        let x108 = 105.98 * x73 + (x66 * x77 - x60 * x79) + x103;
-        let x109 = tau[4] - x106;
-        let x110 = c_q4 * x107 - s_q4 * x108;
-        let x111 = x59
+        let x106 = 105.98 * x72 + (x66 * x78 + x61 * x79) + x101;
+        let x107 = 105.98 * x73 + (x66 * x77 - x60 * x79) + x102;
+        let x108 = c_q4 * x106 - s_q4 * x107;
+        let x109 = x59
             * (105.98 * x69 - (x61 * x77 + x60 * x78) + (s_q5 * x99 + c_q5 * x100));
-        let x112 = 8.305 * x48 + (x46 * x54 - x41 * x53 + (x45 * x56 - x44 * x57))
-            + (c_q4 * x104 - s_q4 * x105 + -0.5692 * x111);
-        let x113 = x40 * x54 - x41 * x52 + (x45 * x55 - x43 * x57)
-            + (s_q4 * x104 + c_q4 * x105);
-        let x114 = 8.0386 * x49 + (x46 * x52 - x40 * x53 + (x44 * x55 - x43 * x56))
-            + (x59 * x106 + 0.5692 * x110);
-        let x115 = 105.98 * x50 + (x41 * x56 + x46 * x57) + x110;
-        let x116 = 105.98 * x51 + (x40 * x56 - x46 * x55) + x111;
-        let x117 = tau[3] - x113;
-        let x118 = x39
-            * (105.98 * x47 + (x41 * x55 + x40 * x57) + (s_q4 * x107 + c_q4 * x108));
-        let x119 = c_q3 * x116 - s_q3 * x115;
-        let x120 = 9.522 * x28 + (x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36))
-            + (c_q3 * x112 + s_q3 * x114);
-        let x121 = -39.95 * x28 + (x18 * x32 + x17 * x34 + (x21 * x37 - x23 * x35))
-            + (x39 * x113 + -7.11 * x119);
-        let x122 = x22 * x35 - x21 * x36 - (x24 * x32 + x17 * x33) - 1966.28 * x29
-            + (c_q3 * x114 - s_q3 * x112 + 7.11 * x118);
-        let x123 = 279.2 * x30 + (x18 * x36 - x24 * x37) + (c_q3 * x115 + s_q3 * x116);
-        let x124 = 279.2 * x31 + (x17 * x36 - x24 * x35) + x119;
-        let x125 = tau[2] - x121;
-        let x126 = c_q2 * x123 + s_q2 * x124;
-        let x127 = c_q2 * x124 - s_q2 * x123;
-        let x128 = tau[1]
-            - (x2 * x10 + x1 * x12 + (x5 * x13 - x4 * x14) - 49.52 * x6
-                + (x16 * x121 + -7.11 * x127));
-        let x129 = tau[0]
-            - (c_q1
-                * (c_q2 * x122 - s_q2 * x120
-                    + (0.475 * x126
-                        + 7.11 * (x16 * (279.2 * x27 + (x18 * x35 - x17 * x37) + x118)))
-                    - (2103.19 * x7 + (qd[1] * x10 + x1 * x11)))
-                - s_q1
-                    * (qd[1] * x12 - x2 * x11 - 15.41 * x6
-                        + (c_q2 * x120 + s_q2 * x122 + -0.475 * x127))
-                + 0.5692
-                    * (c_q1 * (314.88 * x8 - qd[1] * x14 + x126)
-                        + s_q1 * (qd[1] * x13 - 314.88 * x9 + x127)));
-        [x129, x128, x125, x117, x109, x101]
-    }
-    /// The velocity part of `b` only: `−h(q, q̇)` (no drives, no gravity).
-    ///
-    /// Algorithm `spatial`: 317 mul, 211 add, 0 div, 0 sqrt, 5 sincos (emitted).
-    #[must_use]
-    pub fn bias_velocity(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let x1 = qd[0] * s_q1;
-        let x2 = qd[0] * c_q1;
-        let x3 = -0.5692 * qd[0];
-        let x4 = c_q1 * x3;
-        let x5 = s_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = qd[1] * x1;
-        let x8 = qd[1] * x5;
-        let x9 = qd[1] * x4;
-        let x10 = 49.52 * qd[1] - 15.41 * x1;
-        let x11 = 2094.71 * qd[1] - 49.52 * x1;
-        let x12 = 2103.19 * x2;
-        let x13 = 314.88 * x4;
-        let x14 = 314.88 * x5;
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = c_q2 + (1.0 - c_q2);
-        let x17 = x1 * c_q2 + x2 * s_q2;
-        let x18 = x2 * c_q2 - x1 * s_q2;
-        let x19 = x4 + -0.475 * x2;
-        let x20 = x5 + (7.11 * qd[1] - x1 * 0.475);
-        let x21 = s_q2 * x20 - c_q2 * x19;
-        let x22 = x16 * (x2 * -7.11);
-        let x23 = s_q2 * x19 + c_q2 * x20;
-        let x24 = qd[2] + qd[1] * x16;
-        let x25 = x8 + -0.475 * x7;
-        let x26 = x6 * 0.475 - x9;
-        let x27 = x16 * (x7 * -7.11);
-        let x28 = x7 * s_q2 - x6 * c_q2 - qd[2] * x18;
-        let x29 = x6 * s_q2 + x7 * c_q2 + qd[2] * x17;
-        let x30 = c_q2 * x25 - s_q2 * x26 + qd[2] * x23;
-        let x31 = s_q2 * x25 + c_q2 * x26 + qd[2] * x21;
-        let x32 = -39.95 * x24 - 9.522 * x17;
-        let x33 = 1966.28 * x24 - -39.95 * x17;
-        let x34 = 1966.28 * x18;
-        let x35 = 279.2 * x21;
-        let x36 = 279.2 * x22;
-        let x37 = 279.2 * x23;
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x39 = c_q3 + (1.0 - c_q3);
-        let x40 = x17 * c_q3 + x18 * s_q3;
-        let x41 = x18 * c_q3 - x17 * s_q3;
-        let x42 = x23 + 7.11 * x24;
-        let x43 = x21 * c_q3 + s_q3 * x42;
-        let x44 = x39 * (x22 + x18 * -7.11);
-        let x45 = x21 * s_q3 - c_q3 * x42;
-        let x46 = qd[3] + x24 * x39;
-        let x47 = x39 * (x27 + -7.11 * x29);
-        let x48 = x28 * c_q3 + x29 * s_q3 - qd[3] * x41;
-        let x49 = x28 * s_q3 - x29 * c_q3 - qd[3] * x40;
-        let x50 = x30 * c_q3 - x31 * s_q3 - qd[3] * x45;
-        let x51 = x30 * s_q3 + x31 * c_q3 + qd[3] * x43;
-        let x52 = 8.305 * x40;
-        let x53 = 3.061 * x46;
-        let x54 = 8.0386 * x41;
-        let x55 = 105.98 * x43;
-        let x56 = 105.98 * x44;
-        let x57 = 105.98 * x45;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x59 = c_q4 + (1.0 - c_q4);
-        let x60 = x46 * s_q4 - x40 * c_q4;
-        let x61 = x40 * s_q4 + x46 * c_q4;
-        let x62 = x43 - -0.5692 * x41;
-        let x63 = c_q4 * x62 - x44 * s_q4;
-        let x64 = s_q4 * x62 + x44 * c_q4;
-        let x65 = x59 * (x45 + 0.5692 * x40);
-        let x66 = qd[4] + x41 * x59;
-        let x67 = x49 * x59;
-        let x68 = x50 - -0.5692 * x49;
-        let x69 = x59 * (x51 - 0.5692 * x48);
-        let x70 = x48 * c_q4 + qd[4] * x61;
-        let x71 = x48 * s_q4 + qd[4] * x60;
-        let x72 = c_q4 * x68 + x47 * s_q4 - qd[4] * x64;
-        let x73 = x47 * c_q4 - s_q4 * x68 - qd[4] * x63;
-        let x74 = 12.13 * x60;
-        let x75 = 12.13 * x61;
-        let x76 = 3.061 * x66;
-        let x77 = 105.98 * x63;
-        let x78 = 105.98 * x64;
-        let x79 = 105.98 * x65;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x81 = c_q5 + (1.0 - c_q5);
-        let x82 = x61 * c_q5 + x66 * s_q5;
-        let x83 = x66 * c_q5 - x61 * s_q5;
-        let x84 = x64 + -0.7026 * x60;
-        let x85 = x81 * (x63 - 0.7026 * x61);
-        let x86 = x65 * s_q5 - c_q5 * x84;
-        let x87 = s_q5 * x84 + x65 * c_q5;
-        let x88 = qd[5] + x60 * x81;
-        let x89 = x73 - -0.7026 * x70;
-        let x90 = 9.336 * x88;
-        let x91 = 44.41 * x82;
-        let x92 = 44.41 * x83;
-        let x93 = 243.66 * x85;
-        let x94 = 243.66 * x86;
-        let x95 = 243.66 * x87;
-        let x96 = 9.336 * (x70 * x81)
-            + (x82 * x92 - x83 * x91 + (x86 * x95 - x87 * x94));
-        let x97 = 44.41 * (x67 * s_q5 - x71 * c_q5 + qd[5] * x83)
-            + (x83 * x90 - x88 * x92 + (x87 * x93 - x85 * x95));
-        let x98 = 44.41 * (x71 * s_q5 + x67 * c_q5 - qd[5] * x82)
-            + (x88 * x91 - x82 * x90 + (x85 * x94 - x86 * x93));
-        let x99 = 243.66 * (c_q5 * x89 + x69 * s_q5 + qd[5] * x87)
-            + (x83 * x93 - x88 * x95);
-        let x100 = 243.66 * (x69 * c_q5 - s_q5 * x89 - qd[5] * x86)
-            + (x88 * x94 - x82 * x93);
-        let x101 = -x96;
-        let x102 = x81
-            * (243.66 * (x81 * (x72 + 0.7026 * x71)) + (x82 * x95 - x83 * x94));
-        let x103 = c_q5 * x99 - s_q5 * x100;
-        let x104 = 12.13 * x70 + (x61 * x76 - x66 * x75 + (x65 * x78 - x64 * x79))
-            + (x81 * x96 + 0.7026 * x103);
-        let x105 = x66 * x74 - x60 * x76 + (x65 * x77 - x63 * x79) - 12.13 * x71
-            + (c_q5 * x97 - s_q5 * x98 + -0.7026 * x102);
-        let x106 = 3.061 * x67 + (x60 * x75 - x61 * x74 + (x64 * x77 - x63 * x78))
-            + (s_q5 * x97 + c_q5 * x98);
-        let x107 = 105.98 * x72 + (x66 * x78 + x61 * x79) + x102;
-        let x108 = 105.98 * x73 + (x66 * x77 - x60 * x79) + x103;
-        let x109 = -x106;
-        let x110 = c_q4 * x107 - s_q4 * x108;
-        let x111 = x59
-            * (105.98 * x69 - (x61 * x77 + x60 * x78) + (s_q5 * x99 + c_q5 * x100));
-        let x112 = 8.305 * x48 + (x46 * x54 - x41 * x53 + (x45 * x56 - x44 * x57))
-            + (c_q4 * x104 - s_q4 * x105 + -0.5692 * x111);
-        let x113 = x40 * x54 - x41 * x52 + (x45 * x55 - x43 * x57)
-            + (s_q4 * x104 + c_q4 * x105);
-        let x114 = 8.0386 * x49 + (x46 * x52 - x40 * x53 + (x44 * x55 - x43 * x56))
-            + (x59 * x106 + 0.5692 * x110);
-        let x115 = 105.98 * x50 + (x41 * x56 + x46 * x57) + x110;
-        let x116 = 105.98 * x51 + (x40 * x56 - x46 * x55) + x111;
-        let x117 = -x113;
-        let x118 = x39
-            * (105.98 * x47 + (x41 * x55 + x40 * x57) + (s_q4 * x107 + c_q4 * x108));
-        let x119 = c_q3 * x116 - s_q3 * x115;
-        let x120 = 9.522 * x28 + (x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36))
-            + (c_q3 * x112 + s_q3 * x114);
-        let x121 = -39.95 * x28 + (x18 * x32 + x17 * x34 + (x21 * x37 - x23 * x35))
-            + (x39 * x113 + -7.11 * x119);
-        let x122 = x22 * x35 - x21 * x36 - (x24 * x32 + x17 * x33) - 1966.28 * x29
-            + (c_q3 * x114 - s_q3 * x112 + 7.11 * x118);
-        let x123 = 279.2 * x30 + (x18 * x36 - x24 * x37) + (c_q3 * x115 + s_q3 * x116);
-        let x124 = 279.2 * x31 + (x17 * x36 - x24 * x35) + x119;
-        let x125 = -x121;
-        let x126 = c_q2 * x123 + s_q2 * x124;
-        let x127 = c_q2 * x124 - s_q2 * x123;
-        let x128 = -(x2 * x10 + x1 * x12 + (x5 * x13 - x4 * x14) - 49.52 * x6
-            + (x16 * x121 + -7.11 * x127));
-        let x129 = -(c_q1
-            * (c_q2 * x122 - s_q2 * x120
-                + (0.475 * x126
-                    + 7.11 * (x16 * (279.2 * x27 + (x18 * x35 - x17 * x37) + x118)))
+        let x110 = 8.305 * x48 + (x46 * x54 - x41 * x53 + (x45 * x56 - x44 * x57))
+            + (c_q4 * x103 - s_q4 * x104 + -0.5692 * x109);
+        let x111 = x40 * x54 - x41 * x52 + (x45 * x55 - x43 * x57)
+            + (s_q4 * x103 + c_q4 * x104);
+        let x112 = 8.0386 * x49 + (x46 * x52 - x40 * x53 + (x44 * x55 - x43 * x56))
+            + (x59 * x105 + 0.5692 * x108);
+        let x113 = 105.98 * x50 + (x41 * x56 + x46 * x57) + x108;
+        let x114 = 105.98 * x51 + (x40 * x56 - x46 * x55) + x109;
+        let x115 = x39
+            * (105.98 * x47 + (x41 * x55 + x40 * x57) + (s_q4 * x106 + c_q4 * x107));
+        let x116 = c_q3 * x114 - s_q3 * x113;
+        let x117 = 9.522 * x28 + (x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36))
+            + (c_q3 * x110 + s_q3 * x112);
+        let x118 = -39.95 * x28 + (x18 * x32 + x17 * x34 + (x21 * x37 - x23 * x35))
+            + (x39 * x111 + -7.11 * x116);
+        let x119 = x22 * x35 - x21 * x36 - (x24 * x32 + x17 * x33) - 1966.28 * x29
+            + (c_q3 * x112 - s_q3 * x110 + 7.11 * x115);
+        let x120 = 279.2 * x30 + (x18 * x36 - x24 * x37) + (c_q3 * x113 + s_q3 * x114);
+        let x121 = 279.2 * x31 + (x17 * x36 - x24 * x35) + x116;
+        let x122 = c_q2 * x120 + s_q2 * x121;
+        let x123 = c_q2 * x121 - s_q2 * x120;
+        let x124 = x2 * x10 + x1 * x12 + (x5 * x13 - x4 * x14) - 49.52 * x6
+            + (x16 * x118 + -7.11 * x123);
+        let x125 = c_q1
+            * (c_q2 * x119 - s_q2 * x117
+                + (0.475 * x122
+                    + 7.11 * (x16 * (279.2 * x27 + (x18 * x35 - x17 * x37) + x115)))
                 - (2103.19 * x7 + (qd[1] * x10 + x1 * x11)))
             - s_q1
                 * (qd[1] * x12 - x2 * x11 - 15.41 * x6
-                    + (c_q2 * x120 + s_q2 * x122 + -0.475 * x127))
+                    + (c_q2 * x117 + s_q2 * x119 + -0.475 * x123))
             + 0.5692
-                * (c_q1 * (314.88 * x8 - qd[1] * x14 + x126)
-                    + s_q1 * (qd[1] * x13 - 314.88 * x9 + x127)));
-        [x129, x128, x125, x117, x109, x101]
+                * (c_q1 * (314.88 * x8 - qd[1] * x14 + x122)
+                    + s_q1 * (qd[1] * x13 - 314.88 * x9 + x123));
+        [x125, x124, x118, x111, x105, x96]
     }
-    /// Inverse dynamics: the drives `τ = A q̈ − b(q, q̇, τ = 0)`.
+    /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Algorithm `spatial`: 512 mul, 352 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 334 mul, 229 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
+        let x1 = qd[0] * s_q1;
+        let x2 = qd[0] * c_q1;
+        let x3 = -0.5692 * qd[0];
+        let x4 = c_q1 * x3;
+        let x5 = s_q1 * x3;
+        let x6 = -0.5692 * qdd[0];
+        let x7 = qdd[0] * s_q1 + qd[1] * x2;
+        let x8 = qdd[0] * c_q1 - qd[1] * x1;
+        let x9 = qd[1] * x5 - c_q1 * x6;
+        let x10 = s_q1 * x6 + qd[1] * x4;
+        let x11 = 49.52 * qd[1] - 15.41 * x1;
+        let x12 = 2094.71 * qd[1] - 49.52 * x1;
+        let x13 = 2103.19 * x2;
+        let x14 = 314.88 * x4;
+        let x15 = 314.88 * x5;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
+        let x17 = c_q2 + (1.0 - c_q2);
+        let x18 = x1 * c_q2 + x2 * s_q2;
+        let x19 = x2 * c_q2 - x1 * s_q2;
+        let x20 = x4 + -0.475 * x2;
+        let x21 = x5 + (7.11 * qd[1] - x1 * 0.475);
+        let x22 = s_q2 * x21 - c_q2 * x20;
+        let x23 = x17 * (x2 * -7.11);
+        let x24 = s_q2 * x20 + c_q2 * x21;
+        let x25 = qd[2] + qd[1] * x17;
+        let x26 = x9 - -0.475 * x8;
+        let x27 = x10 + (7.11 * qdd[1] - x7 * 0.475);
+        let x28 = x17 * (x8 * -7.11);
+        let x29 = qdd[2] + qdd[1] * x17;
+        let x30 = x7 * c_q2 + x8 * s_q2 + qd[2] * x19;
+        let x31 = x8 * c_q2 - x7 * s_q2 - qd[2] * x18;
+        let x32 = c_q2 * x26 + s_q2 * x27 + qd[2] * x24;
+        let x33 = s_q2 * x26 - c_q2 * x27 + qd[2] * x22;
+        let x34 = -39.95 * x25 - 9.522 * x18;
+        let x35 = 1966.28 * x25 - -39.95 * x18;
+        let x36 = 1966.28 * x19;
+        let x37 = 279.2 * x22;
+        let x38 = 279.2 * x23;
+        let x39 = 279.2 * x24;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
+        let x41 = c_q3 + (1.0 - c_q3);
+        let x42 = x18 * c_q3 + x19 * s_q3;
+        let x43 = x19 * c_q3 - x18 * s_q3;
+        let x44 = x24 + 7.11 * x25;
+        let x45 = x22 * c_q3 + s_q3 * x44;
+        let x46 = x41 * (x23 + x19 * -7.11);
+        let x47 = x22 * s_q3 - c_q3 * x44;
+        let x48 = qd[3] + x25 * x41;
+        let x49 = x33 - 7.11 * x29;
+        let x50 = x41 * (x28 + -7.11 * x31);
+        let x51 = qdd[3] + x29 * x41;
+        let x52 = x30 * c_q3 + x31 * s_q3 + qd[3] * x43;
+        let x53 = x31 * c_q3 - x30 * s_q3 - qd[3] * x42;
+        let x54 = x32 * c_q3 - s_q3 * x49 - qd[3] * x47;
+        let x55 = x32 * s_q3 + c_q3 * x49 + qd[3] * x45;
+        let x56 = 8.305 * x42;
+        let x57 = 3.061 * x48;
+        let x58 = 8.0386 * x43;
+        let x59 = 105.98 * x45;
+        let x60 = 105.98 * x46;
+        let x61 = 105.98 * x47;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
+        let x63 = c_q4 + (1.0 - c_q4);
+        let x64 = x48 * s_q4 - x42 * c_q4;
+        let x65 = x42 * s_q4 + x48 * c_q4;
+        let x66 = x45 - -0.5692 * x43;
+        let x67 = c_q4 * x66 - x46 * s_q4;
+        let x68 = s_q4 * x66 + x46 * c_q4;
+        let x69 = x63 * (x47 + 0.5692 * x42);
+        let x70 = qd[4] + x43 * x63;
+        let x71 = x54 - -0.5692 * x53;
+        let x72 = x63 * (x55 + 0.5692 * x52);
+        let x73 = qdd[4] + x53 * x63;
+        let x74 = x51 * s_q4 - x52 * c_q4 + qd[4] * x65;
+        let x75 = x52 * s_q4 + x51 * c_q4 - qd[4] * x64;
+        let x76 = c_q4 * x71 - x50 * s_q4 - qd[4] * x68;
+        let x77 = s_q4 * x71 + x50 * c_q4 + qd[4] * x67;
+        let x78 = 12.13 * x64;
+        let x79 = 12.13 * x65;
+        let x80 = 3.061 * x70;
+        let x81 = 105.98 * x67;
+        let x82 = 105.98 * x68;
+        let x83 = 105.98 * x69;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 9.336 * x8;
-        let x10 = 44.41 * c_q5;
-        let x11 = 44.41 * s_q5;
-        let x12 = c_q5 * x10 + s_q5 * x11;
-        let x13 = s_q5 * x10;
-        let x14 = c_q5 * x11;
-        let x15 = x13 - x14;
-        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
-        let x17 = 12.13 + (x12 + 120.2819695416);
-        let x18 = 3.061 + x12;
-        let x19 = x6 * -171.195516;
-        let x20 = c_q4 * x16;
-        let x21 = s_q4 * x17;
-        let x22 = s_q4 * x15;
-        let x23 = c_q4 * x15;
-        let x24 = x6 * (x14 - x13);
-        let x25 = x6 * x18;
-        let x26 = s_q4 * x20 - c_q4 * x21;
-        let x27 = x6 * x22;
-        let x28 = s_q4 * x24;
-        let x29 = c_q4 * x24 + x19 * 0.5692;
-        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
-        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
-        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
-        let x33 = s_q3 * x19;
-        let x34 = x4 * -199.01508800000002;
-        let x35 = c_q3 * x19;
-        let x36 = x33 + 3239.4582;
-        let x37 = c_q3 * x30 - s_q3 * x28;
-        let x38 = c_q3 * x26 + s_q3 * x29;
-        let x39 = s_q3 * x32 - c_q3 * x27;
-        let x40 = x4 * x31;
-        let x41 = s_q3 * x30 + c_q3 * x28;
-        let x42 = c_q3 * x29 - s_q3 * x26;
-        let x43 = s_q3 * x27 + c_q3 * x32;
-        let x44 = x4 * x42;
-        let x45 = x33 * -7.11;
-        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
-        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
-        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
-        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
-        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
-        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
-        let x52 = s_q2 * x35;
-        let x53 = c_q2 * x36 + x52;
-        let x54 = x2 * x34;
-        let x55 = c_q2 * x35;
-        let x56 = x55 - s_q2 * x36;
-        let x57 = x53 + 5224.5702;
-        let x58 = x54 + -349.0395;
-        let x59 = c_q2 * x48 + s_q2 * x46;
-        let x60 = c_q2 * x49 + s_q2 * x44;
-        let x61 = c_q2 * x47 + s_q2 * x51;
-        let x62 = x2 * x50;
-        let x63 = c_q2 * x46 - s_q2 * x48;
-        let x64 = c_q2 * x44 - s_q2 * x49;
-        let x65 = c_q2 * x51 - s_q2 * x47;
-        let x66 = -0.475 * x53;
-        let x67 = -7.11 * x53;
-        let x68 = x56 * 0.475;
-        let x69 = (c_q1 + (1.0 - c_q1)) * x58;
-        let x70 = c_q1 * x56;
-        let x71 = c_q1 * (x2 * x64 + x68)
-            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
-            + 0.5692 * (x70 - s_q1 * x57);
-        let x72 = x62 - x67;
-        let x73 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x70 - s_q1 * x53);
-        let x74 = x40 - x45;
-        let x75 = x55 - s_q2 * x33;
-        let x76 = x52 + c_q2 * x33;
-        let x77 = x2 * x74 - -7.11 * x76;
-        let x78 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x75)
-            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x76)
-            + 0.5692 * (c_q1 * x75 - s_q1 * x76);
-        let x79 = s_q3 * x25 - c_q3 * x22;
-        let x80 = x4 * x23;
-        let x81 = s_q3 * x22 + c_q3 * x25;
-        let x82 = x2 * x80;
-        let x83 = c_q1 * (c_q2 * x81 - s_q2 * x79) - s_q1 * (c_q2 * x79 + s_q2 * x81);
-        let x84 = c_q4 * x9;
-        let x85 = s_q4 * x9;
-        let x86 = c_q3 * x84;
-        let x87 = x4 * x85;
-        let x88 = s_q3 * x84;
-        let x89 = x2 * x87;
-        let x90 = s_q1 * (c_q2 * x86 - s_q2 * x88) + c_q1 * (s_q2 * x86 + c_q2 * x88);
-        let x91 = qd[0] * s_q1;
-        let x92 = qd[0] * c_q1;
-        let x93 = -0.5692 * qd[0];
-        let x94 = c_q1 * x93;
-        let x95 = s_q1 * x93;
-        let x96 = qd[1] * x92;
-        let x97 = qd[1] * x91;
-        let x98 = qd[1] * x95;
-        let x99 = qd[1] * x94;
-        let x100 = 49.52 * qd[1] - 15.41 * x91;
-        let x101 = 2094.71 * qd[1] - 49.52 * x91;
-        let x102 = 2103.19 * x92;
-        let x103 = 314.88 * x94;
-        let x104 = 314.88 * x95;
-        let x105 = c_q2 * x91 + s_q2 * x92;
-        let x106 = c_q2 * x92 - s_q2 * x91;
-        let x107 = x94 + -0.475 * x92;
-        let x108 = x95 + (7.11 * qd[1] - 0.475 * x91);
-        let x109 = s_q2 * x108 - c_q2 * x107;
-        let x110 = x2 * (-7.11 * x92);
-        let x111 = s_q2 * x107 + c_q2 * x108;
-        let x112 = qd[2] + qd[1] * x2;
-        let x113 = x98 + -0.475 * x97;
-        let x114 = 0.475 * x96 - x99;
-        let x115 = x2 * (-7.11 * x97);
-        let x116 = s_q2 * x97 - c_q2 * x96 - qd[2] * x106;
-        let x117 = s_q2 * x96 + c_q2 * x97 + qd[2] * x105;
-        let x118 = c_q2 * x113 - s_q2 * x114 + qd[2] * x111;
-        let x119 = s_q2 * x113 + c_q2 * x114 + qd[2] * x109;
-        let x120 = -39.95 * x112 - 9.522 * x105;
-        let x121 = 1966.28 * x112 - -39.95 * x105;
-        let x122 = 1966.28 * x106;
-        let x123 = 279.2 * x109;
-        let x124 = 279.2 * x110;
-        let x125 = 279.2 * x111;
-        let x126 = c_q3 * x105 + s_q3 * x106;
-        let x127 = c_q3 * x106 - s_q3 * x105;
-        let x128 = x111 + 7.11 * x112;
-        let x129 = c_q3 * x109 + s_q3 * x128;
-        let x130 = x4 * (x110 + -7.11 * x106);
-        let x131 = s_q3 * x109 - c_q3 * x128;
-        let x132 = qd[3] + x4 * x112;
-        let x133 = x4 * (x115 + -7.11 * x117);
-        let x134 = c_q3 * x116 + s_q3 * x117 - qd[3] * x127;
-        let x135 = s_q3 * x116 - c_q3 * x117 - qd[3] * x126;
-        let x136 = c_q3 * x118 - s_q3 * x119 - qd[3] * x131;
-        let x137 = s_q3 * x118 + c_q3 * x119 + qd[3] * x129;
-        let x138 = 8.305 * x126;
-        let x139 = 3.061 * x132;
-        let x140 = 8.0386 * x127;
-        let x141 = 105.98 * x129;
-        let x142 = 105.98 * x130;
-        let x143 = 105.98 * x131;
-        let x144 = s_q4 * x132 - c_q4 * x126;
-        let x145 = s_q4 * x126 + c_q4 * x132;
-        let x146 = x129 - -0.5692 * x127;
-        let x147 = c_q4 * x146 - s_q4 * x130;
-        let x148 = s_q4 * x146 + c_q4 * x130;
-        let x149 = x6 * (x131 + 0.5692 * x126);
-        let x150 = qd[4] + x6 * x127;
-        let x151 = x6 * x135;
-        let x152 = x136 - -0.5692 * x135;
-        let x153 = x6 * (x137 - 0.5692 * x134);
-        let x154 = c_q4 * x134 + qd[4] * x145;
-        let x155 = s_q4 * x134 + qd[4] * x144;
-        let x156 = c_q4 * x152 + s_q4 * x133 - qd[4] * x148;
-        let x157 = c_q4 * x133 - s_q4 * x152 - qd[4] * x147;
-        let x158 = 12.13 * x144;
-        let x159 = 12.13 * x145;
-        let x160 = 3.061 * x150;
-        let x161 = 105.98 * x147;
-        let x162 = 105.98 * x148;
-        let x163 = 105.98 * x149;
-        let x164 = c_q5 * x145 + s_q5 * x150;
-        let x165 = c_q5 * x150 - s_q5 * x145;
-        let x166 = x148 + -0.7026 * x144;
-        let x167 = x8 * (x147 - 0.7026 * x145);
-        let x168 = s_q5 * x149 - c_q5 * x166;
-        let x169 = s_q5 * x166 + c_q5 * x149;
-        let x170 = qd[5] + x8 * x144;
-        let x171 = x157 - -0.7026 * x154;
-        let x172 = 9.336 * x170;
-        let x173 = 44.41 * x164;
-        let x174 = 44.41 * x165;
-        let x175 = 243.66 * x167;
-        let x176 = 243.66 * x168;
-        let x177 = 243.66 * x169;
-        let x178 = 9.336 * (x8 * x154)
-            + (x164 * x174 - x165 * x173 + (x168 * x177 - x169 * x176));
-        let x179 = 44.41 * (s_q5 * x151 - c_q5 * x155 + qd[5] * x165)
-            + (x165 * x172 - x170 * x174 + (x169 * x175 - x167 * x177));
-        let x180 = 44.41 * (s_q5 * x155 + c_q5 * x151 - qd[5] * x164)
-            + (x170 * x173 - x164 * x172 + (x167 * x176 - x168 * x175));
-        let x181 = 243.66 * (c_q5 * x171 + s_q5 * x153 + qd[5] * x169)
-            + (x165 * x175 - x170 * x177);
-        let x182 = 243.66 * (c_q5 * x153 - s_q5 * x171 - qd[5] * x168)
-            + (x170 * x176 - x164 * x175);
-        let x183 = x8
-            * (243.66 * (x8 * (x156 + 0.7026 * x155)) + (x164 * x177 - x165 * x176));
-        let x184 = c_q5 * x181 - s_q5 * x182;
-        let x185 = 12.13 * x154
-            + (x145 * x160 - x150 * x159 + (x149 * x162 - x148 * x163))
-            + (x8 * x178 + 0.7026 * x184);
-        let x186 = x150 * x158 - x144 * x160 + (x149 * x161 - x147 * x163) - 12.13 * x155
-            + (c_q5 * x179 - s_q5 * x180 + -0.7026 * x183);
-        let x187 = 3.061 * x151
-            + (x144 * x159 - x145 * x158 + (x148 * x161 - x147 * x162))
-            + (s_q5 * x179 + c_q5 * x180);
-        let x188 = 105.98 * x156 + (x150 * x162 + x145 * x163) + x183;
-        let x189 = 105.98 * x157 + (x150 * x161 - x144 * x163) + x184;
-        let x190 = c_q4 * x188 - s_q4 * x189;
-        let x191 = x6
-            * (105.98 * x153 - (x145 * x161 + x144 * x162)
-                + (s_q5 * x181 + c_q5 * x182));
-        let x192 = 8.305 * x134
-            + (x132 * x140 - x127 * x139 + (x131 * x142 - x130 * x143))
-            + (c_q4 * x185 - s_q4 * x186 + -0.5692 * x191);
-        let x193 = x126 * x140 - x127 * x138 + (x131 * x141 - x129 * x143)
-            + (s_q4 * x185 + c_q4 * x186);
-        let x194 = 8.0386 * x135
-            + (x132 * x138 - x126 * x139 + (x130 * x141 - x129 * x142))
-            + (x6 * x187 + 0.5692 * x190);
-        let x195 = 105.98 * x136 + (x127 * x142 + x132 * x143) + x190;
-        let x196 = 105.98 * x137 + (x126 * x142 - x132 * x141) + x191;
-        let x197 = x4
-            * (105.98 * x133 + (x127 * x141 + x126 * x143)
-                + (s_q4 * x188 + c_q4 * x189));
-        let x198 = c_q3 * x196 - s_q3 * x195;
-        let x199 = 9.522 * x116
-            + (x112 * x122 - x106 * x121 + (x110 * x125 - x111 * x124))
-            + (c_q3 * x192 + s_q3 * x194);
-        let x200 = -39.95 * x116
-            + (x106 * x120 + x105 * x122 + (x109 * x125 - x111 * x123))
-            + (x4 * x193 + -7.11 * x198);
-        let x201 = x110 * x123 - x109 * x124 - (x112 * x120 + x105 * x121)
-            - 1966.28 * x117 + (c_q3 * x194 - s_q3 * x192 + 7.11 * x197);
-        let x202 = 279.2 * x118 + (x106 * x124 - x112 * x125)
-            + (c_q3 * x195 + s_q3 * x196);
-        let x203 = 279.2 * x119 + (x105 * x124 - x112 * x123) + x198;
-        let x204 = c_q2 * x202 + s_q2 * x203;
-        let x205 = c_q2 * x203 - s_q2 * x202;
-        let x206 = c_q1
-            * (c_q2 * x201 - s_q2 * x199
-                + (0.475 * x204
-                    + 7.11 * (x2 * (279.2 * x115 + (x106 * x123 - x105 * x125) + x197)))
-                - (2103.19 * x97 + (qd[1] * x100 + x91 * x101)))
-            - s_q1
-                * (qd[1] * x102 - x92 * x101 - 15.41 * x96
-                    + (c_q2 * x199 + s_q2 * x201 + -0.475 * x205))
-            + 0.5692
-                * (c_q1 * (314.88 * x98 - qd[1] * x104 + x204)
-                    + s_q1 * (qd[1] * x103 - 314.88 * x99 + x205))
-            + (qdd[0]
-                * (8.446
-                    + (c_q1
-                        * (c_q1
-                            * (2103.19
-                                + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
-                                    - (-7.11 * x57 - -0.475 * x58)))
-                            - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
-                        - s_q1
-                            * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
-                                - s_q1
-                                    * (15.41
-                                        + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
-                        - 0.5692 * x69 + -0.5692 * (x69 + -597.4892399999999)))
-                + qdd[1] * x71 + qdd[2] * x73 + qdd[3] * x78 + qdd[4] * x83
-                - qdd[5] * x90);
-        let x207 = x92 * x100 + x91 * x102 + (x95 * x103 - x94 * x104) - 49.52 * x96
-            + (x2 * x200 + -7.11 * x205)
-            + (qdd[0] * x71 + qdd[1] * (2094.71 + (x2 * x62 - x67 + 7.11 * x57))
-                + qdd[2] * x72 + qdd[3] * x77 + qdd[4] * x82 + qdd[5] * x89);
-        let x208 = x200
-            + (qdd[0] * x73 + qdd[1] * x72 + qdd[2] * x50 + qdd[3] * x74 + qdd[4] * x80
-                + qdd[5] * x87);
-        let x209 = x193
-            + (qdd[0] * x78 + qdd[1] * x77 + qdd[2] * x74 + qdd[3] * x31 + qdd[4] * x23
-                + qdd[5] * x85);
-        let x210 = x187
-            + (qdd[0] * x83 + qdd[1] * x82 + qdd[2] * x80 + qdd[3] * x23 + qdd[4] * x18);
-        let x211 = x178
-            + (qdd[1] * x89 - qdd[0] * x90 + qdd[2] * x87 + qdd[3] * x85
-                + 9.336 * qdd[5]);
-        [x206, x207, x208, x209, x210, x211]
+        let x85 = c_q5 + (1.0 - c_q5);
+        let x86 = x65 * c_q5 + x70 * s_q5;
+        let x87 = x70 * c_q5 - x65 * s_q5;
+        let x88 = x68 + -0.7026 * x64;
+        let x89 = x85 * (x67 - 0.7026 * x65);
+        let x90 = x69 * s_q5 - c_q5 * x88;
+        let x91 = s_q5 * x88 + x69 * c_q5;
+        let x92 = qd[5] + x64 * x85;
+        let x93 = x77 + -0.7026 * x74;
+        let x94 = 9.336 * x92;
+        let x95 = 44.41 * x86;
+        let x96 = 44.41 * x87;
+        let x97 = 243.66 * x89;
+        let x98 = 243.66 * x90;
+        let x99 = 243.66 * x91;
+        let x100 = 9.336 * (qdd[5] + x74 * x85)
+            + (x86 * x96 - x87 * x95 + (x90 * x99 - x91 * x98));
+        let x101 = 44.41 * (x75 * c_q5 + x73 * s_q5 + qd[5] * x87)
+            + (x87 * x94 - x92 * x96 + (x91 * x97 - x89 * x99));
+        let x102 = 44.41 * (x73 * c_q5 - x75 * s_q5 - qd[5] * x86)
+            + (x92 * x95 - x86 * x94 + (x89 * x98 - x90 * x97));
+        let x103 = 243.66 * (x72 * s_q5 - c_q5 * x93 + qd[5] * x91)
+            + (x87 * x97 - x92 * x99);
+        let x104 = 243.66 * (s_q5 * x93 + x72 * c_q5 - qd[5] * x90)
+            + (x92 * x98 - x86 * x97);
+        let x105 = x85
+            * (243.66 * (x85 * (x76 - 0.7026 * x75)) + (x86 * x99 - x87 * x98));
+        let x106 = c_q5 * x103 - s_q5 * x104;
+        let x107 = 12.13 * x74 + (x65 * x80 - x70 * x79 + (x69 * x82 - x68 * x83))
+            + (x85 * x100 + 0.7026 * x106);
+        let x108 = 12.13 * x75 + (x70 * x78 - x64 * x80 + (x69 * x81 - x67 * x83))
+            + (c_q5 * x101 - s_q5 * x102 + -0.7026 * x105);
+        let x109 = 3.061 * x73 + (x64 * x79 - x65 * x78 + (x68 * x81 - x67 * x82))
+            + (s_q5 * x101 + c_q5 * x102);
+        let x110 = 105.98 * x76 + (x70 * x82 + x65 * x83) + x105;
+        let x111 = x70 * x81 - x64 * x83 - 105.98 * x77 + x106;
+        let x112 = c_q4 * x110 - s_q4 * x111;
+        let x113 = x63
+            * (105.98 * x72 - (x65 * x81 + x64 * x82) + (s_q5 * x103 + c_q5 * x104));
+        let x114 = x48 * x58 - x43 * x57 + (x47 * x60 - x46 * x61) - 8.305 * x52
+            + (c_q4 * x107 - s_q4 * x108 + -0.5692 * x113);
+        let x115 = 3.061 * x51 + (x42 * x58 - x43 * x56 + (x47 * x59 - x45 * x61))
+            + (s_q4 * x107 + c_q4 * x108);
+        let x116 = 8.0386 * x53 + (x48 * x56 - x42 * x57 + (x46 * x59 - x45 * x60))
+            + (x63 * x109 + 0.5692 * x112);
+        let x117 = 105.98 * x54 + (x43 * x60 + x48 * x61) + x112;
+        let x118 = 105.98 * x55 + (x42 * x60 - x48 * x59) + x113;
+        let x119 = x41
+            * (x43 * x59 + x42 * x61 - 105.98 * x50 + (s_q4 * x110 + c_q4 * x111));
+        let x120 = c_q3 * x118 - s_q3 * x117;
+        let x121 = -39.95 * x29 - 9.522 * x30
+            + (x25 * x36 - x19 * x35 + (x23 * x39 - x24 * x38))
+            + (c_q3 * x114 + s_q3 * x116);
+        let x122 = 1966.28 * x29 - -39.95 * x30
+            + (x19 * x34 + x18 * x36 + (x22 * x39 - x24 * x37))
+            + (x41 * x115 + -7.11 * x120);
+        let x123 = 1966.28 * x31 + (x23 * x37 - x22 * x38 - (x25 * x34 + x18 * x35))
+            + (c_q3 * x116 - s_q3 * x114 + 7.11 * x119);
+        let x124 = 279.2 * x32 + (x19 * x38 - x25 * x39) + (c_q3 * x117 + s_q3 * x118);
+        let x125 = 279.2 * x33 + (x18 * x38 - x25 * x37) + x120;
+        let x126 = c_q2 * x124 + s_q2 * x125;
+        let x127 = c_q2 * x125 - s_q2 * x124;
+        let x128 = 2094.71 * qdd[1] - 49.52 * x7
+            + (x2 * x11 + x1 * x13 + (x5 * x14 - x4 * x15))
+            + (x17 * x122 + -7.11 * x127);
+        let x129 = 8.446 * qdd[0]
+            + (c_q1
+                * (2103.19 * x8 - (qd[1] * x11 + x1 * x12)
+                    + (c_q2 * x123 - s_q2 * x121
+                        + (0.475 * x126
+                            + 7.11
+                                * (x17 * (x19 * x37 - x18 * x39 - 279.2 * x28 + x119)))))
+                - s_q1
+                    * (49.52 * qdd[1] - 15.41 * x7 + (qd[1] * x13 - x2 * x12)
+                        + (c_q2 * x121 + s_q2 * x123 + -0.475 * x127))
+                + 0.5692
+                    * (c_q1 * (314.88 * x9 - qd[1] * x15 + x126)
+                        + s_q1 * (qd[1] * x14 - 314.88 * x10 + x127)));
+        [x129, x128, x122, x115, x109, x100]
     }
-    /// Forward dynamics `q̈ = A⁻¹ b(q, q̇, τ)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Algorithm `spatial`: 564 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1148,5 +1089,288 @@ impl Ssrms6 {
         let x243 = x202 * x203 - x204 * x242 - x205 * x241 - x206 * x240 - x207 * x239
             + x208 * x238;
         [x243, x242, x241, x240, x239, x238]
+    }
+    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 478 mul, 318 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects(
+        q: &[f64; 6],
+        qd: &[f64; 6],
+    ) -> ([[f64; 6]; 6], [f64; 6]) {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let x9 = 9.336 * x8;
+        let x10 = 44.41 * c_q5;
+        let x11 = 44.41 * s_q5;
+        let x12 = c_q5 * x10 + s_q5 * x11;
+        let x13 = s_q5 * x10;
+        let x14 = c_q5 * x11;
+        let x15 = x13 - x14;
+        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
+        let x17 = 12.13 + (x12 + 120.2819695416);
+        let x18 = 3.061 + x12;
+        let x19 = x6 * -171.195516;
+        let x20 = c_q4 * x16;
+        let x21 = s_q4 * x17;
+        let x22 = s_q4 * x15;
+        let x23 = c_q4 * x15;
+        let x24 = x6 * (x14 - x13);
+        let x25 = x6 * x18;
+        let x26 = s_q4 * x20 - c_q4 * x21;
+        let x27 = x6 * x22;
+        let x28 = s_q4 * x24;
+        let x29 = c_q4 * x24 + x19 * 0.5692;
+        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
+        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
+        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
+        let x33 = s_q3 * x19;
+        let x34 = x4 * -199.01508800000002;
+        let x35 = c_q3 * x19;
+        let x36 = x33 + 3239.4582;
+        let x37 = c_q3 * x30 - s_q3 * x28;
+        let x38 = c_q3 * x26 + s_q3 * x29;
+        let x39 = s_q3 * x32 - c_q3 * x27;
+        let x40 = x4 * x31;
+        let x41 = s_q3 * x30 + c_q3 * x28;
+        let x42 = c_q3 * x29 - s_q3 * x26;
+        let x43 = s_q3 * x27 + c_q3 * x32;
+        let x44 = x4 * x42;
+        let x45 = x33 * -7.11;
+        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
+        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
+        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
+        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
+        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
+        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
+        let x52 = s_q2 * x35;
+        let x53 = c_q2 * x36 + x52;
+        let x54 = x2 * x34;
+        let x55 = c_q2 * x35;
+        let x56 = x55 - s_q2 * x36;
+        let x57 = x53 + 5224.5702;
+        let x58 = x54 + -349.0395;
+        let x59 = c_q2 * x48 + s_q2 * x46;
+        let x60 = c_q2 * x49 + s_q2 * x44;
+        let x61 = c_q2 * x47 + s_q2 * x51;
+        let x62 = x2 * x50;
+        let x63 = c_q2 * x46 - s_q2 * x48;
+        let x64 = c_q2 * x44 - s_q2 * x49;
+        let x65 = c_q2 * x51 - s_q2 * x47;
+        let x66 = -0.475 * x53;
+        let x67 = -7.11 * x53;
+        let x68 = x56 * 0.475;
+        let x69 = 2094.71 + (x2 * x62 - x67 + 7.11 * x57);
+        let x70 = (c_q1 + (1.0 - c_q1)) * x58;
+        let x71 = c_q1 * x56;
+        let x72 = 8.446
+            + (c_q1
+                * (c_q1
+                    * (2103.19
+                        + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
+                            - (-7.11 * x57 - -0.475 * x58)))
+                    - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
+                - s_q1
+                    * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
+                        - s_q1
+                            * (15.41
+                                + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
+                - 0.5692 * x70 + -0.5692 * (x70 + -597.4892399999999));
+        let x73 = c_q1 * (x2 * x64 + x68)
+            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
+            + 0.5692 * (x71 - s_q1 * x57);
+        let x74 = x62 - x67;
+        let x75 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x71 - s_q1 * x53);
+        let x76 = x40 - x45;
+        let x77 = x55 - s_q2 * x33;
+        let x78 = x52 + c_q2 * x33;
+        let x79 = x2 * x76 - -7.11 * x78;
+        let x80 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x77)
+            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x78)
+            + 0.5692 * (c_q1 * x77 - s_q1 * x78);
+        let x81 = s_q3 * x25 - c_q3 * x22;
+        let x82 = x4 * x23;
+        let x83 = s_q3 * x22 + c_q3 * x25;
+        let x84 = x2 * x82;
+        let x85 = c_q1 * (c_q2 * x83 - s_q2 * x81) - s_q1 * (c_q2 * x81 + s_q2 * x83);
+        let x86 = c_q4 * x9;
+        let x87 = s_q4 * x9;
+        let x88 = c_q3 * x86;
+        let x89 = x4 * x87;
+        let x90 = s_q3 * x86;
+        let x91 = x2 * x89;
+        let x92 = -(s_q1 * (c_q2 * x88 - s_q2 * x90) + c_q1 * (s_q2 * x88 + c_q2 * x90));
+        let x93 = qd[0] * s_q1;
+        let x94 = qd[0] * c_q1;
+        let x95 = -0.5692 * qd[0];
+        let x96 = c_q1 * x95;
+        let x97 = s_q1 * x95;
+        let x98 = qd[1] * x94;
+        let x99 = qd[1] * x93;
+        let x100 = qd[1] * x97;
+        let x101 = qd[1] * x96;
+        let x102 = 49.52 * qd[1] - 15.41 * x93;
+        let x103 = 2094.71 * qd[1] - 49.52 * x93;
+        let x104 = 2103.19 * x94;
+        let x105 = 314.88 * x96;
+        let x106 = 314.88 * x97;
+        let x107 = c_q2 * x93 + s_q2 * x94;
+        let x108 = c_q2 * x94 - s_q2 * x93;
+        let x109 = x96 + -0.475 * x94;
+        let x110 = x97 + (7.11 * qd[1] - 0.475 * x93);
+        let x111 = s_q2 * x110 - c_q2 * x109;
+        let x112 = x2 * (-7.11 * x94);
+        let x113 = s_q2 * x109 + c_q2 * x110;
+        let x114 = qd[2] + qd[1] * x2;
+        let x115 = x100 + -0.475 * x99;
+        let x116 = 0.475 * x98 - x101;
+        let x117 = x2 * (-7.11 * x99);
+        let x118 = s_q2 * x99 - c_q2 * x98 - qd[2] * x108;
+        let x119 = s_q2 * x98 + c_q2 * x99 + qd[2] * x107;
+        let x120 = c_q2 * x115 - s_q2 * x116 + qd[2] * x113;
+        let x121 = s_q2 * x115 + c_q2 * x116 + qd[2] * x111;
+        let x122 = -39.95 * x114 - 9.522 * x107;
+        let x123 = 1966.28 * x114 - -39.95 * x107;
+        let x124 = 1966.28 * x108;
+        let x125 = 279.2 * x111;
+        let x126 = 279.2 * x112;
+        let x127 = 279.2 * x113;
+        let x128 = c_q3 * x107 + s_q3 * x108;
+        let x129 = c_q3 * x108 - s_q3 * x107;
+        let x130 = x113 + 7.11 * x114;
+        let x131 = c_q3 * x111 + s_q3 * x130;
+        let x132 = x4 * (x112 + -7.11 * x108);
+        let x133 = s_q3 * x111 - c_q3 * x130;
+        let x134 = qd[3] + x4 * x114;
+        let x135 = x4 * (x117 + -7.11 * x119);
+        let x136 = c_q3 * x118 + s_q3 * x119 - qd[3] * x129;
+        let x137 = s_q3 * x118 - c_q3 * x119 - qd[3] * x128;
+        let x138 = c_q3 * x120 - s_q3 * x121 - qd[3] * x133;
+        let x139 = s_q3 * x120 + c_q3 * x121 + qd[3] * x131;
+        let x140 = 8.305 * x128;
+        let x141 = 3.061 * x134;
+        let x142 = 8.0386 * x129;
+        let x143 = 105.98 * x131;
+        let x144 = 105.98 * x132;
+        let x145 = 105.98 * x133;
+        let x146 = s_q4 * x134 - c_q4 * x128;
+        let x147 = s_q4 * x128 + c_q4 * x134;
+        let x148 = x131 - -0.5692 * x129;
+        let x149 = c_q4 * x148 - s_q4 * x132;
+        let x150 = s_q4 * x148 + c_q4 * x132;
+        let x151 = x6 * (x133 + 0.5692 * x128);
+        let x152 = qd[4] + x6 * x129;
+        let x153 = x6 * x137;
+        let x154 = x138 - -0.5692 * x137;
+        let x155 = x6 * (x139 - 0.5692 * x136);
+        let x156 = c_q4 * x136 + qd[4] * x147;
+        let x157 = s_q4 * x136 + qd[4] * x146;
+        let x158 = c_q4 * x154 + s_q4 * x135 - qd[4] * x150;
+        let x159 = c_q4 * x135 - s_q4 * x154 - qd[4] * x149;
+        let x160 = 12.13 * x146;
+        let x161 = 12.13 * x147;
+        let x162 = 3.061 * x152;
+        let x163 = 105.98 * x149;
+        let x164 = 105.98 * x150;
+        let x165 = 105.98 * x151;
+        let x166 = c_q5 * x147 + s_q5 * x152;
+        let x167 = c_q5 * x152 - s_q5 * x147;
+        let x168 = x150 + -0.7026 * x146;
+        let x169 = x8 * (x149 - 0.7026 * x147);
+        let x170 = s_q5 * x151 - c_q5 * x168;
+        let x171 = s_q5 * x168 + c_q5 * x151;
+        let x172 = qd[5] + x8 * x146;
+        let x173 = x159 - -0.7026 * x156;
+        let x174 = 9.336 * x172;
+        let x175 = 44.41 * x166;
+        let x176 = 44.41 * x167;
+        let x177 = 243.66 * x169;
+        let x178 = 243.66 * x170;
+        let x179 = 243.66 * x171;
+        let x180 = 9.336 * (x8 * x156)
+            + (x166 * x176 - x167 * x175 + (x170 * x179 - x171 * x178));
+        let x181 = 44.41 * (s_q5 * x153 - c_q5 * x157 + qd[5] * x167)
+            + (x167 * x174 - x172 * x176 + (x171 * x177 - x169 * x179));
+        let x182 = 44.41 * (s_q5 * x157 + c_q5 * x153 - qd[5] * x166)
+            + (x172 * x175 - x166 * x174 + (x169 * x178 - x170 * x177));
+        let x183 = 243.66 * (c_q5 * x173 + s_q5 * x155 + qd[5] * x171)
+            + (x167 * x177 - x172 * x179);
+        let x184 = 243.66 * (c_q5 * x155 - s_q5 * x173 - qd[5] * x170)
+            + (x172 * x178 - x166 * x177);
+        let x185 = x8
+            * (243.66 * (x8 * (x158 + 0.7026 * x157)) + (x166 * x179 - x167 * x178));
+        let x186 = c_q5 * x183 - s_q5 * x184;
+        let x187 = 12.13 * x156
+            + (x147 * x162 - x152 * x161 + (x151 * x164 - x150 * x165))
+            + (x8 * x180 + 0.7026 * x186);
+        let x188 = x152 * x160 - x146 * x162 + (x151 * x163 - x149 * x165) - 12.13 * x157
+            + (c_q5 * x181 - s_q5 * x182 + -0.7026 * x185);
+        let x189 = 3.061 * x153
+            + (x146 * x161 - x147 * x160 + (x150 * x163 - x149 * x164))
+            + (s_q5 * x181 + c_q5 * x182);
+        let x190 = 105.98 * x158 + (x152 * x164 + x147 * x165) + x185;
+        let x191 = 105.98 * x159 + (x152 * x163 - x146 * x165) + x186;
+        let x192 = c_q4 * x190 - s_q4 * x191;
+        let x193 = x6
+            * (105.98 * x155 - (x147 * x163 + x146 * x164)
+                + (s_q5 * x183 + c_q5 * x184));
+        let x194 = 8.305 * x136
+            + (x134 * x142 - x129 * x141 + (x133 * x144 - x132 * x145))
+            + (c_q4 * x187 - s_q4 * x188 + -0.5692 * x193);
+        let x195 = x128 * x142 - x129 * x140 + (x133 * x143 - x131 * x145)
+            + (s_q4 * x187 + c_q4 * x188);
+        let x196 = 8.0386 * x137
+            + (x134 * x140 - x128 * x141 + (x132 * x143 - x131 * x144))
+            + (x6 * x189 + 0.5692 * x192);
+        let x197 = 105.98 * x138 + (x129 * x144 + x134 * x145) + x192;
+        let x198 = 105.98 * x139 + (x128 * x144 - x134 * x143) + x193;
+        let x199 = x4
+            * (105.98 * x135 + (x129 * x143 + x128 * x145)
+                + (s_q4 * x190 + c_q4 * x191));
+        let x200 = c_q3 * x198 - s_q3 * x197;
+        let x201 = 9.522 * x118
+            + (x114 * x124 - x108 * x123 + (x112 * x127 - x113 * x126))
+            + (c_q3 * x194 + s_q3 * x196);
+        let x202 = -39.95 * x118
+            + (x108 * x122 + x107 * x124 + (x111 * x127 - x113 * x125))
+            + (x4 * x195 + -7.11 * x200);
+        let x203 = x112 * x125 - x111 * x126 - (x114 * x122 + x107 * x123)
+            - 1966.28 * x119 + (c_q3 * x196 - s_q3 * x194 + 7.11 * x199);
+        let x204 = 279.2 * x120 + (x108 * x126 - x114 * x127)
+            + (c_q3 * x197 + s_q3 * x198);
+        let x205 = 279.2 * x121 + (x107 * x126 - x114 * x125) + x200;
+        let x206 = c_q2 * x204 + s_q2 * x205;
+        let x207 = c_q2 * x205 - s_q2 * x204;
+        let x208 = x94 * x102 + x93 * x104 + (x97 * x105 - x96 * x106) - 49.52 * x98
+            + (x2 * x202 + -7.11 * x207);
+        let x209 = c_q1
+            * (c_q2 * x203 - s_q2 * x201
+                + (0.475 * x206
+                    + 7.11 * (x2 * (279.2 * x117 + (x108 * x125 - x107 * x127) + x199)))
+                - (2103.19 * x99 + (qd[1] * x102 + x93 * x103)))
+            - s_q1
+                * (qd[1] * x104 - x94 * x103 - 15.41 * x98
+                    + (c_q2 * x201 + s_q2 * x203 + -0.475 * x207))
+            + 0.5692
+                * (c_q1 * (314.88 * x100 - qd[1] * x106 + x206)
+                    + s_q1 * (qd[1] * x105 - 314.88 * x101 + x207));
+        (
+            [
+                [x72, x73, x75, x80, x85, x92],
+                [x73, x69, x74, x79, x84, x91],
+                [x75, x74, x50, x76, x82, x89],
+                [x80, x79, x76, x31, x23, x87],
+                [x85, x84, x82, x23, x18, 0.0],
+                [x92, x91, x89, x87, 0.0, 9.336],
+            ],
+            [x209, x208, x202, x195, x189, x180],
+        )
     }
 }

@@ -2,7 +2,8 @@
 //!
 //! The `dynamics!` proc-macro: unrolled, allocation-free dynamics code for a fixed model, emitted
 //! at compile time by [`kanegen_codegen`]. Use it through the `kanegen` facade
-//! (`kanegen::dynamics!`), which provides the `libm` the generated code calls.
+//! (`kanegen::dynamics!`), a `macro_rules!` wrapper that passes its own path (`$crate`) first,
+//! so the generated code calls the facade's `libm` however the user names the dependency.
 #![warn(missing_docs)]
 
 use proc_macro::TokenStream;
@@ -12,6 +13,8 @@ use syn::parse::{Parse, ParseStream};
 use syn::{Expr, ExprArray, ExprLit, ExprUnary, Ident, Lit, LitBool, LitStr, Token, UnOp};
 
 struct Input {
+    /// The facade's path (`$crate` of `kanegen::dynamics!`), before a `;`.
+    runtime: syn::Path,
     name: Ident,
     path: LitStr,
     gravity: Option<[f64; 3]>,
@@ -41,10 +44,13 @@ fn float(e: &Expr) -> syn::Result<f64> {
 
 impl Parse for Input {
     fn parse(input: ParseStream) -> syn::Result<Self> {
+        let runtime: syn::Path = input.parse()?;
+        input.parse::<Token![;]>()?;
         let name: Ident = input.parse()?;
         input.parse::<Token![,]>()?;
         let path: LitStr = input.parse()?;
         let mut out = Input {
+            runtime,
             name,
             path,
             gravity: None,
@@ -107,22 +113,8 @@ impl Parse for Input {
     }
 }
 
-/// `dynamics!(Name, "path/to/model.urdf" [, gravity = [x, y, z]] [, allow_nonphysical = true]
-/// [, runtime_payload = true] [, scalar = f32] [, fma = true] [, fma_path = f64::mul_add])`:
-/// defines `pub struct Name;` with the associated constants `N`, `JOINTS`, `OP_COUNTS`,
-/// `ALGORITHMS` and the functions `mass_matrix(q)`, `bias(q, qd, tau)`, `bias_velocity(q, qd)`,
-/// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)` (and `gravity(q)` with
-/// gravity) on `&[f64; N]` arrays. With `runtime_payload = true`, every function takes a last
-/// argument `payload: &NamePayload` (the last body's mass properties).
-///
-/// `scalar = f32` (default `f64`) emits `f32` code: arrays, payload fields, constants (the
-/// model's numbers rounded) and libm calls. `fma = true` fuses each single-use product into its
-/// sum or difference as one call `fma(a, b, c)` = `a·b + c`, by default libm's `fma` / `fmaf`;
-/// `fma_path = PATH` calls `PATH(a, b, c)` instead (e.g. `f64::mul_add`, which needs `std`), and
-/// `Name::FMA_COUNTS` lists the fused operations per function.
-///
-/// The path is relative to the calling crate's `CARGO_MANIFEST_DIR`; the crate is rebuilt when
-/// the file changes. A missing, malformed or non-physical model is a compile error at the path.
+/// The implementation of `kanegen::dynamics!` (documented there): `dynamics!(RUNTIME; Name,
+/// "path" [, options])`, where `RUNTIME` is the path of the `kanegen` facade.
 #[proc_macro]
 pub fn dynamics(input: TokenStream) -> TokenStream {
     let input = syn::parse_macro_input!(input as Input);
@@ -139,25 +131,28 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
     let path = std::path::Path::new(&dir).join(&rel);
     let abs = path.display().to_string();
-    let v = kanegen_codegen::kanegen_core::Validation {
+    let v = kanegen_codegen::kanegen_model::Validation {
         allow_nonphysical_inertia: input.allow_nonphysical,
     };
     // Messages name the path as written, not the machine's absolute path.
-    let chain = kanegen_codegen::kanegen_core::io::load_model_with(&path, v)
+    let model = kanegen_codegen::kanegen_model::io::load_model_with(&path, v)
         .map_err(|e| e.to_string().replace(&abs, &rel))?;
     let name = input.name.to_string();
     let mut opts = kanegen_codegen::Options::new(name.clone());
     opts.gravity = input.gravity;
     opts.runtime_payload = input.runtime_payload;
-    opts.libm_path = "::kanegen::__private::libm".into();
+    let runtime = &input.runtime;
+    opts.libm_path = "kanegen::__private::libm".into();
+    opts.libm_tokens = Some(quote!(#runtime::__private::libm));
     opts.payload_name = format!("{name}Payload");
+    opts.op_count_name = format!("{name}OpCount");
     opts.float = input.float;
     opts.fma = input.fma;
     opts.fma_path = input
         .fma_path
         .as_ref()
         .map(|p| quote!(#p).to_string().replace(' ', ""));
-    let g = kanegen_codegen::generate_items(&chain, &opts).map_err(|e| e.to_string())?;
+    let g = kanegen_codegen::generate_items(&model, &opts).map_err(|e| e.to_string())?;
     let items = g.items;
     let abs_lit = LitStr::new(&abs, Span::call_site());
     Ok(quote! {

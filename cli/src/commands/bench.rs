@@ -1,0 +1,118 @@
+//! `kanegen bench`: nanoseconds per call of generated and interpreted dynamics for SSRMS, measured
+//! side by side in one process run.
+//!
+//! These machines are shared and noisy, so absolute numbers mean little; the report is built for
+//! ratios. Every candidate runs in each of many short rounds, in rotating order, and the median
+//! round is reported: a burst of load on the machine hits every candidate of that round alike.
+
+use crate::timing::{measure, BenchLine, Candidate};
+use serde::Serialize;
+
+/// The report.
+#[derive(Clone, Debug, Serialize)]
+pub struct BenchReport {
+    /// Model measured.
+    pub model: String,
+    /// Degrees of freedom.
+    pub n: usize,
+    /// Rounds per candidate.
+    pub rounds: usize,
+    /// Calls per round.
+    pub calls_per_round: usize,
+    /// Results.
+    pub results: Vec<BenchLine>,
+}
+
+/// Human-readable table.
+pub fn render_text(r: &BenchReport) -> String {
+    use std::fmt::Write;
+    let mut s = format!(
+        "{} (N = {}), {} rounds × {} calls, median ns per call\n\n{:<20} {:<32} {:>12} {:>22} {:>10}\n",
+        r.model, r.n, r.rounds, r.calls_per_round, "function", "candidate", "ns/call", "range", "× first"
+    );
+    for l in &r.results {
+        let _ = writeln!(
+            s,
+            "{:<20} {:<32} {:>12.1} {:>10.1} – {:>9.1} {:>10.2}",
+            l.function, l.name, l.ns, l.ns_range[0], l.ns_range[1], l.ratio_to_first
+        );
+    }
+    s
+}
+
+/// The SSRMS model the generated code was emitted from (embedded, so the command runs anywhere).
+pub const SSRMS_URDF: &str =
+    include_str!("../../../tests/data/reference/ssrms_nguyen_hughes_1994.urdf");
+
+/// Generated SSRMS code against the interpreted f64 algorithms, side by side: `M + c` (one
+/// generated call against each preset's `A` and `b`), forward dynamics and inverse dynamics.
+///
+/// # Errors
+/// If the embedded model does not parse.
+pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
+    use kanegen_dynamics::{Loads, Methods, Params};
+    use kanegen_generated::ssrms::Ssrms;
+    let model = kanegen_model::io::parse_urdf(SSRMS_URDF)?;
+    let p = Params::<f64>::new(&model);
+    let n = model.dof();
+    let arr = |x: &[f64]| -> [f64; 7] { core::array::from_fn(|i| x[i]) };
+    let zero = [0.0; 7];
+    let mut c: Vec<Candidate<'_>> = Vec::new();
+    c.push((
+        "generated".into(),
+        "M+c".into(),
+        Box::new(move |q, qd| {
+            let (m, nle) = Ssrms::mass_matrix_and_nonlinear_effects(&arr(q), &arr(qd));
+            m[0][0] + m[6][6] + nle[0] + nle[6]
+        }),
+    ));
+    for (name, methods) in Methods::PRESETS {
+        let p = &p;
+        c.push((
+            format!("interpreted {name}"),
+            "M+c".into(),
+            Box::new(move |q, qd| {
+                let d = methods.dynamics(p, q, qd, &Loads::default());
+                d.a[0][0] + d.a[6][6] + d.b[0] + d.b[6]
+            }),
+        ));
+    }
+    let fast = [
+        ("recurrent", Methods::RECURRENT),
+        ("crba-base", Methods::CRBA_BASE),
+        ("spatial", Methods::SPATIAL),
+    ];
+    c.push((
+        "generated".into(),
+        "forward_dynamics".into(),
+        Box::new(move |q, qd| Ssrms::forward_dynamics(&arr(q), &arr(qd), &zero)[6]),
+    ));
+    for (name, methods) in fast {
+        let p = &p;
+        c.push((
+            format!("interpreted {name}"),
+            "forward_dynamics".into(),
+            Box::new(move |q, qd| methods.forward_dynamics(p, q, qd, &Loads::default())[6]),
+        ));
+    }
+    c.push((
+        "generated".into(),
+        "inverse_dynamics".into(),
+        Box::new(move |q, qd| Ssrms::inverse_dynamics(&arr(q), &arr(qd), &arr(qd))[6]),
+    ));
+    for (name, methods) in fast {
+        let p = &p;
+        c.push((
+            format!("interpreted {name}"),
+            "inverse_dynamics".into(),
+            Box::new(move |q, qd| methods.inverse_dynamics(p, q, qd, qd, &Loads::default())[6]),
+        ));
+    }
+    Ok(BenchReport {
+        model: model.name().into(),
+        n,
+        rounds,
+        calls_per_round: calls,
+        results: measure(n, c, rounds, calls),
+    })
+}

@@ -1,0 +1,192 @@
+//! `kanegen count MODEL` and `kanegen count SCENE`: operation counts of `A` and `b` per method
+//! and convention, and what each of a scene's effects adds (traced by `kanegen_trace::count`).
+
+use crate::scene_spec;
+use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
+use kanegen_model::Model;
+use kanegen_sim::scene::{BaseSpec, Scene};
+use kanegen_trace::count::{count_lines, effect_lines, CountLine, EffectLine};
+use kanegen_trace::{Spec, TraceError};
+use serde::Serialize;
+use std::path::Path;
+
+/// The report of `kanegen count MODEL`.
+#[derive(Clone, Debug, Serialize)]
+pub struct CountReport {
+    /// Model name.
+    pub model: String,
+    /// Degrees of freedom.
+    pub n: usize,
+    /// Whether gravity was included in `bias`.
+    pub gravity: bool,
+    /// One line per function, method and convention.
+    pub counts: Vec<CountLine>,
+}
+
+/// The methods of a selection of presets, each listed once, in report order.
+fn methods_of(presets: &[Methods]) -> (Vec<MassMatrixMethod>, Vec<BiasMethod>) {
+    let mass = MassMatrixMethod::ALL
+        .into_iter()
+        .filter(|m| presets.iter().any(|p| p.mass_matrix == *m))
+        .collect();
+    let bias = BiasMethod::ALL
+        .into_iter()
+        .filter(|b| presets.iter().any(|p| p.bias == *b))
+        .collect();
+    (mass, bias)
+}
+
+/// Counts of `A` for every mass-matrix method and of `b` for every bias method of `presets`.
+///
+/// # Errors
+/// If a trace is refused (`kanegen_trace::trace`).
+pub fn count(
+    model: &Model,
+    presets: &[Methods],
+    gravity: Option<[f64; 3]>,
+) -> Result<CountReport, TraceError> {
+    let (mass, bias) = methods_of(presets);
+    Ok(CountReport {
+        model: model.name().into(),
+        n: model.dof(),
+        gravity: gravity.is_some(),
+        counts: count_lines(model, &mass, &bias, &Spec::with_gravity(gravity))?,
+    })
+}
+
+/// Appends the table of count lines (header and one row per line) to `s`.
+fn write_count_table(s: &mut String, counts: &[CountLine]) {
+    use std::fmt::Write;
+    let _ = writeln!(
+        s,
+        "{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}",
+        "method", "function", "conv.", "mul", "add", "m+a", "div", "sqrt", "sincos"
+    );
+    for c in counts {
+        let _ = writeln!(
+            s,
+            "{:<14} {:<12} {:<9} {:>8} {:>8} {:>8} {:>5} {:>5} {:>7}",
+            c.method,
+            c.function,
+            c.convention,
+            c.mul,
+            c.add,
+            c.mul + c.add,
+            c.div,
+            c.sqrt,
+            c.sincos
+        );
+    }
+}
+
+/// Human-readable table.
+pub fn render_text(r: &CountReport) -> String {
+    let mut s = format!(
+        "model {} (N = {}), gravity {}\n\n",
+        r.model,
+        r.n,
+        if r.gravity { "on" } else { "off" }
+    );
+    write_count_table(&mut s, &r.counts);
+    s
+}
+
+/// Whether `path` is a scene file: a `.toml` whose top level has a `model` key (a model TOML has
+/// none). Unreadable or unparsable files are not scenes (the model loader reports the error).
+#[must_use]
+pub fn is_scene_file(path: &Path) -> bool {
+    if path.extension().and_then(|e| e.to_str()) != Some("toml") {
+        return false;
+    }
+    std::fs::read_to_string(path)
+        .ok()
+        .and_then(|s| s.parse::<toml::Table>().ok())
+        .is_some_and(|t| t.contains_key("model"))
+}
+
+/// The report of `kanegen count SCENE`.
+#[derive(Clone, Debug, Serialize)]
+pub struct SceneCountReport {
+    /// The scene file.
+    pub scene: String,
+    /// `fixed` or `free-floating`.
+    pub base: String,
+    /// Arm degrees of freedom.
+    pub n: usize,
+    /// `A` and `b` (all the scene's effects) per method and convention.
+    pub counts: Vec<CountLine>,
+    /// Per effect, bias method and convention (`emitted`, `paper`): the operations it adds.
+    pub effects: Vec<EffectLine>,
+}
+
+/// Counts of the scene's `A` and `b` and the cost of each effect, for the methods of `presets`.
+///
+/// # Errors
+/// If a trace is refused (`kanegen_trace::trace`).
+pub fn count_scene(
+    scene: &Scene,
+    name: &str,
+    presets: &[Methods],
+) -> Result<SceneCountReport, TraceError> {
+    let (mass, bias) = methods_of(presets);
+    let spec = scene_spec::spec(scene);
+    Ok(SceneCountReport {
+        scene: name.into(),
+        base: match scene.base {
+            BaseSpec::Fixed => "fixed",
+            BaseSpec::FreeFloating { .. } => "free-floating",
+        }
+        .into(),
+        n: scene.model.dof(),
+        counts: count_lines(&scene.model, &mass, &bias, &spec)?,
+        effects: effect_lines(&scene.model, &bias, &spec)?,
+    })
+}
+
+/// Human-readable rendering of [`SceneCountReport`].
+#[must_use]
+pub fn render_scene_text(r: &SceneCountReport) -> String {
+    use std::fmt::Write;
+    let names: Vec<String> = {
+        let mut v: Vec<String> = Vec::new();
+        for e in &r.effects {
+            if !v.contains(&e.effect) {
+                v.push(e.effect.clone());
+            }
+        }
+        v
+    };
+    let mut s = format!(
+        "scene {} ({} base, N = {}), effects: {}\n\n",
+        r.scene,
+        r.base,
+        r.n,
+        if names.is_empty() {
+            "none".to_string()
+        } else {
+            names.join(", ")
+        }
+    );
+    write_count_table(&mut s, &r.counts);
+    if !r.effects.is_empty() {
+        let _ = writeln!(
+            s,
+            "\noperations each effect adds to b (all effects minus all but that one)\n\n{:<12} {:<14} {:<9} {:>8} {:>8} {:>8} {:>5}",
+            "effect", "method", "conv.", "mul", "add", "m+a", "div"
+        );
+        for e in &r.effects {
+            let _ = writeln!(
+                s,
+                "{:<12} {:<14} {:<9} {:>8} {:>8} {:>8} {:>5}",
+                e.effect,
+                e.method,
+                e.convention,
+                e.mul,
+                e.add,
+                e.mul + e.add,
+                e.div
+            );
+        }
+    }
+    s
+}

@@ -1,0 +1,127 @@
+//! `kanegen generate MODEL`: unrolled, allocation-free, `no_std` Rust for one model (see
+//! [`kanegen_codegen`] and the README section "Code generation").
+
+use kanegen_codegen::{generate_file, Float, Options};
+use kanegen_model::{Model, ModelError};
+
+/// `CamelCase` type name from a model name or file stem: `ssrms_nguyen_hughes_1994` →
+/// `SsrmsNguyenHughes1994`; a leading digit gets a `Model` prefix.
+pub fn type_name(stem: &str) -> String {
+    let mut s: String = stem
+        .split(|c: char| !c.is_ascii_alphanumeric())
+        .filter(|w| !w.is_empty())
+        .map(|w| {
+            let mut c = w.chars();
+            c.next()
+                .map(|f| f.to_ascii_uppercase().to_string() + c.as_str())
+                .unwrap_or_default()
+        })
+        .collect();
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert_str(0, "Model");
+    }
+    s
+}
+
+/// The generated file for `model` as written by `kanegen generate` (the `libm` crate by its plain
+/// name: the including crate depends on `libm`).
+///
+/// # Errors
+/// If the type name is not an identifier, or a function cannot be traced.
+pub fn generate(model: &Model, opts: &Options) -> Result<String, kanegen_codegen::Error> {
+    generate_file(model, opts)
+}
+
+/// One file of the `kanegen-generated` crate.
+#[derive(Clone, Copy, Debug)]
+pub struct GeneratedFile {
+    /// Path of the file, relative to the repository root.
+    pub file: &'static str,
+    /// Model file, relative to the repository root.
+    pub model: &'static str,
+    /// Name of the generated struct.
+    pub type_name: &'static str,
+    /// Joint locked before generation: `(index, value)`.
+    pub lock: Option<(usize, f64)>,
+    /// Precision (`--scalar`).
+    pub float: Float,
+    /// Fused multiply-adds (`--fma`).
+    pub fma: bool,
+}
+
+/// The files of `generated/src/`, each reproducible with
+/// `kanegen generate MODEL --name TYPE [--lock INDEX=VALUE] [--scalar f32] [--fma] -o FILE`.
+pub const GENERATED: [GeneratedFile; 5] = [
+    GeneratedFile {
+        file: "generated/src/ssrms.rs",
+        model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+        type_name: "Ssrms",
+        lock: None,
+        float: Float::F64,
+        fma: false,
+    },
+    GeneratedFile {
+        file: "generated/src/ssrms6.rs",
+        model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+        type_name: "Ssrms6",
+        lock: Some((0, 0.0)),
+        float: Float::F64,
+        fma: false,
+    },
+    GeneratedFile {
+        file: "generated/src/srms.rs",
+        model: "tests/data/reference/srms_nguyen_hughes_1994.urdf",
+        type_name: "Srms",
+        lock: None,
+        float: Float::F64,
+        fma: false,
+    },
+    GeneratedFile {
+        file: "generated/src/ssrms_f32.rs",
+        model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+        type_name: "SsrmsF32",
+        lock: None,
+        float: Float::F32,
+        fma: false,
+    },
+    GeneratedFile {
+        file: "generated/src/ssrms_fma.rs",
+        model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+        type_name: "SsrmsFma",
+        lock: None,
+        float: Float::F64,
+        fma: true,
+    },
+];
+
+impl GeneratedFile {
+    /// The model, locked when asked; `root` is the repository root.
+    ///
+    /// # Errors
+    /// If the model cannot be read or locked.
+    pub fn model(&self, root: &std::path::Path) -> Result<Model, ModelError> {
+        let model = kanegen_model::io::load_model(&root.join(self.model))?;
+        match self.lock {
+            Some((i, v)) => model.lock_joint(i, v),
+            None => Ok(model),
+        }
+    }
+
+    /// The generator options of this file.
+    #[must_use]
+    pub fn options(&self) -> Options {
+        let mut o = Options::new(self.type_name);
+        o.float = self.float;
+        o.fma = self.fma;
+        o
+    }
+
+    /// The file's expected contents.
+    ///
+    /// # Errors
+    /// If the model cannot be read or locked.
+    pub fn render(&self, root: &std::path::Path) -> Result<String, String> {
+        let model = self.model(root).map_err(|e| e.to_string())?;
+        generate(&model, &self.options()).map_err(|e| e.to_string())
+    }
+}

@@ -1,0 +1,9 @@
+//! The CLI's commands, as library functions the tests call directly.
+
+pub mod accuracy;
+pub mod bench;
+pub mod count;
+pub mod eval;
+pub mod generate;
+pub mod simulate;
+pub mod table1;

@@ -1,0 +1,4 @@
+//! SVG figures of the reports (plotters): simulation plots and work–precision charts.
+
+pub mod accuracy;
+pub mod simulate;

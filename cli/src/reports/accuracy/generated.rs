@@ -1,0 +1,61 @@
+//! The generated-code rows of `kanegen accuracy`: the SSRMS functions emitted by kanegen in each
+//! precision, wrapped as [`GeneratedFns`] on `f64` slices.
+//!
+//! All three are checked-in files of `kanegen-generated` (`ssrms`, `ssrms_f32`, `ssrms_fma`),
+//! generated from the same model file (`tests/data/reference/ssrms_nguyen_hughes_1994.urdf`), so
+//! they run the same emitted graph and differ only in the arithmetic. The report's `b = τ − c`
+//! is formed from the generated `c` in the variant's precision.
+//!
+//! The fma variant calls `libm::fma`, the faster of the two on the development machine
+//! (x86-64 with FMA, built without `-C target-cpu=native`): SSRMS forward dynamics (426 fused
+//! operations) took 690 ns with `libm::fma` (which detects the FMA instruction at run time and
+//! calls it through a function pointer) against 970–1380 ns with `f64::mul_add` (a call into
+//! the C library's `fma`), and 180 ns unfused. Neither call is inlined without the target
+//! feature, so fusing costs time here.
+
+use kanegen_generated::{ssrms::Ssrms, ssrms_f32::SsrmsF32, ssrms_fma::SsrmsFma};
+
+use super::evaluation::GeneratedFns;
+
+/// Wraps one generated type (`$ty`, scalar `$t`) as [`GeneratedFns`]: inputs rounded to `$t`,
+/// outputs widened to `f64`.
+macro_rules! generated_fns {
+    ($precision:literal, $ty:ty, $t:ty) => {{
+        const N: usize = <$ty>::N;
+        fn arr(x: &[f64]) -> [$t; N] {
+            core::array::from_fn(|i| x[i] as $t)
+        }
+        fn mass_matrix(q: &[f64]) -> Vec<Vec<f64>> {
+            <$ty>::mass_matrix(&arr(q))
+                .iter()
+                .map(|r| r.iter().map(|&x| f64::from(x)).collect())
+                .collect()
+        }
+        fn bias(q: &[f64], qd: &[f64], tau: &[f64]) -> Vec<f64> {
+            let c = <$ty>::nonlinear_effects(&arr(q), &arr(qd));
+            let tau = arr(tau);
+            (0..N).map(|i| f64::from(tau[i] - c[i])).collect()
+        }
+        fn forward_dynamics(q: &[f64], qd: &[f64], tau: &[f64]) -> Vec<f64> {
+            <$ty>::forward_dynamics(&arr(q), &arr(qd), &arr(tau))
+                .map(f64::from)
+                .to_vec()
+        }
+        GeneratedFns {
+            precision: $precision,
+            mass_matrix,
+            bias,
+            forward_dynamics,
+        }
+    }};
+}
+
+/// The SSRMS variants: the checked-in `f64` code of `kanegen-generated`, `f32` and `f64-fma`.
+#[must_use]
+pub fn ssrms_variants() -> Vec<GeneratedFns> {
+    vec![
+        generated_fns!("f32", SsrmsF32, f32),
+        generated_fns!("f64", Ssrms, f64),
+        generated_fns!("f64-fma", SsrmsFma, f64),
+    ]
+}

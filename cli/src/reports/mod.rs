@@ -1,0 +1,3 @@
+//! Reports computed from several library calls.
+
+pub mod accuracy;

@@ -1,0 +1,388 @@
+//! Emission of one traced graph as straight-line Rust: one `let` per shared or expensive
+//! subexpression and per output, single-use nodes inlined with the parentheses that keep the
+//! graph's evaluation order (so the code performs exactly the emitted operation count), one
+//! `sincos` per angle, optional fused multiply-adds.
+
+use crate::options::{Error, Float, Options};
+use kanegen_trace::{Input, Node, PayloadField, Sym, Traced};
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+use std::collections::{HashMap, HashSet};
+
+/// Operator precedence of an emitted expression (higher binds tighter).
+const P_ADD: u8 = 1;
+const P_MUL: u8 = 2;
+const P_NEG: u8 = 3;
+const P_ATOM: u8 = 4;
+
+#[derive(Clone)]
+struct Expr {
+    tokens: TokenStream,
+    prec: u8,
+}
+
+impl Expr {
+    fn atom(tokens: TokenStream) -> Self {
+        Expr {
+            tokens,
+            prec: P_ATOM,
+        }
+    }
+    /// The expression, parenthesized unless it binds at least as tightly as `min`.
+    fn at(&self, min: u8) -> TokenStream {
+        let t = &self.tokens;
+        if self.prec >= min {
+            t.clone()
+        } else {
+            quote!((#t))
+        }
+    }
+}
+
+/// A constant of type `float`: the f64 value, rounded for `f32`.
+fn constant(x: f64, float: Float) -> Expr {
+    let ty = float.ty();
+    let x = match float {
+        Float::F64 => x,
+        Float::F32 => f64::from(x as f32),
+    };
+    if x.is_nan() {
+        return Expr::atom(quote!(#ty::NAN));
+    }
+    if x.is_infinite() {
+        return if x > 0.0 {
+            Expr::atom(quote!(#ty::INFINITY))
+        } else {
+            Expr::atom(quote!(#ty::NEG_INFINITY))
+        };
+    }
+    let lit = match float {
+        Float::F64 => Literal::f64_unsuffixed(x.abs()),
+        Float::F32 => Literal::f32_unsuffixed((x as f32).abs()),
+    };
+    if x.is_sign_negative() && x != 0.0 {
+        Expr {
+            tokens: quote!(-#lit),
+            prec: P_NEG,
+        }
+    } else {
+        Expr::atom(quote!(#lit))
+    }
+}
+
+/// How one graph is emitted: the libm path, the floating-point type and the fused multiply-add
+/// function (none: no fusion). Built from [`Options`] by [`Emitter::new`].
+#[derive(Clone, Debug)]
+pub struct Emitter {
+    libm: TokenStream,
+    float: Float,
+    fma: Option<TokenStream>,
+}
+
+impl Emitter {
+    /// The emitter of `opts`.
+    ///
+    /// # Errors
+    /// If [`Options::libm_path`] or [`Options::fma_path`] is not a Rust path.
+    pub fn new(opts: &Options) -> Result<Self, Error> {
+        let libm = match &opts.libm_tokens {
+            Some(t) => t.clone(),
+            None => {
+                let libm: syn::Path = syn::parse_str(&opts.libm_path)
+                    .map_err(|e| Error(format!("libm path `{}`: {e}", opts.libm_path)))?;
+                quote!(#libm)
+            }
+        };
+        let fma = if opts.fma {
+            Some(match &opts.fma_path {
+                Some(p) => {
+                    let path: syn::Path =
+                        syn::parse_str(p).map_err(|e| Error(format!("fma path `{p}`: {e}")))?;
+                    quote!(#path)
+                }
+                None => {
+                    let f = opts.float.libm_fn("fma");
+                    quote!(#libm::#f)
+                }
+            })
+        } else {
+            None
+        };
+        Ok(Emitter {
+            libm,
+            float: opts.float,
+            fma,
+        })
+    }
+}
+
+/// The emitted body of one function.
+pub struct Body {
+    /// The statements and the result expression.
+    pub tokens: TokenStream,
+    /// Fused multiply-adds formed (0 without [`Options::fma`]).
+    pub fmas: u64,
+}
+
+/// How the outputs of a traced function are returned.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Shape {
+    /// `[f; n]`.
+    Vector(usize),
+    /// The upper triangle (row-major) of a symmetric `n×n` matrix, returned whole
+    /// (`[[f; n]; n]`, both triangles written).
+    SymMatrix(usize),
+    /// A symmetric matrix's upper triangle then an `n`-vector, returned as a tuple.
+    SymMatrixAndVector(usize),
+}
+
+/// The Rust expression that reads a trace input.
+#[must_use]
+pub fn input_tokens(input: &Input) -> TokenStream {
+    let lit = Literal::usize_unsuffixed;
+    match input {
+        Input::Joint(a, i) => {
+            let a = format_ident!("{}", a.name());
+            let i = lit(*i);
+            quote!(#a[#i])
+        }
+        Input::Payload(PayloadField::Mass) => quote!(payload.mass),
+        Input::Payload(PayloadField::Com(k)) => {
+            let k = lit(*k);
+            quote!(payload.com[#k])
+        }
+        Input::Payload(PayloadField::Inertia(r, c)) => {
+            let (r, c) = (lit(*r), lit(*c));
+            quote!(payload.inertia[#r][#c])
+        }
+        other => {
+            let name = format_ident!("{}", other.to_string().replace(['[', ']', '.'], "_"));
+            quote!(#name)
+        }
+    }
+}
+
+/// The statements and result expression of one traced function, returned as `shape`.
+pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
+    let inputs: Vec<TokenStream> = t.inputs.iter().map(input_tokens).collect();
+    let Emitter { libm, float, fma } = emitter;
+    let float = *float;
+    let trace = &t.trace;
+    let sched = trace.schedule();
+    let outputs: HashSet<u32> = trace.outputs().iter().map(|s| s.id()).collect();
+    let nodes: HashMap<u32, Node> = sched.iter().copied().collect();
+    let mut uses: HashMap<u32, usize> = HashMap::new();
+    // Sine and cosine nodes per argument.
+    let mut trig: HashMap<u32, (Option<u32>, Option<u32>)> = HashMap::new();
+    for (id, node) in &sched {
+        match *node {
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => {
+                *uses.entry(a.id()).or_default() += 1;
+                *uses.entry(b.id()).or_default() += 1;
+            }
+            Node::Neg(a) | Node::Sqrt(a) => *uses.entry(a.id()).or_default() += 1,
+            Node::Sin(a) => {
+                *uses.entry(a.id()).or_default() += 1;
+                trig.entry(a.id()).or_default().0 = Some(*id);
+            }
+            Node::Cos(a) => {
+                *uses.entry(a.id()).or_default() += 1;
+                trig.entry(a.id()).or_default().1 = Some(*id);
+            }
+            Node::Const(_) | Node::Input(_) => {}
+        }
+    }
+    // Inlined (single-use, not an output): its expression appears once, in its user's.
+    let inlined = |s: Sym| !outputs.contains(&s.id()) && uses.get(&s.id()).copied() == Some(1);
+    // The factors of a product that fuses into its user: an inlined multiplication.
+    let product = |s: Sym| match nodes.get(&s.id()) {
+        Some(Node::Mul(a, b)) if fma.is_some() && inlined(s) => Some((*a, *b)),
+        _ => None,
+    };
+    let is_const = |s: Sym| matches!(nodes.get(&s.id()), Some(Node::Const(_)));
+    let mut exprs: HashMap<u32, Expr> = HashMap::new();
+    let mut stmts: Vec<TokenStream> = Vec::new();
+    let mut counter = 0usize;
+    let mut fmas = 0u64;
+    // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
+    let trig_base = |arg: u32, counter: usize| -> String {
+        match nodes[&arg] {
+            Node::Input(i) => inputs[i as usize]
+                .to_string()
+                .chars()
+                .filter(char::is_ascii_alphanumeric)
+                .collect(),
+            _ => format!("{counter}"),
+        }
+    };
+    for (id, node) in &sched {
+        let id = *id;
+        let get = |s: Sym| exprs[&s.id()].clone();
+        // `−s` as a call argument: constants negated, an inlined negation unwrapped.
+        let neg = |s: Sym| -> TokenStream {
+            match nodes.get(&s.id()) {
+                Some(Node::Const(x)) => constant(-x, float).tokens,
+                Some(Node::Neg(z)) if inlined(s) => get(*z).tokens,
+                _ => {
+                    let e = get(s).at(P_NEG);
+                    quote!(-#e)
+                }
+            }
+        };
+        let call = |a: TokenStream, b: TokenStream, c: TokenStream| {
+            let f = fma
+                .as_ref()
+                .expect("products fuse only with an fma function");
+            Expr::atom(quote!(#f(#a, #b, #c)))
+        };
+        let expr = match node {
+            Node::Const(x) => {
+                exprs.insert(id, constant(*x, float));
+                continue;
+            }
+            Node::Input(i) => {
+                exprs.insert(id, Expr::atom(inputs[*i as usize].clone()));
+                continue;
+            }
+            Node::Sin(a) | Node::Cos(a) => {
+                if exprs.contains_key(&id) {
+                    continue; // bound together with its partner by one sincos
+                }
+                let arg = get(*a).tokens;
+                let base = trig_base(a.id(), counter);
+                counter += 1;
+                match trig[&a.id()] {
+                    (Some(s), Some(c)) => {
+                        let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
+                        let f = float.libm_fn("sincos");
+                        stmts.push(quote!(let (#sn, #cn) = #libm::#f(#arg);));
+                        exprs.insert(s, Expr::atom(quote!(#sn)));
+                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                    }
+                    (Some(s), None) => {
+                        let sn = format_ident!("s_{}", base);
+                        let f = float.libm_fn("sin");
+                        stmts.push(quote!(let #sn = #libm::#f(#arg);));
+                        exprs.insert(s, Expr::atom(quote!(#sn)));
+                    }
+                    (None, Some(c)) => {
+                        let cn = format_ident!("c_{}", base);
+                        let f = float.libm_fn("cos");
+                        stmts.push(quote!(let #cn = #libm::#f(#arg);));
+                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                    }
+                    (None, None) => unreachable!("trig node without entry"),
+                }
+                continue;
+            }
+            // x + a·b, a·b + x: fma(a, b, x) (the right product first: sums accumulate
+            // from the left, so the left operand is the running sum).
+            Node::Add(x, y) if product(*y).is_some() || product(*x).is_some() => {
+                fmas += 1;
+                let (m, c) = if product(*y).is_some() {
+                    (*y, *x)
+                } else {
+                    (*x, *y)
+                };
+                let (a, b) = product(m).expect("checked");
+                call(get(a).tokens, get(b).tokens, get(c).tokens)
+            }
+            // x − a·b: fma(−a, b, x) (the constant factor negated when there is one).
+            Node::Sub(x, y) if product(*y).is_some() => {
+                fmas += 1;
+                let (a, b) = product(*y).expect("checked");
+                if is_const(b) && !is_const(a) {
+                    call(get(a).tokens, neg(b), get(*x).tokens)
+                } else {
+                    call(neg(a), get(b).tokens, get(*x).tokens)
+                }
+            }
+            // a·b − y: fma(a, b, −y).
+            Node::Sub(x, y) if product(*x).is_some() => {
+                fmas += 1;
+                let (a, b) = product(*x).expect("checked");
+                call(get(a).tokens, get(b).tokens, neg(*y))
+            }
+            Node::Add(a, b) => {
+                let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
+                Expr {
+                    tokens: quote!(#a + #b),
+                    prec: P_ADD,
+                }
+            }
+            Node::Sub(a, b) => {
+                let (a, b) = (get(*a).at(P_ADD), get(*b).at(P_MUL));
+                Expr {
+                    tokens: quote!(#a - #b),
+                    prec: P_ADD,
+                }
+            }
+            Node::Mul(a, b) => {
+                let (a, b) = (get(*a).at(P_MUL), get(*b).at(P_NEG));
+                Expr {
+                    tokens: quote!(#a * #b),
+                    prec: P_MUL,
+                }
+            }
+            Node::Div(a, b) => {
+                let (a, b) = (get(*a).at(P_MUL), get(*b).at(P_NEG));
+                Expr {
+                    tokens: quote!(#a / #b),
+                    prec: P_MUL,
+                }
+            }
+            Node::Neg(a) => {
+                let a = get(*a).at(P_NEG);
+                Expr {
+                    tokens: quote!(-#a),
+                    prec: P_NEG,
+                }
+            }
+            Node::Sqrt(a) => {
+                let a = get(*a).tokens;
+                let f = float.libm_fn("sqrt");
+                Expr::atom(quote!(#libm::#f(#a)))
+            }
+        };
+        let bind = outputs.contains(&id)
+            || uses.get(&id).copied().unwrap_or(0) > 1
+            || matches!(node, Node::Div(..) | Node::Sqrt(..));
+        if bind {
+            let name = format_ident!("x{}", counter);
+            counter += 1;
+            let e = expr.tokens;
+            stmts.push(quote!(let #name = #e;));
+            exprs.insert(id, Expr::atom(quote!(#name)));
+        } else {
+            exprs.insert(id, expr);
+        }
+    }
+    let out: Vec<TokenStream> = trace
+        .outputs()
+        .iter()
+        .map(|s| exprs[&s.id()].at(P_NEG))
+        .collect();
+    // Upper triangle, row-major: index of (i, j), i ≤ j.
+    let sym_matrix = |out: &[TokenStream], n: usize| {
+        let idx = |i: usize, j: usize| i * n - i * (i + 1) / 2 + j;
+        let rows = (0..n).map(|i| {
+            let row = (0..n).map(|j| &out[idx(i.min(j), i.max(j))]);
+            quote!([#(#row),*])
+        });
+        quote!([#(#rows),*])
+    };
+    let result = match shape {
+        Shape::Vector(_) => quote!([#(#out),*]),
+        Shape::SymMatrix(n) => sym_matrix(&out, n),
+        Shape::SymMatrixAndVector(n) => {
+            let k = n * (n + 1) / 2;
+            let m = sym_matrix(&out[..k], n);
+            let v = &out[k..];
+            quote!((#m, [#(#v),*]))
+        }
+    };
+    Body {
+        tokens: quote!(#(#stmts)* #result),
+        fmas,
+    }
+}

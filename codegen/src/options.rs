@@ -1,0 +1,123 @@
+//! Generator options: the generated type's name, gravity, a runtime payload, the precision, and
+//! the paths the emitted code calls.
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+/// Version of the generator, written into every generated header.
+pub const VERSION: &str = env!("CARGO_PKG_VERSION");
+
+/// Generator options.
+#[derive(Clone, Debug)]
+pub struct Options {
+    /// Name of the generated unit struct (a Rust identifier, e.g. `Ssrms`).
+    pub type_name: String,
+    /// Uniform gravity in the base frame, m/s². `None` (default): space, no gravity code at all
+    /// and no `gravity` function.
+    pub gravity: Option<[f64; 3]>,
+    /// Make the last body's (the payload's) mass, centre of mass and inertia runtime inputs: every
+    /// function then takes a last argument `payload: &Payload`.
+    pub runtime_payload: bool,
+    /// Path of the `libm` crate in the generated code: `libm` for a crate depending on `libm`,
+    /// `$crate::__private::libm` (the facade's) for the output of the `dynamics!` macro.
+    pub libm_path: String,
+    /// The `libm` path as tokens, overriding [`Options::libm_path`] in the code (not in the
+    /// header): the `dynamics!` macro passes `$crate::__private::libm`, which no string spells.
+    pub libm_tokens: Option<TokenStream>,
+    /// Name of the generated payload struct (used with [`Options::runtime_payload`]).
+    pub payload_name: String,
+    /// Name of the generated struct of [`OP_COUNTS`](crate#op-counts) entries.
+    pub op_count_name: String,
+    /// Floating-point type of the emitted code (default [`Float::F64`]).
+    pub float: Float,
+    /// Fuse single-use products into their sum or difference: `c + a·b`, `a·b + c` become
+    /// `fma(a, b, c)`, `c − a·b` becomes `fma(−a, b, c)` and `a·b − c` becomes `fma(a, b, −c)`
+    /// (one rounding instead of two). Default `false`.
+    pub fma: bool,
+    /// The function called for a fused multiply-add, as `path(a, b, c)` = `a·b + c`. `None`
+    /// (default): `fma` (f64) or `fmaf` (f32) of [`Options::libm_path`]. `f64::mul_add` /
+    /// `f32::mul_add` (UFCS of the std method; not `no_std`) work as well.
+    pub fma_path: Option<String>,
+}
+
+/// Floating-point type of the emitted code.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Float {
+    /// `f64` (default).
+    #[default]
+    F64,
+    /// `f32`: inputs, outputs, constants and libm calls.
+    F32,
+}
+
+impl Float {
+    /// The Rust type name, `f64` or `f32`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Float::F64 => "f64",
+            Float::F32 => "f32",
+        }
+    }
+
+    /// `f64` or `f32` from its name.
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "f64" => Some(Float::F64),
+            "f32" => Some(Float::F32),
+            _ => None,
+        }
+    }
+
+    pub(crate) fn ty(self) -> TokenStream {
+        let t = format_ident!("{}", self.name());
+        quote!(#t)
+    }
+
+    /// The libm function `base` for this type: `sin` or `sinf`.
+    pub(crate) fn libm_fn(self, base: &str) -> proc_macro2::Ident {
+        match self {
+            Float::F64 => format_ident!("{}", base),
+            Float::F32 => format_ident!("{}f", base),
+        }
+    }
+
+    /// A literal of this type with the value `x` (rounded for `f32`), suffixed like `quote!`
+    /// suffixes an `f64`.
+    pub(crate) fn suffixed(self, x: f64) -> Literal {
+        match self {
+            Float::F64 => Literal::f64_suffixed(x),
+            Float::F32 => Literal::f32_suffixed(x as f32),
+        }
+    }
+}
+
+impl Options {
+    /// Defaults: space (no gravity), constant payload, `libm` path `libm`, structs `Payload` and
+    /// `OpCount`, `f64`, no fused multiply-adds.
+    pub fn new(type_name: impl Into<String>) -> Self {
+        Options {
+            type_name: type_name.into(),
+            gravity: None,
+            runtime_payload: false,
+            libm_path: "libm".into(),
+            libm_tokens: None,
+            payload_name: "Payload".into(),
+            op_count_name: "OpCount".into(),
+            float: Float::F64,
+            fma: false,
+            fma_path: None,
+        }
+    }
+}
+
+/// An error of the generator.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Error(pub String);
+
+impl core::fmt::Display for Error {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for Error {}

@@ -1,0 +1,314 @@
+//! A serial arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `A` is
+//! `(6+N)×(6+N)`, `b` has `6+N` entries. The conventions are stated once, in [`crate::base`];
+//! they are repeated here for the reader.
+//!
+//! # Conventions
+//!
+//! - **Base pose**: position `p₀` of the base-frame origin in the inertial frame, and the attitude
+//!   as a unit quaternion stored `[x, y, z, w]` (Pinocchio order), i.e. the rotation `R₀` from base
+//!   to inertial coordinates ([`quat_to_matrix`]). [`FloatingState`] holds `R₀` as a matrix.
+//! - **Generalized velocity** `ν = [v_b (3), ω_b (3), q̇ (N)]` (Pinocchio free-flyer): `v_b` the
+//!   linear velocity of the base-frame origin and `ω_b` the base's angular velocity, both in
+//!   **base** coordinates.
+//! - `A ν̇ = b`, `b = Q − h`, where `ν̇` is the time derivative of the components of `ν` (so
+//!   `v̇_b` is the derivative of the base-coordinate components, not the base origin's
+//!   acceleration). Rows `0..3` of `b` hold the external + gravity force on the system and rows
+//!   `3..6` its moment about the base origin, both in base coordinates, minus the velocity-product
+//!   terms; rows `6..` are the arm's rows.
+//! - **Position state** for integrators: `[p₀ (3), quat (4: x, y, z, w), q (N)]`, with
+//!   `ṗ₀ = R₀ v_b`, `Ṙ₀ = R₀ ω̃_b`, `q̇` as given.
+//! - **Loads** ([`Loads`]): `gravity` is in the **inertial** frame. An [`ExternalWrench`] with
+//!   `body = j < N` acts on arm body `j` (force at `O_j`, moment about `O_j`) and with
+//!   `body =` [`BASE_BODY`] on the base body (force at the base origin); its frame
+//!   [`LoadFrame::Body`](super::LoadFrame::Body) is that body's frame and [`LoadFrame::Base`](super::LoadFrame::Base) means the **inertial**
+//!   frame (which is the base frame of a fixed-base chain). `tau` has `N` entries (arm drives;
+//!   the base is not actuated).
+//!
+//! # How (one algorithm source)
+//!
+//! The base-frame algorithms (`recurrent`, `recurrent-r1`, `crba-base`, `kane-direct`) run
+//! unchanged on the extended body list of [`kinematics::floating_base_frame`]: the base as six
+//! virtual joints (3 prismatic, then 3 revolute, axes `R₀e_m` through `p₀`) whose partial
+//! velocities are exactly those of `ν_b`, everything in the inertial frame. The velocity-product
+//! recursion starts from the base body's true motion ([`kinematics::floating_base_motion`]).
+//! `spatial` is an independent implementation (Featherstone's floating-base CRBA + RNEA in body
+//! coordinates, [`spatial::dynamics`]).
+//!
+//! ```
+//! use kanegen_dynamics::algorithms::floating;
+//! use kanegen_dynamics::base::{FloatingBase, FloatingState};
+//! use kanegen_dynamics::{Loads, Methods, Params};
+//! use kanegen_model::random::{random_chain, ChainSpec};
+//! let chain = random_chain(&ChainSpec { n: 3, ..Default::default() }, 1);
+//! let p = Params::<f64>::new(&chain);
+//! let base = FloatingBase::<f64>::from_inertial(&kanegen_model::Inertial {
+//!     mass: 100.0, com: [0.0; 3], inertia: [[10.0, 0.0, 0.0], [0.0, 10.0, 0.0], [0.0, 0.0, 10.0]],
+//! });
+//! let state = FloatingState::<f64>::at_rest();
+//! let d = floating::dynamics(Methods::RECURRENT, &p, &base, &state, &[0.1, 0.2, 0.3], &[0.0; 3],
+//!     &Loads::default());
+//! assert_eq!(d.a.len(), 9);
+//! // The linear block is the total mass times the identity.
+//! let total = 100.0 + chain.joints().iter().map(|j| j.inertial.mass).sum::<f64>();
+//! assert!((d.a[0][0] - total).abs() < 1e-9 && d.a[0][1].abs() < 1e-9);
+//! ```
+
+use crate::algorithms::kinematics::{
+    self, floating_base_frame, floating_motion, BodyKinematics, BodyMotion,
+};
+use crate::algorithms::methods::{BiasMethod, Dynamics, MassMatrixMethod, Methods};
+use crate::algorithms::{crba, kane_direct, recurrent, rnea};
+use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
+use crate::linalg::Vec3;
+use crate::loads::{ExternalWrench, Loads};
+use crate::params::Params;
+use crate::scalar::Scalar;
+use kanegen_model::JointKind;
+
+/// The loads of the extended body list: arm wrenches shifted by 6, base wrenches on virtual
+/// body 5 (the one carrying the base's inertia), arm drives prefixed by 6 zeros.
+fn extended_loads<S: Scalar>(loads: &Loads<S>, n: usize) -> Loads<S> {
+    if let Some(t) = &loads.tau {
+        assert_eq!(t.len(), n, "loads.tau has the wrong length");
+    }
+    Loads {
+        tau: loads.tau.as_ref().map(|t| {
+            let mut v = vec![S::zero(); FLOATING_BASE_DOF];
+            v.extend(t.iter().cloned());
+            v
+        }),
+        gravity: loads.gravity.clone(),
+        external: loads
+            .external
+            .iter()
+            .map(|e| {
+                let body = if e.body == BASE_BODY {
+                    FLOATING_BASE_DOF - 1
+                } else {
+                    assert!(e.body < n, "an external wrench names a body past the end");
+                    e.body + FLOATING_BASE_DOF
+                };
+                ExternalWrench { body, ..e.clone() }
+            })
+            .collect(),
+    }
+}
+
+/// `A` (`(6+N)×(6+N)`) of the arm `p` on the free-floating base `base` at arm positions `q`.
+/// The base-frame methods run on the virtual-joint extension of [`floating_base_frame`];
+/// [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`]. `A` does not depend on the
+/// base pose; `state` is the pose the base-frame methods express their quantities in.
+pub fn mass_matrix<S: Scalar>(
+    method: MassMatrixMethod,
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+) -> Vec<Vec<S>> {
+    match method {
+        MassMatrixMethod::Crba => crba::floating_mass_matrix(p, base, q),
+        base_frame => base_frame
+            .from_base_frame(&floating_base_frame(p, base, state, q))
+            .expect("every method but the CRBA starts from base-frame quantities"),
+    }
+}
+
+/// `b` (`6+N` entries) of `A ν̇ = b` for the arm `p` on the free-floating base `base` in the state
+/// `state`, with arm rates `qd` and `loads` (conventions of [`crate::base`]).
+pub fn bias<S: Scalar>(
+    method: BiasMethod,
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+) -> Vec<S> {
+    let n = p.dof();
+    assert_eq!(qd.len(), n, "qd has the wrong length");
+    if method == BiasMethod::Rnea {
+        return rnea::floating_bias(p, base, state, q, qd, loads);
+    }
+    let kin = floating_base_frame(p, base, state, q);
+    let mot = floating_motion(&kin, state, qd);
+    let ext = extended_loads(loads, n);
+    let f_ie = kinematics::inertial_external(&kin, &mot, &ext);
+    let tau = ext.tau.as_deref();
+    match method {
+        BiasMethod::Recurrent => recurrent::bias_base(&kin, &f_ie, tau),
+        BiasMethod::KaneDirect => kane_direct::bias_base(&kin, &f_ie, tau),
+        BiasMethod::Rnea => unreachable!("handled above"),
+    }
+}
+
+/// `A` and `b` of the free-floating system ([`mass_matrix`], [`bias`]).
+pub fn dynamics<S: Scalar>(
+    methods: Methods,
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+) -> Dynamics<S> {
+    Dynamics {
+        a: mass_matrix(methods.mass_matrix, p, base, state, q),
+        b: bias(methods.bias, p, base, state, q, qd, loads),
+    }
+}
+
+/// Forward dynamics `ν̇ = A⁻¹ b` by the branch-free LDLᵀ of [`crate::ldlt`].
+pub fn forward_dynamics<S: Scalar>(
+    methods: Methods,
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+) -> Vec<S> {
+    let d = dynamics(methods, p, base, state, q, qd, loads);
+    crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+}
+
+/// Positions (inertial frame, from the inertial origin) of the frame origins of the extended
+/// bodies of [`floating_base_frame`].
+fn positions<S: Scalar>(kin: &[BodyKinematics<S>], state: &FloatingState<S>) -> Vec<Vec3<S>> {
+    let mut x = state.position.clone();
+    kin.iter()
+        .enumerate()
+        .map(|(j, k)| {
+            if j >= FLOATING_BASE_DOF {
+                x = &x + &k.r;
+            }
+            x.clone()
+        })
+        .collect()
+}
+
+/// The real bodies (base body, then the arm) of the extended list with their motion and origin.
+fn bodies<'a, S: Scalar>(
+    kin: &'a [BodyKinematics<S>],
+    mot: &'a [BodyMotion<S>],
+    x: &'a [Vec3<S>],
+) -> impl Iterator<Item = ((&'a BodyKinematics<S>, &'a BodyMotion<S>), &'a Vec3<S>)> {
+    kin.iter().zip(mot).zip(x).skip(FLOATING_BASE_DOF - 1)
+}
+
+/// Total linear momentum `P` and angular momentum `L` about the inertial origin, both in inertial
+/// coordinates, summed directly over the bodies (base and arm; independent of `A`):
+/// `P = Σ (m_k v_k + ω_k × c_k)`, `L = Σ [x_k × (m_k v_k + ω_k × c_k) + c_k × v_k + I_k ω_k]`
+/// with `x_k` the body origin, `v_k` its velocity, `c_k` the first moment and `I_k` the inertia
+/// about `O_k`.
+pub fn momentum<S: Scalar>(
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+) -> (Vec3<S>, Vec3<S>) {
+    let kin = floating_base_frame(p, base, state, q);
+    let mot = floating_motion(&kin, state, qd);
+    let x = positions(&kin, state);
+    let mut lin = Vec3::zero();
+    let mut ang = Vec3::zero();
+    for ((k, m), xk) in bodies(&kin, &mot, &x) {
+        let pk = m.v.scale(&k.m) + m.omega.cross(&k.c);
+        ang = ang + xk.cross(&pk) + k.c.cross(&m.v) + k.inertia.mul_vec(&m.omega);
+        lin = lin + pk;
+    }
+    (lin, ang)
+}
+
+/// Total kinetic energy of base and arm, summed directly over the bodies:
+/// `T = Σ ½ (m_k |v_k|² + 2 v_k · (ω_k × c_k) + ω_k · I_k ω_k)`.
+pub fn kinetic_energy<S: Scalar>(
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+) -> S {
+    let kin = floating_base_frame(p, base, state, q);
+    let mot = floating_motion(&kin, state, qd);
+    let x = positions(&kin, state);
+    let two = S::constant(2.0);
+    let mut t = S::zero();
+    for ((k, m), _) in bodies(&kin, &mot, &x) {
+        t = t
+            + k.m.clone() * m.v.dot(&m.v)
+            + two.clone() * m.v.dot(&m.omega.cross(&k.c))
+            + m.omega.dot(&k.inertia.mul_vec(&m.omega));
+    }
+    t * S::constant(0.5)
+}
+
+/// The Jacobian of a point on the last arm body: rows `[v (3); ω (3)]` (the point's velocity and
+/// the body's angular velocity, inertial coordinates), columns the `6 + N` speeds `ν`. `point`
+/// is in the last body's frame. Panics if the arm has no joints.
+pub fn point_jacobian<S: Scalar>(
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    point: &Vec3<S>,
+) -> Vec<Vec<S>> {
+    let kin = floating_base_frame(p, base, state, q);
+    let x = positions(&kin, state);
+    let last = kin.last().expect("empty arm");
+    assert!(kin.len() > FLOATING_BASE_DOF, "the arm has no joints");
+    let xe = x[kin.len() - 1].clone() + last.orientation.mul_vec(point);
+    let cols: Vec<(Vec3<S>, Vec3<S>)> = kin
+        .iter()
+        .zip(&x)
+        .map(|(k, xk)| match k.kind {
+            JointKind::Prismatic => (k.axis.clone(), Vec3::zero()),
+            JointKind::Revolute => (k.axis.cross(&(&xe - xk)), k.axis.clone()),
+        })
+        .collect();
+    (0..6)
+        .map(|row| {
+            cols.iter()
+                .map(|(v, w)| if row < 3 { v.at(row) } else { w.at(row - 3) })
+                .collect()
+        })
+        .collect()
+}
+
+/// The generalized Jacobian (Umetani–Yoshida) of a point on the last body:
+/// `J* = J_m − J_b A_bb⁻¹ A_bm` (6 × N), mapping `q̇` to the point's velocity and the last body's
+/// angular velocity (rows as in [`point_jacobian`]) when the system's momentum is zero (then the
+/// base twist is `ν_b = −A_bb⁻¹ A_bm q̇`). `A` comes from `alg`; `A_bb⁻¹` by LDLᵀ.
+pub fn generalized_jacobian<S: Scalar>(
+    method: MassMatrixMethod,
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    point: &Vec3<S>,
+) -> Vec<Vec<S>> {
+    let n = p.dof();
+    let a = mass_matrix(method, p, base, state, q);
+    let nb = FLOATING_BASE_DOF;
+    let a_bb: Vec<Vec<S>> = a[..nb].iter().map(|r| r[..nb].to_vec()).collect();
+    let f = crate::ldlt::ldlt(&a_bb);
+    // Columns of A_bb⁻¹ A_bm.
+    let sol: Vec<Vec<S>> = (0..n)
+        .map(|j| {
+            let col: Vec<S> = (0..nb).map(|i| a[i][nb + j].clone()).collect();
+            crate::ldlt::solve(&f, &col)
+        })
+        .collect();
+    let jac = point_jacobian(p, base, state, q, point);
+    jac.iter()
+        .map(|row| {
+            (0..n)
+                .map(|j| {
+                    let jb =
+                        (0..nb).fold(S::zero(), |acc, i| acc + row[i].clone() * sol[j][i].clone());
+                    row[nb + j].clone() - jb
+                })
+                .collect()
+        })
+        .collect()
+}

@@ -1,0 +1,283 @@
+//! Which algorithm computes what: the mass-matrix method and the bias method are chosen
+//! separately ([`Methods`]), and every fixed-base entry point dispatches here.
+//!
+//! | mass-matrix method | file | what |
+//! |---|---|---|
+//! | `recurrent` | `recurrent.rs` | the paper's O(N²) recursion (12)–(16), (20), (14b) exact as R2 |
+//! | `recurrent-r1` | `recurrent.rs` | the same with (14b) as R1 (the paper's per-matrix cost + O(N)) |
+//! | `kane-direct` | `kane_direct.rs` | the direct Kane sum (9), O(N³) |
+//! | `crba-base` | `crba_base.rs` | composite rigid bodies in the paper's base-frame notation |
+//! | `crba` | `crba.rs` | Featherstone's composite-rigid-body algorithm in local frames |
+//!
+//! | bias method | file | what |
+//! |---|---|---|
+//! | `recurrent` | `recurrent.rs` | the paper's backward recursion (17)–(19), (21) |
+//! | `kane-direct` | `kane_direct.rs` | the direct Kane sum (10) |
+//! | `rnea` | `rnea.rs` | Featherstone's recursive Newton–Euler algorithm in local frames |
+//!
+//! The CLI's `--algorithm` names are presets of both ([`Methods::PRESETS`]).
+
+use crate::algorithms::kinematics::{self, BodyKinematics};
+use crate::algorithms::{crba, crba_base, kane_direct, recurrent, rnea};
+use crate::loads::Loads;
+use crate::params::Params;
+use crate::scalar::Scalar;
+
+/// `A` (full symmetric, row-major `a[i][j]`) and `b` of `A q̈ = b`.
+#[derive(Clone, Debug)]
+pub struct Dynamics<S> {
+    /// Generalized inertia matrix, N×N, both triangles filled.
+    pub a: Vec<Vec<S>>,
+    /// Generalized forces `b = Q − h`.
+    pub b: Vec<S>,
+}
+
+/// How the generalized inertia matrix `A(q)` is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum MassMatrixMethod {
+    /// The paper's recurrent algorithm, (14b) as R2 (exact).
+    Recurrent,
+    /// The paper's recurrent algorithm, (14b) as R1 (the paper's per-matrix cost plus an O(N)
+    /// correction).
+    RecurrentR1,
+    /// The direct Kane sum (9), O(N³).
+    KaneDirect,
+    /// Composite rigid bodies in the paper's base-frame notation (Stepanenko's baseline).
+    CrbaBase,
+    /// Featherstone's composite-rigid-body algorithm in local frames (RBDA Table 6.2).
+    Crba,
+}
+
+impl MassMatrixMethod {
+    /// All methods, in report order.
+    pub const ALL: [MassMatrixMethod; 5] = [
+        MassMatrixMethod::Recurrent,
+        MassMatrixMethod::RecurrentR1,
+        MassMatrixMethod::KaneDirect,
+        MassMatrixMethod::CrbaBase,
+        MassMatrixMethod::Crba,
+    ];
+
+    /// Its name in reports and generated headers.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            MassMatrixMethod::Recurrent => "recurrent",
+            MassMatrixMethod::RecurrentR1 => "recurrent-r1",
+            MassMatrixMethod::KaneDirect => "kane-direct",
+            MassMatrixMethod::CrbaBase => "crba-base",
+            MassMatrixMethod::Crba => "crba",
+        }
+    }
+
+    /// The method called `name` ([`MassMatrixMethod::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// `A` from the base-frame quantities of eq. (1), (2), (6) (fixed base, or the free-floating
+    /// base's virtual-joint extension); `None` for [`MassMatrixMethod::Crba`], which works in
+    /// local frames from `q`.
+    pub fn from_base_frame<S: Scalar>(self, kin: &[BodyKinematics<S>]) -> Option<Vec<Vec<S>>> {
+        match self {
+            MassMatrixMethod::Recurrent => {
+                Some(recurrent::mass_matrix_base(kin, recurrent::Variant::R2))
+            }
+            MassMatrixMethod::RecurrentR1 => {
+                Some(recurrent::mass_matrix_base(kin, recurrent::Variant::R1))
+            }
+            MassMatrixMethod::KaneDirect => Some(kane_direct::mass_matrix_base(kin)),
+            MassMatrixMethod::CrbaBase => Some(crba_base::mass_matrix_base(kin)),
+            MassMatrixMethod::Crba => None,
+        }
+    }
+
+    /// The generalized inertia matrix `A(q)`, fixed base.
+    pub fn mass_matrix<S: Scalar>(self, p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
+        match self {
+            MassMatrixMethod::Crba => crba::mass_matrix(p, q),
+            base_frame => base_frame
+                .from_base_frame(&kinematics::base_frame(p, q))
+                .expect("every method but the CRBA starts from base-frame quantities"),
+        }
+    }
+}
+
+/// How the generalized forces `b = Q − h` (and so the nonlinear effects `c = −b(τ = 0)`) are
+/// computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum BiasMethod {
+    /// The paper's base-frame backward recursion (17)–(19), (21).
+    Recurrent,
+    /// The direct Kane sum (10).
+    KaneDirect,
+    /// Featherstone's recursive Newton–Euler algorithm in local frames (RBDA Table 5.1).
+    Rnea,
+}
+
+impl BiasMethod {
+    /// All methods, in report order.
+    pub const ALL: [BiasMethod; 3] = [
+        BiasMethod::Recurrent,
+        BiasMethod::KaneDirect,
+        BiasMethod::Rnea,
+    ];
+
+    /// Its name in reports and generated headers.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            BiasMethod::Recurrent => "recurrent",
+            BiasMethod::KaneDirect => "kane-direct",
+            BiasMethod::Rnea => "rnea",
+        }
+    }
+
+    /// The method called `name` ([`BiasMethod::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+
+    /// The generalized forces `b(q, q̇, loads) = Q − h`, fixed base.
+    pub fn bias<S: Scalar>(self, p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+        match self {
+            BiasMethod::Recurrent => recurrent::bias(p, q, qd, loads),
+            BiasMethod::KaneDirect => kane_direct::bias(p, q, qd, loads),
+            BiasMethod::Rnea => rnea::bias(p, q, qd, loads),
+        }
+    }
+}
+
+/// A mass-matrix method and a bias method.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub struct Methods {
+    /// How `A` is computed.
+    pub mass_matrix: MassMatrixMethod,
+    /// How `b` is computed.
+    pub bias: BiasMethod,
+}
+
+impl Methods {
+    /// `recurrent`: the paper's recurrent algorithm for both.
+    pub const RECURRENT: Methods = Methods {
+        mass_matrix: MassMatrixMethod::Recurrent,
+        bias: BiasMethod::Recurrent,
+    };
+    /// `recurrent-r1`: (14b) as R1, with the paper's bias recursion.
+    pub const RECURRENT_R1: Methods = Methods {
+        mass_matrix: MassMatrixMethod::RecurrentR1,
+        bias: BiasMethod::Recurrent,
+    };
+    /// `kane-direct`: the direct sums (9) and (10).
+    pub const KANE_DIRECT: Methods = Methods {
+        mass_matrix: MassMatrixMethod::KaneDirect,
+        bias: BiasMethod::KaneDirect,
+    };
+    /// `crba-base`: base-frame composite rigid bodies, with the paper's bias recursion.
+    pub const CRBA_BASE: Methods = Methods {
+        mass_matrix: MassMatrixMethod::CrbaBase,
+        bias: BiasMethod::Recurrent,
+    };
+    /// `spatial`: Featherstone's CRBA and RNEA in local frames.
+    pub const SPATIAL: Methods = Methods {
+        mass_matrix: MassMatrixMethod::Crba,
+        bias: BiasMethod::Rnea,
+    };
+
+    /// The presets, by the CLI's `--algorithm` names, in report order.
+    pub const PRESETS: [(&'static str, Methods); 5] = [
+        ("recurrent", Methods::RECURRENT),
+        ("recurrent-r1", Methods::RECURRENT_R1),
+        ("kane-direct", Methods::KANE_DIRECT),
+        ("crba-base", Methods::CRBA_BASE),
+        ("spatial", Methods::SPATIAL),
+    ];
+
+    /// The presets' methods ([`Methods::PRESETS`] without the names).
+    pub const ALL: [Methods; 5] = [
+        Methods::RECURRENT,
+        Methods::RECURRENT_R1,
+        Methods::KANE_DIRECT,
+        Methods::CRBA_BASE,
+        Methods::SPATIAL,
+    ];
+
+    /// The preset called `name` ([`Methods::PRESETS`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Methods> {
+        Self::PRESETS
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|(_, m)| *m)
+    }
+
+    /// The preset's name, or `mass+bias` for a combination that is no preset.
+    #[must_use]
+    pub fn name(self) -> String {
+        Self::PRESETS.iter().find(|(_, m)| *m == self).map_or_else(
+            || format!("{}+{}", self.mass_matrix.name(), self.bias.name()),
+            |(n, _)| (*n).to_string(),
+        )
+    }
+
+    /// `A` and `b` together, fixed base.
+    pub fn dynamics<S: Scalar>(
+        self,
+        p: &Params<S>,
+        q: &[S],
+        qd: &[S],
+        loads: &Loads<S>,
+    ) -> Dynamics<S> {
+        Dynamics {
+            a: self.mass_matrix.mass_matrix(p, q),
+            b: self.bias.bias(p, q, qd, loads),
+        }
+    }
+
+    /// Forward dynamics `q̈ = A⁻¹ b`, by the branch-free LDLᵀ of [`crate::ldlt`].
+    pub fn forward_dynamics<S: Scalar>(
+        self,
+        p: &Params<S>,
+        q: &[S],
+        qd: &[S],
+        loads: &Loads<S>,
+    ) -> Vec<S> {
+        let d = self.dynamics(p, q, qd, loads);
+        crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+    }
+
+    /// Inverse dynamics: the joint drives `τ` for which `A q̈ = b(q, q̇, τ)` holds (`loads.tau` is
+    /// ignored). With the RNEA bias method, one O(N) pass ([`rnea::inverse_dynamics`]);
+    /// otherwise `τ = A q̈ − b(q, q̇, τ = 0)` from this pair's own `A` and `b`.
+    pub fn inverse_dynamics<S: Scalar>(
+        self,
+        p: &Params<S>,
+        q: &[S],
+        qd: &[S],
+        qdd: &[S],
+        loads: &Loads<S>,
+    ) -> Vec<S> {
+        let passive = loads.passive();
+        if self.bias == BiasMethod::Rnea {
+            return rnea::inverse_dynamics(p, q, qd, qdd, &passive);
+        }
+        let d = self.dynamics(p, q, qd, &passive);
+        d.a.iter()
+            .zip(d.b)
+            .map(|(row, bi)| {
+                row.iter()
+                    .zip(qdd)
+                    .fold(S::zero(), |acc, (aij, x)| acc + aij.clone() * x.clone())
+                    - bi
+            })
+            .collect()
+    }
+}
+
+impl core::fmt::Display for Methods {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(&self.name())
+    }
+}

@@ -1,0 +1,29 @@
+//! The dynamics algorithms, one per file, each generic over the scalar.
+//!
+//! Every algorithm computes the generalized inertia matrix `A(q)` and/or the generalized force
+//! vector `b(q, q̇, loads) = Q − h` of `A q̈ = b` (paper eq. (8)): `Q` the joint drives plus the
+//! generalized external loads and gravity, `h` the velocity-product terms. In the field's
+//! convention `M q̈ + c = τ`: `M = A` and the nonlinear effects are `c = −b(τ = 0)`.
+//!
+//! | file | what |
+//! |---|---|
+//! | [`kinematics`] | the paper's base-frame kinematics (1)–(7) and resultants (11) |
+//! | [`recurrent`] | the paper's O(N²) recursion (12)–(21) |
+//! | [`kane_direct`] | the direct Kane sums (9)–(11), O(N³) |
+//! | [`crba_base`] | composite rigid bodies in base-frame notation |
+//! | [`crba`] | Featherstone's local-frame CRBA (fixed and floating base) |
+//! | [`rnea`] | Featherstone's local-frame RNEA: bias forces and O(N) inverse dynamics |
+//! | [`floating`] | a free-floating base: the base-frame algorithms on six virtual joints, momentum, Jacobians |
+//! | [`methods`] | the choice of mass-matrix and bias method, and the fixed-base dispatch |
+//!
+//! Module dependencies run one way: `methods` and `floating` use the algorithm files, which use
+//! `kinematics` and the crate's leaf modules; no algorithm file uses `methods` or `floating`.
+
+pub mod crba;
+pub mod crba_base;
+pub mod floating;
+pub mod kane_direct;
+pub mod kinematics;
+pub mod methods;
+pub mod recurrent;
+pub mod rnea;

@@ -1,0 +1,234 @@
+//! The recursive Newton–Euler algorithm in local body coordinates (RBDA Table 5.1; spatial_v2
+//! `ID`, and the `C` part of `HandC`): inverse dynamics in one O(N) pass, and the bias forces
+//! with `q̈ = 0`. Spatial algebra and conventions: [`crate::spatial`].
+//!
+//! Forward pass: `v_i = Xup_i v_λ + vJ_i`, `a_i = Xup_i a_λ + S_i q̈_i + v_i ×ₘ vJ_i`,
+//! `f_i = I_i a_i + v_i ×* I_i v_i − f^x_i`; backward pass: `τ_i = S_iᵀ f_i`,
+//! `f_λ += Xup_iᵀ f_i`. Gravity is the fictitious base acceleration `a_0 = −a_grav = [0; −g]`
+//! (RBDA §5.3); external wrenches enter as `−f^x_i`.
+//!
+//! ```
+//! use kanegen_dynamics::algorithms::{crba, rnea};
+//! use kanegen_dynamics::{Loads, Params};
+//! use kanegen_model::random::{random_chain, ChainSpec};
+//! let model = random_chain(&ChainSpec { n: 3, ..Default::default() }, 1);
+//! let p = Params::<f64>::new(&model);
+//! let (q, qd, qdd) = ([0.1, -0.4, 0.9], [0.5, 0.2, -0.3], [1.0, 0.0, -2.0]);
+//! // τ = H q̈ + C: one O(N) pass against the mass matrix and the q̈ = 0 pass.
+//! let tau = rnea::inverse_dynamics(&p, &q, &qd, &qdd, &Loads::default());
+//! let h = crba::mass_matrix(&p, &q);
+//! let b = rnea::bias(&p, &q, &qd, &Loads::default());
+//! for i in 0..3 {
+//!     let hq: f64 = (0..3).map(|j| h[i][j] * qdd[j]).sum();
+//!     assert!((tau[i] - (hq - b[i])).abs() < 1e-9);
+//! }
+//! ```
+
+use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
+use crate::linalg::{Mat3, Vec3};
+use crate::loads::{LoadFrame, Loads};
+use crate::params::Params;
+use crate::scalar::Scalar;
+use crate::spatial::{base_rows, s_times, s_tr, xup, Force, Motion, RbInertia, Xform};
+
+/// The starting motion of the forward pass: the velocity and acceleration of "body −1" in its own
+/// coordinates, and `E_0`, the rotation from the frame of base-frame (`LoadFrame::Base`)
+/// wrenches to body −1 coordinates (identity for a fixed base).
+struct Start<S> {
+    v: Motion<S>,
+    a: Motion<S>,
+    e0: Mat3<S>,
+}
+
+/// `−f^x`: the external wrenches on `body`, in the coordinates of that body (`e0`: rotation from
+/// the wrenches' base frame to the body), subtracted one by one from `f`.
+fn subtract_external<S: Scalar>(
+    mut f: Force<S>,
+    loads: &Loads<S>,
+    body: usize,
+    e0: &Mat3<S>,
+) -> Force<S> {
+    for ext in loads.external.iter().filter(|e| e.body == body) {
+        let fx = match ext.frame {
+            LoadFrame::Body => Force {
+                ang: ext.moment.clone(),
+                lin: ext.force.clone(),
+            },
+            LoadFrame::Base => Force {
+                ang: e0.mul_vec(&ext.moment),
+                lin: e0.mul_vec(&ext.force),
+            },
+        };
+        f = f - fx;
+    }
+    f
+}
+
+/// Both passes: `(τ_i = S_iᵀ f_i for every joint, f_0 carried onto body −1)`. `qdd = None` is
+/// `q̈ = 0` and adds no operation.
+fn passes<S: Scalar>(
+    p: &Params<S>,
+    q: &[S],
+    qd: &[S],
+    qdd: Option<&[S]>,
+    loads: &Loads<S>,
+    start: Start<S>,
+) -> (Vec<S>, Option<Force<S>>) {
+    let n = p.dof();
+    assert_eq!(q.len(), n, "q has the wrong length");
+    assert_eq!(qd.len(), n, "qd has the wrong length");
+    if let Some(qdd) = qdd {
+        assert_eq!(qdd.len(), n, "qdd has the wrong length");
+    }
+    assert!(
+        loads
+            .external
+            .iter()
+            .all(|e| e.body < n || e.body == BASE_BODY),
+        "an external wrench names a body past the end of the chain"
+    );
+    let need_rot = loads.external.iter().any(|e| e.frame == LoadFrame::Base);
+    let Start {
+        v: mut v_prev,
+        a: mut a_prev,
+        e0: mut e0_prev,
+    } = start;
+    let mut xups: Vec<Xform<S>> = Vec::with_capacity(n);
+    let mut f: Vec<Force<S>> = Vec::with_capacity(n);
+    // Forward pass.
+    for (j, (jp, (qj, qdj))) in p.joints.iter().zip(q.iter().zip(qd)).enumerate() {
+        let x = xup(jp, qj);
+        let vj = s_times(jp, qdj);
+        // v_j = Xup_j v_λ + vJ
+        let v = x.apply(&v_prev) + vj.clone();
+        // a_j = Xup_j a_λ + S_j q̈_j + v_j ×ₘ vJ   (cJ = 0)
+        let mut a = x.apply(&a_prev);
+        if let Some(qdd) = qdd {
+            a = a + s_times(jp, &qdd[j]);
+        }
+        let a = a + v.crm(&vj);
+        // f_j = I_j a_j + v_j ×* I_j v_j − f^x_j
+        let inertia = RbInertia::mci(jp);
+        let fj = inertia.mul(&a) + v.crf(&inertia.mul(&v));
+        if need_rot {
+            e0_prev = x.e.mul_mat(&e0_prev);
+        }
+        f.push(subtract_external(fj, loads, j, &e0_prev));
+        v_prev = v;
+        a_prev = a;
+        xups.push(x);
+    }
+    // Backward pass: τ_j = S_jᵀ f_j; f_λ += Xup_jᵀ f_j.
+    let mut tau = vec![S::zero(); n];
+    let mut onto_base = None;
+    for j in (0..n).rev() {
+        tau[j] = s_tr(&p.joints[j], &f[j]);
+        let carried = xups[j].tr_apply(&f[j]);
+        if j > 0 {
+            let parent = f[j - 1].clone();
+            f[j - 1] = parent + carried;
+        } else {
+            onto_base = Some(carried);
+        }
+    }
+    (tau, onto_base)
+}
+
+/// A fixed base: at rest, accelerating upwards by `−g` (gravity as a fictitious acceleration).
+fn fixed_start<S: Scalar>(loads: &Loads<S>) -> Start<S> {
+    Start {
+        v: Motion::zero(),
+        a: match &loads.gravity {
+            Some(g) => Motion {
+                ang: Vec3::zero(),
+                lin: -g.clone(),
+            },
+            None => Motion::zero(),
+        },
+        e0: Mat3::identity(),
+    }
+}
+
+/// Adds the drives: `b_j = τ_j − C_j` (or `−C_j` without drives).
+fn with_drives<S: Scalar>(c: Vec<S>, loads: &Loads<S>) -> Vec<S> {
+    match &loads.tau {
+        Some(tau) => {
+            assert_eq!(tau.len(), c.len(), "loads.tau has the wrong length");
+            tau.iter().zip(c).map(|(t, c)| t.clone() - c).collect()
+        }
+        None => c.into_iter().map(|c| -c).collect(),
+    }
+}
+
+/// The generalized forces `b = Q − C(q, q̇, f_ext)` with `q̈ = 0`, fixed base.
+///
+/// `p`: the model's parameters; `q`, `q̇`: joint positions and velocities, length `N`; `loads`:
+/// joint drives `Q = loads.tau` (added when present), gravity `g` in the base frame (entered as
+/// the base acceleration `a_0 = [0; −g]`), and external wrenches (force at `O_j`, moment about
+/// `O_j`; base-frame ones are rotated into body coordinates with the body's orientation), which
+/// enter `C` as `−f^x_j`. Section `"spatial:rnea"`.
+pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    S::section("spatial:rnea");
+    let (c, _) = passes(p, q, qd, None, loads, fixed_start(loads));
+    with_drives(c, loads)
+}
+
+/// Inverse dynamics, fixed base: the joint drives `τ = H(q) q̈ + C(q, q̇, f_ext)` (gravity and
+/// external wrenches of `loads` included; `loads.tau` is ignored), in one O(N) pass.
+/// Section `"spatial:rnea"`.
+pub fn inverse_dynamics<S: Scalar>(
+    p: &Params<S>,
+    q: &[S],
+    qd: &[S],
+    qdd: &[S],
+    loads: &Loads<S>,
+) -> Vec<S> {
+    S::section("spatial:rnea");
+    passes(p, q, qd, Some(qdd), loads, fixed_start(loads)).0
+}
+
+/// The generalized forces `b` (`6 + N` entries) of the arm `p` on the free-floating base `base`
+/// in the state `state` (conventions of [`crate::base`]), RNEA with `ν̇ = 0`: base
+/// `v_0 = [ω_b; v_b]`, `a_0 = [0; −R₀ᵀ g]`, `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 − f^x_0`, the arm as in
+/// [`bias`], `f_0 += Xup_0ᵀ f_arm,0`; then `b_base = −[f_0.f; f_0.n]`, `b_arm,j = τ_j − S_jᵀ f_j`.
+/// Inertial-frame wrenches are rotated into body coordinates with `E_{0j} R₀ᵀ`.
+/// Section `"spatial:floating"`.
+pub fn floating_bias<S: Scalar>(
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+) -> Vec<S> {
+    S::section("spatial:floating");
+    let r0t = state.rotation.transpose();
+    let v0 = Motion {
+        ang: state.omega_b.clone(),
+        lin: state.v_b.clone(),
+    };
+    let a0 = match &loads.gravity {
+        Some(g) => Motion {
+            ang: Vec3::zero(),
+            lin: -r0t.mul_vec(g),
+        },
+        None => Motion::zero(),
+    };
+    let i_base = RbInertia::from_com(&base.mass, &base.com, &base.inertia_com);
+    let f0 = i_base.mul(&a0) + v0.crf(&i_base.mul(&v0));
+    let f0 = subtract_external(f0, loads, BASE_BODY, &r0t);
+    let start = Start {
+        v: v0,
+        a: a0,
+        e0: r0t,
+    };
+    let (c, onto_base) = passes(p, q, qd, None, loads, start);
+    let f0 = match onto_base {
+        Some(f) => f0 + f,
+        None => f0,
+    };
+    let mut b: Vec<S> = base_rows(&f0).into_iter().map(|x| -x).collect();
+    debug_assert_eq!(b.len(), FLOATING_BASE_DOF);
+    b.extend(with_drives(c, loads));
+    b
+}

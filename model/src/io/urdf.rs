@@ -1,0 +1,239 @@
+//! URDF reader (serial chains; fixed joints merged into their parent body).
+//!
+//! Parsed with `urdf-rs`, which fills a missing `<inertial>` with zeros: such a link is treated
+//! as massless, which is fine when it is merged through a fixed joint into a body with mass; a
+//! moving body that ends up massless is rejected by [`Model::new`] (mass must be > 0).
+
+use crate::placement::{Placement, M3};
+use crate::{Inertial, Joint, JointKind, Model, ModelError, Validation};
+use std::collections::{HashMap, HashSet};
+use urdf_rs::JointType;
+
+/// Parses a URDF document into a [`Model`].
+///
+/// * Revolute, continuous (treated as revolute), prismatic and fixed joints are accepted;
+///   floating, planar and spherical joints are rejected naming the joint.
+/// * The root is the link that is no joint's child; the chain is walked from it, and a link with
+///   more than one child joint is rejected with [`ModelError::Branching`].
+/// * Fixed joints are merged: the child's inertial is added to the parent body (combined mass,
+///   CoM, and inertia about the combined CoM by the parallel-axis theorem, in the parent body
+///   frame), and the fixed joint's origin is composed into the next moving joint's origin.
+///   Fixed links before the first moving joint merge into the base; fixed links after the last
+///   moving joint merge into the last body.
+/// * The inertial `<origin>` is honoured: `com = xyz`, `I_body = R(rpy) I_urdf Rᵀ`.
+/// * Visual and collision elements are ignored (meshes are never opened).
+///
+/// The chain is named after the robot; the base after the root link, whose (merged) inertial
+/// becomes the base inertial when its mass is non-zero.
+pub fn parse_urdf(text: &str) -> Result<Model, ModelError> {
+    parse_urdf_with(text, Validation::default())
+}
+
+/// [`parse_urdf`] under the given [`Validation`].
+pub fn parse_urdf_with(text: &str, validation: Validation) -> Result<Model, ModelError> {
+    let robot =
+        urdf_rs::read_from_string(text).map_err(|e| ModelError::Parse(format!("URDF: {e}")))?;
+
+    let mut links = HashMap::new();
+    for l in &robot.links {
+        if links.insert(l.name.as_str(), l).is_some() {
+            return Err(ModelError::Duplicate {
+                name: l.name.clone(),
+                what: "link".into(),
+            });
+        }
+    }
+    let mut joint_names = HashSet::new();
+    let mut children: HashMap<&str, Vec<&urdf_rs::Joint>> = HashMap::new();
+    let mut is_child = HashSet::new();
+    for j in &robot.joints {
+        if !joint_names.insert(j.name.as_str()) {
+            return Err(ModelError::Duplicate {
+                name: j.name.clone(),
+                what: "joint".into(),
+            });
+        }
+        match j.joint_type {
+            JointType::Revolute | JointType::Continuous | JointType::Prismatic | JointType::Fixed => {}
+            ref other => {
+                return Err(ModelError::invalid(
+                    &j.name,
+                    "type",
+                    format!(
+                        "{other:?} joints are not supported (only revolute, continuous, prismatic and fixed)"
+                    )
+                    .to_lowercase(),
+                ))
+            }
+        }
+        for (end, link) in [("parent", &j.parent.link), ("child", &j.child.link)] {
+            if !links.contains_key(link.as_str()) {
+                return Err(ModelError::invalid(
+                    &j.name,
+                    end,
+                    format!("unknown link `{link}`"),
+                ));
+            }
+        }
+        if !is_child.insert(j.child.link.as_str()) {
+            return Err(ModelError::invalid(
+                &j.name,
+                "child",
+                format!(
+                    "link `{}` is the child of more than one joint",
+                    j.child.link
+                ),
+            ));
+        }
+        children.entry(j.parent.link.as_str()).or_default().push(j);
+    }
+    let roots: Vec<&str> = robot
+        .links
+        .iter()
+        .map(|l| l.name.as_str())
+        .filter(|n| !is_child.contains(n))
+        .collect();
+    let root = match roots.as_slice() {
+        [r] => *r,
+        [] => {
+            return Err(ModelError::Parse(format!(
+                "URDF `{}`: no root link (every link is some joint's child)",
+                robot.name
+            )))
+        }
+        many => {
+            return Err(ModelError::Parse(format!(
+                "URDF `{}`: several root links ({}); the model must be one connected chain",
+                robot.name,
+                many.join(", ")
+            )))
+        }
+    };
+
+    // Walk from the root, accumulating the current body and the fixed-joint offset from the
+    // current body frame to the current link frame.
+    let mut acc: Option<Inertial> = None;
+    let mut offset = Placement::identity();
+    add_link(&mut acc, &offset, links[root], root)?;
+    let mut base_inertial: Option<Inertial> = None;
+    let mut joints: Vec<Joint> = Vec::new();
+    let mut link = root;
+    let mut visited = 0usize;
+    loop {
+        visited += 1;
+        if visited > robot.links.len() {
+            return Err(ModelError::Parse(format!(
+                "URDF `{}`: the joint graph has a cycle",
+                robot.name
+            )));
+        }
+        let kids = children.get(link).map(Vec::as_slice).unwrap_or(&[]);
+        let j = match kids {
+            [] => break,
+            [j] => *j,
+            _ => return Err(ModelError::Branching(link.to_string())),
+        };
+        let origin = Placement::from_xyz_rpy(*j.origin.xyz, *j.origin.rpy);
+        let child = links[j.child.link.as_str()];
+        let kind = match j.joint_type {
+            JointType::Fixed => None,
+            JointType::Prismatic => Some(JointKind::Prismatic),
+            _ => Some(JointKind::Revolute),
+        };
+        match kind {
+            None => {
+                offset = offset.then(&origin);
+                add_link(&mut acc, &offset, child, &j.name)?;
+            }
+            Some(kind) => {
+                let done = inertial_of(&acc);
+                match joints.last_mut() {
+                    Some(prev) => prev.inertial = done,
+                    None => base_inertial = (done.mass != 0.0).then_some(done),
+                }
+                joints.push(Joint {
+                    name: j.name.clone(),
+                    kind,
+                    origin: offset.then(&origin),
+                    axis: *j.axis.xyz,
+                    body: child.name.clone(),
+                    inertial: Inertial {
+                        mass: 0.0,
+                        com: [0.0; 3],
+                        inertia: [[0.0; 3]; 3],
+                    },
+                });
+                acc = None;
+                offset = Placement::identity();
+                add_link(&mut acc, &offset, child, &j.name)?;
+            }
+        }
+        link = j.child.link.as_str();
+    }
+    let done = inertial_of(&acc);
+    match joints.last_mut() {
+        Some(prev) => prev.inertial = done,
+        None => base_inertial = (done.mass != 0.0).then_some(done),
+    }
+    if visited < robot.links.len() {
+        return Err(ModelError::Parse(format!(
+            "URDF `{}`: {} link(s) are not reachable from the root `{root}`",
+            robot.name,
+            robot.links.len() - visited
+        )));
+    }
+    Model::new_with(robot.name.clone(), root, base_inertial, joints, validation)
+}
+
+/// The accumulated body, or a massless one (rejected later if it is a moving body).
+fn inertial_of(acc: &Option<Inertial>) -> Inertial {
+    acc.clone().unwrap_or(Inertial {
+        mass: 0.0,
+        com: [0.0; 3],
+        inertia: [[0.0; 3]; 3],
+    })
+}
+
+/// Adds a link's `<inertial>` (placed at `offset` in the body frame) to the body.
+/// Errors name `owner` (the joint whose child the link is, or the root link) and the link.
+fn add_link(
+    acc: &mut Option<Inertial>,
+    offset: &Placement,
+    link: &urdf_rs::Link,
+    owner: &str,
+) -> Result<(), ModelError> {
+    let inl = &link.inertial;
+    let m = inl.mass.value;
+    if !m.is_finite() || m < 0.0 {
+        return Err(ModelError::invalid(
+            owner,
+            &format!("inertial.mass (link `{}`)", link.name),
+            format!("link mass must be finite and ≥ 0, got {m}"),
+        ));
+    }
+    let i = &inl.inertia;
+    let inertia: M3 = [
+        [i.ixx, i.ixy, i.ixz],
+        [i.ixy, i.iyy, i.iyz],
+        [i.ixz, i.iyz, i.izz],
+    ];
+    if m == 0.0 {
+        if inertia.iter().flatten().any(|x| *x != 0.0) {
+            return Err(ModelError::invalid(
+                owner,
+                &format!("inertial.inertia (link `{}`)", link.name),
+                "a massless link must have zero inertia",
+            ));
+        }
+        return Ok(());
+    }
+    let frame = offset.then(&Placement::from_xyz_rpy(*inl.origin.xyz, *inl.origin.rpy));
+    let part = Inertial {
+        mass: m,
+        com: [0.0; 3],
+        inertia,
+    }
+    .moved(&frame);
+    *acc = Inertial::merge_opt(acc.take(), Some(part));
+    Ok(())
+}

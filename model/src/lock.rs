@@ -1,0 +1,69 @@
+//! Locking a joint: the model with one joint turned into a fixed placement.
+
+use crate::placement::{axis_rotation, mat_mul, mat_vec, Placement};
+use crate::{JointKind, Model, ModelError, Validation};
+
+impl Model {
+    /// The model with joint `index` locked at `value` (rad or m): the joint becomes a fixed
+    /// placement and its body is merged into its parent (the previous body, or the base when
+    /// `index == 0`) by [`crate::Inertial::merge`]; the next joint's origin is re-expressed in the
+    /// parent frame. The result has `N − 1` joints and the same dynamics as the original with
+    /// `q[index] = value` and `q̇[index] = 0` (rows and columns of the locked joint removed). The
+    /// merged inertia is not re-checked for the triangle inequality (it holds when it held for
+    /// the parts).
+    ///
+    /// # Errors
+    /// If `index` is out of range or the model would become empty.
+    pub fn lock_joint(&self, index: usize, value: f64) -> Result<Model, ModelError> {
+        let n = self.joints().len();
+        if index >= n {
+            return Err(ModelError::invalid(
+                &format!("#{index}"),
+                "lock_joint",
+                format!("joint index {index} out of range (N = {n})"),
+            ));
+        }
+        let j = &self.joints()[index];
+        // Placement of body `index` in its parent frame at q = value.
+        let ups = &j.origin.rotation;
+        let moved = match j.kind {
+            JointKind::Revolute => {
+                let (s, c) = value.sin_cos();
+                Placement {
+                    translation: j.origin.translation,
+                    rotation: mat_mul(ups, &axis_rotation(&j.axis, s, c)),
+                }
+            }
+            JointKind::Prismatic => {
+                let d = mat_vec(ups, &j.axis.map(|a| value * a));
+                Placement {
+                    translation: [0, 1, 2].map(|k| j.origin.translation[k] + d[k]),
+                    rotation: *ups,
+                }
+            }
+        };
+        // The locked body's mass properties in the parent frame.
+        let body = j.inertial.moved(&moved);
+        let mut joints = self.joints().to_vec();
+        let mut base_inertial = self.base_inertial().cloned();
+        if index == 0 {
+            base_inertial = base_inertial.map(|b| b.merge(&body));
+        } else {
+            let parent = &mut joints[index - 1].inertial;
+            *parent = parent.merge(&body);
+        }
+        if let Some(next) = joints.get_mut(index + 1) {
+            next.origin = moved.then(&next.origin);
+        }
+        joints.remove(index);
+        Model::new_with(
+            self.name(),
+            self.base(),
+            base_inertial,
+            joints,
+            Validation {
+                allow_nonphysical_inertia: true,
+            },
+        )
+    }
+}

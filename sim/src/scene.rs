@@ -1,0 +1,749 @@
+//! Simulation scenes: a TOML file naming a model, the base (fixed or free-floating),
+//! an optional payload, the effects (gravity, joint damping, constant or tabulated wrenches), the joint
+//! drives, the initial state and the integrator. See README.md, "Simulation scenes".
+//!
+//! Every table rejects unknown keys, and every validation error names its key
+//! (`simulation.tolerance: must be > 0`). "Effects decide the code": only the effects a scene
+//! names end up in the [`Loads`](kanegen_dynamics::Loads) of the simulation.
+//!
+//! ```
+//! let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("..");
+//! let scene = kanegen_sim::scene::Scene::parse(r#"
+//!     model = "models/two_link.toml"
+//!     [simulation]
+//!     duration = 1.0
+//! "#, &dir).unwrap();
+//! assert_eq!(scene.q0.len(), scene.model.dof());
+//! ```
+
+use anyhow::{anyhow, bail, Context, Result};
+use kanegen_dynamics::base::BASE_BODY;
+use kanegen_dynamics::linalg::Vec3;
+use kanegen_dynamics::{ExternalWrench, LoadFrame, Methods};
+use kanegen_model::io::InertiaSpec;
+use kanegen_model::{Inertial, Model, Validation};
+use serde::Deserialize;
+use std::path::Path;
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawScene {
+    model: String,
+    #[serde(default)]
+    allow_nonphysical: bool,
+    base: Option<RawBase>,
+    payload: Option<RawPayload>,
+    #[serde(default)]
+    effects: RawEffects,
+    drives: Option<RawDrives>,
+    #[serde(default)]
+    initial: RawInitial,
+    simulation: RawSimulation,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBase {
+    #[serde(rename = "type")]
+    kind: String,
+    mass: Option<f64>,
+    com: Option<[f64; 3]>,
+    inertia: Option<InertiaSpec>,
+    position: Option<[f64; 3]>,
+    quaternion: Option<[f64; 4]>,
+    v: Option<[f64; 3]>,
+    omega: Option<[f64; 3]>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawPayload {
+    /// Name of the body (link) that holds the payload; default the last body.
+    body: Option<String>,
+    mass: f64,
+    com: [f64; 3],
+    inertia: InertiaSpec,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawEffects {
+    gravity: Option<[f64; 3]>,
+    damping: Option<Vec<f64>>,
+    #[serde(default)]
+    wrench: Vec<RawWrench>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawWrench {
+    body: String,
+    frame: String,
+    /// Sample times of a tabulated wrench (strictly increasing, s); absent for a constant one.
+    time: Option<Vec<f64>>,
+    force: Option<RawProfile>,
+    moment: Option<RawProfile>,
+}
+
+/// One vector (constant wrench) or one row per sample time (tabulated wrench).
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawProfile {
+    Constant([f64; 3]),
+    Table(Vec<[f64; 3]>),
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum RawGain {
+    Scalar(f64),
+    Vector(Vec<f64>),
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawDrives {
+    #[serde(rename = "type")]
+    kind: String,
+    kp: Option<RawGain>,
+    kd: Option<RawGain>,
+    target: Option<Vec<f64>>,
+    duration_s: Option<f64>,
+    tau: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+struct RawInitial {
+    q: Option<Vec<f64>>,
+    qd: Option<Vec<f64>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawSimulation {
+    duration: f64,
+    integrator: Option<String>,
+    step: Option<f64>,
+    tolerance: Option<f64>,
+    max_step: Option<f64>,
+    output_every: Option<usize>,
+    algorithm: Option<String>,
+}
+
+/// The base of a scene.
+// One value per scene: the size difference of the variants does not matter.
+#[allow(clippy::large_enum_variant)]
+#[derive(Clone, Debug)]
+pub enum BaseSpec {
+    /// Fixed to the inertial frame.
+    Fixed,
+    /// Free-floating (see [`kanegen_dynamics::base`] for the conventions).
+    FreeFloating {
+        /// Mass properties of the base body (base frame).
+        inertial: Inertial,
+        /// Initial `p₀`.
+        position: [f64; 3],
+        /// Initial attitude, unit quaternion `[x, y, z, w]`.
+        quaternion: [f64; 4],
+        /// Initial `v_b` (base coordinates).
+        v: [f64; 3],
+        /// Initial `ω_b` (base coordinates).
+        omega: [f64; 3],
+    },
+}
+
+/// Joint drives.
+#[derive(Clone, Debug)]
+pub enum Drives {
+    /// No drive torques.
+    None,
+    /// Constant joint torques/forces `τ`.
+    Constant {
+        /// The `N` drive values.
+        tau: Vec<f64>,
+    },
+    /// `τ = kp (q_target − q) − kd q̇`.
+    Pd {
+        /// Proportional gains (`N`).
+        kp: Vec<f64>,
+        /// Derivative gains (`N`).
+        kd: Vec<f64>,
+        /// Target positions (`N`).
+        target: Vec<f64>,
+    },
+    /// Computed torque along a quintic from the initial `q` to `target` over `duration`:
+    /// `τ = ID(q, q̇, q̈_d + kd (q̇_d − q̇) + kp (q_d − q))` (fixed base only).
+    ComputedTorque {
+        /// Proportional gains (`N`).
+        kp: Vec<f64>,
+        /// Derivative gains (`N`).
+        kd: Vec<f64>,
+        /// Final positions (`N`).
+        target: Vec<f64>,
+        /// Duration of the quintic, s.
+        duration: f64,
+    },
+}
+
+/// The integrator of a scene.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Integrator {
+    /// Fixed-step RK4 with the scene's `step`.
+    Rk4,
+    /// Adaptive Dormand–Prince 5(4) with `rtol = atol = tolerance`.
+    Dopri5,
+    /// Fixed-step Lie-group implicit midpoint rule with the scene's `step` (long runs: bounded
+    /// energy error, unit quaternion without projection; see `integrate::midpoint`).
+    Midpoint,
+}
+
+/// The `[simulation]` table, validated.
+#[derive(Clone, Debug)]
+pub struct SimulationSpec {
+    /// End time, s.
+    pub duration: f64,
+    /// The integrator.
+    pub integrator: Integrator,
+    /// RK4 and midpoint step; for dopri5 the first step tried (default 0.01 s).
+    pub step: f64,
+    /// dopri5 tolerance (default 1e-8).
+    pub tolerance: f64,
+    /// dopri5 largest step (default: the duration).
+    pub max_step: f64,
+    /// Output every k-th RK4 or midpoint step; dopri5 samples its dense output every `output_every · step`
+    /// seconds (default 10).
+    pub output_every: usize,
+    /// The dynamics algorithm evaluating `A`, `b` (default `recurrent`).
+    pub algorithm: Methods,
+}
+
+/// How an external wrench varies in time.
+#[derive(Clone, Debug, PartialEq)]
+pub enum WrenchProfile {
+    /// The same force and moment at all times.
+    Constant {
+        /// Force, N.
+        force: [f64; 3],
+        /// Moment, N·m.
+        moment: [f64; 3],
+    },
+    /// Samples `(time[k], force[k], moment[k])`, interpolated linearly between samples and held
+    /// at the first (last) sample before (after) the table.
+    Table {
+        /// Strictly increasing sample times, s (at least two).
+        time: Vec<f64>,
+        /// Force at each sample time, N.
+        force: Vec<[f64; 3]>,
+        /// Moment at each sample time, N·m.
+        moment: Vec<[f64; 3]>,
+    },
+}
+
+/// An external wrench of a scene: where it acts, in which frame, and its time profile.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SceneWrench {
+    /// Body index (joint index of the body's inboard joint), or [`BASE_BODY`].
+    pub body: usize,
+    /// Frame of the force and moment vectors.
+    pub frame: LoadFrame,
+    /// Constant or tabulated.
+    pub profile: WrenchProfile,
+}
+
+impl SceneWrench {
+    /// Whether the wrench varies in time (a runtime input of the dynamics, not a constant).
+    #[must_use]
+    pub fn is_tabulated(&self) -> bool {
+        matches!(self.profile, WrenchProfile::Table { .. })
+    }
+
+    /// Force and moment at time `t`.
+    #[must_use]
+    pub fn value_at(&self, t: f64) -> ([f64; 3], [f64; 3]) {
+        match &self.profile {
+            WrenchProfile::Constant { force, moment } => (*force, *moment),
+            WrenchProfile::Table {
+                time,
+                force,
+                moment,
+            } => {
+                // First sample strictly after t (time is strictly increasing, at least 2 long).
+                let k = time.partition_point(|&tk| tk <= t);
+                if k == 0 {
+                    return (force[0], moment[0]);
+                }
+                if k == time.len() {
+                    return (force[k - 1], moment[k - 1]);
+                }
+                let s = (t - time[k - 1]) / (time[k] - time[k - 1]);
+                let lerp =
+                    |v: &[[f64; 3]]| [0, 1, 2].map(|i| v[k - 1][i] + s * (v[k][i] - v[k - 1][i]));
+                (lerp(force), lerp(moment))
+            }
+        }
+    }
+
+    /// The wrench at time `t` as a load of the dynamics.
+    #[must_use]
+    pub fn at(&self, t: f64) -> ExternalWrench<f64> {
+        let (force, moment) = self.value_at(t);
+        ExternalWrench {
+            body: self.body,
+            frame: self.frame,
+            force: Vec3::from_f64(force),
+            moment: Vec3::from_f64(moment),
+        }
+    }
+}
+
+/// Validates `[[effects.wrench]]` number `key`'s force/moment profiles against its `time`.
+fn wrench_profile(
+    key: &str,
+    time: Option<Vec<f64>>,
+    force: Option<RawProfile>,
+    moment: Option<RawProfile>,
+) -> Result<WrenchProfile> {
+    let Some(time) = time else {
+        let constant = |name: &str, p: Option<RawProfile>| match p {
+            None => Ok([0.0; 3]),
+            Some(RawProfile::Constant(v)) => {
+                check_finite(&format!("{key}.{name}"), &v)?;
+                Ok(v)
+            }
+            Some(RawProfile::Table(_)) => Err(anyhow!(
+                "{key}.{name}: one row per sample needs `{key}.time` (or give one vector [x, y, z])"
+            )),
+        };
+        return Ok(WrenchProfile::Constant {
+            force: constant("force", force)?,
+            moment: constant("moment", moment)?,
+        });
+    };
+    let tkey = format!("{key}.time");
+    if time.len() < 2 {
+        bail!("{tkey}: a table needs at least 2 sample times");
+    }
+    check_finite(&tkey, &time)?;
+    if let Some(k) = time.windows(2).position(|w| w[1] <= w[0]) {
+        bail!(
+            "{tkey}: sample times must be strictly increasing (time[{}] = {} after {})",
+            k + 1,
+            time[k + 1],
+            time[k]
+        );
+    }
+    let rows = |name: &str, p: Option<RawProfile>| -> Result<Vec<[f64; 3]>> {
+        let k = format!("{key}.{name}");
+        match p {
+            None => Ok(vec![[0.0; 3]; time.len()]),
+            Some(RawProfile::Constant(_)) => Err(anyhow!(
+                "{k}: with `{tkey}` give one [x, y, z] row per sample time ({} rows)",
+                time.len()
+            )),
+            Some(RawProfile::Table(v)) => {
+                if v.len() != time.len() {
+                    bail!(
+                        "{k}: expected {} rows (one per sample time), got {}",
+                        time.len(),
+                        v.len()
+                    );
+                }
+                check_finite(&k, v.as_flattened())?;
+                Ok(v)
+            }
+        }
+    };
+    if force.is_none() && moment.is_none() {
+        bail!("{key}: a tabulated wrench needs `force` or `moment` rows");
+    }
+    Ok(WrenchProfile::Table {
+        force: rows("force", force)?,
+        moment: rows("moment", moment)?,
+        time,
+    })
+}
+
+/// A validated scene.
+#[derive(Clone, Debug)]
+pub struct Scene {
+    /// The arm, with the payload (if any) merged into the body that holds it (default the last).
+    pub model: Model,
+    /// Fixed or free-floating base.
+    pub base: BaseSpec,
+    /// Uniform gravity (base frame for a fixed base, inertial frame for a free-floating one).
+    pub gravity: Option<[f64; 3]>,
+    /// Joint viscous damping coefficients: `τ_d = −c q̇`.
+    pub damping: Option<Vec<f64>>,
+    /// External wrenches, constant or tabulated in time ([`BASE_BODY`] for the free-floating base
+    /// body).
+    pub wrenches: Vec<SceneWrench>,
+    /// The joint drives.
+    pub drives: Drives,
+    /// Initial joint positions.
+    pub q0: Vec<f64>,
+    /// Initial joint rates.
+    pub qd0: Vec<f64>,
+    /// Integrator settings.
+    pub simulation: SimulationSpec,
+}
+
+fn check_len(key: &str, v: &[f64], n: usize) -> Result<()> {
+    if v.len() != n {
+        bail!(
+            "{key}: expected {n} values (the model's degrees of freedom), got {}",
+            v.len()
+        );
+    }
+    check_finite(key, v)
+}
+
+fn check_finite(key: &str, v: &[f64]) -> Result<()> {
+    if v.iter().any(|x| !x.is_finite()) {
+        bail!("{key}: values must be finite");
+    }
+    Ok(())
+}
+
+fn gain(key: &str, g: Option<RawGain>, n: usize) -> Result<Vec<f64>> {
+    let v = match g.ok_or_else(|| anyhow!("{key}: required by this drive type"))? {
+        RawGain::Scalar(x) => vec![x; n],
+        RawGain::Vector(v) => {
+            check_len(key, &v, n)?;
+            v
+        }
+    };
+    if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
+        bail!("{key}: gains must be finite and >= 0");
+    }
+    Ok(v)
+}
+
+impl Scene {
+    /// Reads and validates a scene file; the model path is relative to the file's directory.
+    pub fn load(path: &Path) -> Result<Scene> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read scene `{}`", path.display()))?;
+        let dir = path.parent().unwrap_or(Path::new("."));
+        Scene::parse(&text, dir).with_context(|| format!("scene `{}`", path.display()))
+    }
+
+    /// Parses and validates scene text; `dir` is the directory the model path is relative to.
+    pub fn parse(text: &str, dir: &Path) -> Result<Scene> {
+        let raw: RawScene = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
+        let model_path = dir.join(&raw.model);
+        let validation = Validation {
+            allow_nonphysical_inertia: raw.allow_nonphysical,
+        };
+        let chain = kanegen_model::io::load_model_with(&model_path, validation)
+            .map_err(|e| anyhow!("model: `{}`: {e}", model_path.display()))?;
+        let n = chain.dof();
+
+        let chain = match raw.payload {
+            None => chain,
+            Some(p) => {
+                if !(p.mass.is_finite() && p.mass > 0.0) {
+                    bail!("payload.mass: must be > 0");
+                }
+                check_finite("payload.com", &p.com)?;
+                let pay = Inertial {
+                    mass: p.mass,
+                    com: p.com,
+                    inertia: p.inertia.0,
+                };
+                kanegen_model::validate_inertial_with("payload", "inertia", &pay, validation)
+                    .map_err(|e| anyhow!("payload.inertia: {e}"))?;
+                let mut joints = chain.joints().to_vec();
+                let holder = match &p.body {
+                    None => joints.last_mut().expect("a chain has a joint"),
+                    Some(name) => {
+                        let names: Vec<String> = joints.iter().map(|j| j.body.clone()).collect();
+                        joints.iter_mut().find(|j| &j.body == name).ok_or_else(|| {
+                            anyhow!(
+                                "payload.body: unknown body `{name}` (moving bodies: {})",
+                                names.join(", ")
+                            )
+                        })?
+                    }
+                };
+                holder.inertial = holder.inertial.merge(&pay);
+                Model::new_with(
+                    chain.name(),
+                    chain.base(),
+                    chain.base_inertial().cloned(),
+                    joints,
+                    validation,
+                )
+                .map_err(|e| anyhow!("payload: {e}"))?
+            }
+        };
+
+        let base = match raw.base {
+            None => BaseSpec::Fixed,
+            Some(b) => match b.kind.as_str() {
+                "fixed" => {
+                    let given = [
+                        ("mass", b.mass.is_some()),
+                        ("com", b.com.is_some()),
+                        ("inertia", b.inertia.is_some()),
+                        ("position", b.position.is_some()),
+                        ("quaternion", b.quaternion.is_some()),
+                        ("v", b.v.is_some()),
+                        ("omega", b.omega.is_some()),
+                    ];
+                    if let Some((k, _)) = given.iter().find(|(_, g)| *g) {
+                        bail!("base.{k}: only for type = \"free-floating\"");
+                    }
+                    BaseSpec::Fixed
+                }
+                "free-floating" => {
+                    let model = chain.base_inertial();
+                    let mass = b.mass.or(model.map(|i| i.mass)).ok_or_else(|| {
+                        anyhow!("base.mass: the model has no base inertial; give mass, com, inertia")
+                    })?;
+                    let com = b.com.or(model.map(|i| i.com)).unwrap_or([0.0; 3]);
+                    let inertia = b
+                        .inertia
+                        .map(|i| i.0)
+                        .or(model.map(|i| i.inertia))
+                        .ok_or_else(|| anyhow!("base.inertia: the model has no base inertial"))?;
+                    if !(mass.is_finite() && mass > 0.0) {
+                        bail!("base.mass: must be > 0");
+                    }
+                    check_finite("base.com", &com)?;
+                    let inertial = Inertial { mass, com, inertia };
+                    kanegen_model::validate_inertial_with(
+                        "base",
+                        "inertia",
+                        &inertial,
+                        validation,
+                    )
+                    .map_err(|e| anyhow!("base.inertia: {e}"))?;
+                    let quat = b.quaternion.unwrap_or([0.0, 0.0, 0.0, 1.0]);
+                    check_finite("base.quaternion", &quat)?;
+                    let norm = quat.iter().map(|x| x * x).sum::<f64>().sqrt();
+                    if norm < 1e-12 {
+                        bail!("base.quaternion: must be non-zero");
+                    }
+                    let position = b.position.unwrap_or([0.0; 3]);
+                    let v = b.v.unwrap_or([0.0; 3]);
+                    let omega = b.omega.unwrap_or([0.0; 3]);
+                    check_finite("base.position", &position)?;
+                    check_finite("base.v", &v)?;
+                    check_finite("base.omega", &omega)?;
+                    BaseSpec::FreeFloating {
+                        inertial,
+                        position,
+                        quaternion: quat.map(|x| x / norm),
+                        v,
+                        omega,
+                    }
+                }
+                other => bail!(
+                    "base.type: unknown base type `{other}` (expected \"fixed\" or \"free-floating\")"
+                ),
+            },
+        };
+        let floating = matches!(base, BaseSpec::FreeFloating { .. });
+
+        let e = raw.effects;
+        if let Some(g) = &e.gravity {
+            check_finite("effects.gravity", g)?;
+        }
+        if let Some(c) = &e.damping {
+            check_len("effects.damping", c, n)?;
+            if c.iter().any(|x| *x < 0.0) {
+                bail!("effects.damping: coefficients must be >= 0");
+            }
+        }
+        let mut wrenches = Vec::new();
+        for (k, w) in e.wrench.into_iter().enumerate() {
+            let key = format!("effects.wrench[{k}]");
+            let body = if w.body == "base" || w.body == chain.base() {
+                if !floating {
+                    bail!("{key}.body: a wrench on a fixed base has no effect");
+                }
+                BASE_BODY
+            } else {
+                chain
+                    .joints()
+                    .iter()
+                    .position(|j| j.body == w.body)
+                    .ok_or_else(|| {
+                        let names: Vec<&str> =
+                            chain.joints().iter().map(|j| j.body.as_str()).collect();
+                        anyhow!(
+                            "{key}.body: unknown body `{}` (known: base, {})",
+                            w.body,
+                            names.join(", ")
+                        )
+                    })?
+            };
+            let frame = match w.frame.as_str() {
+                "body" => LoadFrame::Body,
+                "inertial" => LoadFrame::Base,
+                other => bail!("{key}.frame: unknown frame `{other}` (expected body or inertial)"),
+            };
+            wrenches.push(SceneWrench {
+                body,
+                frame,
+                profile: wrench_profile(&key, w.time, w.force, w.moment)?,
+            });
+        }
+
+        let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
+        check_len("initial.q", &q0, n)?;
+        let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
+        check_len("initial.qd", &qd0, n)?;
+
+        let drives = match raw.drives {
+            None => Drives::None,
+            Some(d) => {
+                let extra = |keys: &[(&str, bool)]| -> Result<()> {
+                    if let Some((k, _)) = keys.iter().find(|(_, g)| *g) {
+                        bail!("drives.{k}: not used by drives.type = \"{}\"", d.kind);
+                    }
+                    Ok(())
+                };
+                match d.kind.as_str() {
+                    "none" => {
+                        extra(&[
+                            ("kp", d.kp.is_some()),
+                            ("kd", d.kd.is_some()),
+                            ("target", d.target.is_some()),
+                            ("duration_s", d.duration_s.is_some()),
+                            ("tau", d.tau.is_some()),
+                        ])?;
+                        Drives::None
+                    }
+                    "constant" => {
+                        extra(&[
+                            ("kp", d.kp.is_some()),
+                            ("kd", d.kd.is_some()),
+                            ("target", d.target.is_some()),
+                            ("duration_s", d.duration_s.is_some()),
+                        ])?;
+                        let tau = d
+                            .tau
+                            .ok_or_else(|| anyhow!("drives.tau: required by type = \"constant\""))?;
+                        check_len("drives.tau", &tau, n)?;
+                        Drives::Constant { tau }
+                    }
+                    "pd" => {
+                        extra(&[("duration_s", d.duration_s.is_some()), ("tau", d.tau.is_some())])?;
+                        let target = d
+                            .target
+                            .ok_or_else(|| anyhow!("drives.target: required by type = \"pd\""))?;
+                        check_len("drives.target", &target, n)?;
+                        Drives::Pd {
+                            kp: gain("drives.kp", d.kp, n)?,
+                            kd: gain("drives.kd", d.kd, n)?,
+                            target,
+                        }
+                    }
+                    "computed-torque" => {
+                        extra(&[("tau", d.tau.is_some())])?;
+                        if floating {
+                            bail!("drives.type: computed-torque needs a fixed base");
+                        }
+                        let target = d.target.ok_or_else(|| {
+                            anyhow!("drives.target: required by type = \"computed-torque\"")
+                        })?;
+                        check_len("drives.target", &target, n)?;
+                        let duration = d.duration_s.ok_or_else(|| {
+                            anyhow!("drives.duration_s: required by type = \"computed-torque\"")
+                        })?;
+                        if !(duration.is_finite() && duration > 0.0) {
+                            bail!("drives.duration_s: must be > 0");
+                        }
+                        Drives::ComputedTorque {
+                            kp: gain("drives.kp", d.kp, n)?,
+                            kd: gain("drives.kd", d.kd, n)?,
+                            target,
+                            duration,
+                        }
+                    }
+                    other => bail!(
+                        "drives.type: unknown drive type `{other}` (expected none, constant, pd or computed-torque)"
+                    ),
+                }
+            }
+        };
+
+        let s = raw.simulation;
+        if !(s.duration.is_finite() && s.duration > 0.0) {
+            bail!("simulation.duration: must be > 0");
+        }
+        let integrator = match s.integrator.as_deref().unwrap_or("rk4") {
+            "rk4" => Integrator::Rk4,
+            "dopri5" => Integrator::Dopri5,
+            "midpoint" => Integrator::Midpoint,
+            other => {
+                bail!(
+                    "simulation.integrator: unknown integrator `{other}` \
+                     (expected rk4, dopri5 or midpoint)"
+                )
+            }
+        };
+        let step = s.step.unwrap_or(0.01);
+        if !(step.is_finite() && step > 0.0) {
+            bail!("simulation.step: must be > 0");
+        }
+        let tolerance = s.tolerance.unwrap_or(1e-8);
+        if !(tolerance.is_finite() && tolerance > 0.0) {
+            bail!("simulation.tolerance: must be > 0");
+        }
+        let max_step = s.max_step.unwrap_or(s.duration);
+        if !(max_step.is_finite() && max_step > 0.0) {
+            bail!("simulation.max_step: must be > 0");
+        }
+        let output_every = s.output_every.unwrap_or(10);
+        if output_every == 0 {
+            bail!("simulation.output_every: must be >= 1");
+        }
+        let algorithm = match s.algorithm {
+            None => Methods::RECURRENT,
+            Some(a) => Methods::from_name(&a).ok_or_else(|| {
+                let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
+                anyhow!(
+                    "simulation.algorithm: unknown algorithm `{a}` (known: {})",
+                    names.join(", ")
+                )
+            })?,
+        };
+        if integrator != Integrator::Dopri5 {
+            if s.tolerance.is_some() {
+                bail!("simulation.tolerance: only for integrator = \"dopri5\"");
+            }
+            if s.max_step.is_some() {
+                bail!("simulation.max_step: only for integrator = \"dopri5\"");
+            }
+        }
+
+        Ok(Scene {
+            model: chain,
+            base,
+            gravity: e.gravity,
+            damping: e.damping,
+            wrenches,
+            drives,
+            q0,
+            qd0,
+            simulation: SimulationSpec {
+                duration: s.duration,
+                integrator,
+                step,
+                tolerance,
+                max_step,
+                output_every,
+                algorithm,
+            },
+        })
+    }
+
+    /// Whether the base is free-floating.
+    #[must_use]
+    pub fn is_floating(&self) -> bool {
+        matches!(self.base, BaseSpec::FreeFloating { .. })
+    }
+}

@@ -1,0 +1,535 @@
+//! Running a [`Scene`]: the scene as a first-order [`System`], integration, conservation
+//! monitors, and the trajectory as CSV (the CLI writes it with the summary and plots).
+//!
+//! State vector: fixed base `[q (N), q̇ (N)]`; free-floating base
+//! `[p₀ (3), quat (4: x, y, z, w), q (N), v_b (3), ω_b (3), q̇ (N)]` with `ṗ₀ = R₀ v_b` and
+//! `q̇uat = ½ quat ⊗ (ω_b, 0)` (body-frame `ω_b`); RK4 and dopri5 renormalize the quaternion
+//! after every accepted step ([`System::project`]); the implicit midpoint rule updates it by the
+//! exponential map ([`System::advance`]) and needs no projection.
+
+use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, Stats, System};
+use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench};
+use anyhow::Result;
+use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
+use kanegen_dynamics::algorithms::kinematics::base_frame;
+use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+use kanegen_dynamics::linalg::Vec3;
+use kanegen_dynamics::{Loads, Params};
+use serde::Serialize;
+
+/// A scene as a first-order system for the integrators.
+pub struct SceneSystem<'a> {
+    scene: &'a Scene,
+    params: Params<f64>,
+    base: Option<FloatingBase<f64>>,
+    /// Loads without `tau` (gravity and constant wrenches, as the scene names them).
+    passive: Loads<f64>,
+    /// Whether some wrench is tabulated in time (then `deriv` evaluates the wrenches at `t`).
+    time_varying: bool,
+    n: usize,
+}
+
+/// Quintic time scaling `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` and its first two derivatives, `τ ∈ [0, 1]`.
+fn quintic(tau: f64) -> (f64, f64, f64) {
+    let t = tau.clamp(0.0, 1.0);
+    let s = t * t * t * (10.0 - 15.0 * t + 6.0 * t * t);
+    let ds = 30.0 * t * t * (1.0 - t) * (1.0 - t);
+    let dds = 60.0 * t * (1.0 - t) * (1.0 - 2.0 * t);
+    (s, ds, dds)
+}
+
+/// The desired trajectory of a computed-torque drive at `t`: `(q_d, q̇_d, q̈_d)`.
+#[must_use]
+pub fn quintic_reference(
+    q0: &[f64],
+    target: &[f64],
+    duration: f64,
+    t: f64,
+) -> (Vec<f64>, Vec<f64>, Vec<f64>) {
+    let (s, ds, dds) = quintic(t / duration);
+    let (ds, dds) = if t >= duration {
+        (0.0, 0.0)
+    } else {
+        (ds / duration, dds / (duration * duration))
+    };
+    let d: Vec<f64> = q0.iter().zip(target).map(|(a, b)| b - a).collect();
+    (
+        q0.iter().zip(&d).map(|(a, di)| a + s * di).collect(),
+        d.iter().map(|di| ds * di).collect(),
+        d.iter().map(|di| dds * di).collect(),
+    )
+}
+
+impl<'a> SceneSystem<'a> {
+    /// The system of `scene`.
+    #[must_use]
+    pub fn new(scene: &'a Scene) -> Self {
+        let base = match &scene.base {
+            BaseSpec::Fixed => None,
+            BaseSpec::FreeFloating { inertial, .. } => Some(FloatingBase::from_inertial(inertial)),
+        };
+        SceneSystem {
+            scene,
+            params: Params::new(&scene.model),
+            base,
+            passive: Loads {
+                tau: None,
+                gravity: scene.gravity.map(Vec3::from_f64),
+                external: scene.wrenches.iter().map(|w| w.at(0.0)).collect(),
+            },
+            time_varying: scene.wrenches.iter().any(SceneWrench::is_tabulated),
+            n: scene.model.dof(),
+        }
+    }
+
+    /// The initial state vector.
+    #[must_use]
+    pub fn initial_state(&self) -> Vec<f64> {
+        let s = self.scene;
+        match &s.base {
+            BaseSpec::Fixed => [s.q0.as_slice(), &s.qd0].concat(),
+            BaseSpec::FreeFloating {
+                position,
+                quaternion,
+                v,
+                omega,
+                ..
+            } => [position.as_slice(), quaternion, &s.q0, v, omega, &s.qd0].concat(),
+        }
+    }
+
+    /// Splits a state into `(q, q̇, base)`.
+    #[must_use]
+    pub fn split<'x>(&self, x: &'x [f64]) -> (&'x [f64], &'x [f64], Option<FloatingState<f64>>) {
+        let n = self.n;
+        if self.base.is_none() {
+            return (&x[..n], &x[n..2 * n], None);
+        }
+        let quat: [f64; 4] = x[3..7].try_into().expect("4 entries");
+        let st = FloatingState {
+            position: Vec3::new(x[0], x[1], x[2]),
+            rotation: quat_to_matrix(&quat),
+            v_b: Vec3::new(x[7 + n], x[8 + n], x[9 + n]),
+            omega_b: Vec3::new(x[10 + n], x[11 + n], x[12 + n]),
+        };
+        (&x[7..7 + n], &x[13 + n..13 + 2 * n], Some(st))
+    }
+
+    /// The joint drive + damping torques at `(t, q, q̇)`; `None` when the scene has neither.
+    #[must_use]
+    pub fn torques(&self, t: f64, q: &[f64], qd: &[f64]) -> Option<Vec<f64>> {
+        let s = self.scene;
+        let mut tau = match &s.drives {
+            Drives::None => None,
+            Drives::Constant { tau } => Some(tau.clone()),
+            Drives::Pd { kp, kd, target } => Some(
+                (0..self.n)
+                    .map(|i| kp[i] * (target[i] - q[i]) - kd[i] * qd[i])
+                    .collect(),
+            ),
+            Drives::ComputedTorque {
+                kp,
+                kd,
+                target,
+                duration,
+            } => {
+                let (qr, qdr, qddr) = quintic_reference(&s.q0, target, *duration, t);
+                let cmd: Vec<f64> = (0..self.n)
+                    .map(|i| qddr[i] + kd[i] * (qdr[i] - qd[i]) + kp[i] * (qr[i] - q[i]))
+                    .collect();
+                Some(s.simulation.algorithm.inverse_dynamics(
+                    &self.params,
+                    q,
+                    qd,
+                    &cmd,
+                    &self.passive,
+                ))
+            }
+        };
+        if let Some(c) = &s.damping {
+            let t = tau.get_or_insert_with(|| vec![0.0; self.n]);
+            for i in 0..self.n {
+                t[i] -= c[i] * qd[i];
+            }
+        }
+        tau
+    }
+
+    /// Total energy: kinetic, plus the gravitational potential `−g · Σ m_k x_{c,k}` on a fixed
+    /// base with gravity. `None` for a free-floating base under gravity (not monitored).
+    #[must_use]
+    pub fn energy(&self, x: &[f64]) -> Option<f64> {
+        let (q, qd, st) = self.split(x);
+        match (&self.base, st) {
+            (Some(b), Some(st)) => {
+                if self.scene.gravity.is_some() {
+                    return None;
+                }
+                Some(kinetic_energy(&self.params, b, &st, q, qd))
+            }
+            _ => {
+                let a = self
+                    .scene
+                    .simulation
+                    .algorithm
+                    .mass_matrix
+                    .mass_matrix(&self.params, q);
+                let t = 0.5
+                    * (0..self.n)
+                        .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
+                        .sum::<f64>();
+                let v = match self.scene.gravity {
+                    None => 0.0,
+                    Some(g) => {
+                        let mut xo = Vec3::<f64>::zero();
+                        let mut v = 0.0;
+                        for k in base_frame(&self.params, q) {
+                            xo = &xo + &k.r;
+                            let first = xo.scale(&k.m) + k.c.clone();
+                            v -= Vec3::from_f64(g).dot(&first);
+                        }
+                        v
+                    }
+                };
+                Some(t + v)
+            }
+        }
+    }
+
+    /// Linear and angular momentum (inertial frame, about the inertial origin) of a free-floating
+    /// system; `None` on a fixed base.
+    #[must_use]
+    pub fn momentum(&self, x: &[f64]) -> Option<([f64; 3], [f64; 3])> {
+        let (q, qd, st) = self.split(x);
+        let (b, st) = (self.base.as_ref()?, st?);
+        let (l, a) = momentum(&self.params, b, &st, q, qd);
+        Some((l.into_array(), a.into_array()))
+    }
+}
+
+impl System for SceneSystem<'_> {
+    fn dim(&self) -> usize {
+        if self.base.is_some() {
+            13 + 2 * self.n
+        } else {
+            2 * self.n
+        }
+    }
+
+    fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
+        let n = self.n;
+        let (q, qd, st) = self.split(x);
+        let mut loads = Loads {
+            tau: self.torques(t, q, qd),
+            ..self.passive.clone()
+        };
+        if self.time_varying {
+            loads.external = self.scene.wrenches.iter().map(|w| w.at(t)).collect();
+        }
+        let alg = self.scene.simulation.algorithm;
+        match (&self.base, st) {
+            (Some(b), Some(st)) => {
+                let nu_dot = floating::forward_dynamics(alg, &self.params, b, &st, q, qd, &loads);
+                let pd = st.rotation.mul_vec(&st.v_b);
+                dx[..3].copy_from_slice(&pd.0);
+                // q̇uat = ½ quat ⊗ (ω, 0): u̇ = ½ (w ω + u × ω), ẇ = −½ u · ω.
+                let (u, w) = (Vec3::new(x[3], x[4], x[5]), x[6]);
+                let om = &st.omega_b;
+                let ud = (om.scale(&w) + u.cross(om)).scale(&0.5);
+                dx[3..6].copy_from_slice(&ud.0);
+                dx[6] = -0.5 * u.dot(om);
+                dx[7..7 + n].copy_from_slice(qd);
+                dx[7 + n..].copy_from_slice(&nu_dot);
+            }
+            _ => {
+                let qdd = alg.forward_dynamics(&self.params, q, qd, &loads);
+                dx[..n].copy_from_slice(qd);
+                dx[n..].copy_from_slice(&qdd);
+            }
+        }
+    }
+
+    /// Additive, except the quaternion: `quat ⊗ exp(h ω_b(at) / 2)` (exponential map, unit by
+    /// construction; symmetric in `h`).
+    fn advance(&self, x: &[f64], h: f64, at: &[f64], f: &[f64], out: &mut [f64]) {
+        for i in 0..out.len() {
+            out[i] = x[i] + h * f[i];
+        }
+        if self.base.is_some() {
+            let n = self.n;
+            let om = [at[10 + n], at[11 + n], at[12 + n]];
+            let w_norm = om.iter().map(|v| v * v).sum::<f64>().sqrt();
+            let half = 0.5 * h * w_norm;
+            // sin(half)/|ω|, with its limit h/2 at ω = 0.
+            let s = if half.abs() < 1e-8 {
+                0.5 * h * (1.0 - half * half / 6.0)
+            } else {
+                half.sin() / w_norm
+            };
+            let (rho, rw) = ([s * om[0], s * om[1], s * om[2]], half.cos());
+            let (u, w) = ([x[3], x[4], x[5]], x[6]);
+            let cross = [
+                u[1] * rho[2] - u[2] * rho[1],
+                u[2] * rho[0] - u[0] * rho[2],
+                u[0] * rho[1] - u[1] * rho[0],
+            ];
+            for i in 0..3 {
+                out[3 + i] = w * rho[i] + rw * u[i] + cross[i];
+            }
+            out[6] = w * rw - (u[0] * rho[0] + u[1] * rho[1] + u[2] * rho[2]);
+        }
+    }
+
+    fn project(&self, x: &mut [f64]) {
+        if self.base.is_some() {
+            let norm = x[3..7].iter().map(|v| v * v).sum::<f64>().sqrt();
+            x[3..7].iter_mut().for_each(|v| *v /= norm);
+        }
+    }
+}
+
+/// The final joint state of a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct FinalState {
+    /// Joint positions.
+    pub q: Vec<f64>,
+    /// Joint rates.
+    pub qd: Vec<f64>,
+}
+
+/// The JSON summary of a run. Drifts are `max_t |X(t) − X(0)| / |X(0)|` over the output samples
+/// (absolute when `X(0) = 0`), and `null` when the scene does not conserve `X`: energy needs no
+/// drives, no damping, no wrenches, and (free-floating) no gravity — on a fixed base the
+/// gravitational potential is included; momentum needs a free-floating base with no wrenches and
+/// no gravity (drives and damping are internal).
+#[derive(Clone, Debug, Serialize)]
+pub struct Summary {
+    /// `"fixed"` or `"free-floating"`.
+    pub base: &'static str,
+    /// Accepted steps.
+    pub steps: usize,
+    /// Rejected steps (dopri5).
+    pub rejected_steps: usize,
+    /// Right-hand-side evaluations.
+    pub evals: usize,
+    /// Wall-clock time of the integration, s.
+    pub wall_s: f64,
+    /// Maximal relative energy drift.
+    pub max_energy_drift_rel: Option<f64>,
+    /// Maximal relative linear-momentum drift.
+    pub max_linear_momentum_drift_rel: Option<f64>,
+    /// Maximal relative angular-momentum drift.
+    pub max_angular_momentum_drift_rel: Option<f64>,
+    /// The final joint state.
+    #[serde(rename = "final")]
+    pub final_state: FinalState,
+}
+
+/// One output sample.
+#[derive(Clone, Debug)]
+pub struct Sample {
+    /// Time.
+    pub t: f64,
+    /// The state vector (see the module doc).
+    pub x: Vec<f64>,
+    /// Energy drift (relative) at `t`, when monitored.
+    pub energy_drift: Option<f64>,
+    /// Linear and angular momentum drift (relative) at `t`, when monitored.
+    pub momentum_drift: Option<(f64, f64)>,
+}
+
+/// A finished run.
+#[derive(Clone, Debug)]
+pub struct Run {
+    /// The summary.
+    pub summary: Summary,
+    /// The output samples, `t = 0` first, the final time last.
+    pub samples: Vec<Sample>,
+}
+
+fn norm(v: &[f64]) -> f64 {
+    v.iter().map(|x| x * x).sum::<f64>().sqrt()
+}
+
+fn rel(x: f64, x0: f64) -> f64 {
+    if x0 == 0.0 {
+        x.abs()
+    } else {
+        x / x0.abs()
+    }
+}
+
+/// Whether the scene conserves energy (see [`Summary`]).
+#[must_use]
+pub fn conserves_energy(scene: &Scene) -> bool {
+    matches!(scene.drives, Drives::None)
+        && scene.damping.is_none()
+        && scene.wrenches.is_empty()
+        && !(scene.is_floating() && scene.gravity.is_some())
+}
+
+/// Whether the scene conserves linear and angular momentum (see [`Summary`]).
+#[must_use]
+pub fn conserves_momentum(scene: &Scene) -> bool {
+    scene.is_floating() && scene.wrenches.is_empty() && scene.gravity.is_none()
+}
+
+/// Integrates `scene` over its duration, sampling every `output_every` steps (RK4) or every
+/// `output_every · step` seconds of dense output (dopri5). `progress` (if any) is advanced to the
+/// simulated time in milliseconds.
+pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Result<Run> {
+    let mut sys = SceneSystem::new(scene);
+    let mut x = sys.initial_state();
+    let sim = &scene.simulation;
+    let energy_on = conserves_energy(scene);
+    let momentum_on = conserves_momentum(scene);
+    let e0 = if energy_on { sys.energy(&x) } else { None };
+    let p0 = if momentum_on { sys.momentum(&x) } else { None };
+    let mut samples = Vec::new();
+    let monitor = SceneSystem::new(scene);
+    let mut record = |t: f64, x: &[f64]| {
+        let energy_drift = e0.and_then(|e0| monitor.energy(x).map(|e| rel(e - e0, e0)));
+        let momentum_drift = p0.and_then(|(l0, a0)| {
+            monitor.momentum(x).map(|(l, a)| {
+                let dl: Vec<f64> = (0..3).map(|i| l[i] - l0[i]).collect();
+                let da: Vec<f64> = (0..3).map(|i| a[i] - a0[i]).collect();
+                (rel(norm(&dl), norm(&l0)), rel(norm(&da), norm(&a0)))
+            })
+        });
+        if let Some(pb) = progress {
+            pb.set_position((t * 1000.0) as u64);
+        }
+        samples.push(Sample {
+            t,
+            x: x.to_vec(),
+            energy_drift,
+            momentum_drift,
+        });
+    };
+    let start = std::time::Instant::now();
+    let stats: Stats = match sim.integrator {
+        Integrator::Rk4 => {
+            let total = ((sim.duration / sim.step) - 1e-9).ceil().max(1.0) as usize;
+            rk4(&mut sys, 0.0, sim.duration, sim.step, &mut x, |k, t, x| {
+                if k % sim.output_every == 0 || k == total {
+                    record(t, x);
+                }
+            })?
+        }
+        Integrator::Midpoint => {
+            let total = ((sim.duration / sim.step) - 1e-9).ceil().max(1.0) as usize;
+            midpoint(&mut sys, 0.0, sim.duration, sim.step, &mut x, |k, t, x| {
+                if k % sim.output_every == 0 || k == total {
+                    record(t, x);
+                }
+            })?
+        }
+        Integrator::Dopri5 => {
+            let opts = Dopri5Options {
+                tolerance: sim.tolerance,
+                max_step: sim.max_step,
+                initial_step: sim.step,
+                output_interval: sim.step * sim.output_every as f64,
+            };
+            dopri5(&mut sys, 0.0, sim.duration, &opts, &mut x, &mut record)?
+        }
+    };
+    let wall_s = start.elapsed().as_secs_f64();
+    let max_of = |f: &dyn Fn(&Sample) -> Option<f64>| -> Option<f64> {
+        samples
+            .iter()
+            .map(f)
+            .try_fold(0.0_f64, |m, v| v.map(|v| m.max(v.abs())))
+    };
+    let (q, qd, _) = sys.split(&x);
+    let summary = Summary {
+        base: if scene.is_floating() {
+            "free-floating"
+        } else {
+            "fixed"
+        },
+        steps: stats.steps,
+        rejected_steps: stats.rejected_steps,
+        evals: stats.evals,
+        wall_s,
+        max_energy_drift_rel: max_of(&|s| s.energy_drift),
+        max_linear_momentum_drift_rel: max_of(&|s| s.momentum_drift.map(|m| m.0)),
+        max_angular_momentum_drift_rel: max_of(&|s| s.momentum_drift.map(|m| m.1)),
+        final_state: FinalState {
+            q: q.to_vec(),
+            qd: qd.to_vec(),
+        },
+    };
+    Ok(Run { summary, samples })
+}
+
+/// A human-readable summary.
+#[must_use]
+pub fn render_text(s: &Summary) -> String {
+    let f = |x: Option<f64>| x.map_or("not conserved".to_string(), |v| format!("{v:.3e}"));
+    format!(
+        "base: {}\nsteps: {} accepted, {} rejected, {} evaluations, {:.3} s\n\
+         energy drift (rel): {}\nlinear momentum drift (rel): {}\n\
+         angular momentum drift (rel): {}\nfinal q: {:?}\nfinal qd: {:?}",
+        s.base,
+        s.steps,
+        s.rejected_steps,
+        s.evals,
+        s.wall_s,
+        f(s.max_energy_drift_rel),
+        f(s.max_linear_momentum_drift_rel),
+        f(s.max_angular_momentum_drift_rel),
+        s.final_state.q,
+        s.final_state.qd,
+    )
+}
+
+/// The CSV header of a scene's trajectory: `t`, `q_<joint>`…, `qd_<joint>`…, and for a
+/// free-floating base `p0_x…`, `quat_x, quat_y, quat_z, quat_w`, `v_b_x…`, `omega_b_x…`.
+#[must_use]
+pub fn csv_header(scene: &Scene) -> Vec<String> {
+    let names: Vec<&str> = scene
+        .model
+        .joints()
+        .iter()
+        .map(|j| j.name.as_str())
+        .collect();
+    let mut h = vec!["t".to_string()];
+    h.extend(names.iter().map(|n| format!("q_{n}")));
+    h.extend(names.iter().map(|n| format!("qd_{n}")));
+    if scene.is_floating() {
+        for (p, comps) in [
+            ("p0", &["x", "y", "z"][..]),
+            ("quat", &["x", "y", "z", "w"][..]),
+            ("v_b", &["x", "y", "z"][..]),
+            ("omega_b", &["x", "y", "z"][..]),
+        ] {
+            h.extend(comps.iter().map(|c| format!("{p}_{c}")));
+        }
+    }
+    h
+}
+
+/// The trajectory as CSV text (see [`csv_header`]).
+#[must_use]
+pub fn trajectory_csv(scene: &Scene, run: &Run) -> String {
+    let n = scene.model.dof();
+    let mut out = csv_header(scene).join(",");
+    out.push('\n');
+    for s in &run.samples {
+        let x = &s.x;
+        let mut row: Vec<f64> = vec![s.t];
+        if scene.is_floating() {
+            row.extend(&x[7..7 + n]);
+            row.extend(&x[13 + n..13 + 2 * n]);
+            row.extend(&x[..7]);
+            row.extend(&x[7 + n..13 + n]);
+        } else {
+            row.extend(x);
+        }
+        let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
+        out.push_str(&cells.join(","));
+        out.push('\n');
+    }
+    out
+}

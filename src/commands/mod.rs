@@ -1,8 +1,0 @@
-//! The CLI's commands, as library functions the tests call directly.
-
-pub mod accuracy;
-pub mod bench;
-pub mod count;
-pub mod eval;
-pub mod generate;
-pub mod table1;

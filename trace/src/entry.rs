@@ -1,0 +1,436 @@
+//! The one entry point that traces a function of a model's dynamics: Table 1, `kanegen count`,
+//! the code generator and the accuracy report all call [`trace`].
+//!
+//! ```
+//! use kanegen_dynamics::Methods;
+//! use kanegen_model::random::{random_chain, ChainSpec};
+//! use kanegen_trace::{trace, Convention, Function, Spec, Subject};
+//! let model = random_chain(&ChainSpec { n: 3, ..Default::default() }, 1);
+//! let t = trace(Subject::Model(&model), Function::MassMatrix, Methods::SPATIAL, &Spec::default())
+//!     .unwrap();
+//! assert_eq!(t.trace.outputs().len(), 6); // the upper triangle of a 3×3 matrix
+//! assert!(t.trace.counts(Convention::Emitted).total() > 0);
+//! // M q̈ + c = τ: inverse dynamics at q̈ = 0 is c.
+//! let id = trace(Subject::Model(&model), Function::InverseDynamics, Methods::SPATIAL,
+//!     &Spec::default()).unwrap();
+//! let c = trace(Subject::Model(&model), Function::NonlinearEffects, Methods::SPATIAL,
+//!     &Spec::default()).unwrap();
+//! let (q, qd) = ([0.1, 0.2, 0.3], [0.4, -0.5, 0.6]);
+//! let x = id.trace.eval(&[q, qd, [0.0; 3]].concat());
+//! let y = c.trace.eval(&[q, qd].concat());
+//! assert!(x.iter().zip(&y).all(|(a, b)| (a - b).abs() < 1e-12));
+//! ```
+
+use crate::function::{Arg, BaseField, Function, Input, PayloadField};
+use crate::spec::{Base, Spec, Subject, WrenchValue};
+use crate::sym::{Sym, Trace, Tracer};
+use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
+use kanegen_dynamics::algorithms::{floating, recurrent};
+use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
+use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::{
+    BiasMethod, ExternalWrench, JointParams, Loads, MassMatrixMethod, Methods, Params, Scalar,
+};
+use kanegen_model::JointKind;
+
+/// A traced function: the frozen graph and, per input in creation order, what it reads.
+#[derive(Debug)]
+pub struct Traced {
+    /// The graph; its outputs are the function's results (a symmetric matrix as its upper
+    /// triangle, row-major).
+    pub trace: Trace,
+    /// `inputs[i]` is the runtime input `i` of [`Trace::eval`] and of the graph's `Input` nodes.
+    pub inputs: Vec<Input>,
+}
+
+/// A request [`trace`] cannot honour.
+#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
+#[error("cannot trace {function} ({methods}): {reason}")]
+pub struct TraceError {
+    /// The function asked for.
+    pub function: &'static str,
+    /// The methods asked for.
+    pub methods: String,
+    /// Why not.
+    pub reason: String,
+}
+
+/// Traces `function` of `subject` under `methods` with the effects of `spec`.
+///
+/// Inputs are created in this order: the payload (with [`Spec::runtime_payload`]: mass, centre
+/// of mass, the inertia's upper triangle) or the generic parameters, then the function's
+/// arguments ([`Function::args`], `N` entries each), then the runtime wrenches, then the
+/// free-floating base state (position, quaternion `[x, y, z, w]`, `v_b`, `ω_b`). Only the
+/// effects `spec` names are traced.
+///
+/// # Errors
+/// A combination that makes no sense: gravity's term without gravity, a base-frame subject with
+/// a local-frame method or with effects, the paper's (14b) bookkeeping outside Table 1's setting,
+/// a runtime payload without a model, a wrench on a body that does not exist, or a function not
+/// (yet) traced for a free-floating base.
+pub fn trace(
+    subject: Subject,
+    function: Function,
+    methods: Methods,
+    spec: &Spec,
+) -> Result<Traced, TraceError> {
+    check(&subject, function, methods, spec).map_err(|reason| TraceError {
+        function: function.name(),
+        methods: methods.name(),
+        reason,
+    })?;
+    let n = subject.dof();
+    let t = Tracer::new();
+    let mut inputs: Vec<Input> = Vec::new();
+    let mut input = |i: Input| {
+        let s = t.input(i.to_string());
+        inputs.push(i);
+        s
+    };
+
+    // Parameters.
+    let params: Option<Params<Sym>> = match subject {
+        Subject::Model(model) => {
+            let mut p = Params::<Sym>::new(model);
+            if spec.runtime_payload {
+                payload_inputs(&mut p, &mut input);
+            }
+            Some(p)
+        }
+        Subject::Generic { n } => Some(generic_params(n, &mut input)),
+        Subject::BaseFrame { .. } => None,
+    };
+    if let (Subject::BaseFrame { n }, None) = (subject, &params) {
+        let kin = base_frame_inputs(n, &mut input);
+        let a = if spec.paper_14b {
+            recurrent::mass_matrix_paper_bookkeeping(&kin)
+        } else {
+            methods
+                .mass_matrix
+                .from_base_frame(&kin)
+                .expect("the CRBA is rejected by check")
+        };
+        let out = upper(&a);
+        return Ok(Traced {
+            trace: t.finish(&out),
+            inputs,
+        });
+    }
+    let p = params.expect("a model or generic subject has parameters");
+
+    // Arguments.
+    let mut args: [Option<Vec<Sym>>; 4] = [None, None, None, None];
+    for &a in function.args() {
+        args[arg_index(a)] = Some((0..n).map(|i| input(Input::Joint(a, i))).collect());
+    }
+    let arg = |a: Arg| args[arg_index(a)].clone();
+    let q = arg(Arg::Q).expect("every function takes q");
+    let zeros = vec![Sym::zero(); n];
+    let qd = arg(Arg::Qd).unwrap_or_else(|| zeros.clone());
+
+    // Effects.
+    let external: Vec<ExternalWrench<Sym>> = spec
+        .wrenches
+        .iter()
+        .enumerate()
+        .map(|(index, w)| {
+            let (force, moment) = match &w.value {
+                WrenchValue::Constant { force, moment } => {
+                    (Vec3::from_f64(*force), Vec3::from_f64(*moment))
+                }
+                WrenchValue::Runtime => {
+                    let mut c = |k: usize| {
+                        input(Input::Wrench {
+                            index,
+                            component: k,
+                        })
+                    };
+                    (Vec3::new(c(0), c(1), c(2)), Vec3::new(c(3), c(4), c(5)))
+                }
+            };
+            ExternalWrench {
+                body: w.body,
+                frame: w.frame,
+                force,
+                moment,
+            }
+        })
+        .collect();
+    let gravity = spec.gravity.map(Vec3::from_f64);
+    // Damping as a drive: τ_d = −d q̇.
+    let damping: Option<Vec<Sym>> = spec.damping.as_ref().map(|d| {
+        d.iter()
+            .zip(&qd)
+            .map(|(di, qdi)| Sym::constant(*di) * *qdi)
+            .collect()
+    });
+    let drives = |tau: Option<Vec<Sym>>| -> Option<Vec<Sym>> {
+        match (tau, &damping) {
+            (Some(t), Some(d)) => Some(t.iter().zip(d).map(|(t, d)| *t - *d).collect()),
+            (Some(t), None) => Some(t),
+            (None, Some(d)) => Some(d.iter().map(|d| -*d).collect()),
+            (None, None) => None,
+        }
+    };
+    let loads = |tau: Option<Vec<Sym>>| Loads {
+        tau: drives(tau),
+        gravity: gravity.clone(),
+        external: external.clone(),
+    };
+    let gravity_only = Loads {
+        tau: None,
+        gravity: gravity.clone(),
+        external: Vec::new(),
+    };
+
+    let out: Vec<Sym> = match &spec.base {
+        Base::Fixed => match function {
+            Function::MassMatrix => upper(&methods.mass_matrix.mass_matrix(&p, &q)),
+            Function::GeneralizedForces => methods.bias.bias(&p, &q, &qd, &loads(arg(Arg::Tau))),
+            Function::NonlinearEffects => negated(methods.bias.bias(&p, &q, &qd, &loads(None))),
+            Function::Gravity => negated(methods.bias.bias(&p, &q, &zeros, &gravity_only)),
+            Function::InverseDynamics => {
+                let qdd = arg(Arg::Qdd).expect("inverse dynamics takes qdd");
+                let tau = methods.inverse_dynamics(&p, &q, &qd, &qdd, &loads(None));
+                match &damping {
+                    // τ = M q̈ + c with the damping force d q̇ inside c.
+                    Some(d) => tau.iter().zip(d).map(|(t, d)| *t + *d).collect(),
+                    None => tau,
+                }
+            }
+            Function::ForwardDynamics => {
+                methods.forward_dynamics(&p, &q, &qd, &loads(arg(Arg::Tau)))
+            }
+            Function::MassMatrixAndNonlinearEffects => {
+                let mut v = upper(&methods.mass_matrix.mass_matrix(&p, &q));
+                v.extend(negated(methods.bias.bias(&p, &q, &qd, &loads(None))));
+                v
+            }
+        },
+        Base::FreeFloating(inertial) => {
+            let base = FloatingBase::<Sym>::from_inertial(inertial);
+            let state = floating_state_inputs(&mut input);
+            let m = |method| floating::mass_matrix(method, &p, &base, &state, &q);
+            let b = |l: &Loads<Sym>| floating::bias(methods.bias, &p, &base, &state, &q, &qd, l);
+            match function {
+                Function::MassMatrix => upper(&m(methods.mass_matrix)),
+                Function::GeneralizedForces => b(&loads(arg(Arg::Tau))),
+                Function::NonlinearEffects => negated(b(&loads(None))),
+                Function::ForwardDynamics => floating::forward_dynamics(
+                    methods,
+                    &p,
+                    &base,
+                    &state,
+                    &q,
+                    &qd,
+                    &loads(arg(Arg::Tau)),
+                ),
+                Function::MassMatrixAndNonlinearEffects => {
+                    let mut v = upper(&m(methods.mass_matrix));
+                    v.extend(negated(b(&loads(None))));
+                    v
+                }
+                Function::Gravity | Function::InverseDynamics => {
+                    unreachable!("rejected by check")
+                }
+            }
+        }
+    };
+    Ok(Traced {
+        trace: t.finish(&out),
+        inputs,
+    })
+}
+
+fn check(
+    subject: &Subject,
+    function: Function,
+    methods: Methods,
+    spec: &Spec,
+) -> Result<(), String> {
+    let n = subject.dof();
+    if n == 0 {
+        return Err("the model has no joint".into());
+    }
+    if function == Function::Gravity && spec.gravity.is_none() {
+        return Err("the gravity term needs gravity".into());
+    }
+    if spec.paper_14b
+        && !(matches!(subject, Subject::BaseFrame { .. })
+            && methods.mass_matrix == MassMatrixMethod::RecurrentR1
+            && function == Function::MassMatrix)
+    {
+        return Err(
+            "the printed (14b) (inexact for N ≥ 3) is traced only as Table 1 counts it: the \
+             recurrent-r1 mass matrix from base-frame inputs"
+                .into(),
+        );
+    }
+    let effects = spec.gravity.is_some()
+        || !spec.wrenches.is_empty()
+        || spec.damping.is_some()
+        || spec.runtime_payload
+        || spec.base != Base::Fixed;
+    match subject {
+        Subject::BaseFrame { .. } => {
+            if function != Function::MassMatrix {
+                return Err("a base-frame subject has only the mass matrix".into());
+            }
+            if methods.mass_matrix == MassMatrixMethod::Crba {
+                return Err("the local-frame CRBA does not start from base-frame inputs".into());
+            }
+            if effects {
+                return Err("a base-frame subject takes no effects".into());
+            }
+        }
+        Subject::Generic { .. } if effects => {
+            return Err("a generic subject takes no effects (fixed base, no loads)".into());
+        }
+        _ => {}
+    }
+    if let Some(d) = &spec.damping {
+        if d.len() != n {
+            return Err(format!("damping has {} entries for N = {n}", d.len()));
+        }
+    }
+    let floating = matches!(spec.base, Base::FreeFloating(_));
+    for (i, w) in spec.wrenches.iter().enumerate() {
+        if !(w.body < n || (floating && w.body == BASE_BODY)) {
+            return Err(format!("wrench[{i}] acts on body {} of {n}", w.body));
+        }
+    }
+    if floating && matches!(function, Function::Gravity | Function::InverseDynamics) {
+        return Err(format!(
+            "{} is not traced for a free-floating base",
+            function.name()
+        ));
+    }
+    let _ = BiasMethod::ALL; // every bias method traces every remaining combination
+    Ok(())
+}
+
+fn arg_index(a: Arg) -> usize {
+    match a {
+        Arg::Q => 0,
+        Arg::Qd => 1,
+        Arg::Qdd => 2,
+        Arg::Tau => 3,
+    }
+}
+
+/// The upper triangle of a symmetric matrix, row-major.
+fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
+    a.iter()
+        .enumerate()
+        .flat_map(|(i, row)| row[i..].to_vec())
+        .collect()
+}
+
+fn negated(v: Vec<Sym>) -> Vec<Sym> {
+    v.into_iter().map(|x| -x).collect()
+}
+
+/// The last body's mass properties as inputs: mass, centre of mass, the inertia's upper triangle
+/// (mirrored: the tensor is symmetric).
+#[allow(clippy::needless_range_loop)] // the symmetric fill reads best with indices
+fn payload_inputs(p: &mut Params<Sym>, input: &mut impl FnMut(Input) -> Sym) {
+    let last = p.joints.last_mut().expect("a model has at least one joint");
+    last.mass = input(Input::Payload(PayloadField::Mass));
+    last.com = Vec3(core::array::from_fn(|k| {
+        input(Input::Payload(PayloadField::Com(k)))
+    }));
+    let mut i = [[Sym::zero(); 3]; 3];
+    for r in 0..3 {
+        for c in r..3 {
+            let s = input(Input::Payload(PayloadField::Inertia(r, c)));
+            i[r][c] = s;
+            i[c][r] = s;
+        }
+    }
+    last.inertia_com = Mat3(i);
+}
+
+/// Three inputs named `{name}x`, `{name}y`, `{name}z`.
+fn vec_input(input: &mut impl FnMut(Input) -> Sym, name: &str) -> Vec3<Sym> {
+    Vec3::new(
+        input(Input::Parameter(format!("{name}x"))),
+        input(Input::Parameter(format!("{name}y"))),
+        input(Input::Parameter(format!("{name}z"))),
+    )
+}
+
+/// A symmetric tensor's six inputs `{name}xx, yy, zz, xy, xz, yz`.
+fn sym3_input(input: &mut impl FnMut(Input) -> Sym, name: &str) -> Mat3<Sym> {
+    let mut i = |s: &str| input(Input::Parameter(format!("{name}{s}")));
+    let (xx, yy, zz, xy, xz, yz) = (i("xx"), i("yy"), i("zz"), i("xy"), i("xz"), i("yz"));
+    Mat3([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+}
+
+/// `n` revolute joints whose every parameter is an input (inertia tensors symmetric).
+fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym> {
+    let joints = (0..n)
+        .map(|j| {
+            let l = vec_input(input, &format!("l{j}_"));
+            let upsilon = Mat3(core::array::from_fn(|r| {
+                core::array::from_fn(|c| input(Input::Parameter(format!("U{j}_{r}{c}"))))
+            }));
+            let axis = vec_input(input, &format!("u{j}_"));
+            let mass = input(Input::Parameter(format!("m{j}")));
+            let com = vec_input(input, &format!("d{j}_"));
+            let inertia_com = sym3_input(input, &format!("Ic{j}_"));
+            JointParams {
+                kind: JointKind::Revolute,
+                l,
+                upsilon,
+                axis,
+                mass,
+                com,
+                inertia_com,
+            }
+        })
+        .collect();
+    Params { joints }
+}
+
+/// `n` revolute bodies' base-frame quantities of eq. (1), (2), (6) as inputs (general geometry
+/// and inertia; inertia tensors symmetric).
+fn base_frame_inputs(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Vec<BodyKinematics<Sym>> {
+    (0..n)
+        .map(|j| {
+            let r = vec_input(input, &format!("r{j}_"));
+            let axis = vec_input(input, &format!("a{j}_"));
+            let m = input(Input::Parameter(format!("m{j}")));
+            let c = vec_input(input, &format!("c{j}_"));
+            let inertia = sym3_input(input, &format!("I{j}_"));
+            BodyKinematics {
+                kind: JointKind::Revolute,
+                orientation: Mat3::identity(),
+                r,
+                axis,
+                m,
+                c,
+                inertia,
+            }
+        })
+        .collect()
+}
+
+/// The free-floating base state as inputs: `p₀`, the quaternion `[x, y, z, w]`, `v_b`, `ω_b`.
+fn floating_state_inputs(input: &mut impl FnMut(Input) -> Sym) -> FloatingState<Sym> {
+    let position = Vec3(core::array::from_fn(|k| {
+        input(Input::Base(BaseField::Position(k)))
+    }));
+    let quat: [Sym; 4] = core::array::from_fn(|k| input(Input::Base(BaseField::Quaternion(k))));
+    let v_b = Vec3(core::array::from_fn(|k| {
+        input(Input::Base(BaseField::V(k)))
+    }));
+    let omega_b = Vec3(core::array::from_fn(|k| {
+        input(Input::Base(BaseField::Omega(k)))
+    }));
+    FloatingState {
+        position,
+        rotation: quat_to_matrix(&quat),
+        v_b,
+        omega_b,
+    }
+}
