@@ -1,6 +1,6 @@
 //! kanegen's TOML model format (see README.md, "Model files"), with optional DH geometry.
 
-use crate::inertial::{rotate_inertia, validate_inertial_with};
+use crate::inertial::{finite, rotate_inertia, validate_inertial_with};
 use crate::placement::{rpy_to_matrix, Placement, I3, M3, V3};
 use crate::{Inertial, Joint, JointKind, Model, ModelError, Validation};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
@@ -180,17 +180,6 @@ pub(crate) fn parse_toml_named(
         })
     })?;
     build(spec, validation)
-}
-
-fn finite(label: &str, field: &str, xs: &[f64]) -> Result<(), ModelError> {
-    match xs.iter().find(|x| !x.is_finite()) {
-        Some(x) => Err(ModelError::invalid(
-            label,
-            field,
-            format!("value {x} is not finite"),
-        )),
-        None => Ok(()),
-    }
 }
 
 fn rotation_of(

@@ -1,0 +1,102 @@
+//! The `kanegen` facade without default features is `no_std`: its normal dependencies are only
+//! the macro crate and `libm`, and a `#![no_std]` crate with one `dynamics!` builds — for the
+//! host, and for `thumbv7em-none-eabihf` (no standard library exists there) when that target is
+//! installed (`.ci/run` installs it; without it the cross build is skipped with a printed reason).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn root() -> &'static Path {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+}
+
+fn cargo() -> Command {
+    Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
+}
+
+/// The crates directly under `kanegen` in `cargo tree -e normal` without default features.
+#[test]
+fn facade_without_default_features_depends_on_the_macro_and_libm_only() {
+    let out = cargo()
+        .current_dir(root())
+        .args([
+            "tree",
+            "-p",
+            "kanegen",
+            "--no-default-features",
+            "-e",
+            "normal",
+            "--depth",
+            "1",
+            "--prefix",
+            "depth",
+            "--format",
+            "{p}",
+        ])
+        .output()
+        .expect("run cargo tree");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let deps: Vec<String> = text
+        .lines()
+        .filter_map(|l| l.strip_prefix('1'))
+        .map(|l| l.split_whitespace().next().unwrap_or("").to_string())
+        .collect();
+    assert_eq!(deps, ["kanegen-macros", "libm"], "cargo tree:\n{text}");
+    // With the defaults, the CLI and the library crates come in.
+    let out = cargo()
+        .current_dir(root())
+        .args(["tree", "-p", "kanegen", "-e", "normal", "--depth", "1"])
+        .output()
+        .expect("run cargo tree");
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(text.contains("kanegen-cli") && text.contains("kanegen-dynamics"));
+}
+
+fn build_no_std_crate(target: Option<&str>) {
+    let dir = root().join("tests/no_std_crate");
+    let target_dir: PathBuf = root().join("target/no_std_crate");
+    let mut cmd = cargo();
+    cmd.current_dir(&dir)
+        .env("CARGO_TARGET_DIR", &target_dir)
+        .env_remove("RUSTFLAGS")
+        .args(["build", "--release", "--locked", "--offline"]);
+    if let Some(t) = target {
+        cmd.args(["--target", t]);
+    }
+    let out = cmd.output().expect("run cargo build");
+    assert!(
+        out.status.success(),
+        "no_std crate ({}) does not build:\n{}",
+        target.unwrap_or("host"),
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn no_std_crate_with_dynamics_builds() {
+    build_no_std_crate(None);
+    const TARGET: &str = "thumbv7em-none-eabihf";
+    let installed = Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .map(|o| {
+            String::from_utf8_lossy(&o.stdout)
+                .lines()
+                .any(|l| l.trim() == TARGET)
+        })
+        .unwrap_or(false);
+    if installed {
+        build_no_std_crate(Some(TARGET));
+        eprintln!("built the no_std crate for {TARGET}");
+    } else {
+        eprintln!(
+            "skipped the {TARGET} build: the target is not installed \
+             (`rustup target add {TARGET}`)"
+        );
+    }
+}

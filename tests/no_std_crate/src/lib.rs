@@ -1,0 +1,13 @@
+//! A flight controller's view of kanegen: no standard library, one `dynamics!`, and a
+//! computed-torque law on the generated code.
+#![no_std]
+
+kanegen::dynamics!(TwoLink, "../../models/two_link.toml");
+
+/// `τ = M(q) (q̈_d + k_d (q̇_d − q̇) + k_p (q_d − q)) + c(q, q̇)`.
+#[must_use]
+pub fn computed_torque(q: &[f64; 2], qd: &[f64; 2], q_ref: &[f64; 2]) -> [f64; 2] {
+    let (kp, kd) = (4.0, 4.0);
+    let a: [f64; 2] = core::array::from_fn(|i| kp * (q_ref[i] - q[i]) - kd * qd[i]);
+    TwoLink::inverse_dynamics(q, qd, &a)
+}
