@@ -513,6 +513,7 @@ fn pair_chain(pairs: usize, theta: f64, at: [f64; 3], inner_mass: f64, seed: u64
             Joint {
                 name: format!("j{k}"),
                 kind: JointKind::Revolute,
+                parent: k.checked_sub(1),
                 origin,
                 axis: [0.0, 0.0, 1.0],
                 body: format!("b{k}"),

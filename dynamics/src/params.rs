@@ -13,6 +13,8 @@ use kanegen_model::{JointKind, Model};
 pub struct JointParams<S> {
     /// Revolute or prismatic.
     pub kind: JointKind,
+    /// The parent body `λ(j) < j`, or `None` for the base.
+    pub parent: Option<usize>,
     /// `l^{(j-1)}_{j-1}`: joint origin in the parent body frame (eq. (2)).
     pub l: Vec3<S>,
     /// `Υ_{j-1}`: joint frame orientation in the parent body frame (eq. (1)).
@@ -27,11 +29,24 @@ pub struct JointParams<S> {
     pub inertia_com: Mat3<S>,
 }
 
+/// A named frame fixed to a body, in the scalar type `S`.
+#[derive(Clone, Debug)]
+pub struct FrameParams<S> {
+    /// The body it is fixed to (`None`: the base).
+    pub parent: Option<usize>,
+    /// Its origin in the body frame.
+    pub translation: Vec3<S>,
+    /// Its orientation in the body frame.
+    pub rotation: Mat3<S>,
+}
+
 /// The model's numbers in the scalar type `S`.
 #[derive(Clone, Debug)]
 pub struct Params<S> {
-    /// Joints in order from the base.
+    /// Joints in topological order (parents first).
     pub joints: Vec<JointParams<S>>,
+    /// The model's named frames, in its order.
+    pub frames: Vec<FrameParams<S>>,
 }
 
 impl<S: Scalar> Params<S> {
@@ -44,12 +59,22 @@ impl<S: Scalar> Params<S> {
                 .iter()
                 .map(|j| JointParams {
                     kind: j.kind,
+                    parent: j.parent,
                     l: Vec3::from_f64(j.origin.translation),
                     upsilon: Mat3::from_f64(j.origin.rotation),
                     axis: Vec3::from_f64(j.axis),
                     mass: S::constant(j.inertial.mass),
                     com: Vec3::from_f64(j.inertial.com),
                     inertia_com: Mat3::from_f64(j.inertial.inertia),
+                })
+                .collect(),
+            frames: model
+                .frames()
+                .iter()
+                .map(|f| FrameParams {
+                    parent: f.parent,
+                    translation: Vec3::from_f64(f.placement.translation),
+                    rotation: Mat3::from_f64(f.placement.rotation),
                 })
                 .collect(),
         }
@@ -61,5 +86,15 @@ impl<S> Params<S> {
     #[must_use]
     pub fn dof(&self) -> usize {
         self.joints.len()
+    }
+
+    /// Whether the tree is a serial chain (`λ(j) = j − 1`), as the paper's base-frame algorithms
+    /// need.
+    #[must_use]
+    pub fn is_chain(&self) -> bool {
+        self.joints
+            .iter()
+            .enumerate()
+            .all(|(j, jp)| jp.parent == j.checked_sub(1))
     }
 }

@@ -659,6 +659,7 @@ fn floating_dynamics_traces_on_sym() {
                     .iter()
                     .map(|j| kanegen_dynamics::JointParams {
                         kind: j.kind,
+                        parent: j.parent,
                         l: Vec3(j.l.0.map(Sym::constant)),
                         upsilon: Mat3(j.upsilon.0.map(|r| r.map(Sym::constant))),
                         axis: Vec3(j.axis.0.map(Sym::constant)),
@@ -667,6 +668,7 @@ fn floating_dynamics_traces_on_sym() {
                         inertia_com: Mat3(j.inertia_com.0.map(|r| r.map(Sym::constant))),
                     })
                     .collect(),
+                frames: Vec::new(),
             };
             let loads = Loads {
                 tau: c

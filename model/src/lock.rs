@@ -1,12 +1,11 @@
 //! Locking a joint: the model with one joint turned into a fixed placement.
 
 use crate::placement::{axis_rotation, mat_mul, mat_vec, Placement};
-use crate::{JointKind, Model, ModelError, Validation};
+use crate::{Frame, JointKind, Model, ModelError, Validation};
 
 impl Model {
     /// The model with joint `index` locked at `value` (rad or m): the joint becomes a fixed
-    /// placement and its body is merged into its parent (the previous body, or the base when
-    /// `index == 0`) by [`crate::Inertial::merge`]; the next joint's origin is re-expressed in the
+    /// placement and its body is merged into its parent body (or the base) by [`crate::Inertial::merge`]; its child joints and frames are re-expressed in the
     /// parent frame. The result has `N − 1` joints and the same dynamics as the original with
     /// `q[index] = value` and `q̇[index] = 0` (rows and columns of the locked joint removed). The
     /// merged inertia is not re-checked for the triangle inequality (it holds when it held for
@@ -44,17 +43,41 @@ impl Model {
         };
         // The locked body's mass properties in the parent frame.
         let body = j.inertial.moved(&moved);
+        let parent = j.parent;
         let mut joints = self.joints().to_vec();
         let mut base_inertial = self.base_inertial().cloned();
-        if index == 0 {
-            base_inertial = base_inertial.map(|b| b.merge(&body));
-        } else {
-            let parent = &mut joints[index - 1].inertial;
-            *parent = parent.merge(&body);
+        match parent {
+            None => base_inertial = base_inertial.map(|b| b.merge(&body)),
+            Some(p) => {
+                let pi = &mut joints[p].inertial;
+                *pi = pi.merge(&body);
+            }
         }
-        if let Some(next) = joints.get_mut(index + 1) {
-            next.origin = moved.then(&next.origin);
+        // Children of the locked body hang from its parent now; later indices move down by one.
+        let reindex = |x: Option<usize>| match x {
+            Some(k) if k == index => parent,
+            Some(k) if k > index => Some(k - 1),
+            other => other,
+        };
+        for c in joints.iter_mut() {
+            if c.parent == Some(index) {
+                c.origin = moved.then(&c.origin);
+            }
+            c.parent = reindex(c.parent);
         }
+        let frames = self
+            .frames()
+            .iter()
+            .map(|f| Frame {
+                name: f.name.clone(),
+                placement: if f.parent == Some(index) {
+                    moved.then(&f.placement)
+                } else {
+                    f.placement
+                },
+                parent: reindex(f.parent),
+            })
+            .collect();
         joints.remove(index);
         Model::new_with(
             self.name(),
@@ -64,6 +87,8 @@ impl Model {
             Validation {
                 allow_nonphysical_inertia: true,
             },
-        )
+        )?
+        .with_frames(frames)?
+        .with_base_kind(self.base_kind())
     }
 }

@@ -1,11 +1,17 @@
-//! The validated model of a serial chain: plain data, no behaviour (Pinocchio's model/data split).
+//! The validated model of a robot: a kinematic tree of bodies on a base, plain data, no behaviour
+//! (Pinocchio's model/data split).
 //!
-//! Conventions (URDF's): joint `j` (0-based here, `j+1` in the paper) sits in its parent body
-//! (body `j-1`, or the base for `j = 0`) at `origin` — translation `l` and rotation `Υ` of the paper's
-//! eq. (1)–(2). The child body's frame is the joint frame moved by the joint: rotated by `q` about
-//! `axis` (revolute, `Θ_j`), or translated by `q · axis` (prismatic, `t^rel`). The child body's
-//! inertial is given by its mass, the centre of mass in the body frame and the inertia tensor about
-//! the centre of mass in body-frame axes.
+//! Conventions (URDF's): joint `j` (0-based here, `j+1` in the paper) moves body `j` and sits in
+//! its parent body `λ(j)` ([`Joint::parent`], Featherstone's λ; `None` is the base) at `origin` —
+//! translation `l` and rotation `Υ` of the paper's eq. (1)–(2). Joints are in topological order:
+//! `λ(j) < j`. A serial chain is the tree with `λ(j) = j − 1` ([`Model::is_chain`]). The child
+//! body's frame is the joint frame moved by the joint: rotated by `q` about `axis` (revolute,
+//! `Θ_j`), or translated by `q · axis` (prismatic, `t^rel`). The child body's inertial is given by
+//! its mass, the centre of mass in the body frame and the inertia tensor about the centre of mass
+//! in body-frame axes. Named [`Frame`]s (tool flanges, sensors) are massless frames fixed to a
+//! body; they are never bodies.
+//!
+//! The base is fixed, or free-floating ([`BaseKind`]) with the base body's inertial.
 //!
 //! A `Model` can only be built through [`Model::new`], which validates every number; readers for
 //! URDF and kanegen's TOML format live in [`crate::io`].
@@ -27,10 +33,12 @@ pub enum JointKind {
 /// A joint together with the body it moves.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Joint {
-    /// Joint name (unique in the chain).
+    /// Joint name (unique in the model).
     pub name: String,
     /// Revolute or prismatic.
     pub kind: JointKind,
+    /// The parent body `λ(j)`: the body of joint `λ(j) < j`, or `None` for the base.
+    pub parent: Option<usize>,
     /// Placement of the joint frame in the parent body frame (`l`, `Υ` of eq. (1)–(2)).
     pub origin: Placement,
     /// Unit joint axis in the joint frame.
@@ -41,13 +49,58 @@ pub struct Joint {
     pub inertial: Inertial,
 }
 
-/// A validated serial chain of `N` bodies, each moved by a 1-dof joint, on a base.
+/// A named frame fixed to a body (a tool flange, a camera): massless, never a body.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Frame {
+    /// Frame name (unique among frames).
+    pub name: String,
+    /// The body it is fixed to: the body of joint `j`, or `None` for the base.
+    pub parent: Option<usize>,
+    /// Its placement in that body's frame.
+    pub placement: Placement,
+}
+
+/// How the base moves.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BaseKind {
+    /// Fixed to the inertial frame: `N` degrees of freedom.
+    #[default]
+    Fixed,
+    /// Free-floating (a spacecraft): `6 + N` degrees of freedom; needs the base inertial.
+    FreeFloating,
+}
+
+impl BaseKind {
+    /// `fixed` or `free-floating`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            BaseKind::Fixed => "fixed",
+            BaseKind::FreeFloating => "free-floating",
+        }
+    }
+
+    /// The kind called `name` ([`BaseKind::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "fixed" => Some(BaseKind::Fixed),
+            "free-floating" => Some(BaseKind::FreeFloating),
+            _ => None,
+        }
+    }
+}
+
+/// A validated kinematic tree of `N` bodies, each moved by a 1-dof joint, on a base.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Model {
     name: String,
     base: String,
     base_inertial: Option<Inertial>,
+    base_kind: BaseKind,
     joints: Vec<Joint>,
+    frames: Vec<Frame>,
 }
 
 /// An error in a model: which joint (or body, or key) and which field, and why.
@@ -74,9 +127,6 @@ pub enum ModelError {
         /// Joint or link.
         what: String,
     },
-    /// A URDF tree branches at a link.
-    #[error("link `{0}` has more than one child joint: kanegen handles serial chains only")]
-    Branching(String),
     /// The file could not be parsed; the message names the key or element.
     #[error("{0}")]
     Parse(String),
@@ -120,10 +170,11 @@ impl Model {
         Self::new_with(name, base, base_inertial, joints, Validation::default())
     }
 
-    /// Builds and validates a chain. Checks, each reported with the joint and field: finite
-    /// numbers; mass > 0; inertia symmetric, positive definite and satisfying the triangle
+    /// Builds and validates a model on a fixed base, without named frames ([`Model::with_frames`],
+    /// [`Model::with_base_kind`] add them). Checks, each reported with the joint and field:
+    /// finite numbers; mass > 0; inertia symmetric, positive definite and satisfying the triangle
     /// inequality; non-zero axis (normalized here); orthonormal right-handed origin rotation;
-    /// unique joint and body names; at least one joint.
+    /// parents before children (`λ(j) < j`); unique joint and body names; at least one joint.
     pub fn new_with(
         name: impl Into<String>,
         base: impl Into<String>,
@@ -139,7 +190,19 @@ impl Model {
         let mut joints = joints;
         let mut names = std::collections::HashSet::new();
         let mut bodies = std::collections::HashSet::from([base.clone()]);
-        for j in &mut joints {
+        for (k, j) in joints.iter_mut().enumerate() {
+            if let Some(p) = j.parent {
+                if p >= k {
+                    return Err(ModelError::invalid(
+                        &j.name,
+                        "parent",
+                        format!(
+                            "joint #{p} comes at or after this joint (#{k}): joints must be \
+                             listed parents first"
+                        ),
+                    ));
+                }
+            }
             if !names.insert(j.name.clone()) {
                 return Err(ModelError::Duplicate {
                     name: j.name.clone(),
@@ -163,8 +226,55 @@ impl Model {
             name,
             base,
             base_inertial,
+            base_kind: BaseKind::Fixed,
             joints,
+            frames: Vec::new(),
         })
+    }
+
+    /// The model with these named frames (replacing any it had). Checks: unique names, an
+    /// existing parent body, a valid placement.
+    ///
+    /// # Errors
+    /// The first frame that fails a check, naming it and the field.
+    pub fn with_frames(mut self, frames: Vec<Frame>) -> Result<Self, ModelError> {
+        let mut names = std::collections::HashSet::new();
+        for f in &frames {
+            if !names.insert(f.name.clone()) {
+                return Err(ModelError::Duplicate {
+                    name: f.name.clone(),
+                    what: "frame".into(),
+                });
+            }
+            if let Some(p) = f.parent {
+                if p >= self.joints.len() {
+                    return Err(ModelError::invalid(
+                        &f.name,
+                        "frame.parent",
+                        format!("no body #{p} (N = {})", self.joints.len()),
+                    ));
+                }
+            }
+            validate_placement(&f.name, "frame.placement", &f.placement)?;
+        }
+        self.frames = frames;
+        Ok(self)
+    }
+
+    /// The model on a base of this kind.
+    ///
+    /// # Errors
+    /// A free-floating base without mass properties.
+    pub fn with_base_kind(mut self, kind: BaseKind) -> Result<Self, ModelError> {
+        if kind == BaseKind::FreeFloating && self.base_inertial.is_none() {
+            return Err(ModelError::invalid(
+                &self.base,
+                "base.mass",
+                "a free-floating base needs its mass properties (mass, com, inertia)",
+            ));
+        }
+        self.base_kind = kind;
+        Ok(self)
     }
 
     /// Model name.
@@ -176,6 +286,34 @@ impl Model {
     #[must_use]
     pub fn base(&self) -> &str {
         &self.base
+    }
+    /// Fixed or free-floating.
+    #[must_use]
+    pub fn base_kind(&self) -> BaseKind {
+        self.base_kind
+    }
+    /// The named frames.
+    #[must_use]
+    pub fn frames(&self) -> &[Frame] {
+        &self.frames
+    }
+    /// Whether the tree is a serial chain (`λ(j) = j − 1`), as the paper's algorithms need.
+    #[must_use]
+    pub fn is_chain(&self) -> bool {
+        self.joints
+            .iter()
+            .enumerate()
+            .all(|(j, jt)| jt.parent == j.checked_sub(1))
+    }
+    /// The first joint, in order, whose parent body has another child joint before it (where
+    /// the tree branches), or `None` for a chain.
+    #[must_use]
+    pub fn first_branch(&self) -> Option<&Joint> {
+        self.joints
+            .iter()
+            .enumerate()
+            .find(|(j, jt)| jt.parent != j.checked_sub(1))
+            .map(|(_, jt)| jt)
     }
     /// Mass properties of the base body, when the model gives them.
     #[must_use]

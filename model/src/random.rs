@@ -98,6 +98,7 @@ pub fn random_chain(spec: &ChainSpec, seed: u64) -> Model {
             Joint {
                 name: format!("j{}", j + 1),
                 kind,
+                parent: j.checked_sub(1),
                 origin: Placement {
                     translation: std::array::from_fn(|_| spec.length * rng.random_range(-1.0..1.0)),
                     rotation: random_rotation(&mut rng),

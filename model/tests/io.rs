@@ -362,16 +362,153 @@ fn urdf_joint_origin_rpy_and_default_axis() {
     assert_m(&j.origin.rotation, &rpy([0.1, 0.2, 0.3]), 1e-15, "origin");
 }
 
+const BOX: &str = r#"<inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial>"#;
+
+/// A trunk with two moving arms and fixed side frames: depth-first order (an arm's whole subtree
+/// before the next arm), parents, fixed links merged and kept as frames.
 #[test]
-fn branching_urdf_is_rejected_naming_the_link() {
-    let text = r#"<robot name="tree"><link name="trunk"/>
-      <link name="l"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
-      <link name="r"><inertial><mass value="1"/><inertia ixx="1" ixy="0" ixz="0" iyy="1" iyz="0" izz="1"/></inertial></link>
-      <joint name="jl" type="continuous"><parent link="trunk"/><child link="l"/></joint>
-      <joint name="jr" type="continuous"><parent link="trunk"/><child link="r"/></joint></robot>"#;
-    let e = parse_urdf(text).unwrap_err();
-    assert_eq!(e, ModelError::Branching("trunk".into()));
-    assert!(e.to_string().contains("`trunk`"), "{e}");
+fn branching_urdf_loads_as_a_tree_depth_first() {
+    let text = format!(
+        r#"<robot name="tree"><link name="trunk">{BOX}</link>
+      <link name="l1">{BOX}</link><link name="l2">{BOX}</link>
+      <link name="r1">{BOX}</link><link name="tool"/><link name="cam">{BOX}</link>
+      <joint name="jl1" type="revolute"><parent link="trunk"/><child link="l1"/><origin xyz="0 1 0"/><axis xyz="0 0 1"/></joint>
+      <joint name="jr1" type="prismatic"><parent link="trunk"/><child link="r1"/><origin xyz="0 -1 0"/><axis xyz="1 0 0"/></joint>
+      <joint name="jl2" type="continuous"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/></joint>
+      <joint name="flange" type="fixed"><parent link="l2"/><child link="tool"/><origin xyz="0.5 0 0" rpy="0 0 1.5707963267948966"/></joint>
+      <joint name="camera" type="fixed"><parent link="trunk"/><child link="cam"/><origin xyz="0 0 2"/></joint></robot>"#
+    );
+    let m = parse_urdf(&text).unwrap();
+    let names: Vec<&str> = m.joints().iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(
+        names,
+        ["jl1", "jl2", "jr1"],
+        "depth first, file order among siblings"
+    );
+    let parents: Vec<Option<usize>> = m.joints().iter().map(|j| j.parent).collect();
+    assert_eq!(parents, [None, Some(0), None]);
+    assert!(!m.is_chain());
+    assert_eq!(m.first_branch().map(|j| j.name.as_str()), Some("jr1"));
+    // The camera (1 kg, fixed to the trunk 2 m up) is merged into the base; the massless tool
+    // is only a frame of body `jl2`.
+    let base = m.base_inertial().unwrap();
+    assert_eq!(base.mass, 2.0);
+    assert_v(&base.com, &[0.0, 0.0, 1.0], 1e-15, "base com");
+    assert_eq!(m.joints()[1].inertial.mass, 1.0);
+    let frames: Vec<(&str, Option<usize>)> = m
+        .frames()
+        .iter()
+        .map(|f| (f.name.as_str(), f.parent))
+        .collect();
+    assert_eq!(frames, [("tool", Some(1)), ("cam", None)]);
+    assert_v(
+        &m.frames()[0].placement.translation,
+        &[0.5, 0.0, 0.0],
+        1e-15,
+        "tool",
+    );
+    // A joint in the TOML writer's round trip keeps its parent and the frames.
+    let back = kanegen_model::io::parse_toml(&kanegen_model::io::to_toml(&m)).unwrap();
+    assert_eq!(back, m);
+}
+
+/// Locking the trunk joint of an arm re-hangs its children and frames on the base.
+#[test]
+fn locking_a_tree_joint_rehangs_its_children_and_frames() {
+    let text = format!(
+        r#"<robot name="tree"><link name="trunk">{BOX}</link>
+      <link name="l1">{BOX}</link><link name="l2">{BOX}</link><link name="r1">{BOX}</link><link name="tip"/>
+      <joint name="jl1" type="revolute"><parent link="trunk"/><child link="l1"/><origin xyz="0 1 0"/><axis xyz="0 0 1"/></joint>
+      <joint name="jl2" type="revolute"><parent link="l1"/><child link="l2"/><origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+      <joint name="tip" type="fixed"><parent link="l1"/><child link="tip"/><origin xyz="2 0 0"/></joint>
+      <joint name="jr1" type="revolute"><parent link="trunk"/><child link="r1"/><origin xyz="0 -1 0"/><axis xyz="0 0 1"/></joint></robot>"#
+    );
+    let m = parse_urdf(&text).unwrap();
+    let l = m.lock_joint(0, std::f64::consts::FRAC_PI_2).unwrap();
+    let names: Vec<&str> = l.joints().iter().map(|j| j.name.as_str()).collect();
+    assert_eq!(names, ["jl2", "jr1"]);
+    assert_eq!(l.joints()[0].parent, None);
+    assert_eq!(l.joints()[1].parent, None);
+    // jl2 sat 1 m along l1's x; l1 is turned a quarter about z at (0, 1, 0): now at (0, 2, 0).
+    assert_v(
+        &l.joints()[0].origin.translation,
+        &[0.0, 2.0, 0.0],
+        1e-15,
+        "jl2",
+    );
+    assert_eq!(l.frames()[0].parent, None);
+    assert_v(
+        &l.frames()[0].placement.translation,
+        &[0.0, 3.0, 0.0],
+        1e-15,
+        "tip",
+    );
+    assert_eq!(l.base_inertial().unwrap().mass, 2.0);
+}
+
+/// TOML trees: `parent` names the base, an earlier joint or its body; `[[frame]]`; a
+/// free-floating `[base]`.
+#[test]
+fn toml_tree_with_frames_and_free_floating_base() {
+    let text = r#"
+name = "two_arms"
+[base]
+name = "bus"
+type = "free-floating"
+mass = 100.0
+inertia = { ixx = 10.0, iyy = 10.0, izz = 10.0 }
+[[joint]]
+name = "a1"
+type = "revolute"
+axis = [0.0, 0.0, 1.0]
+[joint.body]
+name = "arm_a"
+mass = 1.0
+inertia = { ixx = 0.1, iyy = 0.1, izz = 0.1 }
+[[joint]]
+name = "b1"
+type = "revolute"
+parent = "bus"
+axis = [0.0, 0.0, 1.0]
+[joint.body]
+mass = 1.0
+inertia = { ixx = 0.1, iyy = 0.1, izz = 0.1 }
+[[joint]]
+name = "a2"
+type = "revolute"
+parent = "arm_a"
+xyz = [1.0, 0.0, 0.0]
+axis = [0.0, 1.0, 0.0]
+[joint.body]
+mass = 1.0
+inertia = { ixx = 0.1, iyy = 0.1, izz = 0.1 }
+[[frame]]
+name = "gripper"
+parent = "a2"
+xyz = [0.5, 0.0, 0.0]
+"#;
+    let m = parse_toml(text).unwrap();
+    let parents: Vec<Option<usize>> = m.joints().iter().map(|j| j.parent).collect();
+    assert_eq!(parents, [None, None, Some(0)]);
+    assert_eq!(m.base_kind(), kanegen_model::BaseKind::FreeFloating);
+    assert_eq!(m.frames()[0].parent, Some(2));
+    assert_eq!(
+        parse_toml(&kanegen_model::io::to_toml(&m)).unwrap(),
+        m,
+        "round trip"
+    );
+    // A parent that comes later, or does not exist, is an error naming the joint and field.
+    let bad = text.replace("parent = \"arm_a\"", "parent = \"nowhere\"");
+    let e = parse_toml(&bad).unwrap_err().to_string();
+    assert!(
+        e.contains("a2") && e.contains("parent") && e.contains("nowhere"),
+        "{e}"
+    );
+    // A free-floating base needs its mass properties.
+    let e = parse_toml("name = \"x\"\n[base]\ntype = \"free-floating\"\n[[joint]]\ntype = \"revolute\"\naxis = [0.0, 0.0, 1.0]\n[joint.body]\nmass = 1.0\ninertia = { ixx = 1.0, iyy = 1.0, izz = 1.0 }\n")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("base.mass"), "{e}");
 }
 
 #[test]

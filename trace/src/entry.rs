@@ -380,6 +380,7 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
             let inertia_com = sym3_input(input, &format!("Ic{j}_"));
             JointParams {
                 kind: JointKind::Revolute,
+                parent: j.checked_sub(1),
                 l,
                 upsilon,
                 axis,
@@ -389,7 +390,10 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
             }
         })
         .collect();
-    Params { joints }
+    Params {
+        joints,
+        frames: Vec::new(),
+    }
 }
 
 /// `n` revolute bodies' base-frame quantities of eq. (1), (2), (6) as inputs (general geometry

@@ -2,7 +2,7 @@
 
 use crate::inertial::{finite, rotate_inertia, validate_inertial_with};
 use crate::placement::{rpy_to_matrix, Placement, I3, M3, V3};
-use crate::{Inertial, Joint, JointKind, Model, ModelError, Validation};
+use crate::{BaseKind, Frame, Inertial, Joint, JointKind, Model, ModelError, Validation};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
 use serde::Deserialize;
 use std::fmt;
@@ -17,6 +17,19 @@ struct ModelSpec {
     dh: Option<DhSpec>,
     #[serde(default, rename = "joint")]
     joints: Vec<JointSpec>,
+    #[serde(default, rename = "frame")]
+    frames: Vec<FrameSpec>,
+}
+
+/// `[[frame]]`: a named frame fixed to a body.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct FrameSpec {
+    name: String,
+    parent: String,
+    xyz: Option<V3>,
+    rpy: Option<V3>,
+    rotation: Option<M3>,
 }
 
 /// `base = "name"` or a `[base]` table with the base's name and mass properties.
@@ -26,6 +39,8 @@ struct BaseSpec(BaseTable);
 #[serde(deny_unknown_fields)]
 struct BaseTable {
     name: Option<String>,
+    #[serde(rename = "type")]
+    kind: Option<String>,
     mass: Option<f64>,
     com: Option<V3>,
     inertia: Option<InertiaSpec>,
@@ -91,6 +106,7 @@ struct JointSpec {
     alpha: Option<f64>,
     d: Option<f64>,
     theta: Option<f64>,
+    parent: Option<String>,
     body: BodySpec,
 }
 
@@ -257,8 +273,37 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
         None => None,
     };
 
+    let base_kind = match base.kind.as_deref() {
+        None => BaseKind::Fixed,
+        Some(k) => BaseKind::from_name(k).ok_or_else(|| {
+            ModelError::invalid(
+                &base_name,
+                "base.type",
+                format!("unknown base type `{k}` (expected \"fixed\" or \"free-floating\")"),
+            )
+        })?,
+    };
+    // A parent named in the file: the base, an earlier joint, or an earlier joint's body.
+    let parent_of = |label: &str, field: &str, name: &str, joints: &[Joint]| {
+        if name == base_name || name == "base" {
+            return Ok(None);
+        }
+        joints
+            .iter()
+            .position(|j| j.name == name || j.body == name)
+            .map(Some)
+            .ok_or_else(|| {
+                ModelError::invalid(
+                    label,
+                    field,
+                    format!(
+                        "no joint or body `{name}` before it (a parent must be the base, `{base_name}`, or an earlier joint or its body)"
+                    ),
+                )
+            })
+    };
     let mut labels = Vec::new();
-    let mut joints = Vec::new();
+    let mut joints: Vec<Joint> = Vec::new();
     // Standard DH: the constant distal part of the previous joint, to go into the next origin.
     let mut carry = dh_base.unwrap_or_else(Placement::identity);
     for (k, js) in spec.joints.iter().enumerate() {
@@ -283,6 +328,17 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
             &js.body.inertia,
             validation,
         )?;
+        let parent = match (&js.parent, &spec.dh) {
+            (None, _) => k.checked_sub(1),
+            (Some(_), Some(_)) => {
+                return Err(ModelError::invalid(
+                    &label,
+                    "parent",
+                    "a DH model ([dh]) is a serial chain: `parent` is not allowed",
+                ))
+            }
+            (Some(p), None) => parent_of(&label, "parent", p, &joints)?,
+        };
         let (origin, axis) = match &spec.dh {
             None => {
                 for (field, present) in [
@@ -367,41 +423,59 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
                 .unwrap_or_else(|| format!("{name}_body")),
             name,
             kind,
+            parent,
             origin,
             axis,
             inertial,
         });
     }
+    let mut frames = Vec::new();
+    for f in &spec.frames {
+        let xyz = f.xyz.unwrap_or([0.0; 3]);
+        finite(&f.name, "frame.xyz", &xyz)?;
+        frames.push(Frame {
+            name: f.name.clone(),
+            parent: parent_of(&f.name, "frame.parent", &f.parent, &joints)?,
+            placement: Placement {
+                translation: xyz,
+                rotation: rotation_of(&f.name, "frame.", f.rpy, f.rotation)?,
+            },
+        });
+    }
     let is_dh = spec.dh.is_some();
-    Model::new_with(spec.name, base_name, base_inertial, joints, validation).map_err(|e| match e {
-        ModelError::Invalid {
-            joint,
-            field,
-            reason,
-        } => {
-            let joint = labels
-                .iter()
-                .find(|(n, _)| *n == joint)
-                .map_or(joint, |(_, l)| l.clone());
-            let field = match field.as_str() {
-                "origin.rotation" if is_dh => "dh.base_rotation".to_string(),
-                "origin.rotation" => "rotation".to_string(),
-                "origin.translation" => "xyz".to_string(),
-                f => f
-                    .strip_prefix("inertial.")
-                    .map(|r| format!("body.{r}"))
-                    .or_else(|| {
-                        f.strip_prefix("base.inertial.")
-                            .map(|r| format!("base.{r}"))
-                    })
-                    .unwrap_or_else(|| f.to_string()),
-            };
-            ModelError::Invalid {
-                joint,
-                field,
-                reason,
+    let model =
+        Model::new_with(spec.name, base_name, base_inertial, joints, validation).map_err(|e| {
+            match e {
+                ModelError::Invalid {
+                    joint,
+                    field,
+                    reason,
+                } => {
+                    let joint = labels
+                        .iter()
+                        .find(|(n, _)| *n == joint)
+                        .map_or(joint, |(_, l)| l.clone());
+                    let field = match field.as_str() {
+                        "origin.rotation" if is_dh => "dh.base_rotation".to_string(),
+                        "origin.rotation" => "rotation".to_string(),
+                        "origin.translation" => "xyz".to_string(),
+                        f => f
+                            .strip_prefix("inertial.")
+                            .map(|r| format!("body.{r}"))
+                            .or_else(|| {
+                                f.strip_prefix("base.inertial.")
+                                    .map(|r| format!("base.{r}"))
+                            })
+                            .unwrap_or_else(|| f.to_string()),
+                    };
+                    ModelError::Invalid {
+                        joint,
+                        field,
+                        reason,
+                    }
+                }
+                other => other,
             }
-        }
-        other => other,
-    })
+        })?;
+    model.with_frames(frames)?.with_base_kind(base_kind)
 }

@@ -1,11 +1,12 @@
-//! URDF reader (serial chains; fixed joints merged into their parent body).
+//! URDF reader: kinematic trees; fixed joints merged into their moving parent body, fixed links
+//! kept as named frames.
 //!
 //! Parsed with `urdf-rs`, which fills a missing `<inertial>` with zeros: such a link is treated
 //! as massless, which is fine when it is merged through a fixed joint into a body with mass; a
 //! moving body that ends up massless is rejected by [`Model::new`] (mass must be > 0).
 
 use crate::placement::{Placement, M3};
-use crate::{Inertial, Joint, JointKind, Model, ModelError, Validation};
+use crate::{Frame, Inertial, Joint, JointKind, Model, ModelError, Validation};
 use std::collections::{HashMap, HashSet};
 use urdf_rs::JointType;
 
@@ -13,18 +14,21 @@ use urdf_rs::JointType;
 ///
 /// * Revolute, continuous (treated as revolute), prismatic and fixed joints are accepted;
 ///   floating, planar and spherical joints are rejected naming the joint.
-/// * The root is the link that is no joint's child; the chain is walked from it, and a link with
-///   more than one child joint is rejected with [`ModelError::Branching`].
-/// * Fixed joints are merged: the child's inertial is added to the parent body (combined mass,
-///   CoM, and inertia about the combined CoM by the parallel-axis theorem, in the parent body
-///   frame), and the fixed joint's origin is composed into the next moving joint's origin.
-///   Fixed links before the first moving joint merge into the base; fixed links after the last
-///   moving joint merge into the last body.
+/// * The root is the link that is no joint's child; the tree is walked from it depth first,
+///   the child joints of a link in the order of the file. Each moving joint becomes a joint of
+///   the model in that order (so parents come first); its parent is the moving body the joint's
+///   parent link belongs to, or the base.
+/// * Fixed joints are merged: the child link's inertial is added to the moving body (or the base)
+///   its parent link belongs to (combined mass, CoM, and inertia about the combined CoM by the
+///   parallel-axis theorem, in that body's frame), and the fixed joint's origin is composed into
+///   the origins of the moving joints below it. Every link attached by fixed joints is kept as a
+///   named [`Frame`] (tool flanges, sensors), with its placement in that body's frame.
 /// * The inertial `<origin>` is honoured: `com = xyz`, `I_body = R(rpy) I_urdf Rᵀ`.
 /// * Visual and collision elements are ignored (meshes are never opened).
 ///
-/// The chain is named after the robot; the base after the root link, whose (merged) inertial
-/// becomes the base inertial when its mass is non-zero.
+/// The model is named after the robot; the base after the root link, whose (merged) inertial
+/// becomes the base inertial when its mass is non-zero. The base is fixed
+/// ([`Model::with_base_kind`] makes it free-floating).
 pub fn parse_urdf(text: &str) -> Result<Model, ModelError> {
     parse_urdf_with(text, Validation::default())
 }
@@ -110,16 +114,29 @@ pub fn parse_urdf_with(text: &str, validation: Validation) -> Result<Model, Mode
         }
     };
 
-    // Walk from the root, accumulating the current body and the fixed-joint offset from the
-    // current body frame to the current link frame.
-    let mut acc: Option<Inertial> = None;
-    let mut offset = Placement::identity();
-    add_link(&mut acc, &offset, links[root], root)?;
-    let mut base_inertial: Option<Inertial> = None;
+    // Depth-first from the root. Each link belongs to a moving body (`None`: the base) and sits
+    // at `offset` in that body's frame; `acc[body]` accumulates the body's parts.
+    let mut acc: HashMap<Option<usize>, Option<Inertial>> = HashMap::new();
     let mut joints: Vec<Joint> = Vec::new();
-    let mut link = root;
-    let mut visited = 0usize;
-    loop {
+    let mut frames: Vec<Frame> = Vec::new();
+    add_link(
+        acc.entry(None).or_default(),
+        &Placement::identity(),
+        links[root],
+        root,
+    )?;
+    // Joints to walk, each with the moving body its parent link belongs to and that link's
+    // offset in the body frame; a link's child joints are pushed in reverse so that the first in
+    // the file is walked first, and the whole subtree of a joint before its next sibling
+    // (depth-first preorder: parents get smaller indices than their children).
+    let kids = |link: &str| children.get(link).map(Vec::as_slice).unwrap_or(&[]);
+    let mut stack: Vec<(&urdf_rs::Joint, Option<usize>, Placement)> = kids(root)
+        .iter()
+        .rev()
+        .map(|j| (*j, None, Placement::identity()))
+        .collect();
+    let mut visited = 1usize;
+    while let Some((j, owner, offset)) = stack.pop() {
         visited += 1;
         if visited > robot.links.len() {
             return Err(ModelError::Parse(format!(
@@ -127,54 +144,50 @@ pub fn parse_urdf_with(text: &str, validation: Validation) -> Result<Model, Mode
                 robot.name
             )));
         }
-        let kids = children.get(link).map(Vec::as_slice).unwrap_or(&[]);
-        let j = match kids {
-            [] => break,
-            [j] => *j,
-            _ => return Err(ModelError::Branching(link.to_string())),
-        };
-        let origin = Placement::from_xyz_rpy(*j.origin.xyz, *j.origin.rpy);
+        let origin = offset.then(&Placement::from_xyz_rpy(*j.origin.xyz, *j.origin.rpy));
         let child = links[j.child.link.as_str()];
-        let kind = match j.joint_type {
-            JointType::Fixed => None,
-            JointType::Prismatic => Some(JointKind::Prismatic),
-            _ => Some(JointKind::Revolute),
-        };
-        match kind {
-            None => {
-                offset = offset.then(&origin);
-                add_link(&mut acc, &offset, child, &j.name)?;
+        let (child_owner, child_offset) = match j.joint_type {
+            JointType::Fixed => {
+                add_link(acc.entry(owner).or_default(), &origin, child, &j.name)?;
+                frames.push(Frame {
+                    name: child.name.clone(),
+                    parent: owner,
+                    placement: origin,
+                });
+                (owner, origin)
             }
-            Some(kind) => {
-                let done = inertial_of(&acc);
-                match joints.last_mut() {
-                    Some(prev) => prev.inertial = done,
-                    None => base_inertial = (done.mass != 0.0).then_some(done),
-                }
+            ref t => {
+                let k = joints.len();
                 joints.push(Joint {
                     name: j.name.clone(),
-                    kind,
-                    origin: offset.then(&origin),
+                    kind: if *t == JointType::Prismatic {
+                        JointKind::Prismatic
+                    } else {
+                        JointKind::Revolute
+                    },
+                    parent: owner,
+                    origin,
                     axis: *j.axis.xyz,
                     body: child.name.clone(),
-                    inertial: Inertial {
-                        mass: 0.0,
-                        com: [0.0; 3],
-                        inertia: [[0.0; 3]; 3],
-                    },
+                    inertial: inertial_of(&None),
                 });
-                acc = None;
-                offset = Placement::identity();
-                add_link(&mut acc, &offset, child, &j.name)?;
+                let part = acc.entry(Some(k)).or_default();
+                add_link(part, &Placement::identity(), child, &j.name)?;
+                (Some(k), Placement::identity())
             }
-        }
-        link = j.child.link.as_str();
+        };
+        stack.extend(
+            kids(&child.name)
+                .iter()
+                .rev()
+                .map(|c| (*c, child_owner, child_offset)),
+        );
     }
-    let done = inertial_of(&acc);
-    match joints.last_mut() {
-        Some(prev) => prev.inertial = done,
-        None => base_inertial = (done.mass != 0.0).then_some(done),
+    for (k, j) in joints.iter_mut().enumerate() {
+        j.inertial = inertial_of(acc.get(&Some(k)).unwrap_or(&None));
     }
+    let base = inertial_of(acc.get(&None).unwrap_or(&None));
+    let base_inertial = (base.mass != 0.0).then_some(base);
     if visited < robot.links.len() {
         return Err(ModelError::Parse(format!(
             "URDF `{}`: {} link(s) are not reachable from the root `{root}`",
@@ -182,10 +195,10 @@ pub fn parse_urdf_with(text: &str, validation: Validation) -> Result<Model, Mode
             robot.links.len() - visited
         )));
     }
-    Model::new_with(robot.name.clone(), root, base_inertial, joints, validation)
+    Model::new_with(robot.name.clone(), root, base_inertial, joints, validation)?
+        .with_frames(frames)
 }
 
-/// The accumulated body, or a massless one (rejected later if it is a moving body).
 fn inertial_of(acc: &Option<Inertial>) -> Inertial {
     acc.clone().unwrap_or(Inertial {
         mass: 0.0,
