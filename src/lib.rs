@@ -20,13 +20,19 @@ extern crate std;
 
 /// Unrolled, allocation-free, `no_std` dynamics of a fixed model, generated at compile time.
 ///
-/// `dynamics!(Name, "path/to/model.urdf" [, gravity = [x, y, z]] [, allow_nonphysical = true]
-/// [, runtime_payload = true] [, scalar = f32] [, fma = true] [, fma_path = f64::mul_add])`
-/// defines `pub struct Name;` with the associated constants `N`, `JOINTS`, `OP_COUNTS`,
-/// `CANDIDATES` and, on `&[f64; N]` arrays, the functions of `M(q) q̈ + c(q, q̇) = τ`:
-/// `mass_matrix(q)`, `nonlinear_effects(q, qd)`, `inverse_dynamics(q, qd, qdd)`,
-/// `forward_dynamics(q, qd, tau)`, `mass_matrix_and_nonlinear_effects(q, qd)`, and `gravity(q)`
-/// with gravity (README, "Generated API"). It also defines `NameOpCount` (the entries of
+/// `dynamics!(Name, "path/to/model.urdf" [, base = "free-floating"] [, gravity = [x, y, z]]
+/// [, allow_nonphysical = true] [, runtime_payload = true] [, scalar = f32] [, fma = true]
+/// [, fma_path = f64::mul_add])` defines `pub struct Name;` with the associated constants `N`,
+/// `JOINTS`, `FRAMES`, `OP_COUNTS`, `CANDIDATES` and, on `&[f64; N]` arrays, the functions of
+/// `M(q) q̈ + c(q, q̇) = τ`: `mass_matrix(q)`, `nonlinear_effects(q, qd)`,
+/// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)`,
+/// `forward_dynamics_with_wrenches(q, qd, tau, f_ext)`, `mass_matrix_and_nonlinear_effects(q, qd)`,
+/// `gravity(q)` with gravity, and each named frame's `<frame>_placement(q)` and
+/// `<frame>_jacobian(q)`. With `base = "free-floating"` (or a model whose base is free-floating)
+/// the arguments are Pinocchio's free-flyer `q` (`NQ = 7 + N`: base position, quaternion
+/// `[x, y, z, w]`, joints) and `v` (`NV = 6 + N`: base linear and angular velocity in base
+/// coordinates, joint rates), and `momentum(q, v)`, `base_reaction(q, v, a)` and each frame's
+/// `<frame>_generalized_jacobian(q)` come in (README, "Generated API"). It also defines `NameOpCount` (the entries of
 /// `OP_COUNTS`) and, with `runtime_payload = true`, `NamePayload`, the last body's mass
 /// properties, taken by every function as a last argument `payload: &NamePayload`.
 ///

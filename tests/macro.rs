@@ -92,7 +92,8 @@ fn random_models_through_the_macro_equal_interpreted() {
             "nonlinear_effects",
             "inverse_dynamics",
             "forward_dynamics",
-            "mass_matrix_and_nonlinear_effects"
+            "mass_matrix_and_nonlinear_effects",
+            "forward_dynamics_with_wrenches"
         ]
     );
     for chosen in Random5::OP_COUNTS {

@@ -4,7 +4,7 @@ use crate::commands;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use kanegen_dynamics::Methods;
-use kanegen_model::Model;
+use kanegen_model::{BaseKind, Model};
 use std::path::PathBuf;
 
 #[derive(Parser)]
@@ -25,6 +25,27 @@ fn parse_algorithm(s: &str) -> Result<Methods, String> {
     })
 }
 
+fn parse_base(s: &str) -> Result<BaseKind, String> {
+    BaseKind::from_name(s).ok_or_else(|| format!("unknown base `{s}`: fixed or free-floating"))
+}
+
+/// The methods to use on `model`: the given ones, which must suit it, or the default
+/// (`recurrent` for a chain, `spatial` for a tree).
+fn checked_methods(model: &Model, given: Option<Methods>) -> Result<Methods> {
+    let methods = given.unwrap_or_else(|| commands::eval::default_methods(model));
+    if let Some(j) = model.first_branch() {
+        anyhow::ensure!(
+            methods == Methods::SPATIAL,
+            "--algorithm {methods}: the paper's base-frame algorithms handle serial chains only, \
+             and `{}` is a tree (joint `{}` does not hang from the joint before it); use \
+             --algorithm spatial",
+            model.name(),
+            j.name
+        );
+    }
+    Ok(methods)
+}
+
 fn parse_scalar(s: &str) -> Result<kanegen_codegen::Float, String> {
     kanegen_codegen::Float::from_name(s).ok_or_else(|| format!("unknown scalar `{s}`: f64 or f32"))
 }
@@ -35,16 +56,24 @@ enum Command {
     Eval {
         /// Model file (.urdf or .toml).
         model: PathBuf,
-        /// States file: {"states":[{"q":[…],"qd":[…],"tau":[…]}]}.
+        /// States file: {"states":[{"q":[…],"qd":[…],"tau":[…]}]}; free-floating: each state
+        /// also with "base": {"position", "quaternion" [x, y, z, w], "v", "omega"} (base frame).
         #[arg(long)]
         states: PathBuf,
-        /// Methods: recurrent, recurrent-r1, kane-direct, crba-base, spatial.
-        #[arg(long, default_value = "recurrent", value_parser = parse_algorithm)]
-        algorithm: Methods,
-        /// Gravity X,Y,Z in the base frame, m/s² (zero unless given).
+        /// Algorithm: recurrent, recurrent-r1, kane-direct, crba-base (serial chains), spatial
+        /// (any tree). Default: recurrent for a chain, spatial for a tree.
+        #[arg(long, value_parser = parse_algorithm)]
+        algorithm: Option<Methods>,
+        /// The base: fixed or free-floating (default: the model's; a URDF's is fixed, and its
+        /// root link's inertial is the free-floating base's).
+        #[arg(long, value_parser = parse_base)]
+        base: Option<BaseKind>,
+        /// Gravity X,Y,Z, m/s², in the base frame (fixed base) or the inertial frame
+        /// (free-floating base); zero unless given.
         #[arg(long, allow_hyphen_values = true)]
         gravity: Option<String>,
-        /// Print JSON: {"results":[{"A":[[…]],"b":[…]}]}.
+        /// Print JSON: {"joints": [names in the order of q], "base": "fixed" | "free-floating",
+        /// "results": [{"A": [[…]], "b": […]}]}.
         #[arg(long)]
         json: bool,
         /// Accept inertia tensors that violate the triangle inequality (published but not
@@ -66,9 +95,12 @@ enum Command {
     Count {
         /// Model file (.urdf or .toml), or a scene file (.toml with a `model` key).
         model: PathBuf,
-        /// Only this algorithm (default: all).
+        /// Only the methods of this algorithm (default: every method that suits the model).
         #[arg(long, value_parser = parse_algorithm)]
         algorithm: Option<Methods>,
+        /// The base: fixed or free-floating (default: the model's).
+        #[arg(long, value_parser = parse_base)]
+        base: Option<BaseKind>,
         /// Include gravity X,Y,Z in b.
         #[arg(long, allow_hyphen_values = true)]
         gravity: Option<String>,
@@ -86,9 +118,14 @@ enum Command {
         /// Output file (stdout when absent).
         #[arg(short, long)]
         output: Option<PathBuf>,
-        /// Gravity X,Y,Z in the base frame, m/s² (none: space, no gravity code).
+        /// Gravity X,Y,Z, m/s², in the base frame (fixed) or the inertial frame (free-floating);
+        /// none: space, no gravity code.
         #[arg(long, allow_hyphen_values = true)]
         gravity: Option<String>,
+        /// The base: fixed or free-floating (default: the model's; a URDF's is fixed, and its
+        /// root link's inertial is the free-floating base's).
+        #[arg(long, value_parser = parse_base)]
+        base: Option<BaseKind>,
         /// Make the last body's mass, centre of mass and inertia a runtime `payload` argument.
         #[arg(long)]
         runtime_payload: bool,
@@ -170,11 +207,18 @@ pub fn run() -> Result<()> {
             model,
             states,
             algorithm,
+            base,
             gravity,
             json,
             allow_nonphysical,
         } => {
-            let chain = load(&model, allow_nonphysical)?;
+            let mut chain = load(&model, allow_nonphysical)?;
+            if let Some(kind) = base {
+                chain = chain
+                    .with_base_kind(kind)
+                    .with_context(|| format!("model `{}`: --base", model.display()))?;
+            }
+            let algorithm = checked_methods(&chain, algorithm)?;
             let text = std::fs::read_to_string(&states)
                 .with_context(|| format!("cannot read states file `{}`", states.display()))?;
             let g = gravity
@@ -183,7 +227,15 @@ pub fn run() -> Result<()> {
             let results = commands::eval::eval_states(&chain, &text, algorithm, g)
                 .with_context(|| format!("states file `{}`", states.display()))?;
             if json {
-                println!("{}", serde_json::json!({ "results": results }));
+                let joints: Vec<&str> = chain.joints().iter().map(|j| j.name.as_str()).collect();
+                println!(
+                    "{}",
+                    serde_json::json!({
+                        "joints": joints,
+                        "base": chain.base_kind().name(),
+                        "results": results
+                    })
+                );
             } else {
                 print!(
                     "{}",
@@ -209,14 +261,20 @@ pub fn run() -> Result<()> {
         Command::Count {
             model,
             algorithm,
+            base,
             gravity,
             json,
             allow_nonphysical,
         } => {
-            let algs: Vec<Methods> = algorithm.map_or(Methods::ALL.to_vec(), |a| vec![a]);
             if commands::count::is_scene_file(&model) {
+                anyhow::ensure!(base.is_none(), "--base: a scene's [base] decides");
                 anyhow::ensure!(gravity.is_none(), "--gravity: a scene's [effects] decide");
                 let scene = kanegen_sim::scene::Scene::load(&model)?;
+                let algs = match algorithm {
+                    Some(a) => vec![checked_methods(&scene.model, Some(a))?],
+                    None if scene.model.is_chain() => Methods::ALL.to_vec(),
+                    None => vec![Methods::SPATIAL],
+                };
                 let r = commands::count::count_scene(&scene, &model.display().to_string(), &algs)?;
                 if json {
                     println!("{}", serde_json::to_string_pretty(&r)?);
@@ -225,7 +283,17 @@ pub fn run() -> Result<()> {
                 }
                 return Ok(());
             }
-            let chain = load(&model, allow_nonphysical)?;
+            let mut chain = load(&model, allow_nonphysical)?;
+            if let Some(kind) = base {
+                chain = chain
+                    .with_base_kind(kind)
+                    .with_context(|| format!("model `{}`: --base", model.display()))?;
+            }
+            let algs = match algorithm {
+                Some(a) => vec![checked_methods(&chain, Some(a))?],
+                None if chain.is_chain() => Methods::ALL.to_vec(),
+                None => vec![Methods::SPATIAL],
+            };
             let g = gravity
                 .map(|s| crate::states::parse_vec3(&s).context("--gravity"))
                 .transpose()?;
@@ -240,6 +308,7 @@ pub fn run() -> Result<()> {
             model,
             output,
             gravity,
+            base,
             runtime_payload,
             name,
             lock,
@@ -262,6 +331,7 @@ pub fn run() -> Result<()> {
             let name = name.unwrap_or_else(|| commands::generate::type_name(chain.name()));
             let mut opts = kanegen_codegen::Options::new(name);
             opts.gravity = g;
+            opts.base = base;
             opts.runtime_payload = runtime_payload;
             opts.float = scalar;
             opts.fma = fma;

@@ -1,4 +1,6 @@
-//! The states file read by `kanegen eval`: `{"states":[{"q":[…],"qd":[…],"tau":[…]}]}`.
+//! The states file read by `kanegen eval`: `{"states":[{"q":[…],"qd":[…],"tau":[…]}]}`, each
+//! state of a free-floating model also with `"base": {"position": [3], "quaternion": [x, y, z, w],
+//! "v": [3], "omega": [3]}` (base linear and angular velocity in the base frame).
 
 use anyhow::{bail, Context, Result};
 use serde::Deserialize;
@@ -14,6 +16,23 @@ pub struct State {
     /// Joint drive torques/forces; zero when absent.
     #[serde(default)]
     pub tau: Option<Vec<f64>>,
+    /// The base's pose and twist (free-floating models only).
+    #[serde(default)]
+    pub base: Option<BaseState>,
+}
+
+/// The state of a free-floating base (conventions of `kanegen_dynamics::base`).
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BaseState {
+    /// Base-frame origin in the inertial frame, m.
+    pub position: [f64; 3],
+    /// Attitude, `[x, y, z, w]` (normalized on reading).
+    pub quaternion: [f64; 4],
+    /// Velocity of the base-frame origin, base coordinates, m/s.
+    pub v: [f64; 3],
+    /// Angular velocity, base coordinates, rad/s.
+    pub omega: [f64; 3],
 }
 
 #[derive(Deserialize)]
@@ -22,10 +41,39 @@ struct StatesFile {
     states: Vec<State>,
 }
 
-/// Parses and validates a states file for a chain with `n` joints; errors name the state and field.
-pub fn parse_states(text: &str, n: usize) -> Result<Vec<State>> {
-    let f: StatesFile = serde_json::from_str(text).context("malformed states file")?;
-    for (i, s) in f.states.iter().enumerate() {
+/// Parses and validates a states file for a model with `n` joints, on a free-floating base when
+/// `floating` (then every state needs `base`, and a fixed-base model's states must not have it);
+/// errors name the state and field.
+pub fn parse_states(text: &str, n: usize, floating: bool) -> Result<Vec<State>> {
+    let mut f: StatesFile = serde_json::from_str(text).context("malformed states file")?;
+    for (i, s) in f.states.iter_mut().enumerate() {
+        match (&mut s.base, floating) {
+            (None, true) => bail!(
+                "states[{i}].base: missing (a free-floating model needs the base's position, \
+                 quaternion, v and omega)"
+            ),
+            (Some(_), false) => bail!(
+                "states[{i}].base: given for a fixed base (use --base free-floating, or a model \
+                 whose [base] has type = \"free-floating\")"
+            ),
+            (Some(b), true) => {
+                let all = b
+                    .position
+                    .iter()
+                    .chain(&b.quaternion)
+                    .chain(&b.v)
+                    .chain(&b.omega);
+                if all.clone().any(|x| !x.is_finite()) {
+                    bail!("states[{i}].base: values must be finite");
+                }
+                let norm = b.quaternion.iter().map(|x| x * x).sum::<f64>().sqrt();
+                if !(norm > 1e-6 && norm.is_finite()) {
+                    bail!("states[{i}].base.quaternion: must be non-zero (got norm {norm:e})");
+                }
+                b.quaternion = b.quaternion.map(|x| x / norm);
+            }
+            (None, false) => {}
+        }
         let fields: [(&str, Option<&Vec<f64>>); 3] = [
             ("q", Some(&s.q)),
             ("qd", Some(&s.qd)),
@@ -71,13 +119,39 @@ mod tests {
 
     #[test]
     fn rejects_wrong_lengths_and_unknown_keys() {
-        let e = parse_states(r#"{"states":[{"q":[1,2],"qd":[1]}]}"#, 2).unwrap_err();
+        let e = parse_states(r#"{"states":[{"q":[1,2],"qd":[1]}]}"#, 2, false).unwrap_err();
         assert!(e.to_string().contains("states[0].qd"), "{e}");
-        let e = parse_states(r#"{"states":[{"q":[1,2],"qd":[1,2],"qdd":[0,0]}]}"#, 2).unwrap_err();
+        let e = parse_states(
+            r#"{"states":[{"q":[1,2],"qd":[1,2],"qdd":[0,0]}]}"#,
+            2,
+            false,
+        )
+        .unwrap_err();
         assert!(format!("{e:#}").contains("qdd"), "{e:#}");
-        let ok = parse_states(r#"{"states":[{"q":[1,2],"qd":[1,2],"tau":[3,4]}]}"#, 2).unwrap();
+        let ok = parse_states(
+            r#"{"states":[{"q":[1,2],"qd":[1,2],"tau":[3,4]}]}"#,
+            2,
+            false,
+        )
+        .unwrap();
         assert_eq!(ok[0].tau.as_deref(), Some(&[3.0, 4.0][..]));
         assert!(parse_vec3("0,0,-9.81").unwrap()[2] == -9.81);
         assert!(parse_vec3("0,0").is_err() && parse_vec3("a,b,c").is_err());
+    }
+
+    #[test]
+    fn free_floating_states_need_a_base_and_fixed_ones_refuse_it() {
+        let base =
+            r#""base":{"position":[0,0,0],"quaternion":[0,0,0,2],"v":[0,0,0],"omega":[0,0,1]}"#;
+        let with = format!(r#"{{"states":[{{"q":[1],"qd":[0],{base}}}]}}"#);
+        let s = parse_states(&with, 1, true).unwrap();
+        assert_eq!(s[0].base.as_ref().unwrap().quaternion, [0.0, 0.0, 0.0, 1.0]);
+        let e = parse_states(&with, 1, false).unwrap_err();
+        assert!(e.to_string().contains("states[0].base"), "{e}");
+        let e = parse_states(r#"{"states":[{"q":[1],"qd":[0]}]}"#, 1, true).unwrap_err();
+        assert!(e.to_string().contains("states[0].base: missing"), "{e}");
+        let zero = with.replace("[0,0,0,2]", "[0,0,0,0]");
+        let e = parse_states(&zero, 1, true).unwrap_err();
+        assert!(e.to_string().contains("quaternion"), "{e}");
     }
 }

@@ -1,6 +1,8 @@
 //! The generated API, in one place: which functions a generated type has, their arguments,
 //! results and documentation, in the field's convention `M(q) q̈ + c(q, q̇) = τ`.
 //!
+//! Fixed base (`N` joints; `q`, `qd`, `qdd`, `tau` of `N` entries):
+//!
 //! | function | returns |
 //! |---|---|
 //! | `mass_matrix(q)` | `M(q)`, symmetric (upper triangle computed, both written) |
@@ -8,61 +10,149 @@
 //! | `gravity(q)` | `g(q)`, the gravity part of `c` (only when generated with gravity) |
 //! | `inverse_dynamics(q, qd, qdd)` | `τ = M q̈ + c`, one Newton–Euler pass |
 //! | `forward_dynamics(q, qd, tau)` | `q̈ = M⁻¹ (τ − c)`, unrolled branch-free LDLᵀ |
+//! | `forward_dynamics_with_wrenches(q, qd, tau, f_ext)` | the same with a wrench on every body |
 //! | `mass_matrix_and_nonlinear_effects(q, qd)` | `(M, c)` sharing sines, cosines and kinematics |
+//! | `<frame>_placement(q)`, `<frame>_jacobian(q)` | each named frame's pose and geometric Jacobian |
+//!
+//! Free-floating base (Pinocchio's free-flyer layout: `q = [p₀, quaternion x y z w, joints]`
+//! (`7 + N`), `v = [v_b, ω_b, q̇]` (`6 + N`, base coordinates), `a = v̇`): the same functions on
+//! `(q, v)` with `6 + N` speeds, `inverse_dynamics` returning the base wrench then the drives,
+//! and `momentum(q, v)`, `base_reaction(q, v, a)`, `<frame>_generalized_jacobian(q)`.
 
 use crate::emit::Shape;
 use crate::options::Options;
+use kanegen_model::{BaseKind, Model};
 use kanegen_trace::Function;
 
-/// The functions generated for `opts`, in emission order (`gravity` only with gravity).
+/// The functions generated for `model` under `opts`, in emission order: `gravity` only with
+/// gravity; the free-floating ones only on a free-floating base; three (fixed: two) per named
+/// frame. Functions a base cannot trace yet are left out.
 #[must_use]
-pub fn functions(opts: &Options) -> Vec<Function> {
-    [
+pub fn functions(model: &Model, opts: &Options) -> Vec<Function> {
+    let floating = model.base_kind() == BaseKind::FreeFloating;
+    let mut v: Vec<Function> = [
         Function::MassMatrix,
         Function::NonlinearEffects,
         Function::Gravity,
         Function::InverseDynamics,
         Function::ForwardDynamics,
         Function::MassMatrixAndNonlinearEffects,
+        Function::ForwardDynamicsWithWrenches,
+        Function::Momentum,
+        Function::BaseReaction,
     ]
     .into_iter()
     .filter(|f| *f != Function::Gravity || opts.gravity.is_some())
-    .collect()
+    .filter(|f| floating || !f.floating_only())
+    .filter(|f| !(*f == Function::BaseReaction || floating && *f == Function::InverseDynamics))
+    .collect();
+    let _ = &mut v;
+    v
 }
 
-/// How a function's outputs are returned, for `n` degrees of freedom.
+/// A frame name as a Rust identifier: lowercase ASCII letters, digits and `_` (`Tool0` →
+/// `tool0`, `ee-link` → `ee_link`, a leading digit gets `frame_`).
 #[must_use]
-pub fn shape(f: Function, n: usize) -> Shape {
+pub fn frame_ident(name: &str) -> String {
+    let mut s: String = name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() {
+                c.to_ascii_lowercase()
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
+        s.insert_str(0, "frame_");
+    }
+    s
+}
+
+/// The generated function's name: [`Function::name`], prefixed by the frame for a frame's.
+#[must_use]
+pub fn fn_name(f: Function, model: &Model) -> String {
+    match f.frame() {
+        Some(k) => format!("{}_{}", frame_ident(&model.frames()[k].name), f.name()),
+        None => f.name().to_string(),
+    }
+}
+
+/// How a function's outputs are returned, for `n` joints on the given base.
+#[must_use]
+pub fn shape(f: Function, n: usize, floating: bool) -> Shape {
+    let nv = n + if floating { 6 } else { 0 };
     match f {
-        Function::MassMatrix => Shape::SymMatrix(n),
-        Function::MassMatrixAndNonlinearEffects => Shape::SymMatrixAndVector(n),
-        _ => Shape::Vector(n),
+        Function::MassMatrix => Shape::SymMatrix(nv),
+        Function::MassMatrixAndNonlinearEffects => Shape::SymMatrixAndVector(nv),
+        Function::Momentum | Function::BaseReaction => Shape::Vector(6),
+        Function::FramePlacement(_) => Shape::Placement,
+        Function::FrameJacobian(_) => Shape::Matrix(6, nv),
+        Function::GeneralizedJacobian(_) => Shape::Matrix(6, n),
+        _ => Shape::Vector(nv),
     }
 }
 
 /// The first line of a generated function's documentation.
 #[must_use]
-pub fn doc(f: Function) -> &'static str {
+pub fn doc(f: Function, floating: bool) -> String {
+    let speeds = if floating {
+        "`v̇ = [v̇_b, ω̇_b, q̈]`"
+    } else {
+        "`q̈`"
+    };
     match f {
         Function::MassMatrix => {
-            "The joint-space inertia matrix `M(q)` (symmetric, both triangles written)."
+            "The joint-space inertia matrix `M(q)` (symmetric, both triangles written).".into()
         }
-        Function::NonlinearEffects => {
-            "The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity \
-             when the model has it (Pinocchio's `nonLinearEffects`)."
-        }
+        Function::NonlinearEffects => "The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity \
+             products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`)."
+            .into(),
         Function::Gravity => {
-            "The generalized gravity `g(q)`: the gravity part of `c` (`c` at `q̇ = 0`)."
+            "The generalized gravity `g(q)`: the gravity part of `c` (`c` at zero velocity).".into()
         }
-        Function::InverseDynamics => "Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.",
-        Function::ForwardDynamics => {
-            "Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ."
+        Function::InverseDynamics if floating => "Inverse dynamics: the external wrench on the \
+             base (force, moment about its origin, base coordinates) and the joint drives that \
+             produce `a`, i.e. `M a + c`."
+            .into(),
+        Function::InverseDynamics => {
+            "Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.".into()
+        }
+        Function::ForwardDynamics => format!(
+            "Forward dynamics: {speeds} from the joint drives, `M⁻¹ (τ − c)`, by an unrolled \
+             branch-free LDLᵀ."
+        ),
+        Function::ForwardDynamicsWithWrenches => {
+            format!(
+            "Forward dynamics {speeds} with an external wrench on every body: `f_ext[i]` = force \
+             (3) then moment (3), in the body's frame at its origin{}.",
+            if floating { "; `f_ext[0]` is the base's" } else { "" }
+        )
         }
         Function::MassMatrixAndNonlinearEffects => {
-            "`(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics."
+            "`(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.".into()
         }
+        Function::Momentum => "The total momentum `[P (3), L (3)]` of base and arm: linear, and \
+             angular about the inertial origin, in inertial coordinates."
+            .into(),
+        Function::BaseReaction => "The wrench the arm exerts on the base (force, moment about the \
+             base origin, base coordinates) in the motion `(q, v, a)`."
+            .into(),
+        Function::FramePlacement(_) => format!(
+            "The frame's placement: its origin and rotation matrix (frame to {} axes).",
+            if floating { "inertial" } else { "base" }
+        ),
+        Function::FrameJacobian(_) => format!(
+            "The frame's geometric Jacobian: rows `[v (3); ω (3)]` of its origin in {} axes, one \
+             column per speed (Pinocchio's LOCAL_WORLD_ALIGNED).",
+            if floating { "inertial" } else { "base" }
+        ),
+        Function::GeneralizedJacobian(_) => "The frame's generalized Jacobian (Umetani–Yoshida): \
+             rows `[v; ω]` in inertial axes from `q̇` when the total momentum is zero."
+            .into(),
         Function::GeneralizedForces => {
-            "The paper's generalized forces `b = Q − h` of `A q̈ = b` (`b = τ − c`)."
+            "The paper's generalized forces `b = Q − h` of `A q̈ = b` (`b = τ − c`).".into()
         }
     }
 }

@@ -3,8 +3,8 @@
 
 use crate::options::Options;
 use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
-use kanegen_model::Model;
-use kanegen_trace::{trace, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
+use kanegen_model::{BaseKind, Model};
+use kanegen_trace::{trace, Base, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
 
 /// The candidates of one function, their emitted counts, and the winner.
 #[derive(Clone, Debug)]
@@ -43,10 +43,15 @@ impl Choice {
     }
 }
 
-/// The spec of the generated code: gravity and the runtime payload of `opts`.
+/// The spec of the generated code: the model's base, and gravity and the runtime payload of
+/// `opts`.
 #[must_use]
-pub fn spec(opts: &Options) -> Spec {
+pub fn spec(model: &Model, opts: &Options) -> Spec {
     Spec {
+        base: match (model.base_kind(), model.base_inertial()) {
+            (BaseKind::FreeFloating, Some(i)) => Base::FreeFloating(i.clone()),
+            _ => Base::Fixed,
+        },
         gravity: opts.gravity,
         runtime_payload: opts.runtime_payload,
         ..Spec::default()
@@ -54,25 +59,42 @@ pub fn spec(opts: &Options) -> Spec {
 }
 
 /// The candidates of `f`: every mass-matrix method for `M`; every bias method (with the chosen
-/// mass-matrix method `mass`) for the others.
+/// mass-matrix method `mass`) for a function with a bias; the chosen method alone for the others.
+/// On a tree only the local-frame methods (`crba`, `rnea`) are candidates: the paper's
+/// base-frame algorithms handle serial chains only.
 #[must_use]
-pub fn candidates(f: Function, mass: MassMatrixMethod) -> Vec<Methods> {
+pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Methods> {
+    let mass_methods: &[MassMatrixMethod] = if chain {
+        &MassMatrixMethod::ALL
+    } else {
+        &[MassMatrixMethod::Crba]
+    };
+    let bias_methods: &[BiasMethod] = if chain {
+        &BiasMethod::ALL
+    } else {
+        &[BiasMethod::Rnea]
+    };
     if f == Function::MassMatrix {
-        MassMatrixMethod::ALL
+        mass_methods
             .iter()
             .map(|&mass_matrix| Methods {
                 mass_matrix,
                 bias: BiasMethod::Rnea,
             })
             .collect()
-    } else {
-        BiasMethod::ALL
+    } else if f.uses_bias() {
+        bias_methods
             .iter()
             .map(|&bias| Methods {
                 mass_matrix: mass,
                 bias,
             })
             .collect()
+    } else {
+        vec![Methods {
+            mass_matrix: mass,
+            bias: BiasMethod::Rnea,
+        }]
     }
 }
 
@@ -86,10 +108,10 @@ pub fn choose(
     mass: MassMatrixMethod,
     opts: &Options,
 ) -> Result<(Choice, Traced), TraceError> {
-    let spec = spec(opts);
+    let spec = spec(model, opts);
     let mut best: Option<(u64, Methods, Traced)> = None;
     let mut traced = Vec::new();
-    for m in candidates(f, mass) {
+    for m in candidates(f, mass, model.is_chain()) {
         let t = trace(Subject::Model(model), f, m, &spec)?;
         let c = t.trace.counts(Convention::Emitted);
         traced.push((m, c));

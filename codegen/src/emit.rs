@@ -134,6 +134,11 @@ pub enum Shape {
     SymMatrix(usize),
     /// A symmetric matrix's upper triangle then an `n`-vector, returned as a tuple.
     SymMatrixAndVector(usize),
+    /// A `rows × cols` matrix, row-major (`[[f; cols]; rows]`).
+    Matrix(usize, usize),
+    /// A placement: origin (3) then rotation matrix (9, row-major), returned as
+    /// `([f; 3], [[f; 3]; 3])`.
+    Placement,
 }
 
 /// The Rust expression that reads a trace input.
@@ -145,6 +150,11 @@ pub fn input_tokens(input: &Input) -> TokenStream {
             let a = format_ident!("{}", a.name());
             let i = lit(*i);
             quote!(#a[#i])
+        }
+        Input::Row(a, r, c) => {
+            let a = format_ident!("{}", a.name());
+            let (r, c) = (lit(*r), lit(*c));
+            quote!(#a[#r][#c])
         }
         Input::Payload(PayloadField::Mass) => quote!(payload.mass),
         Input::Payload(PayloadField::Com(k)) => {
@@ -379,6 +389,15 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
             let m = sym_matrix(&out[..k], n);
             let v = &out[k..];
             quote!((#m, [#(#v),*]))
+        }
+        Shape::Matrix(_, cols) => {
+            let rows = out.chunks(cols).map(|r| quote!([#(#r),*]));
+            quote!([#(#rows),*])
+        }
+        Shape::Placement => {
+            let p = &out[..3];
+            let rows = out[3..].chunks(3).map(|r| quote!([#(#r),*]));
+            quote!(([#(#p),*], [#(#rows),*]))
         }
     };
     Body {

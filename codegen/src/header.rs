@@ -3,7 +3,7 @@
 
 use crate::choose::Choice;
 use crate::options::{Float, Options, VERSION};
-use kanegen_model::{JointKind, Model};
+use kanegen_model::{BaseKind, JointKind, Model};
 
 /// Text fit for a doc comment: control and bidirectional-override characters dropped.
 #[must_use]
@@ -46,10 +46,29 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
         "Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, \
          `b = τ − c`)."
             .into(),
+        match model.base_kind() {
+            BaseKind::Fixed => "Base: fixed.".into(),
+            BaseKind::FreeFloating => format!(
+                "Base: free-floating (`{}`, {} kg). `q = [p₀ (3), quaternion x, y, z, w (4), \
+                 joints ({})]`, `v = [v_b (3), ω_b (3), q̇ ({})]`: the base origin's position in \
+                 the inertial frame, the base's attitude (base to inertial), its linear and \
+                 angular velocity in base coordinates (Pinocchio's free-flyer).",
+                doc_safe(model.base()),
+                model.base_inertial().map_or(0.0, |i| i.mass),
+                model.dof(),
+                model.dof()
+            ),
+        },
         match opts.gravity {
             Some(g) => format!(
-                "Gravity: [{}, {}, {}] m/s² in the base frame (inside `c`).",
-                g[0], g[1], g[2]
+                "Gravity: [{}, {}, {}] m/s² in the {} frame (inside `c`).",
+                g[0],
+                g[1],
+                g[2],
+                match model.base_kind() {
+                    BaseKind::Fixed => "base",
+                    BaseKind::FreeFloating => "inertial",
+                }
             ),
             None => "Gravity: none (space).".into(),
         },
@@ -76,7 +95,7 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
             let per = choices
                 .iter()
                 .zip(fmas)
-                .map(|(c, k)| format!("`{}` {k}", c.function.name()))
+                .map(|(c, k)| format!("`{}` {k}", crate::api::fn_name(c.function, model)))
                 .collect::<Vec<_>>()
                 .join(", ");
             let path = opts
@@ -104,7 +123,7 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
             let name = |x: Option<&str>| x.map_or_else(|| "—".to_string(), |x| format!("`{x}`"));
             h.push(format!(
                 "| `{}`{star} | {} | {} | {} | {} | {} | {} | {} | {} |",
-                ch.function.name(),
+                crate::api::fn_name(ch.function, model),
                 name(ch.mass_matrix_method(*m)),
                 name(ch.bias_method(*m)),
                 c.mul,

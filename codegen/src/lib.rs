@@ -36,8 +36,8 @@ pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
 pub use options::{Error, Float, Options, VERSION};
 
-use kanegen_model::Model;
-use kanegen_trace::Function;
+use kanegen_model::{BaseKind, Model};
+use kanegen_trace::{Arg, Function};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
@@ -73,6 +73,18 @@ fn generate_items_with(
     opts: &Options,
     header_on_struct: bool,
 ) -> Result<Generated, Error> {
+    let based;
+    let model = match opts.base {
+        Some(kind) if kind != model.base_kind() => {
+            based = model
+                .clone()
+                .with_base_kind(kind)
+                .map_err(|e| Error(e.to_string()))?;
+            &based
+        }
+        _ => model,
+    };
+    let floating = model.base_kind() == BaseKind::FreeFloating;
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
     let ty = ident("type name", &opts.type_name)?;
@@ -85,7 +97,8 @@ fn generate_items_with(
     let mut choices = Vec::new();
     let mut fmas = Vec::new();
     let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
-    for f in api::functions(opts) {
+    let mut names = std::collections::HashSet::new();
+    for f in api::functions(model, opts) {
         let (choice, traced) =
             choose::choose(model, f, mass, opts).map_err(|e| Error(e.to_string()))?;
         if f == Function::MassMatrix {
@@ -94,22 +107,48 @@ fn generate_items_with(
         let Body {
             tokens: body,
             fmas: k,
-        } = emit::emit_body(&traced, &emitter, api::shape(f, n));
-        let name = format_ident!("{}", f.name());
-        let args = f.args().iter().map(|a| {
-            let a = format_ident!("{}", a.name());
-            quote!(#a: &[#fl; #nl])
+        } = emit::emit_body(&traced, &emitter, api::shape(f, n, floating));
+        let fname = api::fn_name(f, model);
+        if !names.insert(fname.clone()) {
+            return Err(Error(format!(
+                "two generated functions are called `{fname}` (rename a frame of the model)"
+            )));
+        }
+        let name = ident("function name", &fname)?;
+        let args = f.args(floating).iter().map(|a| {
+            let len = Literal::usize_unsuffixed(a.len(n, floating));
+            let name = format_ident!("{}", a.name());
+            if *a == Arg::FExt {
+                quote!(#name: &[[#fl; 6]; #len])
+            } else {
+                quote!(#name: &[#fl; #len])
+            }
         });
         let payload_arg = opts
             .runtime_payload
             .then(|| quote!(, payload: &#payload_ty));
-        let ret = match api::shape(f, n) {
-            Shape::Vector(_) => quote!([#fl; #nl]),
-            Shape::SymMatrix(_) => quote!([[#fl; #nl]; #nl]),
-            Shape::SymMatrixAndVector(_) => quote!(([[#fl; #nl]; #nl], [#fl; #nl])),
+        let lit = Literal::usize_unsuffixed;
+        let ret = match api::shape(f, n, floating) {
+            Shape::Vector(k) => {
+                let k = lit(k);
+                quote!([#fl; #k])
+            }
+            Shape::SymMatrix(k) => {
+                let k = lit(k);
+                quote!([[#fl; #k]; #k])
+            }
+            Shape::SymMatrixAndVector(k) => {
+                let k = lit(k);
+                quote!(([[#fl; #k]; #k], [#fl; #k]))
+            }
+            Shape::Matrix(r, c) => {
+                let (r, c) = (lit(r), lit(c));
+                quote!([[#fl; #c]; #r])
+            }
+            Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
         };
         let c = choice.counts();
-        let doc1 = format!(" {}", api::doc(f));
+        let doc1 = format!(" {}", api::doc(f, floating));
         let fused = if opts.fma {
             format!(", of which {k} fused multiply-adds")
         } else {
@@ -150,7 +189,7 @@ fn generate_items_with(
     }
 
     let entry = |ch: &Choice, m: kanegen_dynamics::Methods, c: kanegen_trace::Counts, fma: u64| {
-        let function = ch.function.name();
+        let function = api::fn_name(ch.function, model);
         let opt = |x: Option<&str>| match x {
             Some(s) => quote!(Some(#s)),
             None => quote!(None),
@@ -189,6 +228,22 @@ fn generate_items_with(
         quote!(#[doc = #l])
     });
     let joint_names = model.joints().iter().map(|j| j.name.as_str());
+    let frame_names = model.frames().iter().map(|f| f.name.as_str());
+    let n_frames = Literal::usize_unsuffixed(model.frames().len());
+    let floating_consts = if floating {
+        let (nq, nv) = (
+            Literal::usize_unsuffixed(n + 7),
+            Literal::usize_unsuffixed(n + 6),
+        );
+        quote! {
+            /// Length of `q`: base position (3), quaternion `[x, y, z, w]` (4), joints.
+            pub const NQ: usize = #nq;
+            /// Length of `v`: base linear and angular velocity (base frame), joint rates.
+            pub const NV: usize = #nv;
+        }
+    } else {
+        quote!()
+    };
     let payload_item = if opts.runtime_payload {
         payload_struct(model, opts, &payload_ty)
     } else {
@@ -244,8 +299,11 @@ fn generate_items_with(
         impl #ty {
             /// Degrees of freedom.
             pub const N: usize = #nl;
-            /// Joint names, from the base, in the order of `q`.
+            /// Joint names, in the order of the joint entries of `q`.
             pub const JOINTS: [&'static str; #nl] = [#(#joint_names),*];
+            /// Named frames, in the model's order (one `<frame>_…` function family each).
+            pub const FRAMES: [&'static str; #n_frames] = [#(#frame_names),*];
+            #floating_consts
             /// Emitted operation counts of each generated function, in emission order.
             pub const OP_COUNTS: [#op_ty; #n_fns] = [#(#emitted),*];
             /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -426,7 +484,7 @@ mod tests {
             opts.fma = fma;
             let g = generate_items(&chain, &opts).unwrap();
             let fns = count_ops(g.items);
-            assert_eq!(fns.len(), 6, "all functions, gravity included");
+            assert_eq!(fns.len(), 7, "all functions, gravity included");
             if fma {
                 assert!(fns.values().all(|c| c.fma > 0), "every function fuses");
             } else {

@@ -15,6 +15,9 @@ pub struct Options {
     /// Uniform gravity in the base frame, m/s². `None` (default): space, no gravity code at all
     /// and no `gravity` function.
     pub gravity: Option<[f64; 3]>,
+    /// The base: `None` (default) the model's own ([`kanegen_model::Model::base_kind`]), or
+    /// fixed or free-floating (which needs the model's base inertial).
+    pub base: Option<kanegen_model::BaseKind>,
     /// Make the last body's (the payload's) mass, centre of mass and inertia runtime inputs: every
     /// function then takes a last argument `payload: &Payload`.
     pub runtime_payload: bool,
@@ -98,6 +101,7 @@ impl Options {
         Options {
             type_name: type_name.into(),
             gravity: None,
+            base: None,
             runtime_payload: false,
             libm_path: "libm".into(),
             libm_tokens: None,

@@ -3,6 +3,7 @@
 //! Joints: `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
 //! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
+//! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //!
@@ -27,6 +28,9 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 765 | 542 | 0 | 0 | 6 | 1307 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 842 | 596 | 0 | 0 | 6 | 1438 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 540 | 370 | 0 | 0 | 5 | 910 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 928 | 690 | 6 | 0 | 6 | 1618 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1005 | 744 | 6 | 0 | 6 | 1749 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 626 | 469 | 6 | 0 | 5 | 1095 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -66,7 +70,7 @@ pub struct OpCount {
 impl Srms {
     /// Degrees of freedom.
     pub const N: usize = 6;
-    /// Joint names, from the base, in the order of `q`.
+    /// Joint names, in the order of the joint entries of `q`.
     pub const JOINTS: [&'static str; 6] = [
         "shoulder_yaw",
         "shoulder_pitch",
@@ -75,8 +79,10 @@ impl Srms {
         "wrist_yaw",
         "wrist_roll",
     ];
+    /// Named frames, in the model's order (one `<frame>_…` function family each).
+    pub const FRAMES: [&'static str; 0] = [];
     /// Emitted operation counts of each generated function, in emission order.
-    pub const OP_COUNTS: [OpCount; 5] = [
+    pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
@@ -128,6 +134,17 @@ impl Srms {
             mul: 540u64,
             add: 370u64,
             div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 626u64,
+            add: 469u64,
+            div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
             fma: 0u64,
@@ -322,6 +339,39 @@ impl Srms {
             sincos: 5u64,
             fma: 0u64,
         },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 928u64,
+            add: 690u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1005u64,
+            add: 744u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 626u64,
+            add: 469u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
@@ -463,7 +513,7 @@ impl Srms {
             [x104, x103, x101, x98, x17, 1.903],
         ]
     }
-    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
+    /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: bias `rnea`: 326 mul, 226 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
@@ -782,7 +832,7 @@ impl Srms {
                         + (c_q2 * x121 + s_q2 * x123 + 0.1524 * x126)));
         [x128, x127, x122, x114, x108, x99]
     }
-    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 626 mul, 441 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
@@ -1105,7 +1155,7 @@ impl Srms {
             - x217 * x247;
         [x252, x251, x250, x249, x248, x247]
     }
-    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 540 mul, 370 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
@@ -1394,5 +1444,338 @@ impl Srms {
             ],
             [x218, x217, x212, x204, x198, x189],
         )
+    }
+    /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 626 mul, 469 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches(
+        q: &[f64; 6],
+        qd: &[f64; 6],
+        tau: &[f64; 6],
+        f_ext: &[[f64; 6]; 6],
+    ) -> [f64; 6] {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let x9 = 1.903 * x8;
+        let x10 = 0.385 * x8;
+        let x11 = 0.966 * x8;
+        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x13 = 0.353 * s_q5;
+        let x14 = 3.816 * c_q5 - x13;
+        let x15 = 0.353 * c_q5;
+        let x16 = x15 - 2.823 * s_q5;
+        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
+        let x18 = x15 + 3.816 * s_q5;
+        let x19 = x13 + 2.823 * c_q5;
+        let x20 = c_q5 * x10 - s_q5 * x11;
+        let x21 = s_q5 * x10 + c_q5 * x11;
+        let x22 = x8 * x12;
+        let x23 = s_q5 * x14 + c_q5 * x16;
+        let x24 = 0.408 + x8 * x9;
+        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
+        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
+        let x27 = c_q4 * 34.45002;
+        let x28 = s_q4 * 34.45002;
+        let x29 = x27 + 41.67378;
+        let x30 = c_q4 * x24 - s_q4 * x22;
+        let x31 = c_q4 * x20 - s_q4 * x25;
+        let x32 = c_q4 * x21 - s_q4 * x23;
+        let x33 = s_q4 * x21 + c_q4 * x23;
+        let x34 = x6 * (x8 * x17);
+        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
+        let x36 = x6 * x26;
+        let x37 = x6 * x32;
+        let x38 = c_q4 * x34 - s_q4 * x35;
+        let x39 = s_q4 * x34 + c_q4 * x35;
+        let x40 = 0.4572 * x27;
+        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
+        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
+        let x43 = 0.402
+            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
+                - x27 * -0.4572 + 0.4572 * x29);
+        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
+        let x45 = c_q3 * x29;
+        let x46 = x4 * x28;
+        let x47 = s_q3 * x29;
+        let x48 = x45 + 703.3878000000001;
+        let x49 = -15.183612000000002 - x47;
+        let x50 = c_q3 * x42 + s_q3 * x38;
+        let x51 = c_q3 * x41 + s_q3 * x39;
+        let x52 = c_q3 * x37 + s_q3 * x44;
+        let x53 = x4 * x43;
+        let x54 = c_q3 * x38 - s_q3 * x42;
+        let x55 = c_q3 * x39 - s_q3 * x41;
+        let x56 = c_q3 * x44 - s_q3 * x37;
+        let x57 = -0.1524 * x47 + x45 * -7.06;
+        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
+        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
+        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
+        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
+        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
+        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
+        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
+        let x65 = c_q2 * x48 + s_q2 * x49;
+        let x66 = x2 * x46;
+        let x67 = c_q2 * x49 - s_q2 * x48;
+        let x68 = x65 + 1192.8178500000001;
+        let x69 = x67 + -28.506420000000002;
+        let x70 = c_q2 * x58 + s_q2 * x62;
+        let x71 = c_q2 * x59 + s_q2 * x63;
+        let x72 = c_q2 * x60 + s_q2 * x64;
+        let x73 = x2 * x61;
+        let x74 = c_q2 * x62 - s_q2 * x58;
+        let x75 = c_q2 * x63 - s_q2 * x59;
+        let x76 = c_q2 * x64 - s_q2 * x60;
+        let x77 = -0.1524 * x67;
+        let x78 = x65 * -6.377;
+        let x79 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
+            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
+        let x80 = c_q1 * x75 - s_q1 * x71;
+        let x81 = x53 - x57;
+        let x82 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
+        let x83 = x36 + x40;
+        let x84 = c_q3 * x28;
+        let x85 = x4 * x27;
+        let x86 = s_q3 * x28;
+        let x87 = c_q3 * x32 + s_q3 * x83 + 0.1524 * x85;
+        let x88 = x4 * x33 + (-7.06 * x86 - -0.1524 * x84);
+        let x89 = c_q3 * x83 - s_q3 * x32 + 7.06 * x85;
+        let x90 = x2 * x85;
+        let x91 = c_q1 * (c_q2 * x89 - s_q2 * x87 + 6.377 * x90)
+            - s_q1 * (c_q2 * x87 + s_q2 * x89 + 0.1524 * x90);
+        let x92 = c_q4 * x9 - s_q4 * x12;
+        let x93 = s_q4 * x9 + c_q4 * x12;
+        let x94 = x6 * x17;
+        let x95 = c_q3 * x92 + s_q3 * x94;
+        let x96 = x4 * x93;
+        let x97 = c_q3 * x94 - s_q3 * x92;
+        let x98 = c_q1 * (c_q2 * x97 - s_q2 * x95) - s_q1 * (c_q2 * x95 + s_q2 * x97);
+        let x99 = qd[0] * s_q1;
+        let x100 = qd[0] * c_q1;
+        let x101 = qd[1] * x100;
+        let x102 = qd[1] * x99;
+        let x103 = -1.928 * qd[1] - 3.225 * x99 + 9.185 * x100;
+        let x104 = 998.63 * qd[1] - -1.928 * x99 + -0.0302 * x100;
+        let x105 = -0.0302 * qd[1] - 9.185 * x99 + 997.18 * x100;
+        let x106 = c_q2 * x99 + s_q2 * x100;
+        let x107 = c_q2 * x100 - s_q2 * x99;
+        let x108 = qd[1] * 0.1524;
+        let x109 = 6.377 * qd[1];
+        let x110 = s_q2 * x109 - c_q2 * x108;
+        let x111 = x2 * (-6.377 * x100 - -0.1524 * x99);
+        let x112 = s_q2 * x108 + c_q2 * x109;
+        let x113 = qd[2] + qd[1] * x2;
+        let x114 = x2 * (-0.1524 * x101 + -6.377 * x102);
+        let x115 = qd[2] * x112;
+        let x116 = qd[2] * x110;
+        let x117 = s_q2 * x102 - c_q2 * x101 - qd[2] * x107;
+        let x118 = s_q2 * x101 + c_q2 * x102 + qd[2] * x106;
+        let x119 = 0.8021 * x113 - 1.59 * x106 + -3.786 * x107;
+        let x120 = 632.9 * x113 - 0.8021 * x106 + -0.08 * x107;
+        let x121 = -0.08 * x113 - -3.786 * x106 + 632.51 * x107;
+        let x122 = 87.42 * x110;
+        let x123 = 87.42 * x111;
+        let x124 = 87.42 * x112;
+        let x125 = c_q3 * x106 + s_q3 * x107;
+        let x126 = c_q3 * x107 - s_q3 * x106;
+        let x127 = x110 - 0.1524 * x113;
+        let x128 = x112 + 7.06 * x113;
+        let x129 = c_q3 * x127 + s_q3 * x128;
+        let x130 = x4 * (x111 + (-7.06 * x107 - -0.1524 * x106));
+        let x131 = s_q3 * x127 - c_q3 * x128;
+        let x132 = qd[3] + x4 * x113;
+        let x133 = x4 * (x114 - (-0.1524 * x117 - -7.06 * x118));
+        let x134 = c_q3 * x117 + s_q3 * x118 - qd[3] * x126;
+        let x135 = s_q3 * x117 - c_q3 * x118 - qd[3] * x125;
+        let x136 = c_q3 * x115 - s_q3 * x116 - qd[3] * x131;
+        let x137 = s_q3 * x115 + c_q3 * x116 + qd[3] * x129;
+        let x138 = 0.0893 * x125;
+        let x139 = 0.402 * x132;
+        let x140 = 0.402 * x126;
+        let x141 = 8.48 * x129;
+        let x142 = 8.48 * x130;
+        let x143 = 8.48 * x131;
+        let x144 = s_q4 * x132 - c_q4 * x125;
+        let x145 = s_q4 * x125 + c_q4 * x132;
+        let x146 = x130 + -0.4572 * x126;
+        let x147 = c_q4 * x129 - s_q4 * x146;
+        let x148 = s_q4 * x129 + c_q4 * x146;
+        let x149 = x6 * (x131 - 0.4572 * x132);
+        let x150 = qd[4] + x6 * x126;
+        let x151 = x6 * x135;
+        let x152 = x133 - -0.4572 * x135;
+        let x153 = x6 * x137;
+        let x154 = c_q4 * x134 + qd[4] * x145;
+        let x155 = s_q4 * x134 + qd[4] * x144;
+        let x156 = c_q4 * x136 + s_q4 * x152 - qd[4] * x148;
+        let x157 = c_q4 * x152 - s_q4 * x136 - qd[4] * x147;
+        let x158 = 0.408 * x144;
+        let x159 = 4.68 * x145;
+        let x160 = 4.68 * x150;
+        let x161 = 45.94 * x147;
+        let x162 = 45.94 * x148;
+        let x163 = 45.94 * x149;
+        let x164 = c_q5 * x145 + s_q5 * x150;
+        let x165 = c_q5 * x150 - s_q5 * x145;
+        let x166 = x148 + -0.762 * x150;
+        let x167 = x149 - 0.762 * x145;
+        let x168 = x8 * x147;
+        let x169 = s_q5 * x167 - c_q5 * x166;
+        let x170 = s_q5 * x166 + c_q5 * x167;
+        let x171 = qd[5] + x8 * x144;
+        let x172 = x8 * x154;
+        let x173 = x157 - -0.762 * x151;
+        let x174 = x153 + 0.762 * x155;
+        let x175 = s_q5 * x151 - c_q5 * x155 + qd[5] * x165;
+        let x176 = s_q5 * x155 + c_q5 * x151 - qd[5] * x164;
+        let x177 = 1.903 * x171 + 0.385 * x164 + 0.966 * x165;
+        let x178 = 0.385 * x171 + 3.816 * x164 + 0.353 * x165;
+        let x179 = 0.966 * x171 + 0.353 * x164 + 2.823 * x165;
+        let x180 = 45.21 * x168;
+        let x181 = 45.21 * x169;
+        let x182 = 45.21 * x170;
+        let x183 = 1.903 * x172 + 0.385 * x175 + 0.966 * x176
+            + (x164 * x179 - x165 * x178 + (x169 * x182 - x170 * x181)) - f_ext[5][3];
+        let x184 = 0.385 * x172 + 3.816 * x175 + 0.353 * x176
+            + (x165 * x177 - x171 * x179 + (x170 * x180 - x168 * x182)) - f_ext[5][4];
+        let x185 = 0.966 * x172 + 0.353 * x175 + 2.823 * x176
+            + (x171 * x178 - x164 * x177 + (x168 * x181 - x169 * x180)) - f_ext[5][5];
+        let x186 = 45.21 * (c_q5 * x173 + s_q5 * x174 + qd[5] * x170)
+            + (x165 * x180 - x171 * x182) - f_ext[5][1];
+        let x187 = 45.21 * (c_q5 * x174 - s_q5 * x173 - qd[5] * x169)
+            + (x171 * x181 - x164 * x180) - f_ext[5][2];
+        let x188 = c_q5 * x186 - s_q5 * x187;
+        let x189 = s_q5 * x186 + c_q5 * x187;
+        let x190 = 0.408 * x154
+            + (x145 * x160 - x150 * x159 + (x149 * x162 - x148 * x163)) - f_ext[4][3]
+            + x8 * x183;
+        let x191 = x150 * x158 - x144 * x160 + (x149 * x161 - x147 * x163) - 4.68 * x155
+            - f_ext[4][4] + (c_q5 * x184 - s_q5 * x185 + -0.762 * x189);
+        let x192 = 4.68 * x151
+            + (x144 * x159 - x145 * x158 + (x148 * x161 - x147 * x162)) - f_ext[4][5]
+            + (s_q5 * x184 + c_q5 * x185 + 0.762 * x188);
+        let x193 = 45.94 * x156 + (x150 * x162 + x145 * x163) - f_ext[4][0]
+            + x8 * (45.21 * (x8 * x156) + (x164 * x182 - x165 * x181) - f_ext[5][0]);
+        let x194 = 45.94 * x157 + (x150 * x161 - x144 * x163) - f_ext[4][1] + x188;
+        let x195 = s_q4 * x193 + c_q4 * x194;
+        let x196 = x6
+            * (45.94 * x153 - (x145 * x161 + x144 * x162) - f_ext[4][2] + x189);
+        let x197 = 0.0893 * x134
+            + (x132 * x140 - x126 * x139 + (x131 * x142 - x130 * x143)) - f_ext[3][3]
+            + (c_q4 * x190 - s_q4 * x191);
+        let x198 = x125 * x140 - x126 * x138 + (x131 * x141 - x129 * x143) - f_ext[3][4]
+            + (s_q4 * x190 + c_q4 * x191 + -0.4572 * x196);
+        let x199 = 0.402 * x135
+            + (x132 * x138 - x125 * x139 + (x130 * x141 - x129 * x142)) - f_ext[3][5]
+            + (x6 * x192 + 0.4572 * x195);
+        let x200 = 8.48 * x136 + (x126 * x142 + x132 * x143) - f_ext[3][0]
+            + (c_q4 * x193 - s_q4 * x194);
+        let x201 = 8.48 * x137 + (x125 * x142 - x132 * x141) - f_ext[3][2] + x196;
+        let x202 = c_q3 * x200 + s_q3 * x201;
+        let x203 = x4 * (8.48 * x133 + (x126 * x141 + x125 * x143) - f_ext[3][1] + x195);
+        let x204 = c_q3 * x201 - s_q3 * x200;
+        let x205 = 1.59 * x117 - -3.786 * x118
+            + (x113 * x121 - x107 * x120 + (x111 * x124 - x112 * x123)) - f_ext[2][3]
+            + (c_q3 * x197 + s_q3 * x199 + 0.1524 * x203);
+        let x206 = 0.8021 * x117 - -0.08 * x118
+            + (x107 * x119 + x106 * x121 + (x110 * x124 - x112 * x122)) - f_ext[2][4]
+            + (x4 * x198 + (-0.1524 * x202 + -7.06 * x204));
+        let x207 = -3.786 * x117 - 632.51 * x118
+            + (x111 * x122 - x110 * x123 - (x113 * x119 + x106 * x120)) - f_ext[2][5]
+            + (c_q3 * x199 - s_q3 * x197 + 7.06 * x203);
+        let x208 = 87.42 * x115 + (x107 * x123 - x113 * x124) - f_ext[2][0] + x202;
+        let x209 = 87.42 * x116 + (x106 * x123 - x113 * x122) - f_ext[2][2] + x204;
+        let x210 = x2
+            * (87.42 * x114 + (x107 * x122 - x106 * x124) - f_ext[2][1] + x203);
+        let x211 = tau[0]
+            - (c_q1
+                * (c_q2 * x207 - s_q2 * x205 + 6.377 * x210
+                    - (f_ext[1][5]
+                        + (9.185 * x101 + 997.18 * x102 + (qd[1] * x103 + x99 * x104))))
+                - s_q1
+                    * (qd[1] * x105 - x100 * x104 - (3.225 * x101 + 9.185 * x102)
+                        - f_ext[1][3] + (c_q2 * x205 + s_q2 * x207 + 0.1524 * x210))
+                - f_ext[0][5]);
+        let x212 = 1.0
+            / (0.595
+                + (c_q1
+                    * (c_q1
+                        * (997.18
+                            + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
+                        - s_q1
+                            * (9.185
+                                + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
+                    - s_q1
+                        * (c_q1
+                            * (9.185
+                                + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
+                            - s_q1
+                                * (3.225
+                                    + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
+                                        + -0.1524 * x69)))));
+        let x213 = x79 * x212;
+        let x214 = x80 * x212;
+        let x215 = x82 * x212;
+        let x216 = x91 * x212;
+        let x217 = x98 * x212;
+        let x218 = 1.0
+            / (998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68))
+                - x79 * x213);
+        let x219 = x73 + (x77 - x78) - x79 * x214;
+        let x220 = x218 * x219;
+        let x221 = x2 * x81
+            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45))
+            - x79 * x215;
+        let x222 = x218 * x221;
+        let x223 = x2 * x88
+            + (-0.1524 * (s_q2 * x86 - c_q2 * x84) + -6.377 * (s_q2 * x84 + c_q2 * x86))
+            - x79 * x216;
+        let x224 = x218 * x223;
+        let x225 = x2 * x96 - x79 * x217;
+        let x226 = x218 * x225;
+        let x227 = 1.0 / (x61 - x80 * x214 - x219 * x220);
+        let x228 = x81 - x80 * x215 - x219 * x222;
+        let x229 = x227 * x228;
+        let x230 = x88 - x80 * x216 - x219 * x224;
+        let x231 = x227 * x230;
+        let x232 = x96 - x80 * x217 - x219 * x226;
+        let x233 = x227 * x232;
+        let x234 = 1.0 / (x43 - x82 * x215 - x221 * x222 - x228 * x229);
+        let x235 = x33 - x82 * x216 - x221 * x224 - x228 * x231;
+        let x236 = x234 * x235;
+        let x237 = x93 - x82 * x217 - x221 * x226 - x228 * x233;
+        let x238 = x234 * x237;
+        let x239 = 1.0 / (x26 - x91 * x216 - x223 * x224 - x230 * x231 - x235 * x236);
+        let x240 = x17 - x91 * x217 - x223 * x226 - x230 * x233 - x235 * x238;
+        let x241 = x239 * x240;
+        let x242 = 1.0
+            / (1.903 - x98 * x217 - x225 * x226 - x232 * x233 - x237 * x238
+                - x240 * x241);
+        let x243 = tau[1]
+            - (x100 * x103 + x99 * x105 - (-1.928 * x101 + -0.0302 * x102) - f_ext[1][4]
+                + (x2 * x206
+                    + (-0.1524 * (c_q2 * x208 + s_q2 * x209)
+                        + -6.377 * (c_q2 * x209 - s_q2 * x208)))) - x211 * x213;
+        let x244 = tau[2] - x206 - x211 * x214 - x220 * x243;
+        let x245 = tau[3] - x198 - x211 * x215 - x222 * x243 - x229 * x244;
+        let x246 = tau[4] - x192 - x211 * x216 - x224 * x243 - x231 * x244 - x236 * x245;
+        let x247 = x242
+            * (tau[5] - x183 - x211 * x217 - x226 * x243 - x233 * x244 - x238 * x245
+                - x241 * x246);
+        let x248 = x239 * x246 - x241 * x247;
+        let x249 = x234 * x245 - x236 * x248 - x238 * x247;
+        let x250 = x227 * x244 - x229 * x249 - x231 * x248 - x233 * x247;
+        let x251 = x218 * x243 - x220 * x250 - x222 * x249 - x224 * x248 - x226 * x247;
+        let x252 = x211 * x212 - x213 * x251 - x214 * x250 - x215 * x249 - x216 * x248
+            - x217 * x247;
+        [x252, x251, x250, x249, x248, x247]
     }
 }

@@ -3,6 +3,7 @@
 //! Joints: `shoulder_roll` (revolute), `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
 //! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
+//! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //!
@@ -27,6 +28,9 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 906 | 623 | 0 | 0 | 7 | 1529 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 1051 | 739 | 0 | 0 | 7 | 1790 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 648 | 426 | 0 | 0 | 6 | 1074 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1137 | 832 | 7 | 0 | 7 | 1969 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1282 | 948 | 7 | 0 | 7 | 2230 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 774 | 566 | 7 | 0 | 6 | 1340 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms;
@@ -66,7 +70,7 @@ pub struct OpCount {
 impl Ssrms {
     /// Degrees of freedom.
     pub const N: usize = 7;
-    /// Joint names, from the base, in the order of `q`.
+    /// Joint names, in the order of the joint entries of `q`.
     pub const JOINTS: [&'static str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
@@ -76,8 +80,10 @@ impl Ssrms {
         "wrist_yaw",
         "wrist_roll",
     ];
+    /// Named frames, in the model's order (one `<frame>_…` function family each).
+    pub const FRAMES: [&'static str; 0] = [];
     /// Emitted operation counts of each generated function, in emission order.
-    pub const OP_COUNTS: [OpCount; 5] = [
+    pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
@@ -129,6 +135,17 @@ impl Ssrms {
             mul: 648u64,
             add: 426u64,
             div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 774u64,
+            add: 566u64,
+            div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
             fma: 0u64,
@@ -323,6 +340,39 @@ impl Ssrms {
             sincos: 6u64,
             fma: 0u64,
         },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 1137u64,
+            add: 832u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1282u64,
+            add: 948u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 774u64,
+            add: 566u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
@@ -490,7 +540,7 @@ impl Ssrms {
             [x135, x134, x132, x129, x127, 0.0, 9.336],
         ]
     }
-    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
+    /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: bias `rnea`: 394 mul, 265 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
@@ -888,7 +938,7 @@ impl Ssrms {
                                 + x17 * (314.88 * x28 + (x19 * x37 + x18 * x39) + x151))));
         [x160, x159, x154, x146, x139, x133, x124]
     }
-    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 530 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
@@ -1296,7 +1346,7 @@ impl Ssrms {
             - x281 * x325 - x282 * x324;
         [x330, x329, x328, x327, x326, x325, x324]
     }
-    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 648 mul, 426 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
@@ -1655,5 +1705,424 @@ impl Ssrms {
             ],
             [x283, x282, x277, x269, x262, x256, x247],
         )
+    }
+    /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 566 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches(
+        q: &[f64; 7],
+        qd: &[f64; 7],
+        tau: &[f64; 7],
+        f_ext: &[[f64; 6]; 7],
+    ) -> [f64; 7] {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let x10 = c_q6 + (1.0 - c_q6);
+        let x11 = 9.336 * x10;
+        let x12 = 44.41 * c_q6;
+        let x13 = 44.41 * s_q6;
+        let x14 = c_q6 * x12 + s_q6 * x13;
+        let x15 = s_q6 * x12;
+        let x16 = c_q6 * x13;
+        let x17 = x15 - x16;
+        let x18 = 12.13 + (x10 * x11 + 120.2819695416);
+        let x19 = 12.13 + (x14 + 120.2819695416);
+        let x20 = 3.061 + x14;
+        let x21 = x8 * -171.195516;
+        let x22 = c_q5 * x18;
+        let x23 = s_q5 * x19;
+        let x24 = s_q5 * x17;
+        let x25 = s_q5 * x18;
+        let x26 = c_q5 * x19;
+        let x27 = c_q5 * x17;
+        let x28 = x8 * (x16 - x15);
+        let x29 = x8 * x20;
+        let x30 = s_q5 * x22 - c_q5 * x23;
+        let x31 = x8 * x24;
+        let x32 = s_q5 * x28;
+        let x33 = c_q5 * x28 + x21 * 0.5692;
+        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27938808960002);
+        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
+        let x36 = 8.0386 + (x8 * x29 + 113.27938808960002);
+        let x37 = s_q4 * x21;
+        let x38 = x6 * -199.01508800000002;
+        let x39 = c_q4 * x21;
+        let x40 = x37 + 3239.4582;
+        let x41 = c_q4 * x34 - s_q4 * x32;
+        let x42 = c_q4 * x30 + s_q4 * x33;
+        let x43 = s_q4 * x36 - c_q4 * x31;
+        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
+        let x45 = x6 * x35;
+        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
+        let x47 = s_q4 * x34 + c_q4 * x32;
+        let x48 = c_q4 * x33 - s_q4 * x30;
+        let x49 = s_q4 * x31 + c_q4 * x36;
+        let x50 = x6 * x48;
+        let x51 = x37 * -7.11;
+        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
+        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
+        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
+        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
+        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
+        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
+        let x58 = s_q3 * x39;
+        let x59 = c_q3 * x40 + x58;
+        let x60 = x4 * x38;
+        let x61 = c_q3 * x39;
+        let x62 = x61 - s_q3 * x40;
+        let x63 = x59 + 5224.5702;
+        let x64 = x60 + -349.0395;
+        let x65 = c_q3 * x54 + s_q3 * x52;
+        let x66 = c_q3 * x55 + s_q3 * x50;
+        let x67 = c_q3 * x53 + s_q3 * x57;
+        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
+        let x69 = x4 * x56;
+        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
+        let x71 = c_q3 * x52 - s_q3 * x54;
+        let x72 = c_q3 * x50 - s_q3 * x55;
+        let x73 = c_q3 * x57 - s_q3 * x53;
+        let x74 = -0.475 * x59;
+        let x75 = -7.11 * x59;
+        let x76 = x62 * 0.475;
+        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
+        let x78 = x4 * x72 + x76;
+        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
+        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
+        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
+        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
+        let x83 = 2103.19
+            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
+                - (-7.11 * x63 - -0.475 * x64));
+        let x84 = s_q2 * x62;
+        let x85 = c_q2 * x63 + x84;
+        let x86 = x2 * x64;
+        let x87 = c_q2 * x62;
+        let x88 = x87 - s_q2 * x63;
+        let x89 = x86 + -597.4892399999999;
+        let x90 = c_q2 * x80 + s_q2 * x77;
+        let x91 = c_q2 * x81 + s_q2 * x78;
+        let x92 = c_q2 * x79 + s_q2 * x83;
+        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
+        let x94 = x2 * x82;
+        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
+        let x96 = -0.5692 * x85;
+        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
+        let x98 = c_q1 * (c_q2 * x92 - s_q2 * x90)
+            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
+            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
+        let x99 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
+        let x100 = x66 - x74;
+        let x101 = x69 - x75;
+        let x102 = x72 + x76;
+        let x103 = x87 - s_q2 * x59;
+        let x104 = c_q1 * (c_q2 * x100 + s_q2 * x102 - -0.5692 * (x84 + c_q2 * x59))
+            - s_q1 * (x2 * x101) + -0.7026 * (s_q1 * x103);
+        let x105 = x45 - x51;
+        let x106 = x61 - s_q3 * x37;
+        let x107 = x58 + c_q3 * x37;
+        let x108 = c_q3 * x42 + s_q3 * x48 - -0.475 * x107;
+        let x109 = x4 * x105 - -7.11 * x107;
+        let x110 = c_q3 * x48 - s_q3 * x42 + 0.475 * x106;
+        let x111 = c_q2 * x106 - s_q2 * x107;
+        let x112 = c_q1
+            * (c_q2 * x108 + s_q2 * x110 - -0.5692 * (s_q2 * x106 + c_q2 * x107))
+            - s_q1 * (x2 * x109) + -0.7026 * (s_q1 * x111);
+        let x113 = s_q4 * x29 - c_q4 * x24;
+        let x114 = x6 * x27;
+        let x115 = s_q4 * x24 + c_q4 * x29;
+        let x116 = c_q3 * x113 + s_q3 * x115;
+        let x117 = x4 * x114;
+        let x118 = c_q3 * x115 - s_q3 * x113;
+        let x119 = c_q1 * (c_q2 * x116 + s_q2 * x118) - s_q1 * (x2 * x117);
+        let x120 = c_q5 * x11;
+        let x121 = s_q5 * x11;
+        let x122 = c_q4 * x120;
+        let x123 = x6 * x121;
+        let x124 = s_q4 * x120;
+        let x125 = c_q3 * x122 - s_q3 * x124;
+        let x126 = x4 * x123;
+        let x127 = s_q3 * x122 + c_q3 * x124;
+        let x128 = c_q1 * (c_q2 * x125 - s_q2 * x127) - s_q1 * (x2 * x126);
+        let x129 = qd[0] * c_q1;
+        let x130 = qd[0] * s_q1;
+        let x131 = 0.7026 * qd[0];
+        let x132 = s_q1 * x131;
+        let x133 = c_q1 * x131;
+        let x134 = qd[1] * x130;
+        let x135 = qd[1] * x129;
+        let x136 = qd[1] * x133;
+        let x137 = qd[1] * x132;
+        let x138 = 8.088 * x129;
+        let x139 = 3.061 * x130;
+        let x140 = 8.446 * qd[1];
+        let x141 = 105.98 * x132;
+        let x142 = 105.98 * x133;
+        let x143 = c_q2 * x129 - qd[1] * s_q2;
+        let x144 = s_q2 * x129 + qd[1] * c_q2;
+        let x145 = 0.5692 * x129;
+        let x146 = x132 + -0.5692 * qd[1];
+        let x147 = s_q2 * x145 - c_q2 * x146;
+        let x148 = x2 * x133;
+        let x149 = s_q2 * x146 + c_q2 * x145;
+        let x150 = qd[2] - x2 * x130;
+        let x151 = x2 * x135;
+        let x152 = 0.5692 * x134;
+        let x153 = x2 * x137;
+        let x154 = c_q2 * x134 + qd[2] * x144;
+        let x155 = qd[2] * x143 - s_q2 * x134;
+        let x156 = qd[2] * x149 - (c_q2 * x136 + s_q2 * x152);
+        let x157 = c_q2 * x152 - s_q2 * x136 + qd[2] * x147;
+        let x158 = 15.41 * x143 + 49.52 * x150;
+        let x159 = 49.52 * x143 + 2094.71 * x150;
+        let x160 = 2103.19 * x144;
+        let x161 = 314.88 * x147;
+        let x162 = 314.88 * x148;
+        let x163 = 314.88 * x149;
+        let x164 = c_q3 * x143 - s_q3 * x144;
+        let x165 = s_q3 * x143 + c_q3 * x144;
+        let x166 = x147 - -0.475 * x144;
+        let x167 = x149 + (0.475 * x143 + 7.11 * x150);
+        let x168 = c_q3 * x166 + s_q3 * x167;
+        let x169 = x4 * (x148 + -7.11 * x144);
+        let x170 = s_q3 * x166 - c_q3 * x167;
+        let x171 = qd[3] + x4 * x150;
+        let x172 = x4 * x151;
+        let x173 = x156 - -0.475 * x155;
+        let x174 = x157 + (0.475 * x154 + 7.11 * x151);
+        let x175 = x4 * (x153 - -7.11 * x155);
+        let x176 = c_q3 * x154 + s_q3 * x155 + qd[3] * x165;
+        let x177 = c_q3 * x155 - s_q3 * x154 + qd[3] * x164;
+        let x178 = c_q3 * x173 - s_q3 * x174 - qd[3] * x170;
+        let x179 = s_q3 * x173 + c_q3 * x174 + qd[3] * x168;
+        let x180 = 9.522 * x164 + -39.95 * x171;
+        let x181 = -39.95 * x164 + 1966.28 * x171;
+        let x182 = 1966.28 * x165;
+        let x183 = 279.2 * x168;
+        let x184 = 279.2 * x169;
+        let x185 = 279.2 * x170;
+        let x186 = c_q4 * x164 - s_q4 * x165;
+        let x187 = s_q4 * x164 + c_q4 * x165;
+        let x188 = x170 - 7.11 * x171;
+        let x189 = c_q4 * x168 - s_q4 * x188;
+        let x190 = x6 * (x169 + -7.11 * x165);
+        let x191 = s_q4 * x168 + c_q4 * x188;
+        let x192 = qd[4] + x6 * x171;
+        let x193 = x6 * x172;
+        let x194 = x179 + 7.11 * x172;
+        let x195 = x6 * (x175 - -7.11 * x177);
+        let x196 = c_q4 * x176 + s_q4 * x177 + qd[4] * x187;
+        let x197 = c_q4 * x177 - s_q4 * x176 + qd[4] * x186;
+        let x198 = c_q4 * x178 - s_q4 * x194 - qd[4] * x191;
+        let x199 = s_q4 * x178 + c_q4 * x194 + qd[4] * x189;
+        let x200 = 8.305 * x186;
+        let x201 = 3.061 * x192;
+        let x202 = 8.0386 * x187;
+        let x203 = 105.98 * x189;
+        let x204 = 105.98 * x190;
+        let x205 = 105.98 * x191;
+        let x206 = c_q5 * x186 + s_q5 * x192;
+        let x207 = c_q5 * x192 - s_q5 * x186;
+        let x208 = x189 - -0.5692 * x187;
+        let x209 = c_q5 * x208 - s_q5 * x190;
+        let x210 = s_q5 * x208 + c_q5 * x190;
+        let x211 = x8 * (x191 - 0.5692 * x186);
+        let x212 = qd[5] + x8 * x187;
+        let x213 = x8 * x197;
+        let x214 = x198 - -0.5692 * x197;
+        let x215 = x8 * (x199 + 0.5692 * x196);
+        let x216 = qd[5] * x207 - (c_q5 * x196 + s_q5 * x193);
+        let x217 = s_q5 * x196 - c_q5 * x193 - qd[5] * x206;
+        let x218 = c_q5 * x214 + s_q5 * x195 - qd[5] * x210;
+        let x219 = c_q5 * x195 - s_q5 * x214 - qd[5] * x209;
+        let x220 = 12.13 * x206;
+        let x221 = 12.13 * x207;
+        let x222 = 3.061 * x212;
+        let x223 = 105.98 * x209;
+        let x224 = 105.98 * x210;
+        let x225 = 105.98 * x211;
+        let x226 = c_q6 * x207 + s_q6 * x212;
+        let x227 = c_q6 * x212 - s_q6 * x207;
+        let x228 = x210 + -0.7026 * x206;
+        let x229 = x10 * (x209 - 0.7026 * x207);
+        let x230 = s_q6 * x211 - c_q6 * x228;
+        let x231 = s_q6 * x228 + c_q6 * x211;
+        let x232 = qd[6] + x10 * x206;
+        let x233 = x219 - -0.7026 * x216;
+        let x234 = 9.336 * x232;
+        let x235 = 44.41 * x226;
+        let x236 = 44.41 * x227;
+        let x237 = 243.66 * x229;
+        let x238 = 243.66 * x230;
+        let x239 = 243.66 * x231;
+        let x240 = 9.336 * (x10 * x216)
+            + (x226 * x236 - x227 * x235 + (x230 * x239 - x231 * x238)) - f_ext[6][3];
+        let x241 = 44.41 * (c_q6 * x217 + s_q6 * x213 + qd[6] * x227)
+            + (x227 * x234 - x232 * x236 + (x231 * x237 - x229 * x239)) - f_ext[6][4];
+        let x242 = 44.41 * (c_q6 * x213 - s_q6 * x217 - qd[6] * x226)
+            + (x232 * x235 - x226 * x234 + (x229 * x238 - x230 * x237)) - f_ext[6][5];
+        let x243 = 243.66 * (c_q6 * x233 + s_q6 * x215 + qd[6] * x231)
+            + (x227 * x237 - x232 * x239) - f_ext[6][1];
+        let x244 = 243.66 * (c_q6 * x215 - s_q6 * x233 - qd[6] * x230)
+            + (x232 * x238 - x226 * x237) - f_ext[6][2];
+        let x245 = x10
+            * (243.66 * (x10 * (x218 - 0.7026 * x217)) + (x226 * x239 - x227 * x238)
+                - f_ext[6][0]);
+        let x246 = c_q6 * x243 - s_q6 * x244;
+        let x247 = 12.13 * x216
+            + (x207 * x222 - x212 * x221 + (x211 * x224 - x210 * x225)) - f_ext[5][3]
+            + (x10 * x240 + 0.7026 * x246);
+        let x248 = 12.13 * x217
+            + (x212 * x220 - x206 * x222 + (x211 * x223 - x209 * x225)) - f_ext[5][4]
+            + (c_q6 * x241 - s_q6 * x242 + -0.7026 * x245);
+        let x249 = 3.061 * x213
+            + (x206 * x221 - x207 * x220 + (x210 * x223 - x209 * x224)) - f_ext[5][5]
+            + (s_q6 * x241 + c_q6 * x242);
+        let x250 = 105.98 * x218 + (x212 * x224 + x207 * x225) - f_ext[5][0] + x245;
+        let x251 = 105.98 * x219 + (x212 * x223 - x206 * x225) - f_ext[5][1] + x246;
+        let x252 = c_q5 * x250 - s_q5 * x251;
+        let x253 = x8
+            * (105.98 * x215 - (x207 * x223 + x206 * x224) - f_ext[5][2]
+                + (s_q6 * x243 + c_q6 * x244));
+        let x254 = x192 * x202 - x187 * x201 + (x191 * x204 - x190 * x205) - 8.305 * x196
+            - f_ext[4][3] + (c_q5 * x247 - s_q5 * x248 + -0.5692 * x253);
+        let x255 = x187 * x200 - x186 * x202 + (x191 * x203 - x189 * x205) - 3.061 * x193
+            - f_ext[4][4] + (s_q5 * x247 + c_q5 * x248);
+        let x256 = 8.0386 * x197
+            + (x186 * x201 - x192 * x200 + (x190 * x203 - x189 * x204)) - f_ext[4][5]
+            + (x8 * x249 + 0.5692 * x252);
+        let x257 = 105.98 * x198 + (x187 * x204 + x192 * x205) - f_ext[4][0] + x252;
+        let x258 = 105.98 * x199 - (x192 * x203 + x186 * x204) - f_ext[4][2] + x253;
+        let x259 = x6
+            * (105.98 * x195 + (x187 * x203 - x186 * x205) - f_ext[4][1]
+                + (s_q5 * x250 + c_q5 * x251));
+        let x260 = c_q4 * x258 - s_q4 * x257;
+        let x261 = x171 * x182 - x165 * x181 + (x170 * x184 - x169 * x185)
+            - (9.522 * x176 + -39.95 * x172) - f_ext[3][3] + (c_q4 * x254 + s_q4 * x256);
+        let x262 = x165 * x180 - x164 * x182 + (x170 * x183 - x168 * x185)
+            - (-39.95 * x176 + 1966.28 * x172) - f_ext[3][4]
+            + (x6 * x255 + -7.11 * x260);
+        let x263 = 1966.28 * x177
+            + (x164 * x181 - x171 * x180 + (x169 * x183 - x168 * x184)) - f_ext[3][5]
+            + (c_q4 * x256 - s_q4 * x254 + 7.11 * x259);
+        let x264 = 279.2 * x178 + (x165 * x184 + x171 * x185) - f_ext[3][0]
+            + (c_q4 * x257 + s_q4 * x258);
+        let x265 = 279.2 * x179 - (x171 * x183 + x164 * x184) - f_ext[3][2] + x260;
+        let x266 = c_q3 * x264 + s_q3 * x265;
+        let x267 = x4
+            * (279.2 * x175 + (x165 * x183 - x164 * x185) - f_ext[3][1] + x259);
+        let x268 = c_q3 * x265 - s_q3 * x264;
+        let x269 = x150 * x160 - x144 * x159 + (x148 * x163 - x149 * x162)
+            - (15.41 * x154 + 49.52 * x151) - f_ext[2][3]
+            + (c_q3 * x261 + s_q3 * x263 + -0.475 * x268);
+        let x270 = x144 * x158 - x143 * x160 + (x147 * x163 - x149 * x161)
+            - (49.52 * x154 + 2094.71 * x151) - f_ext[2][4] + (x4 * x262 + -7.11 * x268);
+        let x271 = 2103.19 * x155
+            + (x143 * x159 - x150 * x158 + (x148 * x161 - x147 * x162)) - f_ext[2][5]
+            + (c_q3 * x263 - s_q3 * x261 + (0.475 * x266 + 7.11 * x267));
+        let x272 = 314.88 * x156 + (x144 * x162 - x150 * x163) - f_ext[2][0] + x266;
+        let x273 = 314.88 * x157 - (x150 * x161 + x143 * x162) - f_ext[2][2] + x268;
+        let x274 = c_q2 * x272 + s_q2 * x273;
+        let x275 = tau[0]
+            - (c_q1
+                * (qd[1] * x139 - x130 * x140 - 8.088 * x134 - f_ext[1][3]
+                    + (c_q2 * x269 + s_q2 * x271
+                        + -0.5692 * (c_q2 * x273 - s_q2 * x272)))
+                - s_q1
+                    * (qd[1] * x138 - x129 * x140 - 3.061 * x135 - f_ext[1][4]
+                        + x2 * x270)
+                + -0.7026
+                    * (s_q1 * (qd[1] * x142 - 105.98 * x136 - f_ext[1][0] + x274)
+                        + c_q1
+                            * (105.98 * x137 - qd[1] * x141 - f_ext[1][1]
+                                + x2
+                                    * (314.88 * x153 + (x144 * x161 + x143 * x163) - f_ext[2][1]
+                                        + x267))) - f_ext[0][3]);
+        let x276 = 1.0
+            / (12.19
+                + (c_q1
+                    * (c_q1
+                        * (8.088
+                            + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
+                        - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
+                    - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
+                    - -0.7026 * x97 + 0.7026 * (x97 + 811.9807679999999)));
+        let x277 = x98 * x276;
+        let x278 = x99 * x276;
+        let x279 = x104 * x276;
+        let x280 = x112 * x276;
+        let x281 = x119 * x276;
+        let x282 = x128 * x276;
+        let x283 = 1.0
+            / (8.446
+                + (c_q2 * (c_q2 * x83 - s_q2 * x79) - s_q2 * (c_q2 * x77 - s_q2 * x80)
+                    - 0.5692 * x86 + -0.5692 * x89) - x98 * x277);
+        let x284 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88 - x98 * x278;
+        let x285 = x283 * x284;
+        let x286 = c_q2 * x102 - s_q2 * x100 + 0.5692 * x103 - x98 * x279;
+        let x287 = x283 * x286;
+        let x288 = c_q2 * x110 - s_q2 * x108 + 0.5692 * x111 - x98 * x280;
+        let x289 = x283 * x288;
+        let x290 = c_q2 * x118 - s_q2 * x116 - x98 * x281;
+        let x291 = x283 * x290;
+        let x292 = s_q2 * x125 + c_q2 * x127 + x98 * x282;
+        let x293 = x283 * x292;
+        let x294 = 1.0 / (x82 - x99 * x278 - x284 * x285);
+        let x295 = x101 - x99 * x279 - x284 * x287;
+        let x296 = x294 * x295;
+        let x297 = x109 - x99 * x280 - x284 * x289;
+        let x298 = x294 * x297;
+        let x299 = x117 - x99 * x281 - x284 * x291;
+        let x300 = x294 * x299;
+        let x301 = x126 - x99 * x282 + x284 * x293;
+        let x302 = x294 * x301;
+        let x303 = 1.0 / (x56 - x104 * x279 - x286 * x287 - x295 * x296);
+        let x304 = x105 - x104 * x280 - x286 * x289 - x295 * x298;
+        let x305 = x303 * x304;
+        let x306 = x114 - x104 * x281 - x286 * x291 - x295 * x300;
+        let x307 = x303 * x306;
+        let x308 = x123 - x104 * x282 + x286 * x293 - x295 * x302;
+        let x309 = x303 * x308;
+        let x310 = 1.0 / (x35 - x112 * x280 - x288 * x289 - x297 * x298 - x304 * x305);
+        let x311 = x27 - x112 * x281 - x288 * x291 - x297 * x300 - x304 * x307;
+        let x312 = x310 * x311;
+        let x313 = x121 - x112 * x282 + x288 * x293 - x297 * x302 - x304 * x309;
+        let x314 = x310 * x313;
+        let x315 = 1.0
+            / (x20 - x119 * x281 - x290 * x291 - x299 * x300 - x306 * x307
+                - x311 * x312);
+        let x316 = x290 * x293 - x119 * x282 - x299 * x302 - x306 * x309 - x311 * x314;
+        let x317 = x315 * x316;
+        let x318 = 1.0
+            / (9.336 - x128 * x282 - x292 * x293 - x301 * x302 - x308 * x309
+                - x313 * x314 - x316 * x317);
+        let x319 = tau[1]
+            - (x130 * x138 - x129 * x139 + (x132 * x142 - x133 * x141) - f_ext[1][5]
+                + (c_q2 * x271 - s_q2 * x269 + 0.5692 * x274)) - x275 * x277;
+        let x320 = tau[2] - x270 - x275 * x278 - x285 * x319;
+        let x321 = tau[3] - x262 - x275 * x279 - x287 * x319 - x296 * x320;
+        let x322 = tau[4] - x255 - x275 * x280 - x289 * x319 - x298 * x320 - x305 * x321;
+        let x323 = tau[5] - x249 - x275 * x281 - x291 * x319 - x300 * x320 - x307 * x321
+            - x312 * x322;
+        let x324 = x318
+            * (tau[6] - x240 - x275 * x282 + x293 * x319 - x302 * x320 - x309 * x321
+                - x314 * x322 - x317 * x323);
+        let x325 = x315 * x323 - x317 * x324;
+        let x326 = x310 * x322 - x312 * x325 - x314 * x324;
+        let x327 = x303 * x321 - x305 * x326 - x307 * x325 - x309 * x324;
+        let x328 = x294 * x320 - x296 * x327 - x298 * x326 - x300 * x325 - x302 * x324;
+        let x329 = x283 * x319 - x285 * x328 - x287 * x327 - x289 * x326 - x291 * x325
+            + x293 * x324;
+        let x330 = x275 * x276 - x277 * x329 - x278 * x328 - x279 * x327 - x280 * x326
+            - x281 * x325 - x282 * x324;
+        [x330, x329, x328, x327, x326, x325, x324]
     }
 }

@@ -3,6 +3,7 @@
 //! Joints: `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
 //! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
+//! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //!
@@ -27,6 +28,9 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 670 | 457 | 0 | 0 | 6 | 1127 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 741 | 505 | 0 | 0 | 6 | 1246 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 478 | 318 | 0 | 0 | 5 | 796 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 839 | 610 | 6 | 0 | 6 | 1449 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 910 | 658 | 6 | 0 | 6 | 1568 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 418 | 6 | 0 | 5 | 982 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
@@ -66,7 +70,7 @@ pub struct OpCount {
 impl Ssrms6 {
     /// Degrees of freedom.
     pub const N: usize = 6;
-    /// Joint names, from the base, in the order of `q`.
+    /// Joint names, in the order of the joint entries of `q`.
     pub const JOINTS: [&'static str; 6] = [
         "shoulder_yaw",
         "shoulder_pitch",
@@ -75,8 +79,10 @@ impl Ssrms6 {
         "wrist_yaw",
         "wrist_roll",
     ];
+    /// Named frames, in the model's order (one `<frame>_…` function family each).
+    pub const FRAMES: [&'static str; 0] = [];
     /// Emitted operation counts of each generated function, in emission order.
-    pub const OP_COUNTS: [OpCount; 5] = [
+    pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
@@ -128,6 +134,17 @@ impl Ssrms6 {
             mul: 478u64,
             add: 318u64,
             div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 564u64,
+            add: 418u64,
+            div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
             fma: 0u64,
@@ -322,6 +339,39 @@ impl Ssrms6 {
             sincos: 5u64,
             fma: 0u64,
         },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 839u64,
+            add: 610u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 910u64,
+            add: 658u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 564u64,
+            add: 418u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
@@ -446,7 +496,7 @@ impl Ssrms6 {
             [x92, x91, x89, x87, 0.0, 9.336],
         ]
     }
-    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
+    /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: bias `rnea`: 317 mul, 211 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
@@ -777,7 +827,7 @@ impl Ssrms6 {
                         + s_q1 * (qd[1] * x14 - 314.88 * x10 + x127)));
         [x129, x128, x122, x115, x109, x100]
     }
-    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
@@ -1090,7 +1140,7 @@ impl Ssrms6 {
             + x208 * x238;
         [x243, x242, x241, x240, x239, x238]
     }
-    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 478 mul, 318 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
@@ -1372,5 +1422,327 @@ impl Ssrms6 {
             ],
             [x209, x208, x202, x195, x189, x180],
         )
+    }
+    /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 418 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches(
+        q: &[f64; 6],
+        qd: &[f64; 6],
+        tau: &[f64; 6],
+        f_ext: &[[f64; 6]; 6],
+    ) -> [f64; 6] {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let x9 = 9.336 * x8;
+        let x10 = 44.41 * c_q5;
+        let x11 = 44.41 * s_q5;
+        let x12 = c_q5 * x10 + s_q5 * x11;
+        let x13 = s_q5 * x10;
+        let x14 = c_q5 * x11;
+        let x15 = x13 - x14;
+        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
+        let x17 = 12.13 + (x12 + 120.2819695416);
+        let x18 = 3.061 + x12;
+        let x19 = x6 * -171.195516;
+        let x20 = c_q4 * x16;
+        let x21 = s_q4 * x17;
+        let x22 = s_q4 * x15;
+        let x23 = c_q4 * x15;
+        let x24 = x6 * (x14 - x13);
+        let x25 = x6 * x18;
+        let x26 = s_q4 * x20 - c_q4 * x21;
+        let x27 = x6 * x22;
+        let x28 = s_q4 * x24;
+        let x29 = c_q4 * x24 + x19 * 0.5692;
+        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
+        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
+        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
+        let x33 = s_q3 * x19;
+        let x34 = x4 * -199.01508800000002;
+        let x35 = c_q3 * x19;
+        let x36 = x33 + 3239.4582;
+        let x37 = c_q3 * x30 - s_q3 * x28;
+        let x38 = c_q3 * x26 + s_q3 * x29;
+        let x39 = s_q3 * x32 - c_q3 * x27;
+        let x40 = x4 * x31;
+        let x41 = s_q3 * x30 + c_q3 * x28;
+        let x42 = c_q3 * x29 - s_q3 * x26;
+        let x43 = s_q3 * x27 + c_q3 * x32;
+        let x44 = x4 * x42;
+        let x45 = x33 * -7.11;
+        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
+        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
+        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
+        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
+        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
+        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
+        let x52 = s_q2 * x35;
+        let x53 = c_q2 * x36 + x52;
+        let x54 = x2 * x34;
+        let x55 = c_q2 * x35;
+        let x56 = x55 - s_q2 * x36;
+        let x57 = x53 + 5224.5702;
+        let x58 = x54 + -349.0395;
+        let x59 = c_q2 * x48 + s_q2 * x46;
+        let x60 = c_q2 * x49 + s_q2 * x44;
+        let x61 = c_q2 * x47 + s_q2 * x51;
+        let x62 = x2 * x50;
+        let x63 = c_q2 * x46 - s_q2 * x48;
+        let x64 = c_q2 * x44 - s_q2 * x49;
+        let x65 = c_q2 * x51 - s_q2 * x47;
+        let x66 = -0.475 * x53;
+        let x67 = -7.11 * x53;
+        let x68 = x56 * 0.475;
+        let x69 = (c_q1 + (1.0 - c_q1)) * x58;
+        let x70 = c_q1 * x56;
+        let x71 = c_q1 * (x2 * x64 + x68)
+            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
+            + 0.5692 * (x70 - s_q1 * x57);
+        let x72 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x70 - s_q1 * x53);
+        let x73 = x40 - x45;
+        let x74 = x55 - s_q2 * x33;
+        let x75 = x52 + c_q2 * x33;
+        let x76 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x74)
+            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x75)
+            + 0.5692 * (c_q1 * x74 - s_q1 * x75);
+        let x77 = s_q3 * x25 - c_q3 * x22;
+        let x78 = x4 * x23;
+        let x79 = s_q3 * x22 + c_q3 * x25;
+        let x80 = c_q1 * (c_q2 * x79 - s_q2 * x77) - s_q1 * (c_q2 * x77 + s_q2 * x79);
+        let x81 = c_q4 * x9;
+        let x82 = s_q4 * x9;
+        let x83 = c_q3 * x81;
+        let x84 = x4 * x82;
+        let x85 = s_q3 * x81;
+        let x86 = s_q1 * (c_q2 * x83 - s_q2 * x85) + c_q1 * (s_q2 * x83 + c_q2 * x85);
+        let x87 = qd[0] * s_q1;
+        let x88 = qd[0] * c_q1;
+        let x89 = -0.5692 * qd[0];
+        let x90 = c_q1 * x89;
+        let x91 = s_q1 * x89;
+        let x92 = qd[1] * x88;
+        let x93 = qd[1] * x87;
+        let x94 = qd[1] * x91;
+        let x95 = qd[1] * x90;
+        let x96 = 49.52 * qd[1] - 15.41 * x87;
+        let x97 = 2094.71 * qd[1] - 49.52 * x87;
+        let x98 = 2103.19 * x88;
+        let x99 = 314.88 * x90;
+        let x100 = 314.88 * x91;
+        let x101 = c_q2 * x87 + s_q2 * x88;
+        let x102 = c_q2 * x88 - s_q2 * x87;
+        let x103 = x90 + -0.475 * x88;
+        let x104 = x91 + (7.11 * qd[1] - 0.475 * x87);
+        let x105 = s_q2 * x104 - c_q2 * x103;
+        let x106 = x2 * (-7.11 * x88);
+        let x107 = s_q2 * x103 + c_q2 * x104;
+        let x108 = qd[2] + qd[1] * x2;
+        let x109 = x94 + -0.475 * x93;
+        let x110 = 0.475 * x92 - x95;
+        let x111 = x2 * (-7.11 * x93);
+        let x112 = s_q2 * x93 - c_q2 * x92 - qd[2] * x102;
+        let x113 = s_q2 * x92 + c_q2 * x93 + qd[2] * x101;
+        let x114 = c_q2 * x109 - s_q2 * x110 + qd[2] * x107;
+        let x115 = s_q2 * x109 + c_q2 * x110 + qd[2] * x105;
+        let x116 = -39.95 * x108 - 9.522 * x101;
+        let x117 = 1966.28 * x108 - -39.95 * x101;
+        let x118 = 1966.28 * x102;
+        let x119 = 279.2 * x105;
+        let x120 = 279.2 * x106;
+        let x121 = 279.2 * x107;
+        let x122 = c_q3 * x101 + s_q3 * x102;
+        let x123 = c_q3 * x102 - s_q3 * x101;
+        let x124 = x107 + 7.11 * x108;
+        let x125 = c_q3 * x105 + s_q3 * x124;
+        let x126 = x4 * (x106 + -7.11 * x102);
+        let x127 = s_q3 * x105 - c_q3 * x124;
+        let x128 = qd[3] + x4 * x108;
+        let x129 = x4 * (x111 + -7.11 * x113);
+        let x130 = c_q3 * x112 + s_q3 * x113 - qd[3] * x123;
+        let x131 = s_q3 * x112 - c_q3 * x113 - qd[3] * x122;
+        let x132 = c_q3 * x114 - s_q3 * x115 - qd[3] * x127;
+        let x133 = s_q3 * x114 + c_q3 * x115 + qd[3] * x125;
+        let x134 = 8.305 * x122;
+        let x135 = 3.061 * x128;
+        let x136 = 8.0386 * x123;
+        let x137 = 105.98 * x125;
+        let x138 = 105.98 * x126;
+        let x139 = 105.98 * x127;
+        let x140 = s_q4 * x128 - c_q4 * x122;
+        let x141 = s_q4 * x122 + c_q4 * x128;
+        let x142 = x125 - -0.5692 * x123;
+        let x143 = c_q4 * x142 - s_q4 * x126;
+        let x144 = s_q4 * x142 + c_q4 * x126;
+        let x145 = x6 * (x127 + 0.5692 * x122);
+        let x146 = qd[4] + x6 * x123;
+        let x147 = x6 * x131;
+        let x148 = x132 - -0.5692 * x131;
+        let x149 = x6 * (x133 - 0.5692 * x130);
+        let x150 = c_q4 * x130 + qd[4] * x141;
+        let x151 = s_q4 * x130 + qd[4] * x140;
+        let x152 = c_q4 * x148 + s_q4 * x129 - qd[4] * x144;
+        let x153 = c_q4 * x129 - s_q4 * x148 - qd[4] * x143;
+        let x154 = 12.13 * x140;
+        let x155 = 12.13 * x141;
+        let x156 = 3.061 * x146;
+        let x157 = 105.98 * x143;
+        let x158 = 105.98 * x144;
+        let x159 = 105.98 * x145;
+        let x160 = c_q5 * x141 + s_q5 * x146;
+        let x161 = c_q5 * x146 - s_q5 * x141;
+        let x162 = x144 + -0.7026 * x140;
+        let x163 = x8 * (x143 - 0.7026 * x141);
+        let x164 = s_q5 * x145 - c_q5 * x162;
+        let x165 = s_q5 * x162 + c_q5 * x145;
+        let x166 = qd[5] + x8 * x140;
+        let x167 = x153 - -0.7026 * x150;
+        let x168 = 9.336 * x166;
+        let x169 = 44.41 * x160;
+        let x170 = 44.41 * x161;
+        let x171 = 243.66 * x163;
+        let x172 = 243.66 * x164;
+        let x173 = 243.66 * x165;
+        let x174 = 9.336 * (x8 * x150)
+            + (x160 * x170 - x161 * x169 + (x164 * x173 - x165 * x172)) - f_ext[5][3];
+        let x175 = 44.41 * (s_q5 * x147 - c_q5 * x151 + qd[5] * x161)
+            + (x161 * x168 - x166 * x170 + (x165 * x171 - x163 * x173)) - f_ext[5][4];
+        let x176 = 44.41 * (s_q5 * x151 + c_q5 * x147 - qd[5] * x160)
+            + (x166 * x169 - x160 * x168 + (x163 * x172 - x164 * x171)) - f_ext[5][5];
+        let x177 = 243.66 * (c_q5 * x167 + s_q5 * x149 + qd[5] * x165)
+            + (x161 * x171 - x166 * x173) - f_ext[5][1];
+        let x178 = 243.66 * (c_q5 * x149 - s_q5 * x167 - qd[5] * x164)
+            + (x166 * x172 - x160 * x171) - f_ext[5][2];
+        let x179 = x8
+            * (243.66 * (x8 * (x152 + 0.7026 * x151)) + (x160 * x173 - x161 * x172)
+                - f_ext[5][0]);
+        let x180 = c_q5 * x177 - s_q5 * x178;
+        let x181 = 12.13 * x150
+            + (x141 * x156 - x146 * x155 + (x145 * x158 - x144 * x159)) - f_ext[4][3]
+            + (x8 * x174 + 0.7026 * x180);
+        let x182 = x146 * x154 - x140 * x156 + (x145 * x157 - x143 * x159) - 12.13 * x151
+            - f_ext[4][4] + (c_q5 * x175 - s_q5 * x176 + -0.7026 * x179);
+        let x183 = 3.061 * x147
+            + (x140 * x155 - x141 * x154 + (x144 * x157 - x143 * x158)) - f_ext[4][5]
+            + (s_q5 * x175 + c_q5 * x176);
+        let x184 = 105.98 * x152 + (x146 * x158 + x141 * x159) - f_ext[4][0] + x179;
+        let x185 = 105.98 * x153 + (x146 * x157 - x140 * x159) - f_ext[4][1] + x180;
+        let x186 = c_q4 * x184 - s_q4 * x185;
+        let x187 = x6
+            * (105.98 * x149 - (x141 * x157 + x140 * x158) - f_ext[4][2]
+                + (s_q5 * x177 + c_q5 * x178));
+        let x188 = 8.305 * x130
+            + (x128 * x136 - x123 * x135 + (x127 * x138 - x126 * x139)) - f_ext[3][3]
+            + (c_q4 * x181 - s_q4 * x182 + -0.5692 * x187);
+        let x189 = x122 * x136 - x123 * x134 + (x127 * x137 - x125 * x139) - f_ext[3][4]
+            + (s_q4 * x181 + c_q4 * x182);
+        let x190 = 8.0386 * x131
+            + (x128 * x134 - x122 * x135 + (x126 * x137 - x125 * x138)) - f_ext[3][5]
+            + (x6 * x183 + 0.5692 * x186);
+        let x191 = 105.98 * x132 + (x123 * x138 + x128 * x139) - f_ext[3][0] + x186;
+        let x192 = 105.98 * x133 + (x122 * x138 - x128 * x137) - f_ext[3][2] + x187;
+        let x193 = x4
+            * (105.98 * x129 + (x123 * x137 + x122 * x139) - f_ext[3][1]
+                + (s_q4 * x184 + c_q4 * x185));
+        let x194 = c_q3 * x192 - s_q3 * x191;
+        let x195 = 9.522 * x112
+            + (x108 * x118 - x102 * x117 + (x106 * x121 - x107 * x120)) - f_ext[2][3]
+            + (c_q3 * x188 + s_q3 * x190);
+        let x196 = -39.95 * x112
+            + (x102 * x116 + x101 * x118 + (x105 * x121 - x107 * x119)) - f_ext[2][4]
+            + (x4 * x189 + -7.11 * x194);
+        let x197 = x106 * x119 - x105 * x120 - (x108 * x116 + x101 * x117)
+            - 1966.28 * x113 - f_ext[2][5] + (c_q3 * x190 - s_q3 * x188 + 7.11 * x193);
+        let x198 = 279.2 * x114 + (x102 * x120 - x108 * x121) - f_ext[2][0]
+            + (c_q3 * x191 + s_q3 * x192);
+        let x199 = 279.2 * x115 + (x101 * x120 - x108 * x119) - f_ext[2][2] + x194;
+        let x200 = c_q2 * x198 + s_q2 * x199;
+        let x201 = c_q2 * x199 - s_q2 * x198;
+        let x202 = tau[0]
+            - (c_q1
+                * (c_q2 * x197 - s_q2 * x195
+                    + (0.475 * x200
+                        + 7.11
+                            * (x2
+                                * (279.2 * x111 + (x102 * x119 - x101 * x121) - f_ext[2][1]
+                                    + x193)))
+                    - (f_ext[1][5] + (2103.19 * x93 + (qd[1] * x96 + x87 * x97))))
+                - s_q1
+                    * (qd[1] * x98 - x88 * x97 - 15.41 * x92 - f_ext[1][3]
+                        + (c_q2 * x195 + s_q2 * x197 + -0.475 * x201))
+                + 0.5692
+                    * (c_q1 * (314.88 * x94 - qd[1] * x100 - f_ext[1][0] + x200)
+                        + s_q1 * (qd[1] * x99 - 314.88 * x95 - f_ext[1][2] + x201))
+                - f_ext[0][5]);
+        let x203 = 1.0
+            / (8.446
+                + (c_q1
+                    * (c_q1
+                        * (2103.19
+                            + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
+                                - (-7.11 * x57 - -0.475 * x58)))
+                        - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
+                    - s_q1
+                        * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
+                            - s_q1
+                                * (15.41
+                                    + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
+                    - 0.5692 * x69 + -0.5692 * (x69 + -597.4892399999999)));
+        let x204 = x71 * x203;
+        let x205 = x72 * x203;
+        let x206 = x76 * x203;
+        let x207 = x80 * x203;
+        let x208 = x86 * x203;
+        let x209 = 1.0 / (2094.71 + (x2 * x62 - x67 + 7.11 * x57) - x71 * x204);
+        let x210 = x62 - x67 - x71 * x205;
+        let x211 = x209 * x210;
+        let x212 = x2 * x73 - -7.11 * x75 - x71 * x206;
+        let x213 = x209 * x212;
+        let x214 = x2 * x78 - x71 * x207;
+        let x215 = x209 * x214;
+        let x216 = x2 * x84 + x71 * x208;
+        let x217 = x209 * x216;
+        let x218 = 1.0 / (x50 - x72 * x205 - x210 * x211);
+        let x219 = x73 - x72 * x206 - x210 * x213;
+        let x220 = x218 * x219;
+        let x221 = x78 - x72 * x207 - x210 * x215;
+        let x222 = x218 * x221;
+        let x223 = x84 + x72 * x208 - x210 * x217;
+        let x224 = x218 * x223;
+        let x225 = 1.0 / (x31 - x76 * x206 - x212 * x213 - x219 * x220);
+        let x226 = x23 - x76 * x207 - x212 * x215 - x219 * x222;
+        let x227 = x225 * x226;
+        let x228 = x82 + x76 * x208 - x212 * x217 - x219 * x224;
+        let x229 = x225 * x228;
+        let x230 = 1.0 / (x18 - x80 * x207 - x214 * x215 - x221 * x222 - x226 * x227);
+        let x231 = x80 * x208 - x214 * x217 - x221 * x224 - x226 * x229;
+        let x232 = x230 * x231;
+        let x233 = 1.0
+            / (9.336 - x86 * x208 - x216 * x217 - x223 * x224 - x228 * x229
+                - x231 * x232);
+        let x234 = tau[1]
+            - (x88 * x96 + x87 * x98 + (x91 * x99 - x90 * x100) - 49.52 * x92
+                - f_ext[1][4] + (x2 * x196 + -7.11 * x201)) - x202 * x204;
+        let x235 = tau[2] - x196 - x202 * x205 - x211 * x234;
+        let x236 = tau[3] - x189 - x202 * x206 - x213 * x234 - x220 * x235;
+        let x237 = tau[4] - x183 - x202 * x207 - x215 * x234 - x222 * x235 - x227 * x236;
+        let x238 = x233
+            * (tau[5] - x174 + x202 * x208 - x217 * x234 - x224 * x235 - x229 * x236
+                - x232 * x237);
+        let x239 = x230 * x237 - x232 * x238;
+        let x240 = x225 * x236 - x227 * x239 - x229 * x238;
+        let x241 = x218 * x235 - x220 * x240 - x222 * x239 - x224 * x238;
+        let x242 = x209 * x234 - x211 * x241 - x213 * x240 - x215 * x239 - x217 * x238;
+        let x243 = x202 * x203 - x204 * x242 - x205 * x241 - x206 * x240 - x207 * x239
+            + x208 * x238;
+        [x243, x242, x241, x240, x239, x238]
     }
 }

@@ -3,10 +3,11 @@
 //! Joints: `shoulder_roll` (revolute), `shoulder_yaw` (revolute), `shoulder_pitch` (revolute), `elbow_pitch` (revolute), `wrist_pitch` (revolute), `wrist_yaw` (revolute), `wrist_roll` (revolute).
 //!
 //! Convention: `M(q) q̈ + c(q, q̇) = τ` (Pinocchio's signs; the paper's `A q̈ = b` has `A = M`, `b = τ − c`).
+//! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //! Precision: `f64`.
-//! Fused multiply-adds: 1303 (`mass_matrix` 124, `nonlinear_effects` 205, `inverse_dynamics` 219, `forward_dynamics` 426, `mass_matrix_and_nonlinear_effects` 329), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds: 1729 (`mass_matrix` 124, `nonlinear_effects` 205, `inverse_dynamics` 219, `forward_dynamics` 426, `mass_matrix_and_nonlinear_effects` 329, `forward_dynamics_with_wrenches` 426), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
@@ -29,6 +30,9 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 906 | 623 | 0 | 0 | 7 | 1529 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 1051 | 739 | 0 | 0 | 7 | 1790 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 648 | 426 | 0 | 0 | 6 | 1074 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1137 | 832 | 7 | 0 | 7 | 1969 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1282 | 948 | 7 | 0 | 7 | 2230 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 774 | 566 | 7 | 0 | 6 | 1340 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsFma;
@@ -68,7 +72,7 @@ pub struct OpCount {
 impl SsrmsFma {
     /// Degrees of freedom.
     pub const N: usize = 7;
-    /// Joint names, from the base, in the order of `q`.
+    /// Joint names, in the order of the joint entries of `q`.
     pub const JOINTS: [&'static str; 7] = [
         "shoulder_roll",
         "shoulder_yaw",
@@ -78,8 +82,10 @@ impl SsrmsFma {
         "wrist_yaw",
         "wrist_roll",
     ];
+    /// Named frames, in the model's order (one `<frame>_…` function family each).
+    pub const FRAMES: [&'static str; 0] = [];
     /// Emitted operation counts of each generated function, in emission order.
-    pub const OP_COUNTS: [OpCount; 5] = [
+    pub const OP_COUNTS: [OpCount; 6] = [
         OpCount {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
@@ -134,6 +140,17 @@ impl SsrmsFma {
             sqrt: 0u64,
             sincos: 6u64,
             fma: 329u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 774u64,
+            add: 566u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 426u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -321,6 +338,39 @@ impl SsrmsFma {
             mul: 648u64,
             add: 426u64,
             div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 1137u64,
+            add: 832u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1282u64,
+            add: 948u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 774u64,
+            add: 566u64,
+            div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
             fma: 0u64,
@@ -583,7 +633,7 @@ impl SsrmsFma {
             [x135, x134, x132, x129, x127, 0.0, 9.336],
         ]
     }
-    /// The nonlinear effects `c(q, q̇)` of `M q̈ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
+    /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
     /// Methods: bias `rnea`: 394 mul, 265 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 205 fused multiply-adds.
     #[must_use]
@@ -1115,7 +1165,7 @@ impl SsrmsFma {
         );
         [x160, x159, x154, x146, x139, x133, x124]
     }
-    /// Forward dynamics `q̈ = M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 530 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 426 fused multiply-adds.
     #[must_use]
@@ -1837,7 +1887,7 @@ impl SsrmsFma {
         );
         [x330, x329, x328, x327, x326, x325, x324]
     }
-    /// `(M(q), c(q, q̇))` in one call, sharing sines, cosines and kinematics.
+    /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
     /// Methods: mass matrix `crba`, bias `rnea`: 648 mul, 426 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 329 fused multiply-adds.
     #[must_use]
@@ -2347,5 +2397,745 @@ impl SsrmsFma {
             ],
             [x283, x282, x277, x269, x262, x256, x247],
         )
+    }
+    /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
+    ///
+    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 566 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 426 fused multiply-adds.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches(
+        q: &[f64; 7],
+        qd: &[f64; 7],
+        tau: &[f64; 7],
+        f_ext: &[[f64; 6]; 7],
+    ) -> [f64; 7] {
+        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x2 = c_q2 + (1.0 - c_q2);
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x4 = c_q3 + (1.0 - c_q3);
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x6 = c_q4 + (1.0 - c_q4);
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x8 = c_q5 + (1.0 - c_q5);
+        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let x10 = c_q6 + (1.0 - c_q6);
+        let x11 = 9.336 * x10;
+        let x12 = 44.41 * c_q6;
+        let x13 = 44.41 * s_q6;
+        let x14 = libm::fma(s_q6, x13, c_q6 * x12);
+        let x15 = s_q6 * x12;
+        let x16 = c_q6 * x13;
+        let x17 = x15 - x16;
+        let x18 = 12.13 + libm::fma(x10, x11, 120.2819695416);
+        let x19 = 12.13 + (x14 + 120.2819695416);
+        let x20 = 3.061 + x14;
+        let x21 = x8 * -171.195516;
+        let x22 = c_q5 * x18;
+        let x23 = s_q5 * x19;
+        let x24 = s_q5 * x17;
+        let x25 = s_q5 * x18;
+        let x26 = c_q5 * x19;
+        let x27 = c_q5 * x17;
+        let x28 = x8 * (x16 - x15);
+        let x29 = x8 * x20;
+        let x30 = libm::fma(-c_q5, x23, s_q5 * x22);
+        let x31 = x8 * x24;
+        let x32 = s_q5 * x28;
+        let x33 = libm::fma(x21, 0.5692, c_q5 * x28);
+        let x34 = 8.305 + (libm::fma(s_q5, x23, c_q5 * x22) + 113.27938808960002);
+        let x35 = 3.061 + libm::fma(c_q5, x26, s_q5 * x25);
+        let x36 = 8.0386 + libm::fma(x8, x29, 113.27938808960002);
+        let x37 = s_q4 * x21;
+        let x38 = x6 * -199.01508800000002;
+        let x39 = c_q4 * x21;
+        let x40 = x37 + 3239.4582;
+        let x41 = libm::fma(-s_q4, x32, c_q4 * x34);
+        let x42 = libm::fma(s_q4, x33, c_q4 * x30);
+        let x43 = libm::fma(-c_q4, x31, s_q4 * x36);
+        let x44 = x6 * libm::fma(-s_q5, x26, c_q5 * x25);
+        let x45 = x6 * x35;
+        let x46 = x6 * libm::fma(0.5692, x21, x8 * x27);
+        let x47 = libm::fma(c_q4, x32, s_q4 * x34);
+        let x48 = libm::fma(-s_q4, x30, c_q4 * x33);
+        let x49 = libm::fma(c_q4, x36, s_q4 * x31);
+        let x50 = x6 * x48;
+        let x51 = x37 * -7.11;
+        let x52 = libm::fma(-7.11, x39, libm::fma(-c_q4, x47, s_q4 * x49));
+        let x53 = libm::fma(x39, -7.11, libm::fma(-s_q4, x41, c_q4 * x43));
+        let x54 = 9.522 + libm::fma(s_q4, x43, c_q4 * x41);
+        let x55 = -39.95 + libm::fma(-7.11, x38, x6 * x42);
+        let x56 = 1966.28 + libm::fma(7.11, x40, libm::fma(x6, x45, -x51));
+        let x57 = 1966.28
+            + libm::fma(
+                x40,
+                7.11,
+                libm::fma(7.11, x37, libm::fma(c_q4, x49, s_q4 * x47)),
+            );
+        let x58 = s_q3 * x39;
+        let x59 = libm::fma(c_q3, x40, x58);
+        let x60 = x4 * x38;
+        let x61 = c_q3 * x39;
+        let x62 = libm::fma(-s_q3, x40, x61);
+        let x63 = x59 + 5224.5702;
+        let x64 = x60 + -349.0395;
+        let x65 = libm::fma(s_q3, x52, c_q3 * x54);
+        let x66 = libm::fma(s_q3, x50, c_q3 * x55);
+        let x67 = libm::fma(s_q3, x57, c_q3 * x53);
+        let x68 = x4
+            * (-39.95 + libm::fma(x38, -7.11, libm::fma(s_q4, x46, c_q4 * x44)));
+        let x69 = x4 * x56;
+        let x70 = x4 * libm::fma(-s_q4, x44, c_q4 * x46);
+        let x71 = libm::fma(-s_q3, x54, c_q3 * x52);
+        let x72 = libm::fma(-s_q3, x55, c_q3 * x50);
+        let x73 = libm::fma(-s_q3, x53, c_q3 * x57);
+        let x74 = -0.475 * x59;
+        let x75 = -7.11 * x59;
+        let x76 = x62 * 0.475;
+        let x77 = libm::fma(-7.11, x62, libm::fma(s_q3, x73, c_q3 * x71));
+        let x78 = libm::fma(x4, x72, x76);
+        let x79 = libm::fma(-7.11, x62, libm::fma(-s_q3, x65, c_q3 * x67));
+        let x80 = 15.41
+            + libm::fma(
+                x64,
+                -0.475,
+                libm::fma(-0.475, x60, libm::fma(s_q3, x67, c_q3 * x65)),
+            );
+        let x81 = 49.52 + libm::fma(-7.11, x64, libm::fma(x4, x66, -x74));
+        let x82 = 2094.71 + libm::fma(7.11, x63, libm::fma(x4, x69, -x75));
+        let x83 = 2103.19
+            + (libm::fma(-s_q3, x71, c_q3 * x73) - libm::fma(-7.11, x59, x60 * 0.475)
+                - libm::fma(0.475, x64, -7.11 * x63));
+        let x84 = s_q2 * x62;
+        let x85 = libm::fma(c_q2, x63, x84);
+        let x86 = x2 * x64;
+        let x87 = c_q2 * x62;
+        let x88 = libm::fma(-s_q2, x63, x87);
+        let x89 = x86 + -597.4892399999999;
+        let x90 = libm::fma(s_q2, x77, c_q2 * x80);
+        let x91 = libm::fma(s_q2, x78, c_q2 * x81);
+        let x92 = libm::fma(s_q2, x83, c_q2 * x79);
+        let x93 = x2
+            * (49.52
+                + libm::fma(
+                    x63,
+                    0.475,
+                    libm::fma(-7.11, x60, libm::fma(s_q3, x70, c_q3 * x68)),
+                ));
+        let x94 = x2 * x82;
+        let x95 = x2 * libm::fma(0.475, x62, libm::fma(-s_q3, x68, c_q3 * x70));
+        let x96 = -0.5692 * x85;
+        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
+        let x98 = libm::fma(
+            -0.7026,
+            libm::fma(-s_q1, x89, c_q1 * x85),
+            libm::fma(
+                -s_q1,
+                libm::fma(0.5692, x88, libm::fma(-s_q2, x93, c_q2 * x95)),
+                c_q1 * libm::fma(-s_q2, x90, c_q2 * x92),
+            ),
+        );
+        let x99 = libm::fma(
+            -0.7026,
+            s_q1 * x88,
+            libm::fma(-s_q1, x94, c_q1 * (x91 - x96)),
+        );
+        let x100 = x66 - x74;
+        let x101 = x69 - x75;
+        let x102 = x72 + x76;
+        let x103 = libm::fma(-s_q2, x59, x87);
+        let x104 = libm::fma(
+            -0.7026,
+            s_q1 * x103,
+            libm::fma(
+                -s_q1,
+                x2 * x101,
+                c_q1
+                    * libm::fma(
+                        0.5692,
+                        libm::fma(c_q2, x59, x84),
+                        libm::fma(s_q2, x102, c_q2 * x100),
+                    ),
+            ),
+        );
+        let x105 = x45 - x51;
+        let x106 = libm::fma(-s_q3, x37, x61);
+        let x107 = libm::fma(c_q3, x37, x58);
+        let x108 = libm::fma(0.475, x107, libm::fma(s_q3, x48, c_q3 * x42));
+        let x109 = libm::fma(7.11, x107, x4 * x105);
+        let x110 = libm::fma(0.475, x106, libm::fma(-s_q3, x42, c_q3 * x48));
+        let x111 = libm::fma(-s_q2, x107, c_q2 * x106);
+        let x112 = libm::fma(
+            -0.7026,
+            s_q1 * x111,
+            libm::fma(
+                -s_q1,
+                x2 * x109,
+                c_q1
+                    * libm::fma(
+                        0.5692,
+                        libm::fma(c_q2, x107, s_q2 * x106),
+                        libm::fma(s_q2, x110, c_q2 * x108),
+                    ),
+            ),
+        );
+        let x113 = libm::fma(-c_q4, x24, s_q4 * x29);
+        let x114 = x6 * x27;
+        let x115 = libm::fma(c_q4, x29, s_q4 * x24);
+        let x116 = libm::fma(s_q3, x115, c_q3 * x113);
+        let x117 = x4 * x114;
+        let x118 = libm::fma(-s_q3, x113, c_q3 * x115);
+        let x119 = libm::fma(
+            -s_q1,
+            x2 * x117,
+            c_q1 * libm::fma(s_q2, x118, c_q2 * x116),
+        );
+        let x120 = c_q5 * x11;
+        let x121 = s_q5 * x11;
+        let x122 = c_q4 * x120;
+        let x123 = x6 * x121;
+        let x124 = s_q4 * x120;
+        let x125 = libm::fma(-s_q3, x124, c_q3 * x122);
+        let x126 = x4 * x123;
+        let x127 = libm::fma(c_q3, x124, s_q3 * x122);
+        let x128 = libm::fma(
+            -s_q1,
+            x2 * x126,
+            c_q1 * libm::fma(-s_q2, x127, c_q2 * x125),
+        );
+        let x129 = qd[0] * c_q1;
+        let x130 = qd[0] * s_q1;
+        let x131 = 0.7026 * qd[0];
+        let x132 = s_q1 * x131;
+        let x133 = c_q1 * x131;
+        let x134 = qd[1] * x130;
+        let x135 = qd[1] * x129;
+        let x136 = qd[1] * x133;
+        let x137 = qd[1] * x132;
+        let x138 = 8.088 * x129;
+        let x139 = 3.061 * x130;
+        let x140 = 8.446 * qd[1];
+        let x141 = 105.98 * x132;
+        let x142 = 105.98 * x133;
+        let x143 = libm::fma(-qd[1], s_q2, c_q2 * x129);
+        let x144 = libm::fma(qd[1], c_q2, s_q2 * x129);
+        let x145 = 0.5692 * x129;
+        let x146 = libm::fma(-0.5692, qd[1], x132);
+        let x147 = libm::fma(-c_q2, x146, s_q2 * x145);
+        let x148 = x2 * x133;
+        let x149 = libm::fma(c_q2, x145, s_q2 * x146);
+        let x150 = libm::fma(-x2, x130, qd[2]);
+        let x151 = x2 * x135;
+        let x152 = 0.5692 * x134;
+        let x153 = x2 * x137;
+        let x154 = libm::fma(qd[2], x144, c_q2 * x134);
+        let x155 = libm::fma(-s_q2, x134, qd[2] * x143);
+        let x156 = libm::fma(qd[2], x149, -libm::fma(s_q2, x152, c_q2 * x136));
+        let x157 = libm::fma(qd[2], x147, libm::fma(-s_q2, x136, c_q2 * x152));
+        let x158 = libm::fma(49.52, x150, 15.41 * x143);
+        let x159 = libm::fma(2094.71, x150, 49.52 * x143);
+        let x160 = 2103.19 * x144;
+        let x161 = 314.88 * x147;
+        let x162 = 314.88 * x148;
+        let x163 = 314.88 * x149;
+        let x164 = libm::fma(-s_q3, x144, c_q3 * x143);
+        let x165 = libm::fma(c_q3, x144, s_q3 * x143);
+        let x166 = libm::fma(0.475, x144, x147);
+        let x167 = x149 + libm::fma(7.11, x150, 0.475 * x143);
+        let x168 = libm::fma(s_q3, x167, c_q3 * x166);
+        let x169 = x4 * libm::fma(-7.11, x144, x148);
+        let x170 = libm::fma(-c_q3, x167, s_q3 * x166);
+        let x171 = libm::fma(x4, x150, qd[3]);
+        let x172 = x4 * x151;
+        let x173 = libm::fma(0.475, x155, x156);
+        let x174 = x157 + libm::fma(7.11, x151, 0.475 * x154);
+        let x175 = x4 * libm::fma(7.11, x155, x153);
+        let x176 = libm::fma(qd[3], x165, libm::fma(s_q3, x155, c_q3 * x154));
+        let x177 = libm::fma(qd[3], x164, libm::fma(-s_q3, x154, c_q3 * x155));
+        let x178 = libm::fma(-qd[3], x170, libm::fma(-s_q3, x174, c_q3 * x173));
+        let x179 = libm::fma(qd[3], x168, libm::fma(c_q3, x174, s_q3 * x173));
+        let x180 = libm::fma(-39.95, x171, 9.522 * x164);
+        let x181 = libm::fma(1966.28, x171, -39.95 * x164);
+        let x182 = 1966.28 * x165;
+        let x183 = 279.2 * x168;
+        let x184 = 279.2 * x169;
+        let x185 = 279.2 * x170;
+        let x186 = libm::fma(-s_q4, x165, c_q4 * x164);
+        let x187 = libm::fma(c_q4, x165, s_q4 * x164);
+        let x188 = libm::fma(-7.11, x171, x170);
+        let x189 = libm::fma(-s_q4, x188, c_q4 * x168);
+        let x190 = x6 * libm::fma(-7.11, x165, x169);
+        let x191 = libm::fma(c_q4, x188, s_q4 * x168);
+        let x192 = libm::fma(x6, x171, qd[4]);
+        let x193 = x6 * x172;
+        let x194 = libm::fma(7.11, x172, x179);
+        let x195 = x6 * libm::fma(7.11, x177, x175);
+        let x196 = libm::fma(qd[4], x187, libm::fma(s_q4, x177, c_q4 * x176));
+        let x197 = libm::fma(qd[4], x186, libm::fma(-s_q4, x176, c_q4 * x177));
+        let x198 = libm::fma(-qd[4], x191, libm::fma(-s_q4, x194, c_q4 * x178));
+        let x199 = libm::fma(qd[4], x189, libm::fma(c_q4, x194, s_q4 * x178));
+        let x200 = 8.305 * x186;
+        let x201 = 3.061 * x192;
+        let x202 = 8.0386 * x187;
+        let x203 = 105.98 * x189;
+        let x204 = 105.98 * x190;
+        let x205 = 105.98 * x191;
+        let x206 = libm::fma(s_q5, x192, c_q5 * x186);
+        let x207 = libm::fma(-s_q5, x186, c_q5 * x192);
+        let x208 = libm::fma(0.5692, x187, x189);
+        let x209 = libm::fma(-s_q5, x190, c_q5 * x208);
+        let x210 = libm::fma(c_q5, x190, s_q5 * x208);
+        let x211 = x8 * libm::fma(-0.5692, x186, x191);
+        let x212 = libm::fma(x8, x187, qd[5]);
+        let x213 = x8 * x197;
+        let x214 = libm::fma(0.5692, x197, x198);
+        let x215 = x8 * libm::fma(0.5692, x196, x199);
+        let x216 = libm::fma(qd[5], x207, -libm::fma(s_q5, x193, c_q5 * x196));
+        let x217 = libm::fma(-qd[5], x206, libm::fma(-c_q5, x193, s_q5 * x196));
+        let x218 = libm::fma(-qd[5], x210, libm::fma(s_q5, x195, c_q5 * x214));
+        let x219 = libm::fma(-qd[5], x209, libm::fma(-s_q5, x214, c_q5 * x195));
+        let x220 = 12.13 * x206;
+        let x221 = 12.13 * x207;
+        let x222 = 3.061 * x212;
+        let x223 = 105.98 * x209;
+        let x224 = 105.98 * x210;
+        let x225 = 105.98 * x211;
+        let x226 = libm::fma(s_q6, x212, c_q6 * x207);
+        let x227 = libm::fma(-s_q6, x207, c_q6 * x212);
+        let x228 = libm::fma(-0.7026, x206, x210);
+        let x229 = x10 * libm::fma(-0.7026, x207, x209);
+        let x230 = libm::fma(-c_q6, x228, s_q6 * x211);
+        let x231 = libm::fma(c_q6, x211, s_q6 * x228);
+        let x232 = libm::fma(x10, x206, qd[6]);
+        let x233 = libm::fma(0.7026, x216, x219);
+        let x234 = 9.336 * x232;
+        let x235 = 44.41 * x226;
+        let x236 = 44.41 * x227;
+        let x237 = 243.66 * x229;
+        let x238 = 243.66 * x230;
+        let x239 = 243.66 * x231;
+        let x240 = libm::fma(
+            9.336,
+            x10 * x216,
+            libm::fma(-x227, x235, x226 * x236) + libm::fma(-x231, x238, x230 * x239),
+        ) - f_ext[6][3];
+        let x241 = libm::fma(
+            44.41,
+            libm::fma(qd[6], x227, libm::fma(s_q6, x213, c_q6 * x217)),
+            libm::fma(-x232, x236, x227 * x234) + libm::fma(-x229, x239, x231 * x237),
+        ) - f_ext[6][4];
+        let x242 = libm::fma(
+            44.41,
+            libm::fma(-qd[6], x226, libm::fma(-s_q6, x217, c_q6 * x213)),
+            libm::fma(-x226, x234, x232 * x235) + libm::fma(-x230, x237, x229 * x238),
+        ) - f_ext[6][5];
+        let x243 = libm::fma(
+            243.66,
+            libm::fma(qd[6], x231, libm::fma(s_q6, x215, c_q6 * x233)),
+            libm::fma(-x232, x239, x227 * x237),
+        ) - f_ext[6][1];
+        let x244 = libm::fma(
+            243.66,
+            libm::fma(-qd[6], x230, libm::fma(-s_q6, x233, c_q6 * x215)),
+            libm::fma(-x226, x237, x232 * x238),
+        ) - f_ext[6][2];
+        let x245 = x10
+            * (libm::fma(
+                243.66,
+                x10 * libm::fma(-0.7026, x217, x218),
+                libm::fma(-x227, x238, x226 * x239),
+            ) - f_ext[6][0]);
+        let x246 = libm::fma(-s_q6, x244, c_q6 * x243);
+        let x247 = libm::fma(
+            12.13,
+            x216,
+            libm::fma(-x212, x221, x207 * x222) + libm::fma(-x210, x225, x211 * x224),
+        ) - f_ext[5][3] + libm::fma(0.7026, x246, x10 * x240);
+        let x248 = libm::fma(
+            12.13,
+            x217,
+            libm::fma(-x206, x222, x212 * x220) + libm::fma(-x209, x225, x211 * x223),
+        ) - f_ext[5][4] + libm::fma(-0.7026, x245, libm::fma(-s_q6, x242, c_q6 * x241));
+        let x249 = libm::fma(
+            3.061,
+            x213,
+            libm::fma(-x207, x220, x206 * x221) + libm::fma(-x209, x224, x210 * x223),
+        ) - f_ext[5][5] + libm::fma(c_q6, x242, s_q6 * x241);
+        let x250 = libm::fma(105.98, x218, libm::fma(x207, x225, x212 * x224))
+            - f_ext[5][0] + x245;
+        let x251 = libm::fma(105.98, x219, libm::fma(-x206, x225, x212 * x223))
+            - f_ext[5][1] + x246;
+        let x252 = libm::fma(-s_q5, x251, c_q5 * x250);
+        let x253 = x8
+            * (libm::fma(105.98, x215, -libm::fma(x206, x224, x207 * x223)) - f_ext[5][2]
+                + libm::fma(c_q6, x244, s_q6 * x243));
+        let x254 = libm::fma(
+            -8.305,
+            x196,
+            libm::fma(-x187, x201, x192 * x202) + libm::fma(-x190, x205, x191 * x204),
+        ) - f_ext[4][3] + libm::fma(-0.5692, x253, libm::fma(-s_q5, x248, c_q5 * x247));
+        let x255 = libm::fma(
+            -3.061,
+            x193,
+            libm::fma(-x186, x202, x187 * x200) + libm::fma(-x189, x205, x191 * x203),
+        ) - f_ext[4][4] + libm::fma(c_q5, x248, s_q5 * x247);
+        let x256 = libm::fma(
+            8.0386,
+            x197,
+            libm::fma(-x192, x200, x186 * x201) + libm::fma(-x189, x204, x190 * x203),
+        ) - f_ext[4][5] + libm::fma(0.5692, x252, x8 * x249);
+        let x257 = libm::fma(105.98, x198, libm::fma(x192, x205, x187 * x204))
+            - f_ext[4][0] + x252;
+        let x258 = libm::fma(105.98, x199, -libm::fma(x186, x204, x192 * x203))
+            - f_ext[4][2] + x253;
+        let x259 = x6
+            * (libm::fma(105.98, x195, libm::fma(-x186, x205, x187 * x203)) - f_ext[4][1]
+                + libm::fma(c_q5, x251, s_q5 * x250));
+        let x260 = libm::fma(-s_q4, x257, c_q4 * x258);
+        let x261 = libm::fma(-x165, x181, x171 * x182)
+            + libm::fma(-x169, x185, x170 * x184) - libm::fma(-39.95, x172, 9.522 * x176)
+            - f_ext[3][3] + libm::fma(s_q4, x256, c_q4 * x254);
+        let x262 = libm::fma(-x164, x182, x165 * x180)
+            + libm::fma(-x168, x185, x170 * x183)
+            - libm::fma(1966.28, x172, -39.95 * x176) - f_ext[3][4]
+            + libm::fma(-7.11, x260, x6 * x255);
+        let x263 = libm::fma(
+            1966.28,
+            x177,
+            libm::fma(-x171, x180, x164 * x181) + libm::fma(-x168, x184, x169 * x183),
+        ) - f_ext[3][5] + libm::fma(7.11, x259, libm::fma(-s_q4, x254, c_q4 * x256));
+        let x264 = libm::fma(279.2, x178, libm::fma(x171, x185, x165 * x184))
+            - f_ext[3][0] + libm::fma(s_q4, x258, c_q4 * x257);
+        let x265 = libm::fma(279.2, x179, -libm::fma(x164, x184, x171 * x183))
+            - f_ext[3][2] + x260;
+        let x266 = libm::fma(s_q3, x265, c_q3 * x264);
+        let x267 = x4
+            * (libm::fma(279.2, x175, libm::fma(-x164, x185, x165 * x183)) - f_ext[3][1]
+                + x259);
+        let x268 = libm::fma(-s_q3, x264, c_q3 * x265);
+        let x269 = libm::fma(-x144, x159, x150 * x160)
+            + libm::fma(-x149, x162, x148 * x163) - libm::fma(49.52, x151, 15.41 * x154)
+            - f_ext[2][3] + libm::fma(-0.475, x268, libm::fma(s_q3, x263, c_q3 * x261));
+        let x270 = libm::fma(-x143, x160, x144 * x158)
+            + libm::fma(-x149, x161, x147 * x163)
+            - libm::fma(2094.71, x151, 49.52 * x154) - f_ext[2][4]
+            + libm::fma(-7.11, x268, x4 * x262);
+        let x271 = libm::fma(
+            2103.19,
+            x155,
+            libm::fma(-x150, x158, x143 * x159) + libm::fma(-x147, x162, x148 * x161),
+        ) - f_ext[2][5]
+            + (libm::fma(-s_q3, x261, c_q3 * x263)
+                + libm::fma(7.11, x267, 0.475 * x266));
+        let x272 = libm::fma(314.88, x156, libm::fma(-x150, x163, x144 * x162))
+            - f_ext[2][0] + x266;
+        let x273 = libm::fma(314.88, x157, -libm::fma(x143, x162, x150 * x161))
+            - f_ext[2][2] + x268;
+        let x274 = libm::fma(s_q2, x273, c_q2 * x272);
+        let x275 = tau[0]
+            - (libm::fma(
+                -0.7026,
+                libm::fma(
+                    c_q1,
+                    libm::fma(
+                        x2,
+                        libm::fma(314.88, x153, libm::fma(x143, x163, x144 * x161))
+                            - f_ext[2][1] + x267,
+                        libm::fma(-qd[1], x141, 105.98 * x137) - f_ext[1][1],
+                    ),
+                    s_q1 * (libm::fma(-105.98, x136, qd[1] * x142) - f_ext[1][0] + x274),
+                ),
+                libm::fma(
+                    -s_q1,
+                    libm::fma(
+                        x2,
+                        x270,
+                        libm::fma(-3.061, x135, libm::fma(-x129, x140, qd[1] * x138))
+                            - f_ext[1][4],
+                    ),
+                    c_q1
+                        * (libm::fma(-8.088, x134, libm::fma(-x130, x140, qd[1] * x139))
+                            - f_ext[1][3]
+                            + libm::fma(
+                                -0.5692,
+                                libm::fma(-s_q2, x272, c_q2 * x273),
+                                libm::fma(s_q2, x271, c_q2 * x269),
+                            )),
+                ),
+            ) - f_ext[0][3]);
+        let x276 = 1.0
+            / (12.19
+                + libm::fma(
+                    0.7026,
+                    x97 + 811.9807679999999,
+                    libm::fma(
+                        0.7026,
+                        x97,
+                        libm::fma(
+                            -s_q1,
+                            libm::fma(
+                                -s_q1,
+                                libm::fma(x2, x94, 3.061),
+                                c_q1 * libm::fma(x2, x91, -x96),
+                            ),
+                            c_q1
+                                * libm::fma(
+                                    -s_q1,
+                                    libm::fma(0.5692, x85, libm::fma(s_q2, x95, c_q2 * x93)),
+                                    c_q1
+                                        * (8.088
+                                            + libm::fma(
+                                                -0.5692,
+                                                x89,
+                                                libm::fma(-0.5692, x86, libm::fma(s_q2, x92, c_q2 * x90)),
+                                            )),
+                                ),
+                        ),
+                    ),
+                ));
+        let x277 = x98 * x276;
+        let x278 = x99 * x276;
+        let x279 = x104 * x276;
+        let x280 = x112 * x276;
+        let x281 = x119 * x276;
+        let x282 = x128 * x276;
+        let x283 = 1.0
+            / libm::fma(
+                -x98,
+                x277,
+                8.446
+                    + libm::fma(
+                        -0.5692,
+                        x89,
+                        libm::fma(
+                            -0.5692,
+                            x86,
+                            libm::fma(
+                                -s_q2,
+                                libm::fma(-s_q2, x80, c_q2 * x77),
+                                c_q2 * libm::fma(-s_q2, x79, c_q2 * x83),
+                            ),
+                        ),
+                    ),
+            );
+        let x284 = libm::fma(
+            -x98,
+            x278,
+            libm::fma(0.5692, x88, libm::fma(-s_q2, x81, c_q2 * x78)),
+        );
+        let x285 = x283 * x284;
+        let x286 = libm::fma(
+            -x98,
+            x279,
+            libm::fma(0.5692, x103, libm::fma(-s_q2, x100, c_q2 * x102)),
+        );
+        let x287 = x283 * x286;
+        let x288 = libm::fma(
+            -x98,
+            x280,
+            libm::fma(0.5692, x111, libm::fma(-s_q2, x108, c_q2 * x110)),
+        );
+        let x289 = x283 * x288;
+        let x290 = libm::fma(-x98, x281, libm::fma(-s_q2, x116, c_q2 * x118));
+        let x291 = x283 * x290;
+        let x292 = libm::fma(x98, x282, libm::fma(c_q2, x127, s_q2 * x125));
+        let x293 = x283 * x292;
+        let x294 = 1.0 / libm::fma(-x284, x285, libm::fma(-x99, x278, x82));
+        let x295 = libm::fma(-x284, x287, libm::fma(-x99, x279, x101));
+        let x296 = x294 * x295;
+        let x297 = libm::fma(-x284, x289, libm::fma(-x99, x280, x109));
+        let x298 = x294 * x297;
+        let x299 = libm::fma(-x284, x291, libm::fma(-x99, x281, x117));
+        let x300 = x294 * x299;
+        let x301 = libm::fma(x284, x293, libm::fma(-x99, x282, x126));
+        let x302 = x294 * x301;
+        let x303 = 1.0
+            / libm::fma(
+                -x295,
+                x296,
+                libm::fma(-x286, x287, libm::fma(-x104, x279, x56)),
+            );
+        let x304 = libm::fma(
+            -x295,
+            x298,
+            libm::fma(-x286, x289, libm::fma(-x104, x280, x105)),
+        );
+        let x305 = x303 * x304;
+        let x306 = libm::fma(
+            -x295,
+            x300,
+            libm::fma(-x286, x291, libm::fma(-x104, x281, x114)),
+        );
+        let x307 = x303 * x306;
+        let x308 = libm::fma(
+            -x295,
+            x302,
+            libm::fma(x286, x293, libm::fma(-x104, x282, x123)),
+        );
+        let x309 = x303 * x308;
+        let x310 = 1.0
+            / libm::fma(
+                -x304,
+                x305,
+                libm::fma(
+                    -x297,
+                    x298,
+                    libm::fma(-x288, x289, libm::fma(-x112, x280, x35)),
+                ),
+            );
+        let x311 = libm::fma(
+            -x304,
+            x307,
+            libm::fma(-x297, x300, libm::fma(-x288, x291, libm::fma(-x112, x281, x27))),
+        );
+        let x312 = x310 * x311;
+        let x313 = libm::fma(
+            -x304,
+            x309,
+            libm::fma(-x297, x302, libm::fma(x288, x293, libm::fma(-x112, x282, x121))),
+        );
+        let x314 = x310 * x313;
+        let x315 = 1.0
+            / libm::fma(
+                -x311,
+                x312,
+                libm::fma(
+                    -x306,
+                    x307,
+                    libm::fma(
+                        -x299,
+                        x300,
+                        libm::fma(-x290, x291, libm::fma(-x119, x281, x20)),
+                    ),
+                ),
+            );
+        let x316 = libm::fma(
+            -x311,
+            x314,
+            libm::fma(
+                -x306,
+                x309,
+                libm::fma(-x299, x302, libm::fma(-x119, x282, x290 * x293)),
+            ),
+        );
+        let x317 = x315 * x316;
+        let x318 = 1.0
+            / libm::fma(
+                -x316,
+                x317,
+                libm::fma(
+                    -x313,
+                    x314,
+                    libm::fma(
+                        -x308,
+                        x309,
+                        libm::fma(
+                            -x301,
+                            x302,
+                            libm::fma(-x292, x293, libm::fma(-x128, x282, 9.336)),
+                        ),
+                    ),
+                ),
+            );
+        let x319 = libm::fma(
+            -x275,
+            x277,
+            tau[1]
+                - (libm::fma(-x129, x139, x130 * x138)
+                    + libm::fma(-x133, x141, x132 * x142) - f_ext[1][5]
+                    + libm::fma(0.5692, x274, libm::fma(-s_q2, x269, c_q2 * x271))),
+        );
+        let x320 = libm::fma(-x285, x319, libm::fma(-x275, x278, tau[2] - x270));
+        let x321 = libm::fma(
+            -x296,
+            x320,
+            libm::fma(-x287, x319, libm::fma(-x275, x279, tau[3] - x262)),
+        );
+        let x322 = libm::fma(
+            -x305,
+            x321,
+            libm::fma(
+                -x298,
+                x320,
+                libm::fma(-x289, x319, libm::fma(-x275, x280, tau[4] - x255)),
+            ),
+        );
+        let x323 = libm::fma(
+            -x312,
+            x322,
+            libm::fma(
+                -x307,
+                x321,
+                libm::fma(
+                    -x300,
+                    x320,
+                    libm::fma(-x291, x319, libm::fma(-x275, x281, tau[5] - x249)),
+                ),
+            ),
+        );
+        let x324 = x318
+            * libm::fma(
+                -x317,
+                x323,
+                libm::fma(
+                    -x314,
+                    x322,
+                    libm::fma(
+                        -x309,
+                        x321,
+                        libm::fma(
+                            -x302,
+                            x320,
+                            libm::fma(x293, x319, libm::fma(-x275, x282, tau[6] - x240)),
+                        ),
+                    ),
+                ),
+            );
+        let x325 = libm::fma(-x317, x324, x315 * x323);
+        let x326 = libm::fma(-x314, x324, libm::fma(-x312, x325, x310 * x322));
+        let x327 = libm::fma(
+            -x309,
+            x324,
+            libm::fma(-x307, x325, libm::fma(-x305, x326, x303 * x321)),
+        );
+        let x328 = libm::fma(
+            -x302,
+            x324,
+            libm::fma(
+                -x300,
+                x325,
+                libm::fma(-x298, x326, libm::fma(-x296, x327, x294 * x320)),
+            ),
+        );
+        let x329 = libm::fma(
+            x293,
+            x324,
+            libm::fma(
+                -x291,
+                x325,
+                libm::fma(
+                    -x289,
+                    x326,
+                    libm::fma(-x287, x327, libm::fma(-x285, x328, x283 * x319)),
+                ),
+            ),
+        );
+        let x330 = libm::fma(
+            -x282,
+            x324,
+            libm::fma(
+                -x281,
+                x325,
+                libm::fma(
+                    -x280,
+                    x326,
+                    libm::fma(
+                        -x279,
+                        x327,
+                        libm::fma(-x278, x328, libm::fma(-x277, x329, x275 * x276)),
+                    ),
+                ),
+            ),
+        );
+        [x330, x329, x328, x327, x326, x325, x324]
     }
 }

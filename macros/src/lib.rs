@@ -18,6 +18,7 @@ struct Input {
     name: Ident,
     path: LitStr,
     gravity: Option<[f64; 3]>,
+    base: Option<kanegen_codegen::kanegen_model::BaseKind>,
     allow_nonphysical: bool,
     runtime_payload: bool,
     float: kanegen_codegen::Float,
@@ -54,6 +55,7 @@ impl Parse for Input {
             name,
             path,
             gravity: None,
+            base: None,
             allow_nonphysical: false,
             runtime_payload: false,
             float: kanegen_codegen::Float::F64,
@@ -75,6 +77,21 @@ impl Parse for Input {
                         syn::Error::new_spanned(&arr, "gravity must have three components")
                     })?;
                     out.gravity = Some(g);
+                }
+                "base" => {
+                    let lit: LitStr = input.parse()?;
+                    out.base = Some(
+                        kanegen_codegen::kanegen_model::BaseKind::from_name(&lit.value())
+                            .ok_or_else(|| {
+                                syn::Error::new(
+                                    lit.span(),
+                                    format!(
+                                        "unknown base `{}`: expected \"fixed\" or \"free-floating\"",
+                                        lit.value()
+                                    ),
+                                )
+                            })?,
+                    );
                 }
                 "allow_nonphysical" => out.allow_nonphysical = input.parse::<LitBool>()?.value,
                 "runtime_payload" => out.runtime_payload = input.parse::<LitBool>()?.value,
@@ -99,7 +116,7 @@ impl Parse for Input {
                     return Err(syn::Error::new(
                         key.span(),
                         format!(
-                            "unknown option `{other}` (expected gravity, allow_nonphysical, \
+                            "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
                              runtime_payload, scalar, fma, fma_path)"
                         ),
                     ))
@@ -140,6 +157,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     let name = input.name.to_string();
     let mut opts = kanegen_codegen::Options::new(name.clone());
     opts.gravity = input.gravity;
+    opts.base = input.base;
     opts.runtime_payload = input.runtime_payload;
     let runtime = &input.runtime;
     opts.libm_path = "kanegen::__private::libm".into();

@@ -21,7 +21,7 @@
 //! assert!(x.iter().zip(&y).all(|(a, b)| (a - b).abs() < 1e-12));
 //! ```
 
-use crate::function::{Arg, BaseField, Function, Input, PayloadField};
+use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
 use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
@@ -29,9 +29,11 @@ use kanegen_dynamics::algorithms::{floating, recurrent};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::{
-    BiasMethod, ExternalWrench, JointParams, Loads, MassMatrixMethod, Methods, Params, Scalar,
+    BiasMethod, ExternalWrench, JointParams, LoadFrame, Loads, MassMatrixMethod, Methods, Params,
+    Scalar,
 };
 use kanegen_model::JointKind;
+use std::collections::HashMap;
 
 /// A traced function: the frozen graph and, per input in creation order, what it reads.
 #[derive(Debug)]
@@ -59,9 +61,9 @@ pub struct TraceError {
 ///
 /// Inputs are created in this order: the payload (with [`Spec::runtime_payload`]: mass, centre
 /// of mass, the inertia's upper triangle) or the generic parameters, then the function's
-/// arguments ([`Function::args`], `N` entries each), then the runtime wrenches, then the
-/// free-floating base state (position, quaternion `[x, y, z, w]`, `v_b`, `ω_b`). Only the
-/// effects `spec` names are traced.
+/// arguments ([`Function::args`]; a free-floating base's state is part of `q` and `v`, in
+/// Pinocchio's free-flyer layout), then the runtime wrenches. Only the effects `spec` names are
+/// traced.
 ///
 /// # Errors
 /// A combination that makes no sense: gravity's term without gravity, a base-frame subject with
@@ -119,17 +121,53 @@ pub fn trace(
     let p = params.expect("a model or generic subject has parameters");
 
     // Arguments.
-    let mut args: [Option<Vec<Sym>>; 4] = [None, None, None, None];
-    for &a in function.args() {
-        args[arg_index(a)] = Some((0..n).map(|i| input(Input::Joint(a, i))).collect());
+    let floating = matches!(spec.base, Base::FreeFloating(_));
+    let mut args: HashMap<Arg, Vec<Sym>> = HashMap::new();
+    let mut rows: Vec<[Sym; 6]> = Vec::new();
+    for &a in function.args(floating) {
+        if a == Arg::FExt {
+            rows = (0..a.len(n, floating))
+                .map(|r| core::array::from_fn(|c| input(Input::Row(a, r, c))))
+                .collect();
+        } else {
+            let v = (0..a.len(n, floating))
+                .map(|i| input(Input::Joint(a, i)))
+                .collect();
+            args.insert(a, v);
+        }
     }
-    let arg = |a: Arg| args[arg_index(a)].clone();
-    let q = arg(Arg::Q).expect("every function takes q");
+    let arg = |a: Arg| args.get(&a).cloned();
     let zeros = vec![Sym::zero(); n];
-    let qd = arg(Arg::Qd).unwrap_or_else(|| zeros.clone());
+    // The joint parts of the arguments, and the free-floating base state from q[..7], v[..6].
+    let full_q = arg(Arg::Q).expect("every function takes q");
+    let (q, qd, qdd, state) = if floating {
+        let v = arg(Arg::V);
+        let a = arg(Arg::A);
+        let v3 = |x: &[Sym], k: usize| Vec3([x[k], x[k + 1], x[k + 2]]);
+        let state = FloatingState {
+            position: v3(&full_q, 0),
+            rotation: quat_to_matrix(&[full_q[3], full_q[4], full_q[5], full_q[6]]),
+            v_b: v.as_ref().map_or_else(Vec3::zero, |v| v3(v, 0)),
+            omega_b: v.as_ref().map_or_else(Vec3::zero, |v| v3(v, 3)),
+        };
+        let joints = |x: Option<Vec<Sym>>, skip| x.map(|x| x[skip..].to_vec());
+        (
+            full_q[7..].to_vec(),
+            joints(v, 6).unwrap_or_else(|| zeros.clone()),
+            a,
+            Some(state),
+        )
+    } else {
+        (
+            full_q,
+            arg(Arg::Qd).unwrap_or_else(|| zeros.clone()),
+            arg(Arg::Qdd),
+            None,
+        )
+    };
 
     // Effects.
-    let external: Vec<ExternalWrench<Sym>> = spec
+    let mut external: Vec<ExternalWrench<Sym>> = spec
         .wrenches
         .iter()
         .enumerate()
@@ -156,6 +194,17 @@ pub fn trace(
             }
         })
         .collect();
+    // `f_ext`: one body-frame wrench per body (free-floating: the base first).
+    external.extend(rows.iter().enumerate().map(|(r, w)| ExternalWrench {
+        body: match (floating, r) {
+            (true, 0) => BASE_BODY,
+            (true, r) => r - 1,
+            (false, r) => r,
+        },
+        frame: LoadFrame::Body,
+        force: Vec3([w[0], w[1], w[2]]),
+        moment: Vec3([w[3], w[4], w[5]]),
+    }));
     let gravity = spec.gravity.map(Vec3::from_f64);
     // Damping as a drive: τ_d = −d q̇.
     let damping: Option<Vec<Sym>> = spec.damping.as_ref().map(|d| {
@@ -183,14 +232,57 @@ pub fn trace(
         external: Vec::new(),
     };
 
-    let out: Vec<Sym> = match &spec.base {
-        Base::Fixed => match function {
+    let out: Vec<Sym> = match (&spec.base, state) {
+        (Base::FreeFloating(inertial), Some(state)) => {
+            let base = FloatingBase::<Sym>::from_inertial(inertial);
+            let m = |method| floating::mass_matrix(method, &p, &base, &state, &q);
+            let b = |qd: &[Sym], l: &Loads<Sym>| {
+                floating::bias(methods.bias, &p, &base, &state, &q, qd, l)
+            };
+            let fd =
+                |l: &Loads<Sym>| floating::forward_dynamics(methods, &p, &base, &state, &q, &qd, l);
+            match function {
+                Function::MassMatrix => upper(&m(methods.mass_matrix)),
+                Function::GeneralizedForces => b(&qd, &loads(arg(Arg::Tau))),
+                Function::NonlinearEffects => negated(b(&qd, &loads(None))),
+                Function::Gravity => {
+                    let rest = FloatingState {
+                        v_b: Vec3::zero(),
+                        omega_b: Vec3::zero(),
+                        ..state.clone()
+                    };
+                    negated(floating::bias(
+                        methods.bias,
+                        &p,
+                        &base,
+                        &rest,
+                        &q,
+                        &zeros,
+                        &gravity_only,
+                    ))
+                }
+                Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
+                    fd(&loads(arg(Arg::Tau)))
+                }
+                Function::MassMatrixAndNonlinearEffects => {
+                    let mut v = upper(&m(methods.mass_matrix));
+                    v.extend(negated(b(&qd, &loads(None))));
+                    v
+                }
+                Function::Momentum => {
+                    let (lin, ang) = floating::momentum(&p, &base, &state, &q, &qd);
+                    lin.0.into_iter().chain(ang.0).collect()
+                }
+                _ => unreachable!("rejected by check"),
+            }
+        }
+        _ => match function {
             Function::MassMatrix => upper(&methods.mass_matrix.mass_matrix(&p, &q)),
             Function::GeneralizedForces => methods.bias.bias(&p, &q, &qd, &loads(arg(Arg::Tau))),
             Function::NonlinearEffects => negated(methods.bias.bias(&p, &q, &qd, &loads(None))),
             Function::Gravity => negated(methods.bias.bias(&p, &q, &zeros, &gravity_only)),
             Function::InverseDynamics => {
-                let qdd = arg(Arg::Qdd).expect("inverse dynamics takes qdd");
+                let qdd = qdd.expect("inverse dynamics takes q̈");
                 let tau = methods.inverse_dynamics(&p, &q, &qd, &qdd, &loads(None));
                 match &damping {
                     // τ = M q̈ + c with the damping force d q̇ inside c.
@@ -198,7 +290,7 @@ pub fn trace(
                     None => tau,
                 }
             }
-            Function::ForwardDynamics => {
+            Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches => {
                 methods.forward_dynamics(&p, &q, &qd, &loads(arg(Arg::Tau)))
             }
             Function::MassMatrixAndNonlinearEffects => {
@@ -206,35 +298,8 @@ pub fn trace(
                 v.extend(negated(methods.bias.bias(&p, &q, &qd, &loads(None))));
                 v
             }
+            _ => unreachable!("rejected by check"),
         },
-        Base::FreeFloating(inertial) => {
-            let base = FloatingBase::<Sym>::from_inertial(inertial);
-            let state = floating_state_inputs(&mut input);
-            let m = |method| floating::mass_matrix(method, &p, &base, &state, &q);
-            let b = |l: &Loads<Sym>| floating::bias(methods.bias, &p, &base, &state, &q, &qd, l);
-            match function {
-                Function::MassMatrix => upper(&m(methods.mass_matrix)),
-                Function::GeneralizedForces => b(&loads(arg(Arg::Tau))),
-                Function::NonlinearEffects => negated(b(&loads(None))),
-                Function::ForwardDynamics => floating::forward_dynamics(
-                    methods,
-                    &p,
-                    &base,
-                    &state,
-                    &q,
-                    &qd,
-                    &loads(arg(Arg::Tau)),
-                ),
-                Function::MassMatrixAndNonlinearEffects => {
-                    let mut v = upper(&m(methods.mass_matrix));
-                    v.extend(negated(b(&loads(None))));
-                    v
-                }
-                Function::Gravity | Function::InverseDynamics => {
-                    unreachable!("rejected by check")
-                }
-            }
-        }
     };
     Ok(Traced {
         trace: t.finish(&out),
@@ -299,23 +364,23 @@ fn check(
             return Err(format!("wrench[{i}] acts on body {} of {n}", w.body));
         }
     }
-    if floating && matches!(function, Function::Gravity | Function::InverseDynamics) {
-        return Err(format!(
-            "{} is not traced for a free-floating base",
-            function.name()
-        ));
+    if function.floating_only() && !floating {
+        return Err(format!("{} needs a free-floating base", function.name()));
+    }
+    // Awaiting the tree-capable local-frame algorithms of the dynamics crate.
+    if function.frame().is_some()
+        || matches!(function, Function::BaseReaction)
+        || (floating && function == Function::InverseDynamics)
+    {
+        return Err(format!("{} is not traced yet", function.name()));
+    }
+    if let (Some(k), Subject::Model(m)) = (function.frame(), subject) {
+        if k >= m.frames().len() {
+            return Err(format!("the model has no frame #{k}"));
+        }
     }
     let _ = BiasMethod::ALL; // every bias method traces every remaining combination
     Ok(())
-}
-
-fn arg_index(a: Arg) -> usize {
-    match a {
-        Arg::Q => 0,
-        Arg::Qd => 1,
-        Arg::Qdd => 2,
-        Arg::Tau => 3,
-    }
 }
 
 /// The upper triangle of a symmetric matrix, row-major.
@@ -417,24 +482,4 @@ fn base_frame_inputs(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Vec<Body
             }
         })
         .collect()
-}
-
-/// The free-floating base state as inputs: `p₀`, the quaternion `[x, y, z, w]`, `v_b`, `ω_b`.
-fn floating_state_inputs(input: &mut impl FnMut(Input) -> Sym) -> FloatingState<Sym> {
-    let position = Vec3(core::array::from_fn(|k| {
-        input(Input::Base(BaseField::Position(k)))
-    }));
-    let quat: [Sym; 4] = core::array::from_fn(|k| input(Input::Base(BaseField::Quaternion(k))));
-    let v_b = Vec3(core::array::from_fn(|k| {
-        input(Input::Base(BaseField::V(k)))
-    }));
-    let omega_b = Vec3(core::array::from_fn(|k| {
-        input(Input::Base(BaseField::Omega(k)))
-    }));
-    FloatingState {
-        position,
-        rotation: quat_to_matrix(&quat),
-        v_b,
-        omega_b,
-    }
 }

@@ -17,17 +17,34 @@ pub enum Function {
     NonlinearEffects,
     /// `g(q)`: the gravity part of `c` (needs gravity).
     Gravity,
-    /// `τ = M q̈ + c`: the drives that produce `q̈`.
+    /// `τ = M q̈ + c`: the drives that produce `q̈` (free-floating: the external wrench on the
+    /// base, then the joint drives, that produce `ν̇`).
     InverseDynamics,
-    /// `q̈ = M⁻¹ (τ − c)`.
+    /// `q̈ = M⁻¹ (τ − c)` (free-floating: `ν̇`).
     ForwardDynamics,
     /// `M` (upper triangle) then `c`, in one graph sharing the kinematics.
     MassMatrixAndNonlinearEffects,
+    /// Forward dynamics with an external wrench on every body (`f_ext`: per body, force then
+    /// moment, in the body frame at its origin; free-floating: the base first).
+    ForwardDynamicsWithWrenches,
+    /// Free-floating: the total momentum `[P; L]`, inertial frame, about the inertial origin.
+    Momentum,
+    /// Free-floating: the wrench the arm exerts on the base (force, moment about the base
+    /// origin, base coordinates) for the motion `(q, v, a)`.
+    BaseReaction,
+    /// The placement of named frame `k`: its origin and orientation in the base frame (fixed
+    /// base) or the inertial frame (free-floating).
+    FramePlacement(usize),
+    /// The geometric Jacobian of named frame `k`: rows `[v; ω]` of its origin, base-frame
+    /// (fixed) or inertial (free-floating) axes, one column per speed.
+    FrameJacobian(usize),
+    /// Free-floating: the generalized Jacobian (Umetani–Yoshida) of named frame `k`, `6 × N`.
+    GeneralizedJacobian(usize),
 }
 
 impl Function {
-    /// Every function, in emission order.
-    pub const ALL: [Function; 7] = [
+    /// The functions without a frame, in emission order.
+    pub const ALL: [Function; 10] = [
         Function::MassMatrix,
         Function::GeneralizedForces,
         Function::NonlinearEffects,
@@ -35,9 +52,13 @@ impl Function {
         Function::InverseDynamics,
         Function::ForwardDynamics,
         Function::MassMatrixAndNonlinearEffects,
+        Function::ForwardDynamicsWithWrenches,
+        Function::Momentum,
+        Function::BaseReaction,
     ];
 
-    /// The snake-case name (the generated function's name).
+    /// The snake-case name (the generated function's name; a frame's functions are named
+    /// `<frame>_placement`, `<frame>_jacobian`, `<frame>_generalized_jacobian`).
     #[must_use]
     pub fn name(self) -> &'static str {
         match self {
@@ -48,19 +69,85 @@ impl Function {
             Function::InverseDynamics => "inverse_dynamics",
             Function::ForwardDynamics => "forward_dynamics",
             Function::MassMatrixAndNonlinearEffects => "mass_matrix_and_nonlinear_effects",
+            Function::ForwardDynamicsWithWrenches => "forward_dynamics_with_wrenches",
+            Function::Momentum => "momentum",
+            Function::BaseReaction => "base_reaction",
+            Function::FramePlacement(_) => "placement",
+            Function::FrameJacobian(_) => "jacobian",
+            Function::GeneralizedJacobian(_) => "generalized_jacobian",
         }
     }
 
-    /// The joint-space arguments, in order.
+    /// The named frame it is about, if any.
     #[must_use]
-    pub fn args(self) -> &'static [Arg] {
+    pub fn frame(self) -> Option<usize> {
         match self {
-            Function::MassMatrix | Function::Gravity => &[Arg::Q],
-            Function::GeneralizedForces | Function::ForwardDynamics => &[Arg::Q, Arg::Qd, Arg::Tau],
-            Function::NonlinearEffects | Function::MassMatrixAndNonlinearEffects => {
-                &[Arg::Q, Arg::Qd]
+            Function::FramePlacement(k)
+            | Function::FrameJacobian(k)
+            | Function::GeneralizedJacobian(k) => Some(k),
+            _ => None,
+        }
+    }
+
+    /// Whether it exists only for a free-floating base.
+    #[must_use]
+    pub fn floating_only(self) -> bool {
+        matches!(
+            self,
+            Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_)
+        )
+    }
+
+    /// The arguments, in order, for a fixed or a free-floating base ([`Arg`]).
+    #[must_use]
+    pub fn args(self, floating: bool) -> &'static [Arg] {
+        let (v, a) = if floating {
+            (Arg::V, Arg::A)
+        } else {
+            (Arg::Qd, Arg::Qdd)
+        };
+        match (self, v, a) {
+            (
+                Function::MassMatrix
+                | Function::Gravity
+                | Function::FramePlacement(_)
+                | Function::FrameJacobian(_)
+                | Function::GeneralizedJacobian(_),
+                _,
+                _,
+            ) => &[Arg::Q],
+            (Function::GeneralizedForces | Function::ForwardDynamics, Arg::V, _) => {
+                &[Arg::Q, Arg::V, Arg::Tau]
             }
-            Function::InverseDynamics => &[Arg::Q, Arg::Qd, Arg::Qdd],
+            (Function::GeneralizedForces | Function::ForwardDynamics, _, _) => {
+                &[Arg::Q, Arg::Qd, Arg::Tau]
+            }
+            (
+                Function::NonlinearEffects
+                | Function::MassMatrixAndNonlinearEffects
+                | Function::Momentum,
+                Arg::V,
+                _,
+            ) => &[Arg::Q, Arg::V],
+            (
+                Function::NonlinearEffects
+                | Function::MassMatrixAndNonlinearEffects
+                | Function::Momentum,
+                _,
+                _,
+            ) => &[Arg::Q, Arg::Qd],
+            (Function::InverseDynamics | Function::BaseReaction, Arg::V, _) => {
+                &[Arg::Q, Arg::V, Arg::A]
+            }
+            (Function::InverseDynamics | Function::BaseReaction, _, _) => {
+                &[Arg::Q, Arg::Qd, Arg::Qdd]
+            }
+            (Function::ForwardDynamicsWithWrenches, Arg::V, _) => {
+                &[Arg::Q, Arg::V, Arg::Tau, Arg::FExt]
+            }
+            (Function::ForwardDynamicsWithWrenches, _, _) => {
+                &[Arg::Q, Arg::Qd, Arg::Tau, Arg::FExt]
+            }
         }
     }
 
@@ -71,28 +158,49 @@ impl Function {
             self,
             Function::MassMatrix
                 | Function::ForwardDynamics
+                | Function::ForwardDynamicsWithWrenches
                 | Function::MassMatrixAndNonlinearEffects
+                | Function::GeneralizedJacobian(_)
         )
     }
 
     /// Whether its result involves the bias forces (and so a bias method).
     #[must_use]
     pub fn uses_bias(self) -> bool {
-        !matches!(self, Function::MassMatrix)
+        matches!(
+            self,
+            Function::GeneralizedForces
+                | Function::NonlinearEffects
+                | Function::Gravity
+                | Function::InverseDynamics
+                | Function::ForwardDynamics
+                | Function::ForwardDynamicsWithWrenches
+                | Function::MassMatrixAndNonlinearEffects
+                | Function::BaseReaction
+        )
     }
 }
 
-/// A joint-space argument vector of a generated function (length `N`).
+/// An argument array of a generated function. For a free-floating base the layout is
+/// Pinocchio's free-flyer: `q = [p₀ (3), quaternion x, y, z, w (4), joints (N)]`,
+/// `v = [v_b (3), ω_b (3), q̇ (N)]` (base coordinates), `a = v̇`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Arg {
-    /// Joint positions `q` (rad or m).
+    /// Positions: the joints' (`N`), or free-floating the base pose then the joints' (`7 + N`).
     Q,
-    /// Joint velocities `q̇`.
+    /// Joint velocities `q̇` (fixed base, `N`).
     Qd,
-    /// Joint accelerations `q̈`.
+    /// Joint accelerations `q̈` (fixed base, `N`).
     Qdd,
-    /// Joint drives `τ` (N·m or N).
+    /// Joint drives `τ` (N·m or N, `N`).
     Tau,
+    /// Free-floating velocities `v = [v_b, ω_b, q̇]` (`6 + N`).
+    V,
+    /// Free-floating accelerations `a = v̇` (`6 + N`).
+    A,
+    /// External wrenches, one row `[f (3), m (3)]` per body in its frame at its origin
+    /// (free-floating: the base first; `N` or `1 + N` rows).
+    FExt,
 }
 
 impl Arg {
@@ -104,6 +212,21 @@ impl Arg {
             Arg::Qd => "qd",
             Arg::Qdd => "qdd",
             Arg::Tau => "tau",
+            Arg::V => "v",
+            Arg::A => "a",
+            Arg::FExt => "f_ext",
+        }
+    }
+
+    /// Its number of entries for `n` joints (rows of 6 for [`Arg::FExt`]).
+    #[must_use]
+    pub fn len(self, n: usize, floating: bool) -> usize {
+        let base = usize::from(floating);
+        match self {
+            Arg::Q => n + 7 * base,
+            Arg::Qd | Arg::Qdd | Arg::Tau => n,
+            Arg::V | Arg::A => n + 6 * base,
+            Arg::FExt => n + base,
         }
     }
 }
@@ -119,24 +242,13 @@ pub enum PayloadField {
     Inertia(usize, usize),
 }
 
-/// A part of the free-floating base state.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum BaseField {
-    /// `p₀` component (inertial frame).
-    Position(usize),
-    /// Attitude quaternion component, `[x, y, z, w]`.
-    Quaternion(usize),
-    /// `v_b` component (base frame).
-    V(usize),
-    /// `ω_b` component (base frame).
-    Omega(usize),
-}
-
 /// One runtime input of a trace, in the order [`crate::Traced::inputs`] lists them.
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub enum Input {
-    /// Entry `i` of a joint-space argument.
+    /// Entry `i` of an argument array.
     Joint(Arg, usize),
+    /// Entry `(row, col)` of an argument of rows ([`Arg::FExt`]).
+    Row(Arg, usize, usize),
     /// A payload field.
     Payload(PayloadField),
     /// Component `k` (force x, y, z, then moment x, y, z) of the runtime wrench `index` of the
@@ -147,8 +259,6 @@ pub enum Input {
         /// 0..3 force, 3..6 moment.
         component: usize,
     },
-    /// Part of the free-floating base state.
-    Base(BaseField),
     /// A model parameter made symbolic (generic traces for Table 1), by name.
     Parameter(String),
 }
@@ -158,6 +268,7 @@ impl core::fmt::Display for Input {
         const XYZ: [&str; 3] = ["x", "y", "z"];
         match self {
             Input::Joint(a, i) => write!(f, "{}[{i}]", a.name()),
+            Input::Row(a, r, c) => write!(f, "{}[{r}][{c}]", a.name()),
             Input::Payload(PayloadField::Mass) => f.write_str("payload.mass"),
             Input::Payload(PayloadField::Com(k)) => write!(f, "payload.com[{k}]"),
             Input::Payload(PayloadField::Inertia(r, c)) => write!(f, "payload.inertia[{r}][{c}]"),
@@ -165,10 +276,6 @@ impl core::fmt::Display for Input {
                 let p = if *component < 3 { "f" } else { "m" };
                 write!(f, "{p}{index}_{}", XYZ[component % 3])
             }
-            Input::Base(BaseField::Position(k)) => write!(f, "p0_{}", XYZ[*k]),
-            Input::Base(BaseField::Quaternion(k)) => write!(f, "quat_{}", ["x", "y", "z", "w"][*k]),
-            Input::Base(BaseField::V(k)) => write!(f, "v_b_{}", XYZ[*k]),
-            Input::Base(BaseField::Omega(k)) => write!(f, "omega_b_{}", XYZ[*k]),
             Input::Parameter(name) => f.write_str(name),
         }
     }

@@ -26,6 +26,6 @@ pub mod sym;
 pub mod table1;
 
 pub use entry::{trace, TraceError, Traced};
-pub use function::{Arg, BaseField, Function, Input, PayloadField};
+pub use function::{Arg, Function, Input, PayloadField};
 pub use spec::{Base, Effect, Spec, Subject, Wrench, WrenchValue};
 pub use sym::{Convention, Counts, Node, Sym, Trace, Tracer};

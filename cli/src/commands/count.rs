@@ -3,10 +3,10 @@
 
 use crate::scene_spec;
 use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
-use kanegen_model::Model;
+use kanegen_model::{BaseKind, Model};
 use kanegen_sim::scene::{BaseSpec, Scene};
 use kanegen_trace::count::{count_lines, effect_lines, CountLine, EffectLine};
-use kanegen_trace::{Spec, TraceError};
+use kanegen_trace::{Base, Spec, TraceError};
 use serde::Serialize;
 use std::path::Path;
 
@@ -15,8 +15,10 @@ use std::path::Path;
 pub struct CountReport {
     /// Model name.
     pub model: String,
-    /// Degrees of freedom.
+    /// Degrees of freedom of the joints.
     pub n: usize,
+    /// `fixed` or `free-floating`.
+    pub base: String,
     /// Whether gravity was included in `bias`.
     pub gravity: bool,
     /// One line per function, method and convention.
@@ -36,7 +38,8 @@ fn methods_of(presets: &[Methods]) -> (Vec<MassMatrixMethod>, Vec<BiasMethod>) {
     (mass, bias)
 }
 
-/// Counts of `A` for every mass-matrix method and of `b` for every bias method of `presets`.
+/// Counts of `A` for every mass-matrix method and of `b` for every bias method of `presets`, on
+/// the model's base (free-floating: `6 + N` speeds, the base state as inputs).
 ///
 /// # Errors
 /// If a trace is refused (`kanegen_trace::trace`).
@@ -46,11 +49,19 @@ pub fn count(
     gravity: Option<[f64; 3]>,
 ) -> Result<CountReport, TraceError> {
     let (mass, bias) = methods_of(presets);
+    let spec = Spec {
+        base: match (model.base_kind(), model.base_inertial()) {
+            (BaseKind::FreeFloating, Some(i)) => Base::FreeFloating(i.clone()),
+            _ => Base::Fixed,
+        },
+        ..Spec::with_gravity(gravity)
+    };
     Ok(CountReport {
         model: model.name().into(),
         n: model.dof(),
+        base: model.base_kind().name().into(),
         gravity: gravity.is_some(),
-        counts: count_lines(model, &mass, &bias, &Spec::with_gravity(gravity))?,
+        counts: count_lines(model, &mass, &bias, &spec)?,
     })
 }
 
@@ -82,9 +93,10 @@ fn write_count_table(s: &mut String, counts: &[CountLine]) {
 /// Human-readable table.
 pub fn render_text(r: &CountReport) -> String {
     let mut s = format!(
-        "model {} (N = {}), gravity {}\n\n",
+        "model {} (N = {}, {} base), gravity {}\n\n",
         r.model,
         r.n,
+        r.base,
         if r.gravity { "on" } else { "off" }
     );
     write_count_table(&mut s, &r.counts);

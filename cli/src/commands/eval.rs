@@ -1,9 +1,13 @@
-//! `kanegen eval MODEL --states STATES.json`: A and b of `A q̈ = b` at each state.
+//! `kanegen eval MODEL --states STATES.json`: `A` and `b` of `A q̈ = b` at each state, on a fixed
+//! base (`N × N`) or a free-floating one (`(6+N) × (6+N)`, order base linear, base angular,
+//! joints; conventions of `kanegen_dynamics::base`).
 
 use crate::states::{parse_states, State};
 use anyhow::Result;
+use kanegen_dynamics::algorithms::floating;
+use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::{linalg::Vec3, Dynamics, Loads, Methods, Params};
-use kanegen_model::Model;
+use kanegen_model::{BaseKind, Model};
 use serde::Serialize;
 
 /// One evaluated state, as written by `--json`.
@@ -16,15 +20,34 @@ pub struct EvalResult {
     pub b: Vec<f64>,
 }
 
-/// Evaluates `A` and `b` in f64 at every state of a states file.
+/// The methods `eval` and `count` use when none is given: the paper's recurrent algorithm on a
+/// serial chain, the local-frame CRBA and RNEA on a tree (the paper's algorithms are chain-only).
+#[must_use]
+pub fn default_methods(model: &Model) -> Methods {
+    if model.is_chain() {
+        Methods::RECURRENT
+    } else {
+        Methods::SPATIAL
+    }
+}
+
+/// Evaluates `A` and `b` in f64 at every state of a states file; `gravity` is in the base frame
+/// (fixed base) or the inertial frame (free-floating base).
+///
+/// # Errors
+/// A malformed states file, naming the state and field.
 pub fn eval_states(
-    chain: &Model,
+    model: &Model,
     states_json: &str,
-    algorithm: Methods,
+    methods: Methods,
     gravity: Option<[f64; 3]>,
 ) -> Result<Vec<EvalResult>> {
-    let states = parse_states(states_json, chain.dof())?;
-    let params = Params::<f64>::new(chain);
+    let floating = model.base_kind() == BaseKind::FreeFloating;
+    let states = parse_states(states_json, model.dof(), floating)?;
+    let params = Params::<f64>::new(model);
+    let base = model
+        .base_inertial()
+        .map(FloatingBase::<f64>::from_inertial);
     Ok(states
         .iter()
         .map(|s: &State| {
@@ -33,21 +56,34 @@ pub fn eval_states(
                 gravity: gravity.map(Vec3),
                 external: Vec::new(),
             };
-            let Dynamics { a, b } = algorithm.dynamics(&params, &s.q, &s.qd, &loads);
+            let Dynamics { a, b } = match (&s.base, &base) {
+                (Some(bs), Some(base)) => {
+                    let state = FloatingState {
+                        position: Vec3(bs.position),
+                        rotation: quat_to_matrix(&bs.quaternion),
+                        v_b: Vec3(bs.v),
+                        omega_b: Vec3(bs.omega),
+                    };
+                    floating::dynamics(methods, &params, base, &state, &s.q, &s.qd, &loads)
+                }
+                _ => methods.dynamics(&params, &s.q, &s.qd, &loads),
+            };
             EvalResult { a, b }
         })
         .collect())
 }
 
 /// Human-readable rendering of the results.
-pub fn render_text(chain: &Model, algorithm: Methods, results: &[EvalResult]) -> String {
+#[must_use]
+pub fn render_text(model: &Model, methods: Methods, results: &[EvalResult]) -> String {
     use std::fmt::Write;
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "model {} ({} joints), algorithm {algorithm}",
-        chain.name(),
-        chain.dof()
+        "model {} ({} joints, {} base), algorithm {methods}",
+        model.name(),
+        model.dof(),
+        model.base_kind().name()
     );
     for (k, r) in results.iter().enumerate() {
         let _ = writeln!(s, "\nstate {k}\nA =");
