@@ -701,8 +701,10 @@ impl Scene {
         if output_every == 0 {
             bail!("simulation.output_every: must be >= 1");
         }
+        // The paper's algorithms handle serial chains; a tree takes the local-frame ones.
         let algorithm = match s.algorithm {
-            None => Methods::RECURRENT,
+            None if chain.is_chain() => Methods::RECURRENT,
+            None => Methods::SPATIAL,
             Some(a) => Methods::from_name(&a).ok_or_else(|| {
                 let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
                 anyhow!(
@@ -711,6 +713,16 @@ impl Scene {
                 )
             })?,
         };
+        if let Some(j) = chain.first_branch() {
+            if algorithm != Methods::SPATIAL {
+                bail!(
+                    "simulation.algorithm: `{algorithm}` handles serial chains only, and the \
+                     model is a tree (joint `{}` does not hang from the joint before it): use \
+                     \"spatial\"",
+                    j.name
+                );
+            }
+        }
         if integrator != Integrator::Dopri5 {
             if s.tolerance.is_some() {
                 bail!("simulation.tolerance: only for integrator = \"dopri5\"");
