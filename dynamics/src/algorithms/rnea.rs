@@ -2,10 +2,14 @@
 //! `ID`, and the `C` part of `HandC`): inverse dynamics in one O(N) pass, and the bias forces
 //! with `q̈ = 0`. Spatial algebra and conventions: [`crate::spatial`].
 //!
-//! Forward pass: `v_i = Xup_i v_λ + vJ_i`, `a_i = Xup_i a_λ + S_i q̈_i + v_i ×ₘ vJ_i`,
+//! Any kinematic tree (`λ(i)` = [`crate::JointParams::parent`]). Forward pass:
+//! `v_i = Xup_i v_λ(i) + vJ_i`, `a_i = Xup_i a_λ(i) + S_i q̈_i + v_i ×ₘ vJ_i`,
 //! `f_i = I_i a_i + v_i ×* I_i v_i − f^x_i`; backward pass: `τ_i = S_iᵀ f_i`,
-//! `f_λ += Xup_iᵀ f_i`. Gravity is the fictitious base acceleration `a_0 = −a_grav = [0; −g]`
-//! (RBDA §5.3); external wrenches enter as `−f^x_i`.
+//! `f_λ(i) += Xup_iᵀ f_i`. Gravity is the fictitious base acceleration `a_0 = −a_grav = [0; −g]`
+//! (RBDA §5.3); external wrenches enter as `−f^x_i`, base-frame ones rotated by
+//! `E_0i = E_i E_0λ(i)` along the body's own path. On a serial chain the operations are exactly
+//! those of the chain algorithm.
+
 //!
 //! ```
 //! use kanegen_dynamics::algorithms::{crba, rnea};
@@ -64,8 +68,8 @@ fn subtract_external<S: Scalar>(
     f
 }
 
-/// Both passes: `(τ_i = S_iᵀ f_i for every joint, f_0 carried onto body −1)`. `qdd = None` is
-/// `q̈ = 0` and adds no operation.
+/// Both passes over the tree: `(τ_i = S_iᵀ f_i for every joint, Σ Xup_iᵀ f_i over the joints
+/// on the base, carried onto body −1)`. `qdd = None` is `q̈ = 0` and adds no operation.
 fn passes<S: Scalar>(
     p: &Params<S>,
     q: &[S],
@@ -88,21 +92,24 @@ fn passes<S: Scalar>(
         "an external wrench names a body past the end of the chain"
     );
     let need_rot = loads.external.iter().any(|e| e.frame == LoadFrame::Base);
-    let Start {
-        v: mut v_prev,
-        a: mut a_prev,
-        e0: mut e0_prev,
-    } = start;
     let mut xups: Vec<Xform<S>> = Vec::with_capacity(n);
+    let mut vs: Vec<Motion<S>> = Vec::with_capacity(n);
+    let mut accs: Vec<Motion<S>> = Vec::with_capacity(n);
+    // E_0j: rotation from the frame of base-frame wrenches to body j (kept only when needed).
+    let mut e0s: Vec<Mat3<S>> = Vec::with_capacity(if need_rot { n } else { 0 });
     let mut f: Vec<Force<S>> = Vec::with_capacity(n);
-    // Forward pass.
+    // Forward pass, each body from its parent λ(j) (or from body −1, the start).
     for (j, (jp, (qj, qdj))) in p.joints.iter().zip(q.iter().zip(qd)).enumerate() {
+        let (v_parent, a_parent) = match jp.parent {
+            Some(lambda) => (&vs[lambda], &accs[lambda]),
+            None => (&start.v, &start.a),
+        };
         let x = xup(jp, qj);
         let vj = s_times(jp, qdj);
         // v_j = Xup_j v_λ + vJ
-        let v = x.apply(&v_prev) + vj.clone();
+        let v = x.apply(v_parent) + vj.clone();
         // a_j = Xup_j a_λ + S_j q̈_j + v_j ×ₘ vJ   (cJ = 0)
-        let mut a = x.apply(&a_prev);
+        let mut a = x.apply(a_parent);
         if let Some(qdd) = qdd {
             a = a + s_times(jp, &qdd[j]);
         }
@@ -111,24 +118,36 @@ fn passes<S: Scalar>(
         let inertia = RbInertia::mci(jp);
         let fj = inertia.mul(&a) + v.crf(&inertia.mul(&v));
         if need_rot {
-            e0_prev = x.e.mul_mat(&e0_prev);
+            // E_0j = E_j E_0λ
+            let e0_parent = match jp.parent {
+                Some(lambda) => &e0s[lambda],
+                None => &start.e0,
+            };
+            e0s.push(x.e.mul_mat(e0_parent));
         }
-        f.push(subtract_external(fj, loads, j, &e0_prev));
-        v_prev = v;
-        a_prev = a;
+        let e0 = if need_rot { &e0s[j] } else { &start.e0 };
+        f.push(subtract_external(fj, loads, j, e0));
+        vs.push(v);
+        accs.push(a);
         xups.push(x);
     }
-    // Backward pass: τ_j = S_jᵀ f_j; f_λ += Xup_jᵀ f_j.
+    // Backward pass: τ_j = S_jᵀ f_j; f_λ += Xup_jᵀ f_j (onto body −1 for the joints on the base).
     let mut tau = vec![S::zero(); n];
-    let mut onto_base = None;
+    let mut onto_base: Option<Force<S>> = None;
     for j in (0..n).rev() {
         tau[j] = s_tr(&p.joints[j], &f[j]);
         let carried = xups[j].tr_apply(&f[j]);
-        if j > 0 {
-            let parent = f[j - 1].clone();
-            f[j - 1] = parent + carried;
-        } else {
-            onto_base = Some(carried);
+        match p.joints[j].parent {
+            Some(lambda) => {
+                let parent = f[lambda].clone();
+                f[lambda] = parent + carried;
+            }
+            None => {
+                onto_base = Some(match onto_base {
+                    Some(sum) => sum + carried,
+                    None => carried,
+                });
+            }
         }
     }
     (tau, onto_base)
@@ -187,11 +206,13 @@ pub fn inverse_dynamics<S: Scalar>(
     passes(p, q, qd, Some(qdd), loads, fixed_start(loads)).0
 }
 
-/// The generalized forces `b` (`6 + N` entries) of the arm `p` on the free-floating base `base`
-/// in the state `state` (conventions of [`crate::base`]), RNEA with `ν̇ = 0`: base
-/// `v_0 = [ω_b; v_b]`, `a_0 = [0; −R₀ᵀ g]`, `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 − f^x_0`, the arm as in
-/// [`bias`], `f_0 += Xup_0ᵀ f_arm,0`; then `b_base = −[f_0.f; f_0.n]`, `b_arm,j = τ_j − S_jᵀ f_j`.
-/// Inertial-frame wrenches are rotated into body coordinates with `E_{0j} R₀ᵀ`.
+/// The generalized forces `b` (`6 + N` entries) of the arm `p` (any kinematic tree) on the
+/// free-floating base `base` in the state `state` (conventions of [`crate::base`]), RNEA with
+/// `ν̇ = 0`: base `v_0 = [ω_b; v_b]`, `a_0 = [0; −R₀ᵀ g]`,
+/// `f_0 = I_0 a_0 + v_0 ×* I_0 v_0 − f^x_0`, the arm as in [`bias`],
+/// `f_0 += Σ_{λ(i) = base} Xup_iᵀ f_i`; then `b_base = −[f_0.f; f_0.n]`,
+/// `b_arm,j = τ_j − S_jᵀ f_j`. Inertial-frame wrenches are rotated into body coordinates with
+/// `E_{0j} R₀ᵀ`.
 /// Section `"spatial:floating"`.
 pub fn floating_bias<S: Scalar>(
     p: &Params<S>,
