@@ -31,8 +31,10 @@
 //! virtual joints (3 prismatic, then 3 revolute, axes `R₀e_m` through `p₀`) whose partial
 //! velocities are exactly those of `ν_b`, everything in the inertial frame. The velocity-product
 //! recursion starts from the base body's true motion ([`kinematics::floating_base_motion`]).
-//! `spatial` is an independent implementation (Featherstone's floating-base CRBA + RNEA in body
-//! coordinates, [`spatial::dynamics`]).
+//! This extension is **serial-chain only**, like the base-frame algorithms (it panics on a tree).
+//! `spatial` ([`Methods::SPATIAL`]) is an independent implementation that takes any kinematic
+//! tree: Featherstone's floating-base CRBA and RNEA in body coordinates
+//! ([`crba::floating_mass_matrix`], [`rnea::floating_bias`]).
 //!
 //! ```
 //! use kanegen_dynamics::algorithms::floating;
@@ -95,9 +97,13 @@ fn extended_loads<S: Scalar>(loads: &Loads<S>, n: usize) -> Loads<S> {
 }
 
 /// `A` (`(6+N)×(6+N)`) of the arm `p` on the free-floating base `base` at arm positions `q`.
-/// The base-frame methods run on the virtual-joint extension of [`floating_base_frame`];
-/// [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`]. `A` does not depend on the
-/// base pose; `state` is the pose the base-frame methods express their quantities in.
+/// The base-frame methods run on the virtual-joint extension of [`floating_base_frame`] (serial
+/// chains only); [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`] (any tree). `A`
+/// does not depend on the base pose; `state` is the pose the base-frame methods express their
+/// quantities in.
+///
+/// # Panics
+/// A serial-chain-only method on a tree ([`MassMatrixMethod::check`]).
 pub fn mass_matrix<S: Scalar>(
     method: MassMatrixMethod,
     p: &Params<S>,
@@ -107,14 +113,22 @@ pub fn mass_matrix<S: Scalar>(
 ) -> Vec<Vec<S>> {
     match method {
         MassMatrixMethod::Crba => crba::floating_mass_matrix(p, base, q),
-        base_frame => base_frame
-            .from_base_frame(&floating_base_frame(p, base, state, q))
-            .expect("every method but the CRBA starts from base-frame quantities"),
+        base_frame => {
+            p.assert_chain(base_frame.name());
+            base_frame
+                .from_base_frame(&floating_base_frame(p, base, state, q))
+                .expect("every method but the CRBA starts from base-frame quantities")
+        }
     }
 }
 
 /// `b` (`6+N` entries) of `A ν̇ = b` for the arm `p` on the free-floating base `base` in the state
 /// `state`, with arm rates `qd` and `loads` (conventions of [`crate::base`]).
+/// [`BiasMethod::Rnea`] runs [`rnea::floating_bias`] (any tree), the base-frame methods the
+/// virtual-joint extension (serial chains only).
+///
+/// # Panics
+/// A serial-chain-only method on a tree ([`BiasMethod::check`]).
 pub fn bias<S: Scalar>(
     method: BiasMethod,
     p: &Params<S>,
@@ -129,6 +143,7 @@ pub fn bias<S: Scalar>(
     if method == BiasMethod::Rnea {
         return rnea::floating_bias(p, base, state, q, qd, loads);
     }
+    p.assert_chain(method.name());
     let kin = floating_base_frame(p, base, state, q);
     let mot = floating_motion(&kin, state, qd);
     let ext = extended_loads(loads, n);
@@ -141,7 +156,8 @@ pub fn bias<S: Scalar>(
     }
 }
 
-/// `A` and `b` of the free-floating system ([`mass_matrix`], [`bias`]).
+/// `A` and `b` of the free-floating system ([`mass_matrix`], [`bias`]); any tree with
+/// [`Methods::SPATIAL`].
 pub fn dynamics<S: Scalar>(
     methods: Methods,
     p: &Params<S>,

@@ -16,6 +16,11 @@
 //! | [`floating`] | a free-floating base: the base-frame algorithms on six virtual joints, momentum, Jacobians |
 //! | [`methods`] | the choice of mass-matrix and bias method, and the fixed-base dispatch |
 //!
+//! **Trees.** `crba` and `rnea` take any kinematic tree (`λ(i)` = [`crate::JointParams::parent`]);
+//! the paper's base-frame algorithms (`kinematics`, `recurrent`, `kane_direct`, `crba_base`, and
+//! the virtual-joint extension of `floating`) are serial-chain only and panic on a tree
+//! ([`crate::Params::assert_chain`]; [`methods::Methods::check`] asks first).
+//!
 //! Module dependencies run one way: `methods` and `floating` use the algorithm files, which use
 //! `kinematics` and the crate's leaf modules; no algorithm file uses `methods` or `floating`.
 
