@@ -36,6 +36,9 @@
 //! tree: Featherstone's floating-base CRBA and RNEA in body coordinates
 //! ([`crba::floating_mass_matrix`], [`rnea::floating_bias`]).
 //!
+//! Frame placements and Jacobians, and the generalized Jacobian, are in
+//! [`crate::algorithms::frames`] (any tree).
+//!
 //! ```
 //! use kanegen_dynamics::algorithms::floating;
 //! use kanegen_dynamics::base::{FloatingBase, FloatingState};
@@ -65,7 +68,6 @@ use crate::linalg::Vec3;
 use crate::loads::{ExternalWrench, Loads};
 use crate::params::Params;
 use crate::scalar::Scalar;
-use kanegen_model::JointKind;
 
 /// The loads of the extended body list: arm wrenches shifted by 6, base wrenches on virtual
 /// body 5 (the one carrying the base's inertia), arm drives prefixed by 6 zeros.
@@ -257,74 +259,4 @@ pub fn kinetic_energy<S: Scalar>(
             + m.omega.dot(&k.inertia.mul_vec(&m.omega));
     }
     t * S::constant(0.5)
-}
-
-/// The Jacobian of a point on the last arm body: rows `[v (3); ω (3)]` (the point's velocity and
-/// the body's angular velocity, inertial coordinates), columns the `6 + N` speeds `ν`. `point`
-/// is in the last body's frame. Panics if the arm has no joints.
-pub fn point_jacobian<S: Scalar>(
-    p: &Params<S>,
-    base: &FloatingBase<S>,
-    state: &FloatingState<S>,
-    q: &[S],
-    point: &Vec3<S>,
-) -> Vec<Vec<S>> {
-    let kin = floating_base_frame(p, base, state, q);
-    let x = positions(&kin, state);
-    let last = kin.last().expect("empty arm");
-    assert!(kin.len() > FLOATING_BASE_DOF, "the arm has no joints");
-    let xe = x[kin.len() - 1].clone() + last.orientation.mul_vec(point);
-    let cols: Vec<(Vec3<S>, Vec3<S>)> = kin
-        .iter()
-        .zip(&x)
-        .map(|(k, xk)| match k.kind {
-            JointKind::Prismatic => (k.axis.clone(), Vec3::zero()),
-            JointKind::Revolute => (k.axis.cross(&(&xe - xk)), k.axis.clone()),
-        })
-        .collect();
-    (0..6)
-        .map(|row| {
-            cols.iter()
-                .map(|(v, w)| if row < 3 { v.at(row) } else { w.at(row - 3) })
-                .collect()
-        })
-        .collect()
-}
-
-/// The generalized Jacobian (Umetani–Yoshida) of a point on the last body:
-/// `J* = J_m − J_b A_bb⁻¹ A_bm` (6 × N), mapping `q̇` to the point's velocity and the last body's
-/// angular velocity (rows as in [`point_jacobian`]) when the system's momentum is zero (then the
-/// base twist is `ν_b = −A_bb⁻¹ A_bm q̇`). `A` comes from `alg`; `A_bb⁻¹` by LDLᵀ.
-pub fn generalized_jacobian<S: Scalar>(
-    method: MassMatrixMethod,
-    p: &Params<S>,
-    base: &FloatingBase<S>,
-    state: &FloatingState<S>,
-    q: &[S],
-    point: &Vec3<S>,
-) -> Vec<Vec<S>> {
-    let n = p.dof();
-    let a = mass_matrix(method, p, base, state, q);
-    let nb = FLOATING_BASE_DOF;
-    let a_bb: Vec<Vec<S>> = a[..nb].iter().map(|r| r[..nb].to_vec()).collect();
-    let f = crate::ldlt::ldlt(&a_bb);
-    // Columns of A_bb⁻¹ A_bm.
-    let sol: Vec<Vec<S>> = (0..n)
-        .map(|j| {
-            let col: Vec<S> = (0..nb).map(|i| a[i][nb + j].clone()).collect();
-            crate::ldlt::solve(&f, &col)
-        })
-        .collect();
-    let jac = point_jacobian(p, base, state, q, point);
-    jac.iter()
-        .map(|row| {
-            (0..n)
-                .map(|j| {
-                    let jb =
-                        (0..nb).fold(S::zero(), |acc, i| acc + row[i].clone() * sol[j][i].clone());
-                    row[nb + j].clone() - jb
-                })
-                .collect()
-        })
-        .collect()
 }
