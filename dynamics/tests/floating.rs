@@ -8,7 +8,9 @@
 // Matrix identities read best with explicit indices.
 #![allow(clippy::needless_range_loop)]
 
-use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
+use kanegen_dynamics::algorithms::floating::{
+    self, kinetic_energy, kinetic_energy_by_bodies, momentum, momentum_by_bodies,
+};
 use kanegen_dynamics::algorithms::frames::{floating_jacobian, generalized_jacobian};
 use kanegen_dynamics::algorithms::kinematics::{floating_base_frame, floating_motion};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
@@ -346,6 +348,20 @@ fn kinetic_energy_and_momentum_from_a() {
         let v = nu(&c.state, &c.qd);
         let t = kinetic_energy(&c.p, &c.base, &c.state, &c.q, &c.qd);
         let (lin, ang) = momentum(&c.p, &c.base, &c.state, &c.q, &c.qd);
+        // The spatial sums (any tree) against the body-by-body sums of the virtual-joint
+        // extension (chains).
+        let t_bodies = kinetic_energy_by_bodies(&c.p, &c.base, &c.state, &c.q, &c.qd);
+        let (lin_b, ang_b) = momentum_by_bodies(&c.p, &c.base, &c.state, &c.q, &c.qd);
+        assert!(
+            (t - t_bodies).abs() < 1e-12 * t,
+            "n={n}: T {t} vs {t_bodies}"
+        );
+        let pl: Vec<f64> = lin.0.iter().chain(ang.0.iter()).copied().collect();
+        let pb: Vec<f64> = lin_b.0.iter().chain(ang_b.0.iter()).copied().collect();
+        assert!(
+            rel_vec(&pl, &pb) < 1e-12,
+            "n={n}: momentum {pl:?} vs {pb:?}"
+        );
         // Momentum about the base origin, base coordinates.
         let lin_b = c.state.rotation.tr_mul_vec(&lin);
         let ang_o = &ang - &c.state.position.cross(&lin);

@@ -1,4 +1,4 @@
-//! A serial arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `A` is
+//! An arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `A` is
 //! `(6+N)×(6+N)`, `b` has `6+N` entries. The conventions are stated once, in [`crate::base`];
 //! they are repeated here for the reader.
 //!
@@ -36,8 +36,11 @@
 //! tree: Featherstone's floating-base CRBA and RNEA in body coordinates
 //! ([`crba::floating_mass_matrix`], [`rnea::floating_bias`]).
 //!
-//! Frame placements and Jacobians, and the generalized Jacobian, are in
-//! [`crate::algorithms::frames`] (any tree).
+//! Momentum and kinetic energy ([`momentum()`], [`kinetic_energy()`], re-exported from
+//! [`crate::algorithms::momentum`]) take any tree; [`momentum_by_bodies`] and
+//! [`kinetic_energy_by_bodies`] sum them body by body over the virtual-joint extension (chains
+//! only), the cross-check. Frame placements and Jacobians, and the generalized Jacobian, are in
+//! [`crate::algorithms::frames`].
 //!
 //! ```
 //! use kanegen_dynamics::algorithms::floating;
@@ -68,6 +71,8 @@ use crate::linalg::Vec3;
 use crate::loads::{ExternalWrench, Loads};
 use crate::params::Params;
 use crate::scalar::Scalar;
+
+pub use crate::algorithms::momentum::{kinetic_energy, momentum};
 
 /// The loads of the extended body list: arm wrenches shifted by 6, base wrenches on virtual
 /// body 5 (the one carrying the base's inertia), arm drives prefixed by 6 zeros.
@@ -213,12 +218,15 @@ fn bodies<'a, S: Scalar>(
     kin.iter().zip(mot).zip(x).skip(FLOATING_BASE_DOF - 1)
 }
 
-/// Total linear momentum `P` and angular momentum `L` about the inertial origin, both in inertial
-/// coordinates, summed directly over the bodies (base and arm; independent of `A`):
+/// [`momentum()`] summed directly over the bodies of the virtual-joint extension (base and arm;
+/// independent of `A` and of the spatial algorithms; serial chains only), the cross-check:
 /// `P = Σ (m_k v_k + ω_k × c_k)`, `L = Σ [x_k × (m_k v_k + ω_k × c_k) + c_k × v_k + I_k ω_k]`
 /// with `x_k` the body origin, `v_k` its velocity, `c_k` the first moment and `I_k` the inertia
-/// about `O_k`.
-pub fn momentum<S: Scalar>(
+/// about `O_k`, all in the inertial frame.
+///
+/// # Panics
+/// On a tree.
+pub fn momentum_by_bodies<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
@@ -238,9 +246,12 @@ pub fn momentum<S: Scalar>(
     (lin, ang)
 }
 
-/// Total kinetic energy of base and arm, summed directly over the bodies:
-/// `T = Σ ½ (m_k |v_k|² + 2 v_k · (ω_k × c_k) + ω_k · I_k ω_k)`.
-pub fn kinetic_energy<S: Scalar>(
+/// [`kinetic_energy()`] summed directly over the bodies of the virtual-joint extension (serial
+/// chains only), the cross-check: `T = Σ ½ (m_k |v_k|² + 2 v_k · (ω_k × c_k) + ω_k · I_k ω_k)`.
+///
+/// # Panics
+/// On a tree.
+pub fn kinetic_energy_by_bodies<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
