@@ -6,7 +6,7 @@
 //!
 //! - **Base pose**: position `p₀` of the base-frame origin in the inertial frame, and the attitude
 //!   as a unit quaternion stored `[x, y, z, w]` (Pinocchio order), i.e. the rotation `R₀` from base
-//!   to inertial coordinates ([`quat_to_matrix`]). [`FloatingState`] holds `R₀` as a matrix.
+//!   to inertial coordinates ([`quat_to_matrix`](crate::base::quat_to_matrix)). [`FloatingState`] holds `R₀` as a matrix.
 //! - **Generalized velocity** `ν = [v_b (3), ω_b (3), q̇ (N)]` (Pinocchio free-flyer): `v_b` the
 //!   linear velocity of the base-frame origin and `ω_b` the base's angular velocity, both in
 //!   **base** coordinates.
@@ -20,7 +20,7 @@
 //! - **Loads** ([`Loads`]): `gravity` is in the **inertial** frame. An [`ExternalWrench`] with
 //!   `body = j < N` acts on arm body `j` (force at `O_j`, moment about `O_j`) and with
 //!   `body =` [`BASE_BODY`] on the base body (force at the base origin); its frame
-//!   [`LoadFrame::Body`](super::LoadFrame::Body) is that body's frame and [`LoadFrame::Base`](super::LoadFrame::Base) means the **inertial**
+//!   [`LoadFrame::Body`](crate::LoadFrame::Body) is that body's frame and [`LoadFrame::Base`](crate::LoadFrame::Base) means the **inertial**
 //!   frame (which is the base frame of a fixed-base chain). `tau` has `N` entries (arm drives;
 //!   the base is not actuated).
 //!
