@@ -23,7 +23,7 @@ use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::metrics::{rel_err, rel_err_mat};
 use kanegen_dynamics::{BiasMethod, Loads, MassMatrixMethod, Methods, Params};
 use kanegen_model::io::load_model;
-use kanegen_model::{Inertial, Model};
+use kanegen_model::{BaseKind, Inertial, Model};
 use serde_json::Value;
 use std::path::PathBuf;
 
@@ -278,8 +278,15 @@ fn free_flyer_matches_pinocchio() {
             "{}: base inertial",
             r.name
         );
-        // The base actually used (a stand-in added to a massless root link).
-        let base = FloatingBase::<f64>::from_inertial(&inertial(&ff["base_inertial"]));
+        // The base actually used (a stand-in added to a massless root link), through the model.
+        let model = r
+            .model
+            .clone()
+            .with_base_inertial(inertial(&ff["base_inertial"]))
+            .and_then(|m| m.with_base_kind(BaseKind::FreeFloating))
+            .unwrap_or_else(|e| panic!("{}: {e}", r.name));
+        assert_eq!(model.base_kind(), BaseKind::FreeFloating);
+        let base = FloatingBase::<f64>::from_inertial(model.base_inertial().unwrap());
         let (mut ea, mut eb, mut ep, mut epb, mut et, mut eid, mut eother) = (
             0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64, 0.0_f64,
         );
