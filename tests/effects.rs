@@ -4,12 +4,13 @@
 //!
 //! Run with `--nocapture` to see the measured numbers.
 
-use kanegen::dynamics::algorithms::floating::{self, generalized_jacobian};
+use kanegen::dynamics::algorithms::floating;
+use kanegen::dynamics::algorithms::frames::generalized_jacobian;
 use kanegen::dynamics::algorithms::kinematics::floating_base_frame;
 use kanegen::dynamics::base::FLOATING_BASE_DOF;
 use kanegen::dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
-use kanegen::dynamics::linalg::Vec3;
-use kanegen::dynamics::Params;
+use kanegen::dynamics::linalg::{Mat3, Vec3};
+use kanegen::dynamics::{FrameParams, Params};
 use kanegen::dynamics::{Loads, Methods};
 use kanegen::model::Model;
 use kanegen::sim::integrate::{dopri5, Dopri5Options};
@@ -267,14 +268,12 @@ integrator = "dopri5"
         *omega = [nu_b[3], nu_b[4], nu_b[5]];
     }
     // Predictions: tip velocity J* q̇, base origin velocity R₀ v_b (inertial frame).
-    let js = generalized_jacobian(
-        Methods::RECURRENT.mass_matrix,
-        &p,
-        &base,
-        &st0,
-        &q,
-        &Vec3::zero(),
-    );
+    let tip_frame = FrameParams {
+        parent: Some(n - 1),
+        translation: Vec3::zero(),
+        rotation: Mat3::identity(),
+    };
+    let js = generalized_jacobian(&p, &base, &st0, &q, &tip_frame);
     let tip_rate: Vec<f64> = (0..3)
         .map(|r| (0..n).map(|j| js[r][j] * qd[j]).sum())
         .collect();

@@ -43,5 +43,5 @@ pub mod spatial;
 pub use algorithms::methods::{BiasMethod, Dynamics, MassMatrixMethod, Methods};
 pub use base::{FloatingBase, FloatingState};
 pub use loads::{ExternalWrench, LoadFrame, Loads};
-pub use params::{FrameParams, JointParams, Params};
+pub use params::{FrameParams, JointParams, MethodError, Params};
 pub use scalar::{Real, Scalar, Symbolic};

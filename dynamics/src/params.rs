@@ -92,9 +92,80 @@ impl<S> Params<S> {
     /// need.
     #[must_use]
     pub fn is_chain(&self) -> bool {
+        self.first_branch().is_none()
+    }
+
+    /// The first joint `j`, in order, whose parent is not body `j − 1` (where the tree branches:
+    /// body `λ(j)`, or the base, already has a child), or `None` for a serial chain.
+    #[must_use]
+    pub fn first_branch(&self) -> Option<usize> {
         self.joints
             .iter()
             .enumerate()
-            .all(|(j, jp)| jp.parent == j.checked_sub(1))
+            .position(|(j, jp)| jp.parent != j.checked_sub(1))
+    }
+
+    /// `Ok` on a serial chain; on a tree, the [`MethodError`] of `method` (a serial-chain-only
+    /// algorithm, named as in reports: `"recurrent"`, `"kane-direct"`, …) at the first branching
+    /// joint.
+    ///
+    /// # Errors
+    /// The model is a tree, not a chain.
+    pub fn require_chain(&self, method: &'static str) -> Result<(), MethodError> {
+        match self.first_branch() {
+            None => Ok(()),
+            Some(joint) => Err(MethodError {
+                method,
+                joint,
+                parent: self.joints[joint].parent,
+            }),
+        }
+    }
+
+    /// Panics with the message of [`Params::require_chain`] on a tree: the guard of every
+    /// serial-chain-only algorithm (a programming error once callers check with
+    /// [`crate::Methods::check`]).
+    ///
+    /// # Panics
+    /// The model is a tree.
+    #[track_caller]
+    pub fn assert_chain(&self, method: &'static str) {
+        if let Err(e) = self.require_chain(method) {
+            panic!("{e}");
+        }
     }
 }
+
+/// A serial-chain-only method (the paper's base-frame algorithms) asked to run on a kinematic
+/// tree: which method, and where the tree first branches.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct MethodError {
+    /// The method, by its report name (`"recurrent"`, `"crba-base"`, `"kane-direct"`, …).
+    pub method: &'static str,
+    /// The first joint (0-based) whose parent is not the body of the joint before it.
+    pub joint: usize,
+    /// That joint's parent body (`None`: the base).
+    pub parent: Option<usize>,
+}
+
+impl core::fmt::Display for MethodError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let parent = match self.parent {
+            Some(b) => format!("body #{b}"),
+            None => "the base".to_string(),
+        };
+        let expected = match self.joint.checked_sub(1) {
+            Some(b) => format!("body #{b}"),
+            None => "the base".to_string(),
+        };
+        write!(
+            f,
+            "method `{}` handles serial chains only, but the model is a kinematic tree: joint #{} \
+             hangs from {parent}, not from {expected}; use the local-frame methods `crba` and \
+             `rnea` (Methods::SPATIAL) for trees",
+            self.method, self.joint
+        )
+    }
+}
+
+impl std::error::Error for MethodError {}

@@ -1,7 +1,7 @@
 //! The scalar abstraction every algorithm is written against.
 //!
 //! An algorithm in [`crate::algorithms`] is written once, generic over `S: Scalar`, and runs on
-//! `f64`, `f32`, wider or exact types, and on the symbolic tracer [`crate::sym::Sym`], which
+//! `f64`, `f32`, wider or exact types, and on the symbolic tracer `Sym` of `kanegen-trace`, which
 //! records the expression graph and counts operations.
 //!
 //! The trait deliberately has **no comparison**: a traced value cannot be compared, so a fixed model

@@ -9,14 +9,15 @@
 #![allow(clippy::needless_range_loop)]
 
 use kanegen_dynamics::algorithms::floating::{
-    self, generalized_jacobian, kinetic_energy, momentum,
+    self, kinetic_energy, kinetic_energy_by_bodies, momentum, momentum_by_bodies,
 };
+use kanegen_dynamics::algorithms::frames::{floating_jacobian, generalized_jacobian};
 use kanegen_dynamics::algorithms::kinematics::{floating_base_frame, floating_motion};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::ldlt::{ldlt, solve};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
-use kanegen_dynamics::Params;
 use kanegen_dynamics::{ExternalWrench, LoadFrame, Loads, Methods};
+use kanegen_dynamics::{FrameParams, Params};
 use kanegen_model::io::load_model_with;
 use kanegen_model::random::ChainSpec;
 use kanegen_model::random::{random_chain, random_inertial, random_rotation, random_vec, rng};
@@ -347,6 +348,20 @@ fn kinetic_energy_and_momentum_from_a() {
         let v = nu(&c.state, &c.qd);
         let t = kinetic_energy(&c.p, &c.base, &c.state, &c.q, &c.qd);
         let (lin, ang) = momentum(&c.p, &c.base, &c.state, &c.q, &c.qd);
+        // The spatial sums (any tree) against the body-by-body sums of the virtual-joint
+        // extension (chains).
+        let t_bodies = kinetic_energy_by_bodies(&c.p, &c.base, &c.state, &c.q, &c.qd);
+        let (lin_b, ang_b) = momentum_by_bodies(&c.p, &c.base, &c.state, &c.q, &c.qd);
+        assert!(
+            (t - t_bodies).abs() < 1e-12 * t,
+            "n={n}: T {t} vs {t_bodies}"
+        );
+        let pl: Vec<f64> = lin.0.iter().chain(ang.0.iter()).copied().collect();
+        let pb: Vec<f64> = lin_b.0.iter().chain(ang_b.0.iter()).copied().collect();
+        assert!(
+            rel_vec(&pl, &pb) < 1e-12,
+            "n={n}: momentum {pl:?} vs {pb:?}"
+        );
         // Momentum about the base origin, base coordinates.
         let lin_b = c.state.rotation.tr_mul_vec(&lin);
         let ang_o = &ang - &c.state.position.cross(&lin);
@@ -559,14 +574,17 @@ fn generalized_jacobian_gives_the_end_effector_motion_at_zero_momentum() {
         let (kl, ml) = (kin.last().unwrap(), mot.last().unwrap());
         let ve = &ml.v + &ml.omega.cross(&kl.orientation.mul_vec(&point));
         let want: Vec<f64> = ve.0.iter().chain(ml.omega.0.iter()).copied().collect();
-        for alg in ALGS {
-            let j = generalized_jacobian(alg.mass_matrix, &c.p, &c.base, &c.state, &c.q, &point);
-            assert_eq!((j.len(), j[0].len()), (6, n));
-            let got = mat_vec(&j, &c.qd);
-            let e = rel_vec(&got, &want);
-            worst = worst.max(e);
-            assert!(e < 1e-10, "n={n} {alg}: {e:e}");
-        }
+        let frame = FrameParams {
+            parent: Some(n - 1),
+            translation: point.clone(),
+            rotation: Mat3(random_rotation(&mut r)),
+        };
+        let j = generalized_jacobian(&c.p, &c.base, &c.state, &c.q, &frame);
+        assert_eq!((j.len(), j[0].len()), (6, n));
+        let got = mat_vec(&j, &c.qd);
+        let e = rel_vec(&got, &want);
+        worst = worst.max(e);
+        assert!(e < 1e-10, "n={n}: {e:e}");
     }
     println!("J* q̇ vs end-effector motion at zero momentum: {worst:.2e}");
 }
@@ -718,14 +736,18 @@ fn floating_dynamics_traces_on_sym() {
 fn wrench_on_the_last_body_is_its_jacobian_transpose() {
     // Virtual power: a wrench (f at a point of the last body, moment m), inertial frame, adds
     // Jᵀ [f; m] to b, J the point's (6+N)-column Jacobian.
-    use kanegen_dynamics::algorithms::floating::point_jacobian;
     for n in [1, 2, 5, 9] {
         let c = random_case(n, 3000 + n as u64, 0.3, false);
         let mut r = rng(n as u64 + 11);
         let f = v3(&random_vec(&mut r, 3, 10.0));
         let m = v3(&random_vec(&mut r, 3, 10.0));
         // Force at O_last (point 0).
-        let j = point_jacobian(&c.p, &c.base, &c.state, &c.q, &Vec3::zero());
+        let origin = FrameParams {
+            parent: Some(n - 1),
+            translation: Vec3::zero(),
+            rotation: Mat3::identity(),
+        };
+        let j = floating_jacobian(&c.p, &c.state, &c.q, &origin);
         let w: Vec<f64> = f.0.iter().chain(m.0.iter()).copied().collect();
         let want: Vec<f64> = (0..6 + n)
             .map(|col| (0..6).map(|row| j[row][col] * w[row]).sum())

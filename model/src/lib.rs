@@ -8,7 +8,7 @@
 //!   [`Placement`]); built only through [`Model::new`], which validates every number.
 //! - [`io`]: URDF and kanegen's TOML format in, TOML out.
 //! - [`Inertial::merge`]: the one parallel-axis merge (fixed links, locked joints, payloads).
-//! - [`random`]: seeded random chains and states for tests, benchmarks and traces.
+//! - [`random`]: seeded random chains, trees and states for tests, benchmarks and traces.
 //!
 //! ```
 //! let model = kanegen_model::io::parse_toml(r#"

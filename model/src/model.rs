@@ -261,6 +261,24 @@ impl Model {
         Ok(self)
     }
 
+    /// The model with these base mass properties (replacing any it had), e.g. a stand-in for a
+    /// URDF whose root link is massless, before [`Model::with_base_kind`] makes the base
+    /// free-floating.
+    ///
+    /// # Errors
+    /// The inertial fails the strict checks of [`crate::validate_inertial`] (finite, mass > 0,
+    /// inertia symmetric, positive definite, triangle inequality).
+    pub fn with_base_inertial(mut self, inertial: Inertial) -> Result<Self, ModelError> {
+        validate_inertial_with(
+            &self.base,
+            "base.inertial",
+            &inertial,
+            Validation::default(),
+        )?;
+        self.base_inertial = Some(inertial);
+        Ok(self)
+    }
+
     /// The model on a base of this kind.
     ///
     /// # Errors

@@ -1,10 +1,12 @@
-//! Random valid chains and states, for tests, benchmarks and op-count traces with general
+//! Random valid chains, trees and states, for tests, benchmarks and op-count traces with general
 //! geometry. Deterministic for a given seed (ChaCha8).
 //!
 //! ```
 //! use kanegen_model::random::{random_chain, ChainSpec};
 //! let chain = random_chain(&ChainSpec { n: 5, prismatic_fraction: 0.3, ..Default::default() }, 7);
 //! assert_eq!(chain.dof(), 5);
+//! let tree = kanegen_model::random::random_tree(&ChainSpec { n: 6, ..Default::default() }, 3);
+//! assert!(tree.joints().iter().enumerate().all(|(j, jt)| jt.parent.map_or(true, |p| p < j)));
 //! ```
 
 use crate::placement::{axis_rotation, mat_mul, transpose};
@@ -84,33 +86,59 @@ pub fn random_inertial(rng: &mut ChaCha8Rng, mass: f64, length: f64) -> Inertial
     }
 }
 
+/// One random joint `j` with the given parent: kind, placement, axis and inertial.
+fn random_joint(rng: &mut ChaCha8Rng, spec: &ChainSpec, j: usize, parent: Option<usize>) -> Joint {
+    let kind = if rng.random_bool(spec.prismatic_fraction.clamp(0.0, 1.0)) {
+        JointKind::Prismatic
+    } else {
+        JointKind::Revolute
+    };
+    Joint {
+        name: format!("j{}", j + 1),
+        kind,
+        parent,
+        origin: Placement {
+            translation: std::array::from_fn(|_| spec.length * rng.random_range(-1.0..1.0)),
+            rotation: random_rotation(rng),
+        },
+        axis: unit(rng),
+        body: format!("b{}", j + 1),
+        inertial: random_inertial(rng, spec.mass, spec.length),
+    }
+}
+
 /// A random valid serial chain with general geometry: random joint placements and rotations,
 /// random axes, random inertials.
 pub fn random_chain(spec: &ChainSpec, seed: u64) -> Model {
     let mut rng = rng(seed);
     let joints = (0..spec.n)
-        .map(|j| {
-            let kind = if rng.random_bool(spec.prismatic_fraction.clamp(0.0, 1.0)) {
-                JointKind::Prismatic
-            } else {
-                JointKind::Revolute
-            };
-            Joint {
-                name: format!("j{}", j + 1),
-                kind,
-                parent: j.checked_sub(1),
-                origin: Placement {
-                    translation: std::array::from_fn(|_| spec.length * rng.random_range(-1.0..1.0)),
-                    rotation: random_rotation(&mut rng),
-                },
-                axis: unit(&mut rng),
-                body: format!("b{}", j + 1),
-                inertial: random_inertial(&mut rng, spec.mass, spec.length),
-            }
-        })
+        .map(|j| random_joint(&mut rng, spec, j, j.checked_sub(1)))
         .collect();
     Model::new(format!("random_n{}_s{seed}", spec.n), "base", None, joints)
         .expect("random chains are valid by construction")
+}
+
+/// A random valid kinematic tree with the geometry of [`random_chain`]: joint `j > 0` hangs
+/// from a parent drawn uniformly from the base and bodies `0..j` (so `λ(j) < j`), joint 0 from
+/// the base; revolute or prismatic by `spec.prismatic_fraction`. With `n ≥ 3` most seeds branch
+/// ([`Model::first_branch`]); a seed may still give a chain.
+pub fn random_tree(spec: &ChainSpec, seed: u64) -> Model {
+    let mut rng = rng(seed);
+    let joints = (0..spec.n)
+        .map(|j| {
+            // j + 1 choices: the base (drawn as j) or one of the bodies 0..j.
+            let pick = rng.random_range(0..=j);
+            let parent = (pick < j).then_some(pick);
+            random_joint(&mut rng, spec, j, parent)
+        })
+        .collect();
+    Model::new(
+        format!("random_tree_n{}_s{seed}", spec.n),
+        "base",
+        None,
+        joints,
+    )
+    .expect("random trees are valid by construction")
 }
 
 /// A random vector of length `n` with entries in `(-scale, scale)`.

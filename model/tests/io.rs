@@ -927,3 +927,45 @@ fn to_toml_round_trips_random_chains_exactly() {
         ssrms
     );
 }
+
+#[test]
+fn to_toml_round_trips_random_trees_exactly() {
+    use kanegen_model::random::{random_tree, ChainSpec};
+    for seed in 0..20 {
+        let spec = ChainSpec {
+            n: 1 + seed as usize % 9,
+            prismatic_fraction: 0.3,
+            ..Default::default()
+        };
+        let tree = random_tree(&spec, seed);
+        let text = kanegen_model::io::to_toml(&tree);
+        let back = kanegen_model::io::parse_toml(&text).unwrap_or_else(|e| panic!("{e}\n{text}"));
+        assert_eq!(back, tree, "seed {seed}");
+    }
+}
+
+#[test]
+fn with_base_inertial_sets_validated_base_mass_properties() {
+    use kanegen_model::random::{random_chain, ChainSpec};
+    use kanegen_model::{BaseKind, Inertial};
+    let chain = random_chain(&ChainSpec::default(), 3);
+    assert!(chain.base_inertial().is_none());
+    assert!(chain
+        .clone()
+        .with_base_kind(BaseKind::FreeFloating)
+        .is_err());
+    let bus = Inertial {
+        mass: 10.0,
+        com: [0.0; 3],
+        inertia: [[0.1, 0.0, 0.0], [0.0, 0.1, 0.0], [0.0, 0.0, 0.1]],
+    };
+    let m = chain
+        .clone()
+        .with_base_inertial(bus.clone())
+        .and_then(|m| m.with_base_kind(BaseKind::FreeFloating))
+        .unwrap();
+    assert_eq!(m.base_inertial(), Some(&bus));
+    let bad = Inertial { mass: -1.0, ..bus };
+    let e = chain.with_base_inertial(bad).unwrap_err().to_string();
+    assert!(e.contains("base.inertial") && e.contains("mass"), "{e}");
+}

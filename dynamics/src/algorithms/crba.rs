@@ -3,8 +3,11 @@
 //! does not use `kinematics.rs`), and the fixed- and floating-base mass matrix of choice for
 //! generated code.
 //!
-//! Composite inertias `IC` in a backward loop, then `H_ij = S_iᵀ F` with `F = IC_i S_i` carried
-//! to the ancestors by `Xupᵀ`. Spatial algebra and conventions: [`crate::spatial`].
+//! Any kinematic tree (`λ(i)` = [`crate::JointParams::parent`]): composite inertias `IC` in a
+//! backward loop carried to `λ(i)`, then `H_ij = S_jᵀ F` with `F = IC_i S_i` carried up the
+//! ancestors `j` of `i` by `Xupᵀ`; entries of joints on different branches stay zero. On a serial
+//! chain (`λ(i) = i − 1`) the operations are exactly those of the chain algorithm. Spatial algebra
+//! and conventions: [`crate::spatial`].
 //!
 //! ```
 //! use kanegen_dynamics::algorithms::crba;
@@ -29,14 +32,16 @@ fn transforms<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Xform<S>> {
 }
 
 /// Composite inertias `IC_i` of the subtrees (RBDA Table 6.2 backward loop):
-/// `IC_i = I_i`, then `IC_λ(i) += Xup_iᵀ IC_i Xup_i`.
+/// `IC_i = I_i`, then, for `i = N−1 … 0` with a parent body, `IC_λ(i) += Xup_iᵀ IC_i Xup_i`.
+/// The subtrees hanging from the base are left to the caller.
 fn composite<S: Scalar>(p: &Params<S>, xup: &[Xform<S>]) -> Vec<RbInertia<S>> {
-    let n = p.dof();
     let mut ic: Vec<RbInertia<S>> = p.joints.iter().map(RbInertia::mci).collect();
-    for i in (1..n).rev() {
-        let carried = xup[i].tr_inertia(&ic[i]);
-        let parent = ic[i - 1].clone();
-        ic[i - 1] = parent + carried;
+    for (i, jp) in p.joints.iter().enumerate().rev() {
+        if let Some(lambda) = jp.parent {
+            let carried = xup[i].tr_inertia(&ic[i]);
+            let parent = ic[lambda].clone();
+            ic[lambda] = parent + carried;
+        }
     }
     ic
 }
@@ -50,15 +55,16 @@ pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
     S::section("spatial:crba");
     let xup = transforms(p, q);
     let ic = composite(p, &xup);
-    // Fill loop: F = IC_i S_i, H_ii = S_iᵀ F; up the chain F = Xup_jᵀ F, H_ij = S_jᵀ F.
+    // Fill loop: F = IC_i S_i, H_ii = S_iᵀ F; over the ancestors j = λ(i), λ(λ(i)), …:
+    // F = Xup_jᵀ F (carried from the child to j), H_ij = H_ji = S_jᵀ F.
     let mut h = vec![vec![S::zero(); n]; n];
     for i in 0..n {
         let mut f = inertia_s(&ic[i], &p.joints[i]);
         h[i][i] = s_tr(&p.joints[i], &f);
         let mut j = i;
-        while j > 0 {
+        while let Some(lambda) = p.joints[j].parent {
             f = xup[j].tr_apply(&f);
-            j -= 1;
+            j = lambda;
             let hij = s_tr(&p.joints[j], &f);
             h[j][i] = hij.clone();
             h[i][j] = hij;
@@ -74,9 +80,9 @@ pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
 ///
 /// The base is body 0 with a 6-dof joint whose motion subspace is `1₆` in base coordinates, so
 /// the base speeds of `ν = [v_b; ω_b; q̇]` are the base joint's speeds reordered. The base block
-/// is the composite inertia of the whole tree `IC_0 = I_base + Xup_0ᵀ IC_arm,0 Xup_0` applied to
-/// unit motions; the arm columns `F = IC_i S_i` are carried down to the base, `A_bi = F` (rows
-/// `[f; n]`). `A` does not depend on the base pose. Section `"spatial:floating"`.
+/// is the composite inertia of the whole tree `IC_0 = I_base + Σ_{λ(i) = base} Xup_iᵀ IC_i Xup_i`
+/// applied to unit motions; the arm columns `F = IC_i S_i` are carried down the ancestors to the
+/// base, `A_bi = F` (rows `[f; n]`). Any kinematic tree. `A` does not depend on the base pose. Section `"spatial:floating"`.
 pub fn floating_mass_matrix<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
@@ -88,11 +94,13 @@ pub fn floating_mass_matrix<S: Scalar>(
     let xup = transforms(p, q);
     let i_base = RbInertia::from_com(&base.mass, &base.com, &base.inertia_com);
     let ic = composite(p, &xup);
-    let ic0 = if n > 0 {
-        i_base + xup[0].tr_inertia(&ic[0])
-    } else {
-        i_base
-    };
+    // IC_0 = I_base + Σ over the joints on the base Xup_iᵀ IC_i Xup_i.
+    let mut ic0 = i_base;
+    for (i, jp) in p.joints.iter().enumerate() {
+        if jp.parent.is_none() {
+            ic0 = ic0 + xup[i].tr_inertia(&ic[i]);
+        }
+    }
     let mut a = vec![vec![S::zero(); nb + n]; nb + n];
     // Base block: column m of ν_b is the unit motion [0; e_m] (m < 3) or [e_{m−3}; 0].
     let unit = |m: usize| {
@@ -122,13 +130,14 @@ pub fn floating_mass_matrix<S: Scalar>(
     for i in 0..n {
         let mut f = inertia_s(&ic[i], &p.joints[i]);
         a[nb + i][nb + i] = s_tr(&p.joints[i], &f);
+        // Over the ancestors as in `mass_matrix`, then from the subtree's root onto the base.
         let mut j = i;
         loop {
             f = xup[j].tr_apply(&f);
-            if j == 0 {
+            let Some(lambda) = p.joints[j].parent else {
                 break;
-            }
-            j -= 1;
+            };
+            j = lambda;
             let hij = s_tr(&p.joints[j], &f);
             a[nb + j][nb + i] = hij.clone();
             a[nb + i][nb + j] = hij;

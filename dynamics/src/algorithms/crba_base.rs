@@ -82,14 +82,22 @@ pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
 
 /// The generalized inertia matrix `A(q)`: base-frame kinematics (1), (2), (6) then
 /// [`mass_matrix_base`].
+///
+/// # Panics
+/// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
+    p.assert_chain("crba-base");
     mass_matrix_base(&base_frame(p, q))
 }
 
 /// The generalized forces `b(q, q̇) = Q − h`: the same base-frame computation as the recurrent
 /// algorithm — kinematics (1)–(7), resultants (11) and the force recursion (17)–(21) of
 /// [`recurrent::bias_base`] (a CRBA computes only `A`; `b` comes from an inverse-dynamics pass).
+///
+/// # Panics
+/// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    p.assert_chain("crba-base");
     let kin = base_frame(p, q);
     let mot = motion(&kin, qd);
     let f_ie = inertial_external(&kin, &mot, loads);

@@ -1,4 +1,4 @@
-//! A serial arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `A` is
+//! An arm on a free-floating base (spacecraft): `6 + N` generalized speeds, `A` is
 //! `(6+N)×(6+N)`, `b` has `6+N` entries. The conventions are stated once, in [`crate::base`];
 //! they are repeated here for the reader.
 //!
@@ -6,7 +6,7 @@
 //!
 //! - **Base pose**: position `p₀` of the base-frame origin in the inertial frame, and the attitude
 //!   as a unit quaternion stored `[x, y, z, w]` (Pinocchio order), i.e. the rotation `R₀` from base
-//!   to inertial coordinates ([`quat_to_matrix`]). [`FloatingState`] holds `R₀` as a matrix.
+//!   to inertial coordinates ([`quat_to_matrix`](crate::base::quat_to_matrix)). [`FloatingState`] holds `R₀` as a matrix.
 //! - **Generalized velocity** `ν = [v_b (3), ω_b (3), q̇ (N)]` (Pinocchio free-flyer): `v_b` the
 //!   linear velocity of the base-frame origin and `ω_b` the base's angular velocity, both in
 //!   **base** coordinates.
@@ -20,7 +20,7 @@
 //! - **Loads** ([`Loads`]): `gravity` is in the **inertial** frame. An [`ExternalWrench`] with
 //!   `body = j < N` acts on arm body `j` (force at `O_j`, moment about `O_j`) and with
 //!   `body =` [`BASE_BODY`] on the base body (force at the base origin); its frame
-//!   [`LoadFrame::Body`](super::LoadFrame::Body) is that body's frame and [`LoadFrame::Base`](super::LoadFrame::Base) means the **inertial**
+//!   [`LoadFrame::Body`](crate::LoadFrame::Body) is that body's frame and [`LoadFrame::Base`](crate::LoadFrame::Base) means the **inertial**
 //!   frame (which is the base frame of a fixed-base chain). `tau` has `N` entries (arm drives;
 //!   the base is not actuated).
 //!
@@ -31,8 +31,16 @@
 //! virtual joints (3 prismatic, then 3 revolute, axes `R₀e_m` through `p₀`) whose partial
 //! velocities are exactly those of `ν_b`, everything in the inertial frame. The velocity-product
 //! recursion starts from the base body's true motion ([`kinematics::floating_base_motion`]).
-//! `spatial` is an independent implementation (Featherstone's floating-base CRBA + RNEA in body
-//! coordinates, [`spatial::dynamics`]).
+//! This extension is **serial-chain only**, like the base-frame algorithms (it panics on a tree).
+//! `spatial` ([`Methods::SPATIAL`]) is an independent implementation that takes any kinematic
+//! tree: Featherstone's floating-base CRBA and RNEA in body coordinates
+//! ([`crba::floating_mass_matrix`], [`rnea::floating_bias`]).
+//!
+//! Momentum and kinetic energy ([`momentum()`], [`kinetic_energy()`], re-exported from
+//! [`crate::algorithms::momentum`]) take any tree; [`momentum_by_bodies`] and
+//! [`kinetic_energy_by_bodies`] sum them body by body over the virtual-joint extension (chains
+//! only), the cross-check. Frame placements and Jacobians, and the generalized Jacobian, are in
+//! [`crate::algorithms::frames`].
 //!
 //! ```
 //! use kanegen_dynamics::algorithms::floating;
@@ -63,7 +71,8 @@ use crate::linalg::Vec3;
 use crate::loads::{ExternalWrench, Loads};
 use crate::params::Params;
 use crate::scalar::Scalar;
-use kanegen_model::JointKind;
+
+pub use crate::algorithms::momentum::{kinetic_energy, momentum};
 
 /// The loads of the extended body list: arm wrenches shifted by 6, base wrenches on virtual
 /// body 5 (the one carrying the base's inertia), arm drives prefixed by 6 zeros.
@@ -95,9 +104,13 @@ fn extended_loads<S: Scalar>(loads: &Loads<S>, n: usize) -> Loads<S> {
 }
 
 /// `A` (`(6+N)×(6+N)`) of the arm `p` on the free-floating base `base` at arm positions `q`.
-/// The base-frame methods run on the virtual-joint extension of [`floating_base_frame`];
-/// [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`]. `A` does not depend on the
-/// base pose; `state` is the pose the base-frame methods express their quantities in.
+/// The base-frame methods run on the virtual-joint extension of [`floating_base_frame`] (serial
+/// chains only); [`MassMatrixMethod::Crba`] runs [`crba::floating_mass_matrix`] (any tree). `A`
+/// does not depend on the base pose; `state` is the pose the base-frame methods express their
+/// quantities in.
+///
+/// # Panics
+/// A serial-chain-only method on a tree ([`MassMatrixMethod::check`]).
 pub fn mass_matrix<S: Scalar>(
     method: MassMatrixMethod,
     p: &Params<S>,
@@ -107,14 +120,22 @@ pub fn mass_matrix<S: Scalar>(
 ) -> Vec<Vec<S>> {
     match method {
         MassMatrixMethod::Crba => crba::floating_mass_matrix(p, base, q),
-        base_frame => base_frame
-            .from_base_frame(&floating_base_frame(p, base, state, q))
-            .expect("every method but the CRBA starts from base-frame quantities"),
+        base_frame => {
+            p.assert_chain(base_frame.name());
+            base_frame
+                .from_base_frame(&floating_base_frame(p, base, state, q))
+                .expect("every method but the CRBA starts from base-frame quantities")
+        }
     }
 }
 
 /// `b` (`6+N` entries) of `A ν̇ = b` for the arm `p` on the free-floating base `base` in the state
 /// `state`, with arm rates `qd` and `loads` (conventions of [`crate::base`]).
+/// [`BiasMethod::Rnea`] runs [`rnea::floating_bias`] (any tree), the base-frame methods the
+/// virtual-joint extension (serial chains only).
+///
+/// # Panics
+/// A serial-chain-only method on a tree ([`BiasMethod::check`]).
 pub fn bias<S: Scalar>(
     method: BiasMethod,
     p: &Params<S>,
@@ -129,6 +150,7 @@ pub fn bias<S: Scalar>(
     if method == BiasMethod::Rnea {
         return rnea::floating_bias(p, base, state, q, qd, loads);
     }
+    p.assert_chain(method.name());
     let kin = floating_base_frame(p, base, state, q);
     let mot = floating_motion(&kin, state, qd);
     let ext = extended_loads(loads, n);
@@ -141,7 +163,8 @@ pub fn bias<S: Scalar>(
     }
 }
 
-/// `A` and `b` of the free-floating system ([`mass_matrix`], [`bias`]).
+/// `A` and `b` of the free-floating system ([`mass_matrix`], [`bias`]); any tree with
+/// [`Methods::SPATIAL`].
 pub fn dynamics<S: Scalar>(
     methods: Methods,
     p: &Params<S>,
@@ -195,12 +218,15 @@ fn bodies<'a, S: Scalar>(
     kin.iter().zip(mot).zip(x).skip(FLOATING_BASE_DOF - 1)
 }
 
-/// Total linear momentum `P` and angular momentum `L` about the inertial origin, both in inertial
-/// coordinates, summed directly over the bodies (base and arm; independent of `A`):
+/// [`momentum()`] summed directly over the bodies of the virtual-joint extension (base and arm;
+/// independent of `A` and of the spatial algorithms; serial chains only), the cross-check:
 /// `P = Σ (m_k v_k + ω_k × c_k)`, `L = Σ [x_k × (m_k v_k + ω_k × c_k) + c_k × v_k + I_k ω_k]`
 /// with `x_k` the body origin, `v_k` its velocity, `c_k` the first moment and `I_k` the inertia
-/// about `O_k`.
-pub fn momentum<S: Scalar>(
+/// about `O_k`, all in the inertial frame.
+///
+/// # Panics
+/// On a tree.
+pub fn momentum_by_bodies<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
@@ -220,9 +246,12 @@ pub fn momentum<S: Scalar>(
     (lin, ang)
 }
 
-/// Total kinetic energy of base and arm, summed directly over the bodies:
-/// `T = Σ ½ (m_k |v_k|² + 2 v_k · (ω_k × c_k) + ω_k · I_k ω_k)`.
-pub fn kinetic_energy<S: Scalar>(
+/// [`kinetic_energy()`] summed directly over the bodies of the virtual-joint extension (serial
+/// chains only), the cross-check: `T = Σ ½ (m_k |v_k|² + 2 v_k · (ω_k × c_k) + ω_k · I_k ω_k)`.
+///
+/// # Panics
+/// On a tree.
+pub fn kinetic_energy_by_bodies<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
     state: &FloatingState<S>,
@@ -241,74 +270,4 @@ pub fn kinetic_energy<S: Scalar>(
             + m.omega.dot(&k.inertia.mul_vec(&m.omega));
     }
     t * S::constant(0.5)
-}
-
-/// The Jacobian of a point on the last arm body: rows `[v (3); ω (3)]` (the point's velocity and
-/// the body's angular velocity, inertial coordinates), columns the `6 + N` speeds `ν`. `point`
-/// is in the last body's frame. Panics if the arm has no joints.
-pub fn point_jacobian<S: Scalar>(
-    p: &Params<S>,
-    base: &FloatingBase<S>,
-    state: &FloatingState<S>,
-    q: &[S],
-    point: &Vec3<S>,
-) -> Vec<Vec<S>> {
-    let kin = floating_base_frame(p, base, state, q);
-    let x = positions(&kin, state);
-    let last = kin.last().expect("empty arm");
-    assert!(kin.len() > FLOATING_BASE_DOF, "the arm has no joints");
-    let xe = x[kin.len() - 1].clone() + last.orientation.mul_vec(point);
-    let cols: Vec<(Vec3<S>, Vec3<S>)> = kin
-        .iter()
-        .zip(&x)
-        .map(|(k, xk)| match k.kind {
-            JointKind::Prismatic => (k.axis.clone(), Vec3::zero()),
-            JointKind::Revolute => (k.axis.cross(&(&xe - xk)), k.axis.clone()),
-        })
-        .collect();
-    (0..6)
-        .map(|row| {
-            cols.iter()
-                .map(|(v, w)| if row < 3 { v.at(row) } else { w.at(row - 3) })
-                .collect()
-        })
-        .collect()
-}
-
-/// The generalized Jacobian (Umetani–Yoshida) of a point on the last body:
-/// `J* = J_m − J_b A_bb⁻¹ A_bm` (6 × N), mapping `q̇` to the point's velocity and the last body's
-/// angular velocity (rows as in [`point_jacobian`]) when the system's momentum is zero (then the
-/// base twist is `ν_b = −A_bb⁻¹ A_bm q̇`). `A` comes from `alg`; `A_bb⁻¹` by LDLᵀ.
-pub fn generalized_jacobian<S: Scalar>(
-    method: MassMatrixMethod,
-    p: &Params<S>,
-    base: &FloatingBase<S>,
-    state: &FloatingState<S>,
-    q: &[S],
-    point: &Vec3<S>,
-) -> Vec<Vec<S>> {
-    let n = p.dof();
-    let a = mass_matrix(method, p, base, state, q);
-    let nb = FLOATING_BASE_DOF;
-    let a_bb: Vec<Vec<S>> = a[..nb].iter().map(|r| r[..nb].to_vec()).collect();
-    let f = crate::ldlt::ldlt(&a_bb);
-    // Columns of A_bb⁻¹ A_bm.
-    let sol: Vec<Vec<S>> = (0..n)
-        .map(|j| {
-            let col: Vec<S> = (0..nb).map(|i| a[i][nb + j].clone()).collect();
-            crate::ldlt::solve(&f, &col)
-        })
-        .collect();
-    let jac = point_jacobian(p, base, state, q, point);
-    jac.iter()
-        .map(|row| {
-            (0..n)
-                .map(|j| {
-                    let jb =
-                        (0..nb).fold(S::zero(), |acc, i| acc + row[i].clone() * sol[j][i].clone());
-                    row[nb + j].clone() - jb
-                })
-                .collect()
-        })
-        .collect()
 }

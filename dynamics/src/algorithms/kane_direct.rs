@@ -122,14 +122,22 @@ pub fn mass_matrix_base<S: Scalar>(kin: &[BodyKinematics<S>]) -> Vec<Vec<S>> {
 }
 
 /// The generalized inertia matrix `A(q)` by the direct sum (9).
+///
+/// # Panics
+/// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
+    p.assert_chain("kane-direct");
     mass_matrix_base(&kinematics::base_frame(p, q))
 }
 
 /// The generalized forces `b(q, q̇, loads) = Q − h` by the direct sum (10), with the resultants
 /// (11) (gravity at each centre of mass, external wrenches at `O_j` in the body or base frame) and
 /// the joint drives `loads.tau` (added when present). Section `"(10)"`.
+///
+/// # Panics
+/// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    p.assert_chain("kane-direct");
     let n = p.dof();
     if let Some(tau) = &loads.tau {
         assert_eq!(tau.len(), n, "loads.tau has the wrong length");

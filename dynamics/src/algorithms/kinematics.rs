@@ -1,8 +1,10 @@
 //! Base-frame kinematics of the paper, eq. (1)–(7) and the resultants (11).
 //!
-//! Shared by the base-frame algorithms (`recurrent`, `kane-direct`, `crba-base`). Indices here are
-//! 0-based: body `j` is moved by joint `j`, its predecessor is `j − 1` and "body −1" is the base,
-//! whose frame is the inertial frame (fixed base: zero velocity and acceleration).
+//! Shared by the base-frame algorithms (`recurrent`, `kane-direct`, `crba-base`), which are
+//! **serial-chain only**: [`base_frame`] and [`floating_base_frame`] panic on a kinematic tree
+//! ([`Params::assert_chain`]). Indices here are 0-based: body `j` is moved by joint `j`, its
+//! predecessor is `j − 1` and "body −1" is the base, whose frame is the inertial frame (fixed
+//! base: zero velocity and acceleration).
 //!
 //! | paper | here |
 //! |---|---|
@@ -82,6 +84,7 @@ pub fn base_frame_from<S: Scalar>(
     q: &[S],
     tau_base: Option<&Mat3<S>>,
 ) -> Vec<BodyKinematics<S>> {
+    p.assert_chain("base-frame kinematics (1)-(7)");
     assert_eq!(q.len(), p.dof(), "q has the wrong length");
     let mut out: Vec<BodyKinematics<S>> = Vec::with_capacity(p.dof());
     let mut tau_prev = tau_base.cloned().unwrap_or_else(Mat3::identity);

@@ -16,10 +16,26 @@
 //! | `rnea` | `rnea.rs` | Featherstone's recursive Newton–Euler algorithm in local frames |
 //!
 //! The CLI's `--algorithm` names are presets of both ([`Methods::PRESETS`]).
+//!
+//! **Trees.** Only the local-frame methods (`crba`, `rnea`, i.e. [`Methods::SPATIAL`]) take a
+//! kinematic tree; the paper's base-frame methods are serial-chain only
+//! ([`MassMatrixMethod::supports_trees`], [`BiasMethod::supports_trees`]). [`Methods::check`]
+//! tells a caller before it runs them; the methods themselves panic with the same message.
+//!
+//! ```
+//! use kanegen_dynamics::{Methods, Params};
+//! use kanegen_model::random::{random_tree, ChainSpec};
+//! let tree = random_tree(&ChainSpec { n: 5, ..Default::default() }, 4);
+//! let p = Params::<f64>::new(&tree);
+//! assert!(Methods::SPATIAL.check(&p).is_ok());
+//! let e = Methods::RECURRENT.check(&p).unwrap_err();
+//! assert!(e.to_string().contains("`recurrent` handles serial chains only"));
+//! ```
 
 use crate::algorithms::kinematics::{self, BodyKinematics};
 use crate::algorithms::{crba, crba_base, kane_direct, recurrent, rnea};
 use crate::loads::Loads;
+pub use crate::params::MethodError;
 use crate::params::Params;
 use crate::scalar::Scalar;
 
@@ -76,6 +92,27 @@ impl MassMatrixMethod {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
+    /// Whether the method takes a kinematic tree: only the local-frame [`MassMatrixMethod::Crba`];
+    /// the paper's base-frame methods are serial-chain only.
+    #[must_use]
+    pub fn supports_trees(self) -> bool {
+        self == MassMatrixMethod::Crba
+    }
+
+    /// `Ok` when the method can run on `p` (any model for a tree-capable method, a serial chain
+    /// otherwise).
+    ///
+    /// # Errors
+    /// A serial-chain-only method on a tree: the error names the method and the first branching
+    /// joint.
+    pub fn check<S>(self, p: &Params<S>) -> Result<(), MethodError> {
+        if self.supports_trees() {
+            Ok(())
+        } else {
+            p.require_chain(self.name())
+        }
+    }
+
     /// `A` from the base-frame quantities of eq. (1), (2), (6) (fixed base, or the free-floating
     /// base's virtual-joint extension); `None` for [`MassMatrixMethod::Crba`], which works in
     /// local frames from `q`.
@@ -94,12 +131,18 @@ impl MassMatrixMethod {
     }
 
     /// The generalized inertia matrix `A(q)`, fixed base.
+    ///
+    /// # Panics
+    /// A serial-chain-only method on a tree ([`MassMatrixMethod::check`]).
     pub fn mass_matrix<S: Scalar>(self, p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
         match self {
             MassMatrixMethod::Crba => crba::mass_matrix(p, q),
-            base_frame => base_frame
-                .from_base_frame(&kinematics::base_frame(p, q))
-                .expect("every method but the CRBA starts from base-frame quantities"),
+            base_frame => {
+                p.assert_chain(base_frame.name());
+                base_frame
+                    .from_base_frame(&kinematics::base_frame(p, q))
+                    .expect("every method but the CRBA starts from base-frame quantities")
+            }
         }
     }
 }
@@ -140,7 +183,29 @@ impl BiasMethod {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
+    /// Whether the method takes a kinematic tree: only the local-frame [`BiasMethod::Rnea`]; the
+    /// paper's base-frame methods are serial-chain only.
+    #[must_use]
+    pub fn supports_trees(self) -> bool {
+        self == BiasMethod::Rnea
+    }
+
+    /// `Ok` when the method can run on `p` ([`MassMatrixMethod::check`]).
+    ///
+    /// # Errors
+    /// A serial-chain-only method on a tree.
+    pub fn check<S>(self, p: &Params<S>) -> Result<(), MethodError> {
+        if self.supports_trees() {
+            Ok(())
+        } else {
+            p.require_chain(self.name())
+        }
+    }
+
     /// The generalized forces `b(q, q̇, loads) = Q − h`, fixed base.
+    ///
+    /// # Panics
+    /// A serial-chain-only method on a tree ([`BiasMethod::check`]).
     pub fn bias<S: Scalar>(self, p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
         match self {
             BiasMethod::Recurrent => recurrent::bias(p, q, qd, loads),
@@ -211,6 +276,22 @@ impl Methods {
             .iter()
             .find(|(n, _)| *n == name)
             .map(|(_, m)| *m)
+    }
+
+    /// Whether both methods take a kinematic tree (of the presets, [`Methods::SPATIAL`] only).
+    #[must_use]
+    pub fn supports_trees(self) -> bool {
+        self.mass_matrix.supports_trees() && self.bias.supports_trees()
+    }
+
+    /// `Ok` when both methods can run on `p`: call it before running a model that may be a tree.
+    ///
+    /// # Errors
+    /// The first serial-chain-only method (mass matrix, then bias) on a tree; the message names
+    /// it and the first branching joint.
+    pub fn check<S>(self, p: &Params<S>) -> Result<(), MethodError> {
+        self.mass_matrix.check(p)?;
+        self.bias.check(p)
     }
 
     /// The preset's name, or `mass+bias` for a combination that is no preset.

@@ -358,14 +358,25 @@ fn mass_matrix_form<S: Scalar>(kin: &[BodyKinematics<S>], variant: Form) -> Vec<
 
 /// The generalized inertia matrix `A(q)` of the paper's recurrent algorithm: base-frame
 /// kinematics (1), (2), (6) ([`base_frame`]) then [`mass_matrix_base`].
+///
+/// # Panics
+/// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S], variant: Variant) -> Vec<Vec<S>> {
+    p.assert_chain(match variant {
+        Variant::R2 => "recurrent",
+        Variant::R1 => "recurrent-r1",
+    });
     let kin = base_frame(p, q);
     mass_matrix_base(&kin, variant)
 }
 
 /// The generalized forces `b(q, q̇) = Q − h` of `A q̈ = b` (eq. (8)): kinematics (1)–(7),
 /// resultants (11), then [`bias_base`] with the joint drives `loads.tau` when given.
+///
+/// # Panics
+/// On a kinematic tree (serial chains only; [`Params::assert_chain`]).
 pub fn bias<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    p.assert_chain("recurrent");
     let kin = base_frame(p, q);
     let mot = motion(&kin, qd);
     let f_ie = inertial_external(&kin, &mot, loads);
