@@ -21,20 +21,9 @@ fn generated_files_are_up_to_date() {
         let have = std::fs::read_to_string(root().join(g.file)).unwrap();
         assert!(
             have == want,
-            "{} is stale: regenerate with `kanegen generate {} --name {}{}{}{} -o {}`",
+            "{} is stale: regenerate with `{}`",
             g.file,
-            g.model,
-            g.type_name,
-            g.lock
-                .map(|(i, v)| format!(" --lock {i}={v}"))
-                .unwrap_or_default(),
-            if g.float == kanegen::codegen::Float::F32 {
-                " --scalar f32"
-            } else {
-                ""
-            },
-            if g.fma { " --fma" } else { "" },
-            g.file
+            g.command()
         );
     }
 }

@@ -2,7 +2,8 @@
 //! root) on real URDFs of example-robot-data (`tests/data/erd/*.reference.json`, made by
 //! `tools/reference/pinocchio_reference.py`): the `(6+N)×(6+N)` mass matrix, the nonlinear
 //! effects and the total momentum, at ten random base states and joint states each, to 1e-9
-//! relative. The base is the URDF's root link with every link fixed to it (these models need no
+//! relative — on the TALOS arm (a chain), Panda (a tree: two finger joints on the hand) and
+//! B1 + Z1 (a quadruped carrying an arm: a 19-joint tree). The base is the URDF's root link with every link fixed to it (these models need no
 //! stand-in base inertial). Joint order: Pinocchio's (`"joints"`), permuted by name to the
 //! order of `JOINTS`.
 
@@ -15,6 +16,8 @@ kanegen::dynamics!(
     "tests/data/erd/talos_left_arm.urdf",
     base = "free-floating"
 );
+kanegen::dynamics!(Panda, "tests/data/erd/panda.urdf", base = "free-floating");
+kanegen::dynamics!(B1Z1, "tests/data/erd/b1-z1.urdf", base = "free-floating");
 
 fn reference(name: &str) -> Value {
     let p =
@@ -116,4 +119,6 @@ macro_rules! check_model {
 #[test]
 fn generated_free_floating_dynamics_equal_pinocchio_free_flyer() {
     check_model!(TalosArm, "talos_left_arm");
+    check_model!(Panda, "panda");
+    check_model!(B1Z1, "b1-z1");
 }

@@ -44,9 +44,14 @@ pub fn functions(model: &Model, opts: &Options) -> Vec<Function> {
     .into_iter()
     .filter(|f| *f != Function::Gravity || opts.gravity.is_some())
     .filter(|f| floating || !f.floating_only())
-    .filter(|f| !(*f == Function::BaseReaction || floating && *f == Function::InverseDynamics))
     .collect();
-    let _ = &mut v;
+    for k in 0..model.frames().len() {
+        v.push(Function::FramePlacement(k));
+        v.push(Function::FrameJacobian(k));
+        if floating {
+            v.push(Function::GeneralizedJacobian(k));
+        }
+    }
     v
 }
 

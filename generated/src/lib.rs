@@ -15,6 +15,7 @@
 //! | [`srms`] | `Srms` | Shuttle RMS, 6 dof (`tests/data/reference/srms_nguyen_hughes_1994.urdf`) | `--name Srms -o generated/src/srms.rs` |
 //! | [`ssrms_f32`] | `SsrmsF32` | SSRMS in `f32` | `--name SsrmsF32 --scalar f32 -o generated/src/ssrms_f32.rs` |
 //! | [`ssrms_fma`] | `SsrmsFma` | SSRMS with fused multiply-adds (`libm::fma`) | `--name SsrmsFma --fma -o generated/src/ssrms_fma.rs` |
+//! | [`free_floating_7dof`] | `FreeFloating7` | the 7-dof bMSd arm on its free-floating 1000 kg base (`tests/data/reference/bmsd_7dof_free_floating.urdf`; Pinocchio's free-flyer layout `q` (7 + 7), `v` (6 + 7)) | `--name FreeFloating7 --base free-floating --allow-nonphysical -o generated/src/free_floating_7dof.rs` |
 //!
 //! The files are checked by the root crate's tests: regenerated and compared byte for byte.
 #![no_std]
@@ -22,6 +23,8 @@
 #![warn(missing_docs)]
 
 // The files are written by prettyplease; rustfmt leaves them as generated.
+#[rustfmt::skip]
+pub mod free_floating_7dof;
 #[rustfmt::skip]
 pub mod srms;
 #[rustfmt::skip]

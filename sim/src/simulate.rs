@@ -11,10 +11,10 @@ use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, Stats, System};
 use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench};
 use anyhow::Result;
 use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
-use kanegen_dynamics::algorithms::kinematics::base_frame;
+use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
-use kanegen_dynamics::linalg::Vec3;
-use kanegen_dynamics::{Loads, Params};
+use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::{FrameParams, Loads, Params};
 use serde::Serialize;
 
 /// A scene as a first-order system for the integrators.
@@ -178,17 +178,25 @@ impl<'a> SceneSystem<'a> {
                     * (0..self.n)
                         .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
                         .sum::<f64>();
+                // Gravitational potential: −g · Σ m_k x_k over the bodies' centres of mass.
                 let v = match self.scene.gravity {
                     None => 0.0,
                     Some(g) => {
-                        let mut xo = Vec3::<f64>::zero();
-                        let mut v = 0.0;
-                        for k in base_frame(&self.params, q) {
-                            xo = &xo + &k.r;
-                            let first = xo.scale(&k.m) + k.c.clone();
-                            v -= Vec3::from_f64(g).dot(&first);
-                        }
-                        v
+                        let g = Vec3::from_f64(g);
+                        self.params
+                            .joints
+                            .iter()
+                            .enumerate()
+                            .map(|(k, jp)| {
+                                let com = FrameParams {
+                                    parent: Some(k),
+                                    translation: jp.com.clone(),
+                                    rotation: Mat3::identity(),
+                                };
+                                let (x, _) = frames::placement(&self.params, q, &com);
+                                -jp.mass * g.dot(&x)
+                            })
+                            .sum()
                     }
                 };
                 Some(t + v)

@@ -25,7 +25,7 @@ use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
 use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
-use kanegen_dynamics::algorithms::{floating, recurrent};
+use kanegen_dynamics::algorithms::{floating, frames, recurrent, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::{
@@ -273,7 +273,42 @@ pub fn trace(
                     let (lin, ang) = floating::momentum(&p, &base, &state, &q, &qd);
                     lin.0.into_iter().chain(ang.0).collect()
                 }
-                _ => unreachable!("rejected by check"),
+                Function::InverseDynamics | Function::BaseReaction => {
+                    let a = qdd.expect("takes a");
+                    let base_acc: [Sym; 6] = core::array::from_fn(|k| a[k]);
+                    let joints = &a[6..];
+                    if function == Function::BaseReaction {
+                        rnea::base_reaction(&p, &state, &q, &qd, &base_acc, joints, &loads(None))
+                            .to_vec()
+                    } else {
+                        let mut tau = rnea::floating_inverse_dynamics(
+                            &p,
+                            &base,
+                            &state,
+                            &q,
+                            &qd,
+                            &base_acc,
+                            joints,
+                            &loads(None),
+                        );
+                        if let Some(d) = &damping {
+                            for (t, d) in tau[6..].iter_mut().zip(d) {
+                                *t = *t + *d;
+                            }
+                        }
+                        tau
+                    }
+                }
+                Function::FramePlacement(k) => {
+                    let (x, r) = frames::floating_placement(&p, &state, &q, &p.frames[k]);
+                    placement_outputs(x, r)
+                }
+                Function::FrameJacobian(k) => {
+                    frames::floating_jacobian(&p, &state, &q, &p.frames[k]).concat()
+                }
+                Function::GeneralizedJacobian(k) => {
+                    frames::generalized_jacobian(&p, &base, &state, &q, &p.frames[k]).concat()
+                }
             }
         }
         _ => match function {
@@ -298,7 +333,14 @@ pub fn trace(
                 v.extend(negated(methods.bias.bias(&p, &q, &qd, &loads(None))));
                 v
             }
-            _ => unreachable!("rejected by check"),
+            Function::FramePlacement(k) => {
+                let (x, r) = frames::placement(&p, &q, &p.frames[k]);
+                placement_outputs(x, r)
+            }
+            Function::FrameJacobian(k) => frames::jacobian(&p, &q, &p.frames[k]).concat(),
+            Function::Momentum | Function::BaseReaction | Function::GeneralizedJacobian(_) => {
+                unreachable!("rejected by check: free-floating only")
+            }
         },
     };
     Ok(Traced {
@@ -367,16 +409,21 @@ fn check(
     if function.floating_only() && !floating {
         return Err(format!("{} needs a free-floating base", function.name()));
     }
-    // Awaiting the tree-capable local-frame algorithms of the dynamics crate.
-    if function.frame().is_some()
-        || matches!(function, Function::BaseReaction)
-        || (floating && function == Function::InverseDynamics)
-    {
-        return Err(format!("{} is not traced yet", function.name()));
+    if let Some(k) = function.frame() {
+        match subject {
+            Subject::Model(m) if k < m.frames().len() => {}
+            _ => return Err(format!("the model has no frame #{k}")),
+        }
     }
-    if let (Some(k), Subject::Model(m)) = (function.frame(), subject) {
-        if k >= m.frames().len() {
-            return Err(format!("the model has no frame #{k}"));
+    if let Subject::Model(m) = subject {
+        // The paper's base-frame algorithms handle serial chains only.
+        let p = Params::<f64>::new(m);
+        let uses = |b: bool| b || floating;
+        if uses(function.uses_mass_matrix()) {
+            methods.mass_matrix.check(&p).map_err(|e| e.to_string())?;
+        }
+        if uses(function.uses_bias()) {
+            methods.bias.check(&p).map_err(|e| e.to_string())?;
         }
     }
     let _ = BiasMethod::ALL; // every bias method traces every remaining combination
@@ -389,6 +436,11 @@ fn upper(a: &[Vec<Sym>]) -> Vec<Sym> {
         .enumerate()
         .flat_map(|(i, row)| row[i..].to_vec())
         .collect()
+}
+
+/// A placement as outputs: the origin, then the rotation row by row.
+fn placement_outputs(x: Vec3<Sym>, r: Mat3<Sym>) -> Vec<Sym> {
+    x.0.into_iter().chain(r.0.into_iter().flatten()).collect()
 }
 
 fn negated(v: Vec<Sym>) -> Vec<Sym> {

@@ -108,11 +108,77 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
             Box::new(move |q, qd| methods.inverse_dynamics(p, q, qd, qd, &Loads::default())[6]),
         ));
     }
+    let mut results = measure(n, c, rounds, calls);
+    results.extend(bench_free_floating(rounds, calls)?);
     Ok(BenchReport {
         model: model.name().into(),
         n,
         rounds,
         calls_per_round: calls,
-        results: measure(n, c, rounds, calls),
+        results,
     })
 }
+
+/// The bMSd 7-dof arm on its free-floating base: the generated forward dynamics
+/// (`kanegen_generated::free_floating_7dof`) against the interpreted `spatial` and
+/// `recurrent` free-floating forward dynamics, at base states with the arm's random `q`, `q̇`.
+fn bench_free_floating(rounds: usize, calls: usize) -> anyhow::Result<Vec<BenchLine>> {
+    use kanegen_dynamics::algorithms::floating;
+    use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
+    use kanegen_dynamics::linalg::Vec3;
+    use kanegen_dynamics::{Loads, Methods, Params};
+    use kanegen_generated::free_floating_7dof::FreeFloating7;
+    let v = kanegen_model::Validation {
+        allow_nonphysical_inertia: true,
+    };
+    let model = kanegen_model::io::parse_urdf_with(BMSD_URDF, v)?
+        .with_base_kind(kanegen_model::BaseKind::FreeFloating)?;
+    let p = Params::<f64>::new(&model);
+    let base = FloatingBase::<f64>::from_inertial(model.base_inertial().expect("base inertial"));
+    let n = model.dof();
+    // A fixed, slightly turned and moving base; the arm's state varies.
+    let quat = [0.1, -0.2, 0.3, 0.9273618495495703];
+    let state = FloatingState {
+        position: Vec3([0.5, -0.2, 1.0]),
+        rotation: quat_to_matrix(&quat),
+        v_b: Vec3([0.01, -0.02, 0.005]),
+        omega_b: Vec3([0.002, 0.001, -0.003]),
+    };
+    let qv = |q: &[f64], qd: &[f64]| -> ([f64; 14], [f64; 13]) {
+        let mut x = [0.0; 14];
+        x[..3].copy_from_slice(&state.position.0);
+        x[3..7].copy_from_slice(&quat);
+        x[7..].copy_from_slice(q);
+        let mut v = [0.0; 13];
+        v[..3].copy_from_slice(&state.v_b.0);
+        v[3..6].copy_from_slice(&state.omega_b.0);
+        v[6..].copy_from_slice(qd);
+        (x, v)
+    };
+    let tau = [0.0; 7];
+    let mut c: Vec<Candidate<'_>> = vec![(
+        "generated".into(),
+        "free-floating forward_dynamics".into(),
+        Box::new(move |q, qd| {
+            let (x, v) = qv(q, qd);
+            FreeFloating7::forward_dynamics(&x, &v, &tau)[6]
+        }),
+    )];
+    for (name, methods) in [
+        ("spatial", Methods::SPATIAL),
+        ("recurrent", Methods::RECURRENT),
+    ] {
+        let (p, base, state) = (&p, &base, &state);
+        c.push((
+            format!("interpreted {name}"),
+            "free-floating forward_dynamics".into(),
+            Box::new(move |q, qd| {
+                floating::forward_dynamics(methods, p, base, state, q, qd, &Loads::default())[6]
+            }),
+        ));
+    }
+    Ok(measure(n, c, rounds, calls))
+}
+
+/// The bMSd 7-dof free-floating model of `kanegen_generated::free_floating_7dof`.
+const BMSD_URDF: &str = include_str!("../../../tests/data/reference/bmsd_7dof_free_floating.urdf");

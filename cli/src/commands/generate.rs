@@ -2,7 +2,7 @@
 //! [`kanegen_codegen`] and the README section "Code generation").
 
 use kanegen_codegen::{generate_file, Float, Options};
-use kanegen_model::{Model, ModelError};
+use kanegen_model::{BaseKind, Model, ModelError};
 
 /// `CamelCase` type name from a model name or file stem: `ssrms_nguyen_hughes_1994` →
 /// `SsrmsNguyenHughes1994`; a leading digit gets a `Model` prefix.
@@ -47,11 +47,16 @@ pub struct GeneratedFile {
     pub float: Float,
     /// Fused multiply-adds (`--fma`).
     pub fma: bool,
+    /// The base (`--base`; `None`: the model's).
+    pub base: Option<BaseKind>,
+    /// Accept published inertias that violate the triangle inequality (`--allow-nonphysical`).
+    pub allow_nonphysical: bool,
 }
 
 /// The files of `generated/src/`, each reproducible with
-/// `kanegen generate MODEL --name TYPE [--lock INDEX=VALUE] [--scalar f32] [--fma] -o FILE`.
-pub const GENERATED: [GeneratedFile; 5] = [
+/// `kanegen generate MODEL --name TYPE [--lock INDEX=VALUE] [--scalar f32] [--fma]
+/// [--base free-floating] [--allow-nonphysical] -o FILE`.
+pub const GENERATED: [GeneratedFile; 6] = [
     GeneratedFile {
         file: "generated/src/ssrms.rs",
         model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
@@ -59,6 +64,8 @@ pub const GENERATED: [GeneratedFile; 5] = [
         lock: None,
         float: Float::F64,
         fma: false,
+        base: None,
+        allow_nonphysical: false,
     },
     GeneratedFile {
         file: "generated/src/ssrms6.rs",
@@ -67,6 +74,8 @@ pub const GENERATED: [GeneratedFile; 5] = [
         lock: Some((0, 0.0)),
         float: Float::F64,
         fma: false,
+        base: None,
+        allow_nonphysical: false,
     },
     GeneratedFile {
         file: "generated/src/srms.rs",
@@ -75,6 +84,8 @@ pub const GENERATED: [GeneratedFile; 5] = [
         lock: None,
         float: Float::F64,
         fma: false,
+        base: None,
+        allow_nonphysical: false,
     },
     GeneratedFile {
         file: "generated/src/ssrms_f32.rs",
@@ -83,6 +94,8 @@ pub const GENERATED: [GeneratedFile; 5] = [
         lock: None,
         float: Float::F32,
         fma: false,
+        base: None,
+        allow_nonphysical: false,
     },
     GeneratedFile {
         file: "generated/src/ssrms_fma.rs",
@@ -91,6 +104,18 @@ pub const GENERATED: [GeneratedFile; 5] = [
         lock: None,
         float: Float::F64,
         fma: true,
+        base: None,
+        allow_nonphysical: false,
+    },
+    GeneratedFile {
+        file: "generated/src/free_floating_7dof.rs",
+        model: "tests/data/reference/bmsd_7dof_free_floating.urdf",
+        type_name: "FreeFloating7",
+        lock: None,
+        float: Float::F64,
+        fma: false,
+        base: Some(BaseKind::FreeFloating),
+        allow_nonphysical: true,
     },
 ];
 
@@ -100,11 +125,36 @@ impl GeneratedFile {
     /// # Errors
     /// If the model cannot be read or locked.
     pub fn model(&self, root: &std::path::Path) -> Result<Model, ModelError> {
-        let model = kanegen_model::io::load_model(&root.join(self.model))?;
+        let v = kanegen_model::Validation {
+            allow_nonphysical_inertia: self.allow_nonphysical,
+        };
+        let model = kanegen_model::io::load_model_with(&root.join(self.model), v)?;
         match self.lock {
             Some((i, v)) => model.lock_joint(i, v),
             None => Ok(model),
         }
+    }
+
+    /// The `kanegen generate` command that writes this file.
+    #[must_use]
+    pub fn command(&self) -> String {
+        let mut c = format!("kanegen generate {} --name {}", self.model, self.type_name);
+        if let Some((i, v)) = self.lock {
+            c += &format!(" --lock {i}={v}");
+        }
+        if self.float == Float::F32 {
+            c += " --scalar f32";
+        }
+        if self.fma {
+            c += " --fma";
+        }
+        if let Some(b) = self.base {
+            c += &format!(" --base {}", b.name());
+        }
+        if self.allow_nonphysical {
+            c += " --allow-nonphysical";
+        }
+        c + &format!(" -o {}", self.file)
     }
 
     /// The generator options of this file.
@@ -113,6 +163,7 @@ impl GeneratedFile {
         let mut o = Options::new(self.type_name);
         o.float = self.float;
         o.fma = self.fma;
+        o.base = self.base;
         o
     }
 

@@ -2,10 +2,10 @@
 //! end-effector position and (free-floating) the base attitude.
 
 use anyhow::{Context, Result};
-use kanegen_dynamics::algorithms::kinematics::base_frame;
+use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::quat_to_matrix;
-use kanegen_dynamics::linalg::Vec3;
-use kanegen_dynamics::Params;
+use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::{FrameParams, Params};
 use kanegen_sim::scene::Scene;
 use kanegen_sim::simulate::Run;
 use plotters::prelude::*;
@@ -68,11 +68,17 @@ pub fn line_chart(title: &str, y_desc: &str, series: &[Series]) -> Result<String
     Ok(svg)
 }
 
-/// The inertial-frame origin of the last body at every sample (`x`, `y`, `z` series).
+/// The inertial-frame position of the end effector at every sample (`x`, `y`, `z` series): the
+/// model's first named frame, or the origin of the last body when it names none.
 #[must_use]
 pub fn end_effector_series(scene: &Scene, run: &Run) -> Vec<Series> {
     let n = scene.model.dof();
-    let params = Params::new(&scene.model);
+    let params = Params::<f64>::new(&scene.model);
+    let target = params.frames.first().cloned().unwrap_or(FrameParams {
+        parent: Some(n - 1),
+        translation: Vec3::zero(),
+        rotation: Mat3::identity(),
+    });
     let mut out: Vec<Series> = ["x", "y", "z"]
         .iter()
         .map(|c| ((*c).to_string(), Vec::with_capacity(run.samples.len())))
@@ -84,10 +90,7 @@ pub fn end_effector_series(scene: &Scene, run: &Run) -> Vec<Series> {
         } else {
             &x[..n]
         };
-        let mut o = Vec3::<f64>::zero();
-        for k in base_frame(&params, q) {
-            o = &o + &k.r;
-        }
+        let (o, _) = frames::placement(&params, q, &target);
         let p = if scene.is_floating() {
             let quat: [f64; 4] = x[3..7].try_into().expect("4 entries");
             &quat_to_matrix(&quat).mul_vec(&o) + &Vec3::new(x[0], x[1], x[2])
