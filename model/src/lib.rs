@@ -26,6 +26,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod canonical;
 pub mod inertial;
 pub mod io;
 mod lock;
