@@ -386,3 +386,60 @@ fn f32_fma_payload_gravity_through_the_macro() {
     assert!(efd < 2e-5 && efd > 1e-9, "q̈: {efd:e}");
     assert!(Random5F32Fma::OP_COUNTS.iter().all(|c| c.fma > 0));
 }
+
+kanegen::dynamics!(
+    SsrmsOwnInertia,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    gravity = [0.0, 0.0, -9.81],
+    regroup = false,
+);
+kanegen::dynamics!(
+    SsrmsRegrouped,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    gravity = [0.0, 0.0, -9.81],
+);
+
+/// `regroup = false` traces the model's own inertias: the same dynamics (to rounding), more
+/// operations, and a header that says which.
+#[test]
+fn regrouping_keeps_the_dynamics_and_saves_operations() {
+    let ops = |c: &[SsrmsRegroupedOpCount]| c.iter().map(|e| e.mul + e.add).collect::<Vec<_>>();
+    let own: Vec<u64> = SsrmsOwnInertia::OP_COUNTS
+        .iter()
+        .map(|e| e.mul + e.add)
+        .collect();
+    let reg = ops(&SsrmsRegrouped::OP_COUNTS);
+    for ((e, a), b) in SsrmsRegrouped::OP_COUNTS.iter().zip(&own).zip(&reg) {
+        assert!(b < a, "{}: regrouped {b} ops, own {a}", e.function);
+    }
+    let mut worst = 0.0_f64;
+    for [q, qd, tau, qdd] in ssrms_states(50) {
+        let pairs = [
+            (
+                flat(SsrmsOwnInertia::mass_matrix(&q)),
+                flat(SsrmsRegrouped::mass_matrix(&q)),
+            ),
+            (
+                SsrmsOwnInertia::nonlinear_effects(&q, &qd).to_vec(),
+                SsrmsRegrouped::nonlinear_effects(&q, &qd).to_vec(),
+            ),
+            (
+                SsrmsOwnInertia::gravity(&q).to_vec(),
+                SsrmsRegrouped::gravity(&q).to_vec(),
+            ),
+            (
+                SsrmsOwnInertia::inverse_dynamics(&q, &qd, &qdd).to_vec(),
+                SsrmsRegrouped::inverse_dynamics(&q, &qd, &qdd).to_vec(),
+            ),
+            (
+                SsrmsOwnInertia::forward_dynamics(&q, &qd, &tau).to_vec(),
+                SsrmsRegrouped::forward_dynamics(&q, &qd, &tau).to_vec(),
+            ),
+        ];
+        for (a, b) in pairs {
+            worst = worst.max(rel_err(&b, &a));
+        }
+    }
+    println!("regrouped vs own inertias: worst {worst:.1e}");
+    assert!(worst < 1e-12, "{worst:e}");
+}

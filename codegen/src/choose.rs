@@ -108,7 +108,10 @@ pub fn choose(
     mass: MassMatrixMethod,
     opts: &Options,
 ) -> Result<(Choice, Traced), TraceError> {
-    let spec = spec(model, opts);
+    let spec = Spec {
+        regroup: opts.regroup && f != Function::BaseReaction,
+        ..spec(model, opts)
+    };
     let mut best: Option<(u64, Methods, Traced)> = None;
     let mut traced = Vec::new();
     for m in candidates(f, mass, model.is_chain()) {

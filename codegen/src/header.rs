@@ -80,6 +80,7 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
         } else {
             "Runtime payload: no (every model number is a constant).".into()
         },
+        regroup_line(model, opts),
     ];
     // Precision lines only for a non-default precision.
     if opts.float != Float::F64 || opts.fma {
@@ -136,4 +137,32 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
         }
     }
     h
+}
+
+/// What regrouping did, or that it is off.
+fn regroup_line(model: &Model, opts: &Options) -> String {
+    if !opts.regroup {
+        return "Inertial parameters: the model's own (regrouping off).".into();
+    }
+    let keep: &[usize] = if opts.runtime_payload {
+        &[model.dof() - 1]
+    } else {
+        &[]
+    };
+    let r = kanegen_dynamics::regroup::regrouped::<f64>(model, model.base_inertial(), keep).report;
+    format!(
+        "Inertial parameters: regrouped for the local-frame algorithms (the base parameters of \
+         Khalil and Kleinfinger: what a joint cannot move is carried by its parent): {} of {} \
+         bodies gave, {} → {} non-zero numbers in the spatial inertias{}. The same joint-space \
+         dynamics; `base_reaction`, where generated, reads the model's own numbers.",
+        r.moved,
+        model.dof(),
+        r.nonzero_before,
+        r.nonzero_after,
+        if model.base_kind() == BaseKind::FreeFloating {
+            ", the base included"
+        } else {
+            "; what reaches the fixed base is dropped"
+        }
+    )
 }

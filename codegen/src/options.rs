@@ -41,6 +41,11 @@ pub struct Options {
     /// (default): `fma` (f64) or `fmaf` (f32) of [`Options::libm_path`]. `f64::mul_add` /
     /// `f32::mul_add` (UFCS of the std method; not `no_std`) work as well.
     pub fma_path: Option<String>,
+    /// Let the local-frame algorithms read regrouped inertial parameters
+    /// (`kanegen_dynamics::regroup`: each revolute body's axis mass carried by its parent): the
+    /// same joint-space results in fewer operations. Default `true`; the base reaction always
+    /// reads the model's own numbers.
+    pub regroup: bool,
 }
 
 /// Floating-point type of the emitted code.
@@ -96,7 +101,7 @@ impl Float {
 
 impl Options {
     /// Defaults: space (no gravity), constant payload, `libm` path `libm`, structs `Payload` and
-    /// `OpCount`, `f64`, no fused multiply-adds.
+    /// `OpCount`, `f64`, no fused multiply-adds, regrouped inertial parameters.
     pub fn new(type_name: impl Into<String>) -> Self {
         Options {
             type_name: type_name.into(),
@@ -110,6 +115,7 @@ impl Options {
             float: Float::F64,
             fma: false,
             fma_path: None,
+            regroup: true,
         }
     }
 }

@@ -25,6 +25,7 @@
 
 use crate::linalg::{Mat3, Vec3};
 use crate::scalar::Scalar;
+use crate::spatial::RbInertia;
 use kanegen_model::Inertial;
 
 /// The `body` index of an [`crate::ExternalWrench`] on the base body of a free-floating chain.
@@ -42,16 +43,29 @@ pub struct FloatingBase<S> {
     pub com: Vec3<S>,
     /// Inertia about the centre of mass, base-frame axes.
     pub inertia_com: Mat3<S>,
+    /// The spatial inertia about the base-frame origin, as the local-frame algorithms read it:
+    /// [`RbInertia::from_com`] of the three above, unless regrouped ([`crate::regroup`]).
+    pub inertia: RbInertia<S>,
 }
 
 impl<S: Scalar> FloatingBase<S> {
+    /// From mass, centre of mass and inertia about it.
+    pub fn new(mass: S, com: Vec3<S>, inertia_com: Mat3<S>) -> Self {
+        FloatingBase {
+            inertia: RbInertia::from_com(&mass, &com, &inertia_com),
+            mass,
+            com,
+            inertia_com,
+        }
+    }
+
     /// From a model's inertial (e.g. [`kanegen_model::Model::base_inertial`]), as constants.
     pub fn from_inertial(i: &Inertial) -> Self {
-        FloatingBase {
-            mass: S::constant(i.mass),
-            com: Vec3::from_f64(i.com),
-            inertia_com: Mat3::from_f64(i.inertia),
-        }
+        Self::new(
+            S::constant(i.mass),
+            Vec3::from_f64(i.com),
+            Mat3::from_f64(i.inertia),
+        )
     }
 }
 

@@ -31,11 +31,13 @@
 
 pub mod algorithms;
 pub mod base;
+pub mod joint;
 pub mod ldlt;
 pub mod linalg;
 pub mod loads;
 pub mod metrics;
 pub mod params;
+pub mod regroup;
 pub mod scalar;
 pub mod scalars;
 pub mod spatial;

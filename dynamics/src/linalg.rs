@@ -233,12 +233,24 @@ impl<S: Scalar> Add for &Mat3<S> {
 
 /// Rotation about the unit axis `u` by the angle with sine `s` and cosine `c` (Rodrigues:
 /// `R = c·1 + s·ũ + (1 − c)·u uᵀ`); this is the joint rotation `Θ_j` of eq. (1).
+///
+/// The diagonal is written `u_i² + (1 − u_i²) c`, the same number, so that a constant
+/// coordinate axis folds to the sparse rotation (`R_zz = 1 + 0·c = 1` for `u = e_z`, where
+/// `c + (1 − c)·1` would be two operations that fold cannot remove).
 pub fn axis_rotation<S: Scalar>(u: &Vec3<S>, s: &S, c: &S) -> Mat3<S> {
     let k = S::one() - c.clone();
-    let uu = u.outer(u).scale(&k);
     let su = Mat3::skew(u).scale(s);
-    let ci = Mat3::identity().scale(c);
-    ci + su + uu
+    Mat3(core::array::from_fn(|i| {
+        core::array::from_fn(|j| {
+            let ui = u.at(i);
+            if i == j {
+                let uu = ui.clone() * ui;
+                uu.clone() + (S::one() - uu) * c.clone()
+            } else {
+                ui * u.at(j) * k.clone() + su.at(i, j)
+            }
+        })
+    }))
 }
 
 #[cfg(test)]

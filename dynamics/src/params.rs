@@ -6,6 +6,7 @@
 
 use crate::linalg::{Mat3, Vec3};
 use crate::scalar::Scalar;
+use crate::spatial::RbInertia;
 use kanegen_model::{JointKind, Model};
 
 /// One joint and its child body, with every number in the scalar type `S`.
@@ -27,6 +28,20 @@ pub struct JointParams<S> {
     pub com: Vec3<S>,
     /// Inertia about the centre of mass, body axes.
     pub inertia_com: Mat3<S>,
+    /// The body's spatial inertia about its frame origin, as the local-frame algorithms read it:
+    /// [`RbInertia::from_com`] of `mass`, `com`, `inertia_com`, unless regrouped
+    /// ([`crate::regroup`]: then equivalent in joint space only).
+    pub inertia: RbInertia<S>,
+}
+
+impl<S: Scalar> JointParams<S> {
+    /// Sets `mass`, `com` and `inertia_com`, and `inertia` from them.
+    pub fn set_inertial(&mut self, mass: S, com: Vec3<S>, inertia_com: Mat3<S>) {
+        self.inertia = RbInertia::from_com(&mass, &com, &inertia_com);
+        self.mass = mass;
+        self.com = com;
+        self.inertia_com = inertia_com;
+    }
 }
 
 /// A named frame fixed to a body, in the scalar type `S`.
@@ -57,15 +72,23 @@ impl<S: Scalar> Params<S> {
             joints: model
                 .joints()
                 .iter()
-                .map(|j| JointParams {
-                    kind: j.kind,
-                    parent: j.parent,
-                    l: Vec3::from_f64(j.origin.translation),
-                    upsilon: Mat3::from_f64(j.origin.rotation),
-                    axis: Vec3::from_f64(j.axis),
-                    mass: S::constant(j.inertial.mass),
-                    com: Vec3::from_f64(j.inertial.com),
-                    inertia_com: Mat3::from_f64(j.inertial.inertia),
+                .map(|j| {
+                    let (mass, com, inertia_com) = (
+                        S::constant(j.inertial.mass),
+                        Vec3::from_f64(j.inertial.com),
+                        Mat3::from_f64(j.inertial.inertia),
+                    );
+                    JointParams {
+                        kind: j.kind,
+                        parent: j.parent,
+                        l: Vec3::from_f64(j.origin.translation),
+                        upsilon: Mat3::from_f64(j.origin.rotation),
+                        axis: Vec3::from_f64(j.axis),
+                        inertia: RbInertia::from_com(&mass, &com, &inertia_com),
+                        mass,
+                        com,
+                        inertia_com,
+                    }
                 })
                 .collect(),
             frames: model

@@ -9,16 +9,10 @@
 //! (RBDA §2.8, Table 2.5). A rigid-body inertia is stored as `(m, h = m c, Ī)`, `Ī` about the
 //! frame origin (RBDA eq. (2.62)–(2.63), spatial_v2 `mcI`).
 //!
-//! Joint `j` (URDF convention): `Xtree_j` places the joint frame in the parent (`E = Υᵀ`,
-//! `r = l`); `XJ_j` is the joint motion (revolute: `E = Θ(q)ᵀ`, `r = 0`; prismatic: `E = 1`,
-//! `r = q·axis`); `Xup_j = XJ_j Xtree_j`; the motion subspace is `S_j = [axis; 0]` (revolute) or
-//! `[0; axis]` (prismatic), the axis having the same coordinates in the joint and child frames.
-//! Each revolute `q_j` costs one `sin_cos` per call of [`xup`].
+//! The joints' transforms and motion subspaces are in [`crate::joint`].
 
-use crate::linalg::{axis_rotation, Mat3, Vec3};
-use crate::params::JointParams;
+use crate::linalg::{Mat3, Vec3};
 use crate::scalar::Scalar;
-use kanegen_model::JointKind;
 
 /// A spatial motion vector `[ω; v]` (RBDA §2.2).
 #[derive(Clone, Debug)]
@@ -157,76 +151,12 @@ impl<S: Scalar> RbInertia<S> {
             ibar: inertia_com.clone() + ct.mul_mat(&ct.transpose()).scale(m),
         }
     }
-    /// The inertia of joint `jp`'s body in its own frame ([`RbInertia::from_com`]).
-    pub fn mci(jp: &JointParams<S>) -> Self {
-        Self::from_com(&jp.mass, &jp.com, &jp.inertia_com)
-    }
     /// `I [ω; v] = [Ī ω + h × v; m v − h × ω]`.
     pub fn mul(&self, v: &Motion<S>) -> Force<S> {
         Force {
             ang: self.ibar.mul_vec(&v.ang) + self.h.cross(&v.lin),
             lin: v.lin.scale(&self.m) - self.h.cross(&v.ang),
         }
-    }
-}
-
-/// `Xup_j = XJ(q_j) Xtree_j` (RBDA §4.4; spatial_v2 `jcalc` and `Xtree`).
-pub fn xup<S: Scalar>(jp: &JointParams<S>, q: &S) -> Xform<S> {
-    match jp.kind {
-        JointKind::Revolute => {
-            let (s, c) = q.clone().sin_cos();
-            // E = Θᵀ Υᵀ = (Υ Θ)ᵀ, r = l.
-            let e = jp
-                .upsilon
-                .mul_mat(&axis_rotation(&jp.axis, &s, &c))
-                .transpose();
-            Xform { e, r: jp.l.clone() }
-        }
-        // E = Υᵀ, r = l + Υ (q axis).
-        JointKind::Prismatic => Xform {
-            e: jp.upsilon.transpose(),
-            r: &jp.l + &jp.upsilon.mul_vec(&jp.axis.scale(q)),
-        },
-    }
-}
-
-/// `S_j q̇_j` (spatial_v2 `vJ`).
-pub fn s_times<S: Scalar>(jp: &JointParams<S>, x: &S) -> Motion<S> {
-    let ax = jp.axis.scale(x);
-    match jp.kind {
-        JointKind::Revolute => Motion {
-            ang: ax,
-            lin: Vec3::zero(),
-        },
-        JointKind::Prismatic => Motion {
-            ang: Vec3::zero(),
-            lin: ax,
-        },
-    }
-}
-
-/// `S_jᵀ f`: the axis component of the moment (revolute) or of the force (prismatic).
-pub fn s_tr<S: Scalar>(jp: &JointParams<S>, f: &Force<S>) -> S {
-    match jp.kind {
-        JointKind::Revolute => jp.axis.dot(&f.ang),
-        JointKind::Prismatic => jp.axis.dot(&f.lin),
-    }
-}
-
-/// `I S_j` for a rigid-body inertia (only the non-zero half of `S_j` is multiplied).
-pub fn inertia_s<S: Scalar>(ic: &RbInertia<S>, jp: &JointParams<S>) -> Force<S> {
-    let a = &jp.axis;
-    match jp.kind {
-        // I [a; 0] = [Ī a; −h × a]
-        JointKind::Revolute => Force {
-            ang: ic.ibar.mul_vec(a),
-            lin: -ic.h.cross(a),
-        },
-        // I [0; a] = [h × a; m a]
-        JointKind::Prismatic => Force {
-            ang: ic.h.cross(a),
-            lin: a.scale(&ic.m),
-        },
     }
 }
 

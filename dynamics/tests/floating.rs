@@ -665,25 +665,35 @@ fn floating_dynamics_traces_on_sym() {
                 v_b,
                 omega_b,
             };
-            let base = FloatingBase {
-                mass: Sym::constant(c.base.mass),
-                com: Vec3(c.base.com.0.map(Sym::constant)),
-                inertia_com: Mat3(c.base.inertia_com.0.map(|r| r.map(Sym::constant))),
-            };
+            let base = FloatingBase::new(
+                Sym::constant(c.base.mass),
+                Vec3(c.base.com.0.map(Sym::constant)),
+                Mat3(c.base.inertia_com.0.map(|r| r.map(Sym::constant))),
+            );
             let p = Params {
                 joints: c
                     .p
                     .joints
                     .iter()
-                    .map(|j| kanegen_dynamics::JointParams {
-                        kind: j.kind,
-                        parent: j.parent,
-                        l: Vec3(j.l.0.map(Sym::constant)),
-                        upsilon: Mat3(j.upsilon.0.map(|r| r.map(Sym::constant))),
-                        axis: Vec3(j.axis.0.map(Sym::constant)),
-                        mass: Sym::constant(j.mass),
-                        com: Vec3(j.com.0.map(Sym::constant)),
-                        inertia_com: Mat3(j.inertia_com.0.map(|r| r.map(Sym::constant))),
+                    .map(|j| {
+                        let mass = Sym::constant(j.mass);
+                        let com = Vec3(j.com.0.map(Sym::constant));
+                        let inertia_com = Mat3(j.inertia_com.0.map(|r| r.map(Sym::constant)));
+                        kanegen_dynamics::JointParams {
+                            kind: j.kind,
+                            parent: j.parent,
+                            l: Vec3(j.l.0.map(Sym::constant)),
+                            upsilon: Mat3(j.upsilon.0.map(|r| r.map(Sym::constant))),
+                            axis: Vec3(j.axis.0.map(Sym::constant)),
+                            inertia: kanegen_dynamics::spatial::RbInertia::from_com(
+                                &mass,
+                                &com,
+                                &inertia_com,
+                            ),
+                            mass,
+                            com,
+                            inertia_com,
+                        }
                     })
                     .collect(),
                 frames: Vec::new(),

@@ -347,7 +347,8 @@ fn lagrange_oracle_discriminates() {
     let b_static = rnea::bias(&p, &s.q, &zero, &loads(&s, vec![]));
     assert!(rel_err(&b_static, &b_ref) > 1e-3);
     let mut p2 = p.clone();
-    p2.joints[2].mass *= 1.001;
+    let j2 = p2.joints[2].clone();
+    p2.joints[2].set_inertial(j2.mass * 1.001, j2.com, j2.inertia_com);
     let a_ref = lagrange_mass_matrix(&c, &s.q, &s.qd);
     assert!(rel_err(&flat(&crba::mass_matrix(&p2, &s.q)), &flat(&a_ref)) > 1e-6);
 }

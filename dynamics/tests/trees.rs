@@ -744,11 +744,7 @@ fn base_wrench_and_reaction_are_momentum_rates() {
         let e_total = rel_err(&rate, &want);
         // The arm alone (a massless base carries no momentum): ḣ_arm = −reaction + loads on the
         // arm (the base pushes the arm with minus the arm's push on the base).
-        let massless = FloatingBase {
-            mass: 0.0,
-            com: Vec3::zero(),
-            inertia_com: Mat3::zero(),
-        };
+        let massless = FloatingBase::new(0.0, Vec3::zero(), Mat3::zero());
         let rate_arm = momentum_rate(&p, &massless, &s);
         let want_arm: Vec<f64> = to_inertial(&s.floating, &reaction)
             .iter()

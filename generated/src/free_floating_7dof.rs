@@ -6,35 +6,36 @@
 //! Base: free-floating (`root`, 1000 kg). `q = [p₀ (3), quaternion x, y, z, w (4), joints (7)]`, `v = [v_b (3), ω_b (3), q̇ (7)]`: the base origin's position in the inertial frame, the base's attitude (base to inertial), its linear and angular velocity in base coordinates (Pinocchio's free-flyer).
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
+//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
 //! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 1852 | 2503 | 0 | 0 | 7 | 4355 |
-//! | `mass_matrix` | `recurrent-r1` | — | 2131 | 2572 | 0 | 0 | 7 | 4703 |
-//! | `mass_matrix` | `kane-direct` | — | 3664 | 3020 | 0 | 0 | 7 | 6684 |
-//! | `mass_matrix` | `crba-base` | — | 1330 | 1054 | 0 | 0 | 7 | 2384 |
-//! | `mass_matrix` * | `crba` | — | 773 | 575 | 0 | 0 | 7 | 1348 |
-//! | `nonlinear_effects` | — | `recurrent` | 1174 | 898 | 0 | 0 | 7 | 2072 |
-//! | `nonlinear_effects` | — | `kane-direct` | 1642 | 1322 | 0 | 0 | 7 | 2964 |
-//! | `nonlinear_effects` * | — | `rnea` | 741 | 571 | 0 | 0 | 7 | 1312 |
-//! | `inverse_dynamics` * | — | `recurrent` | 771 | 606 | 0 | 0 | 7 | 1377 |
-//! | `inverse_dynamics` | — | `kane-direct` | 771 | 606 | 0 | 0 | 7 | 1377 |
-//! | `inverse_dynamics` | — | `rnea` | 771 | 606 | 0 | 0 | 7 | 1377 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 2447 | 1899 | 10 | 0 | 7 | 4346 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 2915 | 2323 | 10 | 0 | 7 | 5238 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 1997 | 1568 | 10 | 0 | 7 | 3565 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 1947 | 1459 | 0 | 0 | 7 | 3406 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 2415 | 1883 | 0 | 0 | 7 | 4298 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 1497 | 1128 | 0 | 0 | 7 | 2625 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 2591 | 2043 | 10 | 0 | 7 | 4634 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 3059 | 2467 | 10 | 0 | 7 | 5526 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 1997 | 1616 | 10 | 0 | 7 | 3613 |
-//! | `momentum` * | — | — | 407 | 315 | 0 | 0 | 7 | 722 |
-//! | `base_reaction` * | — | `recurrent` | 741 | 582 | 0 | 0 | 7 | 1323 |
-//! | `base_reaction` | — | `kane-direct` | 741 | 582 | 0 | 0 | 7 | 1323 |
-//! | `base_reaction` | — | `rnea` | 741 | 582 | 0 | 0 | 7 | 1323 |
+//! | `mass_matrix` | `recurrent` | — | 1831 | 2489 | 0 | 0 | 7 | 4320 |
+//! | `mass_matrix` | `recurrent-r1` | — | 2110 | 2558 | 0 | 0 | 7 | 4668 |
+//! | `mass_matrix` | `kane-direct` | — | 3460 | 2896 | 0 | 0 | 7 | 6356 |
+//! | `mass_matrix` | `crba-base` | — | 1309 | 1040 | 0 | 0 | 7 | 2349 |
+//! | `mass_matrix` * | `crba` | — | 654 | 545 | 0 | 0 | 7 | 1199 |
+//! | `nonlinear_effects` | — | `recurrent` | 1153 | 884 | 0 | 0 | 7 | 2037 |
+//! | `nonlinear_effects` | — | `kane-direct` | 1570 | 1279 | 0 | 0 | 7 | 2849 |
+//! | `nonlinear_effects` * | — | `rnea` | 637 | 504 | 0 | 0 | 7 | 1141 |
+//! | `inverse_dynamics` * | — | `recurrent` | 676 | 550 | 0 | 0 | 7 | 1226 |
+//! | `inverse_dynamics` | — | `kane-direct` | 676 | 550 | 0 | 0 | 7 | 1226 |
+//! | `inverse_dynamics` | — | `rnea` | 676 | 550 | 0 | 0 | 7 | 1226 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 2307 | 1868 | 10 | 0 | 7 | 4175 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 2724 | 2263 | 10 | 0 | 7 | 4987 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 1779 | 1484 | 10 | 0 | 7 | 3263 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 1807 | 1429 | 0 | 0 | 7 | 3236 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 2224 | 1824 | 0 | 0 | 7 | 4048 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 1279 | 1045 | 0 | 0 | 7 | 2324 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 2451 | 2012 | 10 | 0 | 7 | 4463 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 2868 | 2407 | 10 | 0 | 7 | 5275 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 1779 | 1532 | 10 | 0 | 7 | 3311 |
+//! | `momentum` * | — | — | 356 | 285 | 0 | 0 | 7 | 641 |
+//! | `base_reaction` * | — | `recurrent` | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | `base_reaction` | — | `kane-direct` | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | `base_reaction` | — | `rnea` | 694 | 568 | 0 | 0 | 7 | 1262 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -96,8 +97,8 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 773u64,
-            add: 575u64,
+            mul: 654u64,
+            add: 545u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -107,8 +108,8 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 741u64,
-            add: 571u64,
+            mul: 637u64,
+            add: 504u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -118,8 +119,8 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 771u64,
-            add: 606u64,
+            mul: 676u64,
+            add: 550u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -129,8 +130,8 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1997u64,
-            add: 1568u64,
+            mul: 1779u64,
+            add: 1484u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -140,8 +141,8 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1497u64,
-            add: 1128u64,
+            mul: 1279u64,
+            add: 1045u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -151,8 +152,8 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1997u64,
-            add: 1616u64,
+            mul: 1779u64,
+            add: 1532u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -162,8 +163,8 @@ impl FreeFloating7 {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
-            mul: 407u64,
-            add: 315u64,
+            mul: 356u64,
+            add: 285u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -173,8 +174,8 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 741u64,
-            add: 582u64,
+            mul: 694u64,
+            add: 568u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -187,8 +188,8 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
-            mul: 1852u64,
-            add: 2503u64,
+            mul: 1831u64,
+            add: 2489u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -198,8 +199,8 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
-            mul: 2131u64,
-            add: 2572u64,
+            mul: 2110u64,
+            add: 2558u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -209,8 +210,8 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
-            mul: 3664u64,
-            add: 3020u64,
+            mul: 3460u64,
+            add: 2896u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -220,8 +221,8 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
-            mul: 1330u64,
-            add: 1054u64,
+            mul: 1309u64,
+            add: 1040u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -231,8 +232,8 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 773u64,
-            add: 575u64,
+            mul: 654u64,
+            add: 545u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -242,8 +243,8 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 1174u64,
-            add: 898u64,
+            mul: 1153u64,
+            add: 884u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -253,8 +254,8 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 1642u64,
-            add: 1322u64,
+            mul: 1570u64,
+            add: 1279u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -264,8 +265,8 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 741u64,
-            add: 571u64,
+            mul: 637u64,
+            add: 504u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -275,8 +276,8 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 771u64,
-            add: 606u64,
+            mul: 676u64,
+            add: 550u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -286,8 +287,8 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 771u64,
-            add: 606u64,
+            mul: 676u64,
+            add: 550u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -297,8 +298,8 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 771u64,
-            add: 606u64,
+            mul: 676u64,
+            add: 550u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -308,8 +309,8 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 2447u64,
-            add: 1899u64,
+            mul: 2307u64,
+            add: 1868u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -319,8 +320,8 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 2915u64,
-            add: 2323u64,
+            mul: 2724u64,
+            add: 2263u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -330,8 +331,8 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1997u64,
-            add: 1568u64,
+            mul: 1779u64,
+            add: 1484u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -341,8 +342,8 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 1947u64,
-            add: 1459u64,
+            mul: 1807u64,
+            add: 1429u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -352,8 +353,8 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 2415u64,
-            add: 1883u64,
+            mul: 2224u64,
+            add: 1824u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -363,8 +364,8 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1497u64,
-            add: 1128u64,
+            mul: 1279u64,
+            add: 1045u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -374,8 +375,8 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 2591u64,
-            add: 2043u64,
+            mul: 2451u64,
+            add: 2012u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -385,8 +386,8 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 3059u64,
-            add: 2467u64,
+            mul: 2868u64,
+            add: 2407u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -396,8 +397,8 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1997u64,
-            add: 1616u64,
+            mul: 1779u64,
+            add: 1532u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -407,8 +408,8 @@ impl FreeFloating7 {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
-            mul: 407u64,
-            add: 315u64,
+            mul: 356u64,
+            add: 285u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -418,8 +419,8 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 741u64,
-            add: 582u64,
+            mul: 694u64,
+            add: 568u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -429,8 +430,8 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 741u64,
-            add: 582u64,
+            mul: 694u64,
+            add: 568u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -440,8 +441,8 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 741u64,
-            add: 582u64,
+            mul: 694u64,
+            add: 568u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -450,2757 +451,2711 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 773 mul, 575 add, 0 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: mass matrix `crba`: 654 mul, 545 add, 0 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x1 = c_q7 + (1.0 - c_q7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x3 = c_q8 + (1.0 - c_q8);
-        let x4 = -0.00000000020510342851533115 * c_q8;
-        let x5 = -0.00000000020510342851533115 * s_q8;
-        let x6 = -0.00000000020510342851533115 * x3;
+        let x2 = -0.00000000020510342851533115 * c_q8;
+        let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x8 = c_q9 + (1.0 - c_q9);
-        let x9 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x10 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x11 = 0.00000000020510342851533115 * x8;
-        let x12 = 0.00000000020510342851533115 * c_q9
+        let x5 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x6 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x7 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x13 = -0.00000000020510342851533115 * c_q9
+        let x8 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x14 = -0.00000000020510342851533115 * x8;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x16 = c_q10 + (1.0 - c_q10);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x18 = c_q11 + (1.0 - c_q11);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x20 = c_q12 + (1.0 - c_q12);
-        let x21 = -0.00000000020510342851533115 * s_q12;
-        let x22 = -0.00000000020510342851533115 * c_q12;
-        let x23 = -0.00000000020510342851533115 * x20;
+        let x12 = -0.00000000020510342851533115 * s_q12;
+        let x13 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x25 = c_q13 + (1.0 - c_q13);
-        let x26 = -0.00000000020510342851533115 * c_q13;
-        let x27 = -0.00000000020510342851533115 * s_q13;
-        let x28 = -0.00000000020510342851533115 * x25;
-        let x29 = x25 * 3.6140000000000003 - x27 * 4.806620000000001;
-        let x30 = c_q13 * 4.806620000000001;
-        let x31 = s_q13 * 4.806620000000001 + x28 * 3.6140000000000003;
-        let x32 = x30 + 9.938500000000001;
-        let x33 = x31 + 2.8912;
-        let x34 = x26 * 2.1663609200000002 - 0.000781 * x27 + -0.0145 * x25;
-        let x35 = 0.000781 * x26 - x27 * 0.9638000000000001 + x25 * -0.9614610000000001;
-        let x36 = -0.0145 * x26 - x27 * -0.9614610000000001 + x25 * 1.4135609200000003;
-        let x37 = 0.000781 * c_q13;
-        let x38 = s_q13 * 2.1663609200000002 + x37;
-        let x39 = 0.000781 * s_q13;
-        let x40 = x39 + c_q13 * 0.9638000000000001;
-        let x41 = -0.0145 * s_q13 + c_q13 * -0.9614610000000001;
-        let x42 = x39 - c_q13 * 2.1663609200000002 + -0.0145 * x28;
-        let x43 = s_q13 * 0.9638000000000001 - x37 + x28 * -0.9614610000000001;
-        let x44 = s_q13 * -0.9614610000000001 - -0.0145 * c_q13
-            + x28 * 1.4135609200000003;
-        let x45 = s_q13 * x34 + c_q13 * x35 - 0.55 * x29;
-        let x46 = x26 * x38 - x27 * x40 + x25 * x41 + x29 * -0.55;
-        let x47 = 7.196750000000001 + x32;
-        let x48 = 4.187200000000001 + x33;
-        let x49 = 3.2217582500000006
-            + (x26 * x34 - x27 * x35 + x25 * x36 - (-0.16 * x31 - 0.55 * x30)
-                - (x32 * -0.55 - 0.16 * x33));
-        let x50 = -0.2313 + (s_q13 * x35 - c_q13 * x34 + x28 * x36 + -0.16 * x29);
-        let x51 = 1.2686520000000001
-            + (s_q13 * x38 + c_q13 * x40 + 0.16 * x31 - -0.16 * x33);
-        let x52 = -1.1514800000000003
-            + (s_q13 * x40 - c_q13 * x38 + x28 * x41 - 0.16 * x30 - 0.55 * x33);
-        let x53 = -0.2313 + (x26 * x42 - x27 * x43 + x25 * x44 - 0.16 * x29);
-        let x54 = -1.1514800000000003
-            + (s_q13 * x42 + c_q13 * x43 + x31 * -0.55 + -0.16 * x32);
-        let x55 = 2.1079062500000005
-            + (s_q13 * x43 - c_q13 * x42 + x28 * x44 - x30 * -0.55 + 0.55 * x32);
-        let x56 = c_q12 * x29;
-        let x57 = s_q12 * x47;
-        let x58 = x56 - x57;
-        let x59 = x21 * x29 + x22 * x47 + x20 * x48;
-        let x60 = s_q12 * x29 + c_q12 * x47;
-        let x61 = x23 * x48 - x60;
-        let x62 = x61 + -15.926400000000001;
-        let x63 = c_q12 * x49 - s_q12 * x46;
-        let x64 = c_q12 * x45 - s_q12 * x51;
-        let x65 = c_q12 * x50 - s_q12 * x52;
-        let x66 = x21 * x49 + x22 * x46 + x20 * x53;
-        let x67 = x21 * x45 + x22 * x51 + x20 * x54;
-        let x68 = x21 * x50 + x22 * x52 + x20 * x55;
-        let x69 = x23 * x53 - (s_q12 * x49 + c_q12 * x46);
-        let x70 = x23 * x54 - (s_q12 * x45 + c_q12 * x51);
-        let x71 = x23 * x55 - (s_q12 * x50 + c_q12 * x52);
-        let x72 = x21 * x63 + x22 * x64 + x20 * x65;
-        let x73 = c_q12 * x66 - s_q12 * x67;
-        let x74 = x23 * x68 - (s_q12 * x66 + c_q12 * x67) - -0.36 * x59;
-        let x75 = 0.9304999999999999
-            + (c_q12 * x63 - s_q12 * x64 - x61 * 0.36 + -0.36 * x62);
-        let x76 = 0.01675 + (x23 * x65 - (s_q12 * x63 + c_q12 * x64) + x58 * 0.36);
-        let x77 = 0.939 + (x21 * x66 + x22 * x67 + x20 * x68 + -0.36 * x61 - x62 * 0.36);
-        let x78 = 0.07271 + (x23 * x71 - (s_q12 * x69 + c_q12 * x70));
-        let x79 = c_q11 * x58 - s_q11 * x59;
-        let x80 = s_q11 * x58 + c_q11 * x59;
-        let x81 = x18 * (-3.0149999999999997 + x62);
-        let x82 = x80 + -38.423700000000004;
-        let x83 = x81 + -16.772250000000003;
-        let x84 = c_q11 * x75 - s_q11 * x73;
-        let x85 = c_q11 * x72 - s_q11 * x77;
-        let x86 = c_q11 * x76 - s_q11 * x74;
-        let x87 = s_q11 * x75 + c_q11 * x73;
-        let x88 = s_q11 * x72 + c_q11 * x77;
-        let x89 = s_q11 * x76 + c_q11 * x74;
-        let x90 = x18 * (0.01675 + (c_q12 * x69 - s_q12 * x70 - -0.36 * x58));
-        let x91 = x18 * (x21 * x69 + x22 * x70 + x20 * x71 + x59 * 0.36);
-        let x92 = x18 * x78;
-        let x93 = 0.275 * x79;
-        let x94 = -0.275 * x80;
-        let x95 = x80 * 0.63;
-        let x96 = s_q11 * x84 + c_q11 * x85 - -0.63 * x79;
-        let x97 = c_q11 * x87 - s_q11 * x88 + x79 * 0.63;
-        let x98 = -6.7347 + x82;
-        let x99 = 4.170993
-            + (c_q11 * x84 - s_q11 * x85 - (0.275 * x81 - -0.63 * x80)
-                - (x82 * 0.63 - -0.275 * x83));
-        let x100 = -0.6328 + (x18 * x86 + x93);
-        let x101 = 3.8828625 + (s_q11 * x87 + c_q11 * x88 + -0.275 * x81 - 0.275 * x83);
-        let x102 = -1.8520425 + (x18 * x89 - x94 - -0.63 * x83);
-        let x103 = 4.0324305 + (x18 * x92 - x95 + -0.63 * x82);
-        let x104 = c_q10 * x79;
-        let x105 = x104 - s_q10 * x98;
-        let x106 = s_q10 * x79;
-        let x107 = x106 + c_q10 * x98;
-        let x108 = x16 * (-5.8795 + x83);
-        let x109 = x107 + -71.6619;
-        let x110 = c_q10 * x99 - s_q10 * x97;
-        let x111 = c_q10 * x96 - s_q10 * x101;
-        let x112 = c_q10 * x100 - s_q10 * x102;
-        let x113 = s_q10 * x99 + c_q10 * x97;
-        let x114 = s_q10 * x96 + c_q10 * x101;
-        let x115 = s_q10 * x100 + c_q10 * x102;
-        let x116 = x16 * (-0.6328 + (c_q11 * x90 - s_q11 * x91 - -0.275 * x79));
-        let x117 = x16
-            * (-1.8520425 + (s_q11 * x90 + c_q11 * x91 + x81 * 0.63 + 0.275 * x82));
-        let x118 = x16 * x103;
-        let x119 = x107 * 0.87;
-        let x120 = s_q10 * x110 + c_q10 * x111 - -0.87 * x105;
-        let x121 = s_q10 * x116 + c_q10 * x117 + x108 * 0.87;
-        let x122 = c_q10 * x113 - s_q10 * x114 + x105 * 0.87;
-        let x123 = x16 * x115 - -0.87 * x108;
-        let x124 = -9.87015 + x109;
-        let x125 = 4.395515250000001
-            + (c_q10 * x110 - s_q10 * x111 + -0.87 * x107 - x109 * 0.87);
-        let x126 = -0.00214 + x16 * x112;
-        let x127 = 3.378 + (s_q10 * x113 + c_q10 * x114);
-        let x128 = -0.00214 + (c_q10 * x116 - s_q10 * x117);
-        let x129 = 7.65251525 + (x16 * x118 - x119 + -0.87 * x109);
-        let x130 = x9 * x105 + x10 * x124 + x11 * x108;
-        let x131 = x12 * x105 + x13 * x124 + x8 * x108;
-        let x132 = c_q9 * x105 - s_q9 * x124 + x14 * x108;
-        let x133 = x131 + 28.891500000000004;
-        let x134 = x132 + 42.024;
-        let x135 = x9 * x125 + x10 * x122 + x11 * x128;
-        let x136 = x9 * x120 + x10 * x127 + x11 * x121;
-        let x137 = x9 * x126 + x10 * x123 + x11 * x129;
-        let x138 = x12 * x125 + x13 * x122 + x8 * x128;
-        let x139 = x12 * x120 + x13 * x127 + x8 * x121;
-        let x140 = x12 * x126 + x13 * x123 + x8 * x129;
-        let x141 = c_q9 * x125 - s_q9 * x122 + x14 * x128;
-        let x142 = c_q9 * x120 - s_q9 * x127 + x14 * x121;
-        let x143 = c_q9 * x126 - s_q9 * x123 + x14 * x129;
-        let x144 = x12 * x135 + x13 * x136 + x8 * x137 - 0.275 * x130;
-        let x145 = x9 * x138 + x10 * x139 + x11 * x140 + -0.275 * x130;
-        let x146 = c_q9 * x138 - s_q9 * x139 + x14 * x140 - 0.4 * x131 - 0.275 * x134;
-        let x147 = x12 * x141 + x13 * x142 + x8 * x143 + -0.275 * x132 + x133 * -0.4;
-        let x148 = 6.0 + x134;
-        let x149 = 3.3000000000000003
-            + (x9 * x135 + x10 * x136 + x11 * x137 - (x132 * -0.4 - 0.275 * x131)
-                - (-0.275 * x133 - 0.4 * x134));
-        let x150 = -0.00214 + (c_q9 * x135 - s_q9 * x136 + x14 * x137 + x130 * -0.4);
-        let x151 = 2.5780000000000003
-            + (x12 * x138 + x13 * x139 + x8 * x140 + 0.4 * x132 - x134 * -0.4);
-        let x152 = -0.00214 + (x9 * x141 + x10 * x142 + x11 * x143 - 0.4 * x130);
-        let x153 = 2.359
-            + (c_q9 * x141 - s_q9 * x142 + x14 * x143 - -0.275 * x131 + 0.275 * x133);
-        let x154 = x4 * x130 - x5 * x133 + x3 * x148;
-        let x155 = s_q8 * x130 + c_q8 * x133;
-        let x156 = c_q8 * x130;
-        let x157 = s_q8 * x133;
-        let x158 = x157 - x156 + x6 * x148;
-        let x159 = x158 + 47.271;
-        let x160 = x4 * x149 - x5 * x145 + x3 * x152;
-        let x161 = x4 * x144 - x5 * x151 + x3 * x147;
-        let x162 = x4 * x150 - x5 * x146 + x3 * x153;
-        let x163 = s_q8 * x149 + c_q8 * x145;
-        let x164 = s_q8 * x144 + c_q8 * x151;
-        let x165 = s_q8 * x150 + c_q8 * x146;
-        let x166 = s_q8 * x146 - c_q8 * x150 + x6 * x153;
-        let x167 = 2.29018125
-            + (x4 * x160 - x5 * x161 + x3 * x162 - x158 * -0.35 + 0.35 * x159);
-        let x168 = -0.07309 + (s_q8 * x160 + c_q8 * x161);
-        let x169 = 0.00071 + (s_q8 * x161 - c_q8 * x160 + x6 * x162 + x154 * -0.35);
-        let x170 = -0.07309 + (x4 * x163 - x5 * x164 + x3 * x165);
-        let x171 = 1.5853812499999997
-            + (s_q8 * x163 + c_q8 * x164 + 0.35 * x158 - x159 * -0.35);
-        let x172 = 0.1132 + (s_q8 * x164 - c_q8 * x163 + x6 * x165 - 0.35 * x155);
-        let x173 = 1.331
-            + (s_q8 * (s_q8 * x151 - c_q8 * x144 + x6 * x147)
-                - c_q8 * (s_q8 * x145 - c_q8 * x149 + x6 * x152) + x6 * x166);
-        let x174 = c_q7 * x154 - s_q7 * x155;
-        let x175 = s_q7 * x154 + c_q7 * x155;
-        let x176 = x1 * (6.1267499999999995 + x159);
-        let x177 = x174 + 110.5455;
-        let x178 = x176 + 127.5525;
-        let x179 = c_q7 * x167 - s_q7 * x170;
-        let x180 = c_q7 * x168 - s_q7 * x171;
-        let x181 = c_q7 * x169 - s_q7 * x172;
-        let x182 = s_q7 * x169 + c_q7 * x172;
-        let x183 = x1 * x173;
-        let x184 = -x175;
-        let x185 = x174 * -0.75;
-        let x186 = 0.75 * x175;
-        let x187 = 0.65 * x174;
-        let x188 = x1 * x182 - x186;
-        let x189 = -x178;
-        let x190 = -x177;
-        let x191 = s_q7 * x179 + c_q7 * x180 - 0.65 * x175;
-        let x192 = x1 * x181 + x185 + x178 * -0.65;
-        let x193 = 1200.0 + (c_q7 * x179 - s_q7 * x180 - x176 * -0.75 + 0.75 * x178);
-        let x194 = 1200.0
-            + (s_q7 * (s_q7 * x167 + c_q7 * x170) + c_q7 * (s_q7 * x168 + c_q7 * x171)
-                - (x174 * -0.65 - 0.75 * x176) - (x178 * -0.75 - 0.65 * x177));
-        let x195 = 1200.0 + (x1 * x183 + x187 - x177 * -0.65);
-        let x196 = x181 + x185;
-        let x197 = x182 - x186;
-        let x198 = x183 + x187;
-        let x199 = x4 * x133 + x5 * x130;
-        let x200 = x156 - x157;
-        let x201 = x162 + -0.35 * x200;
-        let x202 = x165 - 0.35 * x199;
-        let x203 = c_q7 * x199 + s_q7 * x200;
-        let x204 = -x203;
-        let x205 = c_q7 * x200 - s_q7 * x199;
-        let x206 = x1 * x155;
-        let x207 = c_q7 * x201 - s_q7 * x202 + -0.75 * x205;
-        let x208 = s_q7 * x201 + c_q7 * x202 + (-0.65 * x206 - 0.75 * x203);
-        let x209 = x1 * x166 + 0.65 * x205;
-        let x210 = x10 * x105;
-        let x211 = x210 - x9 * x124;
-        let x212 = x13 * x105;
-        let x213 = x212 - x12 * x124;
-        let x214 = s_q9 * x105;
-        let x215 = c_q9 * x124 + x214;
-        let x216 = x137 + (-0.4 * x213 - 0.275 * x215);
-        let x217 = x140 + 0.4 * x211;
-        let x218 = x143 + -0.275 * x211;
-        let x219 = x4 * x211 - x5 * x213 - x3 * x215;
-        let x220 = s_q8 * x211 + c_q8 * x213;
-        let x221 = s_q8 * x217 - c_q8 * x216 + x6 * x218;
-        let x222 = x4 * x216 - x5 * x217 + x3 * x218 + -0.35 * x220;
-        let x223 = s_q8 * x216 + c_q8 * x217 + 0.35 * x219;
-        let x224 = c_q7 * x219 - s_q7 * x220;
-        let x225 = s_q7 * x219 + c_q7 * x220;
-        let x226 = x1 * (s_q8 * x213 - c_q8 * x211 - x6 * x215);
-        let x227 = c_q7 * x222 - s_q7 * x223 + -0.75 * x225;
-        let x228 = s_q7 * x222 + c_q7 * x223 + (0.75 * x224 + -0.65 * x226);
-        let x229 = x1 * x221 + 0.65 * x225;
-        let x230 = x118 - x119;
-        let x231 = x210 - x9 * x107;
-        let x232 = x212 - x12 * x107;
-        let x233 = x214 + c_q9 * x107;
-        let x234 = x9 * x112 + x10 * x115 + x11 * x230 + (-0.4 * x232 - 0.275 * x233);
-        let x235 = x12 * x112 + x13 * x115 + x8 * x230 + 0.4 * x231;
-        let x236 = c_q9 * x112 - s_q9 * x115 + x14 * x230 + -0.275 * x231;
-        let x237 = x4 * x231 - x5 * x232 - x3 * x233;
-        let x238 = s_q8 * x231 + c_q8 * x232;
-        let x239 = s_q8 * x235 - c_q8 * x234 + x6 * x236;
-        let x240 = x4 * x234 - x5 * x235 + x3 * x236 + -0.35 * x238;
-        let x241 = s_q8 * x234 + c_q8 * x235 + 0.35 * x237;
-        let x242 = c_q7 * x237 - s_q7 * x238;
-        let x243 = s_q7 * x237 + c_q7 * x238;
-        let x244 = x1 * (s_q8 * x232 - c_q8 * x231 - x6 * x233);
-        let x245 = c_q7 * x240 - s_q7 * x241 + -0.75 * x243;
-        let x246 = s_q7 * x240 + c_q7 * x241 + (0.75 * x242 + -0.65 * x244);
-        let x247 = x1 * x239 + 0.65 * x243;
-        let x248 = x86 + x93;
-        let x249 = x89 - x94;
-        let x250 = x92 - x95;
-        let x251 = x106 + c_q10 * x80;
-        let x252 = x104 - s_q10 * x80;
-        let x253 = c_q10 * x248 - s_q10 * x249;
-        let x254 = s_q10 * x248 + c_q10 * x249;
-        let x255 = x16 * x250 - 0.87 * x251;
-        let x256 = x10 * x252 - x9 * x251;
-        let x257 = x13 * x252 - x12 * x251;
-        let x258 = c_q9 * x251 + s_q9 * x252;
-        let x259 = x9 * x253 + x10 * x254 + x11 * x255 + (-0.4 * x257 - 0.275 * x258);
-        let x260 = x12 * x253 + x13 * x254 + x8 * x255 + 0.4 * x256;
-        let x261 = c_q9 * x253 - s_q9 * x254 + x14 * x255 + -0.275 * x256;
-        let x262 = x4 * x256 - x5 * x257 - x3 * x258;
-        let x263 = s_q8 * x256 + c_q8 * x257;
-        let x264 = s_q8 * x260 - c_q8 * x259 + x6 * x261;
-        let x265 = x4 * x259 - x5 * x260 + x3 * x261 + -0.35 * x263;
-        let x266 = s_q8 * x259 + c_q8 * x260 + 0.35 * x262;
-        let x267 = c_q7 * x262 - s_q7 * x263;
-        let x268 = s_q7 * x262 + c_q7 * x263;
-        let x269 = x1 * (s_q8 * x257 - c_q8 * x256 - x6 * x258);
-        let x270 = c_q7 * x265 - s_q7 * x266 + -0.75 * x268;
-        let x271 = s_q7 * x265 + c_q7 * x266 + (0.75 * x267 + -0.65 * x269);
-        let x272 = x1 * x264 + 0.65 * x268;
-        let x273 = x22 * x29 - x21 * x47;
-        let x274 = x65 + 0.36 * x273;
-        let x275 = x68 - -0.36 * x60;
-        let x276 = c_q11 * x60 + s_q11 * x273;
-        let x277 = c_q11 * x273 - s_q11 * x60;
-        let x278 = x18 * (x57 - x56);
-        let x279 = c_q11 * x274 - s_q11 * x275 + (0.275 * x277 + -0.63 * x278);
-        let x280 = s_q11 * x274 + c_q11 * x275 - -0.275 * x276;
-        let x281 = x18 * x71 - 0.63 * x276;
-        let x282 = c_q10 * x276 + s_q10 * x277;
-        let x283 = c_q10 * x277 - s_q10 * x276;
-        let x284 = x16 * x278;
-        let x285 = s_q10 * x279 + c_q10 * x280;
-        let x286 = c_q10 * x279 - s_q10 * x280 + -0.87 * x284;
-        let x287 = x16 * x281 - 0.87 * x282;
-        let x288 = x10 * x283 - x9 * x282 + x11 * x284;
-        let x289 = x13 * x283 - x12 * x282 + x8 * x284;
-        let x290 = x14 * x284 - (c_q9 * x282 + s_q9 * x283);
-        let x291 = x9 * x286 + x10 * x285 + x11 * x287 + (-0.4 * x289 + 0.275 * x290);
-        let x292 = x12 * x286 + x13 * x285 + x8 * x287 + 0.4 * x288;
-        let x293 = c_q9 * x286 - s_q9 * x285 + x14 * x287 + -0.275 * x288;
-        let x294 = x4 * x288 - x5 * x289 + x3 * x290;
-        let x295 = s_q8 * x288 + c_q8 * x289;
-        let x296 = s_q8 * x292 - c_q8 * x291 + x6 * x293;
-        let x297 = x4 * x291 - x5 * x292 + x3 * x293 + -0.35 * x295;
-        let x298 = s_q8 * x291 + c_q8 * x292 + 0.35 * x294;
-        let x299 = c_q7 * x294 - s_q7 * x295;
-        let x300 = s_q7 * x294 + c_q7 * x295;
-        let x301 = x1 * (s_q8 * x289 - c_q8 * x288 + x6 * x290);
-        let x302 = c_q7 * x297 - s_q7 * x298 + -0.75 * x300;
-        let x303 = s_q7 * x297 + c_q7 * x298 + (0.75 * x299 + -0.65 * x301);
-        let x304 = x1 * x296 + 0.65 * x300;
-        let x305 = x26 * -4.806620000000001;
-        let x306 = s_q13 * -4.806620000000001;
-        let x307 = c_q13 * -4.806620000000001;
-        let x308 = x36 + (-0.16 * x306 - 0.55 * x307);
-        let x309 = x41 + 0.16 * x305;
-        let x310 = x44 + -0.55 * x305;
-        let x311 = c_q12 * x305 - s_q12 * x306;
-        let x312 = x21 * x305 + x22 * x306 - x20 * x307;
-        let x313 = x23 * x310 - (s_q12 * x308 + c_q12 * x309);
-        let x314 = c_q12 * x308 - s_q12 * x309 + 0.36 * x312;
-        let x315 = x21 * x308 + x22 * x309 + x20 * x310 + -0.36 * x311;
-        let x316 = c_q11 * x311 - s_q11 * x312;
-        let x317 = s_q11 * x311 + c_q11 * x312;
-        let x318 = x18 * (s_q12 * x305 + c_q12 * x306 + x23 * x307);
-        let x319 = c_q11 * x314 - s_q11 * x315 + (0.275 * x317 - -0.63 * x318);
-        let x320 = s_q11 * x314 + c_q11 * x315 + -0.275 * x316;
-        let x321 = x18 * x313 + 0.63 * x316;
-        let x322 = c_q10 * x316 - s_q10 * x317;
-        let x323 = s_q10 * x316 + c_q10 * x317;
-        let x324 = x16 * x318;
-        let x325 = s_q10 * x319 + c_q10 * x320;
-        let x326 = c_q10 * x319 - s_q10 * x320 - -0.87 * x324;
-        let x327 = x16 * x321 + 0.87 * x322;
-        let x328 = x9 * x322 + x10 * x323 - x11 * x324;
-        let x329 = x12 * x322 + x13 * x323 - x8 * x324;
-        let x330 = c_q9 * x322 - s_q9 * x323 - x14 * x324;
-        let x331 = x9 * x326 + x10 * x325 + x11 * x327 + (-0.4 * x329 + 0.275 * x330);
-        let x332 = x12 * x326 + x13 * x325 + x8 * x327 + 0.4 * x328;
-        let x333 = c_q9 * x326 - s_q9 * x325 + x14 * x327 + -0.275 * x328;
-        let x334 = x4 * x328 - x5 * x329 + x3 * x330;
-        let x335 = s_q8 * x328 + c_q8 * x329;
-        let x336 = s_q8 * x332 - c_q8 * x331 + x6 * x333;
-        let x337 = x4 * x331 - x5 * x332 + x3 * x333 + -0.35 * x335;
-        let x338 = s_q8 * x331 + c_q8 * x332 + 0.35 * x334;
-        let x339 = c_q7 * x334 - s_q7 * x335;
-        let x340 = s_q7 * x334 + c_q7 * x335;
-        let x341 = x1 * (s_q8 * x329 - c_q8 * x328 + x6 * x330);
-        let x342 = c_q7 * x337 - s_q7 * x338 + -0.75 * x340;
-        let x343 = s_q7 * x337 + c_q7 * x338 + (0.75 * x339 + -0.65 * x341);
-        let x344 = x1 * x336 + 0.65 * x340;
+        let x15 = -0.00000000020510342851533115 * c_q13;
+        let x16 = -0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = -0.0145 - 0.000781 * x16;
+        let x21 = -0.9614610000000001 + (0.000781 * x15 - -1.2025609200000003 * x16);
+        let x22 = 1.4135609200000003 + (-0.0145 * x15 - -0.9614610000000001 * x16);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = x24 + -1.2025609200000003 * c_q13;
+        let x26 = -0.0145 * s_q13 + -0.9614610000000001 * c_q13;
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = -1.2025609200000003 * s_q13 - x23 + 0.00000000019719894748377882;
+        let x29 = -0.9614610000000001 * s_q13 - -0.0145 * c_q13
+            + -0.0000000002899261911072858;
+        let x30 = -0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = 0.16 * x19;
+        let x33 = x18 * -0.55;
+        let x34 = x22 + (x15 * x20 - x16 * x21) - (x30 - x31) - (x33 - x32);
+        let x35 = 3.6140000000000003 - x17;
+        let x36 = 17.135250000000003 + x18;
+        let x37 = -1.9877000000000002 + (s_q13 * x20 + c_q13 * x21 + 0.55 * x17);
+        let x38 = -0.809539999555672
+            + (s_q13 * x21 - c_q13 * x20 + -0.00000000020510342851533115 * x22
+                - -0.16 * x17);
+        let x39 = -1.9877000000000002 + (x26 + (x15 * x23 - x16 * x25) - x17 * -0.55);
+        let x40 = -5.252920330000002 + (s_q13 * x23 + c_q13 * x25 + x32 - x30);
+        let x41 = -2.741639999592316
+            + (s_q13 * x25 - c_q13 * x23 + -0.00000000020510342851533115 * x26
+                - 0.16 * x18 - 0.55 * x19);
+        let x42 = -0.809539999555672 + (x29 + (x15 * x27 - x16 * x28) + 0.16 * x17);
+        let x43 = -2.7416399995923166
+            + (s_q13 * x27 + c_q13 * x28 + x19 * -0.55 + -0.16 * x18);
+        let x44 = 9.740442170000001
+            + (x31
+                + (s_q13 * x28 - c_q13 * x27 + -0.00000000020510342851533115 * x29
+                    - x33));
+        let x45 = c_q12 * x35;
+        let x46 = s_q12 * x36;
+        let x47 = x45 - x46;
+        let x48 = x19 + (x12 * x35 + x13 * x36);
+        let x49 = s_q12 * x35 + c_q12 * x36;
+        let x50 = -0.00000000020510342851533115 * x19 - x49;
+        let x51 = c_q12 * x34 - s_q12 * x39;
+        let x52 = c_q12 * x37 - s_q12 * x40;
+        let x53 = c_q12 * x38 - s_q12 * x41;
+        let x54 = x42 + (x12 * x34 + x13 * x39);
+        let x55 = x43 + (x12 * x37 + x13 * x40);
+        let x56 = x44 + (x12 * x38 + x13 * x41);
+        let x57 = -0.00000000020510342851533115 * x42 - (s_q12 * x34 + c_q12 * x39);
+        let x58 = -0.00000000020510342851533115 * x43 - (s_q12 * x37 + c_q12 * x40);
+        let x59 = -0.00000000020510342851533115 * x44 - (s_q12 * x38 + c_q12 * x41);
+        let x60 = x53 + (x12 * x51 + x13 * x52);
+        let x61 = c_q12 * x54 - s_q12 * x55;
+        let x62 = x50 * 0.36;
+        let x63 = -0.36 * x50;
+        let x64 = x63 + (c_q12 * x51 - s_q12 * x52 - x62);
+        let x65 = 7.078399999258757 + x48;
+        let x66 = 0.01675
+            + (-0.00000000020510342851533115 * x53 - (s_q12 * x51 + c_q12 * x52)
+                + x47 * 0.36);
+        let x67 = -9.142025249762803 + (x56 + (x12 * x54 + x13 * x55) + x63 - x62);
+        let x68 = 2.5482240016099564
+            + (-0.00000000020510342851533115 * x56 - (s_q12 * x54 + c_q12 * x55)
+                - -0.36 * x48);
+        let x69 = 0.01675 + (c_q12 * x57 - s_q12 * x58 - -0.36 * x47);
+        let x70 = 2.5482240016099564 + (x59 + (x12 * x57 + x13 * x58) + x48 * 0.36);
+        let x71 = 9.223235249762805
+            + (-0.00000000020510342851533115 * x59 - (s_q12 * x57 + c_q12 * x58));
+        let x72 = c_q11 * x47 - s_q11 * x65;
+        let x73 = s_q11 * x47 + c_q11 * x65;
+        let x74 = c_q11 * x64 - s_q11 * x61;
+        let x75 = c_q11 * x60 - s_q11 * x67;
+        let x76 = s_q11 * x64 + c_q11 * x61;
+        let x77 = s_q11 * x60 + c_q11 * x67;
+        let x78 = 0.275 * x50;
+        let x79 = -0.63 * x73;
+        let x80 = -0.275 * x50;
+        let x81 = x73 * 0.63;
+        let x82 = s_q11 * x74 + c_q11 * x75 - -0.63 * x72;
+        let x83 = c_q11 * x66 - s_q11 * x68 + 0.275 * x72;
+        let x84 = s_q11 * x66 + c_q11 * x68 - -0.275 * x73;
+        let x85 = x71 - x81;
+        let x86 = c_q11 * x74 - s_q11 * x75 - (x78 - x79) - (x81 - x80);
+        let x87 = c_q11 * x76 - s_q11 * x77 + x72 * 0.63;
+        let x88 = -45.1584 + x73;
+        let x89 = -0.6328 + x83;
+        let x90 = -24.4950615 + (s_q11 * x76 + c_q11 * x77 + x80 - x78);
+        let x91 = -24.35164200091464 + (x84 - -0.63 * x50);
+        let x92 = -0.6328 + (c_q11 * x69 - s_q11 * x70 - -0.275 * x72);
+        let x93 = -24.351642000914637
+            + (s_q11 * x69 + c_q11 * x70 + x50 * 0.63 + 0.275 * x73);
+        let x94 = 28.2393615 + (x79 + x85);
+        let x95 = c_q10 * x72;
+        let x96 = x95 - s_q10 * x88;
+        let x97 = s_q10 * x72;
+        let x98 = x97 + c_q10 * x88;
+        let x99 = c_q10 * x86 - s_q10 * x87;
+        let x100 = c_q10 * x82 - s_q10 * x90;
+        let x101 = c_q10 * x89 - s_q10 * x91;
+        let x102 = s_q10 * x86 + c_q10 * x87;
+        let x103 = s_q10 * x82 + c_q10 * x90;
+        let x104 = s_q10 * x89 + c_q10 * x91;
+        let x105 = -0.87 * x98;
+        let x106 = x98 * 0.87;
+        let x107 = s_q10 * x99 + c_q10 * x100 - -0.87 * x96;
+        let x108 = x94 - x106;
+        let x109 = c_q10 * x99 - s_q10 * x100 + x105 - x106;
+        let x110 = c_q10 * x102 - s_q10 * x103 + x96 * 0.87;
+        let x111 = -81.53205 + x98;
+        let x112 = -0.00214 + x101;
+        let x113 = -63.36336825000001 + (s_q10 * x102 + c_q10 * x103);
+        let x114 = -36.18604050126307 + (x104 - -0.87 * x50);
+        let x115 = -0.00214 + (c_q10 * x92 - s_q10 * x93);
+        let x116 = -36.18604050126307 + (s_q10 * x92 + c_q10 * x93 + x50 * 0.87);
+        let x117 = 69.99836825 + (x105 + x108);
+        let x118 = x5 * x96 + x6 * x111 + 0.00000000020510342851533115 * x50;
+        let x119 = x50 + (x7 * x96 + x8 * x111);
+        let x120 = c_q9 * x96 - s_q9 * x111 + -0.00000000020510342851533115 * x50;
+        let x121 = x5 * x109 + x6 * x110 + 0.00000000020510342851533115 * x115;
+        let x122 = x5 * x107 + x6 * x113 + 0.00000000020510342851533115 * x116;
+        let x123 = x5 * x112 + x6 * x114 + 0.00000000020510342851533115 * x117;
+        let x124 = x115 + (x7 * x109 + x8 * x110);
+        let x125 = x116 + (x7 * x107 + x8 * x113);
+        let x126 = x117 + (x7 * x112 + x8 * x114);
+        let x127 = c_q9 * x109 - s_q9 * x110 + -0.00000000020510342851533115 * x115;
+        let x128 = c_q9 * x107 - s_q9 * x113 + -0.00000000020510342851533115 * x116;
+        let x129 = c_q9 * x112 - s_q9 * x114 + -0.00000000020510342851533115 * x117;
+        let x130 = x120 * -0.4;
+        let x131 = 0.275 * x119;
+        let x132 = 0.4 * x120;
+        let x133 = -0.275 * x119;
+        let x134 = x5 * x121 + x6 * x122 + 0.00000000020510342851533115 * x123
+            - (x130 - x131) - (x133 - x132);
+        let x135 = -0.000000008530897668050218 + x118;
+        let x136 = -12.701650001451807 + x119;
+        let x137 = -0.0000000234896432582596
+            + (x123 + (x7 * x121 + x8 * x122) - 0.275 * x118);
+        let x138 = -0.0021399965876409276
+            + (c_q9 * x121 - s_q9 * x122 + -0.00000000020510342851533115 * x123
+                + x118 * -0.4);
+        let x139 = -0.0000000234896432582596
+            + (x5 * x124 + x6 * x125 + 0.00000000020510342851533115 * x126
+                + -0.275 * x118);
+        let x140 = -111.7548902508081 + (x126 + (x7 * x124 + x8 * x125) + x132 - x130);
+        let x141 = 5.080660024070365
+            + (c_q9 * x124 - s_q9 * x125 + -0.00000000020510342851533115 * x126
+                - 0.4 * x119 - 0.275 * x120);
+        let x142 = -0.0021399965876409276
+            + (x5 * x127 + x6 * x128 + 0.00000000020510342851533115 * x129 - 0.4 * x118);
+        let x143 = 5.080660024070366
+            + (x129 + (x7 * x127 + x8 * x128) + -0.275 * x120 + x119 * -0.4);
+        let x144 = 113.3918902508081
+            + (x131
+                + (c_q9 * x127 - s_q9 * x128 + -0.00000000020510342851533115 * x129
+                    - x133));
+        let x145 = x120 + (x2 * x135 - x3 * x136);
+        let x146 = s_q8 * x135 + c_q8 * x136;
+        let x147 = c_q8 * x135;
+        let x148 = s_q8 * x136;
+        let x149 = x148 - x147 + -0.00000000020510342851533115 * x120;
+        let x150 = x142 + (x2 * x134 - x3 * x139);
+        let x151 = x143 + (x2 * x137 - x3 * x140);
+        let x152 = x144 + (x2 * x138 - x3 * x141);
+        let x153 = s_q8 * x134 + c_q8 * x139;
+        let x154 = s_q8 * x137 + c_q8 * x140;
+        let x155 = s_q8 * x138 + c_q8 * x141;
+        let x156 = s_q8 * x141 - c_q8 * x138 + -0.00000000020510342851533115 * x144;
+        let x157 = x149 * -0.35;
+        let x158 = 0.35 * x149;
+        let x159 = x158 + (x152 + (x2 * x150 - x3 * x151) - x157);
+        let x160 = 48.0240000085309 + x145;
+        let x161 = -0.07309 + (s_q8 * x150 + c_q8 * x151);
+        let x162 = -16.80768997608804
+            + (s_q8 * x151 - c_q8 * x150 + -0.00000000020510342851533115 * x152
+                + x145 * -0.35);
+        let x163 = -0.07309 + (x155 + (x2 * x153 - x3 * x154));
+        let x164 = 130.43769025763282 + (s_q8 * x153 + c_q8 * x154 + x158 - x157);
+        let x165 = 0.1132
+            + (s_q8 * x154 - c_q8 * x153 + -0.00000000020510342851533115 * x155
+                - 0.35 * x146);
+        let x166 = 132.47349025763282
+            + (s_q8 * (s_q8 * x140 - c_q8 * x137 + -0.00000000020510342851533115 * x143)
+                - c_q8
+                    * (s_q8 * x139 - c_q8 * x134 + -0.00000000020510342851533115 * x142)
+                + -0.00000000020510342851533115 * x156);
+        let x167 = c_q7 * x160 - s_q7 * x146;
+        let x168 = s_q7 * x160 + c_q7 * x146;
+        let x169 = c_q7 * x159 - s_q7 * x163;
+        let x170 = c_q7 * x161 - s_q7 * x164;
+        let x171 = -x168;
+        let x172 = x149 * -0.75;
+        let x173 = 0.75 * x149;
+        let x174 = x167 * -0.65;
+        let x175 = 0.65 * x167;
+        let x176 = c_q7 * x162 - s_q7 * x165 + x167 * -0.75;
+        let x177 = s_q7 * x162 + c_q7 * x165 - 0.75 * x168;
+        let x178 = x166 + x175;
+        let x179 = s_q7 * x169 + c_q7 * x170 - 0.65 * x168;
+        let x180 = 110.5455 + x167;
+        let x181 = 180.9502499901501 + x149;
+        let x182 = 1394.5960312283303 + (x173 + (c_q7 * x169 - s_q7 * x170 - x172));
+        let x183 = -117.61766249359756 + (x176 + x149 * -0.65);
+        let x184 = 1466.4506062283303
+            + (s_q7 * (s_q7 * x159 + c_q7 * x163) + c_q7 * (s_q7 * x161 + c_q7 * x164)
+                - (x174 - x173) - (x172 - x175));
+        let x185 = 1271.854575 + (x178 - x174);
+        let x186 = -x181;
+        let x187 = -x180;
+        let x188 = x2 * x136 + x3 * x135;
+        let x189 = x147 - x148;
+        let x190 = x152 + -0.35 * x189;
+        let x191 = x155 - 0.35 * x188;
+        let x192 = c_q7 * x188 + s_q7 * x189;
+        let x193 = -x192;
+        let x194 = c_q7 * x189 - s_q7 * x188;
+        let x195 = c_q7 * x190 - s_q7 * x191 + -0.75 * x194;
+        let x196 = s_q7 * x190 + c_q7 * x191 + (x146 * -0.65 - 0.75 * x192);
+        let x197 = x156 + 0.65 * x194;
+        let x198 = x6 * x96;
+        let x199 = x198 - x5 * x111;
+        let x200 = x8 * x96;
+        let x201 = x200 - x7 * x111;
+        let x202 = s_q9 * x96;
+        let x203 = c_q9 * x111 + x202;
+        let x204 = x123 + (-0.4 * x201 - 0.275 * x203);
+        let x205 = x126 + 0.4 * x199;
+        let x206 = x129 + -0.275 * x199;
+        let x207 = x2 * x199 - x3 * x201 - x203;
+        let x208 = s_q8 * x199 + c_q8 * x201;
+        let x209 = s_q8 * x201 - c_q8 * x199 - -0.00000000020510342851533115 * x203;
+        let x210 = s_q8 * x205 - c_q8 * x204 + -0.00000000020510342851533115 * x206;
+        let x211 = x206 + (x2 * x204 - x3 * x205) + -0.35 * x208;
+        let x212 = s_q8 * x204 + c_q8 * x205 + 0.35 * x207;
+        let x213 = c_q7 * x207 - s_q7 * x208;
+        let x214 = s_q7 * x207 + c_q7 * x208;
+        let x215 = c_q7 * x211 - s_q7 * x212 + -0.75 * x214;
+        let x216 = s_q7 * x211 + c_q7 * x212 + (0.75 * x213 + -0.65 * x209);
+        let x217 = x210 + 0.65 * x214;
+        let x218 = x198 - x5 * x98;
+        let x219 = x200 - x7 * x98;
+        let x220 = x202 + c_q9 * x98;
+        let x221 = x5 * x101 + x6 * x104 + 0.00000000020510342851533115 * x108
+            + (-0.4 * x219 - 0.275 * x220);
+        let x222 = x108 + (x7 * x101 + x8 * x104) + 0.4 * x218;
+        let x223 = c_q9 * x101 - s_q9 * x104 + -0.00000000020510342851533115 * x108
+            + -0.275 * x218;
+        let x224 = x2 * x218 - x3 * x219 - x220;
+        let x225 = s_q8 * x218 + c_q8 * x219;
+        let x226 = s_q8 * x219 - c_q8 * x218 - -0.00000000020510342851533115 * x220;
+        let x227 = s_q8 * x222 - c_q8 * x221 + -0.00000000020510342851533115 * x223;
+        let x228 = x223 + (x2 * x221 - x3 * x222) + -0.35 * x225;
+        let x229 = s_q8 * x221 + c_q8 * x222 + 0.35 * x224;
+        let x230 = c_q7 * x224 - s_q7 * x225;
+        let x231 = s_q7 * x224 + c_q7 * x225;
+        let x232 = c_q7 * x228 - s_q7 * x229 + -0.75 * x231;
+        let x233 = s_q7 * x228 + c_q7 * x229 + (0.75 * x230 + -0.65 * x226);
+        let x234 = x227 + 0.65 * x231;
+        let x235 = x97 + c_q10 * x73;
+        let x236 = x95 - s_q10 * x73;
+        let x237 = c_q10 * x83 - s_q10 * x84;
+        let x238 = s_q10 * x83 + c_q10 * x84;
+        let x239 = x85 - 0.87 * x235;
+        let x240 = x6 * x236 - x5 * x235;
+        let x241 = x8 * x236 - x7 * x235;
+        let x242 = c_q9 * x235 + s_q9 * x236;
+        let x243 = x5 * x237 + x6 * x238 + 0.00000000020510342851533115 * x239
+            + (-0.4 * x241 - 0.275 * x242);
+        let x244 = x239 + (x7 * x237 + x8 * x238) + 0.4 * x240;
+        let x245 = c_q9 * x237 - s_q9 * x238 + -0.00000000020510342851533115 * x239
+            + -0.275 * x240;
+        let x246 = x2 * x240 - x3 * x241 - x242;
+        let x247 = s_q8 * x240 + c_q8 * x241;
+        let x248 = s_q8 * x241 - c_q8 * x240 - -0.00000000020510342851533115 * x242;
+        let x249 = s_q8 * x244 - c_q8 * x243 + -0.00000000020510342851533115 * x245;
+        let x250 = x245 + (x2 * x243 - x3 * x244) + -0.35 * x247;
+        let x251 = s_q8 * x243 + c_q8 * x244 + 0.35 * x246;
+        let x252 = c_q7 * x246 - s_q7 * x247;
+        let x253 = s_q7 * x246 + c_q7 * x247;
+        let x254 = c_q7 * x250 - s_q7 * x251 + -0.75 * x253;
+        let x255 = s_q7 * x250 + c_q7 * x251 + (0.75 * x252 + -0.65 * x248);
+        let x256 = x249 + 0.65 * x253;
+        let x257 = x13 * x35 - x12 * x36;
+        let x258 = x46 - x45;
+        let x259 = x53 + 0.36 * x257;
+        let x260 = x56 - -0.36 * x49;
+        let x261 = c_q11 * x49 + s_q11 * x257;
+        let x262 = c_q11 * x257 - s_q11 * x49;
+        let x263 = c_q11 * x259 - s_q11 * x260 + (0.275 * x262 + -0.63 * x258);
+        let x264 = s_q11 * x259 + c_q11 * x260 - -0.275 * x261;
+        let x265 = x59 - 0.63 * x261;
+        let x266 = c_q10 * x261 + s_q10 * x262;
+        let x267 = c_q10 * x262 - s_q10 * x261;
+        let x268 = s_q10 * x263 + c_q10 * x264;
+        let x269 = c_q10 * x263 - s_q10 * x264 + -0.87 * x258;
+        let x270 = x265 - 0.87 * x266;
+        let x271 = x6 * x267 - x5 * x266 + 0.00000000020510342851533115 * x258;
+        let x272 = x258 + (x8 * x267 - x7 * x266);
+        let x273 = -0.00000000020510342851533115 * x258 - (c_q9 * x266 + s_q9 * x267);
+        let x274 = x5 * x269 + x6 * x268 + 0.00000000020510342851533115 * x270
+            + (-0.4 * x272 + 0.275 * x273);
+        let x275 = x270 + (x7 * x269 + x8 * x268) + 0.4 * x271;
+        let x276 = c_q9 * x269 - s_q9 * x268 + -0.00000000020510342851533115 * x270
+            + -0.275 * x271;
+        let x277 = x273 + (x2 * x271 - x3 * x272);
+        let x278 = s_q8 * x271 + c_q8 * x272;
+        let x279 = s_q8 * x272 - c_q8 * x271 + -0.00000000020510342851533115 * x273;
+        let x280 = s_q8 * x275 - c_q8 * x274 + -0.00000000020510342851533115 * x276;
+        let x281 = x276 + (x2 * x274 - x3 * x275) + -0.35 * x278;
+        let x282 = s_q8 * x274 + c_q8 * x275 + 0.35 * x277;
+        let x283 = c_q7 * x277 - s_q7 * x278;
+        let x284 = s_q7 * x277 + c_q7 * x278;
+        let x285 = c_q7 * x281 - s_q7 * x282 + -0.75 * x284;
+        let x286 = s_q7 * x281 + c_q7 * x282 + (0.75 * x283 + -0.65 * x279);
+        let x287 = x280 + 0.65 * x284;
+        let x288 = x15 * -4.806620000000001;
+        let x289 = s_q13 * -4.806620000000001;
+        let x290 = c_q13 * -4.806620000000001;
+        let x291 = x22 + (-0.16 * x289 - 0.55 * x290);
+        let x292 = x26 + 0.16 * x288;
+        let x293 = x29 + -0.55 * x288;
+        let x294 = c_q12 * x288 - s_q12 * x289;
+        let x295 = x12 * x288 + x13 * x289 - x290;
+        let x296 = s_q12 * x288 + c_q12 * x289 + -0.00000000020510342851533115 * x290;
+        let x297 = -0.00000000020510342851533115 * x293 - (s_q12 * x291 + c_q12 * x292);
+        let x298 = c_q12 * x291 - s_q12 * x292 + 0.36 * x295;
+        let x299 = x293 + (x12 * x291 + x13 * x292) + -0.36 * x294;
+        let x300 = c_q11 * x294 - s_q11 * x295;
+        let x301 = s_q11 * x294 + c_q11 * x295;
+        let x302 = c_q11 * x298 - s_q11 * x299 + (0.275 * x301 - -0.63 * x296);
+        let x303 = s_q11 * x298 + c_q11 * x299 + -0.275 * x300;
+        let x304 = x297 + 0.63 * x300;
+        let x305 = c_q10 * x300 - s_q10 * x301;
+        let x306 = s_q10 * x300 + c_q10 * x301;
+        let x307 = s_q10 * x302 + c_q10 * x303;
+        let x308 = c_q10 * x302 - s_q10 * x303 - -0.87 * x296;
+        let x309 = x304 + 0.87 * x305;
+        let x310 = x5 * x305 + x6 * x306 - 0.00000000020510342851533115 * x296;
+        let x311 = x7 * x305 + x8 * x306 - x296;
+        let x312 = c_q9 * x305 - s_q9 * x306 - -0.00000000020510342851533115 * x296;
+        let x313 = x5 * x308 + x6 * x307 + 0.00000000020510342851533115 * x309
+            + (-0.4 * x311 + 0.275 * x312);
+        let x314 = x309 + (x7 * x308 + x8 * x307) + 0.4 * x310;
+        let x315 = c_q9 * x308 - s_q9 * x307 + -0.00000000020510342851533115 * x309
+            + -0.275 * x310;
+        let x316 = x312 + (x2 * x310 - x3 * x311);
+        let x317 = s_q8 * x310 + c_q8 * x311;
+        let x318 = s_q8 * x311 - c_q8 * x310 + -0.00000000020510342851533115 * x312;
+        let x319 = s_q8 * x314 - c_q8 * x313 + -0.00000000020510342851533115 * x315;
+        let x320 = x315 + (x2 * x313 - x3 * x314) + -0.35 * x317;
+        let x321 = s_q8 * x313 + c_q8 * x314 + 0.35 * x316;
+        let x322 = c_q7 * x316 - s_q7 * x317;
+        let x323 = s_q7 * x316 + c_q7 * x317;
+        let x324 = c_q7 * x320 - s_q7 * x321 + -0.75 * x323;
+        let x325 = s_q7 * x320 + c_q7 * x321 + (0.75 * x322 + -0.65 * x318);
+        let x326 = x319 + 0.65 * x323;
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x178,
-                x184,
-                x184,
-                x204,
-                x224,
-                x242,
-                x267,
-                x299,
-                x339,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x189,
-                0.0,
-                x177,
-                x174,
-                x205,
-                x225,
-                x243,
-                x268,
-                x300,
-                x340,
-            ],
-            [
-                0.0,
-                0.0,
-                1170.07,
-                x175,
-                x190,
-                0.0,
-                0.0,
-                x206,
-                x226,
-                x244,
-                x269,
-                x301,
-                x341,
-            ],
-            [
-                0.0,
-                x189,
-                x175,
+                x181,
+                x171,
+                x171,
                 x193,
-                x191,
-                x192,
-                x196,
-                x207,
-                x227,
-                x245,
-                x270,
-                x302,
-                x342,
+                x213,
+                x230,
+                x252,
+                x283,
+                x322,
             ],
             [
-                x178,
                 0.0,
-                x190,
-                x191,
+                1170.07,
+                0.0,
+                x186,
+                0.0,
+                x180,
+                x167,
                 x194,
-                x188,
-                x197,
-                x208,
-                x228,
-                x246,
-                x271,
-                x303,
-                x343,
+                x214,
+                x231,
+                x253,
+                x284,
+                x323,
             ],
             [
+                0.0,
+                0.0,
+                1170.07,
+                x168,
+                x187,
+                0.0,
+                0.0,
+                x146,
+                x209,
+                x226,
+                x248,
+                x279,
+                x318,
+            ],
+            [
+                0.0,
+                x186,
+                x168,
+                x182,
+                x179,
+                x183,
+                x176,
+                x195,
+                x215,
+                x232,
+                x254,
+                x285,
+                x324,
+            ],
+            [
+                x181,
+                0.0,
+                x187,
+                x179,
                 x184,
                 x177,
-                0.0,
-                x192,
-                x188,
-                x195,
-                x198,
-                x209,
-                x229,
-                x247,
-                x272,
-                x304,
-                x344,
+                x177,
+                x196,
+                x216,
+                x233,
+                x255,
+                x286,
+                x325,
             ],
             [
-                x184,
-                x174,
+                x171,
+                x180,
                 0.0,
+                x183,
+                x177,
+                x185,
+                x178,
+                x197,
+                x217,
+                x234,
+                x256,
+                x287,
+                x326,
+            ],
+            [
+                x171,
+                x167,
+                0.0,
+                x176,
+                x177,
+                x178,
+                x166,
+                x156,
+                x210,
+                x227,
+                x249,
+                x280,
+                x319,
+            ],
+            [
+                x193,
+                x194,
+                x146,
+                x195,
                 x196,
                 x197,
-                x198,
-                x173,
-                x166,
-                x221,
-                x239,
-                x264,
-                x296,
-                x336,
-            ],
-            [
-                x204,
-                x205,
+                x156,
+                x144,
                 x206,
-                x207,
-                x208,
-                x209,
-                x166,
-                x153,
-                x218,
-                x236,
-                x261,
-                x293,
-                x333,
-            ],
-            [
-                x224,
-                x225,
-                x226,
-                x227,
-                x228,
-                x229,
-                x221,
-                x218,
-                x129,
-                x230,
-                x255,
-                x287,
-                x327,
-            ],
-            [
-                x242,
-                x243,
-                x244,
+                x223,
                 x245,
-                x246,
-                x247,
-                x239,
-                x236,
-                x230,
-                x103,
-                x250,
-                x281,
-                x321,
+                x276,
+                x315,
             ],
-            [x267, x268, x269, x270, x271, x272, x264, x261, x255, x250, x78, x71, x313],
-            [x299, x300, x301, x302, x303, x304, x296, x293, x287, x281, x71, x55, x310],
             [
-                x339,
-                x340,
-                x341,
-                x342,
-                x343,
-                x344,
-                x336,
-                x333,
-                x327,
-                x321,
-                x313,
-                x310,
+                x213,
+                x214,
+                x209,
+                x215,
+                x216,
+                x217,
+                x210,
+                x206,
+                x117,
+                x108,
+                x239,
+                x270,
+                x309,
+            ],
+            [x230, x231, x226, x232, x233, x234, x227, x223, x108, x94, x85, x265, x304],
+            [x252, x253, x248, x254, x255, x256, x249, x245, x239, x85, x71, x59, x297],
+            [x283, x284, x279, x285, x286, x287, x280, x276, x270, x265, x59, x44, x293],
+            [
+                x322,
+                x323,
+                x318,
+                x324,
+                x325,
+                x326,
+                x319,
+                x315,
+                x309,
+                x304,
+                x297,
+                x293,
                 1.4135609200000003,
             ],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 741 mul, 571 add, 0 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: bias `rnea`: 637 mul, 504 add, 0 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
-        let x0 = v[3] * 1200.0;
-        let x1 = v[4] * 1200.0;
-        let x2 = v[5] * 1200.0;
-        let x3 = v[0] * 1000.0;
-        let x4 = v[1] * 1000.0;
-        let x5 = v[2] * 1000.0;
+        let x0 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+            + v[1] * -180.9502499901501;
+        let x1 = 1466.4506062283303 * v[4]
+            + (180.9502499901501 * v[0] + v[2] * -110.5455);
+        let x2 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x3 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x4 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x5 = 1170.07 * v[2] - 110.5455 * v[4];
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x7 = c_q7 + (1.0 - c_q7);
-        let x8 = v[3] * c_q7 + v[4] * s_q7;
-        let x9 = v[4] * c_q7 - v[3] * s_q7;
-        let x10 = v[0] - v[4] * -0.75;
-        let x11 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x12 = c_q7 * x10 + s_q7 * x11;
-        let x13 = c_q7 * x11 - s_q7 * x10;
-        let x14 = x7 * (v[2] - 0.65 * v[4]);
-        let x15 = v[6] + v[5] * x7;
-        let x16 = v[6] * x9;
-        let x17 = v[6] * x8;
-        let x18 = v[6] * x13;
-        let x19 = v[6] * x12;
-        let x20 = 0.00071 * x8 + 0.1132 * x9 + 1.331 * x15;
-        let x21 = x8 * 2.29018125 + -0.07309 * x9 + 0.00071 * x15
-            + x13 * -6.1267499999999995;
-        let x22 = -0.07309 * x8 + x9 * 1.5853812499999997 + 0.1132 * x15
-            + x12 * 6.1267499999999995;
-        let x23 = 35.01 * x14;
-        let x24 = 35.01 * x12 - x9 * -6.1267499999999995;
-        let x25 = 35.01 * x13 - x8 * 6.1267499999999995;
+        let x7 = v[3] * c_q7 + v[4] * s_q7;
+        let x8 = v[4] * c_q7 - v[3] * s_q7;
+        let x9 = v[0] - v[4] * -0.75;
+        let x10 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x11 = v[2] - 0.65 * v[4];
+        let x12 = c_q7 * x9 + s_q7 * x10;
+        let x13 = c_q7 * x10 - s_q7 * x9;
+        let x14 = v[5] + v[6];
+        let x15 = v[6] * x8;
+        let x16 = v[6] * x7;
+        let x17 = v[6] * x12;
+        let x18 = -0.07309 * x8 + -16.80768997608804 * x14;
+        let x19 = -0.07309 * x7 + 130.43769025763282 * x8 + 0.1132 * x14
+            + x11 * -48.0240000085309;
+        let x20 = -16.80768997608804 * x7 + 0.1132 * x8 + 132.47349025763282 * x14
+            + 48.0240000085309 * x13;
+        let x21 = x14 * -48.0240000085309;
+        let x22 = 48.0240000085309 * x8;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x27 = c_q8 + (1.0 - c_q8);
-        let x28 = -0.00000000020510342851533115 * c_q8;
-        let x29 = -0.00000000020510342851533115 * s_q8;
-        let x30 = -0.00000000020510342851533115 * x27;
-        let x31 = x8 * x28 + x9 * s_q8 - x15 * c_q8;
-        let x32 = x9 * c_q8 - x8 * x29 + x15 * s_q8;
-        let x33 = x12 - x9 * -0.35;
-        let x34 = x13 - 0.35 * x8;
-        let x35 = x28 * x33 + s_q8 * x34 - x14 * c_q8;
-        let x36 = c_q8 * x34 - x29 * x33 + x14 * s_q8;
-        let x37 = x27 * x33 + x14 * x30;
-        let x38 = v[7] + (x8 * x27 + x15 * x30);
-        let x39 = x16 * x27;
-        let x40 = x18 + x17 * -0.35;
-        let x41 = x19 + 0.35 * x16;
-        let x42 = x27 * x40;
-        let x43 = x16 * x28 - x17 * s_q8 + v[7] * x32;
-        let x44 = x16 * x29 + x17 * c_q8 + v[7] * x31;
-        let x45 = x28 * x40 - s_q8 * x41 + v[7] * x36;
-        let x46 = x29 * x40 + c_q8 * x41 + v[7] * x35;
-        let x47 = -0.00214 * x31 + 2.359 * x38;
-        let x48 = x31 * 3.3000000000000003 + -0.00214 * x38 + x36 * -6.0;
-        let x49 = x32 * 2.5780000000000003 + x35 * 6.0;
-        let x50 = 30.0 * x37;
-        let x51 = 30.0 * x35 - x32 * -6.0;
-        let x52 = 30.0 * x36 - x31 * 6.0;
+        let x24 = -0.00000000020510342851533115 * c_q8;
+        let x25 = -0.00000000020510342851533115 * s_q8;
+        let x26 = x7 * x24 + x8 * s_q8 - x14 * c_q8;
+        let x27 = x8 * c_q8 - x7 * x25 + x14 * s_q8;
+        let x28 = x12 - x8 * -0.35;
+        let x29 = x13 - 0.35 * x7;
+        let x30 = x24 * x28 + s_q8 * x29 - x11 * c_q8;
+        let x31 = c_q8 * x29 - x25 * x28 + x11 * s_q8;
+        let x32 = x28 + -0.00000000020510342851533115 * x11;
+        let x33 = v[7] + (x7 + -0.00000000020510342851533115 * x14);
+        let x34 = v[6] * x13 + x16 * -0.35;
+        let x35 = x17 + 0.35 * x15;
+        let x36 = x15 * x24 - x16 * s_q8 + v[7] * x27;
+        let x37 = x15 * x25 + x16 * c_q8 + v[7] * x26;
+        let x38 = x24 * x34 - s_q8 * x35 + v[7] * x31;
+        let x39 = x25 * x34 + c_q8 * x35 + v[7] * x30;
+        let x40 = -0.0000000234896432582596 * x27 + -0.0021399965876409276 * x33
+            + -12.701650001451807 * x32;
+        let x41 = -0.0000000234896432582596 * x26 + -111.7548902508081 * x27
+            + 5.080660024070365 * x33 + x32 * 0.000000008530897668050218;
+        let x42 = -0.0021399965876409276 * x26 + 5.080660024070366 * x27
+            + 113.3918902508081 * x33
+            + (x30 * 12.701650001451807 + -0.000000008530897668050218 * x31);
+        let x43 = -12.701650001451807 * x33;
+        let x44 = x33 * 0.000000008530897668050218;
+        let x45 = x26 * 12.701650001451807 + -0.000000008530897668050218 * x27;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x54 = c_q9 + (1.0 - c_q9);
-        let x55 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x56 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x57 = 0.00000000020510342851533115 * x54;
-        let x58 = 0.00000000020510342851533115 * c_q9
+        let x47 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x48 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x49 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x59 = -0.00000000020510342851533115 * c_q9
+        let x50 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x60 = -0.00000000020510342851533115 * x54;
-        let x61 = x31 * x55 + x32 * x58 + x38 * c_q9;
-        let x62 = x31 * x56 + x32 * x59 - x38 * s_q9;
-        let x63 = x35 - (x32 * -0.4 + 0.275 * x38);
-        let x64 = x36 - 0.4 * x31;
-        let x65 = x37 - -0.275 * x31;
-        let x66 = x55 * x63 + x58 * x64 + c_q9 * x65;
-        let x67 = x56 * x63 + x59 * x64 - s_q9 * x65;
-        let x68 = x57 * x63 + x54 * x64 + x60 * x65;
-        let x69 = v[8] + (x31 * x57 + x32 * x54 + x38 * x60);
-        let x70 = x43 * x57 - x44 * x54 + x39 * x60;
-        let x71 = x45 - (0.275 * x39 - x44 * -0.4);
-        let x72 = x46 + 0.4 * x43;
-        let x73 = x42 - -0.275 * x43;
-        let x74 = x57 * x71 - x54 * x72 + x60 * x73;
-        let x75 = x43 * x55 - x44 * x58 + x39 * c_q9 + v[8] * x62;
-        let x76 = x43 * x56 - x44 * x59 - x39 * s_q9 - v[8] * x61;
-        let x77 = x55 * x71 - x58 * x72 + c_q9 * x73 + v[8] * x67;
-        let x78 = x56 * x71 - x59 * x72 - s_q9 * x73 - v[8] * x66;
-        let x79 = 3.378 * x62;
-        let x80 = x61 * 4.395515250000001 + -0.00214 * x69 + x68 * -9.87015;
-        let x81 = -0.00214 * x61 + x69 * 7.65251525 + x66 * 9.87015;
-        let x82 = 22.69 * x67;
-        let x83 = 22.69 * x66 - x69 * -9.87015;
-        let x84 = 22.69 * x68 - x61 * 9.87015;
+        let x51 = x26 * x47 + x27 * x49 + x33 * c_q9;
+        let x52 = x26 * x48 + x27 * x50 - x33 * s_q9;
+        let x53 = x30 - (x27 * -0.4 + 0.275 * x33);
+        let x54 = x31 - 0.4 * x26;
+        let x55 = x32 - -0.275 * x26;
+        let x56 = x47 * x53 + x49 * x54 + c_q9 * x55;
+        let x57 = x48 * x53 + x50 * x54 - s_q9 * x55;
+        let x58 = x54 + 0.00000000020510342851533115 * x53
+            + -0.00000000020510342851533115 * x55;
+        let x59 = v[8]
+            + (x27 + 0.00000000020510342851533115 * x26
+                + -0.00000000020510342851533115 * x33);
+        let x60 = 0.00000000020510342851533115 * x36 - x37
+            + -0.00000000020510342851533115 * x15;
+        let x61 = x38 - (0.275 * x15 - x37 * -0.4);
+        let x62 = x39 + 0.4 * x36;
+        let x63 = x34 - -0.275 * x36;
+        let x64 = 0.00000000020510342851533115 * x61 - x62
+            + -0.00000000020510342851533115 * x63;
+        let x65 = x36 * x47 - x37 * x49 + x15 * c_q9 + v[8] * x52;
+        let x66 = x36 * x48 - x37 * x50 - x15 * s_q9 - v[8] * x51;
+        let x67 = x47 * x61 - x49 * x62 + c_q9 * x63 + v[8] * x57;
+        let x68 = x48 * x61 - x50 * x62 - s_q9 * x63 - v[8] * x56;
+        let x69 = -63.36336825000001 * x52 + -36.18604050126307 * x59;
+        let x70 = -0.00214 * x59 + -81.53205 * x58;
+        let x71 = -0.00214 * x51 + -36.18604050126307 * x52 + 69.99836825 * x59
+            + x56 * 81.53205;
+        let x72 = -81.53205 * x59;
+        let x73 = x51 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x86 = c_q10 + (1.0 - c_q10);
-        let x87 = x61 * c_q10 + x62 * s_q10;
-        let x88 = x62 * c_q10 - x61 * s_q10;
-        let x89 = x66 - -0.87 * x69;
-        let x90 = c_q10 * x89 + x67 * s_q10;
-        let x91 = x67 * c_q10 - s_q10 * x89;
-        let x92 = x86 * (x68 - x61 * 0.87);
-        let x93 = v[9] + x69 * x86;
-        let x94 = x70 * x86;
-        let x95 = x77 - -0.87 * x70;
-        let x96 = x86 * (x74 - x75 * 0.87);
-        let x97 = x75 * c_q10 + x76 * s_q10 + v[9] * x88;
-        let x98 = x76 * c_q10 - x75 * s_q10 - v[9] * x87;
-        let x99 = c_q10 * x95 + x78 * s_q10 + v[9] * x91;
-        let x100 = x78 * c_q10 - s_q10 * x95 - v[9] * x90;
-        let x101 = x87 * 4.170993 + -0.6328 * x93 + (x91 * 5.8795 + x92 * -6.7347);
-        let x102 = x88 * 3.8828625 + x93 * -1.8520425 + x90 * -5.8795;
-        let x103 = -0.6328 * x87 + x88 * -1.8520425 + x93 * 4.0324305 + x90 * 6.7347;
-        let x104 = 21.38 * x90 - (x88 * 5.8795 + x93 * -6.7347);
-        let x105 = 21.38 * x91 - x87 * -5.8795;
-        let x106 = 21.38 * x92 - x87 * 6.7347;
+        let x75 = x51 * c_q10 + x52 * s_q10;
+        let x76 = x52 * c_q10 - x51 * s_q10;
+        let x77 = x56 - -0.87 * x59;
+        let x78 = x58 - x51 * 0.87;
+        let x79 = c_q10 * x77 + x57 * s_q10;
+        let x80 = x57 * c_q10 - s_q10 * x77;
+        let x81 = v[9] + x59;
+        let x82 = x67 - -0.87 * x60;
+        let x83 = x64 - x65 * 0.87;
+        let x84 = x65 * c_q10 + x66 * s_q10 + v[9] * x76;
+        let x85 = x66 * c_q10 - x65 * s_q10 - v[9] * x75;
+        let x86 = c_q10 * x82 + x68 * s_q10 + v[9] * x80;
+        let x87 = -24.4950615 * x76 + -24.35164200091464 * x81;
+        let x88 = -0.6328 * x81 + -45.1584 * x78;
+        let x89 = -0.6328 * x75 + -24.351642000914637 * x76 + 28.2393615 * x81
+            + x79 * 45.1584;
+        let x90 = -45.1584 * x81;
+        let x91 = x75 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x108 = c_q11 + (1.0 - c_q11);
-        let x109 = x87 * c_q11 + x88 * s_q11;
-        let x110 = x88 * c_q11 - x87 * s_q11;
-        let x111 = x90 - (0.275 * x88 + -0.63 * x93);
-        let x112 = x91 - -0.275 * x87;
-        let x113 = c_q11 * x111 + s_q11 * x112;
-        let x114 = c_q11 * x112 - s_q11 * x111;
-        let x115 = x108 * (x92 - x87 * 0.63);
-        let x116 = v[10] + x93 * x108;
-        let x117 = x94 * x108;
-        let x118 = x99 - (0.275 * x98 + -0.63 * x94);
-        let x119 = x100 - -0.275 * x97;
-        let x120 = x108 * (x96 - x97 * 0.63);
-        let x121 = x97 * c_q11 + x98 * s_q11 + v[10] * x110;
-        let x122 = x98 * c_q11 - x97 * s_q11 - v[10] * x109;
-        let x123 = c_q11 * x118 + s_q11 * x119 + v[10] * x114;
-        let x124 = c_q11 * x119 - s_q11 * x118 - v[10] * x113;
-        let x125 = 0.01675 * x109 + 0.07271 * x116;
-        let x126 = x109 * 0.9304999999999999 + 0.01675 * x116
-            + x114 * 3.0149999999999997;
-        let x127 = x110 * 0.939 + x113 * -3.0149999999999997;
-        let x128 = 16.75 * x115;
-        let x129 = 16.75 * x113 - x110 * 3.0149999999999997;
-        let x130 = 16.75 * x114 - x109 * -3.0149999999999997;
+        let x93 = x75 * c_q11 + x76 * s_q11;
+        let x94 = x76 * c_q11 - x75 * s_q11;
+        let x95 = x79 - (0.275 * x76 + -0.63 * x81);
+        let x96 = x80 - -0.275 * x75;
+        let x97 = x78 - x75 * 0.63;
+        let x98 = c_q11 * x95 + s_q11 * x96;
+        let x99 = c_q11 * x96 - s_q11 * x95;
+        let x100 = v[10] + x81;
+        let x101 = x86 - (0.275 * x85 + -0.63 * x60);
+        let x102 = x68 * c_q10 - s_q10 * x82 - v[9] * x79 - -0.275 * x84;
+        let x103 = x83 - x84 * 0.63;
+        let x104 = x84 * c_q11 + x85 * s_q11 + v[10] * x94;
+        let x105 = x85 * c_q11 - x84 * s_q11 - v[10] * x93;
+        let x106 = c_q11 * x101 + s_q11 * x102 + v[10] * x99;
+        let x107 = -9.142025249762803 * x94 + 2.5482240016099564 * x100;
+        let x108 = 0.01675 * x100 + 7.078399999258757 * x97;
+        let x109 = 0.01675 * x93 + 2.5482240016099564 * x94 + 9.223235249762805 * x100
+            + x98 * -7.078399999258757;
+        let x110 = 7.078399999258757 * x100;
+        let x111 = x93 * -7.078399999258757;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x132 = c_q12 + (1.0 - c_q12);
-        let x133 = -0.00000000020510342851533115 * s_q12;
-        let x134 = -0.00000000020510342851533115 * c_q12;
-        let x135 = -0.00000000020510342851533115 * x132;
-        let x136 = x109 * c_q12 + x110 * x133 - x116 * s_q12;
-        let x137 = x110 * x134 - x109 * s_q12 - x116 * c_q12;
-        let x138 = x113 - x110 * 0.36;
-        let x139 = x114 - -0.36 * x109;
-        let x140 = c_q12 * x138 + x133 * x139 - x115 * s_q12;
-        let x141 = x134 * x139 - s_q12 * x138 - x115 * c_q12;
-        let x142 = x132 * x139 + x115 * x135;
-        let x143 = v[11] + (x110 * x132 + x116 * x135);
-        let x144 = x122 * x132 + x117 * x135;
-        let x145 = x123 - x122 * 0.36;
-        let x146 = x124 - -0.36 * x121;
-        let x147 = x132 * x146 + x120 * x135;
-        let x148 = x121 * c_q12 + x122 * x133 - x117 * s_q12 + v[11] * x137;
-        let x149 = x122 * x134 - x121 * s_q12 - x117 * c_q12 - v[11] * x136;
-        let x150 = c_q12 * x145 + x133 * x146 - x120 * s_q12 + v[11] * x141;
-        let x151 = x134 * x146 - s_q12 * x145 - x120 * c_q12 - v[11] * x140;
-        let x152 = x136 * 3.2217582500000006 + -0.2313 * x143
-            + (x141 * -4.187200000000001 + x142 * 7.196750000000001);
-        let x153 = x137 * 1.2686520000000001 + x143 * -1.1514800000000003
-            + x140 * 4.187200000000001;
-        let x154 = -0.2313 * x136 + x137 * -1.1514800000000003
-            + x143 * 2.1079062500000005 + x140 * -7.196750000000001;
-        let x155 = 26.17 * x140 - (x137 * -4.187200000000001 + x143 * 7.196750000000001);
-        let x156 = 26.17 * x141 - x136 * 4.187200000000001;
-        let x157 = 26.17 * x142 - x136 * -7.196750000000001;
+        let x113 = -0.00000000020510342851533115 * s_q12;
+        let x114 = -0.00000000020510342851533115 * c_q12;
+        let x115 = x93 * c_q12 + x94 * x113 - x100 * s_q12;
+        let x116 = x94 * x114 - x93 * s_q12 - x100 * c_q12;
+        let x117 = x98 - x94 * 0.36;
+        let x118 = x99 - -0.36 * x93;
+        let x119 = c_q12 * x117 + x113 * x118 - x97 * s_q12;
+        let x120 = x114 * x118 - s_q12 * x117 - x97 * c_q12;
+        let x121 = x118 + -0.00000000020510342851533115 * x97;
+        let x122 = v[11] + (x94 + -0.00000000020510342851533115 * x100);
+        let x123 = x105 + -0.00000000020510342851533115 * x60;
+        let x124 = x106 - x105 * 0.36;
+        let x125 = c_q11 * x102 - s_q11 * x101 - v[10] * x98 - -0.36 * x104;
+        let x126 = x125 + -0.00000000020510342851533115 * x103;
+        let x127 = x104 * c_q12 + x105 * x113 - x60 * s_q12 + v[11] * x116;
+        let x128 = x105 * x114 - x104 * s_q12 - x60 * c_q12 - v[11] * x115;
+        let x129 = c_q12 * x124 + x113 * x125 - x103 * s_q12 + v[11] * x120;
+        let x130 = x114 * x125 - s_q12 * x124 - x103 * c_q12 - v[11] * x119;
+        let x131 = -1.9877000000000002 * x116 + -0.809539999555672 * x122
+            + 17.135250000000003 * x121;
+        let x132 = -1.9877000000000002 * x115 + -5.252920330000002 * x116
+            + -2.741639999592316 * x122 + x121 * -3.6140000000000003;
+        let x133 = -0.809539999555672 * x115 + -2.7416399995923166 * x116
+            + 9.740442170000001 * x122
+            + (x119 * -17.135250000000003 + 3.6140000000000003 * x120);
+        let x134 = 17.135250000000003 * x122;
+        let x135 = x122 * -3.6140000000000003;
+        let x136 = x115 * -17.135250000000003 + 3.6140000000000003 * x116;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x159 = c_q13 + (1.0 - c_q13);
-        let x160 = -0.00000000020510342851533115 * c_q13;
-        let x161 = -0.00000000020510342851533115 * s_q13;
-        let x162 = -0.00000000020510342851533115 * x159;
-        let x163 = x136 * x160 + x137 * s_q13 - x143 * c_q13;
-        let x164 = x137 * c_q13 - x136 * x161 + x143 * s_q13;
-        let x165 = x140 - (x137 * -0.16 + 0.55 * x143);
-        let x166 = x141 - 0.16 * x136;
-        let x167 = x142 - x136 * -0.55;
-        let x168 = x160 * x165 + s_q13 * x166 - c_q13 * x167;
-        let x169 = c_q13 * x166 - x161 * x165 + s_q13 * x167;
-        let x170 = x159 * x165 + x162 * x167;
-        let x171 = v[12] + (x136 * x159 + x143 * x162);
-        let x172 = x148 * x159 + x144 * x162;
-        let x173 = x150 - (x149 * -0.16 + 0.55 * x144);
-        let x174 = x151 - 0.16 * x148;
-        let x175 = x147 - x148 * -0.55;
-        let x176 = x159 * x173 + x162 * x175;
-        let x177 = x148 * x160 + x149 * s_q13 - x144 * c_q13 + v[12] * x164;
-        let x178 = x149 * c_q13 - x148 * x161 + x144 * s_q13 - v[12] * x163;
-        let x179 = x160 * x173 + s_q13 * x174 - c_q13 * x175 + v[12] * x169;
-        let x180 = c_q13 * x174 - x161 * x173 + s_q13 * x175 - v[12] * x168;
-        let x181 = x163 * 2.1663609200000002 + 0.000781 * x164 + -0.0145 * x171
-            + (x169 * -3.6140000000000003 + x170 * 4.806620000000001);
-        let x182 = 0.000781 * x163 + x164 * 0.9638000000000001
-            + x171 * -0.9614610000000001 + x168 * 3.6140000000000003;
-        let x183 = -0.0145 * x163 + x164 * -0.9614610000000001
-            + x171 * 1.4135609200000003 + x168 * -4.806620000000001;
-        let x184 = 18.07 * x168
-            - (x164 * -3.6140000000000003 + x171 * 4.806620000000001);
-        let x185 = 18.07 * x169 - x163 * 3.6140000000000003;
-        let x186 = 18.07 * x170 - x163 * -4.806620000000001;
-        let x187 = x177 * 2.1663609200000002 + 0.000781 * x178 + -0.0145 * x172
-            + (x180 * -3.6140000000000003 + x176 * 4.806620000000001)
-            + (x164 * x183 - x171 * x182 + (x169 * x186 - x170 * x185));
-        let x188 = 0.000781 * x177 + x178 * 0.9638000000000001
-            + x172 * -0.9614610000000001 + x179 * 3.6140000000000003
-            + (x171 * x181 - x163 * x183 + (x170 * x184 - x168 * x186));
-        let x189 = -0.0145 * x177 + x178 * -0.9614610000000001
-            + x172 * 1.4135609200000003 + x179 * -4.806620000000001
-            + (x163 * x182 - x164 * x181 + (x168 * x185 - x169 * x184));
-        let x190 = 18.07 * x179 - (x178 * -3.6140000000000003 + x172 * 4.806620000000001)
-            + (x164 * x186 - x171 * x185);
-        let x191 = 18.07 * x180 - x177 * 3.6140000000000003
-            + (x171 * x184 - x163 * x186);
-        let x192 = 18.07 * x176 - x177 * -4.806620000000001
-            + (x163 * x185 - x164 * x184);
-        let x193 = x160 * x190 - x161 * x191 + x159 * x192;
-        let x194 = s_q13 * x190 + c_q13 * x191;
-        let x195 = s_q13 * x191 - c_q13 * x190 + x162 * x192;
-        let x196 = x148 * 3.2217582500000006 + -0.2313 * x144
-            + (x151 * -4.187200000000001 + x147 * 7.196750000000001)
-            + (x137 * x154 - x143 * x153 + (x141 * x157 - x142 * x156))
-            + (x160 * x187 - x161 * x188 + x159 * x189 + (-0.16 * x194 + 0.55 * x195));
-        let x197 = x149 * 1.2686520000000001 + x144 * -1.1514800000000003
-            + x150 * 4.187200000000001
-            + (x143 * x152 - x136 * x154 + (x142 * x155 - x140 * x157))
-            + (s_q13 * x187 + c_q13 * x188 + 0.16 * x193);
-        let x198 = -0.2313 * x148 + x149 * -1.1514800000000003
-            + x144 * 2.1079062500000005 + x150 * -7.196750000000001
-            + (x136 * x153 - x137 * x152 + (x140 * x156 - x141 * x155))
-            + (s_q13 * x188 - c_q13 * x187 + x162 * x189 + -0.55 * x193);
-        let x199 = 26.17 * x150 - (x149 * -4.187200000000001 + x144 * 7.196750000000001)
-            + (x137 * x157 - x143 * x156) + x193;
-        let x200 = 26.17 * x151 - x148 * 4.187200000000001 + (x143 * x155 - x136 * x157)
-            + x194;
-        let x201 = 26.17 * x147 - x148 * -7.196750000000001 + (x136 * x156 - x137 * x155)
-            + x195;
-        let x202 = c_q12 * x199 - s_q12 * x200;
-        let x203 = x133 * x199 + x134 * x200 + x132 * x201;
-        let x204 = x121 * 0.9304999999999999 + 0.01675 * x117 + x124 * 3.0149999999999997
-            + (x110 * x125 - x116 * x127 + (x114 * x128 - x115 * x130))
-            + (c_q12 * x196 - s_q12 * x197 + 0.36 * x203);
-        let x205 = x122 * 0.939 + x123 * -3.0149999999999997
-            + (x116 * x126 - x109 * x125 + (x115 * x129 - x113 * x128))
-            + (x133 * x196 + x134 * x197 + x132 * x198 + -0.36 * x202);
-        let x206 = 0.01675 * x121 + 0.07271 * x117
-            + (x109 * x127 - x110 * x126 + (x113 * x130 - x114 * x129))
-            + (x135 * x198 - (s_q12 * x196 + c_q12 * x197));
-        let x207 = 16.75 * x123 - x122 * 3.0149999999999997 + (x110 * x128 - x116 * x130)
-            + x202;
-        let x208 = 16.75 * x124 - x121 * -3.0149999999999997
-            + (x116 * x129 - x109 * x128) + x203;
-        let x209 = c_q11 * x207 - s_q11 * x208;
-        let x210 = s_q11 * x207 + c_q11 * x208;
-        let x211 = x108
-            * (16.75 * x120 + (x109 * x130 - x110 * x129)
-                + (x135 * x201 - (s_q12 * x199 + c_q12 * x200)));
-        let x212 = x97 * 4.170993 + -0.6328 * x94 + (x100 * 5.8795 + x96 * -6.7347)
-            + (x88 * x103 - x93 * x102 + (x91 * x106 - x92 * x105))
-            + (c_q11 * x204 - s_q11 * x205 + (0.275 * x210 + -0.63 * x211));
-        let x213 = x98 * 3.8828625 + x94 * -1.8520425 + x99 * -5.8795
-            + (x93 * x101 - x87 * x103 + (x92 * x104 - x90 * x106))
-            + (s_q11 * x204 + c_q11 * x205 + -0.275 * x209);
-        let x214 = -0.6328 * x97 + x98 * -1.8520425 + x94 * 4.0324305 + x99 * 6.7347
-            + (x87 * x102 - x88 * x101 + (x90 * x105 - x91 * x104))
-            + (x108 * x206 + 0.63 * x209);
-        let x215 = 21.38 * x99 - (x98 * 5.8795 + x94 * -6.7347)
-            + (x88 * x106 - x93 * x105) + x209;
-        let x216 = 21.38 * x100 - x97 * -5.8795 + (x93 * x104 - x87 * x106) + x210;
-        let x217 = c_q10 * x215 - s_q10 * x216;
-        let x218 = x86 * (21.38 * x96 - x97 * 6.7347 + (x87 * x105 - x88 * x104) + x211);
-        let x219 = x75 * 4.395515250000001 + -0.00214 * x70 + x74 * -9.87015
-            + (x62 * x81 - x69 * x79 + (x67 * x84 - x68 * x82))
-            + (c_q10 * x212 - s_q10 * x213 + -0.87 * x218);
-        let x220 = 3.378 * x76 + (x69 * x80 - x61 * x81 + (x68 * x83 - x66 * x84))
-            + (s_q10 * x212 + c_q10 * x213);
-        let x221 = -0.00214 * x75 + x70 * 7.65251525 + x77 * 9.87015
-            + (x61 * x79 - x62 * x80 + (x66 * x82 - x67 * x83))
-            + (x86 * x214 + 0.87 * x217);
-        let x222 = 22.69 * x77 - x70 * -9.87015 + (x62 * x84 - x69 * x82) + x217;
-        let x223 = 22.69 * x78 + (x69 * x83 - x61 * x84) + (s_q10 * x215 + c_q10 * x216);
-        let x224 = 22.69 * x74 - x75 * 9.87015 + (x61 * x82 - x62 * x83) + x218;
-        let x225 = x55 * x222 + x56 * x223 + x57 * x224;
-        let x226 = x58 * x222 + x59 * x223 + x54 * x224;
-        let x227 = c_q9 * x222 - s_q9 * x223 + x60 * x224;
-        let x228 = x43 * 3.3000000000000003 + -0.00214 * x39 - x46 * -6.0
-            + (x32 * x47 - x38 * x49 + (x36 * x50 - x37 * x52))
-            + (x55 * x219 + x56 * x220 + x57 * x221 + (-0.4 * x226 + 0.275 * x227));
-        let x229 = x45 * 6.0 - x44 * 2.5780000000000003
-            + (x38 * x48 - x31 * x47 + (x37 * x51 - x35 * x50))
-            + (x58 * x219 + x59 * x220 + x54 * x221 + 0.4 * x225);
-        let x230 = -0.00214 * x43 + 2.359 * x39
-            + (x31 * x49 - x32 * x48 + (x35 * x52 - x36 * x51))
-            + (c_q9 * x219 - s_q9 * x220 + x60 * x221 + -0.275 * x225);
-        let x231 = 30.0 * x45 + x44 * -6.0 + (x32 * x50 - x38 * x52) + x225;
-        let x232 = x38 * x51 - x31 * x50 - (30.0 * x46 + x43 * 6.0) + x226;
-        let x233 = 30.0 * x42 + (x31 * x52 - x32 * x51) + x227;
-        let x234 = x28 * x231 - x29 * x232 + x27 * x233;
-        let x235 = s_q8 * x231 + c_q8 * x232;
-        let x236 = x16 * 2.29018125 - -0.07309 * x17 - x19 * -6.1267499999999995
-            + (x9 * x20 - x15 * x22 + (x13 * x23 - x14 * x25))
-            + (x28 * x228 - x29 * x229 + x27 * x230 + -0.35 * x235);
-        let x237 = -0.07309 * x16 - x17 * 1.5853812499999997 + x18 * 6.1267499999999995
-            + (x15 * x21 - x8 * x20 + (x14 * x24 - x12 * x23))
-            + (s_q8 * x228 + c_q8 * x229 + 0.35 * x234);
-        let x238 = 0.00071 * x16 - 0.1132 * x17
-            + (x8 * x22 - x9 * x21 + (x12 * x25 - x13 * x24))
-            + (s_q8 * x229 - c_q8 * x228 + x30 * x230);
-        let x239 = 35.01 * x18 + x17 * -6.1267499999999995 + (x9 * x23 - x15 * x25)
-            + x234;
-        let x240 = x15 * x24 - x8 * x23 - (35.01 * x19 + x16 * 6.1267499999999995)
-            + x235;
-        let x241 = c_q7 * x239 - s_q7 * x240;
-        let x242 = s_q7 * x239 + c_q7 * x240;
-        let x243 = x7 * (x8 * x25 - x9 * x24 + (s_q8 * x232 - c_q8 * x231 + x30 * x233));
-        let x244 = v[4] * x2 - v[5] * x1 + (v[1] * x5 - v[2] * x4)
-            + (c_q7 * x236 - s_q7 * x237 + -0.75 * x242);
-        let x245 = v[5] * x0 - v[3] * x2 + (v[2] * x3 - v[0] * x5)
-            + (s_q7 * x236 + c_q7 * x237 + (0.75 * x241 + -0.65 * x243));
-        let x246 = v[3] * x1 - v[4] * x0 + (v[0] * x4 - v[1] * x3)
-            + (x7 * x238 + 0.65 * x242);
-        let x247 = v[4] * x5 - v[5] * x4 + x241;
-        let x248 = v[5] * x3 - v[3] * x5 + x242;
-        let x249 = v[3] * x4 - v[4] * x3 + x243;
-        [x247, x248, x249, x244, x245, x246, x238, x230, x221, x214, x206, x198, x189]
+        let x138 = -0.00000000020510342851533115 * c_q13;
+        let x139 = -0.00000000020510342851533115 * s_q13;
+        let x140 = x115 * x138 + x116 * s_q13 - x122 * c_q13;
+        let x141 = x116 * c_q13 - x115 * x139 + x122 * s_q13;
+        let x142 = x119 - (-0.16 * x116 + 0.55 * x122);
+        let x143 = x120 - 0.16 * x115;
+        let x144 = x121 - x115 * -0.55;
+        let x145 = x138 * x142 + s_q13 * x143 - c_q13 * x144;
+        let x146 = c_q13 * x143 - x139 * x142 + s_q13 * x144;
+        let x147 = x142 + -0.00000000020510342851533115 * x144;
+        let x148 = v[12] + (x115 + -0.00000000020510342851533115 * x122);
+        let x149 = x127 + -0.00000000020510342851533115 * x123;
+        let x150 = x129 - (-0.16 * x128 + 0.55 * x123);
+        let x151 = x126 - x127 * -0.55;
+        let x152 = x127 * x138 + x128 * s_q13 - x123 * c_q13 + v[12] * x141;
+        let x153 = x128 * c_q13 - x127 * x139 + x123 * s_q13 - v[12] * x140;
+        let x154 = 0.000781 * x140 + -1.2025609200000003 * x141
+            + -0.9614610000000001 * x148;
+        let x155 = 0.000781 * x141 + -0.0145 * x148 + 4.806620000000001 * x147;
+        let x156 = -0.0145 * x140 + -0.9614610000000001 * x141
+            + 1.4135609200000003 * x148 + x145 * -4.806620000000001;
+        let x157 = 4.806620000000001 * x148;
+        let x158 = x140 * -4.806620000000001;
+        let x159 = x140 * x158 - x148 * x157;
+        let x160 = 0.000781 * x153 + -0.0145 * x149
+            + 4.806620000000001 * (x150 + -0.00000000020510342851533115 * x151)
+            + (x141 * x156 - x148 * x154 - x146 * x158);
+        let x161 = 0.000781 * x152 + -1.2025609200000003 * x153
+            + -0.9614610000000001 * x149
+            + (x148 * x155 - x140 * x156 + (x145 * x158 - x147 * x157));
+        let x162 = -0.0145 * x152 + -0.9614610000000001 * x153
+            + 1.4135609200000003 * x149
+            + (x138 * x150 + s_q13 * (x130 - 0.16 * x127) - c_q13 * x151 + v[12] * x146)
+                * -4.806620000000001 + (x140 * x154 - x141 * x155 + x146 * x157);
+        let x163 = 4.806620000000001 * x149 + x141 * x158;
+        let x164 = x141 * x157 - x152 * -4.806620000000001;
+        let x165 = x164 - (x138 * x163 + x139 * x159);
+        let x166 = c_q13 * x159 - s_q13 * x163;
+        let x167 = c_q13 * x163 + s_q13 * x159 + -0.00000000020510342851533115 * x164;
+        let x168 = -1.9877000000000002 * x128 + -0.809539999555672 * x123
+            + 17.135250000000003 * x126
+            + (x116 * x133 - x122 * x132 + (x121 * x135 - x120 * x136))
+            + (x162 + (x138 * x160 - x139 * x161) + (-0.16 * x166 + 0.55 * x167));
+        let x169 = -1.9877000000000002 * x127 + -5.252920330000002 * x128
+            + -2.741639999592316 * x123 + x126 * -3.6140000000000003
+            + (x122 * x131 - x115 * x133 + (x119 * x136 - x121 * x134))
+            + (s_q13 * x160 + c_q13 * x161 + 0.16 * x165);
+        let x170 = -0.809539999555672 * x127 + -2.7416399995923166 * x128
+            + 9.740442170000001 * x123
+            + (x129 * -17.135250000000003 + 3.6140000000000003 * x130)
+            + (x115 * x132 - x116 * x131 + (x120 * x134 - x119 * x135))
+            + (s_q13 * x161 - c_q13 * x160 + -0.00000000020510342851533115 * x162
+                + -0.55 * x165);
+        let x171 = x122 * x135 - x116 * x136 - 17.135250000000003 * x123 + x165;
+        let x172 = x115 * x136 - x122 * x134 - x123 * -3.6140000000000003 + x166;
+        let x173 = x116 * x134 - x115 * x135
+            - (x127 * -17.135250000000003 + 3.6140000000000003 * x128) + x167;
+        let x174 = c_q12 * x171 - s_q12 * x172;
+        let x175 = x173 + (x113 * x171 + x114 * x172);
+        let x176 = 0.01675 * x60 + 7.078399999258757 * x103
+            + (x94 * x109 - x100 * x107 - x99 * x111)
+            + (c_q12 * x168 - s_q12 * x169 + 0.36 * x175);
+        let x177 = -9.142025249762803 * x105 + 2.5482240016099564 * x60
+            + (x100 * x108 - x93 * x109 + (x98 * x111 - x97 * x110))
+            + (x170 + (x113 * x168 + x114 * x169) + -0.36 * x174);
+        let x178 = 0.01675 * x104 + 2.5482240016099564 * x105 + 9.223235249762805 * x60
+            + x106 * -7.078399999258757 + (x93 * x107 - x94 * x108 + x99 * x110)
+            + (-0.00000000020510342851533115 * x170 - (s_q12 * x168 + c_q12 * x169));
+        let x179 = x174 - (7.078399999258757 * x60 + x94 * x111);
+        let x180 = x93 * x111 - x100 * x110 + x175;
+        let x181 = x94 * x110 - x104 * -7.078399999258757
+            + (-0.00000000020510342851533115 * x173 - (s_q12 * x171 + c_q12 * x172));
+        let x182 = c_q11 * x179 - s_q11 * x180;
+        let x183 = s_q11 * x179 + c_q11 * x180;
+        let x184 = -0.6328 * x60 + -45.1584 * x83 + (x76 * x89 - x81 * x87 - x80 * x91)
+            + (c_q11 * x176 - s_q11 * x177 + (0.275 * x183 + -0.63 * x181));
+        let x185 = -24.4950615 * x85 + -24.35164200091464 * x60
+            + (x81 * x88 - x75 * x89 + (x79 * x91 - x78 * x90))
+            + (s_q11 * x176 + c_q11 * x177 + -0.275 * x182);
+        let x186 = -0.6328 * x84 + -24.351642000914637 * x85 + 28.2393615 * x60
+            + x86 * 45.1584 + (x75 * x87 - x76 * x88 + x80 * x90) + (x178 + 0.63 * x182);
+        let x187 = x182 - (-45.1584 * x60 + x76 * x91);
+        let x188 = x75 * x91 - x81 * x90 + x183;
+        let x189 = x76 * x90 - x84 * 45.1584 + x181;
+        let x190 = c_q10 * x187 - s_q10 * x188;
+        let x191 = -0.00214 * x60 + -81.53205 * x64 + (x52 * x71 - x59 * x69 - x57 * x73)
+            + (c_q10 * x184 - s_q10 * x185 + -0.87 * x189);
+        let x192 = -63.36336825000001 * x66 + -36.18604050126307 * x60
+            + (x59 * x70 - x51 * x71 + (x56 * x73 - x58 * x72))
+            + (s_q10 * x184 + c_q10 * x185);
+        let x193 = -0.00214 * x65 + -36.18604050126307 * x66 + 69.99836825 * x60
+            + x67 * 81.53205 + (x51 * x69 - x52 * x70 + x57 * x72)
+            + (x186 + 0.87 * x190);
+        let x194 = x190 - (-81.53205 * x60 + x52 * x73);
+        let x195 = x51 * x73 - x59 * x72 + (s_q10 * x187 + c_q10 * x188);
+        let x196 = x52 * x72 - x65 * 81.53205 + x189;
+        let x197 = x47 * x194 + x48 * x195 + 0.00000000020510342851533115 * x196;
+        let x198 = x196 + (x49 * x194 + x50 * x195);
+        let x199 = c_q9 * x194 - s_q9 * x195 + -0.00000000020510342851533115 * x196;
+        let x200 = -0.0021399965876409276 * x15 - -0.0000000234896432582596 * x37
+            + -12.701650001451807 * x34
+            + (x27 * x42 - x33 * x41 + (x32 * x44 - x31 * x45))
+            + (x47 * x191 + x48 * x192 + 0.00000000020510342851533115 * x193
+                + (-0.4 * x198 + 0.275 * x199));
+        let x201 = -0.0000000234896432582596 * x36 - -111.7548902508081 * x37
+            + 5.080660024070365 * x15 + x34 * 0.000000008530897668050218
+            + (x33 * x40 - x26 * x42 + (x30 * x45 - x32 * x43))
+            + (x193 + (x49 * x191 + x50 * x192) + 0.4 * x197);
+        let x202 = -0.0021399965876409276 * x36 - 5.080660024070366 * x37
+            + 113.3918902508081 * x15
+            + (x38 * 12.701650001451807 - -0.000000008530897668050218 * x39)
+            + (x26 * x41 - x27 * x40 + (x31 * x43 - x30 * x44))
+            + (c_q9 * x191 - s_q9 * x192 + -0.00000000020510342851533115 * x193
+                + -0.275 * x197);
+        let x203 = x33 * x44 - x27 * x45 - -12.701650001451807 * x15 + x197;
+        let x204 = x26 * x45 - x33 * x43 - x15 * 0.000000008530897668050218 + x198;
+        let x205 = x27 * x43 - x26 * x44
+            - (x36 * 12.701650001451807 - -0.000000008530897668050218 * x37) + x199;
+        let x206 = x205 + (x24 * x203 - x25 * x204);
+        let x207 = s_q8 * x203 + c_q8 * x204;
+        let x208 = x8 * x20 - x14 * x19 + (x11 * x21 - x13 * x22) - -0.07309 * x16
+            + (x202 + (x24 * x200 - x25 * x201) + -0.35 * x207);
+        let x209 = -0.07309 * x15 - 130.43769025763282 * x16
+            + (x14 * x18 - x7 * x20 + x12 * x22)
+            + (s_q8 * x200 + c_q8 * x201 + 0.35 * x206);
+        let x210 = -16.80768997608804 * x15 - 0.1132 * x16 - 48.0240000085309 * x17
+            + (x7 * x19 - x8 * x18 - x12 * x21)
+            + (s_q8 * x201 - c_q8 * x200 + -0.00000000020510342851533115 * x202);
+        let x211 = x14 * x21 - x8 * x22 + x206;
+        let x212 = x7 * x22 + x207;
+        let x213 = 48.0240000085309 * x16 - x7 * x21
+            + (s_q8 * x204 - c_q8 * x203 + -0.00000000020510342851533115 * x205);
+        let x214 = c_q7 * x211 - s_q7 * x212;
+        let x215 = s_q7 * x211 + c_q7 * x212;
+        let x216 = v[4] * x2 - v[5] * x1 + (v[1] * x5 - v[2] * x4)
+            + (c_q7 * x208 - s_q7 * x209 + -0.75 * x215);
+        let x217 = v[5] * x0 - v[3] * x2 + (v[2] * x3 - v[0] * x5)
+            + (s_q7 * x208 + c_q7 * x209 + (0.75 * x214 + -0.65 * x213));
+        let x218 = v[3] * x1 - v[4] * x0 + (v[0] * x4 - v[1] * x3)
+            + (x210 + 0.65 * x215);
+        let x219 = v[4] * x5 - v[5] * x4 + x214;
+        let x220 = v[5] * x3 - v[3] * x5 + x215;
+        let x221 = v[3] * x4 - v[4] * x3 + x213;
+        [x219, x220, x221, x216, x217, x218, x210, x202, x193, x186, x178, x170, x162]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
-    /// Methods: bias `recurrent`: 771 mul, 606 add, 0 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: bias `recurrent`: 676 mul, 550 add, 0 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
-        let x0 = v[3] * 1200.0;
-        let x1 = v[4] * 1200.0;
-        let x2 = v[5] * 1200.0;
-        let x3 = v[0] * 1000.0;
-        let x4 = v[1] * 1000.0;
-        let x5 = v[2] * 1000.0;
+        let x0 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+            + v[1] * -180.9502499901501;
+        let x1 = 1466.4506062283303 * v[4]
+            + (180.9502499901501 * v[0] + v[2] * -110.5455);
+        let x2 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x3 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x4 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x5 = 1170.07 * v[2] - 110.5455 * v[4];
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x7 = c_q7 + (1.0 - c_q7);
-        let x8 = v[3] * c_q7 + v[4] * s_q7;
-        let x9 = v[4] * c_q7 - v[3] * s_q7;
-        let x10 = v[0] - v[4] * -0.75;
-        let x11 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x12 = c_q7 * x10 + s_q7 * x11;
-        let x13 = c_q7 * x11 - s_q7 * x10;
-        let x14 = x7 * (v[2] - 0.65 * v[4]);
-        let x15 = v[6] + v[5] * x7;
-        let x16 = a[0] - a[4] * -0.75;
-        let x17 = a[1] - (0.75 * a[3] + a[5] * -0.65);
-        let x18 = x7 * (a[2] - 0.65 * a[4]);
-        let x19 = a[6] + a[5] * x7;
-        let x20 = a[3] * c_q7 + a[4] * s_q7 + v[6] * x9;
-        let x21 = a[4] * c_q7 - a[3] * s_q7 - v[6] * x8;
-        let x22 = c_q7 * x16 + s_q7 * x17 + v[6] * x13;
-        let x23 = c_q7 * x17 - s_q7 * x16 - v[6] * x12;
-        let x24 = 0.00071 * x8 + 0.1132 * x9 + 1.331 * x15;
-        let x25 = x8 * 2.29018125 + -0.07309 * x9 + 0.00071 * x15
-            + x13 * -6.1267499999999995;
-        let x26 = -0.07309 * x8 + x9 * 1.5853812499999997 + 0.1132 * x15
-            + x12 * 6.1267499999999995;
-        let x27 = 35.01 * x14;
-        let x28 = 35.01 * x12 - x9 * -6.1267499999999995;
-        let x29 = 35.01 * x13 - x8 * 6.1267499999999995;
+        let x7 = v[3] * c_q7 + v[4] * s_q7;
+        let x8 = v[4] * c_q7 - v[3] * s_q7;
+        let x9 = v[0] - v[4] * -0.75;
+        let x10 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x11 = v[2] - 0.65 * v[4];
+        let x12 = c_q7 * x9 + s_q7 * x10;
+        let x13 = c_q7 * x10 - s_q7 * x9;
+        let x14 = v[5] + v[6];
+        let x15 = a[0] - a[4] * -0.75;
+        let x16 = a[1] - (0.75 * a[3] + a[5] * -0.65);
+        let x17 = a[2] - 0.65 * a[4];
+        let x18 = a[5] + a[6];
+        let x19 = a[3] * c_q7 + a[4] * s_q7 + v[6] * x8;
+        let x20 = a[4] * c_q7 - a[3] * s_q7 - v[6] * x7;
+        let x21 = c_q7 * x16 - s_q7 * x15 - v[6] * x12;
+        let x22 = -0.07309 * x8 + -16.80768997608804 * x14;
+        let x23 = -0.07309 * x7 + 130.43769025763282 * x8 + 0.1132 * x14
+            + x11 * -48.0240000085309;
+        let x24 = -16.80768997608804 * x7 + 0.1132 * x8 + 132.47349025763282 * x14
+            + 48.0240000085309 * x13;
+        let x25 = x14 * -48.0240000085309;
+        let x26 = 48.0240000085309 * x8;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x31 = c_q8 + (1.0 - c_q8);
-        let x32 = -0.00000000020510342851533115 * c_q8;
-        let x33 = -0.00000000020510342851533115 * s_q8;
-        let x34 = -0.00000000020510342851533115 * x31;
-        let x35 = x8 * x32 + x9 * s_q8 - x15 * c_q8;
-        let x36 = x9 * c_q8 - x8 * x33 + x15 * s_q8;
-        let x37 = x12 - x9 * -0.35;
-        let x38 = x13 - 0.35 * x8;
-        let x39 = x32 * x37 + s_q8 * x38 - x14 * c_q8;
-        let x40 = c_q8 * x38 - x33 * x37 + x14 * s_q8;
-        let x41 = x31 * x37 + x14 * x34;
-        let x42 = v[7] + (x8 * x31 + x15 * x34);
-        let x43 = x22 - x21 * -0.35;
-        let x44 = x23 - 0.35 * x20;
-        let x45 = x31 * x43 + x18 * x34;
-        let x46 = a[7] + (x20 * x31 + x19 * x34);
-        let x47 = x20 * x32 + x21 * s_q8 - x19 * c_q8 + v[7] * x36;
-        let x48 = x21 * c_q8 - x20 * x33 + x19 * s_q8 - v[7] * x35;
-        let x49 = x32 * x43 + s_q8 * x44 - x18 * c_q8 + v[7] * x40;
-        let x50 = c_q8 * x44 - x33 * x43 + x18 * s_q8 - v[7] * x39;
-        let x51 = -0.00214 * x35 + 2.359 * x42;
-        let x52 = x35 * 3.3000000000000003 + -0.00214 * x42 + x40 * -6.0;
-        let x53 = x36 * 2.5780000000000003 + x39 * 6.0;
-        let x54 = 30.0 * x41;
-        let x55 = 30.0 * x39 - x36 * -6.0;
-        let x56 = 30.0 * x40 - x35 * 6.0;
+        let x28 = -0.00000000020510342851533115 * c_q8;
+        let x29 = -0.00000000020510342851533115 * s_q8;
+        let x30 = x7 * x28 + x8 * s_q8 - x14 * c_q8;
+        let x31 = x8 * c_q8 - x7 * x29 + x14 * s_q8;
+        let x32 = x12 - x8 * -0.35;
+        let x33 = x13 - 0.35 * x7;
+        let x34 = x28 * x32 + s_q8 * x33 - x11 * c_q8;
+        let x35 = c_q8 * x33 - x29 * x32 + x11 * s_q8;
+        let x36 = x32 + -0.00000000020510342851533115 * x11;
+        let x37 = v[7] + (x7 + -0.00000000020510342851533115 * x14);
+        let x38 = c_q7 * x15 + s_q7 * x16 + v[6] * x13 - x20 * -0.35;
+        let x39 = x21 - 0.35 * x19;
+        let x40 = x38 + -0.00000000020510342851533115 * x17;
+        let x41 = a[7] + (x19 + -0.00000000020510342851533115 * x18);
+        let x42 = x19 * x28 + x20 * s_q8 - x18 * c_q8 + v[7] * x31;
+        let x43 = x20 * c_q8 - x19 * x29 + x18 * s_q8 - v[7] * x30;
+        let x44 = x28 * x38 + s_q8 * x39 - x17 * c_q8 + v[7] * x35;
+        let x45 = c_q8 * x39 - x29 * x38 + x17 * s_q8 - v[7] * x34;
+        let x46 = -0.0000000234896432582596 * x31 + -0.0021399965876409276 * x37
+            + -12.701650001451807 * x36;
+        let x47 = -0.0000000234896432582596 * x30 + -111.7548902508081 * x31
+            + 5.080660024070365 * x37 + x36 * 0.000000008530897668050218;
+        let x48 = -0.0021399965876409276 * x30 + 5.080660024070366 * x31
+            + 113.3918902508081 * x37
+            + (x34 * 12.701650001451807 + -0.000000008530897668050218 * x35);
+        let x49 = -12.701650001451807 * x37;
+        let x50 = x37 * 0.000000008530897668050218;
+        let x51 = x30 * 12.701650001451807 + -0.000000008530897668050218 * x31;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x58 = c_q9 + (1.0 - c_q9);
-        let x59 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x60 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x61 = 0.00000000020510342851533115 * x58;
-        let x62 = 0.00000000020510342851533115 * c_q9
+        let x53 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x54 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x55 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x63 = -0.00000000020510342851533115 * c_q9
+        let x56 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x64 = -0.00000000020510342851533115 * x58;
-        let x65 = x35 * x59 + x36 * x62 + x42 * c_q9;
-        let x66 = x35 * x60 + x36 * x63 - x42 * s_q9;
-        let x67 = x39 - (x36 * -0.4 + 0.275 * x42);
-        let x68 = x40 - 0.4 * x35;
-        let x69 = x41 - -0.275 * x35;
-        let x70 = x59 * x67 + x62 * x68 + c_q9 * x69;
-        let x71 = x60 * x67 + x63 * x68 - s_q9 * x69;
-        let x72 = x61 * x67 + x58 * x68 + x64 * x69;
-        let x73 = v[8] + (x35 * x61 + x36 * x58 + x42 * x64);
-        let x74 = x49 - (x48 * -0.4 + 0.275 * x46);
-        let x75 = x50 - 0.4 * x47;
-        let x76 = x45 - -0.275 * x47;
-        let x77 = x61 * x74 + x58 * x75 + x64 * x76;
-        let x78 = a[8] + (x47 * x61 + x48 * x58 + x46 * x64);
-        let x79 = x47 * x59 + x48 * x62 + x46 * c_q9 + v[8] * x66;
-        let x80 = x47 * x60 + x48 * x63 - x46 * s_q9 - v[8] * x65;
-        let x81 = x59 * x74 + x62 * x75 + c_q9 * x76 + v[8] * x71;
-        let x82 = x60 * x74 + x63 * x75 - s_q9 * x76 - v[8] * x70;
-        let x83 = 3.378 * x66;
-        let x84 = x65 * 4.395515250000001 + -0.00214 * x73 + x72 * -9.87015;
-        let x85 = -0.00214 * x65 + x73 * 7.65251525 + x70 * 9.87015;
-        let x86 = 22.69 * x71;
-        let x87 = 22.69 * x70 - x73 * -9.87015;
-        let x88 = 22.69 * x72 - x65 * 9.87015;
+        let x57 = x30 * x53 + x31 * x55 + x37 * c_q9;
+        let x58 = x30 * x54 + x31 * x56 - x37 * s_q9;
+        let x59 = x34 - (x31 * -0.4 + 0.275 * x37);
+        let x60 = x35 - 0.4 * x30;
+        let x61 = x36 - -0.275 * x30;
+        let x62 = x53 * x59 + x55 * x60 + c_q9 * x61;
+        let x63 = x54 * x59 + x56 * x60 - s_q9 * x61;
+        let x64 = x60 + 0.00000000020510342851533115 * x59
+            + -0.00000000020510342851533115 * x61;
+        let x65 = v[8]
+            + (x31 + 0.00000000020510342851533115 * x30
+                + -0.00000000020510342851533115 * x37);
+        let x66 = x44 - (x43 * -0.4 + 0.275 * x41);
+        let x67 = x45 - 0.4 * x42;
+        let x68 = x40 - -0.275 * x42;
+        let x69 = x67 + 0.00000000020510342851533115 * x66
+            + -0.00000000020510342851533115 * x68;
+        let x70 = a[8]
+            + (x43 + 0.00000000020510342851533115 * x42
+                + -0.00000000020510342851533115 * x41);
+        let x71 = x42 * x53 + x43 * x55 + x41 * c_q9 + v[8] * x58;
+        let x72 = x42 * x54 + x43 * x56 - x41 * s_q9 - v[8] * x57;
+        let x73 = x53 * x66 + x55 * x67 + c_q9 * x68 + v[8] * x63;
+        let x74 = x54 * x66 + x56 * x67 - s_q9 * x68 - v[8] * x62;
+        let x75 = -63.36336825000001 * x58 + -36.18604050126307 * x65;
+        let x76 = -0.00214 * x65 + -81.53205 * x64;
+        let x77 = -0.00214 * x57 + -36.18604050126307 * x58 + 69.99836825 * x65
+            + x62 * 81.53205;
+        let x78 = -81.53205 * x65;
+        let x79 = x57 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x90 = c_q10 + (1.0 - c_q10);
-        let x91 = x65 * c_q10 + x66 * s_q10;
-        let x92 = x66 * c_q10 - x65 * s_q10;
-        let x93 = x70 - -0.87 * x73;
-        let x94 = c_q10 * x93 + x71 * s_q10;
-        let x95 = x71 * c_q10 - s_q10 * x93;
-        let x96 = x90 * (x72 - x65 * 0.87);
-        let x97 = v[9] + x73 * x90;
-        let x98 = x81 - -0.87 * x78;
-        let x99 = x90 * (x77 - x79 * 0.87);
-        let x100 = a[9] + x78 * x90;
-        let x101 = x79 * c_q10 + x80 * s_q10 + v[9] * x92;
-        let x102 = x80 * c_q10 - x79 * s_q10 - v[9] * x91;
-        let x103 = c_q10 * x98 + x82 * s_q10 + v[9] * x95;
-        let x104 = x82 * c_q10 - s_q10 * x98 - v[9] * x94;
-        let x105 = x91 * 4.170993 + -0.6328 * x97 + (x95 * 5.8795 + x96 * -6.7347);
-        let x106 = x92 * 3.8828625 + x97 * -1.8520425 + x94 * -5.8795;
-        let x107 = -0.6328 * x91 + x92 * -1.8520425 + x97 * 4.0324305 + x94 * 6.7347;
-        let x108 = 21.38 * x94 - (x92 * 5.8795 + x97 * -6.7347);
-        let x109 = 21.38 * x95 - x91 * -5.8795;
-        let x110 = 21.38 * x96 - x91 * 6.7347;
+        let x81 = x57 * c_q10 + x58 * s_q10;
+        let x82 = x58 * c_q10 - x57 * s_q10;
+        let x83 = x62 - -0.87 * x65;
+        let x84 = x64 - x57 * 0.87;
+        let x85 = c_q10 * x83 + x63 * s_q10;
+        let x86 = x63 * c_q10 - s_q10 * x83;
+        let x87 = v[9] + x65;
+        let x88 = x73 - -0.87 * x70;
+        let x89 = x69 - x71 * 0.87;
+        let x90 = a[9] + x70;
+        let x91 = x71 * c_q10 + x72 * s_q10 + v[9] * x82;
+        let x92 = x72 * c_q10 - x71 * s_q10 - v[9] * x81;
+        let x93 = c_q10 * x88 + x74 * s_q10 + v[9] * x86;
+        let x94 = -24.4950615 * x82 + -24.35164200091464 * x87;
+        let x95 = -0.6328 * x87 + -45.1584 * x84;
+        let x96 = -0.6328 * x81 + -24.351642000914637 * x82 + 28.2393615 * x87
+            + x85 * 45.1584;
+        let x97 = -45.1584 * x87;
+        let x98 = x81 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x112 = c_q11 + (1.0 - c_q11);
-        let x113 = x91 * c_q11 + x92 * s_q11;
-        let x114 = x92 * c_q11 - x91 * s_q11;
-        let x115 = x94 - (0.275 * x92 + -0.63 * x97);
-        let x116 = x95 - -0.275 * x91;
-        let x117 = c_q11 * x115 + s_q11 * x116;
-        let x118 = c_q11 * x116 - s_q11 * x115;
-        let x119 = x112 * (x96 - x91 * 0.63);
-        let x120 = v[10] + x97 * x112;
-        let x121 = x103 - (0.275 * x102 + -0.63 * x100);
-        let x122 = x104 - -0.275 * x101;
-        let x123 = x112 * (x99 - x101 * 0.63);
-        let x124 = a[10] + x100 * x112;
-        let x125 = x101 * c_q11 + x102 * s_q11 + v[10] * x114;
-        let x126 = x102 * c_q11 - x101 * s_q11 - v[10] * x113;
-        let x127 = c_q11 * x121 + s_q11 * x122 + v[10] * x118;
-        let x128 = c_q11 * x122 - s_q11 * x121 - v[10] * x117;
-        let x129 = 0.01675 * x113 + 0.07271 * x120;
-        let x130 = x113 * 0.9304999999999999 + 0.01675 * x120
-            + x118 * 3.0149999999999997;
-        let x131 = x114 * 0.939 + x117 * -3.0149999999999997;
-        let x132 = 16.75 * x119;
-        let x133 = 16.75 * x117 - x114 * 3.0149999999999997;
-        let x134 = 16.75 * x118 - x113 * -3.0149999999999997;
+        let x100 = x81 * c_q11 + x82 * s_q11;
+        let x101 = x82 * c_q11 - x81 * s_q11;
+        let x102 = x85 - (0.275 * x82 + -0.63 * x87);
+        let x103 = x86 - -0.275 * x81;
+        let x104 = x84 - x81 * 0.63;
+        let x105 = c_q11 * x102 + s_q11 * x103;
+        let x106 = c_q11 * x103 - s_q11 * x102;
+        let x107 = v[10] + x87;
+        let x108 = x93 - (0.275 * x92 + -0.63 * x90);
+        let x109 = x74 * c_q10 - s_q10 * x88 - v[9] * x85 - -0.275 * x91;
+        let x110 = x89 - x91 * 0.63;
+        let x111 = a[10] + x90;
+        let x112 = x91 * c_q11 + x92 * s_q11 + v[10] * x101;
+        let x113 = x92 * c_q11 - x91 * s_q11 - v[10] * x100;
+        let x114 = c_q11 * x108 + s_q11 * x109 + v[10] * x106;
+        let x115 = -9.142025249762803 * x101 + 2.5482240016099564 * x107;
+        let x116 = 0.01675 * x107 + 7.078399999258757 * x104;
+        let x117 = 0.01675 * x100 + 2.5482240016099564 * x101 + 9.223235249762805 * x107
+            + x105 * -7.078399999258757;
+        let x118 = 7.078399999258757 * x107;
+        let x119 = x100 * -7.078399999258757;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x136 = c_q12 + (1.0 - c_q12);
-        let x137 = -0.00000000020510342851533115 * s_q12;
-        let x138 = -0.00000000020510342851533115 * c_q12;
-        let x139 = -0.00000000020510342851533115 * x136;
-        let x140 = x113 * c_q12 + x114 * x137 - x120 * s_q12;
-        let x141 = x114 * x138 - x113 * s_q12 - x120 * c_q12;
-        let x142 = x117 - x114 * 0.36;
-        let x143 = x118 - -0.36 * x113;
-        let x144 = c_q12 * x142 + x137 * x143 - x119 * s_q12;
-        let x145 = x138 * x143 - s_q12 * x142 - x119 * c_q12;
-        let x146 = x136 * x143 + x119 * x139;
-        let x147 = v[11] + (x114 * x136 + x120 * x139);
-        let x148 = x127 - x126 * 0.36;
-        let x149 = x128 - -0.36 * x125;
-        let x150 = x136 * x149 + x123 * x139;
-        let x151 = a[11] + (x126 * x136 + x124 * x139);
-        let x152 = x125 * c_q12 + x126 * x137 - x124 * s_q12 + v[11] * x141;
-        let x153 = x126 * x138 - x125 * s_q12 - x124 * c_q12 - v[11] * x140;
-        let x154 = c_q12 * x148 + x137 * x149 - x123 * s_q12 + v[11] * x145;
-        let x155 = x138 * x149 - s_q12 * x148 - x123 * c_q12 - v[11] * x144;
-        let x156 = x140 * 3.2217582500000006 + -0.2313 * x147
-            + (x145 * -4.187200000000001 + x146 * 7.196750000000001);
-        let x157 = x141 * 1.2686520000000001 + x147 * -1.1514800000000003
-            + x144 * 4.187200000000001;
-        let x158 = -0.2313 * x140 + x141 * -1.1514800000000003
-            + x147 * 2.1079062500000005 + x144 * -7.196750000000001;
-        let x159 = 26.17 * x144 - (x141 * -4.187200000000001 + x147 * 7.196750000000001);
-        let x160 = 26.17 * x145 - x140 * 4.187200000000001;
-        let x161 = 26.17 * x146 - x140 * -7.196750000000001;
+        let x121 = -0.00000000020510342851533115 * s_q12;
+        let x122 = -0.00000000020510342851533115 * c_q12;
+        let x123 = x100 * c_q12 + x101 * x121 - x107 * s_q12;
+        let x124 = x101 * x122 - x100 * s_q12 - x107 * c_q12;
+        let x125 = x105 - x101 * 0.36;
+        let x126 = x106 - -0.36 * x100;
+        let x127 = c_q12 * x125 + x121 * x126 - x104 * s_q12;
+        let x128 = x122 * x126 - s_q12 * x125 - x104 * c_q12;
+        let x129 = x126 + -0.00000000020510342851533115 * x104;
+        let x130 = v[11] + (x101 + -0.00000000020510342851533115 * x107);
+        let x131 = x114 - x113 * 0.36;
+        let x132 = c_q11 * x109 - s_q11 * x108 - v[10] * x105 - -0.36 * x112;
+        let x133 = x132 + -0.00000000020510342851533115 * x110;
+        let x134 = a[11] + (x113 + -0.00000000020510342851533115 * x111);
+        let x135 = x112 * c_q12 + x113 * x121 - x111 * s_q12 + v[11] * x124;
+        let x136 = x113 * x122 - x112 * s_q12 - x111 * c_q12 - v[11] * x123;
+        let x137 = c_q12 * x131 + x121 * x132 - x110 * s_q12 + v[11] * x128;
+        let x138 = x122 * x132 - s_q12 * x131 - x110 * c_q12 - v[11] * x127;
+        let x139 = -1.9877000000000002 * x124 + -0.809539999555672 * x130
+            + 17.135250000000003 * x129;
+        let x140 = -1.9877000000000002 * x123 + -5.252920330000002 * x124
+            + -2.741639999592316 * x130 + x129 * -3.6140000000000003;
+        let x141 = -0.809539999555672 * x123 + -2.7416399995923166 * x124
+            + 9.740442170000001 * x130
+            + (x127 * -17.135250000000003 + 3.6140000000000003 * x128);
+        let x142 = 17.135250000000003 * x130;
+        let x143 = x130 * -3.6140000000000003;
+        let x144 = x123 * -17.135250000000003 + 3.6140000000000003 * x124;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x163 = c_q13 + (1.0 - c_q13);
-        let x164 = -0.00000000020510342851533115 * c_q13;
-        let x165 = -0.00000000020510342851533115 * s_q13;
-        let x166 = -0.00000000020510342851533115 * x163;
-        let x167 = x140 * x164 + x141 * s_q13 - x147 * c_q13;
-        let x168 = x141 * c_q13 - x140 * x165 + x147 * s_q13;
-        let x169 = x144 - (x141 * -0.16 + 0.55 * x147);
-        let x170 = x145 - 0.16 * x140;
-        let x171 = x146 - x140 * -0.55;
-        let x172 = x164 * x169 + s_q13 * x170 - c_q13 * x171;
-        let x173 = c_q13 * x170 - x165 * x169 + s_q13 * x171;
-        let x174 = x163 * x169 + x166 * x171;
-        let x175 = v[12] + (x140 * x163 + x147 * x166);
-        let x176 = x154 - (x153 * -0.16 + 0.55 * x151);
-        let x177 = x155 - 0.16 * x152;
-        let x178 = x150 - x152 * -0.55;
-        let x179 = x163 * x176 + x166 * x178;
-        let x180 = a[12] + (x152 * x163 + x151 * x166);
-        let x181 = x152 * x164 + x153 * s_q13 - x151 * c_q13 + v[12] * x168;
-        let x182 = x153 * c_q13 - x152 * x165 + x151 * s_q13 - v[12] * x167;
-        let x183 = x164 * x176 + s_q13 * x177 - c_q13 * x178 + v[12] * x173;
-        let x184 = c_q13 * x177 - x165 * x176 + s_q13 * x178 - v[12] * x172;
-        let x185 = x167 * 2.1663609200000002 + 0.000781 * x168 + -0.0145 * x175
-            + (x173 * -3.6140000000000003 + x174 * 4.806620000000001);
-        let x186 = 0.000781 * x167 + x168 * 0.9638000000000001
-            + x175 * -0.9614610000000001 + x172 * 3.6140000000000003;
-        let x187 = -0.0145 * x167 + x168 * -0.9614610000000001
-            + x175 * 1.4135609200000003 + x172 * -4.806620000000001;
-        let x188 = 18.07 * x172
-            - (x168 * -3.6140000000000003 + x175 * 4.806620000000001);
-        let x189 = 18.07 * x173 - x167 * 3.6140000000000003;
-        let x190 = 18.07 * x174 - x167 * -4.806620000000001;
-        let x191 = x181 * 2.1663609200000002 + 0.000781 * x182 + -0.0145 * x180
-            + (x184 * -3.6140000000000003 + x179 * 4.806620000000001)
-            + (x168 * x187 - x175 * x186 + (x173 * x190 - x174 * x189));
-        let x192 = 0.000781 * x181 + x182 * 0.9638000000000001
-            + x180 * -0.9614610000000001 + x183 * 3.6140000000000003
-            + (x175 * x185 - x167 * x187 + (x174 * x188 - x172 * x190));
-        let x193 = -0.0145 * x181 + x182 * -0.9614610000000001
-            + x180 * 1.4135609200000003 + x183 * -4.806620000000001
-            + (x167 * x186 - x168 * x185 + (x172 * x189 - x173 * x188));
-        let x194 = 18.07 * x183 - (x182 * -3.6140000000000003 + x180 * 4.806620000000001)
-            + (x168 * x190 - x175 * x189);
-        let x195 = 18.07 * x184 - x181 * 3.6140000000000003
-            + (x175 * x188 - x167 * x190);
-        let x196 = 18.07 * x179 - x181 * -4.806620000000001
-            + (x167 * x189 - x168 * x188);
-        let x197 = x164 * x194 - x165 * x195 + x163 * x196;
-        let x198 = s_q13 * x194 + c_q13 * x195;
-        let x199 = s_q13 * x195 - c_q13 * x194 + x166 * x196;
-        let x200 = x152 * 3.2217582500000006 + -0.2313 * x151
-            + (x155 * -4.187200000000001 + x150 * 7.196750000000001)
-            + (x141 * x158 - x147 * x157 + (x145 * x161 - x146 * x160))
-            + (x164 * x191 - x165 * x192 + x163 * x193 + (-0.16 * x198 + 0.55 * x199));
-        let x201 = x153 * 1.2686520000000001 + x151 * -1.1514800000000003
-            + x154 * 4.187200000000001
-            + (x147 * x156 - x140 * x158 + (x146 * x159 - x144 * x161))
-            + (s_q13 * x191 + c_q13 * x192 + 0.16 * x197);
-        let x202 = -0.2313 * x152 + x153 * -1.1514800000000003
-            + x151 * 2.1079062500000005 + x154 * -7.196750000000001
-            + (x140 * x157 - x141 * x156 + (x144 * x160 - x145 * x159))
-            + (s_q13 * x192 - c_q13 * x191 + x166 * x193 + -0.55 * x197);
-        let x203 = 26.17 * x154 - (x153 * -4.187200000000001 + x151 * 7.196750000000001)
-            + (x141 * x161 - x147 * x160) + x197;
-        let x204 = 26.17 * x155 - x152 * 4.187200000000001 + (x147 * x159 - x140 * x161)
-            + x198;
-        let x205 = 26.17 * x150 - x152 * -7.196750000000001 + (x140 * x160 - x141 * x159)
-            + x199;
-        let x206 = c_q12 * x203 - s_q12 * x204;
-        let x207 = x137 * x203 + x138 * x204 + x136 * x205;
-        let x208 = x125 * 0.9304999999999999 + 0.01675 * x124 + x128 * 3.0149999999999997
-            + (x114 * x129 - x120 * x131 + (x118 * x132 - x119 * x134))
-            + (c_q12 * x200 - s_q12 * x201 + 0.36 * x207);
-        let x209 = x126 * 0.939 + x127 * -3.0149999999999997
-            + (x120 * x130 - x113 * x129 + (x119 * x133 - x117 * x132))
-            + (x137 * x200 + x138 * x201 + x136 * x202 + -0.36 * x206);
-        let x210 = 0.01675 * x125 + 0.07271 * x124
-            + (x113 * x131 - x114 * x130 + (x117 * x134 - x118 * x133))
-            + (x139 * x202 - (s_q12 * x200 + c_q12 * x201));
-        let x211 = 16.75 * x127 - x126 * 3.0149999999999997 + (x114 * x132 - x120 * x134)
-            + x206;
-        let x212 = 16.75 * x128 - x125 * -3.0149999999999997
-            + (x120 * x133 - x113 * x132) + x207;
-        let x213 = c_q11 * x211 - s_q11 * x212;
-        let x214 = s_q11 * x211 + c_q11 * x212;
-        let x215 = x112
-            * (16.75 * x123 + (x113 * x134 - x114 * x133)
-                + (x139 * x205 - (s_q12 * x203 + c_q12 * x204)));
-        let x216 = x101 * 4.170993 + -0.6328 * x100 + (x104 * 5.8795 + x99 * -6.7347)
-            + (x92 * x107 - x97 * x106 + (x95 * x110 - x96 * x109))
-            + (c_q11 * x208 - s_q11 * x209 + (0.275 * x214 + -0.63 * x215));
-        let x217 = x102 * 3.8828625 + x100 * -1.8520425 + x103 * -5.8795
-            + (x97 * x105 - x91 * x107 + (x96 * x108 - x94 * x110))
-            + (s_q11 * x208 + c_q11 * x209 + -0.275 * x213);
-        let x218 = -0.6328 * x101 + x102 * -1.8520425 + x100 * 4.0324305 + x103 * 6.7347
-            + (x91 * x106 - x92 * x105 + (x94 * x109 - x95 * x108))
-            + (x112 * x210 + 0.63 * x213);
-        let x219 = 21.38 * x103 - (x102 * 5.8795 + x100 * -6.7347)
-            + (x92 * x110 - x97 * x109) + x213;
-        let x220 = 21.38 * x104 - x101 * -5.8795 + (x97 * x108 - x91 * x110) + x214;
-        let x221 = c_q10 * x219 - s_q10 * x220;
-        let x222 = x90
-            * (21.38 * x99 - x101 * 6.7347 + (x91 * x109 - x92 * x108) + x215);
-        let x223 = x79 * 4.395515250000001 + -0.00214 * x78 + x77 * -9.87015
-            + (x66 * x85 - x73 * x83 + (x71 * x88 - x72 * x86))
-            + (c_q10 * x216 - s_q10 * x217 + -0.87 * x222);
-        let x224 = 3.378 * x80 + (x73 * x84 - x65 * x85 + (x72 * x87 - x70 * x88))
-            + (s_q10 * x216 + c_q10 * x217);
-        let x225 = -0.00214 * x79 + x78 * 7.65251525 + x81 * 9.87015
-            + (x65 * x83 - x66 * x84 + (x70 * x86 - x71 * x87))
-            + (x90 * x218 + 0.87 * x221);
-        let x226 = 22.69 * x81 - x78 * -9.87015 + (x66 * x88 - x73 * x86) + x221;
-        let x227 = 22.69 * x82 + (x73 * x87 - x65 * x88) + (s_q10 * x219 + c_q10 * x220);
-        let x228 = 22.69 * x77 - x79 * 9.87015 + (x65 * x86 - x66 * x87) + x222;
-        let x229 = x59 * x226 + x60 * x227 + x61 * x228;
-        let x230 = x62 * x226 + x63 * x227 + x58 * x228;
-        let x231 = c_q9 * x226 - s_q9 * x227 + x64 * x228;
-        let x232 = x47 * 3.3000000000000003 + -0.00214 * x46 + x50 * -6.0
-            + (x36 * x51 - x42 * x53 + (x40 * x54 - x41 * x56))
-            + (x59 * x223 + x60 * x224 + x61 * x225 + (-0.4 * x230 + 0.275 * x231));
-        let x233 = x48 * 2.5780000000000003 + x49 * 6.0
-            + (x42 * x52 - x35 * x51 + (x41 * x55 - x39 * x54))
-            + (x62 * x223 + x63 * x224 + x58 * x225 + 0.4 * x229);
-        let x234 = -0.00214 * x47 + 2.359 * x46
-            + (x35 * x53 - x36 * x52 + (x39 * x56 - x40 * x55))
-            + (c_q9 * x223 - s_q9 * x224 + x64 * x225 + -0.275 * x229);
-        let x235 = 30.0 * x49 - x48 * -6.0 + (x36 * x54 - x42 * x56) + x229;
-        let x236 = 30.0 * x50 - x47 * 6.0 + (x42 * x55 - x35 * x54) + x230;
-        let x237 = 30.0 * x45 + (x35 * x56 - x36 * x55) + x231;
-        let x238 = x32 * x235 - x33 * x236 + x31 * x237;
-        let x239 = s_q8 * x235 + c_q8 * x236;
-        let x240 = x20 * 2.29018125 + -0.07309 * x21 + 0.00071 * x19
-            + x23 * -6.1267499999999995
-            + (x9 * x24 - x15 * x26 + (x13 * x27 - x14 * x29))
-            + (x32 * x232 - x33 * x233 + x31 * x234 + -0.35 * x239);
-        let x241 = -0.07309 * x20 + x21 * 1.5853812499999997 + 0.1132 * x19
-            + x22 * 6.1267499999999995 + (x15 * x25 - x8 * x24 + (x14 * x28 - x12 * x27))
-            + (s_q8 * x232 + c_q8 * x233 + 0.35 * x238);
-        let x242 = 0.00071 * x20 + 0.1132 * x21 + 1.331 * x19
-            + (x8 * x26 - x9 * x25 + (x12 * x29 - x13 * x28))
-            + (s_q8 * x233 - c_q8 * x232 + x34 * x234);
-        let x243 = 35.01 * x22 - x21 * -6.1267499999999995 + (x9 * x27 - x15 * x29)
-            + x238;
-        let x244 = 35.01 * x23 - x20 * 6.1267499999999995 + (x15 * x28 - x8 * x27)
-            + x239;
-        let x245 = c_q7 * x243 - s_q7 * x244;
-        let x246 = s_q7 * x243 + c_q7 * x244;
-        let x247 = x7
-            * (35.01 * x18 + (x8 * x29 - x9 * x28)
-                + (s_q8 * x236 - c_q8 * x235 + x34 * x237));
-        let x248 = a[3] * 1200.0 + (v[4] * x2 - v[5] * x1 + (v[1] * x5 - v[2] * x4))
-            + (c_q7 * x240 - s_q7 * x241 + -0.75 * x246);
-        let x249 = a[4] * 1200.0 + (v[5] * x0 - v[3] * x2 + (v[2] * x3 - v[0] * x5))
-            + (s_q7 * x240 + c_q7 * x241 + (0.75 * x245 + -0.65 * x247));
-        let x250 = a[5] * 1200.0 + (v[3] * x1 - v[4] * x0 + (v[0] * x4 - v[1] * x3))
-            + (x7 * x242 + 0.65 * x246);
-        let x251 = a[0] * 1000.0 + (v[4] * x5 - v[5] * x4) + x245;
-        let x252 = a[1] * 1000.0 + (v[5] * x3 - v[3] * x5) + x246;
-        let x253 = a[2] * 1000.0 + (v[3] * x4 - v[4] * x3) + x247;
-        [x251, x252, x253, x248, x249, x250, x242, x234, x225, x218, x210, x202, x193]
+        let x146 = -0.00000000020510342851533115 * c_q13;
+        let x147 = -0.00000000020510342851533115 * s_q13;
+        let x148 = x123 * x146 + x124 * s_q13 - x130 * c_q13;
+        let x149 = x124 * c_q13 - x123 * x147 + x130 * s_q13;
+        let x150 = x127 - (-0.16 * x124 + 0.55 * x130);
+        let x151 = x128 - 0.16 * x123;
+        let x152 = x129 - x123 * -0.55;
+        let x153 = x146 * x150 + s_q13 * x151 - c_q13 * x152;
+        let x154 = c_q13 * x151 - x147 * x150 + s_q13 * x152;
+        let x155 = x150 + -0.00000000020510342851533115 * x152;
+        let x156 = v[12] + (x123 + -0.00000000020510342851533115 * x130);
+        let x157 = x137 - (-0.16 * x136 + 0.55 * x134);
+        let x158 = x133 - x135 * -0.55;
+        let x159 = a[12] + (x135 + -0.00000000020510342851533115 * x134);
+        let x160 = x135 * x146 + x136 * s_q13 - x134 * c_q13 + v[12] * x149;
+        let x161 = x136 * c_q13 - x135 * x147 + x134 * s_q13 - v[12] * x148;
+        let x162 = 0.000781 * x148 + -1.2025609200000003 * x149
+            + -0.9614610000000001 * x156;
+        let x163 = 0.000781 * x149 + -0.0145 * x156 + 4.806620000000001 * x155;
+        let x164 = -0.0145 * x148 + -0.9614610000000001 * x149
+            + 1.4135609200000003 * x156 + x153 * -4.806620000000001;
+        let x165 = 4.806620000000001 * x156;
+        let x166 = x148 * -4.806620000000001;
+        let x167 = x148 * x166 - x156 * x165;
+        let x168 = 0.000781 * x161 + -0.0145 * x159
+            + 4.806620000000001 * (x157 + -0.00000000020510342851533115 * x158)
+            + (x149 * x164 - x156 * x162 - x154 * x166);
+        let x169 = 0.000781 * x160 + -1.2025609200000003 * x161
+            + -0.9614610000000001 * x159
+            + (x156 * x163 - x148 * x164 + (x153 * x166 - x155 * x165));
+        let x170 = -0.0145 * x160 + -0.9614610000000001 * x161
+            + 1.4135609200000003 * x159
+            + (x146 * x157 + s_q13 * (x138 - 0.16 * x135) - c_q13 * x158 + v[12] * x154)
+                * -4.806620000000001 + (x148 * x162 - x149 * x163 + x154 * x165);
+        let x171 = 4.806620000000001 * x159 + x149 * x166;
+        let x172 = x149 * x165 - x160 * -4.806620000000001;
+        let x173 = x172 - (x146 * x171 + x147 * x167);
+        let x174 = c_q13 * x167 - s_q13 * x171;
+        let x175 = c_q13 * x171 + s_q13 * x167 + -0.00000000020510342851533115 * x172;
+        let x176 = -1.9877000000000002 * x136 + -0.809539999555672 * x134
+            + 17.135250000000003 * x133
+            + (x124 * x141 - x130 * x140 + (x129 * x143 - x128 * x144))
+            + (x170 + (x146 * x168 - x147 * x169) + (-0.16 * x174 + 0.55 * x175));
+        let x177 = -1.9877000000000002 * x135 + -5.252920330000002 * x136
+            + -2.741639999592316 * x134 + x133 * -3.6140000000000003
+            + (x130 * x139 - x123 * x141 + (x127 * x144 - x129 * x142))
+            + (s_q13 * x168 + c_q13 * x169 + 0.16 * x173);
+        let x178 = -0.809539999555672 * x135 + -2.7416399995923166 * x136
+            + 9.740442170000001 * x134
+            + (x137 * -17.135250000000003 + 3.6140000000000003 * x138)
+            + (x123 * x140 - x124 * x139 + (x128 * x142 - x127 * x143))
+            + (s_q13 * x169 - c_q13 * x168 + -0.00000000020510342851533115 * x170
+                + -0.55 * x173);
+        let x179 = x130 * x143 - x124 * x144 - 17.135250000000003 * x134 + x173;
+        let x180 = x123 * x144 - x130 * x142 - x134 * -3.6140000000000003 + x174;
+        let x181 = x124 * x142 - x123 * x143
+            - (x135 * -17.135250000000003 + 3.6140000000000003 * x136) + x175;
+        let x182 = c_q12 * x179 - s_q12 * x180;
+        let x183 = x181 + (x121 * x179 + x122 * x180);
+        let x184 = 0.01675 * x111 + 7.078399999258757 * x110
+            + (x101 * x117 - x107 * x115 - x106 * x119)
+            + (c_q12 * x176 - s_q12 * x177 + 0.36 * x183);
+        let x185 = -9.142025249762803 * x113 + 2.5482240016099564 * x111
+            + (x107 * x116 - x100 * x117 + (x105 * x119 - x104 * x118))
+            + (x178 + (x121 * x176 + x122 * x177) + -0.36 * x182);
+        let x186 = 0.01675 * x112 + 2.5482240016099564 * x113 + 9.223235249762805 * x111
+            + x114 * -7.078399999258757 + (x100 * x115 - x101 * x116 + x106 * x118)
+            + (-0.00000000020510342851533115 * x178 - (s_q12 * x176 + c_q12 * x177));
+        let x187 = x182 - (7.078399999258757 * x111 + x101 * x119);
+        let x188 = x100 * x119 - x107 * x118 + x183;
+        let x189 = x101 * x118 - x112 * -7.078399999258757
+            + (-0.00000000020510342851533115 * x181 - (s_q12 * x179 + c_q12 * x180));
+        let x190 = c_q11 * x187 - s_q11 * x188;
+        let x191 = s_q11 * x187 + c_q11 * x188;
+        let x192 = -0.6328 * x90 + -45.1584 * x89 + (x82 * x96 - x87 * x94 - x86 * x98)
+            + (c_q11 * x184 - s_q11 * x185 + (0.275 * x191 + -0.63 * x189));
+        let x193 = -24.4950615 * x92 + -24.35164200091464 * x90
+            + (x87 * x95 - x81 * x96 + (x85 * x98 - x84 * x97))
+            + (s_q11 * x184 + c_q11 * x185 + -0.275 * x190);
+        let x194 = -0.6328 * x91 + -24.351642000914637 * x92 + 28.2393615 * x90
+            + x93 * 45.1584 + (x81 * x94 - x82 * x95 + x86 * x97) + (x186 + 0.63 * x190);
+        let x195 = x190 - (-45.1584 * x90 + x82 * x98);
+        let x196 = x81 * x98 - x87 * x97 + x191;
+        let x197 = x82 * x97 - x91 * 45.1584 + x189;
+        let x198 = c_q10 * x195 - s_q10 * x196;
+        let x199 = -0.00214 * x70 + -81.53205 * x69 + (x58 * x77 - x65 * x75 - x63 * x79)
+            + (c_q10 * x192 - s_q10 * x193 + -0.87 * x197);
+        let x200 = -63.36336825000001 * x72 + -36.18604050126307 * x70
+            + (x65 * x76 - x57 * x77 + (x62 * x79 - x64 * x78))
+            + (s_q10 * x192 + c_q10 * x193);
+        let x201 = -0.00214 * x71 + -36.18604050126307 * x72 + 69.99836825 * x70
+            + x73 * 81.53205 + (x57 * x75 - x58 * x76 + x63 * x78)
+            + (x194 + 0.87 * x198);
+        let x202 = x198 - (-81.53205 * x70 + x58 * x79);
+        let x203 = x57 * x79 - x65 * x78 + (s_q10 * x195 + c_q10 * x196);
+        let x204 = x58 * x78 - x71 * 81.53205 + x197;
+        let x205 = x53 * x202 + x54 * x203 + 0.00000000020510342851533115 * x204;
+        let x206 = x204 + (x55 * x202 + x56 * x203);
+        let x207 = c_q9 * x202 - s_q9 * x203 + -0.00000000020510342851533115 * x204;
+        let x208 = -0.0000000234896432582596 * x43 + -0.0021399965876409276 * x41
+            + -12.701650001451807 * x40
+            + (x31 * x48 - x37 * x47 + (x36 * x50 - x35 * x51))
+            + (x53 * x199 + x54 * x200 + 0.00000000020510342851533115 * x201
+                + (-0.4 * x206 + 0.275 * x207));
+        let x209 = -0.0000000234896432582596 * x42 + -111.7548902508081 * x43
+            + 5.080660024070365 * x41 + x40 * 0.000000008530897668050218
+            + (x37 * x46 - x30 * x48 + (x34 * x51 - x36 * x49))
+            + (x201 + (x55 * x199 + x56 * x200) + 0.4 * x205);
+        let x210 = -0.0021399965876409276 * x42 + 5.080660024070366 * x43
+            + 113.3918902508081 * x41
+            + (x44 * 12.701650001451807 + -0.000000008530897668050218 * x45)
+            + (x30 * x47 - x31 * x46 + (x35 * x49 - x34 * x50))
+            + (c_q9 * x199 - s_q9 * x200 + -0.00000000020510342851533115 * x201
+                + -0.275 * x205);
+        let x211 = x37 * x50 - x31 * x51 - -12.701650001451807 * x41 + x205;
+        let x212 = x30 * x51 - x37 * x49 - x41 * 0.000000008530897668050218 + x206;
+        let x213 = x31 * x49 - x30 * x50
+            - (x42 * 12.701650001451807 + -0.000000008530897668050218 * x43) + x207;
+        let x214 = x213 + (x28 * x211 - x29 * x212);
+        let x215 = s_q8 * x211 + c_q8 * x212;
+        let x216 = -0.07309 * x20 + -16.80768997608804 * x18
+            + (x8 * x24 - x14 * x23 + (x11 * x25 - x13 * x26))
+            + (x210 + (x28 * x208 - x29 * x209) + -0.35 * x215);
+        let x217 = -0.07309 * x19 + 130.43769025763282 * x20 + 0.1132 * x18
+            + x17 * -48.0240000085309 + (x14 * x22 - x7 * x24 + x12 * x26)
+            + (s_q8 * x208 + c_q8 * x209 + 0.35 * x214);
+        let x218 = -16.80768997608804 * x19 + 0.1132 * x20 + 132.47349025763282 * x18
+            + 48.0240000085309 * x21 + (x7 * x23 - x8 * x22 - x12 * x25)
+            + (s_q8 * x209 - c_q8 * x208 + -0.00000000020510342851533115 * x210);
+        let x219 = x14 * x25 - x8 * x26 + x214;
+        let x220 = x7 * x26 - x18 * -48.0240000085309 + x215;
+        let x221 = s_q8 * x212 - c_q8 * x211 + -0.00000000020510342851533115 * x213
+            - (48.0240000085309 * x20 + x7 * x25);
+        let x222 = c_q7 * x219 - s_q7 * x220;
+        let x223 = s_q7 * x219 + c_q7 * x220;
+        let x224 = 1394.5960312283303 * a[3] + -117.61766249359756 * a[5]
+            + a[1] * -180.9502499901501
+            + (v[4] * x2 - v[5] * x1 + (v[1] * x5 - v[2] * x4))
+            + (c_q7 * x216 - s_q7 * x217 + -0.75 * x223);
+        let x225 = 1466.4506062283303 * a[4]
+            + (180.9502499901501 * a[0] + a[2] * -110.5455)
+            + (v[5] * x0 - v[3] * x2 + (v[2] * x3 - v[0] * x5))
+            + (s_q7 * x216 + c_q7 * x217 + (0.75 * x222 + -0.65 * x221));
+        let x226 = -117.61766249359758 * a[3] + 1271.854575 * a[5] + 110.5455 * a[1]
+            + (v[3] * x1 - v[4] * x0 + (v[0] * x4 - v[1] * x3)) + (x218 + 0.65 * x223);
+        let x227 = 1170.07 * a[0] - a[4] * -180.9502499901501 + (v[4] * x5 - v[5] * x4)
+            + x222;
+        let x228 = 1170.07 * a[1] - (180.9502499901501 * a[3] + a[5] * -110.5455)
+            + (v[5] * x3 - v[3] * x5) + x223;
+        let x229 = 1170.07 * a[2] - 110.5455 * a[4] + (v[3] * x4 - v[4] * x3) + x221;
+        [x227, x228, x229, x224, x225, x226, x218, x210, x201, x194, x186, x178, x170]
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 1997 mul, 1568 add, 10 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 1779 mul, 1484 add, 10 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x1 = c_q7 + (1.0 - c_q7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x3 = c_q8 + (1.0 - c_q8);
-        let x4 = -0.00000000020510342851533115 * c_q8;
-        let x5 = -0.00000000020510342851533115 * s_q8;
-        let x6 = -0.00000000020510342851533115 * x3;
+        let x2 = -0.00000000020510342851533115 * c_q8;
+        let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x8 = c_q9 + (1.0 - c_q9);
-        let x9 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x10 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x11 = 0.00000000020510342851533115 * x8;
-        let x12 = 0.00000000020510342851533115 * c_q9
+        let x5 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x6 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x7 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x13 = -0.00000000020510342851533115 * c_q9
+        let x8 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x14 = -0.00000000020510342851533115 * x8;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x16 = c_q10 + (1.0 - c_q10);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x18 = c_q11 + (1.0 - c_q11);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x20 = c_q12 + (1.0 - c_q12);
-        let x21 = -0.00000000020510342851533115 * s_q12;
-        let x22 = -0.00000000020510342851533115 * c_q12;
-        let x23 = -0.00000000020510342851533115 * x20;
+        let x12 = -0.00000000020510342851533115 * s_q12;
+        let x13 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x25 = c_q13 + (1.0 - c_q13);
-        let x26 = -0.00000000020510342851533115 * c_q13;
-        let x27 = -0.00000000020510342851533115 * s_q13;
-        let x28 = -0.00000000020510342851533115 * x25;
-        let x29 = x25 * 3.6140000000000003 - x27 * 4.806620000000001;
-        let x30 = c_q13 * 4.806620000000001;
-        let x31 = s_q13 * 4.806620000000001 + x28 * 3.6140000000000003;
-        let x32 = x30 + 9.938500000000001;
-        let x33 = x31 + 2.8912;
-        let x34 = x26 * 2.1663609200000002 - 0.000781 * x27 + -0.0145 * x25;
-        let x35 = 0.000781 * x26 - x27 * 0.9638000000000001 + x25 * -0.9614610000000001;
-        let x36 = -0.0145 * x26 - x27 * -0.9614610000000001 + x25 * 1.4135609200000003;
-        let x37 = 0.000781 * c_q13;
-        let x38 = s_q13 * 2.1663609200000002 + x37;
-        let x39 = 0.000781 * s_q13;
-        let x40 = x39 + c_q13 * 0.9638000000000001;
-        let x41 = -0.0145 * s_q13 + c_q13 * -0.9614610000000001;
-        let x42 = x39 - c_q13 * 2.1663609200000002 + -0.0145 * x28;
-        let x43 = s_q13 * 0.9638000000000001 - x37 + x28 * -0.9614610000000001;
-        let x44 = s_q13 * -0.9614610000000001 - -0.0145 * c_q13
-            + x28 * 1.4135609200000003;
-        let x45 = s_q13 * x34 + c_q13 * x35 - 0.55 * x29;
-        let x46 = x26 * x38 - x27 * x40 + x25 * x41 + x29 * -0.55;
-        let x47 = 7.196750000000001 + x32;
-        let x48 = 4.187200000000001 + x33;
-        let x49 = 3.2217582500000006
-            + (x26 * x34 - x27 * x35 + x25 * x36 - (-0.16 * x31 - 0.55 * x30)
-                - (x32 * -0.55 - 0.16 * x33));
-        let x50 = -0.2313 + (s_q13 * x35 - c_q13 * x34 + x28 * x36 + -0.16 * x29);
-        let x51 = 1.2686520000000001
-            + (s_q13 * x38 + c_q13 * x40 + 0.16 * x31 - -0.16 * x33);
-        let x52 = -1.1514800000000003
-            + (s_q13 * x40 - c_q13 * x38 + x28 * x41 - 0.16 * x30 - 0.55 * x33);
-        let x53 = -0.2313 + (x26 * x42 - x27 * x43 + x25 * x44 - 0.16 * x29);
-        let x54 = -1.1514800000000003
-            + (s_q13 * x42 + c_q13 * x43 + x31 * -0.55 + -0.16 * x32);
-        let x55 = 2.1079062500000005
-            + (s_q13 * x43 - c_q13 * x42 + x28 * x44 - x30 * -0.55 + 0.55 * x32);
-        let x56 = c_q12 * x29;
-        let x57 = s_q12 * x47;
-        let x58 = x56 - x57;
-        let x59 = x21 * x29 + x22 * x47 + x20 * x48;
-        let x60 = s_q12 * x29 + c_q12 * x47;
-        let x61 = x23 * x48 - x60;
-        let x62 = x61 + -15.926400000000001;
-        let x63 = c_q12 * x49 - s_q12 * x46;
-        let x64 = c_q12 * x45 - s_q12 * x51;
-        let x65 = c_q12 * x50 - s_q12 * x52;
-        let x66 = x21 * x49 + x22 * x46 + x20 * x53;
-        let x67 = x21 * x45 + x22 * x51 + x20 * x54;
-        let x68 = x21 * x50 + x22 * x52 + x20 * x55;
-        let x69 = x23 * x53 - (s_q12 * x49 + c_q12 * x46);
-        let x70 = x23 * x54 - (s_q12 * x45 + c_q12 * x51);
-        let x71 = x23 * x55 - (s_q12 * x50 + c_q12 * x52);
-        let x72 = x21 * x63 + x22 * x64 + x20 * x65;
-        let x73 = c_q12 * x66 - s_q12 * x67;
-        let x74 = x23 * x68 - (s_q12 * x66 + c_q12 * x67) - -0.36 * x59;
-        let x75 = 0.9304999999999999
-            + (c_q12 * x63 - s_q12 * x64 - x61 * 0.36 + -0.36 * x62);
-        let x76 = 0.01675 + (x23 * x65 - (s_q12 * x63 + c_q12 * x64) + x58 * 0.36);
-        let x77 = 0.939 + (x21 * x66 + x22 * x67 + x20 * x68 + -0.36 * x61 - x62 * 0.36);
-        let x78 = 0.07271 + (x23 * x71 - (s_q12 * x69 + c_q12 * x70));
-        let x79 = c_q11 * x58 - s_q11 * x59;
-        let x80 = s_q11 * x58 + c_q11 * x59;
-        let x81 = x18 * (-3.0149999999999997 + x62);
-        let x82 = x80 + -38.423700000000004;
-        let x83 = x81 + -16.772250000000003;
-        let x84 = c_q11 * x75 - s_q11 * x73;
-        let x85 = c_q11 * x72 - s_q11 * x77;
-        let x86 = c_q11 * x76 - s_q11 * x74;
-        let x87 = s_q11 * x75 + c_q11 * x73;
-        let x88 = s_q11 * x72 + c_q11 * x77;
-        let x89 = s_q11 * x76 + c_q11 * x74;
-        let x90 = x18 * (0.01675 + (c_q12 * x69 - s_q12 * x70 - -0.36 * x58));
-        let x91 = x18 * (x21 * x69 + x22 * x70 + x20 * x71 + x59 * 0.36);
-        let x92 = x18 * x78;
-        let x93 = 0.275 * x79;
-        let x94 = -0.275 * x80;
-        let x95 = x80 * 0.63;
-        let x96 = s_q11 * x84 + c_q11 * x85 - -0.63 * x79;
-        let x97 = c_q11 * x87 - s_q11 * x88 + x79 * 0.63;
-        let x98 = -6.7347 + x82;
-        let x99 = 4.170993
-            + (c_q11 * x84 - s_q11 * x85 - (0.275 * x81 - -0.63 * x80)
-                - (x82 * 0.63 - -0.275 * x83));
-        let x100 = -0.6328 + (x18 * x86 + x93);
-        let x101 = 3.8828625 + (s_q11 * x87 + c_q11 * x88 + -0.275 * x81 - 0.275 * x83);
-        let x102 = -1.8520425 + (x18 * x89 - x94 - -0.63 * x83);
-        let x103 = 4.0324305 + (x18 * x92 - x95 + -0.63 * x82);
-        let x104 = c_q10 * x79;
-        let x105 = x104 - s_q10 * x98;
-        let x106 = s_q10 * x79;
-        let x107 = x106 + c_q10 * x98;
-        let x108 = x16 * (-5.8795 + x83);
-        let x109 = x107 + -71.6619;
-        let x110 = c_q10 * x99 - s_q10 * x97;
-        let x111 = c_q10 * x96 - s_q10 * x101;
-        let x112 = c_q10 * x100 - s_q10 * x102;
-        let x113 = s_q10 * x99 + c_q10 * x97;
-        let x114 = s_q10 * x96 + c_q10 * x101;
-        let x115 = s_q10 * x100 + c_q10 * x102;
-        let x116 = x16 * (-0.6328 + (c_q11 * x90 - s_q11 * x91 - -0.275 * x79));
-        let x117 = x16
-            * (-1.8520425 + (s_q11 * x90 + c_q11 * x91 + x81 * 0.63 + 0.275 * x82));
-        let x118 = x16 * x103;
-        let x119 = x107 * 0.87;
-        let x120 = s_q10 * x110 + c_q10 * x111 - -0.87 * x105;
-        let x121 = s_q10 * x116 + c_q10 * x117 + x108 * 0.87;
-        let x122 = c_q10 * x113 - s_q10 * x114 + x105 * 0.87;
-        let x123 = x16 * x115 - -0.87 * x108;
-        let x124 = -9.87015 + x109;
-        let x125 = 4.395515250000001
-            + (c_q10 * x110 - s_q10 * x111 + -0.87 * x107 - x109 * 0.87);
-        let x126 = -0.00214 + x16 * x112;
-        let x127 = 3.378 + (s_q10 * x113 + c_q10 * x114);
-        let x128 = -0.00214 + (c_q10 * x116 - s_q10 * x117);
-        let x129 = 7.65251525 + (x16 * x118 - x119 + -0.87 * x109);
-        let x130 = x9 * x105 + x10 * x124 + x11 * x108;
-        let x131 = x12 * x105 + x13 * x124 + x8 * x108;
-        let x132 = c_q9 * x105 - s_q9 * x124 + x14 * x108;
-        let x133 = x131 + 28.891500000000004;
-        let x134 = x132 + 42.024;
-        let x135 = x9 * x125 + x10 * x122 + x11 * x128;
-        let x136 = x9 * x120 + x10 * x127 + x11 * x121;
-        let x137 = x9 * x126 + x10 * x123 + x11 * x129;
-        let x138 = x12 * x125 + x13 * x122 + x8 * x128;
-        let x139 = x12 * x120 + x13 * x127 + x8 * x121;
-        let x140 = x12 * x126 + x13 * x123 + x8 * x129;
-        let x141 = c_q9 * x125 - s_q9 * x122 + x14 * x128;
-        let x142 = c_q9 * x120 - s_q9 * x127 + x14 * x121;
-        let x143 = c_q9 * x126 - s_q9 * x123 + x14 * x129;
-        let x144 = x12 * x135 + x13 * x136 + x8 * x137 - 0.275 * x130;
-        let x145 = x9 * x138 + x10 * x139 + x11 * x140 + -0.275 * x130;
-        let x146 = c_q9 * x138 - s_q9 * x139 + x14 * x140 - 0.4 * x131 - 0.275 * x134;
-        let x147 = x12 * x141 + x13 * x142 + x8 * x143 + -0.275 * x132 + x133 * -0.4;
-        let x148 = 6.0 + x134;
-        let x149 = 3.3000000000000003
-            + (x9 * x135 + x10 * x136 + x11 * x137 - (x132 * -0.4 - 0.275 * x131)
-                - (-0.275 * x133 - 0.4 * x134));
-        let x150 = -0.00214 + (c_q9 * x135 - s_q9 * x136 + x14 * x137 + x130 * -0.4);
-        let x151 = 2.5780000000000003
-            + (x12 * x138 + x13 * x139 + x8 * x140 + 0.4 * x132 - x134 * -0.4);
-        let x152 = -0.00214 + (x9 * x141 + x10 * x142 + x11 * x143 - 0.4 * x130);
-        let x153 = 2.359
-            + (c_q9 * x141 - s_q9 * x142 + x14 * x143 - -0.275 * x131 + 0.275 * x133);
-        let x154 = x4 * x130 - x5 * x133 + x3 * x148;
-        let x155 = s_q8 * x130 + c_q8 * x133;
-        let x156 = c_q8 * x130;
-        let x157 = s_q8 * x133;
-        let x158 = x157 - x156 + x6 * x148;
-        let x159 = x158 + 47.271;
-        let x160 = x4 * x149 - x5 * x145 + x3 * x152;
-        let x161 = x4 * x144 - x5 * x151 + x3 * x147;
-        let x162 = x4 * x150 - x5 * x146 + x3 * x153;
-        let x163 = s_q8 * x149 + c_q8 * x145;
-        let x164 = s_q8 * x144 + c_q8 * x151;
-        let x165 = s_q8 * x150 + c_q8 * x146;
-        let x166 = s_q8 * x146 - c_q8 * x150 + x6 * x153;
-        let x167 = 2.29018125
-            + (x4 * x160 - x5 * x161 + x3 * x162 - x158 * -0.35 + 0.35 * x159);
-        let x168 = -0.07309 + (s_q8 * x160 + c_q8 * x161);
-        let x169 = 0.00071 + (s_q8 * x161 - c_q8 * x160 + x6 * x162 + x154 * -0.35);
-        let x170 = -0.07309 + (x4 * x163 - x5 * x164 + x3 * x165);
-        let x171 = 1.5853812499999997
-            + (s_q8 * x163 + c_q8 * x164 + 0.35 * x158 - x159 * -0.35);
-        let x172 = 0.1132 + (s_q8 * x164 - c_q8 * x163 + x6 * x165 - 0.35 * x155);
-        let x173 = 1.331
-            + (s_q8 * (s_q8 * x151 - c_q8 * x144 + x6 * x147)
-                - c_q8 * (s_q8 * x145 - c_q8 * x149 + x6 * x152) + x6 * x166);
-        let x174 = c_q7 * x154 - s_q7 * x155;
-        let x175 = s_q7 * x154 + c_q7 * x155;
-        let x176 = x1 * (6.1267499999999995 + x159);
-        let x177 = x174 + 110.5455;
-        let x178 = x176 + 127.5525;
-        let x179 = c_q7 * x167 - s_q7 * x170;
-        let x180 = c_q7 * x168 - s_q7 * x171;
-        let x181 = c_q7 * x169 - s_q7 * x172;
-        let x182 = s_q7 * x169 + c_q7 * x172;
-        let x183 = x1 * x173;
-        let x184 = x174 * -0.75;
-        let x185 = 0.75 * x175;
-        let x186 = 0.65 * x174;
-        let x187 = x4 * x133 + x5 * x130;
-        let x188 = x156 - x157;
-        let x189 = x162 + -0.35 * x188;
-        let x190 = x165 - 0.35 * x187;
-        let x191 = c_q7 * x187 + s_q7 * x188;
-        let x192 = c_q7 * x188 - s_q7 * x187;
-        let x193 = x1 * x155;
-        let x194 = x10 * x105;
-        let x195 = x194 - x9 * x124;
-        let x196 = x13 * x105;
-        let x197 = x196 - x12 * x124;
-        let x198 = s_q9 * x105;
-        let x199 = c_q9 * x124 + x198;
-        let x200 = x137 + (-0.4 * x197 - 0.275 * x199);
-        let x201 = x140 + 0.4 * x195;
-        let x202 = x143 + -0.275 * x195;
-        let x203 = x4 * x195 - x5 * x197 - x3 * x199;
-        let x204 = s_q8 * x195 + c_q8 * x197;
-        let x205 = s_q8 * x201 - c_q8 * x200 + x6 * x202;
-        let x206 = x4 * x200 - x5 * x201 + x3 * x202 + -0.35 * x204;
-        let x207 = s_q8 * x200 + c_q8 * x201 + 0.35 * x203;
-        let x208 = c_q7 * x203 - s_q7 * x204;
-        let x209 = s_q7 * x203 + c_q7 * x204;
-        let x210 = x1 * (s_q8 * x197 - c_q8 * x195 - x6 * x199);
-        let x211 = x118 - x119;
-        let x212 = x194 - x9 * x107;
-        let x213 = x196 - x12 * x107;
-        let x214 = x198 + c_q9 * x107;
-        let x215 = x9 * x112 + x10 * x115 + x11 * x211 + (-0.4 * x213 - 0.275 * x214);
-        let x216 = x12 * x112 + x13 * x115 + x8 * x211 + 0.4 * x212;
-        let x217 = c_q9 * x112 - s_q9 * x115 + x14 * x211 + -0.275 * x212;
-        let x218 = x4 * x212 - x5 * x213 - x3 * x214;
-        let x219 = s_q8 * x212 + c_q8 * x213;
-        let x220 = s_q8 * x216 - c_q8 * x215 + x6 * x217;
-        let x221 = x4 * x215 - x5 * x216 + x3 * x217 + -0.35 * x219;
-        let x222 = s_q8 * x215 + c_q8 * x216 + 0.35 * x218;
-        let x223 = c_q7 * x218 - s_q7 * x219;
-        let x224 = s_q7 * x218 + c_q7 * x219;
-        let x225 = x1 * (s_q8 * x213 - c_q8 * x212 - x6 * x214);
-        let x226 = x86 + x93;
-        let x227 = x89 - x94;
-        let x228 = x92 - x95;
-        let x229 = x106 + c_q10 * x80;
-        let x230 = x104 - s_q10 * x80;
-        let x231 = c_q10 * x226 - s_q10 * x227;
-        let x232 = s_q10 * x226 + c_q10 * x227;
-        let x233 = x16 * x228 - 0.87 * x229;
-        let x234 = x10 * x230 - x9 * x229;
-        let x235 = x13 * x230 - x12 * x229;
-        let x236 = c_q9 * x229 + s_q9 * x230;
-        let x237 = x9 * x231 + x10 * x232 + x11 * x233 + (-0.4 * x235 - 0.275 * x236);
-        let x238 = x12 * x231 + x13 * x232 + x8 * x233 + 0.4 * x234;
-        let x239 = c_q9 * x231 - s_q9 * x232 + x14 * x233 + -0.275 * x234;
-        let x240 = x4 * x234 - x5 * x235 - x3 * x236;
-        let x241 = s_q8 * x234 + c_q8 * x235;
-        let x242 = s_q8 * x238 - c_q8 * x237 + x6 * x239;
-        let x243 = x4 * x237 - x5 * x238 + x3 * x239 + -0.35 * x241;
-        let x244 = s_q8 * x237 + c_q8 * x238 + 0.35 * x240;
-        let x245 = c_q7 * x240 - s_q7 * x241;
-        let x246 = s_q7 * x240 + c_q7 * x241;
-        let x247 = x1 * (s_q8 * x235 - c_q8 * x234 - x6 * x236);
-        let x248 = x22 * x29 - x21 * x47;
-        let x249 = x65 + 0.36 * x248;
-        let x250 = x68 - -0.36 * x60;
-        let x251 = c_q11 * x60 + s_q11 * x248;
-        let x252 = c_q11 * x248 - s_q11 * x60;
-        let x253 = x18 * (x57 - x56);
-        let x254 = c_q11 * x249 - s_q11 * x250 + (0.275 * x252 + -0.63 * x253);
-        let x255 = s_q11 * x249 + c_q11 * x250 - -0.275 * x251;
-        let x256 = x18 * x71 - 0.63 * x251;
-        let x257 = c_q10 * x251 + s_q10 * x252;
-        let x258 = c_q10 * x252 - s_q10 * x251;
-        let x259 = x16 * x253;
-        let x260 = s_q10 * x254 + c_q10 * x255;
-        let x261 = c_q10 * x254 - s_q10 * x255 + -0.87 * x259;
-        let x262 = x16 * x256 - 0.87 * x257;
-        let x263 = x10 * x258 - x9 * x257 + x11 * x259;
-        let x264 = x13 * x258 - x12 * x257 + x8 * x259;
-        let x265 = x14 * x259 - (c_q9 * x257 + s_q9 * x258);
-        let x266 = x9 * x261 + x10 * x260 + x11 * x262 + (-0.4 * x264 + 0.275 * x265);
-        let x267 = x12 * x261 + x13 * x260 + x8 * x262 + 0.4 * x263;
-        let x268 = c_q9 * x261 - s_q9 * x260 + x14 * x262 + -0.275 * x263;
-        let x269 = x4 * x263 - x5 * x264 + x3 * x265;
-        let x270 = s_q8 * x263 + c_q8 * x264;
-        let x271 = s_q8 * x267 - c_q8 * x266 + x6 * x268;
-        let x272 = x4 * x266 - x5 * x267 + x3 * x268 + -0.35 * x270;
-        let x273 = s_q8 * x266 + c_q8 * x267 + 0.35 * x269;
-        let x274 = c_q7 * x269 - s_q7 * x270;
-        let x275 = s_q7 * x269 + c_q7 * x270;
-        let x276 = x1 * (s_q8 * x264 - c_q8 * x263 + x6 * x265);
-        let x277 = x26 * -4.806620000000001;
-        let x278 = s_q13 * -4.806620000000001;
-        let x279 = c_q13 * -4.806620000000001;
-        let x280 = x36 + (-0.16 * x278 - 0.55 * x279);
-        let x281 = x41 + 0.16 * x277;
-        let x282 = x44 + -0.55 * x277;
-        let x283 = c_q12 * x277 - s_q12 * x278;
-        let x284 = x21 * x277 + x22 * x278 - x20 * x279;
-        let x285 = x23 * x282 - (s_q12 * x280 + c_q12 * x281);
-        let x286 = c_q12 * x280 - s_q12 * x281 + 0.36 * x284;
-        let x287 = x21 * x280 + x22 * x281 + x20 * x282 + -0.36 * x283;
-        let x288 = c_q11 * x283 - s_q11 * x284;
-        let x289 = s_q11 * x283 + c_q11 * x284;
-        let x290 = x18 * (s_q12 * x277 + c_q12 * x278 + x23 * x279);
-        let x291 = c_q11 * x286 - s_q11 * x287 + (0.275 * x289 - -0.63 * x290);
-        let x292 = s_q11 * x286 + c_q11 * x287 + -0.275 * x288;
-        let x293 = x18 * x285 + 0.63 * x288;
-        let x294 = c_q10 * x288 - s_q10 * x289;
-        let x295 = s_q10 * x288 + c_q10 * x289;
-        let x296 = x16 * x290;
-        let x297 = s_q10 * x291 + c_q10 * x292;
-        let x298 = c_q10 * x291 - s_q10 * x292 - -0.87 * x296;
-        let x299 = x16 * x293 + 0.87 * x294;
-        let x300 = x9 * x294 + x10 * x295 - x11 * x296;
-        let x301 = x12 * x294 + x13 * x295 - x8 * x296;
-        let x302 = c_q9 * x294 - s_q9 * x295 - x14 * x296;
-        let x303 = x9 * x298 + x10 * x297 + x11 * x299 + (-0.4 * x301 + 0.275 * x302);
-        let x304 = x12 * x298 + x13 * x297 + x8 * x299 + 0.4 * x300;
-        let x305 = c_q9 * x298 - s_q9 * x297 + x14 * x299 + -0.275 * x300;
-        let x306 = x4 * x300 - x5 * x301 + x3 * x302;
-        let x307 = s_q8 * x300 + c_q8 * x301;
-        let x308 = s_q8 * x304 - c_q8 * x303 + x6 * x305;
-        let x309 = x4 * x303 - x5 * x304 + x3 * x305 + -0.35 * x307;
-        let x310 = s_q8 * x303 + c_q8 * x304 + 0.35 * x306;
-        let x311 = c_q7 * x306 - s_q7 * x307;
-        let x312 = s_q7 * x306 + c_q7 * x307;
-        let x313 = x1 * (s_q8 * x301 - c_q8 * x300 + x6 * x302);
-        let x314 = v[3] * 1200.0;
-        let x315 = v[4] * 1200.0;
-        let x316 = v[5] * 1200.0;
-        let x317 = v[0] * 1000.0;
-        let x318 = v[1] * 1000.0;
-        let x319 = v[2] * 1000.0;
-        let x320 = v[3] * c_q7 + v[4] * s_q7;
-        let x321 = v[4] * c_q7 - v[3] * s_q7;
-        let x322 = v[0] - v[4] * -0.75;
-        let x323 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x324 = c_q7 * x322 + s_q7 * x323;
-        let x325 = c_q7 * x323 - s_q7 * x322;
-        let x326 = x1 * (v[2] - 0.65 * v[4]);
-        let x327 = v[6] + v[5] * x1;
-        let x328 = v[6] * x321;
-        let x329 = v[6] * x320;
-        let x330 = v[6] * x325;
-        let x331 = v[6] * x324;
-        let x332 = 0.00071 * x320 + 0.1132 * x321 + 1.331 * x327;
-        let x333 = 2.29018125 * x320 + -0.07309 * x321 + 0.00071 * x327
-            + x325 * -6.1267499999999995;
-        let x334 = -0.07309 * x320 + 1.5853812499999997 * x321 + 0.1132 * x327
-            + 6.1267499999999995 * x324;
-        let x335 = 35.01 * x326;
-        let x336 = 35.01 * x324 - x321 * -6.1267499999999995;
-        let x337 = 35.01 * x325 - 6.1267499999999995 * x320;
-        let x338 = x4 * x320 + s_q8 * x321 - c_q8 * x327;
-        let x339 = c_q8 * x321 - x5 * x320 + s_q8 * x327;
-        let x340 = x324 - -0.35 * x321;
-        let x341 = x325 - 0.35 * x320;
-        let x342 = x4 * x340 + s_q8 * x341 - c_q8 * x326;
-        let x343 = c_q8 * x341 - x5 * x340 + s_q8 * x326;
-        let x344 = x3 * x340 + x6 * x326;
-        let x345 = v[7] + (x3 * x320 + x6 * x327);
-        let x346 = x3 * x328;
-        let x347 = x330 + -0.35 * x329;
-        let x348 = x331 + 0.35 * x328;
-        let x349 = x3 * x347;
-        let x350 = x4 * x328 - s_q8 * x329 + v[7] * x339;
-        let x351 = x5 * x328 + c_q8 * x329 + v[7] * x338;
-        let x352 = x4 * x347 - s_q8 * x348 + v[7] * x343;
-        let x353 = x5 * x347 + c_q8 * x348 + v[7] * x342;
-        let x354 = -0.00214 * x338 + 2.359 * x345;
-        let x355 = 3.3000000000000003 * x338 + -0.00214 * x345 + x343 * -6.0;
-        let x356 = 2.5780000000000003 * x339 + 6.0 * x342;
-        let x357 = 30.0 * x344;
-        let x358 = 30.0 * x342 - x339 * -6.0;
-        let x359 = 30.0 * x343 - 6.0 * x338;
-        let x360 = x9 * x338 + x12 * x339 + c_q9 * x345;
-        let x361 = x10 * x338 + x13 * x339 - s_q9 * x345;
-        let x362 = x342 - (-0.4 * x339 + 0.275 * x345);
-        let x363 = x343 - 0.4 * x338;
-        let x364 = x344 - -0.275 * x338;
-        let x365 = x9 * x362 + x12 * x363 + c_q9 * x364;
-        let x366 = x10 * x362 + x13 * x363 - s_q9 * x364;
-        let x367 = x11 * x362 + x8 * x363 + x14 * x364;
-        let x368 = v[8] + (x11 * x338 + x8 * x339 + x14 * x345);
-        let x369 = x11 * x350 - x8 * x351 + x14 * x346;
-        let x370 = x352 - (0.275 * x346 - -0.4 * x351);
-        let x371 = x353 + 0.4 * x350;
-        let x372 = x349 - -0.275 * x350;
-        let x373 = x11 * x370 - x8 * x371 + x14 * x372;
-        let x374 = x9 * x350 - x12 * x351 + c_q9 * x346 + v[8] * x361;
-        let x375 = x10 * x350 - x13 * x351 - s_q9 * x346 - v[8] * x360;
-        let x376 = x9 * x370 - x12 * x371 + c_q9 * x372 + v[8] * x366;
-        let x377 = x10 * x370 - x13 * x371 - s_q9 * x372 - v[8] * x365;
-        let x378 = 3.378 * x361;
-        let x379 = 4.395515250000001 * x360 + -0.00214 * x368 + -9.87015 * x367;
-        let x380 = -0.00214 * x360 + 7.65251525 * x368 + x365 * 9.87015;
-        let x381 = 22.69 * x366;
-        let x382 = 22.69 * x365 - -9.87015 * x368;
-        let x383 = 22.69 * x367 - x360 * 9.87015;
-        let x384 = c_q10 * x360 + s_q10 * x361;
-        let x385 = c_q10 * x361 - s_q10 * x360;
-        let x386 = x365 - -0.87 * x368;
-        let x387 = c_q10 * x386 + s_q10 * x366;
-        let x388 = c_q10 * x366 - s_q10 * x386;
-        let x389 = x16 * (x367 - 0.87 * x360);
-        let x390 = v[9] + x16 * x368;
-        let x391 = x16 * x369;
-        let x392 = x376 - -0.87 * x369;
-        let x393 = x16 * (x373 - 0.87 * x374);
-        let x394 = c_q10 * x374 + s_q10 * x375 + v[9] * x385;
-        let x395 = c_q10 * x375 - s_q10 * x374 - v[9] * x384;
-        let x396 = c_q10 * x392 + s_q10 * x377 + v[9] * x388;
-        let x397 = c_q10 * x377 - s_q10 * x392 - v[9] * x387;
-        let x398 = 4.170993 * x384 + -0.6328 * x390 + (x388 * 5.8795 + -6.7347 * x389);
-        let x399 = 3.8828625 * x385 + -1.8520425 * x390 + -5.8795 * x387;
-        let x400 = -0.6328 * x384 + -1.8520425 * x385 + 4.0324305 * x390 + x387 * 6.7347;
-        let x401 = 21.38 * x387 - (x385 * 5.8795 + -6.7347 * x390);
-        let x402 = 21.38 * x388 - -5.8795 * x384;
-        let x403 = 21.38 * x389 - x384 * 6.7347;
-        let x404 = c_q11 * x384 + s_q11 * x385;
-        let x405 = c_q11 * x385 - s_q11 * x384;
-        let x406 = x387 - (0.275 * x385 + -0.63 * x390);
-        let x407 = x388 - -0.275 * x384;
-        let x408 = c_q11 * x406 + s_q11 * x407;
-        let x409 = c_q11 * x407 - s_q11 * x406;
-        let x410 = x18 * (x389 - 0.63 * x384);
-        let x411 = v[10] + x18 * x390;
-        let x412 = x18 * x391;
-        let x413 = x396 - (0.275 * x395 + -0.63 * x391);
-        let x414 = x397 - -0.275 * x394;
-        let x415 = x18 * (x393 - 0.63 * x394);
-        let x416 = c_q11 * x394 + s_q11 * x395 + v[10] * x405;
-        let x417 = c_q11 * x395 - s_q11 * x394 - v[10] * x404;
-        let x418 = c_q11 * x413 + s_q11 * x414 + v[10] * x409;
-        let x419 = c_q11 * x414 - s_q11 * x413 - v[10] * x408;
-        let x420 = 0.01675 * x404 + 0.07271 * x411;
-        let x421 = 0.9304999999999999 * x404 + 0.01675 * x411
-            + x409 * 3.0149999999999997;
-        let x422 = 0.939 * x405 + -3.0149999999999997 * x408;
-        let x423 = 16.75 * x410;
-        let x424 = 16.75 * x408 - x405 * 3.0149999999999997;
-        let x425 = 16.75 * x409 - -3.0149999999999997 * x404;
-        let x426 = c_q12 * x404 + x21 * x405 - s_q12 * x411;
-        let x427 = x22 * x405 - s_q12 * x404 - c_q12 * x411;
-        let x428 = x408 - 0.36 * x405;
-        let x429 = x409 - -0.36 * x404;
-        let x430 = c_q12 * x428 + x21 * x429 - s_q12 * x410;
-        let x431 = x22 * x429 - s_q12 * x428 - c_q12 * x410;
-        let x432 = x20 * x429 + x23 * x410;
-        let x433 = v[11] + (x20 * x405 + x23 * x411);
-        let x434 = x20 * x417 + x23 * x412;
-        let x435 = x418 - 0.36 * x417;
-        let x436 = x419 - -0.36 * x416;
-        let x437 = x20 * x436 + x23 * x415;
-        let x438 = c_q12 * x416 + x21 * x417 - s_q12 * x412 + v[11] * x427;
-        let x439 = x22 * x417 - s_q12 * x416 - c_q12 * x412 - v[11] * x426;
-        let x440 = c_q12 * x435 + x21 * x436 - s_q12 * x415 + v[11] * x431;
-        let x441 = x22 * x436 - s_q12 * x435 - c_q12 * x415 - v[11] * x430;
-        let x442 = 3.2217582500000006 * x426 + -0.2313 * x433
-            + (x431 * -4.187200000000001 + 7.196750000000001 * x432);
-        let x443 = 1.2686520000000001 * x427 + -1.1514800000000003 * x433
-            + 4.187200000000001 * x430;
-        let x444 = -0.2313 * x426 + -1.1514800000000003 * x427
-            + 2.1079062500000005 * x433 + x430 * -7.196750000000001;
-        let x445 = 26.17 * x430 - (x427 * -4.187200000000001 + 7.196750000000001 * x433);
-        let x446 = 26.17 * x431 - 4.187200000000001 * x426;
-        let x447 = 26.17 * x432 - x426 * -7.196750000000001;
-        let x448 = x26 * x426 + s_q13 * x427 - c_q13 * x433;
-        let x449 = c_q13 * x427 - x27 * x426 + s_q13 * x433;
-        let x450 = x430 - (-0.16 * x427 + 0.55 * x433);
-        let x451 = x431 - 0.16 * x426;
-        let x452 = x432 - -0.55 * x426;
-        let x453 = x26 * x450 + s_q13 * x451 - c_q13 * x452;
-        let x454 = c_q13 * x451 - x27 * x450 + s_q13 * x452;
-        let x455 = x25 * x450 + x28 * x452;
-        let x456 = v[12] + (x25 * x426 + x28 * x433);
-        let x457 = x25 * x438 + x28 * x434;
-        let x458 = x440 - (-0.16 * x439 + 0.55 * x434);
-        let x459 = x441 - 0.16 * x438;
-        let x460 = x437 - -0.55 * x438;
-        let x461 = x25 * x458 + x28 * x460;
-        let x462 = x26 * x438 + s_q13 * x439 - c_q13 * x434 + v[12] * x449;
-        let x463 = c_q13 * x439 - x27 * x438 + s_q13 * x434 - v[12] * x448;
-        let x464 = x26 * x458 + s_q13 * x459 - c_q13 * x460 + v[12] * x454;
-        let x465 = c_q13 * x459 - x27 * x458 + s_q13 * x460 - v[12] * x453;
-        let x466 = 2.1663609200000002 * x448 + 0.000781 * x449 + -0.0145 * x456
-            + (-3.6140000000000003 * x454 + 4.806620000000001 * x455);
-        let x467 = 0.000781 * x448 + 0.9638000000000001 * x449
-            + -0.9614610000000001 * x456 + 3.6140000000000003 * x453;
-        let x468 = -0.0145 * x448 + -0.9614610000000001 * x449
-            + 1.4135609200000003 * x456 + -4.806620000000001 * x453;
-        let x469 = 18.07 * x453
-            - (-3.6140000000000003 * x449 + 4.806620000000001 * x456);
-        let x470 = 18.07 * x454 - 3.6140000000000003 * x448;
-        let x471 = 18.07 * x455 - -4.806620000000001 * x448;
-        let x472 = 2.1663609200000002 * x462 + 0.000781 * x463 + -0.0145 * x457
-            + (-3.6140000000000003 * x465 + 4.806620000000001 * x461)
-            + (x449 * x468 - x456 * x467 + (x454 * x471 - x455 * x470));
-        let x473 = 0.000781 * x462 + 0.9638000000000001 * x463
-            + -0.9614610000000001 * x457 + 3.6140000000000003 * x464
-            + (x456 * x466 - x448 * x468 + (x455 * x469 - x453 * x471));
-        let x474 = -0.0145 * x462 + -0.9614610000000001 * x463
-            + 1.4135609200000003 * x457 + -4.806620000000001 * x464
-            + (x448 * x467 - x449 * x466 + (x453 * x470 - x454 * x469));
-        let x475 = 18.07 * x464 - (-3.6140000000000003 * x463 + 4.806620000000001 * x457)
-            + (x449 * x471 - x456 * x470);
-        let x476 = 18.07 * x465 - 3.6140000000000003 * x462
-            + (x456 * x469 - x448 * x471);
-        let x477 = 18.07 * x461 - -4.806620000000001 * x462
-            + (x448 * x470 - x449 * x469);
-        let x478 = x26 * x475 - x27 * x476 + x25 * x477;
-        let x479 = s_q13 * x475 + c_q13 * x476;
-        let x480 = s_q13 * x476 - c_q13 * x475 + x28 * x477;
-        let x481 = 3.2217582500000006 * x438 + -0.2313 * x434
-            + (x441 * -4.187200000000001 + 7.196750000000001 * x437)
-            + (x427 * x444 - x433 * x443 + (x431 * x447 - x432 * x446))
-            + (x26 * x472 - x27 * x473 + x25 * x474 + (-0.16 * x479 + 0.55 * x480));
-        let x482 = 1.2686520000000001 * x439 + -1.1514800000000003 * x434
-            + 4.187200000000001 * x440
-            + (x433 * x442 - x426 * x444 + (x432 * x445 - x430 * x447))
-            + (s_q13 * x472 + c_q13 * x473 + 0.16 * x478);
-        let x483 = -0.2313 * x438 + -1.1514800000000003 * x439
-            + 2.1079062500000005 * x434 + x440 * -7.196750000000001
-            + (x426 * x443 - x427 * x442 + (x430 * x446 - x431 * x445))
-            + (s_q13 * x473 - c_q13 * x472 + x28 * x474 + -0.55 * x478);
-        let x484 = 26.17 * x440 - (x439 * -4.187200000000001 + 7.196750000000001 * x434)
-            + (x427 * x447 - x433 * x446) + x478;
-        let x485 = 26.17 * x441 - 4.187200000000001 * x438 + (x433 * x445 - x426 * x447)
-            + x479;
-        let x486 = 26.17 * x437 - x438 * -7.196750000000001 + (x426 * x446 - x427 * x445)
-            + x480;
-        let x487 = c_q12 * x484 - s_q12 * x485;
-        let x488 = x21 * x484 + x22 * x485 + x20 * x486;
-        let x489 = 0.9304999999999999 * x416 + 0.01675 * x412 + x419 * 3.0149999999999997
-            + (x405 * x420 - x411 * x422 + (x409 * x423 - x410 * x425))
-            + (c_q12 * x481 - s_q12 * x482 + 0.36 * x488);
-        let x490 = 0.939 * x417 + -3.0149999999999997 * x418
-            + (x411 * x421 - x404 * x420 + (x410 * x424 - x408 * x423))
-            + (x21 * x481 + x22 * x482 + x20 * x483 + -0.36 * x487);
-        let x491 = 0.01675 * x416 + 0.07271 * x412
-            + (x404 * x422 - x405 * x421 + (x408 * x425 - x409 * x424))
-            + (x23 * x483 - (s_q12 * x481 + c_q12 * x482));
-        let x492 = 16.75 * x418 - x417 * 3.0149999999999997 + (x405 * x423 - x411 * x425)
-            + x487;
-        let x493 = 16.75 * x419 - -3.0149999999999997 * x416
-            + (x411 * x424 - x404 * x423) + x488;
-        let x494 = c_q11 * x492 - s_q11 * x493;
-        let x495 = s_q11 * x492 + c_q11 * x493;
-        let x496 = x18
-            * (16.75 * x415 + (x404 * x425 - x405 * x424)
-                + (x23 * x486 - (s_q12 * x484 + c_q12 * x485)));
-        let x497 = 4.170993 * x394 + -0.6328 * x391 + (x397 * 5.8795 + -6.7347 * x393)
-            + (x385 * x400 - x390 * x399 + (x388 * x403 - x389 * x402))
-            + (c_q11 * x489 - s_q11 * x490 + (0.275 * x495 + -0.63 * x496));
-        let x498 = 3.8828625 * x395 + -1.8520425 * x391 + -5.8795 * x396
-            + (x390 * x398 - x384 * x400 + (x389 * x401 - x387 * x403))
-            + (s_q11 * x489 + c_q11 * x490 + -0.275 * x494);
-        let x499 = -0.6328 * x394 + -1.8520425 * x395 + 4.0324305 * x391 + x396 * 6.7347
-            + (x384 * x399 - x385 * x398 + (x387 * x402 - x388 * x401))
-            + (x18 * x491 + 0.63 * x494);
-        let x500 = 21.38 * x396 - (x395 * 5.8795 + -6.7347 * x391)
-            + (x385 * x403 - x390 * x402) + x494;
-        let x501 = 21.38 * x397 - -5.8795 * x394 + (x390 * x401 - x384 * x403) + x495;
-        let x502 = c_q10 * x500 - s_q10 * x501;
-        let x503 = x16
-            * (21.38 * x393 - x394 * 6.7347 + (x384 * x402 - x385 * x401) + x496);
-        let x504 = 4.395515250000001 * x374 + -0.00214 * x369 + -9.87015 * x373
-            + (x361 * x380 - x368 * x378 + (x366 * x383 - x367 * x381))
-            + (c_q10 * x497 - s_q10 * x498 + -0.87 * x503);
-        let x505 = 3.378 * x375
-            + (x368 * x379 - x360 * x380 + (x367 * x382 - x365 * x383))
-            + (s_q10 * x497 + c_q10 * x498);
-        let x506 = -0.00214 * x374 + 7.65251525 * x369 + x376 * 9.87015
-            + (x360 * x378 - x361 * x379 + (x365 * x381 - x366 * x382))
-            + (x16 * x499 + 0.87 * x502);
-        let x507 = 22.69 * x376 - -9.87015 * x369 + (x361 * x383 - x368 * x381) + x502;
-        let x508 = 22.69 * x377 + (x368 * x382 - x360 * x383)
-            + (s_q10 * x500 + c_q10 * x501);
-        let x509 = 22.69 * x373 - x374 * 9.87015 + (x360 * x381 - x361 * x382) + x503;
-        let x510 = x9 * x507 + x10 * x508 + x11 * x509;
-        let x511 = x12 * x507 + x13 * x508 + x8 * x509;
-        let x512 = c_q9 * x507 - s_q9 * x508 + x14 * x509;
-        let x513 = 3.3000000000000003 * x350 + -0.00214 * x346 - x353 * -6.0
-            + (x339 * x354 - x345 * x356 + (x343 * x357 - x344 * x359))
-            + (x9 * x504 + x10 * x505 + x11 * x506 + (-0.4 * x511 + 0.275 * x512));
-        let x514 = 6.0 * x352 - 2.5780000000000003 * x351
-            + (x345 * x355 - x338 * x354 + (x344 * x358 - x342 * x357))
-            + (x12 * x504 + x13 * x505 + x8 * x506 + 0.4 * x510);
-        let x515 = -0.00214 * x350 + 2.359 * x346
-            + (x338 * x356 - x339 * x355 + (x342 * x359 - x343 * x358))
-            + (c_q9 * x504 - s_q9 * x505 + x14 * x506 + -0.275 * x510);
-        let x516 = 30.0 * x352 + x351 * -6.0 + (x339 * x357 - x345 * x359) + x510;
-        let x517 = x345 * x358 - x338 * x357 - (30.0 * x353 + 6.0 * x350) + x511;
-        let x518 = 30.0 * x349 + (x338 * x359 - x339 * x358) + x512;
-        let x519 = x4 * x516 - x5 * x517 + x3 * x518;
-        let x520 = s_q8 * x516 + c_q8 * x517;
-        let x521 = 2.29018125 * x328 - -0.07309 * x329 - x331 * -6.1267499999999995
-            + (x321 * x332 - x327 * x334 + (x325 * x335 - x326 * x337))
-            + (x4 * x513 - x5 * x514 + x3 * x515 + -0.35 * x520);
-        let x522 = -0.07309 * x328 - 1.5853812499999997 * x329
-            + 6.1267499999999995 * x330
-            + (x327 * x333 - x320 * x332 + (x326 * x336 - x324 * x335))
-            + (s_q8 * x513 + c_q8 * x514 + 0.35 * x519);
-        let x523 = 0.00071 * x328 - 0.1132 * x329
-            + (x320 * x334 - x321 * x333 + (x324 * x337 - x325 * x336))
-            + (s_q8 * x514 - c_q8 * x513 + x6 * x515);
-        let x524 = 35.01 * x330 + x329 * -6.1267499999999995
-            + (x321 * x335 - x327 * x337) + x519;
-        let x525 = x327 * x336 - x320 * x335 - (35.01 * x331 + 6.1267499999999995 * x328)
-            + x520;
-        let x526 = c_q7 * x524 - s_q7 * x525;
-        let x527 = s_q7 * x524 + c_q7 * x525;
-        let x528 = x1
-            * (x320 * x337 - x321 * x336 + (s_q8 * x517 - c_q8 * x516 + x6 * x518));
-        let x529 = v[4] * x319 - v[5] * x318 + x526;
-        let x530 = v[5] * x317 - v[3] * x319 + x527;
-        let x531 = v[3] * x318 - v[4] * x317 + x528;
-        let x532 = x178 * 0.0008546497218115156;
-        let x533 = x175 * 0.0008546497218115156;
-        let x534 = x191 * 0.0008546497218115156;
-        let x535 = x208 * 0.0008546497218115156;
-        let x536 = x223 * 0.0008546497218115156;
-        let x537 = x245 * 0.0008546497218115156;
-        let x538 = x274 * 0.0008546497218115156;
-        let x539 = x311 * 0.0008546497218115156;
-        let x540 = x177 * 0.0008546497218115156;
-        let x541 = x174 * 0.0008546497218115156;
-        let x542 = x192 * 0.0008546497218115156;
-        let x543 = x209 * 0.0008546497218115156;
-        let x544 = x224 * 0.0008546497218115156;
-        let x545 = x246 * 0.0008546497218115156;
-        let x546 = x275 * 0.0008546497218115156;
-        let x547 = x312 * 0.0008546497218115156;
-        let x548 = x193 * 0.0008546497218115156;
-        let x549 = x210 * 0.0008546497218115156;
-        let x550 = x225 * 0.0008546497218115156;
-        let x551 = x247 * 0.0008546497218115156;
-        let x552 = x276 * 0.0008546497218115156;
-        let x553 = x313 * 0.0008546497218115156;
-        let x554 = x178 * x532;
-        let x555 = x175 * x533;
-        let x556 = 1.0
-            / (1200.0 + (c_q7 * x179 - s_q7 * x180 - x176 * -0.75 + 0.75 * x178) - x554
-                - x555);
-        let x557 = s_q7 * x179 + c_q7 * x180 - 0.65 * x175 + x175 * x540;
-        let x558 = x556 * x557;
-        let x559 = x1 * x181 + x184 + x178 * -0.65 + x178 * x540;
-        let x560 = x556 * x559;
-        let x561 = x181 + x184 + x178 * x541;
-        let x562 = x556 * x561;
-        let x563 = c_q7 * x189 - s_q7 * x190 + -0.75 * x192 + x178 * x542 - x175 * x548;
-        let x564 = x556 * x563;
-        let x565 = c_q7 * x206 - s_q7 * x207 + -0.75 * x209 + x178 * x543 - x175 * x549;
-        let x566 = x556 * x565;
-        let x567 = c_q7 * x221 - s_q7 * x222 + -0.75 * x224 + x178 * x544 - x175 * x550;
-        let x568 = x556 * x567;
-        let x569 = c_q7 * x243 - s_q7 * x244 + -0.75 * x246 + x178 * x545 - x175 * x551;
-        let x570 = x556 * x569;
-        let x571 = c_q7 * x272 - s_q7 * x273 + -0.75 * x275 + x178 * x546 - x175 * x552;
-        let x572 = x556 * x571;
-        let x573 = c_q7 * x309 - s_q7 * x310 + -0.75 * x312 + x178 * x547 - x175 * x553;
-        let x574 = x556 * x573;
-        let x575 = x177 * x540;
-        let x576 = 1.0
-            / (1200.0
-                + (s_q7 * (s_q7 * x167 + c_q7 * x170)
-                    + c_q7 * (s_q7 * x168 + c_q7 * x171) - (x174 * -0.65 - 0.75 * x176)
-                    - (x178 * -0.75 - 0.65 * x177)) - x554 - x575 - x557 * x558);
-        let x577 = x178 * x533;
-        let x578 = x1 * x182 - x185 + x577 - x557 * x560;
-        let x579 = x576 * x578;
-        let x580 = x182 - x185 + x577 - x557 * x562;
-        let x581 = x576 * x580;
-        let x582 = s_q7 * x189 + c_q7 * x190 + (-0.65 * x193 - 0.75 * x191) + x178 * x534
-            + x177 * x548 - x557 * x564;
-        let x583 = x576 * x582;
-        let x584 = s_q7 * x206 + c_q7 * x207 + (0.75 * x208 + -0.65 * x210) - x178 * x535
-            + x177 * x549 - x557 * x566;
-        let x585 = x576 * x584;
-        let x586 = s_q7 * x221 + c_q7 * x222 + (0.75 * x223 + -0.65 * x225) - x178 * x536
-            + x177 * x550 - x557 * x568;
-        let x587 = x576 * x586;
-        let x588 = s_q7 * x243 + c_q7 * x244 + (0.75 * x245 + -0.65 * x247) - x178 * x537
-            + x177 * x551 - x557 * x570;
-        let x589 = x576 * x588;
-        let x590 = s_q7 * x272 + c_q7 * x273 + (0.75 * x274 + -0.65 * x276) - x178 * x538
-            + x177 * x552 - x557 * x572;
-        let x591 = x576 * x590;
-        let x592 = s_q7 * x309 + c_q7 * x310 + (0.75 * x311 + -0.65 * x313) - x178 * x539
-            + x177 * x553 - x557 * x574;
-        let x593 = x576 * x592;
-        let x594 = 1.0
-            / (1200.0 + (x1 * x183 + x186 - x177 * -0.65) - x555 - x575 - x559 * x560
-                - x578 * x579);
-        let x595 = x183 + x186 - x555 - x177 * x541 - x559 * x562 - x578 * x581;
-        let x596 = x594 * x595;
-        let x597 = x175 * x534;
-        let x598 = x1 * x166 + 0.65 * x192 - x597 - x177 * x542 - x559 * x564
-            - x578 * x583;
-        let x599 = x594 * x598;
-        let x600 = x175 * x535;
-        let x601 = x1 * x205 + 0.65 * x209 + x600 - x177 * x543 - x559 * x566
-            - x578 * x585;
-        let x602 = x594 * x601;
-        let x603 = x175 * x536;
-        let x604 = x1 * x220 + 0.65 * x224 + x603 - x177 * x544 - x559 * x568
-            - x578 * x587;
-        let x605 = x594 * x604;
-        let x606 = x175 * x537;
-        let x607 = x1 * x242 + 0.65 * x246 + x606 - x177 * x545 - x559 * x570
-            - x578 * x589;
-        let x608 = x594 * x607;
-        let x609 = x175 * x538;
-        let x610 = x1 * x271 + 0.65 * x275 + x609 - x177 * x546 - x559 * x572
-            - x578 * x591;
-        let x611 = x594 * x610;
-        let x612 = x175 * x539;
-        let x613 = x1 * x308 + 0.65 * x312 + x612 - x177 * x547 - x559 * x574
-            - x578 * x593;
-        let x614 = x594 * x613;
-        let x615 = 1.0
-            / (x173 - x555 - x174 * x541 - x561 * x562 - x580 * x581 - x595 * x596);
-        let x616 = x166 - x597 - x174 * x542 - x561 * x564 - x580 * x583 - x595 * x599;
-        let x617 = x615 * x616;
-        let x618 = x205 + x600 - x174 * x543 - x561 * x566 - x580 * x585 - x595 * x602;
-        let x619 = x615 * x618;
-        let x620 = x220 + x603 - x174 * x544 - x561 * x568 - x580 * x587 - x595 * x605;
-        let x621 = x615 * x620;
-        let x622 = x242 + x606 - x174 * x545 - x561 * x570 - x580 * x589 - x595 * x608;
-        let x623 = x615 * x622;
-        let x624 = x271 + x609 - x174 * x546 - x561 * x572 - x580 * x591 - x595 * x611;
-        let x625 = x615 * x624;
-        let x626 = x308 + x612 - x174 * x547 - x561 * x574 - x580 * x593 - x595 * x614;
-        let x627 = x615 * x626;
-        let x628 = 1.0
-            / (x153 - x191 * x534 - x192 * x542 - x193 * x548 - x563 * x564 - x582 * x583
-                - x598 * x599 - x616 * x617);
-        let x629 = x202 + x191 * x535 - x192 * x543 - x193 * x549 - x563 * x566
-            - x582 * x585 - x598 * x602 - x616 * x619;
-        let x630 = x628 * x629;
-        let x631 = x217 + x191 * x536 - x192 * x544 - x193 * x550 - x563 * x568
-            - x582 * x587 - x598 * x605 - x616 * x621;
-        let x632 = x628 * x631;
-        let x633 = x239 + x191 * x537 - x192 * x545 - x193 * x551 - x563 * x570
-            - x582 * x589 - x598 * x608 - x616 * x623;
-        let x634 = x628 * x633;
-        let x635 = x268 + x191 * x538 - x192 * x546 - x193 * x552 - x563 * x572
-            - x582 * x591 - x598 * x611 - x616 * x625;
-        let x636 = x628 * x635;
-        let x637 = x305 + x191 * x539 - x192 * x547 - x193 * x553 - x563 * x574
-            - x582 * x593 - x598 * x614 - x616 * x627;
-        let x638 = x628 * x637;
-        let x639 = 1.0
-            / (x129 - x208 * x535 - x209 * x543 - x210 * x549 - x565 * x566 - x584 * x585
-                - x601 * x602 - x618 * x619 - x629 * x630);
-        let x640 = x211 - x208 * x536 - x209 * x544 - x210 * x550 - x565 * x568
-            - x584 * x587 - x601 * x605 - x618 * x621 - x629 * x632;
-        let x641 = x639 * x640;
-        let x642 = x233 - x208 * x537 - x209 * x545 - x210 * x551 - x565 * x570
-            - x584 * x589 - x601 * x608 - x618 * x623 - x629 * x634;
-        let x643 = x639 * x642;
-        let x644 = x262 - x208 * x538 - x209 * x546 - x210 * x552 - x565 * x572
-            - x584 * x591 - x601 * x611 - x618 * x625 - x629 * x636;
-        let x645 = x639 * x644;
-        let x646 = x299 - x208 * x539 - x209 * x547 - x210 * x553 - x565 * x574
-            - x584 * x593 - x601 * x614 - x618 * x627 - x629 * x638;
-        let x647 = x639 * x646;
-        let x648 = 1.0
-            / (x103 - x223 * x536 - x224 * x544 - x225 * x550 - x567 * x568 - x586 * x587
-                - x604 * x605 - x620 * x621 - x631 * x632 - x640 * x641);
-        let x649 = x228 - x223 * x537 - x224 * x545 - x225 * x551 - x567 * x570
-            - x586 * x589 - x604 * x608 - x620 * x623 - x631 * x634 - x640 * x643;
-        let x650 = x648 * x649;
-        let x651 = x256 - x223 * x538 - x224 * x546 - x225 * x552 - x567 * x572
-            - x586 * x591 - x604 * x611 - x620 * x625 - x631 * x636 - x640 * x645;
-        let x652 = x648 * x651;
-        let x653 = x293 - x223 * x539 - x224 * x547 - x225 * x553 - x567 * x574
-            - x586 * x593 - x604 * x614 - x620 * x627 - x631 * x638 - x640 * x647;
-        let x654 = x648 * x653;
-        let x655 = 1.0
-            / (x78 - x245 * x537 - x246 * x545 - x247 * x551 - x569 * x570 - x588 * x589
-                - x607 * x608 - x622 * x623 - x633 * x634 - x642 * x643 - x649 * x650);
-        let x656 = x71 - x245 * x538 - x246 * x546 - x247 * x552 - x569 * x572
-            - x588 * x591 - x607 * x611 - x622 * x625 - x633 * x636 - x642 * x645
-            - x649 * x652;
-        let x657 = x655 * x656;
-        let x658 = x285 - x245 * x539 - x246 * x547 - x247 * x553 - x569 * x574
-            - x588 * x593 - x607 * x614 - x622 * x627 - x633 * x638 - x642 * x647
-            - x649 * x654;
-        let x659 = x655 * x658;
-        let x660 = 1.0
-            / (x55 - x274 * x538 - x275 * x546 - x276 * x552 - x571 * x572 - x590 * x591
-                - x610 * x611 - x624 * x625 - x635 * x636 - x644 * x645 - x651 * x652
-                - x656 * x657);
-        let x661 = x282 - x274 * x539 - x275 * x547 - x276 * x553 - x571 * x574
-            - x590 * x593 - x610 * x614 - x624 * x627 - x635 * x638 - x644 * x647
-            - x651 * x654 - x656 * x659;
-        let x662 = x660 * x661;
-        let x663 = 1.0
-            / (1.4135609200000003 - x311 * x539 - x312 * x547 - x313 * x553 - x573 * x574
-                - x592 * x593 - x613 * x614 - x626 * x627 - x637 * x638 - x646 * x647
-                - x653 * x654 - x658 * x659 - x661 * x662);
-        let x664 = x531 * x533
-            - (v[4] * x316 - v[5] * x315 + (v[1] * x319 - v[2] * x318)
-                + (c_q7 * x521 - s_q7 * x522 + -0.75 * x527) + x530 * x532);
-        let x665 = x529 * x532
-            - (v[5] * x314 - v[3] * x316 + (v[2] * x317 - v[0] * x319)
-                + (s_q7 * x521 + c_q7 * x522 + (0.75 * x526 + -0.65 * x528)))
-            - x531 * x540 - x558 * x664;
-        let x666 = x529 * x533;
-        let x667 = x530 * x540
-            - (v[3] * x315 - v[4] * x314 + (v[0] * x318 - v[1] * x317)
-                + (x1 * x523 + 0.65 * x527) + x666) - x560 * x664 - x579 * x665;
-        let x668 = tau[0] - x523 - x666 + x530 * x541 - x562 * x664 - x581 * x665
-            - x596 * x667;
-        let x669 = tau[1] - x515 - x529 * x534 + x530 * x542 + x531 * x548 - x564 * x664
-            - x583 * x665 - x599 * x667 - x617 * x668;
-        let x670 = tau[2] - x506 + x529 * x535 + x530 * x543 + x531 * x549 - x566 * x664
-            - x585 * x665 - x602 * x667 - x619 * x668 - x630 * x669;
-        let x671 = tau[3] - x499 + x529 * x536 + x530 * x544 + x531 * x550 - x568 * x664
-            - x587 * x665 - x605 * x667 - x621 * x668 - x632 * x669 - x641 * x670;
-        let x672 = tau[4] - x491 + x529 * x537 + x530 * x545 + x531 * x551 - x570 * x664
-            - x589 * x665 - x608 * x667 - x623 * x668 - x634 * x669 - x643 * x670
-            - x650 * x671;
-        let x673 = tau[5] - x483 + x529 * x538 + x530 * x546 + x531 * x552 - x572 * x664
-            - x591 * x665 - x611 * x667 - x625 * x668 - x636 * x669 - x645 * x670
-            - x652 * x671 - x657 * x672;
-        let x674 = x663
-            * (tau[6] - x474 + x529 * x539 + x530 * x547 + x531 * x553 - x574 * x664
-                - x593 * x665 - x614 * x667 - x627 * x668 - x638 * x669 - x647 * x670
-                - x654 * x671 - x659 * x672 - x662 * x673);
-        let x675 = x660 * x673 - x662 * x674;
-        let x676 = x655 * x672 - x657 * x675 - x659 * x674;
-        let x677 = x648 * x671 - x650 * x676 - x652 * x675 - x654 * x674;
-        let x678 = x639 * x670 - x641 * x677 - x643 * x676 - x645 * x675 - x647 * x674;
-        let x679 = x628 * x669 - x630 * x678 - x632 * x677 - x634 * x676 - x636 * x675
-            - x638 * x674;
-        let x680 = x615 * x668 - x617 * x679 - x619 * x678 - x621 * x677 - x623 * x676
-            - x625 * x675 - x627 * x674;
-        let x681 = x594 * x667 - x596 * x680 - x599 * x679 - x602 * x678 - x605 * x677
-            - x608 * x676 - x611 * x675 - x614 * x674;
-        let x682 = x576 * x665 - x579 * x681 - x581 * x680 - x583 * x679 - x585 * x678
-            - x587 * x677 - x589 * x676 - x591 * x675 - x593 * x674;
-        let x683 = x556 * x664 - x558 * x682 - x560 * x681 - x562 * x680 - x564 * x679
-            - x566 * x678 - x568 * x677 - x570 * x676 - x572 * x675 - x574 * x674;
-        let x684 = x540 * x682 - (x531 * 0.0008546497218115156 + x533 * x683)
-            - x548 * x679 - x549 * x678 - x550 * x677 - x551 * x676 - x552 * x675
-            - x553 * x674;
-        let x685 = x532 * x683 - x530 * 0.0008546497218115156 - x540 * x681 - x541 * x680
-            - x542 * x679 - x543 * x678 - x544 * x677 - x545 * x676 - x546 * x675
-            - x547 * x674;
-        let x686 = x533 * x681 - (x529 * 0.0008546497218115156 + x532 * x682)
-            + x533 * x680 + x534 * x679 - x535 * x678 - x536 * x677 - x537 * x676
-            - x538 * x675 - x539 * x674;
-        [x686, x685, x684, x683, x682, x681, x680, x679, x678, x677, x676, x675, x674]
+        let x15 = -0.00000000020510342851533115 * c_q13;
+        let x16 = -0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = -0.0145 - 0.000781 * x16;
+        let x21 = -0.9614610000000001 + (0.000781 * x15 - -1.2025609200000003 * x16);
+        let x22 = 1.4135609200000003 + (-0.0145 * x15 - -0.9614610000000001 * x16);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = x24 + -1.2025609200000003 * c_q13;
+        let x26 = -0.0145 * s_q13 + -0.9614610000000001 * c_q13;
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = -1.2025609200000003 * s_q13 - x23 + 0.00000000019719894748377882;
+        let x29 = -0.9614610000000001 * s_q13 - -0.0145 * c_q13
+            + -0.0000000002899261911072858;
+        let x30 = -0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = 0.16 * x19;
+        let x33 = x18 * -0.55;
+        let x34 = x22 + (x15 * x20 - x16 * x21) - (x30 - x31) - (x33 - x32);
+        let x35 = 3.6140000000000003 - x17;
+        let x36 = 17.135250000000003 + x18;
+        let x37 = -1.9877000000000002 + (s_q13 * x20 + c_q13 * x21 + 0.55 * x17);
+        let x38 = -0.809539999555672
+            + (s_q13 * x21 - c_q13 * x20 + -0.00000000020510342851533115 * x22
+                - -0.16 * x17);
+        let x39 = -1.9877000000000002 + (x26 + (x15 * x23 - x16 * x25) - x17 * -0.55);
+        let x40 = -5.252920330000002 + (s_q13 * x23 + c_q13 * x25 + x32 - x30);
+        let x41 = -2.741639999592316
+            + (s_q13 * x25 - c_q13 * x23 + -0.00000000020510342851533115 * x26
+                - 0.16 * x18 - 0.55 * x19);
+        let x42 = -0.809539999555672 + (x29 + (x15 * x27 - x16 * x28) + 0.16 * x17);
+        let x43 = -2.7416399995923166
+            + (s_q13 * x27 + c_q13 * x28 + x19 * -0.55 + -0.16 * x18);
+        let x44 = 9.740442170000001
+            + (x31
+                + (s_q13 * x28 - c_q13 * x27 + -0.00000000020510342851533115 * x29
+                    - x33));
+        let x45 = c_q12 * x35;
+        let x46 = s_q12 * x36;
+        let x47 = x45 - x46;
+        let x48 = x19 + (x12 * x35 + x13 * x36);
+        let x49 = s_q12 * x35 + c_q12 * x36;
+        let x50 = -0.00000000020510342851533115 * x19 - x49;
+        let x51 = c_q12 * x34 - s_q12 * x39;
+        let x52 = c_q12 * x37 - s_q12 * x40;
+        let x53 = c_q12 * x38 - s_q12 * x41;
+        let x54 = x42 + (x12 * x34 + x13 * x39);
+        let x55 = x43 + (x12 * x37 + x13 * x40);
+        let x56 = x44 + (x12 * x38 + x13 * x41);
+        let x57 = -0.00000000020510342851533115 * x42 - (s_q12 * x34 + c_q12 * x39);
+        let x58 = -0.00000000020510342851533115 * x43 - (s_q12 * x37 + c_q12 * x40);
+        let x59 = -0.00000000020510342851533115 * x44 - (s_q12 * x38 + c_q12 * x41);
+        let x60 = x53 + (x12 * x51 + x13 * x52);
+        let x61 = c_q12 * x54 - s_q12 * x55;
+        let x62 = x50 * 0.36;
+        let x63 = -0.36 * x50;
+        let x64 = x63 + (c_q12 * x51 - s_q12 * x52 - x62);
+        let x65 = 7.078399999258757 + x48;
+        let x66 = 0.01675
+            + (-0.00000000020510342851533115 * x53 - (s_q12 * x51 + c_q12 * x52)
+                + x47 * 0.36);
+        let x67 = -9.142025249762803 + (x56 + (x12 * x54 + x13 * x55) + x63 - x62);
+        let x68 = 2.5482240016099564
+            + (-0.00000000020510342851533115 * x56 - (s_q12 * x54 + c_q12 * x55)
+                - -0.36 * x48);
+        let x69 = 0.01675 + (c_q12 * x57 - s_q12 * x58 - -0.36 * x47);
+        let x70 = 2.5482240016099564 + (x59 + (x12 * x57 + x13 * x58) + x48 * 0.36);
+        let x71 = 9.223235249762805
+            + (-0.00000000020510342851533115 * x59 - (s_q12 * x57 + c_q12 * x58));
+        let x72 = c_q11 * x47 - s_q11 * x65;
+        let x73 = s_q11 * x47 + c_q11 * x65;
+        let x74 = c_q11 * x64 - s_q11 * x61;
+        let x75 = c_q11 * x60 - s_q11 * x67;
+        let x76 = s_q11 * x64 + c_q11 * x61;
+        let x77 = s_q11 * x60 + c_q11 * x67;
+        let x78 = 0.275 * x50;
+        let x79 = -0.63 * x73;
+        let x80 = -0.275 * x50;
+        let x81 = x73 * 0.63;
+        let x82 = s_q11 * x74 + c_q11 * x75 - -0.63 * x72;
+        let x83 = c_q11 * x66 - s_q11 * x68 + 0.275 * x72;
+        let x84 = s_q11 * x66 + c_q11 * x68 - -0.275 * x73;
+        let x85 = x71 - x81;
+        let x86 = c_q11 * x74 - s_q11 * x75 - (x78 - x79) - (x81 - x80);
+        let x87 = c_q11 * x76 - s_q11 * x77 + x72 * 0.63;
+        let x88 = -45.1584 + x73;
+        let x89 = -0.6328 + x83;
+        let x90 = -24.4950615 + (s_q11 * x76 + c_q11 * x77 + x80 - x78);
+        let x91 = -24.35164200091464 + (x84 - -0.63 * x50);
+        let x92 = -0.6328 + (c_q11 * x69 - s_q11 * x70 - -0.275 * x72);
+        let x93 = -24.351642000914637
+            + (s_q11 * x69 + c_q11 * x70 + x50 * 0.63 + 0.275 * x73);
+        let x94 = 28.2393615 + (x79 + x85);
+        let x95 = c_q10 * x72;
+        let x96 = x95 - s_q10 * x88;
+        let x97 = s_q10 * x72;
+        let x98 = x97 + c_q10 * x88;
+        let x99 = c_q10 * x86 - s_q10 * x87;
+        let x100 = c_q10 * x82 - s_q10 * x90;
+        let x101 = c_q10 * x89 - s_q10 * x91;
+        let x102 = s_q10 * x86 + c_q10 * x87;
+        let x103 = s_q10 * x82 + c_q10 * x90;
+        let x104 = s_q10 * x89 + c_q10 * x91;
+        let x105 = -0.87 * x98;
+        let x106 = x98 * 0.87;
+        let x107 = s_q10 * x99 + c_q10 * x100 - -0.87 * x96;
+        let x108 = x94 - x106;
+        let x109 = c_q10 * x99 - s_q10 * x100 + x105 - x106;
+        let x110 = c_q10 * x102 - s_q10 * x103 + x96 * 0.87;
+        let x111 = -81.53205 + x98;
+        let x112 = -0.00214 + x101;
+        let x113 = -63.36336825000001 + (s_q10 * x102 + c_q10 * x103);
+        let x114 = -36.18604050126307 + (x104 - -0.87 * x50);
+        let x115 = -0.00214 + (c_q10 * x92 - s_q10 * x93);
+        let x116 = -36.18604050126307 + (s_q10 * x92 + c_q10 * x93 + x50 * 0.87);
+        let x117 = 69.99836825 + (x105 + x108);
+        let x118 = x5 * x96 + x6 * x111 + 0.00000000020510342851533115 * x50;
+        let x119 = x50 + (x7 * x96 + x8 * x111);
+        let x120 = c_q9 * x96 - s_q9 * x111 + -0.00000000020510342851533115 * x50;
+        let x121 = x5 * x109 + x6 * x110 + 0.00000000020510342851533115 * x115;
+        let x122 = x5 * x107 + x6 * x113 + 0.00000000020510342851533115 * x116;
+        let x123 = x5 * x112 + x6 * x114 + 0.00000000020510342851533115 * x117;
+        let x124 = x115 + (x7 * x109 + x8 * x110);
+        let x125 = x116 + (x7 * x107 + x8 * x113);
+        let x126 = x117 + (x7 * x112 + x8 * x114);
+        let x127 = c_q9 * x109 - s_q9 * x110 + -0.00000000020510342851533115 * x115;
+        let x128 = c_q9 * x107 - s_q9 * x113 + -0.00000000020510342851533115 * x116;
+        let x129 = c_q9 * x112 - s_q9 * x114 + -0.00000000020510342851533115 * x117;
+        let x130 = x120 * -0.4;
+        let x131 = 0.275 * x119;
+        let x132 = 0.4 * x120;
+        let x133 = -0.275 * x119;
+        let x134 = x5 * x121 + x6 * x122 + 0.00000000020510342851533115 * x123
+            - (x130 - x131) - (x133 - x132);
+        let x135 = -0.000000008530897668050218 + x118;
+        let x136 = -12.701650001451807 + x119;
+        let x137 = -0.0000000234896432582596
+            + (x123 + (x7 * x121 + x8 * x122) - 0.275 * x118);
+        let x138 = -0.0021399965876409276
+            + (c_q9 * x121 - s_q9 * x122 + -0.00000000020510342851533115 * x123
+                + x118 * -0.4);
+        let x139 = -0.0000000234896432582596
+            + (x5 * x124 + x6 * x125 + 0.00000000020510342851533115 * x126
+                + -0.275 * x118);
+        let x140 = -111.7548902508081 + (x126 + (x7 * x124 + x8 * x125) + x132 - x130);
+        let x141 = 5.080660024070365
+            + (c_q9 * x124 - s_q9 * x125 + -0.00000000020510342851533115 * x126
+                - 0.4 * x119 - 0.275 * x120);
+        let x142 = -0.0021399965876409276
+            + (x5 * x127 + x6 * x128 + 0.00000000020510342851533115 * x129 - 0.4 * x118);
+        let x143 = 5.080660024070366
+            + (x129 + (x7 * x127 + x8 * x128) + -0.275 * x120 + x119 * -0.4);
+        let x144 = 113.3918902508081
+            + (x131
+                + (c_q9 * x127 - s_q9 * x128 + -0.00000000020510342851533115 * x129
+                    - x133));
+        let x145 = x120 + (x2 * x135 - x3 * x136);
+        let x146 = s_q8 * x135 + c_q8 * x136;
+        let x147 = c_q8 * x135;
+        let x148 = s_q8 * x136;
+        let x149 = x148 - x147 + -0.00000000020510342851533115 * x120;
+        let x150 = x142 + (x2 * x134 - x3 * x139);
+        let x151 = x143 + (x2 * x137 - x3 * x140);
+        let x152 = x144 + (x2 * x138 - x3 * x141);
+        let x153 = s_q8 * x134 + c_q8 * x139;
+        let x154 = s_q8 * x137 + c_q8 * x140;
+        let x155 = s_q8 * x138 + c_q8 * x141;
+        let x156 = s_q8 * x141 - c_q8 * x138 + -0.00000000020510342851533115 * x144;
+        let x157 = x149 * -0.35;
+        let x158 = 0.35 * x149;
+        let x159 = x158 + (x152 + (x2 * x150 - x3 * x151) - x157);
+        let x160 = 48.0240000085309 + x145;
+        let x161 = -0.07309 + (s_q8 * x150 + c_q8 * x151);
+        let x162 = -16.80768997608804
+            + (s_q8 * x151 - c_q8 * x150 + -0.00000000020510342851533115 * x152
+                + x145 * -0.35);
+        let x163 = -0.07309 + (x155 + (x2 * x153 - x3 * x154));
+        let x164 = 130.43769025763282 + (s_q8 * x153 + c_q8 * x154 + x158 - x157);
+        let x165 = 0.1132
+            + (s_q8 * x154 - c_q8 * x153 + -0.00000000020510342851533115 * x155
+                - 0.35 * x146);
+        let x166 = 132.47349025763282
+            + (s_q8 * (s_q8 * x140 - c_q8 * x137 + -0.00000000020510342851533115 * x143)
+                - c_q8
+                    * (s_q8 * x139 - c_q8 * x134 + -0.00000000020510342851533115 * x142)
+                + -0.00000000020510342851533115 * x156);
+        let x167 = c_q7 * x160 - s_q7 * x146;
+        let x168 = s_q7 * x160 + c_q7 * x146;
+        let x169 = c_q7 * x159 - s_q7 * x163;
+        let x170 = c_q7 * x161 - s_q7 * x164;
+        let x171 = x149 * -0.75;
+        let x172 = 0.75 * x149;
+        let x173 = x167 * -0.65;
+        let x174 = 0.65 * x167;
+        let x175 = c_q7 * x162 - s_q7 * x165 + x167 * -0.75;
+        let x176 = x166 + x174;
+        let x177 = 110.5455 + x167;
+        let x178 = 180.9502499901501 + x149;
+        let x179 = x2 * x136 + x3 * x135;
+        let x180 = x147 - x148;
+        let x181 = x152 + -0.35 * x180;
+        let x182 = x155 - 0.35 * x179;
+        let x183 = c_q7 * x179 + s_q7 * x180;
+        let x184 = c_q7 * x180 - s_q7 * x179;
+        let x185 = x6 * x96;
+        let x186 = x185 - x5 * x111;
+        let x187 = x8 * x96;
+        let x188 = x187 - x7 * x111;
+        let x189 = s_q9 * x96;
+        let x190 = c_q9 * x111 + x189;
+        let x191 = x123 + (-0.4 * x188 - 0.275 * x190);
+        let x192 = x126 + 0.4 * x186;
+        let x193 = x129 + -0.275 * x186;
+        let x194 = x2 * x186 - x3 * x188 - x190;
+        let x195 = s_q8 * x186 + c_q8 * x188;
+        let x196 = s_q8 * x188 - c_q8 * x186 - -0.00000000020510342851533115 * x190;
+        let x197 = s_q8 * x192 - c_q8 * x191 + -0.00000000020510342851533115 * x193;
+        let x198 = x193 + (x2 * x191 - x3 * x192) + -0.35 * x195;
+        let x199 = s_q8 * x191 + c_q8 * x192 + 0.35 * x194;
+        let x200 = c_q7 * x194 - s_q7 * x195;
+        let x201 = s_q7 * x194 + c_q7 * x195;
+        let x202 = x185 - x5 * x98;
+        let x203 = x187 - x7 * x98;
+        let x204 = x189 + c_q9 * x98;
+        let x205 = x5 * x101 + x6 * x104 + 0.00000000020510342851533115 * x108
+            + (-0.4 * x203 - 0.275 * x204);
+        let x206 = x108 + (x7 * x101 + x8 * x104) + 0.4 * x202;
+        let x207 = c_q9 * x101 - s_q9 * x104 + -0.00000000020510342851533115 * x108
+            + -0.275 * x202;
+        let x208 = x2 * x202 - x3 * x203 - x204;
+        let x209 = s_q8 * x202 + c_q8 * x203;
+        let x210 = s_q8 * x203 - c_q8 * x202 - -0.00000000020510342851533115 * x204;
+        let x211 = s_q8 * x206 - c_q8 * x205 + -0.00000000020510342851533115 * x207;
+        let x212 = x207 + (x2 * x205 - x3 * x206) + -0.35 * x209;
+        let x213 = s_q8 * x205 + c_q8 * x206 + 0.35 * x208;
+        let x214 = c_q7 * x208 - s_q7 * x209;
+        let x215 = s_q7 * x208 + c_q7 * x209;
+        let x216 = x97 + c_q10 * x73;
+        let x217 = x95 - s_q10 * x73;
+        let x218 = c_q10 * x83 - s_q10 * x84;
+        let x219 = s_q10 * x83 + c_q10 * x84;
+        let x220 = x85 - 0.87 * x216;
+        let x221 = x6 * x217 - x5 * x216;
+        let x222 = x8 * x217 - x7 * x216;
+        let x223 = c_q9 * x216 + s_q9 * x217;
+        let x224 = x5 * x218 + x6 * x219 + 0.00000000020510342851533115 * x220
+            + (-0.4 * x222 - 0.275 * x223);
+        let x225 = x220 + (x7 * x218 + x8 * x219) + 0.4 * x221;
+        let x226 = c_q9 * x218 - s_q9 * x219 + -0.00000000020510342851533115 * x220
+            + -0.275 * x221;
+        let x227 = x2 * x221 - x3 * x222 - x223;
+        let x228 = s_q8 * x221 + c_q8 * x222;
+        let x229 = s_q8 * x222 - c_q8 * x221 - -0.00000000020510342851533115 * x223;
+        let x230 = s_q8 * x225 - c_q8 * x224 + -0.00000000020510342851533115 * x226;
+        let x231 = x226 + (x2 * x224 - x3 * x225) + -0.35 * x228;
+        let x232 = s_q8 * x224 + c_q8 * x225 + 0.35 * x227;
+        let x233 = c_q7 * x227 - s_q7 * x228;
+        let x234 = s_q7 * x227 + c_q7 * x228;
+        let x235 = x13 * x35 - x12 * x36;
+        let x236 = x46 - x45;
+        let x237 = x53 + 0.36 * x235;
+        let x238 = x56 - -0.36 * x49;
+        let x239 = c_q11 * x49 + s_q11 * x235;
+        let x240 = c_q11 * x235 - s_q11 * x49;
+        let x241 = c_q11 * x237 - s_q11 * x238 + (0.275 * x240 + -0.63 * x236);
+        let x242 = s_q11 * x237 + c_q11 * x238 - -0.275 * x239;
+        let x243 = x59 - 0.63 * x239;
+        let x244 = c_q10 * x239 + s_q10 * x240;
+        let x245 = c_q10 * x240 - s_q10 * x239;
+        let x246 = s_q10 * x241 + c_q10 * x242;
+        let x247 = c_q10 * x241 - s_q10 * x242 + -0.87 * x236;
+        let x248 = x243 - 0.87 * x244;
+        let x249 = x6 * x245 - x5 * x244 + 0.00000000020510342851533115 * x236;
+        let x250 = x236 + (x8 * x245 - x7 * x244);
+        let x251 = -0.00000000020510342851533115 * x236 - (c_q9 * x244 + s_q9 * x245);
+        let x252 = x5 * x247 + x6 * x246 + 0.00000000020510342851533115 * x248
+            + (-0.4 * x250 + 0.275 * x251);
+        let x253 = x248 + (x7 * x247 + x8 * x246) + 0.4 * x249;
+        let x254 = c_q9 * x247 - s_q9 * x246 + -0.00000000020510342851533115 * x248
+            + -0.275 * x249;
+        let x255 = x251 + (x2 * x249 - x3 * x250);
+        let x256 = s_q8 * x249 + c_q8 * x250;
+        let x257 = s_q8 * x250 - c_q8 * x249 + -0.00000000020510342851533115 * x251;
+        let x258 = s_q8 * x253 - c_q8 * x252 + -0.00000000020510342851533115 * x254;
+        let x259 = x254 + (x2 * x252 - x3 * x253) + -0.35 * x256;
+        let x260 = s_q8 * x252 + c_q8 * x253 + 0.35 * x255;
+        let x261 = c_q7 * x255 - s_q7 * x256;
+        let x262 = s_q7 * x255 + c_q7 * x256;
+        let x263 = x15 * -4.806620000000001;
+        let x264 = s_q13 * -4.806620000000001;
+        let x265 = c_q13 * -4.806620000000001;
+        let x266 = x22 + (-0.16 * x264 - 0.55 * x265);
+        let x267 = x26 + 0.16 * x263;
+        let x268 = x29 + -0.55 * x263;
+        let x269 = c_q12 * x263 - s_q12 * x264;
+        let x270 = x12 * x263 + x13 * x264 - x265;
+        let x271 = s_q12 * x263 + c_q12 * x264 + -0.00000000020510342851533115 * x265;
+        let x272 = -0.00000000020510342851533115 * x268 - (s_q12 * x266 + c_q12 * x267);
+        let x273 = c_q12 * x266 - s_q12 * x267 + 0.36 * x270;
+        let x274 = x268 + (x12 * x266 + x13 * x267) + -0.36 * x269;
+        let x275 = c_q11 * x269 - s_q11 * x270;
+        let x276 = s_q11 * x269 + c_q11 * x270;
+        let x277 = c_q11 * x273 - s_q11 * x274 + (0.275 * x276 - -0.63 * x271);
+        let x278 = s_q11 * x273 + c_q11 * x274 + -0.275 * x275;
+        let x279 = x272 + 0.63 * x275;
+        let x280 = c_q10 * x275 - s_q10 * x276;
+        let x281 = s_q10 * x275 + c_q10 * x276;
+        let x282 = s_q10 * x277 + c_q10 * x278;
+        let x283 = c_q10 * x277 - s_q10 * x278 - -0.87 * x271;
+        let x284 = x279 + 0.87 * x280;
+        let x285 = x5 * x280 + x6 * x281 - 0.00000000020510342851533115 * x271;
+        let x286 = x7 * x280 + x8 * x281 - x271;
+        let x287 = c_q9 * x280 - s_q9 * x281 - -0.00000000020510342851533115 * x271;
+        let x288 = x5 * x283 + x6 * x282 + 0.00000000020510342851533115 * x284
+            + (-0.4 * x286 + 0.275 * x287);
+        let x289 = x284 + (x7 * x283 + x8 * x282) + 0.4 * x285;
+        let x290 = c_q9 * x283 - s_q9 * x282 + -0.00000000020510342851533115 * x284
+            + -0.275 * x285;
+        let x291 = x287 + (x2 * x285 - x3 * x286);
+        let x292 = s_q8 * x285 + c_q8 * x286;
+        let x293 = s_q8 * x286 - c_q8 * x285 + -0.00000000020510342851533115 * x287;
+        let x294 = s_q8 * x289 - c_q8 * x288 + -0.00000000020510342851533115 * x290;
+        let x295 = x290 + (x2 * x288 - x3 * x289) + -0.35 * x292;
+        let x296 = s_q8 * x288 + c_q8 * x289 + 0.35 * x291;
+        let x297 = c_q7 * x291 - s_q7 * x292;
+        let x298 = s_q7 * x291 + c_q7 * x292;
+        let x299 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+            + v[1] * -180.9502499901501;
+        let x300 = 1466.4506062283303 * v[4]
+            + (180.9502499901501 * v[0] + v[2] * -110.5455);
+        let x301 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x302 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x303 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x304 = 1170.07 * v[2] - 110.5455 * v[4];
+        let x305 = v[3] * c_q7 + v[4] * s_q7;
+        let x306 = v[4] * c_q7 - v[3] * s_q7;
+        let x307 = v[0] - v[4] * -0.75;
+        let x308 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x309 = v[2] - 0.65 * v[4];
+        let x310 = c_q7 * x307 + s_q7 * x308;
+        let x311 = c_q7 * x308 - s_q7 * x307;
+        let x312 = v[5] + v[6];
+        let x313 = v[6] * x306;
+        let x314 = v[6] * x305;
+        let x315 = v[6] * x310;
+        let x316 = -0.07309 * x306 + -16.80768997608804 * x312;
+        let x317 = -0.07309 * x305 + 130.43769025763282 * x306 + 0.1132 * x312
+            + x309 * -48.0240000085309;
+        let x318 = -16.80768997608804 * x305 + 0.1132 * x306 + 132.47349025763282 * x312
+            + 48.0240000085309 * x311;
+        let x319 = x312 * -48.0240000085309;
+        let x320 = 48.0240000085309 * x306;
+        let x321 = x2 * x305 + s_q8 * x306 - c_q8 * x312;
+        let x322 = c_q8 * x306 - x3 * x305 + s_q8 * x312;
+        let x323 = x310 - -0.35 * x306;
+        let x324 = x311 - 0.35 * x305;
+        let x325 = x2 * x323 + s_q8 * x324 - c_q8 * x309;
+        let x326 = c_q8 * x324 - x3 * x323 + s_q8 * x309;
+        let x327 = x323 + -0.00000000020510342851533115 * x309;
+        let x328 = v[7] + (x305 + -0.00000000020510342851533115 * x312);
+        let x329 = v[6] * x311 + -0.35 * x314;
+        let x330 = x315 + 0.35 * x313;
+        let x331 = x2 * x313 - s_q8 * x314 + v[7] * x322;
+        let x332 = x3 * x313 + c_q8 * x314 + v[7] * x321;
+        let x333 = x2 * x329 - s_q8 * x330 + v[7] * x326;
+        let x334 = x3 * x329 + c_q8 * x330 + v[7] * x325;
+        let x335 = -0.0000000234896432582596 * x322 + -0.0021399965876409276 * x328
+            + -12.701650001451807 * x327;
+        let x336 = -0.0000000234896432582596 * x321 + -111.7548902508081 * x322
+            + 5.080660024070365 * x328 + x327 * 0.000000008530897668050218;
+        let x337 = -0.0021399965876409276 * x321 + 5.080660024070366 * x322
+            + 113.3918902508081 * x328
+            + (x325 * 12.701650001451807 + -0.000000008530897668050218 * x326);
+        let x338 = -12.701650001451807 * x328;
+        let x339 = x328 * 0.000000008530897668050218;
+        let x340 = x321 * 12.701650001451807 + -0.000000008530897668050218 * x322;
+        let x341 = x5 * x321 + x7 * x322 + c_q9 * x328;
+        let x342 = x6 * x321 + x8 * x322 - s_q9 * x328;
+        let x343 = x325 - (-0.4 * x322 + 0.275 * x328);
+        let x344 = x326 - 0.4 * x321;
+        let x345 = x327 - -0.275 * x321;
+        let x346 = x5 * x343 + x7 * x344 + c_q9 * x345;
+        let x347 = x6 * x343 + x8 * x344 - s_q9 * x345;
+        let x348 = x344 + 0.00000000020510342851533115 * x343
+            + -0.00000000020510342851533115 * x345;
+        let x349 = v[8]
+            + (x322 + 0.00000000020510342851533115 * x321
+                + -0.00000000020510342851533115 * x328);
+        let x350 = 0.00000000020510342851533115 * x331 - x332
+            + -0.00000000020510342851533115 * x313;
+        let x351 = x333 - (0.275 * x313 - -0.4 * x332);
+        let x352 = x334 + 0.4 * x331;
+        let x353 = x329 - -0.275 * x331;
+        let x354 = 0.00000000020510342851533115 * x351 - x352
+            + -0.00000000020510342851533115 * x353;
+        let x355 = x5 * x331 - x7 * x332 + c_q9 * x313 + v[8] * x342;
+        let x356 = x6 * x331 - x8 * x332 - s_q9 * x313 - v[8] * x341;
+        let x357 = x5 * x351 - x7 * x352 + c_q9 * x353 + v[8] * x347;
+        let x358 = x6 * x351 - x8 * x352 - s_q9 * x353 - v[8] * x346;
+        let x359 = -63.36336825000001 * x342 + -36.18604050126307 * x349;
+        let x360 = -0.00214 * x349 + -81.53205 * x348;
+        let x361 = -0.00214 * x341 + -36.18604050126307 * x342 + 69.99836825 * x349
+            + x346 * 81.53205;
+        let x362 = -81.53205 * x349;
+        let x363 = x341 * 81.53205;
+        let x364 = c_q10 * x341 + s_q10 * x342;
+        let x365 = c_q10 * x342 - s_q10 * x341;
+        let x366 = x346 - -0.87 * x349;
+        let x367 = x348 - 0.87 * x341;
+        let x368 = c_q10 * x366 + s_q10 * x347;
+        let x369 = c_q10 * x347 - s_q10 * x366;
+        let x370 = v[9] + x349;
+        let x371 = x357 - -0.87 * x350;
+        let x372 = x354 - 0.87 * x355;
+        let x373 = c_q10 * x355 + s_q10 * x356 + v[9] * x365;
+        let x374 = c_q10 * x356 - s_q10 * x355 - v[9] * x364;
+        let x375 = c_q10 * x371 + s_q10 * x358 + v[9] * x369;
+        let x376 = -24.4950615 * x365 + -24.35164200091464 * x370;
+        let x377 = -0.6328 * x370 + -45.1584 * x367;
+        let x378 = -0.6328 * x364 + -24.351642000914637 * x365 + 28.2393615 * x370
+            + x368 * 45.1584;
+        let x379 = -45.1584 * x370;
+        let x380 = x364 * 45.1584;
+        let x381 = c_q11 * x364 + s_q11 * x365;
+        let x382 = c_q11 * x365 - s_q11 * x364;
+        let x383 = x368 - (0.275 * x365 + -0.63 * x370);
+        let x384 = x369 - -0.275 * x364;
+        let x385 = x367 - 0.63 * x364;
+        let x386 = c_q11 * x383 + s_q11 * x384;
+        let x387 = c_q11 * x384 - s_q11 * x383;
+        let x388 = v[10] + x370;
+        let x389 = x375 - (0.275 * x374 + -0.63 * x350);
+        let x390 = c_q10 * x358 - s_q10 * x371 - v[9] * x368 - -0.275 * x373;
+        let x391 = x372 - 0.63 * x373;
+        let x392 = c_q11 * x373 + s_q11 * x374 + v[10] * x382;
+        let x393 = c_q11 * x374 - s_q11 * x373 - v[10] * x381;
+        let x394 = c_q11 * x389 + s_q11 * x390 + v[10] * x387;
+        let x395 = -9.142025249762803 * x382 + 2.5482240016099564 * x388;
+        let x396 = 0.01675 * x388 + 7.078399999258757 * x385;
+        let x397 = 0.01675 * x381 + 2.5482240016099564 * x382 + 9.223235249762805 * x388
+            + x386 * -7.078399999258757;
+        let x398 = 7.078399999258757 * x388;
+        let x399 = x381 * -7.078399999258757;
+        let x400 = c_q12 * x381 + x12 * x382 - s_q12 * x388;
+        let x401 = x13 * x382 - s_q12 * x381 - c_q12 * x388;
+        let x402 = x386 - 0.36 * x382;
+        let x403 = x387 - -0.36 * x381;
+        let x404 = c_q12 * x402 + x12 * x403 - s_q12 * x385;
+        let x405 = x13 * x403 - s_q12 * x402 - c_q12 * x385;
+        let x406 = x403 + -0.00000000020510342851533115 * x385;
+        let x407 = v[11] + (x382 + -0.00000000020510342851533115 * x388);
+        let x408 = x393 + -0.00000000020510342851533115 * x350;
+        let x409 = x394 - 0.36 * x393;
+        let x410 = c_q11 * x390 - s_q11 * x389 - v[10] * x386 - -0.36 * x392;
+        let x411 = x410 + -0.00000000020510342851533115 * x391;
+        let x412 = c_q12 * x392 + x12 * x393 - s_q12 * x350 + v[11] * x401;
+        let x413 = x13 * x393 - s_q12 * x392 - c_q12 * x350 - v[11] * x400;
+        let x414 = c_q12 * x409 + x12 * x410 - s_q12 * x391 + v[11] * x405;
+        let x415 = x13 * x410 - s_q12 * x409 - c_q12 * x391 - v[11] * x404;
+        let x416 = -1.9877000000000002 * x401 + -0.809539999555672 * x407
+            + 17.135250000000003 * x406;
+        let x417 = -1.9877000000000002 * x400 + -5.252920330000002 * x401
+            + -2.741639999592316 * x407 + x406 * -3.6140000000000003;
+        let x418 = -0.809539999555672 * x400 + -2.7416399995923166 * x401
+            + 9.740442170000001 * x407
+            + (x404 * -17.135250000000003 + 3.6140000000000003 * x405);
+        let x419 = 17.135250000000003 * x407;
+        let x420 = x407 * -3.6140000000000003;
+        let x421 = x400 * -17.135250000000003 + 3.6140000000000003 * x401;
+        let x422 = x15 * x400 + s_q13 * x401 - c_q13 * x407;
+        let x423 = c_q13 * x401 - x16 * x400 + s_q13 * x407;
+        let x424 = x404 - (-0.16 * x401 + 0.55 * x407);
+        let x425 = x405 - 0.16 * x400;
+        let x426 = x406 - -0.55 * x400;
+        let x427 = x15 * x424 + s_q13 * x425 - c_q13 * x426;
+        let x428 = c_q13 * x425 - x16 * x424 + s_q13 * x426;
+        let x429 = x424 + -0.00000000020510342851533115 * x426;
+        let x430 = v[12] + (x400 + -0.00000000020510342851533115 * x407);
+        let x431 = x412 + -0.00000000020510342851533115 * x408;
+        let x432 = x414 - (-0.16 * x413 + 0.55 * x408);
+        let x433 = x411 - -0.55 * x412;
+        let x434 = x15 * x412 + s_q13 * x413 - c_q13 * x408 + v[12] * x423;
+        let x435 = c_q13 * x413 - x16 * x412 + s_q13 * x408 - v[12] * x422;
+        let x436 = 0.000781 * x422 + -1.2025609200000003 * x423
+            + -0.9614610000000001 * x430;
+        let x437 = 0.000781 * x423 + -0.0145 * x430 + 4.806620000000001 * x429;
+        let x438 = -0.0145 * x422 + -0.9614610000000001 * x423
+            + 1.4135609200000003 * x430 + -4.806620000000001 * x427;
+        let x439 = 4.806620000000001 * x430;
+        let x440 = -4.806620000000001 * x422;
+        let x441 = x422 * x440 - x430 * x439;
+        let x442 = 0.000781 * x435 + -0.0145 * x431
+            + 4.806620000000001 * (x432 + -0.00000000020510342851533115 * x433)
+            + (x423 * x438 - x430 * x436 - x428 * x440);
+        let x443 = 0.000781 * x434 + -1.2025609200000003 * x435
+            + -0.9614610000000001 * x431
+            + (x430 * x437 - x422 * x438 + (x427 * x440 - x429 * x439));
+        let x444 = -0.0145 * x434 + -0.9614610000000001 * x435
+            + 1.4135609200000003 * x431
+            + -4.806620000000001
+                * (x15 * x432 + s_q13 * (x415 - 0.16 * x412) - c_q13 * x433
+                    + v[12] * x428) + (x422 * x436 - x423 * x437 + x428 * x439);
+        let x445 = 4.806620000000001 * x431 + x423 * x440;
+        let x446 = x423 * x439 - -4.806620000000001 * x434;
+        let x447 = x446 - (x15 * x445 + x16 * x441);
+        let x448 = c_q13 * x441 - s_q13 * x445;
+        let x449 = c_q13 * x445 + s_q13 * x441 + -0.00000000020510342851533115 * x446;
+        let x450 = -1.9877000000000002 * x413 + -0.809539999555672 * x408
+            + 17.135250000000003 * x411
+            + (x401 * x418 - x407 * x417 + (x406 * x420 - x405 * x421))
+            + (x444 + (x15 * x442 - x16 * x443) + (-0.16 * x448 + 0.55 * x449));
+        let x451 = -1.9877000000000002 * x412 + -5.252920330000002 * x413
+            + -2.741639999592316 * x408 + x411 * -3.6140000000000003
+            + (x407 * x416 - x400 * x418 + (x404 * x421 - x406 * x419))
+            + (s_q13 * x442 + c_q13 * x443 + 0.16 * x447);
+        let x452 = -0.809539999555672 * x412 + -2.7416399995923166 * x413
+            + 9.740442170000001 * x408
+            + (x414 * -17.135250000000003 + 3.6140000000000003 * x415)
+            + (x400 * x417 - x401 * x416 + (x405 * x419 - x404 * x420))
+            + (s_q13 * x443 - c_q13 * x442 + -0.00000000020510342851533115 * x444
+                + -0.55 * x447);
+        let x453 = x407 * x420 - x401 * x421 - 17.135250000000003 * x408 + x447;
+        let x454 = x400 * x421 - x407 * x419 - x408 * -3.6140000000000003 + x448;
+        let x455 = x401 * x419 - x400 * x420
+            - (x412 * -17.135250000000003 + 3.6140000000000003 * x413) + x449;
+        let x456 = c_q12 * x453 - s_q12 * x454;
+        let x457 = x455 + (x12 * x453 + x13 * x454);
+        let x458 = 0.01675 * x350 + 7.078399999258757 * x391
+            + (x382 * x397 - x388 * x395 - x387 * x399)
+            + (c_q12 * x450 - s_q12 * x451 + 0.36 * x457);
+        let x459 = -9.142025249762803 * x393 + 2.5482240016099564 * x350
+            + (x388 * x396 - x381 * x397 + (x386 * x399 - x385 * x398))
+            + (x452 + (x12 * x450 + x13 * x451) + -0.36 * x456);
+        let x460 = 0.01675 * x392 + 2.5482240016099564 * x393 + 9.223235249762805 * x350
+            + x394 * -7.078399999258757 + (x381 * x395 - x382 * x396 + x387 * x398)
+            + (-0.00000000020510342851533115 * x452 - (s_q12 * x450 + c_q12 * x451));
+        let x461 = x456 - (7.078399999258757 * x350 + x382 * x399);
+        let x462 = x381 * x399 - x388 * x398 + x457;
+        let x463 = x382 * x398 - x392 * -7.078399999258757
+            + (-0.00000000020510342851533115 * x455 - (s_q12 * x453 + c_q12 * x454));
+        let x464 = c_q11 * x461 - s_q11 * x462;
+        let x465 = s_q11 * x461 + c_q11 * x462;
+        let x466 = -0.6328 * x350 + -45.1584 * x372
+            + (x365 * x378 - x370 * x376 - x369 * x380)
+            + (c_q11 * x458 - s_q11 * x459 + (0.275 * x465 + -0.63 * x463));
+        let x467 = -24.4950615 * x374 + -24.35164200091464 * x350
+            + (x370 * x377 - x364 * x378 + (x368 * x380 - x367 * x379))
+            + (s_q11 * x458 + c_q11 * x459 + -0.275 * x464);
+        let x468 = -0.6328 * x373 + -24.351642000914637 * x374 + 28.2393615 * x350
+            + x375 * 45.1584 + (x364 * x376 - x365 * x377 + x369 * x379)
+            + (x460 + 0.63 * x464);
+        let x469 = x464 - (-45.1584 * x350 + x365 * x380);
+        let x470 = x364 * x380 - x370 * x379 + x465;
+        let x471 = x365 * x379 - x373 * 45.1584 + x463;
+        let x472 = c_q10 * x469 - s_q10 * x470;
+        let x473 = -0.00214 * x350 + -81.53205 * x354
+            + (x342 * x361 - x349 * x359 - x347 * x363)
+            + (c_q10 * x466 - s_q10 * x467 + -0.87 * x471);
+        let x474 = -63.36336825000001 * x356 + -36.18604050126307 * x350
+            + (x349 * x360 - x341 * x361 + (x346 * x363 - x348 * x362))
+            + (s_q10 * x466 + c_q10 * x467);
+        let x475 = -0.00214 * x355 + -36.18604050126307 * x356 + 69.99836825 * x350
+            + x357 * 81.53205 + (x341 * x359 - x342 * x360 + x347 * x362)
+            + (x468 + 0.87 * x472);
+        let x476 = x472 - (-81.53205 * x350 + x342 * x363);
+        let x477 = x341 * x363 - x349 * x362 + (s_q10 * x469 + c_q10 * x470);
+        let x478 = x342 * x362 - x355 * 81.53205 + x471;
+        let x479 = x5 * x476 + x6 * x477 + 0.00000000020510342851533115 * x478;
+        let x480 = x478 + (x7 * x476 + x8 * x477);
+        let x481 = c_q9 * x476 - s_q9 * x477 + -0.00000000020510342851533115 * x478;
+        let x482 = -0.0021399965876409276 * x313 - -0.0000000234896432582596 * x332
+            + -12.701650001451807 * x329
+            + (x322 * x337 - x328 * x336 + (x327 * x339 - x326 * x340))
+            + (x5 * x473 + x6 * x474 + 0.00000000020510342851533115 * x475
+                + (-0.4 * x480 + 0.275 * x481));
+        let x483 = -0.0000000234896432582596 * x331 - -111.7548902508081 * x332
+            + 5.080660024070365 * x313 + x329 * 0.000000008530897668050218
+            + (x328 * x335 - x321 * x337 + (x325 * x340 - x327 * x338))
+            + (x475 + (x7 * x473 + x8 * x474) + 0.4 * x479);
+        let x484 = -0.0021399965876409276 * x331 - 5.080660024070366 * x332
+            + 113.3918902508081 * x313
+            + (x333 * 12.701650001451807 - -0.000000008530897668050218 * x334)
+            + (x321 * x336 - x322 * x335 + (x326 * x338 - x325 * x339))
+            + (c_q9 * x473 - s_q9 * x474 + -0.00000000020510342851533115 * x475
+                + -0.275 * x479);
+        let x485 = x328 * x339 - x322 * x340 - -12.701650001451807 * x313 + x479;
+        let x486 = x321 * x340 - x328 * x338 - x313 * 0.000000008530897668050218 + x480;
+        let x487 = x322 * x338 - x321 * x339
+            - (x331 * 12.701650001451807 - -0.000000008530897668050218 * x332) + x481;
+        let x488 = x487 + (x2 * x485 - x3 * x486);
+        let x489 = s_q8 * x485 + c_q8 * x486;
+        let x490 = x306 * x318 - x312 * x317 + (x309 * x319 - x311 * x320)
+            - -0.07309 * x314 + (x484 + (x2 * x482 - x3 * x483) + -0.35 * x489);
+        let x491 = -0.07309 * x313 - 130.43769025763282 * x314
+            + (x312 * x316 - x305 * x318 + x310 * x320)
+            + (s_q8 * x482 + c_q8 * x483 + 0.35 * x488);
+        let x492 = -16.80768997608804 * x313 - 0.1132 * x314 - 48.0240000085309 * x315
+            + (x305 * x317 - x306 * x316 - x310 * x319)
+            + (s_q8 * x483 - c_q8 * x482 + -0.00000000020510342851533115 * x484);
+        let x493 = x312 * x319 - x306 * x320 + x488;
+        let x494 = x305 * x320 + x489;
+        let x495 = 48.0240000085309 * x314 - x305 * x319
+            + (s_q8 * x486 - c_q8 * x485 + -0.00000000020510342851533115 * x487);
+        let x496 = c_q7 * x493 - s_q7 * x494;
+        let x497 = s_q7 * x493 + c_q7 * x494;
+        let x498 = v[4] * x304 - v[5] * x303 + x496;
+        let x499 = v[5] * x302 - v[3] * x304 + x497;
+        let x500 = v[3] * x303 - v[4] * x302 + x495;
+        let x501 = x178 * 0.0008546497218115156;
+        let x502 = x168 * 0.0008546497218115156;
+        let x503 = x183 * 0.0008546497218115156;
+        let x504 = x200 * 0.0008546497218115156;
+        let x505 = x214 * 0.0008546497218115156;
+        let x506 = x233 * 0.0008546497218115156;
+        let x507 = x261 * 0.0008546497218115156;
+        let x508 = x297 * 0.0008546497218115156;
+        let x509 = x177 * 0.0008546497218115156;
+        let x510 = x167 * 0.0008546497218115156;
+        let x511 = x184 * 0.0008546497218115156;
+        let x512 = x201 * 0.0008546497218115156;
+        let x513 = x215 * 0.0008546497218115156;
+        let x514 = x234 * 0.0008546497218115156;
+        let x515 = x262 * 0.0008546497218115156;
+        let x516 = x298 * 0.0008546497218115156;
+        let x517 = x146 * 0.0008546497218115156;
+        let x518 = x196 * 0.0008546497218115156;
+        let x519 = x210 * 0.0008546497218115156;
+        let x520 = x229 * 0.0008546497218115156;
+        let x521 = x257 * 0.0008546497218115156;
+        let x522 = x293 * 0.0008546497218115156;
+        let x523 = x178 * x501;
+        let x524 = x168 * x502;
+        let x525 = 1.0
+            / (1394.5960312283303 + (x172 + (c_q7 * x169 - s_q7 * x170 - x171)) - x523
+                - x524);
+        let x526 = s_q7 * x169 + c_q7 * x170 - 0.65 * x168 + x168 * x509;
+        let x527 = x525 * x526;
+        let x528 = -117.61766249359756 + (x175 + x149 * -0.65) + x178 * x509;
+        let x529 = x525 * x528;
+        let x530 = x175 + x178 * x510;
+        let x531 = x525 * x530;
+        let x532 = c_q7 * x181 - s_q7 * x182 + -0.75 * x184 + x178 * x511 - x168 * x517;
+        let x533 = x525 * x532;
+        let x534 = c_q7 * x198 - s_q7 * x199 + -0.75 * x201 + x178 * x512 - x168 * x518;
+        let x535 = x525 * x534;
+        let x536 = c_q7 * x212 - s_q7 * x213 + -0.75 * x215 + x178 * x513 - x168 * x519;
+        let x537 = x525 * x536;
+        let x538 = c_q7 * x231 - s_q7 * x232 + -0.75 * x234 + x178 * x514 - x168 * x520;
+        let x539 = x525 * x538;
+        let x540 = c_q7 * x259 - s_q7 * x260 + -0.75 * x262 + x178 * x515 - x168 * x521;
+        let x541 = x525 * x540;
+        let x542 = c_q7 * x295 - s_q7 * x296 + -0.75 * x298 + x178 * x516 - x168 * x522;
+        let x543 = x525 * x542;
+        let x544 = x177 * x509;
+        let x545 = 1.0
+            / (1466.4506062283303
+                + (s_q7 * (s_q7 * x159 + c_q7 * x163)
+                    + c_q7 * (s_q7 * x161 + c_q7 * x164) - (x173 - x172) - (x171 - x174))
+                - x523 - x544 - x526 * x527);
+        let x546 = s_q7 * x162 + c_q7 * x165 - 0.75 * x168 + x178 * x502;
+        let x547 = x546 - x526 * x529;
+        let x548 = x545 * x547;
+        let x549 = x546 - x526 * x531;
+        let x550 = x545 * x549;
+        let x551 = s_q7 * x181 + c_q7 * x182 + (x146 * -0.65 - 0.75 * x183) + x178 * x503
+            + x177 * x517 - x526 * x533;
+        let x552 = x545 * x551;
+        let x553 = s_q7 * x198 + c_q7 * x199 + (0.75 * x200 + -0.65 * x196) - x178 * x504
+            + x177 * x518 - x526 * x535;
+        let x554 = x545 * x553;
+        let x555 = s_q7 * x212 + c_q7 * x213 + (0.75 * x214 + -0.65 * x210) - x178 * x505
+            + x177 * x519 - x526 * x537;
+        let x556 = x545 * x555;
+        let x557 = s_q7 * x231 + c_q7 * x232 + (0.75 * x233 + -0.65 * x229) - x178 * x506
+            + x177 * x520 - x526 * x539;
+        let x558 = x545 * x557;
+        let x559 = s_q7 * x259 + c_q7 * x260 + (0.75 * x261 + -0.65 * x257) - x178 * x507
+            + x177 * x521 - x526 * x541;
+        let x560 = x545 * x559;
+        let x561 = s_q7 * x295 + c_q7 * x296 + (0.75 * x297 + -0.65 * x293) - x178 * x508
+            + x177 * x522 - x526 * x543;
+        let x562 = x545 * x561;
+        let x563 = 1.0
+            / (1271.854575 + (x176 - x173) - x524 - x544 - x528 * x529 - x547 * x548);
+        let x564 = x176 - x524 - x177 * x510 - x528 * x531 - x547 * x550;
+        let x565 = x563 * x564;
+        let x566 = x168 * x503;
+        let x567 = x156 + 0.65 * x184 - x566 - x177 * x511 - x528 * x533 - x547 * x552;
+        let x568 = x563 * x567;
+        let x569 = x168 * x504;
+        let x570 = x197 + 0.65 * x201 + x569 - x177 * x512 - x528 * x535 - x547 * x554;
+        let x571 = x563 * x570;
+        let x572 = x168 * x505;
+        let x573 = x211 + 0.65 * x215 + x572 - x177 * x513 - x528 * x537 - x547 * x556;
+        let x574 = x563 * x573;
+        let x575 = x168 * x506;
+        let x576 = x230 + 0.65 * x234 + x575 - x177 * x514 - x528 * x539 - x547 * x558;
+        let x577 = x563 * x576;
+        let x578 = x168 * x507;
+        let x579 = x258 + 0.65 * x262 + x578 - x177 * x515 - x528 * x541 - x547 * x560;
+        let x580 = x563 * x579;
+        let x581 = x168 * x508;
+        let x582 = x294 + 0.65 * x298 + x581 - x177 * x516 - x528 * x543 - x547 * x562;
+        let x583 = x563 * x582;
+        let x584 = 1.0
+            / (x166 - x524 - x167 * x510 - x530 * x531 - x549 * x550 - x564 * x565);
+        let x585 = x156 - x566 - x167 * x511 - x530 * x533 - x549 * x552 - x564 * x568;
+        let x586 = x584 * x585;
+        let x587 = x197 + x569 - x167 * x512 - x530 * x535 - x549 * x554 - x564 * x571;
+        let x588 = x584 * x587;
+        let x589 = x211 + x572 - x167 * x513 - x530 * x537 - x549 * x556 - x564 * x574;
+        let x590 = x584 * x589;
+        let x591 = x230 + x575 - x167 * x514 - x530 * x539 - x549 * x558 - x564 * x577;
+        let x592 = x584 * x591;
+        let x593 = x258 + x578 - x167 * x515 - x530 * x541 - x549 * x560 - x564 * x580;
+        let x594 = x584 * x593;
+        let x595 = x294 + x581 - x167 * x516 - x530 * x543 - x549 * x562 - x564 * x583;
+        let x596 = x584 * x595;
+        let x597 = 1.0
+            / (x144 - x183 * x503 - x184 * x511 - x146 * x517 - x532 * x533 - x551 * x552
+                - x567 * x568 - x585 * x586);
+        let x598 = x193 + x183 * x504 - x184 * x512 - x146 * x518 - x532 * x535
+            - x551 * x554 - x567 * x571 - x585 * x588;
+        let x599 = x597 * x598;
+        let x600 = x207 + x183 * x505 - x184 * x513 - x146 * x519 - x532 * x537
+            - x551 * x556 - x567 * x574 - x585 * x590;
+        let x601 = x597 * x600;
+        let x602 = x226 + x183 * x506 - x184 * x514 - x146 * x520 - x532 * x539
+            - x551 * x558 - x567 * x577 - x585 * x592;
+        let x603 = x597 * x602;
+        let x604 = x254 + x183 * x507 - x184 * x515 - x146 * x521 - x532 * x541
+            - x551 * x560 - x567 * x580 - x585 * x594;
+        let x605 = x597 * x604;
+        let x606 = x290 + x183 * x508 - x184 * x516 - x146 * x522 - x532 * x543
+            - x551 * x562 - x567 * x583 - x585 * x596;
+        let x607 = x597 * x606;
+        let x608 = 1.0
+            / (x117 - x200 * x504 - x201 * x512 - x196 * x518 - x534 * x535 - x553 * x554
+                - x570 * x571 - x587 * x588 - x598 * x599);
+        let x609 = x108 - x200 * x505 - x201 * x513 - x196 * x519 - x534 * x537
+            - x553 * x556 - x570 * x574 - x587 * x590 - x598 * x601;
+        let x610 = x608 * x609;
+        let x611 = x220 - x200 * x506 - x201 * x514 - x196 * x520 - x534 * x539
+            - x553 * x558 - x570 * x577 - x587 * x592 - x598 * x603;
+        let x612 = x608 * x611;
+        let x613 = x248 - x200 * x507 - x201 * x515 - x196 * x521 - x534 * x541
+            - x553 * x560 - x570 * x580 - x587 * x594 - x598 * x605;
+        let x614 = x608 * x613;
+        let x615 = x284 - x200 * x508 - x201 * x516 - x196 * x522 - x534 * x543
+            - x553 * x562 - x570 * x583 - x587 * x596 - x598 * x607;
+        let x616 = x608 * x615;
+        let x617 = 1.0
+            / (x94 - x214 * x505 - x215 * x513 - x210 * x519 - x536 * x537 - x555 * x556
+                - x573 * x574 - x589 * x590 - x600 * x601 - x609 * x610);
+        let x618 = x85 - x214 * x506 - x215 * x514 - x210 * x520 - x536 * x539
+            - x555 * x558 - x573 * x577 - x589 * x592 - x600 * x603 - x609 * x612;
+        let x619 = x617 * x618;
+        let x620 = x243 - x214 * x507 - x215 * x515 - x210 * x521 - x536 * x541
+            - x555 * x560 - x573 * x580 - x589 * x594 - x600 * x605 - x609 * x614;
+        let x621 = x617 * x620;
+        let x622 = x279 - x214 * x508 - x215 * x516 - x210 * x522 - x536 * x543
+            - x555 * x562 - x573 * x583 - x589 * x596 - x600 * x607 - x609 * x616;
+        let x623 = x617 * x622;
+        let x624 = 1.0
+            / (x71 - x233 * x506 - x234 * x514 - x229 * x520 - x538 * x539 - x557 * x558
+                - x576 * x577 - x591 * x592 - x602 * x603 - x611 * x612 - x618 * x619);
+        let x625 = x59 - x233 * x507 - x234 * x515 - x229 * x521 - x538 * x541
+            - x557 * x560 - x576 * x580 - x591 * x594 - x602 * x605 - x611 * x614
+            - x618 * x621;
+        let x626 = x624 * x625;
+        let x627 = x272 - x233 * x508 - x234 * x516 - x229 * x522 - x538 * x543
+            - x557 * x562 - x576 * x583 - x591 * x596 - x602 * x607 - x611 * x616
+            - x618 * x623;
+        let x628 = x624 * x627;
+        let x629 = 1.0
+            / (x44 - x261 * x507 - x262 * x515 - x257 * x521 - x540 * x541 - x559 * x560
+                - x579 * x580 - x593 * x594 - x604 * x605 - x613 * x614 - x620 * x621
+                - x625 * x626);
+        let x630 = x268 - x261 * x508 - x262 * x516 - x257 * x522 - x540 * x543
+            - x559 * x562 - x579 * x583 - x593 * x596 - x604 * x607 - x613 * x616
+            - x620 * x623 - x625 * x628;
+        let x631 = x629 * x630;
+        let x632 = 1.0
+            / (1.4135609200000003 - x297 * x508 - x298 * x516 - x293 * x522 - x542 * x543
+                - x561 * x562 - x582 * x583 - x595 * x596 - x606 * x607 - x615 * x616
+                - x622 * x623 - x627 * x628 - x630 * x631);
+        let x633 = x500 * x502
+            - (v[4] * x301 - v[5] * x300 + (v[1] * x304 - v[2] * x303)
+                + (c_q7 * x490 - s_q7 * x491 + -0.75 * x497) + x499 * x501);
+        let x634 = x498 * x501
+            - (v[5] * x299 - v[3] * x301 + (v[2] * x302 - v[0] * x304)
+                + (s_q7 * x490 + c_q7 * x491 + (0.75 * x496 + -0.65 * x495)))
+            - x500 * x509 - x527 * x633;
+        let x635 = x498 * x502;
+        let x636 = x499 * x509
+            - (v[3] * x300 - v[4] * x299 + (v[0] * x303 - v[1] * x302)
+                + (x492 + 0.65 * x497) + x635) - x529 * x633 - x548 * x634;
+        let x637 = tau[0] - x492 - x635 + x499 * x510 - x531 * x633 - x550 * x634
+            - x565 * x636;
+        let x638 = tau[1] - x484 - x498 * x503 + x499 * x511 + x500 * x517 - x533 * x633
+            - x552 * x634 - x568 * x636 - x586 * x637;
+        let x639 = tau[2] - x475 + x498 * x504 + x499 * x512 + x500 * x518 - x535 * x633
+            - x554 * x634 - x571 * x636 - x588 * x637 - x599 * x638;
+        let x640 = tau[3] - x468 + x498 * x505 + x499 * x513 + x500 * x519 - x537 * x633
+            - x556 * x634 - x574 * x636 - x590 * x637 - x601 * x638 - x610 * x639;
+        let x641 = tau[4] - x460 + x498 * x506 + x499 * x514 + x500 * x520 - x539 * x633
+            - x558 * x634 - x577 * x636 - x592 * x637 - x603 * x638 - x612 * x639
+            - x619 * x640;
+        let x642 = tau[5] - x452 + x498 * x507 + x499 * x515 + x500 * x521 - x541 * x633
+            - x560 * x634 - x580 * x636 - x594 * x637 - x605 * x638 - x614 * x639
+            - x621 * x640 - x626 * x641;
+        let x643 = x632
+            * (tau[6] - x444 + x498 * x508 + x499 * x516 + x500 * x522 - x543 * x633
+                - x562 * x634 - x583 * x636 - x596 * x637 - x607 * x638 - x616 * x639
+                - x623 * x640 - x628 * x641 - x631 * x642);
+        let x644 = x629 * x642 - x631 * x643;
+        let x645 = x624 * x641 - x626 * x644 - x628 * x643;
+        let x646 = x617 * x640 - x619 * x645 - x621 * x644 - x623 * x643;
+        let x647 = x608 * x639 - x610 * x646 - x612 * x645 - x614 * x644 - x616 * x643;
+        let x648 = x597 * x638 - x599 * x647 - x601 * x646 - x603 * x645 - x605 * x644
+            - x607 * x643;
+        let x649 = x584 * x637 - x586 * x648 - x588 * x647 - x590 * x646 - x592 * x645
+            - x594 * x644 - x596 * x643;
+        let x650 = x563 * x636 - x565 * x649 - x568 * x648 - x571 * x647 - x574 * x646
+            - x577 * x645 - x580 * x644 - x583 * x643;
+        let x651 = x545 * x634 - x548 * x650 - x550 * x649 - x552 * x648 - x554 * x647
+            - x556 * x646 - x558 * x645 - x560 * x644 - x562 * x643;
+        let x652 = x525 * x633 - x527 * x651 - x529 * x650 - x531 * x649 - x533 * x648
+            - x535 * x647 - x537 * x646 - x539 * x645 - x541 * x644 - x543 * x643;
+        let x653 = x509 * x651 - (x500 * 0.0008546497218115156 + x502 * x652)
+            - x517 * x648 - x518 * x647 - x519 * x646 - x520 * x645 - x521 * x644
+            - x522 * x643;
+        let x654 = x501 * x652 - x499 * 0.0008546497218115156 - x509 * x650 - x510 * x649
+            - x511 * x648 - x512 * x647 - x513 * x646 - x514 * x645 - x515 * x644
+            - x516 * x643;
+        let x655 = x502 * x650 - (x498 * 0.0008546497218115156 + x501 * x651)
+            + x502 * x649 + x503 * x648 - x504 * x647 - x505 * x646 - x506 * x645
+            - x507 * x644 - x508 * x643;
+        [x655, x654, x653, x652, x651, x650, x649, x648, x647, x646, x645, x644, x643]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 1497 mul, 1128 add, 0 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 1279 mul, 1045 add, 0 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
         v: &[f64; 13],
     ) -> ([[f64; 13]; 13], [f64; 13]) {
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x1 = c_q7 + (1.0 - c_q7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x3 = c_q8 + (1.0 - c_q8);
-        let x4 = -0.00000000020510342851533115 * c_q8;
-        let x5 = -0.00000000020510342851533115 * s_q8;
-        let x6 = -0.00000000020510342851533115 * x3;
+        let x2 = -0.00000000020510342851533115 * c_q8;
+        let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x8 = c_q9 + (1.0 - c_q9);
-        let x9 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x10 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x11 = 0.00000000020510342851533115 * x8;
-        let x12 = 0.00000000020510342851533115 * c_q9
+        let x5 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x6 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x7 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x13 = -0.00000000020510342851533115 * c_q9
+        let x8 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x14 = -0.00000000020510342851533115 * x8;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x16 = c_q10 + (1.0 - c_q10);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x18 = c_q11 + (1.0 - c_q11);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x20 = c_q12 + (1.0 - c_q12);
-        let x21 = -0.00000000020510342851533115 * s_q12;
-        let x22 = -0.00000000020510342851533115 * c_q12;
-        let x23 = -0.00000000020510342851533115 * x20;
+        let x12 = -0.00000000020510342851533115 * s_q12;
+        let x13 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x25 = c_q13 + (1.0 - c_q13);
-        let x26 = -0.00000000020510342851533115 * c_q13;
-        let x27 = -0.00000000020510342851533115 * s_q13;
-        let x28 = -0.00000000020510342851533115 * x25;
-        let x29 = x25 * 3.6140000000000003 - x27 * 4.806620000000001;
-        let x30 = c_q13 * 4.806620000000001;
-        let x31 = s_q13 * 4.806620000000001 + x28 * 3.6140000000000003;
-        let x32 = x30 + 9.938500000000001;
-        let x33 = x31 + 2.8912;
-        let x34 = x26 * 2.1663609200000002 - 0.000781 * x27 + -0.0145 * x25;
-        let x35 = 0.000781 * x26 - x27 * 0.9638000000000001 + x25 * -0.9614610000000001;
-        let x36 = -0.0145 * x26 - x27 * -0.9614610000000001 + x25 * 1.4135609200000003;
-        let x37 = 0.000781 * c_q13;
-        let x38 = s_q13 * 2.1663609200000002 + x37;
-        let x39 = 0.000781 * s_q13;
-        let x40 = x39 + c_q13 * 0.9638000000000001;
-        let x41 = -0.0145 * s_q13 + c_q13 * -0.9614610000000001;
-        let x42 = x39 - c_q13 * 2.1663609200000002 + -0.0145 * x28;
-        let x43 = s_q13 * 0.9638000000000001 - x37 + x28 * -0.9614610000000001;
-        let x44 = s_q13 * -0.9614610000000001 - -0.0145 * c_q13
-            + x28 * 1.4135609200000003;
-        let x45 = s_q13 * x34 + c_q13 * x35 - 0.55 * x29;
-        let x46 = x26 * x38 - x27 * x40 + x25 * x41 + x29 * -0.55;
-        let x47 = 7.196750000000001 + x32;
-        let x48 = 4.187200000000001 + x33;
-        let x49 = 3.2217582500000006
-            + (x26 * x34 - x27 * x35 + x25 * x36 - (-0.16 * x31 - 0.55 * x30)
-                - (x32 * -0.55 - 0.16 * x33));
-        let x50 = -0.2313 + (s_q13 * x35 - c_q13 * x34 + x28 * x36 + -0.16 * x29);
-        let x51 = 1.2686520000000001
-            + (s_q13 * x38 + c_q13 * x40 + 0.16 * x31 - -0.16 * x33);
-        let x52 = -1.1514800000000003
-            + (s_q13 * x40 - c_q13 * x38 + x28 * x41 - 0.16 * x30 - 0.55 * x33);
-        let x53 = -0.2313 + (x26 * x42 - x27 * x43 + x25 * x44 - 0.16 * x29);
-        let x54 = -1.1514800000000003
-            + (s_q13 * x42 + c_q13 * x43 + x31 * -0.55 + -0.16 * x32);
-        let x55 = 2.1079062500000005
-            + (s_q13 * x43 - c_q13 * x42 + x28 * x44 - x30 * -0.55 + 0.55 * x32);
-        let x56 = c_q12 * x29;
-        let x57 = s_q12 * x47;
-        let x58 = x56 - x57;
-        let x59 = x21 * x29 + x22 * x47 + x20 * x48;
-        let x60 = s_q12 * x29 + c_q12 * x47;
-        let x61 = x23 * x48 - x60;
-        let x62 = x61 + -15.926400000000001;
-        let x63 = c_q12 * x49 - s_q12 * x46;
-        let x64 = c_q12 * x45 - s_q12 * x51;
-        let x65 = c_q12 * x50 - s_q12 * x52;
-        let x66 = x21 * x49 + x22 * x46 + x20 * x53;
-        let x67 = x21 * x45 + x22 * x51 + x20 * x54;
-        let x68 = x21 * x50 + x22 * x52 + x20 * x55;
-        let x69 = x23 * x53 - (s_q12 * x49 + c_q12 * x46);
-        let x70 = x23 * x54 - (s_q12 * x45 + c_q12 * x51);
-        let x71 = x23 * x55 - (s_q12 * x50 + c_q12 * x52);
-        let x72 = x21 * x63 + x22 * x64 + x20 * x65;
-        let x73 = c_q12 * x66 - s_q12 * x67;
-        let x74 = x23 * x68 - (s_q12 * x66 + c_q12 * x67) - -0.36 * x59;
-        let x75 = 0.9304999999999999
-            + (c_q12 * x63 - s_q12 * x64 - x61 * 0.36 + -0.36 * x62);
-        let x76 = 0.01675 + (x23 * x65 - (s_q12 * x63 + c_q12 * x64) + x58 * 0.36);
-        let x77 = 0.939 + (x21 * x66 + x22 * x67 + x20 * x68 + -0.36 * x61 - x62 * 0.36);
-        let x78 = 0.07271 + (x23 * x71 - (s_q12 * x69 + c_q12 * x70));
-        let x79 = c_q11 * x58 - s_q11 * x59;
-        let x80 = s_q11 * x58 + c_q11 * x59;
-        let x81 = x18 * (-3.0149999999999997 + x62);
-        let x82 = x80 + -38.423700000000004;
-        let x83 = x81 + -16.772250000000003;
-        let x84 = c_q11 * x75 - s_q11 * x73;
-        let x85 = c_q11 * x72 - s_q11 * x77;
-        let x86 = c_q11 * x76 - s_q11 * x74;
-        let x87 = s_q11 * x75 + c_q11 * x73;
-        let x88 = s_q11 * x72 + c_q11 * x77;
-        let x89 = s_q11 * x76 + c_q11 * x74;
-        let x90 = x18 * (0.01675 + (c_q12 * x69 - s_q12 * x70 - -0.36 * x58));
-        let x91 = x18 * (x21 * x69 + x22 * x70 + x20 * x71 + x59 * 0.36);
-        let x92 = x18 * x78;
-        let x93 = 0.275 * x79;
-        let x94 = -0.275 * x80;
-        let x95 = x80 * 0.63;
-        let x96 = s_q11 * x84 + c_q11 * x85 - -0.63 * x79;
-        let x97 = c_q11 * x87 - s_q11 * x88 + x79 * 0.63;
-        let x98 = -6.7347 + x82;
-        let x99 = 4.170993
-            + (c_q11 * x84 - s_q11 * x85 - (0.275 * x81 - -0.63 * x80)
-                - (x82 * 0.63 - -0.275 * x83));
-        let x100 = -0.6328 + (x18 * x86 + x93);
-        let x101 = 3.8828625 + (s_q11 * x87 + c_q11 * x88 + -0.275 * x81 - 0.275 * x83);
-        let x102 = -1.8520425 + (x18 * x89 - x94 - -0.63 * x83);
-        let x103 = 4.0324305 + (x18 * x92 - x95 + -0.63 * x82);
-        let x104 = c_q10 * x79;
-        let x105 = x104 - s_q10 * x98;
-        let x106 = s_q10 * x79;
-        let x107 = x106 + c_q10 * x98;
-        let x108 = x16 * (-5.8795 + x83);
-        let x109 = x107 + -71.6619;
-        let x110 = c_q10 * x99 - s_q10 * x97;
-        let x111 = c_q10 * x96 - s_q10 * x101;
-        let x112 = c_q10 * x100 - s_q10 * x102;
-        let x113 = s_q10 * x99 + c_q10 * x97;
-        let x114 = s_q10 * x96 + c_q10 * x101;
-        let x115 = s_q10 * x100 + c_q10 * x102;
-        let x116 = x16 * (-0.6328 + (c_q11 * x90 - s_q11 * x91 - -0.275 * x79));
-        let x117 = x16
-            * (-1.8520425 + (s_q11 * x90 + c_q11 * x91 + x81 * 0.63 + 0.275 * x82));
-        let x118 = x16 * x103;
-        let x119 = x107 * 0.87;
-        let x120 = s_q10 * x110 + c_q10 * x111 - -0.87 * x105;
-        let x121 = s_q10 * x116 + c_q10 * x117 + x108 * 0.87;
-        let x122 = c_q10 * x113 - s_q10 * x114 + x105 * 0.87;
-        let x123 = x16 * x115 - -0.87 * x108;
-        let x124 = -9.87015 + x109;
-        let x125 = 4.395515250000001
-            + (c_q10 * x110 - s_q10 * x111 + -0.87 * x107 - x109 * 0.87);
-        let x126 = -0.00214 + x16 * x112;
-        let x127 = 3.378 + (s_q10 * x113 + c_q10 * x114);
-        let x128 = -0.00214 + (c_q10 * x116 - s_q10 * x117);
-        let x129 = 7.65251525 + (x16 * x118 - x119 + -0.87 * x109);
-        let x130 = x9 * x105 + x10 * x124 + x11 * x108;
-        let x131 = x12 * x105 + x13 * x124 + x8 * x108;
-        let x132 = c_q9 * x105 - s_q9 * x124 + x14 * x108;
-        let x133 = x131 + 28.891500000000004;
-        let x134 = x132 + 42.024;
-        let x135 = x9 * x125 + x10 * x122 + x11 * x128;
-        let x136 = x9 * x120 + x10 * x127 + x11 * x121;
-        let x137 = x9 * x126 + x10 * x123 + x11 * x129;
-        let x138 = x12 * x125 + x13 * x122 + x8 * x128;
-        let x139 = x12 * x120 + x13 * x127 + x8 * x121;
-        let x140 = x12 * x126 + x13 * x123 + x8 * x129;
-        let x141 = c_q9 * x125 - s_q9 * x122 + x14 * x128;
-        let x142 = c_q9 * x120 - s_q9 * x127 + x14 * x121;
-        let x143 = c_q9 * x126 - s_q9 * x123 + x14 * x129;
-        let x144 = x12 * x135 + x13 * x136 + x8 * x137 - 0.275 * x130;
-        let x145 = x9 * x138 + x10 * x139 + x11 * x140 + -0.275 * x130;
-        let x146 = c_q9 * x138 - s_q9 * x139 + x14 * x140 - 0.4 * x131 - 0.275 * x134;
-        let x147 = x12 * x141 + x13 * x142 + x8 * x143 + -0.275 * x132 + x133 * -0.4;
-        let x148 = 6.0 + x134;
-        let x149 = 3.3000000000000003
-            + (x9 * x135 + x10 * x136 + x11 * x137 - (x132 * -0.4 - 0.275 * x131)
-                - (-0.275 * x133 - 0.4 * x134));
-        let x150 = -0.00214 + (c_q9 * x135 - s_q9 * x136 + x14 * x137 + x130 * -0.4);
-        let x151 = 2.5780000000000003
-            + (x12 * x138 + x13 * x139 + x8 * x140 + 0.4 * x132 - x134 * -0.4);
-        let x152 = -0.00214 + (x9 * x141 + x10 * x142 + x11 * x143 - 0.4 * x130);
-        let x153 = 2.359
-            + (c_q9 * x141 - s_q9 * x142 + x14 * x143 - -0.275 * x131 + 0.275 * x133);
-        let x154 = x4 * x130 - x5 * x133 + x3 * x148;
-        let x155 = s_q8 * x130 + c_q8 * x133;
-        let x156 = c_q8 * x130;
-        let x157 = s_q8 * x133;
-        let x158 = x157 - x156 + x6 * x148;
-        let x159 = x158 + 47.271;
-        let x160 = x4 * x149 - x5 * x145 + x3 * x152;
-        let x161 = x4 * x144 - x5 * x151 + x3 * x147;
-        let x162 = x4 * x150 - x5 * x146 + x3 * x153;
-        let x163 = s_q8 * x149 + c_q8 * x145;
-        let x164 = s_q8 * x144 + c_q8 * x151;
-        let x165 = s_q8 * x150 + c_q8 * x146;
-        let x166 = s_q8 * x146 - c_q8 * x150 + x6 * x153;
-        let x167 = 2.29018125
-            + (x4 * x160 - x5 * x161 + x3 * x162 - x158 * -0.35 + 0.35 * x159);
-        let x168 = -0.07309 + (s_q8 * x160 + c_q8 * x161);
-        let x169 = 0.00071 + (s_q8 * x161 - c_q8 * x160 + x6 * x162 + x154 * -0.35);
-        let x170 = -0.07309 + (x4 * x163 - x5 * x164 + x3 * x165);
-        let x171 = 1.5853812499999997
-            + (s_q8 * x163 + c_q8 * x164 + 0.35 * x158 - x159 * -0.35);
-        let x172 = 0.1132 + (s_q8 * x164 - c_q8 * x163 + x6 * x165 - 0.35 * x155);
-        let x173 = 1.331
-            + (s_q8 * (s_q8 * x151 - c_q8 * x144 + x6 * x147)
-                - c_q8 * (s_q8 * x145 - c_q8 * x149 + x6 * x152) + x6 * x166);
-        let x174 = c_q7 * x154 - s_q7 * x155;
-        let x175 = s_q7 * x154 + c_q7 * x155;
-        let x176 = x1 * (6.1267499999999995 + x159);
-        let x177 = x174 + 110.5455;
-        let x178 = x176 + 127.5525;
-        let x179 = c_q7 * x167 - s_q7 * x170;
-        let x180 = c_q7 * x168 - s_q7 * x171;
-        let x181 = c_q7 * x169 - s_q7 * x172;
-        let x182 = s_q7 * x169 + c_q7 * x172;
-        let x183 = x1 * x173;
-        let x184 = -x175;
-        let x185 = x174 * -0.75;
-        let x186 = 0.75 * x175;
-        let x187 = 0.65 * x174;
-        let x188 = x1 * x182 - x186;
-        let x189 = -x178;
-        let x190 = -x177;
-        let x191 = s_q7 * x179 + c_q7 * x180 - 0.65 * x175;
-        let x192 = x1 * x181 + x185 + x178 * -0.65;
-        let x193 = 1200.0 + (c_q7 * x179 - s_q7 * x180 - x176 * -0.75 + 0.75 * x178);
-        let x194 = 1200.0
-            + (s_q7 * (s_q7 * x167 + c_q7 * x170) + c_q7 * (s_q7 * x168 + c_q7 * x171)
-                - (x174 * -0.65 - 0.75 * x176) - (x178 * -0.75 - 0.65 * x177));
-        let x195 = 1200.0 + (x1 * x183 + x187 - x177 * -0.65);
-        let x196 = x181 + x185;
-        let x197 = x182 - x186;
-        let x198 = x183 + x187;
-        let x199 = x4 * x133 + x5 * x130;
-        let x200 = x156 - x157;
-        let x201 = x162 + -0.35 * x200;
-        let x202 = x165 - 0.35 * x199;
-        let x203 = c_q7 * x199 + s_q7 * x200;
-        let x204 = -x203;
-        let x205 = c_q7 * x200 - s_q7 * x199;
-        let x206 = x1 * x155;
-        let x207 = c_q7 * x201 - s_q7 * x202 + -0.75 * x205;
-        let x208 = s_q7 * x201 + c_q7 * x202 + (-0.65 * x206 - 0.75 * x203);
-        let x209 = x1 * x166 + 0.65 * x205;
-        let x210 = x10 * x105;
-        let x211 = x210 - x9 * x124;
-        let x212 = x13 * x105;
-        let x213 = x212 - x12 * x124;
-        let x214 = s_q9 * x105;
-        let x215 = c_q9 * x124 + x214;
-        let x216 = x137 + (-0.4 * x213 - 0.275 * x215);
-        let x217 = x140 + 0.4 * x211;
-        let x218 = x143 + -0.275 * x211;
-        let x219 = x4 * x211 - x5 * x213 - x3 * x215;
-        let x220 = s_q8 * x211 + c_q8 * x213;
-        let x221 = s_q8 * x217 - c_q8 * x216 + x6 * x218;
-        let x222 = x4 * x216 - x5 * x217 + x3 * x218 + -0.35 * x220;
-        let x223 = s_q8 * x216 + c_q8 * x217 + 0.35 * x219;
-        let x224 = c_q7 * x219 - s_q7 * x220;
-        let x225 = s_q7 * x219 + c_q7 * x220;
-        let x226 = x1 * (s_q8 * x213 - c_q8 * x211 - x6 * x215);
-        let x227 = c_q7 * x222 - s_q7 * x223 + -0.75 * x225;
-        let x228 = s_q7 * x222 + c_q7 * x223 + (0.75 * x224 + -0.65 * x226);
-        let x229 = x1 * x221 + 0.65 * x225;
-        let x230 = x118 - x119;
-        let x231 = x210 - x9 * x107;
-        let x232 = x212 - x12 * x107;
-        let x233 = x214 + c_q9 * x107;
-        let x234 = x9 * x112 + x10 * x115 + x11 * x230 + (-0.4 * x232 - 0.275 * x233);
-        let x235 = x12 * x112 + x13 * x115 + x8 * x230 + 0.4 * x231;
-        let x236 = c_q9 * x112 - s_q9 * x115 + x14 * x230 + -0.275 * x231;
-        let x237 = x4 * x231 - x5 * x232 - x3 * x233;
-        let x238 = s_q8 * x231 + c_q8 * x232;
-        let x239 = s_q8 * x235 - c_q8 * x234 + x6 * x236;
-        let x240 = x4 * x234 - x5 * x235 + x3 * x236 + -0.35 * x238;
-        let x241 = s_q8 * x234 + c_q8 * x235 + 0.35 * x237;
-        let x242 = c_q7 * x237 - s_q7 * x238;
-        let x243 = s_q7 * x237 + c_q7 * x238;
-        let x244 = x1 * (s_q8 * x232 - c_q8 * x231 - x6 * x233);
-        let x245 = c_q7 * x240 - s_q7 * x241 + -0.75 * x243;
-        let x246 = s_q7 * x240 + c_q7 * x241 + (0.75 * x242 + -0.65 * x244);
-        let x247 = x1 * x239 + 0.65 * x243;
-        let x248 = x86 + x93;
-        let x249 = x89 - x94;
-        let x250 = x92 - x95;
-        let x251 = x106 + c_q10 * x80;
-        let x252 = x104 - s_q10 * x80;
-        let x253 = c_q10 * x248 - s_q10 * x249;
-        let x254 = s_q10 * x248 + c_q10 * x249;
-        let x255 = x16 * x250 - 0.87 * x251;
-        let x256 = x10 * x252 - x9 * x251;
-        let x257 = x13 * x252 - x12 * x251;
-        let x258 = c_q9 * x251 + s_q9 * x252;
-        let x259 = x9 * x253 + x10 * x254 + x11 * x255 + (-0.4 * x257 - 0.275 * x258);
-        let x260 = x12 * x253 + x13 * x254 + x8 * x255 + 0.4 * x256;
-        let x261 = c_q9 * x253 - s_q9 * x254 + x14 * x255 + -0.275 * x256;
-        let x262 = x4 * x256 - x5 * x257 - x3 * x258;
-        let x263 = s_q8 * x256 + c_q8 * x257;
-        let x264 = s_q8 * x260 - c_q8 * x259 + x6 * x261;
-        let x265 = x4 * x259 - x5 * x260 + x3 * x261 + -0.35 * x263;
-        let x266 = s_q8 * x259 + c_q8 * x260 + 0.35 * x262;
-        let x267 = c_q7 * x262 - s_q7 * x263;
-        let x268 = s_q7 * x262 + c_q7 * x263;
-        let x269 = x1 * (s_q8 * x257 - c_q8 * x256 - x6 * x258);
-        let x270 = c_q7 * x265 - s_q7 * x266 + -0.75 * x268;
-        let x271 = s_q7 * x265 + c_q7 * x266 + (0.75 * x267 + -0.65 * x269);
-        let x272 = x1 * x264 + 0.65 * x268;
-        let x273 = x22 * x29 - x21 * x47;
-        let x274 = x65 + 0.36 * x273;
-        let x275 = x68 - -0.36 * x60;
-        let x276 = c_q11 * x60 + s_q11 * x273;
-        let x277 = c_q11 * x273 - s_q11 * x60;
-        let x278 = x18 * (x57 - x56);
-        let x279 = c_q11 * x274 - s_q11 * x275 + (0.275 * x277 + -0.63 * x278);
-        let x280 = s_q11 * x274 + c_q11 * x275 - -0.275 * x276;
-        let x281 = x18 * x71 - 0.63 * x276;
-        let x282 = c_q10 * x276 + s_q10 * x277;
-        let x283 = c_q10 * x277 - s_q10 * x276;
-        let x284 = x16 * x278;
-        let x285 = s_q10 * x279 + c_q10 * x280;
-        let x286 = c_q10 * x279 - s_q10 * x280 + -0.87 * x284;
-        let x287 = x16 * x281 - 0.87 * x282;
-        let x288 = x10 * x283 - x9 * x282 + x11 * x284;
-        let x289 = x13 * x283 - x12 * x282 + x8 * x284;
-        let x290 = x14 * x284 - (c_q9 * x282 + s_q9 * x283);
-        let x291 = x9 * x286 + x10 * x285 + x11 * x287 + (-0.4 * x289 + 0.275 * x290);
-        let x292 = x12 * x286 + x13 * x285 + x8 * x287 + 0.4 * x288;
-        let x293 = c_q9 * x286 - s_q9 * x285 + x14 * x287 + -0.275 * x288;
-        let x294 = x4 * x288 - x5 * x289 + x3 * x290;
-        let x295 = s_q8 * x288 + c_q8 * x289;
-        let x296 = s_q8 * x292 - c_q8 * x291 + x6 * x293;
-        let x297 = x4 * x291 - x5 * x292 + x3 * x293 + -0.35 * x295;
-        let x298 = s_q8 * x291 + c_q8 * x292 + 0.35 * x294;
-        let x299 = c_q7 * x294 - s_q7 * x295;
-        let x300 = s_q7 * x294 + c_q7 * x295;
-        let x301 = x1 * (s_q8 * x289 - c_q8 * x288 + x6 * x290);
-        let x302 = c_q7 * x297 - s_q7 * x298 + -0.75 * x300;
-        let x303 = s_q7 * x297 + c_q7 * x298 + (0.75 * x299 + -0.65 * x301);
-        let x304 = x1 * x296 + 0.65 * x300;
-        let x305 = x26 * -4.806620000000001;
-        let x306 = s_q13 * -4.806620000000001;
-        let x307 = c_q13 * -4.806620000000001;
-        let x308 = x36 + (-0.16 * x306 - 0.55 * x307);
-        let x309 = x41 + 0.16 * x305;
-        let x310 = x44 + -0.55 * x305;
-        let x311 = c_q12 * x305 - s_q12 * x306;
-        let x312 = x21 * x305 + x22 * x306 - x20 * x307;
-        let x313 = x23 * x310 - (s_q12 * x308 + c_q12 * x309);
-        let x314 = c_q12 * x308 - s_q12 * x309 + 0.36 * x312;
-        let x315 = x21 * x308 + x22 * x309 + x20 * x310 + -0.36 * x311;
-        let x316 = c_q11 * x311 - s_q11 * x312;
-        let x317 = s_q11 * x311 + c_q11 * x312;
-        let x318 = x18 * (s_q12 * x305 + c_q12 * x306 + x23 * x307);
-        let x319 = c_q11 * x314 - s_q11 * x315 + (0.275 * x317 - -0.63 * x318);
-        let x320 = s_q11 * x314 + c_q11 * x315 + -0.275 * x316;
-        let x321 = x18 * x313 + 0.63 * x316;
-        let x322 = c_q10 * x316 - s_q10 * x317;
-        let x323 = s_q10 * x316 + c_q10 * x317;
-        let x324 = x16 * x318;
-        let x325 = s_q10 * x319 + c_q10 * x320;
-        let x326 = c_q10 * x319 - s_q10 * x320 - -0.87 * x324;
-        let x327 = x16 * x321 + 0.87 * x322;
-        let x328 = x9 * x322 + x10 * x323 - x11 * x324;
-        let x329 = x12 * x322 + x13 * x323 - x8 * x324;
-        let x330 = c_q9 * x322 - s_q9 * x323 - x14 * x324;
-        let x331 = x9 * x326 + x10 * x325 + x11 * x327 + (-0.4 * x329 + 0.275 * x330);
-        let x332 = x12 * x326 + x13 * x325 + x8 * x327 + 0.4 * x328;
-        let x333 = c_q9 * x326 - s_q9 * x325 + x14 * x327 + -0.275 * x328;
-        let x334 = x4 * x328 - x5 * x329 + x3 * x330;
-        let x335 = s_q8 * x328 + c_q8 * x329;
-        let x336 = s_q8 * x332 - c_q8 * x331 + x6 * x333;
-        let x337 = x4 * x331 - x5 * x332 + x3 * x333 + -0.35 * x335;
-        let x338 = s_q8 * x331 + c_q8 * x332 + 0.35 * x334;
-        let x339 = c_q7 * x334 - s_q7 * x335;
-        let x340 = s_q7 * x334 + c_q7 * x335;
-        let x341 = x1 * (s_q8 * x329 - c_q8 * x328 + x6 * x330);
-        let x342 = c_q7 * x337 - s_q7 * x338 + -0.75 * x340;
-        let x343 = s_q7 * x337 + c_q7 * x338 + (0.75 * x339 + -0.65 * x341);
-        let x344 = x1 * x336 + 0.65 * x340;
-        let x345 = v[3] * 1200.0;
-        let x346 = v[4] * 1200.0;
-        let x347 = v[5] * 1200.0;
-        let x348 = v[0] * 1000.0;
-        let x349 = v[1] * 1000.0;
-        let x350 = v[2] * 1000.0;
-        let x351 = v[3] * c_q7 + v[4] * s_q7;
-        let x352 = v[4] * c_q7 - v[3] * s_q7;
-        let x353 = v[0] - v[4] * -0.75;
-        let x354 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x355 = c_q7 * x353 + s_q7 * x354;
-        let x356 = c_q7 * x354 - s_q7 * x353;
-        let x357 = x1 * (v[2] - 0.65 * v[4]);
-        let x358 = v[6] + v[5] * x1;
-        let x359 = v[6] * x352;
-        let x360 = v[6] * x351;
-        let x361 = v[6] * x356;
-        let x362 = v[6] * x355;
-        let x363 = 0.00071 * x351 + 0.1132 * x352 + 1.331 * x358;
-        let x364 = 2.29018125 * x351 + -0.07309 * x352 + 0.00071 * x358
-            + x356 * -6.1267499999999995;
-        let x365 = -0.07309 * x351 + 1.5853812499999997 * x352 + 0.1132 * x358
-            + 6.1267499999999995 * x355;
-        let x366 = 35.01 * x357;
-        let x367 = 35.01 * x355 - x352 * -6.1267499999999995;
-        let x368 = 35.01 * x356 - 6.1267499999999995 * x351;
-        let x369 = x4 * x351 + s_q8 * x352 - c_q8 * x358;
-        let x370 = c_q8 * x352 - x5 * x351 + s_q8 * x358;
-        let x371 = x355 - -0.35 * x352;
-        let x372 = x356 - 0.35 * x351;
-        let x373 = x4 * x371 + s_q8 * x372 - c_q8 * x357;
-        let x374 = c_q8 * x372 - x5 * x371 + s_q8 * x357;
-        let x375 = x3 * x371 + x6 * x357;
-        let x376 = v[7] + (x3 * x351 + x6 * x358);
-        let x377 = x3 * x359;
-        let x378 = x361 + -0.35 * x360;
-        let x379 = x362 + 0.35 * x359;
-        let x380 = x3 * x378;
-        let x381 = x4 * x359 - s_q8 * x360 + v[7] * x370;
-        let x382 = x5 * x359 + c_q8 * x360 + v[7] * x369;
-        let x383 = x4 * x378 - s_q8 * x379 + v[7] * x374;
-        let x384 = x5 * x378 + c_q8 * x379 + v[7] * x373;
-        let x385 = -0.00214 * x369 + 2.359 * x376;
-        let x386 = 3.3000000000000003 * x369 + -0.00214 * x376 + x374 * -6.0;
-        let x387 = 2.5780000000000003 * x370 + 6.0 * x373;
-        let x388 = 30.0 * x375;
-        let x389 = 30.0 * x373 - x370 * -6.0;
-        let x390 = 30.0 * x374 - 6.0 * x369;
-        let x391 = x9 * x369 + x12 * x370 + c_q9 * x376;
-        let x392 = x10 * x369 + x13 * x370 - s_q9 * x376;
-        let x393 = x373 - (-0.4 * x370 + 0.275 * x376);
-        let x394 = x374 - 0.4 * x369;
-        let x395 = x375 - -0.275 * x369;
-        let x396 = x9 * x393 + x12 * x394 + c_q9 * x395;
-        let x397 = x10 * x393 + x13 * x394 - s_q9 * x395;
-        let x398 = x11 * x393 + x8 * x394 + x14 * x395;
-        let x399 = v[8] + (x11 * x369 + x8 * x370 + x14 * x376);
-        let x400 = x11 * x381 - x8 * x382 + x14 * x377;
-        let x401 = x383 - (0.275 * x377 - -0.4 * x382);
-        let x402 = x384 + 0.4 * x381;
-        let x403 = x380 - -0.275 * x381;
-        let x404 = x11 * x401 - x8 * x402 + x14 * x403;
-        let x405 = x9 * x381 - x12 * x382 + c_q9 * x377 + v[8] * x392;
-        let x406 = x10 * x381 - x13 * x382 - s_q9 * x377 - v[8] * x391;
-        let x407 = x9 * x401 - x12 * x402 + c_q9 * x403 + v[8] * x397;
-        let x408 = x10 * x401 - x13 * x402 - s_q9 * x403 - v[8] * x396;
-        let x409 = 3.378 * x392;
-        let x410 = 4.395515250000001 * x391 + -0.00214 * x399 + -9.87015 * x398;
-        let x411 = -0.00214 * x391 + 7.65251525 * x399 + x396 * 9.87015;
-        let x412 = 22.69 * x397;
-        let x413 = 22.69 * x396 - -9.87015 * x399;
-        let x414 = 22.69 * x398 - x391 * 9.87015;
-        let x415 = c_q10 * x391 + s_q10 * x392;
-        let x416 = c_q10 * x392 - s_q10 * x391;
-        let x417 = x396 - -0.87 * x399;
-        let x418 = c_q10 * x417 + s_q10 * x397;
-        let x419 = c_q10 * x397 - s_q10 * x417;
-        let x420 = x16 * (x398 - 0.87 * x391);
-        let x421 = v[9] + x16 * x399;
-        let x422 = x16 * x400;
-        let x423 = x407 - -0.87 * x400;
-        let x424 = x16 * (x404 - 0.87 * x405);
-        let x425 = c_q10 * x405 + s_q10 * x406 + v[9] * x416;
-        let x426 = c_q10 * x406 - s_q10 * x405 - v[9] * x415;
-        let x427 = c_q10 * x423 + s_q10 * x408 + v[9] * x419;
-        let x428 = c_q10 * x408 - s_q10 * x423 - v[9] * x418;
-        let x429 = 4.170993 * x415 + -0.6328 * x421 + (x419 * 5.8795 + -6.7347 * x420);
-        let x430 = 3.8828625 * x416 + -1.8520425 * x421 + -5.8795 * x418;
-        let x431 = -0.6328 * x415 + -1.8520425 * x416 + 4.0324305 * x421 + x418 * 6.7347;
-        let x432 = 21.38 * x418 - (x416 * 5.8795 + -6.7347 * x421);
-        let x433 = 21.38 * x419 - -5.8795 * x415;
-        let x434 = 21.38 * x420 - x415 * 6.7347;
-        let x435 = c_q11 * x415 + s_q11 * x416;
-        let x436 = c_q11 * x416 - s_q11 * x415;
-        let x437 = x418 - (0.275 * x416 + -0.63 * x421);
-        let x438 = x419 - -0.275 * x415;
-        let x439 = c_q11 * x437 + s_q11 * x438;
-        let x440 = c_q11 * x438 - s_q11 * x437;
-        let x441 = x18 * (x420 - 0.63 * x415);
-        let x442 = v[10] + x18 * x421;
-        let x443 = x18 * x422;
-        let x444 = x427 - (0.275 * x426 + -0.63 * x422);
-        let x445 = x428 - -0.275 * x425;
-        let x446 = x18 * (x424 - 0.63 * x425);
-        let x447 = c_q11 * x425 + s_q11 * x426 + v[10] * x436;
-        let x448 = c_q11 * x426 - s_q11 * x425 - v[10] * x435;
-        let x449 = c_q11 * x444 + s_q11 * x445 + v[10] * x440;
-        let x450 = c_q11 * x445 - s_q11 * x444 - v[10] * x439;
-        let x451 = 0.01675 * x435 + 0.07271 * x442;
-        let x452 = 0.9304999999999999 * x435 + 0.01675 * x442
-            + x440 * 3.0149999999999997;
-        let x453 = 0.939 * x436 + -3.0149999999999997 * x439;
-        let x454 = 16.75 * x441;
-        let x455 = 16.75 * x439 - x436 * 3.0149999999999997;
-        let x456 = 16.75 * x440 - -3.0149999999999997 * x435;
-        let x457 = c_q12 * x435 + x21 * x436 - s_q12 * x442;
-        let x458 = x22 * x436 - s_q12 * x435 - c_q12 * x442;
-        let x459 = x439 - 0.36 * x436;
-        let x460 = x440 - -0.36 * x435;
-        let x461 = c_q12 * x459 + x21 * x460 - s_q12 * x441;
-        let x462 = x22 * x460 - s_q12 * x459 - c_q12 * x441;
-        let x463 = x20 * x460 + x23 * x441;
-        let x464 = v[11] + (x20 * x436 + x23 * x442);
-        let x465 = x20 * x448 + x23 * x443;
-        let x466 = x449 - 0.36 * x448;
-        let x467 = x450 - -0.36 * x447;
-        let x468 = x20 * x467 + x23 * x446;
-        let x469 = c_q12 * x447 + x21 * x448 - s_q12 * x443 + v[11] * x458;
-        let x470 = x22 * x448 - s_q12 * x447 - c_q12 * x443 - v[11] * x457;
-        let x471 = c_q12 * x466 + x21 * x467 - s_q12 * x446 + v[11] * x462;
-        let x472 = x22 * x467 - s_q12 * x466 - c_q12 * x446 - v[11] * x461;
-        let x473 = 3.2217582500000006 * x457 + -0.2313 * x464
-            + (x462 * -4.187200000000001 + 7.196750000000001 * x463);
-        let x474 = 1.2686520000000001 * x458 + -1.1514800000000003 * x464
-            + 4.187200000000001 * x461;
-        let x475 = -0.2313 * x457 + -1.1514800000000003 * x458
-            + 2.1079062500000005 * x464 + x461 * -7.196750000000001;
-        let x476 = 26.17 * x461 - (x458 * -4.187200000000001 + 7.196750000000001 * x464);
-        let x477 = 26.17 * x462 - 4.187200000000001 * x457;
-        let x478 = 26.17 * x463 - x457 * -7.196750000000001;
-        let x479 = x26 * x457 + s_q13 * x458 - c_q13 * x464;
-        let x480 = c_q13 * x458 - x27 * x457 + s_q13 * x464;
-        let x481 = x461 - (-0.16 * x458 + 0.55 * x464);
-        let x482 = x462 - 0.16 * x457;
-        let x483 = x463 - -0.55 * x457;
-        let x484 = x26 * x481 + s_q13 * x482 - c_q13 * x483;
-        let x485 = c_q13 * x482 - x27 * x481 + s_q13 * x483;
-        let x486 = x25 * x481 + x28 * x483;
-        let x487 = v[12] + (x25 * x457 + x28 * x464);
-        let x488 = x25 * x469 + x28 * x465;
-        let x489 = x471 - (-0.16 * x470 + 0.55 * x465);
-        let x490 = x472 - 0.16 * x469;
-        let x491 = x468 - -0.55 * x469;
-        let x492 = x25 * x489 + x28 * x491;
-        let x493 = x26 * x469 + s_q13 * x470 - c_q13 * x465 + v[12] * x480;
-        let x494 = c_q13 * x470 - x27 * x469 + s_q13 * x465 - v[12] * x479;
-        let x495 = x26 * x489 + s_q13 * x490 - c_q13 * x491 + v[12] * x485;
-        let x496 = c_q13 * x490 - x27 * x489 + s_q13 * x491 - v[12] * x484;
-        let x497 = 2.1663609200000002 * x479 + 0.000781 * x480 + -0.0145 * x487
-            + (-3.6140000000000003 * x485 + 4.806620000000001 * x486);
-        let x498 = 0.000781 * x479 + 0.9638000000000001 * x480
-            + -0.9614610000000001 * x487 + 3.6140000000000003 * x484;
-        let x499 = -0.0145 * x479 + -0.9614610000000001 * x480
-            + 1.4135609200000003 * x487 + -4.806620000000001 * x484;
-        let x500 = 18.07 * x484
-            - (-3.6140000000000003 * x480 + 4.806620000000001 * x487);
-        let x501 = 18.07 * x485 - 3.6140000000000003 * x479;
-        let x502 = 18.07 * x486 - -4.806620000000001 * x479;
-        let x503 = 2.1663609200000002 * x493 + 0.000781 * x494 + -0.0145 * x488
-            + (-3.6140000000000003 * x496 + 4.806620000000001 * x492)
-            + (x480 * x499 - x487 * x498 + (x485 * x502 - x486 * x501));
-        let x504 = 0.000781 * x493 + 0.9638000000000001 * x494
-            + -0.9614610000000001 * x488 + 3.6140000000000003 * x495
-            + (x487 * x497 - x479 * x499 + (x486 * x500 - x484 * x502));
-        let x505 = -0.0145 * x493 + -0.9614610000000001 * x494
-            + 1.4135609200000003 * x488 + -4.806620000000001 * x495
-            + (x479 * x498 - x480 * x497 + (x484 * x501 - x485 * x500));
-        let x506 = 18.07 * x495 - (-3.6140000000000003 * x494 + 4.806620000000001 * x488)
-            + (x480 * x502 - x487 * x501);
-        let x507 = 18.07 * x496 - 3.6140000000000003 * x493
-            + (x487 * x500 - x479 * x502);
-        let x508 = 18.07 * x492 - -4.806620000000001 * x493
-            + (x479 * x501 - x480 * x500);
-        let x509 = x26 * x506 - x27 * x507 + x25 * x508;
-        let x510 = s_q13 * x506 + c_q13 * x507;
-        let x511 = s_q13 * x507 - c_q13 * x506 + x28 * x508;
-        let x512 = 3.2217582500000006 * x469 + -0.2313 * x465
-            + (x472 * -4.187200000000001 + 7.196750000000001 * x468)
-            + (x458 * x475 - x464 * x474 + (x462 * x478 - x463 * x477))
-            + (x26 * x503 - x27 * x504 + x25 * x505 + (-0.16 * x510 + 0.55 * x511));
-        let x513 = 1.2686520000000001 * x470 + -1.1514800000000003 * x465
-            + 4.187200000000001 * x471
-            + (x464 * x473 - x457 * x475 + (x463 * x476 - x461 * x478))
-            + (s_q13 * x503 + c_q13 * x504 + 0.16 * x509);
-        let x514 = -0.2313 * x469 + -1.1514800000000003 * x470
-            + 2.1079062500000005 * x465 + x471 * -7.196750000000001
-            + (x457 * x474 - x458 * x473 + (x461 * x477 - x462 * x476))
-            + (s_q13 * x504 - c_q13 * x503 + x28 * x505 + -0.55 * x509);
-        let x515 = 26.17 * x471 - (x470 * -4.187200000000001 + 7.196750000000001 * x465)
-            + (x458 * x478 - x464 * x477) + x509;
-        let x516 = 26.17 * x472 - 4.187200000000001 * x469 + (x464 * x476 - x457 * x478)
-            + x510;
-        let x517 = 26.17 * x468 - x469 * -7.196750000000001 + (x457 * x477 - x458 * x476)
-            + x511;
-        let x518 = c_q12 * x515 - s_q12 * x516;
-        let x519 = x21 * x515 + x22 * x516 + x20 * x517;
-        let x520 = 0.9304999999999999 * x447 + 0.01675 * x443 + x450 * 3.0149999999999997
-            + (x436 * x451 - x442 * x453 + (x440 * x454 - x441 * x456))
-            + (c_q12 * x512 - s_q12 * x513 + 0.36 * x519);
-        let x521 = 0.939 * x448 + -3.0149999999999997 * x449
-            + (x442 * x452 - x435 * x451 + (x441 * x455 - x439 * x454))
-            + (x21 * x512 + x22 * x513 + x20 * x514 + -0.36 * x518);
-        let x522 = 0.01675 * x447 + 0.07271 * x443
-            + (x435 * x453 - x436 * x452 + (x439 * x456 - x440 * x455))
-            + (x23 * x514 - (s_q12 * x512 + c_q12 * x513));
-        let x523 = 16.75 * x449 - x448 * 3.0149999999999997 + (x436 * x454 - x442 * x456)
-            + x518;
-        let x524 = 16.75 * x450 - -3.0149999999999997 * x447
-            + (x442 * x455 - x435 * x454) + x519;
-        let x525 = c_q11 * x523 - s_q11 * x524;
-        let x526 = s_q11 * x523 + c_q11 * x524;
-        let x527 = x18
-            * (16.75 * x446 + (x435 * x456 - x436 * x455)
-                + (x23 * x517 - (s_q12 * x515 + c_q12 * x516)));
-        let x528 = 4.170993 * x425 + -0.6328 * x422 + (x428 * 5.8795 + -6.7347 * x424)
-            + (x416 * x431 - x421 * x430 + (x419 * x434 - x420 * x433))
-            + (c_q11 * x520 - s_q11 * x521 + (0.275 * x526 + -0.63 * x527));
-        let x529 = 3.8828625 * x426 + -1.8520425 * x422 + -5.8795 * x427
-            + (x421 * x429 - x415 * x431 + (x420 * x432 - x418 * x434))
-            + (s_q11 * x520 + c_q11 * x521 + -0.275 * x525);
-        let x530 = -0.6328 * x425 + -1.8520425 * x426 + 4.0324305 * x422 + x427 * 6.7347
-            + (x415 * x430 - x416 * x429 + (x418 * x433 - x419 * x432))
-            + (x18 * x522 + 0.63 * x525);
-        let x531 = 21.38 * x427 - (x426 * 5.8795 + -6.7347 * x422)
-            + (x416 * x434 - x421 * x433) + x525;
-        let x532 = 21.38 * x428 - -5.8795 * x425 + (x421 * x432 - x415 * x434) + x526;
-        let x533 = c_q10 * x531 - s_q10 * x532;
-        let x534 = x16
-            * (21.38 * x424 - x425 * 6.7347 + (x415 * x433 - x416 * x432) + x527);
-        let x535 = 4.395515250000001 * x405 + -0.00214 * x400 + -9.87015 * x404
-            + (x392 * x411 - x399 * x409 + (x397 * x414 - x398 * x412))
-            + (c_q10 * x528 - s_q10 * x529 + -0.87 * x534);
-        let x536 = 3.378 * x406
-            + (x399 * x410 - x391 * x411 + (x398 * x413 - x396 * x414))
-            + (s_q10 * x528 + c_q10 * x529);
-        let x537 = -0.00214 * x405 + 7.65251525 * x400 + x407 * 9.87015
-            + (x391 * x409 - x392 * x410 + (x396 * x412 - x397 * x413))
-            + (x16 * x530 + 0.87 * x533);
-        let x538 = 22.69 * x407 - -9.87015 * x400 + (x392 * x414 - x399 * x412) + x533;
-        let x539 = 22.69 * x408 + (x399 * x413 - x391 * x414)
-            + (s_q10 * x531 + c_q10 * x532);
-        let x540 = 22.69 * x404 - x405 * 9.87015 + (x391 * x412 - x392 * x413) + x534;
-        let x541 = x9 * x538 + x10 * x539 + x11 * x540;
-        let x542 = x12 * x538 + x13 * x539 + x8 * x540;
-        let x543 = c_q9 * x538 - s_q9 * x539 + x14 * x540;
-        let x544 = 3.3000000000000003 * x381 + -0.00214 * x377 - x384 * -6.0
-            + (x370 * x385 - x376 * x387 + (x374 * x388 - x375 * x390))
-            + (x9 * x535 + x10 * x536 + x11 * x537 + (-0.4 * x542 + 0.275 * x543));
-        let x545 = 6.0 * x383 - 2.5780000000000003 * x382
-            + (x376 * x386 - x369 * x385 + (x375 * x389 - x373 * x388))
-            + (x12 * x535 + x13 * x536 + x8 * x537 + 0.4 * x541);
-        let x546 = -0.00214 * x381 + 2.359 * x377
-            + (x369 * x387 - x370 * x386 + (x373 * x390 - x374 * x389))
-            + (c_q9 * x535 - s_q9 * x536 + x14 * x537 + -0.275 * x541);
-        let x547 = 30.0 * x383 + x382 * -6.0 + (x370 * x388 - x376 * x390) + x541;
-        let x548 = x376 * x389 - x369 * x388 - (30.0 * x384 + 6.0 * x381) + x542;
-        let x549 = 30.0 * x380 + (x369 * x390 - x370 * x389) + x543;
-        let x550 = x4 * x547 - x5 * x548 + x3 * x549;
-        let x551 = s_q8 * x547 + c_q8 * x548;
-        let x552 = 2.29018125 * x359 - -0.07309 * x360 - x362 * -6.1267499999999995
-            + (x352 * x363 - x358 * x365 + (x356 * x366 - x357 * x368))
-            + (x4 * x544 - x5 * x545 + x3 * x546 + -0.35 * x551);
-        let x553 = -0.07309 * x359 - 1.5853812499999997 * x360
-            + 6.1267499999999995 * x361
-            + (x358 * x364 - x351 * x363 + (x357 * x367 - x355 * x366))
-            + (s_q8 * x544 + c_q8 * x545 + 0.35 * x550);
-        let x554 = 0.00071 * x359 - 0.1132 * x360
-            + (x351 * x365 - x352 * x364 + (x355 * x368 - x356 * x367))
-            + (s_q8 * x545 - c_q8 * x544 + x6 * x546);
-        let x555 = 35.01 * x361 + x360 * -6.1267499999999995
-            + (x352 * x366 - x358 * x368) + x550;
-        let x556 = x358 * x367 - x351 * x366 - (35.01 * x362 + 6.1267499999999995 * x359)
-            + x551;
-        let x557 = c_q7 * x555 - s_q7 * x556;
-        let x558 = s_q7 * x555 + c_q7 * x556;
-        let x559 = x1
-            * (x351 * x368 - x352 * x367 + (s_q8 * x548 - c_q8 * x547 + x6 * x549));
-        let x560 = v[4] * x347 - v[5] * x346 + (v[1] * x350 - v[2] * x349)
-            + (c_q7 * x552 - s_q7 * x553 + -0.75 * x558);
-        let x561 = v[5] * x345 - v[3] * x347 + (v[2] * x348 - v[0] * x350)
-            + (s_q7 * x552 + c_q7 * x553 + (0.75 * x557 + -0.65 * x559));
-        let x562 = v[3] * x346 - v[4] * x345 + (v[0] * x349 - v[1] * x348)
-            + (x1 * x554 + 0.65 * x558);
-        let x563 = v[4] * x350 - v[5] * x349 + x557;
-        let x564 = v[5] * x348 - v[3] * x350 + x558;
-        let x565 = v[3] * x349 - v[4] * x348 + x559;
+        let x15 = -0.00000000020510342851533115 * c_q13;
+        let x16 = -0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = -0.0145 - 0.000781 * x16;
+        let x21 = -0.9614610000000001 + (0.000781 * x15 - -1.2025609200000003 * x16);
+        let x22 = 1.4135609200000003 + (-0.0145 * x15 - -0.9614610000000001 * x16);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = x24 + -1.2025609200000003 * c_q13;
+        let x26 = -0.0145 * s_q13 + -0.9614610000000001 * c_q13;
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = -1.2025609200000003 * s_q13 - x23 + 0.00000000019719894748377882;
+        let x29 = -0.9614610000000001 * s_q13 - -0.0145 * c_q13
+            + -0.0000000002899261911072858;
+        let x30 = -0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = 0.16 * x19;
+        let x33 = x18 * -0.55;
+        let x34 = x22 + (x15 * x20 - x16 * x21) - (x30 - x31) - (x33 - x32);
+        let x35 = 3.6140000000000003 - x17;
+        let x36 = 17.135250000000003 + x18;
+        let x37 = -1.9877000000000002 + (s_q13 * x20 + c_q13 * x21 + 0.55 * x17);
+        let x38 = -0.809539999555672
+            + (s_q13 * x21 - c_q13 * x20 + -0.00000000020510342851533115 * x22
+                - -0.16 * x17);
+        let x39 = -1.9877000000000002 + (x26 + (x15 * x23 - x16 * x25) - x17 * -0.55);
+        let x40 = -5.252920330000002 + (s_q13 * x23 + c_q13 * x25 + x32 - x30);
+        let x41 = -2.741639999592316
+            + (s_q13 * x25 - c_q13 * x23 + -0.00000000020510342851533115 * x26
+                - 0.16 * x18 - 0.55 * x19);
+        let x42 = -0.809539999555672 + (x29 + (x15 * x27 - x16 * x28) + 0.16 * x17);
+        let x43 = -2.7416399995923166
+            + (s_q13 * x27 + c_q13 * x28 + x19 * -0.55 + -0.16 * x18);
+        let x44 = 9.740442170000001
+            + (x31
+                + (s_q13 * x28 - c_q13 * x27 + -0.00000000020510342851533115 * x29
+                    - x33));
+        let x45 = c_q12 * x35;
+        let x46 = s_q12 * x36;
+        let x47 = x45 - x46;
+        let x48 = x19 + (x12 * x35 + x13 * x36);
+        let x49 = s_q12 * x35 + c_q12 * x36;
+        let x50 = -0.00000000020510342851533115 * x19 - x49;
+        let x51 = c_q12 * x34 - s_q12 * x39;
+        let x52 = c_q12 * x37 - s_q12 * x40;
+        let x53 = c_q12 * x38 - s_q12 * x41;
+        let x54 = x42 + (x12 * x34 + x13 * x39);
+        let x55 = x43 + (x12 * x37 + x13 * x40);
+        let x56 = x44 + (x12 * x38 + x13 * x41);
+        let x57 = -0.00000000020510342851533115 * x42 - (s_q12 * x34 + c_q12 * x39);
+        let x58 = -0.00000000020510342851533115 * x43 - (s_q12 * x37 + c_q12 * x40);
+        let x59 = -0.00000000020510342851533115 * x44 - (s_q12 * x38 + c_q12 * x41);
+        let x60 = x53 + (x12 * x51 + x13 * x52);
+        let x61 = c_q12 * x54 - s_q12 * x55;
+        let x62 = x50 * 0.36;
+        let x63 = -0.36 * x50;
+        let x64 = x63 + (c_q12 * x51 - s_q12 * x52 - x62);
+        let x65 = 7.078399999258757 + x48;
+        let x66 = 0.01675
+            + (-0.00000000020510342851533115 * x53 - (s_q12 * x51 + c_q12 * x52)
+                + x47 * 0.36);
+        let x67 = -9.142025249762803 + (x56 + (x12 * x54 + x13 * x55) + x63 - x62);
+        let x68 = 2.5482240016099564
+            + (-0.00000000020510342851533115 * x56 - (s_q12 * x54 + c_q12 * x55)
+                - -0.36 * x48);
+        let x69 = 0.01675 + (c_q12 * x57 - s_q12 * x58 - -0.36 * x47);
+        let x70 = 2.5482240016099564 + (x59 + (x12 * x57 + x13 * x58) + x48 * 0.36);
+        let x71 = 9.223235249762805
+            + (-0.00000000020510342851533115 * x59 - (s_q12 * x57 + c_q12 * x58));
+        let x72 = c_q11 * x47 - s_q11 * x65;
+        let x73 = s_q11 * x47 + c_q11 * x65;
+        let x74 = c_q11 * x64 - s_q11 * x61;
+        let x75 = c_q11 * x60 - s_q11 * x67;
+        let x76 = s_q11 * x64 + c_q11 * x61;
+        let x77 = s_q11 * x60 + c_q11 * x67;
+        let x78 = 0.275 * x50;
+        let x79 = -0.63 * x73;
+        let x80 = -0.275 * x50;
+        let x81 = x73 * 0.63;
+        let x82 = s_q11 * x74 + c_q11 * x75 - -0.63 * x72;
+        let x83 = c_q11 * x66 - s_q11 * x68 + 0.275 * x72;
+        let x84 = s_q11 * x66 + c_q11 * x68 - -0.275 * x73;
+        let x85 = x71 - x81;
+        let x86 = c_q11 * x74 - s_q11 * x75 - (x78 - x79) - (x81 - x80);
+        let x87 = c_q11 * x76 - s_q11 * x77 + x72 * 0.63;
+        let x88 = -45.1584 + x73;
+        let x89 = -0.6328 + x83;
+        let x90 = -24.4950615 + (s_q11 * x76 + c_q11 * x77 + x80 - x78);
+        let x91 = -24.35164200091464 + (x84 - -0.63 * x50);
+        let x92 = -0.6328 + (c_q11 * x69 - s_q11 * x70 - -0.275 * x72);
+        let x93 = -24.351642000914637
+            + (s_q11 * x69 + c_q11 * x70 + x50 * 0.63 + 0.275 * x73);
+        let x94 = 28.2393615 + (x79 + x85);
+        let x95 = c_q10 * x72;
+        let x96 = x95 - s_q10 * x88;
+        let x97 = s_q10 * x72;
+        let x98 = x97 + c_q10 * x88;
+        let x99 = c_q10 * x86 - s_q10 * x87;
+        let x100 = c_q10 * x82 - s_q10 * x90;
+        let x101 = c_q10 * x89 - s_q10 * x91;
+        let x102 = s_q10 * x86 + c_q10 * x87;
+        let x103 = s_q10 * x82 + c_q10 * x90;
+        let x104 = s_q10 * x89 + c_q10 * x91;
+        let x105 = -0.87 * x98;
+        let x106 = x98 * 0.87;
+        let x107 = s_q10 * x99 + c_q10 * x100 - -0.87 * x96;
+        let x108 = x94 - x106;
+        let x109 = c_q10 * x99 - s_q10 * x100 + x105 - x106;
+        let x110 = c_q10 * x102 - s_q10 * x103 + x96 * 0.87;
+        let x111 = -81.53205 + x98;
+        let x112 = -0.00214 + x101;
+        let x113 = -63.36336825000001 + (s_q10 * x102 + c_q10 * x103);
+        let x114 = -36.18604050126307 + (x104 - -0.87 * x50);
+        let x115 = -0.00214 + (c_q10 * x92 - s_q10 * x93);
+        let x116 = -36.18604050126307 + (s_q10 * x92 + c_q10 * x93 + x50 * 0.87);
+        let x117 = 69.99836825 + (x105 + x108);
+        let x118 = x5 * x96 + x6 * x111 + 0.00000000020510342851533115 * x50;
+        let x119 = x50 + (x7 * x96 + x8 * x111);
+        let x120 = c_q9 * x96 - s_q9 * x111 + -0.00000000020510342851533115 * x50;
+        let x121 = x5 * x109 + x6 * x110 + 0.00000000020510342851533115 * x115;
+        let x122 = x5 * x107 + x6 * x113 + 0.00000000020510342851533115 * x116;
+        let x123 = x5 * x112 + x6 * x114 + 0.00000000020510342851533115 * x117;
+        let x124 = x115 + (x7 * x109 + x8 * x110);
+        let x125 = x116 + (x7 * x107 + x8 * x113);
+        let x126 = x117 + (x7 * x112 + x8 * x114);
+        let x127 = c_q9 * x109 - s_q9 * x110 + -0.00000000020510342851533115 * x115;
+        let x128 = c_q9 * x107 - s_q9 * x113 + -0.00000000020510342851533115 * x116;
+        let x129 = c_q9 * x112 - s_q9 * x114 + -0.00000000020510342851533115 * x117;
+        let x130 = x120 * -0.4;
+        let x131 = 0.275 * x119;
+        let x132 = 0.4 * x120;
+        let x133 = -0.275 * x119;
+        let x134 = x5 * x121 + x6 * x122 + 0.00000000020510342851533115 * x123
+            - (x130 - x131) - (x133 - x132);
+        let x135 = -0.000000008530897668050218 + x118;
+        let x136 = -12.701650001451807 + x119;
+        let x137 = -0.0000000234896432582596
+            + (x123 + (x7 * x121 + x8 * x122) - 0.275 * x118);
+        let x138 = -0.0021399965876409276
+            + (c_q9 * x121 - s_q9 * x122 + -0.00000000020510342851533115 * x123
+                + x118 * -0.4);
+        let x139 = -0.0000000234896432582596
+            + (x5 * x124 + x6 * x125 + 0.00000000020510342851533115 * x126
+                + -0.275 * x118);
+        let x140 = -111.7548902508081 + (x126 + (x7 * x124 + x8 * x125) + x132 - x130);
+        let x141 = 5.080660024070365
+            + (c_q9 * x124 - s_q9 * x125 + -0.00000000020510342851533115 * x126
+                - 0.4 * x119 - 0.275 * x120);
+        let x142 = -0.0021399965876409276
+            + (x5 * x127 + x6 * x128 + 0.00000000020510342851533115 * x129 - 0.4 * x118);
+        let x143 = 5.080660024070366
+            + (x129 + (x7 * x127 + x8 * x128) + -0.275 * x120 + x119 * -0.4);
+        let x144 = 113.3918902508081
+            + (x131
+                + (c_q9 * x127 - s_q9 * x128 + -0.00000000020510342851533115 * x129
+                    - x133));
+        let x145 = x120 + (x2 * x135 - x3 * x136);
+        let x146 = s_q8 * x135 + c_q8 * x136;
+        let x147 = c_q8 * x135;
+        let x148 = s_q8 * x136;
+        let x149 = x148 - x147 + -0.00000000020510342851533115 * x120;
+        let x150 = x142 + (x2 * x134 - x3 * x139);
+        let x151 = x143 + (x2 * x137 - x3 * x140);
+        let x152 = x144 + (x2 * x138 - x3 * x141);
+        let x153 = s_q8 * x134 + c_q8 * x139;
+        let x154 = s_q8 * x137 + c_q8 * x140;
+        let x155 = s_q8 * x138 + c_q8 * x141;
+        let x156 = s_q8 * x141 - c_q8 * x138 + -0.00000000020510342851533115 * x144;
+        let x157 = x149 * -0.35;
+        let x158 = 0.35 * x149;
+        let x159 = x158 + (x152 + (x2 * x150 - x3 * x151) - x157);
+        let x160 = 48.0240000085309 + x145;
+        let x161 = -0.07309 + (s_q8 * x150 + c_q8 * x151);
+        let x162 = -16.80768997608804
+            + (s_q8 * x151 - c_q8 * x150 + -0.00000000020510342851533115 * x152
+                + x145 * -0.35);
+        let x163 = -0.07309 + (x155 + (x2 * x153 - x3 * x154));
+        let x164 = 130.43769025763282 + (s_q8 * x153 + c_q8 * x154 + x158 - x157);
+        let x165 = 0.1132
+            + (s_q8 * x154 - c_q8 * x153 + -0.00000000020510342851533115 * x155
+                - 0.35 * x146);
+        let x166 = 132.47349025763282
+            + (s_q8 * (s_q8 * x140 - c_q8 * x137 + -0.00000000020510342851533115 * x143)
+                - c_q8
+                    * (s_q8 * x139 - c_q8 * x134 + -0.00000000020510342851533115 * x142)
+                + -0.00000000020510342851533115 * x156);
+        let x167 = c_q7 * x160 - s_q7 * x146;
+        let x168 = s_q7 * x160 + c_q7 * x146;
+        let x169 = c_q7 * x159 - s_q7 * x163;
+        let x170 = c_q7 * x161 - s_q7 * x164;
+        let x171 = -x168;
+        let x172 = x149 * -0.75;
+        let x173 = 0.75 * x149;
+        let x174 = x167 * -0.65;
+        let x175 = 0.65 * x167;
+        let x176 = c_q7 * x162 - s_q7 * x165 + x167 * -0.75;
+        let x177 = s_q7 * x162 + c_q7 * x165 - 0.75 * x168;
+        let x178 = x166 + x175;
+        let x179 = s_q7 * x169 + c_q7 * x170 - 0.65 * x168;
+        let x180 = 110.5455 + x167;
+        let x181 = 180.9502499901501 + x149;
+        let x182 = 1394.5960312283303 + (x173 + (c_q7 * x169 - s_q7 * x170 - x172));
+        let x183 = -117.61766249359756 + (x176 + x149 * -0.65);
+        let x184 = 1466.4506062283303
+            + (s_q7 * (s_q7 * x159 + c_q7 * x163) + c_q7 * (s_q7 * x161 + c_q7 * x164)
+                - (x174 - x173) - (x172 - x175));
+        let x185 = 1271.854575 + (x178 - x174);
+        let x186 = -x181;
+        let x187 = -x180;
+        let x188 = x2 * x136 + x3 * x135;
+        let x189 = x147 - x148;
+        let x190 = x152 + -0.35 * x189;
+        let x191 = x155 - 0.35 * x188;
+        let x192 = c_q7 * x188 + s_q7 * x189;
+        let x193 = -x192;
+        let x194 = c_q7 * x189 - s_q7 * x188;
+        let x195 = c_q7 * x190 - s_q7 * x191 + -0.75 * x194;
+        let x196 = s_q7 * x190 + c_q7 * x191 + (x146 * -0.65 - 0.75 * x192);
+        let x197 = x156 + 0.65 * x194;
+        let x198 = x6 * x96;
+        let x199 = x198 - x5 * x111;
+        let x200 = x8 * x96;
+        let x201 = x200 - x7 * x111;
+        let x202 = s_q9 * x96;
+        let x203 = c_q9 * x111 + x202;
+        let x204 = x123 + (-0.4 * x201 - 0.275 * x203);
+        let x205 = x126 + 0.4 * x199;
+        let x206 = x129 + -0.275 * x199;
+        let x207 = x2 * x199 - x3 * x201 - x203;
+        let x208 = s_q8 * x199 + c_q8 * x201;
+        let x209 = s_q8 * x201 - c_q8 * x199 - -0.00000000020510342851533115 * x203;
+        let x210 = s_q8 * x205 - c_q8 * x204 + -0.00000000020510342851533115 * x206;
+        let x211 = x206 + (x2 * x204 - x3 * x205) + -0.35 * x208;
+        let x212 = s_q8 * x204 + c_q8 * x205 + 0.35 * x207;
+        let x213 = c_q7 * x207 - s_q7 * x208;
+        let x214 = s_q7 * x207 + c_q7 * x208;
+        let x215 = c_q7 * x211 - s_q7 * x212 + -0.75 * x214;
+        let x216 = s_q7 * x211 + c_q7 * x212 + (0.75 * x213 + -0.65 * x209);
+        let x217 = x210 + 0.65 * x214;
+        let x218 = x198 - x5 * x98;
+        let x219 = x200 - x7 * x98;
+        let x220 = x202 + c_q9 * x98;
+        let x221 = x5 * x101 + x6 * x104 + 0.00000000020510342851533115 * x108
+            + (-0.4 * x219 - 0.275 * x220);
+        let x222 = x108 + (x7 * x101 + x8 * x104) + 0.4 * x218;
+        let x223 = c_q9 * x101 - s_q9 * x104 + -0.00000000020510342851533115 * x108
+            + -0.275 * x218;
+        let x224 = x2 * x218 - x3 * x219 - x220;
+        let x225 = s_q8 * x218 + c_q8 * x219;
+        let x226 = s_q8 * x219 - c_q8 * x218 - -0.00000000020510342851533115 * x220;
+        let x227 = s_q8 * x222 - c_q8 * x221 + -0.00000000020510342851533115 * x223;
+        let x228 = x223 + (x2 * x221 - x3 * x222) + -0.35 * x225;
+        let x229 = s_q8 * x221 + c_q8 * x222 + 0.35 * x224;
+        let x230 = c_q7 * x224 - s_q7 * x225;
+        let x231 = s_q7 * x224 + c_q7 * x225;
+        let x232 = c_q7 * x228 - s_q7 * x229 + -0.75 * x231;
+        let x233 = s_q7 * x228 + c_q7 * x229 + (0.75 * x230 + -0.65 * x226);
+        let x234 = x227 + 0.65 * x231;
+        let x235 = x97 + c_q10 * x73;
+        let x236 = x95 - s_q10 * x73;
+        let x237 = c_q10 * x83 - s_q10 * x84;
+        let x238 = s_q10 * x83 + c_q10 * x84;
+        let x239 = x85 - 0.87 * x235;
+        let x240 = x6 * x236 - x5 * x235;
+        let x241 = x8 * x236 - x7 * x235;
+        let x242 = c_q9 * x235 + s_q9 * x236;
+        let x243 = x5 * x237 + x6 * x238 + 0.00000000020510342851533115 * x239
+            + (-0.4 * x241 - 0.275 * x242);
+        let x244 = x239 + (x7 * x237 + x8 * x238) + 0.4 * x240;
+        let x245 = c_q9 * x237 - s_q9 * x238 + -0.00000000020510342851533115 * x239
+            + -0.275 * x240;
+        let x246 = x2 * x240 - x3 * x241 - x242;
+        let x247 = s_q8 * x240 + c_q8 * x241;
+        let x248 = s_q8 * x241 - c_q8 * x240 - -0.00000000020510342851533115 * x242;
+        let x249 = s_q8 * x244 - c_q8 * x243 + -0.00000000020510342851533115 * x245;
+        let x250 = x245 + (x2 * x243 - x3 * x244) + -0.35 * x247;
+        let x251 = s_q8 * x243 + c_q8 * x244 + 0.35 * x246;
+        let x252 = c_q7 * x246 - s_q7 * x247;
+        let x253 = s_q7 * x246 + c_q7 * x247;
+        let x254 = c_q7 * x250 - s_q7 * x251 + -0.75 * x253;
+        let x255 = s_q7 * x250 + c_q7 * x251 + (0.75 * x252 + -0.65 * x248);
+        let x256 = x249 + 0.65 * x253;
+        let x257 = x13 * x35 - x12 * x36;
+        let x258 = x46 - x45;
+        let x259 = x53 + 0.36 * x257;
+        let x260 = x56 - -0.36 * x49;
+        let x261 = c_q11 * x49 + s_q11 * x257;
+        let x262 = c_q11 * x257 - s_q11 * x49;
+        let x263 = c_q11 * x259 - s_q11 * x260 + (0.275 * x262 + -0.63 * x258);
+        let x264 = s_q11 * x259 + c_q11 * x260 - -0.275 * x261;
+        let x265 = x59 - 0.63 * x261;
+        let x266 = c_q10 * x261 + s_q10 * x262;
+        let x267 = c_q10 * x262 - s_q10 * x261;
+        let x268 = s_q10 * x263 + c_q10 * x264;
+        let x269 = c_q10 * x263 - s_q10 * x264 + -0.87 * x258;
+        let x270 = x265 - 0.87 * x266;
+        let x271 = x6 * x267 - x5 * x266 + 0.00000000020510342851533115 * x258;
+        let x272 = x258 + (x8 * x267 - x7 * x266);
+        let x273 = -0.00000000020510342851533115 * x258 - (c_q9 * x266 + s_q9 * x267);
+        let x274 = x5 * x269 + x6 * x268 + 0.00000000020510342851533115 * x270
+            + (-0.4 * x272 + 0.275 * x273);
+        let x275 = x270 + (x7 * x269 + x8 * x268) + 0.4 * x271;
+        let x276 = c_q9 * x269 - s_q9 * x268 + -0.00000000020510342851533115 * x270
+            + -0.275 * x271;
+        let x277 = x273 + (x2 * x271 - x3 * x272);
+        let x278 = s_q8 * x271 + c_q8 * x272;
+        let x279 = s_q8 * x272 - c_q8 * x271 + -0.00000000020510342851533115 * x273;
+        let x280 = s_q8 * x275 - c_q8 * x274 + -0.00000000020510342851533115 * x276;
+        let x281 = x276 + (x2 * x274 - x3 * x275) + -0.35 * x278;
+        let x282 = s_q8 * x274 + c_q8 * x275 + 0.35 * x277;
+        let x283 = c_q7 * x277 - s_q7 * x278;
+        let x284 = s_q7 * x277 + c_q7 * x278;
+        let x285 = c_q7 * x281 - s_q7 * x282 + -0.75 * x284;
+        let x286 = s_q7 * x281 + c_q7 * x282 + (0.75 * x283 + -0.65 * x279);
+        let x287 = x280 + 0.65 * x284;
+        let x288 = x15 * -4.806620000000001;
+        let x289 = s_q13 * -4.806620000000001;
+        let x290 = c_q13 * -4.806620000000001;
+        let x291 = x22 + (-0.16 * x289 - 0.55 * x290);
+        let x292 = x26 + 0.16 * x288;
+        let x293 = x29 + -0.55 * x288;
+        let x294 = c_q12 * x288 - s_q12 * x289;
+        let x295 = x12 * x288 + x13 * x289 - x290;
+        let x296 = s_q12 * x288 + c_q12 * x289 + -0.00000000020510342851533115 * x290;
+        let x297 = -0.00000000020510342851533115 * x293 - (s_q12 * x291 + c_q12 * x292);
+        let x298 = c_q12 * x291 - s_q12 * x292 + 0.36 * x295;
+        let x299 = x293 + (x12 * x291 + x13 * x292) + -0.36 * x294;
+        let x300 = c_q11 * x294 - s_q11 * x295;
+        let x301 = s_q11 * x294 + c_q11 * x295;
+        let x302 = c_q11 * x298 - s_q11 * x299 + (0.275 * x301 - -0.63 * x296);
+        let x303 = s_q11 * x298 + c_q11 * x299 + -0.275 * x300;
+        let x304 = x297 + 0.63 * x300;
+        let x305 = c_q10 * x300 - s_q10 * x301;
+        let x306 = s_q10 * x300 + c_q10 * x301;
+        let x307 = s_q10 * x302 + c_q10 * x303;
+        let x308 = c_q10 * x302 - s_q10 * x303 - -0.87 * x296;
+        let x309 = x304 + 0.87 * x305;
+        let x310 = x5 * x305 + x6 * x306 - 0.00000000020510342851533115 * x296;
+        let x311 = x7 * x305 + x8 * x306 - x296;
+        let x312 = c_q9 * x305 - s_q9 * x306 - -0.00000000020510342851533115 * x296;
+        let x313 = x5 * x308 + x6 * x307 + 0.00000000020510342851533115 * x309
+            + (-0.4 * x311 + 0.275 * x312);
+        let x314 = x309 + (x7 * x308 + x8 * x307) + 0.4 * x310;
+        let x315 = c_q9 * x308 - s_q9 * x307 + -0.00000000020510342851533115 * x309
+            + -0.275 * x310;
+        let x316 = x312 + (x2 * x310 - x3 * x311);
+        let x317 = s_q8 * x310 + c_q8 * x311;
+        let x318 = s_q8 * x311 - c_q8 * x310 + -0.00000000020510342851533115 * x312;
+        let x319 = s_q8 * x314 - c_q8 * x313 + -0.00000000020510342851533115 * x315;
+        let x320 = x315 + (x2 * x313 - x3 * x314) + -0.35 * x317;
+        let x321 = s_q8 * x313 + c_q8 * x314 + 0.35 * x316;
+        let x322 = c_q7 * x316 - s_q7 * x317;
+        let x323 = s_q7 * x316 + c_q7 * x317;
+        let x324 = c_q7 * x320 - s_q7 * x321 + -0.75 * x323;
+        let x325 = s_q7 * x320 + c_q7 * x321 + (0.75 * x322 + -0.65 * x318);
+        let x326 = x319 + 0.65 * x323;
+        let x327 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+            + v[1] * -180.9502499901501;
+        let x328 = 1466.4506062283303 * v[4]
+            + (180.9502499901501 * v[0] + v[2] * -110.5455);
+        let x329 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x330 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x331 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x332 = 1170.07 * v[2] - 110.5455 * v[4];
+        let x333 = v[3] * c_q7 + v[4] * s_q7;
+        let x334 = v[4] * c_q7 - v[3] * s_q7;
+        let x335 = v[0] - v[4] * -0.75;
+        let x336 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x337 = v[2] - 0.65 * v[4];
+        let x338 = c_q7 * x335 + s_q7 * x336;
+        let x339 = c_q7 * x336 - s_q7 * x335;
+        let x340 = v[5] + v[6];
+        let x341 = v[6] * x334;
+        let x342 = v[6] * x333;
+        let x343 = v[6] * x338;
+        let x344 = -0.07309 * x334 + -16.80768997608804 * x340;
+        let x345 = -0.07309 * x333 + 130.43769025763282 * x334 + 0.1132 * x340
+            + x337 * -48.0240000085309;
+        let x346 = -16.80768997608804 * x333 + 0.1132 * x334 + 132.47349025763282 * x340
+            + 48.0240000085309 * x339;
+        let x347 = x340 * -48.0240000085309;
+        let x348 = 48.0240000085309 * x334;
+        let x349 = x2 * x333 + s_q8 * x334 - c_q8 * x340;
+        let x350 = c_q8 * x334 - x3 * x333 + s_q8 * x340;
+        let x351 = x338 - -0.35 * x334;
+        let x352 = x339 - 0.35 * x333;
+        let x353 = x2 * x351 + s_q8 * x352 - c_q8 * x337;
+        let x354 = c_q8 * x352 - x3 * x351 + s_q8 * x337;
+        let x355 = x351 + -0.00000000020510342851533115 * x337;
+        let x356 = v[7] + (x333 + -0.00000000020510342851533115 * x340);
+        let x357 = v[6] * x339 + -0.35 * x342;
+        let x358 = x343 + 0.35 * x341;
+        let x359 = x2 * x341 - s_q8 * x342 + v[7] * x350;
+        let x360 = x3 * x341 + c_q8 * x342 + v[7] * x349;
+        let x361 = x2 * x357 - s_q8 * x358 + v[7] * x354;
+        let x362 = x3 * x357 + c_q8 * x358 + v[7] * x353;
+        let x363 = -0.0000000234896432582596 * x350 + -0.0021399965876409276 * x356
+            + -12.701650001451807 * x355;
+        let x364 = -0.0000000234896432582596 * x349 + -111.7548902508081 * x350
+            + 5.080660024070365 * x356 + x355 * 0.000000008530897668050218;
+        let x365 = -0.0021399965876409276 * x349 + 5.080660024070366 * x350
+            + 113.3918902508081 * x356
+            + (x353 * 12.701650001451807 + -0.000000008530897668050218 * x354);
+        let x366 = -12.701650001451807 * x356;
+        let x367 = x356 * 0.000000008530897668050218;
+        let x368 = x349 * 12.701650001451807 + -0.000000008530897668050218 * x350;
+        let x369 = x5 * x349 + x7 * x350 + c_q9 * x356;
+        let x370 = x6 * x349 + x8 * x350 - s_q9 * x356;
+        let x371 = x353 - (-0.4 * x350 + 0.275 * x356);
+        let x372 = x354 - 0.4 * x349;
+        let x373 = x355 - -0.275 * x349;
+        let x374 = x5 * x371 + x7 * x372 + c_q9 * x373;
+        let x375 = x6 * x371 + x8 * x372 - s_q9 * x373;
+        let x376 = x372 + 0.00000000020510342851533115 * x371
+            + -0.00000000020510342851533115 * x373;
+        let x377 = v[8]
+            + (x350 + 0.00000000020510342851533115 * x349
+                + -0.00000000020510342851533115 * x356);
+        let x378 = 0.00000000020510342851533115 * x359 - x360
+            + -0.00000000020510342851533115 * x341;
+        let x379 = x361 - (0.275 * x341 - -0.4 * x360);
+        let x380 = x362 + 0.4 * x359;
+        let x381 = x357 - -0.275 * x359;
+        let x382 = 0.00000000020510342851533115 * x379 - x380
+            + -0.00000000020510342851533115 * x381;
+        let x383 = x5 * x359 - x7 * x360 + c_q9 * x341 + v[8] * x370;
+        let x384 = x6 * x359 - x8 * x360 - s_q9 * x341 - v[8] * x369;
+        let x385 = x5 * x379 - x7 * x380 + c_q9 * x381 + v[8] * x375;
+        let x386 = x6 * x379 - x8 * x380 - s_q9 * x381 - v[8] * x374;
+        let x387 = -63.36336825000001 * x370 + -36.18604050126307 * x377;
+        let x388 = -0.00214 * x377 + -81.53205 * x376;
+        let x389 = -0.00214 * x369 + -36.18604050126307 * x370 + 69.99836825 * x377
+            + x374 * 81.53205;
+        let x390 = -81.53205 * x377;
+        let x391 = x369 * 81.53205;
+        let x392 = c_q10 * x369 + s_q10 * x370;
+        let x393 = c_q10 * x370 - s_q10 * x369;
+        let x394 = x374 - -0.87 * x377;
+        let x395 = x376 - 0.87 * x369;
+        let x396 = c_q10 * x394 + s_q10 * x375;
+        let x397 = c_q10 * x375 - s_q10 * x394;
+        let x398 = v[9] + x377;
+        let x399 = x385 - -0.87 * x378;
+        let x400 = x382 - 0.87 * x383;
+        let x401 = c_q10 * x383 + s_q10 * x384 + v[9] * x393;
+        let x402 = c_q10 * x384 - s_q10 * x383 - v[9] * x392;
+        let x403 = c_q10 * x399 + s_q10 * x386 + v[9] * x397;
+        let x404 = -24.4950615 * x393 + -24.35164200091464 * x398;
+        let x405 = -0.6328 * x398 + -45.1584 * x395;
+        let x406 = -0.6328 * x392 + -24.351642000914637 * x393 + 28.2393615 * x398
+            + x396 * 45.1584;
+        let x407 = -45.1584 * x398;
+        let x408 = x392 * 45.1584;
+        let x409 = c_q11 * x392 + s_q11 * x393;
+        let x410 = c_q11 * x393 - s_q11 * x392;
+        let x411 = x396 - (0.275 * x393 + -0.63 * x398);
+        let x412 = x397 - -0.275 * x392;
+        let x413 = x395 - 0.63 * x392;
+        let x414 = c_q11 * x411 + s_q11 * x412;
+        let x415 = c_q11 * x412 - s_q11 * x411;
+        let x416 = v[10] + x398;
+        let x417 = x403 - (0.275 * x402 + -0.63 * x378);
+        let x418 = c_q10 * x386 - s_q10 * x399 - v[9] * x396 - -0.275 * x401;
+        let x419 = x400 - 0.63 * x401;
+        let x420 = c_q11 * x401 + s_q11 * x402 + v[10] * x410;
+        let x421 = c_q11 * x402 - s_q11 * x401 - v[10] * x409;
+        let x422 = c_q11 * x417 + s_q11 * x418 + v[10] * x415;
+        let x423 = -9.142025249762803 * x410 + 2.5482240016099564 * x416;
+        let x424 = 0.01675 * x416 + 7.078399999258757 * x413;
+        let x425 = 0.01675 * x409 + 2.5482240016099564 * x410 + 9.223235249762805 * x416
+            + x414 * -7.078399999258757;
+        let x426 = 7.078399999258757 * x416;
+        let x427 = x409 * -7.078399999258757;
+        let x428 = c_q12 * x409 + x12 * x410 - s_q12 * x416;
+        let x429 = x13 * x410 - s_q12 * x409 - c_q12 * x416;
+        let x430 = x414 - 0.36 * x410;
+        let x431 = x415 - -0.36 * x409;
+        let x432 = c_q12 * x430 + x12 * x431 - s_q12 * x413;
+        let x433 = x13 * x431 - s_q12 * x430 - c_q12 * x413;
+        let x434 = x431 + -0.00000000020510342851533115 * x413;
+        let x435 = v[11] + (x410 + -0.00000000020510342851533115 * x416);
+        let x436 = x421 + -0.00000000020510342851533115 * x378;
+        let x437 = x422 - 0.36 * x421;
+        let x438 = c_q11 * x418 - s_q11 * x417 - v[10] * x414 - -0.36 * x420;
+        let x439 = x438 + -0.00000000020510342851533115 * x419;
+        let x440 = c_q12 * x420 + x12 * x421 - s_q12 * x378 + v[11] * x429;
+        let x441 = x13 * x421 - s_q12 * x420 - c_q12 * x378 - v[11] * x428;
+        let x442 = c_q12 * x437 + x12 * x438 - s_q12 * x419 + v[11] * x433;
+        let x443 = x13 * x438 - s_q12 * x437 - c_q12 * x419 - v[11] * x432;
+        let x444 = -1.9877000000000002 * x429 + -0.809539999555672 * x435
+            + 17.135250000000003 * x434;
+        let x445 = -1.9877000000000002 * x428 + -5.252920330000002 * x429
+            + -2.741639999592316 * x435 + x434 * -3.6140000000000003;
+        let x446 = -0.809539999555672 * x428 + -2.7416399995923166 * x429
+            + 9.740442170000001 * x435
+            + (x432 * -17.135250000000003 + 3.6140000000000003 * x433);
+        let x447 = 17.135250000000003 * x435;
+        let x448 = x435 * -3.6140000000000003;
+        let x449 = x428 * -17.135250000000003 + 3.6140000000000003 * x429;
+        let x450 = x15 * x428 + s_q13 * x429 - c_q13 * x435;
+        let x451 = c_q13 * x429 - x16 * x428 + s_q13 * x435;
+        let x452 = x432 - (-0.16 * x429 + 0.55 * x435);
+        let x453 = x433 - 0.16 * x428;
+        let x454 = x434 - -0.55 * x428;
+        let x455 = x15 * x452 + s_q13 * x453 - c_q13 * x454;
+        let x456 = c_q13 * x453 - x16 * x452 + s_q13 * x454;
+        let x457 = x452 + -0.00000000020510342851533115 * x454;
+        let x458 = v[12] + (x428 + -0.00000000020510342851533115 * x435);
+        let x459 = x440 + -0.00000000020510342851533115 * x436;
+        let x460 = x442 - (-0.16 * x441 + 0.55 * x436);
+        let x461 = x439 - -0.55 * x440;
+        let x462 = x15 * x440 + s_q13 * x441 - c_q13 * x436 + v[12] * x451;
+        let x463 = c_q13 * x441 - x16 * x440 + s_q13 * x436 - v[12] * x450;
+        let x464 = 0.000781 * x450 + -1.2025609200000003 * x451
+            + -0.9614610000000001 * x458;
+        let x465 = 0.000781 * x451 + -0.0145 * x458 + 4.806620000000001 * x457;
+        let x466 = -0.0145 * x450 + -0.9614610000000001 * x451
+            + 1.4135609200000003 * x458 + -4.806620000000001 * x455;
+        let x467 = 4.806620000000001 * x458;
+        let x468 = -4.806620000000001 * x450;
+        let x469 = x450 * x468 - x458 * x467;
+        let x470 = 0.000781 * x463 + -0.0145 * x459
+            + 4.806620000000001 * (x460 + -0.00000000020510342851533115 * x461)
+            + (x451 * x466 - x458 * x464 - x456 * x468);
+        let x471 = 0.000781 * x462 + -1.2025609200000003 * x463
+            + -0.9614610000000001 * x459
+            + (x458 * x465 - x450 * x466 + (x455 * x468 - x457 * x467));
+        let x472 = -0.0145 * x462 + -0.9614610000000001 * x463
+            + 1.4135609200000003 * x459
+            + -4.806620000000001
+                * (x15 * x460 + s_q13 * (x443 - 0.16 * x440) - c_q13 * x461
+                    + v[12] * x456) + (x450 * x464 - x451 * x465 + x456 * x467);
+        let x473 = 4.806620000000001 * x459 + x451 * x468;
+        let x474 = x451 * x467 - -4.806620000000001 * x462;
+        let x475 = x474 - (x15 * x473 + x16 * x469);
+        let x476 = c_q13 * x469 - s_q13 * x473;
+        let x477 = c_q13 * x473 + s_q13 * x469 + -0.00000000020510342851533115 * x474;
+        let x478 = -1.9877000000000002 * x441 + -0.809539999555672 * x436
+            + 17.135250000000003 * x439
+            + (x429 * x446 - x435 * x445 + (x434 * x448 - x433 * x449))
+            + (x472 + (x15 * x470 - x16 * x471) + (-0.16 * x476 + 0.55 * x477));
+        let x479 = -1.9877000000000002 * x440 + -5.252920330000002 * x441
+            + -2.741639999592316 * x436 + x439 * -3.6140000000000003
+            + (x435 * x444 - x428 * x446 + (x432 * x449 - x434 * x447))
+            + (s_q13 * x470 + c_q13 * x471 + 0.16 * x475);
+        let x480 = -0.809539999555672 * x440 + -2.7416399995923166 * x441
+            + 9.740442170000001 * x436
+            + (x442 * -17.135250000000003 + 3.6140000000000003 * x443)
+            + (x428 * x445 - x429 * x444 + (x433 * x447 - x432 * x448))
+            + (s_q13 * x471 - c_q13 * x470 + -0.00000000020510342851533115 * x472
+                + -0.55 * x475);
+        let x481 = x435 * x448 - x429 * x449 - 17.135250000000003 * x436 + x475;
+        let x482 = x428 * x449 - x435 * x447 - x436 * -3.6140000000000003 + x476;
+        let x483 = x429 * x447 - x428 * x448
+            - (x440 * -17.135250000000003 + 3.6140000000000003 * x441) + x477;
+        let x484 = c_q12 * x481 - s_q12 * x482;
+        let x485 = x483 + (x12 * x481 + x13 * x482);
+        let x486 = 0.01675 * x378 + 7.078399999258757 * x419
+            + (x410 * x425 - x416 * x423 - x415 * x427)
+            + (c_q12 * x478 - s_q12 * x479 + 0.36 * x485);
+        let x487 = -9.142025249762803 * x421 + 2.5482240016099564 * x378
+            + (x416 * x424 - x409 * x425 + (x414 * x427 - x413 * x426))
+            + (x480 + (x12 * x478 + x13 * x479) + -0.36 * x484);
+        let x488 = 0.01675 * x420 + 2.5482240016099564 * x421 + 9.223235249762805 * x378
+            + x422 * -7.078399999258757 + (x409 * x423 - x410 * x424 + x415 * x426)
+            + (-0.00000000020510342851533115 * x480 - (s_q12 * x478 + c_q12 * x479));
+        let x489 = x484 - (7.078399999258757 * x378 + x410 * x427);
+        let x490 = x409 * x427 - x416 * x426 + x485;
+        let x491 = x410 * x426 - x420 * -7.078399999258757
+            + (-0.00000000020510342851533115 * x483 - (s_q12 * x481 + c_q12 * x482));
+        let x492 = c_q11 * x489 - s_q11 * x490;
+        let x493 = s_q11 * x489 + c_q11 * x490;
+        let x494 = -0.6328 * x378 + -45.1584 * x400
+            + (x393 * x406 - x398 * x404 - x397 * x408)
+            + (c_q11 * x486 - s_q11 * x487 + (0.275 * x493 + -0.63 * x491));
+        let x495 = -24.4950615 * x402 + -24.35164200091464 * x378
+            + (x398 * x405 - x392 * x406 + (x396 * x408 - x395 * x407))
+            + (s_q11 * x486 + c_q11 * x487 + -0.275 * x492);
+        let x496 = -0.6328 * x401 + -24.351642000914637 * x402 + 28.2393615 * x378
+            + x403 * 45.1584 + (x392 * x404 - x393 * x405 + x397 * x407)
+            + (x488 + 0.63 * x492);
+        let x497 = x492 - (-45.1584 * x378 + x393 * x408);
+        let x498 = x392 * x408 - x398 * x407 + x493;
+        let x499 = x393 * x407 - x401 * 45.1584 + x491;
+        let x500 = c_q10 * x497 - s_q10 * x498;
+        let x501 = -0.00214 * x378 + -81.53205 * x382
+            + (x370 * x389 - x377 * x387 - x375 * x391)
+            + (c_q10 * x494 - s_q10 * x495 + -0.87 * x499);
+        let x502 = -63.36336825000001 * x384 + -36.18604050126307 * x378
+            + (x377 * x388 - x369 * x389 + (x374 * x391 - x376 * x390))
+            + (s_q10 * x494 + c_q10 * x495);
+        let x503 = -0.00214 * x383 + -36.18604050126307 * x384 + 69.99836825 * x378
+            + x385 * 81.53205 + (x369 * x387 - x370 * x388 + x375 * x390)
+            + (x496 + 0.87 * x500);
+        let x504 = x500 - (-81.53205 * x378 + x370 * x391);
+        let x505 = x369 * x391 - x377 * x390 + (s_q10 * x497 + c_q10 * x498);
+        let x506 = x370 * x390 - x383 * 81.53205 + x499;
+        let x507 = x5 * x504 + x6 * x505 + 0.00000000020510342851533115 * x506;
+        let x508 = x506 + (x7 * x504 + x8 * x505);
+        let x509 = c_q9 * x504 - s_q9 * x505 + -0.00000000020510342851533115 * x506;
+        let x510 = -0.0021399965876409276 * x341 - -0.0000000234896432582596 * x360
+            + -12.701650001451807 * x357
+            + (x350 * x365 - x356 * x364 + (x355 * x367 - x354 * x368))
+            + (x5 * x501 + x6 * x502 + 0.00000000020510342851533115 * x503
+                + (-0.4 * x508 + 0.275 * x509));
+        let x511 = -0.0000000234896432582596 * x359 - -111.7548902508081 * x360
+            + 5.080660024070365 * x341 + x357 * 0.000000008530897668050218
+            + (x356 * x363 - x349 * x365 + (x353 * x368 - x355 * x366))
+            + (x503 + (x7 * x501 + x8 * x502) + 0.4 * x507);
+        let x512 = -0.0021399965876409276 * x359 - 5.080660024070366 * x360
+            + 113.3918902508081 * x341
+            + (x361 * 12.701650001451807 - -0.000000008530897668050218 * x362)
+            + (x349 * x364 - x350 * x363 + (x354 * x366 - x353 * x367))
+            + (c_q9 * x501 - s_q9 * x502 + -0.00000000020510342851533115 * x503
+                + -0.275 * x507);
+        let x513 = x356 * x367 - x350 * x368 - -12.701650001451807 * x341 + x507;
+        let x514 = x349 * x368 - x356 * x366 - x341 * 0.000000008530897668050218 + x508;
+        let x515 = x350 * x366 - x349 * x367
+            - (x359 * 12.701650001451807 - -0.000000008530897668050218 * x360) + x509;
+        let x516 = x515 + (x2 * x513 - x3 * x514);
+        let x517 = s_q8 * x513 + c_q8 * x514;
+        let x518 = x334 * x346 - x340 * x345 + (x337 * x347 - x339 * x348)
+            - -0.07309 * x342 + (x512 + (x2 * x510 - x3 * x511) + -0.35 * x517);
+        let x519 = -0.07309 * x341 - 130.43769025763282 * x342
+            + (x340 * x344 - x333 * x346 + x338 * x348)
+            + (s_q8 * x510 + c_q8 * x511 + 0.35 * x516);
+        let x520 = -16.80768997608804 * x341 - 0.1132 * x342 - 48.0240000085309 * x343
+            + (x333 * x345 - x334 * x344 - x338 * x347)
+            + (s_q8 * x511 - c_q8 * x510 + -0.00000000020510342851533115 * x512);
+        let x521 = x340 * x347 - x334 * x348 + x516;
+        let x522 = x333 * x348 + x517;
+        let x523 = 48.0240000085309 * x342 - x333 * x347
+            + (s_q8 * x514 - c_q8 * x513 + -0.00000000020510342851533115 * x515);
+        let x524 = c_q7 * x521 - s_q7 * x522;
+        let x525 = s_q7 * x521 + c_q7 * x522;
+        let x526 = v[4] * x329 - v[5] * x328 + (v[1] * x332 - v[2] * x331)
+            + (c_q7 * x518 - s_q7 * x519 + -0.75 * x525);
+        let x527 = v[5] * x327 - v[3] * x329 + (v[2] * x330 - v[0] * x332)
+            + (s_q7 * x518 + c_q7 * x519 + (0.75 * x524 + -0.65 * x523));
+        let x528 = v[3] * x328 - v[4] * x327 + (v[0] * x331 - v[1] * x330)
+            + (x520 + 0.65 * x525);
+        let x529 = v[4] * x332 - v[5] * x331 + x524;
+        let x530 = v[5] * x330 - v[3] * x332 + x525;
+        let x531 = v[3] * x331 - v[4] * x330 + x523;
         (
             [
                 [
@@ -3208,217 +3163,217 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x178,
-                    x184,
-                    x184,
-                    x204,
-                    x224,
-                    x242,
-                    x267,
-                    x299,
-                    x339,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x189,
-                    0.0,
-                    x177,
-                    x174,
-                    x205,
-                    x225,
-                    x243,
-                    x268,
-                    x300,
-                    x340,
-                ],
-                [
-                    0.0,
-                    0.0,
-                    1170.07,
-                    x175,
-                    x190,
-                    0.0,
-                    0.0,
-                    x206,
-                    x226,
-                    x244,
-                    x269,
-                    x301,
-                    x341,
-                ],
-                [
-                    0.0,
-                    x189,
-                    x175,
+                    x181,
+                    x171,
+                    x171,
                     x193,
-                    x191,
-                    x192,
-                    x196,
-                    x207,
-                    x227,
-                    x245,
-                    x270,
-                    x302,
-                    x342,
+                    x213,
+                    x230,
+                    x252,
+                    x283,
+                    x322,
                 ],
                 [
-                    x178,
                     0.0,
-                    x190,
-                    x191,
+                    1170.07,
+                    0.0,
+                    x186,
+                    0.0,
+                    x180,
+                    x167,
                     x194,
-                    x188,
-                    x197,
-                    x208,
-                    x228,
-                    x246,
-                    x271,
-                    x303,
-                    x343,
+                    x214,
+                    x231,
+                    x253,
+                    x284,
+                    x323,
                 ],
                 [
+                    0.0,
+                    0.0,
+                    1170.07,
+                    x168,
+                    x187,
+                    0.0,
+                    0.0,
+                    x146,
+                    x209,
+                    x226,
+                    x248,
+                    x279,
+                    x318,
+                ],
+                [
+                    0.0,
+                    x186,
+                    x168,
+                    x182,
+                    x179,
+                    x183,
+                    x176,
+                    x195,
+                    x215,
+                    x232,
+                    x254,
+                    x285,
+                    x324,
+                ],
+                [
+                    x181,
+                    0.0,
+                    x187,
+                    x179,
                     x184,
                     x177,
-                    0.0,
-                    x192,
-                    x188,
-                    x195,
-                    x198,
-                    x209,
-                    x229,
-                    x247,
-                    x272,
-                    x304,
-                    x344,
+                    x177,
+                    x196,
+                    x216,
+                    x233,
+                    x255,
+                    x286,
+                    x325,
                 ],
                 [
-                    x184,
-                    x174,
+                    x171,
+                    x180,
                     0.0,
+                    x183,
+                    x177,
+                    x185,
+                    x178,
+                    x197,
+                    x217,
+                    x234,
+                    x256,
+                    x287,
+                    x326,
+                ],
+                [
+                    x171,
+                    x167,
+                    0.0,
+                    x176,
+                    x177,
+                    x178,
+                    x166,
+                    x156,
+                    x210,
+                    x227,
+                    x249,
+                    x280,
+                    x319,
+                ],
+                [
+                    x193,
+                    x194,
+                    x146,
+                    x195,
                     x196,
                     x197,
-                    x198,
-                    x173,
-                    x166,
-                    x221,
-                    x239,
-                    x264,
-                    x296,
-                    x336,
-                ],
-                [
-                    x204,
-                    x205,
+                    x156,
+                    x144,
                     x206,
-                    x207,
-                    x208,
-                    x209,
-                    x166,
-                    x153,
-                    x218,
-                    x236,
-                    x261,
-                    x293,
-                    x333,
-                ],
-                [
-                    x224,
-                    x225,
-                    x226,
-                    x227,
-                    x228,
-                    x229,
-                    x221,
-                    x218,
-                    x129,
-                    x230,
-                    x255,
-                    x287,
-                    x327,
-                ],
-                [
-                    x242,
-                    x243,
-                    x244,
+                    x223,
                     x245,
-                    x246,
-                    x247,
+                    x276,
+                    x315,
+                ],
+                [
+                    x213,
+                    x214,
+                    x209,
+                    x215,
+                    x216,
+                    x217,
+                    x210,
+                    x206,
+                    x117,
+                    x108,
                     x239,
-                    x236,
-                    x230,
-                    x103,
-                    x250,
-                    x281,
-                    x321,
-                ],
-                [
-                    x267,
-                    x268,
-                    x269,
                     x270,
-                    x271,
-                    x272,
-                    x264,
-                    x261,
-                    x255,
-                    x250,
-                    x78,
-                    x71,
-                    x313,
+                    x309,
                 ],
                 [
-                    x299,
-                    x300,
-                    x301,
-                    x302,
-                    x303,
+                    x230,
+                    x231,
+                    x226,
+                    x232,
+                    x233,
+                    x234,
+                    x227,
+                    x223,
+                    x108,
+                    x94,
+                    x85,
+                    x265,
                     x304,
-                    x296,
-                    x293,
-                    x287,
-                    x281,
-                    x71,
-                    x55,
-                    x310,
                 ],
                 [
-                    x339,
-                    x340,
-                    x341,
-                    x342,
-                    x343,
-                    x344,
-                    x336,
-                    x333,
-                    x327,
-                    x321,
-                    x313,
-                    x310,
+                    x252,
+                    x253,
+                    x248,
+                    x254,
+                    x255,
+                    x256,
+                    x249,
+                    x245,
+                    x239,
+                    x85,
+                    x71,
+                    x59,
+                    x297,
+                ],
+                [
+                    x283,
+                    x284,
+                    x279,
+                    x285,
+                    x286,
+                    x287,
+                    x280,
+                    x276,
+                    x270,
+                    x265,
+                    x59,
+                    x44,
+                    x293,
+                ],
+                [
+                    x322,
+                    x323,
+                    x318,
+                    x324,
+                    x325,
+                    x326,
+                    x319,
+                    x315,
+                    x309,
+                    x304,
+                    x297,
+                    x293,
                     1.4135609200000003,
                 ],
             ],
             [
-                x563,
-                x564,
-                x565,
-                x560,
-                x561,
-                x562,
-                x554,
-                x546,
-                x537,
+                x529,
                 x530,
-                x522,
-                x514,
-                x505,
+                x531,
+                x526,
+                x527,
+                x528,
+                x520,
+                x512,
+                x503,
+                x496,
+                x488,
+                x480,
+                x472,
             ],
         )
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 1997 mul, 1616 add, 10 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 1779 mul, 1532 add, 10 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -3427,880 +3382,877 @@ impl FreeFloating7 {
         f_ext: &[[f64; 6]; 8],
     ) -> [f64; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x1 = c_q7 + (1.0 - c_q7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x3 = c_q8 + (1.0 - c_q8);
-        let x4 = -0.00000000020510342851533115 * c_q8;
-        let x5 = -0.00000000020510342851533115 * s_q8;
-        let x6 = -0.00000000020510342851533115 * x3;
+        let x2 = -0.00000000020510342851533115 * c_q8;
+        let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x8 = c_q9 + (1.0 - c_q9);
-        let x9 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x10 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x11 = 0.00000000020510342851533115 * x8;
-        let x12 = 0.00000000020510342851533115 * c_q9
+        let x5 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x6 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x7 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x13 = -0.00000000020510342851533115 * c_q9
+        let x8 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x14 = -0.00000000020510342851533115 * x8;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x16 = c_q10 + (1.0 - c_q10);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x18 = c_q11 + (1.0 - c_q11);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x20 = c_q12 + (1.0 - c_q12);
-        let x21 = -0.00000000020510342851533115 * s_q12;
-        let x22 = -0.00000000020510342851533115 * c_q12;
-        let x23 = -0.00000000020510342851533115 * x20;
+        let x12 = -0.00000000020510342851533115 * s_q12;
+        let x13 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x25 = c_q13 + (1.0 - c_q13);
-        let x26 = -0.00000000020510342851533115 * c_q13;
-        let x27 = -0.00000000020510342851533115 * s_q13;
-        let x28 = -0.00000000020510342851533115 * x25;
-        let x29 = x25 * 3.6140000000000003 - x27 * 4.806620000000001;
-        let x30 = c_q13 * 4.806620000000001;
-        let x31 = s_q13 * 4.806620000000001 + x28 * 3.6140000000000003;
-        let x32 = x30 + 9.938500000000001;
-        let x33 = x31 + 2.8912;
-        let x34 = x26 * 2.1663609200000002 - 0.000781 * x27 + -0.0145 * x25;
-        let x35 = 0.000781 * x26 - x27 * 0.9638000000000001 + x25 * -0.9614610000000001;
-        let x36 = -0.0145 * x26 - x27 * -0.9614610000000001 + x25 * 1.4135609200000003;
-        let x37 = 0.000781 * c_q13;
-        let x38 = s_q13 * 2.1663609200000002 + x37;
-        let x39 = 0.000781 * s_q13;
-        let x40 = x39 + c_q13 * 0.9638000000000001;
-        let x41 = -0.0145 * s_q13 + c_q13 * -0.9614610000000001;
-        let x42 = x39 - c_q13 * 2.1663609200000002 + -0.0145 * x28;
-        let x43 = s_q13 * 0.9638000000000001 - x37 + x28 * -0.9614610000000001;
-        let x44 = s_q13 * -0.9614610000000001 - -0.0145 * c_q13
-            + x28 * 1.4135609200000003;
-        let x45 = s_q13 * x34 + c_q13 * x35 - 0.55 * x29;
-        let x46 = x26 * x38 - x27 * x40 + x25 * x41 + x29 * -0.55;
-        let x47 = 7.196750000000001 + x32;
-        let x48 = 4.187200000000001 + x33;
-        let x49 = 3.2217582500000006
-            + (x26 * x34 - x27 * x35 + x25 * x36 - (-0.16 * x31 - 0.55 * x30)
-                - (x32 * -0.55 - 0.16 * x33));
-        let x50 = -0.2313 + (s_q13 * x35 - c_q13 * x34 + x28 * x36 + -0.16 * x29);
-        let x51 = 1.2686520000000001
-            + (s_q13 * x38 + c_q13 * x40 + 0.16 * x31 - -0.16 * x33);
-        let x52 = -1.1514800000000003
-            + (s_q13 * x40 - c_q13 * x38 + x28 * x41 - 0.16 * x30 - 0.55 * x33);
-        let x53 = -0.2313 + (x26 * x42 - x27 * x43 + x25 * x44 - 0.16 * x29);
-        let x54 = -1.1514800000000003
-            + (s_q13 * x42 + c_q13 * x43 + x31 * -0.55 + -0.16 * x32);
-        let x55 = 2.1079062500000005
-            + (s_q13 * x43 - c_q13 * x42 + x28 * x44 - x30 * -0.55 + 0.55 * x32);
-        let x56 = c_q12 * x29;
-        let x57 = s_q12 * x47;
-        let x58 = x56 - x57;
-        let x59 = x21 * x29 + x22 * x47 + x20 * x48;
-        let x60 = s_q12 * x29 + c_q12 * x47;
-        let x61 = x23 * x48 - x60;
-        let x62 = x61 + -15.926400000000001;
-        let x63 = c_q12 * x49 - s_q12 * x46;
-        let x64 = c_q12 * x45 - s_q12 * x51;
-        let x65 = c_q12 * x50 - s_q12 * x52;
-        let x66 = x21 * x49 + x22 * x46 + x20 * x53;
-        let x67 = x21 * x45 + x22 * x51 + x20 * x54;
-        let x68 = x21 * x50 + x22 * x52 + x20 * x55;
-        let x69 = x23 * x53 - (s_q12 * x49 + c_q12 * x46);
-        let x70 = x23 * x54 - (s_q12 * x45 + c_q12 * x51);
-        let x71 = x23 * x55 - (s_q12 * x50 + c_q12 * x52);
-        let x72 = x21 * x63 + x22 * x64 + x20 * x65;
-        let x73 = c_q12 * x66 - s_q12 * x67;
-        let x74 = x23 * x68 - (s_q12 * x66 + c_q12 * x67) - -0.36 * x59;
-        let x75 = 0.9304999999999999
-            + (c_q12 * x63 - s_q12 * x64 - x61 * 0.36 + -0.36 * x62);
-        let x76 = 0.01675 + (x23 * x65 - (s_q12 * x63 + c_q12 * x64) + x58 * 0.36);
-        let x77 = 0.939 + (x21 * x66 + x22 * x67 + x20 * x68 + -0.36 * x61 - x62 * 0.36);
-        let x78 = 0.07271 + (x23 * x71 - (s_q12 * x69 + c_q12 * x70));
-        let x79 = c_q11 * x58 - s_q11 * x59;
-        let x80 = s_q11 * x58 + c_q11 * x59;
-        let x81 = x18 * (-3.0149999999999997 + x62);
-        let x82 = x80 + -38.423700000000004;
-        let x83 = x81 + -16.772250000000003;
-        let x84 = c_q11 * x75 - s_q11 * x73;
-        let x85 = c_q11 * x72 - s_q11 * x77;
-        let x86 = c_q11 * x76 - s_q11 * x74;
-        let x87 = s_q11 * x75 + c_q11 * x73;
-        let x88 = s_q11 * x72 + c_q11 * x77;
-        let x89 = s_q11 * x76 + c_q11 * x74;
-        let x90 = x18 * (0.01675 + (c_q12 * x69 - s_q12 * x70 - -0.36 * x58));
-        let x91 = x18 * (x21 * x69 + x22 * x70 + x20 * x71 + x59 * 0.36);
-        let x92 = x18 * x78;
-        let x93 = 0.275 * x79;
-        let x94 = -0.275 * x80;
-        let x95 = x80 * 0.63;
-        let x96 = s_q11 * x84 + c_q11 * x85 - -0.63 * x79;
-        let x97 = c_q11 * x87 - s_q11 * x88 + x79 * 0.63;
-        let x98 = -6.7347 + x82;
-        let x99 = 4.170993
-            + (c_q11 * x84 - s_q11 * x85 - (0.275 * x81 - -0.63 * x80)
-                - (x82 * 0.63 - -0.275 * x83));
-        let x100 = -0.6328 + (x18 * x86 + x93);
-        let x101 = 3.8828625 + (s_q11 * x87 + c_q11 * x88 + -0.275 * x81 - 0.275 * x83);
-        let x102 = -1.8520425 + (x18 * x89 - x94 - -0.63 * x83);
-        let x103 = 4.0324305 + (x18 * x92 - x95 + -0.63 * x82);
-        let x104 = c_q10 * x79;
-        let x105 = x104 - s_q10 * x98;
-        let x106 = s_q10 * x79;
-        let x107 = x106 + c_q10 * x98;
-        let x108 = x16 * (-5.8795 + x83);
-        let x109 = x107 + -71.6619;
-        let x110 = c_q10 * x99 - s_q10 * x97;
-        let x111 = c_q10 * x96 - s_q10 * x101;
-        let x112 = c_q10 * x100 - s_q10 * x102;
-        let x113 = s_q10 * x99 + c_q10 * x97;
-        let x114 = s_q10 * x96 + c_q10 * x101;
-        let x115 = s_q10 * x100 + c_q10 * x102;
-        let x116 = x16 * (-0.6328 + (c_q11 * x90 - s_q11 * x91 - -0.275 * x79));
-        let x117 = x16
-            * (-1.8520425 + (s_q11 * x90 + c_q11 * x91 + x81 * 0.63 + 0.275 * x82));
-        let x118 = x16 * x103;
-        let x119 = x107 * 0.87;
-        let x120 = s_q10 * x110 + c_q10 * x111 - -0.87 * x105;
-        let x121 = s_q10 * x116 + c_q10 * x117 + x108 * 0.87;
-        let x122 = c_q10 * x113 - s_q10 * x114 + x105 * 0.87;
-        let x123 = x16 * x115 - -0.87 * x108;
-        let x124 = -9.87015 + x109;
-        let x125 = 4.395515250000001
-            + (c_q10 * x110 - s_q10 * x111 + -0.87 * x107 - x109 * 0.87);
-        let x126 = -0.00214 + x16 * x112;
-        let x127 = 3.378 + (s_q10 * x113 + c_q10 * x114);
-        let x128 = -0.00214 + (c_q10 * x116 - s_q10 * x117);
-        let x129 = 7.65251525 + (x16 * x118 - x119 + -0.87 * x109);
-        let x130 = x9 * x105 + x10 * x124 + x11 * x108;
-        let x131 = x12 * x105 + x13 * x124 + x8 * x108;
-        let x132 = c_q9 * x105 - s_q9 * x124 + x14 * x108;
-        let x133 = x131 + 28.891500000000004;
-        let x134 = x132 + 42.024;
-        let x135 = x9 * x125 + x10 * x122 + x11 * x128;
-        let x136 = x9 * x120 + x10 * x127 + x11 * x121;
-        let x137 = x9 * x126 + x10 * x123 + x11 * x129;
-        let x138 = x12 * x125 + x13 * x122 + x8 * x128;
-        let x139 = x12 * x120 + x13 * x127 + x8 * x121;
-        let x140 = x12 * x126 + x13 * x123 + x8 * x129;
-        let x141 = c_q9 * x125 - s_q9 * x122 + x14 * x128;
-        let x142 = c_q9 * x120 - s_q9 * x127 + x14 * x121;
-        let x143 = c_q9 * x126 - s_q9 * x123 + x14 * x129;
-        let x144 = x12 * x135 + x13 * x136 + x8 * x137 - 0.275 * x130;
-        let x145 = x9 * x138 + x10 * x139 + x11 * x140 + -0.275 * x130;
-        let x146 = c_q9 * x138 - s_q9 * x139 + x14 * x140 - 0.4 * x131 - 0.275 * x134;
-        let x147 = x12 * x141 + x13 * x142 + x8 * x143 + -0.275 * x132 + x133 * -0.4;
-        let x148 = 6.0 + x134;
-        let x149 = 3.3000000000000003
-            + (x9 * x135 + x10 * x136 + x11 * x137 - (x132 * -0.4 - 0.275 * x131)
-                - (-0.275 * x133 - 0.4 * x134));
-        let x150 = -0.00214 + (c_q9 * x135 - s_q9 * x136 + x14 * x137 + x130 * -0.4);
-        let x151 = 2.5780000000000003
-            + (x12 * x138 + x13 * x139 + x8 * x140 + 0.4 * x132 - x134 * -0.4);
-        let x152 = -0.00214 + (x9 * x141 + x10 * x142 + x11 * x143 - 0.4 * x130);
-        let x153 = 2.359
-            + (c_q9 * x141 - s_q9 * x142 + x14 * x143 - -0.275 * x131 + 0.275 * x133);
-        let x154 = x4 * x130 - x5 * x133 + x3 * x148;
-        let x155 = s_q8 * x130 + c_q8 * x133;
-        let x156 = c_q8 * x130;
-        let x157 = s_q8 * x133;
-        let x158 = x157 - x156 + x6 * x148;
-        let x159 = x158 + 47.271;
-        let x160 = x4 * x149 - x5 * x145 + x3 * x152;
-        let x161 = x4 * x144 - x5 * x151 + x3 * x147;
-        let x162 = x4 * x150 - x5 * x146 + x3 * x153;
-        let x163 = s_q8 * x149 + c_q8 * x145;
-        let x164 = s_q8 * x144 + c_q8 * x151;
-        let x165 = s_q8 * x150 + c_q8 * x146;
-        let x166 = s_q8 * x146 - c_q8 * x150 + x6 * x153;
-        let x167 = 2.29018125
-            + (x4 * x160 - x5 * x161 + x3 * x162 - x158 * -0.35 + 0.35 * x159);
-        let x168 = -0.07309 + (s_q8 * x160 + c_q8 * x161);
-        let x169 = 0.00071 + (s_q8 * x161 - c_q8 * x160 + x6 * x162 + x154 * -0.35);
-        let x170 = -0.07309 + (x4 * x163 - x5 * x164 + x3 * x165);
-        let x171 = 1.5853812499999997
-            + (s_q8 * x163 + c_q8 * x164 + 0.35 * x158 - x159 * -0.35);
-        let x172 = 0.1132 + (s_q8 * x164 - c_q8 * x163 + x6 * x165 - 0.35 * x155);
-        let x173 = 1.331
-            + (s_q8 * (s_q8 * x151 - c_q8 * x144 + x6 * x147)
-                - c_q8 * (s_q8 * x145 - c_q8 * x149 + x6 * x152) + x6 * x166);
-        let x174 = c_q7 * x154 - s_q7 * x155;
-        let x175 = s_q7 * x154 + c_q7 * x155;
-        let x176 = x1 * (6.1267499999999995 + x159);
-        let x177 = x174 + 110.5455;
-        let x178 = x176 + 127.5525;
-        let x179 = c_q7 * x167 - s_q7 * x170;
-        let x180 = c_q7 * x168 - s_q7 * x171;
-        let x181 = c_q7 * x169 - s_q7 * x172;
-        let x182 = s_q7 * x169 + c_q7 * x172;
-        let x183 = x1 * x173;
-        let x184 = x174 * -0.75;
-        let x185 = 0.75 * x175;
-        let x186 = 0.65 * x174;
-        let x187 = x4 * x133 + x5 * x130;
-        let x188 = x156 - x157;
-        let x189 = x162 + -0.35 * x188;
-        let x190 = x165 - 0.35 * x187;
-        let x191 = c_q7 * x187 + s_q7 * x188;
-        let x192 = c_q7 * x188 - s_q7 * x187;
-        let x193 = x1 * x155;
-        let x194 = x10 * x105;
-        let x195 = x194 - x9 * x124;
-        let x196 = x13 * x105;
-        let x197 = x196 - x12 * x124;
-        let x198 = s_q9 * x105;
-        let x199 = c_q9 * x124 + x198;
-        let x200 = x137 + (-0.4 * x197 - 0.275 * x199);
-        let x201 = x140 + 0.4 * x195;
-        let x202 = x143 + -0.275 * x195;
-        let x203 = x4 * x195 - x5 * x197 - x3 * x199;
-        let x204 = s_q8 * x195 + c_q8 * x197;
-        let x205 = s_q8 * x201 - c_q8 * x200 + x6 * x202;
-        let x206 = x4 * x200 - x5 * x201 + x3 * x202 + -0.35 * x204;
-        let x207 = s_q8 * x200 + c_q8 * x201 + 0.35 * x203;
-        let x208 = c_q7 * x203 - s_q7 * x204;
-        let x209 = s_q7 * x203 + c_q7 * x204;
-        let x210 = x1 * (s_q8 * x197 - c_q8 * x195 - x6 * x199);
-        let x211 = x118 - x119;
-        let x212 = x194 - x9 * x107;
-        let x213 = x196 - x12 * x107;
-        let x214 = x198 + c_q9 * x107;
-        let x215 = x9 * x112 + x10 * x115 + x11 * x211 + (-0.4 * x213 - 0.275 * x214);
-        let x216 = x12 * x112 + x13 * x115 + x8 * x211 + 0.4 * x212;
-        let x217 = c_q9 * x112 - s_q9 * x115 + x14 * x211 + -0.275 * x212;
-        let x218 = x4 * x212 - x5 * x213 - x3 * x214;
-        let x219 = s_q8 * x212 + c_q8 * x213;
-        let x220 = s_q8 * x216 - c_q8 * x215 + x6 * x217;
-        let x221 = x4 * x215 - x5 * x216 + x3 * x217 + -0.35 * x219;
-        let x222 = s_q8 * x215 + c_q8 * x216 + 0.35 * x218;
-        let x223 = c_q7 * x218 - s_q7 * x219;
-        let x224 = s_q7 * x218 + c_q7 * x219;
-        let x225 = x1 * (s_q8 * x213 - c_q8 * x212 - x6 * x214);
-        let x226 = x86 + x93;
-        let x227 = x89 - x94;
-        let x228 = x92 - x95;
-        let x229 = x106 + c_q10 * x80;
-        let x230 = x104 - s_q10 * x80;
-        let x231 = c_q10 * x226 - s_q10 * x227;
-        let x232 = s_q10 * x226 + c_q10 * x227;
-        let x233 = x16 * x228 - 0.87 * x229;
-        let x234 = x10 * x230 - x9 * x229;
-        let x235 = x13 * x230 - x12 * x229;
-        let x236 = c_q9 * x229 + s_q9 * x230;
-        let x237 = x9 * x231 + x10 * x232 + x11 * x233 + (-0.4 * x235 - 0.275 * x236);
-        let x238 = x12 * x231 + x13 * x232 + x8 * x233 + 0.4 * x234;
-        let x239 = c_q9 * x231 - s_q9 * x232 + x14 * x233 + -0.275 * x234;
-        let x240 = x4 * x234 - x5 * x235 - x3 * x236;
-        let x241 = s_q8 * x234 + c_q8 * x235;
-        let x242 = s_q8 * x238 - c_q8 * x237 + x6 * x239;
-        let x243 = x4 * x237 - x5 * x238 + x3 * x239 + -0.35 * x241;
-        let x244 = s_q8 * x237 + c_q8 * x238 + 0.35 * x240;
-        let x245 = c_q7 * x240 - s_q7 * x241;
-        let x246 = s_q7 * x240 + c_q7 * x241;
-        let x247 = x1 * (s_q8 * x235 - c_q8 * x234 - x6 * x236);
-        let x248 = x22 * x29 - x21 * x47;
-        let x249 = x65 + 0.36 * x248;
-        let x250 = x68 - -0.36 * x60;
-        let x251 = c_q11 * x60 + s_q11 * x248;
-        let x252 = c_q11 * x248 - s_q11 * x60;
-        let x253 = x18 * (x57 - x56);
-        let x254 = c_q11 * x249 - s_q11 * x250 + (0.275 * x252 + -0.63 * x253);
-        let x255 = s_q11 * x249 + c_q11 * x250 - -0.275 * x251;
-        let x256 = x18 * x71 - 0.63 * x251;
-        let x257 = c_q10 * x251 + s_q10 * x252;
-        let x258 = c_q10 * x252 - s_q10 * x251;
-        let x259 = x16 * x253;
-        let x260 = s_q10 * x254 + c_q10 * x255;
-        let x261 = c_q10 * x254 - s_q10 * x255 + -0.87 * x259;
-        let x262 = x16 * x256 - 0.87 * x257;
-        let x263 = x10 * x258 - x9 * x257 + x11 * x259;
-        let x264 = x13 * x258 - x12 * x257 + x8 * x259;
-        let x265 = x14 * x259 - (c_q9 * x257 + s_q9 * x258);
-        let x266 = x9 * x261 + x10 * x260 + x11 * x262 + (-0.4 * x264 + 0.275 * x265);
-        let x267 = x12 * x261 + x13 * x260 + x8 * x262 + 0.4 * x263;
-        let x268 = c_q9 * x261 - s_q9 * x260 + x14 * x262 + -0.275 * x263;
-        let x269 = x4 * x263 - x5 * x264 + x3 * x265;
-        let x270 = s_q8 * x263 + c_q8 * x264;
-        let x271 = s_q8 * x267 - c_q8 * x266 + x6 * x268;
-        let x272 = x4 * x266 - x5 * x267 + x3 * x268 + -0.35 * x270;
-        let x273 = s_q8 * x266 + c_q8 * x267 + 0.35 * x269;
-        let x274 = c_q7 * x269 - s_q7 * x270;
-        let x275 = s_q7 * x269 + c_q7 * x270;
-        let x276 = x1 * (s_q8 * x264 - c_q8 * x263 + x6 * x265);
-        let x277 = x26 * -4.806620000000001;
-        let x278 = s_q13 * -4.806620000000001;
-        let x279 = c_q13 * -4.806620000000001;
-        let x280 = x36 + (-0.16 * x278 - 0.55 * x279);
-        let x281 = x41 + 0.16 * x277;
-        let x282 = x44 + -0.55 * x277;
-        let x283 = c_q12 * x277 - s_q12 * x278;
-        let x284 = x21 * x277 + x22 * x278 - x20 * x279;
-        let x285 = x23 * x282 - (s_q12 * x280 + c_q12 * x281);
-        let x286 = c_q12 * x280 - s_q12 * x281 + 0.36 * x284;
-        let x287 = x21 * x280 + x22 * x281 + x20 * x282 + -0.36 * x283;
-        let x288 = c_q11 * x283 - s_q11 * x284;
-        let x289 = s_q11 * x283 + c_q11 * x284;
-        let x290 = x18 * (s_q12 * x277 + c_q12 * x278 + x23 * x279);
-        let x291 = c_q11 * x286 - s_q11 * x287 + (0.275 * x289 - -0.63 * x290);
-        let x292 = s_q11 * x286 + c_q11 * x287 + -0.275 * x288;
-        let x293 = x18 * x285 + 0.63 * x288;
-        let x294 = c_q10 * x288 - s_q10 * x289;
-        let x295 = s_q10 * x288 + c_q10 * x289;
-        let x296 = x16 * x290;
-        let x297 = s_q10 * x291 + c_q10 * x292;
-        let x298 = c_q10 * x291 - s_q10 * x292 - -0.87 * x296;
-        let x299 = x16 * x293 + 0.87 * x294;
-        let x300 = x9 * x294 + x10 * x295 - x11 * x296;
-        let x301 = x12 * x294 + x13 * x295 - x8 * x296;
-        let x302 = c_q9 * x294 - s_q9 * x295 - x14 * x296;
-        let x303 = x9 * x298 + x10 * x297 + x11 * x299 + (-0.4 * x301 + 0.275 * x302);
-        let x304 = x12 * x298 + x13 * x297 + x8 * x299 + 0.4 * x300;
-        let x305 = c_q9 * x298 - s_q9 * x297 + x14 * x299 + -0.275 * x300;
-        let x306 = x4 * x300 - x5 * x301 + x3 * x302;
-        let x307 = s_q8 * x300 + c_q8 * x301;
-        let x308 = s_q8 * x304 - c_q8 * x303 + x6 * x305;
-        let x309 = x4 * x303 - x5 * x304 + x3 * x305 + -0.35 * x307;
-        let x310 = s_q8 * x303 + c_q8 * x304 + 0.35 * x306;
-        let x311 = c_q7 * x306 - s_q7 * x307;
-        let x312 = s_q7 * x306 + c_q7 * x307;
-        let x313 = x1 * (s_q8 * x301 - c_q8 * x300 + x6 * x302);
-        let x314 = v[3] * 1200.0;
-        let x315 = v[4] * 1200.0;
-        let x316 = v[5] * 1200.0;
-        let x317 = v[0] * 1000.0;
-        let x318 = v[1] * 1000.0;
-        let x319 = v[2] * 1000.0;
-        let x320 = v[3] * c_q7 + v[4] * s_q7;
-        let x321 = v[4] * c_q7 - v[3] * s_q7;
-        let x322 = v[0] - v[4] * -0.75;
-        let x323 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x324 = c_q7 * x322 + s_q7 * x323;
-        let x325 = c_q7 * x323 - s_q7 * x322;
-        let x326 = x1 * (v[2] - 0.65 * v[4]);
-        let x327 = v[6] + v[5] * x1;
-        let x328 = v[6] * x321;
-        let x329 = v[6] * x320;
-        let x330 = v[6] * x325;
-        let x331 = v[6] * x324;
-        let x332 = 0.00071 * x320 + 0.1132 * x321 + 1.331 * x327;
-        let x333 = 2.29018125 * x320 + -0.07309 * x321 + 0.00071 * x327
-            + x325 * -6.1267499999999995;
-        let x334 = -0.07309 * x320 + 1.5853812499999997 * x321 + 0.1132 * x327
-            + 6.1267499999999995 * x324;
-        let x335 = 35.01 * x326;
-        let x336 = 35.01 * x324 - x321 * -6.1267499999999995;
-        let x337 = 35.01 * x325 - 6.1267499999999995 * x320;
-        let x338 = x4 * x320 + s_q8 * x321 - c_q8 * x327;
-        let x339 = c_q8 * x321 - x5 * x320 + s_q8 * x327;
-        let x340 = x324 - -0.35 * x321;
-        let x341 = x325 - 0.35 * x320;
-        let x342 = x4 * x340 + s_q8 * x341 - c_q8 * x326;
-        let x343 = c_q8 * x341 - x5 * x340 + s_q8 * x326;
-        let x344 = x3 * x340 + x6 * x326;
-        let x345 = v[7] + (x3 * x320 + x6 * x327);
-        let x346 = x3 * x328;
-        let x347 = x330 + -0.35 * x329;
-        let x348 = x331 + 0.35 * x328;
-        let x349 = x3 * x347;
-        let x350 = x4 * x328 - s_q8 * x329 + v[7] * x339;
-        let x351 = x5 * x328 + c_q8 * x329 + v[7] * x338;
-        let x352 = x4 * x347 - s_q8 * x348 + v[7] * x343;
-        let x353 = x5 * x347 + c_q8 * x348 + v[7] * x342;
-        let x354 = -0.00214 * x338 + 2.359 * x345;
-        let x355 = 3.3000000000000003 * x338 + -0.00214 * x345 + x343 * -6.0;
-        let x356 = 2.5780000000000003 * x339 + 6.0 * x342;
-        let x357 = 30.0 * x344;
-        let x358 = 30.0 * x342 - x339 * -6.0;
-        let x359 = 30.0 * x343 - 6.0 * x338;
-        let x360 = x9 * x338 + x12 * x339 + c_q9 * x345;
-        let x361 = x10 * x338 + x13 * x339 - s_q9 * x345;
-        let x362 = x342 - (-0.4 * x339 + 0.275 * x345);
-        let x363 = x343 - 0.4 * x338;
-        let x364 = x344 - -0.275 * x338;
-        let x365 = x9 * x362 + x12 * x363 + c_q9 * x364;
-        let x366 = x10 * x362 + x13 * x363 - s_q9 * x364;
-        let x367 = x11 * x362 + x8 * x363 + x14 * x364;
-        let x368 = v[8] + (x11 * x338 + x8 * x339 + x14 * x345);
-        let x369 = x11 * x350 - x8 * x351 + x14 * x346;
-        let x370 = x352 - (0.275 * x346 - -0.4 * x351);
-        let x371 = x353 + 0.4 * x350;
-        let x372 = x349 - -0.275 * x350;
-        let x373 = x11 * x370 - x8 * x371 + x14 * x372;
-        let x374 = x9 * x350 - x12 * x351 + c_q9 * x346 + v[8] * x361;
-        let x375 = x10 * x350 - x13 * x351 - s_q9 * x346 - v[8] * x360;
-        let x376 = x9 * x370 - x12 * x371 + c_q9 * x372 + v[8] * x366;
-        let x377 = x10 * x370 - x13 * x371 - s_q9 * x372 - v[8] * x365;
-        let x378 = 3.378 * x361;
-        let x379 = 4.395515250000001 * x360 + -0.00214 * x368 + -9.87015 * x367;
-        let x380 = -0.00214 * x360 + 7.65251525 * x368 + x365 * 9.87015;
-        let x381 = 22.69 * x366;
-        let x382 = 22.69 * x365 - -9.87015 * x368;
-        let x383 = 22.69 * x367 - x360 * 9.87015;
-        let x384 = c_q10 * x360 + s_q10 * x361;
-        let x385 = c_q10 * x361 - s_q10 * x360;
-        let x386 = x365 - -0.87 * x368;
-        let x387 = c_q10 * x386 + s_q10 * x366;
-        let x388 = c_q10 * x366 - s_q10 * x386;
-        let x389 = x16 * (x367 - 0.87 * x360);
-        let x390 = v[9] + x16 * x368;
-        let x391 = x16 * x369;
-        let x392 = x376 - -0.87 * x369;
-        let x393 = x16 * (x373 - 0.87 * x374);
-        let x394 = c_q10 * x374 + s_q10 * x375 + v[9] * x385;
-        let x395 = c_q10 * x375 - s_q10 * x374 - v[9] * x384;
-        let x396 = c_q10 * x392 + s_q10 * x377 + v[9] * x388;
-        let x397 = c_q10 * x377 - s_q10 * x392 - v[9] * x387;
-        let x398 = 4.170993 * x384 + -0.6328 * x390 + (x388 * 5.8795 + -6.7347 * x389);
-        let x399 = 3.8828625 * x385 + -1.8520425 * x390 + -5.8795 * x387;
-        let x400 = -0.6328 * x384 + -1.8520425 * x385 + 4.0324305 * x390 + x387 * 6.7347;
-        let x401 = 21.38 * x387 - (x385 * 5.8795 + -6.7347 * x390);
-        let x402 = 21.38 * x388 - -5.8795 * x384;
-        let x403 = 21.38 * x389 - x384 * 6.7347;
-        let x404 = c_q11 * x384 + s_q11 * x385;
-        let x405 = c_q11 * x385 - s_q11 * x384;
-        let x406 = x387 - (0.275 * x385 + -0.63 * x390);
-        let x407 = x388 - -0.275 * x384;
-        let x408 = c_q11 * x406 + s_q11 * x407;
-        let x409 = c_q11 * x407 - s_q11 * x406;
-        let x410 = x18 * (x389 - 0.63 * x384);
-        let x411 = v[10] + x18 * x390;
-        let x412 = x18 * x391;
-        let x413 = x396 - (0.275 * x395 + -0.63 * x391);
-        let x414 = x397 - -0.275 * x394;
-        let x415 = x18 * (x393 - 0.63 * x394);
-        let x416 = c_q11 * x394 + s_q11 * x395 + v[10] * x405;
-        let x417 = c_q11 * x395 - s_q11 * x394 - v[10] * x404;
-        let x418 = c_q11 * x413 + s_q11 * x414 + v[10] * x409;
-        let x419 = c_q11 * x414 - s_q11 * x413 - v[10] * x408;
-        let x420 = 0.01675 * x404 + 0.07271 * x411;
-        let x421 = 0.9304999999999999 * x404 + 0.01675 * x411
-            + x409 * 3.0149999999999997;
-        let x422 = 0.939 * x405 + -3.0149999999999997 * x408;
-        let x423 = 16.75 * x410;
-        let x424 = 16.75 * x408 - x405 * 3.0149999999999997;
-        let x425 = 16.75 * x409 - -3.0149999999999997 * x404;
-        let x426 = c_q12 * x404 + x21 * x405 - s_q12 * x411;
-        let x427 = x22 * x405 - s_q12 * x404 - c_q12 * x411;
-        let x428 = x408 - 0.36 * x405;
-        let x429 = x409 - -0.36 * x404;
-        let x430 = c_q12 * x428 + x21 * x429 - s_q12 * x410;
-        let x431 = x22 * x429 - s_q12 * x428 - c_q12 * x410;
-        let x432 = x20 * x429 + x23 * x410;
-        let x433 = v[11] + (x20 * x405 + x23 * x411);
-        let x434 = x20 * x417 + x23 * x412;
-        let x435 = x418 - 0.36 * x417;
-        let x436 = x419 - -0.36 * x416;
-        let x437 = x20 * x436 + x23 * x415;
-        let x438 = c_q12 * x416 + x21 * x417 - s_q12 * x412 + v[11] * x427;
-        let x439 = x22 * x417 - s_q12 * x416 - c_q12 * x412 - v[11] * x426;
-        let x440 = c_q12 * x435 + x21 * x436 - s_q12 * x415 + v[11] * x431;
-        let x441 = x22 * x436 - s_q12 * x435 - c_q12 * x415 - v[11] * x430;
-        let x442 = 3.2217582500000006 * x426 + -0.2313 * x433
-            + (x431 * -4.187200000000001 + 7.196750000000001 * x432);
-        let x443 = 1.2686520000000001 * x427 + -1.1514800000000003 * x433
-            + 4.187200000000001 * x430;
-        let x444 = -0.2313 * x426 + -1.1514800000000003 * x427
-            + 2.1079062500000005 * x433 + x430 * -7.196750000000001;
-        let x445 = 26.17 * x430 - (x427 * -4.187200000000001 + 7.196750000000001 * x433);
-        let x446 = 26.17 * x431 - 4.187200000000001 * x426;
-        let x447 = 26.17 * x432 - x426 * -7.196750000000001;
-        let x448 = x26 * x426 + s_q13 * x427 - c_q13 * x433;
-        let x449 = c_q13 * x427 - x27 * x426 + s_q13 * x433;
-        let x450 = x430 - (-0.16 * x427 + 0.55 * x433);
-        let x451 = x431 - 0.16 * x426;
-        let x452 = x432 - -0.55 * x426;
-        let x453 = x26 * x450 + s_q13 * x451 - c_q13 * x452;
-        let x454 = c_q13 * x451 - x27 * x450 + s_q13 * x452;
-        let x455 = x25 * x450 + x28 * x452;
-        let x456 = v[12] + (x25 * x426 + x28 * x433);
-        let x457 = x25 * x438 + x28 * x434;
-        let x458 = x440 - (-0.16 * x439 + 0.55 * x434);
-        let x459 = x441 - 0.16 * x438;
-        let x460 = x437 - -0.55 * x438;
-        let x461 = x25 * x458 + x28 * x460;
-        let x462 = x26 * x438 + s_q13 * x439 - c_q13 * x434 + v[12] * x449;
-        let x463 = c_q13 * x439 - x27 * x438 + s_q13 * x434 - v[12] * x448;
-        let x464 = x26 * x458 + s_q13 * x459 - c_q13 * x460 + v[12] * x454;
-        let x465 = c_q13 * x459 - x27 * x458 + s_q13 * x460 - v[12] * x453;
-        let x466 = 2.1663609200000002 * x448 + 0.000781 * x449 + -0.0145 * x456
-            + (-3.6140000000000003 * x454 + 4.806620000000001 * x455);
-        let x467 = 0.000781 * x448 + 0.9638000000000001 * x449
-            + -0.9614610000000001 * x456 + 3.6140000000000003 * x453;
-        let x468 = -0.0145 * x448 + -0.9614610000000001 * x449
-            + 1.4135609200000003 * x456 + -4.806620000000001 * x453;
-        let x469 = 18.07 * x453
-            - (-3.6140000000000003 * x449 + 4.806620000000001 * x456);
-        let x470 = 18.07 * x454 - 3.6140000000000003 * x448;
-        let x471 = 18.07 * x455 - -4.806620000000001 * x448;
-        let x472 = 2.1663609200000002 * x462 + 0.000781 * x463 + -0.0145 * x457
-            + (-3.6140000000000003 * x465 + 4.806620000000001 * x461)
-            + (x449 * x468 - x456 * x467 + (x454 * x471 - x455 * x470)) - f_ext[7][3];
-        let x473 = 0.000781 * x462 + 0.9638000000000001 * x463
-            + -0.9614610000000001 * x457 + 3.6140000000000003 * x464
-            + (x456 * x466 - x448 * x468 + (x455 * x469 - x453 * x471)) - f_ext[7][4];
-        let x474 = -0.0145 * x462 + -0.9614610000000001 * x463
-            + 1.4135609200000003 * x457 + -4.806620000000001 * x464
-            + (x448 * x467 - x449 * x466 + (x453 * x470 - x454 * x469)) - f_ext[7][5];
-        let x475 = 18.07 * x464 - (-3.6140000000000003 * x463 + 4.806620000000001 * x457)
-            + (x449 * x471 - x456 * x470) - f_ext[7][0];
-        let x476 = 18.07 * x465 - 3.6140000000000003 * x462 + (x456 * x469 - x448 * x471)
-            - f_ext[7][1];
-        let x477 = 18.07 * x461 - -4.806620000000001 * x462 + (x448 * x470 - x449 * x469)
-            - f_ext[7][2];
-        let x478 = x26 * x475 - x27 * x476 + x25 * x477;
-        let x479 = s_q13 * x475 + c_q13 * x476;
-        let x480 = s_q13 * x476 - c_q13 * x475 + x28 * x477;
-        let x481 = 3.2217582500000006 * x438 + -0.2313 * x434
-            + (x441 * -4.187200000000001 + 7.196750000000001 * x437)
-            + (x427 * x444 - x433 * x443 + (x431 * x447 - x432 * x446)) - f_ext[6][3]
-            + (x26 * x472 - x27 * x473 + x25 * x474 + (-0.16 * x479 + 0.55 * x480));
-        let x482 = 1.2686520000000001 * x439 + -1.1514800000000003 * x434
-            + 4.187200000000001 * x440
-            + (x433 * x442 - x426 * x444 + (x432 * x445 - x430 * x447)) - f_ext[6][4]
-            + (s_q13 * x472 + c_q13 * x473 + 0.16 * x478);
-        let x483 = -0.2313 * x438 + -1.1514800000000003 * x439
-            + 2.1079062500000005 * x434 + x440 * -7.196750000000001
-            + (x426 * x443 - x427 * x442 + (x430 * x446 - x431 * x445)) - f_ext[6][5]
-            + (s_q13 * x473 - c_q13 * x472 + x28 * x474 + -0.55 * x478);
-        let x484 = 26.17 * x440 - (x439 * -4.187200000000001 + 7.196750000000001 * x434)
-            + (x427 * x447 - x433 * x446) - f_ext[6][0] + x478;
-        let x485 = 26.17 * x441 - 4.187200000000001 * x438 + (x433 * x445 - x426 * x447)
-            - f_ext[6][1] + x479;
-        let x486 = 26.17 * x437 - x438 * -7.196750000000001 + (x426 * x446 - x427 * x445)
-            - f_ext[6][2] + x480;
-        let x487 = c_q12 * x484 - s_q12 * x485;
-        let x488 = x21 * x484 + x22 * x485 + x20 * x486;
-        let x489 = 0.9304999999999999 * x416 + 0.01675 * x412 + x419 * 3.0149999999999997
-            + (x405 * x420 - x411 * x422 + (x409 * x423 - x410 * x425)) - f_ext[5][3]
-            + (c_q12 * x481 - s_q12 * x482 + 0.36 * x488);
-        let x490 = 0.939 * x417 + -3.0149999999999997 * x418
-            + (x411 * x421 - x404 * x420 + (x410 * x424 - x408 * x423)) - f_ext[5][4]
-            + (x21 * x481 + x22 * x482 + x20 * x483 + -0.36 * x487);
-        let x491 = 0.01675 * x416 + 0.07271 * x412
-            + (x404 * x422 - x405 * x421 + (x408 * x425 - x409 * x424)) - f_ext[5][5]
-            + (x23 * x483 - (s_q12 * x481 + c_q12 * x482));
-        let x492 = 16.75 * x418 - x417 * 3.0149999999999997 + (x405 * x423 - x411 * x425)
-            - f_ext[5][0] + x487;
-        let x493 = 16.75 * x419 - -3.0149999999999997 * x416
-            + (x411 * x424 - x404 * x423) - f_ext[5][1] + x488;
-        let x494 = c_q11 * x492 - s_q11 * x493;
-        let x495 = s_q11 * x492 + c_q11 * x493;
-        let x496 = x18
-            * (16.75 * x415 + (x404 * x425 - x405 * x424) - f_ext[5][2]
-                + (x23 * x486 - (s_q12 * x484 + c_q12 * x485)));
-        let x497 = 4.170993 * x394 + -0.6328 * x391 + (x397 * 5.8795 + -6.7347 * x393)
-            + (x385 * x400 - x390 * x399 + (x388 * x403 - x389 * x402)) - f_ext[4][3]
-            + (c_q11 * x489 - s_q11 * x490 + (0.275 * x495 + -0.63 * x496));
-        let x498 = 3.8828625 * x395 + -1.8520425 * x391 + -5.8795 * x396
-            + (x390 * x398 - x384 * x400 + (x389 * x401 - x387 * x403)) - f_ext[4][4]
-            + (s_q11 * x489 + c_q11 * x490 + -0.275 * x494);
-        let x499 = -0.6328 * x394 + -1.8520425 * x395 + 4.0324305 * x391 + x396 * 6.7347
-            + (x384 * x399 - x385 * x398 + (x387 * x402 - x388 * x401)) - f_ext[4][5]
-            + (x18 * x491 + 0.63 * x494);
-        let x500 = 21.38 * x396 - (x395 * 5.8795 + -6.7347 * x391)
-            + (x385 * x403 - x390 * x402) - f_ext[4][0] + x494;
-        let x501 = 21.38 * x397 - -5.8795 * x394 + (x390 * x401 - x384 * x403)
-            - f_ext[4][1] + x495;
-        let x502 = c_q10 * x500 - s_q10 * x501;
-        let x503 = x16
-            * (21.38 * x393 - x394 * 6.7347 + (x384 * x402 - x385 * x401) - f_ext[4][2]
-                + x496);
-        let x504 = 4.395515250000001 * x374 + -0.00214 * x369 + -9.87015 * x373
-            + (x361 * x380 - x368 * x378 + (x366 * x383 - x367 * x381)) - f_ext[3][3]
-            + (c_q10 * x497 - s_q10 * x498 + -0.87 * x503);
-        let x505 = 3.378 * x375
-            + (x368 * x379 - x360 * x380 + (x367 * x382 - x365 * x383)) - f_ext[3][4]
-            + (s_q10 * x497 + c_q10 * x498);
-        let x506 = -0.00214 * x374 + 7.65251525 * x369 + x376 * 9.87015
-            + (x360 * x378 - x361 * x379 + (x365 * x381 - x366 * x382)) - f_ext[3][5]
-            + (x16 * x499 + 0.87 * x502);
-        let x507 = 22.69 * x376 - -9.87015 * x369 + (x361 * x383 - x368 * x381)
-            - f_ext[3][0] + x502;
-        let x508 = 22.69 * x377 + (x368 * x382 - x360 * x383) - f_ext[3][1]
-            + (s_q10 * x500 + c_q10 * x501);
-        let x509 = 22.69 * x373 - x374 * 9.87015 + (x360 * x381 - x361 * x382)
-            - f_ext[3][2] + x503;
-        let x510 = x9 * x507 + x10 * x508 + x11 * x509;
-        let x511 = x12 * x507 + x13 * x508 + x8 * x509;
-        let x512 = c_q9 * x507 - s_q9 * x508 + x14 * x509;
-        let x513 = 3.3000000000000003 * x350 + -0.00214 * x346 - x353 * -6.0
-            + (x339 * x354 - x345 * x356 + (x343 * x357 - x344 * x359)) - f_ext[2][3]
-            + (x9 * x504 + x10 * x505 + x11 * x506 + (-0.4 * x511 + 0.275 * x512));
-        let x514 = 6.0 * x352 - 2.5780000000000003 * x351
-            + (x345 * x355 - x338 * x354 + (x344 * x358 - x342 * x357)) - f_ext[2][4]
-            + (x12 * x504 + x13 * x505 + x8 * x506 + 0.4 * x510);
-        let x515 = -0.00214 * x350 + 2.359 * x346
-            + (x338 * x356 - x339 * x355 + (x342 * x359 - x343 * x358)) - f_ext[2][5]
-            + (c_q9 * x504 - s_q9 * x505 + x14 * x506 + -0.275 * x510);
-        let x516 = 30.0 * x352 + x351 * -6.0 + (x339 * x357 - x345 * x359) - f_ext[2][0]
-            + x510;
-        let x517 = x345 * x358 - x338 * x357 - (30.0 * x353 + 6.0 * x350) - f_ext[2][1]
-            + x511;
-        let x518 = 30.0 * x349 + (x338 * x359 - x339 * x358) - f_ext[2][2] + x512;
-        let x519 = x4 * x516 - x5 * x517 + x3 * x518;
-        let x520 = s_q8 * x516 + c_q8 * x517;
-        let x521 = 2.29018125 * x328 - -0.07309 * x329 - x331 * -6.1267499999999995
-            + (x321 * x332 - x327 * x334 + (x325 * x335 - x326 * x337)) - f_ext[1][3]
-            + (x4 * x513 - x5 * x514 + x3 * x515 + -0.35 * x520);
-        let x522 = -0.07309 * x328 - 1.5853812499999997 * x329
-            + 6.1267499999999995 * x330
-            + (x327 * x333 - x320 * x332 + (x326 * x336 - x324 * x335)) - f_ext[1][4]
-            + (s_q8 * x513 + c_q8 * x514 + 0.35 * x519);
-        let x523 = 0.00071 * x328 - 0.1132 * x329
-            + (x320 * x334 - x321 * x333 + (x324 * x337 - x325 * x336)) - f_ext[1][5]
-            + (s_q8 * x514 - c_q8 * x513 + x6 * x515);
-        let x524 = 35.01 * x330 + x329 * -6.1267499999999995
-            + (x321 * x335 - x327 * x337) - f_ext[1][0] + x519;
-        let x525 = x327 * x336 - x320 * x335 - (35.01 * x331 + 6.1267499999999995 * x328)
-            - f_ext[1][1] + x520;
-        let x526 = c_q7 * x524 - s_q7 * x525;
-        let x527 = s_q7 * x524 + c_q7 * x525;
-        let x528 = x1
-            * (x320 * x337 - x321 * x336 - f_ext[1][2]
-                + (s_q8 * x517 - c_q8 * x516 + x6 * x518));
-        let x529 = v[4] * x319 - v[5] * x318 - f_ext[0][0] + x526;
-        let x530 = v[5] * x317 - v[3] * x319 - f_ext[0][1] + x527;
-        let x531 = v[3] * x318 - v[4] * x317 - f_ext[0][2] + x528;
-        let x532 = x178 * 0.0008546497218115156;
-        let x533 = x175 * 0.0008546497218115156;
-        let x534 = x191 * 0.0008546497218115156;
-        let x535 = x208 * 0.0008546497218115156;
-        let x536 = x223 * 0.0008546497218115156;
-        let x537 = x245 * 0.0008546497218115156;
-        let x538 = x274 * 0.0008546497218115156;
-        let x539 = x311 * 0.0008546497218115156;
-        let x540 = x177 * 0.0008546497218115156;
-        let x541 = x174 * 0.0008546497218115156;
-        let x542 = x192 * 0.0008546497218115156;
-        let x543 = x209 * 0.0008546497218115156;
-        let x544 = x224 * 0.0008546497218115156;
-        let x545 = x246 * 0.0008546497218115156;
-        let x546 = x275 * 0.0008546497218115156;
-        let x547 = x312 * 0.0008546497218115156;
-        let x548 = x193 * 0.0008546497218115156;
-        let x549 = x210 * 0.0008546497218115156;
-        let x550 = x225 * 0.0008546497218115156;
-        let x551 = x247 * 0.0008546497218115156;
-        let x552 = x276 * 0.0008546497218115156;
-        let x553 = x313 * 0.0008546497218115156;
-        let x554 = x178 * x532;
-        let x555 = x175 * x533;
-        let x556 = 1.0
-            / (1200.0 + (c_q7 * x179 - s_q7 * x180 - x176 * -0.75 + 0.75 * x178) - x554
-                - x555);
-        let x557 = s_q7 * x179 + c_q7 * x180 - 0.65 * x175 + x175 * x540;
-        let x558 = x556 * x557;
-        let x559 = x1 * x181 + x184 + x178 * -0.65 + x178 * x540;
-        let x560 = x556 * x559;
-        let x561 = x181 + x184 + x178 * x541;
-        let x562 = x556 * x561;
-        let x563 = c_q7 * x189 - s_q7 * x190 + -0.75 * x192 + x178 * x542 - x175 * x548;
-        let x564 = x556 * x563;
-        let x565 = c_q7 * x206 - s_q7 * x207 + -0.75 * x209 + x178 * x543 - x175 * x549;
-        let x566 = x556 * x565;
-        let x567 = c_q7 * x221 - s_q7 * x222 + -0.75 * x224 + x178 * x544 - x175 * x550;
-        let x568 = x556 * x567;
-        let x569 = c_q7 * x243 - s_q7 * x244 + -0.75 * x246 + x178 * x545 - x175 * x551;
-        let x570 = x556 * x569;
-        let x571 = c_q7 * x272 - s_q7 * x273 + -0.75 * x275 + x178 * x546 - x175 * x552;
-        let x572 = x556 * x571;
-        let x573 = c_q7 * x309 - s_q7 * x310 + -0.75 * x312 + x178 * x547 - x175 * x553;
-        let x574 = x556 * x573;
-        let x575 = x177 * x540;
-        let x576 = 1.0
-            / (1200.0
-                + (s_q7 * (s_q7 * x167 + c_q7 * x170)
-                    + c_q7 * (s_q7 * x168 + c_q7 * x171) - (x174 * -0.65 - 0.75 * x176)
-                    - (x178 * -0.75 - 0.65 * x177)) - x554 - x575 - x557 * x558);
-        let x577 = x178 * x533;
-        let x578 = x1 * x182 - x185 + x577 - x557 * x560;
-        let x579 = x576 * x578;
-        let x580 = x182 - x185 + x577 - x557 * x562;
-        let x581 = x576 * x580;
-        let x582 = s_q7 * x189 + c_q7 * x190 + (-0.65 * x193 - 0.75 * x191) + x178 * x534
-            + x177 * x548 - x557 * x564;
-        let x583 = x576 * x582;
-        let x584 = s_q7 * x206 + c_q7 * x207 + (0.75 * x208 + -0.65 * x210) - x178 * x535
-            + x177 * x549 - x557 * x566;
-        let x585 = x576 * x584;
-        let x586 = s_q7 * x221 + c_q7 * x222 + (0.75 * x223 + -0.65 * x225) - x178 * x536
-            + x177 * x550 - x557 * x568;
-        let x587 = x576 * x586;
-        let x588 = s_q7 * x243 + c_q7 * x244 + (0.75 * x245 + -0.65 * x247) - x178 * x537
-            + x177 * x551 - x557 * x570;
-        let x589 = x576 * x588;
-        let x590 = s_q7 * x272 + c_q7 * x273 + (0.75 * x274 + -0.65 * x276) - x178 * x538
-            + x177 * x552 - x557 * x572;
-        let x591 = x576 * x590;
-        let x592 = s_q7 * x309 + c_q7 * x310 + (0.75 * x311 + -0.65 * x313) - x178 * x539
-            + x177 * x553 - x557 * x574;
-        let x593 = x576 * x592;
-        let x594 = 1.0
-            / (1200.0 + (x1 * x183 + x186 - x177 * -0.65) - x555 - x575 - x559 * x560
-                - x578 * x579);
-        let x595 = x183 + x186 - x555 - x177 * x541 - x559 * x562 - x578 * x581;
-        let x596 = x594 * x595;
-        let x597 = x175 * x534;
-        let x598 = x1 * x166 + 0.65 * x192 - x597 - x177 * x542 - x559 * x564
-            - x578 * x583;
-        let x599 = x594 * x598;
-        let x600 = x175 * x535;
-        let x601 = x1 * x205 + 0.65 * x209 + x600 - x177 * x543 - x559 * x566
-            - x578 * x585;
-        let x602 = x594 * x601;
-        let x603 = x175 * x536;
-        let x604 = x1 * x220 + 0.65 * x224 + x603 - x177 * x544 - x559 * x568
-            - x578 * x587;
-        let x605 = x594 * x604;
-        let x606 = x175 * x537;
-        let x607 = x1 * x242 + 0.65 * x246 + x606 - x177 * x545 - x559 * x570
-            - x578 * x589;
-        let x608 = x594 * x607;
-        let x609 = x175 * x538;
-        let x610 = x1 * x271 + 0.65 * x275 + x609 - x177 * x546 - x559 * x572
-            - x578 * x591;
-        let x611 = x594 * x610;
-        let x612 = x175 * x539;
-        let x613 = x1 * x308 + 0.65 * x312 + x612 - x177 * x547 - x559 * x574
-            - x578 * x593;
-        let x614 = x594 * x613;
-        let x615 = 1.0
-            / (x173 - x555 - x174 * x541 - x561 * x562 - x580 * x581 - x595 * x596);
-        let x616 = x166 - x597 - x174 * x542 - x561 * x564 - x580 * x583 - x595 * x599;
-        let x617 = x615 * x616;
-        let x618 = x205 + x600 - x174 * x543 - x561 * x566 - x580 * x585 - x595 * x602;
-        let x619 = x615 * x618;
-        let x620 = x220 + x603 - x174 * x544 - x561 * x568 - x580 * x587 - x595 * x605;
-        let x621 = x615 * x620;
-        let x622 = x242 + x606 - x174 * x545 - x561 * x570 - x580 * x589 - x595 * x608;
-        let x623 = x615 * x622;
-        let x624 = x271 + x609 - x174 * x546 - x561 * x572 - x580 * x591 - x595 * x611;
-        let x625 = x615 * x624;
-        let x626 = x308 + x612 - x174 * x547 - x561 * x574 - x580 * x593 - x595 * x614;
-        let x627 = x615 * x626;
-        let x628 = 1.0
-            / (x153 - x191 * x534 - x192 * x542 - x193 * x548 - x563 * x564 - x582 * x583
-                - x598 * x599 - x616 * x617);
-        let x629 = x202 + x191 * x535 - x192 * x543 - x193 * x549 - x563 * x566
-            - x582 * x585 - x598 * x602 - x616 * x619;
-        let x630 = x628 * x629;
-        let x631 = x217 + x191 * x536 - x192 * x544 - x193 * x550 - x563 * x568
-            - x582 * x587 - x598 * x605 - x616 * x621;
-        let x632 = x628 * x631;
-        let x633 = x239 + x191 * x537 - x192 * x545 - x193 * x551 - x563 * x570
-            - x582 * x589 - x598 * x608 - x616 * x623;
-        let x634 = x628 * x633;
-        let x635 = x268 + x191 * x538 - x192 * x546 - x193 * x552 - x563 * x572
-            - x582 * x591 - x598 * x611 - x616 * x625;
-        let x636 = x628 * x635;
-        let x637 = x305 + x191 * x539 - x192 * x547 - x193 * x553 - x563 * x574
-            - x582 * x593 - x598 * x614 - x616 * x627;
-        let x638 = x628 * x637;
-        let x639 = 1.0
-            / (x129 - x208 * x535 - x209 * x543 - x210 * x549 - x565 * x566 - x584 * x585
-                - x601 * x602 - x618 * x619 - x629 * x630);
-        let x640 = x211 - x208 * x536 - x209 * x544 - x210 * x550 - x565 * x568
-            - x584 * x587 - x601 * x605 - x618 * x621 - x629 * x632;
-        let x641 = x639 * x640;
-        let x642 = x233 - x208 * x537 - x209 * x545 - x210 * x551 - x565 * x570
-            - x584 * x589 - x601 * x608 - x618 * x623 - x629 * x634;
-        let x643 = x639 * x642;
-        let x644 = x262 - x208 * x538 - x209 * x546 - x210 * x552 - x565 * x572
-            - x584 * x591 - x601 * x611 - x618 * x625 - x629 * x636;
-        let x645 = x639 * x644;
-        let x646 = x299 - x208 * x539 - x209 * x547 - x210 * x553 - x565 * x574
-            - x584 * x593 - x601 * x614 - x618 * x627 - x629 * x638;
-        let x647 = x639 * x646;
-        let x648 = 1.0
-            / (x103 - x223 * x536 - x224 * x544 - x225 * x550 - x567 * x568 - x586 * x587
-                - x604 * x605 - x620 * x621 - x631 * x632 - x640 * x641);
-        let x649 = x228 - x223 * x537 - x224 * x545 - x225 * x551 - x567 * x570
-            - x586 * x589 - x604 * x608 - x620 * x623 - x631 * x634 - x640 * x643;
-        let x650 = x648 * x649;
-        let x651 = x256 - x223 * x538 - x224 * x546 - x225 * x552 - x567 * x572
-            - x586 * x591 - x604 * x611 - x620 * x625 - x631 * x636 - x640 * x645;
-        let x652 = x648 * x651;
-        let x653 = x293 - x223 * x539 - x224 * x547 - x225 * x553 - x567 * x574
-            - x586 * x593 - x604 * x614 - x620 * x627 - x631 * x638 - x640 * x647;
-        let x654 = x648 * x653;
-        let x655 = 1.0
-            / (x78 - x245 * x537 - x246 * x545 - x247 * x551 - x569 * x570 - x588 * x589
-                - x607 * x608 - x622 * x623 - x633 * x634 - x642 * x643 - x649 * x650);
-        let x656 = x71 - x245 * x538 - x246 * x546 - x247 * x552 - x569 * x572
-            - x588 * x591 - x607 * x611 - x622 * x625 - x633 * x636 - x642 * x645
-            - x649 * x652;
-        let x657 = x655 * x656;
-        let x658 = x285 - x245 * x539 - x246 * x547 - x247 * x553 - x569 * x574
-            - x588 * x593 - x607 * x614 - x622 * x627 - x633 * x638 - x642 * x647
-            - x649 * x654;
-        let x659 = x655 * x658;
-        let x660 = 1.0
-            / (x55 - x274 * x538 - x275 * x546 - x276 * x552 - x571 * x572 - x590 * x591
-                - x610 * x611 - x624 * x625 - x635 * x636 - x644 * x645 - x651 * x652
-                - x656 * x657);
-        let x661 = x282 - x274 * x539 - x275 * x547 - x276 * x553 - x571 * x574
-            - x590 * x593 - x610 * x614 - x624 * x627 - x635 * x638 - x644 * x647
-            - x651 * x654 - x656 * x659;
-        let x662 = x660 * x661;
-        let x663 = 1.0
-            / (1.4135609200000003 - x311 * x539 - x312 * x547 - x313 * x553 - x573 * x574
-                - x592 * x593 - x613 * x614 - x626 * x627 - x637 * x638 - x646 * x647
-                - x653 * x654 - x658 * x659 - x661 * x662);
-        let x664 = x531 * x533
-            - (v[4] * x316 - v[5] * x315 + (v[1] * x319 - v[2] * x318) - f_ext[0][3]
-                + (c_q7 * x521 - s_q7 * x522 + -0.75 * x527) + x530 * x532);
-        let x665 = x529 * x532
-            - (v[5] * x314 - v[3] * x316 + (v[2] * x317 - v[0] * x319) - f_ext[0][4]
-                + (s_q7 * x521 + c_q7 * x522 + (0.75 * x526 + -0.65 * x528)))
-            - x531 * x540 - x558 * x664;
-        let x666 = x529 * x533;
-        let x667 = x530 * x540
-            - (v[3] * x315 - v[4] * x314 + (v[0] * x318 - v[1] * x317) - f_ext[0][5]
-                + (x1 * x523 + 0.65 * x527) + x666) - x560 * x664 - x579 * x665;
-        let x668 = tau[0] - x523 - x666 + x530 * x541 - x562 * x664 - x581 * x665
-            - x596 * x667;
-        let x669 = tau[1] - x515 - x529 * x534 + x530 * x542 + x531 * x548 - x564 * x664
-            - x583 * x665 - x599 * x667 - x617 * x668;
-        let x670 = tau[2] - x506 + x529 * x535 + x530 * x543 + x531 * x549 - x566 * x664
-            - x585 * x665 - x602 * x667 - x619 * x668 - x630 * x669;
-        let x671 = tau[3] - x499 + x529 * x536 + x530 * x544 + x531 * x550 - x568 * x664
-            - x587 * x665 - x605 * x667 - x621 * x668 - x632 * x669 - x641 * x670;
-        let x672 = tau[4] - x491 + x529 * x537 + x530 * x545 + x531 * x551 - x570 * x664
-            - x589 * x665 - x608 * x667 - x623 * x668 - x634 * x669 - x643 * x670
-            - x650 * x671;
-        let x673 = tau[5] - x483 + x529 * x538 + x530 * x546 + x531 * x552 - x572 * x664
-            - x591 * x665 - x611 * x667 - x625 * x668 - x636 * x669 - x645 * x670
-            - x652 * x671 - x657 * x672;
-        let x674 = x663
-            * (tau[6] - x474 + x529 * x539 + x530 * x547 + x531 * x553 - x574 * x664
-                - x593 * x665 - x614 * x667 - x627 * x668 - x638 * x669 - x647 * x670
-                - x654 * x671 - x659 * x672 - x662 * x673);
-        let x675 = x660 * x673 - x662 * x674;
-        let x676 = x655 * x672 - x657 * x675 - x659 * x674;
-        let x677 = x648 * x671 - x650 * x676 - x652 * x675 - x654 * x674;
-        let x678 = x639 * x670 - x641 * x677 - x643 * x676 - x645 * x675 - x647 * x674;
-        let x679 = x628 * x669 - x630 * x678 - x632 * x677 - x634 * x676 - x636 * x675
-            - x638 * x674;
-        let x680 = x615 * x668 - x617 * x679 - x619 * x678 - x621 * x677 - x623 * x676
-            - x625 * x675 - x627 * x674;
-        let x681 = x594 * x667 - x596 * x680 - x599 * x679 - x602 * x678 - x605 * x677
-            - x608 * x676 - x611 * x675 - x614 * x674;
-        let x682 = x576 * x665 - x579 * x681 - x581 * x680 - x583 * x679 - x585 * x678
-            - x587 * x677 - x589 * x676 - x591 * x675 - x593 * x674;
-        let x683 = x556 * x664 - x558 * x682 - x560 * x681 - x562 * x680 - x564 * x679
-            - x566 * x678 - x568 * x677 - x570 * x676 - x572 * x675 - x574 * x674;
-        let x684 = x540 * x682 - (x531 * 0.0008546497218115156 + x533 * x683)
-            - x548 * x679 - x549 * x678 - x550 * x677 - x551 * x676 - x552 * x675
-            - x553 * x674;
-        let x685 = x532 * x683 - x530 * 0.0008546497218115156 - x540 * x681 - x541 * x680
-            - x542 * x679 - x543 * x678 - x544 * x677 - x545 * x676 - x546 * x675
-            - x547 * x674;
-        let x686 = x533 * x681 - (x529 * 0.0008546497218115156 + x532 * x682)
-            + x533 * x680 + x534 * x679 - x535 * x678 - x536 * x677 - x537 * x676
-            - x538 * x675 - x539 * x674;
-        [x686, x685, x684, x683, x682, x681, x680, x679, x678, x677, x676, x675, x674]
+        let x15 = -0.00000000020510342851533115 * c_q13;
+        let x16 = -0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = -0.0145 - 0.000781 * x16;
+        let x21 = -0.9614610000000001 + (0.000781 * x15 - -1.2025609200000003 * x16);
+        let x22 = 1.4135609200000003 + (-0.0145 * x15 - -0.9614610000000001 * x16);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = x24 + -1.2025609200000003 * c_q13;
+        let x26 = -0.0145 * s_q13 + -0.9614610000000001 * c_q13;
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = -1.2025609200000003 * s_q13 - x23 + 0.00000000019719894748377882;
+        let x29 = -0.9614610000000001 * s_q13 - -0.0145 * c_q13
+            + -0.0000000002899261911072858;
+        let x30 = -0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = 0.16 * x19;
+        let x33 = x18 * -0.55;
+        let x34 = x22 + (x15 * x20 - x16 * x21) - (x30 - x31) - (x33 - x32);
+        let x35 = 3.6140000000000003 - x17;
+        let x36 = 17.135250000000003 + x18;
+        let x37 = -1.9877000000000002 + (s_q13 * x20 + c_q13 * x21 + 0.55 * x17);
+        let x38 = -0.809539999555672
+            + (s_q13 * x21 - c_q13 * x20 + -0.00000000020510342851533115 * x22
+                - -0.16 * x17);
+        let x39 = -1.9877000000000002 + (x26 + (x15 * x23 - x16 * x25) - x17 * -0.55);
+        let x40 = -5.252920330000002 + (s_q13 * x23 + c_q13 * x25 + x32 - x30);
+        let x41 = -2.741639999592316
+            + (s_q13 * x25 - c_q13 * x23 + -0.00000000020510342851533115 * x26
+                - 0.16 * x18 - 0.55 * x19);
+        let x42 = -0.809539999555672 + (x29 + (x15 * x27 - x16 * x28) + 0.16 * x17);
+        let x43 = -2.7416399995923166
+            + (s_q13 * x27 + c_q13 * x28 + x19 * -0.55 + -0.16 * x18);
+        let x44 = 9.740442170000001
+            + (x31
+                + (s_q13 * x28 - c_q13 * x27 + -0.00000000020510342851533115 * x29
+                    - x33));
+        let x45 = c_q12 * x35;
+        let x46 = s_q12 * x36;
+        let x47 = x45 - x46;
+        let x48 = x19 + (x12 * x35 + x13 * x36);
+        let x49 = s_q12 * x35 + c_q12 * x36;
+        let x50 = -0.00000000020510342851533115 * x19 - x49;
+        let x51 = c_q12 * x34 - s_q12 * x39;
+        let x52 = c_q12 * x37 - s_q12 * x40;
+        let x53 = c_q12 * x38 - s_q12 * x41;
+        let x54 = x42 + (x12 * x34 + x13 * x39);
+        let x55 = x43 + (x12 * x37 + x13 * x40);
+        let x56 = x44 + (x12 * x38 + x13 * x41);
+        let x57 = -0.00000000020510342851533115 * x42 - (s_q12 * x34 + c_q12 * x39);
+        let x58 = -0.00000000020510342851533115 * x43 - (s_q12 * x37 + c_q12 * x40);
+        let x59 = -0.00000000020510342851533115 * x44 - (s_q12 * x38 + c_q12 * x41);
+        let x60 = x53 + (x12 * x51 + x13 * x52);
+        let x61 = c_q12 * x54 - s_q12 * x55;
+        let x62 = x50 * 0.36;
+        let x63 = -0.36 * x50;
+        let x64 = x63 + (c_q12 * x51 - s_q12 * x52 - x62);
+        let x65 = 7.078399999258757 + x48;
+        let x66 = 0.01675
+            + (-0.00000000020510342851533115 * x53 - (s_q12 * x51 + c_q12 * x52)
+                + x47 * 0.36);
+        let x67 = -9.142025249762803 + (x56 + (x12 * x54 + x13 * x55) + x63 - x62);
+        let x68 = 2.5482240016099564
+            + (-0.00000000020510342851533115 * x56 - (s_q12 * x54 + c_q12 * x55)
+                - -0.36 * x48);
+        let x69 = 0.01675 + (c_q12 * x57 - s_q12 * x58 - -0.36 * x47);
+        let x70 = 2.5482240016099564 + (x59 + (x12 * x57 + x13 * x58) + x48 * 0.36);
+        let x71 = 9.223235249762805
+            + (-0.00000000020510342851533115 * x59 - (s_q12 * x57 + c_q12 * x58));
+        let x72 = c_q11 * x47 - s_q11 * x65;
+        let x73 = s_q11 * x47 + c_q11 * x65;
+        let x74 = c_q11 * x64 - s_q11 * x61;
+        let x75 = c_q11 * x60 - s_q11 * x67;
+        let x76 = s_q11 * x64 + c_q11 * x61;
+        let x77 = s_q11 * x60 + c_q11 * x67;
+        let x78 = 0.275 * x50;
+        let x79 = -0.63 * x73;
+        let x80 = -0.275 * x50;
+        let x81 = x73 * 0.63;
+        let x82 = s_q11 * x74 + c_q11 * x75 - -0.63 * x72;
+        let x83 = c_q11 * x66 - s_q11 * x68 + 0.275 * x72;
+        let x84 = s_q11 * x66 + c_q11 * x68 - -0.275 * x73;
+        let x85 = x71 - x81;
+        let x86 = c_q11 * x74 - s_q11 * x75 - (x78 - x79) - (x81 - x80);
+        let x87 = c_q11 * x76 - s_q11 * x77 + x72 * 0.63;
+        let x88 = -45.1584 + x73;
+        let x89 = -0.6328 + x83;
+        let x90 = -24.4950615 + (s_q11 * x76 + c_q11 * x77 + x80 - x78);
+        let x91 = -24.35164200091464 + (x84 - -0.63 * x50);
+        let x92 = -0.6328 + (c_q11 * x69 - s_q11 * x70 - -0.275 * x72);
+        let x93 = -24.351642000914637
+            + (s_q11 * x69 + c_q11 * x70 + x50 * 0.63 + 0.275 * x73);
+        let x94 = 28.2393615 + (x79 + x85);
+        let x95 = c_q10 * x72;
+        let x96 = x95 - s_q10 * x88;
+        let x97 = s_q10 * x72;
+        let x98 = x97 + c_q10 * x88;
+        let x99 = c_q10 * x86 - s_q10 * x87;
+        let x100 = c_q10 * x82 - s_q10 * x90;
+        let x101 = c_q10 * x89 - s_q10 * x91;
+        let x102 = s_q10 * x86 + c_q10 * x87;
+        let x103 = s_q10 * x82 + c_q10 * x90;
+        let x104 = s_q10 * x89 + c_q10 * x91;
+        let x105 = -0.87 * x98;
+        let x106 = x98 * 0.87;
+        let x107 = s_q10 * x99 + c_q10 * x100 - -0.87 * x96;
+        let x108 = x94 - x106;
+        let x109 = c_q10 * x99 - s_q10 * x100 + x105 - x106;
+        let x110 = c_q10 * x102 - s_q10 * x103 + x96 * 0.87;
+        let x111 = -81.53205 + x98;
+        let x112 = -0.00214 + x101;
+        let x113 = -63.36336825000001 + (s_q10 * x102 + c_q10 * x103);
+        let x114 = -36.18604050126307 + (x104 - -0.87 * x50);
+        let x115 = -0.00214 + (c_q10 * x92 - s_q10 * x93);
+        let x116 = -36.18604050126307 + (s_q10 * x92 + c_q10 * x93 + x50 * 0.87);
+        let x117 = 69.99836825 + (x105 + x108);
+        let x118 = x5 * x96 + x6 * x111 + 0.00000000020510342851533115 * x50;
+        let x119 = x50 + (x7 * x96 + x8 * x111);
+        let x120 = c_q9 * x96 - s_q9 * x111 + -0.00000000020510342851533115 * x50;
+        let x121 = x5 * x109 + x6 * x110 + 0.00000000020510342851533115 * x115;
+        let x122 = x5 * x107 + x6 * x113 + 0.00000000020510342851533115 * x116;
+        let x123 = x5 * x112 + x6 * x114 + 0.00000000020510342851533115 * x117;
+        let x124 = x115 + (x7 * x109 + x8 * x110);
+        let x125 = x116 + (x7 * x107 + x8 * x113);
+        let x126 = x117 + (x7 * x112 + x8 * x114);
+        let x127 = c_q9 * x109 - s_q9 * x110 + -0.00000000020510342851533115 * x115;
+        let x128 = c_q9 * x107 - s_q9 * x113 + -0.00000000020510342851533115 * x116;
+        let x129 = c_q9 * x112 - s_q9 * x114 + -0.00000000020510342851533115 * x117;
+        let x130 = x120 * -0.4;
+        let x131 = 0.275 * x119;
+        let x132 = 0.4 * x120;
+        let x133 = -0.275 * x119;
+        let x134 = x5 * x121 + x6 * x122 + 0.00000000020510342851533115 * x123
+            - (x130 - x131) - (x133 - x132);
+        let x135 = -0.000000008530897668050218 + x118;
+        let x136 = -12.701650001451807 + x119;
+        let x137 = -0.0000000234896432582596
+            + (x123 + (x7 * x121 + x8 * x122) - 0.275 * x118);
+        let x138 = -0.0021399965876409276
+            + (c_q9 * x121 - s_q9 * x122 + -0.00000000020510342851533115 * x123
+                + x118 * -0.4);
+        let x139 = -0.0000000234896432582596
+            + (x5 * x124 + x6 * x125 + 0.00000000020510342851533115 * x126
+                + -0.275 * x118);
+        let x140 = -111.7548902508081 + (x126 + (x7 * x124 + x8 * x125) + x132 - x130);
+        let x141 = 5.080660024070365
+            + (c_q9 * x124 - s_q9 * x125 + -0.00000000020510342851533115 * x126
+                - 0.4 * x119 - 0.275 * x120);
+        let x142 = -0.0021399965876409276
+            + (x5 * x127 + x6 * x128 + 0.00000000020510342851533115 * x129 - 0.4 * x118);
+        let x143 = 5.080660024070366
+            + (x129 + (x7 * x127 + x8 * x128) + -0.275 * x120 + x119 * -0.4);
+        let x144 = 113.3918902508081
+            + (x131
+                + (c_q9 * x127 - s_q9 * x128 + -0.00000000020510342851533115 * x129
+                    - x133));
+        let x145 = x120 + (x2 * x135 - x3 * x136);
+        let x146 = s_q8 * x135 + c_q8 * x136;
+        let x147 = c_q8 * x135;
+        let x148 = s_q8 * x136;
+        let x149 = x148 - x147 + -0.00000000020510342851533115 * x120;
+        let x150 = x142 + (x2 * x134 - x3 * x139);
+        let x151 = x143 + (x2 * x137 - x3 * x140);
+        let x152 = x144 + (x2 * x138 - x3 * x141);
+        let x153 = s_q8 * x134 + c_q8 * x139;
+        let x154 = s_q8 * x137 + c_q8 * x140;
+        let x155 = s_q8 * x138 + c_q8 * x141;
+        let x156 = s_q8 * x141 - c_q8 * x138 + -0.00000000020510342851533115 * x144;
+        let x157 = x149 * -0.35;
+        let x158 = 0.35 * x149;
+        let x159 = x158 + (x152 + (x2 * x150 - x3 * x151) - x157);
+        let x160 = 48.0240000085309 + x145;
+        let x161 = -0.07309 + (s_q8 * x150 + c_q8 * x151);
+        let x162 = -16.80768997608804
+            + (s_q8 * x151 - c_q8 * x150 + -0.00000000020510342851533115 * x152
+                + x145 * -0.35);
+        let x163 = -0.07309 + (x155 + (x2 * x153 - x3 * x154));
+        let x164 = 130.43769025763282 + (s_q8 * x153 + c_q8 * x154 + x158 - x157);
+        let x165 = 0.1132
+            + (s_q8 * x154 - c_q8 * x153 + -0.00000000020510342851533115 * x155
+                - 0.35 * x146);
+        let x166 = 132.47349025763282
+            + (s_q8 * (s_q8 * x140 - c_q8 * x137 + -0.00000000020510342851533115 * x143)
+                - c_q8
+                    * (s_q8 * x139 - c_q8 * x134 + -0.00000000020510342851533115 * x142)
+                + -0.00000000020510342851533115 * x156);
+        let x167 = c_q7 * x160 - s_q7 * x146;
+        let x168 = s_q7 * x160 + c_q7 * x146;
+        let x169 = c_q7 * x159 - s_q7 * x163;
+        let x170 = c_q7 * x161 - s_q7 * x164;
+        let x171 = x149 * -0.75;
+        let x172 = 0.75 * x149;
+        let x173 = x167 * -0.65;
+        let x174 = 0.65 * x167;
+        let x175 = c_q7 * x162 - s_q7 * x165 + x167 * -0.75;
+        let x176 = x166 + x174;
+        let x177 = 110.5455 + x167;
+        let x178 = 180.9502499901501 + x149;
+        let x179 = x2 * x136 + x3 * x135;
+        let x180 = x147 - x148;
+        let x181 = x152 + -0.35 * x180;
+        let x182 = x155 - 0.35 * x179;
+        let x183 = c_q7 * x179 + s_q7 * x180;
+        let x184 = c_q7 * x180 - s_q7 * x179;
+        let x185 = x6 * x96;
+        let x186 = x185 - x5 * x111;
+        let x187 = x8 * x96;
+        let x188 = x187 - x7 * x111;
+        let x189 = s_q9 * x96;
+        let x190 = c_q9 * x111 + x189;
+        let x191 = x123 + (-0.4 * x188 - 0.275 * x190);
+        let x192 = x126 + 0.4 * x186;
+        let x193 = x129 + -0.275 * x186;
+        let x194 = x2 * x186 - x3 * x188 - x190;
+        let x195 = s_q8 * x186 + c_q8 * x188;
+        let x196 = s_q8 * x188 - c_q8 * x186 - -0.00000000020510342851533115 * x190;
+        let x197 = s_q8 * x192 - c_q8 * x191 + -0.00000000020510342851533115 * x193;
+        let x198 = x193 + (x2 * x191 - x3 * x192) + -0.35 * x195;
+        let x199 = s_q8 * x191 + c_q8 * x192 + 0.35 * x194;
+        let x200 = c_q7 * x194 - s_q7 * x195;
+        let x201 = s_q7 * x194 + c_q7 * x195;
+        let x202 = x185 - x5 * x98;
+        let x203 = x187 - x7 * x98;
+        let x204 = x189 + c_q9 * x98;
+        let x205 = x5 * x101 + x6 * x104 + 0.00000000020510342851533115 * x108
+            + (-0.4 * x203 - 0.275 * x204);
+        let x206 = x108 + (x7 * x101 + x8 * x104) + 0.4 * x202;
+        let x207 = c_q9 * x101 - s_q9 * x104 + -0.00000000020510342851533115 * x108
+            + -0.275 * x202;
+        let x208 = x2 * x202 - x3 * x203 - x204;
+        let x209 = s_q8 * x202 + c_q8 * x203;
+        let x210 = s_q8 * x203 - c_q8 * x202 - -0.00000000020510342851533115 * x204;
+        let x211 = s_q8 * x206 - c_q8 * x205 + -0.00000000020510342851533115 * x207;
+        let x212 = x207 + (x2 * x205 - x3 * x206) + -0.35 * x209;
+        let x213 = s_q8 * x205 + c_q8 * x206 + 0.35 * x208;
+        let x214 = c_q7 * x208 - s_q7 * x209;
+        let x215 = s_q7 * x208 + c_q7 * x209;
+        let x216 = x97 + c_q10 * x73;
+        let x217 = x95 - s_q10 * x73;
+        let x218 = c_q10 * x83 - s_q10 * x84;
+        let x219 = s_q10 * x83 + c_q10 * x84;
+        let x220 = x85 - 0.87 * x216;
+        let x221 = x6 * x217 - x5 * x216;
+        let x222 = x8 * x217 - x7 * x216;
+        let x223 = c_q9 * x216 + s_q9 * x217;
+        let x224 = x5 * x218 + x6 * x219 + 0.00000000020510342851533115 * x220
+            + (-0.4 * x222 - 0.275 * x223);
+        let x225 = x220 + (x7 * x218 + x8 * x219) + 0.4 * x221;
+        let x226 = c_q9 * x218 - s_q9 * x219 + -0.00000000020510342851533115 * x220
+            + -0.275 * x221;
+        let x227 = x2 * x221 - x3 * x222 - x223;
+        let x228 = s_q8 * x221 + c_q8 * x222;
+        let x229 = s_q8 * x222 - c_q8 * x221 - -0.00000000020510342851533115 * x223;
+        let x230 = s_q8 * x225 - c_q8 * x224 + -0.00000000020510342851533115 * x226;
+        let x231 = x226 + (x2 * x224 - x3 * x225) + -0.35 * x228;
+        let x232 = s_q8 * x224 + c_q8 * x225 + 0.35 * x227;
+        let x233 = c_q7 * x227 - s_q7 * x228;
+        let x234 = s_q7 * x227 + c_q7 * x228;
+        let x235 = x13 * x35 - x12 * x36;
+        let x236 = x46 - x45;
+        let x237 = x53 + 0.36 * x235;
+        let x238 = x56 - -0.36 * x49;
+        let x239 = c_q11 * x49 + s_q11 * x235;
+        let x240 = c_q11 * x235 - s_q11 * x49;
+        let x241 = c_q11 * x237 - s_q11 * x238 + (0.275 * x240 + -0.63 * x236);
+        let x242 = s_q11 * x237 + c_q11 * x238 - -0.275 * x239;
+        let x243 = x59 - 0.63 * x239;
+        let x244 = c_q10 * x239 + s_q10 * x240;
+        let x245 = c_q10 * x240 - s_q10 * x239;
+        let x246 = s_q10 * x241 + c_q10 * x242;
+        let x247 = c_q10 * x241 - s_q10 * x242 + -0.87 * x236;
+        let x248 = x243 - 0.87 * x244;
+        let x249 = x6 * x245 - x5 * x244 + 0.00000000020510342851533115 * x236;
+        let x250 = x236 + (x8 * x245 - x7 * x244);
+        let x251 = -0.00000000020510342851533115 * x236 - (c_q9 * x244 + s_q9 * x245);
+        let x252 = x5 * x247 + x6 * x246 + 0.00000000020510342851533115 * x248
+            + (-0.4 * x250 + 0.275 * x251);
+        let x253 = x248 + (x7 * x247 + x8 * x246) + 0.4 * x249;
+        let x254 = c_q9 * x247 - s_q9 * x246 + -0.00000000020510342851533115 * x248
+            + -0.275 * x249;
+        let x255 = x251 + (x2 * x249 - x3 * x250);
+        let x256 = s_q8 * x249 + c_q8 * x250;
+        let x257 = s_q8 * x250 - c_q8 * x249 + -0.00000000020510342851533115 * x251;
+        let x258 = s_q8 * x253 - c_q8 * x252 + -0.00000000020510342851533115 * x254;
+        let x259 = x254 + (x2 * x252 - x3 * x253) + -0.35 * x256;
+        let x260 = s_q8 * x252 + c_q8 * x253 + 0.35 * x255;
+        let x261 = c_q7 * x255 - s_q7 * x256;
+        let x262 = s_q7 * x255 + c_q7 * x256;
+        let x263 = x15 * -4.806620000000001;
+        let x264 = s_q13 * -4.806620000000001;
+        let x265 = c_q13 * -4.806620000000001;
+        let x266 = x22 + (-0.16 * x264 - 0.55 * x265);
+        let x267 = x26 + 0.16 * x263;
+        let x268 = x29 + -0.55 * x263;
+        let x269 = c_q12 * x263 - s_q12 * x264;
+        let x270 = x12 * x263 + x13 * x264 - x265;
+        let x271 = s_q12 * x263 + c_q12 * x264 + -0.00000000020510342851533115 * x265;
+        let x272 = -0.00000000020510342851533115 * x268 - (s_q12 * x266 + c_q12 * x267);
+        let x273 = c_q12 * x266 - s_q12 * x267 + 0.36 * x270;
+        let x274 = x268 + (x12 * x266 + x13 * x267) + -0.36 * x269;
+        let x275 = c_q11 * x269 - s_q11 * x270;
+        let x276 = s_q11 * x269 + c_q11 * x270;
+        let x277 = c_q11 * x273 - s_q11 * x274 + (0.275 * x276 - -0.63 * x271);
+        let x278 = s_q11 * x273 + c_q11 * x274 + -0.275 * x275;
+        let x279 = x272 + 0.63 * x275;
+        let x280 = c_q10 * x275 - s_q10 * x276;
+        let x281 = s_q10 * x275 + c_q10 * x276;
+        let x282 = s_q10 * x277 + c_q10 * x278;
+        let x283 = c_q10 * x277 - s_q10 * x278 - -0.87 * x271;
+        let x284 = x279 + 0.87 * x280;
+        let x285 = x5 * x280 + x6 * x281 - 0.00000000020510342851533115 * x271;
+        let x286 = x7 * x280 + x8 * x281 - x271;
+        let x287 = c_q9 * x280 - s_q9 * x281 - -0.00000000020510342851533115 * x271;
+        let x288 = x5 * x283 + x6 * x282 + 0.00000000020510342851533115 * x284
+            + (-0.4 * x286 + 0.275 * x287);
+        let x289 = x284 + (x7 * x283 + x8 * x282) + 0.4 * x285;
+        let x290 = c_q9 * x283 - s_q9 * x282 + -0.00000000020510342851533115 * x284
+            + -0.275 * x285;
+        let x291 = x287 + (x2 * x285 - x3 * x286);
+        let x292 = s_q8 * x285 + c_q8 * x286;
+        let x293 = s_q8 * x286 - c_q8 * x285 + -0.00000000020510342851533115 * x287;
+        let x294 = s_q8 * x289 - c_q8 * x288 + -0.00000000020510342851533115 * x290;
+        let x295 = x290 + (x2 * x288 - x3 * x289) + -0.35 * x292;
+        let x296 = s_q8 * x288 + c_q8 * x289 + 0.35 * x291;
+        let x297 = c_q7 * x291 - s_q7 * x292;
+        let x298 = s_q7 * x291 + c_q7 * x292;
+        let x299 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+            + v[1] * -180.9502499901501;
+        let x300 = 1466.4506062283303 * v[4]
+            + (180.9502499901501 * v[0] + v[2] * -110.5455);
+        let x301 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x302 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x303 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x304 = 1170.07 * v[2] - 110.5455 * v[4];
+        let x305 = v[3] * c_q7 + v[4] * s_q7;
+        let x306 = v[4] * c_q7 - v[3] * s_q7;
+        let x307 = v[0] - v[4] * -0.75;
+        let x308 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x309 = v[2] - 0.65 * v[4];
+        let x310 = c_q7 * x307 + s_q7 * x308;
+        let x311 = c_q7 * x308 - s_q7 * x307;
+        let x312 = v[5] + v[6];
+        let x313 = v[6] * x306;
+        let x314 = v[6] * x305;
+        let x315 = v[6] * x310;
+        let x316 = -0.07309 * x306 + -16.80768997608804 * x312;
+        let x317 = -0.07309 * x305 + 130.43769025763282 * x306 + 0.1132 * x312
+            + x309 * -48.0240000085309;
+        let x318 = -16.80768997608804 * x305 + 0.1132 * x306 + 132.47349025763282 * x312
+            + 48.0240000085309 * x311;
+        let x319 = x312 * -48.0240000085309;
+        let x320 = 48.0240000085309 * x306;
+        let x321 = x2 * x305 + s_q8 * x306 - c_q8 * x312;
+        let x322 = c_q8 * x306 - x3 * x305 + s_q8 * x312;
+        let x323 = x310 - -0.35 * x306;
+        let x324 = x311 - 0.35 * x305;
+        let x325 = x2 * x323 + s_q8 * x324 - c_q8 * x309;
+        let x326 = c_q8 * x324 - x3 * x323 + s_q8 * x309;
+        let x327 = x323 + -0.00000000020510342851533115 * x309;
+        let x328 = v[7] + (x305 + -0.00000000020510342851533115 * x312);
+        let x329 = v[6] * x311 + -0.35 * x314;
+        let x330 = x315 + 0.35 * x313;
+        let x331 = x2 * x313 - s_q8 * x314 + v[7] * x322;
+        let x332 = x3 * x313 + c_q8 * x314 + v[7] * x321;
+        let x333 = x2 * x329 - s_q8 * x330 + v[7] * x326;
+        let x334 = x3 * x329 + c_q8 * x330 + v[7] * x325;
+        let x335 = -0.0000000234896432582596 * x322 + -0.0021399965876409276 * x328
+            + -12.701650001451807 * x327;
+        let x336 = -0.0000000234896432582596 * x321 + -111.7548902508081 * x322
+            + 5.080660024070365 * x328 + x327 * 0.000000008530897668050218;
+        let x337 = -0.0021399965876409276 * x321 + 5.080660024070366 * x322
+            + 113.3918902508081 * x328
+            + (x325 * 12.701650001451807 + -0.000000008530897668050218 * x326);
+        let x338 = -12.701650001451807 * x328;
+        let x339 = x328 * 0.000000008530897668050218;
+        let x340 = x321 * 12.701650001451807 + -0.000000008530897668050218 * x322;
+        let x341 = x5 * x321 + x7 * x322 + c_q9 * x328;
+        let x342 = x6 * x321 + x8 * x322 - s_q9 * x328;
+        let x343 = x325 - (-0.4 * x322 + 0.275 * x328);
+        let x344 = x326 - 0.4 * x321;
+        let x345 = x327 - -0.275 * x321;
+        let x346 = x5 * x343 + x7 * x344 + c_q9 * x345;
+        let x347 = x6 * x343 + x8 * x344 - s_q9 * x345;
+        let x348 = x344 + 0.00000000020510342851533115 * x343
+            + -0.00000000020510342851533115 * x345;
+        let x349 = v[8]
+            + (x322 + 0.00000000020510342851533115 * x321
+                + -0.00000000020510342851533115 * x328);
+        let x350 = 0.00000000020510342851533115 * x331 - x332
+            + -0.00000000020510342851533115 * x313;
+        let x351 = x333 - (0.275 * x313 - -0.4 * x332);
+        let x352 = x334 + 0.4 * x331;
+        let x353 = x329 - -0.275 * x331;
+        let x354 = 0.00000000020510342851533115 * x351 - x352
+            + -0.00000000020510342851533115 * x353;
+        let x355 = x5 * x331 - x7 * x332 + c_q9 * x313 + v[8] * x342;
+        let x356 = x6 * x331 - x8 * x332 - s_q9 * x313 - v[8] * x341;
+        let x357 = x5 * x351 - x7 * x352 + c_q9 * x353 + v[8] * x347;
+        let x358 = x6 * x351 - x8 * x352 - s_q9 * x353 - v[8] * x346;
+        let x359 = -63.36336825000001 * x342 + -36.18604050126307 * x349;
+        let x360 = -0.00214 * x349 + -81.53205 * x348;
+        let x361 = -0.00214 * x341 + -36.18604050126307 * x342 + 69.99836825 * x349
+            + x346 * 81.53205;
+        let x362 = -81.53205 * x349;
+        let x363 = x341 * 81.53205;
+        let x364 = c_q10 * x341 + s_q10 * x342;
+        let x365 = c_q10 * x342 - s_q10 * x341;
+        let x366 = x346 - -0.87 * x349;
+        let x367 = x348 - 0.87 * x341;
+        let x368 = c_q10 * x366 + s_q10 * x347;
+        let x369 = c_q10 * x347 - s_q10 * x366;
+        let x370 = v[9] + x349;
+        let x371 = x357 - -0.87 * x350;
+        let x372 = x354 - 0.87 * x355;
+        let x373 = c_q10 * x355 + s_q10 * x356 + v[9] * x365;
+        let x374 = c_q10 * x356 - s_q10 * x355 - v[9] * x364;
+        let x375 = c_q10 * x371 + s_q10 * x358 + v[9] * x369;
+        let x376 = -24.4950615 * x365 + -24.35164200091464 * x370;
+        let x377 = -0.6328 * x370 + -45.1584 * x367;
+        let x378 = -0.6328 * x364 + -24.351642000914637 * x365 + 28.2393615 * x370
+            + x368 * 45.1584;
+        let x379 = -45.1584 * x370;
+        let x380 = x364 * 45.1584;
+        let x381 = c_q11 * x364 + s_q11 * x365;
+        let x382 = c_q11 * x365 - s_q11 * x364;
+        let x383 = x368 - (0.275 * x365 + -0.63 * x370);
+        let x384 = x369 - -0.275 * x364;
+        let x385 = x367 - 0.63 * x364;
+        let x386 = c_q11 * x383 + s_q11 * x384;
+        let x387 = c_q11 * x384 - s_q11 * x383;
+        let x388 = v[10] + x370;
+        let x389 = x375 - (0.275 * x374 + -0.63 * x350);
+        let x390 = c_q10 * x358 - s_q10 * x371 - v[9] * x368 - -0.275 * x373;
+        let x391 = x372 - 0.63 * x373;
+        let x392 = c_q11 * x373 + s_q11 * x374 + v[10] * x382;
+        let x393 = c_q11 * x374 - s_q11 * x373 - v[10] * x381;
+        let x394 = c_q11 * x389 + s_q11 * x390 + v[10] * x387;
+        let x395 = -9.142025249762803 * x382 + 2.5482240016099564 * x388;
+        let x396 = 0.01675 * x388 + 7.078399999258757 * x385;
+        let x397 = 0.01675 * x381 + 2.5482240016099564 * x382 + 9.223235249762805 * x388
+            + x386 * -7.078399999258757;
+        let x398 = 7.078399999258757 * x388;
+        let x399 = x381 * -7.078399999258757;
+        let x400 = c_q12 * x381 + x12 * x382 - s_q12 * x388;
+        let x401 = x13 * x382 - s_q12 * x381 - c_q12 * x388;
+        let x402 = x386 - 0.36 * x382;
+        let x403 = x387 - -0.36 * x381;
+        let x404 = c_q12 * x402 + x12 * x403 - s_q12 * x385;
+        let x405 = x13 * x403 - s_q12 * x402 - c_q12 * x385;
+        let x406 = x403 + -0.00000000020510342851533115 * x385;
+        let x407 = v[11] + (x382 + -0.00000000020510342851533115 * x388);
+        let x408 = x393 + -0.00000000020510342851533115 * x350;
+        let x409 = x394 - 0.36 * x393;
+        let x410 = c_q11 * x390 - s_q11 * x389 - v[10] * x386 - -0.36 * x392;
+        let x411 = x410 + -0.00000000020510342851533115 * x391;
+        let x412 = c_q12 * x392 + x12 * x393 - s_q12 * x350 + v[11] * x401;
+        let x413 = x13 * x393 - s_q12 * x392 - c_q12 * x350 - v[11] * x400;
+        let x414 = c_q12 * x409 + x12 * x410 - s_q12 * x391 + v[11] * x405;
+        let x415 = x13 * x410 - s_q12 * x409 - c_q12 * x391 - v[11] * x404;
+        let x416 = -1.9877000000000002 * x401 + -0.809539999555672 * x407
+            + 17.135250000000003 * x406;
+        let x417 = -1.9877000000000002 * x400 + -5.252920330000002 * x401
+            + -2.741639999592316 * x407 + x406 * -3.6140000000000003;
+        let x418 = -0.809539999555672 * x400 + -2.7416399995923166 * x401
+            + 9.740442170000001 * x407
+            + (x404 * -17.135250000000003 + 3.6140000000000003 * x405);
+        let x419 = 17.135250000000003 * x407;
+        let x420 = x407 * -3.6140000000000003;
+        let x421 = x400 * -17.135250000000003 + 3.6140000000000003 * x401;
+        let x422 = x15 * x400 + s_q13 * x401 - c_q13 * x407;
+        let x423 = c_q13 * x401 - x16 * x400 + s_q13 * x407;
+        let x424 = x404 - (-0.16 * x401 + 0.55 * x407);
+        let x425 = x405 - 0.16 * x400;
+        let x426 = x406 - -0.55 * x400;
+        let x427 = x15 * x424 + s_q13 * x425 - c_q13 * x426;
+        let x428 = c_q13 * x425 - x16 * x424 + s_q13 * x426;
+        let x429 = x424 + -0.00000000020510342851533115 * x426;
+        let x430 = v[12] + (x400 + -0.00000000020510342851533115 * x407);
+        let x431 = x412 + -0.00000000020510342851533115 * x408;
+        let x432 = x414 - (-0.16 * x413 + 0.55 * x408);
+        let x433 = x411 - -0.55 * x412;
+        let x434 = x15 * x412 + s_q13 * x413 - c_q13 * x408 + v[12] * x423;
+        let x435 = c_q13 * x413 - x16 * x412 + s_q13 * x408 - v[12] * x422;
+        let x436 = 0.000781 * x422 + -1.2025609200000003 * x423
+            + -0.9614610000000001 * x430;
+        let x437 = 0.000781 * x423 + -0.0145 * x430 + 4.806620000000001 * x429;
+        let x438 = -0.0145 * x422 + -0.9614610000000001 * x423
+            + 1.4135609200000003 * x430 + -4.806620000000001 * x427;
+        let x439 = 4.806620000000001 * x430;
+        let x440 = -4.806620000000001 * x422;
+        let x441 = 0.000781 * x435 + -0.0145 * x431
+            + 4.806620000000001 * (x432 + -0.00000000020510342851533115 * x433)
+            + (x423 * x438 - x430 * x436 - x428 * x440) - f_ext[7][3];
+        let x442 = 0.000781 * x434 + -1.2025609200000003 * x435
+            + -0.9614610000000001 * x431
+            + (x430 * x437 - x422 * x438 + (x427 * x440 - x429 * x439)) - f_ext[7][4];
+        let x443 = -0.0145 * x434 + -0.9614610000000001 * x435
+            + 1.4135609200000003 * x431
+            + -4.806620000000001
+                * (x15 * x432 + s_q13 * (x415 - 0.16 * x412) - c_q13 * x433
+                    + v[12] * x428) + (x422 * x436 - x423 * x437 + x428 * x439)
+            - f_ext[7][5];
+        let x444 = f_ext[7][0] + (4.806620000000001 * x431 + x423 * x440);
+        let x445 = x422 * x440 - x430 * x439 - f_ext[7][1];
+        let x446 = x423 * x439 - -4.806620000000001 * x434 - f_ext[7][2];
+        let x447 = x446 - (x15 * x444 + x16 * x445);
+        let x448 = c_q13 * x445 - s_q13 * x444;
+        let x449 = c_q13 * x444 + s_q13 * x445 + -0.00000000020510342851533115 * x446;
+        let x450 = -1.9877000000000002 * x413 + -0.809539999555672 * x408
+            + 17.135250000000003 * x411
+            + (x401 * x418 - x407 * x417 + (x406 * x420 - x405 * x421)) - f_ext[6][3]
+            + (x443 + (x15 * x441 - x16 * x442) + (-0.16 * x448 + 0.55 * x449));
+        let x451 = -1.9877000000000002 * x412 + -5.252920330000002 * x413
+            + -2.741639999592316 * x408 + x411 * -3.6140000000000003
+            + (x407 * x416 - x400 * x418 + (x404 * x421 - x406 * x419)) - f_ext[6][4]
+            + (s_q13 * x441 + c_q13 * x442 + 0.16 * x447);
+        let x452 = -0.809539999555672 * x412 + -2.7416399995923166 * x413
+            + 9.740442170000001 * x408
+            + (x414 * -17.135250000000003 + 3.6140000000000003 * x415)
+            + (x400 * x417 - x401 * x416 + (x405 * x419 - x404 * x420)) - f_ext[6][5]
+            + (s_q13 * x442 - c_q13 * x441 + -0.00000000020510342851533115 * x443
+                + -0.55 * x447);
+        let x453 = x407 * x420 - x401 * x421 - 17.135250000000003 * x408 - f_ext[6][0]
+            + x447;
+        let x454 = x400 * x421 - x407 * x419 - x408 * -3.6140000000000003 - f_ext[6][1]
+            + x448;
+        let x455 = x401 * x419 - x400 * x420
+            - (x412 * -17.135250000000003 + 3.6140000000000003 * x413) - f_ext[6][2]
+            + x449;
+        let x456 = c_q12 * x453 - s_q12 * x454;
+        let x457 = x455 + (x12 * x453 + x13 * x454);
+        let x458 = 0.01675 * x350 + 7.078399999258757 * x391
+            + (x382 * x397 - x388 * x395 - x387 * x399) - f_ext[5][3]
+            + (c_q12 * x450 - s_q12 * x451 + 0.36 * x457);
+        let x459 = -9.142025249762803 * x393 + 2.5482240016099564 * x350
+            + (x388 * x396 - x381 * x397 + (x386 * x399 - x385 * x398)) - f_ext[5][4]
+            + (x452 + (x12 * x450 + x13 * x451) + -0.36 * x456);
+        let x460 = 0.01675 * x392 + 2.5482240016099564 * x393 + 9.223235249762805 * x350
+            + x394 * -7.078399999258757 + (x381 * x395 - x382 * x396 + x387 * x398)
+            - f_ext[5][5]
+            + (-0.00000000020510342851533115 * x452 - (s_q12 * x450 + c_q12 * x451));
+        let x461 = x456 - (f_ext[5][0] + (7.078399999258757 * x350 + x382 * x399));
+        let x462 = x381 * x399 - x388 * x398 - f_ext[5][1] + x457;
+        let x463 = x382 * x398 - x392 * -7.078399999258757 - f_ext[5][2]
+            + (-0.00000000020510342851533115 * x455 - (s_q12 * x453 + c_q12 * x454));
+        let x464 = c_q11 * x461 - s_q11 * x462;
+        let x465 = s_q11 * x461 + c_q11 * x462;
+        let x466 = -0.6328 * x350 + -45.1584 * x372
+            + (x365 * x378 - x370 * x376 - x369 * x380) - f_ext[4][3]
+            + (c_q11 * x458 - s_q11 * x459 + (0.275 * x465 + -0.63 * x463));
+        let x467 = -24.4950615 * x374 + -24.35164200091464 * x350
+            + (x370 * x377 - x364 * x378 + (x368 * x380 - x367 * x379)) - f_ext[4][4]
+            + (s_q11 * x458 + c_q11 * x459 + -0.275 * x464);
+        let x468 = -0.6328 * x373 + -24.351642000914637 * x374 + 28.2393615 * x350
+            + x375 * 45.1584 + (x364 * x376 - x365 * x377 + x369 * x379) - f_ext[4][5]
+            + (x460 + 0.63 * x464);
+        let x469 = x464 - (f_ext[4][0] + (-45.1584 * x350 + x365 * x380));
+        let x470 = x364 * x380 - x370 * x379 - f_ext[4][1] + x465;
+        let x471 = x365 * x379 - x373 * 45.1584 - f_ext[4][2] + x463;
+        let x472 = c_q10 * x469 - s_q10 * x470;
+        let x473 = -0.00214 * x350 + -81.53205 * x354
+            + (x342 * x361 - x349 * x359 - x347 * x363) - f_ext[3][3]
+            + (c_q10 * x466 - s_q10 * x467 + -0.87 * x471);
+        let x474 = -63.36336825000001 * x356 + -36.18604050126307 * x350
+            + (x349 * x360 - x341 * x361 + (x346 * x363 - x348 * x362)) - f_ext[3][4]
+            + (s_q10 * x466 + c_q10 * x467);
+        let x475 = -0.00214 * x355 + -36.18604050126307 * x356 + 69.99836825 * x350
+            + x357 * 81.53205 + (x341 * x359 - x342 * x360 + x347 * x362) - f_ext[3][5]
+            + (x468 + 0.87 * x472);
+        let x476 = x472 - (f_ext[3][0] + (-81.53205 * x350 + x342 * x363));
+        let x477 = x341 * x363 - x349 * x362 - f_ext[3][1]
+            + (s_q10 * x469 + c_q10 * x470);
+        let x478 = x342 * x362 - x355 * 81.53205 - f_ext[3][2] + x471;
+        let x479 = x5 * x476 + x6 * x477 + 0.00000000020510342851533115 * x478;
+        let x480 = x478 + (x7 * x476 + x8 * x477);
+        let x481 = c_q9 * x476 - s_q9 * x477 + -0.00000000020510342851533115 * x478;
+        let x482 = -0.0021399965876409276 * x313 - -0.0000000234896432582596 * x332
+            + -12.701650001451807 * x329
+            + (x322 * x337 - x328 * x336 + (x327 * x339 - x326 * x340)) - f_ext[2][3]
+            + (x5 * x473 + x6 * x474 + 0.00000000020510342851533115 * x475
+                + (-0.4 * x480 + 0.275 * x481));
+        let x483 = -0.0000000234896432582596 * x331 - -111.7548902508081 * x332
+            + 5.080660024070365 * x313 + x329 * 0.000000008530897668050218
+            + (x328 * x335 - x321 * x337 + (x325 * x340 - x327 * x338)) - f_ext[2][4]
+            + (x475 + (x7 * x473 + x8 * x474) + 0.4 * x479);
+        let x484 = -0.0021399965876409276 * x331 - 5.080660024070366 * x332
+            + 113.3918902508081 * x313
+            + (x333 * 12.701650001451807 - -0.000000008530897668050218 * x334)
+            + (x321 * x336 - x322 * x335 + (x326 * x338 - x325 * x339)) - f_ext[2][5]
+            + (c_q9 * x473 - s_q9 * x474 + -0.00000000020510342851533115 * x475
+                + -0.275 * x479);
+        let x485 = x328 * x339 - x322 * x340 - -12.701650001451807 * x313 - f_ext[2][0]
+            + x479;
+        let x486 = x321 * x340 - x328 * x338 - x313 * 0.000000008530897668050218
+            - f_ext[2][1] + x480;
+        let x487 = x322 * x338 - x321 * x339
+            - (x331 * 12.701650001451807 - -0.000000008530897668050218 * x332)
+            - f_ext[2][2] + x481;
+        let x488 = x487 + (x2 * x485 - x3 * x486);
+        let x489 = s_q8 * x485 + c_q8 * x486;
+        let x490 = x306 * x318 - x312 * x317 + (x309 * x319 - x311 * x320)
+            - -0.07309 * x314 - f_ext[1][3]
+            + (x484 + (x2 * x482 - x3 * x483) + -0.35 * x489);
+        let x491 = -0.07309 * x313 - 130.43769025763282 * x314
+            + (x312 * x316 - x305 * x318 + x310 * x320) - f_ext[1][4]
+            + (s_q8 * x482 + c_q8 * x483 + 0.35 * x488);
+        let x492 = -16.80768997608804 * x313 - 0.1132 * x314 - 48.0240000085309 * x315
+            + (x305 * x317 - x306 * x316 - x310 * x319) - f_ext[1][5]
+            + (s_q8 * x483 - c_q8 * x482 + -0.00000000020510342851533115 * x484);
+        let x493 = x312 * x319 - x306 * x320 - f_ext[1][0] + x488;
+        let x494 = x305 * x320 - f_ext[1][1] + x489;
+        let x495 = 48.0240000085309 * x314 - x305 * x319 - f_ext[1][2]
+            + (s_q8 * x486 - c_q8 * x485 + -0.00000000020510342851533115 * x487);
+        let x496 = c_q7 * x493 - s_q7 * x494;
+        let x497 = s_q7 * x493 + c_q7 * x494;
+        let x498 = v[4] * x304 - v[5] * x303 - f_ext[0][0] + x496;
+        let x499 = v[5] * x302 - v[3] * x304 - f_ext[0][1] + x497;
+        let x500 = v[3] * x303 - v[4] * x302 - f_ext[0][2] + x495;
+        let x501 = x178 * 0.0008546497218115156;
+        let x502 = x168 * 0.0008546497218115156;
+        let x503 = x183 * 0.0008546497218115156;
+        let x504 = x200 * 0.0008546497218115156;
+        let x505 = x214 * 0.0008546497218115156;
+        let x506 = x233 * 0.0008546497218115156;
+        let x507 = x261 * 0.0008546497218115156;
+        let x508 = x297 * 0.0008546497218115156;
+        let x509 = x177 * 0.0008546497218115156;
+        let x510 = x167 * 0.0008546497218115156;
+        let x511 = x184 * 0.0008546497218115156;
+        let x512 = x201 * 0.0008546497218115156;
+        let x513 = x215 * 0.0008546497218115156;
+        let x514 = x234 * 0.0008546497218115156;
+        let x515 = x262 * 0.0008546497218115156;
+        let x516 = x298 * 0.0008546497218115156;
+        let x517 = x146 * 0.0008546497218115156;
+        let x518 = x196 * 0.0008546497218115156;
+        let x519 = x210 * 0.0008546497218115156;
+        let x520 = x229 * 0.0008546497218115156;
+        let x521 = x257 * 0.0008546497218115156;
+        let x522 = x293 * 0.0008546497218115156;
+        let x523 = x178 * x501;
+        let x524 = x168 * x502;
+        let x525 = 1.0
+            / (1394.5960312283303 + (x172 + (c_q7 * x169 - s_q7 * x170 - x171)) - x523
+                - x524);
+        let x526 = s_q7 * x169 + c_q7 * x170 - 0.65 * x168 + x168 * x509;
+        let x527 = x525 * x526;
+        let x528 = -117.61766249359756 + (x175 + x149 * -0.65) + x178 * x509;
+        let x529 = x525 * x528;
+        let x530 = x175 + x178 * x510;
+        let x531 = x525 * x530;
+        let x532 = c_q7 * x181 - s_q7 * x182 + -0.75 * x184 + x178 * x511 - x168 * x517;
+        let x533 = x525 * x532;
+        let x534 = c_q7 * x198 - s_q7 * x199 + -0.75 * x201 + x178 * x512 - x168 * x518;
+        let x535 = x525 * x534;
+        let x536 = c_q7 * x212 - s_q7 * x213 + -0.75 * x215 + x178 * x513 - x168 * x519;
+        let x537 = x525 * x536;
+        let x538 = c_q7 * x231 - s_q7 * x232 + -0.75 * x234 + x178 * x514 - x168 * x520;
+        let x539 = x525 * x538;
+        let x540 = c_q7 * x259 - s_q7 * x260 + -0.75 * x262 + x178 * x515 - x168 * x521;
+        let x541 = x525 * x540;
+        let x542 = c_q7 * x295 - s_q7 * x296 + -0.75 * x298 + x178 * x516 - x168 * x522;
+        let x543 = x525 * x542;
+        let x544 = x177 * x509;
+        let x545 = 1.0
+            / (1466.4506062283303
+                + (s_q7 * (s_q7 * x159 + c_q7 * x163)
+                    + c_q7 * (s_q7 * x161 + c_q7 * x164) - (x173 - x172) - (x171 - x174))
+                - x523 - x544 - x526 * x527);
+        let x546 = s_q7 * x162 + c_q7 * x165 - 0.75 * x168 + x178 * x502;
+        let x547 = x546 - x526 * x529;
+        let x548 = x545 * x547;
+        let x549 = x546 - x526 * x531;
+        let x550 = x545 * x549;
+        let x551 = s_q7 * x181 + c_q7 * x182 + (x146 * -0.65 - 0.75 * x183) + x178 * x503
+            + x177 * x517 - x526 * x533;
+        let x552 = x545 * x551;
+        let x553 = s_q7 * x198 + c_q7 * x199 + (0.75 * x200 + -0.65 * x196) - x178 * x504
+            + x177 * x518 - x526 * x535;
+        let x554 = x545 * x553;
+        let x555 = s_q7 * x212 + c_q7 * x213 + (0.75 * x214 + -0.65 * x210) - x178 * x505
+            + x177 * x519 - x526 * x537;
+        let x556 = x545 * x555;
+        let x557 = s_q7 * x231 + c_q7 * x232 + (0.75 * x233 + -0.65 * x229) - x178 * x506
+            + x177 * x520 - x526 * x539;
+        let x558 = x545 * x557;
+        let x559 = s_q7 * x259 + c_q7 * x260 + (0.75 * x261 + -0.65 * x257) - x178 * x507
+            + x177 * x521 - x526 * x541;
+        let x560 = x545 * x559;
+        let x561 = s_q7 * x295 + c_q7 * x296 + (0.75 * x297 + -0.65 * x293) - x178 * x508
+            + x177 * x522 - x526 * x543;
+        let x562 = x545 * x561;
+        let x563 = 1.0
+            / (1271.854575 + (x176 - x173) - x524 - x544 - x528 * x529 - x547 * x548);
+        let x564 = x176 - x524 - x177 * x510 - x528 * x531 - x547 * x550;
+        let x565 = x563 * x564;
+        let x566 = x168 * x503;
+        let x567 = x156 + 0.65 * x184 - x566 - x177 * x511 - x528 * x533 - x547 * x552;
+        let x568 = x563 * x567;
+        let x569 = x168 * x504;
+        let x570 = x197 + 0.65 * x201 + x569 - x177 * x512 - x528 * x535 - x547 * x554;
+        let x571 = x563 * x570;
+        let x572 = x168 * x505;
+        let x573 = x211 + 0.65 * x215 + x572 - x177 * x513 - x528 * x537 - x547 * x556;
+        let x574 = x563 * x573;
+        let x575 = x168 * x506;
+        let x576 = x230 + 0.65 * x234 + x575 - x177 * x514 - x528 * x539 - x547 * x558;
+        let x577 = x563 * x576;
+        let x578 = x168 * x507;
+        let x579 = x258 + 0.65 * x262 + x578 - x177 * x515 - x528 * x541 - x547 * x560;
+        let x580 = x563 * x579;
+        let x581 = x168 * x508;
+        let x582 = x294 + 0.65 * x298 + x581 - x177 * x516 - x528 * x543 - x547 * x562;
+        let x583 = x563 * x582;
+        let x584 = 1.0
+            / (x166 - x524 - x167 * x510 - x530 * x531 - x549 * x550 - x564 * x565);
+        let x585 = x156 - x566 - x167 * x511 - x530 * x533 - x549 * x552 - x564 * x568;
+        let x586 = x584 * x585;
+        let x587 = x197 + x569 - x167 * x512 - x530 * x535 - x549 * x554 - x564 * x571;
+        let x588 = x584 * x587;
+        let x589 = x211 + x572 - x167 * x513 - x530 * x537 - x549 * x556 - x564 * x574;
+        let x590 = x584 * x589;
+        let x591 = x230 + x575 - x167 * x514 - x530 * x539 - x549 * x558 - x564 * x577;
+        let x592 = x584 * x591;
+        let x593 = x258 + x578 - x167 * x515 - x530 * x541 - x549 * x560 - x564 * x580;
+        let x594 = x584 * x593;
+        let x595 = x294 + x581 - x167 * x516 - x530 * x543 - x549 * x562 - x564 * x583;
+        let x596 = x584 * x595;
+        let x597 = 1.0
+            / (x144 - x183 * x503 - x184 * x511 - x146 * x517 - x532 * x533 - x551 * x552
+                - x567 * x568 - x585 * x586);
+        let x598 = x193 + x183 * x504 - x184 * x512 - x146 * x518 - x532 * x535
+            - x551 * x554 - x567 * x571 - x585 * x588;
+        let x599 = x597 * x598;
+        let x600 = x207 + x183 * x505 - x184 * x513 - x146 * x519 - x532 * x537
+            - x551 * x556 - x567 * x574 - x585 * x590;
+        let x601 = x597 * x600;
+        let x602 = x226 + x183 * x506 - x184 * x514 - x146 * x520 - x532 * x539
+            - x551 * x558 - x567 * x577 - x585 * x592;
+        let x603 = x597 * x602;
+        let x604 = x254 + x183 * x507 - x184 * x515 - x146 * x521 - x532 * x541
+            - x551 * x560 - x567 * x580 - x585 * x594;
+        let x605 = x597 * x604;
+        let x606 = x290 + x183 * x508 - x184 * x516 - x146 * x522 - x532 * x543
+            - x551 * x562 - x567 * x583 - x585 * x596;
+        let x607 = x597 * x606;
+        let x608 = 1.0
+            / (x117 - x200 * x504 - x201 * x512 - x196 * x518 - x534 * x535 - x553 * x554
+                - x570 * x571 - x587 * x588 - x598 * x599);
+        let x609 = x108 - x200 * x505 - x201 * x513 - x196 * x519 - x534 * x537
+            - x553 * x556 - x570 * x574 - x587 * x590 - x598 * x601;
+        let x610 = x608 * x609;
+        let x611 = x220 - x200 * x506 - x201 * x514 - x196 * x520 - x534 * x539
+            - x553 * x558 - x570 * x577 - x587 * x592 - x598 * x603;
+        let x612 = x608 * x611;
+        let x613 = x248 - x200 * x507 - x201 * x515 - x196 * x521 - x534 * x541
+            - x553 * x560 - x570 * x580 - x587 * x594 - x598 * x605;
+        let x614 = x608 * x613;
+        let x615 = x284 - x200 * x508 - x201 * x516 - x196 * x522 - x534 * x543
+            - x553 * x562 - x570 * x583 - x587 * x596 - x598 * x607;
+        let x616 = x608 * x615;
+        let x617 = 1.0
+            / (x94 - x214 * x505 - x215 * x513 - x210 * x519 - x536 * x537 - x555 * x556
+                - x573 * x574 - x589 * x590 - x600 * x601 - x609 * x610);
+        let x618 = x85 - x214 * x506 - x215 * x514 - x210 * x520 - x536 * x539
+            - x555 * x558 - x573 * x577 - x589 * x592 - x600 * x603 - x609 * x612;
+        let x619 = x617 * x618;
+        let x620 = x243 - x214 * x507 - x215 * x515 - x210 * x521 - x536 * x541
+            - x555 * x560 - x573 * x580 - x589 * x594 - x600 * x605 - x609 * x614;
+        let x621 = x617 * x620;
+        let x622 = x279 - x214 * x508 - x215 * x516 - x210 * x522 - x536 * x543
+            - x555 * x562 - x573 * x583 - x589 * x596 - x600 * x607 - x609 * x616;
+        let x623 = x617 * x622;
+        let x624 = 1.0
+            / (x71 - x233 * x506 - x234 * x514 - x229 * x520 - x538 * x539 - x557 * x558
+                - x576 * x577 - x591 * x592 - x602 * x603 - x611 * x612 - x618 * x619);
+        let x625 = x59 - x233 * x507 - x234 * x515 - x229 * x521 - x538 * x541
+            - x557 * x560 - x576 * x580 - x591 * x594 - x602 * x605 - x611 * x614
+            - x618 * x621;
+        let x626 = x624 * x625;
+        let x627 = x272 - x233 * x508 - x234 * x516 - x229 * x522 - x538 * x543
+            - x557 * x562 - x576 * x583 - x591 * x596 - x602 * x607 - x611 * x616
+            - x618 * x623;
+        let x628 = x624 * x627;
+        let x629 = 1.0
+            / (x44 - x261 * x507 - x262 * x515 - x257 * x521 - x540 * x541 - x559 * x560
+                - x579 * x580 - x593 * x594 - x604 * x605 - x613 * x614 - x620 * x621
+                - x625 * x626);
+        let x630 = x268 - x261 * x508 - x262 * x516 - x257 * x522 - x540 * x543
+            - x559 * x562 - x579 * x583 - x593 * x596 - x604 * x607 - x613 * x616
+            - x620 * x623 - x625 * x628;
+        let x631 = x629 * x630;
+        let x632 = 1.0
+            / (1.4135609200000003 - x297 * x508 - x298 * x516 - x293 * x522 - x542 * x543
+                - x561 * x562 - x582 * x583 - x595 * x596 - x606 * x607 - x615 * x616
+                - x622 * x623 - x627 * x628 - x630 * x631);
+        let x633 = x500 * x502
+            - (v[4] * x301 - v[5] * x300 + (v[1] * x304 - v[2] * x303) - f_ext[0][3]
+                + (c_q7 * x490 - s_q7 * x491 + -0.75 * x497) + x499 * x501);
+        let x634 = x498 * x501
+            - (v[5] * x299 - v[3] * x301 + (v[2] * x302 - v[0] * x304) - f_ext[0][4]
+                + (s_q7 * x490 + c_q7 * x491 + (0.75 * x496 + -0.65 * x495)))
+            - x500 * x509 - x527 * x633;
+        let x635 = x498 * x502;
+        let x636 = x499 * x509
+            - (v[3] * x300 - v[4] * x299 + (v[0] * x303 - v[1] * x302) - f_ext[0][5]
+                + (x492 + 0.65 * x497) + x635) - x529 * x633 - x548 * x634;
+        let x637 = tau[0] - x492 - x635 + x499 * x510 - x531 * x633 - x550 * x634
+            - x565 * x636;
+        let x638 = tau[1] - x484 - x498 * x503 + x499 * x511 + x500 * x517 - x533 * x633
+            - x552 * x634 - x568 * x636 - x586 * x637;
+        let x639 = tau[2] - x475 + x498 * x504 + x499 * x512 + x500 * x518 - x535 * x633
+            - x554 * x634 - x571 * x636 - x588 * x637 - x599 * x638;
+        let x640 = tau[3] - x468 + x498 * x505 + x499 * x513 + x500 * x519 - x537 * x633
+            - x556 * x634 - x574 * x636 - x590 * x637 - x601 * x638 - x610 * x639;
+        let x641 = tau[4] - x460 + x498 * x506 + x499 * x514 + x500 * x520 - x539 * x633
+            - x558 * x634 - x577 * x636 - x592 * x637 - x603 * x638 - x612 * x639
+            - x619 * x640;
+        let x642 = tau[5] - x452 + x498 * x507 + x499 * x515 + x500 * x521 - x541 * x633
+            - x560 * x634 - x580 * x636 - x594 * x637 - x605 * x638 - x614 * x639
+            - x621 * x640 - x626 * x641;
+        let x643 = x632
+            * (tau[6] - x443 + x498 * x508 + x499 * x516 + x500 * x522 - x543 * x633
+                - x562 * x634 - x583 * x636 - x596 * x637 - x607 * x638 - x616 * x639
+                - x623 * x640 - x628 * x641 - x631 * x642);
+        let x644 = x629 * x642 - x631 * x643;
+        let x645 = x624 * x641 - x626 * x644 - x628 * x643;
+        let x646 = x617 * x640 - x619 * x645 - x621 * x644 - x623 * x643;
+        let x647 = x608 * x639 - x610 * x646 - x612 * x645 - x614 * x644 - x616 * x643;
+        let x648 = x597 * x638 - x599 * x647 - x601 * x646 - x603 * x645 - x605 * x644
+            - x607 * x643;
+        let x649 = x584 * x637 - x586 * x648 - x588 * x647 - x590 * x646 - x592 * x645
+            - x594 * x644 - x596 * x643;
+        let x650 = x563 * x636 - x565 * x649 - x568 * x648 - x571 * x647 - x574 * x646
+            - x577 * x645 - x580 * x644 - x583 * x643;
+        let x651 = x545 * x634 - x548 * x650 - x550 * x649 - x552 * x648 - x554 * x647
+            - x556 * x646 - x558 * x645 - x560 * x644 - x562 * x643;
+        let x652 = x525 * x633 - x527 * x651 - x529 * x650 - x531 * x649 - x533 * x648
+            - x535 * x647 - x537 * x646 - x539 * x645 - x541 * x644 - x543 * x643;
+        let x653 = x509 * x651 - (x500 * 0.0008546497218115156 + x502 * x652)
+            - x517 * x648 - x518 * x647 - x519 * x646 - x520 * x645 - x521 * x644
+            - x522 * x643;
+        let x654 = x501 * x652 - x499 * 0.0008546497218115156 - x509 * x650 - x510 * x649
+            - x511 * x648 - x512 * x647 - x513 * x646 - x514 * x645 - x515 * x644
+            - x516 * x643;
+        let x655 = x502 * x650 - (x498 * 0.0008546497218115156 + x501 * x651)
+            + x502 * x649 + x503 * x648 - x504 * x647 - x505 * x646 - x506 * x645
+            - x507 * x644 - x508 * x643;
+        [x655, x654, x653, x652, x651, x650, x649, x648, x647, x646, x645, x644, x643]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
-    /// : 407 mul, 315 add, 0 div, 0 sqrt, 7 sincos (emitted).
+    /// : 356 mul, 285 add, 0 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn momentum(q: &[f64; 14], v: &[f64; 13]) -> [f64; 6] {
         let x0 = q[6] * 2.0;
@@ -4323,515 +4275,501 @@ impl FreeFloating7 {
         let x17 = x3 + x9;
         let x18 = 1.0 - 2.0 * (x5 + x6);
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x20 = c_q7 + (1.0 - c_q7);
-        let x21 = v[3] * c_q7 + v[4] * s_q7;
-        let x22 = v[4] * c_q7 - v[3] * s_q7;
-        let x23 = v[0] - v[4] * -0.75;
-        let x24 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x25 = c_q7 * x23 + s_q7 * x24;
-        let x26 = c_q7 * x24 - s_q7 * x23;
-        let x27 = x20 * (v[2] - 0.65 * v[4]);
-        let x28 = v[6] + v[5] * x20;
+        let x20 = v[3] * c_q7 + v[4] * s_q7;
+        let x21 = v[4] * c_q7 - v[3] * s_q7;
+        let x22 = v[0] - v[4] * -0.75;
+        let x23 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x24 = v[2] - 0.65 * v[4];
+        let x25 = c_q7 * x23 - s_q7 * x22;
+        let x26 = v[5] + v[6];
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x30 = c_q8 + (1.0 - c_q8);
-        let x31 = -0.00000000020510342851533115 * c_q8;
-        let x32 = -0.00000000020510342851533115 * s_q8;
-        let x33 = -0.00000000020510342851533115 * x30;
-        let x34 = x21 * x31 + x22 * s_q8 - x28 * c_q8;
-        let x35 = x22 * c_q8 - x21 * x32 + x28 * s_q8;
-        let x36 = x25 - x22 * -0.35;
-        let x37 = x26 - 0.35 * x21;
-        let x38 = x31 * x36 + s_q8 * x37 - x27 * c_q8;
-        let x39 = c_q8 * x37 - x32 * x36 + x27 * s_q8;
-        let x40 = x30 * x36 + x27 * x33;
-        let x41 = v[7] + (x21 * x30 + x28 * x33);
+        let x28 = -0.00000000020510342851533115 * c_q8;
+        let x29 = -0.00000000020510342851533115 * s_q8;
+        let x30 = x20 * x28 + x21 * s_q8 - x26 * c_q8;
+        let x31 = x21 * c_q8 - x20 * x29 + x26 * s_q8;
+        let x32 = c_q7 * x22 + s_q7 * x23 - x21 * -0.35;
+        let x33 = x25 - 0.35 * x20;
+        let x34 = x28 * x32 + s_q8 * x33 - x24 * c_q8;
+        let x35 = c_q8 * x33 - x29 * x32 + x24 * s_q8;
+        let x36 = x32 + -0.00000000020510342851533115 * x24;
+        let x37 = v[7] + (x20 + -0.00000000020510342851533115 * x26);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x43 = c_q9 + (1.0 - c_q9);
-        let x44 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x45 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x46 = 0.00000000020510342851533115 * x43;
-        let x47 = 0.00000000020510342851533115 * c_q9
+        let x39 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x40 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x41 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x48 = -0.00000000020510342851533115 * c_q9
+        let x42 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x49 = -0.00000000020510342851533115 * x43;
-        let x50 = x34 * x44 + x35 * x47 + x41 * c_q9;
-        let x51 = x34 * x45 + x35 * x48 - x41 * s_q9;
-        let x52 = x38 - (x35 * -0.4 + 0.275 * x41);
-        let x53 = x39 - 0.4 * x34;
-        let x54 = x40 - -0.275 * x34;
-        let x55 = x44 * x52 + x47 * x53 + c_q9 * x54;
-        let x56 = x45 * x52 + x48 * x53 - s_q9 * x54;
-        let x57 = x46 * x52 + x43 * x53 + x49 * x54;
-        let x58 = v[8] + (x34 * x46 + x35 * x43 + x41 * x49);
+        let x43 = x30 * x39 + x31 * x41 + x37 * c_q9;
+        let x44 = x30 * x40 + x31 * x42 - x37 * s_q9;
+        let x45 = x34 - (x31 * -0.4 + 0.275 * x37);
+        let x46 = x35 - 0.4 * x30;
+        let x47 = x36 - -0.275 * x30;
+        let x48 = x39 * x45 + x41 * x46 + c_q9 * x47;
+        let x49 = x40 * x45 + x42 * x46 - s_q9 * x47;
+        let x50 = x46 + 0.00000000020510342851533115 * x45
+            + -0.00000000020510342851533115 * x47;
+        let x51 = v[8]
+            + (x31 + 0.00000000020510342851533115 * x30
+                + -0.00000000020510342851533115 * x37);
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x60 = c_q10 + (1.0 - c_q10);
-        let x61 = x50 * c_q10 + x51 * s_q10;
-        let x62 = x51 * c_q10 - x50 * s_q10;
-        let x63 = x55 - -0.87 * x58;
-        let x64 = c_q10 * x63 + x56 * s_q10;
-        let x65 = x56 * c_q10 - s_q10 * x63;
-        let x66 = x60 * (x57 - x50 * 0.87);
-        let x67 = v[9] + x58 * x60;
+        let x53 = x43 * c_q10 + x44 * s_q10;
+        let x54 = x44 * c_q10 - x43 * s_q10;
+        let x55 = x48 - -0.87 * x51;
+        let x56 = x50 - x43 * 0.87;
+        let x57 = c_q10 * x55 + x49 * s_q10;
+        let x58 = v[9] + x51;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x69 = c_q11 + (1.0 - c_q11);
-        let x70 = x61 * c_q11 + x62 * s_q11;
-        let x71 = x62 * c_q11 - x61 * s_q11;
-        let x72 = x64 - (0.275 * x62 + -0.63 * x67);
-        let x73 = x65 - -0.275 * x61;
-        let x74 = c_q11 * x72 + s_q11 * x73;
-        let x75 = c_q11 * x73 - s_q11 * x72;
-        let x76 = x69 * (x66 - x61 * 0.63);
-        let x77 = v[10] + x67 * x69;
+        let x60 = x53 * c_q11 + x54 * s_q11;
+        let x61 = x54 * c_q11 - x53 * s_q11;
+        let x62 = x57 - (0.275 * x54 + -0.63 * x58);
+        let x63 = x49 * c_q10 - s_q10 * x55 - -0.275 * x53;
+        let x64 = x56 - x53 * 0.63;
+        let x65 = c_q11 * x62 + s_q11 * x63;
+        let x66 = v[10] + x58;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x79 = c_q12 + (1.0 - c_q12);
-        let x80 = -0.00000000020510342851533115 * s_q12;
-        let x81 = -0.00000000020510342851533115 * c_q12;
-        let x82 = -0.00000000020510342851533115 * x79;
-        let x83 = x70 * c_q12 + x71 * x80 - x77 * s_q12;
-        let x84 = x71 * x81 - x70 * s_q12 - x77 * c_q12;
-        let x85 = x74 - x71 * 0.36;
-        let x86 = x75 - -0.36 * x70;
-        let x87 = c_q12 * x85 + x80 * x86 - x76 * s_q12;
-        let x88 = x81 * x86 - s_q12 * x85 - x76 * c_q12;
-        let x89 = x79 * x86 + x76 * x82;
-        let x90 = v[11] + (x71 * x79 + x77 * x82);
+        let x68 = -0.00000000020510342851533115 * s_q12;
+        let x69 = -0.00000000020510342851533115 * c_q12;
+        let x70 = x60 * c_q12 + x61 * x68 - x66 * s_q12;
+        let x71 = x61 * x69 - x60 * s_q12 - x66 * c_q12;
+        let x72 = x65 - x61 * 0.36;
+        let x73 = c_q11 * x63 - s_q11 * x62 - -0.36 * x60;
+        let x74 = c_q12 * x72 + x68 * x73 - x64 * s_q12;
+        let x75 = x69 * x73 - s_q12 * x72 - x64 * c_q12;
+        let x76 = x73 + -0.00000000020510342851533115 * x64;
+        let x77 = v[11] + (x61 + -0.00000000020510342851533115 * x66);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x92 = c_q13 + (1.0 - c_q13);
-        let x93 = -0.00000000020510342851533115 * c_q13;
-        let x94 = -0.00000000020510342851533115 * s_q13;
-        let x95 = -0.00000000020510342851533115 * x92;
-        let x96 = x83 * x93 + x84 * s_q13 - x90 * c_q13;
-        let x97 = x84 * c_q13 - x83 * x94 + x90 * s_q13;
-        let x98 = x87 - (x84 * -0.16 + 0.55 * x90);
-        let x99 = x88 - 0.16 * x83;
-        let x100 = x89 - x83 * -0.55;
-        let x101 = x93 * x98 + s_q13 * x99 - c_q13 * x100;
-        let x102 = c_q13 * x99 - x94 * x98 + s_q13 * x100;
-        let x103 = x92 * x98 + x95 * x100;
-        let x104 = v[12] + (x83 * x92 + x90 * x95);
-        let x105 = x96 * 2.1663609200000002 + 0.000781 * x97 + -0.0145 * x104
-            + (x102 * -3.6140000000000003 + x103 * 4.806620000000001);
-        let x106 = 0.000781 * x96 + x97 * 0.9638000000000001 + x104 * -0.9614610000000001
-            + x101 * 3.6140000000000003;
-        let x107 = -0.0145 * x96 + x97 * -0.9614610000000001 + x104 * 1.4135609200000003
-            + x101 * -4.806620000000001;
-        let x108 = 18.07 * x101 - (x97 * -3.6140000000000003 + x104 * 4.806620000000001);
-        let x109 = 18.07 * x102 - x96 * 3.6140000000000003;
-        let x110 = 18.07 * x103 - x96 * -4.806620000000001;
-        let x111 = x93 * x108 - x94 * x109 + x92 * x110;
-        let x112 = s_q13 * x108 + c_q13 * x109;
-        let x113 = s_q13 * x109 - c_q13 * x108 + x95 * x110;
-        let x114 = x83 * 3.2217582500000006 + -0.2313 * x90
-            + (x88 * -4.187200000000001 + x89 * 7.196750000000001)
-            + (x93 * x105 - x94 * x106 + x92 * x107 + (-0.16 * x112 + 0.55 * x113));
-        let x115 = x84 * 1.2686520000000001 + x90 * -1.1514800000000003
-            + x87 * 4.187200000000001 + (s_q13 * x105 + c_q13 * x106 + 0.16 * x111);
-        let x116 = -0.2313 * x83 + x84 * -1.1514800000000003 + x90 * 2.1079062500000005
-            + x87 * -7.196750000000001
-            + (s_q13 * x106 - c_q13 * x105 + x95 * x107 + -0.55 * x111);
-        let x117 = 26.17 * x87 - (x84 * -4.187200000000001 + x90 * 7.196750000000001)
-            + x111;
-        let x118 = 26.17 * x88 - x83 * 4.187200000000001 + x112;
-        let x119 = 26.17 * x89 - x83 * -7.196750000000001 + x113;
-        let x120 = c_q12 * x117 - s_q12 * x118;
-        let x121 = x80 * x117 + x81 * x118 + x79 * x119;
-        let x122 = x70 * 0.9304999999999999 + 0.01675 * x77 + x75 * 3.0149999999999997
-            + (c_q12 * x114 - s_q12 * x115 + 0.36 * x121);
-        let x123 = x71 * 0.939 + x74 * -3.0149999999999997
-            + (x80 * x114 + x81 * x115 + x79 * x116 + -0.36 * x120);
-        let x124 = 16.75 * x74 - x71 * 3.0149999999999997 + x120;
-        let x125 = 16.75 * x75 - x70 * -3.0149999999999997 + x121;
-        let x126 = c_q11 * x124 - s_q11 * x125;
-        let x127 = s_q11 * x124 + c_q11 * x125;
-        let x128 = x69 * (16.75 * x76 + (x82 * x119 - (s_q12 * x117 + c_q12 * x118)));
-        let x129 = x61 * 4.170993 + -0.6328 * x67 + (x65 * 5.8795 + x66 * -6.7347)
-            + (c_q11 * x122 - s_q11 * x123 + (0.275 * x127 + -0.63 * x128));
-        let x130 = x62 * 3.8828625 + x67 * -1.8520425 + x64 * -5.8795
-            + (s_q11 * x122 + c_q11 * x123 + -0.275 * x126);
-        let x131 = 21.38 * x64 - (x62 * 5.8795 + x67 * -6.7347) + x126;
-        let x132 = 21.38 * x65 - x61 * -5.8795 + x127;
-        let x133 = c_q10 * x131 - s_q10 * x132;
-        let x134 = x60 * (21.38 * x66 - x61 * 6.7347 + x128);
-        let x135 = x50 * 4.395515250000001 + -0.00214 * x58 + x57 * -9.87015
-            + (c_q10 * x129 - s_q10 * x130 + -0.87 * x134);
-        let x136 = 3.378 * x51 + (s_q10 * x129 + c_q10 * x130);
-        let x137 = -0.00214 * x50 + x58 * 7.65251525 + x55 * 9.87015
-            + (x60
-                * (-0.6328 * x61 + x62 * -1.8520425 + x67 * 4.0324305 + x64 * 6.7347
-                    + (x69
-                        * (0.01675 * x70 + 0.07271 * x77
-                            + (x82 * x116 - (s_q12 * x114 + c_q12 * x115)))
-                        + 0.63 * x126)) + 0.87 * x133);
-        let x138 = 22.69 * x55 - x58 * -9.87015 + x133;
-        let x139 = 22.69 * x56 + (s_q10 * x131 + c_q10 * x132);
-        let x140 = 22.69 * x57 - x50 * 9.87015 + x134;
-        let x141 = x44 * x138 + x45 * x139 + x46 * x140;
-        let x142 = x47 * x138 + x48 * x139 + x43 * x140;
-        let x143 = c_q9 * x138 - s_q9 * x139 + x49 * x140;
-        let x144 = x34 * 3.3000000000000003 + -0.00214 * x41 + x39 * -6.0
-            + (x44 * x135 + x45 * x136 + x46 * x137 + (-0.4 * x142 + 0.275 * x143));
-        let x145 = x35 * 2.5780000000000003 + x38 * 6.0
-            + (x47 * x135 + x48 * x136 + x43 * x137 + 0.4 * x141);
-        let x146 = -0.00214 * x34 + 2.359 * x41
-            + (c_q9 * x135 - s_q9 * x136 + x49 * x137 + -0.275 * x141);
-        let x147 = 30.0 * x38 - x35 * -6.0 + x141;
-        let x148 = 30.0 * x39 - x34 * 6.0 + x142;
-        let x149 = 30.0 * x40 + x143;
-        let x150 = x31 * x147 - x32 * x148 + x30 * x149;
-        let x151 = s_q8 * x147 + c_q8 * x148;
-        let x152 = x21 * 2.29018125 + -0.07309 * x22 + 0.00071 * x28
-            + x26 * -6.1267499999999995
-            + (x31 * x144 - x32 * x145 + x30 * x146 + -0.35 * x151);
-        let x153 = -0.07309 * x21 + x22 * 1.5853812499999997 + 0.1132 * x28
-            + x25 * 6.1267499999999995 + (s_q8 * x144 + c_q8 * x145 + 0.35 * x150);
-        let x154 = 35.01 * x25 - x22 * -6.1267499999999995 + x150;
-        let x155 = 35.01 * x26 - x21 * 6.1267499999999995 + x151;
-        let x156 = c_q7 * x154 - s_q7 * x155;
-        let x157 = s_q7 * x154 + c_q7 * x155;
-        let x158 = x20 * (35.01 * x27 + (s_q8 * x148 - c_q8 * x147 + x33 * x149));
-        let x159 = v[3] * 1200.0 + (c_q7 * x152 - s_q7 * x153 + -0.75 * x157);
-        let x160 = v[4] * 1200.0
-            + (s_q7 * x152 + c_q7 * x153 + (0.75 * x156 + -0.65 * x158));
-        let x161 = v[5] * 1200.0
-            + (x20
-                * (0.00071 * x21 + 0.1132 * x22 + 1.331 * x28
-                    + (s_q8 * x145 - c_q8 * x144 + x33 * x146)) + 0.65 * x157);
-        let x162 = v[0] * 1000.0 + x156;
-        let x163 = v[1] * 1000.0 + x157;
-        let x164 = v[2] * 1000.0 + x158;
-        let x165 = x10 * x162 + x11 * x163 + x12 * x164;
-        let x166 = x13 * x162 + x14 * x163 + x15 * x164;
-        let x167 = x16 * x162 + x17 * x163 + x18 * x164;
-        let x168 = x10 * x159 + x11 * x160 + x12 * x161 + (q[1] * x167 - q[2] * x166);
-        let x169 = x13 * x159 + x14 * x160 + x15 * x161 + (q[2] * x165 - q[0] * x167);
-        let x170 = x16 * x159 + x17 * x160 + x18 * x161 + (q[0] * x166 - q[1] * x165);
-        [x165, x166, x167, x168, x169, x170]
+        let x79 = -0.00000000020510342851533115 * c_q13;
+        let x80 = -0.00000000020510342851533115 * s_q13;
+        let x81 = x70 * x79 + x71 * s_q13 - x77 * c_q13;
+        let x82 = x71 * c_q13 - x70 * x80 + x77 * s_q13;
+        let x83 = x74 - (-0.16 * x71 + 0.55 * x77);
+        let x84 = x76 - x70 * -0.55;
+        let x85 = v[12] + (x70 + -0.00000000020510342851533115 * x77);
+        let x86 = 0.000781 * x81 + -1.2025609200000003 * x82 + -0.9614610000000001 * x85;
+        let x87 = 0.000781 * x82 + -0.0145 * x85
+            + 4.806620000000001 * (x83 + -0.00000000020510342851533115 * x84);
+        let x88 = -0.0145 * x81 + -0.9614610000000001 * x82 + 1.4135609200000003 * x85
+            + (x79 * x83 + s_q13 * (x75 - 0.16 * x70) - c_q13 * x84)
+                * -4.806620000000001;
+        let x89 = 4.806620000000001 * x85;
+        let x90 = x81 * -4.806620000000001;
+        let x91 = x90 + x79 * x89;
+        let x92 = s_q13 * x89;
+        let x93 = c_q13 * x89 - -0.00000000020510342851533115 * x90;
+        let x94 = -1.9877000000000002 * x71 + -0.809539999555672 * x77
+            + 17.135250000000003 * x76
+            + (x88 + (x79 * x87 - x80 * x86) + (0.55 * x93 - -0.16 * x92));
+        let x95 = -1.9877000000000002 * x70 + -5.252920330000002 * x71
+            + -2.741639999592316 * x77 + x76 * -3.6140000000000003
+            + (s_q13 * x87 + c_q13 * x86 - 0.16 * x91);
+        let x96 = -0.809539999555672 * x70 + -2.7416399995923166 * x71
+            + 9.740442170000001 * x77
+            + (x74 * -17.135250000000003 + 3.6140000000000003 * x75)
+            + (s_q13 * x86 - c_q13 * x87 + -0.00000000020510342851533115 * x88
+                - -0.55 * x91);
+        let x97 = 17.135250000000003 * x77 + x91;
+        let x98 = x77 * -3.6140000000000003 + x92;
+        let x99 = x93 - (x70 * -17.135250000000003 + 3.6140000000000003 * x71);
+        let x100 = s_q12 * x98 - c_q12 * x97;
+        let x101 = x99 - (x68 * x97 + x69 * x98);
+        let x102 = 0.01675 * x66 + 7.078399999258757 * x64
+            + (c_q12 * x94 - s_q12 * x95 + 0.36 * x101);
+        let x103 = -9.142025249762803 * x61 + 2.5482240016099564 * x66
+            + (x96 + (x68 * x94 + x69 * x95) + -0.36 * x100);
+        let x104 = x100 - 7.078399999258757 * x66;
+        let x105 = s_q12 * x97 + c_q12 * x98 + -0.00000000020510342851533115 * x99
+            - x60 * -7.078399999258757;
+        let x106 = c_q11 * x104 - s_q11 * x101;
+        let x107 = s_q11 * x104 + c_q11 * x101;
+        let x108 = -0.6328 * x58 + -45.1584 * x56
+            + (c_q11 * x102 - s_q11 * x103 + (0.275 * x107 + -0.63 * x105));
+        let x109 = -24.4950615 * x54 + -24.35164200091464 * x58
+            + (s_q11 * x102 + c_q11 * x103 + -0.275 * x106);
+        let x110 = x106 - -45.1584 * x58;
+        let x111 = x105 - x53 * 45.1584;
+        let x112 = c_q10 * x110 - s_q10 * x107;
+        let x113 = s_q10 * x110 + c_q10 * x107;
+        let x114 = -0.00214 * x51 + -81.53205 * x50
+            + (c_q10 * x108 - s_q10 * x109 + -0.87 * x111);
+        let x115 = -63.36336825000001 * x44 + -36.18604050126307 * x51
+            + (s_q10 * x108 + c_q10 * x109);
+        let x116 = -0.00214 * x43 + -36.18604050126307 * x44 + 69.99836825 * x51
+            + x48 * 81.53205
+            + (-0.6328 * x53 + -24.351642000914637 * x54 + 28.2393615 * x58
+                + x57 * 45.1584
+                + (0.01675 * x60 + 2.5482240016099564 * x61 + 9.223235249762805 * x66
+                    + x65 * -7.078399999258757
+                    + (-0.00000000020510342851533115 * x96 - (s_q12 * x94 + c_q12 * x95))
+                    + 0.63 * x106) + 0.87 * x112);
+        let x117 = x112 - -81.53205 * x51;
+        let x118 = x111 - x43 * 81.53205;
+        let x119 = x39 * x117 + x40 * x113 + 0.00000000020510342851533115 * x118;
+        let x120 = x118 + (x41 * x117 + x42 * x113);
+        let x121 = c_q9 * x117 - s_q9 * x113 + -0.00000000020510342851533115 * x118;
+        let x122 = -0.0000000234896432582596 * x31 + -0.0021399965876409276 * x37
+            + -12.701650001451807 * x36
+            + (x39 * x114 + x40 * x115 + 0.00000000020510342851533115 * x116
+                + (-0.4 * x120 + 0.275 * x121));
+        let x123 = -0.0000000234896432582596 * x30 + -111.7548902508081 * x31
+            + 5.080660024070365 * x37 + x36 * 0.000000008530897668050218
+            + (x116 + (x41 * x114 + x42 * x115) + 0.4 * x119);
+        let x124 = -0.0021399965876409276 * x30 + 5.080660024070366 * x31
+            + 113.3918902508081 * x37
+            + (x34 * 12.701650001451807 + -0.000000008530897668050218 * x35)
+            + (c_q9 * x114 - s_q9 * x115 + -0.00000000020510342851533115 * x116
+                + -0.275 * x119);
+        let x125 = x119 - -12.701650001451807 * x37;
+        let x126 = x120 - x37 * 0.000000008530897668050218;
+        let x127 = x121 - (x30 * 12.701650001451807 + -0.000000008530897668050218 * x31);
+        let x128 = x127 + (x28 * x125 - x29 * x126);
+        let x129 = s_q8 * x125 + c_q8 * x126;
+        let x130 = -0.07309 * x21 + -16.80768997608804 * x26
+            + (x124 + (x28 * x122 - x29 * x123) + -0.35 * x129);
+        let x131 = -0.07309 * x20 + 130.43769025763282 * x21 + 0.1132 * x26
+            + x24 * -48.0240000085309 + (s_q8 * x122 + c_q8 * x123 + 0.35 * x128);
+        let x132 = x129 - x26 * -48.0240000085309;
+        let x133 = s_q8 * x126 - c_q8 * x125 + -0.00000000020510342851533115 * x127
+            - 48.0240000085309 * x21;
+        let x134 = c_q7 * x128 - s_q7 * x132;
+        let x135 = s_q7 * x128 + c_q7 * x132;
+        let x136 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+            + v[1] * -180.9502499901501 + (c_q7 * x130 - s_q7 * x131 + -0.75 * x135);
+        let x137 = 1466.4506062283303 * v[4]
+            + (180.9502499901501 * v[0] + v[2] * -110.5455)
+            + (s_q7 * x130 + c_q7 * x131 + (0.75 * x134 + -0.65 * x133));
+        let x138 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1]
+            + (-16.80768997608804 * x20 + 0.1132 * x21 + 132.47349025763282 * x26
+                + 48.0240000085309 * x25
+                + (s_q8 * x123 - c_q8 * x122 + -0.00000000020510342851533115 * x124)
+                + 0.65 * x135);
+        let x139 = 1170.07 * v[0] - v[4] * -180.9502499901501 + x134;
+        let x140 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455) + x135;
+        let x141 = 1170.07 * v[2] - 110.5455 * v[4] + x133;
+        let x142 = x10 * x139 + x11 * x140 + x12 * x141;
+        let x143 = x13 * x139 + x14 * x140 + x15 * x141;
+        let x144 = x16 * x139 + x17 * x140 + x18 * x141;
+        let x145 = x10 * x136 + x11 * x137 + x12 * x138 + (q[1] * x144 - q[2] * x143);
+        let x146 = x13 * x136 + x14 * x137 + x15 * x138 + (q[2] * x142 - q[0] * x144);
+        let x147 = x16 * x136 + x17 * x137 + x18 * x138 + (q[0] * x143 - q[1] * x142);
+        [x142, x143, x144, x145, x146, x147]
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
-    /// Methods: bias `recurrent`: 741 mul, 582 add, 0 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: bias `recurrent`: 694 mul, 568 add, 0 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x1 = c_q7 + (1.0 - c_q7);
-        let x2 = v[3] * c_q7 + v[4] * s_q7;
-        let x3 = v[4] * c_q7 - v[3] * s_q7;
-        let x4 = v[0] - v[4] * -0.75;
-        let x5 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x6 = c_q7 * x4 + s_q7 * x5;
-        let x7 = c_q7 * x5 - s_q7 * x4;
-        let x8 = x1 * (v[2] - 0.65 * v[4]);
-        let x9 = v[6] + v[5] * x1;
-        let x10 = a[0] - a[4] * -0.75;
-        let x11 = a[1] - (0.75 * a[3] + a[5] * -0.65);
-        let x12 = x1 * (a[2] - 0.65 * a[4]);
-        let x13 = a[6] + a[5] * x1;
-        let x14 = a[3] * c_q7 + a[4] * s_q7 + v[6] * x3;
-        let x15 = a[4] * c_q7 - a[3] * s_q7 - v[6] * x2;
-        let x16 = c_q7 * x10 + s_q7 * x11 + v[6] * x7;
-        let x17 = c_q7 * x11 - s_q7 * x10 - v[6] * x6;
-        let x18 = 0.00071 * x2 + 0.1132 * x3 + 1.331 * x9;
-        let x19 = x2 * 2.29018125 + -0.07309 * x3 + 0.00071 * x9
+        let x1 = v[3] * c_q7 + v[4] * s_q7;
+        let x2 = v[4] * c_q7 - v[3] * s_q7;
+        let x3 = v[0] - v[4] * -0.75;
+        let x4 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x5 = v[2] - 0.65 * v[4];
+        let x6 = c_q7 * x3 + s_q7 * x4;
+        let x7 = c_q7 * x4 - s_q7 * x3;
+        let x8 = v[5] + v[6];
+        let x9 = a[0] - a[4] * -0.75;
+        let x10 = a[1] - (0.75 * a[3] + a[5] * -0.65);
+        let x11 = a[2] - 0.65 * a[4];
+        let x12 = a[5] + a[6];
+        let x13 = a[3] * c_q7 + a[4] * s_q7 + v[6] * x2;
+        let x14 = a[4] * c_q7 - a[3] * s_q7 - v[6] * x1;
+        let x15 = c_q7 * x9 + s_q7 * x10 + v[6] * x7;
+        let x16 = c_q7 * x10 - s_q7 * x9 - v[6] * x6;
+        let x17 = 0.00071 * x1 + 0.1132 * x2 + 1.331 * x8;
+        let x18 = 2.29018125 * x1 + -0.07309 * x2 + 0.00071 * x8
             + x7 * -6.1267499999999995;
-        let x20 = -0.07309 * x2 + x3 * 1.5853812499999997 + 0.1132 * x9
-            + x6 * 6.1267499999999995;
-        let x21 = 35.01 * x8;
-        let x22 = 35.01 * x6 - x3 * -6.1267499999999995;
-        let x23 = 35.01 * x7 - x2 * 6.1267499999999995;
+        let x19 = -0.07309 * x1 + 1.5853812499999997 * x2 + 0.1132 * x8
+            + 6.1267499999999995 * x6;
+        let x20 = 35.01 * x5;
+        let x21 = 35.01 * x6 - x2 * -6.1267499999999995;
+        let x22 = 35.01 * x7 - 6.1267499999999995 * x1;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x25 = c_q8 + (1.0 - c_q8);
-        let x26 = -0.00000000020510342851533115 * c_q8;
-        let x27 = -0.00000000020510342851533115 * s_q8;
-        let x28 = -0.00000000020510342851533115 * x25;
-        let x29 = x2 * x26 + x3 * s_q8 - x9 * c_q8;
-        let x30 = x3 * c_q8 - x2 * x27 + x9 * s_q8;
-        let x31 = x6 - x3 * -0.35;
-        let x32 = x7 - 0.35 * x2;
-        let x33 = x26 * x31 + s_q8 * x32 - x8 * c_q8;
-        let x34 = c_q8 * x32 - x27 * x31 + x8 * s_q8;
-        let x35 = x25 * x31 + x8 * x28;
-        let x36 = v[7] + (x2 * x25 + x9 * x28);
-        let x37 = x16 - x15 * -0.35;
-        let x38 = x17 - 0.35 * x14;
-        let x39 = x25 * x37 + x12 * x28;
-        let x40 = a[7] + (x14 * x25 + x13 * x28);
-        let x41 = x14 * x26 + x15 * s_q8 - x13 * c_q8 + v[7] * x30;
-        let x42 = x15 * c_q8 - x14 * x27 + x13 * s_q8 - v[7] * x29;
-        let x43 = x26 * x37 + s_q8 * x38 - x12 * c_q8 + v[7] * x34;
-        let x44 = c_q8 * x38 - x27 * x37 + x12 * s_q8 - v[7] * x33;
-        let x45 = -0.00214 * x29 + 2.359 * x36;
-        let x46 = x29 * 3.3000000000000003 + -0.00214 * x36 + x34 * -6.0;
-        let x47 = x30 * 2.5780000000000003 + x33 * 6.0;
-        let x48 = 30.0 * x35;
-        let x49 = 30.0 * x33 - x30 * -6.0;
-        let x50 = 30.0 * x34 - x29 * 6.0;
+        let x24 = -0.00000000020510342851533115 * c_q8;
+        let x25 = -0.00000000020510342851533115 * s_q8;
+        let x26 = x1 * x24 + x2 * s_q8 - x8 * c_q8;
+        let x27 = x2 * c_q8 - x1 * x25 + x8 * s_q8;
+        let x28 = x6 - x2 * -0.35;
+        let x29 = x7 - 0.35 * x1;
+        let x30 = x24 * x28 + s_q8 * x29 - x5 * c_q8;
+        let x31 = c_q8 * x29 - x25 * x28 + x5 * s_q8;
+        let x32 = x28 + -0.00000000020510342851533115 * x5;
+        let x33 = v[7] + (x1 + -0.00000000020510342851533115 * x8);
+        let x34 = x15 - x14 * -0.35;
+        let x35 = x16 - 0.35 * x13;
+        let x36 = x34 + -0.00000000020510342851533115 * x11;
+        let x37 = a[7] + (x13 + -0.00000000020510342851533115 * x12);
+        let x38 = x13 * x24 + x14 * s_q8 - x12 * c_q8 + v[7] * x27;
+        let x39 = x14 * c_q8 - x13 * x25 + x12 * s_q8 - v[7] * x26;
+        let x40 = x24 * x34 + s_q8 * x35 - x11 * c_q8 + v[7] * x31;
+        let x41 = c_q8 * x35 - x25 * x34 + x11 * s_q8 - v[7] * x30;
+        let x42 = -0.00214 * x26 + 2.359 * x33;
+        let x43 = 3.3000000000000003 * x26 + -0.00214 * x33 + x31 * -6.0;
+        let x44 = 2.5780000000000003 * x27 + 6.0 * x30;
+        let x45 = 30.0 * x32;
+        let x46 = 30.0 * x30 - x27 * -6.0;
+        let x47 = 30.0 * x31 - 6.0 * x26;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x52 = c_q9 + (1.0 - c_q9);
-        let x53 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x54 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x55 = 0.00000000020510342851533115 * x52;
-        let x56 = 0.00000000020510342851533115 * c_q9
+        let x49 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x50 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x51 = 0.00000000020510342851533115 * c_q9
             + -0.00000000020510342851533115 * s_q9;
-        let x57 = -0.00000000020510342851533115 * c_q9
+        let x52 = -0.00000000020510342851533115 * c_q9
             - 0.00000000020510342851533115 * s_q9;
-        let x58 = -0.00000000020510342851533115 * x52;
-        let x59 = x29 * x53 + x30 * x56 + x36 * c_q9;
-        let x60 = x29 * x54 + x30 * x57 - x36 * s_q9;
-        let x61 = x33 - (x30 * -0.4 + 0.275 * x36);
-        let x62 = x34 - 0.4 * x29;
-        let x63 = x35 - -0.275 * x29;
-        let x64 = x53 * x61 + x56 * x62 + c_q9 * x63;
-        let x65 = x54 * x61 + x57 * x62 - s_q9 * x63;
-        let x66 = x55 * x61 + x52 * x62 + x58 * x63;
-        let x67 = v[8] + (x29 * x55 + x30 * x52 + x36 * x58);
-        let x68 = x43 - (x42 * -0.4 + 0.275 * x40);
-        let x69 = x44 - 0.4 * x41;
-        let x70 = x39 - -0.275 * x41;
-        let x71 = x55 * x68 + x52 * x69 + x58 * x70;
-        let x72 = a[8] + (x41 * x55 + x42 * x52 + x40 * x58);
-        let x73 = x41 * x53 + x42 * x56 + x40 * c_q9 + v[8] * x60;
-        let x74 = x41 * x54 + x42 * x57 - x40 * s_q9 - v[8] * x59;
-        let x75 = x53 * x68 + x56 * x69 + c_q9 * x70 + v[8] * x65;
-        let x76 = x54 * x68 + x57 * x69 - s_q9 * x70 - v[8] * x64;
-        let x77 = 3.378 * x60;
-        let x78 = x59 * 4.395515250000001 + -0.00214 * x67 + x66 * -9.87015;
-        let x79 = -0.00214 * x59 + x67 * 7.65251525 + x64 * 9.87015;
-        let x80 = 22.69 * x65;
-        let x81 = 22.69 * x64 - x67 * -9.87015;
-        let x82 = 22.69 * x66 - x59 * 9.87015;
+        let x53 = x26 * x49 + x27 * x51 + x33 * c_q9;
+        let x54 = x26 * x50 + x27 * x52 - x33 * s_q9;
+        let x55 = x30 - (x27 * -0.4 + 0.275 * x33);
+        let x56 = x31 - 0.4 * x26;
+        let x57 = x32 - -0.275 * x26;
+        let x58 = x49 * x55 + x51 * x56 + c_q9 * x57;
+        let x59 = x50 * x55 + x52 * x56 - s_q9 * x57;
+        let x60 = x56 + 0.00000000020510342851533115 * x55
+            + -0.00000000020510342851533115 * x57;
+        let x61 = v[8]
+            + (x27 + 0.00000000020510342851533115 * x26
+                + -0.00000000020510342851533115 * x33);
+        let x62 = x40 - (x39 * -0.4 + 0.275 * x37);
+        let x63 = x41 - 0.4 * x38;
+        let x64 = x36 - -0.275 * x38;
+        let x65 = x63 + 0.00000000020510342851533115 * x62
+            + -0.00000000020510342851533115 * x64;
+        let x66 = a[8]
+            + (x39 + 0.00000000020510342851533115 * x38
+                + -0.00000000020510342851533115 * x37);
+        let x67 = x38 * x49 + x39 * x51 + x37 * c_q9 + v[8] * x54;
+        let x68 = x38 * x50 + x39 * x52 - x37 * s_q9 - v[8] * x53;
+        let x69 = x49 * x62 + x51 * x63 + c_q9 * x64 + v[8] * x59;
+        let x70 = x50 * x62 + x52 * x63 - s_q9 * x64 - v[8] * x58;
+        let x71 = 3.378 * x54;
+        let x72 = 4.395515250000001 * x53 + -0.00214 * x61 + -9.87015 * x60;
+        let x73 = -0.00214 * x53 + 7.65251525 * x61 + x58 * 9.87015;
+        let x74 = 22.69 * x59;
+        let x75 = 22.69 * x58 - -9.87015 * x61;
+        let x76 = 22.69 * x60 - x53 * 9.87015;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x84 = c_q10 + (1.0 - c_q10);
-        let x85 = x59 * c_q10 + x60 * s_q10;
-        let x86 = x60 * c_q10 - x59 * s_q10;
-        let x87 = x64 - -0.87 * x67;
-        let x88 = c_q10 * x87 + x65 * s_q10;
-        let x89 = x65 * c_q10 - s_q10 * x87;
-        let x90 = x84 * (x66 - x59 * 0.87);
-        let x91 = v[9] + x67 * x84;
-        let x92 = x75 - -0.87 * x72;
-        let x93 = x84 * (x71 - x73 * 0.87);
-        let x94 = a[9] + x72 * x84;
-        let x95 = x73 * c_q10 + x74 * s_q10 + v[9] * x86;
-        let x96 = x74 * c_q10 - x73 * s_q10 - v[9] * x85;
-        let x97 = c_q10 * x92 + x76 * s_q10 + v[9] * x89;
-        let x98 = x76 * c_q10 - s_q10 * x92 - v[9] * x88;
-        let x99 = x85 * 4.170993 + -0.6328 * x91 + (x89 * 5.8795 + x90 * -6.7347);
-        let x100 = x86 * 3.8828625 + x91 * -1.8520425 + x88 * -5.8795;
-        let x101 = -0.6328 * x85 + x86 * -1.8520425 + x91 * 4.0324305 + x88 * 6.7347;
-        let x102 = 21.38 * x88 - (x86 * 5.8795 + x91 * -6.7347);
-        let x103 = 21.38 * x89 - x85 * -5.8795;
-        let x104 = 21.38 * x90 - x85 * 6.7347;
+        let x78 = x53 * c_q10 + x54 * s_q10;
+        let x79 = x54 * c_q10 - x53 * s_q10;
+        let x80 = x58 - -0.87 * x61;
+        let x81 = x60 - x53 * 0.87;
+        let x82 = c_q10 * x80 + x59 * s_q10;
+        let x83 = x59 * c_q10 - s_q10 * x80;
+        let x84 = v[9] + x61;
+        let x85 = x69 - -0.87 * x66;
+        let x86 = x65 - x67 * 0.87;
+        let x87 = a[9] + x66;
+        let x88 = x67 * c_q10 + x68 * s_q10 + v[9] * x79;
+        let x89 = x68 * c_q10 - x67 * s_q10 - v[9] * x78;
+        let x90 = c_q10 * x85 + x70 * s_q10 + v[9] * x83;
+        let x91 = x70 * c_q10 - s_q10 * x85 - v[9] * x82;
+        let x92 = 4.170993 * x78 + -0.6328 * x84 + (x83 * 5.8795 + -6.7347 * x81);
+        let x93 = 3.8828625 * x79 + -1.8520425 * x84 + -5.8795 * x82;
+        let x94 = -0.6328 * x78 + -1.8520425 * x79 + 4.0324305 * x84 + x82 * 6.7347;
+        let x95 = 21.38 * x82 - (x79 * 5.8795 + -6.7347 * x84);
+        let x96 = 21.38 * x83 - -5.8795 * x78;
+        let x97 = 21.38 * x81 - x78 * 6.7347;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x106 = c_q11 + (1.0 - c_q11);
-        let x107 = x85 * c_q11 + x86 * s_q11;
-        let x108 = x86 * c_q11 - x85 * s_q11;
-        let x109 = x88 - (0.275 * x86 + -0.63 * x91);
-        let x110 = x89 - -0.275 * x85;
-        let x111 = c_q11 * x109 + s_q11 * x110;
-        let x112 = c_q11 * x110 - s_q11 * x109;
-        let x113 = x106 * (x90 - x85 * 0.63);
-        let x114 = v[10] + x91 * x106;
-        let x115 = x97 - (0.275 * x96 + -0.63 * x94);
-        let x116 = x98 - -0.275 * x95;
-        let x117 = x106 * (x93 - x95 * 0.63);
-        let x118 = a[10] + x94 * x106;
-        let x119 = x95 * c_q11 + x96 * s_q11 + v[10] * x108;
-        let x120 = x96 * c_q11 - x95 * s_q11 - v[10] * x107;
-        let x121 = c_q11 * x115 + s_q11 * x116 + v[10] * x112;
-        let x122 = c_q11 * x116 - s_q11 * x115 - v[10] * x111;
-        let x123 = 0.01675 * x107 + 0.07271 * x114;
-        let x124 = x107 * 0.9304999999999999 + 0.01675 * x114
-            + x112 * 3.0149999999999997;
-        let x125 = x108 * 0.939 + x111 * -3.0149999999999997;
-        let x126 = 16.75 * x113;
-        let x127 = 16.75 * x111 - x108 * 3.0149999999999997;
-        let x128 = 16.75 * x112 - x107 * -3.0149999999999997;
+        let x99 = x78 * c_q11 + x79 * s_q11;
+        let x100 = x79 * c_q11 - x78 * s_q11;
+        let x101 = x82 - (0.275 * x79 + -0.63 * x84);
+        let x102 = x83 - -0.275 * x78;
+        let x103 = x81 - x78 * 0.63;
+        let x104 = c_q11 * x101 + s_q11 * x102;
+        let x105 = c_q11 * x102 - s_q11 * x101;
+        let x106 = v[10] + x84;
+        let x107 = x90 - (0.275 * x89 + -0.63 * x87);
+        let x108 = x91 - -0.275 * x88;
+        let x109 = x86 - x88 * 0.63;
+        let x110 = a[10] + x87;
+        let x111 = x88 * c_q11 + x89 * s_q11 + v[10] * x100;
+        let x112 = x89 * c_q11 - x88 * s_q11 - v[10] * x99;
+        let x113 = c_q11 * x107 + s_q11 * x108 + v[10] * x105;
+        let x114 = c_q11 * x108 - s_q11 * x107 - v[10] * x104;
+        let x115 = 0.01675 * x99 + 0.07271 * x106;
+        let x116 = 0.9304999999999999 * x99 + 0.01675 * x106 + x105 * 3.0149999999999997;
+        let x117 = 0.939 * x100 + -3.0149999999999997 * x104;
+        let x118 = 16.75 * x103;
+        let x119 = 16.75 * x104 - x100 * 3.0149999999999997;
+        let x120 = 16.75 * x105 - -3.0149999999999997 * x99;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x130 = c_q12 + (1.0 - c_q12);
-        let x131 = -0.00000000020510342851533115 * s_q12;
-        let x132 = -0.00000000020510342851533115 * c_q12;
-        let x133 = -0.00000000020510342851533115 * x130;
-        let x134 = x107 * c_q12 + x108 * x131 - x114 * s_q12;
-        let x135 = x108 * x132 - x107 * s_q12 - x114 * c_q12;
-        let x136 = x111 - x108 * 0.36;
-        let x137 = x112 - -0.36 * x107;
-        let x138 = c_q12 * x136 + x131 * x137 - x113 * s_q12;
-        let x139 = x132 * x137 - s_q12 * x136 - x113 * c_q12;
-        let x140 = x130 * x137 + x113 * x133;
-        let x141 = v[11] + (x108 * x130 + x114 * x133);
-        let x142 = x121 - x120 * 0.36;
-        let x143 = x122 - -0.36 * x119;
-        let x144 = x130 * x143 + x117 * x133;
-        let x145 = a[11] + (x120 * x130 + x118 * x133);
-        let x146 = x119 * c_q12 + x120 * x131 - x118 * s_q12 + v[11] * x135;
-        let x147 = x120 * x132 - x119 * s_q12 - x118 * c_q12 - v[11] * x134;
-        let x148 = c_q12 * x142 + x131 * x143 - x117 * s_q12 + v[11] * x139;
-        let x149 = x132 * x143 - s_q12 * x142 - x117 * c_q12 - v[11] * x138;
-        let x150 = x134 * 3.2217582500000006 + -0.2313 * x141
-            + (x139 * -4.187200000000001 + x140 * 7.196750000000001);
-        let x151 = x135 * 1.2686520000000001 + x141 * -1.1514800000000003
-            + x138 * 4.187200000000001;
-        let x152 = -0.2313 * x134 + x135 * -1.1514800000000003
-            + x141 * 2.1079062500000005 + x138 * -7.196750000000001;
-        let x153 = 26.17 * x138 - (x135 * -4.187200000000001 + x141 * 7.196750000000001);
-        let x154 = 26.17 * x139 - x134 * 4.187200000000001;
-        let x155 = 26.17 * x140 - x134 * -7.196750000000001;
+        let x122 = -0.00000000020510342851533115 * s_q12;
+        let x123 = -0.00000000020510342851533115 * c_q12;
+        let x124 = x99 * c_q12 + x100 * x122 - x106 * s_q12;
+        let x125 = x100 * x123 - x99 * s_q12 - x106 * c_q12;
+        let x126 = x104 - x100 * 0.36;
+        let x127 = x105 - -0.36 * x99;
+        let x128 = c_q12 * x126 + x122 * x127 - x103 * s_q12;
+        let x129 = x123 * x127 - s_q12 * x126 - x103 * c_q12;
+        let x130 = x127 + -0.00000000020510342851533115 * x103;
+        let x131 = v[11] + (x100 + -0.00000000020510342851533115 * x106);
+        let x132 = x113 - x112 * 0.36;
+        let x133 = x114 - -0.36 * x111;
+        let x134 = x133 + -0.00000000020510342851533115 * x109;
+        let x135 = a[11] + (x112 + -0.00000000020510342851533115 * x110);
+        let x136 = x111 * c_q12 + x112 * x122 - x110 * s_q12 + v[11] * x125;
+        let x137 = x112 * x123 - x111 * s_q12 - x110 * c_q12 - v[11] * x124;
+        let x138 = c_q12 * x132 + x122 * x133 - x109 * s_q12 + v[11] * x129;
+        let x139 = x123 * x133 - s_q12 * x132 - x109 * c_q12 - v[11] * x128;
+        let x140 = 3.2217582500000006 * x124 + -0.2313 * x131
+            + (x129 * -4.187200000000001 + 7.196750000000001 * x130);
+        let x141 = 1.2686520000000001 * x125 + -1.1514800000000003 * x131
+            + 4.187200000000001 * x128;
+        let x142 = -0.2313 * x124 + -1.1514800000000003 * x125
+            + 2.1079062500000005 * x131 + x128 * -7.196750000000001;
+        let x143 = 26.17 * x128 - (x125 * -4.187200000000001 + 7.196750000000001 * x131);
+        let x144 = 26.17 * x129 - 4.187200000000001 * x124;
+        let x145 = 26.17 * x130 - x124 * -7.196750000000001;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x157 = c_q13 + (1.0 - c_q13);
-        let x158 = -0.00000000020510342851533115 * c_q13;
-        let x159 = -0.00000000020510342851533115 * s_q13;
-        let x160 = -0.00000000020510342851533115 * x157;
-        let x161 = x134 * x158 + x135 * s_q13 - x141 * c_q13;
-        let x162 = x135 * c_q13 - x134 * x159 + x141 * s_q13;
-        let x163 = x138 - (x135 * -0.16 + 0.55 * x141);
-        let x164 = x139 - 0.16 * x134;
-        let x165 = x140 - x134 * -0.55;
-        let x166 = x158 * x163 + s_q13 * x164 - c_q13 * x165;
-        let x167 = c_q13 * x164 - x159 * x163 + s_q13 * x165;
-        let x168 = x157 * x163 + x160 * x165;
-        let x169 = v[12] + (x134 * x157 + x141 * x160);
-        let x170 = x148 - (x147 * -0.16 + 0.55 * x145);
-        let x171 = x149 - 0.16 * x146;
-        let x172 = x144 - x146 * -0.55;
-        let x173 = x157 * x170 + x160 * x172;
-        let x174 = a[12] + (x146 * x157 + x145 * x160);
-        let x175 = x146 * x158 + x147 * s_q13 - x145 * c_q13 + v[12] * x162;
-        let x176 = x147 * c_q13 - x146 * x159 + x145 * s_q13 - v[12] * x161;
-        let x177 = x158 * x170 + s_q13 * x171 - c_q13 * x172 + v[12] * x167;
-        let x178 = c_q13 * x171 - x159 * x170 + s_q13 * x172 - v[12] * x166;
-        let x179 = x161 * 2.1663609200000002 + 0.000781 * x162 + -0.0145 * x169
-            + (x167 * -3.6140000000000003 + x168 * 4.806620000000001);
-        let x180 = 0.000781 * x161 + x162 * 0.9638000000000001
-            + x169 * -0.9614610000000001 + x166 * 3.6140000000000003;
-        let x181 = -0.0145 * x161 + x162 * -0.9614610000000001
-            + x169 * 1.4135609200000003 + x166 * -4.806620000000001;
-        let x182 = 18.07 * x166
-            - (x162 * -3.6140000000000003 + x169 * 4.806620000000001);
-        let x183 = 18.07 * x167 - x161 * 3.6140000000000003;
-        let x184 = 18.07 * x168 - x161 * -4.806620000000001;
-        let x185 = x175 * 2.1663609200000002 + 0.000781 * x176 + -0.0145 * x174
-            + (x178 * -3.6140000000000003 + x173 * 4.806620000000001)
-            + (x162 * x181 - x169 * x180 + (x167 * x184 - x168 * x183));
-        let x186 = 0.000781 * x175 + x176 * 0.9638000000000001
-            + x174 * -0.9614610000000001 + x177 * 3.6140000000000003
-            + (x169 * x179 - x161 * x181 + (x168 * x182 - x166 * x184));
-        let x187 = -0.0145 * x175 + x176 * -0.9614610000000001
-            + x174 * 1.4135609200000003 + x177 * -4.806620000000001
-            + (x161 * x180 - x162 * x179 + (x166 * x183 - x167 * x182));
-        let x188 = 18.07 * x177 - (x176 * -3.6140000000000003 + x174 * 4.806620000000001)
-            + (x162 * x184 - x169 * x183);
-        let x189 = 18.07 * x178 - x175 * 3.6140000000000003
-            + (x169 * x182 - x161 * x184);
-        let x190 = 18.07 * x173 - x175 * -4.806620000000001
-            + (x161 * x183 - x162 * x182);
-        let x191 = x158 * x188 - x159 * x189 + x157 * x190;
-        let x192 = s_q13 * x188 + c_q13 * x189;
-        let x193 = s_q13 * x189 - c_q13 * x188 + x160 * x190;
-        let x194 = x146 * 3.2217582500000006 + -0.2313 * x145
-            + (x149 * -4.187200000000001 + x144 * 7.196750000000001)
-            + (x135 * x152 - x141 * x151 + (x139 * x155 - x140 * x154))
-            + (x158 * x185 - x159 * x186 + x157 * x187 + (-0.16 * x192 + 0.55 * x193));
-        let x195 = x147 * 1.2686520000000001 + x145 * -1.1514800000000003
-            + x148 * 4.187200000000001
-            + (x141 * x150 - x134 * x152 + (x140 * x153 - x138 * x155))
-            + (s_q13 * x185 + c_q13 * x186 + 0.16 * x191);
-        let x196 = -0.2313 * x146 + x147 * -1.1514800000000003
-            + x145 * 2.1079062500000005 + x148 * -7.196750000000001
-            + (x134 * x151 - x135 * x150 + (x138 * x154 - x139 * x153))
-            + (s_q13 * x186 - c_q13 * x185 + x160 * x187 + -0.55 * x191);
-        let x197 = 26.17 * x148 - (x147 * -4.187200000000001 + x145 * 7.196750000000001)
-            + (x135 * x155 - x141 * x154) + x191;
-        let x198 = 26.17 * x149 - x146 * 4.187200000000001 + (x141 * x153 - x134 * x155)
-            + x192;
-        let x199 = 26.17 * x144 - x146 * -7.196750000000001 + (x134 * x154 - x135 * x153)
-            + x193;
-        let x200 = c_q12 * x197 - s_q12 * x198;
-        let x201 = x131 * x197 + x132 * x198 + x130 * x199;
-        let x202 = x119 * 0.9304999999999999 + 0.01675 * x118 + x122 * 3.0149999999999997
-            + (x108 * x123 - x114 * x125 + (x112 * x126 - x113 * x128))
-            + (c_q12 * x194 - s_q12 * x195 + 0.36 * x201);
-        let x203 = x120 * 0.939 + x121 * -3.0149999999999997
-            + (x114 * x124 - x107 * x123 + (x113 * x127 - x111 * x126))
-            + (x131 * x194 + x132 * x195 + x130 * x196 + -0.36 * x200);
-        let x204 = 16.75 * x121 - x120 * 3.0149999999999997 + (x108 * x126 - x114 * x128)
-            + x200;
-        let x205 = 16.75 * x122 - x119 * -3.0149999999999997
-            + (x114 * x127 - x107 * x126) + x201;
-        let x206 = c_q11 * x204 - s_q11 * x205;
-        let x207 = s_q11 * x204 + c_q11 * x205;
-        let x208 = x106
-            * (16.75 * x117 + (x107 * x128 - x108 * x127)
-                + (x133 * x199 - (s_q12 * x197 + c_q12 * x198)));
-        let x209 = x95 * 4.170993 + -0.6328 * x94 + (x98 * 5.8795 + x93 * -6.7347)
-            + (x86 * x101 - x91 * x100 + (x89 * x104 - x90 * x103))
-            + (c_q11 * x202 - s_q11 * x203 + (0.275 * x207 + -0.63 * x208));
-        let x210 = x96 * 3.8828625 + x94 * -1.8520425 + x97 * -5.8795
-            + (x91 * x99 - x85 * x101 + (x90 * x102 - x88 * x104))
-            + (s_q11 * x202 + c_q11 * x203 + -0.275 * x206);
-        let x211 = 21.38 * x97 - (x96 * 5.8795 + x94 * -6.7347)
-            + (x86 * x104 - x91 * x103) + x206;
-        let x212 = 21.38 * x98 - x95 * -5.8795 + (x91 * x102 - x85 * x104) + x207;
-        let x213 = c_q10 * x211 - s_q10 * x212;
-        let x214 = x84 * (21.38 * x93 - x95 * 6.7347 + (x85 * x103 - x86 * x102) + x208);
-        let x215 = x73 * 4.395515250000001 + -0.00214 * x72 + x71 * -9.87015
-            + (x60 * x79 - x67 * x77 + (x65 * x82 - x66 * x80))
-            + (c_q10 * x209 - s_q10 * x210 + -0.87 * x214);
-        let x216 = 3.378 * x74 + (x67 * x78 - x59 * x79 + (x66 * x81 - x64 * x82))
-            + (s_q10 * x209 + c_q10 * x210);
-        let x217 = -0.00214 * x73 + x72 * 7.65251525 + x75 * 9.87015
-            + (x59 * x77 - x60 * x78 + (x64 * x80 - x65 * x81))
-            + (x84
-                * (-0.6328 * x95 + x96 * -1.8520425 + x94 * 4.0324305 + x97 * 6.7347
-                    + (x85 * x100 - x86 * x99 + (x88 * x103 - x89 * x102))
-                    + (x106
-                        * (0.01675 * x119 + 0.07271 * x118
-                            + (x107 * x125 - x108 * x124 + (x111 * x128 - x112 * x127))
-                            + (x133 * x196 - (s_q12 * x194 + c_q12 * x195)))
-                        + 0.63 * x206)) + 0.87 * x213);
-        let x218 = 22.69 * x75 - x72 * -9.87015 + (x60 * x82 - x67 * x80) + x213;
-        let x219 = 22.69 * x76 + (x67 * x81 - x59 * x82) + (s_q10 * x211 + c_q10 * x212);
-        let x220 = 22.69 * x71 - x73 * 9.87015 + (x59 * x80 - x60 * x81) + x214;
-        let x221 = x53 * x218 + x54 * x219 + x55 * x220;
-        let x222 = x56 * x218 + x57 * x219 + x52 * x220;
-        let x223 = c_q9 * x218 - s_q9 * x219 + x58 * x220;
-        let x224 = x41 * 3.3000000000000003 + -0.00214 * x40 + x44 * -6.0
-            + (x30 * x45 - x36 * x47 + (x34 * x48 - x35 * x50))
-            + (x53 * x215 + x54 * x216 + x55 * x217 + (-0.4 * x222 + 0.275 * x223));
-        let x225 = x42 * 2.5780000000000003 + x43 * 6.0
-            + (x36 * x46 - x29 * x45 + (x35 * x49 - x33 * x48))
-            + (x56 * x215 + x57 * x216 + x52 * x217 + 0.4 * x221);
-        let x226 = -0.00214 * x41 + 2.359 * x40
-            + (x29 * x47 - x30 * x46 + (x33 * x50 - x34 * x49))
-            + (c_q9 * x215 - s_q9 * x216 + x58 * x217 + -0.275 * x221);
-        let x227 = 30.0 * x43 - x42 * -6.0 + (x30 * x48 - x36 * x50) + x221;
-        let x228 = 30.0 * x44 - x41 * 6.0 + (x36 * x49 - x29 * x48) + x222;
-        let x229 = 30.0 * x39 + (x29 * x50 - x30 * x49) + x223;
-        let x230 = x26 * x227 - x27 * x228 + x25 * x229;
-        let x231 = s_q8 * x227 + c_q8 * x228;
-        let x232 = x14 * 2.29018125 + -0.07309 * x15 + 0.00071 * x13
-            + x17 * -6.1267499999999995 + (x3 * x18 - x9 * x20 + (x7 * x21 - x8 * x23))
-            + (x26 * x224 - x27 * x225 + x25 * x226 + -0.35 * x231);
-        let x233 = -0.07309 * x14 + x15 * 1.5853812499999997 + 0.1132 * x13
-            + x16 * 6.1267499999999995 + (x9 * x19 - x2 * x18 + (x8 * x22 - x6 * x21))
-            + (s_q8 * x224 + c_q8 * x225 + 0.35 * x230);
-        let x234 = 35.01 * x16 - x15 * -6.1267499999999995 + (x3 * x21 - x9 * x23)
-            + x230;
-        let x235 = 35.01 * x17 - x14 * 6.1267499999999995 + (x9 * x22 - x2 * x21) + x231;
-        let x236 = c_q7 * x234 - s_q7 * x235;
-        let x237 = s_q7 * x234 + c_q7 * x235;
-        let x238 = x1
-            * (35.01 * x12 + (x2 * x23 - x3 * x22)
-                + (s_q8 * x228 - c_q8 * x227 + x28 * x229));
-        let x239 = -x236;
-        let x240 = -x237;
-        let x241 = -x238;
-        let x242 = -(c_q7 * x232 - s_q7 * x233 + -0.75 * x237);
-        let x243 = -(s_q7 * x232 + c_q7 * x233 + (0.75 * x236 + -0.65 * x238));
-        let x244 = -(x1
-            * (0.00071 * x14 + 0.1132 * x15 + 1.331 * x13
-                + (x2 * x20 - x3 * x19 + (x6 * x23 - x7 * x22))
-                + (s_q8 * x225 - c_q8 * x224 + x28 * x226)) + 0.65 * x237);
-        [x239, x240, x241, x242, x243, x244]
+        let x147 = -0.00000000020510342851533115 * c_q13;
+        let x148 = -0.00000000020510342851533115 * s_q13;
+        let x149 = x124 * x147 + x125 * s_q13 - x131 * c_q13;
+        let x150 = x125 * c_q13 - x124 * x148 + x131 * s_q13;
+        let x151 = x128 - (-0.16 * x125 + 0.55 * x131);
+        let x152 = x129 - 0.16 * x124;
+        let x153 = x130 - x124 * -0.55;
+        let x154 = x147 * x151 + s_q13 * x152 - c_q13 * x153;
+        let x155 = c_q13 * x152 - x148 * x151 + s_q13 * x153;
+        let x156 = x151 + -0.00000000020510342851533115 * x153;
+        let x157 = v[12] + (x124 + -0.00000000020510342851533115 * x131);
+        let x158 = x138 - (-0.16 * x137 + 0.55 * x135);
+        let x159 = x139 - 0.16 * x136;
+        let x160 = x134 - x136 * -0.55;
+        let x161 = x158 + -0.00000000020510342851533115 * x160;
+        let x162 = a[12] + (x136 + -0.00000000020510342851533115 * x135);
+        let x163 = x136 * x147 + x137 * s_q13 - x135 * c_q13 + v[12] * x150;
+        let x164 = x137 * c_q13 - x136 * x148 + x135 * s_q13 - v[12] * x149;
+        let x165 = x147 * x158 + s_q13 * x159 - c_q13 * x160 + v[12] * x155;
+        let x166 = c_q13 * x159 - x148 * x158 + s_q13 * x160 - v[12] * x154;
+        let x167 = 2.1663609200000002 * x149 + 0.000781 * x150 + -0.0145 * x157
+            + (x155 * -3.6140000000000003 + 4.806620000000001 * x156);
+        let x168 = 0.000781 * x149 + 0.9638000000000001 * x150
+            + -0.9614610000000001 * x157 + 3.6140000000000003 * x154;
+        let x169 = -0.0145 * x149 + -0.9614610000000001 * x150
+            + 1.4135609200000003 * x157 + x154 * -4.806620000000001;
+        let x170 = 18.07 * x154
+            - (x150 * -3.6140000000000003 + 4.806620000000001 * x157);
+        let x171 = 18.07 * x155 - 3.6140000000000003 * x149;
+        let x172 = 18.07 * x156 - x149 * -4.806620000000001;
+        let x173 = 2.1663609200000002 * x163 + 0.000781 * x164 + -0.0145 * x162
+            + (x166 * -3.6140000000000003 + 4.806620000000001 * x161)
+            + (x150 * x169 - x157 * x168 + (x155 * x172 - x156 * x171));
+        let x174 = 0.000781 * x163 + 0.9638000000000001 * x164
+            + -0.9614610000000001 * x162 + 3.6140000000000003 * x165
+            + (x157 * x167 - x149 * x169 + (x156 * x170 - x154 * x172));
+        let x175 = -0.0145 * x163 + -0.9614610000000001 * x164
+            + 1.4135609200000003 * x162 + x165 * -4.806620000000001
+            + (x149 * x168 - x150 * x167 + (x154 * x171 - x155 * x170));
+        let x176 = 18.07 * x165 - (x164 * -3.6140000000000003 + 4.806620000000001 * x162)
+            + (x150 * x172 - x157 * x171);
+        let x177 = 18.07 * x166 - 3.6140000000000003 * x163
+            + (x157 * x170 - x149 * x172);
+        let x178 = 18.07 * x161 - x163 * -4.806620000000001
+            + (x149 * x171 - x150 * x170);
+        let x179 = x178 + (x147 * x176 - x148 * x177);
+        let x180 = s_q13 * x176 + c_q13 * x177;
+        let x181 = s_q13 * x177 - c_q13 * x176 + -0.00000000020510342851533115 * x178;
+        let x182 = 3.2217582500000006 * x136 + -0.2313 * x135
+            + (x139 * -4.187200000000001 + 7.196750000000001 * x134)
+            + (x125 * x142 - x131 * x141 + (x129 * x145 - x130 * x144))
+            + (x175 + (x147 * x173 - x148 * x174) + (-0.16 * x180 + 0.55 * x181));
+        let x183 = 1.2686520000000001 * x137 + -1.1514800000000003 * x135
+            + 4.187200000000001 * x138
+            + (x131 * x140 - x124 * x142 + (x130 * x143 - x128 * x145))
+            + (s_q13 * x173 + c_q13 * x174 + 0.16 * x179);
+        let x184 = -0.2313 * x136 + -1.1514800000000003 * x137
+            + 2.1079062500000005 * x135 + x138 * -7.196750000000001
+            + (x124 * x141 - x125 * x140 + (x128 * x144 - x129 * x143))
+            + (s_q13 * x174 - c_q13 * x173 + -0.00000000020510342851533115 * x175
+                + -0.55 * x179);
+        let x185 = 26.17 * x138 - (x137 * -4.187200000000001 + 7.196750000000001 * x135)
+            + (x125 * x145 - x131 * x144) + x179;
+        let x186 = 26.17 * x139 - 4.187200000000001 * x136 + (x131 * x143 - x124 * x145)
+            + x180;
+        let x187 = 26.17 * x134 - x136 * -7.196750000000001 + (x124 * x144 - x125 * x143)
+            + x181;
+        let x188 = c_q12 * x185 - s_q12 * x186;
+        let x189 = x187 + (x122 * x185 + x123 * x186);
+        let x190 = 0.9304999999999999 * x111 + 0.01675 * x110 + x114 * 3.0149999999999997
+            + (x100 * x115 - x106 * x117 + (x105 * x118 - x103 * x120))
+            + (c_q12 * x182 - s_q12 * x183 + 0.36 * x189);
+        let x191 = 0.939 * x112 + -3.0149999999999997 * x113
+            + (x106 * x116 - x99 * x115 + (x103 * x119 - x104 * x118))
+            + (x184 + (x122 * x182 + x123 * x183) + -0.36 * x188);
+        let x192 = 16.75 * x113 - x112 * 3.0149999999999997 + (x100 * x118 - x106 * x120)
+            + x188;
+        let x193 = 16.75 * x114 - -3.0149999999999997 * x111 + (x106 * x119 - x99 * x118)
+            + x189;
+        let x194 = 16.75 * x109 + (x99 * x120 - x100 * x119)
+            + (-0.00000000020510342851533115 * x187 - (s_q12 * x185 + c_q12 * x186));
+        let x195 = c_q11 * x192 - s_q11 * x193;
+        let x196 = s_q11 * x192 + c_q11 * x193;
+        let x197 = 4.170993 * x88 + -0.6328 * x87 + (x91 * 5.8795 + -6.7347 * x86)
+            + (x79 * x94 - x84 * x93 + (x83 * x97 - x81 * x96))
+            + (c_q11 * x190 - s_q11 * x191 + (0.275 * x196 + -0.63 * x194));
+        let x198 = 3.8828625 * x89 + -1.8520425 * x87 + -5.8795 * x90
+            + (x84 * x92 - x78 * x94 + (x81 * x95 - x82 * x97))
+            + (s_q11 * x190 + c_q11 * x191 + -0.275 * x195);
+        let x199 = 21.38 * x90 - (x89 * 5.8795 + -6.7347 * x87) + (x79 * x97 - x84 * x96)
+            + x195;
+        let x200 = 21.38 * x91 - -5.8795 * x88 + (x84 * x95 - x78 * x97) + x196;
+        let x201 = 21.38 * x86 - x88 * 6.7347 + (x78 * x96 - x79 * x95) + x194;
+        let x202 = c_q10 * x199 - s_q10 * x200;
+        let x203 = 4.395515250000001 * x67 + -0.00214 * x66 + -9.87015 * x65
+            + (x54 * x73 - x61 * x71 + (x59 * x76 - x60 * x74))
+            + (c_q10 * x197 - s_q10 * x198 + -0.87 * x201);
+        let x204 = 3.378 * x68 + (x61 * x72 - x53 * x73 + (x60 * x75 - x58 * x76))
+            + (s_q10 * x197 + c_q10 * x198);
+        let x205 = -0.00214 * x67 + 7.65251525 * x66 + x69 * 9.87015
+            + (x53 * x71 - x54 * x72 + (x58 * x74 - x59 * x75))
+            + (-0.6328 * x88 + -1.8520425 * x89 + 4.0324305 * x87 + x90 * 6.7347
+                + (x78 * x93 - x79 * x92 + (x82 * x96 - x83 * x95))
+                + (0.01675 * x111 + 0.07271 * x110
+                    + (x99 * x117 - x100 * x116 + (x104 * x120 - x105 * x119))
+                    + (-0.00000000020510342851533115 * x184
+                        - (s_q12 * x182 + c_q12 * x183)) + 0.63 * x195) + 0.87 * x202);
+        let x206 = 22.69 * x69 - -9.87015 * x66 + (x54 * x76 - x61 * x74) + x202;
+        let x207 = 22.69 * x70 + (x61 * x75 - x53 * x76) + (s_q10 * x199 + c_q10 * x200);
+        let x208 = 22.69 * x65 - x67 * 9.87015 + (x53 * x74 - x54 * x75) + x201;
+        let x209 = x49 * x206 + x50 * x207 + 0.00000000020510342851533115 * x208;
+        let x210 = x208 + (x51 * x206 + x52 * x207);
+        let x211 = c_q9 * x206 - s_q9 * x207 + -0.00000000020510342851533115 * x208;
+        let x212 = 3.3000000000000003 * x38 + -0.00214 * x37 + x41 * -6.0
+            + (x27 * x42 - x33 * x44 + (x31 * x45 - x32 * x47))
+            + (x49 * x203 + x50 * x204 + 0.00000000020510342851533115 * x205
+                + (-0.4 * x210 + 0.275 * x211));
+        let x213 = 2.5780000000000003 * x39 + 6.0 * x40
+            + (x33 * x43 - x26 * x42 + (x32 * x46 - x30 * x45))
+            + (x205 + (x51 * x203 + x52 * x204) + 0.4 * x209);
+        let x214 = -0.00214 * x38 + 2.359 * x37
+            + (x26 * x44 - x27 * x43 + (x30 * x47 - x31 * x46))
+            + (c_q9 * x203 - s_q9 * x204 + -0.00000000020510342851533115 * x205
+                + -0.275 * x209);
+        let x215 = 30.0 * x40 - x39 * -6.0 + (x27 * x45 - x33 * x47) + x209;
+        let x216 = 30.0 * x41 - 6.0 * x38 + (x33 * x46 - x26 * x45) + x210;
+        let x217 = 30.0 * x36 + (x26 * x47 - x27 * x46) + x211;
+        let x218 = x217 + (x24 * x215 - x25 * x216);
+        let x219 = s_q8 * x215 + c_q8 * x216;
+        let x220 = 2.29018125 * x13 + -0.07309 * x14 + 0.00071 * x12
+            + x16 * -6.1267499999999995 + (x2 * x17 - x8 * x19 + (x7 * x20 - x5 * x22))
+            + (x214 + (x24 * x212 - x25 * x213) + -0.35 * x219);
+        let x221 = -0.07309 * x13 + 1.5853812499999997 * x14 + 0.1132 * x12
+            + 6.1267499999999995 * x15 + (x8 * x18 - x1 * x17 + (x5 * x21 - x6 * x20))
+            + (s_q8 * x212 + c_q8 * x213 + 0.35 * x218);
+        let x222 = 35.01 * x15 - x14 * -6.1267499999999995 + (x2 * x20 - x8 * x22)
+            + x218;
+        let x223 = 35.01 * x16 - 6.1267499999999995 * x13 + (x8 * x21 - x1 * x20) + x219;
+        let x224 = 35.01 * x11 + (x1 * x22 - x2 * x21)
+            + (s_q8 * x216 - c_q8 * x215 + -0.00000000020510342851533115 * x217);
+        let x225 = c_q7 * x222 - s_q7 * x223;
+        let x226 = s_q7 * x222 + c_q7 * x223;
+        let x227 = -x225;
+        let x228 = -x226;
+        let x229 = -x224;
+        let x230 = -(c_q7 * x220 - s_q7 * x221 + -0.75 * x226);
+        let x231 = -(s_q7 * x220 + c_q7 * x221 + (0.75 * x225 + -0.65 * x224));
+        let x232 = -(0.00071 * x13 + 0.1132 * x14 + 1.331 * x12
+            + (x1 * x19 - x2 * x18 + (x6 * x22 - x7 * x21))
+            + (s_q8 * x213 - c_q8 * x212 + -0.00000000020510342851533115 * x214)
+            + 0.65 * x226);
+        [x227, x228, x229, x230, x231, x232]
     }
 }

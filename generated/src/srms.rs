@@ -6,31 +6,32 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
+//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
 //! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 488 | 406 | 0 | 0 | 6 | 894 |
-//! | `mass_matrix` | `recurrent-r1` | — | 539 | 436 | 0 | 0 | 6 | 975 |
-//! | `mass_matrix` | `kane-direct` | — | 629 | 413 | 0 | 0 | 6 | 1042 |
-//! | `mass_matrix` | `crba-base` | — | 470 | 353 | 0 | 0 | 6 | 823 |
-//! | `mass_matrix` * | `crba` | — | 214 | 152 | 0 | 0 | 5 | 366 |
-//! | `nonlinear_effects` | — | `recurrent` | 551 | 398 | 0 | 0 | 6 | 949 |
-//! | `nonlinear_effects` | — | `kane-direct` | 628 | 452 | 0 | 0 | 6 | 1080 |
-//! | `nonlinear_effects` * | — | `rnea` | 326 | 226 | 0 | 0 | 5 | 552 |
-//! | `inverse_dynamics` | — | `recurrent` | 801 | 578 | 0 | 0 | 6 | 1379 |
-//! | `inverse_dynamics` | — | `kane-direct` | 878 | 632 | 0 | 0 | 6 | 1510 |
-//! | `inverse_dynamics` * | — | `rnea` | 349 | 249 | 0 | 0 | 5 | 598 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 851 | 613 | 6 | 0 | 6 | 1464 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 928 | 667 | 6 | 0 | 6 | 1595 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 626 | 441 | 6 | 0 | 5 | 1067 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 765 | 542 | 0 | 0 | 6 | 1307 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 842 | 596 | 0 | 0 | 6 | 1438 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 540 | 370 | 0 | 0 | 5 | 910 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 928 | 690 | 6 | 0 | 6 | 1618 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1005 | 744 | 6 | 0 | 6 | 1749 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 626 | 469 | 6 | 0 | 5 | 1095 |
+//! | `mass_matrix` | `recurrent` | — | 468 | 392 | 0 | 0 | 6 | 860 |
+//! | `mass_matrix` | `recurrent-r1` | — | 519 | 422 | 0 | 0 | 6 | 941 |
+//! | `mass_matrix` | `kane-direct` | — | 505 | 352 | 0 | 0 | 6 | 857 |
+//! | `mass_matrix` | `crba-base` | — | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` * | `crba` | — | 157 | 128 | 0 | 0 | 5 | 285 |
+//! | `nonlinear_effects` | — | `recurrent` | 537 | 386 | 0 | 0 | 6 | 923 |
+//! | `nonlinear_effects` | — | `kane-direct` | 580 | 428 | 0 | 0 | 6 | 1008 |
+//! | `nonlinear_effects` * | — | `rnea` | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `inverse_dynamics` | — | `recurrent` | 728 | 550 | 0 | 0 | 6 | 1278 |
+//! | `inverse_dynamics` | — | `kane-direct` | 771 | 592 | 0 | 0 | 6 | 1363 |
+//! | `inverse_dynamics` * | — | `rnea` | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 780 | 585 | 6 | 0 | 6 | 1365 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 823 | 627 | 6 | 0 | 6 | 1450 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 497 | 380 | 6 | 0 | 5 | 877 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 694 | 514 | 0 | 0 | 6 | 1208 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 737 | 556 | 0 | 0 | 6 | 1293 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 411 | 309 | 0 | 0 | 5 | 720 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 856 | 662 | 6 | 0 | 6 | 1518 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 899 | 704 | 6 | 0 | 6 | 1603 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 503 | 412 | 6 | 0 | 5 | 915 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -87,8 +88,8 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 214u64,
-            add: 152u64,
+            mul: 157u64,
+            add: 128u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -98,8 +99,8 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 326u64,
-            add: 226u64,
+            mul: 254u64,
+            add: 181u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -109,8 +110,8 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 349u64,
-            add: 249u64,
+            mul: 278u64,
+            add: 207u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -120,8 +121,8 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 626u64,
-            add: 441u64,
+            mul: 497u64,
+            add: 380u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -131,8 +132,8 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 540u64,
-            add: 370u64,
+            mul: 411u64,
+            add: 309u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -142,8 +143,8 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 626u64,
-            add: 469u64,
+            mul: 503u64,
+            add: 412u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -156,8 +157,8 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
-            mul: 488u64,
-            add: 406u64,
+            mul: 468u64,
+            add: 392u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -167,8 +168,8 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
-            mul: 539u64,
-            add: 436u64,
+            mul: 519u64,
+            add: 422u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -178,8 +179,8 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
-            mul: 629u64,
-            add: 413u64,
+            mul: 505u64,
+            add: 352u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -189,8 +190,8 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
-            mul: 470u64,
-            add: 353u64,
+            mul: 450u64,
+            add: 339u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -200,8 +201,8 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 214u64,
-            add: 152u64,
+            mul: 157u64,
+            add: 128u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -211,8 +212,8 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 551u64,
-            add: 398u64,
+            mul: 537u64,
+            add: 386u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -222,8 +223,8 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 628u64,
-            add: 452u64,
+            mul: 580u64,
+            add: 428u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -233,8 +234,8 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 326u64,
-            add: 226u64,
+            mul: 254u64,
+            add: 181u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -244,8 +245,8 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 801u64,
-            add: 578u64,
+            mul: 728u64,
+            add: 550u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -255,8 +256,8 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 878u64,
-            add: 632u64,
+            mul: 771u64,
+            add: 592u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -266,8 +267,8 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 349u64,
-            add: 249u64,
+            mul: 278u64,
+            add: 207u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -277,8 +278,8 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 851u64,
-            add: 613u64,
+            mul: 780u64,
+            add: 585u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -288,8 +289,8 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 928u64,
-            add: 667u64,
+            mul: 823u64,
+            add: 627u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -299,8 +300,8 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 626u64,
-            add: 441u64,
+            mul: 497u64,
+            add: 380u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -310,8 +311,8 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 765u64,
-            add: 542u64,
+            mul: 694u64,
+            add: 514u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -321,8 +322,8 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 842u64,
-            add: 596u64,
+            mul: 737u64,
+            add: 556u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -332,8 +333,8 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 540u64,
-            add: 370u64,
+            mul: 411u64,
+            add: 309u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -343,8 +344,8 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 928u64,
-            add: 690u64,
+            mul: 856u64,
+            add: 662u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -354,8 +355,8 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 1005u64,
-            add: 744u64,
+            mul: 899u64,
+            add: 704u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -365,8 +366,8 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 626u64,
-            add: 469u64,
+            mul: 503u64,
+            add: 412u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -375,147 +376,130 @@ impl Srms {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 214 mul, 152 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`: 157 mul, 128 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 1.903 * x8;
-        let x10 = 0.385 * x8;
-        let x11 = 0.966 * x8;
-        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
-        let x13 = 0.353 * s_q5;
-        let x14 = 3.816 * c_q5 - x13;
-        let x15 = 0.353 * c_q5;
-        let x16 = x15 - 2.823 * s_q5;
-        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x18 = x15 + 3.816 * s_q5;
-        let x19 = x13 + 2.823 * c_q5;
-        let x20 = c_q5 * x10 - s_q5 * x11;
-        let x21 = s_q5 * x10 + c_q5 * x11;
-        let x22 = x8 * x12;
-        let x23 = s_q5 * x14 + c_q5 * x16;
-        let x24 = 0.408 + x8 * x9;
-        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
-        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
-        let x27 = c_q4 * 34.45002;
-        let x28 = s_q4 * 34.45002;
-        let x29 = x27 + 41.67378;
-        let x30 = c_q4 * x24 - s_q4 * x22;
-        let x31 = c_q4 * x20 - s_q4 * x25;
-        let x32 = c_q4 * x21 - s_q4 * x23;
-        let x33 = s_q4 * x21 + c_q4 * x23;
-        let x34 = x6 * (x8 * x17);
-        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
-        let x36 = x6 * x26;
-        let x37 = x6 * x32;
-        let x38 = c_q4 * x34 - s_q4 * x35;
-        let x39 = s_q4 * x34 + c_q4 * x35;
-        let x40 = 0.4572 * x27;
-        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
-        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
-        let x43 = 0.402
-            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
-                - x27 * -0.4572 + 0.4572 * x29);
-        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
-        let x45 = c_q3 * x29;
-        let x46 = x4 * x28;
-        let x47 = s_q3 * x29;
-        let x48 = x45 + 703.3878000000001;
-        let x49 = -15.183612000000002 - x47;
-        let x50 = c_q3 * x42 + s_q3 * x38;
-        let x51 = c_q3 * x41 + s_q3 * x39;
-        let x52 = c_q3 * x37 + s_q3 * x44;
-        let x53 = x4 * x43;
-        let x54 = c_q3 * x38 - s_q3 * x42;
-        let x55 = c_q3 * x39 - s_q3 * x41;
-        let x56 = c_q3 * x44 - s_q3 * x37;
-        let x57 = -0.1524 * x47 + x45 * -7.06;
-        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
-        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
-        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
-        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
-        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
-        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
-        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
-        let x65 = c_q2 * x48 + s_q2 * x49;
-        let x66 = x2 * x46;
-        let x67 = c_q2 * x49 - s_q2 * x48;
-        let x68 = x65 + 1192.8178500000001;
-        let x69 = x67 + -28.506420000000002;
-        let x70 = c_q2 * x58 + s_q2 * x62;
-        let x71 = c_q2 * x59 + s_q2 * x63;
-        let x72 = c_q2 * x60 + s_q2 * x64;
-        let x73 = x2 * x61;
-        let x74 = c_q2 * x62 - s_q2 * x58;
-        let x75 = c_q2 * x63 - s_q2 * x59;
-        let x76 = c_q2 * x64 - s_q2 * x60;
-        let x77 = -0.1524 * x67;
-        let x78 = x65 * -6.377;
-        let x79 = 998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68));
-        let x80 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
-            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
-        let x81 = 0.595
+        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x6 = 0.353 * s_q5;
+        let x7 = 0.353 * c_q5;
+        let x8 = x7 - -0.9929999999999999 * s_q5;
+        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
+        let x10 = x6 + -0.9929999999999999 * c_q5;
+        let x11 = c_q5 * x8 - s_q5 * x6;
+        let x12 = c_q5 * x7 - s_q5 * x10;
+        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
+        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x15 = 34.45002 * c_q4;
+        let x16 = 34.45002 * s_q4;
+        let x17 = s_q4 * x5;
+        let x18 = 1.903 * c_q4 - x17;
+        let x19 = c_q4 * x5;
+        let x20 = x19 - s_q4 * x13;
+        let x21 = c_q4 * x9;
+        let x22 = x21 - s_q4 * x11;
+        let x23 = x19 + 1.903 * s_q4;
+        let x24 = s_q4 * x9;
+        let x25 = x24 + c_q4 * x11;
+        let x26 = x21 - s_q4 * x12;
+        let x27 = x24 + c_q4 * x12;
+        let x28 = x15 * -0.4572;
+        let x29 = 0.4572 * x15;
+        let x30 = x14 + x29;
+        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x32 = x30 - x28;
+        let x33 = 41.67378 + x15;
+        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x35 = 19.863252216000003
+            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+        let x36 = c_q3 * x33;
+        let x37 = s_q3 * x33;
+        let x38 = c_q3 * x34 + s_q3 * x26;
+        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x40 = c_q3 * x22;
+        let x41 = x40 + s_q3 * x32;
+        let x42 = c_q3 * x26 - s_q3 * x34;
+        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x44 = s_q3 * x22;
+        let x45 = c_q3 * x32 - x44;
+        let x46 = x37 * 0.1524;
+        let x47 = -0.1524 * x37;
+        let x48 = x36 * -7.06;
+        let x49 = 7.06 * x36;
+        let x50 = x35 - (x47 + x48);
+        let x51 = x16 * 0.1524;
+        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x53 = 703.3878000000001 + x36;
+        let x54 = -15.183612000000002 - x37;
+        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
+        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x57 = 103.41030072000001
+            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x59 = 103.41030072000002
+            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+        let x60 = -0.08 + (x43 + x51);
+        let x61 = c_q2 * x53 + s_q2 * x54;
+        let x62 = c_q2 * x54 - s_q2 * x53;
+        let x63 = c_q2 * x55 + s_q2 * x59;
+        let x64 = c_q2 * x56 + s_q2 * x60;
+        let x65 = c_q2 * x57 + s_q2 * x52;
+        let x66 = c_q2 * x59 - s_q2 * x55;
+        let x67 = c_q2 * x60 - s_q2 * x56;
+        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x69 = 0.1524 * x62;
+        let x70 = -0.1524 * x62;
+        let x71 = x61 * -6.377;
+        let x72 = 6.377 * x61;
+        let x73 = 8609.573807858 + (x58 - (x71 - x70) - (x69 - x72));
+        let x74 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
+        let x75 = 14222.257549666001
             + (c_q1
-                * (c_q1
-                    * (997.18 + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
+                * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
                     - s_q1
-                        * (9.185
-                            + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
+                        * (190.97044034
+                            + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
                 - s_q1
                     * (c_q1
-                        * (9.185
-                            + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
+                        * (190.97044034000004
+                            + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
                         - s_q1
-                            * (3.225
-                                + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
-                                    + -0.1524 * x69))));
-        let x82 = x73 + (x77 - x78);
-        let x83 = c_q1 * x75 - s_q1 * x71;
-        let x84 = x53 - x57;
-        let x85 = x2 * x84
-            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45));
-        let x86 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
-        let x87 = x36 + x40;
-        let x88 = c_q3 * x28;
-        let x89 = x4 * x27;
-        let x90 = s_q3 * x28;
-        let x91 = c_q3 * x32 + s_q3 * x87 + 0.1524 * x89;
-        let x92 = x4 * x33 + (-7.06 * x90 - -0.1524 * x88);
-        let x93 = c_q3 * x87 - s_q3 * x32 + 7.06 * x89;
-        let x94 = x2 * x89;
-        let x95 = x2 * x92
-            + (-0.1524 * (s_q2 * x90 - c_q2 * x88) + -6.377 * (s_q2 * x88 + c_q2 * x90));
-        let x96 = c_q1 * (c_q2 * x93 - s_q2 * x91 + 6.377 * x94)
-            - s_q1 * (c_q2 * x91 + s_q2 * x93 + 0.1524 * x94);
-        let x97 = c_q4 * x9 - s_q4 * x12;
-        let x98 = s_q4 * x9 + c_q4 * x12;
-        let x99 = x6 * x17;
-        let x100 = c_q3 * x97 + s_q3 * x99;
-        let x101 = x4 * x98;
-        let x102 = c_q3 * x99 - s_q3 * x97;
-        let x103 = x2 * x101;
-        let x104 = c_q1 * (c_q2 * x102 - s_q2 * x100)
-            - s_q1 * (c_q2 * x100 + s_q2 * x102);
+                            * (-8596.210051042
+                                + (x70 + (c_q2 * x63 + s_q2 * x65 - x69)))));
+        let x76 = x58 + (x70 - x71);
+        let x77 = c_q1 * x67 - s_q1 * x64;
+        let x78 = x50
+            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36));
+        let x79 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+        let x80 = c_q3 * x16;
+        let x81 = s_q3 * x16;
+        let x82 = x15 * 0.1524;
+        let x83 = x40 + s_q3 * x30 + x82;
+        let x84 = x25 + (-7.06 * x81 - -0.1524 * x80);
+        let x85 = c_q3 * x30 - x44 + 7.06 * x15;
+        let x86 = x84
+            + (-0.1524 * (s_q2 * x81 - c_q2 * x80) + -6.377 * (s_q2 * x80 + c_q2 * x81));
+        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x83 + 6.377 * x15)
+            - s_q1 * (x82 + (c_q2 * x83 + s_q2 * x85));
+        let x88 = c_q3 * x18 + s_q3 * x9;
+        let x89 = c_q3 * x9 - s_q3 * x18;
+        let x90 = c_q1 * (c_q2 * x89 - s_q2 * x88) - s_q1 * (c_q2 * x88 + s_q2 * x89);
         [
-            [x81, x80, x83, x86, x96, x104],
-            [x80, x79, x82, x85, x95, x103],
-            [x83, x82, x61, x84, x92, x101],
-            [x86, x85, x84, x43, x33, x98],
-            [x96, x95, x92, x33, x26, x17],
-            [x104, x103, x101, x98, x17, 1.903],
+            [x75, x74, x77, x79, x87, x90],
+            [x74, x73, x76, x78, x86, x23],
+            [x77, x76, x58, x50, x84, x23],
+            [x79, x78, x50, x35, x25, x23],
+            [x87, x86, x84, x25, x14, x9],
+            [x90, x23, x23, x23, x9, 1.903],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 326 mul, 226 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 254 mul, 181 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -523,155 +507,131 @@ impl Srms {
         let x2 = qd[0] * c_q1;
         let x3 = qd[1] * x2;
         let x4 = qd[1] * x1;
-        let x5 = -1.928 * qd[1] - 3.225 * x1 + 9.185 * x2;
-        let x6 = 998.63 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x7 = -0.0302 * qd[1] - 9.185 * x1 + 997.18 * x2;
+        let x5 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
+        let x6 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
+        let x7 = -0.0302 * qd[1] - 190.97044034000004 * x1;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x9 = c_q2 + (1.0 - c_q2);
-        let x10 = x1 * c_q2 + x2 * s_q2;
-        let x11 = x2 * c_q2 - x1 * s_q2;
-        let x12 = qd[1] * 0.1524;
+        let x9 = x1 * c_q2 + x2 * s_q2;
+        let x10 = x2 * c_q2 - x1 * s_q2;
+        let x11 = qd[1] * 0.1524;
+        let x12 = x2 * -6.377 - -0.1524 * x1;
         let x13 = 6.377 * qd[1];
-        let x14 = s_q2 * x13 - c_q2 * x12;
-        let x15 = x9 * (x2 * -6.377 - -0.1524 * x1);
-        let x16 = s_q2 * x12 + c_q2 * x13;
-        let x17 = qd[2] + qd[1] * x9;
-        let x18 = x9 * (-0.1524 * x3 + x4 * -6.377);
-        let x19 = qd[2] * x16;
-        let x20 = qd[2] * x14;
-        let x21 = x4 * s_q2 - x3 * c_q2 - qd[2] * x11;
-        let x22 = x3 * s_q2 + x4 * c_q2 + qd[2] * x10;
-        let x23 = 0.8021 * x17 - 1.59 * x10 + -3.786 * x11;
-        let x24 = 632.9 * x17 - 0.8021 * x10 + -0.08 * x11;
-        let x25 = -0.08 * x17 - -3.786 * x10 + 632.51 * x11;
-        let x26 = 87.42 * x14;
-        let x27 = 87.42 * x15;
-        let x28 = 87.42 * x16;
+        let x14 = s_q2 * x13 - c_q2 * x11;
+        let x15 = s_q2 * x11 + c_q2 * x13;
+        let x16 = qd[1] + qd[2];
+        let x17 = -0.1524 * x3 + x4 * -6.377;
+        let x18 = qd[2] * x15;
+        let x19 = qd[2] * x14;
+        let x20 = x4 * s_q2 - x3 * c_q2 - qd[2] * x10;
+        let x21 = x3 * s_q2 + x4 * c_q2 + qd[2] * x9;
+        let x22 = 0.8021 * x16 - -5594.523885531201 * x9 + 103.41030072000001 * x10
+            - x12 * 15.183612000000002;
+        let x23 = 5601.1318504688 * x16 - 0.8021 * x9 + -0.08 * x10
+            + (-15.183612000000002 * x14 - x15 * -703.3878000000001);
+        let x24 = -0.08 * x16 - 103.41030072000002 * x9 - 703.3878000000001 * x12;
+        let x25 = x16 * 15.183612000000002;
+        let x26 = x10 * -703.3878000000001 - -15.183612000000002 * x9;
+        let x27 = 703.3878000000001 * x16;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x30 = c_q3 + (1.0 - c_q3);
-        let x31 = x10 * c_q3 + x11 * s_q3;
-        let x32 = x11 * c_q3 - x10 * s_q3;
-        let x33 = x14 - 0.1524 * x17;
-        let x34 = x16 + 7.06 * x17;
-        let x35 = c_q3 * x33 + s_q3 * x34;
-        let x36 = x30 * (x15 + (x11 * -7.06 - -0.1524 * x10));
-        let x37 = s_q3 * x33 - c_q3 * x34;
-        let x38 = qd[3] + x17 * x30;
-        let x39 = x30 * (x18 - (-0.1524 * x21 - x22 * -7.06));
-        let x40 = x21 * c_q3 + x22 * s_q3 - qd[3] * x32;
-        let x41 = x21 * s_q3 - x22 * c_q3 - qd[3] * x31;
-        let x42 = x19 * c_q3 - x20 * s_q3 - qd[3] * x37;
-        let x43 = x19 * s_q3 + x20 * c_q3 + qd[3] * x35;
-        let x44 = 0.0893 * x31;
-        let x45 = 0.402 * x38;
-        let x46 = 0.402 * x32;
-        let x47 = 8.48 * x35;
-        let x48 = 8.48 * x36;
-        let x49 = 8.48 * x37;
+        let x29 = x9 * c_q3 + x10 * s_q3;
+        let x30 = x10 * c_q3 - x9 * s_q3;
+        let x31 = x14 - 0.1524 * x16;
+        let x32 = x12 + (x10 * -7.06 - -0.1524 * x9);
+        let x33 = x15 + 7.06 * x16;
+        let x34 = c_q3 * x31 + s_q3 * x33;
+        let x35 = s_q3 * x31 - c_q3 * x33;
+        let x36 = qd[3] + x16;
+        let x37 = x17 - (-0.1524 * x20 - x21 * -7.06);
+        let x38 = x20 * c_q3 + x21 * s_q3 - qd[3] * x30;
+        let x39 = x20 * s_q3 - x21 * c_q3 - qd[3] * x29;
+        let x40 = x18 * s_q3 + x19 * c_q3 + qd[3] * x34;
+        let x41 = -18.957952216000002 * x29;
+        let x42 = 41.67378 * x32;
+        let x43 = 19.863252216000003 * x36 + x35 * -41.67378;
+        let x44 = x30 * -41.67378;
+        let x45 = 41.67378 * x36;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x51 = c_q4 + (1.0 - c_q4);
-        let x52 = x38 * s_q4 - x31 * c_q4;
-        let x53 = x31 * s_q4 + x38 * c_q4;
-        let x54 = x36 + x32 * -0.4572;
-        let x55 = x35 * c_q4 - s_q4 * x54;
-        let x56 = x35 * s_q4 + c_q4 * x54;
-        let x57 = x51 * (x37 - 0.4572 * x38);
-        let x58 = qd[4] + x32 * x51;
-        let x59 = x41 * x51;
-        let x60 = x39 - x41 * -0.4572;
-        let x61 = x43 * x51;
-        let x62 = x40 * c_q4 + qd[4] * x53;
-        let x63 = x40 * s_q4 + qd[4] * x52;
-        let x64 = x42 * c_q4 + s_q4 * x60 - qd[4] * x56;
-        let x65 = c_q4 * x60 - x42 * s_q4 - qd[4] * x55;
-        let x66 = 0.408 * x52;
-        let x67 = 4.68 * x53;
-        let x68 = 4.68 * x58;
-        let x69 = 45.94 * x55;
-        let x70 = 45.94 * x56;
-        let x71 = 45.94 * x57;
+        let x47 = x36 * s_q4 - x29 * c_q4;
+        let x48 = x29 * s_q4 + x36 * c_q4;
+        let x49 = x32 + x30 * -0.4572;
+        let x50 = x35 - 0.4572 * x36;
+        let x51 = x34 * c_q4 - s_q4 * x49;
+        let x52 = x34 * s_q4 + c_q4 * x49;
+        let x53 = qd[4] + x30;
+        let x54 = x38 * c_q4 + qd[4] * x48;
+        let x55 = x38 * s_q4 + qd[4] * x47;
+        let x56 = 34.33891524 * x48 + x50 * -34.45002;
+        let x57 = 34.74691524 * x53 - 34.45002 * x52;
+        let x58 = x53 * -34.45002;
+        let x59 = 34.45002 * x48;
+        let x60 = x53 * x58 - x48 * x59;
+        let x61 = x47 * x59 - x39 * -34.45002;
+        let x62 = 34.45002 * x55 - x47 * x58;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x73 = c_q5 + (1.0 - c_q5);
-        let x74 = x53 * c_q5 + x58 * s_q5;
-        let x75 = x58 * c_q5 - x53 * s_q5;
-        let x76 = x56 + x58 * -0.762;
-        let x77 = x57 - 0.762 * x53;
-        let x78 = x55 * x73;
-        let x79 = s_q5 * x77 - c_q5 * x76;
-        let x80 = s_q5 * x76 + c_q5 * x77;
-        let x81 = qd[5] + x52 * x73;
-        let x82 = x62 * x73;
-        let x83 = x65 - x59 * -0.762;
-        let x84 = x61 + 0.762 * x63;
-        let x85 = x59 * s_q5 - x63 * c_q5 + qd[5] * x75;
-        let x86 = x63 * s_q5 + x59 * c_q5 - qd[5] * x74;
-        let x87 = 1.903 * x81 + 0.385 * x74 + 0.966 * x75;
-        let x88 = 0.385 * x81 + 3.816 * x74 + 0.353 * x75;
-        let x89 = 0.966 * x81 + 0.353 * x74 + 2.823 * x75;
-        let x90 = 45.21 * x78;
-        let x91 = 45.21 * x79;
-        let x92 = 45.21 * x80;
-        let x93 = 1.903 * x82 + 0.385 * x85 + 0.966 * x86
-            + (x74 * x89 - x75 * x88 + (x79 * x92 - x80 * x91));
-        let x94 = 0.385 * x82 + 3.816 * x85 + 0.353 * x86
-            + (x75 * x87 - x81 * x89 + (x80 * x90 - x78 * x92));
-        let x95 = 0.966 * x82 + 0.353 * x85 + 2.823 * x86
-            + (x81 * x88 - x74 * x87 + (x78 * x91 - x79 * x90));
-        let x96 = 45.21 * (c_q5 * x83 + s_q5 * x84 + qd[5] * x80)
-            + (x75 * x90 - x81 * x92);
-        let x97 = 45.21 * (c_q5 * x84 - s_q5 * x83 - qd[5] * x79)
-            + (x81 * x91 - x74 * x90);
-        let x98 = c_q5 * x96 - s_q5 * x97;
-        let x99 = s_q5 * x96 + c_q5 * x97;
-        let x100 = 0.408 * x62 + (x53 * x68 - x58 * x67 + (x57 * x70 - x56 * x71))
-            + x73 * x93;
-        let x101 = x58 * x66 - x52 * x68 + (x57 * x69 - x55 * x71) - 4.68 * x63
-            + (c_q5 * x94 - s_q5 * x95 + -0.762 * x99);
-        let x102 = 4.68 * x59 + (x52 * x67 - x53 * x66 + (x56 * x69 - x55 * x70))
-            + (s_q5 * x94 + c_q5 * x95 + 0.762 * x98);
-        let x103 = 45.94 * x64 + (x58 * x70 + x53 * x71)
-            + x73 * (45.21 * (x64 * x73) + (x74 * x92 - x75 * x91));
-        let x104 = 45.94 * x65 + (x58 * x69 - x52 * x71) + x98;
-        let x105 = s_q4 * x103 + c_q4 * x104;
-        let x106 = x51 * (45.94 * x61 - (x53 * x69 + x52 * x70) + x99);
-        let x107 = 0.0893 * x40 + (x38 * x46 - x32 * x45 + (x37 * x48 - x36 * x49))
-            + (c_q4 * x100 - s_q4 * x101);
-        let x108 = x31 * x46 - x32 * x44 + (x37 * x47 - x35 * x49)
-            + (s_q4 * x100 + c_q4 * x101 + -0.4572 * x106);
-        let x109 = 0.402 * x41 + (x38 * x44 - x31 * x45 + (x36 * x47 - x35 * x48))
-            + (x51 * x102 + 0.4572 * x105);
-        let x110 = 8.48 * x42 + (x32 * x48 + x38 * x49) + (c_q4 * x103 - s_q4 * x104);
-        let x111 = 8.48 * x43 + (x31 * x48 - x38 * x47) + x106;
-        let x112 = c_q3 * x110 + s_q3 * x111;
-        let x113 = x30 * (8.48 * x39 + (x32 * x47 + x31 * x49) + x105);
-        let x114 = c_q3 * x111 - s_q3 * x110;
-        let x115 = 1.59 * x21 - -3.786 * x22
-            + (x17 * x25 - x11 * x24 + (x15 * x28 - x16 * x27))
-            + (c_q3 * x107 + s_q3 * x109 + 0.1524 * x113);
-        let x116 = 0.8021 * x21 - -0.08 * x22
-            + (x11 * x23 + x10 * x25 + (x14 * x28 - x16 * x26))
-            + (x30 * x108 + (-0.1524 * x112 + -7.06 * x114));
-        let x117 = -3.786 * x21 - 632.51 * x22
-            + (x15 * x26 - x14 * x27 - (x17 * x23 + x10 * x24))
-            + (c_q3 * x109 - s_q3 * x107 + 7.06 * x113);
-        let x118 = 87.42 * x19 + (x11 * x27 - x17 * x28) + x112;
-        let x119 = 87.42 * x20 + (x10 * x27 - x17 * x26) + x114;
-        let x120 = x9 * (87.42 * x18 + (x11 * x26 - x10 * x28) + x113);
-        let x121 = x2 * x5 + x1 * x7 - (-1.928 * x3 + -0.0302 * x4)
-            + (x9 * x116
-                + (-0.1524 * (c_q2 * x118 + s_q2 * x119)
-                    + -6.377 * (c_q2 * x119 - s_q2 * x118)));
-        let x122 = c_q1
-            * (c_q2 * x117 - s_q2 * x115 + 6.377 * x120
-                - (9.185 * x3 + 997.18 * x4 + (qd[1] * x5 + x1 * x6)))
+        let x64 = x48 * c_q5 + x53 * s_q5;
+        let x65 = x53 * c_q5 - x48 * s_q5;
+        let x66 = qd[5] + x47;
+        let x67 = x39 * s_q5 - x55 * c_q5 + qd[5] * x65;
+        let x68 = x55 * s_q5 + x39 * c_q5 - qd[5] * x64;
+        let x69 = 1.903 * x66 + 0.385 * x64 + 0.966 * x65;
+        let x70 = 0.385 * x66 + 0.353 * x65;
+        let x71 = 0.966 * x66 + 0.353 * x64 + -0.9929999999999999 * x65;
+        let x72 = 1.903 * x54 + 0.385 * x67 + 0.966 * x68 + (x64 * x71 - x65 * x70);
+        let x73 = 0.385 * x54 + 0.353 * x68 + (x65 * x69 - x66 * x71);
+        let x74 = 0.966 * x54 + 0.353 * x67 + -0.9929999999999999 * x68
+            + (x66 * x70 - x64 * x69);
+        let x75 = x48 * x57 - x53 * x56 + (x50 * x58 + x52 * x59) + x72;
+        let x76 = x40 * -34.45002 - 34.33891524 * x55 + (x51 * x59 - x47 * x57)
+            + (c_q5 * x73 - s_q5 * x74);
+        let x77 = 34.74691524 * x39
+            + 34.45002
+                * (c_q4 * (x37 - x39 * -0.4572)
+                    - (x18 * c_q3 - x19 * s_q3 - qd[3] * x35) * s_q4 - qd[4] * x51)
+            + (x47 * x56 - x51 * x58) + (s_q5 * x73 + c_q5 * x74);
+        let x78 = s_q4 * x60 + c_q4 * x61;
+        let x79 = -18.957952216000002 * x38
+            + (x35 * x44 + x32 * x45 - (x30 * x43 + x36 * x42))
+            + (c_q4 * x75 - s_q4 * x76);
+        let x80 = x40 * -41.67378 + (x34 * x45 - (x30 * x41 + x29 * x42))
+            + (s_q4 * x75 + c_q4 * x76 + -0.4572 * x62);
+        let x81 = 41.67378 * x37 + (x36 * x41 - x29 * x43 - x34 * x44)
+            + (x77 + 0.4572 * x78);
+        let x82 = x30 * x44 - x36 * x45 + (c_q4 * x60 - s_q4 * x61);
+        let x83 = x78 - (x39 * -41.67378 + x29 * x45);
+        let x84 = x29 * x44 + x62;
+        let x85 = c_q3 * x82 + s_q3 * x84;
+        let x86 = c_q3 * x84 - s_q3 * x82;
+        let x87 = -5594.523885531201 * x20 - 103.41030072000001 * x21
+            + x17 * 15.183612000000002
+            + (x16 * x24 - x10 * x23 + (x12 * x27 - x15 * x26))
+            + (c_q3 * x79 + s_q3 * x81 + 0.1524 * x83);
+        let x88 = 0.8021 * x20 - -0.08 * x21
+            + (-15.183612000000002 * x18 + x19 * -703.3878000000001)
+            + (x10 * x22 + x9 * x24 + (x15 * x25 + x14 * x27))
+            + (x80 + (-0.1524 * x85 + -7.06 * x86));
+        let x89 = 103.41030072000002 * x20 + 703.3878000000001 * x17
+            - (x16 * x22 + x9 * x23 + (x12 * x25 + x14 * x26))
+            + (c_q3 * x81 - s_q3 * x79 + 7.06 * x83);
+        let x90 = x10 * x26 - x16 * x27 + x85;
+        let x91 = x83
+            - (-15.183612000000002 * x20 - x21 * -703.3878000000001
+                + (x10 * x25 + x9 * x27));
+        let x92 = x16 * x25 + x9 * x26 + x86;
+        let x93 = x2 * x5 + x1 * x7 - (-1.928 * x3 + -0.0302 * x4)
+            + (x88
+                + (-0.1524 * (c_q2 * x90 + s_q2 * x92)
+                    + -6.377 * (c_q2 * x92 - s_q2 * x90)));
+        let x94 = c_q1
+            * (c_q2 * x89 - s_q2 * x87 + 6.377 * x91
+                - (190.97044034000004 * x3 + (qd[1] * x5 + x1 * x6)))
             - s_q1
-                * (qd[1] * x7 - x2 * x6 - (3.225 * x3 + 9.185 * x4)
-                    + (c_q2 * x115 + s_q2 * x117 + 0.1524 * x120));
-        [x122, x121, x116, x108, x102, x93]
+                * (qd[1] * x7 - x2 * x6 - (-8596.210051042 * x3 + 190.97044034 * x4)
+                    + (c_q2 * x87 + s_q2 * x89 + 0.1524 * x91));
+        [x94, x93, x88, x80, x77, x72]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 349 mul, 249 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 278 mul, 207 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -679,485 +639,425 @@ impl Srms {
         let x2 = qd[0] * c_q1;
         let x3 = qdd[0] * s_q1 + qd[1] * x2;
         let x4 = qdd[0] * c_q1 - qd[1] * x1;
-        let x5 = -1.928 * qd[1] - 3.225 * x1 + 9.185 * x2;
-        let x6 = 998.63 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x7 = -0.0302 * qd[1] - 9.185 * x1 + 997.18 * x2;
+        let x5 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
+        let x6 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
+        let x7 = -0.0302 * qd[1] - 190.97044034000004 * x1;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x9 = c_q2 + (1.0 - c_q2);
-        let x10 = x1 * c_q2 + x2 * s_q2;
-        let x11 = x2 * c_q2 - x1 * s_q2;
-        let x12 = qd[1] * 0.1524;
+        let x9 = x1 * c_q2 + x2 * s_q2;
+        let x10 = x2 * c_q2 - x1 * s_q2;
+        let x11 = qd[1] * 0.1524;
+        let x12 = x2 * -6.377 - -0.1524 * x1;
         let x13 = 6.377 * qd[1];
-        let x14 = s_q2 * x13 - c_q2 * x12;
-        let x15 = x9 * (x2 * -6.377 - -0.1524 * x1);
-        let x16 = s_q2 * x12 + c_q2 * x13;
-        let x17 = qd[2] + qd[1] * x9;
-        let x18 = qdd[1] * 0.1524;
+        let x14 = s_q2 * x13 - c_q2 * x11;
+        let x15 = s_q2 * x11 + c_q2 * x13;
+        let x16 = qd[1] + qd[2];
+        let x17 = qdd[1] * 0.1524;
+        let x18 = x4 * -6.377 - -0.1524 * x3;
         let x19 = 6.377 * qdd[1];
-        let x20 = x9 * (x4 * -6.377 - -0.1524 * x3);
-        let x21 = qdd[2] + qdd[1] * x9;
-        let x22 = x3 * c_q2 + x4 * s_q2 + qd[2] * x11;
-        let x23 = x4 * c_q2 - x3 * s_q2 - qd[2] * x10;
-        let x24 = s_q2 * x19 - c_q2 * x18 + qd[2] * x16;
-        let x25 = qd[2] * x14 - (s_q2 * x18 + c_q2 * x19);
-        let x26 = 0.8021 * x17 - 1.59 * x10 + -3.786 * x11;
-        let x27 = 632.9 * x17 - 0.8021 * x10 + -0.08 * x11;
-        let x28 = -0.08 * x17 - -3.786 * x10 + 632.51 * x11;
-        let x29 = 87.42 * x14;
-        let x30 = 87.42 * x15;
-        let x31 = 87.42 * x16;
+        let x20 = qdd[1] + qdd[2];
+        let x21 = x3 * c_q2 + x4 * s_q2 + qd[2] * x10;
+        let x22 = x4 * c_q2 - x3 * s_q2 - qd[2] * x9;
+        let x23 = s_q2 * x19 - c_q2 * x17 + qd[2] * x15;
+        let x24 = qd[2] * x14 - (s_q2 * x17 + c_q2 * x19);
+        let x25 = 0.8021 * x16 - -5594.523885531201 * x9 + 103.41030072000001 * x10
+            - x12 * 15.183612000000002;
+        let x26 = 5601.1318504688 * x16 - 0.8021 * x9 + -0.08 * x10
+            + (-15.183612000000002 * x14 - x15 * -703.3878000000001);
+        let x27 = -0.08 * x16 - 103.41030072000002 * x9 - 703.3878000000001 * x12;
+        let x28 = x16 * 15.183612000000002;
+        let x29 = x10 * -703.3878000000001 - -15.183612000000002 * x9;
+        let x30 = 703.3878000000001 * x16;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x33 = c_q3 + (1.0 - c_q3);
-        let x34 = x10 * c_q3 + x11 * s_q3;
-        let x35 = x11 * c_q3 - x10 * s_q3;
-        let x36 = x14 - 0.1524 * x17;
-        let x37 = x16 + 7.06 * x17;
-        let x38 = c_q3 * x36 + s_q3 * x37;
-        let x39 = x33 * (x15 + (x11 * -7.06 - -0.1524 * x10));
-        let x40 = s_q3 * x36 - c_q3 * x37;
-        let x41 = qd[3] + x17 * x33;
-        let x42 = x24 - 0.1524 * x21;
-        let x43 = x25 - 7.06 * x21;
-        let x44 = x33 * (x20 + (x23 * -7.06 - -0.1524 * x22));
-        let x45 = qdd[3] + x21 * x33;
-        let x46 = x22 * c_q3 + x23 * s_q3 + qd[3] * x35;
-        let x47 = x23 * c_q3 - x22 * s_q3 - qd[3] * x34;
-        let x48 = c_q3 * x42 - s_q3 * x43 - qd[3] * x40;
-        let x49 = s_q3 * x42 + c_q3 * x43 + qd[3] * x38;
-        let x50 = 0.0893 * x34;
-        let x51 = 0.402 * x41;
-        let x52 = 0.402 * x35;
-        let x53 = 8.48 * x38;
-        let x54 = 8.48 * x39;
-        let x55 = 8.48 * x40;
+        let x32 = x9 * c_q3 + x10 * s_q3;
+        let x33 = x10 * c_q3 - x9 * s_q3;
+        let x34 = x14 - 0.1524 * x16;
+        let x35 = x12 + (x10 * -7.06 - -0.1524 * x9);
+        let x36 = x15 + 7.06 * x16;
+        let x37 = c_q3 * x34 + s_q3 * x36;
+        let x38 = s_q3 * x34 - c_q3 * x36;
+        let x39 = qd[3] + x16;
+        let x40 = x23 - 0.1524 * x20;
+        let x41 = x18 + (x22 * -7.06 - -0.1524 * x21);
+        let x42 = x24 - 7.06 * x20;
+        let x43 = qdd[3] + x20;
+        let x44 = x21 * c_q3 + x22 * s_q3 + qd[3] * x33;
+        let x45 = x22 * c_q3 - x21 * s_q3 - qd[3] * x32;
+        let x46 = s_q3 * x40 + c_q3 * x42 + qd[3] * x37;
+        let x47 = -18.957952216000002 * x32;
+        let x48 = 41.67378 * x35;
+        let x49 = 19.863252216000003 * x39 + x38 * -41.67378;
+        let x50 = x33 * -41.67378;
+        let x51 = 41.67378 * x39;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x57 = c_q4 + (1.0 - c_q4);
-        let x58 = x41 * s_q4 - x34 * c_q4;
-        let x59 = x34 * s_q4 + x41 * c_q4;
-        let x60 = x39 + x35 * -0.4572;
-        let x61 = x38 * c_q4 - s_q4 * x60;
-        let x62 = x38 * s_q4 + c_q4 * x60;
-        let x63 = x57 * (x40 - 0.4572 * x41);
-        let x64 = qd[4] + x35 * x57;
-        let x65 = x44 + x47 * -0.4572;
-        let x66 = x57 * (x49 - 0.4572 * x45);
-        let x67 = qdd[4] + x47 * x57;
-        let x68 = x45 * s_q4 - x46 * c_q4 + qd[4] * x59;
-        let x69 = x46 * s_q4 + x45 * c_q4 - qd[4] * x58;
-        let x70 = x48 * c_q4 - s_q4 * x65 - qd[4] * x62;
-        let x71 = x48 * s_q4 + c_q4 * x65 + qd[4] * x61;
-        let x72 = 0.408 * x58;
-        let x73 = 4.68 * x59;
-        let x74 = 4.68 * x64;
-        let x75 = 45.94 * x61;
-        let x76 = 45.94 * x62;
-        let x77 = 45.94 * x63;
+        let x53 = x39 * s_q4 - x32 * c_q4;
+        let x54 = x32 * s_q4 + x39 * c_q4;
+        let x55 = x35 + x33 * -0.4572;
+        let x56 = x38 - 0.4572 * x39;
+        let x57 = x37 * c_q4 - s_q4 * x55;
+        let x58 = x37 * s_q4 + c_q4 * x55;
+        let x59 = qd[4] + x33;
+        let x60 = qdd[4] + x45;
+        let x61 = x44 * s_q4 + x43 * c_q4 - qd[4] * x53;
+        let x62 = 34.33891524 * x54 + x56 * -34.45002;
+        let x63 = 34.74691524 * x59 - 34.45002 * x58;
+        let x64 = x59 * -34.45002;
+        let x65 = 34.45002 * x54;
+        let x66 = x59 * x64 - x54 * x65;
+        let x67 = x53 * x65 - x60 * -34.45002;
+        let x68 = 34.45002 * x61 + x53 * x64;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x79 = c_q5 + (1.0 - c_q5);
-        let x80 = x59 * c_q5 + x64 * s_q5;
-        let x81 = x64 * c_q5 - x59 * s_q5;
-        let x82 = x62 + x64 * -0.762;
-        let x83 = x63 - 0.762 * x59;
-        let x84 = x61 * x79;
-        let x85 = s_q5 * x83 - c_q5 * x82;
-        let x86 = s_q5 * x82 + c_q5 * x83;
-        let x87 = qd[5] + x58 * x79;
-        let x88 = x71 + x67 * -0.762;
-        let x89 = x66 - 0.762 * x69;
-        let x90 = qdd[5] + x68 * x79;
-        let x91 = x69 * c_q5 + x67 * s_q5 + qd[5] * x81;
-        let x92 = x67 * c_q5 - x69 * s_q5 - qd[5] * x80;
-        let x93 = 1.903 * x87 + 0.385 * x80 + 0.966 * x81;
-        let x94 = 0.385 * x87 + 3.816 * x80 + 0.353 * x81;
-        let x95 = 0.966 * x87 + 0.353 * x80 + 2.823 * x81;
-        let x96 = 45.21 * x84;
-        let x97 = 45.21 * x85;
-        let x98 = 45.21 * x86;
-        let x99 = 1.903 * x90 + 0.385 * x91 + 0.966 * x92
-            + (x80 * x95 - x81 * x94 + (x85 * x98 - x86 * x97));
-        let x100 = 0.385 * x90 + 3.816 * x91 + 0.353 * x92
-            + (x81 * x93 - x87 * x95 + (x86 * x96 - x84 * x98));
-        let x101 = 0.966 * x90 + 0.353 * x91 + 2.823 * x92
-            + (x87 * x94 - x80 * x93 + (x84 * x97 - x85 * x96));
-        let x102 = 45.21 * (s_q5 * x89 - c_q5 * x88 + qd[5] * x86)
-            + (x81 * x96 - x87 * x98);
-        let x103 = 45.21 * (s_q5 * x88 + c_q5 * x89 - qd[5] * x85)
-            + (x87 * x97 - x80 * x96);
-        let x104 = c_q5 * x102 - s_q5 * x103;
-        let x105 = s_q5 * x102 + c_q5 * x103;
-        let x106 = 0.408 * x68 + (x59 * x74 - x64 * x73 + (x63 * x76 - x62 * x77))
-            + x79 * x99;
-        let x107 = 4.68 * x69 + (x64 * x72 - x58 * x74 + (x63 * x75 - x61 * x77))
-            + (c_q5 * x100 - s_q5 * x101 + -0.762 * x105);
-        let x108 = 4.68 * x67 + (x58 * x73 - x59 * x72 + (x62 * x75 - x61 * x76))
-            + (s_q5 * x100 + c_q5 * x101 + 0.762 * x104);
-        let x109 = 45.94 * x70 + (x64 * x76 + x59 * x77)
-            + x79 * (45.21 * (x70 * x79) + (x80 * x98 - x81 * x97));
-        let x110 = x64 * x75 - x58 * x77 - 45.94 * x71 + x104;
-        let x111 = s_q4 * x109 + c_q4 * x110;
-        let x112 = x57 * (45.94 * x66 - (x59 * x75 + x58 * x76) + x105);
-        let x113 = x41 * x52 - x35 * x51 + (x40 * x54 - x39 * x55) - 0.0893 * x46
-            + (c_q4 * x106 - s_q4 * x107);
-        let x114 = 0.402 * x45 + (x34 * x52 - x35 * x50 + (x40 * x53 - x38 * x55))
-            + (s_q4 * x106 + c_q4 * x107 + -0.4572 * x112);
-        let x115 = 0.402 * x47 + (x41 * x50 - x34 * x51 + (x39 * x53 - x38 * x54))
-            + (x57 * x108 + 0.4572 * x111);
-        let x116 = 8.48 * x48 + (x35 * x54 + x41 * x55) + (c_q4 * x109 - s_q4 * x110);
-        let x117 = 8.48 * x49 + (x34 * x54 - x41 * x53) + x112;
-        let x118 = c_q3 * x116 + s_q3 * x117;
-        let x119 = x33 * (x35 * x53 + x34 * x55 - 8.48 * x44 + x111);
-        let x120 = c_q3 * x117 - s_q3 * x116;
-        let x121 = 0.8021 * x21 - 1.59 * x22 + -3.786 * x23
-            + (x17 * x28 - x11 * x27 + (x15 * x31 - x16 * x30))
-            + (c_q3 * x113 + s_q3 * x115 + 0.1524 * x119);
-        let x122 = 632.9 * x21 - 0.8021 * x22 + -0.08 * x23
-            + (x11 * x26 + x10 * x28 + (x14 * x31 - x16 * x29))
-            + (x33 * x114 + (-0.1524 * x118 + -7.06 * x120));
-        let x123 = -0.08 * x21 - -3.786 * x22 + 632.51 * x23
-            + (x15 * x29 - x14 * x30 - (x17 * x26 + x10 * x27))
-            + (c_q3 * x115 - s_q3 * x113 + 7.06 * x119);
-        let x124 = 87.42 * x24 + (x11 * x30 - x17 * x31) + x118;
-        let x125 = 87.42 * x25 + (x10 * x30 - x17 * x29) + x120;
-        let x126 = x9 * (x11 * x29 - x10 * x31 - 87.42 * x20 + x119);
-        let x127 = 998.63 * qdd[1] - -1.928 * x3 + -0.0302 * x4 + (x2 * x5 + x1 * x7)
-            + (x9 * x122
-                + (-0.1524 * (c_q2 * x124 + s_q2 * x125)
-                    + -6.377 * (c_q2 * x125 - s_q2 * x124)));
-        let x128 = 0.595 * qdd[0]
+        let x70 = x54 * c_q5 + x59 * s_q5;
+        let x71 = x59 * c_q5 - x54 * s_q5;
+        let x72 = qd[5] + x53;
+        let x73 = qdd[5] + (x43 * s_q4 - x44 * c_q4 + qd[4] * x54);
+        let x74 = x61 * c_q5 + x60 * s_q5 + qd[5] * x71;
+        let x75 = x60 * c_q5 - x61 * s_q5 - qd[5] * x70;
+        let x76 = 1.903 * x72 + 0.385 * x70 + 0.966 * x71;
+        let x77 = 0.385 * x72 + 0.353 * x71;
+        let x78 = 0.966 * x72 + 0.353 * x70 + -0.9929999999999999 * x71;
+        let x79 = 1.903 * x73 + 0.385 * x74 + 0.966 * x75 + (x70 * x78 - x71 * x77);
+        let x80 = 0.385 * x73 + 0.353 * x75 + (x71 * x76 - x72 * x78);
+        let x81 = 0.966 * x73 + 0.353 * x74 + -0.9929999999999999 * x75
+            + (x72 * x77 - x70 * x76);
+        let x82 = x54 * x63 - x59 * x62 + (x56 * x64 + x58 * x65) + x79;
+        let x83 = 34.33891524 * x61 + (x46 - 0.4572 * x43) * -34.45002
+            + (x57 * x65 - x53 * x63) + (c_q5 * x80 - s_q5 * x81);
+        let x84 = 34.74691524 * x60
+            - 34.45002
+                * ((c_q3 * x40 - s_q3 * x42 - qd[3] * x38) * s_q4
+                    + c_q4 * (x41 + x45 * -0.4572) + qd[4] * x57)
+            + (x53 * x62 - x57 * x64) + (s_q5 * x80 + c_q5 * x81);
+        let x85 = s_q4 * x66 + c_q4 * x67;
+        let x86 = x38 * x50 + x35 * x51 - (x33 * x49 + x39 * x48)
+            - -18.957952216000002 * x44 + (c_q4 * x82 - s_q4 * x83);
+        let x87 = 19.863252216000003 * x43 + x46 * -41.67378
+            + (x37 * x51 - (x33 * x47 + x32 * x48))
+            + (s_q4 * x82 + c_q4 * x83 - -0.4572 * x68);
+        let x88 = x39 * x47 - x32 * x49 - x37 * x50 - 41.67378 * x41
+            + (x84 + 0.4572 * x85);
+        let x89 = x33 * x50 - x39 * x51 + (c_q4 * x66 - s_q4 * x67);
+        let x90 = x85 - (x45 * -41.67378 + x32 * x51);
+        let x91 = x32 * x50 - 41.67378 * x43 - x68;
+        let x92 = c_q3 * x89 + s_q3 * x91;
+        let x93 = c_q3 * x91 - s_q3 * x89;
+        let x94 = 0.8021 * x20 - -5594.523885531201 * x21 + 103.41030072000001 * x22
+            - x18 * 15.183612000000002
+            + (x16 * x27 - x10 * x26 + (x12 * x30 - x15 * x29))
+            + (c_q3 * x86 + s_q3 * x88 + 0.1524 * x90);
+        let x95 = 5601.1318504688 * x20 - 0.8021 * x21 + -0.08 * x22
+            + (-15.183612000000002 * x23 + x24 * -703.3878000000001)
+            + (x10 * x25 + x9 * x27 + (x15 * x28 + x14 * x30))
+            + (x87 + (-0.1524 * x92 + -7.06 * x93));
+        let x96 = -0.08 * x20 - 103.41030072000002 * x21 - 703.3878000000001 * x18
+            - (x16 * x25 + x9 * x26 + (x12 * x28 + x14 * x29))
+            + (c_q3 * x88 - s_q3 * x86 + 7.06 * x90);
+        let x97 = x10 * x29 - x16 * x30 - x20 * 15.183612000000002 + x92;
+        let x98 = x90
+            - (x22 * -703.3878000000001 - -15.183612000000002 * x21
+                + (x10 * x28 + x9 * x30));
+        let x99 = x16 * x28 + x9 * x29 - 703.3878000000001 * x20 + x93;
+        let x100 = 8609.573807858 * qdd[1] - -1.928 * x3 + -0.0302 * x4
+            + (x2 * x5 + x1 * x7)
+            + (x95
+                + (-0.1524 * (c_q2 * x97 + s_q2 * x99)
+                    + -6.377 * (c_q2 * x99 - s_q2 * x97)));
+        let x101 = 14222.257549666001 * qdd[0]
             + (c_q1
-                * (-0.0302 * qdd[1] - 9.185 * x3 + 997.18 * x4 - (qd[1] * x5 + x1 * x6)
-                    + (c_q2 * x123 - s_q2 * x121 + 6.377 * x126))
+                * (-0.0302 * qdd[1] - 190.97044034000004 * x3 - (qd[1] * x5 + x1 * x6)
+                    + (c_q2 * x96 - s_q2 * x94 + 6.377 * x98))
                 - s_q1
-                    * (-1.928 * qdd[1] - 3.225 * x3 + 9.185 * x4 + (qd[1] * x7 - x2 * x6)
-                        + (c_q2 * x121 + s_q2 * x123 + 0.1524 * x126)));
-        [x128, x127, x122, x114, x108, x99]
+                    * (-1.928 * qdd[1] - -8596.210051042 * x3 + 190.97044034 * x4
+                        + (qd[1] * x7 - x2 * x6)
+                        + (c_q2 * x94 + s_q2 * x96 + 0.1524 * x98)));
+        [x101, x100, x95, x87, x84, x79]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 626 mul, 441 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 497 mul, 380 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 1.903 * x8;
-        let x10 = 0.385 * x8;
-        let x11 = 0.966 * x8;
-        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
-        let x13 = 0.353 * s_q5;
-        let x14 = 3.816 * c_q5 - x13;
-        let x15 = 0.353 * c_q5;
-        let x16 = x15 - 2.823 * s_q5;
-        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x18 = x15 + 3.816 * s_q5;
-        let x19 = x13 + 2.823 * c_q5;
-        let x20 = c_q5 * x10 - s_q5 * x11;
-        let x21 = s_q5 * x10 + c_q5 * x11;
-        let x22 = x8 * x12;
-        let x23 = s_q5 * x14 + c_q5 * x16;
-        let x24 = 0.408 + x8 * x9;
-        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
-        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
-        let x27 = c_q4 * 34.45002;
-        let x28 = s_q4 * 34.45002;
-        let x29 = x27 + 41.67378;
-        let x30 = c_q4 * x24 - s_q4 * x22;
-        let x31 = c_q4 * x20 - s_q4 * x25;
-        let x32 = c_q4 * x21 - s_q4 * x23;
-        let x33 = s_q4 * x21 + c_q4 * x23;
-        let x34 = x6 * (x8 * x17);
-        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
-        let x36 = x6 * x26;
-        let x37 = x6 * x32;
-        let x38 = c_q4 * x34 - s_q4 * x35;
-        let x39 = s_q4 * x34 + c_q4 * x35;
-        let x40 = 0.4572 * x27;
-        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
-        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
-        let x43 = 0.402
-            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
-                - x27 * -0.4572 + 0.4572 * x29);
-        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
-        let x45 = c_q3 * x29;
-        let x46 = x4 * x28;
-        let x47 = s_q3 * x29;
-        let x48 = x45 + 703.3878000000001;
-        let x49 = -15.183612000000002 - x47;
-        let x50 = c_q3 * x42 + s_q3 * x38;
-        let x51 = c_q3 * x41 + s_q3 * x39;
-        let x52 = c_q3 * x37 + s_q3 * x44;
-        let x53 = x4 * x43;
-        let x54 = c_q3 * x38 - s_q3 * x42;
-        let x55 = c_q3 * x39 - s_q3 * x41;
-        let x56 = c_q3 * x44 - s_q3 * x37;
-        let x57 = -0.1524 * x47 + x45 * -7.06;
-        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
-        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
-        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
-        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
-        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
-        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
-        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
-        let x65 = c_q2 * x48 + s_q2 * x49;
-        let x66 = x2 * x46;
-        let x67 = c_q2 * x49 - s_q2 * x48;
-        let x68 = x65 + 1192.8178500000001;
-        let x69 = x67 + -28.506420000000002;
-        let x70 = c_q2 * x58 + s_q2 * x62;
-        let x71 = c_q2 * x59 + s_q2 * x63;
-        let x72 = c_q2 * x60 + s_q2 * x64;
-        let x73 = x2 * x61;
-        let x74 = c_q2 * x62 - s_q2 * x58;
-        let x75 = c_q2 * x63 - s_q2 * x59;
-        let x76 = c_q2 * x64 - s_q2 * x60;
-        let x77 = -0.1524 * x67;
-        let x78 = x65 * -6.377;
-        let x79 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
-            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
-        let x80 = c_q1 * x75 - s_q1 * x71;
-        let x81 = x53 - x57;
-        let x82 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
-        let x83 = x36 + x40;
-        let x84 = c_q3 * x28;
-        let x85 = x4 * x27;
-        let x86 = s_q3 * x28;
-        let x87 = c_q3 * x32 + s_q3 * x83 + 0.1524 * x85;
-        let x88 = x4 * x33 + (-7.06 * x86 - -0.1524 * x84);
-        let x89 = c_q3 * x83 - s_q3 * x32 + 7.06 * x85;
-        let x90 = x2 * x85;
-        let x91 = c_q1 * (c_q2 * x89 - s_q2 * x87 + 6.377 * x90)
-            - s_q1 * (c_q2 * x87 + s_q2 * x89 + 0.1524 * x90);
-        let x92 = c_q4 * x9 - s_q4 * x12;
-        let x93 = s_q4 * x9 + c_q4 * x12;
-        let x94 = x6 * x17;
-        let x95 = c_q3 * x92 + s_q3 * x94;
-        let x96 = x4 * x93;
-        let x97 = c_q3 * x94 - s_q3 * x92;
-        let x98 = c_q1 * (c_q2 * x97 - s_q2 * x95) - s_q1 * (c_q2 * x95 + s_q2 * x97);
-        let x99 = qd[0] * s_q1;
-        let x100 = qd[0] * c_q1;
-        let x101 = qd[1] * x100;
-        let x102 = qd[1] * x99;
-        let x103 = -1.928 * qd[1] - 3.225 * x99 + 9.185 * x100;
-        let x104 = 998.63 * qd[1] - -1.928 * x99 + -0.0302 * x100;
-        let x105 = -0.0302 * qd[1] - 9.185 * x99 + 997.18 * x100;
-        let x106 = c_q2 * x99 + s_q2 * x100;
-        let x107 = c_q2 * x100 - s_q2 * x99;
-        let x108 = qd[1] * 0.1524;
-        let x109 = 6.377 * qd[1];
-        let x110 = s_q2 * x109 - c_q2 * x108;
-        let x111 = x2 * (-6.377 * x100 - -0.1524 * x99);
-        let x112 = s_q2 * x108 + c_q2 * x109;
-        let x113 = qd[2] + qd[1] * x2;
-        let x114 = x2 * (-0.1524 * x101 + -6.377 * x102);
-        let x115 = qd[2] * x112;
-        let x116 = qd[2] * x110;
-        let x117 = s_q2 * x102 - c_q2 * x101 - qd[2] * x107;
-        let x118 = s_q2 * x101 + c_q2 * x102 + qd[2] * x106;
-        let x119 = 0.8021 * x113 - 1.59 * x106 + -3.786 * x107;
-        let x120 = 632.9 * x113 - 0.8021 * x106 + -0.08 * x107;
-        let x121 = -0.08 * x113 - -3.786 * x106 + 632.51 * x107;
-        let x122 = 87.42 * x110;
-        let x123 = 87.42 * x111;
-        let x124 = 87.42 * x112;
-        let x125 = c_q3 * x106 + s_q3 * x107;
-        let x126 = c_q3 * x107 - s_q3 * x106;
-        let x127 = x110 - 0.1524 * x113;
-        let x128 = x112 + 7.06 * x113;
-        let x129 = c_q3 * x127 + s_q3 * x128;
-        let x130 = x4 * (x111 + (-7.06 * x107 - -0.1524 * x106));
-        let x131 = s_q3 * x127 - c_q3 * x128;
-        let x132 = qd[3] + x4 * x113;
-        let x133 = x4 * (x114 - (-0.1524 * x117 - -7.06 * x118));
-        let x134 = c_q3 * x117 + s_q3 * x118 - qd[3] * x126;
-        let x135 = s_q3 * x117 - c_q3 * x118 - qd[3] * x125;
-        let x136 = c_q3 * x115 - s_q3 * x116 - qd[3] * x131;
-        let x137 = s_q3 * x115 + c_q3 * x116 + qd[3] * x129;
-        let x138 = 0.0893 * x125;
-        let x139 = 0.402 * x132;
-        let x140 = 0.402 * x126;
-        let x141 = 8.48 * x129;
-        let x142 = 8.48 * x130;
-        let x143 = 8.48 * x131;
-        let x144 = s_q4 * x132 - c_q4 * x125;
-        let x145 = s_q4 * x125 + c_q4 * x132;
-        let x146 = x130 + -0.4572 * x126;
-        let x147 = c_q4 * x129 - s_q4 * x146;
-        let x148 = s_q4 * x129 + c_q4 * x146;
-        let x149 = x6 * (x131 - 0.4572 * x132);
-        let x150 = qd[4] + x6 * x126;
-        let x151 = x6 * x135;
-        let x152 = x133 - -0.4572 * x135;
-        let x153 = x6 * x137;
-        let x154 = c_q4 * x134 + qd[4] * x145;
-        let x155 = s_q4 * x134 + qd[4] * x144;
-        let x156 = c_q4 * x136 + s_q4 * x152 - qd[4] * x148;
-        let x157 = c_q4 * x152 - s_q4 * x136 - qd[4] * x147;
-        let x158 = 0.408 * x144;
-        let x159 = 4.68 * x145;
-        let x160 = 4.68 * x150;
-        let x161 = 45.94 * x147;
-        let x162 = 45.94 * x148;
-        let x163 = 45.94 * x149;
-        let x164 = c_q5 * x145 + s_q5 * x150;
-        let x165 = c_q5 * x150 - s_q5 * x145;
-        let x166 = x148 + -0.762 * x150;
-        let x167 = x149 - 0.762 * x145;
-        let x168 = x8 * x147;
-        let x169 = s_q5 * x167 - c_q5 * x166;
-        let x170 = s_q5 * x166 + c_q5 * x167;
-        let x171 = qd[5] + x8 * x144;
-        let x172 = x8 * x154;
-        let x173 = x157 - -0.762 * x151;
-        let x174 = x153 + 0.762 * x155;
-        let x175 = s_q5 * x151 - c_q5 * x155 + qd[5] * x165;
-        let x176 = s_q5 * x155 + c_q5 * x151 - qd[5] * x164;
-        let x177 = 1.903 * x171 + 0.385 * x164 + 0.966 * x165;
-        let x178 = 0.385 * x171 + 3.816 * x164 + 0.353 * x165;
-        let x179 = 0.966 * x171 + 0.353 * x164 + 2.823 * x165;
-        let x180 = 45.21 * x168;
-        let x181 = 45.21 * x169;
-        let x182 = 45.21 * x170;
-        let x183 = 1.903 * x172 + 0.385 * x175 + 0.966 * x176
-            + (x164 * x179 - x165 * x178 + (x169 * x182 - x170 * x181));
-        let x184 = 0.385 * x172 + 3.816 * x175 + 0.353 * x176
-            + (x165 * x177 - x171 * x179 + (x170 * x180 - x168 * x182));
-        let x185 = 0.966 * x172 + 0.353 * x175 + 2.823 * x176
-            + (x171 * x178 - x164 * x177 + (x168 * x181 - x169 * x180));
-        let x186 = 45.21 * (c_q5 * x173 + s_q5 * x174 + qd[5] * x170)
-            + (x165 * x180 - x171 * x182);
-        let x187 = 45.21 * (c_q5 * x174 - s_q5 * x173 - qd[5] * x169)
-            + (x171 * x181 - x164 * x180);
-        let x188 = c_q5 * x186 - s_q5 * x187;
-        let x189 = s_q5 * x186 + c_q5 * x187;
-        let x190 = 0.408 * x154
-            + (x145 * x160 - x150 * x159 + (x149 * x162 - x148 * x163)) + x8 * x183;
-        let x191 = x150 * x158 - x144 * x160 + (x149 * x161 - x147 * x163) - 4.68 * x155
-            + (c_q5 * x184 - s_q5 * x185 + -0.762 * x189);
-        let x192 = 4.68 * x151
-            + (x144 * x159 - x145 * x158 + (x148 * x161 - x147 * x162))
-            + (s_q5 * x184 + c_q5 * x185 + 0.762 * x188);
-        let x193 = 45.94 * x156 + (x150 * x162 + x145 * x163)
-            + x8 * (45.21 * (x8 * x156) + (x164 * x182 - x165 * x181));
-        let x194 = 45.94 * x157 + (x150 * x161 - x144 * x163) + x188;
-        let x195 = s_q4 * x193 + c_q4 * x194;
-        let x196 = x6 * (45.94 * x153 - (x145 * x161 + x144 * x162) + x189);
-        let x197 = 0.0893 * x134
-            + (x132 * x140 - x126 * x139 + (x131 * x142 - x130 * x143))
-            + (c_q4 * x190 - s_q4 * x191);
-        let x198 = x125 * x140 - x126 * x138 + (x131 * x141 - x129 * x143)
-            + (s_q4 * x190 + c_q4 * x191 + -0.4572 * x196);
-        let x199 = 0.402 * x135
-            + (x132 * x138 - x125 * x139 + (x130 * x141 - x129 * x142))
-            + (x6 * x192 + 0.4572 * x195);
-        let x200 = 8.48 * x136 + (x126 * x142 + x132 * x143)
-            + (c_q4 * x193 - s_q4 * x194);
-        let x201 = 8.48 * x137 + (x125 * x142 - x132 * x141) + x196;
-        let x202 = c_q3 * x200 + s_q3 * x201;
-        let x203 = x4 * (8.48 * x133 + (x126 * x141 + x125 * x143) + x195);
-        let x204 = c_q3 * x201 - s_q3 * x200;
-        let x205 = 1.59 * x117 - -3.786 * x118
-            + (x113 * x121 - x107 * x120 + (x111 * x124 - x112 * x123))
-            + (c_q3 * x197 + s_q3 * x199 + 0.1524 * x203);
-        let x206 = 0.8021 * x117 - -0.08 * x118
-            + (x107 * x119 + x106 * x121 + (x110 * x124 - x112 * x122))
-            + (x4 * x198 + (-0.1524 * x202 + -7.06 * x204));
-        let x207 = -3.786 * x117 - 632.51 * x118
-            + (x111 * x122 - x110 * x123 - (x113 * x119 + x106 * x120))
-            + (c_q3 * x199 - s_q3 * x197 + 7.06 * x203);
-        let x208 = 87.42 * x115 + (x107 * x123 - x113 * x124) + x202;
-        let x209 = 87.42 * x116 + (x106 * x123 - x113 * x122) + x204;
-        let x210 = x2 * (87.42 * x114 + (x107 * x122 - x106 * x124) + x203);
-        let x211 = tau[0]
+        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x6 = 0.353 * s_q5;
+        let x7 = 0.353 * c_q5;
+        let x8 = x7 - -0.9929999999999999 * s_q5;
+        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
+        let x10 = x6 + -0.9929999999999999 * c_q5;
+        let x11 = c_q5 * x8 - s_q5 * x6;
+        let x12 = c_q5 * x7 - s_q5 * x10;
+        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
+        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x15 = 34.45002 * c_q4;
+        let x16 = 34.45002 * s_q4;
+        let x17 = s_q4 * x5;
+        let x18 = 1.903 * c_q4 - x17;
+        let x19 = c_q4 * x5;
+        let x20 = x19 - s_q4 * x13;
+        let x21 = c_q4 * x9;
+        let x22 = x21 - s_q4 * x11;
+        let x23 = x19 + 1.903 * s_q4;
+        let x24 = s_q4 * x9;
+        let x25 = x24 + c_q4 * x11;
+        let x26 = x21 - s_q4 * x12;
+        let x27 = x24 + c_q4 * x12;
+        let x28 = x15 * -0.4572;
+        let x29 = 0.4572 * x15;
+        let x30 = x14 + x29;
+        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x32 = x30 - x28;
+        let x33 = 41.67378 + x15;
+        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x35 = 19.863252216000003
+            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+        let x36 = c_q3 * x33;
+        let x37 = s_q3 * x33;
+        let x38 = c_q3 * x34 + s_q3 * x26;
+        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x40 = c_q3 * x22;
+        let x41 = x40 + s_q3 * x32;
+        let x42 = c_q3 * x26 - s_q3 * x34;
+        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x44 = s_q3 * x22;
+        let x45 = c_q3 * x32 - x44;
+        let x46 = x37 * 0.1524;
+        let x47 = -0.1524 * x37;
+        let x48 = x36 * -7.06;
+        let x49 = 7.06 * x36;
+        let x50 = x35 - (x47 + x48);
+        let x51 = x16 * 0.1524;
+        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x53 = 703.3878000000001 + x36;
+        let x54 = -15.183612000000002 - x37;
+        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
+        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x57 = 103.41030072000001
+            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x59 = 103.41030072000002
+            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+        let x60 = -0.08 + (x43 + x51);
+        let x61 = c_q2 * x53 + s_q2 * x54;
+        let x62 = c_q2 * x54 - s_q2 * x53;
+        let x63 = c_q2 * x55 + s_q2 * x59;
+        let x64 = c_q2 * x56 + s_q2 * x60;
+        let x65 = c_q2 * x57 + s_q2 * x52;
+        let x66 = c_q2 * x59 - s_q2 * x55;
+        let x67 = c_q2 * x60 - s_q2 * x56;
+        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x69 = 0.1524 * x62;
+        let x70 = -0.1524 * x62;
+        let x71 = x61 * -6.377;
+        let x72 = 6.377 * x61;
+        let x73 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
+        let x74 = c_q1 * x67 - s_q1 * x64;
+        let x75 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+        let x76 = c_q3 * x16;
+        let x77 = s_q3 * x16;
+        let x78 = x15 * 0.1524;
+        let x79 = x40 + s_q3 * x30 + x78;
+        let x80 = x25 + (-7.06 * x77 - -0.1524 * x76);
+        let x81 = c_q3 * x30 - x44 + 7.06 * x15;
+        let x82 = c_q1 * (c_q2 * x81 - s_q2 * x79 + 6.377 * x15)
+            - s_q1 * (x78 + (c_q2 * x79 + s_q2 * x81));
+        let x83 = c_q3 * x18 + s_q3 * x9;
+        let x84 = c_q3 * x9 - s_q3 * x18;
+        let x85 = c_q1 * (c_q2 * x84 - s_q2 * x83) - s_q1 * (c_q2 * x83 + s_q2 * x84);
+        let x86 = qd[0] * s_q1;
+        let x87 = qd[0] * c_q1;
+        let x88 = qd[1] * x87;
+        let x89 = qd[1] * x86;
+        let x90 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
+        let x91 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
+        let x92 = -0.0302 * qd[1] - 190.97044034000004 * x86;
+        let x93 = c_q2 * x86 + s_q2 * x87;
+        let x94 = c_q2 * x87 - s_q2 * x86;
+        let x95 = qd[1] * 0.1524;
+        let x96 = -6.377 * x87 - -0.1524 * x86;
+        let x97 = 6.377 * qd[1];
+        let x98 = s_q2 * x97 - c_q2 * x95;
+        let x99 = s_q2 * x95 + c_q2 * x97;
+        let x100 = qd[1] + qd[2];
+        let x101 = -0.1524 * x88 + -6.377 * x89;
+        let x102 = qd[2] * x99;
+        let x103 = qd[2] * x98;
+        let x104 = s_q2 * x89 - c_q2 * x88 - qd[2] * x94;
+        let x105 = s_q2 * x88 + c_q2 * x89 + qd[2] * x93;
+        let x106 = 0.8021 * x100 - -5594.523885531201 * x93 + 103.41030072000001 * x94
+            - x96 * 15.183612000000002;
+        let x107 = 5601.1318504688 * x100 - 0.8021 * x93 + -0.08 * x94
+            + (-15.183612000000002 * x98 - x99 * -703.3878000000001);
+        let x108 = -0.08 * x100 - 103.41030072000002 * x93 - 703.3878000000001 * x96;
+        let x109 = x100 * 15.183612000000002;
+        let x110 = x94 * -703.3878000000001 - -15.183612000000002 * x93;
+        let x111 = 703.3878000000001 * x100;
+        let x112 = c_q3 * x93 + s_q3 * x94;
+        let x113 = c_q3 * x94 - s_q3 * x93;
+        let x114 = x98 - 0.1524 * x100;
+        let x115 = x96 + (-7.06 * x94 - -0.1524 * x93);
+        let x116 = x99 + 7.06 * x100;
+        let x117 = c_q3 * x114 + s_q3 * x116;
+        let x118 = s_q3 * x114 - c_q3 * x116;
+        let x119 = qd[3] + x100;
+        let x120 = x101 - (-0.1524 * x104 - -7.06 * x105);
+        let x121 = c_q3 * x104 + s_q3 * x105 - qd[3] * x113;
+        let x122 = s_q3 * x104 - c_q3 * x105 - qd[3] * x112;
+        let x123 = s_q3 * x102 + c_q3 * x103 + qd[3] * x117;
+        let x124 = -18.957952216000002 * x112;
+        let x125 = 41.67378 * x115;
+        let x126 = 19.863252216000003 * x119 + x118 * -41.67378;
+        let x127 = x113 * -41.67378;
+        let x128 = 41.67378 * x119;
+        let x129 = s_q4 * x119 - c_q4 * x112;
+        let x130 = s_q4 * x112 + c_q4 * x119;
+        let x131 = x115 + -0.4572 * x113;
+        let x132 = x118 - 0.4572 * x119;
+        let x133 = c_q4 * x117 - s_q4 * x131;
+        let x134 = s_q4 * x117 + c_q4 * x131;
+        let x135 = qd[4] + x113;
+        let x136 = c_q4 * x121 + qd[4] * x130;
+        let x137 = s_q4 * x121 + qd[4] * x129;
+        let x138 = 34.33891524 * x130 + -34.45002 * x132;
+        let x139 = 34.74691524 * x135 - 34.45002 * x134;
+        let x140 = -34.45002 * x135;
+        let x141 = 34.45002 * x130;
+        let x142 = x135 * x140 - x130 * x141;
+        let x143 = x129 * x141 - -34.45002 * x122;
+        let x144 = 34.45002 * x137 - x129 * x140;
+        let x145 = c_q5 * x130 + s_q5 * x135;
+        let x146 = c_q5 * x135 - s_q5 * x130;
+        let x147 = qd[5] + x129;
+        let x148 = s_q5 * x122 - c_q5 * x137 + qd[5] * x146;
+        let x149 = s_q5 * x137 + c_q5 * x122 - qd[5] * x145;
+        let x150 = 1.903 * x147 + 0.385 * x145 + 0.966 * x146;
+        let x151 = 0.385 * x147 + 0.353 * x146;
+        let x152 = 0.966 * x147 + 0.353 * x145 + -0.9929999999999999 * x146;
+        let x153 = 1.903 * x136 + 0.385 * x148 + 0.966 * x149
+            + (x145 * x152 - x146 * x151);
+        let x154 = 0.385 * x136 + 0.353 * x149 + (x146 * x150 - x147 * x152);
+        let x155 = 0.966 * x136 + 0.353 * x148 + -0.9929999999999999 * x149
+            + (x147 * x151 - x145 * x150);
+        let x156 = x130 * x139 - x135 * x138 + (x132 * x140 + x134 * x141) + x153;
+        let x157 = -34.45002 * x123 - 34.33891524 * x137 + (x133 * x141 - x129 * x139)
+            + (c_q5 * x154 - s_q5 * x155);
+        let x158 = 34.74691524 * x122
+            + 34.45002
+                * (c_q4 * (x120 - -0.4572 * x122)
+                    - s_q4 * (c_q3 * x102 - s_q3 * x103 - qd[3] * x118) - qd[4] * x133)
+            + (x129 * x138 - x133 * x140) + (s_q5 * x154 + c_q5 * x155);
+        let x159 = s_q4 * x142 + c_q4 * x143;
+        let x160 = -18.957952216000002 * x121
+            + (x118 * x127 + x115 * x128 - (x113 * x126 + x119 * x125))
+            + (c_q4 * x156 - s_q4 * x157);
+        let x161 = x123 * -41.67378 + (x117 * x128 - (x113 * x124 + x112 * x125))
+            + (s_q4 * x156 + c_q4 * x157 + -0.4572 * x144);
+        let x162 = 41.67378 * x120 + (x119 * x124 - x112 * x126 - x117 * x127)
+            + (x158 + 0.4572 * x159);
+        let x163 = x113 * x127 - x119 * x128 + (c_q4 * x142 - s_q4 * x143);
+        let x164 = x159 - (x122 * -41.67378 + x112 * x128);
+        let x165 = x112 * x127 + x144;
+        let x166 = c_q3 * x163 + s_q3 * x165;
+        let x167 = c_q3 * x165 - s_q3 * x163;
+        let x168 = -5594.523885531201 * x104 - 103.41030072000001 * x105
+            + x101 * 15.183612000000002
+            + (x100 * x108 - x94 * x107 + (x96 * x111 - x99 * x110))
+            + (c_q3 * x160 + s_q3 * x162 + 0.1524 * x164);
+        let x169 = 0.8021 * x104 - -0.08 * x105
+            + (-15.183612000000002 * x102 + x103 * -703.3878000000001)
+            + (x94 * x106 + x93 * x108 + (x99 * x109 + x98 * x111))
+            + (x161 + (-0.1524 * x166 + -7.06 * x167));
+        let x170 = 103.41030072000002 * x104 + 703.3878000000001 * x101
+            - (x100 * x106 + x93 * x107 + (x96 * x109 + x98 * x110))
+            + (c_q3 * x162 - s_q3 * x160 + 7.06 * x164);
+        let x171 = x94 * x110 - x100 * x111 + x166;
+        let x172 = x164
+            - (-15.183612000000002 * x104 - x105 * -703.3878000000001
+                + (x94 * x109 + x93 * x111));
+        let x173 = x100 * x109 + x93 * x110 + x167;
+        let x174 = tau[0]
             - (c_q1
-                * (c_q2 * x207 - s_q2 * x205 + 6.377 * x210
-                    - (9.185 * x101 + 997.18 * x102 + (qd[1] * x103 + x99 * x104)))
+                * (c_q2 * x170 - s_q2 * x168 + 6.377 * x172
+                    - (190.97044034000004 * x88 + (qd[1] * x90 + x86 * x91)))
                 - s_q1
-                    * (qd[1] * x105 - x100 * x104 - (3.225 * x101 + 9.185 * x102)
-                        + (c_q2 * x205 + s_q2 * x207 + 0.1524 * x210)));
-        let x212 = 1.0
-            / (0.595
+                    * (qd[1] * x92 - x87 * x91
+                        - (-8596.210051042 * x88 + 190.97044034 * x89)
+                        + (c_q2 * x168 + s_q2 * x170 + 0.1524 * x172)));
+        let x175 = 1.0
+            / (14222.257549666001
                 + (c_q1
-                    * (c_q1
-                        * (997.18
-                            + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
+                    * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
                         - s_q1
-                            * (9.185
-                                + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
+                            * (190.97044034
+                                + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
                     - s_q1
                         * (c_q1
-                            * (9.185
-                                + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
+                            * (190.97044034000004
+                                + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
                             - s_q1
-                                * (3.225
-                                    + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
-                                        + -0.1524 * x69)))));
-        let x213 = x79 * x212;
-        let x214 = x80 * x212;
-        let x215 = x82 * x212;
-        let x216 = x91 * x212;
-        let x217 = x98 * x212;
-        let x218 = 1.0
-            / (998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68))
-                - x79 * x213);
-        let x219 = x73 + (x77 - x78) - x79 * x214;
-        let x220 = x218 * x219;
-        let x221 = x2 * x81
-            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45))
-            - x79 * x215;
-        let x222 = x218 * x221;
-        let x223 = x2 * x88
-            + (-0.1524 * (s_q2 * x86 - c_q2 * x84) + -6.377 * (s_q2 * x84 + c_q2 * x86))
-            - x79 * x216;
-        let x224 = x218 * x223;
-        let x225 = x2 * x96 - x79 * x217;
-        let x226 = x218 * x225;
-        let x227 = 1.0 / (x61 - x80 * x214 - x219 * x220);
-        let x228 = x81 - x80 * x215 - x219 * x222;
-        let x229 = x227 * x228;
-        let x230 = x88 - x80 * x216 - x219 * x224;
-        let x231 = x227 * x230;
-        let x232 = x96 - x80 * x217 - x219 * x226;
-        let x233 = x227 * x232;
-        let x234 = 1.0 / (x43 - x82 * x215 - x221 * x222 - x228 * x229);
-        let x235 = x33 - x82 * x216 - x221 * x224 - x228 * x231;
-        let x236 = x234 * x235;
-        let x237 = x93 - x82 * x217 - x221 * x226 - x228 * x233;
-        let x238 = x234 * x237;
-        let x239 = 1.0 / (x26 - x91 * x216 - x223 * x224 - x230 * x231 - x235 * x236);
-        let x240 = x17 - x91 * x217 - x223 * x226 - x230 * x233 - x235 * x238;
-        let x241 = x239 * x240;
-        let x242 = 1.0
-            / (1.903 - x98 * x217 - x225 * x226 - x232 * x233 - x237 * x238
-                - x240 * x241);
-        let x243 = tau[1]
-            - (x100 * x103 + x99 * x105 - (-1.928 * x101 + -0.0302 * x102)
-                + (x2 * x206
-                    + (-0.1524 * (c_q2 * x208 + s_q2 * x209)
-                        + -6.377 * (c_q2 * x209 - s_q2 * x208)))) - x211 * x213;
-        let x244 = tau[2] - x206 - x211 * x214 - x220 * x243;
-        let x245 = tau[3] - x198 - x211 * x215 - x222 * x243 - x229 * x244;
-        let x246 = tau[4] - x192 - x211 * x216 - x224 * x243 - x231 * x244 - x236 * x245;
-        let x247 = x242
-            * (tau[5] - x183 - x211 * x217 - x226 * x243 - x233 * x244 - x238 * x245
-                - x241 * x246);
-        let x248 = x239 * x246 - x241 * x247;
-        let x249 = x234 * x245 - x236 * x248 - x238 * x247;
-        let x250 = x227 * x244 - x229 * x249 - x231 * x248 - x233 * x247;
-        let x251 = x218 * x243 - x220 * x250 - x222 * x249 - x224 * x248 - x226 * x247;
-        let x252 = x211 * x212 - x213 * x251 - x214 * x250 - x215 * x249 - x216 * x248
-            - x217 * x247;
-        [x252, x251, x250, x249, x248, x247]
+                                * (-8596.210051042
+                                    + (x70 + (c_q2 * x63 + s_q2 * x65 - x69))))));
+        let x176 = x73 * x175;
+        let x177 = x74 * x175;
+        let x178 = x75 * x175;
+        let x179 = x82 * x175;
+        let x180 = x85 * x175;
+        let x181 = 1.0
+            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x176);
+        let x182 = x58 + (x70 - x71) - x73 * x177;
+        let x183 = x181 * x182;
+        let x184 = x50
+            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36))
+            - x73 * x178;
+        let x185 = x181 * x184;
+        let x186 = x80
+            + (-0.1524 * (s_q2 * x77 - c_q2 * x76) + -6.377 * (s_q2 * x76 + c_q2 * x77))
+            - x73 * x179;
+        let x187 = x181 * x186;
+        let x188 = x23 - x73 * x180;
+        let x189 = x181 * x188;
+        let x190 = 1.0 / (x58 - x74 * x177 - x182 * x183);
+        let x191 = x50 - x74 * x178 - x182 * x185;
+        let x192 = x190 * x191;
+        let x193 = x80 - x74 * x179 - x182 * x187;
+        let x194 = x190 * x193;
+        let x195 = x23 - x74 * x180 - x182 * x189;
+        let x196 = x190 * x195;
+        let x197 = 1.0 / (x35 - x75 * x178 - x184 * x185 - x191 * x192);
+        let x198 = x25 - x75 * x179 - x184 * x187 - x191 * x194;
+        let x199 = x197 * x198;
+        let x200 = x23 - x75 * x180 - x184 * x189 - x191 * x196;
+        let x201 = x197 * x200;
+        let x202 = 1.0 / (x14 - x82 * x179 - x186 * x187 - x193 * x194 - x198 * x199);
+        let x203 = x9 - x82 * x180 - x186 * x189 - x193 * x196 - x198 * x201;
+        let x204 = x202 * x203;
+        let x205 = 1.0
+            / (1.903 - x85 * x180 - x188 * x189 - x195 * x196 - x200 * x201
+                - x203 * x204);
+        let x206 = tau[1]
+            - (x87 * x90 + x86 * x92 - (-1.928 * x88 + -0.0302 * x89)
+                + (x169
+                    + (-0.1524 * (c_q2 * x171 + s_q2 * x173)
+                        + -6.377 * (c_q2 * x173 - s_q2 * x171)))) - x174 * x176;
+        let x207 = tau[2] - x169 - x174 * x177 - x183 * x206;
+        let x208 = tau[3] - x161 - x174 * x178 - x185 * x206 - x192 * x207;
+        let x209 = tau[4] - x158 - x174 * x179 - x187 * x206 - x194 * x207 - x199 * x208;
+        let x210 = x205
+            * (tau[5] - x153 - x174 * x180 - x189 * x206 - x196 * x207 - x201 * x208
+                - x204 * x209);
+        let x211 = x202 * x209 - x204 * x210;
+        let x212 = x197 * x208 - x199 * x211 - x201 * x210;
+        let x213 = x190 * x207 - x192 * x212 - x194 * x211 - x196 * x210;
+        let x214 = x181 * x206 - x183 * x213 - x185 * x212 - x187 * x211 - x189 * x210;
+        let x215 = x174 * x175 - x176 * x214 - x177 * x213 - x178 * x212 - x179 * x211
+            - x180 * x210;
+        [x215, x214, x213, x212, x211, x210]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 540 mul, 370 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 411 mul, 309 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1165,289 +1065,249 @@ impl Srms {
     ) -> ([[f64; 6]; 6], [f64; 6]) {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 1.903 * x8;
-        let x10 = 0.385 * x8;
-        let x11 = 0.966 * x8;
-        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
-        let x13 = 0.353 * s_q5;
-        let x14 = 3.816 * c_q5 - x13;
-        let x15 = 0.353 * c_q5;
-        let x16 = x15 - 2.823 * s_q5;
-        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x18 = x15 + 3.816 * s_q5;
-        let x19 = x13 + 2.823 * c_q5;
-        let x20 = c_q5 * x10 - s_q5 * x11;
-        let x21 = s_q5 * x10 + c_q5 * x11;
-        let x22 = x8 * x12;
-        let x23 = s_q5 * x14 + c_q5 * x16;
-        let x24 = 0.408 + x8 * x9;
-        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
-        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
-        let x27 = c_q4 * 34.45002;
-        let x28 = s_q4 * 34.45002;
-        let x29 = x27 + 41.67378;
-        let x30 = c_q4 * x24 - s_q4 * x22;
-        let x31 = c_q4 * x20 - s_q4 * x25;
-        let x32 = c_q4 * x21 - s_q4 * x23;
-        let x33 = s_q4 * x21 + c_q4 * x23;
-        let x34 = x6 * (x8 * x17);
-        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
-        let x36 = x6 * x26;
-        let x37 = x6 * x32;
-        let x38 = c_q4 * x34 - s_q4 * x35;
-        let x39 = s_q4 * x34 + c_q4 * x35;
-        let x40 = 0.4572 * x27;
-        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
-        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
-        let x43 = 0.402
-            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
-                - x27 * -0.4572 + 0.4572 * x29);
-        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
-        let x45 = c_q3 * x29;
-        let x46 = x4 * x28;
-        let x47 = s_q3 * x29;
-        let x48 = x45 + 703.3878000000001;
-        let x49 = -15.183612000000002 - x47;
-        let x50 = c_q3 * x42 + s_q3 * x38;
-        let x51 = c_q3 * x41 + s_q3 * x39;
-        let x52 = c_q3 * x37 + s_q3 * x44;
-        let x53 = x4 * x43;
-        let x54 = c_q3 * x38 - s_q3 * x42;
-        let x55 = c_q3 * x39 - s_q3 * x41;
-        let x56 = c_q3 * x44 - s_q3 * x37;
-        let x57 = -0.1524 * x47 + x45 * -7.06;
-        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
-        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
-        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
-        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
-        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
-        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
-        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
-        let x65 = c_q2 * x48 + s_q2 * x49;
-        let x66 = x2 * x46;
-        let x67 = c_q2 * x49 - s_q2 * x48;
-        let x68 = x65 + 1192.8178500000001;
-        let x69 = x67 + -28.506420000000002;
-        let x70 = c_q2 * x58 + s_q2 * x62;
-        let x71 = c_q2 * x59 + s_q2 * x63;
-        let x72 = c_q2 * x60 + s_q2 * x64;
-        let x73 = x2 * x61;
-        let x74 = c_q2 * x62 - s_q2 * x58;
-        let x75 = c_q2 * x63 - s_q2 * x59;
-        let x76 = c_q2 * x64 - s_q2 * x60;
-        let x77 = -0.1524 * x67;
-        let x78 = x65 * -6.377;
-        let x79 = 998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68));
-        let x80 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
-            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
-        let x81 = 0.595
+        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x6 = 0.353 * s_q5;
+        let x7 = 0.353 * c_q5;
+        let x8 = x7 - -0.9929999999999999 * s_q5;
+        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
+        let x10 = x6 + -0.9929999999999999 * c_q5;
+        let x11 = c_q5 * x8 - s_q5 * x6;
+        let x12 = c_q5 * x7 - s_q5 * x10;
+        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
+        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x15 = 34.45002 * c_q4;
+        let x16 = 34.45002 * s_q4;
+        let x17 = s_q4 * x5;
+        let x18 = 1.903 * c_q4 - x17;
+        let x19 = c_q4 * x5;
+        let x20 = x19 - s_q4 * x13;
+        let x21 = c_q4 * x9;
+        let x22 = x21 - s_q4 * x11;
+        let x23 = x19 + 1.903 * s_q4;
+        let x24 = s_q4 * x9;
+        let x25 = x24 + c_q4 * x11;
+        let x26 = x21 - s_q4 * x12;
+        let x27 = x24 + c_q4 * x12;
+        let x28 = x15 * -0.4572;
+        let x29 = 0.4572 * x15;
+        let x30 = x14 + x29;
+        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x32 = x30 - x28;
+        let x33 = 41.67378 + x15;
+        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x35 = 19.863252216000003
+            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+        let x36 = c_q3 * x33;
+        let x37 = s_q3 * x33;
+        let x38 = c_q3 * x34 + s_q3 * x26;
+        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x40 = c_q3 * x22;
+        let x41 = x40 + s_q3 * x32;
+        let x42 = c_q3 * x26 - s_q3 * x34;
+        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x44 = s_q3 * x22;
+        let x45 = c_q3 * x32 - x44;
+        let x46 = x37 * 0.1524;
+        let x47 = -0.1524 * x37;
+        let x48 = x36 * -7.06;
+        let x49 = 7.06 * x36;
+        let x50 = x35 - (x47 + x48);
+        let x51 = x16 * 0.1524;
+        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x53 = 703.3878000000001 + x36;
+        let x54 = -15.183612000000002 - x37;
+        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
+        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x57 = 103.41030072000001
+            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x59 = 103.41030072000002
+            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+        let x60 = -0.08 + (x43 + x51);
+        let x61 = c_q2 * x53 + s_q2 * x54;
+        let x62 = c_q2 * x54 - s_q2 * x53;
+        let x63 = c_q2 * x55 + s_q2 * x59;
+        let x64 = c_q2 * x56 + s_q2 * x60;
+        let x65 = c_q2 * x57 + s_q2 * x52;
+        let x66 = c_q2 * x59 - s_q2 * x55;
+        let x67 = c_q2 * x60 - s_q2 * x56;
+        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x69 = 0.1524 * x62;
+        let x70 = -0.1524 * x62;
+        let x71 = x61 * -6.377;
+        let x72 = 6.377 * x61;
+        let x73 = 8609.573807858 + (x58 - (x71 - x70) - (x69 - x72));
+        let x74 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
+        let x75 = 14222.257549666001
             + (c_q1
-                * (c_q1
-                    * (997.18 + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
+                * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
                     - s_q1
-                        * (9.185
-                            + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
+                        * (190.97044034
+                            + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
                 - s_q1
                     * (c_q1
-                        * (9.185
-                            + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
+                        * (190.97044034000004
+                            + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
                         - s_q1
-                            * (3.225
-                                + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
-                                    + -0.1524 * x69))));
-        let x82 = x73 + (x77 - x78);
-        let x83 = c_q1 * x75 - s_q1 * x71;
-        let x84 = x53 - x57;
-        let x85 = x2 * x84
-            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45));
-        let x86 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
-        let x87 = x36 + x40;
-        let x88 = c_q3 * x28;
-        let x89 = x4 * x27;
-        let x90 = s_q3 * x28;
-        let x91 = c_q3 * x32 + s_q3 * x87 + 0.1524 * x89;
-        let x92 = x4 * x33 + (-7.06 * x90 - -0.1524 * x88);
-        let x93 = c_q3 * x87 - s_q3 * x32 + 7.06 * x89;
-        let x94 = x2 * x89;
-        let x95 = x2 * x92
-            + (-0.1524 * (s_q2 * x90 - c_q2 * x88) + -6.377 * (s_q2 * x88 + c_q2 * x90));
-        let x96 = c_q1 * (c_q2 * x93 - s_q2 * x91 + 6.377 * x94)
-            - s_q1 * (c_q2 * x91 + s_q2 * x93 + 0.1524 * x94);
-        let x97 = c_q4 * x9 - s_q4 * x12;
-        let x98 = s_q4 * x9 + c_q4 * x12;
-        let x99 = x6 * x17;
-        let x100 = c_q3 * x97 + s_q3 * x99;
-        let x101 = x4 * x98;
-        let x102 = c_q3 * x99 - s_q3 * x97;
-        let x103 = x2 * x101;
-        let x104 = c_q1 * (c_q2 * x102 - s_q2 * x100)
-            - s_q1 * (c_q2 * x100 + s_q2 * x102);
-        let x105 = qd[0] * s_q1;
-        let x106 = qd[0] * c_q1;
-        let x107 = qd[1] * x106;
-        let x108 = qd[1] * x105;
-        let x109 = -1.928 * qd[1] - 3.225 * x105 + 9.185 * x106;
-        let x110 = 998.63 * qd[1] - -1.928 * x105 + -0.0302 * x106;
-        let x111 = -0.0302 * qd[1] - 9.185 * x105 + 997.18 * x106;
-        let x112 = c_q2 * x105 + s_q2 * x106;
-        let x113 = c_q2 * x106 - s_q2 * x105;
-        let x114 = qd[1] * 0.1524;
-        let x115 = 6.377 * qd[1];
-        let x116 = s_q2 * x115 - c_q2 * x114;
-        let x117 = x2 * (-6.377 * x106 - -0.1524 * x105);
-        let x118 = s_q2 * x114 + c_q2 * x115;
-        let x119 = qd[2] + qd[1] * x2;
-        let x120 = x2 * (-0.1524 * x107 + -6.377 * x108);
-        let x121 = qd[2] * x118;
-        let x122 = qd[2] * x116;
-        let x123 = s_q2 * x108 - c_q2 * x107 - qd[2] * x113;
-        let x124 = s_q2 * x107 + c_q2 * x108 + qd[2] * x112;
-        let x125 = 0.8021 * x119 - 1.59 * x112 + -3.786 * x113;
-        let x126 = 632.9 * x119 - 0.8021 * x112 + -0.08 * x113;
-        let x127 = -0.08 * x119 - -3.786 * x112 + 632.51 * x113;
-        let x128 = 87.42 * x116;
-        let x129 = 87.42 * x117;
-        let x130 = 87.42 * x118;
-        let x131 = c_q3 * x112 + s_q3 * x113;
-        let x132 = c_q3 * x113 - s_q3 * x112;
-        let x133 = x116 - 0.1524 * x119;
-        let x134 = x118 + 7.06 * x119;
-        let x135 = c_q3 * x133 + s_q3 * x134;
-        let x136 = x4 * (x117 + (-7.06 * x113 - -0.1524 * x112));
-        let x137 = s_q3 * x133 - c_q3 * x134;
-        let x138 = qd[3] + x4 * x119;
-        let x139 = x4 * (x120 - (-0.1524 * x123 - -7.06 * x124));
-        let x140 = c_q3 * x123 + s_q3 * x124 - qd[3] * x132;
-        let x141 = s_q3 * x123 - c_q3 * x124 - qd[3] * x131;
-        let x142 = c_q3 * x121 - s_q3 * x122 - qd[3] * x137;
-        let x143 = s_q3 * x121 + c_q3 * x122 + qd[3] * x135;
-        let x144 = 0.0893 * x131;
-        let x145 = 0.402 * x138;
-        let x146 = 0.402 * x132;
-        let x147 = 8.48 * x135;
-        let x148 = 8.48 * x136;
-        let x149 = 8.48 * x137;
-        let x150 = s_q4 * x138 - c_q4 * x131;
-        let x151 = s_q4 * x131 + c_q4 * x138;
-        let x152 = x136 + -0.4572 * x132;
-        let x153 = c_q4 * x135 - s_q4 * x152;
-        let x154 = s_q4 * x135 + c_q4 * x152;
-        let x155 = x6 * (x137 - 0.4572 * x138);
-        let x156 = qd[4] + x6 * x132;
-        let x157 = x6 * x141;
-        let x158 = x139 - -0.4572 * x141;
-        let x159 = x6 * x143;
-        let x160 = c_q4 * x140 + qd[4] * x151;
-        let x161 = s_q4 * x140 + qd[4] * x150;
-        let x162 = c_q4 * x142 + s_q4 * x158 - qd[4] * x154;
-        let x163 = c_q4 * x158 - s_q4 * x142 - qd[4] * x153;
-        let x164 = 0.408 * x150;
-        let x165 = 4.68 * x151;
-        let x166 = 4.68 * x156;
-        let x167 = 45.94 * x153;
-        let x168 = 45.94 * x154;
-        let x169 = 45.94 * x155;
-        let x170 = c_q5 * x151 + s_q5 * x156;
-        let x171 = c_q5 * x156 - s_q5 * x151;
-        let x172 = x154 + -0.762 * x156;
-        let x173 = x155 - 0.762 * x151;
-        let x174 = x8 * x153;
-        let x175 = s_q5 * x173 - c_q5 * x172;
-        let x176 = s_q5 * x172 + c_q5 * x173;
-        let x177 = qd[5] + x8 * x150;
-        let x178 = x8 * x160;
-        let x179 = x163 - -0.762 * x157;
-        let x180 = x159 + 0.762 * x161;
-        let x181 = s_q5 * x157 - c_q5 * x161 + qd[5] * x171;
-        let x182 = s_q5 * x161 + c_q5 * x157 - qd[5] * x170;
-        let x183 = 1.903 * x177 + 0.385 * x170 + 0.966 * x171;
-        let x184 = 0.385 * x177 + 3.816 * x170 + 0.353 * x171;
-        let x185 = 0.966 * x177 + 0.353 * x170 + 2.823 * x171;
-        let x186 = 45.21 * x174;
-        let x187 = 45.21 * x175;
-        let x188 = 45.21 * x176;
-        let x189 = 1.903 * x178 + 0.385 * x181 + 0.966 * x182
-            + (x170 * x185 - x171 * x184 + (x175 * x188 - x176 * x187));
-        let x190 = 0.385 * x178 + 3.816 * x181 + 0.353 * x182
-            + (x171 * x183 - x177 * x185 + (x176 * x186 - x174 * x188));
-        let x191 = 0.966 * x178 + 0.353 * x181 + 2.823 * x182
-            + (x177 * x184 - x170 * x183 + (x174 * x187 - x175 * x186));
-        let x192 = 45.21 * (c_q5 * x179 + s_q5 * x180 + qd[5] * x176)
-            + (x171 * x186 - x177 * x188);
-        let x193 = 45.21 * (c_q5 * x180 - s_q5 * x179 - qd[5] * x175)
-            + (x177 * x187 - x170 * x186);
-        let x194 = c_q5 * x192 - s_q5 * x193;
-        let x195 = s_q5 * x192 + c_q5 * x193;
-        let x196 = 0.408 * x160
-            + (x151 * x166 - x156 * x165 + (x155 * x168 - x154 * x169)) + x8 * x189;
-        let x197 = x156 * x164 - x150 * x166 + (x155 * x167 - x153 * x169) - 4.68 * x161
-            + (c_q5 * x190 - s_q5 * x191 + -0.762 * x195);
-        let x198 = 4.68 * x157
-            + (x150 * x165 - x151 * x164 + (x154 * x167 - x153 * x168))
-            + (s_q5 * x190 + c_q5 * x191 + 0.762 * x194);
-        let x199 = 45.94 * x162 + (x156 * x168 + x151 * x169)
-            + x8 * (45.21 * (x8 * x162) + (x170 * x188 - x171 * x187));
-        let x200 = 45.94 * x163 + (x156 * x167 - x150 * x169) + x194;
-        let x201 = s_q4 * x199 + c_q4 * x200;
-        let x202 = x6 * (45.94 * x159 - (x151 * x167 + x150 * x168) + x195);
-        let x203 = 0.0893 * x140
-            + (x138 * x146 - x132 * x145 + (x137 * x148 - x136 * x149))
-            + (c_q4 * x196 - s_q4 * x197);
-        let x204 = x131 * x146 - x132 * x144 + (x137 * x147 - x135 * x149)
-            + (s_q4 * x196 + c_q4 * x197 + -0.4572 * x202);
-        let x205 = 0.402 * x141
-            + (x138 * x144 - x131 * x145 + (x136 * x147 - x135 * x148))
-            + (x6 * x198 + 0.4572 * x201);
-        let x206 = 8.48 * x142 + (x132 * x148 + x138 * x149)
-            + (c_q4 * x199 - s_q4 * x200);
-        let x207 = 8.48 * x143 + (x131 * x148 - x138 * x147) + x202;
-        let x208 = c_q3 * x206 + s_q3 * x207;
-        let x209 = x4 * (8.48 * x139 + (x132 * x147 + x131 * x149) + x201);
-        let x210 = c_q3 * x207 - s_q3 * x206;
-        let x211 = 1.59 * x123 - -3.786 * x124
-            + (x119 * x127 - x113 * x126 + (x117 * x130 - x118 * x129))
-            + (c_q3 * x203 + s_q3 * x205 + 0.1524 * x209);
-        let x212 = 0.8021 * x123 - -0.08 * x124
-            + (x113 * x125 + x112 * x127 + (x116 * x130 - x118 * x128))
-            + (x4 * x204 + (-0.1524 * x208 + -7.06 * x210));
-        let x213 = -3.786 * x123 - 632.51 * x124
-            + (x117 * x128 - x116 * x129 - (x119 * x125 + x112 * x126))
-            + (c_q3 * x205 - s_q3 * x203 + 7.06 * x209);
-        let x214 = 87.42 * x121 + (x113 * x129 - x119 * x130) + x208;
-        let x215 = 87.42 * x122 + (x112 * x129 - x119 * x128) + x210;
-        let x216 = x2 * (87.42 * x120 + (x113 * x128 - x112 * x130) + x209);
-        let x217 = x106 * x109 + x105 * x111 - (-1.928 * x107 + -0.0302 * x108)
-            + (x2 * x212
-                + (-0.1524 * (c_q2 * x214 + s_q2 * x215)
-                    + -6.377 * (c_q2 * x215 - s_q2 * x214)));
-        let x218 = c_q1
-            * (c_q2 * x213 - s_q2 * x211 + 6.377 * x216
-                - (9.185 * x107 + 997.18 * x108 + (qd[1] * x109 + x105 * x110)))
+                            * (-8596.210051042
+                                + (x70 + (c_q2 * x63 + s_q2 * x65 - x69)))));
+        let x76 = x58 + (x70 - x71);
+        let x77 = c_q1 * x67 - s_q1 * x64;
+        let x78 = x50
+            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36));
+        let x79 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+        let x80 = c_q3 * x16;
+        let x81 = s_q3 * x16;
+        let x82 = x15 * 0.1524;
+        let x83 = x40 + s_q3 * x30 + x82;
+        let x84 = x25 + (-7.06 * x81 - -0.1524 * x80);
+        let x85 = c_q3 * x30 - x44 + 7.06 * x15;
+        let x86 = x84
+            + (-0.1524 * (s_q2 * x81 - c_q2 * x80) + -6.377 * (s_q2 * x80 + c_q2 * x81));
+        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x83 + 6.377 * x15)
+            - s_q1 * (x82 + (c_q2 * x83 + s_q2 * x85));
+        let x88 = c_q3 * x18 + s_q3 * x9;
+        let x89 = c_q3 * x9 - s_q3 * x18;
+        let x90 = c_q1 * (c_q2 * x89 - s_q2 * x88) - s_q1 * (c_q2 * x88 + s_q2 * x89);
+        let x91 = qd[0] * s_q1;
+        let x92 = qd[0] * c_q1;
+        let x93 = qd[1] * x92;
+        let x94 = qd[1] * x91;
+        let x95 = -1.928 * qd[1] - -8596.210051042 * x91 + 190.97044034 * x92;
+        let x96 = 8609.573807858 * qd[1] - -1.928 * x91 + -0.0302 * x92;
+        let x97 = -0.0302 * qd[1] - 190.97044034000004 * x91;
+        let x98 = c_q2 * x91 + s_q2 * x92;
+        let x99 = c_q2 * x92 - s_q2 * x91;
+        let x100 = qd[1] * 0.1524;
+        let x101 = -6.377 * x92 - -0.1524 * x91;
+        let x102 = 6.377 * qd[1];
+        let x103 = s_q2 * x102 - c_q2 * x100;
+        let x104 = s_q2 * x100 + c_q2 * x102;
+        let x105 = qd[1] + qd[2];
+        let x106 = -0.1524 * x93 + -6.377 * x94;
+        let x107 = qd[2] * x104;
+        let x108 = qd[2] * x103;
+        let x109 = s_q2 * x94 - c_q2 * x93 - qd[2] * x99;
+        let x110 = s_q2 * x93 + c_q2 * x94 + qd[2] * x98;
+        let x111 = 0.8021 * x105 - -5594.523885531201 * x98 + 103.41030072000001 * x99
+            - x101 * 15.183612000000002;
+        let x112 = 5601.1318504688 * x105 - 0.8021 * x98 + -0.08 * x99
+            + (-15.183612000000002 * x103 - x104 * -703.3878000000001);
+        let x113 = -0.08 * x105 - 103.41030072000002 * x98 - 703.3878000000001 * x101;
+        let x114 = x105 * 15.183612000000002;
+        let x115 = x99 * -703.3878000000001 - -15.183612000000002 * x98;
+        let x116 = 703.3878000000001 * x105;
+        let x117 = c_q3 * x98 + s_q3 * x99;
+        let x118 = c_q3 * x99 - s_q3 * x98;
+        let x119 = x103 - 0.1524 * x105;
+        let x120 = x101 + (-7.06 * x99 - -0.1524 * x98);
+        let x121 = x104 + 7.06 * x105;
+        let x122 = c_q3 * x119 + s_q3 * x121;
+        let x123 = s_q3 * x119 - c_q3 * x121;
+        let x124 = qd[3] + x105;
+        let x125 = x106 - (-0.1524 * x109 - -7.06 * x110);
+        let x126 = c_q3 * x109 + s_q3 * x110 - qd[3] * x118;
+        let x127 = s_q3 * x109 - c_q3 * x110 - qd[3] * x117;
+        let x128 = s_q3 * x107 + c_q3 * x108 + qd[3] * x122;
+        let x129 = -18.957952216000002 * x117;
+        let x130 = 41.67378 * x120;
+        let x131 = 19.863252216000003 * x124 + x123 * -41.67378;
+        let x132 = x118 * -41.67378;
+        let x133 = 41.67378 * x124;
+        let x134 = s_q4 * x124 - c_q4 * x117;
+        let x135 = s_q4 * x117 + c_q4 * x124;
+        let x136 = x120 + -0.4572 * x118;
+        let x137 = x123 - 0.4572 * x124;
+        let x138 = c_q4 * x122 - s_q4 * x136;
+        let x139 = s_q4 * x122 + c_q4 * x136;
+        let x140 = qd[4] + x118;
+        let x141 = c_q4 * x126 + qd[4] * x135;
+        let x142 = s_q4 * x126 + qd[4] * x134;
+        let x143 = 34.33891524 * x135 + -34.45002 * x137;
+        let x144 = 34.74691524 * x140 - 34.45002 * x139;
+        let x145 = -34.45002 * x140;
+        let x146 = 34.45002 * x135;
+        let x147 = x140 * x145 - x135 * x146;
+        let x148 = x134 * x146 - -34.45002 * x127;
+        let x149 = 34.45002 * x142 - x134 * x145;
+        let x150 = c_q5 * x135 + s_q5 * x140;
+        let x151 = c_q5 * x140 - s_q5 * x135;
+        let x152 = qd[5] + x134;
+        let x153 = s_q5 * x127 - c_q5 * x142 + qd[5] * x151;
+        let x154 = s_q5 * x142 + c_q5 * x127 - qd[5] * x150;
+        let x155 = 1.903 * x152 + 0.385 * x150 + 0.966 * x151;
+        let x156 = 0.385 * x152 + 0.353 * x151;
+        let x157 = 0.966 * x152 + 0.353 * x150 + -0.9929999999999999 * x151;
+        let x158 = 1.903 * x141 + 0.385 * x153 + 0.966 * x154
+            + (x150 * x157 - x151 * x156);
+        let x159 = 0.385 * x141 + 0.353 * x154 + (x151 * x155 - x152 * x157);
+        let x160 = 0.966 * x141 + 0.353 * x153 + -0.9929999999999999 * x154
+            + (x152 * x156 - x150 * x155);
+        let x161 = x135 * x144 - x140 * x143 + (x137 * x145 + x139 * x146) + x158;
+        let x162 = -34.45002 * x128 - 34.33891524 * x142 + (x138 * x146 - x134 * x144)
+            + (c_q5 * x159 - s_q5 * x160);
+        let x163 = 34.74691524 * x127
+            + 34.45002
+                * (c_q4 * (x125 - -0.4572 * x127)
+                    - s_q4 * (c_q3 * x107 - s_q3 * x108 - qd[3] * x123) - qd[4] * x138)
+            + (x134 * x143 - x138 * x145) + (s_q5 * x159 + c_q5 * x160);
+        let x164 = s_q4 * x147 + c_q4 * x148;
+        let x165 = -18.957952216000002 * x126
+            + (x123 * x132 + x120 * x133 - (x118 * x131 + x124 * x130))
+            + (c_q4 * x161 - s_q4 * x162);
+        let x166 = x128 * -41.67378 + (x122 * x133 - (x118 * x129 + x117 * x130))
+            + (s_q4 * x161 + c_q4 * x162 + -0.4572 * x149);
+        let x167 = 41.67378 * x125 + (x124 * x129 - x117 * x131 - x122 * x132)
+            + (x163 + 0.4572 * x164);
+        let x168 = x118 * x132 - x124 * x133 + (c_q4 * x147 - s_q4 * x148);
+        let x169 = x164 - (x127 * -41.67378 + x117 * x133);
+        let x170 = x117 * x132 + x149;
+        let x171 = c_q3 * x168 + s_q3 * x170;
+        let x172 = c_q3 * x170 - s_q3 * x168;
+        let x173 = -5594.523885531201 * x109 - 103.41030072000001 * x110
+            + x106 * 15.183612000000002
+            + (x105 * x113 - x99 * x112 + (x101 * x116 - x104 * x115))
+            + (c_q3 * x165 + s_q3 * x167 + 0.1524 * x169);
+        let x174 = 0.8021 * x109 - -0.08 * x110
+            + (-15.183612000000002 * x107 + x108 * -703.3878000000001)
+            + (x99 * x111 + x98 * x113 + (x104 * x114 + x103 * x116))
+            + (x166 + (-0.1524 * x171 + -7.06 * x172));
+        let x175 = 103.41030072000002 * x109 + 703.3878000000001 * x106
+            - (x105 * x111 + x98 * x112 + (x101 * x114 + x103 * x115))
+            + (c_q3 * x167 - s_q3 * x165 + 7.06 * x169);
+        let x176 = x99 * x115 - x105 * x116 + x171;
+        let x177 = x169
+            - (-15.183612000000002 * x109 - x110 * -703.3878000000001
+                + (x99 * x114 + x98 * x116));
+        let x178 = x105 * x114 + x98 * x115 + x172;
+        let x179 = x92 * x95 + x91 * x97 - (-1.928 * x93 + -0.0302 * x94)
+            + (x174
+                + (-0.1524 * (c_q2 * x176 + s_q2 * x178)
+                    + -6.377 * (c_q2 * x178 - s_q2 * x176)));
+        let x180 = c_q1
+            * (c_q2 * x175 - s_q2 * x173 + 6.377 * x177
+                - (190.97044034000004 * x93 + (qd[1] * x95 + x91 * x96)))
             - s_q1
-                * (qd[1] * x111 - x106 * x110 - (3.225 * x107 + 9.185 * x108)
-                    + (c_q2 * x211 + s_q2 * x213 + 0.1524 * x216));
+                * (qd[1] * x97 - x92 * x96 - (-8596.210051042 * x93 + 190.97044034 * x94)
+                    + (c_q2 * x173 + s_q2 * x175 + 0.1524 * x177));
         (
             [
-                [x81, x80, x83, x86, x96, x104],
-                [x80, x79, x82, x85, x95, x103],
-                [x83, x82, x61, x84, x92, x101],
-                [x86, x85, x84, x43, x33, x98],
-                [x96, x95, x92, x33, x26, x17],
-                [x104, x103, x101, x98, x17, 1.903],
+                [x75, x74, x77, x79, x87, x90],
+                [x74, x73, x76, x78, x86, x23],
+                [x77, x76, x58, x50, x84, x23],
+                [x79, x78, x50, x35, x25, x23],
+                [x87, x86, x84, x25, x14, x9],
+                [x90, x23, x23, x23, x9, 1.903],
             ],
-            [x218, x217, x212, x204, x198, x189],
+            [x180, x179, x174, x166, x163, x158],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 626 mul, 469 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 503 mul, 412 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1457,325 +1317,288 @@ impl Srms {
     ) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 1.903 * x8;
-        let x10 = 0.385 * x8;
-        let x11 = 0.966 * x8;
-        let x12 = 0.385 * c_q5 - 0.966 * s_q5;
-        let x13 = 0.353 * s_q5;
-        let x14 = 3.816 * c_q5 - x13;
-        let x15 = 0.353 * c_q5;
-        let x16 = x15 - 2.823 * s_q5;
-        let x17 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x18 = x15 + 3.816 * s_q5;
-        let x19 = x13 + 2.823 * c_q5;
-        let x20 = c_q5 * x10 - s_q5 * x11;
-        let x21 = s_q5 * x10 + c_q5 * x11;
-        let x22 = x8 * x12;
-        let x23 = s_q5 * x14 + c_q5 * x16;
-        let x24 = 0.408 + x8 * x9;
-        let x25 = 4.68 + (c_q5 * x14 - s_q5 * x16 + 26.25091524);
-        let x26 = 4.68 + (s_q5 * x18 + c_q5 * x19 + 26.25091524);
-        let x27 = c_q4 * 34.45002;
-        let x28 = s_q4 * 34.45002;
-        let x29 = x27 + 41.67378;
-        let x30 = c_q4 * x24 - s_q4 * x22;
-        let x31 = c_q4 * x20 - s_q4 * x25;
-        let x32 = c_q4 * x21 - s_q4 * x23;
-        let x33 = s_q4 * x21 + c_q4 * x23;
-        let x34 = x6 * (x8 * x17);
-        let x35 = x6 * (c_q5 * x18 - s_q5 * x19);
-        let x36 = x6 * x26;
-        let x37 = x6 * x32;
-        let x38 = c_q4 * x34 - s_q4 * x35;
-        let x39 = s_q4 * x34 + c_q4 * x35;
-        let x40 = 0.4572 * x27;
-        let x41 = s_q4 * x30 + c_q4 * x31 - 0.4572 * x28;
-        let x42 = 0.0893 + (c_q4 * x30 - s_q4 * x31);
-        let x43 = 0.402
-            + (s_q4 * (s_q4 * x24 + c_q4 * x22) + c_q4 * (s_q4 * x20 + c_q4 * x25)
-                - x27 * -0.4572 + 0.4572 * x29);
-        let x44 = 0.402 + (x6 * x36 + x40 - x29 * -0.4572);
-        let x45 = c_q3 * x29;
-        let x46 = x4 * x28;
-        let x47 = s_q3 * x29;
-        let x48 = x45 + 703.3878000000001;
-        let x49 = -15.183612000000002 - x47;
-        let x50 = c_q3 * x42 + s_q3 * x38;
-        let x51 = c_q3 * x41 + s_q3 * x39;
-        let x52 = c_q3 * x37 + s_q3 * x44;
-        let x53 = x4 * x43;
-        let x54 = c_q3 * x38 - s_q3 * x42;
-        let x55 = c_q3 * x39 - s_q3 * x41;
-        let x56 = c_q3 * x44 - s_q3 * x37;
-        let x57 = -0.1524 * x47 + x45 * -7.06;
-        let x58 = 1.59 + (c_q3 * x50 + s_q3 * x52 + x47 * 0.1524 + -0.1524 * x49);
-        let x59 = 0.8021 + (x4 * x51 - 7.06 * x46);
-        let x60 = -3.786 + (c_q3 * x52 - s_q3 * x50 + x45 * 0.1524 + x49 * -7.06);
-        let x61 = 632.9 + (x4 * x53 - x57 - (x49 * 0.1524 - 7.06 * x48));
-        let x62 = -3.786 + (c_q3 * x54 + s_q3 * x56 + 7.06 * x47 - -0.1524 * x48);
-        let x63 = -0.08 + (x4 * x55 + x46 * 0.1524);
-        let x64 = 632.51 + (c_q3 * x56 - s_q3 * x54 + 7.06 * x45 - x48 * -7.06);
-        let x65 = c_q2 * x48 + s_q2 * x49;
-        let x66 = x2 * x46;
-        let x67 = c_q2 * x49 - s_q2 * x48;
-        let x68 = x65 + 1192.8178500000001;
-        let x69 = x67 + -28.506420000000002;
-        let x70 = c_q2 * x58 + s_q2 * x62;
-        let x71 = c_q2 * x59 + s_q2 * x63;
-        let x72 = c_q2 * x60 + s_q2 * x64;
-        let x73 = x2 * x61;
-        let x74 = c_q2 * x62 - s_q2 * x58;
-        let x75 = c_q2 * x63 - s_q2 * x59;
-        let x76 = c_q2 * x64 - s_q2 * x60;
-        let x77 = -0.1524 * x67;
-        let x78 = x65 * -6.377;
-        let x79 = c_q1 * (-0.0302 + (x2 * x75 + 0.1524 * x66))
-            - s_q1 * (-1.928 + (x2 * x71 - 6.377 * x66));
-        let x80 = c_q1 * x75 - s_q1 * x71;
-        let x81 = x53 - x57;
-        let x82 = c_q1 * (c_q2 * x55 - s_q2 * x51) - s_q1 * (c_q2 * x51 + s_q2 * x55);
-        let x83 = x36 + x40;
-        let x84 = c_q3 * x28;
-        let x85 = x4 * x27;
-        let x86 = s_q3 * x28;
-        let x87 = c_q3 * x32 + s_q3 * x83 + 0.1524 * x85;
-        let x88 = x4 * x33 + (-7.06 * x86 - -0.1524 * x84);
-        let x89 = c_q3 * x83 - s_q3 * x32 + 7.06 * x85;
-        let x90 = x2 * x85;
-        let x91 = c_q1 * (c_q2 * x89 - s_q2 * x87 + 6.377 * x90)
-            - s_q1 * (c_q2 * x87 + s_q2 * x89 + 0.1524 * x90);
-        let x92 = c_q4 * x9 - s_q4 * x12;
-        let x93 = s_q4 * x9 + c_q4 * x12;
-        let x94 = x6 * x17;
-        let x95 = c_q3 * x92 + s_q3 * x94;
-        let x96 = x4 * x93;
-        let x97 = c_q3 * x94 - s_q3 * x92;
-        let x98 = c_q1 * (c_q2 * x97 - s_q2 * x95) - s_q1 * (c_q2 * x95 + s_q2 * x97);
-        let x99 = qd[0] * s_q1;
-        let x100 = qd[0] * c_q1;
-        let x101 = qd[1] * x100;
-        let x102 = qd[1] * x99;
-        let x103 = -1.928 * qd[1] - 3.225 * x99 + 9.185 * x100;
-        let x104 = 998.63 * qd[1] - -1.928 * x99 + -0.0302 * x100;
-        let x105 = -0.0302 * qd[1] - 9.185 * x99 + 997.18 * x100;
-        let x106 = c_q2 * x99 + s_q2 * x100;
-        let x107 = c_q2 * x100 - s_q2 * x99;
-        let x108 = qd[1] * 0.1524;
-        let x109 = 6.377 * qd[1];
-        let x110 = s_q2 * x109 - c_q2 * x108;
-        let x111 = x2 * (-6.377 * x100 - -0.1524 * x99);
-        let x112 = s_q2 * x108 + c_q2 * x109;
-        let x113 = qd[2] + qd[1] * x2;
-        let x114 = x2 * (-0.1524 * x101 + -6.377 * x102);
-        let x115 = qd[2] * x112;
-        let x116 = qd[2] * x110;
-        let x117 = s_q2 * x102 - c_q2 * x101 - qd[2] * x107;
-        let x118 = s_q2 * x101 + c_q2 * x102 + qd[2] * x106;
-        let x119 = 0.8021 * x113 - 1.59 * x106 + -3.786 * x107;
-        let x120 = 632.9 * x113 - 0.8021 * x106 + -0.08 * x107;
-        let x121 = -0.08 * x113 - -3.786 * x106 + 632.51 * x107;
-        let x122 = 87.42 * x110;
-        let x123 = 87.42 * x111;
-        let x124 = 87.42 * x112;
-        let x125 = c_q3 * x106 + s_q3 * x107;
-        let x126 = c_q3 * x107 - s_q3 * x106;
-        let x127 = x110 - 0.1524 * x113;
-        let x128 = x112 + 7.06 * x113;
-        let x129 = c_q3 * x127 + s_q3 * x128;
-        let x130 = x4 * (x111 + (-7.06 * x107 - -0.1524 * x106));
-        let x131 = s_q3 * x127 - c_q3 * x128;
-        let x132 = qd[3] + x4 * x113;
-        let x133 = x4 * (x114 - (-0.1524 * x117 - -7.06 * x118));
-        let x134 = c_q3 * x117 + s_q3 * x118 - qd[3] * x126;
-        let x135 = s_q3 * x117 - c_q3 * x118 - qd[3] * x125;
-        let x136 = c_q3 * x115 - s_q3 * x116 - qd[3] * x131;
-        let x137 = s_q3 * x115 + c_q3 * x116 + qd[3] * x129;
-        let x138 = 0.0893 * x125;
-        let x139 = 0.402 * x132;
-        let x140 = 0.402 * x126;
-        let x141 = 8.48 * x129;
-        let x142 = 8.48 * x130;
-        let x143 = 8.48 * x131;
-        let x144 = s_q4 * x132 - c_q4 * x125;
-        let x145 = s_q4 * x125 + c_q4 * x132;
-        let x146 = x130 + -0.4572 * x126;
-        let x147 = c_q4 * x129 - s_q4 * x146;
-        let x148 = s_q4 * x129 + c_q4 * x146;
-        let x149 = x6 * (x131 - 0.4572 * x132);
-        let x150 = qd[4] + x6 * x126;
-        let x151 = x6 * x135;
-        let x152 = x133 - -0.4572 * x135;
-        let x153 = x6 * x137;
-        let x154 = c_q4 * x134 + qd[4] * x145;
-        let x155 = s_q4 * x134 + qd[4] * x144;
-        let x156 = c_q4 * x136 + s_q4 * x152 - qd[4] * x148;
-        let x157 = c_q4 * x152 - s_q4 * x136 - qd[4] * x147;
-        let x158 = 0.408 * x144;
-        let x159 = 4.68 * x145;
-        let x160 = 4.68 * x150;
-        let x161 = 45.94 * x147;
-        let x162 = 45.94 * x148;
-        let x163 = 45.94 * x149;
-        let x164 = c_q5 * x145 + s_q5 * x150;
-        let x165 = c_q5 * x150 - s_q5 * x145;
-        let x166 = x148 + -0.762 * x150;
-        let x167 = x149 - 0.762 * x145;
-        let x168 = x8 * x147;
-        let x169 = s_q5 * x167 - c_q5 * x166;
-        let x170 = s_q5 * x166 + c_q5 * x167;
-        let x171 = qd[5] + x8 * x144;
-        let x172 = x8 * x154;
-        let x173 = x157 - -0.762 * x151;
-        let x174 = x153 + 0.762 * x155;
-        let x175 = s_q5 * x151 - c_q5 * x155 + qd[5] * x165;
-        let x176 = s_q5 * x155 + c_q5 * x151 - qd[5] * x164;
-        let x177 = 1.903 * x171 + 0.385 * x164 + 0.966 * x165;
-        let x178 = 0.385 * x171 + 3.816 * x164 + 0.353 * x165;
-        let x179 = 0.966 * x171 + 0.353 * x164 + 2.823 * x165;
-        let x180 = 45.21 * x168;
-        let x181 = 45.21 * x169;
-        let x182 = 45.21 * x170;
-        let x183 = 1.903 * x172 + 0.385 * x175 + 0.966 * x176
-            + (x164 * x179 - x165 * x178 + (x169 * x182 - x170 * x181)) - f_ext[5][3];
-        let x184 = 0.385 * x172 + 3.816 * x175 + 0.353 * x176
-            + (x165 * x177 - x171 * x179 + (x170 * x180 - x168 * x182)) - f_ext[5][4];
-        let x185 = 0.966 * x172 + 0.353 * x175 + 2.823 * x176
-            + (x171 * x178 - x164 * x177 + (x168 * x181 - x169 * x180)) - f_ext[5][5];
-        let x186 = 45.21 * (c_q5 * x173 + s_q5 * x174 + qd[5] * x170)
-            + (x165 * x180 - x171 * x182) - f_ext[5][1];
-        let x187 = 45.21 * (c_q5 * x174 - s_q5 * x173 - qd[5] * x169)
-            + (x171 * x181 - x164 * x180) - f_ext[5][2];
-        let x188 = c_q5 * x186 - s_q5 * x187;
-        let x189 = s_q5 * x186 + c_q5 * x187;
-        let x190 = 0.408 * x154
-            + (x145 * x160 - x150 * x159 + (x149 * x162 - x148 * x163)) - f_ext[4][3]
-            + x8 * x183;
-        let x191 = x150 * x158 - x144 * x160 + (x149 * x161 - x147 * x163) - 4.68 * x155
-            - f_ext[4][4] + (c_q5 * x184 - s_q5 * x185 + -0.762 * x189);
-        let x192 = 4.68 * x151
-            + (x144 * x159 - x145 * x158 + (x148 * x161 - x147 * x162)) - f_ext[4][5]
-            + (s_q5 * x184 + c_q5 * x185 + 0.762 * x188);
-        let x193 = 45.94 * x156 + (x150 * x162 + x145 * x163) - f_ext[4][0]
-            + x8 * (45.21 * (x8 * x156) + (x164 * x182 - x165 * x181) - f_ext[5][0]);
-        let x194 = 45.94 * x157 + (x150 * x161 - x144 * x163) - f_ext[4][1] + x188;
-        let x195 = s_q4 * x193 + c_q4 * x194;
-        let x196 = x6
-            * (45.94 * x153 - (x145 * x161 + x144 * x162) - f_ext[4][2] + x189);
-        let x197 = 0.0893 * x134
-            + (x132 * x140 - x126 * x139 + (x131 * x142 - x130 * x143)) - f_ext[3][3]
-            + (c_q4 * x190 - s_q4 * x191);
-        let x198 = x125 * x140 - x126 * x138 + (x131 * x141 - x129 * x143) - f_ext[3][4]
-            + (s_q4 * x190 + c_q4 * x191 + -0.4572 * x196);
-        let x199 = 0.402 * x135
-            + (x132 * x138 - x125 * x139 + (x130 * x141 - x129 * x142)) - f_ext[3][5]
-            + (x6 * x192 + 0.4572 * x195);
-        let x200 = 8.48 * x136 + (x126 * x142 + x132 * x143) - f_ext[3][0]
-            + (c_q4 * x193 - s_q4 * x194);
-        let x201 = 8.48 * x137 + (x125 * x142 - x132 * x141) - f_ext[3][2] + x196;
-        let x202 = c_q3 * x200 + s_q3 * x201;
-        let x203 = x4 * (8.48 * x133 + (x126 * x141 + x125 * x143) - f_ext[3][1] + x195);
-        let x204 = c_q3 * x201 - s_q3 * x200;
-        let x205 = 1.59 * x117 - -3.786 * x118
-            + (x113 * x121 - x107 * x120 + (x111 * x124 - x112 * x123)) - f_ext[2][3]
-            + (c_q3 * x197 + s_q3 * x199 + 0.1524 * x203);
-        let x206 = 0.8021 * x117 - -0.08 * x118
-            + (x107 * x119 + x106 * x121 + (x110 * x124 - x112 * x122)) - f_ext[2][4]
-            + (x4 * x198 + (-0.1524 * x202 + -7.06 * x204));
-        let x207 = -3.786 * x117 - 632.51 * x118
-            + (x111 * x122 - x110 * x123 - (x113 * x119 + x106 * x120)) - f_ext[2][5]
-            + (c_q3 * x199 - s_q3 * x197 + 7.06 * x203);
-        let x208 = 87.42 * x115 + (x107 * x123 - x113 * x124) - f_ext[2][0] + x202;
-        let x209 = 87.42 * x116 + (x106 * x123 - x113 * x122) - f_ext[2][2] + x204;
-        let x210 = x2
-            * (87.42 * x114 + (x107 * x122 - x106 * x124) - f_ext[2][1] + x203);
-        let x211 = tau[0]
+        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x6 = 0.353 * s_q5;
+        let x7 = 0.353 * c_q5;
+        let x8 = x7 - -0.9929999999999999 * s_q5;
+        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
+        let x10 = x6 + -0.9929999999999999 * c_q5;
+        let x11 = c_q5 * x8 - s_q5 * x6;
+        let x12 = c_q5 * x7 - s_q5 * x10;
+        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
+        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x15 = 34.45002 * c_q4;
+        let x16 = 34.45002 * s_q4;
+        let x17 = s_q4 * x5;
+        let x18 = 1.903 * c_q4 - x17;
+        let x19 = c_q4 * x5;
+        let x20 = x19 - s_q4 * x13;
+        let x21 = c_q4 * x9;
+        let x22 = x21 - s_q4 * x11;
+        let x23 = x19 + 1.903 * s_q4;
+        let x24 = s_q4 * x9;
+        let x25 = x24 + c_q4 * x11;
+        let x26 = x21 - s_q4 * x12;
+        let x27 = x24 + c_q4 * x12;
+        let x28 = x15 * -0.4572;
+        let x29 = 0.4572 * x15;
+        let x30 = x14 + x29;
+        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x32 = x30 - x28;
+        let x33 = 41.67378 + x15;
+        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x35 = 19.863252216000003
+            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+        let x36 = c_q3 * x33;
+        let x37 = s_q3 * x33;
+        let x38 = c_q3 * x34 + s_q3 * x26;
+        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x40 = c_q3 * x22;
+        let x41 = x40 + s_q3 * x32;
+        let x42 = c_q3 * x26 - s_q3 * x34;
+        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x44 = s_q3 * x22;
+        let x45 = c_q3 * x32 - x44;
+        let x46 = x37 * 0.1524;
+        let x47 = -0.1524 * x37;
+        let x48 = x36 * -7.06;
+        let x49 = 7.06 * x36;
+        let x50 = x35 - (x47 + x48);
+        let x51 = x16 * 0.1524;
+        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x53 = 703.3878000000001 + x36;
+        let x54 = -15.183612000000002 - x37;
+        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
+        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x57 = 103.41030072000001
+            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x59 = 103.41030072000002
+            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+        let x60 = -0.08 + (x43 + x51);
+        let x61 = c_q2 * x53 + s_q2 * x54;
+        let x62 = c_q2 * x54 - s_q2 * x53;
+        let x63 = c_q2 * x55 + s_q2 * x59;
+        let x64 = c_q2 * x56 + s_q2 * x60;
+        let x65 = c_q2 * x57 + s_q2 * x52;
+        let x66 = c_q2 * x59 - s_q2 * x55;
+        let x67 = c_q2 * x60 - s_q2 * x56;
+        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x69 = 0.1524 * x62;
+        let x70 = -0.1524 * x62;
+        let x71 = x61 * -6.377;
+        let x72 = 6.377 * x61;
+        let x73 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
+        let x74 = c_q1 * x67 - s_q1 * x64;
+        let x75 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+        let x76 = c_q3 * x16;
+        let x77 = s_q3 * x16;
+        let x78 = x15 * 0.1524;
+        let x79 = x40 + s_q3 * x30 + x78;
+        let x80 = x25 + (-7.06 * x77 - -0.1524 * x76);
+        let x81 = c_q3 * x30 - x44 + 7.06 * x15;
+        let x82 = c_q1 * (c_q2 * x81 - s_q2 * x79 + 6.377 * x15)
+            - s_q1 * (x78 + (c_q2 * x79 + s_q2 * x81));
+        let x83 = c_q3 * x18 + s_q3 * x9;
+        let x84 = c_q3 * x9 - s_q3 * x18;
+        let x85 = c_q1 * (c_q2 * x84 - s_q2 * x83) - s_q1 * (c_q2 * x83 + s_q2 * x84);
+        let x86 = qd[0] * s_q1;
+        let x87 = qd[0] * c_q1;
+        let x88 = qd[1] * x87;
+        let x89 = qd[1] * x86;
+        let x90 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
+        let x91 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
+        let x92 = -0.0302 * qd[1] - 190.97044034000004 * x86;
+        let x93 = c_q2 * x86 + s_q2 * x87;
+        let x94 = c_q2 * x87 - s_q2 * x86;
+        let x95 = qd[1] * 0.1524;
+        let x96 = -6.377 * x87 - -0.1524 * x86;
+        let x97 = 6.377 * qd[1];
+        let x98 = s_q2 * x97 - c_q2 * x95;
+        let x99 = s_q2 * x95 + c_q2 * x97;
+        let x100 = qd[1] + qd[2];
+        let x101 = -0.1524 * x88 + -6.377 * x89;
+        let x102 = qd[2] * x99;
+        let x103 = qd[2] * x98;
+        let x104 = s_q2 * x89 - c_q2 * x88 - qd[2] * x94;
+        let x105 = s_q2 * x88 + c_q2 * x89 + qd[2] * x93;
+        let x106 = 0.8021 * x100 - -5594.523885531201 * x93 + 103.41030072000001 * x94
+            - x96 * 15.183612000000002;
+        let x107 = 5601.1318504688 * x100 - 0.8021 * x93 + -0.08 * x94
+            + (-15.183612000000002 * x98 - x99 * -703.3878000000001);
+        let x108 = -0.08 * x100 - 103.41030072000002 * x93 - 703.3878000000001 * x96;
+        let x109 = x100 * 15.183612000000002;
+        let x110 = x94 * -703.3878000000001 - -15.183612000000002 * x93;
+        let x111 = 703.3878000000001 * x100;
+        let x112 = c_q3 * x93 + s_q3 * x94;
+        let x113 = c_q3 * x94 - s_q3 * x93;
+        let x114 = x98 - 0.1524 * x100;
+        let x115 = x96 + (-7.06 * x94 - -0.1524 * x93);
+        let x116 = x99 + 7.06 * x100;
+        let x117 = c_q3 * x114 + s_q3 * x116;
+        let x118 = s_q3 * x114 - c_q3 * x116;
+        let x119 = qd[3] + x100;
+        let x120 = x101 - (-0.1524 * x104 - -7.06 * x105);
+        let x121 = c_q3 * x104 + s_q3 * x105 - qd[3] * x113;
+        let x122 = s_q3 * x104 - c_q3 * x105 - qd[3] * x112;
+        let x123 = s_q3 * x102 + c_q3 * x103 + qd[3] * x117;
+        let x124 = -18.957952216000002 * x112;
+        let x125 = 41.67378 * x115;
+        let x126 = 19.863252216000003 * x119 + x118 * -41.67378;
+        let x127 = x113 * -41.67378;
+        let x128 = 41.67378 * x119;
+        let x129 = s_q4 * x119 - c_q4 * x112;
+        let x130 = s_q4 * x112 + c_q4 * x119;
+        let x131 = x115 + -0.4572 * x113;
+        let x132 = x118 - 0.4572 * x119;
+        let x133 = c_q4 * x117 - s_q4 * x131;
+        let x134 = s_q4 * x117 + c_q4 * x131;
+        let x135 = qd[4] + x113;
+        let x136 = c_q4 * x121 + qd[4] * x130;
+        let x137 = s_q4 * x121 + qd[4] * x129;
+        let x138 = 34.33891524 * x130 + -34.45002 * x132;
+        let x139 = 34.74691524 * x135 - 34.45002 * x134;
+        let x140 = -34.45002 * x135;
+        let x141 = 34.45002 * x130;
+        let x142 = c_q5 * x130 + s_q5 * x135;
+        let x143 = c_q5 * x135 - s_q5 * x130;
+        let x144 = qd[5] + x129;
+        let x145 = s_q5 * x122 - c_q5 * x137 + qd[5] * x143;
+        let x146 = s_q5 * x137 + c_q5 * x122 - qd[5] * x142;
+        let x147 = 1.903 * x144 + 0.385 * x142 + 0.966 * x143;
+        let x148 = 0.385 * x144 + 0.353 * x143;
+        let x149 = 0.966 * x144 + 0.353 * x142 + -0.9929999999999999 * x143;
+        let x150 = 1.903 * x136 + 0.385 * x145 + 0.966 * x146
+            + (x142 * x149 - x143 * x148) - f_ext[5][3];
+        let x151 = 0.385 * x136 + 0.353 * x146 + (x143 * x147 - x144 * x149)
+            - f_ext[5][4];
+        let x152 = 0.966 * x136 + 0.353 * x145 + -0.9929999999999999 * x146
+            + (x144 * x148 - x142 * x147) - f_ext[5][5];
+        let x153 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
+        let x154 = f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5;
+        let x155 = x130 * x139 - x135 * x138 + (x132 * x140 + x134 * x141) - f_ext[4][3]
+            + x150;
+        let x156 = -34.45002 * x123 - 34.33891524 * x137 + (x133 * x141 - x129 * x139)
+            - f_ext[4][4] + (c_q5 * x151 - s_q5 * x152 - -0.762 * x154);
+        let x157 = 34.74691524 * x122
+            + 34.45002
+                * (c_q4 * (x120 - -0.4572 * x122)
+                    - s_q4 * (c_q3 * x102 - s_q3 * x103 - qd[3] * x118) - qd[4] * x133)
+            + (x129 * x138 - x133 * x140) - f_ext[4][5]
+            + (s_q5 * x151 + c_q5 * x152 + 0.762 * x153);
+        let x158 = x135 * x140 - x130 * x141 - f_ext[4][0] - f_ext[5][0];
+        let x159 = x129 * x141 - -34.45002 * x122 - f_ext[4][1] + x153;
+        let x160 = 34.45002 * x137 - x129 * x140 - f_ext[4][2] - x154;
+        let x161 = s_q4 * x158 + c_q4 * x159;
+        let x162 = -18.957952216000002 * x121
+            + (x118 * x127 + x115 * x128 - (x113 * x126 + x119 * x125)) - f_ext[3][3]
+            + (c_q4 * x155 - s_q4 * x156);
+        let x163 = x123 * -41.67378 + (x117 * x128 - (x113 * x124 + x112 * x125))
+            - f_ext[3][4] + (s_q4 * x155 + c_q4 * x156 + -0.4572 * x160);
+        let x164 = 41.67378 * x120 + (x119 * x124 - x112 * x126 - x117 * x127)
+            - f_ext[3][5] + (x157 + 0.4572 * x161);
+        let x165 = x113 * x127 - x119 * x128 - f_ext[3][0] + (c_q4 * x158 - s_q4 * x159);
+        let x166 = x161 - (f_ext[3][1] + (x122 * -41.67378 + x112 * x128));
+        let x167 = x112 * x127 - f_ext[3][2] + x160;
+        let x168 = c_q3 * x165 + s_q3 * x167;
+        let x169 = c_q3 * x167 - s_q3 * x165;
+        let x170 = -5594.523885531201 * x104 - 103.41030072000001 * x105
+            + x101 * 15.183612000000002
+            + (x100 * x108 - x94 * x107 + (x96 * x111 - x99 * x110)) - f_ext[2][3]
+            + (c_q3 * x162 + s_q3 * x164 + 0.1524 * x166);
+        let x171 = 0.8021 * x104 - -0.08 * x105
+            + (-15.183612000000002 * x102 + x103 * -703.3878000000001)
+            + (x94 * x106 + x93 * x108 + (x99 * x109 + x98 * x111)) - f_ext[2][4]
+            + (x163 + (-0.1524 * x168 + -7.06 * x169));
+        let x172 = 103.41030072000002 * x104 + 703.3878000000001 * x101
+            - (x100 * x106 + x93 * x107 + (x96 * x109 + x98 * x110)) - f_ext[2][5]
+            + (c_q3 * x164 - s_q3 * x162 + 7.06 * x166);
+        let x173 = x94 * x110 - x100 * x111 - f_ext[2][0] + x168;
+        let x174 = x166
+            - (f_ext[2][1]
+                + (-15.183612000000002 * x104 - x105 * -703.3878000000001
+                    + (x94 * x109 + x93 * x111)));
+        let x175 = x100 * x109 + x93 * x110 - f_ext[2][2] + x169;
+        let x176 = tau[0]
             - (c_q1
-                * (c_q2 * x207 - s_q2 * x205 + 6.377 * x210
+                * (c_q2 * x172 - s_q2 * x170 + 6.377 * x174
                     - (f_ext[1][5]
-                        + (9.185 * x101 + 997.18 * x102 + (qd[1] * x103 + x99 * x104))))
+                        + (190.97044034000004 * x88 + (qd[1] * x90 + x86 * x91))))
                 - s_q1
-                    * (qd[1] * x105 - x100 * x104 - (3.225 * x101 + 9.185 * x102)
-                        - f_ext[1][3] + (c_q2 * x205 + s_q2 * x207 + 0.1524 * x210))
-                - f_ext[0][5]);
-        let x212 = 1.0
-            / (0.595
+                    * (qd[1] * x92 - x87 * x91
+                        - (-8596.210051042 * x88 + 190.97044034 * x89) - f_ext[1][3]
+                        + (c_q2 * x170 + s_q2 * x172 + 0.1524 * x174)) - f_ext[0][5]);
+        let x177 = 1.0
+            / (14222.257549666001
                 + (c_q1
-                    * (c_q1
-                        * (997.18
-                            + (c_q2 * x76 - s_q2 * x74 + 6.377 * x65 - x68 * -6.377))
+                    * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
                         - s_q1
-                            * (9.185
-                                + (c_q2 * x72 - s_q2 * x70 + 0.1524 * x65 + x69 * -6.377)))
+                            * (190.97044034
+                                + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
                     - s_q1
                         * (c_q1
-                            * (9.185
-                                + (c_q2 * x74 + s_q2 * x76 - 6.377 * x67 - -0.1524 * x68))
+                            * (190.97044034000004
+                                + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
                             - s_q1
-                                * (3.225
-                                    + (c_q2 * x70 + s_q2 * x72 - 0.1524 * x67
-                                        + -0.1524 * x69)))));
-        let x213 = x79 * x212;
-        let x214 = x80 * x212;
-        let x215 = x82 * x212;
-        let x216 = x91 * x212;
-        let x217 = x98 * x212;
-        let x218 = 1.0
-            / (998.63 + (x2 * x73 - (x78 - x77) - (0.1524 * x69 - 6.377 * x68))
-                - x79 * x213);
-        let x219 = x73 + (x77 - x78) - x79 * x214;
-        let x220 = x218 * x219;
-        let x221 = x2 * x81
-            + (-6.377 * (s_q2 * x47 - c_q2 * x45) - -0.1524 * (c_q2 * x47 + s_q2 * x45))
-            - x79 * x215;
-        let x222 = x218 * x221;
-        let x223 = x2 * x88
-            + (-0.1524 * (s_q2 * x86 - c_q2 * x84) + -6.377 * (s_q2 * x84 + c_q2 * x86))
-            - x79 * x216;
-        let x224 = x218 * x223;
-        let x225 = x2 * x96 - x79 * x217;
-        let x226 = x218 * x225;
-        let x227 = 1.0 / (x61 - x80 * x214 - x219 * x220);
-        let x228 = x81 - x80 * x215 - x219 * x222;
-        let x229 = x227 * x228;
-        let x230 = x88 - x80 * x216 - x219 * x224;
-        let x231 = x227 * x230;
-        let x232 = x96 - x80 * x217 - x219 * x226;
-        let x233 = x227 * x232;
-        let x234 = 1.0 / (x43 - x82 * x215 - x221 * x222 - x228 * x229);
-        let x235 = x33 - x82 * x216 - x221 * x224 - x228 * x231;
-        let x236 = x234 * x235;
-        let x237 = x93 - x82 * x217 - x221 * x226 - x228 * x233;
-        let x238 = x234 * x237;
-        let x239 = 1.0 / (x26 - x91 * x216 - x223 * x224 - x230 * x231 - x235 * x236);
-        let x240 = x17 - x91 * x217 - x223 * x226 - x230 * x233 - x235 * x238;
-        let x241 = x239 * x240;
-        let x242 = 1.0
-            / (1.903 - x98 * x217 - x225 * x226 - x232 * x233 - x237 * x238
-                - x240 * x241);
-        let x243 = tau[1]
-            - (x100 * x103 + x99 * x105 - (-1.928 * x101 + -0.0302 * x102) - f_ext[1][4]
-                + (x2 * x206
-                    + (-0.1524 * (c_q2 * x208 + s_q2 * x209)
-                        + -6.377 * (c_q2 * x209 - s_q2 * x208)))) - x211 * x213;
-        let x244 = tau[2] - x206 - x211 * x214 - x220 * x243;
-        let x245 = tau[3] - x198 - x211 * x215 - x222 * x243 - x229 * x244;
-        let x246 = tau[4] - x192 - x211 * x216 - x224 * x243 - x231 * x244 - x236 * x245;
-        let x247 = x242
-            * (tau[5] - x183 - x211 * x217 - x226 * x243 - x233 * x244 - x238 * x245
-                - x241 * x246);
-        let x248 = x239 * x246 - x241 * x247;
-        let x249 = x234 * x245 - x236 * x248 - x238 * x247;
-        let x250 = x227 * x244 - x229 * x249 - x231 * x248 - x233 * x247;
-        let x251 = x218 * x243 - x220 * x250 - x222 * x249 - x224 * x248 - x226 * x247;
-        let x252 = x211 * x212 - x213 * x251 - x214 * x250 - x215 * x249 - x216 * x248
-            - x217 * x247;
-        [x252, x251, x250, x249, x248, x247]
+                                * (-8596.210051042
+                                    + (x70 + (c_q2 * x63 + s_q2 * x65 - x69))))));
+        let x178 = x73 * x177;
+        let x179 = x74 * x177;
+        let x180 = x75 * x177;
+        let x181 = x82 * x177;
+        let x182 = x85 * x177;
+        let x183 = 1.0
+            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x178);
+        let x184 = x58 + (x70 - x71) - x73 * x179;
+        let x185 = x183 * x184;
+        let x186 = x50
+            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36))
+            - x73 * x180;
+        let x187 = x183 * x186;
+        let x188 = x80
+            + (-0.1524 * (s_q2 * x77 - c_q2 * x76) + -6.377 * (s_q2 * x76 + c_q2 * x77))
+            - x73 * x181;
+        let x189 = x183 * x188;
+        let x190 = x23 - x73 * x182;
+        let x191 = x183 * x190;
+        let x192 = 1.0 / (x58 - x74 * x179 - x184 * x185);
+        let x193 = x50 - x74 * x180 - x184 * x187;
+        let x194 = x192 * x193;
+        let x195 = x80 - x74 * x181 - x184 * x189;
+        let x196 = x192 * x195;
+        let x197 = x23 - x74 * x182 - x184 * x191;
+        let x198 = x192 * x197;
+        let x199 = 1.0 / (x35 - x75 * x180 - x186 * x187 - x193 * x194);
+        let x200 = x25 - x75 * x181 - x186 * x189 - x193 * x196;
+        let x201 = x199 * x200;
+        let x202 = x23 - x75 * x182 - x186 * x191 - x193 * x198;
+        let x203 = x199 * x202;
+        let x204 = 1.0 / (x14 - x82 * x181 - x188 * x189 - x195 * x196 - x200 * x201);
+        let x205 = x9 - x82 * x182 - x188 * x191 - x195 * x198 - x200 * x203;
+        let x206 = x204 * x205;
+        let x207 = 1.0
+            / (1.903 - x85 * x182 - x190 * x191 - x197 * x198 - x202 * x203
+                - x205 * x206);
+        let x208 = tau[1]
+            - (x87 * x90 + x86 * x92 - (-1.928 * x88 + -0.0302 * x89) - f_ext[1][4]
+                + (x171
+                    + (-0.1524 * (c_q2 * x173 + s_q2 * x175)
+                        + -6.377 * (c_q2 * x175 - s_q2 * x173)))) - x176 * x178;
+        let x209 = tau[2] - x171 - x176 * x179 - x185 * x208;
+        let x210 = tau[3] - x163 - x176 * x180 - x187 * x208 - x194 * x209;
+        let x211 = tau[4] - x157 - x176 * x181 - x189 * x208 - x196 * x209 - x201 * x210;
+        let x212 = x207
+            * (tau[5] - x150 - x176 * x182 - x191 * x208 - x198 * x209 - x203 * x210
+                - x206 * x211);
+        let x213 = x204 * x211 - x206 * x212;
+        let x214 = x199 * x210 - x201 * x213 - x203 * x212;
+        let x215 = x192 * x209 - x194 * x214 - x196 * x213 - x198 * x212;
+        let x216 = x183 * x208 - x185 * x215 - x187 * x214 - x189 * x213 - x191 * x212;
+        let x217 = x176 * x177 - x178 * x216 - x179 * x215 - x180 * x214 - x181 * x213
+            - x182 * x212;
+        [x217, x216, x215, x214, x213, x212]
     }
 }

@@ -6,31 +6,32 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
+//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
 //! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 451 | 366 | 0 | 0 | 6 | 817 |
-//! | `mass_matrix` | `recurrent-r1` | — | 493 | 386 | 0 | 0 | 6 | 879 |
-//! | `mass_matrix` | `kane-direct` | — | 564 | 356 | 0 | 0 | 6 | 920 |
-//! | `mass_matrix` | `crba-base` | — | 436 | 314 | 0 | 0 | 6 | 750 |
-//! | `mass_matrix` * | `crba` | — | 161 | 115 | 0 | 0 | 5 | 276 |
-//! | `nonlinear_effects` | — | `recurrent` | 509 | 352 | 0 | 0 | 6 | 861 |
-//! | `nonlinear_effects` | — | `kane-direct` | 580 | 400 | 0 | 0 | 6 | 980 |
-//! | `nonlinear_effects` * | — | `rnea` | 317 | 211 | 0 | 0 | 5 | 528 |
-//! | `inverse_dynamics` | — | `recurrent` | 704 | 491 | 0 | 0 | 6 | 1195 |
-//! | `inverse_dynamics` | — | `kane-direct` | 775 | 539 | 0 | 0 | 6 | 1314 |
-//! | `inverse_dynamics` * | — | `rnea` | 334 | 229 | 0 | 0 | 5 | 563 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 756 | 527 | 6 | 0 | 6 | 1283 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 827 | 575 | 6 | 0 | 6 | 1402 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 564 | 388 | 6 | 0 | 5 | 952 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 670 | 457 | 0 | 0 | 6 | 1127 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 741 | 505 | 0 | 0 | 6 | 1246 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 478 | 318 | 0 | 0 | 5 | 796 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 839 | 610 | 6 | 0 | 6 | 1449 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 910 | 658 | 6 | 0 | 6 | 1568 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 418 | 6 | 0 | 5 | 982 |
+//! | `mass_matrix` | `recurrent` | — | 429 | 352 | 0 | 0 | 6 | 781 |
+//! | `mass_matrix` | `recurrent-r1` | — | 469 | 372 | 0 | 0 | 6 | 841 |
+//! | `mass_matrix` | `kane-direct` | — | 442 | 295 | 0 | 0 | 6 | 737 |
+//! | `mass_matrix` | `crba-base` | — | 412 | 299 | 0 | 0 | 6 | 711 |
+//! | `mass_matrix` * | `crba` | — | 102 | 71 | 0 | 0 | 4 | 173 |
+//! | `nonlinear_effects` | — | `recurrent` | 493 | 340 | 0 | 0 | 6 | 833 |
+//! | `nonlinear_effects` | — | `kane-direct` | 534 | 376 | 0 | 0 | 6 | 910 |
+//! | `nonlinear_effects` * | — | `rnea` | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `inverse_dynamics` | — | `recurrent` | 621 | 439 | 0 | 0 | 6 | 1060 |
+//! | `inverse_dynamics` | — | `kane-direct` | 662 | 475 | 0 | 0 | 6 | 1137 |
+//! | `inverse_dynamics` * | — | `rnea` | 208 | 146 | 0 | 0 | 5 | 354 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 681 | 478 | 6 | 0 | 6 | 1159 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 722 | 514 | 6 | 0 | 6 | 1236 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 377 | 262 | 6 | 0 | 5 | 639 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 595 | 411 | 0 | 0 | 6 | 1006 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 636 | 447 | 0 | 0 | 6 | 1083 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 291 | 195 | 0 | 0 | 5 | 486 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 763 | 561 | 6 | 0 | 6 | 1324 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 804 | 597 | 6 | 0 | 6 | 1401 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 389 | 300 | 6 | 0 | 5 | 689 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
@@ -87,19 +88,19 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 161u64,
-            add: 115u64,
+            mul: 102u64,
+            add: 71u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 5u64,
+            sincos: 4u64,
             fma: 0u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 317u64,
-            add: 211u64,
+            mul: 189u64,
+            add: 124u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -109,8 +110,8 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 334u64,
-            add: 229u64,
+            mul: 208u64,
+            add: 146u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -120,8 +121,8 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 564u64,
-            add: 388u64,
+            mul: 377u64,
+            add: 262u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -131,8 +132,8 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 478u64,
-            add: 318u64,
+            mul: 291u64,
+            add: 195u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -142,8 +143,8 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 564u64,
-            add: 418u64,
+            mul: 389u64,
+            add: 300u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -156,8 +157,8 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
-            mul: 451u64,
-            add: 366u64,
+            mul: 429u64,
+            add: 352u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -167,8 +168,8 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
-            mul: 493u64,
-            add: 386u64,
+            mul: 469u64,
+            add: 372u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -178,8 +179,8 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
-            mul: 564u64,
-            add: 356u64,
+            mul: 442u64,
+            add: 295u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -189,8 +190,8 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
-            mul: 436u64,
-            add: 314u64,
+            mul: 412u64,
+            add: 299u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -200,19 +201,19 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 161u64,
-            add: 115u64,
+            mul: 102u64,
+            add: 71u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 5u64,
+            sincos: 4u64,
             fma: 0u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 509u64,
-            add: 352u64,
+            mul: 493u64,
+            add: 340u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -222,8 +223,8 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 580u64,
-            add: 400u64,
+            mul: 534u64,
+            add: 376u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -233,8 +234,8 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 317u64,
-            add: 211u64,
+            mul: 189u64,
+            add: 124u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -244,8 +245,8 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 704u64,
-            add: 491u64,
+            mul: 621u64,
+            add: 439u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -255,8 +256,8 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 775u64,
-            add: 539u64,
+            mul: 662u64,
+            add: 475u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -266,8 +267,8 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 334u64,
-            add: 229u64,
+            mul: 208u64,
+            add: 146u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -277,8 +278,8 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 756u64,
-            add: 527u64,
+            mul: 681u64,
+            add: 478u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -288,8 +289,8 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 827u64,
-            add: 575u64,
+            mul: 722u64,
+            add: 514u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -299,8 +300,8 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 564u64,
-            add: 388u64,
+            mul: 377u64,
+            add: 262u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -310,8 +311,8 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 670u64,
-            add: 457u64,
+            mul: 595u64,
+            add: 411u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -321,8 +322,8 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 741u64,
-            add: 505u64,
+            mul: 636u64,
+            add: 447u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -332,8 +333,8 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 478u64,
-            add: 318u64,
+            mul: 291u64,
+            add: 195u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -343,8 +344,8 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 839u64,
-            add: 610u64,
+            mul: 763u64,
+            add: 561u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -354,8 +355,8 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 910u64,
-            add: 658u64,
+            mul: 804u64,
+            add: 597u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -365,8 +366,8 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 564u64,
-            add: 418u64,
+            mul: 389u64,
+            add: 300u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -375,130 +376,86 @@ impl Ssrms6 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 161 mul, 115 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`: 102 mul, 71 add, 0 div, 0 sqrt, 4 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 9.336 * x8;
-        let x10 = 44.41 * c_q5;
-        let x11 = 44.41 * s_q5;
-        let x12 = c_q5 * x10 + s_q5 * x11;
-        let x13 = s_q5 * x10;
-        let x14 = c_q5 * x11;
-        let x15 = x13 - x14;
-        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
-        let x17 = 12.13 + (x12 + 120.2819695416);
-        let x18 = 3.061 + x12;
-        let x19 = x6 * -171.195516;
-        let x20 = c_q4 * x16;
-        let x21 = s_q4 * x17;
-        let x22 = s_q4 * x15;
-        let x23 = c_q4 * x15;
-        let x24 = x6 * (x14 - x13);
-        let x25 = x6 * x18;
-        let x26 = s_q4 * x20 - c_q4 * x21;
-        let x27 = x6 * x22;
-        let x28 = s_q4 * x24;
-        let x29 = c_q4 * x24 + x19 * 0.5692;
-        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
-        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
-        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
-        let x33 = s_q3 * x19;
-        let x34 = x4 * -199.01508800000002;
-        let x35 = c_q3 * x19;
-        let x36 = x33 + 3239.4582;
-        let x37 = c_q3 * x30 - s_q3 * x28;
-        let x38 = c_q3 * x26 + s_q3 * x29;
-        let x39 = s_q3 * x32 - c_q3 * x27;
-        let x40 = x4 * x31;
-        let x41 = s_q3 * x30 + c_q3 * x28;
-        let x42 = c_q3 * x29 - s_q3 * x26;
-        let x43 = s_q3 * x27 + c_q3 * x32;
-        let x44 = x4 * x42;
-        let x45 = x33 * -7.11;
-        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
-        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
-        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
-        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
-        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
-        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
-        let x52 = s_q2 * x35;
-        let x53 = c_q2 * x36 + x52;
-        let x54 = x2 * x34;
-        let x55 = c_q2 * x35;
-        let x56 = x55 - s_q2 * x36;
-        let x57 = x53 + 5224.5702;
-        let x58 = x54 + -349.0395;
-        let x59 = c_q2 * x48 + s_q2 * x46;
-        let x60 = c_q2 * x49 + s_q2 * x44;
-        let x61 = c_q2 * x47 + s_q2 * x51;
-        let x62 = x2 * x50;
-        let x63 = c_q2 * x46 - s_q2 * x48;
-        let x64 = c_q2 * x44 - s_q2 * x49;
-        let x65 = c_q2 * x51 - s_q2 * x47;
-        let x66 = -0.475 * x53;
-        let x67 = -7.11 * x53;
-        let x68 = x56 * 0.475;
-        let x69 = 2094.71 + (x2 * x62 - x67 + 7.11 * x57);
-        let x70 = (c_q1 + (1.0 - c_q1)) * x58;
-        let x71 = c_q1 * x56;
-        let x72 = 8.446
+        let x4 = 9.336 * c_q4;
+        let x5 = 44.41 * s_q4;
+        let x6 = 9.336 * s_q4;
+        let x7 = s_q4 * x4 - c_q4 * x5;
+        let x8 = 132.6783695416 + (c_q4 * x4 + s_q4 * x5);
+        let x9 = 135.4729695416 + (s_q4 * x6 + c_q4 * (44.41 * c_q4));
+        let x10 = -171.195516 * s_q3;
+        let x11 = -171.195516 * c_q3;
+        let x12 = c_q3 * x8;
+        let x13 = c_q3 * x7 + -97.44448770720001 * s_q3;
+        let x14 = 47.471 * s_q3;
+        let x15 = s_q3 * x8;
+        let x16 = -97.44448770720001 * c_q3 - s_q3 * x7;
+        let x17 = 47.471 * c_q3;
+        let x18 = x10 * -7.11;
+        let x19 = 7.11 * x10;
+        let x20 = x9 - x18;
+        let x21 = s_q3 * x17 - c_q3 * x15 - 7.11 * x11;
+        let x22 = c_q3 * x14 - s_q3 * x12 + x11 * -7.11;
+        let x23 = s_q3 * x15 + c_q3 * x17 + x19 - x18;
+        let x24 = 3239.4582 + x10;
+        let x25 = -24989.305802 + (c_q3 * x12 + s_q3 * x14);
+        let x26 = 1375.0472756800002 + x13;
+        let x27 = 24998.827802 + (x19 + x20);
+        let x28 = s_q2 * x11;
+        let x29 = c_q2 * x24 + x28;
+        let x30 = c_q2 * x11;
+        let x31 = x30 - s_q2 * x24;
+        let x32 = c_q2 * x25 + s_q2 * x21;
+        let x33 = s_q2 * x16;
+        let x34 = c_q2 * x22 + s_q2 * x23;
+        let x35 = c_q2 * x21 - s_q2 * x25;
+        let x36 = c_q2 * x16;
+        let x37 = c_q2 * x23 - s_q2 * x22;
+        let x38 = -7.11 * x29;
+        let x39 = 7.11 * x29;
+        let x40 = c_q2 * x26 + x33 - -0.475 * x29;
+        let x41 = x27 - x38;
+        let x42 = 39241.404122 + (x39 + x41);
+        let x43 = c_q1 * x31;
+        let x44 = c_q1 * (x36 - s_q2 * x26 + x31 * 0.475);
+        let x45 = x44 - s_q1 * (3946.18812068 + x40)
+            + 0.5692 * (x43 - s_q1 * (5224.5702 + x29));
+        let x46 = 65697.3302265768
             + (c_q1
-                * (c_q1
-                    * (2103.19
-                        + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
-                            - (-7.11 * x57 - -0.475 * x58)))
-                    - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
+                * (c_q1 * (c_q2 * x37 - s_q2 * x35 + x39 - x38)
+                    - s_q1 * (c_q2 * x34 - s_q2 * x32 + -7.11 * x31))
                 - s_q1
-                    * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
-                        - s_q1
-                            * (15.41
-                                + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
-                - 0.5692 * x70 + -0.5692 * (x70 + -597.4892399999999));
-        let x73 = c_q1 * (x2 * x64 + x68)
-            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
-            + 0.5692 * (x71 - s_q1 * x57);
-        let x74 = x62 - x67;
-        let x75 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x71 - s_q1 * x53);
-        let x76 = x40 - x45;
-        let x77 = x55 - s_q2 * x33;
-        let x78 = x52 + c_q2 * x33;
-        let x79 = x2 * x76 - -7.11 * x78;
-        let x80 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x77)
-            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x78)
-            + 0.5692 * (c_q1 * x77 - s_q1 * x78);
-        let x81 = s_q3 * x25 - c_q3 * x22;
-        let x82 = x4 * x23;
-        let x83 = s_q3 * x22 + c_q3 * x25;
-        let x84 = x2 * x82;
-        let x85 = c_q1 * (c_q2 * x83 - s_q2 * x81) - s_q1 * (c_q2 * x81 + s_q2 * x83);
-        let x86 = c_q4 * x9;
-        let x87 = s_q4 * x9;
-        let x88 = c_q3 * x86;
-        let x89 = x4 * x87;
-        let x90 = s_q3 * x86;
-        let x91 = x2 * x89;
-        let x92 = -(s_q1 * (c_q2 * x88 - s_q2 * x90) + c_q1 * (s_q2 * x88 + c_q2 * x90));
+                    * (c_q1 * (c_q2 * x35 + s_q2 * x37 - 7.11 * x31)
+                        - s_q1 * (-39234.47412200001 + (c_q2 * x32 + s_q2 * x34))));
+        let x47 = x44 - s_q1 * x40 + 0.5692 * (x43 - s_q1 * x29);
+        let x48 = x30 - s_q2 * x10;
+        let x49 = x28 + c_q2 * x10;
+        let x50 = x20 - -7.11 * x49;
+        let x51 = c_q1 * (x36 - s_q2 * x13 + 0.475 * x48)
+            - s_q1 * (x33 + c_q2 * x13 - -0.475 * x49)
+            + 0.5692 * (c_q1 * x48 - s_q1 * x49);
+        let x52 = c_q1 * (c_q2 * x17 - s_q2 * x14) - s_q1 * (c_q2 * x14 + s_q2 * x17);
+        let x53 = c_q3 * x4;
+        let x54 = s_q3 * x4;
+        let x55 = -(s_q1 * (c_q2 * x53 - s_q2 * x54) + c_q1 * (s_q2 * x53 + c_q2 * x54));
         [
-            [x72, x73, x75, x80, x85, x92],
-            [x73, x69, x74, x79, x84, x91],
-            [x75, x74, x50, x76, x82, x89],
-            [x80, x79, x76, x31, x23, x87],
-            [x85, x84, x82, x23, x18, 0.0],
-            [x92, x91, x89, x87, 0.0, 9.336],
+            [x46, x45, x47, x51, x52, x55],
+            [x45, x42, x41, x50, 0.0, x6],
+            [x47, x41, x27, x20, 0.0, x6],
+            [x51, x50, x20, x9, 0.0, x6],
+            [x52, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x55, x6, x6, x6, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 317 mul, 211 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 189 mul, 124 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -509,157 +466,98 @@ impl Ssrms6 {
         let x5 = s_q1 * x3;
         let x6 = qd[1] * x2;
         let x7 = qd[1] * x1;
-        let x8 = qd[1] * x5;
-        let x9 = qd[1] * x4;
-        let x10 = 49.52 * qd[1] - 15.41 * x1;
-        let x11 = 2094.71 * qd[1] - 49.52 * x1;
-        let x12 = 2103.19 * x2;
-        let x13 = 314.88 * x4;
-        let x14 = 314.88 * x5;
+        let x8 = qd[1] * x4;
+        let x9 = 3946.18812068 * qd[1] - -39234.47412200001 * x1;
+        let x10 = 39241.404122 * qd[1] - 3946.1881206800003 * x1 - x5 * -5224.5702;
+        let x11 = x2 * -5224.5702;
+        let x12 = 5224.5702 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = c_q2 + (1.0 - c_q2);
-        let x17 = x1 * c_q2 + x2 * s_q2;
-        let x18 = x2 * c_q2 - x1 * s_q2;
-        let x19 = x4 + -0.475 * x2;
-        let x20 = x5 + (7.11 * qd[1] - x1 * 0.475);
-        let x21 = s_q2 * x20 - c_q2 * x19;
-        let x22 = x16 * (x2 * -7.11);
-        let x23 = s_q2 * x19 + c_q2 * x20;
-        let x24 = qd[2] + qd[1] * x16;
-        let x25 = x8 + -0.475 * x7;
-        let x26 = x6 * 0.475 - x9;
-        let x27 = x16 * (x7 * -7.11);
-        let x28 = x7 * s_q2 - x6 * c_q2 - qd[2] * x18;
-        let x29 = x6 * s_q2 + x7 * c_q2 + qd[2] * x17;
-        let x30 = c_q2 * x25 - s_q2 * x26 + qd[2] * x23;
-        let x31 = s_q2 * x25 + c_q2 * x26 + qd[2] * x21;
-        let x32 = -39.95 * x24 - 9.522 * x17;
-        let x33 = 1966.28 * x24 - -39.95 * x17;
-        let x34 = 1966.28 * x18;
-        let x35 = 279.2 * x21;
-        let x36 = 279.2 * x22;
-        let x37 = 279.2 * x23;
+        let x14 = x1 * c_q2 + x2 * s_q2;
+        let x15 = x2 * c_q2 - x1 * s_q2;
+        let x16 = x2 * -7.11;
+        let x17 = x4 + -0.475 * x2;
+        let x18 = x5 + (7.11 * qd[1] - x1 * 0.475);
+        let x19 = s_q2 * x18 - c_q2 * x17;
+        let x20 = s_q2 * x17 + c_q2 * x18;
+        let x21 = qd[1] + qd[2];
+        let x22 = x7 * -7.11;
+        let x23 = qd[1] * x5 + -0.475 * x7;
+        let x24 = x6 * 0.475 - x8;
+        let x25 = x7 * s_q2 - x6 * c_q2 - qd[2] * x15;
+        let x26 = x6 * s_q2 + x7 * c_q2 + qd[2] * x14;
+        let x27 = s_q2 * x23 + c_q2 * x24 + qd[2] * x19;
+        let x28 = 1375.0472756800002 * x21 - -24989.305802 * x14;
+        let x29 = 3239.4582 * x16;
+        let x30 = 24998.827802 * x21 - 1375.0472756800002 * x14 - x20 * -3239.4582;
+        let x31 = x15 * -3239.4582;
+        let x32 = 3239.4582 * x21;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x39 = c_q3 + (1.0 - c_q3);
-        let x40 = x17 * c_q3 + x18 * s_q3;
-        let x41 = x18 * c_q3 - x17 * s_q3;
-        let x42 = x23 + 7.11 * x24;
-        let x43 = x21 * c_q3 + s_q3 * x42;
-        let x44 = x39 * (x22 + x18 * -7.11);
-        let x45 = x21 * s_q3 - c_q3 * x42;
-        let x46 = qd[3] + x24 * x39;
-        let x47 = x39 * (x27 + -7.11 * x29);
-        let x48 = x28 * c_q3 + x29 * s_q3 - qd[3] * x41;
-        let x49 = x28 * s_q3 - x29 * c_q3 - qd[3] * x40;
-        let x50 = x30 * c_q3 - x31 * s_q3 - qd[3] * x45;
-        let x51 = x30 * s_q3 + x31 * c_q3 + qd[3] * x43;
-        let x52 = 8.305 * x40;
-        let x53 = 3.061 * x46;
-        let x54 = 8.0386 * x41;
-        let x55 = 105.98 * x43;
-        let x56 = 105.98 * x44;
-        let x57 = 105.98 * x45;
+        let x34 = x14 * c_q3 + x15 * s_q3;
+        let x35 = x15 * c_q3 - x14 * s_q3;
+        let x36 = x16 + x15 * -7.11;
+        let x37 = x20 + 7.11 * x21;
+        let x38 = x19 * c_q3 + s_q3 * x37;
+        let x39 = x19 * s_q3 - c_q3 * x37;
+        let x40 = qd[3] + x21;
+        let x41 = x25 * c_q3 + x26 * s_q3 - qd[3] * x35;
+        let x42 = x25 * s_q3 - x26 * c_q3 - qd[3] * x34;
+        let x43 = -97.44448770720001 * x40;
+        let x44 = 132.6783695416 * x34 + x36 * 171.195516;
+        let x45 = 135.4729695416 * x40 + -97.44448770720001 * x35 + -171.195516 * x38;
+        let x46 = x40 * 171.195516;
+        let x47 = -171.195516 * x34;
+        let x48 = x35 * x47;
+        let x49 = x40 * x46 - x34 * x47;
+        let x50 = -171.195516 * x41 + x35 * x46;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x59 = c_q4 + (1.0 - c_q4);
-        let x60 = x46 * s_q4 - x40 * c_q4;
-        let x61 = x40 * s_q4 + x46 * c_q4;
-        let x62 = x43 - -0.5692 * x41;
-        let x63 = c_q4 * x62 - x44 * s_q4;
-        let x64 = s_q4 * x62 + x44 * c_q4;
-        let x65 = x59 * (x45 + 0.5692 * x40);
-        let x66 = qd[4] + x41 * x59;
-        let x67 = x49 * x59;
-        let x68 = x50 - -0.5692 * x49;
-        let x69 = x59 * (x51 - 0.5692 * x48);
-        let x70 = x48 * c_q4 + qd[4] * x61;
-        let x71 = x48 * s_q4 + qd[4] * x60;
-        let x72 = c_q4 * x68 + x47 * s_q4 - qd[4] * x64;
-        let x73 = x47 * c_q4 - s_q4 * x68 - qd[4] * x63;
-        let x74 = 12.13 * x60;
-        let x75 = 12.13 * x61;
-        let x76 = 3.061 * x66;
-        let x77 = 105.98 * x63;
-        let x78 = 105.98 * x64;
-        let x79 = 105.98 * x65;
+        let x52 = x40 * s_q4 - x34 * c_q4;
+        let x53 = x34 * s_q4 + x40 * c_q4;
+        let x54 = qd[4] + x35;
+        let x55 = 44.41 * x53;
+        let x56 = 47.471 * x54;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x81 = c_q5 + (1.0 - c_q5);
-        let x82 = x61 * c_q5 + x66 * s_q5;
-        let x83 = x66 * c_q5 - x61 * s_q5;
-        let x84 = x64 + -0.7026 * x60;
-        let x85 = x81 * (x63 - 0.7026 * x61);
-        let x86 = x65 * s_q5 - c_q5 * x84;
-        let x87 = s_q5 * x84 + x65 * c_q5;
-        let x88 = qd[5] + x60 * x81;
-        let x89 = x73 - -0.7026 * x70;
-        let x90 = 9.336 * x88;
-        let x91 = 44.41 * x82;
-        let x92 = 44.41 * x83;
-        let x93 = 243.66 * x85;
-        let x94 = 243.66 * x86;
-        let x95 = 243.66 * x87;
-        let x96 = 9.336 * (x70 * x81)
-            + (x82 * x92 - x83 * x91 + (x86 * x95 - x87 * x94));
-        let x97 = 44.41 * (x67 * s_q5 - x71 * c_q5 + qd[5] * x83)
-            + (x83 * x90 - x88 * x92 + (x87 * x93 - x85 * x95));
-        let x98 = 44.41 * (x71 * s_q5 + x67 * c_q5 - qd[5] * x82)
-            + (x88 * x91 - x82 * x90 + (x85 * x94 - x86 * x93));
-        let x99 = 243.66 * (c_q5 * x89 + x69 * s_q5 + qd[5] * x87)
-            + (x83 * x93 - x88 * x95);
-        let x100 = 243.66 * (x69 * c_q5 - s_q5 * x89 - qd[5] * x86)
-            + (x88 * x94 - x82 * x93);
-        let x101 = x81
-            * (243.66 * (x81 * (x72 + 0.7026 * x71)) + (x82 * x95 - x83 * x94));
-        let x102 = c_q5 * x99 - s_q5 * x100;
-        let x103 = 12.13 * x70 + (x61 * x76 - x66 * x75 + (x65 * x78 - x64 * x79))
-            + (x81 * x96 + 0.7026 * x102);
-        let x104 = x66 * x74 - x60 * x76 + (x65 * x77 - x63 * x79) - 12.13 * x71
-            + (c_q5 * x97 - s_q5 * x98 + -0.7026 * x101);
-        let x105 = 3.061 * x67 + (x60 * x75 - x61 * x74 + (x64 * x77 - x63 * x78))
-            + (s_q5 * x97 + c_q5 * x98);
-        let x106 = 105.98 * x72 + (x66 * x78 + x61 * x79) + x101;
-        let x107 = 105.98 * x73 + (x66 * x77 - x60 * x79) + x102;
-        let x108 = c_q4 * x106 - s_q4 * x107;
-        let x109 = x59
-            * (105.98 * x69 - (x61 * x77 + x60 * x78) + (s_q5 * x99 + c_q5 * x100));
-        let x110 = 8.305 * x48 + (x46 * x54 - x41 * x53 + (x45 * x56 - x44 * x57))
-            + (c_q4 * x103 - s_q4 * x104 + -0.5692 * x109);
-        let x111 = x40 * x54 - x41 * x52 + (x45 * x55 - x43 * x57)
-            + (s_q4 * x103 + c_q4 * x104);
-        let x112 = 8.0386 * x49 + (x46 * x52 - x40 * x53 + (x44 * x55 - x43 * x56))
-            + (x59 * x105 + 0.5692 * x108);
-        let x113 = 105.98 * x50 + (x41 * x56 + x46 * x57) + x108;
-        let x114 = 105.98 * x51 + (x40 * x56 - x46 * x55) + x109;
-        let x115 = x39
-            * (105.98 * x47 + (x41 * x55 + x40 * x57) + (s_q4 * x106 + c_q4 * x107));
-        let x116 = c_q3 * x114 - s_q3 * x113;
-        let x117 = 9.522 * x28 + (x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36))
-            + (c_q3 * x110 + s_q3 * x112);
-        let x118 = -39.95 * x28 + (x18 * x32 + x17 * x34 + (x21 * x37 - x23 * x35))
-            + (x39 * x111 + -7.11 * x116);
-        let x119 = x22 * x35 - x21 * x36 - (x24 * x32 + x17 * x33) - 1966.28 * x29
-            + (c_q3 * x112 - s_q3 * x110 + 7.11 * x115);
-        let x120 = 279.2 * x30 + (x18 * x36 - x24 * x37) + (c_q3 * x113 + s_q3 * x114);
-        let x121 = 279.2 * x31 + (x17 * x36 - x24 * x35) + x116;
-        let x122 = c_q2 * x120 + s_q2 * x121;
-        let x123 = c_q2 * x121 - s_q2 * x120;
-        let x124 = x2 * x10 + x1 * x12 + (x5 * x13 - x4 * x14) - 49.52 * x6
-            + (x16 * x118 + -7.11 * x123);
-        let x125 = c_q1
-            * (c_q2 * x119 - s_q2 * x117
-                + (0.475 * x122
-                    + 7.11 * (x16 * (279.2 * x27 + (x18 * x35 - x17 * x37) + x115)))
-                - (2103.19 * x7 + (qd[1] * x10 + x1 * x11)))
+        let x58 = 9.336 * (x41 * c_q4 + qd[4] * x53);
+        let x59 = 9.336 * (qd[5] + x52);
+        let x60 = (x54 * c_q5 - x53 * s_q5) * x59;
+        let x61 = (x53 * c_q5 + x54 * s_q5) * x59;
+        let x62 = x53 * x56 - x54 * x55 + x58;
+        let x63 = c_q5 * x60 + s_q5 * x61
+            - (44.41 * (x41 * s_q4 + qd[4] * x52) + x52 * x56);
+        let x64 = 47.471 * x42 + x52 * x55 + (s_q5 * x60 - c_q5 * x61);
+        let x65 = 132.6783695416 * x41 + (x22 + -7.11 * x26) * 171.195516
+            + (x40 * x43 - x35 * x45 - x39 * x47) + (c_q4 * x62 - s_q4 * x63);
+        let x66 = -97.44448770720001 * x42
+            + -171.195516
+                * ((c_q2 * x23 - s_q2 * x24 + qd[2] * x20) * c_q3 - x27 * s_q3
+                    - qd[3] * x39) + (x34 * x43 - x35 * x44 - x39 * x46)
+            + (s_q4 * x62 + c_q4 * x63);
+        let x67 = x40 * x44 - x34 * x45 + (x38 * x47 - x36 * x46) + x64;
+        let x68 = s_q3 * x48 + c_q3 * x49;
+        let x69 = -24989.305802 * x25 + (x16 * x32 - x20 * x31 - (x15 * x30 + x21 * x29))
+            + (c_q3 * x65 + s_q3 * x67);
+        let x70 = 1375.0472756800002 * x25 + x27 * -3239.4582
+            + (x15 * x28 - x14 * x29 + x19 * x32) + (x66 + -7.11 * x68);
+        let x71 = 3239.4582 * x22 - (x21 * x28 + x14 * x30 + x19 * x31)
+            + (c_q3 * x67 - s_q3 * x65 - 7.11 * x50);
+        let x72 = x15 * x31 - x21 * x32 + (s_q3 * x49 - c_q3 * x48);
+        let x73 = x14 * x31 + x68;
+        let x74 = c_q2 * x72 + s_q2 * x73;
+        let x75 = c_q2 * x73 - s_q2 * x72;
+        let x76 = x2 * x9 - x4 * x12 - (3946.1881206800003 * x6 + x8 * -5224.5702)
+            + (x70 + -7.11 * x75);
+        let x77 = c_q1
+            * (x4 * x11 - (qd[1] * x9 + x1 * x10)
+                + (c_q2 * x71 - s_q2 * x69
+                    + (0.475 * x74 + 7.11 * (x26 * -3239.4582 - x14 * x32 - x50))))
             - s_q1
-                * (qd[1] * x12 - x2 * x11 - 15.41 * x6
-                    + (c_q2 * x117 + s_q2 * x119 + -0.475 * x123))
-            + 0.5692
-                * (c_q1 * (314.88 * x8 - qd[1] * x14 + x122)
-                    + s_q1 * (qd[1] * x13 - 314.88 * x9 + x123));
-        [x125, x124, x118, x111, x105, x96]
+                * (c_q2 * x69 + s_q2 * x71 + -0.475 * x75
+                    - (-39234.47412200001 * x6 + (x2 * x10 + x5 * x11)))
+            + 0.5692 * (c_q1 * (x2 * x11 - qd[1] * x12 + x74) + s_q1 * (x1 * x11 + x75));
+        [x77, x76, x70, x66, x64, x58]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 334 mul, 229 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `rnea`: 208 mul, 146 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -671,478 +569,318 @@ impl Ssrms6 {
         let x6 = -0.5692 * qdd[0];
         let x7 = qdd[0] * s_q1 + qd[1] * x2;
         let x8 = qdd[0] * c_q1 - qd[1] * x1;
-        let x9 = qd[1] * x5 - c_q1 * x6;
-        let x10 = s_q1 * x6 + qd[1] * x4;
-        let x11 = 49.52 * qd[1] - 15.41 * x1;
-        let x12 = 2094.71 * qd[1] - 49.52 * x1;
-        let x13 = 2103.19 * x2;
-        let x14 = 314.88 * x4;
-        let x15 = 314.88 * x5;
+        let x9 = s_q1 * x6 + qd[1] * x4;
+        let x10 = 3946.18812068 * qd[1] - -39234.47412200001 * x1;
+        let x11 = 39241.404122 * qd[1] - 3946.1881206800003 * x1 - x5 * -5224.5702;
+        let x12 = x2 * -5224.5702;
+        let x13 = 5224.5702 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x17 = c_q2 + (1.0 - c_q2);
-        let x18 = x1 * c_q2 + x2 * s_q2;
-        let x19 = x2 * c_q2 - x1 * s_q2;
-        let x20 = x4 + -0.475 * x2;
-        let x21 = x5 + (7.11 * qd[1] - x1 * 0.475);
-        let x22 = s_q2 * x21 - c_q2 * x20;
-        let x23 = x17 * (x2 * -7.11);
-        let x24 = s_q2 * x20 + c_q2 * x21;
-        let x25 = qd[2] + qd[1] * x17;
-        let x26 = x9 - -0.475 * x8;
-        let x27 = x10 + (7.11 * qdd[1] - x7 * 0.475);
-        let x28 = x17 * (x8 * -7.11);
-        let x29 = qdd[2] + qdd[1] * x17;
-        let x30 = x7 * c_q2 + x8 * s_q2 + qd[2] * x19;
-        let x31 = x8 * c_q2 - x7 * s_q2 - qd[2] * x18;
-        let x32 = c_q2 * x26 + s_q2 * x27 + qd[2] * x24;
-        let x33 = s_q2 * x26 - c_q2 * x27 + qd[2] * x22;
-        let x34 = -39.95 * x25 - 9.522 * x18;
-        let x35 = 1966.28 * x25 - -39.95 * x18;
-        let x36 = 1966.28 * x19;
-        let x37 = 279.2 * x22;
-        let x38 = 279.2 * x23;
-        let x39 = 279.2 * x24;
+        let x15 = x1 * c_q2 + x2 * s_q2;
+        let x16 = x2 * c_q2 - x1 * s_q2;
+        let x17 = x2 * -7.11;
+        let x18 = x4 + -0.475 * x2;
+        let x19 = x5 + (7.11 * qd[1] - x1 * 0.475);
+        let x20 = s_q2 * x19 - c_q2 * x18;
+        let x21 = s_q2 * x18 + c_q2 * x19;
+        let x22 = qd[1] + qd[2];
+        let x23 = x8 * -7.11;
+        let x24 = qd[1] * x5 - c_q1 * x6 - -0.475 * x8;
+        let x25 = x9 + (7.11 * qdd[1] - x7 * 0.475);
+        let x26 = qdd[1] + qdd[2];
+        let x27 = x7 * c_q2 + x8 * s_q2 + qd[2] * x16;
+        let x28 = x8 * c_q2 - x7 * s_q2 - qd[2] * x15;
+        let x29 = s_q2 * x24 - c_q2 * x25 + qd[2] * x20;
+        let x30 = 1375.0472756800002 * x22 - -24989.305802 * x15;
+        let x31 = 3239.4582 * x17;
+        let x32 = 24998.827802 * x22 - 1375.0472756800002 * x15 - x21 * -3239.4582;
+        let x33 = x16 * -3239.4582;
+        let x34 = 3239.4582 * x22;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x41 = c_q3 + (1.0 - c_q3);
-        let x42 = x18 * c_q3 + x19 * s_q3;
-        let x43 = x19 * c_q3 - x18 * s_q3;
-        let x44 = x24 + 7.11 * x25;
-        let x45 = x22 * c_q3 + s_q3 * x44;
-        let x46 = x41 * (x23 + x19 * -7.11);
-        let x47 = x22 * s_q3 - c_q3 * x44;
-        let x48 = qd[3] + x25 * x41;
-        let x49 = x33 - 7.11 * x29;
-        let x50 = x41 * (x28 + -7.11 * x31);
-        let x51 = qdd[3] + x29 * x41;
-        let x52 = x30 * c_q3 + x31 * s_q3 + qd[3] * x43;
-        let x53 = x31 * c_q3 - x30 * s_q3 - qd[3] * x42;
-        let x54 = x32 * c_q3 - s_q3 * x49 - qd[3] * x47;
-        let x55 = x32 * s_q3 + c_q3 * x49 + qd[3] * x45;
-        let x56 = 8.305 * x42;
-        let x57 = 3.061 * x48;
-        let x58 = 8.0386 * x43;
-        let x59 = 105.98 * x45;
-        let x60 = 105.98 * x46;
-        let x61 = 105.98 * x47;
+        let x36 = x15 * c_q3 + x16 * s_q3;
+        let x37 = x16 * c_q3 - x15 * s_q3;
+        let x38 = x17 + x16 * -7.11;
+        let x39 = x21 + 7.11 * x22;
+        let x40 = x20 * c_q3 + s_q3 * x39;
+        let x41 = x20 * s_q3 - c_q3 * x39;
+        let x42 = qd[3] + x22;
+        let x43 = qdd[3] + x26;
+        let x44 = x27 * c_q3 + x28 * s_q3 + qd[3] * x37;
+        let x45 = x28 * c_q3 - x27 * s_q3 - qd[3] * x36;
+        let x46 = -97.44448770720001 * x42;
+        let x47 = 132.6783695416 * x36 + x38 * 171.195516;
+        let x48 = 135.4729695416 * x42 + -97.44448770720001 * x37 + -171.195516 * x40;
+        let x49 = x42 * 171.195516;
+        let x50 = -171.195516 * x36;
+        let x51 = x42 * x49 - x36 * x50;
+        let x52 = x43 * 171.195516 + x37 * x50;
+        let x53 = -171.195516 * x44 - x37 * x49;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x63 = c_q4 + (1.0 - c_q4);
-        let x64 = x48 * s_q4 - x42 * c_q4;
-        let x65 = x42 * s_q4 + x48 * c_q4;
-        let x66 = x45 - -0.5692 * x43;
-        let x67 = c_q4 * x66 - x46 * s_q4;
-        let x68 = s_q4 * x66 + x46 * c_q4;
-        let x69 = x63 * (x47 + 0.5692 * x42);
-        let x70 = qd[4] + x43 * x63;
-        let x71 = x54 - -0.5692 * x53;
-        let x72 = x63 * (x55 + 0.5692 * x52);
-        let x73 = qdd[4] + x53 * x63;
-        let x74 = x51 * s_q4 - x52 * c_q4 + qd[4] * x65;
-        let x75 = x52 * s_q4 + x51 * c_q4 - qd[4] * x64;
-        let x76 = c_q4 * x71 - x50 * s_q4 - qd[4] * x68;
-        let x77 = s_q4 * x71 + x50 * c_q4 + qd[4] * x67;
-        let x78 = 12.13 * x64;
-        let x79 = 12.13 * x65;
-        let x80 = 3.061 * x70;
-        let x81 = 105.98 * x67;
-        let x82 = 105.98 * x68;
-        let x83 = 105.98 * x69;
+        let x55 = x42 * s_q4 - x36 * c_q4;
+        let x56 = x36 * s_q4 + x42 * c_q4;
+        let x57 = qd[4] + x37;
+        let x58 = 44.41 * x56;
+        let x59 = 47.471 * x57;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x85 = c_q5 + (1.0 - c_q5);
-        let x86 = x65 * c_q5 + x70 * s_q5;
-        let x87 = x70 * c_q5 - x65 * s_q5;
-        let x88 = x68 + -0.7026 * x64;
-        let x89 = x85 * (x67 - 0.7026 * x65);
-        let x90 = x69 * s_q5 - c_q5 * x88;
-        let x91 = s_q5 * x88 + x69 * c_q5;
-        let x92 = qd[5] + x64 * x85;
-        let x93 = x77 + -0.7026 * x74;
-        let x94 = 9.336 * x92;
-        let x95 = 44.41 * x86;
-        let x96 = 44.41 * x87;
-        let x97 = 243.66 * x89;
-        let x98 = 243.66 * x90;
-        let x99 = 243.66 * x91;
-        let x100 = 9.336 * (qdd[5] + x74 * x85)
-            + (x86 * x96 - x87 * x95 + (x90 * x99 - x91 * x98));
-        let x101 = 44.41 * (x75 * c_q5 + x73 * s_q5 + qd[5] * x87)
-            + (x87 * x94 - x92 * x96 + (x91 * x97 - x89 * x99));
-        let x102 = 44.41 * (x73 * c_q5 - x75 * s_q5 - qd[5] * x86)
-            + (x92 * x95 - x86 * x94 + (x89 * x98 - x90 * x97));
-        let x103 = 243.66 * (x72 * s_q5 - c_q5 * x93 + qd[5] * x91)
-            + (x87 * x97 - x92 * x99);
-        let x104 = 243.66 * (s_q5 * x93 + x72 * c_q5 - qd[5] * x90)
-            + (x92 * x98 - x86 * x97);
-        let x105 = x85
-            * (243.66 * (x85 * (x76 - 0.7026 * x75)) + (x86 * x99 - x87 * x98));
-        let x106 = c_q5 * x103 - s_q5 * x104;
-        let x107 = 12.13 * x74 + (x65 * x80 - x70 * x79 + (x69 * x82 - x68 * x83))
-            + (x85 * x100 + 0.7026 * x106);
-        let x108 = 12.13 * x75 + (x70 * x78 - x64 * x80 + (x69 * x81 - x67 * x83))
-            + (c_q5 * x101 - s_q5 * x102 + -0.7026 * x105);
-        let x109 = 3.061 * x73 + (x64 * x79 - x65 * x78 + (x68 * x81 - x67 * x82))
-            + (s_q5 * x101 + c_q5 * x102);
-        let x110 = 105.98 * x76 + (x70 * x82 + x65 * x83) + x105;
-        let x111 = x70 * x81 - x64 * x83 - 105.98 * x77 + x106;
-        let x112 = c_q4 * x110 - s_q4 * x111;
-        let x113 = x63
-            * (105.98 * x72 - (x65 * x81 + x64 * x82) + (s_q5 * x103 + c_q5 * x104));
-        let x114 = x48 * x58 - x43 * x57 + (x47 * x60 - x46 * x61) - 8.305 * x52
-            + (c_q4 * x107 - s_q4 * x108 + -0.5692 * x113);
-        let x115 = 3.061 * x51 + (x42 * x58 - x43 * x56 + (x47 * x59 - x45 * x61))
-            + (s_q4 * x107 + c_q4 * x108);
-        let x116 = 8.0386 * x53 + (x48 * x56 - x42 * x57 + (x46 * x59 - x45 * x60))
-            + (x63 * x109 + 0.5692 * x112);
-        let x117 = 105.98 * x54 + (x43 * x60 + x48 * x61) + x112;
-        let x118 = 105.98 * x55 + (x42 * x60 - x48 * x59) + x113;
-        let x119 = x41
-            * (x43 * x59 + x42 * x61 - 105.98 * x50 + (s_q4 * x110 + c_q4 * x111));
-        let x120 = c_q3 * x118 - s_q3 * x117;
-        let x121 = -39.95 * x29 - 9.522 * x30
-            + (x25 * x36 - x19 * x35 + (x23 * x39 - x24 * x38))
-            + (c_q3 * x114 + s_q3 * x116);
-        let x122 = 1966.28 * x29 - -39.95 * x30
-            + (x19 * x34 + x18 * x36 + (x22 * x39 - x24 * x37))
-            + (x41 * x115 + -7.11 * x120);
-        let x123 = 1966.28 * x31 + (x23 * x37 - x22 * x38 - (x25 * x34 + x18 * x35))
-            + (c_q3 * x116 - s_q3 * x114 + 7.11 * x119);
-        let x124 = 279.2 * x32 + (x19 * x38 - x25 * x39) + (c_q3 * x117 + s_q3 * x118);
-        let x125 = 279.2 * x33 + (x18 * x38 - x25 * x37) + x120;
-        let x126 = c_q2 * x124 + s_q2 * x125;
-        let x127 = c_q2 * x125 - s_q2 * x124;
-        let x128 = 2094.71 * qdd[1] - 49.52 * x7
-            + (x2 * x11 + x1 * x13 + (x5 * x14 - x4 * x15))
-            + (x17 * x122 + -7.11 * x127);
-        let x129 = 8.446 * qdd[0]
+        let x61 = 9.336 * (qdd[5] + (x43 * s_q4 - x44 * c_q4 + qd[4] * x56));
+        let x62 = 9.336 * (qd[5] + x55);
+        let x63 = (x57 * c_q5 - x56 * s_q5) * x62;
+        let x64 = (x56 * c_q5 + x57 * s_q5) * x62;
+        let x65 = x56 * x59 - x57 * x58 + x61;
+        let x66 = 44.41 * (x44 * s_q4 + x43 * c_q4 - qd[4] * x55) - x55 * x59
+            + (c_q5 * x63 + s_q5 * x64);
+        let x67 = 47.471 * (qdd[4] + x45) + x55 * x58 + (s_q5 * x63 - c_q5 * x64);
+        let x68 = x42 * x46 - x37 * x48 - x41 * x50
+            - (132.6783695416 * x44 + (x23 + -7.11 * x28) * 171.195516)
+            + (c_q4 * x65 - s_q4 * x66);
+        let x69 = 135.4729695416 * x43 + -97.44448770720001 * x45
+            + -171.195516
+                * ((c_q2 * x24 + s_q2 * x25 + qd[2] * x21) * c_q3
+                    - s_q3 * (x29 - 7.11 * x26) - qd[3] * x41)
+            + (x36 * x46 - x37 * x47 - x41 * x49) + (s_q4 * x65 + c_q4 * x66);
+        let x70 = -97.44448770720001 * x43
+            + (x42 * x47 - x36 * x48 + (x40 * x50 - x38 * x49)) + x67;
+        let x71 = s_q3 * x52 + c_q3 * x51;
+        let x72 = 1375.0472756800002 * x26 - -24989.305802 * x27
+            + (x17 * x34 - x21 * x33 - (x16 * x32 + x22 * x31))
+            + (c_q3 * x68 + s_q3 * x70);
+        let x73 = 24998.827802 * x26 - 1375.0472756800002 * x27 + x29 * -3239.4582
+            + (x16 * x30 - x15 * x31 + x20 * x34) + (x69 + -7.11 * x71);
+        let x74 = c_q3 * x70 - s_q3 * x68 + 7.11 * x53
+            - (3239.4582 * x23 + (x22 * x30 + x15 * x32 + x20 * x33));
+        let x75 = x16 * x33 - x22 * x34 + (s_q3 * x51 - c_q3 * x52);
+        let x76 = x15 * x33 - 3239.4582 * x26 + x71;
+        let x77 = c_q2 * x75 + s_q2 * x76;
+        let x78 = c_q2 * x76 - s_q2 * x75;
+        let x79 = 39241.404122 * qdd[1] - 3946.1881206800003 * x7 - x9 * -5224.5702
+            + (x2 * x10 - x4 * x13) + (x73 + -7.11 * x78);
+        let x80 = 65697.3302265768 * qdd[0]
             + (c_q1
-                * (2103.19 * x8 - (qd[1] * x11 + x1 * x12)
-                    + (c_q2 * x123 - s_q2 * x121
-                        + (0.475 * x126
-                            + 7.11
-                                * (x17 * (x19 * x37 - x18 * x39 - 279.2 * x28 + x119)))))
+                * (x4 * x12 - (qd[1] * x10 + x1 * x11)
+                    + (c_q2 * x74 - s_q2 * x72
+                        + (0.475 * x77 + 7.11 * (x53 - (x28 * -3239.4582 + x15 * x34)))))
                 - s_q1
-                    * (49.52 * qdd[1] - 15.41 * x7 + (qd[1] * x13 - x2 * x12)
-                        + (c_q2 * x121 + s_q2 * x123 + -0.475 * x127))
+                    * (3946.18812068 * qdd[1] - -39234.47412200001 * x7
+                        - (x2 * x11 + x5 * x12)
+                        + (c_q2 * x72 + s_q2 * x74 + -0.475 * x78))
                 + 0.5692
-                    * (c_q1 * (314.88 * x9 - qd[1] * x15 + x126)
-                        + s_q1 * (qd[1] * x14 - 314.88 * x10 + x127)));
-        [x129, x128, x122, x115, x109, x100]
+                    * (c_q1 * (x2 * x12 - qd[1] * x13 + x77)
+                        + s_q1 * (x1 * x12 - 5224.5702 * qdd[1] + x78)));
+        [x80, x79, x73, x69, x67, x61]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 377 mul, 262 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 9.336 * x8;
-        let x10 = 44.41 * c_q5;
-        let x11 = 44.41 * s_q5;
-        let x12 = c_q5 * x10 + s_q5 * x11;
-        let x13 = s_q5 * x10;
-        let x14 = c_q5 * x11;
-        let x15 = x13 - x14;
-        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
-        let x17 = 12.13 + (x12 + 120.2819695416);
-        let x18 = 3.061 + x12;
-        let x19 = x6 * -171.195516;
-        let x20 = c_q4 * x16;
-        let x21 = s_q4 * x17;
-        let x22 = s_q4 * x15;
-        let x23 = c_q4 * x15;
-        let x24 = x6 * (x14 - x13);
-        let x25 = x6 * x18;
-        let x26 = s_q4 * x20 - c_q4 * x21;
-        let x27 = x6 * x22;
-        let x28 = s_q4 * x24;
-        let x29 = c_q4 * x24 + x19 * 0.5692;
-        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
-        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
-        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
-        let x33 = s_q3 * x19;
-        let x34 = x4 * -199.01508800000002;
-        let x35 = c_q3 * x19;
-        let x36 = x33 + 3239.4582;
-        let x37 = c_q3 * x30 - s_q3 * x28;
-        let x38 = c_q3 * x26 + s_q3 * x29;
-        let x39 = s_q3 * x32 - c_q3 * x27;
-        let x40 = x4 * x31;
-        let x41 = s_q3 * x30 + c_q3 * x28;
-        let x42 = c_q3 * x29 - s_q3 * x26;
-        let x43 = s_q3 * x27 + c_q3 * x32;
-        let x44 = x4 * x42;
-        let x45 = x33 * -7.11;
-        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
-        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
-        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
-        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
-        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
-        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
-        let x52 = s_q2 * x35;
-        let x53 = c_q2 * x36 + x52;
-        let x54 = x2 * x34;
-        let x55 = c_q2 * x35;
-        let x56 = x55 - s_q2 * x36;
-        let x57 = x53 + 5224.5702;
-        let x58 = x54 + -349.0395;
-        let x59 = c_q2 * x48 + s_q2 * x46;
-        let x60 = c_q2 * x49 + s_q2 * x44;
-        let x61 = c_q2 * x47 + s_q2 * x51;
-        let x62 = x2 * x50;
-        let x63 = c_q2 * x46 - s_q2 * x48;
-        let x64 = c_q2 * x44 - s_q2 * x49;
-        let x65 = c_q2 * x51 - s_q2 * x47;
-        let x66 = -0.475 * x53;
-        let x67 = -7.11 * x53;
-        let x68 = x56 * 0.475;
-        let x69 = (c_q1 + (1.0 - c_q1)) * x58;
-        let x70 = c_q1 * x56;
-        let x71 = c_q1 * (x2 * x64 + x68)
-            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
-            + 0.5692 * (x70 - s_q1 * x57);
-        let x72 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x70 - s_q1 * x53);
-        let x73 = x40 - x45;
-        let x74 = x55 - s_q2 * x33;
-        let x75 = x52 + c_q2 * x33;
-        let x76 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x74)
-            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x75)
-            + 0.5692 * (c_q1 * x74 - s_q1 * x75);
-        let x77 = s_q3 * x25 - c_q3 * x22;
-        let x78 = x4 * x23;
-        let x79 = s_q3 * x22 + c_q3 * x25;
-        let x80 = c_q1 * (c_q2 * x79 - s_q2 * x77) - s_q1 * (c_q2 * x77 + s_q2 * x79);
-        let x81 = c_q4 * x9;
-        let x82 = s_q4 * x9;
-        let x83 = c_q3 * x81;
-        let x84 = x4 * x82;
-        let x85 = s_q3 * x81;
-        let x86 = s_q1 * (c_q2 * x83 - s_q2 * x85) + c_q1 * (s_q2 * x83 + c_q2 * x85);
-        let x87 = qd[0] * s_q1;
-        let x88 = qd[0] * c_q1;
-        let x89 = -0.5692 * qd[0];
-        let x90 = c_q1 * x89;
-        let x91 = s_q1 * x89;
-        let x92 = qd[1] * x88;
-        let x93 = qd[1] * x87;
-        let x94 = qd[1] * x91;
-        let x95 = qd[1] * x90;
-        let x96 = 49.52 * qd[1] - 15.41 * x87;
-        let x97 = 2094.71 * qd[1] - 49.52 * x87;
-        let x98 = 2103.19 * x88;
-        let x99 = 314.88 * x90;
-        let x100 = 314.88 * x91;
-        let x101 = c_q2 * x87 + s_q2 * x88;
-        let x102 = c_q2 * x88 - s_q2 * x87;
-        let x103 = x90 + -0.475 * x88;
-        let x104 = x91 + (7.11 * qd[1] - 0.475 * x87);
-        let x105 = s_q2 * x104 - c_q2 * x103;
-        let x106 = x2 * (-7.11 * x88);
-        let x107 = s_q2 * x103 + c_q2 * x104;
-        let x108 = qd[2] + qd[1] * x2;
-        let x109 = x94 + -0.475 * x93;
-        let x110 = 0.475 * x92 - x95;
-        let x111 = x2 * (-7.11 * x93);
-        let x112 = s_q2 * x93 - c_q2 * x92 - qd[2] * x102;
-        let x113 = s_q2 * x92 + c_q2 * x93 + qd[2] * x101;
-        let x114 = c_q2 * x109 - s_q2 * x110 + qd[2] * x107;
-        let x115 = s_q2 * x109 + c_q2 * x110 + qd[2] * x105;
-        let x116 = -39.95 * x108 - 9.522 * x101;
-        let x117 = 1966.28 * x108 - -39.95 * x101;
-        let x118 = 1966.28 * x102;
-        let x119 = 279.2 * x105;
-        let x120 = 279.2 * x106;
-        let x121 = 279.2 * x107;
-        let x122 = c_q3 * x101 + s_q3 * x102;
-        let x123 = c_q3 * x102 - s_q3 * x101;
-        let x124 = x107 + 7.11 * x108;
-        let x125 = c_q3 * x105 + s_q3 * x124;
-        let x126 = x4 * (x106 + -7.11 * x102);
-        let x127 = s_q3 * x105 - c_q3 * x124;
-        let x128 = qd[3] + x4 * x108;
-        let x129 = x4 * (x111 + -7.11 * x113);
-        let x130 = c_q3 * x112 + s_q3 * x113 - qd[3] * x123;
-        let x131 = s_q3 * x112 - c_q3 * x113 - qd[3] * x122;
-        let x132 = c_q3 * x114 - s_q3 * x115 - qd[3] * x127;
-        let x133 = s_q3 * x114 + c_q3 * x115 + qd[3] * x125;
-        let x134 = 8.305 * x122;
-        let x135 = 3.061 * x128;
-        let x136 = 8.0386 * x123;
-        let x137 = 105.98 * x125;
-        let x138 = 105.98 * x126;
-        let x139 = 105.98 * x127;
-        let x140 = s_q4 * x128 - c_q4 * x122;
-        let x141 = s_q4 * x122 + c_q4 * x128;
-        let x142 = x125 - -0.5692 * x123;
-        let x143 = c_q4 * x142 - s_q4 * x126;
-        let x144 = s_q4 * x142 + c_q4 * x126;
-        let x145 = x6 * (x127 + 0.5692 * x122);
-        let x146 = qd[4] + x6 * x123;
-        let x147 = x6 * x131;
-        let x148 = x132 - -0.5692 * x131;
-        let x149 = x6 * (x133 - 0.5692 * x130);
-        let x150 = c_q4 * x130 + qd[4] * x141;
-        let x151 = s_q4 * x130 + qd[4] * x140;
-        let x152 = c_q4 * x148 + s_q4 * x129 - qd[4] * x144;
-        let x153 = c_q4 * x129 - s_q4 * x148 - qd[4] * x143;
-        let x154 = 12.13 * x140;
-        let x155 = 12.13 * x141;
-        let x156 = 3.061 * x146;
-        let x157 = 105.98 * x143;
-        let x158 = 105.98 * x144;
-        let x159 = 105.98 * x145;
-        let x160 = c_q5 * x141 + s_q5 * x146;
-        let x161 = c_q5 * x146 - s_q5 * x141;
-        let x162 = x144 + -0.7026 * x140;
-        let x163 = x8 * (x143 - 0.7026 * x141);
-        let x164 = s_q5 * x145 - c_q5 * x162;
-        let x165 = s_q5 * x162 + c_q5 * x145;
-        let x166 = qd[5] + x8 * x140;
-        let x167 = x153 - -0.7026 * x150;
-        let x168 = 9.336 * x166;
-        let x169 = 44.41 * x160;
-        let x170 = 44.41 * x161;
-        let x171 = 243.66 * x163;
-        let x172 = 243.66 * x164;
-        let x173 = 243.66 * x165;
-        let x174 = 9.336 * (x8 * x150)
-            + (x160 * x170 - x161 * x169 + (x164 * x173 - x165 * x172));
-        let x175 = 44.41 * (s_q5 * x147 - c_q5 * x151 + qd[5] * x161)
-            + (x161 * x168 - x166 * x170 + (x165 * x171 - x163 * x173));
-        let x176 = 44.41 * (s_q5 * x151 + c_q5 * x147 - qd[5] * x160)
-            + (x166 * x169 - x160 * x168 + (x163 * x172 - x164 * x171));
-        let x177 = 243.66 * (c_q5 * x167 + s_q5 * x149 + qd[5] * x165)
-            + (x161 * x171 - x166 * x173);
-        let x178 = 243.66 * (c_q5 * x149 - s_q5 * x167 - qd[5] * x164)
-            + (x166 * x172 - x160 * x171);
-        let x179 = x8
-            * (243.66 * (x8 * (x152 + 0.7026 * x151)) + (x160 * x173 - x161 * x172));
-        let x180 = c_q5 * x177 - s_q5 * x178;
-        let x181 = 12.13 * x150
-            + (x141 * x156 - x146 * x155 + (x145 * x158 - x144 * x159))
-            + (x8 * x174 + 0.7026 * x180);
-        let x182 = x146 * x154 - x140 * x156 + (x145 * x157 - x143 * x159) - 12.13 * x151
-            + (c_q5 * x175 - s_q5 * x176 + -0.7026 * x179);
-        let x183 = 3.061 * x147
-            + (x140 * x155 - x141 * x154 + (x144 * x157 - x143 * x158))
-            + (s_q5 * x175 + c_q5 * x176);
-        let x184 = 105.98 * x152 + (x146 * x158 + x141 * x159) + x179;
-        let x185 = 105.98 * x153 + (x146 * x157 - x140 * x159) + x180;
-        let x186 = c_q4 * x184 - s_q4 * x185;
-        let x187 = x6
-            * (105.98 * x149 - (x141 * x157 + x140 * x158)
-                + (s_q5 * x177 + c_q5 * x178));
-        let x188 = 8.305 * x130
-            + (x128 * x136 - x123 * x135 + (x127 * x138 - x126 * x139))
-            + (c_q4 * x181 - s_q4 * x182 + -0.5692 * x187);
-        let x189 = x122 * x136 - x123 * x134 + (x127 * x137 - x125 * x139)
-            + (s_q4 * x181 + c_q4 * x182);
-        let x190 = 8.0386 * x131
-            + (x128 * x134 - x122 * x135 + (x126 * x137 - x125 * x138))
-            + (x6 * x183 + 0.5692 * x186);
-        let x191 = 105.98 * x132 + (x123 * x138 + x128 * x139) + x186;
-        let x192 = 105.98 * x133 + (x122 * x138 - x128 * x137) + x187;
-        let x193 = x4
-            * (105.98 * x129 + (x123 * x137 + x122 * x139)
-                + (s_q4 * x184 + c_q4 * x185));
-        let x194 = c_q3 * x192 - s_q3 * x191;
-        let x195 = 9.522 * x112
-            + (x108 * x118 - x102 * x117 + (x106 * x121 - x107 * x120))
-            + (c_q3 * x188 + s_q3 * x190);
-        let x196 = -39.95 * x112
-            + (x102 * x116 + x101 * x118 + (x105 * x121 - x107 * x119))
-            + (x4 * x189 + -7.11 * x194);
-        let x197 = x106 * x119 - x105 * x120 - (x108 * x116 + x101 * x117)
-            - 1966.28 * x113 + (c_q3 * x190 - s_q3 * x188 + 7.11 * x193);
-        let x198 = 279.2 * x114 + (x102 * x120 - x108 * x121)
-            + (c_q3 * x191 + s_q3 * x192);
-        let x199 = 279.2 * x115 + (x101 * x120 - x108 * x119) + x194;
-        let x200 = c_q2 * x198 + s_q2 * x199;
-        let x201 = c_q2 * x199 - s_q2 * x198;
-        let x202 = tau[0]
+        let x5 = 9.336 * c_q4;
+        let x6 = 44.41 * s_q4;
+        let x7 = 9.336 * s_q4;
+        let x8 = s_q4 * x5 - c_q4 * x6;
+        let x9 = 132.6783695416 + (c_q4 * x5 + s_q4 * x6);
+        let x10 = 135.4729695416 + (s_q4 * x7 + c_q4 * (44.41 * c_q4));
+        let x11 = -171.195516 * s_q3;
+        let x12 = -171.195516 * c_q3;
+        let x13 = c_q3 * x9;
+        let x14 = c_q3 * x8 + -97.44448770720001 * s_q3;
+        let x15 = 47.471 * s_q3;
+        let x16 = s_q3 * x9;
+        let x17 = -97.44448770720001 * c_q3 - s_q3 * x8;
+        let x18 = 47.471 * c_q3;
+        let x19 = x11 * -7.11;
+        let x20 = 7.11 * x11;
+        let x21 = x10 - x19;
+        let x22 = s_q3 * x18 - c_q3 * x16 - 7.11 * x12;
+        let x23 = c_q3 * x15 - s_q3 * x13 + x12 * -7.11;
+        let x24 = s_q3 * x16 + c_q3 * x18 + x20 - x19;
+        let x25 = 3239.4582 + x11;
+        let x26 = -24989.305802 + (c_q3 * x13 + s_q3 * x15);
+        let x27 = 1375.0472756800002 + x14;
+        let x28 = 24998.827802 + (x20 + x21);
+        let x29 = s_q2 * x12;
+        let x30 = c_q2 * x25 + x29;
+        let x31 = c_q2 * x12;
+        let x32 = x31 - s_q2 * x25;
+        let x33 = c_q2 * x26 + s_q2 * x22;
+        let x34 = s_q2 * x17;
+        let x35 = c_q2 * x23 + s_q2 * x24;
+        let x36 = c_q2 * x22 - s_q2 * x26;
+        let x37 = c_q2 * x17;
+        let x38 = c_q2 * x24 - s_q2 * x23;
+        let x39 = -7.11 * x30;
+        let x40 = 7.11 * x30;
+        let x41 = c_q2 * x27 + x34 - -0.475 * x30;
+        let x42 = x28 - x39;
+        let x43 = c_q1 * x32;
+        let x44 = c_q1 * (x37 - s_q2 * x27 + x32 * 0.475);
+        let x45 = x44 - s_q1 * (3946.18812068 + x41)
+            + 0.5692 * (x43 - s_q1 * (5224.5702 + x30));
+        let x46 = x44 - s_q1 * x41 + 0.5692 * (x43 - s_q1 * x30);
+        let x47 = x31 - s_q2 * x11;
+        let x48 = x29 + c_q2 * x11;
+        let x49 = c_q1 * (x37 - s_q2 * x14 + 0.475 * x47)
+            - s_q1 * (x34 + c_q2 * x14 - -0.475 * x48)
+            + 0.5692 * (c_q1 * x47 - s_q1 * x48);
+        let x50 = c_q1 * (c_q2 * x18 - s_q2 * x15) - s_q1 * (c_q2 * x15 + s_q2 * x18);
+        let x51 = c_q3 * x5;
+        let x52 = s_q3 * x5;
+        let x53 = s_q1 * (c_q2 * x51 - s_q2 * x52) + c_q1 * (s_q2 * x51 + c_q2 * x52);
+        let x54 = qd[0] * s_q1;
+        let x55 = qd[0] * c_q1;
+        let x56 = -0.5692 * qd[0];
+        let x57 = c_q1 * x56;
+        let x58 = s_q1 * x56;
+        let x59 = qd[1] * x55;
+        let x60 = qd[1] * x54;
+        let x61 = qd[1] * x57;
+        let x62 = 3946.18812068 * qd[1] - -39234.47412200001 * x54;
+        let x63 = 39241.404122 * qd[1] - 3946.1881206800003 * x54 - x58 * -5224.5702;
+        let x64 = x55 * -5224.5702;
+        let x65 = 5224.5702 * qd[1];
+        let x66 = c_q2 * x54 + s_q2 * x55;
+        let x67 = c_q2 * x55 - s_q2 * x54;
+        let x68 = -7.11 * x55;
+        let x69 = x57 + -0.475 * x55;
+        let x70 = x58 + (7.11 * qd[1] - 0.475 * x54);
+        let x71 = s_q2 * x70 - c_q2 * x69;
+        let x72 = s_q2 * x69 + c_q2 * x70;
+        let x73 = qd[1] + qd[2];
+        let x74 = -7.11 * x60;
+        let x75 = qd[1] * x58 + -0.475 * x60;
+        let x76 = 0.475 * x59 - x61;
+        let x77 = s_q2 * x60 - c_q2 * x59 - qd[2] * x67;
+        let x78 = s_q2 * x59 + c_q2 * x60 + qd[2] * x66;
+        let x79 = s_q2 * x75 + c_q2 * x76 + qd[2] * x71;
+        let x80 = 1375.0472756800002 * x73 - -24989.305802 * x66;
+        let x81 = 3239.4582 * x68;
+        let x82 = 24998.827802 * x73 - 1375.0472756800002 * x66 - x72 * -3239.4582;
+        let x83 = x67 * -3239.4582;
+        let x84 = 3239.4582 * x73;
+        let x85 = c_q3 * x66 + s_q3 * x67;
+        let x86 = c_q3 * x67 - s_q3 * x66;
+        let x87 = x68 + -7.11 * x67;
+        let x88 = x72 + 7.11 * x73;
+        let x89 = c_q3 * x71 + s_q3 * x88;
+        let x90 = s_q3 * x71 - c_q3 * x88;
+        let x91 = qd[3] + x73;
+        let x92 = c_q3 * x77 + s_q3 * x78 - qd[3] * x86;
+        let x93 = s_q3 * x77 - c_q3 * x78 - qd[3] * x85;
+        let x94 = -97.44448770720001 * x91;
+        let x95 = 132.6783695416 * x85 + 171.195516 * x87;
+        let x96 = 135.4729695416 * x91 + -97.44448770720001 * x86 + -171.195516 * x89;
+        let x97 = 171.195516 * x91;
+        let x98 = -171.195516 * x85;
+        let x99 = x86 * x98;
+        let x100 = x91 * x97 - x85 * x98;
+        let x101 = -171.195516 * x92 + x86 * x97;
+        let x102 = s_q4 * x91 - c_q4 * x85;
+        let x103 = s_q4 * x85 + c_q4 * x91;
+        let x104 = qd[4] + x86;
+        let x105 = 44.41 * x103;
+        let x106 = 47.471 * x104;
+        let x107 = 9.336 * (c_q4 * x92 + qd[4] * x103);
+        let x108 = 9.336 * (qd[5] + x102);
+        let x109 = (c_q5 * x104 - s_q5 * x103) * x108;
+        let x110 = (c_q5 * x103 + s_q5 * x104) * x108;
+        let x111 = x103 * x106 - x104 * x105 + x107;
+        let x112 = c_q5 * x109 + s_q5 * x110
+            - (44.41 * (s_q4 * x92 + qd[4] * x102) + x102 * x106);
+        let x113 = 47.471 * x93 + x102 * x105 + (s_q5 * x109 - c_q5 * x110);
+        let x114 = 132.6783695416 * x92 + 171.195516 * (x74 + -7.11 * x78)
+            + (x91 * x94 - x86 * x96 - x90 * x98) + (c_q4 * x111 - s_q4 * x112);
+        let x115 = -97.44448770720001 * x93
+            + -171.195516
+                * (c_q3 * (c_q2 * x75 - s_q2 * x76 + qd[2] * x72) - s_q3 * x79
+                    - qd[3] * x90) + (x85 * x94 - x86 * x95 - x90 * x97)
+            + (s_q4 * x111 + c_q4 * x112);
+        let x116 = x91 * x95 - x85 * x96 + (x89 * x98 - x87 * x97) + x113;
+        let x117 = s_q3 * x99 + c_q3 * x100;
+        let x118 = -24989.305802 * x77
+            + (x68 * x84 - x72 * x83 - (x67 * x82 + x73 * x81))
+            + (c_q3 * x114 + s_q3 * x116);
+        let x119 = 1375.0472756800002 * x77 + x79 * -3239.4582
+            + (x67 * x80 - x66 * x81 + x71 * x84) + (x115 + -7.11 * x117);
+        let x120 = 3239.4582 * x74 - (x73 * x80 + x66 * x82 + x71 * x83)
+            + (c_q3 * x116 - s_q3 * x114 - 7.11 * x101);
+        let x121 = x67 * x83 - x73 * x84 + (s_q3 * x100 - c_q3 * x99);
+        let x122 = x66 * x83 + x117;
+        let x123 = c_q2 * x121 + s_q2 * x122;
+        let x124 = c_q2 * x122 - s_q2 * x121;
+        let x125 = tau[0]
             - (c_q1
-                * (c_q2 * x197 - s_q2 * x195
-                    + (0.475 * x200
-                        + 7.11
-                            * (x2 * (279.2 * x111 + (x102 * x119 - x101 * x121) + x193)))
-                    - (2103.19 * x93 + (qd[1] * x96 + x87 * x97)))
+                * (x57 * x64 - (qd[1] * x62 + x54 * x63)
+                    + (c_q2 * x120 - s_q2 * x118
+                        + (0.475 * x123 + 7.11 * (x78 * -3239.4582 - x66 * x84 - x101))))
                 - s_q1
-                    * (qd[1] * x98 - x88 * x97 - 15.41 * x92
-                        + (c_q2 * x195 + s_q2 * x197 + -0.475 * x201))
+                    * (c_q2 * x118 + s_q2 * x120 + -0.475 * x124
+                        - (-39234.47412200001 * x59 + (x55 * x63 + x58 * x64)))
                 + 0.5692
-                    * (c_q1 * (314.88 * x94 - qd[1] * x100 + x200)
-                        + s_q1 * (qd[1] * x99 - 314.88 * x95 + x201)));
-        let x203 = 1.0
-            / (8.446
+                    * (c_q1 * (x55 * x64 - qd[1] * x65 + x123)
+                        + s_q1 * (x54 * x64 + x124)));
+        let x126 = 1.0
+            / (65697.3302265768
                 + (c_q1
-                    * (c_q1
-                        * (2103.19
-                            + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
-                                - (-7.11 * x57 - -0.475 * x58)))
-                        - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
+                    * (c_q1 * (c_q2 * x38 - s_q2 * x36 + x40 - x39)
+                        - s_q1 * (c_q2 * x35 - s_q2 * x33 + -7.11 * x32))
                     - s_q1
-                        * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
-                            - s_q1
-                                * (15.41
-                                    + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
-                    - 0.5692 * x69 + -0.5692 * (x69 + -597.4892399999999)));
-        let x204 = x71 * x203;
-        let x205 = x72 * x203;
-        let x206 = x76 * x203;
-        let x207 = x80 * x203;
-        let x208 = x86 * x203;
-        let x209 = 1.0 / (2094.71 + (x2 * x62 - x67 + 7.11 * x57) - x71 * x204);
-        let x210 = x62 - x67 - x71 * x205;
-        let x211 = x209 * x210;
-        let x212 = x2 * x73 - -7.11 * x75 - x71 * x206;
-        let x213 = x209 * x212;
-        let x214 = x2 * x78 - x71 * x207;
-        let x215 = x209 * x214;
-        let x216 = x2 * x84 + x71 * x208;
-        let x217 = x209 * x216;
-        let x218 = 1.0 / (x50 - x72 * x205 - x210 * x211);
-        let x219 = x73 - x72 * x206 - x210 * x213;
-        let x220 = x218 * x219;
-        let x221 = x78 - x72 * x207 - x210 * x215;
-        let x222 = x218 * x221;
-        let x223 = x84 + x72 * x208 - x210 * x217;
-        let x224 = x218 * x223;
-        let x225 = 1.0 / (x31 - x76 * x206 - x212 * x213 - x219 * x220);
-        let x226 = x23 - x76 * x207 - x212 * x215 - x219 * x222;
-        let x227 = x225 * x226;
-        let x228 = x82 + x76 * x208 - x212 * x217 - x219 * x224;
-        let x229 = x225 * x228;
-        let x230 = 1.0 / (x18 - x80 * x207 - x214 * x215 - x221 * x222 - x226 * x227);
-        let x231 = x80 * x208 - x214 * x217 - x221 * x224 - x226 * x229;
-        let x232 = x230 * x231;
-        let x233 = 1.0
-            / (9.336 - x86 * x208 - x216 * x217 - x223 * x224 - x228 * x229
-                - x231 * x232);
-        let x234 = tau[1]
-            - (x88 * x96 + x87 * x98 + (x91 * x99 - x90 * x100) - 49.52 * x92
-                + (x2 * x196 + -7.11 * x201)) - x202 * x204;
-        let x235 = tau[2] - x196 - x202 * x205 - x211 * x234;
-        let x236 = tau[3] - x189 - x202 * x206 - x213 * x234 - x220 * x235;
-        let x237 = tau[4] - x183 - x202 * x207 - x215 * x234 - x222 * x235 - x227 * x236;
-        let x238 = x233
-            * (tau[5] - x174 + x202 * x208 - x217 * x234 - x224 * x235 - x229 * x236
-                - x232 * x237);
-        let x239 = x230 * x237 - x232 * x238;
-        let x240 = x225 * x236 - x227 * x239 - x229 * x238;
-        let x241 = x218 * x235 - x220 * x240 - x222 * x239 - x224 * x238;
-        let x242 = x209 * x234 - x211 * x241 - x213 * x240 - x215 * x239 - x217 * x238;
-        let x243 = x202 * x203 - x204 * x242 - x205 * x241 - x206 * x240 - x207 * x239
-            + x208 * x238;
-        [x243, x242, x241, x240, x239, x238]
+                        * (c_q1 * (c_q2 * x36 + s_q2 * x38 - 7.11 * x32)
+                            - s_q1 * (-39234.47412200001 + (c_q2 * x33 + s_q2 * x35)))));
+        let x127 = x45 * x126;
+        let x128 = x46 * x126;
+        let x129 = x49 * x126;
+        let x130 = x50 * x126;
+        let x131 = x53 * x126;
+        let x132 = 1.0 / (39241.404122 + (x40 + x42) - x45 * x127);
+        let x133 = x42 - x45 * x128;
+        let x134 = x132 * x133;
+        let x135 = x21 - -7.11 * x48 - x45 * x129;
+        let x136 = x132 * x135;
+        let x137 = x45 * x130;
+        let x138 = x132 * x137;
+        let x139 = x7 + x45 * x131;
+        let x140 = x132 * x139;
+        let x141 = 1.0 / (x28 - x46 * x128 - x133 * x134);
+        let x142 = x21 - x46 * x129 - x133 * x136;
+        let x143 = x141 * x142;
+        let x144 = x133 * x138 - x46 * x130;
+        let x145 = x141 * x144;
+        let x146 = x7 + x46 * x131 - x133 * x140;
+        let x147 = x141 * x146;
+        let x148 = 1.0 / (x10 - x49 * x129 - x135 * x136 - x142 * x143);
+        let x149 = x135 * x138 - x49 * x130 - x142 * x145;
+        let x150 = x148 * x149;
+        let x151 = x7 + x49 * x131 - x135 * x140 - x142 * x147;
+        let x152 = x148 * x151;
+        let x153 = 1.0 / (47.471 - x50 * x130 - x137 * x138 - x144 * x145 - x149 * x150);
+        let x154 = x50 * x131 + x137 * x140 - x144 * x147 - x149 * x152;
+        let x155 = x153 * x154;
+        let x156 = 1.0
+            / (9.336 - x53 * x131 - x139 * x140 - x146 * x147 - x151 * x152
+                - x154 * x155);
+        let x157 = tau[1]
+            - (x55 * x62 - x57 * x65 - (3946.1881206800003 * x59 + x61 * -5224.5702)
+                + (x119 + -7.11 * x124)) - x125 * x127;
+        let x158 = tau[2] - x119 - x125 * x128 - x134 * x157;
+        let x159 = tau[3] - x115 - x125 * x129 - x136 * x157 - x143 * x158;
+        let x160 = tau[4] - x113 - x125 * x130 + x138 * x157 - x145 * x158 - x150 * x159;
+        let x161 = x156
+            * (tau[5] - x107 + x125 * x131 - x140 * x157 - x147 * x158 - x152 * x159
+                - x155 * x160);
+        let x162 = x153 * x160 - x155 * x161;
+        let x163 = x148 * x159 - x150 * x162 - x152 * x161;
+        let x164 = x141 * x158 - x143 * x163 - x145 * x162 - x147 * x161;
+        let x165 = x132 * x157 - x134 * x164 - x136 * x163 + x138 * x162 - x140 * x161;
+        let x166 = x125 * x126 - x127 * x165 - x128 * x164 - x129 * x163 - x130 * x162
+            + x131 * x161;
+        [x166, x165, x164, x163, x162, x161]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 478 mul, 318 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 291 mul, 195 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1150,282 +888,177 @@ impl Ssrms6 {
     ) -> ([[f64; 6]; 6], [f64; 6]) {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 9.336 * x8;
-        let x10 = 44.41 * c_q5;
-        let x11 = 44.41 * s_q5;
-        let x12 = c_q5 * x10 + s_q5 * x11;
-        let x13 = s_q5 * x10;
-        let x14 = c_q5 * x11;
-        let x15 = x13 - x14;
-        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
-        let x17 = 12.13 + (x12 + 120.2819695416);
-        let x18 = 3.061 + x12;
-        let x19 = x6 * -171.195516;
-        let x20 = c_q4 * x16;
-        let x21 = s_q4 * x17;
-        let x22 = s_q4 * x15;
-        let x23 = c_q4 * x15;
-        let x24 = x6 * (x14 - x13);
-        let x25 = x6 * x18;
-        let x26 = s_q4 * x20 - c_q4 * x21;
-        let x27 = x6 * x22;
-        let x28 = s_q4 * x24;
-        let x29 = c_q4 * x24 + x19 * 0.5692;
-        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
-        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
-        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
-        let x33 = s_q3 * x19;
-        let x34 = x4 * -199.01508800000002;
-        let x35 = c_q3 * x19;
-        let x36 = x33 + 3239.4582;
-        let x37 = c_q3 * x30 - s_q3 * x28;
-        let x38 = c_q3 * x26 + s_q3 * x29;
-        let x39 = s_q3 * x32 - c_q3 * x27;
-        let x40 = x4 * x31;
-        let x41 = s_q3 * x30 + c_q3 * x28;
-        let x42 = c_q3 * x29 - s_q3 * x26;
-        let x43 = s_q3 * x27 + c_q3 * x32;
-        let x44 = x4 * x42;
-        let x45 = x33 * -7.11;
-        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
-        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
-        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
-        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
-        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
-        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
-        let x52 = s_q2 * x35;
-        let x53 = c_q2 * x36 + x52;
-        let x54 = x2 * x34;
-        let x55 = c_q2 * x35;
-        let x56 = x55 - s_q2 * x36;
-        let x57 = x53 + 5224.5702;
-        let x58 = x54 + -349.0395;
-        let x59 = c_q2 * x48 + s_q2 * x46;
-        let x60 = c_q2 * x49 + s_q2 * x44;
-        let x61 = c_q2 * x47 + s_q2 * x51;
-        let x62 = x2 * x50;
-        let x63 = c_q2 * x46 - s_q2 * x48;
-        let x64 = c_q2 * x44 - s_q2 * x49;
-        let x65 = c_q2 * x51 - s_q2 * x47;
-        let x66 = -0.475 * x53;
-        let x67 = -7.11 * x53;
-        let x68 = x56 * 0.475;
-        let x69 = 2094.71 + (x2 * x62 - x67 + 7.11 * x57);
-        let x70 = (c_q1 + (1.0 - c_q1)) * x58;
-        let x71 = c_q1 * x56;
-        let x72 = 8.446
+        let x5 = 9.336 * c_q4;
+        let x6 = 44.41 * s_q4;
+        let x7 = 9.336 * s_q4;
+        let x8 = s_q4 * x5 - c_q4 * x6;
+        let x9 = 132.6783695416 + (c_q4 * x5 + s_q4 * x6);
+        let x10 = 135.4729695416 + (s_q4 * x7 + c_q4 * (44.41 * c_q4));
+        let x11 = -171.195516 * s_q3;
+        let x12 = -171.195516 * c_q3;
+        let x13 = c_q3 * x9;
+        let x14 = c_q3 * x8 + -97.44448770720001 * s_q3;
+        let x15 = 47.471 * s_q3;
+        let x16 = s_q3 * x9;
+        let x17 = -97.44448770720001 * c_q3 - s_q3 * x8;
+        let x18 = 47.471 * c_q3;
+        let x19 = x11 * -7.11;
+        let x20 = 7.11 * x11;
+        let x21 = x10 - x19;
+        let x22 = s_q3 * x18 - c_q3 * x16 - 7.11 * x12;
+        let x23 = c_q3 * x15 - s_q3 * x13 + x12 * -7.11;
+        let x24 = s_q3 * x16 + c_q3 * x18 + x20 - x19;
+        let x25 = 3239.4582 + x11;
+        let x26 = -24989.305802 + (c_q3 * x13 + s_q3 * x15);
+        let x27 = 1375.0472756800002 + x14;
+        let x28 = 24998.827802 + (x20 + x21);
+        let x29 = s_q2 * x12;
+        let x30 = c_q2 * x25 + x29;
+        let x31 = c_q2 * x12;
+        let x32 = x31 - s_q2 * x25;
+        let x33 = c_q2 * x26 + s_q2 * x22;
+        let x34 = s_q2 * x17;
+        let x35 = c_q2 * x23 + s_q2 * x24;
+        let x36 = c_q2 * x22 - s_q2 * x26;
+        let x37 = c_q2 * x17;
+        let x38 = c_q2 * x24 - s_q2 * x23;
+        let x39 = -7.11 * x30;
+        let x40 = 7.11 * x30;
+        let x41 = c_q2 * x27 + x34 - -0.475 * x30;
+        let x42 = x28 - x39;
+        let x43 = 39241.404122 + (x40 + x42);
+        let x44 = c_q1 * x32;
+        let x45 = c_q1 * (x37 - s_q2 * x27 + x32 * 0.475);
+        let x46 = x45 - s_q1 * (3946.18812068 + x41)
+            + 0.5692 * (x44 - s_q1 * (5224.5702 + x30));
+        let x47 = 65697.3302265768
             + (c_q1
-                * (c_q1
-                    * (2103.19
-                        + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
-                            - (-7.11 * x57 - -0.475 * x58)))
-                    - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
+                * (c_q1 * (c_q2 * x38 - s_q2 * x36 + x40 - x39)
+                    - s_q1 * (c_q2 * x35 - s_q2 * x33 + -7.11 * x32))
                 - s_q1
-                    * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
-                        - s_q1
-                            * (15.41
-                                + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
-                - 0.5692 * x70 + -0.5692 * (x70 + -597.4892399999999));
-        let x73 = c_q1 * (x2 * x64 + x68)
-            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
-            + 0.5692 * (x71 - s_q1 * x57);
-        let x74 = x62 - x67;
-        let x75 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x71 - s_q1 * x53);
-        let x76 = x40 - x45;
-        let x77 = x55 - s_q2 * x33;
-        let x78 = x52 + c_q2 * x33;
-        let x79 = x2 * x76 - -7.11 * x78;
-        let x80 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x77)
-            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x78)
-            + 0.5692 * (c_q1 * x77 - s_q1 * x78);
-        let x81 = s_q3 * x25 - c_q3 * x22;
-        let x82 = x4 * x23;
-        let x83 = s_q3 * x22 + c_q3 * x25;
-        let x84 = x2 * x82;
-        let x85 = c_q1 * (c_q2 * x83 - s_q2 * x81) - s_q1 * (c_q2 * x81 + s_q2 * x83);
-        let x86 = c_q4 * x9;
-        let x87 = s_q4 * x9;
-        let x88 = c_q3 * x86;
-        let x89 = x4 * x87;
-        let x90 = s_q3 * x86;
-        let x91 = x2 * x89;
-        let x92 = -(s_q1 * (c_q2 * x88 - s_q2 * x90) + c_q1 * (s_q2 * x88 + c_q2 * x90));
-        let x93 = qd[0] * s_q1;
-        let x94 = qd[0] * c_q1;
-        let x95 = -0.5692 * qd[0];
-        let x96 = c_q1 * x95;
-        let x97 = s_q1 * x95;
-        let x98 = qd[1] * x94;
-        let x99 = qd[1] * x93;
-        let x100 = qd[1] * x97;
-        let x101 = qd[1] * x96;
-        let x102 = 49.52 * qd[1] - 15.41 * x93;
-        let x103 = 2094.71 * qd[1] - 49.52 * x93;
-        let x104 = 2103.19 * x94;
-        let x105 = 314.88 * x96;
-        let x106 = 314.88 * x97;
-        let x107 = c_q2 * x93 + s_q2 * x94;
-        let x108 = c_q2 * x94 - s_q2 * x93;
-        let x109 = x96 + -0.475 * x94;
-        let x110 = x97 + (7.11 * qd[1] - 0.475 * x93);
-        let x111 = s_q2 * x110 - c_q2 * x109;
-        let x112 = x2 * (-7.11 * x94);
-        let x113 = s_q2 * x109 + c_q2 * x110;
-        let x114 = qd[2] + qd[1] * x2;
-        let x115 = x100 + -0.475 * x99;
-        let x116 = 0.475 * x98 - x101;
-        let x117 = x2 * (-7.11 * x99);
-        let x118 = s_q2 * x99 - c_q2 * x98 - qd[2] * x108;
-        let x119 = s_q2 * x98 + c_q2 * x99 + qd[2] * x107;
-        let x120 = c_q2 * x115 - s_q2 * x116 + qd[2] * x113;
-        let x121 = s_q2 * x115 + c_q2 * x116 + qd[2] * x111;
-        let x122 = -39.95 * x114 - 9.522 * x107;
-        let x123 = 1966.28 * x114 - -39.95 * x107;
-        let x124 = 1966.28 * x108;
-        let x125 = 279.2 * x111;
-        let x126 = 279.2 * x112;
-        let x127 = 279.2 * x113;
-        let x128 = c_q3 * x107 + s_q3 * x108;
-        let x129 = c_q3 * x108 - s_q3 * x107;
-        let x130 = x113 + 7.11 * x114;
-        let x131 = c_q3 * x111 + s_q3 * x130;
-        let x132 = x4 * (x112 + -7.11 * x108);
-        let x133 = s_q3 * x111 - c_q3 * x130;
-        let x134 = qd[3] + x4 * x114;
-        let x135 = x4 * (x117 + -7.11 * x119);
-        let x136 = c_q3 * x118 + s_q3 * x119 - qd[3] * x129;
-        let x137 = s_q3 * x118 - c_q3 * x119 - qd[3] * x128;
-        let x138 = c_q3 * x120 - s_q3 * x121 - qd[3] * x133;
-        let x139 = s_q3 * x120 + c_q3 * x121 + qd[3] * x131;
-        let x140 = 8.305 * x128;
-        let x141 = 3.061 * x134;
-        let x142 = 8.0386 * x129;
-        let x143 = 105.98 * x131;
-        let x144 = 105.98 * x132;
-        let x145 = 105.98 * x133;
-        let x146 = s_q4 * x134 - c_q4 * x128;
-        let x147 = s_q4 * x128 + c_q4 * x134;
-        let x148 = x131 - -0.5692 * x129;
-        let x149 = c_q4 * x148 - s_q4 * x132;
-        let x150 = s_q4 * x148 + c_q4 * x132;
-        let x151 = x6 * (x133 + 0.5692 * x128);
-        let x152 = qd[4] + x6 * x129;
-        let x153 = x6 * x137;
-        let x154 = x138 - -0.5692 * x137;
-        let x155 = x6 * (x139 - 0.5692 * x136);
-        let x156 = c_q4 * x136 + qd[4] * x147;
-        let x157 = s_q4 * x136 + qd[4] * x146;
-        let x158 = c_q4 * x154 + s_q4 * x135 - qd[4] * x150;
-        let x159 = c_q4 * x135 - s_q4 * x154 - qd[4] * x149;
-        let x160 = 12.13 * x146;
-        let x161 = 12.13 * x147;
-        let x162 = 3.061 * x152;
-        let x163 = 105.98 * x149;
-        let x164 = 105.98 * x150;
-        let x165 = 105.98 * x151;
-        let x166 = c_q5 * x147 + s_q5 * x152;
-        let x167 = c_q5 * x152 - s_q5 * x147;
-        let x168 = x150 + -0.7026 * x146;
-        let x169 = x8 * (x149 - 0.7026 * x147);
-        let x170 = s_q5 * x151 - c_q5 * x168;
-        let x171 = s_q5 * x168 + c_q5 * x151;
-        let x172 = qd[5] + x8 * x146;
-        let x173 = x159 - -0.7026 * x156;
-        let x174 = 9.336 * x172;
-        let x175 = 44.41 * x166;
-        let x176 = 44.41 * x167;
-        let x177 = 243.66 * x169;
-        let x178 = 243.66 * x170;
-        let x179 = 243.66 * x171;
-        let x180 = 9.336 * (x8 * x156)
-            + (x166 * x176 - x167 * x175 + (x170 * x179 - x171 * x178));
-        let x181 = 44.41 * (s_q5 * x153 - c_q5 * x157 + qd[5] * x167)
-            + (x167 * x174 - x172 * x176 + (x171 * x177 - x169 * x179));
-        let x182 = 44.41 * (s_q5 * x157 + c_q5 * x153 - qd[5] * x166)
-            + (x172 * x175 - x166 * x174 + (x169 * x178 - x170 * x177));
-        let x183 = 243.66 * (c_q5 * x173 + s_q5 * x155 + qd[5] * x171)
-            + (x167 * x177 - x172 * x179);
-        let x184 = 243.66 * (c_q5 * x155 - s_q5 * x173 - qd[5] * x170)
-            + (x172 * x178 - x166 * x177);
-        let x185 = x8
-            * (243.66 * (x8 * (x158 + 0.7026 * x157)) + (x166 * x179 - x167 * x178));
-        let x186 = c_q5 * x183 - s_q5 * x184;
-        let x187 = 12.13 * x156
-            + (x147 * x162 - x152 * x161 + (x151 * x164 - x150 * x165))
-            + (x8 * x180 + 0.7026 * x186);
-        let x188 = x152 * x160 - x146 * x162 + (x151 * x163 - x149 * x165) - 12.13 * x157
-            + (c_q5 * x181 - s_q5 * x182 + -0.7026 * x185);
-        let x189 = 3.061 * x153
-            + (x146 * x161 - x147 * x160 + (x150 * x163 - x149 * x164))
-            + (s_q5 * x181 + c_q5 * x182);
-        let x190 = 105.98 * x158 + (x152 * x164 + x147 * x165) + x185;
-        let x191 = 105.98 * x159 + (x152 * x163 - x146 * x165) + x186;
-        let x192 = c_q4 * x190 - s_q4 * x191;
-        let x193 = x6
-            * (105.98 * x155 - (x147 * x163 + x146 * x164)
-                + (s_q5 * x183 + c_q5 * x184));
-        let x194 = 8.305 * x136
-            + (x134 * x142 - x129 * x141 + (x133 * x144 - x132 * x145))
-            + (c_q4 * x187 - s_q4 * x188 + -0.5692 * x193);
-        let x195 = x128 * x142 - x129 * x140 + (x133 * x143 - x131 * x145)
-            + (s_q4 * x187 + c_q4 * x188);
-        let x196 = 8.0386 * x137
-            + (x134 * x140 - x128 * x141 + (x132 * x143 - x131 * x144))
-            + (x6 * x189 + 0.5692 * x192);
-        let x197 = 105.98 * x138 + (x129 * x144 + x134 * x145) + x192;
-        let x198 = 105.98 * x139 + (x128 * x144 - x134 * x143) + x193;
-        let x199 = x4
-            * (105.98 * x135 + (x129 * x143 + x128 * x145)
-                + (s_q4 * x190 + c_q4 * x191));
-        let x200 = c_q3 * x198 - s_q3 * x197;
-        let x201 = 9.522 * x118
-            + (x114 * x124 - x108 * x123 + (x112 * x127 - x113 * x126))
-            + (c_q3 * x194 + s_q3 * x196);
-        let x202 = -39.95 * x118
-            + (x108 * x122 + x107 * x124 + (x111 * x127 - x113 * x125))
-            + (x4 * x195 + -7.11 * x200);
-        let x203 = x112 * x125 - x111 * x126 - (x114 * x122 + x107 * x123)
-            - 1966.28 * x119 + (c_q3 * x196 - s_q3 * x194 + 7.11 * x199);
-        let x204 = 279.2 * x120 + (x108 * x126 - x114 * x127)
-            + (c_q3 * x197 + s_q3 * x198);
-        let x205 = 279.2 * x121 + (x107 * x126 - x114 * x125) + x200;
-        let x206 = c_q2 * x204 + s_q2 * x205;
-        let x207 = c_q2 * x205 - s_q2 * x204;
-        let x208 = x94 * x102 + x93 * x104 + (x97 * x105 - x96 * x106) - 49.52 * x98
-            + (x2 * x202 + -7.11 * x207);
-        let x209 = c_q1
-            * (c_q2 * x203 - s_q2 * x201
-                + (0.475 * x206
-                    + 7.11 * (x2 * (279.2 * x117 + (x108 * x125 - x107 * x127) + x199)))
-                - (2103.19 * x99 + (qd[1] * x102 + x93 * x103)))
+                    * (c_q1 * (c_q2 * x36 + s_q2 * x38 - 7.11 * x32)
+                        - s_q1 * (-39234.47412200001 + (c_q2 * x33 + s_q2 * x35))));
+        let x48 = x45 - s_q1 * x41 + 0.5692 * (x44 - s_q1 * x30);
+        let x49 = x31 - s_q2 * x11;
+        let x50 = x29 + c_q2 * x11;
+        let x51 = x21 - -7.11 * x50;
+        let x52 = c_q1 * (x37 - s_q2 * x14 + 0.475 * x49)
+            - s_q1 * (x34 + c_q2 * x14 - -0.475 * x50)
+            + 0.5692 * (c_q1 * x49 - s_q1 * x50);
+        let x53 = c_q1 * (c_q2 * x18 - s_q2 * x15) - s_q1 * (c_q2 * x15 + s_q2 * x18);
+        let x54 = c_q3 * x5;
+        let x55 = s_q3 * x5;
+        let x56 = -(s_q1 * (c_q2 * x54 - s_q2 * x55) + c_q1 * (s_q2 * x54 + c_q2 * x55));
+        let x57 = qd[0] * s_q1;
+        let x58 = qd[0] * c_q1;
+        let x59 = -0.5692 * qd[0];
+        let x60 = c_q1 * x59;
+        let x61 = s_q1 * x59;
+        let x62 = qd[1] * x58;
+        let x63 = qd[1] * x57;
+        let x64 = qd[1] * x60;
+        let x65 = 3946.18812068 * qd[1] - -39234.47412200001 * x57;
+        let x66 = 39241.404122 * qd[1] - 3946.1881206800003 * x57 - x61 * -5224.5702;
+        let x67 = x58 * -5224.5702;
+        let x68 = 5224.5702 * qd[1];
+        let x69 = c_q2 * x57 + s_q2 * x58;
+        let x70 = c_q2 * x58 - s_q2 * x57;
+        let x71 = -7.11 * x58;
+        let x72 = x60 + -0.475 * x58;
+        let x73 = x61 + (7.11 * qd[1] - 0.475 * x57);
+        let x74 = s_q2 * x73 - c_q2 * x72;
+        let x75 = s_q2 * x72 + c_q2 * x73;
+        let x76 = qd[1] + qd[2];
+        let x77 = -7.11 * x63;
+        let x78 = qd[1] * x61 + -0.475 * x63;
+        let x79 = 0.475 * x62 - x64;
+        let x80 = s_q2 * x63 - c_q2 * x62 - qd[2] * x70;
+        let x81 = s_q2 * x62 + c_q2 * x63 + qd[2] * x69;
+        let x82 = s_q2 * x78 + c_q2 * x79 + qd[2] * x74;
+        let x83 = 1375.0472756800002 * x76 - -24989.305802 * x69;
+        let x84 = 3239.4582 * x71;
+        let x85 = 24998.827802 * x76 - 1375.0472756800002 * x69 - x75 * -3239.4582;
+        let x86 = x70 * -3239.4582;
+        let x87 = 3239.4582 * x76;
+        let x88 = c_q3 * x69 + s_q3 * x70;
+        let x89 = c_q3 * x70 - s_q3 * x69;
+        let x90 = x71 + -7.11 * x70;
+        let x91 = x75 + 7.11 * x76;
+        let x92 = c_q3 * x74 + s_q3 * x91;
+        let x93 = s_q3 * x74 - c_q3 * x91;
+        let x94 = qd[3] + x76;
+        let x95 = c_q3 * x80 + s_q3 * x81 - qd[3] * x89;
+        let x96 = s_q3 * x80 - c_q3 * x81 - qd[3] * x88;
+        let x97 = -97.44448770720001 * x94;
+        let x98 = 132.6783695416 * x88 + 171.195516 * x90;
+        let x99 = 135.4729695416 * x94 + -97.44448770720001 * x89 + -171.195516 * x92;
+        let x100 = 171.195516 * x94;
+        let x101 = -171.195516 * x88;
+        let x102 = x89 * x101;
+        let x103 = x94 * x100 - x88 * x101;
+        let x104 = -171.195516 * x95 + x89 * x100;
+        let x105 = s_q4 * x94 - c_q4 * x88;
+        let x106 = s_q4 * x88 + c_q4 * x94;
+        let x107 = qd[4] + x89;
+        let x108 = 44.41 * x106;
+        let x109 = 47.471 * x107;
+        let x110 = 9.336 * (c_q4 * x95 + qd[4] * x106);
+        let x111 = 9.336 * (qd[5] + x105);
+        let x112 = (c_q5 * x107 - s_q5 * x106) * x111;
+        let x113 = (c_q5 * x106 + s_q5 * x107) * x111;
+        let x114 = x106 * x109 - x107 * x108 + x110;
+        let x115 = c_q5 * x112 + s_q5 * x113
+            - (44.41 * (s_q4 * x95 + qd[4] * x105) + x105 * x109);
+        let x116 = 47.471 * x96 + x105 * x108 + (s_q5 * x112 - c_q5 * x113);
+        let x117 = 132.6783695416 * x95 + 171.195516 * (x77 + -7.11 * x81)
+            + (x94 * x97 - x89 * x99 - x93 * x101) + (c_q4 * x114 - s_q4 * x115);
+        let x118 = -97.44448770720001 * x96
+            + -171.195516
+                * (c_q3 * (c_q2 * x78 - s_q2 * x79 + qd[2] * x75) - s_q3 * x82
+                    - qd[3] * x93) + (x88 * x97 - x89 * x98 - x93 * x100)
+            + (s_q4 * x114 + c_q4 * x115);
+        let x119 = x94 * x98 - x88 * x99 + (x92 * x101 - x90 * x100) + x116;
+        let x120 = s_q3 * x102 + c_q3 * x103;
+        let x121 = -24989.305802 * x80
+            + (x71 * x87 - x75 * x86 - (x70 * x85 + x76 * x84))
+            + (c_q3 * x117 + s_q3 * x119);
+        let x122 = 1375.0472756800002 * x80 + x82 * -3239.4582
+            + (x70 * x83 - x69 * x84 + x74 * x87) + (x118 + -7.11 * x120);
+        let x123 = 3239.4582 * x77 - (x76 * x83 + x69 * x85 + x74 * x86)
+            + (c_q3 * x119 - s_q3 * x117 - 7.11 * x104);
+        let x124 = x70 * x86 - x76 * x87 + (s_q3 * x103 - c_q3 * x102);
+        let x125 = x69 * x86 + x120;
+        let x126 = c_q2 * x124 + s_q2 * x125;
+        let x127 = c_q2 * x125 - s_q2 * x124;
+        let x128 = x58 * x65 - x60 * x68 - (3946.1881206800003 * x62 + x64 * -5224.5702)
+            + (x122 + -7.11 * x127);
+        let x129 = c_q1
+            * (x60 * x67 - (qd[1] * x65 + x57 * x66)
+                + (c_q2 * x123 - s_q2 * x121
+                    + (0.475 * x126 + 7.11 * (x81 * -3239.4582 - x69 * x87 - x104))))
             - s_q1
-                * (qd[1] * x104 - x94 * x103 - 15.41 * x98
-                    + (c_q2 * x201 + s_q2 * x203 + -0.475 * x207))
+                * (c_q2 * x121 + s_q2 * x123 + -0.475 * x127
+                    - (-39234.47412200001 * x62 + (x58 * x66 + x61 * x67)))
             + 0.5692
-                * (c_q1 * (314.88 * x100 - qd[1] * x106 + x206)
-                    + s_q1 * (qd[1] * x105 - 314.88 * x101 + x207));
+                * (c_q1 * (x58 * x67 - qd[1] * x68 + x126) + s_q1 * (x57 * x67 + x127));
         (
             [
-                [x72, x73, x75, x80, x85, x92],
-                [x73, x69, x74, x79, x84, x91],
-                [x75, x74, x50, x76, x82, x89],
-                [x80, x79, x76, x31, x23, x87],
-                [x85, x84, x82, x23, x18, 0.0],
-                [x92, x91, x89, x87, 0.0, 9.336],
+                [x47, x46, x48, x52, x53, x56],
+                [x46, x43, x42, x51, 0.0, x7],
+                [x48, x42, x28, x21, 0.0, x7],
+                [x52, x51, x21, x10, 0.0, x7],
+                [x53, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x56, x7, x7, x7, 0.0, 9.336],
             ],
-            [x209, x208, x202, x195, x189, x180],
+            [x129, x128, x122, x118, x116, x110],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 418 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 389 mul, 300 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1435,314 +1068,219 @@ impl Ssrms6 {
     ) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let x9 = 9.336 * x8;
-        let x10 = 44.41 * c_q5;
-        let x11 = 44.41 * s_q5;
-        let x12 = c_q5 * x10 + s_q5 * x11;
-        let x13 = s_q5 * x10;
-        let x14 = c_q5 * x11;
-        let x15 = x13 - x14;
-        let x16 = 12.13 + (x8 * x9 + 120.2819695416);
-        let x17 = 12.13 + (x12 + 120.2819695416);
-        let x18 = 3.061 + x12;
-        let x19 = x6 * -171.195516;
-        let x20 = c_q4 * x16;
-        let x21 = s_q4 * x17;
-        let x22 = s_q4 * x15;
-        let x23 = c_q4 * x15;
-        let x24 = x6 * (x14 - x13);
-        let x25 = x6 * x18;
-        let x26 = s_q4 * x20 - c_q4 * x21;
-        let x27 = x6 * x22;
-        let x28 = s_q4 * x24;
-        let x29 = c_q4 * x24 + x19 * 0.5692;
-        let x30 = 8.305 + (c_q4 * x20 + s_q4 * x21 + 113.27938808960002);
-        let x31 = 3.061 + (s_q4 * (s_q4 * x16) + c_q4 * (c_q4 * x17));
-        let x32 = 8.0386 + (x6 * x25 + 113.27938808960002);
-        let x33 = s_q3 * x19;
-        let x34 = x4 * -199.01508800000002;
-        let x35 = c_q3 * x19;
-        let x36 = x33 + 3239.4582;
-        let x37 = c_q3 * x30 - s_q3 * x28;
-        let x38 = c_q3 * x26 + s_q3 * x29;
-        let x39 = s_q3 * x32 - c_q3 * x27;
-        let x40 = x4 * x31;
-        let x41 = s_q3 * x30 + c_q3 * x28;
-        let x42 = c_q3 * x29 - s_q3 * x26;
-        let x43 = s_q3 * x27 + c_q3 * x32;
-        let x44 = x4 * x42;
-        let x45 = x33 * -7.11;
-        let x46 = s_q3 * x43 - c_q3 * x41 - 7.11 * x35;
-        let x47 = c_q3 * x39 - s_q3 * x37 + x35 * -7.11;
-        let x48 = 9.522 + (c_q3 * x37 + s_q3 * x39);
-        let x49 = -39.95 + (x4 * x38 - 7.11 * x34);
-        let x50 = 1966.28 + (x4 * x40 - x45 + 7.11 * x36);
-        let x51 = 1966.28 + (s_q3 * x41 + c_q3 * x43 + 7.11 * x33 - x36 * -7.11);
-        let x52 = s_q2 * x35;
-        let x53 = c_q2 * x36 + x52;
-        let x54 = x2 * x34;
-        let x55 = c_q2 * x35;
-        let x56 = x55 - s_q2 * x36;
-        let x57 = x53 + 5224.5702;
-        let x58 = x54 + -349.0395;
-        let x59 = c_q2 * x48 + s_q2 * x46;
-        let x60 = c_q2 * x49 + s_q2 * x44;
-        let x61 = c_q2 * x47 + s_q2 * x51;
-        let x62 = x2 * x50;
-        let x63 = c_q2 * x46 - s_q2 * x48;
-        let x64 = c_q2 * x44 - s_q2 * x49;
-        let x65 = c_q2 * x51 - s_q2 * x47;
-        let x66 = -0.475 * x53;
-        let x67 = -7.11 * x53;
-        let x68 = x56 * 0.475;
-        let x69 = (c_q1 + (1.0 - c_q1)) * x58;
-        let x70 = c_q1 * x56;
-        let x71 = c_q1 * (x2 * x64 + x68)
-            - s_q1 * (49.52 + (x2 * x60 - x66 - 7.11 * x58))
-            + 0.5692 * (x70 - s_q1 * x57);
-        let x72 = c_q1 * (x64 + x68) - s_q1 * (x60 - x66) + 0.5692 * (x70 - s_q1 * x53);
-        let x73 = x40 - x45;
-        let x74 = x55 - s_q2 * x33;
-        let x75 = x52 + c_q2 * x33;
-        let x76 = c_q1 * (c_q2 * x42 - s_q2 * x38 + 0.475 * x74)
-            - s_q1 * (c_q2 * x38 + s_q2 * x42 - -0.475 * x75)
-            + 0.5692 * (c_q1 * x74 - s_q1 * x75);
-        let x77 = s_q3 * x25 - c_q3 * x22;
-        let x78 = x4 * x23;
-        let x79 = s_q3 * x22 + c_q3 * x25;
-        let x80 = c_q1 * (c_q2 * x79 - s_q2 * x77) - s_q1 * (c_q2 * x77 + s_q2 * x79);
-        let x81 = c_q4 * x9;
-        let x82 = s_q4 * x9;
-        let x83 = c_q3 * x81;
-        let x84 = x4 * x82;
-        let x85 = s_q3 * x81;
-        let x86 = s_q1 * (c_q2 * x83 - s_q2 * x85) + c_q1 * (s_q2 * x83 + c_q2 * x85);
-        let x87 = qd[0] * s_q1;
-        let x88 = qd[0] * c_q1;
-        let x89 = -0.5692 * qd[0];
-        let x90 = c_q1 * x89;
-        let x91 = s_q1 * x89;
-        let x92 = qd[1] * x88;
-        let x93 = qd[1] * x87;
-        let x94 = qd[1] * x91;
-        let x95 = qd[1] * x90;
-        let x96 = 49.52 * qd[1] - 15.41 * x87;
-        let x97 = 2094.71 * qd[1] - 49.52 * x87;
-        let x98 = 2103.19 * x88;
-        let x99 = 314.88 * x90;
-        let x100 = 314.88 * x91;
-        let x101 = c_q2 * x87 + s_q2 * x88;
-        let x102 = c_q2 * x88 - s_q2 * x87;
-        let x103 = x90 + -0.475 * x88;
-        let x104 = x91 + (7.11 * qd[1] - 0.475 * x87);
-        let x105 = s_q2 * x104 - c_q2 * x103;
-        let x106 = x2 * (-7.11 * x88);
-        let x107 = s_q2 * x103 + c_q2 * x104;
-        let x108 = qd[2] + qd[1] * x2;
-        let x109 = x94 + -0.475 * x93;
-        let x110 = 0.475 * x92 - x95;
-        let x111 = x2 * (-7.11 * x93);
-        let x112 = s_q2 * x93 - c_q2 * x92 - qd[2] * x102;
-        let x113 = s_q2 * x92 + c_q2 * x93 + qd[2] * x101;
-        let x114 = c_q2 * x109 - s_q2 * x110 + qd[2] * x107;
-        let x115 = s_q2 * x109 + c_q2 * x110 + qd[2] * x105;
-        let x116 = -39.95 * x108 - 9.522 * x101;
-        let x117 = 1966.28 * x108 - -39.95 * x101;
-        let x118 = 1966.28 * x102;
-        let x119 = 279.2 * x105;
-        let x120 = 279.2 * x106;
-        let x121 = 279.2 * x107;
-        let x122 = c_q3 * x101 + s_q3 * x102;
-        let x123 = c_q3 * x102 - s_q3 * x101;
-        let x124 = x107 + 7.11 * x108;
-        let x125 = c_q3 * x105 + s_q3 * x124;
-        let x126 = x4 * (x106 + -7.11 * x102);
-        let x127 = s_q3 * x105 - c_q3 * x124;
-        let x128 = qd[3] + x4 * x108;
-        let x129 = x4 * (x111 + -7.11 * x113);
-        let x130 = c_q3 * x112 + s_q3 * x113 - qd[3] * x123;
-        let x131 = s_q3 * x112 - c_q3 * x113 - qd[3] * x122;
-        let x132 = c_q3 * x114 - s_q3 * x115 - qd[3] * x127;
-        let x133 = s_q3 * x114 + c_q3 * x115 + qd[3] * x125;
-        let x134 = 8.305 * x122;
-        let x135 = 3.061 * x128;
-        let x136 = 8.0386 * x123;
-        let x137 = 105.98 * x125;
-        let x138 = 105.98 * x126;
-        let x139 = 105.98 * x127;
-        let x140 = s_q4 * x128 - c_q4 * x122;
-        let x141 = s_q4 * x122 + c_q4 * x128;
-        let x142 = x125 - -0.5692 * x123;
-        let x143 = c_q4 * x142 - s_q4 * x126;
-        let x144 = s_q4 * x142 + c_q4 * x126;
-        let x145 = x6 * (x127 + 0.5692 * x122);
-        let x146 = qd[4] + x6 * x123;
-        let x147 = x6 * x131;
-        let x148 = x132 - -0.5692 * x131;
-        let x149 = x6 * (x133 - 0.5692 * x130);
-        let x150 = c_q4 * x130 + qd[4] * x141;
-        let x151 = s_q4 * x130 + qd[4] * x140;
-        let x152 = c_q4 * x148 + s_q4 * x129 - qd[4] * x144;
-        let x153 = c_q4 * x129 - s_q4 * x148 - qd[4] * x143;
-        let x154 = 12.13 * x140;
-        let x155 = 12.13 * x141;
-        let x156 = 3.061 * x146;
-        let x157 = 105.98 * x143;
-        let x158 = 105.98 * x144;
-        let x159 = 105.98 * x145;
-        let x160 = c_q5 * x141 + s_q5 * x146;
-        let x161 = c_q5 * x146 - s_q5 * x141;
-        let x162 = x144 + -0.7026 * x140;
-        let x163 = x8 * (x143 - 0.7026 * x141);
-        let x164 = s_q5 * x145 - c_q5 * x162;
-        let x165 = s_q5 * x162 + c_q5 * x145;
-        let x166 = qd[5] + x8 * x140;
-        let x167 = x153 - -0.7026 * x150;
-        let x168 = 9.336 * x166;
-        let x169 = 44.41 * x160;
-        let x170 = 44.41 * x161;
-        let x171 = 243.66 * x163;
-        let x172 = 243.66 * x164;
-        let x173 = 243.66 * x165;
-        let x174 = 9.336 * (x8 * x150)
-            + (x160 * x170 - x161 * x169 + (x164 * x173 - x165 * x172)) - f_ext[5][3];
-        let x175 = 44.41 * (s_q5 * x147 - c_q5 * x151 + qd[5] * x161)
-            + (x161 * x168 - x166 * x170 + (x165 * x171 - x163 * x173)) - f_ext[5][4];
-        let x176 = 44.41 * (s_q5 * x151 + c_q5 * x147 - qd[5] * x160)
-            + (x166 * x169 - x160 * x168 + (x163 * x172 - x164 * x171)) - f_ext[5][5];
-        let x177 = 243.66 * (c_q5 * x167 + s_q5 * x149 + qd[5] * x165)
-            + (x161 * x171 - x166 * x173) - f_ext[5][1];
-        let x178 = 243.66 * (c_q5 * x149 - s_q5 * x167 - qd[5] * x164)
-            + (x166 * x172 - x160 * x171) - f_ext[5][2];
-        let x179 = x8
-            * (243.66 * (x8 * (x152 + 0.7026 * x151)) + (x160 * x173 - x161 * x172)
-                - f_ext[5][0]);
-        let x180 = c_q5 * x177 - s_q5 * x178;
-        let x181 = 12.13 * x150
-            + (x141 * x156 - x146 * x155 + (x145 * x158 - x144 * x159)) - f_ext[4][3]
-            + (x8 * x174 + 0.7026 * x180);
-        let x182 = x146 * x154 - x140 * x156 + (x145 * x157 - x143 * x159) - 12.13 * x151
-            - f_ext[4][4] + (c_q5 * x175 - s_q5 * x176 + -0.7026 * x179);
-        let x183 = 3.061 * x147
-            + (x140 * x155 - x141 * x154 + (x144 * x157 - x143 * x158)) - f_ext[4][5]
-            + (s_q5 * x175 + c_q5 * x176);
-        let x184 = 105.98 * x152 + (x146 * x158 + x141 * x159) - f_ext[4][0] + x179;
-        let x185 = 105.98 * x153 + (x146 * x157 - x140 * x159) - f_ext[4][1] + x180;
-        let x186 = c_q4 * x184 - s_q4 * x185;
-        let x187 = x6
-            * (105.98 * x149 - (x141 * x157 + x140 * x158) - f_ext[4][2]
-                + (s_q5 * x177 + c_q5 * x178));
-        let x188 = 8.305 * x130
-            + (x128 * x136 - x123 * x135 + (x127 * x138 - x126 * x139)) - f_ext[3][3]
-            + (c_q4 * x181 - s_q4 * x182 + -0.5692 * x187);
-        let x189 = x122 * x136 - x123 * x134 + (x127 * x137 - x125 * x139) - f_ext[3][4]
-            + (s_q4 * x181 + c_q4 * x182);
-        let x190 = 8.0386 * x131
-            + (x128 * x134 - x122 * x135 + (x126 * x137 - x125 * x138)) - f_ext[3][5]
-            + (x6 * x183 + 0.5692 * x186);
-        let x191 = 105.98 * x132 + (x123 * x138 + x128 * x139) - f_ext[3][0] + x186;
-        let x192 = 105.98 * x133 + (x122 * x138 - x128 * x137) - f_ext[3][2] + x187;
-        let x193 = x4
-            * (105.98 * x129 + (x123 * x137 + x122 * x139) - f_ext[3][1]
-                + (s_q4 * x184 + c_q4 * x185));
-        let x194 = c_q3 * x192 - s_q3 * x191;
-        let x195 = 9.522 * x112
-            + (x108 * x118 - x102 * x117 + (x106 * x121 - x107 * x120)) - f_ext[2][3]
-            + (c_q3 * x188 + s_q3 * x190);
-        let x196 = -39.95 * x112
-            + (x102 * x116 + x101 * x118 + (x105 * x121 - x107 * x119)) - f_ext[2][4]
-            + (x4 * x189 + -7.11 * x194);
-        let x197 = x106 * x119 - x105 * x120 - (x108 * x116 + x101 * x117)
-            - 1966.28 * x113 - f_ext[2][5] + (c_q3 * x190 - s_q3 * x188 + 7.11 * x193);
-        let x198 = 279.2 * x114 + (x102 * x120 - x108 * x121) - f_ext[2][0]
-            + (c_q3 * x191 + s_q3 * x192);
-        let x199 = 279.2 * x115 + (x101 * x120 - x108 * x119) - f_ext[2][2] + x194;
-        let x200 = c_q2 * x198 + s_q2 * x199;
-        let x201 = c_q2 * x199 - s_q2 * x198;
-        let x202 = tau[0]
+        let x5 = 9.336 * c_q4;
+        let x6 = 44.41 * s_q4;
+        let x7 = 9.336 * s_q4;
+        let x8 = s_q4 * x5 - c_q4 * x6;
+        let x9 = 132.6783695416 + (c_q4 * x5 + s_q4 * x6);
+        let x10 = 135.4729695416 + (s_q4 * x7 + c_q4 * (44.41 * c_q4));
+        let x11 = -171.195516 * s_q3;
+        let x12 = -171.195516 * c_q3;
+        let x13 = c_q3 * x9;
+        let x14 = c_q3 * x8 + -97.44448770720001 * s_q3;
+        let x15 = 47.471 * s_q3;
+        let x16 = s_q3 * x9;
+        let x17 = -97.44448770720001 * c_q3 - s_q3 * x8;
+        let x18 = 47.471 * c_q3;
+        let x19 = x11 * -7.11;
+        let x20 = 7.11 * x11;
+        let x21 = x10 - x19;
+        let x22 = s_q3 * x18 - c_q3 * x16 - 7.11 * x12;
+        let x23 = c_q3 * x15 - s_q3 * x13 + x12 * -7.11;
+        let x24 = s_q3 * x16 + c_q3 * x18 + x20 - x19;
+        let x25 = 3239.4582 + x11;
+        let x26 = -24989.305802 + (c_q3 * x13 + s_q3 * x15);
+        let x27 = 1375.0472756800002 + x14;
+        let x28 = 24998.827802 + (x20 + x21);
+        let x29 = s_q2 * x12;
+        let x30 = c_q2 * x25 + x29;
+        let x31 = c_q2 * x12;
+        let x32 = x31 - s_q2 * x25;
+        let x33 = c_q2 * x26 + s_q2 * x22;
+        let x34 = s_q2 * x17;
+        let x35 = c_q2 * x23 + s_q2 * x24;
+        let x36 = c_q2 * x22 - s_q2 * x26;
+        let x37 = c_q2 * x17;
+        let x38 = c_q2 * x24 - s_q2 * x23;
+        let x39 = -7.11 * x30;
+        let x40 = 7.11 * x30;
+        let x41 = c_q2 * x27 + x34 - -0.475 * x30;
+        let x42 = x28 - x39;
+        let x43 = c_q1 * x32;
+        let x44 = c_q1 * (x37 - s_q2 * x27 + x32 * 0.475);
+        let x45 = x44 - s_q1 * (3946.18812068 + x41)
+            + 0.5692 * (x43 - s_q1 * (5224.5702 + x30));
+        let x46 = x44 - s_q1 * x41 + 0.5692 * (x43 - s_q1 * x30);
+        let x47 = x31 - s_q2 * x11;
+        let x48 = x29 + c_q2 * x11;
+        let x49 = c_q1 * (x37 - s_q2 * x14 + 0.475 * x47)
+            - s_q1 * (x34 + c_q2 * x14 - -0.475 * x48)
+            + 0.5692 * (c_q1 * x47 - s_q1 * x48);
+        let x50 = c_q1 * (c_q2 * x18 - s_q2 * x15) - s_q1 * (c_q2 * x15 + s_q2 * x18);
+        let x51 = c_q3 * x5;
+        let x52 = s_q3 * x5;
+        let x53 = s_q1 * (c_q2 * x51 - s_q2 * x52) + c_q1 * (s_q2 * x51 + c_q2 * x52);
+        let x54 = qd[0] * s_q1;
+        let x55 = qd[0] * c_q1;
+        let x56 = -0.5692 * qd[0];
+        let x57 = c_q1 * x56;
+        let x58 = s_q1 * x56;
+        let x59 = qd[1] * x55;
+        let x60 = qd[1] * x54;
+        let x61 = qd[1] * x57;
+        let x62 = 3946.18812068 * qd[1] - -39234.47412200001 * x54;
+        let x63 = 39241.404122 * qd[1] - 3946.1881206800003 * x54 - x58 * -5224.5702;
+        let x64 = x55 * -5224.5702;
+        let x65 = 5224.5702 * qd[1];
+        let x66 = c_q2 * x54 + s_q2 * x55;
+        let x67 = c_q2 * x55 - s_q2 * x54;
+        let x68 = -7.11 * x55;
+        let x69 = x57 + -0.475 * x55;
+        let x70 = x58 + (7.11 * qd[1] - 0.475 * x54);
+        let x71 = s_q2 * x70 - c_q2 * x69;
+        let x72 = s_q2 * x69 + c_q2 * x70;
+        let x73 = qd[1] + qd[2];
+        let x74 = -7.11 * x60;
+        let x75 = qd[1] * x58 + -0.475 * x60;
+        let x76 = 0.475 * x59 - x61;
+        let x77 = s_q2 * x60 - c_q2 * x59 - qd[2] * x67;
+        let x78 = s_q2 * x59 + c_q2 * x60 + qd[2] * x66;
+        let x79 = s_q2 * x75 + c_q2 * x76 + qd[2] * x71;
+        let x80 = 1375.0472756800002 * x73 - -24989.305802 * x66;
+        let x81 = 3239.4582 * x68;
+        let x82 = 24998.827802 * x73 - 1375.0472756800002 * x66 - x72 * -3239.4582;
+        let x83 = x67 * -3239.4582;
+        let x84 = 3239.4582 * x73;
+        let x85 = c_q3 * x66 + s_q3 * x67;
+        let x86 = c_q3 * x67 - s_q3 * x66;
+        let x87 = x68 + -7.11 * x67;
+        let x88 = x72 + 7.11 * x73;
+        let x89 = c_q3 * x71 + s_q3 * x88;
+        let x90 = s_q3 * x71 - c_q3 * x88;
+        let x91 = qd[3] + x73;
+        let x92 = c_q3 * x77 + s_q3 * x78 - qd[3] * x86;
+        let x93 = s_q3 * x77 - c_q3 * x78 - qd[3] * x85;
+        let x94 = -97.44448770720001 * x91;
+        let x95 = 132.6783695416 * x85 + 171.195516 * x87;
+        let x96 = 135.4729695416 * x91 + -97.44448770720001 * x86 + -171.195516 * x89;
+        let x97 = 171.195516 * x91;
+        let x98 = -171.195516 * x85;
+        let x99 = s_q4 * x91 - c_q4 * x85;
+        let x100 = s_q4 * x85 + c_q4 * x91;
+        let x101 = qd[4] + x86;
+        let x102 = 44.41 * x100;
+        let x103 = 47.471 * x101;
+        let x104 = 9.336 * (qd[5] + x99);
+        let x105 = 9.336 * (c_q4 * x92 + qd[4] * x100) - f_ext[5][3];
+        let x106 = (c_q5 * x101 - s_q5 * x100) * x104 - f_ext[5][4];
+        let x107 = f_ext[5][5] + (c_q5 * x100 + s_q5 * x101) * x104;
+        let x108 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
+        let x109 = x100 * x103 - x101 * x102 - f_ext[4][3] + (x105 + 0.7026 * x108);
+        let x110 = c_q5 * x106 + s_q5 * x107 - -0.7026 * f_ext[5][0]
+            - (f_ext[4][4] + (44.41 * (s_q4 * x92 + qd[4] * x99) + x99 * x103));
+        let x111 = 47.471 * x93 + x99 * x102 - f_ext[4][5] + (s_q5 * x106 - c_q5 * x107);
+        let x112 = f_ext[4][0] + f_ext[5][0];
+        let x113 = x108 - f_ext[4][1];
+        let x114 = f_ext[4][2] + (f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5);
+        let x115 = c_q4 * x112 + s_q4 * x113;
+        let x116 = 132.6783695416 * x92 + 171.195516 * (x74 + -7.11 * x78)
+            + (x91 * x94 - x86 * x96 - x90 * x98) - f_ext[3][3]
+            + (c_q4 * x109 - s_q4 * x110 - -0.5692 * x114);
+        let x117 = -97.44448770720001 * x93
+            + -171.195516
+                * (c_q3 * (c_q2 * x75 - s_q2 * x76 + qd[2] * x72) - s_q3 * x79
+                    - qd[3] * x90) + (x85 * x94 - x86 * x95 - x90 * x97) - f_ext[3][4]
+            + (s_q4 * x109 + c_q4 * x110);
+        let x118 = x91 * x95 - x85 * x96 + (x89 * x98 - x87 * x97) - f_ext[3][5]
+            + (x111 - 0.5692 * x115);
+        let x119 = f_ext[3][0] + x86 * x98 + x115;
+        let x120 = c_q4 * x113 - s_q4 * x112
+            - (f_ext[3][1] + (-171.195516 * x92 + x86 * x97));
+        let x121 = x91 * x97 - x85 * x98 - f_ext[3][2] - x114;
+        let x122 = s_q3 * x119 + c_q3 * x121;
+        let x123 = -24989.305802 * x77
+            + (x68 * x84 - x72 * x83 - (x67 * x82 + x73 * x81)) - f_ext[2][3]
+            + (c_q3 * x116 + s_q3 * x118);
+        let x124 = 1375.0472756800002 * x77 + x79 * -3239.4582
+            + (x67 * x80 - x66 * x81 + x71 * x84) - f_ext[2][4] + (x117 + -7.11 * x122);
+        let x125 = 3239.4582 * x74 - (x73 * x80 + x66 * x82 + x71 * x83) - f_ext[2][5]
+            + (c_q3 * x118 - s_q3 * x116 + 7.11 * x120);
+        let x126 = x67 * x83 - x73 * x84 - f_ext[2][0] + (s_q3 * x121 - c_q3 * x119);
+        let x127 = x66 * x83 - f_ext[2][2] + x122;
+        let x128 = c_q2 * x126 + s_q2 * x127;
+        let x129 = c_q2 * x127 - s_q2 * x126;
+        let x130 = tau[0]
             - (c_q1
-                * (c_q2 * x197 - s_q2 * x195
-                    + (0.475 * x200
-                        + 7.11
-                            * (x2
-                                * (279.2 * x111 + (x102 * x119 - x101 * x121) - f_ext[2][1]
-                                    + x193)))
-                    - (f_ext[1][5] + (2103.19 * x93 + (qd[1] * x96 + x87 * x97))))
+                * (x57 * x64 - (qd[1] * x62 + x54 * x63) - f_ext[1][5]
+                    + (c_q2 * x125 - s_q2 * x123
+                        + (0.475 * x128
+                            + 7.11
+                                * (x78 * -3239.4582 - x66 * x84 - f_ext[2][1] + x120))))
                 - s_q1
-                    * (qd[1] * x98 - x88 * x97 - 15.41 * x92 - f_ext[1][3]
-                        + (c_q2 * x195 + s_q2 * x197 + -0.475 * x201))
+                    * (c_q2 * x123 + s_q2 * x125 + -0.475 * x129
+                        - (f_ext[1][3]
+                            + (-39234.47412200001 * x59 + (x55 * x63 + x58 * x64))))
                 + 0.5692
-                    * (c_q1 * (314.88 * x94 - qd[1] * x100 - f_ext[1][0] + x200)
-                        + s_q1 * (qd[1] * x99 - 314.88 * x95 - f_ext[1][2] + x201))
-                - f_ext[0][5]);
-        let x203 = 1.0
-            / (8.446
+                    * (c_q1 * (x55 * x64 - qd[1] * x65 - f_ext[1][0] + x128)
+                        + s_q1 * (x54 * x64 - f_ext[1][2] + x129)) - f_ext[0][5]);
+        let x131 = 1.0
+            / (65697.3302265768
                 + (c_q1
-                    * (c_q1
-                        * (2103.19
-                            + (c_q2 * x65 - s_q2 * x63 - (x54 * 0.475 - 7.11 * x53)
-                                - (-7.11 * x57 - -0.475 * x58)))
-                        - s_q1 * (c_q2 * x61 - s_q2 * x59 + -7.11 * x56))
+                    * (c_q1 * (c_q2 * x38 - s_q2 * x36 + x40 - x39)
+                        - s_q1 * (c_q2 * x35 - s_q2 * x33 + -7.11 * x32))
                     - s_q1
-                        * (c_q1 * (c_q2 * x63 + s_q2 * x65 - 7.11 * x56)
-                            - s_q1
-                                * (15.41
-                                    + (c_q2 * x59 + s_q2 * x61 + -0.475 * x54 - x58 * 0.475)))
-                    - 0.5692 * x69 + -0.5692 * (x69 + -597.4892399999999)));
-        let x204 = x71 * x203;
-        let x205 = x72 * x203;
-        let x206 = x76 * x203;
-        let x207 = x80 * x203;
-        let x208 = x86 * x203;
-        let x209 = 1.0 / (2094.71 + (x2 * x62 - x67 + 7.11 * x57) - x71 * x204);
-        let x210 = x62 - x67 - x71 * x205;
-        let x211 = x209 * x210;
-        let x212 = x2 * x73 - -7.11 * x75 - x71 * x206;
-        let x213 = x209 * x212;
-        let x214 = x2 * x78 - x71 * x207;
-        let x215 = x209 * x214;
-        let x216 = x2 * x84 + x71 * x208;
-        let x217 = x209 * x216;
-        let x218 = 1.0 / (x50 - x72 * x205 - x210 * x211);
-        let x219 = x73 - x72 * x206 - x210 * x213;
-        let x220 = x218 * x219;
-        let x221 = x78 - x72 * x207 - x210 * x215;
-        let x222 = x218 * x221;
-        let x223 = x84 + x72 * x208 - x210 * x217;
-        let x224 = x218 * x223;
-        let x225 = 1.0 / (x31 - x76 * x206 - x212 * x213 - x219 * x220);
-        let x226 = x23 - x76 * x207 - x212 * x215 - x219 * x222;
-        let x227 = x225 * x226;
-        let x228 = x82 + x76 * x208 - x212 * x217 - x219 * x224;
-        let x229 = x225 * x228;
-        let x230 = 1.0 / (x18 - x80 * x207 - x214 * x215 - x221 * x222 - x226 * x227);
-        let x231 = x80 * x208 - x214 * x217 - x221 * x224 - x226 * x229;
-        let x232 = x230 * x231;
-        let x233 = 1.0
-            / (9.336 - x86 * x208 - x216 * x217 - x223 * x224 - x228 * x229
-                - x231 * x232);
-        let x234 = tau[1]
-            - (x88 * x96 + x87 * x98 + (x91 * x99 - x90 * x100) - 49.52 * x92
-                - f_ext[1][4] + (x2 * x196 + -7.11 * x201)) - x202 * x204;
-        let x235 = tau[2] - x196 - x202 * x205 - x211 * x234;
-        let x236 = tau[3] - x189 - x202 * x206 - x213 * x234 - x220 * x235;
-        let x237 = tau[4] - x183 - x202 * x207 - x215 * x234 - x222 * x235 - x227 * x236;
-        let x238 = x233
-            * (tau[5] - x174 + x202 * x208 - x217 * x234 - x224 * x235 - x229 * x236
-                - x232 * x237);
-        let x239 = x230 * x237 - x232 * x238;
-        let x240 = x225 * x236 - x227 * x239 - x229 * x238;
-        let x241 = x218 * x235 - x220 * x240 - x222 * x239 - x224 * x238;
-        let x242 = x209 * x234 - x211 * x241 - x213 * x240 - x215 * x239 - x217 * x238;
-        let x243 = x202 * x203 - x204 * x242 - x205 * x241 - x206 * x240 - x207 * x239
-            + x208 * x238;
-        [x243, x242, x241, x240, x239, x238]
+                        * (c_q1 * (c_q2 * x36 + s_q2 * x38 - 7.11 * x32)
+                            - s_q1 * (-39234.47412200001 + (c_q2 * x33 + s_q2 * x35)))));
+        let x132 = x45 * x131;
+        let x133 = x46 * x131;
+        let x134 = x49 * x131;
+        let x135 = x50 * x131;
+        let x136 = x53 * x131;
+        let x137 = 1.0 / (39241.404122 + (x40 + x42) - x45 * x132);
+        let x138 = x42 - x45 * x133;
+        let x139 = x137 * x138;
+        let x140 = x21 - -7.11 * x48 - x45 * x134;
+        let x141 = x137 * x140;
+        let x142 = x45 * x135;
+        let x143 = x137 * x142;
+        let x144 = x7 + x45 * x136;
+        let x145 = x137 * x144;
+        let x146 = 1.0 / (x28 - x46 * x133 - x138 * x139);
+        let x147 = x21 - x46 * x134 - x138 * x141;
+        let x148 = x146 * x147;
+        let x149 = x138 * x143 - x46 * x135;
+        let x150 = x146 * x149;
+        let x151 = x7 + x46 * x136 - x138 * x145;
+        let x152 = x146 * x151;
+        let x153 = 1.0 / (x10 - x49 * x134 - x140 * x141 - x147 * x148);
+        let x154 = x140 * x143 - x49 * x135 - x147 * x150;
+        let x155 = x153 * x154;
+        let x156 = x7 + x49 * x136 - x140 * x145 - x147 * x152;
+        let x157 = x153 * x156;
+        let x158 = 1.0 / (47.471 - x50 * x135 - x142 * x143 - x149 * x150 - x154 * x155);
+        let x159 = x50 * x136 + x142 * x145 - x149 * x152 - x154 * x157;
+        let x160 = x158 * x159;
+        let x161 = 1.0
+            / (9.336 - x53 * x136 - x144 * x145 - x151 * x152 - x156 * x157
+                - x159 * x160);
+        let x162 = tau[1]
+            - (x55 * x62 - x57 * x65 - (3946.1881206800003 * x59 + x61 * -5224.5702)
+                - f_ext[1][4] + (x124 + -7.11 * x129)) - x130 * x132;
+        let x163 = tau[2] - x124 - x130 * x133 - x139 * x162;
+        let x164 = tau[3] - x117 - x130 * x134 - x141 * x162 - x148 * x163;
+        let x165 = tau[4] - x111 - x130 * x135 + x143 * x162 - x150 * x163 - x155 * x164;
+        let x166 = x161
+            * (tau[5] - x105 + x130 * x136 - x145 * x162 - x152 * x163 - x157 * x164
+                - x160 * x165);
+        let x167 = x158 * x165 - x160 * x166;
+        let x168 = x153 * x164 - x155 * x167 - x157 * x166;
+        let x169 = x146 * x163 - x148 * x168 - x150 * x167 - x152 * x166;
+        let x170 = x137 * x162 - x139 * x169 - x141 * x168 + x143 * x167 - x145 * x166;
+        let x171 = x130 * x131 - x132 * x170 - x133 * x169 - x134 * x168 - x135 * x167
+            + x136 * x166;
+        [x171, x170, x169, x168, x167, x166]
     }
 }

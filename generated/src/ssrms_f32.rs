@@ -6,6 +6,7 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
+//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Precision: `f32`: inputs, outputs and every intermediate; the model's numbers rounded to `f32` constants; libm's `sincosf`, `sinf`, `cosf`, `sqrtf`.
 //! Fused multiply-adds: none.
 //!
@@ -13,26 +14,26 @@
 //!
 //! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 721 | 679 | 0 | 0 | 7 | 1400 |
-//! | `mass_matrix` | `recurrent-r1` | — | 822 | 723 | 0 | 0 | 7 | 1545 |
-//! | `mass_matrix` | `kane-direct` | — | 923 | 635 | 0 | 0 | 7 | 1558 |
-//! | `mass_matrix` | `crba-base` | — | 623 | 475 | 0 | 0 | 7 | 1098 |
-//! | `mass_matrix` * | `crba` | — | 254 | 171 | 0 | 0 | 6 | 425 |
-//! | `nonlinear_effects` | — | `recurrent` | 652 | 464 | 0 | 0 | 7 | 1116 |
-//! | `nonlinear_effects` | — | `kane-direct` | 797 | 580 | 0 | 0 | 7 | 1377 |
-//! | `nonlinear_effects` * | — | `rnea` | 394 | 265 | 0 | 0 | 6 | 659 |
-//! | `inverse_dynamics` | — | `recurrent` | 953 | 670 | 0 | 0 | 7 | 1623 |
-//! | `inverse_dynamics` | — | `kane-direct` | 1098 | 786 | 0 | 0 | 7 | 1884 |
-//! | `inverse_dynamics` * | — | `rnea` | 404 | 279 | 0 | 0 | 6 | 683 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 1032 | 727 | 7 | 0 | 7 | 1759 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 1177 | 843 | 7 | 0 | 7 | 2020 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 774 | 530 | 7 | 0 | 6 | 1304 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 906 | 623 | 0 | 0 | 7 | 1529 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 1051 | 739 | 0 | 0 | 7 | 1790 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 648 | 426 | 0 | 0 | 6 | 1074 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1137 | 832 | 7 | 0 | 7 | 1969 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1282 | 948 | 7 | 0 | 7 | 2230 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 774 | 566 | 7 | 0 | 6 | 1340 |
+//! | `mass_matrix` | `recurrent` | — | 681 | 661 | 0 | 0 | 7 | 1342 |
+//! | `mass_matrix` | `recurrent-r1` | — | 778 | 703 | 0 | 0 | 7 | 1481 |
+//! | `mass_matrix` | `kane-direct` | — | 709 | 510 | 0 | 0 | 7 | 1219 |
+//! | `mass_matrix` | `crba-base` | — | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` * | `crba` | — | 170 | 116 | 0 | 0 | 5 | 286 |
+//! | `nonlinear_effects` | — | `recurrent` | 618 | 450 | 0 | 0 | 7 | 1068 |
+//! | `nonlinear_effects` | — | `kane-direct` | 708 | 536 | 0 | 0 | 7 | 1244 |
+//! | `nonlinear_effects` * | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `inverse_dynamics` | — | `recurrent` | 827 | 607 | 0 | 0 | 7 | 1434 |
+//! | `inverse_dynamics` | — | `kane-direct` | 917 | 693 | 0 | 0 | 7 | 1610 |
+//! | `inverse_dynamics` * | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 914 | 667 | 7 | 0 | 7 | 1581 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 1004 | 753 | 7 | 0 | 7 | 1757 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 788 | 566 | 0 | 0 | 7 | 1354 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 878 | 652 | 0 | 0 | 7 | 1530 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1018 | 772 | 7 | 0 | 7 | 1790 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1108 | 858 | 7 | 0 | 7 | 1966 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsF32;
@@ -90,19 +91,19 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 254u64,
-            add: 171u64,
+            mul: 170u64,
+            add: 116u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 6u64,
+            sincos: 5u64,
             fma: 0u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 394u64,
-            add: 265u64,
+            mul: 256u64,
+            add: 176u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -112,8 +113,8 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 404u64,
-            add: 279u64,
+            mul: 268u64,
+            add: 191u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -123,8 +124,8 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 774u64,
-            add: 530u64,
+            mul: 552u64,
+            add: 393u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -134,8 +135,8 @@ impl SsrmsF32 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 648u64,
-            add: 426u64,
+            mul: 426u64,
+            add: 292u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -145,8 +146,8 @@ impl SsrmsF32 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 774u64,
-            add: 566u64,
+            mul: 564u64,
+            add: 437u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -159,8 +160,8 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
-            mul: 721u64,
-            add: 679u64,
+            mul: 681u64,
+            add: 661u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -170,8 +171,8 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
-            mul: 822u64,
-            add: 723u64,
+            mul: 778u64,
+            add: 703u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -181,8 +182,8 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
-            mul: 923u64,
-            add: 635u64,
+            mul: 709u64,
+            add: 510u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -192,8 +193,8 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
-            mul: 623u64,
-            add: 475u64,
+            mul: 577u64,
+            add: 454u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -203,19 +204,19 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 254u64,
-            add: 171u64,
+            mul: 170u64,
+            add: 116u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 6u64,
+            sincos: 5u64,
             fma: 0u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 652u64,
-            add: 464u64,
+            mul: 618u64,
+            add: 450u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -225,8 +226,8 @@ impl SsrmsF32 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 797u64,
-            add: 580u64,
+            mul: 708u64,
+            add: 536u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -236,8 +237,8 @@ impl SsrmsF32 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 394u64,
-            add: 265u64,
+            mul: 256u64,
+            add: 176u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -247,8 +248,8 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 953u64,
-            add: 670u64,
+            mul: 827u64,
+            add: 607u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -258,8 +259,8 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 1098u64,
-            add: 786u64,
+            mul: 917u64,
+            add: 693u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -269,8 +270,8 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 404u64,
-            add: 279u64,
+            mul: 268u64,
+            add: 191u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -280,8 +281,8 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 1032u64,
-            add: 727u64,
+            mul: 914u64,
+            add: 667u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -291,8 +292,8 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 1177u64,
-            add: 843u64,
+            mul: 1004u64,
+            add: 753u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -302,8 +303,8 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 774u64,
-            add: 530u64,
+            mul: 552u64,
+            add: 393u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -313,63 +314,63 @@ impl SsrmsF32 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 906u64,
-            add: 623u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
-            mul: 1051u64,
-            add: 739u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 648u64,
-            add: 426u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
-            mul: 1137u64,
-            add: 832u64,
-            div: 7u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
-            mul: 1282u64,
-            add: 948u64,
-            div: 7u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 774u64,
+            mul: 788u64,
             add: 566u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 878u64,
+            add: 652u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 426u64,
+            add: 292u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 1018u64,
+            add: 772u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1108u64,
+            add: 858u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 564u64,
+            add: 437u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -378,173 +379,126 @@ impl SsrmsF32 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 254 mul, 171 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`: 170 mul, 116 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix(q: &[f32; 7]) -> [[f32; 7]; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = c_q6 * x12 + s_q6 * x13;
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + (x10 * x11 + 120.28197);
-        let x19 = 12.13 + (x14 + 120.28197);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.19551;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = s_q5 * x22 - c_q5 * x23;
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = c_q5 * x28 + x21 * 0.5692;
-        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27939);
-        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
-        let x36 = 8.0386 + (x8 * x29 + 113.27939);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01509;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4583;
-        let x41 = c_q4 * x34 - s_q4 * x32;
-        let x42 = c_q4 * x30 + s_q4 * x33;
-        let x43 = s_q4 * x36 - c_q4 * x31;
-        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
-        let x45 = x6 * x35;
-        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
-        let x47 = s_q4 * x34 + c_q4 * x32;
-        let x48 = c_q4 * x33 - s_q4 * x30;
-        let x49 = s_q4 * x31 + c_q4 * x36;
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
-        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
-        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
-        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
-        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
-        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
-        let x58 = s_q3 * x39;
-        let x59 = c_q3 * x40 + x58;
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = x61 - s_q3 * x40;
-        let x63 = x59 + 5224.5703;
-        let x64 = x60 + -349.0395;
-        let x65 = c_q3 * x54 + s_q3 * x52;
-        let x66 = c_q3 * x55 + s_q3 * x50;
-        let x67 = c_q3 * x53 + s_q3 * x57;
-        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
-        let x69 = x4 * x56;
-        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
-        let x71 = c_q3 * x52 - s_q3 * x54;
-        let x72 = c_q3 * x50 - s_q3 * x55;
-        let x73 = c_q3 * x57 - s_q3 * x53;
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
-        let x78 = x4 * x72 + x76;
-        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
-        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
-        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
-        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
-        let x83 = 2103.19
-            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
-                - (-7.11 * x63 - -0.475 * x64));
-        let x84 = s_q2 * x62;
-        let x85 = c_q2 * x63 + x84;
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = x87 - s_q2 * x63;
-        let x89 = x86 + -597.48926;
-        let x90 = c_q2 * x80 + s_q2 * x77;
-        let x91 = c_q2 * x81 + s_q2 * x78;
-        let x92 = c_q2 * x79 + s_q2 * x83;
-        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
-        let x94 = x2 * x82;
-        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
-        let x96 = -0.5692 * x85;
-        let x97 = 8.446
-            + (c_q2 * (c_q2 * x83 - s_q2 * x79) - s_q2 * (c_q2 * x77 - s_q2 * x80)
-                - 0.5692 * x86 + -0.5692 * x89);
-        let x98 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x99 = 12.19
-            + (c_q1
-                * (c_q1
-                    * (8.088 + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
-                    - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
-                - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
-                - -0.7026 * x98 + 0.7026 * (x98 + 811.9808));
-        let x100 = c_q1 * (c_q2 * x92 - s_q2 * x90)
-            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
-            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
-        let x101 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88;
-        let x102 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
-        let x103 = x66 - x74;
-        let x104 = x69 - x75;
-        let x105 = x72 + x76;
-        let x106 = x87 - s_q2 * x59;
-        let x107 = c_q2 * x105 - s_q2 * x103 + 0.5692 * x106;
-        let x108 = c_q1 * (c_q2 * x103 + s_q2 * x105 - -0.5692 * (x84 + c_q2 * x59))
-            - s_q1 * (x2 * x104) + -0.7026 * (s_q1 * x106);
-        let x109 = x45 - x51;
-        let x110 = x61 - s_q3 * x37;
-        let x111 = x58 + c_q3 * x37;
-        let x112 = c_q3 * x42 + s_q3 * x48 - -0.475 * x111;
-        let x113 = x4 * x109 - -7.11 * x111;
-        let x114 = c_q3 * x48 - s_q3 * x42 + 0.475 * x110;
-        let x115 = c_q2 * x110 - s_q2 * x111;
-        let x116 = c_q2 * x114 - s_q2 * x112 + 0.5692 * x115;
-        let x117 = c_q1
-            * (c_q2 * x112 + s_q2 * x114 - -0.5692 * (s_q2 * x110 + c_q2 * x111))
-            - s_q1 * (x2 * x113) + -0.7026 * (s_q1 * x115);
-        let x118 = s_q4 * x29 - c_q4 * x24;
-        let x119 = x6 * x27;
-        let x120 = s_q4 * x24 + c_q4 * x29;
-        let x121 = c_q3 * x118 + s_q3 * x120;
-        let x122 = x4 * x119;
-        let x123 = c_q3 * x120 - s_q3 * x118;
-        let x124 = c_q2 * x123 - s_q2 * x121;
-        let x125 = c_q1 * (c_q2 * x121 + s_q2 * x123) - s_q1 * (x2 * x122);
-        let x126 = c_q5 * x11;
-        let x127 = s_q5 * x11;
-        let x128 = c_q4 * x126;
-        let x129 = x6 * x127;
-        let x130 = s_q4 * x126;
-        let x131 = c_q3 * x128 - s_q3 * x130;
-        let x132 = x4 * x129;
-        let x133 = s_q3 * x128 + c_q3 * x130;
-        let x134 = -(s_q2 * x131 + c_q2 * x133);
-        let x135 = c_q1 * (c_q2 * x131 - s_q2 * x133) - s_q1 * (x2 * x132);
+        let x5 = 9.336 * c_q5;
+        let x6 = 44.41 * s_q5;
+        let x7 = 9.336 * s_q5;
+        let x8 = 44.41 * c_q5;
+        let x9 = s_q5 * x5 - c_q5 * x6;
+        let x10 = c_q5 * x7 - s_q5 * x8;
+        let x11 = 132.67838 + (c_q5 * x5 + s_q5 * x6);
+        let x12 = 135.47298 + (s_q5 * x7 + c_q5 * x8);
+        let x13 = -171.19551 * s_q4;
+        let x14 = -171.19551 * c_q4;
+        let x15 = c_q4 * x11;
+        let x16 = -97.44449 * s_q4;
+        let x17 = c_q4 * x9 + x16;
+        let x18 = 47.471 * s_q4;
+        let x19 = s_q4 * x11;
+        let x20 = -97.44449 * c_q4;
+        let x21 = x20 - s_q4 * x9;
+        let x22 = 47.471 * c_q4;
+        let x23 = x20 - s_q4 * x10;
+        let x24 = x13 * -7.11;
+        let x25 = 7.11 * x13;
+        let x26 = x12 - x24;
+        let x27 = s_q4 * x22 - c_q4 * x19 - 7.11 * x14;
+        let x28 = c_q4 * x18 - s_q4 * x15 + x14 * -7.11;
+        let x29 = s_q4 * x19 + c_q4 * x22 + x25 - x24;
+        let x30 = 3239.4583 + x13;
+        let x31 = -24989.307 + (c_q4 * x15 + s_q4 * x18);
+        let x32 = 1375.0472 + x17;
+        let x33 = 1375.0472 + (x16 + c_q4 * x10);
+        let x34 = 24998.828 + (x25 + x26);
+        let x35 = s_q3 * x14;
+        let x36 = c_q3 * x30 + x35;
+        let x37 = c_q3 * x14;
+        let x38 = x37 - s_q3 * x30;
+        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x40 = s_q3 * x21;
+        let x41 = c_q3 * x28 + s_q3 * x29;
+        let x42 = c_q3 * x27 - s_q3 * x31;
+        let x43 = c_q3 * x21;
+        let x44 = c_q3 * x29 - s_q3 * x28;
+        let x45 = -7.11 * x36;
+        let x46 = 7.11 * x36;
+        let x47 = c_q3 * x32 + x40 - -0.475 * x36;
+        let x48 = x34 - x45;
+        let x49 = c_q3 * x42 + s_q3 * x44 - 7.11 * x38;
+        let x50 = x43 - s_q3 * x32 + x38 * 0.475;
+        let x51 = c_q3 * x41 - s_q3 * x39 + -7.11 * x38;
+        let x52 = c_q3 * x23 - s_q3 * x33 - -0.475 * x38;
+        let x53 = c_q3 * x44 - s_q3 * x42 + x46 - x45;
+        let x54 = 5224.5703 + x36;
+        let x55 = -39234.473 + (c_q3 * x39 + s_q3 * x41);
+        let x56 = 3946.1882 + x47;
+        let x57 = 3946.1882 + (c_q3 * x33 + s_q3 * x23 + x36 * 0.475);
+        let x58 = 39241.402 + (x46 + x48);
+        let x59 = s_q2 * x38;
+        let x60 = c_q2 * x54 + x59;
+        let x61 = c_q2 * x38;
+        let x62 = x61 - s_q2 * x54;
+        let x63 = c_q2 * x55 + s_q2 * x49;
+        let x64 = s_q2 * x50;
+        let x65 = c_q2 * x51 + s_q2 * x53;
+        let x66 = c_q2 * x50;
+        let x67 = x66 - s_q2 * x56 + 0.5692 * x62;
+        let x68 = 65697.33
+            + (c_q2 * (c_q2 * x53 - s_q2 * x51) - s_q2 * (c_q2 * x49 - s_q2 * x55));
+        let x69 = c_q1 * (c_q2 * x56 + x64 - -0.5692 * x60);
+        let x70 = 66279.66
+            + (0.7026 * x62
+                + (c_q1
+                    * (c_q1 * (c_q2 * x63 + s_q2 * x65)
+                        - s_q1 * (c_q2 * x57 + s_q2 * x52 + 0.5692 * x60))
+                    - s_q1 * (x69 - s_q1 * (-65693.914 + x58)) - -0.7026 * x62));
+        let x71 = c_q1 * (c_q2 * x65 - s_q2 * x63)
+            - s_q1 * (c_q2 * x52 - s_q2 * x57 - -0.5692 * x62)
+            + -0.7026 * (c_q1 * x60 + s_q1 * 1145.5438);
+        let x72 = x69 - s_q1 * x58 + -0.7026 * (s_q1 * x62);
+        let x73 = x61 - s_q2 * x36;
+        let x74 = x66 - s_q2 * x47 + 0.5692 * x73;
+        let x75 = c_q1 * (x64 + c_q2 * x47 - -0.5692 * (x59 + c_q2 * x36)) - s_q1 * x48
+            + -0.7026 * (s_q1 * x73);
+        let x76 = x37 - s_q3 * x13;
+        let x77 = x35 + c_q3 * x13;
+        let x78 = x40 + c_q3 * x17 - -0.475 * x77;
+        let x79 = x26 - -7.11 * x77;
+        let x80 = x43 - s_q3 * x17 + 0.475 * x76;
+        let x81 = c_q2 * x76 - s_q2 * x77;
+        let x82 = c_q2 * x80 - s_q2 * x78 + 0.5692 * x81;
+        let x83 = c_q1 * (c_q2 * x78 + s_q2 * x80 - -0.5692 * (s_q2 * x76 + c_q2 * x77))
+            - s_q1 * x79 + -0.7026 * (s_q1 * x81);
+        let x84 = c_q3 * x18 + s_q3 * x22;
+        let x85 = c_q3 * x22 - s_q3 * x18;
+        let x86 = c_q2 * x85 - s_q2 * x84;
+        let x87 = c_q1 * (c_q2 * x84 + s_q2 * x85);
+        let x88 = c_q4 * x5;
+        let x89 = s_q4 * x5;
+        let x90 = c_q3 * x88 - s_q3 * x89;
+        let x91 = s_q3 * x88 + c_q3 * x89;
+        let x92 = -(s_q2 * x90 + c_q2 * x91);
+        let x93 = c_q1 * (c_q2 * x90 - s_q2 * x91) - s_q1 * x7;
         [
-            [x99, x100, x102, x108, x117, x125, x135],
-            [x100, x97, x101, x107, x116, x124, x134],
-            [x102, x101, x82, x104, x113, x122, x132],
-            [x108, x107, x104, x56, x109, x119, x129],
-            [x117, x116, x113, x109, x35, x27, x127],
-            [x125, x124, x122, x119, x27, x20, 0.0],
-            [x135, x134, x132, x129, x127, 0.0, 9.336],
+            [x70, x71, x72, x75, x83, x87, x93],
+            [x71, x68, x67, x74, x82, x86, x92],
+            [x72, x67, x58, x48, x79, 0.0, x7],
+            [x75, x74, x48, x34, x26, 0.0, x7],
+            [x83, x82, x79, x26, x12, 0.0, x7],
+            [x87, x86, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x93, x92, x7, x7, x7, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 394 mul, 265 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `rnea`: 256 mul, 176 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f32; 7], qd: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -557,189 +511,127 @@ impl SsrmsF32 {
         let x7 = qd[1] * x1;
         let x8 = qd[1] * x5;
         let x9 = qd[1] * x4;
-        let x10 = 8.088 * x1;
-        let x11 = 3.061 * x2;
-        let x12 = 8.446 * qd[1];
-        let x13 = 105.98 * x4;
-        let x14 = 105.98 * x5;
+        let x10 = -65693.914 * x2;
+        let x11 = 65697.33 * qd[1] - x4 * 1145.5438;
+        let x12 = -1145.5438 * qd[1];
+        let x13 = x1 * 1145.5438;
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x16 = c_q2 + (1.0 - c_q2);
-        let x17 = x1 * c_q2 - qd[1] * s_q2;
-        let x18 = x1 * s_q2 + qd[1] * c_q2;
-        let x19 = x1 * 0.5692;
-        let x20 = x4 + -0.5692 * qd[1];
-        let x21 = s_q2 * x19 - c_q2 * x20;
-        let x22 = x5 * x16;
-        let x23 = s_q2 * x20 + c_q2 * x19;
-        let x24 = qd[2] - x2 * x16;
-        let x25 = x7 * x16;
-        let x26 = x6 * 0.5692;
-        let x27 = x9 * x16;
-        let x28 = x6 * c_q2 + qd[2] * x18;
-        let x29 = qd[2] * x17 - x6 * s_q2;
-        let x30 = qd[2] * x23 - (x8 * c_q2 + s_q2 * x26);
-        let x31 = c_q2 * x26 - x8 * s_q2 + qd[2] * x21;
-        let x32 = 15.41 * x17 + 49.52 * x24;
-        let x33 = 49.52 * x17 + 2094.71 * x24;
-        let x34 = 2103.19 * x18;
-        let x35 = 314.88 * x21;
-        let x36 = 314.88 * x22;
-        let x37 = 314.88 * x23;
+        let x15 = x1 * c_q2 - qd[1] * s_q2;
+        let x16 = x1 * s_q2 + qd[1] * c_q2;
+        let x17 = x1 * 0.5692;
+        let x18 = x4 + -0.5692 * qd[1];
+        let x19 = s_q2 * x17 - c_q2 * x18;
+        let x20 = s_q2 * x18 + c_q2 * x17;
+        let x21 = qd[2] - x2;
+        let x22 = x6 * 0.5692;
+        let x23 = x6 * c_q2 + qd[2] * x16;
+        let x24 = qd[2] * x15 - x6 * s_q2;
+        let x25 = c_q2 * x22 - x8 * s_q2 + qd[2] * x19;
+        let x26 = -39234.473 * x15 + 3946.1882 * x21;
+        let x27 = 5224.5703 * x5;
+        let x28 = 3946.1882 * x15 + 39241.402 * x21 - x20 * -5224.5703;
+        let x29 = x16 * -5224.5703;
+        let x30 = 5224.5703 * x21;
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x39 = c_q3 + (1.0 - c_q3);
-        let x40 = x17 * c_q3 - x18 * s_q3;
-        let x41 = x17 * s_q3 + x18 * c_q3;
-        let x42 = x21 - -0.475 * x18;
-        let x43 = x23 + (x17 * 0.475 + 7.11 * x24);
-        let x44 = c_q3 * x42 + s_q3 * x43;
-        let x45 = x39 * (x22 + x18 * -7.11);
-        let x46 = s_q3 * x42 - c_q3 * x43;
-        let x47 = qd[3] + x24 * x39;
-        let x48 = x25 * x39;
-        let x49 = x30 - -0.475 * x29;
-        let x50 = x31 + (x28 * 0.475 + 7.11 * x25);
-        let x51 = x39 * (x27 - x29 * -7.11);
-        let x52 = x28 * c_q3 + x29 * s_q3 + qd[3] * x41;
-        let x53 = x29 * c_q3 - x28 * s_q3 + qd[3] * x40;
-        let x54 = c_q3 * x49 - s_q3 * x50 - qd[3] * x46;
-        let x55 = s_q3 * x49 + c_q3 * x50 + qd[3] * x44;
-        let x56 = 9.522 * x40 + -39.95 * x47;
-        let x57 = -39.95 * x40 + 1966.28 * x47;
-        let x58 = 1966.28 * x41;
-        let x59 = 279.2 * x44;
-        let x60 = 279.2 * x45;
-        let x61 = 279.2 * x46;
+        let x32 = x15 * c_q3 - x16 * s_q3;
+        let x33 = x15 * s_q3 + x16 * c_q3;
+        let x34 = x19 - -0.475 * x16;
+        let x35 = x5 + x16 * -7.11;
+        let x36 = x20 + (x15 * 0.475 + 7.11 * x21);
+        let x37 = c_q3 * x34 + s_q3 * x36;
+        let x38 = s_q3 * x34 - c_q3 * x36;
+        let x39 = qd[3] + x21;
+        let x40 = 7.11 * x7;
+        let x41 = qd[2] * x20 - (x8 * c_q2 + s_q2 * x22) - -0.475 * x24;
+        let x42 = x9 - x24 * -7.11;
+        let x43 = x25 + (x23 * 0.475 + x40);
+        let x44 = x23 * c_q3 + x24 * s_q3 + qd[3] * x33;
+        let x45 = x24 * c_q3 - x23 * s_q3 + qd[3] * x32;
+        let x46 = s_q3 * x41 + c_q3 * x43 + qd[3] * x37;
+        let x47 = -24989.307 * x32 + 1375.0472 * x39;
+        let x48 = 3239.4583 * x35;
+        let x49 = 1375.0472 * x32 + 24998.828 * x39 + x38 * -3239.4583;
+        let x50 = x33 * -3239.4583;
+        let x51 = 3239.4583 * x39;
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x63 = c_q4 + (1.0 - c_q4);
-        let x64 = x40 * c_q4 - x41 * s_q4;
-        let x65 = x40 * s_q4 + x41 * c_q4;
-        let x66 = x46 - 7.11 * x47;
-        let x67 = x44 * c_q4 - s_q4 * x66;
-        let x68 = x63 * (x45 + x41 * -7.11);
-        let x69 = x44 * s_q4 + c_q4 * x66;
-        let x70 = qd[4] + x47 * x63;
-        let x71 = x48 * x63;
-        let x72 = x55 + 7.11 * x48;
-        let x73 = x63 * (x51 - -7.11 * x53);
-        let x74 = x52 * c_q4 + x53 * s_q4 + qd[4] * x65;
-        let x75 = x53 * c_q4 - x52 * s_q4 + qd[4] * x64;
-        let x76 = x54 * c_q4 - s_q4 * x72 - qd[4] * x69;
-        let x77 = x54 * s_q4 + c_q4 * x72 + qd[4] * x67;
-        let x78 = 8.305 * x64;
-        let x79 = 3.061 * x70;
-        let x80 = 8.0386 * x65;
-        let x81 = 105.98 * x67;
-        let x82 = 105.98 * x68;
-        let x83 = 105.98 * x69;
+        let x53 = x32 * c_q4 - x33 * s_q4;
+        let x54 = x32 * s_q4 + x33 * c_q4;
+        let x55 = x35 + x33 * -7.11;
+        let x56 = x38 - 7.11 * x39;
+        let x57 = x37 * c_q4 - s_q4 * x56;
+        let x58 = x37 * s_q4 + c_q4 * x56;
+        let x59 = qd[4] + x39;
+        let x60 = x44 * c_q4 + x45 * s_q4 + qd[4] * x54;
+        let x61 = x45 * c_q4 - x44 * s_q4 + qd[4] * x53;
+        let x62 = -97.44449 * x59;
+        let x63 = 132.67838 * x53 - x55 * 171.19551;
+        let x64 = 135.47298 * x59 + -97.44449 * x54 + -171.19551 * x57;
+        let x65 = x59 * 171.19551;
+        let x66 = -171.19551 * x53;
+        let x67 = x59 * x65 - x53 * x66;
+        let x68 = x7 * 171.19551 + x54 * x66;
+        let x69 = -171.19551 * x60 - x54 * x65;
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x85 = c_q5 + (1.0 - c_q5);
-        let x86 = x64 * c_q5 + x70 * s_q5;
-        let x87 = x70 * c_q5 - x64 * s_q5;
-        let x88 = x67 - -0.5692 * x65;
-        let x89 = c_q5 * x88 - x68 * s_q5;
-        let x90 = s_q5 * x88 + x68 * c_q5;
-        let x91 = x85 * (x69 - 0.5692 * x64);
-        let x92 = qd[5] + x65 * x85;
-        let x93 = x75 * x85;
-        let x94 = x76 - -0.5692 * x75;
-        let x95 = x85 * (x77 + 0.5692 * x74);
-        let x96 = qd[5] * x87 - (x74 * c_q5 + x71 * s_q5);
-        let x97 = x74 * s_q5 - x71 * c_q5 - qd[5] * x86;
-        let x98 = c_q5 * x94 + x73 * s_q5 - qd[5] * x90;
-        let x99 = x73 * c_q5 - s_q5 * x94 - qd[5] * x89;
-        let x100 = 12.13 * x86;
-        let x101 = 12.13 * x87;
-        let x102 = 3.061 * x92;
-        let x103 = 105.98 * x89;
-        let x104 = 105.98 * x90;
-        let x105 = 105.98 * x91;
+        let x71 = x53 * c_q5 + x59 * s_q5;
+        let x72 = x59 * c_q5 - x53 * s_q5;
+        let x73 = qd[5] + x54;
+        let x74 = 44.41 * x72;
+        let x75 = 47.471 * x73;
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x107 = c_q6 + (1.0 - c_q6);
-        let x108 = x87 * c_q6 + x92 * s_q6;
-        let x109 = x92 * c_q6 - x87 * s_q6;
-        let x110 = x90 + -0.7026 * x86;
-        let x111 = x107 * (x89 - 0.7026 * x87);
-        let x112 = x91 * s_q6 - c_q6 * x110;
-        let x113 = s_q6 * x110 + x91 * c_q6;
-        let x114 = qd[6] + x86 * x107;
-        let x115 = x99 - -0.7026 * x96;
-        let x116 = 9.336 * x114;
-        let x117 = 44.41 * x108;
-        let x118 = 44.41 * x109;
-        let x119 = 243.66 * x111;
-        let x120 = 243.66 * x112;
-        let x121 = 243.66 * x113;
-        let x122 = 9.336 * (x96 * x107)
-            + (x108 * x118 - x109 * x117 + (x112 * x121 - x113 * x120));
-        let x123 = 44.41 * (x97 * c_q6 + x93 * s_q6 + qd[6] * x109)
-            + (x109 * x116 - x114 * x118 + (x113 * x119 - x111 * x121));
-        let x124 = 44.41 * (x93 * c_q6 - x97 * s_q6 - qd[6] * x108)
-            + (x114 * x117 - x108 * x116 + (x111 * x120 - x112 * x119));
-        let x125 = 243.66 * (c_q6 * x115 + x95 * s_q6 + qd[6] * x113)
-            + (x109 * x119 - x114 * x121);
-        let x126 = 243.66 * (x95 * c_q6 - s_q6 * x115 - qd[6] * x112)
-            + (x114 * x120 - x108 * x119);
-        let x127 = x107
-            * (243.66 * (x107 * (x98 - 0.7026 * x97)) + (x108 * x121 - x109 * x120));
-        let x128 = c_q6 * x125 - s_q6 * x126;
-        let x129 = 12.13 * x96 + (x87 * x102 - x92 * x101 + (x91 * x104 - x90 * x105))
-            + (x107 * x122 + 0.7026 * x128);
-        let x130 = 12.13 * x97 + (x92 * x100 - x86 * x102 + (x91 * x103 - x89 * x105))
-            + (c_q6 * x123 - s_q6 * x124 + -0.7026 * x127);
-        let x131 = 3.061 * x93 + (x86 * x101 - x87 * x100 + (x90 * x103 - x89 * x104))
-            + (s_q6 * x123 + c_q6 * x124);
-        let x132 = 105.98 * x98 + (x92 * x104 + x87 * x105) + x127;
-        let x133 = 105.98 * x99 + (x92 * x103 - x86 * x105) + x128;
-        let x134 = c_q5 * x132 - s_q5 * x133;
-        let x135 = x85
-            * (105.98 * x95 - (x87 * x103 + x86 * x104) + (s_q6 * x125 + c_q6 * x126));
-        let x136 = x70 * x80 - x65 * x79 + (x69 * x82 - x68 * x83) - 8.305 * x74
-            + (c_q5 * x129 - s_q5 * x130 + -0.5692 * x135);
-        let x137 = x65 * x78 - x64 * x80 + (x69 * x81 - x67 * x83) - 3.061 * x71
-            + (s_q5 * x129 + c_q5 * x130);
-        let x138 = 8.0386 * x75 + (x64 * x79 - x70 * x78 + (x68 * x81 - x67 * x82))
-            + (x85 * x131 + 0.5692 * x134);
-        let x139 = 105.98 * x76 + (x65 * x82 + x70 * x83) + x134;
-        let x140 = 105.98 * x77 - (x70 * x81 + x64 * x82) + x135;
-        let x141 = x63
-            * (105.98 * x73 + (x65 * x81 - x64 * x83) + (s_q5 * x132 + c_q5 * x133));
-        let x142 = c_q4 * x140 - s_q4 * x139;
-        let x143 = x47 * x58 - x41 * x57 + (x46 * x60 - x45 * x61)
-            - (9.522 * x52 + -39.95 * x48) + (c_q4 * x136 + s_q4 * x138);
-        let x144 = x41 * x56 - x40 * x58 + (x46 * x59 - x44 * x61)
-            - (-39.95 * x52 + 1966.28 * x48) + (x63 * x137 + -7.11 * x142);
-        let x145 = 1966.28 * x53 + (x40 * x57 - x47 * x56 + (x45 * x59 - x44 * x60))
-            + (c_q4 * x138 - s_q4 * x136 + 7.11 * x141);
-        let x146 = 279.2 * x54 + (x41 * x60 + x47 * x61) + (c_q4 * x139 + s_q4 * x140);
-        let x147 = 279.2 * x55 - (x47 * x59 + x40 * x60) + x142;
-        let x148 = c_q3 * x146 + s_q3 * x147;
-        let x149 = x39 * (279.2 * x51 + (x41 * x59 - x40 * x61) + x141);
-        let x150 = c_q3 * x147 - s_q3 * x146;
-        let x151 = x24 * x34 - x18 * x33 + (x22 * x37 - x23 * x36)
-            - (15.41 * x28 + 49.52 * x25) + (c_q3 * x143 + s_q3 * x145 + -0.475 * x150);
-        let x152 = x18 * x32 - x17 * x34 + (x21 * x37 - x23 * x35)
-            - (49.52 * x28 + 2094.71 * x25) + (x39 * x144 + -7.11 * x150);
-        let x153 = 2103.19 * x29 + (x17 * x33 - x24 * x32 + (x22 * x35 - x21 * x36))
-            + (c_q3 * x145 - s_q3 * x143 + (0.475 * x148 + 7.11 * x149));
-        let x154 = 314.88 * x30 + (x18 * x36 - x24 * x37) + x148;
-        let x155 = 314.88 * x31 - (x24 * x35 + x17 * x36) + x150;
-        let x156 = c_q2 * x154 + s_q2 * x155;
-        let x157 = x2 * x10 - x1 * x11 + (x4 * x14 - x5 * x13)
-            + (c_q2 * x153 - s_q2 * x151 + 0.5692 * x156);
-        let x158 = c_q1
-            * (qd[1] * x11 - x2 * x12 - 8.088 * x6
-                + (c_q2 * x151 + s_q2 * x153 + -0.5692 * (c_q2 * x155 - s_q2 * x154)))
-            - s_q1 * (qd[1] * x10 - x1 * x12 - 3.061 * x7 + x16 * x152)
+        let x77 = 9.336 * (qd[5] * x72 - (x60 * c_q5 + x7 * s_q5));
+        let x78 = 9.336 * (qd[6] + x71);
+        let x79 = (x73 * c_q6 - x72 * s_q6) * x78;
+        let x80 = (x72 * c_q6 + x73 * s_q6) * x78;
+        let x81 = x72 * x75 - x73 * x74 + x77;
+        let x82 = 44.41 * (x60 * s_q5 - x7 * c_q5 - qd[5] * x71) - x71 * x75
+            + (c_q6 * x79 + s_q6 * x80);
+        let x83 = 47.471 * x61 + x71 * x74 + (s_q6 * x79 - c_q6 * x80);
+        let x84 = (x42 - -7.11 * x45) * 171.19551 - 132.67838 * x60
+            + (x59 * x62 - x54 * x64 + x58 * x66) + (c_q5 * x81 - s_q5 * x82);
+        let x85 = -97.44449 * x61 - 135.47298 * x7
+            + -171.19551
+                * ((c_q3 * x41 - s_q3 * x43 - qd[3] * x38) * c_q4 - s_q4 * (x40 + x46)
+                    - qd[4] * x58) + (x54 * x63 - x53 * x62 - x58 * x65)
+            + (s_q5 * x81 + c_q5 * x82);
+        let x86 = x53 * x64 - x59 * x63 - (x55 * x65 + x57 * x66) - -97.44449 * x7 + x83;
+        let x87 = c_q4 * x67 - s_q4 * x68;
+        let x88 = x38 * x50 + x35 * x51 - (x33 * x49 + x39 * x48)
+            - (-24989.307 * x44 + 1375.0472 * x7) + (c_q4 * x84 + s_q4 * x86);
+        let x89 = x46 * -3239.4583 - (1375.0472 * x44 + 24998.828 * x7)
+            + (x33 * x47 + x32 * x48 + x37 * x51) + (x85 + -7.11 * x87);
+        let x90 = 3239.4583 * x42 + (x32 * x49 - x39 * x47 - x37 * x50)
+            + (c_q4 * x86 - s_q4 * x84 + 7.11 * x69);
+        let x91 = x33 * x50 - x39 * x51 + (c_q4 * x68 + s_q4 * x67);
+        let x92 = x32 * x51 - x45 * -3239.4583 + x69;
+        let x93 = 3239.4583 * x7 - x32 * x50 + x87;
+        let x94 = c_q3 * x91 + s_q3 * x93;
+        let x95 = c_q3 * x93 - s_q3 * x91;
+        let x96 = x5 * x30 - x20 * x29 - (x16 * x28 + x21 * x27)
+            - (-39234.473 * x23 + 3946.1882 * x7)
+            + (c_q3 * x88 + s_q3 * x90 + -0.475 * x95);
+        let x97 = x25 * -5224.5703 - (3946.1882 * x23 + 39241.402 * x7)
+            + (x16 * x26 + x15 * x27 + x19 * x30) + (x89 + -7.11 * x95);
+        let x98 = 5224.5703 * x9 + (x15 * x28 - x21 * x26 - x19 * x29)
+            + (c_q3 * x90 - s_q3 * x88 + (0.475 * x94 + 7.11 * x92));
+        let x99 = x16 * x29 - x21 * x30 + x94;
+        let x100 = 5224.5703 * x7 - x15 * x29 + x95;
+        let x101 = c_q2 * x99 + s_q2 * x100;
+        let x102 = c_q2 * x98 - s_q2 * x96 + 0.5692 * x101
+            - (x8 * 1145.5438 + (x1 * x10 + x5 * x12));
+        let x103 = c_q1
+            * (qd[1] * x10 - x2 * x11 + x5 * x13
+                + (c_q2 * x96 + s_q2 * x98 + -0.5692 * (c_q2 * x100 - s_q2 * x99)))
+            - s_q1 * (x97 - (-65693.914 * x7 + (x1 * x11 + x4 * x13)))
             + -0.7026
-                * (s_q1 * (qd[1] * x14 - 105.98 * x8 + x156)
+                * (s_q1 * (x2 * x13 + x101)
                     + c_q1
-                        * (105.98 * x9 - qd[1] * x13
-                            + x16 * (314.88 * x27 + (x18 * x35 + x17 * x37) + x149)));
-        [x158, x157, x152, x144, x137, x131, x122]
+                        * (x1 * x13 - qd[1] * x12
+                            + (x15 * x30 - x24 * -5224.5703 + x92)));
+        [x103, x102, x97, x89, x85, x83, x77]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 404 mul, 279 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `rnea`: 268 mul, 191 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f32; 7], qd: &[f32; 7], qdd: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -753,604 +645,429 @@ impl SsrmsF32 {
         let x8 = qdd[0] * s_q1 + qd[1] * x1;
         let x9 = s_q1 * x6 + qd[1] * x5;
         let x10 = qd[1] * x4 - c_q1 * x6;
-        let x11 = 8.088 * x1;
-        let x12 = 3.061 * x2;
-        let x13 = 8.446 * qd[1];
-        let x14 = 105.98 * x4;
-        let x15 = 105.98 * x5;
+        let x11 = -65693.914 * x2;
+        let x12 = 65697.33 * qd[1] - x4 * 1145.5438;
+        let x13 = -1145.5438 * qd[1];
+        let x14 = x1 * 1145.5438;
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x17 = c_q2 + (1.0 - c_q2);
-        let x18 = x1 * c_q2 - qd[1] * s_q2;
-        let x19 = x1 * s_q2 + qd[1] * c_q2;
-        let x20 = x1 * 0.5692;
-        let x21 = x4 + -0.5692 * qd[1];
-        let x22 = s_q2 * x20 - c_q2 * x21;
-        let x23 = x5 * x17;
-        let x24 = s_q2 * x21 + c_q2 * x20;
-        let x25 = qd[2] - x2 * x17;
-        let x26 = x7 * 0.5692;
-        let x27 = x9 + -0.5692 * qdd[1];
-        let x28 = x10 * x17;
-        let x29 = qdd[2] - x8 * x17;
-        let x30 = x7 * c_q2 - qdd[1] * s_q2 - qd[2] * x19;
-        let x31 = x7 * s_q2 + qdd[1] * c_q2 + qd[2] * x18;
-        let x32 = s_q2 * x26 - c_q2 * x27 + qd[2] * x24;
-        let x33 = qd[2] * x22 - (s_q2 * x27 + c_q2 * x26);
-        let x34 = 15.41 * x18 + 49.52 * x25;
-        let x35 = 49.52 * x18 + 2094.71 * x25;
-        let x36 = 2103.19 * x19;
-        let x37 = 314.88 * x22;
-        let x38 = 314.88 * x23;
-        let x39 = 314.88 * x24;
+        let x16 = x1 * c_q2 - qd[1] * s_q2;
+        let x17 = x1 * s_q2 + qd[1] * c_q2;
+        let x18 = x1 * 0.5692;
+        let x19 = x4 + -0.5692 * qd[1];
+        let x20 = s_q2 * x18 - c_q2 * x19;
+        let x21 = s_q2 * x19 + c_q2 * x18;
+        let x22 = qd[2] - x2;
+        let x23 = x7 * 0.5692;
+        let x24 = x9 + -0.5692 * qdd[1];
+        let x25 = qdd[2] - x8;
+        let x26 = x7 * c_q2 - qdd[1] * s_q2 - qd[2] * x17;
+        let x27 = x7 * s_q2 + qdd[1] * c_q2 + qd[2] * x16;
+        let x28 = qd[2] * x20 - (s_q2 * x24 + c_q2 * x23);
+        let x29 = -39234.473 * x16 + 3946.1882 * x22;
+        let x30 = 5224.5703 * x5;
+        let x31 = 3946.1882 * x16 + 39241.402 * x22 - x21 * -5224.5703;
+        let x32 = x17 * -5224.5703;
+        let x33 = 5224.5703 * x22;
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x41 = c_q3 + (1.0 - c_q3);
-        let x42 = x18 * c_q3 - x19 * s_q3;
-        let x43 = x18 * s_q3 + x19 * c_q3;
-        let x44 = x22 - -0.475 * x19;
-        let x45 = x24 + (x18 * 0.475 + 7.11 * x25);
-        let x46 = c_q3 * x44 + s_q3 * x45;
-        let x47 = x41 * (x23 + x19 * -7.11);
-        let x48 = s_q3 * x44 - c_q3 * x45;
-        let x49 = qd[3] + x25 * x41;
-        let x50 = x32 - -0.475 * x31;
-        let x51 = x33 - (x30 * 0.475 + 7.11 * x29);
-        let x52 = x41 * (x28 - x31 * -7.11);
-        let x53 = qdd[3] + x29 * x41;
-        let x54 = x30 * c_q3 - x31 * s_q3 - qd[3] * x43;
-        let x55 = x30 * s_q3 + x31 * c_q3 + qd[3] * x42;
-        let x56 = c_q3 * x50 - s_q3 * x51 - qd[3] * x48;
-        let x57 = s_q3 * x50 + c_q3 * x51 + qd[3] * x46;
-        let x58 = 9.522 * x42 + -39.95 * x49;
-        let x59 = -39.95 * x42 + 1966.28 * x49;
-        let x60 = 1966.28 * x43;
-        let x61 = 279.2 * x46;
-        let x62 = 279.2 * x47;
-        let x63 = 279.2 * x48;
+        let x35 = x16 * c_q3 - x17 * s_q3;
+        let x36 = x16 * s_q3 + x17 * c_q3;
+        let x37 = x20 - -0.475 * x17;
+        let x38 = x5 + x17 * -7.11;
+        let x39 = x21 + (x16 * 0.475 + 7.11 * x22);
+        let x40 = c_q3 * x37 + s_q3 * x39;
+        let x41 = s_q3 * x37 - c_q3 * x39;
+        let x42 = qd[3] + x22;
+        let x43 = s_q2 * x23 - c_q2 * x24 + qd[2] * x21 - -0.475 * x27;
+        let x44 = x10 - x27 * -7.11;
+        let x45 = x28 - (x26 * 0.475 + 7.11 * x25);
+        let x46 = qdd[3] + x25;
+        let x47 = x26 * c_q3 - x27 * s_q3 - qd[3] * x36;
+        let x48 = x26 * s_q3 + x27 * c_q3 + qd[3] * x35;
+        let x49 = s_q3 * x43 + c_q3 * x45 + qd[3] * x40;
+        let x50 = -24989.307 * x35 + 1375.0472 * x42;
+        let x51 = 3239.4583 * x38;
+        let x52 = 1375.0472 * x35 + 24998.828 * x42 + x41 * -3239.4583;
+        let x53 = x36 * -3239.4583;
+        let x54 = 3239.4583 * x42;
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x65 = c_q4 + (1.0 - c_q4);
-        let x66 = x42 * c_q4 - x43 * s_q4;
-        let x67 = x42 * s_q4 + x43 * c_q4;
-        let x68 = x48 - 7.11 * x49;
-        let x69 = x46 * c_q4 - s_q4 * x68;
-        let x70 = x65 * (x47 + x43 * -7.11);
-        let x71 = x46 * s_q4 + c_q4 * x68;
-        let x72 = qd[4] + x49 * x65;
-        let x73 = x57 - 7.11 * x53;
-        let x74 = x65 * (x52 - -7.11 * x55);
-        let x75 = qdd[4] + x53 * x65;
-        let x76 = x54 * c_q4 - x55 * s_q4 - qd[4] * x67;
-        let x77 = x54 * s_q4 + x55 * c_q4 + qd[4] * x66;
-        let x78 = x56 * c_q4 - s_q4 * x73 - qd[4] * x71;
-        let x79 = x56 * s_q4 + c_q4 * x73 + qd[4] * x69;
-        let x80 = 8.305 * x66;
-        let x81 = 3.061 * x72;
-        let x82 = 8.0386 * x67;
-        let x83 = 105.98 * x69;
-        let x84 = 105.98 * x70;
-        let x85 = 105.98 * x71;
+        let x56 = x35 * c_q4 - x36 * s_q4;
+        let x57 = x35 * s_q4 + x36 * c_q4;
+        let x58 = x38 + x36 * -7.11;
+        let x59 = x41 - 7.11 * x42;
+        let x60 = x40 * c_q4 - s_q4 * x59;
+        let x61 = x40 * s_q4 + c_q4 * x59;
+        let x62 = qd[4] + x42;
+        let x63 = qdd[4] + x46;
+        let x64 = x47 * c_q4 - x48 * s_q4 - qd[4] * x57;
+        let x65 = x47 * s_q4 + x48 * c_q4 + qd[4] * x56;
+        let x66 = -97.44449 * x62;
+        let x67 = 132.67838 * x56 - x58 * 171.19551;
+        let x68 = 135.47298 * x62 + -97.44449 * x57 + -171.19551 * x60;
+        let x69 = x62 * 171.19551;
+        let x70 = -171.19551 * x56;
+        let x71 = x62 * x69 - x56 * x70;
+        let x72 = x57 * x70 - x63 * 171.19551;
+        let x73 = -171.19551 * x64 + x57 * x69;
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x87 = c_q5 + (1.0 - c_q5);
-        let x88 = x66 * c_q5 + x72 * s_q5;
-        let x89 = x72 * c_q5 - x66 * s_q5;
-        let x90 = x69 - -0.5692 * x67;
-        let x91 = c_q5 * x90 - x70 * s_q5;
-        let x92 = s_q5 * x90 + x70 * c_q5;
-        let x93 = x87 * (x71 - 0.5692 * x66);
-        let x94 = qd[5] + x67 * x87;
-        let x95 = x78 - -0.5692 * x77;
-        let x96 = x87 * (x79 - 0.5692 * x76);
-        let x97 = qdd[5] + x77 * x87;
-        let x98 = x76 * c_q5 + x75 * s_q5 + qd[5] * x89;
-        let x99 = x75 * c_q5 - x76 * s_q5 - qd[5] * x88;
-        let x100 = c_q5 * x95 + x74 * s_q5 - qd[5] * x92;
-        let x101 = x74 * c_q5 - s_q5 * x95 - qd[5] * x91;
-        let x102 = 12.13 * x88;
-        let x103 = 12.13 * x89;
-        let x104 = 3.061 * x94;
-        let x105 = 105.98 * x91;
-        let x106 = 105.98 * x92;
-        let x107 = 105.98 * x93;
+        let x75 = x56 * c_q5 + x62 * s_q5;
+        let x76 = x62 * c_q5 - x56 * s_q5;
+        let x77 = qd[5] + x57;
+        let x78 = 44.41 * x76;
+        let x79 = 47.471 * x77;
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x109 = c_q6 + (1.0 - c_q6);
-        let x110 = x89 * c_q6 + x94 * s_q6;
-        let x111 = x94 * c_q6 - x89 * s_q6;
-        let x112 = x92 + -0.7026 * x88;
-        let x113 = x109 * (x91 - 0.7026 * x89);
-        let x114 = x93 * s_q6 - c_q6 * x112;
-        let x115 = s_q6 * x112 + x93 * c_q6;
-        let x116 = qd[6] + x88 * x109;
-        let x117 = x101 - -0.7026 * x98;
-        let x118 = 9.336 * x116;
-        let x119 = 44.41 * x110;
-        let x120 = 44.41 * x111;
-        let x121 = 243.66 * x113;
-        let x122 = 243.66 * x114;
-        let x123 = 243.66 * x115;
-        let x124 = 9.336 * (qdd[6] + x98 * x109)
-            + (x110 * x120 - x111 * x119 + (x114 * x123 - x115 * x122));
-        let x125 = 44.41 * (x99 * c_q6 + x97 * s_q6 + qd[6] * x111)
-            + (x111 * x118 - x116 * x120 + (x115 * x121 - x113 * x123));
-        let x126 = 44.41 * (x97 * c_q6 - x99 * s_q6 - qd[6] * x110)
-            + (x116 * x119 - x110 * x118 + (x113 * x122 - x114 * x121));
-        let x127 = 243.66 * (c_q6 * x117 + x96 * s_q6 + qd[6] * x115)
-            + (x111 * x121 - x116 * x123);
-        let x128 = 243.66 * (x96 * c_q6 - s_q6 * x117 - qd[6] * x114)
-            + (x116 * x122 - x110 * x121);
-        let x129 = x109
-            * (243.66 * (x109 * (x100 - 0.7026 * x99)) + (x110 * x123 - x111 * x122));
-        let x130 = c_q6 * x127 - s_q6 * x128;
-        let x131 = 12.13 * x98 + (x89 * x104 - x94 * x103 + (x93 * x106 - x92 * x107))
-            + (x109 * x124 + 0.7026 * x130);
-        let x132 = 12.13 * x99 + (x94 * x102 - x88 * x104 + (x93 * x105 - x91 * x107))
-            + (c_q6 * x125 - s_q6 * x126 + -0.7026 * x129);
-        let x133 = 3.061 * x97 + (x88 * x103 - x89 * x102 + (x92 * x105 - x91 * x106))
-            + (s_q6 * x125 + c_q6 * x126);
-        let x134 = 105.98 * x100 + (x94 * x106 + x89 * x107) + x129;
-        let x135 = 105.98 * x101 + (x94 * x105 - x88 * x107) + x130;
-        let x136 = c_q5 * x134 - s_q5 * x135;
-        let x137 = x87
-            * (105.98 * x96 - (x89 * x105 + x88 * x106) + (s_q6 * x127 + c_q6 * x128));
-        let x138 = 8.305 * x76 + (x72 * x82 - x67 * x81 + (x71 * x84 - x70 * x85))
-            + (c_q5 * x131 - s_q5 * x132 + -0.5692 * x137);
-        let x139 = 3.061 * x75 + (x67 * x80 - x66 * x82 + (x71 * x83 - x69 * x85))
-            + (s_q5 * x131 + c_q5 * x132);
-        let x140 = 8.0386 * x77 + (x66 * x81 - x72 * x80 + (x70 * x83 - x69 * x84))
-            + (x87 * x133 + 0.5692 * x136);
-        let x141 = 105.98 * x78 + (x67 * x84 + x72 * x85) + x136;
-        let x142 = 105.98 * x79 - (x72 * x83 + x66 * x84) + x137;
-        let x143 = x65
-            * (105.98 * x74 + (x67 * x83 - x66 * x85) + (s_q5 * x134 + c_q5 * x135));
-        let x144 = c_q4 * x142 - s_q4 * x141;
-        let x145 = 9.522 * x54 + -39.95 * x53
-            + (x49 * x60 - x43 * x59 + (x48 * x62 - x47 * x63))
-            + (c_q4 * x138 + s_q4 * x140);
-        let x146 = -39.95 * x54 + 1966.28 * x53
-            + (x43 * x58 - x42 * x60 + (x48 * x61 - x46 * x63))
-            + (x65 * x139 + -7.11 * x144);
-        let x147 = 1966.28 * x55 + (x42 * x59 - x49 * x58 + (x47 * x61 - x46 * x62))
-            + (c_q4 * x140 - s_q4 * x138 + 7.11 * x143);
-        let x148 = 279.2 * x56 + (x43 * x62 + x49 * x63) + (c_q4 * x141 + s_q4 * x142);
-        let x149 = 279.2 * x57 - (x49 * x61 + x42 * x62) + x144;
-        let x150 = c_q3 * x148 + s_q3 * x149;
-        let x151 = x41 * (279.2 * x52 + (x43 * x61 - x42 * x63) + x143);
-        let x152 = c_q3 * x149 - s_q3 * x148;
-        let x153 = 15.41 * x30 + 49.52 * x29
-            + (x25 * x36 - x19 * x35 + (x23 * x39 - x24 * x38))
-            + (c_q3 * x145 + s_q3 * x147 + -0.475 * x152);
-        let x154 = 49.52 * x30 + 2094.71 * x29
-            + (x19 * x34 - x18 * x36 + (x22 * x39 - x24 * x37))
-            + (x41 * x146 + -7.11 * x152);
-        let x155 = 2103.19 * x31 + (x18 * x35 - x25 * x34 + (x23 * x37 - x22 * x38))
-            + (c_q3 * x147 - s_q3 * x145 + (0.475 * x150 + 7.11 * x151));
-        let x156 = 314.88 * x32 + (x19 * x38 - x25 * x39) + x150;
-        let x157 = 314.88 * x33 - (x25 * x37 + x18 * x38) + x152;
-        let x158 = c_q2 * x156 + s_q2 * x157;
-        let x159 = 8.446 * qdd[1] + (x2 * x11 - x1 * x12 + (x4 * x15 - x5 * x14))
-            + (c_q2 * x155 - s_q2 * x153 + 0.5692 * x158);
-        let x160 = 12.19 * qdd[0]
+        let x81 = 9.336 * (qdd[6] + (x64 * c_q5 + x63 * s_q5 + qd[5] * x76));
+        let x82 = 9.336 * (qd[6] + x75);
+        let x83 = (x77 * c_q6 - x76 * s_q6) * x82;
+        let x84 = (x76 * c_q6 + x77 * s_q6) * x82;
+        let x85 = x76 * x79 - x77 * x78 + x81;
+        let x86 = 44.41 * (x63 * c_q5 - x64 * s_q5 - qd[5] * x75) - x75 * x79
+            + (c_q6 * x83 + s_q6 * x84);
+        let x87 = 47.471 * (qdd[5] + x65) + x75 * x78 + (s_q6 * x83 - c_q6 * x84);
+        let x88 = 132.67838 * x64 + (x44 - -7.11 * x48) * 171.19551
+            + (x62 * x66 - x57 * x68 + x61 * x70) + (c_q5 * x85 - s_q5 * x86);
+        let x89 = 135.47298 * x63 + -97.44449 * x65
+            + -171.19551
+                * ((c_q3 * x43 - s_q3 * x45 - qd[3] * x41) * c_q4
+                    - s_q4 * (x49 - 7.11 * x46) - qd[4] * x61)
+            + (x57 * x67 - x56 * x66 - x61 * x69) + (s_q5 * x85 + c_q5 * x86);
+        let x90 = -97.44449 * x63 + (x56 * x68 - x62 * x67 - (x58 * x69 + x60 * x70))
+            + x87;
+        let x91 = c_q4 * x71 - s_q4 * x72;
+        let x92 = -24989.307 * x47 + 1375.0472 * x46
+            + (x41 * x53 + x38 * x54 - (x36 * x52 + x42 * x51))
+            + (c_q4 * x88 + s_q4 * x90);
+        let x93 = 1375.0472 * x47 + 24998.828 * x46 + x49 * -3239.4583
+            + (x36 * x50 + x35 * x51 + x40 * x54) + (x89 + -7.11 * x91);
+        let x94 = 3239.4583 * x44 + (x35 * x52 - x42 * x50 - x40 * x53)
+            + (c_q4 * x90 - s_q4 * x88 - 7.11 * x73);
+        let x95 = x36 * x53 - x42 * x54 + (c_q4 * x72 + s_q4 * x71);
+        let x96 = x35 * x54 - x48 * -3239.4583 - x73;
+        let x97 = x91 - (3239.4583 * x46 + x35 * x53);
+        let x98 = c_q3 * x95 + s_q3 * x97;
+        let x99 = c_q3 * x97 - s_q3 * x95;
+        let x100 = -39234.473 * x26 + 3946.1882 * x25
+            + (x5 * x33 - x21 * x32 - (x17 * x31 + x22 * x30))
+            + (c_q3 * x92 + s_q3 * x94 + -0.475 * x99);
+        let x101 = 3946.1882 * x26 + 39241.402 * x25 + x28 * -5224.5703
+            + (x17 * x29 + x16 * x30 + x20 * x33) + (x93 + -7.11 * x99);
+        let x102 = 5224.5703 * x10 + (x16 * x31 - x22 * x29 - x20 * x32)
+            + (c_q3 * x94 - s_q3 * x92 + (0.475 * x98 + 7.11 * x96));
+        let x103 = x17 * x32 - x22 * x33 + x98;
+        let x104 = x99 - (5224.5703 * x25 + x16 * x32);
+        let x105 = c_q2 * x103 + s_q2 * x104;
+        let x106 = 65697.33 * qdd[1] - x9 * 1145.5438 - (x1 * x11 + x5 * x13)
+            + (c_q2 * x102 - s_q2 * x100 + 0.5692 * x105);
+        let x107 = 66279.66 * qdd[0]
             + (c_q1
-                * (8.088 * x7 + (qd[1] * x12 - x2 * x13)
-                    + (c_q2 * x153 + s_q2 * x155
-                        + -0.5692 * (c_q2 * x157 - s_q2 * x156)))
-                - s_q1 * (qd[1] * x11 - x1 * x13 - 3.061 * x8 + x17 * x154)
+                * (qd[1] * x11 - x2 * x12 + x5 * x14
+                    + (c_q2 * x100 + s_q2 * x102
+                        + -0.5692 * (c_q2 * x104 - s_q2 * x103)))
+                - s_q1 * (x101 - (-65693.914 * x8 + (x1 * x12 + x4 * x14)))
                 + -0.7026
-                    * (s_q1 * (qd[1] * x15 - 105.98 * x9 + x158)
+                    * (s_q1 * (x2 * x14 - -1145.5438 * qdd[1] + x105)
                         + c_q1
-                            * (105.98 * x10 - qd[1] * x14
-                                + x17 * (314.88 * x28 + (x19 * x37 + x18 * x39) + x151))));
-        [x160, x159, x154, x146, x139, x133, x124]
+                            * (x1 * x14 - qd[1] * x13
+                                + (x16 * x33 - x27 * -5224.5703 + x96))));
+        [x107, x106, x101, x93, x89, x87, x81]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 530 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 552 mul, 393 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f32; 7], qd: &[f32; 7], tau: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = c_q6 * x12 + s_q6 * x13;
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + (x10 * x11 + 120.28197);
-        let x19 = 12.13 + (x14 + 120.28197);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.19551;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = s_q5 * x22 - c_q5 * x23;
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = c_q5 * x28 + x21 * 0.5692;
-        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27939);
-        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
-        let x36 = 8.0386 + (x8 * x29 + 113.27939);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01509;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4583;
-        let x41 = c_q4 * x34 - s_q4 * x32;
-        let x42 = c_q4 * x30 + s_q4 * x33;
-        let x43 = s_q4 * x36 - c_q4 * x31;
-        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
-        let x45 = x6 * x35;
-        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
-        let x47 = s_q4 * x34 + c_q4 * x32;
-        let x48 = c_q4 * x33 - s_q4 * x30;
-        let x49 = s_q4 * x31 + c_q4 * x36;
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
-        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
-        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
-        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
-        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
-        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
-        let x58 = s_q3 * x39;
-        let x59 = c_q3 * x40 + x58;
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = x61 - s_q3 * x40;
-        let x63 = x59 + 5224.5703;
-        let x64 = x60 + -349.0395;
-        let x65 = c_q3 * x54 + s_q3 * x52;
-        let x66 = c_q3 * x55 + s_q3 * x50;
-        let x67 = c_q3 * x53 + s_q3 * x57;
-        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
-        let x69 = x4 * x56;
-        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
-        let x71 = c_q3 * x52 - s_q3 * x54;
-        let x72 = c_q3 * x50 - s_q3 * x55;
-        let x73 = c_q3 * x57 - s_q3 * x53;
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
-        let x78 = x4 * x72 + x76;
-        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
-        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
-        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
-        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
-        let x83 = 2103.19
-            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
-                - (-7.11 * x63 - -0.475 * x64));
-        let x84 = s_q2 * x62;
-        let x85 = c_q2 * x63 + x84;
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = x87 - s_q2 * x63;
-        let x89 = x86 + -597.48926;
-        let x90 = c_q2 * x80 + s_q2 * x77;
-        let x91 = c_q2 * x81 + s_q2 * x78;
-        let x92 = c_q2 * x79 + s_q2 * x83;
-        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
-        let x94 = x2 * x82;
-        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
-        let x96 = -0.5692 * x85;
-        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x98 = c_q1 * (c_q2 * x92 - s_q2 * x90)
-            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
-            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
-        let x99 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
-        let x100 = x66 - x74;
-        let x101 = x69 - x75;
-        let x102 = x72 + x76;
-        let x103 = x87 - s_q2 * x59;
-        let x104 = c_q1 * (c_q2 * x100 + s_q2 * x102 - -0.5692 * (x84 + c_q2 * x59))
-            - s_q1 * (x2 * x101) + -0.7026 * (s_q1 * x103);
-        let x105 = x45 - x51;
-        let x106 = x61 - s_q3 * x37;
-        let x107 = x58 + c_q3 * x37;
-        let x108 = c_q3 * x42 + s_q3 * x48 - -0.475 * x107;
-        let x109 = x4 * x105 - -7.11 * x107;
-        let x110 = c_q3 * x48 - s_q3 * x42 + 0.475 * x106;
-        let x111 = c_q2 * x106 - s_q2 * x107;
-        let x112 = c_q1
-            * (c_q2 * x108 + s_q2 * x110 - -0.5692 * (s_q2 * x106 + c_q2 * x107))
-            - s_q1 * (x2 * x109) + -0.7026 * (s_q1 * x111);
-        let x113 = s_q4 * x29 - c_q4 * x24;
-        let x114 = x6 * x27;
-        let x115 = s_q4 * x24 + c_q4 * x29;
-        let x116 = c_q3 * x113 + s_q3 * x115;
-        let x117 = x4 * x114;
-        let x118 = c_q3 * x115 - s_q3 * x113;
-        let x119 = c_q1 * (c_q2 * x116 + s_q2 * x118) - s_q1 * (x2 * x117);
-        let x120 = c_q5 * x11;
-        let x121 = s_q5 * x11;
-        let x122 = c_q4 * x120;
-        let x123 = x6 * x121;
-        let x124 = s_q4 * x120;
-        let x125 = c_q3 * x122 - s_q3 * x124;
-        let x126 = x4 * x123;
-        let x127 = s_q3 * x122 + c_q3 * x124;
-        let x128 = c_q1 * (c_q2 * x125 - s_q2 * x127) - s_q1 * (x2 * x126);
-        let x129 = qd[0] * c_q1;
-        let x130 = qd[0] * s_q1;
-        let x131 = 0.7026 * qd[0];
-        let x132 = s_q1 * x131;
-        let x133 = c_q1 * x131;
-        let x134 = qd[1] * x130;
-        let x135 = qd[1] * x129;
-        let x136 = qd[1] * x133;
-        let x137 = qd[1] * x132;
-        let x138 = 8.088 * x129;
-        let x139 = 3.061 * x130;
-        let x140 = 8.446 * qd[1];
-        let x141 = 105.98 * x132;
-        let x142 = 105.98 * x133;
-        let x143 = c_q2 * x129 - qd[1] * s_q2;
-        let x144 = s_q2 * x129 + qd[1] * c_q2;
-        let x145 = 0.5692 * x129;
-        let x146 = x132 + -0.5692 * qd[1];
-        let x147 = s_q2 * x145 - c_q2 * x146;
-        let x148 = x2 * x133;
-        let x149 = s_q2 * x146 + c_q2 * x145;
-        let x150 = qd[2] - x2 * x130;
-        let x151 = x2 * x135;
-        let x152 = 0.5692 * x134;
-        let x153 = x2 * x137;
-        let x154 = c_q2 * x134 + qd[2] * x144;
-        let x155 = qd[2] * x143 - s_q2 * x134;
-        let x156 = qd[2] * x149 - (c_q2 * x136 + s_q2 * x152);
-        let x157 = c_q2 * x152 - s_q2 * x136 + qd[2] * x147;
-        let x158 = 15.41 * x143 + 49.52 * x150;
-        let x159 = 49.52 * x143 + 2094.71 * x150;
-        let x160 = 2103.19 * x144;
-        let x161 = 314.88 * x147;
-        let x162 = 314.88 * x148;
-        let x163 = 314.88 * x149;
-        let x164 = c_q3 * x143 - s_q3 * x144;
-        let x165 = s_q3 * x143 + c_q3 * x144;
-        let x166 = x147 - -0.475 * x144;
-        let x167 = x149 + (0.475 * x143 + 7.11 * x150);
-        let x168 = c_q3 * x166 + s_q3 * x167;
-        let x169 = x4 * (x148 + -7.11 * x144);
-        let x170 = s_q3 * x166 - c_q3 * x167;
-        let x171 = qd[3] + x4 * x150;
-        let x172 = x4 * x151;
-        let x173 = x156 - -0.475 * x155;
-        let x174 = x157 + (0.475 * x154 + 7.11 * x151);
-        let x175 = x4 * (x153 - -7.11 * x155);
-        let x176 = c_q3 * x154 + s_q3 * x155 + qd[3] * x165;
-        let x177 = c_q3 * x155 - s_q3 * x154 + qd[3] * x164;
-        let x178 = c_q3 * x173 - s_q3 * x174 - qd[3] * x170;
-        let x179 = s_q3 * x173 + c_q3 * x174 + qd[3] * x168;
-        let x180 = 9.522 * x164 + -39.95 * x171;
-        let x181 = -39.95 * x164 + 1966.28 * x171;
-        let x182 = 1966.28 * x165;
-        let x183 = 279.2 * x168;
-        let x184 = 279.2 * x169;
-        let x185 = 279.2 * x170;
-        let x186 = c_q4 * x164 - s_q4 * x165;
-        let x187 = s_q4 * x164 + c_q4 * x165;
-        let x188 = x170 - 7.11 * x171;
-        let x189 = c_q4 * x168 - s_q4 * x188;
-        let x190 = x6 * (x169 + -7.11 * x165);
-        let x191 = s_q4 * x168 + c_q4 * x188;
-        let x192 = qd[4] + x6 * x171;
-        let x193 = x6 * x172;
-        let x194 = x179 + 7.11 * x172;
-        let x195 = x6 * (x175 - -7.11 * x177);
-        let x196 = c_q4 * x176 + s_q4 * x177 + qd[4] * x187;
-        let x197 = c_q4 * x177 - s_q4 * x176 + qd[4] * x186;
-        let x198 = c_q4 * x178 - s_q4 * x194 - qd[4] * x191;
-        let x199 = s_q4 * x178 + c_q4 * x194 + qd[4] * x189;
-        let x200 = 8.305 * x186;
-        let x201 = 3.061 * x192;
-        let x202 = 8.0386 * x187;
-        let x203 = 105.98 * x189;
-        let x204 = 105.98 * x190;
-        let x205 = 105.98 * x191;
-        let x206 = c_q5 * x186 + s_q5 * x192;
-        let x207 = c_q5 * x192 - s_q5 * x186;
-        let x208 = x189 - -0.5692 * x187;
-        let x209 = c_q5 * x208 - s_q5 * x190;
-        let x210 = s_q5 * x208 + c_q5 * x190;
-        let x211 = x8 * (x191 - 0.5692 * x186);
-        let x212 = qd[5] + x8 * x187;
-        let x213 = x8 * x197;
-        let x214 = x198 - -0.5692 * x197;
-        let x215 = x8 * (x199 + 0.5692 * x196);
-        let x216 = qd[5] * x207 - (c_q5 * x196 + s_q5 * x193);
-        let x217 = s_q5 * x196 - c_q5 * x193 - qd[5] * x206;
-        let x218 = c_q5 * x214 + s_q5 * x195 - qd[5] * x210;
-        let x219 = c_q5 * x195 - s_q5 * x214 - qd[5] * x209;
-        let x220 = 12.13 * x206;
-        let x221 = 12.13 * x207;
-        let x222 = 3.061 * x212;
-        let x223 = 105.98 * x209;
-        let x224 = 105.98 * x210;
-        let x225 = 105.98 * x211;
-        let x226 = c_q6 * x207 + s_q6 * x212;
-        let x227 = c_q6 * x212 - s_q6 * x207;
-        let x228 = x210 + -0.7026 * x206;
-        let x229 = x10 * (x209 - 0.7026 * x207);
-        let x230 = s_q6 * x211 - c_q6 * x228;
-        let x231 = s_q6 * x228 + c_q6 * x211;
-        let x232 = qd[6] + x10 * x206;
-        let x233 = x219 - -0.7026 * x216;
-        let x234 = 9.336 * x232;
-        let x235 = 44.41 * x226;
-        let x236 = 44.41 * x227;
-        let x237 = 243.66 * x229;
-        let x238 = 243.66 * x230;
-        let x239 = 243.66 * x231;
-        let x240 = 9.336 * (x10 * x216)
-            + (x226 * x236 - x227 * x235 + (x230 * x239 - x231 * x238));
-        let x241 = 44.41 * (c_q6 * x217 + s_q6 * x213 + qd[6] * x227)
-            + (x227 * x234 - x232 * x236 + (x231 * x237 - x229 * x239));
-        let x242 = 44.41 * (c_q6 * x213 - s_q6 * x217 - qd[6] * x226)
-            + (x232 * x235 - x226 * x234 + (x229 * x238 - x230 * x237));
-        let x243 = 243.66 * (c_q6 * x233 + s_q6 * x215 + qd[6] * x231)
-            + (x227 * x237 - x232 * x239);
-        let x244 = 243.66 * (c_q6 * x215 - s_q6 * x233 - qd[6] * x230)
-            + (x232 * x238 - x226 * x237);
-        let x245 = x10
-            * (243.66 * (x10 * (x218 - 0.7026 * x217)) + (x226 * x239 - x227 * x238));
-        let x246 = c_q6 * x243 - s_q6 * x244;
-        let x247 = 12.13 * x216
-            + (x207 * x222 - x212 * x221 + (x211 * x224 - x210 * x225))
-            + (x10 * x240 + 0.7026 * x246);
-        let x248 = 12.13 * x217
-            + (x212 * x220 - x206 * x222 + (x211 * x223 - x209 * x225))
-            + (c_q6 * x241 - s_q6 * x242 + -0.7026 * x245);
-        let x249 = 3.061 * x213
-            + (x206 * x221 - x207 * x220 + (x210 * x223 - x209 * x224))
-            + (s_q6 * x241 + c_q6 * x242);
-        let x250 = 105.98 * x218 + (x212 * x224 + x207 * x225) + x245;
-        let x251 = 105.98 * x219 + (x212 * x223 - x206 * x225) + x246;
-        let x252 = c_q5 * x250 - s_q5 * x251;
-        let x253 = x8
-            * (105.98 * x215 - (x207 * x223 + x206 * x224)
-                + (s_q6 * x243 + c_q6 * x244));
-        let x254 = x192 * x202 - x187 * x201 + (x191 * x204 - x190 * x205) - 8.305 * x196
-            + (c_q5 * x247 - s_q5 * x248 + -0.5692 * x253);
-        let x255 = x187 * x200 - x186 * x202 + (x191 * x203 - x189 * x205) - 3.061 * x193
-            + (s_q5 * x247 + c_q5 * x248);
-        let x256 = 8.0386 * x197
-            + (x186 * x201 - x192 * x200 + (x190 * x203 - x189 * x204))
-            + (x8 * x249 + 0.5692 * x252);
-        let x257 = 105.98 * x198 + (x187 * x204 + x192 * x205) + x252;
-        let x258 = 105.98 * x199 - (x192 * x203 + x186 * x204) + x253;
-        let x259 = x6
-            * (105.98 * x195 + (x187 * x203 - x186 * x205)
-                + (s_q5 * x250 + c_q5 * x251));
-        let x260 = c_q4 * x258 - s_q4 * x257;
-        let x261 = x171 * x182 - x165 * x181 + (x170 * x184 - x169 * x185)
-            - (9.522 * x176 + -39.95 * x172) + (c_q4 * x254 + s_q4 * x256);
-        let x262 = x165 * x180 - x164 * x182 + (x170 * x183 - x168 * x185)
-            - (-39.95 * x176 + 1966.28 * x172) + (x6 * x255 + -7.11 * x260);
-        let x263 = 1966.28 * x177
-            + (x164 * x181 - x171 * x180 + (x169 * x183 - x168 * x184))
-            + (c_q4 * x256 - s_q4 * x254 + 7.11 * x259);
-        let x264 = 279.2 * x178 + (x165 * x184 + x171 * x185)
-            + (c_q4 * x257 + s_q4 * x258);
-        let x265 = 279.2 * x179 - (x171 * x183 + x164 * x184) + x260;
-        let x266 = c_q3 * x264 + s_q3 * x265;
-        let x267 = x4 * (279.2 * x175 + (x165 * x183 - x164 * x185) + x259);
-        let x268 = c_q3 * x265 - s_q3 * x264;
-        let x269 = x150 * x160 - x144 * x159 + (x148 * x163 - x149 * x162)
-            - (15.41 * x154 + 49.52 * x151)
-            + (c_q3 * x261 + s_q3 * x263 + -0.475 * x268);
-        let x270 = x144 * x158 - x143 * x160 + (x147 * x163 - x149 * x161)
-            - (49.52 * x154 + 2094.71 * x151) + (x4 * x262 + -7.11 * x268);
-        let x271 = 2103.19 * x155
-            + (x143 * x159 - x150 * x158 + (x148 * x161 - x147 * x162))
-            + (c_q3 * x263 - s_q3 * x261 + (0.475 * x266 + 7.11 * x267));
-        let x272 = 314.88 * x156 + (x144 * x162 - x150 * x163) + x266;
-        let x273 = 314.88 * x157 - (x150 * x161 + x143 * x162) + x268;
-        let x274 = c_q2 * x272 + s_q2 * x273;
-        let x275 = tau[0]
+        let x6 = 9.336 * c_q5;
+        let x7 = 44.41 * s_q5;
+        let x8 = 9.336 * s_q5;
+        let x9 = 44.41 * c_q5;
+        let x10 = s_q5 * x6 - c_q5 * x7;
+        let x11 = c_q5 * x8 - s_q5 * x9;
+        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
+        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
+        let x14 = -171.19551 * s_q4;
+        let x15 = -171.19551 * c_q4;
+        let x16 = c_q4 * x12;
+        let x17 = -97.44449 * s_q4;
+        let x18 = c_q4 * x10 + x17;
+        let x19 = 47.471 * s_q4;
+        let x20 = s_q4 * x12;
+        let x21 = -97.44449 * c_q4;
+        let x22 = x21 - s_q4 * x10;
+        let x23 = 47.471 * c_q4;
+        let x24 = x21 - s_q4 * x11;
+        let x25 = x14 * -7.11;
+        let x26 = 7.11 * x14;
+        let x27 = x13 - x25;
+        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
+        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
+        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
+        let x31 = 3239.4583 + x14;
+        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
+        let x33 = 1375.0472 + x18;
+        let x34 = 1375.0472 + (x17 + c_q4 * x11);
+        let x35 = 24998.828 + (x26 + x27);
+        let x36 = s_q3 * x15;
+        let x37 = c_q3 * x31 + x36;
+        let x38 = c_q3 * x15;
+        let x39 = x38 - s_q3 * x31;
+        let x40 = c_q3 * x32 + s_q3 * x28;
+        let x41 = s_q3 * x22;
+        let x42 = c_q3 * x29 + s_q3 * x30;
+        let x43 = c_q3 * x28 - s_q3 * x32;
+        let x44 = c_q3 * x22;
+        let x45 = c_q3 * x30 - s_q3 * x29;
+        let x46 = -7.11 * x37;
+        let x47 = 7.11 * x37;
+        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
+        let x49 = x35 - x46;
+        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
+        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
+        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
+        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
+        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
+        let x55 = 5224.5703 + x37;
+        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
+        let x57 = 3946.1882 + x48;
+        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
+        let x59 = 39241.402 + (x47 + x49);
+        let x60 = s_q2 * x39;
+        let x61 = c_q2 * x55 + x60;
+        let x62 = c_q2 * x39;
+        let x63 = x62 - s_q2 * x55;
+        let x64 = c_q2 * x56 + s_q2 * x50;
+        let x65 = s_q2 * x51;
+        let x66 = c_q2 * x52 + s_q2 * x54;
+        let x67 = c_q2 * x51;
+        let x68 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
+        let x69 = c_q1 * (c_q2 * x66 - s_q2 * x64)
+            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
+            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
+        let x70 = x68 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
+        let x71 = x62 - s_q2 * x37;
+        let x72 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
+            + -0.7026 * (s_q1 * x71);
+        let x73 = x38 - s_q3 * x14;
+        let x74 = x36 + c_q3 * x14;
+        let x75 = x41 + c_q3 * x18 - -0.475 * x74;
+        let x76 = x27 - -7.11 * x74;
+        let x77 = x44 - s_q3 * x18 + 0.475 * x73;
+        let x78 = c_q2 * x73 - s_q2 * x74;
+        let x79 = c_q1 * (c_q2 * x75 + s_q2 * x77 - -0.5692 * (s_q2 * x73 + c_q2 * x74))
+            - s_q1 * x76 + -0.7026 * (s_q1 * x78);
+        let x80 = c_q3 * x19 + s_q3 * x23;
+        let x81 = c_q3 * x23 - s_q3 * x19;
+        let x82 = c_q1 * (c_q2 * x80 + s_q2 * x81);
+        let x83 = c_q4 * x6;
+        let x84 = s_q4 * x6;
+        let x85 = c_q3 * x83 - s_q3 * x84;
+        let x86 = s_q3 * x83 + c_q3 * x84;
+        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
+        let x88 = qd[0] * c_q1;
+        let x89 = qd[0] * s_q1;
+        let x90 = 0.7026 * qd[0];
+        let x91 = s_q1 * x90;
+        let x92 = c_q1 * x90;
+        let x93 = qd[1] * x89;
+        let x94 = qd[1] * x88;
+        let x95 = qd[1] * x92;
+        let x96 = qd[1] * x91;
+        let x97 = -65693.914 * x89;
+        let x98 = 65697.33 * qd[1] - 1145.5438 * x91;
+        let x99 = -1145.5438 * qd[1];
+        let x100 = 1145.5438 * x88;
+        let x101 = c_q2 * x88 - qd[1] * s_q2;
+        let x102 = s_q2 * x88 + qd[1] * c_q2;
+        let x103 = 0.5692 * x88;
+        let x104 = x91 + -0.5692 * qd[1];
+        let x105 = s_q2 * x103 - c_q2 * x104;
+        let x106 = s_q2 * x104 + c_q2 * x103;
+        let x107 = qd[2] - x89;
+        let x108 = 0.5692 * x93;
+        let x109 = c_q2 * x93 + qd[2] * x102;
+        let x110 = qd[2] * x101 - s_q2 * x93;
+        let x111 = c_q2 * x108 - s_q2 * x95 + qd[2] * x105;
+        let x112 = -39234.473 * x101 + 3946.1882 * x107;
+        let x113 = 5224.5703 * x92;
+        let x114 = 3946.1882 * x101 + 39241.402 * x107 - x106 * -5224.5703;
+        let x115 = x102 * -5224.5703;
+        let x116 = 5224.5703 * x107;
+        let x117 = c_q3 * x101 - s_q3 * x102;
+        let x118 = s_q3 * x101 + c_q3 * x102;
+        let x119 = x105 - -0.475 * x102;
+        let x120 = x92 + -7.11 * x102;
+        let x121 = x106 + (0.475 * x101 + 7.11 * x107);
+        let x122 = c_q3 * x119 + s_q3 * x121;
+        let x123 = s_q3 * x119 - c_q3 * x121;
+        let x124 = qd[3] + x107;
+        let x125 = 7.11 * x94;
+        let x126 = qd[2] * x106 - (c_q2 * x95 + s_q2 * x108) - -0.475 * x110;
+        let x127 = x96 - -7.11 * x110;
+        let x128 = x111 + (0.475 * x109 + x125);
+        let x129 = c_q3 * x109 + s_q3 * x110 + qd[3] * x118;
+        let x130 = c_q3 * x110 - s_q3 * x109 + qd[3] * x117;
+        let x131 = s_q3 * x126 + c_q3 * x128 + qd[3] * x122;
+        let x132 = -24989.307 * x117 + 1375.0472 * x124;
+        let x133 = 3239.4583 * x120;
+        let x134 = 1375.0472 * x117 + 24998.828 * x124 + x123 * -3239.4583;
+        let x135 = x118 * -3239.4583;
+        let x136 = 3239.4583 * x124;
+        let x137 = c_q4 * x117 - s_q4 * x118;
+        let x138 = s_q4 * x117 + c_q4 * x118;
+        let x139 = x120 + -7.11 * x118;
+        let x140 = x123 - 7.11 * x124;
+        let x141 = c_q4 * x122 - s_q4 * x140;
+        let x142 = s_q4 * x122 + c_q4 * x140;
+        let x143 = qd[4] + x124;
+        let x144 = c_q4 * x129 + s_q4 * x130 + qd[4] * x138;
+        let x145 = c_q4 * x130 - s_q4 * x129 + qd[4] * x137;
+        let x146 = -97.44449 * x143;
+        let x147 = 132.67838 * x137 - 171.19551 * x139;
+        let x148 = 135.47298 * x143 + -97.44449 * x138 + -171.19551 * x141;
+        let x149 = 171.19551 * x143;
+        let x150 = -171.19551 * x137;
+        let x151 = x143 * x149 - x137 * x150;
+        let x152 = 171.19551 * x94 + x138 * x150;
+        let x153 = -171.19551 * x144 - x138 * x149;
+        let x154 = c_q5 * x137 + s_q5 * x143;
+        let x155 = c_q5 * x143 - s_q5 * x137;
+        let x156 = qd[5] + x138;
+        let x157 = 44.41 * x155;
+        let x158 = 47.471 * x156;
+        let x159 = 9.336 * (qd[5] * x155 - (c_q5 * x144 + s_q5 * x94));
+        let x160 = 9.336 * (qd[6] + x154);
+        let x161 = (c_q6 * x156 - s_q6 * x155) * x160;
+        let x162 = (c_q6 * x155 + s_q6 * x156) * x160;
+        let x163 = x155 * x158 - x156 * x157 + x159;
+        let x164 = 44.41 * (s_q5 * x144 - c_q5 * x94 - qd[5] * x154) - x154 * x158
+            + (c_q6 * x161 + s_q6 * x162);
+        let x165 = 47.471 * x145 + x154 * x157 + (s_q6 * x161 - c_q6 * x162);
+        let x166 = 171.19551 * (x127 - -7.11 * x130) - 132.67838 * x144
+            + (x143 * x146 - x138 * x148 + x142 * x150) + (c_q5 * x163 - s_q5 * x164);
+        let x167 = -97.44449 * x145 - 135.47298 * x94
+            + -171.19551
+                * (c_q4 * (c_q3 * x126 - s_q3 * x128 - qd[3] * x123)
+                    - s_q4 * (x125 + x131) - qd[4] * x142)
+            + (x138 * x147 - x137 * x146 - x142 * x149) + (s_q5 * x163 + c_q5 * x164);
+        let x168 = x137 * x148 - x143 * x147 - (x139 * x149 + x141 * x150)
+            - -97.44449 * x94 + x165;
+        let x169 = c_q4 * x151 - s_q4 * x152;
+        let x170 = x123 * x135 + x120 * x136 - (x118 * x134 + x124 * x133)
+            - (-24989.307 * x129 + 1375.0472 * x94) + (c_q4 * x166 + s_q4 * x168);
+        let x171 = x131 * -3239.4583 - (1375.0472 * x129 + 24998.828 * x94)
+            + (x118 * x132 + x117 * x133 + x122 * x136) + (x167 + -7.11 * x169);
+        let x172 = 3239.4583 * x127 + (x117 * x134 - x124 * x132 - x122 * x135)
+            + (c_q4 * x168 - s_q4 * x166 + 7.11 * x153);
+        let x173 = x118 * x135 - x124 * x136 + (c_q4 * x152 + s_q4 * x151);
+        let x174 = x117 * x136 - x130 * -3239.4583 + x153;
+        let x175 = 3239.4583 * x94 - x117 * x135 + x169;
+        let x176 = c_q3 * x173 + s_q3 * x175;
+        let x177 = c_q3 * x175 - s_q3 * x173;
+        let x178 = x92 * x116 - x106 * x115 - (x102 * x114 + x107 * x113)
+            - (-39234.473 * x109 + 3946.1882 * x94)
+            + (c_q3 * x170 + s_q3 * x172 + -0.475 * x177);
+        let x179 = x111 * -5224.5703 - (3946.1882 * x109 + 39241.402 * x94)
+            + (x102 * x112 + x101 * x113 + x105 * x116) + (x171 + -7.11 * x177);
+        let x180 = 5224.5703 * x96 + (x101 * x114 - x107 * x112 - x105 * x115)
+            + (c_q3 * x172 - s_q3 * x170 + (0.475 * x176 + 7.11 * x174));
+        let x181 = x102 * x115 - x107 * x116 + x176;
+        let x182 = 5224.5703 * x94 - x101 * x115 + x177;
+        let x183 = c_q2 * x181 + s_q2 * x182;
+        let x184 = tau[0]
             - (c_q1
-                * (qd[1] * x139 - x130 * x140 - 8.088 * x134
-                    + (c_q2 * x269 + s_q2 * x271
-                        + -0.5692 * (c_q2 * x273 - s_q2 * x272)))
-                - s_q1 * (qd[1] * x138 - x129 * x140 - 3.061 * x135 + x2 * x270)
+                * (qd[1] * x97 - x89 * x98 + x92 * x100
+                    + (c_q2 * x178 + s_q2 * x180
+                        + -0.5692 * (c_q2 * x182 - s_q2 * x181)))
+                - s_q1 * (x179 - (-65693.914 * x94 + (x88 * x98 + x91 * x100)))
                 + -0.7026
-                    * (s_q1 * (qd[1] * x142 - 105.98 * x136 + x274)
+                    * (s_q1 * (x89 * x100 + x183)
                         + c_q1
-                            * (105.98 * x137 - qd[1] * x141
-                                + x2
-                                    * (314.88 * x153 + (x144 * x161 + x143 * x163) + x267))));
-        let x276 = 1.0
-            / (12.19
-                + (c_q1
-                    * (c_q1
-                        * (8.088
-                            + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
-                        - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
-                    - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
-                    - -0.7026 * x97 + 0.7026 * (x97 + 811.9808)));
-        let x277 = x98 * x276;
-        let x278 = x99 * x276;
-        let x279 = x104 * x276;
-        let x280 = x112 * x276;
-        let x281 = x119 * x276;
-        let x282 = x128 * x276;
-        let x283 = 1.0
-            / (8.446
-                + (c_q2 * (c_q2 * x83 - s_q2 * x79) - s_q2 * (c_q2 * x77 - s_q2 * x80)
-                    - 0.5692 * x86 + -0.5692 * x89) - x98 * x277);
-        let x284 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88 - x98 * x278;
-        let x285 = x283 * x284;
-        let x286 = c_q2 * x102 - s_q2 * x100 + 0.5692 * x103 - x98 * x279;
-        let x287 = x283 * x286;
-        let x288 = c_q2 * x110 - s_q2 * x108 + 0.5692 * x111 - x98 * x280;
-        let x289 = x283 * x288;
-        let x290 = c_q2 * x118 - s_q2 * x116 - x98 * x281;
-        let x291 = x283 * x290;
-        let x292 = s_q2 * x125 + c_q2 * x127 + x98 * x282;
-        let x293 = x283 * x292;
-        let x294 = 1.0 / (x82 - x99 * x278 - x284 * x285);
-        let x295 = x101 - x99 * x279 - x284 * x287;
-        let x296 = x294 * x295;
-        let x297 = x109 - x99 * x280 - x284 * x289;
-        let x298 = x294 * x297;
-        let x299 = x117 - x99 * x281 - x284 * x291;
-        let x300 = x294 * x299;
-        let x301 = x126 - x99 * x282 + x284 * x293;
-        let x302 = x294 * x301;
-        let x303 = 1.0 / (x56 - x104 * x279 - x286 * x287 - x295 * x296);
-        let x304 = x105 - x104 * x280 - x286 * x289 - x295 * x298;
-        let x305 = x303 * x304;
-        let x306 = x114 - x104 * x281 - x286 * x291 - x295 * x300;
-        let x307 = x303 * x306;
-        let x308 = x123 - x104 * x282 + x286 * x293 - x295 * x302;
-        let x309 = x303 * x308;
-        let x310 = 1.0 / (x35 - x112 * x280 - x288 * x289 - x297 * x298 - x304 * x305);
-        let x311 = x27 - x112 * x281 - x288 * x291 - x297 * x300 - x304 * x307;
-        let x312 = x310 * x311;
-        let x313 = x121 - x112 * x282 + x288 * x293 - x297 * x302 - x304 * x309;
-        let x314 = x310 * x313;
-        let x315 = 1.0
-            / (x20 - x119 * x281 - x290 * x291 - x299 * x300 - x306 * x307
-                - x311 * x312);
-        let x316 = x290 * x293 - x119 * x282 - x299 * x302 - x306 * x309 - x311 * x314;
-        let x317 = x315 * x316;
-        let x318 = 1.0
-            / (9.336 - x128 * x282 - x292 * x293 - x301 * x302 - x308 * x309
-                - x313 * x314 - x316 * x317);
-        let x319 = tau[1]
-            - (x130 * x138 - x129 * x139 + (x132 * x142 - x133 * x141)
-                + (c_q2 * x271 - s_q2 * x269 + 0.5692 * x274)) - x275 * x277;
-        let x320 = tau[2] - x270 - x275 * x278 - x285 * x319;
-        let x321 = tau[3] - x262 - x275 * x279 - x287 * x319 - x296 * x320;
-        let x322 = tau[4] - x255 - x275 * x280 - x289 * x319 - x298 * x320 - x305 * x321;
-        let x323 = tau[5] - x249 - x275 * x281 - x291 * x319 - x300 * x320 - x307 * x321
-            - x312 * x322;
-        let x324 = x318
-            * (tau[6] - x240 - x275 * x282 + x293 * x319 - x302 * x320 - x309 * x321
-                - x314 * x322 - x317 * x323);
-        let x325 = x315 * x323 - x317 * x324;
-        let x326 = x310 * x322 - x312 * x325 - x314 * x324;
-        let x327 = x303 * x321 - x305 * x326 - x307 * x325 - x309 * x324;
-        let x328 = x294 * x320 - x296 * x327 - x298 * x326 - x300 * x325 - x302 * x324;
-        let x329 = x283 * x319 - x285 * x328 - x287 * x327 - x289 * x326 - x291 * x325
-            + x293 * x324;
-        let x330 = x275 * x276 - x277 * x329 - x278 * x328 - x279 * x327 - x280 * x326
-            - x281 * x325 - x282 * x324;
-        [x330, x329, x328, x327, x326, x325, x324]
+                            * (x88 * x100 - qd[1] * x99
+                                + (x101 * x116 - x110 * -5224.5703 + x174))));
+        let x185 = 1.0
+            / (66279.66
+                + (0.7026 * x63
+                    + (c_q1
+                        * (c_q1 * (c_q2 * x64 + s_q2 * x66)
+                            - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
+                        - s_q1 * (x68 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63)));
+        let x186 = x69 * x185;
+        let x187 = x70 * x185;
+        let x188 = x72 * x185;
+        let x189 = x79 * x185;
+        let x190 = x82 * x185;
+        let x191 = x87 * x185;
+        let x192 = 1.0
+            / (65697.33
+                + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
+                - x69 * x186);
+        let x193 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x187;
+        let x194 = x192 * x193;
+        let x195 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x188;
+        let x196 = x192 * x195;
+        let x197 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x189;
+        let x198 = x192 * x197;
+        let x199 = c_q2 * x81 - s_q2 * x80 - x69 * x190;
+        let x200 = x192 * x199;
+        let x201 = s_q2 * x85 + c_q2 * x86 + x69 * x191;
+        let x202 = x192 * x201;
+        let x203 = 1.0 / (x59 - x70 * x187 - x193 * x194);
+        let x204 = x49 - x70 * x188 - x193 * x196;
+        let x205 = x203 * x204;
+        let x206 = x76 - x70 * x189 - x193 * x198;
+        let x207 = x203 * x206;
+        let x208 = x70 * x190 + x193 * x200;
+        let x209 = x203 * x208;
+        let x210 = x8 - x70 * x191 + x193 * x202;
+        let x211 = x203 * x210;
+        let x212 = 1.0 / (x35 - x72 * x188 - x195 * x196 - x204 * x205);
+        let x213 = x27 - x72 * x189 - x195 * x198 - x204 * x207;
+        let x214 = x212 * x213;
+        let x215 = x204 * x209 - (x72 * x190 + x195 * x200);
+        let x216 = x212 * x215;
+        let x217 = x8 - x72 * x191 + x195 * x202 - x204 * x211;
+        let x218 = x212 * x217;
+        let x219 = 1.0 / (x13 - x79 * x189 - x197 * x198 - x206 * x207 - x213 * x214);
+        let x220 = x206 * x209 - (x79 * x190 + x197 * x200) - x213 * x216;
+        let x221 = x219 * x220;
+        let x222 = x8 - x79 * x191 + x197 * x202 - x206 * x211 - x213 * x218;
+        let x223 = x219 * x222;
+        let x224 = 1.0
+            / (47.471 - x82 * x190 - x199 * x200 - x208 * x209 - x215 * x216
+                - x220 * x221);
+        let x225 = x199 * x202 - x82 * x191 + x208 * x211 - x215 * x218 - x220 * x223;
+        let x226 = x224 * x225;
+        let x227 = 1.0
+            / (9.336 - x87 * x191 - x201 * x202 - x210 * x211 - x217 * x218 - x222 * x223
+                - x225 * x226);
+        let x228 = tau[1]
+            - (c_q2 * x180 - s_q2 * x178 + 0.5692 * x183
+                - (1145.5438 * x95 + (x88 * x97 + x92 * x99))) - x184 * x186;
+        let x229 = tau[2] - x179 - x184 * x187 - x194 * x228;
+        let x230 = tau[3] - x171 - x184 * x188 - x196 * x228 - x205 * x229;
+        let x231 = tau[4] - x167 - x184 * x189 - x198 * x228 - x207 * x229 - x214 * x230;
+        let x232 = tau[5] - x165 - x184 * x190 - x200 * x228 + x209 * x229 - x216 * x230
+            - x221 * x231;
+        let x233 = x227
+            * (tau[6] - x159 - x184 * x191 + x202 * x228 - x211 * x229 - x218 * x230
+                - x223 * x231 - x226 * x232);
+        let x234 = x224 * x232 - x226 * x233;
+        let x235 = x219 * x231 - x221 * x234 - x223 * x233;
+        let x236 = x212 * x230 - x214 * x235 - x216 * x234 - x218 * x233;
+        let x237 = x203 * x229 - x205 * x236 - x207 * x235 + x209 * x234 - x211 * x233;
+        let x238 = x192 * x228 - x194 * x237 - x196 * x236 - x198 * x235 - x200 * x234
+            + x202 * x233;
+        let x239 = x184 * x185 - x186 * x238 - x187 * x237 - x188 * x236 - x189 * x235
+            - x190 * x234 - x191 * x233;
+        [x239, x238, x237, x236, x235, x234, x233]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 648 mul, 426 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 426 mul, 292 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f32; 7],
@@ -1358,359 +1075,246 @@ impl SsrmsF32 {
     ) -> ([[f32; 7]; 7], [f32; 7]) {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = c_q6 * x12 + s_q6 * x13;
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + (x10 * x11 + 120.28197);
-        let x19 = 12.13 + (x14 + 120.28197);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.19551;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = s_q5 * x22 - c_q5 * x23;
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = c_q5 * x28 + x21 * 0.5692;
-        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27939);
-        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
-        let x36 = 8.0386 + (x8 * x29 + 113.27939);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01509;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4583;
-        let x41 = c_q4 * x34 - s_q4 * x32;
-        let x42 = c_q4 * x30 + s_q4 * x33;
-        let x43 = s_q4 * x36 - c_q4 * x31;
-        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
-        let x45 = x6 * x35;
-        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
-        let x47 = s_q4 * x34 + c_q4 * x32;
-        let x48 = c_q4 * x33 - s_q4 * x30;
-        let x49 = s_q4 * x31 + c_q4 * x36;
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
-        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
-        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
-        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
-        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
-        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
-        let x58 = s_q3 * x39;
-        let x59 = c_q3 * x40 + x58;
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = x61 - s_q3 * x40;
-        let x63 = x59 + 5224.5703;
-        let x64 = x60 + -349.0395;
-        let x65 = c_q3 * x54 + s_q3 * x52;
-        let x66 = c_q3 * x55 + s_q3 * x50;
-        let x67 = c_q3 * x53 + s_q3 * x57;
-        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
-        let x69 = x4 * x56;
-        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
-        let x71 = c_q3 * x52 - s_q3 * x54;
-        let x72 = c_q3 * x50 - s_q3 * x55;
-        let x73 = c_q3 * x57 - s_q3 * x53;
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
-        let x78 = x4 * x72 + x76;
-        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
-        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
-        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
-        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
-        let x83 = 2103.19
-            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
-                - (-7.11 * x63 - -0.475 * x64));
-        let x84 = s_q2 * x62;
-        let x85 = c_q2 * x63 + x84;
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = x87 - s_q2 * x63;
-        let x89 = x86 + -597.48926;
-        let x90 = c_q2 * x80 + s_q2 * x77;
-        let x91 = c_q2 * x81 + s_q2 * x78;
-        let x92 = c_q2 * x79 + s_q2 * x83;
-        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
-        let x94 = x2 * x82;
-        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
-        let x96 = -0.5692 * x85;
-        let x97 = 8.446
-            + (c_q2 * (c_q2 * x83 - s_q2 * x79) - s_q2 * (c_q2 * x77 - s_q2 * x80)
-                - 0.5692 * x86 + -0.5692 * x89);
-        let x98 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x99 = 12.19
-            + (c_q1
-                * (c_q1
-                    * (8.088 + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
-                    - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
-                - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
-                - -0.7026 * x98 + 0.7026 * (x98 + 811.9808));
-        let x100 = c_q1 * (c_q2 * x92 - s_q2 * x90)
-            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
-            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
-        let x101 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88;
-        let x102 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
-        let x103 = x66 - x74;
-        let x104 = x69 - x75;
-        let x105 = x72 + x76;
-        let x106 = x87 - s_q2 * x59;
-        let x107 = c_q2 * x105 - s_q2 * x103 + 0.5692 * x106;
-        let x108 = c_q1 * (c_q2 * x103 + s_q2 * x105 - -0.5692 * (x84 + c_q2 * x59))
-            - s_q1 * (x2 * x104) + -0.7026 * (s_q1 * x106);
-        let x109 = x45 - x51;
-        let x110 = x61 - s_q3 * x37;
-        let x111 = x58 + c_q3 * x37;
-        let x112 = c_q3 * x42 + s_q3 * x48 - -0.475 * x111;
-        let x113 = x4 * x109 - -7.11 * x111;
-        let x114 = c_q3 * x48 - s_q3 * x42 + 0.475 * x110;
-        let x115 = c_q2 * x110 - s_q2 * x111;
-        let x116 = c_q2 * x114 - s_q2 * x112 + 0.5692 * x115;
-        let x117 = c_q1
-            * (c_q2 * x112 + s_q2 * x114 - -0.5692 * (s_q2 * x110 + c_q2 * x111))
-            - s_q1 * (x2 * x113) + -0.7026 * (s_q1 * x115);
-        let x118 = s_q4 * x29 - c_q4 * x24;
-        let x119 = x6 * x27;
-        let x120 = s_q4 * x24 + c_q4 * x29;
-        let x121 = c_q3 * x118 + s_q3 * x120;
-        let x122 = x4 * x119;
-        let x123 = c_q3 * x120 - s_q3 * x118;
-        let x124 = c_q2 * x123 - s_q2 * x121;
-        let x125 = c_q1 * (c_q2 * x121 + s_q2 * x123) - s_q1 * (x2 * x122);
-        let x126 = c_q5 * x11;
-        let x127 = s_q5 * x11;
-        let x128 = c_q4 * x126;
-        let x129 = x6 * x127;
-        let x130 = s_q4 * x126;
-        let x131 = c_q3 * x128 - s_q3 * x130;
-        let x132 = x4 * x129;
-        let x133 = s_q3 * x128 + c_q3 * x130;
-        let x134 = -(s_q2 * x131 + c_q2 * x133);
-        let x135 = c_q1 * (c_q2 * x131 - s_q2 * x133) - s_q1 * (x2 * x132);
-        let x136 = qd[0] * c_q1;
-        let x137 = qd[0] * s_q1;
-        let x138 = 0.7026 * qd[0];
-        let x139 = s_q1 * x138;
-        let x140 = c_q1 * x138;
-        let x141 = qd[1] * x137;
-        let x142 = qd[1] * x136;
-        let x143 = qd[1] * x140;
-        let x144 = qd[1] * x139;
-        let x145 = 8.088 * x136;
-        let x146 = 3.061 * x137;
-        let x147 = 8.446 * qd[1];
-        let x148 = 105.98 * x139;
-        let x149 = 105.98 * x140;
-        let x150 = c_q2 * x136 - qd[1] * s_q2;
-        let x151 = s_q2 * x136 + qd[1] * c_q2;
-        let x152 = 0.5692 * x136;
-        let x153 = x139 + -0.5692 * qd[1];
-        let x154 = s_q2 * x152 - c_q2 * x153;
-        let x155 = x2 * x140;
-        let x156 = s_q2 * x153 + c_q2 * x152;
-        let x157 = qd[2] - x2 * x137;
-        let x158 = x2 * x142;
-        let x159 = 0.5692 * x141;
-        let x160 = x2 * x144;
-        let x161 = c_q2 * x141 + qd[2] * x151;
-        let x162 = qd[2] * x150 - s_q2 * x141;
-        let x163 = qd[2] * x156 - (c_q2 * x143 + s_q2 * x159);
-        let x164 = c_q2 * x159 - s_q2 * x143 + qd[2] * x154;
-        let x165 = 15.41 * x150 + 49.52 * x157;
-        let x166 = 49.52 * x150 + 2094.71 * x157;
-        let x167 = 2103.19 * x151;
-        let x168 = 314.88 * x154;
-        let x169 = 314.88 * x155;
-        let x170 = 314.88 * x156;
-        let x171 = c_q3 * x150 - s_q3 * x151;
-        let x172 = s_q3 * x150 + c_q3 * x151;
-        let x173 = x154 - -0.475 * x151;
-        let x174 = x156 + (0.475 * x150 + 7.11 * x157);
-        let x175 = c_q3 * x173 + s_q3 * x174;
-        let x176 = x4 * (x155 + -7.11 * x151);
-        let x177 = s_q3 * x173 - c_q3 * x174;
-        let x178 = qd[3] + x4 * x157;
-        let x179 = x4 * x158;
-        let x180 = x163 - -0.475 * x162;
-        let x181 = x164 + (0.475 * x161 + 7.11 * x158);
-        let x182 = x4 * (x160 - -7.11 * x162);
-        let x183 = c_q3 * x161 + s_q3 * x162 + qd[3] * x172;
-        let x184 = c_q3 * x162 - s_q3 * x161 + qd[3] * x171;
-        let x185 = c_q3 * x180 - s_q3 * x181 - qd[3] * x177;
-        let x186 = s_q3 * x180 + c_q3 * x181 + qd[3] * x175;
-        let x187 = 9.522 * x171 + -39.95 * x178;
-        let x188 = -39.95 * x171 + 1966.28 * x178;
-        let x189 = 1966.28 * x172;
-        let x190 = 279.2 * x175;
-        let x191 = 279.2 * x176;
-        let x192 = 279.2 * x177;
-        let x193 = c_q4 * x171 - s_q4 * x172;
-        let x194 = s_q4 * x171 + c_q4 * x172;
-        let x195 = x177 - 7.11 * x178;
-        let x196 = c_q4 * x175 - s_q4 * x195;
-        let x197 = x6 * (x176 + -7.11 * x172);
-        let x198 = s_q4 * x175 + c_q4 * x195;
-        let x199 = qd[4] + x6 * x178;
-        let x200 = x6 * x179;
-        let x201 = x186 + 7.11 * x179;
-        let x202 = x6 * (x182 - -7.11 * x184);
-        let x203 = c_q4 * x183 + s_q4 * x184 + qd[4] * x194;
-        let x204 = c_q4 * x184 - s_q4 * x183 + qd[4] * x193;
-        let x205 = c_q4 * x185 - s_q4 * x201 - qd[4] * x198;
-        let x206 = s_q4 * x185 + c_q4 * x201 + qd[4] * x196;
-        let x207 = 8.305 * x193;
-        let x208 = 3.061 * x199;
-        let x209 = 8.0386 * x194;
-        let x210 = 105.98 * x196;
-        let x211 = 105.98 * x197;
-        let x212 = 105.98 * x198;
-        let x213 = c_q5 * x193 + s_q5 * x199;
-        let x214 = c_q5 * x199 - s_q5 * x193;
-        let x215 = x196 - -0.5692 * x194;
-        let x216 = c_q5 * x215 - s_q5 * x197;
-        let x217 = s_q5 * x215 + c_q5 * x197;
-        let x218 = x8 * (x198 - 0.5692 * x193);
-        let x219 = qd[5] + x8 * x194;
-        let x220 = x8 * x204;
-        let x221 = x205 - -0.5692 * x204;
-        let x222 = x8 * (x206 + 0.5692 * x203);
-        let x223 = qd[5] * x214 - (c_q5 * x203 + s_q5 * x200);
-        let x224 = s_q5 * x203 - c_q5 * x200 - qd[5] * x213;
-        let x225 = c_q5 * x221 + s_q5 * x202 - qd[5] * x217;
-        let x226 = c_q5 * x202 - s_q5 * x221 - qd[5] * x216;
-        let x227 = 12.13 * x213;
-        let x228 = 12.13 * x214;
-        let x229 = 3.061 * x219;
-        let x230 = 105.98 * x216;
-        let x231 = 105.98 * x217;
-        let x232 = 105.98 * x218;
-        let x233 = c_q6 * x214 + s_q6 * x219;
-        let x234 = c_q6 * x219 - s_q6 * x214;
-        let x235 = x217 + -0.7026 * x213;
-        let x236 = x10 * (x216 - 0.7026 * x214);
-        let x237 = s_q6 * x218 - c_q6 * x235;
-        let x238 = s_q6 * x235 + c_q6 * x218;
-        let x239 = qd[6] + x10 * x213;
-        let x240 = x226 - -0.7026 * x223;
-        let x241 = 9.336 * x239;
-        let x242 = 44.41 * x233;
-        let x243 = 44.41 * x234;
-        let x244 = 243.66 * x236;
-        let x245 = 243.66 * x237;
-        let x246 = 243.66 * x238;
-        let x247 = 9.336 * (x10 * x223)
-            + (x233 * x243 - x234 * x242 + (x237 * x246 - x238 * x245));
-        let x248 = 44.41 * (c_q6 * x224 + s_q6 * x220 + qd[6] * x234)
-            + (x234 * x241 - x239 * x243 + (x238 * x244 - x236 * x246));
-        let x249 = 44.41 * (c_q6 * x220 - s_q6 * x224 - qd[6] * x233)
-            + (x239 * x242 - x233 * x241 + (x236 * x245 - x237 * x244));
-        let x250 = 243.66 * (c_q6 * x240 + s_q6 * x222 + qd[6] * x238)
-            + (x234 * x244 - x239 * x246);
-        let x251 = 243.66 * (c_q6 * x222 - s_q6 * x240 - qd[6] * x237)
-            + (x239 * x245 - x233 * x244);
-        let x252 = x10
-            * (243.66 * (x10 * (x225 - 0.7026 * x224)) + (x233 * x246 - x234 * x245));
-        let x253 = c_q6 * x250 - s_q6 * x251;
-        let x254 = 12.13 * x223
-            + (x214 * x229 - x219 * x228 + (x218 * x231 - x217 * x232))
-            + (x10 * x247 + 0.7026 * x253);
-        let x255 = 12.13 * x224
-            + (x219 * x227 - x213 * x229 + (x218 * x230 - x216 * x232))
-            + (c_q6 * x248 - s_q6 * x249 + -0.7026 * x252);
-        let x256 = 3.061 * x220
-            + (x213 * x228 - x214 * x227 + (x217 * x230 - x216 * x231))
-            + (s_q6 * x248 + c_q6 * x249);
-        let x257 = 105.98 * x225 + (x219 * x231 + x214 * x232) + x252;
-        let x258 = 105.98 * x226 + (x219 * x230 - x213 * x232) + x253;
-        let x259 = c_q5 * x257 - s_q5 * x258;
-        let x260 = x8
-            * (105.98 * x222 - (x214 * x230 + x213 * x231)
-                + (s_q6 * x250 + c_q6 * x251));
-        let x261 = x199 * x209 - x194 * x208 + (x198 * x211 - x197 * x212) - 8.305 * x203
-            + (c_q5 * x254 - s_q5 * x255 + -0.5692 * x260);
-        let x262 = x194 * x207 - x193 * x209 + (x198 * x210 - x196 * x212) - 3.061 * x200
-            + (s_q5 * x254 + c_q5 * x255);
-        let x263 = 8.0386 * x204
-            + (x193 * x208 - x199 * x207 + (x197 * x210 - x196 * x211))
-            + (x8 * x256 + 0.5692 * x259);
-        let x264 = 105.98 * x205 + (x194 * x211 + x199 * x212) + x259;
-        let x265 = 105.98 * x206 - (x199 * x210 + x193 * x211) + x260;
-        let x266 = x6
-            * (105.98 * x202 + (x194 * x210 - x193 * x212)
-                + (s_q5 * x257 + c_q5 * x258));
-        let x267 = c_q4 * x265 - s_q4 * x264;
-        let x268 = x178 * x189 - x172 * x188 + (x177 * x191 - x176 * x192)
-            - (9.522 * x183 + -39.95 * x179) + (c_q4 * x261 + s_q4 * x263);
-        let x269 = x172 * x187 - x171 * x189 + (x177 * x190 - x175 * x192)
-            - (-39.95 * x183 + 1966.28 * x179) + (x6 * x262 + -7.11 * x267);
-        let x270 = 1966.28 * x184
-            + (x171 * x188 - x178 * x187 + (x176 * x190 - x175 * x191))
-            + (c_q4 * x263 - s_q4 * x261 + 7.11 * x266);
-        let x271 = 279.2 * x185 + (x172 * x191 + x178 * x192)
-            + (c_q4 * x264 + s_q4 * x265);
-        let x272 = 279.2 * x186 - (x178 * x190 + x171 * x191) + x267;
-        let x273 = c_q3 * x271 + s_q3 * x272;
-        let x274 = x4 * (279.2 * x182 + (x172 * x190 - x171 * x192) + x266);
-        let x275 = c_q3 * x272 - s_q3 * x271;
-        let x276 = x157 * x167 - x151 * x166 + (x155 * x170 - x156 * x169)
-            - (15.41 * x161 + 49.52 * x158)
-            + (c_q3 * x268 + s_q3 * x270 + -0.475 * x275);
-        let x277 = x151 * x165 - x150 * x167 + (x154 * x170 - x156 * x168)
-            - (49.52 * x161 + 2094.71 * x158) + (x4 * x269 + -7.11 * x275);
-        let x278 = 2103.19 * x162
-            + (x150 * x166 - x157 * x165 + (x155 * x168 - x154 * x169))
-            + (c_q3 * x270 - s_q3 * x268 + (0.475 * x273 + 7.11 * x274));
-        let x279 = 314.88 * x163 + (x151 * x169 - x157 * x170) + x273;
-        let x280 = 314.88 * x164 - (x157 * x168 + x150 * x169) + x275;
-        let x281 = c_q2 * x279 + s_q2 * x280;
-        let x282 = x137 * x145 - x136 * x146 + (x139 * x149 - x140 * x148)
-            + (c_q2 * x278 - s_q2 * x276 + 0.5692 * x281);
-        let x283 = c_q1
-            * (qd[1] * x146 - x137 * x147 - 8.088 * x141
-                + (c_q2 * x276 + s_q2 * x278 + -0.5692 * (c_q2 * x280 - s_q2 * x279)))
-            - s_q1 * (qd[1] * x145 - x136 * x147 - 3.061 * x142 + x2 * x277)
+        let x6 = 9.336 * c_q5;
+        let x7 = 44.41 * s_q5;
+        let x8 = 9.336 * s_q5;
+        let x9 = 44.41 * c_q5;
+        let x10 = s_q5 * x6 - c_q5 * x7;
+        let x11 = c_q5 * x8 - s_q5 * x9;
+        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
+        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
+        let x14 = -171.19551 * s_q4;
+        let x15 = -171.19551 * c_q4;
+        let x16 = c_q4 * x12;
+        let x17 = -97.44449 * s_q4;
+        let x18 = c_q4 * x10 + x17;
+        let x19 = 47.471 * s_q4;
+        let x20 = s_q4 * x12;
+        let x21 = -97.44449 * c_q4;
+        let x22 = x21 - s_q4 * x10;
+        let x23 = 47.471 * c_q4;
+        let x24 = x21 - s_q4 * x11;
+        let x25 = x14 * -7.11;
+        let x26 = 7.11 * x14;
+        let x27 = x13 - x25;
+        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
+        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
+        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
+        let x31 = 3239.4583 + x14;
+        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
+        let x33 = 1375.0472 + x18;
+        let x34 = 1375.0472 + (x17 + c_q4 * x11);
+        let x35 = 24998.828 + (x26 + x27);
+        let x36 = s_q3 * x15;
+        let x37 = c_q3 * x31 + x36;
+        let x38 = c_q3 * x15;
+        let x39 = x38 - s_q3 * x31;
+        let x40 = c_q3 * x32 + s_q3 * x28;
+        let x41 = s_q3 * x22;
+        let x42 = c_q3 * x29 + s_q3 * x30;
+        let x43 = c_q3 * x28 - s_q3 * x32;
+        let x44 = c_q3 * x22;
+        let x45 = c_q3 * x30 - s_q3 * x29;
+        let x46 = -7.11 * x37;
+        let x47 = 7.11 * x37;
+        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
+        let x49 = x35 - x46;
+        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
+        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
+        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
+        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
+        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
+        let x55 = 5224.5703 + x37;
+        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
+        let x57 = 3946.1882 + x48;
+        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
+        let x59 = 39241.402 + (x47 + x49);
+        let x60 = s_q2 * x39;
+        let x61 = c_q2 * x55 + x60;
+        let x62 = c_q2 * x39;
+        let x63 = x62 - s_q2 * x55;
+        let x64 = c_q2 * x56 + s_q2 * x50;
+        let x65 = s_q2 * x51;
+        let x66 = c_q2 * x52 + s_q2 * x54;
+        let x67 = c_q2 * x51;
+        let x68 = x67 - s_q2 * x57 + 0.5692 * x63;
+        let x69 = 65697.33
+            + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56));
+        let x70 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
+        let x71 = 66279.66
+            + (0.7026 * x63
+                + (c_q1
+                    * (c_q1 * (c_q2 * x64 + s_q2 * x66)
+                        - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
+                    - s_q1 * (x70 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63));
+        let x72 = c_q1 * (c_q2 * x66 - s_q2 * x64)
+            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
+            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
+        let x73 = x70 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
+        let x74 = x62 - s_q2 * x37;
+        let x75 = x67 - s_q2 * x48 + 0.5692 * x74;
+        let x76 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
+            + -0.7026 * (s_q1 * x74);
+        let x77 = x38 - s_q3 * x14;
+        let x78 = x36 + c_q3 * x14;
+        let x79 = x41 + c_q3 * x18 - -0.475 * x78;
+        let x80 = x27 - -7.11 * x78;
+        let x81 = x44 - s_q3 * x18 + 0.475 * x77;
+        let x82 = c_q2 * x77 - s_q2 * x78;
+        let x83 = c_q2 * x81 - s_q2 * x79 + 0.5692 * x82;
+        let x84 = c_q1 * (c_q2 * x79 + s_q2 * x81 - -0.5692 * (s_q2 * x77 + c_q2 * x78))
+            - s_q1 * x80 + -0.7026 * (s_q1 * x82);
+        let x85 = c_q3 * x19 + s_q3 * x23;
+        let x86 = c_q3 * x23 - s_q3 * x19;
+        let x87 = c_q2 * x86 - s_q2 * x85;
+        let x88 = c_q1 * (c_q2 * x85 + s_q2 * x86);
+        let x89 = c_q4 * x6;
+        let x90 = s_q4 * x6;
+        let x91 = c_q3 * x89 - s_q3 * x90;
+        let x92 = s_q3 * x89 + c_q3 * x90;
+        let x93 = -(s_q2 * x91 + c_q2 * x92);
+        let x94 = c_q1 * (c_q2 * x91 - s_q2 * x92) - s_q1 * x8;
+        let x95 = qd[0] * c_q1;
+        let x96 = qd[0] * s_q1;
+        let x97 = 0.7026 * qd[0];
+        let x98 = s_q1 * x97;
+        let x99 = c_q1 * x97;
+        let x100 = qd[1] * x96;
+        let x101 = qd[1] * x95;
+        let x102 = qd[1] * x99;
+        let x103 = qd[1] * x98;
+        let x104 = -65693.914 * x96;
+        let x105 = 65697.33 * qd[1] - 1145.5438 * x98;
+        let x106 = -1145.5438 * qd[1];
+        let x107 = 1145.5438 * x95;
+        let x108 = c_q2 * x95 - qd[1] * s_q2;
+        let x109 = s_q2 * x95 + qd[1] * c_q2;
+        let x110 = 0.5692 * x95;
+        let x111 = x98 + -0.5692 * qd[1];
+        let x112 = s_q2 * x110 - c_q2 * x111;
+        let x113 = s_q2 * x111 + c_q2 * x110;
+        let x114 = qd[2] - x96;
+        let x115 = 0.5692 * x100;
+        let x116 = c_q2 * x100 + qd[2] * x109;
+        let x117 = qd[2] * x108 - s_q2 * x100;
+        let x118 = c_q2 * x115 - s_q2 * x102 + qd[2] * x112;
+        let x119 = -39234.473 * x108 + 3946.1882 * x114;
+        let x120 = 5224.5703 * x99;
+        let x121 = 3946.1882 * x108 + 39241.402 * x114 - x113 * -5224.5703;
+        let x122 = x109 * -5224.5703;
+        let x123 = 5224.5703 * x114;
+        let x124 = c_q3 * x108 - s_q3 * x109;
+        let x125 = s_q3 * x108 + c_q3 * x109;
+        let x126 = x112 - -0.475 * x109;
+        let x127 = x99 + -7.11 * x109;
+        let x128 = x113 + (0.475 * x108 + 7.11 * x114);
+        let x129 = c_q3 * x126 + s_q3 * x128;
+        let x130 = s_q3 * x126 - c_q3 * x128;
+        let x131 = qd[3] + x114;
+        let x132 = 7.11 * x101;
+        let x133 = qd[2] * x113 - (c_q2 * x102 + s_q2 * x115) - -0.475 * x117;
+        let x134 = x103 - -7.11 * x117;
+        let x135 = x118 + (0.475 * x116 + x132);
+        let x136 = c_q3 * x116 + s_q3 * x117 + qd[3] * x125;
+        let x137 = c_q3 * x117 - s_q3 * x116 + qd[3] * x124;
+        let x138 = s_q3 * x133 + c_q3 * x135 + qd[3] * x129;
+        let x139 = -24989.307 * x124 + 1375.0472 * x131;
+        let x140 = 3239.4583 * x127;
+        let x141 = 1375.0472 * x124 + 24998.828 * x131 + x130 * -3239.4583;
+        let x142 = x125 * -3239.4583;
+        let x143 = 3239.4583 * x131;
+        let x144 = c_q4 * x124 - s_q4 * x125;
+        let x145 = s_q4 * x124 + c_q4 * x125;
+        let x146 = x127 + -7.11 * x125;
+        let x147 = x130 - 7.11 * x131;
+        let x148 = c_q4 * x129 - s_q4 * x147;
+        let x149 = s_q4 * x129 + c_q4 * x147;
+        let x150 = qd[4] + x131;
+        let x151 = c_q4 * x136 + s_q4 * x137 + qd[4] * x145;
+        let x152 = c_q4 * x137 - s_q4 * x136 + qd[4] * x144;
+        let x153 = -97.44449 * x150;
+        let x154 = 132.67838 * x144 - 171.19551 * x146;
+        let x155 = 135.47298 * x150 + -97.44449 * x145 + -171.19551 * x148;
+        let x156 = 171.19551 * x150;
+        let x157 = -171.19551 * x144;
+        let x158 = x150 * x156 - x144 * x157;
+        let x159 = 171.19551 * x101 + x145 * x157;
+        let x160 = -171.19551 * x151 - x145 * x156;
+        let x161 = c_q5 * x144 + s_q5 * x150;
+        let x162 = c_q5 * x150 - s_q5 * x144;
+        let x163 = qd[5] + x145;
+        let x164 = 44.41 * x162;
+        let x165 = 47.471 * x163;
+        let x166 = 9.336 * (qd[5] * x162 - (c_q5 * x151 + s_q5 * x101));
+        let x167 = 9.336 * (qd[6] + x161);
+        let x168 = (c_q6 * x163 - s_q6 * x162) * x167;
+        let x169 = (c_q6 * x162 + s_q6 * x163) * x167;
+        let x170 = x162 * x165 - x163 * x164 + x166;
+        let x171 = 44.41 * (s_q5 * x151 - c_q5 * x101 - qd[5] * x161) - x161 * x165
+            + (c_q6 * x168 + s_q6 * x169);
+        let x172 = 47.471 * x152 + x161 * x164 + (s_q6 * x168 - c_q6 * x169);
+        let x173 = 171.19551 * (x134 - -7.11 * x137) - 132.67838 * x151
+            + (x150 * x153 - x145 * x155 + x149 * x157) + (c_q5 * x170 - s_q5 * x171);
+        let x174 = -97.44449 * x152 - 135.47298 * x101
+            + -171.19551
+                * (c_q4 * (c_q3 * x133 - s_q3 * x135 - qd[3] * x130)
+                    - s_q4 * (x132 + x138) - qd[4] * x149)
+            + (x145 * x154 - x144 * x153 - x149 * x156) + (s_q5 * x170 + c_q5 * x171);
+        let x175 = x144 * x155 - x150 * x154 - (x146 * x156 + x148 * x157)
+            - -97.44449 * x101 + x172;
+        let x176 = c_q4 * x158 - s_q4 * x159;
+        let x177 = x130 * x142 + x127 * x143 - (x125 * x141 + x131 * x140)
+            - (-24989.307 * x136 + 1375.0472 * x101) + (c_q4 * x173 + s_q4 * x175);
+        let x178 = x138 * -3239.4583 - (1375.0472 * x136 + 24998.828 * x101)
+            + (x125 * x139 + x124 * x140 + x129 * x143) + (x174 + -7.11 * x176);
+        let x179 = 3239.4583 * x134 + (x124 * x141 - x131 * x139 - x129 * x142)
+            + (c_q4 * x175 - s_q4 * x173 + 7.11 * x160);
+        let x180 = x125 * x142 - x131 * x143 + (c_q4 * x159 + s_q4 * x158);
+        let x181 = x124 * x143 - x137 * -3239.4583 + x160;
+        let x182 = 3239.4583 * x101 - x124 * x142 + x176;
+        let x183 = c_q3 * x180 + s_q3 * x182;
+        let x184 = c_q3 * x182 - s_q3 * x180;
+        let x185 = x99 * x123 - x113 * x122 - (x109 * x121 + x114 * x120)
+            - (-39234.473 * x116 + 3946.1882 * x101)
+            + (c_q3 * x177 + s_q3 * x179 + -0.475 * x184);
+        let x186 = x118 * -5224.5703 - (3946.1882 * x116 + 39241.402 * x101)
+            + (x109 * x119 + x108 * x120 + x112 * x123) + (x178 + -7.11 * x184);
+        let x187 = 5224.5703 * x103 + (x108 * x121 - x114 * x119 - x112 * x122)
+            + (c_q3 * x179 - s_q3 * x177 + (0.475 * x183 + 7.11 * x181));
+        let x188 = x109 * x122 - x114 * x123 + x183;
+        let x189 = 5224.5703 * x101 - x108 * x122 + x184;
+        let x190 = c_q2 * x188 + s_q2 * x189;
+        let x191 = c_q2 * x187 - s_q2 * x185 + 0.5692 * x190
+            - (1145.5438 * x102 + (x95 * x104 + x99 * x106));
+        let x192 = c_q1
+            * (qd[1] * x104 - x96 * x105 + x99 * x107
+                + (c_q2 * x185 + s_q2 * x187 + -0.5692 * (c_q2 * x189 - s_q2 * x188)))
+            - s_q1 * (x186 - (-65693.914 * x101 + (x95 * x105 + x98 * x107)))
             + -0.7026
-                * (s_q1 * (qd[1] * x149 - 105.98 * x143 + x281)
+                * (s_q1 * (x96 * x107 + x190)
                     + c_q1
-                        * (105.98 * x144 - qd[1] * x148
-                            + x2
-                                * (314.88 * x160 + (x151 * x168 + x150 * x170) + x274)));
+                        * (x95 * x107 - qd[1] * x106
+                            + (x108 * x123 - x117 * -5224.5703 + x181)));
         (
             [
-                [x99, x100, x102, x108, x117, x125, x135],
-                [x100, x97, x101, x107, x116, x124, x134],
-                [x102, x101, x82, x104, x113, x122, x132],
-                [x108, x107, x104, x56, x109, x119, x129],
-                [x117, x116, x113, x109, x35, x27, x127],
-                [x125, x124, x122, x119, x27, x20, 0.0],
-                [x135, x134, x132, x129, x127, 0.0, 9.336],
+                [x71, x72, x73, x76, x84, x88, x94],
+                [x72, x69, x68, x75, x83, x87, x93],
+                [x73, x68, x59, x49, x80, 0.0, x8],
+                [x76, x75, x49, x35, x27, 0.0, x8],
+                [x84, x83, x80, x27, x13, 0.0, x8],
+                [x88, x87, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x94, x93, x8, x8, x8, 0.0, 9.336],
             ],
-            [x283, x282, x277, x269, x262, x256, x247],
+            [x192, x191, x186, x178, x174, x172, x166],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 566 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f32; 7],
@@ -1720,411 +1324,308 @@ impl SsrmsF32 {
     ) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = c_q6 * x12 + s_q6 * x13;
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + (x10 * x11 + 120.28197);
-        let x19 = 12.13 + (x14 + 120.28197);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.19551;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = s_q5 * x22 - c_q5 * x23;
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = c_q5 * x28 + x21 * 0.5692;
-        let x34 = 8.305 + (c_q5 * x22 + s_q5 * x23 + 113.27939);
-        let x35 = 3.061 + (s_q5 * x25 + c_q5 * x26);
-        let x36 = 8.0386 + (x8 * x29 + 113.27939);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01509;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4583;
-        let x41 = c_q4 * x34 - s_q4 * x32;
-        let x42 = c_q4 * x30 + s_q4 * x33;
-        let x43 = s_q4 * x36 - c_q4 * x31;
-        let x44 = x6 * (c_q5 * x25 - s_q5 * x26);
-        let x45 = x6 * x35;
-        let x46 = x6 * (x8 * x27 - -0.5692 * x21);
-        let x47 = s_q4 * x34 + c_q4 * x32;
-        let x48 = c_q4 * x33 - s_q4 * x30;
-        let x49 = s_q4 * x31 + c_q4 * x36;
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = s_q4 * x49 - c_q4 * x47 - 7.11 * x39;
-        let x53 = c_q4 * x43 - s_q4 * x41 + x39 * -7.11;
-        let x54 = 9.522 + (c_q4 * x41 + s_q4 * x43);
-        let x55 = -39.95 + (x6 * x42 - 7.11 * x38);
-        let x56 = 1966.28 + (x6 * x45 - x51 + 7.11 * x40);
-        let x57 = 1966.28 + (s_q4 * x47 + c_q4 * x49 + 7.11 * x37 - x40 * -7.11);
-        let x58 = s_q3 * x39;
-        let x59 = c_q3 * x40 + x58;
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = x61 - s_q3 * x40;
-        let x63 = x59 + 5224.5703;
-        let x64 = x60 + -349.0395;
-        let x65 = c_q3 * x54 + s_q3 * x52;
-        let x66 = c_q3 * x55 + s_q3 * x50;
-        let x67 = c_q3 * x53 + s_q3 * x57;
-        let x68 = x4 * (-39.95 + (c_q4 * x44 + s_q4 * x46 + x38 * -7.11));
-        let x69 = x4 * x56;
-        let x70 = x4 * (c_q4 * x46 - s_q4 * x44);
-        let x71 = c_q3 * x52 - s_q3 * x54;
-        let x72 = c_q3 * x50 - s_q3 * x55;
-        let x73 = c_q3 * x57 - s_q3 * x53;
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = c_q3 * x71 + s_q3 * x73 - 7.11 * x62;
-        let x78 = x4 * x72 + x76;
-        let x79 = c_q3 * x67 - s_q3 * x65 + -7.11 * x62;
-        let x80 = 15.41 + (c_q3 * x65 + s_q3 * x67 + -0.475 * x60 - x64 * 0.475);
-        let x81 = 49.52 + (x4 * x66 - x74 - 7.11 * x64);
-        let x82 = 2094.71 + (x4 * x69 - x75 + 7.11 * x63);
-        let x83 = 2103.19
-            + (c_q3 * x73 - s_q3 * x71 - (x60 * 0.475 - 7.11 * x59)
-                - (-7.11 * x63 - -0.475 * x64));
-        let x84 = s_q2 * x62;
-        let x85 = c_q2 * x63 + x84;
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = x87 - s_q2 * x63;
-        let x89 = x86 + -597.48926;
-        let x90 = c_q2 * x80 + s_q2 * x77;
-        let x91 = c_q2 * x81 + s_q2 * x78;
-        let x92 = c_q2 * x79 + s_q2 * x83;
-        let x93 = x2 * (49.52 + (c_q3 * x68 + s_q3 * x70 + -7.11 * x60 + x63 * 0.475));
-        let x94 = x2 * x82;
-        let x95 = x2 * (c_q3 * x70 - s_q3 * x68 - -0.475 * x62);
-        let x96 = -0.5692 * x85;
-        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x98 = c_q1 * (c_q2 * x92 - s_q2 * x90)
-            - s_q1 * (c_q2 * x95 - s_q2 * x93 - -0.5692 * x88)
-            + -0.7026 * (c_q1 * x85 - s_q1 * x89);
-        let x99 = c_q1 * (x91 - x96) - s_q1 * x94 + -0.7026 * (s_q1 * x88);
-        let x100 = x66 - x74;
-        let x101 = x69 - x75;
-        let x102 = x72 + x76;
-        let x103 = x87 - s_q2 * x59;
-        let x104 = c_q1 * (c_q2 * x100 + s_q2 * x102 - -0.5692 * (x84 + c_q2 * x59))
-            - s_q1 * (x2 * x101) + -0.7026 * (s_q1 * x103);
-        let x105 = x45 - x51;
-        let x106 = x61 - s_q3 * x37;
-        let x107 = x58 + c_q3 * x37;
-        let x108 = c_q3 * x42 + s_q3 * x48 - -0.475 * x107;
-        let x109 = x4 * x105 - -7.11 * x107;
-        let x110 = c_q3 * x48 - s_q3 * x42 + 0.475 * x106;
-        let x111 = c_q2 * x106 - s_q2 * x107;
-        let x112 = c_q1
-            * (c_q2 * x108 + s_q2 * x110 - -0.5692 * (s_q2 * x106 + c_q2 * x107))
-            - s_q1 * (x2 * x109) + -0.7026 * (s_q1 * x111);
-        let x113 = s_q4 * x29 - c_q4 * x24;
-        let x114 = x6 * x27;
-        let x115 = s_q4 * x24 + c_q4 * x29;
-        let x116 = c_q3 * x113 + s_q3 * x115;
-        let x117 = x4 * x114;
-        let x118 = c_q3 * x115 - s_q3 * x113;
-        let x119 = c_q1 * (c_q2 * x116 + s_q2 * x118) - s_q1 * (x2 * x117);
-        let x120 = c_q5 * x11;
-        let x121 = s_q5 * x11;
-        let x122 = c_q4 * x120;
-        let x123 = x6 * x121;
-        let x124 = s_q4 * x120;
-        let x125 = c_q3 * x122 - s_q3 * x124;
-        let x126 = x4 * x123;
-        let x127 = s_q3 * x122 + c_q3 * x124;
-        let x128 = c_q1 * (c_q2 * x125 - s_q2 * x127) - s_q1 * (x2 * x126);
-        let x129 = qd[0] * c_q1;
-        let x130 = qd[0] * s_q1;
-        let x131 = 0.7026 * qd[0];
-        let x132 = s_q1 * x131;
-        let x133 = c_q1 * x131;
-        let x134 = qd[1] * x130;
-        let x135 = qd[1] * x129;
-        let x136 = qd[1] * x133;
-        let x137 = qd[1] * x132;
-        let x138 = 8.088 * x129;
-        let x139 = 3.061 * x130;
-        let x140 = 8.446 * qd[1];
-        let x141 = 105.98 * x132;
-        let x142 = 105.98 * x133;
-        let x143 = c_q2 * x129 - qd[1] * s_q2;
-        let x144 = s_q2 * x129 + qd[1] * c_q2;
-        let x145 = 0.5692 * x129;
-        let x146 = x132 + -0.5692 * qd[1];
-        let x147 = s_q2 * x145 - c_q2 * x146;
-        let x148 = x2 * x133;
-        let x149 = s_q2 * x146 + c_q2 * x145;
-        let x150 = qd[2] - x2 * x130;
-        let x151 = x2 * x135;
-        let x152 = 0.5692 * x134;
-        let x153 = x2 * x137;
-        let x154 = c_q2 * x134 + qd[2] * x144;
-        let x155 = qd[2] * x143 - s_q2 * x134;
-        let x156 = qd[2] * x149 - (c_q2 * x136 + s_q2 * x152);
-        let x157 = c_q2 * x152 - s_q2 * x136 + qd[2] * x147;
-        let x158 = 15.41 * x143 + 49.52 * x150;
-        let x159 = 49.52 * x143 + 2094.71 * x150;
-        let x160 = 2103.19 * x144;
-        let x161 = 314.88 * x147;
-        let x162 = 314.88 * x148;
-        let x163 = 314.88 * x149;
-        let x164 = c_q3 * x143 - s_q3 * x144;
-        let x165 = s_q3 * x143 + c_q3 * x144;
-        let x166 = x147 - -0.475 * x144;
-        let x167 = x149 + (0.475 * x143 + 7.11 * x150);
-        let x168 = c_q3 * x166 + s_q3 * x167;
-        let x169 = x4 * (x148 + -7.11 * x144);
-        let x170 = s_q3 * x166 - c_q3 * x167;
-        let x171 = qd[3] + x4 * x150;
-        let x172 = x4 * x151;
-        let x173 = x156 - -0.475 * x155;
-        let x174 = x157 + (0.475 * x154 + 7.11 * x151);
-        let x175 = x4 * (x153 - -7.11 * x155);
-        let x176 = c_q3 * x154 + s_q3 * x155 + qd[3] * x165;
-        let x177 = c_q3 * x155 - s_q3 * x154 + qd[3] * x164;
-        let x178 = c_q3 * x173 - s_q3 * x174 - qd[3] * x170;
-        let x179 = s_q3 * x173 + c_q3 * x174 + qd[3] * x168;
-        let x180 = 9.522 * x164 + -39.95 * x171;
-        let x181 = -39.95 * x164 + 1966.28 * x171;
-        let x182 = 1966.28 * x165;
-        let x183 = 279.2 * x168;
-        let x184 = 279.2 * x169;
-        let x185 = 279.2 * x170;
-        let x186 = c_q4 * x164 - s_q4 * x165;
-        let x187 = s_q4 * x164 + c_q4 * x165;
-        let x188 = x170 - 7.11 * x171;
-        let x189 = c_q4 * x168 - s_q4 * x188;
-        let x190 = x6 * (x169 + -7.11 * x165);
-        let x191 = s_q4 * x168 + c_q4 * x188;
-        let x192 = qd[4] + x6 * x171;
-        let x193 = x6 * x172;
-        let x194 = x179 + 7.11 * x172;
-        let x195 = x6 * (x175 - -7.11 * x177);
-        let x196 = c_q4 * x176 + s_q4 * x177 + qd[4] * x187;
-        let x197 = c_q4 * x177 - s_q4 * x176 + qd[4] * x186;
-        let x198 = c_q4 * x178 - s_q4 * x194 - qd[4] * x191;
-        let x199 = s_q4 * x178 + c_q4 * x194 + qd[4] * x189;
-        let x200 = 8.305 * x186;
-        let x201 = 3.061 * x192;
-        let x202 = 8.0386 * x187;
-        let x203 = 105.98 * x189;
-        let x204 = 105.98 * x190;
-        let x205 = 105.98 * x191;
-        let x206 = c_q5 * x186 + s_q5 * x192;
-        let x207 = c_q5 * x192 - s_q5 * x186;
-        let x208 = x189 - -0.5692 * x187;
-        let x209 = c_q5 * x208 - s_q5 * x190;
-        let x210 = s_q5 * x208 + c_q5 * x190;
-        let x211 = x8 * (x191 - 0.5692 * x186);
-        let x212 = qd[5] + x8 * x187;
-        let x213 = x8 * x197;
-        let x214 = x198 - -0.5692 * x197;
-        let x215 = x8 * (x199 + 0.5692 * x196);
-        let x216 = qd[5] * x207 - (c_q5 * x196 + s_q5 * x193);
-        let x217 = s_q5 * x196 - c_q5 * x193 - qd[5] * x206;
-        let x218 = c_q5 * x214 + s_q5 * x195 - qd[5] * x210;
-        let x219 = c_q5 * x195 - s_q5 * x214 - qd[5] * x209;
-        let x220 = 12.13 * x206;
-        let x221 = 12.13 * x207;
-        let x222 = 3.061 * x212;
-        let x223 = 105.98 * x209;
-        let x224 = 105.98 * x210;
-        let x225 = 105.98 * x211;
-        let x226 = c_q6 * x207 + s_q6 * x212;
-        let x227 = c_q6 * x212 - s_q6 * x207;
-        let x228 = x210 + -0.7026 * x206;
-        let x229 = x10 * (x209 - 0.7026 * x207);
-        let x230 = s_q6 * x211 - c_q6 * x228;
-        let x231 = s_q6 * x228 + c_q6 * x211;
-        let x232 = qd[6] + x10 * x206;
-        let x233 = x219 - -0.7026 * x216;
-        let x234 = 9.336 * x232;
-        let x235 = 44.41 * x226;
-        let x236 = 44.41 * x227;
-        let x237 = 243.66 * x229;
-        let x238 = 243.66 * x230;
-        let x239 = 243.66 * x231;
-        let x240 = 9.336 * (x10 * x216)
-            + (x226 * x236 - x227 * x235 + (x230 * x239 - x231 * x238)) - f_ext[6][3];
-        let x241 = 44.41 * (c_q6 * x217 + s_q6 * x213 + qd[6] * x227)
-            + (x227 * x234 - x232 * x236 + (x231 * x237 - x229 * x239)) - f_ext[6][4];
-        let x242 = 44.41 * (c_q6 * x213 - s_q6 * x217 - qd[6] * x226)
-            + (x232 * x235 - x226 * x234 + (x229 * x238 - x230 * x237)) - f_ext[6][5];
-        let x243 = 243.66 * (c_q6 * x233 + s_q6 * x215 + qd[6] * x231)
-            + (x227 * x237 - x232 * x239) - f_ext[6][1];
-        let x244 = 243.66 * (c_q6 * x215 - s_q6 * x233 - qd[6] * x230)
-            + (x232 * x238 - x226 * x237) - f_ext[6][2];
-        let x245 = x10
-            * (243.66 * (x10 * (x218 - 0.7026 * x217)) + (x226 * x239 - x227 * x238)
-                - f_ext[6][0]);
-        let x246 = c_q6 * x243 - s_q6 * x244;
-        let x247 = 12.13 * x216
-            + (x207 * x222 - x212 * x221 + (x211 * x224 - x210 * x225)) - f_ext[5][3]
-            + (x10 * x240 + 0.7026 * x246);
-        let x248 = 12.13 * x217
-            + (x212 * x220 - x206 * x222 + (x211 * x223 - x209 * x225)) - f_ext[5][4]
-            + (c_q6 * x241 - s_q6 * x242 + -0.7026 * x245);
-        let x249 = 3.061 * x213
-            + (x206 * x221 - x207 * x220 + (x210 * x223 - x209 * x224)) - f_ext[5][5]
-            + (s_q6 * x241 + c_q6 * x242);
-        let x250 = 105.98 * x218 + (x212 * x224 + x207 * x225) - f_ext[5][0] + x245;
-        let x251 = 105.98 * x219 + (x212 * x223 - x206 * x225) - f_ext[5][1] + x246;
-        let x252 = c_q5 * x250 - s_q5 * x251;
-        let x253 = x8
-            * (105.98 * x215 - (x207 * x223 + x206 * x224) - f_ext[5][2]
-                + (s_q6 * x243 + c_q6 * x244));
-        let x254 = x192 * x202 - x187 * x201 + (x191 * x204 - x190 * x205) - 8.305 * x196
-            - f_ext[4][3] + (c_q5 * x247 - s_q5 * x248 + -0.5692 * x253);
-        let x255 = x187 * x200 - x186 * x202 + (x191 * x203 - x189 * x205) - 3.061 * x193
-            - f_ext[4][4] + (s_q5 * x247 + c_q5 * x248);
-        let x256 = 8.0386 * x197
-            + (x186 * x201 - x192 * x200 + (x190 * x203 - x189 * x204)) - f_ext[4][5]
-            + (x8 * x249 + 0.5692 * x252);
-        let x257 = 105.98 * x198 + (x187 * x204 + x192 * x205) - f_ext[4][0] + x252;
-        let x258 = 105.98 * x199 - (x192 * x203 + x186 * x204) - f_ext[4][2] + x253;
-        let x259 = x6
-            * (105.98 * x195 + (x187 * x203 - x186 * x205) - f_ext[4][1]
-                + (s_q5 * x250 + c_q5 * x251));
-        let x260 = c_q4 * x258 - s_q4 * x257;
-        let x261 = x171 * x182 - x165 * x181 + (x170 * x184 - x169 * x185)
-            - (9.522 * x176 + -39.95 * x172) - f_ext[3][3] + (c_q4 * x254 + s_q4 * x256);
-        let x262 = x165 * x180 - x164 * x182 + (x170 * x183 - x168 * x185)
-            - (-39.95 * x176 + 1966.28 * x172) - f_ext[3][4]
-            + (x6 * x255 + -7.11 * x260);
-        let x263 = 1966.28 * x177
-            + (x164 * x181 - x171 * x180 + (x169 * x183 - x168 * x184)) - f_ext[3][5]
-            + (c_q4 * x256 - s_q4 * x254 + 7.11 * x259);
-        let x264 = 279.2 * x178 + (x165 * x184 + x171 * x185) - f_ext[3][0]
-            + (c_q4 * x257 + s_q4 * x258);
-        let x265 = 279.2 * x179 - (x171 * x183 + x164 * x184) - f_ext[3][2] + x260;
-        let x266 = c_q3 * x264 + s_q3 * x265;
-        let x267 = x4
-            * (279.2 * x175 + (x165 * x183 - x164 * x185) - f_ext[3][1] + x259);
-        let x268 = c_q3 * x265 - s_q3 * x264;
-        let x269 = x150 * x160 - x144 * x159 + (x148 * x163 - x149 * x162)
-            - (15.41 * x154 + 49.52 * x151) - f_ext[2][3]
-            + (c_q3 * x261 + s_q3 * x263 + -0.475 * x268);
-        let x270 = x144 * x158 - x143 * x160 + (x147 * x163 - x149 * x161)
-            - (49.52 * x154 + 2094.71 * x151) - f_ext[2][4] + (x4 * x262 + -7.11 * x268);
-        let x271 = 2103.19 * x155
-            + (x143 * x159 - x150 * x158 + (x148 * x161 - x147 * x162)) - f_ext[2][5]
-            + (c_q3 * x263 - s_q3 * x261 + (0.475 * x266 + 7.11 * x267));
-        let x272 = 314.88 * x156 + (x144 * x162 - x150 * x163) - f_ext[2][0] + x266;
-        let x273 = 314.88 * x157 - (x150 * x161 + x143 * x162) - f_ext[2][2] + x268;
-        let x274 = c_q2 * x272 + s_q2 * x273;
-        let x275 = tau[0]
+        let x6 = 9.336 * c_q5;
+        let x7 = 44.41 * s_q5;
+        let x8 = 9.336 * s_q5;
+        let x9 = 44.41 * c_q5;
+        let x10 = s_q5 * x6 - c_q5 * x7;
+        let x11 = c_q5 * x8 - s_q5 * x9;
+        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
+        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
+        let x14 = -171.19551 * s_q4;
+        let x15 = -171.19551 * c_q4;
+        let x16 = c_q4 * x12;
+        let x17 = -97.44449 * s_q4;
+        let x18 = c_q4 * x10 + x17;
+        let x19 = 47.471 * s_q4;
+        let x20 = s_q4 * x12;
+        let x21 = -97.44449 * c_q4;
+        let x22 = x21 - s_q4 * x10;
+        let x23 = 47.471 * c_q4;
+        let x24 = x21 - s_q4 * x11;
+        let x25 = x14 * -7.11;
+        let x26 = 7.11 * x14;
+        let x27 = x13 - x25;
+        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
+        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
+        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
+        let x31 = 3239.4583 + x14;
+        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
+        let x33 = 1375.0472 + x18;
+        let x34 = 1375.0472 + (x17 + c_q4 * x11);
+        let x35 = 24998.828 + (x26 + x27);
+        let x36 = s_q3 * x15;
+        let x37 = c_q3 * x31 + x36;
+        let x38 = c_q3 * x15;
+        let x39 = x38 - s_q3 * x31;
+        let x40 = c_q3 * x32 + s_q3 * x28;
+        let x41 = s_q3 * x22;
+        let x42 = c_q3 * x29 + s_q3 * x30;
+        let x43 = c_q3 * x28 - s_q3 * x32;
+        let x44 = c_q3 * x22;
+        let x45 = c_q3 * x30 - s_q3 * x29;
+        let x46 = -7.11 * x37;
+        let x47 = 7.11 * x37;
+        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
+        let x49 = x35 - x46;
+        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
+        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
+        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
+        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
+        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
+        let x55 = 5224.5703 + x37;
+        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
+        let x57 = 3946.1882 + x48;
+        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
+        let x59 = 39241.402 + (x47 + x49);
+        let x60 = s_q2 * x39;
+        let x61 = c_q2 * x55 + x60;
+        let x62 = c_q2 * x39;
+        let x63 = x62 - s_q2 * x55;
+        let x64 = c_q2 * x56 + s_q2 * x50;
+        let x65 = s_q2 * x51;
+        let x66 = c_q2 * x52 + s_q2 * x54;
+        let x67 = c_q2 * x51;
+        let x68 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
+        let x69 = c_q1 * (c_q2 * x66 - s_q2 * x64)
+            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
+            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
+        let x70 = x68 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
+        let x71 = x62 - s_q2 * x37;
+        let x72 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
+            + -0.7026 * (s_q1 * x71);
+        let x73 = x38 - s_q3 * x14;
+        let x74 = x36 + c_q3 * x14;
+        let x75 = x41 + c_q3 * x18 - -0.475 * x74;
+        let x76 = x27 - -7.11 * x74;
+        let x77 = x44 - s_q3 * x18 + 0.475 * x73;
+        let x78 = c_q2 * x73 - s_q2 * x74;
+        let x79 = c_q1 * (c_q2 * x75 + s_q2 * x77 - -0.5692 * (s_q2 * x73 + c_q2 * x74))
+            - s_q1 * x76 + -0.7026 * (s_q1 * x78);
+        let x80 = c_q3 * x19 + s_q3 * x23;
+        let x81 = c_q3 * x23 - s_q3 * x19;
+        let x82 = c_q1 * (c_q2 * x80 + s_q2 * x81);
+        let x83 = c_q4 * x6;
+        let x84 = s_q4 * x6;
+        let x85 = c_q3 * x83 - s_q3 * x84;
+        let x86 = s_q3 * x83 + c_q3 * x84;
+        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
+        let x88 = qd[0] * c_q1;
+        let x89 = qd[0] * s_q1;
+        let x90 = 0.7026 * qd[0];
+        let x91 = s_q1 * x90;
+        let x92 = c_q1 * x90;
+        let x93 = qd[1] * x89;
+        let x94 = qd[1] * x88;
+        let x95 = qd[1] * x92;
+        let x96 = qd[1] * x91;
+        let x97 = -65693.914 * x89;
+        let x98 = 65697.33 * qd[1] - 1145.5438 * x91;
+        let x99 = -1145.5438 * qd[1];
+        let x100 = 1145.5438 * x88;
+        let x101 = c_q2 * x88 - qd[1] * s_q2;
+        let x102 = s_q2 * x88 + qd[1] * c_q2;
+        let x103 = 0.5692 * x88;
+        let x104 = x91 + -0.5692 * qd[1];
+        let x105 = s_q2 * x103 - c_q2 * x104;
+        let x106 = s_q2 * x104 + c_q2 * x103;
+        let x107 = qd[2] - x89;
+        let x108 = 0.5692 * x93;
+        let x109 = c_q2 * x93 + qd[2] * x102;
+        let x110 = qd[2] * x101 - s_q2 * x93;
+        let x111 = c_q2 * x108 - s_q2 * x95 + qd[2] * x105;
+        let x112 = -39234.473 * x101 + 3946.1882 * x107;
+        let x113 = 5224.5703 * x92;
+        let x114 = 3946.1882 * x101 + 39241.402 * x107 - x106 * -5224.5703;
+        let x115 = x102 * -5224.5703;
+        let x116 = 5224.5703 * x107;
+        let x117 = c_q3 * x101 - s_q3 * x102;
+        let x118 = s_q3 * x101 + c_q3 * x102;
+        let x119 = x105 - -0.475 * x102;
+        let x120 = x92 + -7.11 * x102;
+        let x121 = x106 + (0.475 * x101 + 7.11 * x107);
+        let x122 = c_q3 * x119 + s_q3 * x121;
+        let x123 = s_q3 * x119 - c_q3 * x121;
+        let x124 = qd[3] + x107;
+        let x125 = 7.11 * x94;
+        let x126 = qd[2] * x106 - (c_q2 * x95 + s_q2 * x108) - -0.475 * x110;
+        let x127 = x96 - -7.11 * x110;
+        let x128 = x111 + (0.475 * x109 + x125);
+        let x129 = c_q3 * x109 + s_q3 * x110 + qd[3] * x118;
+        let x130 = c_q3 * x110 - s_q3 * x109 + qd[3] * x117;
+        let x131 = s_q3 * x126 + c_q3 * x128 + qd[3] * x122;
+        let x132 = -24989.307 * x117 + 1375.0472 * x124;
+        let x133 = 3239.4583 * x120;
+        let x134 = 1375.0472 * x117 + 24998.828 * x124 + x123 * -3239.4583;
+        let x135 = x118 * -3239.4583;
+        let x136 = 3239.4583 * x124;
+        let x137 = c_q4 * x117 - s_q4 * x118;
+        let x138 = s_q4 * x117 + c_q4 * x118;
+        let x139 = x120 + -7.11 * x118;
+        let x140 = x123 - 7.11 * x124;
+        let x141 = c_q4 * x122 - s_q4 * x140;
+        let x142 = s_q4 * x122 + c_q4 * x140;
+        let x143 = qd[4] + x124;
+        let x144 = c_q4 * x129 + s_q4 * x130 + qd[4] * x138;
+        let x145 = c_q4 * x130 - s_q4 * x129 + qd[4] * x137;
+        let x146 = -97.44449 * x143;
+        let x147 = 132.67838 * x137 - 171.19551 * x139;
+        let x148 = 135.47298 * x143 + -97.44449 * x138 + -171.19551 * x141;
+        let x149 = 171.19551 * x143;
+        let x150 = -171.19551 * x137;
+        let x151 = c_q5 * x137 + s_q5 * x143;
+        let x152 = c_q5 * x143 - s_q5 * x137;
+        let x153 = qd[5] + x138;
+        let x154 = 44.41 * x152;
+        let x155 = 47.471 * x153;
+        let x156 = 9.336 * (qd[6] + x151);
+        let x157 = 9.336 * (qd[5] * x152 - (c_q5 * x144 + s_q5 * x94)) - f_ext[6][3];
+        let x158 = (c_q6 * x153 - s_q6 * x152) * x156 - f_ext[6][4];
+        let x159 = f_ext[6][5] + (c_q6 * x152 + s_q6 * x153) * x156;
+        let x160 = f_ext[6][2] * s_q6 - f_ext[6][1] * c_q6;
+        let x161 = x152 * x155 - x153 * x154 - f_ext[5][3] + (x157 + 0.7026 * x160);
+        let x162 = 44.41 * (s_q5 * x144 - c_q5 * x94 - qd[5] * x151) - x151 * x155
+            - f_ext[5][4] + (c_q6 * x158 + s_q6 * x159 - -0.7026 * f_ext[6][0]);
+        let x163 = 47.471 * x145 + x151 * x154 - f_ext[5][5]
+            + (s_q6 * x158 - c_q6 * x159);
+        let x164 = f_ext[5][0] + f_ext[6][0];
+        let x165 = x160 - f_ext[5][1];
+        let x166 = f_ext[5][2] + (f_ext[6][1] * s_q6 + f_ext[6][2] * c_q6);
+        let x167 = c_q5 * x164 + s_q5 * x165;
+        let x168 = 171.19551 * (x127 - -7.11 * x130) - 132.67838 * x144
+            + (x143 * x146 - x138 * x148 + x142 * x150) - f_ext[4][3]
+            + (c_q5 * x161 - s_q5 * x162 - -0.5692 * x166);
+        let x169 = -97.44449 * x145 - 135.47298 * x94
+            + -171.19551
+                * (c_q4 * (c_q3 * x126 - s_q3 * x128 - qd[3] * x123)
+                    - s_q4 * (x125 + x131) - qd[4] * x142)
+            + (x138 * x147 - x137 * x146 - x142 * x149) - f_ext[4][4]
+            + (s_q5 * x161 + c_q5 * x162);
+        let x170 = x137 * x148 - x143 * x147 - (x139 * x149 + x141 * x150)
+            - -97.44449 * x94 - f_ext[4][5] + (x163 - 0.5692 * x167);
+        let x171 = 171.19551 * x94 + x138 * x150 - f_ext[4][0] - x167;
+        let x172 = -171.19551 * x144 - x138 * x149 - f_ext[4][1]
+            + (c_q5 * x165 - s_q5 * x164);
+        let x173 = x143 * x149 - x137 * x150 - f_ext[4][2] - x166;
+        let x174 = c_q4 * x173 - s_q4 * x171;
+        let x175 = x123 * x135 + x120 * x136 - (x118 * x134 + x124 * x133)
+            - (-24989.307 * x129 + 1375.0472 * x94) - f_ext[3][3]
+            + (c_q4 * x168 + s_q4 * x170);
+        let x176 = x131 * -3239.4583 - (1375.0472 * x129 + 24998.828 * x94)
+            + (x118 * x132 + x117 * x133 + x122 * x136) - f_ext[3][4]
+            + (x169 + -7.11 * x174);
+        let x177 = 3239.4583 * x127 + (x117 * x134 - x124 * x132 - x122 * x135)
+            - f_ext[3][5] + (c_q4 * x170 - s_q4 * x168 + 7.11 * x172);
+        let x178 = x118 * x135 - x124 * x136 - f_ext[3][0] + (c_q4 * x171 + s_q4 * x173);
+        let x179 = x117 * x136 - x130 * -3239.4583 - f_ext[3][1] + x172;
+        let x180 = 3239.4583 * x94 - x117 * x135 - f_ext[3][2] + x174;
+        let x181 = c_q3 * x178 + s_q3 * x180;
+        let x182 = c_q3 * x180 - s_q3 * x178;
+        let x183 = x92 * x116 - x106 * x115 - (x102 * x114 + x107 * x113)
+            - (-39234.473 * x109 + 3946.1882 * x94) - f_ext[2][3]
+            + (c_q3 * x175 + s_q3 * x177 + -0.475 * x182);
+        let x184 = x111 * -5224.5703 - (3946.1882 * x109 + 39241.402 * x94)
+            + (x102 * x112 + x101 * x113 + x105 * x116) - f_ext[2][4]
+            + (x176 + -7.11 * x182);
+        let x185 = 5224.5703 * x96 + (x101 * x114 - x107 * x112 - x105 * x115)
+            - f_ext[2][5] + (c_q3 * x177 - s_q3 * x175 + (0.475 * x181 + 7.11 * x179));
+        let x186 = x102 * x115 - x107 * x116 - f_ext[2][0] + x181;
+        let x187 = 5224.5703 * x94 - x101 * x115 - f_ext[2][2] + x182;
+        let x188 = c_q2 * x186 + s_q2 * x187;
+        let x189 = tau[0]
             - (c_q1
-                * (qd[1] * x139 - x130 * x140 - 8.088 * x134 - f_ext[1][3]
-                    + (c_q2 * x269 + s_q2 * x271
-                        + -0.5692 * (c_q2 * x273 - s_q2 * x272)))
+                * (qd[1] * x97 - x89 * x98 + x92 * x100 - f_ext[1][3]
+                    + (c_q2 * x183 + s_q2 * x185
+                        + -0.5692 * (c_q2 * x187 - s_q2 * x186)))
                 - s_q1
-                    * (qd[1] * x138 - x129 * x140 - 3.061 * x135 - f_ext[1][4]
-                        + x2 * x270)
+                    * (x184
+                        - (f_ext[1][4] + (-65693.914 * x94 + (x88 * x98 + x91 * x100))))
                 + -0.7026
-                    * (s_q1 * (qd[1] * x142 - 105.98 * x136 - f_ext[1][0] + x274)
+                    * (s_q1 * (x89 * x100 - f_ext[1][0] + x188)
                         + c_q1
-                            * (105.98 * x137 - qd[1] * x141 - f_ext[1][1]
-                                + x2
-                                    * (314.88 * x153 + (x144 * x161 + x143 * x163) - f_ext[2][1]
-                                        + x267))) - f_ext[0][3]);
-        let x276 = 1.0
-            / (12.19
-                + (c_q1
-                    * (c_q1
-                        * (8.088
-                            + (c_q2 * x90 + s_q2 * x92 + -0.5692 * x86 - 0.5692 * x89))
-                        - s_q1 * (c_q2 * x93 + s_q2 * x95 + 0.5692 * x85))
-                    - s_q1 * (c_q1 * (x2 * x91 - x96) - s_q1 * (3.061 + x2 * x94))
-                    - -0.7026 * x97 + 0.7026 * (x97 + 811.9808)));
-        let x277 = x98 * x276;
-        let x278 = x99 * x276;
-        let x279 = x104 * x276;
-        let x280 = x112 * x276;
-        let x281 = x119 * x276;
-        let x282 = x128 * x276;
-        let x283 = 1.0
-            / (8.446
-                + (c_q2 * (c_q2 * x83 - s_q2 * x79) - s_q2 * (c_q2 * x77 - s_q2 * x80)
-                    - 0.5692 * x86 + -0.5692 * x89) - x98 * x277);
-        let x284 = c_q2 * x78 - s_q2 * x81 + 0.5692 * x88 - x98 * x278;
-        let x285 = x283 * x284;
-        let x286 = c_q2 * x102 - s_q2 * x100 + 0.5692 * x103 - x98 * x279;
-        let x287 = x283 * x286;
-        let x288 = c_q2 * x110 - s_q2 * x108 + 0.5692 * x111 - x98 * x280;
-        let x289 = x283 * x288;
-        let x290 = c_q2 * x118 - s_q2 * x116 - x98 * x281;
-        let x291 = x283 * x290;
-        let x292 = s_q2 * x125 + c_q2 * x127 + x98 * x282;
-        let x293 = x283 * x292;
-        let x294 = 1.0 / (x82 - x99 * x278 - x284 * x285);
-        let x295 = x101 - x99 * x279 - x284 * x287;
-        let x296 = x294 * x295;
-        let x297 = x109 - x99 * x280 - x284 * x289;
-        let x298 = x294 * x297;
-        let x299 = x117 - x99 * x281 - x284 * x291;
-        let x300 = x294 * x299;
-        let x301 = x126 - x99 * x282 + x284 * x293;
-        let x302 = x294 * x301;
-        let x303 = 1.0 / (x56 - x104 * x279 - x286 * x287 - x295 * x296);
-        let x304 = x105 - x104 * x280 - x286 * x289 - x295 * x298;
-        let x305 = x303 * x304;
-        let x306 = x114 - x104 * x281 - x286 * x291 - x295 * x300;
-        let x307 = x303 * x306;
-        let x308 = x123 - x104 * x282 + x286 * x293 - x295 * x302;
-        let x309 = x303 * x308;
-        let x310 = 1.0 / (x35 - x112 * x280 - x288 * x289 - x297 * x298 - x304 * x305);
-        let x311 = x27 - x112 * x281 - x288 * x291 - x297 * x300 - x304 * x307;
-        let x312 = x310 * x311;
-        let x313 = x121 - x112 * x282 + x288 * x293 - x297 * x302 - x304 * x309;
-        let x314 = x310 * x313;
-        let x315 = 1.0
-            / (x20 - x119 * x281 - x290 * x291 - x299 * x300 - x306 * x307
-                - x311 * x312);
-        let x316 = x290 * x293 - x119 * x282 - x299 * x302 - x306 * x309 - x311 * x314;
-        let x317 = x315 * x316;
-        let x318 = 1.0
-            / (9.336 - x128 * x282 - x292 * x293 - x301 * x302 - x308 * x309
-                - x313 * x314 - x316 * x317);
-        let x319 = tau[1]
-            - (x130 * x138 - x129 * x139 + (x132 * x142 - x133 * x141) - f_ext[1][5]
-                + (c_q2 * x271 - s_q2 * x269 + 0.5692 * x274)) - x275 * x277;
-        let x320 = tau[2] - x270 - x275 * x278 - x285 * x319;
-        let x321 = tau[3] - x262 - x275 * x279 - x287 * x319 - x296 * x320;
-        let x322 = tau[4] - x255 - x275 * x280 - x289 * x319 - x298 * x320 - x305 * x321;
-        let x323 = tau[5] - x249 - x275 * x281 - x291 * x319 - x300 * x320 - x307 * x321
-            - x312 * x322;
-        let x324 = x318
-            * (tau[6] - x240 - x275 * x282 + x293 * x319 - x302 * x320 - x309 * x321
-                - x314 * x322 - x317 * x323);
-        let x325 = x315 * x323 - x317 * x324;
-        let x326 = x310 * x322 - x312 * x325 - x314 * x324;
-        let x327 = x303 * x321 - x305 * x326 - x307 * x325 - x309 * x324;
-        let x328 = x294 * x320 - x296 * x327 - x298 * x326 - x300 * x325 - x302 * x324;
-        let x329 = x283 * x319 - x285 * x328 - x287 * x327 - x289 * x326 - x291 * x325
-            + x293 * x324;
-        let x330 = x275 * x276 - x277 * x329 - x278 * x328 - x279 * x327 - x280 * x326
-            - x281 * x325 - x282 * x324;
-        [x330, x329, x328, x327, x326, x325, x324]
+                            * (x88 * x100 - qd[1] * x99 - f_ext[1][1]
+                                + (x101 * x116 - x110 * -5224.5703 - f_ext[2][1] + x179)))
+                - f_ext[0][3]);
+        let x190 = 1.0
+            / (66279.66
+                + (0.7026 * x63
+                    + (c_q1
+                        * (c_q1 * (c_q2 * x64 + s_q2 * x66)
+                            - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
+                        - s_q1 * (x68 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63)));
+        let x191 = x69 * x190;
+        let x192 = x70 * x190;
+        let x193 = x72 * x190;
+        let x194 = x79 * x190;
+        let x195 = x82 * x190;
+        let x196 = x87 * x190;
+        let x197 = 1.0
+            / (65697.33
+                + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
+                - x69 * x191);
+        let x198 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x192;
+        let x199 = x197 * x198;
+        let x200 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x193;
+        let x201 = x197 * x200;
+        let x202 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x194;
+        let x203 = x197 * x202;
+        let x204 = c_q2 * x81 - s_q2 * x80 - x69 * x195;
+        let x205 = x197 * x204;
+        let x206 = s_q2 * x85 + c_q2 * x86 + x69 * x196;
+        let x207 = x197 * x206;
+        let x208 = 1.0 / (x59 - x70 * x192 - x198 * x199);
+        let x209 = x49 - x70 * x193 - x198 * x201;
+        let x210 = x208 * x209;
+        let x211 = x76 - x70 * x194 - x198 * x203;
+        let x212 = x208 * x211;
+        let x213 = x70 * x195 + x198 * x205;
+        let x214 = x208 * x213;
+        let x215 = x8 - x70 * x196 + x198 * x207;
+        let x216 = x208 * x215;
+        let x217 = 1.0 / (x35 - x72 * x193 - x200 * x201 - x209 * x210);
+        let x218 = x27 - x72 * x194 - x200 * x203 - x209 * x212;
+        let x219 = x217 * x218;
+        let x220 = x209 * x214 - (x72 * x195 + x200 * x205);
+        let x221 = x217 * x220;
+        let x222 = x8 - x72 * x196 + x200 * x207 - x209 * x216;
+        let x223 = x217 * x222;
+        let x224 = 1.0 / (x13 - x79 * x194 - x202 * x203 - x211 * x212 - x218 * x219);
+        let x225 = x211 * x214 - (x79 * x195 + x202 * x205) - x218 * x221;
+        let x226 = x224 * x225;
+        let x227 = x8 - x79 * x196 + x202 * x207 - x211 * x216 - x218 * x223;
+        let x228 = x224 * x227;
+        let x229 = 1.0
+            / (47.471 - x82 * x195 - x204 * x205 - x213 * x214 - x220 * x221
+                - x225 * x226);
+        let x230 = x204 * x207 - x82 * x196 + x213 * x216 - x220 * x223 - x225 * x228;
+        let x231 = x229 * x230;
+        let x232 = 1.0
+            / (9.336 - x87 * x196 - x206 * x207 - x215 * x216 - x222 * x223 - x227 * x228
+                - x230 * x231);
+        let x233 = tau[1]
+            - (c_q2 * x185 - s_q2 * x183 + 0.5692 * x188
+                - (f_ext[1][5] + (1145.5438 * x95 + (x88 * x97 + x92 * x99))))
+            - x189 * x191;
+        let x234 = tau[2] - x184 - x189 * x192 - x199 * x233;
+        let x235 = tau[3] - x176 - x189 * x193 - x201 * x233 - x210 * x234;
+        let x236 = tau[4] - x169 - x189 * x194 - x203 * x233 - x212 * x234 - x219 * x235;
+        let x237 = tau[5] - x163 - x189 * x195 - x205 * x233 + x214 * x234 - x221 * x235
+            - x226 * x236;
+        let x238 = x232
+            * (tau[6] - x157 - x189 * x196 + x207 * x233 - x216 * x234 - x223 * x235
+                - x228 * x236 - x231 * x237);
+        let x239 = x229 * x237 - x231 * x238;
+        let x240 = x224 * x236 - x226 * x239 - x228 * x238;
+        let x241 = x217 * x235 - x219 * x240 - x221 * x239 - x223 * x238;
+        let x242 = x208 * x234 - x210 * x241 - x212 * x240 + x214 * x239 - x216 * x238;
+        let x243 = x197 * x233 - x199 * x242 - x201 * x241 - x203 * x240 - x205 * x239
+            + x207 * x238;
+        let x244 = x189 * x190 - x191 * x243 - x192 * x242 - x193 * x241 - x194 * x240
+            - x195 * x239 - x196 * x238;
+        [x244, x243, x242, x241, x240, x239, x238]
     }
 }

@@ -6,33 +6,34 @@
 //! Base: fixed.
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
+//! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Precision: `f64`.
-//! Fused multiply-adds: 1729 (`mass_matrix` 124, `nonlinear_effects` 205, `inverse_dynamics` 219, `forward_dynamics` 426, `mass_matrix_and_nonlinear_effects` 329, `forward_dynamics_with_wrenches` 426), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds: 1260 (`mass_matrix` 93, `nonlinear_effects` 136, `inverse_dynamics` 145, `forward_dynamics` 323, `mass_matrix_and_nonlinear_effects` 229, `forward_dynamics_with_wrenches` 334), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
 //! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 721 | 679 | 0 | 0 | 7 | 1400 |
-//! | `mass_matrix` | `recurrent-r1` | — | 822 | 723 | 0 | 0 | 7 | 1545 |
-//! | `mass_matrix` | `kane-direct` | — | 923 | 635 | 0 | 0 | 7 | 1558 |
-//! | `mass_matrix` | `crba-base` | — | 623 | 475 | 0 | 0 | 7 | 1098 |
-//! | `mass_matrix` * | `crba` | — | 254 | 171 | 0 | 0 | 6 | 425 |
-//! | `nonlinear_effects` | — | `recurrent` | 652 | 464 | 0 | 0 | 7 | 1116 |
-//! | `nonlinear_effects` | — | `kane-direct` | 797 | 580 | 0 | 0 | 7 | 1377 |
-//! | `nonlinear_effects` * | — | `rnea` | 394 | 265 | 0 | 0 | 6 | 659 |
-//! | `inverse_dynamics` | — | `recurrent` | 953 | 670 | 0 | 0 | 7 | 1623 |
-//! | `inverse_dynamics` | — | `kane-direct` | 1098 | 786 | 0 | 0 | 7 | 1884 |
-//! | `inverse_dynamics` * | — | `rnea` | 404 | 279 | 0 | 0 | 6 | 683 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 1032 | 727 | 7 | 0 | 7 | 1759 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 1177 | 843 | 7 | 0 | 7 | 2020 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 774 | 530 | 7 | 0 | 6 | 1304 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 906 | 623 | 0 | 0 | 7 | 1529 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 1051 | 739 | 0 | 0 | 7 | 1790 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 648 | 426 | 0 | 0 | 6 | 1074 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1137 | 832 | 7 | 0 | 7 | 1969 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1282 | 948 | 7 | 0 | 7 | 2230 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 774 | 566 | 7 | 0 | 6 | 1340 |
+//! | `mass_matrix` | `recurrent` | — | 681 | 661 | 0 | 0 | 7 | 1342 |
+//! | `mass_matrix` | `recurrent-r1` | — | 778 | 703 | 0 | 0 | 7 | 1481 |
+//! | `mass_matrix` | `kane-direct` | — | 709 | 510 | 0 | 0 | 7 | 1219 |
+//! | `mass_matrix` | `crba-base` | — | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` * | `crba` | — | 170 | 116 | 0 | 0 | 5 | 286 |
+//! | `nonlinear_effects` | — | `recurrent` | 618 | 450 | 0 | 0 | 7 | 1068 |
+//! | `nonlinear_effects` | — | `kane-direct` | 708 | 536 | 0 | 0 | 7 | 1244 |
+//! | `nonlinear_effects` * | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `inverse_dynamics` | — | `recurrent` | 827 | 607 | 0 | 0 | 7 | 1434 |
+//! | `inverse_dynamics` | — | `kane-direct` | 917 | 693 | 0 | 0 | 7 | 1610 |
+//! | `inverse_dynamics` * | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `forward_dynamics` | `crba` | `recurrent` | 914 | 667 | 7 | 0 | 7 | 1581 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | 1004 | 753 | 7 | 0 | 7 | 1757 |
+//! | `forward_dynamics` * | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 788 | 566 | 0 | 0 | 7 | 1354 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 878 | 652 | 0 | 0 | 7 | 1530 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1018 | 772 | 7 | 0 | 7 | 1790 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1108 | 858 | 7 | 0 | 7 | 1966 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsFma;
@@ -90,67 +91,67 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 254u64,
-            add: 171u64,
+            mul: 170u64,
+            add: 116u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 6u64,
-            fma: 124u64,
+            sincos: 5u64,
+            fma: 93u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 394u64,
-            add: 265u64,
+            mul: 256u64,
+            add: 176u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 205u64,
+            fma: 136u64,
         },
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 404u64,
-            add: 279u64,
+            mul: 268u64,
+            add: 191u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 219u64,
+            fma: 145u64,
         },
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 774u64,
-            add: 530u64,
+            mul: 552u64,
+            add: 393u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 426u64,
+            fma: 323u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 648u64,
-            add: 426u64,
+            mul: 426u64,
+            add: 292u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 329u64,
+            fma: 229u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 774u64,
-            add: 566u64,
+            mul: 564u64,
+            add: 437u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 426u64,
+            fma: 334u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -159,8 +160,8 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
-            mul: 721u64,
-            add: 679u64,
+            mul: 681u64,
+            add: 661u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -170,8 +171,8 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
-            mul: 822u64,
-            add: 723u64,
+            mul: 778u64,
+            add: 703u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -181,8 +182,8 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
-            mul: 923u64,
-            add: 635u64,
+            mul: 709u64,
+            add: 510u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -192,8 +193,8 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
-            mul: 623u64,
-            add: 475u64,
+            mul: 577u64,
+            add: 454u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -203,19 +204,19 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 254u64,
-            add: 171u64,
+            mul: 170u64,
+            add: 116u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 6u64,
+            sincos: 5u64,
             fma: 0u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 652u64,
-            add: 464u64,
+            mul: 618u64,
+            add: 450u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -225,8 +226,8 @@ impl SsrmsFma {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 797u64,
-            add: 580u64,
+            mul: 708u64,
+            add: 536u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -236,8 +237,8 @@ impl SsrmsFma {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 394u64,
-            add: 265u64,
+            mul: 256u64,
+            add: 176u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -247,8 +248,8 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 953u64,
-            add: 670u64,
+            mul: 827u64,
+            add: 607u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -258,8 +259,8 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 1098u64,
-            add: 786u64,
+            mul: 917u64,
+            add: 693u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -269,8 +270,8 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 404u64,
-            add: 279u64,
+            mul: 268u64,
+            add: 191u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -280,8 +281,8 @@ impl SsrmsFma {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 1032u64,
-            add: 727u64,
+            mul: 914u64,
+            add: 667u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -291,8 +292,8 @@ impl SsrmsFma {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 1177u64,
-            add: 843u64,
+            mul: 1004u64,
+            add: 753u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -302,8 +303,8 @@ impl SsrmsFma {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 774u64,
-            add: 530u64,
+            mul: 552u64,
+            add: 393u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -313,63 +314,63 @@ impl SsrmsFma {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 906u64,
-            add: 623u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
-            mul: 1051u64,
-            add: 739u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 648u64,
-            add: 426u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
-            mul: 1137u64,
-            add: 832u64,
-            div: 7u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
-            mul: 1282u64,
-            add: 948u64,
-            div: 7u64,
-            sqrt: 0u64,
-            sincos: 7u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 774u64,
+            mul: 788u64,
             add: 566u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 878u64,
+            add: 652u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 426u64,
+            add: 292u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            mul: 1018u64,
+            add: 772u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            mul: 1108u64,
+            add: 858u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            mul: 564u64,
+            add: 437u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -378,264 +379,174 @@ impl SsrmsFma {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 254 mul, 171 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 124 fused multiply-adds.
+    /// Methods: mass matrix `crba`: 170 mul, 116 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 93 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
-        let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = libm::fma(s_q6, x13, c_q6 * x12);
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + libm::fma(x10, x11, 120.2819695416);
-        let x19 = 12.13 + (x14 + 120.2819695416);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.195516;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = libm::fma(-c_q5, x23, s_q5 * x22);
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = libm::fma(x21, 0.5692, c_q5 * x28);
-        let x34 = 8.305 + (libm::fma(s_q5, x23, c_q5 * x22) + 113.27938808960002);
-        let x35 = 3.061 + libm::fma(c_q5, x26, s_q5 * x25);
-        let x36 = 8.0386 + libm::fma(x8, x29, 113.27938808960002);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01508800000002;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4582;
-        let x41 = libm::fma(-s_q4, x32, c_q4 * x34);
-        let x42 = libm::fma(s_q4, x33, c_q4 * x30);
-        let x43 = libm::fma(-c_q4, x31, s_q4 * x36);
-        let x44 = x6 * libm::fma(-s_q5, x26, c_q5 * x25);
-        let x45 = x6 * x35;
-        let x46 = x6 * libm::fma(0.5692, x21, x8 * x27);
-        let x47 = libm::fma(c_q4, x32, s_q4 * x34);
-        let x48 = libm::fma(-s_q4, x30, c_q4 * x33);
-        let x49 = libm::fma(c_q4, x36, s_q4 * x31);
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = libm::fma(-7.11, x39, libm::fma(-c_q4, x47, s_q4 * x49));
-        let x53 = libm::fma(x39, -7.11, libm::fma(-s_q4, x41, c_q4 * x43));
-        let x54 = 9.522 + libm::fma(s_q4, x43, c_q4 * x41);
-        let x55 = -39.95 + libm::fma(-7.11, x38, x6 * x42);
-        let x56 = 1966.28 + libm::fma(7.11, x40, libm::fma(x6, x45, -x51));
-        let x57 = 1966.28
+        let x5 = 9.336 * c_q5;
+        let x6 = 44.41 * s_q5;
+        let x7 = 9.336 * s_q5;
+        let x8 = 44.41 * c_q5;
+        let x9 = libm::fma(-c_q5, x6, s_q5 * x5);
+        let x10 = libm::fma(-s_q5, x8, c_q5 * x7);
+        let x11 = 132.6783695416 + libm::fma(s_q5, x6, c_q5 * x5);
+        let x12 = 135.4729695416 + libm::fma(c_q5, x8, s_q5 * x7);
+        let x13 = -171.195516 * s_q4;
+        let x14 = -171.195516 * c_q4;
+        let x15 = c_q4 * x11;
+        let x16 = -97.44448770720001 * s_q4;
+        let x17 = libm::fma(c_q4, x9, x16);
+        let x18 = 47.471 * s_q4;
+        let x19 = s_q4 * x11;
+        let x20 = -97.44448770720001 * c_q4;
+        let x21 = libm::fma(-s_q4, x9, x20);
+        let x22 = 47.471 * c_q4;
+        let x23 = libm::fma(-s_q4, x10, x20);
+        let x24 = x13 * -7.11;
+        let x25 = 7.11 * x13;
+        let x26 = x12 - x24;
+        let x27 = libm::fma(-7.11, x14, libm::fma(-c_q4, x19, s_q4 * x22));
+        let x28 = libm::fma(x14, -7.11, libm::fma(-s_q4, x15, c_q4 * x18));
+        let x29 = libm::fma(c_q4, x22, s_q4 * x19) + x25 - x24;
+        let x30 = 3239.4582 + x13;
+        let x31 = -24989.305802 + libm::fma(s_q4, x18, c_q4 * x15);
+        let x32 = 1375.0472756800002 + x17;
+        let x33 = 1375.0472756800002 + libm::fma(c_q4, x10, x16);
+        let x34 = 24998.827802 + (x25 + x26);
+        let x35 = s_q3 * x14;
+        let x36 = libm::fma(c_q3, x30, x35);
+        let x37 = c_q3 * x14;
+        let x38 = libm::fma(-s_q3, x30, x37);
+        let x39 = libm::fma(s_q3, x27, c_q3 * x31);
+        let x40 = s_q3 * x21;
+        let x41 = libm::fma(s_q3, x29, c_q3 * x28);
+        let x42 = libm::fma(-s_q3, x31, c_q3 * x27);
+        let x43 = c_q3 * x21;
+        let x44 = libm::fma(-s_q3, x28, c_q3 * x29);
+        let x45 = -7.11 * x36;
+        let x46 = 7.11 * x36;
+        let x47 = libm::fma(0.475, x36, libm::fma(c_q3, x32, x40));
+        let x48 = x34 - x45;
+        let x49 = libm::fma(-7.11, x38, libm::fma(s_q3, x44, c_q3 * x42));
+        let x50 = libm::fma(x38, 0.475, libm::fma(-s_q3, x32, x43));
+        let x51 = libm::fma(-7.11, x38, libm::fma(-s_q3, x39, c_q3 * x41));
+        let x52 = libm::fma(0.475, x38, libm::fma(-s_q3, x33, c_q3 * x23));
+        let x53 = libm::fma(-s_q3, x42, c_q3 * x44) + x46 - x45;
+        let x54 = 5224.5702 + x36;
+        let x55 = -39234.47412200001 + libm::fma(s_q3, x41, c_q3 * x39);
+        let x56 = 3946.18812068 + x47;
+        let x57 = 3946.1881206800003
+            + libm::fma(x36, 0.475, libm::fma(s_q3, x23, c_q3 * x33));
+        let x58 = 39241.404122 + (x46 + x48);
+        let x59 = s_q2 * x38;
+        let x60 = libm::fma(c_q2, x54, x59);
+        let x61 = c_q2 * x38;
+        let x62 = libm::fma(-s_q2, x54, x61);
+        let x63 = libm::fma(s_q2, x49, c_q2 * x55);
+        let x64 = s_q2 * x50;
+        let x65 = libm::fma(s_q2, x53, c_q2 * x51);
+        let x66 = c_q2 * x50;
+        let x67 = libm::fma(0.5692, x62, libm::fma(-s_q2, x56, x66));
+        let x68 = 65697.3302265768
             + libm::fma(
-                x40,
-                7.11,
-                libm::fma(7.11, x37, libm::fma(c_q4, x49, s_q4 * x47)),
+                -s_q2,
+                libm::fma(-s_q2, x55, c_q2 * x49),
+                c_q2 * libm::fma(-s_q2, x51, c_q2 * x53),
             );
-        let x58 = s_q3 * x39;
-        let x59 = libm::fma(c_q3, x40, x58);
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = libm::fma(-s_q3, x40, x61);
-        let x63 = x59 + 5224.5702;
-        let x64 = x60 + -349.0395;
-        let x65 = libm::fma(s_q3, x52, c_q3 * x54);
-        let x66 = libm::fma(s_q3, x50, c_q3 * x55);
-        let x67 = libm::fma(s_q3, x57, c_q3 * x53);
-        let x68 = x4
-            * (-39.95 + libm::fma(x38, -7.11, libm::fma(s_q4, x46, c_q4 * x44)));
-        let x69 = x4 * x56;
-        let x70 = x4 * libm::fma(-s_q4, x44, c_q4 * x46);
-        let x71 = libm::fma(-s_q3, x54, c_q3 * x52);
-        let x72 = libm::fma(-s_q3, x55, c_q3 * x50);
-        let x73 = libm::fma(-s_q3, x53, c_q3 * x57);
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = libm::fma(-7.11, x62, libm::fma(s_q3, x73, c_q3 * x71));
-        let x78 = libm::fma(x4, x72, x76);
-        let x79 = libm::fma(-7.11, x62, libm::fma(-s_q3, x65, c_q3 * x67));
-        let x80 = 15.41
-            + libm::fma(
-                x64,
-                -0.475,
-                libm::fma(-0.475, x60, libm::fma(s_q3, x67, c_q3 * x65)),
-            );
-        let x81 = 49.52 + libm::fma(-7.11, x64, libm::fma(x4, x66, -x74));
-        let x82 = 2094.71 + libm::fma(7.11, x63, libm::fma(x4, x69, -x75));
-        let x83 = 2103.19
-            + (libm::fma(-s_q3, x71, c_q3 * x73) - libm::fma(-7.11, x59, x60 * 0.475)
-                - libm::fma(0.475, x64, -7.11 * x63));
-        let x84 = s_q2 * x62;
-        let x85 = libm::fma(c_q2, x63, x84);
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = libm::fma(-s_q2, x63, x87);
-        let x89 = x86 + -597.4892399999999;
-        let x90 = libm::fma(s_q2, x77, c_q2 * x80);
-        let x91 = libm::fma(s_q2, x78, c_q2 * x81);
-        let x92 = libm::fma(s_q2, x83, c_q2 * x79);
-        let x93 = x2
-            * (49.52
-                + libm::fma(
-                    x63,
-                    0.475,
-                    libm::fma(-7.11, x60, libm::fma(s_q3, x70, c_q3 * x68)),
-                ));
-        let x94 = x2 * x82;
-        let x95 = x2 * libm::fma(0.475, x62, libm::fma(-s_q3, x68, c_q3 * x70));
-        let x96 = -0.5692 * x85;
-        let x97 = 8.446
-            + libm::fma(
-                -0.5692,
-                x89,
-                libm::fma(
-                    -0.5692,
-                    x86,
-                    libm::fma(
-                        -s_q2,
-                        libm::fma(-s_q2, x80, c_q2 * x77),
-                        c_q2 * libm::fma(-s_q2, x79, c_q2 * x83),
-                    ),
-                ),
-            );
-        let x98 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x99 = 12.19
+        let x69 = c_q1 * libm::fma(0.5692, x60, libm::fma(c_q2, x56, x64));
+        let x70 = 66279.65991417361
             + libm::fma(
                 0.7026,
-                x98 + 811.9807679999999,
+                x62,
                 libm::fma(
                     0.7026,
-                    x98,
+                    x62,
                     libm::fma(
                         -s_q1,
-                        libm::fma(
-                            -s_q1,
-                            libm::fma(x2, x94, 3.061),
-                            c_q1 * libm::fma(x2, x91, -x96),
-                        ),
+                        libm::fma(-s_q1, -65693.9112265768 + x58, x69),
                         c_q1
                             * libm::fma(
                                 -s_q1,
-                                libm::fma(0.5692, x85, libm::fma(s_q2, x95, c_q2 * x93)),
-                                c_q1
-                                    * (8.088
-                                        + libm::fma(
-                                            -0.5692,
-                                            x89,
-                                            libm::fma(-0.5692, x86, libm::fma(s_q2, x92, c_q2 * x90)),
-                                        )),
+                                libm::fma(0.5692, x60, libm::fma(s_q2, x52, c_q2 * x57)),
+                                c_q1 * libm::fma(s_q2, x65, c_q2 * x63),
                             ),
                     ),
                 ),
             );
-        let x100 = libm::fma(
+        let x71 = libm::fma(
             -0.7026,
-            libm::fma(-s_q1, x89, c_q1 * x85),
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x60),
             libm::fma(
                 -s_q1,
-                libm::fma(0.5692, x88, libm::fma(-s_q2, x93, c_q2 * x95)),
-                c_q1 * libm::fma(-s_q2, x90, c_q2 * x92),
+                libm::fma(0.5692, x62, libm::fma(-s_q2, x57, c_q2 * x52)),
+                c_q1 * libm::fma(-s_q2, x63, c_q2 * x65),
             ),
         );
-        let x101 = libm::fma(0.5692, x88, libm::fma(-s_q2, x81, c_q2 * x78));
-        let x102 = libm::fma(
+        let x72 = libm::fma(-0.7026, s_q1 * x62, libm::fma(-s_q1, x58, x69));
+        let x73 = libm::fma(-s_q2, x36, x61);
+        let x74 = libm::fma(0.5692, x73, libm::fma(-s_q2, x47, x66));
+        let x75 = libm::fma(
             -0.7026,
-            s_q1 * x88,
-            libm::fma(-s_q1, x94, c_q1 * (x91 - x96)),
-        );
-        let x103 = x66 - x74;
-        let x104 = x69 - x75;
-        let x105 = x72 + x76;
-        let x106 = libm::fma(-s_q2, x59, x87);
-        let x107 = libm::fma(0.5692, x106, libm::fma(-s_q2, x103, c_q2 * x105));
-        let x108 = libm::fma(
-            -0.7026,
-            s_q1 * x106,
+            s_q1 * x73,
             libm::fma(
                 -s_q1,
-                x2 * x104,
+                x48,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x59, x84),
-                        libm::fma(s_q2, x105, c_q2 * x103),
+                        libm::fma(c_q2, x36, x59),
+                        libm::fma(c_q2, x47, x64),
                     ),
             ),
         );
-        let x109 = x45 - x51;
-        let x110 = libm::fma(-s_q3, x37, x61);
-        let x111 = libm::fma(c_q3, x37, x58);
-        let x112 = libm::fma(0.475, x111, libm::fma(s_q3, x48, c_q3 * x42));
-        let x113 = libm::fma(7.11, x111, x4 * x109);
-        let x114 = libm::fma(0.475, x110, libm::fma(-s_q3, x42, c_q3 * x48));
-        let x115 = libm::fma(-s_q2, x111, c_q2 * x110);
-        let x116 = libm::fma(0.5692, x115, libm::fma(-s_q2, x112, c_q2 * x114));
-        let x117 = libm::fma(
+        let x76 = libm::fma(-s_q3, x13, x37);
+        let x77 = libm::fma(c_q3, x13, x35);
+        let x78 = libm::fma(0.475, x77, libm::fma(c_q3, x17, x40));
+        let x79 = libm::fma(7.11, x77, x26);
+        let x80 = libm::fma(0.475, x76, libm::fma(-s_q3, x17, x43));
+        let x81 = libm::fma(-s_q2, x77, c_q2 * x76);
+        let x82 = libm::fma(0.5692, x81, libm::fma(-s_q2, x78, c_q2 * x80));
+        let x83 = libm::fma(
             -0.7026,
-            s_q1 * x115,
+            s_q1 * x81,
             libm::fma(
                 -s_q1,
-                x2 * x113,
+                x79,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x111, s_q2 * x110),
-                        libm::fma(s_q2, x114, c_q2 * x112),
+                        libm::fma(c_q2, x77, s_q2 * x76),
+                        libm::fma(s_q2, x80, c_q2 * x78),
                     ),
             ),
         );
-        let x118 = libm::fma(-c_q4, x24, s_q4 * x29);
-        let x119 = x6 * x27;
-        let x120 = libm::fma(c_q4, x29, s_q4 * x24);
-        let x121 = libm::fma(s_q3, x120, c_q3 * x118);
-        let x122 = x4 * x119;
-        let x123 = libm::fma(-s_q3, x118, c_q3 * x120);
-        let x124 = libm::fma(-s_q2, x121, c_q2 * x123);
-        let x125 = libm::fma(
-            -s_q1,
-            x2 * x122,
-            c_q1 * libm::fma(s_q2, x123, c_q2 * x121),
-        );
-        let x126 = c_q5 * x11;
-        let x127 = s_q5 * x11;
-        let x128 = c_q4 * x126;
-        let x129 = x6 * x127;
-        let x130 = s_q4 * x126;
-        let x131 = libm::fma(-s_q3, x130, c_q3 * x128);
-        let x132 = x4 * x129;
-        let x133 = libm::fma(c_q3, x130, s_q3 * x128);
-        let x134 = -libm::fma(c_q2, x133, s_q2 * x131);
-        let x135 = libm::fma(
-            -s_q1,
-            x2 * x132,
-            c_q1 * libm::fma(-s_q2, x133, c_q2 * x131),
-        );
+        let x84 = libm::fma(s_q3, x22, c_q3 * x18);
+        let x85 = libm::fma(-s_q3, x18, c_q3 * x22);
+        let x86 = libm::fma(-s_q2, x84, c_q2 * x85);
+        let x87 = c_q1 * libm::fma(s_q2, x85, c_q2 * x84);
+        let x88 = c_q4 * x5;
+        let x89 = s_q4 * x5;
+        let x90 = libm::fma(-s_q3, x89, c_q3 * x88);
+        let x91 = libm::fma(c_q3, x89, s_q3 * x88);
+        let x92 = -libm::fma(c_q2, x91, s_q2 * x90);
+        let x93 = libm::fma(-s_q1, x7, c_q1 * libm::fma(-s_q2, x91, c_q2 * x90));
         [
-            [x99, x100, x102, x108, x117, x125, x135],
-            [x100, x97, x101, x107, x116, x124, x134],
-            [x102, x101, x82, x104, x113, x122, x132],
-            [x108, x107, x104, x56, x109, x119, x129],
-            [x117, x116, x113, x109, x35, x27, x127],
-            [x125, x124, x122, x119, x27, x20, 0.0],
-            [x135, x134, x132, x129, x127, 0.0, 9.336],
+            [x70, x71, x72, x75, x83, x87, x93],
+            [x71, x68, x67, x74, x82, x86, x92],
+            [x72, x67, x58, x48, x79, 0.0, x7],
+            [x75, x74, x48, x34, x26, 0.0, x7],
+            [x83, x82, x79, x26, x12, 0.0, x7],
+            [x87, x86, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x93, x92, x7, x7, x7, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 394 mul, 265 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 205 fused multiply-adds.
+    /// Methods: bias `rnea`: 256 mul, 176 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 136 fused multiply-adds.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -648,254 +559,186 @@ impl SsrmsFma {
         let x7 = qd[1] * x1;
         let x8 = qd[1] * x5;
         let x9 = qd[1] * x4;
-        let x10 = 8.088 * x1;
-        let x11 = 3.061 * x2;
-        let x12 = 8.446 * qd[1];
-        let x13 = 105.98 * x4;
-        let x14 = 105.98 * x5;
+        let x10 = -65693.9112265768 * x2;
+        let x11 = libm::fma(x4, -1145.5438279999998, 65697.3302265768 * qd[1]);
+        let x12 = -1145.5438279999998 * qd[1];
+        let x13 = x1 * 1145.5438279999998;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = c_q2 + (1.0 - c_q2);
-        let x17 = libm::fma(-qd[1], s_q2, x1 * c_q2);
-        let x18 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x19 = x1 * 0.5692;
-        let x20 = libm::fma(-0.5692, qd[1], x4);
-        let x21 = libm::fma(-c_q2, x20, s_q2 * x19);
-        let x22 = x5 * x16;
-        let x23 = libm::fma(c_q2, x19, s_q2 * x20);
-        let x24 = libm::fma(-x2, x16, qd[2]);
-        let x25 = x7 * x16;
-        let x26 = x6 * 0.5692;
-        let x27 = x9 * x16;
-        let x28 = libm::fma(qd[2], x18, x6 * c_q2);
-        let x29 = libm::fma(-x6, s_q2, qd[2] * x17);
-        let x30 = libm::fma(qd[2], x23, -libm::fma(s_q2, x26, x8 * c_q2));
-        let x31 = libm::fma(qd[2], x21, libm::fma(-x8, s_q2, c_q2 * x26));
-        let x32 = libm::fma(49.52, x24, 15.41 * x17);
-        let x33 = libm::fma(2094.71, x24, 49.52 * x17);
-        let x34 = 2103.19 * x18;
-        let x35 = 314.88 * x21;
-        let x36 = 314.88 * x22;
-        let x37 = 314.88 * x23;
+        let x15 = libm::fma(-qd[1], s_q2, x1 * c_q2);
+        let x16 = libm::fma(qd[1], c_q2, x1 * s_q2);
+        let x17 = x1 * 0.5692;
+        let x18 = libm::fma(-0.5692, qd[1], x4);
+        let x19 = libm::fma(-c_q2, x18, s_q2 * x17);
+        let x20 = libm::fma(c_q2, x17, s_q2 * x18);
+        let x21 = qd[2] - x2;
+        let x22 = x6 * 0.5692;
+        let x23 = libm::fma(qd[2], x16, x6 * c_q2);
+        let x24 = libm::fma(-x6, s_q2, qd[2] * x15);
+        let x25 = libm::fma(qd[2], x19, libm::fma(-x8, s_q2, c_q2 * x22));
+        let x26 = libm::fma(3946.18812068, x21, -39234.47412200001 * x15);
+        let x27 = 5224.5702 * x5;
+        let x28 = libm::fma(
+            x20,
+            5224.5702,
+            libm::fma(39241.404122, x21, 3946.1881206800003 * x15),
+        );
+        let x29 = x16 * -5224.5702;
+        let x30 = 5224.5702 * x21;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x39 = c_q3 + (1.0 - c_q3);
-        let x40 = libm::fma(-x18, s_q3, x17 * c_q3);
-        let x41 = libm::fma(x18, c_q3, x17 * s_q3);
-        let x42 = libm::fma(0.475, x18, x21);
-        let x43 = x23 + libm::fma(7.11, x24, x17 * 0.475);
-        let x44 = libm::fma(s_q3, x43, c_q3 * x42);
-        let x45 = x39 * libm::fma(x18, -7.11, x22);
-        let x46 = libm::fma(-c_q3, x43, s_q3 * x42);
-        let x47 = libm::fma(x24, x39, qd[3]);
-        let x48 = x25 * x39;
-        let x49 = libm::fma(0.475, x29, x30);
-        let x50 = x31 + libm::fma(7.11, x25, x28 * 0.475);
-        let x51 = x39 * libm::fma(x29, 7.11, x27);
-        let x52 = libm::fma(qd[3], x41, libm::fma(x29, s_q3, x28 * c_q3));
-        let x53 = libm::fma(qd[3], x40, libm::fma(-x28, s_q3, x29 * c_q3));
-        let x54 = libm::fma(-qd[3], x46, libm::fma(-s_q3, x50, c_q3 * x49));
-        let x55 = libm::fma(qd[3], x44, libm::fma(c_q3, x50, s_q3 * x49));
-        let x56 = libm::fma(-39.95, x47, 9.522 * x40);
-        let x57 = libm::fma(1966.28, x47, -39.95 * x40);
-        let x58 = 1966.28 * x41;
-        let x59 = 279.2 * x44;
-        let x60 = 279.2 * x45;
-        let x61 = 279.2 * x46;
+        let x32 = libm::fma(-x16, s_q3, x15 * c_q3);
+        let x33 = libm::fma(x16, c_q3, x15 * s_q3);
+        let x34 = libm::fma(0.475, x16, x19);
+        let x35 = libm::fma(x16, -7.11, x5);
+        let x36 = x20 + libm::fma(7.11, x21, x15 * 0.475);
+        let x37 = libm::fma(s_q3, x36, c_q3 * x34);
+        let x38 = libm::fma(-c_q3, x36, s_q3 * x34);
+        let x39 = qd[3] + x21;
+        let x40 = 7.11 * x7;
+        let x41 = libm::fma(
+            0.475,
+            x24,
+            libm::fma(qd[2], x20, -libm::fma(s_q2, x22, x8 * c_q2)),
+        );
+        let x42 = libm::fma(x24, 7.11, x9);
+        let x43 = x25 + libm::fma(x23, 0.475, x40);
+        let x44 = libm::fma(qd[3], x33, libm::fma(x24, s_q3, x23 * c_q3));
+        let x45 = libm::fma(qd[3], x32, libm::fma(-x23, s_q3, x24 * c_q3));
+        let x46 = libm::fma(qd[3], x37, libm::fma(c_q3, x43, s_q3 * x41));
+        let x47 = libm::fma(1375.0472756800002, x39, -24989.305802 * x32);
+        let x48 = 3239.4582 * x35;
+        let x49 = libm::fma(
+            x38,
+            -3239.4582,
+            libm::fma(24998.827802, x39, 1375.0472756800002 * x32),
+        );
+        let x50 = x33 * -3239.4582;
+        let x51 = 3239.4582 * x39;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x63 = c_q4 + (1.0 - c_q4);
-        let x64 = libm::fma(-x41, s_q4, x40 * c_q4);
-        let x65 = libm::fma(x41, c_q4, x40 * s_q4);
-        let x66 = libm::fma(-7.11, x47, x46);
-        let x67 = libm::fma(-s_q4, x66, x44 * c_q4);
-        let x68 = x63 * libm::fma(x41, -7.11, x45);
-        let x69 = libm::fma(c_q4, x66, x44 * s_q4);
-        let x70 = libm::fma(x47, x63, qd[4]);
-        let x71 = x48 * x63;
-        let x72 = libm::fma(7.11, x48, x55);
-        let x73 = x63 * libm::fma(7.11, x53, x51);
-        let x74 = libm::fma(qd[4], x65, libm::fma(x53, s_q4, x52 * c_q4));
-        let x75 = libm::fma(qd[4], x64, libm::fma(-x52, s_q4, x53 * c_q4));
-        let x76 = libm::fma(-qd[4], x69, libm::fma(-s_q4, x72, x54 * c_q4));
-        let x77 = libm::fma(qd[4], x67, libm::fma(c_q4, x72, x54 * s_q4));
-        let x78 = 8.305 * x64;
-        let x79 = 3.061 * x70;
-        let x80 = 8.0386 * x65;
-        let x81 = 105.98 * x67;
-        let x82 = 105.98 * x68;
-        let x83 = 105.98 * x69;
+        let x53 = libm::fma(-x33, s_q4, x32 * c_q4);
+        let x54 = libm::fma(x33, c_q4, x32 * s_q4);
+        let x55 = libm::fma(x33, -7.11, x35);
+        let x56 = libm::fma(-7.11, x39, x38);
+        let x57 = libm::fma(-s_q4, x56, x37 * c_q4);
+        let x58 = libm::fma(c_q4, x56, x37 * s_q4);
+        let x59 = qd[4] + x39;
+        let x60 = libm::fma(qd[4], x54, libm::fma(x45, s_q4, x44 * c_q4));
+        let x61 = libm::fma(qd[4], x53, libm::fma(-x44, s_q4, x45 * c_q4));
+        let x62 = -97.44448770720001 * x59;
+        let x63 = libm::fma(x55, -171.195516, 132.6783695416 * x53);
+        let x64 = libm::fma(
+            -171.195516,
+            x57,
+            libm::fma(-97.44448770720001, x54, 135.4729695416 * x59),
+        );
+        let x65 = x59 * 171.195516;
+        let x66 = -171.195516 * x53;
+        let x67 = libm::fma(-x53, x66, x59 * x65);
+        let x68 = libm::fma(x54, x66, x7 * 171.195516);
+        let x69 = libm::fma(-x54, x65, -171.195516 * x60);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x85 = c_q5 + (1.0 - c_q5);
-        let x86 = libm::fma(x70, s_q5, x64 * c_q5);
-        let x87 = libm::fma(-x64, s_q5, x70 * c_q5);
-        let x88 = libm::fma(0.5692, x65, x67);
-        let x89 = libm::fma(-x68, s_q5, c_q5 * x88);
-        let x90 = libm::fma(x68, c_q5, s_q5 * x88);
-        let x91 = x85 * libm::fma(-0.5692, x64, x69);
-        let x92 = libm::fma(x65, x85, qd[5]);
-        let x93 = x75 * x85;
-        let x94 = libm::fma(0.5692, x75, x76);
-        let x95 = x85 * libm::fma(0.5692, x74, x77);
-        let x96 = libm::fma(qd[5], x87, -libm::fma(x71, s_q5, x74 * c_q5));
-        let x97 = libm::fma(-qd[5], x86, libm::fma(-x71, c_q5, x74 * s_q5));
-        let x98 = libm::fma(-qd[5], x90, libm::fma(x73, s_q5, c_q5 * x94));
-        let x99 = libm::fma(-qd[5], x89, libm::fma(-s_q5, x94, x73 * c_q5));
-        let x100 = 12.13 * x86;
-        let x101 = 12.13 * x87;
-        let x102 = 3.061 * x92;
-        let x103 = 105.98 * x89;
-        let x104 = 105.98 * x90;
-        let x105 = 105.98 * x91;
+        let x71 = libm::fma(x59, s_q5, x53 * c_q5);
+        let x72 = libm::fma(-x53, s_q5, x59 * c_q5);
+        let x73 = qd[5] + x54;
+        let x74 = 44.41 * x72;
+        let x75 = 47.471 * x73;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x107 = c_q6 + (1.0 - c_q6);
-        let x108 = libm::fma(x92, s_q6, x87 * c_q6);
-        let x109 = libm::fma(-x87, s_q6, x92 * c_q6);
-        let x110 = libm::fma(-0.7026, x86, x90);
-        let x111 = x107 * libm::fma(-0.7026, x87, x89);
-        let x112 = libm::fma(-c_q6, x110, x91 * s_q6);
-        let x113 = libm::fma(x91, c_q6, s_q6 * x110);
-        let x114 = libm::fma(x86, x107, qd[6]);
-        let x115 = libm::fma(0.7026, x96, x99);
-        let x116 = 9.336 * x114;
-        let x117 = 44.41 * x108;
-        let x118 = 44.41 * x109;
-        let x119 = 243.66 * x111;
-        let x120 = 243.66 * x112;
-        let x121 = 243.66 * x113;
-        let x122 = libm::fma(
-            9.336,
-            x96 * x107,
-            libm::fma(-x109, x117, x108 * x118) + libm::fma(-x113, x120, x112 * x121),
-        );
-        let x123 = libm::fma(
-            44.41,
-            libm::fma(qd[6], x109, libm::fma(x93, s_q6, x97 * c_q6)),
-            libm::fma(-x114, x118, x109 * x116) + libm::fma(-x111, x121, x113 * x119),
-        );
-        let x124 = libm::fma(
-            44.41,
-            libm::fma(-qd[6], x108, libm::fma(-x97, s_q6, x93 * c_q6)),
-            libm::fma(-x108, x116, x114 * x117) + libm::fma(-x112, x119, x111 * x120),
-        );
-        let x125 = libm::fma(
-            243.66,
-            libm::fma(qd[6], x113, libm::fma(x95, s_q6, c_q6 * x115)),
-            libm::fma(-x114, x121, x109 * x119),
-        );
-        let x126 = libm::fma(
-            243.66,
-            libm::fma(-qd[6], x112, libm::fma(-s_q6, x115, x95 * c_q6)),
-            libm::fma(-x108, x119, x114 * x120),
-        );
-        let x127 = x107
-            * libm::fma(
-                243.66,
-                x107 * libm::fma(-0.7026, x97, x98),
-                libm::fma(-x109, x120, x108 * x121),
-            );
-        let x128 = libm::fma(-s_q6, x126, c_q6 * x125);
-        let x129 = libm::fma(
-            12.13,
-            x96,
-            libm::fma(-x92, x101, x87 * x102) + libm::fma(-x90, x105, x91 * x104),
-        ) + libm::fma(0.7026, x128, x107 * x122);
-        let x130 = libm::fma(
-            12.13,
-            x97,
-            libm::fma(-x86, x102, x92 * x100) + libm::fma(-x89, x105, x91 * x103),
-        ) + libm::fma(-0.7026, x127, libm::fma(-s_q6, x124, c_q6 * x123));
-        let x131 = libm::fma(
-            3.061,
-            x93,
-            libm::fma(-x87, x100, x86 * x101) + libm::fma(-x89, x104, x90 * x103),
-        ) + libm::fma(c_q6, x124, s_q6 * x123);
-        let x132 = libm::fma(105.98, x98, libm::fma(x87, x105, x92 * x104)) + x127;
-        let x133 = libm::fma(105.98, x99, libm::fma(-x86, x105, x92 * x103)) + x128;
-        let x134 = libm::fma(-s_q5, x133, c_q5 * x132);
-        let x135 = x85
-            * (libm::fma(105.98, x95, -libm::fma(x86, x104, x87 * x103))
-                + libm::fma(c_q6, x126, s_q6 * x125));
-        let x136 = libm::fma(
-            -8.305,
-            x74,
-            libm::fma(-x65, x79, x70 * x80) + libm::fma(-x68, x83, x69 * x82),
-        ) + libm::fma(-0.5692, x135, libm::fma(-s_q5, x130, c_q5 * x129));
-        let x137 = libm::fma(
-            -3.061,
-            x71,
-            libm::fma(-x64, x80, x65 * x78) + libm::fma(-x67, x83, x69 * x81),
-        ) + libm::fma(c_q5, x130, s_q5 * x129);
-        let x138 = libm::fma(
-            8.0386,
+        let x77 = 9.336 * libm::fma(qd[5], x72, -libm::fma(x7, s_q5, x60 * c_q5));
+        let x78 = 9.336 * (qd[6] + x71);
+        let x79 = libm::fma(-x72, s_q6, x73 * c_q6) * x78;
+        let x80 = libm::fma(x73, s_q6, x72 * c_q6) * x78;
+        let x81 = libm::fma(-x73, x74, x72 * x75) + x77;
+        let x82 = libm::fma(
+            -x71,
             x75,
-            libm::fma(-x70, x78, x64 * x79) + libm::fma(-x67, x82, x68 * x81),
-        ) + libm::fma(0.5692, x134, x85 * x131);
-        let x139 = libm::fma(105.98, x76, libm::fma(x70, x83, x65 * x82)) + x134;
-        let x140 = libm::fma(105.98, x77, -libm::fma(x64, x82, x70 * x81)) + x135;
-        let x141 = x63
-            * (libm::fma(105.98, x73, libm::fma(-x64, x83, x65 * x81))
-                + libm::fma(c_q5, x133, s_q5 * x132));
-        let x142 = libm::fma(-s_q4, x139, c_q4 * x140);
-        let x143 = libm::fma(-x41, x57, x47 * x58) + libm::fma(-x45, x61, x46 * x60)
-            - libm::fma(-39.95, x48, 9.522 * x52) + libm::fma(s_q4, x138, c_q4 * x136);
-        let x144 = libm::fma(-x40, x58, x41 * x56) + libm::fma(-x44, x61, x46 * x59)
-            - libm::fma(1966.28, x48, -39.95 * x52) + libm::fma(-7.11, x142, x63 * x137);
-        let x145 = libm::fma(
-            1966.28,
-            x53,
-            libm::fma(-x47, x56, x40 * x57) + libm::fma(-x44, x60, x45 * x59),
-        ) + libm::fma(7.11, x141, libm::fma(-s_q4, x136, c_q4 * x138));
-        let x146 = libm::fma(279.2, x54, libm::fma(x47, x61, x41 * x60))
-            + libm::fma(s_q4, x140, c_q4 * x139);
-        let x147 = libm::fma(279.2, x55, -libm::fma(x40, x60, x47 * x59)) + x142;
-        let x148 = libm::fma(s_q3, x147, c_q3 * x146);
-        let x149 = x39 * (libm::fma(279.2, x51, libm::fma(-x40, x61, x41 * x59)) + x141);
-        let x150 = libm::fma(-s_q3, x146, c_q3 * x147);
-        let x151 = libm::fma(-x18, x33, x24 * x34) + libm::fma(-x23, x36, x22 * x37)
-            - libm::fma(49.52, x25, 15.41 * x28)
-            + libm::fma(-0.475, x150, libm::fma(s_q3, x145, c_q3 * x143));
-        let x152 = libm::fma(-x17, x34, x18 * x32) + libm::fma(-x23, x35, x21 * x37)
-            - libm::fma(2094.71, x25, 49.52 * x28) + libm::fma(-7.11, x150, x39 * x144);
-        let x153 = libm::fma(
-            2103.19,
-            x29,
-            libm::fma(-x24, x32, x17 * x33) + libm::fma(-x21, x36, x22 * x35),
-        ) + (libm::fma(-s_q3, x143, c_q3 * x145) + libm::fma(7.11, x149, 0.475 * x148));
-        let x154 = libm::fma(314.88, x30, libm::fma(-x24, x37, x18 * x36)) + x148;
-        let x155 = libm::fma(314.88, x31, -libm::fma(x17, x36, x24 * x35)) + x150;
-        let x156 = libm::fma(s_q2, x155, c_q2 * x154);
-        let x157 = libm::fma(-x1, x11, x2 * x10) + libm::fma(-x5, x13, x4 * x14)
-            + libm::fma(0.5692, x156, libm::fma(-s_q2, x151, c_q2 * x153));
-        let x158 = libm::fma(
+            44.41 * libm::fma(-qd[5], x71, libm::fma(-x7, c_q5, x60 * s_q5)),
+        ) + libm::fma(s_q6, x80, c_q6 * x79);
+        let x83 = libm::fma(x71, x74, 47.471 * x61) + libm::fma(-c_q6, x80, s_q6 * x79);
+        let x84 = libm::fma(-132.6783695416, x60, libm::fma(7.11, x45, x42) * 171.195516)
+            + libm::fma(x58, x66, libm::fma(-x54, x64, x59 * x62))
+            + libm::fma(-s_q5, x82, c_q5 * x81);
+        let x85 = libm::fma(
+            -171.195516,
+            libm::fma(
+                -qd[4],
+                x58,
+                libm::fma(
+                    -s_q4,
+                    x40 + x46,
+                    libm::fma(-qd[3], x38, libm::fma(-s_q3, x43, c_q3 * x41)) * c_q4,
+                ),
+            ),
+            libm::fma(-135.4729695416, x7, -97.44448770720001 * x61),
+        ) + libm::fma(-x58, x65, libm::fma(-x53, x62, x54 * x63))
+            + libm::fma(c_q5, x82, s_q5 * x81);
+        let x86 = libm::fma(
+            97.44448770720001,
+            x7,
+            libm::fma(-x59, x63, x53 * x64) - libm::fma(x57, x66, x55 * x65),
+        ) + x83;
+        let x87 = libm::fma(-s_q4, x68, c_q4 * x67);
+        let x88 = libm::fma(x35, x51, x38 * x50) - libm::fma(x39, x48, x33 * x49)
+            - libm::fma(1375.0472756800002, x7, -24989.305802 * x44)
+            + libm::fma(s_q4, x86, c_q4 * x84);
+        let x89 = libm::fma(
+            x46,
+            -3239.4582,
+            -libm::fma(24998.827802, x7, 1375.0472756800002 * x44),
+        ) + libm::fma(x37, x51, libm::fma(x32, x48, x33 * x47))
+            + libm::fma(-7.11, x87, x85);
+        let x90 = libm::fma(
+            3239.4582,
+            x42,
+            libm::fma(-x37, x50, libm::fma(-x39, x47, x32 * x49)),
+        ) + libm::fma(7.11, x69, libm::fma(-s_q4, x84, c_q4 * x86));
+        let x91 = libm::fma(-x39, x51, x33 * x50) + libm::fma(s_q4, x67, c_q4 * x68);
+        let x92 = libm::fma(x45, 3239.4582, x32 * x51) + x69;
+        let x93 = libm::fma(-x32, x50, 3239.4582 * x7) + x87;
+        let x94 = libm::fma(s_q3, x93, c_q3 * x91);
+        let x95 = libm::fma(-s_q3, x91, c_q3 * x93);
+        let x96 = libm::fma(-x20, x29, x5 * x30) - libm::fma(x21, x27, x16 * x28)
+            - libm::fma(3946.18812068, x7, -39234.47412200001 * x23)
+            + libm::fma(-0.475, x95, libm::fma(s_q3, x90, c_q3 * x88));
+        let x97 = libm::fma(
+            x25,
+            -5224.5702,
+            -libm::fma(39241.404122, x7, 3946.1881206800003 * x23),
+        ) + libm::fma(x19, x30, libm::fma(x15, x27, x16 * x26))
+            + libm::fma(-7.11, x95, x89);
+        let x98 = libm::fma(
+            5224.5702,
+            x9,
+            libm::fma(-x19, x29, libm::fma(-x21, x26, x15 * x28)),
+        ) + (libm::fma(-s_q3, x88, c_q3 * x90) + libm::fma(7.11, x92, 0.475 * x94));
+        let x99 = libm::fma(-x21, x30, x16 * x29) + x94;
+        let x100 = libm::fma(-x15, x29, 5224.5702 * x7) + x95;
+        let x101 = libm::fma(s_q2, x100, c_q2 * x99);
+        let x102 = libm::fma(0.5692, x101, libm::fma(-s_q2, x96, c_q2 * x98))
+            - libm::fma(x8, 1145.5438279999998, libm::fma(x5, x12, x1 * x10));
+        let x103 = libm::fma(
             -0.7026,
             libm::fma(
                 c_q1,
-                libm::fma(
-                    x16,
-                    libm::fma(314.88, x27, libm::fma(x17, x37, x18 * x35)) + x149,
-                    libm::fma(-qd[1], x13, 105.98 * x9),
-                ),
-                s_q1 * (libm::fma(-105.98, x8, qd[1] * x14) + x156),
+                libm::fma(-qd[1], x12, x1 * x13)
+                    + (libm::fma(x24, 5224.5702, x15 * x30) + x92),
+                s_q1 * libm::fma(x2, x13, x101),
             ),
             libm::fma(
                 -s_q1,
-                libm::fma(
-                    x16,
-                    x152,
-                    libm::fma(-3.061, x7, libm::fma(-x1, x12, qd[1] * x10)),
-                ),
+                x97 - libm::fma(-65693.9112265768, x7, libm::fma(x4, x13, x1 * x11)),
                 c_q1
-                    * (libm::fma(-8.088, x6, libm::fma(-x2, x12, qd[1] * x11))
+                    * (libm::fma(x5, x13, libm::fma(-x2, x11, qd[1] * x10))
                         + libm::fma(
                             -0.5692,
-                            libm::fma(-s_q2, x154, c_q2 * x155),
-                            libm::fma(s_q2, x153, c_q2 * x151),
+                            libm::fma(-s_q2, x99, c_q2 * x100),
+                            libm::fma(s_q2, x98, c_q2 * x96),
                         )),
             ),
         );
-        [x158, x157, x152, x144, x137, x131, x122]
+        [x103, x102, x97, x89, x85, x83, x77]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 404 mul, 279 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 219 fused multiply-adds.
+    /// Methods: bias `rnea`: 268 mul, 191 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 145 fused multiply-adds.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -909,987 +752,764 @@ impl SsrmsFma {
         let x8 = libm::fma(qd[1], x1, qdd[0] * s_q1);
         let x9 = libm::fma(qd[1], x5, s_q1 * x6);
         let x10 = libm::fma(-c_q1, x6, qd[1] * x4);
-        let x11 = 8.088 * x1;
-        let x12 = 3.061 * x2;
-        let x13 = 8.446 * qd[1];
-        let x14 = 105.98 * x4;
-        let x15 = 105.98 * x5;
+        let x11 = -65693.9112265768 * x2;
+        let x12 = libm::fma(x4, -1145.5438279999998, 65697.3302265768 * qd[1]);
+        let x13 = -1145.5438279999998 * qd[1];
+        let x14 = x1 * 1145.5438279999998;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x17 = c_q2 + (1.0 - c_q2);
-        let x18 = libm::fma(-qd[1], s_q2, x1 * c_q2);
-        let x19 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x20 = x1 * 0.5692;
-        let x21 = libm::fma(-0.5692, qd[1], x4);
-        let x22 = libm::fma(-c_q2, x21, s_q2 * x20);
-        let x23 = x5 * x17;
-        let x24 = libm::fma(c_q2, x20, s_q2 * x21);
-        let x25 = libm::fma(-x2, x17, qd[2]);
-        let x26 = x7 * 0.5692;
-        let x27 = libm::fma(-0.5692, qdd[1], x9);
-        let x28 = x10 * x17;
-        let x29 = libm::fma(-x8, x17, qdd[2]);
-        let x30 = libm::fma(-qd[2], x19, libm::fma(-qdd[1], s_q2, x7 * c_q2));
-        let x31 = libm::fma(qd[2], x18, libm::fma(qdd[1], c_q2, x7 * s_q2));
-        let x32 = libm::fma(qd[2], x24, libm::fma(-c_q2, x27, s_q2 * x26));
-        let x33 = libm::fma(qd[2], x22, -libm::fma(c_q2, x26, s_q2 * x27));
-        let x34 = libm::fma(49.52, x25, 15.41 * x18);
-        let x35 = libm::fma(2094.71, x25, 49.52 * x18);
-        let x36 = 2103.19 * x19;
-        let x37 = 314.88 * x22;
-        let x38 = 314.88 * x23;
-        let x39 = 314.88 * x24;
+        let x16 = libm::fma(-qd[1], s_q2, x1 * c_q2);
+        let x17 = libm::fma(qd[1], c_q2, x1 * s_q2);
+        let x18 = x1 * 0.5692;
+        let x19 = libm::fma(-0.5692, qd[1], x4);
+        let x20 = libm::fma(-c_q2, x19, s_q2 * x18);
+        let x21 = libm::fma(c_q2, x18, s_q2 * x19);
+        let x22 = qd[2] - x2;
+        let x23 = x7 * 0.5692;
+        let x24 = libm::fma(-0.5692, qdd[1], x9);
+        let x25 = qdd[2] - x8;
+        let x26 = libm::fma(-qd[2], x17, libm::fma(-qdd[1], s_q2, x7 * c_q2));
+        let x27 = libm::fma(qd[2], x16, libm::fma(qdd[1], c_q2, x7 * s_q2));
+        let x28 = libm::fma(qd[2], x20, -libm::fma(c_q2, x23, s_q2 * x24));
+        let x29 = libm::fma(3946.18812068, x22, -39234.47412200001 * x16);
+        let x30 = 5224.5702 * x5;
+        let x31 = libm::fma(
+            x21,
+            5224.5702,
+            libm::fma(39241.404122, x22, 3946.1881206800003 * x16),
+        );
+        let x32 = x17 * -5224.5702;
+        let x33 = 5224.5702 * x22;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x41 = c_q3 + (1.0 - c_q3);
-        let x42 = libm::fma(-x19, s_q3, x18 * c_q3);
-        let x43 = libm::fma(x19, c_q3, x18 * s_q3);
-        let x44 = libm::fma(0.475, x19, x22);
-        let x45 = x24 + libm::fma(7.11, x25, x18 * 0.475);
-        let x46 = libm::fma(s_q3, x45, c_q3 * x44);
-        let x47 = x41 * libm::fma(x19, -7.11, x23);
-        let x48 = libm::fma(-c_q3, x45, s_q3 * x44);
-        let x49 = libm::fma(x25, x41, qd[3]);
-        let x50 = libm::fma(0.475, x31, x32);
-        let x51 = x33 - libm::fma(7.11, x29, x30 * 0.475);
-        let x52 = x41 * libm::fma(x31, 7.11, x28);
-        let x53 = libm::fma(x29, x41, qdd[3]);
-        let x54 = libm::fma(-qd[3], x43, libm::fma(-x31, s_q3, x30 * c_q3));
-        let x55 = libm::fma(qd[3], x42, libm::fma(x31, c_q3, x30 * s_q3));
-        let x56 = libm::fma(-qd[3], x48, libm::fma(-s_q3, x51, c_q3 * x50));
-        let x57 = libm::fma(qd[3], x46, libm::fma(c_q3, x51, s_q3 * x50));
-        let x58 = libm::fma(-39.95, x49, 9.522 * x42);
-        let x59 = libm::fma(1966.28, x49, -39.95 * x42);
-        let x60 = 1966.28 * x43;
-        let x61 = 279.2 * x46;
-        let x62 = 279.2 * x47;
-        let x63 = 279.2 * x48;
+        let x35 = libm::fma(-x17, s_q3, x16 * c_q3);
+        let x36 = libm::fma(x17, c_q3, x16 * s_q3);
+        let x37 = libm::fma(0.475, x17, x20);
+        let x38 = libm::fma(x17, -7.11, x5);
+        let x39 = x21 + libm::fma(7.11, x22, x16 * 0.475);
+        let x40 = libm::fma(s_q3, x39, c_q3 * x37);
+        let x41 = libm::fma(-c_q3, x39, s_q3 * x37);
+        let x42 = qd[3] + x22;
+        let x43 = libm::fma(
+            0.475,
+            x27,
+            libm::fma(qd[2], x21, libm::fma(-c_q2, x24, s_q2 * x23)),
+        );
+        let x44 = libm::fma(x27, 7.11, x10);
+        let x45 = x28 - libm::fma(7.11, x25, x26 * 0.475);
+        let x46 = qdd[3] + x25;
+        let x47 = libm::fma(-qd[3], x36, libm::fma(-x27, s_q3, x26 * c_q3));
+        let x48 = libm::fma(qd[3], x35, libm::fma(x27, c_q3, x26 * s_q3));
+        let x49 = libm::fma(qd[3], x40, libm::fma(c_q3, x45, s_q3 * x43));
+        let x50 = libm::fma(1375.0472756800002, x42, -24989.305802 * x35);
+        let x51 = 3239.4582 * x38;
+        let x52 = libm::fma(
+            x41,
+            -3239.4582,
+            libm::fma(24998.827802, x42, 1375.0472756800002 * x35),
+        );
+        let x53 = x36 * -3239.4582;
+        let x54 = 3239.4582 * x42;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x65 = c_q4 + (1.0 - c_q4);
-        let x66 = libm::fma(-x43, s_q4, x42 * c_q4);
-        let x67 = libm::fma(x43, c_q4, x42 * s_q4);
-        let x68 = libm::fma(-7.11, x49, x48);
-        let x69 = libm::fma(-s_q4, x68, x46 * c_q4);
-        let x70 = x65 * libm::fma(x43, -7.11, x47);
-        let x71 = libm::fma(c_q4, x68, x46 * s_q4);
-        let x72 = libm::fma(x49, x65, qd[4]);
-        let x73 = libm::fma(-7.11, x53, x57);
-        let x74 = x65 * libm::fma(7.11, x55, x52);
-        let x75 = libm::fma(x53, x65, qdd[4]);
-        let x76 = libm::fma(-qd[4], x67, libm::fma(-x55, s_q4, x54 * c_q4));
-        let x77 = libm::fma(qd[4], x66, libm::fma(x55, c_q4, x54 * s_q4));
-        let x78 = libm::fma(-qd[4], x71, libm::fma(-s_q4, x73, x56 * c_q4));
-        let x79 = libm::fma(qd[4], x69, libm::fma(c_q4, x73, x56 * s_q4));
-        let x80 = 8.305 * x66;
-        let x81 = 3.061 * x72;
-        let x82 = 8.0386 * x67;
-        let x83 = 105.98 * x69;
-        let x84 = 105.98 * x70;
-        let x85 = 105.98 * x71;
+        let x56 = libm::fma(-x36, s_q4, x35 * c_q4);
+        let x57 = libm::fma(x36, c_q4, x35 * s_q4);
+        let x58 = libm::fma(x36, -7.11, x38);
+        let x59 = libm::fma(-7.11, x42, x41);
+        let x60 = libm::fma(-s_q4, x59, x40 * c_q4);
+        let x61 = libm::fma(c_q4, x59, x40 * s_q4);
+        let x62 = qd[4] + x42;
+        let x63 = qdd[4] + x46;
+        let x64 = libm::fma(-qd[4], x57, libm::fma(-x48, s_q4, x47 * c_q4));
+        let x65 = libm::fma(qd[4], x56, libm::fma(x48, c_q4, x47 * s_q4));
+        let x66 = -97.44448770720001 * x62;
+        let x67 = libm::fma(x58, -171.195516, 132.6783695416 * x56);
+        let x68 = libm::fma(
+            -171.195516,
+            x60,
+            libm::fma(-97.44448770720001, x57, 135.4729695416 * x62),
+        );
+        let x69 = x62 * 171.195516;
+        let x70 = -171.195516 * x56;
+        let x71 = libm::fma(-x56, x70, x62 * x69);
+        let x72 = libm::fma(x63, -171.195516, x57 * x70);
+        let x73 = libm::fma(x57, x69, -171.195516 * x64);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x87 = c_q5 + (1.0 - c_q5);
-        let x88 = libm::fma(x72, s_q5, x66 * c_q5);
-        let x89 = libm::fma(-x66, s_q5, x72 * c_q5);
-        let x90 = libm::fma(0.5692, x67, x69);
-        let x91 = libm::fma(-x70, s_q5, c_q5 * x90);
-        let x92 = libm::fma(x70, c_q5, s_q5 * x90);
-        let x93 = x87 * libm::fma(-0.5692, x66, x71);
-        let x94 = libm::fma(x67, x87, qd[5]);
-        let x95 = libm::fma(0.5692, x77, x78);
-        let x96 = x87 * libm::fma(-0.5692, x76, x79);
-        let x97 = libm::fma(x77, x87, qdd[5]);
-        let x98 = libm::fma(qd[5], x89, libm::fma(x75, s_q5, x76 * c_q5));
-        let x99 = libm::fma(-qd[5], x88, libm::fma(-x76, s_q5, x75 * c_q5));
-        let x100 = libm::fma(-qd[5], x92, libm::fma(x74, s_q5, c_q5 * x95));
-        let x101 = libm::fma(-qd[5], x91, libm::fma(-s_q5, x95, x74 * c_q5));
-        let x102 = 12.13 * x88;
-        let x103 = 12.13 * x89;
-        let x104 = 3.061 * x94;
-        let x105 = 105.98 * x91;
-        let x106 = 105.98 * x92;
-        let x107 = 105.98 * x93;
+        let x75 = libm::fma(x62, s_q5, x56 * c_q5);
+        let x76 = libm::fma(-x56, s_q5, x62 * c_q5);
+        let x77 = qd[5] + x57;
+        let x78 = 44.41 * x76;
+        let x79 = 47.471 * x77;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x109 = c_q6 + (1.0 - c_q6);
-        let x110 = libm::fma(x94, s_q6, x89 * c_q6);
-        let x111 = libm::fma(-x89, s_q6, x94 * c_q6);
-        let x112 = libm::fma(-0.7026, x88, x92);
-        let x113 = x109 * libm::fma(-0.7026, x89, x91);
-        let x114 = libm::fma(-c_q6, x112, x93 * s_q6);
-        let x115 = libm::fma(x93, c_q6, s_q6 * x112);
-        let x116 = libm::fma(x88, x109, qd[6]);
-        let x117 = libm::fma(0.7026, x98, x101);
-        let x118 = 9.336 * x116;
-        let x119 = 44.41 * x110;
-        let x120 = 44.41 * x111;
-        let x121 = 243.66 * x113;
-        let x122 = 243.66 * x114;
-        let x123 = 243.66 * x115;
-        let x124 = libm::fma(
-            9.336,
-            libm::fma(x98, x109, qdd[6]),
-            libm::fma(-x111, x119, x110 * x120) + libm::fma(-x115, x122, x114 * x123),
-        );
-        let x125 = libm::fma(
-            44.41,
-            libm::fma(qd[6], x111, libm::fma(x97, s_q6, x99 * c_q6)),
-            libm::fma(-x116, x120, x111 * x118) + libm::fma(-x113, x123, x115 * x121),
-        );
-        let x126 = libm::fma(
-            44.41,
-            libm::fma(-qd[6], x110, libm::fma(-x99, s_q6, x97 * c_q6)),
-            libm::fma(-x110, x118, x116 * x119) + libm::fma(-x114, x121, x113 * x122),
-        );
-        let x127 = libm::fma(
-            243.66,
-            libm::fma(qd[6], x115, libm::fma(x96, s_q6, c_q6 * x117)),
-            libm::fma(-x116, x123, x111 * x121),
-        );
-        let x128 = libm::fma(
-            243.66,
-            libm::fma(-qd[6], x114, libm::fma(-s_q6, x117, x96 * c_q6)),
-            libm::fma(-x110, x121, x116 * x122),
-        );
-        let x129 = x109
-            * libm::fma(
-                243.66,
-                x109 * libm::fma(-0.7026, x99, x100),
-                libm::fma(-x111, x122, x110 * x123),
-            );
-        let x130 = libm::fma(-s_q6, x128, c_q6 * x127);
-        let x131 = libm::fma(
-            12.13,
-            x98,
-            libm::fma(-x94, x103, x89 * x104) + libm::fma(-x92, x107, x93 * x106),
-        ) + libm::fma(0.7026, x130, x109 * x124);
-        let x132 = libm::fma(
-            12.13,
-            x99,
-            libm::fma(-x88, x104, x94 * x102) + libm::fma(-x91, x107, x93 * x105),
-        ) + libm::fma(-0.7026, x129, libm::fma(-s_q6, x126, c_q6 * x125));
-        let x133 = libm::fma(
-            3.061,
-            x97,
-            libm::fma(-x89, x102, x88 * x103) + libm::fma(-x91, x106, x92 * x105),
-        ) + libm::fma(c_q6, x126, s_q6 * x125);
-        let x134 = libm::fma(105.98, x100, libm::fma(x89, x107, x94 * x106)) + x129;
-        let x135 = libm::fma(105.98, x101, libm::fma(-x88, x107, x94 * x105)) + x130;
-        let x136 = libm::fma(-s_q5, x135, c_q5 * x134);
-        let x137 = x87
-            * (libm::fma(105.98, x96, -libm::fma(x88, x106, x89 * x105))
-                + libm::fma(c_q6, x128, s_q6 * x127));
-        let x138 = libm::fma(
-            8.305,
-            x76,
-            libm::fma(-x67, x81, x72 * x82) + libm::fma(-x70, x85, x71 * x84),
-        ) + libm::fma(-0.5692, x137, libm::fma(-s_q5, x132, c_q5 * x131));
-        let x139 = libm::fma(
-            3.061,
-            x75,
-            libm::fma(-x66, x82, x67 * x80) + libm::fma(-x69, x85, x71 * x83),
-        ) + libm::fma(c_q5, x132, s_q5 * x131);
-        let x140 = libm::fma(
-            8.0386,
-            x77,
-            libm::fma(-x72, x80, x66 * x81) + libm::fma(-x69, x84, x70 * x83),
-        ) + libm::fma(0.5692, x136, x87 * x133);
-        let x141 = libm::fma(105.98, x78, libm::fma(x72, x85, x67 * x84)) + x136;
-        let x142 = libm::fma(105.98, x79, -libm::fma(x66, x84, x72 * x83)) + x137;
-        let x143 = x65
-            * (libm::fma(105.98, x74, libm::fma(-x66, x85, x67 * x83))
-                + libm::fma(c_q5, x135, s_q5 * x134));
-        let x144 = libm::fma(-s_q4, x141, c_q4 * x142);
-        let x145 = libm::fma(-39.95, x53, 9.522 * x54)
-            + (libm::fma(-x43, x59, x49 * x60) + libm::fma(-x47, x63, x48 * x62))
-            + libm::fma(s_q4, x140, c_q4 * x138);
-        let x146 = libm::fma(1966.28, x53, -39.95 * x54)
-            + (libm::fma(-x42, x60, x43 * x58) + libm::fma(-x46, x63, x48 * x61))
-            + libm::fma(-7.11, x144, x65 * x139);
-        let x147 = libm::fma(
-            1966.28,
-            x55,
-            libm::fma(-x49, x58, x42 * x59) + libm::fma(-x46, x62, x47 * x61),
-        ) + libm::fma(7.11, x143, libm::fma(-s_q4, x138, c_q4 * x140));
-        let x148 = libm::fma(279.2, x56, libm::fma(x49, x63, x43 * x62))
-            + libm::fma(s_q4, x142, c_q4 * x141);
-        let x149 = libm::fma(279.2, x57, -libm::fma(x42, x62, x49 * x61)) + x144;
-        let x150 = libm::fma(s_q3, x149, c_q3 * x148);
-        let x151 = x41 * (libm::fma(279.2, x52, libm::fma(-x42, x63, x43 * x61)) + x143);
-        let x152 = libm::fma(-s_q3, x148, c_q3 * x149);
-        let x153 = libm::fma(49.52, x29, 15.41 * x30)
-            + (libm::fma(-x19, x35, x25 * x36) + libm::fma(-x24, x38, x23 * x39))
-            + libm::fma(-0.475, x152, libm::fma(s_q3, x147, c_q3 * x145));
-        let x154 = libm::fma(2094.71, x29, 49.52 * x30)
-            + (libm::fma(-x18, x36, x19 * x34) + libm::fma(-x24, x37, x22 * x39))
-            + libm::fma(-7.11, x152, x41 * x146);
-        let x155 = libm::fma(
-            2103.19,
-            x31,
-            libm::fma(-x25, x34, x18 * x35) + libm::fma(-x22, x38, x23 * x37),
-        ) + (libm::fma(-s_q3, x145, c_q3 * x147) + libm::fma(7.11, x151, 0.475 * x150));
-        let x156 = libm::fma(314.88, x32, libm::fma(-x25, x39, x19 * x38)) + x150;
-        let x157 = libm::fma(314.88, x33, -libm::fma(x18, x38, x25 * x37)) + x152;
-        let x158 = libm::fma(s_q2, x157, c_q2 * x156);
-        let x159 = libm::fma(
-            8.446,
-            qdd[1],
-            libm::fma(-x1, x12, x2 * x11) + libm::fma(-x5, x14, x4 * x15),
-        ) + libm::fma(0.5692, x158, libm::fma(-s_q2, x153, c_q2 * x155));
-        let x160 = libm::fma(
-            12.19,
+        let x81 = 9.336
+            * (qdd[6] + libm::fma(qd[5], x76, libm::fma(x63, s_q5, x64 * c_q5)));
+        let x82 = 9.336 * (qd[6] + x75);
+        let x83 = libm::fma(-x76, s_q6, x77 * c_q6) * x82;
+        let x84 = libm::fma(x77, s_q6, x76 * c_q6) * x82;
+        let x85 = libm::fma(-x77, x78, x76 * x79) + x81;
+        let x86 = libm::fma(
+            -x75,
+            x79,
+            44.41 * libm::fma(-qd[5], x75, libm::fma(-x64, s_q5, x63 * c_q5)),
+        ) + libm::fma(s_q6, x84, c_q6 * x83);
+        let x87 = libm::fma(x75, x78, 47.471 * (qdd[5] + x65))
+            + libm::fma(-c_q6, x84, s_q6 * x83);
+        let x88 = libm::fma(libm::fma(7.11, x48, x44), 171.195516, 132.6783695416 * x64)
+            + libm::fma(x61, x70, libm::fma(-x57, x68, x62 * x66))
+            + libm::fma(-s_q5, x86, c_q5 * x85);
+        let x89 = libm::fma(
+            -171.195516,
+            libm::fma(
+                -qd[4],
+                x61,
+                libm::fma(
+                    -s_q4,
+                    libm::fma(-7.11, x46, x49),
+                    libm::fma(-qd[3], x41, libm::fma(-s_q3, x45, c_q3 * x43)) * c_q4,
+                ),
+            ),
+            libm::fma(-97.44448770720001, x65, 135.4729695416 * x63),
+        ) + libm::fma(-x61, x69, libm::fma(-x56, x66, x57 * x67))
+            + libm::fma(c_q5, x86, s_q5 * x85);
+        let x90 = libm::fma(
+            -97.44448770720001,
+            x63,
+            libm::fma(-x62, x67, x56 * x68) - libm::fma(x60, x70, x58 * x69),
+        ) + x87;
+        let x91 = libm::fma(-s_q4, x72, c_q4 * x71);
+        let x92 = libm::fma(1375.0472756800002, x46, -24989.305802 * x47)
+            + (libm::fma(x38, x54, x41 * x53) - libm::fma(x42, x51, x36 * x52))
+            + libm::fma(s_q4, x90, c_q4 * x88);
+        let x93 = libm::fma(
+            x49,
+            -3239.4582,
+            libm::fma(24998.827802, x46, 1375.0472756800002 * x47),
+        ) + libm::fma(x40, x54, libm::fma(x35, x51, x36 * x50))
+            + libm::fma(-7.11, x91, x89);
+        let x94 = libm::fma(
+            3239.4582,
+            x44,
+            libm::fma(-x40, x53, libm::fma(-x42, x50, x35 * x52)),
+        ) + libm::fma(-7.11, x73, libm::fma(-s_q4, x88, c_q4 * x90));
+        let x95 = libm::fma(-x42, x54, x36 * x53) + libm::fma(s_q4, x71, c_q4 * x72);
+        let x96 = libm::fma(x48, 3239.4582, x35 * x54) - x73;
+        let x97 = x91 - libm::fma(x35, x53, 3239.4582 * x46);
+        let x98 = libm::fma(s_q3, x97, c_q3 * x95);
+        let x99 = libm::fma(-s_q3, x95, c_q3 * x97);
+        let x100 = libm::fma(3946.18812068, x25, -39234.47412200001 * x26)
+            + (libm::fma(-x21, x32, x5 * x33) - libm::fma(x22, x30, x17 * x31))
+            + libm::fma(-0.475, x99, libm::fma(s_q3, x94, c_q3 * x92));
+        let x101 = libm::fma(
+            x28,
+            -5224.5702,
+            libm::fma(39241.404122, x25, 3946.1881206800003 * x26),
+        ) + libm::fma(x20, x33, libm::fma(x16, x30, x17 * x29))
+            + libm::fma(-7.11, x99, x93);
+        let x102 = libm::fma(
+            5224.5702,
+            x10,
+            libm::fma(-x20, x32, libm::fma(-x22, x29, x16 * x31)),
+        ) + (libm::fma(-s_q3, x92, c_q3 * x94) + libm::fma(7.11, x96, 0.475 * x98));
+        let x103 = libm::fma(-x22, x33, x17 * x32) + x98;
+        let x104 = x99 - libm::fma(x16, x32, 5224.5702 * x25);
+        let x105 = libm::fma(s_q2, x104, c_q2 * x103);
+        let x106 = libm::fma(x9, -1145.5438279999998, 65697.3302265768 * qdd[1])
+            - libm::fma(x5, x13, x1 * x11)
+            + libm::fma(0.5692, x105, libm::fma(-s_q2, x100, c_q2 * x102));
+        let x107 = libm::fma(
+            66279.65991417361,
             qdd[0],
             libm::fma(
                 -0.7026,
                 libm::fma(
                     c_q1,
-                    libm::fma(
-                        x17,
-                        libm::fma(314.88, x28, libm::fma(x18, x39, x19 * x37)) + x151,
-                        libm::fma(-qd[1], x14, 105.98 * x10),
-                    ),
-                    s_q1 * (libm::fma(-105.98, x9, qd[1] * x15) + x158),
+                    libm::fma(-qd[1], x13, x1 * x14)
+                        + (libm::fma(x27, 5224.5702, x16 * x33) + x96),
+                    s_q1 * (libm::fma(1145.5438279999998, qdd[1], x2 * x14) + x105),
                 ),
                 libm::fma(
                     -s_q1,
-                    libm::fma(
-                        x17,
-                        x154,
-                        libm::fma(-3.061, x8, libm::fma(-x1, x13, qd[1] * x11)),
-                    ),
+                    x101
+                        - libm::fma(-65693.9112265768, x8, libm::fma(x4, x14, x1 * x12)),
                     c_q1
-                        * (libm::fma(8.088, x7, libm::fma(-x2, x13, qd[1] * x12))
+                        * (libm::fma(x5, x14, libm::fma(-x2, x12, qd[1] * x11))
                             + libm::fma(
                                 -0.5692,
-                                libm::fma(-s_q2, x156, c_q2 * x157),
-                                libm::fma(s_q2, x155, c_q2 * x153),
+                                libm::fma(-s_q2, x103, c_q2 * x104),
+                                libm::fma(s_q2, x102, c_q2 * x100),
                             )),
                 ),
             ),
         );
-        [x160, x159, x154, x146, x139, x133, x124]
+        [x107, x106, x101, x93, x89, x87, x81]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 530 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 426 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `rnea`: 552 mul, 393 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 323 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = libm::fma(s_q6, x13, c_q6 * x12);
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + libm::fma(x10, x11, 120.2819695416);
-        let x19 = 12.13 + (x14 + 120.2819695416);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.195516;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = libm::fma(-c_q5, x23, s_q5 * x22);
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = libm::fma(x21, 0.5692, c_q5 * x28);
-        let x34 = 8.305 + (libm::fma(s_q5, x23, c_q5 * x22) + 113.27938808960002);
-        let x35 = 3.061 + libm::fma(c_q5, x26, s_q5 * x25);
-        let x36 = 8.0386 + libm::fma(x8, x29, 113.27938808960002);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01508800000002;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4582;
-        let x41 = libm::fma(-s_q4, x32, c_q4 * x34);
-        let x42 = libm::fma(s_q4, x33, c_q4 * x30);
-        let x43 = libm::fma(-c_q4, x31, s_q4 * x36);
-        let x44 = x6 * libm::fma(-s_q5, x26, c_q5 * x25);
-        let x45 = x6 * x35;
-        let x46 = x6 * libm::fma(0.5692, x21, x8 * x27);
-        let x47 = libm::fma(c_q4, x32, s_q4 * x34);
-        let x48 = libm::fma(-s_q4, x30, c_q4 * x33);
-        let x49 = libm::fma(c_q4, x36, s_q4 * x31);
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = libm::fma(-7.11, x39, libm::fma(-c_q4, x47, s_q4 * x49));
-        let x53 = libm::fma(x39, -7.11, libm::fma(-s_q4, x41, c_q4 * x43));
-        let x54 = 9.522 + libm::fma(s_q4, x43, c_q4 * x41);
-        let x55 = -39.95 + libm::fma(-7.11, x38, x6 * x42);
-        let x56 = 1966.28 + libm::fma(7.11, x40, libm::fma(x6, x45, -x51));
-        let x57 = 1966.28
-            + libm::fma(
-                x40,
-                7.11,
-                libm::fma(7.11, x37, libm::fma(c_q4, x49, s_q4 * x47)),
-            );
-        let x58 = s_q3 * x39;
-        let x59 = libm::fma(c_q3, x40, x58);
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = libm::fma(-s_q3, x40, x61);
-        let x63 = x59 + 5224.5702;
-        let x64 = x60 + -349.0395;
-        let x65 = libm::fma(s_q3, x52, c_q3 * x54);
-        let x66 = libm::fma(s_q3, x50, c_q3 * x55);
-        let x67 = libm::fma(s_q3, x57, c_q3 * x53);
-        let x68 = x4
-            * (-39.95 + libm::fma(x38, -7.11, libm::fma(s_q4, x46, c_q4 * x44)));
-        let x69 = x4 * x56;
-        let x70 = x4 * libm::fma(-s_q4, x44, c_q4 * x46);
-        let x71 = libm::fma(-s_q3, x54, c_q3 * x52);
-        let x72 = libm::fma(-s_q3, x55, c_q3 * x50);
-        let x73 = libm::fma(-s_q3, x53, c_q3 * x57);
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = libm::fma(-7.11, x62, libm::fma(s_q3, x73, c_q3 * x71));
-        let x78 = libm::fma(x4, x72, x76);
-        let x79 = libm::fma(-7.11, x62, libm::fma(-s_q3, x65, c_q3 * x67));
-        let x80 = 15.41
-            + libm::fma(
-                x64,
-                -0.475,
-                libm::fma(-0.475, x60, libm::fma(s_q3, x67, c_q3 * x65)),
-            );
-        let x81 = 49.52 + libm::fma(-7.11, x64, libm::fma(x4, x66, -x74));
-        let x82 = 2094.71 + libm::fma(7.11, x63, libm::fma(x4, x69, -x75));
-        let x83 = 2103.19
-            + (libm::fma(-s_q3, x71, c_q3 * x73) - libm::fma(-7.11, x59, x60 * 0.475)
-                - libm::fma(0.475, x64, -7.11 * x63));
-        let x84 = s_q2 * x62;
-        let x85 = libm::fma(c_q2, x63, x84);
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = libm::fma(-s_q2, x63, x87);
-        let x89 = x86 + -597.4892399999999;
-        let x90 = libm::fma(s_q2, x77, c_q2 * x80);
-        let x91 = libm::fma(s_q2, x78, c_q2 * x81);
-        let x92 = libm::fma(s_q2, x83, c_q2 * x79);
-        let x93 = x2
-            * (49.52
-                + libm::fma(
-                    x63,
-                    0.475,
-                    libm::fma(-7.11, x60, libm::fma(s_q3, x70, c_q3 * x68)),
-                ));
-        let x94 = x2 * x82;
-        let x95 = x2 * libm::fma(0.475, x62, libm::fma(-s_q3, x68, c_q3 * x70));
-        let x96 = -0.5692 * x85;
-        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x98 = libm::fma(
+        let x6 = 9.336 * c_q5;
+        let x7 = 44.41 * s_q5;
+        let x8 = 9.336 * s_q5;
+        let x9 = 44.41 * c_q5;
+        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
+        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
+        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
+        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
+        let x14 = -171.195516 * s_q4;
+        let x15 = -171.195516 * c_q4;
+        let x16 = c_q4 * x12;
+        let x17 = -97.44448770720001 * s_q4;
+        let x18 = libm::fma(c_q4, x10, x17);
+        let x19 = 47.471 * s_q4;
+        let x20 = s_q4 * x12;
+        let x21 = -97.44448770720001 * c_q4;
+        let x22 = libm::fma(-s_q4, x10, x21);
+        let x23 = 47.471 * c_q4;
+        let x24 = libm::fma(-s_q4, x11, x21);
+        let x25 = x14 * -7.11;
+        let x26 = 7.11 * x14;
+        let x27 = x13 - x25;
+        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
+        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
+        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
+        let x31 = 3239.4582 + x14;
+        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
+        let x33 = 1375.0472756800002 + x18;
+        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
+        let x35 = 24998.827802 + (x26 + x27);
+        let x36 = s_q3 * x15;
+        let x37 = libm::fma(c_q3, x31, x36);
+        let x38 = c_q3 * x15;
+        let x39 = libm::fma(-s_q3, x31, x38);
+        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
+        let x41 = s_q3 * x22;
+        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
+        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
+        let x44 = c_q3 * x22;
+        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
+        let x46 = -7.11 * x37;
+        let x47 = 7.11 * x37;
+        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
+        let x49 = x35 - x46;
+        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
+        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
+        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
+        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
+        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
+        let x55 = 5224.5702 + x37;
+        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
+        let x57 = 3946.18812068 + x48;
+        let x58 = 3946.1881206800003
+            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
+        let x59 = 39241.404122 + (x47 + x49);
+        let x60 = s_q2 * x39;
+        let x61 = libm::fma(c_q2, x55, x60);
+        let x62 = c_q2 * x39;
+        let x63 = libm::fma(-s_q2, x55, x62);
+        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
+        let x65 = s_q2 * x51;
+        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
+        let x67 = c_q2 * x51;
+        let x68 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
+        let x69 = libm::fma(
             -0.7026,
-            libm::fma(-s_q1, x89, c_q1 * x85),
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
             libm::fma(
                 -s_q1,
-                libm::fma(0.5692, x88, libm::fma(-s_q2, x93, c_q2 * x95)),
-                c_q1 * libm::fma(-s_q2, x90, c_q2 * x92),
+                libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
+                c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
             ),
         );
-        let x99 = libm::fma(
+        let x70 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x68));
+        let x71 = libm::fma(-s_q2, x37, x62);
+        let x72 = libm::fma(
             -0.7026,
-            s_q1 * x88,
-            libm::fma(-s_q1, x94, c_q1 * (x91 - x96)),
-        );
-        let x100 = x66 - x74;
-        let x101 = x69 - x75;
-        let x102 = x72 + x76;
-        let x103 = libm::fma(-s_q2, x59, x87);
-        let x104 = libm::fma(
-            -0.7026,
-            s_q1 * x103,
+            s_q1 * x71,
             libm::fma(
                 -s_q1,
-                x2 * x101,
+                x49,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x59, x84),
-                        libm::fma(s_q2, x102, c_q2 * x100),
+                        libm::fma(c_q2, x37, x60),
+                        libm::fma(c_q2, x48, x65),
                     ),
             ),
         );
-        let x105 = x45 - x51;
-        let x106 = libm::fma(-s_q3, x37, x61);
-        let x107 = libm::fma(c_q3, x37, x58);
-        let x108 = libm::fma(0.475, x107, libm::fma(s_q3, x48, c_q3 * x42));
-        let x109 = libm::fma(7.11, x107, x4 * x105);
-        let x110 = libm::fma(0.475, x106, libm::fma(-s_q3, x42, c_q3 * x48));
-        let x111 = libm::fma(-s_q2, x107, c_q2 * x106);
-        let x112 = libm::fma(
+        let x73 = libm::fma(-s_q3, x14, x38);
+        let x74 = libm::fma(c_q3, x14, x36);
+        let x75 = libm::fma(0.475, x74, libm::fma(c_q3, x18, x41));
+        let x76 = libm::fma(7.11, x74, x27);
+        let x77 = libm::fma(0.475, x73, libm::fma(-s_q3, x18, x44));
+        let x78 = libm::fma(-s_q2, x74, c_q2 * x73);
+        let x79 = libm::fma(
             -0.7026,
-            s_q1 * x111,
+            s_q1 * x78,
             libm::fma(
                 -s_q1,
-                x2 * x109,
+                x76,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x107, s_q2 * x106),
-                        libm::fma(s_q2, x110, c_q2 * x108),
+                        libm::fma(c_q2, x74, s_q2 * x73),
+                        libm::fma(s_q2, x77, c_q2 * x75),
                     ),
             ),
         );
-        let x113 = libm::fma(-c_q4, x24, s_q4 * x29);
-        let x114 = x6 * x27;
-        let x115 = libm::fma(c_q4, x29, s_q4 * x24);
-        let x116 = libm::fma(s_q3, x115, c_q3 * x113);
-        let x117 = x4 * x114;
-        let x118 = libm::fma(-s_q3, x113, c_q3 * x115);
-        let x119 = libm::fma(
-            -s_q1,
-            x2 * x117,
-            c_q1 * libm::fma(s_q2, x118, c_q2 * x116),
+        let x80 = libm::fma(s_q3, x23, c_q3 * x19);
+        let x81 = libm::fma(-s_q3, x19, c_q3 * x23);
+        let x82 = c_q1 * libm::fma(s_q2, x81, c_q2 * x80);
+        let x83 = c_q4 * x6;
+        let x84 = s_q4 * x6;
+        let x85 = libm::fma(-s_q3, x84, c_q3 * x83);
+        let x86 = libm::fma(c_q3, x84, s_q3 * x83);
+        let x87 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x86, c_q2 * x85));
+        let x88 = qd[0] * c_q1;
+        let x89 = qd[0] * s_q1;
+        let x90 = 0.7026 * qd[0];
+        let x91 = s_q1 * x90;
+        let x92 = c_q1 * x90;
+        let x93 = qd[1] * x89;
+        let x94 = qd[1] * x88;
+        let x95 = qd[1] * x92;
+        let x96 = qd[1] * x91;
+        let x97 = -65693.9112265768 * x89;
+        let x98 = libm::fma(-1145.5438279999998, x91, 65697.3302265768 * qd[1]);
+        let x99 = -1145.5438279999998 * qd[1];
+        let x100 = 1145.5438279999998 * x88;
+        let x101 = libm::fma(-qd[1], s_q2, c_q2 * x88);
+        let x102 = libm::fma(qd[1], c_q2, s_q2 * x88);
+        let x103 = 0.5692 * x88;
+        let x104 = libm::fma(-0.5692, qd[1], x91);
+        let x105 = libm::fma(-c_q2, x104, s_q2 * x103);
+        let x106 = libm::fma(c_q2, x103, s_q2 * x104);
+        let x107 = qd[2] - x89;
+        let x108 = 0.5692 * x93;
+        let x109 = libm::fma(qd[2], x102, c_q2 * x93);
+        let x110 = libm::fma(-s_q2, x93, qd[2] * x101);
+        let x111 = libm::fma(qd[2], x105, libm::fma(-s_q2, x95, c_q2 * x108));
+        let x112 = libm::fma(3946.18812068, x107, -39234.47412200001 * x101);
+        let x113 = 5224.5702 * x92;
+        let x114 = libm::fma(
+            x106,
+            5224.5702,
+            libm::fma(39241.404122, x107, 3946.1881206800003 * x101),
         );
-        let x120 = c_q5 * x11;
-        let x121 = s_q5 * x11;
-        let x122 = c_q4 * x120;
-        let x123 = x6 * x121;
-        let x124 = s_q4 * x120;
-        let x125 = libm::fma(-s_q3, x124, c_q3 * x122);
-        let x126 = x4 * x123;
-        let x127 = libm::fma(c_q3, x124, s_q3 * x122);
-        let x128 = libm::fma(
-            -s_q1,
-            x2 * x126,
-            c_q1 * libm::fma(-s_q2, x127, c_q2 * x125),
+        let x115 = x102 * -5224.5702;
+        let x116 = 5224.5702 * x107;
+        let x117 = libm::fma(-s_q3, x102, c_q3 * x101);
+        let x118 = libm::fma(c_q3, x102, s_q3 * x101);
+        let x119 = libm::fma(0.475, x102, x105);
+        let x120 = libm::fma(-7.11, x102, x92);
+        let x121 = x106 + libm::fma(7.11, x107, 0.475 * x101);
+        let x122 = libm::fma(s_q3, x121, c_q3 * x119);
+        let x123 = libm::fma(-c_q3, x121, s_q3 * x119);
+        let x124 = qd[3] + x107;
+        let x125 = 7.11 * x94;
+        let x126 = libm::fma(
+            0.475,
+            x110,
+            libm::fma(qd[2], x106, -libm::fma(s_q2, x108, c_q2 * x95)),
         );
-        let x129 = qd[0] * c_q1;
-        let x130 = qd[0] * s_q1;
-        let x131 = 0.7026 * qd[0];
-        let x132 = s_q1 * x131;
-        let x133 = c_q1 * x131;
-        let x134 = qd[1] * x130;
-        let x135 = qd[1] * x129;
-        let x136 = qd[1] * x133;
-        let x137 = qd[1] * x132;
-        let x138 = 8.088 * x129;
-        let x139 = 3.061 * x130;
-        let x140 = 8.446 * qd[1];
-        let x141 = 105.98 * x132;
-        let x142 = 105.98 * x133;
-        let x143 = libm::fma(-qd[1], s_q2, c_q2 * x129);
-        let x144 = libm::fma(qd[1], c_q2, s_q2 * x129);
-        let x145 = 0.5692 * x129;
-        let x146 = libm::fma(-0.5692, qd[1], x132);
-        let x147 = libm::fma(-c_q2, x146, s_q2 * x145);
-        let x148 = x2 * x133;
-        let x149 = libm::fma(c_q2, x145, s_q2 * x146);
-        let x150 = libm::fma(-x2, x130, qd[2]);
-        let x151 = x2 * x135;
-        let x152 = 0.5692 * x134;
-        let x153 = x2 * x137;
-        let x154 = libm::fma(qd[2], x144, c_q2 * x134);
-        let x155 = libm::fma(-s_q2, x134, qd[2] * x143);
-        let x156 = libm::fma(qd[2], x149, -libm::fma(s_q2, x152, c_q2 * x136));
-        let x157 = libm::fma(qd[2], x147, libm::fma(-s_q2, x136, c_q2 * x152));
-        let x158 = libm::fma(49.52, x150, 15.41 * x143);
-        let x159 = libm::fma(2094.71, x150, 49.52 * x143);
-        let x160 = 2103.19 * x144;
-        let x161 = 314.88 * x147;
-        let x162 = 314.88 * x148;
-        let x163 = 314.88 * x149;
-        let x164 = libm::fma(-s_q3, x144, c_q3 * x143);
-        let x165 = libm::fma(c_q3, x144, s_q3 * x143);
-        let x166 = libm::fma(0.475, x144, x147);
-        let x167 = x149 + libm::fma(7.11, x150, 0.475 * x143);
-        let x168 = libm::fma(s_q3, x167, c_q3 * x166);
-        let x169 = x4 * libm::fma(-7.11, x144, x148);
-        let x170 = libm::fma(-c_q3, x167, s_q3 * x166);
-        let x171 = libm::fma(x4, x150, qd[3]);
-        let x172 = x4 * x151;
-        let x173 = libm::fma(0.475, x155, x156);
-        let x174 = x157 + libm::fma(7.11, x151, 0.475 * x154);
-        let x175 = x4 * libm::fma(7.11, x155, x153);
-        let x176 = libm::fma(qd[3], x165, libm::fma(s_q3, x155, c_q3 * x154));
-        let x177 = libm::fma(qd[3], x164, libm::fma(-s_q3, x154, c_q3 * x155));
-        let x178 = libm::fma(-qd[3], x170, libm::fma(-s_q3, x174, c_q3 * x173));
-        let x179 = libm::fma(qd[3], x168, libm::fma(c_q3, x174, s_q3 * x173));
-        let x180 = libm::fma(-39.95, x171, 9.522 * x164);
-        let x181 = libm::fma(1966.28, x171, -39.95 * x164);
-        let x182 = 1966.28 * x165;
-        let x183 = 279.2 * x168;
-        let x184 = 279.2 * x169;
-        let x185 = 279.2 * x170;
-        let x186 = libm::fma(-s_q4, x165, c_q4 * x164);
-        let x187 = libm::fma(c_q4, x165, s_q4 * x164);
-        let x188 = libm::fma(-7.11, x171, x170);
-        let x189 = libm::fma(-s_q4, x188, c_q4 * x168);
-        let x190 = x6 * libm::fma(-7.11, x165, x169);
-        let x191 = libm::fma(c_q4, x188, s_q4 * x168);
-        let x192 = libm::fma(x6, x171, qd[4]);
-        let x193 = x6 * x172;
-        let x194 = libm::fma(7.11, x172, x179);
-        let x195 = x6 * libm::fma(7.11, x177, x175);
-        let x196 = libm::fma(qd[4], x187, libm::fma(s_q4, x177, c_q4 * x176));
-        let x197 = libm::fma(qd[4], x186, libm::fma(-s_q4, x176, c_q4 * x177));
-        let x198 = libm::fma(-qd[4], x191, libm::fma(-s_q4, x194, c_q4 * x178));
-        let x199 = libm::fma(qd[4], x189, libm::fma(c_q4, x194, s_q4 * x178));
-        let x200 = 8.305 * x186;
-        let x201 = 3.061 * x192;
-        let x202 = 8.0386 * x187;
-        let x203 = 105.98 * x189;
-        let x204 = 105.98 * x190;
-        let x205 = 105.98 * x191;
-        let x206 = libm::fma(s_q5, x192, c_q5 * x186);
-        let x207 = libm::fma(-s_q5, x186, c_q5 * x192);
-        let x208 = libm::fma(0.5692, x187, x189);
-        let x209 = libm::fma(-s_q5, x190, c_q5 * x208);
-        let x210 = libm::fma(c_q5, x190, s_q5 * x208);
-        let x211 = x8 * libm::fma(-0.5692, x186, x191);
-        let x212 = libm::fma(x8, x187, qd[5]);
-        let x213 = x8 * x197;
-        let x214 = libm::fma(0.5692, x197, x198);
-        let x215 = x8 * libm::fma(0.5692, x196, x199);
-        let x216 = libm::fma(qd[5], x207, -libm::fma(s_q5, x193, c_q5 * x196));
-        let x217 = libm::fma(-qd[5], x206, libm::fma(-c_q5, x193, s_q5 * x196));
-        let x218 = libm::fma(-qd[5], x210, libm::fma(s_q5, x195, c_q5 * x214));
-        let x219 = libm::fma(-qd[5], x209, libm::fma(-s_q5, x214, c_q5 * x195));
-        let x220 = 12.13 * x206;
-        let x221 = 12.13 * x207;
-        let x222 = 3.061 * x212;
-        let x223 = 105.98 * x209;
-        let x224 = 105.98 * x210;
-        let x225 = 105.98 * x211;
-        let x226 = libm::fma(s_q6, x212, c_q6 * x207);
-        let x227 = libm::fma(-s_q6, x207, c_q6 * x212);
-        let x228 = libm::fma(-0.7026, x206, x210);
-        let x229 = x10 * libm::fma(-0.7026, x207, x209);
-        let x230 = libm::fma(-c_q6, x228, s_q6 * x211);
-        let x231 = libm::fma(c_q6, x211, s_q6 * x228);
-        let x232 = libm::fma(x10, x206, qd[6]);
-        let x233 = libm::fma(0.7026, x216, x219);
-        let x234 = 9.336 * x232;
-        let x235 = 44.41 * x226;
-        let x236 = 44.41 * x227;
-        let x237 = 243.66 * x229;
-        let x238 = 243.66 * x230;
-        let x239 = 243.66 * x231;
-        let x240 = libm::fma(
-            9.336,
-            x10 * x216,
-            libm::fma(-x227, x235, x226 * x236) + libm::fma(-x231, x238, x230 * x239),
+        let x127 = libm::fma(7.11, x110, x96);
+        let x128 = x111 + libm::fma(0.475, x109, x125);
+        let x129 = libm::fma(qd[3], x118, libm::fma(s_q3, x110, c_q3 * x109));
+        let x130 = libm::fma(qd[3], x117, libm::fma(-s_q3, x109, c_q3 * x110));
+        let x131 = libm::fma(qd[3], x122, libm::fma(c_q3, x128, s_q3 * x126));
+        let x132 = libm::fma(1375.0472756800002, x124, -24989.305802 * x117);
+        let x133 = 3239.4582 * x120;
+        let x134 = libm::fma(
+            x123,
+            -3239.4582,
+            libm::fma(24998.827802, x124, 1375.0472756800002 * x117),
         );
-        let x241 = libm::fma(
-            44.41,
-            libm::fma(qd[6], x227, libm::fma(s_q6, x213, c_q6 * x217)),
-            libm::fma(-x232, x236, x227 * x234) + libm::fma(-x229, x239, x231 * x237),
+        let x135 = x118 * -3239.4582;
+        let x136 = 3239.4582 * x124;
+        let x137 = libm::fma(-s_q4, x118, c_q4 * x117);
+        let x138 = libm::fma(c_q4, x118, s_q4 * x117);
+        let x139 = libm::fma(-7.11, x118, x120);
+        let x140 = libm::fma(-7.11, x124, x123);
+        let x141 = libm::fma(-s_q4, x140, c_q4 * x122);
+        let x142 = libm::fma(c_q4, x140, s_q4 * x122);
+        let x143 = qd[4] + x124;
+        let x144 = libm::fma(qd[4], x138, libm::fma(s_q4, x130, c_q4 * x129));
+        let x145 = libm::fma(qd[4], x137, libm::fma(-s_q4, x129, c_q4 * x130));
+        let x146 = -97.44448770720001 * x143;
+        let x147 = libm::fma(-171.195516, x139, 132.6783695416 * x137);
+        let x148 = libm::fma(
+            -171.195516,
+            x141,
+            libm::fma(-97.44448770720001, x138, 135.4729695416 * x143),
         );
-        let x242 = libm::fma(
-            44.41,
-            libm::fma(-qd[6], x226, libm::fma(-s_q6, x217, c_q6 * x213)),
-            libm::fma(-x226, x234, x232 * x235) + libm::fma(-x230, x237, x229 * x238),
-        );
-        let x243 = libm::fma(
-            243.66,
-            libm::fma(qd[6], x231, libm::fma(s_q6, x215, c_q6 * x233)),
-            libm::fma(-x232, x239, x227 * x237),
-        );
-        let x244 = libm::fma(
-            243.66,
-            libm::fma(-qd[6], x230, libm::fma(-s_q6, x233, c_q6 * x215)),
-            libm::fma(-x226, x237, x232 * x238),
-        );
-        let x245 = x10
-            * libm::fma(
-                243.66,
-                x10 * libm::fma(-0.7026, x217, x218),
-                libm::fma(-x227, x238, x226 * x239),
-            );
-        let x246 = libm::fma(-s_q6, x244, c_q6 * x243);
-        let x247 = libm::fma(
-            12.13,
-            x216,
-            libm::fma(-x212, x221, x207 * x222) + libm::fma(-x210, x225, x211 * x224),
-        ) + libm::fma(0.7026, x246, x10 * x240);
-        let x248 = libm::fma(
-            12.13,
-            x217,
-            libm::fma(-x206, x222, x212 * x220) + libm::fma(-x209, x225, x211 * x223),
-        ) + libm::fma(-0.7026, x245, libm::fma(-s_q6, x242, c_q6 * x241));
-        let x249 = libm::fma(
-            3.061,
-            x213,
-            libm::fma(-x207, x220, x206 * x221) + libm::fma(-x209, x224, x210 * x223),
-        ) + libm::fma(c_q6, x242, s_q6 * x241);
-        let x250 = libm::fma(105.98, x218, libm::fma(x207, x225, x212 * x224)) + x245;
-        let x251 = libm::fma(105.98, x219, libm::fma(-x206, x225, x212 * x223)) + x246;
-        let x252 = libm::fma(-s_q5, x251, c_q5 * x250);
-        let x253 = x8
-            * (libm::fma(105.98, x215, -libm::fma(x206, x224, x207 * x223))
-                + libm::fma(c_q6, x244, s_q6 * x243));
-        let x254 = libm::fma(
-            -8.305,
-            x196,
-            libm::fma(-x187, x201, x192 * x202) + libm::fma(-x190, x205, x191 * x204),
-        ) + libm::fma(-0.5692, x253, libm::fma(-s_q5, x248, c_q5 * x247));
-        let x255 = libm::fma(
-            -3.061,
-            x193,
-            libm::fma(-x186, x202, x187 * x200) + libm::fma(-x189, x205, x191 * x203),
-        ) + libm::fma(c_q5, x248, s_q5 * x247);
-        let x256 = libm::fma(
-            8.0386,
-            x197,
-            libm::fma(-x192, x200, x186 * x201) + libm::fma(-x189, x204, x190 * x203),
-        ) + libm::fma(0.5692, x252, x8 * x249);
-        let x257 = libm::fma(105.98, x198, libm::fma(x192, x205, x187 * x204)) + x252;
-        let x258 = libm::fma(105.98, x199, -libm::fma(x186, x204, x192 * x203)) + x253;
-        let x259 = x6
-            * (libm::fma(105.98, x195, libm::fma(-x186, x205, x187 * x203))
-                + libm::fma(c_q5, x251, s_q5 * x250));
-        let x260 = libm::fma(-s_q4, x257, c_q4 * x258);
-        let x261 = libm::fma(-x165, x181, x171 * x182)
-            + libm::fma(-x169, x185, x170 * x184) - libm::fma(-39.95, x172, 9.522 * x176)
-            + libm::fma(s_q4, x256, c_q4 * x254);
-        let x262 = libm::fma(-x164, x182, x165 * x180)
-            + libm::fma(-x168, x185, x170 * x183)
-            - libm::fma(1966.28, x172, -39.95 * x176)
-            + libm::fma(-7.11, x260, x6 * x255);
-        let x263 = libm::fma(
-            1966.28,
-            x177,
-            libm::fma(-x171, x180, x164 * x181) + libm::fma(-x168, x184, x169 * x183),
-        ) + libm::fma(7.11, x259, libm::fma(-s_q4, x254, c_q4 * x256));
-        let x264 = libm::fma(279.2, x178, libm::fma(x171, x185, x165 * x184))
-            + libm::fma(s_q4, x258, c_q4 * x257);
-        let x265 = libm::fma(279.2, x179, -libm::fma(x164, x184, x171 * x183)) + x260;
-        let x266 = libm::fma(s_q3, x265, c_q3 * x264);
-        let x267 = x4
-            * (libm::fma(279.2, x175, libm::fma(-x164, x185, x165 * x183)) + x259);
-        let x268 = libm::fma(-s_q3, x264, c_q3 * x265);
-        let x269 = libm::fma(-x144, x159, x150 * x160)
-            + libm::fma(-x149, x162, x148 * x163) - libm::fma(49.52, x151, 15.41 * x154)
-            + libm::fma(-0.475, x268, libm::fma(s_q3, x263, c_q3 * x261));
-        let x270 = libm::fma(-x143, x160, x144 * x158)
-            + libm::fma(-x149, x161, x147 * x163)
-            - libm::fma(2094.71, x151, 49.52 * x154) + libm::fma(-7.11, x268, x4 * x262);
-        let x271 = libm::fma(
-            2103.19,
-            x155,
-            libm::fma(-x150, x158, x143 * x159) + libm::fma(-x147, x162, x148 * x161),
-        ) + (libm::fma(-s_q3, x261, c_q3 * x263) + libm::fma(7.11, x267, 0.475 * x266));
-        let x272 = libm::fma(314.88, x156, libm::fma(-x150, x163, x144 * x162)) + x266;
-        let x273 = libm::fma(314.88, x157, -libm::fma(x143, x162, x150 * x161)) + x268;
-        let x274 = libm::fma(s_q2, x273, c_q2 * x272);
-        let x275 = tau[0]
+        let x149 = 171.195516 * x143;
+        let x150 = -171.195516 * x137;
+        let x151 = libm::fma(-x137, x150, x143 * x149);
+        let x152 = libm::fma(x138, x150, 171.195516 * x94);
+        let x153 = libm::fma(-x138, x149, -171.195516 * x144);
+        let x154 = libm::fma(s_q5, x143, c_q5 * x137);
+        let x155 = libm::fma(-s_q5, x137, c_q5 * x143);
+        let x156 = qd[5] + x138;
+        let x157 = 44.41 * x155;
+        let x158 = 47.471 * x156;
+        let x159 = 9.336 * libm::fma(qd[5], x155, -libm::fma(s_q5, x94, c_q5 * x144));
+        let x160 = 9.336 * (qd[6] + x154);
+        let x161 = libm::fma(-s_q6, x155, c_q6 * x156) * x160;
+        let x162 = libm::fma(s_q6, x156, c_q6 * x155) * x160;
+        let x163 = libm::fma(-x156, x157, x155 * x158) + x159;
+        let x164 = libm::fma(
+            -x154,
+            x158,
+            44.41 * libm::fma(-qd[5], x154, libm::fma(-c_q5, x94, s_q5 * x144)),
+        ) + libm::fma(s_q6, x162, c_q6 * x161);
+        let x165 = libm::fma(x154, x157, 47.471 * x145)
+            + libm::fma(-c_q6, x162, s_q6 * x161);
+        let x166 = libm::fma(
+            -132.6783695416,
+            x144,
+            171.195516 * libm::fma(7.11, x130, x127),
+        ) + libm::fma(x142, x150, libm::fma(-x138, x148, x143 * x146))
+            + libm::fma(-s_q5, x164, c_q5 * x163);
+        let x167 = libm::fma(
+            -171.195516,
+            libm::fma(
+                -qd[4],
+                x142,
+                libm::fma(
+                    -s_q4,
+                    x125 + x131,
+                    c_q4 * libm::fma(-qd[3], x123, libm::fma(-s_q3, x128, c_q3 * x126)),
+                ),
+            ),
+            libm::fma(-135.4729695416, x94, -97.44448770720001 * x145),
+        ) + libm::fma(-x142, x149, libm::fma(-x137, x146, x138 * x147))
+            + libm::fma(c_q5, x164, s_q5 * x163);
+        let x168 = libm::fma(
+            97.44448770720001,
+            x94,
+            libm::fma(-x143, x147, x137 * x148) - libm::fma(x141, x150, x139 * x149),
+        ) + x165;
+        let x169 = libm::fma(-s_q4, x152, c_q4 * x151);
+        let x170 = libm::fma(x120, x136, x123 * x135)
+            - libm::fma(x124, x133, x118 * x134)
+            - libm::fma(1375.0472756800002, x94, -24989.305802 * x129)
+            + libm::fma(s_q4, x168, c_q4 * x166);
+        let x171 = libm::fma(
+            x131,
+            -3239.4582,
+            -libm::fma(24998.827802, x94, 1375.0472756800002 * x129),
+        ) + libm::fma(x122, x136, libm::fma(x117, x133, x118 * x132))
+            + libm::fma(-7.11, x169, x167);
+        let x172 = libm::fma(
+            3239.4582,
+            x127,
+            libm::fma(-x122, x135, libm::fma(-x124, x132, x117 * x134)),
+        ) + libm::fma(7.11, x153, libm::fma(-s_q4, x166, c_q4 * x168));
+        let x173 = libm::fma(-x124, x136, x118 * x135)
+            + libm::fma(s_q4, x151, c_q4 * x152);
+        let x174 = libm::fma(x130, 3239.4582, x117 * x136) + x153;
+        let x175 = libm::fma(-x117, x135, 3239.4582 * x94) + x169;
+        let x176 = libm::fma(s_q3, x175, c_q3 * x173);
+        let x177 = libm::fma(-s_q3, x173, c_q3 * x175);
+        let x178 = libm::fma(-x106, x115, x92 * x116)
+            - libm::fma(x107, x113, x102 * x114)
+            - libm::fma(3946.18812068, x94, -39234.47412200001 * x109)
+            + libm::fma(-0.475, x177, libm::fma(s_q3, x172, c_q3 * x170));
+        let x179 = libm::fma(
+            x111,
+            -5224.5702,
+            -libm::fma(39241.404122, x94, 3946.1881206800003 * x109),
+        ) + libm::fma(x105, x116, libm::fma(x101, x113, x102 * x112))
+            + libm::fma(-7.11, x177, x171);
+        let x180 = libm::fma(
+            5224.5702,
+            x96,
+            libm::fma(-x105, x115, libm::fma(-x107, x112, x101 * x114)),
+        ) + (libm::fma(-s_q3, x170, c_q3 * x172) + libm::fma(7.11, x174, 0.475 * x176));
+        let x181 = libm::fma(-x107, x116, x102 * x115) + x176;
+        let x182 = libm::fma(-x101, x115, 5224.5702 * x94) + x177;
+        let x183 = libm::fma(s_q2, x182, c_q2 * x181);
+        let x184 = tau[0]
             - libm::fma(
                 -0.7026,
                 libm::fma(
                     c_q1,
-                    libm::fma(
-                        x2,
-                        libm::fma(314.88, x153, libm::fma(x143, x163, x144 * x161))
-                            + x267,
-                        libm::fma(-qd[1], x141, 105.98 * x137),
-                    ),
-                    s_q1 * (libm::fma(-105.98, x136, qd[1] * x142) + x274),
+                    libm::fma(-qd[1], x99, x88 * x100)
+                        + (libm::fma(x110, 5224.5702, x101 * x116) + x174),
+                    s_q1 * libm::fma(x89, x100, x183),
                 ),
                 libm::fma(
                     -s_q1,
-                    libm::fma(
-                        x2,
-                        x270,
-                        libm::fma(-3.061, x135, libm::fma(-x129, x140, qd[1] * x138)),
-                    ),
+                    x179
+                        - libm::fma(
+                            -65693.9112265768,
+                            x94,
+                            libm::fma(x91, x100, x88 * x98),
+                        ),
                     c_q1
-                        * (libm::fma(-8.088, x134, libm::fma(-x130, x140, qd[1] * x139))
+                        * (libm::fma(x92, x100, libm::fma(-x89, x98, qd[1] * x97))
                             + libm::fma(
                                 -0.5692,
-                                libm::fma(-s_q2, x272, c_q2 * x273),
-                                libm::fma(s_q2, x271, c_q2 * x269),
+                                libm::fma(-s_q2, x181, c_q2 * x182),
+                                libm::fma(s_q2, x180, c_q2 * x178),
                             )),
                 ),
             );
-        let x276 = 1.0
-            / (12.19
+        let x185 = 1.0
+            / (66279.65991417361
                 + libm::fma(
                     0.7026,
-                    x97 + 811.9807679999999,
+                    x63,
                     libm::fma(
                         0.7026,
-                        x97,
+                        x63,
                         libm::fma(
                             -s_q1,
-                            libm::fma(
-                                -s_q1,
-                                libm::fma(x2, x94, 3.061),
-                                c_q1 * libm::fma(x2, x91, -x96),
-                            ),
+                            libm::fma(-s_q1, -65693.9112265768 + x59, x68),
                             c_q1
                                 * libm::fma(
                                     -s_q1,
-                                    libm::fma(0.5692, x85, libm::fma(s_q2, x95, c_q2 * x93)),
-                                    c_q1
-                                        * (8.088
-                                            + libm::fma(
-                                                -0.5692,
-                                                x89,
-                                                libm::fma(-0.5692, x86, libm::fma(s_q2, x92, c_q2 * x90)),
-                                            )),
+                                    libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
+                                    c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
                                 ),
                         ),
                     ),
                 ));
-        let x277 = x98 * x276;
-        let x278 = x99 * x276;
-        let x279 = x104 * x276;
-        let x280 = x112 * x276;
-        let x281 = x119 * x276;
-        let x282 = x128 * x276;
-        let x283 = 1.0
+        let x186 = x69 * x185;
+        let x187 = x70 * x185;
+        let x188 = x72 * x185;
+        let x189 = x79 * x185;
+        let x190 = x82 * x185;
+        let x191 = x87 * x185;
+        let x192 = 1.0
             / libm::fma(
-                -x98,
-                x277,
-                8.446
+                -x69,
+                x186,
+                65697.3302265768
                     + libm::fma(
-                        -0.5692,
-                        x89,
-                        libm::fma(
-                            -0.5692,
-                            x86,
-                            libm::fma(
-                                -s_q2,
-                                libm::fma(-s_q2, x80, c_q2 * x77),
-                                c_q2 * libm::fma(-s_q2, x79, c_q2 * x83),
-                            ),
-                        ),
+                        -s_q2,
+                        libm::fma(-s_q2, x56, c_q2 * x50),
+                        c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
                     ),
             );
-        let x284 = libm::fma(
-            -x98,
-            x278,
-            libm::fma(0.5692, x88, libm::fma(-s_q2, x81, c_q2 * x78)),
+        let x193 = libm::fma(
+            -x69,
+            x187,
+            libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
         );
-        let x285 = x283 * x284;
-        let x286 = libm::fma(
-            -x98,
-            x279,
-            libm::fma(0.5692, x103, libm::fma(-s_q2, x100, c_q2 * x102)),
+        let x194 = x192 * x193;
+        let x195 = libm::fma(
+            -x69,
+            x188,
+            libm::fma(0.5692, x71, libm::fma(-s_q2, x48, x67)),
         );
-        let x287 = x283 * x286;
-        let x288 = libm::fma(
-            -x98,
-            x280,
-            libm::fma(0.5692, x111, libm::fma(-s_q2, x108, c_q2 * x110)),
+        let x196 = x192 * x195;
+        let x197 = libm::fma(
+            -x69,
+            x189,
+            libm::fma(0.5692, x78, libm::fma(-s_q2, x75, c_q2 * x77)),
         );
-        let x289 = x283 * x288;
-        let x290 = libm::fma(-x98, x281, libm::fma(-s_q2, x116, c_q2 * x118));
-        let x291 = x283 * x290;
-        let x292 = libm::fma(x98, x282, libm::fma(c_q2, x127, s_q2 * x125));
-        let x293 = x283 * x292;
-        let x294 = 1.0 / libm::fma(-x284, x285, libm::fma(-x99, x278, x82));
-        let x295 = libm::fma(-x284, x287, libm::fma(-x99, x279, x101));
-        let x296 = x294 * x295;
-        let x297 = libm::fma(-x284, x289, libm::fma(-x99, x280, x109));
-        let x298 = x294 * x297;
-        let x299 = libm::fma(-x284, x291, libm::fma(-x99, x281, x117));
-        let x300 = x294 * x299;
-        let x301 = libm::fma(x284, x293, libm::fma(-x99, x282, x126));
-        let x302 = x294 * x301;
-        let x303 = 1.0
+        let x198 = x192 * x197;
+        let x199 = libm::fma(-x69, x190, libm::fma(-s_q2, x80, c_q2 * x81));
+        let x200 = x192 * x199;
+        let x201 = libm::fma(x69, x191, libm::fma(c_q2, x86, s_q2 * x85));
+        let x202 = x192 * x201;
+        let x203 = 1.0 / libm::fma(-x193, x194, libm::fma(-x70, x187, x59));
+        let x204 = libm::fma(-x193, x196, libm::fma(-x70, x188, x49));
+        let x205 = x203 * x204;
+        let x206 = libm::fma(-x193, x198, libm::fma(-x70, x189, x76));
+        let x207 = x203 * x206;
+        let x208 = libm::fma(x193, x200, x70 * x190);
+        let x209 = x203 * x208;
+        let x210 = libm::fma(x193, x202, libm::fma(-x70, x191, x8));
+        let x211 = x203 * x210;
+        let x212 = 1.0
+            / libm::fma(-x204, x205, libm::fma(-x195, x196, libm::fma(-x72, x188, x35)));
+        let x213 = libm::fma(
+            -x204,
+            x207,
+            libm::fma(-x195, x198, libm::fma(-x72, x189, x27)),
+        );
+        let x214 = x212 * x213;
+        let x215 = libm::fma(x204, x209, -libm::fma(x195, x200, x72 * x190));
+        let x216 = x212 * x215;
+        let x217 = libm::fma(
+            -x204,
+            x211,
+            libm::fma(x195, x202, libm::fma(-x72, x191, x8)),
+        );
+        let x218 = x212 * x217;
+        let x219 = 1.0
             / libm::fma(
-                -x295,
-                x296,
-                libm::fma(-x286, x287, libm::fma(-x104, x279, x56)),
-            );
-        let x304 = libm::fma(
-            -x295,
-            x298,
-            libm::fma(-x286, x289, libm::fma(-x104, x280, x105)),
-        );
-        let x305 = x303 * x304;
-        let x306 = libm::fma(
-            -x295,
-            x300,
-            libm::fma(-x286, x291, libm::fma(-x104, x281, x114)),
-        );
-        let x307 = x303 * x306;
-        let x308 = libm::fma(
-            -x295,
-            x302,
-            libm::fma(x286, x293, libm::fma(-x104, x282, x123)),
-        );
-        let x309 = x303 * x308;
-        let x310 = 1.0
-            / libm::fma(
-                -x304,
-                x305,
+                -x213,
+                x214,
                 libm::fma(
-                    -x297,
-                    x298,
-                    libm::fma(-x288, x289, libm::fma(-x112, x280, x35)),
+                    -x206,
+                    x207,
+                    libm::fma(-x197, x198, libm::fma(-x79, x189, x13)),
                 ),
             );
-        let x311 = libm::fma(
-            -x304,
-            x307,
-            libm::fma(-x297, x300, libm::fma(-x288, x291, libm::fma(-x112, x281, x27))),
+        let x220 = libm::fma(
+            -x213,
+            x216,
+            libm::fma(x206, x209, -libm::fma(x197, x200, x79 * x190)),
         );
-        let x312 = x310 * x311;
-        let x313 = libm::fma(
-            -x304,
-            x309,
-            libm::fma(-x297, x302, libm::fma(x288, x293, libm::fma(-x112, x282, x121))),
+        let x221 = x219 * x220;
+        let x222 = libm::fma(
+            -x213,
+            x218,
+            libm::fma(-x206, x211, libm::fma(x197, x202, libm::fma(-x79, x191, x8))),
         );
-        let x314 = x310 * x313;
-        let x315 = 1.0
+        let x223 = x219 * x222;
+        let x224 = 1.0
             / libm::fma(
-                -x311,
-                x312,
+                -x220,
+                x221,
                 libm::fma(
-                    -x306,
-                    x307,
+                    -x215,
+                    x216,
                     libm::fma(
-                        -x299,
-                        x300,
-                        libm::fma(-x290, x291, libm::fma(-x119, x281, x20)),
+                        -x208,
+                        x209,
+                        libm::fma(-x199, x200, libm::fma(-x82, x190, 47.471)),
                     ),
                 ),
             );
-        let x316 = libm::fma(
-            -x311,
-            x314,
+        let x225 = libm::fma(
+            -x220,
+            x223,
             libm::fma(
-                -x306,
-                x309,
-                libm::fma(-x299, x302, libm::fma(-x119, x282, x290 * x293)),
+                -x215,
+                x218,
+                libm::fma(x208, x211, libm::fma(-x82, x191, x199 * x202)),
             ),
         );
-        let x317 = x315 * x316;
-        let x318 = 1.0
+        let x226 = x224 * x225;
+        let x227 = 1.0
             / libm::fma(
-                -x316,
-                x317,
+                -x225,
+                x226,
                 libm::fma(
-                    -x313,
-                    x314,
+                    -x222,
+                    x223,
                     libm::fma(
-                        -x308,
-                        x309,
+                        -x217,
+                        x218,
                         libm::fma(
-                            -x301,
-                            x302,
-                            libm::fma(-x292, x293, libm::fma(-x128, x282, 9.336)),
+                            -x210,
+                            x211,
+                            libm::fma(-x201, x202, libm::fma(-x87, x191, 9.336)),
                         ),
                     ),
                 ),
             );
-        let x319 = libm::fma(
-            -x275,
-            x277,
+        let x228 = libm::fma(
+            -x184,
+            x186,
             tau[1]
-                - (libm::fma(-x129, x139, x130 * x138)
-                    + libm::fma(-x133, x141, x132 * x142)
-                    + libm::fma(0.5692, x274, libm::fma(-s_q2, x269, c_q2 * x271))),
+                - (libm::fma(0.5692, x183, libm::fma(-s_q2, x178, c_q2 * x180))
+                    - libm::fma(1145.5438279999998, x95, libm::fma(x92, x99, x88 * x97))),
         );
-        let x320 = libm::fma(-x285, x319, libm::fma(-x275, x278, tau[2] - x270));
-        let x321 = libm::fma(
-            -x296,
-            x320,
-            libm::fma(-x287, x319, libm::fma(-x275, x279, tau[3] - x262)),
+        let x229 = libm::fma(-x194, x228, libm::fma(-x184, x187, tau[2] - x179));
+        let x230 = libm::fma(
+            -x205,
+            x229,
+            libm::fma(-x196, x228, libm::fma(-x184, x188, tau[3] - x171)),
         );
-        let x322 = libm::fma(
-            -x305,
-            x321,
+        let x231 = libm::fma(
+            -x214,
+            x230,
             libm::fma(
-                -x298,
-                x320,
-                libm::fma(-x289, x319, libm::fma(-x275, x280, tau[4] - x255)),
+                -x207,
+                x229,
+                libm::fma(-x198, x228, libm::fma(-x184, x189, tau[4] - x167)),
             ),
         );
-        let x323 = libm::fma(
-            -x312,
-            x322,
+        let x232 = libm::fma(
+            -x221,
+            x231,
             libm::fma(
-                -x307,
-                x321,
+                -x216,
+                x230,
                 libm::fma(
-                    -x300,
-                    x320,
-                    libm::fma(-x291, x319, libm::fma(-x275, x281, tau[5] - x249)),
+                    x209,
+                    x229,
+                    libm::fma(-x200, x228, libm::fma(-x184, x190, tau[5] - x165)),
                 ),
             ),
         );
-        let x324 = x318
+        let x233 = x227
             * libm::fma(
-                -x317,
-                x323,
+                -x226,
+                x232,
                 libm::fma(
-                    -x314,
-                    x322,
+                    -x223,
+                    x231,
                     libm::fma(
-                        -x309,
-                        x321,
+                        -x218,
+                        x230,
                         libm::fma(
-                            -x302,
-                            x320,
-                            libm::fma(x293, x319, libm::fma(-x275, x282, tau[6] - x240)),
+                            -x211,
+                            x229,
+                            libm::fma(x202, x228, libm::fma(-x184, x191, tau[6] - x159)),
                         ),
                     ),
                 ),
             );
-        let x325 = libm::fma(-x317, x324, x315 * x323);
-        let x326 = libm::fma(-x314, x324, libm::fma(-x312, x325, x310 * x322));
-        let x327 = libm::fma(
-            -x309,
-            x324,
-            libm::fma(-x307, x325, libm::fma(-x305, x326, x303 * x321)),
+        let x234 = libm::fma(-x226, x233, x224 * x232);
+        let x235 = libm::fma(-x223, x233, libm::fma(-x221, x234, x219 * x231));
+        let x236 = libm::fma(
+            -x218,
+            x233,
+            libm::fma(-x216, x234, libm::fma(-x214, x235, x212 * x230)),
         );
-        let x328 = libm::fma(
-            -x302,
-            x324,
+        let x237 = libm::fma(
+            -x211,
+            x233,
             libm::fma(
-                -x300,
-                x325,
-                libm::fma(-x298, x326, libm::fma(-x296, x327, x294 * x320)),
+                x209,
+                x234,
+                libm::fma(-x207, x235, libm::fma(-x205, x236, x203 * x229)),
             ),
         );
-        let x329 = libm::fma(
-            x293,
-            x324,
+        let x238 = libm::fma(
+            x202,
+            x233,
             libm::fma(
-                -x291,
-                x325,
+                -x200,
+                x234,
                 libm::fma(
-                    -x289,
-                    x326,
-                    libm::fma(-x287, x327, libm::fma(-x285, x328, x283 * x319)),
+                    -x198,
+                    x235,
+                    libm::fma(-x196, x236, libm::fma(-x194, x237, x192 * x228)),
                 ),
             ),
         );
-        let x330 = libm::fma(
-            -x282,
-            x324,
+        let x239 = libm::fma(
+            -x191,
+            x233,
             libm::fma(
-                -x281,
-                x325,
+                -x190,
+                x234,
                 libm::fma(
-                    -x280,
-                    x326,
+                    -x189,
+                    x235,
                     libm::fma(
-                        -x279,
-                        x327,
-                        libm::fma(-x278, x328, libm::fma(-x277, x329, x275 * x276)),
+                        -x188,
+                        x236,
+                        libm::fma(-x187, x237, libm::fma(-x186, x238, x184 * x185)),
                     ),
                 ),
             ),
         );
-        [x330, x329, x328, x327, x326, x325, x324]
+        [x239, x238, x237, x236, x235, x234, x233]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 648 mul, 426 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 329 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `rnea`: 426 mul, 292 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 229 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 7],
@@ -1897,510 +1517,364 @@ impl SsrmsFma {
     ) -> ([[f64; 7]; 7], [f64; 7]) {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = libm::fma(s_q6, x13, c_q6 * x12);
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + libm::fma(x10, x11, 120.2819695416);
-        let x19 = 12.13 + (x14 + 120.2819695416);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.195516;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = libm::fma(-c_q5, x23, s_q5 * x22);
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = libm::fma(x21, 0.5692, c_q5 * x28);
-        let x34 = 8.305 + (libm::fma(s_q5, x23, c_q5 * x22) + 113.27938808960002);
-        let x35 = 3.061 + libm::fma(c_q5, x26, s_q5 * x25);
-        let x36 = 8.0386 + libm::fma(x8, x29, 113.27938808960002);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01508800000002;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4582;
-        let x41 = libm::fma(-s_q4, x32, c_q4 * x34);
-        let x42 = libm::fma(s_q4, x33, c_q4 * x30);
-        let x43 = libm::fma(-c_q4, x31, s_q4 * x36);
-        let x44 = x6 * libm::fma(-s_q5, x26, c_q5 * x25);
-        let x45 = x6 * x35;
-        let x46 = x6 * libm::fma(0.5692, x21, x8 * x27);
-        let x47 = libm::fma(c_q4, x32, s_q4 * x34);
-        let x48 = libm::fma(-s_q4, x30, c_q4 * x33);
-        let x49 = libm::fma(c_q4, x36, s_q4 * x31);
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = libm::fma(-7.11, x39, libm::fma(-c_q4, x47, s_q4 * x49));
-        let x53 = libm::fma(x39, -7.11, libm::fma(-s_q4, x41, c_q4 * x43));
-        let x54 = 9.522 + libm::fma(s_q4, x43, c_q4 * x41);
-        let x55 = -39.95 + libm::fma(-7.11, x38, x6 * x42);
-        let x56 = 1966.28 + libm::fma(7.11, x40, libm::fma(x6, x45, -x51));
-        let x57 = 1966.28
+        let x6 = 9.336 * c_q5;
+        let x7 = 44.41 * s_q5;
+        let x8 = 9.336 * s_q5;
+        let x9 = 44.41 * c_q5;
+        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
+        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
+        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
+        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
+        let x14 = -171.195516 * s_q4;
+        let x15 = -171.195516 * c_q4;
+        let x16 = c_q4 * x12;
+        let x17 = -97.44448770720001 * s_q4;
+        let x18 = libm::fma(c_q4, x10, x17);
+        let x19 = 47.471 * s_q4;
+        let x20 = s_q4 * x12;
+        let x21 = -97.44448770720001 * c_q4;
+        let x22 = libm::fma(-s_q4, x10, x21);
+        let x23 = 47.471 * c_q4;
+        let x24 = libm::fma(-s_q4, x11, x21);
+        let x25 = x14 * -7.11;
+        let x26 = 7.11 * x14;
+        let x27 = x13 - x25;
+        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
+        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
+        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
+        let x31 = 3239.4582 + x14;
+        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
+        let x33 = 1375.0472756800002 + x18;
+        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
+        let x35 = 24998.827802 + (x26 + x27);
+        let x36 = s_q3 * x15;
+        let x37 = libm::fma(c_q3, x31, x36);
+        let x38 = c_q3 * x15;
+        let x39 = libm::fma(-s_q3, x31, x38);
+        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
+        let x41 = s_q3 * x22;
+        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
+        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
+        let x44 = c_q3 * x22;
+        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
+        let x46 = -7.11 * x37;
+        let x47 = 7.11 * x37;
+        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
+        let x49 = x35 - x46;
+        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
+        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
+        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
+        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
+        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
+        let x55 = 5224.5702 + x37;
+        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
+        let x57 = 3946.18812068 + x48;
+        let x58 = 3946.1881206800003
+            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
+        let x59 = 39241.404122 + (x47 + x49);
+        let x60 = s_q2 * x39;
+        let x61 = libm::fma(c_q2, x55, x60);
+        let x62 = c_q2 * x39;
+        let x63 = libm::fma(-s_q2, x55, x62);
+        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
+        let x65 = s_q2 * x51;
+        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
+        let x67 = c_q2 * x51;
+        let x68 = libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67));
+        let x69 = 65697.3302265768
             + libm::fma(
-                x40,
-                7.11,
-                libm::fma(7.11, x37, libm::fma(c_q4, x49, s_q4 * x47)),
+                -s_q2,
+                libm::fma(-s_q2, x56, c_q2 * x50),
+                c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
             );
-        let x58 = s_q3 * x39;
-        let x59 = libm::fma(c_q3, x40, x58);
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = libm::fma(-s_q3, x40, x61);
-        let x63 = x59 + 5224.5702;
-        let x64 = x60 + -349.0395;
-        let x65 = libm::fma(s_q3, x52, c_q3 * x54);
-        let x66 = libm::fma(s_q3, x50, c_q3 * x55);
-        let x67 = libm::fma(s_q3, x57, c_q3 * x53);
-        let x68 = x4
-            * (-39.95 + libm::fma(x38, -7.11, libm::fma(s_q4, x46, c_q4 * x44)));
-        let x69 = x4 * x56;
-        let x70 = x4 * libm::fma(-s_q4, x44, c_q4 * x46);
-        let x71 = libm::fma(-s_q3, x54, c_q3 * x52);
-        let x72 = libm::fma(-s_q3, x55, c_q3 * x50);
-        let x73 = libm::fma(-s_q3, x53, c_q3 * x57);
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = libm::fma(-7.11, x62, libm::fma(s_q3, x73, c_q3 * x71));
-        let x78 = libm::fma(x4, x72, x76);
-        let x79 = libm::fma(-7.11, x62, libm::fma(-s_q3, x65, c_q3 * x67));
-        let x80 = 15.41
-            + libm::fma(
-                x64,
-                -0.475,
-                libm::fma(-0.475, x60, libm::fma(s_q3, x67, c_q3 * x65)),
-            );
-        let x81 = 49.52 + libm::fma(-7.11, x64, libm::fma(x4, x66, -x74));
-        let x82 = 2094.71 + libm::fma(7.11, x63, libm::fma(x4, x69, -x75));
-        let x83 = 2103.19
-            + (libm::fma(-s_q3, x71, c_q3 * x73) - libm::fma(-7.11, x59, x60 * 0.475)
-                - libm::fma(0.475, x64, -7.11 * x63));
-        let x84 = s_q2 * x62;
-        let x85 = libm::fma(c_q2, x63, x84);
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = libm::fma(-s_q2, x63, x87);
-        let x89 = x86 + -597.4892399999999;
-        let x90 = libm::fma(s_q2, x77, c_q2 * x80);
-        let x91 = libm::fma(s_q2, x78, c_q2 * x81);
-        let x92 = libm::fma(s_q2, x83, c_q2 * x79);
-        let x93 = x2
-            * (49.52
-                + libm::fma(
-                    x63,
-                    0.475,
-                    libm::fma(-7.11, x60, libm::fma(s_q3, x70, c_q3 * x68)),
-                ));
-        let x94 = x2 * x82;
-        let x95 = x2 * libm::fma(0.475, x62, libm::fma(-s_q3, x68, c_q3 * x70));
-        let x96 = -0.5692 * x85;
-        let x97 = 8.446
-            + libm::fma(
-                -0.5692,
-                x89,
-                libm::fma(
-                    -0.5692,
-                    x86,
-                    libm::fma(
-                        -s_q2,
-                        libm::fma(-s_q2, x80, c_q2 * x77),
-                        c_q2 * libm::fma(-s_q2, x79, c_q2 * x83),
-                    ),
-                ),
-            );
-        let x98 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x99 = 12.19
+        let x70 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
+        let x71 = 66279.65991417361
             + libm::fma(
                 0.7026,
-                x98 + 811.9807679999999,
+                x63,
                 libm::fma(
                     0.7026,
-                    x98,
+                    x63,
                     libm::fma(
                         -s_q1,
-                        libm::fma(
-                            -s_q1,
-                            libm::fma(x2, x94, 3.061),
-                            c_q1 * libm::fma(x2, x91, -x96),
-                        ),
+                        libm::fma(-s_q1, -65693.9112265768 + x59, x70),
                         c_q1
                             * libm::fma(
                                 -s_q1,
-                                libm::fma(0.5692, x85, libm::fma(s_q2, x95, c_q2 * x93)),
-                                c_q1
-                                    * (8.088
-                                        + libm::fma(
-                                            -0.5692,
-                                            x89,
-                                            libm::fma(-0.5692, x86, libm::fma(s_q2, x92, c_q2 * x90)),
-                                        )),
+                                libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
+                                c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
                             ),
                     ),
                 ),
             );
-        let x100 = libm::fma(
+        let x72 = libm::fma(
             -0.7026,
-            libm::fma(-s_q1, x89, c_q1 * x85),
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
             libm::fma(
                 -s_q1,
-                libm::fma(0.5692, x88, libm::fma(-s_q2, x93, c_q2 * x95)),
-                c_q1 * libm::fma(-s_q2, x90, c_q2 * x92),
+                libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
+                c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
             ),
         );
-        let x101 = libm::fma(0.5692, x88, libm::fma(-s_q2, x81, c_q2 * x78));
-        let x102 = libm::fma(
+        let x73 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x70));
+        let x74 = libm::fma(-s_q2, x37, x62);
+        let x75 = libm::fma(0.5692, x74, libm::fma(-s_q2, x48, x67));
+        let x76 = libm::fma(
             -0.7026,
-            s_q1 * x88,
-            libm::fma(-s_q1, x94, c_q1 * (x91 - x96)),
-        );
-        let x103 = x66 - x74;
-        let x104 = x69 - x75;
-        let x105 = x72 + x76;
-        let x106 = libm::fma(-s_q2, x59, x87);
-        let x107 = libm::fma(0.5692, x106, libm::fma(-s_q2, x103, c_q2 * x105));
-        let x108 = libm::fma(
-            -0.7026,
-            s_q1 * x106,
+            s_q1 * x74,
             libm::fma(
                 -s_q1,
-                x2 * x104,
+                x49,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x59, x84),
-                        libm::fma(s_q2, x105, c_q2 * x103),
+                        libm::fma(c_q2, x37, x60),
+                        libm::fma(c_q2, x48, x65),
                     ),
             ),
         );
-        let x109 = x45 - x51;
-        let x110 = libm::fma(-s_q3, x37, x61);
-        let x111 = libm::fma(c_q3, x37, x58);
-        let x112 = libm::fma(0.475, x111, libm::fma(s_q3, x48, c_q3 * x42));
-        let x113 = libm::fma(7.11, x111, x4 * x109);
-        let x114 = libm::fma(0.475, x110, libm::fma(-s_q3, x42, c_q3 * x48));
-        let x115 = libm::fma(-s_q2, x111, c_q2 * x110);
-        let x116 = libm::fma(0.5692, x115, libm::fma(-s_q2, x112, c_q2 * x114));
-        let x117 = libm::fma(
+        let x77 = libm::fma(-s_q3, x14, x38);
+        let x78 = libm::fma(c_q3, x14, x36);
+        let x79 = libm::fma(0.475, x78, libm::fma(c_q3, x18, x41));
+        let x80 = libm::fma(7.11, x78, x27);
+        let x81 = libm::fma(0.475, x77, libm::fma(-s_q3, x18, x44));
+        let x82 = libm::fma(-s_q2, x78, c_q2 * x77);
+        let x83 = libm::fma(0.5692, x82, libm::fma(-s_q2, x79, c_q2 * x81));
+        let x84 = libm::fma(
             -0.7026,
-            s_q1 * x115,
+            s_q1 * x82,
             libm::fma(
                 -s_q1,
-                x2 * x113,
+                x80,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x111, s_q2 * x110),
-                        libm::fma(s_q2, x114, c_q2 * x112),
+                        libm::fma(c_q2, x78, s_q2 * x77),
+                        libm::fma(s_q2, x81, c_q2 * x79),
                     ),
             ),
         );
-        let x118 = libm::fma(-c_q4, x24, s_q4 * x29);
-        let x119 = x6 * x27;
-        let x120 = libm::fma(c_q4, x29, s_q4 * x24);
-        let x121 = libm::fma(s_q3, x120, c_q3 * x118);
-        let x122 = x4 * x119;
-        let x123 = libm::fma(-s_q3, x118, c_q3 * x120);
-        let x124 = libm::fma(-s_q2, x121, c_q2 * x123);
-        let x125 = libm::fma(
-            -s_q1,
-            x2 * x122,
-            c_q1 * libm::fma(s_q2, x123, c_q2 * x121),
+        let x85 = libm::fma(s_q3, x23, c_q3 * x19);
+        let x86 = libm::fma(-s_q3, x19, c_q3 * x23);
+        let x87 = libm::fma(-s_q2, x85, c_q2 * x86);
+        let x88 = c_q1 * libm::fma(s_q2, x86, c_q2 * x85);
+        let x89 = c_q4 * x6;
+        let x90 = s_q4 * x6;
+        let x91 = libm::fma(-s_q3, x90, c_q3 * x89);
+        let x92 = libm::fma(c_q3, x90, s_q3 * x89);
+        let x93 = -libm::fma(c_q2, x92, s_q2 * x91);
+        let x94 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x92, c_q2 * x91));
+        let x95 = qd[0] * c_q1;
+        let x96 = qd[0] * s_q1;
+        let x97 = 0.7026 * qd[0];
+        let x98 = s_q1 * x97;
+        let x99 = c_q1 * x97;
+        let x100 = qd[1] * x96;
+        let x101 = qd[1] * x95;
+        let x102 = qd[1] * x99;
+        let x103 = qd[1] * x98;
+        let x104 = -65693.9112265768 * x96;
+        let x105 = libm::fma(-1145.5438279999998, x98, 65697.3302265768 * qd[1]);
+        let x106 = -1145.5438279999998 * qd[1];
+        let x107 = 1145.5438279999998 * x95;
+        let x108 = libm::fma(-qd[1], s_q2, c_q2 * x95);
+        let x109 = libm::fma(qd[1], c_q2, s_q2 * x95);
+        let x110 = 0.5692 * x95;
+        let x111 = libm::fma(-0.5692, qd[1], x98);
+        let x112 = libm::fma(-c_q2, x111, s_q2 * x110);
+        let x113 = libm::fma(c_q2, x110, s_q2 * x111);
+        let x114 = qd[2] - x96;
+        let x115 = 0.5692 * x100;
+        let x116 = libm::fma(qd[2], x109, c_q2 * x100);
+        let x117 = libm::fma(-s_q2, x100, qd[2] * x108);
+        let x118 = libm::fma(qd[2], x112, libm::fma(-s_q2, x102, c_q2 * x115));
+        let x119 = libm::fma(3946.18812068, x114, -39234.47412200001 * x108);
+        let x120 = 5224.5702 * x99;
+        let x121 = libm::fma(
+            x113,
+            5224.5702,
+            libm::fma(39241.404122, x114, 3946.1881206800003 * x108),
         );
-        let x126 = c_q5 * x11;
-        let x127 = s_q5 * x11;
-        let x128 = c_q4 * x126;
-        let x129 = x6 * x127;
-        let x130 = s_q4 * x126;
-        let x131 = libm::fma(-s_q3, x130, c_q3 * x128);
-        let x132 = x4 * x129;
-        let x133 = libm::fma(c_q3, x130, s_q3 * x128);
-        let x134 = -libm::fma(c_q2, x133, s_q2 * x131);
-        let x135 = libm::fma(
-            -s_q1,
-            x2 * x132,
-            c_q1 * libm::fma(-s_q2, x133, c_q2 * x131),
+        let x122 = x109 * -5224.5702;
+        let x123 = 5224.5702 * x114;
+        let x124 = libm::fma(-s_q3, x109, c_q3 * x108);
+        let x125 = libm::fma(c_q3, x109, s_q3 * x108);
+        let x126 = libm::fma(0.475, x109, x112);
+        let x127 = libm::fma(-7.11, x109, x99);
+        let x128 = x113 + libm::fma(7.11, x114, 0.475 * x108);
+        let x129 = libm::fma(s_q3, x128, c_q3 * x126);
+        let x130 = libm::fma(-c_q3, x128, s_q3 * x126);
+        let x131 = qd[3] + x114;
+        let x132 = 7.11 * x101;
+        let x133 = libm::fma(
+            0.475,
+            x117,
+            libm::fma(qd[2], x113, -libm::fma(s_q2, x115, c_q2 * x102)),
         );
-        let x136 = qd[0] * c_q1;
-        let x137 = qd[0] * s_q1;
-        let x138 = 0.7026 * qd[0];
-        let x139 = s_q1 * x138;
-        let x140 = c_q1 * x138;
-        let x141 = qd[1] * x137;
-        let x142 = qd[1] * x136;
-        let x143 = qd[1] * x140;
-        let x144 = qd[1] * x139;
-        let x145 = 8.088 * x136;
-        let x146 = 3.061 * x137;
-        let x147 = 8.446 * qd[1];
-        let x148 = 105.98 * x139;
-        let x149 = 105.98 * x140;
-        let x150 = libm::fma(-qd[1], s_q2, c_q2 * x136);
-        let x151 = libm::fma(qd[1], c_q2, s_q2 * x136);
-        let x152 = 0.5692 * x136;
-        let x153 = libm::fma(-0.5692, qd[1], x139);
-        let x154 = libm::fma(-c_q2, x153, s_q2 * x152);
-        let x155 = x2 * x140;
-        let x156 = libm::fma(c_q2, x152, s_q2 * x153);
-        let x157 = libm::fma(-x2, x137, qd[2]);
-        let x158 = x2 * x142;
-        let x159 = 0.5692 * x141;
-        let x160 = x2 * x144;
-        let x161 = libm::fma(qd[2], x151, c_q2 * x141);
-        let x162 = libm::fma(-s_q2, x141, qd[2] * x150);
-        let x163 = libm::fma(qd[2], x156, -libm::fma(s_q2, x159, c_q2 * x143));
-        let x164 = libm::fma(qd[2], x154, libm::fma(-s_q2, x143, c_q2 * x159));
-        let x165 = libm::fma(49.52, x157, 15.41 * x150);
-        let x166 = libm::fma(2094.71, x157, 49.52 * x150);
-        let x167 = 2103.19 * x151;
-        let x168 = 314.88 * x154;
-        let x169 = 314.88 * x155;
-        let x170 = 314.88 * x156;
-        let x171 = libm::fma(-s_q3, x151, c_q3 * x150);
-        let x172 = libm::fma(c_q3, x151, s_q3 * x150);
-        let x173 = libm::fma(0.475, x151, x154);
-        let x174 = x156 + libm::fma(7.11, x157, 0.475 * x150);
-        let x175 = libm::fma(s_q3, x174, c_q3 * x173);
-        let x176 = x4 * libm::fma(-7.11, x151, x155);
-        let x177 = libm::fma(-c_q3, x174, s_q3 * x173);
-        let x178 = libm::fma(x4, x157, qd[3]);
-        let x179 = x4 * x158;
-        let x180 = libm::fma(0.475, x162, x163);
-        let x181 = x164 + libm::fma(7.11, x158, 0.475 * x161);
-        let x182 = x4 * libm::fma(7.11, x162, x160);
-        let x183 = libm::fma(qd[3], x172, libm::fma(s_q3, x162, c_q3 * x161));
-        let x184 = libm::fma(qd[3], x171, libm::fma(-s_q3, x161, c_q3 * x162));
-        let x185 = libm::fma(-qd[3], x177, libm::fma(-s_q3, x181, c_q3 * x180));
-        let x186 = libm::fma(qd[3], x175, libm::fma(c_q3, x181, s_q3 * x180));
-        let x187 = libm::fma(-39.95, x178, 9.522 * x171);
-        let x188 = libm::fma(1966.28, x178, -39.95 * x171);
-        let x189 = 1966.28 * x172;
-        let x190 = 279.2 * x175;
-        let x191 = 279.2 * x176;
-        let x192 = 279.2 * x177;
-        let x193 = libm::fma(-s_q4, x172, c_q4 * x171);
-        let x194 = libm::fma(c_q4, x172, s_q4 * x171);
-        let x195 = libm::fma(-7.11, x178, x177);
-        let x196 = libm::fma(-s_q4, x195, c_q4 * x175);
-        let x197 = x6 * libm::fma(-7.11, x172, x176);
-        let x198 = libm::fma(c_q4, x195, s_q4 * x175);
-        let x199 = libm::fma(x6, x178, qd[4]);
-        let x200 = x6 * x179;
-        let x201 = libm::fma(7.11, x179, x186);
-        let x202 = x6 * libm::fma(7.11, x184, x182);
-        let x203 = libm::fma(qd[4], x194, libm::fma(s_q4, x184, c_q4 * x183));
-        let x204 = libm::fma(qd[4], x193, libm::fma(-s_q4, x183, c_q4 * x184));
-        let x205 = libm::fma(-qd[4], x198, libm::fma(-s_q4, x201, c_q4 * x185));
-        let x206 = libm::fma(qd[4], x196, libm::fma(c_q4, x201, s_q4 * x185));
-        let x207 = 8.305 * x193;
-        let x208 = 3.061 * x199;
-        let x209 = 8.0386 * x194;
-        let x210 = 105.98 * x196;
-        let x211 = 105.98 * x197;
-        let x212 = 105.98 * x198;
-        let x213 = libm::fma(s_q5, x199, c_q5 * x193);
-        let x214 = libm::fma(-s_q5, x193, c_q5 * x199);
-        let x215 = libm::fma(0.5692, x194, x196);
-        let x216 = libm::fma(-s_q5, x197, c_q5 * x215);
-        let x217 = libm::fma(c_q5, x197, s_q5 * x215);
-        let x218 = x8 * libm::fma(-0.5692, x193, x198);
-        let x219 = libm::fma(x8, x194, qd[5]);
-        let x220 = x8 * x204;
-        let x221 = libm::fma(0.5692, x204, x205);
-        let x222 = x8 * libm::fma(0.5692, x203, x206);
-        let x223 = libm::fma(qd[5], x214, -libm::fma(s_q5, x200, c_q5 * x203));
-        let x224 = libm::fma(-qd[5], x213, libm::fma(-c_q5, x200, s_q5 * x203));
-        let x225 = libm::fma(-qd[5], x217, libm::fma(s_q5, x202, c_q5 * x221));
-        let x226 = libm::fma(-qd[5], x216, libm::fma(-s_q5, x221, c_q5 * x202));
-        let x227 = 12.13 * x213;
-        let x228 = 12.13 * x214;
-        let x229 = 3.061 * x219;
-        let x230 = 105.98 * x216;
-        let x231 = 105.98 * x217;
-        let x232 = 105.98 * x218;
-        let x233 = libm::fma(s_q6, x219, c_q6 * x214);
-        let x234 = libm::fma(-s_q6, x214, c_q6 * x219);
-        let x235 = libm::fma(-0.7026, x213, x217);
-        let x236 = x10 * libm::fma(-0.7026, x214, x216);
-        let x237 = libm::fma(-c_q6, x235, s_q6 * x218);
-        let x238 = libm::fma(c_q6, x218, s_q6 * x235);
-        let x239 = libm::fma(x10, x213, qd[6]);
-        let x240 = libm::fma(0.7026, x223, x226);
-        let x241 = 9.336 * x239;
-        let x242 = 44.41 * x233;
-        let x243 = 44.41 * x234;
-        let x244 = 243.66 * x236;
-        let x245 = 243.66 * x237;
-        let x246 = 243.66 * x238;
-        let x247 = libm::fma(
-            9.336,
-            x10 * x223,
-            libm::fma(-x234, x242, x233 * x243) + libm::fma(-x238, x245, x237 * x246),
+        let x134 = libm::fma(7.11, x117, x103);
+        let x135 = x118 + libm::fma(0.475, x116, x132);
+        let x136 = libm::fma(qd[3], x125, libm::fma(s_q3, x117, c_q3 * x116));
+        let x137 = libm::fma(qd[3], x124, libm::fma(-s_q3, x116, c_q3 * x117));
+        let x138 = libm::fma(qd[3], x129, libm::fma(c_q3, x135, s_q3 * x133));
+        let x139 = libm::fma(1375.0472756800002, x131, -24989.305802 * x124);
+        let x140 = 3239.4582 * x127;
+        let x141 = libm::fma(
+            x130,
+            -3239.4582,
+            libm::fma(24998.827802, x131, 1375.0472756800002 * x124),
         );
-        let x248 = libm::fma(
-            44.41,
-            libm::fma(qd[6], x234, libm::fma(s_q6, x220, c_q6 * x224)),
-            libm::fma(-x239, x243, x234 * x241) + libm::fma(-x236, x246, x238 * x244),
+        let x142 = x125 * -3239.4582;
+        let x143 = 3239.4582 * x131;
+        let x144 = libm::fma(-s_q4, x125, c_q4 * x124);
+        let x145 = libm::fma(c_q4, x125, s_q4 * x124);
+        let x146 = libm::fma(-7.11, x125, x127);
+        let x147 = libm::fma(-7.11, x131, x130);
+        let x148 = libm::fma(-s_q4, x147, c_q4 * x129);
+        let x149 = libm::fma(c_q4, x147, s_q4 * x129);
+        let x150 = qd[4] + x131;
+        let x151 = libm::fma(qd[4], x145, libm::fma(s_q4, x137, c_q4 * x136));
+        let x152 = libm::fma(qd[4], x144, libm::fma(-s_q4, x136, c_q4 * x137));
+        let x153 = -97.44448770720001 * x150;
+        let x154 = libm::fma(-171.195516, x146, 132.6783695416 * x144);
+        let x155 = libm::fma(
+            -171.195516,
+            x148,
+            libm::fma(-97.44448770720001, x145, 135.4729695416 * x150),
         );
-        let x249 = libm::fma(
-            44.41,
-            libm::fma(-qd[6], x233, libm::fma(-s_q6, x224, c_q6 * x220)),
-            libm::fma(-x233, x241, x239 * x242) + libm::fma(-x237, x244, x236 * x245),
-        );
-        let x250 = libm::fma(
-            243.66,
-            libm::fma(qd[6], x238, libm::fma(s_q6, x222, c_q6 * x240)),
-            libm::fma(-x239, x246, x234 * x244),
-        );
-        let x251 = libm::fma(
-            243.66,
-            libm::fma(-qd[6], x237, libm::fma(-s_q6, x240, c_q6 * x222)),
-            libm::fma(-x233, x244, x239 * x245),
-        );
-        let x252 = x10
-            * libm::fma(
-                243.66,
-                x10 * libm::fma(-0.7026, x224, x225),
-                libm::fma(-x234, x245, x233 * x246),
-            );
-        let x253 = libm::fma(-s_q6, x251, c_q6 * x250);
-        let x254 = libm::fma(
-            12.13,
-            x223,
-            libm::fma(-x219, x228, x214 * x229) + libm::fma(-x217, x232, x218 * x231),
-        ) + libm::fma(0.7026, x253, x10 * x247);
-        let x255 = libm::fma(
-            12.13,
-            x224,
-            libm::fma(-x213, x229, x219 * x227) + libm::fma(-x216, x232, x218 * x230),
-        ) + libm::fma(-0.7026, x252, libm::fma(-s_q6, x249, c_q6 * x248));
-        let x256 = libm::fma(
-            3.061,
-            x220,
-            libm::fma(-x214, x227, x213 * x228) + libm::fma(-x216, x231, x217 * x230),
-        ) + libm::fma(c_q6, x249, s_q6 * x248);
-        let x257 = libm::fma(105.98, x225, libm::fma(x214, x232, x219 * x231)) + x252;
-        let x258 = libm::fma(105.98, x226, libm::fma(-x213, x232, x219 * x230)) + x253;
-        let x259 = libm::fma(-s_q5, x258, c_q5 * x257);
-        let x260 = x8
-            * (libm::fma(105.98, x222, -libm::fma(x213, x231, x214 * x230))
-                + libm::fma(c_q6, x251, s_q6 * x250));
-        let x261 = libm::fma(
-            -8.305,
-            x203,
-            libm::fma(-x194, x208, x199 * x209) + libm::fma(-x197, x212, x198 * x211),
-        ) + libm::fma(-0.5692, x260, libm::fma(-s_q5, x255, c_q5 * x254));
-        let x262 = libm::fma(
-            -3.061,
-            x200,
-            libm::fma(-x193, x209, x194 * x207) + libm::fma(-x196, x212, x198 * x210),
-        ) + libm::fma(c_q5, x255, s_q5 * x254);
-        let x263 = libm::fma(
-            8.0386,
-            x204,
-            libm::fma(-x199, x207, x193 * x208) + libm::fma(-x196, x211, x197 * x210),
-        ) + libm::fma(0.5692, x259, x8 * x256);
-        let x264 = libm::fma(105.98, x205, libm::fma(x199, x212, x194 * x211)) + x259;
-        let x265 = libm::fma(105.98, x206, -libm::fma(x193, x211, x199 * x210)) + x260;
-        let x266 = x6
-            * (libm::fma(105.98, x202, libm::fma(-x193, x212, x194 * x210))
-                + libm::fma(c_q5, x258, s_q5 * x257));
-        let x267 = libm::fma(-s_q4, x264, c_q4 * x265);
-        let x268 = libm::fma(-x172, x188, x178 * x189)
-            + libm::fma(-x176, x192, x177 * x191) - libm::fma(-39.95, x179, 9.522 * x183)
-            + libm::fma(s_q4, x263, c_q4 * x261);
-        let x269 = libm::fma(-x171, x189, x172 * x187)
-            + libm::fma(-x175, x192, x177 * x190)
-            - libm::fma(1966.28, x179, -39.95 * x183)
-            + libm::fma(-7.11, x267, x6 * x262);
-        let x270 = libm::fma(
-            1966.28,
-            x184,
-            libm::fma(-x178, x187, x171 * x188) + libm::fma(-x175, x191, x176 * x190),
-        ) + libm::fma(7.11, x266, libm::fma(-s_q4, x261, c_q4 * x263));
-        let x271 = libm::fma(279.2, x185, libm::fma(x178, x192, x172 * x191))
-            + libm::fma(s_q4, x265, c_q4 * x264);
-        let x272 = libm::fma(279.2, x186, -libm::fma(x171, x191, x178 * x190)) + x267;
-        let x273 = libm::fma(s_q3, x272, c_q3 * x271);
-        let x274 = x4
-            * (libm::fma(279.2, x182, libm::fma(-x171, x192, x172 * x190)) + x266);
-        let x275 = libm::fma(-s_q3, x271, c_q3 * x272);
-        let x276 = libm::fma(-x151, x166, x157 * x167)
-            + libm::fma(-x156, x169, x155 * x170) - libm::fma(49.52, x158, 15.41 * x161)
-            + libm::fma(-0.475, x275, libm::fma(s_q3, x270, c_q3 * x268));
-        let x277 = libm::fma(-x150, x167, x151 * x165)
-            + libm::fma(-x156, x168, x154 * x170)
-            - libm::fma(2094.71, x158, 49.52 * x161) + libm::fma(-7.11, x275, x4 * x269);
-        let x278 = libm::fma(
-            2103.19,
-            x162,
-            libm::fma(-x157, x165, x150 * x166) + libm::fma(-x154, x169, x155 * x168),
-        ) + (libm::fma(-s_q3, x268, c_q3 * x270) + libm::fma(7.11, x274, 0.475 * x273));
-        let x279 = libm::fma(314.88, x163, libm::fma(-x157, x170, x151 * x169)) + x273;
-        let x280 = libm::fma(314.88, x164, -libm::fma(x150, x169, x157 * x168)) + x275;
-        let x281 = libm::fma(s_q2, x280, c_q2 * x279);
-        let x282 = libm::fma(-x136, x146, x137 * x145)
-            + libm::fma(-x140, x148, x139 * x149)
-            + libm::fma(0.5692, x281, libm::fma(-s_q2, x276, c_q2 * x278));
-        let x283 = libm::fma(
+        let x156 = 171.195516 * x150;
+        let x157 = -171.195516 * x144;
+        let x158 = libm::fma(-x144, x157, x150 * x156);
+        let x159 = libm::fma(x145, x157, 171.195516 * x101);
+        let x160 = libm::fma(-x145, x156, -171.195516 * x151);
+        let x161 = libm::fma(s_q5, x150, c_q5 * x144);
+        let x162 = libm::fma(-s_q5, x144, c_q5 * x150);
+        let x163 = qd[5] + x145;
+        let x164 = 44.41 * x162;
+        let x165 = 47.471 * x163;
+        let x166 = 9.336 * libm::fma(qd[5], x162, -libm::fma(s_q5, x101, c_q5 * x151));
+        let x167 = 9.336 * (qd[6] + x161);
+        let x168 = libm::fma(-s_q6, x162, c_q6 * x163) * x167;
+        let x169 = libm::fma(s_q6, x163, c_q6 * x162) * x167;
+        let x170 = libm::fma(-x163, x164, x162 * x165) + x166;
+        let x171 = libm::fma(
+            -x161,
+            x165,
+            44.41 * libm::fma(-qd[5], x161, libm::fma(-c_q5, x101, s_q5 * x151)),
+        ) + libm::fma(s_q6, x169, c_q6 * x168);
+        let x172 = libm::fma(x161, x164, 47.471 * x152)
+            + libm::fma(-c_q6, x169, s_q6 * x168);
+        let x173 = libm::fma(
+            -132.6783695416,
+            x151,
+            171.195516 * libm::fma(7.11, x137, x134),
+        ) + libm::fma(x149, x157, libm::fma(-x145, x155, x150 * x153))
+            + libm::fma(-s_q5, x171, c_q5 * x170);
+        let x174 = libm::fma(
+            -171.195516,
+            libm::fma(
+                -qd[4],
+                x149,
+                libm::fma(
+                    -s_q4,
+                    x132 + x138,
+                    c_q4 * libm::fma(-qd[3], x130, libm::fma(-s_q3, x135, c_q3 * x133)),
+                ),
+            ),
+            libm::fma(-135.4729695416, x101, -97.44448770720001 * x152),
+        ) + libm::fma(-x149, x156, libm::fma(-x144, x153, x145 * x154))
+            + libm::fma(c_q5, x171, s_q5 * x170);
+        let x175 = libm::fma(
+            97.44448770720001,
+            x101,
+            libm::fma(-x150, x154, x144 * x155) - libm::fma(x148, x157, x146 * x156),
+        ) + x172;
+        let x176 = libm::fma(-s_q4, x159, c_q4 * x158);
+        let x177 = libm::fma(x127, x143, x130 * x142)
+            - libm::fma(x131, x140, x125 * x141)
+            - libm::fma(1375.0472756800002, x101, -24989.305802 * x136)
+            + libm::fma(s_q4, x175, c_q4 * x173);
+        let x178 = libm::fma(
+            x138,
+            -3239.4582,
+            -libm::fma(24998.827802, x101, 1375.0472756800002 * x136),
+        ) + libm::fma(x129, x143, libm::fma(x124, x140, x125 * x139))
+            + libm::fma(-7.11, x176, x174);
+        let x179 = libm::fma(
+            3239.4582,
+            x134,
+            libm::fma(-x129, x142, libm::fma(-x131, x139, x124 * x141)),
+        ) + libm::fma(7.11, x160, libm::fma(-s_q4, x173, c_q4 * x175));
+        let x180 = libm::fma(-x131, x143, x125 * x142)
+            + libm::fma(s_q4, x158, c_q4 * x159);
+        let x181 = libm::fma(x137, 3239.4582, x124 * x143) + x160;
+        let x182 = libm::fma(-x124, x142, 3239.4582 * x101) + x176;
+        let x183 = libm::fma(s_q3, x182, c_q3 * x180);
+        let x184 = libm::fma(-s_q3, x180, c_q3 * x182);
+        let x185 = libm::fma(-x113, x122, x99 * x123)
+            - libm::fma(x114, x120, x109 * x121)
+            - libm::fma(3946.18812068, x101, -39234.47412200001 * x116)
+            + libm::fma(-0.475, x184, libm::fma(s_q3, x179, c_q3 * x177));
+        let x186 = libm::fma(
+            x118,
+            -5224.5702,
+            -libm::fma(39241.404122, x101, 3946.1881206800003 * x116),
+        ) + libm::fma(x112, x123, libm::fma(x108, x120, x109 * x119))
+            + libm::fma(-7.11, x184, x178);
+        let x187 = libm::fma(
+            5224.5702,
+            x103,
+            libm::fma(-x112, x122, libm::fma(-x114, x119, x108 * x121)),
+        ) + (libm::fma(-s_q3, x177, c_q3 * x179) + libm::fma(7.11, x181, 0.475 * x183));
+        let x188 = libm::fma(-x114, x123, x109 * x122) + x183;
+        let x189 = libm::fma(-x108, x122, 5224.5702 * x101) + x184;
+        let x190 = libm::fma(s_q2, x189, c_q2 * x188);
+        let x191 = libm::fma(0.5692, x190, libm::fma(-s_q2, x185, c_q2 * x187))
+            - libm::fma(1145.5438279999998, x102, libm::fma(x99, x106, x95 * x104));
+        let x192 = libm::fma(
             -0.7026,
             libm::fma(
                 c_q1,
-                libm::fma(
-                    x2,
-                    libm::fma(314.88, x160, libm::fma(x150, x170, x151 * x168)) + x274,
-                    libm::fma(-qd[1], x148, 105.98 * x144),
-                ),
-                s_q1 * (libm::fma(-105.98, x143, qd[1] * x149) + x281),
+                libm::fma(-qd[1], x106, x95 * x107)
+                    + (libm::fma(x117, 5224.5702, x108 * x123) + x181),
+                s_q1 * libm::fma(x96, x107, x190),
             ),
             libm::fma(
                 -s_q1,
-                libm::fma(
-                    x2,
-                    x277,
-                    libm::fma(-3.061, x142, libm::fma(-x136, x147, qd[1] * x145)),
-                ),
+                x186
+                    - libm::fma(
+                        -65693.9112265768,
+                        x101,
+                        libm::fma(x98, x107, x95 * x105),
+                    ),
                 c_q1
-                    * (libm::fma(-8.088, x141, libm::fma(-x137, x147, qd[1] * x146))
+                    * (libm::fma(x99, x107, libm::fma(-x96, x105, qd[1] * x104))
                         + libm::fma(
                             -0.5692,
-                            libm::fma(-s_q2, x279, c_q2 * x280),
-                            libm::fma(s_q2, x278, c_q2 * x276),
+                            libm::fma(-s_q2, x188, c_q2 * x189),
+                            libm::fma(s_q2, x187, c_q2 * x185),
                         )),
             ),
         );
         (
             [
-                [x99, x100, x102, x108, x117, x125, x135],
-                [x100, x97, x101, x107, x116, x124, x134],
-                [x102, x101, x82, x104, x113, x122, x132],
-                [x108, x107, x104, x56, x109, x119, x129],
-                [x117, x116, x113, x109, x35, x27, x127],
-                [x125, x124, x122, x119, x27, x20, 0.0],
-                [x135, x134, x132, x129, x127, 0.0, 9.336],
+                [x71, x72, x73, x76, x84, x88, x94],
+                [x72, x69, x68, x75, x83, x87, x93],
+                [x73, x68, x59, x49, x80, 0.0, x8],
+                [x76, x75, x49, x35, x27, 0.0, x8],
+                [x84, x83, x80, x27, x13, 0.0, x8],
+                [x88, x87, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x94, x93, x8, x8, x8, 0.0, 9.336],
             ],
-            [x283, x282, x277, x269, x262, x256, x247],
+            [x192, x191, x186, x178, x174, x172, x166],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 774 mul, 566 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 426 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 334 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],
@@ -2410,732 +1884,585 @@ impl SsrmsFma {
     ) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x2 = c_q2 + (1.0 - c_q2);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x4 = c_q3 + (1.0 - c_q3);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x6 = c_q4 + (1.0 - c_q4);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x8 = c_q5 + (1.0 - c_q5);
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x10 = c_q6 + (1.0 - c_q6);
-        let x11 = 9.336 * x10;
-        let x12 = 44.41 * c_q6;
-        let x13 = 44.41 * s_q6;
-        let x14 = libm::fma(s_q6, x13, c_q6 * x12);
-        let x15 = s_q6 * x12;
-        let x16 = c_q6 * x13;
-        let x17 = x15 - x16;
-        let x18 = 12.13 + libm::fma(x10, x11, 120.2819695416);
-        let x19 = 12.13 + (x14 + 120.2819695416);
-        let x20 = 3.061 + x14;
-        let x21 = x8 * -171.195516;
-        let x22 = c_q5 * x18;
-        let x23 = s_q5 * x19;
-        let x24 = s_q5 * x17;
-        let x25 = s_q5 * x18;
-        let x26 = c_q5 * x19;
-        let x27 = c_q5 * x17;
-        let x28 = x8 * (x16 - x15);
-        let x29 = x8 * x20;
-        let x30 = libm::fma(-c_q5, x23, s_q5 * x22);
-        let x31 = x8 * x24;
-        let x32 = s_q5 * x28;
-        let x33 = libm::fma(x21, 0.5692, c_q5 * x28);
-        let x34 = 8.305 + (libm::fma(s_q5, x23, c_q5 * x22) + 113.27938808960002);
-        let x35 = 3.061 + libm::fma(c_q5, x26, s_q5 * x25);
-        let x36 = 8.0386 + libm::fma(x8, x29, 113.27938808960002);
-        let x37 = s_q4 * x21;
-        let x38 = x6 * -199.01508800000002;
-        let x39 = c_q4 * x21;
-        let x40 = x37 + 3239.4582;
-        let x41 = libm::fma(-s_q4, x32, c_q4 * x34);
-        let x42 = libm::fma(s_q4, x33, c_q4 * x30);
-        let x43 = libm::fma(-c_q4, x31, s_q4 * x36);
-        let x44 = x6 * libm::fma(-s_q5, x26, c_q5 * x25);
-        let x45 = x6 * x35;
-        let x46 = x6 * libm::fma(0.5692, x21, x8 * x27);
-        let x47 = libm::fma(c_q4, x32, s_q4 * x34);
-        let x48 = libm::fma(-s_q4, x30, c_q4 * x33);
-        let x49 = libm::fma(c_q4, x36, s_q4 * x31);
-        let x50 = x6 * x48;
-        let x51 = x37 * -7.11;
-        let x52 = libm::fma(-7.11, x39, libm::fma(-c_q4, x47, s_q4 * x49));
-        let x53 = libm::fma(x39, -7.11, libm::fma(-s_q4, x41, c_q4 * x43));
-        let x54 = 9.522 + libm::fma(s_q4, x43, c_q4 * x41);
-        let x55 = -39.95 + libm::fma(-7.11, x38, x6 * x42);
-        let x56 = 1966.28 + libm::fma(7.11, x40, libm::fma(x6, x45, -x51));
-        let x57 = 1966.28
-            + libm::fma(
-                x40,
-                7.11,
-                libm::fma(7.11, x37, libm::fma(c_q4, x49, s_q4 * x47)),
-            );
-        let x58 = s_q3 * x39;
-        let x59 = libm::fma(c_q3, x40, x58);
-        let x60 = x4 * x38;
-        let x61 = c_q3 * x39;
-        let x62 = libm::fma(-s_q3, x40, x61);
-        let x63 = x59 + 5224.5702;
-        let x64 = x60 + -349.0395;
-        let x65 = libm::fma(s_q3, x52, c_q3 * x54);
-        let x66 = libm::fma(s_q3, x50, c_q3 * x55);
-        let x67 = libm::fma(s_q3, x57, c_q3 * x53);
-        let x68 = x4
-            * (-39.95 + libm::fma(x38, -7.11, libm::fma(s_q4, x46, c_q4 * x44)));
-        let x69 = x4 * x56;
-        let x70 = x4 * libm::fma(-s_q4, x44, c_q4 * x46);
-        let x71 = libm::fma(-s_q3, x54, c_q3 * x52);
-        let x72 = libm::fma(-s_q3, x55, c_q3 * x50);
-        let x73 = libm::fma(-s_q3, x53, c_q3 * x57);
-        let x74 = -0.475 * x59;
-        let x75 = -7.11 * x59;
-        let x76 = x62 * 0.475;
-        let x77 = libm::fma(-7.11, x62, libm::fma(s_q3, x73, c_q3 * x71));
-        let x78 = libm::fma(x4, x72, x76);
-        let x79 = libm::fma(-7.11, x62, libm::fma(-s_q3, x65, c_q3 * x67));
-        let x80 = 15.41
-            + libm::fma(
-                x64,
-                -0.475,
-                libm::fma(-0.475, x60, libm::fma(s_q3, x67, c_q3 * x65)),
-            );
-        let x81 = 49.52 + libm::fma(-7.11, x64, libm::fma(x4, x66, -x74));
-        let x82 = 2094.71 + libm::fma(7.11, x63, libm::fma(x4, x69, -x75));
-        let x83 = 2103.19
-            + (libm::fma(-s_q3, x71, c_q3 * x73) - libm::fma(-7.11, x59, x60 * 0.475)
-                - libm::fma(0.475, x64, -7.11 * x63));
-        let x84 = s_q2 * x62;
-        let x85 = libm::fma(c_q2, x63, x84);
-        let x86 = x2 * x64;
-        let x87 = c_q2 * x62;
-        let x88 = libm::fma(-s_q2, x63, x87);
-        let x89 = x86 + -597.4892399999999;
-        let x90 = libm::fma(s_q2, x77, c_q2 * x80);
-        let x91 = libm::fma(s_q2, x78, c_q2 * x81);
-        let x92 = libm::fma(s_q2, x83, c_q2 * x79);
-        let x93 = x2
-            * (49.52
-                + libm::fma(
-                    x63,
-                    0.475,
-                    libm::fma(-7.11, x60, libm::fma(s_q3, x70, c_q3 * x68)),
-                ));
-        let x94 = x2 * x82;
-        let x95 = x2 * libm::fma(0.475, x62, libm::fma(-s_q3, x68, c_q3 * x70));
-        let x96 = -0.5692 * x85;
-        let x97 = (c_q1 + (1.0 - c_q1)) * x88;
-        let x98 = libm::fma(
+        let x6 = 9.336 * c_q5;
+        let x7 = 44.41 * s_q5;
+        let x8 = 9.336 * s_q5;
+        let x9 = 44.41 * c_q5;
+        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
+        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
+        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
+        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
+        let x14 = -171.195516 * s_q4;
+        let x15 = -171.195516 * c_q4;
+        let x16 = c_q4 * x12;
+        let x17 = -97.44448770720001 * s_q4;
+        let x18 = libm::fma(c_q4, x10, x17);
+        let x19 = 47.471 * s_q4;
+        let x20 = s_q4 * x12;
+        let x21 = -97.44448770720001 * c_q4;
+        let x22 = libm::fma(-s_q4, x10, x21);
+        let x23 = 47.471 * c_q4;
+        let x24 = libm::fma(-s_q4, x11, x21);
+        let x25 = x14 * -7.11;
+        let x26 = 7.11 * x14;
+        let x27 = x13 - x25;
+        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
+        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
+        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
+        let x31 = 3239.4582 + x14;
+        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
+        let x33 = 1375.0472756800002 + x18;
+        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
+        let x35 = 24998.827802 + (x26 + x27);
+        let x36 = s_q3 * x15;
+        let x37 = libm::fma(c_q3, x31, x36);
+        let x38 = c_q3 * x15;
+        let x39 = libm::fma(-s_q3, x31, x38);
+        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
+        let x41 = s_q3 * x22;
+        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
+        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
+        let x44 = c_q3 * x22;
+        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
+        let x46 = -7.11 * x37;
+        let x47 = 7.11 * x37;
+        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
+        let x49 = x35 - x46;
+        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
+        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
+        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
+        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
+        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
+        let x55 = 5224.5702 + x37;
+        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
+        let x57 = 3946.18812068 + x48;
+        let x58 = 3946.1881206800003
+            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
+        let x59 = 39241.404122 + (x47 + x49);
+        let x60 = s_q2 * x39;
+        let x61 = libm::fma(c_q2, x55, x60);
+        let x62 = c_q2 * x39;
+        let x63 = libm::fma(-s_q2, x55, x62);
+        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
+        let x65 = s_q2 * x51;
+        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
+        let x67 = c_q2 * x51;
+        let x68 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
+        let x69 = libm::fma(
             -0.7026,
-            libm::fma(-s_q1, x89, c_q1 * x85),
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
             libm::fma(
                 -s_q1,
-                libm::fma(0.5692, x88, libm::fma(-s_q2, x93, c_q2 * x95)),
-                c_q1 * libm::fma(-s_q2, x90, c_q2 * x92),
+                libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
+                c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
             ),
         );
-        let x99 = libm::fma(
+        let x70 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x68));
+        let x71 = libm::fma(-s_q2, x37, x62);
+        let x72 = libm::fma(
             -0.7026,
-            s_q1 * x88,
-            libm::fma(-s_q1, x94, c_q1 * (x91 - x96)),
-        );
-        let x100 = x66 - x74;
-        let x101 = x69 - x75;
-        let x102 = x72 + x76;
-        let x103 = libm::fma(-s_q2, x59, x87);
-        let x104 = libm::fma(
-            -0.7026,
-            s_q1 * x103,
+            s_q1 * x71,
             libm::fma(
                 -s_q1,
-                x2 * x101,
+                x49,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x59, x84),
-                        libm::fma(s_q2, x102, c_q2 * x100),
+                        libm::fma(c_q2, x37, x60),
+                        libm::fma(c_q2, x48, x65),
                     ),
             ),
         );
-        let x105 = x45 - x51;
-        let x106 = libm::fma(-s_q3, x37, x61);
-        let x107 = libm::fma(c_q3, x37, x58);
-        let x108 = libm::fma(0.475, x107, libm::fma(s_q3, x48, c_q3 * x42));
-        let x109 = libm::fma(7.11, x107, x4 * x105);
-        let x110 = libm::fma(0.475, x106, libm::fma(-s_q3, x42, c_q3 * x48));
-        let x111 = libm::fma(-s_q2, x107, c_q2 * x106);
-        let x112 = libm::fma(
+        let x73 = libm::fma(-s_q3, x14, x38);
+        let x74 = libm::fma(c_q3, x14, x36);
+        let x75 = libm::fma(0.475, x74, libm::fma(c_q3, x18, x41));
+        let x76 = libm::fma(7.11, x74, x27);
+        let x77 = libm::fma(0.475, x73, libm::fma(-s_q3, x18, x44));
+        let x78 = libm::fma(-s_q2, x74, c_q2 * x73);
+        let x79 = libm::fma(
             -0.7026,
-            s_q1 * x111,
+            s_q1 * x78,
             libm::fma(
                 -s_q1,
-                x2 * x109,
+                x76,
                 c_q1
                     * libm::fma(
                         0.5692,
-                        libm::fma(c_q2, x107, s_q2 * x106),
-                        libm::fma(s_q2, x110, c_q2 * x108),
+                        libm::fma(c_q2, x74, s_q2 * x73),
+                        libm::fma(s_q2, x77, c_q2 * x75),
                     ),
             ),
         );
-        let x113 = libm::fma(-c_q4, x24, s_q4 * x29);
-        let x114 = x6 * x27;
-        let x115 = libm::fma(c_q4, x29, s_q4 * x24);
-        let x116 = libm::fma(s_q3, x115, c_q3 * x113);
-        let x117 = x4 * x114;
-        let x118 = libm::fma(-s_q3, x113, c_q3 * x115);
-        let x119 = libm::fma(
-            -s_q1,
-            x2 * x117,
-            c_q1 * libm::fma(s_q2, x118, c_q2 * x116),
+        let x80 = libm::fma(s_q3, x23, c_q3 * x19);
+        let x81 = libm::fma(-s_q3, x19, c_q3 * x23);
+        let x82 = c_q1 * libm::fma(s_q2, x81, c_q2 * x80);
+        let x83 = c_q4 * x6;
+        let x84 = s_q4 * x6;
+        let x85 = libm::fma(-s_q3, x84, c_q3 * x83);
+        let x86 = libm::fma(c_q3, x84, s_q3 * x83);
+        let x87 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x86, c_q2 * x85));
+        let x88 = qd[0] * c_q1;
+        let x89 = qd[0] * s_q1;
+        let x90 = 0.7026 * qd[0];
+        let x91 = s_q1 * x90;
+        let x92 = c_q1 * x90;
+        let x93 = qd[1] * x89;
+        let x94 = qd[1] * x88;
+        let x95 = qd[1] * x92;
+        let x96 = qd[1] * x91;
+        let x97 = -65693.9112265768 * x89;
+        let x98 = libm::fma(-1145.5438279999998, x91, 65697.3302265768 * qd[1]);
+        let x99 = -1145.5438279999998 * qd[1];
+        let x100 = 1145.5438279999998 * x88;
+        let x101 = libm::fma(-qd[1], s_q2, c_q2 * x88);
+        let x102 = libm::fma(qd[1], c_q2, s_q2 * x88);
+        let x103 = 0.5692 * x88;
+        let x104 = libm::fma(-0.5692, qd[1], x91);
+        let x105 = libm::fma(-c_q2, x104, s_q2 * x103);
+        let x106 = libm::fma(c_q2, x103, s_q2 * x104);
+        let x107 = qd[2] - x89;
+        let x108 = 0.5692 * x93;
+        let x109 = libm::fma(qd[2], x102, c_q2 * x93);
+        let x110 = libm::fma(-s_q2, x93, qd[2] * x101);
+        let x111 = libm::fma(qd[2], x105, libm::fma(-s_q2, x95, c_q2 * x108));
+        let x112 = libm::fma(3946.18812068, x107, -39234.47412200001 * x101);
+        let x113 = 5224.5702 * x92;
+        let x114 = libm::fma(
+            x106,
+            5224.5702,
+            libm::fma(39241.404122, x107, 3946.1881206800003 * x101),
         );
-        let x120 = c_q5 * x11;
-        let x121 = s_q5 * x11;
-        let x122 = c_q4 * x120;
-        let x123 = x6 * x121;
-        let x124 = s_q4 * x120;
-        let x125 = libm::fma(-s_q3, x124, c_q3 * x122);
-        let x126 = x4 * x123;
-        let x127 = libm::fma(c_q3, x124, s_q3 * x122);
-        let x128 = libm::fma(
-            -s_q1,
-            x2 * x126,
-            c_q1 * libm::fma(-s_q2, x127, c_q2 * x125),
+        let x115 = x102 * -5224.5702;
+        let x116 = 5224.5702 * x107;
+        let x117 = libm::fma(-s_q3, x102, c_q3 * x101);
+        let x118 = libm::fma(c_q3, x102, s_q3 * x101);
+        let x119 = libm::fma(0.475, x102, x105);
+        let x120 = libm::fma(-7.11, x102, x92);
+        let x121 = x106 + libm::fma(7.11, x107, 0.475 * x101);
+        let x122 = libm::fma(s_q3, x121, c_q3 * x119);
+        let x123 = libm::fma(-c_q3, x121, s_q3 * x119);
+        let x124 = qd[3] + x107;
+        let x125 = 7.11 * x94;
+        let x126 = libm::fma(
+            0.475,
+            x110,
+            libm::fma(qd[2], x106, -libm::fma(s_q2, x108, c_q2 * x95)),
         );
-        let x129 = qd[0] * c_q1;
-        let x130 = qd[0] * s_q1;
-        let x131 = 0.7026 * qd[0];
-        let x132 = s_q1 * x131;
-        let x133 = c_q1 * x131;
-        let x134 = qd[1] * x130;
-        let x135 = qd[1] * x129;
-        let x136 = qd[1] * x133;
-        let x137 = qd[1] * x132;
-        let x138 = 8.088 * x129;
-        let x139 = 3.061 * x130;
-        let x140 = 8.446 * qd[1];
-        let x141 = 105.98 * x132;
-        let x142 = 105.98 * x133;
-        let x143 = libm::fma(-qd[1], s_q2, c_q2 * x129);
-        let x144 = libm::fma(qd[1], c_q2, s_q2 * x129);
-        let x145 = 0.5692 * x129;
-        let x146 = libm::fma(-0.5692, qd[1], x132);
-        let x147 = libm::fma(-c_q2, x146, s_q2 * x145);
-        let x148 = x2 * x133;
-        let x149 = libm::fma(c_q2, x145, s_q2 * x146);
-        let x150 = libm::fma(-x2, x130, qd[2]);
-        let x151 = x2 * x135;
-        let x152 = 0.5692 * x134;
-        let x153 = x2 * x137;
-        let x154 = libm::fma(qd[2], x144, c_q2 * x134);
-        let x155 = libm::fma(-s_q2, x134, qd[2] * x143);
-        let x156 = libm::fma(qd[2], x149, -libm::fma(s_q2, x152, c_q2 * x136));
-        let x157 = libm::fma(qd[2], x147, libm::fma(-s_q2, x136, c_q2 * x152));
-        let x158 = libm::fma(49.52, x150, 15.41 * x143);
-        let x159 = libm::fma(2094.71, x150, 49.52 * x143);
-        let x160 = 2103.19 * x144;
-        let x161 = 314.88 * x147;
-        let x162 = 314.88 * x148;
-        let x163 = 314.88 * x149;
-        let x164 = libm::fma(-s_q3, x144, c_q3 * x143);
-        let x165 = libm::fma(c_q3, x144, s_q3 * x143);
-        let x166 = libm::fma(0.475, x144, x147);
-        let x167 = x149 + libm::fma(7.11, x150, 0.475 * x143);
-        let x168 = libm::fma(s_q3, x167, c_q3 * x166);
-        let x169 = x4 * libm::fma(-7.11, x144, x148);
-        let x170 = libm::fma(-c_q3, x167, s_q3 * x166);
-        let x171 = libm::fma(x4, x150, qd[3]);
-        let x172 = x4 * x151;
-        let x173 = libm::fma(0.475, x155, x156);
-        let x174 = x157 + libm::fma(7.11, x151, 0.475 * x154);
-        let x175 = x4 * libm::fma(7.11, x155, x153);
-        let x176 = libm::fma(qd[3], x165, libm::fma(s_q3, x155, c_q3 * x154));
-        let x177 = libm::fma(qd[3], x164, libm::fma(-s_q3, x154, c_q3 * x155));
-        let x178 = libm::fma(-qd[3], x170, libm::fma(-s_q3, x174, c_q3 * x173));
-        let x179 = libm::fma(qd[3], x168, libm::fma(c_q3, x174, s_q3 * x173));
-        let x180 = libm::fma(-39.95, x171, 9.522 * x164);
-        let x181 = libm::fma(1966.28, x171, -39.95 * x164);
-        let x182 = 1966.28 * x165;
-        let x183 = 279.2 * x168;
-        let x184 = 279.2 * x169;
-        let x185 = 279.2 * x170;
-        let x186 = libm::fma(-s_q4, x165, c_q4 * x164);
-        let x187 = libm::fma(c_q4, x165, s_q4 * x164);
-        let x188 = libm::fma(-7.11, x171, x170);
-        let x189 = libm::fma(-s_q4, x188, c_q4 * x168);
-        let x190 = x6 * libm::fma(-7.11, x165, x169);
-        let x191 = libm::fma(c_q4, x188, s_q4 * x168);
-        let x192 = libm::fma(x6, x171, qd[4]);
-        let x193 = x6 * x172;
-        let x194 = libm::fma(7.11, x172, x179);
-        let x195 = x6 * libm::fma(7.11, x177, x175);
-        let x196 = libm::fma(qd[4], x187, libm::fma(s_q4, x177, c_q4 * x176));
-        let x197 = libm::fma(qd[4], x186, libm::fma(-s_q4, x176, c_q4 * x177));
-        let x198 = libm::fma(-qd[4], x191, libm::fma(-s_q4, x194, c_q4 * x178));
-        let x199 = libm::fma(qd[4], x189, libm::fma(c_q4, x194, s_q4 * x178));
-        let x200 = 8.305 * x186;
-        let x201 = 3.061 * x192;
-        let x202 = 8.0386 * x187;
-        let x203 = 105.98 * x189;
-        let x204 = 105.98 * x190;
-        let x205 = 105.98 * x191;
-        let x206 = libm::fma(s_q5, x192, c_q5 * x186);
-        let x207 = libm::fma(-s_q5, x186, c_q5 * x192);
-        let x208 = libm::fma(0.5692, x187, x189);
-        let x209 = libm::fma(-s_q5, x190, c_q5 * x208);
-        let x210 = libm::fma(c_q5, x190, s_q5 * x208);
-        let x211 = x8 * libm::fma(-0.5692, x186, x191);
-        let x212 = libm::fma(x8, x187, qd[5]);
-        let x213 = x8 * x197;
-        let x214 = libm::fma(0.5692, x197, x198);
-        let x215 = x8 * libm::fma(0.5692, x196, x199);
-        let x216 = libm::fma(qd[5], x207, -libm::fma(s_q5, x193, c_q5 * x196));
-        let x217 = libm::fma(-qd[5], x206, libm::fma(-c_q5, x193, s_q5 * x196));
-        let x218 = libm::fma(-qd[5], x210, libm::fma(s_q5, x195, c_q5 * x214));
-        let x219 = libm::fma(-qd[5], x209, libm::fma(-s_q5, x214, c_q5 * x195));
-        let x220 = 12.13 * x206;
-        let x221 = 12.13 * x207;
-        let x222 = 3.061 * x212;
-        let x223 = 105.98 * x209;
-        let x224 = 105.98 * x210;
-        let x225 = 105.98 * x211;
-        let x226 = libm::fma(s_q6, x212, c_q6 * x207);
-        let x227 = libm::fma(-s_q6, x207, c_q6 * x212);
-        let x228 = libm::fma(-0.7026, x206, x210);
-        let x229 = x10 * libm::fma(-0.7026, x207, x209);
-        let x230 = libm::fma(-c_q6, x228, s_q6 * x211);
-        let x231 = libm::fma(c_q6, x211, s_q6 * x228);
-        let x232 = libm::fma(x10, x206, qd[6]);
-        let x233 = libm::fma(0.7026, x216, x219);
-        let x234 = 9.336 * x232;
-        let x235 = 44.41 * x226;
-        let x236 = 44.41 * x227;
-        let x237 = 243.66 * x229;
-        let x238 = 243.66 * x230;
-        let x239 = 243.66 * x231;
-        let x240 = libm::fma(
+        let x127 = libm::fma(7.11, x110, x96);
+        let x128 = x111 + libm::fma(0.475, x109, x125);
+        let x129 = libm::fma(qd[3], x118, libm::fma(s_q3, x110, c_q3 * x109));
+        let x130 = libm::fma(qd[3], x117, libm::fma(-s_q3, x109, c_q3 * x110));
+        let x131 = libm::fma(qd[3], x122, libm::fma(c_q3, x128, s_q3 * x126));
+        let x132 = libm::fma(1375.0472756800002, x124, -24989.305802 * x117);
+        let x133 = 3239.4582 * x120;
+        let x134 = libm::fma(
+            x123,
+            -3239.4582,
+            libm::fma(24998.827802, x124, 1375.0472756800002 * x117),
+        );
+        let x135 = x118 * -3239.4582;
+        let x136 = 3239.4582 * x124;
+        let x137 = libm::fma(-s_q4, x118, c_q4 * x117);
+        let x138 = libm::fma(c_q4, x118, s_q4 * x117);
+        let x139 = libm::fma(-7.11, x118, x120);
+        let x140 = libm::fma(-7.11, x124, x123);
+        let x141 = libm::fma(-s_q4, x140, c_q4 * x122);
+        let x142 = libm::fma(c_q4, x140, s_q4 * x122);
+        let x143 = qd[4] + x124;
+        let x144 = libm::fma(qd[4], x138, libm::fma(s_q4, x130, c_q4 * x129));
+        let x145 = libm::fma(qd[4], x137, libm::fma(-s_q4, x129, c_q4 * x130));
+        let x146 = -97.44448770720001 * x143;
+        let x147 = libm::fma(-171.195516, x139, 132.6783695416 * x137);
+        let x148 = libm::fma(
+            -171.195516,
+            x141,
+            libm::fma(-97.44448770720001, x138, 135.4729695416 * x143),
+        );
+        let x149 = 171.195516 * x143;
+        let x150 = -171.195516 * x137;
+        let x151 = libm::fma(s_q5, x143, c_q5 * x137);
+        let x152 = libm::fma(-s_q5, x137, c_q5 * x143);
+        let x153 = qd[5] + x138;
+        let x154 = 44.41 * x152;
+        let x155 = 47.471 * x153;
+        let x156 = 9.336 * (qd[6] + x151);
+        let x157 = libm::fma(
             9.336,
-            x10 * x216,
-            libm::fma(-x227, x235, x226 * x236) + libm::fma(-x231, x238, x230 * x239),
-        ) - f_ext[6][3];
-        let x241 = libm::fma(
-            44.41,
-            libm::fma(qd[6], x227, libm::fma(s_q6, x213, c_q6 * x217)),
-            libm::fma(-x232, x236, x227 * x234) + libm::fma(-x229, x239, x231 * x237),
-        ) - f_ext[6][4];
-        let x242 = libm::fma(
-            44.41,
-            libm::fma(-qd[6], x226, libm::fma(-s_q6, x217, c_q6 * x213)),
-            libm::fma(-x226, x234, x232 * x235) + libm::fma(-x230, x237, x229 * x238),
-        ) - f_ext[6][5];
-        let x243 = libm::fma(
-            243.66,
-            libm::fma(qd[6], x231, libm::fma(s_q6, x215, c_q6 * x233)),
-            libm::fma(-x232, x239, x227 * x237),
-        ) - f_ext[6][1];
-        let x244 = libm::fma(
-            243.66,
-            libm::fma(-qd[6], x230, libm::fma(-s_q6, x233, c_q6 * x215)),
-            libm::fma(-x226, x237, x232 * x238),
-        ) - f_ext[6][2];
-        let x245 = x10
-            * (libm::fma(
-                243.66,
-                x10 * libm::fma(-0.7026, x217, x218),
-                libm::fma(-x227, x238, x226 * x239),
-            ) - f_ext[6][0]);
-        let x246 = libm::fma(-s_q6, x244, c_q6 * x243);
-        let x247 = libm::fma(
-            12.13,
-            x216,
-            libm::fma(-x212, x221, x207 * x222) + libm::fma(-x210, x225, x211 * x224),
-        ) - f_ext[5][3] + libm::fma(0.7026, x246, x10 * x240);
-        let x248 = libm::fma(
-            12.13,
-            x217,
-            libm::fma(-x206, x222, x212 * x220) + libm::fma(-x209, x225, x211 * x223),
-        ) - f_ext[5][4] + libm::fma(-0.7026, x245, libm::fma(-s_q6, x242, c_q6 * x241));
-        let x249 = libm::fma(
-            3.061,
-            x213,
-            libm::fma(-x207, x220, x206 * x221) + libm::fma(-x209, x224, x210 * x223),
-        ) - f_ext[5][5] + libm::fma(c_q6, x242, s_q6 * x241);
-        let x250 = libm::fma(105.98, x218, libm::fma(x207, x225, x212 * x224))
-            - f_ext[5][0] + x245;
-        let x251 = libm::fma(105.98, x219, libm::fma(-x206, x225, x212 * x223))
-            - f_ext[5][1] + x246;
-        let x252 = libm::fma(-s_q5, x251, c_q5 * x250);
-        let x253 = x8
-            * (libm::fma(105.98, x215, -libm::fma(x206, x224, x207 * x223)) - f_ext[5][2]
-                + libm::fma(c_q6, x244, s_q6 * x243));
-        let x254 = libm::fma(
-            -8.305,
-            x196,
-            libm::fma(-x187, x201, x192 * x202) + libm::fma(-x190, x205, x191 * x204),
-        ) - f_ext[4][3] + libm::fma(-0.5692, x253, libm::fma(-s_q5, x248, c_q5 * x247));
-        let x255 = libm::fma(
-            -3.061,
-            x193,
-            libm::fma(-x186, x202, x187 * x200) + libm::fma(-x189, x205, x191 * x203),
-        ) - f_ext[4][4] + libm::fma(c_q5, x248, s_q5 * x247);
-        let x256 = libm::fma(
-            8.0386,
-            x197,
-            libm::fma(-x192, x200, x186 * x201) + libm::fma(-x189, x204, x190 * x203),
-        ) - f_ext[4][5] + libm::fma(0.5692, x252, x8 * x249);
-        let x257 = libm::fma(105.98, x198, libm::fma(x192, x205, x187 * x204))
-            - f_ext[4][0] + x252;
-        let x258 = libm::fma(105.98, x199, -libm::fma(x186, x204, x192 * x203))
-            - f_ext[4][2] + x253;
-        let x259 = x6
-            * (libm::fma(105.98, x195, libm::fma(-x186, x205, x187 * x203)) - f_ext[4][1]
-                + libm::fma(c_q5, x251, s_q5 * x250));
-        let x260 = libm::fma(-s_q4, x257, c_q4 * x258);
-        let x261 = libm::fma(-x165, x181, x171 * x182)
-            + libm::fma(-x169, x185, x170 * x184) - libm::fma(-39.95, x172, 9.522 * x176)
-            - f_ext[3][3] + libm::fma(s_q4, x256, c_q4 * x254);
-        let x262 = libm::fma(-x164, x182, x165 * x180)
-            + libm::fma(-x168, x185, x170 * x183)
-            - libm::fma(1966.28, x172, -39.95 * x176) - f_ext[3][4]
-            + libm::fma(-7.11, x260, x6 * x255);
-        let x263 = libm::fma(
-            1966.28,
-            x177,
-            libm::fma(-x171, x180, x164 * x181) + libm::fma(-x168, x184, x169 * x183),
-        ) - f_ext[3][5] + libm::fma(7.11, x259, libm::fma(-s_q4, x254, c_q4 * x256));
-        let x264 = libm::fma(279.2, x178, libm::fma(x171, x185, x165 * x184))
-            - f_ext[3][0] + libm::fma(s_q4, x258, c_q4 * x257);
-        let x265 = libm::fma(279.2, x179, -libm::fma(x164, x184, x171 * x183))
-            - f_ext[3][2] + x260;
-        let x266 = libm::fma(s_q3, x265, c_q3 * x264);
-        let x267 = x4
-            * (libm::fma(279.2, x175, libm::fma(-x164, x185, x165 * x183)) - f_ext[3][1]
-                + x259);
-        let x268 = libm::fma(-s_q3, x264, c_q3 * x265);
-        let x269 = libm::fma(-x144, x159, x150 * x160)
-            + libm::fma(-x149, x162, x148 * x163) - libm::fma(49.52, x151, 15.41 * x154)
-            - f_ext[2][3] + libm::fma(-0.475, x268, libm::fma(s_q3, x263, c_q3 * x261));
-        let x270 = libm::fma(-x143, x160, x144 * x158)
-            + libm::fma(-x149, x161, x147 * x163)
-            - libm::fma(2094.71, x151, 49.52 * x154) - f_ext[2][4]
-            + libm::fma(-7.11, x268, x4 * x262);
-        let x271 = libm::fma(
-            2103.19,
+            libm::fma(qd[5], x152, -libm::fma(s_q5, x94, c_q5 * x144)),
+            -f_ext[6][3],
+        );
+        let x158 = libm::fma(libm::fma(-s_q6, x152, c_q6 * x153), x156, -f_ext[6][4]);
+        let x159 = libm::fma(libm::fma(s_q6, x153, c_q6 * x152), x156, f_ext[6][5]);
+        let x160 = libm::fma(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
+        let x161 = libm::fma(-x153, x154, x152 * x155) - f_ext[5][3]
+            + libm::fma(0.7026, x160, x157);
+        let x162 = libm::fma(
+            -x151,
             x155,
-            libm::fma(-x150, x158, x143 * x159) + libm::fma(-x147, x162, x148 * x161),
+            44.41 * libm::fma(-qd[5], x151, libm::fma(-c_q5, x94, s_q5 * x144)),
+        ) - f_ext[5][4]
+            + libm::fma(0.7026, f_ext[6][0], libm::fma(s_q6, x159, c_q6 * x158));
+        let x163 = libm::fma(x151, x154, 47.471 * x145) - f_ext[5][5]
+            + libm::fma(-c_q6, x159, s_q6 * x158);
+        let x164 = f_ext[5][0] + f_ext[6][0];
+        let x165 = x160 - f_ext[5][1];
+        let x166 = f_ext[5][2] + libm::fma(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
+        let x167 = libm::fma(s_q5, x165, c_q5 * x164);
+        let x168 = libm::fma(
+            -132.6783695416,
+            x144,
+            171.195516 * libm::fma(7.11, x130, x127),
+        ) + libm::fma(x142, x150, libm::fma(-x138, x148, x143 * x146)) - f_ext[4][3]
+            + libm::fma(0.5692, x166, libm::fma(-s_q5, x162, c_q5 * x161));
+        let x169 = libm::fma(
+            -171.195516,
+            libm::fma(
+                -qd[4],
+                x142,
+                libm::fma(
+                    -s_q4,
+                    x125 + x131,
+                    c_q4 * libm::fma(-qd[3], x123, libm::fma(-s_q3, x128, c_q3 * x126)),
+                ),
+            ),
+            libm::fma(-135.4729695416, x94, -97.44448770720001 * x145),
+        ) + libm::fma(-x142, x149, libm::fma(-x137, x146, x138 * x147)) - f_ext[4][4]
+            + libm::fma(c_q5, x162, s_q5 * x161);
+        let x170 = libm::fma(
+            97.44448770720001,
+            x94,
+            libm::fma(-x143, x147, x137 * x148) - libm::fma(x141, x150, x139 * x149),
+        ) - f_ext[4][5] + libm::fma(-0.5692, x167, x163);
+        let x171 = libm::fma(x138, x150, 171.195516 * x94) - f_ext[4][0] - x167;
+        let x172 = libm::fma(-x138, x149, -171.195516 * x144) - f_ext[4][1]
+            + libm::fma(-s_q5, x164, c_q5 * x165);
+        let x173 = libm::fma(-x137, x150, x143 * x149) - f_ext[4][2] - x166;
+        let x174 = libm::fma(-s_q4, x171, c_q4 * x173);
+        let x175 = libm::fma(x120, x136, x123 * x135)
+            - libm::fma(x124, x133, x118 * x134)
+            - libm::fma(1375.0472756800002, x94, -24989.305802 * x129) - f_ext[3][3]
+            + libm::fma(s_q4, x170, c_q4 * x168);
+        let x176 = libm::fma(
+            x131,
+            -3239.4582,
+            -libm::fma(24998.827802, x94, 1375.0472756800002 * x129),
+        ) + libm::fma(x122, x136, libm::fma(x117, x133, x118 * x132)) - f_ext[3][4]
+            + libm::fma(-7.11, x174, x169);
+        let x177 = libm::fma(
+            3239.4582,
+            x127,
+            libm::fma(-x122, x135, libm::fma(-x124, x132, x117 * x134)),
+        ) - f_ext[3][5] + libm::fma(7.11, x172, libm::fma(-s_q4, x168, c_q4 * x170));
+        let x178 = libm::fma(-x124, x136, x118 * x135) - f_ext[3][0]
+            + libm::fma(s_q4, x173, c_q4 * x171);
+        let x179 = libm::fma(x130, 3239.4582, x117 * x136) - f_ext[3][1] + x172;
+        let x180 = libm::fma(-x117, x135, 3239.4582 * x94) - f_ext[3][2] + x174;
+        let x181 = libm::fma(s_q3, x180, c_q3 * x178);
+        let x182 = libm::fma(-s_q3, x178, c_q3 * x180);
+        let x183 = libm::fma(-x106, x115, x92 * x116)
+            - libm::fma(x107, x113, x102 * x114)
+            - libm::fma(3946.18812068, x94, -39234.47412200001 * x109) - f_ext[2][3]
+            + libm::fma(-0.475, x182, libm::fma(s_q3, x177, c_q3 * x175));
+        let x184 = libm::fma(
+            x111,
+            -5224.5702,
+            -libm::fma(39241.404122, x94, 3946.1881206800003 * x109),
+        ) + libm::fma(x105, x116, libm::fma(x101, x113, x102 * x112)) - f_ext[2][4]
+            + libm::fma(-7.11, x182, x176);
+        let x185 = libm::fma(
+            5224.5702,
+            x96,
+            libm::fma(-x105, x115, libm::fma(-x107, x112, x101 * x114)),
         ) - f_ext[2][5]
-            + (libm::fma(-s_q3, x261, c_q3 * x263)
-                + libm::fma(7.11, x267, 0.475 * x266));
-        let x272 = libm::fma(314.88, x156, libm::fma(-x150, x163, x144 * x162))
-            - f_ext[2][0] + x266;
-        let x273 = libm::fma(314.88, x157, -libm::fma(x143, x162, x150 * x161))
-            - f_ext[2][2] + x268;
-        let x274 = libm::fma(s_q2, x273, c_q2 * x272);
-        let x275 = tau[0]
+            + (libm::fma(-s_q3, x175, c_q3 * x177)
+                + libm::fma(7.11, x179, 0.475 * x181));
+        let x186 = libm::fma(-x107, x116, x102 * x115) - f_ext[2][0] + x181;
+        let x187 = libm::fma(-x101, x115, 5224.5702 * x94) - f_ext[2][2] + x182;
+        let x188 = libm::fma(s_q2, x187, c_q2 * x186);
+        let x189 = tau[0]
             - (libm::fma(
                 -0.7026,
                 libm::fma(
                     c_q1,
-                    libm::fma(
-                        x2,
-                        libm::fma(314.88, x153, libm::fma(x143, x163, x144 * x161))
-                            - f_ext[2][1] + x267,
-                        libm::fma(-qd[1], x141, 105.98 * x137) - f_ext[1][1],
-                    ),
-                    s_q1 * (libm::fma(-105.98, x136, qd[1] * x142) - f_ext[1][0] + x274),
+                    libm::fma(-qd[1], x99, x88 * x100) - f_ext[1][1]
+                        + (libm::fma(x110, 5224.5702, x101 * x116) - f_ext[2][1] + x179),
+                    s_q1 * (libm::fma(x89, x100, -f_ext[1][0]) + x188),
                 ),
                 libm::fma(
                     -s_q1,
-                    libm::fma(
-                        x2,
-                        x270,
-                        libm::fma(-3.061, x135, libm::fma(-x129, x140, qd[1] * x138))
-                            - f_ext[1][4],
-                    ),
+                    x184
+                        - (f_ext[1][4]
+                            + libm::fma(
+                                -65693.9112265768,
+                                x94,
+                                libm::fma(x91, x100, x88 * x98),
+                            )),
                     c_q1
-                        * (libm::fma(-8.088, x134, libm::fma(-x130, x140, qd[1] * x139))
+                        * (libm::fma(x92, x100, libm::fma(-x89, x98, qd[1] * x97))
                             - f_ext[1][3]
                             + libm::fma(
                                 -0.5692,
-                                libm::fma(-s_q2, x272, c_q2 * x273),
-                                libm::fma(s_q2, x271, c_q2 * x269),
+                                libm::fma(-s_q2, x186, c_q2 * x187),
+                                libm::fma(s_q2, x185, c_q2 * x183),
                             )),
                 ),
             ) - f_ext[0][3]);
-        let x276 = 1.0
-            / (12.19
+        let x190 = 1.0
+            / (66279.65991417361
                 + libm::fma(
                     0.7026,
-                    x97 + 811.9807679999999,
+                    x63,
                     libm::fma(
                         0.7026,
-                        x97,
+                        x63,
                         libm::fma(
                             -s_q1,
-                            libm::fma(
-                                -s_q1,
-                                libm::fma(x2, x94, 3.061),
-                                c_q1 * libm::fma(x2, x91, -x96),
-                            ),
+                            libm::fma(-s_q1, -65693.9112265768 + x59, x68),
                             c_q1
                                 * libm::fma(
                                     -s_q1,
-                                    libm::fma(0.5692, x85, libm::fma(s_q2, x95, c_q2 * x93)),
-                                    c_q1
-                                        * (8.088
-                                            + libm::fma(
-                                                -0.5692,
-                                                x89,
-                                                libm::fma(-0.5692, x86, libm::fma(s_q2, x92, c_q2 * x90)),
-                                            )),
+                                    libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
+                                    c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
                                 ),
                         ),
                     ),
                 ));
-        let x277 = x98 * x276;
-        let x278 = x99 * x276;
-        let x279 = x104 * x276;
-        let x280 = x112 * x276;
-        let x281 = x119 * x276;
-        let x282 = x128 * x276;
-        let x283 = 1.0
+        let x191 = x69 * x190;
+        let x192 = x70 * x190;
+        let x193 = x72 * x190;
+        let x194 = x79 * x190;
+        let x195 = x82 * x190;
+        let x196 = x87 * x190;
+        let x197 = 1.0
             / libm::fma(
-                -x98,
-                x277,
-                8.446
+                -x69,
+                x191,
+                65697.3302265768
                     + libm::fma(
-                        -0.5692,
-                        x89,
-                        libm::fma(
-                            -0.5692,
-                            x86,
-                            libm::fma(
-                                -s_q2,
-                                libm::fma(-s_q2, x80, c_q2 * x77),
-                                c_q2 * libm::fma(-s_q2, x79, c_q2 * x83),
-                            ),
-                        ),
+                        -s_q2,
+                        libm::fma(-s_q2, x56, c_q2 * x50),
+                        c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
                     ),
             );
-        let x284 = libm::fma(
-            -x98,
-            x278,
-            libm::fma(0.5692, x88, libm::fma(-s_q2, x81, c_q2 * x78)),
+        let x198 = libm::fma(
+            -x69,
+            x192,
+            libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
         );
-        let x285 = x283 * x284;
-        let x286 = libm::fma(
-            -x98,
-            x279,
-            libm::fma(0.5692, x103, libm::fma(-s_q2, x100, c_q2 * x102)),
+        let x199 = x197 * x198;
+        let x200 = libm::fma(
+            -x69,
+            x193,
+            libm::fma(0.5692, x71, libm::fma(-s_q2, x48, x67)),
         );
-        let x287 = x283 * x286;
-        let x288 = libm::fma(
-            -x98,
-            x280,
-            libm::fma(0.5692, x111, libm::fma(-s_q2, x108, c_q2 * x110)),
+        let x201 = x197 * x200;
+        let x202 = libm::fma(
+            -x69,
+            x194,
+            libm::fma(0.5692, x78, libm::fma(-s_q2, x75, c_q2 * x77)),
         );
-        let x289 = x283 * x288;
-        let x290 = libm::fma(-x98, x281, libm::fma(-s_q2, x116, c_q2 * x118));
-        let x291 = x283 * x290;
-        let x292 = libm::fma(x98, x282, libm::fma(c_q2, x127, s_q2 * x125));
-        let x293 = x283 * x292;
-        let x294 = 1.0 / libm::fma(-x284, x285, libm::fma(-x99, x278, x82));
-        let x295 = libm::fma(-x284, x287, libm::fma(-x99, x279, x101));
-        let x296 = x294 * x295;
-        let x297 = libm::fma(-x284, x289, libm::fma(-x99, x280, x109));
-        let x298 = x294 * x297;
-        let x299 = libm::fma(-x284, x291, libm::fma(-x99, x281, x117));
-        let x300 = x294 * x299;
-        let x301 = libm::fma(x284, x293, libm::fma(-x99, x282, x126));
-        let x302 = x294 * x301;
-        let x303 = 1.0
+        let x203 = x197 * x202;
+        let x204 = libm::fma(-x69, x195, libm::fma(-s_q2, x80, c_q2 * x81));
+        let x205 = x197 * x204;
+        let x206 = libm::fma(x69, x196, libm::fma(c_q2, x86, s_q2 * x85));
+        let x207 = x197 * x206;
+        let x208 = 1.0 / libm::fma(-x198, x199, libm::fma(-x70, x192, x59));
+        let x209 = libm::fma(-x198, x201, libm::fma(-x70, x193, x49));
+        let x210 = x208 * x209;
+        let x211 = libm::fma(-x198, x203, libm::fma(-x70, x194, x76));
+        let x212 = x208 * x211;
+        let x213 = libm::fma(x198, x205, x70 * x195);
+        let x214 = x208 * x213;
+        let x215 = libm::fma(x198, x207, libm::fma(-x70, x196, x8));
+        let x216 = x208 * x215;
+        let x217 = 1.0
+            / libm::fma(-x209, x210, libm::fma(-x200, x201, libm::fma(-x72, x193, x35)));
+        let x218 = libm::fma(
+            -x209,
+            x212,
+            libm::fma(-x200, x203, libm::fma(-x72, x194, x27)),
+        );
+        let x219 = x217 * x218;
+        let x220 = libm::fma(x209, x214, -libm::fma(x200, x205, x72 * x195));
+        let x221 = x217 * x220;
+        let x222 = libm::fma(
+            -x209,
+            x216,
+            libm::fma(x200, x207, libm::fma(-x72, x196, x8)),
+        );
+        let x223 = x217 * x222;
+        let x224 = 1.0
             / libm::fma(
-                -x295,
-                x296,
-                libm::fma(-x286, x287, libm::fma(-x104, x279, x56)),
-            );
-        let x304 = libm::fma(
-            -x295,
-            x298,
-            libm::fma(-x286, x289, libm::fma(-x104, x280, x105)),
-        );
-        let x305 = x303 * x304;
-        let x306 = libm::fma(
-            -x295,
-            x300,
-            libm::fma(-x286, x291, libm::fma(-x104, x281, x114)),
-        );
-        let x307 = x303 * x306;
-        let x308 = libm::fma(
-            -x295,
-            x302,
-            libm::fma(x286, x293, libm::fma(-x104, x282, x123)),
-        );
-        let x309 = x303 * x308;
-        let x310 = 1.0
-            / libm::fma(
-                -x304,
-                x305,
+                -x218,
+                x219,
                 libm::fma(
-                    -x297,
-                    x298,
-                    libm::fma(-x288, x289, libm::fma(-x112, x280, x35)),
+                    -x211,
+                    x212,
+                    libm::fma(-x202, x203, libm::fma(-x79, x194, x13)),
                 ),
             );
-        let x311 = libm::fma(
-            -x304,
-            x307,
-            libm::fma(-x297, x300, libm::fma(-x288, x291, libm::fma(-x112, x281, x27))),
+        let x225 = libm::fma(
+            -x218,
+            x221,
+            libm::fma(x211, x214, -libm::fma(x202, x205, x79 * x195)),
         );
-        let x312 = x310 * x311;
-        let x313 = libm::fma(
-            -x304,
-            x309,
-            libm::fma(-x297, x302, libm::fma(x288, x293, libm::fma(-x112, x282, x121))),
+        let x226 = x224 * x225;
+        let x227 = libm::fma(
+            -x218,
+            x223,
+            libm::fma(-x211, x216, libm::fma(x202, x207, libm::fma(-x79, x196, x8))),
         );
-        let x314 = x310 * x313;
-        let x315 = 1.0
+        let x228 = x224 * x227;
+        let x229 = 1.0
             / libm::fma(
-                -x311,
-                x312,
+                -x225,
+                x226,
                 libm::fma(
-                    -x306,
-                    x307,
+                    -x220,
+                    x221,
                     libm::fma(
-                        -x299,
-                        x300,
-                        libm::fma(-x290, x291, libm::fma(-x119, x281, x20)),
+                        -x213,
+                        x214,
+                        libm::fma(-x204, x205, libm::fma(-x82, x195, 47.471)),
                     ),
                 ),
             );
-        let x316 = libm::fma(
-            -x311,
-            x314,
+        let x230 = libm::fma(
+            -x225,
+            x228,
             libm::fma(
-                -x306,
-                x309,
-                libm::fma(-x299, x302, libm::fma(-x119, x282, x290 * x293)),
+                -x220,
+                x223,
+                libm::fma(x213, x216, libm::fma(-x82, x196, x204 * x207)),
             ),
         );
-        let x317 = x315 * x316;
-        let x318 = 1.0
+        let x231 = x229 * x230;
+        let x232 = 1.0
             / libm::fma(
-                -x316,
-                x317,
+                -x230,
+                x231,
                 libm::fma(
-                    -x313,
-                    x314,
+                    -x227,
+                    x228,
                     libm::fma(
-                        -x308,
-                        x309,
+                        -x222,
+                        x223,
                         libm::fma(
-                            -x301,
-                            x302,
-                            libm::fma(-x292, x293, libm::fma(-x128, x282, 9.336)),
+                            -x215,
+                            x216,
+                            libm::fma(-x206, x207, libm::fma(-x87, x196, 9.336)),
                         ),
                     ),
                 ),
             );
-        let x319 = libm::fma(
-            -x275,
-            x277,
+        let x233 = libm::fma(
+            -x189,
+            x191,
             tau[1]
-                - (libm::fma(-x129, x139, x130 * x138)
-                    + libm::fma(-x133, x141, x132 * x142) - f_ext[1][5]
-                    + libm::fma(0.5692, x274, libm::fma(-s_q2, x269, c_q2 * x271))),
+                - (libm::fma(0.5692, x188, libm::fma(-s_q2, x183, c_q2 * x185))
+                    - (f_ext[1][5]
+                        + libm::fma(
+                            1145.5438279999998,
+                            x95,
+                            libm::fma(x92, x99, x88 * x97),
+                        ))),
         );
-        let x320 = libm::fma(-x285, x319, libm::fma(-x275, x278, tau[2] - x270));
-        let x321 = libm::fma(
-            -x296,
-            x320,
-            libm::fma(-x287, x319, libm::fma(-x275, x279, tau[3] - x262)),
+        let x234 = libm::fma(-x199, x233, libm::fma(-x189, x192, tau[2] - x184));
+        let x235 = libm::fma(
+            -x210,
+            x234,
+            libm::fma(-x201, x233, libm::fma(-x189, x193, tau[3] - x176)),
         );
-        let x322 = libm::fma(
-            -x305,
-            x321,
+        let x236 = libm::fma(
+            -x219,
+            x235,
             libm::fma(
-                -x298,
-                x320,
-                libm::fma(-x289, x319, libm::fma(-x275, x280, tau[4] - x255)),
+                -x212,
+                x234,
+                libm::fma(-x203, x233, libm::fma(-x189, x194, tau[4] - x169)),
             ),
         );
-        let x323 = libm::fma(
-            -x312,
-            x322,
+        let x237 = libm::fma(
+            -x226,
+            x236,
             libm::fma(
-                -x307,
-                x321,
+                -x221,
+                x235,
                 libm::fma(
-                    -x300,
-                    x320,
-                    libm::fma(-x291, x319, libm::fma(-x275, x281, tau[5] - x249)),
+                    x214,
+                    x234,
+                    libm::fma(-x205, x233, libm::fma(-x189, x195, tau[5] - x163)),
                 ),
             ),
         );
-        let x324 = x318
+        let x238 = x232
             * libm::fma(
-                -x317,
-                x323,
+                -x231,
+                x237,
                 libm::fma(
-                    -x314,
-                    x322,
+                    -x228,
+                    x236,
                     libm::fma(
-                        -x309,
-                        x321,
+                        -x223,
+                        x235,
                         libm::fma(
-                            -x302,
-                            x320,
-                            libm::fma(x293, x319, libm::fma(-x275, x282, tau[6] - x240)),
+                            -x216,
+                            x234,
+                            libm::fma(x207, x233, libm::fma(-x189, x196, tau[6] - x157)),
                         ),
                     ),
                 ),
             );
-        let x325 = libm::fma(-x317, x324, x315 * x323);
-        let x326 = libm::fma(-x314, x324, libm::fma(-x312, x325, x310 * x322));
-        let x327 = libm::fma(
-            -x309,
-            x324,
-            libm::fma(-x307, x325, libm::fma(-x305, x326, x303 * x321)),
+        let x239 = libm::fma(-x231, x238, x229 * x237);
+        let x240 = libm::fma(-x228, x238, libm::fma(-x226, x239, x224 * x236));
+        let x241 = libm::fma(
+            -x223,
+            x238,
+            libm::fma(-x221, x239, libm::fma(-x219, x240, x217 * x235)),
         );
-        let x328 = libm::fma(
-            -x302,
-            x324,
+        let x242 = libm::fma(
+            -x216,
+            x238,
             libm::fma(
-                -x300,
-                x325,
-                libm::fma(-x298, x326, libm::fma(-x296, x327, x294 * x320)),
+                x214,
+                x239,
+                libm::fma(-x212, x240, libm::fma(-x210, x241, x208 * x234)),
             ),
         );
-        let x329 = libm::fma(
-            x293,
-            x324,
+        let x243 = libm::fma(
+            x207,
+            x238,
             libm::fma(
-                -x291,
-                x325,
+                -x205,
+                x239,
                 libm::fma(
-                    -x289,
-                    x326,
-                    libm::fma(-x287, x327, libm::fma(-x285, x328, x283 * x319)),
+                    -x203,
+                    x240,
+                    libm::fma(-x201, x241, libm::fma(-x199, x242, x197 * x233)),
                 ),
             ),
         );
-        let x330 = libm::fma(
-            -x282,
-            x324,
+        let x244 = libm::fma(
+            -x196,
+            x238,
             libm::fma(
-                -x281,
-                x325,
+                -x195,
+                x239,
                 libm::fma(
-                    -x280,
-                    x326,
+                    -x194,
+                    x240,
                     libm::fma(
-                        -x279,
-                        x327,
-                        libm::fma(-x278, x328, libm::fma(-x277, x329, x275 * x276)),
+                        -x193,
+                        x241,
+                        libm::fma(-x192, x242, libm::fma(-x191, x243, x189 * x190)),
                     ),
                 ),
             ),
         );
-        [x330, x329, x328, x327, x326, x325, x324]
+        [x244, x243, x242, x241, x240, x239, x238]
     }
 }

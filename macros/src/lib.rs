@@ -24,6 +24,7 @@ struct Input {
     float: kanegen_codegen::Float,
     fma: bool,
     fma_path: Option<syn::Path>,
+    regroup: bool,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -61,6 +62,7 @@ impl Parse for Input {
             float: kanegen_codegen::Float::F64,
             fma: false,
             fma_path: None,
+            regroup: true,
         };
         let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
@@ -108,6 +110,7 @@ impl Parse for Input {
                         })?;
                 }
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
+                "regroup" => out.regroup = input.parse::<LitBool>()?.value,
                 "fma_path" => {
                     out.fma_path = Some(input.parse::<syn::Path>()?);
                     fma_path_key = Some(key);
@@ -117,7 +120,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path)"
+                             runtime_payload, scalar, fma, fma_path, regroup)"
                         ),
                     ))
                 }
@@ -166,6 +169,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.op_count_name = format!("{name}OpCount");
     opts.float = input.float;
     opts.fma = input.fma;
+    opts.regroup = input.regroup;
     opts.fma_path = input
         .fma_path
         .as_ref()

@@ -28,6 +28,8 @@ use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
 use kanegen_dynamics::algorithms::{floating, frames, recurrent, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::regroup::regrouped;
+use kanegen_dynamics::spatial::RbInertia;
 use kanegen_dynamics::{
     BiasMethod, ExternalWrench, JointParams, LoadFrame, Loads, MassMatrixMethod, Methods, Params,
     Scalar,
@@ -91,9 +93,21 @@ pub fn trace(
     };
 
     // Parameters.
+    let mut regrouped_base: Option<FloatingBase<Sym>> = None;
     let params: Option<Params<Sym>> = match subject {
         Subject::Model(model) => {
-            let mut p = Params::<Sym>::new(model);
+            let mut p = if spec.regroup {
+                let base = match &spec.base {
+                    Base::FreeFloating(i) => Some(i),
+                    Base::Fixed => None,
+                };
+                let keep: &[usize] = if spec.runtime_payload { &[n - 1] } else { &[] };
+                let r = regrouped::<Sym>(model, base, keep);
+                regrouped_base = r.base;
+                r.params
+            } else {
+                Params::<Sym>::new(model)
+            };
             if spec.runtime_payload {
                 payload_inputs(&mut p, &mut input);
             }
@@ -234,7 +248,9 @@ pub fn trace(
 
     let out: Vec<Sym> = match (&spec.base, state) {
         (Base::FreeFloating(inertial), Some(state)) => {
-            let base = FloatingBase::<Sym>::from_inertial(inertial);
+            let base = regrouped_base
+                .clone()
+                .unwrap_or_else(|| FloatingBase::<Sym>::from_inertial(inertial));
             let m = |method| floating::mass_matrix(method, &p, &base, &state, &q);
             let b = |qd: &[Sym], l: &Loads<Sym>| {
                 floating::bias(methods.bias, &p, &base, &state, &q, qd, l)
@@ -395,6 +411,17 @@ fn check(
         }
         _ => {}
     }
+    if spec.regroup {
+        if !matches!(subject, Subject::Model(_)) {
+            return Err("regrouped inertial parameters need a model's numbers".into());
+        }
+        if function == Function::BaseReaction {
+            return Err(
+                "the arm's reaction on its base changes under regrouping (a per-body wrench)"
+                    .into(),
+            );
+        }
+    }
     if let Some(d) = &spec.damping {
         if d.len() != n {
             return Err(format!("damping has {} entries for N = {n}", d.len()));
@@ -452,8 +479,8 @@ fn negated(v: Vec<Sym>) -> Vec<Sym> {
 #[allow(clippy::needless_range_loop)] // the symmetric fill reads best with indices
 fn payload_inputs(p: &mut Params<Sym>, input: &mut impl FnMut(Input) -> Sym) {
     let last = p.joints.last_mut().expect("a model has at least one joint");
-    last.mass = input(Input::Payload(PayloadField::Mass));
-    last.com = Vec3(core::array::from_fn(|k| {
+    let mass = input(Input::Payload(PayloadField::Mass));
+    let com = Vec3(core::array::from_fn(|k| {
         input(Input::Payload(PayloadField::Com(k)))
     }));
     let mut i = [[Sym::zero(); 3]; 3];
@@ -464,7 +491,7 @@ fn payload_inputs(p: &mut Params<Sym>, input: &mut impl FnMut(Input) -> Sym) {
             i[c][r] = s;
         }
     }
-    last.inertia_com = Mat3(i);
+    last.set_inertial(mass, com, Mat3(i));
 }
 
 /// Three inputs named `{name}x`, `{name}y`, `{name}z`.
@@ -496,6 +523,7 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
             let com = vec_input(input, &format!("d{j}_"));
             let inertia_com = sym3_input(input, &format!("Ic{j}_"));
             JointParams {
+                inertia: RbInertia::from_com(&mass, &com, &inertia_com),
                 kind: JointKind::Revolute,
                 parent: j.checked_sub(1),
                 l,

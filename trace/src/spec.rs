@@ -86,6 +86,10 @@ pub struct Spec {
     pub damping: Option<Vec<f64>>,
     /// The last body's mass properties are runtime inputs ([`crate::PayloadField`]).
     pub runtime_payload: bool,
+    /// The local-frame algorithms read regrouped inertial parameters
+    /// (`kanegen_dynamics::regroup`): fewer operations, the same joint-space results. Only for a
+    /// model, and not for the base reaction (a per-body wrench regrouping changes).
+    pub regroup: bool,
     /// Evaluate (14b) as printed, without the exact correction: the paper's Table 1 bookkeeping,
     /// **inexact for N ≥ 3**; only with [`Subject::BaseFrame`] and the `recurrent-r1` mass-matrix
     /// method.

@@ -20,10 +20,11 @@
 //! ```
 
 use crate::base::{FloatingBase, FLOATING_BASE_DOF};
+use crate::joint::{inertia_s, s_tr, xup};
 use crate::linalg::Vec3;
 use crate::params::Params;
 use crate::scalar::Scalar;
-use crate::spatial::{base_rows, inertia_s, s_tr, xup, Motion, RbInertia, Xform};
+use crate::spatial::{base_rows, Motion, RbInertia, Xform};
 
 /// `Xup_j` of every joint (one `sin_cos` per revolute joint).
 fn transforms<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Xform<S>> {
@@ -35,7 +36,7 @@ fn transforms<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Xform<S>> {
 /// `IC_i = I_i`, then, for `i = N−1 … 0` with a parent body, `IC_λ(i) += Xup_iᵀ IC_i Xup_i`.
 /// The subtrees hanging from the base are left to the caller.
 fn composite<S: Scalar>(p: &Params<S>, xup: &[Xform<S>]) -> Vec<RbInertia<S>> {
-    let mut ic: Vec<RbInertia<S>> = p.joints.iter().map(RbInertia::mci).collect();
+    let mut ic: Vec<RbInertia<S>> = p.joints.iter().map(|jp| jp.inertia.clone()).collect();
     for (i, jp) in p.joints.iter().enumerate().rev() {
         if let Some(lambda) = jp.parent {
             let carried = xup[i].tr_inertia(&ic[i]);
@@ -92,7 +93,7 @@ pub fn floating_mass_matrix<S: Scalar>(
     S::section("spatial:floating");
     let nb = FLOATING_BASE_DOF;
     let xup = transforms(p, q);
-    let i_base = RbInertia::from_com(&base.mass, &base.com, &base.inertia_com);
+    let i_base = base.inertia.clone();
     let ic = composite(p, &xup);
     // IC_0 = I_base + Σ over the joints on the base Xup_iᵀ IC_i Xup_i.
     let mut ic0 = i_base;

@@ -38,11 +38,11 @@
 
 use crate::algorithms::crba;
 use crate::base::{FloatingBase, FloatingState, FLOATING_BASE_DOF};
+use crate::joint::xup;
 use crate::ldlt::{ldlt, solve};
 use crate::linalg::{Mat3, Vec3};
 use crate::params::{FrameParams, Params};
 use crate::scalar::Scalar;
-use crate::spatial::xup;
 use kanegen_model::JointKind;
 
 /// A placement `(x, R)`: origin and orientation (`x_outer = R x_inner + x`).

@@ -31,10 +31,11 @@
 //! ```
 
 use crate::base::{FloatingBase, FloatingState};
+use crate::joint::{s_times, xup};
 use crate::linalg::Vec3;
 use crate::params::Params;
 use crate::scalar::Scalar;
-use crate::spatial::{base_rows, s_times, xup, Force, Motion, RbInertia, Xform};
+use crate::spatial::{base_rows, Force, Motion, RbInertia, Xform};
 
 /// The forward pass: `Xup_i`, `v_i` and the body inertia `I_i` of every body, and `(I_0, v_0)`
 /// of the base.
@@ -56,7 +57,7 @@ fn velocities<S: Scalar>(
         ang: state.omega_b.clone(),
         lin: state.v_b.clone(),
     };
-    let i0 = RbInertia::from_com(&base.mass, &base.com, &base.inertia_com);
+    let i0 = base.inertia.clone();
     let mut bodies: Vec<(Xform<S>, Motion<S>, RbInertia<S>)> = Vec::with_capacity(n);
     for (jp, (qj, qdj)) in p.joints.iter().zip(q.iter().zip(qd)) {
         let x = xup(jp, qj);
@@ -66,7 +67,7 @@ fn velocities<S: Scalar>(
             None => &v0,
         };
         let v = x.apply(v_parent) + s_times(jp, qdj);
-        bodies.push((x, v, RbInertia::mci(jp)));
+        bodies.push((x, v, jp.inertia.clone()));
     }
     ((i0, v0), bodies)
 }

@@ -31,11 +31,12 @@
 //! ```
 
 use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
+use crate::joint::{s_times, s_tr, xup};
 use crate::linalg::{Mat3, Vec3};
 use crate::loads::{LoadFrame, Loads};
 use crate::params::Params;
 use crate::scalar::Scalar;
-use crate::spatial::{base_rows, s_times, s_tr, xup, Force, Motion, RbInertia, Xform};
+use crate::spatial::{base_rows, Force, Motion, Xform};
 
 /// The starting motion of the forward pass: the velocity and acceleration of "body −1" in its own
 /// coordinates, and `E_0`, the rotation from the frame of base-frame (`LoadFrame::Base`)
@@ -117,7 +118,7 @@ fn passes<S: Scalar>(
         }
         let a = a + v.crm(&vj);
         // f_j = I_j a_j + v_j ×* I_j v_j − f^x_j
-        let inertia = RbInertia::mci(jp);
+        let inertia = jp.inertia.clone();
         let fj = inertia.mul(&a) + v.crf(&inertia.mul(&v));
         if need_rot {
             // E_0j = E_j E_0λ
@@ -246,7 +247,7 @@ fn isolated_base<S: Scalar>(
     loads: &Loads<S>,
     start: &Start<S>,
 ) -> Force<S> {
-    let i_base = RbInertia::from_com(&base.mass, &base.com, &base.inertia_com);
+    let i_base = base.inertia.clone();
     let f0 = i_base.mul(&start.a) + start.v.crf(&i_base.mul(&start.v));
     subtract_external(f0, loads, BASE_BODY, &start.e0)
 }
