@@ -60,7 +60,7 @@ pub fn spec(model: &Model, opts: &Options) -> Spec {
 
 /// The candidates of `f`: every mass-matrix method for `M`; every bias method (with the chosen
 /// mass-matrix method `mass`) for a function with a bias; the chosen method alone for the others.
-/// On a tree only the local-frame methods (`crba`, `rnea`) are candidates: the paper's
+/// On a tree only the local-frame methods (`crba`, `rnea`, `newton-euler`) are candidates: the paper's
 /// base-frame algorithms handle serial chains only.
 #[must_use]
 pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Methods> {
@@ -72,7 +72,7 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
     let bias_methods: &[BiasMethod] = if chain {
         &BiasMethod::ALL
     } else {
-        &[BiasMethod::Rnea]
+        &[BiasMethod::Rnea, BiasMethod::NewtonEuler]
     };
     if f == Function::MassMatrix {
         mass_methods

@@ -19,19 +19,24 @@
 //! | `mass_matrix` * | `crba` | — | 157 | 128 | 0 | 0 | 5 | 285 |
 //! | `nonlinear_effects` | — | `recurrent` | 537 | 386 | 0 | 0 | 6 | 923 |
 //! | `nonlinear_effects` | — | `kane-direct` | 580 | 428 | 0 | 0 | 6 | 1008 |
-//! | `nonlinear_effects` * | — | `rnea` | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `nonlinear_effects` | — | `rnea` | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `nonlinear_effects` * | — | `newton-euler` | 220 | 157 | 0 | 0 | 5 | 377 |
 //! | `inverse_dynamics` | — | `recurrent` | 728 | 550 | 0 | 0 | 6 | 1278 |
 //! | `inverse_dynamics` | — | `kane-direct` | 771 | 592 | 0 | 0 | 6 | 1363 |
-//! | `inverse_dynamics` * | — | `rnea` | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `inverse_dynamics` | — | `rnea` | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `inverse_dynamics` * | — | `newton-euler` | 232 | 178 | 0 | 0 | 5 | 410 |
 //! | `forward_dynamics` | `crba` | `recurrent` | 780 | 585 | 6 | 0 | 6 | 1365 |
 //! | `forward_dynamics` | `crba` | `kane-direct` | 823 | 627 | 6 | 0 | 6 | 1450 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 497 | 380 | 6 | 0 | 5 | 877 |
+//! | `forward_dynamics` | `crba` | `rnea` | 497 | 380 | 6 | 0 | 5 | 877 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | 463 | 356 | 6 | 0 | 5 | 819 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 694 | 514 | 0 | 0 | 6 | 1208 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 737 | 556 | 0 | 0 | 6 | 1293 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 411 | 309 | 0 | 0 | 5 | 720 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 411 | 309 | 0 | 0 | 5 | 720 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 377 | 285 | 0 | 0 | 5 | 662 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 856 | 662 | 6 | 0 | 6 | 1518 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 899 | 704 | 6 | 0 | 6 | 1603 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 503 | 412 | 6 | 0 | 5 | 915 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 503 | 412 | 6 | 0 | 5 | 915 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 469 | 388 | 6 | 0 | 5 | 857 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -98,9 +103,9 @@ impl Srms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 254u64,
-            add: 181u64,
+            bias_method: Some("newton-euler"),
+            mul: 220u64,
+            add: 157u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -109,9 +114,9 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 278u64,
-            add: 207u64,
+            bias_method: Some("newton-euler"),
+            mul: 232u64,
+            add: 178u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -120,9 +125,9 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 497u64,
-            add: 380u64,
+            bias_method: Some("newton-euler"),
+            mul: 463u64,
+            add: 356u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -131,9 +136,9 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 411u64,
-            add: 309u64,
+            bias_method: Some("newton-euler"),
+            mul: 377u64,
+            add: 285u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -142,9 +147,9 @@ impl Srms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 503u64,
-            add: 412u64,
+            bias_method: Some("newton-euler"),
+            mul: 469u64,
+            add: 388u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -242,6 +247,17 @@ impl Srms {
             fma: 0u64,
         },
         OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 220u64,
+            add: 157u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
@@ -269,6 +285,17 @@ impl Srms {
             bias_method: Some("rnea"),
             mul: 278u64,
             add: 207u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 232u64,
+            add: 178u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -308,6 +335,17 @@ impl Srms {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 463u64,
+            add: 356u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -341,6 +379,17 @@ impl Srms {
             fma: 0u64,
         },
         OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 377u64,
+            add: 285u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -368,6 +417,17 @@ impl Srms {
             bias_method: Some("rnea"),
             mul: 503u64,
             add: 412u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 469u64,
+            add: 388u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -499,7 +559,7 @@ impl Srms {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 254 mul, 181 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -507,273 +567,240 @@ impl Srms {
         let x2 = qd[0] * c_q1;
         let x3 = qd[1] * x2;
         let x4 = qd[1] * x1;
-        let x5 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
-        let x6 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x7 = -0.0302 * qd[1] - 190.97044034000004 * x1;
+        let x5 = qd[1] * qd[1];
+        let x6 = x1 * x2;
+        let x7 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
+        let x8 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
+        let x9 = -0.0302 * qd[1] - 190.97044034000004 * x1;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x9 = x1 * c_q2 + x2 * s_q2;
-        let x10 = x2 * c_q2 - x1 * s_q2;
-        let x11 = qd[1] * 0.1524;
-        let x12 = x2 * -6.377 - -0.1524 * x1;
-        let x13 = 6.377 * qd[1];
-        let x14 = s_q2 * x13 - c_q2 * x11;
-        let x15 = s_q2 * x11 + c_q2 * x13;
-        let x16 = qd[1] + qd[2];
-        let x17 = -0.1524 * x3 + x4 * -6.377;
-        let x18 = qd[2] * x15;
-        let x19 = qd[2] * x14;
-        let x20 = x4 * s_q2 - x3 * c_q2 - qd[2] * x10;
-        let x21 = x3 * s_q2 + x4 * c_q2 + qd[2] * x9;
-        let x22 = 0.8021 * x16 - -5594.523885531201 * x9 + 103.41030072000001 * x10
-            - x12 * 15.183612000000002;
-        let x23 = 5601.1318504688 * x16 - 0.8021 * x9 + -0.08 * x10
-            + (-15.183612000000002 * x14 - x15 * -703.3878000000001);
-        let x24 = -0.08 * x16 - 103.41030072000002 * x9 - 703.3878000000001 * x12;
-        let x25 = x16 * 15.183612000000002;
-        let x26 = x10 * -703.3878000000001 - -15.183612000000002 * x9;
-        let x27 = 703.3878000000001 * x16;
+        let x11 = x1 * c_q2 + x2 * s_q2;
+        let x12 = x2 * c_q2 - x1 * s_q2;
+        let x13 = 6.377 * (x5 + x2 * x2) + -0.1524 * x6;
+        let x14 = -0.1524 * (x3 + x3) - 6.377 * (x4 + x4);
+        let x15 = 6.377 * x6 + -0.1524 * (x5 + x1 * x1);
+        let x16 = s_q2 * x15 - c_q2 * x13;
+        let x17 = s_q2 * x13 + c_q2 * x15;
+        let x18 = x4 * s_q2 - x3 * c_q2 - qd[2] * x12;
+        let x19 = x3 * s_q2 + x4 * c_q2 + qd[2] * x11;
+        let x20 = qd[1] + qd[2];
+        let x21 = x20 * x20;
+        let x22 = x21 + x12 * x12;
+        let x23 = x11 * x12;
+        let x24 = x19 + x11 * x20;
+        let x25 = x12 * x20 - x18;
+        let x26 = x21 + x11 * x11;
+        let x27 = 0.8021 * x20 - -5594.523885531201 * x11 + 103.41030072000001 * x12;
+        let x28 = 5601.1318504688 * x20 - 0.8021 * x11 + -0.08 * x12;
+        let x29 = -0.08 * x20 - 103.41030072000002 * x11;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x29 = x9 * c_q3 + x10 * s_q3;
-        let x30 = x10 * c_q3 - x9 * s_q3;
-        let x31 = x14 - 0.1524 * x16;
-        let x32 = x12 + (x10 * -7.06 - -0.1524 * x9);
-        let x33 = x15 + 7.06 * x16;
-        let x34 = c_q3 * x31 + s_q3 * x33;
-        let x35 = s_q3 * x31 - c_q3 * x33;
-        let x36 = qd[3] + x16;
-        let x37 = x17 - (-0.1524 * x20 - x21 * -7.06);
-        let x38 = x20 * c_q3 + x21 * s_q3 - qd[3] * x30;
-        let x39 = x20 * s_q3 - x21 * c_q3 - qd[3] * x29;
-        let x40 = x18 * s_q3 + x19 * c_q3 + qd[3] * x34;
-        let x41 = -18.957952216000002 * x29;
-        let x42 = 41.67378 * x32;
-        let x43 = 19.863252216000003 * x36 + x35 * -41.67378;
-        let x44 = x30 * -41.67378;
-        let x45 = 41.67378 * x36;
+        let x31 = x11 * c_q3 + x12 * s_q3;
+        let x32 = x12 * c_q3 - x11 * s_q3;
+        let x33 = x16 - (7.06 * x22 + -0.1524 * x23);
+        let x34 = x14 + (-0.1524 * x25 - 7.06 * x24);
+        let x35 = x17 + (7.06 * x23 + -0.1524 * x26);
+        let x36 = s_q3 * x33 - c_q3 * x35;
+        let x37 = x18 * c_q3 + x19 * s_q3 - qd[3] * x32;
+        let x38 = x18 * s_q3 - x19 * c_q3 - qd[3] * x31;
+        let x39 = qd[3] + x20;
+        let x40 = x39 * x39 + x32 * x32;
+        let x41 = x31 * x32;
+        let x42 = x38 - x31 * x39;
+        let x43 = -18.957952216000002 * x31;
+        let x44 = 19.863252216000003 * x39;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x47 = x36 * s_q4 - x29 * c_q4;
-        let x48 = x29 * s_q4 + x36 * c_q4;
-        let x49 = x32 + x30 * -0.4572;
-        let x50 = x35 - 0.4572 * x36;
-        let x51 = x34 * c_q4 - s_q4 * x49;
-        let x52 = x34 * s_q4 + c_q4 * x49;
-        let x53 = qd[4] + x30;
-        let x54 = x38 * c_q4 + qd[4] * x48;
-        let x55 = x38 * s_q4 + qd[4] * x47;
-        let x56 = 34.33891524 * x48 + x50 * -34.45002;
-        let x57 = 34.74691524 * x53 - 34.45002 * x52;
-        let x58 = x53 * -34.45002;
-        let x59 = 34.45002 * x48;
-        let x60 = x53 * x58 - x48 * x59;
-        let x61 = x47 * x59 - x39 * -34.45002;
-        let x62 = 34.45002 * x55 - x47 * x58;
+        let x46 = x39 * s_q4 - x31 * c_q4;
+        let x47 = x31 * s_q4 + x39 * c_q4;
+        let x48 = x37 * c_q4 + qd[4] * x47;
+        let x49 = x37 * s_q4 + qd[4] * x46;
+        let x50 = qd[4] + x32;
+        let x51 = 34.45002 * (x47 * x47 + x50 * x50);
+        let x52 = 34.45002 * (x38 + x46 * x47);
+        let x53 = 34.45002 * (x49 + x46 * x50);
+        let x54 = 34.33891524 * x47;
+        let x55 = 34.74691524 * x50;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x64 = x48 * c_q5 + x53 * s_q5;
-        let x65 = x53 * c_q5 - x48 * s_q5;
-        let x66 = qd[5] + x47;
-        let x67 = x39 * s_q5 - x55 * c_q5 + qd[5] * x65;
-        let x68 = x55 * s_q5 + x39 * c_q5 - qd[5] * x64;
-        let x69 = 1.903 * x66 + 0.385 * x64 + 0.966 * x65;
-        let x70 = 0.385 * x66 + 0.353 * x65;
-        let x71 = 0.966 * x66 + 0.353 * x64 + -0.9929999999999999 * x65;
-        let x72 = 1.903 * x54 + 0.385 * x67 + 0.966 * x68 + (x64 * x71 - x65 * x70);
-        let x73 = 0.385 * x54 + 0.353 * x68 + (x65 * x69 - x66 * x71);
-        let x74 = 0.966 * x54 + 0.353 * x67 + -0.9929999999999999 * x68
-            + (x66 * x70 - x64 * x69);
-        let x75 = x48 * x57 - x53 * x56 + (x50 * x58 + x52 * x59) + x72;
-        let x76 = x40 * -34.45002 - 34.33891524 * x55 + (x51 * x59 - x47 * x57)
-            + (c_q5 * x73 - s_q5 * x74);
-        let x77 = 34.74691524 * x39
+        let x57 = x47 * c_q5 + x50 * s_q5;
+        let x58 = x50 * c_q5 - x47 * s_q5;
+        let x59 = x38 * s_q5 - x49 * c_q5 + qd[5] * x58;
+        let x60 = x49 * s_q5 + x38 * c_q5 - qd[5] * x57;
+        let x61 = qd[5] + x46;
+        let x62 = 1.903 * x61 + 0.385 * x57 + 0.966 * x58;
+        let x63 = 0.385 * x61 + 0.353 * x58;
+        let x64 = 0.966 * x61 + 0.353 * x57 + -0.9929999999999999 * x58;
+        let x65 = 1.903 * x48 + 0.385 * x59 + 0.966 * x60 + (x57 * x64 - x58 * x63);
+        let x66 = 0.385 * x48 + 0.353 * x60 + (x58 * x62 - x61 * x64);
+        let x67 = 0.966 * x48 + 0.353 * x59 + -0.9929999999999999 * x60
+            + (x61 * x63 - x57 * x62);
+        let x68 = x47 * x55 - x50 * x54 + x65;
+        let x69 = (x36 - 0.4572 * x41) * -34.45002 - (34.33891524 * x49 + x46 * x55)
+            + (c_q5 * x66 - s_q5 * x67);
+        let x70 = 34.74691524 * x38 + x46 * x54
             + 34.45002
-                * (c_q4 * (x37 - x39 * -0.4572)
-                    - (x18 * c_q3 - x19 * s_q3 - qd[3] * x35) * s_q4 - qd[4] * x51)
-            + (x47 * x56 - x51 * x58) + (s_q5 * x73 + c_q5 * x74);
-        let x78 = s_q4 * x60 + c_q4 * x61;
-        let x79 = -18.957952216000002 * x38
-            + (x35 * x44 + x32 * x45 - (x30 * x43 + x36 * x42))
-            + (c_q4 * x75 - s_q4 * x76);
-        let x80 = x40 * -41.67378 + (x34 * x45 - (x30 * x41 + x29 * x42))
-            + (s_q4 * x75 + c_q4 * x76 + -0.4572 * x62);
-        let x81 = 41.67378 * x37 + (x36 * x41 - x29 * x43 - x34 * x44)
-            + (x77 + 0.4572 * x78);
-        let x82 = x30 * x44 - x36 * x45 + (c_q4 * x60 - s_q4 * x61);
-        let x83 = x78 - (x39 * -41.67378 + x29 * x45);
-        let x84 = x29 * x44 + x62;
-        let x85 = c_q3 * x82 + s_q3 * x84;
-        let x86 = c_q3 * x84 - s_q3 * x82;
-        let x87 = -5594.523885531201 * x20 - 103.41030072000001 * x21
-            + x17 * 15.183612000000002
-            + (x16 * x24 - x10 * x23 + (x12 * x27 - x15 * x26))
-            + (c_q3 * x79 + s_q3 * x81 + 0.1524 * x83);
-        let x88 = 0.8021 * x20 - -0.08 * x21
-            + (-15.183612000000002 * x18 + x19 * -703.3878000000001)
-            + (x10 * x22 + x9 * x24 + (x15 * x25 + x14 * x27))
-            + (x80 + (-0.1524 * x85 + -7.06 * x86));
-        let x89 = 103.41030072000002 * x20 + 703.3878000000001 * x17
-            - (x16 * x22 + x9 * x23 + (x12 * x25 + x14 * x26))
-            + (c_q3 * x81 - s_q3 * x79 + 7.06 * x83);
-        let x90 = x10 * x26 - x16 * x27 + x85;
-        let x91 = x83
-            - (-15.183612000000002 * x20 - x21 * -703.3878000000001
-                + (x10 * x25 + x9 * x27));
-        let x92 = x16 * x25 + x9 * x26 + x86;
-        let x93 = x2 * x5 + x1 * x7 - (-1.928 * x3 + -0.0302 * x4)
-            + (x88
-                + (-0.1524 * (c_q2 * x90 + s_q2 * x92)
-                    + -6.377 * (c_q2 * x92 - s_q2 * x90)));
-        let x94 = c_q1
-            * (c_q2 * x89 - s_q2 * x87 + 6.377 * x91
-                - (190.97044034000004 * x3 + (qd[1] * x5 + x1 * x6)))
+                * (c_q4 * (x34 + 0.4572 * x42)
+                    - s_q4 * (c_q3 * x33 + s_q3 * x35 - 0.4572 * x40))
+            + (s_q5 * x66 + c_q5 * x67);
+        let x71 = c_q4 * x52 - s_q4 * x51;
+        let x72 = 41.67378 * x40 + (c_q4 * x51 + s_q4 * x52);
+        let x73 = 41.67378 * x42 + x71;
+        let x74 = x53 - 41.67378 * x41;
+        let x75 = -18.957952216000002 * x37 - x32 * x44 + (c_q4 * x68 - s_q4 * x69);
+        let x76 = x36 * -41.67378 - x32 * x43
+            + (s_q4 * x68 + c_q4 * x69 + x53 * -0.4572);
+        let x77 = x39 * x43 - x31 * x44 + 41.67378 * x34 + (x70 + 0.4572 * x71);
+        let x78 = s_q3 * x74 - c_q3 * x72;
+        let x79 = s_q3 * x72 + c_q3 * x74;
+        let x80 = x78 - (703.3878000000001 * x22 + -15.183612000000002 * x23);
+        let x81 = -15.183612000000002 * x25 - 703.3878000000001 * x24 + x73;
+        let x82 = x79 - (703.3878000000001 * x23 + -15.183612000000002 * x26);
+        let x83 = -5594.523885531201 * x18 - 103.41030072000001 * x19
+            + (x20 * x29 - x12 * x28) + x14 * 15.183612000000002
+            + (c_q3 * x75 + s_q3 * x77 + x73 * 0.1524);
+        let x84 = 0.8021 * x18 - -0.08 * x19 + (x12 * x27 + x11 * x29)
+            + (-15.183612000000002 * x16 - x17 * -703.3878000000001)
+            + (x76 + (-0.1524 * x78 + x79 * -7.06));
+        let x85 = 103.41030072000002 * x18 - (x20 * x27 + x11 * x28)
+            + 703.3878000000001 * x14 + (c_q3 * x77 - s_q3 * x75 + 7.06 * x73);
+        let x86 = x2 * x7 + x1 * x9 - (-1.928 * x3 + -0.0302 * x4)
+            + (x84
+                + (-0.1524 * (c_q2 * x80 + s_q2 * x82)
+                    + (c_q2 * x82 - s_q2 * x80) * -6.377));
+        let x87 = c_q1
+            * (c_q2 * x85 - s_q2 * x83 + 6.377 * x81
+                - (190.97044034000004 * x3 + (qd[1] * x7 + x1 * x8)))
             - s_q1
-                * (qd[1] * x7 - x2 * x6 - (-8596.210051042 * x3 + 190.97044034 * x4)
-                    + (c_q2 * x87 + s_q2 * x89 + 0.1524 * x91));
-        [x94, x93, x88, x80, x77, x72]
+                * (qd[1] * x9 - x2 * x8 - (-8596.210051042 * x3 + 190.97044034 * x4)
+                    + (c_q2 * x83 + s_q2 * x85 + 0.1524 * x81));
+        [x87, x86, x84, x76, x70, x65]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 278 mul, 207 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * s_q1;
         let x2 = qd[0] * c_q1;
-        let x3 = qdd[0] * s_q1 + qd[1] * x2;
-        let x4 = qdd[0] * c_q1 - qd[1] * x1;
-        let x5 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
-        let x6 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x7 = -0.0302 * qd[1] - 190.97044034000004 * x1;
+        let x3 = qd[1] * x2;
+        let x4 = qd[1] * x1;
+        let x5 = qdd[0] * s_q1 + x3;
+        let x6 = qdd[0] * c_q1 - x4;
+        let x7 = qd[1] * qd[1];
+        let x8 = x1 * x2;
+        let x9 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
+        let x10 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
+        let x11 = -0.0302 * qd[1] - 190.97044034000004 * x1;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x9 = x1 * c_q2 + x2 * s_q2;
-        let x10 = x2 * c_q2 - x1 * s_q2;
-        let x11 = qd[1] * 0.1524;
-        let x12 = x2 * -6.377 - -0.1524 * x1;
-        let x13 = 6.377 * qd[1];
-        let x14 = s_q2 * x13 - c_q2 * x11;
-        let x15 = s_q2 * x11 + c_q2 * x13;
-        let x16 = qd[1] + qd[2];
-        let x17 = qdd[1] * 0.1524;
-        let x18 = x4 * -6.377 - -0.1524 * x3;
-        let x19 = 6.377 * qdd[1];
-        let x20 = qdd[1] + qdd[2];
-        let x21 = x3 * c_q2 + x4 * s_q2 + qd[2] * x10;
-        let x22 = x4 * c_q2 - x3 * s_q2 - qd[2] * x9;
-        let x23 = s_q2 * x19 - c_q2 * x17 + qd[2] * x15;
-        let x24 = qd[2] * x14 - (s_q2 * x17 + c_q2 * x19);
-        let x25 = 0.8021 * x16 - -5594.523885531201 * x9 + 103.41030072000001 * x10
-            - x12 * 15.183612000000002;
-        let x26 = 5601.1318504688 * x16 - 0.8021 * x9 + -0.08 * x10
-            + (-15.183612000000002 * x14 - x15 * -703.3878000000001);
-        let x27 = -0.08 * x16 - 103.41030072000002 * x9 - 703.3878000000001 * x12;
-        let x28 = x16 * 15.183612000000002;
-        let x29 = x10 * -703.3878000000001 - -15.183612000000002 * x9;
-        let x30 = 703.3878000000001 * x16;
+        let x13 = x1 * c_q2 + x2 * s_q2;
+        let x14 = x2 * c_q2 - x1 * s_q2;
+        let x15 = -0.1524 * (qdd[1] - x8) - 6.377 * (x7 + x2 * x2);
+        let x16 = 6.377 * (x6 - x4) + -0.1524 * (x3 + x5);
+        let x17 = 6.377 * (qdd[1] + x8) + -0.1524 * (x7 + x1 * x1);
+        let x18 = c_q2 * x15 + s_q2 * x17;
+        let x19 = s_q2 * x15 - c_q2 * x17;
+        let x20 = x5 * c_q2 + x6 * s_q2 + qd[2] * x14;
+        let x21 = x6 * c_q2 - x5 * s_q2 - qd[2] * x13;
+        let x22 = qdd[1] + qdd[2];
+        let x23 = qd[1] + qd[2];
+        let x24 = x23 * x23;
+        let x25 = x24 + x14 * x14;
+        let x26 = x13 * x14;
+        let x27 = x22 - x26;
+        let x28 = x21 - x13 * x23;
+        let x29 = x20 + x14 * x23;
+        let x30 = x22 + x26;
+        let x31 = x24 + x13 * x13;
+        let x32 = 0.8021 * x23 - -5594.523885531201 * x13 + 103.41030072000001 * x14;
+        let x33 = 5601.1318504688 * x23 - 0.8021 * x13 + -0.08 * x14;
+        let x34 = -0.08 * x23 - 103.41030072000002 * x13;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x32 = x9 * c_q3 + x10 * s_q3;
-        let x33 = x10 * c_q3 - x9 * s_q3;
-        let x34 = x14 - 0.1524 * x16;
-        let x35 = x12 + (x10 * -7.06 - -0.1524 * x9);
-        let x36 = x15 + 7.06 * x16;
-        let x37 = c_q3 * x34 + s_q3 * x36;
-        let x38 = s_q3 * x34 - c_q3 * x36;
-        let x39 = qd[3] + x16;
-        let x40 = x23 - 0.1524 * x20;
-        let x41 = x18 + (x22 * -7.06 - -0.1524 * x21);
-        let x42 = x24 - 7.06 * x20;
-        let x43 = qdd[3] + x20;
-        let x44 = x21 * c_q3 + x22 * s_q3 + qd[3] * x33;
-        let x45 = x22 * c_q3 - x21 * s_q3 - qd[3] * x32;
-        let x46 = s_q3 * x40 + c_q3 * x42 + qd[3] * x37;
-        let x47 = -18.957952216000002 * x32;
-        let x48 = 41.67378 * x35;
-        let x49 = 19.863252216000003 * x39 + x38 * -41.67378;
-        let x50 = x33 * -41.67378;
-        let x51 = 41.67378 * x39;
+        let x36 = x13 * c_q3 + x14 * s_q3;
+        let x37 = x14 * c_q3 - x13 * s_q3;
+        let x38 = x18 + (-0.1524 * x27 - 7.06 * x25);
+        let x39 = x16 + (7.06 * x28 + -0.1524 * x29);
+        let x40 = x19 - (7.06 * x30 + -0.1524 * x31);
+        let x41 = s_q3 * x38 + c_q3 * x40;
+        let x42 = x20 * c_q3 + x21 * s_q3 + qd[3] * x37;
+        let x43 = x21 * c_q3 - x20 * s_q3 - qd[3] * x36;
+        let x44 = qdd[3] + x22;
+        let x45 = qd[3] + x23;
+        let x46 = x45 * x45 + x37 * x37;
+        let x47 = x43 - x36 * x45;
+        let x48 = x44 + x36 * x37;
+        let x49 = -18.957952216000002 * x36;
+        let x50 = 19.863252216000003 * x45;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x53 = x39 * s_q4 - x32 * c_q4;
-        let x54 = x32 * s_q4 + x39 * c_q4;
-        let x55 = x35 + x33 * -0.4572;
-        let x56 = x38 - 0.4572 * x39;
-        let x57 = x37 * c_q4 - s_q4 * x55;
-        let x58 = x37 * s_q4 + c_q4 * x55;
-        let x59 = qd[4] + x33;
-        let x60 = qdd[4] + x45;
-        let x61 = x44 * s_q4 + x43 * c_q4 - qd[4] * x53;
-        let x62 = 34.33891524 * x54 + x56 * -34.45002;
-        let x63 = 34.74691524 * x59 - 34.45002 * x58;
-        let x64 = x59 * -34.45002;
-        let x65 = 34.45002 * x54;
-        let x66 = x59 * x64 - x54 * x65;
-        let x67 = x53 * x65 - x60 * -34.45002;
-        let x68 = 34.45002 * x61 + x53 * x64;
+        let x52 = x45 * s_q4 - x36 * c_q4;
+        let x53 = x36 * s_q4 + x45 * c_q4;
+        let x54 = x42 * s_q4 + x44 * c_q4 - qd[4] * x52;
+        let x55 = qdd[4] + x43;
+        let x56 = qd[4] + x37;
+        let x57 = 34.45002 * (x53 * x53 + x56 * x56);
+        let x58 = 34.45002 * (x55 + x52 * x53);
+        let x59 = 34.45002 * (x52 * x56 - x54);
+        let x60 = 34.33891524 * x53;
+        let x61 = 34.74691524 * x56;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x70 = x54 * c_q5 + x59 * s_q5;
-        let x71 = x59 * c_q5 - x54 * s_q5;
-        let x72 = qd[5] + x53;
-        let x73 = qdd[5] + (x43 * s_q4 - x44 * c_q4 + qd[4] * x54);
-        let x74 = x61 * c_q5 + x60 * s_q5 + qd[5] * x71;
-        let x75 = x60 * c_q5 - x61 * s_q5 - qd[5] * x70;
-        let x76 = 1.903 * x72 + 0.385 * x70 + 0.966 * x71;
-        let x77 = 0.385 * x72 + 0.353 * x71;
-        let x78 = 0.966 * x72 + 0.353 * x70 + -0.9929999999999999 * x71;
-        let x79 = 1.903 * x73 + 0.385 * x74 + 0.966 * x75 + (x70 * x78 - x71 * x77);
-        let x80 = 0.385 * x73 + 0.353 * x75 + (x71 * x76 - x72 * x78);
-        let x81 = 0.966 * x73 + 0.353 * x74 + -0.9929999999999999 * x75
-            + (x72 * x77 - x70 * x76);
-        let x82 = x54 * x63 - x59 * x62 + (x56 * x64 + x58 * x65) + x79;
-        let x83 = 34.33891524 * x61 + (x46 - 0.4572 * x43) * -34.45002
-            + (x57 * x65 - x53 * x63) + (c_q5 * x80 - s_q5 * x81);
-        let x84 = 34.74691524 * x60
-            - 34.45002
-                * ((c_q3 * x40 - s_q3 * x42 - qd[3] * x38) * s_q4
-                    + c_q4 * (x41 + x45 * -0.4572) + qd[4] * x57)
-            + (x53 * x62 - x57 * x64) + (s_q5 * x80 + c_q5 * x81);
-        let x85 = s_q4 * x66 + c_q4 * x67;
-        let x86 = x38 * x50 + x35 * x51 - (x33 * x49 + x39 * x48)
-            - -18.957952216000002 * x44 + (c_q4 * x82 - s_q4 * x83);
-        let x87 = 19.863252216000003 * x43 + x46 * -41.67378
-            + (x37 * x51 - (x33 * x47 + x32 * x48))
-            + (s_q4 * x82 + c_q4 * x83 - -0.4572 * x68);
-        let x88 = x39 * x47 - x32 * x49 - x37 * x50 - 41.67378 * x41
-            + (x84 + 0.4572 * x85);
-        let x89 = x33 * x50 - x39 * x51 + (c_q4 * x66 - s_q4 * x67);
-        let x90 = x85 - (x45 * -41.67378 + x32 * x51);
-        let x91 = x32 * x50 - 41.67378 * x43 - x68;
-        let x92 = c_q3 * x89 + s_q3 * x91;
-        let x93 = c_q3 * x91 - s_q3 * x89;
-        let x94 = 0.8021 * x20 - -5594.523885531201 * x21 + 103.41030072000001 * x22
-            - x18 * 15.183612000000002
-            + (x16 * x27 - x10 * x26 + (x12 * x30 - x15 * x29))
-            + (c_q3 * x86 + s_q3 * x88 + 0.1524 * x90);
-        let x95 = 5601.1318504688 * x20 - 0.8021 * x21 + -0.08 * x22
-            + (-15.183612000000002 * x23 + x24 * -703.3878000000001)
-            + (x10 * x25 + x9 * x27 + (x15 * x28 + x14 * x30))
-            + (x87 + (-0.1524 * x92 + -7.06 * x93));
-        let x96 = -0.08 * x20 - 103.41030072000002 * x21 - 703.3878000000001 * x18
-            - (x16 * x25 + x9 * x26 + (x12 * x28 + x14 * x29))
-            + (c_q3 * x88 - s_q3 * x86 + 7.06 * x90);
-        let x97 = x10 * x29 - x16 * x30 - x20 * 15.183612000000002 + x92;
-        let x98 = x90
-            - (x22 * -703.3878000000001 - -15.183612000000002 * x21
-                + (x10 * x28 + x9 * x30));
-        let x99 = x16 * x28 + x9 * x29 - 703.3878000000001 * x20 + x93;
-        let x100 = 8609.573807858 * qdd[1] - -1.928 * x3 + -0.0302 * x4
-            + (x2 * x5 + x1 * x7)
-            + (x95
-                + (-0.1524 * (c_q2 * x97 + s_q2 * x99)
-                    + -6.377 * (c_q2 * x99 - s_q2 * x97)));
-        let x101 = 14222.257549666001 * qdd[0]
+        let x63 = x53 * c_q5 + x56 * s_q5;
+        let x64 = x56 * c_q5 - x53 * s_q5;
+        let x65 = x54 * c_q5 + x55 * s_q5 + qd[5] * x64;
+        let x66 = x55 * c_q5 - x54 * s_q5 - qd[5] * x63;
+        let x67 = qdd[5] + (x44 * s_q4 - x42 * c_q4 + qd[4] * x53);
+        let x68 = qd[5] + x52;
+        let x69 = 1.903 * x68 + 0.385 * x63 + 0.966 * x64;
+        let x70 = 0.385 * x68 + 0.353 * x64;
+        let x71 = 0.966 * x68 + 0.353 * x63 + -0.9929999999999999 * x64;
+        let x72 = 1.903 * x67 + 0.385 * x65 + 0.966 * x66 + (x63 * x71 - x64 * x70);
+        let x73 = 0.385 * x67 + 0.353 * x66 + (x64 * x69 - x68 * x71);
+        let x74 = 0.966 * x67 + 0.353 * x65 + -0.9929999999999999 * x66
+            + (x68 * x70 - x63 * x69);
+        let x75 = x53 * x61 - x56 * x60 + x72;
+        let x76 = 34.33891524 * x54 - x52 * x61 + (x41 - 0.4572 * x48) * -34.45002
+            + (c_q5 * x73 - s_q5 * x74);
+        let x77 = 34.74691524 * x55 + x52 * x60
+            + 34.45002
+                * (c_q4 * (x39 + 0.4572 * x47)
+                    - s_q4 * (c_q3 * x38 - s_q3 * x40 - 0.4572 * x46))
+            + (s_q5 * x73 + c_q5 * x74);
+        let x78 = c_q4 * x58 - s_q4 * x57;
+        let x79 = 41.67378 * x46 + (c_q4 * x57 + s_q4 * x58);
+        let x80 = 41.67378 * x47 + x78;
+        let x81 = x59 - 41.67378 * x48;
+        let x82 = c_q4 * x75 - s_q4 * x76 - (-18.957952216000002 * x42 + x37 * x50);
+        let x83 = 19.863252216000003 * x44 - x37 * x49 + x41 * -41.67378
+            + (s_q4 * x75 + c_q4 * x76 + x59 * -0.4572);
+        let x84 = x45 * x49 - x36 * x50 + 41.67378 * x39 + (x77 + 0.4572 * x78);
+        let x85 = s_q3 * x81 - c_q3 * x79;
+        let x86 = s_q3 * x79 + c_q3 * x81;
+        let x87 = -15.183612000000002 * x27 - 703.3878000000001 * x25 + x85;
+        let x88 = 703.3878000000001 * x28 + -15.183612000000002 * x29 + x80;
+        let x89 = x86 - (703.3878000000001 * x30 + -15.183612000000002 * x31);
+        let x90 = 0.8021 * x22 - -5594.523885531201 * x20 + 103.41030072000001 * x21
+            + (x23 * x34 - x14 * x33) + x16 * 15.183612000000002
+            + (c_q3 * x82 + s_q3 * x84 + x80 * 0.1524);
+        let x91 = 5601.1318504688 * x22 - 0.8021 * x20 + -0.08 * x21
+            + (x14 * x32 + x13 * x34)
+            + (-15.183612000000002 * x18 + x19 * -703.3878000000001)
+            + (x83 + (-0.1524 * x85 + x86 * -7.06));
+        let x92 = -0.08 * x22 - 103.41030072000002 * x20 - (x23 * x32 + x13 * x33)
+            + 703.3878000000001 * x16 + (c_q3 * x84 - s_q3 * x82 + 7.06 * x80);
+        let x93 = 8609.573807858 * qdd[1] - -1.928 * x5 + -0.0302 * x6
+            + (x2 * x9 + x1 * x11)
+            + (x91
+                + (-0.1524 * (c_q2 * x87 + s_q2 * x89)
+                    + (c_q2 * x89 - s_q2 * x87) * -6.377));
+        let x94 = 14222.257549666001 * qdd[0]
             + (c_q1
-                * (-0.0302 * qdd[1] - 190.97044034000004 * x3 - (qd[1] * x5 + x1 * x6)
-                    + (c_q2 * x96 - s_q2 * x94 + 6.377 * x98))
+                * (-0.0302 * qdd[1] - 190.97044034000004 * x5 - (qd[1] * x9 + x1 * x10)
+                    + (c_q2 * x92 - s_q2 * x90 + 6.377 * x88))
                 - s_q1
-                    * (-1.928 * qdd[1] - -8596.210051042 * x3 + 190.97044034 * x4
-                        + (qd[1] * x7 - x2 * x6)
-                        + (c_q2 * x94 + s_q2 * x96 + 0.1524 * x98)));
-        [x101, x100, x95, x87, x84, x79]
+                    * (-1.928 * qdd[1] - -8596.210051042 * x5 + 190.97044034 * x6
+                        + (qd[1] * x11 - x2 * x10)
+                        + (c_q2 * x90 + s_q2 * x92 + 0.1524 * x88)));
+        [x94, x93, x91, x83, x77, x72]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 497 mul, 380 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 463 mul, 356 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -870,122 +897,106 @@ impl Srms {
         let x87 = qd[0] * c_q1;
         let x88 = qd[1] * x87;
         let x89 = qd[1] * x86;
-        let x90 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
-        let x91 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
-        let x92 = -0.0302 * qd[1] - 190.97044034000004 * x86;
-        let x93 = c_q2 * x86 + s_q2 * x87;
-        let x94 = c_q2 * x87 - s_q2 * x86;
-        let x95 = qd[1] * 0.1524;
-        let x96 = -6.377 * x87 - -0.1524 * x86;
-        let x97 = 6.377 * qd[1];
-        let x98 = s_q2 * x97 - c_q2 * x95;
-        let x99 = s_q2 * x95 + c_q2 * x97;
-        let x100 = qd[1] + qd[2];
-        let x101 = -0.1524 * x88 + -6.377 * x89;
-        let x102 = qd[2] * x99;
-        let x103 = qd[2] * x98;
-        let x104 = s_q2 * x89 - c_q2 * x88 - qd[2] * x94;
-        let x105 = s_q2 * x88 + c_q2 * x89 + qd[2] * x93;
-        let x106 = 0.8021 * x100 - -5594.523885531201 * x93 + 103.41030072000001 * x94
-            - x96 * 15.183612000000002;
-        let x107 = 5601.1318504688 * x100 - 0.8021 * x93 + -0.08 * x94
-            + (-15.183612000000002 * x98 - x99 * -703.3878000000001);
-        let x108 = -0.08 * x100 - 103.41030072000002 * x93 - 703.3878000000001 * x96;
-        let x109 = x100 * 15.183612000000002;
-        let x110 = x94 * -703.3878000000001 - -15.183612000000002 * x93;
-        let x111 = 703.3878000000001 * x100;
-        let x112 = c_q3 * x93 + s_q3 * x94;
-        let x113 = c_q3 * x94 - s_q3 * x93;
-        let x114 = x98 - 0.1524 * x100;
-        let x115 = x96 + (-7.06 * x94 - -0.1524 * x93);
-        let x116 = x99 + 7.06 * x100;
-        let x117 = c_q3 * x114 + s_q3 * x116;
-        let x118 = s_q3 * x114 - c_q3 * x116;
-        let x119 = qd[3] + x100;
-        let x120 = x101 - (-0.1524 * x104 - -7.06 * x105);
-        let x121 = c_q3 * x104 + s_q3 * x105 - qd[3] * x113;
-        let x122 = s_q3 * x104 - c_q3 * x105 - qd[3] * x112;
-        let x123 = s_q3 * x102 + c_q3 * x103 + qd[3] * x117;
-        let x124 = -18.957952216000002 * x112;
-        let x125 = 41.67378 * x115;
-        let x126 = 19.863252216000003 * x119 + x118 * -41.67378;
-        let x127 = x113 * -41.67378;
-        let x128 = 41.67378 * x119;
-        let x129 = s_q4 * x119 - c_q4 * x112;
-        let x130 = s_q4 * x112 + c_q4 * x119;
-        let x131 = x115 + -0.4572 * x113;
-        let x132 = x118 - 0.4572 * x119;
-        let x133 = c_q4 * x117 - s_q4 * x131;
-        let x134 = s_q4 * x117 + c_q4 * x131;
-        let x135 = qd[4] + x113;
-        let x136 = c_q4 * x121 + qd[4] * x130;
-        let x137 = s_q4 * x121 + qd[4] * x129;
-        let x138 = 34.33891524 * x130 + -34.45002 * x132;
-        let x139 = 34.74691524 * x135 - 34.45002 * x134;
-        let x140 = -34.45002 * x135;
-        let x141 = 34.45002 * x130;
-        let x142 = x135 * x140 - x130 * x141;
-        let x143 = x129 * x141 - -34.45002 * x122;
-        let x144 = 34.45002 * x137 - x129 * x140;
-        let x145 = c_q5 * x130 + s_q5 * x135;
-        let x146 = c_q5 * x135 - s_q5 * x130;
-        let x147 = qd[5] + x129;
-        let x148 = s_q5 * x122 - c_q5 * x137 + qd[5] * x146;
-        let x149 = s_q5 * x137 + c_q5 * x122 - qd[5] * x145;
-        let x150 = 1.903 * x147 + 0.385 * x145 + 0.966 * x146;
-        let x151 = 0.385 * x147 + 0.353 * x146;
-        let x152 = 0.966 * x147 + 0.353 * x145 + -0.9929999999999999 * x146;
-        let x153 = 1.903 * x136 + 0.385 * x148 + 0.966 * x149
-            + (x145 * x152 - x146 * x151);
-        let x154 = 0.385 * x136 + 0.353 * x149 + (x146 * x150 - x147 * x152);
-        let x155 = 0.966 * x136 + 0.353 * x148 + -0.9929999999999999 * x149
-            + (x147 * x151 - x145 * x150);
-        let x156 = x130 * x139 - x135 * x138 + (x132 * x140 + x134 * x141) + x153;
-        let x157 = -34.45002 * x123 - 34.33891524 * x137 + (x133 * x141 - x129 * x139)
-            + (c_q5 * x154 - s_q5 * x155);
-        let x158 = 34.74691524 * x122
+        let x90 = qd[1] * qd[1];
+        let x91 = x86 * x87;
+        let x92 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
+        let x93 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
+        let x94 = -0.0302 * qd[1] - 190.97044034000004 * x86;
+        let x95 = c_q2 * x86 + s_q2 * x87;
+        let x96 = c_q2 * x87 - s_q2 * x86;
+        let x97 = 6.377 * (x90 + x87 * x87) + -0.1524 * x91;
+        let x98 = -0.1524 * (x88 + x88) - 6.377 * (x89 + x89);
+        let x99 = 6.377 * x91 + -0.1524 * (x90 + x86 * x86);
+        let x100 = s_q2 * x99 - c_q2 * x97;
+        let x101 = s_q2 * x97 + c_q2 * x99;
+        let x102 = s_q2 * x89 - c_q2 * x88 - qd[2] * x96;
+        let x103 = s_q2 * x88 + c_q2 * x89 + qd[2] * x95;
+        let x104 = qd[1] + qd[2];
+        let x105 = x104 * x104;
+        let x106 = x105 + x96 * x96;
+        let x107 = x95 * x96;
+        let x108 = x103 + x95 * x104;
+        let x109 = x96 * x104 - x102;
+        let x110 = x105 + x95 * x95;
+        let x111 = 0.8021 * x104 - -5594.523885531201 * x95 + 103.41030072000001 * x96;
+        let x112 = 5601.1318504688 * x104 - 0.8021 * x95 + -0.08 * x96;
+        let x113 = -0.08 * x104 - 103.41030072000002 * x95;
+        let x114 = c_q3 * x95 + s_q3 * x96;
+        let x115 = c_q3 * x96 - s_q3 * x95;
+        let x116 = x100 - (7.06 * x106 + -0.1524 * x107);
+        let x117 = x98 + (-0.1524 * x109 - 7.06 * x108);
+        let x118 = x101 + (7.06 * x107 + -0.1524 * x110);
+        let x119 = s_q3 * x116 - c_q3 * x118;
+        let x120 = c_q3 * x102 + s_q3 * x103 - qd[3] * x115;
+        let x121 = s_q3 * x102 - c_q3 * x103 - qd[3] * x114;
+        let x122 = qd[3] + x104;
+        let x123 = x122 * x122 + x115 * x115;
+        let x124 = x114 * x115;
+        let x125 = x121 - x114 * x122;
+        let x126 = -18.957952216000002 * x114;
+        let x127 = 19.863252216000003 * x122;
+        let x128 = s_q4 * x122 - c_q4 * x114;
+        let x129 = s_q4 * x114 + c_q4 * x122;
+        let x130 = c_q4 * x120 + qd[4] * x129;
+        let x131 = s_q4 * x120 + qd[4] * x128;
+        let x132 = qd[4] + x115;
+        let x133 = 34.45002 * (x129 * x129 + x132 * x132);
+        let x134 = 34.45002 * (x121 + x128 * x129);
+        let x135 = 34.45002 * (x131 + x128 * x132);
+        let x136 = 34.33891524 * x129;
+        let x137 = 34.74691524 * x132;
+        let x138 = c_q5 * x129 + s_q5 * x132;
+        let x139 = c_q5 * x132 - s_q5 * x129;
+        let x140 = s_q5 * x121 - c_q5 * x131 + qd[5] * x139;
+        let x141 = s_q5 * x131 + c_q5 * x121 - qd[5] * x138;
+        let x142 = qd[5] + x128;
+        let x143 = 1.903 * x142 + 0.385 * x138 + 0.966 * x139;
+        let x144 = 0.385 * x142 + 0.353 * x139;
+        let x145 = 0.966 * x142 + 0.353 * x138 + -0.9929999999999999 * x139;
+        let x146 = 1.903 * x130 + 0.385 * x140 + 0.966 * x141
+            + (x138 * x145 - x139 * x144);
+        let x147 = 0.385 * x130 + 0.353 * x141 + (x139 * x143 - x142 * x145);
+        let x148 = 0.966 * x130 + 0.353 * x140 + -0.9929999999999999 * x141
+            + (x142 * x144 - x138 * x143);
+        let x149 = x129 * x137 - x132 * x136 + x146;
+        let x150 = -34.45002 * (x119 - 0.4572 * x124)
+            - (34.33891524 * x131 + x128 * x137) + (c_q5 * x147 - s_q5 * x148);
+        let x151 = 34.74691524 * x121 + x128 * x136
             + 34.45002
-                * (c_q4 * (x120 - -0.4572 * x122)
-                    - s_q4 * (c_q3 * x102 - s_q3 * x103 - qd[3] * x118) - qd[4] * x133)
-            + (x129 * x138 - x133 * x140) + (s_q5 * x154 + c_q5 * x155);
-        let x159 = s_q4 * x142 + c_q4 * x143;
-        let x160 = -18.957952216000002 * x121
-            + (x118 * x127 + x115 * x128 - (x113 * x126 + x119 * x125))
-            + (c_q4 * x156 - s_q4 * x157);
-        let x161 = x123 * -41.67378 + (x117 * x128 - (x113 * x124 + x112 * x125))
-            + (s_q4 * x156 + c_q4 * x157 + -0.4572 * x144);
-        let x162 = 41.67378 * x120 + (x119 * x124 - x112 * x126 - x117 * x127)
-            + (x158 + 0.4572 * x159);
-        let x163 = x113 * x127 - x119 * x128 + (c_q4 * x142 - s_q4 * x143);
-        let x164 = x159 - (x122 * -41.67378 + x112 * x128);
-        let x165 = x112 * x127 + x144;
-        let x166 = c_q3 * x163 + s_q3 * x165;
-        let x167 = c_q3 * x165 - s_q3 * x163;
-        let x168 = -5594.523885531201 * x104 - 103.41030072000001 * x105
-            + x101 * 15.183612000000002
-            + (x100 * x108 - x94 * x107 + (x96 * x111 - x99 * x110))
-            + (c_q3 * x160 + s_q3 * x162 + 0.1524 * x164);
-        let x169 = 0.8021 * x104 - -0.08 * x105
-            + (-15.183612000000002 * x102 + x103 * -703.3878000000001)
-            + (x94 * x106 + x93 * x108 + (x99 * x109 + x98 * x111))
-            + (x161 + (-0.1524 * x166 + -7.06 * x167));
-        let x170 = 103.41030072000002 * x104 + 703.3878000000001 * x101
-            - (x100 * x106 + x93 * x107 + (x96 * x109 + x98 * x110))
-            + (c_q3 * x162 - s_q3 * x160 + 7.06 * x164);
-        let x171 = x94 * x110 - x100 * x111 + x166;
-        let x172 = x164
-            - (-15.183612000000002 * x104 - x105 * -703.3878000000001
-                + (x94 * x109 + x93 * x111));
-        let x173 = x100 * x109 + x93 * x110 + x167;
-        let x174 = tau[0]
+                * (c_q4 * (x117 + 0.4572 * x125)
+                    - s_q4 * (c_q3 * x116 + s_q3 * x118 - 0.4572 * x123))
+            + (s_q5 * x147 + c_q5 * x148);
+        let x152 = c_q4 * x134 - s_q4 * x133;
+        let x153 = 41.67378 * x123 + (c_q4 * x133 + s_q4 * x134);
+        let x154 = 41.67378 * x125 + x152;
+        let x155 = x135 - 41.67378 * x124;
+        let x156 = -18.957952216000002 * x120 - x115 * x127
+            + (c_q4 * x149 - s_q4 * x150);
+        let x157 = x119 * -41.67378 - x115 * x126
+            + (s_q4 * x149 + c_q4 * x150 + -0.4572 * x135);
+        let x158 = x122 * x126 - x114 * x127 + 41.67378 * x117 + (x151 + 0.4572 * x152);
+        let x159 = s_q3 * x155 - c_q3 * x153;
+        let x160 = s_q3 * x153 + c_q3 * x155;
+        let x161 = x159 - (703.3878000000001 * x106 + -15.183612000000002 * x107);
+        let x162 = -15.183612000000002 * x109 - 703.3878000000001 * x108 + x154;
+        let x163 = x160 - (703.3878000000001 * x107 + -15.183612000000002 * x110);
+        let x164 = -5594.523885531201 * x102 - 103.41030072000001 * x103
+            + (x104 * x113 - x96 * x112) + x98 * 15.183612000000002
+            + (c_q3 * x156 + s_q3 * x158 + 0.1524 * x154);
+        let x165 = 0.8021 * x102 - -0.08 * x103 + (x96 * x111 + x95 * x113)
+            + (-15.183612000000002 * x100 - x101 * -703.3878000000001)
+            + (x157 + (-0.1524 * x159 + -7.06 * x160));
+        let x166 = 103.41030072000002 * x102 - (x104 * x111 + x95 * x112)
+            + 703.3878000000001 * x98 + (c_q3 * x158 - s_q3 * x156 + 7.06 * x154);
+        let x167 = tau[0]
             - (c_q1
-                * (c_q2 * x170 - s_q2 * x168 + 6.377 * x172
-                    - (190.97044034000004 * x88 + (qd[1] * x90 + x86 * x91)))
+                * (c_q2 * x166 - s_q2 * x164 + 6.377 * x162
+                    - (190.97044034000004 * x88 + (qd[1] * x92 + x86 * x93)))
                 - s_q1
-                    * (qd[1] * x92 - x87 * x91
+                    * (qd[1] * x94 - x87 * x93
                         - (-8596.210051042 * x88 + 190.97044034 * x89)
-                        + (c_q2 * x168 + s_q2 * x170 + 0.1524 * x172)));
-        let x175 = 1.0
+                        + (c_q2 * x164 + s_q2 * x166 + 0.1524 * x162)));
+        let x168 = 1.0
             / (14222.257549666001
                 + (c_q1
                     * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
@@ -999,65 +1010,65 @@ impl Srms {
                             - s_q1
                                 * (-8596.210051042
                                     + (x70 + (c_q2 * x63 + s_q2 * x65 - x69))))));
-        let x176 = x73 * x175;
-        let x177 = x74 * x175;
-        let x178 = x75 * x175;
-        let x179 = x82 * x175;
-        let x180 = x85 * x175;
-        let x181 = 1.0
-            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x176);
-        let x182 = x58 + (x70 - x71) - x73 * x177;
-        let x183 = x181 * x182;
-        let x184 = x50
+        let x169 = x73 * x168;
+        let x170 = x74 * x168;
+        let x171 = x75 * x168;
+        let x172 = x82 * x168;
+        let x173 = x85 * x168;
+        let x174 = 1.0
+            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x169);
+        let x175 = x58 + (x70 - x71) - x73 * x170;
+        let x176 = x174 * x175;
+        let x177 = x50
             + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36))
-            - x73 * x178;
-        let x185 = x181 * x184;
-        let x186 = x80
+            - x73 * x171;
+        let x178 = x174 * x177;
+        let x179 = x80
             + (-0.1524 * (s_q2 * x77 - c_q2 * x76) + -6.377 * (s_q2 * x76 + c_q2 * x77))
-            - x73 * x179;
-        let x187 = x181 * x186;
-        let x188 = x23 - x73 * x180;
-        let x189 = x181 * x188;
-        let x190 = 1.0 / (x58 - x74 * x177 - x182 * x183);
-        let x191 = x50 - x74 * x178 - x182 * x185;
+            - x73 * x172;
+        let x180 = x174 * x179;
+        let x181 = x23 - x73 * x173;
+        let x182 = x174 * x181;
+        let x183 = 1.0 / (x58 - x74 * x170 - x175 * x176);
+        let x184 = x50 - x74 * x171 - x175 * x178;
+        let x185 = x183 * x184;
+        let x186 = x80 - x74 * x172 - x175 * x180;
+        let x187 = x183 * x186;
+        let x188 = x23 - x74 * x173 - x175 * x182;
+        let x189 = x183 * x188;
+        let x190 = 1.0 / (x35 - x75 * x171 - x177 * x178 - x184 * x185);
+        let x191 = x25 - x75 * x172 - x177 * x180 - x184 * x187;
         let x192 = x190 * x191;
-        let x193 = x80 - x74 * x179 - x182 * x187;
+        let x193 = x23 - x75 * x173 - x177 * x182 - x184 * x189;
         let x194 = x190 * x193;
-        let x195 = x23 - x74 * x180 - x182 * x189;
-        let x196 = x190 * x195;
-        let x197 = 1.0 / (x35 - x75 * x178 - x184 * x185 - x191 * x192);
-        let x198 = x25 - x75 * x179 - x184 * x187 - x191 * x194;
-        let x199 = x197 * x198;
-        let x200 = x23 - x75 * x180 - x184 * x189 - x191 * x196;
-        let x201 = x197 * x200;
-        let x202 = 1.0 / (x14 - x82 * x179 - x186 * x187 - x193 * x194 - x198 * x199);
-        let x203 = x9 - x82 * x180 - x186 * x189 - x193 * x196 - x198 * x201;
-        let x204 = x202 * x203;
-        let x205 = 1.0
-            / (1.903 - x85 * x180 - x188 * x189 - x195 * x196 - x200 * x201
-                - x203 * x204);
-        let x206 = tau[1]
-            - (x87 * x90 + x86 * x92 - (-1.928 * x88 + -0.0302 * x89)
-                + (x169
-                    + (-0.1524 * (c_q2 * x171 + s_q2 * x173)
-                        + -6.377 * (c_q2 * x173 - s_q2 * x171)))) - x174 * x176;
-        let x207 = tau[2] - x169 - x174 * x177 - x183 * x206;
-        let x208 = tau[3] - x161 - x174 * x178 - x185 * x206 - x192 * x207;
-        let x209 = tau[4] - x158 - x174 * x179 - x187 * x206 - x194 * x207 - x199 * x208;
-        let x210 = x205
-            * (tau[5] - x153 - x174 * x180 - x189 * x206 - x196 * x207 - x201 * x208
-                - x204 * x209);
-        let x211 = x202 * x209 - x204 * x210;
-        let x212 = x197 * x208 - x199 * x211 - x201 * x210;
-        let x213 = x190 * x207 - x192 * x212 - x194 * x211 - x196 * x210;
-        let x214 = x181 * x206 - x183 * x213 - x185 * x212 - x187 * x211 - x189 * x210;
-        let x215 = x174 * x175 - x176 * x214 - x177 * x213 - x178 * x212 - x179 * x211
-            - x180 * x210;
-        [x215, x214, x213, x212, x211, x210]
+        let x195 = 1.0 / (x14 - x82 * x172 - x179 * x180 - x186 * x187 - x191 * x192);
+        let x196 = x9 - x82 * x173 - x179 * x182 - x186 * x189 - x191 * x194;
+        let x197 = x195 * x196;
+        let x198 = 1.0
+            / (1.903 - x85 * x173 - x181 * x182 - x188 * x189 - x193 * x194
+                - x196 * x197);
+        let x199 = tau[1]
+            - (x87 * x92 + x86 * x94 - (-1.928 * x88 + -0.0302 * x89)
+                + (x165
+                    + (-0.1524 * (c_q2 * x161 + s_q2 * x163)
+                        + -6.377 * (c_q2 * x163 - s_q2 * x161)))) - x167 * x169;
+        let x200 = tau[2] - x165 - x167 * x170 - x176 * x199;
+        let x201 = tau[3] - x157 - x167 * x171 - x178 * x199 - x185 * x200;
+        let x202 = tau[4] - x151 - x167 * x172 - x180 * x199 - x187 * x200 - x192 * x201;
+        let x203 = x198
+            * (tau[5] - x146 - x167 * x173 - x182 * x199 - x189 * x200 - x194 * x201
+                - x197 * x202);
+        let x204 = x195 * x202 - x197 * x203;
+        let x205 = x190 * x201 - x192 * x204 - x194 * x203;
+        let x206 = x183 * x200 - x185 * x205 - x187 * x204 - x189 * x203;
+        let x207 = x174 * x199 - x176 * x206 - x178 * x205 - x180 * x204 - x182 * x203;
+        let x208 = x167 * x168 - x169 * x207 - x170 * x206 - x171 * x205 - x172 * x204
+            - x173 * x203;
+        [x208, x207, x206, x205, x204, x203]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 411 mul, 309 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 285 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1176,123 +1187,107 @@ impl Srms {
         let x92 = qd[0] * c_q1;
         let x93 = qd[1] * x92;
         let x94 = qd[1] * x91;
-        let x95 = -1.928 * qd[1] - -8596.210051042 * x91 + 190.97044034 * x92;
-        let x96 = 8609.573807858 * qd[1] - -1.928 * x91 + -0.0302 * x92;
-        let x97 = -0.0302 * qd[1] - 190.97044034000004 * x91;
-        let x98 = c_q2 * x91 + s_q2 * x92;
-        let x99 = c_q2 * x92 - s_q2 * x91;
-        let x100 = qd[1] * 0.1524;
-        let x101 = -6.377 * x92 - -0.1524 * x91;
-        let x102 = 6.377 * qd[1];
-        let x103 = s_q2 * x102 - c_q2 * x100;
-        let x104 = s_q2 * x100 + c_q2 * x102;
-        let x105 = qd[1] + qd[2];
-        let x106 = -0.1524 * x93 + -6.377 * x94;
-        let x107 = qd[2] * x104;
-        let x108 = qd[2] * x103;
-        let x109 = s_q2 * x94 - c_q2 * x93 - qd[2] * x99;
-        let x110 = s_q2 * x93 + c_q2 * x94 + qd[2] * x98;
-        let x111 = 0.8021 * x105 - -5594.523885531201 * x98 + 103.41030072000001 * x99
-            - x101 * 15.183612000000002;
-        let x112 = 5601.1318504688 * x105 - 0.8021 * x98 + -0.08 * x99
-            + (-15.183612000000002 * x103 - x104 * -703.3878000000001);
-        let x113 = -0.08 * x105 - 103.41030072000002 * x98 - 703.3878000000001 * x101;
-        let x114 = x105 * 15.183612000000002;
-        let x115 = x99 * -703.3878000000001 - -15.183612000000002 * x98;
-        let x116 = 703.3878000000001 * x105;
-        let x117 = c_q3 * x98 + s_q3 * x99;
-        let x118 = c_q3 * x99 - s_q3 * x98;
-        let x119 = x103 - 0.1524 * x105;
-        let x120 = x101 + (-7.06 * x99 - -0.1524 * x98);
-        let x121 = x104 + 7.06 * x105;
-        let x122 = c_q3 * x119 + s_q3 * x121;
-        let x123 = s_q3 * x119 - c_q3 * x121;
-        let x124 = qd[3] + x105;
-        let x125 = x106 - (-0.1524 * x109 - -7.06 * x110);
-        let x126 = c_q3 * x109 + s_q3 * x110 - qd[3] * x118;
-        let x127 = s_q3 * x109 - c_q3 * x110 - qd[3] * x117;
-        let x128 = s_q3 * x107 + c_q3 * x108 + qd[3] * x122;
-        let x129 = -18.957952216000002 * x117;
-        let x130 = 41.67378 * x120;
-        let x131 = 19.863252216000003 * x124 + x123 * -41.67378;
-        let x132 = x118 * -41.67378;
-        let x133 = 41.67378 * x124;
-        let x134 = s_q4 * x124 - c_q4 * x117;
-        let x135 = s_q4 * x117 + c_q4 * x124;
-        let x136 = x120 + -0.4572 * x118;
-        let x137 = x123 - 0.4572 * x124;
-        let x138 = c_q4 * x122 - s_q4 * x136;
-        let x139 = s_q4 * x122 + c_q4 * x136;
-        let x140 = qd[4] + x118;
-        let x141 = c_q4 * x126 + qd[4] * x135;
-        let x142 = s_q4 * x126 + qd[4] * x134;
-        let x143 = 34.33891524 * x135 + -34.45002 * x137;
-        let x144 = 34.74691524 * x140 - 34.45002 * x139;
-        let x145 = -34.45002 * x140;
-        let x146 = 34.45002 * x135;
-        let x147 = x140 * x145 - x135 * x146;
-        let x148 = x134 * x146 - -34.45002 * x127;
-        let x149 = 34.45002 * x142 - x134 * x145;
-        let x150 = c_q5 * x135 + s_q5 * x140;
-        let x151 = c_q5 * x140 - s_q5 * x135;
-        let x152 = qd[5] + x134;
-        let x153 = s_q5 * x127 - c_q5 * x142 + qd[5] * x151;
-        let x154 = s_q5 * x142 + c_q5 * x127 - qd[5] * x150;
-        let x155 = 1.903 * x152 + 0.385 * x150 + 0.966 * x151;
-        let x156 = 0.385 * x152 + 0.353 * x151;
-        let x157 = 0.966 * x152 + 0.353 * x150 + -0.9929999999999999 * x151;
-        let x158 = 1.903 * x141 + 0.385 * x153 + 0.966 * x154
-            + (x150 * x157 - x151 * x156);
-        let x159 = 0.385 * x141 + 0.353 * x154 + (x151 * x155 - x152 * x157);
-        let x160 = 0.966 * x141 + 0.353 * x153 + -0.9929999999999999 * x154
-            + (x152 * x156 - x150 * x155);
-        let x161 = x135 * x144 - x140 * x143 + (x137 * x145 + x139 * x146) + x158;
-        let x162 = -34.45002 * x128 - 34.33891524 * x142 + (x138 * x146 - x134 * x144)
-            + (c_q5 * x159 - s_q5 * x160);
-        let x163 = 34.74691524 * x127
+        let x95 = qd[1] * qd[1];
+        let x96 = x91 * x92;
+        let x97 = -1.928 * qd[1] - -8596.210051042 * x91 + 190.97044034 * x92;
+        let x98 = 8609.573807858 * qd[1] - -1.928 * x91 + -0.0302 * x92;
+        let x99 = -0.0302 * qd[1] - 190.97044034000004 * x91;
+        let x100 = c_q2 * x91 + s_q2 * x92;
+        let x101 = c_q2 * x92 - s_q2 * x91;
+        let x102 = 6.377 * (x95 + x92 * x92) + -0.1524 * x96;
+        let x103 = -0.1524 * (x93 + x93) - 6.377 * (x94 + x94);
+        let x104 = 6.377 * x96 + -0.1524 * (x95 + x91 * x91);
+        let x105 = s_q2 * x104 - c_q2 * x102;
+        let x106 = s_q2 * x102 + c_q2 * x104;
+        let x107 = s_q2 * x94 - c_q2 * x93 - qd[2] * x101;
+        let x108 = s_q2 * x93 + c_q2 * x94 + qd[2] * x100;
+        let x109 = qd[1] + qd[2];
+        let x110 = x109 * x109;
+        let x111 = x110 + x101 * x101;
+        let x112 = x100 * x101;
+        let x113 = x108 + x100 * x109;
+        let x114 = x101 * x109 - x107;
+        let x115 = x110 + x100 * x100;
+        let x116 = 0.8021 * x109 - -5594.523885531201 * x100 + 103.41030072000001 * x101;
+        let x117 = 5601.1318504688 * x109 - 0.8021 * x100 + -0.08 * x101;
+        let x118 = -0.08 * x109 - 103.41030072000002 * x100;
+        let x119 = c_q3 * x100 + s_q3 * x101;
+        let x120 = c_q3 * x101 - s_q3 * x100;
+        let x121 = x105 - (7.06 * x111 + -0.1524 * x112);
+        let x122 = x103 + (-0.1524 * x114 - 7.06 * x113);
+        let x123 = x106 + (7.06 * x112 + -0.1524 * x115);
+        let x124 = s_q3 * x121 - c_q3 * x123;
+        let x125 = c_q3 * x107 + s_q3 * x108 - qd[3] * x120;
+        let x126 = s_q3 * x107 - c_q3 * x108 - qd[3] * x119;
+        let x127 = qd[3] + x109;
+        let x128 = x127 * x127 + x120 * x120;
+        let x129 = x119 * x120;
+        let x130 = x126 - x119 * x127;
+        let x131 = -18.957952216000002 * x119;
+        let x132 = 19.863252216000003 * x127;
+        let x133 = s_q4 * x127 - c_q4 * x119;
+        let x134 = s_q4 * x119 + c_q4 * x127;
+        let x135 = c_q4 * x125 + qd[4] * x134;
+        let x136 = s_q4 * x125 + qd[4] * x133;
+        let x137 = qd[4] + x120;
+        let x138 = 34.45002 * (x134 * x134 + x137 * x137);
+        let x139 = 34.45002 * (x126 + x133 * x134);
+        let x140 = 34.45002 * (x136 + x133 * x137);
+        let x141 = 34.33891524 * x134;
+        let x142 = 34.74691524 * x137;
+        let x143 = c_q5 * x134 + s_q5 * x137;
+        let x144 = c_q5 * x137 - s_q5 * x134;
+        let x145 = s_q5 * x126 - c_q5 * x136 + qd[5] * x144;
+        let x146 = s_q5 * x136 + c_q5 * x126 - qd[5] * x143;
+        let x147 = qd[5] + x133;
+        let x148 = 1.903 * x147 + 0.385 * x143 + 0.966 * x144;
+        let x149 = 0.385 * x147 + 0.353 * x144;
+        let x150 = 0.966 * x147 + 0.353 * x143 + -0.9929999999999999 * x144;
+        let x151 = 1.903 * x135 + 0.385 * x145 + 0.966 * x146
+            + (x143 * x150 - x144 * x149);
+        let x152 = 0.385 * x135 + 0.353 * x146 + (x144 * x148 - x147 * x150);
+        let x153 = 0.966 * x135 + 0.353 * x145 + -0.9929999999999999 * x146
+            + (x147 * x149 - x143 * x148);
+        let x154 = x134 * x142 - x137 * x141 + x151;
+        let x155 = -34.45002 * (x124 - 0.4572 * x129)
+            - (34.33891524 * x136 + x133 * x142) + (c_q5 * x152 - s_q5 * x153);
+        let x156 = 34.74691524 * x126 + x133 * x141
             + 34.45002
-                * (c_q4 * (x125 - -0.4572 * x127)
-                    - s_q4 * (c_q3 * x107 - s_q3 * x108 - qd[3] * x123) - qd[4] * x138)
-            + (x134 * x143 - x138 * x145) + (s_q5 * x159 + c_q5 * x160);
-        let x164 = s_q4 * x147 + c_q4 * x148;
-        let x165 = -18.957952216000002 * x126
-            + (x123 * x132 + x120 * x133 - (x118 * x131 + x124 * x130))
-            + (c_q4 * x161 - s_q4 * x162);
-        let x166 = x128 * -41.67378 + (x122 * x133 - (x118 * x129 + x117 * x130))
-            + (s_q4 * x161 + c_q4 * x162 + -0.4572 * x149);
-        let x167 = 41.67378 * x125 + (x124 * x129 - x117 * x131 - x122 * x132)
-            + (x163 + 0.4572 * x164);
-        let x168 = x118 * x132 - x124 * x133 + (c_q4 * x147 - s_q4 * x148);
-        let x169 = x164 - (x127 * -41.67378 + x117 * x133);
-        let x170 = x117 * x132 + x149;
-        let x171 = c_q3 * x168 + s_q3 * x170;
-        let x172 = c_q3 * x170 - s_q3 * x168;
-        let x173 = -5594.523885531201 * x109 - 103.41030072000001 * x110
-            + x106 * 15.183612000000002
-            + (x105 * x113 - x99 * x112 + (x101 * x116 - x104 * x115))
-            + (c_q3 * x165 + s_q3 * x167 + 0.1524 * x169);
-        let x174 = 0.8021 * x109 - -0.08 * x110
-            + (-15.183612000000002 * x107 + x108 * -703.3878000000001)
-            + (x99 * x111 + x98 * x113 + (x104 * x114 + x103 * x116))
-            + (x166 + (-0.1524 * x171 + -7.06 * x172));
-        let x175 = 103.41030072000002 * x109 + 703.3878000000001 * x106
-            - (x105 * x111 + x98 * x112 + (x101 * x114 + x103 * x115))
-            + (c_q3 * x167 - s_q3 * x165 + 7.06 * x169);
-        let x176 = x99 * x115 - x105 * x116 + x171;
-        let x177 = x169
-            - (-15.183612000000002 * x109 - x110 * -703.3878000000001
-                + (x99 * x114 + x98 * x116));
-        let x178 = x105 * x114 + x98 * x115 + x172;
-        let x179 = x92 * x95 + x91 * x97 - (-1.928 * x93 + -0.0302 * x94)
-            + (x174
-                + (-0.1524 * (c_q2 * x176 + s_q2 * x178)
-                    + -6.377 * (c_q2 * x178 - s_q2 * x176)));
-        let x180 = c_q1
-            * (c_q2 * x175 - s_q2 * x173 + 6.377 * x177
-                - (190.97044034000004 * x93 + (qd[1] * x95 + x91 * x96)))
+                * (c_q4 * (x122 + 0.4572 * x130)
+                    - s_q4 * (c_q3 * x121 + s_q3 * x123 - 0.4572 * x128))
+            + (s_q5 * x152 + c_q5 * x153);
+        let x157 = c_q4 * x139 - s_q4 * x138;
+        let x158 = 41.67378 * x128 + (c_q4 * x138 + s_q4 * x139);
+        let x159 = 41.67378 * x130 + x157;
+        let x160 = x140 - 41.67378 * x129;
+        let x161 = -18.957952216000002 * x125 - x120 * x132
+            + (c_q4 * x154 - s_q4 * x155);
+        let x162 = x124 * -41.67378 - x120 * x131
+            + (s_q4 * x154 + c_q4 * x155 + -0.4572 * x140);
+        let x163 = x127 * x131 - x119 * x132 + 41.67378 * x122 + (x156 + 0.4572 * x157);
+        let x164 = s_q3 * x160 - c_q3 * x158;
+        let x165 = s_q3 * x158 + c_q3 * x160;
+        let x166 = x164 - (703.3878000000001 * x111 + -15.183612000000002 * x112);
+        let x167 = -15.183612000000002 * x114 - 703.3878000000001 * x113 + x159;
+        let x168 = x165 - (703.3878000000001 * x112 + -15.183612000000002 * x115);
+        let x169 = -5594.523885531201 * x107 - 103.41030072000001 * x108
+            + (x109 * x118 - x101 * x117) + x103 * 15.183612000000002
+            + (c_q3 * x161 + s_q3 * x163 + 0.1524 * x159);
+        let x170 = 0.8021 * x107 - -0.08 * x108 + (x101 * x116 + x100 * x118)
+            + (-15.183612000000002 * x105 - x106 * -703.3878000000001)
+            + (x162 + (-0.1524 * x164 + -7.06 * x165));
+        let x171 = 103.41030072000002 * x107 - (x109 * x116 + x100 * x117)
+            + 703.3878000000001 * x103 + (c_q3 * x163 - s_q3 * x161 + 7.06 * x159);
+        let x172 = x92 * x97 + x91 * x99 - (-1.928 * x93 + -0.0302 * x94)
+            + (x170
+                + (-0.1524 * (c_q2 * x166 + s_q2 * x168)
+                    + -6.377 * (c_q2 * x168 - s_q2 * x166)));
+        let x173 = c_q1
+            * (c_q2 * x171 - s_q2 * x169 + 6.377 * x167
+                - (190.97044034000004 * x93 + (qd[1] * x97 + x91 * x98)))
             - s_q1
-                * (qd[1] * x97 - x92 * x96 - (-8596.210051042 * x93 + 190.97044034 * x94)
-                    + (c_q2 * x173 + s_q2 * x175 + 0.1524 * x177));
+                * (qd[1] * x99 - x92 * x98 - (-8596.210051042 * x93 + 190.97044034 * x94)
+                    + (c_q2 * x169 + s_q2 * x171 + 0.1524 * x167));
         (
             [
                 [x75, x74, x77, x79, x87, x90],
@@ -1302,12 +1297,12 @@ impl Srms {
                 [x87, x86, x84, x25, x14, x9],
                 [x90, x23, x23, x23, x9, 1.903],
             ],
-            [x180, x179, x174, x166, x163, x158],
+            [x173, x172, x170, x162, x156, x151],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 503 mul, 412 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 469 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1409,129 +1404,116 @@ impl Srms {
         let x87 = qd[0] * c_q1;
         let x88 = qd[1] * x87;
         let x89 = qd[1] * x86;
-        let x90 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
-        let x91 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
-        let x92 = -0.0302 * qd[1] - 190.97044034000004 * x86;
-        let x93 = c_q2 * x86 + s_q2 * x87;
-        let x94 = c_q2 * x87 - s_q2 * x86;
-        let x95 = qd[1] * 0.1524;
-        let x96 = -6.377 * x87 - -0.1524 * x86;
-        let x97 = 6.377 * qd[1];
-        let x98 = s_q2 * x97 - c_q2 * x95;
-        let x99 = s_q2 * x95 + c_q2 * x97;
-        let x100 = qd[1] + qd[2];
-        let x101 = -0.1524 * x88 + -6.377 * x89;
-        let x102 = qd[2] * x99;
-        let x103 = qd[2] * x98;
-        let x104 = s_q2 * x89 - c_q2 * x88 - qd[2] * x94;
-        let x105 = s_q2 * x88 + c_q2 * x89 + qd[2] * x93;
-        let x106 = 0.8021 * x100 - -5594.523885531201 * x93 + 103.41030072000001 * x94
-            - x96 * 15.183612000000002;
-        let x107 = 5601.1318504688 * x100 - 0.8021 * x93 + -0.08 * x94
-            + (-15.183612000000002 * x98 - x99 * -703.3878000000001);
-        let x108 = -0.08 * x100 - 103.41030072000002 * x93 - 703.3878000000001 * x96;
-        let x109 = x100 * 15.183612000000002;
-        let x110 = x94 * -703.3878000000001 - -15.183612000000002 * x93;
-        let x111 = 703.3878000000001 * x100;
-        let x112 = c_q3 * x93 + s_q3 * x94;
-        let x113 = c_q3 * x94 - s_q3 * x93;
-        let x114 = x98 - 0.1524 * x100;
-        let x115 = x96 + (-7.06 * x94 - -0.1524 * x93);
-        let x116 = x99 + 7.06 * x100;
-        let x117 = c_q3 * x114 + s_q3 * x116;
-        let x118 = s_q3 * x114 - c_q3 * x116;
-        let x119 = qd[3] + x100;
-        let x120 = x101 - (-0.1524 * x104 - -7.06 * x105);
-        let x121 = c_q3 * x104 + s_q3 * x105 - qd[3] * x113;
-        let x122 = s_q3 * x104 - c_q3 * x105 - qd[3] * x112;
-        let x123 = s_q3 * x102 + c_q3 * x103 + qd[3] * x117;
-        let x124 = -18.957952216000002 * x112;
-        let x125 = 41.67378 * x115;
-        let x126 = 19.863252216000003 * x119 + x118 * -41.67378;
-        let x127 = x113 * -41.67378;
-        let x128 = 41.67378 * x119;
-        let x129 = s_q4 * x119 - c_q4 * x112;
-        let x130 = s_q4 * x112 + c_q4 * x119;
-        let x131 = x115 + -0.4572 * x113;
-        let x132 = x118 - 0.4572 * x119;
-        let x133 = c_q4 * x117 - s_q4 * x131;
-        let x134 = s_q4 * x117 + c_q4 * x131;
-        let x135 = qd[4] + x113;
-        let x136 = c_q4 * x121 + qd[4] * x130;
-        let x137 = s_q4 * x121 + qd[4] * x129;
-        let x138 = 34.33891524 * x130 + -34.45002 * x132;
-        let x139 = 34.74691524 * x135 - 34.45002 * x134;
-        let x140 = -34.45002 * x135;
-        let x141 = 34.45002 * x130;
-        let x142 = c_q5 * x130 + s_q5 * x135;
-        let x143 = c_q5 * x135 - s_q5 * x130;
-        let x144 = qd[5] + x129;
-        let x145 = s_q5 * x122 - c_q5 * x137 + qd[5] * x143;
-        let x146 = s_q5 * x137 + c_q5 * x122 - qd[5] * x142;
-        let x147 = 1.903 * x144 + 0.385 * x142 + 0.966 * x143;
-        let x148 = 0.385 * x144 + 0.353 * x143;
-        let x149 = 0.966 * x144 + 0.353 * x142 + -0.9929999999999999 * x143;
-        let x150 = 1.903 * x136 + 0.385 * x145 + 0.966 * x146
-            + (x142 * x149 - x143 * x148) - f_ext[5][3];
-        let x151 = 0.385 * x136 + 0.353 * x146 + (x143 * x147 - x144 * x149)
+        let x90 = qd[1] * qd[1];
+        let x91 = x86 * x87;
+        let x92 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
+        let x93 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
+        let x94 = -0.0302 * qd[1] - 190.97044034000004 * x86;
+        let x95 = c_q2 * x86 + s_q2 * x87;
+        let x96 = c_q2 * x87 - s_q2 * x86;
+        let x97 = 6.377 * (x90 + x87 * x87) + -0.1524 * x91;
+        let x98 = -0.1524 * (x88 + x88) - 6.377 * (x89 + x89);
+        let x99 = 6.377 * x91 + -0.1524 * (x90 + x86 * x86);
+        let x100 = s_q2 * x99 - c_q2 * x97;
+        let x101 = s_q2 * x97 + c_q2 * x99;
+        let x102 = s_q2 * x89 - c_q2 * x88 - qd[2] * x96;
+        let x103 = s_q2 * x88 + c_q2 * x89 + qd[2] * x95;
+        let x104 = qd[1] + qd[2];
+        let x105 = x104 * x104;
+        let x106 = x105 + x96 * x96;
+        let x107 = x95 * x96;
+        let x108 = x103 + x95 * x104;
+        let x109 = x96 * x104 - x102;
+        let x110 = x105 + x95 * x95;
+        let x111 = 0.8021 * x104 - -5594.523885531201 * x95 + 103.41030072000001 * x96;
+        let x112 = 5601.1318504688 * x104 - 0.8021 * x95 + -0.08 * x96;
+        let x113 = -0.08 * x104 - 103.41030072000002 * x95;
+        let x114 = c_q3 * x95 + s_q3 * x96;
+        let x115 = c_q3 * x96 - s_q3 * x95;
+        let x116 = x100 - (7.06 * x106 + -0.1524 * x107);
+        let x117 = x98 + (-0.1524 * x109 - 7.06 * x108);
+        let x118 = x101 + (7.06 * x107 + -0.1524 * x110);
+        let x119 = s_q3 * x116 - c_q3 * x118;
+        let x120 = c_q3 * x102 + s_q3 * x103 - qd[3] * x115;
+        let x121 = s_q3 * x102 - c_q3 * x103 - qd[3] * x114;
+        let x122 = qd[3] + x104;
+        let x123 = x122 * x122 + x115 * x115;
+        let x124 = x114 * x115;
+        let x125 = x121 - x114 * x122;
+        let x126 = -18.957952216000002 * x114;
+        let x127 = 19.863252216000003 * x122;
+        let x128 = s_q4 * x122 - c_q4 * x114;
+        let x129 = s_q4 * x114 + c_q4 * x122;
+        let x130 = c_q4 * x120 + qd[4] * x129;
+        let x131 = s_q4 * x120 + qd[4] * x128;
+        let x132 = qd[4] + x115;
+        let x133 = 34.33891524 * x129;
+        let x134 = 34.74691524 * x132;
+        let x135 = c_q5 * x129 + s_q5 * x132;
+        let x136 = c_q5 * x132 - s_q5 * x129;
+        let x137 = s_q5 * x121 - c_q5 * x131 + qd[5] * x136;
+        let x138 = s_q5 * x131 + c_q5 * x121 - qd[5] * x135;
+        let x139 = qd[5] + x128;
+        let x140 = 1.903 * x139 + 0.385 * x135 + 0.966 * x136;
+        let x141 = 0.385 * x139 + 0.353 * x136;
+        let x142 = 0.966 * x139 + 0.353 * x135 + -0.9929999999999999 * x136;
+        let x143 = 1.903 * x130 + 0.385 * x137 + 0.966 * x138
+            + (x135 * x142 - x136 * x141) - f_ext[5][3];
+        let x144 = 0.385 * x130 + 0.353 * x138 + (x136 * x140 - x139 * x142)
             - f_ext[5][4];
-        let x152 = 0.966 * x136 + 0.353 * x145 + -0.9929999999999999 * x146
-            + (x144 * x148 - x142 * x147) - f_ext[5][5];
-        let x153 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
-        let x154 = f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5;
-        let x155 = x130 * x139 - x135 * x138 + (x132 * x140 + x134 * x141) - f_ext[4][3]
-            + x150;
-        let x156 = -34.45002 * x123 - 34.33891524 * x137 + (x133 * x141 - x129 * x139)
-            - f_ext[4][4] + (c_q5 * x151 - s_q5 * x152 - -0.762 * x154);
-        let x157 = 34.74691524 * x122
+        let x145 = 0.966 * x130 + 0.353 * x137 + -0.9929999999999999 * x138
+            + (x139 * x141 - x135 * x140) - f_ext[5][5];
+        let x146 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
+        let x147 = f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5;
+        let x148 = f_ext[5][0] + (f_ext[4][0] + 34.45002 * (x129 * x129 + x132 * x132));
+        let x149 = 34.45002 * (x121 + x128 * x129) - f_ext[4][1] + x146;
+        let x150 = 34.45002 * (x131 + x128 * x132) - f_ext[4][2] - x147;
+        let x151 = x129 * x134 - x132 * x133 - f_ext[4][3] + x143;
+        let x152 = -34.45002 * (x119 - 0.4572 * x124)
+            - (34.33891524 * x131 + x128 * x134) - f_ext[4][4]
+            + (c_q5 * x144 - s_q5 * x145 - -0.762 * x147);
+        let x153 = 34.74691524 * x121 + x128 * x133
             + 34.45002
-                * (c_q4 * (x120 - -0.4572 * x122)
-                    - s_q4 * (c_q3 * x102 - s_q3 * x103 - qd[3] * x118) - qd[4] * x133)
-            + (x129 * x138 - x133 * x140) - f_ext[4][5]
-            + (s_q5 * x151 + c_q5 * x152 + 0.762 * x153);
-        let x158 = x135 * x140 - x130 * x141 - f_ext[4][0] - f_ext[5][0];
-        let x159 = x129 * x141 - -34.45002 * x122 - f_ext[4][1] + x153;
-        let x160 = 34.45002 * x137 - x129 * x140 - f_ext[4][2] - x154;
-        let x161 = s_q4 * x158 + c_q4 * x159;
-        let x162 = -18.957952216000002 * x121
-            + (x118 * x127 + x115 * x128 - (x113 * x126 + x119 * x125)) - f_ext[3][3]
-            + (c_q4 * x155 - s_q4 * x156);
-        let x163 = x123 * -41.67378 + (x117 * x128 - (x113 * x124 + x112 * x125))
-            - f_ext[3][4] + (s_q4 * x155 + c_q4 * x156 + -0.4572 * x160);
-        let x164 = 41.67378 * x120 + (x119 * x124 - x112 * x126 - x117 * x127)
-            - f_ext[3][5] + (x157 + 0.4572 * x161);
-        let x165 = x113 * x127 - x119 * x128 - f_ext[3][0] + (c_q4 * x158 - s_q4 * x159);
-        let x166 = x161 - (f_ext[3][1] + (x122 * -41.67378 + x112 * x128));
-        let x167 = x112 * x127 - f_ext[3][2] + x160;
-        let x168 = c_q3 * x165 + s_q3 * x167;
-        let x169 = c_q3 * x167 - s_q3 * x165;
-        let x170 = -5594.523885531201 * x104 - 103.41030072000001 * x105
-            + x101 * 15.183612000000002
-            + (x100 * x108 - x94 * x107 + (x96 * x111 - x99 * x110)) - f_ext[2][3]
-            + (c_q3 * x162 + s_q3 * x164 + 0.1524 * x166);
-        let x171 = 0.8021 * x104 - -0.08 * x105
-            + (-15.183612000000002 * x102 + x103 * -703.3878000000001)
-            + (x94 * x106 + x93 * x108 + (x99 * x109 + x98 * x111)) - f_ext[2][4]
-            + (x163 + (-0.1524 * x168 + -7.06 * x169));
-        let x172 = 103.41030072000002 * x104 + 703.3878000000001 * x101
-            - (x100 * x106 + x93 * x107 + (x96 * x109 + x98 * x110)) - f_ext[2][5]
-            + (c_q3 * x164 - s_q3 * x162 + 7.06 * x166);
-        let x173 = x94 * x110 - x100 * x111 - f_ext[2][0] + x168;
-        let x174 = x166
-            - (f_ext[2][1]
-                + (-15.183612000000002 * x104 - x105 * -703.3878000000001
-                    + (x94 * x109 + x93 * x111)));
-        let x175 = x100 * x109 + x93 * x110 - f_ext[2][2] + x169;
-        let x176 = tau[0]
+                * (c_q4 * (x117 + 0.4572 * x125)
+                    - s_q4 * (c_q3 * x116 + s_q3 * x118 - 0.4572 * x123)) - f_ext[4][5]
+            + (s_q5 * x144 + c_q5 * x145 + 0.762 * x146);
+        let x154 = c_q4 * x149 - s_q4 * x148;
+        let x155 = f_ext[3][0] + 41.67378 * x123 + (c_q4 * x148 + s_q4 * x149);
+        let x156 = 41.67378 * x125 - f_ext[3][1] + x154;
+        let x157 = x150 - (f_ext[3][2] + 41.67378 * x124);
+        let x158 = -18.957952216000002 * x120 - x115 * x127 - f_ext[3][3]
+            + (c_q4 * x151 - s_q4 * x152);
+        let x159 = x119 * -41.67378 - x115 * x126 - f_ext[3][4]
+            + (s_q4 * x151 + c_q4 * x152 + -0.4572 * x150);
+        let x160 = x122 * x126 - x114 * x127 + 41.67378 * x117 - f_ext[3][5]
+            + (x153 + 0.4572 * x154);
+        let x161 = s_q3 * x157 - c_q3 * x155;
+        let x162 = s_q3 * x155 + c_q3 * x157;
+        let x163 = x161
+            - (f_ext[2][0] + (703.3878000000001 * x106 + -15.183612000000002 * x107));
+        let x164 = -15.183612000000002 * x109 - 703.3878000000001 * x108 - f_ext[2][1]
+            + x156;
+        let x165 = x162
+            - (f_ext[2][2] + (703.3878000000001 * x107 + -15.183612000000002 * x110));
+        let x166 = -5594.523885531201 * x102 - 103.41030072000001 * x103
+            + (x104 * x113 - x96 * x112) + x98 * 15.183612000000002 - f_ext[2][3]
+            + (c_q3 * x158 + s_q3 * x160 + 0.1524 * x156);
+        let x167 = 0.8021 * x102 - -0.08 * x103 + (x96 * x111 + x95 * x113)
+            + (-15.183612000000002 * x100 - x101 * -703.3878000000001) - f_ext[2][4]
+            + (x159 + (-0.1524 * x161 + -7.06 * x162));
+        let x168 = 103.41030072000002 * x102 - (x104 * x111 + x95 * x112)
+            + 703.3878000000001 * x98 - f_ext[2][5]
+            + (c_q3 * x160 - s_q3 * x158 + 7.06 * x156);
+        let x169 = tau[0]
             - (c_q1
-                * (c_q2 * x172 - s_q2 * x170 + 6.377 * x174
+                * (c_q2 * x168 - s_q2 * x166 + 6.377 * x164
                     - (f_ext[1][5]
-                        + (190.97044034000004 * x88 + (qd[1] * x90 + x86 * x91))))
+                        + (190.97044034000004 * x88 + (qd[1] * x92 + x86 * x93))))
                 - s_q1
-                    * (qd[1] * x92 - x87 * x91
+                    * (qd[1] * x94 - x87 * x93
                         - (-8596.210051042 * x88 + 190.97044034 * x89) - f_ext[1][3]
-                        + (c_q2 * x170 + s_q2 * x172 + 0.1524 * x174)) - f_ext[0][5]);
-        let x177 = 1.0
+                        + (c_q2 * x166 + s_q2 * x168 + 0.1524 * x164)) - f_ext[0][5]);
+        let x170 = 1.0
             / (14222.257549666001
                 + (c_q1
                     * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
@@ -1545,60 +1527,60 @@ impl Srms {
                             - s_q1
                                 * (-8596.210051042
                                     + (x70 + (c_q2 * x63 + s_q2 * x65 - x69))))));
-        let x178 = x73 * x177;
-        let x179 = x74 * x177;
-        let x180 = x75 * x177;
-        let x181 = x82 * x177;
-        let x182 = x85 * x177;
-        let x183 = 1.0
-            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x178);
-        let x184 = x58 + (x70 - x71) - x73 * x179;
-        let x185 = x183 * x184;
-        let x186 = x50
+        let x171 = x73 * x170;
+        let x172 = x74 * x170;
+        let x173 = x75 * x170;
+        let x174 = x82 * x170;
+        let x175 = x85 * x170;
+        let x176 = 1.0
+            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x171);
+        let x177 = x58 + (x70 - x71) - x73 * x172;
+        let x178 = x176 * x177;
+        let x179 = x50
             + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36))
-            - x73 * x180;
-        let x187 = x183 * x186;
-        let x188 = x80
+            - x73 * x173;
+        let x180 = x176 * x179;
+        let x181 = x80
             + (-0.1524 * (s_q2 * x77 - c_q2 * x76) + -6.377 * (s_q2 * x76 + c_q2 * x77))
-            - x73 * x181;
-        let x189 = x183 * x188;
-        let x190 = x23 - x73 * x182;
-        let x191 = x183 * x190;
-        let x192 = 1.0 / (x58 - x74 * x179 - x184 * x185);
-        let x193 = x50 - x74 * x180 - x184 * x187;
+            - x73 * x174;
+        let x182 = x176 * x181;
+        let x183 = x23 - x73 * x175;
+        let x184 = x176 * x183;
+        let x185 = 1.0 / (x58 - x74 * x172 - x177 * x178);
+        let x186 = x50 - x74 * x173 - x177 * x180;
+        let x187 = x185 * x186;
+        let x188 = x80 - x74 * x174 - x177 * x182;
+        let x189 = x185 * x188;
+        let x190 = x23 - x74 * x175 - x177 * x184;
+        let x191 = x185 * x190;
+        let x192 = 1.0 / (x35 - x75 * x173 - x179 * x180 - x186 * x187);
+        let x193 = x25 - x75 * x174 - x179 * x182 - x186 * x189;
         let x194 = x192 * x193;
-        let x195 = x80 - x74 * x181 - x184 * x189;
+        let x195 = x23 - x75 * x175 - x179 * x184 - x186 * x191;
         let x196 = x192 * x195;
-        let x197 = x23 - x74 * x182 - x184 * x191;
-        let x198 = x192 * x197;
-        let x199 = 1.0 / (x35 - x75 * x180 - x186 * x187 - x193 * x194);
-        let x200 = x25 - x75 * x181 - x186 * x189 - x193 * x196;
-        let x201 = x199 * x200;
-        let x202 = x23 - x75 * x182 - x186 * x191 - x193 * x198;
-        let x203 = x199 * x202;
-        let x204 = 1.0 / (x14 - x82 * x181 - x188 * x189 - x195 * x196 - x200 * x201);
-        let x205 = x9 - x82 * x182 - x188 * x191 - x195 * x198 - x200 * x203;
-        let x206 = x204 * x205;
-        let x207 = 1.0
-            / (1.903 - x85 * x182 - x190 * x191 - x197 * x198 - x202 * x203
-                - x205 * x206);
-        let x208 = tau[1]
-            - (x87 * x90 + x86 * x92 - (-1.928 * x88 + -0.0302 * x89) - f_ext[1][4]
-                + (x171
-                    + (-0.1524 * (c_q2 * x173 + s_q2 * x175)
-                        + -6.377 * (c_q2 * x175 - s_q2 * x173)))) - x176 * x178;
-        let x209 = tau[2] - x171 - x176 * x179 - x185 * x208;
-        let x210 = tau[3] - x163 - x176 * x180 - x187 * x208 - x194 * x209;
-        let x211 = tau[4] - x157 - x176 * x181 - x189 * x208 - x196 * x209 - x201 * x210;
-        let x212 = x207
-            * (tau[5] - x150 - x176 * x182 - x191 * x208 - x198 * x209 - x203 * x210
-                - x206 * x211);
-        let x213 = x204 * x211 - x206 * x212;
-        let x214 = x199 * x210 - x201 * x213 - x203 * x212;
-        let x215 = x192 * x209 - x194 * x214 - x196 * x213 - x198 * x212;
-        let x216 = x183 * x208 - x185 * x215 - x187 * x214 - x189 * x213 - x191 * x212;
-        let x217 = x176 * x177 - x178 * x216 - x179 * x215 - x180 * x214 - x181 * x213
-            - x182 * x212;
-        [x217, x216, x215, x214, x213, x212]
+        let x197 = 1.0 / (x14 - x82 * x174 - x181 * x182 - x188 * x189 - x193 * x194);
+        let x198 = x9 - x82 * x175 - x181 * x184 - x188 * x191 - x193 * x196;
+        let x199 = x197 * x198;
+        let x200 = 1.0
+            / (1.903 - x85 * x175 - x183 * x184 - x190 * x191 - x195 * x196
+                - x198 * x199);
+        let x201 = tau[1]
+            - (x87 * x92 + x86 * x94 - (-1.928 * x88 + -0.0302 * x89) - f_ext[1][4]
+                + (x167
+                    + (-0.1524 * (c_q2 * x163 + s_q2 * x165)
+                        + -6.377 * (c_q2 * x165 - s_q2 * x163)))) - x169 * x171;
+        let x202 = tau[2] - x167 - x169 * x172 - x178 * x201;
+        let x203 = tau[3] - x159 - x169 * x173 - x180 * x201 - x187 * x202;
+        let x204 = tau[4] - x153 - x169 * x174 - x182 * x201 - x189 * x202 - x194 * x203;
+        let x205 = x200
+            * (tau[5] - x143 - x169 * x175 - x184 * x201 - x191 * x202 - x196 * x203
+                - x199 * x204);
+        let x206 = x197 * x204 - x199 * x205;
+        let x207 = x192 * x203 - x194 * x206 - x196 * x205;
+        let x208 = x185 * x202 - x187 * x207 - x189 * x206 - x191 * x205;
+        let x209 = x176 * x201 - x178 * x208 - x180 * x207 - x182 * x206 - x184 * x205;
+        let x210 = x169 * x170 - x171 * x209 - x172 * x208 - x173 * x207 - x174 * x206
+            - x175 * x205;
+        [x210, x209, x208, x207, x206, x205]
     }
 }

@@ -19,19 +19,24 @@
 //! | `mass_matrix` * | `crba` | — | 170 | 116 | 0 | 0 | 5 | 286 |
 //! | `nonlinear_effects` | — | `recurrent` | 618 | 450 | 0 | 0 | 7 | 1068 |
 //! | `nonlinear_effects` | — | `kane-direct` | 708 | 536 | 0 | 0 | 7 | 1244 |
-//! | `nonlinear_effects` * | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `nonlinear_effects` | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `nonlinear_effects` * | — | `newton-euler` | 207 | 142 | 0 | 0 | 6 | 349 |
 //! | `inverse_dynamics` | — | `recurrent` | 827 | 607 | 0 | 0 | 7 | 1434 |
 //! | `inverse_dynamics` | — | `kane-direct` | 917 | 693 | 0 | 0 | 7 | 1610 |
-//! | `inverse_dynamics` * | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `inverse_dynamics` | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `inverse_dynamics` * | — | `newton-euler` | 217 | 157 | 0 | 0 | 6 | 374 |
 //! | `forward_dynamics` | `crba` | `recurrent` | 914 | 667 | 7 | 0 | 7 | 1581 |
 //! | `forward_dynamics` | `crba` | `kane-direct` | 1004 | 753 | 7 | 0 | 7 | 1757 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `forward_dynamics` | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | 503 | 359 | 7 | 0 | 6 | 862 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 788 | 566 | 0 | 0 | 7 | 1354 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 878 | 652 | 0 | 0 | 7 | 1530 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 377 | 258 | 0 | 0 | 6 | 635 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1018 | 772 | 7 | 0 | 7 | 1790 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1108 | 858 | 7 | 0 | 7 | 1966 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 515 | 403 | 7 | 0 | 6 | 918 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms;
@@ -99,9 +104,9 @@ impl Ssrms {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 256u64,
-            add: 176u64,
+            bias_method: Some("newton-euler"),
+            mul: 207u64,
+            add: 142u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -110,9 +115,9 @@ impl Ssrms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 268u64,
-            add: 191u64,
+            bias_method: Some("newton-euler"),
+            mul: 217u64,
+            add: 157u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -121,9 +126,9 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 552u64,
-            add: 393u64,
+            bias_method: Some("newton-euler"),
+            mul: 503u64,
+            add: 359u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -132,9 +137,9 @@ impl Ssrms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 426u64,
-            add: 292u64,
+            bias_method: Some("newton-euler"),
+            mul: 377u64,
+            add: 258u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -143,9 +148,9 @@ impl Ssrms {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 564u64,
-            add: 437u64,
+            bias_method: Some("newton-euler"),
+            mul: 515u64,
+            add: 403u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -243,6 +248,17 @@ impl Ssrms {
             fma: 0u64,
         },
         OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 207u64,
+            add: 142u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
@@ -270,6 +286,17 @@ impl Ssrms {
             bias_method: Some("rnea"),
             mul: 268u64,
             add: 191u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 217u64,
+            add: 157u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -309,6 +336,17 @@ impl Ssrms {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 503u64,
+            add: 359u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -342,6 +380,17 @@ impl Ssrms {
             fma: 0u64,
         },
         OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 377u64,
+            add: 258u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -369,6 +418,17 @@ impl Ssrms {
             bias_method: Some("rnea"),
             mul: 564u64,
             add: 437u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 515u64,
+            add: 403u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -496,283 +556,241 @@ impl Ssrms {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 256 mul, 176 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `newton-euler`: 207 mul, 142 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * qd[0];
-        let x4 = s_q1 * x3;
-        let x5 = c_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = qd[1] * x1;
-        let x8 = qd[1] * x5;
-        let x9 = qd[1] * x4;
-        let x10 = -65693.9112265768 * x2;
-        let x11 = 65697.3302265768 * qd[1] - x4 * 1145.5438279999998;
-        let x12 = -1145.5438279999998 * qd[1];
-        let x13 = x1 * 1145.5438279999998;
+        let x3 = 0.7026 * (qd[0] * qd[0]);
+        let x4 = qd[1] * x2;
+        let x5 = qd[1] * x1;
+        let x6 = x1 * x2;
+        let x7 = qd[1] * qd[1] + x1 * x1;
+        let x8 = -65693.9112265768 * x2;
+        let x9 = 65697.3302265768 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x15 = x1 * c_q2 - qd[1] * s_q2;
-        let x16 = x1 * s_q2 + qd[1] * c_q2;
-        let x17 = x1 * 0.5692;
-        let x18 = x4 + -0.5692 * qd[1];
-        let x19 = s_q2 * x17 - c_q2 * x18;
-        let x20 = s_q2 * x18 + c_q2 * x17;
-        let x21 = qd[2] - x2;
-        let x22 = x6 * 0.5692;
-        let x23 = x6 * c_q2 + qd[2] * x16;
-        let x24 = qd[2] * x15 - x6 * s_q2;
-        let x25 = c_q2 * x22 - x8 * s_q2 + qd[2] * x19;
-        let x26 = -39234.47412200001 * x15 + 3946.18812068 * x21;
-        let x27 = 5224.5702 * x5;
-        let x28 = 3946.1881206800003 * x15 + 39241.404122 * x21 - x20 * -5224.5702;
-        let x29 = x16 * -5224.5702;
-        let x30 = 5224.5702 * x21;
+        let x11 = x1 * c_q2 - qd[1] * s_q2;
+        let x12 = x1 * s_q2 + qd[1] * c_q2;
+        let x13 = -0.5692 * x6;
+        let x14 = -0.5692 * x7;
+        let x15 = x3 + -0.5692 * (x4 + x4);
+        let x16 = s_q2 * x13 + c_q2 * x15;
+        let x17 = x4 * c_q2 + qd[2] * x12;
+        let x18 = qd[2] * x11 - x4 * s_q2;
+        let x19 = qd[2] - x2;
+        let x20 = x12 * x12;
+        let x21 = x19 * x19 + x20;
+        let x22 = x11 * x19;
+        let x23 = x18 + x22;
+        let x24 = x5 + x11 * x12;
+        let x25 = -39234.47412200001 * x11 + 3946.18812068 * x19;
+        let x26 = 3946.1881206800003 * x11 + 39241.404122 * x19;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x32 = x15 * c_q3 - x16 * s_q3;
-        let x33 = x15 * s_q3 + x16 * c_q3;
-        let x34 = x19 - -0.475 * x16;
-        let x35 = x5 + x16 * -7.11;
-        let x36 = x20 + (x15 * 0.475 + 7.11 * x21);
-        let x37 = c_q3 * x34 + s_q3 * x36;
-        let x38 = s_q3 * x34 - c_q3 * x36;
-        let x39 = qd[3] + x21;
-        let x40 = 7.11 * x7;
-        let x41 = qd[2] * x20 - (x8 * c_q2 + s_q2 * x22) - -0.475 * x24;
-        let x42 = x9 - x24 * -7.11;
-        let x43 = x25 + (x23 * 0.475 + x40);
-        let x44 = x23 * c_q3 + x24 * s_q3 + qd[3] * x33;
-        let x45 = x24 * c_q3 - x23 * s_q3 + qd[3] * x32;
-        let x46 = s_q3 * x41 + c_q3 * x43 + qd[3] * x37;
-        let x47 = -24989.305802 * x32 + 1375.0472756800002 * x39;
-        let x48 = 3239.4582 * x35;
-        let x49 = 1375.0472756800002 * x32 + 24998.827802 * x39 + x38 * -3239.4582;
-        let x50 = x33 * -3239.4582;
-        let x51 = 3239.4582 * x39;
+        let x28 = x11 * c_q3 - x12 * s_q3;
+        let x29 = x11 * s_q3 + x12 * c_q3;
+        let x30 = s_q2 * x15 - c_q2 * x13 + (-0.475 * (x22 - x18) - 7.11 * x21);
+        let x31 = 7.11 * x23 - -0.475 * (x20 + x11 * x11) - x14;
+        let x32 = 7.11 * x24 + -0.475 * (x12 * x19 - x17) - x16;
+        let x33 = s_q3 * x30 + c_q3 * x32;
+        let x34 = x17 * c_q3 + x18 * s_q3 + qd[3] * x29;
+        let x35 = x18 * c_q3 - x17 * s_q3 + qd[3] * x28;
+        let x36 = qd[3] + x19;
+        let x37 = x36 * x36 + x29 * x29;
+        let x38 = x35 + x28 * x36;
+        let x39 = x5 + x28 * x29;
+        let x40 = -24989.305802 * x28 + 1375.0472756800002 * x36;
+        let x41 = 1375.0472756800002 * x28 + 24998.827802 * x36;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x53 = x32 * c_q4 - x33 * s_q4;
-        let x54 = x32 * s_q4 + x33 * c_q4;
-        let x55 = x35 + x33 * -7.11;
-        let x56 = x38 - 7.11 * x39;
-        let x57 = x37 * c_q4 - s_q4 * x56;
-        let x58 = x37 * s_q4 + c_q4 * x56;
-        let x59 = qd[4] + x39;
-        let x60 = x44 * c_q4 + x45 * s_q4 + qd[4] * x54;
-        let x61 = x45 * c_q4 - x44 * s_q4 + qd[4] * x53;
-        let x62 = -97.44448770720001 * x59;
-        let x63 = 132.6783695416 * x53 - x55 * 171.195516;
-        let x64 = 135.4729695416 * x59 + -97.44448770720001 * x54 + -171.195516 * x57;
-        let x65 = x59 * 171.195516;
-        let x66 = -171.195516 * x53;
-        let x67 = x59 * x65 - x53 * x66;
-        let x68 = x7 * 171.195516 + x54 * x66;
-        let x69 = -171.195516 * x60 - x54 * x65;
+        let x43 = x28 * c_q4 - x29 * s_q4;
+        let x44 = x28 * s_q4 + x29 * c_q4;
+        let x45 = x34 * c_q4 + x35 * s_q4 + qd[4] * x44;
+        let x46 = x35 * c_q4 - x34 * s_q4 + qd[4] * x43;
+        let x47 = qd[4] + x36;
+        let x48 = -171.195516 * (x43 * x44 - x5);
+        let x49 = -171.195516 * (x45 + x44 * x47);
+        let x50 = -171.195516 * (x47 * x47 + x43 * x43);
+        let x51 = 132.6783695416 * x43;
+        let x52 = 135.4729695416 * x47 + -97.44448770720001 * x44;
+        let x53 = -97.44448770720001 * x47;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x71 = x53 * c_q5 + x59 * s_q5;
-        let x72 = x59 * c_q5 - x53 * s_q5;
-        let x73 = qd[5] + x54;
-        let x74 = 44.41 * x72;
-        let x75 = 47.471 * x73;
+        let x55 = x43 * c_q5 + x47 * s_q5;
+        let x56 = x47 * c_q5 - x43 * s_q5;
+        let x57 = qd[5] + x44;
+        let x58 = 44.41 * x56;
+        let x59 = 47.471 * x57;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x77 = 9.336 * (qd[5] * x72 - (x60 * c_q5 + x7 * s_q5));
-        let x78 = 9.336 * (qd[6] + x71);
-        let x79 = (x73 * c_q6 - x72 * s_q6) * x78;
-        let x80 = (x72 * c_q6 + x73 * s_q6) * x78;
-        let x81 = x72 * x75 - x73 * x74 + x77;
-        let x82 = 44.41 * (x60 * s_q5 - x7 * c_q5 - qd[5] * x71) - x71 * x75
-            + (c_q6 * x79 + s_q6 * x80);
-        let x83 = 47.471 * x61 + x71 * x74 + (s_q6 * x79 - c_q6 * x80);
-        let x84 = (x42 - -7.11 * x45) * 171.195516 - 132.6783695416 * x60
-            + (x59 * x62 - x54 * x64 + x58 * x66) + (c_q5 * x81 - s_q5 * x82);
-        let x85 = -97.44448770720001 * x61 - 135.4729695416 * x7
+        let x61 = 9.336 * (qd[5] * x56 - (x45 * c_q5 + x5 * s_q5));
+        let x62 = 9.336 * (qd[6] + x55);
+        let x63 = (x57 * c_q6 - x56 * s_q6) * x62;
+        let x64 = (x56 * c_q6 + x57 * s_q6) * x62;
+        let x65 = x56 * x59 - x57 * x58 + x61;
+        let x66 = 44.41 * (x45 * s_q5 - x5 * c_q5 - qd[5] * x55) - x55 * x59
+            + (c_q6 * x63 + s_q6 * x64);
+        let x67 = 47.471 * x46 + x55 * x58 + (s_q6 * x63 - c_q6 * x64);
+        let x68 = x47 * x53 - x44 * x52 - 132.6783695416 * x45
+            + (x31 + 7.11 * x38) * 171.195516 + (c_q5 * x65 - s_q5 * x66);
+        let x69 = -97.44448770720001 * x46 - 135.4729695416 * x5
+            + (x44 * x51 - x43 * x53)
             + -171.195516
-                * ((c_q3 * x41 - s_q3 * x43 - qd[3] * x38) * c_q4 - s_q4 * (x40 + x46)
-                    - qd[4] * x58) + (x54 * x63 - x53 * x62 - x58 * x65)
-            + (s_q5 * x81 + c_q5 * x82);
-        let x86 = x53 * x64 - x59 * x63 - (x55 * x65 + x57 * x66)
-            - -97.44448770720001 * x7 + x83;
-        let x87 = c_q4 * x67 - s_q4 * x68;
-        let x88 = x38 * x50 + x35 * x51 - (x33 * x49 + x39 * x48)
-            - (-24989.305802 * x44 + 1375.0472756800002 * x7)
-            + (c_q4 * x84 + s_q4 * x86);
-        let x89 = x46 * -3239.4582 - (1375.0472756800002 * x44 + 24998.827802 * x7)
-            + (x33 * x47 + x32 * x48 + x37 * x51) + (x85 + -7.11 * x87);
-        let x90 = 3239.4582 * x42 + (x32 * x49 - x39 * x47 - x37 * x50)
-            + (c_q4 * x86 - s_q4 * x84 + 7.11 * x69);
-        let x91 = x33 * x50 - x39 * x51 + (c_q4 * x68 + s_q4 * x67);
-        let x92 = x32 * x51 - x45 * -3239.4582 + x69;
-        let x93 = 3239.4582 * x7 - x32 * x50 + x87;
-        let x94 = c_q3 * x91 + s_q3 * x93;
-        let x95 = c_q3 * x93 - s_q3 * x91;
-        let x96 = x5 * x30 - x20 * x29 - (x16 * x28 + x21 * x27)
-            - (-39234.47412200001 * x23 + 3946.18812068 * x7)
-            + (c_q3 * x88 + s_q3 * x90 + -0.475 * x95);
-        let x97 = x25 * -5224.5702 - (3946.1881206800003 * x23 + 39241.404122 * x7)
-            + (x16 * x26 + x15 * x27 + x19 * x30) + (x89 + -7.11 * x95);
-        let x98 = 5224.5702 * x9 + (x15 * x28 - x21 * x26 - x19 * x29)
-            + (c_q3 * x90 - s_q3 * x88 + (0.475 * x94 + 7.11 * x92));
-        let x99 = x16 * x29 - x21 * x30 + x94;
-        let x100 = 5224.5702 * x7 - x15 * x29 + x95;
-        let x101 = c_q2 * x99 + s_q2 * x100;
-        let x102 = c_q2 * x98 - s_q2 * x96 + 0.5692 * x101
-            - (x8 * 1145.5438279999998 + (x1 * x10 + x5 * x12));
-        let x103 = c_q1
-            * (qd[1] * x10 - x2 * x11 + x5 * x13
-                + (c_q2 * x96 + s_q2 * x98 + -0.5692 * (c_q2 * x100 - s_q2 * x99)))
-            - s_q1 * (x97 - (-65693.9112265768 * x7 + (x1 * x11 + x4 * x13)))
+                * (c_q4 * (c_q3 * x30 - s_q3 * x32 - 7.11 * x37)
+                    - s_q4 * (x33 + 7.11 * x39)) + (s_q5 * x65 + c_q5 * x66);
+        let x70 = x43 * x52 - x47 * x51 - -97.44448770720001 * x5 + x67;
+        let x71 = s_q4 * x48 + c_q4 * x50;
+        let x72 = c_q4 * x48 - s_q4 * x50 - 3239.4582 * x37;
+        let x73 = 3239.4582 * x38 + x49;
+        let x74 = 3239.4582 * x39 - x71;
+        let x75 = c_q4 * x68 + s_q4 * x70
+            - (-24989.305802 * x34 + 1375.0472756800002 * x5 + x29 * x41);
+        let x76 = x29 * x40 - (1375.0472756800002 * x34 + 24998.827802 * x5)
+            + x33 * -3239.4582 + (x69 - x71 * -7.11);
+        let x77 = x28 * x41 - x36 * x40 + 3239.4582 * x31
+            + (c_q4 * x70 - s_q4 * x68 + 7.11 * x49);
+        let x78 = c_q3 * x72 + s_q3 * x74;
+        let x79 = c_q3 * x74 - s_q3 * x72;
+        let x80 = x78 - 5224.5702 * x21;
+        let x81 = 5224.5702 * x24 + x79;
+        let x82 = c_q3 * x75 + s_q3 * x77 + -0.475 * x79
+            - (-39234.47412200001 * x17 + 3946.18812068 * x5 + x12 * x26);
+        let x83 = x12 * x25 - (3946.1881206800003 * x17 + 39241.404122 * x5)
+            - x16 * -5224.5702 + (x76 + -7.11 * x79);
+        let x84 = x11 * x26 - x19 * x25 - 5224.5702 * x14
+            + (c_q3 * x77 - s_q3 * x75 + (x78 * 0.475 + 7.11 * x73));
+        let x85 = c_q2 * x80 + s_q2 * x81;
+        let x86 = c_q2 * x84 - s_q2 * x82 + 0.5692 * x85 - x1 * x8;
+        let x87 = c_q1
+            * (qd[1] * x8 - x2 * x9 - -1145.5438279999998 * x3
+                + (c_q2 * x82 + s_q2 * x84 + -0.5692 * (c_q2 * x81 - s_q2 * x80)))
+            - s_q1 * (x83 - (-65693.9112265768 * x5 + x1 * x9))
             + -0.7026
-                * (s_q1 * (x2 * x13 + x101)
-                    + c_q1
-                        * (x1 * x13 - qd[1] * x12
-                            + (x15 * x30 - x24 * -5224.5702 + x92)));
-        [x103, x102, x97, x89, x85, x83, x77]
+                * (s_q1 * (x85 - -1145.5438279999998 * x6)
+                    + c_q1 * (5224.5702 * x23 + x73 - -1145.5438279999998 * x7));
+        [x87, x86, x83, x76, x69, x67, x61]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 268 mul, 191 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `newton-euler`: 217 mul, 157 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * qd[0];
-        let x4 = s_q1 * x3;
-        let x5 = c_q1 * x3;
-        let x6 = 0.7026 * qdd[0];
-        let x7 = qdd[0] * c_q1 - qd[1] * x2;
+        let x3 = 0.7026 * qdd[0];
+        let x4 = 0.7026 * (qd[0] * qd[0]);
+        let x5 = s_q1 * x3;
+        let x6 = qd[1] * x2;
+        let x7 = qdd[0] * c_q1 - x6;
         let x8 = qdd[0] * s_q1 + qd[1] * x1;
-        let x9 = s_q1 * x6 + qd[1] * x5;
-        let x10 = qd[1] * x4 - c_q1 * x6;
+        let x9 = qdd[1] + x1 * x2;
+        let x10 = qd[1] * qd[1] + x1 * x1;
         let x11 = -65693.9112265768 * x2;
-        let x12 = 65697.3302265768 * qd[1] - x4 * 1145.5438279999998;
-        let x13 = -1145.5438279999998 * qd[1];
-        let x14 = x1 * 1145.5438279999998;
+        let x12 = 65697.3302265768 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = x1 * c_q2 - qd[1] * s_q2;
-        let x17 = x1 * s_q2 + qd[1] * c_q2;
-        let x18 = x1 * 0.5692;
-        let x19 = x4 + -0.5692 * qd[1];
-        let x20 = s_q2 * x18 - c_q2 * x19;
-        let x21 = s_q2 * x19 + c_q2 * x18;
-        let x22 = qd[2] - x2;
-        let x23 = x7 * 0.5692;
-        let x24 = x9 + -0.5692 * qdd[1];
-        let x25 = qdd[2] - x8;
-        let x26 = x7 * c_q2 - qdd[1] * s_q2 - qd[2] * x17;
-        let x27 = x7 * s_q2 + qdd[1] * c_q2 + qd[2] * x16;
-        let x28 = qd[2] * x20 - (s_q2 * x24 + c_q2 * x23);
-        let x29 = -39234.47412200001 * x16 + 3946.18812068 * x22;
-        let x30 = 5224.5702 * x5;
-        let x31 = 3946.1881206800003 * x16 + 39241.404122 * x22 - x21 * -5224.5702;
-        let x32 = x17 * -5224.5702;
-        let x33 = 5224.5702 * x22;
+        let x14 = x1 * c_q2 - qd[1] * s_q2;
+        let x15 = x1 * s_q2 + qd[1] * c_q2;
+        let x16 = x5 + -0.5692 * x9;
+        let x17 = c_q1 * x3 + -0.5692 * x10;
+        let x18 = -0.5692 * (x7 - x6) - x4;
+        let x19 = c_q2 * x18 - s_q2 * x16;
+        let x20 = x7 * c_q2 - qdd[1] * s_q2 - qd[2] * x15;
+        let x21 = x7 * s_q2 + qdd[1] * c_q2 + qd[2] * x14;
+        let x22 = qdd[2] - x8;
+        let x23 = qd[2] - x2;
+        let x24 = x15 * x15;
+        let x25 = x23 * x23 + x24;
+        let x26 = x14 * x23;
+        let x27 = x21 + x26;
+        let x28 = x14 * x15 - x22;
+        let x29 = -39234.47412200001 * x14 + 3946.18812068 * x23;
+        let x30 = 3946.1881206800003 * x14 + 39241.404122 * x23;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x35 = x16 * c_q3 - x17 * s_q3;
-        let x36 = x16 * s_q3 + x17 * c_q3;
-        let x37 = x20 - -0.475 * x17;
-        let x38 = x5 + x17 * -7.11;
-        let x39 = x21 + (x16 * 0.475 + 7.11 * x22);
-        let x40 = c_q3 * x37 + s_q3 * x39;
-        let x41 = s_q3 * x37 - c_q3 * x39;
-        let x42 = qd[3] + x22;
-        let x43 = s_q2 * x23 - c_q2 * x24 + qd[2] * x21 - -0.475 * x27;
-        let x44 = x10 - x27 * -7.11;
-        let x45 = x28 - (x26 * 0.475 + 7.11 * x25);
-        let x46 = qdd[3] + x25;
-        let x47 = x26 * c_q3 - x27 * s_q3 - qd[3] * x36;
-        let x48 = x26 * s_q3 + x27 * c_q3 + qd[3] * x35;
-        let x49 = s_q3 * x43 + c_q3 * x45 + qd[3] * x40;
-        let x50 = -24989.305802 * x35 + 1375.0472756800002 * x42;
-        let x51 = 3239.4582 * x38;
-        let x52 = 1375.0472756800002 * x35 + 24998.827802 * x42 + x41 * -3239.4582;
-        let x53 = x36 * -3239.4582;
-        let x54 = 3239.4582 * x42;
+        let x32 = x14 * c_q3 - x15 * s_q3;
+        let x33 = x14 * s_q3 + x15 * c_q3;
+        let x34 = -0.475 * (x26 - x21) - 7.11 * x25 - (c_q2 * x16 + s_q2 * x18);
+        let x35 = 7.11 * x27 - -0.475 * (x24 + x14 * x14) - x17;
+        let x36 = x19 + (7.11 * x28 + -0.475 * (x20 + x15 * x23));
+        let x37 = s_q3 * x34 + c_q3 * x36;
+        let x38 = x20 * c_q3 - x21 * s_q3 - qd[3] * x33;
+        let x39 = x20 * s_q3 + x21 * c_q3 + qd[3] * x32;
+        let x40 = qdd[3] + x22;
+        let x41 = qd[3] + x23;
+        let x42 = x41 * x41 + x33 * x33;
+        let x43 = x39 + x32 * x41;
+        let x44 = x32 * x33 - x40;
+        let x45 = -24989.305802 * x32 + 1375.0472756800002 * x41;
+        let x46 = 1375.0472756800002 * x32 + 24998.827802 * x41;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x56 = x35 * c_q4 - x36 * s_q4;
-        let x57 = x35 * s_q4 + x36 * c_q4;
-        let x58 = x38 + x36 * -7.11;
-        let x59 = x41 - 7.11 * x42;
-        let x60 = x40 * c_q4 - s_q4 * x59;
-        let x61 = x40 * s_q4 + c_q4 * x59;
-        let x62 = qd[4] + x42;
-        let x63 = qdd[4] + x46;
-        let x64 = x47 * c_q4 - x48 * s_q4 - qd[4] * x57;
-        let x65 = x47 * s_q4 + x48 * c_q4 + qd[4] * x56;
-        let x66 = -97.44448770720001 * x62;
-        let x67 = 132.6783695416 * x56 - x58 * 171.195516;
-        let x68 = 135.4729695416 * x62 + -97.44448770720001 * x57 + -171.195516 * x60;
-        let x69 = x62 * 171.195516;
-        let x70 = -171.195516 * x56;
-        let x71 = x62 * x69 - x56 * x70;
-        let x72 = x57 * x70 - x63 * 171.195516;
-        let x73 = -171.195516 * x64 + x57 * x69;
+        let x48 = x32 * c_q4 - x33 * s_q4;
+        let x49 = x32 * s_q4 + x33 * c_q4;
+        let x50 = x38 * c_q4 - x39 * s_q4 - qd[4] * x49;
+        let x51 = x38 * s_q4 + x39 * c_q4 + qd[4] * x48;
+        let x52 = qdd[4] + x40;
+        let x53 = qd[4] + x41;
+        let x54 = -171.195516 * (x52 + x48 * x49);
+        let x55 = -171.195516 * (x49 * x53 - x50);
+        let x56 = -171.195516 * (x53 * x53 + x48 * x48);
+        let x57 = 132.6783695416 * x48;
+        let x58 = 135.4729695416 * x53 + -97.44448770720001 * x49;
+        let x59 = -97.44448770720001 * x53;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x75 = x56 * c_q5 + x62 * s_q5;
-        let x76 = x62 * c_q5 - x56 * s_q5;
-        let x77 = qd[5] + x57;
-        let x78 = 44.41 * x76;
-        let x79 = 47.471 * x77;
+        let x61 = x48 * c_q5 + x53 * s_q5;
+        let x62 = x53 * c_q5 - x48 * s_q5;
+        let x63 = qd[5] + x49;
+        let x64 = 44.41 * x62;
+        let x65 = 47.471 * x63;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x81 = 9.336 * (qdd[6] + (x64 * c_q5 + x63 * s_q5 + qd[5] * x76));
-        let x82 = 9.336 * (qd[6] + x75);
-        let x83 = (x77 * c_q6 - x76 * s_q6) * x82;
-        let x84 = (x76 * c_q6 + x77 * s_q6) * x82;
-        let x85 = x76 * x79 - x77 * x78 + x81;
-        let x86 = 44.41 * (x63 * c_q5 - x64 * s_q5 - qd[5] * x75) - x75 * x79
-            + (c_q6 * x83 + s_q6 * x84);
-        let x87 = 47.471 * (qdd[5] + x65) + x75 * x78 + (s_q6 * x83 - c_q6 * x84);
-        let x88 = 132.6783695416 * x64 + (x44 - -7.11 * x48) * 171.195516
-            + (x62 * x66 - x57 * x68 + x61 * x70) + (c_q5 * x85 - s_q5 * x86);
-        let x89 = 135.4729695416 * x63 + -97.44448770720001 * x65
+        let x67 = 9.336 * (qdd[6] + (x50 * c_q5 + x52 * s_q5 + qd[5] * x62));
+        let x68 = 9.336 * (qd[6] + x61);
+        let x69 = (x63 * c_q6 - x62 * s_q6) * x68;
+        let x70 = (x62 * c_q6 + x63 * s_q6) * x68;
+        let x71 = x62 * x65 - x63 * x64 + x67;
+        let x72 = 44.41 * (x52 * c_q5 - x50 * s_q5 - qd[5] * x61) - x61 * x65
+            + (c_q6 * x69 + s_q6 * x70);
+        let x73 = 47.471 * (qdd[5] + x51) + x61 * x64 + (s_q6 * x69 - c_q6 * x70);
+        let x74 = 132.6783695416 * x50 + (x53 * x59 - x49 * x58)
+            + (x35 + 7.11 * x43) * 171.195516 + (c_q5 * x71 - s_q5 * x72);
+        let x75 = 135.4729695416 * x52 + -97.44448770720001 * x51
+            + (x49 * x57 - x48 * x59)
             + -171.195516
-                * ((c_q3 * x43 - s_q3 * x45 - qd[3] * x41) * c_q4
-                    - s_q4 * (x49 - 7.11 * x46) - qd[4] * x61)
-            + (x57 * x67 - x56 * x66 - x61 * x69) + (s_q5 * x85 + c_q5 * x86);
-        let x90 = -97.44448770720001 * x63
-            + (x56 * x68 - x62 * x67 - (x58 * x69 + x60 * x70)) + x87;
-        let x91 = c_q4 * x71 - s_q4 * x72;
-        let x92 = -24989.305802 * x47 + 1375.0472756800002 * x46
-            + (x41 * x53 + x38 * x54 - (x36 * x52 + x42 * x51))
-            + (c_q4 * x88 + s_q4 * x90);
-        let x93 = 1375.0472756800002 * x47 + 24998.827802 * x46 + x49 * -3239.4582
-            + (x36 * x50 + x35 * x51 + x40 * x54) + (x89 + -7.11 * x91);
-        let x94 = 3239.4582 * x44 + (x35 * x52 - x42 * x50 - x40 * x53)
-            + (c_q4 * x90 - s_q4 * x88 - 7.11 * x73);
-        let x95 = x36 * x53 - x42 * x54 + (c_q4 * x72 + s_q4 * x71);
-        let x96 = x35 * x54 - x48 * -3239.4582 - x73;
-        let x97 = x91 - (3239.4582 * x46 + x35 * x53);
-        let x98 = c_q3 * x95 + s_q3 * x97;
-        let x99 = c_q3 * x97 - s_q3 * x95;
-        let x100 = -39234.47412200001 * x26 + 3946.18812068 * x25
-            + (x5 * x33 - x21 * x32 - (x17 * x31 + x22 * x30))
-            + (c_q3 * x92 + s_q3 * x94 + -0.475 * x99);
-        let x101 = 3946.1881206800003 * x26 + 39241.404122 * x25 + x28 * -5224.5702
-            + (x17 * x29 + x16 * x30 + x20 * x33) + (x93 + -7.11 * x99);
-        let x102 = 5224.5702 * x10 + (x16 * x31 - x22 * x29 - x20 * x32)
-            + (c_q3 * x94 - s_q3 * x92 + (0.475 * x98 + 7.11 * x96));
-        let x103 = x17 * x32 - x22 * x33 + x98;
-        let x104 = x99 - (5224.5702 * x25 + x16 * x32);
-        let x105 = c_q2 * x103 + s_q2 * x104;
-        let x106 = 65697.3302265768 * qdd[1] - x9 * 1145.5438279999998
-            - (x1 * x11 + x5 * x13) + (c_q2 * x102 - s_q2 * x100 + 0.5692 * x105);
-        let x107 = 66279.65991417361 * qdd[0]
+                * (c_q4 * (c_q3 * x34 - s_q3 * x36 - 7.11 * x42)
+                    - s_q4 * (x37 + 7.11 * x44)) + (s_q5 * x71 + c_q5 * x72);
+        let x76 = -97.44448770720001 * x52 + (x48 * x58 - x53 * x57) + x73;
+        let x77 = s_q4 * x54 + c_q4 * x56;
+        let x78 = c_q4 * x54 - s_q4 * x56 - 3239.4582 * x42;
+        let x79 = 3239.4582 * x43 + x55;
+        let x80 = 3239.4582 * x44 - x77;
+        let x81 = -24989.305802 * x38 + 1375.0472756800002 * x40 - x33 * x46
+            + (c_q4 * x74 + s_q4 * x76);
+        let x82 = 1375.0472756800002 * x38 + 24998.827802 * x40 + x33 * x45
+            + x37 * -3239.4582 + (x75 - x77 * -7.11);
+        let x83 = x32 * x46 - x41 * x45 + 3239.4582 * x35
+            + (c_q4 * x76 - s_q4 * x74 + 7.11 * x55);
+        let x84 = c_q3 * x78 + s_q3 * x80;
+        let x85 = c_q3 * x80 - s_q3 * x78;
+        let x86 = x84 - 5224.5702 * x25;
+        let x87 = 5224.5702 * x28 + x85;
+        let x88 = -39234.47412200001 * x20 + 3946.18812068 * x22 - x15 * x30
+            + (c_q3 * x81 + s_q3 * x83 + -0.475 * x85);
+        let x89 = 3946.1881206800003 * x20 + 39241.404122 * x22 + x15 * x29
+            + x19 * -5224.5702 + (x82 + -7.11 * x85);
+        let x90 = x14 * x30 - x23 * x29 - 5224.5702 * x17
+            + (c_q3 * x83 - s_q3 * x81 + (x84 * 0.475 + 7.11 * x79));
+        let x91 = c_q2 * x86 + s_q2 * x87;
+        let x92 = 65697.3302265768 * qdd[1] - x1 * x11 - x5 * 1145.5438279999998
+            + (c_q2 * x90 - s_q2 * x88 + 0.5692 * x91);
+        let x93 = 66279.65991417361 * qdd[0]
             + (c_q1
-                * (qd[1] * x11 - x2 * x12 + x5 * x14
-                    + (c_q2 * x100 + s_q2 * x102
-                        + -0.5692 * (c_q2 * x104 - s_q2 * x103)))
-                - s_q1 * (x101 - (-65693.9112265768 * x8 + (x1 * x12 + x4 * x14)))
+                * (qd[1] * x11 - x2 * x12 - -1145.5438279999998 * x4
+                    + (c_q2 * x88 + s_q2 * x90 + -0.5692 * (c_q2 * x87 - s_q2 * x86)))
+                - s_q1 * (x89 - (-65693.9112265768 * x8 + x1 * x12))
                 + -0.7026
-                    * (s_q1 * (x2 * x14 - -1145.5438279999998 * qdd[1] + x105)
-                        + c_q1
-                            * (x1 * x14 - qd[1] * x13
-                                + (x16 * x33 - x27 * -5224.5702 + x96))));
-        [x107, x106, x101, x93, x89, x87, x81]
+                    * (s_q1 * (x91 - -1145.5438279999998 * x9)
+                        + c_q1 * (5224.5702 * x27 + x79 - -1145.5438279999998 * x10)));
+        [x93, x92, x89, x82, x75, x73, x67]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 552 mul, 393 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 503 mul, 359 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -869,128 +887,106 @@ impl Ssrms {
         let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
         let x88 = qd[0] * c_q1;
         let x89 = qd[0] * s_q1;
-        let x90 = 0.7026 * qd[0];
-        let x91 = s_q1 * x90;
-        let x92 = c_q1 * x90;
-        let x93 = qd[1] * x89;
-        let x94 = qd[1] * x88;
-        let x95 = qd[1] * x92;
-        let x96 = qd[1] * x91;
-        let x97 = -65693.9112265768 * x89;
-        let x98 = 65697.3302265768 * qd[1] - 1145.5438279999998 * x91;
-        let x99 = -1145.5438279999998 * qd[1];
-        let x100 = 1145.5438279999998 * x88;
-        let x101 = c_q2 * x88 - qd[1] * s_q2;
-        let x102 = s_q2 * x88 + qd[1] * c_q2;
-        let x103 = 0.5692 * x88;
-        let x104 = x91 + -0.5692 * qd[1];
-        let x105 = s_q2 * x103 - c_q2 * x104;
-        let x106 = s_q2 * x104 + c_q2 * x103;
-        let x107 = qd[2] - x89;
-        let x108 = 0.5692 * x93;
-        let x109 = c_q2 * x93 + qd[2] * x102;
-        let x110 = qd[2] * x101 - s_q2 * x93;
-        let x111 = c_q2 * x108 - s_q2 * x95 + qd[2] * x105;
-        let x112 = -39234.47412200001 * x101 + 3946.18812068 * x107;
-        let x113 = 5224.5702 * x92;
-        let x114 = 3946.1881206800003 * x101 + 39241.404122 * x107 - x106 * -5224.5702;
-        let x115 = x102 * -5224.5702;
-        let x116 = 5224.5702 * x107;
-        let x117 = c_q3 * x101 - s_q3 * x102;
-        let x118 = s_q3 * x101 + c_q3 * x102;
-        let x119 = x105 - -0.475 * x102;
-        let x120 = x92 + -7.11 * x102;
-        let x121 = x106 + (0.475 * x101 + 7.11 * x107);
-        let x122 = c_q3 * x119 + s_q3 * x121;
-        let x123 = s_q3 * x119 - c_q3 * x121;
-        let x124 = qd[3] + x107;
-        let x125 = 7.11 * x94;
-        let x126 = qd[2] * x106 - (c_q2 * x95 + s_q2 * x108) - -0.475 * x110;
-        let x127 = x96 - -7.11 * x110;
-        let x128 = x111 + (0.475 * x109 + x125);
-        let x129 = c_q3 * x109 + s_q3 * x110 + qd[3] * x118;
-        let x130 = c_q3 * x110 - s_q3 * x109 + qd[3] * x117;
-        let x131 = s_q3 * x126 + c_q3 * x128 + qd[3] * x122;
-        let x132 = -24989.305802 * x117 + 1375.0472756800002 * x124;
-        let x133 = 3239.4582 * x120;
-        let x134 = 1375.0472756800002 * x117 + 24998.827802 * x124 + x123 * -3239.4582;
-        let x135 = x118 * -3239.4582;
-        let x136 = 3239.4582 * x124;
-        let x137 = c_q4 * x117 - s_q4 * x118;
-        let x138 = s_q4 * x117 + c_q4 * x118;
-        let x139 = x120 + -7.11 * x118;
-        let x140 = x123 - 7.11 * x124;
-        let x141 = c_q4 * x122 - s_q4 * x140;
-        let x142 = s_q4 * x122 + c_q4 * x140;
-        let x143 = qd[4] + x124;
-        let x144 = c_q4 * x129 + s_q4 * x130 + qd[4] * x138;
-        let x145 = c_q4 * x130 - s_q4 * x129 + qd[4] * x137;
-        let x146 = -97.44448770720001 * x143;
-        let x147 = 132.6783695416 * x137 - 171.195516 * x139;
-        let x148 = 135.4729695416 * x143 + -97.44448770720001 * x138
-            + -171.195516 * x141;
-        let x149 = 171.195516 * x143;
-        let x150 = -171.195516 * x137;
-        let x151 = x143 * x149 - x137 * x150;
-        let x152 = 171.195516 * x94 + x138 * x150;
-        let x153 = -171.195516 * x144 - x138 * x149;
-        let x154 = c_q5 * x137 + s_q5 * x143;
-        let x155 = c_q5 * x143 - s_q5 * x137;
-        let x156 = qd[5] + x138;
-        let x157 = 44.41 * x155;
-        let x158 = 47.471 * x156;
-        let x159 = 9.336 * (qd[5] * x155 - (c_q5 * x144 + s_q5 * x94));
-        let x160 = 9.336 * (qd[6] + x154);
-        let x161 = (c_q6 * x156 - s_q6 * x155) * x160;
-        let x162 = (c_q6 * x155 + s_q6 * x156) * x160;
-        let x163 = x155 * x158 - x156 * x157 + x159;
-        let x164 = 44.41 * (s_q5 * x144 - c_q5 * x94 - qd[5] * x154) - x154 * x158
-            + (c_q6 * x161 + s_q6 * x162);
-        let x165 = 47.471 * x145 + x154 * x157 + (s_q6 * x161 - c_q6 * x162);
-        let x166 = 171.195516 * (x127 - -7.11 * x130) - 132.6783695416 * x144
-            + (x143 * x146 - x138 * x148 + x142 * x150) + (c_q5 * x163 - s_q5 * x164);
-        let x167 = -97.44448770720001 * x145 - 135.4729695416 * x94
+        let x90 = 0.7026 * (qd[0] * qd[0]);
+        let x91 = qd[1] * x89;
+        let x92 = qd[1] * x88;
+        let x93 = x88 * x89;
+        let x94 = qd[1] * qd[1] + x88 * x88;
+        let x95 = -65693.9112265768 * x89;
+        let x96 = 65697.3302265768 * qd[1];
+        let x97 = c_q2 * x88 - qd[1] * s_q2;
+        let x98 = s_q2 * x88 + qd[1] * c_q2;
+        let x99 = -0.5692 * x93;
+        let x100 = -0.5692 * x94;
+        let x101 = x90 + -0.5692 * (x91 + x91);
+        let x102 = s_q2 * x99 + c_q2 * x101;
+        let x103 = c_q2 * x91 + qd[2] * x98;
+        let x104 = qd[2] * x97 - s_q2 * x91;
+        let x105 = qd[2] - x89;
+        let x106 = x98 * x98;
+        let x107 = x105 * x105 + x106;
+        let x108 = x97 * x105;
+        let x109 = x104 + x108;
+        let x110 = x92 + x97 * x98;
+        let x111 = -39234.47412200001 * x97 + 3946.18812068 * x105;
+        let x112 = 3946.1881206800003 * x97 + 39241.404122 * x105;
+        let x113 = c_q3 * x97 - s_q3 * x98;
+        let x114 = s_q3 * x97 + c_q3 * x98;
+        let x115 = s_q2 * x101 - c_q2 * x99 + (-0.475 * (x108 - x104) - 7.11 * x107);
+        let x116 = 7.11 * x109 - -0.475 * (x106 + x97 * x97) - x100;
+        let x117 = 7.11 * x110 + -0.475 * (x98 * x105 - x103) - x102;
+        let x118 = s_q3 * x115 + c_q3 * x117;
+        let x119 = c_q3 * x103 + s_q3 * x104 + qd[3] * x114;
+        let x120 = c_q3 * x104 - s_q3 * x103 + qd[3] * x113;
+        let x121 = qd[3] + x105;
+        let x122 = x121 * x121 + x114 * x114;
+        let x123 = x120 + x113 * x121;
+        let x124 = x92 + x113 * x114;
+        let x125 = -24989.305802 * x113 + 1375.0472756800002 * x121;
+        let x126 = 1375.0472756800002 * x113 + 24998.827802 * x121;
+        let x127 = c_q4 * x113 - s_q4 * x114;
+        let x128 = s_q4 * x113 + c_q4 * x114;
+        let x129 = c_q4 * x119 + s_q4 * x120 + qd[4] * x128;
+        let x130 = c_q4 * x120 - s_q4 * x119 + qd[4] * x127;
+        let x131 = qd[4] + x121;
+        let x132 = -171.195516 * (x127 * x128 - x92);
+        let x133 = -171.195516 * (x129 + x128 * x131);
+        let x134 = -171.195516 * (x131 * x131 + x127 * x127);
+        let x135 = 132.6783695416 * x127;
+        let x136 = 135.4729695416 * x131 + -97.44448770720001 * x128;
+        let x137 = -97.44448770720001 * x131;
+        let x138 = c_q5 * x127 + s_q5 * x131;
+        let x139 = c_q5 * x131 - s_q5 * x127;
+        let x140 = qd[5] + x128;
+        let x141 = 44.41 * x139;
+        let x142 = 47.471 * x140;
+        let x143 = 9.336 * (qd[5] * x139 - (c_q5 * x129 + s_q5 * x92));
+        let x144 = 9.336 * (qd[6] + x138);
+        let x145 = (c_q6 * x140 - s_q6 * x139) * x144;
+        let x146 = (c_q6 * x139 + s_q6 * x140) * x144;
+        let x147 = x139 * x142 - x140 * x141 + x143;
+        let x148 = 44.41 * (s_q5 * x129 - c_q5 * x92 - qd[5] * x138) - x138 * x142
+            + (c_q6 * x145 + s_q6 * x146);
+        let x149 = 47.471 * x130 + x138 * x141 + (s_q6 * x145 - c_q6 * x146);
+        let x150 = x131 * x137 - x128 * x136 - 132.6783695416 * x129
+            + 171.195516 * (x116 + 7.11 * x123) + (c_q5 * x147 - s_q5 * x148);
+        let x151 = -97.44448770720001 * x130 - 135.4729695416 * x92
+            + (x128 * x135 - x127 * x137)
             + -171.195516
-                * (c_q4 * (c_q3 * x126 - s_q3 * x128 - qd[3] * x123)
-                    - s_q4 * (x125 + x131) - qd[4] * x142)
-            + (x138 * x147 - x137 * x146 - x142 * x149) + (s_q5 * x163 + c_q5 * x164);
-        let x168 = x137 * x148 - x143 * x147 - (x139 * x149 + x141 * x150)
-            - -97.44448770720001 * x94 + x165;
-        let x169 = c_q4 * x151 - s_q4 * x152;
-        let x170 = x123 * x135 + x120 * x136 - (x118 * x134 + x124 * x133)
-            - (-24989.305802 * x129 + 1375.0472756800002 * x94)
-            + (c_q4 * x166 + s_q4 * x168);
-        let x171 = x131 * -3239.4582 - (1375.0472756800002 * x129 + 24998.827802 * x94)
-            + (x118 * x132 + x117 * x133 + x122 * x136) + (x167 + -7.11 * x169);
-        let x172 = 3239.4582 * x127 + (x117 * x134 - x124 * x132 - x122 * x135)
-            + (c_q4 * x168 - s_q4 * x166 + 7.11 * x153);
-        let x173 = x118 * x135 - x124 * x136 + (c_q4 * x152 + s_q4 * x151);
-        let x174 = x117 * x136 - x130 * -3239.4582 + x153;
-        let x175 = 3239.4582 * x94 - x117 * x135 + x169;
-        let x176 = c_q3 * x173 + s_q3 * x175;
-        let x177 = c_q3 * x175 - s_q3 * x173;
-        let x178 = x92 * x116 - x106 * x115 - (x102 * x114 + x107 * x113)
-            - (-39234.47412200001 * x109 + 3946.18812068 * x94)
-            + (c_q3 * x170 + s_q3 * x172 + -0.475 * x177);
-        let x179 = x111 * -5224.5702 - (3946.1881206800003 * x109 + 39241.404122 * x94)
-            + (x102 * x112 + x101 * x113 + x105 * x116) + (x171 + -7.11 * x177);
-        let x180 = 5224.5702 * x96 + (x101 * x114 - x107 * x112 - x105 * x115)
-            + (c_q3 * x172 - s_q3 * x170 + (0.475 * x176 + 7.11 * x174));
-        let x181 = x102 * x115 - x107 * x116 + x176;
-        let x182 = 5224.5702 * x94 - x101 * x115 + x177;
-        let x183 = c_q2 * x181 + s_q2 * x182;
-        let x184 = tau[0]
+                * (c_q4 * (c_q3 * x115 - s_q3 * x117 - 7.11 * x122)
+                    - s_q4 * (x118 + 7.11 * x124)) + (s_q5 * x147 + c_q5 * x148);
+        let x152 = x127 * x136 - x131 * x135 - -97.44448770720001 * x92 + x149;
+        let x153 = s_q4 * x132 + c_q4 * x134;
+        let x154 = c_q4 * x132 - s_q4 * x134 - 3239.4582 * x122;
+        let x155 = 3239.4582 * x123 + x133;
+        let x156 = 3239.4582 * x124 - x153;
+        let x157 = c_q4 * x150 + s_q4 * x152
+            - (-24989.305802 * x119 + 1375.0472756800002 * x92 + x114 * x126);
+        let x158 = x114 * x125 - (1375.0472756800002 * x119 + 24998.827802 * x92)
+            + x118 * -3239.4582 + (x151 - -7.11 * x153);
+        let x159 = x113 * x126 - x121 * x125 + 3239.4582 * x116
+            + (c_q4 * x152 - s_q4 * x150 + 7.11 * x133);
+        let x160 = c_q3 * x154 + s_q3 * x156;
+        let x161 = c_q3 * x156 - s_q3 * x154;
+        let x162 = x160 - 5224.5702 * x107;
+        let x163 = 5224.5702 * x110 + x161;
+        let x164 = c_q3 * x157 + s_q3 * x159 + -0.475 * x161
+            - (-39234.47412200001 * x103 + 3946.18812068 * x92 + x98 * x112);
+        let x165 = x98 * x111 - (3946.1881206800003 * x103 + 39241.404122 * x92)
+            - x102 * -5224.5702 + (x158 + -7.11 * x161);
+        let x166 = x97 * x112 - x105 * x111 - 5224.5702 * x100
+            + (c_q3 * x159 - s_q3 * x157 + (0.475 * x160 + 7.11 * x155));
+        let x167 = c_q2 * x162 + s_q2 * x163;
+        let x168 = tau[0]
             - (c_q1
-                * (qd[1] * x97 - x89 * x98 + x92 * x100
-                    + (c_q2 * x178 + s_q2 * x180
-                        + -0.5692 * (c_q2 * x182 - s_q2 * x181)))
-                - s_q1 * (x179 - (-65693.9112265768 * x94 + (x88 * x98 + x91 * x100)))
+                * (qd[1] * x95 - x89 * x96 - -1145.5438279999998 * x90
+                    + (c_q2 * x164 + s_q2 * x166
+                        + -0.5692 * (c_q2 * x163 - s_q2 * x162)))
+                - s_q1 * (x165 - (-65693.9112265768 * x92 + x88 * x96))
                 + -0.7026
-                    * (s_q1 * (x89 * x100 + x183)
-                        + c_q1
-                            * (x88 * x100 - qd[1] * x99
-                                + (x101 * x116 - x110 * -5224.5702 + x174))));
-        let x185 = 1.0
+                    * (s_q1 * (x167 - -1145.5438279999998 * x93)
+                        + c_q1 * (5224.5702 * x109 + x155 - -1145.5438279999998 * x94)));
+        let x169 = 1.0
             / (66279.65991417361
                 + (0.7026 * x63
                     + (c_q1
@@ -998,79 +994,78 @@ impl Ssrms {
                             - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
                         - s_q1 * (x68 - s_q1 * (-65693.9112265768 + x59))
                         - -0.7026 * x63)));
-        let x186 = x69 * x185;
-        let x187 = x70 * x185;
-        let x188 = x72 * x185;
-        let x189 = x79 * x185;
-        let x190 = x82 * x185;
-        let x191 = x87 * x185;
-        let x192 = 1.0
+        let x170 = x69 * x169;
+        let x171 = x70 * x169;
+        let x172 = x72 * x169;
+        let x173 = x79 * x169;
+        let x174 = x82 * x169;
+        let x175 = x87 * x169;
+        let x176 = 1.0
             / (65697.3302265768
                 + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
-                - x69 * x186);
-        let x193 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x187;
-        let x194 = x192 * x193;
-        let x195 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x188;
-        let x196 = x192 * x195;
-        let x197 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x189;
-        let x198 = x192 * x197;
-        let x199 = c_q2 * x81 - s_q2 * x80 - x69 * x190;
-        let x200 = x192 * x199;
-        let x201 = s_q2 * x85 + c_q2 * x86 + x69 * x191;
-        let x202 = x192 * x201;
-        let x203 = 1.0 / (x59 - x70 * x187 - x193 * x194);
-        let x204 = x49 - x70 * x188 - x193 * x196;
+                - x69 * x170);
+        let x177 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x171;
+        let x178 = x176 * x177;
+        let x179 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x172;
+        let x180 = x176 * x179;
+        let x181 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x173;
+        let x182 = x176 * x181;
+        let x183 = c_q2 * x81 - s_q2 * x80 - x69 * x174;
+        let x184 = x176 * x183;
+        let x185 = s_q2 * x85 + c_q2 * x86 + x69 * x175;
+        let x186 = x176 * x185;
+        let x187 = 1.0 / (x59 - x70 * x171 - x177 * x178);
+        let x188 = x49 - x70 * x172 - x177 * x180;
+        let x189 = x187 * x188;
+        let x190 = x76 - x70 * x173 - x177 * x182;
+        let x191 = x187 * x190;
+        let x192 = x70 * x174 + x177 * x184;
+        let x193 = x187 * x192;
+        let x194 = x8 - x70 * x175 + x177 * x186;
+        let x195 = x187 * x194;
+        let x196 = 1.0 / (x35 - x72 * x172 - x179 * x180 - x188 * x189);
+        let x197 = x27 - x72 * x173 - x179 * x182 - x188 * x191;
+        let x198 = x196 * x197;
+        let x199 = x188 * x193 - (x72 * x174 + x179 * x184);
+        let x200 = x196 * x199;
+        let x201 = x8 - x72 * x175 + x179 * x186 - x188 * x195;
+        let x202 = x196 * x201;
+        let x203 = 1.0 / (x13 - x79 * x173 - x181 * x182 - x190 * x191 - x197 * x198);
+        let x204 = x190 * x193 - (x79 * x174 + x181 * x184) - x197 * x200;
         let x205 = x203 * x204;
-        let x206 = x76 - x70 * x189 - x193 * x198;
+        let x206 = x8 - x79 * x175 + x181 * x186 - x190 * x195 - x197 * x202;
         let x207 = x203 * x206;
-        let x208 = x70 * x190 + x193 * x200;
-        let x209 = x203 * x208;
-        let x210 = x8 - x70 * x191 + x193 * x202;
-        let x211 = x203 * x210;
-        let x212 = 1.0 / (x35 - x72 * x188 - x195 * x196 - x204 * x205);
-        let x213 = x27 - x72 * x189 - x195 * x198 - x204 * x207;
-        let x214 = x212 * x213;
-        let x215 = x204 * x209 - (x72 * x190 + x195 * x200);
-        let x216 = x212 * x215;
-        let x217 = x8 - x72 * x191 + x195 * x202 - x204 * x211;
-        let x218 = x212 * x217;
-        let x219 = 1.0 / (x13 - x79 * x189 - x197 * x198 - x206 * x207 - x213 * x214);
-        let x220 = x206 * x209 - (x79 * x190 + x197 * x200) - x213 * x216;
-        let x221 = x219 * x220;
-        let x222 = x8 - x79 * x191 + x197 * x202 - x206 * x211 - x213 * x218;
-        let x223 = x219 * x222;
-        let x224 = 1.0
-            / (47.471 - x82 * x190 - x199 * x200 - x208 * x209 - x215 * x216
-                - x220 * x221);
-        let x225 = x199 * x202 - x82 * x191 + x208 * x211 - x215 * x218 - x220 * x223;
-        let x226 = x224 * x225;
-        let x227 = 1.0
-            / (9.336 - x87 * x191 - x201 * x202 - x210 * x211 - x217 * x218 - x222 * x223
-                - x225 * x226);
-        let x228 = tau[1]
-            - (c_q2 * x180 - s_q2 * x178 + 0.5692 * x183
-                - (1145.5438279999998 * x95 + (x88 * x97 + x92 * x99))) - x184 * x186;
-        let x229 = tau[2] - x179 - x184 * x187 - x194 * x228;
-        let x230 = tau[3] - x171 - x184 * x188 - x196 * x228 - x205 * x229;
-        let x231 = tau[4] - x167 - x184 * x189 - x198 * x228 - x207 * x229 - x214 * x230;
-        let x232 = tau[5] - x165 - x184 * x190 - x200 * x228 + x209 * x229 - x216 * x230
-            - x221 * x231;
-        let x233 = x227
-            * (tau[6] - x159 - x184 * x191 + x202 * x228 - x211 * x229 - x218 * x230
-                - x223 * x231 - x226 * x232);
-        let x234 = x224 * x232 - x226 * x233;
-        let x235 = x219 * x231 - x221 * x234 - x223 * x233;
-        let x236 = x212 * x230 - x214 * x235 - x216 * x234 - x218 * x233;
-        let x237 = x203 * x229 - x205 * x236 - x207 * x235 + x209 * x234 - x211 * x233;
-        let x238 = x192 * x228 - x194 * x237 - x196 * x236 - x198 * x235 - x200 * x234
-            + x202 * x233;
-        let x239 = x184 * x185 - x186 * x238 - x187 * x237 - x188 * x236 - x189 * x235
-            - x190 * x234 - x191 * x233;
-        [x239, x238, x237, x236, x235, x234, x233]
+        let x208 = 1.0
+            / (47.471 - x82 * x174 - x183 * x184 - x192 * x193 - x199 * x200
+                - x204 * x205);
+        let x209 = x183 * x186 - x82 * x175 + x192 * x195 - x199 * x202 - x204 * x207;
+        let x210 = x208 * x209;
+        let x211 = 1.0
+            / (9.336 - x87 * x175 - x185 * x186 - x194 * x195 - x201 * x202 - x206 * x207
+                - x209 * x210);
+        let x212 = tau[1] - (c_q2 * x166 - s_q2 * x164 + 0.5692 * x167 - x88 * x95)
+            - x168 * x170;
+        let x213 = tau[2] - x165 - x168 * x171 - x178 * x212;
+        let x214 = tau[3] - x158 - x168 * x172 - x180 * x212 - x189 * x213;
+        let x215 = tau[4] - x151 - x168 * x173 - x182 * x212 - x191 * x213 - x198 * x214;
+        let x216 = tau[5] - x149 - x168 * x174 - x184 * x212 + x193 * x213 - x200 * x214
+            - x205 * x215;
+        let x217 = x211
+            * (tau[6] - x143 - x168 * x175 + x186 * x212 - x195 * x213 - x202 * x214
+                - x207 * x215 - x210 * x216);
+        let x218 = x208 * x216 - x210 * x217;
+        let x219 = x203 * x215 - x205 * x218 - x207 * x217;
+        let x220 = x196 * x214 - x198 * x219 - x200 * x218 - x202 * x217;
+        let x221 = x187 * x213 - x189 * x220 - x191 * x219 + x193 * x218 - x195 * x217;
+        let x222 = x176 * x212 - x178 * x221 - x180 * x220 - x182 * x219 - x184 * x218
+            + x186 * x217;
+        let x223 = x168 * x169 - x170 * x222 - x171 * x221 - x172 * x220 - x173 * x219
+            - x174 * x218 - x175 * x217;
+        [x223, x222, x221, x220, x219, x218, x217]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 426 mul, 292 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 258 add, 0 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 7],
@@ -1183,127 +1178,104 @@ impl Ssrms {
         let x94 = c_q1 * (c_q2 * x91 - s_q2 * x92) - s_q1 * x8;
         let x95 = qd[0] * c_q1;
         let x96 = qd[0] * s_q1;
-        let x97 = 0.7026 * qd[0];
-        let x98 = s_q1 * x97;
-        let x99 = c_q1 * x97;
-        let x100 = qd[1] * x96;
-        let x101 = qd[1] * x95;
-        let x102 = qd[1] * x99;
-        let x103 = qd[1] * x98;
-        let x104 = -65693.9112265768 * x96;
-        let x105 = 65697.3302265768 * qd[1] - 1145.5438279999998 * x98;
-        let x106 = -1145.5438279999998 * qd[1];
-        let x107 = 1145.5438279999998 * x95;
-        let x108 = c_q2 * x95 - qd[1] * s_q2;
-        let x109 = s_q2 * x95 + qd[1] * c_q2;
-        let x110 = 0.5692 * x95;
-        let x111 = x98 + -0.5692 * qd[1];
-        let x112 = s_q2 * x110 - c_q2 * x111;
-        let x113 = s_q2 * x111 + c_q2 * x110;
-        let x114 = qd[2] - x96;
-        let x115 = 0.5692 * x100;
-        let x116 = c_q2 * x100 + qd[2] * x109;
-        let x117 = qd[2] * x108 - s_q2 * x100;
-        let x118 = c_q2 * x115 - s_q2 * x102 + qd[2] * x112;
-        let x119 = -39234.47412200001 * x108 + 3946.18812068 * x114;
-        let x120 = 5224.5702 * x99;
-        let x121 = 3946.1881206800003 * x108 + 39241.404122 * x114 - x113 * -5224.5702;
-        let x122 = x109 * -5224.5702;
-        let x123 = 5224.5702 * x114;
-        let x124 = c_q3 * x108 - s_q3 * x109;
-        let x125 = s_q3 * x108 + c_q3 * x109;
-        let x126 = x112 - -0.475 * x109;
-        let x127 = x99 + -7.11 * x109;
-        let x128 = x113 + (0.475 * x108 + 7.11 * x114);
-        let x129 = c_q3 * x126 + s_q3 * x128;
-        let x130 = s_q3 * x126 - c_q3 * x128;
-        let x131 = qd[3] + x114;
-        let x132 = 7.11 * x101;
-        let x133 = qd[2] * x113 - (c_q2 * x102 + s_q2 * x115) - -0.475 * x117;
-        let x134 = x103 - -7.11 * x117;
-        let x135 = x118 + (0.475 * x116 + x132);
-        let x136 = c_q3 * x116 + s_q3 * x117 + qd[3] * x125;
-        let x137 = c_q3 * x117 - s_q3 * x116 + qd[3] * x124;
-        let x138 = s_q3 * x133 + c_q3 * x135 + qd[3] * x129;
-        let x139 = -24989.305802 * x124 + 1375.0472756800002 * x131;
-        let x140 = 3239.4582 * x127;
-        let x141 = 1375.0472756800002 * x124 + 24998.827802 * x131 + x130 * -3239.4582;
-        let x142 = x125 * -3239.4582;
-        let x143 = 3239.4582 * x131;
-        let x144 = c_q4 * x124 - s_q4 * x125;
-        let x145 = s_q4 * x124 + c_q4 * x125;
-        let x146 = x127 + -7.11 * x125;
-        let x147 = x130 - 7.11 * x131;
-        let x148 = c_q4 * x129 - s_q4 * x147;
-        let x149 = s_q4 * x129 + c_q4 * x147;
-        let x150 = qd[4] + x131;
-        let x151 = c_q4 * x136 + s_q4 * x137 + qd[4] * x145;
-        let x152 = c_q4 * x137 - s_q4 * x136 + qd[4] * x144;
-        let x153 = -97.44448770720001 * x150;
-        let x154 = 132.6783695416 * x144 - 171.195516 * x146;
-        let x155 = 135.4729695416 * x150 + -97.44448770720001 * x145
-            + -171.195516 * x148;
-        let x156 = 171.195516 * x150;
-        let x157 = -171.195516 * x144;
-        let x158 = x150 * x156 - x144 * x157;
-        let x159 = 171.195516 * x101 + x145 * x157;
-        let x160 = -171.195516 * x151 - x145 * x156;
-        let x161 = c_q5 * x144 + s_q5 * x150;
-        let x162 = c_q5 * x150 - s_q5 * x144;
-        let x163 = qd[5] + x145;
-        let x164 = 44.41 * x162;
-        let x165 = 47.471 * x163;
-        let x166 = 9.336 * (qd[5] * x162 - (c_q5 * x151 + s_q5 * x101));
-        let x167 = 9.336 * (qd[6] + x161);
-        let x168 = (c_q6 * x163 - s_q6 * x162) * x167;
-        let x169 = (c_q6 * x162 + s_q6 * x163) * x167;
-        let x170 = x162 * x165 - x163 * x164 + x166;
-        let x171 = 44.41 * (s_q5 * x151 - c_q5 * x101 - qd[5] * x161) - x161 * x165
-            + (c_q6 * x168 + s_q6 * x169);
-        let x172 = 47.471 * x152 + x161 * x164 + (s_q6 * x168 - c_q6 * x169);
-        let x173 = 171.195516 * (x134 - -7.11 * x137) - 132.6783695416 * x151
-            + (x150 * x153 - x145 * x155 + x149 * x157) + (c_q5 * x170 - s_q5 * x171);
-        let x174 = -97.44448770720001 * x152 - 135.4729695416 * x101
+        let x97 = 0.7026 * (qd[0] * qd[0]);
+        let x98 = qd[1] * x96;
+        let x99 = qd[1] * x95;
+        let x100 = x95 * x96;
+        let x101 = qd[1] * qd[1] + x95 * x95;
+        let x102 = -65693.9112265768 * x96;
+        let x103 = 65697.3302265768 * qd[1];
+        let x104 = c_q2 * x95 - qd[1] * s_q2;
+        let x105 = s_q2 * x95 + qd[1] * c_q2;
+        let x106 = -0.5692 * x100;
+        let x107 = -0.5692 * x101;
+        let x108 = x97 + -0.5692 * (x98 + x98);
+        let x109 = s_q2 * x106 + c_q2 * x108;
+        let x110 = c_q2 * x98 + qd[2] * x105;
+        let x111 = qd[2] * x104 - s_q2 * x98;
+        let x112 = qd[2] - x96;
+        let x113 = x105 * x105;
+        let x114 = x112 * x112 + x113;
+        let x115 = x104 * x112;
+        let x116 = x111 + x115;
+        let x117 = x99 + x104 * x105;
+        let x118 = -39234.47412200001 * x104 + 3946.18812068 * x112;
+        let x119 = 3946.1881206800003 * x104 + 39241.404122 * x112;
+        let x120 = c_q3 * x104 - s_q3 * x105;
+        let x121 = s_q3 * x104 + c_q3 * x105;
+        let x122 = s_q2 * x108 - c_q2 * x106 + (-0.475 * (x115 - x111) - 7.11 * x114);
+        let x123 = 7.11 * x116 - -0.475 * (x113 + x104 * x104) - x107;
+        let x124 = 7.11 * x117 + -0.475 * (x105 * x112 - x110) - x109;
+        let x125 = s_q3 * x122 + c_q3 * x124;
+        let x126 = c_q3 * x110 + s_q3 * x111 + qd[3] * x121;
+        let x127 = c_q3 * x111 - s_q3 * x110 + qd[3] * x120;
+        let x128 = qd[3] + x112;
+        let x129 = x128 * x128 + x121 * x121;
+        let x130 = x127 + x120 * x128;
+        let x131 = x99 + x120 * x121;
+        let x132 = -24989.305802 * x120 + 1375.0472756800002 * x128;
+        let x133 = 1375.0472756800002 * x120 + 24998.827802 * x128;
+        let x134 = c_q4 * x120 - s_q4 * x121;
+        let x135 = s_q4 * x120 + c_q4 * x121;
+        let x136 = c_q4 * x126 + s_q4 * x127 + qd[4] * x135;
+        let x137 = c_q4 * x127 - s_q4 * x126 + qd[4] * x134;
+        let x138 = qd[4] + x128;
+        let x139 = -171.195516 * (x134 * x135 - x99);
+        let x140 = -171.195516 * (x136 + x135 * x138);
+        let x141 = -171.195516 * (x138 * x138 + x134 * x134);
+        let x142 = 132.6783695416 * x134;
+        let x143 = 135.4729695416 * x138 + -97.44448770720001 * x135;
+        let x144 = -97.44448770720001 * x138;
+        let x145 = c_q5 * x134 + s_q5 * x138;
+        let x146 = c_q5 * x138 - s_q5 * x134;
+        let x147 = qd[5] + x135;
+        let x148 = 44.41 * x146;
+        let x149 = 47.471 * x147;
+        let x150 = 9.336 * (qd[5] * x146 - (c_q5 * x136 + s_q5 * x99));
+        let x151 = 9.336 * (qd[6] + x145);
+        let x152 = (c_q6 * x147 - s_q6 * x146) * x151;
+        let x153 = (c_q6 * x146 + s_q6 * x147) * x151;
+        let x154 = x146 * x149 - x147 * x148 + x150;
+        let x155 = 44.41 * (s_q5 * x136 - c_q5 * x99 - qd[5] * x145) - x145 * x149
+            + (c_q6 * x152 + s_q6 * x153);
+        let x156 = 47.471 * x137 + x145 * x148 + (s_q6 * x152 - c_q6 * x153);
+        let x157 = x138 * x144 - x135 * x143 - 132.6783695416 * x136
+            + 171.195516 * (x123 + 7.11 * x130) + (c_q5 * x154 - s_q5 * x155);
+        let x158 = -97.44448770720001 * x137 - 135.4729695416 * x99
+            + (x135 * x142 - x134 * x144)
             + -171.195516
-                * (c_q4 * (c_q3 * x133 - s_q3 * x135 - qd[3] * x130)
-                    - s_q4 * (x132 + x138) - qd[4] * x149)
-            + (x145 * x154 - x144 * x153 - x149 * x156) + (s_q5 * x170 + c_q5 * x171);
-        let x175 = x144 * x155 - x150 * x154 - (x146 * x156 + x148 * x157)
-            - -97.44448770720001 * x101 + x172;
-        let x176 = c_q4 * x158 - s_q4 * x159;
-        let x177 = x130 * x142 + x127 * x143 - (x125 * x141 + x131 * x140)
-            - (-24989.305802 * x136 + 1375.0472756800002 * x101)
-            + (c_q4 * x173 + s_q4 * x175);
-        let x178 = x138 * -3239.4582 - (1375.0472756800002 * x136 + 24998.827802 * x101)
-            + (x125 * x139 + x124 * x140 + x129 * x143) + (x174 + -7.11 * x176);
-        let x179 = 3239.4582 * x134 + (x124 * x141 - x131 * x139 - x129 * x142)
-            + (c_q4 * x175 - s_q4 * x173 + 7.11 * x160);
-        let x180 = x125 * x142 - x131 * x143 + (c_q4 * x159 + s_q4 * x158);
-        let x181 = x124 * x143 - x137 * -3239.4582 + x160;
-        let x182 = 3239.4582 * x101 - x124 * x142 + x176;
-        let x183 = c_q3 * x180 + s_q3 * x182;
-        let x184 = c_q3 * x182 - s_q3 * x180;
-        let x185 = x99 * x123 - x113 * x122 - (x109 * x121 + x114 * x120)
-            - (-39234.47412200001 * x116 + 3946.18812068 * x101)
-            + (c_q3 * x177 + s_q3 * x179 + -0.475 * x184);
-        let x186 = x118 * -5224.5702 - (3946.1881206800003 * x116 + 39241.404122 * x101)
-            + (x109 * x119 + x108 * x120 + x112 * x123) + (x178 + -7.11 * x184);
-        let x187 = 5224.5702 * x103 + (x108 * x121 - x114 * x119 - x112 * x122)
-            + (c_q3 * x179 - s_q3 * x177 + (0.475 * x183 + 7.11 * x181));
-        let x188 = x109 * x122 - x114 * x123 + x183;
-        let x189 = 5224.5702 * x101 - x108 * x122 + x184;
-        let x190 = c_q2 * x188 + s_q2 * x189;
-        let x191 = c_q2 * x187 - s_q2 * x185 + 0.5692 * x190
-            - (1145.5438279999998 * x102 + (x95 * x104 + x99 * x106));
-        let x192 = c_q1
-            * (qd[1] * x104 - x96 * x105 + x99 * x107
-                + (c_q2 * x185 + s_q2 * x187 + -0.5692 * (c_q2 * x189 - s_q2 * x188)))
-            - s_q1 * (x186 - (-65693.9112265768 * x101 + (x95 * x105 + x98 * x107)))
+                * (c_q4 * (c_q3 * x122 - s_q3 * x124 - 7.11 * x129)
+                    - s_q4 * (x125 + 7.11 * x131)) + (s_q5 * x154 + c_q5 * x155);
+        let x159 = x134 * x143 - x138 * x142 - -97.44448770720001 * x99 + x156;
+        let x160 = s_q4 * x139 + c_q4 * x141;
+        let x161 = c_q4 * x139 - s_q4 * x141 - 3239.4582 * x129;
+        let x162 = 3239.4582 * x130 + x140;
+        let x163 = 3239.4582 * x131 - x160;
+        let x164 = c_q4 * x157 + s_q4 * x159
+            - (-24989.305802 * x126 + 1375.0472756800002 * x99 + x121 * x133);
+        let x165 = x121 * x132 - (1375.0472756800002 * x126 + 24998.827802 * x99)
+            + x125 * -3239.4582 + (x158 - -7.11 * x160);
+        let x166 = x120 * x133 - x128 * x132 + 3239.4582 * x123
+            + (c_q4 * x159 - s_q4 * x157 + 7.11 * x140);
+        let x167 = c_q3 * x161 + s_q3 * x163;
+        let x168 = c_q3 * x163 - s_q3 * x161;
+        let x169 = x167 - 5224.5702 * x114;
+        let x170 = 5224.5702 * x117 + x168;
+        let x171 = c_q3 * x164 + s_q3 * x166 + -0.475 * x168
+            - (-39234.47412200001 * x110 + 3946.18812068 * x99 + x105 * x119);
+        let x172 = x105 * x118 - (3946.1881206800003 * x110 + 39241.404122 * x99)
+            - x109 * -5224.5702 + (x165 + -7.11 * x168);
+        let x173 = x104 * x119 - x112 * x118 - 5224.5702 * x107
+            + (c_q3 * x166 - s_q3 * x164 + (0.475 * x167 + 7.11 * x162));
+        let x174 = c_q2 * x169 + s_q2 * x170;
+        let x175 = c_q2 * x173 - s_q2 * x171 + 0.5692 * x174 - x95 * x102;
+        let x176 = c_q1
+            * (qd[1] * x102 - x96 * x103 - -1145.5438279999998 * x97
+                + (c_q2 * x171 + s_q2 * x173 + -0.5692 * (c_q2 * x170 - s_q2 * x169)))
+            - s_q1 * (x172 - (-65693.9112265768 * x99 + x95 * x103))
             + -0.7026
-                * (s_q1 * (x96 * x107 + x190)
-                    + c_q1
-                        * (x95 * x107 - qd[1] * x106
-                            + (x108 * x123 - x117 * -5224.5702 + x181)));
+                * (s_q1 * (x174 - -1145.5438279999998 * x100)
+                    + c_q1 * (5224.5702 * x116 + x162 - -1145.5438279999998 * x101));
         (
             [
                 [x71, x72, x73, x76, x84, x88, x94],
@@ -1314,12 +1286,12 @@ impl Ssrms {
                 [x88, x87, 0.0, 0.0, 0.0, 47.471, 0.0],
                 [x94, x93, x8, x8, x8, 0.0, 9.336],
             ],
-            [x192, x191, x186, x178, x174, x172, x166],
+            [x176, x175, x172, x165, x158, x156, x150],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 515 mul, 403 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],
@@ -1421,143 +1393,121 @@ impl Ssrms {
         let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
         let x88 = qd[0] * c_q1;
         let x89 = qd[0] * s_q1;
-        let x90 = 0.7026 * qd[0];
-        let x91 = s_q1 * x90;
-        let x92 = c_q1 * x90;
-        let x93 = qd[1] * x89;
-        let x94 = qd[1] * x88;
-        let x95 = qd[1] * x92;
-        let x96 = qd[1] * x91;
-        let x97 = -65693.9112265768 * x89;
-        let x98 = 65697.3302265768 * qd[1] - 1145.5438279999998 * x91;
-        let x99 = -1145.5438279999998 * qd[1];
-        let x100 = 1145.5438279999998 * x88;
-        let x101 = c_q2 * x88 - qd[1] * s_q2;
-        let x102 = s_q2 * x88 + qd[1] * c_q2;
-        let x103 = 0.5692 * x88;
-        let x104 = x91 + -0.5692 * qd[1];
-        let x105 = s_q2 * x103 - c_q2 * x104;
-        let x106 = s_q2 * x104 + c_q2 * x103;
-        let x107 = qd[2] - x89;
-        let x108 = 0.5692 * x93;
-        let x109 = c_q2 * x93 + qd[2] * x102;
-        let x110 = qd[2] * x101 - s_q2 * x93;
-        let x111 = c_q2 * x108 - s_q2 * x95 + qd[2] * x105;
-        let x112 = -39234.47412200001 * x101 + 3946.18812068 * x107;
-        let x113 = 5224.5702 * x92;
-        let x114 = 3946.1881206800003 * x101 + 39241.404122 * x107 - x106 * -5224.5702;
-        let x115 = x102 * -5224.5702;
-        let x116 = 5224.5702 * x107;
-        let x117 = c_q3 * x101 - s_q3 * x102;
-        let x118 = s_q3 * x101 + c_q3 * x102;
-        let x119 = x105 - -0.475 * x102;
-        let x120 = x92 + -7.11 * x102;
-        let x121 = x106 + (0.475 * x101 + 7.11 * x107);
-        let x122 = c_q3 * x119 + s_q3 * x121;
-        let x123 = s_q3 * x119 - c_q3 * x121;
-        let x124 = qd[3] + x107;
-        let x125 = 7.11 * x94;
-        let x126 = qd[2] * x106 - (c_q2 * x95 + s_q2 * x108) - -0.475 * x110;
-        let x127 = x96 - -7.11 * x110;
-        let x128 = x111 + (0.475 * x109 + x125);
-        let x129 = c_q3 * x109 + s_q3 * x110 + qd[3] * x118;
-        let x130 = c_q3 * x110 - s_q3 * x109 + qd[3] * x117;
-        let x131 = s_q3 * x126 + c_q3 * x128 + qd[3] * x122;
-        let x132 = -24989.305802 * x117 + 1375.0472756800002 * x124;
-        let x133 = 3239.4582 * x120;
-        let x134 = 1375.0472756800002 * x117 + 24998.827802 * x124 + x123 * -3239.4582;
-        let x135 = x118 * -3239.4582;
-        let x136 = 3239.4582 * x124;
-        let x137 = c_q4 * x117 - s_q4 * x118;
-        let x138 = s_q4 * x117 + c_q4 * x118;
-        let x139 = x120 + -7.11 * x118;
-        let x140 = x123 - 7.11 * x124;
-        let x141 = c_q4 * x122 - s_q4 * x140;
-        let x142 = s_q4 * x122 + c_q4 * x140;
-        let x143 = qd[4] + x124;
-        let x144 = c_q4 * x129 + s_q4 * x130 + qd[4] * x138;
-        let x145 = c_q4 * x130 - s_q4 * x129 + qd[4] * x137;
-        let x146 = -97.44448770720001 * x143;
-        let x147 = 132.6783695416 * x137 - 171.195516 * x139;
-        let x148 = 135.4729695416 * x143 + -97.44448770720001 * x138
-            + -171.195516 * x141;
-        let x149 = 171.195516 * x143;
-        let x150 = -171.195516 * x137;
-        let x151 = c_q5 * x137 + s_q5 * x143;
-        let x152 = c_q5 * x143 - s_q5 * x137;
-        let x153 = qd[5] + x138;
-        let x154 = 44.41 * x152;
-        let x155 = 47.471 * x153;
-        let x156 = 9.336 * (qd[6] + x151);
-        let x157 = 9.336 * (qd[5] * x152 - (c_q5 * x144 + s_q5 * x94)) - f_ext[6][3];
-        let x158 = (c_q6 * x153 - s_q6 * x152) * x156 - f_ext[6][4];
-        let x159 = f_ext[6][5] + (c_q6 * x152 + s_q6 * x153) * x156;
-        let x160 = f_ext[6][2] * s_q6 - f_ext[6][1] * c_q6;
-        let x161 = x152 * x155 - x153 * x154 - f_ext[5][3] + (x157 + 0.7026 * x160);
-        let x162 = 44.41 * (s_q5 * x144 - c_q5 * x94 - qd[5] * x151) - x151 * x155
-            - f_ext[5][4] + (c_q6 * x158 + s_q6 * x159 - -0.7026 * f_ext[6][0]);
-        let x163 = 47.471 * x145 + x151 * x154 - f_ext[5][5]
-            + (s_q6 * x158 - c_q6 * x159);
-        let x164 = f_ext[5][0] + f_ext[6][0];
-        let x165 = x160 - f_ext[5][1];
-        let x166 = f_ext[5][2] + (f_ext[6][1] * s_q6 + f_ext[6][2] * c_q6);
-        let x167 = c_q5 * x164 + s_q5 * x165;
-        let x168 = 171.195516 * (x127 - -7.11 * x130) - 132.6783695416 * x144
-            + (x143 * x146 - x138 * x148 + x142 * x150) - f_ext[4][3]
-            + (c_q5 * x161 - s_q5 * x162 - -0.5692 * x166);
-        let x169 = -97.44448770720001 * x145 - 135.4729695416 * x94
+        let x90 = 0.7026 * (qd[0] * qd[0]);
+        let x91 = qd[1] * x89;
+        let x92 = qd[1] * x88;
+        let x93 = x88 * x89;
+        let x94 = qd[1] * qd[1] + x88 * x88;
+        let x95 = -65693.9112265768 * x89;
+        let x96 = 65697.3302265768 * qd[1];
+        let x97 = c_q2 * x88 - qd[1] * s_q2;
+        let x98 = s_q2 * x88 + qd[1] * c_q2;
+        let x99 = -0.5692 * x93;
+        let x100 = -0.5692 * x94;
+        let x101 = x90 + -0.5692 * (x91 + x91);
+        let x102 = s_q2 * x99 + c_q2 * x101;
+        let x103 = c_q2 * x91 + qd[2] * x98;
+        let x104 = qd[2] * x97 - s_q2 * x91;
+        let x105 = qd[2] - x89;
+        let x106 = x98 * x98;
+        let x107 = x105 * x105 + x106;
+        let x108 = x97 * x105;
+        let x109 = x104 + x108;
+        let x110 = x92 + x97 * x98;
+        let x111 = -39234.47412200001 * x97 + 3946.18812068 * x105;
+        let x112 = 3946.1881206800003 * x97 + 39241.404122 * x105;
+        let x113 = c_q3 * x97 - s_q3 * x98;
+        let x114 = s_q3 * x97 + c_q3 * x98;
+        let x115 = s_q2 * x101 - c_q2 * x99 + (-0.475 * (x108 - x104) - 7.11 * x107);
+        let x116 = 7.11 * x109 - -0.475 * (x106 + x97 * x97) - x100;
+        let x117 = 7.11 * x110 + -0.475 * (x98 * x105 - x103) - x102;
+        let x118 = s_q3 * x115 + c_q3 * x117;
+        let x119 = c_q3 * x103 + s_q3 * x104 + qd[3] * x114;
+        let x120 = c_q3 * x104 - s_q3 * x103 + qd[3] * x113;
+        let x121 = qd[3] + x105;
+        let x122 = x121 * x121 + x114 * x114;
+        let x123 = x120 + x113 * x121;
+        let x124 = x92 + x113 * x114;
+        let x125 = -24989.305802 * x113 + 1375.0472756800002 * x121;
+        let x126 = 1375.0472756800002 * x113 + 24998.827802 * x121;
+        let x127 = c_q4 * x113 - s_q4 * x114;
+        let x128 = s_q4 * x113 + c_q4 * x114;
+        let x129 = c_q4 * x119 + s_q4 * x120 + qd[4] * x128;
+        let x130 = c_q4 * x120 - s_q4 * x119 + qd[4] * x127;
+        let x131 = qd[4] + x121;
+        let x132 = 132.6783695416 * x127;
+        let x133 = 135.4729695416 * x131 + -97.44448770720001 * x128;
+        let x134 = -97.44448770720001 * x131;
+        let x135 = c_q5 * x127 + s_q5 * x131;
+        let x136 = c_q5 * x131 - s_q5 * x127;
+        let x137 = qd[5] + x128;
+        let x138 = 44.41 * x136;
+        let x139 = 47.471 * x137;
+        let x140 = 9.336 * (qd[6] + x135);
+        let x141 = 9.336 * (qd[5] * x136 - (c_q5 * x129 + s_q5 * x92)) - f_ext[6][3];
+        let x142 = (c_q6 * x137 - s_q6 * x136) * x140 - f_ext[6][4];
+        let x143 = f_ext[6][5] + (c_q6 * x136 + s_q6 * x137) * x140;
+        let x144 = f_ext[6][2] * s_q6 - f_ext[6][1] * c_q6;
+        let x145 = f_ext[5][0] + f_ext[6][0];
+        let x146 = x144 - f_ext[5][1];
+        let x147 = f_ext[5][2] + (f_ext[6][1] * s_q6 + f_ext[6][2] * c_q6);
+        let x148 = x136 * x139 - x137 * x138 - f_ext[5][3] + (x141 + 0.7026 * x144);
+        let x149 = 44.41 * (s_q5 * x129 - c_q5 * x92 - qd[5] * x135) - x135 * x139
+            - f_ext[5][4] + (c_q6 * x142 + s_q6 * x143 - -0.7026 * f_ext[6][0]);
+        let x150 = 47.471 * x130 + x135 * x138 - f_ext[5][5]
+            + (s_q6 * x142 - c_q6 * x143);
+        let x151 = c_q5 * x145 + s_q5 * x146;
+        let x152 = -171.195516 * (x127 * x128 - x92) - f_ext[4][0] - x151;
+        let x153 = -171.195516 * (x129 + x128 * x131) - f_ext[4][1]
+            + (c_q5 * x146 - s_q5 * x145);
+        let x154 = f_ext[4][2] + -171.195516 * (x131 * x131 + x127 * x127) + x147;
+        let x155 = x131 * x134 - x128 * x133 - 132.6783695416 * x129
+            + 171.195516 * (x116 + 7.11 * x123) - f_ext[4][3]
+            + (c_q5 * x148 - s_q5 * x149 - -0.5692 * x147);
+        let x156 = -97.44448770720001 * x130 - 135.4729695416 * x92
+            + (x128 * x132 - x127 * x134)
             + -171.195516
-                * (c_q4 * (c_q3 * x126 - s_q3 * x128 - qd[3] * x123)
-                    - s_q4 * (x125 + x131) - qd[4] * x142)
-            + (x138 * x147 - x137 * x146 - x142 * x149) - f_ext[4][4]
-            + (s_q5 * x161 + c_q5 * x162);
-        let x170 = x137 * x148 - x143 * x147 - (x139 * x149 + x141 * x150)
-            - -97.44448770720001 * x94 - f_ext[4][5] + (x163 - 0.5692 * x167);
-        let x171 = 171.195516 * x94 + x138 * x150 - f_ext[4][0] - x167;
-        let x172 = -171.195516 * x144 - x138 * x149 - f_ext[4][1]
-            + (c_q5 * x165 - s_q5 * x164);
-        let x173 = x143 * x149 - x137 * x150 - f_ext[4][2] - x166;
-        let x174 = c_q4 * x173 - s_q4 * x171;
-        let x175 = x123 * x135 + x120 * x136 - (x118 * x134 + x124 * x133)
-            - (-24989.305802 * x129 + 1375.0472756800002 * x94) - f_ext[3][3]
-            + (c_q4 * x168 + s_q4 * x170);
-        let x176 = x131 * -3239.4582 - (1375.0472756800002 * x129 + 24998.827802 * x94)
-            + (x118 * x132 + x117 * x133 + x122 * x136) - f_ext[3][4]
-            + (x169 + -7.11 * x174);
-        let x177 = 3239.4582 * x127 + (x117 * x134 - x124 * x132 - x122 * x135)
-            - f_ext[3][5] + (c_q4 * x170 - s_q4 * x168 + 7.11 * x172);
-        let x178 = x118 * x135 - x124 * x136 - f_ext[3][0] + (c_q4 * x171 + s_q4 * x173);
-        let x179 = x117 * x136 - x130 * -3239.4582 - f_ext[3][1] + x172;
-        let x180 = 3239.4582 * x94 - x117 * x135 - f_ext[3][2] + x174;
-        let x181 = c_q3 * x178 + s_q3 * x180;
-        let x182 = c_q3 * x180 - s_q3 * x178;
-        let x183 = x92 * x116 - x106 * x115 - (x102 * x114 + x107 * x113)
-            - (-39234.47412200001 * x109 + 3946.18812068 * x94) - f_ext[2][3]
-            + (c_q3 * x175 + s_q3 * x177 + -0.475 * x182);
-        let x184 = x111 * -5224.5702 - (3946.1881206800003 * x109 + 39241.404122 * x94)
-            + (x102 * x112 + x101 * x113 + x105 * x116) - f_ext[2][4]
-            + (x176 + -7.11 * x182);
-        let x185 = 5224.5702 * x96 + (x101 * x114 - x107 * x112 - x105 * x115)
-            - f_ext[2][5] + (c_q3 * x177 - s_q3 * x175 + (0.475 * x181 + 7.11 * x179));
-        let x186 = x102 * x115 - x107 * x116 - f_ext[2][0] + x181;
-        let x187 = 5224.5702 * x94 - x101 * x115 - f_ext[2][2] + x182;
-        let x188 = c_q2 * x186 + s_q2 * x187;
-        let x189 = tau[0]
+                * (c_q4 * (c_q3 * x115 - s_q3 * x117 - 7.11 * x122)
+                    - s_q4 * (x118 + 7.11 * x124)) - f_ext[4][4]
+            + (s_q5 * x148 + c_q5 * x149);
+        let x157 = x127 * x133 - x131 * x132 - -97.44448770720001 * x92 - f_ext[4][5]
+            + (x150 - 0.5692 * x151);
+        let x158 = s_q4 * x152 + c_q4 * x154;
+        let x159 = c_q4 * x152 - s_q4 * x154 - (f_ext[3][0] + 3239.4582 * x122);
+        let x160 = 3239.4582 * x123 - f_ext[3][1] + x153;
+        let x161 = 3239.4582 * x124 - f_ext[3][2] - x158;
+        let x162 = c_q4 * x155 + s_q4 * x157
+            - (f_ext[3][3]
+                + (-24989.305802 * x119 + 1375.0472756800002 * x92 + x114 * x126));
+        let x163 = x114 * x125 - (1375.0472756800002 * x119 + 24998.827802 * x92)
+            + x118 * -3239.4582 - f_ext[3][4] + (x156 - -7.11 * x158);
+        let x164 = x113 * x126 - x121 * x125 + 3239.4582 * x116 - f_ext[3][5]
+            + (c_q4 * x157 - s_q4 * x155 + 7.11 * x153);
+        let x165 = c_q3 * x159 + s_q3 * x161;
+        let x166 = c_q3 * x161 - s_q3 * x159;
+        let x167 = x165 - (f_ext[2][0] + 5224.5702 * x107);
+        let x168 = 5224.5702 * x110 - f_ext[2][2] + x166;
+        let x169 = c_q3 * x162 + s_q3 * x164 + -0.475 * x166
+            - (f_ext[2][3]
+                + (-39234.47412200001 * x103 + 3946.18812068 * x92 + x98 * x112));
+        let x170 = x98 * x111 - (3946.1881206800003 * x103 + 39241.404122 * x92)
+            - x102 * -5224.5702 - f_ext[2][4] + (x163 + -7.11 * x166);
+        let x171 = x97 * x112 - x105 * x111 - 5224.5702 * x100 - f_ext[2][5]
+            + (c_q3 * x164 - s_q3 * x162 + (0.475 * x165 + 7.11 * x160));
+        let x172 = c_q2 * x167 + s_q2 * x168;
+        let x173 = tau[0]
             - (c_q1
-                * (qd[1] * x97 - x89 * x98 + x92 * x100 - f_ext[1][3]
-                    + (c_q2 * x183 + s_q2 * x185
-                        + -0.5692 * (c_q2 * x187 - s_q2 * x186)))
-                - s_q1
-                    * (x184
-                        - (f_ext[1][4]
-                            + (-65693.9112265768 * x94 + (x88 * x98 + x91 * x100))))
+                * (qd[1] * x95 - x89 * x96 - -1145.5438279999998 * x90 - f_ext[1][3]
+                    + (c_q2 * x169 + s_q2 * x171
+                        + -0.5692 * (c_q2 * x168 - s_q2 * x167)))
+                - s_q1 * (x170 - (f_ext[1][4] + (-65693.9112265768 * x92 + x88 * x96)))
                 + -0.7026
-                    * (s_q1 * (x89 * x100 - f_ext[1][0] + x188)
+                    * (s_q1 * (x172 - (f_ext[1][0] + -1145.5438279999998 * x93))
                         + c_q1
-                            * (x88 * x100 - qd[1] * x99 - f_ext[1][1]
-                                + (x101 * x116 - x110 * -5224.5702 - f_ext[2][1] + x179)))
+                            * (5224.5702 * x109 - f_ext[2][1] + x160
+                                - (f_ext[1][1] + -1145.5438279999998 * x94)))
                 - f_ext[0][3]);
-        let x190 = 1.0
+        let x174 = 1.0
             / (66279.65991417361
                 + (0.7026 * x63
                     + (c_q1
@@ -1565,75 +1515,74 @@ impl Ssrms {
                             - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
                         - s_q1 * (x68 - s_q1 * (-65693.9112265768 + x59))
                         - -0.7026 * x63)));
-        let x191 = x69 * x190;
-        let x192 = x70 * x190;
-        let x193 = x72 * x190;
-        let x194 = x79 * x190;
-        let x195 = x82 * x190;
-        let x196 = x87 * x190;
-        let x197 = 1.0
+        let x175 = x69 * x174;
+        let x176 = x70 * x174;
+        let x177 = x72 * x174;
+        let x178 = x79 * x174;
+        let x179 = x82 * x174;
+        let x180 = x87 * x174;
+        let x181 = 1.0
             / (65697.3302265768
                 + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
-                - x69 * x191);
-        let x198 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x192;
-        let x199 = x197 * x198;
-        let x200 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x193;
-        let x201 = x197 * x200;
-        let x202 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x194;
-        let x203 = x197 * x202;
-        let x204 = c_q2 * x81 - s_q2 * x80 - x69 * x195;
-        let x205 = x197 * x204;
-        let x206 = s_q2 * x85 + c_q2 * x86 + x69 * x196;
-        let x207 = x197 * x206;
-        let x208 = 1.0 / (x59 - x70 * x192 - x198 * x199);
-        let x209 = x49 - x70 * x193 - x198 * x201;
+                - x69 * x175);
+        let x182 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x176;
+        let x183 = x181 * x182;
+        let x184 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x177;
+        let x185 = x181 * x184;
+        let x186 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x178;
+        let x187 = x181 * x186;
+        let x188 = c_q2 * x81 - s_q2 * x80 - x69 * x179;
+        let x189 = x181 * x188;
+        let x190 = s_q2 * x85 + c_q2 * x86 + x69 * x180;
+        let x191 = x181 * x190;
+        let x192 = 1.0 / (x59 - x70 * x176 - x182 * x183);
+        let x193 = x49 - x70 * x177 - x182 * x185;
+        let x194 = x192 * x193;
+        let x195 = x76 - x70 * x178 - x182 * x187;
+        let x196 = x192 * x195;
+        let x197 = x70 * x179 + x182 * x189;
+        let x198 = x192 * x197;
+        let x199 = x8 - x70 * x180 + x182 * x191;
+        let x200 = x192 * x199;
+        let x201 = 1.0 / (x35 - x72 * x177 - x184 * x185 - x193 * x194);
+        let x202 = x27 - x72 * x178 - x184 * x187 - x193 * x196;
+        let x203 = x201 * x202;
+        let x204 = x193 * x198 - (x72 * x179 + x184 * x189);
+        let x205 = x201 * x204;
+        let x206 = x8 - x72 * x180 + x184 * x191 - x193 * x200;
+        let x207 = x201 * x206;
+        let x208 = 1.0 / (x13 - x79 * x178 - x186 * x187 - x195 * x196 - x202 * x203);
+        let x209 = x195 * x198 - (x79 * x179 + x186 * x189) - x202 * x205;
         let x210 = x208 * x209;
-        let x211 = x76 - x70 * x194 - x198 * x203;
+        let x211 = x8 - x79 * x180 + x186 * x191 - x195 * x200 - x202 * x207;
         let x212 = x208 * x211;
-        let x213 = x70 * x195 + x198 * x205;
-        let x214 = x208 * x213;
-        let x215 = x8 - x70 * x196 + x198 * x207;
-        let x216 = x208 * x215;
-        let x217 = 1.0 / (x35 - x72 * x193 - x200 * x201 - x209 * x210);
-        let x218 = x27 - x72 * x194 - x200 * x203 - x209 * x212;
-        let x219 = x217 * x218;
-        let x220 = x209 * x214 - (x72 * x195 + x200 * x205);
-        let x221 = x217 * x220;
-        let x222 = x8 - x72 * x196 + x200 * x207 - x209 * x216;
-        let x223 = x217 * x222;
-        let x224 = 1.0 / (x13 - x79 * x194 - x202 * x203 - x211 * x212 - x218 * x219);
-        let x225 = x211 * x214 - (x79 * x195 + x202 * x205) - x218 * x221;
-        let x226 = x224 * x225;
-        let x227 = x8 - x79 * x196 + x202 * x207 - x211 * x216 - x218 * x223;
-        let x228 = x224 * x227;
-        let x229 = 1.0
-            / (47.471 - x82 * x195 - x204 * x205 - x213 * x214 - x220 * x221
-                - x225 * x226);
-        let x230 = x204 * x207 - x82 * x196 + x213 * x216 - x220 * x223 - x225 * x228;
-        let x231 = x229 * x230;
-        let x232 = 1.0
-            / (9.336 - x87 * x196 - x206 * x207 - x215 * x216 - x222 * x223 - x227 * x228
-                - x230 * x231);
-        let x233 = tau[1]
-            - (c_q2 * x185 - s_q2 * x183 + 0.5692 * x188
-                - (f_ext[1][5] + (1145.5438279999998 * x95 + (x88 * x97 + x92 * x99))))
-            - x189 * x191;
-        let x234 = tau[2] - x184 - x189 * x192 - x199 * x233;
-        let x235 = tau[3] - x176 - x189 * x193 - x201 * x233 - x210 * x234;
-        let x236 = tau[4] - x169 - x189 * x194 - x203 * x233 - x212 * x234 - x219 * x235;
-        let x237 = tau[5] - x163 - x189 * x195 - x205 * x233 + x214 * x234 - x221 * x235
-            - x226 * x236;
-        let x238 = x232
-            * (tau[6] - x157 - x189 * x196 + x207 * x233 - x216 * x234 - x223 * x235
-                - x228 * x236 - x231 * x237);
-        let x239 = x229 * x237 - x231 * x238;
-        let x240 = x224 * x236 - x226 * x239 - x228 * x238;
-        let x241 = x217 * x235 - x219 * x240 - x221 * x239 - x223 * x238;
-        let x242 = x208 * x234 - x210 * x241 - x212 * x240 + x214 * x239 - x216 * x238;
-        let x243 = x197 * x233 - x199 * x242 - x201 * x241 - x203 * x240 - x205 * x239
-            + x207 * x238;
-        let x244 = x189 * x190 - x191 * x243 - x192 * x242 - x193 * x241 - x194 * x240
-            - x195 * x239 - x196 * x238;
-        [x244, x243, x242, x241, x240, x239, x238]
+        let x213 = 1.0
+            / (47.471 - x82 * x179 - x188 * x189 - x197 * x198 - x204 * x205
+                - x209 * x210);
+        let x214 = x188 * x191 - x82 * x180 + x197 * x200 - x204 * x207 - x209 * x212;
+        let x215 = x213 * x214;
+        let x216 = 1.0
+            / (9.336 - x87 * x180 - x190 * x191 - x199 * x200 - x206 * x207 - x211 * x212
+                - x214 * x215);
+        let x217 = tau[1]
+            - (c_q2 * x171 - s_q2 * x169 + 0.5692 * x172 - (f_ext[1][5] + x88 * x95))
+            - x173 * x175;
+        let x218 = tau[2] - x170 - x173 * x176 - x183 * x217;
+        let x219 = tau[3] - x163 - x173 * x177 - x185 * x217 - x194 * x218;
+        let x220 = tau[4] - x156 - x173 * x178 - x187 * x217 - x196 * x218 - x203 * x219;
+        let x221 = tau[5] - x150 - x173 * x179 - x189 * x217 + x198 * x218 - x205 * x219
+            - x210 * x220;
+        let x222 = x216
+            * (tau[6] - x141 - x173 * x180 + x191 * x217 - x200 * x218 - x207 * x219
+                - x212 * x220 - x215 * x221);
+        let x223 = x213 * x221 - x215 * x222;
+        let x224 = x208 * x220 - x210 * x223 - x212 * x222;
+        let x225 = x201 * x219 - x203 * x224 - x205 * x223 - x207 * x222;
+        let x226 = x192 * x218 - x194 * x225 - x196 * x224 + x198 * x223 - x200 * x222;
+        let x227 = x181 * x217 - x183 * x226 - x185 * x225 - x187 * x224 - x189 * x223
+            + x191 * x222;
+        let x228 = x173 * x174 - x175 * x227 - x176 * x226 - x177 * x225 - x178 * x224
+            - x179 * x223 - x180 * x222;
+        [x228, x227, x226, x225, x224, x223, x222]
     }
 }

@@ -19,19 +19,24 @@
 //! | `mass_matrix` * | `crba` | — | 102 | 71 | 0 | 0 | 4 | 173 |
 //! | `nonlinear_effects` | — | `recurrent` | 493 | 340 | 0 | 0 | 6 | 833 |
 //! | `nonlinear_effects` | — | `kane-direct` | 534 | 376 | 0 | 0 | 6 | 910 |
-//! | `nonlinear_effects` * | — | `rnea` | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `nonlinear_effects` | — | `rnea` | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `nonlinear_effects` * | — | `newton-euler` | 155 | 99 | 0 | 0 | 5 | 254 |
 //! | `inverse_dynamics` | — | `recurrent` | 621 | 439 | 0 | 0 | 6 | 1060 |
 //! | `inverse_dynamics` | — | `kane-direct` | 662 | 475 | 0 | 0 | 6 | 1137 |
-//! | `inverse_dynamics` * | — | `rnea` | 208 | 146 | 0 | 0 | 5 | 354 |
+//! | `inverse_dynamics` | — | `rnea` | 208 | 146 | 0 | 0 | 5 | 354 |
+//! | `inverse_dynamics` * | — | `newton-euler` | 172 | 124 | 0 | 0 | 5 | 296 |
 //! | `forward_dynamics` | `crba` | `recurrent` | 681 | 478 | 6 | 0 | 6 | 1159 |
 //! | `forward_dynamics` | `crba` | `kane-direct` | 722 | 514 | 6 | 0 | 6 | 1236 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 377 | 262 | 6 | 0 | 5 | 639 |
+//! | `forward_dynamics` | `crba` | `rnea` | 377 | 262 | 6 | 0 | 5 | 639 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | 343 | 237 | 6 | 0 | 5 | 580 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 595 | 411 | 0 | 0 | 6 | 1006 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 636 | 447 | 0 | 0 | 6 | 1083 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 291 | 195 | 0 | 0 | 5 | 486 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 291 | 195 | 0 | 0 | 5 | 486 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 257 | 170 | 0 | 0 | 5 | 427 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 763 | 561 | 6 | 0 | 6 | 1324 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 804 | 597 | 6 | 0 | 6 | 1401 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 389 | 300 | 6 | 0 | 5 | 689 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 389 | 300 | 6 | 0 | 5 | 689 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 355 | 275 | 6 | 0 | 5 | 630 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
@@ -98,9 +103,9 @@ impl Ssrms6 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 189u64,
-            add: 124u64,
+            bias_method: Some("newton-euler"),
+            mul: 155u64,
+            add: 99u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -109,9 +114,9 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 208u64,
-            add: 146u64,
+            bias_method: Some("newton-euler"),
+            mul: 172u64,
+            add: 124u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -120,9 +125,9 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 377u64,
-            add: 262u64,
+            bias_method: Some("newton-euler"),
+            mul: 343u64,
+            add: 237u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -131,9 +136,9 @@ impl Ssrms6 {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 291u64,
-            add: 195u64,
+            bias_method: Some("newton-euler"),
+            mul: 257u64,
+            add: 170u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -142,9 +147,9 @@ impl Ssrms6 {
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 389u64,
-            add: 300u64,
+            bias_method: Some("newton-euler"),
+            mul: 355u64,
+            add: 275u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -242,6 +247,17 @@ impl Ssrms6 {
             fma: 0u64,
         },
         OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 155u64,
+            add: 99u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
@@ -269,6 +285,17 @@ impl Ssrms6 {
             bias_method: Some("rnea"),
             mul: 208u64,
             add: 146u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 172u64,
+            add: 124u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -308,6 +335,17 @@ impl Ssrms6 {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 343u64,
+            add: 237u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -341,6 +379,17 @@ impl Ssrms6 {
             fma: 0u64,
         },
         OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 257u64,
+            add: 170u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -368,6 +417,17 @@ impl Ssrms6 {
             bias_method: Some("rnea"),
             mul: 389u64,
             add: 300u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 355u64,
+            add: 275u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -455,221 +515,189 @@ impl Ssrms6 {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 189 mul, 124 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `newton-euler`: 155 mul, 99 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * s_q1;
         let x2 = qd[0] * c_q1;
-        let x3 = -0.5692 * qd[0];
-        let x4 = c_q1 * x3;
-        let x5 = s_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = qd[1] * x1;
-        let x8 = qd[1] * x4;
+        let x3 = -0.5692 * (qd[0] * qd[0]);
+        let x4 = qd[1] * x2;
+        let x5 = qd[1] * x1;
+        let x6 = x2 * x2;
+        let x7 = qd[1] * qd[1] + x6;
+        let x8 = x1 * x2;
         let x9 = 3946.18812068 * qd[1] - -39234.47412200001 * x1;
-        let x10 = 39241.404122 * qd[1] - 3946.1881206800003 * x1 - x5 * -5224.5702;
-        let x11 = x2 * -5224.5702;
-        let x12 = 5224.5702 * qd[1];
+        let x10 = 39241.404122 * qd[1] - 3946.1881206800003 * x1;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x14 = x1 * c_q2 + x2 * s_q2;
-        let x15 = x2 * c_q2 - x1 * s_q2;
-        let x16 = x2 * -7.11;
-        let x17 = x4 + -0.475 * x2;
-        let x18 = x5 + (7.11 * qd[1] - x1 * 0.475);
-        let x19 = s_q2 * x18 - c_q2 * x17;
-        let x20 = s_q2 * x17 + c_q2 * x18;
-        let x21 = qd[1] + qd[2];
-        let x22 = x7 * -7.11;
-        let x23 = qd[1] * x5 + -0.475 * x7;
-        let x24 = x6 * 0.475 - x8;
-        let x25 = x7 * s_q2 - x6 * c_q2 - qd[2] * x15;
-        let x26 = x6 * s_q2 + x7 * c_q2 + qd[2] * x14;
-        let x27 = s_q2 * x23 + c_q2 * x24 + qd[2] * x19;
-        let x28 = 1375.0472756800002 * x21 - -24989.305802 * x14;
-        let x29 = 3239.4582 * x16;
-        let x30 = 24998.827802 * x21 - 1375.0472756800002 * x14 - x20 * -3239.4582;
-        let x31 = x15 * -3239.4582;
-        let x32 = 3239.4582 * x21;
+        let x12 = x1 * c_q2 + x2 * s_q2;
+        let x13 = x2 * c_q2 - x1 * s_q2;
+        let x14 = 7.11 * x7;
+        let x15 = 7.11 * x8;
+        let x16 = x3 + (7.11 * (x5 + x5) + -0.475 * (x6 + x1 * x1));
+        let x17 = s_q2 * x14 + c_q2 * x15;
+        let x18 = x5 * s_q2 - x4 * c_q2 - qd[2] * x13;
+        let x19 = x4 * s_q2 + x5 * c_q2 + qd[2] * x12;
+        let x20 = qd[1] + qd[2];
+        let x21 = x20 * x20 + x13 * x13;
+        let x22 = x12 * x13;
+        let x23 = x19 + x12 * x20;
+        let x24 = 1375.0472756800002 * x20 - -24989.305802 * x12;
+        let x25 = 24998.827802 * x20 - 1375.0472756800002 * x12;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x34 = x14 * c_q3 + x15 * s_q3;
-        let x35 = x15 * c_q3 - x14 * s_q3;
-        let x36 = x16 + x15 * -7.11;
-        let x37 = x20 + 7.11 * x21;
-        let x38 = x19 * c_q3 + s_q3 * x37;
-        let x39 = x19 * s_q3 - c_q3 * x37;
-        let x40 = qd[3] + x21;
-        let x41 = x25 * c_q3 + x26 * s_q3 - qd[3] * x35;
-        let x42 = x25 * s_q3 - x26 * c_q3 - qd[3] * x34;
-        let x43 = -97.44448770720001 * x40;
-        let x44 = 132.6783695416 * x34 + x36 * 171.195516;
-        let x45 = 135.4729695416 * x40 + -97.44448770720001 * x35 + -171.195516 * x38;
-        let x46 = x40 * 171.195516;
-        let x47 = -171.195516 * x34;
-        let x48 = x35 * x47;
-        let x49 = x40 * x46 - x34 * x47;
-        let x50 = -171.195516 * x41 + x35 * x46;
+        let x27 = x12 * c_q3 + x13 * s_q3;
+        let x28 = x13 * c_q3 - x12 * s_q3;
+        let x29 = x18 * c_q3 + x19 * s_q3 - qd[3] * x28;
+        let x30 = x18 * s_q3 - x19 * c_q3 - qd[3] * x27;
+        let x31 = qd[3] + x20;
+        let x32 = -171.195516 * (x27 * x28);
+        let x33 = -171.195516 * (x28 * x31 - x29);
+        let x34 = -171.195516 * (x31 * x31 + x27 * x27);
+        let x35 = 132.6783695416 * x27;
+        let x36 = 135.4729695416 * x31 + -97.44448770720001 * x28;
+        let x37 = -97.44448770720001 * x31;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x52 = x40 * s_q4 - x34 * c_q4;
-        let x53 = x34 * s_q4 + x40 * c_q4;
-        let x54 = qd[4] + x35;
-        let x55 = 44.41 * x53;
-        let x56 = 47.471 * x54;
+        let x39 = x31 * s_q4 - x27 * c_q4;
+        let x40 = x27 * s_q4 + x31 * c_q4;
+        let x41 = qd[4] + x28;
+        let x42 = 44.41 * x40;
+        let x43 = 47.471 * x41;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x58 = 9.336 * (x41 * c_q4 + qd[4] * x53);
-        let x59 = 9.336 * (qd[5] + x52);
-        let x60 = (x54 * c_q5 - x53 * s_q5) * x59;
-        let x61 = (x53 * c_q5 + x54 * s_q5) * x59;
-        let x62 = x53 * x56 - x54 * x55 + x58;
-        let x63 = c_q5 * x60 + s_q5 * x61
-            - (44.41 * (x41 * s_q4 + qd[4] * x52) + x52 * x56);
-        let x64 = 47.471 * x42 + x52 * x55 + (s_q5 * x60 - c_q5 * x61);
-        let x65 = 132.6783695416 * x41 + (x22 + -7.11 * x26) * 171.195516
-            + (x40 * x43 - x35 * x45 - x39 * x47) + (c_q4 * x62 - s_q4 * x63);
-        let x66 = -97.44448770720001 * x42
+        let x45 = 9.336 * (x29 * c_q4 + qd[4] * x40);
+        let x46 = 9.336 * (qd[5] + x39);
+        let x47 = (x41 * c_q5 - x40 * s_q5) * x46;
+        let x48 = (x40 * c_q5 + x41 * s_q5) * x46;
+        let x49 = x40 * x43 - x41 * x42 + x45;
+        let x50 = c_q5 * x47 + s_q5 * x48
+            - (44.41 * (x29 * s_q4 + qd[4] * x39) + x39 * x43);
+        let x51 = 47.471 * x30 + x39 * x42 + (s_q5 * x47 - c_q5 * x48);
+        let x52 = 132.6783695416 * x29 + (x31 * x37 - x28 * x36)
+            - (x16 + 7.11 * x23) * 171.195516 + (c_q4 * x49 - s_q4 * x50);
+        let x53 = -97.44448770720001 * x30 + (x27 * x37 - x28 * x35)
             + -171.195516
-                * ((c_q2 * x23 - s_q2 * x24 + qd[2] * x20) * c_q3 - x27 * s_q3
-                    - qd[3] * x39) + (x34 * x43 - x35 * x44 - x39 * x46)
-            + (s_q4 * x62 + c_q4 * x63);
-        let x67 = x40 * x44 - x34 * x45 + (x38 * x47 - x36 * x46) + x64;
-        let x68 = s_q3 * x48 + c_q3 * x49;
-        let x69 = -24989.305802 * x25 + (x16 * x32 - x20 * x31 - (x15 * x30 + x21 * x29))
-            + (c_q3 * x65 + s_q3 * x67);
-        let x70 = 1375.0472756800002 * x25 + x27 * -3239.4582
-            + (x15 * x28 - x14 * x29 + x19 * x32) + (x66 + -7.11 * x68);
-        let x71 = 3239.4582 * x22 - (x21 * x28 + x14 * x30 + x19 * x31)
-            + (c_q3 * x67 - s_q3 * x65 - 7.11 * x50);
-        let x72 = x15 * x31 - x21 * x32 + (s_q3 * x49 - c_q3 * x48);
-        let x73 = x14 * x31 + x68;
-        let x74 = c_q2 * x72 + s_q2 * x73;
-        let x75 = c_q2 * x73 - s_q2 * x72;
-        let x76 = x2 * x9 - x4 * x12 - (3946.1881206800003 * x6 + x8 * -5224.5702)
-            + (x70 + -7.11 * x75);
-        let x77 = c_q1
-            * (x4 * x11 - (qd[1] * x9 + x1 * x10)
-                + (c_q2 * x71 - s_q2 * x69
-                    + (0.475 * x74 + 7.11 * (x26 * -3239.4582 - x14 * x32 - x50))))
+                * (c_q3 * (s_q2 * x15 - c_q2 * x14 - 7.11 * x21)
+                    + s_q3 * (x17 + 7.11 * x22)) + (s_q4 * x49 + c_q4 * x50);
+        let x54 = x31 * x35 - x27 * x36 + x51;
+        let x55 = s_q3 * x32 - c_q3 * x34;
+        let x56 = 3239.4582 * x21 + (c_q3 * x32 + s_q3 * x34);
+        let x57 = x55 - 3239.4582 * x22;
+        let x58 = -24989.305802 * x18 - x13 * x25 + (c_q3 * x52 + s_q3 * x54);
+        let x59 = 1375.0472756800002 * x18 + x13 * x24 - x17 * -3239.4582
+            + (x53 + x55 * -7.11);
+        let x60 = c_q3 * x54 - s_q3 * x52 + 7.11 * x33
+            - (x20 * x24 + x12 * x25 + 3239.4582 * x16);
+        let x61 = s_q2 * x57 - c_q2 * x56;
+        let x62 = s_q2 * x56 + c_q2 * x57;
+        let x63 = x2 * x9 - 3946.1881206800003 * x4 + (x59 + -7.11 * x62);
+        let x64 = c_q1
+            * (c_q2 * x60 - s_q2 * x58 + (x61 * 0.475 + 7.11 * (x33 - 3239.4582 * x23))
+                - (qd[1] * x9 + x1 * x10 + 5224.5702 * x3))
             - s_q1
-                * (c_q2 * x69 + s_q2 * x71 + -0.475 * x75
-                    - (-39234.47412200001 * x6 + (x2 * x10 + x5 * x11)))
-            + 0.5692 * (c_q1 * (x2 * x11 - qd[1] * x12 + x74) + s_q1 * (x1 * x11 + x75));
-        [x77, x76, x70, x66, x64, x58]
+                * (c_q2 * x58 + s_q2 * x60 + -0.475 * x62
+                    - (-39234.47412200001 * x4 + x2 * x10))
+            + 0.5692 * (c_q1 * (x61 - 5224.5702 * x7) + s_q1 * (x62 - 5224.5702 * x8));
+        [x64, x63, x59, x53, x51, x45]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 208 mul, 146 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `newton-euler`: 172 mul, 124 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * s_q1;
         let x2 = qd[0] * c_q1;
-        let x3 = -0.5692 * qd[0];
-        let x4 = c_q1 * x3;
+        let x3 = -0.5692 * qdd[0];
+        let x4 = -0.5692 * (qd[0] * qd[0]);
         let x5 = s_q1 * x3;
-        let x6 = -0.5692 * qdd[0];
-        let x7 = qdd[0] * s_q1 + qd[1] * x2;
-        let x8 = qdd[0] * c_q1 - qd[1] * x1;
-        let x9 = s_q1 * x6 + qd[1] * x4;
-        let x10 = 3946.18812068 * qd[1] - -39234.47412200001 * x1;
-        let x11 = 39241.404122 * qd[1] - 3946.1881206800003 * x1 - x5 * -5224.5702;
-        let x12 = x2 * -5224.5702;
-        let x13 = 5224.5702 * qd[1];
+        let x6 = qd[1] * x2;
+        let x7 = qd[1] * x1;
+        let x8 = qdd[0] * s_q1 + x6;
+        let x9 = qdd[0] * c_q1 - x7;
+        let x10 = x2 * x2;
+        let x11 = qd[1] * qd[1] + x10;
+        let x12 = qdd[1] + x1 * x2;
+        let x13 = 3946.18812068 * qd[1] - -39234.47412200001 * x1;
+        let x14 = 39241.404122 * qd[1] - 3946.1881206800003 * x1;
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x15 = x1 * c_q2 + x2 * s_q2;
-        let x16 = x2 * c_q2 - x1 * s_q2;
-        let x17 = x2 * -7.11;
-        let x18 = x4 + -0.475 * x2;
-        let x19 = x5 + (7.11 * qd[1] - x1 * 0.475);
-        let x20 = s_q2 * x19 - c_q2 * x18;
-        let x21 = s_q2 * x18 + c_q2 * x19;
-        let x22 = qd[1] + qd[2];
-        let x23 = x8 * -7.11;
-        let x24 = qd[1] * x5 - c_q1 * x6 - -0.475 * x8;
-        let x25 = x9 + (7.11 * qdd[1] - x7 * 0.475);
-        let x26 = qdd[1] + qdd[2];
-        let x27 = x7 * c_q2 + x8 * s_q2 + qd[2] * x16;
-        let x28 = x8 * c_q2 - x7 * s_q2 - qd[2] * x15;
-        let x29 = s_q2 * x24 - c_q2 * x25 + qd[2] * x20;
-        let x30 = 1375.0472756800002 * x22 - -24989.305802 * x15;
-        let x31 = 3239.4582 * x17;
-        let x32 = 24998.827802 * x22 - 1375.0472756800002 * x15 - x21 * -3239.4582;
-        let x33 = x16 * -3239.4582;
-        let x34 = 3239.4582 * x22;
+        let x16 = x1 * c_q2 + x2 * s_q2;
+        let x17 = x2 * c_q2 - x1 * s_q2;
+        let x18 = c_q1 * x3 + (7.11 * x11 + -0.475 * (x7 + x9));
+        let x19 = 7.11 * (x9 - x7) - -0.475 * (x10 + x1 * x1) - x4;
+        let x20 = -0.475 * (x6 - x8) - 7.11 * x12 - x5;
+        let x21 = c_q2 * x20 - s_q2 * x18;
+        let x22 = x8 * c_q2 + x9 * s_q2 + qd[2] * x17;
+        let x23 = x9 * c_q2 - x8 * s_q2 - qd[2] * x16;
+        let x24 = qdd[1] + qdd[2];
+        let x25 = qd[1] + qd[2];
+        let x26 = x25 * x25 + x17 * x17;
+        let x27 = x23 - x16 * x25;
+        let x28 = x24 + x16 * x17;
+        let x29 = 1375.0472756800002 * x25 - -24989.305802 * x16;
+        let x30 = 24998.827802 * x25 - 1375.0472756800002 * x16;
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x36 = x15 * c_q3 + x16 * s_q3;
-        let x37 = x16 * c_q3 - x15 * s_q3;
-        let x38 = x17 + x16 * -7.11;
-        let x39 = x21 + 7.11 * x22;
-        let x40 = x20 * c_q3 + s_q3 * x39;
-        let x41 = x20 * s_q3 - c_q3 * x39;
-        let x42 = qd[3] + x22;
-        let x43 = qdd[3] + x26;
-        let x44 = x27 * c_q3 + x28 * s_q3 + qd[3] * x37;
-        let x45 = x28 * c_q3 - x27 * s_q3 - qd[3] * x36;
-        let x46 = -97.44448770720001 * x42;
-        let x47 = 132.6783695416 * x36 + x38 * 171.195516;
-        let x48 = 135.4729695416 * x42 + -97.44448770720001 * x37 + -171.195516 * x40;
-        let x49 = x42 * 171.195516;
-        let x50 = -171.195516 * x36;
-        let x51 = x42 * x49 - x36 * x50;
-        let x52 = x43 * 171.195516 + x37 * x50;
-        let x53 = -171.195516 * x44 - x37 * x49;
+        let x32 = x16 * c_q3 + x17 * s_q3;
+        let x33 = x17 * c_q3 - x16 * s_q3;
+        let x34 = x22 * c_q3 + x23 * s_q3 + qd[3] * x33;
+        let x35 = x23 * c_q3 - x22 * s_q3 - qd[3] * x32;
+        let x36 = qdd[3] + x24;
+        let x37 = qd[3] + x25;
+        let x38 = -171.195516 * (x36 - x32 * x33);
+        let x39 = -171.195516 * (x34 + x33 * x37);
+        let x40 = -171.195516 * (x37 * x37 + x32 * x32);
+        let x41 = 132.6783695416 * x32;
+        let x42 = 135.4729695416 * x37 + -97.44448770720001 * x33;
+        let x43 = -97.44448770720001 * x37;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x55 = x42 * s_q4 - x36 * c_q4;
-        let x56 = x36 * s_q4 + x42 * c_q4;
-        let x57 = qd[4] + x37;
-        let x58 = 44.41 * x56;
-        let x59 = 47.471 * x57;
+        let x45 = x37 * s_q4 - x32 * c_q4;
+        let x46 = x32 * s_q4 + x37 * c_q4;
+        let x47 = qd[4] + x33;
+        let x48 = 44.41 * x46;
+        let x49 = 47.471 * x47;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x61 = 9.336 * (qdd[5] + (x43 * s_q4 - x44 * c_q4 + qd[4] * x56));
-        let x62 = 9.336 * (qd[5] + x55);
-        let x63 = (x57 * c_q5 - x56 * s_q5) * x62;
-        let x64 = (x56 * c_q5 + x57 * s_q5) * x62;
-        let x65 = x56 * x59 - x57 * x58 + x61;
-        let x66 = 44.41 * (x44 * s_q4 + x43 * c_q4 - qd[4] * x55) - x55 * x59
-            + (c_q5 * x63 + s_q5 * x64);
-        let x67 = 47.471 * (qdd[4] + x45) + x55 * x58 + (s_q5 * x63 - c_q5 * x64);
-        let x68 = x42 * x46 - x37 * x48 - x41 * x50
-            - (132.6783695416 * x44 + (x23 + -7.11 * x28) * 171.195516)
-            + (c_q4 * x65 - s_q4 * x66);
-        let x69 = 135.4729695416 * x43 + -97.44448770720001 * x45
-            + -171.195516
-                * ((c_q2 * x24 + s_q2 * x25 + qd[2] * x21) * c_q3
-                    - s_q3 * (x29 - 7.11 * x26) - qd[3] * x41)
-            + (x36 * x46 - x37 * x47 - x41 * x49) + (s_q4 * x65 + c_q4 * x66);
-        let x70 = -97.44448770720001 * x43
-            + (x42 * x47 - x36 * x48 + (x40 * x50 - x38 * x49)) + x67;
-        let x71 = s_q3 * x52 + c_q3 * x51;
-        let x72 = 1375.0472756800002 * x26 - -24989.305802 * x27
-            + (x17 * x34 - x21 * x33 - (x16 * x32 + x22 * x31))
-            + (c_q3 * x68 + s_q3 * x70);
-        let x73 = 24998.827802 * x26 - 1375.0472756800002 * x27 + x29 * -3239.4582
-            + (x16 * x30 - x15 * x31 + x20 * x34) + (x69 + -7.11 * x71);
-        let x74 = c_q3 * x70 - s_q3 * x68 + 7.11 * x53
-            - (3239.4582 * x23 + (x22 * x30 + x15 * x32 + x20 * x33));
-        let x75 = x16 * x33 - x22 * x34 + (s_q3 * x51 - c_q3 * x52);
-        let x76 = x15 * x33 - 3239.4582 * x26 + x71;
-        let x77 = c_q2 * x75 + s_q2 * x76;
-        let x78 = c_q2 * x76 - s_q2 * x75;
-        let x79 = 39241.404122 * qdd[1] - 3946.1881206800003 * x7 - x9 * -5224.5702
-            + (x2 * x10 - x4 * x13) + (x73 + -7.11 * x78);
-        let x80 = 65697.3302265768 * qdd[0]
+        let x51 = 9.336 * (qdd[5] + (x36 * s_q4 - x34 * c_q4 + qd[4] * x46));
+        let x52 = 9.336 * (qd[5] + x45);
+        let x53 = (x47 * c_q5 - x46 * s_q5) * x52;
+        let x54 = (x46 * c_q5 + x47 * s_q5) * x52;
+        let x55 = x46 * x49 - x47 * x48 + x51;
+        let x56 = 44.41 * (x34 * s_q4 + x36 * c_q4 - qd[4] * x45) - x45 * x49
+            + (c_q5 * x53 + s_q5 * x54);
+        let x57 = 47.471 * (qdd[4] + x35) + x45 * x48 + (s_q5 * x53 - c_q5 * x54);
+        let x58 = x37 * x43 - x33 * x42 - 132.6783695416 * x34
+            + (x19 + 7.11 * x27) * 171.195516 + (c_q4 * x55 - s_q4 * x56);
+        let x59 = 135.4729695416 * x36 + -97.44448770720001 * x35
+            + (x32 * x43 - x33 * x41)
+            - -171.195516
+                * (c_q3 * (c_q2 * x18 + s_q2 * x20 + 7.11 * x26)
+                    + s_q3 * (x21 - 7.11 * x28)) + (s_q4 * x55 + c_q4 * x56);
+        let x60 = -97.44448770720001 * x36 + (x37 * x41 - x32 * x42) + x57;
+        let x61 = s_q3 * x38 + c_q3 * x40;
+        let x62 = c_q3 * x38 - s_q3 * x40 - 3239.4582 * x26;
+        let x63 = 3239.4582 * x28 + x61;
+        let x64 = 1375.0472756800002 * x24 - -24989.305802 * x22 - x17 * x30
+            + (c_q3 * x58 + s_q3 * x60);
+        let x65 = 24998.827802 * x24 - 1375.0472756800002 * x22 + x17 * x29
+            + x21 * -3239.4582 + (x59 - x61 * -7.11);
+        let x66 = 3239.4582 * x19 - (x25 * x29 + x16 * x30)
+            + (c_q3 * x60 - s_q3 * x58 + 7.11 * x39);
+        let x67 = c_q2 * x62 - s_q2 * x63;
+        let x68 = s_q2 * x62 + c_q2 * x63;
+        let x69 = 39241.404122 * qdd[1] - 3946.1881206800003 * x8 + x2 * x13
+            - x5 * -5224.5702 + (x65 - -7.11 * x68);
+        let x70 = 65697.3302265768 * qdd[0]
             + (c_q1
-                * (x4 * x12 - (qd[1] * x10 + x1 * x11)
-                    + (c_q2 * x74 - s_q2 * x72
-                        + (0.475 * x77 + 7.11 * (x53 - (x28 * -3239.4582 + x15 * x34)))))
+                * (c_q2 * x66 - s_q2 * x64
+                    + (x67 * 0.475 + 7.11 * (3239.4582 * x27 + x39))
+                    - (qd[1] * x13 + x1 * x14 + 5224.5702 * x4))
                 - s_q1
-                    * (3946.18812068 * qdd[1] - -39234.47412200001 * x7
-                        - (x2 * x11 + x5 * x12)
-                        + (c_q2 * x72 + s_q2 * x74 + -0.475 * x78))
+                    * (3946.18812068 * qdd[1] - -39234.47412200001 * x8 - x2 * x14
+                        + (c_q2 * x64 + s_q2 * x66 - -0.475 * x68))
                 + 0.5692
-                    * (c_q1 * (x2 * x12 - qd[1] * x13 + x77)
-                        + s_q1 * (x1 * x12 - 5224.5702 * qdd[1] + x78)));
-        [x80, x79, x73, x69, x67, x61]
+                    * (c_q1 * (x67 - 5224.5702 * x11) - s_q1 * (5224.5702 * x12 + x68)));
+        [x70, x69, x65, x59, x57, x51]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 377 mul, 262 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 343 mul, 237 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -731,97 +759,81 @@ impl Ssrms6 {
         let x53 = s_q1 * (c_q2 * x51 - s_q2 * x52) + c_q1 * (s_q2 * x51 + c_q2 * x52);
         let x54 = qd[0] * s_q1;
         let x55 = qd[0] * c_q1;
-        let x56 = -0.5692 * qd[0];
-        let x57 = c_q1 * x56;
-        let x58 = s_q1 * x56;
-        let x59 = qd[1] * x55;
-        let x60 = qd[1] * x54;
-        let x61 = qd[1] * x57;
+        let x56 = -0.5692 * (qd[0] * qd[0]);
+        let x57 = qd[1] * x55;
+        let x58 = qd[1] * x54;
+        let x59 = x55 * x55;
+        let x60 = qd[1] * qd[1] + x59;
+        let x61 = x54 * x55;
         let x62 = 3946.18812068 * qd[1] - -39234.47412200001 * x54;
-        let x63 = 39241.404122 * qd[1] - 3946.1881206800003 * x54 - x58 * -5224.5702;
-        let x64 = x55 * -5224.5702;
-        let x65 = 5224.5702 * qd[1];
-        let x66 = c_q2 * x54 + s_q2 * x55;
-        let x67 = c_q2 * x55 - s_q2 * x54;
-        let x68 = -7.11 * x55;
-        let x69 = x57 + -0.475 * x55;
-        let x70 = x58 + (7.11 * qd[1] - 0.475 * x54);
-        let x71 = s_q2 * x70 - c_q2 * x69;
-        let x72 = s_q2 * x69 + c_q2 * x70;
-        let x73 = qd[1] + qd[2];
-        let x74 = -7.11 * x60;
-        let x75 = qd[1] * x58 + -0.475 * x60;
-        let x76 = 0.475 * x59 - x61;
-        let x77 = s_q2 * x60 - c_q2 * x59 - qd[2] * x67;
-        let x78 = s_q2 * x59 + c_q2 * x60 + qd[2] * x66;
-        let x79 = s_q2 * x75 + c_q2 * x76 + qd[2] * x71;
-        let x80 = 1375.0472756800002 * x73 - -24989.305802 * x66;
-        let x81 = 3239.4582 * x68;
-        let x82 = 24998.827802 * x73 - 1375.0472756800002 * x66 - x72 * -3239.4582;
-        let x83 = x67 * -3239.4582;
-        let x84 = 3239.4582 * x73;
-        let x85 = c_q3 * x66 + s_q3 * x67;
-        let x86 = c_q3 * x67 - s_q3 * x66;
-        let x87 = x68 + -7.11 * x67;
-        let x88 = x72 + 7.11 * x73;
-        let x89 = c_q3 * x71 + s_q3 * x88;
-        let x90 = s_q3 * x71 - c_q3 * x88;
-        let x91 = qd[3] + x73;
-        let x92 = c_q3 * x77 + s_q3 * x78 - qd[3] * x86;
-        let x93 = s_q3 * x77 - c_q3 * x78 - qd[3] * x85;
-        let x94 = -97.44448770720001 * x91;
-        let x95 = 132.6783695416 * x85 + 171.195516 * x87;
-        let x96 = 135.4729695416 * x91 + -97.44448770720001 * x86 + -171.195516 * x89;
-        let x97 = 171.195516 * x91;
-        let x98 = -171.195516 * x85;
-        let x99 = x86 * x98;
-        let x100 = x91 * x97 - x85 * x98;
-        let x101 = -171.195516 * x92 + x86 * x97;
-        let x102 = s_q4 * x91 - c_q4 * x85;
-        let x103 = s_q4 * x85 + c_q4 * x91;
-        let x104 = qd[4] + x86;
-        let x105 = 44.41 * x103;
-        let x106 = 47.471 * x104;
-        let x107 = 9.336 * (c_q4 * x92 + qd[4] * x103);
-        let x108 = 9.336 * (qd[5] + x102);
-        let x109 = (c_q5 * x104 - s_q5 * x103) * x108;
-        let x110 = (c_q5 * x103 + s_q5 * x104) * x108;
-        let x111 = x103 * x106 - x104 * x105 + x107;
-        let x112 = c_q5 * x109 + s_q5 * x110
-            - (44.41 * (s_q4 * x92 + qd[4] * x102) + x102 * x106);
-        let x113 = 47.471 * x93 + x102 * x105 + (s_q5 * x109 - c_q5 * x110);
-        let x114 = 132.6783695416 * x92 + 171.195516 * (x74 + -7.11 * x78)
-            + (x91 * x94 - x86 * x96 - x90 * x98) + (c_q4 * x111 - s_q4 * x112);
-        let x115 = -97.44448770720001 * x93
+        let x63 = 39241.404122 * qd[1] - 3946.1881206800003 * x54;
+        let x64 = c_q2 * x54 + s_q2 * x55;
+        let x65 = c_q2 * x55 - s_q2 * x54;
+        let x66 = 7.11 * x60;
+        let x67 = 7.11 * x61;
+        let x68 = x56 + (7.11 * (x58 + x58) + -0.475 * (x59 + x54 * x54));
+        let x69 = s_q2 * x66 + c_q2 * x67;
+        let x70 = s_q2 * x58 - c_q2 * x57 - qd[2] * x65;
+        let x71 = s_q2 * x57 + c_q2 * x58 + qd[2] * x64;
+        let x72 = qd[1] + qd[2];
+        let x73 = x72 * x72 + x65 * x65;
+        let x74 = x64 * x65;
+        let x75 = x71 + x64 * x72;
+        let x76 = 1375.0472756800002 * x72 - -24989.305802 * x64;
+        let x77 = 24998.827802 * x72 - 1375.0472756800002 * x64;
+        let x78 = c_q3 * x64 + s_q3 * x65;
+        let x79 = c_q3 * x65 - s_q3 * x64;
+        let x80 = c_q3 * x70 + s_q3 * x71 - qd[3] * x79;
+        let x81 = s_q3 * x70 - c_q3 * x71 - qd[3] * x78;
+        let x82 = qd[3] + x72;
+        let x83 = -171.195516 * (x78 * x79);
+        let x84 = -171.195516 * (x79 * x82 - x80);
+        let x85 = -171.195516 * (x82 * x82 + x78 * x78);
+        let x86 = 132.6783695416 * x78;
+        let x87 = 135.4729695416 * x82 + -97.44448770720001 * x79;
+        let x88 = -97.44448770720001 * x82;
+        let x89 = s_q4 * x82 - c_q4 * x78;
+        let x90 = s_q4 * x78 + c_q4 * x82;
+        let x91 = qd[4] + x79;
+        let x92 = 44.41 * x90;
+        let x93 = 47.471 * x91;
+        let x94 = 9.336 * (c_q4 * x80 + qd[4] * x90);
+        let x95 = 9.336 * (qd[5] + x89);
+        let x96 = (c_q5 * x91 - s_q5 * x90) * x95;
+        let x97 = (c_q5 * x90 + s_q5 * x91) * x95;
+        let x98 = x90 * x93 - x91 * x92 + x94;
+        let x99 = c_q5 * x96 + s_q5 * x97
+            - (44.41 * (s_q4 * x80 + qd[4] * x89) + x89 * x93);
+        let x100 = 47.471 * x81 + x89 * x92 + (s_q5 * x96 - c_q5 * x97);
+        let x101 = 132.6783695416 * x80 + (x82 * x88 - x79 * x87)
+            - 171.195516 * (x68 + 7.11 * x75) + (c_q4 * x98 - s_q4 * x99);
+        let x102 = -97.44448770720001 * x81 + (x78 * x88 - x79 * x86)
             + -171.195516
-                * (c_q3 * (c_q2 * x75 - s_q2 * x76 + qd[2] * x72) - s_q3 * x79
-                    - qd[3] * x90) + (x85 * x94 - x86 * x95 - x90 * x97)
-            + (s_q4 * x111 + c_q4 * x112);
-        let x116 = x91 * x95 - x85 * x96 + (x89 * x98 - x87 * x97) + x113;
-        let x117 = s_q3 * x99 + c_q3 * x100;
-        let x118 = -24989.305802 * x77
-            + (x68 * x84 - x72 * x83 - (x67 * x82 + x73 * x81))
-            + (c_q3 * x114 + s_q3 * x116);
-        let x119 = 1375.0472756800002 * x77 + x79 * -3239.4582
-            + (x67 * x80 - x66 * x81 + x71 * x84) + (x115 + -7.11 * x117);
-        let x120 = 3239.4582 * x74 - (x73 * x80 + x66 * x82 + x71 * x83)
-            + (c_q3 * x116 - s_q3 * x114 - 7.11 * x101);
-        let x121 = x67 * x83 - x73 * x84 + (s_q3 * x100 - c_q3 * x99);
-        let x122 = x66 * x83 + x117;
-        let x123 = c_q2 * x121 + s_q2 * x122;
-        let x124 = c_q2 * x122 - s_q2 * x121;
-        let x125 = tau[0]
+                * (c_q3 * (s_q2 * x67 - c_q2 * x66 - 7.11 * x73)
+                    + s_q3 * (x69 + 7.11 * x74)) + (s_q4 * x98 + c_q4 * x99);
+        let x103 = x82 * x86 - x78 * x87 + x100;
+        let x104 = s_q3 * x83 - c_q3 * x85;
+        let x105 = 3239.4582 * x73 + (c_q3 * x83 + s_q3 * x85);
+        let x106 = x104 - 3239.4582 * x74;
+        let x107 = -24989.305802 * x70 - x65 * x77 + (c_q3 * x101 + s_q3 * x103);
+        let x108 = 1375.0472756800002 * x70 + x65 * x76 - x69 * -3239.4582
+            + (x102 + -7.11 * x104);
+        let x109 = c_q3 * x103 - s_q3 * x101 + 7.11 * x84
+            - (x72 * x76 + x64 * x77 + 3239.4582 * x68);
+        let x110 = s_q2 * x106 - c_q2 * x105;
+        let x111 = s_q2 * x105 + c_q2 * x106;
+        let x112 = tau[0]
             - (c_q1
-                * (x57 * x64 - (qd[1] * x62 + x54 * x63)
-                    + (c_q2 * x120 - s_q2 * x118
-                        + (0.475 * x123 + 7.11 * (x78 * -3239.4582 - x66 * x84 - x101))))
+                * (c_q2 * x109 - s_q2 * x107
+                    + (0.475 * x110 + 7.11 * (x84 - 3239.4582 * x75))
+                    - (qd[1] * x62 + x54 * x63 + 5224.5702 * x56))
                 - s_q1
-                    * (c_q2 * x118 + s_q2 * x120 + -0.475 * x124
-                        - (-39234.47412200001 * x59 + (x55 * x63 + x58 * x64)))
+                    * (c_q2 * x107 + s_q2 * x109 + -0.475 * x111
+                        - (-39234.47412200001 * x57 + x55 * x63))
                 + 0.5692
-                    * (c_q1 * (x55 * x64 - qd[1] * x65 + x123)
-                        + s_q1 * (x54 * x64 + x124)));
-        let x126 = 1.0
+                    * (c_q1 * (x110 - 5224.5702 * x60)
+                        + s_q1 * (x111 - 5224.5702 * x61)));
+        let x113 = 1.0
             / (65697.3302265768
                 + (c_q1
                     * (c_q1 * (c_q2 * x38 - s_q2 * x36 + x40 - x39)
@@ -829,58 +841,58 @@ impl Ssrms6 {
                     - s_q1
                         * (c_q1 * (c_q2 * x36 + s_q2 * x38 - 7.11 * x32)
                             - s_q1 * (-39234.47412200001 + (c_q2 * x33 + s_q2 * x35)))));
-        let x127 = x45 * x126;
-        let x128 = x46 * x126;
-        let x129 = x49 * x126;
-        let x130 = x50 * x126;
-        let x131 = x53 * x126;
-        let x132 = 1.0 / (39241.404122 + (x40 + x42) - x45 * x127);
-        let x133 = x42 - x45 * x128;
-        let x134 = x132 * x133;
-        let x135 = x21 - -7.11 * x48 - x45 * x129;
-        let x136 = x132 * x135;
-        let x137 = x45 * x130;
-        let x138 = x132 * x137;
-        let x139 = x7 + x45 * x131;
-        let x140 = x132 * x139;
-        let x141 = 1.0 / (x28 - x46 * x128 - x133 * x134);
-        let x142 = x21 - x46 * x129 - x133 * x136;
-        let x143 = x141 * x142;
-        let x144 = x133 * x138 - x46 * x130;
-        let x145 = x141 * x144;
-        let x146 = x7 + x46 * x131 - x133 * x140;
-        let x147 = x141 * x146;
-        let x148 = 1.0 / (x10 - x49 * x129 - x135 * x136 - x142 * x143);
-        let x149 = x135 * x138 - x49 * x130 - x142 * x145;
-        let x150 = x148 * x149;
-        let x151 = x7 + x49 * x131 - x135 * x140 - x142 * x147;
-        let x152 = x148 * x151;
-        let x153 = 1.0 / (47.471 - x50 * x130 - x137 * x138 - x144 * x145 - x149 * x150);
-        let x154 = x50 * x131 + x137 * x140 - x144 * x147 - x149 * x152;
-        let x155 = x153 * x154;
-        let x156 = 1.0
-            / (9.336 - x53 * x131 - x139 * x140 - x146 * x147 - x151 * x152
-                - x154 * x155);
-        let x157 = tau[1]
-            - (x55 * x62 - x57 * x65 - (3946.1881206800003 * x59 + x61 * -5224.5702)
-                + (x119 + -7.11 * x124)) - x125 * x127;
-        let x158 = tau[2] - x119 - x125 * x128 - x134 * x157;
-        let x159 = tau[3] - x115 - x125 * x129 - x136 * x157 - x143 * x158;
-        let x160 = tau[4] - x113 - x125 * x130 + x138 * x157 - x145 * x158 - x150 * x159;
-        let x161 = x156
-            * (tau[5] - x107 + x125 * x131 - x140 * x157 - x147 * x158 - x152 * x159
-                - x155 * x160);
-        let x162 = x153 * x160 - x155 * x161;
-        let x163 = x148 * x159 - x150 * x162 - x152 * x161;
-        let x164 = x141 * x158 - x143 * x163 - x145 * x162 - x147 * x161;
-        let x165 = x132 * x157 - x134 * x164 - x136 * x163 + x138 * x162 - x140 * x161;
-        let x166 = x125 * x126 - x127 * x165 - x128 * x164 - x129 * x163 - x130 * x162
-            + x131 * x161;
-        [x166, x165, x164, x163, x162, x161]
+        let x114 = x45 * x113;
+        let x115 = x46 * x113;
+        let x116 = x49 * x113;
+        let x117 = x50 * x113;
+        let x118 = x53 * x113;
+        let x119 = 1.0 / (39241.404122 + (x40 + x42) - x45 * x114);
+        let x120 = x42 - x45 * x115;
+        let x121 = x119 * x120;
+        let x122 = x21 - -7.11 * x48 - x45 * x116;
+        let x123 = x119 * x122;
+        let x124 = x45 * x117;
+        let x125 = x119 * x124;
+        let x126 = x7 + x45 * x118;
+        let x127 = x119 * x126;
+        let x128 = 1.0 / (x28 - x46 * x115 - x120 * x121);
+        let x129 = x21 - x46 * x116 - x120 * x123;
+        let x130 = x128 * x129;
+        let x131 = x120 * x125 - x46 * x117;
+        let x132 = x128 * x131;
+        let x133 = x7 + x46 * x118 - x120 * x127;
+        let x134 = x128 * x133;
+        let x135 = 1.0 / (x10 - x49 * x116 - x122 * x123 - x129 * x130);
+        let x136 = x122 * x125 - x49 * x117 - x129 * x132;
+        let x137 = x135 * x136;
+        let x138 = x7 + x49 * x118 - x122 * x127 - x129 * x134;
+        let x139 = x135 * x138;
+        let x140 = 1.0 / (47.471 - x50 * x117 - x124 * x125 - x131 * x132 - x136 * x137);
+        let x141 = x50 * x118 + x124 * x127 - x131 * x134 - x136 * x139;
+        let x142 = x140 * x141;
+        let x143 = 1.0
+            / (9.336 - x53 * x118 - x126 * x127 - x133 * x134 - x138 * x139
+                - x141 * x142);
+        let x144 = tau[1]
+            - (x55 * x62 - 3946.1881206800003 * x57 + (x108 + -7.11 * x111))
+            - x112 * x114;
+        let x145 = tau[2] - x108 - x112 * x115 - x121 * x144;
+        let x146 = tau[3] - x102 - x112 * x116 - x123 * x144 - x130 * x145;
+        let x147 = tau[4] - x100 - x112 * x117 + x125 * x144 - x132 * x145 - x137 * x146;
+        let x148 = x143
+            * (tau[5] - x94 + x112 * x118 - x127 * x144 - x134 * x145 - x139 * x146
+                - x142 * x147);
+        let x149 = x140 * x147 - x142 * x148;
+        let x150 = x135 * x146 - x137 * x149 - x139 * x148;
+        let x151 = x128 * x145 - x130 * x150 - x132 * x149 - x134 * x148;
+        let x152 = x119 * x144 - x121 * x151 - x123 * x150 + x125 * x149 - x127 * x148;
+        let x153 = x112 * x113 - x114 * x152 - x115 * x151 - x116 * x150 - x117 * x149
+            + x118 * x148;
+        [x153, x152, x151, x150, x149, x148]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 291 mul, 195 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 257 mul, 170 add, 0 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -954,96 +966,79 @@ impl Ssrms6 {
         let x56 = -(s_q1 * (c_q2 * x54 - s_q2 * x55) + c_q1 * (s_q2 * x54 + c_q2 * x55));
         let x57 = qd[0] * s_q1;
         let x58 = qd[0] * c_q1;
-        let x59 = -0.5692 * qd[0];
-        let x60 = c_q1 * x59;
-        let x61 = s_q1 * x59;
-        let x62 = qd[1] * x58;
-        let x63 = qd[1] * x57;
-        let x64 = qd[1] * x60;
+        let x59 = -0.5692 * (qd[0] * qd[0]);
+        let x60 = qd[1] * x58;
+        let x61 = qd[1] * x57;
+        let x62 = x58 * x58;
+        let x63 = qd[1] * qd[1] + x62;
+        let x64 = x57 * x58;
         let x65 = 3946.18812068 * qd[1] - -39234.47412200001 * x57;
-        let x66 = 39241.404122 * qd[1] - 3946.1881206800003 * x57 - x61 * -5224.5702;
-        let x67 = x58 * -5224.5702;
-        let x68 = 5224.5702 * qd[1];
-        let x69 = c_q2 * x57 + s_q2 * x58;
-        let x70 = c_q2 * x58 - s_q2 * x57;
-        let x71 = -7.11 * x58;
-        let x72 = x60 + -0.475 * x58;
-        let x73 = x61 + (7.11 * qd[1] - 0.475 * x57);
-        let x74 = s_q2 * x73 - c_q2 * x72;
-        let x75 = s_q2 * x72 + c_q2 * x73;
-        let x76 = qd[1] + qd[2];
-        let x77 = -7.11 * x63;
-        let x78 = qd[1] * x61 + -0.475 * x63;
-        let x79 = 0.475 * x62 - x64;
-        let x80 = s_q2 * x63 - c_q2 * x62 - qd[2] * x70;
-        let x81 = s_q2 * x62 + c_q2 * x63 + qd[2] * x69;
-        let x82 = s_q2 * x78 + c_q2 * x79 + qd[2] * x74;
-        let x83 = 1375.0472756800002 * x76 - -24989.305802 * x69;
-        let x84 = 3239.4582 * x71;
-        let x85 = 24998.827802 * x76 - 1375.0472756800002 * x69 - x75 * -3239.4582;
-        let x86 = x70 * -3239.4582;
-        let x87 = 3239.4582 * x76;
-        let x88 = c_q3 * x69 + s_q3 * x70;
-        let x89 = c_q3 * x70 - s_q3 * x69;
-        let x90 = x71 + -7.11 * x70;
-        let x91 = x75 + 7.11 * x76;
-        let x92 = c_q3 * x74 + s_q3 * x91;
-        let x93 = s_q3 * x74 - c_q3 * x91;
-        let x94 = qd[3] + x76;
-        let x95 = c_q3 * x80 + s_q3 * x81 - qd[3] * x89;
-        let x96 = s_q3 * x80 - c_q3 * x81 - qd[3] * x88;
-        let x97 = -97.44448770720001 * x94;
-        let x98 = 132.6783695416 * x88 + 171.195516 * x90;
-        let x99 = 135.4729695416 * x94 + -97.44448770720001 * x89 + -171.195516 * x92;
-        let x100 = 171.195516 * x94;
-        let x101 = -171.195516 * x88;
-        let x102 = x89 * x101;
-        let x103 = x94 * x100 - x88 * x101;
-        let x104 = -171.195516 * x95 + x89 * x100;
-        let x105 = s_q4 * x94 - c_q4 * x88;
-        let x106 = s_q4 * x88 + c_q4 * x94;
-        let x107 = qd[4] + x89;
-        let x108 = 44.41 * x106;
-        let x109 = 47.471 * x107;
-        let x110 = 9.336 * (c_q4 * x95 + qd[4] * x106);
-        let x111 = 9.336 * (qd[5] + x105);
-        let x112 = (c_q5 * x107 - s_q5 * x106) * x111;
-        let x113 = (c_q5 * x106 + s_q5 * x107) * x111;
-        let x114 = x106 * x109 - x107 * x108 + x110;
-        let x115 = c_q5 * x112 + s_q5 * x113
-            - (44.41 * (s_q4 * x95 + qd[4] * x105) + x105 * x109);
-        let x116 = 47.471 * x96 + x105 * x108 + (s_q5 * x112 - c_q5 * x113);
-        let x117 = 132.6783695416 * x95 + 171.195516 * (x77 + -7.11 * x81)
-            + (x94 * x97 - x89 * x99 - x93 * x101) + (c_q4 * x114 - s_q4 * x115);
-        let x118 = -97.44448770720001 * x96
+        let x66 = 39241.404122 * qd[1] - 3946.1881206800003 * x57;
+        let x67 = c_q2 * x57 + s_q2 * x58;
+        let x68 = c_q2 * x58 - s_q2 * x57;
+        let x69 = 7.11 * x63;
+        let x70 = 7.11 * x64;
+        let x71 = x59 + (7.11 * (x61 + x61) + -0.475 * (x62 + x57 * x57));
+        let x72 = s_q2 * x69 + c_q2 * x70;
+        let x73 = s_q2 * x61 - c_q2 * x60 - qd[2] * x68;
+        let x74 = s_q2 * x60 + c_q2 * x61 + qd[2] * x67;
+        let x75 = qd[1] + qd[2];
+        let x76 = x75 * x75 + x68 * x68;
+        let x77 = x67 * x68;
+        let x78 = x74 + x67 * x75;
+        let x79 = 1375.0472756800002 * x75 - -24989.305802 * x67;
+        let x80 = 24998.827802 * x75 - 1375.0472756800002 * x67;
+        let x81 = c_q3 * x67 + s_q3 * x68;
+        let x82 = c_q3 * x68 - s_q3 * x67;
+        let x83 = c_q3 * x73 + s_q3 * x74 - qd[3] * x82;
+        let x84 = s_q3 * x73 - c_q3 * x74 - qd[3] * x81;
+        let x85 = qd[3] + x75;
+        let x86 = -171.195516 * (x81 * x82);
+        let x87 = -171.195516 * (x82 * x85 - x83);
+        let x88 = -171.195516 * (x85 * x85 + x81 * x81);
+        let x89 = 132.6783695416 * x81;
+        let x90 = 135.4729695416 * x85 + -97.44448770720001 * x82;
+        let x91 = -97.44448770720001 * x85;
+        let x92 = s_q4 * x85 - c_q4 * x81;
+        let x93 = s_q4 * x81 + c_q4 * x85;
+        let x94 = qd[4] + x82;
+        let x95 = 44.41 * x93;
+        let x96 = 47.471 * x94;
+        let x97 = 9.336 * (c_q4 * x83 + qd[4] * x93);
+        let x98 = 9.336 * (qd[5] + x92);
+        let x99 = (c_q5 * x94 - s_q5 * x93) * x98;
+        let x100 = (c_q5 * x93 + s_q5 * x94) * x98;
+        let x101 = x93 * x96 - x94 * x95 + x97;
+        let x102 = c_q5 * x99 + s_q5 * x100
+            - (44.41 * (s_q4 * x83 + qd[4] * x92) + x92 * x96);
+        let x103 = 47.471 * x84 + x92 * x95 + (s_q5 * x99 - c_q5 * x100);
+        let x104 = 132.6783695416 * x83 + (x85 * x91 - x82 * x90)
+            - 171.195516 * (x71 + 7.11 * x78) + (c_q4 * x101 - s_q4 * x102);
+        let x105 = -97.44448770720001 * x84 + (x81 * x91 - x82 * x89)
             + -171.195516
-                * (c_q3 * (c_q2 * x78 - s_q2 * x79 + qd[2] * x75) - s_q3 * x82
-                    - qd[3] * x93) + (x88 * x97 - x89 * x98 - x93 * x100)
-            + (s_q4 * x114 + c_q4 * x115);
-        let x119 = x94 * x98 - x88 * x99 + (x92 * x101 - x90 * x100) + x116;
-        let x120 = s_q3 * x102 + c_q3 * x103;
-        let x121 = -24989.305802 * x80
-            + (x71 * x87 - x75 * x86 - (x70 * x85 + x76 * x84))
-            + (c_q3 * x117 + s_q3 * x119);
-        let x122 = 1375.0472756800002 * x80 + x82 * -3239.4582
-            + (x70 * x83 - x69 * x84 + x74 * x87) + (x118 + -7.11 * x120);
-        let x123 = 3239.4582 * x77 - (x76 * x83 + x69 * x85 + x74 * x86)
-            + (c_q3 * x119 - s_q3 * x117 - 7.11 * x104);
-        let x124 = x70 * x86 - x76 * x87 + (s_q3 * x103 - c_q3 * x102);
-        let x125 = x69 * x86 + x120;
-        let x126 = c_q2 * x124 + s_q2 * x125;
-        let x127 = c_q2 * x125 - s_q2 * x124;
-        let x128 = x58 * x65 - x60 * x68 - (3946.1881206800003 * x62 + x64 * -5224.5702)
-            + (x122 + -7.11 * x127);
-        let x129 = c_q1
-            * (x60 * x67 - (qd[1] * x65 + x57 * x66)
-                + (c_q2 * x123 - s_q2 * x121
-                    + (0.475 * x126 + 7.11 * (x81 * -3239.4582 - x69 * x87 - x104))))
+                * (c_q3 * (s_q2 * x70 - c_q2 * x69 - 7.11 * x76)
+                    + s_q3 * (x72 + 7.11 * x77)) + (s_q4 * x101 + c_q4 * x102);
+        let x106 = x85 * x89 - x81 * x90 + x103;
+        let x107 = s_q3 * x86 - c_q3 * x88;
+        let x108 = 3239.4582 * x76 + (c_q3 * x86 + s_q3 * x88);
+        let x109 = x107 - 3239.4582 * x77;
+        let x110 = -24989.305802 * x73 - x68 * x80 + (c_q3 * x104 + s_q3 * x106);
+        let x111 = 1375.0472756800002 * x73 + x68 * x79 - x72 * -3239.4582
+            + (x105 + -7.11 * x107);
+        let x112 = c_q3 * x106 - s_q3 * x104 + 7.11 * x87
+            - (x75 * x79 + x67 * x80 + 3239.4582 * x71);
+        let x113 = s_q2 * x109 - c_q2 * x108;
+        let x114 = s_q2 * x108 + c_q2 * x109;
+        let x115 = x58 * x65 - 3946.1881206800003 * x60 + (x111 + -7.11 * x114);
+        let x116 = c_q1
+            * (c_q2 * x112 - s_q2 * x110
+                + (0.475 * x113 + 7.11 * (x87 - 3239.4582 * x78))
+                - (qd[1] * x65 + x57 * x66 + 5224.5702 * x59))
             - s_q1
-                * (c_q2 * x121 + s_q2 * x123 + -0.475 * x127
-                    - (-39234.47412200001 * x62 + (x58 * x66 + x61 * x67)))
+                * (c_q2 * x110 + s_q2 * x112 + -0.475 * x114
+                    - (-39234.47412200001 * x60 + x58 * x66))
             + 0.5692
-                * (c_q1 * (x58 * x67 - qd[1] * x68 + x126) + s_q1 * (x57 * x67 + x127));
+                * (c_q1 * (x113 - 5224.5702 * x63) + s_q1 * (x114 - 5224.5702 * x64));
         (
             [
                 [x47, x46, x48, x52, x53, x56],
@@ -1053,12 +1048,12 @@ impl Ssrms6 {
                 [x53, 0.0, 0.0, 0.0, 47.471, 0.0],
                 [x56, x7, x7, x7, 0.0, 9.336],
             ],
-            [x129, x128, x122, x118, x116, x110],
+            [x116, x115, x111, x105, x103, x97],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 389 mul, 300 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 355 mul, 275 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1125,108 +1120,91 @@ impl Ssrms6 {
         let x53 = s_q1 * (c_q2 * x51 - s_q2 * x52) + c_q1 * (s_q2 * x51 + c_q2 * x52);
         let x54 = qd[0] * s_q1;
         let x55 = qd[0] * c_q1;
-        let x56 = -0.5692 * qd[0];
-        let x57 = c_q1 * x56;
-        let x58 = s_q1 * x56;
-        let x59 = qd[1] * x55;
-        let x60 = qd[1] * x54;
-        let x61 = qd[1] * x57;
+        let x56 = -0.5692 * (qd[0] * qd[0]);
+        let x57 = qd[1] * x55;
+        let x58 = qd[1] * x54;
+        let x59 = x55 * x55;
+        let x60 = qd[1] * qd[1] + x59;
+        let x61 = x54 * x55;
         let x62 = 3946.18812068 * qd[1] - -39234.47412200001 * x54;
-        let x63 = 39241.404122 * qd[1] - 3946.1881206800003 * x54 - x58 * -5224.5702;
-        let x64 = x55 * -5224.5702;
-        let x65 = 5224.5702 * qd[1];
-        let x66 = c_q2 * x54 + s_q2 * x55;
-        let x67 = c_q2 * x55 - s_q2 * x54;
-        let x68 = -7.11 * x55;
-        let x69 = x57 + -0.475 * x55;
-        let x70 = x58 + (7.11 * qd[1] - 0.475 * x54);
-        let x71 = s_q2 * x70 - c_q2 * x69;
-        let x72 = s_q2 * x69 + c_q2 * x70;
-        let x73 = qd[1] + qd[2];
-        let x74 = -7.11 * x60;
-        let x75 = qd[1] * x58 + -0.475 * x60;
-        let x76 = 0.475 * x59 - x61;
-        let x77 = s_q2 * x60 - c_q2 * x59 - qd[2] * x67;
-        let x78 = s_q2 * x59 + c_q2 * x60 + qd[2] * x66;
-        let x79 = s_q2 * x75 + c_q2 * x76 + qd[2] * x71;
-        let x80 = 1375.0472756800002 * x73 - -24989.305802 * x66;
-        let x81 = 3239.4582 * x68;
-        let x82 = 24998.827802 * x73 - 1375.0472756800002 * x66 - x72 * -3239.4582;
-        let x83 = x67 * -3239.4582;
-        let x84 = 3239.4582 * x73;
-        let x85 = c_q3 * x66 + s_q3 * x67;
-        let x86 = c_q3 * x67 - s_q3 * x66;
-        let x87 = x68 + -7.11 * x67;
-        let x88 = x72 + 7.11 * x73;
-        let x89 = c_q3 * x71 + s_q3 * x88;
-        let x90 = s_q3 * x71 - c_q3 * x88;
-        let x91 = qd[3] + x73;
-        let x92 = c_q3 * x77 + s_q3 * x78 - qd[3] * x86;
-        let x93 = s_q3 * x77 - c_q3 * x78 - qd[3] * x85;
-        let x94 = -97.44448770720001 * x91;
-        let x95 = 132.6783695416 * x85 + 171.195516 * x87;
-        let x96 = 135.4729695416 * x91 + -97.44448770720001 * x86 + -171.195516 * x89;
-        let x97 = 171.195516 * x91;
-        let x98 = -171.195516 * x85;
-        let x99 = s_q4 * x91 - c_q4 * x85;
-        let x100 = s_q4 * x85 + c_q4 * x91;
-        let x101 = qd[4] + x86;
-        let x102 = 44.41 * x100;
-        let x103 = 47.471 * x101;
-        let x104 = 9.336 * (qd[5] + x99);
-        let x105 = 9.336 * (c_q4 * x92 + qd[4] * x100) - f_ext[5][3];
-        let x106 = (c_q5 * x101 - s_q5 * x100) * x104 - f_ext[5][4];
-        let x107 = f_ext[5][5] + (c_q5 * x100 + s_q5 * x101) * x104;
-        let x108 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
-        let x109 = x100 * x103 - x101 * x102 - f_ext[4][3] + (x105 + 0.7026 * x108);
-        let x110 = c_q5 * x106 + s_q5 * x107 - -0.7026 * f_ext[5][0]
-            - (f_ext[4][4] + (44.41 * (s_q4 * x92 + qd[4] * x99) + x99 * x103));
-        let x111 = 47.471 * x93 + x99 * x102 - f_ext[4][5] + (s_q5 * x106 - c_q5 * x107);
-        let x112 = f_ext[4][0] + f_ext[5][0];
-        let x113 = x108 - f_ext[4][1];
-        let x114 = f_ext[4][2] + (f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5);
-        let x115 = c_q4 * x112 + s_q4 * x113;
-        let x116 = 132.6783695416 * x92 + 171.195516 * (x74 + -7.11 * x78)
-            + (x91 * x94 - x86 * x96 - x90 * x98) - f_ext[3][3]
-            + (c_q4 * x109 - s_q4 * x110 - -0.5692 * x114);
-        let x117 = -97.44448770720001 * x93
+        let x63 = 39241.404122 * qd[1] - 3946.1881206800003 * x54;
+        let x64 = c_q2 * x54 + s_q2 * x55;
+        let x65 = c_q2 * x55 - s_q2 * x54;
+        let x66 = 7.11 * x60;
+        let x67 = 7.11 * x61;
+        let x68 = x56 + (7.11 * (x58 + x58) + -0.475 * (x59 + x54 * x54));
+        let x69 = s_q2 * x66 + c_q2 * x67;
+        let x70 = s_q2 * x58 - c_q2 * x57 - qd[2] * x65;
+        let x71 = s_q2 * x57 + c_q2 * x58 + qd[2] * x64;
+        let x72 = qd[1] + qd[2];
+        let x73 = x72 * x72 + x65 * x65;
+        let x74 = x64 * x65;
+        let x75 = x71 + x64 * x72;
+        let x76 = 1375.0472756800002 * x72 - -24989.305802 * x64;
+        let x77 = 24998.827802 * x72 - 1375.0472756800002 * x64;
+        let x78 = c_q3 * x64 + s_q3 * x65;
+        let x79 = c_q3 * x65 - s_q3 * x64;
+        let x80 = c_q3 * x70 + s_q3 * x71 - qd[3] * x79;
+        let x81 = s_q3 * x70 - c_q3 * x71 - qd[3] * x78;
+        let x82 = qd[3] + x72;
+        let x83 = 132.6783695416 * x78;
+        let x84 = 135.4729695416 * x82 + -97.44448770720001 * x79;
+        let x85 = -97.44448770720001 * x82;
+        let x86 = s_q4 * x82 - c_q4 * x78;
+        let x87 = s_q4 * x78 + c_q4 * x82;
+        let x88 = qd[4] + x79;
+        let x89 = 44.41 * x87;
+        let x90 = 47.471 * x88;
+        let x91 = 9.336 * (qd[5] + x86);
+        let x92 = 9.336 * (c_q4 * x80 + qd[4] * x87) - f_ext[5][3];
+        let x93 = (c_q5 * x88 - s_q5 * x87) * x91 - f_ext[5][4];
+        let x94 = f_ext[5][5] + (c_q5 * x87 + s_q5 * x88) * x91;
+        let x95 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
+        let x96 = f_ext[4][0] + f_ext[5][0];
+        let x97 = x95 - f_ext[4][1];
+        let x98 = f_ext[4][2] + (f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5);
+        let x99 = x87 * x90 - x88 * x89 - f_ext[4][3] + (x92 + 0.7026 * x95);
+        let x100 = c_q5 * x93 + s_q5 * x94 - -0.7026 * f_ext[5][0]
+            - (f_ext[4][4] + (44.41 * (s_q4 * x80 + qd[4] * x86) + x86 * x90));
+        let x101 = 47.471 * x81 + x86 * x89 - f_ext[4][5] + (s_q5 * x93 - c_q5 * x94);
+        let x102 = c_q4 * x96 + s_q4 * x97;
+        let x103 = f_ext[3][0] + -171.195516 * (x78 * x79) + x102;
+        let x104 = -171.195516 * (x79 * x82 - x80) - f_ext[3][1]
+            + (c_q4 * x97 - s_q4 * x96);
+        let x105 = f_ext[3][2] + -171.195516 * (x82 * x82 + x78 * x78) + x98;
+        let x106 = 132.6783695416 * x80 + (x82 * x85 - x79 * x84)
+            - 171.195516 * (x68 + 7.11 * x75) - f_ext[3][3]
+            + (c_q4 * x99 - s_q4 * x100 - -0.5692 * x98);
+        let x107 = -97.44448770720001 * x81 + (x78 * x85 - x79 * x83)
             + -171.195516
-                * (c_q3 * (c_q2 * x75 - s_q2 * x76 + qd[2] * x72) - s_q3 * x79
-                    - qd[3] * x90) + (x85 * x94 - x86 * x95 - x90 * x97) - f_ext[3][4]
-            + (s_q4 * x109 + c_q4 * x110);
-        let x118 = x91 * x95 - x85 * x96 + (x89 * x98 - x87 * x97) - f_ext[3][5]
-            + (x111 - 0.5692 * x115);
-        let x119 = f_ext[3][0] + x86 * x98 + x115;
-        let x120 = c_q4 * x113 - s_q4 * x112
-            - (f_ext[3][1] + (-171.195516 * x92 + x86 * x97));
-        let x121 = x91 * x97 - x85 * x98 - f_ext[3][2] - x114;
-        let x122 = s_q3 * x119 + c_q3 * x121;
-        let x123 = -24989.305802 * x77
-            + (x68 * x84 - x72 * x83 - (x67 * x82 + x73 * x81)) - f_ext[2][3]
-            + (c_q3 * x116 + s_q3 * x118);
-        let x124 = 1375.0472756800002 * x77 + x79 * -3239.4582
-            + (x67 * x80 - x66 * x81 + x71 * x84) - f_ext[2][4] + (x117 + -7.11 * x122);
-        let x125 = 3239.4582 * x74 - (x73 * x80 + x66 * x82 + x71 * x83) - f_ext[2][5]
-            + (c_q3 * x118 - s_q3 * x116 + 7.11 * x120);
-        let x126 = x67 * x83 - x73 * x84 - f_ext[2][0] + (s_q3 * x121 - c_q3 * x119);
-        let x127 = x66 * x83 - f_ext[2][2] + x122;
-        let x128 = c_q2 * x126 + s_q2 * x127;
-        let x129 = c_q2 * x127 - s_q2 * x126;
-        let x130 = tau[0]
+                * (c_q3 * (s_q2 * x67 - c_q2 * x66 - 7.11 * x73)
+                    + s_q3 * (x69 + 7.11 * x74)) - f_ext[3][4]
+            + (s_q4 * x99 + c_q4 * x100);
+        let x108 = x82 * x83 - x78 * x84 - f_ext[3][5] + (x101 - 0.5692 * x102);
+        let x109 = s_q3 * x103 - c_q3 * x105;
+        let x110 = f_ext[2][0] + 3239.4582 * x73 + (c_q3 * x103 + s_q3 * x105);
+        let x111 = x109 - (f_ext[2][2] + 3239.4582 * x74);
+        let x112 = -24989.305802 * x70 - x65 * x77 - f_ext[2][3]
+            + (c_q3 * x106 + s_q3 * x108);
+        let x113 = 1375.0472756800002 * x70 + x65 * x76 - x69 * -3239.4582 - f_ext[2][4]
+            + (x107 + -7.11 * x109);
+        let x114 = c_q3 * x108 - s_q3 * x106 + 7.11 * x104
+            - (f_ext[2][5] + (x72 * x76 + x64 * x77 + 3239.4582 * x68));
+        let x115 = s_q2 * x111 - c_q2 * x110;
+        let x116 = s_q2 * x110 + c_q2 * x111;
+        let x117 = tau[0]
             - (c_q1
-                * (x57 * x64 - (qd[1] * x62 + x54 * x63) - f_ext[1][5]
-                    + (c_q2 * x125 - s_q2 * x123
-                        + (0.475 * x128
-                            + 7.11
-                                * (x78 * -3239.4582 - x66 * x84 - f_ext[2][1] + x120))))
+                * (c_q2 * x114 - s_q2 * x112
+                    + (0.475 * x115 + 7.11 * (x104 - (f_ext[2][1] + 3239.4582 * x75)))
+                    - (f_ext[1][5] + (qd[1] * x62 + x54 * x63 + 5224.5702 * x56)))
                 - s_q1
-                    * (c_q2 * x123 + s_q2 * x125 + -0.475 * x129
-                        - (f_ext[1][3]
-                            + (-39234.47412200001 * x59 + (x55 * x63 + x58 * x64))))
+                    * (c_q2 * x112 + s_q2 * x114 + -0.475 * x116
+                        - (f_ext[1][3] + (-39234.47412200001 * x57 + x55 * x63)))
                 + 0.5692
-                    * (c_q1 * (x55 * x64 - qd[1] * x65 - f_ext[1][0] + x128)
-                        + s_q1 * (x54 * x64 - f_ext[1][2] + x129)) - f_ext[0][5]);
-        let x131 = 1.0
+                    * (c_q1 * (x115 - (f_ext[1][0] + 5224.5702 * x60))
+                        + s_q1 * (x116 - (f_ext[1][2] + 5224.5702 * x61)))
+                - f_ext[0][5]);
+        let x118 = 1.0
             / (65697.3302265768
                 + (c_q1
                     * (c_q1 * (c_q2 * x38 - s_q2 * x36 + x40 - x39)
@@ -1234,53 +1212,53 @@ impl Ssrms6 {
                     - s_q1
                         * (c_q1 * (c_q2 * x36 + s_q2 * x38 - 7.11 * x32)
                             - s_q1 * (-39234.47412200001 + (c_q2 * x33 + s_q2 * x35)))));
-        let x132 = x45 * x131;
-        let x133 = x46 * x131;
-        let x134 = x49 * x131;
-        let x135 = x50 * x131;
-        let x136 = x53 * x131;
-        let x137 = 1.0 / (39241.404122 + (x40 + x42) - x45 * x132);
-        let x138 = x42 - x45 * x133;
-        let x139 = x137 * x138;
-        let x140 = x21 - -7.11 * x48 - x45 * x134;
-        let x141 = x137 * x140;
-        let x142 = x45 * x135;
-        let x143 = x137 * x142;
-        let x144 = x7 + x45 * x136;
-        let x145 = x137 * x144;
-        let x146 = 1.0 / (x28 - x46 * x133 - x138 * x139);
-        let x147 = x21 - x46 * x134 - x138 * x141;
-        let x148 = x146 * x147;
-        let x149 = x138 * x143 - x46 * x135;
-        let x150 = x146 * x149;
-        let x151 = x7 + x46 * x136 - x138 * x145;
-        let x152 = x146 * x151;
-        let x153 = 1.0 / (x10 - x49 * x134 - x140 * x141 - x147 * x148);
-        let x154 = x140 * x143 - x49 * x135 - x147 * x150;
-        let x155 = x153 * x154;
-        let x156 = x7 + x49 * x136 - x140 * x145 - x147 * x152;
-        let x157 = x153 * x156;
-        let x158 = 1.0 / (47.471 - x50 * x135 - x142 * x143 - x149 * x150 - x154 * x155);
-        let x159 = x50 * x136 + x142 * x145 - x149 * x152 - x154 * x157;
-        let x160 = x158 * x159;
-        let x161 = 1.0
-            / (9.336 - x53 * x136 - x144 * x145 - x151 * x152 - x156 * x157
-                - x159 * x160);
-        let x162 = tau[1]
-            - (x55 * x62 - x57 * x65 - (3946.1881206800003 * x59 + x61 * -5224.5702)
-                - f_ext[1][4] + (x124 + -7.11 * x129)) - x130 * x132;
-        let x163 = tau[2] - x124 - x130 * x133 - x139 * x162;
-        let x164 = tau[3] - x117 - x130 * x134 - x141 * x162 - x148 * x163;
-        let x165 = tau[4] - x111 - x130 * x135 + x143 * x162 - x150 * x163 - x155 * x164;
-        let x166 = x161
-            * (tau[5] - x105 + x130 * x136 - x145 * x162 - x152 * x163 - x157 * x164
-                - x160 * x165);
-        let x167 = x158 * x165 - x160 * x166;
-        let x168 = x153 * x164 - x155 * x167 - x157 * x166;
-        let x169 = x146 * x163 - x148 * x168 - x150 * x167 - x152 * x166;
-        let x170 = x137 * x162 - x139 * x169 - x141 * x168 + x143 * x167 - x145 * x166;
-        let x171 = x130 * x131 - x132 * x170 - x133 * x169 - x134 * x168 - x135 * x167
-            + x136 * x166;
-        [x171, x170, x169, x168, x167, x166]
+        let x119 = x45 * x118;
+        let x120 = x46 * x118;
+        let x121 = x49 * x118;
+        let x122 = x50 * x118;
+        let x123 = x53 * x118;
+        let x124 = 1.0 / (39241.404122 + (x40 + x42) - x45 * x119);
+        let x125 = x42 - x45 * x120;
+        let x126 = x124 * x125;
+        let x127 = x21 - -7.11 * x48 - x45 * x121;
+        let x128 = x124 * x127;
+        let x129 = x45 * x122;
+        let x130 = x124 * x129;
+        let x131 = x7 + x45 * x123;
+        let x132 = x124 * x131;
+        let x133 = 1.0 / (x28 - x46 * x120 - x125 * x126);
+        let x134 = x21 - x46 * x121 - x125 * x128;
+        let x135 = x133 * x134;
+        let x136 = x125 * x130 - x46 * x122;
+        let x137 = x133 * x136;
+        let x138 = x7 + x46 * x123 - x125 * x132;
+        let x139 = x133 * x138;
+        let x140 = 1.0 / (x10 - x49 * x121 - x127 * x128 - x134 * x135);
+        let x141 = x127 * x130 - x49 * x122 - x134 * x137;
+        let x142 = x140 * x141;
+        let x143 = x7 + x49 * x123 - x127 * x132 - x134 * x139;
+        let x144 = x140 * x143;
+        let x145 = 1.0 / (47.471 - x50 * x122 - x129 * x130 - x136 * x137 - x141 * x142);
+        let x146 = x50 * x123 + x129 * x132 - x136 * x139 - x141 * x144;
+        let x147 = x145 * x146;
+        let x148 = 1.0
+            / (9.336 - x53 * x123 - x131 * x132 - x138 * x139 - x143 * x144
+                - x146 * x147);
+        let x149 = tau[1]
+            - (x55 * x62 - 3946.1881206800003 * x57 - f_ext[1][4]
+                + (x113 + -7.11 * x116)) - x117 * x119;
+        let x150 = tau[2] - x113 - x117 * x120 - x126 * x149;
+        let x151 = tau[3] - x107 - x117 * x121 - x128 * x149 - x135 * x150;
+        let x152 = tau[4] - x101 - x117 * x122 + x130 * x149 - x137 * x150 - x142 * x151;
+        let x153 = x148
+            * (tau[5] - x92 + x117 * x123 - x132 * x149 - x139 * x150 - x144 * x151
+                - x147 * x152);
+        let x154 = x145 * x152 - x147 * x153;
+        let x155 = x140 * x151 - x142 * x154 - x144 * x153;
+        let x156 = x133 * x150 - x135 * x155 - x137 * x154 - x139 * x153;
+        let x157 = x124 * x149 - x126 * x156 - x128 * x155 + x130 * x154 - x132 * x153;
+        let x158 = x117 * x118 - x119 * x157 - x120 * x156 - x121 * x155 - x122 * x154
+            + x123 * x153;
+        [x158, x157, x156, x155, x154, x153]
     }
 }

@@ -8,7 +8,7 @@
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Precision: `f64`.
-//! Fused multiply-adds: 1260 (`mass_matrix` 93, `nonlinear_effects` 136, `inverse_dynamics` 145, `forward_dynamics` 323, `mass_matrix_and_nonlinear_effects` 229, `forward_dynamics_with_wrenches` 334), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds: 1158 (`mass_matrix` 93, `nonlinear_effects` 115, `inverse_dynamics` 124, `forward_dynamics` 302, `mass_matrix_and_nonlinear_effects` 208, `forward_dynamics_with_wrenches` 316), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
@@ -21,19 +21,24 @@
 //! | `mass_matrix` * | `crba` | — | 170 | 116 | 0 | 0 | 5 | 286 |
 //! | `nonlinear_effects` | — | `recurrent` | 618 | 450 | 0 | 0 | 7 | 1068 |
 //! | `nonlinear_effects` | — | `kane-direct` | 708 | 536 | 0 | 0 | 7 | 1244 |
-//! | `nonlinear_effects` * | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `nonlinear_effects` | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `nonlinear_effects` * | — | `newton-euler` | 207 | 142 | 0 | 0 | 6 | 349 |
 //! | `inverse_dynamics` | — | `recurrent` | 827 | 607 | 0 | 0 | 7 | 1434 |
 //! | `inverse_dynamics` | — | `kane-direct` | 917 | 693 | 0 | 0 | 7 | 1610 |
-//! | `inverse_dynamics` * | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `inverse_dynamics` | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `inverse_dynamics` * | — | `newton-euler` | 217 | 157 | 0 | 0 | 6 | 374 |
 //! | `forward_dynamics` | `crba` | `recurrent` | 914 | 667 | 7 | 0 | 7 | 1581 |
 //! | `forward_dynamics` | `crba` | `kane-direct` | 1004 | 753 | 7 | 0 | 7 | 1757 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `forward_dynamics` | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | 503 | 359 | 7 | 0 | 6 | 862 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 788 | 566 | 0 | 0 | 7 | 1354 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 878 | 652 | 0 | 0 | 7 | 1530 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 377 | 258 | 0 | 0 | 6 | 635 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1018 | 772 | 7 | 0 | 7 | 1790 |
 //! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1108 | 858 | 7 | 0 | 7 | 1966 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 515 | 403 | 7 | 0 | 6 | 918 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsFma;
@@ -101,57 +106,57 @@ impl SsrmsFma {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 256u64,
-            add: 176u64,
+            bias_method: Some("newton-euler"),
+            mul: 207u64,
+            add: 142u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 136u64,
+            fma: 115u64,
         },
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            mul: 268u64,
-            add: 191u64,
+            bias_method: Some("newton-euler"),
+            mul: 217u64,
+            add: 157u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 145u64,
+            fma: 124u64,
         },
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 552u64,
-            add: 393u64,
+            bias_method: Some("newton-euler"),
+            mul: 503u64,
+            add: 359u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 323u64,
+            fma: 302u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 426u64,
-            add: 292u64,
+            bias_method: Some("newton-euler"),
+            mul: 377u64,
+            add: 258u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 229u64,
+            fma: 208u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 564u64,
-            add: 437u64,
+            bias_method: Some("newton-euler"),
+            mul: 515u64,
+            add: 403u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 334u64,
+            fma: 316u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -245,6 +250,17 @@ impl SsrmsFma {
             fma: 0u64,
         },
         OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 207u64,
+            add: 142u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
@@ -272,6 +288,17 @@ impl SsrmsFma {
             bias_method: Some("rnea"),
             mul: 268u64,
             add: 191u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            mul: 217u64,
+            add: 157u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -311,6 +338,17 @@ impl SsrmsFma {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 503u64,
+            add: 359u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -344,6 +382,17 @@ impl SsrmsFma {
             fma: 0u64,
         },
         OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 377u64,
+            add: 258u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
@@ -371,6 +420,17 @@ impl SsrmsFma {
             bias_method: Some("rnea"),
             mul: 564u64,
             add: 437u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            mul: 515u64,
+            add: 403u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -546,403 +606,333 @@ impl SsrmsFma {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `rnea`: 256 mul, 176 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 136 fused multiply-adds.
+    /// Methods: bias `newton-euler`: 207 mul, 142 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 115 fused multiply-adds.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * qd[0];
-        let x4 = s_q1 * x3;
-        let x5 = c_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = qd[1] * x1;
-        let x8 = qd[1] * x5;
-        let x9 = qd[1] * x4;
-        let x10 = -65693.9112265768 * x2;
-        let x11 = libm::fma(x4, -1145.5438279999998, 65697.3302265768 * qd[1]);
-        let x12 = -1145.5438279999998 * qd[1];
-        let x13 = x1 * 1145.5438279999998;
+        let x3 = 0.7026 * (qd[0] * qd[0]);
+        let x4 = qd[1] * x2;
+        let x5 = qd[1] * x1;
+        let x6 = x1 * x2;
+        let x7 = libm::fma(x1, x1, qd[1] * qd[1]);
+        let x8 = -65693.9112265768 * x2;
+        let x9 = 65697.3302265768 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x15 = libm::fma(-qd[1], s_q2, x1 * c_q2);
-        let x16 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x17 = x1 * 0.5692;
-        let x18 = libm::fma(-0.5692, qd[1], x4);
-        let x19 = libm::fma(-c_q2, x18, s_q2 * x17);
-        let x20 = libm::fma(c_q2, x17, s_q2 * x18);
-        let x21 = qd[2] - x2;
-        let x22 = x6 * 0.5692;
-        let x23 = libm::fma(qd[2], x16, x6 * c_q2);
-        let x24 = libm::fma(-x6, s_q2, qd[2] * x15);
-        let x25 = libm::fma(qd[2], x19, libm::fma(-x8, s_q2, c_q2 * x22));
-        let x26 = libm::fma(3946.18812068, x21, -39234.47412200001 * x15);
-        let x27 = 5224.5702 * x5;
-        let x28 = libm::fma(
-            x20,
-            5224.5702,
-            libm::fma(39241.404122, x21, 3946.1881206800003 * x15),
-        );
-        let x29 = x16 * -5224.5702;
-        let x30 = 5224.5702 * x21;
+        let x11 = libm::fma(-qd[1], s_q2, x1 * c_q2);
+        let x12 = libm::fma(qd[1], c_q2, x1 * s_q2);
+        let x13 = -0.5692 * x6;
+        let x14 = -0.5692 * x7;
+        let x15 = libm::fma(-0.5692, x4 + x4, x3);
+        let x16 = libm::fma(c_q2, x15, s_q2 * x13);
+        let x17 = libm::fma(qd[2], x12, x4 * c_q2);
+        let x18 = libm::fma(-x4, s_q2, qd[2] * x11);
+        let x19 = qd[2] - x2;
+        let x20 = x12 * x12;
+        let x21 = libm::fma(x19, x19, x20);
+        let x22 = x11 * x19;
+        let x23 = x18 + x22;
+        let x24 = libm::fma(x11, x12, x5);
+        let x25 = libm::fma(3946.18812068, x19, -39234.47412200001 * x11);
+        let x26 = libm::fma(39241.404122, x19, 3946.1881206800003 * x11);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x32 = libm::fma(-x16, s_q3, x15 * c_q3);
-        let x33 = libm::fma(x16, c_q3, x15 * s_q3);
-        let x34 = libm::fma(0.475, x16, x19);
-        let x35 = libm::fma(x16, -7.11, x5);
-        let x36 = x20 + libm::fma(7.11, x21, x15 * 0.475);
-        let x37 = libm::fma(s_q3, x36, c_q3 * x34);
-        let x38 = libm::fma(-c_q3, x36, s_q3 * x34);
-        let x39 = qd[3] + x21;
-        let x40 = 7.11 * x7;
-        let x41 = libm::fma(
-            0.475,
-            x24,
-            libm::fma(qd[2], x20, -libm::fma(s_q2, x22, x8 * c_q2)),
-        );
-        let x42 = libm::fma(x24, 7.11, x9);
-        let x43 = x25 + libm::fma(x23, 0.475, x40);
-        let x44 = libm::fma(qd[3], x33, libm::fma(x24, s_q3, x23 * c_q3));
-        let x45 = libm::fma(qd[3], x32, libm::fma(-x23, s_q3, x24 * c_q3));
-        let x46 = libm::fma(qd[3], x37, libm::fma(c_q3, x43, s_q3 * x41));
-        let x47 = libm::fma(1375.0472756800002, x39, -24989.305802 * x32);
-        let x48 = 3239.4582 * x35;
-        let x49 = libm::fma(
-            x38,
-            -3239.4582,
-            libm::fma(24998.827802, x39, 1375.0472756800002 * x32),
-        );
-        let x50 = x33 * -3239.4582;
-        let x51 = 3239.4582 * x39;
+        let x28 = libm::fma(-x12, s_q3, x11 * c_q3);
+        let x29 = libm::fma(x12, c_q3, x11 * s_q3);
+        let x30 = libm::fma(-c_q2, x13, s_q2 * x15)
+            + libm::fma(-7.11, x21, -0.475 * (x22 - x18));
+        let x31 = libm::fma(0.475, libm::fma(x11, x11, x20), 7.11 * x23) - x14;
+        let x32 = libm::fma(-0.475, libm::fma(x12, x19, -x17), 7.11 * x24) - x16;
+        let x33 = libm::fma(c_q3, x32, s_q3 * x30);
+        let x34 = libm::fma(qd[3], x29, libm::fma(x18, s_q3, x17 * c_q3));
+        let x35 = libm::fma(qd[3], x28, libm::fma(-x17, s_q3, x18 * c_q3));
+        let x36 = qd[3] + x19;
+        let x37 = libm::fma(x29, x29, x36 * x36);
+        let x38 = libm::fma(x28, x36, x35);
+        let x39 = libm::fma(x28, x29, x5);
+        let x40 = libm::fma(1375.0472756800002, x36, -24989.305802 * x28);
+        let x41 = libm::fma(24998.827802, x36, 1375.0472756800002 * x28);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x53 = libm::fma(-x33, s_q4, x32 * c_q4);
-        let x54 = libm::fma(x33, c_q4, x32 * s_q4);
-        let x55 = libm::fma(x33, -7.11, x35);
-        let x56 = libm::fma(-7.11, x39, x38);
-        let x57 = libm::fma(-s_q4, x56, x37 * c_q4);
-        let x58 = libm::fma(c_q4, x56, x37 * s_q4);
-        let x59 = qd[4] + x39;
-        let x60 = libm::fma(qd[4], x54, libm::fma(x45, s_q4, x44 * c_q4));
-        let x61 = libm::fma(qd[4], x53, libm::fma(-x44, s_q4, x45 * c_q4));
-        let x62 = -97.44448770720001 * x59;
-        let x63 = libm::fma(x55, -171.195516, 132.6783695416 * x53);
-        let x64 = libm::fma(
-            -171.195516,
-            x57,
-            libm::fma(-97.44448770720001, x54, 135.4729695416 * x59),
-        );
-        let x65 = x59 * 171.195516;
-        let x66 = -171.195516 * x53;
-        let x67 = libm::fma(-x53, x66, x59 * x65);
-        let x68 = libm::fma(x54, x66, x7 * 171.195516);
-        let x69 = libm::fma(-x54, x65, -171.195516 * x60);
+        let x43 = libm::fma(-x29, s_q4, x28 * c_q4);
+        let x44 = libm::fma(x29, c_q4, x28 * s_q4);
+        let x45 = libm::fma(qd[4], x44, libm::fma(x35, s_q4, x34 * c_q4));
+        let x46 = libm::fma(qd[4], x43, libm::fma(-x34, s_q4, x35 * c_q4));
+        let x47 = qd[4] + x36;
+        let x48 = -171.195516 * libm::fma(x43, x44, -x5);
+        let x49 = -171.195516 * libm::fma(x44, x47, x45);
+        let x50 = -171.195516 * libm::fma(x43, x43, x47 * x47);
+        let x51 = 132.6783695416 * x43;
+        let x52 = libm::fma(-97.44448770720001, x44, 135.4729695416 * x47);
+        let x53 = -97.44448770720001 * x47;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x71 = libm::fma(x59, s_q5, x53 * c_q5);
-        let x72 = libm::fma(-x53, s_q5, x59 * c_q5);
-        let x73 = qd[5] + x54;
-        let x74 = 44.41 * x72;
-        let x75 = 47.471 * x73;
+        let x55 = libm::fma(x47, s_q5, x43 * c_q5);
+        let x56 = libm::fma(-x43, s_q5, x47 * c_q5);
+        let x57 = qd[5] + x44;
+        let x58 = 44.41 * x56;
+        let x59 = 47.471 * x57;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x77 = 9.336 * libm::fma(qd[5], x72, -libm::fma(x7, s_q5, x60 * c_q5));
-        let x78 = 9.336 * (qd[6] + x71);
-        let x79 = libm::fma(-x72, s_q6, x73 * c_q6) * x78;
-        let x80 = libm::fma(x73, s_q6, x72 * c_q6) * x78;
-        let x81 = libm::fma(-x73, x74, x72 * x75) + x77;
-        let x82 = libm::fma(
-            -x71,
-            x75,
-            44.41 * libm::fma(-qd[5], x71, libm::fma(-x7, c_q5, x60 * s_q5)),
-        ) + libm::fma(s_q6, x80, c_q6 * x79);
-        let x83 = libm::fma(x71, x74, 47.471 * x61) + libm::fma(-c_q6, x80, s_q6 * x79);
-        let x84 = libm::fma(-132.6783695416, x60, libm::fma(7.11, x45, x42) * 171.195516)
-            + libm::fma(x58, x66, libm::fma(-x54, x64, x59 * x62))
-            + libm::fma(-s_q5, x82, c_q5 * x81);
-        let x85 = libm::fma(
+        let x61 = 9.336 * libm::fma(qd[5], x56, -libm::fma(x5, s_q5, x45 * c_q5));
+        let x62 = 9.336 * (qd[6] + x55);
+        let x63 = libm::fma(-x56, s_q6, x57 * c_q6) * x62;
+        let x64 = libm::fma(x57, s_q6, x56 * c_q6) * x62;
+        let x65 = libm::fma(-x57, x58, x56 * x59) + x61;
+        let x66 = libm::fma(
+            -x55,
+            x59,
+            44.41 * libm::fma(-qd[5], x55, libm::fma(-x5, c_q5, x45 * s_q5)),
+        ) + libm::fma(s_q6, x64, c_q6 * x63);
+        let x67 = libm::fma(x55, x58, 47.471 * x46) + libm::fma(-c_q6, x64, s_q6 * x63);
+        let x68 = libm::fma(
+            libm::fma(7.11, x38, x31),
+            171.195516,
+            libm::fma(-132.6783695416, x45, libm::fma(-x44, x52, x47 * x53)),
+        ) + libm::fma(-s_q5, x66, c_q5 * x65);
+        let x69 = libm::fma(
             -171.195516,
             libm::fma(
-                -qd[4],
-                x58,
-                libm::fma(
-                    -s_q4,
-                    x40 + x46,
-                    libm::fma(-qd[3], x38, libm::fma(-s_q3, x43, c_q3 * x41)) * c_q4,
-                ),
+                -s_q4,
+                libm::fma(7.11, x39, x33),
+                c_q4 * libm::fma(-7.11, x37, libm::fma(-s_q3, x32, c_q3 * x30)),
             ),
-            libm::fma(-135.4729695416, x7, -97.44448770720001 * x61),
-        ) + libm::fma(-x58, x65, libm::fma(-x53, x62, x54 * x63))
-            + libm::fma(c_q5, x82, s_q5 * x81);
-        let x86 = libm::fma(
-            97.44448770720001,
-            x7,
-            libm::fma(-x59, x63, x53 * x64) - libm::fma(x57, x66, x55 * x65),
-        ) + x83;
-        let x87 = libm::fma(-s_q4, x68, c_q4 * x67);
-        let x88 = libm::fma(x35, x51, x38 * x50) - libm::fma(x39, x48, x33 * x49)
-            - libm::fma(1375.0472756800002, x7, -24989.305802 * x44)
-            + libm::fma(s_q4, x86, c_q4 * x84);
-        let x89 = libm::fma(
-            x46,
+            libm::fma(-135.4729695416, x5, -97.44448770720001 * x46)
+                + libm::fma(-x43, x53, x44 * x51),
+        ) + libm::fma(c_q5, x66, s_q5 * x65);
+        let x70 = libm::fma(97.44448770720001, x5, libm::fma(-x47, x51, x43 * x52))
+            + x67;
+        let x71 = libm::fma(c_q4, x50, s_q4 * x48);
+        let x72 = libm::fma(-3239.4582, x37, libm::fma(-s_q4, x50, c_q4 * x48));
+        let x73 = libm::fma(3239.4582, x38, x49);
+        let x74 = libm::fma(3239.4582, x39, -x71);
+        let x75 = libm::fma(s_q4, x70, c_q4 * x68)
+            - libm::fma(
+                x29,
+                x41,
+                libm::fma(1375.0472756800002, x5, -24989.305802 * x34),
+            );
+        let x76 = libm::fma(
+            x33,
             -3239.4582,
-            -libm::fma(24998.827802, x7, 1375.0472756800002 * x44),
-        ) + libm::fma(x37, x51, libm::fma(x32, x48, x33 * x47))
-            + libm::fma(-7.11, x87, x85);
-        let x90 = libm::fma(
-            3239.4582,
-            x42,
-            libm::fma(-x37, x50, libm::fma(-x39, x47, x32 * x49)),
-        ) + libm::fma(7.11, x69, libm::fma(-s_q4, x84, c_q4 * x86));
-        let x91 = libm::fma(-x39, x51, x33 * x50) + libm::fma(s_q4, x67, c_q4 * x68);
-        let x92 = libm::fma(x45, 3239.4582, x32 * x51) + x69;
-        let x93 = libm::fma(-x32, x50, 3239.4582 * x7) + x87;
-        let x94 = libm::fma(s_q3, x93, c_q3 * x91);
-        let x95 = libm::fma(-s_q3, x91, c_q3 * x93);
-        let x96 = libm::fma(-x20, x29, x5 * x30) - libm::fma(x21, x27, x16 * x28)
-            - libm::fma(3946.18812068, x7, -39234.47412200001 * x23)
-            + libm::fma(-0.475, x95, libm::fma(s_q3, x90, c_q3 * x88));
-        let x97 = libm::fma(
-            x25,
-            -5224.5702,
-            -libm::fma(39241.404122, x7, 3946.1881206800003 * x23),
-        ) + libm::fma(x19, x30, libm::fma(x15, x27, x16 * x26))
-            + libm::fma(-7.11, x95, x89);
-        let x98 = libm::fma(
+            libm::fma(x29, x40, -libm::fma(24998.827802, x5, 1375.0472756800002 * x34)),
+        ) + libm::fma(x71, 7.11, x69);
+        let x77 = libm::fma(3239.4582, x31, libm::fma(-x36, x40, x28 * x41))
+            + libm::fma(7.11, x49, libm::fma(-s_q4, x68, c_q4 * x70));
+        let x78 = libm::fma(s_q3, x74, c_q3 * x72);
+        let x79 = libm::fma(-s_q3, x72, c_q3 * x74);
+        let x80 = libm::fma(-5224.5702, x21, x78);
+        let x81 = libm::fma(5224.5702, x24, x79);
+        let x82 = libm::fma(-0.475, x79, libm::fma(s_q3, x77, c_q3 * x75))
+            - libm::fma(
+                x12,
+                x26,
+                libm::fma(3946.18812068, x5, -39234.47412200001 * x17),
+            );
+        let x83 = libm::fma(
+            x16,
             5224.5702,
-            x9,
-            libm::fma(-x19, x29, libm::fma(-x21, x26, x15 * x28)),
-        ) + (libm::fma(-s_q3, x88, c_q3 * x90) + libm::fma(7.11, x92, 0.475 * x94));
-        let x99 = libm::fma(-x21, x30, x16 * x29) + x94;
-        let x100 = libm::fma(-x15, x29, 5224.5702 * x7) + x95;
-        let x101 = libm::fma(s_q2, x100, c_q2 * x99);
-        let x102 = libm::fma(0.5692, x101, libm::fma(-s_q2, x96, c_q2 * x98))
-            - libm::fma(x8, 1145.5438279999998, libm::fma(x5, x12, x1 * x10));
-        let x103 = libm::fma(
+            libm::fma(x12, x25, -libm::fma(39241.404122, x5, 3946.1881206800003 * x17)),
+        ) + libm::fma(-7.11, x79, x76);
+        let x84 = libm::fma(-5224.5702, x14, libm::fma(-x19, x25, x11 * x26))
+            + (libm::fma(-s_q3, x75, c_q3 * x77) + libm::fma(7.11, x73, x78 * 0.475));
+        let x85 = libm::fma(s_q2, x81, c_q2 * x80);
+        let x86 = libm::fma(
+            -x1,
+            x8,
+            libm::fma(0.5692, x85, libm::fma(-s_q2, x82, c_q2 * x84)),
+        );
+        let x87 = libm::fma(
             -0.7026,
             libm::fma(
                 c_q1,
-                libm::fma(-qd[1], x12, x1 * x13)
-                    + (libm::fma(x24, 5224.5702, x15 * x30) + x92),
-                s_q1 * libm::fma(x2, x13, x101),
+                libm::fma(1145.5438279999998, x7, libm::fma(5224.5702, x23, x73)),
+                s_q1 * libm::fma(1145.5438279999998, x6, x85),
             ),
             libm::fma(
                 -s_q1,
-                x97 - libm::fma(-65693.9112265768, x7, libm::fma(x4, x13, x1 * x11)),
+                x83 - libm::fma(x1, x9, -65693.9112265768 * x5),
                 c_q1
-                    * (libm::fma(x5, x13, libm::fma(-x2, x11, qd[1] * x10))
+                    * (libm::fma(1145.5438279999998, x3, libm::fma(-x2, x9, qd[1] * x8))
                         + libm::fma(
                             -0.5692,
-                            libm::fma(-s_q2, x99, c_q2 * x100),
-                            libm::fma(s_q2, x98, c_q2 * x96),
+                            libm::fma(-s_q2, x80, c_q2 * x81),
+                            libm::fma(s_q2, x84, c_q2 * x82),
                         )),
             ),
         );
-        [x103, x102, x97, x89, x85, x83, x77]
+        [x87, x86, x83, x76, x69, x67, x61]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `rnea`: 268 mul, 191 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 145 fused multiply-adds.
+    /// Methods: bias `newton-euler`: 217 mul, 157 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 124 fused multiply-adds.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * qd[0];
-        let x4 = s_q1 * x3;
-        let x5 = c_q1 * x3;
-        let x6 = 0.7026 * qdd[0];
-        let x7 = libm::fma(-qd[1], x2, qdd[0] * c_q1);
+        let x3 = 0.7026 * qdd[0];
+        let x4 = 0.7026 * (qd[0] * qd[0]);
+        let x5 = s_q1 * x3;
+        let x6 = qd[1] * x2;
+        let x7 = libm::fma(qdd[0], c_q1, -x6);
         let x8 = libm::fma(qd[1], x1, qdd[0] * s_q1);
-        let x9 = libm::fma(qd[1], x5, s_q1 * x6);
-        let x10 = libm::fma(-c_q1, x6, qd[1] * x4);
+        let x9 = libm::fma(x1, x2, qdd[1]);
+        let x10 = libm::fma(x1, x1, qd[1] * qd[1]);
         let x11 = -65693.9112265768 * x2;
-        let x12 = libm::fma(x4, -1145.5438279999998, 65697.3302265768 * qd[1]);
-        let x13 = -1145.5438279999998 * qd[1];
-        let x14 = x1 * 1145.5438279999998;
+        let x12 = 65697.3302265768 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = libm::fma(-qd[1], s_q2, x1 * c_q2);
-        let x17 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x18 = x1 * 0.5692;
-        let x19 = libm::fma(-0.5692, qd[1], x4);
-        let x20 = libm::fma(-c_q2, x19, s_q2 * x18);
-        let x21 = libm::fma(c_q2, x18, s_q2 * x19);
-        let x22 = qd[2] - x2;
-        let x23 = x7 * 0.5692;
-        let x24 = libm::fma(-0.5692, qdd[1], x9);
-        let x25 = qdd[2] - x8;
-        let x26 = libm::fma(-qd[2], x17, libm::fma(-qdd[1], s_q2, x7 * c_q2));
-        let x27 = libm::fma(qd[2], x16, libm::fma(qdd[1], c_q2, x7 * s_q2));
-        let x28 = libm::fma(qd[2], x20, -libm::fma(c_q2, x23, s_q2 * x24));
-        let x29 = libm::fma(3946.18812068, x22, -39234.47412200001 * x16);
-        let x30 = 5224.5702 * x5;
-        let x31 = libm::fma(
-            x21,
-            5224.5702,
-            libm::fma(39241.404122, x22, 3946.1881206800003 * x16),
-        );
-        let x32 = x17 * -5224.5702;
-        let x33 = 5224.5702 * x22;
+        let x14 = libm::fma(-qd[1], s_q2, x1 * c_q2);
+        let x15 = libm::fma(qd[1], c_q2, x1 * s_q2);
+        let x16 = libm::fma(-0.5692, x9, x5);
+        let x17 = libm::fma(-0.5692, x10, c_q1 * x3);
+        let x18 = libm::fma(-0.5692, x7 - x6, -x4);
+        let x19 = libm::fma(-s_q2, x16, c_q2 * x18);
+        let x20 = libm::fma(-qd[2], x15, libm::fma(-qdd[1], s_q2, x7 * c_q2));
+        let x21 = libm::fma(qd[2], x14, libm::fma(qdd[1], c_q2, x7 * s_q2));
+        let x22 = qdd[2] - x8;
+        let x23 = qd[2] - x2;
+        let x24 = x15 * x15;
+        let x25 = libm::fma(x23, x23, x24);
+        let x26 = x14 * x23;
+        let x27 = x21 + x26;
+        let x28 = libm::fma(x14, x15, -x22);
+        let x29 = libm::fma(3946.18812068, x23, -39234.47412200001 * x14);
+        let x30 = libm::fma(39241.404122, x23, 3946.1881206800003 * x14);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x35 = libm::fma(-x17, s_q3, x16 * c_q3);
-        let x36 = libm::fma(x17, c_q3, x16 * s_q3);
-        let x37 = libm::fma(0.475, x17, x20);
-        let x38 = libm::fma(x17, -7.11, x5);
-        let x39 = x21 + libm::fma(7.11, x22, x16 * 0.475);
-        let x40 = libm::fma(s_q3, x39, c_q3 * x37);
-        let x41 = libm::fma(-c_q3, x39, s_q3 * x37);
-        let x42 = qd[3] + x22;
-        let x43 = libm::fma(
-            0.475,
-            x27,
-            libm::fma(qd[2], x21, libm::fma(-c_q2, x24, s_q2 * x23)),
-        );
-        let x44 = libm::fma(x27, 7.11, x10);
-        let x45 = x28 - libm::fma(7.11, x25, x26 * 0.475);
-        let x46 = qdd[3] + x25;
-        let x47 = libm::fma(-qd[3], x36, libm::fma(-x27, s_q3, x26 * c_q3));
-        let x48 = libm::fma(qd[3], x35, libm::fma(x27, c_q3, x26 * s_q3));
-        let x49 = libm::fma(qd[3], x40, libm::fma(c_q3, x45, s_q3 * x43));
-        let x50 = libm::fma(1375.0472756800002, x42, -24989.305802 * x35);
-        let x51 = 3239.4582 * x38;
-        let x52 = libm::fma(
-            x41,
-            -3239.4582,
-            libm::fma(24998.827802, x42, 1375.0472756800002 * x35),
-        );
-        let x53 = x36 * -3239.4582;
-        let x54 = 3239.4582 * x42;
+        let x32 = libm::fma(-x15, s_q3, x14 * c_q3);
+        let x33 = libm::fma(x15, c_q3, x14 * s_q3);
+        let x34 = libm::fma(-7.11, x25, -0.475 * (x26 - x21))
+            - libm::fma(s_q2, x18, c_q2 * x16);
+        let x35 = libm::fma(0.475, libm::fma(x14, x14, x24), 7.11 * x27) - x17;
+        let x36 = x19 + libm::fma(-0.475, libm::fma(x15, x23, x20), 7.11 * x28);
+        let x37 = libm::fma(c_q3, x36, s_q3 * x34);
+        let x38 = libm::fma(-qd[3], x33, libm::fma(-x21, s_q3, x20 * c_q3));
+        let x39 = libm::fma(qd[3], x32, libm::fma(x21, c_q3, x20 * s_q3));
+        let x40 = qdd[3] + x22;
+        let x41 = qd[3] + x23;
+        let x42 = libm::fma(x33, x33, x41 * x41);
+        let x43 = libm::fma(x32, x41, x39);
+        let x44 = libm::fma(x32, x33, -x40);
+        let x45 = libm::fma(1375.0472756800002, x41, -24989.305802 * x32);
+        let x46 = libm::fma(24998.827802, x41, 1375.0472756800002 * x32);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x56 = libm::fma(-x36, s_q4, x35 * c_q4);
-        let x57 = libm::fma(x36, c_q4, x35 * s_q4);
-        let x58 = libm::fma(x36, -7.11, x38);
-        let x59 = libm::fma(-7.11, x42, x41);
-        let x60 = libm::fma(-s_q4, x59, x40 * c_q4);
-        let x61 = libm::fma(c_q4, x59, x40 * s_q4);
-        let x62 = qd[4] + x42;
-        let x63 = qdd[4] + x46;
-        let x64 = libm::fma(-qd[4], x57, libm::fma(-x48, s_q4, x47 * c_q4));
-        let x65 = libm::fma(qd[4], x56, libm::fma(x48, c_q4, x47 * s_q4));
-        let x66 = -97.44448770720001 * x62;
-        let x67 = libm::fma(x58, -171.195516, 132.6783695416 * x56);
-        let x68 = libm::fma(
-            -171.195516,
-            x60,
-            libm::fma(-97.44448770720001, x57, 135.4729695416 * x62),
-        );
-        let x69 = x62 * 171.195516;
-        let x70 = -171.195516 * x56;
-        let x71 = libm::fma(-x56, x70, x62 * x69);
-        let x72 = libm::fma(x63, -171.195516, x57 * x70);
-        let x73 = libm::fma(x57, x69, -171.195516 * x64);
+        let x48 = libm::fma(-x33, s_q4, x32 * c_q4);
+        let x49 = libm::fma(x33, c_q4, x32 * s_q4);
+        let x50 = libm::fma(-qd[4], x49, libm::fma(-x39, s_q4, x38 * c_q4));
+        let x51 = libm::fma(qd[4], x48, libm::fma(x39, c_q4, x38 * s_q4));
+        let x52 = qdd[4] + x40;
+        let x53 = qd[4] + x41;
+        let x54 = -171.195516 * libm::fma(x48, x49, x52);
+        let x55 = -171.195516 * libm::fma(x49, x53, -x50);
+        let x56 = -171.195516 * libm::fma(x48, x48, x53 * x53);
+        let x57 = 132.6783695416 * x48;
+        let x58 = libm::fma(-97.44448770720001, x49, 135.4729695416 * x53);
+        let x59 = -97.44448770720001 * x53;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x75 = libm::fma(x62, s_q5, x56 * c_q5);
-        let x76 = libm::fma(-x56, s_q5, x62 * c_q5);
-        let x77 = qd[5] + x57;
-        let x78 = 44.41 * x76;
-        let x79 = 47.471 * x77;
+        let x61 = libm::fma(x53, s_q5, x48 * c_q5);
+        let x62 = libm::fma(-x48, s_q5, x53 * c_q5);
+        let x63 = qd[5] + x49;
+        let x64 = 44.41 * x62;
+        let x65 = 47.471 * x63;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x81 = 9.336
-            * (qdd[6] + libm::fma(qd[5], x76, libm::fma(x63, s_q5, x64 * c_q5)));
-        let x82 = 9.336 * (qd[6] + x75);
-        let x83 = libm::fma(-x76, s_q6, x77 * c_q6) * x82;
-        let x84 = libm::fma(x77, s_q6, x76 * c_q6) * x82;
-        let x85 = libm::fma(-x77, x78, x76 * x79) + x81;
-        let x86 = libm::fma(
-            -x75,
-            x79,
-            44.41 * libm::fma(-qd[5], x75, libm::fma(-x64, s_q5, x63 * c_q5)),
-        ) + libm::fma(s_q6, x84, c_q6 * x83);
-        let x87 = libm::fma(x75, x78, 47.471 * (qdd[5] + x65))
-            + libm::fma(-c_q6, x84, s_q6 * x83);
-        let x88 = libm::fma(libm::fma(7.11, x48, x44), 171.195516, 132.6783695416 * x64)
-            + libm::fma(x61, x70, libm::fma(-x57, x68, x62 * x66))
-            + libm::fma(-s_q5, x86, c_q5 * x85);
-        let x89 = libm::fma(
+        let x67 = 9.336
+            * (qdd[6] + libm::fma(qd[5], x62, libm::fma(x52, s_q5, x50 * c_q5)));
+        let x68 = 9.336 * (qd[6] + x61);
+        let x69 = libm::fma(-x62, s_q6, x63 * c_q6) * x68;
+        let x70 = libm::fma(x63, s_q6, x62 * c_q6) * x68;
+        let x71 = libm::fma(-x63, x64, x62 * x65) + x67;
+        let x72 = libm::fma(
+            -x61,
+            x65,
+            44.41 * libm::fma(-qd[5], x61, libm::fma(-x50, s_q5, x52 * c_q5)),
+        ) + libm::fma(s_q6, x70, c_q6 * x69);
+        let x73 = libm::fma(x61, x64, 47.471 * (qdd[5] + x51))
+            + libm::fma(-c_q6, x70, s_q6 * x69);
+        let x74 = libm::fma(
+            libm::fma(7.11, x43, x35),
+            171.195516,
+            libm::fma(132.6783695416, x50, libm::fma(-x49, x58, x53 * x59)),
+        ) + libm::fma(-s_q5, x72, c_q5 * x71);
+        let x75 = libm::fma(
             -171.195516,
             libm::fma(
-                -qd[4],
-                x61,
-                libm::fma(
-                    -s_q4,
-                    libm::fma(-7.11, x46, x49),
-                    libm::fma(-qd[3], x41, libm::fma(-s_q3, x45, c_q3 * x43)) * c_q4,
-                ),
+                -s_q4,
+                libm::fma(7.11, x44, x37),
+                c_q4 * libm::fma(-7.11, x42, libm::fma(-s_q3, x36, c_q3 * x34)),
             ),
-            libm::fma(-97.44448770720001, x65, 135.4729695416 * x63),
-        ) + libm::fma(-x61, x69, libm::fma(-x56, x66, x57 * x67))
-            + libm::fma(c_q5, x86, s_q5 * x85);
-        let x90 = libm::fma(
-            -97.44448770720001,
-            x63,
-            libm::fma(-x62, x67, x56 * x68) - libm::fma(x60, x70, x58 * x69),
-        ) + x87;
-        let x91 = libm::fma(-s_q4, x72, c_q4 * x71);
-        let x92 = libm::fma(1375.0472756800002, x46, -24989.305802 * x47)
-            + (libm::fma(x38, x54, x41 * x53) - libm::fma(x42, x51, x36 * x52))
-            + libm::fma(s_q4, x90, c_q4 * x88);
-        let x93 = libm::fma(
-            x49,
+            libm::fma(-97.44448770720001, x51, 135.4729695416 * x52)
+                + libm::fma(-x48, x59, x49 * x57),
+        ) + libm::fma(c_q5, x72, s_q5 * x71);
+        let x76 = libm::fma(-97.44448770720001, x52, libm::fma(-x53, x57, x48 * x58))
+            + x73;
+        let x77 = libm::fma(c_q4, x56, s_q4 * x54);
+        let x78 = libm::fma(-3239.4582, x42, libm::fma(-s_q4, x56, c_q4 * x54));
+        let x79 = libm::fma(3239.4582, x43, x55);
+        let x80 = libm::fma(3239.4582, x44, -x77);
+        let x81 = libm::fma(
+            -x33,
+            x46,
+            libm::fma(1375.0472756800002, x40, -24989.305802 * x38),
+        ) + libm::fma(s_q4, x76, c_q4 * x74);
+        let x82 = libm::fma(
+            x37,
             -3239.4582,
-            libm::fma(24998.827802, x46, 1375.0472756800002 * x47),
-        ) + libm::fma(x40, x54, libm::fma(x35, x51, x36 * x50))
-            + libm::fma(-7.11, x91, x89);
-        let x94 = libm::fma(
-            3239.4582,
-            x44,
-            libm::fma(-x40, x53, libm::fma(-x42, x50, x35 * x52)),
-        ) + libm::fma(-7.11, x73, libm::fma(-s_q4, x88, c_q4 * x90));
-        let x95 = libm::fma(-x42, x54, x36 * x53) + libm::fma(s_q4, x71, c_q4 * x72);
-        let x96 = libm::fma(x48, 3239.4582, x35 * x54) - x73;
-        let x97 = x91 - libm::fma(x35, x53, 3239.4582 * x46);
-        let x98 = libm::fma(s_q3, x97, c_q3 * x95);
-        let x99 = libm::fma(-s_q3, x95, c_q3 * x97);
-        let x100 = libm::fma(3946.18812068, x25, -39234.47412200001 * x26)
-            + (libm::fma(-x21, x32, x5 * x33) - libm::fma(x22, x30, x17 * x31))
-            + libm::fma(-0.475, x99, libm::fma(s_q3, x94, c_q3 * x92));
-        let x101 = libm::fma(
-            x28,
+            libm::fma(x33, x45, libm::fma(24998.827802, x40, 1375.0472756800002 * x38)),
+        ) + libm::fma(x77, 7.11, x75);
+        let x83 = libm::fma(3239.4582, x35, libm::fma(-x41, x45, x32 * x46))
+            + libm::fma(7.11, x55, libm::fma(-s_q4, x74, c_q4 * x76));
+        let x84 = libm::fma(s_q3, x80, c_q3 * x78);
+        let x85 = libm::fma(-s_q3, x78, c_q3 * x80);
+        let x86 = libm::fma(-5224.5702, x25, x84);
+        let x87 = libm::fma(5224.5702, x28, x85);
+        let x88 = libm::fma(
+            -x15,
+            x30,
+            libm::fma(3946.18812068, x22, -39234.47412200001 * x20),
+        ) + libm::fma(-0.475, x85, libm::fma(s_q3, x83, c_q3 * x81));
+        let x89 = libm::fma(
+            x19,
             -5224.5702,
-            libm::fma(39241.404122, x25, 3946.1881206800003 * x26),
-        ) + libm::fma(x20, x33, libm::fma(x16, x30, x17 * x29))
-            + libm::fma(-7.11, x99, x93);
-        let x102 = libm::fma(
-            5224.5702,
-            x10,
-            libm::fma(-x20, x32, libm::fma(-x22, x29, x16 * x31)),
-        ) + (libm::fma(-s_q3, x92, c_q3 * x94) + libm::fma(7.11, x96, 0.475 * x98));
-        let x103 = libm::fma(-x22, x33, x17 * x32) + x98;
-        let x104 = x99 - libm::fma(x16, x32, 5224.5702 * x25);
-        let x105 = libm::fma(s_q2, x104, c_q2 * x103);
-        let x106 = libm::fma(x9, -1145.5438279999998, 65697.3302265768 * qdd[1])
-            - libm::fma(x5, x13, x1 * x11)
-            + libm::fma(0.5692, x105, libm::fma(-s_q2, x100, c_q2 * x102));
-        let x107 = libm::fma(
+            libm::fma(x15, x29, libm::fma(39241.404122, x22, 3946.1881206800003 * x20)),
+        ) + libm::fma(-7.11, x85, x82);
+        let x90 = libm::fma(-5224.5702, x17, libm::fma(-x23, x29, x14 * x30))
+            + (libm::fma(-s_q3, x81, c_q3 * x83) + libm::fma(7.11, x79, x84 * 0.475));
+        let x91 = libm::fma(s_q2, x87, c_q2 * x86);
+        let x92 = libm::fma(
+            x5,
+            -1145.5438279999998,
+            libm::fma(-x1, x11, 65697.3302265768 * qdd[1]),
+        ) + libm::fma(0.5692, x91, libm::fma(-s_q2, x88, c_q2 * x90));
+        let x93 = libm::fma(
             66279.65991417361,
             qdd[0],
             libm::fma(
                 -0.7026,
                 libm::fma(
                     c_q1,
-                    libm::fma(-qd[1], x13, x1 * x14)
-                        + (libm::fma(x27, 5224.5702, x16 * x33) + x96),
-                    s_q1 * (libm::fma(1145.5438279999998, qdd[1], x2 * x14) + x105),
+                    libm::fma(1145.5438279999998, x10, libm::fma(5224.5702, x27, x79)),
+                    s_q1 * libm::fma(1145.5438279999998, x9, x91),
                 ),
                 libm::fma(
                     -s_q1,
-                    x101
-                        - libm::fma(-65693.9112265768, x8, libm::fma(x4, x14, x1 * x12)),
+                    x89 - libm::fma(x1, x12, -65693.9112265768 * x8),
                     c_q1
-                        * (libm::fma(x5, x14, libm::fma(-x2, x12, qd[1] * x11))
+                        * (libm::fma(
+                            1145.5438279999998,
+                            x4,
+                            libm::fma(-x2, x12, qd[1] * x11),
+                        )
                             + libm::fma(
                                 -0.5692,
-                                libm::fma(-s_q2, x103, c_q2 * x104),
-                                libm::fma(s_q2, x102, c_q2 * x100),
+                                libm::fma(-s_q2, x86, c_q2 * x87),
+                                libm::fma(s_q2, x90, c_q2 * x88),
                             )),
                 ),
             ),
         );
-        [x107, x106, x101, x93, x89, x87, x81]
+        [x93, x92, x89, x82, x75, x73, x67]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 552 mul, 393 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 323 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 503 mul, 359 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 302 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1070,195 +1060,158 @@ impl SsrmsFma {
         let x87 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x86, c_q2 * x85));
         let x88 = qd[0] * c_q1;
         let x89 = qd[0] * s_q1;
-        let x90 = 0.7026 * qd[0];
-        let x91 = s_q1 * x90;
-        let x92 = c_q1 * x90;
-        let x93 = qd[1] * x89;
-        let x94 = qd[1] * x88;
-        let x95 = qd[1] * x92;
-        let x96 = qd[1] * x91;
-        let x97 = -65693.9112265768 * x89;
-        let x98 = libm::fma(-1145.5438279999998, x91, 65697.3302265768 * qd[1]);
-        let x99 = -1145.5438279999998 * qd[1];
-        let x100 = 1145.5438279999998 * x88;
-        let x101 = libm::fma(-qd[1], s_q2, c_q2 * x88);
-        let x102 = libm::fma(qd[1], c_q2, s_q2 * x88);
-        let x103 = 0.5692 * x88;
-        let x104 = libm::fma(-0.5692, qd[1], x91);
-        let x105 = libm::fma(-c_q2, x104, s_q2 * x103);
-        let x106 = libm::fma(c_q2, x103, s_q2 * x104);
-        let x107 = qd[2] - x89;
-        let x108 = 0.5692 * x93;
-        let x109 = libm::fma(qd[2], x102, c_q2 * x93);
-        let x110 = libm::fma(-s_q2, x93, qd[2] * x101);
-        let x111 = libm::fma(qd[2], x105, libm::fma(-s_q2, x95, c_q2 * x108));
-        let x112 = libm::fma(3946.18812068, x107, -39234.47412200001 * x101);
-        let x113 = 5224.5702 * x92;
-        let x114 = libm::fma(
-            x106,
-            5224.5702,
-            libm::fma(39241.404122, x107, 3946.1881206800003 * x101),
-        );
-        let x115 = x102 * -5224.5702;
-        let x116 = 5224.5702 * x107;
-        let x117 = libm::fma(-s_q3, x102, c_q3 * x101);
-        let x118 = libm::fma(c_q3, x102, s_q3 * x101);
-        let x119 = libm::fma(0.475, x102, x105);
-        let x120 = libm::fma(-7.11, x102, x92);
-        let x121 = x106 + libm::fma(7.11, x107, 0.475 * x101);
-        let x122 = libm::fma(s_q3, x121, c_q3 * x119);
-        let x123 = libm::fma(-c_q3, x121, s_q3 * x119);
-        let x124 = qd[3] + x107;
-        let x125 = 7.11 * x94;
-        let x126 = libm::fma(
-            0.475,
-            x110,
-            libm::fma(qd[2], x106, -libm::fma(s_q2, x108, c_q2 * x95)),
-        );
-        let x127 = libm::fma(7.11, x110, x96);
-        let x128 = x111 + libm::fma(0.475, x109, x125);
-        let x129 = libm::fma(qd[3], x118, libm::fma(s_q3, x110, c_q3 * x109));
-        let x130 = libm::fma(qd[3], x117, libm::fma(-s_q3, x109, c_q3 * x110));
-        let x131 = libm::fma(qd[3], x122, libm::fma(c_q3, x128, s_q3 * x126));
-        let x132 = libm::fma(1375.0472756800002, x124, -24989.305802 * x117);
-        let x133 = 3239.4582 * x120;
-        let x134 = libm::fma(
-            x123,
-            -3239.4582,
-            libm::fma(24998.827802, x124, 1375.0472756800002 * x117),
-        );
-        let x135 = x118 * -3239.4582;
-        let x136 = 3239.4582 * x124;
-        let x137 = libm::fma(-s_q4, x118, c_q4 * x117);
-        let x138 = libm::fma(c_q4, x118, s_q4 * x117);
-        let x139 = libm::fma(-7.11, x118, x120);
-        let x140 = libm::fma(-7.11, x124, x123);
-        let x141 = libm::fma(-s_q4, x140, c_q4 * x122);
-        let x142 = libm::fma(c_q4, x140, s_q4 * x122);
-        let x143 = qd[4] + x124;
-        let x144 = libm::fma(qd[4], x138, libm::fma(s_q4, x130, c_q4 * x129));
-        let x145 = libm::fma(qd[4], x137, libm::fma(-s_q4, x129, c_q4 * x130));
-        let x146 = -97.44448770720001 * x143;
-        let x147 = libm::fma(-171.195516, x139, 132.6783695416 * x137);
+        let x90 = 0.7026 * (qd[0] * qd[0]);
+        let x91 = qd[1] * x89;
+        let x92 = qd[1] * x88;
+        let x93 = x88 * x89;
+        let x94 = libm::fma(x88, x88, qd[1] * qd[1]);
+        let x95 = -65693.9112265768 * x89;
+        let x96 = 65697.3302265768 * qd[1];
+        let x97 = libm::fma(-qd[1], s_q2, c_q2 * x88);
+        let x98 = libm::fma(qd[1], c_q2, s_q2 * x88);
+        let x99 = -0.5692 * x93;
+        let x100 = -0.5692 * x94;
+        let x101 = libm::fma(-0.5692, x91 + x91, x90);
+        let x102 = libm::fma(c_q2, x101, s_q2 * x99);
+        let x103 = libm::fma(qd[2], x98, c_q2 * x91);
+        let x104 = libm::fma(-s_q2, x91, qd[2] * x97);
+        let x105 = qd[2] - x89;
+        let x106 = x98 * x98;
+        let x107 = libm::fma(x105, x105, x106);
+        let x108 = x97 * x105;
+        let x109 = x104 + x108;
+        let x110 = libm::fma(x97, x98, x92);
+        let x111 = libm::fma(3946.18812068, x105, -39234.47412200001 * x97);
+        let x112 = libm::fma(39241.404122, x105, 3946.1881206800003 * x97);
+        let x113 = libm::fma(-s_q3, x98, c_q3 * x97);
+        let x114 = libm::fma(c_q3, x98, s_q3 * x97);
+        let x115 = libm::fma(-c_q2, x99, s_q2 * x101)
+            + libm::fma(-7.11, x107, -0.475 * (x108 - x104));
+        let x116 = libm::fma(0.475, libm::fma(x97, x97, x106), 7.11 * x109) - x100;
+        let x117 = libm::fma(-0.475, libm::fma(x98, x105, -x103), 7.11 * x110) - x102;
+        let x118 = libm::fma(c_q3, x117, s_q3 * x115);
+        let x119 = libm::fma(qd[3], x114, libm::fma(s_q3, x104, c_q3 * x103));
+        let x120 = libm::fma(qd[3], x113, libm::fma(-s_q3, x103, c_q3 * x104));
+        let x121 = qd[3] + x105;
+        let x122 = libm::fma(x114, x114, x121 * x121);
+        let x123 = libm::fma(x113, x121, x120);
+        let x124 = libm::fma(x113, x114, x92);
+        let x125 = libm::fma(1375.0472756800002, x121, -24989.305802 * x113);
+        let x126 = libm::fma(24998.827802, x121, 1375.0472756800002 * x113);
+        let x127 = libm::fma(-s_q4, x114, c_q4 * x113);
+        let x128 = libm::fma(c_q4, x114, s_q4 * x113);
+        let x129 = libm::fma(qd[4], x128, libm::fma(s_q4, x120, c_q4 * x119));
+        let x130 = libm::fma(qd[4], x127, libm::fma(-s_q4, x119, c_q4 * x120));
+        let x131 = qd[4] + x121;
+        let x132 = -171.195516 * libm::fma(x127, x128, -x92);
+        let x133 = -171.195516 * libm::fma(x128, x131, x129);
+        let x134 = -171.195516 * libm::fma(x127, x127, x131 * x131);
+        let x135 = 132.6783695416 * x127;
+        let x136 = libm::fma(-97.44448770720001, x128, 135.4729695416 * x131);
+        let x137 = -97.44448770720001 * x131;
+        let x138 = libm::fma(s_q5, x131, c_q5 * x127);
+        let x139 = libm::fma(-s_q5, x127, c_q5 * x131);
+        let x140 = qd[5] + x128;
+        let x141 = 44.41 * x139;
+        let x142 = 47.471 * x140;
+        let x143 = 9.336 * libm::fma(qd[5], x139, -libm::fma(s_q5, x92, c_q5 * x129));
+        let x144 = 9.336 * (qd[6] + x138);
+        let x145 = libm::fma(-s_q6, x139, c_q6 * x140) * x144;
+        let x146 = libm::fma(s_q6, x140, c_q6 * x139) * x144;
+        let x147 = libm::fma(-x140, x141, x139 * x142) + x143;
         let x148 = libm::fma(
-            -171.195516,
-            x141,
-            libm::fma(-97.44448770720001, x138, 135.4729695416 * x143),
-        );
-        let x149 = 171.195516 * x143;
-        let x150 = -171.195516 * x137;
-        let x151 = libm::fma(-x137, x150, x143 * x149);
-        let x152 = libm::fma(x138, x150, 171.195516 * x94);
-        let x153 = libm::fma(-x138, x149, -171.195516 * x144);
-        let x154 = libm::fma(s_q5, x143, c_q5 * x137);
-        let x155 = libm::fma(-s_q5, x137, c_q5 * x143);
-        let x156 = qd[5] + x138;
-        let x157 = 44.41 * x155;
-        let x158 = 47.471 * x156;
-        let x159 = 9.336 * libm::fma(qd[5], x155, -libm::fma(s_q5, x94, c_q5 * x144));
-        let x160 = 9.336 * (qd[6] + x154);
-        let x161 = libm::fma(-s_q6, x155, c_q6 * x156) * x160;
-        let x162 = libm::fma(s_q6, x156, c_q6 * x155) * x160;
-        let x163 = libm::fma(-x156, x157, x155 * x158) + x159;
-        let x164 = libm::fma(
-            -x154,
-            x158,
-            44.41 * libm::fma(-qd[5], x154, libm::fma(-c_q5, x94, s_q5 * x144)),
-        ) + libm::fma(s_q6, x162, c_q6 * x161);
-        let x165 = libm::fma(x154, x157, 47.471 * x145)
-            + libm::fma(-c_q6, x162, s_q6 * x161);
-        let x166 = libm::fma(
-            -132.6783695416,
-            x144,
-            171.195516 * libm::fma(7.11, x130, x127),
-        ) + libm::fma(x142, x150, libm::fma(-x138, x148, x143 * x146))
-            + libm::fma(-s_q5, x164, c_q5 * x163);
-        let x167 = libm::fma(
+            -x138,
+            x142,
+            44.41 * libm::fma(-qd[5], x138, libm::fma(-c_q5, x92, s_q5 * x129)),
+        ) + libm::fma(s_q6, x146, c_q6 * x145);
+        let x149 = libm::fma(x138, x141, 47.471 * x130)
+            + libm::fma(-c_q6, x146, s_q6 * x145);
+        let x150 = libm::fma(
+            171.195516,
+            libm::fma(7.11, x123, x116),
+            libm::fma(-132.6783695416, x129, libm::fma(-x128, x136, x131 * x137)),
+        ) + libm::fma(-s_q5, x148, c_q5 * x147);
+        let x151 = libm::fma(
             -171.195516,
             libm::fma(
-                -qd[4],
-                x142,
-                libm::fma(
-                    -s_q4,
-                    x125 + x131,
-                    c_q4 * libm::fma(-qd[3], x123, libm::fma(-s_q3, x128, c_q3 * x126)),
-                ),
+                -s_q4,
+                libm::fma(7.11, x124, x118),
+                c_q4 * libm::fma(-7.11, x122, libm::fma(-s_q3, x117, c_q3 * x115)),
             ),
-            libm::fma(-135.4729695416, x94, -97.44448770720001 * x145),
-        ) + libm::fma(-x142, x149, libm::fma(-x137, x146, x138 * x147))
-            + libm::fma(c_q5, x164, s_q5 * x163);
-        let x168 = libm::fma(
-            97.44448770720001,
-            x94,
-            libm::fma(-x143, x147, x137 * x148) - libm::fma(x141, x150, x139 * x149),
-        ) + x165;
-        let x169 = libm::fma(-s_q4, x152, c_q4 * x151);
-        let x170 = libm::fma(x120, x136, x123 * x135)
-            - libm::fma(x124, x133, x118 * x134)
-            - libm::fma(1375.0472756800002, x94, -24989.305802 * x129)
-            + libm::fma(s_q4, x168, c_q4 * x166);
-        let x171 = libm::fma(
-            x131,
+            libm::fma(-135.4729695416, x92, -97.44448770720001 * x130)
+                + libm::fma(-x127, x137, x128 * x135),
+        ) + libm::fma(c_q5, x148, s_q5 * x147);
+        let x152 = libm::fma(97.44448770720001, x92, libm::fma(-x131, x135, x127 * x136))
+            + x149;
+        let x153 = libm::fma(c_q4, x134, s_q4 * x132);
+        let x154 = libm::fma(-3239.4582, x122, libm::fma(-s_q4, x134, c_q4 * x132));
+        let x155 = libm::fma(3239.4582, x123, x133);
+        let x156 = libm::fma(3239.4582, x124, -x153);
+        let x157 = libm::fma(s_q4, x152, c_q4 * x150)
+            - libm::fma(
+                x114,
+                x126,
+                libm::fma(1375.0472756800002, x92, -24989.305802 * x119),
+            );
+        let x158 = libm::fma(
+            x118,
             -3239.4582,
-            -libm::fma(24998.827802, x94, 1375.0472756800002 * x129),
-        ) + libm::fma(x122, x136, libm::fma(x117, x133, x118 * x132))
-            + libm::fma(-7.11, x169, x167);
-        let x172 = libm::fma(
-            3239.4582,
-            x127,
-            libm::fma(-x122, x135, libm::fma(-x124, x132, x117 * x134)),
-        ) + libm::fma(7.11, x153, libm::fma(-s_q4, x166, c_q4 * x168));
-        let x173 = libm::fma(-x124, x136, x118 * x135)
-            + libm::fma(s_q4, x151, c_q4 * x152);
-        let x174 = libm::fma(x130, 3239.4582, x117 * x136) + x153;
-        let x175 = libm::fma(-x117, x135, 3239.4582 * x94) + x169;
-        let x176 = libm::fma(s_q3, x175, c_q3 * x173);
-        let x177 = libm::fma(-s_q3, x173, c_q3 * x175);
-        let x178 = libm::fma(-x106, x115, x92 * x116)
-            - libm::fma(x107, x113, x102 * x114)
-            - libm::fma(3946.18812068, x94, -39234.47412200001 * x109)
-            + libm::fma(-0.475, x177, libm::fma(s_q3, x172, c_q3 * x170));
-        let x179 = libm::fma(
-            x111,
-            -5224.5702,
-            -libm::fma(39241.404122, x94, 3946.1881206800003 * x109),
-        ) + libm::fma(x105, x116, libm::fma(x101, x113, x102 * x112))
-            + libm::fma(-7.11, x177, x171);
-        let x180 = libm::fma(
+            libm::fma(
+                x114,
+                x125,
+                -libm::fma(24998.827802, x92, 1375.0472756800002 * x119),
+            ),
+        ) + libm::fma(7.11, x153, x151);
+        let x159 = libm::fma(3239.4582, x116, libm::fma(-x121, x125, x113 * x126))
+            + libm::fma(7.11, x133, libm::fma(-s_q4, x150, c_q4 * x152));
+        let x160 = libm::fma(s_q3, x156, c_q3 * x154);
+        let x161 = libm::fma(-s_q3, x154, c_q3 * x156);
+        let x162 = libm::fma(-5224.5702, x107, x160);
+        let x163 = libm::fma(5224.5702, x110, x161);
+        let x164 = libm::fma(-0.475, x161, libm::fma(s_q3, x159, c_q3 * x157))
+            - libm::fma(
+                x98,
+                x112,
+                libm::fma(3946.18812068, x92, -39234.47412200001 * x103),
+            );
+        let x165 = libm::fma(
+            x102,
             5224.5702,
-            x96,
-            libm::fma(-x105, x115, libm::fma(-x107, x112, x101 * x114)),
-        ) + (libm::fma(-s_q3, x170, c_q3 * x172) + libm::fma(7.11, x174, 0.475 * x176));
-        let x181 = libm::fma(-x107, x116, x102 * x115) + x176;
-        let x182 = libm::fma(-x101, x115, 5224.5702 * x94) + x177;
-        let x183 = libm::fma(s_q2, x182, c_q2 * x181);
-        let x184 = tau[0]
+            libm::fma(
+                x98,
+                x111,
+                -libm::fma(39241.404122, x92, 3946.1881206800003 * x103),
+            ),
+        ) + libm::fma(-7.11, x161, x158);
+        let x166 = libm::fma(-5224.5702, x100, libm::fma(-x105, x111, x97 * x112))
+            + (libm::fma(-s_q3, x157, c_q3 * x159)
+                + libm::fma(7.11, x155, 0.475 * x160));
+        let x167 = libm::fma(s_q2, x163, c_q2 * x162);
+        let x168 = tau[0]
             - libm::fma(
                 -0.7026,
                 libm::fma(
                     c_q1,
-                    libm::fma(-qd[1], x99, x88 * x100)
-                        + (libm::fma(x110, 5224.5702, x101 * x116) + x174),
-                    s_q1 * libm::fma(x89, x100, x183),
+                    libm::fma(1145.5438279999998, x94, libm::fma(5224.5702, x109, x155)),
+                    s_q1 * libm::fma(1145.5438279999998, x93, x167),
                 ),
                 libm::fma(
                     -s_q1,
-                    x179
-                        - libm::fma(
-                            -65693.9112265768,
-                            x94,
-                            libm::fma(x91, x100, x88 * x98),
-                        ),
+                    x165 - libm::fma(x88, x96, -65693.9112265768 * x92),
                     c_q1
-                        * (libm::fma(x92, x100, libm::fma(-x89, x98, qd[1] * x97))
+                        * (libm::fma(
+                            1145.5438279999998,
+                            x90,
+                            libm::fma(-x89, x96, qd[1] * x95),
+                        )
                             + libm::fma(
                                 -0.5692,
-                                libm::fma(-s_q2, x181, c_q2 * x182),
-                                libm::fma(s_q2, x180, c_q2 * x178),
+                                libm::fma(-s_q2, x162, c_q2 * x163),
+                                libm::fma(s_q2, x166, c_q2 * x164),
                             )),
                 ),
             );
-        let x185 = 1.0
+        let x169 = 1.0
             / (66279.65991417361
                 + libm::fma(
                     0.7026,
@@ -1278,16 +1231,16 @@ impl SsrmsFma {
                         ),
                     ),
                 ));
-        let x186 = x69 * x185;
-        let x187 = x70 * x185;
-        let x188 = x72 * x185;
-        let x189 = x79 * x185;
-        let x190 = x82 * x185;
-        let x191 = x87 * x185;
-        let x192 = 1.0
+        let x170 = x69 * x169;
+        let x171 = x70 * x169;
+        let x172 = x72 * x169;
+        let x173 = x79 * x169;
+        let x174 = x82 * x169;
+        let x175 = x87 * x169;
+        let x176 = 1.0
             / libm::fma(
                 -x69,
-                x186,
+                x170,
                 65697.3302265768
                     + libm::fma(
                         -s_q2,
@@ -1295,221 +1248,224 @@ impl SsrmsFma {
                         c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
                     ),
             );
-        let x193 = libm::fma(
+        let x177 = libm::fma(
             -x69,
-            x187,
+            x171,
             libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
         );
-        let x194 = x192 * x193;
-        let x195 = libm::fma(
+        let x178 = x176 * x177;
+        let x179 = libm::fma(
             -x69,
-            x188,
+            x172,
             libm::fma(0.5692, x71, libm::fma(-s_q2, x48, x67)),
         );
-        let x196 = x192 * x195;
-        let x197 = libm::fma(
+        let x180 = x176 * x179;
+        let x181 = libm::fma(
             -x69,
-            x189,
+            x173,
             libm::fma(0.5692, x78, libm::fma(-s_q2, x75, c_q2 * x77)),
         );
-        let x198 = x192 * x197;
-        let x199 = libm::fma(-x69, x190, libm::fma(-s_q2, x80, c_q2 * x81));
-        let x200 = x192 * x199;
-        let x201 = libm::fma(x69, x191, libm::fma(c_q2, x86, s_q2 * x85));
-        let x202 = x192 * x201;
-        let x203 = 1.0 / libm::fma(-x193, x194, libm::fma(-x70, x187, x59));
-        let x204 = libm::fma(-x193, x196, libm::fma(-x70, x188, x49));
+        let x182 = x176 * x181;
+        let x183 = libm::fma(-x69, x174, libm::fma(-s_q2, x80, c_q2 * x81));
+        let x184 = x176 * x183;
+        let x185 = libm::fma(x69, x175, libm::fma(c_q2, x86, s_q2 * x85));
+        let x186 = x176 * x185;
+        let x187 = 1.0 / libm::fma(-x177, x178, libm::fma(-x70, x171, x59));
+        let x188 = libm::fma(-x177, x180, libm::fma(-x70, x172, x49));
+        let x189 = x187 * x188;
+        let x190 = libm::fma(-x177, x182, libm::fma(-x70, x173, x76));
+        let x191 = x187 * x190;
+        let x192 = libm::fma(x177, x184, x70 * x174);
+        let x193 = x187 * x192;
+        let x194 = libm::fma(x177, x186, libm::fma(-x70, x175, x8));
+        let x195 = x187 * x194;
+        let x196 = 1.0
+            / libm::fma(-x188, x189, libm::fma(-x179, x180, libm::fma(-x72, x172, x35)));
+        let x197 = libm::fma(
+            -x188,
+            x191,
+            libm::fma(-x179, x182, libm::fma(-x72, x173, x27)),
+        );
+        let x198 = x196 * x197;
+        let x199 = libm::fma(x188, x193, -libm::fma(x179, x184, x72 * x174));
+        let x200 = x196 * x199;
+        let x201 = libm::fma(
+            -x188,
+            x195,
+            libm::fma(x179, x186, libm::fma(-x72, x175, x8)),
+        );
+        let x202 = x196 * x201;
+        let x203 = 1.0
+            / libm::fma(
+                -x197,
+                x198,
+                libm::fma(
+                    -x190,
+                    x191,
+                    libm::fma(-x181, x182, libm::fma(-x79, x173, x13)),
+                ),
+            );
+        let x204 = libm::fma(
+            -x197,
+            x200,
+            libm::fma(x190, x193, -libm::fma(x181, x184, x79 * x174)),
+        );
         let x205 = x203 * x204;
-        let x206 = libm::fma(-x193, x198, libm::fma(-x70, x189, x76));
+        let x206 = libm::fma(
+            -x197,
+            x202,
+            libm::fma(-x190, x195, libm::fma(x181, x186, libm::fma(-x79, x175, x8))),
+        );
         let x207 = x203 * x206;
-        let x208 = libm::fma(x193, x200, x70 * x190);
-        let x209 = x203 * x208;
-        let x210 = libm::fma(x193, x202, libm::fma(-x70, x191, x8));
-        let x211 = x203 * x210;
-        let x212 = 1.0
-            / libm::fma(-x204, x205, libm::fma(-x195, x196, libm::fma(-x72, x188, x35)));
-        let x213 = libm::fma(
+        let x208 = 1.0
+            / libm::fma(
+                -x204,
+                x205,
+                libm::fma(
+                    -x199,
+                    x200,
+                    libm::fma(
+                        -x192,
+                        x193,
+                        libm::fma(-x183, x184, libm::fma(-x82, x174, 47.471)),
+                    ),
+                ),
+            );
+        let x209 = libm::fma(
             -x204,
             x207,
-            libm::fma(-x195, x198, libm::fma(-x72, x189, x27)),
+            libm::fma(
+                -x199,
+                x202,
+                libm::fma(x192, x195, libm::fma(-x82, x175, x183 * x186)),
+            ),
         );
-        let x214 = x212 * x213;
-        let x215 = libm::fma(x204, x209, -libm::fma(x195, x200, x72 * x190));
-        let x216 = x212 * x215;
-        let x217 = libm::fma(
-            -x204,
-            x211,
-            libm::fma(x195, x202, libm::fma(-x72, x191, x8)),
-        );
-        let x218 = x212 * x217;
-        let x219 = 1.0
+        let x210 = x208 * x209;
+        let x211 = 1.0
             / libm::fma(
-                -x213,
-                x214,
+                -x209,
+                x210,
                 libm::fma(
                     -x206,
                     x207,
-                    libm::fma(-x197, x198, libm::fma(-x79, x189, x13)),
-                ),
-            );
-        let x220 = libm::fma(
-            -x213,
-            x216,
-            libm::fma(x206, x209, -libm::fma(x197, x200, x79 * x190)),
-        );
-        let x221 = x219 * x220;
-        let x222 = libm::fma(
-            -x213,
-            x218,
-            libm::fma(-x206, x211, libm::fma(x197, x202, libm::fma(-x79, x191, x8))),
-        );
-        let x223 = x219 * x222;
-        let x224 = 1.0
-            / libm::fma(
-                -x220,
-                x221,
-                libm::fma(
-                    -x215,
-                    x216,
                     libm::fma(
-                        -x208,
-                        x209,
-                        libm::fma(-x199, x200, libm::fma(-x82, x190, 47.471)),
-                    ),
-                ),
-            );
-        let x225 = libm::fma(
-            -x220,
-            x223,
-            libm::fma(
-                -x215,
-                x218,
-                libm::fma(x208, x211, libm::fma(-x82, x191, x199 * x202)),
-            ),
-        );
-        let x226 = x224 * x225;
-        let x227 = 1.0
-            / libm::fma(
-                -x225,
-                x226,
-                libm::fma(
-                    -x222,
-                    x223,
-                    libm::fma(
-                        -x217,
-                        x218,
+                        -x201,
+                        x202,
                         libm::fma(
-                            -x210,
-                            x211,
-                            libm::fma(-x201, x202, libm::fma(-x87, x191, 9.336)),
+                            -x194,
+                            x195,
+                            libm::fma(-x185, x186, libm::fma(-x87, x175, 9.336)),
                         ),
                     ),
                 ),
             );
-        let x228 = libm::fma(
-            -x184,
-            x186,
+        let x212 = libm::fma(
+            -x168,
+            x170,
             tau[1]
-                - (libm::fma(0.5692, x183, libm::fma(-s_q2, x178, c_q2 * x180))
-                    - libm::fma(1145.5438279999998, x95, libm::fma(x92, x99, x88 * x97))),
+                - libm::fma(
+                    -x88,
+                    x95,
+                    libm::fma(0.5692, x167, libm::fma(-s_q2, x164, c_q2 * x166)),
+                ),
         );
-        let x229 = libm::fma(-x194, x228, libm::fma(-x184, x187, tau[2] - x179));
-        let x230 = libm::fma(
+        let x213 = libm::fma(-x178, x212, libm::fma(-x168, x171, tau[2] - x165));
+        let x214 = libm::fma(
+            -x189,
+            x213,
+            libm::fma(-x180, x212, libm::fma(-x168, x172, tau[3] - x158)),
+        );
+        let x215 = libm::fma(
+            -x198,
+            x214,
+            libm::fma(
+                -x191,
+                x213,
+                libm::fma(-x182, x212, libm::fma(-x168, x173, tau[4] - x151)),
+            ),
+        );
+        let x216 = libm::fma(
             -x205,
-            x229,
-            libm::fma(-x196, x228, libm::fma(-x184, x188, tau[3] - x171)),
-        );
-        let x231 = libm::fma(
-            -x214,
-            x230,
-            libm::fma(
-                -x207,
-                x229,
-                libm::fma(-x198, x228, libm::fma(-x184, x189, tau[4] - x167)),
-            ),
-        );
-        let x232 = libm::fma(
-            -x221,
-            x231,
-            libm::fma(
-                -x216,
-                x230,
-                libm::fma(
-                    x209,
-                    x229,
-                    libm::fma(-x200, x228, libm::fma(-x184, x190, tau[5] - x165)),
-                ),
-            ),
-        );
-        let x233 = x227
-            * libm::fma(
-                -x226,
-                x232,
-                libm::fma(
-                    -x223,
-                    x231,
-                    libm::fma(
-                        -x218,
-                        x230,
-                        libm::fma(
-                            -x211,
-                            x229,
-                            libm::fma(x202, x228, libm::fma(-x184, x191, tau[6] - x159)),
-                        ),
-                    ),
-                ),
-            );
-        let x234 = libm::fma(-x226, x233, x224 * x232);
-        let x235 = libm::fma(-x223, x233, libm::fma(-x221, x234, x219 * x231));
-        let x236 = libm::fma(
-            -x218,
-            x233,
-            libm::fma(-x216, x234, libm::fma(-x214, x235, x212 * x230)),
-        );
-        let x237 = libm::fma(
-            -x211,
-            x233,
-            libm::fma(
-                x209,
-                x234,
-                libm::fma(-x207, x235, libm::fma(-x205, x236, x203 * x229)),
-            ),
-        );
-        let x238 = libm::fma(
-            x202,
-            x233,
+            x215,
             libm::fma(
                 -x200,
-                x234,
+                x214,
                 libm::fma(
-                    -x198,
-                    x235,
-                    libm::fma(-x196, x236, libm::fma(-x194, x237, x192 * x228)),
+                    x193,
+                    x213,
+                    libm::fma(-x184, x212, libm::fma(-x168, x174, tau[5] - x149)),
                 ),
             ),
         );
-        let x239 = libm::fma(
-            -x191,
-            x233,
-            libm::fma(
-                -x190,
-                x234,
+        let x217 = x211
+            * libm::fma(
+                -x210,
+                x216,
                 libm::fma(
-                    -x189,
-                    x235,
+                    -x207,
+                    x215,
                     libm::fma(
-                        -x188,
-                        x236,
-                        libm::fma(-x187, x237, libm::fma(-x186, x238, x184 * x185)),
+                        -x202,
+                        x214,
+                        libm::fma(
+                            -x195,
+                            x213,
+                            libm::fma(x186, x212, libm::fma(-x168, x175, tau[6] - x143)),
+                        ),
+                    ),
+                ),
+            );
+        let x218 = libm::fma(-x210, x217, x208 * x216);
+        let x219 = libm::fma(-x207, x217, libm::fma(-x205, x218, x203 * x215));
+        let x220 = libm::fma(
+            -x202,
+            x217,
+            libm::fma(-x200, x218, libm::fma(-x198, x219, x196 * x214)),
+        );
+        let x221 = libm::fma(
+            -x195,
+            x217,
+            libm::fma(
+                x193,
+                x218,
+                libm::fma(-x191, x219, libm::fma(-x189, x220, x187 * x213)),
+            ),
+        );
+        let x222 = libm::fma(
+            x186,
+            x217,
+            libm::fma(
+                -x184,
+                x218,
+                libm::fma(
+                    -x182,
+                    x219,
+                    libm::fma(-x180, x220, libm::fma(-x178, x221, x176 * x212)),
+                ),
+            ),
+        );
+        let x223 = libm::fma(
+            -x175,
+            x217,
+            libm::fma(
+                -x174,
+                x218,
+                libm::fma(
+                    -x173,
+                    x219,
+                    libm::fma(
+                        -x172,
+                        x220,
+                        libm::fma(-x171, x221, libm::fma(-x170, x222, x168 * x169)),
                     ),
                 ),
             ),
         );
-        [x239, x238, x237, x236, x235, x234, x233]
+        [x223, x222, x221, x220, x219, x218, x217]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 426 mul, 292 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 229 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 258 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 208 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 7],
@@ -1670,192 +1626,158 @@ impl SsrmsFma {
         let x94 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x92, c_q2 * x91));
         let x95 = qd[0] * c_q1;
         let x96 = qd[0] * s_q1;
-        let x97 = 0.7026 * qd[0];
-        let x98 = s_q1 * x97;
-        let x99 = c_q1 * x97;
-        let x100 = qd[1] * x96;
-        let x101 = qd[1] * x95;
-        let x102 = qd[1] * x99;
-        let x103 = qd[1] * x98;
-        let x104 = -65693.9112265768 * x96;
-        let x105 = libm::fma(-1145.5438279999998, x98, 65697.3302265768 * qd[1]);
-        let x106 = -1145.5438279999998 * qd[1];
-        let x107 = 1145.5438279999998 * x95;
-        let x108 = libm::fma(-qd[1], s_q2, c_q2 * x95);
-        let x109 = libm::fma(qd[1], c_q2, s_q2 * x95);
-        let x110 = 0.5692 * x95;
-        let x111 = libm::fma(-0.5692, qd[1], x98);
-        let x112 = libm::fma(-c_q2, x111, s_q2 * x110);
-        let x113 = libm::fma(c_q2, x110, s_q2 * x111);
-        let x114 = qd[2] - x96;
-        let x115 = 0.5692 * x100;
-        let x116 = libm::fma(qd[2], x109, c_q2 * x100);
-        let x117 = libm::fma(-s_q2, x100, qd[2] * x108);
-        let x118 = libm::fma(qd[2], x112, libm::fma(-s_q2, x102, c_q2 * x115));
-        let x119 = libm::fma(3946.18812068, x114, -39234.47412200001 * x108);
-        let x120 = 5224.5702 * x99;
-        let x121 = libm::fma(
-            x113,
-            5224.5702,
-            libm::fma(39241.404122, x114, 3946.1881206800003 * x108),
-        );
-        let x122 = x109 * -5224.5702;
-        let x123 = 5224.5702 * x114;
-        let x124 = libm::fma(-s_q3, x109, c_q3 * x108);
-        let x125 = libm::fma(c_q3, x109, s_q3 * x108);
-        let x126 = libm::fma(0.475, x109, x112);
-        let x127 = libm::fma(-7.11, x109, x99);
-        let x128 = x113 + libm::fma(7.11, x114, 0.475 * x108);
-        let x129 = libm::fma(s_q3, x128, c_q3 * x126);
-        let x130 = libm::fma(-c_q3, x128, s_q3 * x126);
-        let x131 = qd[3] + x114;
-        let x132 = 7.11 * x101;
-        let x133 = libm::fma(
-            0.475,
-            x117,
-            libm::fma(qd[2], x113, -libm::fma(s_q2, x115, c_q2 * x102)),
-        );
-        let x134 = libm::fma(7.11, x117, x103);
-        let x135 = x118 + libm::fma(0.475, x116, x132);
-        let x136 = libm::fma(qd[3], x125, libm::fma(s_q3, x117, c_q3 * x116));
-        let x137 = libm::fma(qd[3], x124, libm::fma(-s_q3, x116, c_q3 * x117));
-        let x138 = libm::fma(qd[3], x129, libm::fma(c_q3, x135, s_q3 * x133));
-        let x139 = libm::fma(1375.0472756800002, x131, -24989.305802 * x124);
-        let x140 = 3239.4582 * x127;
-        let x141 = libm::fma(
-            x130,
-            -3239.4582,
-            libm::fma(24998.827802, x131, 1375.0472756800002 * x124),
-        );
-        let x142 = x125 * -3239.4582;
-        let x143 = 3239.4582 * x131;
-        let x144 = libm::fma(-s_q4, x125, c_q4 * x124);
-        let x145 = libm::fma(c_q4, x125, s_q4 * x124);
-        let x146 = libm::fma(-7.11, x125, x127);
-        let x147 = libm::fma(-7.11, x131, x130);
-        let x148 = libm::fma(-s_q4, x147, c_q4 * x129);
-        let x149 = libm::fma(c_q4, x147, s_q4 * x129);
-        let x150 = qd[4] + x131;
-        let x151 = libm::fma(qd[4], x145, libm::fma(s_q4, x137, c_q4 * x136));
-        let x152 = libm::fma(qd[4], x144, libm::fma(-s_q4, x136, c_q4 * x137));
-        let x153 = -97.44448770720001 * x150;
-        let x154 = libm::fma(-171.195516, x146, 132.6783695416 * x144);
+        let x97 = 0.7026 * (qd[0] * qd[0]);
+        let x98 = qd[1] * x96;
+        let x99 = qd[1] * x95;
+        let x100 = x95 * x96;
+        let x101 = libm::fma(x95, x95, qd[1] * qd[1]);
+        let x102 = -65693.9112265768 * x96;
+        let x103 = 65697.3302265768 * qd[1];
+        let x104 = libm::fma(-qd[1], s_q2, c_q2 * x95);
+        let x105 = libm::fma(qd[1], c_q2, s_q2 * x95);
+        let x106 = -0.5692 * x100;
+        let x107 = -0.5692 * x101;
+        let x108 = libm::fma(-0.5692, x98 + x98, x97);
+        let x109 = libm::fma(c_q2, x108, s_q2 * x106);
+        let x110 = libm::fma(qd[2], x105, c_q2 * x98);
+        let x111 = libm::fma(-s_q2, x98, qd[2] * x104);
+        let x112 = qd[2] - x96;
+        let x113 = x105 * x105;
+        let x114 = libm::fma(x112, x112, x113);
+        let x115 = x104 * x112;
+        let x116 = x111 + x115;
+        let x117 = libm::fma(x104, x105, x99);
+        let x118 = libm::fma(3946.18812068, x112, -39234.47412200001 * x104);
+        let x119 = libm::fma(39241.404122, x112, 3946.1881206800003 * x104);
+        let x120 = libm::fma(-s_q3, x105, c_q3 * x104);
+        let x121 = libm::fma(c_q3, x105, s_q3 * x104);
+        let x122 = libm::fma(-c_q2, x106, s_q2 * x108)
+            + libm::fma(-7.11, x114, -0.475 * (x115 - x111));
+        let x123 = libm::fma(0.475, libm::fma(x104, x104, x113), 7.11 * x116) - x107;
+        let x124 = libm::fma(-0.475, libm::fma(x105, x112, -x110), 7.11 * x117) - x109;
+        let x125 = libm::fma(c_q3, x124, s_q3 * x122);
+        let x126 = libm::fma(qd[3], x121, libm::fma(s_q3, x111, c_q3 * x110));
+        let x127 = libm::fma(qd[3], x120, libm::fma(-s_q3, x110, c_q3 * x111));
+        let x128 = qd[3] + x112;
+        let x129 = libm::fma(x121, x121, x128 * x128);
+        let x130 = libm::fma(x120, x128, x127);
+        let x131 = libm::fma(x120, x121, x99);
+        let x132 = libm::fma(1375.0472756800002, x128, -24989.305802 * x120);
+        let x133 = libm::fma(24998.827802, x128, 1375.0472756800002 * x120);
+        let x134 = libm::fma(-s_q4, x121, c_q4 * x120);
+        let x135 = libm::fma(c_q4, x121, s_q4 * x120);
+        let x136 = libm::fma(qd[4], x135, libm::fma(s_q4, x127, c_q4 * x126));
+        let x137 = libm::fma(qd[4], x134, libm::fma(-s_q4, x126, c_q4 * x127));
+        let x138 = qd[4] + x128;
+        let x139 = -171.195516 * libm::fma(x134, x135, -x99);
+        let x140 = -171.195516 * libm::fma(x135, x138, x136);
+        let x141 = -171.195516 * libm::fma(x134, x134, x138 * x138);
+        let x142 = 132.6783695416 * x134;
+        let x143 = libm::fma(-97.44448770720001, x135, 135.4729695416 * x138);
+        let x144 = -97.44448770720001 * x138;
+        let x145 = libm::fma(s_q5, x138, c_q5 * x134);
+        let x146 = libm::fma(-s_q5, x134, c_q5 * x138);
+        let x147 = qd[5] + x135;
+        let x148 = 44.41 * x146;
+        let x149 = 47.471 * x147;
+        let x150 = 9.336 * libm::fma(qd[5], x146, -libm::fma(s_q5, x99, c_q5 * x136));
+        let x151 = 9.336 * (qd[6] + x145);
+        let x152 = libm::fma(-s_q6, x146, c_q6 * x147) * x151;
+        let x153 = libm::fma(s_q6, x147, c_q6 * x146) * x151;
+        let x154 = libm::fma(-x147, x148, x146 * x149) + x150;
         let x155 = libm::fma(
-            -171.195516,
-            x148,
-            libm::fma(-97.44448770720001, x145, 135.4729695416 * x150),
-        );
-        let x156 = 171.195516 * x150;
-        let x157 = -171.195516 * x144;
-        let x158 = libm::fma(-x144, x157, x150 * x156);
-        let x159 = libm::fma(x145, x157, 171.195516 * x101);
-        let x160 = libm::fma(-x145, x156, -171.195516 * x151);
-        let x161 = libm::fma(s_q5, x150, c_q5 * x144);
-        let x162 = libm::fma(-s_q5, x144, c_q5 * x150);
-        let x163 = qd[5] + x145;
-        let x164 = 44.41 * x162;
-        let x165 = 47.471 * x163;
-        let x166 = 9.336 * libm::fma(qd[5], x162, -libm::fma(s_q5, x101, c_q5 * x151));
-        let x167 = 9.336 * (qd[6] + x161);
-        let x168 = libm::fma(-s_q6, x162, c_q6 * x163) * x167;
-        let x169 = libm::fma(s_q6, x163, c_q6 * x162) * x167;
-        let x170 = libm::fma(-x163, x164, x162 * x165) + x166;
-        let x171 = libm::fma(
-            -x161,
-            x165,
-            44.41 * libm::fma(-qd[5], x161, libm::fma(-c_q5, x101, s_q5 * x151)),
-        ) + libm::fma(s_q6, x169, c_q6 * x168);
-        let x172 = libm::fma(x161, x164, 47.471 * x152)
-            + libm::fma(-c_q6, x169, s_q6 * x168);
-        let x173 = libm::fma(
-            -132.6783695416,
-            x151,
-            171.195516 * libm::fma(7.11, x137, x134),
-        ) + libm::fma(x149, x157, libm::fma(-x145, x155, x150 * x153))
-            + libm::fma(-s_q5, x171, c_q5 * x170);
-        let x174 = libm::fma(
+            -x145,
+            x149,
+            44.41 * libm::fma(-qd[5], x145, libm::fma(-c_q5, x99, s_q5 * x136)),
+        ) + libm::fma(s_q6, x153, c_q6 * x152);
+        let x156 = libm::fma(x145, x148, 47.471 * x137)
+            + libm::fma(-c_q6, x153, s_q6 * x152);
+        let x157 = libm::fma(
+            171.195516,
+            libm::fma(7.11, x130, x123),
+            libm::fma(-132.6783695416, x136, libm::fma(-x135, x143, x138 * x144)),
+        ) + libm::fma(-s_q5, x155, c_q5 * x154);
+        let x158 = libm::fma(
             -171.195516,
             libm::fma(
-                -qd[4],
-                x149,
-                libm::fma(
-                    -s_q4,
-                    x132 + x138,
-                    c_q4 * libm::fma(-qd[3], x130, libm::fma(-s_q3, x135, c_q3 * x133)),
-                ),
+                -s_q4,
+                libm::fma(7.11, x131, x125),
+                c_q4 * libm::fma(-7.11, x129, libm::fma(-s_q3, x124, c_q3 * x122)),
             ),
-            libm::fma(-135.4729695416, x101, -97.44448770720001 * x152),
-        ) + libm::fma(-x149, x156, libm::fma(-x144, x153, x145 * x154))
-            + libm::fma(c_q5, x171, s_q5 * x170);
-        let x175 = libm::fma(
-            97.44448770720001,
-            x101,
-            libm::fma(-x150, x154, x144 * x155) - libm::fma(x148, x157, x146 * x156),
-        ) + x172;
-        let x176 = libm::fma(-s_q4, x159, c_q4 * x158);
-        let x177 = libm::fma(x127, x143, x130 * x142)
-            - libm::fma(x131, x140, x125 * x141)
-            - libm::fma(1375.0472756800002, x101, -24989.305802 * x136)
-            + libm::fma(s_q4, x175, c_q4 * x173);
-        let x178 = libm::fma(
-            x138,
+            libm::fma(-135.4729695416, x99, -97.44448770720001 * x137)
+                + libm::fma(-x134, x144, x135 * x142),
+        ) + libm::fma(c_q5, x155, s_q5 * x154);
+        let x159 = libm::fma(97.44448770720001, x99, libm::fma(-x138, x142, x134 * x143))
+            + x156;
+        let x160 = libm::fma(c_q4, x141, s_q4 * x139);
+        let x161 = libm::fma(-3239.4582, x129, libm::fma(-s_q4, x141, c_q4 * x139));
+        let x162 = libm::fma(3239.4582, x130, x140);
+        let x163 = libm::fma(3239.4582, x131, -x160);
+        let x164 = libm::fma(s_q4, x159, c_q4 * x157)
+            - libm::fma(
+                x121,
+                x133,
+                libm::fma(1375.0472756800002, x99, -24989.305802 * x126),
+            );
+        let x165 = libm::fma(
+            x125,
             -3239.4582,
-            -libm::fma(24998.827802, x101, 1375.0472756800002 * x136),
-        ) + libm::fma(x129, x143, libm::fma(x124, x140, x125 * x139))
-            + libm::fma(-7.11, x176, x174);
-        let x179 = libm::fma(
-            3239.4582,
-            x134,
-            libm::fma(-x129, x142, libm::fma(-x131, x139, x124 * x141)),
-        ) + libm::fma(7.11, x160, libm::fma(-s_q4, x173, c_q4 * x175));
-        let x180 = libm::fma(-x131, x143, x125 * x142)
-            + libm::fma(s_q4, x158, c_q4 * x159);
-        let x181 = libm::fma(x137, 3239.4582, x124 * x143) + x160;
-        let x182 = libm::fma(-x124, x142, 3239.4582 * x101) + x176;
-        let x183 = libm::fma(s_q3, x182, c_q3 * x180);
-        let x184 = libm::fma(-s_q3, x180, c_q3 * x182);
-        let x185 = libm::fma(-x113, x122, x99 * x123)
-            - libm::fma(x114, x120, x109 * x121)
-            - libm::fma(3946.18812068, x101, -39234.47412200001 * x116)
-            + libm::fma(-0.475, x184, libm::fma(s_q3, x179, c_q3 * x177));
-        let x186 = libm::fma(
-            x118,
-            -5224.5702,
-            -libm::fma(39241.404122, x101, 3946.1881206800003 * x116),
-        ) + libm::fma(x112, x123, libm::fma(x108, x120, x109 * x119))
-            + libm::fma(-7.11, x184, x178);
-        let x187 = libm::fma(
+            libm::fma(
+                x121,
+                x132,
+                -libm::fma(24998.827802, x99, 1375.0472756800002 * x126),
+            ),
+        ) + libm::fma(7.11, x160, x158);
+        let x166 = libm::fma(3239.4582, x123, libm::fma(-x128, x132, x120 * x133))
+            + libm::fma(7.11, x140, libm::fma(-s_q4, x157, c_q4 * x159));
+        let x167 = libm::fma(s_q3, x163, c_q3 * x161);
+        let x168 = libm::fma(-s_q3, x161, c_q3 * x163);
+        let x169 = libm::fma(-5224.5702, x114, x167);
+        let x170 = libm::fma(5224.5702, x117, x168);
+        let x171 = libm::fma(-0.475, x168, libm::fma(s_q3, x166, c_q3 * x164))
+            - libm::fma(
+                x105,
+                x119,
+                libm::fma(3946.18812068, x99, -39234.47412200001 * x110),
+            );
+        let x172 = libm::fma(
+            x109,
             5224.5702,
-            x103,
-            libm::fma(-x112, x122, libm::fma(-x114, x119, x108 * x121)),
-        ) + (libm::fma(-s_q3, x177, c_q3 * x179) + libm::fma(7.11, x181, 0.475 * x183));
-        let x188 = libm::fma(-x114, x123, x109 * x122) + x183;
-        let x189 = libm::fma(-x108, x122, 5224.5702 * x101) + x184;
-        let x190 = libm::fma(s_q2, x189, c_q2 * x188);
-        let x191 = libm::fma(0.5692, x190, libm::fma(-s_q2, x185, c_q2 * x187))
-            - libm::fma(1145.5438279999998, x102, libm::fma(x99, x106, x95 * x104));
-        let x192 = libm::fma(
+            libm::fma(
+                x105,
+                x118,
+                -libm::fma(39241.404122, x99, 3946.1881206800003 * x110),
+            ),
+        ) + libm::fma(-7.11, x168, x165);
+        let x173 = libm::fma(-5224.5702, x107, libm::fma(-x112, x118, x104 * x119))
+            + (libm::fma(-s_q3, x164, c_q3 * x166)
+                + libm::fma(7.11, x162, 0.475 * x167));
+        let x174 = libm::fma(s_q2, x170, c_q2 * x169);
+        let x175 = libm::fma(
+            -x95,
+            x102,
+            libm::fma(0.5692, x174, libm::fma(-s_q2, x171, c_q2 * x173)),
+        );
+        let x176 = libm::fma(
             -0.7026,
             libm::fma(
                 c_q1,
-                libm::fma(-qd[1], x106, x95 * x107)
-                    + (libm::fma(x117, 5224.5702, x108 * x123) + x181),
-                s_q1 * libm::fma(x96, x107, x190),
+                libm::fma(1145.5438279999998, x101, libm::fma(5224.5702, x116, x162)),
+                s_q1 * libm::fma(1145.5438279999998, x100, x174),
             ),
             libm::fma(
                 -s_q1,
-                x186
-                    - libm::fma(
-                        -65693.9112265768,
-                        x101,
-                        libm::fma(x98, x107, x95 * x105),
-                    ),
+                x172 - libm::fma(x95, x103, -65693.9112265768 * x99),
                 c_q1
-                    * (libm::fma(x99, x107, libm::fma(-x96, x105, qd[1] * x104))
+                    * (libm::fma(
+                        1145.5438279999998,
+                        x97,
+                        libm::fma(-x96, x103, qd[1] * x102),
+                    )
                         + libm::fma(
                             -0.5692,
-                            libm::fma(-s_q2, x188, c_q2 * x189),
-                            libm::fma(s_q2, x187, c_q2 * x185),
+                            libm::fma(-s_q2, x169, c_q2 * x170),
+                            libm::fma(s_q2, x173, c_q2 * x171),
                         )),
             ),
         );
@@ -1869,12 +1791,12 @@ impl SsrmsFma {
                 [x88, x87, 0.0, 0.0, 0.0, 47.471, 0.0],
                 [x94, x93, x8, x8, x8, 0.0, 9.336],
             ],
-            [x192, x191, x186, x178, x174, x172, x166],
+            [x176, x175, x172, x165, x158, x156, x150],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 334 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 515 mul, 403 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 316 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],
@@ -2007,211 +1929,180 @@ impl SsrmsFma {
         let x87 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x86, c_q2 * x85));
         let x88 = qd[0] * c_q1;
         let x89 = qd[0] * s_q1;
-        let x90 = 0.7026 * qd[0];
-        let x91 = s_q1 * x90;
-        let x92 = c_q1 * x90;
-        let x93 = qd[1] * x89;
-        let x94 = qd[1] * x88;
-        let x95 = qd[1] * x92;
-        let x96 = qd[1] * x91;
-        let x97 = -65693.9112265768 * x89;
-        let x98 = libm::fma(-1145.5438279999998, x91, 65697.3302265768 * qd[1]);
-        let x99 = -1145.5438279999998 * qd[1];
-        let x100 = 1145.5438279999998 * x88;
-        let x101 = libm::fma(-qd[1], s_q2, c_q2 * x88);
-        let x102 = libm::fma(qd[1], c_q2, s_q2 * x88);
-        let x103 = 0.5692 * x88;
-        let x104 = libm::fma(-0.5692, qd[1], x91);
-        let x105 = libm::fma(-c_q2, x104, s_q2 * x103);
-        let x106 = libm::fma(c_q2, x103, s_q2 * x104);
-        let x107 = qd[2] - x89;
-        let x108 = 0.5692 * x93;
-        let x109 = libm::fma(qd[2], x102, c_q2 * x93);
-        let x110 = libm::fma(-s_q2, x93, qd[2] * x101);
-        let x111 = libm::fma(qd[2], x105, libm::fma(-s_q2, x95, c_q2 * x108));
-        let x112 = libm::fma(3946.18812068, x107, -39234.47412200001 * x101);
-        let x113 = 5224.5702 * x92;
-        let x114 = libm::fma(
-            x106,
-            5224.5702,
-            libm::fma(39241.404122, x107, 3946.1881206800003 * x101),
-        );
-        let x115 = x102 * -5224.5702;
-        let x116 = 5224.5702 * x107;
-        let x117 = libm::fma(-s_q3, x102, c_q3 * x101);
-        let x118 = libm::fma(c_q3, x102, s_q3 * x101);
-        let x119 = libm::fma(0.475, x102, x105);
-        let x120 = libm::fma(-7.11, x102, x92);
-        let x121 = x106 + libm::fma(7.11, x107, 0.475 * x101);
-        let x122 = libm::fma(s_q3, x121, c_q3 * x119);
-        let x123 = libm::fma(-c_q3, x121, s_q3 * x119);
-        let x124 = qd[3] + x107;
-        let x125 = 7.11 * x94;
-        let x126 = libm::fma(
-            0.475,
-            x110,
-            libm::fma(qd[2], x106, -libm::fma(s_q2, x108, c_q2 * x95)),
-        );
-        let x127 = libm::fma(7.11, x110, x96);
-        let x128 = x111 + libm::fma(0.475, x109, x125);
-        let x129 = libm::fma(qd[3], x118, libm::fma(s_q3, x110, c_q3 * x109));
-        let x130 = libm::fma(qd[3], x117, libm::fma(-s_q3, x109, c_q3 * x110));
-        let x131 = libm::fma(qd[3], x122, libm::fma(c_q3, x128, s_q3 * x126));
-        let x132 = libm::fma(1375.0472756800002, x124, -24989.305802 * x117);
-        let x133 = 3239.4582 * x120;
-        let x134 = libm::fma(
-            x123,
-            -3239.4582,
-            libm::fma(24998.827802, x124, 1375.0472756800002 * x117),
-        );
-        let x135 = x118 * -3239.4582;
-        let x136 = 3239.4582 * x124;
-        let x137 = libm::fma(-s_q4, x118, c_q4 * x117);
-        let x138 = libm::fma(c_q4, x118, s_q4 * x117);
-        let x139 = libm::fma(-7.11, x118, x120);
-        let x140 = libm::fma(-7.11, x124, x123);
-        let x141 = libm::fma(-s_q4, x140, c_q4 * x122);
-        let x142 = libm::fma(c_q4, x140, s_q4 * x122);
-        let x143 = qd[4] + x124;
-        let x144 = libm::fma(qd[4], x138, libm::fma(s_q4, x130, c_q4 * x129));
-        let x145 = libm::fma(qd[4], x137, libm::fma(-s_q4, x129, c_q4 * x130));
-        let x146 = -97.44448770720001 * x143;
-        let x147 = libm::fma(-171.195516, x139, 132.6783695416 * x137);
-        let x148 = libm::fma(
-            -171.195516,
-            x141,
-            libm::fma(-97.44448770720001, x138, 135.4729695416 * x143),
-        );
-        let x149 = 171.195516 * x143;
-        let x150 = -171.195516 * x137;
-        let x151 = libm::fma(s_q5, x143, c_q5 * x137);
-        let x152 = libm::fma(-s_q5, x137, c_q5 * x143);
-        let x153 = qd[5] + x138;
-        let x154 = 44.41 * x152;
-        let x155 = 47.471 * x153;
-        let x156 = 9.336 * (qd[6] + x151);
-        let x157 = libm::fma(
+        let x90 = 0.7026 * (qd[0] * qd[0]);
+        let x91 = qd[1] * x89;
+        let x92 = qd[1] * x88;
+        let x93 = x88 * x89;
+        let x94 = libm::fma(x88, x88, qd[1] * qd[1]);
+        let x95 = -65693.9112265768 * x89;
+        let x96 = 65697.3302265768 * qd[1];
+        let x97 = libm::fma(-qd[1], s_q2, c_q2 * x88);
+        let x98 = libm::fma(qd[1], c_q2, s_q2 * x88);
+        let x99 = -0.5692 * x93;
+        let x100 = -0.5692 * x94;
+        let x101 = libm::fma(-0.5692, x91 + x91, x90);
+        let x102 = libm::fma(c_q2, x101, s_q2 * x99);
+        let x103 = libm::fma(qd[2], x98, c_q2 * x91);
+        let x104 = libm::fma(-s_q2, x91, qd[2] * x97);
+        let x105 = qd[2] - x89;
+        let x106 = x98 * x98;
+        let x107 = libm::fma(x105, x105, x106);
+        let x108 = x97 * x105;
+        let x109 = x104 + x108;
+        let x110 = libm::fma(x97, x98, x92);
+        let x111 = libm::fma(3946.18812068, x105, -39234.47412200001 * x97);
+        let x112 = libm::fma(39241.404122, x105, 3946.1881206800003 * x97);
+        let x113 = libm::fma(-s_q3, x98, c_q3 * x97);
+        let x114 = libm::fma(c_q3, x98, s_q3 * x97);
+        let x115 = libm::fma(-c_q2, x99, s_q2 * x101)
+            + libm::fma(-7.11, x107, -0.475 * (x108 - x104));
+        let x116 = libm::fma(0.475, libm::fma(x97, x97, x106), 7.11 * x109) - x100;
+        let x117 = libm::fma(-0.475, libm::fma(x98, x105, -x103), 7.11 * x110) - x102;
+        let x118 = libm::fma(c_q3, x117, s_q3 * x115);
+        let x119 = libm::fma(qd[3], x114, libm::fma(s_q3, x104, c_q3 * x103));
+        let x120 = libm::fma(qd[3], x113, libm::fma(-s_q3, x103, c_q3 * x104));
+        let x121 = qd[3] + x105;
+        let x122 = libm::fma(x114, x114, x121 * x121);
+        let x123 = libm::fma(x113, x121, x120);
+        let x124 = libm::fma(x113, x114, x92);
+        let x125 = libm::fma(1375.0472756800002, x121, -24989.305802 * x113);
+        let x126 = libm::fma(24998.827802, x121, 1375.0472756800002 * x113);
+        let x127 = libm::fma(-s_q4, x114, c_q4 * x113);
+        let x128 = libm::fma(c_q4, x114, s_q4 * x113);
+        let x129 = libm::fma(qd[4], x128, libm::fma(s_q4, x120, c_q4 * x119));
+        let x130 = libm::fma(qd[4], x127, libm::fma(-s_q4, x119, c_q4 * x120));
+        let x131 = qd[4] + x121;
+        let x132 = 132.6783695416 * x127;
+        let x133 = libm::fma(-97.44448770720001, x128, 135.4729695416 * x131);
+        let x134 = -97.44448770720001 * x131;
+        let x135 = libm::fma(s_q5, x131, c_q5 * x127);
+        let x136 = libm::fma(-s_q5, x127, c_q5 * x131);
+        let x137 = qd[5] + x128;
+        let x138 = 44.41 * x136;
+        let x139 = 47.471 * x137;
+        let x140 = 9.336 * (qd[6] + x135);
+        let x141 = libm::fma(
             9.336,
-            libm::fma(qd[5], x152, -libm::fma(s_q5, x94, c_q5 * x144)),
+            libm::fma(qd[5], x136, -libm::fma(s_q5, x92, c_q5 * x129)),
             -f_ext[6][3],
         );
-        let x158 = libm::fma(libm::fma(-s_q6, x152, c_q6 * x153), x156, -f_ext[6][4]);
-        let x159 = libm::fma(libm::fma(s_q6, x153, c_q6 * x152), x156, f_ext[6][5]);
-        let x160 = libm::fma(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
-        let x161 = libm::fma(-x153, x154, x152 * x155) - f_ext[5][3]
-            + libm::fma(0.7026, x160, x157);
-        let x162 = libm::fma(
-            -x151,
-            x155,
-            44.41 * libm::fma(-qd[5], x151, libm::fma(-c_q5, x94, s_q5 * x144)),
+        let x142 = libm::fma(libm::fma(-s_q6, x136, c_q6 * x137), x140, -f_ext[6][4]);
+        let x143 = libm::fma(libm::fma(s_q6, x137, c_q6 * x136), x140, f_ext[6][5]);
+        let x144 = libm::fma(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
+        let x145 = f_ext[5][0] + f_ext[6][0];
+        let x146 = x144 - f_ext[5][1];
+        let x147 = f_ext[5][2] + libm::fma(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
+        let x148 = libm::fma(-x137, x138, x136 * x139) - f_ext[5][3]
+            + libm::fma(0.7026, x144, x141);
+        let x149 = libm::fma(
+            -x135,
+            x139,
+            44.41 * libm::fma(-qd[5], x135, libm::fma(-c_q5, x92, s_q5 * x129)),
         ) - f_ext[5][4]
-            + libm::fma(0.7026, f_ext[6][0], libm::fma(s_q6, x159, c_q6 * x158));
-        let x163 = libm::fma(x151, x154, 47.471 * x145) - f_ext[5][5]
-            + libm::fma(-c_q6, x159, s_q6 * x158);
-        let x164 = f_ext[5][0] + f_ext[6][0];
-        let x165 = x160 - f_ext[5][1];
-        let x166 = f_ext[5][2] + libm::fma(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
-        let x167 = libm::fma(s_q5, x165, c_q5 * x164);
-        let x168 = libm::fma(
-            -132.6783695416,
-            x144,
-            171.195516 * libm::fma(7.11, x130, x127),
-        ) + libm::fma(x142, x150, libm::fma(-x138, x148, x143 * x146)) - f_ext[4][3]
-            + libm::fma(0.5692, x166, libm::fma(-s_q5, x162, c_q5 * x161));
-        let x169 = libm::fma(
+            + libm::fma(0.7026, f_ext[6][0], libm::fma(s_q6, x143, c_q6 * x142));
+        let x150 = libm::fma(x135, x138, 47.471 * x130) - f_ext[5][5]
+            + libm::fma(-c_q6, x143, s_q6 * x142);
+        let x151 = libm::fma(s_q5, x146, c_q5 * x145);
+        let x152 = libm::fma(-171.195516, libm::fma(x127, x128, -x92), -f_ext[4][0])
+            - x151;
+        let x153 = libm::fma(-171.195516, libm::fma(x128, x131, x129), -f_ext[4][1])
+            + libm::fma(-s_q5, x145, c_q5 * x146);
+        let x154 = libm::fma(
+            -171.195516,
+            libm::fma(x127, x127, x131 * x131),
+            f_ext[4][2],
+        ) + x147;
+        let x155 = libm::fma(
+            171.195516,
+            libm::fma(7.11, x123, x116),
+            libm::fma(-132.6783695416, x129, libm::fma(-x128, x133, x131 * x134)),
+        ) - f_ext[4][3] + libm::fma(0.5692, x147, libm::fma(-s_q5, x149, c_q5 * x148));
+        let x156 = libm::fma(
             -171.195516,
             libm::fma(
-                -qd[4],
-                x142,
-                libm::fma(
-                    -s_q4,
-                    x125 + x131,
-                    c_q4 * libm::fma(-qd[3], x123, libm::fma(-s_q3, x128, c_q3 * x126)),
-                ),
+                -s_q4,
+                libm::fma(7.11, x124, x118),
+                c_q4 * libm::fma(-7.11, x122, libm::fma(-s_q3, x117, c_q3 * x115)),
             ),
-            libm::fma(-135.4729695416, x94, -97.44448770720001 * x145),
-        ) + libm::fma(-x142, x149, libm::fma(-x137, x146, x138 * x147)) - f_ext[4][4]
-            + libm::fma(c_q5, x162, s_q5 * x161);
-        let x170 = libm::fma(
-            97.44448770720001,
-            x94,
-            libm::fma(-x143, x147, x137 * x148) - libm::fma(x141, x150, x139 * x149),
-        ) - f_ext[4][5] + libm::fma(-0.5692, x167, x163);
-        let x171 = libm::fma(x138, x150, 171.195516 * x94) - f_ext[4][0] - x167;
-        let x172 = libm::fma(-x138, x149, -171.195516 * x144) - f_ext[4][1]
-            + libm::fma(-s_q5, x164, c_q5 * x165);
-        let x173 = libm::fma(-x137, x150, x143 * x149) - f_ext[4][2] - x166;
-        let x174 = libm::fma(-s_q4, x171, c_q4 * x173);
-        let x175 = libm::fma(x120, x136, x123 * x135)
-            - libm::fma(x124, x133, x118 * x134)
-            - libm::fma(1375.0472756800002, x94, -24989.305802 * x129) - f_ext[3][3]
-            + libm::fma(s_q4, x170, c_q4 * x168);
-        let x176 = libm::fma(
-            x131,
+            libm::fma(-135.4729695416, x92, -97.44448770720001 * x130)
+                + libm::fma(-x127, x134, x128 * x132),
+        ) - f_ext[4][4] + libm::fma(c_q5, x149, s_q5 * x148);
+        let x157 = libm::fma(97.44448770720001, x92, libm::fma(-x131, x132, x127 * x133))
+            - f_ext[4][5] + libm::fma(-0.5692, x151, x150);
+        let x158 = libm::fma(c_q4, x154, s_q4 * x152);
+        let x159 = libm::fma(-s_q4, x154, c_q4 * x152)
+            - libm::fma(3239.4582, x122, f_ext[3][0]);
+        let x160 = libm::fma(3239.4582, x123, -f_ext[3][1]) + x153;
+        let x161 = libm::fma(3239.4582, x124, -f_ext[3][2]) - x158;
+        let x162 = libm::fma(s_q4, x157, c_q4 * x155)
+            - (f_ext[3][3]
+                + libm::fma(
+                    x114,
+                    x126,
+                    libm::fma(1375.0472756800002, x92, -24989.305802 * x119),
+                ));
+        let x163 = libm::fma(
+            x118,
             -3239.4582,
-            -libm::fma(24998.827802, x94, 1375.0472756800002 * x129),
-        ) + libm::fma(x122, x136, libm::fma(x117, x133, x118 * x132)) - f_ext[3][4]
-            + libm::fma(-7.11, x174, x169);
-        let x177 = libm::fma(
-            3239.4582,
-            x127,
-            libm::fma(-x122, x135, libm::fma(-x124, x132, x117 * x134)),
-        ) - f_ext[3][5] + libm::fma(7.11, x172, libm::fma(-s_q4, x168, c_q4 * x170));
-        let x178 = libm::fma(-x124, x136, x118 * x135) - f_ext[3][0]
-            + libm::fma(s_q4, x173, c_q4 * x171);
-        let x179 = libm::fma(x130, 3239.4582, x117 * x136) - f_ext[3][1] + x172;
-        let x180 = libm::fma(-x117, x135, 3239.4582 * x94) - f_ext[3][2] + x174;
-        let x181 = libm::fma(s_q3, x180, c_q3 * x178);
-        let x182 = libm::fma(-s_q3, x178, c_q3 * x180);
-        let x183 = libm::fma(-x106, x115, x92 * x116)
-            - libm::fma(x107, x113, x102 * x114)
-            - libm::fma(3946.18812068, x94, -39234.47412200001 * x109) - f_ext[2][3]
-            + libm::fma(-0.475, x182, libm::fma(s_q3, x177, c_q3 * x175));
-        let x184 = libm::fma(
-            x111,
-            -5224.5702,
-            -libm::fma(39241.404122, x94, 3946.1881206800003 * x109),
-        ) + libm::fma(x105, x116, libm::fma(x101, x113, x102 * x112)) - f_ext[2][4]
-            + libm::fma(-7.11, x182, x176);
-        let x185 = libm::fma(
+            libm::fma(
+                x114,
+                x125,
+                -libm::fma(24998.827802, x92, 1375.0472756800002 * x119),
+            ),
+        ) - f_ext[3][4] + libm::fma(7.11, x158, x156);
+        let x164 = libm::fma(3239.4582, x116, libm::fma(-x121, x125, x113 * x126))
+            - f_ext[3][5] + libm::fma(7.11, x153, libm::fma(-s_q4, x155, c_q4 * x157));
+        let x165 = libm::fma(s_q3, x161, c_q3 * x159);
+        let x166 = libm::fma(-s_q3, x159, c_q3 * x161);
+        let x167 = x165 - libm::fma(5224.5702, x107, f_ext[2][0]);
+        let x168 = libm::fma(5224.5702, x110, -f_ext[2][2]) + x166;
+        let x169 = libm::fma(-0.475, x166, libm::fma(s_q3, x164, c_q3 * x162))
+            - (f_ext[2][3]
+                + libm::fma(
+                    x98,
+                    x112,
+                    libm::fma(3946.18812068, x92, -39234.47412200001 * x103),
+                ));
+        let x170 = libm::fma(
+            x102,
             5224.5702,
-            x96,
-            libm::fma(-x105, x115, libm::fma(-x107, x112, x101 * x114)),
-        ) - f_ext[2][5]
-            + (libm::fma(-s_q3, x175, c_q3 * x177)
-                + libm::fma(7.11, x179, 0.475 * x181));
-        let x186 = libm::fma(-x107, x116, x102 * x115) - f_ext[2][0] + x181;
-        let x187 = libm::fma(-x101, x115, 5224.5702 * x94) - f_ext[2][2] + x182;
-        let x188 = libm::fma(s_q2, x187, c_q2 * x186);
-        let x189 = tau[0]
+            libm::fma(
+                x98,
+                x111,
+                -libm::fma(39241.404122, x92, 3946.1881206800003 * x103),
+            ),
+        ) - f_ext[2][4] + libm::fma(-7.11, x166, x163);
+        let x171 = libm::fma(-5224.5702, x100, libm::fma(-x105, x111, x97 * x112))
+            - f_ext[2][5]
+            + (libm::fma(-s_q3, x162, c_q3 * x164)
+                + libm::fma(7.11, x160, 0.475 * x165));
+        let x172 = libm::fma(s_q2, x168, c_q2 * x167);
+        let x173 = tau[0]
             - (libm::fma(
                 -0.7026,
                 libm::fma(
                     c_q1,
-                    libm::fma(-qd[1], x99, x88 * x100) - f_ext[1][1]
-                        + (libm::fma(x110, 5224.5702, x101 * x116) - f_ext[2][1] + x179),
-                    s_q1 * (libm::fma(x89, x100, -f_ext[1][0]) + x188),
+                    libm::fma(5224.5702, x109, -f_ext[2][1]) + x160
+                        - libm::fma(-1145.5438279999998, x94, f_ext[1][1]),
+                    s_q1 * (x172 - libm::fma(-1145.5438279999998, x93, f_ext[1][0])),
                 ),
                 libm::fma(
                     -s_q1,
-                    x184
-                        - (f_ext[1][4]
-                            + libm::fma(
-                                -65693.9112265768,
-                                x94,
-                                libm::fma(x91, x100, x88 * x98),
-                            )),
+                    x170 - (f_ext[1][4] + libm::fma(x88, x96, -65693.9112265768 * x92)),
                     c_q1
-                        * (libm::fma(x92, x100, libm::fma(-x89, x98, qd[1] * x97))
-                            - f_ext[1][3]
+                        * (libm::fma(
+                            1145.5438279999998,
+                            x90,
+                            libm::fma(-x89, x96, qd[1] * x95),
+                        ) - f_ext[1][3]
                             + libm::fma(
                                 -0.5692,
-                                libm::fma(-s_q2, x186, c_q2 * x187),
-                                libm::fma(s_q2, x185, c_q2 * x183),
+                                libm::fma(-s_q2, x167, c_q2 * x168),
+                                libm::fma(s_q2, x171, c_q2 * x169),
                             )),
                 ),
             ) - f_ext[0][3]);
-        let x190 = 1.0
+        let x174 = 1.0
             / (66279.65991417361
                 + libm::fma(
                     0.7026,
@@ -2231,16 +2122,16 @@ impl SsrmsFma {
                         ),
                     ),
                 ));
-        let x191 = x69 * x190;
-        let x192 = x70 * x190;
-        let x193 = x72 * x190;
-        let x194 = x79 * x190;
-        let x195 = x82 * x190;
-        let x196 = x87 * x190;
-        let x197 = 1.0
+        let x175 = x69 * x174;
+        let x176 = x70 * x174;
+        let x177 = x72 * x174;
+        let x178 = x79 * x174;
+        let x179 = x82 * x174;
+        let x180 = x87 * x174;
+        let x181 = 1.0
             / libm::fma(
                 -x69,
-                x191,
+                x175,
                 65697.3302265768
                     + libm::fma(
                         -s_q2,
@@ -2248,221 +2139,216 @@ impl SsrmsFma {
                         c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
                     ),
             );
-        let x198 = libm::fma(
+        let x182 = libm::fma(
             -x69,
-            x192,
+            x176,
             libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
         );
-        let x199 = x197 * x198;
-        let x200 = libm::fma(
+        let x183 = x181 * x182;
+        let x184 = libm::fma(
             -x69,
-            x193,
+            x177,
             libm::fma(0.5692, x71, libm::fma(-s_q2, x48, x67)),
         );
-        let x201 = x197 * x200;
-        let x202 = libm::fma(
+        let x185 = x181 * x184;
+        let x186 = libm::fma(
             -x69,
-            x194,
+            x178,
             libm::fma(0.5692, x78, libm::fma(-s_q2, x75, c_q2 * x77)),
         );
-        let x203 = x197 * x202;
-        let x204 = libm::fma(-x69, x195, libm::fma(-s_q2, x80, c_q2 * x81));
-        let x205 = x197 * x204;
-        let x206 = libm::fma(x69, x196, libm::fma(c_q2, x86, s_q2 * x85));
-        let x207 = x197 * x206;
-        let x208 = 1.0 / libm::fma(-x198, x199, libm::fma(-x70, x192, x59));
-        let x209 = libm::fma(-x198, x201, libm::fma(-x70, x193, x49));
+        let x187 = x181 * x186;
+        let x188 = libm::fma(-x69, x179, libm::fma(-s_q2, x80, c_q2 * x81));
+        let x189 = x181 * x188;
+        let x190 = libm::fma(x69, x180, libm::fma(c_q2, x86, s_q2 * x85));
+        let x191 = x181 * x190;
+        let x192 = 1.0 / libm::fma(-x182, x183, libm::fma(-x70, x176, x59));
+        let x193 = libm::fma(-x182, x185, libm::fma(-x70, x177, x49));
+        let x194 = x192 * x193;
+        let x195 = libm::fma(-x182, x187, libm::fma(-x70, x178, x76));
+        let x196 = x192 * x195;
+        let x197 = libm::fma(x182, x189, x70 * x179);
+        let x198 = x192 * x197;
+        let x199 = libm::fma(x182, x191, libm::fma(-x70, x180, x8));
+        let x200 = x192 * x199;
+        let x201 = 1.0
+            / libm::fma(-x193, x194, libm::fma(-x184, x185, libm::fma(-x72, x177, x35)));
+        let x202 = libm::fma(
+            -x193,
+            x196,
+            libm::fma(-x184, x187, libm::fma(-x72, x178, x27)),
+        );
+        let x203 = x201 * x202;
+        let x204 = libm::fma(x193, x198, -libm::fma(x184, x189, x72 * x179));
+        let x205 = x201 * x204;
+        let x206 = libm::fma(
+            -x193,
+            x200,
+            libm::fma(x184, x191, libm::fma(-x72, x180, x8)),
+        );
+        let x207 = x201 * x206;
+        let x208 = 1.0
+            / libm::fma(
+                -x202,
+                x203,
+                libm::fma(
+                    -x195,
+                    x196,
+                    libm::fma(-x186, x187, libm::fma(-x79, x178, x13)),
+                ),
+            );
+        let x209 = libm::fma(
+            -x202,
+            x205,
+            libm::fma(x195, x198, -libm::fma(x186, x189, x79 * x179)),
+        );
         let x210 = x208 * x209;
-        let x211 = libm::fma(-x198, x203, libm::fma(-x70, x194, x76));
+        let x211 = libm::fma(
+            -x202,
+            x207,
+            libm::fma(-x195, x200, libm::fma(x186, x191, libm::fma(-x79, x180, x8))),
+        );
         let x212 = x208 * x211;
-        let x213 = libm::fma(x198, x205, x70 * x195);
-        let x214 = x208 * x213;
-        let x215 = libm::fma(x198, x207, libm::fma(-x70, x196, x8));
-        let x216 = x208 * x215;
-        let x217 = 1.0
-            / libm::fma(-x209, x210, libm::fma(-x200, x201, libm::fma(-x72, x193, x35)));
-        let x218 = libm::fma(
+        let x213 = 1.0
+            / libm::fma(
+                -x209,
+                x210,
+                libm::fma(
+                    -x204,
+                    x205,
+                    libm::fma(
+                        -x197,
+                        x198,
+                        libm::fma(-x188, x189, libm::fma(-x82, x179, 47.471)),
+                    ),
+                ),
+            );
+        let x214 = libm::fma(
             -x209,
             x212,
-            libm::fma(-x200, x203, libm::fma(-x72, x194, x27)),
+            libm::fma(
+                -x204,
+                x207,
+                libm::fma(x197, x200, libm::fma(-x82, x180, x188 * x191)),
+            ),
         );
-        let x219 = x217 * x218;
-        let x220 = libm::fma(x209, x214, -libm::fma(x200, x205, x72 * x195));
-        let x221 = x217 * x220;
-        let x222 = libm::fma(
-            -x209,
-            x216,
-            libm::fma(x200, x207, libm::fma(-x72, x196, x8)),
-        );
-        let x223 = x217 * x222;
-        let x224 = 1.0
+        let x215 = x213 * x214;
+        let x216 = 1.0
             / libm::fma(
-                -x218,
-                x219,
+                -x214,
+                x215,
                 libm::fma(
                     -x211,
                     x212,
-                    libm::fma(-x202, x203, libm::fma(-x79, x194, x13)),
-                ),
-            );
-        let x225 = libm::fma(
-            -x218,
-            x221,
-            libm::fma(x211, x214, -libm::fma(x202, x205, x79 * x195)),
-        );
-        let x226 = x224 * x225;
-        let x227 = libm::fma(
-            -x218,
-            x223,
-            libm::fma(-x211, x216, libm::fma(x202, x207, libm::fma(-x79, x196, x8))),
-        );
-        let x228 = x224 * x227;
-        let x229 = 1.0
-            / libm::fma(
-                -x225,
-                x226,
-                libm::fma(
-                    -x220,
-                    x221,
                     libm::fma(
-                        -x213,
-                        x214,
-                        libm::fma(-x204, x205, libm::fma(-x82, x195, 47.471)),
-                    ),
-                ),
-            );
-        let x230 = libm::fma(
-            -x225,
-            x228,
-            libm::fma(
-                -x220,
-                x223,
-                libm::fma(x213, x216, libm::fma(-x82, x196, x204 * x207)),
-            ),
-        );
-        let x231 = x229 * x230;
-        let x232 = 1.0
-            / libm::fma(
-                -x230,
-                x231,
-                libm::fma(
-                    -x227,
-                    x228,
-                    libm::fma(
-                        -x222,
-                        x223,
+                        -x206,
+                        x207,
                         libm::fma(
-                            -x215,
-                            x216,
-                            libm::fma(-x206, x207, libm::fma(-x87, x196, 9.336)),
+                            -x199,
+                            x200,
+                            libm::fma(-x190, x191, libm::fma(-x87, x180, 9.336)),
                         ),
                     ),
                 ),
             );
-        let x233 = libm::fma(
-            -x189,
-            x191,
+        let x217 = libm::fma(
+            -x173,
+            x175,
             tau[1]
-                - (libm::fma(0.5692, x188, libm::fma(-s_q2, x183, c_q2 * x185))
-                    - (f_ext[1][5]
-                        + libm::fma(
-                            1145.5438279999998,
-                            x95,
-                            libm::fma(x92, x99, x88 * x97),
-                        ))),
+                - (libm::fma(0.5692, x172, libm::fma(-s_q2, x169, c_q2 * x171))
+                    - libm::fma(x88, x95, f_ext[1][5])),
         );
-        let x234 = libm::fma(-x199, x233, libm::fma(-x189, x192, tau[2] - x184));
-        let x235 = libm::fma(
+        let x218 = libm::fma(-x183, x217, libm::fma(-x173, x176, tau[2] - x170));
+        let x219 = libm::fma(
+            -x194,
+            x218,
+            libm::fma(-x185, x217, libm::fma(-x173, x177, tau[3] - x163)),
+        );
+        let x220 = libm::fma(
+            -x203,
+            x219,
+            libm::fma(
+                -x196,
+                x218,
+                libm::fma(-x187, x217, libm::fma(-x173, x178, tau[4] - x156)),
+            ),
+        );
+        let x221 = libm::fma(
             -x210,
-            x234,
-            libm::fma(-x201, x233, libm::fma(-x189, x193, tau[3] - x176)),
-        );
-        let x236 = libm::fma(
-            -x219,
-            x235,
-            libm::fma(
-                -x212,
-                x234,
-                libm::fma(-x203, x233, libm::fma(-x189, x194, tau[4] - x169)),
-            ),
-        );
-        let x237 = libm::fma(
-            -x226,
-            x236,
-            libm::fma(
-                -x221,
-                x235,
-                libm::fma(
-                    x214,
-                    x234,
-                    libm::fma(-x205, x233, libm::fma(-x189, x195, tau[5] - x163)),
-                ),
-            ),
-        );
-        let x238 = x232
-            * libm::fma(
-                -x231,
-                x237,
-                libm::fma(
-                    -x228,
-                    x236,
-                    libm::fma(
-                        -x223,
-                        x235,
-                        libm::fma(
-                            -x216,
-                            x234,
-                            libm::fma(x207, x233, libm::fma(-x189, x196, tau[6] - x157)),
-                        ),
-                    ),
-                ),
-            );
-        let x239 = libm::fma(-x231, x238, x229 * x237);
-        let x240 = libm::fma(-x228, x238, libm::fma(-x226, x239, x224 * x236));
-        let x241 = libm::fma(
-            -x223,
-            x238,
-            libm::fma(-x221, x239, libm::fma(-x219, x240, x217 * x235)),
-        );
-        let x242 = libm::fma(
-            -x216,
-            x238,
-            libm::fma(
-                x214,
-                x239,
-                libm::fma(-x212, x240, libm::fma(-x210, x241, x208 * x234)),
-            ),
-        );
-        let x243 = libm::fma(
-            x207,
-            x238,
+            x220,
             libm::fma(
                 -x205,
-                x239,
+                x219,
                 libm::fma(
-                    -x203,
-                    x240,
-                    libm::fma(-x201, x241, libm::fma(-x199, x242, x197 * x233)),
+                    x198,
+                    x218,
+                    libm::fma(-x189, x217, libm::fma(-x173, x179, tau[5] - x150)),
                 ),
             ),
         );
-        let x244 = libm::fma(
-            -x196,
-            x238,
-            libm::fma(
-                -x195,
-                x239,
+        let x222 = x216
+            * libm::fma(
+                -x215,
+                x221,
                 libm::fma(
-                    -x194,
-                    x240,
+                    -x212,
+                    x220,
                     libm::fma(
-                        -x193,
-                        x241,
-                        libm::fma(-x192, x242, libm::fma(-x191, x243, x189 * x190)),
+                        -x207,
+                        x219,
+                        libm::fma(
+                            -x200,
+                            x218,
+                            libm::fma(x191, x217, libm::fma(-x173, x180, tau[6] - x141)),
+                        ),
+                    ),
+                ),
+            );
+        let x223 = libm::fma(-x215, x222, x213 * x221);
+        let x224 = libm::fma(-x212, x222, libm::fma(-x210, x223, x208 * x220));
+        let x225 = libm::fma(
+            -x207,
+            x222,
+            libm::fma(-x205, x223, libm::fma(-x203, x224, x201 * x219)),
+        );
+        let x226 = libm::fma(
+            -x200,
+            x222,
+            libm::fma(
+                x198,
+                x223,
+                libm::fma(-x196, x224, libm::fma(-x194, x225, x192 * x218)),
+            ),
+        );
+        let x227 = libm::fma(
+            x191,
+            x222,
+            libm::fma(
+                -x189,
+                x223,
+                libm::fma(
+                    -x187,
+                    x224,
+                    libm::fma(-x185, x225, libm::fma(-x183, x226, x181 * x217)),
+                ),
+            ),
+        );
+        let x228 = libm::fma(
+            -x180,
+            x222,
+            libm::fma(
+                -x179,
+                x223,
+                libm::fma(
+                    -x178,
+                    x224,
+                    libm::fma(
+                        -x177,
+                        x225,
+                        libm::fma(-x176, x226, libm::fma(-x175, x227, x173 * x174)),
                     ),
                 ),
             ),
         );
-        [x244, x243, x242, x241, x240, x239, x238]
+        [x228, x227, x226, x225, x224, x223, x222]
     }
 }

@@ -25,7 +25,7 @@ use crate::function::{Arg, Function, Input, PayloadField};
 use crate::spec::{Base, Spec, Subject, WrenchValue};
 use crate::sym::{Sym, Trace, Tracer};
 use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
-use kanegen_dynamics::algorithms::{floating, frames, recurrent, rnea};
+use kanegen_dynamics::algorithms::{floating, frames, newton_euler, recurrent, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::regroup::regrouped;
@@ -297,16 +297,13 @@ pub fn trace(
                         rnea::base_reaction(&p, &state, &q, &qd, &base_acc, joints, &loads(None))
                             .to_vec()
                     } else {
-                        let mut tau = rnea::floating_inverse_dynamics(
-                            &p,
-                            &base,
-                            &state,
-                            &q,
-                            &qd,
-                            &base_acc,
-                            joints,
-                            &loads(None),
-                        );
+                        let id = if methods.bias == BiasMethod::NewtonEuler {
+                            newton_euler::floating_inverse_dynamics
+                        } else {
+                            rnea::floating_inverse_dynamics
+                        };
+                        let mut tau =
+                            id(&p, &base, &state, &q, &qd, &base_acc, joints, &loads(None));
                         if let Some(d) = &damping {
                             for (t, d) in tau[6..].iter_mut().zip(d) {
                                 *t = *t + *d;

@@ -65,7 +65,7 @@ use crate::algorithms::kinematics::{
     self, floating_base_frame, floating_motion, BodyKinematics, BodyMotion,
 };
 use crate::algorithms::methods::{BiasMethod, Dynamics, MassMatrixMethod, Methods};
-use crate::algorithms::{crba, kane_direct, recurrent, rnea};
+use crate::algorithms::{crba, kane_direct, newton_euler, recurrent, rnea};
 use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
 use crate::linalg::Vec3;
 use crate::loads::{ExternalWrench, Loads};
@@ -147,8 +147,12 @@ pub fn bias<S: Scalar>(
 ) -> Vec<S> {
     let n = p.dof();
     assert_eq!(qd.len(), n, "qd has the wrong length");
-    if method == BiasMethod::Rnea {
-        return rnea::floating_bias(p, base, state, q, qd, loads);
+    match method {
+        BiasMethod::Rnea => return rnea::floating_bias(p, base, state, q, qd, loads),
+        BiasMethod::NewtonEuler => {
+            return newton_euler::floating_bias(p, base, state, q, qd, loads)
+        }
+        BiasMethod::Recurrent | BiasMethod::KaneDirect => {}
     }
     p.assert_chain(method.name());
     let kin = floating_base_frame(p, base, state, q);
@@ -159,7 +163,7 @@ pub fn bias<S: Scalar>(
     match method {
         BiasMethod::Recurrent => recurrent::bias_base(&kin, &f_ie, tau),
         BiasMethod::KaneDirect => kane_direct::bias_base(&kin, &f_ie, tau),
-        BiasMethod::Rnea => unreachable!("handled above"),
+        BiasMethod::Rnea | BiasMethod::NewtonEuler => unreachable!("handled above"),
     }
 }
 

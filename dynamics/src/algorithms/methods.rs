@@ -14,10 +14,11 @@
 //! | `recurrent` | `recurrent.rs` | the paper's backward recursion (17)–(19), (21) |
 //! | `kane-direct` | `kane_direct.rs` | the direct Kane sum (10) |
 //! | `rnea` | `rnea.rs` | Featherstone's recursive Newton–Euler algorithm in local frames |
+//! | `newton-euler` | `newton_euler.rs` | the classical Newton–Euler algorithm in local frames (3-vectors) |
 //!
 //! The CLI's `--algorithm` names are presets of both ([`Methods::PRESETS`]).
 //!
-//! **Trees.** Only the local-frame methods (`crba`, `rnea`, i.e. [`Methods::SPATIAL`]) take a
+//! **Trees.** Only the local-frame methods (`crba`, `rnea`, `newton-euler`) take a
 //! kinematic tree; the paper's base-frame methods are serial-chain only
 //! ([`MassMatrixMethod::supports_trees`], [`BiasMethod::supports_trees`]). [`Methods::check`]
 //! tells a caller before it runs them; the methods themselves panic with the same message.
@@ -33,7 +34,7 @@
 //! ```
 
 use crate::algorithms::kinematics::{self, BodyKinematics};
-use crate::algorithms::{crba, crba_base, kane_direct, recurrent, rnea};
+use crate::algorithms::{crba, crba_base, kane_direct, newton_euler, recurrent, rnea};
 use crate::loads::Loads;
 pub use crate::params::MethodError;
 use crate::params::Params;
@@ -157,14 +158,18 @@ pub enum BiasMethod {
     KaneDirect,
     /// Featherstone's recursive Newton–Euler algorithm in local frames (RBDA Table 5.1).
     Rnea,
+    /// The classical Newton–Euler algorithm in local frames with 3-vectors (Luh–Walker–Paul, in
+    /// Khalil's customized form): no linear velocities.
+    NewtonEuler,
 }
 
 impl BiasMethod {
     /// All methods, in report order.
-    pub const ALL: [BiasMethod; 3] = [
+    pub const ALL: [BiasMethod; 4] = [
         BiasMethod::Recurrent,
         BiasMethod::KaneDirect,
         BiasMethod::Rnea,
+        BiasMethod::NewtonEuler,
     ];
 
     /// Its name in reports and generated headers.
@@ -174,6 +179,7 @@ impl BiasMethod {
             BiasMethod::Recurrent => "recurrent",
             BiasMethod::KaneDirect => "kane-direct",
             BiasMethod::Rnea => "rnea",
+            BiasMethod::NewtonEuler => "newton-euler",
         }
     }
 
@@ -183,11 +189,11 @@ impl BiasMethod {
         Self::ALL.into_iter().find(|m| m.name() == name)
     }
 
-    /// Whether the method takes a kinematic tree: only the local-frame [`BiasMethod::Rnea`]; the
-    /// paper's base-frame methods are serial-chain only.
+    /// Whether the method takes a kinematic tree: the local-frame [`BiasMethod::Rnea`] and
+    /// [`BiasMethod::NewtonEuler`]; the paper's base-frame methods are serial-chain only.
     #[must_use]
     pub fn supports_trees(self) -> bool {
-        self == BiasMethod::Rnea
+        matches!(self, BiasMethod::Rnea | BiasMethod::NewtonEuler)
     }
 
     /// `Ok` when the method can run on `p` ([`MassMatrixMethod::check`]).
@@ -211,6 +217,7 @@ impl BiasMethod {
             BiasMethod::Recurrent => recurrent::bias(p, q, qd, loads),
             BiasMethod::KaneDirect => kane_direct::bias(p, q, qd, loads),
             BiasMethod::Rnea => rnea::bias(p, q, qd, loads),
+            BiasMethod::NewtonEuler => newton_euler::bias(p, q, qd, loads),
         }
     }
 }
@@ -330,8 +337,8 @@ impl Methods {
     }
 
     /// Inverse dynamics: the joint drives `τ` for which `A q̈ = b(q, q̇, τ)` holds (`loads.tau` is
-    /// ignored). With the RNEA bias method, one O(N) pass ([`rnea::inverse_dynamics`]);
-    /// otherwise `τ = A q̈ − b(q, q̇, τ = 0)` from this pair's own `A` and `b`.
+    /// ignored). With a local-frame bias method, one O(N) pass ([`rnea::inverse_dynamics`],
+    /// [`newton_euler::inverse_dynamics`]); otherwise `τ = A q̈ − b(q, q̇, τ = 0)` from this pair's own `A` and `b`.
     pub fn inverse_dynamics<S: Scalar>(
         self,
         p: &Params<S>,
@@ -341,8 +348,12 @@ impl Methods {
         loads: &Loads<S>,
     ) -> Vec<S> {
         let passive = loads.passive();
-        if self.bias == BiasMethod::Rnea {
-            return rnea::inverse_dynamics(p, q, qd, qdd, &passive);
+        match self.bias {
+            BiasMethod::Rnea => return rnea::inverse_dynamics(p, q, qd, qdd, &passive),
+            BiasMethod::NewtonEuler => {
+                return newton_euler::inverse_dynamics(p, q, qd, qdd, &passive)
+            }
+            BiasMethod::Recurrent | BiasMethod::KaneDirect => {}
         }
         let d = self.dynamics(p, q, qd, &passive);
         d.a.iter()

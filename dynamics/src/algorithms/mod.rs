@@ -13,12 +13,13 @@
 //! | [`crba_base`] | composite rigid bodies in base-frame notation |
 //! | [`crba`] | Featherstone's local-frame CRBA (fixed and floating base) |
 //! | [`rnea`] | Featherstone's local-frame RNEA: bias forces and O(N) inverse dynamics (fixed and floating base) |
+//! | [`newton_euler`] | the classical local-frame Newton–Euler with 3-vectors (Luh–Walker–Paul, Khalil): the same, no linear velocities |
 //! | [`frames`] | placements and Jacobians of frames on bodies, the generalized Jacobian |
 //! | [`momentum`] | total momentum and kinetic energy of a free-floating system |
 //! | [`floating`] | a free-floating base: the dispatch, and the base-frame algorithms on six virtual joints |
 //! | [`methods`] | the choice of mass-matrix and bias method, and the fixed-base dispatch |
 //!
-//! **Trees.** `crba`, `rnea`, `frames` and `momentum` take any kinematic tree
+//! **Trees.** `crba`, `rnea`, `newton_euler`, `frames` and `momentum` take any kinematic tree
 //! (`λ(i)` = [`crate::JointParams::parent`]); the paper's base-frame algorithms (`kinematics`,
 //! `recurrent`, `kane_direct`, `crba_base`, and the virtual-joint extension of `floating`) are
 //! serial-chain only and panic on a tree ([`crate::Params::assert_chain`];
@@ -36,5 +37,6 @@ pub mod kane_direct;
 pub mod kinematics;
 pub mod methods;
 pub mod momentum;
+pub mod newton_euler;
 pub mod recurrent;
 pub mod rnea;
