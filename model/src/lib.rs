@@ -9,6 +9,7 @@
 //! - [`io`]: URDF and kanegen's TOML format in, TOML out.
 //! - [`Inertial::merge`]: the one parallel-axis merge (fixed links, locked joints, payloads).
 //! - [`random`]: seeded random chains and states for tests, benchmarks and traces.
+//! - [`bounds`]: the magnitude bounds every reader checks, so products stay finite.
 //!
 //! ```
 //! let model = kanegen_model::io::parse_toml(r#"
@@ -26,6 +27,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod bounds;
 pub mod inertial;
 pub mod io;
 mod lock;
