@@ -7,6 +7,7 @@ use crate::options::{Error, Float, Options};
 use kanegen_trace::{Input, Node, PayloadField, Sym, Traced};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 
 /// Operator precedence of an emitted expression (higher binds tighter).
@@ -210,7 +211,10 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
         _ => None,
     };
     let is_const = |s: Sym| matches!(nodes.get(&s.id()), Some(Node::Const(_)));
-    let mut exprs: HashMap<u32, Expr> = HashMap::new();
+    // An inlined node's expression is taken out when its one user reads it (without fused
+    // multiply-adds, whose users also read their operands' operands): memory stays linear in the
+    // emitted code, and a long single-use chain is moved into its user, not copied.
+    let exprs: RefCell<HashMap<u32, Expr>> = RefCell::new(HashMap::new());
     let mut stmts: Vec<TokenStream> = Vec::new();
     let mut counter = 0usize;
     let mut fmas = 0u64;
@@ -227,7 +231,16 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
     };
     for (id, node) in &sched {
         let id = *id;
-        let get = |s: Sym| exprs[&s.id()].clone();
+        let get = |s: Sym| {
+            if fma.is_none() && inlined(s) {
+                exprs
+                    .borrow_mut()
+                    .remove(&s.id())
+                    .expect("an operand is emitted before its user")
+            } else {
+                exprs.borrow()[&s.id()].clone()
+            }
+        };
         // `−s` as a call argument: constants negated, an inlined negation unwrapped.
         let neg = |s: Sym| -> TokenStream {
             match nodes.get(&s.id()) {
@@ -247,15 +260,17 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
         };
         let expr = match node {
             Node::Const(x) => {
-                exprs.insert(id, constant(*x, float));
+                exprs.borrow_mut().insert(id, constant(*x, float));
                 continue;
             }
             Node::Input(i) => {
-                exprs.insert(id, Expr::atom(inputs[*i as usize].clone()));
+                exprs
+                    .borrow_mut()
+                    .insert(id, Expr::atom(inputs[*i as usize].clone()));
                 continue;
             }
             Node::Sin(a) | Node::Cos(a) => {
-                if exprs.contains_key(&id) {
+                if exprs.borrow().contains_key(&id) {
                     continue; // bound together with its partner by one sincos
                 }
                 let arg = get(*a).tokens;
@@ -266,20 +281,20 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
                         let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
                         let f = float.libm_fn("sincos");
                         stmts.push(quote!(let (#sn, #cn) = #libm::#f(#arg);));
-                        exprs.insert(s, Expr::atom(quote!(#sn)));
-                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                        exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
+                        exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (Some(s), None) => {
                         let sn = format_ident!("s_{}", base);
                         let f = float.libm_fn("sin");
                         stmts.push(quote!(let #sn = #libm::#f(#arg);));
-                        exprs.insert(s, Expr::atom(quote!(#sn)));
+                        exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
                     }
                     (None, Some(c)) => {
                         let cn = format_ident!("c_{}", base);
                         let f = float.libm_fn("cos");
                         stmts.push(quote!(let #cn = #libm::#f(#arg);));
-                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                        exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (None, None) => unreachable!("trig node without entry"),
                 }
@@ -362,15 +377,15 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
             counter += 1;
             let e = expr.tokens;
             stmts.push(quote!(let #name = #e;));
-            exprs.insert(id, Expr::atom(quote!(#name)));
+            exprs.borrow_mut().insert(id, Expr::atom(quote!(#name)));
         } else {
-            exprs.insert(id, expr);
+            exprs.borrow_mut().insert(id, expr);
         }
     }
     let out: Vec<TokenStream> = trace
         .outputs()
         .iter()
-        .map(|s| exprs[&s.id()].at(P_NEG))
+        .map(|s| exprs.borrow()[&s.id()].at(P_NEG))
         .collect();
     // Upper triangle, row-major: index of (i, j), i ≤ j.
     let sym_matrix = |out: &[TokenStream], n: usize| {
