@@ -32,6 +32,32 @@ pub fn generate(model: &Model, opts: &Options) -> Result<String, kanegen_codegen
     generate_file(model, opts)
 }
 
+/// [`generate`], refusing code that holds a non-finite constant (`f64::NAN`, `f64::INFINITY`):
+/// a model quantity folded into the code overflowed.
+///
+/// # Errors
+/// As [`generate`], or a non-finite constant.
+pub fn generate_checked(model: &Model, opts: &Options) -> anyhow::Result<String> {
+    let code = generate(model, opts)?;
+    for ty in ["f64", "f32"] {
+        for c in ["NAN", "INFINITY", "NEG_INFINITY"] {
+            let token = format!("{ty}::{c}");
+            if let Some(line) = code.lines().position(|l| {
+                !l.trim_start().starts_with("//")
+                    && l.split(|ch: char| !(ch.is_alphanumeric() || ch == '_' || ch == ':'))
+                        .any(|w| w == token)
+            }) {
+                anyhow::bail!(
+                    "the generated code holds the non-finite constant `{token}` (line {}): a \
+                     model quantity folded into the code overflowed",
+                    line + 1
+                );
+            }
+        }
+    }
+    Ok(code)
+}
+
 /// One file of the `kanegen-generated` crate.
 #[derive(Clone, Copy, Debug)]
 pub struct GeneratedFile {
