@@ -108,8 +108,9 @@ impl Bound {
     }
 }
 
-/// A direction normalized to unit length without overflow or underflow: divided by its largest
-/// component first, so `[1e200, 0, 0]` gives `[1, 0, 0]`. `None` for a zero (or non-finite)
+/// A direction normalized to unit length without overflow or underflow: outside `1e-100 ≤
+/// max |vᵢ| ≤ 1e100` divided by its largest component first, so `[1e200, 0, 0]` gives
+/// `[1, 0, 0]` (its square would overflow). `None` for a zero (or non-finite)
 /// vector, or one shorter than `min_norm`.
 #[must_use]
 pub fn normalize(v: &[f64; 3], min_norm: f64) -> Option<[f64; 3]> {
@@ -120,9 +121,20 @@ pub fn normalize(v: &[f64; 3], min_norm: f64) -> Option<[f64; 3]> {
     if m == 0.0 {
         return None;
     }
-    let s = v.map(|x| x / m);
+    // In the ordinary range the plain formula (bit-identical to earlier releases: a unit axis
+    // stays the same bits); outside it, scaled by the largest component first.
+    let s = if (1e-100..=1e100).contains(&m) {
+        *v
+    } else {
+        v.map(|x| x / m)
+    };
     let n = (s[0] * s[0] + s[1] * s[1] + s[2] * s[2]).sqrt();
-    if m * n < min_norm {
+    let norm = if (1e-100..=1e100).contains(&m) {
+        n
+    } else {
+        m * n
+    };
+    if norm < min_norm {
         return None;
     }
     Some(s.map(|x| x / n))
