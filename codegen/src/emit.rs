@@ -175,6 +175,27 @@ pub fn input_tokens(input: &Input) -> TokenStream {
 
 /// The statements and result expression of one traced function, returned as `shape`.
 pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
+    let mut stmts: Vec<TokenStream> = Vec::new();
+    let Body {
+        tokens: result,
+        fmas,
+    } = emit_body_streamed(t, emitter, shape, &mut |s| stmts.push(s));
+    Body {
+        tokens: quote!(#(#stmts)* #result),
+        fmas,
+    }
+}
+
+/// [`emit_body`], handing each `let` statement to `stmt` as soon as it is emitted instead of
+/// keeping it: the returned body holds the result expression only. A caller that turns each
+/// statement into text at once keeps the memory of one statement, not of the whole body (33 MB
+/// of text for `forward_dynamics` at N = 200).
+pub fn emit_body_streamed(
+    t: &Traced,
+    emitter: &Emitter,
+    shape: Shape,
+    stmt: &mut dyn FnMut(TokenStream),
+) -> Body {
     let inputs: Vec<TokenStream> = t.inputs.iter().map(input_tokens).collect();
     let Emitter { libm, float, fma } = emitter;
     let float = *float;
@@ -215,7 +236,6 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
     // multiply-adds, whose users also read their operands' operands): memory stays linear in the
     // emitted code, and a long single-use chain is moved into its user, not copied.
     let exprs: RefCell<HashMap<u32, Expr>> = RefCell::new(HashMap::new());
-    let mut stmts: Vec<TokenStream> = Vec::new();
     let mut counter = 0usize;
     let mut fmas = 0u64;
     // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
@@ -280,20 +300,20 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
                     (Some(s), Some(c)) => {
                         let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
                         let f = float.libm_fn("sincos");
-                        stmts.push(quote!(let (#sn, #cn) = #libm::#f(#arg);));
+                        stmt(quote!(let (#sn, #cn) = #libm::#f(#arg);));
                         exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
                         exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (Some(s), None) => {
                         let sn = format_ident!("s_{}", base);
                         let f = float.libm_fn("sin");
-                        stmts.push(quote!(let #sn = #libm::#f(#arg);));
+                        stmt(quote!(let #sn = #libm::#f(#arg);));
                         exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
                     }
                     (None, Some(c)) => {
                         let cn = format_ident!("c_{}", base);
                         let f = float.libm_fn("cos");
-                        stmts.push(quote!(let #cn = #libm::#f(#arg);));
+                        stmt(quote!(let #cn = #libm::#f(#arg);));
                         exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (None, None) => unreachable!("trig node without entry"),
@@ -376,7 +396,7 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
             let name = format_ident!("x{}", counter);
             counter += 1;
             let e = expr.tokens;
-            stmts.push(quote!(let #name = #e;));
+            stmt(quote!(let #name = #e;));
             exprs.borrow_mut().insert(id, Expr::atom(quote!(#name)));
         } else {
             exprs.borrow_mut().insert(id, expr);
@@ -416,7 +436,7 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
         }
     };
     Body {
-        tokens: quote!(#(#stmts)* #result),
+        tokens: result,
         fmas,
     }
 }
