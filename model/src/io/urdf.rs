@@ -9,8 +9,8 @@
 //! `<material>` are ignored. A link without `<inertial>` is massless, which is fine when it is
 //! merged through a fixed joint into a body with mass; a moving body that ends up massless is
 //! rejected by [`Model::new`] (mass must be > 0). Every link with mass has its own inertial
-//! validated (bounds, positive definite, triangle inequality) before it is merged, naming the
-//! link.
+//! validated (bounds, positive definite, triangle inequality; a zero inertia is a point mass and
+//! accepted) before it is merged, naming the link.
 
 use crate::bounds::{INERTIA, LENGTH, MASS};
 use crate::placement::{Placement, M3};
@@ -476,12 +476,16 @@ fn add_link(
         com: [0.0; 3],
         inertia,
     };
-    crate::inertial::validate_inertial_with(
-        owner,
-        &format!("inertial (link `{}`, URDF line {})", link.name, link.line),
-        &part,
-        validation,
-    )?;
+    // A point mass (zero inertia, e.g. a sensor frame) is physical; any other inertia must be a
+    // valid rigid-body inertia on its own, whatever it is merged into.
+    if inertia.iter().flatten().any(|x| *x != 0.0) {
+        crate::inertial::validate_inertial_with(
+            owner,
+            &format!("inertial (link `{}`, URDF line {})", link.name, link.line),
+            &part,
+            validation,
+        )?;
+    }
     let frame = offset.then(&Placement::from_xyz_rpy(inl.xyz, inl.rpy));
     *acc = Inertial::merge_opt(acc.take(), Some(part.moved(&frame)));
     Ok(())
