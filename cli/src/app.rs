@@ -334,7 +334,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                 .as_deref()
                 .map(|d| OutputDir::plan(d, &commands::table1::FILES, force, &[]))
                 .transpose()?;
-            let progress = Progress::spinner(interactive, "table1: tracing every algorithm");
+            let progress = Progress::spinner(interactive.0, "table1: tracing every algorithm");
             let t = kanegen_trace::table1::build(&kanegen_trace::table1::trace_all());
             progress.finish();
             if let Some(d) = &planned {
@@ -368,7 +368,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                     None => vec![Methods::SPATIAL],
                 };
                 let progress = Progress::spinner(
-                    interactive,
+                    interactive.0,
                     &format!(
                         "count: tracing the scene's A and b (N = {})",
                         scene.model.dof()
@@ -396,7 +396,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             };
             let g = gravity_arg(gravity)?;
             let explicit = algorithm.is_some();
-            let progress = Progress::bar(interactive, "count: tracing");
+            let progress = Progress::bar(interactive.0, "count: tracing");
             let r = commands::count::count_with_progress(&chain, &algs, g, explicit, &|k, n| {
                 progress.set(k, n);
             })?;
@@ -444,7 +444,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             opts.float = scalar;
             opts.fma = fma;
             let progress = Progress::spinner(
-                interactive,
+                interactive.0,
                 &format!(
                     "generate: tracing and emitting every function of `{}` (N = {})",
                     chain.name(),
@@ -494,7 +494,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
                 })
                 .transpose()?;
             let opts = crate::reports::accuracy::Options { timing: true };
-            let progress = Progress::bar(interactive, "accuracy");
+            let progress = Progress::bar(interactive.0, "accuracy");
             let reports = commands::accuracy::run_with_progress(
                 &inputs,
                 allow_nonphysical,

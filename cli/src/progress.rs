@@ -4,15 +4,16 @@
 use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::time::Duration;
 
-/// A progress bar or spinner that appears after one second (see the module doc).
+/// A progress bar or spinner that appears after one second (see the module doc); with
+/// `interactive` false (tests, in-process runs) it is never drawn.
 pub struct Progress {
     pb: ProgressBar,
 }
 
 impl Progress {
-    fn new(interactive: crate::app::Interactive, pb: ProgressBar) -> Self {
+    fn new(interactive: bool, pb: ProgressBar) -> Self {
         pb.set_draw_target(ProgressDrawTarget::hidden());
-        if interactive.0 {
+        if interactive {
             let late = pb.clone();
             std::thread::spawn(move || {
                 std::thread::sleep(Duration::from_secs(1));
@@ -27,7 +28,7 @@ impl Progress {
 
     /// A spinner with elapsed time, for work whose length is not known in advance.
     #[must_use]
-    pub fn spinner(interactive: crate::app::Interactive, message: &str) -> Self {
+    pub fn spinner(interactive: bool, message: &str) -> Self {
         let pb = ProgressBar::new_spinner();
         if let Ok(style) = ProgressStyle::with_template("{spinner} {msg} ({elapsed})") {
             pb.set_style(style);
@@ -38,7 +39,7 @@ impl Progress {
 
     /// A bar of steps (set with [`Progress::set`]).
     #[must_use]
-    pub fn bar(interactive: crate::app::Interactive, message: &str) -> Self {
+    pub fn bar(interactive: bool, message: &str) -> Self {
         let pb = ProgressBar::new(1);
         if let Ok(style) =
             ProgressStyle::with_template("{msg} [{bar:30}] {pos}/{len} ({elapsed}, eta {eta})")

@@ -486,7 +486,8 @@ impl Decimated {
 
 impl Sink for Decimated {
     fn sample(&mut self, s: &Sample) -> Result<()> {
-        if self.seen % self.stride == 0 {
+        // `stride` is a power of two.
+        if self.seen & (self.stride - 1) == 0 {
             if self.kept.len() == self.cap {
                 let mut i = 0;
                 self.kept.retain(|_| {
@@ -495,7 +496,7 @@ impl Sink for Decimated {
                 });
                 self.stride *= 2;
             }
-            if self.seen % self.stride == 0 {
+            if self.seen & (self.stride - 1) == 0 {
                 self.kept.push(s.clone());
             }
         }
@@ -617,7 +618,6 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     if result.is_err() && last_t.get() != t_end {
         let _ = record(t_end, &x);
     }
-    drop(record);
     if let Some(e) = sink_error {
         return Err(e);
     }
