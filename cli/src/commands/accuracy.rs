@@ -93,6 +93,8 @@ pub fn file_names(inputs: &[PathBuf]) -> Vec<String> {
 fn sci(x: f64) -> String {
     if x.is_nan() {
         "—".into()
+    } else if x.is_infinite() {
+        "overflow".into()
     } else if x == 0.0 {
         "0 (rounds to the reference)".into()
     } else {
