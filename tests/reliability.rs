@@ -388,3 +388,64 @@ fn generate_at_n_200_stays_under_1_gb() {
     assert!(code.contains("pub fn forward_dynamics(") && code.contains("[f64; 200]"));
     std::fs::remove_dir_all(&d).ok();
 }
+
+/// Errors blame the right thing: the scene key and the bound or limit, the lock, the state.
+#[test]
+fn messages_name_what_is_wrong() {
+    use kanegen::sim::scene::{Scene, SceneOptions};
+    let scene = |sim: &str| format!("model = \"models/two_link.toml\"\n[simulation]\n{sim}\n");
+    let err = |text: &str| match Scene::parse(text, root()) {
+        Ok(_) => panic!("accepted:\n{text}"),
+        Err(e) => format!("{e:#}"),
+    };
+    let e = err(&scene(
+        "duration = 1.0\nintegrator = \"dopri5\"\ntolerance = 1e-300",
+    ));
+    assert!(
+        e.contains("simulation.tolerance") && e.contains("1e-14") && e.contains("round"),
+        "{e}"
+    );
+    let e = err(&scene("duration = 1.0\nstep = 1e-300"));
+    assert!(
+        e.contains("simulation.step") && e.contains("allow_long"),
+        "{e}"
+    );
+    let e = err(&scene("duration = 1e300"));
+    assert!(e.contains("exceeds the limit 1e8"), "{e}");
+    // Allowed when asked for (not run here).
+    let long = scene("duration = 1e7\nstep = 0.01");
+    assert!(Scene::parse(&long, root()).is_err());
+    assert!(Scene::parse_with(&long, root(), SceneOptions { allow_long: true }).is_ok());
+    let e = err("model = \"models/two_link.toml\"\n[effects]\ngravity = [0.0, 0.0, 1e308]\n[simulation]\nduration = 1.0\n");
+    assert!(
+        e.contains("effects.gravity") && e.contains("1e3 m/s²"),
+        "{e}"
+    );
+    let e = err("model = \"models/two_link.toml\"\n[initial]\nqd = [1e160, 0.0]\n[simulation]\nduration = 1.0\n");
+    assert!(e.contains("initial.qd") && e.contains("1e6"), "{e}");
+
+    let mut out = Vec::new();
+    let e = kanegen::cli::app::run_args(
+        [
+            "kanegen",
+            "generate",
+            "models/two_link.toml",
+            "--lock",
+            "0=nan",
+        ]
+        .map(|a| {
+            if a.starts_with("models/") {
+                root().join(a).display().to_string()
+            } else {
+                a.to_string()
+            }
+        }),
+        &mut out,
+    )
+    .unwrap_err();
+    let e = format!("{e:#}");
+    assert!(
+        e.contains("--lock `0=nan`") && e.contains("lock value") && !e.contains("origin"),
+        "{e}"
+    );
+}
