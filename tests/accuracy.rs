@@ -41,7 +41,7 @@ fn docs_accuracy_md_renders_docs_accuracy_json() {
     assert!(
         md == render_markdown(&reports, true).unwrap(),
         "docs/accuracy.md is not the rendering of docs/accuracy.json: run \
-         `cargo run --release -- accuracy --out docs`"
+         `cargo run --release -- accuracy --out docs --force`"
     );
     for r in &reports {
         if !r.integration.is_empty() {
@@ -56,7 +56,8 @@ fn docs_accuracy_md_renders_docs_accuracy_json() {
 #[test]
 fn docs_accuracy_json_is_fresh() {
     let (old, new) = (committed(), fresh());
-    let stale = "docs/accuracy.json is stale: run `cargo run --release -- accuracy --out docs`";
+    let stale =
+        "docs/accuracy.json is stale: run `cargo run --release -- accuracy --out docs --force`";
     assert_eq!(old.len(), new.len(), "{stale}");
     for (o, n) in old.iter().zip(&new) {
         assert_eq!(
@@ -217,6 +218,88 @@ fn the_rows_say_what_they_should() {
                 "{}: {} changes nothing",
                 r.subject,
                 e.effect
+            );
+        }
+    }
+}
+
+/// Max-norm of `a − b`, relative to `max(1, |b|∞)`.
+fn rel_diff(a: &[f64], b: &[f64]) -> f64 {
+    let scale = b.iter().fold(1.0_f64, |m, v| m.max(v.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
+        / scale
+}
+
+/// The fixed-step integrators' orders on a fresh run (not the committed JSON): the SRMS scene
+/// (PD drives, damping) over 2 s, RK4 at h = 0.04, 0.02, 0.01 and the implicit midpoint rule at
+/// h = 0.02, 0.01, 0.005, each final state against a reference whose own error is measured —
+/// dopri5 at its tightest tolerance (1e-14) against an independent Richardson-extrapolated RK4
+/// (h = 2.5e-3 and 1.25e-3, `x(h/2) + (x(h/2) − x(h))/15`): every error must be 1000× the
+/// reference's, and halving the step must divide it by 2^p (RK4 p = 4, midpoint p = 2) within
+/// ±0.3 in p.
+#[test]
+fn fixed_step_orders_on_a_fresh_run_against_a_measured_reference() {
+    use kanegen::sim::integrate::{dopri5, midpoint, rk4, Dopri5Options};
+    use kanegen::sim::scene::Scene;
+    use kanegen::sim::simulate::SceneSystem;
+    let mut scene = Scene::load(&root().join("scenes/srms.toml")).unwrap();
+    let t1 = 2.0;
+    scene.simulation.duration = t1;
+    let run = |method: &str, h: f64| -> Vec<f64> {
+        let mut sys = SceneSystem::new(&scene);
+        let mut x = sys.initial_state();
+        match method {
+            "rk4" => {
+                rk4(&mut sys, 0.0, t1, h, &mut x, |_, _, _| {}).unwrap();
+            }
+            "midpoint" => {
+                midpoint(&mut sys, 0.0, t1, h, &mut x, |_, _, _| {}).unwrap();
+            }
+            _ => {
+                let opts = Dopri5Options {
+                    tolerance: h,
+                    max_step: 0.05,
+                    initial_step: 1e-3,
+                    output_interval: t1,
+                };
+                dopri5(&mut sys, 0.0, t1, &opts, &mut x, |_, _| {}).unwrap();
+            }
+        }
+        x
+    };
+    let reference = run("dopri5", kanegen::sim::scene::MIN_TOLERANCE);
+    let (coarse, fine) = (run("rk4", 2.5e-3), run("rk4", 1.25e-3));
+    let richardson: Vec<f64> = coarse
+        .iter()
+        .zip(&fine)
+        .map(|(c, f)| f + (f - c) / 15.0)
+        .collect();
+    let ref_error = rel_diff(&reference, &richardson);
+    println!("reference (dopri5 1e-14) against Richardson RK4: {ref_error:.2e}");
+    assert!(ref_error < 1e-11, "reference error {ref_error:.2e}");
+    for (method, p, steps) in [
+        ("rk4", 4.0, [0.04, 0.02, 0.01]),
+        ("midpoint", 2.0, [0.02, 0.01, 0.005]),
+    ] {
+        let errs: Vec<f64> = steps
+            .iter()
+            .map(|&h| rel_diff(&run(method, h), &reference))
+            .collect();
+        for (h, e) in steps.iter().zip(&errs) {
+            println!("{method} h = {h}: error {e:.3e}");
+            assert!(
+                *e > 1e3 * ref_error,
+                "{method} h = {h}: {e:.2e} at the reference's floor"
+            );
+        }
+        for w in errs.windows(2) {
+            let order = (w[0] / w[1]).log2();
+            println!("{method}: observed order {order:.3}");
+            assert!(
+                (order - p).abs() < 0.3,
+                "{method}: order {order:.3}, expected {p}"
             );
         }
     }

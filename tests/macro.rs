@@ -19,6 +19,18 @@ kanegen::dynamics!(
     runtime_payload = true,
 );
 
+// Joint and frame names with U+202E, U+2066/7 and BEL: the expansion compiles (rustc denies
+// bidirectional code points in literals and comments), the names kept, escaped.
+kanegen::dynamics!(Bidi, "tests/data/reliability/bidi_names.toml");
+
+#[test]
+fn bidirectional_names_compile_and_are_kept() {
+    assert_eq!(Bidi::JOINTS[0], "shoulder\u{202E}\u{2066}evil\u{7}");
+    assert_eq!(Bidi::FRAMES[0], "tool\u{202E}\u{2067}");
+    let m = Bidi::mass_matrix(&[0.1, 0.2]);
+    assert!(m[0][0] > 0.0 && m[1][1] > 0.0);
+}
+
 const G: [f64; 3] = [0.3, -1.2, -9.81];
 
 fn load(rel: &str) -> Model {

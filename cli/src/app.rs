@@ -1,19 +1,28 @@
 //! The `kanegen` command line: arguments and dispatch to [`crate::commands`].
 
 use crate::commands;
+use crate::output::{print, OutputDir, OutputFile};
+use crate::progress::Progress;
 use anyhow::{Context, Result};
 use clap::{Parser, Subcommand};
 use kanegen_dynamics::Methods;
 use kanegen_model::{BaseKind, Model};
-use std::path::PathBuf;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
 
 #[derive(Parser)]
 #[command(
     name = "kanegen",
     version,
-    about = "Equations of motion of space manipulators: evaluate, count, reproduce the paper's Table 1"
+    about = "Equations of motion of space manipulators: evaluate, count, reproduce the paper's Table 1",
+    long_about = None
 )]
-struct Cli {
+/// The command line: a command and the global `--verbose` flag.
+pub struct Cli {
+    /// On an error, print the whole chain with a backtrace (also `KANEGEN_BACKTRACE=1`).
+    #[arg(short, long, global = true)]
+    pub verbose: bool,
     #[command(subcommand)]
     command: Command,
 }
@@ -50,6 +59,7 @@ fn parse_scalar(s: &str) -> Result<kanegen_codegen::Float, String> {
     kanegen_codegen::Float::from_name(s).ok_or_else(|| format!("unknown scalar `{s}`: f64 or f32"))
 }
 
+/// The commands.
 #[derive(Subcommand)]
 enum Command {
     /// Evaluate A(q) and b(q, q̇) at the states of a JSON file.
@@ -90,6 +100,9 @@ enum Command {
         /// Write table1.md, table1.json and fig2.svg into this directory.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace existing files in --out.
+        #[arg(long)]
+        force: bool,
     },
     /// Operation counts of A and b for a model, per algorithm and convention.
     Count {
@@ -115,9 +128,12 @@ enum Command {
     Generate {
         /// Model file (.urdf or .toml).
         model: PathBuf,
-        /// Output file (stdout when absent).
+        /// Output file (stdout when absent); never the model file itself.
         #[arg(short, long)]
         output: Option<PathBuf>,
+        /// Replace an existing output file.
+        #[arg(long)]
+        force: bool,
         /// Gravity X,Y,Z, m/s², in the base frame (fixed) or the inertial frame (free-floating);
         /// none: space, no gravity code.
         #[arg(long, allow_hyphen_values = true)]
@@ -144,6 +160,10 @@ enum Command {
         /// Accept inertia tensors that violate the triangle inequality.
         #[arg(long)]
         allow_nonphysical: bool,
+        /// Generate for more than 256 joints (the code grows as N³: 96 MB of Rust at N = 200,
+        /// more than 8 GB of memory at N = 500).
+        #[arg(long)]
+        allow_large: bool,
     },
     /// ns per call of the generated SSRMS code against the interpreted algorithms, measured side
     /// by side in one run (report ratios: the machine is shared and noisy).
@@ -151,12 +171,12 @@ enum Command {
         /// Print JSON.
         #[arg(long)]
         json: bool,
-        /// Measurement rounds per candidate (the median is reported).
-        #[arg(long, default_value_t = 31)]
-        rounds: usize,
-        /// Calls per round.
-        #[arg(long, default_value_t = 2000)]
-        calls: usize,
+        /// Measurement rounds per candidate (the median is reported), 1 to 100000.
+        #[arg(long, default_value_t = 31, value_parser = clap::value_parser!(u32).range(1..=100_000))]
+        rounds: u32,
+        /// Calls per round, 1 to 100000000.
+        #[arg(long, default_value_t = 2000, value_parser = clap::value_parser!(u32).range(1..=100_000_000))]
+        calls: u32,
     },
     /// What accuracy costs in time: errors of A, b, q̈ per precision against a double-double
     /// reference with ns per call; integrators' work–precision; each scene effect's cost and
@@ -167,6 +187,9 @@ enum Command {
         /// Write accuracy.md, accuracy.json and work-precision SVGs into this directory.
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Replace existing files in --out.
+        #[arg(long)]
+        force: bool,
         /// Print JSON (one input: the report; several: {"subjects": [...]}).
         #[arg(long)]
         json: bool,
@@ -179,12 +202,19 @@ enum Command {
     Simulate {
         /// Scene file (.toml).
         scene: PathBuf,
-        /// Write trajectory.csv, summary.json, joints.svg, drift.svg into this directory.
+        /// Write trajectory.csv, summary.json, joints.svg, drift.svg into this directory
+        /// (the trajectory as it is computed; Ctrl-C keeps what was computed).
         #[arg(long)]
         out: Option<PathBuf>,
         /// Print the JSON summary to stdout (and no progress bar).
         #[arg(long)]
         json: bool,
+        /// Replace existing files in --out.
+        #[arg(long)]
+        force: bool,
+        /// Allow more than 1e8 steps or output samples (as `allow_long = true` in [simulation]).
+        #[arg(long)]
+        allow_long: bool,
     },
 }
 
@@ -196,12 +226,72 @@ fn load(model: &std::path::Path, allow_nonphysical: bool) -> Result<Model> {
         .with_context(|| format!("model `{}`", model.display()))
 }
 
-/// Parses the command line and runs the command.
+/// How a run is attached to the world: whether progress bars may be drawn (on a terminal's
+/// stderr, after a second) and Ctrl-C stops a simulation.
+#[derive(Clone, Copy, Debug)]
+pub struct Interactive(pub bool);
+
+/// A simulation stopped by Ctrl-C (exit code 130 after its partial outputs are written).
+#[derive(Debug)]
+pub struct Interrupted;
+
+impl std::fmt::Display for Interrupted {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("interrupted")
+    }
+}
+
+impl std::error::Error for Interrupted {}
+
+/// Set by Ctrl-C during `simulate`.
+static STOP: AtomicBool = AtomicBool::new(false);
+
+/// Installs the Ctrl-C handler once: the first Ctrl-C stops the simulation at its next step,
+/// a second one exits at once.
+fn install_ctrlc() {
+    static ONCE: std::sync::Once = std::sync::Once::new();
+    ONCE.call_once(|| {
+        let _ = ctrlc::set_handler(|| {
+            if STOP.swap(true, Ordering::SeqCst) {
+                std::process::exit(130);
+            }
+        });
+    });
+}
+
+/// Gravity `X,Y,Z` within [`GRAVITY`](kanegen_model::bounds::GRAVITY).
+fn gravity_arg(g: Option<String>) -> Result<Option<[f64; 3]>> {
+    g.map(|s| crate::states::parse_gravity(&s).context("--gravity"))
+        .transpose()
+}
+
+fn json(value: &impl serde::Serialize) -> Result<String> {
+    Ok(serde_json::to_string_pretty(value)? + "\n")
+}
+
+/// Parses `args` (the first is the program name) and runs the command, writing its results to
+/// `out`; what the binary does, callable in-process (tests).
+///
+/// # Errors
+/// A usage error, or any error of the command with its context chain.
+pub fn run_args<I, T>(args: I, out: &mut dyn Write) -> Result<()>
+where
+    I: IntoIterator<Item = T>,
+    T: Into<std::ffi::OsString> + Clone,
+{
+    let cli = Cli::try_parse_from(args)?;
+    run(cli, out, Interactive(false))
+}
+
+/// Runs a parsed command line.
 ///
 /// # Errors
 /// Any error of the command, with its context chain.
-pub fn run() -> Result<()> {
-    let cli = Cli::parse();
+#[allow(clippy::too_many_lines)]
+pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()> {
+    let say = |msg: &str| {
+        let _ = writeln!(std::io::stderr(), "{msg}");
+    };
     match cli.command {
         Command::Eval {
             model,
@@ -209,7 +299,7 @@ pub fn run() -> Result<()> {
             algorithm,
             base,
             gravity,
-            json,
+            json: as_json,
             allow_nonphysical,
         } => {
             let mut chain = load(&model, allow_nonphysical)?;
@@ -221,41 +311,47 @@ pub fn run() -> Result<()> {
             let algorithm = checked_methods(&chain, algorithm)?;
             let text = std::fs::read_to_string(&states)
                 .with_context(|| format!("cannot read states file `{}`", states.display()))?;
-            let g = gravity
-                .map(|s| crate::states::parse_vec3(&s).context("--gravity"))
-                .transpose()?;
+            let g = gravity_arg(gravity)?;
             let results = commands::eval::eval_states(&chain, &text, algorithm, g)
                 .with_context(|| format!("states file `{}`", states.display()))?;
-            if json {
+            if as_json {
                 let joints: Vec<&str> = chain.joints().iter().map(|j| j.name.as_str()).collect();
-                println!(
-                    "{}",
-                    serde_json::json!({
-                        "joints": joints,
-                        "base": chain.base_kind().name(),
-                        "results": results
-                    })
-                );
+                let v = serde_json::json!({
+                    "joints": joints,
+                    "base": chain.base_kind().name(),
+                    "results": results
+                });
+                print(out, &format!("{v}\n"))?;
             } else {
-                print!(
-                    "{}",
-                    commands::eval::render_text(&chain, algorithm, &results)
-                );
+                print(
+                    out,
+                    &commands::eval::render_text(&chain, algorithm, &results),
+                )?;
             }
         }
-        Command::Table1 { json, out } => {
+        Command::Table1 {
+            json: as_json,
+            out: dir,
+            force,
+        } => {
+            let planned = dir
+                .as_deref()
+                .map(|d| OutputDir::plan(d, &commands::table1::FILES, force, &[]))
+                .transpose()?;
+            let progress = Progress::spinner(interactive.0, "table1: tracing every algorithm");
             let t = kanegen_trace::table1::build(&kanegen_trace::table1::trace_all());
-            if let Some(dir) = &out {
-                commands::table1::write_all(&t, dir)?;
-                eprintln!(
+            progress.finish();
+            if let Some(d) = &planned {
+                commands::table1::write_planned(&t, d)?;
+                say(&format!(
                     "wrote table1.md, table1.json, fig2.svg to {}",
-                    dir.display()
-                );
+                    d.dir().display()
+                ));
             }
-            if json {
-                println!("{}", serde_json::to_string_pretty(&t)?);
-            } else if out.is_none() {
-                print!("{}", commands::table1::render_markdown(&t)?);
+            if as_json {
+                print(out, &json(&t)?)?;
+            } else if planned.is_none() {
+                print(out, &commands::table1::render_markdown(&t)?)?;
             }
         }
         Command::Count {
@@ -263,7 +359,7 @@ pub fn run() -> Result<()> {
             algorithm,
             base,
             gravity,
-            json,
+            json: as_json,
             allow_nonphysical,
         } => {
             if commands::count::is_scene_file(&model) {
@@ -275,11 +371,19 @@ pub fn run() -> Result<()> {
                     None if scene.model.is_chain() => Methods::ALL.to_vec(),
                     None => vec![Methods::SPATIAL],
                 };
+                let progress = Progress::spinner(
+                    interactive.0,
+                    &format!(
+                        "count: tracing the scene's A and b (N = {})",
+                        scene.model.dof()
+                    ),
+                );
                 let r = commands::count::count_scene(&scene, &model.display().to_string(), &algs)?;
-                if json {
-                    println!("{}", serde_json::to_string_pretty(&r)?);
+                progress.finish();
+                if as_json {
+                    print(out, &json(&r)?)?;
                 } else {
-                    print!("{}", commands::count::render_scene_text(&r));
+                    print(out, &commands::count::render_scene_text(&r))?;
                 }
                 return Ok(());
             }
@@ -294,19 +398,23 @@ pub fn run() -> Result<()> {
                 None if chain.is_chain() => Methods::ALL.to_vec(),
                 None => vec![Methods::SPATIAL],
             };
-            let g = gravity
-                .map(|s| crate::states::parse_vec3(&s).context("--gravity"))
-                .transpose()?;
-            let r = commands::count::count(&chain, &algs, g)?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&r)?);
+            let g = gravity_arg(gravity)?;
+            let explicit = algorithm.is_some();
+            let progress = Progress::bar(interactive.0, "count: tracing");
+            let r = commands::count::count_with_progress(&chain, &algs, g, explicit, &|k, n| {
+                progress.set(k, n);
+            })?;
+            progress.finish();
+            if as_json {
+                print(out, &json(&r)?)?;
             } else {
-                print!("{}", commands::count::render_text(&r));
+                print(out, &commands::count::render_text(&r))?;
             }
         }
         Command::Generate {
             model,
             output,
+            force,
             gravity,
             base,
             runtime_payload,
@@ -315,7 +423,12 @@ pub fn run() -> Result<()> {
             scalar,
             fma,
             allow_nonphysical,
+            allow_large,
         } => {
+            let target = output
+                .as_deref()
+                .map(|p| OutputFile::plan(p, force, std::slice::from_ref(&model)))
+                .transpose()?;
             let mut chain = load(&model, allow_nonphysical)?;
             for l in &lock {
                 let (i, v) = l
@@ -323,11 +436,20 @@ pub fn run() -> Result<()> {
                     .with_context(|| format!("--lock `{l}`: expected INDEX=VALUE"))?;
                 let i: usize = i.trim().parse().with_context(|| format!("--lock `{l}`"))?;
                 let v: f64 = v.trim().parse().with_context(|| format!("--lock `{l}`"))?;
-                chain = chain.lock_joint(i, v)?;
+                chain = chain
+                    .lock_joint(i, v)
+                    .with_context(|| format!("--lock `{l}`"))?;
             }
-            let g = gravity
-                .map(|s| crate::states::parse_vec3(&s).context("--gravity"))
-                .transpose()?;
+            let n = chain.dof();
+            anyhow::ensure!(
+                allow_large || n <= commands::generate::MAX_N,
+                "`{}` has {n} joints, more than {}: the generated code grows as N³ (the \
+                 unrolled forward dynamics; 96 MB of Rust, 92 s and 0.7 GB at N = 200; more \
+                 than 8 GB of memory at N = 500); pass --allow-large to generate it anyway",
+                model.display(),
+                commands::generate::MAX_N
+            );
+            let g = gravity_arg(gravity)?;
             let name = name.unwrap_or_else(|| commands::generate::type_name(chain.name()));
             let mut opts = kanegen_codegen::Options::new(name);
             opts.gravity = g;
@@ -335,29 +457,38 @@ pub fn run() -> Result<()> {
             opts.runtime_payload = runtime_payload;
             opts.float = scalar;
             opts.fma = fma;
-            let code = commands::generate::generate(&chain, &opts)?;
-            match output {
-                Some(path) => std::fs::write(&path, code)
-                    .with_context(|| format!("cannot write `{}`", path.display()))?,
-                None => print!("{code}"),
+            let progress = Progress::spinner(
+                interactive.0,
+                &format!(
+                    "generate: tracing and emitting every function of `{}` (N = {})",
+                    chain.name(),
+                    chain.dof()
+                ),
+            );
+            let code = commands::generate::generate_checked(&chain, &opts)?;
+            progress.finish();
+            match target {
+                Some(f) => f.write(code.as_bytes())?,
+                None => print(out, &code)?,
             }
         }
         Command::Bench {
-            json,
+            json: as_json,
             rounds,
             calls,
         } => {
-            let r = commands::bench::bench_ssrms(rounds, calls)?;
-            if json {
-                println!("{}", serde_json::to_string_pretty(&r)?);
+            let r = commands::bench::bench_ssrms(rounds as usize, calls as usize)?;
+            if as_json {
+                print(out, &json(&r)?)?;
             } else {
-                print!("{}", commands::bench::render_text(&r));
+                print(out, &commands::bench::render_text(&r))?;
             }
         }
         Command::Accuracy {
             inputs,
-            out,
-            json,
+            out: dir,
+            force,
+            json: as_json,
             allow_nonphysical,
         } => {
             let inputs: Vec<PathBuf> = if inputs.is_empty() {
@@ -368,46 +499,104 @@ pub fn run() -> Result<()> {
             } else {
                 inputs
             };
+            let planned = dir
+                .as_deref()
+                .map(|d| {
+                    let names = commands::accuracy::file_names(&inputs);
+                    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+                    OutputDir::plan(d, &names, force, &inputs)
+                })
+                .transpose()?;
             let opts = crate::reports::accuracy::Options { timing: true };
-            let reports = commands::accuracy::run(&inputs, allow_nonphysical, opts)?;
-            if let Some(dir) = &out {
-                commands::accuracy::write_all(&reports, dir)?;
-                eprintln!(
+            let progress = Progress::bar(interactive.0, "accuracy");
+            let reports = commands::accuracy::run_with_progress(
+                &inputs,
+                allow_nonphysical,
+                opts,
+                &|k, n| {
+                    progress.set(k, n);
+                },
+            )?;
+            progress.finish();
+            if let Some(d) = &planned {
+                commands::accuracy::write_planned(&reports, d)?;
+                say(&format!(
                     "wrote accuracy.md, accuracy.json, work-precision SVGs to {}",
-                    dir.display()
-                );
+                    d.dir().display()
+                ));
             }
-            if json {
-                println!(
-                    "{}",
-                    serde_json::to_string_pretty(&commands::accuracy::to_json(&reports))?
-                );
-            } else if out.is_none() {
-                print!("{}", commands::accuracy::render_markdown(&reports, true)?);
+            if as_json {
+                print(out, &json(&commands::accuracy::to_json(&reports))?)?;
+            } else if planned.is_none() {
+                print(out, &commands::accuracy::render_markdown(&reports, true)?)?;
             }
         }
-        Command::Simulate { scene, out, json } => {
-            let sc = kanegen_sim::scene::Scene::load(&scene)?;
-            let pb = if json {
+        Command::Simulate {
+            scene,
+            out: dir,
+            json: as_json,
+            force,
+            allow_long,
+        } => {
+            let options = kanegen_sim::scene::SceneOptions { allow_long };
+            let sc = kanegen_sim::scene::Scene::load_with(&scene, options)?;
+            let mut inputs = vec![scene.clone()];
+            if let Some(m) = std::fs::read_to_string(&scene).ok().and_then(|t| {
+                kanegen_sim::scene::Scene::model_path(&t, scene.parent().unwrap_or(Path::new(".")))
+            }) {
+                inputs.push(m);
+            }
+            let planned = dir
+                .as_deref()
+                .map(|d| OutputDir::plan(d, &commands::simulate::FILES, force, &inputs))
+                .transpose()?;
+            let pb = if as_json || !interactive.0 {
                 indicatif::ProgressBar::hidden()
             } else {
                 indicatif::ProgressBar::new((sc.simulation.duration * 1000.0) as u64)
             };
-            let run = kanegen_sim::simulate::simulate(&sc, Some(&pb))?;
-            pb.finish_and_clear();
-            if let Some(dir) = &out {
-                commands::simulate::write_outputs(&sc, &run, dir)?;
+            if interactive.0 {
+                STOP.store(false, Ordering::SeqCst);
+                install_ctrlc();
             }
-            if json {
-                println!("{}", serde_json::to_string_pretty(&run.summary)?);
+            let control = kanegen_sim::simulate::Control {
+                progress: Some(&pb),
+                stop: interactive.0.then_some(&STOP),
+            };
+            let summary = commands::simulate::run(&sc, planned.as_ref(), control)?;
+            pb.finish_and_clear();
+            if as_json {
+                print(out, &json(&summary)?)?;
             } else {
-                println!("{}", kanegen_sim::simulate::render_text(&run.summary));
-                if let Some(dir) = &out {
-                    eprintln!(
-                        "wrote trajectory.csv, summary.json, plots to {}",
-                        dir.display()
-                    );
-                }
+                print(
+                    out,
+                    &format!("{}\n", kanegen_sim::simulate::render_text(&summary)),
+                )?;
+            }
+            if let Some(d) = &planned {
+                say(&format!(
+                    "wrote trajectory.csv, summary.json, plots to {}{}",
+                    d.dir().display(),
+                    if summary.complete {
+                        ""
+                    } else {
+                        " (incomplete run)"
+                    }
+                ));
+            }
+            match summary.stopped.as_deref() {
+                None => {}
+                Some("interrupted") => return Err(Interrupted.into()),
+                Some(why) => anyhow::bail!(
+                    "the simulation stopped at t = {}: {why}{}",
+                    summary.t_end,
+                    if planned.is_some() {
+                        "; the trajectory up to there and a summary with \"complete\": false \
+                         were written"
+                    } else {
+                        ""
+                    }
+                ),
             }
         }
     }

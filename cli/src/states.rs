@@ -3,6 +3,7 @@
 //! "v": [3], "omega": [3]}` (base linear and angular velocity in the base frame).
 
 use anyhow::{bail, Context, Result};
+use kanegen_model::bounds::{Bound, FORCE, GRAVITY, LENGTH, POSITION, RATE};
 use serde::Deserialize;
 
 /// One state: joint positions, rates and (optional) drive torques/forces.
@@ -66,6 +67,15 @@ pub fn parse_states(text: &str, n: usize, floating: bool) -> Result<Vec<State>> 
                 if all.clone().any(|x| !x.is_finite()) {
                     bail!("states[{i}].base: values must be finite");
                 }
+                for (name, v, bound) in [
+                    ("position", &b.position, LENGTH),
+                    ("v", &b.v, RATE),
+                    ("omega", &b.omega, RATE),
+                ] {
+                    bound
+                        .check(v)
+                        .map_err(|e| anyhow::anyhow!("states[{i}].base.{name}: {e}"))?;
+                }
                 let norm = b.quaternion.iter().map(|x| x * x).sum::<f64>().sqrt();
                 if !(norm > 1e-6 && norm.is_finite()) {
                     bail!("states[{i}].base.quaternion: must be non-zero (got norm {norm:e})");
@@ -74,12 +84,12 @@ pub fn parse_states(text: &str, n: usize, floating: bool) -> Result<Vec<State>> 
             }
             (None, false) => {}
         }
-        let fields: [(&str, Option<&Vec<f64>>); 3] = [
-            ("q", Some(&s.q)),
-            ("qd", Some(&s.qd)),
-            ("tau", s.tau.as_ref()),
+        let fields: [(&str, Option<&Vec<f64>>, Bound); 3] = [
+            ("q", Some(&s.q), POSITION),
+            ("qd", Some(&s.qd), RATE),
+            ("tau", s.tau.as_ref(), FORCE),
         ];
-        for (name, v) in fields {
+        for (name, v, bound) in fields {
             let Some(v) = v else { continue };
             if v.len() != n {
                 bail!(
@@ -90,9 +100,24 @@ pub fn parse_states(text: &str, n: usize, floating: bool) -> Result<Vec<State>> 
             if let Some(k) = v.iter().position(|x| !x.is_finite()) {
                 bail!("states[{i}].{name}[{k}]: value is not finite");
             }
+            for (k, x) in v.iter().enumerate() {
+                bound
+                    .check(&[*x])
+                    .map_err(|e| anyhow::anyhow!("states[{i}].{name}[{k}]: {e}"))?;
+            }
         }
     }
     Ok(f.states)
+}
+
+/// Parses a gravity vector `X,Y,Z` (m/s²) within [`GRAVITY`].
+///
+/// # Errors
+/// A malformed vector, or a component beyond the bound.
+pub fn parse_gravity(s: &str) -> Result<[f64; 3]> {
+    let g = parse_vec3(s)?;
+    GRAVITY.check(&g).map_err(|e| anyhow::anyhow!("{e}"))?;
+    Ok(g)
 }
 
 /// Parses a vector written `X,Y,Z`.

@@ -7,6 +7,7 @@ use crate::options::{Error, Float, Options};
 use kanegen_trace::{Input, Node, PayloadField, Sym, Traced};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
+use std::cell::RefCell;
 use std::collections::{HashMap, HashSet};
 
 /// Operator precedence of an emitted expression (higher binds tighter).
@@ -174,6 +175,27 @@ pub fn input_tokens(input: &Input) -> TokenStream {
 
 /// The statements and result expression of one traced function, returned as `shape`.
 pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
+    let mut stmts: Vec<TokenStream> = Vec::new();
+    let Body {
+        tokens: result,
+        fmas,
+    } = emit_body_streamed(t, emitter, shape, &mut |s| stmts.push(s));
+    Body {
+        tokens: quote!(#(#stmts)* #result),
+        fmas,
+    }
+}
+
+/// [`emit_body`], handing each `let` statement to `stmt` as soon as it is emitted instead of
+/// keeping it: the returned body holds the result expression only. A caller that turns each
+/// statement into text at once keeps the memory of one statement, not of the whole body (33 MB
+/// of text for `forward_dynamics` at N = 200).
+pub fn emit_body_streamed(
+    t: &Traced,
+    emitter: &Emitter,
+    shape: Shape,
+    stmt: &mut dyn FnMut(TokenStream),
+) -> Body {
     let inputs: Vec<TokenStream> = t.inputs.iter().map(input_tokens).collect();
     let Emitter { libm, float, fma } = emitter;
     let float = *float;
@@ -210,8 +232,10 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
         _ => None,
     };
     let is_const = |s: Sym| matches!(nodes.get(&s.id()), Some(Node::Const(_)));
-    let mut exprs: HashMap<u32, Expr> = HashMap::new();
-    let mut stmts: Vec<TokenStream> = Vec::new();
+    // An inlined node's expression is taken out when its one user reads it (without fused
+    // multiply-adds, whose users also read their operands' operands): memory stays linear in the
+    // emitted code, and a long single-use chain is moved into its user, not copied.
+    let exprs: RefCell<HashMap<u32, Expr>> = RefCell::new(HashMap::new());
     let mut counter = 0usize;
     let mut fmas = 0u64;
     // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
@@ -227,7 +251,16 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
     };
     for (id, node) in &sched {
         let id = *id;
-        let get = |s: Sym| exprs[&s.id()].clone();
+        let get = |s: Sym| {
+            if fma.is_none() && inlined(s) {
+                exprs
+                    .borrow_mut()
+                    .remove(&s.id())
+                    .expect("an operand is emitted before its user")
+            } else {
+                exprs.borrow()[&s.id()].clone()
+            }
+        };
         // `−s` as a call argument: constants negated, an inlined negation unwrapped.
         let neg = |s: Sym| -> TokenStream {
             match nodes.get(&s.id()) {
@@ -247,15 +280,17 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
         };
         let expr = match node {
             Node::Const(x) => {
-                exprs.insert(id, constant(*x, float));
+                exprs.borrow_mut().insert(id, constant(*x, float));
                 continue;
             }
             Node::Input(i) => {
-                exprs.insert(id, Expr::atom(inputs[*i as usize].clone()));
+                exprs
+                    .borrow_mut()
+                    .insert(id, Expr::atom(inputs[*i as usize].clone()));
                 continue;
             }
             Node::Sin(a) | Node::Cos(a) => {
-                if exprs.contains_key(&id) {
+                if exprs.borrow().contains_key(&id) {
                     continue; // bound together with its partner by one sincos
                 }
                 let arg = get(*a).tokens;
@@ -265,21 +300,21 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
                     (Some(s), Some(c)) => {
                         let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
                         let f = float.libm_fn("sincos");
-                        stmts.push(quote!(let (#sn, #cn) = #libm::#f(#arg);));
-                        exprs.insert(s, Expr::atom(quote!(#sn)));
-                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                        stmt(quote!(let (#sn, #cn) = #libm::#f(#arg);));
+                        exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
+                        exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (Some(s), None) => {
                         let sn = format_ident!("s_{}", base);
                         let f = float.libm_fn("sin");
-                        stmts.push(quote!(let #sn = #libm::#f(#arg);));
-                        exprs.insert(s, Expr::atom(quote!(#sn)));
+                        stmt(quote!(let #sn = #libm::#f(#arg);));
+                        exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
                     }
                     (None, Some(c)) => {
                         let cn = format_ident!("c_{}", base);
                         let f = float.libm_fn("cos");
-                        stmts.push(quote!(let #cn = #libm::#f(#arg);));
-                        exprs.insert(c, Expr::atom(quote!(#cn)));
+                        stmt(quote!(let #cn = #libm::#f(#arg);));
+                        exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (None, None) => unreachable!("trig node without entry"),
                 }
@@ -361,16 +396,16 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
             let name = format_ident!("x{}", counter);
             counter += 1;
             let e = expr.tokens;
-            stmts.push(quote!(let #name = #e;));
-            exprs.insert(id, Expr::atom(quote!(#name)));
+            stmt(quote!(let #name = #e;));
+            exprs.borrow_mut().insert(id, Expr::atom(quote!(#name)));
         } else {
-            exprs.insert(id, expr);
+            exprs.borrow_mut().insert(id, expr);
         }
     }
     let out: Vec<TokenStream> = trace
         .outputs()
         .iter()
-        .map(|s| exprs[&s.id()].at(P_NEG))
+        .map(|s| exprs.borrow()[&s.id()].at(P_NEG))
         .collect();
     // Upper triangle, row-major: index of (i, j), i ≤ j.
     let sym_matrix = |out: &[TokenStream], n: usize| {
@@ -401,7 +436,7 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
         }
     };
     Body {
-        tokens: quote!(#(#stmts)* #result),
+        tokens: result,
         fmas,
     }
 }

@@ -59,7 +59,7 @@ pub struct Generated {
 /// # Errors
 /// If an option is not a valid Rust identifier or path, or a function cannot be traced.
 pub fn generate_items(model: &Model, opts: &Options) -> Result<Generated, Error> {
-    generate_items_with(model, opts, true)
+    generate_items_with(model, opts, true, None)
 }
 
 fn ident(what: &str, name: &str) -> Result<syn::Ident, Error> {
@@ -67,11 +67,14 @@ fn ident(what: &str, name: &str) -> Result<syn::Ident, Error> {
 }
 
 /// [`generate_items`]; `header_on_struct`: document the struct with the full header (else one
-/// line, for files whose module docs carry the header).
+/// line, for files whose module docs carry the header). With `bodies`, each function body is
+/// formatted to text statement by statement as it is emitted ([`format_body`]) and pushed
+/// there, and the items hold the placeholder `__kanegen_body_K()` instead ([`generate_file`]).
 fn generate_items_with(
     model: &Model,
     opts: &Options,
     header_on_struct: bool,
+    mut bodies: Option<&mut Vec<String>>,
 ) -> Result<Generated, Error> {
     let based;
     let model = match opts.base {
@@ -104,10 +107,33 @@ fn generate_items_with(
         if f == Function::MassMatrix {
             mass = choice.chosen.mass_matrix;
         }
+        let shape = api::shape(f, n, floating);
         let Body {
             tokens: body,
             fmas: k,
-        } = emit::emit_body(&traced, &emitter, api::shape(f, n, floating));
+        } = match bodies.as_deref_mut() {
+            None => emit::emit_body(&traced, &emitter, shape),
+            Some(texts) => {
+                let mut text = String::new();
+                let mut failed = None;
+                let mut b =
+                    emit::emit_body_streamed(&traced, &emitter, shape, &mut |s| match format_body(
+                        &s,
+                    ) {
+                        Ok(t) => text.push_str(&t),
+                        Err(e) => failed = Some(e),
+                    });
+                drop(traced);
+                if let Some(e) = failed {
+                    return Err(e);
+                }
+                text.push_str(&format_body(&b.tokens)?);
+                let placeholder = format_ident!("__kanegen_body_{}", texts.len());
+                texts.push(text);
+                b.tokens = quote!(#placeholder());
+                b
+            }
+        };
         let fname = api::fn_name(f, model);
         if !names.insert(fname.clone()) {
             return Err(Error(format!(
@@ -369,7 +395,8 @@ fn payload_struct(model: &Model, opts: &Options, payload_ty: &syn::Ident) -> Tok
 /// # Errors
 /// As [`generate_items`].
 pub fn generate_file(model: &Model, opts: &Options) -> Result<String, Error> {
-    let g = generate_items_with(model, opts, false)?;
+    let mut bodies = Vec::new();
+    let g = generate_items_with(model, opts, false, Some(&mut bodies))?;
     let docs = g.header.iter().map(|l| {
         let l = if l.is_empty() {
             String::new()
@@ -385,7 +412,49 @@ pub fn generate_file(model: &Model, opts: &Options) -> Result<String, Error> {
     };
     let parsed: syn::File =
         syn::parse2(file).map_err(|e| Error(format!("generated code does not parse: {e}")))?;
-    Ok(prettyplease::unparse(&parsed))
+    let skeleton = prettyplease::unparse(&parsed);
+    drop(parsed);
+    // Splice each body (formatted at the same indentation) in place of its placeholder line.
+    let mut out =
+        String::with_capacity(skeleton.len() + bodies.iter().map(String::len).sum::<usize>());
+    let mut next = 0;
+    for line in skeleton.split_inclusive('\n') {
+        let placeholder = format!("        __kanegen_body_{next}()\n");
+        if next < bodies.len() && line == placeholder {
+            out.push_str(&bodies[next]);
+            bodies[next] = String::new();
+            next += 1;
+        } else {
+            out.push_str(line);
+        }
+    }
+    if next != bodies.len() {
+        return Err(Error(format!(
+            "generated code: {} of {} function bodies placed",
+            next,
+            bodies.len()
+        )));
+    }
+    Ok(out)
+}
+
+/// Statements (or a result expression) of a function body as prettyplease formats them inside a
+/// method of an `impl` block (eight spaces of indentation): formatted alone, inside the same
+/// nesting, they come out as they would in the whole file, without ever holding the whole
+/// file's syntax tree (5 GB at N = 200).
+fn format_body(tokens: &TokenStream) -> Result<String, Error> {
+    let wrapped = quote!(impl W { fn f() { #tokens } });
+    let parsed: syn::File =
+        syn::parse2(wrapped).map_err(|e| Error(format!("generated code does not parse: {e}")))?;
+    let text = prettyplease::unparse(&parsed);
+    let mut lines = text.split_inclusive('\n');
+    let (open, close) = (lines.next(), lines.next());
+    debug_assert_eq!(open, Some("impl W {\n"));
+    debug_assert_eq!(close, Some("    fn f() {\n"));
+    let body: Vec<&str> = lines.collect();
+    let end = body.len().saturating_sub(2);
+    debug_assert_eq!(&body[end..], ["    }\n", "}\n"]);
+    Ok(body[..end].concat())
 }
 
 /// The model crate, re-exported for the proc-macro (readers, validation).

@@ -12,6 +12,7 @@
 //! assert_eq!(both.inertia[1][1], 12.0);
 //! ```
 
+use crate::bounds::{Bound, INERTIA, LENGTH, MASS};
 use crate::placement::{mat_mul, transpose, Placement, M3, V3};
 use crate::{ModelError, Validation};
 use serde::Serialize;
@@ -100,6 +101,12 @@ pub(crate) fn finite(owner: &str, field: &str, xs: &[f64]) -> Result<(), ModelEr
     }
 }
 
+/// Checks `xs` against a magnitude [`Bound`] (finite, `|x| ≤ max`), naming `owner` and `field`.
+pub(crate) fn bounded(owner: &str, field: &str, xs: &[f64], b: Bound) -> Result<(), ModelError> {
+    b.check(xs)
+        .map_err(|reason| ModelError::invalid(owner, field, reason))
+}
+
 /// Checks a body's mass properties strictly; `owner` names the joint (or body) in the message.
 pub fn validate_inertial(owner: &str, field: &str, b: &Inertial) -> Result<(), ModelError> {
     validate_inertial_with(owner, field, b, Validation::default())
@@ -113,7 +120,7 @@ pub fn validate_inertial_with(
     b: &Inertial,
     validation: Validation,
 ) -> Result<(), ModelError> {
-    finite(owner, &format!("{field}.mass"), &[b.mass])?;
+    bounded(owner, &format!("{field}.mass"), &[b.mass], MASS)?;
     if b.mass <= 0.0 {
         return Err(ModelError::invalid(
             owner,
@@ -121,10 +128,10 @@ pub fn validate_inertial_with(
             format!("mass must be > 0, got {}", b.mass),
         ));
     }
-    finite(owner, &format!("{field}.com"), &b.com)?;
+    bounded(owner, &format!("{field}.com"), &b.com, LENGTH)?;
     let i = &b.inertia;
     let flat: Vec<f64> = i.iter().flatten().copied().collect();
-    finite(owner, &format!("{field}.inertia"), &flat)?;
+    bounded(owner, &format!("{field}.inertia"), &flat, INERTIA)?;
     let scale = flat
         .iter()
         .fold(0.0f64, |m, x| m.max(x.abs()))

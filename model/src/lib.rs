@@ -9,6 +9,8 @@
 //! - [`io`]: URDF and kanegen's TOML format in, TOML out.
 //! - [`Inertial::merge`]: the one parallel-axis merge (fixed links, locked joints, payloads).
 //! - [`random`]: seeded random chains, trees and states for tests, benchmarks and traces.
+//! - [`bounds`]: the magnitude bounds every reader checks, so products stay finite.
+//! - [`canonical`]: the same robot in frames that make its dynamics cheap (every axis `z`).
 //!
 //! ```
 //! let model = kanegen_model::io::parse_toml(r#"
@@ -26,6 +28,7 @@
 //! ```
 #![warn(missing_docs)]
 
+pub mod bounds;
 pub mod canonical;
 pub mod inertial;
 pub mod io;

@@ -12,7 +12,8 @@ impl Model {
     /// the parts).
     ///
     /// # Errors
-    /// If `index` is out of range or the model would become empty.
+    /// If `index` is out of range, `value` is not finite or exceeds
+    /// [`POSITION`](crate::bounds::POSITION), or the model would become empty.
     pub fn lock_joint(&self, index: usize, value: f64) -> Result<Model, ModelError> {
         let n = self.joints().len();
         if index >= n {
@@ -23,6 +24,9 @@ impl Model {
             ));
         }
         let j = &self.joints()[index];
+        crate::bounds::POSITION
+            .check(&[value])
+            .map_err(|reason| ModelError::invalid(&j.name, "lock value", reason))?;
         // Placement of body `index` in its parent frame at q = value.
         let ups = &j.origin.rotation;
         let moved = match j.kind {

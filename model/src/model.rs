@@ -16,7 +16,8 @@
 //! A `Model` can only be built through [`Model::new`], which validates every number; readers for
 //! URDF and kanegen's TOML format live in [`crate::io`].
 
-use crate::inertial::{finite, validate_inertial_with};
+use crate::bounds::{normalize, LENGTH};
+use crate::inertial::{bounded, finite, validate_inertial_with};
 use crate::{Inertial, Placement};
 use serde::Serialize;
 
@@ -351,7 +352,12 @@ impl Model {
 }
 
 fn validate_placement(joint: &str, field: &str, p: &Placement) -> Result<(), ModelError> {
-    finite(joint, &format!("{field}.translation"), &p.translation)?;
+    bounded(
+        joint,
+        &format!("{field}.translation"),
+        &p.translation,
+        LENGTH,
+    )?;
     let flat: Vec<f64> = p.rotation.iter().flatten().copied().collect();
     finite(joint, &format!("{field}.rotation"), &flat)?;
     let r = &p.rotation;
@@ -380,13 +386,12 @@ fn validate_placement(joint: &str, field: &str, p: &Placement) -> Result<(), Mod
 
 fn validate_axis(joint: &str, a: &[f64; 3]) -> Result<[f64; 3], ModelError> {
     finite(joint, "axis", a)?;
-    let n = (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt();
-    if n < 1e-9 {
-        return Err(ModelError::invalid(
+    // Normalized by the largest component first, so no square overflows or underflows.
+    normalize(a, 1e-9).ok_or_else(|| {
+        ModelError::invalid(
             joint,
             "axis",
             "zero axis: a joint axis must have non-zero length",
-        ));
-    }
-    Ok([a[0] / n, a[1] / n, a[2] / n])
+        )
+    })
 }

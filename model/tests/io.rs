@@ -969,3 +969,134 @@ fn with_base_inertial_sets_validated_base_mass_properties() {
     let e = chain.with_base_inertial(bad).unwrap_err().to_string();
     assert!(e.contains("base.inertial") && e.contains("mass"), "{e}");
 }
+
+// ---------------------------------------------------------------------------------------------
+// Reliability: URDF positions, per-link inertials, magnitude bounds
+
+/// URDF syntax errors carry the line and column; malformed elements their line and element.
+#[test]
+fn urdf_errors_name_the_line_and_element() {
+    let e = parse_urdf("<robot name=\"r\">\n  <link name=\"a\">\n</robot>")
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("line 3"), "{e}");
+    let text = MERGE_URDF.replace(r#"<origin xyz="2 0 0"/>"#, r#"<origin xyz="2 0"/>"#);
+    let e = parse_urdf(&text).unwrap_err().to_string();
+    let line = MERGE_URDF
+        .lines()
+        .position(|l| l.contains(r#"<origin xyz="2 0 0"/>"#))
+        .unwrap()
+        + 1;
+    assert!(
+        e.contains(&format!("line {line}")) && e.contains("<origin") && e.contains("xyz"),
+        "{e}"
+    );
+    let text = MERGE_URDF.replace(
+        r#"ixx="0.1" ixy="0" ixz="0" iyy="0.2""#,
+        r#"ixx="x" ixy="0" ixz="0" iyy="0.2""#,
+    );
+    let e = parse_urdf(&text).unwrap_err().to_string();
+    assert!(
+        e.contains("<inertia") && e.contains("ixx") && e.contains("line"),
+        "{e}"
+    );
+}
+
+/// A fixed link's own inertia is checked before it is merged (the merged one may be fine),
+/// naming the joint and the link; a rank-one placeholder inertia (B1's dummy `base` link: 1e-6
+/// kg, every entry 1e-6) is semidefinite and accepted, as Pinocchio accepts it.
+#[test]
+fn urdf_fixed_link_with_a_non_positive_definite_inertia_is_rejected() {
+    let dummy = MERGE_URDF.replace(
+        r#"<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/>"#,
+        r#"<inertia ixx="1e-6" ixy="1e-6" ixz="1e-6" iyy="1e-6" iyz="1e-6" izz="1e-6"/>"#,
+    );
+    assert_ne!(dummy, MERGE_URDF);
+    parse_urdf(&dummy).unwrap();
+    let text = MERGE_URDF.replace(
+        r#"<inertia ixx="0.1" ixy="0" ixz="0" iyy="0.2" iyz="0" izz="0.3"/>"#,
+        r#"<inertia ixx="0.1" ixy="0" ixz="0" iyy="-0.05" iyz="0" izz="0.3"/>"#,
+    );
+    let e = parse_urdf(&text).unwrap_err().to_string();
+    assert!(
+        e.contains("`bracket`") && e.contains("link1b") && e.contains("positive semidefinite"),
+        "{e}"
+    );
+}
+
+/// Magnitudes whose squares or products overflow are errors naming the field and the bound; an
+/// axis of 1e200 is normalized without overflow.
+#[test]
+fn magnitude_bounds_name_the_field_and_the_bound() {
+    let base = r#"name = "b"
+[[joint]]
+name = "j"
+type = "revolute"
+xyz = XYZ
+axis = AXIS
+[joint.body]
+mass = MASS
+com = COM
+inertia = { ixx = 1.0, iyy = 1.0, izz = 1.0 }
+"#;
+    let model = |xyz: &str, axis: &str, mass: &str, com: &str| {
+        parse_toml(
+            &base
+                .replace("XYZ", xyz)
+                .replace("AXIS", axis)
+                .replace("MASS", mass)
+                .replace("COM", com),
+        )
+    };
+    let ok = model(
+        "[0.0, 0.0, 1.0]",
+        "[1e200, 0.0, 0.0]",
+        "1.0",
+        "[0.0, 0.0, 0.0]",
+    )
+    .unwrap();
+    assert_eq!(ok.joints()[0].axis, [1.0, 0.0, 0.0]);
+    // Shorter than 1e-9: a zero axis (its square would underflow to 0 as well).
+    let e = model(
+        "[0.0, 0.0, 1.0]",
+        "[1e-200, 1e-200, 0.0]",
+        "1.0",
+        "[0.0, 0.0, 0.0]",
+    )
+    .unwrap_err()
+    .to_string();
+    assert!(e.contains("zero axis"), "{e}");
+    for (xyz, mass, com, field, bound) in [
+        (
+            "[0.0, 0.0, 1e308]",
+            "1.0",
+            "[0.0, 0.0, 0.0]",
+            "xyz",
+            "1e6 m",
+        ),
+        (
+            "[0.0, 0.0, 1.0]",
+            "1e13",
+            "[0.0, 0.0, 0.0]",
+            "body.mass",
+            "1e12 kg",
+        ),
+        (
+            "[0.0, 0.0, 1.0]",
+            "1.0",
+            "[1e200, 0.0, 0.0]",
+            "body.com",
+            "1e6 m",
+        ),
+    ] {
+        let e = model(xyz, "[0.0, 0.0, 1.0]", mass, com)
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains(&format!("`{field}`")) && e.contains(bound) && e.contains("exceeds"),
+            "{e}"
+        );
+    }
+    let e = ok.lock_joint(0, f64::NAN).unwrap_err().to_string();
+    assert!(e.contains("lock value") && e.contains("not finite"), "{e}");
+}

@@ -10,6 +10,8 @@
 //! accepted step; the two methods are ~200 lines here and are tested for their order and
 //! accuracy in `tests/simulate.rs`.
 
+use std::ops::ControlFlow;
+
 /// A first-order system `ẋ = f(t, x)`.
 pub trait System {
     /// Dimension of the state.
@@ -30,6 +32,31 @@ pub trait System {
             out[i] = x[i] + h * f[i];
         }
     }
+    /// Whether the run was asked to stop (Ctrl-C): checked after every accepted step; the
+    /// integrator then returns [`IntegrateError::Interrupted`] with the state reached in `x`.
+    /// Default: never.
+    fn interrupted(&self) -> bool {
+        false
+    }
+}
+
+/// What an `observe` callback returns: `()` (go on) or a [`ControlFlow`] (`Break` stops the run
+/// with [`IntegrateError::Interrupted`]).
+pub trait Flow {
+    /// Whether the run is to stop.
+    fn stop(self) -> bool;
+}
+
+impl Flow for () {
+    fn stop(self) -> bool {
+        false
+    }
+}
+
+impl Flow for ControlFlow<()> {
+    fn stop(self) -> bool {
+        self.is_break()
+    }
 }
 
 /// Work counters of a run.
@@ -43,24 +70,74 @@ pub struct Stats {
     pub evals: usize,
 }
 
-/// Why an integration stopped early.
+/// Why an integration stopped early. Each variant carries the time reached and the work done
+/// up to there; the state passed in holds the last accepted state.
 #[derive(Debug)]
 pub enum IntegrateError {
     /// The adaptive step size fell below the floating-point resolution of `t`.
     StepTooSmall {
         /// Time reached.
         t: f64,
+        /// Work done.
+        stats: Stats,
     },
-    /// The state became non-finite.
+    /// The state became non-finite (the last accepted state, in `x`, is still finite).
     NonFinite {
+        /// Time of the step that overflowed.
+        t: f64,
+        /// The first non-finite component of the new state.
+        index: usize,
+        /// Work done.
+        stats: Stats,
+    },
+    /// The error estimate of a [`dopri5`] step overflowed while the state stayed finite: the
+    /// tolerance is too small for the size of the state, or the derivative overflowed.
+    ErrorEstimate {
         /// Time reached.
         t: f64,
+        /// Work done.
+        stats: Stats,
     },
     /// The implicit equations of a [`midpoint`] step were not solved.
     NotConverged {
         /// Time reached.
         t: f64,
+        /// Work done.
+        stats: Stats,
     },
+    /// The run was stopped ([`System::interrupted`], or `observe` returned `Break`).
+    Interrupted {
+        /// Time reached.
+        t: f64,
+        /// Work done.
+        stats: Stats,
+    },
+}
+
+impl IntegrateError {
+    /// The time reached.
+    #[must_use]
+    pub fn t(&self) -> f64 {
+        match self {
+            IntegrateError::StepTooSmall { t, .. }
+            | IntegrateError::NonFinite { t, .. }
+            | IntegrateError::ErrorEstimate { t, .. }
+            | IntegrateError::NotConverged { t, .. }
+            | IntegrateError::Interrupted { t, .. } => *t,
+        }
+    }
+
+    /// The work done up to the stop.
+    #[must_use]
+    pub fn stats(&self) -> Stats {
+        match self {
+            IntegrateError::StepTooSmall { stats, .. }
+            | IntegrateError::NonFinite { stats, .. }
+            | IntegrateError::ErrorEstimate { stats, .. }
+            | IntegrateError::NotConverged { stats, .. }
+            | IntegrateError::Interrupted { stats, .. } => *stats,
+        }
+    }
 }
 
 impl std::error::Error for IntegrateError {}
@@ -68,14 +145,33 @@ impl std::error::Error for IntegrateError {}
 impl std::fmt::Display for IntegrateError {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
-            IntegrateError::StepTooSmall { t } => write!(f, "step size underflow at t = {t}"),
-            IntegrateError::NonFinite { t } => write!(f, "state became non-finite at t = {t}"),
-            IntegrateError::NotConverged { t } => write!(
+            IntegrateError::StepTooSmall { t, .. } => write!(
+                f,
+                "step size underflow at t = {t} (the tolerance cannot be met at this time: a \
+                 singularity or a stiff drive)"
+            ),
+            IntegrateError::NonFinite { t, index, .. } => write!(
+                f,
+                "state component {index} became non-finite in the step to t = {t}"
+            ),
+            IntegrateError::ErrorEstimate { t, .. } => write!(
+                f,
+                "the dopri5 error estimate overflowed at t = {t} while the state stayed finite \
+                 (the tolerance is too small for the size of the state, or the derivative \
+                 overflowed)"
+            ),
+            IntegrateError::NotConverged { t, .. } => write!(
                 f,
                 "implicit midpoint iterations did not converge at t = {t} (reduce the step)"
             ),
+            IntegrateError::Interrupted { t, .. } => write!(f, "interrupted at t = {t}"),
         }
     }
+}
+
+/// The first non-finite component of `x`.
+fn non_finite(x: &[f64]) -> Option<usize> {
+    x.iter().position(|v| !v.is_finite())
 }
 
 fn axpy(out: &mut [f64], x: &[f64], terms: &[(f64, &[f64])]) {
@@ -87,13 +183,13 @@ fn axpy(out: &mut [f64], x: &[f64], terms: &[(f64, &[f64])]) {
 /// Classical RK4 from `t0` to `t1` with `n = ⌈(t1 − t0)/h⌉` equal steps (the step is shortened
 /// to `(t1 − t0)/n` so the run ends exactly at `t1`). `x` is advanced in place and projected
 /// after each step. `observe(step, t, x)` is called at `t0` (step 0) and after every step.
-pub fn rk4<S: System>(
+pub fn rk4<S: System, R: Flow>(
     sys: &mut S,
     t0: f64,
     t1: f64,
     h: f64,
     x: &mut [f64],
-    mut observe: impl FnMut(usize, f64, &[f64]),
+    mut observe: impl FnMut(usize, f64, &[f64]) -> R,
 ) -> Result<Stats, IntegrateError> {
     assert!(h > 0.0 && t1 >= t0, "rk4 needs h > 0 and t1 >= t0");
     let n = ((t1 - t0) / h - 1e-9).ceil().max(1.0) as usize;
@@ -107,7 +203,9 @@ pub fn rk4<S: System>(
         vec![0.0; d],
     );
     let mut stats = Stats::default();
-    observe(0, t0, x);
+    if observe(0, t0, x).stop() {
+        return Err(IntegrateError::Interrupted { t: t0, stats });
+    }
     for step in 1..=n {
         let t = t0 + (step - 1) as f64 * h;
         sys.deriv(t, x, &mut k1);
@@ -127,15 +225,17 @@ pub fn rk4<S: System>(
                 (h / 6.0, &k4),
             ],
         );
-        x.copy_from_slice(&tmp);
-        sys.project(x);
-        stats.steps += 1;
         stats.evals += 4;
         let t = if step == n { t1 } else { t0 + step as f64 * h };
-        if x.iter().any(|v| !v.is_finite()) {
-            return Err(IntegrateError::NonFinite { t });
+        sys.project(&mut tmp);
+        if let Some(index) = non_finite(&tmp) {
+            return Err(IntegrateError::NonFinite { t, index, stats });
         }
-        observe(step, t, x);
+        x.copy_from_slice(&tmp);
+        stats.steps += 1;
+        if observe(step, t, x).stop() || (step < n && sys.interrupted()) {
+            return Err(IntegrateError::Interrupted { t, stats });
+        }
     }
     Ok(stats)
 }
@@ -216,13 +316,13 @@ const D: [f64; 7] = [
 /// `observe(t, x)` is called at `t0`, at every `t0 + k·output_interval < t1` — these samples come
 /// from the standard DOPRI5 continuous extension (4th-order dense output, Hairer's coefficients)
 /// — and at `t1`.
-pub fn dopri5<S: System>(
+pub fn dopri5<S: System, R: Flow>(
     sys: &mut S,
     t0: f64,
     t1: f64,
     opts: &Dopri5Options,
     x: &mut [f64],
-    mut observe: impl FnMut(f64, &[f64]),
+    mut observe: impl FnMut(f64, &[f64]) -> R,
 ) -> Result<Stats, IntegrateError> {
     assert!(opts.tolerance > 0.0 && opts.max_step > 0.0 && opts.initial_step > 0.0);
     assert!(opts.output_interval > 0.0 && t1 >= t0);
@@ -239,7 +339,9 @@ pub fn dopri5<S: System>(
     let expo = 0.2 - 0.75 * beta;
     let mut facold: f64 = 1e-4;
     let mut next_out = 1usize;
-    observe(t0, x);
+    if observe(t0, x).stop() {
+        return Err(IntegrateError::Interrupted { t: t0, stats });
+    }
     sys.deriv(t, x, &mut k[0]);
     stats.evals += 1;
     while t < t1 {
@@ -248,7 +350,7 @@ pub fn dopri5<S: System>(
             h = t1 - t;
         }
         if h <= f64::EPSILON * t.abs().max(1.0) {
-            return Err(IntegrateError::StepTooSmall { t });
+            return Err(IntegrateError::StepTooSmall { t, stats });
         }
         for s in 1..7 {
             for i in 0..d {
@@ -271,7 +373,14 @@ pub fn dopri5<S: System>(
         }
         let err = (err / d as f64).sqrt();
         if !err.is_finite() {
-            return Err(IntegrateError::NonFinite { t });
+            return Err(match non_finite(&xnew) {
+                Some(index) => IntegrateError::NonFinite {
+                    t: t + h,
+                    index,
+                    stats,
+                },
+                None => IntegrateError::ErrorEstimate { t, stats },
+            });
         }
         let fac11 = err.powf(expo);
         if err <= 1.0 {
@@ -288,26 +397,37 @@ pub fn dopri5<S: System>(
                     let r5 = h * (0..7).map(|s| D[s] * k[s][i]).sum::<f64>();
                     dense[i] = x[i] + th * (ydiff + th1 * (bspl + th * (r4 + th1 * r5)));
                 }
-                observe(ts, &dense);
+                if observe(ts, &dense).stop() {
+                    return Err(IntegrateError::Interrupted { t, stats });
+                }
                 next_out += 1;
             }
+            sys.project(&mut xnew);
+            if let Some(index) = non_finite(&xnew) {
+                return Err(IntegrateError::NonFinite {
+                    t: tn,
+                    index,
+                    stats,
+                });
+            }
             x.copy_from_slice(&xnew);
-            sys.project(x);
             t = tn;
             stats.steps += 1;
-            if x == xnew.as_slice() {
+            if x == tmp.as_slice() {
                 let k6 = k[6].clone();
                 k[0].copy_from_slice(&k6);
             } else {
                 sys.deriv(t, x, &mut k[0]);
                 stats.evals += 1;
             }
-            if x.iter().any(|v| !v.is_finite()) {
-                return Err(IntegrateError::NonFinite { t });
-            }
             if last {
-                observe(t1, x);
+                if observe(t1, x).stop() {
+                    return Err(IntegrateError::Interrupted { t, stats });
+                }
                 break;
+            }
+            if sys.interrupted() {
+                return Err(IntegrateError::Interrupted { t, stats });
             }
             let fac = (fac11 / facold.powf(beta) / safety).clamp(0.1, 5.0);
             facold = err.max(1e-4);
@@ -349,13 +469,13 @@ const MIDPOINT_MAX_ITER: usize = 60;
 /// No crate fits: `ode_solvers`, `diffsol`, `russell_ode` offer implicit Runge–Kutta methods on
 /// vector states only (no Lie-group update of a user state component), and the geometric crates
 /// found target canonical Hamiltonians `H(q, p)`, which would need `∂A/∂q`.
-pub fn midpoint<S: System>(
+pub fn midpoint<S: System, R: Flow>(
     sys: &mut S,
     t0: f64,
     t1: f64,
     h: f64,
     x: &mut [f64],
-    mut observe: impl FnMut(usize, f64, &[f64]),
+    mut observe: impl FnMut(usize, f64, &[f64]) -> R,
 ) -> Result<Stats, IntegrateError> {
     assert!(h > 0.0 && t1 >= t0, "midpoint needs h > 0 and t1 >= t0");
     let n = ((t1 - t0) / h - 1e-9).ceil().max(1.0) as usize;
@@ -363,7 +483,9 @@ pub fn midpoint<S: System>(
     let d = sys.dim();
     let (mut f, mut xm, mut xm_new) = (vec![0.0; d], vec![0.0; d], vec![0.0; d]);
     let mut stats = Stats::default();
-    observe(0, t0, x);
+    if observe(0, t0, x).stop() {
+        return Err(IntegrateError::Interrupted { t: t0, stats });
+    }
     for step in 1..=n {
         let t = t0 + (step - 1) as f64 * h;
         let tm = t + 0.5 * h;
@@ -383,7 +505,8 @@ pub fn midpoint<S: System>(
                 .fold(0.0_f64, |m, (a, b)| m.max((a - b).abs()));
             std::mem::swap(&mut xm, &mut xm_new);
             if !diff.is_finite() {
-                return Err(IntegrateError::NonFinite { t });
+                let index = non_finite(&xm).unwrap_or(0);
+                return Err(IntegrateError::NonFinite { t, index, stats });
             }
             if diff <= 1e-14 * scale {
                 converged = true;
@@ -391,17 +514,19 @@ pub fn midpoint<S: System>(
             }
         }
         if !converged {
-            return Err(IntegrateError::NotConverged { t });
+            return Err(IntegrateError::NotConverged { t, stats });
         }
         // Full step along the derivative at the (converged) midpoint.
         sys.advance(x, h, &xm, &f, &mut xm_new);
+        let t = if step == n { t1 } else { t0 + step as f64 * h };
+        if let Some(index) = non_finite(&xm_new) {
+            return Err(IntegrateError::NonFinite { t, index, stats });
+        }
         x.copy_from_slice(&xm_new);
         stats.steps += 1;
-        let t = if step == n { t1 } else { t0 + step as f64 * h };
-        if x.iter().any(|v| !v.is_finite()) {
-            return Err(IntegrateError::NonFinite { t });
+        if observe(step, t, x).stop() || (step < n && sys.interrupted()) {
+            return Err(IntegrateError::Interrupted { t, stats });
         }
-        observe(step, t, x);
     }
     Ok(stats)
 }

@@ -20,6 +20,7 @@ use anyhow::{anyhow, bail, Context, Result};
 use kanegen_dynamics::base::BASE_BODY;
 use kanegen_dynamics::linalg::Vec3;
 use kanegen_dynamics::{ExternalWrench, LoadFrame, Methods};
+use kanegen_model::bounds::{Bound, FORCE, GAIN, GRAVITY, LENGTH, POSITION, RATE};
 use kanegen_model::io::InertiaSpec;
 use kanegen_model::{Inertial, Model, Validation};
 use serde::Deserialize;
@@ -129,6 +130,8 @@ struct RawSimulation {
     max_step: Option<f64>,
     output_every: Option<usize>,
     algorithm: Option<String>,
+    #[serde(default)]
+    allow_long: bool,
 }
 
 /// The base of a scene.
@@ -216,6 +219,30 @@ pub struct SimulationSpec {
     pub output_every: usize,
     /// The dynamics algorithm evaluating `A`, `b` (default `recurrent`).
     pub algorithm: Methods,
+    /// Whether more than [`MAX_STEPS`] steps or output samples were allowed
+    /// (`allow_long = true`, or [`SceneOptions::allow_long`]).
+    pub allow_long: bool,
+}
+
+/// Most steps (RK4, midpoint: `duration / step`) or output samples (every integrator:
+/// `duration / (step · output_every)`) a scene may ask for without `allow_long = true` in
+/// `[simulation]` (or `kanegen simulate --allow-long`): 1e8 steps of a 7-dof arm take about an
+/// hour and 1e8 samples fill about 15 GB of CSV.
+pub const MAX_STEPS: f64 = 1e8;
+
+/// Even with `allow_long`, at most this many steps or samples (2⁵³: the step counter and `k·h`
+/// stay exact).
+pub const MAX_STEPS_LONG: f64 = 9_007_199_254_740_992.0;
+
+/// Smallest dopri5 tolerance: below it the error estimate is dominated by the rounding error of
+/// the state (`ε ≈ 2.2e-16` relative) and the step size shrinks until it underflows.
+pub const MIN_TOLERANCE: f64 = 1e-14;
+
+/// Options of [`Scene::load_with`] and [`Scene::parse_with`].
+#[derive(Clone, Copy, Debug, Default)]
+pub struct SceneOptions {
+    /// Allow more than [`MAX_STEPS`] steps or samples (as `allow_long = true` in the file).
+    pub allow_long: bool,
 }
 
 /// How an external wrench varies in time.
@@ -308,7 +335,7 @@ fn wrench_profile(
         let constant = |name: &str, p: Option<RawProfile>| match p {
             None => Ok([0.0; 3]),
             Some(RawProfile::Constant(v)) => {
-                check_finite(&format!("{key}.{name}"), &v)?;
+                check_bound(&format!("{key}.{name}"), &v, FORCE)?;
                 Ok(v)
             }
             Some(RawProfile::Table(_)) => Err(anyhow!(
@@ -349,7 +376,7 @@ fn wrench_profile(
                         v.len()
                     );
                 }
-                check_finite(&k, v.as_flattened())?;
+                check_bound(&k, v.as_flattened(), FORCE)?;
                 Ok(v)
             }
         }
@@ -388,14 +415,14 @@ pub struct Scene {
     pub simulation: SimulationSpec,
 }
 
-fn check_len(key: &str, v: &[f64], n: usize) -> Result<()> {
+fn check_len(key: &str, v: &[f64], n: usize, b: Bound) -> Result<()> {
     if v.len() != n {
         bail!(
             "{key}: expected {n} values (the model's degrees of freedom), got {}",
             v.len()
         );
     }
-    check_finite(key, v)
+    check_bound(key, v, b)
 }
 
 fn check_finite(key: &str, v: &[f64]) -> Result<()> {
@@ -405,31 +432,55 @@ fn check_finite(key: &str, v: &[f64]) -> Result<()> {
     Ok(())
 }
 
+/// Finite and within the magnitude bound `b` ([`kanegen_model::bounds`]).
+fn check_bound(key: &str, v: &[f64], b: Bound) -> Result<()> {
+    b.check(v).map_err(|e| anyhow!("{key}: {e}"))
+}
+
 fn gain(key: &str, g: Option<RawGain>, n: usize) -> Result<Vec<f64>> {
     let v = match g.ok_or_else(|| anyhow!("{key}: required by this drive type"))? {
         RawGain::Scalar(x) => vec![x; n],
         RawGain::Vector(v) => {
-            check_len(key, &v, n)?;
+            check_len(key, &v, n, GAIN)?;
             v
         }
     };
     if v.iter().any(|x| !(x.is_finite() && *x >= 0.0)) {
         bail!("{key}: gains must be finite and >= 0");
     }
+    check_bound(key, &v, GAIN)?;
     Ok(v)
 }
 
 impl Scene {
     /// Reads and validates a scene file; the model path is relative to the file's directory.
     pub fn load(path: &Path) -> Result<Scene> {
+        Scene::load_with(path, SceneOptions::default())
+    }
+
+    /// [`Scene::load`] with options.
+    pub fn load_with(path: &Path, options: SceneOptions) -> Result<Scene> {
         let text = std::fs::read_to_string(path)
             .with_context(|| format!("cannot read scene `{}`", path.display()))?;
         let dir = path.parent().unwrap_or(Path::new("."));
-        Scene::parse(&text, dir).with_context(|| format!("scene `{}`", path.display()))
+        Scene::parse_with(&text, dir, options)
+            .with_context(|| format!("scene `{}`", path.display()))
+    }
+
+    /// The model file a scene names (relative to `dir`), without validating the rest.
+    #[must_use]
+    pub fn model_path(text: &str, dir: &Path) -> Option<std::path::PathBuf> {
+        let t: toml::Table = text.parse().ok()?;
+        Some(dir.join(t.get("model")?.as_str()?))
     }
 
     /// Parses and validates scene text; `dir` is the directory the model path is relative to.
     pub fn parse(text: &str, dir: &Path) -> Result<Scene> {
+        Scene::parse_with(text, dir, SceneOptions::default())
+    }
+
+    /// [`Scene::parse`] with options.
+    pub fn parse_with(text: &str, dir: &Path, options: SceneOptions) -> Result<Scene> {
         let raw: RawScene = toml::from_str(text).map_err(|e| anyhow!("{e}"))?;
         let model_path = dir.join(&raw.model);
         let validation = Validation {
@@ -445,7 +496,7 @@ impl Scene {
                 if !(p.mass.is_finite() && p.mass > 0.0) {
                     bail!("payload.mass: must be > 0");
                 }
-                check_finite("payload.com", &p.com)?;
+                check_bound("payload.com", &p.com, LENGTH)?;
                 let pay = Inertial {
                     mass: p.mass,
                     com: p.com,
@@ -510,7 +561,7 @@ impl Scene {
                     if !(mass.is_finite() && mass > 0.0) {
                         bail!("base.mass: must be > 0");
                     }
-                    check_finite("base.com", &com)?;
+                    check_bound("base.com", &com, LENGTH)?;
                     let inertial = Inertial { mass, com, inertia };
                     kanegen_model::validate_inertial_with(
                         "base",
@@ -528,9 +579,9 @@ impl Scene {
                     let position = b.position.unwrap_or([0.0; 3]);
                     let v = b.v.unwrap_or([0.0; 3]);
                     let omega = b.omega.unwrap_or([0.0; 3]);
-                    check_finite("base.position", &position)?;
-                    check_finite("base.v", &v)?;
-                    check_finite("base.omega", &omega)?;
+                    check_bound("base.position", &position, LENGTH)?;
+                    check_bound("base.v", &v, RATE)?;
+                    check_bound("base.omega", &omega, RATE)?;
                     BaseSpec::FreeFloating {
                         inertial,
                         position,
@@ -548,10 +599,10 @@ impl Scene {
 
         let e = raw.effects;
         if let Some(g) = &e.gravity {
-            check_finite("effects.gravity", g)?;
+            check_bound("effects.gravity", g, GRAVITY)?;
         }
         if let Some(c) = &e.damping {
-            check_len("effects.damping", c, n)?;
+            check_len("effects.damping", c, n, GAIN)?;
             if c.iter().any(|x| *x < 0.0) {
                 bail!("effects.damping: coefficients must be >= 0");
             }
@@ -592,9 +643,9 @@ impl Scene {
         }
 
         let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
-        check_len("initial.q", &q0, n)?;
+        check_len("initial.q", &q0, n, POSITION)?;
         let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
-        check_len("initial.qd", &qd0, n)?;
+        check_len("initial.qd", &qd0, n, RATE)?;
 
         let drives = match raw.drives {
             None => Drives::None,
@@ -626,7 +677,7 @@ impl Scene {
                         let tau = d
                             .tau
                             .ok_or_else(|| anyhow!("drives.tau: required by type = \"constant\""))?;
-                        check_len("drives.tau", &tau, n)?;
+                        check_len("drives.tau", &tau, n, FORCE)?;
                         Drives::Constant { tau }
                     }
                     "pd" => {
@@ -634,7 +685,7 @@ impl Scene {
                         let target = d
                             .target
                             .ok_or_else(|| anyhow!("drives.target: required by type = \"pd\""))?;
-                        check_len("drives.target", &target, n)?;
+                        check_len("drives.target", &target, n, POSITION)?;
                         Drives::Pd {
                             kp: gain("drives.kp", d.kp, n)?,
                             kd: gain("drives.kd", d.kd, n)?,
@@ -649,7 +700,7 @@ impl Scene {
                         let target = d.target.ok_or_else(|| {
                             anyhow!("drives.target: required by type = \"computed-torque\"")
                         })?;
-                        check_len("drives.target", &target, n)?;
+                        check_len("drives.target", &target, n, POSITION)?;
                         let duration = d.duration_s.ok_or_else(|| {
                             anyhow!("drives.duration_s: required by type = \"computed-torque\"")
                         })?;
@@ -693,6 +744,13 @@ impl Scene {
         if !(tolerance.is_finite() && tolerance > 0.0) {
             bail!("simulation.tolerance: must be > 0");
         }
+        if tolerance < MIN_TOLERANCE {
+            bail!(
+                "simulation.tolerance: {tolerance:e} is below {MIN_TOLERANCE:e}: the error \
+                 estimate would be dominated by the rounding error of the state (2.2e-16 \
+                 relative) and the step size would shrink until it underflows"
+            );
+        }
         let max_step = s.max_step.unwrap_or(s.duration);
         if !(max_step.is_finite() && max_step > 0.0) {
             bail!("simulation.max_step: must be > 0");
@@ -700,6 +758,30 @@ impl Scene {
         let output_every = s.output_every.unwrap_or(10);
         if output_every == 0 {
             bail!("simulation.output_every: must be >= 1");
+        }
+        let allow_long = s.allow_long || options.allow_long;
+        let limit = if allow_long {
+            MAX_STEPS_LONG
+        } else {
+            MAX_STEPS
+        };
+        let hint = if allow_long {
+            ""
+        } else {
+            " (set allow_long = true in [simulation], or pass --allow-long, to run it)"
+        };
+        let samples = s.duration / (step * output_every as f64);
+        if integrator != Integrator::Dopri5 && s.duration / step > limit {
+            bail!(
+                "simulation.step: duration / step = {:.3e} steps exceeds the limit {limit:.0e}{hint}",
+                s.duration / step
+            );
+        }
+        if samples > limit {
+            bail!(
+                "simulation.output_every: duration / (step · output_every) = {samples:.3e} output \
+                 samples exceeds the limit {limit:.0e}{hint}"
+            );
         }
         // The paper's algorithms handle serial chains; a tree takes the local-frame ones.
         let algorithm = match s.algorithm {
@@ -749,6 +831,7 @@ impl Scene {
                 max_step,
                 output_every,
                 algorithm,
+                allow_long,
             },
         })
     }

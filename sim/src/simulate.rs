@@ -7,7 +7,7 @@
 //! after every accepted step ([`System::project`]); the implicit midpoint rule updates it by the
 //! exponential map ([`System::advance`]) and needs no projection.
 
-use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, Stats, System};
+use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, System};
 use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench};
 use anyhow::Result;
 use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
@@ -16,6 +16,8 @@ use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::{FrameParams, Loads, Params};
 use serde::Serialize;
+use std::ops::ControlFlow;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 /// A scene as a first-order system for the integrators.
 pub struct SceneSystem<'a> {
@@ -27,6 +29,8 @@ pub struct SceneSystem<'a> {
     /// Whether some wrench is tabulated in time (then `deriv` evaluates the wrenches at `t`).
     time_varying: bool,
     n: usize,
+    /// Set (by a Ctrl-C handler) to stop the run at the next step.
+    stop: Option<&'a AtomicBool>,
 }
 
 /// Quintic time scaling `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` and its first two derivatives, `τ ∈ [0, 1]`.
@@ -79,6 +83,37 @@ impl<'a> SceneSystem<'a> {
             },
             time_varying: scene.wrenches.iter().any(SceneWrench::is_tabulated),
             n: scene.model.dof(),
+            stop: None,
+        }
+    }
+
+    /// The system, stopped at the next step once `stop` is set ([`System::interrupted`]).
+    #[must_use]
+    pub fn with_stop(mut self, stop: Option<&'a AtomicBool>) -> Self {
+        self.stop = stop;
+        self
+    }
+
+    /// The name of state component `i` (the CSV column, see [`csv_header`]).
+    #[must_use]
+    pub fn component_name(&self, i: usize) -> String {
+        let n = self.n;
+        let joint = |k: usize| self.scene.model.joints()[k].name.clone();
+        let xyz = ["x", "y", "z"];
+        if self.base.is_none() {
+            return if i < n {
+                format!("q_{}", joint(i))
+            } else {
+                format!("qd_{}", joint(i - n))
+            };
+        }
+        match i {
+            0..=2 => format!("p0_{}", xyz[i]),
+            3..=6 => format!("quat_{}", ["x", "y", "z", "w"][i - 3]),
+            _ if i < 7 + n => format!("q_{}", joint(i - 7)),
+            _ if i < 10 + n => format!("v_b_{}", xyz[i - 7 - n]),
+            _ if i < 13 + n => format!("omega_b_{}", xyz[i - 10 - n]),
+            _ => format!("qd_{}", joint(i - 13 - n)),
         }
     }
 
@@ -288,6 +323,10 @@ impl System for SceneSystem<'_> {
         }
     }
 
+    fn interrupted(&self) -> bool {
+        self.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
     fn project(&self, x: &mut [f64]) {
         if self.base.is_some() {
             let norm = x[3..7].iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -328,9 +367,16 @@ pub struct Summary {
     pub max_linear_momentum_drift_rel: Option<f64>,
     /// Maximal relative angular-momentum drift.
     pub max_angular_momentum_drift_rel: Option<f64>,
-    /// The final joint state.
+    /// The final joint state (at `t_end`).
     #[serde(rename = "final")]
     pub final_state: FinalState,
+    /// Whether the run reached the scene's duration.
+    pub complete: bool,
+    /// Time reached, s (the duration when complete).
+    pub t_end: f64,
+    /// Why an incomplete run stopped: `interrupted`, or the integrator's error; `null` when
+    /// complete.
+    pub stopped: Option<String>,
 }
 
 /// One output sample.
@@ -382,20 +428,120 @@ pub fn conserves_momentum(scene: &Scene) -> bool {
     scene.is_floating() && scene.wrenches.is_empty() && scene.gravity.is_none()
 }
 
-/// Integrates `scene` over its duration, sampling every `output_every` steps (RK4) or every
-/// `output_every · step` seconds of dense output (dopri5). `progress` (if any) is advanced to the
-/// simulated time in milliseconds.
-pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Result<Run> {
-    let mut sys = SceneSystem::new(scene);
+/// Where the output samples of a run go, one at a time, as they are produced (the CLI's CSV
+/// writer and plot buffer, [`Decimated`], or a closure).
+pub trait Sink {
+    /// Takes one sample. An error stops the run; [`simulate_to`] returns it.
+    ///
+    /// # Errors
+    /// Whatever the sink cannot do (a full disk).
+    fn sample(&mut self, s: &Sample) -> Result<()>;
+}
+
+impl<F: FnMut(&Sample) -> Result<()>> Sink for F {
+    fn sample(&mut self, s: &Sample) -> Result<()> {
+        self(s)
+    }
+}
+
+/// How a run is watched and stopped.
+#[derive(Clone, Copy, Default)]
+pub struct Control<'a> {
+    /// Advanced to the simulated time in milliseconds.
+    pub progress: Option<&'a indicatif::ProgressBar>,
+    /// When set (by a Ctrl-C handler), the run stops after the current step and the summary says
+    /// `complete: false`, `stopped: "interrupted"`.
+    pub stop: Option<&'a AtomicBool>,
+}
+
+/// A bounded, evenly decimated copy of a run's samples, for plots: at most `cap` samples (every
+/// `stride`-th; when full, every other one is dropped and the stride doubles), plus the last
+/// sample seen. Memory stays `O(cap)` however long the run.
+#[derive(Clone, Debug)]
+pub struct Decimated {
+    cap: usize,
+    stride: usize,
+    seen: usize,
+    kept: Vec<Sample>,
+    last: Option<Sample>,
+}
+
+impl Decimated {
+    /// An empty buffer of at most `cap` (≥ 2) samples.
+    #[must_use]
+    pub fn new(cap: usize) -> Self {
+        Decimated {
+            cap: cap.max(2),
+            stride: 1,
+            seen: 0,
+            kept: Vec::new(),
+            last: None,
+        }
+    }
+
+    /// The kept samples in time order, the last sample seen at the end.
+    #[must_use]
+    pub fn into_samples(self) -> Vec<Sample> {
+        let mut v = self.kept;
+        if let Some(l) = self.last {
+            if v.last().is_none_or(|k| k.t != l.t) {
+                v.push(l);
+            }
+        }
+        v
+    }
+}
+
+impl Sink for Decimated {
+    fn sample(&mut self, s: &Sample) -> Result<()> {
+        // `stride` is a power of two.
+        if self.seen & (self.stride - 1) == 0 {
+            if self.kept.len() == self.cap {
+                let mut i = 0;
+                self.kept.retain(|_| {
+                    i += 1;
+                    i % 2 == 1
+                });
+                self.stride *= 2;
+            }
+            if self.seen & (self.stride - 1) == 0 {
+                self.kept.push(s.clone());
+            }
+        }
+        self.seen += 1;
+        self.last = Some(s.clone());
+        Ok(())
+    }
+}
+
+/// Integrates `scene` over its duration, sampling every `output_every` steps (RK4, midpoint) or
+/// every `output_every · step` seconds of dense output (dopri5), and streams each sample to
+/// `sink`; only the drift maxima and the last state are kept, so memory does not grow with the
+/// duration.
+///
+/// An integrator failure (a non-finite state, a step-size underflow) or a stop through
+/// [`Control::stop`] ends the run early with a summary saying `complete: false` and why
+/// (`stopped`); every sample up to there has gone to the sink.
+///
+/// # Errors
+/// Only the sink's.
+pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> Result<Summary> {
+    let mut sys = SceneSystem::new(scene).with_stop(control.stop);
     let mut x = sys.initial_state();
     let sim = &scene.simulation;
     let energy_on = conserves_energy(scene);
     let momentum_on = conserves_momentum(scene);
     let e0 = if energy_on { sys.energy(&x) } else { None };
     let p0 = if momentum_on { sys.momentum(&x) } else { None };
-    let mut samples = Vec::new();
     let monitor = SceneSystem::new(scene);
-    let mut record = |t: f64, x: &[f64]| {
+    let mut max_e: Option<f64> = e0.map(|_| 0.0);
+    let mut max_p: Option<(f64, f64)> = p0.map(|_| (0.0, 0.0));
+    let mut sink_error: Option<anyhow::Error> = None;
+    let last_t = std::cell::Cell::new(f64::NAN);
+    let mut record = |t: f64, x: &[f64]| -> ControlFlow<()> {
+        if sink_error.is_some() {
+            return ControlFlow::Break(());
+        }
         let energy_drift = e0.and_then(|e0| monitor.energy(x).map(|e| rel(e - e0, e0)));
         let momentum_drift = p0.and_then(|(l0, a0)| {
             monitor.momentum(x).map(|(l, a)| {
@@ -404,33 +550,51 @@ pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Res
                 (rel(norm(&dl), norm(&l0)), rel(norm(&da), norm(&a0)))
             })
         });
-        if let Some(pb) = progress {
+        if let (Some(m), Some(d)) = (max_e.as_mut(), energy_drift) {
+            *m = m.max(d.abs());
+        }
+        if let (Some(m), Some(d)) = (max_p.as_mut(), momentum_drift) {
+            *m = (m.0.max(d.0.abs()), m.1.max(d.1.abs()));
+        }
+        if let Some(pb) = control.progress {
             pb.set_position((t * 1000.0) as u64);
         }
-        samples.push(Sample {
+        last_t.set(t);
+        let sample = Sample {
             t,
             x: x.to_vec(),
             energy_drift,
             momentum_drift,
-        });
+        };
+        match sink.sample(&sample) {
+            Ok(()) => ControlFlow::Continue(()),
+            Err(e) => {
+                sink_error = Some(e);
+                ControlFlow::Break(())
+            }
+        }
     };
     let start = std::time::Instant::now();
-    let stats: Stats = match sim.integrator {
+    let result = match sim.integrator {
         Integrator::Rk4 => {
             let total = ((sim.duration / sim.step) - 1e-9).ceil().max(1.0) as usize;
             rk4(&mut sys, 0.0, sim.duration, sim.step, &mut x, |k, t, x| {
                 if k % sim.output_every == 0 || k == total {
-                    record(t, x);
+                    record(t, x)
+                } else {
+                    ControlFlow::Continue(())
                 }
-            })?
+            })
         }
         Integrator::Midpoint => {
             let total = ((sim.duration / sim.step) - 1e-9).ceil().max(1.0) as usize;
             midpoint(&mut sys, 0.0, sim.duration, sim.step, &mut x, |k, t, x| {
                 if k % sim.output_every == 0 || k == total {
-                    record(t, x);
+                    record(t, x)
+                } else {
+                    ControlFlow::Continue(())
                 }
-            })?
+            })
         }
         Integrator::Dopri5 => {
             let opts = Dopri5Options {
@@ -439,18 +603,34 @@ pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Res
                 initial_step: sim.step,
                 output_interval: sim.step * sim.output_every as f64,
             };
-            dopri5(&mut sys, 0.0, sim.duration, &opts, &mut x, &mut record)?
+            dopri5(&mut sys, 0.0, sim.duration, &opts, &mut x, &mut record)
         }
     };
     let wall_s = start.elapsed().as_secs_f64();
-    let max_of = |f: &dyn Fn(&Sample) -> Option<f64>| -> Option<f64> {
-        samples
-            .iter()
-            .map(f)
-            .try_fold(0.0_f64, |m, v| v.map(|v| m.max(v.abs())))
+    let (stats, t_end, stopped) = match &result {
+        Ok(stats) => (*stats, sim.duration, None),
+        Err(e) => {
+            let why = match e {
+                IntegrateError::Interrupted { .. } => "interrupted".to_string(),
+                IntegrateError::NonFinite { t, index, .. } => format!(
+                    "`{}` became non-finite in the step to t = {t} (the state overflowed: a \
+                     singular mass matrix or an unstable drive)",
+                    sys.component_name(*index)
+                ),
+                other => other.to_string(),
+            };
+            (e.stats(), e.t(), Some(why))
+        }
     };
+    // An early stop: the state reached (the last accepted one) ends the samples.
+    if result.is_err() && last_t.get() != t_end {
+        let _ = record(t_end, &x);
+    }
+    if let Some(e) = sink_error {
+        return Err(e);
+    }
     let (q, qd, _) = sys.split(&x);
-    let summary = Summary {
+    Ok(Summary {
         base: if scene.is_floating() {
             "free-floating"
         } else {
@@ -460,14 +640,37 @@ pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Res
         rejected_steps: stats.rejected_steps,
         evals: stats.evals,
         wall_s,
-        max_energy_drift_rel: max_of(&|s| s.energy_drift),
-        max_linear_momentum_drift_rel: max_of(&|s| s.momentum_drift.map(|m| m.0)),
-        max_angular_momentum_drift_rel: max_of(&|s| s.momentum_drift.map(|m| m.1)),
+        max_energy_drift_rel: max_e,
+        max_linear_momentum_drift_rel: max_p.map(|m| m.0),
+        max_angular_momentum_drift_rel: max_p.map(|m| m.1),
         final_state: FinalState {
             q: q.to_vec(),
             qd: qd.to_vec(),
         },
+        complete: result.is_ok(),
+        t_end,
+        stopped,
+    })
+}
+
+/// [`simulate_to`] keeping every sample in memory (tests and short runs).
+///
+/// # Errors
+/// If the run did not complete (the integrator's error).
+pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Result<Run> {
+    let mut samples: Vec<Sample> = Vec::new();
+    let mut sink = |s: &Sample| -> Result<()> {
+        samples.push(s.clone());
+        Ok(())
     };
+    let control = Control {
+        progress,
+        stop: None,
+    };
+    let summary = simulate_to(scene, &mut sink, control)?;
+    if let Some(why) = &summary.stopped {
+        anyhow::bail!("{why}");
+    }
     Ok(Run { summary, samples })
 }
 
@@ -475,8 +678,17 @@ pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Res
 #[must_use]
 pub fn render_text(s: &Summary) -> String {
     let f = |x: Option<f64>| x.map_or("not conserved".to_string(), |v| format!("{v:.3e}"));
+    let status = if s.complete {
+        String::new()
+    } else {
+        format!(
+            "INCOMPLETE: stopped at t = {} ({})\n",
+            s.t_end,
+            s.stopped.as_deref().unwrap_or("")
+        )
+    };
     format!(
-        "base: {}\nsteps: {} accepted, {} rejected, {} evaluations, {:.3} s\n\
+        "{status}base: {}\nsteps: {} accepted, {} rejected, {} evaluations, {:.3} s\n\
          energy drift (rel): {}\nlinear momentum drift (rel): {}\n\
          angular momentum drift (rel): {}\nfinal q: {:?}\nfinal qd: {:?}",
         s.base,
@@ -518,26 +730,71 @@ pub fn csv_header(scene: &Scene) -> Vec<String> {
     h
 }
 
+/// One CSV row of a sample (see [`csv_header`]), with its newline. Numbers in Rust's shortest
+/// round-trip `{:e}` form.
+#[must_use]
+pub fn csv_row(scene: &Scene, s: &Sample) -> String {
+    let n = scene.model.dof();
+    let x = &s.x;
+    let mut row: Vec<f64> = vec![s.t];
+    if scene.is_floating() {
+        row.extend(&x[7..7 + n]);
+        row.extend(&x[13 + n..13 + 2 * n]);
+        row.extend(&x[..7]);
+        row.extend(&x[7 + n..13 + n]);
+    } else {
+        row.extend(x);
+    }
+    let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
+    let mut out = cells.join(",");
+    out.push('\n');
+    out
+}
+
 /// The trajectory as CSV text (see [`csv_header`]).
 #[must_use]
 pub fn trajectory_csv(scene: &Scene, run: &Run) -> String {
-    let n = scene.model.dof();
     let mut out = csv_header(scene).join(",");
     out.push('\n');
     for s in &run.samples {
-        let x = &s.x;
-        let mut row: Vec<f64> = vec![s.t];
-        if scene.is_floating() {
-            row.extend(&x[7..7 + n]);
-            row.extend(&x[13 + n..13 + 2 * n]);
-            row.extend(&x[..7]);
-            row.extend(&x[7 + n..13 + n]);
-        } else {
-            row.extend(x);
-        }
-        let cells: Vec<String> = row.iter().map(|v| format!("{v:e}")).collect();
-        out.push_str(&cells.join(","));
-        out.push('\n');
+        out.push_str(&csv_row(scene, s));
     }
     out
+}
+
+impl Summary {
+    /// Checks every number of the summary is finite.
+    ///
+    /// # Errors
+    /// Naming the first field that is not.
+    pub fn check_finite(&self) -> Result<()> {
+        let mut fields: Vec<(String, f64)> = vec![("t_end".into(), self.t_end)];
+        for (k, v) in [
+            ("max_energy_drift_rel", self.max_energy_drift_rel),
+            (
+                "max_linear_momentum_drift_rel",
+                self.max_linear_momentum_drift_rel,
+            ),
+            (
+                "max_angular_momentum_drift_rel",
+                self.max_angular_momentum_drift_rel,
+            ),
+        ] {
+            if let Some(v) = v {
+                fields.push((k.into(), v));
+            }
+        }
+        for (i, v) in self.final_state.q.iter().enumerate() {
+            fields.push((format!("final.q[{i}]"), *v));
+        }
+        for (i, v) in self.final_state.qd.iter().enumerate() {
+            fields.push((format!("final.qd[{i}]"), *v));
+        }
+        match fields.iter().find(|(_, v)| !v.is_finite()) {
+            Some((k, v)) => anyhow::bail!(
+                "summary field `{k}` is {v} (not finite): a monitored quantity overflowed"
+            ),
+            None => Ok(()),
+        }
+    }
 }

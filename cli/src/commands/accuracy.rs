@@ -5,6 +5,7 @@ use crate::plots::accuracy::{work_precision_chart, Curve};
 use crate::reports::accuracy::evaluation::GeneratedFns;
 use crate::reports::accuracy::{model_report, scene_report, AccuracyReport, Options};
 use anyhow::{Context, Result};
+
 use std::path::{Path, PathBuf};
 
 /// What `kanegen accuracy` reports on when given no input (and what `docs/accuracy.md` holds):
@@ -33,8 +34,21 @@ pub fn run(
     allow_nonphysical: bool,
     opts: Options,
 ) -> Result<Vec<AccuracyReport>> {
+    run_with_progress(inputs, allow_nonphysical, opts, &|_, _| {})
+}
+
+/// [`run`], calling `progress(done, total)` after each input. A subject whose `A` is singular
+/// or not finite at the evaluation states (condition number not a finite number ≥ 1) is an
+/// error: its errors and digits would mean nothing.
+pub fn run_with_progress(
+    inputs: &[PathBuf],
+    allow_nonphysical: bool,
+    opts: Options,
+    progress: &dyn Fn(usize, usize),
+) -> Result<Vec<AccuracyReport>> {
     let mut out = Vec::new();
-    for path in inputs {
+    for (k, path) in inputs.iter().enumerate() {
+        progress(k, inputs.len());
         let name = path.display().to_string();
         let r = if super::count::is_scene_file(path) {
             let scene = kanegen_sim::scene::Scene::load(path)?;
@@ -47,14 +61,40 @@ pub fn run(
                 .with_context(|| format!("model `{name}`"))?;
             model_report(&name, &chain, &generated_for(&chain)?, opts)
         };
+        if !(r.cond_a.is_finite() && r.cond_a >= 1.0) {
+            anyhow::bail!(
+                "`{name}`: the condition number of A is {}: A is singular or not finite at the \
+                 evaluation states (a model quantity or the state overflowed), so no error or \
+                 digit of the report would mean anything",
+                r.cond_a
+            );
+        }
         out.push(r);
+        progress(k + 1, inputs.len());
     }
     Ok(out)
+}
+
+/// Every file `accuracy --out DIR` may write for `inputs`: `accuracy.md`, `accuracy.json` and
+/// two work–precision figures per input (written for scenes).
+#[must_use]
+pub fn file_names(inputs: &[PathBuf]) -> Vec<String> {
+    let mut v = vec!["accuracy.md".to_string(), "accuracy.json".to_string()];
+    for p in inputs {
+        let stem = p
+            .file_stem()
+            .map_or("subject".into(), |s| s.to_string_lossy().into_owned());
+        v.push(format!("work_precision_{stem}.svg"));
+        v.push(format!("work_precision_{stem}_evals.svg"));
+    }
+    v
 }
 
 fn sci(x: f64) -> String {
     if x.is_nan() {
         "—".into()
+    } else if x.is_infinite() {
+        "overflow".into()
     } else if x == 0.0 {
         "0 (rounds to the reference)".into()
     } else {
@@ -178,22 +218,37 @@ pub fn to_json(reports: &[AccuracyReport]) -> serde_json::Value {
     }
 }
 
-/// Writes `accuracy.md`, `accuracy.json` and one work–precision SVG per scene into `dir`.
+/// Writes `accuracy.md`, `accuracy.json` and one work–precision SVG per scene into `dir`
+/// (created if needed, files replaced).
 pub fn write_all(reports: &[AccuracyReport], dir: &Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("cannot create `{}`", dir.display()))?;
-    let w = |name: &str, text: String| {
-        std::fs::write(dir.join(name), text)
-            .with_context(|| format!("cannot write `{}`", dir.join(name).display()))
-    };
-    w("accuracy.md", render_markdown(reports, true)?)?;
-    w(
-        "accuracy.json",
-        serde_json::to_string_pretty(&to_json(reports))? + "\n",
-    )?;
+    let inputs: Vec<PathBuf> = reports.iter().map(|r| PathBuf::from(&r.subject)).collect();
+    let names = file_names(&inputs);
+    let names: Vec<&str> = names.iter().map(String::as_str).collect();
+    write_planned(
+        reports,
+        &crate::output::OutputDir::plan(dir, &names, true, &[])?,
+    )
+}
+
+/// Writes the files into a planned output directory, atomically.
+pub fn write_planned(reports: &[AccuracyReport], dir: &crate::output::OutputDir) -> Result<()> {
+    let mut files: Vec<(String, Vec<u8>)> = vec![
+        (
+            "accuracy.md".into(),
+            render_markdown(reports, true)?.into_bytes(),
+        ),
+        (
+            "accuracy.json".into(),
+            (serde_json::to_string_pretty(&to_json(reports))? + "\n").into_bytes(),
+        ),
+    ];
     for r in reports.iter().filter(|r| !r.integration.is_empty()) {
         for cost in [Cost::Wall, Cost::Evals] {
-            w(&figure_name(r, cost), render_figure(r, cost)?)?;
+            files.push((figure_name(r, cost), render_figure(r, cost)?.into_bytes()));
         }
     }
-    Ok(())
+    let files: Vec<(&str, Vec<u8>)> = files.iter().map(|(n, c)| (n.as_str(), c.clone())).collect();
+    dir.write_all(&files)?;
+    let written: Vec<&str> = files.iter().map(|(n, _)| *n).collect();
+    dir.remove_stale(&written)
 }

@@ -48,7 +48,7 @@ pub fn eval_states(
     let base = model
         .base_inertial()
         .map(FloatingBase::<f64>::from_inertial);
-    Ok(states
+    let results: Vec<EvalResult> = states
         .iter()
         .map(|s: &State| {
             let loads = Loads {
@@ -70,7 +70,38 @@ pub fn eval_states(
             };
             EvalResult { a, b }
         })
-        .collect())
+        .collect();
+    for (k, (r, s)) in results.iter().zip(&states).enumerate() {
+        check_finite(k, r, s)?;
+    }
+    Ok(results)
+}
+
+/// Every entry of `A` and `b` of state `k` is finite, or an error naming the entry and the
+/// state's largest magnitudes.
+fn check_finite(k: usize, r: &EvalResult, s: &State) -> Result<()> {
+    let bad =
+        r.a.iter()
+            .enumerate()
+            .flat_map(|(i, row)| {
+                row.iter()
+                    .enumerate()
+                    .map(move |(j, v)| (format!("A[{i}][{j}]"), *v))
+            })
+            .chain(r.b.iter().enumerate().map(|(i, v)| (format!("b[{i}]"), *v)))
+            .find(|(_, v)| !v.is_finite());
+    if let Some((entry, v)) = bad {
+        let max = |v: &[f64]| v.iter().fold(0.0_f64, |m, x| m.max(x.abs()));
+        anyhow::bail!(
+            "states[{k}]: {entry} = {v} is not finite: the computation overflowed (largest |q| = \
+             {:e}, |qd| = {:e}, |tau| = {:e}; the model's lengths, masses and inertias, or the \
+             gravity, are too large together)",
+            max(&s.q),
+            max(&s.qd),
+            s.tau.as_deref().map_or(0.0, max)
+        );
+    }
+    Ok(())
 }
 
 /// Human-readable rendering of the results.

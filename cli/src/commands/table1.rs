@@ -1,6 +1,6 @@
 //! `kanegen table1`: the Markdown, JSON and Fig. 2 renderings of [`crate::table1`].
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use kanegen_trace::poly::Poly;
 use kanegen_trace::table1::{Table1, TableAlgorithm, N_MAX};
 use plotters::prelude::*;
@@ -175,14 +175,24 @@ pub fn render_fig2(t: &Table1) -> Result<String> {
     Ok(svg)
 }
 
-/// Writes `table1.md`, `table1.json` and `fig2.svg` into `dir`.
+/// The files `table1 --out DIR` writes.
+pub const FILES: [&str; 3] = ["table1.md", "table1.json", "fig2.svg"];
+
+/// Writes `table1.md`, `table1.json` and `fig2.svg` into `dir` (created if needed, files
+/// replaced).
 pub fn write_all(t: &Table1, dir: &std::path::Path) -> Result<()> {
-    std::fs::create_dir_all(dir).with_context(|| format!("create {}", dir.display()))?;
-    std::fs::write(dir.join("table1.md"), render_markdown(t)?)?;
-    std::fs::write(dir.join("fig2.svg"), render_fig2(t)?)?;
-    std::fs::write(
-        dir.join("table1.json"),
-        serde_json::to_string_pretty(t)? + "\n",
-    )?;
-    Ok(())
+    write_planned(t, &crate::output::OutputDir::plan(dir, &FILES, true, &[])?)
+}
+
+/// Writes the files into a planned output directory, atomically.
+pub fn write_planned(t: &Table1, dir: &crate::output::OutputDir) -> Result<()> {
+    let files = [
+        (FILES[0], render_markdown(t)?.into_bytes()),
+        (
+            FILES[1],
+            (serde_json::to_string_pretty(t)? + "\n").into_bytes(),
+        ),
+        (FILES[2], render_fig2(t)?.into_bytes()),
+    ];
+    dir.write_all(&files)
 }

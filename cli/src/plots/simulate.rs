@@ -1,7 +1,7 @@
 //! SVG plots of a simulation run against time: joint angles, energy/momentum drift, the
 //! end-effector position and (free-floating) the base attitude.
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::quat_to_matrix;
 use kanegen_dynamics::linalg::{Mat3, Vec3};
@@ -9,7 +9,6 @@ use kanegen_dynamics::{FrameParams, Params};
 use kanegen_sim::scene::Scene;
 use kanegen_sim::simulate::Run;
 use plotters::prelude::*;
-use std::path::Path;
 
 /// A named polyline.
 pub type Series = (String, Vec<(f64, f64)>);
@@ -131,10 +130,11 @@ pub fn base_attitude_series(run: &Run) -> Vec<Series> {
     out
 }
 
-/// Writes `joints.svg` (joint positions), `end_effector.svg` (inertial position of the last
-/// body's origin), for a free-floating base `base_attitude.svg` (roll/pitch/yaw) and, when the scene monitors any conserved quantity,
-/// `drift.svg` (relative energy and momentum drift) into `dir`.
-pub fn write_plots(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
+/// Renders `joints.svg` (joint positions), `end_effector.svg` (inertial position of the last
+/// body's origin), for a free-floating base `base_attitude.svg` (roll/pitch/yaw) and, when the
+/// scene monitors any conserved quantity, `drift.svg` (relative energy and momentum drift):
+/// `(file name, SVG)`.
+pub fn render_plots(scene: &Scene, run: &Run) -> Result<Vec<(&'static str, String)>> {
     let n = scene.model.dof();
     let off = if scene.is_floating() { 7 } else { 0 };
     let joints: Vec<Series> = scene
@@ -150,9 +150,10 @@ pub fn write_plots(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
             )
         })
         .collect();
-    let write = |name: &str, svg: String| -> Result<()> {
-        let p = dir.join(name);
-        std::fs::write(&p, svg).with_context(|| format!("cannot write `{}`", p.display()))
+    let mut files: Vec<(&'static str, String)> = Vec::new();
+    let mut write = |name: &'static str, svg: String| -> Result<()> {
+        files.push((name, svg));
+        Ok(())
     };
     write(
         "joints.svg",
@@ -200,5 +201,5 @@ pub fn write_plots(scene: &Scene, run: &Run, dir: &Path) -> Result<()> {
             )?,
         )?;
     }
-    Ok(())
+    Ok(files)
 }

@@ -1,6 +1,7 @@
 //! kanegen's TOML model format (see README.md, "Model files"), with optional DH geometry.
 
-use crate::inertial::{finite, rotate_inertia, validate_inertial_with};
+use crate::bounds::{LENGTH, POSITION};
+use crate::inertial::{bounded, finite, rotate_inertia, validate_inertial_with};
 use crate::placement::{rpy_to_matrix, Placement, I3, M3, V3};
 use crate::{BaseKind, Frame, Inertial, Joint, JointKind, Model, ModelError, Validation};
 use serde::de::{self, Deserializer, MapAccess, SeqAccess, Visitor};
@@ -264,7 +265,7 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
     let dh_base = match &spec.dh {
         Some(dh) => {
             let xyz = dh.base_xyz.unwrap_or([0.0; 3]);
-            finite("dh", "dh.base_xyz", &xyz)?;
+            bounded("dh", "dh.base_xyz", &xyz, LENGTH)?;
             Some(Placement {
                 rotation: rotation_of("dh", "dh.base_", dh.base_rpy, dh.base_rotation)?,
                 translation: xyz,
@@ -356,7 +357,7 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
                     }
                 }
                 let xyz = js.xyz.unwrap_or([0.0; 3]);
-                finite(&label, "xyz", &xyz)?;
+                bounded(&label, "xyz", &xyz, LENGTH)?;
                 let r = rotation_of(&label, "", js.rpy, js.rotation)?;
                 let axis = js.axis.ok_or_else(|| {
                     ModelError::invalid(&label, "axis", "missing (required unless [dh] is given)")
@@ -387,8 +388,13 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
                 }
                 let [a, alpha, d, theta] =
                     [js.a, js.alpha, js.d, js.theta].map(|x| x.unwrap_or(0.0));
-                for (field, x) in [("a", a), ("alpha", alpha), ("d", d), ("theta", theta)] {
-                    finite(&label, field, &[x])?;
+                for (field, x, b) in [
+                    ("a", a, LENGTH),
+                    ("alpha", alpha, POSITION),
+                    ("d", d, LENGTH),
+                    ("theta", theta, POSITION),
+                ] {
+                    bounded(&label, field, &[x], b)?;
                 }
                 let origin = match dh.convention {
                     DhConvention::Modified => {
@@ -432,7 +438,7 @@ fn build(spec: ModelSpec, validation: Validation) -> Result<Model, ModelError> {
     let mut frames = Vec::new();
     for f in &spec.frames {
         let xyz = f.xyz.unwrap_or([0.0; 3]);
-        finite(&f.name, "frame.xyz", &xyz)?;
+        bounded(&f.name, "frame.xyz", &xyz, LENGTH)?;
         frames.push(Frame {
             name: f.name.clone(),
             parent: parent_of(&f.name, "frame.parent", &f.parent, &joints)?,

@@ -245,20 +245,41 @@ pub struct EvalRow {
     pub ns: f64,
 }
 
-/// NaN (not measured) as JSON `null` and back.
+/// NaN (not measured) as JSON `null`, an infinite error (the precision failed: an overflow or a
+/// singular solve) as the string `"inf"`, and back: JSON has no non-finite numbers, and
+/// `serde_json` would write both as `null`.
 mod nan_as_null {
     use serde::{Deserialize, Deserializer, Serializer};
 
     pub fn serialize<S: Serializer>(x: &f64, s: S) -> Result<S::Ok, S::Error> {
         if x.is_nan() {
             s.serialize_none()
+        } else if x.is_infinite() {
+            s.serialize_str(if *x > 0.0 { "inf" } else { "-inf" })
         } else {
             s.serialize_f64(*x)
         }
     }
 
+    #[derive(Deserialize)]
+    #[serde(untagged)]
+    enum Value {
+        Number(f64),
+        Text(String),
+    }
+
     pub fn deserialize<'de, D: Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
-        Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+        Ok(match Option::<Value>::deserialize(d)? {
+            None => f64::NAN,
+            Some(Value::Number(x)) => x,
+            Some(Value::Text(t)) if t == "inf" => f64::INFINITY,
+            Some(Value::Text(t)) if t == "-inf" => f64::NEG_INFINITY,
+            Some(Value::Text(t)) => {
+                return Err(serde::de::Error::custom(format!(
+                    "expected a number, null or \"inf\", got \"{t}\""
+                )))
+            }
+        })
     }
 }
 

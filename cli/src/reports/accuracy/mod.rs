@@ -53,10 +53,13 @@ pub struct AccuracyReport {
 pub const STATES: usize = 8;
 
 /// Decimal digits of a relative error (`−log10`). A zero error means the result, delivered in
-/// `f64`, rounds to the reference in every entry: the ≈16 digits of an `f64`.
+/// `f64`, rounds to the reference in every entry: the ≈16 digits of an `f64`; an error of 1 or
+/// more, or a non-finite one, means no correct digit (0).
 #[must_use]
 pub fn digits(err: f64) -> f64 {
-    if err > 0.0 {
+    if !err.is_finite() || err >= 1.0 {
+        0.0
+    } else if err > 0.0 {
         -err.log10()
     } else {
         -(f64::EPSILON / 2.0).log10()
