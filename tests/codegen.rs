@@ -277,10 +277,10 @@ fn ssrms_mass_matrix_against_like_candidates() {
 }
 
 /// Per-function counts of the header line `Fused multiply-adds: T (`f` k, …)`, and `T`.
-fn header_fmas(src: &str) -> (u64, Vec<(String, u64)>) {
+fn header_fmas(src: &str, prefix: &str) -> (u64, Vec<(String, u64)>) {
     let line = src
         .lines()
-        .find_map(|l| l.strip_prefix("//! Fused multiply-adds: "))
+        .find_map(|l| l.strip_prefix(prefix))
         .expect("the fma header line");
     let (total, rest) = line.split_once(" (").unwrap();
     let per = rest
@@ -323,14 +323,34 @@ fn fma_source_has_the_fused_calls_its_header_states() {
     let chain = GENERATED[0].model(root()).unwrap();
     let plain =
         kanegen::codegen::generate_file(&chain, &kanegen::codegen::Options::new("Ssrms")).unwrap();
-    assert!(!plain.contains("//! Fused multiply-adds") && !plain.contains("fma("));
+    assert!(!plain.contains("//! Fused multiply-adds:") && !plain.contains("fma("));
+    // The default fuses through `Self::mul_add` (fused where the build targets FMA): the calls
+    // are those its header states, and its one `unsafe` pair is in that helper, behind `cfg`s.
+    let (total, per) = header_fmas(
+        &plain,
+        "//! Fused multiply-adds where the target has them: ",
+    );
+    assert_eq!(calls_per_function(&plain, "Self::mul_add("), per);
+    assert!(total > 0 && per.iter().all(|(_, k)| *k > 0), "{per:?}");
+    assert_eq!(plain.matches("unsafe {").count(), 2);
+    assert_eq!(plain.matches("fn mul_add(").count(), 1);
+    // Without it: no fusion, no helper, no unsafe.
+    let mut o = kanegen::codegen::Options::new("Ssrms");
+    o.target_fma = false;
+    let unfused = kanegen::codegen::generate_file(&chain, &o).unwrap();
+    assert!(
+        !unfused.contains("//! Fused multiply-adds")
+            && !unfused.contains("fn mul_add")
+            && !unfused.contains("Self::mul_add")
+            && !unfused.contains("unsafe")
+    );
     for path in [None, Some("f64::mul_add")] {
         let mut o = kanegen::codegen::Options::new("Ssrms");
         o.fma = true;
         o.fma_path = path.map(String::from);
         let src = kanegen::codegen::generate_file(&chain, &o).unwrap();
         let call = format!("{}(", path.unwrap_or("libm::fma"));
-        let (total, per) = header_fmas(&src);
+        let (total, per) = header_fmas(&src, "//! Fused multiply-adds: ");
         let have = calls_per_function(&src, &call);
         eprintln!("SSRMS fma ({call}): {total} in all, {per:?}");
         assert_eq!(have, per, "{call}");

@@ -106,6 +106,8 @@ impl Emitter {
                     quote!(#libm::#f)
                 }
             })
+        } else if opts.target_fma {
+            Some(quote!(Self::mul_add))
         } else {
             None
         };
@@ -225,16 +227,19 @@ pub fn emit_body_streamed(
         }
     }
     // Inlined (single-use, not an output): its expression appears once, in its user's.
-    let inlined = |s: Sym| !outputs.contains(&s.id()) && uses.get(&s.id()).copied() == Some(1);
+    let inlined_id = |id: u32| !outputs.contains(&id) && uses.get(&id).copied() == Some(1);
+    let inlined = |s: Sym| inlined_id(s.id());
     // The factors of a product that fuses into its user: an inlined multiplication.
     let product = |s: Sym| match nodes.get(&s.id()) {
         Some(Node::Mul(a, b)) if fma.is_some() && inlined(s) => Some((*a, *b)),
         _ => None,
     };
     let is_const = |s: Sym| matches!(nodes.get(&s.id()), Some(Node::Const(_)));
-    // An inlined node's expression is taken out when its one user reads it (without fused
-    // multiply-adds, whose users also read their operands' operands): memory stays linear in the
-    // emitted code, and a long single-use chain is moved into its user, not copied.
+    // An inlined node's expression is taken out when its one user reads it: memory stays linear
+    // in the emitted code, and a long single-use chain is moved into its user, not copied. A
+    // node its user may look through (a product that fuses, an inlined negation that a fused
+    // call unwraps) builds its own expression from copies, so the user can still take the
+    // operands.
     let exprs: RefCell<HashMap<u32, Expr>> = RefCell::new(HashMap::new());
     let mut counter = 0usize;
     let mut fmas = 0u64;
@@ -251,8 +256,13 @@ pub fn emit_body_streamed(
     };
     for (id, node) in &sched {
         let id = *id;
+        let see_through = match node {
+            Node::Mul(..) => fma.is_some() && inlined_id(id),
+            Node::Neg(..) => fma.is_some(),
+            _ => false,
+        };
         let get = |s: Sym| {
-            if fma.is_none() && inlined(s) {
+            if !see_through && inlined(s) {
                 exprs
                     .borrow_mut()
                     .remove(&s.id())
@@ -265,12 +275,20 @@ pub fn emit_body_streamed(
         let neg = |s: Sym| -> TokenStream {
             match nodes.get(&s.id()) {
                 Some(Node::Const(x)) => constant(-x, float).tokens,
-                Some(Node::Neg(z)) if inlined(s) => get(*z).tokens,
+                Some(Node::Neg(z)) if inlined(s) => {
+                    exprs.borrow_mut().remove(&s.id()); // looked through
+                    get(*z).tokens
+                }
                 _ => {
                     let e = get(s).at(P_NEG);
                     quote!(-#e)
                 }
             }
+        };
+        // The factors of the fusing product `m`, its own expression dropped (looked through).
+        let factors = |m: Sym| {
+            exprs.borrow_mut().remove(&m.id());
+            product(m).expect("checked")
         };
         let call = |a: TokenStream, b: TokenStream, c: TokenStream| {
             let f = fma
@@ -329,13 +347,13 @@ pub fn emit_body_streamed(
                 } else {
                     (*x, *y)
                 };
-                let (a, b) = product(m).expect("checked");
+                let (a, b) = factors(m);
                 call(get(a).tokens, get(b).tokens, get(c).tokens)
             }
             // x − a·b: fma(−a, b, x) (the constant factor negated when there is one).
             Node::Sub(x, y) if product(*y).is_some() => {
                 fmas += 1;
-                let (a, b) = product(*y).expect("checked");
+                let (a, b) = factors(*y);
                 if is_const(b) && !is_const(a) {
                     call(get(a).tokens, neg(b), get(*x).tokens)
                 } else {
@@ -345,7 +363,7 @@ pub fn emit_body_streamed(
             // a·b − y: fma(a, b, −y).
             Node::Sub(x, y) if product(*x).is_some() => {
                 fmas += 1;
-                let (a, b) = product(*x).expect("checked");
+                let (a, b) = factors(*x);
                 call(get(a).tokens, get(b).tokens, neg(*y))
             }
             Node::Add(a, b) => {

@@ -82,6 +82,13 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
         },
         regroup_line(model, opts),
     ];
+    let total: u64 = fmas.iter().sum();
+    let per = choices
+        .iter()
+        .zip(fmas)
+        .map(|(c, k)| format!("`{}` {k}", crate::api::fn_name(c.function, model)))
+        .collect::<Vec<_>>()
+        .join(", ");
     // Precision lines only for a non-default precision.
     if opts.float != Float::F64 || opts.fma {
         h.push(match opts.float {
@@ -92,13 +99,6 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
                 .into(),
         });
         h.push(if opts.fma {
-            let total: u64 = fmas.iter().sum();
-            let per = choices
-                .iter()
-                .zip(fmas)
-                .map(|(c, k)| format!("`{}` {k}", crate::api::fn_name(c.function, model)))
-                .collect::<Vec<_>>()
-                .join(", ");
             let path = opts
                 .fma_path
                 .clone()
@@ -110,6 +110,15 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
         } else {
             "Fused multiply-adds: none.".into()
         });
+    }
+    if !opts.fma && opts.target_fma && total > 0 {
+        h.push(format!(
+            "Fused multiply-adds where the target has them: {total} ({per}), each \
+             `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA \
+             (x86-64 with `target_feature = \"fma\"`, e.g. `-C target-cpu=native`; AArch64), \
+             and `a·b + c` otherwise, where the code is bit-identical to unfused code. The \
+             counts below count each as 1 mul + 1 add."
+        ));
     }
     h.extend([
         String::new(),

@@ -177,6 +177,8 @@ fn generate_items_with(
         let doc1 = format!(" {}", api::doc(f, floating));
         let fused = if opts.fma {
             format!(", of which {k} fused multiply-adds")
+        } else if opts.target_fma && k > 0 {
+            format!(", of which {k} fused where the target has FMA")
         } else {
             String::new()
         };
@@ -281,6 +283,11 @@ fn generate_items_with(
         opts.type_name
     );
 
+    let mul_add_item = if !opts.fma && opts.target_fma && fmas.iter().any(|k| *k > 0) {
+        mul_add_fn(opts.float)
+    } else {
+        quote!()
+    };
     let items = quote! {
         #(#struct_docs)*
         #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -307,7 +314,7 @@ fn generate_items_with(
             pub sqrt: u64,
             /// Angles whose sine and cosine are taken.
             pub sincos: u64,
-            /// Fused multiply-adds.
+            /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
             pub fma: u64,
         }
 
@@ -336,6 +343,8 @@ fn generate_items_with(
             pub const CANDIDATES: &'static [#op_ty] = &[#(#all),*];
 
             #(#fns)*
+
+            #mul_add_item
         }
     };
     Ok(Generated {
@@ -459,6 +468,58 @@ fn format_body(tokens: &TokenStream) -> Result<String, Error> {
 
 /// The model crate, re-exported for the proc-macro (readers, validation).
 pub use kanegen_model;
+/// The private `mul_add` of [`Options::target_fma`]: one fused instruction where the build
+/// targets it, `a·b + c` (two roundings, bit-identical to unfused code) elsewhere.
+fn mul_add_fn(float: Float) -> TokenStream {
+    let (ty, x86, set, get, arm_dup, arm_fma, arm_get) = match float {
+        Float::F64 => (
+            quote!(f64),
+            quote!(_mm_fmadd_sd),
+            quote!(_mm_set_sd),
+            quote!(_mm_cvtsd_f64),
+            quote!(vdup_n_f64),
+            quote!(vfma_f64),
+            quote!(vget_lane_f64),
+        ),
+        Float::F32 => (
+            quote!(f32),
+            quote!(_mm_fmadd_ss),
+            quote!(_mm_set_ss),
+            quote!(_mm_cvtss_f32),
+            quote!(vdup_n_f32),
+            quote!(vfma_f32),
+            quote!(vget_lane_f32),
+        ),
+    };
+    quote! {
+        /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
+        /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
+        /// elsewhere.
+        #[inline(always)]
+        fn mul_add(a: #ty, b: #ty, c: #ty) -> #ty {
+            #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+            {
+                use core::arch::x86_64::{#get, #x86, #set};
+                // SAFETY: the build targets FMA (the `cfg` above), so the instruction exists.
+                unsafe { #get(#x86(#set(a), #set(b), #set(c))) }
+            }
+            #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+            {
+                use core::arch::aarch64::{#arm_dup, #arm_fma, #arm_get};
+                // SAFETY: AArch64 with NEON (the `cfg` above) has the fused multiply-add.
+                unsafe { #arm_get::<0>(#arm_fma(#arm_dup(c), #arm_dup(a), #arm_dup(b))) }
+            }
+            #[cfg(not(any(
+                all(target_arch = "x86_64", target_feature = "fma"),
+                all(target_arch = "aarch64", target_feature = "neon")
+            )))]
+            {
+                a * b + c
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

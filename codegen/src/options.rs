@@ -41,6 +41,11 @@ pub struct Options {
     /// (default): `fma` (f64) or `fmaf` (f32) of [`Options::libm_path`]. `f64::mul_add` /
     /// `f32::mul_add` (UFCS of the std method; not `no_std`) work as well.
     pub fma_path: Option<String>,
+    /// Without [`Options::fma`]: fuse the same products through a private `Self::mul_add(a, b,
+    /// c)` that is one fused instruction where the build targets it (`x86_64` with
+    /// `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64) and `a·b + c` otherwise,
+    /// where the code is then bit-identical to unfused code. Default `true`.
+    pub target_fma: bool,
     /// Let the local-frame algorithms read regrouped inertial parameters
     /// (`kanegen_dynamics::regroup`: each revolute body's axis mass carried by its parent): the
     /// same joint-space results in fewer operations. Default `true`; the base reaction always
@@ -101,7 +106,8 @@ impl Float {
 
 impl Options {
     /// Defaults: space (no gravity), constant payload, `libm` path `libm`, structs `Payload` and
-    /// `OpCount`, `f64`, no fused multiply-adds, regrouped inertial parameters.
+    /// `OpCount`, `f64`, products fused where the target has FMA ([`Options::target_fma`]), regrouped
+    /// inertial parameters.
     pub fn new(type_name: impl Into<String>) -> Self {
         Options {
             type_name: type_name.into(),
@@ -115,6 +121,7 @@ impl Options {
             float: Float::F64,
             fma: false,
             fma_path: None,
+            target_fma: true,
             regroup: true,
         }
     }

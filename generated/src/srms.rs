@@ -7,6 +7,7 @@
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Fused multiply-adds where the target has them: 1079 (`mass_matrix` 79, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 267, `mass_matrix_and_nonlinear_effects` 202, `forward_dynamics_with_wrenches` 274), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
@@ -59,7 +60,7 @@ pub struct OpCount {
     pub sqrt: u64,
     /// Angles whose sine and cosine are taken.
     pub sincos: u64,
-    /// Fused multiply-adds.
+    /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
     pub fma: u64,
 }
 #[allow(
@@ -98,7 +99,7 @@ impl Srms {
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 79u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -109,7 +110,7 @@ impl Srms {
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 123u64,
         },
         OpCount {
             function: "inverse_dynamics",
@@ -120,7 +121,7 @@ impl Srms {
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 134u64,
         },
         OpCount {
             function: "forward_dynamics",
@@ -131,7 +132,7 @@ impl Srms {
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 267u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -142,7 +143,7 @@ impl Srms {
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 202u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -153,7 +154,7 @@ impl Srms {
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 274u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -436,7 +437,7 @@ impl Srms {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 157 mul, 128 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`: 157 mul, 128 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 79 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -444,110 +445,166 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x6 = 0.353 * s_q5;
         let x7 = 0.353 * c_q5;
-        let x8 = x7 - -0.9929999999999999 * s_q5;
-        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x10 = x6 + -0.9929999999999999 * c_q5;
-        let x11 = c_q5 * x8 - s_q5 * x6;
-        let x12 = c_q5 * x7 - s_q5 * x10;
-        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
-        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
+        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
+        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
+        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
+        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
+        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
         let x15 = 34.45002 * c_q4;
         let x16 = 34.45002 * s_q4;
         let x17 = s_q4 * x5;
-        let x18 = 1.903 * c_q4 - x17;
+        let x18 = Self::mul_add(1.903, c_q4, -x17);
         let x19 = c_q4 * x5;
-        let x20 = x19 - s_q4 * x13;
+        let x20 = Self::mul_add(-s_q4, x13, x19);
         let x21 = c_q4 * x9;
-        let x22 = x21 - s_q4 * x11;
-        let x23 = x19 + 1.903 * s_q4;
+        let x22 = Self::mul_add(-s_q4, x11, x21);
+        let x23 = Self::mul_add(1.903, s_q4, x19);
         let x24 = s_q4 * x9;
-        let x25 = x24 + c_q4 * x11;
-        let x26 = x21 - s_q4 * x12;
-        let x27 = x24 + c_q4 * x12;
+        let x25 = Self::mul_add(c_q4, x11, x24);
+        let x26 = Self::mul_add(-s_q4, x12, x21);
+        let x27 = Self::mul_add(c_q4, x12, x24);
         let x28 = x15 * -0.4572;
         let x29 = 0.4572 * x15;
         let x30 = x14 + x29;
-        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
         let x32 = x30 - x28;
         let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
         let x35 = 19.863252216000003
-            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+            + (x29
+                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
+                    - x28));
         let x36 = c_q3 * x33;
         let x37 = s_q3 * x33;
-        let x38 = c_q3 * x34 + s_q3 * x26;
-        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
+        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
         let x40 = c_q3 * x22;
-        let x41 = x40 + s_q3 * x32;
-        let x42 = c_q3 * x26 - s_q3 * x34;
-        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x41 = Self::mul_add(s_q3, x32, x40);
+        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
+        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
         let x44 = s_q3 * x22;
-        let x45 = c_q3 * x32 - x44;
+        let x45 = Self::mul_add(c_q3, x32, -x44);
         let x46 = x37 * 0.1524;
         let x47 = -0.1524 * x37;
         let x48 = x36 * -7.06;
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
         let x53 = 703.3878000000001 + x36;
         let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
-        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x55 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
         let x57 = 103.41030072000001
-            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+            + Self::mul_add(
+                x37,
+                7.06,
+                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
+            );
         let x58 = 5601.1318504688 + (x50 + (x46 + x49));
         let x59 = 103.41030072000002
-            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+            + Self::mul_add(
+                0.1524,
+                x36,
+                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            );
         let x60 = -0.08 + (x43 + x51);
-        let x61 = c_q2 * x53 + s_q2 * x54;
-        let x62 = c_q2 * x54 - s_q2 * x53;
-        let x63 = c_q2 * x55 + s_q2 * x59;
-        let x64 = c_q2 * x56 + s_q2 * x60;
-        let x65 = c_q2 * x57 + s_q2 * x52;
-        let x66 = c_q2 * x59 - s_q2 * x55;
-        let x67 = c_q2 * x60 - s_q2 * x56;
-        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
+        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
+        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
+        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
+        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
+        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
         let x69 = 0.1524 * x62;
         let x70 = -0.1524 * x62;
         let x71 = x61 * -6.377;
         let x72 = 6.377 * x61;
         let x73 = 8609.573807858 + (x58 - (x71 - x70) - (x69 - x72));
-        let x74 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
+        let x74 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x64),
+            c_q1 * (-0.0302 + (x51 + x67)),
+        );
         let x75 = 14222.257549666001
-            + (c_q1
-                * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
-                    - s_q1
-                        * (190.97044034
-                            + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
-                - s_q1
-                    * (c_q1
+            + Self::mul_add(
+                -s_q1,
+                Self::mul_add(
+                    -s_q1,
+                    -8596.210051042
+                        + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
+                    c_q1
                         * (190.97044034000004
-                            + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
-                        - s_q1
-                            * (-8596.210051042
-                                + (x70 + (c_q2 * x63 + s_q2 * x65 - x69)))));
+                            + Self::mul_add(
+                                0.1524,
+                                x61,
+                                Self::mul_add(
+                                    -6.377,
+                                    x62,
+                                    Self::mul_add(s_q2, x68, c_q2 * x66),
+                                ),
+                            )),
+                ),
+                c_q1
+                    * Self::mul_add(
+                        -s_q1,
+                        190.97044034
+                            + Self::mul_add(
+                                x62,
+                                -6.377,
+                                Self::mul_add(
+                                    0.1524,
+                                    x61,
+                                    Self::mul_add(-s_q2, x63, c_q2 * x65),
+                                ),
+                            ),
+                        c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
+                    ),
+            );
         let x76 = x58 + (x70 - x71);
-        let x77 = c_q1 * x67 - s_q1 * x64;
+        let x77 = Self::mul_add(-s_q1, x64, c_q1 * x67);
         let x78 = x50
-            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36));
-        let x79 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+            + Self::mul_add(
+                0.1524,
+                Self::mul_add(s_q2, x36, c_q2 * x37),
+                -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+            );
+        let x79 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x43, c_q2 * x39),
+            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+        );
         let x80 = c_q3 * x16;
         let x81 = s_q3 * x16;
         let x82 = x15 * 0.1524;
-        let x83 = x40 + s_q3 * x30 + x82;
-        let x84 = x25 + (-7.06 * x81 - -0.1524 * x80);
-        let x85 = c_q3 * x30 - x44 + 7.06 * x15;
+        let x83 = Self::mul_add(s_q3, x30, x40) + x82;
+        let x84 = x25 + Self::mul_add(0.1524, x80, -7.06 * x81);
+        let x85 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
         let x86 = x84
-            + (-0.1524 * (s_q2 * x81 - c_q2 * x80) + -6.377 * (s_q2 * x80 + c_q2 * x81));
-        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x83 + 6.377 * x15)
-            - s_q1 * (x82 + (c_q2 * x83 + s_q2 * x85));
-        let x88 = c_q3 * x18 + s_q3 * x9;
-        let x89 = c_q3 * x9 - s_q3 * x18;
-        let x90 = c_q1 * (c_q2 * x89 - s_q2 * x88) - s_q1 * (c_q2 * x88 + s_q2 * x89);
+            + Self::mul_add(
+                -6.377,
+                Self::mul_add(c_q2, x81, s_q2 * x80),
+                -0.1524 * Self::mul_add(-c_q2, x80, s_q2 * x81),
+            );
+        let x87 = Self::mul_add(
+            -s_q1,
+            x82 + Self::mul_add(s_q2, x85, c_q2 * x83),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x83, c_q2 * x85)),
+        );
+        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x90 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x89, c_q2 * x88),
+            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
+        );
         [
             [x75, x74, x77, x79, x87, x90],
             [x74, x73, x76, x78, x86, x23],
@@ -559,7 +616,7 @@ impl Srms {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 123 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -569,112 +626,165 @@ impl Srms {
         let x4 = qd[1] * x1;
         let x5 = qd[1] * qd[1];
         let x6 = x1 * x2;
-        let x7 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
-        let x8 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x9 = -0.0302 * qd[1] - 190.97044034000004 * x1;
+        let x7 = Self::mul_add(
+            190.97044034,
+            x2,
+            Self::mul_add(8596.210051042, x1, -1.928 * qd[1]),
+        );
+        let x8 = Self::mul_add(
+            -0.0302,
+            x2,
+            Self::mul_add(1.928, x1, 8609.573807858 * qd[1]),
+        );
+        let x9 = Self::mul_add(-190.97044034000004, x1, -0.0302 * qd[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x11 = x1 * c_q2 + x2 * s_q2;
-        let x12 = x2 * c_q2 - x1 * s_q2;
-        let x13 = 6.377 * (x5 + x2 * x2) + -0.1524 * x6;
-        let x14 = -0.1524 * (x3 + x3) - 6.377 * (x4 + x4);
-        let x15 = 6.377 * x6 + -0.1524 * (x5 + x1 * x1);
-        let x16 = s_q2 * x15 - c_q2 * x13;
-        let x17 = s_q2 * x13 + c_q2 * x15;
-        let x18 = x4 * s_q2 - x3 * c_q2 - qd[2] * x12;
-        let x19 = x3 * s_q2 + x4 * c_q2 + qd[2] * x11;
+        let x11 = Self::mul_add(x2, s_q2, x1 * c_q2);
+        let x12 = Self::mul_add(-x1, s_q2, x2 * c_q2);
+        let x13 = Self::mul_add(-0.1524, x6, 6.377 * Self::mul_add(x2, x2, x5));
+        let x14 = Self::mul_add(-6.377, x4 + x4, -0.1524 * (x3 + x3));
+        let x15 = Self::mul_add(-0.1524, Self::mul_add(x1, x1, x5), 6.377 * x6);
+        let x16 = Self::mul_add(-c_q2, x13, s_q2 * x15);
+        let x17 = Self::mul_add(c_q2, x15, s_q2 * x13);
+        let x18 = Self::mul_add(-qd[2], x12, Self::mul_add(-x3, c_q2, x4 * s_q2));
+        let x19 = Self::mul_add(qd[2], x11, Self::mul_add(x4, c_q2, x3 * s_q2));
         let x20 = qd[1] + qd[2];
         let x21 = x20 * x20;
-        let x22 = x21 + x12 * x12;
+        let x22 = Self::mul_add(x12, x12, x21);
         let x23 = x11 * x12;
-        let x24 = x19 + x11 * x20;
-        let x25 = x12 * x20 - x18;
-        let x26 = x21 + x11 * x11;
-        let x27 = 0.8021 * x20 - -5594.523885531201 * x11 + 103.41030072000001 * x12;
-        let x28 = 5601.1318504688 * x20 - 0.8021 * x11 + -0.08 * x12;
-        let x29 = -0.08 * x20 - 103.41030072000002 * x11;
+        let x24 = Self::mul_add(x11, x20, x19);
+        let x25 = Self::mul_add(x12, x20, -x18);
+        let x26 = Self::mul_add(x11, x11, x21);
+        let x27 = Self::mul_add(
+            103.41030072000001,
+            x12,
+            Self::mul_add(5594.523885531201, x11, 0.8021 * x20),
+        );
+        let x28 = Self::mul_add(
+            -0.08,
+            x12,
+            Self::mul_add(-0.8021, x11, 5601.1318504688 * x20),
+        );
+        let x29 = Self::mul_add(-103.41030072000002, x11, -0.08 * x20);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x31 = x11 * c_q3 + x12 * s_q3;
-        let x32 = x12 * c_q3 - x11 * s_q3;
-        let x33 = x16 - (7.06 * x22 + -0.1524 * x23);
-        let x34 = x14 + (-0.1524 * x25 - 7.06 * x24);
-        let x35 = x17 + (7.06 * x23 + -0.1524 * x26);
-        let x36 = s_q3 * x33 - c_q3 * x35;
-        let x37 = x18 * c_q3 + x19 * s_q3 - qd[3] * x32;
-        let x38 = x18 * s_q3 - x19 * c_q3 - qd[3] * x31;
+        let x31 = Self::mul_add(x12, s_q3, x11 * c_q3);
+        let x32 = Self::mul_add(-x11, s_q3, x12 * c_q3);
+        let x33 = x16 - Self::mul_add(-0.1524, x23, 7.06 * x22);
+        let x34 = x14 + Self::mul_add(-7.06, x24, -0.1524 * x25);
+        let x35 = x17 + Self::mul_add(-0.1524, x26, 7.06 * x23);
+        let x36 = Self::mul_add(-c_q3, x35, s_q3 * x33);
+        let x37 = Self::mul_add(-qd[3], x32, Self::mul_add(x19, s_q3, x18 * c_q3));
+        let x38 = Self::mul_add(-qd[3], x31, Self::mul_add(-x19, c_q3, x18 * s_q3));
         let x39 = qd[3] + x20;
-        let x40 = x39 * x39 + x32 * x32;
+        let x40 = Self::mul_add(x32, x32, x39 * x39);
         let x41 = x31 * x32;
-        let x42 = x38 - x31 * x39;
+        let x42 = Self::mul_add(-x31, x39, x38);
         let x43 = -18.957952216000002 * x31;
         let x44 = 19.863252216000003 * x39;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x46 = x39 * s_q4 - x31 * c_q4;
-        let x47 = x31 * s_q4 + x39 * c_q4;
-        let x48 = x37 * c_q4 + qd[4] * x47;
-        let x49 = x37 * s_q4 + qd[4] * x46;
+        let x46 = Self::mul_add(-x31, c_q4, x39 * s_q4);
+        let x47 = Self::mul_add(x39, c_q4, x31 * s_q4);
+        let x48 = Self::mul_add(qd[4], x47, x37 * c_q4);
+        let x49 = Self::mul_add(qd[4], x46, x37 * s_q4);
         let x50 = qd[4] + x32;
-        let x51 = 34.45002 * (x47 * x47 + x50 * x50);
-        let x52 = 34.45002 * (x38 + x46 * x47);
-        let x53 = 34.45002 * (x49 + x46 * x50);
+        let x51 = 34.45002 * Self::mul_add(x50, x50, x47 * x47);
+        let x52 = 34.45002 * Self::mul_add(x46, x47, x38);
+        let x53 = 34.45002 * Self::mul_add(x46, x50, x49);
         let x54 = 34.33891524 * x47;
         let x55 = 34.74691524 * x50;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x57 = x47 * c_q5 + x50 * s_q5;
-        let x58 = x50 * c_q5 - x47 * s_q5;
-        let x59 = x38 * s_q5 - x49 * c_q5 + qd[5] * x58;
-        let x60 = x49 * s_q5 + x38 * c_q5 - qd[5] * x57;
+        let x57 = Self::mul_add(x50, s_q5, x47 * c_q5);
+        let x58 = Self::mul_add(-x47, s_q5, x50 * c_q5);
+        let x59 = Self::mul_add(qd[5], x58, Self::mul_add(-x49, c_q5, x38 * s_q5));
+        let x60 = Self::mul_add(-qd[5], x57, Self::mul_add(x38, c_q5, x49 * s_q5));
         let x61 = qd[5] + x46;
-        let x62 = 1.903 * x61 + 0.385 * x57 + 0.966 * x58;
-        let x63 = 0.385 * x61 + 0.353 * x58;
-        let x64 = 0.966 * x61 + 0.353 * x57 + -0.9929999999999999 * x58;
-        let x65 = 1.903 * x48 + 0.385 * x59 + 0.966 * x60 + (x57 * x64 - x58 * x63);
-        let x66 = 0.385 * x48 + 0.353 * x60 + (x58 * x62 - x61 * x64);
-        let x67 = 0.966 * x48 + 0.353 * x59 + -0.9929999999999999 * x60
-            + (x61 * x63 - x57 * x62);
-        let x68 = x47 * x55 - x50 * x54 + x65;
-        let x69 = (x36 - 0.4572 * x41) * -34.45002 - (34.33891524 * x49 + x46 * x55)
-            + (c_q5 * x66 - s_q5 * x67);
-        let x70 = 34.74691524 * x38 + x46 * x54
-            + 34.45002
-                * (c_q4 * (x34 + 0.4572 * x42)
-                    - s_q4 * (c_q3 * x33 + s_q3 * x35 - 0.4572 * x40))
-            + (s_q5 * x66 + c_q5 * x67);
-        let x71 = c_q4 * x52 - s_q4 * x51;
-        let x72 = 41.67378 * x40 + (c_q4 * x51 + s_q4 * x52);
-        let x73 = 41.67378 * x42 + x71;
-        let x74 = x53 - 41.67378 * x41;
-        let x75 = -18.957952216000002 * x37 - x32 * x44 + (c_q4 * x68 - s_q4 * x69);
-        let x76 = x36 * -41.67378 - x32 * x43
-            + (s_q4 * x68 + c_q4 * x69 + x53 * -0.4572);
-        let x77 = x39 * x43 - x31 * x44 + 41.67378 * x34 + (x70 + 0.4572 * x71);
-        let x78 = s_q3 * x74 - c_q3 * x72;
-        let x79 = s_q3 * x72 + c_q3 * x74;
-        let x80 = x78 - (703.3878000000001 * x22 + -15.183612000000002 * x23);
-        let x81 = -15.183612000000002 * x25 - 703.3878000000001 * x24 + x73;
-        let x82 = x79 - (703.3878000000001 * x23 + -15.183612000000002 * x26);
-        let x83 = -5594.523885531201 * x18 - 103.41030072000001 * x19
-            + (x20 * x29 - x12 * x28) + x14 * 15.183612000000002
-            + (c_q3 * x75 + s_q3 * x77 + x73 * 0.1524);
-        let x84 = 0.8021 * x18 - -0.08 * x19 + (x12 * x27 + x11 * x29)
-            + (-15.183612000000002 * x16 - x17 * -703.3878000000001)
-            + (x76 + (-0.1524 * x78 + x79 * -7.06));
-        let x85 = 103.41030072000002 * x18 - (x20 * x27 + x11 * x28)
-            + 703.3878000000001 * x14 + (c_q3 * x77 - s_q3 * x75 + 7.06 * x73);
-        let x86 = x2 * x7 + x1 * x9 - (-1.928 * x3 + -0.0302 * x4)
+        let x62 = Self::mul_add(0.966, x58, Self::mul_add(0.385, x57, 1.903 * x61));
+        let x63 = Self::mul_add(0.353, x58, 0.385 * x61);
+        let x64 = Self::mul_add(
+            -0.9929999999999999,
+            x58,
+            Self::mul_add(0.353, x57, 0.966 * x61),
+        );
+        let x65 = Self::mul_add(0.966, x60, Self::mul_add(0.385, x59, 1.903 * x48))
+            + Self::mul_add(-x58, x63, x57 * x64);
+        let x66 = Self::mul_add(0.353, x60, 0.385 * x48)
+            + Self::mul_add(-x61, x64, x58 * x62);
+        let x67 = Self::mul_add(
+            -0.9929999999999999,
+            x60,
+            Self::mul_add(0.353, x59, 0.966 * x48),
+        ) + Self::mul_add(-x57, x62, x61 * x63);
+        let x68 = Self::mul_add(-x50, x54, x47 * x55) + x65;
+        let x69 = Self::mul_add(
+            Self::mul_add(-0.4572, x41, x36),
+            -34.45002,
+            -Self::mul_add(x46, x55, 34.33891524 * x49),
+        ) + Self::mul_add(-s_q5, x67, c_q5 * x66);
+        let x70 = Self::mul_add(
+            34.45002,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(-0.4572, x40, Self::mul_add(s_q3, x35, c_q3 * x33)),
+                c_q4 * Self::mul_add(0.4572, x42, x34),
+            ),
+            Self::mul_add(x46, x54, 34.74691524 * x38),
+        ) + Self::mul_add(c_q5, x67, s_q5 * x66);
+        let x71 = Self::mul_add(-s_q4, x51, c_q4 * x52);
+        let x72 = Self::mul_add(41.67378, x40, Self::mul_add(s_q4, x52, c_q4 * x51));
+        let x73 = Self::mul_add(41.67378, x42, x71);
+        let x74 = Self::mul_add(-41.67378, x41, x53);
+        let x75 = Self::mul_add(-x32, x44, -18.957952216000002 * x37)
+            + Self::mul_add(-s_q4, x69, c_q4 * x68);
+        let x76 = Self::mul_add(-x32, x43, x36 * -41.67378)
+            + Self::mul_add(x53, -0.4572, Self::mul_add(c_q4, x69, s_q4 * x68));
+        let x77 = Self::mul_add(41.67378, x34, Self::mul_add(-x31, x44, x39 * x43))
+            + Self::mul_add(0.4572, x71, x70);
+        let x78 = Self::mul_add(-c_q3, x72, s_q3 * x74);
+        let x79 = Self::mul_add(c_q3, x74, s_q3 * x72);
+        let x80 = x78 - Self::mul_add(-15.183612000000002, x23, 703.3878000000001 * x22);
+        let x81 = Self::mul_add(-703.3878000000001, x24, -15.183612000000002 * x25)
+            + x73;
+        let x82 = x79 - Self::mul_add(-15.183612000000002, x26, 703.3878000000001 * x23);
+        let x83 = Self::mul_add(
+            x14,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x19, -5594.523885531201 * x18)
+                + Self::mul_add(-x12, x28, x20 * x29),
+        ) + Self::mul_add(x73, 0.1524, Self::mul_add(s_q3, x77, c_q3 * x75));
+        let x84 = Self::mul_add(0.08, x19, 0.8021 * x18)
+            + Self::mul_add(x11, x29, x12 * x27)
+            + Self::mul_add(x17, 703.3878000000001, -15.183612000000002 * x16)
+            + (x76 + Self::mul_add(x79, -7.06, -0.1524 * x78));
+        let x85 = Self::mul_add(
+            703.3878000000001,
+            x14,
+            Self::mul_add(103.41030072000002, x18, -Self::mul_add(x11, x28, x20 * x27)),
+        ) + Self::mul_add(7.06, x73, Self::mul_add(-s_q3, x75, c_q3 * x77));
+        let x86 = Self::mul_add(x1, x9, x2 * x7)
+            - Self::mul_add(-0.0302, x4, -1.928 * x3)
             + (x84
-                + (-0.1524 * (c_q2 * x80 + s_q2 * x82)
-                    + (c_q2 * x82 - s_q2 * x80) * -6.377));
-        let x87 = c_q1
-            * (c_q2 * x85 - s_q2 * x83 + 6.377 * x81
-                - (190.97044034000004 * x3 + (qd[1] * x7 + x1 * x8)))
-            - s_q1
-                * (qd[1] * x9 - x2 * x8 - (-8596.210051042 * x3 + 190.97044034 * x4)
-                    + (c_q2 * x83 + s_q2 * x85 + 0.1524 * x81));
+                + Self::mul_add(
+                    Self::mul_add(-s_q2, x80, c_q2 * x82),
+                    -6.377,
+                    -0.1524 * Self::mul_add(s_q2, x82, c_q2 * x80),
+                ));
+        let x87 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-x2, x8, qd[1] * x9)
+                - Self::mul_add(190.97044034, x4, -8596.210051042 * x3)
+                + Self::mul_add(0.1524, x81, Self::mul_add(s_q2, x85, c_q2 * x83)),
+            c_q1
+                * (Self::mul_add(6.377, x81, Self::mul_add(-s_q2, x83, c_q2 * x85))
+                    - Self::mul_add(
+                        190.97044034000004,
+                        x3,
+                        Self::mul_add(x1, x8, qd[1] * x7),
+                    )),
+        );
         [x87, x86, x84, x76, x70, x65]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: bias `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 134 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -682,125 +792,204 @@ impl Srms {
         let x2 = qd[0] * c_q1;
         let x3 = qd[1] * x2;
         let x4 = qd[1] * x1;
-        let x5 = qdd[0] * s_q1 + x3;
-        let x6 = qdd[0] * c_q1 - x4;
+        let x5 = Self::mul_add(qdd[0], s_q1, x3);
+        let x6 = Self::mul_add(qdd[0], c_q1, -x4);
         let x7 = qd[1] * qd[1];
         let x8 = x1 * x2;
-        let x9 = -1.928 * qd[1] - -8596.210051042 * x1 + 190.97044034 * x2;
-        let x10 = 8609.573807858 * qd[1] - -1.928 * x1 + -0.0302 * x2;
-        let x11 = -0.0302 * qd[1] - 190.97044034000004 * x1;
+        let x9 = Self::mul_add(
+            190.97044034,
+            x2,
+            Self::mul_add(8596.210051042, x1, -1.928 * qd[1]),
+        );
+        let x10 = Self::mul_add(
+            -0.0302,
+            x2,
+            Self::mul_add(1.928, x1, 8609.573807858 * qd[1]),
+        );
+        let x11 = Self::mul_add(-190.97044034000004, x1, -0.0302 * qd[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x13 = x1 * c_q2 + x2 * s_q2;
-        let x14 = x2 * c_q2 - x1 * s_q2;
-        let x15 = -0.1524 * (qdd[1] - x8) - 6.377 * (x7 + x2 * x2);
-        let x16 = 6.377 * (x6 - x4) + -0.1524 * (x3 + x5);
-        let x17 = 6.377 * (qdd[1] + x8) + -0.1524 * (x7 + x1 * x1);
-        let x18 = c_q2 * x15 + s_q2 * x17;
-        let x19 = s_q2 * x15 - c_q2 * x17;
-        let x20 = x5 * c_q2 + x6 * s_q2 + qd[2] * x14;
-        let x21 = x6 * c_q2 - x5 * s_q2 - qd[2] * x13;
+        let x13 = Self::mul_add(x2, s_q2, x1 * c_q2);
+        let x14 = Self::mul_add(-x1, s_q2, x2 * c_q2);
+        let x15 = Self::mul_add(
+            -6.377,
+            Self::mul_add(x2, x2, x7),
+            -0.1524 * (qdd[1] - x8),
+        );
+        let x16 = Self::mul_add(-0.1524, x3 + x5, 6.377 * (x6 - x4));
+        let x17 = Self::mul_add(
+            -0.1524,
+            Self::mul_add(x1, x1, x7),
+            6.377 * (qdd[1] + x8),
+        );
+        let x18 = Self::mul_add(s_q2, x17, c_q2 * x15);
+        let x19 = Self::mul_add(-c_q2, x17, s_q2 * x15);
+        let x20 = Self::mul_add(qd[2], x14, Self::mul_add(x6, s_q2, x5 * c_q2));
+        let x21 = Self::mul_add(-qd[2], x13, Self::mul_add(-x5, s_q2, x6 * c_q2));
         let x22 = qdd[1] + qdd[2];
         let x23 = qd[1] + qd[2];
         let x24 = x23 * x23;
-        let x25 = x24 + x14 * x14;
+        let x25 = Self::mul_add(x14, x14, x24);
         let x26 = x13 * x14;
         let x27 = x22 - x26;
-        let x28 = x21 - x13 * x23;
-        let x29 = x20 + x14 * x23;
+        let x28 = Self::mul_add(-x13, x23, x21);
+        let x29 = Self::mul_add(x14, x23, x20);
         let x30 = x22 + x26;
-        let x31 = x24 + x13 * x13;
-        let x32 = 0.8021 * x23 - -5594.523885531201 * x13 + 103.41030072000001 * x14;
-        let x33 = 5601.1318504688 * x23 - 0.8021 * x13 + -0.08 * x14;
-        let x34 = -0.08 * x23 - 103.41030072000002 * x13;
+        let x31 = Self::mul_add(x13, x13, x24);
+        let x32 = Self::mul_add(
+            103.41030072000001,
+            x14,
+            Self::mul_add(5594.523885531201, x13, 0.8021 * x23),
+        );
+        let x33 = Self::mul_add(
+            -0.08,
+            x14,
+            Self::mul_add(-0.8021, x13, 5601.1318504688 * x23),
+        );
+        let x34 = Self::mul_add(-103.41030072000002, x13, -0.08 * x23);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x36 = x13 * c_q3 + x14 * s_q3;
-        let x37 = x14 * c_q3 - x13 * s_q3;
-        let x38 = x18 + (-0.1524 * x27 - 7.06 * x25);
-        let x39 = x16 + (7.06 * x28 + -0.1524 * x29);
-        let x40 = x19 - (7.06 * x30 + -0.1524 * x31);
-        let x41 = s_q3 * x38 + c_q3 * x40;
-        let x42 = x20 * c_q3 + x21 * s_q3 + qd[3] * x37;
-        let x43 = x21 * c_q3 - x20 * s_q3 - qd[3] * x36;
+        let x36 = Self::mul_add(x14, s_q3, x13 * c_q3);
+        let x37 = Self::mul_add(-x13, s_q3, x14 * c_q3);
+        let x38 = x18 + Self::mul_add(-7.06, x25, -0.1524 * x27);
+        let x39 = x16 + Self::mul_add(-0.1524, x29, 7.06 * x28);
+        let x40 = x19 - Self::mul_add(-0.1524, x31, 7.06 * x30);
+        let x41 = Self::mul_add(c_q3, x40, s_q3 * x38);
+        let x42 = Self::mul_add(qd[3], x37, Self::mul_add(x21, s_q3, x20 * c_q3));
+        let x43 = Self::mul_add(-qd[3], x36, Self::mul_add(-x20, s_q3, x21 * c_q3));
         let x44 = qdd[3] + x22;
         let x45 = qd[3] + x23;
-        let x46 = x45 * x45 + x37 * x37;
-        let x47 = x43 - x36 * x45;
-        let x48 = x44 + x36 * x37;
+        let x46 = Self::mul_add(x37, x37, x45 * x45);
+        let x47 = Self::mul_add(-x36, x45, x43);
+        let x48 = Self::mul_add(x36, x37, x44);
         let x49 = -18.957952216000002 * x36;
         let x50 = 19.863252216000003 * x45;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x52 = x45 * s_q4 - x36 * c_q4;
-        let x53 = x36 * s_q4 + x45 * c_q4;
-        let x54 = x42 * s_q4 + x44 * c_q4 - qd[4] * x52;
+        let x52 = Self::mul_add(-x36, c_q4, x45 * s_q4);
+        let x53 = Self::mul_add(x45, c_q4, x36 * s_q4);
+        let x54 = Self::mul_add(-qd[4], x52, Self::mul_add(x44, c_q4, x42 * s_q4));
         let x55 = qdd[4] + x43;
         let x56 = qd[4] + x37;
-        let x57 = 34.45002 * (x53 * x53 + x56 * x56);
-        let x58 = 34.45002 * (x55 + x52 * x53);
-        let x59 = 34.45002 * (x52 * x56 - x54);
+        let x57 = 34.45002 * Self::mul_add(x56, x56, x53 * x53);
+        let x58 = 34.45002 * Self::mul_add(x52, x53, x55);
+        let x59 = 34.45002 * Self::mul_add(x52, x56, -x54);
         let x60 = 34.33891524 * x53;
         let x61 = 34.74691524 * x56;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x63 = x53 * c_q5 + x56 * s_q5;
-        let x64 = x56 * c_q5 - x53 * s_q5;
-        let x65 = x54 * c_q5 + x55 * s_q5 + qd[5] * x64;
-        let x66 = x55 * c_q5 - x54 * s_q5 - qd[5] * x63;
-        let x67 = qdd[5] + (x44 * s_q4 - x42 * c_q4 + qd[4] * x53);
+        let x63 = Self::mul_add(x56, s_q5, x53 * c_q5);
+        let x64 = Self::mul_add(-x53, s_q5, x56 * c_q5);
+        let x65 = Self::mul_add(qd[5], x64, Self::mul_add(x55, s_q5, x54 * c_q5));
+        let x66 = Self::mul_add(-qd[5], x63, Self::mul_add(-x54, s_q5, x55 * c_q5));
+        let x67 = qdd[5]
+            + Self::mul_add(qd[4], x53, Self::mul_add(-x42, c_q4, x44 * s_q4));
         let x68 = qd[5] + x52;
-        let x69 = 1.903 * x68 + 0.385 * x63 + 0.966 * x64;
-        let x70 = 0.385 * x68 + 0.353 * x64;
-        let x71 = 0.966 * x68 + 0.353 * x63 + -0.9929999999999999 * x64;
-        let x72 = 1.903 * x67 + 0.385 * x65 + 0.966 * x66 + (x63 * x71 - x64 * x70);
-        let x73 = 0.385 * x67 + 0.353 * x66 + (x64 * x69 - x68 * x71);
-        let x74 = 0.966 * x67 + 0.353 * x65 + -0.9929999999999999 * x66
-            + (x68 * x70 - x63 * x69);
-        let x75 = x53 * x61 - x56 * x60 + x72;
-        let x76 = 34.33891524 * x54 - x52 * x61 + (x41 - 0.4572 * x48) * -34.45002
-            + (c_q5 * x73 - s_q5 * x74);
-        let x77 = 34.74691524 * x55 + x52 * x60
-            + 34.45002
-                * (c_q4 * (x39 + 0.4572 * x47)
-                    - s_q4 * (c_q3 * x38 - s_q3 * x40 - 0.4572 * x46))
-            + (s_q5 * x73 + c_q5 * x74);
-        let x78 = c_q4 * x58 - s_q4 * x57;
-        let x79 = 41.67378 * x46 + (c_q4 * x57 + s_q4 * x58);
-        let x80 = 41.67378 * x47 + x78;
-        let x81 = x59 - 41.67378 * x48;
-        let x82 = c_q4 * x75 - s_q4 * x76 - (-18.957952216000002 * x42 + x37 * x50);
-        let x83 = 19.863252216000003 * x44 - x37 * x49 + x41 * -41.67378
-            + (s_q4 * x75 + c_q4 * x76 + x59 * -0.4572);
-        let x84 = x45 * x49 - x36 * x50 + 41.67378 * x39 + (x77 + 0.4572 * x78);
-        let x85 = s_q3 * x81 - c_q3 * x79;
-        let x86 = s_q3 * x79 + c_q3 * x81;
-        let x87 = -15.183612000000002 * x27 - 703.3878000000001 * x25 + x85;
-        let x88 = 703.3878000000001 * x28 + -15.183612000000002 * x29 + x80;
-        let x89 = x86 - (703.3878000000001 * x30 + -15.183612000000002 * x31);
-        let x90 = 0.8021 * x22 - -5594.523885531201 * x20 + 103.41030072000001 * x21
-            + (x23 * x34 - x14 * x33) + x16 * 15.183612000000002
-            + (c_q3 * x82 + s_q3 * x84 + x80 * 0.1524);
-        let x91 = 5601.1318504688 * x22 - 0.8021 * x20 + -0.08 * x21
-            + (x14 * x32 + x13 * x34)
-            + (-15.183612000000002 * x18 + x19 * -703.3878000000001)
-            + (x83 + (-0.1524 * x85 + x86 * -7.06));
-        let x92 = -0.08 * x22 - 103.41030072000002 * x20 - (x23 * x32 + x13 * x33)
-            + 703.3878000000001 * x16 + (c_q3 * x84 - s_q3 * x82 + 7.06 * x80);
-        let x93 = 8609.573807858 * qdd[1] - -1.928 * x5 + -0.0302 * x6
-            + (x2 * x9 + x1 * x11)
+        let x69 = Self::mul_add(0.966, x64, Self::mul_add(0.385, x63, 1.903 * x68));
+        let x70 = Self::mul_add(0.353, x64, 0.385 * x68);
+        let x71 = Self::mul_add(
+            -0.9929999999999999,
+            x64,
+            Self::mul_add(0.353, x63, 0.966 * x68),
+        );
+        let x72 = Self::mul_add(0.966, x66, Self::mul_add(0.385, x65, 1.903 * x67))
+            + Self::mul_add(-x64, x70, x63 * x71);
+        let x73 = Self::mul_add(0.353, x66, 0.385 * x67)
+            + Self::mul_add(-x68, x71, x64 * x69);
+        let x74 = Self::mul_add(
+            -0.9929999999999999,
+            x66,
+            Self::mul_add(0.353, x65, 0.966 * x67),
+        ) + Self::mul_add(-x63, x69, x68 * x70);
+        let x75 = Self::mul_add(-x56, x60, x53 * x61) + x72;
+        let x76 = Self::mul_add(
+            Self::mul_add(-0.4572, x48, x41),
+            -34.45002,
+            Self::mul_add(-x52, x61, 34.33891524 * x54),
+        ) + Self::mul_add(-s_q5, x74, c_q5 * x73);
+        let x77 = Self::mul_add(
+            34.45002,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(-0.4572, x46, Self::mul_add(-s_q3, x40, c_q3 * x38)),
+                c_q4 * Self::mul_add(0.4572, x47, x39),
+            ),
+            Self::mul_add(x52, x60, 34.74691524 * x55),
+        ) + Self::mul_add(c_q5, x74, s_q5 * x73);
+        let x78 = Self::mul_add(-s_q4, x57, c_q4 * x58);
+        let x79 = Self::mul_add(41.67378, x46, Self::mul_add(s_q4, x58, c_q4 * x57));
+        let x80 = Self::mul_add(41.67378, x47, x78);
+        let x81 = Self::mul_add(-41.67378, x48, x59);
+        let x82 = Self::mul_add(-s_q4, x76, c_q4 * x75)
+            - Self::mul_add(x37, x50, -18.957952216000002 * x42);
+        let x83 = Self::mul_add(
+            x41,
+            -41.67378,
+            Self::mul_add(-x37, x49, 19.863252216000003 * x44),
+        ) + Self::mul_add(x59, -0.4572, Self::mul_add(c_q4, x76, s_q4 * x75));
+        let x84 = Self::mul_add(41.67378, x39, Self::mul_add(-x36, x50, x45 * x49))
+            + Self::mul_add(0.4572, x78, x77);
+        let x85 = Self::mul_add(-c_q3, x79, s_q3 * x81);
+        let x86 = Self::mul_add(c_q3, x81, s_q3 * x79);
+        let x87 = Self::mul_add(-703.3878000000001, x25, -15.183612000000002 * x27)
+            + x85;
+        let x88 = Self::mul_add(-15.183612000000002, x29, 703.3878000000001 * x28) + x80;
+        let x89 = x86 - Self::mul_add(-15.183612000000002, x31, 703.3878000000001 * x30);
+        let x90 = Self::mul_add(
+            x16,
+            15.183612000000002,
+            Self::mul_add(
+                103.41030072000001,
+                x21,
+                Self::mul_add(5594.523885531201, x20, 0.8021 * x22),
+            ) + Self::mul_add(-x14, x33, x23 * x34),
+        ) + Self::mul_add(x80, 0.1524, Self::mul_add(s_q3, x84, c_q3 * x82));
+        let x91 = Self::mul_add(
+            -0.08,
+            x21,
+            Self::mul_add(-0.8021, x20, 5601.1318504688 * x22),
+        ) + Self::mul_add(x13, x34, x14 * x32)
+            + Self::mul_add(x19, -703.3878000000001, -15.183612000000002 * x18)
+            + (x83 + Self::mul_add(x86, -7.06, -0.1524 * x85));
+        let x92 = Self::mul_add(
+            703.3878000000001,
+            x16,
+            Self::mul_add(-103.41030072000002, x20, -0.08 * x22)
+                - Self::mul_add(x13, x33, x23 * x32),
+        ) + Self::mul_add(7.06, x80, Self::mul_add(-s_q3, x82, c_q3 * x84));
+        let x93 = Self::mul_add(
+            -0.0302,
+            x6,
+            Self::mul_add(1.928, x5, 8609.573807858 * qdd[1]),
+        ) + Self::mul_add(x1, x11, x2 * x9)
             + (x91
-                + (-0.1524 * (c_q2 * x87 + s_q2 * x89)
-                    + (c_q2 * x89 - s_q2 * x87) * -6.377));
-        let x94 = 14222.257549666001 * qdd[0]
-            + (c_q1
-                * (-0.0302 * qdd[1] - 190.97044034000004 * x5 - (qd[1] * x9 + x1 * x10)
-                    + (c_q2 * x92 - s_q2 * x90 + 6.377 * x88))
-                - s_q1
-                    * (-1.928 * qdd[1] - -8596.210051042 * x5 + 190.97044034 * x6
-                        + (qd[1] * x11 - x2 * x10)
-                        + (c_q2 * x90 + s_q2 * x92 + 0.1524 * x88)));
+                + Self::mul_add(
+                    Self::mul_add(-s_q2, x87, c_q2 * x89),
+                    -6.377,
+                    -0.1524 * Self::mul_add(s_q2, x89, c_q2 * x87),
+                ));
+        let x94 = Self::mul_add(
+            14222.257549666001,
+            qdd[0],
+            Self::mul_add(
+                -s_q1,
+                Self::mul_add(
+                    190.97044034,
+                    x6,
+                    Self::mul_add(8596.210051042, x5, -1.928 * qdd[1]),
+                ) + Self::mul_add(-x2, x10, qd[1] * x11)
+                    + Self::mul_add(0.1524, x88, Self::mul_add(s_q2, x92, c_q2 * x90)),
+                c_q1
+                    * (Self::mul_add(-190.97044034000004, x5, -0.0302 * qdd[1])
+                        - Self::mul_add(x1, x10, qd[1] * x9)
+                        + Self::mul_add(
+                            6.377,
+                            x88,
+                            Self::mul_add(-s_q2, x90, c_q2 * x92),
+                        )),
+            ),
+        );
         [x94, x93, x91, x83, x77, x72]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 463 mul, 356 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 463 mul, 356 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 267 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -808,267 +997,492 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x6 = 0.353 * s_q5;
         let x7 = 0.353 * c_q5;
-        let x8 = x7 - -0.9929999999999999 * s_q5;
-        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x10 = x6 + -0.9929999999999999 * c_q5;
-        let x11 = c_q5 * x8 - s_q5 * x6;
-        let x12 = c_q5 * x7 - s_q5 * x10;
-        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
-        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
+        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
+        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
+        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
+        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
+        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
         let x15 = 34.45002 * c_q4;
         let x16 = 34.45002 * s_q4;
         let x17 = s_q4 * x5;
-        let x18 = 1.903 * c_q4 - x17;
+        let x18 = Self::mul_add(1.903, c_q4, -x17);
         let x19 = c_q4 * x5;
-        let x20 = x19 - s_q4 * x13;
+        let x20 = Self::mul_add(-s_q4, x13, x19);
         let x21 = c_q4 * x9;
-        let x22 = x21 - s_q4 * x11;
-        let x23 = x19 + 1.903 * s_q4;
+        let x22 = Self::mul_add(-s_q4, x11, x21);
+        let x23 = Self::mul_add(1.903, s_q4, x19);
         let x24 = s_q4 * x9;
-        let x25 = x24 + c_q4 * x11;
-        let x26 = x21 - s_q4 * x12;
-        let x27 = x24 + c_q4 * x12;
+        let x25 = Self::mul_add(c_q4, x11, x24);
+        let x26 = Self::mul_add(-s_q4, x12, x21);
+        let x27 = Self::mul_add(c_q4, x12, x24);
         let x28 = x15 * -0.4572;
         let x29 = 0.4572 * x15;
         let x30 = x14 + x29;
-        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
         let x32 = x30 - x28;
         let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
         let x35 = 19.863252216000003
-            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+            + (x29
+                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
+                    - x28));
         let x36 = c_q3 * x33;
         let x37 = s_q3 * x33;
-        let x38 = c_q3 * x34 + s_q3 * x26;
-        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
+        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
         let x40 = c_q3 * x22;
-        let x41 = x40 + s_q3 * x32;
-        let x42 = c_q3 * x26 - s_q3 * x34;
-        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x41 = Self::mul_add(s_q3, x32, x40);
+        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
+        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
         let x44 = s_q3 * x22;
-        let x45 = c_q3 * x32 - x44;
+        let x45 = Self::mul_add(c_q3, x32, -x44);
         let x46 = x37 * 0.1524;
         let x47 = -0.1524 * x37;
         let x48 = x36 * -7.06;
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
         let x53 = 703.3878000000001 + x36;
         let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
-        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x55 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
         let x57 = 103.41030072000001
-            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+            + Self::mul_add(
+                x37,
+                7.06,
+                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
+            );
         let x58 = 5601.1318504688 + (x50 + (x46 + x49));
         let x59 = 103.41030072000002
-            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+            + Self::mul_add(
+                0.1524,
+                x36,
+                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            );
         let x60 = -0.08 + (x43 + x51);
-        let x61 = c_q2 * x53 + s_q2 * x54;
-        let x62 = c_q2 * x54 - s_q2 * x53;
-        let x63 = c_q2 * x55 + s_q2 * x59;
-        let x64 = c_q2 * x56 + s_q2 * x60;
-        let x65 = c_q2 * x57 + s_q2 * x52;
-        let x66 = c_q2 * x59 - s_q2 * x55;
-        let x67 = c_q2 * x60 - s_q2 * x56;
-        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
+        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
+        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
+        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
+        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
+        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
         let x69 = 0.1524 * x62;
         let x70 = -0.1524 * x62;
         let x71 = x61 * -6.377;
         let x72 = 6.377 * x61;
-        let x73 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
-        let x74 = c_q1 * x67 - s_q1 * x64;
-        let x75 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+        let x73 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x64),
+            c_q1 * (-0.0302 + (x51 + x67)),
+        );
+        let x74 = Self::mul_add(-s_q1, x64, c_q1 * x67);
+        let x75 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x43, c_q2 * x39),
+            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+        );
         let x76 = c_q3 * x16;
         let x77 = s_q3 * x16;
         let x78 = x15 * 0.1524;
-        let x79 = x40 + s_q3 * x30 + x78;
-        let x80 = x25 + (-7.06 * x77 - -0.1524 * x76);
-        let x81 = c_q3 * x30 - x44 + 7.06 * x15;
-        let x82 = c_q1 * (c_q2 * x81 - s_q2 * x79 + 6.377 * x15)
-            - s_q1 * (x78 + (c_q2 * x79 + s_q2 * x81));
-        let x83 = c_q3 * x18 + s_q3 * x9;
-        let x84 = c_q3 * x9 - s_q3 * x18;
-        let x85 = c_q1 * (c_q2 * x84 - s_q2 * x83) - s_q1 * (c_q2 * x83 + s_q2 * x84);
+        let x79 = Self::mul_add(s_q3, x30, x40) + x78;
+        let x80 = x25 + Self::mul_add(0.1524, x76, -7.06 * x77);
+        let x81 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
+        let x82 = Self::mul_add(
+            -s_q1,
+            x78 + Self::mul_add(s_q2, x81, c_q2 * x79),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x79, c_q2 * x81)),
+        );
+        let x83 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x84 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x85 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x84, c_q2 * x83),
+            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x84),
+        );
         let x86 = qd[0] * s_q1;
         let x87 = qd[0] * c_q1;
         let x88 = qd[1] * x87;
         let x89 = qd[1] * x86;
         let x90 = qd[1] * qd[1];
         let x91 = x86 * x87;
-        let x92 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
-        let x93 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
-        let x94 = -0.0302 * qd[1] - 190.97044034000004 * x86;
-        let x95 = c_q2 * x86 + s_q2 * x87;
-        let x96 = c_q2 * x87 - s_q2 * x86;
-        let x97 = 6.377 * (x90 + x87 * x87) + -0.1524 * x91;
-        let x98 = -0.1524 * (x88 + x88) - 6.377 * (x89 + x89);
-        let x99 = 6.377 * x91 + -0.1524 * (x90 + x86 * x86);
-        let x100 = s_q2 * x99 - c_q2 * x97;
-        let x101 = s_q2 * x97 + c_q2 * x99;
-        let x102 = s_q2 * x89 - c_q2 * x88 - qd[2] * x96;
-        let x103 = s_q2 * x88 + c_q2 * x89 + qd[2] * x95;
+        let x92 = Self::mul_add(
+            190.97044034,
+            x87,
+            Self::mul_add(8596.210051042, x86, -1.928 * qd[1]),
+        );
+        let x93 = Self::mul_add(
+            -0.0302,
+            x87,
+            Self::mul_add(1.928, x86, 8609.573807858 * qd[1]),
+        );
+        let x94 = Self::mul_add(-190.97044034000004, x86, -0.0302 * qd[1]);
+        let x95 = Self::mul_add(s_q2, x87, c_q2 * x86);
+        let x96 = Self::mul_add(-s_q2, x86, c_q2 * x87);
+        let x97 = Self::mul_add(-0.1524, x91, 6.377 * Self::mul_add(x87, x87, x90));
+        let x98 = Self::mul_add(-6.377, x89 + x89, -0.1524 * (x88 + x88));
+        let x99 = Self::mul_add(-0.1524, Self::mul_add(x86, x86, x90), 6.377 * x91);
+        let x100 = Self::mul_add(-c_q2, x97, s_q2 * x99);
+        let x101 = Self::mul_add(c_q2, x99, s_q2 * x97);
+        let x102 = Self::mul_add(-qd[2], x96, Self::mul_add(-c_q2, x88, s_q2 * x89));
+        let x103 = Self::mul_add(qd[2], x95, Self::mul_add(c_q2, x89, s_q2 * x88));
         let x104 = qd[1] + qd[2];
         let x105 = x104 * x104;
-        let x106 = x105 + x96 * x96;
+        let x106 = Self::mul_add(x96, x96, x105);
         let x107 = x95 * x96;
-        let x108 = x103 + x95 * x104;
-        let x109 = x96 * x104 - x102;
-        let x110 = x105 + x95 * x95;
-        let x111 = 0.8021 * x104 - -5594.523885531201 * x95 + 103.41030072000001 * x96;
-        let x112 = 5601.1318504688 * x104 - 0.8021 * x95 + -0.08 * x96;
-        let x113 = -0.08 * x104 - 103.41030072000002 * x95;
-        let x114 = c_q3 * x95 + s_q3 * x96;
-        let x115 = c_q3 * x96 - s_q3 * x95;
-        let x116 = x100 - (7.06 * x106 + -0.1524 * x107);
-        let x117 = x98 + (-0.1524 * x109 - 7.06 * x108);
-        let x118 = x101 + (7.06 * x107 + -0.1524 * x110);
-        let x119 = s_q3 * x116 - c_q3 * x118;
-        let x120 = c_q3 * x102 + s_q3 * x103 - qd[3] * x115;
-        let x121 = s_q3 * x102 - c_q3 * x103 - qd[3] * x114;
+        let x108 = Self::mul_add(x95, x104, x103);
+        let x109 = Self::mul_add(x96, x104, -x102);
+        let x110 = Self::mul_add(x95, x95, x105);
+        let x111 = Self::mul_add(
+            103.41030072000001,
+            x96,
+            Self::mul_add(5594.523885531201, x95, 0.8021 * x104),
+        );
+        let x112 = Self::mul_add(
+            -0.08,
+            x96,
+            Self::mul_add(-0.8021, x95, 5601.1318504688 * x104),
+        );
+        let x113 = Self::mul_add(-103.41030072000002, x95, -0.08 * x104);
+        let x114 = Self::mul_add(s_q3, x96, c_q3 * x95);
+        let x115 = Self::mul_add(-s_q3, x95, c_q3 * x96);
+        let x116 = x100 - Self::mul_add(-0.1524, x107, 7.06 * x106);
+        let x117 = x98 + Self::mul_add(-7.06, x108, -0.1524 * x109);
+        let x118 = x101 + Self::mul_add(-0.1524, x110, 7.06 * x107);
+        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
+        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x103, c_q3 * x102));
+        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x103, s_q3 * x102));
         let x122 = qd[3] + x104;
-        let x123 = x122 * x122 + x115 * x115;
+        let x123 = Self::mul_add(x115, x115, x122 * x122);
         let x124 = x114 * x115;
-        let x125 = x121 - x114 * x122;
+        let x125 = Self::mul_add(-x114, x122, x121);
         let x126 = -18.957952216000002 * x114;
         let x127 = 19.863252216000003 * x122;
-        let x128 = s_q4 * x122 - c_q4 * x114;
-        let x129 = s_q4 * x114 + c_q4 * x122;
-        let x130 = c_q4 * x120 + qd[4] * x129;
-        let x131 = s_q4 * x120 + qd[4] * x128;
+        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
+        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
+        let x130 = Self::mul_add(qd[4], x129, c_q4 * x120);
+        let x131 = Self::mul_add(qd[4], x128, s_q4 * x120);
         let x132 = qd[4] + x115;
-        let x133 = 34.45002 * (x129 * x129 + x132 * x132);
-        let x134 = 34.45002 * (x121 + x128 * x129);
-        let x135 = 34.45002 * (x131 + x128 * x132);
+        let x133 = 34.45002 * Self::mul_add(x132, x132, x129 * x129);
+        let x134 = 34.45002 * Self::mul_add(x128, x129, x121);
+        let x135 = 34.45002 * Self::mul_add(x128, x132, x131);
         let x136 = 34.33891524 * x129;
         let x137 = 34.74691524 * x132;
-        let x138 = c_q5 * x129 + s_q5 * x132;
-        let x139 = c_q5 * x132 - s_q5 * x129;
-        let x140 = s_q5 * x121 - c_q5 * x131 + qd[5] * x139;
-        let x141 = s_q5 * x131 + c_q5 * x121 - qd[5] * x138;
+        let x138 = Self::mul_add(s_q5, x132, c_q5 * x129);
+        let x139 = Self::mul_add(-s_q5, x129, c_q5 * x132);
+        let x140 = Self::mul_add(qd[5], x139, Self::mul_add(-c_q5, x131, s_q5 * x121));
+        let x141 = Self::mul_add(-qd[5], x138, Self::mul_add(c_q5, x121, s_q5 * x131));
         let x142 = qd[5] + x128;
-        let x143 = 1.903 * x142 + 0.385 * x138 + 0.966 * x139;
-        let x144 = 0.385 * x142 + 0.353 * x139;
-        let x145 = 0.966 * x142 + 0.353 * x138 + -0.9929999999999999 * x139;
-        let x146 = 1.903 * x130 + 0.385 * x140 + 0.966 * x141
-            + (x138 * x145 - x139 * x144);
-        let x147 = 0.385 * x130 + 0.353 * x141 + (x139 * x143 - x142 * x145);
-        let x148 = 0.966 * x130 + 0.353 * x140 + -0.9929999999999999 * x141
-            + (x142 * x144 - x138 * x143);
-        let x149 = x129 * x137 - x132 * x136 + x146;
-        let x150 = -34.45002 * (x119 - 0.4572 * x124)
-            - (34.33891524 * x131 + x128 * x137) + (c_q5 * x147 - s_q5 * x148);
-        let x151 = 34.74691524 * x121 + x128 * x136
-            + 34.45002
-                * (c_q4 * (x117 + 0.4572 * x125)
-                    - s_q4 * (c_q3 * x116 + s_q3 * x118 - 0.4572 * x123))
-            + (s_q5 * x147 + c_q5 * x148);
-        let x152 = c_q4 * x134 - s_q4 * x133;
-        let x153 = 41.67378 * x123 + (c_q4 * x133 + s_q4 * x134);
-        let x154 = 41.67378 * x125 + x152;
-        let x155 = x135 - 41.67378 * x124;
-        let x156 = -18.957952216000002 * x120 - x115 * x127
-            + (c_q4 * x149 - s_q4 * x150);
-        let x157 = x119 * -41.67378 - x115 * x126
-            + (s_q4 * x149 + c_q4 * x150 + -0.4572 * x135);
-        let x158 = x122 * x126 - x114 * x127 + 41.67378 * x117 + (x151 + 0.4572 * x152);
-        let x159 = s_q3 * x155 - c_q3 * x153;
-        let x160 = s_q3 * x153 + c_q3 * x155;
-        let x161 = x159 - (703.3878000000001 * x106 + -15.183612000000002 * x107);
-        let x162 = -15.183612000000002 * x109 - 703.3878000000001 * x108 + x154;
-        let x163 = x160 - (703.3878000000001 * x107 + -15.183612000000002 * x110);
-        let x164 = -5594.523885531201 * x102 - 103.41030072000001 * x103
-            + (x104 * x113 - x96 * x112) + x98 * 15.183612000000002
-            + (c_q3 * x156 + s_q3 * x158 + 0.1524 * x154);
-        let x165 = 0.8021 * x102 - -0.08 * x103 + (x96 * x111 + x95 * x113)
-            + (-15.183612000000002 * x100 - x101 * -703.3878000000001)
-            + (x157 + (-0.1524 * x159 + -7.06 * x160));
-        let x166 = 103.41030072000002 * x102 - (x104 * x111 + x95 * x112)
-            + 703.3878000000001 * x98 + (c_q3 * x158 - s_q3 * x156 + 7.06 * x154);
+        let x143 = Self::mul_add(0.966, x139, Self::mul_add(0.385, x138, 1.903 * x142));
+        let x144 = Self::mul_add(0.353, x139, 0.385 * x142);
+        let x145 = Self::mul_add(
+            -0.9929999999999999,
+            x139,
+            Self::mul_add(0.353, x138, 0.966 * x142),
+        );
+        let x146 = Self::mul_add(0.966, x141, Self::mul_add(0.385, x140, 1.903 * x130))
+            + Self::mul_add(-x139, x144, x138 * x145);
+        let x147 = Self::mul_add(0.353, x141, 0.385 * x130)
+            + Self::mul_add(-x142, x145, x139 * x143);
+        let x148 = Self::mul_add(
+            -0.9929999999999999,
+            x141,
+            Self::mul_add(0.353, x140, 0.966 * x130),
+        ) + Self::mul_add(-x138, x143, x142 * x144);
+        let x149 = Self::mul_add(-x132, x136, x129 * x137) + x146;
+        let x150 = Self::mul_add(
+            -34.45002,
+            Self::mul_add(-0.4572, x124, x119),
+            -Self::mul_add(x128, x137, 34.33891524 * x131),
+        ) + Self::mul_add(-s_q5, x148, c_q5 * x147);
+        let x151 = Self::mul_add(
+            34.45002,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
+                c_q4 * Self::mul_add(0.4572, x125, x117),
+            ),
+            Self::mul_add(x128, x136, 34.74691524 * x121),
+        ) + Self::mul_add(c_q5, x148, s_q5 * x147);
+        let x152 = Self::mul_add(-s_q4, x133, c_q4 * x134);
+        let x153 = Self::mul_add(41.67378, x123, Self::mul_add(s_q4, x134, c_q4 * x133));
+        let x154 = Self::mul_add(41.67378, x125, x152);
+        let x155 = Self::mul_add(-41.67378, x124, x135);
+        let x156 = Self::mul_add(-x115, x127, -18.957952216000002 * x120)
+            + Self::mul_add(-s_q4, x150, c_q4 * x149);
+        let x157 = Self::mul_add(-x115, x126, x119 * -41.67378)
+            + Self::mul_add(-0.4572, x135, Self::mul_add(c_q4, x150, s_q4 * x149));
+        let x158 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
+            + Self::mul_add(0.4572, x152, x151);
+        let x159 = Self::mul_add(-c_q3, x153, s_q3 * x155);
+        let x160 = Self::mul_add(c_q3, x155, s_q3 * x153);
+        let x161 = x159
+            - Self::mul_add(-15.183612000000002, x107, 703.3878000000001 * x106);
+        let x162 = Self::mul_add(-703.3878000000001, x108, -15.183612000000002 * x109)
+            + x154;
+        let x163 = x160
+            - Self::mul_add(-15.183612000000002, x110, 703.3878000000001 * x107);
+        let x164 = Self::mul_add(
+            x98,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x103, -5594.523885531201 * x102)
+                + Self::mul_add(-x96, x112, x104 * x113),
+        ) + Self::mul_add(0.1524, x154, Self::mul_add(s_q3, x158, c_q3 * x156));
+        let x165 = Self::mul_add(0.08, x103, 0.8021 * x102)
+            + Self::mul_add(x95, x113, x96 * x111)
+            + Self::mul_add(x101, 703.3878000000001, -15.183612000000002 * x100)
+            + (x157 + Self::mul_add(-7.06, x160, -0.1524 * x159));
+        let x166 = Self::mul_add(
+            703.3878000000001,
+            x98,
+            Self::mul_add(
+                103.41030072000002,
+                x102,
+                -Self::mul_add(x95, x112, x104 * x111),
+            ),
+        ) + Self::mul_add(7.06, x154, Self::mul_add(-s_q3, x156, c_q3 * x158));
         let x167 = tau[0]
-            - (c_q1
-                * (c_q2 * x166 - s_q2 * x164 + 6.377 * x162
-                    - (190.97044034000004 * x88 + (qd[1] * x92 + x86 * x93)))
-                - s_q1
-                    * (qd[1] * x94 - x87 * x93
-                        - (-8596.210051042 * x88 + 190.97044034 * x89)
-                        + (c_q2 * x164 + s_q2 * x166 + 0.1524 * x162)));
+            - Self::mul_add(
+                -s_q1,
+                Self::mul_add(-x87, x93, qd[1] * x94)
+                    - Self::mul_add(190.97044034, x89, -8596.210051042 * x88)
+                    + Self::mul_add(
+                        0.1524,
+                        x162,
+                        Self::mul_add(s_q2, x166, c_q2 * x164),
+                    ),
+                c_q1
+                    * (Self::mul_add(
+                        6.377,
+                        x162,
+                        Self::mul_add(-s_q2, x164, c_q2 * x166),
+                    )
+                        - Self::mul_add(
+                            190.97044034000004,
+                            x88,
+                            Self::mul_add(x86, x93, qd[1] * x92),
+                        )),
+            );
         let x168 = 1.0
             / (14222.257549666001
-                + (c_q1
-                    * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
-                        - s_q1
-                            * (190.97044034
-                                + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
-                    - s_q1
-                        * (c_q1
+                + Self::mul_add(
+                    -s_q1,
+                    Self::mul_add(
+                        -s_q1,
+                        -8596.210051042
+                            + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
+                        c_q1
                             * (190.97044034000004
-                                + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
-                            - s_q1
-                                * (-8596.210051042
-                                    + (x70 + (c_q2 * x63 + s_q2 * x65 - x69))))));
+                                + Self::mul_add(
+                                    0.1524,
+                                    x61,
+                                    Self::mul_add(
+                                        -6.377,
+                                        x62,
+                                        Self::mul_add(s_q2, x68, c_q2 * x66),
+                                    ),
+                                )),
+                    ),
+                    c_q1
+                        * Self::mul_add(
+                            -s_q1,
+                            190.97044034
+                                + Self::mul_add(
+                                    x62,
+                                    -6.377,
+                                    Self::mul_add(
+                                        0.1524,
+                                        x61,
+                                        Self::mul_add(-s_q2, x63, c_q2 * x65),
+                                    ),
+                                ),
+                            c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
+                        ),
+                ));
         let x169 = x73 * x168;
         let x170 = x74 * x168;
         let x171 = x75 * x168;
         let x172 = x82 * x168;
         let x173 = x85 * x168;
         let x174 = 1.0
-            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x169);
-        let x175 = x58 + (x70 - x71) - x73 * x170;
+            / Self::mul_add(
+                -x73,
+                x169,
+                8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)),
+            );
+        let x175 = Self::mul_add(-x73, x170, x58 + (x70 - x71));
         let x176 = x174 * x175;
-        let x177 = x50
-            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36))
-            - x73 * x171;
+        let x177 = Self::mul_add(
+            -x73,
+            x171,
+            x50
+                + Self::mul_add(
+                    0.1524,
+                    Self::mul_add(s_q2, x36, c_q2 * x37),
+                    -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+                ),
+        );
         let x178 = x174 * x177;
-        let x179 = x80
-            + (-0.1524 * (s_q2 * x77 - c_q2 * x76) + -6.377 * (s_q2 * x76 + c_q2 * x77))
-            - x73 * x172;
+        let x179 = Self::mul_add(
+            -x73,
+            x172,
+            x80
+                + Self::mul_add(
+                    -6.377,
+                    Self::mul_add(c_q2, x77, s_q2 * x76),
+                    -0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
+                ),
+        );
         let x180 = x174 * x179;
-        let x181 = x23 - x73 * x173;
+        let x181 = Self::mul_add(-x73, x173, x23);
         let x182 = x174 * x181;
-        let x183 = 1.0 / (x58 - x74 * x170 - x175 * x176);
-        let x184 = x50 - x74 * x171 - x175 * x178;
+        let x183 = 1.0 / Self::mul_add(-x175, x176, Self::mul_add(-x74, x170, x58));
+        let x184 = Self::mul_add(-x175, x178, Self::mul_add(-x74, x171, x50));
         let x185 = x183 * x184;
-        let x186 = x80 - x74 * x172 - x175 * x180;
+        let x186 = Self::mul_add(-x175, x180, Self::mul_add(-x74, x172, x80));
         let x187 = x183 * x186;
-        let x188 = x23 - x74 * x173 - x175 * x182;
+        let x188 = Self::mul_add(-x175, x182, Self::mul_add(-x74, x173, x23));
         let x189 = x183 * x188;
-        let x190 = 1.0 / (x35 - x75 * x171 - x177 * x178 - x184 * x185);
-        let x191 = x25 - x75 * x172 - x177 * x180 - x184 * x187;
+        let x190 = 1.0
+            / Self::mul_add(
+                -x184,
+                x185,
+                Self::mul_add(-x177, x178, Self::mul_add(-x75, x171, x35)),
+            );
+        let x191 = Self::mul_add(
+            -x184,
+            x187,
+            Self::mul_add(-x177, x180, Self::mul_add(-x75, x172, x25)),
+        );
         let x192 = x190 * x191;
-        let x193 = x23 - x75 * x173 - x177 * x182 - x184 * x189;
+        let x193 = Self::mul_add(
+            -x184,
+            x189,
+            Self::mul_add(-x177, x182, Self::mul_add(-x75, x173, x23)),
+        );
         let x194 = x190 * x193;
-        let x195 = 1.0 / (x14 - x82 * x172 - x179 * x180 - x186 * x187 - x191 * x192);
-        let x196 = x9 - x82 * x173 - x179 * x182 - x186 * x189 - x191 * x194;
+        let x195 = 1.0
+            / Self::mul_add(
+                -x191,
+                x192,
+                Self::mul_add(
+                    -x186,
+                    x187,
+                    Self::mul_add(-x179, x180, Self::mul_add(-x82, x172, x14)),
+                ),
+            );
+        let x196 = Self::mul_add(
+            -x191,
+            x194,
+            Self::mul_add(
+                -x186,
+                x189,
+                Self::mul_add(-x179, x182, Self::mul_add(-x82, x173, x9)),
+            ),
+        );
         let x197 = x195 * x196;
         let x198 = 1.0
-            / (1.903 - x85 * x173 - x181 * x182 - x188 * x189 - x193 * x194
-                - x196 * x197);
-        let x199 = tau[1]
-            - (x87 * x92 + x86 * x94 - (-1.928 * x88 + -0.0302 * x89)
-                + (x165
-                    + (-0.1524 * (c_q2 * x161 + s_q2 * x163)
-                        + -6.377 * (c_q2 * x163 - s_q2 * x161)))) - x167 * x169;
-        let x200 = tau[2] - x165 - x167 * x170 - x176 * x199;
-        let x201 = tau[3] - x157 - x167 * x171 - x178 * x199 - x185 * x200;
-        let x202 = tau[4] - x151 - x167 * x172 - x180 * x199 - x187 * x200 - x192 * x201;
+            / Self::mul_add(
+                -x196,
+                x197,
+                Self::mul_add(
+                    -x193,
+                    x194,
+                    Self::mul_add(
+                        -x188,
+                        x189,
+                        Self::mul_add(-x181, x182, Self::mul_add(-x85, x173, 1.903)),
+                    ),
+                ),
+            );
+        let x199 = Self::mul_add(
+            -x167,
+            x169,
+            tau[1]
+                - (Self::mul_add(x86, x94, x87 * x92)
+                    - Self::mul_add(-0.0302, x89, -1.928 * x88)
+                    + (x165
+                        + Self::mul_add(
+                            -6.377,
+                            Self::mul_add(-s_q2, x161, c_q2 * x163),
+                            -0.1524 * Self::mul_add(s_q2, x163, c_q2 * x161),
+                        ))),
+        );
+        let x200 = Self::mul_add(-x176, x199, Self::mul_add(-x167, x170, tau[2] - x165));
+        let x201 = Self::mul_add(
+            -x185,
+            x200,
+            Self::mul_add(-x178, x199, Self::mul_add(-x167, x171, tau[3] - x157)),
+        );
+        let x202 = Self::mul_add(
+            -x192,
+            x201,
+            Self::mul_add(
+                -x187,
+                x200,
+                Self::mul_add(-x180, x199, Self::mul_add(-x167, x172, tau[4] - x151)),
+            ),
+        );
         let x203 = x198
-            * (tau[5] - x146 - x167 * x173 - x182 * x199 - x189 * x200 - x194 * x201
-                - x197 * x202);
-        let x204 = x195 * x202 - x197 * x203;
-        let x205 = x190 * x201 - x192 * x204 - x194 * x203;
-        let x206 = x183 * x200 - x185 * x205 - x187 * x204 - x189 * x203;
-        let x207 = x174 * x199 - x176 * x206 - x178 * x205 - x180 * x204 - x182 * x203;
-        let x208 = x167 * x168 - x169 * x207 - x170 * x206 - x171 * x205 - x172 * x204
-            - x173 * x203;
+            * Self::mul_add(
+                -x197,
+                x202,
+                Self::mul_add(
+                    -x194,
+                    x201,
+                    Self::mul_add(
+                        -x189,
+                        x200,
+                        Self::mul_add(
+                            -x182,
+                            x199,
+                            Self::mul_add(-x167, x173, tau[5] - x146),
+                        ),
+                    ),
+                ),
+            );
+        let x204 = Self::mul_add(-x197, x203, x195 * x202);
+        let x205 = Self::mul_add(-x194, x203, Self::mul_add(-x192, x204, x190 * x201));
+        let x206 = Self::mul_add(
+            -x189,
+            x203,
+            Self::mul_add(-x187, x204, Self::mul_add(-x185, x205, x183 * x200)),
+        );
+        let x207 = Self::mul_add(
+            -x182,
+            x203,
+            Self::mul_add(
+                -x180,
+                x204,
+                Self::mul_add(-x178, x205, Self::mul_add(-x176, x206, x174 * x199)),
+            ),
+        );
+        let x208 = Self::mul_add(
+            -x173,
+            x203,
+            Self::mul_add(
+                -x172,
+                x204,
+                Self::mul_add(
+                    -x171,
+                    x205,
+                    Self::mul_add(-x170, x206, Self::mul_add(-x169, x207, x167 * x168)),
+                ),
+            ),
+        );
         [x208, x207, x206, x205, x204, x203]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 285 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 285 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 202 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1079,215 +1493,328 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x6 = 0.353 * s_q5;
         let x7 = 0.353 * c_q5;
-        let x8 = x7 - -0.9929999999999999 * s_q5;
-        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x10 = x6 + -0.9929999999999999 * c_q5;
-        let x11 = c_q5 * x8 - s_q5 * x6;
-        let x12 = c_q5 * x7 - s_q5 * x10;
-        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
-        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
+        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
+        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
+        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
+        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
+        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
         let x15 = 34.45002 * c_q4;
         let x16 = 34.45002 * s_q4;
         let x17 = s_q4 * x5;
-        let x18 = 1.903 * c_q4 - x17;
+        let x18 = Self::mul_add(1.903, c_q4, -x17);
         let x19 = c_q4 * x5;
-        let x20 = x19 - s_q4 * x13;
+        let x20 = Self::mul_add(-s_q4, x13, x19);
         let x21 = c_q4 * x9;
-        let x22 = x21 - s_q4 * x11;
-        let x23 = x19 + 1.903 * s_q4;
+        let x22 = Self::mul_add(-s_q4, x11, x21);
+        let x23 = Self::mul_add(1.903, s_q4, x19);
         let x24 = s_q4 * x9;
-        let x25 = x24 + c_q4 * x11;
-        let x26 = x21 - s_q4 * x12;
-        let x27 = x24 + c_q4 * x12;
+        let x25 = Self::mul_add(c_q4, x11, x24);
+        let x26 = Self::mul_add(-s_q4, x12, x21);
+        let x27 = Self::mul_add(c_q4, x12, x24);
         let x28 = x15 * -0.4572;
         let x29 = 0.4572 * x15;
         let x30 = x14 + x29;
-        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
         let x32 = x30 - x28;
         let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
         let x35 = 19.863252216000003
-            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+            + (x29
+                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
+                    - x28));
         let x36 = c_q3 * x33;
         let x37 = s_q3 * x33;
-        let x38 = c_q3 * x34 + s_q3 * x26;
-        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
+        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
         let x40 = c_q3 * x22;
-        let x41 = x40 + s_q3 * x32;
-        let x42 = c_q3 * x26 - s_q3 * x34;
-        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x41 = Self::mul_add(s_q3, x32, x40);
+        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
+        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
         let x44 = s_q3 * x22;
-        let x45 = c_q3 * x32 - x44;
+        let x45 = Self::mul_add(c_q3, x32, -x44);
         let x46 = x37 * 0.1524;
         let x47 = -0.1524 * x37;
         let x48 = x36 * -7.06;
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
         let x53 = 703.3878000000001 + x36;
         let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
-        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x55 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
         let x57 = 103.41030072000001
-            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+            + Self::mul_add(
+                x37,
+                7.06,
+                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
+            );
         let x58 = 5601.1318504688 + (x50 + (x46 + x49));
         let x59 = 103.41030072000002
-            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+            + Self::mul_add(
+                0.1524,
+                x36,
+                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            );
         let x60 = -0.08 + (x43 + x51);
-        let x61 = c_q2 * x53 + s_q2 * x54;
-        let x62 = c_q2 * x54 - s_q2 * x53;
-        let x63 = c_q2 * x55 + s_q2 * x59;
-        let x64 = c_q2 * x56 + s_q2 * x60;
-        let x65 = c_q2 * x57 + s_q2 * x52;
-        let x66 = c_q2 * x59 - s_q2 * x55;
-        let x67 = c_q2 * x60 - s_q2 * x56;
-        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
+        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
+        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
+        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
+        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
+        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
         let x69 = 0.1524 * x62;
         let x70 = -0.1524 * x62;
         let x71 = x61 * -6.377;
         let x72 = 6.377 * x61;
         let x73 = 8609.573807858 + (x58 - (x71 - x70) - (x69 - x72));
-        let x74 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
+        let x74 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x64),
+            c_q1 * (-0.0302 + (x51 + x67)),
+        );
         let x75 = 14222.257549666001
-            + (c_q1
-                * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
-                    - s_q1
-                        * (190.97044034
-                            + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
-                - s_q1
-                    * (c_q1
+            + Self::mul_add(
+                -s_q1,
+                Self::mul_add(
+                    -s_q1,
+                    -8596.210051042
+                        + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
+                    c_q1
                         * (190.97044034000004
-                            + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
-                        - s_q1
-                            * (-8596.210051042
-                                + (x70 + (c_q2 * x63 + s_q2 * x65 - x69)))));
+                            + Self::mul_add(
+                                0.1524,
+                                x61,
+                                Self::mul_add(
+                                    -6.377,
+                                    x62,
+                                    Self::mul_add(s_q2, x68, c_q2 * x66),
+                                ),
+                            )),
+                ),
+                c_q1
+                    * Self::mul_add(
+                        -s_q1,
+                        190.97044034
+                            + Self::mul_add(
+                                x62,
+                                -6.377,
+                                Self::mul_add(
+                                    0.1524,
+                                    x61,
+                                    Self::mul_add(-s_q2, x63, c_q2 * x65),
+                                ),
+                            ),
+                        c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
+                    ),
+            );
         let x76 = x58 + (x70 - x71);
-        let x77 = c_q1 * x67 - s_q1 * x64;
+        let x77 = Self::mul_add(-s_q1, x64, c_q1 * x67);
         let x78 = x50
-            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36));
-        let x79 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+            + Self::mul_add(
+                0.1524,
+                Self::mul_add(s_q2, x36, c_q2 * x37),
+                -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+            );
+        let x79 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x43, c_q2 * x39),
+            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+        );
         let x80 = c_q3 * x16;
         let x81 = s_q3 * x16;
         let x82 = x15 * 0.1524;
-        let x83 = x40 + s_q3 * x30 + x82;
-        let x84 = x25 + (-7.06 * x81 - -0.1524 * x80);
-        let x85 = c_q3 * x30 - x44 + 7.06 * x15;
+        let x83 = Self::mul_add(s_q3, x30, x40) + x82;
+        let x84 = x25 + Self::mul_add(0.1524, x80, -7.06 * x81);
+        let x85 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
         let x86 = x84
-            + (-0.1524 * (s_q2 * x81 - c_q2 * x80) + -6.377 * (s_q2 * x80 + c_q2 * x81));
-        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x83 + 6.377 * x15)
-            - s_q1 * (x82 + (c_q2 * x83 + s_q2 * x85));
-        let x88 = c_q3 * x18 + s_q3 * x9;
-        let x89 = c_q3 * x9 - s_q3 * x18;
-        let x90 = c_q1 * (c_q2 * x89 - s_q2 * x88) - s_q1 * (c_q2 * x88 + s_q2 * x89);
+            + Self::mul_add(
+                -6.377,
+                Self::mul_add(c_q2, x81, s_q2 * x80),
+                -0.1524 * Self::mul_add(-c_q2, x80, s_q2 * x81),
+            );
+        let x87 = Self::mul_add(
+            -s_q1,
+            x82 + Self::mul_add(s_q2, x85, c_q2 * x83),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x83, c_q2 * x85)),
+        );
+        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x90 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x89, c_q2 * x88),
+            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
+        );
         let x91 = qd[0] * s_q1;
         let x92 = qd[0] * c_q1;
         let x93 = qd[1] * x92;
         let x94 = qd[1] * x91;
         let x95 = qd[1] * qd[1];
         let x96 = x91 * x92;
-        let x97 = -1.928 * qd[1] - -8596.210051042 * x91 + 190.97044034 * x92;
-        let x98 = 8609.573807858 * qd[1] - -1.928 * x91 + -0.0302 * x92;
-        let x99 = -0.0302 * qd[1] - 190.97044034000004 * x91;
-        let x100 = c_q2 * x91 + s_q2 * x92;
-        let x101 = c_q2 * x92 - s_q2 * x91;
-        let x102 = 6.377 * (x95 + x92 * x92) + -0.1524 * x96;
-        let x103 = -0.1524 * (x93 + x93) - 6.377 * (x94 + x94);
-        let x104 = 6.377 * x96 + -0.1524 * (x95 + x91 * x91);
-        let x105 = s_q2 * x104 - c_q2 * x102;
-        let x106 = s_q2 * x102 + c_q2 * x104;
-        let x107 = s_q2 * x94 - c_q2 * x93 - qd[2] * x101;
-        let x108 = s_q2 * x93 + c_q2 * x94 + qd[2] * x100;
+        let x97 = Self::mul_add(
+            190.97044034,
+            x92,
+            Self::mul_add(8596.210051042, x91, -1.928 * qd[1]),
+        );
+        let x98 = Self::mul_add(
+            -0.0302,
+            x92,
+            Self::mul_add(1.928, x91, 8609.573807858 * qd[1]),
+        );
+        let x99 = Self::mul_add(-190.97044034000004, x91, -0.0302 * qd[1]);
+        let x100 = Self::mul_add(s_q2, x92, c_q2 * x91);
+        let x101 = Self::mul_add(-s_q2, x91, c_q2 * x92);
+        let x102 = Self::mul_add(-0.1524, x96, 6.377 * Self::mul_add(x92, x92, x95));
+        let x103 = Self::mul_add(-6.377, x94 + x94, -0.1524 * (x93 + x93));
+        let x104 = Self::mul_add(-0.1524, Self::mul_add(x91, x91, x95), 6.377 * x96);
+        let x105 = Self::mul_add(-c_q2, x102, s_q2 * x104);
+        let x106 = Self::mul_add(c_q2, x104, s_q2 * x102);
+        let x107 = Self::mul_add(-qd[2], x101, Self::mul_add(-c_q2, x93, s_q2 * x94));
+        let x108 = Self::mul_add(qd[2], x100, Self::mul_add(c_q2, x94, s_q2 * x93));
         let x109 = qd[1] + qd[2];
         let x110 = x109 * x109;
-        let x111 = x110 + x101 * x101;
+        let x111 = Self::mul_add(x101, x101, x110);
         let x112 = x100 * x101;
-        let x113 = x108 + x100 * x109;
-        let x114 = x101 * x109 - x107;
-        let x115 = x110 + x100 * x100;
-        let x116 = 0.8021 * x109 - -5594.523885531201 * x100 + 103.41030072000001 * x101;
-        let x117 = 5601.1318504688 * x109 - 0.8021 * x100 + -0.08 * x101;
-        let x118 = -0.08 * x109 - 103.41030072000002 * x100;
-        let x119 = c_q3 * x100 + s_q3 * x101;
-        let x120 = c_q3 * x101 - s_q3 * x100;
-        let x121 = x105 - (7.06 * x111 + -0.1524 * x112);
-        let x122 = x103 + (-0.1524 * x114 - 7.06 * x113);
-        let x123 = x106 + (7.06 * x112 + -0.1524 * x115);
-        let x124 = s_q3 * x121 - c_q3 * x123;
-        let x125 = c_q3 * x107 + s_q3 * x108 - qd[3] * x120;
-        let x126 = s_q3 * x107 - c_q3 * x108 - qd[3] * x119;
+        let x113 = Self::mul_add(x100, x109, x108);
+        let x114 = Self::mul_add(x101, x109, -x107);
+        let x115 = Self::mul_add(x100, x100, x110);
+        let x116 = Self::mul_add(
+            103.41030072000001,
+            x101,
+            Self::mul_add(5594.523885531201, x100, 0.8021 * x109),
+        );
+        let x117 = Self::mul_add(
+            -0.08,
+            x101,
+            Self::mul_add(-0.8021, x100, 5601.1318504688 * x109),
+        );
+        let x118 = Self::mul_add(-103.41030072000002, x100, -0.08 * x109);
+        let x119 = Self::mul_add(s_q3, x101, c_q3 * x100);
+        let x120 = Self::mul_add(-s_q3, x100, c_q3 * x101);
+        let x121 = x105 - Self::mul_add(-0.1524, x112, 7.06 * x111);
+        let x122 = x103 + Self::mul_add(-7.06, x113, -0.1524 * x114);
+        let x123 = x106 + Self::mul_add(-0.1524, x115, 7.06 * x112);
+        let x124 = Self::mul_add(-c_q3, x123, s_q3 * x121);
+        let x125 = Self::mul_add(-qd[3], x120, Self::mul_add(s_q3, x108, c_q3 * x107));
+        let x126 = Self::mul_add(-qd[3], x119, Self::mul_add(-c_q3, x108, s_q3 * x107));
         let x127 = qd[3] + x109;
-        let x128 = x127 * x127 + x120 * x120;
+        let x128 = Self::mul_add(x120, x120, x127 * x127);
         let x129 = x119 * x120;
-        let x130 = x126 - x119 * x127;
+        let x130 = Self::mul_add(-x119, x127, x126);
         let x131 = -18.957952216000002 * x119;
         let x132 = 19.863252216000003 * x127;
-        let x133 = s_q4 * x127 - c_q4 * x119;
-        let x134 = s_q4 * x119 + c_q4 * x127;
-        let x135 = c_q4 * x125 + qd[4] * x134;
-        let x136 = s_q4 * x125 + qd[4] * x133;
+        let x133 = Self::mul_add(-c_q4, x119, s_q4 * x127);
+        let x134 = Self::mul_add(c_q4, x127, s_q4 * x119);
+        let x135 = Self::mul_add(qd[4], x134, c_q4 * x125);
+        let x136 = Self::mul_add(qd[4], x133, s_q4 * x125);
         let x137 = qd[4] + x120;
-        let x138 = 34.45002 * (x134 * x134 + x137 * x137);
-        let x139 = 34.45002 * (x126 + x133 * x134);
-        let x140 = 34.45002 * (x136 + x133 * x137);
+        let x138 = 34.45002 * Self::mul_add(x137, x137, x134 * x134);
+        let x139 = 34.45002 * Self::mul_add(x133, x134, x126);
+        let x140 = 34.45002 * Self::mul_add(x133, x137, x136);
         let x141 = 34.33891524 * x134;
         let x142 = 34.74691524 * x137;
-        let x143 = c_q5 * x134 + s_q5 * x137;
-        let x144 = c_q5 * x137 - s_q5 * x134;
-        let x145 = s_q5 * x126 - c_q5 * x136 + qd[5] * x144;
-        let x146 = s_q5 * x136 + c_q5 * x126 - qd[5] * x143;
+        let x143 = Self::mul_add(s_q5, x137, c_q5 * x134);
+        let x144 = Self::mul_add(-s_q5, x134, c_q5 * x137);
+        let x145 = Self::mul_add(qd[5], x144, Self::mul_add(-c_q5, x136, s_q5 * x126));
+        let x146 = Self::mul_add(-qd[5], x143, Self::mul_add(c_q5, x126, s_q5 * x136));
         let x147 = qd[5] + x133;
-        let x148 = 1.903 * x147 + 0.385 * x143 + 0.966 * x144;
-        let x149 = 0.385 * x147 + 0.353 * x144;
-        let x150 = 0.966 * x147 + 0.353 * x143 + -0.9929999999999999 * x144;
-        let x151 = 1.903 * x135 + 0.385 * x145 + 0.966 * x146
-            + (x143 * x150 - x144 * x149);
-        let x152 = 0.385 * x135 + 0.353 * x146 + (x144 * x148 - x147 * x150);
-        let x153 = 0.966 * x135 + 0.353 * x145 + -0.9929999999999999 * x146
-            + (x147 * x149 - x143 * x148);
-        let x154 = x134 * x142 - x137 * x141 + x151;
-        let x155 = -34.45002 * (x124 - 0.4572 * x129)
-            - (34.33891524 * x136 + x133 * x142) + (c_q5 * x152 - s_q5 * x153);
-        let x156 = 34.74691524 * x126 + x133 * x141
-            + 34.45002
-                * (c_q4 * (x122 + 0.4572 * x130)
-                    - s_q4 * (c_q3 * x121 + s_q3 * x123 - 0.4572 * x128))
-            + (s_q5 * x152 + c_q5 * x153);
-        let x157 = c_q4 * x139 - s_q4 * x138;
-        let x158 = 41.67378 * x128 + (c_q4 * x138 + s_q4 * x139);
-        let x159 = 41.67378 * x130 + x157;
-        let x160 = x140 - 41.67378 * x129;
-        let x161 = -18.957952216000002 * x125 - x120 * x132
-            + (c_q4 * x154 - s_q4 * x155);
-        let x162 = x124 * -41.67378 - x120 * x131
-            + (s_q4 * x154 + c_q4 * x155 + -0.4572 * x140);
-        let x163 = x127 * x131 - x119 * x132 + 41.67378 * x122 + (x156 + 0.4572 * x157);
-        let x164 = s_q3 * x160 - c_q3 * x158;
-        let x165 = s_q3 * x158 + c_q3 * x160;
-        let x166 = x164 - (703.3878000000001 * x111 + -15.183612000000002 * x112);
-        let x167 = -15.183612000000002 * x114 - 703.3878000000001 * x113 + x159;
-        let x168 = x165 - (703.3878000000001 * x112 + -15.183612000000002 * x115);
-        let x169 = -5594.523885531201 * x107 - 103.41030072000001 * x108
-            + (x109 * x118 - x101 * x117) + x103 * 15.183612000000002
-            + (c_q3 * x161 + s_q3 * x163 + 0.1524 * x159);
-        let x170 = 0.8021 * x107 - -0.08 * x108 + (x101 * x116 + x100 * x118)
-            + (-15.183612000000002 * x105 - x106 * -703.3878000000001)
-            + (x162 + (-0.1524 * x164 + -7.06 * x165));
-        let x171 = 103.41030072000002 * x107 - (x109 * x116 + x100 * x117)
-            + 703.3878000000001 * x103 + (c_q3 * x163 - s_q3 * x161 + 7.06 * x159);
-        let x172 = x92 * x97 + x91 * x99 - (-1.928 * x93 + -0.0302 * x94)
+        let x148 = Self::mul_add(0.966, x144, Self::mul_add(0.385, x143, 1.903 * x147));
+        let x149 = Self::mul_add(0.353, x144, 0.385 * x147);
+        let x150 = Self::mul_add(
+            -0.9929999999999999,
+            x144,
+            Self::mul_add(0.353, x143, 0.966 * x147),
+        );
+        let x151 = Self::mul_add(0.966, x146, Self::mul_add(0.385, x145, 1.903 * x135))
+            + Self::mul_add(-x144, x149, x143 * x150);
+        let x152 = Self::mul_add(0.353, x146, 0.385 * x135)
+            + Self::mul_add(-x147, x150, x144 * x148);
+        let x153 = Self::mul_add(
+            -0.9929999999999999,
+            x146,
+            Self::mul_add(0.353, x145, 0.966 * x135),
+        ) + Self::mul_add(-x143, x148, x147 * x149);
+        let x154 = Self::mul_add(-x137, x141, x134 * x142) + x151;
+        let x155 = Self::mul_add(
+            -34.45002,
+            Self::mul_add(-0.4572, x129, x124),
+            -Self::mul_add(x133, x142, 34.33891524 * x136),
+        ) + Self::mul_add(-s_q5, x153, c_q5 * x152);
+        let x156 = Self::mul_add(
+            34.45002,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(-0.4572, x128, Self::mul_add(s_q3, x123, c_q3 * x121)),
+                c_q4 * Self::mul_add(0.4572, x130, x122),
+            ),
+            Self::mul_add(x133, x141, 34.74691524 * x126),
+        ) + Self::mul_add(c_q5, x153, s_q5 * x152);
+        let x157 = Self::mul_add(-s_q4, x138, c_q4 * x139);
+        let x158 = Self::mul_add(41.67378, x128, Self::mul_add(s_q4, x139, c_q4 * x138));
+        let x159 = Self::mul_add(41.67378, x130, x157);
+        let x160 = Self::mul_add(-41.67378, x129, x140);
+        let x161 = Self::mul_add(-x120, x132, -18.957952216000002 * x125)
+            + Self::mul_add(-s_q4, x155, c_q4 * x154);
+        let x162 = Self::mul_add(-x120, x131, x124 * -41.67378)
+            + Self::mul_add(-0.4572, x140, Self::mul_add(c_q4, x155, s_q4 * x154));
+        let x163 = Self::mul_add(41.67378, x122, Self::mul_add(-x119, x132, x127 * x131))
+            + Self::mul_add(0.4572, x157, x156);
+        let x164 = Self::mul_add(-c_q3, x158, s_q3 * x160);
+        let x165 = Self::mul_add(c_q3, x160, s_q3 * x158);
+        let x166 = x164
+            - Self::mul_add(-15.183612000000002, x112, 703.3878000000001 * x111);
+        let x167 = Self::mul_add(-703.3878000000001, x113, -15.183612000000002 * x114)
+            + x159;
+        let x168 = x165
+            - Self::mul_add(-15.183612000000002, x115, 703.3878000000001 * x112);
+        let x169 = Self::mul_add(
+            x103,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x108, -5594.523885531201 * x107)
+                + Self::mul_add(-x101, x117, x109 * x118),
+        ) + Self::mul_add(0.1524, x159, Self::mul_add(s_q3, x163, c_q3 * x161));
+        let x170 = Self::mul_add(0.08, x108, 0.8021 * x107)
+            + Self::mul_add(x100, x118, x101 * x116)
+            + Self::mul_add(x106, 703.3878000000001, -15.183612000000002 * x105)
+            + (x162 + Self::mul_add(-7.06, x165, -0.1524 * x164));
+        let x171 = Self::mul_add(
+            703.3878000000001,
+            x103,
+            Self::mul_add(
+                103.41030072000002,
+                x107,
+                -Self::mul_add(x100, x117, x109 * x116),
+            ),
+        ) + Self::mul_add(7.06, x159, Self::mul_add(-s_q3, x161, c_q3 * x163));
+        let x172 = Self::mul_add(x91, x99, x92 * x97)
+            - Self::mul_add(-0.0302, x94, -1.928 * x93)
             + (x170
-                + (-0.1524 * (c_q2 * x166 + s_q2 * x168)
-                    + -6.377 * (c_q2 * x168 - s_q2 * x166)));
-        let x173 = c_q1
-            * (c_q2 * x171 - s_q2 * x169 + 6.377 * x167
-                - (190.97044034000004 * x93 + (qd[1] * x97 + x91 * x98)))
-            - s_q1
-                * (qd[1] * x99 - x92 * x98 - (-8596.210051042 * x93 + 190.97044034 * x94)
-                    + (c_q2 * x169 + s_q2 * x171 + 0.1524 * x167));
+                + Self::mul_add(
+                    -6.377,
+                    Self::mul_add(-s_q2, x166, c_q2 * x168),
+                    -0.1524 * Self::mul_add(s_q2, x168, c_q2 * x166),
+                ));
+        let x173 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-x92, x98, qd[1] * x99)
+                - Self::mul_add(190.97044034, x94, -8596.210051042 * x93)
+                + Self::mul_add(0.1524, x167, Self::mul_add(s_q2, x171, c_q2 * x169)),
+            c_q1
+                * (Self::mul_add(6.377, x167, Self::mul_add(-s_q2, x169, c_q2 * x171))
+                    - Self::mul_add(
+                        190.97044034000004,
+                        x93,
+                        Self::mul_add(x91, x98, qd[1] * x97),
+                    )),
+        );
         (
             [
                 [x75, x74, x77, x79, x87, x90],
@@ -1302,7 +1829,7 @@ impl Srms {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 469 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 469 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 274 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1315,272 +1842,533 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 0.385 * c_q5 - 0.966 * s_q5;
+        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x6 = 0.353 * s_q5;
         let x7 = 0.353 * c_q5;
-        let x8 = x7 - -0.9929999999999999 * s_q5;
-        let x9 = 0.385 * s_q5 + 0.966 * c_q5;
-        let x10 = x6 + -0.9929999999999999 * c_q5;
-        let x11 = c_q5 * x8 - s_q5 * x6;
-        let x12 = c_q5 * x7 - s_q5 * x10;
-        let x13 = 34.33891524 - (c_q5 * x6 + s_q5 * x8);
-        let x14 = 34.74691524 + (s_q5 * x7 + c_q5 * x10);
+        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
+        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
+        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
+        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
+        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
+        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
         let x15 = 34.45002 * c_q4;
         let x16 = 34.45002 * s_q4;
         let x17 = s_q4 * x5;
-        let x18 = 1.903 * c_q4 - x17;
+        let x18 = Self::mul_add(1.903, c_q4, -x17);
         let x19 = c_q4 * x5;
-        let x20 = x19 - s_q4 * x13;
+        let x20 = Self::mul_add(-s_q4, x13, x19);
         let x21 = c_q4 * x9;
-        let x22 = x21 - s_q4 * x11;
-        let x23 = x19 + 1.903 * s_q4;
+        let x22 = Self::mul_add(-s_q4, x11, x21);
+        let x23 = Self::mul_add(1.903, s_q4, x19);
         let x24 = s_q4 * x9;
-        let x25 = x24 + c_q4 * x11;
-        let x26 = x21 - s_q4 * x12;
-        let x27 = x24 + c_q4 * x12;
+        let x25 = Self::mul_add(c_q4, x11, x24);
+        let x26 = Self::mul_add(-s_q4, x12, x21);
+        let x27 = Self::mul_add(c_q4, x12, x24);
         let x28 = x15 * -0.4572;
         let x29 = 0.4572 * x15;
         let x30 = x14 + x29;
-        let x31 = s_q4 * x18 + c_q4 * x20 - 0.4572 * x16;
+        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
         let x32 = x30 - x28;
         let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + (c_q4 * x18 - s_q4 * x20);
+        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
         let x35 = 19.863252216000003
-            + (x29 + (s_q4 * x23 + c_q4 * (x17 + c_q4 * x13) - x28));
+            + (x29
+                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
+                    - x28));
         let x36 = c_q3 * x33;
         let x37 = s_q3 * x33;
-        let x38 = c_q3 * x34 + s_q3 * x26;
-        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
+        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
         let x40 = c_q3 * x22;
-        let x41 = x40 + s_q3 * x32;
-        let x42 = c_q3 * x26 - s_q3 * x34;
-        let x43 = c_q3 * x27 - s_q3 * x31;
+        let x41 = Self::mul_add(s_q3, x32, x40);
+        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
+        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
         let x44 = s_q3 * x22;
-        let x45 = c_q3 * x32 - x44;
+        let x45 = Self::mul_add(c_q3, x32, -x44);
         let x46 = x37 * 0.1524;
         let x47 = -0.1524 * x37;
         let x48 = x36 * -7.06;
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = c_q3 * x45 - s_q3 * x42 + x49 - x48;
+        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
         let x53 = 703.3878000000001 + x36;
         let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201 + (c_q3 * x38 + s_q3 * x41 + x46 - x47);
-        let x56 = 0.8021 + (x39 - 7.06 * x16);
+        let x55 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
         let x57 = 103.41030072000001
-            + (c_q3 * x41 - s_q3 * x38 + x36 * 0.1524 - x37 * -7.06);
+            + Self::mul_add(
+                x37,
+                7.06,
+                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
+            );
         let x58 = 5601.1318504688 + (x50 + (x46 + x49));
         let x59 = 103.41030072000002
-            + (c_q3 * x42 + s_q3 * x45 + 7.06 * x37 - -0.1524 * x36);
+            + Self::mul_add(
+                0.1524,
+                x36,
+                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            );
         let x60 = -0.08 + (x43 + x51);
-        let x61 = c_q2 * x53 + s_q2 * x54;
-        let x62 = c_q2 * x54 - s_q2 * x53;
-        let x63 = c_q2 * x55 + s_q2 * x59;
-        let x64 = c_q2 * x56 + s_q2 * x60;
-        let x65 = c_q2 * x57 + s_q2 * x52;
-        let x66 = c_q2 * x59 - s_q2 * x55;
-        let x67 = c_q2 * x60 - s_q2 * x56;
-        let x68 = c_q2 * x52 - s_q2 * x57;
+        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
+        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
+        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
+        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
+        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
+        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
         let x69 = 0.1524 * x62;
         let x70 = -0.1524 * x62;
         let x71 = x61 * -6.377;
         let x72 = 6.377 * x61;
-        let x73 = c_q1 * (-0.0302 + (x51 + x67)) - s_q1 * (-1.928 + (x64 - 6.377 * x16));
-        let x74 = c_q1 * x67 - s_q1 * x64;
-        let x75 = c_q1 * (c_q2 * x43 - s_q2 * x39) - s_q1 * (c_q2 * x39 + s_q2 * x43);
+        let x73 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x64),
+            c_q1 * (-0.0302 + (x51 + x67)),
+        );
+        let x74 = Self::mul_add(-s_q1, x64, c_q1 * x67);
+        let x75 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x43, c_q2 * x39),
+            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+        );
         let x76 = c_q3 * x16;
         let x77 = s_q3 * x16;
         let x78 = x15 * 0.1524;
-        let x79 = x40 + s_q3 * x30 + x78;
-        let x80 = x25 + (-7.06 * x77 - -0.1524 * x76);
-        let x81 = c_q3 * x30 - x44 + 7.06 * x15;
-        let x82 = c_q1 * (c_q2 * x81 - s_q2 * x79 + 6.377 * x15)
-            - s_q1 * (x78 + (c_q2 * x79 + s_q2 * x81));
-        let x83 = c_q3 * x18 + s_q3 * x9;
-        let x84 = c_q3 * x9 - s_q3 * x18;
-        let x85 = c_q1 * (c_q2 * x84 - s_q2 * x83) - s_q1 * (c_q2 * x83 + s_q2 * x84);
+        let x79 = Self::mul_add(s_q3, x30, x40) + x78;
+        let x80 = x25 + Self::mul_add(0.1524, x76, -7.06 * x77);
+        let x81 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
+        let x82 = Self::mul_add(
+            -s_q1,
+            x78 + Self::mul_add(s_q2, x81, c_q2 * x79),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x79, c_q2 * x81)),
+        );
+        let x83 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x84 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x85 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x84, c_q2 * x83),
+            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x84),
+        );
         let x86 = qd[0] * s_q1;
         let x87 = qd[0] * c_q1;
         let x88 = qd[1] * x87;
         let x89 = qd[1] * x86;
         let x90 = qd[1] * qd[1];
         let x91 = x86 * x87;
-        let x92 = -1.928 * qd[1] - -8596.210051042 * x86 + 190.97044034 * x87;
-        let x93 = 8609.573807858 * qd[1] - -1.928 * x86 + -0.0302 * x87;
-        let x94 = -0.0302 * qd[1] - 190.97044034000004 * x86;
-        let x95 = c_q2 * x86 + s_q2 * x87;
-        let x96 = c_q2 * x87 - s_q2 * x86;
-        let x97 = 6.377 * (x90 + x87 * x87) + -0.1524 * x91;
-        let x98 = -0.1524 * (x88 + x88) - 6.377 * (x89 + x89);
-        let x99 = 6.377 * x91 + -0.1524 * (x90 + x86 * x86);
-        let x100 = s_q2 * x99 - c_q2 * x97;
-        let x101 = s_q2 * x97 + c_q2 * x99;
-        let x102 = s_q2 * x89 - c_q2 * x88 - qd[2] * x96;
-        let x103 = s_q2 * x88 + c_q2 * x89 + qd[2] * x95;
+        let x92 = Self::mul_add(
+            190.97044034,
+            x87,
+            Self::mul_add(8596.210051042, x86, -1.928 * qd[1]),
+        );
+        let x93 = Self::mul_add(
+            -0.0302,
+            x87,
+            Self::mul_add(1.928, x86, 8609.573807858 * qd[1]),
+        );
+        let x94 = Self::mul_add(-190.97044034000004, x86, -0.0302 * qd[1]);
+        let x95 = Self::mul_add(s_q2, x87, c_q2 * x86);
+        let x96 = Self::mul_add(-s_q2, x86, c_q2 * x87);
+        let x97 = Self::mul_add(-0.1524, x91, 6.377 * Self::mul_add(x87, x87, x90));
+        let x98 = Self::mul_add(-6.377, x89 + x89, -0.1524 * (x88 + x88));
+        let x99 = Self::mul_add(-0.1524, Self::mul_add(x86, x86, x90), 6.377 * x91);
+        let x100 = Self::mul_add(-c_q2, x97, s_q2 * x99);
+        let x101 = Self::mul_add(c_q2, x99, s_q2 * x97);
+        let x102 = Self::mul_add(-qd[2], x96, Self::mul_add(-c_q2, x88, s_q2 * x89));
+        let x103 = Self::mul_add(qd[2], x95, Self::mul_add(c_q2, x89, s_q2 * x88));
         let x104 = qd[1] + qd[2];
         let x105 = x104 * x104;
-        let x106 = x105 + x96 * x96;
+        let x106 = Self::mul_add(x96, x96, x105);
         let x107 = x95 * x96;
-        let x108 = x103 + x95 * x104;
-        let x109 = x96 * x104 - x102;
-        let x110 = x105 + x95 * x95;
-        let x111 = 0.8021 * x104 - -5594.523885531201 * x95 + 103.41030072000001 * x96;
-        let x112 = 5601.1318504688 * x104 - 0.8021 * x95 + -0.08 * x96;
-        let x113 = -0.08 * x104 - 103.41030072000002 * x95;
-        let x114 = c_q3 * x95 + s_q3 * x96;
-        let x115 = c_q3 * x96 - s_q3 * x95;
-        let x116 = x100 - (7.06 * x106 + -0.1524 * x107);
-        let x117 = x98 + (-0.1524 * x109 - 7.06 * x108);
-        let x118 = x101 + (7.06 * x107 + -0.1524 * x110);
-        let x119 = s_q3 * x116 - c_q3 * x118;
-        let x120 = c_q3 * x102 + s_q3 * x103 - qd[3] * x115;
-        let x121 = s_q3 * x102 - c_q3 * x103 - qd[3] * x114;
+        let x108 = Self::mul_add(x95, x104, x103);
+        let x109 = Self::mul_add(x96, x104, -x102);
+        let x110 = Self::mul_add(x95, x95, x105);
+        let x111 = Self::mul_add(
+            103.41030072000001,
+            x96,
+            Self::mul_add(5594.523885531201, x95, 0.8021 * x104),
+        );
+        let x112 = Self::mul_add(
+            -0.08,
+            x96,
+            Self::mul_add(-0.8021, x95, 5601.1318504688 * x104),
+        );
+        let x113 = Self::mul_add(-103.41030072000002, x95, -0.08 * x104);
+        let x114 = Self::mul_add(s_q3, x96, c_q3 * x95);
+        let x115 = Self::mul_add(-s_q3, x95, c_q3 * x96);
+        let x116 = x100 - Self::mul_add(-0.1524, x107, 7.06 * x106);
+        let x117 = x98 + Self::mul_add(-7.06, x108, -0.1524 * x109);
+        let x118 = x101 + Self::mul_add(-0.1524, x110, 7.06 * x107);
+        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
+        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x103, c_q3 * x102));
+        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x103, s_q3 * x102));
         let x122 = qd[3] + x104;
-        let x123 = x122 * x122 + x115 * x115;
+        let x123 = Self::mul_add(x115, x115, x122 * x122);
         let x124 = x114 * x115;
-        let x125 = x121 - x114 * x122;
+        let x125 = Self::mul_add(-x114, x122, x121);
         let x126 = -18.957952216000002 * x114;
         let x127 = 19.863252216000003 * x122;
-        let x128 = s_q4 * x122 - c_q4 * x114;
-        let x129 = s_q4 * x114 + c_q4 * x122;
-        let x130 = c_q4 * x120 + qd[4] * x129;
-        let x131 = s_q4 * x120 + qd[4] * x128;
+        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
+        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
+        let x130 = Self::mul_add(qd[4], x129, c_q4 * x120);
+        let x131 = Self::mul_add(qd[4], x128, s_q4 * x120);
         let x132 = qd[4] + x115;
         let x133 = 34.33891524 * x129;
         let x134 = 34.74691524 * x132;
-        let x135 = c_q5 * x129 + s_q5 * x132;
-        let x136 = c_q5 * x132 - s_q5 * x129;
-        let x137 = s_q5 * x121 - c_q5 * x131 + qd[5] * x136;
-        let x138 = s_q5 * x131 + c_q5 * x121 - qd[5] * x135;
+        let x135 = Self::mul_add(s_q5, x132, c_q5 * x129);
+        let x136 = Self::mul_add(-s_q5, x129, c_q5 * x132);
+        let x137 = Self::mul_add(qd[5], x136, Self::mul_add(-c_q5, x131, s_q5 * x121));
+        let x138 = Self::mul_add(-qd[5], x135, Self::mul_add(c_q5, x121, s_q5 * x131));
         let x139 = qd[5] + x128;
-        let x140 = 1.903 * x139 + 0.385 * x135 + 0.966 * x136;
-        let x141 = 0.385 * x139 + 0.353 * x136;
-        let x142 = 0.966 * x139 + 0.353 * x135 + -0.9929999999999999 * x136;
-        let x143 = 1.903 * x130 + 0.385 * x137 + 0.966 * x138
-            + (x135 * x142 - x136 * x141) - f_ext[5][3];
-        let x144 = 0.385 * x130 + 0.353 * x138 + (x136 * x140 - x139 * x142)
-            - f_ext[5][4];
-        let x145 = 0.966 * x130 + 0.353 * x137 + -0.9929999999999999 * x138
-            + (x139 * x141 - x135 * x140) - f_ext[5][5];
-        let x146 = f_ext[5][2] * s_q5 - f_ext[5][1] * c_q5;
-        let x147 = f_ext[5][1] * s_q5 + f_ext[5][2] * c_q5;
-        let x148 = f_ext[5][0] + (f_ext[4][0] + 34.45002 * (x129 * x129 + x132 * x132));
-        let x149 = 34.45002 * (x121 + x128 * x129) - f_ext[4][1] + x146;
-        let x150 = 34.45002 * (x131 + x128 * x132) - f_ext[4][2] - x147;
-        let x151 = x129 * x134 - x132 * x133 - f_ext[4][3] + x143;
-        let x152 = -34.45002 * (x119 - 0.4572 * x124)
-            - (34.33891524 * x131 + x128 * x134) - f_ext[4][4]
-            + (c_q5 * x144 - s_q5 * x145 - -0.762 * x147);
-        let x153 = 34.74691524 * x121 + x128 * x133
-            + 34.45002
-                * (c_q4 * (x117 + 0.4572 * x125)
-                    - s_q4 * (c_q3 * x116 + s_q3 * x118 - 0.4572 * x123)) - f_ext[4][5]
-            + (s_q5 * x144 + c_q5 * x145 + 0.762 * x146);
-        let x154 = c_q4 * x149 - s_q4 * x148;
-        let x155 = f_ext[3][0] + 41.67378 * x123 + (c_q4 * x148 + s_q4 * x149);
-        let x156 = 41.67378 * x125 - f_ext[3][1] + x154;
-        let x157 = x150 - (f_ext[3][2] + 41.67378 * x124);
-        let x158 = -18.957952216000002 * x120 - x115 * x127 - f_ext[3][3]
-            + (c_q4 * x151 - s_q4 * x152);
-        let x159 = x119 * -41.67378 - x115 * x126 - f_ext[3][4]
-            + (s_q4 * x151 + c_q4 * x152 + -0.4572 * x150);
-        let x160 = x122 * x126 - x114 * x127 + 41.67378 * x117 - f_ext[3][5]
-            + (x153 + 0.4572 * x154);
-        let x161 = s_q3 * x157 - c_q3 * x155;
-        let x162 = s_q3 * x155 + c_q3 * x157;
+        let x140 = Self::mul_add(0.966, x136, Self::mul_add(0.385, x135, 1.903 * x139));
+        let x141 = Self::mul_add(0.353, x136, 0.385 * x139);
+        let x142 = Self::mul_add(
+            -0.9929999999999999,
+            x136,
+            Self::mul_add(0.353, x135, 0.966 * x139),
+        );
+        let x143 = Self::mul_add(0.966, x138, Self::mul_add(0.385, x137, 1.903 * x130))
+            + Self::mul_add(-x136, x141, x135 * x142) - f_ext[5][3];
+        let x144 = Self::mul_add(0.353, x138, 0.385 * x130)
+            + Self::mul_add(-x139, x142, x136 * x140) - f_ext[5][4];
+        let x145 = Self::mul_add(
+            -0.9929999999999999,
+            x138,
+            Self::mul_add(0.353, x137, 0.966 * x130),
+        ) + Self::mul_add(-x135, x140, x139 * x141) - f_ext[5][5];
+        let x146 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
+        let x147 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x148 = f_ext[5][0]
+            + Self::mul_add(
+                34.45002,
+                Self::mul_add(x132, x132, x129 * x129),
+                f_ext[4][0],
+            );
+        let x149 = Self::mul_add(34.45002, Self::mul_add(x128, x129, x121), -f_ext[4][1])
+            + x146;
+        let x150 = Self::mul_add(34.45002, Self::mul_add(x128, x132, x131), -f_ext[4][2])
+            - x147;
+        let x151 = Self::mul_add(-x132, x133, x129 * x134) - f_ext[4][3] + x143;
+        let x152 = Self::mul_add(
+            -34.45002,
+            Self::mul_add(-0.4572, x124, x119),
+            -Self::mul_add(x128, x134, 34.33891524 * x131),
+        ) - f_ext[4][4]
+            + Self::mul_add(0.762, x147, Self::mul_add(-s_q5, x145, c_q5 * x144));
+        let x153 = Self::mul_add(
+            34.45002,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
+                c_q4 * Self::mul_add(0.4572, x125, x117),
+            ),
+            Self::mul_add(x128, x133, 34.74691524 * x121),
+        ) - f_ext[4][5]
+            + Self::mul_add(0.762, x146, Self::mul_add(c_q5, x145, s_q5 * x144));
+        let x154 = Self::mul_add(-s_q4, x148, c_q4 * x149);
+        let x155 = Self::mul_add(41.67378, x123, f_ext[3][0])
+            + Self::mul_add(s_q4, x149, c_q4 * x148);
+        let x156 = Self::mul_add(41.67378, x125, -f_ext[3][1]) + x154;
+        let x157 = x150 - Self::mul_add(41.67378, x124, f_ext[3][2]);
+        let x158 = Self::mul_add(-x115, x127, -18.957952216000002 * x120) - f_ext[3][3]
+            + Self::mul_add(-s_q4, x152, c_q4 * x151);
+        let x159 = Self::mul_add(-x115, x126, x119 * -41.67378) - f_ext[3][4]
+            + Self::mul_add(-0.4572, x150, Self::mul_add(c_q4, x152, s_q4 * x151));
+        let x160 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
+            - f_ext[3][5] + Self::mul_add(0.4572, x154, x153);
+        let x161 = Self::mul_add(-c_q3, x155, s_q3 * x157);
+        let x162 = Self::mul_add(c_q3, x157, s_q3 * x155);
         let x163 = x161
-            - (f_ext[2][0] + (703.3878000000001 * x106 + -15.183612000000002 * x107));
-        let x164 = -15.183612000000002 * x109 - 703.3878000000001 * x108 - f_ext[2][1]
-            + x156;
+            - (f_ext[2][0]
+                + Self::mul_add(-15.183612000000002, x107, 703.3878000000001 * x106));
+        let x164 = Self::mul_add(-703.3878000000001, x108, -15.183612000000002 * x109)
+            - f_ext[2][1] + x156;
         let x165 = x162
-            - (f_ext[2][2] + (703.3878000000001 * x107 + -15.183612000000002 * x110));
-        let x166 = -5594.523885531201 * x102 - 103.41030072000001 * x103
-            + (x104 * x113 - x96 * x112) + x98 * 15.183612000000002 - f_ext[2][3]
-            + (c_q3 * x158 + s_q3 * x160 + 0.1524 * x156);
-        let x167 = 0.8021 * x102 - -0.08 * x103 + (x96 * x111 + x95 * x113)
-            + (-15.183612000000002 * x100 - x101 * -703.3878000000001) - f_ext[2][4]
-            + (x159 + (-0.1524 * x161 + -7.06 * x162));
-        let x168 = 103.41030072000002 * x102 - (x104 * x111 + x95 * x112)
-            + 703.3878000000001 * x98 - f_ext[2][5]
-            + (c_q3 * x160 - s_q3 * x158 + 7.06 * x156);
+            - (f_ext[2][2]
+                + Self::mul_add(-15.183612000000002, x110, 703.3878000000001 * x107));
+        let x166 = Self::mul_add(
+            x98,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x103, -5594.523885531201 * x102)
+                + Self::mul_add(-x96, x112, x104 * x113),
+        ) - f_ext[2][3]
+            + Self::mul_add(0.1524, x156, Self::mul_add(s_q3, x160, c_q3 * x158));
+        let x167 = Self::mul_add(0.08, x103, 0.8021 * x102)
+            + Self::mul_add(x95, x113, x96 * x111)
+            + Self::mul_add(x101, 703.3878000000001, -15.183612000000002 * x100)
+            - f_ext[2][4] + (x159 + Self::mul_add(-7.06, x162, -0.1524 * x161));
+        let x168 = Self::mul_add(
+            703.3878000000001,
+            x98,
+            Self::mul_add(
+                103.41030072000002,
+                x102,
+                -Self::mul_add(x95, x112, x104 * x111),
+            ),
+        ) - f_ext[2][5]
+            + Self::mul_add(7.06, x156, Self::mul_add(-s_q3, x158, c_q3 * x160));
         let x169 = tau[0]
-            - (c_q1
-                * (c_q2 * x168 - s_q2 * x166 + 6.377 * x164
-                    - (f_ext[1][5]
-                        + (190.97044034000004 * x88 + (qd[1] * x92 + x86 * x93))))
-                - s_q1
-                    * (qd[1] * x94 - x87 * x93
-                        - (-8596.210051042 * x88 + 190.97044034 * x89) - f_ext[1][3]
-                        + (c_q2 * x166 + s_q2 * x168 + 0.1524 * x164)) - f_ext[0][5]);
+            - (Self::mul_add(
+                -s_q1,
+                Self::mul_add(-x87, x93, qd[1] * x94)
+                    - Self::mul_add(190.97044034, x89, -8596.210051042 * x88)
+                    - f_ext[1][3]
+                    + Self::mul_add(
+                        0.1524,
+                        x164,
+                        Self::mul_add(s_q2, x168, c_q2 * x166),
+                    ),
+                c_q1
+                    * (Self::mul_add(
+                        6.377,
+                        x164,
+                        Self::mul_add(-s_q2, x166, c_q2 * x168),
+                    )
+                        - (f_ext[1][5]
+                            + Self::mul_add(
+                                190.97044034000004,
+                                x88,
+                                Self::mul_add(x86, x93, qd[1] * x92),
+                            ))),
+            ) - f_ext[0][5]);
         let x170 = 1.0
             / (14222.257549666001
-                + (c_q1
-                    * (c_q1 * (c_q2 * x68 - s_q2 * x66 + x72 - x71)
-                        - s_q1
-                            * (190.97044034
-                                + (c_q2 * x65 - s_q2 * x63 + 0.1524 * x61 + x62 * -6.377)))
-                    - s_q1
-                        * (c_q1
+                + Self::mul_add(
+                    -s_q1,
+                    Self::mul_add(
+                        -s_q1,
+                        -8596.210051042
+                            + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
+                        c_q1
                             * (190.97044034000004
-                                + (c_q2 * x66 + s_q2 * x68 - 6.377 * x62 - -0.1524 * x61))
-                            - s_q1
-                                * (-8596.210051042
-                                    + (x70 + (c_q2 * x63 + s_q2 * x65 - x69))))));
+                                + Self::mul_add(
+                                    0.1524,
+                                    x61,
+                                    Self::mul_add(
+                                        -6.377,
+                                        x62,
+                                        Self::mul_add(s_q2, x68, c_q2 * x66),
+                                    ),
+                                )),
+                    ),
+                    c_q1
+                        * Self::mul_add(
+                            -s_q1,
+                            190.97044034
+                                + Self::mul_add(
+                                    x62,
+                                    -6.377,
+                                    Self::mul_add(
+                                        0.1524,
+                                        x61,
+                                        Self::mul_add(-s_q2, x63, c_q2 * x65),
+                                    ),
+                                ),
+                            c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
+                        ),
+                ));
         let x171 = x73 * x170;
         let x172 = x74 * x170;
         let x173 = x75 * x170;
         let x174 = x82 * x170;
         let x175 = x85 * x170;
         let x176 = 1.0
-            / (8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)) - x73 * x171);
-        let x177 = x58 + (x70 - x71) - x73 * x172;
+            / Self::mul_add(
+                -x73,
+                x171,
+                8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)),
+            );
+        let x177 = Self::mul_add(-x73, x172, x58 + (x70 - x71));
         let x178 = x176 * x177;
-        let x179 = x50
-            + (-6.377 * (s_q2 * x37 - c_q2 * x36) - -0.1524 * (c_q2 * x37 + s_q2 * x36))
-            - x73 * x173;
+        let x179 = Self::mul_add(
+            -x73,
+            x173,
+            x50
+                + Self::mul_add(
+                    0.1524,
+                    Self::mul_add(s_q2, x36, c_q2 * x37),
+                    -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+                ),
+        );
         let x180 = x176 * x179;
-        let x181 = x80
-            + (-0.1524 * (s_q2 * x77 - c_q2 * x76) + -6.377 * (s_q2 * x76 + c_q2 * x77))
-            - x73 * x174;
+        let x181 = Self::mul_add(
+            -x73,
+            x174,
+            x80
+                + Self::mul_add(
+                    -6.377,
+                    Self::mul_add(c_q2, x77, s_q2 * x76),
+                    -0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
+                ),
+        );
         let x182 = x176 * x181;
-        let x183 = x23 - x73 * x175;
+        let x183 = Self::mul_add(-x73, x175, x23);
         let x184 = x176 * x183;
-        let x185 = 1.0 / (x58 - x74 * x172 - x177 * x178);
-        let x186 = x50 - x74 * x173 - x177 * x180;
+        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x74, x172, x58));
+        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x74, x173, x50));
         let x187 = x185 * x186;
-        let x188 = x80 - x74 * x174 - x177 * x182;
+        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x74, x174, x80));
         let x189 = x185 * x188;
-        let x190 = x23 - x74 * x175 - x177 * x184;
+        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x74, x175, x23));
         let x191 = x185 * x190;
-        let x192 = 1.0 / (x35 - x75 * x173 - x179 * x180 - x186 * x187);
-        let x193 = x25 - x75 * x174 - x179 * x182 - x186 * x189;
+        let x192 = 1.0
+            / Self::mul_add(
+                -x186,
+                x187,
+                Self::mul_add(-x179, x180, Self::mul_add(-x75, x173, x35)),
+            );
+        let x193 = Self::mul_add(
+            -x186,
+            x189,
+            Self::mul_add(-x179, x182, Self::mul_add(-x75, x174, x25)),
+        );
         let x194 = x192 * x193;
-        let x195 = x23 - x75 * x175 - x179 * x184 - x186 * x191;
+        let x195 = Self::mul_add(
+            -x186,
+            x191,
+            Self::mul_add(-x179, x184, Self::mul_add(-x75, x175, x23)),
+        );
         let x196 = x192 * x195;
-        let x197 = 1.0 / (x14 - x82 * x174 - x181 * x182 - x188 * x189 - x193 * x194);
-        let x198 = x9 - x82 * x175 - x181 * x184 - x188 * x191 - x193 * x196;
+        let x197 = 1.0
+            / Self::mul_add(
+                -x193,
+                x194,
+                Self::mul_add(
+                    -x188,
+                    x189,
+                    Self::mul_add(-x181, x182, Self::mul_add(-x82, x174, x14)),
+                ),
+            );
+        let x198 = Self::mul_add(
+            -x193,
+            x196,
+            Self::mul_add(
+                -x188,
+                x191,
+                Self::mul_add(-x181, x184, Self::mul_add(-x82, x175, x9)),
+            ),
+        );
         let x199 = x197 * x198;
         let x200 = 1.0
-            / (1.903 - x85 * x175 - x183 * x184 - x190 * x191 - x195 * x196
-                - x198 * x199);
-        let x201 = tau[1]
-            - (x87 * x92 + x86 * x94 - (-1.928 * x88 + -0.0302 * x89) - f_ext[1][4]
-                + (x167
-                    + (-0.1524 * (c_q2 * x163 + s_q2 * x165)
-                        + -6.377 * (c_q2 * x165 - s_q2 * x163)))) - x169 * x171;
-        let x202 = tau[2] - x167 - x169 * x172 - x178 * x201;
-        let x203 = tau[3] - x159 - x169 * x173 - x180 * x201 - x187 * x202;
-        let x204 = tau[4] - x153 - x169 * x174 - x182 * x201 - x189 * x202 - x194 * x203;
+            / Self::mul_add(
+                -x198,
+                x199,
+                Self::mul_add(
+                    -x195,
+                    x196,
+                    Self::mul_add(
+                        -x190,
+                        x191,
+                        Self::mul_add(-x183, x184, Self::mul_add(-x85, x175, 1.903)),
+                    ),
+                ),
+            );
+        let x201 = Self::mul_add(
+            -x169,
+            x171,
+            tau[1]
+                - (Self::mul_add(x86, x94, x87 * x92)
+                    - Self::mul_add(-0.0302, x89, -1.928 * x88) - f_ext[1][4]
+                    + (x167
+                        + Self::mul_add(
+                            -6.377,
+                            Self::mul_add(-s_q2, x163, c_q2 * x165),
+                            -0.1524 * Self::mul_add(s_q2, x165, c_q2 * x163),
+                        ))),
+        );
+        let x202 = Self::mul_add(-x178, x201, Self::mul_add(-x169, x172, tau[2] - x167));
+        let x203 = Self::mul_add(
+            -x187,
+            x202,
+            Self::mul_add(-x180, x201, Self::mul_add(-x169, x173, tau[3] - x159)),
+        );
+        let x204 = Self::mul_add(
+            -x194,
+            x203,
+            Self::mul_add(
+                -x189,
+                x202,
+                Self::mul_add(-x182, x201, Self::mul_add(-x169, x174, tau[4] - x153)),
+            ),
+        );
         let x205 = x200
-            * (tau[5] - x143 - x169 * x175 - x184 * x201 - x191 * x202 - x196 * x203
-                - x199 * x204);
-        let x206 = x197 * x204 - x199 * x205;
-        let x207 = x192 * x203 - x194 * x206 - x196 * x205;
-        let x208 = x185 * x202 - x187 * x207 - x189 * x206 - x191 * x205;
-        let x209 = x176 * x201 - x178 * x208 - x180 * x207 - x182 * x206 - x184 * x205;
-        let x210 = x169 * x170 - x171 * x209 - x172 * x208 - x173 * x207 - x174 * x206
-            - x175 * x205;
+            * Self::mul_add(
+                -x199,
+                x204,
+                Self::mul_add(
+                    -x196,
+                    x203,
+                    Self::mul_add(
+                        -x191,
+                        x202,
+                        Self::mul_add(
+                            -x184,
+                            x201,
+                            Self::mul_add(-x169, x175, tau[5] - x143),
+                        ),
+                    ),
+                ),
+            );
+        let x206 = Self::mul_add(-x199, x205, x197 * x204);
+        let x207 = Self::mul_add(-x196, x205, Self::mul_add(-x194, x206, x192 * x203));
+        let x208 = Self::mul_add(
+            -x191,
+            x205,
+            Self::mul_add(-x189, x206, Self::mul_add(-x187, x207, x185 * x202)),
+        );
+        let x209 = Self::mul_add(
+            -x184,
+            x205,
+            Self::mul_add(
+                -x182,
+                x206,
+                Self::mul_add(-x180, x207, Self::mul_add(-x178, x208, x176 * x201)),
+            ),
+        );
+        let x210 = Self::mul_add(
+            -x175,
+            x205,
+            Self::mul_add(
+                -x174,
+                x206,
+                Self::mul_add(
+                    -x173,
+                    x207,
+                    Self::mul_add(-x172, x208, Self::mul_add(-x171, x209, x169 * x170)),
+                ),
+            ),
+        );
         [x210, x209, x208, x207, x206, x205]
+    }
+    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
+    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
+    /// elsewhere.
+    #[inline(always)]
+    fn mul_add(a: f64, b: f64, c: f64) -> f64 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+        {
+            use core::arch::x86_64::{_mm_cvtsd_f64, _mm_fmadd_sd, _mm_set_sd};
+            unsafe {
+                _mm_cvtsd_f64(_mm_fmadd_sd(_mm_set_sd(a), _mm_set_sd(b), _mm_set_sd(c)))
+            }
+        }
+        #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+        {
+            use core::arch::aarch64::{vdup_n_f64, vfma_f64, vget_lane_f64};
+            unsafe {
+                vget_lane_f64::<0>(vfma_f64(vdup_n_f64(c), vdup_n_f64(a), vdup_n_f64(b)))
+            }
+        }
+        #[cfg(
+            not(
+                any(
+                    all(target_arch = "x86_64", target_feature = "fma"),
+                    all(target_arch = "aarch64", target_feature = "neon")
+                )
+            )
+        )] { a * b + c }
     }
 }

@@ -9,6 +9,7 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Precision: `f32`: inputs, outputs and every intermediate; the model's numbers rounded to `f32` constants; libm's `sincosf`, `sinf`, `cosf`, `sqrtf`.
 //! Fused multiply-adds: none.
+//! Fused multiply-adds where the target has them: 1158 (`mass_matrix` 93, `nonlinear_effects` 115, `inverse_dynamics` 124, `forward_dynamics` 302, `mass_matrix_and_nonlinear_effects` 208, `forward_dynamics_with_wrenches` 316), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
 //!
@@ -61,7 +62,7 @@ pub struct OpCount {
     pub sqrt: u64,
     /// Angles whose sine and cosine are taken.
     pub sincos: u64,
-    /// Fused multiply-adds.
+    /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
     pub fma: u64,
 }
 #[allow(
@@ -101,7 +102,7 @@ impl SsrmsF32 {
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 0u64,
+            fma: 93u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -112,7 +113,7 @@ impl SsrmsF32 {
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 0u64,
+            fma: 115u64,
         },
         OpCount {
             function: "inverse_dynamics",
@@ -123,7 +124,7 @@ impl SsrmsF32 {
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 0u64,
+            fma: 124u64,
         },
         OpCount {
             function: "forward_dynamics",
@@ -134,7 +135,7 @@ impl SsrmsF32 {
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 0u64,
+            fma: 302u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -145,7 +146,7 @@ impl SsrmsF32 {
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 0u64,
+            fma: 208u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -156,7 +157,7 @@ impl SsrmsF32 {
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 0u64,
+            fma: 316u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -439,7 +440,7 @@ impl SsrmsF32 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 170 mul, 116 add, 0 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`: 170 mul, 116 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 93 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f32; 7]) -> [[f32; 7]; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -451,101 +452,153 @@ impl SsrmsF32 {
         let x6 = 44.41 * s_q5;
         let x7 = 9.336 * s_q5;
         let x8 = 44.41 * c_q5;
-        let x9 = s_q5 * x5 - c_q5 * x6;
-        let x10 = c_q5 * x7 - s_q5 * x8;
-        let x11 = 132.67838 + (c_q5 * x5 + s_q5 * x6);
-        let x12 = 135.47298 + (s_q5 * x7 + c_q5 * x8);
+        let x9 = Self::mul_add(-c_q5, x6, s_q5 * x5);
+        let x10 = Self::mul_add(-s_q5, x8, c_q5 * x7);
+        let x11 = 132.67838 + Self::mul_add(s_q5, x6, c_q5 * x5);
+        let x12 = 135.47298 + Self::mul_add(c_q5, x8, s_q5 * x7);
         let x13 = -171.19551 * s_q4;
         let x14 = -171.19551 * c_q4;
         let x15 = c_q4 * x11;
         let x16 = -97.44449 * s_q4;
-        let x17 = c_q4 * x9 + x16;
+        let x17 = Self::mul_add(c_q4, x9, x16);
         let x18 = 47.471 * s_q4;
         let x19 = s_q4 * x11;
         let x20 = -97.44449 * c_q4;
-        let x21 = x20 - s_q4 * x9;
+        let x21 = Self::mul_add(-s_q4, x9, x20);
         let x22 = 47.471 * c_q4;
-        let x23 = x20 - s_q4 * x10;
+        let x23 = Self::mul_add(-s_q4, x10, x20);
         let x24 = x13 * -7.11;
         let x25 = 7.11 * x13;
         let x26 = x12 - x24;
-        let x27 = s_q4 * x22 - c_q4 * x19 - 7.11 * x14;
-        let x28 = c_q4 * x18 - s_q4 * x15 + x14 * -7.11;
-        let x29 = s_q4 * x19 + c_q4 * x22 + x25 - x24;
+        let x27 = Self::mul_add(-7.11, x14, Self::mul_add(-c_q4, x19, s_q4 * x22));
+        let x28 = Self::mul_add(x14, -7.11, Self::mul_add(-s_q4, x15, c_q4 * x18));
+        let x29 = Self::mul_add(c_q4, x22, s_q4 * x19) + x25 - x24;
         let x30 = 3239.4583 + x13;
-        let x31 = -24989.307 + (c_q4 * x15 + s_q4 * x18);
+        let x31 = -24989.307 + Self::mul_add(s_q4, x18, c_q4 * x15);
         let x32 = 1375.0472 + x17;
-        let x33 = 1375.0472 + (x16 + c_q4 * x10);
+        let x33 = 1375.0472 + Self::mul_add(c_q4, x10, x16);
         let x34 = 24998.828 + (x25 + x26);
         let x35 = s_q3 * x14;
-        let x36 = c_q3 * x30 + x35;
+        let x36 = Self::mul_add(c_q3, x30, x35);
         let x37 = c_q3 * x14;
-        let x38 = x37 - s_q3 * x30;
-        let x39 = c_q3 * x31 + s_q3 * x27;
+        let x38 = Self::mul_add(-s_q3, x30, x37);
+        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
         let x40 = s_q3 * x21;
-        let x41 = c_q3 * x28 + s_q3 * x29;
-        let x42 = c_q3 * x27 - s_q3 * x31;
+        let x41 = Self::mul_add(s_q3, x29, c_q3 * x28);
+        let x42 = Self::mul_add(-s_q3, x31, c_q3 * x27);
         let x43 = c_q3 * x21;
-        let x44 = c_q3 * x29 - s_q3 * x28;
+        let x44 = Self::mul_add(-s_q3, x28, c_q3 * x29);
         let x45 = -7.11 * x36;
         let x46 = 7.11 * x36;
-        let x47 = c_q3 * x32 + x40 - -0.475 * x36;
+        let x47 = Self::mul_add(0.475, x36, Self::mul_add(c_q3, x32, x40));
         let x48 = x34 - x45;
-        let x49 = c_q3 * x42 + s_q3 * x44 - 7.11 * x38;
-        let x50 = x43 - s_q3 * x32 + x38 * 0.475;
-        let x51 = c_q3 * x41 - s_q3 * x39 + -7.11 * x38;
-        let x52 = c_q3 * x23 - s_q3 * x33 - -0.475 * x38;
-        let x53 = c_q3 * x44 - s_q3 * x42 + x46 - x45;
+        let x49 = Self::mul_add(-7.11, x38, Self::mul_add(s_q3, x44, c_q3 * x42));
+        let x50 = Self::mul_add(x38, 0.475, Self::mul_add(-s_q3, x32, x43));
+        let x51 = Self::mul_add(-7.11, x38, Self::mul_add(-s_q3, x39, c_q3 * x41));
+        let x52 = Self::mul_add(0.475, x38, Self::mul_add(-s_q3, x33, c_q3 * x23));
+        let x53 = Self::mul_add(-s_q3, x42, c_q3 * x44) + x46 - x45;
         let x54 = 5224.5703 + x36;
-        let x55 = -39234.473 + (c_q3 * x39 + s_q3 * x41);
+        let x55 = -39234.473 + Self::mul_add(s_q3, x41, c_q3 * x39);
         let x56 = 3946.1882 + x47;
-        let x57 = 3946.1882 + (c_q3 * x33 + s_q3 * x23 + x36 * 0.475);
+        let x57 = 3946.1882
+            + Self::mul_add(x36, 0.475, Self::mul_add(s_q3, x23, c_q3 * x33));
         let x58 = 39241.402 + (x46 + x48);
         let x59 = s_q2 * x38;
-        let x60 = c_q2 * x54 + x59;
+        let x60 = Self::mul_add(c_q2, x54, x59);
         let x61 = c_q2 * x38;
-        let x62 = x61 - s_q2 * x54;
-        let x63 = c_q2 * x55 + s_q2 * x49;
+        let x62 = Self::mul_add(-s_q2, x54, x61);
+        let x63 = Self::mul_add(s_q2, x49, c_q2 * x55);
         let x64 = s_q2 * x50;
-        let x65 = c_q2 * x51 + s_q2 * x53;
+        let x65 = Self::mul_add(s_q2, x53, c_q2 * x51);
         let x66 = c_q2 * x50;
-        let x67 = x66 - s_q2 * x56 + 0.5692 * x62;
+        let x67 = Self::mul_add(0.5692, x62, Self::mul_add(-s_q2, x56, x66));
         let x68 = 65697.33
-            + (c_q2 * (c_q2 * x53 - s_q2 * x51) - s_q2 * (c_q2 * x49 - s_q2 * x55));
-        let x69 = c_q1 * (c_q2 * x56 + x64 - -0.5692 * x60);
+            + Self::mul_add(
+                -s_q2,
+                Self::mul_add(-s_q2, x55, c_q2 * x49),
+                c_q2 * Self::mul_add(-s_q2, x51, c_q2 * x53),
+            );
+        let x69 = c_q1 * Self::mul_add(0.5692, x60, Self::mul_add(c_q2, x56, x64));
         let x70 = 66279.66
-            + (0.7026 * x62
-                + (c_q1
-                    * (c_q1 * (c_q2 * x63 + s_q2 * x65)
-                        - s_q1 * (c_q2 * x57 + s_q2 * x52 + 0.5692 * x60))
-                    - s_q1 * (x69 - s_q1 * (-65693.914 + x58)) - -0.7026 * x62));
-        let x71 = c_q1 * (c_q2 * x65 - s_q2 * x63)
-            - s_q1 * (c_q2 * x52 - s_q2 * x57 - -0.5692 * x62)
-            + -0.7026 * (c_q1 * x60 + s_q1 * 1145.5438);
-        let x72 = x69 - s_q1 * x58 + -0.7026 * (s_q1 * x62);
-        let x73 = x61 - s_q2 * x36;
-        let x74 = x66 - s_q2 * x47 + 0.5692 * x73;
-        let x75 = c_q1 * (x64 + c_q2 * x47 - -0.5692 * (x59 + c_q2 * x36)) - s_q1 * x48
-            + -0.7026 * (s_q1 * x73);
-        let x76 = x37 - s_q3 * x13;
-        let x77 = x35 + c_q3 * x13;
-        let x78 = x40 + c_q3 * x17 - -0.475 * x77;
-        let x79 = x26 - -7.11 * x77;
-        let x80 = x43 - s_q3 * x17 + 0.475 * x76;
-        let x81 = c_q2 * x76 - s_q2 * x77;
-        let x82 = c_q2 * x80 - s_q2 * x78 + 0.5692 * x81;
-        let x83 = c_q1 * (c_q2 * x78 + s_q2 * x80 - -0.5692 * (s_q2 * x76 + c_q2 * x77))
-            - s_q1 * x79 + -0.7026 * (s_q1 * x81);
-        let x84 = c_q3 * x18 + s_q3 * x22;
-        let x85 = c_q3 * x22 - s_q3 * x18;
-        let x86 = c_q2 * x85 - s_q2 * x84;
-        let x87 = c_q1 * (c_q2 * x84 + s_q2 * x85);
+            + Self::mul_add(
+                0.7026,
+                x62,
+                Self::mul_add(
+                    0.7026,
+                    x62,
+                    Self::mul_add(
+                        -s_q1,
+                        Self::mul_add(-s_q1, -65693.914 + x58, x69),
+                        c_q1
+                            * Self::mul_add(
+                                -s_q1,
+                                Self::mul_add(
+                                    0.5692,
+                                    x60,
+                                    Self::mul_add(s_q2, x52, c_q2 * x57),
+                                ),
+                                c_q1 * Self::mul_add(s_q2, x65, c_q2 * x63),
+                            ),
+                    ),
+                ),
+            );
+        let x71 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(s_q1, 1145.5438, c_q1 * x60),
+            Self::mul_add(
+                -s_q1,
+                Self::mul_add(0.5692, x62, Self::mul_add(-s_q2, x57, c_q2 * x52)),
+                c_q1 * Self::mul_add(-s_q2, x63, c_q2 * x65),
+            ),
+        );
+        let x72 = Self::mul_add(-0.7026, s_q1 * x62, Self::mul_add(-s_q1, x58, x69));
+        let x73 = Self::mul_add(-s_q2, x36, x61);
+        let x74 = Self::mul_add(0.5692, x73, Self::mul_add(-s_q2, x47, x66));
+        let x75 = Self::mul_add(
+            -0.7026,
+            s_q1 * x73,
+            Self::mul_add(
+                -s_q1,
+                x48,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x36, x59),
+                        Self::mul_add(c_q2, x47, x64),
+                    ),
+            ),
+        );
+        let x76 = Self::mul_add(-s_q3, x13, x37);
+        let x77 = Self::mul_add(c_q3, x13, x35);
+        let x78 = Self::mul_add(0.475, x77, Self::mul_add(c_q3, x17, x40));
+        let x79 = Self::mul_add(7.11, x77, x26);
+        let x80 = Self::mul_add(0.475, x76, Self::mul_add(-s_q3, x17, x43));
+        let x81 = Self::mul_add(-s_q2, x77, c_q2 * x76);
+        let x82 = Self::mul_add(0.5692, x81, Self::mul_add(-s_q2, x78, c_q2 * x80));
+        let x83 = Self::mul_add(
+            -0.7026,
+            s_q1 * x81,
+            Self::mul_add(
+                -s_q1,
+                x79,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x77, s_q2 * x76),
+                        Self::mul_add(s_q2, x80, c_q2 * x78),
+                    ),
+            ),
+        );
+        let x84 = Self::mul_add(s_q3, x22, c_q3 * x18);
+        let x85 = Self::mul_add(-s_q3, x18, c_q3 * x22);
+        let x86 = Self::mul_add(-s_q2, x84, c_q2 * x85);
+        let x87 = c_q1 * Self::mul_add(s_q2, x85, c_q2 * x84);
         let x88 = c_q4 * x5;
         let x89 = s_q4 * x5;
-        let x90 = c_q3 * x88 - s_q3 * x89;
-        let x91 = s_q3 * x88 + c_q3 * x89;
-        let x92 = -(s_q2 * x90 + c_q2 * x91);
-        let x93 = c_q1 * (c_q2 * x90 - s_q2 * x91) - s_q1 * x7;
+        let x90 = Self::mul_add(-s_q3, x89, c_q3 * x88);
+        let x91 = Self::mul_add(c_q3, x89, s_q3 * x88);
+        let x92 = -Self::mul_add(c_q2, x91, s_q2 * x90);
+        let x93 = Self::mul_add(-s_q1, x7, c_q1 * Self::mul_add(-s_q2, x91, c_q2 * x90));
         [
             [x70, x71, x72, x75, x83, x87, x93],
             [x71, x68, x67, x74, x82, x86, x92],
@@ -558,7 +611,7 @@ impl SsrmsF32 {
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 207 mul, 142 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `newton-euler`: 207 mul, 142 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 115 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f32; 7], qd: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -568,109 +621,147 @@ impl SsrmsF32 {
         let x4 = qd[1] * x2;
         let x5 = qd[1] * x1;
         let x6 = x1 * x2;
-        let x7 = qd[1] * qd[1] + x1 * x1;
+        let x7 = Self::mul_add(x1, x1, qd[1] * qd[1]);
         let x8 = -65693.914 * x2;
         let x9 = 65697.33 * qd[1];
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x11 = x1 * c_q2 - qd[1] * s_q2;
-        let x12 = x1 * s_q2 + qd[1] * c_q2;
+        let x11 = Self::mul_add(-qd[1], s_q2, x1 * c_q2);
+        let x12 = Self::mul_add(qd[1], c_q2, x1 * s_q2);
         let x13 = -0.5692 * x6;
         let x14 = -0.5692 * x7;
-        let x15 = x3 + -0.5692 * (x4 + x4);
-        let x16 = s_q2 * x13 + c_q2 * x15;
-        let x17 = x4 * c_q2 + qd[2] * x12;
-        let x18 = qd[2] * x11 - x4 * s_q2;
+        let x15 = Self::mul_add(-0.5692, x4 + x4, x3);
+        let x16 = Self::mul_add(c_q2, x15, s_q2 * x13);
+        let x17 = Self::mul_add(qd[2], x12, x4 * c_q2);
+        let x18 = Self::mul_add(-x4, s_q2, qd[2] * x11);
         let x19 = qd[2] - x2;
         let x20 = x12 * x12;
-        let x21 = x19 * x19 + x20;
+        let x21 = Self::mul_add(x19, x19, x20);
         let x22 = x11 * x19;
         let x23 = x18 + x22;
-        let x24 = x5 + x11 * x12;
-        let x25 = -39234.473 * x11 + 3946.1882 * x19;
-        let x26 = 3946.1882 * x11 + 39241.402 * x19;
+        let x24 = Self::mul_add(x11, x12, x5);
+        let x25 = Self::mul_add(3946.1882, x19, -39234.473 * x11);
+        let x26 = Self::mul_add(39241.402, x19, 3946.1882 * x11);
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x28 = x11 * c_q3 - x12 * s_q3;
-        let x29 = x11 * s_q3 + x12 * c_q3;
-        let x30 = s_q2 * x15 - c_q2 * x13 + (-0.475 * (x22 - x18) - 7.11 * x21);
-        let x31 = 7.11 * x23 - -0.475 * (x20 + x11 * x11) - x14;
-        let x32 = 7.11 * x24 + -0.475 * (x12 * x19 - x17) - x16;
-        let x33 = s_q3 * x30 + c_q3 * x32;
-        let x34 = x17 * c_q3 + x18 * s_q3 + qd[3] * x29;
-        let x35 = x18 * c_q3 - x17 * s_q3 + qd[3] * x28;
+        let x28 = Self::mul_add(-x12, s_q3, x11 * c_q3);
+        let x29 = Self::mul_add(x12, c_q3, x11 * s_q3);
+        let x30 = Self::mul_add(-c_q2, x13, s_q2 * x15)
+            + Self::mul_add(-7.11, x21, -0.475 * (x22 - x18));
+        let x31 = Self::mul_add(0.475, Self::mul_add(x11, x11, x20), 7.11 * x23) - x14;
+        let x32 = Self::mul_add(-0.475, Self::mul_add(x12, x19, -x17), 7.11 * x24) - x16;
+        let x33 = Self::mul_add(c_q3, x32, s_q3 * x30);
+        let x34 = Self::mul_add(qd[3], x29, Self::mul_add(x18, s_q3, x17 * c_q3));
+        let x35 = Self::mul_add(qd[3], x28, Self::mul_add(-x17, s_q3, x18 * c_q3));
         let x36 = qd[3] + x19;
-        let x37 = x36 * x36 + x29 * x29;
-        let x38 = x35 + x28 * x36;
-        let x39 = x5 + x28 * x29;
-        let x40 = -24989.307 * x28 + 1375.0472 * x36;
-        let x41 = 1375.0472 * x28 + 24998.828 * x36;
+        let x37 = Self::mul_add(x29, x29, x36 * x36);
+        let x38 = Self::mul_add(x28, x36, x35);
+        let x39 = Self::mul_add(x28, x29, x5);
+        let x40 = Self::mul_add(1375.0472, x36, -24989.307 * x28);
+        let x41 = Self::mul_add(24998.828, x36, 1375.0472 * x28);
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x43 = x28 * c_q4 - x29 * s_q4;
-        let x44 = x28 * s_q4 + x29 * c_q4;
-        let x45 = x34 * c_q4 + x35 * s_q4 + qd[4] * x44;
-        let x46 = x35 * c_q4 - x34 * s_q4 + qd[4] * x43;
+        let x43 = Self::mul_add(-x29, s_q4, x28 * c_q4);
+        let x44 = Self::mul_add(x29, c_q4, x28 * s_q4);
+        let x45 = Self::mul_add(qd[4], x44, Self::mul_add(x35, s_q4, x34 * c_q4));
+        let x46 = Self::mul_add(qd[4], x43, Self::mul_add(-x34, s_q4, x35 * c_q4));
         let x47 = qd[4] + x36;
-        let x48 = -171.19551 * (x43 * x44 - x5);
-        let x49 = -171.19551 * (x45 + x44 * x47);
-        let x50 = -171.19551 * (x47 * x47 + x43 * x43);
+        let x48 = -171.19551 * Self::mul_add(x43, x44, -x5);
+        let x49 = -171.19551 * Self::mul_add(x44, x47, x45);
+        let x50 = -171.19551 * Self::mul_add(x43, x43, x47 * x47);
         let x51 = 132.67838 * x43;
-        let x52 = 135.47298 * x47 + -97.44449 * x44;
+        let x52 = Self::mul_add(-97.44449, x44, 135.47298 * x47);
         let x53 = -97.44449 * x47;
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x55 = x43 * c_q5 + x47 * s_q5;
-        let x56 = x47 * c_q5 - x43 * s_q5;
+        let x55 = Self::mul_add(x47, s_q5, x43 * c_q5);
+        let x56 = Self::mul_add(-x43, s_q5, x47 * c_q5);
         let x57 = qd[5] + x44;
         let x58 = 44.41 * x56;
         let x59 = 47.471 * x57;
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x61 = 9.336 * (qd[5] * x56 - (x45 * c_q5 + x5 * s_q5));
+        let x61 = 9.336
+            * Self::mul_add(qd[5], x56, -Self::mul_add(x5, s_q5, x45 * c_q5));
         let x62 = 9.336 * (qd[6] + x55);
-        let x63 = (x57 * c_q6 - x56 * s_q6) * x62;
-        let x64 = (x56 * c_q6 + x57 * s_q6) * x62;
-        let x65 = x56 * x59 - x57 * x58 + x61;
-        let x66 = 44.41 * (x45 * s_q5 - x5 * c_q5 - qd[5] * x55) - x55 * x59
-            + (c_q6 * x63 + s_q6 * x64);
-        let x67 = 47.471 * x46 + x55 * x58 + (s_q6 * x63 - c_q6 * x64);
-        let x68 = x47 * x53 - x44 * x52 - 132.67838 * x45
-            + (x31 + 7.11 * x38) * 171.19551 + (c_q5 * x65 - s_q5 * x66);
-        let x69 = -97.44449 * x46 - 135.47298 * x5 + (x44 * x51 - x43 * x53)
-            + -171.19551
-                * (c_q4 * (c_q3 * x30 - s_q3 * x32 - 7.11 * x37)
-                    - s_q4 * (x33 + 7.11 * x39)) + (s_q5 * x65 + c_q5 * x66);
-        let x70 = x43 * x52 - x47 * x51 - -97.44449 * x5 + x67;
-        let x71 = s_q4 * x48 + c_q4 * x50;
-        let x72 = c_q4 * x48 - s_q4 * x50 - 3239.4583 * x37;
-        let x73 = 3239.4583 * x38 + x49;
-        let x74 = 3239.4583 * x39 - x71;
-        let x75 = c_q4 * x68 + s_q4 * x70
-            - (-24989.307 * x34 + 1375.0472 * x5 + x29 * x41);
-        let x76 = x29 * x40 - (1375.0472 * x34 + 24998.828 * x5) + x33 * -3239.4583
-            + (x69 - x71 * -7.11);
-        let x77 = x28 * x41 - x36 * x40 + 3239.4583 * x31
-            + (c_q4 * x70 - s_q4 * x68 + 7.11 * x49);
-        let x78 = c_q3 * x72 + s_q3 * x74;
-        let x79 = c_q3 * x74 - s_q3 * x72;
-        let x80 = x78 - 5224.5703 * x21;
-        let x81 = 5224.5703 * x24 + x79;
-        let x82 = c_q3 * x75 + s_q3 * x77 + -0.475 * x79
-            - (-39234.473 * x17 + 3946.1882 * x5 + x12 * x26);
-        let x83 = x12 * x25 - (3946.1882 * x17 + 39241.402 * x5) - x16 * -5224.5703
-            + (x76 + -7.11 * x79);
-        let x84 = x11 * x26 - x19 * x25 - 5224.5703 * x14
-            + (c_q3 * x77 - s_q3 * x75 + (x78 * 0.475 + 7.11 * x73));
-        let x85 = c_q2 * x80 + s_q2 * x81;
-        let x86 = c_q2 * x84 - s_q2 * x82 + 0.5692 * x85 - x1 * x8;
-        let x87 = c_q1
-            * (qd[1] * x8 - x2 * x9 - -1145.5438 * x3
-                + (c_q2 * x82 + s_q2 * x84 + -0.5692 * (c_q2 * x81 - s_q2 * x80)))
-            - s_q1 * (x83 - (-65693.914 * x5 + x1 * x9))
-            + -0.7026
-                * (s_q1 * (x85 - -1145.5438 * x6)
-                    + c_q1 * (5224.5703 * x23 + x73 - -1145.5438 * x7));
+        let x63 = Self::mul_add(-x56, s_q6, x57 * c_q6) * x62;
+        let x64 = Self::mul_add(x57, s_q6, x56 * c_q6) * x62;
+        let x65 = Self::mul_add(-x57, x58, x56 * x59) + x61;
+        let x66 = Self::mul_add(
+            -x55,
+            x59,
+            44.41 * Self::mul_add(-qd[5], x55, Self::mul_add(-x5, c_q5, x45 * s_q5)),
+        ) + Self::mul_add(s_q6, x64, c_q6 * x63);
+        let x67 = Self::mul_add(x55, x58, 47.471 * x46)
+            + Self::mul_add(-c_q6, x64, s_q6 * x63);
+        let x68 = Self::mul_add(
+            Self::mul_add(7.11, x38, x31),
+            171.19551,
+            Self::mul_add(-132.67838, x45, Self::mul_add(-x44, x52, x47 * x53)),
+        ) + Self::mul_add(-s_q5, x66, c_q5 * x65);
+        let x69 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(7.11, x39, x33),
+                c_q4 * Self::mul_add(-7.11, x37, Self::mul_add(-s_q3, x32, c_q3 * x30)),
+            ),
+            Self::mul_add(-135.47298, x5, -97.44449 * x46)
+                + Self::mul_add(-x43, x53, x44 * x51),
+        ) + Self::mul_add(c_q5, x66, s_q5 * x65);
+        let x70 = Self::mul_add(97.44449, x5, Self::mul_add(-x47, x51, x43 * x52)) + x67;
+        let x71 = Self::mul_add(c_q4, x50, s_q4 * x48);
+        let x72 = Self::mul_add(-3239.4583, x37, Self::mul_add(-s_q4, x50, c_q4 * x48));
+        let x73 = Self::mul_add(3239.4583, x38, x49);
+        let x74 = Self::mul_add(3239.4583, x39, -x71);
+        let x75 = Self::mul_add(s_q4, x70, c_q4 * x68)
+            - Self::mul_add(x29, x41, Self::mul_add(1375.0472, x5, -24989.307 * x34));
+        let x76 = Self::mul_add(
+            x33,
+            -3239.4583,
+            Self::mul_add(x29, x40, -Self::mul_add(24998.828, x5, 1375.0472 * x34)),
+        ) + Self::mul_add(x71, 7.11, x69);
+        let x77 = Self::mul_add(3239.4583, x31, Self::mul_add(-x36, x40, x28 * x41))
+            + Self::mul_add(7.11, x49, Self::mul_add(-s_q4, x68, c_q4 * x70));
+        let x78 = Self::mul_add(s_q3, x74, c_q3 * x72);
+        let x79 = Self::mul_add(-s_q3, x72, c_q3 * x74);
+        let x80 = Self::mul_add(-5224.5703, x21, x78);
+        let x81 = Self::mul_add(5224.5703, x24, x79);
+        let x82 = Self::mul_add(-0.475, x79, Self::mul_add(s_q3, x77, c_q3 * x75))
+            - Self::mul_add(x12, x26, Self::mul_add(3946.1882, x5, -39234.473 * x17));
+        let x83 = Self::mul_add(
+            x16,
+            5224.5703,
+            Self::mul_add(x12, x25, -Self::mul_add(39241.402, x5, 3946.1882 * x17)),
+        ) + Self::mul_add(-7.11, x79, x76);
+        let x84 = Self::mul_add(-5224.5703, x14, Self::mul_add(-x19, x25, x11 * x26))
+            + (Self::mul_add(-s_q3, x75, c_q3 * x77)
+                + Self::mul_add(7.11, x73, x78 * 0.475));
+        let x85 = Self::mul_add(s_q2, x81, c_q2 * x80);
+        let x86 = Self::mul_add(
+            -x1,
+            x8,
+            Self::mul_add(0.5692, x85, Self::mul_add(-s_q2, x82, c_q2 * x84)),
+        );
+        let x87 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(
+                c_q1,
+                Self::mul_add(1145.5438, x7, Self::mul_add(5224.5703, x23, x73)),
+                s_q1 * Self::mul_add(1145.5438, x6, x85),
+            ),
+            Self::mul_add(
+                -s_q1,
+                x83 - Self::mul_add(x1, x9, -65693.914 * x5),
+                c_q1
+                    * (Self::mul_add(1145.5438, x3, Self::mul_add(-x2, x9, qd[1] * x8))
+                        + Self::mul_add(
+                            -0.5692,
+                            Self::mul_add(-s_q2, x80, c_q2 * x81),
+                            Self::mul_add(s_q2, x84, c_q2 * x82),
+                        )),
+            ),
+        );
         [x87, x86, x83, x76, x69, x67, x61]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 217 mul, 157 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: bias `newton-euler`: 217 mul, 157 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 124 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f32; 7], qd: &[f32; 7], qdd: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -680,117 +771,168 @@ impl SsrmsF32 {
         let x4 = 0.7026 * (qd[0] * qd[0]);
         let x5 = s_q1 * x3;
         let x6 = qd[1] * x2;
-        let x7 = qdd[0] * c_q1 - x6;
-        let x8 = qdd[0] * s_q1 + qd[1] * x1;
-        let x9 = qdd[1] + x1 * x2;
-        let x10 = qd[1] * qd[1] + x1 * x1;
+        let x7 = Self::mul_add(qdd[0], c_q1, -x6);
+        let x8 = Self::mul_add(qd[1], x1, qdd[0] * s_q1);
+        let x9 = Self::mul_add(x1, x2, qdd[1]);
+        let x10 = Self::mul_add(x1, x1, qd[1] * qd[1]);
         let x11 = -65693.914 * x2;
         let x12 = 65697.33 * qd[1];
         let (s_q2, c_q2) = libm::sincosf(q[2]);
-        let x14 = x1 * c_q2 - qd[1] * s_q2;
-        let x15 = x1 * s_q2 + qd[1] * c_q2;
-        let x16 = x5 + -0.5692 * x9;
-        let x17 = c_q1 * x3 + -0.5692 * x10;
-        let x18 = -0.5692 * (x7 - x6) - x4;
-        let x19 = c_q2 * x18 - s_q2 * x16;
-        let x20 = x7 * c_q2 - qdd[1] * s_q2 - qd[2] * x15;
-        let x21 = x7 * s_q2 + qdd[1] * c_q2 + qd[2] * x14;
+        let x14 = Self::mul_add(-qd[1], s_q2, x1 * c_q2);
+        let x15 = Self::mul_add(qd[1], c_q2, x1 * s_q2);
+        let x16 = Self::mul_add(-0.5692, x9, x5);
+        let x17 = Self::mul_add(-0.5692, x10, c_q1 * x3);
+        let x18 = Self::mul_add(-0.5692, x7 - x6, -x4);
+        let x19 = Self::mul_add(-s_q2, x16, c_q2 * x18);
+        let x20 = Self::mul_add(-qd[2], x15, Self::mul_add(-qdd[1], s_q2, x7 * c_q2));
+        let x21 = Self::mul_add(qd[2], x14, Self::mul_add(qdd[1], c_q2, x7 * s_q2));
         let x22 = qdd[2] - x8;
         let x23 = qd[2] - x2;
         let x24 = x15 * x15;
-        let x25 = x23 * x23 + x24;
+        let x25 = Self::mul_add(x23, x23, x24);
         let x26 = x14 * x23;
         let x27 = x21 + x26;
-        let x28 = x14 * x15 - x22;
-        let x29 = -39234.473 * x14 + 3946.1882 * x23;
-        let x30 = 3946.1882 * x14 + 39241.402 * x23;
+        let x28 = Self::mul_add(x14, x15, -x22);
+        let x29 = Self::mul_add(3946.1882, x23, -39234.473 * x14);
+        let x30 = Self::mul_add(39241.402, x23, 3946.1882 * x14);
         let (s_q3, c_q3) = libm::sincosf(q[3]);
-        let x32 = x14 * c_q3 - x15 * s_q3;
-        let x33 = x14 * s_q3 + x15 * c_q3;
-        let x34 = -0.475 * (x26 - x21) - 7.11 * x25 - (c_q2 * x16 + s_q2 * x18);
-        let x35 = 7.11 * x27 - -0.475 * (x24 + x14 * x14) - x17;
-        let x36 = x19 + (7.11 * x28 + -0.475 * (x20 + x15 * x23));
-        let x37 = s_q3 * x34 + c_q3 * x36;
-        let x38 = x20 * c_q3 - x21 * s_q3 - qd[3] * x33;
-        let x39 = x20 * s_q3 + x21 * c_q3 + qd[3] * x32;
+        let x32 = Self::mul_add(-x15, s_q3, x14 * c_q3);
+        let x33 = Self::mul_add(x15, c_q3, x14 * s_q3);
+        let x34 = Self::mul_add(-7.11, x25, -0.475 * (x26 - x21))
+            - Self::mul_add(s_q2, x18, c_q2 * x16);
+        let x35 = Self::mul_add(0.475, Self::mul_add(x14, x14, x24), 7.11 * x27) - x17;
+        let x36 = x19 + Self::mul_add(-0.475, Self::mul_add(x15, x23, x20), 7.11 * x28);
+        let x37 = Self::mul_add(c_q3, x36, s_q3 * x34);
+        let x38 = Self::mul_add(-qd[3], x33, Self::mul_add(-x21, s_q3, x20 * c_q3));
+        let x39 = Self::mul_add(qd[3], x32, Self::mul_add(x21, c_q3, x20 * s_q3));
         let x40 = qdd[3] + x22;
         let x41 = qd[3] + x23;
-        let x42 = x41 * x41 + x33 * x33;
-        let x43 = x39 + x32 * x41;
-        let x44 = x32 * x33 - x40;
-        let x45 = -24989.307 * x32 + 1375.0472 * x41;
-        let x46 = 1375.0472 * x32 + 24998.828 * x41;
+        let x42 = Self::mul_add(x33, x33, x41 * x41);
+        let x43 = Self::mul_add(x32, x41, x39);
+        let x44 = Self::mul_add(x32, x33, -x40);
+        let x45 = Self::mul_add(1375.0472, x41, -24989.307 * x32);
+        let x46 = Self::mul_add(24998.828, x41, 1375.0472 * x32);
         let (s_q4, c_q4) = libm::sincosf(q[4]);
-        let x48 = x32 * c_q4 - x33 * s_q4;
-        let x49 = x32 * s_q4 + x33 * c_q4;
-        let x50 = x38 * c_q4 - x39 * s_q4 - qd[4] * x49;
-        let x51 = x38 * s_q4 + x39 * c_q4 + qd[4] * x48;
+        let x48 = Self::mul_add(-x33, s_q4, x32 * c_q4);
+        let x49 = Self::mul_add(x33, c_q4, x32 * s_q4);
+        let x50 = Self::mul_add(-qd[4], x49, Self::mul_add(-x39, s_q4, x38 * c_q4));
+        let x51 = Self::mul_add(qd[4], x48, Self::mul_add(x39, c_q4, x38 * s_q4));
         let x52 = qdd[4] + x40;
         let x53 = qd[4] + x41;
-        let x54 = -171.19551 * (x52 + x48 * x49);
-        let x55 = -171.19551 * (x49 * x53 - x50);
-        let x56 = -171.19551 * (x53 * x53 + x48 * x48);
+        let x54 = -171.19551 * Self::mul_add(x48, x49, x52);
+        let x55 = -171.19551 * Self::mul_add(x49, x53, -x50);
+        let x56 = -171.19551 * Self::mul_add(x48, x48, x53 * x53);
         let x57 = 132.67838 * x48;
-        let x58 = 135.47298 * x53 + -97.44449 * x49;
+        let x58 = Self::mul_add(-97.44449, x49, 135.47298 * x53);
         let x59 = -97.44449 * x53;
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x61 = x48 * c_q5 + x53 * s_q5;
-        let x62 = x53 * c_q5 - x48 * s_q5;
+        let x61 = Self::mul_add(x53, s_q5, x48 * c_q5);
+        let x62 = Self::mul_add(-x48, s_q5, x53 * c_q5);
         let x63 = qd[5] + x49;
         let x64 = 44.41 * x62;
         let x65 = 47.471 * x63;
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x67 = 9.336 * (qdd[6] + (x50 * c_q5 + x52 * s_q5 + qd[5] * x62));
+        let x67 = 9.336
+            * (qdd[6] + Self::mul_add(qd[5], x62, Self::mul_add(x52, s_q5, x50 * c_q5)));
         let x68 = 9.336 * (qd[6] + x61);
-        let x69 = (x63 * c_q6 - x62 * s_q6) * x68;
-        let x70 = (x62 * c_q6 + x63 * s_q6) * x68;
-        let x71 = x62 * x65 - x63 * x64 + x67;
-        let x72 = 44.41 * (x52 * c_q5 - x50 * s_q5 - qd[5] * x61) - x61 * x65
-            + (c_q6 * x69 + s_q6 * x70);
-        let x73 = 47.471 * (qdd[5] + x51) + x61 * x64 + (s_q6 * x69 - c_q6 * x70);
-        let x74 = 132.67838 * x50 + (x53 * x59 - x49 * x58)
-            + (x35 + 7.11 * x43) * 171.19551 + (c_q5 * x71 - s_q5 * x72);
-        let x75 = 135.47298 * x52 + -97.44449 * x51 + (x49 * x57 - x48 * x59)
-            + -171.19551
-                * (c_q4 * (c_q3 * x34 - s_q3 * x36 - 7.11 * x42)
-                    - s_q4 * (x37 + 7.11 * x44)) + (s_q5 * x71 + c_q5 * x72);
-        let x76 = -97.44449 * x52 + (x48 * x58 - x53 * x57) + x73;
-        let x77 = s_q4 * x54 + c_q4 * x56;
-        let x78 = c_q4 * x54 - s_q4 * x56 - 3239.4583 * x42;
-        let x79 = 3239.4583 * x43 + x55;
-        let x80 = 3239.4583 * x44 - x77;
-        let x81 = -24989.307 * x38 + 1375.0472 * x40 - x33 * x46
-            + (c_q4 * x74 + s_q4 * x76);
-        let x82 = 1375.0472 * x38 + 24998.828 * x40 + x33 * x45 + x37 * -3239.4583
-            + (x75 - x77 * -7.11);
-        let x83 = x32 * x46 - x41 * x45 + 3239.4583 * x35
-            + (c_q4 * x76 - s_q4 * x74 + 7.11 * x55);
-        let x84 = c_q3 * x78 + s_q3 * x80;
-        let x85 = c_q3 * x80 - s_q3 * x78;
-        let x86 = x84 - 5224.5703 * x25;
-        let x87 = 5224.5703 * x28 + x85;
-        let x88 = -39234.473 * x20 + 3946.1882 * x22 - x15 * x30
-            + (c_q3 * x81 + s_q3 * x83 + -0.475 * x85);
-        let x89 = 3946.1882 * x20 + 39241.402 * x22 + x15 * x29 + x19 * -5224.5703
-            + (x82 + -7.11 * x85);
-        let x90 = x14 * x30 - x23 * x29 - 5224.5703 * x17
-            + (c_q3 * x83 - s_q3 * x81 + (x84 * 0.475 + 7.11 * x79));
-        let x91 = c_q2 * x86 + s_q2 * x87;
-        let x92 = 65697.33 * qdd[1] - x1 * x11 - x5 * 1145.5438
-            + (c_q2 * x90 - s_q2 * x88 + 0.5692 * x91);
-        let x93 = 66279.66 * qdd[0]
-            + (c_q1
-                * (qd[1] * x11 - x2 * x12 - -1145.5438 * x4
-                    + (c_q2 * x88 + s_q2 * x90 + -0.5692 * (c_q2 * x87 - s_q2 * x86)))
-                - s_q1 * (x89 - (-65693.914 * x8 + x1 * x12))
-                + -0.7026
-                    * (s_q1 * (x91 - -1145.5438 * x9)
-                        + c_q1 * (5224.5703 * x27 + x79 - -1145.5438 * x10)));
+        let x69 = Self::mul_add(-x62, s_q6, x63 * c_q6) * x68;
+        let x70 = Self::mul_add(x63, s_q6, x62 * c_q6) * x68;
+        let x71 = Self::mul_add(-x63, x64, x62 * x65) + x67;
+        let x72 = Self::mul_add(
+            -x61,
+            x65,
+            44.41 * Self::mul_add(-qd[5], x61, Self::mul_add(-x50, s_q5, x52 * c_q5)),
+        ) + Self::mul_add(s_q6, x70, c_q6 * x69);
+        let x73 = Self::mul_add(x61, x64, 47.471 * (qdd[5] + x51))
+            + Self::mul_add(-c_q6, x70, s_q6 * x69);
+        let x74 = Self::mul_add(
+            Self::mul_add(7.11, x43, x35),
+            171.19551,
+            Self::mul_add(132.67838, x50, Self::mul_add(-x49, x58, x53 * x59)),
+        ) + Self::mul_add(-s_q5, x72, c_q5 * x71);
+        let x75 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(7.11, x44, x37),
+                c_q4 * Self::mul_add(-7.11, x42, Self::mul_add(-s_q3, x36, c_q3 * x34)),
+            ),
+            Self::mul_add(-97.44449, x51, 135.47298 * x52)
+                + Self::mul_add(-x48, x59, x49 * x57),
+        ) + Self::mul_add(c_q5, x72, s_q5 * x71);
+        let x76 = Self::mul_add(-97.44449, x52, Self::mul_add(-x53, x57, x48 * x58))
+            + x73;
+        let x77 = Self::mul_add(c_q4, x56, s_q4 * x54);
+        let x78 = Self::mul_add(-3239.4583, x42, Self::mul_add(-s_q4, x56, c_q4 * x54));
+        let x79 = Self::mul_add(3239.4583, x43, x55);
+        let x80 = Self::mul_add(3239.4583, x44, -x77);
+        let x81 = Self::mul_add(
+            -x33,
+            x46,
+            Self::mul_add(1375.0472, x40, -24989.307 * x38),
+        ) + Self::mul_add(s_q4, x76, c_q4 * x74);
+        let x82 = Self::mul_add(
+            x37,
+            -3239.4583,
+            Self::mul_add(x33, x45, Self::mul_add(24998.828, x40, 1375.0472 * x38)),
+        ) + Self::mul_add(x77, 7.11, x75);
+        let x83 = Self::mul_add(3239.4583, x35, Self::mul_add(-x41, x45, x32 * x46))
+            + Self::mul_add(7.11, x55, Self::mul_add(-s_q4, x74, c_q4 * x76));
+        let x84 = Self::mul_add(s_q3, x80, c_q3 * x78);
+        let x85 = Self::mul_add(-s_q3, x78, c_q3 * x80);
+        let x86 = Self::mul_add(-5224.5703, x25, x84);
+        let x87 = Self::mul_add(5224.5703, x28, x85);
+        let x88 = Self::mul_add(
+            -x15,
+            x30,
+            Self::mul_add(3946.1882, x22, -39234.473 * x20),
+        ) + Self::mul_add(-0.475, x85, Self::mul_add(s_q3, x83, c_q3 * x81));
+        let x89 = Self::mul_add(
+            x19,
+            -5224.5703,
+            Self::mul_add(x15, x29, Self::mul_add(39241.402, x22, 3946.1882 * x20)),
+        ) + Self::mul_add(-7.11, x85, x82);
+        let x90 = Self::mul_add(-5224.5703, x17, Self::mul_add(-x23, x29, x14 * x30))
+            + (Self::mul_add(-s_q3, x81, c_q3 * x83)
+                + Self::mul_add(7.11, x79, x84 * 0.475));
+        let x91 = Self::mul_add(s_q2, x87, c_q2 * x86);
+        let x92 = Self::mul_add(
+            x5,
+            -1145.5438,
+            Self::mul_add(-x1, x11, 65697.33 * qdd[1]),
+        ) + Self::mul_add(0.5692, x91, Self::mul_add(-s_q2, x88, c_q2 * x90));
+        let x93 = Self::mul_add(
+            66279.66,
+            qdd[0],
+            Self::mul_add(
+                -0.7026,
+                Self::mul_add(
+                    c_q1,
+                    Self::mul_add(1145.5438, x10, Self::mul_add(5224.5703, x27, x79)),
+                    s_q1 * Self::mul_add(1145.5438, x9, x91),
+                ),
+                Self::mul_add(
+                    -s_q1,
+                    x89 - Self::mul_add(x1, x12, -65693.914 * x8),
+                    c_q1
+                        * (Self::mul_add(
+                            1145.5438,
+                            x4,
+                            Self::mul_add(-x2, x12, qd[1] * x11),
+                        )
+                            + Self::mul_add(
+                                -0.5692,
+                                Self::mul_add(-s_q2, x86, c_q2 * x87),
+                                Self::mul_add(s_q2, x90, c_q2 * x88),
+                            )),
+                ),
+            ),
+        );
         [x93, x92, x89, x82, x75, x73, x67]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 503 mul, 359 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 503 mul, 359 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 302 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f32; 7], qd: &[f32; 7], tau: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -803,195 +945,299 @@ impl SsrmsF32 {
         let x7 = 44.41 * s_q5;
         let x8 = 9.336 * s_q5;
         let x9 = 44.41 * c_q5;
-        let x10 = s_q5 * x6 - c_q5 * x7;
-        let x11 = c_q5 * x8 - s_q5 * x9;
-        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
-        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
+        let x10 = Self::mul_add(-c_q5, x7, s_q5 * x6);
+        let x11 = Self::mul_add(-s_q5, x9, c_q5 * x8);
+        let x12 = 132.67838 + Self::mul_add(s_q5, x7, c_q5 * x6);
+        let x13 = 135.47298 + Self::mul_add(c_q5, x9, s_q5 * x8);
         let x14 = -171.19551 * s_q4;
         let x15 = -171.19551 * c_q4;
         let x16 = c_q4 * x12;
         let x17 = -97.44449 * s_q4;
-        let x18 = c_q4 * x10 + x17;
+        let x18 = Self::mul_add(c_q4, x10, x17);
         let x19 = 47.471 * s_q4;
         let x20 = s_q4 * x12;
         let x21 = -97.44449 * c_q4;
-        let x22 = x21 - s_q4 * x10;
+        let x22 = Self::mul_add(-s_q4, x10, x21);
         let x23 = 47.471 * c_q4;
-        let x24 = x21 - s_q4 * x11;
+        let x24 = Self::mul_add(-s_q4, x11, x21);
         let x25 = x14 * -7.11;
         let x26 = 7.11 * x14;
         let x27 = x13 - x25;
-        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
-        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
-        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
+        let x28 = Self::mul_add(-7.11, x15, Self::mul_add(-c_q4, x20, s_q4 * x23));
+        let x29 = Self::mul_add(x15, -7.11, Self::mul_add(-s_q4, x16, c_q4 * x19));
+        let x30 = Self::mul_add(c_q4, x23, s_q4 * x20) + x26 - x25;
         let x31 = 3239.4583 + x14;
-        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
+        let x32 = -24989.307 + Self::mul_add(s_q4, x19, c_q4 * x16);
         let x33 = 1375.0472 + x18;
-        let x34 = 1375.0472 + (x17 + c_q4 * x11);
+        let x34 = 1375.0472 + Self::mul_add(c_q4, x11, x17);
         let x35 = 24998.828 + (x26 + x27);
         let x36 = s_q3 * x15;
-        let x37 = c_q3 * x31 + x36;
+        let x37 = Self::mul_add(c_q3, x31, x36);
         let x38 = c_q3 * x15;
-        let x39 = x38 - s_q3 * x31;
-        let x40 = c_q3 * x32 + s_q3 * x28;
+        let x39 = Self::mul_add(-s_q3, x31, x38);
+        let x40 = Self::mul_add(s_q3, x28, c_q3 * x32);
         let x41 = s_q3 * x22;
-        let x42 = c_q3 * x29 + s_q3 * x30;
-        let x43 = c_q3 * x28 - s_q3 * x32;
+        let x42 = Self::mul_add(s_q3, x30, c_q3 * x29);
+        let x43 = Self::mul_add(-s_q3, x32, c_q3 * x28);
         let x44 = c_q3 * x22;
-        let x45 = c_q3 * x30 - s_q3 * x29;
+        let x45 = Self::mul_add(-s_q3, x29, c_q3 * x30);
         let x46 = -7.11 * x37;
         let x47 = 7.11 * x37;
-        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
+        let x48 = Self::mul_add(0.475, x37, Self::mul_add(c_q3, x33, x41));
         let x49 = x35 - x46;
-        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
-        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
-        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
-        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
-        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
+        let x50 = Self::mul_add(-7.11, x39, Self::mul_add(s_q3, x45, c_q3 * x43));
+        let x51 = Self::mul_add(x39, 0.475, Self::mul_add(-s_q3, x33, x44));
+        let x52 = Self::mul_add(-7.11, x39, Self::mul_add(-s_q3, x40, c_q3 * x42));
+        let x53 = Self::mul_add(0.475, x39, Self::mul_add(-s_q3, x34, c_q3 * x24));
+        let x54 = Self::mul_add(-s_q3, x43, c_q3 * x45) + x47 - x46;
         let x55 = 5224.5703 + x37;
-        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
+        let x56 = -39234.473 + Self::mul_add(s_q3, x42, c_q3 * x40);
         let x57 = 3946.1882 + x48;
-        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
+        let x58 = 3946.1882
+            + Self::mul_add(x37, 0.475, Self::mul_add(s_q3, x24, c_q3 * x34));
         let x59 = 39241.402 + (x47 + x49);
         let x60 = s_q2 * x39;
-        let x61 = c_q2 * x55 + x60;
+        let x61 = Self::mul_add(c_q2, x55, x60);
         let x62 = c_q2 * x39;
-        let x63 = x62 - s_q2 * x55;
-        let x64 = c_q2 * x56 + s_q2 * x50;
+        let x63 = Self::mul_add(-s_q2, x55, x62);
+        let x64 = Self::mul_add(s_q2, x50, c_q2 * x56);
         let x65 = s_q2 * x51;
-        let x66 = c_q2 * x52 + s_q2 * x54;
+        let x66 = Self::mul_add(s_q2, x54, c_q2 * x52);
         let x67 = c_q2 * x51;
-        let x68 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
-        let x69 = c_q1 * (c_q2 * x66 - s_q2 * x64)
-            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
-            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
-        let x70 = x68 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
-        let x71 = x62 - s_q2 * x37;
-        let x72 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
-            + -0.7026 * (s_q1 * x71);
-        let x73 = x38 - s_q3 * x14;
-        let x74 = x36 + c_q3 * x14;
-        let x75 = x41 + c_q3 * x18 - -0.475 * x74;
-        let x76 = x27 - -7.11 * x74;
-        let x77 = x44 - s_q3 * x18 + 0.475 * x73;
-        let x78 = c_q2 * x73 - s_q2 * x74;
-        let x79 = c_q1 * (c_q2 * x75 + s_q2 * x77 - -0.5692 * (s_q2 * x73 + c_q2 * x74))
-            - s_q1 * x76 + -0.7026 * (s_q1 * x78);
-        let x80 = c_q3 * x19 + s_q3 * x23;
-        let x81 = c_q3 * x23 - s_q3 * x19;
-        let x82 = c_q1 * (c_q2 * x80 + s_q2 * x81);
+        let x68 = c_q1 * Self::mul_add(0.5692, x61, Self::mul_add(c_q2, x57, x65));
+        let x69 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(s_q1, 1145.5438, c_q1 * x61),
+            Self::mul_add(
+                -s_q1,
+                Self::mul_add(0.5692, x63, Self::mul_add(-s_q2, x58, c_q2 * x53)),
+                c_q1 * Self::mul_add(-s_q2, x64, c_q2 * x66),
+            ),
+        );
+        let x70 = Self::mul_add(-0.7026, s_q1 * x63, Self::mul_add(-s_q1, x59, x68));
+        let x71 = Self::mul_add(-s_q2, x37, x62);
+        let x72 = Self::mul_add(
+            -0.7026,
+            s_q1 * x71,
+            Self::mul_add(
+                -s_q1,
+                x49,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x37, x60),
+                        Self::mul_add(c_q2, x48, x65),
+                    ),
+            ),
+        );
+        let x73 = Self::mul_add(-s_q3, x14, x38);
+        let x74 = Self::mul_add(c_q3, x14, x36);
+        let x75 = Self::mul_add(0.475, x74, Self::mul_add(c_q3, x18, x41));
+        let x76 = Self::mul_add(7.11, x74, x27);
+        let x77 = Self::mul_add(0.475, x73, Self::mul_add(-s_q3, x18, x44));
+        let x78 = Self::mul_add(-s_q2, x74, c_q2 * x73);
+        let x79 = Self::mul_add(
+            -0.7026,
+            s_q1 * x78,
+            Self::mul_add(
+                -s_q1,
+                x76,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x74, s_q2 * x73),
+                        Self::mul_add(s_q2, x77, c_q2 * x75),
+                    ),
+            ),
+        );
+        let x80 = Self::mul_add(s_q3, x23, c_q3 * x19);
+        let x81 = Self::mul_add(-s_q3, x19, c_q3 * x23);
+        let x82 = c_q1 * Self::mul_add(s_q2, x81, c_q2 * x80);
         let x83 = c_q4 * x6;
         let x84 = s_q4 * x6;
-        let x85 = c_q3 * x83 - s_q3 * x84;
-        let x86 = s_q3 * x83 + c_q3 * x84;
-        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
+        let x85 = Self::mul_add(-s_q3, x84, c_q3 * x83);
+        let x86 = Self::mul_add(c_q3, x84, s_q3 * x83);
+        let x87 = Self::mul_add(-s_q1, x8, c_q1 * Self::mul_add(-s_q2, x86, c_q2 * x85));
         let x88 = qd[0] * c_q1;
         let x89 = qd[0] * s_q1;
         let x90 = 0.7026 * (qd[0] * qd[0]);
         let x91 = qd[1] * x89;
         let x92 = qd[1] * x88;
         let x93 = x88 * x89;
-        let x94 = qd[1] * qd[1] + x88 * x88;
+        let x94 = Self::mul_add(x88, x88, qd[1] * qd[1]);
         let x95 = -65693.914 * x89;
         let x96 = 65697.33 * qd[1];
-        let x97 = c_q2 * x88 - qd[1] * s_q2;
-        let x98 = s_q2 * x88 + qd[1] * c_q2;
+        let x97 = Self::mul_add(-qd[1], s_q2, c_q2 * x88);
+        let x98 = Self::mul_add(qd[1], c_q2, s_q2 * x88);
         let x99 = -0.5692 * x93;
         let x100 = -0.5692 * x94;
-        let x101 = x90 + -0.5692 * (x91 + x91);
-        let x102 = s_q2 * x99 + c_q2 * x101;
-        let x103 = c_q2 * x91 + qd[2] * x98;
-        let x104 = qd[2] * x97 - s_q2 * x91;
+        let x101 = Self::mul_add(-0.5692, x91 + x91, x90);
+        let x102 = Self::mul_add(c_q2, x101, s_q2 * x99);
+        let x103 = Self::mul_add(qd[2], x98, c_q2 * x91);
+        let x104 = Self::mul_add(-s_q2, x91, qd[2] * x97);
         let x105 = qd[2] - x89;
         let x106 = x98 * x98;
-        let x107 = x105 * x105 + x106;
+        let x107 = Self::mul_add(x105, x105, x106);
         let x108 = x97 * x105;
         let x109 = x104 + x108;
-        let x110 = x92 + x97 * x98;
-        let x111 = -39234.473 * x97 + 3946.1882 * x105;
-        let x112 = 3946.1882 * x97 + 39241.402 * x105;
-        let x113 = c_q3 * x97 - s_q3 * x98;
-        let x114 = s_q3 * x97 + c_q3 * x98;
-        let x115 = s_q2 * x101 - c_q2 * x99 + (-0.475 * (x108 - x104) - 7.11 * x107);
-        let x116 = 7.11 * x109 - -0.475 * (x106 + x97 * x97) - x100;
-        let x117 = 7.11 * x110 + -0.475 * (x98 * x105 - x103) - x102;
-        let x118 = s_q3 * x115 + c_q3 * x117;
-        let x119 = c_q3 * x103 + s_q3 * x104 + qd[3] * x114;
-        let x120 = c_q3 * x104 - s_q3 * x103 + qd[3] * x113;
+        let x110 = Self::mul_add(x97, x98, x92);
+        let x111 = Self::mul_add(3946.1882, x105, -39234.473 * x97);
+        let x112 = Self::mul_add(39241.402, x105, 3946.1882 * x97);
+        let x113 = Self::mul_add(-s_q3, x98, c_q3 * x97);
+        let x114 = Self::mul_add(c_q3, x98, s_q3 * x97);
+        let x115 = Self::mul_add(-c_q2, x99, s_q2 * x101)
+            + Self::mul_add(-7.11, x107, -0.475 * (x108 - x104));
+        let x116 = Self::mul_add(0.475, Self::mul_add(x97, x97, x106), 7.11 * x109)
+            - x100;
+        let x117 = Self::mul_add(-0.475, Self::mul_add(x98, x105, -x103), 7.11 * x110)
+            - x102;
+        let x118 = Self::mul_add(c_q3, x117, s_q3 * x115);
+        let x119 = Self::mul_add(qd[3], x114, Self::mul_add(s_q3, x104, c_q3 * x103));
+        let x120 = Self::mul_add(qd[3], x113, Self::mul_add(-s_q3, x103, c_q3 * x104));
         let x121 = qd[3] + x105;
-        let x122 = x121 * x121 + x114 * x114;
-        let x123 = x120 + x113 * x121;
-        let x124 = x92 + x113 * x114;
-        let x125 = -24989.307 * x113 + 1375.0472 * x121;
-        let x126 = 1375.0472 * x113 + 24998.828 * x121;
-        let x127 = c_q4 * x113 - s_q4 * x114;
-        let x128 = s_q4 * x113 + c_q4 * x114;
-        let x129 = c_q4 * x119 + s_q4 * x120 + qd[4] * x128;
-        let x130 = c_q4 * x120 - s_q4 * x119 + qd[4] * x127;
+        let x122 = Self::mul_add(x114, x114, x121 * x121);
+        let x123 = Self::mul_add(x113, x121, x120);
+        let x124 = Self::mul_add(x113, x114, x92);
+        let x125 = Self::mul_add(1375.0472, x121, -24989.307 * x113);
+        let x126 = Self::mul_add(24998.828, x121, 1375.0472 * x113);
+        let x127 = Self::mul_add(-s_q4, x114, c_q4 * x113);
+        let x128 = Self::mul_add(c_q4, x114, s_q4 * x113);
+        let x129 = Self::mul_add(qd[4], x128, Self::mul_add(s_q4, x120, c_q4 * x119));
+        let x130 = Self::mul_add(qd[4], x127, Self::mul_add(-s_q4, x119, c_q4 * x120));
         let x131 = qd[4] + x121;
-        let x132 = -171.19551 * (x127 * x128 - x92);
-        let x133 = -171.19551 * (x129 + x128 * x131);
-        let x134 = -171.19551 * (x131 * x131 + x127 * x127);
+        let x132 = -171.19551 * Self::mul_add(x127, x128, -x92);
+        let x133 = -171.19551 * Self::mul_add(x128, x131, x129);
+        let x134 = -171.19551 * Self::mul_add(x127, x127, x131 * x131);
         let x135 = 132.67838 * x127;
-        let x136 = 135.47298 * x131 + -97.44449 * x128;
+        let x136 = Self::mul_add(-97.44449, x128, 135.47298 * x131);
         let x137 = -97.44449 * x131;
-        let x138 = c_q5 * x127 + s_q5 * x131;
-        let x139 = c_q5 * x131 - s_q5 * x127;
+        let x138 = Self::mul_add(s_q5, x131, c_q5 * x127);
+        let x139 = Self::mul_add(-s_q5, x127, c_q5 * x131);
         let x140 = qd[5] + x128;
         let x141 = 44.41 * x139;
         let x142 = 47.471 * x140;
-        let x143 = 9.336 * (qd[5] * x139 - (c_q5 * x129 + s_q5 * x92));
+        let x143 = 9.336
+            * Self::mul_add(qd[5], x139, -Self::mul_add(s_q5, x92, c_q5 * x129));
         let x144 = 9.336 * (qd[6] + x138);
-        let x145 = (c_q6 * x140 - s_q6 * x139) * x144;
-        let x146 = (c_q6 * x139 + s_q6 * x140) * x144;
-        let x147 = x139 * x142 - x140 * x141 + x143;
-        let x148 = 44.41 * (s_q5 * x129 - c_q5 * x92 - qd[5] * x138) - x138 * x142
-            + (c_q6 * x145 + s_q6 * x146);
-        let x149 = 47.471 * x130 + x138 * x141 + (s_q6 * x145 - c_q6 * x146);
-        let x150 = x131 * x137 - x128 * x136 - 132.67838 * x129
-            + 171.19551 * (x116 + 7.11 * x123) + (c_q5 * x147 - s_q5 * x148);
-        let x151 = -97.44449 * x130 - 135.47298 * x92 + (x128 * x135 - x127 * x137)
-            + -171.19551
-                * (c_q4 * (c_q3 * x115 - s_q3 * x117 - 7.11 * x122)
-                    - s_q4 * (x118 + 7.11 * x124)) + (s_q5 * x147 + c_q5 * x148);
-        let x152 = x127 * x136 - x131 * x135 - -97.44449 * x92 + x149;
-        let x153 = s_q4 * x132 + c_q4 * x134;
-        let x154 = c_q4 * x132 - s_q4 * x134 - 3239.4583 * x122;
-        let x155 = 3239.4583 * x123 + x133;
-        let x156 = 3239.4583 * x124 - x153;
-        let x157 = c_q4 * x150 + s_q4 * x152
-            - (-24989.307 * x119 + 1375.0472 * x92 + x114 * x126);
-        let x158 = x114 * x125 - (1375.0472 * x119 + 24998.828 * x92) + x118 * -3239.4583
-            + (x151 - -7.11 * x153);
-        let x159 = x113 * x126 - x121 * x125 + 3239.4583 * x116
-            + (c_q4 * x152 - s_q4 * x150 + 7.11 * x133);
-        let x160 = c_q3 * x154 + s_q3 * x156;
-        let x161 = c_q3 * x156 - s_q3 * x154;
-        let x162 = x160 - 5224.5703 * x107;
-        let x163 = 5224.5703 * x110 + x161;
-        let x164 = c_q3 * x157 + s_q3 * x159 + -0.475 * x161
-            - (-39234.473 * x103 + 3946.1882 * x92 + x98 * x112);
-        let x165 = x98 * x111 - (3946.1882 * x103 + 39241.402 * x92) - x102 * -5224.5703
-            + (x158 + -7.11 * x161);
-        let x166 = x97 * x112 - x105 * x111 - 5224.5703 * x100
-            + (c_q3 * x159 - s_q3 * x157 + (0.475 * x160 + 7.11 * x155));
-        let x167 = c_q2 * x162 + s_q2 * x163;
+        let x145 = Self::mul_add(-s_q6, x139, c_q6 * x140) * x144;
+        let x146 = Self::mul_add(s_q6, x140, c_q6 * x139) * x144;
+        let x147 = Self::mul_add(-x140, x141, x139 * x142) + x143;
+        let x148 = Self::mul_add(
+            -x138,
+            x142,
+            44.41 * Self::mul_add(-qd[5], x138, Self::mul_add(-c_q5, x92, s_q5 * x129)),
+        ) + Self::mul_add(s_q6, x146, c_q6 * x145);
+        let x149 = Self::mul_add(x138, x141, 47.471 * x130)
+            + Self::mul_add(-c_q6, x146, s_q6 * x145);
+        let x150 = Self::mul_add(
+            171.19551,
+            Self::mul_add(7.11, x123, x116),
+            Self::mul_add(-132.67838, x129, Self::mul_add(-x128, x136, x131 * x137)),
+        ) + Self::mul_add(-s_q5, x148, c_q5 * x147);
+        let x151 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(7.11, x124, x118),
+                c_q4
+                    * Self::mul_add(-7.11, x122, Self::mul_add(-s_q3, x117, c_q3 * x115)),
+            ),
+            Self::mul_add(-135.47298, x92, -97.44449 * x130)
+                + Self::mul_add(-x127, x137, x128 * x135),
+        ) + Self::mul_add(c_q5, x148, s_q5 * x147);
+        let x152 = Self::mul_add(97.44449, x92, Self::mul_add(-x131, x135, x127 * x136))
+            + x149;
+        let x153 = Self::mul_add(c_q4, x134, s_q4 * x132);
+        let x154 = Self::mul_add(
+            -3239.4583,
+            x122,
+            Self::mul_add(-s_q4, x134, c_q4 * x132),
+        );
+        let x155 = Self::mul_add(3239.4583, x123, x133);
+        let x156 = Self::mul_add(3239.4583, x124, -x153);
+        let x157 = Self::mul_add(s_q4, x152, c_q4 * x150)
+            - Self::mul_add(
+                x114,
+                x126,
+                Self::mul_add(1375.0472, x92, -24989.307 * x119),
+            );
+        let x158 = Self::mul_add(
+            x118,
+            -3239.4583,
+            Self::mul_add(x114, x125, -Self::mul_add(24998.828, x92, 1375.0472 * x119)),
+        ) + Self::mul_add(7.11, x153, x151);
+        let x159 = Self::mul_add(
+            3239.4583,
+            x116,
+            Self::mul_add(-x121, x125, x113 * x126),
+        ) + Self::mul_add(7.11, x133, Self::mul_add(-s_q4, x150, c_q4 * x152));
+        let x160 = Self::mul_add(s_q3, x156, c_q3 * x154);
+        let x161 = Self::mul_add(-s_q3, x154, c_q3 * x156);
+        let x162 = Self::mul_add(-5224.5703, x107, x160);
+        let x163 = Self::mul_add(5224.5703, x110, x161);
+        let x164 = Self::mul_add(-0.475, x161, Self::mul_add(s_q3, x159, c_q3 * x157))
+            - Self::mul_add(x98, x112, Self::mul_add(3946.1882, x92, -39234.473 * x103));
+        let x165 = Self::mul_add(
+            x102,
+            5224.5703,
+            Self::mul_add(x98, x111, -Self::mul_add(39241.402, x92, 3946.1882 * x103)),
+        ) + Self::mul_add(-7.11, x161, x158);
+        let x166 = Self::mul_add(
+            -5224.5703,
+            x100,
+            Self::mul_add(-x105, x111, x97 * x112),
+        )
+            + (Self::mul_add(-s_q3, x157, c_q3 * x159)
+                + Self::mul_add(7.11, x155, 0.475 * x160));
+        let x167 = Self::mul_add(s_q2, x163, c_q2 * x162);
         let x168 = tau[0]
-            - (c_q1
-                * (qd[1] * x95 - x89 * x96 - -1145.5438 * x90
-                    + (c_q2 * x164 + s_q2 * x166
-                        + -0.5692 * (c_q2 * x163 - s_q2 * x162)))
-                - s_q1 * (x165 - (-65693.914 * x92 + x88 * x96))
-                + -0.7026
-                    * (s_q1 * (x167 - -1145.5438 * x93)
-                        + c_q1 * (5224.5703 * x109 + x155 - -1145.5438 * x94)));
+            - Self::mul_add(
+                -0.7026,
+                Self::mul_add(
+                    c_q1,
+                    Self::mul_add(1145.5438, x94, Self::mul_add(5224.5703, x109, x155)),
+                    s_q1 * Self::mul_add(1145.5438, x93, x167),
+                ),
+                Self::mul_add(
+                    -s_q1,
+                    x165 - Self::mul_add(x88, x96, -65693.914 * x92),
+                    c_q1
+                        * (Self::mul_add(
+                            1145.5438,
+                            x90,
+                            Self::mul_add(-x89, x96, qd[1] * x95),
+                        )
+                            + Self::mul_add(
+                                -0.5692,
+                                Self::mul_add(-s_q2, x162, c_q2 * x163),
+                                Self::mul_add(s_q2, x166, c_q2 * x164),
+                            )),
+                ),
+            );
         let x169 = 1.0
             / (66279.66
-                + (0.7026 * x63
-                    + (c_q1
-                        * (c_q1 * (c_q2 * x64 + s_q2 * x66)
-                            - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
-                        - s_q1 * (x68 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63)));
+                + Self::mul_add(
+                    0.7026,
+                    x63,
+                    Self::mul_add(
+                        0.7026,
+                        x63,
+                        Self::mul_add(
+                            -s_q1,
+                            Self::mul_add(-s_q1, -65693.914 + x59, x68),
+                            c_q1
+                                * Self::mul_add(
+                                    -s_q1,
+                                    Self::mul_add(
+                                        0.5692,
+                                        x61,
+                                        Self::mul_add(s_q2, x53, c_q2 * x58),
+                                    ),
+                                    c_q1 * Self::mul_add(s_q2, x66, c_q2 * x64),
+                                ),
+                        ),
+                    ),
+                ));
         let x170 = x69 * x169;
         let x171 = x70 * x169;
         let x172 = x72 * x169;
@@ -999,71 +1245,250 @@ impl SsrmsF32 {
         let x174 = x82 * x169;
         let x175 = x87 * x169;
         let x176 = 1.0
-            / (65697.33
-                + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
-                - x69 * x170);
-        let x177 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x171;
+            / Self::mul_add(
+                -x69,
+                x170,
+                65697.33
+                    + Self::mul_add(
+                        -s_q2,
+                        Self::mul_add(-s_q2, x56, c_q2 * x50),
+                        c_q2 * Self::mul_add(-s_q2, x52, c_q2 * x54),
+                    ),
+            );
+        let x177 = Self::mul_add(
+            -x69,
+            x171,
+            Self::mul_add(0.5692, x63, Self::mul_add(-s_q2, x57, x67)),
+        );
         let x178 = x176 * x177;
-        let x179 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x172;
+        let x179 = Self::mul_add(
+            -x69,
+            x172,
+            Self::mul_add(0.5692, x71, Self::mul_add(-s_q2, x48, x67)),
+        );
         let x180 = x176 * x179;
-        let x181 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x173;
+        let x181 = Self::mul_add(
+            -x69,
+            x173,
+            Self::mul_add(0.5692, x78, Self::mul_add(-s_q2, x75, c_q2 * x77)),
+        );
         let x182 = x176 * x181;
-        let x183 = c_q2 * x81 - s_q2 * x80 - x69 * x174;
+        let x183 = Self::mul_add(-x69, x174, Self::mul_add(-s_q2, x80, c_q2 * x81));
         let x184 = x176 * x183;
-        let x185 = s_q2 * x85 + c_q2 * x86 + x69 * x175;
+        let x185 = Self::mul_add(x69, x175, Self::mul_add(c_q2, x86, s_q2 * x85));
         let x186 = x176 * x185;
-        let x187 = 1.0 / (x59 - x70 * x171 - x177 * x178);
-        let x188 = x49 - x70 * x172 - x177 * x180;
+        let x187 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x70, x171, x59));
+        let x188 = Self::mul_add(-x177, x180, Self::mul_add(-x70, x172, x49));
         let x189 = x187 * x188;
-        let x190 = x76 - x70 * x173 - x177 * x182;
+        let x190 = Self::mul_add(-x177, x182, Self::mul_add(-x70, x173, x76));
         let x191 = x187 * x190;
-        let x192 = x70 * x174 + x177 * x184;
+        let x192 = Self::mul_add(x177, x184, x70 * x174);
         let x193 = x187 * x192;
-        let x194 = x8 - x70 * x175 + x177 * x186;
+        let x194 = Self::mul_add(x177, x186, Self::mul_add(-x70, x175, x8));
         let x195 = x187 * x194;
-        let x196 = 1.0 / (x35 - x72 * x172 - x179 * x180 - x188 * x189);
-        let x197 = x27 - x72 * x173 - x179 * x182 - x188 * x191;
+        let x196 = 1.0
+            / Self::mul_add(
+                -x188,
+                x189,
+                Self::mul_add(-x179, x180, Self::mul_add(-x72, x172, x35)),
+            );
+        let x197 = Self::mul_add(
+            -x188,
+            x191,
+            Self::mul_add(-x179, x182, Self::mul_add(-x72, x173, x27)),
+        );
         let x198 = x196 * x197;
-        let x199 = x188 * x193 - (x72 * x174 + x179 * x184);
+        let x199 = Self::mul_add(x188, x193, -Self::mul_add(x179, x184, x72 * x174));
         let x200 = x196 * x199;
-        let x201 = x8 - x72 * x175 + x179 * x186 - x188 * x195;
+        let x201 = Self::mul_add(
+            -x188,
+            x195,
+            Self::mul_add(x179, x186, Self::mul_add(-x72, x175, x8)),
+        );
         let x202 = x196 * x201;
-        let x203 = 1.0 / (x13 - x79 * x173 - x181 * x182 - x190 * x191 - x197 * x198);
-        let x204 = x190 * x193 - (x79 * x174 + x181 * x184) - x197 * x200;
+        let x203 = 1.0
+            / Self::mul_add(
+                -x197,
+                x198,
+                Self::mul_add(
+                    -x190,
+                    x191,
+                    Self::mul_add(-x181, x182, Self::mul_add(-x79, x173, x13)),
+                ),
+            );
+        let x204 = Self::mul_add(
+            -x197,
+            x200,
+            Self::mul_add(x190, x193, -Self::mul_add(x181, x184, x79 * x174)),
+        );
         let x205 = x203 * x204;
-        let x206 = x8 - x79 * x175 + x181 * x186 - x190 * x195 - x197 * x202;
+        let x206 = Self::mul_add(
+            -x197,
+            x202,
+            Self::mul_add(
+                -x190,
+                x195,
+                Self::mul_add(x181, x186, Self::mul_add(-x79, x175, x8)),
+            ),
+        );
         let x207 = x203 * x206;
         let x208 = 1.0
-            / (47.471 - x82 * x174 - x183 * x184 - x192 * x193 - x199 * x200
-                - x204 * x205);
-        let x209 = x183 * x186 - x82 * x175 + x192 * x195 - x199 * x202 - x204 * x207;
+            / Self::mul_add(
+                -x204,
+                x205,
+                Self::mul_add(
+                    -x199,
+                    x200,
+                    Self::mul_add(
+                        -x192,
+                        x193,
+                        Self::mul_add(-x183, x184, Self::mul_add(-x82, x174, 47.471)),
+                    ),
+                ),
+            );
+        let x209 = Self::mul_add(
+            -x204,
+            x207,
+            Self::mul_add(
+                -x199,
+                x202,
+                Self::mul_add(x192, x195, Self::mul_add(-x82, x175, x183 * x186)),
+            ),
+        );
         let x210 = x208 * x209;
         let x211 = 1.0
-            / (9.336 - x87 * x175 - x185 * x186 - x194 * x195 - x201 * x202 - x206 * x207
-                - x209 * x210);
-        let x212 = tau[1] - (c_q2 * x166 - s_q2 * x164 + 0.5692 * x167 - x88 * x95)
-            - x168 * x170;
-        let x213 = tau[2] - x165 - x168 * x171 - x178 * x212;
-        let x214 = tau[3] - x158 - x168 * x172 - x180 * x212 - x189 * x213;
-        let x215 = tau[4] - x151 - x168 * x173 - x182 * x212 - x191 * x213 - x198 * x214;
-        let x216 = tau[5] - x149 - x168 * x174 - x184 * x212 + x193 * x213 - x200 * x214
-            - x205 * x215;
+            / Self::mul_add(
+                -x209,
+                x210,
+                Self::mul_add(
+                    -x206,
+                    x207,
+                    Self::mul_add(
+                        -x201,
+                        x202,
+                        Self::mul_add(
+                            -x194,
+                            x195,
+                            Self::mul_add(-x185, x186, Self::mul_add(-x87, x175, 9.336)),
+                        ),
+                    ),
+                ),
+            );
+        let x212 = Self::mul_add(
+            -x168,
+            x170,
+            tau[1]
+                - Self::mul_add(
+                    -x88,
+                    x95,
+                    Self::mul_add(0.5692, x167, Self::mul_add(-s_q2, x164, c_q2 * x166)),
+                ),
+        );
+        let x213 = Self::mul_add(-x178, x212, Self::mul_add(-x168, x171, tau[2] - x165));
+        let x214 = Self::mul_add(
+            -x189,
+            x213,
+            Self::mul_add(-x180, x212, Self::mul_add(-x168, x172, tau[3] - x158)),
+        );
+        let x215 = Self::mul_add(
+            -x198,
+            x214,
+            Self::mul_add(
+                -x191,
+                x213,
+                Self::mul_add(-x182, x212, Self::mul_add(-x168, x173, tau[4] - x151)),
+            ),
+        );
+        let x216 = Self::mul_add(
+            -x205,
+            x215,
+            Self::mul_add(
+                -x200,
+                x214,
+                Self::mul_add(
+                    x193,
+                    x213,
+                    Self::mul_add(-x184, x212, Self::mul_add(-x168, x174, tau[5] - x149)),
+                ),
+            ),
+        );
         let x217 = x211
-            * (tau[6] - x143 - x168 * x175 + x186 * x212 - x195 * x213 - x202 * x214
-                - x207 * x215 - x210 * x216);
-        let x218 = x208 * x216 - x210 * x217;
-        let x219 = x203 * x215 - x205 * x218 - x207 * x217;
-        let x220 = x196 * x214 - x198 * x219 - x200 * x218 - x202 * x217;
-        let x221 = x187 * x213 - x189 * x220 - x191 * x219 + x193 * x218 - x195 * x217;
-        let x222 = x176 * x212 - x178 * x221 - x180 * x220 - x182 * x219 - x184 * x218
-            + x186 * x217;
-        let x223 = x168 * x169 - x170 * x222 - x171 * x221 - x172 * x220 - x173 * x219
-            - x174 * x218 - x175 * x217;
+            * Self::mul_add(
+                -x210,
+                x216,
+                Self::mul_add(
+                    -x207,
+                    x215,
+                    Self::mul_add(
+                        -x202,
+                        x214,
+                        Self::mul_add(
+                            -x195,
+                            x213,
+                            Self::mul_add(
+                                x186,
+                                x212,
+                                Self::mul_add(-x168, x175, tau[6] - x143),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+        let x218 = Self::mul_add(-x210, x217, x208 * x216);
+        let x219 = Self::mul_add(-x207, x217, Self::mul_add(-x205, x218, x203 * x215));
+        let x220 = Self::mul_add(
+            -x202,
+            x217,
+            Self::mul_add(-x200, x218, Self::mul_add(-x198, x219, x196 * x214)),
+        );
+        let x221 = Self::mul_add(
+            -x195,
+            x217,
+            Self::mul_add(
+                x193,
+                x218,
+                Self::mul_add(-x191, x219, Self::mul_add(-x189, x220, x187 * x213)),
+            ),
+        );
+        let x222 = Self::mul_add(
+            x186,
+            x217,
+            Self::mul_add(
+                -x184,
+                x218,
+                Self::mul_add(
+                    -x182,
+                    x219,
+                    Self::mul_add(-x180, x220, Self::mul_add(-x178, x221, x176 * x212)),
+                ),
+            ),
+        );
+        let x223 = Self::mul_add(
+            -x175,
+            x217,
+            Self::mul_add(
+                -x174,
+                x218,
+                Self::mul_add(
+                    -x173,
+                    x219,
+                    Self::mul_add(
+                        -x172,
+                        x220,
+                        Self::mul_add(
+                            -x171,
+                            x221,
+                            Self::mul_add(-x170, x222, x168 * x169),
+                        ),
+                    ),
+                ),
+            ),
+        );
         [x223, x222, x221, x220, x219, x218, x217]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 258 add, 0 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 258 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 208 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f32; 7],
@@ -1079,200 +1504,317 @@ impl SsrmsF32 {
         let x7 = 44.41 * s_q5;
         let x8 = 9.336 * s_q5;
         let x9 = 44.41 * c_q5;
-        let x10 = s_q5 * x6 - c_q5 * x7;
-        let x11 = c_q5 * x8 - s_q5 * x9;
-        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
-        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
+        let x10 = Self::mul_add(-c_q5, x7, s_q5 * x6);
+        let x11 = Self::mul_add(-s_q5, x9, c_q5 * x8);
+        let x12 = 132.67838 + Self::mul_add(s_q5, x7, c_q5 * x6);
+        let x13 = 135.47298 + Self::mul_add(c_q5, x9, s_q5 * x8);
         let x14 = -171.19551 * s_q4;
         let x15 = -171.19551 * c_q4;
         let x16 = c_q4 * x12;
         let x17 = -97.44449 * s_q4;
-        let x18 = c_q4 * x10 + x17;
+        let x18 = Self::mul_add(c_q4, x10, x17);
         let x19 = 47.471 * s_q4;
         let x20 = s_q4 * x12;
         let x21 = -97.44449 * c_q4;
-        let x22 = x21 - s_q4 * x10;
+        let x22 = Self::mul_add(-s_q4, x10, x21);
         let x23 = 47.471 * c_q4;
-        let x24 = x21 - s_q4 * x11;
+        let x24 = Self::mul_add(-s_q4, x11, x21);
         let x25 = x14 * -7.11;
         let x26 = 7.11 * x14;
         let x27 = x13 - x25;
-        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
-        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
-        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
+        let x28 = Self::mul_add(-7.11, x15, Self::mul_add(-c_q4, x20, s_q4 * x23));
+        let x29 = Self::mul_add(x15, -7.11, Self::mul_add(-s_q4, x16, c_q4 * x19));
+        let x30 = Self::mul_add(c_q4, x23, s_q4 * x20) + x26 - x25;
         let x31 = 3239.4583 + x14;
-        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
+        let x32 = -24989.307 + Self::mul_add(s_q4, x19, c_q4 * x16);
         let x33 = 1375.0472 + x18;
-        let x34 = 1375.0472 + (x17 + c_q4 * x11);
+        let x34 = 1375.0472 + Self::mul_add(c_q4, x11, x17);
         let x35 = 24998.828 + (x26 + x27);
         let x36 = s_q3 * x15;
-        let x37 = c_q3 * x31 + x36;
+        let x37 = Self::mul_add(c_q3, x31, x36);
         let x38 = c_q3 * x15;
-        let x39 = x38 - s_q3 * x31;
-        let x40 = c_q3 * x32 + s_q3 * x28;
+        let x39 = Self::mul_add(-s_q3, x31, x38);
+        let x40 = Self::mul_add(s_q3, x28, c_q3 * x32);
         let x41 = s_q3 * x22;
-        let x42 = c_q3 * x29 + s_q3 * x30;
-        let x43 = c_q3 * x28 - s_q3 * x32;
+        let x42 = Self::mul_add(s_q3, x30, c_q3 * x29);
+        let x43 = Self::mul_add(-s_q3, x32, c_q3 * x28);
         let x44 = c_q3 * x22;
-        let x45 = c_q3 * x30 - s_q3 * x29;
+        let x45 = Self::mul_add(-s_q3, x29, c_q3 * x30);
         let x46 = -7.11 * x37;
         let x47 = 7.11 * x37;
-        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
+        let x48 = Self::mul_add(0.475, x37, Self::mul_add(c_q3, x33, x41));
         let x49 = x35 - x46;
-        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
-        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
-        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
-        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
-        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
+        let x50 = Self::mul_add(-7.11, x39, Self::mul_add(s_q3, x45, c_q3 * x43));
+        let x51 = Self::mul_add(x39, 0.475, Self::mul_add(-s_q3, x33, x44));
+        let x52 = Self::mul_add(-7.11, x39, Self::mul_add(-s_q3, x40, c_q3 * x42));
+        let x53 = Self::mul_add(0.475, x39, Self::mul_add(-s_q3, x34, c_q3 * x24));
+        let x54 = Self::mul_add(-s_q3, x43, c_q3 * x45) + x47 - x46;
         let x55 = 5224.5703 + x37;
-        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
+        let x56 = -39234.473 + Self::mul_add(s_q3, x42, c_q3 * x40);
         let x57 = 3946.1882 + x48;
-        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
+        let x58 = 3946.1882
+            + Self::mul_add(x37, 0.475, Self::mul_add(s_q3, x24, c_q3 * x34));
         let x59 = 39241.402 + (x47 + x49);
         let x60 = s_q2 * x39;
-        let x61 = c_q2 * x55 + x60;
+        let x61 = Self::mul_add(c_q2, x55, x60);
         let x62 = c_q2 * x39;
-        let x63 = x62 - s_q2 * x55;
-        let x64 = c_q2 * x56 + s_q2 * x50;
+        let x63 = Self::mul_add(-s_q2, x55, x62);
+        let x64 = Self::mul_add(s_q2, x50, c_q2 * x56);
         let x65 = s_q2 * x51;
-        let x66 = c_q2 * x52 + s_q2 * x54;
+        let x66 = Self::mul_add(s_q2, x54, c_q2 * x52);
         let x67 = c_q2 * x51;
-        let x68 = x67 - s_q2 * x57 + 0.5692 * x63;
+        let x68 = Self::mul_add(0.5692, x63, Self::mul_add(-s_q2, x57, x67));
         let x69 = 65697.33
-            + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56));
-        let x70 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
+            + Self::mul_add(
+                -s_q2,
+                Self::mul_add(-s_q2, x56, c_q2 * x50),
+                c_q2 * Self::mul_add(-s_q2, x52, c_q2 * x54),
+            );
+        let x70 = c_q1 * Self::mul_add(0.5692, x61, Self::mul_add(c_q2, x57, x65));
         let x71 = 66279.66
-            + (0.7026 * x63
-                + (c_q1
-                    * (c_q1 * (c_q2 * x64 + s_q2 * x66)
-                        - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
-                    - s_q1 * (x70 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63));
-        let x72 = c_q1 * (c_q2 * x66 - s_q2 * x64)
-            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
-            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
-        let x73 = x70 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
-        let x74 = x62 - s_q2 * x37;
-        let x75 = x67 - s_q2 * x48 + 0.5692 * x74;
-        let x76 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
-            + -0.7026 * (s_q1 * x74);
-        let x77 = x38 - s_q3 * x14;
-        let x78 = x36 + c_q3 * x14;
-        let x79 = x41 + c_q3 * x18 - -0.475 * x78;
-        let x80 = x27 - -7.11 * x78;
-        let x81 = x44 - s_q3 * x18 + 0.475 * x77;
-        let x82 = c_q2 * x77 - s_q2 * x78;
-        let x83 = c_q2 * x81 - s_q2 * x79 + 0.5692 * x82;
-        let x84 = c_q1 * (c_q2 * x79 + s_q2 * x81 - -0.5692 * (s_q2 * x77 + c_q2 * x78))
-            - s_q1 * x80 + -0.7026 * (s_q1 * x82);
-        let x85 = c_q3 * x19 + s_q3 * x23;
-        let x86 = c_q3 * x23 - s_q3 * x19;
-        let x87 = c_q2 * x86 - s_q2 * x85;
-        let x88 = c_q1 * (c_q2 * x85 + s_q2 * x86);
+            + Self::mul_add(
+                0.7026,
+                x63,
+                Self::mul_add(
+                    0.7026,
+                    x63,
+                    Self::mul_add(
+                        -s_q1,
+                        Self::mul_add(-s_q1, -65693.914 + x59, x70),
+                        c_q1
+                            * Self::mul_add(
+                                -s_q1,
+                                Self::mul_add(
+                                    0.5692,
+                                    x61,
+                                    Self::mul_add(s_q2, x53, c_q2 * x58),
+                                ),
+                                c_q1 * Self::mul_add(s_q2, x66, c_q2 * x64),
+                            ),
+                    ),
+                ),
+            );
+        let x72 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(s_q1, 1145.5438, c_q1 * x61),
+            Self::mul_add(
+                -s_q1,
+                Self::mul_add(0.5692, x63, Self::mul_add(-s_q2, x58, c_q2 * x53)),
+                c_q1 * Self::mul_add(-s_q2, x64, c_q2 * x66),
+            ),
+        );
+        let x73 = Self::mul_add(-0.7026, s_q1 * x63, Self::mul_add(-s_q1, x59, x70));
+        let x74 = Self::mul_add(-s_q2, x37, x62);
+        let x75 = Self::mul_add(0.5692, x74, Self::mul_add(-s_q2, x48, x67));
+        let x76 = Self::mul_add(
+            -0.7026,
+            s_q1 * x74,
+            Self::mul_add(
+                -s_q1,
+                x49,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x37, x60),
+                        Self::mul_add(c_q2, x48, x65),
+                    ),
+            ),
+        );
+        let x77 = Self::mul_add(-s_q3, x14, x38);
+        let x78 = Self::mul_add(c_q3, x14, x36);
+        let x79 = Self::mul_add(0.475, x78, Self::mul_add(c_q3, x18, x41));
+        let x80 = Self::mul_add(7.11, x78, x27);
+        let x81 = Self::mul_add(0.475, x77, Self::mul_add(-s_q3, x18, x44));
+        let x82 = Self::mul_add(-s_q2, x78, c_q2 * x77);
+        let x83 = Self::mul_add(0.5692, x82, Self::mul_add(-s_q2, x79, c_q2 * x81));
+        let x84 = Self::mul_add(
+            -0.7026,
+            s_q1 * x82,
+            Self::mul_add(
+                -s_q1,
+                x80,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x78, s_q2 * x77),
+                        Self::mul_add(s_q2, x81, c_q2 * x79),
+                    ),
+            ),
+        );
+        let x85 = Self::mul_add(s_q3, x23, c_q3 * x19);
+        let x86 = Self::mul_add(-s_q3, x19, c_q3 * x23);
+        let x87 = Self::mul_add(-s_q2, x85, c_q2 * x86);
+        let x88 = c_q1 * Self::mul_add(s_q2, x86, c_q2 * x85);
         let x89 = c_q4 * x6;
         let x90 = s_q4 * x6;
-        let x91 = c_q3 * x89 - s_q3 * x90;
-        let x92 = s_q3 * x89 + c_q3 * x90;
-        let x93 = -(s_q2 * x91 + c_q2 * x92);
-        let x94 = c_q1 * (c_q2 * x91 - s_q2 * x92) - s_q1 * x8;
+        let x91 = Self::mul_add(-s_q3, x90, c_q3 * x89);
+        let x92 = Self::mul_add(c_q3, x90, s_q3 * x89);
+        let x93 = -Self::mul_add(c_q2, x92, s_q2 * x91);
+        let x94 = Self::mul_add(-s_q1, x8, c_q1 * Self::mul_add(-s_q2, x92, c_q2 * x91));
         let x95 = qd[0] * c_q1;
         let x96 = qd[0] * s_q1;
         let x97 = 0.7026 * (qd[0] * qd[0]);
         let x98 = qd[1] * x96;
         let x99 = qd[1] * x95;
         let x100 = x95 * x96;
-        let x101 = qd[1] * qd[1] + x95 * x95;
+        let x101 = Self::mul_add(x95, x95, qd[1] * qd[1]);
         let x102 = -65693.914 * x96;
         let x103 = 65697.33 * qd[1];
-        let x104 = c_q2 * x95 - qd[1] * s_q2;
-        let x105 = s_q2 * x95 + qd[1] * c_q2;
+        let x104 = Self::mul_add(-qd[1], s_q2, c_q2 * x95);
+        let x105 = Self::mul_add(qd[1], c_q2, s_q2 * x95);
         let x106 = -0.5692 * x100;
         let x107 = -0.5692 * x101;
-        let x108 = x97 + -0.5692 * (x98 + x98);
-        let x109 = s_q2 * x106 + c_q2 * x108;
-        let x110 = c_q2 * x98 + qd[2] * x105;
-        let x111 = qd[2] * x104 - s_q2 * x98;
+        let x108 = Self::mul_add(-0.5692, x98 + x98, x97);
+        let x109 = Self::mul_add(c_q2, x108, s_q2 * x106);
+        let x110 = Self::mul_add(qd[2], x105, c_q2 * x98);
+        let x111 = Self::mul_add(-s_q2, x98, qd[2] * x104);
         let x112 = qd[2] - x96;
         let x113 = x105 * x105;
-        let x114 = x112 * x112 + x113;
+        let x114 = Self::mul_add(x112, x112, x113);
         let x115 = x104 * x112;
         let x116 = x111 + x115;
-        let x117 = x99 + x104 * x105;
-        let x118 = -39234.473 * x104 + 3946.1882 * x112;
-        let x119 = 3946.1882 * x104 + 39241.402 * x112;
-        let x120 = c_q3 * x104 - s_q3 * x105;
-        let x121 = s_q3 * x104 + c_q3 * x105;
-        let x122 = s_q2 * x108 - c_q2 * x106 + (-0.475 * (x115 - x111) - 7.11 * x114);
-        let x123 = 7.11 * x116 - -0.475 * (x113 + x104 * x104) - x107;
-        let x124 = 7.11 * x117 + -0.475 * (x105 * x112 - x110) - x109;
-        let x125 = s_q3 * x122 + c_q3 * x124;
-        let x126 = c_q3 * x110 + s_q3 * x111 + qd[3] * x121;
-        let x127 = c_q3 * x111 - s_q3 * x110 + qd[3] * x120;
+        let x117 = Self::mul_add(x104, x105, x99);
+        let x118 = Self::mul_add(3946.1882, x112, -39234.473 * x104);
+        let x119 = Self::mul_add(39241.402, x112, 3946.1882 * x104);
+        let x120 = Self::mul_add(-s_q3, x105, c_q3 * x104);
+        let x121 = Self::mul_add(c_q3, x105, s_q3 * x104);
+        let x122 = Self::mul_add(-c_q2, x106, s_q2 * x108)
+            + Self::mul_add(-7.11, x114, -0.475 * (x115 - x111));
+        let x123 = Self::mul_add(0.475, Self::mul_add(x104, x104, x113), 7.11 * x116)
+            - x107;
+        let x124 = Self::mul_add(-0.475, Self::mul_add(x105, x112, -x110), 7.11 * x117)
+            - x109;
+        let x125 = Self::mul_add(c_q3, x124, s_q3 * x122);
+        let x126 = Self::mul_add(qd[3], x121, Self::mul_add(s_q3, x111, c_q3 * x110));
+        let x127 = Self::mul_add(qd[3], x120, Self::mul_add(-s_q3, x110, c_q3 * x111));
         let x128 = qd[3] + x112;
-        let x129 = x128 * x128 + x121 * x121;
-        let x130 = x127 + x120 * x128;
-        let x131 = x99 + x120 * x121;
-        let x132 = -24989.307 * x120 + 1375.0472 * x128;
-        let x133 = 1375.0472 * x120 + 24998.828 * x128;
-        let x134 = c_q4 * x120 - s_q4 * x121;
-        let x135 = s_q4 * x120 + c_q4 * x121;
-        let x136 = c_q4 * x126 + s_q4 * x127 + qd[4] * x135;
-        let x137 = c_q4 * x127 - s_q4 * x126 + qd[4] * x134;
+        let x129 = Self::mul_add(x121, x121, x128 * x128);
+        let x130 = Self::mul_add(x120, x128, x127);
+        let x131 = Self::mul_add(x120, x121, x99);
+        let x132 = Self::mul_add(1375.0472, x128, -24989.307 * x120);
+        let x133 = Self::mul_add(24998.828, x128, 1375.0472 * x120);
+        let x134 = Self::mul_add(-s_q4, x121, c_q4 * x120);
+        let x135 = Self::mul_add(c_q4, x121, s_q4 * x120);
+        let x136 = Self::mul_add(qd[4], x135, Self::mul_add(s_q4, x127, c_q4 * x126));
+        let x137 = Self::mul_add(qd[4], x134, Self::mul_add(-s_q4, x126, c_q4 * x127));
         let x138 = qd[4] + x128;
-        let x139 = -171.19551 * (x134 * x135 - x99);
-        let x140 = -171.19551 * (x136 + x135 * x138);
-        let x141 = -171.19551 * (x138 * x138 + x134 * x134);
+        let x139 = -171.19551 * Self::mul_add(x134, x135, -x99);
+        let x140 = -171.19551 * Self::mul_add(x135, x138, x136);
+        let x141 = -171.19551 * Self::mul_add(x134, x134, x138 * x138);
         let x142 = 132.67838 * x134;
-        let x143 = 135.47298 * x138 + -97.44449 * x135;
+        let x143 = Self::mul_add(-97.44449, x135, 135.47298 * x138);
         let x144 = -97.44449 * x138;
-        let x145 = c_q5 * x134 + s_q5 * x138;
-        let x146 = c_q5 * x138 - s_q5 * x134;
+        let x145 = Self::mul_add(s_q5, x138, c_q5 * x134);
+        let x146 = Self::mul_add(-s_q5, x134, c_q5 * x138);
         let x147 = qd[5] + x135;
         let x148 = 44.41 * x146;
         let x149 = 47.471 * x147;
-        let x150 = 9.336 * (qd[5] * x146 - (c_q5 * x136 + s_q5 * x99));
+        let x150 = 9.336
+            * Self::mul_add(qd[5], x146, -Self::mul_add(s_q5, x99, c_q5 * x136));
         let x151 = 9.336 * (qd[6] + x145);
-        let x152 = (c_q6 * x147 - s_q6 * x146) * x151;
-        let x153 = (c_q6 * x146 + s_q6 * x147) * x151;
-        let x154 = x146 * x149 - x147 * x148 + x150;
-        let x155 = 44.41 * (s_q5 * x136 - c_q5 * x99 - qd[5] * x145) - x145 * x149
-            + (c_q6 * x152 + s_q6 * x153);
-        let x156 = 47.471 * x137 + x145 * x148 + (s_q6 * x152 - c_q6 * x153);
-        let x157 = x138 * x144 - x135 * x143 - 132.67838 * x136
-            + 171.19551 * (x123 + 7.11 * x130) + (c_q5 * x154 - s_q5 * x155);
-        let x158 = -97.44449 * x137 - 135.47298 * x99 + (x135 * x142 - x134 * x144)
-            + -171.19551
-                * (c_q4 * (c_q3 * x122 - s_q3 * x124 - 7.11 * x129)
-                    - s_q4 * (x125 + 7.11 * x131)) + (s_q5 * x154 + c_q5 * x155);
-        let x159 = x134 * x143 - x138 * x142 - -97.44449 * x99 + x156;
-        let x160 = s_q4 * x139 + c_q4 * x141;
-        let x161 = c_q4 * x139 - s_q4 * x141 - 3239.4583 * x129;
-        let x162 = 3239.4583 * x130 + x140;
-        let x163 = 3239.4583 * x131 - x160;
-        let x164 = c_q4 * x157 + s_q4 * x159
-            - (-24989.307 * x126 + 1375.0472 * x99 + x121 * x133);
-        let x165 = x121 * x132 - (1375.0472 * x126 + 24998.828 * x99) + x125 * -3239.4583
-            + (x158 - -7.11 * x160);
-        let x166 = x120 * x133 - x128 * x132 + 3239.4583 * x123
-            + (c_q4 * x159 - s_q4 * x157 + 7.11 * x140);
-        let x167 = c_q3 * x161 + s_q3 * x163;
-        let x168 = c_q3 * x163 - s_q3 * x161;
-        let x169 = x167 - 5224.5703 * x114;
-        let x170 = 5224.5703 * x117 + x168;
-        let x171 = c_q3 * x164 + s_q3 * x166 + -0.475 * x168
-            - (-39234.473 * x110 + 3946.1882 * x99 + x105 * x119);
-        let x172 = x105 * x118 - (3946.1882 * x110 + 39241.402 * x99) - x109 * -5224.5703
-            + (x165 + -7.11 * x168);
-        let x173 = x104 * x119 - x112 * x118 - 5224.5703 * x107
-            + (c_q3 * x166 - s_q3 * x164 + (0.475 * x167 + 7.11 * x162));
-        let x174 = c_q2 * x169 + s_q2 * x170;
-        let x175 = c_q2 * x173 - s_q2 * x171 + 0.5692 * x174 - x95 * x102;
-        let x176 = c_q1
-            * (qd[1] * x102 - x96 * x103 - -1145.5438 * x97
-                + (c_q2 * x171 + s_q2 * x173 + -0.5692 * (c_q2 * x170 - s_q2 * x169)))
-            - s_q1 * (x172 - (-65693.914 * x99 + x95 * x103))
-            + -0.7026
-                * (s_q1 * (x174 - -1145.5438 * x100)
-                    + c_q1 * (5224.5703 * x116 + x162 - -1145.5438 * x101));
+        let x152 = Self::mul_add(-s_q6, x146, c_q6 * x147) * x151;
+        let x153 = Self::mul_add(s_q6, x147, c_q6 * x146) * x151;
+        let x154 = Self::mul_add(-x147, x148, x146 * x149) + x150;
+        let x155 = Self::mul_add(
+            -x145,
+            x149,
+            44.41 * Self::mul_add(-qd[5], x145, Self::mul_add(-c_q5, x99, s_q5 * x136)),
+        ) + Self::mul_add(s_q6, x153, c_q6 * x152);
+        let x156 = Self::mul_add(x145, x148, 47.471 * x137)
+            + Self::mul_add(-c_q6, x153, s_q6 * x152);
+        let x157 = Self::mul_add(
+            171.19551,
+            Self::mul_add(7.11, x130, x123),
+            Self::mul_add(-132.67838, x136, Self::mul_add(-x135, x143, x138 * x144)),
+        ) + Self::mul_add(-s_q5, x155, c_q5 * x154);
+        let x158 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(7.11, x131, x125),
+                c_q4
+                    * Self::mul_add(-7.11, x129, Self::mul_add(-s_q3, x124, c_q3 * x122)),
+            ),
+            Self::mul_add(-135.47298, x99, -97.44449 * x137)
+                + Self::mul_add(-x134, x144, x135 * x142),
+        ) + Self::mul_add(c_q5, x155, s_q5 * x154);
+        let x159 = Self::mul_add(97.44449, x99, Self::mul_add(-x138, x142, x134 * x143))
+            + x156;
+        let x160 = Self::mul_add(c_q4, x141, s_q4 * x139);
+        let x161 = Self::mul_add(
+            -3239.4583,
+            x129,
+            Self::mul_add(-s_q4, x141, c_q4 * x139),
+        );
+        let x162 = Self::mul_add(3239.4583, x130, x140);
+        let x163 = Self::mul_add(3239.4583, x131, -x160);
+        let x164 = Self::mul_add(s_q4, x159, c_q4 * x157)
+            - Self::mul_add(
+                x121,
+                x133,
+                Self::mul_add(1375.0472, x99, -24989.307 * x126),
+            );
+        let x165 = Self::mul_add(
+            x125,
+            -3239.4583,
+            Self::mul_add(x121, x132, -Self::mul_add(24998.828, x99, 1375.0472 * x126)),
+        ) + Self::mul_add(7.11, x160, x158);
+        let x166 = Self::mul_add(
+            3239.4583,
+            x123,
+            Self::mul_add(-x128, x132, x120 * x133),
+        ) + Self::mul_add(7.11, x140, Self::mul_add(-s_q4, x157, c_q4 * x159));
+        let x167 = Self::mul_add(s_q3, x163, c_q3 * x161);
+        let x168 = Self::mul_add(-s_q3, x161, c_q3 * x163);
+        let x169 = Self::mul_add(-5224.5703, x114, x167);
+        let x170 = Self::mul_add(5224.5703, x117, x168);
+        let x171 = Self::mul_add(-0.475, x168, Self::mul_add(s_q3, x166, c_q3 * x164))
+            - Self::mul_add(
+                x105,
+                x119,
+                Self::mul_add(3946.1882, x99, -39234.473 * x110),
+            );
+        let x172 = Self::mul_add(
+            x109,
+            5224.5703,
+            Self::mul_add(x105, x118, -Self::mul_add(39241.402, x99, 3946.1882 * x110)),
+        ) + Self::mul_add(-7.11, x168, x165);
+        let x173 = Self::mul_add(
+            -5224.5703,
+            x107,
+            Self::mul_add(-x112, x118, x104 * x119),
+        )
+            + (Self::mul_add(-s_q3, x164, c_q3 * x166)
+                + Self::mul_add(7.11, x162, 0.475 * x167));
+        let x174 = Self::mul_add(s_q2, x170, c_q2 * x169);
+        let x175 = Self::mul_add(
+            -x95,
+            x102,
+            Self::mul_add(0.5692, x174, Self::mul_add(-s_q2, x171, c_q2 * x173)),
+        );
+        let x176 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(
+                c_q1,
+                Self::mul_add(1145.5438, x101, Self::mul_add(5224.5703, x116, x162)),
+                s_q1 * Self::mul_add(1145.5438, x100, x174),
+            ),
+            Self::mul_add(
+                -s_q1,
+                x172 - Self::mul_add(x95, x103, -65693.914 * x99),
+                c_q1
+                    * (Self::mul_add(
+                        1145.5438,
+                        x97,
+                        Self::mul_add(-x96, x103, qd[1] * x102),
+                    )
+                        + Self::mul_add(
+                            -0.5692,
+                            Self::mul_add(-s_q2, x169, c_q2 * x170),
+                            Self::mul_add(s_q2, x173, c_q2 * x171),
+                        )),
+            ),
+        );
         (
             [
                 [x71, x72, x73, x76, x84, x88, x94],
@@ -1288,7 +1830,7 @@ impl SsrmsF32 {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 515 mul, 403 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 515 mul, 403 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 316 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f32; 7],
@@ -1306,207 +1848,335 @@ impl SsrmsF32 {
         let x7 = 44.41 * s_q5;
         let x8 = 9.336 * s_q5;
         let x9 = 44.41 * c_q5;
-        let x10 = s_q5 * x6 - c_q5 * x7;
-        let x11 = c_q5 * x8 - s_q5 * x9;
-        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
-        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
+        let x10 = Self::mul_add(-c_q5, x7, s_q5 * x6);
+        let x11 = Self::mul_add(-s_q5, x9, c_q5 * x8);
+        let x12 = 132.67838 + Self::mul_add(s_q5, x7, c_q5 * x6);
+        let x13 = 135.47298 + Self::mul_add(c_q5, x9, s_q5 * x8);
         let x14 = -171.19551 * s_q4;
         let x15 = -171.19551 * c_q4;
         let x16 = c_q4 * x12;
         let x17 = -97.44449 * s_q4;
-        let x18 = c_q4 * x10 + x17;
+        let x18 = Self::mul_add(c_q4, x10, x17);
         let x19 = 47.471 * s_q4;
         let x20 = s_q4 * x12;
         let x21 = -97.44449 * c_q4;
-        let x22 = x21 - s_q4 * x10;
+        let x22 = Self::mul_add(-s_q4, x10, x21);
         let x23 = 47.471 * c_q4;
-        let x24 = x21 - s_q4 * x11;
+        let x24 = Self::mul_add(-s_q4, x11, x21);
         let x25 = x14 * -7.11;
         let x26 = 7.11 * x14;
         let x27 = x13 - x25;
-        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
-        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
-        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
+        let x28 = Self::mul_add(-7.11, x15, Self::mul_add(-c_q4, x20, s_q4 * x23));
+        let x29 = Self::mul_add(x15, -7.11, Self::mul_add(-s_q4, x16, c_q4 * x19));
+        let x30 = Self::mul_add(c_q4, x23, s_q4 * x20) + x26 - x25;
         let x31 = 3239.4583 + x14;
-        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
+        let x32 = -24989.307 + Self::mul_add(s_q4, x19, c_q4 * x16);
         let x33 = 1375.0472 + x18;
-        let x34 = 1375.0472 + (x17 + c_q4 * x11);
+        let x34 = 1375.0472 + Self::mul_add(c_q4, x11, x17);
         let x35 = 24998.828 + (x26 + x27);
         let x36 = s_q3 * x15;
-        let x37 = c_q3 * x31 + x36;
+        let x37 = Self::mul_add(c_q3, x31, x36);
         let x38 = c_q3 * x15;
-        let x39 = x38 - s_q3 * x31;
-        let x40 = c_q3 * x32 + s_q3 * x28;
+        let x39 = Self::mul_add(-s_q3, x31, x38);
+        let x40 = Self::mul_add(s_q3, x28, c_q3 * x32);
         let x41 = s_q3 * x22;
-        let x42 = c_q3 * x29 + s_q3 * x30;
-        let x43 = c_q3 * x28 - s_q3 * x32;
+        let x42 = Self::mul_add(s_q3, x30, c_q3 * x29);
+        let x43 = Self::mul_add(-s_q3, x32, c_q3 * x28);
         let x44 = c_q3 * x22;
-        let x45 = c_q3 * x30 - s_q3 * x29;
+        let x45 = Self::mul_add(-s_q3, x29, c_q3 * x30);
         let x46 = -7.11 * x37;
         let x47 = 7.11 * x37;
-        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
+        let x48 = Self::mul_add(0.475, x37, Self::mul_add(c_q3, x33, x41));
         let x49 = x35 - x46;
-        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
-        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
-        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
-        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
-        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
+        let x50 = Self::mul_add(-7.11, x39, Self::mul_add(s_q3, x45, c_q3 * x43));
+        let x51 = Self::mul_add(x39, 0.475, Self::mul_add(-s_q3, x33, x44));
+        let x52 = Self::mul_add(-7.11, x39, Self::mul_add(-s_q3, x40, c_q3 * x42));
+        let x53 = Self::mul_add(0.475, x39, Self::mul_add(-s_q3, x34, c_q3 * x24));
+        let x54 = Self::mul_add(-s_q3, x43, c_q3 * x45) + x47 - x46;
         let x55 = 5224.5703 + x37;
-        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
+        let x56 = -39234.473 + Self::mul_add(s_q3, x42, c_q3 * x40);
         let x57 = 3946.1882 + x48;
-        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
+        let x58 = 3946.1882
+            + Self::mul_add(x37, 0.475, Self::mul_add(s_q3, x24, c_q3 * x34));
         let x59 = 39241.402 + (x47 + x49);
         let x60 = s_q2 * x39;
-        let x61 = c_q2 * x55 + x60;
+        let x61 = Self::mul_add(c_q2, x55, x60);
         let x62 = c_q2 * x39;
-        let x63 = x62 - s_q2 * x55;
-        let x64 = c_q2 * x56 + s_q2 * x50;
+        let x63 = Self::mul_add(-s_q2, x55, x62);
+        let x64 = Self::mul_add(s_q2, x50, c_q2 * x56);
         let x65 = s_q2 * x51;
-        let x66 = c_q2 * x52 + s_q2 * x54;
+        let x66 = Self::mul_add(s_q2, x54, c_q2 * x52);
         let x67 = c_q2 * x51;
-        let x68 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
-        let x69 = c_q1 * (c_q2 * x66 - s_q2 * x64)
-            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
-            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
-        let x70 = x68 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
-        let x71 = x62 - s_q2 * x37;
-        let x72 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
-            + -0.7026 * (s_q1 * x71);
-        let x73 = x38 - s_q3 * x14;
-        let x74 = x36 + c_q3 * x14;
-        let x75 = x41 + c_q3 * x18 - -0.475 * x74;
-        let x76 = x27 - -7.11 * x74;
-        let x77 = x44 - s_q3 * x18 + 0.475 * x73;
-        let x78 = c_q2 * x73 - s_q2 * x74;
-        let x79 = c_q1 * (c_q2 * x75 + s_q2 * x77 - -0.5692 * (s_q2 * x73 + c_q2 * x74))
-            - s_q1 * x76 + -0.7026 * (s_q1 * x78);
-        let x80 = c_q3 * x19 + s_q3 * x23;
-        let x81 = c_q3 * x23 - s_q3 * x19;
-        let x82 = c_q1 * (c_q2 * x80 + s_q2 * x81);
+        let x68 = c_q1 * Self::mul_add(0.5692, x61, Self::mul_add(c_q2, x57, x65));
+        let x69 = Self::mul_add(
+            -0.7026,
+            Self::mul_add(s_q1, 1145.5438, c_q1 * x61),
+            Self::mul_add(
+                -s_q1,
+                Self::mul_add(0.5692, x63, Self::mul_add(-s_q2, x58, c_q2 * x53)),
+                c_q1 * Self::mul_add(-s_q2, x64, c_q2 * x66),
+            ),
+        );
+        let x70 = Self::mul_add(-0.7026, s_q1 * x63, Self::mul_add(-s_q1, x59, x68));
+        let x71 = Self::mul_add(-s_q2, x37, x62);
+        let x72 = Self::mul_add(
+            -0.7026,
+            s_q1 * x71,
+            Self::mul_add(
+                -s_q1,
+                x49,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x37, x60),
+                        Self::mul_add(c_q2, x48, x65),
+                    ),
+            ),
+        );
+        let x73 = Self::mul_add(-s_q3, x14, x38);
+        let x74 = Self::mul_add(c_q3, x14, x36);
+        let x75 = Self::mul_add(0.475, x74, Self::mul_add(c_q3, x18, x41));
+        let x76 = Self::mul_add(7.11, x74, x27);
+        let x77 = Self::mul_add(0.475, x73, Self::mul_add(-s_q3, x18, x44));
+        let x78 = Self::mul_add(-s_q2, x74, c_q2 * x73);
+        let x79 = Self::mul_add(
+            -0.7026,
+            s_q1 * x78,
+            Self::mul_add(
+                -s_q1,
+                x76,
+                c_q1
+                    * Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x74, s_q2 * x73),
+                        Self::mul_add(s_q2, x77, c_q2 * x75),
+                    ),
+            ),
+        );
+        let x80 = Self::mul_add(s_q3, x23, c_q3 * x19);
+        let x81 = Self::mul_add(-s_q3, x19, c_q3 * x23);
+        let x82 = c_q1 * Self::mul_add(s_q2, x81, c_q2 * x80);
         let x83 = c_q4 * x6;
         let x84 = s_q4 * x6;
-        let x85 = c_q3 * x83 - s_q3 * x84;
-        let x86 = s_q3 * x83 + c_q3 * x84;
-        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
+        let x85 = Self::mul_add(-s_q3, x84, c_q3 * x83);
+        let x86 = Self::mul_add(c_q3, x84, s_q3 * x83);
+        let x87 = Self::mul_add(-s_q1, x8, c_q1 * Self::mul_add(-s_q2, x86, c_q2 * x85));
         let x88 = qd[0] * c_q1;
         let x89 = qd[0] * s_q1;
         let x90 = 0.7026 * (qd[0] * qd[0]);
         let x91 = qd[1] * x89;
         let x92 = qd[1] * x88;
         let x93 = x88 * x89;
-        let x94 = qd[1] * qd[1] + x88 * x88;
+        let x94 = Self::mul_add(x88, x88, qd[1] * qd[1]);
         let x95 = -65693.914 * x89;
         let x96 = 65697.33 * qd[1];
-        let x97 = c_q2 * x88 - qd[1] * s_q2;
-        let x98 = s_q2 * x88 + qd[1] * c_q2;
+        let x97 = Self::mul_add(-qd[1], s_q2, c_q2 * x88);
+        let x98 = Self::mul_add(qd[1], c_q2, s_q2 * x88);
         let x99 = -0.5692 * x93;
         let x100 = -0.5692 * x94;
-        let x101 = x90 + -0.5692 * (x91 + x91);
-        let x102 = s_q2 * x99 + c_q2 * x101;
-        let x103 = c_q2 * x91 + qd[2] * x98;
-        let x104 = qd[2] * x97 - s_q2 * x91;
+        let x101 = Self::mul_add(-0.5692, x91 + x91, x90);
+        let x102 = Self::mul_add(c_q2, x101, s_q2 * x99);
+        let x103 = Self::mul_add(qd[2], x98, c_q2 * x91);
+        let x104 = Self::mul_add(-s_q2, x91, qd[2] * x97);
         let x105 = qd[2] - x89;
         let x106 = x98 * x98;
-        let x107 = x105 * x105 + x106;
+        let x107 = Self::mul_add(x105, x105, x106);
         let x108 = x97 * x105;
         let x109 = x104 + x108;
-        let x110 = x92 + x97 * x98;
-        let x111 = -39234.473 * x97 + 3946.1882 * x105;
-        let x112 = 3946.1882 * x97 + 39241.402 * x105;
-        let x113 = c_q3 * x97 - s_q3 * x98;
-        let x114 = s_q3 * x97 + c_q3 * x98;
-        let x115 = s_q2 * x101 - c_q2 * x99 + (-0.475 * (x108 - x104) - 7.11 * x107);
-        let x116 = 7.11 * x109 - -0.475 * (x106 + x97 * x97) - x100;
-        let x117 = 7.11 * x110 + -0.475 * (x98 * x105 - x103) - x102;
-        let x118 = s_q3 * x115 + c_q3 * x117;
-        let x119 = c_q3 * x103 + s_q3 * x104 + qd[3] * x114;
-        let x120 = c_q3 * x104 - s_q3 * x103 + qd[3] * x113;
+        let x110 = Self::mul_add(x97, x98, x92);
+        let x111 = Self::mul_add(3946.1882, x105, -39234.473 * x97);
+        let x112 = Self::mul_add(39241.402, x105, 3946.1882 * x97);
+        let x113 = Self::mul_add(-s_q3, x98, c_q3 * x97);
+        let x114 = Self::mul_add(c_q3, x98, s_q3 * x97);
+        let x115 = Self::mul_add(-c_q2, x99, s_q2 * x101)
+            + Self::mul_add(-7.11, x107, -0.475 * (x108 - x104));
+        let x116 = Self::mul_add(0.475, Self::mul_add(x97, x97, x106), 7.11 * x109)
+            - x100;
+        let x117 = Self::mul_add(-0.475, Self::mul_add(x98, x105, -x103), 7.11 * x110)
+            - x102;
+        let x118 = Self::mul_add(c_q3, x117, s_q3 * x115);
+        let x119 = Self::mul_add(qd[3], x114, Self::mul_add(s_q3, x104, c_q3 * x103));
+        let x120 = Self::mul_add(qd[3], x113, Self::mul_add(-s_q3, x103, c_q3 * x104));
         let x121 = qd[3] + x105;
-        let x122 = x121 * x121 + x114 * x114;
-        let x123 = x120 + x113 * x121;
-        let x124 = x92 + x113 * x114;
-        let x125 = -24989.307 * x113 + 1375.0472 * x121;
-        let x126 = 1375.0472 * x113 + 24998.828 * x121;
-        let x127 = c_q4 * x113 - s_q4 * x114;
-        let x128 = s_q4 * x113 + c_q4 * x114;
-        let x129 = c_q4 * x119 + s_q4 * x120 + qd[4] * x128;
-        let x130 = c_q4 * x120 - s_q4 * x119 + qd[4] * x127;
+        let x122 = Self::mul_add(x114, x114, x121 * x121);
+        let x123 = Self::mul_add(x113, x121, x120);
+        let x124 = Self::mul_add(x113, x114, x92);
+        let x125 = Self::mul_add(1375.0472, x121, -24989.307 * x113);
+        let x126 = Self::mul_add(24998.828, x121, 1375.0472 * x113);
+        let x127 = Self::mul_add(-s_q4, x114, c_q4 * x113);
+        let x128 = Self::mul_add(c_q4, x114, s_q4 * x113);
+        let x129 = Self::mul_add(qd[4], x128, Self::mul_add(s_q4, x120, c_q4 * x119));
+        let x130 = Self::mul_add(qd[4], x127, Self::mul_add(-s_q4, x119, c_q4 * x120));
         let x131 = qd[4] + x121;
         let x132 = 132.67838 * x127;
-        let x133 = 135.47298 * x131 + -97.44449 * x128;
+        let x133 = Self::mul_add(-97.44449, x128, 135.47298 * x131);
         let x134 = -97.44449 * x131;
-        let x135 = c_q5 * x127 + s_q5 * x131;
-        let x136 = c_q5 * x131 - s_q5 * x127;
+        let x135 = Self::mul_add(s_q5, x131, c_q5 * x127);
+        let x136 = Self::mul_add(-s_q5, x127, c_q5 * x131);
         let x137 = qd[5] + x128;
         let x138 = 44.41 * x136;
         let x139 = 47.471 * x137;
         let x140 = 9.336 * (qd[6] + x135);
-        let x141 = 9.336 * (qd[5] * x136 - (c_q5 * x129 + s_q5 * x92)) - f_ext[6][3];
-        let x142 = (c_q6 * x137 - s_q6 * x136) * x140 - f_ext[6][4];
-        let x143 = f_ext[6][5] + (c_q6 * x136 + s_q6 * x137) * x140;
-        let x144 = f_ext[6][2] * s_q6 - f_ext[6][1] * c_q6;
+        let x141 = Self::mul_add(
+            9.336,
+            Self::mul_add(qd[5], x136, -Self::mul_add(s_q5, x92, c_q5 * x129)),
+            -f_ext[6][3],
+        );
+        let x142 = Self::mul_add(
+            Self::mul_add(-s_q6, x136, c_q6 * x137),
+            x140,
+            -f_ext[6][4],
+        );
+        let x143 = Self::mul_add(
+            Self::mul_add(s_q6, x137, c_q6 * x136),
+            x140,
+            f_ext[6][5],
+        );
+        let x144 = Self::mul_add(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
         let x145 = f_ext[5][0] + f_ext[6][0];
         let x146 = x144 - f_ext[5][1];
-        let x147 = f_ext[5][2] + (f_ext[6][1] * s_q6 + f_ext[6][2] * c_q6);
-        let x148 = x136 * x139 - x137 * x138 - f_ext[5][3] + (x141 + 0.7026 * x144);
-        let x149 = 44.41 * (s_q5 * x129 - c_q5 * x92 - qd[5] * x135) - x135 * x139
-            - f_ext[5][4] + (c_q6 * x142 + s_q6 * x143 - -0.7026 * f_ext[6][0]);
-        let x150 = 47.471 * x130 + x135 * x138 - f_ext[5][5]
-            + (s_q6 * x142 - c_q6 * x143);
-        let x151 = c_q5 * x145 + s_q5 * x146;
-        let x152 = -171.19551 * (x127 * x128 - x92) - f_ext[4][0] - x151;
-        let x153 = -171.19551 * (x129 + x128 * x131) - f_ext[4][1]
-            + (c_q5 * x146 - s_q5 * x145);
-        let x154 = f_ext[4][2] + -171.19551 * (x131 * x131 + x127 * x127) + x147;
-        let x155 = x131 * x134 - x128 * x133 - 132.67838 * x129
-            + 171.19551 * (x116 + 7.11 * x123) - f_ext[4][3]
-            + (c_q5 * x148 - s_q5 * x149 - -0.5692 * x147);
-        let x156 = -97.44449 * x130 - 135.47298 * x92 + (x128 * x132 - x127 * x134)
-            + -171.19551
-                * (c_q4 * (c_q3 * x115 - s_q3 * x117 - 7.11 * x122)
-                    - s_q4 * (x118 + 7.11 * x124)) - f_ext[4][4]
-            + (s_q5 * x148 + c_q5 * x149);
-        let x157 = x127 * x133 - x131 * x132 - -97.44449 * x92 - f_ext[4][5]
-            + (x150 - 0.5692 * x151);
-        let x158 = s_q4 * x152 + c_q4 * x154;
-        let x159 = c_q4 * x152 - s_q4 * x154 - (f_ext[3][0] + 3239.4583 * x122);
-        let x160 = 3239.4583 * x123 - f_ext[3][1] + x153;
-        let x161 = 3239.4583 * x124 - f_ext[3][2] - x158;
-        let x162 = c_q4 * x155 + s_q4 * x157
-            - (f_ext[3][3] + (-24989.307 * x119 + 1375.0472 * x92 + x114 * x126));
-        let x163 = x114 * x125 - (1375.0472 * x119 + 24998.828 * x92) + x118 * -3239.4583
-            - f_ext[3][4] + (x156 - -7.11 * x158);
-        let x164 = x113 * x126 - x121 * x125 + 3239.4583 * x116 - f_ext[3][5]
-            + (c_q4 * x157 - s_q4 * x155 + 7.11 * x153);
-        let x165 = c_q3 * x159 + s_q3 * x161;
-        let x166 = c_q3 * x161 - s_q3 * x159;
-        let x167 = x165 - (f_ext[2][0] + 5224.5703 * x107);
-        let x168 = 5224.5703 * x110 - f_ext[2][2] + x166;
-        let x169 = c_q3 * x162 + s_q3 * x164 + -0.475 * x166
-            - (f_ext[2][3] + (-39234.473 * x103 + 3946.1882 * x92 + x98 * x112));
-        let x170 = x98 * x111 - (3946.1882 * x103 + 39241.402 * x92) - x102 * -5224.5703
-            - f_ext[2][4] + (x163 + -7.11 * x166);
-        let x171 = x97 * x112 - x105 * x111 - 5224.5703 * x100 - f_ext[2][5]
-            + (c_q3 * x164 - s_q3 * x162 + (0.475 * x165 + 7.11 * x160));
-        let x172 = c_q2 * x167 + s_q2 * x168;
+        let x147 = f_ext[5][2] + Self::mul_add(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
+        let x148 = Self::mul_add(-x137, x138, x136 * x139) - f_ext[5][3]
+            + Self::mul_add(0.7026, x144, x141);
+        let x149 = Self::mul_add(
+            -x135,
+            x139,
+            44.41 * Self::mul_add(-qd[5], x135, Self::mul_add(-c_q5, x92, s_q5 * x129)),
+        ) - f_ext[5][4]
+            + Self::mul_add(0.7026, f_ext[6][0], Self::mul_add(s_q6, x143, c_q6 * x142));
+        let x150 = Self::mul_add(x135, x138, 47.471 * x130) - f_ext[5][5]
+            + Self::mul_add(-c_q6, x143, s_q6 * x142);
+        let x151 = Self::mul_add(s_q5, x146, c_q5 * x145);
+        let x152 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(x127, x128, -x92),
+            -f_ext[4][0],
+        ) - x151;
+        let x153 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(x128, x131, x129),
+            -f_ext[4][1],
+        ) + Self::mul_add(-s_q5, x145, c_q5 * x146);
+        let x154 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(x127, x127, x131 * x131),
+            f_ext[4][2],
+        ) + x147;
+        let x155 = Self::mul_add(
+            171.19551,
+            Self::mul_add(7.11, x123, x116),
+            Self::mul_add(-132.67838, x129, Self::mul_add(-x128, x133, x131 * x134)),
+        ) - f_ext[4][3]
+            + Self::mul_add(0.5692, x147, Self::mul_add(-s_q5, x149, c_q5 * x148));
+        let x156 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(
+                -s_q4,
+                Self::mul_add(7.11, x124, x118),
+                c_q4
+                    * Self::mul_add(-7.11, x122, Self::mul_add(-s_q3, x117, c_q3 * x115)),
+            ),
+            Self::mul_add(-135.47298, x92, -97.44449 * x130)
+                + Self::mul_add(-x127, x134, x128 * x132),
+        ) - f_ext[4][4] + Self::mul_add(c_q5, x149, s_q5 * x148);
+        let x157 = Self::mul_add(97.44449, x92, Self::mul_add(-x131, x132, x127 * x133))
+            - f_ext[4][5] + Self::mul_add(-0.5692, x151, x150);
+        let x158 = Self::mul_add(c_q4, x154, s_q4 * x152);
+        let x159 = Self::mul_add(-s_q4, x154, c_q4 * x152)
+            - Self::mul_add(3239.4583, x122, f_ext[3][0]);
+        let x160 = Self::mul_add(3239.4583, x123, -f_ext[3][1]) + x153;
+        let x161 = Self::mul_add(3239.4583, x124, -f_ext[3][2]) - x158;
+        let x162 = Self::mul_add(s_q4, x157, c_q4 * x155)
+            - (f_ext[3][3]
+                + Self::mul_add(
+                    x114,
+                    x126,
+                    Self::mul_add(1375.0472, x92, -24989.307 * x119),
+                ));
+        let x163 = Self::mul_add(
+            x118,
+            -3239.4583,
+            Self::mul_add(x114, x125, -Self::mul_add(24998.828, x92, 1375.0472 * x119)),
+        ) - f_ext[3][4] + Self::mul_add(7.11, x158, x156);
+        let x164 = Self::mul_add(
+            3239.4583,
+            x116,
+            Self::mul_add(-x121, x125, x113 * x126),
+        ) - f_ext[3][5]
+            + Self::mul_add(7.11, x153, Self::mul_add(-s_q4, x155, c_q4 * x157));
+        let x165 = Self::mul_add(s_q3, x161, c_q3 * x159);
+        let x166 = Self::mul_add(-s_q3, x159, c_q3 * x161);
+        let x167 = x165 - Self::mul_add(5224.5703, x107, f_ext[2][0]);
+        let x168 = Self::mul_add(5224.5703, x110, -f_ext[2][2]) + x166;
+        let x169 = Self::mul_add(-0.475, x166, Self::mul_add(s_q3, x164, c_q3 * x162))
+            - (f_ext[2][3]
+                + Self::mul_add(
+                    x98,
+                    x112,
+                    Self::mul_add(3946.1882, x92, -39234.473 * x103),
+                ));
+        let x170 = Self::mul_add(
+            x102,
+            5224.5703,
+            Self::mul_add(x98, x111, -Self::mul_add(39241.402, x92, 3946.1882 * x103)),
+        ) - f_ext[2][4] + Self::mul_add(-7.11, x166, x163);
+        let x171 = Self::mul_add(
+            -5224.5703,
+            x100,
+            Self::mul_add(-x105, x111, x97 * x112),
+        ) - f_ext[2][5]
+            + (Self::mul_add(-s_q3, x162, c_q3 * x164)
+                + Self::mul_add(7.11, x160, 0.475 * x165));
+        let x172 = Self::mul_add(s_q2, x168, c_q2 * x167);
         let x173 = tau[0]
-            - (c_q1
-                * (qd[1] * x95 - x89 * x96 - -1145.5438 * x90 - f_ext[1][3]
-                    + (c_q2 * x169 + s_q2 * x171
-                        + -0.5692 * (c_q2 * x168 - s_q2 * x167)))
-                - s_q1 * (x170 - (f_ext[1][4] + (-65693.914 * x92 + x88 * x96)))
-                + -0.7026
-                    * (s_q1 * (x172 - (f_ext[1][0] + -1145.5438 * x93))
-                        + c_q1
-                            * (5224.5703 * x109 - f_ext[2][1] + x160
-                                - (f_ext[1][1] + -1145.5438 * x94))) - f_ext[0][3]);
+            - (Self::mul_add(
+                -0.7026,
+                Self::mul_add(
+                    c_q1,
+                    Self::mul_add(5224.5703, x109, -f_ext[2][1]) + x160
+                        - Self::mul_add(-1145.5438, x94, f_ext[1][1]),
+                    s_q1 * (x172 - Self::mul_add(-1145.5438, x93, f_ext[1][0])),
+                ),
+                Self::mul_add(
+                    -s_q1,
+                    x170 - (f_ext[1][4] + Self::mul_add(x88, x96, -65693.914 * x92)),
+                    c_q1
+                        * (Self::mul_add(
+                            1145.5438,
+                            x90,
+                            Self::mul_add(-x89, x96, qd[1] * x95),
+                        ) - f_ext[1][3]
+                            + Self::mul_add(
+                                -0.5692,
+                                Self::mul_add(-s_q2, x167, c_q2 * x168),
+                                Self::mul_add(s_q2, x171, c_q2 * x169),
+                            )),
+                ),
+            ) - f_ext[0][3]);
         let x174 = 1.0
             / (66279.66
-                + (0.7026 * x63
-                    + (c_q1
-                        * (c_q1 * (c_q2 * x64 + s_q2 * x66)
-                            - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
-                        - s_q1 * (x68 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63)));
+                + Self::mul_add(
+                    0.7026,
+                    x63,
+                    Self::mul_add(
+                        0.7026,
+                        x63,
+                        Self::mul_add(
+                            -s_q1,
+                            Self::mul_add(-s_q1, -65693.914 + x59, x68),
+                            c_q1
+                                * Self::mul_add(
+                                    -s_q1,
+                                    Self::mul_add(
+                                        0.5692,
+                                        x61,
+                                        Self::mul_add(s_q2, x53, c_q2 * x58),
+                                    ),
+                                    c_q1 * Self::mul_add(s_q2, x66, c_q2 * x64),
+                                ),
+                        ),
+                    ),
+                ));
         let x175 = x69 * x174;
         let x176 = x70 * x174;
         let x177 = x72 * x174;
@@ -1514,67 +2184,270 @@ impl SsrmsF32 {
         let x179 = x82 * x174;
         let x180 = x87 * x174;
         let x181 = 1.0
-            / (65697.33
-                + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
-                - x69 * x175);
-        let x182 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x176;
+            / Self::mul_add(
+                -x69,
+                x175,
+                65697.33
+                    + Self::mul_add(
+                        -s_q2,
+                        Self::mul_add(-s_q2, x56, c_q2 * x50),
+                        c_q2 * Self::mul_add(-s_q2, x52, c_q2 * x54),
+                    ),
+            );
+        let x182 = Self::mul_add(
+            -x69,
+            x176,
+            Self::mul_add(0.5692, x63, Self::mul_add(-s_q2, x57, x67)),
+        );
         let x183 = x181 * x182;
-        let x184 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x177;
+        let x184 = Self::mul_add(
+            -x69,
+            x177,
+            Self::mul_add(0.5692, x71, Self::mul_add(-s_q2, x48, x67)),
+        );
         let x185 = x181 * x184;
-        let x186 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x178;
+        let x186 = Self::mul_add(
+            -x69,
+            x178,
+            Self::mul_add(0.5692, x78, Self::mul_add(-s_q2, x75, c_q2 * x77)),
+        );
         let x187 = x181 * x186;
-        let x188 = c_q2 * x81 - s_q2 * x80 - x69 * x179;
+        let x188 = Self::mul_add(-x69, x179, Self::mul_add(-s_q2, x80, c_q2 * x81));
         let x189 = x181 * x188;
-        let x190 = s_q2 * x85 + c_q2 * x86 + x69 * x180;
+        let x190 = Self::mul_add(x69, x180, Self::mul_add(c_q2, x86, s_q2 * x85));
         let x191 = x181 * x190;
-        let x192 = 1.0 / (x59 - x70 * x176 - x182 * x183);
-        let x193 = x49 - x70 * x177 - x182 * x185;
+        let x192 = 1.0 / Self::mul_add(-x182, x183, Self::mul_add(-x70, x176, x59));
+        let x193 = Self::mul_add(-x182, x185, Self::mul_add(-x70, x177, x49));
         let x194 = x192 * x193;
-        let x195 = x76 - x70 * x178 - x182 * x187;
+        let x195 = Self::mul_add(-x182, x187, Self::mul_add(-x70, x178, x76));
         let x196 = x192 * x195;
-        let x197 = x70 * x179 + x182 * x189;
+        let x197 = Self::mul_add(x182, x189, x70 * x179);
         let x198 = x192 * x197;
-        let x199 = x8 - x70 * x180 + x182 * x191;
+        let x199 = Self::mul_add(x182, x191, Self::mul_add(-x70, x180, x8));
         let x200 = x192 * x199;
-        let x201 = 1.0 / (x35 - x72 * x177 - x184 * x185 - x193 * x194);
-        let x202 = x27 - x72 * x178 - x184 * x187 - x193 * x196;
+        let x201 = 1.0
+            / Self::mul_add(
+                -x193,
+                x194,
+                Self::mul_add(-x184, x185, Self::mul_add(-x72, x177, x35)),
+            );
+        let x202 = Self::mul_add(
+            -x193,
+            x196,
+            Self::mul_add(-x184, x187, Self::mul_add(-x72, x178, x27)),
+        );
         let x203 = x201 * x202;
-        let x204 = x193 * x198 - (x72 * x179 + x184 * x189);
+        let x204 = Self::mul_add(x193, x198, -Self::mul_add(x184, x189, x72 * x179));
         let x205 = x201 * x204;
-        let x206 = x8 - x72 * x180 + x184 * x191 - x193 * x200;
+        let x206 = Self::mul_add(
+            -x193,
+            x200,
+            Self::mul_add(x184, x191, Self::mul_add(-x72, x180, x8)),
+        );
         let x207 = x201 * x206;
-        let x208 = 1.0 / (x13 - x79 * x178 - x186 * x187 - x195 * x196 - x202 * x203);
-        let x209 = x195 * x198 - (x79 * x179 + x186 * x189) - x202 * x205;
+        let x208 = 1.0
+            / Self::mul_add(
+                -x202,
+                x203,
+                Self::mul_add(
+                    -x195,
+                    x196,
+                    Self::mul_add(-x186, x187, Self::mul_add(-x79, x178, x13)),
+                ),
+            );
+        let x209 = Self::mul_add(
+            -x202,
+            x205,
+            Self::mul_add(x195, x198, -Self::mul_add(x186, x189, x79 * x179)),
+        );
         let x210 = x208 * x209;
-        let x211 = x8 - x79 * x180 + x186 * x191 - x195 * x200 - x202 * x207;
+        let x211 = Self::mul_add(
+            -x202,
+            x207,
+            Self::mul_add(
+                -x195,
+                x200,
+                Self::mul_add(x186, x191, Self::mul_add(-x79, x180, x8)),
+            ),
+        );
         let x212 = x208 * x211;
         let x213 = 1.0
-            / (47.471 - x82 * x179 - x188 * x189 - x197 * x198 - x204 * x205
-                - x209 * x210);
-        let x214 = x188 * x191 - x82 * x180 + x197 * x200 - x204 * x207 - x209 * x212;
+            / Self::mul_add(
+                -x209,
+                x210,
+                Self::mul_add(
+                    -x204,
+                    x205,
+                    Self::mul_add(
+                        -x197,
+                        x198,
+                        Self::mul_add(-x188, x189, Self::mul_add(-x82, x179, 47.471)),
+                    ),
+                ),
+            );
+        let x214 = Self::mul_add(
+            -x209,
+            x212,
+            Self::mul_add(
+                -x204,
+                x207,
+                Self::mul_add(x197, x200, Self::mul_add(-x82, x180, x188 * x191)),
+            ),
+        );
         let x215 = x213 * x214;
         let x216 = 1.0
-            / (9.336 - x87 * x180 - x190 * x191 - x199 * x200 - x206 * x207 - x211 * x212
-                - x214 * x215);
-        let x217 = tau[1]
-            - (c_q2 * x171 - s_q2 * x169 + 0.5692 * x172 - (f_ext[1][5] + x88 * x95))
-            - x173 * x175;
-        let x218 = tau[2] - x170 - x173 * x176 - x183 * x217;
-        let x219 = tau[3] - x163 - x173 * x177 - x185 * x217 - x194 * x218;
-        let x220 = tau[4] - x156 - x173 * x178 - x187 * x217 - x196 * x218 - x203 * x219;
-        let x221 = tau[5] - x150 - x173 * x179 - x189 * x217 + x198 * x218 - x205 * x219
-            - x210 * x220;
+            / Self::mul_add(
+                -x214,
+                x215,
+                Self::mul_add(
+                    -x211,
+                    x212,
+                    Self::mul_add(
+                        -x206,
+                        x207,
+                        Self::mul_add(
+                            -x199,
+                            x200,
+                            Self::mul_add(-x190, x191, Self::mul_add(-x87, x180, 9.336)),
+                        ),
+                    ),
+                ),
+            );
+        let x217 = Self::mul_add(
+            -x173,
+            x175,
+            tau[1]
+                - (Self::mul_add(0.5692, x172, Self::mul_add(-s_q2, x169, c_q2 * x171))
+                    - Self::mul_add(x88, x95, f_ext[1][5])),
+        );
+        let x218 = Self::mul_add(-x183, x217, Self::mul_add(-x173, x176, tau[2] - x170));
+        let x219 = Self::mul_add(
+            -x194,
+            x218,
+            Self::mul_add(-x185, x217, Self::mul_add(-x173, x177, tau[3] - x163)),
+        );
+        let x220 = Self::mul_add(
+            -x203,
+            x219,
+            Self::mul_add(
+                -x196,
+                x218,
+                Self::mul_add(-x187, x217, Self::mul_add(-x173, x178, tau[4] - x156)),
+            ),
+        );
+        let x221 = Self::mul_add(
+            -x210,
+            x220,
+            Self::mul_add(
+                -x205,
+                x219,
+                Self::mul_add(
+                    x198,
+                    x218,
+                    Self::mul_add(-x189, x217, Self::mul_add(-x173, x179, tau[5] - x150)),
+                ),
+            ),
+        );
         let x222 = x216
-            * (tau[6] - x141 - x173 * x180 + x191 * x217 - x200 * x218 - x207 * x219
-                - x212 * x220 - x215 * x221);
-        let x223 = x213 * x221 - x215 * x222;
-        let x224 = x208 * x220 - x210 * x223 - x212 * x222;
-        let x225 = x201 * x219 - x203 * x224 - x205 * x223 - x207 * x222;
-        let x226 = x192 * x218 - x194 * x225 - x196 * x224 + x198 * x223 - x200 * x222;
-        let x227 = x181 * x217 - x183 * x226 - x185 * x225 - x187 * x224 - x189 * x223
-            + x191 * x222;
-        let x228 = x173 * x174 - x175 * x227 - x176 * x226 - x177 * x225 - x178 * x224
-            - x179 * x223 - x180 * x222;
+            * Self::mul_add(
+                -x215,
+                x221,
+                Self::mul_add(
+                    -x212,
+                    x220,
+                    Self::mul_add(
+                        -x207,
+                        x219,
+                        Self::mul_add(
+                            -x200,
+                            x218,
+                            Self::mul_add(
+                                x191,
+                                x217,
+                                Self::mul_add(-x173, x180, tau[6] - x141),
+                            ),
+                        ),
+                    ),
+                ),
+            );
+        let x223 = Self::mul_add(-x215, x222, x213 * x221);
+        let x224 = Self::mul_add(-x212, x222, Self::mul_add(-x210, x223, x208 * x220));
+        let x225 = Self::mul_add(
+            -x207,
+            x222,
+            Self::mul_add(-x205, x223, Self::mul_add(-x203, x224, x201 * x219)),
+        );
+        let x226 = Self::mul_add(
+            -x200,
+            x222,
+            Self::mul_add(
+                x198,
+                x223,
+                Self::mul_add(-x196, x224, Self::mul_add(-x194, x225, x192 * x218)),
+            ),
+        );
+        let x227 = Self::mul_add(
+            x191,
+            x222,
+            Self::mul_add(
+                -x189,
+                x223,
+                Self::mul_add(
+                    -x187,
+                    x224,
+                    Self::mul_add(-x185, x225, Self::mul_add(-x183, x226, x181 * x217)),
+                ),
+            ),
+        );
+        let x228 = Self::mul_add(
+            -x180,
+            x222,
+            Self::mul_add(
+                -x179,
+                x223,
+                Self::mul_add(
+                    -x178,
+                    x224,
+                    Self::mul_add(
+                        -x177,
+                        x225,
+                        Self::mul_add(
+                            -x176,
+                            x226,
+                            Self::mul_add(-x175, x227, x173 * x174),
+                        ),
+                    ),
+                ),
+            ),
+        );
         [x228, x227, x226, x225, x224, x223, x222]
+    }
+    /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
+    /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
+    /// elsewhere.
+    #[inline(always)]
+    fn mul_add(a: f32, b: f32, c: f32) -> f32 {
+        #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
+        {
+            use core::arch::x86_64::{_mm_cvtss_f32, _mm_fmadd_ss, _mm_set_ss};
+            unsafe {
+                _mm_cvtss_f32(_mm_fmadd_ss(_mm_set_ss(a), _mm_set_ss(b), _mm_set_ss(c)))
+            }
+        }
+        #[cfg(all(target_arch = "aarch64", target_feature = "neon"))]
+        {
+            use core::arch::aarch64::{vdup_n_f32, vfma_f32, vget_lane_f32};
+            unsafe {
+                vget_lane_f32::<0>(vfma_f32(vdup_n_f32(c), vdup_n_f32(a), vdup_n_f32(b)))
+            }
+        }
+        #[cfg(
+            not(
+                any(
+                    all(target_arch = "x86_64", target_feature = "fma"),
+                    all(target_arch = "aarch64", target_feature = "neon")
+                )
+            )
+        )] { a * b + c }
     }
 }

@@ -61,7 +61,7 @@ pub struct OpCount {
     pub sqrt: u64,
     /// Angles whose sine and cosine are taken.
     pub sincos: u64,
-    /// Fused multiply-adds.
+    /// Fused multiply-adds (with `target_fma`, fused where the build targets FMA).
     pub fma: u64,
 }
 #[allow(
