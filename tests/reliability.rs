@@ -243,7 +243,28 @@ fn interrupted_simulation_keeps_a_valid_partial_csv_and_an_incomplete_summary() 
         .stderr(Stdio::piped())
         .spawn()
         .unwrap();
-    std::thread::sleep(Duration::from_millis(1500));
+    // Interrupt once the run has streamed some rows (a fixed sleep loses on a loaded machine).
+    // The CSV streams into `.trajectory.csv-*.partial` (buffered) until it is renamed.
+    let streamed = || {
+        std::fs::read_dir(&out).map_or(0, |rd| {
+            rd.filter_map(Result::ok)
+                .filter(|e| {
+                    e.file_name()
+                        .to_string_lossy()
+                        .starts_with(".trajectory.csv-")
+                })
+                .map(|e| e.metadata().map_or(0, |m| m.len()))
+                .sum::<u64>()
+        })
+    };
+    let started = std::time::Instant::now();
+    while streamed() == 0 {
+        assert!(
+            started.elapsed() < Duration::from_secs(120),
+            "no rows streamed in 120 s"
+        );
+        std::thread::sleep(Duration::from_millis(50));
+    }
     let killed = Command::new("kill")
         .args(["-INT", &child.id().to_string()])
         .status()

@@ -188,6 +188,9 @@ pub fn emit_body(t: &Traced, emitter: &Emitter, shape: Shape) -> Body {
     }
 }
 
+/// Fused calls an inlined expression may nest before it is bound to a name.
+const MAX_CALL_NESTING: u32 = 2;
+
 /// [`emit_body`], handing each `let` statement to `stmt` as soon as it is emitted instead of
 /// keeping it: the returned body holds the result expression only. A caller that turns each
 /// statement into text at once keeps the memory of one statement, not of the whole body (33 MB
@@ -241,6 +244,10 @@ pub fn emit_body_streamed(
     // call unwraps) builds its own expression from copies, so the user can still take the
     // operands.
     let exprs: RefCell<HashMap<u32, Expr>> = RefCell::new(HashMap::new());
+    // Fused calls nested in an inlined expression: past `MAX_CALL_NESTING` the expression is
+    // bound to a name, so a long fused sum reads as a few short lines instead of a staircase
+    // (formatted, each level indents every line below it: N = 100 code grew 10× before).
+    let mut nesting: HashMap<u32, u32> = HashMap::new();
     let mut counter = 0usize;
     let mut fmas = 0u64;
     // A readable name for the sine/cosine of an argument: `s_q0` for `q[0]`.
@@ -296,6 +303,23 @@ pub fn emit_body_streamed(
                 .expect("products fuse only with an fma function");
             Expr::atom(quote!(#f(#a, #b, #c)))
         };
+        let operands: &[Sym] = match node {
+            Node::Add(a, b) | Node::Sub(a, b) | Node::Mul(a, b) | Node::Div(a, b) => &[*a, *b],
+            Node::Neg(a) | Node::Sqrt(a) => core::slice::from_ref(a),
+            _ => &[],
+        };
+        // Nesting of this node's expression: its deepest operand's (a looked-through product
+        // counts as its factors), one more when it becomes a fused call.
+        let deepest = operands
+            .iter()
+            .flat_map(|o| match product(*o) {
+                Some((a, b)) => [a, b],
+                None => [*o, *o],
+            })
+            .map(|o| nesting.get(&o.id()).copied().unwrap_or(0))
+            .max()
+            .unwrap_or(0);
+        let fmas_before = fmas;
         let expr = match node {
             Node::Const(x) => {
                 exprs.borrow_mut().insert(id, constant(*x, float));
@@ -407,9 +431,11 @@ pub fn emit_body_streamed(
                 Expr::atom(quote!(#libm::#f(#a)))
             }
         };
+        let depth = deepest + u32::from(fmas > fmas_before);
         let bind = outputs.contains(&id)
             || uses.get(&id).copied().unwrap_or(0) > 1
-            || matches!(node, Node::Div(..) | Node::Sqrt(..));
+            || matches!(node, Node::Div(..) | Node::Sqrt(..))
+            || depth > MAX_CALL_NESTING;
         if bind {
             let name = format_ident!("x{}", counter);
             counter += 1;
@@ -417,6 +443,7 @@ pub fn emit_body_streamed(
             stmt(quote!(let #name = #e;));
             exprs.borrow_mut().insert(id, Expr::atom(quote!(#name)));
         } else {
+            nesting.insert(id, depth);
             exprs.borrow_mut().insert(id, expr);
         }
     }
