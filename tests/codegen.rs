@@ -54,6 +54,7 @@ fn methods_of(mass: Option<&str>, bias: Option<&str>) -> Methods {
             MassMatrixMethod::from_name(m).unwrap()
         }),
         bias: bias.map_or(BiasMethod::Rnea, |b| BiasMethod::from_name(b).unwrap()),
+        ..Methods::SPATIAL
     }
 }
 

@@ -2,7 +2,7 @@
 //! fewest emitted operations (`mul + add`) wins, the first in report order on ties.
 
 use crate::options::Options;
-use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
+use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
 use kanegen_model::{BaseKind, Model};
 use kanegen_trace::{trace, Base, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
 
@@ -80,6 +80,7 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
             .map(|&mass_matrix| Methods {
                 mass_matrix,
                 bias: BiasMethod::Rnea,
+                forward: ForwardMethod::Ldlt,
             })
             .collect()
     } else if f.uses_bias() {
@@ -88,12 +89,14 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
             .map(|&bias| Methods {
                 mass_matrix: mass,
                 bias,
+                forward: ForwardMethod::Ldlt,
             })
             .collect()
     } else {
         vec![Methods {
             mass_matrix: mass,
             bias: BiasMethod::Rnea,
+            forward: ForwardMethod::Ldlt,
         }]
     }
 }
