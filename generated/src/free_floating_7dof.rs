@@ -8,34 +8,36 @@
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 1831 | 2489 | 0 | 0 | 7 | 4320 |
-//! | `mass_matrix` | `recurrent-r1` | — | 2110 | 2558 | 0 | 0 | 7 | 4668 |
-//! | `mass_matrix` | `kane-direct` | — | 3460 | 2896 | 0 | 0 | 7 | 6356 |
-//! | `mass_matrix` | `crba-base` | — | 1309 | 1040 | 0 | 0 | 7 | 2349 |
-//! | `mass_matrix` * | `crba` | — | 654 | 545 | 0 | 0 | 7 | 1199 |
-//! | `nonlinear_effects` | — | `recurrent` | 1153 | 884 | 0 | 0 | 7 | 2037 |
-//! | `nonlinear_effects` | — | `kane-direct` | 1570 | 1279 | 0 | 0 | 7 | 2849 |
-//! | `nonlinear_effects` * | — | `rnea` | 637 | 504 | 0 | 0 | 7 | 1141 |
-//! | `inverse_dynamics` * | — | `recurrent` | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` | — | `kane-direct` | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` | — | `rnea` | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 2307 | 1868 | 10 | 0 | 7 | 4175 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 2724 | 2263 | 10 | 0 | 7 | 4987 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 1779 | 1484 | 10 | 0 | 7 | 3263 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 1807 | 1429 | 0 | 0 | 7 | 3236 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 2224 | 1824 | 0 | 0 | 7 | 4048 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 1279 | 1045 | 0 | 0 | 7 | 2324 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 2451 | 2012 | 10 | 0 | 7 | 4463 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 2868 | 2407 | 10 | 0 | 7 | 5275 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 1779 | 1532 | 10 | 0 | 7 | 3311 |
-//! | `momentum` * | — | — | 356 | 285 | 0 | 0 | 7 | 641 |
-//! | `base_reaction` * | — | `recurrent` | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `kane-direct` | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `rnea` | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 1831 | 2489 | 0 | 0 | 7 | 4320 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 2110 | 2558 | 0 | 0 | 7 | 4668 |
+//! | `mass_matrix` | `kane-direct` | — | — | 3460 | 2896 | 0 | 0 | 7 | 6356 |
+//! | `mass_matrix` | `crba-base` | — | — | 1309 | 1040 | 0 | 0 | 7 | 2349 |
+//! | `mass_matrix` * | `crba` | — | — | 654 | 545 | 0 | 0 | 7 | 1199 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 1153 | 884 | 0 | 0 | 7 | 2037 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 1570 | 1279 | 0 | 0 | 7 | 2849 |
+//! | `nonlinear_effects` * | — | `rnea` | — | 637 | 504 | 0 | 0 | 7 | 1141 |
+//! | `inverse_dynamics` * | — | `recurrent` | — | 676 | 550 | 0 | 0 | 7 | 1226 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 676 | 550 | 0 | 0 | 7 | 1226 |
+//! | `inverse_dynamics` | — | `rnea` | — | 676 | 550 | 0 | 0 | 7 | 1226 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 2307 | 1868 | 10 | 0 | 7 | 4175 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 2724 | 2263 | 10 | 0 | 7 | 4987 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 1779 | 1484 | 10 | 0 | 7 | 3263 |
+//! | `forward_dynamics` * | — | — | `aba` | 1619 | 1279 | 12 | 0 | 7 | 2898 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 1807 | 1429 | 0 | 0 | 7 | 3236 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 2224 | 1824 | 0 | 0 | 7 | 4048 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | — | 1279 | 1045 | 0 | 0 | 7 | 2324 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 2451 | 2012 | 10 | 0 | 7 | 4463 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 2868 | 2407 | 10 | 0 | 7 | 5275 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 1779 | 1532 | 10 | 0 | 7 | 3311 |
+//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | 1619 | 1327 | 12 | 0 | 7 | 2946 |
+//! | `momentum` * | — | — | — | 356 | 285 | 0 | 0 | 7 | 641 |
+//! | `base_reaction` * | — | `recurrent` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | `base_reaction` | — | `kane-direct` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | `base_reaction` | — | `rnea` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -48,6 +50,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -97,6 +102,7 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 654u64,
             add: 545u64,
             div: 0u64,
@@ -108,6 +114,7 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 637u64,
             add: 504u64,
             div: 0u64,
@@ -119,6 +126,7 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 676u64,
             add: 550u64,
             div: 0u64,
@@ -128,11 +136,12 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 1779u64,
-            add: 1484u64,
-            div: 10u64,
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1619u64,
+            add: 1279u64,
+            div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -141,6 +150,7 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 1279u64,
             add: 1045u64,
             div: 0u64,
@@ -150,11 +160,12 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 1779u64,
-            add: 1532u64,
-            div: 10u64,
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1619u64,
+            add: 1327u64,
+            div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -163,6 +174,7 @@ impl FreeFloating7 {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
+            forward_method: None,
             mul: 356u64,
             add: 285u64,
             div: 0u64,
@@ -174,6 +186,7 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 694u64,
             add: 568u64,
             div: 0u64,
@@ -188,6 +201,7 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 1831u64,
             add: 2489u64,
             div: 0u64,
@@ -199,6 +213,7 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 2110u64,
             add: 2558u64,
             div: 0u64,
@@ -210,6 +225,7 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 3460u64,
             add: 2896u64,
             div: 0u64,
@@ -221,6 +237,7 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 1309u64,
             add: 1040u64,
             div: 0u64,
@@ -232,6 +249,7 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 654u64,
             add: 545u64,
             div: 0u64,
@@ -243,6 +261,7 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 1153u64,
             add: 884u64,
             div: 0u64,
@@ -254,6 +273,7 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 1570u64,
             add: 1279u64,
             div: 0u64,
@@ -265,6 +285,7 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 637u64,
             add: 504u64,
             div: 0u64,
@@ -276,6 +297,7 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 676u64,
             add: 550u64,
             div: 0u64,
@@ -287,6 +309,7 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 676u64,
             add: 550u64,
             div: 0u64,
@@ -298,6 +321,7 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 676u64,
             add: 550u64,
             div: 0u64,
@@ -309,6 +333,7 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 2307u64,
             add: 1868u64,
             div: 10u64,
@@ -320,6 +345,7 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 2724u64,
             add: 2263u64,
             div: 10u64,
@@ -331,6 +357,7 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 1779u64,
             add: 1484u64,
             div: 10u64,
@@ -339,9 +366,22 @@ impl FreeFloating7 {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1619u64,
+            add: 1279u64,
+            div: 12u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 1807u64,
             add: 1429u64,
             div: 0u64,
@@ -353,6 +393,7 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 2224u64,
             add: 1824u64,
             div: 0u64,
@@ -364,6 +405,7 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 1279u64,
             add: 1045u64,
             div: 0u64,
@@ -375,6 +417,7 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 2451u64,
             add: 2012u64,
             div: 10u64,
@@ -386,6 +429,7 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 2868u64,
             add: 2407u64,
             div: 10u64,
@@ -397,6 +441,7 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 1779u64,
             add: 1532u64,
             div: 10u64,
@@ -405,9 +450,22 @@ impl FreeFloating7 {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1619u64,
+            add: 1327u64,
+            div: 12u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
+            forward_method: None,
             mul: 356u64,
             add: 285u64,
             div: 0u64,
@@ -419,6 +477,7 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 694u64,
             add: 568u64,
             div: 0u64,
@@ -430,6 +489,7 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 694u64,
             add: 568u64,
             div: 0u64,
@@ -441,6 +501,7 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 694u64,
             add: 568u64,
             div: 0u64,
@@ -1621,869 +1682,874 @@ impl FreeFloating7 {
         let x229 = 1170.07 * a[2] - 110.5455 * a[4] + (v[3] * x4 - v[4] * x3) + x221;
         [x227, x228, x229, x224, x225, x226, x218, x210, x201, x194, x186, x178, x170]
     }
-    /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 1779 mul, 1484 add, 10 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: forward `aba`: 1619 mul, 1279 add, 12 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
-        let (s_q7, c_q7) = libm::sincos(q[7]);
-        let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
-        let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x6 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x7 = 0.00000000020510342851533115 * c_q9
-            + -0.00000000020510342851533115 * s_q9;
-        let x8 = -0.00000000020510342851533115 * c_q9
-            - 0.00000000020510342851533115 * s_q9;
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = -0.0145 - 0.000781 * x16;
-        let x21 = -0.9614610000000001 + (0.000781 * x15 - -1.2025609200000003 * x16);
-        let x22 = 1.4135609200000003 + (-0.0145 * x15 - -0.9614610000000001 * x16);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = x24 + -1.2025609200000003 * c_q13;
-        let x26 = -0.0145 * s_q13 + -0.9614610000000001 * c_q13;
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = -1.2025609200000003 * s_q13 - x23 + 0.00000000019719894748377882;
-        let x29 = -0.9614610000000001 * s_q13 - -0.0145 * c_q13
-            + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = x22 + (x15 * x20 - x16 * x21) - (x30 - x31) - (x33 - x32);
-        let x35 = 3.6140000000000003 - x17;
-        let x36 = 17.135250000000003 + x18;
-        let x37 = -1.9877000000000002 + (s_q13 * x20 + c_q13 * x21 + 0.55 * x17);
-        let x38 = -0.809539999555672
-            + (s_q13 * x21 - c_q13 * x20 + -0.00000000020510342851533115 * x22
-                - -0.16 * x17);
-        let x39 = -1.9877000000000002 + (x26 + (x15 * x23 - x16 * x25) - x17 * -0.55);
-        let x40 = -5.252920330000002 + (s_q13 * x23 + c_q13 * x25 + x32 - x30);
-        let x41 = -2.741639999592316
-            + (s_q13 * x25 - c_q13 * x23 + -0.00000000020510342851533115 * x26
-                - 0.16 * x18 - 0.55 * x19);
-        let x42 = -0.809539999555672 + (x29 + (x15 * x27 - x16 * x28) + 0.16 * x17);
-        let x43 = -2.7416399995923166
-            + (s_q13 * x27 + c_q13 * x28 + x19 * -0.55 + -0.16 * x18);
-        let x44 = 9.740442170000001
-            + (x31
-                + (s_q13 * x28 - c_q13 * x27 + -0.00000000020510342851533115 * x29
-                    - x33));
-        let x45 = c_q12 * x35;
-        let x46 = s_q12 * x36;
-        let x47 = x45 - x46;
-        let x48 = x19 + (x12 * x35 + x13 * x36);
-        let x49 = s_q12 * x35 + c_q12 * x36;
-        let x50 = -0.00000000020510342851533115 * x19 - x49;
-        let x51 = c_q12 * x34 - s_q12 * x39;
-        let x52 = c_q12 * x37 - s_q12 * x40;
-        let x53 = c_q12 * x38 - s_q12 * x41;
-        let x54 = x42 + (x12 * x34 + x13 * x39);
-        let x55 = x43 + (x12 * x37 + x13 * x40);
-        let x56 = x44 + (x12 * x38 + x13 * x41);
-        let x57 = -0.00000000020510342851533115 * x42 - (s_q12 * x34 + c_q12 * x39);
-        let x58 = -0.00000000020510342851533115 * x43 - (s_q12 * x37 + c_q12 * x40);
-        let x59 = -0.00000000020510342851533115 * x44 - (s_q12 * x38 + c_q12 * x41);
-        let x60 = x53 + (x12 * x51 + x13 * x52);
-        let x61 = c_q12 * x54 - s_q12 * x55;
-        let x62 = x50 * 0.36;
-        let x63 = -0.36 * x50;
-        let x64 = x63 + (c_q12 * x51 - s_q12 * x52 - x62);
-        let x65 = 7.078399999258757 + x48;
-        let x66 = 0.01675
-            + (-0.00000000020510342851533115 * x53 - (s_q12 * x51 + c_q12 * x52)
-                + x47 * 0.36);
-        let x67 = -9.142025249762803 + (x56 + (x12 * x54 + x13 * x55) + x63 - x62);
-        let x68 = 2.5482240016099564
-            + (-0.00000000020510342851533115 * x56 - (s_q12 * x54 + c_q12 * x55)
-                - -0.36 * x48);
-        let x69 = 0.01675 + (c_q12 * x57 - s_q12 * x58 - -0.36 * x47);
-        let x70 = 2.5482240016099564 + (x59 + (x12 * x57 + x13 * x58) + x48 * 0.36);
-        let x71 = 9.223235249762805
-            + (-0.00000000020510342851533115 * x59 - (s_q12 * x57 + c_q12 * x58));
-        let x72 = c_q11 * x47 - s_q11 * x65;
-        let x73 = s_q11 * x47 + c_q11 * x65;
-        let x74 = c_q11 * x64 - s_q11 * x61;
-        let x75 = c_q11 * x60 - s_q11 * x67;
-        let x76 = s_q11 * x64 + c_q11 * x61;
-        let x77 = s_q11 * x60 + c_q11 * x67;
-        let x78 = 0.275 * x50;
-        let x79 = -0.63 * x73;
-        let x80 = -0.275 * x50;
-        let x81 = x73 * 0.63;
-        let x82 = s_q11 * x74 + c_q11 * x75 - -0.63 * x72;
-        let x83 = c_q11 * x66 - s_q11 * x68 + 0.275 * x72;
-        let x84 = s_q11 * x66 + c_q11 * x68 - -0.275 * x73;
-        let x85 = x71 - x81;
-        let x86 = c_q11 * x74 - s_q11 * x75 - (x78 - x79) - (x81 - x80);
-        let x87 = c_q11 * x76 - s_q11 * x77 + x72 * 0.63;
-        let x88 = -45.1584 + x73;
-        let x89 = -0.6328 + x83;
-        let x90 = -24.4950615 + (s_q11 * x76 + c_q11 * x77 + x80 - x78);
-        let x91 = -24.35164200091464 + (x84 - -0.63 * x50);
-        let x92 = -0.6328 + (c_q11 * x69 - s_q11 * x70 - -0.275 * x72);
-        let x93 = -24.351642000914637
-            + (s_q11 * x69 + c_q11 * x70 + x50 * 0.63 + 0.275 * x73);
-        let x94 = 28.2393615 + (x79 + x85);
-        let x95 = c_q10 * x72;
-        let x96 = x95 - s_q10 * x88;
-        let x97 = s_q10 * x72;
-        let x98 = x97 + c_q10 * x88;
-        let x99 = c_q10 * x86 - s_q10 * x87;
-        let x100 = c_q10 * x82 - s_q10 * x90;
-        let x101 = c_q10 * x89 - s_q10 * x91;
-        let x102 = s_q10 * x86 + c_q10 * x87;
-        let x103 = s_q10 * x82 + c_q10 * x90;
-        let x104 = s_q10 * x89 + c_q10 * x91;
-        let x105 = -0.87 * x98;
-        let x106 = x98 * 0.87;
-        let x107 = s_q10 * x99 + c_q10 * x100 - -0.87 * x96;
-        let x108 = x94 - x106;
-        let x109 = c_q10 * x99 - s_q10 * x100 + x105 - x106;
-        let x110 = c_q10 * x102 - s_q10 * x103 + x96 * 0.87;
-        let x111 = -81.53205 + x98;
-        let x112 = -0.00214 + x101;
-        let x113 = -63.36336825000001 + (s_q10 * x102 + c_q10 * x103);
-        let x114 = -36.18604050126307 + (x104 - -0.87 * x50);
-        let x115 = -0.00214 + (c_q10 * x92 - s_q10 * x93);
-        let x116 = -36.18604050126307 + (s_q10 * x92 + c_q10 * x93 + x50 * 0.87);
-        let x117 = 69.99836825 + (x105 + x108);
-        let x118 = x5 * x96 + x6 * x111 + 0.00000000020510342851533115 * x50;
-        let x119 = x50 + (x7 * x96 + x8 * x111);
-        let x120 = c_q9 * x96 - s_q9 * x111 + -0.00000000020510342851533115 * x50;
-        let x121 = x5 * x109 + x6 * x110 + 0.00000000020510342851533115 * x115;
-        let x122 = x5 * x107 + x6 * x113 + 0.00000000020510342851533115 * x116;
-        let x123 = x5 * x112 + x6 * x114 + 0.00000000020510342851533115 * x117;
-        let x124 = x115 + (x7 * x109 + x8 * x110);
-        let x125 = x116 + (x7 * x107 + x8 * x113);
-        let x126 = x117 + (x7 * x112 + x8 * x114);
-        let x127 = c_q9 * x109 - s_q9 * x110 + -0.00000000020510342851533115 * x115;
-        let x128 = c_q9 * x107 - s_q9 * x113 + -0.00000000020510342851533115 * x116;
-        let x129 = c_q9 * x112 - s_q9 * x114 + -0.00000000020510342851533115 * x117;
-        let x130 = x120 * -0.4;
-        let x131 = 0.275 * x119;
-        let x132 = 0.4 * x120;
-        let x133 = -0.275 * x119;
-        let x134 = x5 * x121 + x6 * x122 + 0.00000000020510342851533115 * x123
-            - (x130 - x131) - (x133 - x132);
-        let x135 = -0.000000008530897668050218 + x118;
-        let x136 = -12.701650001451807 + x119;
-        let x137 = -0.0000000234896432582596
-            + (x123 + (x7 * x121 + x8 * x122) - 0.275 * x118);
-        let x138 = -0.0021399965876409276
-            + (c_q9 * x121 - s_q9 * x122 + -0.00000000020510342851533115 * x123
-                + x118 * -0.4);
-        let x139 = -0.0000000234896432582596
-            + (x5 * x124 + x6 * x125 + 0.00000000020510342851533115 * x126
-                + -0.275 * x118);
-        let x140 = -111.7548902508081 + (x126 + (x7 * x124 + x8 * x125) + x132 - x130);
-        let x141 = 5.080660024070365
-            + (c_q9 * x124 - s_q9 * x125 + -0.00000000020510342851533115 * x126
-                - 0.4 * x119 - 0.275 * x120);
-        let x142 = -0.0021399965876409276
-            + (x5 * x127 + x6 * x128 + 0.00000000020510342851533115 * x129 - 0.4 * x118);
-        let x143 = 5.080660024070366
-            + (x129 + (x7 * x127 + x8 * x128) + -0.275 * x120 + x119 * -0.4);
-        let x144 = 113.3918902508081
-            + (x131
-                + (c_q9 * x127 - s_q9 * x128 + -0.00000000020510342851533115 * x129
-                    - x133));
-        let x145 = x120 + (x2 * x135 - x3 * x136);
-        let x146 = s_q8 * x135 + c_q8 * x136;
-        let x147 = c_q8 * x135;
-        let x148 = s_q8 * x136;
-        let x149 = x148 - x147 + -0.00000000020510342851533115 * x120;
-        let x150 = x142 + (x2 * x134 - x3 * x139);
-        let x151 = x143 + (x2 * x137 - x3 * x140);
-        let x152 = x144 + (x2 * x138 - x3 * x141);
-        let x153 = s_q8 * x134 + c_q8 * x139;
-        let x154 = s_q8 * x137 + c_q8 * x140;
-        let x155 = s_q8 * x138 + c_q8 * x141;
-        let x156 = s_q8 * x141 - c_q8 * x138 + -0.00000000020510342851533115 * x144;
-        let x157 = x149 * -0.35;
-        let x158 = 0.35 * x149;
-        let x159 = x158 + (x152 + (x2 * x150 - x3 * x151) - x157);
-        let x160 = 48.0240000085309 + x145;
-        let x161 = -0.07309 + (s_q8 * x150 + c_q8 * x151);
-        let x162 = -16.80768997608804
-            + (s_q8 * x151 - c_q8 * x150 + -0.00000000020510342851533115 * x152
-                + x145 * -0.35);
-        let x163 = -0.07309 + (x155 + (x2 * x153 - x3 * x154));
-        let x164 = 130.43769025763282 + (s_q8 * x153 + c_q8 * x154 + x158 - x157);
-        let x165 = 0.1132
-            + (s_q8 * x154 - c_q8 * x153 + -0.00000000020510342851533115 * x155
-                - 0.35 * x146);
-        let x166 = 132.47349025763282
-            + (s_q8 * (s_q8 * x140 - c_q8 * x137 + -0.00000000020510342851533115 * x143)
-                - c_q8
-                    * (s_q8 * x139 - c_q8 * x134 + -0.00000000020510342851533115 * x142)
-                + -0.00000000020510342851533115 * x156);
-        let x167 = c_q7 * x160 - s_q7 * x146;
-        let x168 = s_q7 * x160 + c_q7 * x146;
-        let x169 = c_q7 * x159 - s_q7 * x163;
-        let x170 = c_q7 * x161 - s_q7 * x164;
-        let x171 = x149 * -0.75;
-        let x172 = 0.75 * x149;
-        let x173 = x167 * -0.65;
-        let x174 = 0.65 * x167;
-        let x175 = c_q7 * x162 - s_q7 * x165 + x167 * -0.75;
-        let x176 = x166 + x174;
-        let x177 = 110.5455 + x167;
-        let x178 = 180.9502499901501 + x149;
-        let x179 = x2 * x136 + x3 * x135;
-        let x180 = x147 - x148;
-        let x181 = x152 + -0.35 * x180;
-        let x182 = x155 - 0.35 * x179;
-        let x183 = c_q7 * x179 + s_q7 * x180;
-        let x184 = c_q7 * x180 - s_q7 * x179;
-        let x185 = x6 * x96;
-        let x186 = x185 - x5 * x111;
-        let x187 = x8 * x96;
-        let x188 = x187 - x7 * x111;
-        let x189 = s_q9 * x96;
-        let x190 = c_q9 * x111 + x189;
-        let x191 = x123 + (-0.4 * x188 - 0.275 * x190);
-        let x192 = x126 + 0.4 * x186;
-        let x193 = x129 + -0.275 * x186;
-        let x194 = x2 * x186 - x3 * x188 - x190;
-        let x195 = s_q8 * x186 + c_q8 * x188;
-        let x196 = s_q8 * x188 - c_q8 * x186 - -0.00000000020510342851533115 * x190;
-        let x197 = s_q8 * x192 - c_q8 * x191 + -0.00000000020510342851533115 * x193;
-        let x198 = x193 + (x2 * x191 - x3 * x192) + -0.35 * x195;
-        let x199 = s_q8 * x191 + c_q8 * x192 + 0.35 * x194;
-        let x200 = c_q7 * x194 - s_q7 * x195;
-        let x201 = s_q7 * x194 + c_q7 * x195;
-        let x202 = x185 - x5 * x98;
-        let x203 = x187 - x7 * x98;
-        let x204 = x189 + c_q9 * x98;
-        let x205 = x5 * x101 + x6 * x104 + 0.00000000020510342851533115 * x108
-            + (-0.4 * x203 - 0.275 * x204);
-        let x206 = x108 + (x7 * x101 + x8 * x104) + 0.4 * x202;
-        let x207 = c_q9 * x101 - s_q9 * x104 + -0.00000000020510342851533115 * x108
-            + -0.275 * x202;
-        let x208 = x2 * x202 - x3 * x203 - x204;
-        let x209 = s_q8 * x202 + c_q8 * x203;
-        let x210 = s_q8 * x203 - c_q8 * x202 - -0.00000000020510342851533115 * x204;
-        let x211 = s_q8 * x206 - c_q8 * x205 + -0.00000000020510342851533115 * x207;
-        let x212 = x207 + (x2 * x205 - x3 * x206) + -0.35 * x209;
-        let x213 = s_q8 * x205 + c_q8 * x206 + 0.35 * x208;
-        let x214 = c_q7 * x208 - s_q7 * x209;
-        let x215 = s_q7 * x208 + c_q7 * x209;
-        let x216 = x97 + c_q10 * x73;
-        let x217 = x95 - s_q10 * x73;
-        let x218 = c_q10 * x83 - s_q10 * x84;
-        let x219 = s_q10 * x83 + c_q10 * x84;
-        let x220 = x85 - 0.87 * x216;
-        let x221 = x6 * x217 - x5 * x216;
-        let x222 = x8 * x217 - x7 * x216;
-        let x223 = c_q9 * x216 + s_q9 * x217;
-        let x224 = x5 * x218 + x6 * x219 + 0.00000000020510342851533115 * x220
-            + (-0.4 * x222 - 0.275 * x223);
-        let x225 = x220 + (x7 * x218 + x8 * x219) + 0.4 * x221;
-        let x226 = c_q9 * x218 - s_q9 * x219 + -0.00000000020510342851533115 * x220
-            + -0.275 * x221;
-        let x227 = x2 * x221 - x3 * x222 - x223;
-        let x228 = s_q8 * x221 + c_q8 * x222;
-        let x229 = s_q8 * x222 - c_q8 * x221 - -0.00000000020510342851533115 * x223;
-        let x230 = s_q8 * x225 - c_q8 * x224 + -0.00000000020510342851533115 * x226;
-        let x231 = x226 + (x2 * x224 - x3 * x225) + -0.35 * x228;
-        let x232 = s_q8 * x224 + c_q8 * x225 + 0.35 * x227;
-        let x233 = c_q7 * x227 - s_q7 * x228;
-        let x234 = s_q7 * x227 + c_q7 * x228;
-        let x235 = x13 * x35 - x12 * x36;
-        let x236 = x46 - x45;
-        let x237 = x53 + 0.36 * x235;
-        let x238 = x56 - -0.36 * x49;
-        let x239 = c_q11 * x49 + s_q11 * x235;
-        let x240 = c_q11 * x235 - s_q11 * x49;
-        let x241 = c_q11 * x237 - s_q11 * x238 + (0.275 * x240 + -0.63 * x236);
-        let x242 = s_q11 * x237 + c_q11 * x238 - -0.275 * x239;
-        let x243 = x59 - 0.63 * x239;
-        let x244 = c_q10 * x239 + s_q10 * x240;
-        let x245 = c_q10 * x240 - s_q10 * x239;
-        let x246 = s_q10 * x241 + c_q10 * x242;
-        let x247 = c_q10 * x241 - s_q10 * x242 + -0.87 * x236;
-        let x248 = x243 - 0.87 * x244;
-        let x249 = x6 * x245 - x5 * x244 + 0.00000000020510342851533115 * x236;
-        let x250 = x236 + (x8 * x245 - x7 * x244);
-        let x251 = -0.00000000020510342851533115 * x236 - (c_q9 * x244 + s_q9 * x245);
-        let x252 = x5 * x247 + x6 * x246 + 0.00000000020510342851533115 * x248
-            + (-0.4 * x250 + 0.275 * x251);
-        let x253 = x248 + (x7 * x247 + x8 * x246) + 0.4 * x249;
-        let x254 = c_q9 * x247 - s_q9 * x246 + -0.00000000020510342851533115 * x248
-            + -0.275 * x249;
-        let x255 = x251 + (x2 * x249 - x3 * x250);
-        let x256 = s_q8 * x249 + c_q8 * x250;
-        let x257 = s_q8 * x250 - c_q8 * x249 + -0.00000000020510342851533115 * x251;
-        let x258 = s_q8 * x253 - c_q8 * x252 + -0.00000000020510342851533115 * x254;
-        let x259 = x254 + (x2 * x252 - x3 * x253) + -0.35 * x256;
-        let x260 = s_q8 * x252 + c_q8 * x253 + 0.35 * x255;
-        let x261 = c_q7 * x255 - s_q7 * x256;
-        let x262 = s_q7 * x255 + c_q7 * x256;
-        let x263 = x15 * -4.806620000000001;
-        let x264 = s_q13 * -4.806620000000001;
-        let x265 = c_q13 * -4.806620000000001;
-        let x266 = x22 + (-0.16 * x264 - 0.55 * x265);
-        let x267 = x26 + 0.16 * x263;
-        let x268 = x29 + -0.55 * x263;
-        let x269 = c_q12 * x263 - s_q12 * x264;
-        let x270 = x12 * x263 + x13 * x264 - x265;
-        let x271 = s_q12 * x263 + c_q12 * x264 + -0.00000000020510342851533115 * x265;
-        let x272 = -0.00000000020510342851533115 * x268 - (s_q12 * x266 + c_q12 * x267);
-        let x273 = c_q12 * x266 - s_q12 * x267 + 0.36 * x270;
-        let x274 = x268 + (x12 * x266 + x13 * x267) + -0.36 * x269;
-        let x275 = c_q11 * x269 - s_q11 * x270;
-        let x276 = s_q11 * x269 + c_q11 * x270;
-        let x277 = c_q11 * x273 - s_q11 * x274 + (0.275 * x276 - -0.63 * x271);
-        let x278 = s_q11 * x273 + c_q11 * x274 + -0.275 * x275;
-        let x279 = x272 + 0.63 * x275;
-        let x280 = c_q10 * x275 - s_q10 * x276;
-        let x281 = s_q10 * x275 + c_q10 * x276;
-        let x282 = s_q10 * x277 + c_q10 * x278;
-        let x283 = c_q10 * x277 - s_q10 * x278 - -0.87 * x271;
-        let x284 = x279 + 0.87 * x280;
-        let x285 = x5 * x280 + x6 * x281 - 0.00000000020510342851533115 * x271;
-        let x286 = x7 * x280 + x8 * x281 - x271;
-        let x287 = c_q9 * x280 - s_q9 * x281 - -0.00000000020510342851533115 * x271;
-        let x288 = x5 * x283 + x6 * x282 + 0.00000000020510342851533115 * x284
-            + (-0.4 * x286 + 0.275 * x287);
-        let x289 = x284 + (x7 * x283 + x8 * x282) + 0.4 * x285;
-        let x290 = c_q9 * x283 - s_q9 * x282 + -0.00000000020510342851533115 * x284
-            + -0.275 * x285;
-        let x291 = x287 + (x2 * x285 - x3 * x286);
-        let x292 = s_q8 * x285 + c_q8 * x286;
-        let x293 = s_q8 * x286 - c_q8 * x285 + -0.00000000020510342851533115 * x287;
-        let x294 = s_q8 * x289 - c_q8 * x288 + -0.00000000020510342851533115 * x290;
-        let x295 = x290 + (x2 * x288 - x3 * x289) + -0.35 * x292;
-        let x296 = s_q8 * x288 + c_q8 * x289 + 0.35 * x291;
-        let x297 = c_q7 * x291 - s_q7 * x292;
-        let x298 = s_q7 * x291 + c_q7 * x292;
-        let x299 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+        let x0 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
             + v[1] * -180.9502499901501;
-        let x300 = 1466.4506062283303 * v[4]
+        let x1 = 1466.4506062283303 * v[4]
             + (180.9502499901501 * v[0] + v[2] * -110.5455);
-        let x301 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
-        let x302 = 1170.07 * v[0] - v[4] * -180.9502499901501;
-        let x303 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
-        let x304 = 1170.07 * v[2] - 110.5455 * v[4];
-        let x305 = v[3] * c_q7 + v[4] * s_q7;
-        let x306 = v[4] * c_q7 - v[3] * s_q7;
-        let x307 = v[0] - v[4] * -0.75;
-        let x308 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x309 = v[2] - 0.65 * v[4];
-        let x310 = c_q7 * x307 + s_q7 * x308;
-        let x311 = c_q7 * x308 - s_q7 * x307;
-        let x312 = v[5] + v[6];
-        let x313 = v[6] * x306;
-        let x314 = v[6] * x305;
-        let x315 = v[6] * x310;
-        let x316 = -0.07309 * x306 + -16.80768997608804 * x312;
-        let x317 = -0.07309 * x305 + 130.43769025763282 * x306 + 0.1132 * x312
-            + x309 * -48.0240000085309;
-        let x318 = -16.80768997608804 * x305 + 0.1132 * x306 + 132.47349025763282 * x312
-            + 48.0240000085309 * x311;
-        let x319 = x312 * -48.0240000085309;
-        let x320 = 48.0240000085309 * x306;
-        let x321 = x2 * x305 + s_q8 * x306 - c_q8 * x312;
-        let x322 = c_q8 * x306 - x3 * x305 + s_q8 * x312;
-        let x323 = x310 - -0.35 * x306;
-        let x324 = x311 - 0.35 * x305;
-        let x325 = x2 * x323 + s_q8 * x324 - c_q8 * x309;
-        let x326 = c_q8 * x324 - x3 * x323 + s_q8 * x309;
-        let x327 = x323 + -0.00000000020510342851533115 * x309;
-        let x328 = v[7] + (x305 + -0.00000000020510342851533115 * x312);
-        let x329 = v[6] * x311 + -0.35 * x314;
-        let x330 = x315 + 0.35 * x313;
-        let x331 = x2 * x313 - s_q8 * x314 + v[7] * x322;
-        let x332 = x3 * x313 + c_q8 * x314 + v[7] * x321;
-        let x333 = x2 * x329 - s_q8 * x330 + v[7] * x326;
-        let x334 = x3 * x329 + c_q8 * x330 + v[7] * x325;
-        let x335 = -0.0000000234896432582596 * x322 + -0.0021399965876409276 * x328
-            + -12.701650001451807 * x327;
-        let x336 = -0.0000000234896432582596 * x321 + -111.7548902508081 * x322
-            + 5.080660024070365 * x328 + x327 * 0.000000008530897668050218;
-        let x337 = -0.0021399965876409276 * x321 + 5.080660024070366 * x322
-            + 113.3918902508081 * x328
-            + (x325 * 12.701650001451807 + -0.000000008530897668050218 * x326);
-        let x338 = -12.701650001451807 * x328;
-        let x339 = x328 * 0.000000008530897668050218;
-        let x340 = x321 * 12.701650001451807 + -0.000000008530897668050218 * x322;
-        let x341 = x5 * x321 + x7 * x322 + c_q9 * x328;
-        let x342 = x6 * x321 + x8 * x322 - s_q9 * x328;
-        let x343 = x325 - (-0.4 * x322 + 0.275 * x328);
-        let x344 = x326 - 0.4 * x321;
-        let x345 = x327 - -0.275 * x321;
-        let x346 = x5 * x343 + x7 * x344 + c_q9 * x345;
-        let x347 = x6 * x343 + x8 * x344 - s_q9 * x345;
-        let x348 = x344 + 0.00000000020510342851533115 * x343
-            + -0.00000000020510342851533115 * x345;
-        let x349 = v[8]
-            + (x322 + 0.00000000020510342851533115 * x321
-                + -0.00000000020510342851533115 * x328);
-        let x350 = 0.00000000020510342851533115 * x331 - x332
-            + -0.00000000020510342851533115 * x313;
-        let x351 = x333 - (0.275 * x313 - -0.4 * x332);
-        let x352 = x334 + 0.4 * x331;
-        let x353 = x329 - -0.275 * x331;
-        let x354 = 0.00000000020510342851533115 * x351 - x352
-            + -0.00000000020510342851533115 * x353;
-        let x355 = x5 * x331 - x7 * x332 + c_q9 * x313 + v[8] * x342;
-        let x356 = x6 * x331 - x8 * x332 - s_q9 * x313 - v[8] * x341;
-        let x357 = x5 * x351 - x7 * x352 + c_q9 * x353 + v[8] * x347;
-        let x358 = x6 * x351 - x8 * x352 - s_q9 * x353 - v[8] * x346;
-        let x359 = -63.36336825000001 * x342 + -36.18604050126307 * x349;
-        let x360 = -0.00214 * x349 + -81.53205 * x348;
-        let x361 = -0.00214 * x341 + -36.18604050126307 * x342 + 69.99836825 * x349
-            + x346 * 81.53205;
-        let x362 = -81.53205 * x349;
-        let x363 = x341 * 81.53205;
-        let x364 = c_q10 * x341 + s_q10 * x342;
-        let x365 = c_q10 * x342 - s_q10 * x341;
-        let x366 = x346 - -0.87 * x349;
-        let x367 = x348 - 0.87 * x341;
-        let x368 = c_q10 * x366 + s_q10 * x347;
-        let x369 = c_q10 * x347 - s_q10 * x366;
-        let x370 = v[9] + x349;
-        let x371 = x357 - -0.87 * x350;
-        let x372 = x354 - 0.87 * x355;
-        let x373 = c_q10 * x355 + s_q10 * x356 + v[9] * x365;
-        let x374 = c_q10 * x356 - s_q10 * x355 - v[9] * x364;
-        let x375 = c_q10 * x371 + s_q10 * x358 + v[9] * x369;
-        let x376 = -24.4950615 * x365 + -24.35164200091464 * x370;
-        let x377 = -0.6328 * x370 + -45.1584 * x367;
-        let x378 = -0.6328 * x364 + -24.351642000914637 * x365 + 28.2393615 * x370
-            + x368 * 45.1584;
-        let x379 = -45.1584 * x370;
-        let x380 = x364 * 45.1584;
-        let x381 = c_q11 * x364 + s_q11 * x365;
-        let x382 = c_q11 * x365 - s_q11 * x364;
-        let x383 = x368 - (0.275 * x365 + -0.63 * x370);
-        let x384 = x369 - -0.275 * x364;
-        let x385 = x367 - 0.63 * x364;
-        let x386 = c_q11 * x383 + s_q11 * x384;
-        let x387 = c_q11 * x384 - s_q11 * x383;
-        let x388 = v[10] + x370;
-        let x389 = x375 - (0.275 * x374 + -0.63 * x350);
-        let x390 = c_q10 * x358 - s_q10 * x371 - v[9] * x368 - -0.275 * x373;
-        let x391 = x372 - 0.63 * x373;
-        let x392 = c_q11 * x373 + s_q11 * x374 + v[10] * x382;
-        let x393 = c_q11 * x374 - s_q11 * x373 - v[10] * x381;
-        let x394 = c_q11 * x389 + s_q11 * x390 + v[10] * x387;
-        let x395 = -9.142025249762803 * x382 + 2.5482240016099564 * x388;
-        let x396 = 0.01675 * x388 + 7.078399999258757 * x385;
-        let x397 = 0.01675 * x381 + 2.5482240016099564 * x382 + 9.223235249762805 * x388
-            + x386 * -7.078399999258757;
-        let x398 = 7.078399999258757 * x388;
-        let x399 = x381 * -7.078399999258757;
-        let x400 = c_q12 * x381 + x12 * x382 - s_q12 * x388;
-        let x401 = x13 * x382 - s_q12 * x381 - c_q12 * x388;
-        let x402 = x386 - 0.36 * x382;
-        let x403 = x387 - -0.36 * x381;
-        let x404 = c_q12 * x402 + x12 * x403 - s_q12 * x385;
-        let x405 = x13 * x403 - s_q12 * x402 - c_q12 * x385;
-        let x406 = x403 + -0.00000000020510342851533115 * x385;
-        let x407 = v[11] + (x382 + -0.00000000020510342851533115 * x388);
-        let x408 = x393 + -0.00000000020510342851533115 * x350;
-        let x409 = x394 - 0.36 * x393;
-        let x410 = c_q11 * x390 - s_q11 * x389 - v[10] * x386 - -0.36 * x392;
-        let x411 = x410 + -0.00000000020510342851533115 * x391;
-        let x412 = c_q12 * x392 + x12 * x393 - s_q12 * x350 + v[11] * x401;
-        let x413 = x13 * x393 - s_q12 * x392 - c_q12 * x350 - v[11] * x400;
-        let x414 = c_q12 * x409 + x12 * x410 - s_q12 * x391 + v[11] * x405;
-        let x415 = x13 * x410 - s_q12 * x409 - c_q12 * x391 - v[11] * x404;
-        let x416 = -1.9877000000000002 * x401 + -0.809539999555672 * x407
-            + 17.135250000000003 * x406;
-        let x417 = -1.9877000000000002 * x400 + -5.252920330000002 * x401
-            + -2.741639999592316 * x407 + x406 * -3.6140000000000003;
-        let x418 = -0.809539999555672 * x400 + -2.7416399995923166 * x401
-            + 9.740442170000001 * x407
-            + (x404 * -17.135250000000003 + 3.6140000000000003 * x405);
-        let x419 = 17.135250000000003 * x407;
-        let x420 = x407 * -3.6140000000000003;
-        let x421 = x400 * -17.135250000000003 + 3.6140000000000003 * x401;
-        let x422 = x15 * x400 + s_q13 * x401 - c_q13 * x407;
-        let x423 = c_q13 * x401 - x16 * x400 + s_q13 * x407;
-        let x424 = x404 - (-0.16 * x401 + 0.55 * x407);
-        let x425 = x405 - 0.16 * x400;
-        let x426 = x406 - -0.55 * x400;
-        let x427 = x15 * x424 + s_q13 * x425 - c_q13 * x426;
-        let x428 = c_q13 * x425 - x16 * x424 + s_q13 * x426;
-        let x429 = x424 + -0.00000000020510342851533115 * x426;
-        let x430 = v[12] + (x400 + -0.00000000020510342851533115 * x407);
-        let x431 = x412 + -0.00000000020510342851533115 * x408;
-        let x432 = x414 - (-0.16 * x413 + 0.55 * x408);
-        let x433 = x411 - -0.55 * x412;
-        let x434 = x15 * x412 + s_q13 * x413 - c_q13 * x408 + v[12] * x423;
-        let x435 = c_q13 * x413 - x16 * x412 + s_q13 * x408 - v[12] * x422;
-        let x436 = 0.000781 * x422 + -1.2025609200000003 * x423
-            + -0.9614610000000001 * x430;
-        let x437 = 0.000781 * x423 + -0.0145 * x430 + 4.806620000000001 * x429;
-        let x438 = -0.0145 * x422 + -0.9614610000000001 * x423
-            + 1.4135609200000003 * x430 + -4.806620000000001 * x427;
-        let x439 = 4.806620000000001 * x430;
-        let x440 = -4.806620000000001 * x422;
-        let x441 = x422 * x440 - x430 * x439;
-        let x442 = 0.000781 * x435 + -0.0145 * x431
-            + 4.806620000000001 * (x432 + -0.00000000020510342851533115 * x433)
-            + (x423 * x438 - x430 * x436 - x428 * x440);
-        let x443 = 0.000781 * x434 + -1.2025609200000003 * x435
-            + -0.9614610000000001 * x431
-            + (x430 * x437 - x422 * x438 + (x427 * x440 - x429 * x439));
-        let x444 = -0.0145 * x434 + -0.9614610000000001 * x435
-            + 1.4135609200000003 * x431
-            + -4.806620000000001
-                * (x15 * x432 + s_q13 * (x415 - 0.16 * x412) - c_q13 * x433
-                    + v[12] * x428) + (x422 * x436 - x423 * x437 + x428 * x439);
-        let x445 = 4.806620000000001 * x431 + x423 * x440;
-        let x446 = x423 * x439 - -4.806620000000001 * x434;
-        let x447 = x446 - (x15 * x445 + x16 * x441);
-        let x448 = c_q13 * x441 - s_q13 * x445;
-        let x449 = c_q13 * x445 + s_q13 * x441 + -0.00000000020510342851533115 * x446;
-        let x450 = -1.9877000000000002 * x413 + -0.809539999555672 * x408
-            + 17.135250000000003 * x411
-            + (x401 * x418 - x407 * x417 + (x406 * x420 - x405 * x421))
-            + (x444 + (x15 * x442 - x16 * x443) + (-0.16 * x448 + 0.55 * x449));
-        let x451 = -1.9877000000000002 * x412 + -5.252920330000002 * x413
-            + -2.741639999592316 * x408 + x411 * -3.6140000000000003
-            + (x407 * x416 - x400 * x418 + (x404 * x421 - x406 * x419))
-            + (s_q13 * x442 + c_q13 * x443 + 0.16 * x447);
-        let x452 = -0.809539999555672 * x412 + -2.7416399995923166 * x413
-            + 9.740442170000001 * x408
-            + (x414 * -17.135250000000003 + 3.6140000000000003 * x415)
-            + (x400 * x417 - x401 * x416 + (x405 * x419 - x404 * x420))
-            + (s_q13 * x443 - c_q13 * x442 + -0.00000000020510342851533115 * x444
-                + -0.55 * x447);
-        let x453 = x407 * x420 - x401 * x421 - 17.135250000000003 * x408 + x447;
-        let x454 = x400 * x421 - x407 * x419 - x408 * -3.6140000000000003 + x448;
-        let x455 = x401 * x419 - x400 * x420
-            - (x412 * -17.135250000000003 + 3.6140000000000003 * x413) + x449;
-        let x456 = c_q12 * x453 - s_q12 * x454;
-        let x457 = x455 + (x12 * x453 + x13 * x454);
-        let x458 = 0.01675 * x350 + 7.078399999258757 * x391
-            + (x382 * x397 - x388 * x395 - x387 * x399)
-            + (c_q12 * x450 - s_q12 * x451 + 0.36 * x457);
-        let x459 = -9.142025249762803 * x393 + 2.5482240016099564 * x350
-            + (x388 * x396 - x381 * x397 + (x386 * x399 - x385 * x398))
-            + (x452 + (x12 * x450 + x13 * x451) + -0.36 * x456);
-        let x460 = 0.01675 * x392 + 2.5482240016099564 * x393 + 9.223235249762805 * x350
-            + x394 * -7.078399999258757 + (x381 * x395 - x382 * x396 + x387 * x398)
-            + (-0.00000000020510342851533115 * x452 - (s_q12 * x450 + c_q12 * x451));
-        let x461 = x456 - (7.078399999258757 * x350 + x382 * x399);
-        let x462 = x381 * x399 - x388 * x398 + x457;
-        let x463 = x382 * x398 - x392 * -7.078399999258757
-            + (-0.00000000020510342851533115 * x455 - (s_q12 * x453 + c_q12 * x454));
-        let x464 = c_q11 * x461 - s_q11 * x462;
-        let x465 = s_q11 * x461 + c_q11 * x462;
-        let x466 = -0.6328 * x350 + -45.1584 * x372
-            + (x365 * x378 - x370 * x376 - x369 * x380)
-            + (c_q11 * x458 - s_q11 * x459 + (0.275 * x465 + -0.63 * x463));
-        let x467 = -24.4950615 * x374 + -24.35164200091464 * x350
-            + (x370 * x377 - x364 * x378 + (x368 * x380 - x367 * x379))
-            + (s_q11 * x458 + c_q11 * x459 + -0.275 * x464);
-        let x468 = -0.6328 * x373 + -24.351642000914637 * x374 + 28.2393615 * x350
-            + x375 * 45.1584 + (x364 * x376 - x365 * x377 + x369 * x379)
-            + (x460 + 0.63 * x464);
-        let x469 = x464 - (-45.1584 * x350 + x365 * x380);
-        let x470 = x364 * x380 - x370 * x379 + x465;
-        let x471 = x365 * x379 - x373 * 45.1584 + x463;
-        let x472 = c_q10 * x469 - s_q10 * x470;
-        let x473 = -0.00214 * x350 + -81.53205 * x354
-            + (x342 * x361 - x349 * x359 - x347 * x363)
-            + (c_q10 * x466 - s_q10 * x467 + -0.87 * x471);
-        let x474 = -63.36336825000001 * x356 + -36.18604050126307 * x350
-            + (x349 * x360 - x341 * x361 + (x346 * x363 - x348 * x362))
-            + (s_q10 * x466 + c_q10 * x467);
-        let x475 = -0.00214 * x355 + -36.18604050126307 * x356 + 69.99836825 * x350
-            + x357 * 81.53205 + (x341 * x359 - x342 * x360 + x347 * x362)
-            + (x468 + 0.87 * x472);
-        let x476 = x472 - (-81.53205 * x350 + x342 * x363);
-        let x477 = x341 * x363 - x349 * x362 + (s_q10 * x469 + c_q10 * x470);
-        let x478 = x342 * x362 - x355 * 81.53205 + x471;
-        let x479 = x5 * x476 + x6 * x477 + 0.00000000020510342851533115 * x478;
-        let x480 = x478 + (x7 * x476 + x8 * x477);
-        let x481 = c_q9 * x476 - s_q9 * x477 + -0.00000000020510342851533115 * x478;
-        let x482 = -0.0021399965876409276 * x313 - -0.0000000234896432582596 * x332
-            + -12.701650001451807 * x329
-            + (x322 * x337 - x328 * x336 + (x327 * x339 - x326 * x340))
-            + (x5 * x473 + x6 * x474 + 0.00000000020510342851533115 * x475
-                + (-0.4 * x480 + 0.275 * x481));
-        let x483 = -0.0000000234896432582596 * x331 - -111.7548902508081 * x332
-            + 5.080660024070365 * x313 + x329 * 0.000000008530897668050218
-            + (x328 * x335 - x321 * x337 + (x325 * x340 - x327 * x338))
-            + (x475 + (x7 * x473 + x8 * x474) + 0.4 * x479);
-        let x484 = -0.0021399965876409276 * x331 - 5.080660024070366 * x332
-            + 113.3918902508081 * x313
-            + (x333 * 12.701650001451807 - -0.000000008530897668050218 * x334)
-            + (x321 * x336 - x322 * x335 + (x326 * x338 - x325 * x339))
-            + (c_q9 * x473 - s_q9 * x474 + -0.00000000020510342851533115 * x475
-                + -0.275 * x479);
-        let x485 = x328 * x339 - x322 * x340 - -12.701650001451807 * x313 + x479;
-        let x486 = x321 * x340 - x328 * x338 - x313 * 0.000000008530897668050218 + x480;
-        let x487 = x322 * x338 - x321 * x339
-            - (x331 * 12.701650001451807 - -0.000000008530897668050218 * x332) + x481;
-        let x488 = x487 + (x2 * x485 - x3 * x486);
-        let x489 = s_q8 * x485 + c_q8 * x486;
-        let x490 = x306 * x318 - x312 * x317 + (x309 * x319 - x311 * x320)
-            - -0.07309 * x314 + (x484 + (x2 * x482 - x3 * x483) + -0.35 * x489);
-        let x491 = -0.07309 * x313 - 130.43769025763282 * x314
-            + (x312 * x316 - x305 * x318 + x310 * x320)
-            + (s_q8 * x482 + c_q8 * x483 + 0.35 * x488);
-        let x492 = -16.80768997608804 * x313 - 0.1132 * x314 - 48.0240000085309 * x315
-            + (x305 * x317 - x306 * x316 - x310 * x319)
-            + (s_q8 * x483 - c_q8 * x482 + -0.00000000020510342851533115 * x484);
-        let x493 = x312 * x319 - x306 * x320 + x488;
-        let x494 = x305 * x320 + x489;
-        let x495 = 48.0240000085309 * x314 - x305 * x319
-            + (s_q8 * x486 - c_q8 * x485 + -0.00000000020510342851533115 * x487);
-        let x496 = c_q7 * x493 - s_q7 * x494;
-        let x497 = s_q7 * x493 + c_q7 * x494;
-        let x498 = v[4] * x304 - v[5] * x303 + x496;
-        let x499 = v[5] * x302 - v[3] * x304 + x497;
-        let x500 = v[3] * x303 - v[4] * x302 + x495;
-        let x501 = x178 * 0.0008546497218115156;
-        let x502 = x168 * 0.0008546497218115156;
-        let x503 = x183 * 0.0008546497218115156;
-        let x504 = x200 * 0.0008546497218115156;
-        let x505 = x214 * 0.0008546497218115156;
-        let x506 = x233 * 0.0008546497218115156;
-        let x507 = x261 * 0.0008546497218115156;
-        let x508 = x297 * 0.0008546497218115156;
-        let x509 = x177 * 0.0008546497218115156;
-        let x510 = x167 * 0.0008546497218115156;
-        let x511 = x184 * 0.0008546497218115156;
-        let x512 = x201 * 0.0008546497218115156;
-        let x513 = x215 * 0.0008546497218115156;
-        let x514 = x234 * 0.0008546497218115156;
-        let x515 = x262 * 0.0008546497218115156;
-        let x516 = x298 * 0.0008546497218115156;
-        let x517 = x146 * 0.0008546497218115156;
-        let x518 = x196 * 0.0008546497218115156;
-        let x519 = x210 * 0.0008546497218115156;
-        let x520 = x229 * 0.0008546497218115156;
-        let x521 = x257 * 0.0008546497218115156;
-        let x522 = x293 * 0.0008546497218115156;
-        let x523 = x178 * x501;
-        let x524 = x168 * x502;
-        let x525 = 1.0
-            / (1394.5960312283303 + (x172 + (c_q7 * x169 - s_q7 * x170 - x171)) - x523
-                - x524);
-        let x526 = s_q7 * x169 + c_q7 * x170 - 0.65 * x168 + x168 * x509;
-        let x527 = x525 * x526;
-        let x528 = -117.61766249359756 + (x175 + x149 * -0.65) + x178 * x509;
-        let x529 = x525 * x528;
-        let x530 = x175 + x178 * x510;
-        let x531 = x525 * x530;
-        let x532 = c_q7 * x181 - s_q7 * x182 + -0.75 * x184 + x178 * x511 - x168 * x517;
-        let x533 = x525 * x532;
-        let x534 = c_q7 * x198 - s_q7 * x199 + -0.75 * x201 + x178 * x512 - x168 * x518;
-        let x535 = x525 * x534;
-        let x536 = c_q7 * x212 - s_q7 * x213 + -0.75 * x215 + x178 * x513 - x168 * x519;
-        let x537 = x525 * x536;
-        let x538 = c_q7 * x231 - s_q7 * x232 + -0.75 * x234 + x178 * x514 - x168 * x520;
-        let x539 = x525 * x538;
-        let x540 = c_q7 * x259 - s_q7 * x260 + -0.75 * x262 + x178 * x515 - x168 * x521;
-        let x541 = x525 * x540;
-        let x542 = c_q7 * x295 - s_q7 * x296 + -0.75 * x298 + x178 * x516 - x168 * x522;
-        let x543 = x525 * x542;
-        let x544 = x177 * x509;
-        let x545 = 1.0
+        let x2 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x3 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x4 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x5 = 1170.07 * v[2] - 110.5455 * v[4];
+        let (s_q7, c_q7) = libm::sincos(q[7]);
+        let x7 = v[3] * c_q7 + v[4] * s_q7;
+        let x8 = v[4] * c_q7 - v[3] * s_q7;
+        let x9 = v[0] - v[4] * -0.75;
+        let x10 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x11 = v[2] - 0.65 * v[4];
+        let x12 = c_q7 * x9 + s_q7 * x10;
+        let x13 = c_q7 * x10 - s_q7 * x9;
+        let x14 = v[6] * x8;
+        let x15 = v[6] * x7;
+        let x16 = v[6] * x13;
+        let x17 = v[6] * x12;
+        let x18 = v[5] + v[6];
+        let x19 = -0.07309 * x8 + -16.80768997608804 * x18;
+        let x20 = -0.07309 * x7 + 130.43769025763282 * x8 + 0.1132 * x18
+            + x11 * -48.0240000085309;
+        let x21 = -16.80768997608804 * x7 + 0.1132 * x8 + 132.47349025763282 * x18
+            + 48.0240000085309 * x13;
+        let x22 = x18 * -48.0240000085309;
+        let x23 = 48.0240000085309 * x8;
+        let (s_q8, c_q8) = libm::sincos(q[8]);
+        let x25 = -0.00000000020510342851533115 * c_q8;
+        let x26 = -0.00000000020510342851533115 * s_q8;
+        let x27 = x7 * x25 + x8 * s_q8 - x18 * c_q8;
+        let x28 = x8 * c_q8 - x7 * x26 + x18 * s_q8;
+        let x29 = x12 - x8 * -0.35;
+        let x30 = x13 - 0.35 * x7;
+        let x31 = x25 * x29 + s_q8 * x30 - x11 * c_q8;
+        let x32 = c_q8 * x30 - x26 * x29 + x11 * s_q8;
+        let x33 = x29 + -0.00000000020510342851533115 * x11;
+        let x34 = v[7] * x28;
+        let x35 = v[7] * x27;
+        let x36 = v[7] * x32;
+        let x37 = v[7] * x31;
+        let x38 = v[7] + (x7 + -0.00000000020510342851533115 * x18);
+        let x39 = -0.0000000234896432582596 * x28 + -0.0021399965876409276 * x38
+            + -12.701650001451807 * x33;
+        let x40 = -0.0000000234896432582596 * x27 + -111.7548902508081 * x28
+            + 5.080660024070365 * x38 + x33 * 0.000000008530897668050218;
+        let x41 = -0.0021399965876409276 * x27 + 5.080660024070366 * x28
+            + 113.3918902508081 * x38
+            + (x31 * 12.701650001451807 + -0.000000008530897668050218 * x32);
+        let x42 = -12.701650001451807 * x38;
+        let x43 = x38 * 0.000000008530897668050218;
+        let x44 = x27 * 12.701650001451807 + -0.000000008530897668050218 * x28;
+        let (s_q9, c_q9) = libm::sincos(q[9]);
+        let x46 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x47 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x48 = 0.00000000020510342851533115 * c_q9
+            + -0.00000000020510342851533115 * s_q9;
+        let x49 = -0.00000000020510342851533115 * c_q9
+            - 0.00000000020510342851533115 * s_q9;
+        let x50 = x27 * x46 + x28 * x48 + x38 * c_q9;
+        let x51 = x27 * x47 + x28 * x49 - x38 * s_q9;
+        let x52 = x31 - (x28 * -0.4 + 0.275 * x38);
+        let x53 = x32 - 0.4 * x27;
+        let x54 = x33 - -0.275 * x27;
+        let x55 = x46 * x52 + x48 * x53 + c_q9 * x54;
+        let x56 = x47 * x52 + x49 * x53 - s_q9 * x54;
+        let x57 = x53 + 0.00000000020510342851533115 * x52
+            + -0.00000000020510342851533115 * x54;
+        let x58 = v[8] * x51;
+        let x59 = v[8] * x50;
+        let x60 = v[8] * x56;
+        let x61 = v[8] * x55;
+        let x62 = v[8]
+            + (x28 + 0.00000000020510342851533115 * x27
+                + -0.00000000020510342851533115 * x38);
+        let x63 = -63.36336825000001 * x51 + -36.18604050126307 * x62;
+        let x64 = -0.00214 * x62 + -81.53205 * x57;
+        let x65 = -0.00214 * x50 + -36.18604050126307 * x51 + 69.99836825 * x62
+            + x55 * 81.53205;
+        let x66 = -81.53205 * x62;
+        let x67 = x50 * 81.53205;
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x69 = x50 * c_q10 + x51 * s_q10;
+        let x70 = x51 * c_q10 - x50 * s_q10;
+        let x71 = x55 - -0.87 * x62;
+        let x72 = x57 - x50 * 0.87;
+        let x73 = c_q10 * x71 + x56 * s_q10;
+        let x74 = x56 * c_q10 - s_q10 * x71;
+        let x75 = v[9] * x70;
+        let x76 = v[9] * x69;
+        let x77 = v[9] * x74;
+        let x78 = v[9] * x73;
+        let x79 = v[9] + x62;
+        let x80 = -24.4950615 * x70 + -24.35164200091464 * x79;
+        let x81 = -0.6328 * x79 + -45.1584 * x72;
+        let x82 = -0.6328 * x69 + -24.351642000914637 * x70 + 28.2393615 * x79
+            + x73 * 45.1584;
+        let x83 = -45.1584 * x79;
+        let x84 = x69 * 45.1584;
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x86 = x69 * c_q11 + x70 * s_q11;
+        let x87 = x70 * c_q11 - x69 * s_q11;
+        let x88 = x73 - (0.275 * x70 + -0.63 * x79);
+        let x89 = x74 - -0.275 * x69;
+        let x90 = x72 - x69 * 0.63;
+        let x91 = c_q11 * x88 + s_q11 * x89;
+        let x92 = c_q11 * x89 - s_q11 * x88;
+        let x93 = v[10] * x87;
+        let x94 = v[10] * x86;
+        let x95 = v[10] * x92;
+        let x96 = v[10] * x91;
+        let x97 = v[10] + x79;
+        let x98 = -9.142025249762803 * x87 + 2.5482240016099564 * x97;
+        let x99 = 0.01675 * x97 + 7.078399999258757 * x90;
+        let x100 = 0.01675 * x86 + 2.5482240016099564 * x87 + 9.223235249762805 * x97
+            + x91 * -7.078399999258757;
+        let x101 = 7.078399999258757 * x97;
+        let x102 = x86 * -7.078399999258757;
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x104 = -0.00000000020510342851533115 * s_q12;
+        let x105 = -0.00000000020510342851533115 * c_q12;
+        let x106 = x86 * c_q12 + x87 * x104 - x97 * s_q12;
+        let x107 = x87 * x105 - x86 * s_q12 - x97 * c_q12;
+        let x108 = x91 - x87 * 0.36;
+        let x109 = x92 - -0.36 * x86;
+        let x110 = c_q12 * x108 + x104 * x109 - x90 * s_q12;
+        let x111 = x105 * x109 - s_q12 * x108 - x90 * c_q12;
+        let x112 = x109 + -0.00000000020510342851533115 * x90;
+        let x113 = v[11] * x107;
+        let x114 = v[11] * x106;
+        let x115 = v[11] * x111;
+        let x116 = v[11] * x110;
+        let x117 = v[11] + (x87 + -0.00000000020510342851533115 * x97);
+        let x118 = -1.9877000000000002 * x107 + -0.809539999555672 * x117
+            + 17.135250000000003 * x112;
+        let x119 = -1.9877000000000002 * x106 + -5.252920330000002 * x107
+            + -2.741639999592316 * x117 + x112 * -3.6140000000000003;
+        let x120 = -0.809539999555672 * x106 + -2.7416399995923166 * x107
+            + 9.740442170000001 * x117
+            + (x110 * -17.135250000000003 + 3.6140000000000003 * x111);
+        let x121 = 17.135250000000003 * x117;
+        let x122 = x117 * -3.6140000000000003;
+        let x123 = x106 * -17.135250000000003 + 3.6140000000000003 * x107;
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x125 = -0.00000000020510342851533115 * c_q13;
+        let x126 = -0.00000000020510342851533115 * s_q13;
+        let x127 = x106 * x125 + x107 * s_q13 - x117 * c_q13;
+        let x128 = x107 * c_q13 - x106 * x126 + x117 * s_q13;
+        let x129 = x110 - (-0.16 * x107 + 0.55 * x117);
+        let x130 = x111 - 0.16 * x106;
+        let x131 = x112 - x106 * -0.55;
+        let x132 = x125 * x129 + s_q13 * x130 - c_q13 * x131;
+        let x133 = c_q13 * x130 - x126 * x129 + s_q13 * x131;
+        let x134 = x129 + -0.00000000020510342851533115 * x131;
+        let x135 = v[12] * x128;
+        let x136 = v[12] * x127;
+        let x137 = v[12] * x133;
+        let x138 = v[12] + (x106 + -0.00000000020510342851533115 * x117);
+        let x139 = 0.000781 * x127 + -1.2025609200000003 * x128
+            + -0.9614610000000001 * x138;
+        let x140 = 0.000781 * x128 + -0.0145 * x138 + 4.806620000000001 * x134;
+        let x141 = -0.0145 * x127 + -0.9614610000000001 * x128
+            + 1.4135609200000003 * x138 + x132 * -4.806620000000001;
+        let x142 = 4.806620000000001 * x138;
+        let x143 = x127 * -4.806620000000001;
+        let x144 = x127 * x139 - x128 * x140 + x133 * x142;
+        let x145 = x127 * x143 - x138 * x142;
+        let x146 = tau[6] - x144;
+        let x147 = x128 * x142 + 4.806620000000001 * x135;
+        let x148 = x128 * x141 - x138 * x139 - x133 * x143
+            + (x135 * -0.00014873784145079505 - x136 * -0.009081457502008472
+                + x137 * -0.049305260929256585) + x146 * -0.010257782169020348;
+        let x149 = x138 * x140 - x127 * x141 + (x132 * x143 - x134 * x142)
+            + (x135 * -0.009081457502008472 - x136 * -1.8565173511957638
+                + x137 * -3.2693162398830324) + x146 * -0.6801694828971361;
+        let x150 = x144 + x146;
+        let x151 = x135 * -0.049305260929256585 - x136 * -3.2693162398830324
+            + x137 * -16.344251950881606 - x128 * x143 + x146 * -3.4003628227073506;
+        let x152 = c_q13 * -0.009081457502008472;
+        let x153 = s_q13 * -0.00014873784145079505 + x152;
+        let x154 = s_q13 * -0.009081457502008472;
+        let x155 = x154 - c_q13 * -0.00014873784145079505;
+        let x156 = x154 + c_q13 * -1.8565173511957638;
+        let x157 = s_q13 * -1.8565173511957638 - x152;
+        let x158 = 4.806620000000001 + x125 * -0.049305260929256585;
+        let x159 = s_q13 * -0.049305260929256585;
+        let x160 = -0.0000000009858542415703612 - c_q13 * -0.049305260929256585;
+        let x161 = x125 * -3.2693162398830324;
+        let x162 = s_q13 * -3.2693162398830324;
+        let x163 = c_q13 * -3.2693162398830324;
+        let x164 = x125 * x158 - x126 * x161;
+        let x165 = x125 * x159 - x126 * x162;
+        let x166 = x125 * x160 + x126 * x163;
+        let x167 = s_q13 * x158 + c_q13 * x161;
+        let x168 = s_q13 * x161 - c_q13 * x158;
+        let x169 = s_q13 * -16.344251950881606;
+        let x170 = c_q13 * -16.344251950881606;
+        let x171 = x125 * (x125 * -16.344251950881606);
+        let x172 = x125 * x169;
+        let x173 = x125 * x170;
+        let x174 = s_q13 * x169;
+        let x175 = s_q13 * x170;
+        let x176 = c_q13 * x170;
+        let x177 = x165 + (-0.16 * x174 - 0.55 * x175);
+        let x178 = x166 + (0.55 * x176 - -0.16 * x175);
+        let x179 = x167 + 0.16 * x171;
+        let x180 = s_q13 * x159 + c_q13 * x162 + 0.16 * x172;
+        let x181 = s_q13 * x160 - c_q13 * x163 - 0.16 * x173;
+        let x182 = x168 + -0.55 * x171;
+        let x183 = s_q13 * x162 - c_q13 * x159 + -0.55 * x172;
+        let x184 = c_q13 * x160 + s_q13 * x163 + -0.55 * x173;
+        let x185 = x147 + (x125 * x151 - x126 * x145);
+        let x186 = s_q13 * x151 + c_q13 * x145;
+        let x187 = s_q13 * x145 - c_q13 * x151 + -0.00000000020510342851533115 * x147;
+        let x188 = -0.809539999555672
+            + (-0.55 * x164
+                + (x125 * x155 - x126 * x157 + (-0.16 * x183 - 0.55 * x184)));
+        let x189 = -2.741639999592316
+            + (-0.55 * x167 + (s_q13 * x155 + c_q13 * x157 + 0.16 * x182));
+        let x190 = 9.740442170000001
+            + (-0.55 * x168 + (s_q13 * x157 - c_q13 * x155 + -0.55 * x182));
+        let x191 = -17.135250000000003 + x182;
+        let x192 = 3.6140000000000003 + x183;
+        let x193 = x106 * x119 - x107 * x118 + (x111 * x121 - x110 * x122)
+            + (s_q13 * x149 - c_q13 * x148 + -0.00000000020510342851533115 * x150
+                + -0.55 * x185);
+        let x194 = 1.0 / x190;
+        let x195 = tau[5] - x193;
+        let x196 = x188 * x194;
+        let x197 = x189 * x194;
+        let x198 = x191 * x194;
+        let x199 = x192 * x194;
+        let x200 = x184 * x194;
+        let x201 = -0.16 * x165 + 0.55 * x166
+            + (x125 * (x125 * -0.00014873784145079505 - x126 * -0.009081457502008472)
+                - x126 * (x125 * -0.009081457502008472 - x126 * -1.8565173511957638)
+                + (-0.16 * x177 + 0.55 * x178)) - x188 * x196;
+        let x202 = -1.9877000000000002
+            + (0.16 * x164 + (x125 * x153 - x126 * x156 + (-0.16 * x180 + 0.55 * x181)))
+            - x188 * x197;
+        let x203 = -5.252920330000002
+            + (0.16 * x167 + (s_q13 * x153 + c_q13 * x156 + 0.16 * x179)) - x189 * x197;
+        let x204 = x164 + (-0.16 * x172 - 0.55 * x173) - x188 * x198;
+        let x205 = x177 - x188 * x199;
+        let x206 = 17.135250000000003 + x178 + x188 * x200;
+        let x207 = x179 - x189 * x198;
+        let x208 = x180 - x189 * x199;
+        let x209 = -3.6140000000000003 + x181 + x189 * x200;
+        let x210 = x171 - x191 * x198;
+        let x211 = x172 - x191 * x199;
+        let x212 = x191 * x200 - x173;
+        let x213 = x174 - x192 * x199;
+        let x214 = x192 * x200 - x175;
+        let x215 = x176 - x184 * x200;
+        let x216 = x107 * x120 - x117 * x119 + (x112 * x122 - x111 * x123)
+            + (x150 + (x125 * x148 - x126 * x149) + (-0.16 * x186 + 0.55 * x187))
+            + (x113 * x201 - x114 * x202 + (x115 * x204 - x116 * x205)) + x195 * x196;
+        let x217 = x117 * x118 - x106 * x120 + (x110 * x123 - x112 * x121)
+            + (s_q13 * x148 + c_q13 * x149 + 0.16 * x185)
+            + (x113 * x202 - x114 * x203 + (x115 * x207 - x116 * x208)) + x195 * x197;
+        let x218 = x193 + x195 * (x190 * x194);
+        let x219 = x117 * x122 - x107 * x123 + x185
+            + (x113 * x204 - x114 * x207 + (x115 * x210 - x116 * x211)) + x195 * x198;
+        let x220 = x106 * x123 - x117 * x121 + x186
+            + (x113 * x205 - x114 * x208 + (x115 * x211 - x116 * x213)) + x195 * x199;
+        let x221 = x107 * x121 - x106 * x122 + x187
+            + (x113 * x206 - x114 * x209 + (x115 * x212 - x116 * x214)) - x195 * x200;
+        let x222 = s_q12 * x202;
+        let x223 = x104 * x201 + x105 * x202;
+        let x224 = c_q12 * x202;
+        let x225 = s_q12 * x201 + x224;
+        let x226 = x104 * x202 + x105 * x203;
+        let x227 = x222 + c_q12 * x203;
+        let x228 = c_q12 * x204 - s_q12 * x205;
+        let x229 = x206 + (x104 * x204 + x105 * x205);
+        let x230 = -0.00000000020510342851533115 * x206 - (s_q12 * x204 + c_q12 * x205);
+        let x231 = c_q12 * x207 - s_q12 * x208;
+        let x232 = x209 + (x104 * x207 + x105 * x208);
+        let x233 = -0.00000000020510342851533115 * x209 - (s_q12 * x207 + c_q12 * x208);
+        let x234 = c_q12 * x228 - s_q12 * x231;
+        let x235 = c_q12 * x229 - s_q12 * x232;
+        let x236 = x104 * x228 + x105 * x231;
+        let x237 = s_q12 * x228 + c_q12 * x231;
+        let x238 = s_q12 * x229 + c_q12 * x232;
+        let x239 = s_q12 * x230 + c_q12 * x233;
+        let x240 = s_q12 * x211;
+        let x241 = x212 + (x104 * x210 + x105 * x211);
+        let x242 = c_q12 * x211;
+        let x243 = -0.00000000020510342851533115 * x212 - (s_q12 * x210 + x242);
+        let x244 = x214 + (x104 * x211 + x105 * x213);
+        let x245 = -0.00000000020510342851533115 * x214 - (x240 + c_q12 * x213);
+        let x246 = -0.00000000020510342851533115 * x215 - (s_q12 * x212 + c_q12 * x214);
+        let x247 = c_q12 * (c_q12 * x210 - x240) - s_q12 * (x242 - s_q12 * x213);
+        let x248 = c_q12 * x241 - s_q12 * x244;
+        let x249 = c_q12 * x243 - s_q12 * x245;
+        let x250 = x215 + (x104 * x212 + x105 * x214) + (x104 * x241 + x105 * x244);
+        let x251 = x246 + (x104 * x243 + x105 * x245);
+        let x252 = x235 + 0.36 * x250;
+        let x253 = x236 + -0.36 * x247;
+        let x254 = x104 * x229 + x105 * x232 + -0.36 * x248;
+        let x255 = c_q12 * x219 - s_q12 * x220;
+        let x256 = x221 + (x104 * x219 + x105 * x220);
+        let x257 = 0.01675 + (s_q12 * x227 - c_q12 * x225 - 0.36 * x238);
+        let x258 = 2.5482240016099564 - (x104 * x225 + x105 * x227 + -0.36 * x237);
+        let x259 = 9.223235249762805 + (s_q12 * x225 + c_q12 * x227);
+        let x260 = -7.078399999258757 - x237;
+        let x261 = x86 * x98 - x87 * x99 + x92 * x101
+            + (-0.00000000020510342851533115 * x218 - (s_q12 * x216 + c_q12 * x217));
+        let x262 = 1.0 / x259;
+        let x263 = tau[4] - x261;
+        let x264 = x257 * x262;
+        let x265 = x258 * x262;
+        let x266 = x260 * x262;
+        let x267 = x238 * x262;
+        let x268 = x239 * x262;
+        let x269 = 0.36 * x235
+            + (c_q12 * (c_q12 * x201 - x222) - s_q12 * (x224 - s_q12 * x203)
+                + 0.36 * x252) - x257 * x264;
+        let x270 = -0.36 * x234 + (c_q12 * x223 - s_q12 * x226 + 0.36 * x254)
+            - x257 * x265;
+        let x271 = -9.142025249762803
+            + (-0.36 * x236 + (x104 * x223 + x105 * x226 + -0.36 * x253)) - x258 * x265;
+        let x272 = x234 + 0.36 * x248 - x257 * x266;
+        let x273 = x252 + x257 * x267;
+        let x274 = 7.078399999258757 + (c_q12 * x230 - s_q12 * x233 + 0.36 * x251)
+            + x257 * x268;
+        let x275 = x253 - x258 * x266;
+        let x276 = x254 + x258 * x267;
+        let x277 = x104 * x230 + x105 * x233 + -0.36 * x249 + x258 * x268;
+        let x278 = x247 - x260 * x266;
+        let x279 = x248 + x260 * x267;
+        let x280 = x249 + x260 * x268;
+        let x281 = x250 - x238 * x267;
+        let x282 = x251 - x238 * x268;
+        let x283 = -0.00000000020510342851533115 * x246 - (s_q12 * x243 + c_q12 * x245)
+            - x239 * x268;
+        let x284 = x87 * x100 - x97 * x98 - x92 * x102
+            + (c_q12 * x216 - s_q12 * x217 + 0.36 * x256)
+            + (x93 * x269 - x94 * x270 + (x95 * x272 - x96 * x273)) + x263 * x264;
+        let x285 = x97 * x99 - x86 * x100 + (x91 * x102 - x90 * x101)
+            + (x218 + (x104 * x216 + x105 * x217) + -0.36 * x255)
+            + (x93 * x270 - x94 * x271 + (x95 * x275 - x96 * x276)) + x263 * x265;
+        let x286 = x255 - x87 * x102
+            + (x93 * x272 - x94 * x275 + (x95 * x278 - x96 * x279)) + x263 * x266;
+        let x287 = x86 * x102 - x97 * x101 + x256
+            + (x93 * x273 - x94 * x276 + (x95 * x279 - x96 * x281)) - x263 * x267;
+        let x288 = x87 * x101
+            + (-0.00000000020510342851533115 * x221 - (s_q12 * x219 + c_q12 * x220))
+            + (x93 * x274 - x94 * x277 + (x95 * x280 - x96 * x282)) - x263 * x268;
+        let x289 = s_q11 * x270;
+        let x290 = c_q11 * x270;
+        let x291 = s_q11 * x269 + x290;
+        let x292 = x289 + c_q11 * x271;
+        let x293 = c_q11 * x272 - s_q11 * x273;
+        let x294 = s_q11 * x272 + c_q11 * x273;
+        let x295 = c_q11 * x275 - s_q11 * x276;
+        let x296 = s_q11 * x275 + c_q11 * x276;
+        let x297 = c_q11 * x293 - s_q11 * x295;
+        let x298 = c_q11 * x294 - s_q11 * x296;
+        let x299 = c_q11 * x274 - s_q11 * x277;
+        let x300 = s_q11 * x293 + c_q11 * x295;
+        let x301 = s_q11 * x279;
+        let x302 = c_q11 * x279;
+        let x303 = s_q11 * x278 + x302;
+        let x304 = x301 + c_q11 * x281;
+        let x305 = c_q11 * x280 - s_q11 * x282;
+        let x306 = s_q11 * x280 + c_q11 * x282;
+        let x307 = c_q11 * (c_q11 * x278 - x301) - s_q11 * (x302 - s_q11 * x281);
+        let x308 = c_q11 * x303 - s_q11 * x304;
+        let x309 = s_q11 * x303 + c_q11 * x304;
+        let x310 = 0.63 * x307;
+        let x311 = 0.63 * x308;
+        let x312 = 0.63 * x305;
+        let x313 = x298 + (0.275 * x309 + -0.63 * x306);
+        let x314 = x299 + (0.275 * x306 + -0.63 * x283);
+        let x315 = x300 + -0.275 * x307;
+        let x316 = s_q11 * x294 + c_q11 * x296 + -0.275 * x308;
+        let x317 = s_q11 * x274 + c_q11 * x277 + -0.275 * x305;
+        let x318 = c_q11 * x286 - s_q11 * x287;
+        let x319 = s_q11 * x286 + c_q11 * x287;
+        let x320 = -0.6328 + (0.275 * x311 + -0.63 * x312 + 0.63 * x297);
+        let x321 = -24.35164200091464 + (-0.275 * x310 + 0.63 * x300);
+        let x322 = 28.2393615 + 0.63 * x310;
+        let x323 = 45.1584 + x310;
+        let x324 = x69 * x80 - x70 * x81 + x74 * x83
+            + (x261 + x263 * (x259 * x262) + 0.63 * x318);
+        let x325 = 1.0 / x322;
+        let x326 = tau[3] - x324;
+        let x327 = x320 * x325;
+        let x328 = x321 * x325;
+        let x329 = x323 * x325;
+        let x330 = x311 * x325;
+        let x331 = x312 * x325;
+        let x332 = 0.275 * x298 + -0.63 * x299
+            + (c_q11 * (c_q11 * x269 - x289) - s_q11 * (x290 - s_q11 * x271)
+                + (0.275 * x313 + -0.63 * x314)) - x320 * x327;
+        let x333 = -0.275 * x297
+            + (c_q11 * x291 - s_q11 * x292 + (0.275 * x316 + -0.63 * x317))
+            - x320 * x328;
+        let x334 = -24.4950615
+            + (-0.275 * x300 + (s_q11 * x291 + c_q11 * x292 + -0.275 * x315))
+            - x321 * x328;
+        let x335 = x297 + (0.275 * x308 + -0.63 * x305) - x320 * x329;
+        let x336 = x313 - x320 * x330;
+        let x337 = -45.1584 + x314 - x320 * x331;
+        let x338 = x315 - x321 * x329;
+        let x339 = x316 - x321 * x330;
+        let x340 = x317 - x321 * x331;
+        let x341 = x307 - x323 * x329;
+        let x342 = x308 - x323 * x330;
+        let x343 = x305 - x323 * x331;
+        let x344 = x309 - x311 * x330;
+        let x345 = x306 - x311 * x331;
+        let x346 = x283 - x312 * x331;
+        let x347 = x70 * x82 - x79 * x80 - x74 * x84
+            + (c_q11 * x284 - s_q11 * x285 + (0.275 * x319 + -0.63 * x288))
+            + (x75 * x332 - x76 * x333 + (x77 * x335 - x78 * x336)) + x326 * x327;
+        let x348 = x79 * x81 - x69 * x82 + (x73 * x84 - x72 * x83)
+            + (s_q11 * x284 + c_q11 * x285 + -0.275 * x318)
+            + (x75 * x333 - x76 * x334 + (x77 * x338 - x78 * x339)) + x326 * x328;
+        let x349 = x318 - x70 * x84
+            + (x75 * x335 - x76 * x338 + (x77 * x341 - x78 * x342)) + x326 * x329;
+        let x350 = x69 * x84 - x79 * x83 + x319
+            + (x75 * x336 - x76 * x339 + (x77 * x342 - x78 * x344)) + x326 * x330;
+        let x351 = x70 * x83 + x288
+            + (x75 * x337 - x76 * x340 + (x77 * x343 - x78 * x345)) + x326 * x331;
+        let x352 = s_q10 * x333;
+        let x353 = c_q10 * x333;
+        let x354 = s_q10 * x332 + x353;
+        let x355 = x352 + c_q10 * x334;
+        let x356 = c_q10 * x335 - s_q10 * x336;
+        let x357 = s_q10 * x335 + c_q10 * x336;
+        let x358 = c_q10 * x338 - s_q10 * x339;
+        let x359 = s_q10 * x338 + c_q10 * x339;
+        let x360 = c_q10 * x356 - s_q10 * x358;
+        let x361 = c_q10 * x337 - s_q10 * x340;
+        let x362 = s_q10 * x356 + c_q10 * x358;
+        let x363 = s_q10 * x337 + c_q10 * x340;
+        let x364 = s_q10 * x342;
+        let x365 = c_q10 * x342;
+        let x366 = s_q10 * x341 + x365;
+        let x367 = x364 + c_q10 * x344;
+        let x368 = c_q10 * x343 - s_q10 * x345;
+        let x369 = s_q10 * x343 + c_q10 * x345;
+        let x370 = c_q10 * (c_q10 * x341 - x364) - s_q10 * (x365 - s_q10 * x344);
+        let x371 = c_q10 * x366 - s_q10 * x367;
+        let x372 = 0.87 * x370;
+        let x373 = 0.87 * x371;
+        let x374 = 0.87 * x368;
+        let x375 = x361 + -0.87 * x346;
+        let x376 = c_q10 * x349 - s_q10 * x350;
+        let x377 = -0.00214 + (-0.87 * x374 + 0.87 * x360);
+        let x378 = -36.18604050126307 + 0.87 * x362;
+        let x379 = 69.99836825 + 0.87 * x372;
+        let x380 = 81.53205 + x372;
+        let x381 = x50 * x63 - x51 * x64 + x56 * x66
+            + (x324 + x326 * (x322 * x325) + 0.87 * x376);
+        let x382 = 1.0 / x379;
+        let x383 = tau[2] - x381;
+        let x384 = x377 * x382;
+        let x385 = x378 * x382;
+        let x386 = x380 * x382;
+        let x387 = x373 * x382;
+        let x388 = x374 * x382;
+        let x389 = -0.87 * x361
+            + (c_q10 * (c_q10 * x332 - x352) - s_q10 * (x353 - s_q10 * x334)
+                + -0.87 * x375) - x377 * x384;
+        let x390 = c_q10 * x354 - s_q10 * x355 + -0.87 * x363 - x377 * x385;
+        let x391 = -63.36336825000001 + (s_q10 * x354 + c_q10 * x355) - x378 * x385;
+        let x392 = x360 + -0.87 * x368 - x377 * x386;
+        let x393 = c_q10 * x357 - s_q10 * x359 + -0.87 * x369 - x377 * x387;
+        let x394 = -81.53205 + x375 - x377 * x388;
+        let x395 = x362 - x378 * x386;
+        let x396 = s_q10 * x357 + c_q10 * x359 - x378 * x387;
+        let x397 = x363 - x378 * x388;
+        let x398 = x370 - x380 * x386;
+        let x399 = x371 - x380 * x387;
+        let x400 = x368 - x380 * x388;
+        let x401 = s_q10 * x366 + c_q10 * x367 - x373 * x387;
+        let x402 = x369 - x373 * x388;
+        let x403 = x346 - x374 * x388;
+        let x404 = x51 * x65 - x62 * x63 - x56 * x67
+            + (c_q10 * x347 - s_q10 * x348 + -0.87 * x351)
+            + (x58 * x389 - x59 * x390 + (x60 * x392 - x61 * x393)) + x383 * x384;
+        let x405 = x62 * x64 - x50 * x65 + (x55 * x67 - x57 * x66)
+            + (s_q10 * x347 + c_q10 * x348)
+            + (x58 * x390 - x59 * x391 + (x60 * x395 - x61 * x396)) + x383 * x385;
+        let x406 = x381 + x383 * (x379 * x382);
+        let x407 = x376 - x51 * x67
+            + (x58 * x392 - x59 * x395 + (x60 * x398 - x61 * x399)) + x383 * x386;
+        let x408 = x50 * x67 - x62 * x66 + (s_q10 * x349 + c_q10 * x350)
+            + (x58 * x393 - x59 * x396 + (x60 * x399 - x61 * x401)) + x383 * x387;
+        let x409 = x51 * x66 + x351
+            + (x58 * x394 - x59 * x397 + (x60 * x400 - x61 * x402)) + x383 * x388;
+        let x410 = x48 * x389 + x49 * x390;
+        let x411 = c_q9 * x389 - s_q9 * x390;
+        let x412 = x48 * x390 + x49 * x391;
+        let x413 = c_q9 * x390 - s_q9 * x391;
+        let x414 = x46 * x392 + x47 * x393 + 0.00000000020510342851533115 * x394;
+        let x415 = x394 + (x48 * x392 + x49 * x393);
+        let x416 = c_q9 * x392 - s_q9 * x393 + -0.00000000020510342851533115 * x394;
+        let x417 = x46 * x395 + x47 * x396 + 0.00000000020510342851533115 * x397;
+        let x418 = x397 + (x48 * x395 + x49 * x396);
+        let x419 = c_q9 * x395 - s_q9 * x396 + -0.00000000020510342851533115 * x397;
+        let x420 = x46 * x414 + x47 * x417;
+        let x421 = x46 * x415 + x47 * x418;
+        let x422 = x46 * x416 + x47 * x419;
+        let x423 = x48 * x414 + x49 * x417;
+        let x424 = c_q9 * x414 - s_q9 * x417;
+        let x425 = x400 + (x48 * x398 + x49 * x399);
+        let x426 = c_q9 * x398 - s_q9 * x399 + -0.00000000020510342851533115 * x400;
+        let x427 = x402 + (x48 * x399 + x49 * x401);
+        let x428 = c_q9 * x399 - s_q9 * x401 + -0.00000000020510342851533115 * x402;
+        let x429 = x403 + (x48 * x400 + x49 * x402);
+        let x430 = c_q9 * x400 - s_q9 * x402 + -0.00000000020510342851533115 * x403;
+        let x431 = x46 * (x46 * x398 + x47 * x399 + 0.00000000020510342851533115 * x400)
+            + x47 * (x46 * x399 + x47 * x401 + 0.00000000020510342851533115 * x402)
+            + 0.00000000020510342851533115
+                * (x46 * x400 + x47 * x402 + 0.00000000020510342851533115 * x403);
+        let x432 = x46 * x425 + x47 * x427 + 0.00000000020510342851533115 * x429;
+        let x433 = x46 * x426 + x47 * x428 + 0.00000000020510342851533115 * x430;
+        let x434 = x429 + (x48 * x425 + x49 * x427);
+        let x435 = x430 + (x48 * x426 + x49 * x428);
+        let x436 = c_q9 * x426 - s_q9 * x428 + -0.00000000020510342851533115 * x430;
+        let x437 = x421 + (-0.4 * x434 + 0.275 * x435);
+        let x438 = x422 + (-0.4 * x435 + 0.275 * x436);
+        let x439 = x423 + 0.4 * x431;
+        let x440 = x48 * x415 + x49 * x418 + 0.4 * x432;
+        let x441 = x48 * x416 + x49 * x419 + 0.4 * x433;
+        let x442 = x424 + -0.275 * x431;
+        let x443 = c_q9 * x415 - s_q9 * x418 + -0.275 * x432;
+        let x444 = c_q9 * x416 - s_q9 * x419 + -0.275 * x433;
+        let x445 = x46 * x407 + x47 * x408 + 0.00000000020510342851533115 * x409;
+        let x446 = x409 + (x48 * x407 + x49 * x408);
+        let x447 = c_q9 * x407 - s_q9 * x408 + -0.00000000020510342851533115 * x409;
+        let x448 = -0.0021399965876409276
+            + (-0.275 * x420 + (x46 * x411 + x47 * x413 + (-0.4 * x443 + 0.275 * x444)));
+        let x449 = 5.080660024070365
+            + (-0.275 * x423 + (x48 * x411 + x49 * x413 + 0.4 * x442));
+        let x450 = 113.3918902508081
+            + (-0.275 * x424 + (c_q9 * x411 - s_q9 * x413 + -0.275 * x442));
+        let x451 = 12.701650001451807 + x442;
+        let x452 = -0.000000008530897668050218 + x443;
+        let x453 = x27 * x40 - x28 * x39 + (x32 * x42 - x31 * x43)
+            + (c_q9 * x404 - s_q9 * x405 + -0.00000000020510342851533115 * x406
+                + -0.275 * x445);
+        let x454 = 1.0 / x450;
+        let x455 = tau[1] - x453;
+        let x456 = x448 * x454;
+        let x457 = x449 * x454;
+        let x458 = x451 * x454;
+        let x459 = x452 * x454;
+        let x460 = x444 * x454;
+        let x461 = -0.4 * x421 + 0.275 * x422
+            + (x46 * (x46 * x389 + x47 * x390) + x47 * (x46 * x390 + x47 * x391)
+                + (-0.4 * x437 + 0.275 * x438)) - x448 * x456;
+        let x462 = -0.0000000234896432582596
+            + (0.4 * x420 + (x46 * x410 + x47 * x412 + (-0.4 * x440 + 0.275 * x441)))
+            - x448 * x457;
+        let x463 = -111.7548902508081
+            + (0.4 * x423 + (x48 * x410 + x49 * x412 + 0.4 * x439)) - x449 * x457;
+        let x464 = x420 + (-0.4 * x432 + 0.275 * x433) - x448 * x458;
+        let x465 = x437 - x448 * x459;
+        let x466 = -12.701650001451807 + x438 - x448 * x460;
+        let x467 = x439 - x449 * x458;
+        let x468 = x440 - x449 * x459;
+        let x469 = 0.000000008530897668050218 + x441 - x449 * x460;
+        let x470 = x431 - x451 * x458;
+        let x471 = x432 - x451 * x459;
+        let x472 = x433 - x451 * x460;
+        let x473 = x434 - x452 * x459;
+        let x474 = x435 - x452 * x460;
+        let x475 = x436 - x444 * x460;
+        let x476 = x28 * x41 - x38 * x40 + (x33 * x43 - x32 * x44)
+            + (x46 * x404 + x47 * x405 + 0.00000000020510342851533115 * x406
+                + (-0.4 * x446 + 0.275 * x447))
+            + (x34 * x461 - x35 * x462 + (x36 * x464 - x37 * x465)) + x455 * x456;
+        let x477 = x38 * x39 - x27 * x41 + (x31 * x44 - x33 * x42)
+            + (x406 + (x48 * x404 + x49 * x405) + 0.4 * x445)
+            + (x34 * x462 - x35 * x463 + (x36 * x467 - x37 * x468)) + x455 * x457;
+        let x478 = x453 + x455 * (x450 * x454);
+        let x479 = x38 * x43 - x28 * x44 + x445
+            + (x34 * x464 - x35 * x467 + (x36 * x470 - x37 * x471)) + x455 * x458;
+        let x480 = x27 * x44 - x38 * x42 + x446
+            + (x34 * x465 - x35 * x468 + (x36 * x471 - x37 * x473)) + x455 * x459;
+        let x481 = x28 * x42 - x27 * x43 + x447
+            + (x34 * x466 - x35 * x469 + (x36 * x472 - x37 * x474)) + x455 * x460;
+        let x482 = c_q8 * x462;
+        let x483 = s_q8 * x461 + x482;
+        let x484 = s_q8 * x462;
+        let x485 = x484 - c_q8 * x461;
+        let x486 = x484 + c_q8 * x463;
+        let x487 = s_q8 * x463 - x482;
+        let x488 = x466 + (x25 * x464 - x26 * x465);
+        let x489 = s_q8 * x464 + c_q8 * x465;
+        let x490 = s_q8 * x465 - c_q8 * x464 + -0.00000000020510342851533115 * x466;
+        let x491 = x469 + (x25 * x467 - x26 * x468);
+        let x492 = s_q8 * x467 + c_q8 * x468;
+        let x493 = s_q8 * x468 - c_q8 * x467 + -0.00000000020510342851533115 * x469;
+        let x494 = x25 * x488 - x26 * x491;
+        let x495 = x25 * x489 - x26 * x492;
+        let x496 = s_q8 * x488 + c_q8 * x491;
+        let x497 = s_q8 * x491 - c_q8 * x488;
+        let x498 = s_q8 * x492 - c_q8 * x489;
+        let x499 = s_q8 * x493 - c_q8 * x490;
+        let x500 = c_q8 * x471;
+        let x501 = s_q8 * x470 + x500;
+        let x502 = s_q8 * x471;
+        let x503 = x502 - c_q8 * x470 + -0.00000000020510342851533115 * x472;
+        let x504 = x502 + c_q8 * x473;
+        let x505 = s_q8 * x473 - x500 + -0.00000000020510342851533115 * x474;
+        let x506 = s_q8 * x474 - c_q8 * x472 + -0.00000000020510342851533115 * x475;
+        let x507 = x475 + (x25 * x472 - x26 * x474)
+            + (x25 * (x472 + (x25 * x470 - x26 * x471))
+                - x26 * (x474 + (x25 * x471 - x26 * x473)));
+        let x508 = s_q8 * x472 + c_q8 * x474 + (x25 * x501 - x26 * x504);
+        let x509 = x506 + (x25 * x503 - x26 * x505);
+        let x510 = s_q8 * x501 + c_q8 * x504;
+        let x511 = s_q8 * x503 + c_q8 * x505;
+        let x512 = x495 + -0.35 * x510;
+        let x513 = x496 + 0.35 * x507;
+        let x514 = s_q8 * x489 + c_q8 * x492 + 0.35 * x508;
+        let x515 = x481 + (x25 * x479 - x26 * x480);
+        let x516 = s_q8 * x479 + c_q8 * x480;
+        let x517 = -16.80768997608804 + (x25 * x485 - x26 * x487 + -0.35 * x498);
+        let x518 = 0.1132 + (s_q8 * x485 + c_q8 * x487 + 0.35 * x497);
+        let x519 = 132.47349025763282 + (s_q8 * x487 - c_q8 * x485);
+        let x520 = 48.0240000085309 + x498;
+        let x521 = x7 * x20 - x8 * x19 - x12 * x22
+            + (s_q8 * x477 - c_q8 * x476 + -0.00000000020510342851533115 * x478);
+        let x522 = 1.0 / x519;
+        let x523 = tau[0] - x521;
+        let x524 = x517 * x522;
+        let x525 = x518 * x522;
+        let x526 = x497 * x522;
+        let x527 = x520 * x522;
+        let x528 = x499 * x522;
+        let x529 = -0.35 * x495
+            + (x25 * (x25 * x461 - x26 * x462) - x26 * (x25 * x462 - x26 * x463)
+                + -0.35 * x512) - x517 * x524;
+        let x530 = -0.07309 + (0.35 * x494 + (x25 * x483 - x26 * x486 + -0.35 * x514))
+            - x517 * x525;
+        let x531 = 130.43769025763282
+            + (0.35 * x496 + (s_q8 * x483 + c_q8 * x486 + 0.35 * x513)) - x518 * x525;
+        let x532 = x494 + -0.35 * x508 - x517 * x526;
+        let x533 = x512 - x517 * x527;
+        let x534 = x25 * x490 - x26 * x493 + -0.35 * x511 - x517 * x528;
+        let x535 = x513 - x518 * x526;
+        let x536 = x514 - x518 * x527;
+        let x537 = -48.0240000085309 + (s_q8 * x490 + c_q8 * x493 + 0.35 * x509)
+            - x518 * x528;
+        let x538 = x507 - x497 * x526;
+        let x539 = x508 - x497 * x527;
+        let x540 = x509 - x497 * x528;
+        let x541 = x510 - x520 * x527;
+        let x542 = x511 - x520 * x528;
+        let x543 = s_q8 * x505 - c_q8 * x503 + -0.00000000020510342851533115 * x506
+            - x499 * x528;
+        let x544 = x8 * x21 - x18 * x20 + (x11 * x22 - x13 * x23)
+            + (x478 + (x25 * x476 - x26 * x477) + -0.35 * x516)
+            + (x14 * x529 - x15 * x530 + (x16 * x532 - x17 * x533)) + x523 * x524;
+        let x545 = x18 * x19 - x7 * x21 + x12 * x23
+            + (s_q8 * x476 + c_q8 * x477 + 0.35 * x515)
+            + (x14 * x530 - x15 * x531 + (x16 * x535 - x17 * x536)) + x523 * x525;
+        let x546 = x18 * x22 - x8 * x23 + x515
+            + (x14 * x532 - x15 * x535 + (x16 * x538 - x17 * x539)) + x523 * x526;
+        let x547 = x7 * x23 + x516
+            + (x14 * x533 - x15 * x536 + (x16 * x539 - x17 * x541)) + x523 * x527;
+        let x548 = s_q8 * x480 - c_q8 * x479 + -0.00000000020510342851533115 * x481
+            - x7 * x22 + (x14 * x534 - x15 * x537 + (x16 * x540 - x17 * x542))
+            + x523 * x528;
+        let x549 = s_q7 * x530;
+        let x550 = c_q7 * x530;
+        let x551 = s_q7 * x529 + x550;
+        let x552 = x549 + c_q7 * x531;
+        let x553 = c_q7 * x532 - s_q7 * x533;
+        let x554 = s_q7 * x532 + c_q7 * x533;
+        let x555 = c_q7 * x535 - s_q7 * x536;
+        let x556 = s_q7 * x535 + c_q7 * x536;
+        let x557 = c_q7 * x553 - s_q7 * x555;
+        let x558 = c_q7 * x554 - s_q7 * x556;
+        let x559 = c_q7 * x534 - s_q7 * x537;
+        let x560 = s_q7 * x553 + c_q7 * x555;
+        let x561 = s_q7 * x554 + c_q7 * x556;
+        let x562 = s_q7 * x534 + c_q7 * x537;
+        let x563 = s_q7 * x539;
+        let x564 = c_q7 * x539;
+        let x565 = s_q7 * x538 + x564;
+        let x566 = x563 + c_q7 * x541;
+        let x567 = c_q7 * x540 - s_q7 * x542;
+        let x568 = s_q7 * x540 + c_q7 * x542;
+        let x569 = c_q7 * (c_q7 * x538 - x563) - s_q7 * (x564 - s_q7 * x541);
+        let x570 = c_q7 * x565 - s_q7 * x566;
+        let x571 = s_q7 * x565 + c_q7 * x566;
+        let x572 = 0.65 * x570;
+        let x573 = 0.65 * x571;
+        let x574 = 0.65 * x568;
+        let x575 = x557 + -0.75 * x570;
+        let x576 = x558 + -0.75 * x571;
+        let x577 = x560 + (0.75 * x569 + -0.65 * x567);
+        let x578 = x561 + (0.75 * x570 + -0.65 * x568);
+        let x579 = x562 + (0.75 * x567 + -0.65 * x543);
+        let x580 = c_q7 * x546 - s_q7 * x547;
+        let x581 = s_q7 * x546 + c_q7 * x547;
+        let x582 = 180.9502499901501 + x577;
+        let x583 = v[4] * x5 - v[5] * x4 + x580;
+        let x584 = 1.0 / (1170.07 + x569);
+        let x585 = x570 * x584;
+        let x586 = x567 * x584;
+        let x587 = x575 * x584;
+        let x588 = x582 * x584;
+        let x589 = x572 * x584;
+        let x590 = 1.0 / (1170.07 + x571 - x570 * x585);
+        let x591 = x568 - x570 * x586;
+        let x592 = x590 * x591;
+        let x593 = -180.9502499901501 + x576 - x570 * x587;
+        let x594 = x590 * x593;
+        let x595 = x578 - x570 * x588;
+        let x596 = x590 * x595;
+        let x597 = 110.5455 + x573 - x570 * x589;
+        let x598 = x590 * x597;
+        let x599 = 1.0 / (1170.07 + x543 - x567 * x586 - x591 * x592);
+        let x600 = x559 + -0.75 * x568 - x567 * x587 - x591 * x594;
+        let x601 = x599 * x600;
+        let x602 = -110.5455 + x579 - x567 * x588 - x591 * x596;
+        let x603 = x599 * x602;
+        let x604 = x574 - x567 * x589 - x591 * x598;
+        let x605 = x599 * x604;
+        let x606 = 1.0
+            / (1394.5960312283303
+                + (-0.75 * x558
+                    + (c_q7 * (c_q7 * x529 - x549) - s_q7 * (x550 - s_q7 * x531)
+                        + -0.75 * x576)) - x575 * x587 - x593 * x594 - x600 * x601);
+        let x607 = 0.75 * x557 + -0.65 * x559
+            + (c_q7 * x551 - s_q7 * x552 + -0.75 * x578) - x575 * x588 - x593 * x596
+            - x600 * x603;
+        let x608 = x606 * x607;
+        let x609 = -117.61766249359756 + (-0.75 * x573 + 0.65 * x558) - x575 * x589
+            - x593 * x598 - x600 * x605;
+        let x610 = x606 * x609;
+        let x611 = 1.0
             / (1466.4506062283303
-                + (s_q7 * (s_q7 * x159 + c_q7 * x163)
-                    + c_q7 * (s_q7 * x161 + c_q7 * x164) - (x173 - x172) - (x171 - x174))
-                - x523 - x544 - x526 * x527);
-        let x546 = s_q7 * x162 + c_q7 * x165 - 0.75 * x168 + x178 * x502;
-        let x547 = x546 - x526 * x529;
-        let x548 = x545 * x547;
-        let x549 = x546 - x526 * x531;
-        let x550 = x545 * x549;
-        let x551 = s_q7 * x181 + c_q7 * x182 + (x146 * -0.65 - 0.75 * x183) + x178 * x503
-            + x177 * x517 - x526 * x533;
-        let x552 = x545 * x551;
-        let x553 = s_q7 * x198 + c_q7 * x199 + (0.75 * x200 + -0.65 * x196) - x178 * x504
-            + x177 * x518 - x526 * x535;
-        let x554 = x545 * x553;
-        let x555 = s_q7 * x212 + c_q7 * x213 + (0.75 * x214 + -0.65 * x210) - x178 * x505
-            + x177 * x519 - x526 * x537;
-        let x556 = x545 * x555;
-        let x557 = s_q7 * x231 + c_q7 * x232 + (0.75 * x233 + -0.65 * x229) - x178 * x506
-            + x177 * x520 - x526 * x539;
-        let x558 = x545 * x557;
-        let x559 = s_q7 * x259 + c_q7 * x260 + (0.75 * x261 + -0.65 * x257) - x178 * x507
-            + x177 * x521 - x526 * x541;
-        let x560 = x545 * x559;
-        let x561 = s_q7 * x295 + c_q7 * x296 + (0.75 * x297 + -0.65 * x293) - x178 * x508
-            + x177 * x522 - x526 * x543;
-        let x562 = x545 * x561;
-        let x563 = 1.0
-            / (1271.854575 + (x176 - x173) - x524 - x544 - x528 * x529 - x547 * x548);
-        let x564 = x176 - x524 - x177 * x510 - x528 * x531 - x547 * x550;
-        let x565 = x563 * x564;
-        let x566 = x168 * x503;
-        let x567 = x156 + 0.65 * x184 - x566 - x177 * x511 - x528 * x533 - x547 * x552;
-        let x568 = x563 * x567;
-        let x569 = x168 * x504;
-        let x570 = x197 + 0.65 * x201 + x569 - x177 * x512 - x528 * x535 - x547 * x554;
-        let x571 = x563 * x570;
-        let x572 = x168 * x505;
-        let x573 = x211 + 0.65 * x215 + x572 - x177 * x513 - x528 * x537 - x547 * x556;
-        let x574 = x563 * x573;
-        let x575 = x168 * x506;
-        let x576 = x230 + 0.65 * x234 + x575 - x177 * x514 - x528 * x539 - x547 * x558;
-        let x577 = x563 * x576;
-        let x578 = x168 * x507;
-        let x579 = x258 + 0.65 * x262 + x578 - x177 * x515 - x528 * x541 - x547 * x560;
-        let x580 = x563 * x579;
-        let x581 = x168 * x508;
-        let x582 = x294 + 0.65 * x298 + x581 - x177 * x516 - x528 * x543 - x547 * x562;
-        let x583 = x563 * x582;
-        let x584 = 1.0
-            / (x166 - x524 - x167 * x510 - x530 * x531 - x549 * x550 - x564 * x565);
-        let x585 = x156 - x566 - x167 * x511 - x530 * x533 - x549 * x552 - x564 * x568;
-        let x586 = x584 * x585;
-        let x587 = x197 + x569 - x167 * x512 - x530 * x535 - x549 * x554 - x564 * x571;
-        let x588 = x584 * x587;
-        let x589 = x211 + x572 - x167 * x513 - x530 * x537 - x549 * x556 - x564 * x574;
-        let x590 = x584 * x589;
-        let x591 = x230 + x575 - x167 * x514 - x530 * x539 - x549 * x558 - x564 * x577;
-        let x592 = x584 * x591;
-        let x593 = x258 + x578 - x167 * x515 - x530 * x541 - x549 * x560 - x564 * x580;
-        let x594 = x584 * x593;
-        let x595 = x294 + x581 - x167 * x516 - x530 * x543 - x549 * x562 - x564 * x583;
-        let x596 = x584 * x595;
-        let x597 = 1.0
-            / (x144 - x183 * x503 - x184 * x511 - x146 * x517 - x532 * x533 - x551 * x552
-                - x567 * x568 - x585 * x586);
-        let x598 = x193 + x183 * x504 - x184 * x512 - x146 * x518 - x532 * x535
-            - x551 * x554 - x567 * x571 - x585 * x588;
-        let x599 = x597 * x598;
-        let x600 = x207 + x183 * x505 - x184 * x513 - x146 * x519 - x532 * x537
-            - x551 * x556 - x567 * x574 - x585 * x590;
-        let x601 = x597 * x600;
-        let x602 = x226 + x183 * x506 - x184 * x514 - x146 * x520 - x532 * x539
-            - x551 * x558 - x567 * x577 - x585 * x592;
-        let x603 = x597 * x602;
-        let x604 = x254 + x183 * x507 - x184 * x515 - x146 * x521 - x532 * x541
-            - x551 * x560 - x567 * x580 - x585 * x594;
-        let x605 = x597 * x604;
-        let x606 = x290 + x183 * x508 - x184 * x516 - x146 * x522 - x532 * x543
-            - x551 * x562 - x567 * x583 - x585 * x596;
-        let x607 = x597 * x606;
-        let x608 = 1.0
-            / (x117 - x200 * x504 - x201 * x512 - x196 * x518 - x534 * x535 - x553 * x554
-                - x570 * x571 - x587 * x588 - x598 * x599);
-        let x609 = x108 - x200 * x505 - x201 * x513 - x196 * x519 - x534 * x537
-            - x553 * x556 - x570 * x574 - x587 * x590 - x598 * x601;
-        let x610 = x608 * x609;
-        let x611 = x220 - x200 * x506 - x201 * x514 - x196 * x520 - x534 * x539
-            - x553 * x558 - x570 * x577 - x587 * x592 - x598 * x603;
-        let x612 = x608 * x611;
-        let x613 = x248 - x200 * x507 - x201 * x515 - x196 * x521 - x534 * x541
-            - x553 * x560 - x570 * x580 - x587 * x594 - x598 * x605;
-        let x614 = x608 * x613;
-        let x615 = x284 - x200 * x508 - x201 * x516 - x196 * x522 - x534 * x543
-            - x553 * x562 - x570 * x583 - x587 * x596 - x598 * x607;
-        let x616 = x608 * x615;
-        let x617 = 1.0
-            / (x94 - x214 * x505 - x215 * x513 - x210 * x519 - x536 * x537 - x555 * x556
-                - x573 * x574 - x589 * x590 - x600 * x601 - x609 * x610);
-        let x618 = x85 - x214 * x506 - x215 * x514 - x210 * x520 - x536 * x539
-            - x555 * x558 - x573 * x577 - x589 * x592 - x600 * x603 - x609 * x612;
-        let x619 = x617 * x618;
-        let x620 = x243 - x214 * x507 - x215 * x515 - x210 * x521 - x536 * x541
-            - x555 * x560 - x573 * x580 - x589 * x594 - x600 * x605 - x609 * x614;
-        let x621 = x617 * x620;
-        let x622 = x279 - x214 * x508 - x215 * x516 - x210 * x522 - x536 * x543
-            - x555 * x562 - x573 * x583 - x589 * x596 - x600 * x607 - x609 * x616;
-        let x623 = x617 * x622;
-        let x624 = 1.0
-            / (x71 - x233 * x506 - x234 * x514 - x229 * x520 - x538 * x539 - x557 * x558
-                - x576 * x577 - x591 * x592 - x602 * x603 - x611 * x612 - x618 * x619);
-        let x625 = x59 - x233 * x507 - x234 * x515 - x229 * x521 - x538 * x541
-            - x557 * x560 - x576 * x580 - x591 * x594 - x602 * x605 - x611 * x614
-            - x618 * x621;
-        let x626 = x624 * x625;
-        let x627 = x272 - x233 * x508 - x234 * x516 - x229 * x522 - x538 * x543
-            - x557 * x562 - x576 * x583 - x591 * x596 - x602 * x607 - x611 * x616
-            - x618 * x623;
-        let x628 = x624 * x627;
-        let x629 = 1.0
-            / (x44 - x261 * x507 - x262 * x515 - x257 * x521 - x540 * x541 - x559 * x560
-                - x579 * x580 - x593 * x594 - x604 * x605 - x613 * x614 - x620 * x621
-                - x625 * x626);
-        let x630 = x268 - x261 * x508 - x262 * x516 - x257 * x522 - x540 * x543
-            - x559 * x562 - x579 * x583 - x593 * x596 - x604 * x607 - x613 * x616
-            - x620 * x623 - x625 * x628;
-        let x631 = x629 * x630;
-        let x632 = 1.0
-            / (1.4135609200000003 - x297 * x508 - x298 * x516 - x293 * x522 - x542 * x543
-                - x561 * x562 - x582 * x583 - x595 * x596 - x606 * x607 - x615 * x616
-                - x622 * x623 - x627 * x628 - x630 * x631);
-        let x633 = x500 * x502
-            - (v[4] * x301 - v[5] * x300 + (v[1] * x304 - v[2] * x303)
-                + (c_q7 * x490 - s_q7 * x491 + -0.75 * x497) + x499 * x501);
-        let x634 = x498 * x501
-            - (v[5] * x299 - v[3] * x301 + (v[2] * x302 - v[0] * x304)
-                + (s_q7 * x490 + c_q7 * x491 + (0.75 * x496 + -0.65 * x495)))
-            - x500 * x509 - x527 * x633;
-        let x635 = x498 * x502;
-        let x636 = x499 * x509
-            - (v[3] * x300 - v[4] * x299 + (v[0] * x303 - v[1] * x302)
-                + (x492 + 0.65 * x497) + x635) - x529 * x633 - x548 * x634;
-        let x637 = tau[0] - x492 - x635 + x499 * x510 - x531 * x633 - x550 * x634
-            - x565 * x636;
-        let x638 = tau[1] - x484 - x498 * x503 + x499 * x511 + x500 * x517 - x533 * x633
-            - x552 * x634 - x568 * x636 - x586 * x637;
-        let x639 = tau[2] - x475 + x498 * x504 + x499 * x512 + x500 * x518 - x535 * x633
-            - x554 * x634 - x571 * x636 - x588 * x637 - x599 * x638;
-        let x640 = tau[3] - x468 + x498 * x505 + x499 * x513 + x500 * x519 - x537 * x633
-            - x556 * x634 - x574 * x636 - x590 * x637 - x601 * x638 - x610 * x639;
-        let x641 = tau[4] - x460 + x498 * x506 + x499 * x514 + x500 * x520 - x539 * x633
-            - x558 * x634 - x577 * x636 - x592 * x637 - x603 * x638 - x612 * x639
-            - x619 * x640;
-        let x642 = tau[5] - x452 + x498 * x507 + x499 * x515 + x500 * x521 - x541 * x633
-            - x560 * x634 - x580 * x636 - x594 * x637 - x605 * x638 - x614 * x639
-            - x621 * x640 - x626 * x641;
-        let x643 = x632
-            * (tau[6] - x444 + x498 * x508 + x499 * x516 + x500 * x522 - x543 * x633
-                - x562 * x634 - x583 * x636 - x596 * x637 - x607 * x638 - x616 * x639
-                - x623 * x640 - x628 * x641 - x631 * x642);
-        let x644 = x629 * x642 - x631 * x643;
-        let x645 = x624 * x641 - x626 * x644 - x628 * x643;
-        let x646 = x617 * x640 - x619 * x645 - x621 * x644 - x623 * x643;
-        let x647 = x608 * x639 - x610 * x646 - x612 * x645 - x614 * x644 - x616 * x643;
-        let x648 = x597 * x638 - x599 * x647 - x601 * x646 - x603 * x645 - x605 * x644
-            - x607 * x643;
-        let x649 = x584 * x637 - x586 * x648 - x588 * x647 - x590 * x646 - x592 * x645
-            - x594 * x644 - x596 * x643;
-        let x650 = x563 * x636 - x565 * x649 - x568 * x648 - x571 * x647 - x574 * x646
-            - x577 * x645 - x580 * x644 - x583 * x643;
-        let x651 = x545 * x634 - x548 * x650 - x550 * x649 - x552 * x648 - x554 * x647
-            - x556 * x646 - x558 * x645 - x560 * x644 - x562 * x643;
-        let x652 = x525 * x633 - x527 * x651 - x529 * x650 - x531 * x649 - x533 * x648
-            - x535 * x647 - x537 * x646 - x539 * x645 - x541 * x644 - x543 * x643;
-        let x653 = x509 * x651 - (x500 * 0.0008546497218115156 + x502 * x652)
-            - x517 * x648 - x518 * x647 - x519 * x646 - x520 * x645 - x521 * x644
-            - x522 * x643;
-        let x654 = x501 * x652 - x499 * 0.0008546497218115156 - x509 * x650 - x510 * x649
-            - x511 * x648 - x512 * x647 - x513 * x646 - x514 * x645 - x515 * x644
-            - x516 * x643;
-        let x655 = x502 * x650 - (x498 * 0.0008546497218115156 + x501 * x651)
-            + x502 * x649 + x503 * x648 - x504 * x647 - x505 * x646 - x506 * x645
-            - x507 * x644 - x508 * x643;
-        [x655, x654, x653, x652, x651, x650, x649, x648, x647, x646, x645, x644, x643]
+                + (0.75 * x560 + -0.65 * x562
+                    + (s_q7 * x551 + c_q7 * x552 + (0.75 * x577 + -0.65 * x579)))
+                - x582 * x588 - x595 * x596 - x602 * x603 - x607 * x608);
+        let x612 = 0.75 * x572 + -0.65 * x574 + 0.65 * x561 - x582 * x589 - x595 * x598
+            - x602 * x605 - x607 * x610;
+        let x613 = x611 * x612;
+        let x614 = 1.0
+            / (1271.854575 + 0.65 * x573 - x572 * x589 - x597 * x598 - x604 * x605
+                - x609 * x610 - x612 * x613);
+        let x615 = x583 * x585 - (v[5] * x3 - v[3] * x5 + x581);
+        let x616 = x583 * x586 - (v[3] * x4 - v[4] * x3 + x548) - x592 * x615;
+        let x617 = x583 * x587
+            - (v[4] * x2 - v[5] * x1 + (v[1] * x5 - v[2] * x4)
+                + (c_q7 * x544 - s_q7 * x545 + -0.75 * x581)) - x594 * x615
+            - x601 * x616;
+        let x618 = x583 * x588
+            - (v[5] * x0 - v[3] * x2 + (v[2] * x3 - v[0] * x5)
+                + (s_q7 * x544 + c_q7 * x545 + (0.75 * x580 + -0.65 * x548)))
+            - x596 * x615 - x603 * x616 - x608 * x617;
+        let x619 = x614
+            * (x583 * x589
+                - (v[3] * x1 - v[4] * x0 + (v[0] * x4 - v[1] * x3)
+                    + (x521 + x523 * (x519 * x522) + 0.65 * x581)) - x598 * x615
+                - x605 * x616 - x610 * x617 - x613 * x618);
+        let x620 = x611 * x618 - x613 * x619;
+        let x621 = x606 * x617 - x608 * x620 - x610 * x619;
+        let x622 = x599 * x616 - x601 * x621 - x603 * x620 - x605 * x619;
+        let x623 = x590 * x615 - x592 * x622 - x594 * x621 - x596 * x620 - x598 * x619;
+        let x624 = x583 * x584 + x585 * x623 + x586 * x622 + x587 * x621 + x588 * x620
+            + x589 * x619;
+        let x625 = -x624;
+        let x626 = x624 + -0.75 * x620;
+        let x627 = x623 - (0.75 * x621 + -0.65 * x619);
+        let x628 = x622 - 0.65 * x620;
+        let x629 = x14 + (c_q7 * x621 + s_q7 * x620);
+        let x630 = c_q7 * x620 - s_q7 * x621 - x15;
+        let x631 = x16 + (s_q7 * x627 - c_q7 * x626);
+        let x632 = s_q7 * x626 + c_q7 * x627 - x17;
+        let x633 = x522
+            * (x523
+                - (x517 * x629 + x518 * x630 + x519 * x619
+                    + (x497 * x631 + x520 * x632 + x499 * x628)));
+        let x634 = x619 + x633;
+        let x635 = x629 + -0.00000000020510342851533115 * x634;
+        let x636 = x631 - -0.35 * x630;
+        let x637 = x632 - 0.35 * x629;
+        let x638 = x636 + -0.00000000020510342851533115 * x628;
+        let x639 = x34 + (x25 * x629 + s_q8 * x630 - c_q8 * x634);
+        let x640 = c_q8 * x630 - x26 * x629 + s_q8 * x634 - x35;
+        let x641 = x36 + (x25 * x636 + s_q8 * x637 - c_q8 * x628);
+        let x642 = c_q8 * x637 - x26 * x636 + s_q8 * x628 - x37;
+        let x643 = x454
+            * (x455
+                - (x448 * x639 + x449 * x640 + x450 * x635
+                    + (x451 * x641 + x452 * x642 + x444 * x638)));
+        let x644 = x635 + x643;
+        let x645 = x640 + 0.00000000020510342851533115 * x639
+            + -0.00000000020510342851533115 * x644;
+        let x646 = x641 - (-0.4 * x640 + 0.275 * x644);
+        let x647 = x642 - 0.4 * x639;
+        let x648 = x638 - -0.275 * x639;
+        let x649 = x647 + 0.00000000020510342851533115 * x646
+            + -0.00000000020510342851533115 * x648;
+        let x650 = x58 + (x46 * x639 + x48 * x640 + c_q9 * x644);
+        let x651 = x47 * x639 + x49 * x640 - s_q9 * x644 - x59;
+        let x652 = x60 + (x46 * x646 + x48 * x647 + c_q9 * x648);
+        let x653 = x47 * x646 + x49 * x647 - s_q9 * x648 - x61;
+        let x654 = x382
+            * (x383
+                - (x377 * x650 + x378 * x651 + x379 * x645
+                    + (x380 * x652 + x373 * x653 + x374 * x649)));
+        let x655 = x645 + x654;
+        let x656 = x652 - -0.87 * x655;
+        let x657 = x649 - 0.87 * x650;
+        let x658 = x75 + (c_q10 * x650 + s_q10 * x651);
+        let x659 = c_q10 * x651 - s_q10 * x650 - x76;
+        let x660 = x77 + (c_q10 * x656 + s_q10 * x653);
+        let x661 = c_q10 * x653 - s_q10 * x656 - x78;
+        let x662 = x325
+            * (x326
+                - (x320 * x658 + x321 * x659 + x322 * x655
+                    + (x323 * x660 + x311 * x661 + x312 * x657)));
+        let x663 = x655 + x662;
+        let x664 = x660 - (0.275 * x659 + -0.63 * x663);
+        let x665 = x661 - -0.275 * x658;
+        let x666 = x657 - 0.63 * x658;
+        let x667 = x93 + (c_q11 * x658 + s_q11 * x659);
+        let x668 = c_q11 * x659 - s_q11 * x658 - x94;
+        let x669 = x95 + (c_q11 * x664 + s_q11 * x665);
+        let x670 = c_q11 * x665 - s_q11 * x664 - x96;
+        let x671 = x262
+            * (x263
+                - (x257 * x667 + x258 * x668 + x259 * x663
+                    + (x260 * x669 - x238 * x670 - x239 * x666)));
+        let x672 = x663 + x671;
+        let x673 = x668 + -0.00000000020510342851533115 * x672;
+        let x674 = x669 - 0.36 * x668;
+        let x675 = x670 - -0.36 * x667;
+        let x676 = x675 + -0.00000000020510342851533115 * x666;
+        let x677 = x113 + (c_q12 * x667 + x104 * x668 - s_q12 * x672);
+        let x678 = x105 * x668 - s_q12 * x667 - c_q12 * x672 - x114;
+        let x679 = x115 + (c_q12 * x674 + x104 * x675 - s_q12 * x666);
+        let x680 = x105 * x675 - s_q12 * x674 - c_q12 * x666 - x116;
+        let x681 = x194
+            * (x195
+                - (x188 * x677 + x189 * x678 + x190 * x673
+                    + (x191 * x679 + x192 * x680 - x184 * x676)));
+        let x682 = x673 + x681;
+        let x683 = 0.707433253035886
+            * (x146
+                - (-0.0145 * (x135 + (x125 * x677 + s_q13 * x678 - c_q13 * x682))
+                    + -0.9614610000000001
+                        * (c_q13 * x678 - x126 * x677 + s_q13 * x682 - x136)
+                    + 1.4135609200000003 * (x677 + -0.00000000020510342851533115 * x682)
+                    + -4.806620000000001
+                        * (x137
+                            + (x125 * (x679 - (-0.16 * x678 + 0.55 * x682))
+                                + s_q13 * (x680 - 0.16 * x677)
+                                - c_q13 * (x676 - -0.55 * x677)))));
+        [x625, x623, x622, x621, x620, x619, x633, x643, x654, x662, x671, x681, x683]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -3373,7 +3439,7 @@ impl FreeFloating7 {
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 1779 mul, 1532 add, 10 div, 0 sqrt, 7 sincos (emitted).
+    /// Methods: forward `aba`: 1619 mul, 1327 add, 12 div, 0 sqrt, 7 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -3381,874 +3447,871 @@ impl FreeFloating7 {
         tau: &[f64; 7],
         f_ext: &[[f64; 6]; 8],
     ) -> [f64; 13] {
-        let (s_q7, c_q7) = libm::sincos(q[7]);
-        let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
-        let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
-        let x6 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
-        let x7 = 0.00000000020510342851533115 * c_q9
-            + -0.00000000020510342851533115 * s_q9;
-        let x8 = -0.00000000020510342851533115 * c_q9
-            - 0.00000000020510342851533115 * s_q9;
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = -0.0145 - 0.000781 * x16;
-        let x21 = -0.9614610000000001 + (0.000781 * x15 - -1.2025609200000003 * x16);
-        let x22 = 1.4135609200000003 + (-0.0145 * x15 - -0.9614610000000001 * x16);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = x24 + -1.2025609200000003 * c_q13;
-        let x26 = -0.0145 * s_q13 + -0.9614610000000001 * c_q13;
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = -1.2025609200000003 * s_q13 - x23 + 0.00000000019719894748377882;
-        let x29 = -0.9614610000000001 * s_q13 - -0.0145 * c_q13
-            + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = x22 + (x15 * x20 - x16 * x21) - (x30 - x31) - (x33 - x32);
-        let x35 = 3.6140000000000003 - x17;
-        let x36 = 17.135250000000003 + x18;
-        let x37 = -1.9877000000000002 + (s_q13 * x20 + c_q13 * x21 + 0.55 * x17);
-        let x38 = -0.809539999555672
-            + (s_q13 * x21 - c_q13 * x20 + -0.00000000020510342851533115 * x22
-                - -0.16 * x17);
-        let x39 = -1.9877000000000002 + (x26 + (x15 * x23 - x16 * x25) - x17 * -0.55);
-        let x40 = -5.252920330000002 + (s_q13 * x23 + c_q13 * x25 + x32 - x30);
-        let x41 = -2.741639999592316
-            + (s_q13 * x25 - c_q13 * x23 + -0.00000000020510342851533115 * x26
-                - 0.16 * x18 - 0.55 * x19);
-        let x42 = -0.809539999555672 + (x29 + (x15 * x27 - x16 * x28) + 0.16 * x17);
-        let x43 = -2.7416399995923166
-            + (s_q13 * x27 + c_q13 * x28 + x19 * -0.55 + -0.16 * x18);
-        let x44 = 9.740442170000001
-            + (x31
-                + (s_q13 * x28 - c_q13 * x27 + -0.00000000020510342851533115 * x29
-                    - x33));
-        let x45 = c_q12 * x35;
-        let x46 = s_q12 * x36;
-        let x47 = x45 - x46;
-        let x48 = x19 + (x12 * x35 + x13 * x36);
-        let x49 = s_q12 * x35 + c_q12 * x36;
-        let x50 = -0.00000000020510342851533115 * x19 - x49;
-        let x51 = c_q12 * x34 - s_q12 * x39;
-        let x52 = c_q12 * x37 - s_q12 * x40;
-        let x53 = c_q12 * x38 - s_q12 * x41;
-        let x54 = x42 + (x12 * x34 + x13 * x39);
-        let x55 = x43 + (x12 * x37 + x13 * x40);
-        let x56 = x44 + (x12 * x38 + x13 * x41);
-        let x57 = -0.00000000020510342851533115 * x42 - (s_q12 * x34 + c_q12 * x39);
-        let x58 = -0.00000000020510342851533115 * x43 - (s_q12 * x37 + c_q12 * x40);
-        let x59 = -0.00000000020510342851533115 * x44 - (s_q12 * x38 + c_q12 * x41);
-        let x60 = x53 + (x12 * x51 + x13 * x52);
-        let x61 = c_q12 * x54 - s_q12 * x55;
-        let x62 = x50 * 0.36;
-        let x63 = -0.36 * x50;
-        let x64 = x63 + (c_q12 * x51 - s_q12 * x52 - x62);
-        let x65 = 7.078399999258757 + x48;
-        let x66 = 0.01675
-            + (-0.00000000020510342851533115 * x53 - (s_q12 * x51 + c_q12 * x52)
-                + x47 * 0.36);
-        let x67 = -9.142025249762803 + (x56 + (x12 * x54 + x13 * x55) + x63 - x62);
-        let x68 = 2.5482240016099564
-            + (-0.00000000020510342851533115 * x56 - (s_q12 * x54 + c_q12 * x55)
-                - -0.36 * x48);
-        let x69 = 0.01675 + (c_q12 * x57 - s_q12 * x58 - -0.36 * x47);
-        let x70 = 2.5482240016099564 + (x59 + (x12 * x57 + x13 * x58) + x48 * 0.36);
-        let x71 = 9.223235249762805
-            + (-0.00000000020510342851533115 * x59 - (s_q12 * x57 + c_q12 * x58));
-        let x72 = c_q11 * x47 - s_q11 * x65;
-        let x73 = s_q11 * x47 + c_q11 * x65;
-        let x74 = c_q11 * x64 - s_q11 * x61;
-        let x75 = c_q11 * x60 - s_q11 * x67;
-        let x76 = s_q11 * x64 + c_q11 * x61;
-        let x77 = s_q11 * x60 + c_q11 * x67;
-        let x78 = 0.275 * x50;
-        let x79 = -0.63 * x73;
-        let x80 = -0.275 * x50;
-        let x81 = x73 * 0.63;
-        let x82 = s_q11 * x74 + c_q11 * x75 - -0.63 * x72;
-        let x83 = c_q11 * x66 - s_q11 * x68 + 0.275 * x72;
-        let x84 = s_q11 * x66 + c_q11 * x68 - -0.275 * x73;
-        let x85 = x71 - x81;
-        let x86 = c_q11 * x74 - s_q11 * x75 - (x78 - x79) - (x81 - x80);
-        let x87 = c_q11 * x76 - s_q11 * x77 + x72 * 0.63;
-        let x88 = -45.1584 + x73;
-        let x89 = -0.6328 + x83;
-        let x90 = -24.4950615 + (s_q11 * x76 + c_q11 * x77 + x80 - x78);
-        let x91 = -24.35164200091464 + (x84 - -0.63 * x50);
-        let x92 = -0.6328 + (c_q11 * x69 - s_q11 * x70 - -0.275 * x72);
-        let x93 = -24.351642000914637
-            + (s_q11 * x69 + c_q11 * x70 + x50 * 0.63 + 0.275 * x73);
-        let x94 = 28.2393615 + (x79 + x85);
-        let x95 = c_q10 * x72;
-        let x96 = x95 - s_q10 * x88;
-        let x97 = s_q10 * x72;
-        let x98 = x97 + c_q10 * x88;
-        let x99 = c_q10 * x86 - s_q10 * x87;
-        let x100 = c_q10 * x82 - s_q10 * x90;
-        let x101 = c_q10 * x89 - s_q10 * x91;
-        let x102 = s_q10 * x86 + c_q10 * x87;
-        let x103 = s_q10 * x82 + c_q10 * x90;
-        let x104 = s_q10 * x89 + c_q10 * x91;
-        let x105 = -0.87 * x98;
-        let x106 = x98 * 0.87;
-        let x107 = s_q10 * x99 + c_q10 * x100 - -0.87 * x96;
-        let x108 = x94 - x106;
-        let x109 = c_q10 * x99 - s_q10 * x100 + x105 - x106;
-        let x110 = c_q10 * x102 - s_q10 * x103 + x96 * 0.87;
-        let x111 = -81.53205 + x98;
-        let x112 = -0.00214 + x101;
-        let x113 = -63.36336825000001 + (s_q10 * x102 + c_q10 * x103);
-        let x114 = -36.18604050126307 + (x104 - -0.87 * x50);
-        let x115 = -0.00214 + (c_q10 * x92 - s_q10 * x93);
-        let x116 = -36.18604050126307 + (s_q10 * x92 + c_q10 * x93 + x50 * 0.87);
-        let x117 = 69.99836825 + (x105 + x108);
-        let x118 = x5 * x96 + x6 * x111 + 0.00000000020510342851533115 * x50;
-        let x119 = x50 + (x7 * x96 + x8 * x111);
-        let x120 = c_q9 * x96 - s_q9 * x111 + -0.00000000020510342851533115 * x50;
-        let x121 = x5 * x109 + x6 * x110 + 0.00000000020510342851533115 * x115;
-        let x122 = x5 * x107 + x6 * x113 + 0.00000000020510342851533115 * x116;
-        let x123 = x5 * x112 + x6 * x114 + 0.00000000020510342851533115 * x117;
-        let x124 = x115 + (x7 * x109 + x8 * x110);
-        let x125 = x116 + (x7 * x107 + x8 * x113);
-        let x126 = x117 + (x7 * x112 + x8 * x114);
-        let x127 = c_q9 * x109 - s_q9 * x110 + -0.00000000020510342851533115 * x115;
-        let x128 = c_q9 * x107 - s_q9 * x113 + -0.00000000020510342851533115 * x116;
-        let x129 = c_q9 * x112 - s_q9 * x114 + -0.00000000020510342851533115 * x117;
-        let x130 = x120 * -0.4;
-        let x131 = 0.275 * x119;
-        let x132 = 0.4 * x120;
-        let x133 = -0.275 * x119;
-        let x134 = x5 * x121 + x6 * x122 + 0.00000000020510342851533115 * x123
-            - (x130 - x131) - (x133 - x132);
-        let x135 = -0.000000008530897668050218 + x118;
-        let x136 = -12.701650001451807 + x119;
-        let x137 = -0.0000000234896432582596
-            + (x123 + (x7 * x121 + x8 * x122) - 0.275 * x118);
-        let x138 = -0.0021399965876409276
-            + (c_q9 * x121 - s_q9 * x122 + -0.00000000020510342851533115 * x123
-                + x118 * -0.4);
-        let x139 = -0.0000000234896432582596
-            + (x5 * x124 + x6 * x125 + 0.00000000020510342851533115 * x126
-                + -0.275 * x118);
-        let x140 = -111.7548902508081 + (x126 + (x7 * x124 + x8 * x125) + x132 - x130);
-        let x141 = 5.080660024070365
-            + (c_q9 * x124 - s_q9 * x125 + -0.00000000020510342851533115 * x126
-                - 0.4 * x119 - 0.275 * x120);
-        let x142 = -0.0021399965876409276
-            + (x5 * x127 + x6 * x128 + 0.00000000020510342851533115 * x129 - 0.4 * x118);
-        let x143 = 5.080660024070366
-            + (x129 + (x7 * x127 + x8 * x128) + -0.275 * x120 + x119 * -0.4);
-        let x144 = 113.3918902508081
-            + (x131
-                + (c_q9 * x127 - s_q9 * x128 + -0.00000000020510342851533115 * x129
-                    - x133));
-        let x145 = x120 + (x2 * x135 - x3 * x136);
-        let x146 = s_q8 * x135 + c_q8 * x136;
-        let x147 = c_q8 * x135;
-        let x148 = s_q8 * x136;
-        let x149 = x148 - x147 + -0.00000000020510342851533115 * x120;
-        let x150 = x142 + (x2 * x134 - x3 * x139);
-        let x151 = x143 + (x2 * x137 - x3 * x140);
-        let x152 = x144 + (x2 * x138 - x3 * x141);
-        let x153 = s_q8 * x134 + c_q8 * x139;
-        let x154 = s_q8 * x137 + c_q8 * x140;
-        let x155 = s_q8 * x138 + c_q8 * x141;
-        let x156 = s_q8 * x141 - c_q8 * x138 + -0.00000000020510342851533115 * x144;
-        let x157 = x149 * -0.35;
-        let x158 = 0.35 * x149;
-        let x159 = x158 + (x152 + (x2 * x150 - x3 * x151) - x157);
-        let x160 = 48.0240000085309 + x145;
-        let x161 = -0.07309 + (s_q8 * x150 + c_q8 * x151);
-        let x162 = -16.80768997608804
-            + (s_q8 * x151 - c_q8 * x150 + -0.00000000020510342851533115 * x152
-                + x145 * -0.35);
-        let x163 = -0.07309 + (x155 + (x2 * x153 - x3 * x154));
-        let x164 = 130.43769025763282 + (s_q8 * x153 + c_q8 * x154 + x158 - x157);
-        let x165 = 0.1132
-            + (s_q8 * x154 - c_q8 * x153 + -0.00000000020510342851533115 * x155
-                - 0.35 * x146);
-        let x166 = 132.47349025763282
-            + (s_q8 * (s_q8 * x140 - c_q8 * x137 + -0.00000000020510342851533115 * x143)
-                - c_q8
-                    * (s_q8 * x139 - c_q8 * x134 + -0.00000000020510342851533115 * x142)
-                + -0.00000000020510342851533115 * x156);
-        let x167 = c_q7 * x160 - s_q7 * x146;
-        let x168 = s_q7 * x160 + c_q7 * x146;
-        let x169 = c_q7 * x159 - s_q7 * x163;
-        let x170 = c_q7 * x161 - s_q7 * x164;
-        let x171 = x149 * -0.75;
-        let x172 = 0.75 * x149;
-        let x173 = x167 * -0.65;
-        let x174 = 0.65 * x167;
-        let x175 = c_q7 * x162 - s_q7 * x165 + x167 * -0.75;
-        let x176 = x166 + x174;
-        let x177 = 110.5455 + x167;
-        let x178 = 180.9502499901501 + x149;
-        let x179 = x2 * x136 + x3 * x135;
-        let x180 = x147 - x148;
-        let x181 = x152 + -0.35 * x180;
-        let x182 = x155 - 0.35 * x179;
-        let x183 = c_q7 * x179 + s_q7 * x180;
-        let x184 = c_q7 * x180 - s_q7 * x179;
-        let x185 = x6 * x96;
-        let x186 = x185 - x5 * x111;
-        let x187 = x8 * x96;
-        let x188 = x187 - x7 * x111;
-        let x189 = s_q9 * x96;
-        let x190 = c_q9 * x111 + x189;
-        let x191 = x123 + (-0.4 * x188 - 0.275 * x190);
-        let x192 = x126 + 0.4 * x186;
-        let x193 = x129 + -0.275 * x186;
-        let x194 = x2 * x186 - x3 * x188 - x190;
-        let x195 = s_q8 * x186 + c_q8 * x188;
-        let x196 = s_q8 * x188 - c_q8 * x186 - -0.00000000020510342851533115 * x190;
-        let x197 = s_q8 * x192 - c_q8 * x191 + -0.00000000020510342851533115 * x193;
-        let x198 = x193 + (x2 * x191 - x3 * x192) + -0.35 * x195;
-        let x199 = s_q8 * x191 + c_q8 * x192 + 0.35 * x194;
-        let x200 = c_q7 * x194 - s_q7 * x195;
-        let x201 = s_q7 * x194 + c_q7 * x195;
-        let x202 = x185 - x5 * x98;
-        let x203 = x187 - x7 * x98;
-        let x204 = x189 + c_q9 * x98;
-        let x205 = x5 * x101 + x6 * x104 + 0.00000000020510342851533115 * x108
-            + (-0.4 * x203 - 0.275 * x204);
-        let x206 = x108 + (x7 * x101 + x8 * x104) + 0.4 * x202;
-        let x207 = c_q9 * x101 - s_q9 * x104 + -0.00000000020510342851533115 * x108
-            + -0.275 * x202;
-        let x208 = x2 * x202 - x3 * x203 - x204;
-        let x209 = s_q8 * x202 + c_q8 * x203;
-        let x210 = s_q8 * x203 - c_q8 * x202 - -0.00000000020510342851533115 * x204;
-        let x211 = s_q8 * x206 - c_q8 * x205 + -0.00000000020510342851533115 * x207;
-        let x212 = x207 + (x2 * x205 - x3 * x206) + -0.35 * x209;
-        let x213 = s_q8 * x205 + c_q8 * x206 + 0.35 * x208;
-        let x214 = c_q7 * x208 - s_q7 * x209;
-        let x215 = s_q7 * x208 + c_q7 * x209;
-        let x216 = x97 + c_q10 * x73;
-        let x217 = x95 - s_q10 * x73;
-        let x218 = c_q10 * x83 - s_q10 * x84;
-        let x219 = s_q10 * x83 + c_q10 * x84;
-        let x220 = x85 - 0.87 * x216;
-        let x221 = x6 * x217 - x5 * x216;
-        let x222 = x8 * x217 - x7 * x216;
-        let x223 = c_q9 * x216 + s_q9 * x217;
-        let x224 = x5 * x218 + x6 * x219 + 0.00000000020510342851533115 * x220
-            + (-0.4 * x222 - 0.275 * x223);
-        let x225 = x220 + (x7 * x218 + x8 * x219) + 0.4 * x221;
-        let x226 = c_q9 * x218 - s_q9 * x219 + -0.00000000020510342851533115 * x220
-            + -0.275 * x221;
-        let x227 = x2 * x221 - x3 * x222 - x223;
-        let x228 = s_q8 * x221 + c_q8 * x222;
-        let x229 = s_q8 * x222 - c_q8 * x221 - -0.00000000020510342851533115 * x223;
-        let x230 = s_q8 * x225 - c_q8 * x224 + -0.00000000020510342851533115 * x226;
-        let x231 = x226 + (x2 * x224 - x3 * x225) + -0.35 * x228;
-        let x232 = s_q8 * x224 + c_q8 * x225 + 0.35 * x227;
-        let x233 = c_q7 * x227 - s_q7 * x228;
-        let x234 = s_q7 * x227 + c_q7 * x228;
-        let x235 = x13 * x35 - x12 * x36;
-        let x236 = x46 - x45;
-        let x237 = x53 + 0.36 * x235;
-        let x238 = x56 - -0.36 * x49;
-        let x239 = c_q11 * x49 + s_q11 * x235;
-        let x240 = c_q11 * x235 - s_q11 * x49;
-        let x241 = c_q11 * x237 - s_q11 * x238 + (0.275 * x240 + -0.63 * x236);
-        let x242 = s_q11 * x237 + c_q11 * x238 - -0.275 * x239;
-        let x243 = x59 - 0.63 * x239;
-        let x244 = c_q10 * x239 + s_q10 * x240;
-        let x245 = c_q10 * x240 - s_q10 * x239;
-        let x246 = s_q10 * x241 + c_q10 * x242;
-        let x247 = c_q10 * x241 - s_q10 * x242 + -0.87 * x236;
-        let x248 = x243 - 0.87 * x244;
-        let x249 = x6 * x245 - x5 * x244 + 0.00000000020510342851533115 * x236;
-        let x250 = x236 + (x8 * x245 - x7 * x244);
-        let x251 = -0.00000000020510342851533115 * x236 - (c_q9 * x244 + s_q9 * x245);
-        let x252 = x5 * x247 + x6 * x246 + 0.00000000020510342851533115 * x248
-            + (-0.4 * x250 + 0.275 * x251);
-        let x253 = x248 + (x7 * x247 + x8 * x246) + 0.4 * x249;
-        let x254 = c_q9 * x247 - s_q9 * x246 + -0.00000000020510342851533115 * x248
-            + -0.275 * x249;
-        let x255 = x251 + (x2 * x249 - x3 * x250);
-        let x256 = s_q8 * x249 + c_q8 * x250;
-        let x257 = s_q8 * x250 - c_q8 * x249 + -0.00000000020510342851533115 * x251;
-        let x258 = s_q8 * x253 - c_q8 * x252 + -0.00000000020510342851533115 * x254;
-        let x259 = x254 + (x2 * x252 - x3 * x253) + -0.35 * x256;
-        let x260 = s_q8 * x252 + c_q8 * x253 + 0.35 * x255;
-        let x261 = c_q7 * x255 - s_q7 * x256;
-        let x262 = s_q7 * x255 + c_q7 * x256;
-        let x263 = x15 * -4.806620000000001;
-        let x264 = s_q13 * -4.806620000000001;
-        let x265 = c_q13 * -4.806620000000001;
-        let x266 = x22 + (-0.16 * x264 - 0.55 * x265);
-        let x267 = x26 + 0.16 * x263;
-        let x268 = x29 + -0.55 * x263;
-        let x269 = c_q12 * x263 - s_q12 * x264;
-        let x270 = x12 * x263 + x13 * x264 - x265;
-        let x271 = s_q12 * x263 + c_q12 * x264 + -0.00000000020510342851533115 * x265;
-        let x272 = -0.00000000020510342851533115 * x268 - (s_q12 * x266 + c_q12 * x267);
-        let x273 = c_q12 * x266 - s_q12 * x267 + 0.36 * x270;
-        let x274 = x268 + (x12 * x266 + x13 * x267) + -0.36 * x269;
-        let x275 = c_q11 * x269 - s_q11 * x270;
-        let x276 = s_q11 * x269 + c_q11 * x270;
-        let x277 = c_q11 * x273 - s_q11 * x274 + (0.275 * x276 - -0.63 * x271);
-        let x278 = s_q11 * x273 + c_q11 * x274 + -0.275 * x275;
-        let x279 = x272 + 0.63 * x275;
-        let x280 = c_q10 * x275 - s_q10 * x276;
-        let x281 = s_q10 * x275 + c_q10 * x276;
-        let x282 = s_q10 * x277 + c_q10 * x278;
-        let x283 = c_q10 * x277 - s_q10 * x278 - -0.87 * x271;
-        let x284 = x279 + 0.87 * x280;
-        let x285 = x5 * x280 + x6 * x281 - 0.00000000020510342851533115 * x271;
-        let x286 = x7 * x280 + x8 * x281 - x271;
-        let x287 = c_q9 * x280 - s_q9 * x281 - -0.00000000020510342851533115 * x271;
-        let x288 = x5 * x283 + x6 * x282 + 0.00000000020510342851533115 * x284
-            + (-0.4 * x286 + 0.275 * x287);
-        let x289 = x284 + (x7 * x283 + x8 * x282) + 0.4 * x285;
-        let x290 = c_q9 * x283 - s_q9 * x282 + -0.00000000020510342851533115 * x284
-            + -0.275 * x285;
-        let x291 = x287 + (x2 * x285 - x3 * x286);
-        let x292 = s_q8 * x285 + c_q8 * x286;
-        let x293 = s_q8 * x286 - c_q8 * x285 + -0.00000000020510342851533115 * x287;
-        let x294 = s_q8 * x289 - c_q8 * x288 + -0.00000000020510342851533115 * x290;
-        let x295 = x290 + (x2 * x288 - x3 * x289) + -0.35 * x292;
-        let x296 = s_q8 * x288 + c_q8 * x289 + 0.35 * x291;
-        let x297 = c_q7 * x291 - s_q7 * x292;
-        let x298 = s_q7 * x291 + c_q7 * x292;
-        let x299 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
+        let x0 = 1394.5960312283303 * v[3] + -117.61766249359756 * v[5]
             + v[1] * -180.9502499901501;
-        let x300 = 1466.4506062283303 * v[4]
+        let x1 = 1466.4506062283303 * v[4]
             + (180.9502499901501 * v[0] + v[2] * -110.5455);
-        let x301 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
-        let x302 = 1170.07 * v[0] - v[4] * -180.9502499901501;
-        let x303 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
-        let x304 = 1170.07 * v[2] - 110.5455 * v[4];
-        let x305 = v[3] * c_q7 + v[4] * s_q7;
-        let x306 = v[4] * c_q7 - v[3] * s_q7;
-        let x307 = v[0] - v[4] * -0.75;
-        let x308 = v[1] - (0.75 * v[3] + v[5] * -0.65);
-        let x309 = v[2] - 0.65 * v[4];
-        let x310 = c_q7 * x307 + s_q7 * x308;
-        let x311 = c_q7 * x308 - s_q7 * x307;
-        let x312 = v[5] + v[6];
-        let x313 = v[6] * x306;
-        let x314 = v[6] * x305;
-        let x315 = v[6] * x310;
-        let x316 = -0.07309 * x306 + -16.80768997608804 * x312;
-        let x317 = -0.07309 * x305 + 130.43769025763282 * x306 + 0.1132 * x312
-            + x309 * -48.0240000085309;
-        let x318 = -16.80768997608804 * x305 + 0.1132 * x306 + 132.47349025763282 * x312
-            + 48.0240000085309 * x311;
-        let x319 = x312 * -48.0240000085309;
-        let x320 = 48.0240000085309 * x306;
-        let x321 = x2 * x305 + s_q8 * x306 - c_q8 * x312;
-        let x322 = c_q8 * x306 - x3 * x305 + s_q8 * x312;
-        let x323 = x310 - -0.35 * x306;
-        let x324 = x311 - 0.35 * x305;
-        let x325 = x2 * x323 + s_q8 * x324 - c_q8 * x309;
-        let x326 = c_q8 * x324 - x3 * x323 + s_q8 * x309;
-        let x327 = x323 + -0.00000000020510342851533115 * x309;
-        let x328 = v[7] + (x305 + -0.00000000020510342851533115 * x312);
-        let x329 = v[6] * x311 + -0.35 * x314;
-        let x330 = x315 + 0.35 * x313;
-        let x331 = x2 * x313 - s_q8 * x314 + v[7] * x322;
-        let x332 = x3 * x313 + c_q8 * x314 + v[7] * x321;
-        let x333 = x2 * x329 - s_q8 * x330 + v[7] * x326;
-        let x334 = x3 * x329 + c_q8 * x330 + v[7] * x325;
-        let x335 = -0.0000000234896432582596 * x322 + -0.0021399965876409276 * x328
-            + -12.701650001451807 * x327;
-        let x336 = -0.0000000234896432582596 * x321 + -111.7548902508081 * x322
-            + 5.080660024070365 * x328 + x327 * 0.000000008530897668050218;
-        let x337 = -0.0021399965876409276 * x321 + 5.080660024070366 * x322
-            + 113.3918902508081 * x328
-            + (x325 * 12.701650001451807 + -0.000000008530897668050218 * x326);
-        let x338 = -12.701650001451807 * x328;
-        let x339 = x328 * 0.000000008530897668050218;
-        let x340 = x321 * 12.701650001451807 + -0.000000008530897668050218 * x322;
-        let x341 = x5 * x321 + x7 * x322 + c_q9 * x328;
-        let x342 = x6 * x321 + x8 * x322 - s_q9 * x328;
-        let x343 = x325 - (-0.4 * x322 + 0.275 * x328);
-        let x344 = x326 - 0.4 * x321;
-        let x345 = x327 - -0.275 * x321;
-        let x346 = x5 * x343 + x7 * x344 + c_q9 * x345;
-        let x347 = x6 * x343 + x8 * x344 - s_q9 * x345;
-        let x348 = x344 + 0.00000000020510342851533115 * x343
-            + -0.00000000020510342851533115 * x345;
-        let x349 = v[8]
-            + (x322 + 0.00000000020510342851533115 * x321
-                + -0.00000000020510342851533115 * x328);
-        let x350 = 0.00000000020510342851533115 * x331 - x332
-            + -0.00000000020510342851533115 * x313;
-        let x351 = x333 - (0.275 * x313 - -0.4 * x332);
-        let x352 = x334 + 0.4 * x331;
-        let x353 = x329 - -0.275 * x331;
-        let x354 = 0.00000000020510342851533115 * x351 - x352
-            + -0.00000000020510342851533115 * x353;
-        let x355 = x5 * x331 - x7 * x332 + c_q9 * x313 + v[8] * x342;
-        let x356 = x6 * x331 - x8 * x332 - s_q9 * x313 - v[8] * x341;
-        let x357 = x5 * x351 - x7 * x352 + c_q9 * x353 + v[8] * x347;
-        let x358 = x6 * x351 - x8 * x352 - s_q9 * x353 - v[8] * x346;
-        let x359 = -63.36336825000001 * x342 + -36.18604050126307 * x349;
-        let x360 = -0.00214 * x349 + -81.53205 * x348;
-        let x361 = -0.00214 * x341 + -36.18604050126307 * x342 + 69.99836825 * x349
-            + x346 * 81.53205;
-        let x362 = -81.53205 * x349;
-        let x363 = x341 * 81.53205;
-        let x364 = c_q10 * x341 + s_q10 * x342;
-        let x365 = c_q10 * x342 - s_q10 * x341;
-        let x366 = x346 - -0.87 * x349;
-        let x367 = x348 - 0.87 * x341;
-        let x368 = c_q10 * x366 + s_q10 * x347;
-        let x369 = c_q10 * x347 - s_q10 * x366;
-        let x370 = v[9] + x349;
-        let x371 = x357 - -0.87 * x350;
-        let x372 = x354 - 0.87 * x355;
-        let x373 = c_q10 * x355 + s_q10 * x356 + v[9] * x365;
-        let x374 = c_q10 * x356 - s_q10 * x355 - v[9] * x364;
-        let x375 = c_q10 * x371 + s_q10 * x358 + v[9] * x369;
-        let x376 = -24.4950615 * x365 + -24.35164200091464 * x370;
-        let x377 = -0.6328 * x370 + -45.1584 * x367;
-        let x378 = -0.6328 * x364 + -24.351642000914637 * x365 + 28.2393615 * x370
-            + x368 * 45.1584;
-        let x379 = -45.1584 * x370;
-        let x380 = x364 * 45.1584;
-        let x381 = c_q11 * x364 + s_q11 * x365;
-        let x382 = c_q11 * x365 - s_q11 * x364;
-        let x383 = x368 - (0.275 * x365 + -0.63 * x370);
-        let x384 = x369 - -0.275 * x364;
-        let x385 = x367 - 0.63 * x364;
-        let x386 = c_q11 * x383 + s_q11 * x384;
-        let x387 = c_q11 * x384 - s_q11 * x383;
-        let x388 = v[10] + x370;
-        let x389 = x375 - (0.275 * x374 + -0.63 * x350);
-        let x390 = c_q10 * x358 - s_q10 * x371 - v[9] * x368 - -0.275 * x373;
-        let x391 = x372 - 0.63 * x373;
-        let x392 = c_q11 * x373 + s_q11 * x374 + v[10] * x382;
-        let x393 = c_q11 * x374 - s_q11 * x373 - v[10] * x381;
-        let x394 = c_q11 * x389 + s_q11 * x390 + v[10] * x387;
-        let x395 = -9.142025249762803 * x382 + 2.5482240016099564 * x388;
-        let x396 = 0.01675 * x388 + 7.078399999258757 * x385;
-        let x397 = 0.01675 * x381 + 2.5482240016099564 * x382 + 9.223235249762805 * x388
-            + x386 * -7.078399999258757;
-        let x398 = 7.078399999258757 * x388;
-        let x399 = x381 * -7.078399999258757;
-        let x400 = c_q12 * x381 + x12 * x382 - s_q12 * x388;
-        let x401 = x13 * x382 - s_q12 * x381 - c_q12 * x388;
-        let x402 = x386 - 0.36 * x382;
-        let x403 = x387 - -0.36 * x381;
-        let x404 = c_q12 * x402 + x12 * x403 - s_q12 * x385;
-        let x405 = x13 * x403 - s_q12 * x402 - c_q12 * x385;
-        let x406 = x403 + -0.00000000020510342851533115 * x385;
-        let x407 = v[11] + (x382 + -0.00000000020510342851533115 * x388);
-        let x408 = x393 + -0.00000000020510342851533115 * x350;
-        let x409 = x394 - 0.36 * x393;
-        let x410 = c_q11 * x390 - s_q11 * x389 - v[10] * x386 - -0.36 * x392;
-        let x411 = x410 + -0.00000000020510342851533115 * x391;
-        let x412 = c_q12 * x392 + x12 * x393 - s_q12 * x350 + v[11] * x401;
-        let x413 = x13 * x393 - s_q12 * x392 - c_q12 * x350 - v[11] * x400;
-        let x414 = c_q12 * x409 + x12 * x410 - s_q12 * x391 + v[11] * x405;
-        let x415 = x13 * x410 - s_q12 * x409 - c_q12 * x391 - v[11] * x404;
-        let x416 = -1.9877000000000002 * x401 + -0.809539999555672 * x407
-            + 17.135250000000003 * x406;
-        let x417 = -1.9877000000000002 * x400 + -5.252920330000002 * x401
-            + -2.741639999592316 * x407 + x406 * -3.6140000000000003;
-        let x418 = -0.809539999555672 * x400 + -2.7416399995923166 * x401
-            + 9.740442170000001 * x407
-            + (x404 * -17.135250000000003 + 3.6140000000000003 * x405);
-        let x419 = 17.135250000000003 * x407;
-        let x420 = x407 * -3.6140000000000003;
-        let x421 = x400 * -17.135250000000003 + 3.6140000000000003 * x401;
-        let x422 = x15 * x400 + s_q13 * x401 - c_q13 * x407;
-        let x423 = c_q13 * x401 - x16 * x400 + s_q13 * x407;
-        let x424 = x404 - (-0.16 * x401 + 0.55 * x407);
-        let x425 = x405 - 0.16 * x400;
-        let x426 = x406 - -0.55 * x400;
-        let x427 = x15 * x424 + s_q13 * x425 - c_q13 * x426;
-        let x428 = c_q13 * x425 - x16 * x424 + s_q13 * x426;
-        let x429 = x424 + -0.00000000020510342851533115 * x426;
-        let x430 = v[12] + (x400 + -0.00000000020510342851533115 * x407);
-        let x431 = x412 + -0.00000000020510342851533115 * x408;
-        let x432 = x414 - (-0.16 * x413 + 0.55 * x408);
-        let x433 = x411 - -0.55 * x412;
-        let x434 = x15 * x412 + s_q13 * x413 - c_q13 * x408 + v[12] * x423;
-        let x435 = c_q13 * x413 - x16 * x412 + s_q13 * x408 - v[12] * x422;
-        let x436 = 0.000781 * x422 + -1.2025609200000003 * x423
-            + -0.9614610000000001 * x430;
-        let x437 = 0.000781 * x423 + -0.0145 * x430 + 4.806620000000001 * x429;
-        let x438 = -0.0145 * x422 + -0.9614610000000001 * x423
-            + 1.4135609200000003 * x430 + -4.806620000000001 * x427;
-        let x439 = 4.806620000000001 * x430;
-        let x440 = -4.806620000000001 * x422;
-        let x441 = 0.000781 * x435 + -0.0145 * x431
-            + 4.806620000000001 * (x432 + -0.00000000020510342851533115 * x433)
-            + (x423 * x438 - x430 * x436 - x428 * x440) - f_ext[7][3];
-        let x442 = 0.000781 * x434 + -1.2025609200000003 * x435
-            + -0.9614610000000001 * x431
-            + (x430 * x437 - x422 * x438 + (x427 * x440 - x429 * x439)) - f_ext[7][4];
-        let x443 = -0.0145 * x434 + -0.9614610000000001 * x435
-            + 1.4135609200000003 * x431
-            + -4.806620000000001
-                * (x15 * x432 + s_q13 * (x415 - 0.16 * x412) - c_q13 * x433
-                    + v[12] * x428) + (x422 * x436 - x423 * x437 + x428 * x439)
-            - f_ext[7][5];
-        let x444 = f_ext[7][0] + (4.806620000000001 * x431 + x423 * x440);
-        let x445 = x422 * x440 - x430 * x439 - f_ext[7][1];
-        let x446 = x423 * x439 - -4.806620000000001 * x434 - f_ext[7][2];
-        let x447 = x446 - (x15 * x444 + x16 * x445);
-        let x448 = c_q13 * x445 - s_q13 * x444;
-        let x449 = c_q13 * x444 + s_q13 * x445 + -0.00000000020510342851533115 * x446;
-        let x450 = -1.9877000000000002 * x413 + -0.809539999555672 * x408
-            + 17.135250000000003 * x411
-            + (x401 * x418 - x407 * x417 + (x406 * x420 - x405 * x421)) - f_ext[6][3]
-            + (x443 + (x15 * x441 - x16 * x442) + (-0.16 * x448 + 0.55 * x449));
-        let x451 = -1.9877000000000002 * x412 + -5.252920330000002 * x413
-            + -2.741639999592316 * x408 + x411 * -3.6140000000000003
-            + (x407 * x416 - x400 * x418 + (x404 * x421 - x406 * x419)) - f_ext[6][4]
-            + (s_q13 * x441 + c_q13 * x442 + 0.16 * x447);
-        let x452 = -0.809539999555672 * x412 + -2.7416399995923166 * x413
-            + 9.740442170000001 * x408
-            + (x414 * -17.135250000000003 + 3.6140000000000003 * x415)
-            + (x400 * x417 - x401 * x416 + (x405 * x419 - x404 * x420)) - f_ext[6][5]
-            + (s_q13 * x442 - c_q13 * x441 + -0.00000000020510342851533115 * x443
-                + -0.55 * x447);
-        let x453 = x407 * x420 - x401 * x421 - 17.135250000000003 * x408 - f_ext[6][0]
-            + x447;
-        let x454 = x400 * x421 - x407 * x419 - x408 * -3.6140000000000003 - f_ext[6][1]
-            + x448;
-        let x455 = x401 * x419 - x400 * x420
-            - (x412 * -17.135250000000003 + 3.6140000000000003 * x413) - f_ext[6][2]
-            + x449;
-        let x456 = c_q12 * x453 - s_q12 * x454;
-        let x457 = x455 + (x12 * x453 + x13 * x454);
-        let x458 = 0.01675 * x350 + 7.078399999258757 * x391
-            + (x382 * x397 - x388 * x395 - x387 * x399) - f_ext[5][3]
-            + (c_q12 * x450 - s_q12 * x451 + 0.36 * x457);
-        let x459 = -9.142025249762803 * x393 + 2.5482240016099564 * x350
-            + (x388 * x396 - x381 * x397 + (x386 * x399 - x385 * x398)) - f_ext[5][4]
-            + (x452 + (x12 * x450 + x13 * x451) + -0.36 * x456);
-        let x460 = 0.01675 * x392 + 2.5482240016099564 * x393 + 9.223235249762805 * x350
-            + x394 * -7.078399999258757 + (x381 * x395 - x382 * x396 + x387 * x398)
-            - f_ext[5][5]
-            + (-0.00000000020510342851533115 * x452 - (s_q12 * x450 + c_q12 * x451));
-        let x461 = x456 - (f_ext[5][0] + (7.078399999258757 * x350 + x382 * x399));
-        let x462 = x381 * x399 - x388 * x398 - f_ext[5][1] + x457;
-        let x463 = x382 * x398 - x392 * -7.078399999258757 - f_ext[5][2]
-            + (-0.00000000020510342851533115 * x455 - (s_q12 * x453 + c_q12 * x454));
-        let x464 = c_q11 * x461 - s_q11 * x462;
-        let x465 = s_q11 * x461 + c_q11 * x462;
-        let x466 = -0.6328 * x350 + -45.1584 * x372
-            + (x365 * x378 - x370 * x376 - x369 * x380) - f_ext[4][3]
-            + (c_q11 * x458 - s_q11 * x459 + (0.275 * x465 + -0.63 * x463));
-        let x467 = -24.4950615 * x374 + -24.35164200091464 * x350
-            + (x370 * x377 - x364 * x378 + (x368 * x380 - x367 * x379)) - f_ext[4][4]
-            + (s_q11 * x458 + c_q11 * x459 + -0.275 * x464);
-        let x468 = -0.6328 * x373 + -24.351642000914637 * x374 + 28.2393615 * x350
-            + x375 * 45.1584 + (x364 * x376 - x365 * x377 + x369 * x379) - f_ext[4][5]
-            + (x460 + 0.63 * x464);
-        let x469 = x464 - (f_ext[4][0] + (-45.1584 * x350 + x365 * x380));
-        let x470 = x364 * x380 - x370 * x379 - f_ext[4][1] + x465;
-        let x471 = x365 * x379 - x373 * 45.1584 - f_ext[4][2] + x463;
-        let x472 = c_q10 * x469 - s_q10 * x470;
-        let x473 = -0.00214 * x350 + -81.53205 * x354
-            + (x342 * x361 - x349 * x359 - x347 * x363) - f_ext[3][3]
-            + (c_q10 * x466 - s_q10 * x467 + -0.87 * x471);
-        let x474 = -63.36336825000001 * x356 + -36.18604050126307 * x350
-            + (x349 * x360 - x341 * x361 + (x346 * x363 - x348 * x362)) - f_ext[3][4]
-            + (s_q10 * x466 + c_q10 * x467);
-        let x475 = -0.00214 * x355 + -36.18604050126307 * x356 + 69.99836825 * x350
-            + x357 * 81.53205 + (x341 * x359 - x342 * x360 + x347 * x362) - f_ext[3][5]
-            + (x468 + 0.87 * x472);
-        let x476 = x472 - (f_ext[3][0] + (-81.53205 * x350 + x342 * x363));
-        let x477 = x341 * x363 - x349 * x362 - f_ext[3][1]
-            + (s_q10 * x469 + c_q10 * x470);
-        let x478 = x342 * x362 - x355 * 81.53205 - f_ext[3][2] + x471;
-        let x479 = x5 * x476 + x6 * x477 + 0.00000000020510342851533115 * x478;
-        let x480 = x478 + (x7 * x476 + x8 * x477);
-        let x481 = c_q9 * x476 - s_q9 * x477 + -0.00000000020510342851533115 * x478;
-        let x482 = -0.0021399965876409276 * x313 - -0.0000000234896432582596 * x332
-            + -12.701650001451807 * x329
-            + (x322 * x337 - x328 * x336 + (x327 * x339 - x326 * x340)) - f_ext[2][3]
-            + (x5 * x473 + x6 * x474 + 0.00000000020510342851533115 * x475
-                + (-0.4 * x480 + 0.275 * x481));
-        let x483 = -0.0000000234896432582596 * x331 - -111.7548902508081 * x332
-            + 5.080660024070365 * x313 + x329 * 0.000000008530897668050218
-            + (x328 * x335 - x321 * x337 + (x325 * x340 - x327 * x338)) - f_ext[2][4]
-            + (x475 + (x7 * x473 + x8 * x474) + 0.4 * x479);
-        let x484 = -0.0021399965876409276 * x331 - 5.080660024070366 * x332
-            + 113.3918902508081 * x313
-            + (x333 * 12.701650001451807 - -0.000000008530897668050218 * x334)
-            + (x321 * x336 - x322 * x335 + (x326 * x338 - x325 * x339)) - f_ext[2][5]
-            + (c_q9 * x473 - s_q9 * x474 + -0.00000000020510342851533115 * x475
-                + -0.275 * x479);
-        let x485 = x328 * x339 - x322 * x340 - -12.701650001451807 * x313 - f_ext[2][0]
-            + x479;
-        let x486 = x321 * x340 - x328 * x338 - x313 * 0.000000008530897668050218
-            - f_ext[2][1] + x480;
-        let x487 = x322 * x338 - x321 * x339
-            - (x331 * 12.701650001451807 - -0.000000008530897668050218 * x332)
-            - f_ext[2][2] + x481;
-        let x488 = x487 + (x2 * x485 - x3 * x486);
-        let x489 = s_q8 * x485 + c_q8 * x486;
-        let x490 = x306 * x318 - x312 * x317 + (x309 * x319 - x311 * x320)
-            - -0.07309 * x314 - f_ext[1][3]
-            + (x484 + (x2 * x482 - x3 * x483) + -0.35 * x489);
-        let x491 = -0.07309 * x313 - 130.43769025763282 * x314
-            + (x312 * x316 - x305 * x318 + x310 * x320) - f_ext[1][4]
-            + (s_q8 * x482 + c_q8 * x483 + 0.35 * x488);
-        let x492 = -16.80768997608804 * x313 - 0.1132 * x314 - 48.0240000085309 * x315
-            + (x305 * x317 - x306 * x316 - x310 * x319) - f_ext[1][5]
-            + (s_q8 * x483 - c_q8 * x482 + -0.00000000020510342851533115 * x484);
-        let x493 = x312 * x319 - x306 * x320 - f_ext[1][0] + x488;
-        let x494 = x305 * x320 - f_ext[1][1] + x489;
-        let x495 = 48.0240000085309 * x314 - x305 * x319 - f_ext[1][2]
-            + (s_q8 * x486 - c_q8 * x485 + -0.00000000020510342851533115 * x487);
-        let x496 = c_q7 * x493 - s_q7 * x494;
-        let x497 = s_q7 * x493 + c_q7 * x494;
-        let x498 = v[4] * x304 - v[5] * x303 - f_ext[0][0] + x496;
-        let x499 = v[5] * x302 - v[3] * x304 - f_ext[0][1] + x497;
-        let x500 = v[3] * x303 - v[4] * x302 - f_ext[0][2] + x495;
-        let x501 = x178 * 0.0008546497218115156;
-        let x502 = x168 * 0.0008546497218115156;
-        let x503 = x183 * 0.0008546497218115156;
-        let x504 = x200 * 0.0008546497218115156;
-        let x505 = x214 * 0.0008546497218115156;
-        let x506 = x233 * 0.0008546497218115156;
-        let x507 = x261 * 0.0008546497218115156;
-        let x508 = x297 * 0.0008546497218115156;
-        let x509 = x177 * 0.0008546497218115156;
-        let x510 = x167 * 0.0008546497218115156;
-        let x511 = x184 * 0.0008546497218115156;
-        let x512 = x201 * 0.0008546497218115156;
-        let x513 = x215 * 0.0008546497218115156;
-        let x514 = x234 * 0.0008546497218115156;
-        let x515 = x262 * 0.0008546497218115156;
-        let x516 = x298 * 0.0008546497218115156;
-        let x517 = x146 * 0.0008546497218115156;
-        let x518 = x196 * 0.0008546497218115156;
-        let x519 = x210 * 0.0008546497218115156;
-        let x520 = x229 * 0.0008546497218115156;
-        let x521 = x257 * 0.0008546497218115156;
-        let x522 = x293 * 0.0008546497218115156;
-        let x523 = x178 * x501;
-        let x524 = x168 * x502;
-        let x525 = 1.0
-            / (1394.5960312283303 + (x172 + (c_q7 * x169 - s_q7 * x170 - x171)) - x523
-                - x524);
-        let x526 = s_q7 * x169 + c_q7 * x170 - 0.65 * x168 + x168 * x509;
-        let x527 = x525 * x526;
-        let x528 = -117.61766249359756 + (x175 + x149 * -0.65) + x178 * x509;
-        let x529 = x525 * x528;
-        let x530 = x175 + x178 * x510;
-        let x531 = x525 * x530;
-        let x532 = c_q7 * x181 - s_q7 * x182 + -0.75 * x184 + x178 * x511 - x168 * x517;
-        let x533 = x525 * x532;
-        let x534 = c_q7 * x198 - s_q7 * x199 + -0.75 * x201 + x178 * x512 - x168 * x518;
-        let x535 = x525 * x534;
-        let x536 = c_q7 * x212 - s_q7 * x213 + -0.75 * x215 + x178 * x513 - x168 * x519;
-        let x537 = x525 * x536;
-        let x538 = c_q7 * x231 - s_q7 * x232 + -0.75 * x234 + x178 * x514 - x168 * x520;
-        let x539 = x525 * x538;
-        let x540 = c_q7 * x259 - s_q7 * x260 + -0.75 * x262 + x178 * x515 - x168 * x521;
-        let x541 = x525 * x540;
-        let x542 = c_q7 * x295 - s_q7 * x296 + -0.75 * x298 + x178 * x516 - x168 * x522;
-        let x543 = x525 * x542;
-        let x544 = x177 * x509;
-        let x545 = 1.0
+        let x2 = -117.61766249359758 * v[3] + 1271.854575 * v[5] + 110.5455 * v[1];
+        let x3 = 1170.07 * v[0] - v[4] * -180.9502499901501;
+        let x4 = 1170.07 * v[1] - (180.9502499901501 * v[3] + v[5] * -110.5455);
+        let x5 = 1170.07 * v[2] - 110.5455 * v[4];
+        let (s_q7, c_q7) = libm::sincos(q[7]);
+        let x7 = v[3] * c_q7 + v[4] * s_q7;
+        let x8 = v[4] * c_q7 - v[3] * s_q7;
+        let x9 = v[0] - v[4] * -0.75;
+        let x10 = v[1] - (0.75 * v[3] + v[5] * -0.65);
+        let x11 = v[2] - 0.65 * v[4];
+        let x12 = c_q7 * x9 + s_q7 * x10;
+        let x13 = c_q7 * x10 - s_q7 * x9;
+        let x14 = v[6] * x8;
+        let x15 = v[6] * x7;
+        let x16 = v[6] * x13;
+        let x17 = v[6] * x12;
+        let x18 = v[5] + v[6];
+        let x19 = -0.07309 * x8 + -16.80768997608804 * x18;
+        let x20 = -0.07309 * x7 + 130.43769025763282 * x8 + 0.1132 * x18
+            + x11 * -48.0240000085309;
+        let x21 = -16.80768997608804 * x7 + 0.1132 * x8 + 132.47349025763282 * x18
+            + 48.0240000085309 * x13;
+        let x22 = x18 * -48.0240000085309;
+        let x23 = 48.0240000085309 * x8;
+        let (s_q8, c_q8) = libm::sincos(q[8]);
+        let x25 = -0.00000000020510342851533115 * c_q8;
+        let x26 = -0.00000000020510342851533115 * s_q8;
+        let x27 = x7 * x25 + x8 * s_q8 - x18 * c_q8;
+        let x28 = x8 * c_q8 - x7 * x26 + x18 * s_q8;
+        let x29 = x12 - x8 * -0.35;
+        let x30 = x13 - 0.35 * x7;
+        let x31 = x25 * x29 + s_q8 * x30 - x11 * c_q8;
+        let x32 = c_q8 * x30 - x26 * x29 + x11 * s_q8;
+        let x33 = x29 + -0.00000000020510342851533115 * x11;
+        let x34 = v[7] * x28;
+        let x35 = v[7] * x27;
+        let x36 = v[7] * x32;
+        let x37 = v[7] * x31;
+        let x38 = v[7] + (x7 + -0.00000000020510342851533115 * x18);
+        let x39 = -0.0000000234896432582596 * x28 + -0.0021399965876409276 * x38
+            + -12.701650001451807 * x33;
+        let x40 = -0.0000000234896432582596 * x27 + -111.7548902508081 * x28
+            + 5.080660024070365 * x38 + x33 * 0.000000008530897668050218;
+        let x41 = -0.0021399965876409276 * x27 + 5.080660024070366 * x28
+            + 113.3918902508081 * x38
+            + (x31 * 12.701650001451807 + -0.000000008530897668050218 * x32);
+        let x42 = -12.701650001451807 * x38;
+        let x43 = x38 * 0.000000008530897668050218;
+        let x44 = x27 * 12.701650001451807 + -0.000000008530897668050218 * x28;
+        let (s_q9, c_q9) = libm::sincos(q[9]);
+        let x46 = s_q9 + 0.000000000000000000042067416388743556 * c_q9;
+        let x47 = c_q9 - 0.000000000000000000042067416388743556 * s_q9;
+        let x48 = 0.00000000020510342851533115 * c_q9
+            + -0.00000000020510342851533115 * s_q9;
+        let x49 = -0.00000000020510342851533115 * c_q9
+            - 0.00000000020510342851533115 * s_q9;
+        let x50 = x27 * x46 + x28 * x48 + x38 * c_q9;
+        let x51 = x27 * x47 + x28 * x49 - x38 * s_q9;
+        let x52 = x31 - (x28 * -0.4 + 0.275 * x38);
+        let x53 = x32 - 0.4 * x27;
+        let x54 = x33 - -0.275 * x27;
+        let x55 = x46 * x52 + x48 * x53 + c_q9 * x54;
+        let x56 = x47 * x52 + x49 * x53 - s_q9 * x54;
+        let x57 = x53 + 0.00000000020510342851533115 * x52
+            + -0.00000000020510342851533115 * x54;
+        let x58 = v[8] * x51;
+        let x59 = v[8] * x50;
+        let x60 = v[8] * x56;
+        let x61 = v[8] * x55;
+        let x62 = v[8]
+            + (x28 + 0.00000000020510342851533115 * x27
+                + -0.00000000020510342851533115 * x38);
+        let x63 = -63.36336825000001 * x51 + -36.18604050126307 * x62;
+        let x64 = -0.00214 * x62 + -81.53205 * x57;
+        let x65 = -0.00214 * x50 + -36.18604050126307 * x51 + 69.99836825 * x62
+            + x55 * 81.53205;
+        let x66 = -81.53205 * x62;
+        let x67 = x50 * 81.53205;
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x69 = x50 * c_q10 + x51 * s_q10;
+        let x70 = x51 * c_q10 - x50 * s_q10;
+        let x71 = x55 - -0.87 * x62;
+        let x72 = x57 - x50 * 0.87;
+        let x73 = c_q10 * x71 + x56 * s_q10;
+        let x74 = x56 * c_q10 - s_q10 * x71;
+        let x75 = v[9] * x70;
+        let x76 = v[9] * x69;
+        let x77 = v[9] * x74;
+        let x78 = v[9] * x73;
+        let x79 = v[9] + x62;
+        let x80 = -24.4950615 * x70 + -24.35164200091464 * x79;
+        let x81 = -0.6328 * x79 + -45.1584 * x72;
+        let x82 = -0.6328 * x69 + -24.351642000914637 * x70 + 28.2393615 * x79
+            + x73 * 45.1584;
+        let x83 = -45.1584 * x79;
+        let x84 = x69 * 45.1584;
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x86 = x69 * c_q11 + x70 * s_q11;
+        let x87 = x70 * c_q11 - x69 * s_q11;
+        let x88 = x73 - (0.275 * x70 + -0.63 * x79);
+        let x89 = x74 - -0.275 * x69;
+        let x90 = x72 - x69 * 0.63;
+        let x91 = c_q11 * x88 + s_q11 * x89;
+        let x92 = c_q11 * x89 - s_q11 * x88;
+        let x93 = v[10] * x87;
+        let x94 = v[10] * x86;
+        let x95 = v[10] * x92;
+        let x96 = v[10] * x91;
+        let x97 = v[10] + x79;
+        let x98 = -9.142025249762803 * x87 + 2.5482240016099564 * x97;
+        let x99 = 0.01675 * x97 + 7.078399999258757 * x90;
+        let x100 = 0.01675 * x86 + 2.5482240016099564 * x87 + 9.223235249762805 * x97
+            + x91 * -7.078399999258757;
+        let x101 = 7.078399999258757 * x97;
+        let x102 = x86 * -7.078399999258757;
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x104 = -0.00000000020510342851533115 * s_q12;
+        let x105 = -0.00000000020510342851533115 * c_q12;
+        let x106 = x86 * c_q12 + x87 * x104 - x97 * s_q12;
+        let x107 = x87 * x105 - x86 * s_q12 - x97 * c_q12;
+        let x108 = x91 - x87 * 0.36;
+        let x109 = x92 - -0.36 * x86;
+        let x110 = c_q12 * x108 + x104 * x109 - x90 * s_q12;
+        let x111 = x105 * x109 - s_q12 * x108 - x90 * c_q12;
+        let x112 = x109 + -0.00000000020510342851533115 * x90;
+        let x113 = v[11] * x107;
+        let x114 = v[11] * x106;
+        let x115 = v[11] * x111;
+        let x116 = v[11] * x110;
+        let x117 = v[11] + (x87 + -0.00000000020510342851533115 * x97);
+        let x118 = -1.9877000000000002 * x107 + -0.809539999555672 * x117
+            + 17.135250000000003 * x112;
+        let x119 = -1.9877000000000002 * x106 + -5.252920330000002 * x107
+            + -2.741639999592316 * x117 + x112 * -3.6140000000000003;
+        let x120 = -0.809539999555672 * x106 + -2.7416399995923166 * x107
+            + 9.740442170000001 * x117
+            + (x110 * -17.135250000000003 + 3.6140000000000003 * x111);
+        let x121 = 17.135250000000003 * x117;
+        let x122 = x117 * -3.6140000000000003;
+        let x123 = x106 * -17.135250000000003 + 3.6140000000000003 * x107;
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x125 = -0.00000000020510342851533115 * c_q13;
+        let x126 = -0.00000000020510342851533115 * s_q13;
+        let x127 = x106 * x125 + x107 * s_q13 - x117 * c_q13;
+        let x128 = x107 * c_q13 - x106 * x126 + x117 * s_q13;
+        let x129 = x110 - (-0.16 * x107 + 0.55 * x117);
+        let x130 = x111 - 0.16 * x106;
+        let x131 = x112 - x106 * -0.55;
+        let x132 = x125 * x129 + s_q13 * x130 - c_q13 * x131;
+        let x133 = c_q13 * x130 - x126 * x129 + s_q13 * x131;
+        let x134 = x129 + -0.00000000020510342851533115 * x131;
+        let x135 = v[12] * x128;
+        let x136 = v[12] * x127;
+        let x137 = v[12] * x133;
+        let x138 = v[12] + (x106 + -0.00000000020510342851533115 * x117);
+        let x139 = 0.000781 * x127 + -1.2025609200000003 * x128
+            + -0.9614610000000001 * x138;
+        let x140 = 0.000781 * x128 + -0.0145 * x138 + 4.806620000000001 * x134;
+        let x141 = -0.0145 * x127 + -0.9614610000000001 * x128
+            + 1.4135609200000003 * x138 + x132 * -4.806620000000001;
+        let x142 = 4.806620000000001 * x138;
+        let x143 = x127 * -4.806620000000001;
+        let x144 = x127 * x139 - x128 * x140 + x133 * x142 - f_ext[7][5];
+        let x145 = x127 * x143 - x138 * x142 - f_ext[7][1];
+        let x146 = tau[6] - x144;
+        let x147 = x128 * x142 - f_ext[7][2] + 4.806620000000001 * x135;
+        let x148 = x128 * x141 - x138 * x139 - x133 * x143 - f_ext[7][3]
+            + (x135 * -0.00014873784145079505 - x136 * -0.009081457502008472
+                + x137 * -0.049305260929256585) + x146 * -0.010257782169020348;
+        let x149 = x138 * x140 - x127 * x141 + (x132 * x143 - x134 * x142) - f_ext[7][4]
+            + (x135 * -0.009081457502008472 - x136 * -1.8565173511957638
+                + x137 * -3.2693162398830324) + x146 * -0.6801694828971361;
+        let x150 = x144 + x146;
+        let x151 = x135 * -0.049305260929256585 - x136 * -3.2693162398830324
+            + x137 * -16.344251950881606 - (f_ext[7][0] + x128 * x143)
+            + x146 * -3.4003628227073506;
+        let x152 = c_q13 * -0.009081457502008472;
+        let x153 = s_q13 * -0.00014873784145079505 + x152;
+        let x154 = s_q13 * -0.009081457502008472;
+        let x155 = x154 - c_q13 * -0.00014873784145079505;
+        let x156 = x154 + c_q13 * -1.8565173511957638;
+        let x157 = s_q13 * -1.8565173511957638 - x152;
+        let x158 = 4.806620000000001 + x125 * -0.049305260929256585;
+        let x159 = s_q13 * -0.049305260929256585;
+        let x160 = -0.0000000009858542415703612 - c_q13 * -0.049305260929256585;
+        let x161 = x125 * -3.2693162398830324;
+        let x162 = s_q13 * -3.2693162398830324;
+        let x163 = c_q13 * -3.2693162398830324;
+        let x164 = x125 * x158 - x126 * x161;
+        let x165 = x125 * x159 - x126 * x162;
+        let x166 = x125 * x160 + x126 * x163;
+        let x167 = s_q13 * x158 + c_q13 * x161;
+        let x168 = s_q13 * x161 - c_q13 * x158;
+        let x169 = s_q13 * -16.344251950881606;
+        let x170 = c_q13 * -16.344251950881606;
+        let x171 = x125 * (x125 * -16.344251950881606);
+        let x172 = x125 * x169;
+        let x173 = x125 * x170;
+        let x174 = s_q13 * x169;
+        let x175 = s_q13 * x170;
+        let x176 = c_q13 * x170;
+        let x177 = x165 + (-0.16 * x174 - 0.55 * x175);
+        let x178 = x166 + (0.55 * x176 - -0.16 * x175);
+        let x179 = x167 + 0.16 * x171;
+        let x180 = s_q13 * x159 + c_q13 * x162 + 0.16 * x172;
+        let x181 = s_q13 * x160 - c_q13 * x163 - 0.16 * x173;
+        let x182 = x168 + -0.55 * x171;
+        let x183 = s_q13 * x162 - c_q13 * x159 + -0.55 * x172;
+        let x184 = c_q13 * x160 + s_q13 * x163 + -0.55 * x173;
+        let x185 = x147 + (x125 * x151 - x126 * x145);
+        let x186 = s_q13 * x151 + c_q13 * x145;
+        let x187 = s_q13 * x145 - c_q13 * x151 + -0.00000000020510342851533115 * x147;
+        let x188 = -0.809539999555672
+            + (-0.55 * x164
+                + (x125 * x155 - x126 * x157 + (-0.16 * x183 - 0.55 * x184)));
+        let x189 = -2.741639999592316
+            + (-0.55 * x167 + (s_q13 * x155 + c_q13 * x157 + 0.16 * x182));
+        let x190 = 9.740442170000001
+            + (-0.55 * x168 + (s_q13 * x157 - c_q13 * x155 + -0.55 * x182));
+        let x191 = -17.135250000000003 + x182;
+        let x192 = 3.6140000000000003 + x183;
+        let x193 = x106 * x119 - x107 * x118 + (x111 * x121 - x110 * x122) - f_ext[6][5]
+            + (s_q13 * x149 - c_q13 * x148 + -0.00000000020510342851533115 * x150
+                + -0.55 * x185);
+        let x194 = 1.0 / x190;
+        let x195 = tau[5] - x193;
+        let x196 = x188 * x194;
+        let x197 = x189 * x194;
+        let x198 = x191 * x194;
+        let x199 = x192 * x194;
+        let x200 = x184 * x194;
+        let x201 = -0.16 * x165 + 0.55 * x166
+            + (x125 * (x125 * -0.00014873784145079505 - x126 * -0.009081457502008472)
+                - x126 * (x125 * -0.009081457502008472 - x126 * -1.8565173511957638)
+                + (-0.16 * x177 + 0.55 * x178)) - x188 * x196;
+        let x202 = -1.9877000000000002
+            + (0.16 * x164 + (x125 * x153 - x126 * x156 + (-0.16 * x180 + 0.55 * x181)))
+            - x188 * x197;
+        let x203 = -5.252920330000002
+            + (0.16 * x167 + (s_q13 * x153 + c_q13 * x156 + 0.16 * x179)) - x189 * x197;
+        let x204 = x164 + (-0.16 * x172 - 0.55 * x173) - x188 * x198;
+        let x205 = x177 - x188 * x199;
+        let x206 = 17.135250000000003 + x178 + x188 * x200;
+        let x207 = x179 - x189 * x198;
+        let x208 = x180 - x189 * x199;
+        let x209 = -3.6140000000000003 + x181 + x189 * x200;
+        let x210 = x171 - x191 * x198;
+        let x211 = x172 - x191 * x199;
+        let x212 = x191 * x200 - x173;
+        let x213 = x174 - x192 * x199;
+        let x214 = x192 * x200 - x175;
+        let x215 = x176 - x184 * x200;
+        let x216 = x107 * x120 - x117 * x119 + (x112 * x122 - x111 * x123) - f_ext[6][3]
+            + (x150 + (x125 * x148 - x126 * x149) + (-0.16 * x186 + 0.55 * x187))
+            + (x113 * x201 - x114 * x202 + (x115 * x204 - x116 * x205)) + x195 * x196;
+        let x217 = x117 * x118 - x106 * x120 + (x110 * x123 - x112 * x121) - f_ext[6][4]
+            + (s_q13 * x148 + c_q13 * x149 + 0.16 * x185)
+            + (x113 * x202 - x114 * x203 + (x115 * x207 - x116 * x208)) + x195 * x197;
+        let x218 = x193 + x195 * (x190 * x194);
+        let x219 = x117 * x122 - x107 * x123 - f_ext[6][0] + x185
+            + (x113 * x204 - x114 * x207 + (x115 * x210 - x116 * x211)) + x195 * x198;
+        let x220 = x106 * x123 - x117 * x121 - f_ext[6][1] + x186
+            + (x113 * x205 - x114 * x208 + (x115 * x211 - x116 * x213)) + x195 * x199;
+        let x221 = x107 * x121 - x106 * x122 - f_ext[6][2] + x187
+            + (x113 * x206 - x114 * x209 + (x115 * x212 - x116 * x214)) - x195 * x200;
+        let x222 = s_q12 * x202;
+        let x223 = x104 * x201 + x105 * x202;
+        let x224 = c_q12 * x202;
+        let x225 = s_q12 * x201 + x224;
+        let x226 = x104 * x202 + x105 * x203;
+        let x227 = x222 + c_q12 * x203;
+        let x228 = c_q12 * x204 - s_q12 * x205;
+        let x229 = x206 + (x104 * x204 + x105 * x205);
+        let x230 = -0.00000000020510342851533115 * x206 - (s_q12 * x204 + c_q12 * x205);
+        let x231 = c_q12 * x207 - s_q12 * x208;
+        let x232 = x209 + (x104 * x207 + x105 * x208);
+        let x233 = -0.00000000020510342851533115 * x209 - (s_q12 * x207 + c_q12 * x208);
+        let x234 = c_q12 * x228 - s_q12 * x231;
+        let x235 = c_q12 * x229 - s_q12 * x232;
+        let x236 = x104 * x228 + x105 * x231;
+        let x237 = s_q12 * x228 + c_q12 * x231;
+        let x238 = s_q12 * x229 + c_q12 * x232;
+        let x239 = s_q12 * x230 + c_q12 * x233;
+        let x240 = s_q12 * x211;
+        let x241 = x212 + (x104 * x210 + x105 * x211);
+        let x242 = c_q12 * x211;
+        let x243 = -0.00000000020510342851533115 * x212 - (s_q12 * x210 + x242);
+        let x244 = x214 + (x104 * x211 + x105 * x213);
+        let x245 = -0.00000000020510342851533115 * x214 - (x240 + c_q12 * x213);
+        let x246 = -0.00000000020510342851533115 * x215 - (s_q12 * x212 + c_q12 * x214);
+        let x247 = c_q12 * (c_q12 * x210 - x240) - s_q12 * (x242 - s_q12 * x213);
+        let x248 = c_q12 * x241 - s_q12 * x244;
+        let x249 = c_q12 * x243 - s_q12 * x245;
+        let x250 = x215 + (x104 * x212 + x105 * x214) + (x104 * x241 + x105 * x244);
+        let x251 = x246 + (x104 * x243 + x105 * x245);
+        let x252 = x235 + 0.36 * x250;
+        let x253 = x236 + -0.36 * x247;
+        let x254 = x104 * x229 + x105 * x232 + -0.36 * x248;
+        let x255 = c_q12 * x219 - s_q12 * x220;
+        let x256 = x221 + (x104 * x219 + x105 * x220);
+        let x257 = 0.01675 + (s_q12 * x227 - c_q12 * x225 - 0.36 * x238);
+        let x258 = 2.5482240016099564 - (x104 * x225 + x105 * x227 + -0.36 * x237);
+        let x259 = 9.223235249762805 + (s_q12 * x225 + c_q12 * x227);
+        let x260 = -7.078399999258757 - x237;
+        let x261 = x86 * x98 - x87 * x99 + x92 * x101 - f_ext[5][5]
+            + (-0.00000000020510342851533115 * x218 - (s_q12 * x216 + c_q12 * x217));
+        let x262 = 1.0 / x259;
+        let x263 = tau[4] - x261;
+        let x264 = x257 * x262;
+        let x265 = x258 * x262;
+        let x266 = x260 * x262;
+        let x267 = x238 * x262;
+        let x268 = x239 * x262;
+        let x269 = 0.36 * x235
+            + (c_q12 * (c_q12 * x201 - x222) - s_q12 * (x224 - s_q12 * x203)
+                + 0.36 * x252) - x257 * x264;
+        let x270 = -0.36 * x234 + (c_q12 * x223 - s_q12 * x226 + 0.36 * x254)
+            - x257 * x265;
+        let x271 = -9.142025249762803
+            + (-0.36 * x236 + (x104 * x223 + x105 * x226 + -0.36 * x253)) - x258 * x265;
+        let x272 = x234 + 0.36 * x248 - x257 * x266;
+        let x273 = x252 + x257 * x267;
+        let x274 = 7.078399999258757 + (c_q12 * x230 - s_q12 * x233 + 0.36 * x251)
+            + x257 * x268;
+        let x275 = x253 - x258 * x266;
+        let x276 = x254 + x258 * x267;
+        let x277 = x104 * x230 + x105 * x233 + -0.36 * x249 + x258 * x268;
+        let x278 = x247 - x260 * x266;
+        let x279 = x248 + x260 * x267;
+        let x280 = x249 + x260 * x268;
+        let x281 = x250 - x238 * x267;
+        let x282 = x251 - x238 * x268;
+        let x283 = -0.00000000020510342851533115 * x246 - (s_q12 * x243 + c_q12 * x245)
+            - x239 * x268;
+        let x284 = x87 * x100 - x97 * x98 - x92 * x102 - f_ext[5][3]
+            + (c_q12 * x216 - s_q12 * x217 + 0.36 * x256)
+            + (x93 * x269 - x94 * x270 + (x95 * x272 - x96 * x273)) + x263 * x264;
+        let x285 = x97 * x99 - x86 * x100 + (x91 * x102 - x90 * x101) - f_ext[5][4]
+            + (x218 + (x104 * x216 + x105 * x217) + -0.36 * x255)
+            + (x93 * x270 - x94 * x271 + (x95 * x275 - x96 * x276)) + x263 * x265;
+        let x286 = x255 - (f_ext[5][0] + x87 * x102)
+            + (x93 * x272 - x94 * x275 + (x95 * x278 - x96 * x279)) + x263 * x266;
+        let x287 = x86 * x102 - x97 * x101 - f_ext[5][1] + x256
+            + (x93 * x273 - x94 * x276 + (x95 * x279 - x96 * x281)) - x263 * x267;
+        let x288 = x87 * x101 - f_ext[5][2]
+            + (-0.00000000020510342851533115 * x221 - (s_q12 * x219 + c_q12 * x220))
+            + (x93 * x274 - x94 * x277 + (x95 * x280 - x96 * x282)) - x263 * x268;
+        let x289 = s_q11 * x270;
+        let x290 = c_q11 * x270;
+        let x291 = s_q11 * x269 + x290;
+        let x292 = x289 + c_q11 * x271;
+        let x293 = c_q11 * x272 - s_q11 * x273;
+        let x294 = s_q11 * x272 + c_q11 * x273;
+        let x295 = c_q11 * x275 - s_q11 * x276;
+        let x296 = s_q11 * x275 + c_q11 * x276;
+        let x297 = c_q11 * x293 - s_q11 * x295;
+        let x298 = c_q11 * x294 - s_q11 * x296;
+        let x299 = c_q11 * x274 - s_q11 * x277;
+        let x300 = s_q11 * x293 + c_q11 * x295;
+        let x301 = s_q11 * x279;
+        let x302 = c_q11 * x279;
+        let x303 = s_q11 * x278 + x302;
+        let x304 = x301 + c_q11 * x281;
+        let x305 = c_q11 * x280 - s_q11 * x282;
+        let x306 = s_q11 * x280 + c_q11 * x282;
+        let x307 = c_q11 * (c_q11 * x278 - x301) - s_q11 * (x302 - s_q11 * x281);
+        let x308 = c_q11 * x303 - s_q11 * x304;
+        let x309 = s_q11 * x303 + c_q11 * x304;
+        let x310 = 0.63 * x307;
+        let x311 = 0.63 * x308;
+        let x312 = 0.63 * x305;
+        let x313 = x298 + (0.275 * x309 + -0.63 * x306);
+        let x314 = x299 + (0.275 * x306 + -0.63 * x283);
+        let x315 = x300 + -0.275 * x307;
+        let x316 = s_q11 * x294 + c_q11 * x296 + -0.275 * x308;
+        let x317 = s_q11 * x274 + c_q11 * x277 + -0.275 * x305;
+        let x318 = c_q11 * x286 - s_q11 * x287;
+        let x319 = s_q11 * x286 + c_q11 * x287;
+        let x320 = -0.6328 + (0.275 * x311 + -0.63 * x312 + 0.63 * x297);
+        let x321 = -24.35164200091464 + (-0.275 * x310 + 0.63 * x300);
+        let x322 = 28.2393615 + 0.63 * x310;
+        let x323 = 45.1584 + x310;
+        let x324 = x69 * x80 - x70 * x81 + x74 * x83 - f_ext[4][5]
+            + (x261 + x263 * (x259 * x262) + 0.63 * x318);
+        let x325 = 1.0 / x322;
+        let x326 = tau[3] - x324;
+        let x327 = x320 * x325;
+        let x328 = x321 * x325;
+        let x329 = x323 * x325;
+        let x330 = x311 * x325;
+        let x331 = x312 * x325;
+        let x332 = 0.275 * x298 + -0.63 * x299
+            + (c_q11 * (c_q11 * x269 - x289) - s_q11 * (x290 - s_q11 * x271)
+                + (0.275 * x313 + -0.63 * x314)) - x320 * x327;
+        let x333 = -0.275 * x297
+            + (c_q11 * x291 - s_q11 * x292 + (0.275 * x316 + -0.63 * x317))
+            - x320 * x328;
+        let x334 = -24.4950615
+            + (-0.275 * x300 + (s_q11 * x291 + c_q11 * x292 + -0.275 * x315))
+            - x321 * x328;
+        let x335 = x297 + (0.275 * x308 + -0.63 * x305) - x320 * x329;
+        let x336 = x313 - x320 * x330;
+        let x337 = -45.1584 + x314 - x320 * x331;
+        let x338 = x315 - x321 * x329;
+        let x339 = x316 - x321 * x330;
+        let x340 = x317 - x321 * x331;
+        let x341 = x307 - x323 * x329;
+        let x342 = x308 - x323 * x330;
+        let x343 = x305 - x323 * x331;
+        let x344 = x309 - x311 * x330;
+        let x345 = x306 - x311 * x331;
+        let x346 = x283 - x312 * x331;
+        let x347 = x70 * x82 - x79 * x80 - x74 * x84 - f_ext[4][3]
+            + (c_q11 * x284 - s_q11 * x285 + (0.275 * x319 + -0.63 * x288))
+            + (x75 * x332 - x76 * x333 + (x77 * x335 - x78 * x336)) + x326 * x327;
+        let x348 = x79 * x81 - x69 * x82 + (x73 * x84 - x72 * x83) - f_ext[4][4]
+            + (s_q11 * x284 + c_q11 * x285 + -0.275 * x318)
+            + (x75 * x333 - x76 * x334 + (x77 * x338 - x78 * x339)) + x326 * x328;
+        let x349 = x318 - (f_ext[4][0] + x70 * x84)
+            + (x75 * x335 - x76 * x338 + (x77 * x341 - x78 * x342)) + x326 * x329;
+        let x350 = x69 * x84 - x79 * x83 - f_ext[4][1] + x319
+            + (x75 * x336 - x76 * x339 + (x77 * x342 - x78 * x344)) + x326 * x330;
+        let x351 = x70 * x83 - f_ext[4][2] + x288
+            + (x75 * x337 - x76 * x340 + (x77 * x343 - x78 * x345)) + x326 * x331;
+        let x352 = s_q10 * x333;
+        let x353 = c_q10 * x333;
+        let x354 = s_q10 * x332 + x353;
+        let x355 = x352 + c_q10 * x334;
+        let x356 = c_q10 * x335 - s_q10 * x336;
+        let x357 = s_q10 * x335 + c_q10 * x336;
+        let x358 = c_q10 * x338 - s_q10 * x339;
+        let x359 = s_q10 * x338 + c_q10 * x339;
+        let x360 = c_q10 * x356 - s_q10 * x358;
+        let x361 = c_q10 * x337 - s_q10 * x340;
+        let x362 = s_q10 * x356 + c_q10 * x358;
+        let x363 = s_q10 * x337 + c_q10 * x340;
+        let x364 = s_q10 * x342;
+        let x365 = c_q10 * x342;
+        let x366 = s_q10 * x341 + x365;
+        let x367 = x364 + c_q10 * x344;
+        let x368 = c_q10 * x343 - s_q10 * x345;
+        let x369 = s_q10 * x343 + c_q10 * x345;
+        let x370 = c_q10 * (c_q10 * x341 - x364) - s_q10 * (x365 - s_q10 * x344);
+        let x371 = c_q10 * x366 - s_q10 * x367;
+        let x372 = 0.87 * x370;
+        let x373 = 0.87 * x371;
+        let x374 = 0.87 * x368;
+        let x375 = x361 + -0.87 * x346;
+        let x376 = c_q10 * x349 - s_q10 * x350;
+        let x377 = -0.00214 + (-0.87 * x374 + 0.87 * x360);
+        let x378 = -36.18604050126307 + 0.87 * x362;
+        let x379 = 69.99836825 + 0.87 * x372;
+        let x380 = 81.53205 + x372;
+        let x381 = x50 * x63 - x51 * x64 + x56 * x66 - f_ext[3][5]
+            + (x324 + x326 * (x322 * x325) + 0.87 * x376);
+        let x382 = 1.0 / x379;
+        let x383 = tau[2] - x381;
+        let x384 = x377 * x382;
+        let x385 = x378 * x382;
+        let x386 = x380 * x382;
+        let x387 = x373 * x382;
+        let x388 = x374 * x382;
+        let x389 = -0.87 * x361
+            + (c_q10 * (c_q10 * x332 - x352) - s_q10 * (x353 - s_q10 * x334)
+                + -0.87 * x375) - x377 * x384;
+        let x390 = c_q10 * x354 - s_q10 * x355 + -0.87 * x363 - x377 * x385;
+        let x391 = -63.36336825000001 + (s_q10 * x354 + c_q10 * x355) - x378 * x385;
+        let x392 = x360 + -0.87 * x368 - x377 * x386;
+        let x393 = c_q10 * x357 - s_q10 * x359 + -0.87 * x369 - x377 * x387;
+        let x394 = -81.53205 + x375 - x377 * x388;
+        let x395 = x362 - x378 * x386;
+        let x396 = s_q10 * x357 + c_q10 * x359 - x378 * x387;
+        let x397 = x363 - x378 * x388;
+        let x398 = x370 - x380 * x386;
+        let x399 = x371 - x380 * x387;
+        let x400 = x368 - x380 * x388;
+        let x401 = s_q10 * x366 + c_q10 * x367 - x373 * x387;
+        let x402 = x369 - x373 * x388;
+        let x403 = x346 - x374 * x388;
+        let x404 = x51 * x65 - x62 * x63 - x56 * x67 - f_ext[3][3]
+            + (c_q10 * x347 - s_q10 * x348 + -0.87 * x351)
+            + (x58 * x389 - x59 * x390 + (x60 * x392 - x61 * x393)) + x383 * x384;
+        let x405 = x62 * x64 - x50 * x65 + (x55 * x67 - x57 * x66) - f_ext[3][4]
+            + (s_q10 * x347 + c_q10 * x348)
+            + (x58 * x390 - x59 * x391 + (x60 * x395 - x61 * x396)) + x383 * x385;
+        let x406 = x381 + x383 * (x379 * x382);
+        let x407 = x376 - (f_ext[3][0] + x51 * x67)
+            + (x58 * x392 - x59 * x395 + (x60 * x398 - x61 * x399)) + x383 * x386;
+        let x408 = x50 * x67 - x62 * x66 - f_ext[3][1] + (s_q10 * x349 + c_q10 * x350)
+            + (x58 * x393 - x59 * x396 + (x60 * x399 - x61 * x401)) + x383 * x387;
+        let x409 = x51 * x66 - f_ext[3][2] + x351
+            + (x58 * x394 - x59 * x397 + (x60 * x400 - x61 * x402)) + x383 * x388;
+        let x410 = x48 * x389 + x49 * x390;
+        let x411 = c_q9 * x389 - s_q9 * x390;
+        let x412 = x48 * x390 + x49 * x391;
+        let x413 = c_q9 * x390 - s_q9 * x391;
+        let x414 = x46 * x392 + x47 * x393 + 0.00000000020510342851533115 * x394;
+        let x415 = x394 + (x48 * x392 + x49 * x393);
+        let x416 = c_q9 * x392 - s_q9 * x393 + -0.00000000020510342851533115 * x394;
+        let x417 = x46 * x395 + x47 * x396 + 0.00000000020510342851533115 * x397;
+        let x418 = x397 + (x48 * x395 + x49 * x396);
+        let x419 = c_q9 * x395 - s_q9 * x396 + -0.00000000020510342851533115 * x397;
+        let x420 = x46 * x414 + x47 * x417;
+        let x421 = x46 * x415 + x47 * x418;
+        let x422 = x46 * x416 + x47 * x419;
+        let x423 = x48 * x414 + x49 * x417;
+        let x424 = c_q9 * x414 - s_q9 * x417;
+        let x425 = x400 + (x48 * x398 + x49 * x399);
+        let x426 = c_q9 * x398 - s_q9 * x399 + -0.00000000020510342851533115 * x400;
+        let x427 = x402 + (x48 * x399 + x49 * x401);
+        let x428 = c_q9 * x399 - s_q9 * x401 + -0.00000000020510342851533115 * x402;
+        let x429 = x403 + (x48 * x400 + x49 * x402);
+        let x430 = c_q9 * x400 - s_q9 * x402 + -0.00000000020510342851533115 * x403;
+        let x431 = x46 * (x46 * x398 + x47 * x399 + 0.00000000020510342851533115 * x400)
+            + x47 * (x46 * x399 + x47 * x401 + 0.00000000020510342851533115 * x402)
+            + 0.00000000020510342851533115
+                * (x46 * x400 + x47 * x402 + 0.00000000020510342851533115 * x403);
+        let x432 = x46 * x425 + x47 * x427 + 0.00000000020510342851533115 * x429;
+        let x433 = x46 * x426 + x47 * x428 + 0.00000000020510342851533115 * x430;
+        let x434 = x429 + (x48 * x425 + x49 * x427);
+        let x435 = x430 + (x48 * x426 + x49 * x428);
+        let x436 = c_q9 * x426 - s_q9 * x428 + -0.00000000020510342851533115 * x430;
+        let x437 = x421 + (-0.4 * x434 + 0.275 * x435);
+        let x438 = x422 + (-0.4 * x435 + 0.275 * x436);
+        let x439 = x423 + 0.4 * x431;
+        let x440 = x48 * x415 + x49 * x418 + 0.4 * x432;
+        let x441 = x48 * x416 + x49 * x419 + 0.4 * x433;
+        let x442 = x424 + -0.275 * x431;
+        let x443 = c_q9 * x415 - s_q9 * x418 + -0.275 * x432;
+        let x444 = c_q9 * x416 - s_q9 * x419 + -0.275 * x433;
+        let x445 = x46 * x407 + x47 * x408 + 0.00000000020510342851533115 * x409;
+        let x446 = x409 + (x48 * x407 + x49 * x408);
+        let x447 = c_q9 * x407 - s_q9 * x408 + -0.00000000020510342851533115 * x409;
+        let x448 = -0.0021399965876409276
+            + (-0.275 * x420 + (x46 * x411 + x47 * x413 + (-0.4 * x443 + 0.275 * x444)));
+        let x449 = 5.080660024070365
+            + (-0.275 * x423 + (x48 * x411 + x49 * x413 + 0.4 * x442));
+        let x450 = 113.3918902508081
+            + (-0.275 * x424 + (c_q9 * x411 - s_q9 * x413 + -0.275 * x442));
+        let x451 = 12.701650001451807 + x442;
+        let x452 = -0.000000008530897668050218 + x443;
+        let x453 = x27 * x40 - x28 * x39 + (x32 * x42 - x31 * x43) - f_ext[2][5]
+            + (c_q9 * x404 - s_q9 * x405 + -0.00000000020510342851533115 * x406
+                + -0.275 * x445);
+        let x454 = 1.0 / x450;
+        let x455 = tau[1] - x453;
+        let x456 = x448 * x454;
+        let x457 = x449 * x454;
+        let x458 = x451 * x454;
+        let x459 = x452 * x454;
+        let x460 = x444 * x454;
+        let x461 = -0.4 * x421 + 0.275 * x422
+            + (x46 * (x46 * x389 + x47 * x390) + x47 * (x46 * x390 + x47 * x391)
+                + (-0.4 * x437 + 0.275 * x438)) - x448 * x456;
+        let x462 = -0.0000000234896432582596
+            + (0.4 * x420 + (x46 * x410 + x47 * x412 + (-0.4 * x440 + 0.275 * x441)))
+            - x448 * x457;
+        let x463 = -111.7548902508081
+            + (0.4 * x423 + (x48 * x410 + x49 * x412 + 0.4 * x439)) - x449 * x457;
+        let x464 = x420 + (-0.4 * x432 + 0.275 * x433) - x448 * x458;
+        let x465 = x437 - x448 * x459;
+        let x466 = -12.701650001451807 + x438 - x448 * x460;
+        let x467 = x439 - x449 * x458;
+        let x468 = x440 - x449 * x459;
+        let x469 = 0.000000008530897668050218 + x441 - x449 * x460;
+        let x470 = x431 - x451 * x458;
+        let x471 = x432 - x451 * x459;
+        let x472 = x433 - x451 * x460;
+        let x473 = x434 - x452 * x459;
+        let x474 = x435 - x452 * x460;
+        let x475 = x436 - x444 * x460;
+        let x476 = x28 * x41 - x38 * x40 + (x33 * x43 - x32 * x44) - f_ext[2][3]
+            + (x46 * x404 + x47 * x405 + 0.00000000020510342851533115 * x406
+                + (-0.4 * x446 + 0.275 * x447))
+            + (x34 * x461 - x35 * x462 + (x36 * x464 - x37 * x465)) + x455 * x456;
+        let x477 = x38 * x39 - x27 * x41 + (x31 * x44 - x33 * x42) - f_ext[2][4]
+            + (x406 + (x48 * x404 + x49 * x405) + 0.4 * x445)
+            + (x34 * x462 - x35 * x463 + (x36 * x467 - x37 * x468)) + x455 * x457;
+        let x478 = x453 + x455 * (x450 * x454);
+        let x479 = x38 * x43 - x28 * x44 - f_ext[2][0] + x445
+            + (x34 * x464 - x35 * x467 + (x36 * x470 - x37 * x471)) + x455 * x458;
+        let x480 = x27 * x44 - x38 * x42 - f_ext[2][1] + x446
+            + (x34 * x465 - x35 * x468 + (x36 * x471 - x37 * x473)) + x455 * x459;
+        let x481 = x28 * x42 - x27 * x43 - f_ext[2][2] + x447
+            + (x34 * x466 - x35 * x469 + (x36 * x472 - x37 * x474)) + x455 * x460;
+        let x482 = c_q8 * x462;
+        let x483 = s_q8 * x461 + x482;
+        let x484 = s_q8 * x462;
+        let x485 = x484 - c_q8 * x461;
+        let x486 = x484 + c_q8 * x463;
+        let x487 = s_q8 * x463 - x482;
+        let x488 = x466 + (x25 * x464 - x26 * x465);
+        let x489 = s_q8 * x464 + c_q8 * x465;
+        let x490 = s_q8 * x465 - c_q8 * x464 + -0.00000000020510342851533115 * x466;
+        let x491 = x469 + (x25 * x467 - x26 * x468);
+        let x492 = s_q8 * x467 + c_q8 * x468;
+        let x493 = s_q8 * x468 - c_q8 * x467 + -0.00000000020510342851533115 * x469;
+        let x494 = x25 * x488 - x26 * x491;
+        let x495 = x25 * x489 - x26 * x492;
+        let x496 = s_q8 * x488 + c_q8 * x491;
+        let x497 = s_q8 * x491 - c_q8 * x488;
+        let x498 = s_q8 * x492 - c_q8 * x489;
+        let x499 = s_q8 * x493 - c_q8 * x490;
+        let x500 = c_q8 * x471;
+        let x501 = s_q8 * x470 + x500;
+        let x502 = s_q8 * x471;
+        let x503 = x502 - c_q8 * x470 + -0.00000000020510342851533115 * x472;
+        let x504 = x502 + c_q8 * x473;
+        let x505 = s_q8 * x473 - x500 + -0.00000000020510342851533115 * x474;
+        let x506 = s_q8 * x474 - c_q8 * x472 + -0.00000000020510342851533115 * x475;
+        let x507 = x475 + (x25 * x472 - x26 * x474)
+            + (x25 * (x472 + (x25 * x470 - x26 * x471))
+                - x26 * (x474 + (x25 * x471 - x26 * x473)));
+        let x508 = s_q8 * x472 + c_q8 * x474 + (x25 * x501 - x26 * x504);
+        let x509 = x506 + (x25 * x503 - x26 * x505);
+        let x510 = s_q8 * x501 + c_q8 * x504;
+        let x511 = s_q8 * x503 + c_q8 * x505;
+        let x512 = x495 + -0.35 * x510;
+        let x513 = x496 + 0.35 * x507;
+        let x514 = s_q8 * x489 + c_q8 * x492 + 0.35 * x508;
+        let x515 = x481 + (x25 * x479 - x26 * x480);
+        let x516 = s_q8 * x479 + c_q8 * x480;
+        let x517 = -16.80768997608804 + (x25 * x485 - x26 * x487 + -0.35 * x498);
+        let x518 = 0.1132 + (s_q8 * x485 + c_q8 * x487 + 0.35 * x497);
+        let x519 = 132.47349025763282 + (s_q8 * x487 - c_q8 * x485);
+        let x520 = 48.0240000085309 + x498;
+        let x521 = x7 * x20 - x8 * x19 - x12 * x22 - f_ext[1][5]
+            + (s_q8 * x477 - c_q8 * x476 + -0.00000000020510342851533115 * x478);
+        let x522 = 1.0 / x519;
+        let x523 = tau[0] - x521;
+        let x524 = x517 * x522;
+        let x525 = x518 * x522;
+        let x526 = x497 * x522;
+        let x527 = x520 * x522;
+        let x528 = x499 * x522;
+        let x529 = -0.35 * x495
+            + (x25 * (x25 * x461 - x26 * x462) - x26 * (x25 * x462 - x26 * x463)
+                + -0.35 * x512) - x517 * x524;
+        let x530 = -0.07309 + (0.35 * x494 + (x25 * x483 - x26 * x486 + -0.35 * x514))
+            - x517 * x525;
+        let x531 = 130.43769025763282
+            + (0.35 * x496 + (s_q8 * x483 + c_q8 * x486 + 0.35 * x513)) - x518 * x525;
+        let x532 = x494 + -0.35 * x508 - x517 * x526;
+        let x533 = x512 - x517 * x527;
+        let x534 = x25 * x490 - x26 * x493 + -0.35 * x511 - x517 * x528;
+        let x535 = x513 - x518 * x526;
+        let x536 = x514 - x518 * x527;
+        let x537 = -48.0240000085309 + (s_q8 * x490 + c_q8 * x493 + 0.35 * x509)
+            - x518 * x528;
+        let x538 = x507 - x497 * x526;
+        let x539 = x508 - x497 * x527;
+        let x540 = x509 - x497 * x528;
+        let x541 = x510 - x520 * x527;
+        let x542 = x511 - x520 * x528;
+        let x543 = s_q8 * x505 - c_q8 * x503 + -0.00000000020510342851533115 * x506
+            - x499 * x528;
+        let x544 = x8 * x21 - x18 * x20 + (x11 * x22 - x13 * x23) - f_ext[1][3]
+            + (x478 + (x25 * x476 - x26 * x477) + -0.35 * x516)
+            + (x14 * x529 - x15 * x530 + (x16 * x532 - x17 * x533)) + x523 * x524;
+        let x545 = x18 * x19 - x7 * x21 + x12 * x23 - f_ext[1][4]
+            + (s_q8 * x476 + c_q8 * x477 + 0.35 * x515)
+            + (x14 * x530 - x15 * x531 + (x16 * x535 - x17 * x536)) + x523 * x525;
+        let x546 = x18 * x22 - x8 * x23 - f_ext[1][0] + x515
+            + (x14 * x532 - x15 * x535 + (x16 * x538 - x17 * x539)) + x523 * x526;
+        let x547 = x7 * x23 - f_ext[1][1] + x516
+            + (x14 * x533 - x15 * x536 + (x16 * x539 - x17 * x541)) + x523 * x527;
+        let x548 = s_q8 * x480 - c_q8 * x479 + -0.00000000020510342851533115 * x481
+            - (f_ext[1][2] + x7 * x22)
+            + (x14 * x534 - x15 * x537 + (x16 * x540 - x17 * x542)) + x523 * x528;
+        let x549 = s_q7 * x530;
+        let x550 = c_q7 * x530;
+        let x551 = s_q7 * x529 + x550;
+        let x552 = x549 + c_q7 * x531;
+        let x553 = c_q7 * x532 - s_q7 * x533;
+        let x554 = s_q7 * x532 + c_q7 * x533;
+        let x555 = c_q7 * x535 - s_q7 * x536;
+        let x556 = s_q7 * x535 + c_q7 * x536;
+        let x557 = c_q7 * x553 - s_q7 * x555;
+        let x558 = c_q7 * x554 - s_q7 * x556;
+        let x559 = c_q7 * x534 - s_q7 * x537;
+        let x560 = s_q7 * x553 + c_q7 * x555;
+        let x561 = s_q7 * x554 + c_q7 * x556;
+        let x562 = s_q7 * x534 + c_q7 * x537;
+        let x563 = s_q7 * x539;
+        let x564 = c_q7 * x539;
+        let x565 = s_q7 * x538 + x564;
+        let x566 = x563 + c_q7 * x541;
+        let x567 = c_q7 * x540 - s_q7 * x542;
+        let x568 = s_q7 * x540 + c_q7 * x542;
+        let x569 = c_q7 * (c_q7 * x538 - x563) - s_q7 * (x564 - s_q7 * x541);
+        let x570 = c_q7 * x565 - s_q7 * x566;
+        let x571 = s_q7 * x565 + c_q7 * x566;
+        let x572 = 0.65 * x570;
+        let x573 = 0.65 * x571;
+        let x574 = 0.65 * x568;
+        let x575 = x557 + -0.75 * x570;
+        let x576 = x558 + -0.75 * x571;
+        let x577 = x560 + (0.75 * x569 + -0.65 * x567);
+        let x578 = x561 + (0.75 * x570 + -0.65 * x568);
+        let x579 = x562 + (0.75 * x567 + -0.65 * x543);
+        let x580 = c_q7 * x546 - s_q7 * x547;
+        let x581 = s_q7 * x546 + c_q7 * x547;
+        let x582 = 180.9502499901501 + x577;
+        let x583 = v[4] * x5 - v[5] * x4 - f_ext[0][0] + x580;
+        let x584 = 1.0 / (1170.07 + x569);
+        let x585 = x570 * x584;
+        let x586 = x567 * x584;
+        let x587 = x575 * x584;
+        let x588 = x582 * x584;
+        let x589 = x572 * x584;
+        let x590 = 1.0 / (1170.07 + x571 - x570 * x585);
+        let x591 = x568 - x570 * x586;
+        let x592 = x590 * x591;
+        let x593 = -180.9502499901501 + x576 - x570 * x587;
+        let x594 = x590 * x593;
+        let x595 = x578 - x570 * x588;
+        let x596 = x590 * x595;
+        let x597 = 110.5455 + x573 - x570 * x589;
+        let x598 = x590 * x597;
+        let x599 = 1.0 / (1170.07 + x543 - x567 * x586 - x591 * x592);
+        let x600 = x559 + -0.75 * x568 - x567 * x587 - x591 * x594;
+        let x601 = x599 * x600;
+        let x602 = -110.5455 + x579 - x567 * x588 - x591 * x596;
+        let x603 = x599 * x602;
+        let x604 = x574 - x567 * x589 - x591 * x598;
+        let x605 = x599 * x604;
+        let x606 = 1.0
+            / (1394.5960312283303
+                + (-0.75 * x558
+                    + (c_q7 * (c_q7 * x529 - x549) - s_q7 * (x550 - s_q7 * x531)
+                        + -0.75 * x576)) - x575 * x587 - x593 * x594 - x600 * x601);
+        let x607 = 0.75 * x557 + -0.65 * x559
+            + (c_q7 * x551 - s_q7 * x552 + -0.75 * x578) - x575 * x588 - x593 * x596
+            - x600 * x603;
+        let x608 = x606 * x607;
+        let x609 = -117.61766249359756 + (-0.75 * x573 + 0.65 * x558) - x575 * x589
+            - x593 * x598 - x600 * x605;
+        let x610 = x606 * x609;
+        let x611 = 1.0
             / (1466.4506062283303
-                + (s_q7 * (s_q7 * x159 + c_q7 * x163)
-                    + c_q7 * (s_q7 * x161 + c_q7 * x164) - (x173 - x172) - (x171 - x174))
-                - x523 - x544 - x526 * x527);
-        let x546 = s_q7 * x162 + c_q7 * x165 - 0.75 * x168 + x178 * x502;
-        let x547 = x546 - x526 * x529;
-        let x548 = x545 * x547;
-        let x549 = x546 - x526 * x531;
-        let x550 = x545 * x549;
-        let x551 = s_q7 * x181 + c_q7 * x182 + (x146 * -0.65 - 0.75 * x183) + x178 * x503
-            + x177 * x517 - x526 * x533;
-        let x552 = x545 * x551;
-        let x553 = s_q7 * x198 + c_q7 * x199 + (0.75 * x200 + -0.65 * x196) - x178 * x504
-            + x177 * x518 - x526 * x535;
-        let x554 = x545 * x553;
-        let x555 = s_q7 * x212 + c_q7 * x213 + (0.75 * x214 + -0.65 * x210) - x178 * x505
-            + x177 * x519 - x526 * x537;
-        let x556 = x545 * x555;
-        let x557 = s_q7 * x231 + c_q7 * x232 + (0.75 * x233 + -0.65 * x229) - x178 * x506
-            + x177 * x520 - x526 * x539;
-        let x558 = x545 * x557;
-        let x559 = s_q7 * x259 + c_q7 * x260 + (0.75 * x261 + -0.65 * x257) - x178 * x507
-            + x177 * x521 - x526 * x541;
-        let x560 = x545 * x559;
-        let x561 = s_q7 * x295 + c_q7 * x296 + (0.75 * x297 + -0.65 * x293) - x178 * x508
-            + x177 * x522 - x526 * x543;
-        let x562 = x545 * x561;
-        let x563 = 1.0
-            / (1271.854575 + (x176 - x173) - x524 - x544 - x528 * x529 - x547 * x548);
-        let x564 = x176 - x524 - x177 * x510 - x528 * x531 - x547 * x550;
-        let x565 = x563 * x564;
-        let x566 = x168 * x503;
-        let x567 = x156 + 0.65 * x184 - x566 - x177 * x511 - x528 * x533 - x547 * x552;
-        let x568 = x563 * x567;
-        let x569 = x168 * x504;
-        let x570 = x197 + 0.65 * x201 + x569 - x177 * x512 - x528 * x535 - x547 * x554;
-        let x571 = x563 * x570;
-        let x572 = x168 * x505;
-        let x573 = x211 + 0.65 * x215 + x572 - x177 * x513 - x528 * x537 - x547 * x556;
-        let x574 = x563 * x573;
-        let x575 = x168 * x506;
-        let x576 = x230 + 0.65 * x234 + x575 - x177 * x514 - x528 * x539 - x547 * x558;
-        let x577 = x563 * x576;
-        let x578 = x168 * x507;
-        let x579 = x258 + 0.65 * x262 + x578 - x177 * x515 - x528 * x541 - x547 * x560;
-        let x580 = x563 * x579;
-        let x581 = x168 * x508;
-        let x582 = x294 + 0.65 * x298 + x581 - x177 * x516 - x528 * x543 - x547 * x562;
-        let x583 = x563 * x582;
-        let x584 = 1.0
-            / (x166 - x524 - x167 * x510 - x530 * x531 - x549 * x550 - x564 * x565);
-        let x585 = x156 - x566 - x167 * x511 - x530 * x533 - x549 * x552 - x564 * x568;
-        let x586 = x584 * x585;
-        let x587 = x197 + x569 - x167 * x512 - x530 * x535 - x549 * x554 - x564 * x571;
-        let x588 = x584 * x587;
-        let x589 = x211 + x572 - x167 * x513 - x530 * x537 - x549 * x556 - x564 * x574;
-        let x590 = x584 * x589;
-        let x591 = x230 + x575 - x167 * x514 - x530 * x539 - x549 * x558 - x564 * x577;
-        let x592 = x584 * x591;
-        let x593 = x258 + x578 - x167 * x515 - x530 * x541 - x549 * x560 - x564 * x580;
-        let x594 = x584 * x593;
-        let x595 = x294 + x581 - x167 * x516 - x530 * x543 - x549 * x562 - x564 * x583;
-        let x596 = x584 * x595;
-        let x597 = 1.0
-            / (x144 - x183 * x503 - x184 * x511 - x146 * x517 - x532 * x533 - x551 * x552
-                - x567 * x568 - x585 * x586);
-        let x598 = x193 + x183 * x504 - x184 * x512 - x146 * x518 - x532 * x535
-            - x551 * x554 - x567 * x571 - x585 * x588;
-        let x599 = x597 * x598;
-        let x600 = x207 + x183 * x505 - x184 * x513 - x146 * x519 - x532 * x537
-            - x551 * x556 - x567 * x574 - x585 * x590;
-        let x601 = x597 * x600;
-        let x602 = x226 + x183 * x506 - x184 * x514 - x146 * x520 - x532 * x539
-            - x551 * x558 - x567 * x577 - x585 * x592;
-        let x603 = x597 * x602;
-        let x604 = x254 + x183 * x507 - x184 * x515 - x146 * x521 - x532 * x541
-            - x551 * x560 - x567 * x580 - x585 * x594;
-        let x605 = x597 * x604;
-        let x606 = x290 + x183 * x508 - x184 * x516 - x146 * x522 - x532 * x543
-            - x551 * x562 - x567 * x583 - x585 * x596;
-        let x607 = x597 * x606;
-        let x608 = 1.0
-            / (x117 - x200 * x504 - x201 * x512 - x196 * x518 - x534 * x535 - x553 * x554
-                - x570 * x571 - x587 * x588 - x598 * x599);
-        let x609 = x108 - x200 * x505 - x201 * x513 - x196 * x519 - x534 * x537
-            - x553 * x556 - x570 * x574 - x587 * x590 - x598 * x601;
-        let x610 = x608 * x609;
-        let x611 = x220 - x200 * x506 - x201 * x514 - x196 * x520 - x534 * x539
-            - x553 * x558 - x570 * x577 - x587 * x592 - x598 * x603;
-        let x612 = x608 * x611;
-        let x613 = x248 - x200 * x507 - x201 * x515 - x196 * x521 - x534 * x541
-            - x553 * x560 - x570 * x580 - x587 * x594 - x598 * x605;
-        let x614 = x608 * x613;
-        let x615 = x284 - x200 * x508 - x201 * x516 - x196 * x522 - x534 * x543
-            - x553 * x562 - x570 * x583 - x587 * x596 - x598 * x607;
-        let x616 = x608 * x615;
-        let x617 = 1.0
-            / (x94 - x214 * x505 - x215 * x513 - x210 * x519 - x536 * x537 - x555 * x556
-                - x573 * x574 - x589 * x590 - x600 * x601 - x609 * x610);
-        let x618 = x85 - x214 * x506 - x215 * x514 - x210 * x520 - x536 * x539
-            - x555 * x558 - x573 * x577 - x589 * x592 - x600 * x603 - x609 * x612;
-        let x619 = x617 * x618;
-        let x620 = x243 - x214 * x507 - x215 * x515 - x210 * x521 - x536 * x541
-            - x555 * x560 - x573 * x580 - x589 * x594 - x600 * x605 - x609 * x614;
-        let x621 = x617 * x620;
-        let x622 = x279 - x214 * x508 - x215 * x516 - x210 * x522 - x536 * x543
-            - x555 * x562 - x573 * x583 - x589 * x596 - x600 * x607 - x609 * x616;
-        let x623 = x617 * x622;
-        let x624 = 1.0
-            / (x71 - x233 * x506 - x234 * x514 - x229 * x520 - x538 * x539 - x557 * x558
-                - x576 * x577 - x591 * x592 - x602 * x603 - x611 * x612 - x618 * x619);
-        let x625 = x59 - x233 * x507 - x234 * x515 - x229 * x521 - x538 * x541
-            - x557 * x560 - x576 * x580 - x591 * x594 - x602 * x605 - x611 * x614
-            - x618 * x621;
-        let x626 = x624 * x625;
-        let x627 = x272 - x233 * x508 - x234 * x516 - x229 * x522 - x538 * x543
-            - x557 * x562 - x576 * x583 - x591 * x596 - x602 * x607 - x611 * x616
-            - x618 * x623;
-        let x628 = x624 * x627;
-        let x629 = 1.0
-            / (x44 - x261 * x507 - x262 * x515 - x257 * x521 - x540 * x541 - x559 * x560
-                - x579 * x580 - x593 * x594 - x604 * x605 - x613 * x614 - x620 * x621
-                - x625 * x626);
-        let x630 = x268 - x261 * x508 - x262 * x516 - x257 * x522 - x540 * x543
-            - x559 * x562 - x579 * x583 - x593 * x596 - x604 * x607 - x613 * x616
-            - x620 * x623 - x625 * x628;
-        let x631 = x629 * x630;
-        let x632 = 1.0
-            / (1.4135609200000003 - x297 * x508 - x298 * x516 - x293 * x522 - x542 * x543
-                - x561 * x562 - x582 * x583 - x595 * x596 - x606 * x607 - x615 * x616
-                - x622 * x623 - x627 * x628 - x630 * x631);
-        let x633 = x500 * x502
-            - (v[4] * x301 - v[5] * x300 + (v[1] * x304 - v[2] * x303) - f_ext[0][3]
-                + (c_q7 * x490 - s_q7 * x491 + -0.75 * x497) + x499 * x501);
-        let x634 = x498 * x501
-            - (v[5] * x299 - v[3] * x301 + (v[2] * x302 - v[0] * x304) - f_ext[0][4]
-                + (s_q7 * x490 + c_q7 * x491 + (0.75 * x496 + -0.65 * x495)))
-            - x500 * x509 - x527 * x633;
-        let x635 = x498 * x502;
-        let x636 = x499 * x509
-            - (v[3] * x300 - v[4] * x299 + (v[0] * x303 - v[1] * x302) - f_ext[0][5]
-                + (x492 + 0.65 * x497) + x635) - x529 * x633 - x548 * x634;
-        let x637 = tau[0] - x492 - x635 + x499 * x510 - x531 * x633 - x550 * x634
-            - x565 * x636;
-        let x638 = tau[1] - x484 - x498 * x503 + x499 * x511 + x500 * x517 - x533 * x633
-            - x552 * x634 - x568 * x636 - x586 * x637;
-        let x639 = tau[2] - x475 + x498 * x504 + x499 * x512 + x500 * x518 - x535 * x633
-            - x554 * x634 - x571 * x636 - x588 * x637 - x599 * x638;
-        let x640 = tau[3] - x468 + x498 * x505 + x499 * x513 + x500 * x519 - x537 * x633
-            - x556 * x634 - x574 * x636 - x590 * x637 - x601 * x638 - x610 * x639;
-        let x641 = tau[4] - x460 + x498 * x506 + x499 * x514 + x500 * x520 - x539 * x633
-            - x558 * x634 - x577 * x636 - x592 * x637 - x603 * x638 - x612 * x639
-            - x619 * x640;
-        let x642 = tau[5] - x452 + x498 * x507 + x499 * x515 + x500 * x521 - x541 * x633
-            - x560 * x634 - x580 * x636 - x594 * x637 - x605 * x638 - x614 * x639
-            - x621 * x640 - x626 * x641;
-        let x643 = x632
-            * (tau[6] - x443 + x498 * x508 + x499 * x516 + x500 * x522 - x543 * x633
-                - x562 * x634 - x583 * x636 - x596 * x637 - x607 * x638 - x616 * x639
-                - x623 * x640 - x628 * x641 - x631 * x642);
-        let x644 = x629 * x642 - x631 * x643;
-        let x645 = x624 * x641 - x626 * x644 - x628 * x643;
-        let x646 = x617 * x640 - x619 * x645 - x621 * x644 - x623 * x643;
-        let x647 = x608 * x639 - x610 * x646 - x612 * x645 - x614 * x644 - x616 * x643;
-        let x648 = x597 * x638 - x599 * x647 - x601 * x646 - x603 * x645 - x605 * x644
-            - x607 * x643;
-        let x649 = x584 * x637 - x586 * x648 - x588 * x647 - x590 * x646 - x592 * x645
-            - x594 * x644 - x596 * x643;
-        let x650 = x563 * x636 - x565 * x649 - x568 * x648 - x571 * x647 - x574 * x646
-            - x577 * x645 - x580 * x644 - x583 * x643;
-        let x651 = x545 * x634 - x548 * x650 - x550 * x649 - x552 * x648 - x554 * x647
-            - x556 * x646 - x558 * x645 - x560 * x644 - x562 * x643;
-        let x652 = x525 * x633 - x527 * x651 - x529 * x650 - x531 * x649 - x533 * x648
-            - x535 * x647 - x537 * x646 - x539 * x645 - x541 * x644 - x543 * x643;
-        let x653 = x509 * x651 - (x500 * 0.0008546497218115156 + x502 * x652)
-            - x517 * x648 - x518 * x647 - x519 * x646 - x520 * x645 - x521 * x644
-            - x522 * x643;
-        let x654 = x501 * x652 - x499 * 0.0008546497218115156 - x509 * x650 - x510 * x649
-            - x511 * x648 - x512 * x647 - x513 * x646 - x514 * x645 - x515 * x644
-            - x516 * x643;
-        let x655 = x502 * x650 - (x498 * 0.0008546497218115156 + x501 * x651)
-            + x502 * x649 + x503 * x648 - x504 * x647 - x505 * x646 - x506 * x645
-            - x507 * x644 - x508 * x643;
-        [x655, x654, x653, x652, x651, x650, x649, x648, x647, x646, x645, x644, x643]
+                + (0.75 * x560 + -0.65 * x562
+                    + (s_q7 * x551 + c_q7 * x552 + (0.75 * x577 + -0.65 * x579)))
+                - x582 * x588 - x595 * x596 - x602 * x603 - x607 * x608);
+        let x612 = 0.75 * x572 + -0.65 * x574 + 0.65 * x561 - x582 * x589 - x595 * x598
+            - x602 * x605 - x607 * x610;
+        let x613 = x611 * x612;
+        let x614 = 1.0
+            / (1271.854575 + 0.65 * x573 - x572 * x589 - x597 * x598 - x604 * x605
+                - x609 * x610 - x612 * x613);
+        let x615 = x583 * x585 - (v[5] * x3 - v[3] * x5 - f_ext[0][1] + x581);
+        let x616 = x583 * x586 - (v[3] * x4 - v[4] * x3 - f_ext[0][2] + x548)
+            - x592 * x615;
+        let x617 = x583 * x587
+            - (v[4] * x2 - v[5] * x1 + (v[1] * x5 - v[2] * x4) - f_ext[0][3]
+                + (c_q7 * x544 - s_q7 * x545 + -0.75 * x581)) - x594 * x615
+            - x601 * x616;
+        let x618 = x583 * x588
+            - (v[5] * x0 - v[3] * x2 + (v[2] * x3 - v[0] * x5) - f_ext[0][4]
+                + (s_q7 * x544 + c_q7 * x545 + (0.75 * x580 + -0.65 * x548)))
+            - x596 * x615 - x603 * x616 - x608 * x617;
+        let x619 = x614
+            * (x583 * x589
+                - (v[3] * x1 - v[4] * x0 + (v[0] * x4 - v[1] * x3) - f_ext[0][5]
+                    + (x521 + x523 * (x519 * x522) + 0.65 * x581)) - x598 * x615
+                - x605 * x616 - x610 * x617 - x613 * x618);
+        let x620 = x611 * x618 - x613 * x619;
+        let x621 = x606 * x617 - x608 * x620 - x610 * x619;
+        let x622 = x599 * x616 - x601 * x621 - x603 * x620 - x605 * x619;
+        let x623 = x590 * x615 - x592 * x622 - x594 * x621 - x596 * x620 - x598 * x619;
+        let x624 = x583 * x584 + x585 * x623 + x586 * x622 + x587 * x621 + x588 * x620
+            + x589 * x619;
+        let x625 = -x624;
+        let x626 = x624 + -0.75 * x620;
+        let x627 = x623 - (0.75 * x621 + -0.65 * x619);
+        let x628 = x622 - 0.65 * x620;
+        let x629 = x14 + (c_q7 * x621 + s_q7 * x620);
+        let x630 = c_q7 * x620 - s_q7 * x621 - x15;
+        let x631 = x16 + (s_q7 * x627 - c_q7 * x626);
+        let x632 = s_q7 * x626 + c_q7 * x627 - x17;
+        let x633 = x522
+            * (x523
+                - (x517 * x629 + x518 * x630 + x519 * x619
+                    + (x497 * x631 + x520 * x632 + x499 * x628)));
+        let x634 = x619 + x633;
+        let x635 = x629 + -0.00000000020510342851533115 * x634;
+        let x636 = x631 - -0.35 * x630;
+        let x637 = x632 - 0.35 * x629;
+        let x638 = x636 + -0.00000000020510342851533115 * x628;
+        let x639 = x34 + (x25 * x629 + s_q8 * x630 - c_q8 * x634);
+        let x640 = c_q8 * x630 - x26 * x629 + s_q8 * x634 - x35;
+        let x641 = x36 + (x25 * x636 + s_q8 * x637 - c_q8 * x628);
+        let x642 = c_q8 * x637 - x26 * x636 + s_q8 * x628 - x37;
+        let x643 = x454
+            * (x455
+                - (x448 * x639 + x449 * x640 + x450 * x635
+                    + (x451 * x641 + x452 * x642 + x444 * x638)));
+        let x644 = x635 + x643;
+        let x645 = x640 + 0.00000000020510342851533115 * x639
+            + -0.00000000020510342851533115 * x644;
+        let x646 = x641 - (-0.4 * x640 + 0.275 * x644);
+        let x647 = x642 - 0.4 * x639;
+        let x648 = x638 - -0.275 * x639;
+        let x649 = x647 + 0.00000000020510342851533115 * x646
+            + -0.00000000020510342851533115 * x648;
+        let x650 = x58 + (x46 * x639 + x48 * x640 + c_q9 * x644);
+        let x651 = x47 * x639 + x49 * x640 - s_q9 * x644 - x59;
+        let x652 = x60 + (x46 * x646 + x48 * x647 + c_q9 * x648);
+        let x653 = x47 * x646 + x49 * x647 - s_q9 * x648 - x61;
+        let x654 = x382
+            * (x383
+                - (x377 * x650 + x378 * x651 + x379 * x645
+                    + (x380 * x652 + x373 * x653 + x374 * x649)));
+        let x655 = x645 + x654;
+        let x656 = x652 - -0.87 * x655;
+        let x657 = x649 - 0.87 * x650;
+        let x658 = x75 + (c_q10 * x650 + s_q10 * x651);
+        let x659 = c_q10 * x651 - s_q10 * x650 - x76;
+        let x660 = x77 + (c_q10 * x656 + s_q10 * x653);
+        let x661 = c_q10 * x653 - s_q10 * x656 - x78;
+        let x662 = x325
+            * (x326
+                - (x320 * x658 + x321 * x659 + x322 * x655
+                    + (x323 * x660 + x311 * x661 + x312 * x657)));
+        let x663 = x655 + x662;
+        let x664 = x660 - (0.275 * x659 + -0.63 * x663);
+        let x665 = x661 - -0.275 * x658;
+        let x666 = x657 - 0.63 * x658;
+        let x667 = x93 + (c_q11 * x658 + s_q11 * x659);
+        let x668 = c_q11 * x659 - s_q11 * x658 - x94;
+        let x669 = x95 + (c_q11 * x664 + s_q11 * x665);
+        let x670 = c_q11 * x665 - s_q11 * x664 - x96;
+        let x671 = x262
+            * (x263
+                - (x257 * x667 + x258 * x668 + x259 * x663
+                    + (x260 * x669 - x238 * x670 - x239 * x666)));
+        let x672 = x663 + x671;
+        let x673 = x668 + -0.00000000020510342851533115 * x672;
+        let x674 = x669 - 0.36 * x668;
+        let x675 = x670 - -0.36 * x667;
+        let x676 = x675 + -0.00000000020510342851533115 * x666;
+        let x677 = x113 + (c_q12 * x667 + x104 * x668 - s_q12 * x672);
+        let x678 = x105 * x668 - s_q12 * x667 - c_q12 * x672 - x114;
+        let x679 = x115 + (c_q12 * x674 + x104 * x675 - s_q12 * x666);
+        let x680 = x105 * x675 - s_q12 * x674 - c_q12 * x666 - x116;
+        let x681 = x194
+            * (x195
+                - (x188 * x677 + x189 * x678 + x190 * x673
+                    + (x191 * x679 + x192 * x680 - x184 * x676)));
+        let x682 = x673 + x681;
+        let x683 = 0.707433253035886
+            * (x146
+                - (-0.0145 * (x135 + (x125 * x677 + s_q13 * x678 - c_q13 * x682))
+                    + -0.9614610000000001
+                        * (c_q13 * x678 - x126 * x677 + s_q13 * x682 - x136)
+                    + 1.4135609200000003 * (x677 + -0.00000000020510342851533115 * x682)
+                    + -4.806620000000001
+                        * (x137
+                            + (x125 * (x679 - (-0.16 * x678 + 0.55 * x682))
+                                + s_q13 * (x680 - 0.16 * x677)
+                                - c_q13 * (x676 - -0.55 * x677)))));
+        [x625, x623, x622, x621, x620, x619, x633, x643, x654, x662, x671, x681, x683]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///

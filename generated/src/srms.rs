@@ -8,30 +8,32 @@
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 468 | 392 | 0 | 0 | 6 | 860 |
-//! | `mass_matrix` | `recurrent-r1` | — | 519 | 422 | 0 | 0 | 6 | 941 |
-//! | `mass_matrix` | `kane-direct` | — | 505 | 352 | 0 | 0 | 6 | 857 |
-//! | `mass_matrix` | `crba-base` | — | 450 | 339 | 0 | 0 | 6 | 789 |
-//! | `mass_matrix` * | `crba` | — | 157 | 128 | 0 | 0 | 5 | 285 |
-//! | `nonlinear_effects` | — | `recurrent` | 537 | 386 | 0 | 0 | 6 | 923 |
-//! | `nonlinear_effects` | — | `kane-direct` | 580 | 428 | 0 | 0 | 6 | 1008 |
-//! | `nonlinear_effects` * | — | `rnea` | 254 | 181 | 0 | 0 | 5 | 435 |
-//! | `inverse_dynamics` | — | `recurrent` | 728 | 550 | 0 | 0 | 6 | 1278 |
-//! | `inverse_dynamics` | — | `kane-direct` | 771 | 592 | 0 | 0 | 6 | 1363 |
-//! | `inverse_dynamics` * | — | `rnea` | 278 | 207 | 0 | 0 | 5 | 485 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 780 | 585 | 6 | 0 | 6 | 1365 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 823 | 627 | 6 | 0 | 6 | 1450 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 497 | 380 | 6 | 0 | 5 | 877 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 694 | 514 | 0 | 0 | 6 | 1208 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 737 | 556 | 0 | 0 | 6 | 1293 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 411 | 309 | 0 | 0 | 5 | 720 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 856 | 662 | 6 | 0 | 6 | 1518 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 899 | 704 | 6 | 0 | 6 | 1603 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 503 | 412 | 6 | 0 | 5 | 915 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 468 | 392 | 0 | 0 | 6 | 860 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 519 | 422 | 0 | 0 | 6 | 941 |
+//! | `mass_matrix` | `kane-direct` | — | — | 505 | 352 | 0 | 0 | 6 | 857 |
+//! | `mass_matrix` | `crba-base` | — | — | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` * | `crba` | — | — | 157 | 128 | 0 | 0 | 5 | 285 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 537 | 386 | 0 | 0 | 6 | 923 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 580 | 428 | 0 | 0 | 6 | 1008 |
+//! | `nonlinear_effects` * | — | `rnea` | — | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 728 | 550 | 0 | 0 | 6 | 1278 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 771 | 592 | 0 | 0 | 6 | 1363 |
+//! | `inverse_dynamics` * | — | `rnea` | — | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 780 | 585 | 6 | 0 | 6 | 1365 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 823 | 627 | 6 | 0 | 6 | 1450 |
+//! | `forward_dynamics` * | `crba` | `rnea` | `ldlt` | 497 | 380 | 6 | 0 | 5 | 877 |
+//! | `forward_dynamics` | — | — | `aba` | 570 | 411 | 5 | 0 | 5 | 981 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 694 | 514 | 0 | 0 | 6 | 1208 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 737 | 556 | 0 | 0 | 6 | 1293 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | — | 411 | 309 | 0 | 0 | 5 | 720 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 856 | 662 | 6 | 0 | 6 | 1518 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 899 | 704 | 6 | 0 | 6 | 1603 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | `ldlt` | 503 | 412 | 6 | 0 | 5 | 915 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 576 | 443 | 5 | 0 | 5 | 1019 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -44,6 +46,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -88,6 +93,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 157u64,
             add: 128u64,
             div: 0u64,
@@ -99,6 +105,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 254u64,
             add: 181u64,
             div: 0u64,
@@ -110,6 +117,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 278u64,
             add: 207u64,
             div: 0u64,
@@ -121,6 +129,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 497u64,
             add: 380u64,
             div: 6u64,
@@ -132,6 +141,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 411u64,
             add: 309u64,
             div: 0u64,
@@ -143,6 +153,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 503u64,
             add: 412u64,
             div: 6u64,
@@ -157,6 +168,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 468u64,
             add: 392u64,
             div: 0u64,
@@ -168,6 +180,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 519u64,
             add: 422u64,
             div: 0u64,
@@ -179,6 +192,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 505u64,
             add: 352u64,
             div: 0u64,
@@ -190,6 +204,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 450u64,
             add: 339u64,
             div: 0u64,
@@ -201,6 +216,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 157u64,
             add: 128u64,
             div: 0u64,
@@ -212,6 +228,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 537u64,
             add: 386u64,
             div: 0u64,
@@ -223,6 +240,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 580u64,
             add: 428u64,
             div: 0u64,
@@ -234,6 +252,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 254u64,
             add: 181u64,
             div: 0u64,
@@ -245,6 +264,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 728u64,
             add: 550u64,
             div: 0u64,
@@ -256,6 +276,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 771u64,
             add: 592u64,
             div: 0u64,
@@ -267,6 +288,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 278u64,
             add: 207u64,
             div: 0u64,
@@ -278,6 +300,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 780u64,
             add: 585u64,
             div: 6u64,
@@ -289,6 +312,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 823u64,
             add: 627u64,
             div: 6u64,
@@ -300,6 +324,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 497u64,
             add: 380u64,
             div: 6u64,
@@ -308,9 +333,22 @@ impl Srms {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 570u64,
+            add: 411u64,
+            div: 5u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 694u64,
             add: 514u64,
             div: 0u64,
@@ -322,6 +360,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 737u64,
             add: 556u64,
             div: 0u64,
@@ -333,6 +372,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 411u64,
             add: 309u64,
             div: 0u64,
@@ -344,6 +384,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 856u64,
             add: 662u64,
             div: 6u64,
@@ -355,6 +396,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 899u64,
             add: 704u64,
             div: 6u64,
@@ -366,9 +408,22 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 503u64,
             add: 412u64,
             div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 576u64,
+            add: 443u64,
+            div: 5u64,
             sqrt: 0u64,
             sincos: 5u64,
             fma: 0u64,
@@ -773,7 +828,7 @@ impl Srms {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 497 mul, 380 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`, forward `ldlt`: 497 mul, 380 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1307,7 +1362,7 @@ impl Srms {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 503 mul, 412 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`, forward `ldlt`: 503 mul, 412 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],

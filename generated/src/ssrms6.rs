@@ -8,30 +8,32 @@
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 429 | 352 | 0 | 0 | 6 | 781 |
-//! | `mass_matrix` | `recurrent-r1` | — | 469 | 372 | 0 | 0 | 6 | 841 |
-//! | `mass_matrix` | `kane-direct` | — | 442 | 295 | 0 | 0 | 6 | 737 |
-//! | `mass_matrix` | `crba-base` | — | 412 | 299 | 0 | 0 | 6 | 711 |
-//! | `mass_matrix` * | `crba` | — | 102 | 71 | 0 | 0 | 4 | 173 |
-//! | `nonlinear_effects` | — | `recurrent` | 493 | 340 | 0 | 0 | 6 | 833 |
-//! | `nonlinear_effects` | — | `kane-direct` | 534 | 376 | 0 | 0 | 6 | 910 |
-//! | `nonlinear_effects` * | — | `rnea` | 189 | 124 | 0 | 0 | 5 | 313 |
-//! | `inverse_dynamics` | — | `recurrent` | 621 | 439 | 0 | 0 | 6 | 1060 |
-//! | `inverse_dynamics` | — | `kane-direct` | 662 | 475 | 0 | 0 | 6 | 1137 |
-//! | `inverse_dynamics` * | — | `rnea` | 208 | 146 | 0 | 0 | 5 | 354 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 681 | 478 | 6 | 0 | 6 | 1159 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 722 | 514 | 6 | 0 | 6 | 1236 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 377 | 262 | 6 | 0 | 5 | 639 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 595 | 411 | 0 | 0 | 6 | 1006 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 636 | 447 | 0 | 0 | 6 | 1083 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 291 | 195 | 0 | 0 | 5 | 486 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 763 | 561 | 6 | 0 | 6 | 1324 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 804 | 597 | 6 | 0 | 6 | 1401 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 389 | 300 | 6 | 0 | 5 | 689 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 429 | 352 | 0 | 0 | 6 | 781 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 469 | 372 | 0 | 0 | 6 | 841 |
+//! | `mass_matrix` | `kane-direct` | — | — | 442 | 295 | 0 | 0 | 6 | 737 |
+//! | `mass_matrix` | `crba-base` | — | — | 412 | 299 | 0 | 0 | 6 | 711 |
+//! | `mass_matrix` * | `crba` | — | — | 102 | 71 | 0 | 0 | 4 | 173 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 493 | 340 | 0 | 0 | 6 | 833 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 534 | 376 | 0 | 0 | 6 | 910 |
+//! | `nonlinear_effects` * | — | `rnea` | — | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 621 | 439 | 0 | 0 | 6 | 1060 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 662 | 475 | 0 | 0 | 6 | 1137 |
+//! | `inverse_dynamics` * | — | `rnea` | — | 208 | 146 | 0 | 0 | 5 | 354 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 681 | 478 | 6 | 0 | 6 | 1159 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 722 | 514 | 6 | 0 | 6 | 1236 |
+//! | `forward_dynamics` * | `crba` | `rnea` | `ldlt` | 377 | 262 | 6 | 0 | 5 | 639 |
+//! | `forward_dynamics` | — | — | `aba` | 422 | 292 | 4 | 0 | 5 | 714 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 595 | 411 | 0 | 0 | 6 | 1006 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 636 | 447 | 0 | 0 | 6 | 1083 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | — | 291 | 195 | 0 | 0 | 5 | 486 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 763 | 561 | 6 | 0 | 6 | 1324 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 804 | 597 | 6 | 0 | 6 | 1401 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | `ldlt` | 389 | 300 | 6 | 0 | 5 | 689 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 434 | 331 | 4 | 0 | 5 | 765 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
@@ -44,6 +46,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -88,6 +93,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 102u64,
             add: 71u64,
             div: 0u64,
@@ -99,6 +105,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 189u64,
             add: 124u64,
             div: 0u64,
@@ -110,6 +117,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 208u64,
             add: 146u64,
             div: 0u64,
@@ -121,6 +129,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 377u64,
             add: 262u64,
             div: 6u64,
@@ -132,6 +141,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 291u64,
             add: 195u64,
             div: 0u64,
@@ -143,6 +153,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 389u64,
             add: 300u64,
             div: 6u64,
@@ -157,6 +168,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 429u64,
             add: 352u64,
             div: 0u64,
@@ -168,6 +180,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 469u64,
             add: 372u64,
             div: 0u64,
@@ -179,6 +192,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 442u64,
             add: 295u64,
             div: 0u64,
@@ -190,6 +204,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 412u64,
             add: 299u64,
             div: 0u64,
@@ -201,6 +216,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 102u64,
             add: 71u64,
             div: 0u64,
@@ -212,6 +228,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 493u64,
             add: 340u64,
             div: 0u64,
@@ -223,6 +240,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 534u64,
             add: 376u64,
             div: 0u64,
@@ -234,6 +252,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 189u64,
             add: 124u64,
             div: 0u64,
@@ -245,6 +264,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 621u64,
             add: 439u64,
             div: 0u64,
@@ -256,6 +276,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 662u64,
             add: 475u64,
             div: 0u64,
@@ -267,6 +288,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 208u64,
             add: 146u64,
             div: 0u64,
@@ -278,6 +300,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 681u64,
             add: 478u64,
             div: 6u64,
@@ -289,6 +312,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 722u64,
             add: 514u64,
             div: 6u64,
@@ -300,6 +324,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 377u64,
             add: 262u64,
             div: 6u64,
@@ -308,9 +333,22 @@ impl Ssrms6 {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 422u64,
+            add: 292u64,
+            div: 4u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 595u64,
             add: 411u64,
             div: 0u64,
@@ -322,6 +360,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 636u64,
             add: 447u64,
             div: 0u64,
@@ -333,6 +372,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 291u64,
             add: 195u64,
             div: 0u64,
@@ -344,6 +384,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 763u64,
             add: 561u64,
             div: 6u64,
@@ -355,6 +396,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 804u64,
             add: 597u64,
             div: 6u64,
@@ -366,9 +408,22 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 389u64,
             add: 300u64,
             div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 434u64,
+            add: 331u64,
+            div: 4u64,
             sqrt: 0u64,
             sincos: 5u64,
             fma: 0u64,
@@ -669,7 +724,7 @@ impl Ssrms6 {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 377 mul, 262 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`, forward `ldlt`: 377 mul, 262 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1058,7 +1113,7 @@ impl Ssrms6 {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 389 mul, 300 add, 6 div, 0 sqrt, 5 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`, forward `ldlt`: 389 mul, 300 add, 6 div, 0 sqrt, 5 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],

@@ -10,30 +10,32 @@
 //! Precision: `f32`: inputs, outputs and every intermediate; the model's numbers rounded to `f32` constants; libm's `sincosf`, `sinf`, `cosf`, `sqrtf`.
 //! Fused multiply-adds: none.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 681 | 661 | 0 | 0 | 7 | 1342 |
-//! | `mass_matrix` | `recurrent-r1` | — | 778 | 703 | 0 | 0 | 7 | 1481 |
-//! | `mass_matrix` | `kane-direct` | — | 709 | 510 | 0 | 0 | 7 | 1219 |
-//! | `mass_matrix` | `crba-base` | — | 577 | 454 | 0 | 0 | 7 | 1031 |
-//! | `mass_matrix` * | `crba` | — | 170 | 116 | 0 | 0 | 5 | 286 |
-//! | `nonlinear_effects` | — | `recurrent` | 618 | 450 | 0 | 0 | 7 | 1068 |
-//! | `nonlinear_effects` | — | `kane-direct` | 708 | 536 | 0 | 0 | 7 | 1244 |
-//! | `nonlinear_effects` * | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
-//! | `inverse_dynamics` | — | `recurrent` | 827 | 607 | 0 | 0 | 7 | 1434 |
-//! | `inverse_dynamics` | — | `kane-direct` | 917 | 693 | 0 | 0 | 7 | 1610 |
-//! | `inverse_dynamics` * | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 914 | 667 | 7 | 0 | 7 | 1581 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 1004 | 753 | 7 | 0 | 7 | 1757 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 788 | 566 | 0 | 0 | 7 | 1354 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 878 | 652 | 0 | 0 | 7 | 1530 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1018 | 772 | 7 | 0 | 7 | 1790 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1108 | 858 | 7 | 0 | 7 | 1966 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 681 | 661 | 0 | 0 | 7 | 1342 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 778 | 703 | 0 | 0 | 7 | 1481 |
+//! | `mass_matrix` | `kane-direct` | — | — | 709 | 510 | 0 | 0 | 7 | 1219 |
+//! | `mass_matrix` | `crba-base` | — | — | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` * | `crba` | — | — | 170 | 116 | 0 | 0 | 5 | 286 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 618 | 450 | 0 | 0 | 7 | 1068 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 708 | 536 | 0 | 0 | 7 | 1244 |
+//! | `nonlinear_effects` * | — | `rnea` | — | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 827 | 607 | 0 | 0 | 7 | 1434 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 917 | 693 | 0 | 0 | 7 | 1610 |
+//! | `inverse_dynamics` * | — | `rnea` | — | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 914 | 667 | 7 | 0 | 7 | 1581 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 1004 | 753 | 7 | 0 | 7 | 1757 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `forward_dynamics` * | — | — | `aba` | 556 | 388 | 5 | 0 | 6 | 944 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 788 | 566 | 0 | 0 | 7 | 1354 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 878 | 652 | 0 | 0 | 7 | 1530 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | — | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 1018 | 772 | 7 | 0 | 7 | 1790 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 1108 | 858 | 7 | 0 | 7 | 1966 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | `ldlt` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 568 | 433 | 5 | 0 | 6 | 1001 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsF32;
@@ -46,6 +48,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -91,6 +96,7 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 170u64,
             add: 116u64,
             div: 0u64,
@@ -102,6 +108,7 @@ impl SsrmsF32 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 256u64,
             add: 176u64,
             div: 0u64,
@@ -113,6 +120,7 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 268u64,
             add: 191u64,
             div: 0u64,
@@ -122,11 +130,12 @@ impl SsrmsF32 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 552u64,
-            add: 393u64,
-            div: 7u64,
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 556u64,
+            add: 388u64,
+            div: 5u64,
             sqrt: 0u64,
             sincos: 6u64,
             fma: 0u64,
@@ -135,6 +144,7 @@ impl SsrmsF32 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 426u64,
             add: 292u64,
             div: 0u64,
@@ -146,6 +156,7 @@ impl SsrmsF32 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 564u64,
             add: 437u64,
             div: 7u64,
@@ -160,6 +171,7 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 681u64,
             add: 661u64,
             div: 0u64,
@@ -171,6 +183,7 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 778u64,
             add: 703u64,
             div: 0u64,
@@ -182,6 +195,7 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 709u64,
             add: 510u64,
             div: 0u64,
@@ -193,6 +207,7 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 577u64,
             add: 454u64,
             div: 0u64,
@@ -204,6 +219,7 @@ impl SsrmsF32 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 170u64,
             add: 116u64,
             div: 0u64,
@@ -215,6 +231,7 @@ impl SsrmsF32 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 618u64,
             add: 450u64,
             div: 0u64,
@@ -226,6 +243,7 @@ impl SsrmsF32 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 708u64,
             add: 536u64,
             div: 0u64,
@@ -237,6 +255,7 @@ impl SsrmsF32 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 256u64,
             add: 176u64,
             div: 0u64,
@@ -248,6 +267,7 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 827u64,
             add: 607u64,
             div: 0u64,
@@ -259,6 +279,7 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 917u64,
             add: 693u64,
             div: 0u64,
@@ -270,6 +291,7 @@ impl SsrmsF32 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 268u64,
             add: 191u64,
             div: 0u64,
@@ -281,6 +303,7 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 914u64,
             add: 667u64,
             div: 7u64,
@@ -292,6 +315,7 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 1004u64,
             add: 753u64,
             div: 7u64,
@@ -303,6 +327,7 @@ impl SsrmsF32 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 552u64,
             add: 393u64,
             div: 7u64,
@@ -311,9 +336,22 @@ impl SsrmsF32 {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 556u64,
+            add: 388u64,
+            div: 5u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 788u64,
             add: 566u64,
             div: 0u64,
@@ -325,6 +363,7 @@ impl SsrmsF32 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 878u64,
             add: 652u64,
             div: 0u64,
@@ -336,6 +375,7 @@ impl SsrmsF32 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 426u64,
             add: 292u64,
             div: 0u64,
@@ -347,6 +387,7 @@ impl SsrmsF32 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 1018u64,
             add: 772u64,
             div: 7u64,
@@ -358,6 +399,7 @@ impl SsrmsF32 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 1108u64,
             add: 858u64,
             div: 7u64,
@@ -369,9 +411,22 @@ impl SsrmsF32 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 564u64,
             add: 437u64,
             div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 568u64,
+            add: 433u64,
+            div: 5u64,
             sqrt: 0u64,
             sincos: 6u64,
             fma: 0u64,
@@ -770,300 +825,338 @@ impl SsrmsF32 {
                                 + (x16 * x33 - x27 * -5224.5703 + x96))));
         [x107, x106, x101, x93, x89, x87, x81]
     }
-    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 552 mul, 393 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: forward `aba`: 556 mul, 388 add, 5 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics(q: &[f32; 7], qd: &[f32; 7], tau: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
+        let x1 = qd[0] * c_q1;
+        let x2 = qd[0] * s_q1;
+        let x3 = 0.7026 * qd[0];
+        let x4 = s_q1 * x3;
+        let x5 = c_q1 * x3;
+        let x6 = qd[1] * x2;
+        let x7 = qd[1] * x1;
+        let x8 = qd[1] * x5;
+        let x9 = qd[1] * x4;
+        let x10 = -65693.914 * x2;
+        let x11 = 65697.33 * qd[1] - x4 * 1145.5438;
+        let x12 = -1145.5438 * qd[1];
+        let x13 = x1 * 1145.5438;
         let (s_q2, c_q2) = libm::sincosf(q[2]);
+        let x15 = x1 * c_q2 - qd[1] * s_q2;
+        let x16 = x1 * s_q2 + qd[1] * c_q2;
+        let x17 = x1 * 0.5692;
+        let x18 = x4 + -0.5692 * qd[1];
+        let x19 = s_q2 * x17 - c_q2 * x18;
+        let x20 = s_q2 * x18 + c_q2 * x17;
+        let x21 = qd[2] * x16;
+        let x22 = qd[2] * x15;
+        let x23 = qd[2] * x20;
+        let x24 = qd[2] * x19;
+        let x25 = qd[2] - x2;
+        let x26 = -39234.473 * x15 + 3946.1882 * x25;
+        let x27 = 5224.5703 * x5;
+        let x28 = 3946.1882 * x15 + 39241.402 * x25 - x20 * -5224.5703;
+        let x29 = x16 * -5224.5703;
+        let x30 = 5224.5703 * x25;
         let (s_q3, c_q3) = libm::sincosf(q[3]);
+        let x32 = x15 * c_q3 - x16 * s_q3;
+        let x33 = x15 * s_q3 + x16 * c_q3;
+        let x34 = x19 - -0.475 * x16;
+        let x35 = x5 + x16 * -7.11;
+        let x36 = x20 + (x15 * 0.475 + 7.11 * x25);
+        let x37 = c_q3 * x34 + s_q3 * x36;
+        let x38 = s_q3 * x34 - c_q3 * x36;
+        let x39 = qd[3] * x33;
+        let x40 = qd[3] * x32;
+        let x41 = qd[3] * x38;
+        let x42 = qd[3] * x37;
+        let x43 = qd[3] + x25;
+        let x44 = -24989.307 * x32 + 1375.0472 * x43;
+        let x45 = 3239.4583 * x35;
+        let x46 = 1375.0472 * x32 + 24998.828 * x43 + x38 * -3239.4583;
+        let x47 = x33 * -3239.4583;
+        let x48 = 3239.4583 * x43;
         let (s_q4, c_q4) = libm::sincosf(q[4]);
+        let x50 = x32 * c_q4 - x33 * s_q4;
+        let x51 = x32 * s_q4 + x33 * c_q4;
+        let x52 = x35 + x33 * -7.11;
+        let x53 = x38 - 7.11 * x43;
+        let x54 = x37 * c_q4 - s_q4 * x53;
+        let x55 = x37 * s_q4 + c_q4 * x53;
+        let x56 = qd[4] * x51;
+        let x57 = qd[4] * x50;
+        let x58 = qd[4] * x55;
+        let x59 = qd[4] + x43;
+        let x60 = -97.44449 * x59;
+        let x61 = 132.67838 * x50 - x52 * 171.19551;
+        let x62 = 135.47298 * x59 + -97.44449 * x51 + -171.19551 * x54;
+        let x63 = x59 * 171.19551;
+        let x64 = -171.19551 * x50;
+        let x65 = x59 * x63 - x50 * x64;
         let (s_q5, c_q5) = libm::sincosf(q[5]);
+        let x67 = x50 * c_q5 + x59 * s_q5;
+        let x68 = x59 * c_q5 - x50 * s_q5;
+        let x69 = qd[5] + x51;
+        let x70 = 44.41 * x68;
+        let x71 = 47.471 * x69;
         let (s_q6, c_q6) = libm::sincosf(q[6]);
-        let x6 = 9.336 * c_q5;
-        let x7 = 44.41 * s_q5;
-        let x8 = 9.336 * s_q5;
-        let x9 = 44.41 * c_q5;
-        let x10 = s_q5 * x6 - c_q5 * x7;
-        let x11 = c_q5 * x8 - s_q5 * x9;
-        let x12 = 132.67838 + (c_q5 * x6 + s_q5 * x7);
-        let x13 = 135.47298 + (s_q5 * x8 + c_q5 * x9);
-        let x14 = -171.19551 * s_q4;
-        let x15 = -171.19551 * c_q4;
-        let x16 = c_q4 * x12;
-        let x17 = -97.44449 * s_q4;
-        let x18 = c_q4 * x10 + x17;
-        let x19 = 47.471 * s_q4;
-        let x20 = s_q4 * x12;
-        let x21 = -97.44449 * c_q4;
-        let x22 = x21 - s_q4 * x10;
-        let x23 = 47.471 * c_q4;
-        let x24 = x21 - s_q4 * x11;
-        let x25 = x14 * -7.11;
-        let x26 = 7.11 * x14;
-        let x27 = x13 - x25;
-        let x28 = s_q4 * x23 - c_q4 * x20 - 7.11 * x15;
-        let x29 = c_q4 * x19 - s_q4 * x16 + x15 * -7.11;
-        let x30 = s_q4 * x20 + c_q4 * x23 + x26 - x25;
-        let x31 = 3239.4583 + x14;
-        let x32 = -24989.307 + (c_q4 * x16 + s_q4 * x19);
-        let x33 = 1375.0472 + x18;
-        let x34 = 1375.0472 + (x17 + c_q4 * x11);
-        let x35 = 24998.828 + (x26 + x27);
-        let x36 = s_q3 * x15;
-        let x37 = c_q3 * x31 + x36;
-        let x38 = c_q3 * x15;
-        let x39 = x38 - s_q3 * x31;
-        let x40 = c_q3 * x32 + s_q3 * x28;
-        let x41 = s_q3 * x22;
-        let x42 = c_q3 * x29 + s_q3 * x30;
-        let x43 = c_q3 * x28 - s_q3 * x32;
-        let x44 = c_q3 * x22;
-        let x45 = c_q3 * x30 - s_q3 * x29;
-        let x46 = -7.11 * x37;
-        let x47 = 7.11 * x37;
-        let x48 = c_q3 * x33 + x41 - -0.475 * x37;
-        let x49 = x35 - x46;
-        let x50 = c_q3 * x43 + s_q3 * x45 - 7.11 * x39;
-        let x51 = x44 - s_q3 * x33 + x39 * 0.475;
-        let x52 = c_q3 * x42 - s_q3 * x40 + -7.11 * x39;
-        let x53 = c_q3 * x24 - s_q3 * x34 - -0.475 * x39;
-        let x54 = c_q3 * x45 - s_q3 * x43 + x47 - x46;
-        let x55 = 5224.5703 + x37;
-        let x56 = -39234.473 + (c_q3 * x40 + s_q3 * x42);
-        let x57 = 3946.1882 + x48;
-        let x58 = 3946.1882 + (c_q3 * x34 + s_q3 * x24 + x37 * 0.475);
-        let x59 = 39241.402 + (x47 + x49);
-        let x60 = s_q2 * x39;
-        let x61 = c_q2 * x55 + x60;
-        let x62 = c_q2 * x39;
-        let x63 = x62 - s_q2 * x55;
-        let x64 = c_q2 * x56 + s_q2 * x50;
-        let x65 = s_q2 * x51;
-        let x66 = c_q2 * x52 + s_q2 * x54;
-        let x67 = c_q2 * x51;
-        let x68 = c_q1 * (c_q2 * x57 + x65 - -0.5692 * x61);
-        let x69 = c_q1 * (c_q2 * x66 - s_q2 * x64)
-            - s_q1 * (c_q2 * x53 - s_q2 * x58 - -0.5692 * x63)
-            + -0.7026 * (c_q1 * x61 + s_q1 * 1145.5438);
-        let x70 = x68 - s_q1 * x59 + -0.7026 * (s_q1 * x63);
-        let x71 = x62 - s_q2 * x37;
-        let x72 = c_q1 * (x65 + c_q2 * x48 - -0.5692 * (x60 + c_q2 * x37)) - s_q1 * x49
-            + -0.7026 * (s_q1 * x71);
-        let x73 = x38 - s_q3 * x14;
-        let x74 = x36 + c_q3 * x14;
-        let x75 = x41 + c_q3 * x18 - -0.475 * x74;
-        let x76 = x27 - -7.11 * x74;
-        let x77 = x44 - s_q3 * x18 + 0.475 * x73;
-        let x78 = c_q2 * x73 - s_q2 * x74;
-        let x79 = c_q1 * (c_q2 * x75 + s_q2 * x77 - -0.5692 * (s_q2 * x73 + c_q2 * x74))
-            - s_q1 * x76 + -0.7026 * (s_q1 * x78);
-        let x80 = c_q3 * x19 + s_q3 * x23;
-        let x81 = c_q3 * x23 - s_q3 * x19;
-        let x82 = c_q1 * (c_q2 * x80 + s_q2 * x81);
-        let x83 = c_q4 * x6;
-        let x84 = s_q4 * x6;
-        let x85 = c_q3 * x83 - s_q3 * x84;
-        let x86 = s_q3 * x83 + c_q3 * x84;
-        let x87 = c_q1 * (c_q2 * x85 - s_q2 * x86) - s_q1 * x8;
-        let x88 = qd[0] * c_q1;
-        let x89 = qd[0] * s_q1;
-        let x90 = 0.7026 * qd[0];
-        let x91 = s_q1 * x90;
-        let x92 = c_q1 * x90;
-        let x93 = qd[1] * x89;
-        let x94 = qd[1] * x88;
-        let x95 = qd[1] * x92;
-        let x96 = qd[1] * x91;
-        let x97 = -65693.914 * x89;
-        let x98 = 65697.33 * qd[1] - 1145.5438 * x91;
-        let x99 = -1145.5438 * qd[1];
-        let x100 = 1145.5438 * x88;
-        let x101 = c_q2 * x88 - qd[1] * s_q2;
-        let x102 = s_q2 * x88 + qd[1] * c_q2;
-        let x103 = 0.5692 * x88;
-        let x104 = x91 + -0.5692 * qd[1];
-        let x105 = s_q2 * x103 - c_q2 * x104;
-        let x106 = s_q2 * x104 + c_q2 * x103;
-        let x107 = qd[2] - x89;
-        let x108 = 0.5692 * x93;
-        let x109 = c_q2 * x93 + qd[2] * x102;
-        let x110 = qd[2] * x101 - s_q2 * x93;
-        let x111 = c_q2 * x108 - s_q2 * x95 + qd[2] * x105;
-        let x112 = -39234.473 * x101 + 3946.1882 * x107;
-        let x113 = 5224.5703 * x92;
-        let x114 = 3946.1882 * x101 + 39241.402 * x107 - x106 * -5224.5703;
-        let x115 = x102 * -5224.5703;
-        let x116 = 5224.5703 * x107;
-        let x117 = c_q3 * x101 - s_q3 * x102;
-        let x118 = s_q3 * x101 + c_q3 * x102;
-        let x119 = x105 - -0.475 * x102;
-        let x120 = x92 + -7.11 * x102;
-        let x121 = x106 + (0.475 * x101 + 7.11 * x107);
-        let x122 = c_q3 * x119 + s_q3 * x121;
-        let x123 = s_q3 * x119 - c_q3 * x121;
-        let x124 = qd[3] + x107;
-        let x125 = 7.11 * x94;
-        let x126 = qd[2] * x106 - (c_q2 * x95 + s_q2 * x108) - -0.475 * x110;
-        let x127 = x96 - -7.11 * x110;
-        let x128 = x111 + (0.475 * x109 + x125);
-        let x129 = c_q3 * x109 + s_q3 * x110 + qd[3] * x118;
-        let x130 = c_q3 * x110 - s_q3 * x109 + qd[3] * x117;
-        let x131 = s_q3 * x126 + c_q3 * x128 + qd[3] * x122;
-        let x132 = -24989.307 * x117 + 1375.0472 * x124;
-        let x133 = 3239.4583 * x120;
-        let x134 = 1375.0472 * x117 + 24998.828 * x124 + x123 * -3239.4583;
-        let x135 = x118 * -3239.4583;
-        let x136 = 3239.4583 * x124;
-        let x137 = c_q4 * x117 - s_q4 * x118;
-        let x138 = s_q4 * x117 + c_q4 * x118;
-        let x139 = x120 + -7.11 * x118;
-        let x140 = x123 - 7.11 * x124;
-        let x141 = c_q4 * x122 - s_q4 * x140;
-        let x142 = s_q4 * x122 + c_q4 * x140;
-        let x143 = qd[4] + x124;
-        let x144 = c_q4 * x129 + s_q4 * x130 + qd[4] * x138;
-        let x145 = c_q4 * x130 - s_q4 * x129 + qd[4] * x137;
-        let x146 = -97.44449 * x143;
-        let x147 = 132.67838 * x137 - 171.19551 * x139;
-        let x148 = 135.47298 * x143 + -97.44449 * x138 + -171.19551 * x141;
-        let x149 = 171.19551 * x143;
-        let x150 = -171.19551 * x137;
-        let x151 = x143 * x149 - x137 * x150;
-        let x152 = 171.19551 * x94 + x138 * x150;
-        let x153 = -171.19551 * x144 - x138 * x149;
-        let x154 = c_q5 * x137 + s_q5 * x143;
-        let x155 = c_q5 * x143 - s_q5 * x137;
-        let x156 = qd[5] + x138;
-        let x157 = 44.41 * x155;
-        let x158 = 47.471 * x156;
-        let x159 = 9.336 * (qd[5] * x155 - (c_q5 * x144 + s_q5 * x94));
-        let x160 = 9.336 * (qd[6] + x154);
-        let x161 = (c_q6 * x156 - s_q6 * x155) * x160;
-        let x162 = (c_q6 * x155 + s_q6 * x156) * x160;
-        let x163 = x155 * x158 - x156 * x157 + x159;
-        let x164 = 44.41 * (s_q5 * x144 - c_q5 * x94 - qd[5] * x154) - x154 * x158
-            + (c_q6 * x161 + s_q6 * x162);
-        let x165 = 47.471 * x145 + x154 * x157 + (s_q6 * x161 - c_q6 * x162);
-        let x166 = 171.19551 * (x127 - -7.11 * x130) - 132.67838 * x144
-            + (x143 * x146 - x138 * x148 + x142 * x150) + (c_q5 * x163 - s_q5 * x164);
-        let x167 = -97.44449 * x145 - 135.47298 * x94
-            + -171.19551
-                * (c_q4 * (c_q3 * x126 - s_q3 * x128 - qd[3] * x123)
-                    - s_q4 * (x125 + x131) - qd[4] * x142)
-            + (x138 * x147 - x137 * x146 - x142 * x149) + (s_q5 * x163 + c_q5 * x164);
-        let x168 = x137 * x148 - x143 * x147 - (x139 * x149 + x141 * x150)
-            - -97.44449 * x94 + x165;
-        let x169 = c_q4 * x151 - s_q4 * x152;
-        let x170 = x123 * x135 + x120 * x136 - (x118 * x134 + x124 * x133)
-            - (-24989.307 * x129 + 1375.0472 * x94) + (c_q4 * x166 + s_q4 * x168);
-        let x171 = x131 * -3239.4583 - (1375.0472 * x129 + 24998.828 * x94)
-            + (x118 * x132 + x117 * x133 + x122 * x136) + (x167 + -7.11 * x169);
-        let x172 = 3239.4583 * x127 + (x117 * x134 - x124 * x132 - x122 * x135)
-            + (c_q4 * x168 - s_q4 * x166 + 7.11 * x153);
-        let x173 = x118 * x135 - x124 * x136 + (c_q4 * x152 + s_q4 * x151);
-        let x174 = x117 * x136 - x130 * -3239.4583 + x153;
-        let x175 = 3239.4583 * x94 - x117 * x135 + x169;
-        let x176 = c_q3 * x173 + s_q3 * x175;
-        let x177 = c_q3 * x175 - s_q3 * x173;
-        let x178 = x92 * x116 - x106 * x115 - (x102 * x114 + x107 * x113)
-            - (-39234.473 * x109 + 3946.1882 * x94)
-            + (c_q3 * x170 + s_q3 * x172 + -0.475 * x177);
-        let x179 = x111 * -5224.5703 - (3946.1882 * x109 + 39241.402 * x94)
-            + (x102 * x112 + x101 * x113 + x105 * x116) + (x171 + -7.11 * x177);
-        let x180 = 5224.5703 * x96 + (x101 * x114 - x107 * x112 - x105 * x115)
-            + (c_q3 * x172 - s_q3 * x170 + (0.475 * x176 + 7.11 * x174));
-        let x181 = x102 * x115 - x107 * x116 + x176;
-        let x182 = 5224.5703 * x94 - x101 * x115 + x177;
-        let x183 = c_q2 * x181 + s_q2 * x182;
-        let x184 = tau[0]
-            - (c_q1
-                * (qd[1] * x97 - x89 * x98 + x92 * x100
-                    + (c_q2 * x178 + s_q2 * x180
-                        + -0.5692 * (c_q2 * x182 - s_q2 * x181)))
-                - s_q1 * (x179 - (-65693.914 * x94 + (x88 * x98 + x91 * x100)))
-                + -0.7026
-                    * (s_q1 * (x89 * x100 + x183)
-                        + c_q1
-                            * (x88 * x100 - qd[1] * x99
-                                + (x101 * x116 - x110 * -5224.5703 + x174))));
-        let x185 = 1.0
+        let x73 = 9.336 * (qd[6] + x67);
+        let x74 = (x69 * c_q6 - x68 * s_q6) * x73;
+        let x75 = (x68 * c_q6 + x69 * s_q6) * x73;
+        let x76 = tau[6] + (x68 * x71 - x69 * x70);
+        let x77 = x67 * x70 + (s_q6 * x74 - c_q6 * x75);
+        let x78 = tau[5] - x77;
+        let x79 = c_q6 * x74 + s_q6 * x75 - x67 * x71 - 44.41 * (qd[5] * x67);
+        let x80 = 44.41 * c_q5;
+        let x81 = s_q5 * x80;
+        let x82 = 135.47298 + c_q5 * x80;
+        let x83 = x51 * x61 - x50 * x60 - x55 * x63 + (s_q5 * x76 + c_q5 * x79);
+        let x84 = 1.0 / x82;
+        let x85 = tau[4] - x83;
+        let x86 = x81 * x84;
+        let x87 = -97.44449 * x84;
+        let x88 = -171.19551 * x84;
+        let x89 = 132.67838 + s_q5 * (44.41 * s_q5) - x81 * x86;
+        let x90 = x81 * x87;
+        let x91 = -97.44449 * x87;
+        let x92 = x81 * x88;
+        let x93 = -97.44449 * x88;
+        let x94 = -171.19551 * x88;
+        let x95 = x51 * x63 + x56 * 171.19551;
+        let x96 = x59 * x60 - x51 * x62 + x55 * x64 + (c_q5 * x76 - s_q5 * x79)
+            + (x57 * x90 - x56 * x89 - x58 * x92) - x85 * x86;
+        let x97 = x50 * x62 - x59 * x61 - (x52 * x63 + x54 * x64) + (x77 + x78)
+            + (x58 * x93 - (x56 * x90 + x57 * x91)) + x85 * x87;
+        let x98 = x51 * x64 + (x58 * x94 - (x56 * x92 + x57 * x93)) + x85 * x88;
+        let x99 = s_q4 * x90;
+        let x100 = c_q4 * x90;
+        let x101 = x100 - s_q4 * x89;
+        let x102 = x99 + c_q4 * x91;
+        let x103 = c_q4 * x92;
+        let x104 = s_q4 * x92;
+        let x105 = c_q4 * x93;
+        let x106 = s_q4 * x93;
+        let x107 = c_q4 * 171.19551;
+        let x108 = s_q4 * x106 - c_q4 * x104;
+        let x109 = s_q4 * 171.19551;
+        let x110 = s_q4 * x104 + c_q4 * x106;
+        let x111 = s_q4 * x94;
+        let x112 = c_q4 * x111;
+        let x113 = s_q4 * x111;
+        let x114 = -7.11 * x112;
+        let x115 = -7.11 * x113;
+        let x116 = -7.11 * x110;
+        let x117 = 7.11 * x109;
+        let x118 = c_q4 * x65 - s_q4 * x98;
+        let x119 = 1375.0472 + -7.11 * x108;
+        let x120 = 24998.828 - -7.11 * x115;
+        let x121 = -3239.4583 - x115;
+        let x122 = 3239.4583 - x109;
+        let x123 = x33 * x44 + x32 * x45 + x37 * x48
+            + (x83 + x85 * (x82 * x84) + -7.11 * x118);
+        let x124 = 1.0 / x120;
+        let x125 = tau[3] - x123;
+        let x126 = x119 * x124;
+        let x127 = x116 * x124;
+        let x128 = x114 * x124;
+        let x129 = x121 * x124;
+        let x130 = -24989.307 + (c_q4 * (c_q4 * x89 + x99) + s_q4 * (x100 - s_q4 * x91))
+            - x119 * x126;
+        let x131 = c_q4 * x101 - s_q4 * x102 + 7.11 * x107 - x119 * x127;
+        let x132 = x117 + (s_q4 * x101 + c_q4 * x102 + x117) + x116 * x127;
+        let x133 = c_q4 * x103 - s_q4 * x105 - x119 * x128;
+        let x134 = x108 - x119 * x129;
+        let x135 = s_q4 * x103 + c_q4 * x105 + x116 * x128;
+        let x136 = x110 - x116 * x129;
+        let x137 = c_q4 * (c_q4 * x94) + x114 * x128;
+        let x138 = x112 - x114 * x129;
+        let x139 = x113 + x121 * x129;
+        let x140 = x32 * x48 - x95 + (x40 * x122 - x39 * x107);
+        let x141 = x38 * x47 + x35 * x48 - (x33 * x46 + x43 * x45)
+            + (c_q4 * x96 + s_q4 * x97)
+            + (x40 * x131 - x39 * x130 + (x42 * x134 - x41 * x133)) + x125 * x126;
+        let x142 = x32 * x46 - x43 * x44 - x37 * x47
+            + (c_q4 * x97 - s_q4 * x96 - 7.11 * x95)
+            + (x41 * x135 + x42 * x136 - (x39 * x131 + x40 * x132)) + x125 * x127;
+        let x143 = x33 * x47 - x43 * x48 + (c_q4 * x98 + s_q4 * x65)
+            + (x41 * x137 + x42 * x138 - (x39 * x133 + x40 * x135)) + x125 * x128;
+        let x144 = x118 - x32 * x47
+            + (x40 * x136 - x39 * x134 - (x41 * x138 + x42 * x139)) + x125 * x129;
+        let x145 = s_q3 * x131;
+        let x146 = c_q3 * x131;
+        let x147 = x146 - s_q3 * x130;
+        let x148 = x145 + c_q3 * x132;
+        let x149 = c_q3 * x133 + s_q3 * x134;
+        let x150 = c_q3 * x134 - s_q3 * x133;
+        let x151 = s_q3 * x136 - c_q3 * x135;
+        let x152 = s_q3 * x135 + c_q3 * x136;
+        let x153 = c_q3 * x149 + s_q3 * x151;
+        let x154 = c_q3 * x107 + s_q3 * x122;
+        let x155 = c_q3 * x150 + s_q3 * x152;
+        let x156 = c_q3 * x151 - s_q3 * x149;
+        let x157 = c_q3 * x122 - s_q3 * x107;
+        let x158 = s_q3 * x138;
+        let x159 = c_q3 * x138;
+        let x160 = s_q3 * x137 + x159;
+        let x161 = x158 + c_q3 * x139;
+        let x162 = c_q3 * (x158 - c_q3 * x137) + s_q3 * (x159 - s_q3 * x139);
+        let x163 = c_q3 * x160 - s_q3 * x161;
+        let x164 = s_q3 * x160 + c_q3 * x161;
+        let x165 = -7.11 * x163;
+        let x166 = -7.11 * x164;
+        let x167 = x155 - -0.475 * x164;
+        let x168 = x156 + 0.475 * x162;
+        let x169 = c_q3 * x152 - s_q3 * x150 + 0.475 * x163;
+        let x170 = -7.11 * x169;
+        let x171 = 7.11 * x157;
+        let x172 = c_q3 * x143 + s_q3 * x144;
+        let x173 = c_q3 * x144 - s_q3 * x143;
+        let x174 = 3946.1882 + (-7.11 * x155 - -0.475 * x166);
+        let x175 = 39241.402 - -7.11 * x166;
+        let x176 = -5224.5703 - x166;
+        let x177 = 5224.5703 + x157;
+        let x178 = x16 * x26 + x15 * x27 + x19 * x30
+            + (x123 + x125 * (x120 * x124) + -7.11 * x173);
+        let x179 = 1.0 / x175;
+        let x180 = tau[2] - x178;
+        let x181 = x174 * x179;
+        let x182 = x170 * x179;
+        let x183 = x165 * x179;
+        let x184 = x176 * x179;
+        let x185 = -39234.473
+            + (-0.475 * x155
+                + (c_q3 * (c_q3 * x130 + x145) + s_q3 * (x146 - s_q3 * x132)
+                    + -0.475 * x167)) - x174 * x181;
+        let x186 = 7.11 * x154 + 0.475 * x153
+            + (c_q3 * x147 - s_q3 * x148 + -0.475 * x169) - x174 * x182;
+        let x187 = x171 + 0.475 * x156
+            + (0.475 * x168 + x171 - (s_q3 * x147 + c_q3 * x148)) - x170 * x182;
+        let x188 = x153 + -0.475 * x163 - x174 * x183;
+        let x189 = x167 - x174 * x184;
+        let x190 = x168 - x170 * x183;
+        let x191 = x169 - x170 * x184;
+        let x192 = x162 - x165 * x183;
+        let x193 = x163 - x165 * x184;
+        let x194 = x164 + x176 * x184;
+        let x195 = x5 * x30 - x20 * x29 - (x16 * x28 + x25 * x27)
+            + (c_q3 * x141 + s_q3 * x142 + -0.475 * x173)
+            + (x22 * x186 - x21 * x185 + (x23 * x188 + x24 * x189)) + x180 * x181;
+        let x196 = x15 * x28 - x25 * x26 - x19 * x29
+            + (c_q3 * x142 - s_q3 * x141 + (0.475 * x172 + 7.11 * x140))
+            + (x22 * x187 - x21 * x186 + (x23 * x190 + x24 * x191)) + x180 * x182;
+        let x197 = x16 * x29 - x25 * x30 + x172
+            + (x22 * x190 - x21 * x188 + (x23 * x192 + x24 * x193)) + x180 * x183;
+        let x198 = x173 - x15 * x29
+            + (x22 * x191 - x21 * x189 + (x23 * x193 - x24 * x194)) + x180 * x184;
+        let x199 = s_q2 * x186;
+        let x200 = c_q2 * x186;
+        let x201 = x200 - s_q2 * x185;
+        let x202 = c_q2 * x187 - x199;
+        let x203 = c_q2 * x188 + s_q2 * x189;
+        let x204 = c_q2 * x189 - s_q2 * x188;
+        let x205 = c_q2 * x190 + s_q2 * x191;
+        let x206 = c_q2 * x191 - s_q2 * x190;
+        let x207 = c_q2 * x203 + s_q2 * x205;
+        let x208 = c_q2 * x204 + s_q2 * x206;
+        let x209 = c_q2 * x205 - s_q2 * x203;
+        let x210 = c_q2 * x177 - s_q2 * x154;
+        let x211 = s_q2 * x193;
+        let x212 = c_q2 * x193;
+        let x213 = x212 - s_q2 * x192;
+        let x214 = x211 + c_q2 * x194;
+        let x215 = c_q2 * (c_q2 * x192 + x211) + s_q2 * (x212 - s_q2 * x194);
+        let x216 = c_q2 * x213 - s_q2 * x214;
+        let x217 = x209 + 0.5692 * x215;
+        let x218 = 0.5692 * x207
+            + (c_q2 * x201 + s_q2 * x202
+                + -0.5692 * (c_q2 * x206 - s_q2 * x204 + 0.5692 * x216));
+        let x219 = c_q2 * x197 + s_q2 * x198;
+        let x220 = 1145.5438 + x217;
+        let x221 = 1.0
+            / (65697.33 + (0.5692 * x209 + (c_q2 * x202 - s_q2 * x201 + 0.5692 * x217)));
+        let x222 = tau[1]
+            - (c_q2 * x196 - s_q2 * x195 + 0.5692 * x219 - (x1 * x10 + x5 * x12));
+        let x223 = x218 * x221;
+        let x224 = x220 * x221;
+        let x225 = x210 * x221;
+        let x226 = -0.5692 * x208
+            + (c_q2 * (c_q2 * x185 + x199) + s_q2 * (x200 + s_q2 * x187)
+                + -0.5692 * (x208 - -0.5692 * (s_q2 * x213 + c_q2 * x214)))
+            - x218 * x223;
+        let x227 = x207 + -0.5692 * x216 - x218 * x224;
+        let x228 = c_q2 * x154 + s_q2 * x177 - x218 * x225;
+        let x229 = x215 - x220 * x224;
+        let x230 = x220 * x225;
+        let x231 = x210 * x225;
+        let x232 = c_q1 * (s_q1 * x227 + c_q1 * x228);
+        let x233 = 1.0
             / (66279.66
-                + (0.7026 * x63
-                    + (c_q1
-                        * (c_q1 * (c_q2 * x64 + s_q2 * x66)
-                            - s_q1 * (c_q2 * x58 + s_q2 * x53 + 0.5692 * x61))
-                        - s_q1 * (x68 - s_q1 * (-65693.914 + x59)) - -0.7026 * x63)));
-        let x186 = x69 * x185;
-        let x187 = x70 * x185;
-        let x188 = x72 * x185;
-        let x189 = x79 * x185;
-        let x190 = x82 * x185;
-        let x191 = x87 * x185;
-        let x192 = 1.0
-            / (65697.33
-                + (c_q2 * (c_q2 * x54 - s_q2 * x52) - s_q2 * (c_q2 * x50 - s_q2 * x56))
-                - x69 * x186);
-        let x193 = x67 - s_q2 * x57 + 0.5692 * x63 - x69 * x187;
-        let x194 = x192 * x193;
-        let x195 = x67 - s_q2 * x48 + 0.5692 * x71 - x69 * x188;
-        let x196 = x192 * x195;
-        let x197 = c_q2 * x77 - s_q2 * x75 + 0.5692 * x78 - x69 * x189;
-        let x198 = x192 * x197;
-        let x199 = c_q2 * x81 - s_q2 * x80 - x69 * x190;
-        let x200 = x192 * x199;
-        let x201 = s_q2 * x85 + c_q2 * x86 + x69 * x191;
-        let x202 = x192 * x201;
-        let x203 = 1.0 / (x59 - x70 * x187 - x193 * x194);
-        let x204 = x49 - x70 * x188 - x193 * x196;
-        let x205 = x203 * x204;
-        let x206 = x76 - x70 * x189 - x193 * x198;
-        let x207 = x203 * x206;
-        let x208 = x70 * x190 + x193 * x200;
-        let x209 = x203 * x208;
-        let x210 = x8 - x70 * x191 + x193 * x202;
-        let x211 = x203 * x210;
-        let x212 = 1.0 / (x35 - x72 * x188 - x195 * x196 - x204 * x205);
-        let x213 = x27 - x72 * x189 - x195 * x198 - x204 * x207;
-        let x214 = x212 * x213;
-        let x215 = x204 * x209 - (x72 * x190 + x195 * x200);
-        let x216 = x212 * x215;
-        let x217 = x8 - x72 * x191 + x195 * x202 - x204 * x211;
-        let x218 = x212 * x217;
-        let x219 = 1.0 / (x13 - x79 * x189 - x197 * x198 - x206 * x207 - x213 * x214);
-        let x220 = x206 * x209 - (x79 * x190 + x197 * x200) - x213 * x216;
-        let x221 = x219 * x220;
-        let x222 = x8 - x79 * x191 + x197 * x202 - x206 * x211 - x213 * x218;
-        let x223 = x219 * x222;
-        let x224 = 1.0
-            / (47.471 - x82 * x190 - x199 * x200 - x208 * x209 - x215 * x216
-                - x220 * x221);
-        let x225 = x199 * x202 - x82 * x191 + x208 * x211 - x215 * x218 - x220 * x223;
-        let x226 = x224 * x225;
-        let x227 = 1.0
-            / (9.336 - x87 * x191 - x201 * x202 - x210 * x211 - x217 * x218 - x222 * x223
-                - x225 * x226);
-        let x228 = tau[1]
-            - (c_q2 * x180 - s_q2 * x178 + 0.5692 * x183
-                - (1145.5438 * x95 + (x88 * x97 + x92 * x99))) - x184 * x186;
-        let x229 = tau[2] - x179 - x184 * x187 - x194 * x228;
-        let x230 = tau[3] - x171 - x184 * x188 - x196 * x228 - x205 * x229;
-        let x231 = tau[4] - x167 - x184 * x189 - x198 * x228 - x207 * x229 - x214 * x230;
-        let x232 = tau[5] - x165 - x184 * x190 - x200 * x228 + x209 * x229 - x216 * x230
-            - x221 * x231;
-        let x233 = x227
-            * (tau[6] - x159 - x184 * x191 + x202 * x228 - x211 * x229 - x218 * x230
-                - x223 * x231 - x226 * x232);
-        let x234 = x224 * x232 - x226 * x233;
-        let x235 = x219 * x231 - x221 * x234 - x223 * x233;
-        let x236 = x212 * x230 - x214 * x235 - x216 * x234 - x218 * x233;
-        let x237 = x203 * x229 - x205 * x236 - x207 * x235 + x209 * x234 - x211 * x233;
-        let x238 = x192 * x228 - x194 * x237 - x196 * x236 - x198 * x235 - x200 * x234
-            + x202 * x233;
-        let x239 = x184 * x185 - x186 * x238 - x187 * x237 - x188 * x236 - x189 * x235
-            - x190 * x234 - x191 * x233;
-        [x239, x238, x237, x236, x235, x234, x233]
+                + (-0.7026 * x232
+                    + (c_q1 * (c_q1 * x226) + s_q1 * (-65693.914 * s_q1)
+                        + -0.7026
+                            * (x232
+                                + -0.7026
+                                    * (s_q1 * (s_q1 * x229 - c_q1 * x230)
+                                        - c_q1 * (s_q1 * x230 + c_q1 * x231))))));
+        let x234 = x233
+            * (tau[0]
+                - (c_q1
+                    * (qd[1] * x10 - x2 * x11 + x5 * x13
+                        + (c_q2 * x195 + s_q2 * x196
+                            + -0.5692 * (c_q2 * x198 - s_q2 * x197))
+                        + (x9 * x228 - x8 * x227 - x6 * x226) + x222 * x223)
+                    - s_q1
+                        * (x178 + x180 * (x175 * x179) - (x1 * x11 + x4 * x13)
+                            - -65693.914 * x7)
+                    + -0.7026
+                        * (s_q1
+                            * (x2 * x13 + x219 - (x6 * x227 + (x8 * x229 + x9 * x230))
+                                + x222 * x224)
+                            + c_q1
+                                * (x1 * x13 - qd[1] * x12
+                                    + (x15 * x30 + x140 + (x22 * x177 - x21 * x154))
+                                    + (x8 * x230 - x9 * x231 - x6 * x228) + x222 * x225))));
+        let x235 = 0.7026 * x234;
+        let x236 = c_q1 * x234 - x6;
+        let x237 = x7 + s_q1 * x234;
+        let x238 = x8 + s_q1 * x235;
+        let x239 = x221
+            * (x222 - (x218 * x236 + (x210 * (x9 - c_q1 * x235) - x220 * x238)));
+        let x240 = 0.5692 * x236;
+        let x241 = x238 + -0.5692 * x239;
+        let x242 = c_q2 * x236 - s_q2 * x239 - x21;
+        let x243 = x22 + (s_q2 * x236 + c_q2 * x239);
+        let x244 = x23 + (s_q2 * x240 - c_q2 * x241);
+        let x245 = x24 - (s_q2 * x241 + c_q2 * x240);
+        let x246 = x179
+            * (x180
+                - (x174 * x242 - x175 * x237 + x170 * x243
+                    + (x165 * x244 + x176 * x245)));
+        let x247 = x246 - x237;
+        let x248 = x244 - -0.475 * x243;
+        let x249 = x245 - (0.475 * x242 + 7.11 * x247);
+        let x250 = c_q3 * x242 - s_q3 * x243 - x39;
+        let x251 = x40 + (s_q3 * x242 + c_q3 * x243);
+        let x252 = c_q3 * x248 - s_q3 * x249 - x41;
+        let x253 = x42 + (s_q3 * x248 + c_q3 * x249);
+        let x254 = x124
+            * (x125
+                - (x119 * x250 + x120 * x247 + x116 * x251
+                    + (x114 * x252 + x121 * x253)));
+        let x255 = x247 + x254;
+        let x256 = c_q4 * x250 - s_q4 * x251 - x56;
+        let x257 = x57 + (s_q4 * x250 + c_q4 * x251);
+        let x258 = x84
+            * (x85
+                - (x82 * x255 - x81 * x256 + -97.44449 * x257
+                    + -171.19551 * (c_q4 * x252 - s_q4 * (x253 - 7.11 * x255) - x58)));
+        let x259 = 0.021065492 * (x78 - 47.471 * x257);
+        let x260 = 0.10711225
+            * (tau[6] - 9.336 * (qd[5] * x68 + (c_q5 * x256 + s_q5 * (x255 + x258))));
+        [x234, x239, x246, x254, x258, x259, x260]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -1314,7 +1407,7 @@ impl SsrmsF32 {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted).
+    /// Methods: mass matrix `crba`, bias `rnea`, forward `ldlt`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted).
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f32; 7],

@@ -8,32 +8,34 @@
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Precision: `f64`.
-//! Fused multiply-adds: 1260 (`mass_matrix` 93, `nonlinear_effects` 136, `inverse_dynamics` 145, `forward_dynamics` 323, `mass_matrix_and_nonlinear_effects` 229, `forward_dynamics_with_wrenches` 334), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds: 1233 (`mass_matrix` 93, `nonlinear_effects` 136, `inverse_dynamics` 145, `forward_dynamics` 296, `mass_matrix_and_nonlinear_effects` 229, `forward_dynamics_with_wrenches` 334), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 681 | 661 | 0 | 0 | 7 | 1342 |
-//! | `mass_matrix` | `recurrent-r1` | — | 778 | 703 | 0 | 0 | 7 | 1481 |
-//! | `mass_matrix` | `kane-direct` | — | 709 | 510 | 0 | 0 | 7 | 1219 |
-//! | `mass_matrix` | `crba-base` | — | 577 | 454 | 0 | 0 | 7 | 1031 |
-//! | `mass_matrix` * | `crba` | — | 170 | 116 | 0 | 0 | 5 | 286 |
-//! | `nonlinear_effects` | — | `recurrent` | 618 | 450 | 0 | 0 | 7 | 1068 |
-//! | `nonlinear_effects` | — | `kane-direct` | 708 | 536 | 0 | 0 | 7 | 1244 |
-//! | `nonlinear_effects` * | — | `rnea` | 256 | 176 | 0 | 0 | 6 | 432 |
-//! | `inverse_dynamics` | — | `recurrent` | 827 | 607 | 0 | 0 | 7 | 1434 |
-//! | `inverse_dynamics` | — | `kane-direct` | 917 | 693 | 0 | 0 | 7 | 1610 |
-//! | `inverse_dynamics` * | — | `rnea` | 268 | 191 | 0 | 0 | 6 | 459 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 914 | 667 | 7 | 0 | 7 | 1581 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 1004 | 753 | 7 | 0 | 7 | 1757 |
-//! | `forward_dynamics` * | `crba` | `rnea` | 552 | 393 | 7 | 0 | 6 | 945 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 788 | 566 | 0 | 0 | 7 | 1354 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 878 | 652 | 0 | 0 | 7 | 1530 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | 426 | 292 | 0 | 0 | 6 | 718 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 1018 | 772 | 7 | 0 | 7 | 1790 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 1108 | 858 | 7 | 0 | 7 | 1966 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 681 | 661 | 0 | 0 | 7 | 1342 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 778 | 703 | 0 | 0 | 7 | 1481 |
+//! | `mass_matrix` | `kane-direct` | — | — | 709 | 510 | 0 | 0 | 7 | 1219 |
+//! | `mass_matrix` | `crba-base` | — | — | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` * | `crba` | — | — | 170 | 116 | 0 | 0 | 5 | 286 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 618 | 450 | 0 | 0 | 7 | 1068 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 708 | 536 | 0 | 0 | 7 | 1244 |
+//! | `nonlinear_effects` * | — | `rnea` | — | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 827 | 607 | 0 | 0 | 7 | 1434 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 917 | 693 | 0 | 0 | 7 | 1610 |
+//! | `inverse_dynamics` * | — | `rnea` | — | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 914 | 667 | 7 | 0 | 7 | 1581 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 1004 | 753 | 7 | 0 | 7 | 1757 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 552 | 393 | 7 | 0 | 6 | 945 |
+//! | `forward_dynamics` * | — | — | `aba` | 556 | 388 | 5 | 0 | 6 | 944 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 788 | 566 | 0 | 0 | 7 | 1354 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 878 | 652 | 0 | 0 | 7 | 1530 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `rnea` | — | 426 | 292 | 0 | 0 | 6 | 718 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 1018 | 772 | 7 | 0 | 7 | 1790 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 1108 | 858 | 7 | 0 | 7 | 1966 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `rnea` | `ldlt` | 564 | 437 | 7 | 0 | 6 | 1001 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 568 | 433 | 5 | 0 | 6 | 1001 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsFma;
@@ -46,6 +48,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -91,6 +96,7 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 170u64,
             add: 116u64,
             div: 0u64,
@@ -102,6 +108,7 @@ impl SsrmsFma {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 256u64,
             add: 176u64,
             div: 0u64,
@@ -113,6 +120,7 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 268u64,
             add: 191u64,
             div: 0u64,
@@ -122,19 +130,21 @@ impl SsrmsFma {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
-            mul: 552u64,
-            add: 393u64,
-            div: 7u64,
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 556u64,
+            add: 388u64,
+            div: 5u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 323u64,
+            fma: 296u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 426u64,
             add: 292u64,
             div: 0u64,
@@ -146,6 +156,7 @@ impl SsrmsFma {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 564u64,
             add: 437u64,
             div: 7u64,
@@ -160,6 +171,7 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 681u64,
             add: 661u64,
             div: 0u64,
@@ -171,6 +183,7 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 778u64,
             add: 703u64,
             div: 0u64,
@@ -182,6 +195,7 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 709u64,
             add: 510u64,
             div: 0u64,
@@ -193,6 +207,7 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 577u64,
             add: 454u64,
             div: 0u64,
@@ -204,6 +219,7 @@ impl SsrmsFma {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 170u64,
             add: 116u64,
             div: 0u64,
@@ -215,6 +231,7 @@ impl SsrmsFma {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 618u64,
             add: 450u64,
             div: 0u64,
@@ -226,6 +243,7 @@ impl SsrmsFma {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 708u64,
             add: 536u64,
             div: 0u64,
@@ -237,6 +255,7 @@ impl SsrmsFma {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 256u64,
             add: 176u64,
             div: 0u64,
@@ -248,6 +267,7 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 827u64,
             add: 607u64,
             div: 0u64,
@@ -259,6 +279,7 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 917u64,
             add: 693u64,
             div: 0u64,
@@ -270,6 +291,7 @@ impl SsrmsFma {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 268u64,
             add: 191u64,
             div: 0u64,
@@ -281,6 +303,7 @@ impl SsrmsFma {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 914u64,
             add: 667u64,
             div: 7u64,
@@ -292,6 +315,7 @@ impl SsrmsFma {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 1004u64,
             add: 753u64,
             div: 7u64,
@@ -303,6 +327,7 @@ impl SsrmsFma {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 552u64,
             add: 393u64,
             div: 7u64,
@@ -311,9 +336,22 @@ impl SsrmsFma {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 556u64,
+            add: 388u64,
+            div: 5u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 788u64,
             add: 566u64,
             div: 0u64,
@@ -325,6 +363,7 @@ impl SsrmsFma {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 878u64,
             add: 652u64,
             div: 0u64,
@@ -336,6 +375,7 @@ impl SsrmsFma {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 426u64,
             add: 292u64,
             div: 0u64,
@@ -347,6 +387,7 @@ impl SsrmsFma {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 1018u64,
             add: 772u64,
             div: 7u64,
@@ -358,6 +399,7 @@ impl SsrmsFma {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 1108u64,
             add: 858u64,
             div: 7u64,
@@ -369,9 +411,22 @@ impl SsrmsFma {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 564u64,
             add: 437u64,
             div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 568u64,
+            add: 433u64,
+            div: 5u64,
             sqrt: 0u64,
             sincos: 6u64,
             fma: 0u64,
@@ -940,572 +995,523 @@ impl SsrmsFma {
         );
         [x107, x106, x101, x93, x89, x87, x81]
     }
-    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 552 mul, 393 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 323 fused multiply-adds.
+    /// Methods: forward `aba`: 556 mul, 388 add, 5 div, 0 sqrt, 6 sincos (emitted), of which 296 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
+        let x1 = qd[0] * c_q1;
+        let x2 = qd[0] * s_q1;
+        let x3 = 0.7026 * qd[0];
+        let x4 = s_q1 * x3;
+        let x5 = c_q1 * x3;
+        let x6 = qd[1] * x2;
+        let x7 = qd[1] * x1;
+        let x8 = qd[1] * x5;
+        let x9 = qd[1] * x4;
+        let x10 = -65693.9112265768 * x2;
+        let x11 = libm::fma(x4, -1145.5438279999998, 65697.3302265768 * qd[1]);
+        let x12 = -1145.5438279999998 * qd[1];
+        let x13 = x1 * 1145.5438279999998;
         let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x15 = libm::fma(-qd[1], s_q2, x1 * c_q2);
+        let x16 = libm::fma(qd[1], c_q2, x1 * s_q2);
+        let x17 = x1 * 0.5692;
+        let x18 = libm::fma(-0.5692, qd[1], x4);
+        let x19 = libm::fma(-c_q2, x18, s_q2 * x17);
+        let x20 = libm::fma(c_q2, x17, s_q2 * x18);
+        let x21 = qd[2] * x16;
+        let x22 = qd[2] * x15;
+        let x23 = qd[2] * x20;
+        let x24 = qd[2] * x19;
+        let x25 = qd[2] - x2;
+        let x26 = libm::fma(3946.18812068, x25, -39234.47412200001 * x15);
+        let x27 = 5224.5702 * x5;
+        let x28 = libm::fma(
+            x20,
+            5224.5702,
+            libm::fma(39241.404122, x25, 3946.1881206800003 * x15),
+        );
+        let x29 = x16 * -5224.5702;
+        let x30 = 5224.5702 * x25;
         let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x32 = libm::fma(-x16, s_q3, x15 * c_q3);
+        let x33 = libm::fma(x16, c_q3, x15 * s_q3);
+        let x34 = libm::fma(0.475, x16, x19);
+        let x35 = libm::fma(x16, -7.11, x5);
+        let x36 = x20 + libm::fma(7.11, x25, x15 * 0.475);
+        let x37 = libm::fma(s_q3, x36, c_q3 * x34);
+        let x38 = libm::fma(-c_q3, x36, s_q3 * x34);
+        let x39 = qd[3] * x33;
+        let x40 = qd[3] * x32;
+        let x41 = qd[3] * x38;
+        let x42 = qd[3] * x37;
+        let x43 = qd[3] + x25;
+        let x44 = libm::fma(1375.0472756800002, x43, -24989.305802 * x32);
+        let x45 = 3239.4582 * x35;
+        let x46 = libm::fma(
+            x38,
+            -3239.4582,
+            libm::fma(24998.827802, x43, 1375.0472756800002 * x32),
+        );
+        let x47 = x33 * -3239.4582;
+        let x48 = 3239.4582 * x43;
         let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x50 = libm::fma(-x33, s_q4, x32 * c_q4);
+        let x51 = libm::fma(x33, c_q4, x32 * s_q4);
+        let x52 = libm::fma(x33, -7.11, x35);
+        let x53 = libm::fma(-7.11, x43, x38);
+        let x54 = libm::fma(-s_q4, x53, x37 * c_q4);
+        let x55 = libm::fma(c_q4, x53, x37 * s_q4);
+        let x56 = qd[4] * x51;
+        let x57 = qd[4] * x50;
+        let x58 = qd[4] * x55;
+        let x59 = qd[4] + x43;
+        let x60 = -97.44448770720001 * x59;
+        let x61 = libm::fma(x52, -171.195516, 132.6783695416 * x50);
+        let x62 = libm::fma(
+            -171.195516,
+            x54,
+            libm::fma(-97.44448770720001, x51, 135.4729695416 * x59),
+        );
+        let x63 = x59 * 171.195516;
+        let x64 = -171.195516 * x50;
+        let x65 = libm::fma(-x50, x64, x59 * x63);
         let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x67 = libm::fma(x59, s_q5, x50 * c_q5);
+        let x68 = libm::fma(-x50, s_q5, x59 * c_q5);
+        let x69 = qd[5] + x51;
+        let x70 = 44.41 * x68;
+        let x71 = 47.471 * x69;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x6 = 9.336 * c_q5;
-        let x7 = 44.41 * s_q5;
-        let x8 = 9.336 * s_q5;
-        let x9 = 44.41 * c_q5;
-        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
-        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
-        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
-        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
-        let x14 = -171.195516 * s_q4;
-        let x15 = -171.195516 * c_q4;
-        let x16 = c_q4 * x12;
-        let x17 = -97.44448770720001 * s_q4;
-        let x18 = libm::fma(c_q4, x10, x17);
-        let x19 = 47.471 * s_q4;
-        let x20 = s_q4 * x12;
-        let x21 = -97.44448770720001 * c_q4;
-        let x22 = libm::fma(-s_q4, x10, x21);
-        let x23 = 47.471 * c_q4;
-        let x24 = libm::fma(-s_q4, x11, x21);
-        let x25 = x14 * -7.11;
-        let x26 = 7.11 * x14;
-        let x27 = x13 - x25;
-        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
-        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
-        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
-        let x31 = 3239.4582 + x14;
-        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
-        let x33 = 1375.0472756800002 + x18;
-        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
-        let x35 = 24998.827802 + (x26 + x27);
-        let x36 = s_q3 * x15;
-        let x37 = libm::fma(c_q3, x31, x36);
-        let x38 = c_q3 * x15;
-        let x39 = libm::fma(-s_q3, x31, x38);
-        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
-        let x41 = s_q3 * x22;
-        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
-        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
-        let x44 = c_q3 * x22;
-        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
-        let x46 = -7.11 * x37;
-        let x47 = 7.11 * x37;
-        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
-        let x49 = x35 - x46;
-        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
-        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
-        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
-        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
-        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
-        let x55 = 5224.5702 + x37;
-        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
-        let x57 = 3946.18812068 + x48;
-        let x58 = 3946.1881206800003
-            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
-        let x59 = 39241.404122 + (x47 + x49);
-        let x60 = s_q2 * x39;
-        let x61 = libm::fma(c_q2, x55, x60);
-        let x62 = c_q2 * x39;
-        let x63 = libm::fma(-s_q2, x55, x62);
-        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
-        let x65 = s_q2 * x51;
-        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
-        let x67 = c_q2 * x51;
-        let x68 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
-        let x69 = libm::fma(
-            -0.7026,
-            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
-            libm::fma(
-                -s_q1,
-                libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
-                c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
-            ),
-        );
-        let x70 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x68));
-        let x71 = libm::fma(-s_q2, x37, x62);
-        let x72 = libm::fma(
-            -0.7026,
-            s_q1 * x71,
-            libm::fma(
-                -s_q1,
-                x49,
-                c_q1
-                    * libm::fma(
-                        0.5692,
-                        libm::fma(c_q2, x37, x60),
-                        libm::fma(c_q2, x48, x65),
-                    ),
-            ),
-        );
-        let x73 = libm::fma(-s_q3, x14, x38);
-        let x74 = libm::fma(c_q3, x14, x36);
-        let x75 = libm::fma(0.475, x74, libm::fma(c_q3, x18, x41));
-        let x76 = libm::fma(7.11, x74, x27);
-        let x77 = libm::fma(0.475, x73, libm::fma(-s_q3, x18, x44));
-        let x78 = libm::fma(-s_q2, x74, c_q2 * x73);
+        let x73 = 9.336 * (qd[6] + x67);
+        let x74 = libm::fma(-x68, s_q6, x69 * c_q6) * x73;
+        let x75 = libm::fma(x69, s_q6, x68 * c_q6) * x73;
+        let x76 = tau[6] + libm::fma(-x69, x70, x68 * x71);
+        let x77 = libm::fma(x67, x70, libm::fma(-c_q6, x75, s_q6 * x74));
+        let x78 = tau[5] - x77;
         let x79 = libm::fma(
-            -0.7026,
-            s_q1 * x78,
-            libm::fma(
-                -s_q1,
-                x76,
-                c_q1
-                    * libm::fma(
-                        0.5692,
-                        libm::fma(c_q2, x74, s_q2 * x73),
-                        libm::fma(s_q2, x77, c_q2 * x75),
-                    ),
-            ),
+            -44.41,
+            qd[5] * x67,
+            libm::fma(-x67, x71, libm::fma(s_q6, x75, c_q6 * x74)),
         );
-        let x80 = libm::fma(s_q3, x23, c_q3 * x19);
-        let x81 = libm::fma(-s_q3, x19, c_q3 * x23);
-        let x82 = c_q1 * libm::fma(s_q2, x81, c_q2 * x80);
-        let x83 = c_q4 * x6;
-        let x84 = s_q4 * x6;
-        let x85 = libm::fma(-s_q3, x84, c_q3 * x83);
-        let x86 = libm::fma(c_q3, x84, s_q3 * x83);
-        let x87 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x86, c_q2 * x85));
-        let x88 = qd[0] * c_q1;
-        let x89 = qd[0] * s_q1;
-        let x90 = 0.7026 * qd[0];
-        let x91 = s_q1 * x90;
-        let x92 = c_q1 * x90;
-        let x93 = qd[1] * x89;
-        let x94 = qd[1] * x88;
-        let x95 = qd[1] * x92;
-        let x96 = qd[1] * x91;
-        let x97 = -65693.9112265768 * x89;
-        let x98 = libm::fma(-1145.5438279999998, x91, 65697.3302265768 * qd[1]);
-        let x99 = -1145.5438279999998 * qd[1];
-        let x100 = 1145.5438279999998 * x88;
-        let x101 = libm::fma(-qd[1], s_q2, c_q2 * x88);
-        let x102 = libm::fma(qd[1], c_q2, s_q2 * x88);
-        let x103 = 0.5692 * x88;
-        let x104 = libm::fma(-0.5692, qd[1], x91);
-        let x105 = libm::fma(-c_q2, x104, s_q2 * x103);
-        let x106 = libm::fma(c_q2, x103, s_q2 * x104);
-        let x107 = qd[2] - x89;
-        let x108 = 0.5692 * x93;
-        let x109 = libm::fma(qd[2], x102, c_q2 * x93);
-        let x110 = libm::fma(-s_q2, x93, qd[2] * x101);
-        let x111 = libm::fma(qd[2], x105, libm::fma(-s_q2, x95, c_q2 * x108));
-        let x112 = libm::fma(3946.18812068, x107, -39234.47412200001 * x101);
-        let x113 = 5224.5702 * x92;
-        let x114 = libm::fma(
-            x106,
-            5224.5702,
-            libm::fma(39241.404122, x107, 3946.1881206800003 * x101),
+        let x80 = 44.41 * c_q5;
+        let x81 = s_q5 * x80;
+        let x82 = libm::fma(c_q5, x80, 135.4729695416);
+        let x83 = libm::fma(-x55, x63, libm::fma(-x50, x60, x51 * x61))
+            + libm::fma(c_q5, x79, s_q5 * x76);
+        let x84 = 1.0 / x82;
+        let x85 = tau[4] - x83;
+        let x86 = x81 * x84;
+        let x87 = -97.44448770720001 * x84;
+        let x88 = -171.195516 * x84;
+        let x89 = libm::fma(-x81, x86, libm::fma(s_q5, 44.41 * s_q5, 132.6783695416));
+        let x90 = x81 * x87;
+        let x91 = -97.44448770720001 * x87;
+        let x92 = x81 * x88;
+        let x93 = -97.44448770720001 * x88;
+        let x94 = -171.195516 * x88;
+        let x95 = libm::fma(x56, 171.195516, x51 * x63);
+        let x96 = libm::fma(
+            -x85,
+            x86,
+            libm::fma(x55, x64, libm::fma(-x51, x62, x59 * x60))
+                + libm::fma(-s_q5, x79, c_q5 * x76)
+                + libm::fma(-x58, x92, libm::fma(-x56, x89, x57 * x90)),
         );
-        let x115 = x102 * -5224.5702;
-        let x116 = 5224.5702 * x107;
-        let x117 = libm::fma(-s_q3, x102, c_q3 * x101);
-        let x118 = libm::fma(c_q3, x102, s_q3 * x101);
-        let x119 = libm::fma(0.475, x102, x105);
-        let x120 = libm::fma(-7.11, x102, x92);
-        let x121 = x106 + libm::fma(7.11, x107, 0.475 * x101);
-        let x122 = libm::fma(s_q3, x121, c_q3 * x119);
-        let x123 = libm::fma(-c_q3, x121, s_q3 * x119);
-        let x124 = qd[3] + x107;
-        let x125 = 7.11 * x94;
-        let x126 = libm::fma(
-            0.475,
-            x110,
-            libm::fma(qd[2], x106, -libm::fma(s_q2, x108, c_q2 * x95)),
+        let x97 = libm::fma(
+            x85,
+            x87,
+            libm::fma(-x59, x61, x50 * x62) - libm::fma(x54, x64, x52 * x63)
+                + (x77 + x78) + libm::fma(x58, x93, -libm::fma(x57, x91, x56 * x90)),
         );
-        let x127 = libm::fma(7.11, x110, x96);
-        let x128 = x111 + libm::fma(0.475, x109, x125);
-        let x129 = libm::fma(qd[3], x118, libm::fma(s_q3, x110, c_q3 * x109));
-        let x130 = libm::fma(qd[3], x117, libm::fma(-s_q3, x109, c_q3 * x110));
-        let x131 = libm::fma(qd[3], x122, libm::fma(c_q3, x128, s_q3 * x126));
-        let x132 = libm::fma(1375.0472756800002, x124, -24989.305802 * x117);
-        let x133 = 3239.4582 * x120;
-        let x134 = libm::fma(
-            x123,
-            -3239.4582,
-            libm::fma(24998.827802, x124, 1375.0472756800002 * x117),
+        let x98 = libm::fma(
+            x85,
+            x88,
+            libm::fma(x51, x64, libm::fma(x58, x94, -libm::fma(x57, x93, x56 * x92))),
         );
-        let x135 = x118 * -3239.4582;
-        let x136 = 3239.4582 * x124;
-        let x137 = libm::fma(-s_q4, x118, c_q4 * x117);
-        let x138 = libm::fma(c_q4, x118, s_q4 * x117);
-        let x139 = libm::fma(-7.11, x118, x120);
-        let x140 = libm::fma(-7.11, x124, x123);
-        let x141 = libm::fma(-s_q4, x140, c_q4 * x122);
-        let x142 = libm::fma(c_q4, x140, s_q4 * x122);
-        let x143 = qd[4] + x124;
-        let x144 = libm::fma(qd[4], x138, libm::fma(s_q4, x130, c_q4 * x129));
-        let x145 = libm::fma(qd[4], x137, libm::fma(-s_q4, x129, c_q4 * x130));
-        let x146 = -97.44448770720001 * x143;
-        let x147 = libm::fma(-171.195516, x139, 132.6783695416 * x137);
-        let x148 = libm::fma(
-            -171.195516,
-            x141,
-            libm::fma(-97.44448770720001, x138, 135.4729695416 * x143),
-        );
-        let x149 = 171.195516 * x143;
-        let x150 = -171.195516 * x137;
-        let x151 = libm::fma(-x137, x150, x143 * x149);
-        let x152 = libm::fma(x138, x150, 171.195516 * x94);
-        let x153 = libm::fma(-x138, x149, -171.195516 * x144);
-        let x154 = libm::fma(s_q5, x143, c_q5 * x137);
-        let x155 = libm::fma(-s_q5, x137, c_q5 * x143);
-        let x156 = qd[5] + x138;
-        let x157 = 44.41 * x155;
-        let x158 = 47.471 * x156;
-        let x159 = 9.336 * libm::fma(qd[5], x155, -libm::fma(s_q5, x94, c_q5 * x144));
-        let x160 = 9.336 * (qd[6] + x154);
-        let x161 = libm::fma(-s_q6, x155, c_q6 * x156) * x160;
-        let x162 = libm::fma(s_q6, x156, c_q6 * x155) * x160;
-        let x163 = libm::fma(-x156, x157, x155 * x158) + x159;
-        let x164 = libm::fma(
-            -x154,
-            x158,
-            44.41 * libm::fma(-qd[5], x154, libm::fma(-c_q5, x94, s_q5 * x144)),
-        ) + libm::fma(s_q6, x162, c_q6 * x161);
-        let x165 = libm::fma(x154, x157, 47.471 * x145)
-            + libm::fma(-c_q6, x162, s_q6 * x161);
-        let x166 = libm::fma(
-            -132.6783695416,
-            x144,
-            171.195516 * libm::fma(7.11, x130, x127),
-        ) + libm::fma(x142, x150, libm::fma(-x138, x148, x143 * x146))
-            + libm::fma(-s_q5, x164, c_q5 * x163);
-        let x167 = libm::fma(
-            -171.195516,
-            libm::fma(
-                -qd[4],
-                x142,
-                libm::fma(
-                    -s_q4,
-                    x125 + x131,
-                    c_q4 * libm::fma(-qd[3], x123, libm::fma(-s_q3, x128, c_q3 * x126)),
-                ),
-            ),
-            libm::fma(-135.4729695416, x94, -97.44448770720001 * x145),
-        ) + libm::fma(-x142, x149, libm::fma(-x137, x146, x138 * x147))
-            + libm::fma(c_q5, x164, s_q5 * x163);
-        let x168 = libm::fma(
-            97.44448770720001,
-            x94,
-            libm::fma(-x143, x147, x137 * x148) - libm::fma(x141, x150, x139 * x149),
-        ) + x165;
-        let x169 = libm::fma(-s_q4, x152, c_q4 * x151);
-        let x170 = libm::fma(x120, x136, x123 * x135)
-            - libm::fma(x124, x133, x118 * x134)
-            - libm::fma(1375.0472756800002, x94, -24989.305802 * x129)
-            + libm::fma(s_q4, x168, c_q4 * x166);
-        let x171 = libm::fma(
-            x131,
-            -3239.4582,
-            -libm::fma(24998.827802, x94, 1375.0472756800002 * x129),
-        ) + libm::fma(x122, x136, libm::fma(x117, x133, x118 * x132))
-            + libm::fma(-7.11, x169, x167);
-        let x172 = libm::fma(
-            3239.4582,
-            x127,
-            libm::fma(-x122, x135, libm::fma(-x124, x132, x117 * x134)),
-        ) + libm::fma(7.11, x153, libm::fma(-s_q4, x166, c_q4 * x168));
-        let x173 = libm::fma(-x124, x136, x118 * x135)
-            + libm::fma(s_q4, x151, c_q4 * x152);
-        let x174 = libm::fma(x130, 3239.4582, x117 * x136) + x153;
-        let x175 = libm::fma(-x117, x135, 3239.4582 * x94) + x169;
-        let x176 = libm::fma(s_q3, x175, c_q3 * x173);
-        let x177 = libm::fma(-s_q3, x173, c_q3 * x175);
-        let x178 = libm::fma(-x106, x115, x92 * x116)
-            - libm::fma(x107, x113, x102 * x114)
-            - libm::fma(3946.18812068, x94, -39234.47412200001 * x109)
-            + libm::fma(-0.475, x177, libm::fma(s_q3, x172, c_q3 * x170));
-        let x179 = libm::fma(
-            x111,
-            -5224.5702,
-            -libm::fma(39241.404122, x94, 3946.1881206800003 * x109),
-        ) + libm::fma(x105, x116, libm::fma(x101, x113, x102 * x112))
-            + libm::fma(-7.11, x177, x171);
-        let x180 = libm::fma(
-            5224.5702,
-            x96,
-            libm::fma(-x105, x115, libm::fma(-x107, x112, x101 * x114)),
-        ) + (libm::fma(-s_q3, x170, c_q3 * x172) + libm::fma(7.11, x174, 0.475 * x176));
-        let x181 = libm::fma(-x107, x116, x102 * x115) + x176;
-        let x182 = libm::fma(-x101, x115, 5224.5702 * x94) + x177;
-        let x183 = libm::fma(s_q2, x182, c_q2 * x181);
-        let x184 = tau[0]
-            - libm::fma(
-                -0.7026,
-                libm::fma(
-                    c_q1,
-                    libm::fma(-qd[1], x99, x88 * x100)
-                        + (libm::fma(x110, 5224.5702, x101 * x116) + x174),
-                    s_q1 * libm::fma(x89, x100, x183),
-                ),
-                libm::fma(
-                    -s_q1,
-                    x179
-                        - libm::fma(
-                            -65693.9112265768,
-                            x94,
-                            libm::fma(x91, x100, x88 * x98),
-                        ),
-                    c_q1
-                        * (libm::fma(x92, x100, libm::fma(-x89, x98, qd[1] * x97))
-                            + libm::fma(
-                                -0.5692,
-                                libm::fma(-s_q2, x181, c_q2 * x182),
-                                libm::fma(s_q2, x180, c_q2 * x178),
-                            )),
-                ),
-            );
-        let x185 = 1.0
-            / (66279.65991417361
+        let x99 = s_q4 * x90;
+        let x100 = c_q4 * x90;
+        let x101 = libm::fma(-s_q4, x89, x100);
+        let x102 = libm::fma(c_q4, x91, x99);
+        let x103 = c_q4 * x92;
+        let x104 = s_q4 * x92;
+        let x105 = c_q4 * x93;
+        let x106 = s_q4 * x93;
+        let x107 = c_q4 * 171.195516;
+        let x108 = libm::fma(-c_q4, x104, s_q4 * x106);
+        let x109 = s_q4 * 171.195516;
+        let x110 = libm::fma(c_q4, x106, s_q4 * x104);
+        let x111 = s_q4 * x94;
+        let x112 = c_q4 * x111;
+        let x113 = s_q4 * x111;
+        let x114 = -7.11 * x112;
+        let x115 = -7.11 * x113;
+        let x116 = -7.11 * x110;
+        let x117 = 7.11 * x109;
+        let x118 = libm::fma(-s_q4, x98, c_q4 * x65);
+        let x119 = libm::fma(-7.11, x108, 1375.0472756800002);
+        let x120 = libm::fma(7.11, x115, 24998.827802);
+        let x121 = -3239.4582 - x115;
+        let x122 = 3239.4582 - x109;
+        let x123 = libm::fma(x37, x48, libm::fma(x32, x45, x33 * x44))
+            + libm::fma(-7.11, x118, libm::fma(x85, x82 * x84, x83));
+        let x124 = 1.0 / x120;
+        let x125 = tau[3] - x123;
+        let x126 = x119 * x124;
+        let x127 = x116 * x124;
+        let x128 = x114 * x124;
+        let x129 = x121 * x124;
+        let x130 = libm::fma(
+            -x119,
+            x126,
+            -24989.305802
                 + libm::fma(
-                    0.7026,
-                    x63,
+                    s_q4,
+                    libm::fma(-s_q4, x91, x100),
+                    c_q4 * libm::fma(c_q4, x89, x99),
+                ),
+        );
+        let x131 = libm::fma(
+            -x119,
+            x127,
+            libm::fma(7.11, x107, libm::fma(-s_q4, x102, c_q4 * x101)),
+        );
+        let x132 = libm::fma(
+            x116,
+            x127,
+            x117 + (libm::fma(c_q4, x102, s_q4 * x101) + x117),
+        );
+        let x133 = libm::fma(-x119, x128, libm::fma(-s_q4, x105, c_q4 * x103));
+        let x134 = libm::fma(-x119, x129, x108);
+        let x135 = libm::fma(x116, x128, libm::fma(c_q4, x105, s_q4 * x103));
+        let x136 = libm::fma(-x116, x129, x110);
+        let x137 = libm::fma(x114, x128, c_q4 * (c_q4 * x94));
+        let x138 = libm::fma(-x114, x129, x112);
+        let x139 = libm::fma(x121, x129, x113);
+        let x140 = libm::fma(x32, x48, -x95) + libm::fma(-x39, x107, x40 * x122);
+        let x141 = libm::fma(
+            x125,
+            x126,
+            libm::fma(x35, x48, x38 * x47) - libm::fma(x43, x45, x33 * x46)
+                + libm::fma(s_q4, x97, c_q4 * x96)
+                + (libm::fma(-x39, x130, x40 * x131) + libm::fma(-x41, x133, x42 * x134)),
+        );
+        let x142 = libm::fma(
+            x125,
+            x127,
+            libm::fma(-x37, x47, libm::fma(-x43, x44, x32 * x46))
+                + libm::fma(-7.11, x95, libm::fma(-s_q4, x96, c_q4 * x97))
+                + (libm::fma(x42, x136, x41 * x135) - libm::fma(x40, x132, x39 * x131)),
+        );
+        let x143 = libm::fma(
+            x125,
+            x128,
+            libm::fma(-x43, x48, x33 * x47) + libm::fma(s_q4, x65, c_q4 * x98)
+                + (libm::fma(x42, x138, x41 * x137) - libm::fma(x40, x135, x39 * x133)),
+        );
+        let x144 = libm::fma(
+            x125,
+            x129,
+            libm::fma(-x32, x47, x118)
+                + (libm::fma(-x39, x134, x40 * x136) - libm::fma(x42, x139, x41 * x138)),
+        );
+        let x145 = s_q3 * x131;
+        let x146 = c_q3 * x131;
+        let x147 = libm::fma(-s_q3, x130, x146);
+        let x148 = libm::fma(c_q3, x132, x145);
+        let x149 = libm::fma(s_q3, x134, c_q3 * x133);
+        let x150 = libm::fma(-s_q3, x133, c_q3 * x134);
+        let x151 = libm::fma(-c_q3, x135, s_q3 * x136);
+        let x152 = libm::fma(c_q3, x136, s_q3 * x135);
+        let x153 = libm::fma(s_q3, x151, c_q3 * x149);
+        let x154 = libm::fma(s_q3, x122, c_q3 * x107);
+        let x155 = libm::fma(s_q3, x152, c_q3 * x150);
+        let x156 = libm::fma(-s_q3, x149, c_q3 * x151);
+        let x157 = libm::fma(-s_q3, x107, c_q3 * x122);
+        let x158 = s_q3 * x138;
+        let x159 = c_q3 * x138;
+        let x160 = libm::fma(s_q3, x137, x159);
+        let x161 = libm::fma(c_q3, x139, x158);
+        let x162 = libm::fma(
+            s_q3,
+            libm::fma(-s_q3, x139, x159),
+            c_q3 * libm::fma(-c_q3, x137, x158),
+        );
+        let x163 = libm::fma(-s_q3, x161, c_q3 * x160);
+        let x164 = libm::fma(c_q3, x161, s_q3 * x160);
+        let x165 = -7.11 * x163;
+        let x166 = -7.11 * x164;
+        let x167 = libm::fma(0.475, x164, x155);
+        let x168 = libm::fma(0.475, x162, x156);
+        let x169 = libm::fma(0.475, x163, libm::fma(-s_q3, x150, c_q3 * x152));
+        let x170 = -7.11 * x169;
+        let x171 = 7.11 * x157;
+        let x172 = libm::fma(s_q3, x144, c_q3 * x143);
+        let x173 = libm::fma(-s_q3, x143, c_q3 * x144);
+        let x174 = 3946.18812068 + libm::fma(0.475, x166, -7.11 * x155);
+        let x175 = libm::fma(7.11, x166, 39241.404122);
+        let x176 = -5224.5702 - x166;
+        let x177 = 5224.5702 + x157;
+        let x178 = libm::fma(x19, x30, libm::fma(x15, x27, x16 * x26))
+            + libm::fma(-7.11, x173, libm::fma(x125, x120 * x124, x123));
+        let x179 = 1.0 / x175;
+        let x180 = tau[2] - x178;
+        let x181 = x174 * x179;
+        let x182 = x170 * x179;
+        let x183 = x165 * x179;
+        let x184 = x176 * x179;
+        let x185 = libm::fma(
+            -x174,
+            x181,
+            -39234.47412200001
+                + libm::fma(
+                    -0.475,
+                    x155,
                     libm::fma(
-                        0.7026,
-                        x63,
+                        -0.475,
+                        x167,
                         libm::fma(
-                            -s_q1,
-                            libm::fma(-s_q1, -65693.9112265768 + x59, x68),
-                            c_q1
-                                * libm::fma(
-                                    -s_q1,
-                                    libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
-                                    c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
-                                ),
+                            s_q3,
+                            libm::fma(-s_q3, x132, x146),
+                            c_q3 * libm::fma(c_q3, x130, x145),
                         ),
                     ),
-                ));
-        let x186 = x69 * x185;
-        let x187 = x70 * x185;
-        let x188 = x72 * x185;
-        let x189 = x79 * x185;
-        let x190 = x82 * x185;
-        let x191 = x87 * x185;
-        let x192 = 1.0
-            / libm::fma(
-                -x69,
-                x186,
-                65697.3302265768
-                    + libm::fma(
-                        -s_q2,
-                        libm::fma(-s_q2, x56, c_q2 * x50),
-                        c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
-                    ),
-            );
-        let x193 = libm::fma(
-            -x69,
-            x187,
-            libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
+                ),
         );
-        let x194 = x192 * x193;
+        let x186 = libm::fma(
+            -x174,
+            x182,
+            libm::fma(0.475, x153, 7.11 * x154)
+                + libm::fma(-0.475, x169, libm::fma(-s_q3, x148, c_q3 * x147)),
+        );
+        let x187 = libm::fma(
+            -x170,
+            x182,
+            libm::fma(0.475, x156, x171)
+                + (libm::fma(0.475, x168, x171) - libm::fma(c_q3, x148, s_q3 * x147)),
+        );
+        let x188 = libm::fma(-x174, x183, libm::fma(-0.475, x163, x153));
+        let x189 = libm::fma(-x174, x184, x167);
+        let x190 = libm::fma(-x170, x183, x168);
+        let x191 = libm::fma(-x170, x184, x169);
+        let x192 = libm::fma(-x165, x183, x162);
+        let x193 = libm::fma(-x165, x184, x163);
+        let x194 = libm::fma(x176, x184, x164);
         let x195 = libm::fma(
-            -x69,
-            x188,
-            libm::fma(0.5692, x71, libm::fma(-s_q2, x48, x67)),
+            x180,
+            x181,
+            libm::fma(-x20, x29, x5 * x30) - libm::fma(x25, x27, x16 * x28)
+                + libm::fma(-0.475, x173, libm::fma(s_q3, x142, c_q3 * x141))
+                + (libm::fma(-x21, x185, x22 * x186) + libm::fma(x24, x189, x23 * x188)),
         );
-        let x196 = x192 * x195;
+        let x196 = libm::fma(
+            x180,
+            x182,
+            libm::fma(-x19, x29, libm::fma(-x25, x26, x15 * x28))
+                + (libm::fma(-s_q3, x141, c_q3 * x142)
+                    + libm::fma(7.11, x140, 0.475 * x172))
+                + (libm::fma(-x21, x186, x22 * x187) + libm::fma(x24, x191, x23 * x190)),
+        );
         let x197 = libm::fma(
-            -x69,
-            x189,
-            libm::fma(0.5692, x78, libm::fma(-s_q2, x75, c_q2 * x77)),
+            x180,
+            x183,
+            libm::fma(-x25, x30, x16 * x29) + x172
+                + (libm::fma(-x21, x188, x22 * x190) + libm::fma(x24, x193, x23 * x192)),
         );
-        let x198 = x192 * x197;
-        let x199 = libm::fma(-x69, x190, libm::fma(-s_q2, x80, c_q2 * x81));
-        let x200 = x192 * x199;
-        let x201 = libm::fma(x69, x191, libm::fma(c_q2, x86, s_q2 * x85));
-        let x202 = x192 * x201;
-        let x203 = 1.0 / libm::fma(-x193, x194, libm::fma(-x70, x187, x59));
-        let x204 = libm::fma(-x193, x196, libm::fma(-x70, x188, x49));
-        let x205 = x203 * x204;
-        let x206 = libm::fma(-x193, x198, libm::fma(-x70, x189, x76));
-        let x207 = x203 * x206;
-        let x208 = libm::fma(x193, x200, x70 * x190);
-        let x209 = x203 * x208;
-        let x210 = libm::fma(x193, x202, libm::fma(-x70, x191, x8));
-        let x211 = x203 * x210;
-        let x212 = 1.0
-            / libm::fma(-x204, x205, libm::fma(-x195, x196, libm::fma(-x72, x188, x35)));
-        let x213 = libm::fma(
-            -x204,
+        let x198 = libm::fma(
+            x180,
+            x184,
+            libm::fma(-x15, x29, x173)
+                + (libm::fma(-x21, x189, x22 * x191) + libm::fma(-x24, x194, x23 * x193)),
+        );
+        let x199 = s_q2 * x186;
+        let x200 = c_q2 * x186;
+        let x201 = libm::fma(-s_q2, x185, x200);
+        let x202 = libm::fma(c_q2, x187, -x199);
+        let x203 = libm::fma(s_q2, x189, c_q2 * x188);
+        let x204 = libm::fma(-s_q2, x188, c_q2 * x189);
+        let x205 = libm::fma(s_q2, x191, c_q2 * x190);
+        let x206 = libm::fma(-s_q2, x190, c_q2 * x191);
+        let x207 = libm::fma(s_q2, x205, c_q2 * x203);
+        let x208 = libm::fma(s_q2, x206, c_q2 * x204);
+        let x209 = libm::fma(-s_q2, x203, c_q2 * x205);
+        let x210 = libm::fma(-s_q2, x154, c_q2 * x177);
+        let x211 = s_q2 * x193;
+        let x212 = c_q2 * x193;
+        let x213 = libm::fma(-s_q2, x192, x212);
+        let x214 = libm::fma(c_q2, x194, x211);
+        let x215 = libm::fma(
+            s_q2,
+            libm::fma(-s_q2, x194, x212),
+            c_q2 * libm::fma(c_q2, x192, x211),
+        );
+        let x216 = libm::fma(-s_q2, x214, c_q2 * x213);
+        let x217 = libm::fma(0.5692, x215, x209);
+        let x218 = libm::fma(
+            0.5692,
             x207,
-            libm::fma(-x195, x198, libm::fma(-x72, x189, x27)),
+            libm::fma(
+                -0.5692,
+                libm::fma(0.5692, x216, libm::fma(-s_q2, x204, c_q2 * x206)),
+                libm::fma(s_q2, x202, c_q2 * x201),
+            ),
         );
-        let x214 = x212 * x213;
-        let x215 = libm::fma(x204, x209, -libm::fma(x195, x200, x72 * x190));
-        let x216 = x212 * x215;
-        let x217 = libm::fma(
-            -x204,
-            x211,
-            libm::fma(x195, x202, libm::fma(-x72, x191, x8)),
-        );
-        let x218 = x212 * x217;
-        let x219 = 1.0
-            / libm::fma(
-                -x213,
-                x214,
-                libm::fma(
-                    -x206,
-                    x207,
-                    libm::fma(-x197, x198, libm::fma(-x79, x189, x13)),
-                ),
-            );
-        let x220 = libm::fma(
-            -x213,
-            x216,
-            libm::fma(x206, x209, -libm::fma(x197, x200, x79 * x190)),
-        );
-        let x221 = x219 * x220;
-        let x222 = libm::fma(
-            -x213,
-            x218,
-            libm::fma(-x206, x211, libm::fma(x197, x202, libm::fma(-x79, x191, x8))),
-        );
-        let x223 = x219 * x222;
-        let x224 = 1.0
-            / libm::fma(
-                -x220,
-                x221,
-                libm::fma(
-                    -x215,
-                    x216,
-                    libm::fma(
-                        -x208,
-                        x209,
-                        libm::fma(-x199, x200, libm::fma(-x82, x190, 47.471)),
-                    ),
-                ),
-            );
-        let x225 = libm::fma(
-            -x220,
+        let x219 = libm::fma(s_q2, x198, c_q2 * x197);
+        let x220 = 1145.5438279999998 + x217;
+        let x221 = 1.0
+            / (65697.3302265768
+                + libm::fma(
+                    0.5692,
+                    x209,
+                    libm::fma(0.5692, x217, libm::fma(-s_q2, x201, c_q2 * x202)),
+                ));
+        let x222 = tau[1]
+            - (libm::fma(0.5692, x219, libm::fma(-s_q2, x195, c_q2 * x196))
+                - libm::fma(x5, x12, x1 * x10));
+        let x223 = x218 * x221;
+        let x224 = x220 * x221;
+        let x225 = x210 * x221;
+        let x226 = libm::fma(
+            -x218,
             x223,
             libm::fma(
-                -x215,
-                x218,
-                libm::fma(x208, x211, libm::fma(-x82, x191, x199 * x202)),
-            ),
-        );
-        let x226 = x224 * x225;
-        let x227 = 1.0
-            / libm::fma(
-                -x225,
-                x226,
+                -0.5692,
+                x208,
                 libm::fma(
-                    -x222,
-                    x223,
+                    -0.5692,
+                    libm::fma(0.5692, libm::fma(c_q2, x214, s_q2 * x213), x208),
                     libm::fma(
-                        -x217,
-                        x218,
-                        libm::fma(
-                            -x210,
-                            x211,
-                            libm::fma(-x201, x202, libm::fma(-x87, x191, 9.336)),
-                        ),
+                        s_q2,
+                        libm::fma(s_q2, x187, x200),
+                        c_q2 * libm::fma(c_q2, x185, x199),
                     ),
                 ),
-            );
-        let x228 = libm::fma(
-            -x184,
-            x186,
-            tau[1]
-                - (libm::fma(0.5692, x183, libm::fma(-s_q2, x178, c_q2 * x180))
-                    - libm::fma(1145.5438279999998, x95, libm::fma(x92, x99, x88 * x97))),
-        );
-        let x229 = libm::fma(-x194, x228, libm::fma(-x184, x187, tau[2] - x179));
-        let x230 = libm::fma(
-            -x205,
-            x229,
-            libm::fma(-x196, x228, libm::fma(-x184, x188, tau[3] - x171)),
-        );
-        let x231 = libm::fma(
-            -x214,
-            x230,
-            libm::fma(
-                -x207,
-                x229,
-                libm::fma(-x198, x228, libm::fma(-x184, x189, tau[4] - x167)),
             ),
         );
-        let x232 = libm::fma(
-            -x221,
-            x231,
-            libm::fma(
-                -x216,
-                x230,
-                libm::fma(
-                    x209,
-                    x229,
-                    libm::fma(-x200, x228, libm::fma(-x184, x190, tau[5] - x165)),
-                ),
-            ),
-        );
-        let x233 = x227
+        let x227 = libm::fma(-x218, x224, libm::fma(-0.5692, x216, x207));
+        let x228 = libm::fma(-x218, x225, libm::fma(s_q2, x177, c_q2 * x154));
+        let x229 = libm::fma(-x220, x224, x215);
+        let x230 = x220 * x225;
+        let x231 = x210 * x225;
+        let x232 = c_q1 * libm::fma(c_q1, x228, s_q1 * x227);
+        let x233 = 1.0
+            / (66279.65991417361
+                + libm::fma(
+                    -0.7026,
+                    x232,
+                    libm::fma(
+                        -0.7026,
+                        libm::fma(
+                            -0.7026,
+                            libm::fma(
+                                -c_q1,
+                                libm::fma(c_q1, x231, s_q1 * x230),
+                                s_q1 * libm::fma(-c_q1, x230, s_q1 * x229),
+                            ),
+                            x232,
+                        ),
+                        libm::fma(s_q1, -65693.9112265768 * s_q1, c_q1 * (c_q1 * x226)),
+                    ),
+                ));
+        let x234 = x233
+            * (tau[0]
+                - libm::fma(
+                    -0.7026,
+                    libm::fma(
+                        c_q1,
+                        libm::fma(
+                            x222,
+                            x225,
+                            libm::fma(-qd[1], x12, x1 * x13)
+                                + (libm::fma(x15, x30, x140)
+                                    + libm::fma(-x21, x154, x22 * x177))
+                                + libm::fma(-x6, x228, libm::fma(-x9, x231, x8 * x230)),
+                        ),
+                        s_q1
+                            * libm::fma(
+                                x222,
+                                x224,
+                                libm::fma(x2, x13, x219)
+                                    - libm::fma(x6, x227, libm::fma(x9, x230, x8 * x229)),
+                            ),
+                    ),
+                    libm::fma(
+                        -s_q1,
+                        libm::fma(
+                            65693.9112265768,
+                            x7,
+                            libm::fma(x180, x175 * x179, x178)
+                                - libm::fma(x4, x13, x1 * x11),
+                        ),
+                        c_q1
+                            * libm::fma(
+                                x222,
+                                x223,
+                                libm::fma(x5, x13, libm::fma(-x2, x11, qd[1] * x10))
+                                    + libm::fma(
+                                        -0.5692,
+                                        libm::fma(-s_q2, x197, c_q2 * x198),
+                                        libm::fma(s_q2, x196, c_q2 * x195),
+                                    ) + libm::fma(-x6, x226, libm::fma(-x8, x227, x9 * x228)),
+                            ),
+                    ),
+                ));
+        let x235 = 0.7026 * x234;
+        let x236 = libm::fma(c_q1, x234, -x6);
+        let x237 = libm::fma(s_q1, x234, x7);
+        let x238 = libm::fma(s_q1, x235, x8);
+        let x239 = x221
+            * (x222
+                - libm::fma(
+                    x218,
+                    x236,
+                    libm::fma(-x220, x238, x210 * libm::fma(-c_q1, x235, x9)),
+                ));
+        let x240 = 0.5692 * x236;
+        let x241 = libm::fma(-0.5692, x239, x238);
+        let x242 = libm::fma(-s_q2, x239, c_q2 * x236) - x21;
+        let x243 = x22 + libm::fma(c_q2, x239, s_q2 * x236);
+        let x244 = x23 + libm::fma(-c_q2, x241, s_q2 * x240);
+        let x245 = x24 - libm::fma(c_q2, x240, s_q2 * x241);
+        let x246 = x179
+            * (x180
+                - (libm::fma(x170, x243, libm::fma(-x175, x237, x174 * x242))
+                    + libm::fma(x176, x245, x165 * x244)));
+        let x247 = x246 - x237;
+        let x248 = libm::fma(0.475, x243, x244);
+        let x249 = x245 - libm::fma(7.11, x247, 0.475 * x242);
+        let x250 = libm::fma(-s_q3, x243, c_q3 * x242) - x39;
+        let x251 = x40 + libm::fma(c_q3, x243, s_q3 * x242);
+        let x252 = libm::fma(-s_q3, x249, c_q3 * x248) - x41;
+        let x253 = x42 + libm::fma(c_q3, x249, s_q3 * x248);
+        let x254 = x124
+            * (x125
+                - (libm::fma(x116, x251, libm::fma(x120, x247, x119 * x250))
+                    + libm::fma(x121, x253, x114 * x252)));
+        let x255 = x247 + x254;
+        let x256 = libm::fma(-s_q4, x251, c_q4 * x250) - x56;
+        let x257 = x57 + libm::fma(c_q4, x251, s_q4 * x250);
+        let x258 = x84
+            * (x85
+                - libm::fma(
+                    -171.195516,
+                    libm::fma(-s_q4, libm::fma(-7.11, x255, x253), c_q4 * x252) - x58,
+                    libm::fma(
+                        -97.44448770720001,
+                        x257,
+                        libm::fma(-x81, x256, x82 * x255),
+                    ),
+                ));
+        let x259 = 0.02106549261654484 * libm::fma(-47.471, x257, x78);
+        let x260 = 0.10711225364181662
             * libm::fma(
-                -x226,
-                x232,
-                libm::fma(
-                    -x223,
-                    x231,
-                    libm::fma(
-                        -x218,
-                        x230,
-                        libm::fma(
-                            -x211,
-                            x229,
-                            libm::fma(x202, x228, libm::fma(-x184, x191, tau[6] - x159)),
-                        ),
-                    ),
-                ),
+                -9.336,
+                libm::fma(qd[5], x68, libm::fma(s_q5, x255 + x258, c_q5 * x256)),
+                tau[6],
             );
-        let x234 = libm::fma(-x226, x233, x224 * x232);
-        let x235 = libm::fma(-x223, x233, libm::fma(-x221, x234, x219 * x231));
-        let x236 = libm::fma(
-            -x218,
-            x233,
-            libm::fma(-x216, x234, libm::fma(-x214, x235, x212 * x230)),
-        );
-        let x237 = libm::fma(
-            -x211,
-            x233,
-            libm::fma(
-                x209,
-                x234,
-                libm::fma(-x207, x235, libm::fma(-x205, x236, x203 * x229)),
-            ),
-        );
-        let x238 = libm::fma(
-            x202,
-            x233,
-            libm::fma(
-                -x200,
-                x234,
-                libm::fma(
-                    -x198,
-                    x235,
-                    libm::fma(-x196, x236, libm::fma(-x194, x237, x192 * x228)),
-                ),
-            ),
-        );
-        let x239 = libm::fma(
-            -x191,
-            x233,
-            libm::fma(
-                -x190,
-                x234,
-                libm::fma(
-                    -x189,
-                    x235,
-                    libm::fma(
-                        -x188,
-                        x236,
-                        libm::fma(-x187, x237, libm::fma(-x186, x238, x184 * x185)),
-                    ),
-                ),
-            ),
-        );
-        [x239, x238, x237, x236, x235, x234, x233]
+        [x234, x239, x246, x254, x258, x259, x260]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -1874,7 +1880,7 @@ impl SsrmsFma {
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `rnea`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 334 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `rnea`, forward `ldlt`: 564 mul, 437 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 334 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],

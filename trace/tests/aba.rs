@@ -16,7 +16,7 @@ use kanegen_model::random::{
 };
 use kanegen_model::Model;
 use kanegen_trace::{
-    trace, Arg, Base, Convention, Function, Input, Spec, Subject, Wrench, WrenchValue,
+    trace, Arg, Base, Convention, Function, Input, PayloadField, Spec, Subject, Wrench, WrenchValue,
 };
 
 const TOL: f64 = 1e-12;
@@ -241,4 +241,89 @@ fn aba_traces_a_different_cheaper_graph_on_a_long_chain() {
     // The leaf's D is a constant of the model: N − 1 divisions.
     assert_eq!(a.div, 23);
     assert_eq!(l.div, 24);
+}
+
+/// A runtime payload (the last body's mass properties as inputs; regrouping keeps that body):
+/// the traced ABA evaluates to the f64 ABA with the payload set, fixed and free-floating.
+#[test]
+fn traced_aba_with_a_runtime_payload() {
+    let m = random_chain(
+        &ChainSpec {
+            n: 5,
+            prismatic_fraction: 0.35,
+            ..Default::default()
+        },
+        8,
+    );
+    let n = m.dof();
+    let payload = random_inertial(&mut rng(3), 40.0, 0.8);
+    let mut p = Params::<f64>::new(&m);
+    p.joints[n - 1].set_inertial(
+        payload.mass,
+        Vec3(payload.com),
+        kanegen_dynamics::linalg::Mat3(payload.inertia),
+    );
+    let inertial = random_inertial(&mut rng(4), 60.0, 1.0);
+    for floating in [false, true] {
+        let spec = Spec {
+            base: if floating {
+                Base::FreeFloating(inertial.clone())
+            } else {
+                Base::Fixed
+            },
+            gravity: Some([0.0, 0.2, -9.81]),
+            runtime_payload: true,
+            regroup: true,
+            ..Spec::default()
+        };
+        let t = trace(
+            Subject::Model(&m),
+            Function::ForwardDynamics,
+            Methods::ABA,
+            &spec,
+        )
+        .unwrap();
+        let mut g = rng(9);
+        let mut q = random_vec(&mut g, n + 7, 2.0);
+        if floating {
+            let norm = q[3..7].iter().map(|x| x * x).sum::<f64>().sqrt();
+            for x in &mut q[3..7] {
+                *x /= norm;
+            }
+        }
+        let v = random_vec(&mut g, n + 6, 1.0);
+        let tau = random_vec(&mut g, n, 10.0);
+        let values: Vec<f64> = t
+            .inputs
+            .iter()
+            .map(|i| match i {
+                Input::Payload(PayloadField::Mass) => payload.mass,
+                Input::Payload(PayloadField::Com(k)) => payload.com[*k],
+                Input::Payload(PayloadField::Inertia(r, c)) => payload.inertia[*r][*c],
+                Input::Joint(Arg::Q, k) => q[*k],
+                Input::Joint(Arg::Qd | Arg::V, k) => v[*k],
+                Input::Joint(Arg::Tau, k) => tau[*k],
+                other => panic!("unexpected input {other}"),
+            })
+            .collect();
+        let l = Loads {
+            tau: Some(tau.clone()),
+            gravity: Some(Vec3::new(0.0, 0.2, -9.81)),
+            external: Vec::new(),
+        };
+        let want = if floating {
+            let fs = FloatingState {
+                position: Vec3::new(q[0], q[1], q[2]),
+                rotation: quat_to_matrix(&[q[3], q[4], q[5], q[6]]),
+                v_b: Vec3::new(v[0], v[1], v[2]),
+                omega_b: Vec3::new(v[3], v[4], v[5]),
+            };
+            let b = FloatingBase::<f64>::from_inertial(&inertial);
+            aba::floating(&p, &b, &fs, &q[7..], &v[6..], &l)
+        } else {
+            aba::forward_dynamics(&p, &q[..n], &v[..n], &l)
+        };
+        let e = rel_err(&t.trace.eval(&values), &want);
+        assert!(e < TOL, "floating={floating}: {e:e}");
+    }
 }

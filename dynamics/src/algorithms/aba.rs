@@ -38,6 +38,39 @@
 //! per joint (`D_i⁻¹`, a constant for a leaf), and on a free-floating base six more in the
 //! LDLᵀ of the base's `6×6` articulated inertia ([`crate::ldlt`]).
 //!
+//! # Cost against LDLᵀ on the mass matrix
+//!
+//! Emitted operations (`mul + add` after folding, common-subexpression and dead-code
+//! elimination; divisions apart) of the generated `forward_dynamics`: fixed base, no gravity,
+//! regrouped parameters (`kanegen_codegen`'s defaults). LDLᵀ on the CRBA's `M` and the RNEA's
+//! `c`; LDLᵀ as the generator pairs it, with its cheapest mass-matrix method and its cheapest
+//! bias method (on the random chains the base-frame CRBA and the paper's bias recursion, from
+//! N = 8); this algorithm. The random chains are `random_chain(N, seed 1000 + N)` of
+//! `benches/data` (general geometry: dense rotations, skew axes). `codegen/tests/aba.rs` measures
+//! them again and fails when this table is stale.
+//!
+//! | model | N | LDLᵀ, CRBA + RNEA | LDLᵀ, cheapest | ABA | div (cheapest LDLᵀ / ABA) | emitted |
+//! |---|---:|---:|---:|---:|---:|---|
+//! | SSRMS (Nguyen & Hughes 1994) | 7 | 945 | 945 | 944 | 7 / 5 | ABA |
+//! | random chain | 4 | 1896 | 1896 | 2418 | 4 / 3 | LDLᵀ |
+//! | random chain | 8 | 5316 | 4401 | 5710 | 8 / 7 | LDLᵀ |
+//! | random chain | 16 | 15548 | 11513 | 12294 | 16 / 15 | LDLᵀ |
+//! | random chain | 32 | 53164 | 37129 | 25462 | 32 / 31 | ABA |
+//! | random chain | 64 | 225676 | 162601 | 51798 | 64 / 63 | ABA |
+//!
+//! On the random chains ABA costs `823 N − 874` exactly (823 per joint, of which 324 carry
+//! `I^a` to the parent through a dense rotation), LDLᵀ grows like `N³/6` on top of the mass
+//! matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is cheaper than LDLᵀ on
+//! the CRBA and the RNEA from **N = 10** (7356 against 7426), and than the generator's cheapest
+//! LDLᵀ from **N = 19** (14763 against 15016), which is where generated code switches to it;
+//! at N = 64 it needs 3.1× fewer operations. SSRMS sits on the crossover already at N = 7
+//! (944 against 945, so its `forward_dynamics` is ABA; with `f_ext` the two tie at 1001 and
+//! LDLᵀ is kept): its axes are coordinate axes (`I^a S = 0` gives zero rows and columns) and its
+//! joint placements signed permutations and offsets along one axis, which fold. A free-floating
+//! base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: the 7-dof free-flyer of
+//! `kanegen-generated` emits ABA (2898 against 3263, its axes being coordinate axes too). The
+//! leaf's `D` is a constant of the model, hence `N − 1` divisions.
+//!
 //! ```
 //! use kanegen_dynamics::algorithms::aba;
 //! use kanegen_dynamics::{Loads, Methods, Params};
