@@ -47,13 +47,18 @@ struct Fns {
     chosen: Chosen,
 }
 
-/// The methods of an `OP_COUNTS` entry (an unused method is reported as the CRBA / RNEA).
-fn methods_of(mass: Option<&str>, bias: Option<&str>) -> Methods {
+/// The methods of an `OP_COUNTS` entry (an unused method is reported as the CRBA / RNEA;
+/// forward dynamics by `aba` is [`Methods::ABA`]).
+fn methods_of(mass: Option<&str>, bias: Option<&str>, forward: Option<&str>) -> Methods {
+    if forward == Some("aba") {
+        return Methods::ABA;
+    }
     Methods {
         mass_matrix: mass.map_or(MassMatrixMethod::Crba, |m| {
             MassMatrixMethod::from_name(m).unwrap()
         }),
         bias: bias.map_or(BiasMethod::Rnea, |b| BiasMethod::from_name(b).unwrap()),
+        ..Methods::SPATIAL
     }
 }
 
@@ -95,7 +100,7 @@ macro_rules! fns {
             chosen: |name| {
                 let c = <$t>::OP_COUNTS.iter().find(|c| c.function == name).unwrap();
                 (
-                    methods_of(c.mass_matrix_method, c.bias_method),
+                    methods_of(c.mass_matrix_method, c.bias_method, c.forward_method),
                     c.mul + c.add,
                 )
             },

@@ -122,20 +122,25 @@ pub fn lines(model: &Model, opts: &Options, choices: &[Choice], fmas: &[u64]) ->
     }
     h.extend([
         String::new(),
-        "Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):".into(),
+        "Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward \
+         dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which \
+         uses neither):"
+            .into(),
         String::new(),
-        "| function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |".into(),
-        "|---|---|---|---:|---:|---:|---:|---:|---:|".into(),
+        "| function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |"
+            .into(),
+        "|---|---|---|---|---:|---:|---:|---:|---:|---:|".into(),
     ]);
     for ch in choices {
         for (m, c) in &ch.candidates {
             let star = if *m == ch.chosen { " *" } else { "" };
             let name = |x: Option<&str>| x.map_or_else(|| "—".to_string(), |x| format!("`{x}`"));
             h.push(format!(
-                "| `{}`{star} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| `{}`{star} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 crate::api::fn_name(ch.function, model),
                 name(ch.mass_matrix_method(*m)),
                 name(ch.bias_method(*m)),
+                name(ch.forward_method(*m)),
                 c.mul,
                 c.add,
                 c.div,
