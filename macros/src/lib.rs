@@ -24,6 +24,7 @@ struct Input {
     float: kanegen_codegen::Float,
     fma: bool,
     fma_path: Option<syn::Path>,
+    target_fma: bool,
     regroup: bool,
 }
 
@@ -62,6 +63,7 @@ impl Parse for Input {
             float: kanegen_codegen::Float::F64,
             fma: false,
             fma_path: None,
+            target_fma: true,
             regroup: true,
         };
         let mut fma_path_key: Option<Ident> = None;
@@ -111,6 +113,7 @@ impl Parse for Input {
                 }
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
+                "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
                 "fma_path" => {
                     out.fma_path = Some(input.parse::<syn::Path>()?);
                     fma_path_key = Some(key);
@@ -120,7 +123,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, regroup)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup)"
                         ),
                     ))
                 }
@@ -170,6 +173,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.float = input.float;
     opts.fma = input.fma;
     opts.regroup = input.regroup;
+    opts.target_fma = input.target_fma;
     opts.fma_path = input
         .fma_path
         .as_ref()
