@@ -89,6 +89,14 @@ fn generate_items_with(
         }
         _ => model,
     };
+    if !(opts.snap.is_finite() && (0.0..0.1).contains(&opts.snap)) {
+        return Err(Error(format!(
+            "snap tolerance {} is not in [0, 0.1)",
+            opts.snap
+        )));
+    }
+    let snapped = model.snapped(opts.snap);
+    let model = &snapped.model;
     let floating = model.base_kind() == BaseKind::FreeFloating;
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
@@ -255,7 +263,7 @@ fn generate_items_with(
         .flat_map(|ch| ch.candidates.iter().map(|(m, c)| entry(ch, *m, *c, 0)));
     let n_fns = Literal::usize_unsuffixed(choices.len());
 
-    let header = header::lines(model, opts, &choices, &fmas);
+    let header = header::lines(model, opts, &choices, &fmas, &snapped.report);
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())

@@ -7,44 +7,45 @@
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
-//! Fused multiply-adds where the target has them: 4386 (`mass_matrix` 383, `nonlinear_effects` 325, `inverse_dynamics` 340, `forward_dynamics` 988, `mass_matrix_and_nonlinear_effects` 704, `forward_dynamics_with_wrenches` 989, `momentum` 223, `base_reaction` 434), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Float noise: 1 numbers snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
+//! Fused multiply-adds where the target has them: 4366 (`mass_matrix` 379, `nonlinear_effects` 323, `inverse_dynamics` 338, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 700, `forward_dynamics_with_wrenches` 987, `momentum` 221, `base_reaction` 432), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
 //! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | — | 1831 | 2489 | 0 | 0 | 7 | 4320 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | 2110 | 2558 | 0 | 0 | 7 | 4668 |
-//! | `mass_matrix` | `kane-direct` | — | — | 3460 | 2896 | 0 | 0 | 7 | 6356 |
-//! | `mass_matrix` | `crba-base` | — | — | 1309 | 1040 | 0 | 0 | 7 | 2349 |
-//! | `mass_matrix` * | `crba` | — | — | 654 | 545 | 0 | 0 | 7 | 1199 |
-//! | `nonlinear_effects` | — | `recurrent` | — | 1153 | 884 | 0 | 0 | 7 | 2037 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | 1570 | 1279 | 0 | 0 | 7 | 2849 |
-//! | `nonlinear_effects` | — | `rnea` | — | 637 | 504 | 0 | 0 | 7 | 1141 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | 534 | 430 | 0 | 0 | 7 | 964 |
-//! | `inverse_dynamics` | — | `recurrent` | — | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` | — | `rnea` | — | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | 549 | 460 | 0 | 0 | 7 | 1009 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 2307 | 1868 | 10 | 0 | 7 | 4175 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 2724 | 2263 | 10 | 0 | 7 | 4987 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 1779 | 1484 | 10 | 0 | 7 | 3263 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | 1676 | 1410 | 10 | 0 | 7 | 3086 |
-//! | `forward_dynamics` * | — | — | `aba` | 1619 | 1279 | 12 | 0 | 7 | 2898 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 1807 | 1429 | 0 | 0 | 7 | 3236 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 2224 | 1824 | 0 | 0 | 7 | 4048 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 1279 | 1045 | 0 | 0 | 7 | 2324 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 1176 | 971 | 0 | 0 | 7 | 2147 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 2451 | 2012 | 10 | 0 | 7 | 4463 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 2868 | 2407 | 10 | 0 | 7 | 5275 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 1779 | 1532 | 10 | 0 | 7 | 3311 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | 1676 | 1458 | 10 | 0 | 7 | 3134 |
-//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | 1619 | 1327 | 12 | 0 | 7 | 2946 |
-//! | `momentum` * | — | — | — | 356 | 285 | 0 | 0 | 7 | 641 |
-//! | `base_reaction` * | — | `recurrent` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `kane-direct` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `rnea` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `newton-euler` | — | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | `mass_matrix` | `recurrent` | — | — | 1828 | 2486 | 0 | 0 | 7 | 4314 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 2107 | 2555 | 0 | 0 | 7 | 4662 |
+//! | `mass_matrix` | `kane-direct` | — | — | 3457 | 2893 | 0 | 0 | 7 | 6350 |
+//! | `mass_matrix` | `crba-base` | — | — | 1306 | 1037 | 0 | 0 | 7 | 2343 |
+//! | `mass_matrix` * | `crba` | — | — | 648 | 541 | 0 | 0 | 7 | 1189 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 1150 | 881 | 0 | 0 | 7 | 2031 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 1567 | 1276 | 0 | 0 | 7 | 2843 |
+//! | `nonlinear_effects` | — | `rnea` | — | 635 | 502 | 0 | 0 | 7 | 1137 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | 532 | 428 | 0 | 0 | 7 | 960 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `rnea` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | 547 | 458 | 0 | 0 | 7 | 1005 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 2298 | 1861 | 10 | 0 | 7 | 4159 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 2715 | 2256 | 10 | 0 | 7 | 4971 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 1773 | 1480 | 10 | 0 | 7 | 3253 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | 1670 | 1406 | 10 | 0 | 7 | 3076 |
+//! | `forward_dynamics` * | — | — | `aba` | 1613 | 1277 | 12 | 0 | 7 | 2890 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 1798 | 1422 | 0 | 0 | 7 | 3220 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 2215 | 1817 | 0 | 0 | 7 | 4032 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 1273 | 1041 | 0 | 0 | 7 | 2314 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 1170 | 967 | 0 | 0 | 7 | 2137 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 2442 | 2005 | 10 | 0 | 7 | 4447 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 2859 | 2400 | 10 | 0 | 7 | 5259 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 1773 | 1528 | 10 | 0 | 7 | 3301 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | 1670 | 1454 | 10 | 0 | 7 | 3124 |
+//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | 1613 | 1325 | 12 | 0 | 7 | 2938 |
+//! | `momentum` * | — | — | — | 354 | 283 | 0 | 0 | 7 | 637 |
+//! | `base_reaction` * | — | `recurrent` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `kane-direct` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `rnea` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `newton-euler` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -110,96 +111,96 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 654u64,
-            add: 545u64,
+            mul: 648u64,
+            add: 541u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 383u64,
+            fma: 379u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 534u64,
-            add: 430u64,
+            mul: 532u64,
+            add: 428u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 325u64,
+            fma: 323u64,
         },
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 549u64,
-            add: 460u64,
+            mul: 547u64,
+            add: 458u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 340u64,
+            fma: 338u64,
         },
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
-            mul: 1619u64,
-            add: 1279u64,
+            mul: 1613u64,
+            add: 1277u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 988u64,
+            fma: 986u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 1176u64,
-            add: 971u64,
+            mul: 1170u64,
+            add: 967u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 704u64,
+            fma: 700u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
-            mul: 1619u64,
-            add: 1327u64,
+            mul: 1613u64,
+            add: 1325u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 989u64,
+            fma: 987u64,
         },
         OpCount {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
             forward_method: None,
-            mul: 356u64,
-            add: 285u64,
+            mul: 354u64,
+            add: 283u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 223u64,
+            fma: 221u64,
         },
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 694u64,
-            add: 568u64,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 434u64,
+            fma: 432u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -209,8 +210,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
-            mul: 1831u64,
-            add: 2489u64,
+            mul: 1828u64,
+            add: 2486u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -221,8 +222,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
             forward_method: None,
-            mul: 2110u64,
-            add: 2558u64,
+            mul: 2107u64,
+            add: 2555u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -233,8 +234,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
             forward_method: None,
-            mul: 3460u64,
-            add: 2896u64,
+            mul: 3457u64,
+            add: 2893u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -245,8 +246,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
             forward_method: None,
-            mul: 1309u64,
-            add: 1040u64,
+            mul: 1306u64,
+            add: 1037u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -257,8 +258,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 654u64,
-            add: 545u64,
+            mul: 648u64,
+            add: 541u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -269,8 +270,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 1153u64,
-            add: 884u64,
+            mul: 1150u64,
+            add: 881u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -281,8 +282,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 1570u64,
-            add: 1279u64,
+            mul: 1567u64,
+            add: 1276u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -293,8 +294,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 637u64,
-            add: 504u64,
+            mul: 635u64,
+            add: 502u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -305,8 +306,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 534u64,
-            add: 430u64,
+            mul: 532u64,
+            add: 428u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -317,8 +318,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 676u64,
-            add: 550u64,
+            mul: 674u64,
+            add: 548u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -329,8 +330,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 676u64,
-            add: 550u64,
+            mul: 674u64,
+            add: 548u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -341,8 +342,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 676u64,
-            add: 550u64,
+            mul: 674u64,
+            add: 548u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -353,8 +354,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 549u64,
-            add: 460u64,
+            mul: 547u64,
+            add: 458u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -365,8 +366,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 2307u64,
-            add: 1868u64,
+            mul: 2298u64,
+            add: 1861u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -377,8 +378,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 2724u64,
-            add: 2263u64,
+            mul: 2715u64,
+            add: 2256u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -389,8 +390,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 1779u64,
-            add: 1484u64,
+            mul: 1773u64,
+            add: 1480u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -401,8 +402,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 1676u64,
-            add: 1410u64,
+            mul: 1670u64,
+            add: 1406u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -413,8 +414,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
-            mul: 1619u64,
-            add: 1279u64,
+            mul: 1613u64,
+            add: 1277u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -425,8 +426,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 1807u64,
-            add: 1429u64,
+            mul: 1798u64,
+            add: 1422u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -437,8 +438,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 2224u64,
-            add: 1824u64,
+            mul: 2215u64,
+            add: 1817u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -449,8 +450,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 1279u64,
-            add: 1045u64,
+            mul: 1273u64,
+            add: 1041u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -461,8 +462,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 1176u64,
-            add: 971u64,
+            mul: 1170u64,
+            add: 967u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -473,8 +474,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 2451u64,
-            add: 2012u64,
+            mul: 2442u64,
+            add: 2005u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -485,8 +486,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 2868u64,
-            add: 2407u64,
+            mul: 2859u64,
+            add: 2400u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -497,8 +498,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 1779u64,
-            add: 1532u64,
+            mul: 1773u64,
+            add: 1528u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -509,8 +510,8 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 1676u64,
-            add: 1458u64,
+            mul: 1670u64,
+            add: 1454u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -521,8 +522,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
-            mul: 1619u64,
-            add: 1327u64,
+            mul: 1613u64,
+            add: 1325u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -533,8 +534,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: None,
-            mul: 356u64,
-            add: 285u64,
+            mul: 354u64,
+            add: 283u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -545,8 +546,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 694u64,
-            add: 568u64,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -557,8 +558,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 694u64,
-            add: 568u64,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -569,8 +570,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 694u64,
-            add: 568u64,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -581,8 +582,8 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 694u64,
-            add: 568u64,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -591,7 +592,7 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 654 mul, 545 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 383 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 648 mul, 541 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 379 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
@@ -599,14 +600,12 @@ impl FreeFloating7 {
         let x2 = -0.00000000020510342851533115 * c_q8;
         let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x6 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x7 = Self::mul_add(
+        let x5 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x8 = Self::mul_add(
+        let x6 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
@@ -614,686 +613,723 @@ impl FreeFloating7 {
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let (s_q11, c_q11) = libm::sincos(q[11]);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
+        let x10 = -0.00000000020510342851533115 * s_q12;
+        let x11 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(-0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x16, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x16, -0.0145 * x15);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(-1.2025609200000003, c_q13, x24);
-        let x26 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(-1.2025609200000003, s_q13, -x23)
+        let x13 = -0.00000000020510342851533115 * c_q13;
+        let x14 = -0.00000000020510342851533115 * s_q13;
+        let x15 = 4.806620000000001 * x14;
+        let x16 = 4.806620000000001 * c_q13;
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = Self::mul_add(-0.000781, x14, -0.0145);
+        let x19 = -0.9614610000000001
+            + Self::mul_add(1.2025609200000003, x14, 0.000781 * x13);
+        let x20 = 1.4135609200000003
+            + Self::mul_add(0.9614610000000001, x14, -0.0145 * x13);
+        let x21 = 0.000781 * c_q13;
+        let x22 = 0.000781 * s_q13;
+        let x23 = Self::mul_add(-1.2025609200000003, c_q13, x22);
+        let x24 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
+        let x25 = x22 + 0.000000000002973999713472302;
+        let x26 = Self::mul_add(-1.2025609200000003, s_q13, -x21)
             + 0.00000000019719894748377882;
-        let x29 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
+        let x27 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
             + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = Self::mul_add(
+        let x28 = -0.16 * x17;
+        let x29 = 0.55 * x16;
+        let x30 = 0.16 * x17;
+        let x31 = x16 * -0.55;
+        let x32 = Self::mul_add(
             0.16,
-            x17,
+            x15,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x22,
-                Self::mul_add(-c_q13, x20, s_q13 * x21),
+                x20,
+                Self::mul_add(-c_q13, x18, s_q13 * x19),
             ),
         );
+        let x33 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x24,
+                Self::mul_add(-c_q13, x21, s_q13 * x23),
+            ),
+        );
+        let x34 = x20 + Self::mul_add(-x14, x19, x13 * x18) - (x28 - x29) - (x31 - x30);
         let x35 = Self::mul_add(
             -0.16,
-            x18,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x26,
-                Self::mul_add(-c_q13, x23, s_q13 * x25),
-            ),
+            x16,
+            Self::mul_add(x17, -0.55, Self::mul_add(c_q13, x26, s_q13 * x25)),
         );
-        let x36 = x22 + Self::mul_add(-x16, x21, x15 * x20) - (x30 - x31) - (x33 - x32);
-        let x37 = Self::mul_add(
-            -0.16,
-            x18,
-            Self::mul_add(x19, -0.55, Self::mul_add(c_q13, x28, s_q13 * x27)),
-        );
-        let x38 = 3.6140000000000003 - x17;
-        let x39 = 17.135250000000003 + x18;
+        let x36 = 3.6140000000000003 - x15;
+        let x37 = 17.135250000000003 + x16;
+        let x38 = -1.9877000000000002
+            + Self::mul_add(0.55, x15, Self::mul_add(c_q13, x19, s_q13 * x18));
+        let x39 = -0.809539999555672 + x32;
         let x40 = -1.9877000000000002
-            + Self::mul_add(0.55, x17, Self::mul_add(c_q13, x21, s_q13 * x20));
-        let x41 = -0.809539999555672 + x34;
-        let x42 = -1.9877000000000002
-            + Self::mul_add(x17, 0.55, x26 + Self::mul_add(-x16, x25, x15 * x23));
-        let x43 = -5.252920330000002
-            + (Self::mul_add(c_q13, x25, s_q13 * x23) + x32 - x30);
-        let x44 = -2.741639999592316 + Self::mul_add(-0.55, x19, x35);
-        let x45 = -0.809539999555672
-            + Self::mul_add(0.16, x17, x29 + Self::mul_add(-x16, x28, x15 * x27));
-        let x46 = -2.7416399995923166 + x37;
-        let x47 = 9.740442170000001
-            + (x31
+            + Self::mul_add(x15, 0.55, x24 + Self::mul_add(-x14, x23, x13 * x21));
+        let x41 = -5.252920330000002
+            + (Self::mul_add(c_q13, x23, s_q13 * x21) + x30 - x28);
+        let x42 = -2.741639999592316 + Self::mul_add(-0.55, x17, x33);
+        let x43 = -0.809539999555672
+            + Self::mul_add(0.16, x15, x27 + Self::mul_add(-x14, x26, x13 * x25));
+        let x44 = -2.7416399995923166 + x35;
+        let x45 = 9.740442170000001
+            + (x29
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) - x33));
-        let x48 = c_q12 * x38;
-        let x49 = s_q12 * x39;
-        let x50 = x48 - x49;
-        let x51 = x19 + Self::mul_add(x13, x39, x12 * x38);
-        let x52 = Self::mul_add(c_q12, x39, s_q12 * x38);
-        let x53 = Self::mul_add(-0.00000000020510342851533115, x19, -x52);
-        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x36);
-        let x55 = Self::mul_add(-s_q12, x43, c_q12 * x40);
-        let x56 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x57 = x45 + Self::mul_add(x13, x42, x12 * x36);
-        let x58 = x46 + Self::mul_add(x13, x43, x12 * x40);
-        let x59 = x47 + Self::mul_add(x13, x44, x12 * x41);
+                    x27,
+                    Self::mul_add(-c_q13, x25, s_q13 * x26),
+                ) - x31));
+        let x46 = c_q12 * x36;
+        let x47 = s_q12 * x37;
+        let x48 = x46 - x47;
+        let x49 = x17 + Self::mul_add(x11, x37, x10 * x36);
+        let x50 = Self::mul_add(c_q12, x37, s_q12 * x36);
+        let x51 = Self::mul_add(-0.00000000020510342851533115, x17, -x50);
+        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x34);
+        let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
+        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x39);
+        let x55 = x43 + Self::mul_add(x11, x40, x10 * x34);
+        let x56 = x44 + Self::mul_add(x11, x41, x10 * x38);
+        let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
+        let x58 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x43,
+            -Self::mul_add(c_q12, x40, s_q12 * x34),
+        );
+        let x59 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x44,
+            -Self::mul_add(c_q12, x41, s_q12 * x38),
+        );
         let x60 = Self::mul_add(
             -0.00000000020510342851533115,
             x45,
-            -Self::mul_add(c_q12, x42, s_q12 * x36),
+            -Self::mul_add(c_q12, x42, s_q12 * x39),
         );
-        let x61 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x46,
-            -Self::mul_add(c_q12, x43, s_q12 * x40),
-        );
-        let x62 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x47,
-            -Self::mul_add(c_q12, x44, s_q12 * x41),
-        );
-        let x63 = x56 + Self::mul_add(x13, x55, x12 * x54);
-        let x64 = Self::mul_add(-s_q12, x58, c_q12 * x57);
-        let x65 = x53 * 0.36;
-        let x66 = -0.36 * x53;
-        let x67 = Self::mul_add(
-            x50,
+        let x61 = x54 + Self::mul_add(x11, x53, x10 * x52);
+        let x62 = Self::mul_add(-s_q12, x56, c_q12 * x55);
+        let x63 = x51 * 0.36;
+        let x64 = -0.36 * x51;
+        let x65 = Self::mul_add(
+            x48,
             0.36,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x56,
-                -Self::mul_add(c_q12, x55, s_q12 * x54),
+                x54,
+                -Self::mul_add(c_q12, x53, s_q12 * x52),
             ),
         );
-        let x68 = Self::mul_add(
+        let x66 = Self::mul_add(
             0.36,
-            x51,
+            x49,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x59,
-                -Self::mul_add(c_q12, x58, s_q12 * x57),
+                x57,
+                -Self::mul_add(c_q12, x56, s_q12 * x55),
             ),
         );
-        let x69 = x66 + (Self::mul_add(-s_q12, x55, c_q12 * x54) - x65);
-        let x70 = 7.078399999258757 + x51;
-        let x71 = 0.01675 + x67;
-        let x72 = -9.142025249762803
-            + (x59 + Self::mul_add(x13, x58, x12 * x57) + x66 - x65);
-        let x73 = 2.5482240016099564 + x68;
-        let x74 = 0.01675
-            + Self::mul_add(0.36, x50, Self::mul_add(-s_q12, x61, c_q12 * x60));
-        let x75 = 2.5482240016099564
-            + Self::mul_add(x51, 0.36, x62 + Self::mul_add(x13, x61, x12 * x60));
-        let x76 = 9.223235249762805
+        let x67 = x64 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x63);
+        let x68 = 7.078399999258757 + x49;
+        let x69 = 0.01675 + x65;
+        let x70 = -9.142025249762803
+            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x64 - x63);
+        let x71 = 2.5482240016099564 + x66;
+        let x72 = 0.01675
+            + Self::mul_add(0.36, x48, Self::mul_add(-s_q12, x59, c_q12 * x58));
+        let x73 = 2.5482240016099564
+            + Self::mul_add(x49, 0.36, x60 + Self::mul_add(x11, x59, x10 * x58));
+        let x74 = 9.223235249762805
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x62,
-                -Self::mul_add(c_q12, x61, s_q12 * x60),
+                x60,
+                -Self::mul_add(c_q12, x59, s_q12 * x58),
             );
-        let x77 = Self::mul_add(-s_q11, x70, c_q11 * x50);
-        let x78 = Self::mul_add(c_q11, x70, s_q11 * x50);
-        let x79 = Self::mul_add(-s_q11, x64, c_q11 * x69);
-        let x80 = Self::mul_add(-s_q11, x72, c_q11 * x63);
-        let x81 = Self::mul_add(c_q11, x64, s_q11 * x69);
-        let x82 = Self::mul_add(c_q11, x72, s_q11 * x63);
-        let x83 = 0.275 * x53;
-        let x84 = -0.63 * x78;
-        let x85 = -0.275 * x53;
-        let x86 = x78 * 0.63;
-        let x87 = Self::mul_add(0.63, x77, Self::mul_add(c_q11, x80, s_q11 * x79));
-        let x88 = Self::mul_add(0.275, x77, Self::mul_add(-s_q11, x73, c_q11 * x71));
-        let x89 = Self::mul_add(0.275, x78, Self::mul_add(c_q11, x73, s_q11 * x71));
-        let x90 = x76 - x86;
-        let x91 = Self::mul_add(-s_q11, x80, c_q11 * x79) - (x83 - x84) - (x86 - x85);
-        let x92 = Self::mul_add(x77, 0.63, Self::mul_add(-s_q11, x82, c_q11 * x81));
-        let x93 = Self::mul_add(
+        let x75 = Self::mul_add(-s_q11, x68, c_q11 * x48);
+        let x76 = Self::mul_add(c_q11, x68, s_q11 * x48);
+        let x77 = Self::mul_add(-s_q11, x62, c_q11 * x67);
+        let x78 = Self::mul_add(-s_q11, x70, c_q11 * x61);
+        let x79 = Self::mul_add(c_q11, x62, s_q11 * x67);
+        let x80 = Self::mul_add(c_q11, x70, s_q11 * x61);
+        let x81 = 0.275 * x51;
+        let x82 = -0.63 * x76;
+        let x83 = -0.275 * x51;
+        let x84 = x76 * 0.63;
+        let x85 = Self::mul_add(0.63, x75, Self::mul_add(c_q11, x78, s_q11 * x77));
+        let x86 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x71, c_q11 * x69));
+        let x87 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x71, s_q11 * x69));
+        let x88 = x74 - x84;
+        let x89 = Self::mul_add(-s_q11, x78, c_q11 * x77) - (x81 - x82) - (x84 - x83);
+        let x90 = Self::mul_add(x75, 0.63, Self::mul_add(-s_q11, x80, c_q11 * x79));
+        let x91 = Self::mul_add(
             0.275,
-            x78,
-            Self::mul_add(x53, 0.63, Self::mul_add(c_q11, x75, s_q11 * x74)),
+            x76,
+            Self::mul_add(x51, 0.63, Self::mul_add(c_q11, x73, s_q11 * x72)),
         );
-        let x94 = -45.1584 + x78;
-        let x95 = -0.6328 + x88;
-        let x96 = -24.4950615 + (Self::mul_add(c_q11, x82, s_q11 * x81) + x85 - x83);
-        let x97 = -24.35164200091464 + Self::mul_add(0.63, x53, x89);
-        let x98 = -0.6328
-            + Self::mul_add(0.275, x77, Self::mul_add(-s_q11, x75, c_q11 * x74));
-        let x99 = -24.351642000914637 + x93;
-        let x100 = 28.2393615 + (x84 + x90);
-        let x101 = c_q10 * x77;
-        let x102 = Self::mul_add(-s_q10, x94, x101);
-        let x103 = s_q10 * x77;
-        let x104 = Self::mul_add(c_q10, x94, x103);
-        let x105 = Self::mul_add(-s_q10, x92, c_q10 * x91);
-        let x106 = Self::mul_add(-s_q10, x96, c_q10 * x87);
-        let x107 = Self::mul_add(-s_q10, x97, c_q10 * x95);
-        let x108 = Self::mul_add(c_q10, x92, s_q10 * x91);
-        let x109 = Self::mul_add(c_q10, x96, s_q10 * x87);
-        let x110 = Self::mul_add(c_q10, x97, s_q10 * x95);
-        let x111 = -0.87 * x104;
-        let x112 = x104 * 0.87;
-        let x113 = Self::mul_add(0.87, x102, Self::mul_add(c_q10, x106, s_q10 * x105));
-        let x114 = x100 - x112;
-        let x115 = Self::mul_add(-s_q10, x106, c_q10 * x105) + x111 - x112;
-        let x116 = Self::mul_add(x102, 0.87, Self::mul_add(-s_q10, x109, c_q10 * x108));
-        let x117 = -81.53205 + x104;
-        let x118 = -0.00214 + x107;
-        let x119 = -63.36336825000001 + Self::mul_add(c_q10, x109, s_q10 * x108);
-        let x120 = -36.18604050126307 + Self::mul_add(0.87, x53, x110);
-        let x121 = -0.00214 + Self::mul_add(-s_q10, x99, c_q10 * x98);
-        let x122 = -36.18604050126307
-            + Self::mul_add(x53, 0.87, Self::mul_add(c_q10, x99, s_q10 * x98));
-        let x123 = 69.99836825 + (x111 + x114);
-        let x124 = Self::mul_add(
-            0.00000000020510342851533115,
-            x53,
-            Self::mul_add(x6, x117, x5 * x102),
-        );
-        let x125 = x53 + Self::mul_add(x8, x117, x7 * x102);
-        let x126 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x53,
-            Self::mul_add(-s_q9, x117, c_q9 * x102),
-        );
-        let x127 = Self::mul_add(
-            0.00000000020510342851533115,
-            x121,
-            Self::mul_add(x6, x116, x5 * x115),
-        );
-        let x128 = Self::mul_add(
-            0.00000000020510342851533115,
-            x122,
-            Self::mul_add(x6, x119, x5 * x113),
-        );
+        let x92 = -45.1584 + x76;
+        let x93 = -0.6328 + x86;
+        let x94 = -24.4950615 + (Self::mul_add(c_q11, x80, s_q11 * x79) + x83 - x81);
+        let x95 = -24.35164200091464 + Self::mul_add(0.63, x51, x87);
+        let x96 = -0.6328
+            + Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x73, c_q11 * x72));
+        let x97 = -24.351642000914637 + x91;
+        let x98 = 28.2393615 + (x82 + x88);
+        let x99 = c_q10 * x75;
+        let x100 = Self::mul_add(-s_q10, x92, x99);
+        let x101 = s_q10 * x75;
+        let x102 = Self::mul_add(c_q10, x92, x101);
+        let x103 = Self::mul_add(-s_q10, x90, c_q10 * x89);
+        let x104 = Self::mul_add(-s_q10, x94, c_q10 * x85);
+        let x105 = Self::mul_add(-s_q10, x95, c_q10 * x93);
+        let x106 = Self::mul_add(c_q10, x90, s_q10 * x89);
+        let x107 = Self::mul_add(c_q10, x94, s_q10 * x85);
+        let x108 = Self::mul_add(c_q10, x95, s_q10 * x93);
+        let x109 = -0.87 * x102;
+        let x110 = x102 * 0.87;
+        let x111 = Self::mul_add(0.87, x100, Self::mul_add(c_q10, x104, s_q10 * x103));
+        let x112 = x98 - x110;
+        let x113 = Self::mul_add(-s_q10, x104, c_q10 * x103) + x109 - x110;
+        let x114 = Self::mul_add(x100, 0.87, Self::mul_add(-s_q10, x107, c_q10 * x106));
+        let x115 = -81.53205 + x102;
+        let x116 = -0.00214 + x105;
+        let x117 = -63.36336825000001 + Self::mul_add(c_q10, x107, s_q10 * x106);
+        let x118 = -36.18604050126307 + Self::mul_add(0.87, x51, x108);
+        let x119 = -0.00214 + Self::mul_add(-s_q10, x97, c_q10 * x96);
+        let x120 = -36.18604050126307
+            + Self::mul_add(x51, 0.87, Self::mul_add(c_q10, x97, s_q10 * x96));
+        let x121 = 69.99836825 + (x109 + x112);
+        let x122 = s_q9 * x100;
+        let x123 = Self::mul_add(c_q9, x115, x122);
+        let x124 = Self::mul_add(0.00000000020510342851533115, x51, x123);
+        let x125 = x51 + Self::mul_add(x6, x115, x5 * x100);
+        let x126 = c_q9 * x100;
+        let x127 = Self::mul_add(-s_q9, x115, x126);
+        let x128 = Self::mul_add(-0.00000000020510342851533115, x51, x127);
         let x129 = Self::mul_add(
             0.00000000020510342851533115,
-            x123,
-            Self::mul_add(x6, x120, x5 * x118),
+            x119,
+            Self::mul_add(c_q9, x114, s_q9 * x113),
         );
-        let x130 = x121 + Self::mul_add(x8, x116, x7 * x115);
-        let x131 = x122 + Self::mul_add(x8, x119, x7 * x113);
-        let x132 = x123 + Self::mul_add(x8, x120, x7 * x118);
-        let x133 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x130 = Self::mul_add(
+            0.00000000020510342851533115,
+            x120,
+            Self::mul_add(c_q9, x117, s_q9 * x111),
+        );
+        let x131 = Self::mul_add(
+            0.00000000020510342851533115,
             x121,
-            Self::mul_add(-s_q9, x116, c_q9 * x115),
+            Self::mul_add(c_q9, x118, s_q9 * x116),
         );
-        let x134 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x122,
-            Self::mul_add(-s_q9, x119, c_q9 * x113),
-        );
+        let x132 = x119 + Self::mul_add(x6, x114, x5 * x113);
+        let x133 = x120 + Self::mul_add(x6, x117, x5 * x111);
+        let x134 = x121 + Self::mul_add(x6, x118, x5 * x116);
         let x135 = Self::mul_add(
             -0.00000000020510342851533115,
-            x123,
-            Self::mul_add(-s_q9, x120, c_q9 * x118),
+            x119,
+            Self::mul_add(-s_q9, x114, c_q9 * x113),
         );
-        let x136 = x126 * -0.4;
-        let x137 = 0.275 * x125;
-        let x138 = 0.4 * x126;
-        let x139 = -0.275 * x125;
-        let x140 = Self::mul_add(
+        let x136 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x120,
+            Self::mul_add(-s_q9, x117, c_q9 * x111),
+        );
+        let x137 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x121,
+            Self::mul_add(-s_q9, x118, c_q9 * x116),
+        );
+        let x138 = x128 * -0.4;
+        let x139 = 0.275 * x125;
+        let x140 = 0.4 * x128;
+        let x141 = -0.275 * x125;
+        let x142 = Self::mul_add(
             x124,
             -0.4,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x129,
-                Self::mul_add(-s_q9, x128, c_q9 * x127),
+                x131,
+                Self::mul_add(-s_q9, x130, c_q9 * x129),
             ),
         );
-        let x141 = Self::mul_add(
+        let x143 = Self::mul_add(
             -0.4,
             x125,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x132,
-                Self::mul_add(-s_q9, x131, c_q9 * x130),
+                x134,
+                Self::mul_add(-s_q9, x133, c_q9 * x132),
             ),
         );
-        let x142 = Self::mul_add(
+        let x144 = Self::mul_add(
             0.00000000020510342851533115,
-            x129,
-            Self::mul_add(x6, x128, x5 * x127),
-        ) - (x136 - x137) - (x139 - x138);
-        let x143 = Self::mul_add(
+            x131,
+            Self::mul_add(c_q9, x130, s_q9 * x129),
+        ) - (x138 - x139) - (x141 - x140);
+        let x145 = Self::mul_add(
             -0.275,
             x124,
             Self::mul_add(
                 0.00000000020510342851533115,
-                x132,
-                Self::mul_add(x6, x131, x5 * x130),
+                x134,
+                Self::mul_add(c_q9, x133, s_q9 * x132),
             ),
         );
-        let x144 = Self::mul_add(
+        let x146 = Self::mul_add(
             -0.4,
             x124,
             Self::mul_add(
                 0.00000000020510342851533115,
-                x135,
-                Self::mul_add(x6, x134, x5 * x133),
+                x137,
+                Self::mul_add(c_q9, x136, s_q9 * x135),
             ),
         );
-        let x145 = Self::mul_add(
+        let x147 = Self::mul_add(
             x125,
             -0.4,
-            Self::mul_add(-0.275, x126, x135 + Self::mul_add(x8, x134, x7 * x133)),
+            Self::mul_add(-0.275, x128, x137 + Self::mul_add(x6, x136, x5 * x135)),
         );
-        let x146 = -0.000000008530897668050218 + x124;
-        let x147 = -12.701650001451807 + x125;
-        let x148 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x124, x129 + Self::mul_add(x8, x128, x7 * x127));
-        let x149 = -0.0021399965876409276 + x140;
-        let x150 = -0.0000000234896432582596 + x143;
-        let x151 = -111.7548902508081
-            + (x132 + Self::mul_add(x8, x131, x7 * x130) + x138 - x136);
-        let x152 = 5.080660024070365 + Self::mul_add(-0.275, x126, x141);
-        let x153 = -0.0021399965876409276 + x144;
-        let x154 = 5.080660024070366 + x145;
-        let x155 = 113.3918902508081
-            + (x137
+        let x148 = -0.000000008530897668050218 + x124;
+        let x149 = -12.701650001451807 + x125;
+        let x150 = -0.0000000234896432582596
+            + Self::mul_add(-0.275, x124, x131 + Self::mul_add(x6, x130, x5 * x129));
+        let x151 = -0.002139996587640933 + x142;
+        let x152 = -0.0000000234896432582596 + x145;
+        let x153 = -111.7548902508081
+            + (x134 + Self::mul_add(x6, x133, x5 * x132) + x140 - x138);
+        let x154 = 5.080660024070365 + Self::mul_add(-0.275, x128, x143);
+        let x155 = -0.002139996587640933 + x146;
+        let x156 = 5.080660024070366 + x147;
+        let x157 = 113.3918902508081
+            + (x139
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x135,
-                    Self::mul_add(-s_q9, x134, c_q9 * x133),
-                ) - x139));
-        let x156 = x126 + Self::mul_add(-x3, x147, x2 * x146);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x146);
-        let x158 = c_q8 * x146;
-        let x159 = s_q8 * x147;
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x126, x159 - x158);
-        let x161 = x153 + Self::mul_add(-x3, x150, x2 * x142);
-        let x162 = x154 + Self::mul_add(-x3, x151, x2 * x148);
-        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x149);
-        let x164 = Self::mul_add(c_q8, x150, s_q8 * x142);
-        let x165 = Self::mul_add(c_q8, x151, s_q8 * x148);
-        let x166 = Self::mul_add(c_q8, x152, s_q8 * x149);
-        let x167 = Self::mul_add(
+                    x137,
+                    Self::mul_add(-s_q9, x136, c_q9 * x135),
+                ) - x141));
+        let x158 = x128 + Self::mul_add(-x3, x149, x2 * x148);
+        let x159 = Self::mul_add(c_q8, x149, s_q8 * x148);
+        let x160 = c_q8 * x148;
+        let x161 = s_q8 * x149;
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x128, x161 - x160);
+        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x144);
+        let x164 = x156 + Self::mul_add(-x3, x153, x2 * x150);
+        let x165 = x157 + Self::mul_add(-x3, x154, x2 * x151);
+        let x166 = Self::mul_add(c_q8, x152, s_q8 * x144);
+        let x167 = Self::mul_add(c_q8, x153, s_q8 * x150);
+        let x168 = Self::mul_add(c_q8, x154, s_q8 * x151);
+        let x169 = Self::mul_add(
             -0.00000000020510342851533115,
-            x155,
-            Self::mul_add(-c_q8, x149, s_q8 * x152),
+            x157,
+            Self::mul_add(-c_q8, x151, s_q8 * x154),
         );
-        let x168 = Self::mul_add(
+        let x170 = Self::mul_add(
             -c_q8,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x153,
-                Self::mul_add(-c_q8, x142, s_q8 * x150),
+                x155,
+                Self::mul_add(-c_q8, x144, s_q8 * x152),
             ),
             s_q8
                 * Self::mul_add(
                     -0.00000000020510342851533115,
-                    x154,
-                    Self::mul_add(-c_q8, x148, s_q8 * x151),
+                    x156,
+                    Self::mul_add(-c_q8, x150, s_q8 * x153),
                 ),
         );
-        let x169 = x160 * -0.35;
-        let x170 = 0.35 * x160;
-        let x171 = Self::mul_add(
-            x156,
+        let x171 = x162 * -0.35;
+        let x172 = 0.35 * x162;
+        let x173 = Self::mul_add(
+            x158,
             -0.35,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x163,
-                Self::mul_add(-c_q8, x161, s_q8 * x162),
+                x165,
+                Self::mul_add(-c_q8, x163, s_q8 * x164),
             ),
         );
-        let x172 = Self::mul_add(
+        let x174 = Self::mul_add(
             -0.35,
-            x157,
+            x159,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x166,
-                Self::mul_add(-c_q8, x164, s_q8 * x165),
+                x168,
+                Self::mul_add(-c_q8, x166, s_q8 * x167),
             ),
         );
-        let x173 = x170 + (x163 + Self::mul_add(-x3, x162, x2 * x161) - x169);
-        let x174 = 48.0240000085309 + x156;
-        let x175 = -0.07309 + Self::mul_add(c_q8, x162, s_q8 * x161);
-        let x176 = -16.80768997608804 + x171;
-        let x177 = -0.07309 + (x166 + Self::mul_add(-x3, x165, x2 * x164));
-        let x178 = 130.43769025763282
-            + (Self::mul_add(c_q8, x165, s_q8 * x164) + x170 - x169);
-        let x179 = 0.1132 + x172;
-        let x180 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x167, x168);
-        let x181 = Self::mul_add(-s_q7, x157, c_q7 * x174);
-        let x182 = Self::mul_add(c_q7, x157, s_q7 * x174);
-        let x183 = Self::mul_add(-s_q7, x177, c_q7 * x173);
-        let x184 = Self::mul_add(-s_q7, x178, c_q7 * x175);
-        let x185 = -x182;
-        let x186 = x160 * -0.75;
-        let x187 = 0.75 * x160;
-        let x188 = x181 * -0.65;
-        let x189 = 0.65 * x181;
-        let x190 = Self::mul_add(x181, -0.75, Self::mul_add(-s_q7, x179, c_q7 * x176));
-        let x191 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x179, s_q7 * x176));
-        let x192 = x180 + x189;
-        let x193 = Self::mul_add(-0.65, x182, Self::mul_add(c_q7, x184, s_q7 * x183));
-        let x194 = 110.5455 + x181;
-        let x195 = 180.9502499901501 + x160;
-        let x196 = 1394.5960312283303
-            + (x187 + (Self::mul_add(-s_q7, x184, c_q7 * x183) - x186));
-        let x197 = -117.61766249359756 + Self::mul_add(x160, -0.65, x190);
-        let x198 = 1466.4506062283303
+        let x175 = x172 + (x165 + Self::mul_add(-x3, x164, x2 * x163) - x171);
+        let x176 = 48.0240000085309 + x158;
+        let x177 = -0.07309 + Self::mul_add(c_q8, x164, s_q8 * x163);
+        let x178 = -16.80768997608804 + x173;
+        let x179 = -0.07309 + (x168 + Self::mul_add(-x3, x167, x2 * x166));
+        let x180 = 130.43769025763282
+            + (Self::mul_add(c_q8, x167, s_q8 * x166) + x172 - x171);
+        let x181 = 0.1132 + x174;
+        let x182 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x169, x170);
+        let x183 = Self::mul_add(-s_q7, x159, c_q7 * x176);
+        let x184 = Self::mul_add(c_q7, x159, s_q7 * x176);
+        let x185 = Self::mul_add(-s_q7, x179, c_q7 * x175);
+        let x186 = Self::mul_add(-s_q7, x180, c_q7 * x177);
+        let x187 = -x184;
+        let x188 = x162 * -0.75;
+        let x189 = 0.75 * x162;
+        let x190 = x183 * -0.65;
+        let x191 = 0.65 * x183;
+        let x192 = Self::mul_add(x183, -0.75, Self::mul_add(-s_q7, x181, c_q7 * x178));
+        let x193 = Self::mul_add(-0.75, x184, Self::mul_add(c_q7, x181, s_q7 * x178));
+        let x194 = x182 + x191;
+        let x195 = Self::mul_add(-0.65, x184, Self::mul_add(c_q7, x186, s_q7 * x185));
+        let x196 = 110.5455 + x183;
+        let x197 = 180.9502499901501 + x162;
+        let x198 = 1394.5960312283303
+            + (x189 + (Self::mul_add(-s_q7, x186, c_q7 * x185) - x188));
+        let x199 = -117.61766249359756 + Self::mul_add(x162, -0.65, x192);
+        let x200 = 1466.4506062283303
             + (Self::mul_add(
                 c_q7,
-                Self::mul_add(c_q7, x178, s_q7 * x175),
-                s_q7 * Self::mul_add(c_q7, x177, s_q7 * x173),
-            ) - (x188 - x187) - (x186 - x189));
-        let x199 = 1271.854575 + (x192 - x188);
-        let x200 = -x195;
-        let x201 = -x194;
-        let x202 = Self::mul_add(x3, x146, x2 * x147);
-        let x203 = x158 - x159;
-        let x204 = Self::mul_add(-0.35, x203, x163);
-        let x205 = Self::mul_add(-0.35, x202, x166);
-        let x206 = Self::mul_add(s_q7, x203, c_q7 * x202);
-        let x207 = -x206;
-        let x208 = Self::mul_add(-s_q7, x202, c_q7 * x203);
-        let x209 = Self::mul_add(-0.75, x208, Self::mul_add(-s_q7, x205, c_q7 * x204));
-        let x210 = Self::mul_add(c_q7, x205, s_q7 * x204)
-            + Self::mul_add(-0.75, x206, x157 * -0.65);
-        let x211 = Self::mul_add(0.65, x208, x167);
-        let x212 = x6 * x102;
-        let x213 = Self::mul_add(-x5, x117, x212);
-        let x214 = x8 * x102;
-        let x215 = Self::mul_add(-x7, x117, x214);
-        let x216 = s_q9 * x102;
-        let x217 = Self::mul_add(c_q9, x117, x216);
-        let x218 = x129 + Self::mul_add(-0.275, x217, -0.4 * x215);
-        let x219 = Self::mul_add(0.4, x213, x132);
-        let x220 = Self::mul_add(-0.275, x213, x135);
-        let x221 = Self::mul_add(-x3, x215, x2 * x213) - x217;
-        let x222 = Self::mul_add(c_q8, x215, s_q8 * x213);
+                Self::mul_add(c_q7, x180, s_q7 * x177),
+                s_q7 * Self::mul_add(c_q7, x179, s_q7 * x175),
+            ) - (x190 - x189) - (x188 - x191));
+        let x201 = 1271.854575 + (x194 - x190);
+        let x202 = -x197;
+        let x203 = -x196;
+        let x204 = Self::mul_add(x3, x148, x2 * x149);
+        let x205 = x160 - x161;
+        let x206 = Self::mul_add(-0.35, x205, x165);
+        let x207 = Self::mul_add(-0.35, x204, x168);
+        let x208 = Self::mul_add(s_q7, x205, c_q7 * x204);
+        let x209 = -x208;
+        let x210 = Self::mul_add(-s_q7, x204, c_q7 * x205);
+        let x211 = Self::mul_add(-0.75, x210, Self::mul_add(-s_q7, x207, c_q7 * x206));
+        let x212 = Self::mul_add(c_q7, x207, s_q7 * x206)
+            + Self::mul_add(-0.75, x208, x159 * -0.65);
+        let x213 = Self::mul_add(0.65, x210, x169);
+        let x214 = x6 * x100;
+        let x215 = Self::mul_add(-x5, x115, x214);
+        let x216 = x131 + Self::mul_add(-0.275, x123, -0.4 * x215);
+        let x217 = Self::mul_add(0.4, x127, x134);
+        let x218 = Self::mul_add(-0.275, x127, x137);
+        let x219 = Self::mul_add(-x3, x215, x2 * x127) - x123;
+        let x220 = Self::mul_add(c_q8, x215, s_q8 * x127);
+        let x221 = Self::mul_add(
+            0.00000000020510342851533115,
+            x123,
+            Self::mul_add(-c_q8, x127, s_q8 * x215),
+        );
+        let x222 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x218,
+            Self::mul_add(-c_q8, x216, s_q8 * x217),
+        );
         let x223 = Self::mul_add(
-            0.00000000020510342851533115,
-            x217,
-            Self::mul_add(-c_q8, x213, s_q8 * x215),
-        );
-        let x224 = Self::mul_add(
-            -0.00000000020510342851533115,
+            -0.35,
             x220,
-            Self::mul_add(-c_q8, x218, s_q8 * x219),
+            x218 + Self::mul_add(-x3, x217, x2 * x216),
         );
-        let x225 = Self::mul_add(
-            -0.35,
-            x222,
-            x220 + Self::mul_add(-x3, x219, x2 * x218),
-        );
-        let x226 = Self::mul_add(0.35, x221, Self::mul_add(c_q8, x219, s_q8 * x218));
-        let x227 = Self::mul_add(-s_q7, x222, c_q7 * x221);
-        let x228 = Self::mul_add(c_q7, x222, s_q7 * x221);
-        let x229 = Self::mul_add(-0.75, x228, Self::mul_add(-s_q7, x226, c_q7 * x225));
-        let x230 = Self::mul_add(c_q7, x226, s_q7 * x225)
-            + Self::mul_add(-0.65, x223, 0.75 * x227);
-        let x231 = Self::mul_add(0.65, x228, x224);
-        let x232 = Self::mul_add(-x5, x104, x212);
-        let x233 = Self::mul_add(-x7, x104, x214);
-        let x234 = Self::mul_add(c_q9, x104, x216);
+        let x224 = Self::mul_add(0.35, x219, Self::mul_add(c_q8, x217, s_q8 * x216));
+        let x225 = Self::mul_add(-s_q7, x220, c_q7 * x219);
+        let x226 = Self::mul_add(c_q7, x220, s_q7 * x219);
+        let x227 = Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x224, c_q7 * x223));
+        let x228 = Self::mul_add(c_q7, x224, s_q7 * x223)
+            + Self::mul_add(-0.65, x221, 0.75 * x225);
+        let x229 = Self::mul_add(0.65, x226, x222);
+        let x230 = Self::mul_add(-s_q9, x102, x126);
+        let x231 = Self::mul_add(-x5, x102, x214);
+        let x232 = Self::mul_add(c_q9, x102, x122);
+        let x233 = Self::mul_add(
+            0.00000000020510342851533115,
+            x112,
+            Self::mul_add(c_q9, x108, s_q9 * x105),
+        ) + Self::mul_add(-0.275, x232, -0.4 * x231);
+        let x234 = Self::mul_add(0.4, x230, x112 + Self::mul_add(x6, x108, x5 * x105));
         let x235 = Self::mul_add(
-            0.00000000020510342851533115,
-            x114,
-            Self::mul_add(x6, x110, x5 * x107),
-        ) + Self::mul_add(-0.275, x234, -0.4 * x233);
-        let x236 = Self::mul_add(0.4, x232, x114 + Self::mul_add(x8, x110, x7 * x107));
-        let x237 = Self::mul_add(
             -0.275,
+            x230,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x112,
+                Self::mul_add(-s_q9, x108, c_q9 * x105),
+            ),
+        );
+        let x236 = Self::mul_add(-x3, x231, x2 * x230) - x232;
+        let x237 = Self::mul_add(c_q8, x231, s_q8 * x230);
+        let x238 = Self::mul_add(
+            0.00000000020510342851533115,
             x232,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x114,
-                Self::mul_add(-s_q9, x110, c_q9 * x107),
-            ),
+            Self::mul_add(-c_q8, x230, s_q8 * x231),
         );
-        let x238 = Self::mul_add(-x3, x233, x2 * x232) - x234;
-        let x239 = Self::mul_add(c_q8, x233, s_q8 * x232);
+        let x239 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x235,
+            Self::mul_add(-c_q8, x233, s_q8 * x234),
+        );
         let x240 = Self::mul_add(
-            0.00000000020510342851533115,
-            x234,
-            Self::mul_add(-c_q8, x232, s_q8 * x233),
-        );
-        let x241 = Self::mul_add(
-            -0.00000000020510342851533115,
+            -0.35,
             x237,
-            Self::mul_add(-c_q8, x235, s_q8 * x236),
+            x235 + Self::mul_add(-x3, x234, x2 * x233),
         );
-        let x242 = Self::mul_add(
-            -0.35,
-            x239,
-            x237 + Self::mul_add(-x3, x236, x2 * x235),
-        );
-        let x243 = Self::mul_add(0.35, x238, Self::mul_add(c_q8, x236, s_q8 * x235));
-        let x244 = Self::mul_add(-s_q7, x239, c_q7 * x238);
-        let x245 = Self::mul_add(c_q7, x239, s_q7 * x238);
-        let x246 = Self::mul_add(-0.75, x245, Self::mul_add(-s_q7, x243, c_q7 * x242));
-        let x247 = Self::mul_add(c_q7, x243, s_q7 * x242)
-            + Self::mul_add(-0.65, x240, 0.75 * x244);
-        let x248 = Self::mul_add(0.65, x245, x241);
-        let x249 = Self::mul_add(c_q10, x78, x103);
-        let x250 = Self::mul_add(-s_q10, x78, x101);
-        let x251 = Self::mul_add(-s_q10, x89, c_q10 * x88);
-        let x252 = Self::mul_add(c_q10, x89, s_q10 * x88);
-        let x253 = Self::mul_add(-0.87, x249, x90);
-        let x254 = Self::mul_add(-x5, x249, x6 * x250);
-        let x255 = Self::mul_add(-x7, x249, x8 * x250);
-        let x256 = Self::mul_add(s_q9, x250, c_q9 * x249);
+        let x241 = Self::mul_add(0.35, x236, Self::mul_add(c_q8, x234, s_q8 * x233));
+        let x242 = Self::mul_add(-s_q7, x237, c_q7 * x236);
+        let x243 = Self::mul_add(c_q7, x237, s_q7 * x236);
+        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x241, c_q7 * x240));
+        let x245 = Self::mul_add(c_q7, x241, s_q7 * x240)
+            + Self::mul_add(-0.65, x238, 0.75 * x242);
+        let x246 = Self::mul_add(0.65, x243, x239);
+        let x247 = Self::mul_add(c_q10, x76, x101);
+        let x248 = Self::mul_add(-s_q10, x76, x99);
+        let x249 = Self::mul_add(-s_q10, x87, c_q10 * x86);
+        let x250 = Self::mul_add(c_q10, x87, s_q10 * x86);
+        let x251 = Self::mul_add(-0.87, x247, x88);
+        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
+        let x253 = Self::mul_add(-x5, x247, x6 * x248);
+        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
+        let x255 = Self::mul_add(
+            0.00000000020510342851533115,
+            x251,
+            Self::mul_add(c_q9, x250, s_q9 * x249),
+        ) + Self::mul_add(-0.275, x254, -0.4 * x253);
+        let x256 = Self::mul_add(0.4, x252, x251 + Self::mul_add(x6, x250, x5 * x249));
         let x257 = Self::mul_add(
-            0.00000000020510342851533115,
-            x253,
-            Self::mul_add(x6, x252, x5 * x251),
-        ) + Self::mul_add(-0.275, x256, -0.4 * x255);
-        let x258 = Self::mul_add(0.4, x254, x253 + Self::mul_add(x8, x252, x7 * x251));
-        let x259 = Self::mul_add(
             -0.275,
+            x252,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x251,
+                Self::mul_add(-s_q9, x250, c_q9 * x249),
+            ),
+        );
+        let x258 = Self::mul_add(-x3, x253, x2 * x252) - x254;
+        let x259 = Self::mul_add(c_q8, x253, s_q8 * x252);
+        let x260 = Self::mul_add(
+            0.00000000020510342851533115,
             x254,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x253,
-                Self::mul_add(-s_q9, x252, c_q9 * x251),
-            ),
+            Self::mul_add(-c_q8, x252, s_q8 * x253),
         );
-        let x260 = Self::mul_add(-x3, x255, x2 * x254) - x256;
-        let x261 = Self::mul_add(c_q8, x255, s_q8 * x254);
+        let x261 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x257,
+            Self::mul_add(-c_q8, x255, s_q8 * x256),
+        );
         let x262 = Self::mul_add(
-            0.00000000020510342851533115,
-            x256,
-            Self::mul_add(-c_q8, x254, s_q8 * x255),
-        );
-        let x263 = Self::mul_add(
-            -0.00000000020510342851533115,
+            -0.35,
             x259,
-            Self::mul_add(-c_q8, x257, s_q8 * x258),
+            x257 + Self::mul_add(-x3, x256, x2 * x255),
         );
-        let x264 = Self::mul_add(
-            -0.35,
-            x261,
-            x259 + Self::mul_add(-x3, x258, x2 * x257),
+        let x263 = Self::mul_add(0.35, x258, Self::mul_add(c_q8, x256, s_q8 * x255));
+        let x264 = Self::mul_add(-s_q7, x259, c_q7 * x258);
+        let x265 = Self::mul_add(c_q7, x259, s_q7 * x258);
+        let x266 = Self::mul_add(-0.75, x265, Self::mul_add(-s_q7, x263, c_q7 * x262));
+        let x267 = Self::mul_add(c_q7, x263, s_q7 * x262)
+            + Self::mul_add(-0.65, x260, 0.75 * x264);
+        let x268 = Self::mul_add(0.65, x265, x261);
+        let x269 = Self::mul_add(-x10, x37, x11 * x36);
+        let x270 = x47 - x46;
+        let x271 = Self::mul_add(0.36, x269, x54);
+        let x272 = Self::mul_add(0.36, x50, x57);
+        let x273 = Self::mul_add(s_q11, x269, c_q11 * x50);
+        let x274 = Self::mul_add(-s_q11, x50, c_q11 * x269);
+        let x275 = Self::mul_add(-s_q11, x272, c_q11 * x271)
+            + Self::mul_add(-0.63, x270, 0.275 * x274);
+        let x276 = Self::mul_add(0.275, x273, Self::mul_add(c_q11, x272, s_q11 * x271));
+        let x277 = Self::mul_add(-0.63, x273, x60);
+        let x278 = Self::mul_add(s_q10, x274, c_q10 * x273);
+        let x279 = Self::mul_add(-s_q10, x273, c_q10 * x274);
+        let x280 = Self::mul_add(c_q10, x276, s_q10 * x275);
+        let x281 = Self::mul_add(-0.87, x270, Self::mul_add(-s_q10, x276, c_q10 * x275));
+        let x282 = Self::mul_add(-0.87, x278, x277);
+        let x283 = Self::mul_add(
+            0.00000000020510342851533115,
+            x270,
+            Self::mul_add(-s_q9, x278, c_q9 * x279),
         );
-        let x265 = Self::mul_add(0.35, x260, Self::mul_add(c_q8, x258, s_q8 * x257));
-        let x266 = Self::mul_add(-s_q7, x261, c_q7 * x260);
-        let x267 = Self::mul_add(c_q7, x261, s_q7 * x260);
-        let x268 = Self::mul_add(-0.75, x267, Self::mul_add(-s_q7, x265, c_q7 * x264));
-        let x269 = Self::mul_add(c_q7, x265, s_q7 * x264)
-            + Self::mul_add(-0.65, x262, 0.75 * x266);
-        let x270 = Self::mul_add(0.65, x267, x263);
-        let x271 = Self::mul_add(-x12, x39, x13 * x38);
-        let x272 = x49 - x48;
-        let x273 = Self::mul_add(0.36, x271, x56);
-        let x274 = Self::mul_add(0.36, x52, x59);
-        let x275 = Self::mul_add(s_q11, x271, c_q11 * x52);
-        let x276 = Self::mul_add(-s_q11, x52, c_q11 * x271);
-        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
-            + Self::mul_add(-0.63, x272, 0.275 * x276);
-        let x278 = Self::mul_add(0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
-        let x279 = Self::mul_add(-0.63, x275, x62);
-        let x280 = Self::mul_add(s_q10, x276, c_q10 * x275);
-        let x281 = Self::mul_add(-s_q10, x275, c_q10 * x276);
-        let x282 = Self::mul_add(c_q10, x278, s_q10 * x277);
-        let x283 = Self::mul_add(-0.87, x272, Self::mul_add(-s_q10, x278, c_q10 * x277));
-        let x284 = Self::mul_add(-0.87, x280, x279);
+        let x284 = x270 + Self::mul_add(-x5, x278, x6 * x279);
         let x285 = Self::mul_add(
-            0.00000000020510342851533115,
-            x272,
-            Self::mul_add(-x5, x280, x6 * x281),
-        );
-        let x286 = x272 + Self::mul_add(-x7, x280, x8 * x281);
-        let x287 = Self::mul_add(
             -0.00000000020510342851533115,
-            x272,
-            -Self::mul_add(s_q9, x281, c_q9 * x280),
+            x270,
+            -Self::mul_add(s_q9, x279, c_q9 * x278),
         );
+        let x286 = Self::mul_add(
+            0.00000000020510342851533115,
+            x282,
+            Self::mul_add(c_q9, x280, s_q9 * x281),
+        ) + Self::mul_add(0.275, x285, -0.4 * x284);
+        let x287 = Self::mul_add(0.4, x283, x282 + Self::mul_add(x6, x280, x5 * x281));
         let x288 = Self::mul_add(
-            0.00000000020510342851533115,
-            x284,
-            Self::mul_add(x6, x282, x5 * x283),
-        ) + Self::mul_add(0.275, x287, -0.4 * x286);
-        let x289 = Self::mul_add(0.4, x285, x284 + Self::mul_add(x8, x282, x7 * x283));
-        let x290 = Self::mul_add(
             -0.275,
+            x283,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x282,
+                Self::mul_add(-s_q9, x280, c_q9 * x281),
+            ),
+        );
+        let x289 = x285 + Self::mul_add(-x3, x284, x2 * x283);
+        let x290 = Self::mul_add(c_q8, x284, s_q8 * x283);
+        let x291 = Self::mul_add(
+            -0.00000000020510342851533115,
             x285,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x284,
-                Self::mul_add(-s_q9, x282, c_q9 * x283),
-            ),
+            Self::mul_add(-c_q8, x283, s_q8 * x284),
         );
-        let x291 = x287 + Self::mul_add(-x3, x286, x2 * x285);
-        let x292 = Self::mul_add(c_q8, x286, s_q8 * x285);
+        let x292 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x288,
+            Self::mul_add(-c_q8, x286, s_q8 * x287),
+        );
         let x293 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x287,
-            Self::mul_add(-c_q8, x285, s_q8 * x286),
-        );
-        let x294 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x290,
-            Self::mul_add(-c_q8, x288, s_q8 * x289),
-        );
-        let x295 = Self::mul_add(
             -0.35,
-            x292,
-            x290 + Self::mul_add(-x3, x289, x2 * x288),
+            x290,
+            x288 + Self::mul_add(-x3, x287, x2 * x286),
         );
-        let x296 = Self::mul_add(0.35, x291, Self::mul_add(c_q8, x289, s_q8 * x288));
-        let x297 = Self::mul_add(-s_q7, x292, c_q7 * x291);
-        let x298 = Self::mul_add(c_q7, x292, s_q7 * x291);
-        let x299 = Self::mul_add(-0.75, x298, Self::mul_add(-s_q7, x296, c_q7 * x295));
-        let x300 = Self::mul_add(c_q7, x296, s_q7 * x295)
-            + Self::mul_add(-0.65, x293, 0.75 * x297);
-        let x301 = Self::mul_add(0.65, x298, x294);
-        let x302 = x15 * -4.806620000000001;
-        let x303 = s_q13 * -4.806620000000001;
-        let x304 = c_q13 * -4.806620000000001;
-        let x305 = x22 + Self::mul_add(-0.55, x304, -0.16 * x303);
-        let x306 = Self::mul_add(0.16, x302, x26);
-        let x307 = Self::mul_add(-0.55, x302, x29);
-        let x308 = Self::mul_add(-s_q12, x303, c_q12 * x302);
-        let x309 = Self::mul_add(x13, x303, x12 * x302) - x304;
-        let x310 = Self::mul_add(
+        let x294 = Self::mul_add(0.35, x289, Self::mul_add(c_q8, x287, s_q8 * x286));
+        let x295 = Self::mul_add(-s_q7, x290, c_q7 * x289);
+        let x296 = Self::mul_add(c_q7, x290, s_q7 * x289);
+        let x297 = Self::mul_add(-0.75, x296, Self::mul_add(-s_q7, x294, c_q7 * x293));
+        let x298 = Self::mul_add(c_q7, x294, s_q7 * x293)
+            + Self::mul_add(-0.65, x291, 0.75 * x295);
+        let x299 = Self::mul_add(0.65, x296, x292);
+        let x300 = x13 * -4.806620000000001;
+        let x301 = s_q13 * -4.806620000000001;
+        let x302 = c_q13 * -4.806620000000001;
+        let x303 = x20 + Self::mul_add(-0.55, x302, -0.16 * x301);
+        let x304 = Self::mul_add(0.16, x300, x24);
+        let x305 = Self::mul_add(-0.55, x300, x27);
+        let x306 = Self::mul_add(-s_q12, x301, c_q12 * x300);
+        let x307 = Self::mul_add(x11, x301, x10 * x300) - x302;
+        let x308 = Self::mul_add(
             -0.00000000020510342851533115,
-            x304,
-            Self::mul_add(c_q12, x303, s_q12 * x302),
+            x302,
+            Self::mul_add(c_q12, x301, s_q12 * x300),
         );
+        let x309 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x305,
+            -Self::mul_add(c_q12, x304, s_q12 * x303),
+        );
+        let x310 = Self::mul_add(0.36, x307, Self::mul_add(-s_q12, x304, c_q12 * x303));
         let x311 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x307,
-            -Self::mul_add(c_q12, x306, s_q12 * x305),
-        );
-        let x312 = Self::mul_add(0.36, x309, Self::mul_add(-s_q12, x306, c_q12 * x305));
-        let x313 = Self::mul_add(
             -0.36,
-            x308,
-            x307 + Self::mul_add(x13, x306, x12 * x305),
+            x306,
+            x305 + Self::mul_add(x11, x304, x10 * x303),
         );
-        let x314 = Self::mul_add(-s_q11, x309, c_q11 * x308);
-        let x315 = Self::mul_add(c_q11, x309, s_q11 * x308);
-        let x316 = Self::mul_add(-s_q11, x313, c_q11 * x312)
-            + Self::mul_add(0.63, x310, 0.275 * x315);
-        let x317 = Self::mul_add(-0.275, x314, Self::mul_add(c_q11, x313, s_q11 * x312));
-        let x318 = Self::mul_add(0.63, x314, x311);
-        let x319 = Self::mul_add(-s_q10, x315, c_q10 * x314);
-        let x320 = Self::mul_add(c_q10, x315, s_q10 * x314);
-        let x321 = Self::mul_add(c_q10, x317, s_q10 * x316);
-        let x322 = Self::mul_add(0.87, x310, Self::mul_add(-s_q10, x317, c_q10 * x316));
-        let x323 = Self::mul_add(0.87, x319, x318);
-        let x324 = Self::mul_add(
+        let x312 = Self::mul_add(-s_q11, x307, c_q11 * x306);
+        let x313 = Self::mul_add(c_q11, x307, s_q11 * x306);
+        let x314 = Self::mul_add(-s_q11, x311, c_q11 * x310)
+            + Self::mul_add(0.63, x308, 0.275 * x313);
+        let x315 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x311, s_q11 * x310));
+        let x316 = Self::mul_add(0.63, x312, x309);
+        let x317 = Self::mul_add(-s_q10, x313, c_q10 * x312);
+        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
+        let x319 = Self::mul_add(c_q10, x315, s_q10 * x314);
+        let x320 = Self::mul_add(0.87, x308, Self::mul_add(-s_q10, x315, c_q10 * x314));
+        let x321 = Self::mul_add(0.87, x317, x316);
+        let x322 = Self::mul_add(
             -0.00000000020510342851533115,
-            x310,
-            Self::mul_add(x6, x320, x5 * x319),
+            x308,
+            Self::mul_add(c_q9, x318, s_q9 * x317),
         );
-        let x325 = Self::mul_add(x8, x320, x7 * x319) - x310;
-        let x326 = Self::mul_add(
+        let x323 = Self::mul_add(x6, x318, x5 * x317) - x308;
+        let x324 = Self::mul_add(
             0.00000000020510342851533115,
-            x310,
-            Self::mul_add(-s_q9, x320, c_q9 * x319),
+            x308,
+            Self::mul_add(-s_q9, x318, c_q9 * x317),
         );
+        let x325 = Self::mul_add(
+            0.00000000020510342851533115,
+            x321,
+            Self::mul_add(c_q9, x319, s_q9 * x320),
+        ) + Self::mul_add(0.275, x324, -0.4 * x323);
+        let x326 = Self::mul_add(0.4, x322, x321 + Self::mul_add(x6, x319, x5 * x320));
         let x327 = Self::mul_add(
-            0.00000000020510342851533115,
-            x323,
-            Self::mul_add(x6, x321, x5 * x322),
-        ) + Self::mul_add(0.275, x326, -0.4 * x325);
-        let x328 = Self::mul_add(0.4, x324, x323 + Self::mul_add(x8, x321, x7 * x322));
-        let x329 = Self::mul_add(
             -0.275,
-            x324,
+            x322,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x323,
-                Self::mul_add(-s_q9, x321, c_q9 * x322),
+                x321,
+                Self::mul_add(-s_q9, x319, c_q9 * x320),
             ),
         );
-        let x330 = x326 + Self::mul_add(-x3, x325, x2 * x324);
-        let x331 = Self::mul_add(c_q8, x325, s_q8 * x324);
+        let x328 = x324 + Self::mul_add(-x3, x323, x2 * x322);
+        let x329 = Self::mul_add(c_q8, x323, s_q8 * x322);
+        let x330 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x324,
+            Self::mul_add(-c_q8, x322, s_q8 * x323),
+        );
+        let x331 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x327,
+            Self::mul_add(-c_q8, x325, s_q8 * x326),
+        );
         let x332 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x326,
-            Self::mul_add(-c_q8, x324, s_q8 * x325),
-        );
-        let x333 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x329,
-            Self::mul_add(-c_q8, x327, s_q8 * x328),
-        );
-        let x334 = Self::mul_add(
             -0.35,
-            x331,
-            x329 + Self::mul_add(-x3, x328, x2 * x327),
+            x329,
+            x327 + Self::mul_add(-x3, x326, x2 * x325),
         );
-        let x335 = Self::mul_add(0.35, x330, Self::mul_add(c_q8, x328, s_q8 * x327));
-        let x336 = Self::mul_add(-s_q7, x331, c_q7 * x330);
-        let x337 = Self::mul_add(c_q7, x331, s_q7 * x330);
-        let x338 = Self::mul_add(-0.75, x337, Self::mul_add(-s_q7, x335, c_q7 * x334));
-        let x339 = Self::mul_add(c_q7, x335, s_q7 * x334)
-            + Self::mul_add(-0.65, x332, 0.75 * x336);
-        let x340 = Self::mul_add(0.65, x337, x333);
+        let x333 = Self::mul_add(0.35, x328, Self::mul_add(c_q8, x326, s_q8 * x325));
+        let x334 = Self::mul_add(-s_q7, x329, c_q7 * x328);
+        let x335 = Self::mul_add(c_q7, x329, s_q7 * x328);
+        let x336 = Self::mul_add(-0.75, x335, Self::mul_add(-s_q7, x333, c_q7 * x332));
+        let x337 = Self::mul_add(c_q7, x333, s_q7 * x332)
+            + Self::mul_add(-0.65, x330, 0.75 * x334);
+        let x338 = Self::mul_add(0.65, x335, x331);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
+                x197,
+                x187,
+                x187,
+                x209,
+                x225,
+                x242,
+                x264,
+                x295,
+                x334,
+            ],
+            [
+                0.0,
+                1170.07,
+                0.0,
+                x202,
+                0.0,
+                x196,
+                x183,
+                x210,
+                x226,
+                x243,
+                x265,
+                x296,
+                x335,
+            ],
+            [
+                0.0,
+                0.0,
+                1170.07,
+                x184,
+                x203,
+                0.0,
+                0.0,
+                x159,
+                x221,
+                x238,
+                x260,
+                x291,
+                x330,
+            ],
+            [
+                0.0,
+                x202,
+                x184,
+                x198,
                 x195,
-                x185,
-                x185,
-                x207,
+                x199,
+                x192,
+                x211,
                 x227,
                 x244,
                 x266,
@@ -1301,14 +1337,14 @@ impl FreeFloating7 {
                 x336,
             ],
             [
+                x197,
                 0.0,
-                1170.07,
-                0.0,
+                x203,
+                x195,
                 x200,
-                0.0,
-                x194,
-                x181,
-                x208,
+                x193,
+                x193,
+                x212,
                 x228,
                 x245,
                 x267,
@@ -1316,29 +1352,14 @@ impl FreeFloating7 {
                 x337,
             ],
             [
-                0.0,
-                0.0,
-                1170.07,
-                x182,
-                x201,
-                0.0,
-                0.0,
-                x157,
-                x223,
-                x240,
-                x262,
-                x293,
-                x332,
-            ],
-            [
-                0.0,
-                x200,
-                x182,
+                x187,
                 x196,
+                0.0,
+                x199,
                 x193,
-                x197,
-                x190,
-                x209,
+                x201,
+                x194,
+                x213,
                 x229,
                 x246,
                 x268,
@@ -1346,117 +1367,73 @@ impl FreeFloating7 {
                 x338,
             ],
             [
-                x195,
+                x187,
+                x183,
                 0.0,
-                x201,
+                x192,
                 x193,
-                x198,
-                x191,
-                x191,
-                x210,
-                x230,
-                x247,
-                x269,
-                x300,
-                x339,
-            ],
-            [
-                x185,
                 x194,
-                0.0,
-                x197,
-                x191,
-                x199,
-                x192,
-                x211,
-                x231,
-                x248,
-                x270,
-                x301,
-                x340,
+                x182,
+                x169,
+                x222,
+                x239,
+                x261,
+                x292,
+                x331,
             ],
             [
-                x185,
-                x181,
-                0.0,
-                x190,
-                x191,
-                x192,
-                x180,
-                x167,
-                x224,
-                x241,
-                x263,
-                x294,
-                x333,
-            ],
-            [
-                x207,
-                x208,
-                x157,
                 x209,
                 x210,
+                x159,
                 x211,
-                x167,
-                x155,
-                x220,
-                x237,
-                x259,
-                x290,
-                x329,
+                x212,
+                x213,
+                x169,
+                x157,
+                x218,
+                x235,
+                x257,
+                x288,
+                x327,
             ],
             [
+                x225,
+                x226,
+                x221,
                 x227,
                 x228,
-                x223,
                 x229,
-                x230,
-                x231,
-                x224,
-                x220,
-                x123,
-                x114,
-                x253,
-                x284,
-                x323,
+                x222,
+                x218,
+                x121,
+                x112,
+                x251,
+                x282,
+                x321,
             ],
+            [x242, x243, x238, x244, x245, x246, x239, x235, x112, x98, x88, x277, x316],
+            [x264, x265, x260, x266, x267, x268, x261, x257, x251, x88, x74, x60, x309],
+            [x295, x296, x291, x297, x298, x299, x292, x288, x282, x277, x60, x45, x305],
             [
-                x244,
-                x245,
-                x240,
-                x246,
-                x247,
-                x248,
-                x241,
-                x237,
-                x114,
-                x100,
-                x90,
-                x279,
-                x318,
-            ],
-            [x266, x267, x262, x268, x269, x270, x263, x259, x253, x90, x76, x62, x311],
-            [x297, x298, x293, x299, x300, x301, x294, x290, x284, x279, x62, x47, x307],
-            [
+                x334,
+                x335,
+                x330,
                 x336,
                 x337,
-                x332,
                 x338,
-                x339,
-                x340,
-                x333,
-                x329,
-                x323,
-                x318,
-                x311,
-                x307,
+                x331,
+                x327,
+                x321,
+                x316,
+                x309,
+                x305,
                 1.4135609200000003,
             ],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 534 mul, 430 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 325 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 532 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 323 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
         let x0 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
@@ -1515,7 +1492,7 @@ impl FreeFloating7 {
         let x45 = x28 * x37;
         let x46 = x35 + x45;
         let x47 = Self::mul_add(
-            -0.0021399965876409276,
+            -0.002139996587640933,
             x37,
             -0.0000000234896432582596 * x28,
         );
@@ -1527,7 +1504,7 @@ impl FreeFloating7 {
         let x49 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(5.080660024070366, x28, -0.0021399965876409276 * x27),
+            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
         );
         let x50 = Self::mul_add(
             x34,
@@ -1539,444 +1516,442 @@ impl FreeFloating7 {
             ) + Self::mul_add(-x27, x49, x37 * x47),
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x52 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x53 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x54 = Self::mul_add(
+        let x52 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x55 = Self::mul_add(
+        let x53 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x56 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x54, x27 * x52));
-        let x57 = Self::mul_add(-x37, s_q9, Self::mul_add(x28, x55, x27 * x53));
-        let x58 = x32 + Self::mul_add(0.4, x42 - x36, 0.275 * x41);
-        let x59 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
-        let x60 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
-        let x61 = Self::mul_add(c_q9, x60, Self::mul_add(x54, x59, x52 * x58));
-        let x62 = Self::mul_add(
+        let x54 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x52, x27 * s_q9));
+        let x55 = Self::mul_add(-x37, s_q9, Self::mul_add(x28, x53, x27 * c_q9));
+        let x56 = x32 + Self::mul_add(0.4, x42 - x36, 0.275 * x41);
+        let x57 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
+        let x58 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
+        let x59 = Self::mul_add(c_q9, x58, Self::mul_add(x52, x57, s_q9 * x56));
+        let x60 = Self::mul_add(
             -0.00000000020510342851533115,
-            x60,
-            Self::mul_add(0.00000000020510342851533115, x58, x59),
+            x58,
+            Self::mul_add(0.00000000020510342851533115, x56, x57),
         );
-        let x63 = Self::mul_add(
+        let x61 = Self::mul_add(
             -0.00000000020510342851533115,
             x16,
             Self::mul_add(0.00000000020510342851533115, x35, -x36),
         );
-        let x64 = Self::mul_add(
+        let x62 = Self::mul_add(
             v[8],
-            x57,
-            Self::mul_add(x16, c_q9, Self::mul_add(-x36, x54, x35 * x52)),
+            x55,
+            Self::mul_add(x16, c_q9, Self::mul_add(-x36, x52, x35 * s_q9)),
         );
-        let x65 = Self::mul_add(
+        let x63 = Self::mul_add(
             -v[8],
-            x56,
-            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x55, x35 * x53)),
+            x54,
+            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x53, x35 * c_q9)),
         );
-        let x66 = v[8]
+        let x64 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
                 Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x67 = Self::mul_add(x56, x57, -x63);
-        let x68 = Self::mul_add(x56, x56, x66 * x66);
-        let x69 = Self::mul_add(x57, x66, x64);
-        let x70 = -0.00214 * x66;
-        let x71 = Self::mul_add(-36.18604050126307, x66, -63.36336825000001 * x57);
-        let x72 = Self::mul_add(
+        let x65 = Self::mul_add(x54, x55, -x61);
+        let x66 = Self::mul_add(x54, x54, x64 * x64);
+        let x67 = Self::mul_add(x55, x64, x62);
+        let x68 = -0.00214 * x64;
+        let x69 = Self::mul_add(-36.18604050126307, x64, -63.36336825000001 * x55);
+        let x70 = Self::mul_add(
             69.99836825,
-            x66,
-            Self::mul_add(-36.18604050126307, x57, -0.00214 * x56),
+            x64,
+            Self::mul_add(-36.18604050126307, x55, -0.00214 * x54),
         );
-        let x73 = Self::mul_add(
+        let x71 = Self::mul_add(
             -81.53205,
-            x62,
-            Self::mul_add(-0.00214, x63, Self::mul_add(-x66, x71, x57 * x72)),
+            x60,
+            Self::mul_add(-0.00214, x61, Self::mul_add(-x64, x69, x55 * x70)),
         );
-        let x74 = Self::mul_add(
-            x61,
+        let x72 = Self::mul_add(
+            x59,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x63,
-                Self::mul_add(-36.18604050126307, x65, -0.00214 * x64),
-            ) + Self::mul_add(-x57, x70, x56 * x71),
+                x61,
+                Self::mul_add(-36.18604050126307, x63, -0.00214 * x62),
+            ) + Self::mul_add(-x55, x68, x54 * x69),
         );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x76 = Self::mul_add(x57, s_q10, x56 * c_q10);
-        let x77 = Self::mul_add(-x56, s_q10, x57 * c_q10);
-        let x78 = Self::mul_add(-0.87, x67, x61);
-        let x79 = Self::mul_add(
+        let x74 = Self::mul_add(x55, s_q10, x54 * c_q10);
+        let x75 = Self::mul_add(-x54, s_q10, x55 * c_q10);
+        let x76 = Self::mul_add(-0.87, x65, x59);
+        let x77 = Self::mul_add(
             0.87,
-            x68,
-            Self::mul_add(-s_q9, x60, Self::mul_add(x55, x59, x53 * x58)),
+            x66,
+            Self::mul_add(-s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56)),
         );
-        let x80 = Self::mul_add(-0.87, x69, x62);
-        let x81 = Self::mul_add(s_q10, x79, c_q10 * x78);
-        let x82 = Self::mul_add(v[9], x77, Self::mul_add(x65, s_q10, x64 * c_q10));
-        let x83 = Self::mul_add(-v[9], x76, Self::mul_add(-x64, s_q10, x65 * c_q10));
-        let x84 = v[9] + x66;
-        let x85 = Self::mul_add(x76, x77, -x63);
-        let x86 = x76 * x76;
-        let x87 = Self::mul_add(x84, x84, x86);
-        let x88 = x77 * x84;
-        let x89 = x82 + x88;
-        let x90 = -0.6328 * x84;
-        let x91 = Self::mul_add(-24.35164200091464, x84, -24.4950615 * x77);
-        let x92 = Self::mul_add(
+        let x78 = Self::mul_add(-0.87, x67, x60);
+        let x79 = Self::mul_add(s_q10, x77, c_q10 * x76);
+        let x80 = Self::mul_add(v[9], x75, Self::mul_add(x63, s_q10, x62 * c_q10));
+        let x81 = Self::mul_add(-v[9], x74, Self::mul_add(-x62, s_q10, x63 * c_q10));
+        let x82 = v[9] + x64;
+        let x83 = Self::mul_add(x74, x75, -x61);
+        let x84 = x74 * x74;
+        let x85 = Self::mul_add(x82, x82, x84);
+        let x86 = x75 * x82;
+        let x87 = x80 + x86;
+        let x88 = -0.6328 * x82;
+        let x89 = Self::mul_add(-24.35164200091464, x82, -24.4950615 * x75);
+        let x90 = Self::mul_add(
             28.2393615,
-            x84,
-            Self::mul_add(-24.351642000914637, x77, -0.6328 * x76),
+            x82,
+            Self::mul_add(-24.351642000914637, x75, -0.6328 * x74),
         );
-        let x93 = Self::mul_add(
+        let x91 = Self::mul_add(
             -45.1584,
-            x80,
-            Self::mul_add(-0.6328, x63, Self::mul_add(-x84, x91, x77 * x92)),
+            x78,
+            Self::mul_add(-0.6328, x61, Self::mul_add(-x82, x89, x75 * x90)),
         );
-        let x94 = Self::mul_add(
-            x81,
+        let x92 = Self::mul_add(
+            x79,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x63,
-                Self::mul_add(-24.351642000914637, x83, -0.6328 * x82),
-            ) + Self::mul_add(-x77, x90, x76 * x91),
+                x61,
+                Self::mul_add(-24.351642000914637, x81, -0.6328 * x80),
+            ) + Self::mul_add(-x75, x88, x74 * x89),
         );
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x96 = Self::mul_add(x77, s_q11, x76 * c_q11);
-        let x97 = Self::mul_add(-x76, s_q11, x77 * c_q11);
-        let x98 = x81 + Self::mul_add(-0.275, Self::mul_add(x76, x84, x83), -0.63 * x85);
-        let x99 = Self::mul_add(-s_q10, x78, c_q10 * x79)
-            + Self::mul_add(0.63, x87, -0.275 * (x88 - x82));
-        let x100 = x80 + Self::mul_add(0.275, Self::mul_add(x77, x77, x86), -0.63 * x89);
-        let x101 = Self::mul_add(s_q11, x99, c_q11 * x98);
-        let x102 = Self::mul_add(v[10], x97, Self::mul_add(x83, s_q11, x82 * c_q11));
-        let x103 = Self::mul_add(-v[10], x96, Self::mul_add(-x82, s_q11, x83 * c_q11));
-        let x104 = v[10] + x84;
-        let x105 = x96 * x96;
-        let x106 = x97 * x104;
-        let x107 = 0.01675 * x104;
-        let x108 = Self::mul_add(2.5482240016099564, x104, -9.142025249762803 * x97);
-        let x109 = Self::mul_add(
+        let x94 = Self::mul_add(x75, s_q11, x74 * c_q11);
+        let x95 = Self::mul_add(-x74, s_q11, x75 * c_q11);
+        let x96 = x79 + Self::mul_add(-0.275, Self::mul_add(x74, x82, x81), -0.63 * x83);
+        let x97 = Self::mul_add(-s_q10, x76, c_q10 * x77)
+            + Self::mul_add(0.63, x85, -0.275 * (x86 - x80));
+        let x98 = x78 + Self::mul_add(0.275, Self::mul_add(x75, x75, x84), -0.63 * x87);
+        let x99 = Self::mul_add(s_q11, x97, c_q11 * x96);
+        let x100 = Self::mul_add(v[10], x95, Self::mul_add(x81, s_q11, x80 * c_q11));
+        let x101 = Self::mul_add(-v[10], x94, Self::mul_add(-x80, s_q11, x81 * c_q11));
+        let x102 = v[10] + x82;
+        let x103 = x94 * x94;
+        let x104 = x95 * x102;
+        let x105 = 0.01675 * x102;
+        let x106 = Self::mul_add(2.5482240016099564, x102, -9.142025249762803 * x95);
+        let x107 = Self::mul_add(
             9.223235249762805,
-            x104,
-            Self::mul_add(2.5482240016099564, x97, 0.01675 * x96),
+            x102,
+            Self::mul_add(2.5482240016099564, x95, 0.01675 * x94),
         );
-        let x110 = Self::mul_add(
+        let x108 = Self::mul_add(
             7.078399999258757,
-            x100,
-            Self::mul_add(0.01675, x63, Self::mul_add(-x104, x108, x97 * x109)),
+            x98,
+            Self::mul_add(0.01675, x61, Self::mul_add(-x102, x106, x95 * x107)),
         );
-        let x111 = Self::mul_add(
-            x101,
+        let x109 = Self::mul_add(
+            x99,
             -7.078399999258757,
             Self::mul_add(
                 9.223235249762805,
-                x63,
-                Self::mul_add(2.5482240016099564, x103, 0.01675 * x102),
-            ) + Self::mul_add(-x97, x107, x96 * x108),
+                x61,
+                Self::mul_add(2.5482240016099564, x101, 0.01675 * x100),
+            ) + Self::mul_add(-x95, x105, x94 * x106),
         );
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x113 = -0.00000000020510342851533115 * s_q12;
-        let x114 = -0.00000000020510342851533115 * c_q12;
-        let x115 = Self::mul_add(-x104, s_q12, Self::mul_add(x97, x113, x96 * c_q12));
-        let x116 = Self::mul_add(-x104, c_q12, Self::mul_add(-x96, s_q12, x97 * x114));
-        let x117 = Self::mul_add(-0.36, Self::mul_add(x96, x104, x103), x101);
-        let x118 = Self::mul_add(
+        let x111 = -0.00000000020510342851533115 * s_q12;
+        let x112 = -0.00000000020510342851533115 * c_q12;
+        let x113 = Self::mul_add(-x102, s_q12, Self::mul_add(x95, x111, x94 * c_q12));
+        let x114 = Self::mul_add(-x102, c_q12, Self::mul_add(-x94, s_q12, x95 * x112));
+        let x115 = Self::mul_add(-0.36, Self::mul_add(x94, x102, x101), x99);
+        let x116 = Self::mul_add(
             -0.36,
-            x106 - x102,
-            Self::mul_add(-s_q11, x98, c_q11 * x99),
+            x104 - x100,
+            Self::mul_add(-s_q11, x96, c_q11 * x97),
         );
-        let x119 = Self::mul_add(0.36, Self::mul_add(x97, x97, x105), x100);
-        let x120 = Self::mul_add(-s_q12, x119, Self::mul_add(x113, x118, c_q12 * x117));
-        let x121 = Self::mul_add(-c_q12, x119, Self::mul_add(-s_q12, x117, x114 * x118));
-        let x122 = Self::mul_add(-0.00000000020510342851533115, x119, x118);
-        let x123 = Self::mul_add(-0.00000000020510342851533115, x63, x103);
-        let x124 = Self::mul_add(
+        let x117 = Self::mul_add(0.36, Self::mul_add(x95, x95, x103), x98);
+        let x118 = Self::mul_add(-s_q12, x117, Self::mul_add(x111, x116, c_q12 * x115));
+        let x119 = Self::mul_add(-c_q12, x117, Self::mul_add(-s_q12, x115, x112 * x116));
+        let x120 = Self::mul_add(-0.00000000020510342851533115, x117, x116);
+        let x121 = Self::mul_add(-0.00000000020510342851533115, x61, x101);
+        let x122 = Self::mul_add(
             v[11],
-            x116,
-            Self::mul_add(-x63, s_q12, Self::mul_add(x103, x113, x102 * c_q12)),
+            x114,
+            Self::mul_add(-x61, s_q12, Self::mul_add(x101, x111, x100 * c_q12)),
         );
-        let x125 = Self::mul_add(
+        let x123 = Self::mul_add(
             -v[11],
-            x115,
-            Self::mul_add(-x63, c_q12, Self::mul_add(-x102, s_q12, x103 * x114)),
+            x113,
+            Self::mul_add(-x61, c_q12, Self::mul_add(-x100, s_q12, x101 * x112)),
         );
-        let x126 = v[11] + Self::mul_add(-0.00000000020510342851533115, x104, x97);
-        let x127 = x116 * x116;
-        let x128 = x126 * x126;
-        let x129 = x115 * x116;
-        let x130 = x129 - x123;
-        let x131 = x115 * x126;
-        let x132 = x115 * x115;
-        let x133 = x128 + x132;
-        let x134 = x116 * x126;
-        let x135 = x124 + x134;
-        let x136 = Self::mul_add(-0.809539999555672, x126, -1.9877000000000002 * x116);
-        let x137 = Self::mul_add(
+        let x124 = v[11] + Self::mul_add(-0.00000000020510342851533115, x102, x95);
+        let x125 = x114 * x114;
+        let x126 = x124 * x124;
+        let x127 = x113 * x114;
+        let x128 = x127 - x121;
+        let x129 = x113 * x124;
+        let x130 = x113 * x113;
+        let x131 = x126 + x130;
+        let x132 = x114 * x124;
+        let x133 = x122 + x132;
+        let x134 = Self::mul_add(-0.809539999555672, x124, -1.9877000000000002 * x114);
+        let x135 = Self::mul_add(
             -2.741639999592316,
-            x126,
-            Self::mul_add(-5.252920330000002, x116, -1.9877000000000002 * x115),
+            x124,
+            Self::mul_add(-5.252920330000002, x114, -1.9877000000000002 * x113),
         );
-        let x138 = Self::mul_add(
+        let x136 = Self::mul_add(
             9.740442170000001,
-            x126,
-            Self::mul_add(-2.7416399995923166, x116, -0.809539999555672 * x115),
+            x124,
+            Self::mul_add(-2.7416399995923166, x114, -0.809539999555672 * x113),
         );
-        let x139 = Self::mul_add(
-            x122,
+        let x137 = Self::mul_add(
+            x120,
             -3.6140000000000003,
             Self::mul_add(
                 -2.741639999592316,
-                x123,
-                Self::mul_add(-5.252920330000002, x125, -1.9877000000000002 * x124),
-            ) + Self::mul_add(-x115, x138, x126 * x136),
+                x121,
+                Self::mul_add(-5.252920330000002, x123, -1.9877000000000002 * x122),
+            ) + Self::mul_add(-x113, x136, x124 * x134),
         );
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x141 = -0.00000000020510342851533115 * c_q13;
-        let x142 = -0.00000000020510342851533115 * s_q13;
-        let x143 = Self::mul_add(-x126, c_q13, Self::mul_add(x116, s_q13, x115 * x141));
-        let x144 = Self::mul_add(x126, s_q13, Self::mul_add(-x115, x142, x116 * c_q13));
-        let x145 = x120 + Self::mul_add(0.16, x125 + x131, 0.55 * x130);
-        let x146 = x122 + Self::mul_add(-0.16, x127 + x132, 0.55 * x135);
-        let x147 = Self::mul_add(
+        let x139 = -0.00000000020510342851533115 * c_q13;
+        let x140 = -0.00000000020510342851533115 * s_q13;
+        let x141 = Self::mul_add(-x124, c_q13, Self::mul_add(x114, s_q13, x113 * x139));
+        let x142 = Self::mul_add(x124, s_q13, Self::mul_add(-x113, x140, x114 * c_q13));
+        let x143 = x118 + Self::mul_add(0.16, x123 + x129, 0.55 * x128);
+        let x144 = x120 + Self::mul_add(-0.16, x125 + x130, 0.55 * x133);
+        let x145 = Self::mul_add(
             -c_q13,
-            x146,
+            x144,
             Self::mul_add(
                 s_q13,
-                x121 + Self::mul_add(-0.55, x133, 0.16 * (x134 - x124)),
-                x141 * x145,
+                x119 + Self::mul_add(-0.55, x131, 0.16 * (x132 - x122)),
+                x139 * x143,
             ),
         );
-        let x148 = Self::mul_add(-0.00000000020510342851533115, x123, x124);
-        let x149 = Self::mul_add(
+        let x146 = Self::mul_add(-0.00000000020510342851533115, x121, x122);
+        let x147 = Self::mul_add(
             v[12],
-            x144,
-            Self::mul_add(-x123, c_q13, Self::mul_add(x125, s_q13, x124 * x141)),
+            x142,
+            Self::mul_add(-x121, c_q13, Self::mul_add(x123, s_q13, x122 * x139)),
         );
-        let x150 = Self::mul_add(
+        let x148 = Self::mul_add(
             -v[12],
-            x143,
-            Self::mul_add(x123, s_q13, Self::mul_add(-x124, x142, x125 * c_q13)),
+            x141,
+            Self::mul_add(x121, s_q13, Self::mul_add(-x122, x140, x123 * c_q13)),
         );
-        let x151 = v[12] + Self::mul_add(-0.00000000020510342851533115, x126, x115);
-        let x152 = 4.806620000000001 * Self::mul_add(x143, x144, -x148);
-        let x153 = 4.806620000000001 * Self::mul_add(x143, x143, x151 * x151);
-        let x154 = 4.806620000000001 * Self::mul_add(x144, x151, x149);
-        let x155 = Self::mul_add(-0.0145, x151, 0.000781 * x144);
+        let x149 = v[12] + Self::mul_add(-0.00000000020510342851533115, x124, x113);
+        let x150 = 4.806620000000001 * Self::mul_add(x141, x142, -x146);
+        let x151 = 4.806620000000001 * Self::mul_add(x141, x141, x149 * x149);
+        let x152 = 4.806620000000001 * Self::mul_add(x142, x149, x147);
+        let x153 = Self::mul_add(-0.0145, x149, 0.000781 * x142);
+        let x154 = Self::mul_add(
+            -0.9614610000000001,
+            x149,
+            Self::mul_add(-1.2025609200000003, x142, 0.000781 * x141),
+        );
+        let x155 = Self::mul_add(
+            1.4135609200000003,
+            x149,
+            Self::mul_add(-0.9614610000000001, x142, -0.0145 * x141),
+        );
         let x156 = Self::mul_add(
             -0.9614610000000001,
-            x151,
-            Self::mul_add(-1.2025609200000003, x144, 0.000781 * x143),
-        );
+            x146,
+            Self::mul_add(-1.2025609200000003, x148, 0.000781 * x147),
+        ) + Self::mul_add(-x141, x155, x149 * x153);
         let x157 = Self::mul_add(
-            1.4135609200000003,
-            x151,
-            Self::mul_add(-0.9614610000000001, x144, -0.0145 * x143),
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x144, x143),
+            Self::mul_add(-0.0145, x146, 0.000781 * x148)
+                + Self::mul_add(-x149, x154, x142 * x155),
         );
         let x158 = Self::mul_add(
-            -0.9614610000000001,
-            x148,
-            Self::mul_add(-1.2025609200000003, x150, 0.000781 * x149),
-        ) + Self::mul_add(-x143, x157, x151 * x155);
-        let x159 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x146, x145),
-            Self::mul_add(-0.0145, x148, 0.000781 * x150)
-                + Self::mul_add(-x151, x156, x144 * x157),
-        );
-        let x160 = Self::mul_add(
-            x147,
+            x145,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x148,
-                Self::mul_add(-0.9614610000000001, x150, -0.0145 * x149),
-            ) + Self::mul_add(-x144, x155, x143 * x156),
+                x146,
+                Self::mul_add(-0.9614610000000001, x148, -0.0145 * x147),
+            ) + Self::mul_add(-x142, x153, x141 * x154),
         );
-        let x161 = x154 + Self::mul_add(x142, x153, x141 * x152);
-        let x162 = Self::mul_add(-c_q13, x153, s_q13 * x152);
-        let x163 = Self::mul_add(
+        let x159 = x152 + Self::mul_add(x140, x151, x139 * x150);
+        let x160 = Self::mul_add(-c_q13, x151, s_q13 * x150);
+        let x161 = Self::mul_add(
             -0.00000000020510342851533115,
-            x154,
-            -Self::mul_add(s_q13, x153, c_q13 * x152),
+            x152,
+            -Self::mul_add(s_q13, x151, c_q13 * x150),
         );
-        let x164 = Self::mul_add(
-            x161,
+        let x162 = Self::mul_add(
+            x159,
             -0.55,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x160,
-                Self::mul_add(-c_q13, x159, s_q13 * x158),
+                x158,
+                Self::mul_add(-c_q13, x157, s_q13 * x156),
             ),
         );
-        let x165 = Self::mul_add(
+        let x163 = Self::mul_add(
             -3.6140000000000003,
-            x127 + x128,
-            17.135250000000003 * x130,
+            x125 + x126,
+            17.135250000000003 * x128,
+        ) + x159;
+        let x164 = Self::mul_add(
+            -17.135250000000003,
+            x131,
+            3.6140000000000003 * (x121 + x127),
+        ) + x160;
+        let x165 = Self::mul_add(
+            17.135250000000003,
+            x133,
+            3.6140000000000003 * (x129 - x123),
         ) + x161;
         let x166 = Self::mul_add(
-            -17.135250000000003,
-            x133,
-            3.6140000000000003 * (x123 + x129),
-        ) + x162;
-        let x167 = Self::mul_add(
             17.135250000000003,
-            x135,
-            3.6140000000000003 * (x131 - x125),
-        ) + x163;
-        let x168 = Self::mul_add(
-            17.135250000000003,
-            x122,
-            Self::mul_add(-0.809539999555672, x123, -1.9877000000000002 * x125)
-                + Self::mul_add(-x126, x137, x116 * x138),
+            x120,
+            Self::mul_add(-0.809539999555672, x121, -1.9877000000000002 * x123)
+                + Self::mul_add(-x124, x135, x114 * x136),
         )
-            + (x160 + Self::mul_add(-x142, x158, x141 * x159)
-                + Self::mul_add(0.55, x163, -0.16 * x162));
-        let x169 = x139
-            + Self::mul_add(0.16, x161, Self::mul_add(c_q13, x158, s_q13 * x159));
-        let x170 = Self::mul_add(
+            + (x158 + Self::mul_add(-x140, x156, x139 * x157)
+                + Self::mul_add(0.55, x161, -0.16 * x160));
+        let x167 = x137
+            + Self::mul_add(0.16, x159, Self::mul_add(c_q13, x156, s_q13 * x157));
+        let x168 = Self::mul_add(
             9.740442170000001,
-            x123,
-            Self::mul_add(-2.7416399995923166, x125, -0.809539999555672 * x124),
-        ) + Self::mul_add(-x116, x136, x115 * x137)
-            + Self::mul_add(3.6140000000000003, x121, x120 * -17.135250000000003) + x164;
-        let x171 = Self::mul_add(-s_q12, x166, c_q12 * x165);
-        let x172 = x167 + Self::mul_add(x114, x166, x113 * x165);
-        let x173 = Self::mul_add(7.078399999258757, Self::mul_add(x96, x97, -x63), x171);
-        let x174 = Self::mul_add(
+            x121,
+            Self::mul_add(-2.7416399995923166, x123, -0.809539999555672 * x122),
+        ) + Self::mul_add(-x114, x134, x113 * x135)
+            + Self::mul_add(3.6140000000000003, x119, x118 * -17.135250000000003) + x162;
+        let x169 = Self::mul_add(-s_q12, x164, c_q12 * x163);
+        let x170 = x165 + Self::mul_add(x112, x164, x111 * x163);
+        let x171 = Self::mul_add(7.078399999258757, Self::mul_add(x94, x95, -x61), x169);
+        let x172 = Self::mul_add(
             -7.078399999258757,
-            Self::mul_add(x104, x104, x105),
-            x172,
+            Self::mul_add(x102, x102, x103),
+            x170,
         );
-        let x175 = Self::mul_add(
+        let x173 = Self::mul_add(
             7.078399999258757,
-            x102 + x106,
+            x100 + x104,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x167,
-                -Self::mul_add(c_q12, x166, s_q12 * x165),
+                x165,
+                -Self::mul_add(c_q12, x164, s_q12 * x163),
             ),
         );
-        let x176 = x110
-            + Self::mul_add(x172, 0.36, Self::mul_add(-s_q12, x169, c_q12 * x168));
-        let x177 = Self::mul_add(2.5482240016099564, x63, -9.142025249762803 * x103)
-            + Self::mul_add(-x96, x109, x104 * x107)
-            + Self::mul_add(-0.36, x171, x170 + Self::mul_add(x114, x169, x113 * x168));
-        let x178 = x111
+        let x174 = x108
+            + Self::mul_add(x170, 0.36, Self::mul_add(-s_q12, x167, c_q12 * x166));
+        let x175 = Self::mul_add(2.5482240016099564, x61, -9.142025249762803 * x101)
+            + Self::mul_add(-x94, x107, x102 * x105)
+            + Self::mul_add(-0.36, x169, x168 + Self::mul_add(x112, x167, x111 * x166));
+        let x176 = x109
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x170,
-                -Self::mul_add(c_q12, x169, s_q12 * x168),
+                x168,
+                -Self::mul_add(c_q12, x167, s_q12 * x166),
             );
-        let x179 = Self::mul_add(-s_q11, x174, c_q11 * x173);
-        let x180 = Self::mul_add(c_q11, x174, s_q11 * x173);
-        let x181 = Self::mul_add(-45.1584, x85, x179);
-        let x182 = Self::mul_add(45.1584, x87, x180);
-        let x183 = Self::mul_add(-45.1584, x89, x175);
-        let x184 = x93
-            + (Self::mul_add(-s_q11, x177, c_q11 * x176)
-                + Self::mul_add(-0.63, x175, 0.275 * x180));
-        let x185 = Self::mul_add(-24.35164200091464, x63, -24.4950615 * x83)
-            + Self::mul_add(-x76, x92, x84 * x90)
-            + Self::mul_add(-0.275, x179, Self::mul_add(c_q11, x177, s_q11 * x176));
-        let x186 = x94 + Self::mul_add(x179, 0.63, x178);
-        let x187 = Self::mul_add(-s_q10, x182, c_q10 * x181);
-        let x188 = Self::mul_add(-81.53205, x67, x187);
-        let x189 = Self::mul_add(
+        let x177 = Self::mul_add(-s_q11, x172, c_q11 * x171);
+        let x178 = Self::mul_add(c_q11, x172, s_q11 * x171);
+        let x179 = Self::mul_add(-45.1584, x83, x177);
+        let x180 = Self::mul_add(45.1584, x85, x178);
+        let x181 = Self::mul_add(-45.1584, x87, x173);
+        let x182 = x91
+            + (Self::mul_add(-s_q11, x175, c_q11 * x174)
+                + Self::mul_add(-0.63, x173, 0.275 * x178));
+        let x183 = Self::mul_add(-24.35164200091464, x61, -24.4950615 * x81)
+            + Self::mul_add(-x74, x90, x82 * x88)
+            + Self::mul_add(-0.275, x177, Self::mul_add(c_q11, x175, s_q11 * x174));
+        let x184 = x92 + Self::mul_add(x177, 0.63, x176);
+        let x185 = Self::mul_add(-s_q10, x180, c_q10 * x179);
+        let x186 = Self::mul_add(-81.53205, x65, x185);
+        let x187 = Self::mul_add(
             81.53205,
-            x68,
-            Self::mul_add(c_q10, x182, s_q10 * x181),
+            x66,
+            Self::mul_add(c_q10, x180, s_q10 * x179),
         );
-        let x190 = Self::mul_add(-81.53205, x69, x183);
-        let x191 = x73
-            + Self::mul_add(-0.87, x183, Self::mul_add(-s_q10, x185, c_q10 * x184));
-        let x192 = Self::mul_add(-36.18604050126307, x63, -63.36336825000001 * x65)
-            + Self::mul_add(-x56, x72, x66 * x70)
-            + Self::mul_add(c_q10, x185, s_q10 * x184);
-        let x193 = x74 + Self::mul_add(x187, 0.87, x186);
-        let x194 = Self::mul_add(
+        let x188 = Self::mul_add(-81.53205, x67, x181);
+        let x189 = x71
+            + Self::mul_add(-0.87, x181, Self::mul_add(-s_q10, x183, c_q10 * x182));
+        let x190 = Self::mul_add(-36.18604050126307, x61, -63.36336825000001 * x63)
+            + Self::mul_add(-x54, x70, x64 * x68)
+            + Self::mul_add(c_q10, x183, s_q10 * x182);
+        let x191 = x72 + Self::mul_add(x185, 0.87, x184);
+        let x192 = Self::mul_add(
             0.00000000020510342851533115,
-            x190,
-            Self::mul_add(x53, x189, x52 * x188),
+            x188,
+            Self::mul_add(c_q9, x187, s_q9 * x186),
         );
-        let x195 = x190 + Self::mul_add(x55, x189, x54 * x188);
-        let x196 = Self::mul_add(
+        let x193 = x188 + Self::mul_add(x53, x187, x52 * x186);
+        let x194 = Self::mul_add(
             -0.00000000020510342851533115,
-            x190,
-            Self::mul_add(-s_q9, x189, c_q9 * x188),
+            x188,
+            Self::mul_add(-s_q9, x187, c_q9 * x186),
         );
-        let x197 = Self::mul_add(
+        let x195 = Self::mul_add(
             -0.275,
-            x194,
+            x192,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x193,
-                Self::mul_add(-s_q9, x192, c_q9 * x191),
+                x191,
+                Self::mul_add(-s_q9, x190, c_q9 * x189),
             ),
         );
-        let x198 = Self::mul_add(
+        let x196 = Self::mul_add(
             0.000000008530897668050218,
             x38 + x39,
             -12.701650001451807 * x41,
-        ) + x194;
-        let x199 = Self::mul_add(
+        ) + x192;
+        let x197 = Self::mul_add(
             12.701650001451807,
             x44,
             -0.000000008530897668050218 * (x16 + x40),
-        ) + x195;
-        let x200 = Self::mul_add(
+        ) + x193;
+        let x198 = Self::mul_add(
             -12.701650001451807,
             x46,
             -0.000000008530897668050218 * (x36 + x42),
-        ) + x196;
-        let x201 = Self::mul_add(
+        ) + x194;
+        let x199 = Self::mul_add(
             -12.701650001451807,
             x34,
-            Self::mul_add(0.0000000234896432582596, x36, -0.0021399965876409276 * x16)
+            Self::mul_add(0.0000000234896432582596, x36, -0.002139996587640933 * x16)
                 + Self::mul_add(-x37, x48, x28 * x49),
         )
             + (Self::mul_add(
                 0.00000000020510342851533115,
-                x193,
-                Self::mul_add(x53, x192, x52 * x191),
-            ) + Self::mul_add(0.275, x196, x195 * -0.4));
-        let x202 = x50
-            + Self::mul_add(0.4, x194, x193 + Self::mul_add(x55, x192, x54 * x191));
-        let x203 = Self::mul_add(
+                x191,
+                Self::mul_add(c_q9, x190, s_q9 * x189),
+            ) + Self::mul_add(0.275, x194, x193 * -0.4));
+        let x200 = x50
+            + Self::mul_add(0.4, x192, x191 + Self::mul_add(x53, x190, x52 * x189));
+        let x201 = Self::mul_add(
             113.3918902508081,
             x16,
-            Self::mul_add(-5.080660024070366, x36, -0.0021399965876409276 * x35),
+            Self::mul_add(-5.080660024070366, x36, -0.002139996587640933 * x35),
         ) + Self::mul_add(-x28, x47, x27 * x48)
             + Self::mul_add(-0.000000008530897668050218, x33, x32 * 12.701650001451807)
-            + x197;
-        let x204 = x200 + Self::mul_add(-x26, x199, x25 * x198);
-        let x205 = Self::mul_add(c_q8, x199, s_q8 * x198);
-        let x206 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x204);
-        let x207 = Self::mul_add(48.0240000085309, x4 * x5, x205);
-        let x208 = Self::mul_add(
+            + x195;
+        let x202 = x198 + Self::mul_add(-x26, x197, x25 * x196);
+        let x203 = Self::mul_add(c_q8, x197, s_q8 * x196);
+        let x204 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x202);
+        let x205 = Self::mul_add(48.0240000085309, x4 * x5, x203);
+        let x206 = Self::mul_add(
             48.0240000085309,
             x17 + x20,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x200,
-                Self::mul_add(-c_q8, x198, s_q8 * x199),
+                x198,
+                Self::mul_add(-c_q8, x196, s_q8 * x197),
             ),
         );
-        let x209 = Self::mul_add(0.07309, x17, Self::mul_add(-x18, x22, x5 * x23))
-            + Self::mul_add(x205, -0.35, x203 + Self::mul_add(-x26, x202, x25 * x201));
-        let x210 = Self::mul_add(
+        let x207 = Self::mul_add(0.07309, x17, Self::mul_add(-x18, x22, x5 * x23))
+            + Self::mul_add(x203, -0.35, x201 + Self::mul_add(-x26, x200, x25 * x199));
+        let x208 = Self::mul_add(
             x14,
             -48.0240000085309,
             Self::mul_add(-130.43769025763282, x17, -0.07309 * x16)
                 + Self::mul_add(-x4, x23, x18 * x21),
-        ) + Self::mul_add(0.35, x204, Self::mul_add(c_q8, x202, s_q8 * x201));
-        let x211 = Self::mul_add(
+        ) + Self::mul_add(0.35, x202, Self::mul_add(c_q8, x200, s_q8 * x199));
+        let x209 = Self::mul_add(
             48.0240000085309,
             x15,
             Self::mul_add(-0.1132, x17, -16.80768997608804 * x16)
@@ -1984,49 +1959,49 @@ impl FreeFloating7 {
         )
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x203,
-                Self::mul_add(-c_q8, x201, s_q8 * x202),
+                x201,
+                Self::mul_add(-c_q8, x199, s_q8 * x200),
             );
-        let x212 = Self::mul_add(-s_q7, x207, c_q7 * x206);
-        let x213 = Self::mul_add(c_q7, x207, s_q7 * x206);
-        let x214 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x215 = 1466.4506062283303 * v[4];
-        let x216 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x217 = x212
+        let x210 = Self::mul_add(-s_q7, x205, c_q7 * x204);
+        let x211 = Self::mul_add(c_q7, x205, s_q7 * x204);
+        let x212 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x213 = 1466.4506062283303 * v[4];
+        let x214 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x215 = x210
             + Self::mul_add(
                 1170.07,
                 x0,
                 Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
             );
-        let x218 = x213
+        let x216 = x211
             + Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x10, 110.5455 * x8),
             );
-        let x219 = x208
+        let x217 = x206
             + Self::mul_add(
                 1170.07,
                 x2,
                 Self::mul_add(-180.9502499901501, x11, 110.5455 * x9),
             );
-        let x220 = Self::mul_add(x213, -0.75, Self::mul_add(-s_q7, x210, c_q7 * x209))
+        let x218 = Self::mul_add(x211, -0.75, Self::mul_add(-s_q7, x208, c_q7 * x207))
             + Self::mul_add(
                 x1,
                 -180.9502499901501,
-                Self::mul_add(-v[5], x215, v[4] * x216),
+                Self::mul_add(-v[5], x213, v[4] * x214),
             );
-        let x221 = Self::mul_add(c_q7, x210, s_q7 * x209)
-            + Self::mul_add(x208, -0.65, 0.75 * x212)
-            + (Self::mul_add(-v[3], x216, v[5] * x214)
+        let x219 = Self::mul_add(c_q7, x208, s_q7 * x207)
+            + Self::mul_add(x206, -0.65, 0.75 * x210)
+            + (Self::mul_add(-v[3], x214, v[5] * x212)
                 + Self::mul_add(x2, -110.5455, 180.9502499901501 * x0));
-        let x222 = Self::mul_add(0.65, x213, x211)
-            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x214, v[3] * x215));
-        [x217, x218, x219, x220, x221, x222, x211, x203, x193, x186, x178, x170, x160]
+        let x220 = Self::mul_add(0.65, x211, x209)
+            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x212, v[3] * x213));
+        [x215, x216, x217, x218, x219, x220, x209, x201, x191, x184, x176, x168, x158]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
-    /// Methods: bias `newton-euler`: 549 mul, 460 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 340 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 547 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 338 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
         let x0 = a[0] + Self::mul_add(-v[1], v[5], v[2] * v[4]);
@@ -2115,7 +2090,7 @@ impl FreeFloating7 {
         let x51 = x33 * x43;
         let x52 = x40 + x51;
         let x53 = Self::mul_add(
-            -0.0021399965876409276,
+            -0.002139996587640933,
             x43,
             -0.0000000234896432582596 * x33,
         );
@@ -2127,7 +2102,7 @@ impl FreeFloating7 {
         let x55 = Self::mul_add(
             113.3918902508081,
             x43,
-            Self::mul_add(5.080660024070366, x33, -0.0021399965876409276 * x32),
+            Self::mul_add(5.080660024070366, x33, -0.002139996587640933 * x32),
         );
         let x56 = Self::mul_add(
             x39,
@@ -2139,503 +2114,501 @@ impl FreeFloating7 {
             ) + Self::mul_add(-x32, x55, x43 * x53),
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x58 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x59 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x60 = Self::mul_add(
+        let x58 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x61 = Self::mul_add(
+        let x59 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x62 = Self::mul_add(x43, c_q9, Self::mul_add(x33, x60, x32 * x58));
-        let x63 = Self::mul_add(-x43, s_q9, Self::mul_add(x33, x61, x32 * x59));
-        let x64 = x37 + Self::mul_add(0.4, x41 + x48, 0.275 * x47);
-        let x65 = x38 + Self::mul_add(-0.275, x50, 0.4 * (x51 - x40));
-        let x66 = x39 + Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
-        let x67 = Self::mul_add(c_q9, x66, Self::mul_add(x60, x65, x58 * x64));
-        let x68 = Self::mul_add(
+        let x60 = Self::mul_add(x43, c_q9, Self::mul_add(x33, x58, x32 * s_q9));
+        let x61 = Self::mul_add(-x43, s_q9, Self::mul_add(x33, x59, x32 * c_q9));
+        let x62 = x37 + Self::mul_add(0.4, x41 + x48, 0.275 * x47);
+        let x63 = x38 + Self::mul_add(-0.275, x50, 0.4 * (x51 - x40));
+        let x64 = x39 + Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
+        let x65 = Self::mul_add(c_q9, x64, Self::mul_add(x58, x63, s_q9 * x62));
+        let x66 = Self::mul_add(
             -0.00000000020510342851533115,
-            x66,
-            Self::mul_add(0.00000000020510342851533115, x64, x65),
+            x64,
+            Self::mul_add(0.00000000020510342851533115, x62, x63),
         );
-        let x69 = Self::mul_add(
+        let x67 = Self::mul_add(
             v[8],
-            x63,
-            Self::mul_add(x42, c_q9, Self::mul_add(x41, x60, x40 * x58)),
+            x61,
+            Self::mul_add(x42, c_q9, Self::mul_add(x41, x58, x40 * s_q9)),
         );
-        let x70 = Self::mul_add(
+        let x68 = Self::mul_add(
             -v[8],
-            x62,
-            Self::mul_add(-x42, s_q9, Self::mul_add(x41, x61, x40 * x59)),
+            x60,
+            Self::mul_add(-x42, s_q9, Self::mul_add(x41, x59, x40 * c_q9)),
         );
-        let x71 = a[8]
+        let x69 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x42,
                 Self::mul_add(0.00000000020510342851533115, x40, x41),
             );
-        let x72 = v[8]
+        let x70 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x43,
                 Self::mul_add(0.00000000020510342851533115, x32, x33),
             );
-        let x73 = Self::mul_add(x62, x63, -x71);
-        let x74 = Self::mul_add(x62, x62, x72 * x72);
-        let x75 = Self::mul_add(x63, x72, x69);
-        let x76 = -0.00214 * x72;
-        let x77 = Self::mul_add(-36.18604050126307, x72, -63.36336825000001 * x63);
-        let x78 = Self::mul_add(
+        let x71 = Self::mul_add(x60, x61, -x69);
+        let x72 = Self::mul_add(x60, x60, x70 * x70);
+        let x73 = Self::mul_add(x61, x70, x67);
+        let x74 = -0.00214 * x70;
+        let x75 = Self::mul_add(-36.18604050126307, x70, -63.36336825000001 * x61);
+        let x76 = Self::mul_add(
             69.99836825,
-            x72,
-            Self::mul_add(-36.18604050126307, x63, -0.00214 * x62),
+            x70,
+            Self::mul_add(-36.18604050126307, x61, -0.00214 * x60),
         );
-        let x79 = Self::mul_add(
+        let x77 = Self::mul_add(
             -81.53205,
-            x68,
-            Self::mul_add(-0.00214, x71, Self::mul_add(-x72, x77, x63 * x78)),
+            x66,
+            Self::mul_add(-0.00214, x69, Self::mul_add(-x70, x75, x61 * x76)),
         );
-        let x80 = Self::mul_add(
-            x67,
+        let x78 = Self::mul_add(
+            x65,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x71,
-                Self::mul_add(-36.18604050126307, x70, -0.00214 * x69),
-            ) + Self::mul_add(-x63, x76, x62 * x77),
+                x69,
+                Self::mul_add(-36.18604050126307, x68, -0.00214 * x67),
+            ) + Self::mul_add(-x61, x74, x60 * x75),
         );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x82 = Self::mul_add(x63, s_q10, x62 * c_q10);
-        let x83 = Self::mul_add(-x62, s_q10, x63 * c_q10);
-        let x84 = Self::mul_add(-0.87, x73, x67);
-        let x85 = Self::mul_add(
+        let x80 = Self::mul_add(x61, s_q10, x60 * c_q10);
+        let x81 = Self::mul_add(-x60, s_q10, x61 * c_q10);
+        let x82 = Self::mul_add(-0.87, x71, x65);
+        let x83 = Self::mul_add(
             0.87,
-            x74,
-            Self::mul_add(-s_q9, x66, Self::mul_add(x61, x65, x59 * x64)),
+            x72,
+            Self::mul_add(-s_q9, x64, Self::mul_add(x59, x63, c_q9 * x62)),
         );
-        let x86 = Self::mul_add(-0.87, x75, x68);
-        let x87 = Self::mul_add(s_q10, x85, c_q10 * x84);
-        let x88 = Self::mul_add(v[9], x83, Self::mul_add(x70, s_q10, x69 * c_q10));
-        let x89 = Self::mul_add(-v[9], x82, Self::mul_add(-x69, s_q10, x70 * c_q10));
-        let x90 = a[9] + x71;
-        let x91 = v[9] + x72;
-        let x92 = Self::mul_add(x82, x83, -x90);
-        let x93 = x82 * x82;
-        let x94 = Self::mul_add(x91, x91, x93);
-        let x95 = x83 * x91;
-        let x96 = x88 + x95;
-        let x97 = -0.6328 * x91;
-        let x98 = Self::mul_add(-24.35164200091464, x91, -24.4950615 * x83);
-        let x99 = Self::mul_add(
+        let x84 = Self::mul_add(-0.87, x73, x66);
+        let x85 = Self::mul_add(s_q10, x83, c_q10 * x82);
+        let x86 = Self::mul_add(v[9], x81, Self::mul_add(x68, s_q10, x67 * c_q10));
+        let x87 = Self::mul_add(-v[9], x80, Self::mul_add(-x67, s_q10, x68 * c_q10));
+        let x88 = a[9] + x69;
+        let x89 = v[9] + x70;
+        let x90 = Self::mul_add(x80, x81, -x88);
+        let x91 = x80 * x80;
+        let x92 = Self::mul_add(x89, x89, x91);
+        let x93 = x81 * x89;
+        let x94 = x86 + x93;
+        let x95 = -0.6328 * x89;
+        let x96 = Self::mul_add(-24.35164200091464, x89, -24.4950615 * x81);
+        let x97 = Self::mul_add(
             28.2393615,
-            x91,
-            Self::mul_add(-24.351642000914637, x83, -0.6328 * x82),
+            x89,
+            Self::mul_add(-24.351642000914637, x81, -0.6328 * x80),
         );
-        let x100 = Self::mul_add(
+        let x98 = Self::mul_add(
             -45.1584,
-            x86,
-            Self::mul_add(-0.6328, x90, Self::mul_add(-x91, x98, x83 * x99)),
+            x84,
+            Self::mul_add(-0.6328, x88, Self::mul_add(-x89, x96, x81 * x97)),
         );
-        let x101 = Self::mul_add(
-            x87,
+        let x99 = Self::mul_add(
+            x85,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x90,
-                Self::mul_add(-24.351642000914637, x89, -0.6328 * x88),
-            ) + Self::mul_add(-x83, x97, x82 * x98),
+                x88,
+                Self::mul_add(-24.351642000914637, x87, -0.6328 * x86),
+            ) + Self::mul_add(-x81, x95, x80 * x96),
         );
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x103 = Self::mul_add(x83, s_q11, x82 * c_q11);
-        let x104 = Self::mul_add(-x82, s_q11, x83 * c_q11);
-        let x105 = x87
-            + Self::mul_add(-0.275, Self::mul_add(x82, x91, x89), -0.63 * x92);
-        let x106 = Self::mul_add(-s_q10, x84, c_q10 * x85)
-            + Self::mul_add(0.63, x94, -0.275 * (x95 - x88));
-        let x107 = x86 + Self::mul_add(0.275, Self::mul_add(x83, x83, x93), -0.63 * x96);
-        let x108 = Self::mul_add(s_q11, x106, c_q11 * x105);
-        let x109 = Self::mul_add(v[10], x104, Self::mul_add(x89, s_q11, x88 * c_q11));
-        let x110 = Self::mul_add(-v[10], x103, Self::mul_add(-x88, s_q11, x89 * c_q11));
-        let x111 = a[10] + x90;
-        let x112 = v[10] + x91;
-        let x113 = x103 * x103;
-        let x114 = x104 * x112;
-        let x115 = 0.01675 * x112;
-        let x116 = Self::mul_add(2.5482240016099564, x112, -9.142025249762803 * x104);
-        let x117 = Self::mul_add(
+        let x101 = Self::mul_add(x81, s_q11, x80 * c_q11);
+        let x102 = Self::mul_add(-x80, s_q11, x81 * c_q11);
+        let x103 = x85
+            + Self::mul_add(-0.275, Self::mul_add(x80, x89, x87), -0.63 * x90);
+        let x104 = Self::mul_add(-s_q10, x82, c_q10 * x83)
+            + Self::mul_add(0.63, x92, -0.275 * (x93 - x86));
+        let x105 = x84 + Self::mul_add(0.275, Self::mul_add(x81, x81, x91), -0.63 * x94);
+        let x106 = Self::mul_add(s_q11, x104, c_q11 * x103);
+        let x107 = Self::mul_add(v[10], x102, Self::mul_add(x87, s_q11, x86 * c_q11));
+        let x108 = Self::mul_add(-v[10], x101, Self::mul_add(-x86, s_q11, x87 * c_q11));
+        let x109 = a[10] + x88;
+        let x110 = v[10] + x89;
+        let x111 = x101 * x101;
+        let x112 = x102 * x110;
+        let x113 = 0.01675 * x110;
+        let x114 = Self::mul_add(2.5482240016099564, x110, -9.142025249762803 * x102);
+        let x115 = Self::mul_add(
             9.223235249762805,
-            x112,
-            Self::mul_add(2.5482240016099564, x104, 0.01675 * x103),
+            x110,
+            Self::mul_add(2.5482240016099564, x102, 0.01675 * x101),
         );
-        let x118 = Self::mul_add(
+        let x116 = Self::mul_add(
             7.078399999258757,
-            x107,
-            Self::mul_add(0.01675, x111, Self::mul_add(-x112, x116, x104 * x117)),
+            x105,
+            Self::mul_add(0.01675, x109, Self::mul_add(-x110, x114, x102 * x115)),
         );
-        let x119 = Self::mul_add(
-            x108,
+        let x117 = Self::mul_add(
+            x106,
             -7.078399999258757,
             Self::mul_add(
                 9.223235249762805,
-                x111,
-                Self::mul_add(2.5482240016099564, x110, 0.01675 * x109),
-            ) + Self::mul_add(-x104, x115, x103 * x116),
+                x109,
+                Self::mul_add(2.5482240016099564, x108, 0.01675 * x107),
+            ) + Self::mul_add(-x102, x113, x101 * x114),
         );
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x121 = -0.00000000020510342851533115 * s_q12;
-        let x122 = -0.00000000020510342851533115 * c_q12;
-        let x123 = Self::mul_add(-x112, s_q12, Self::mul_add(x104, x121, x103 * c_q12));
-        let x124 = Self::mul_add(-x112, c_q12, Self::mul_add(-x103, s_q12, x104 * x122));
-        let x125 = Self::mul_add(-0.36, Self::mul_add(x103, x112, x110), x108);
-        let x126 = Self::mul_add(
+        let x119 = -0.00000000020510342851533115 * s_q12;
+        let x120 = -0.00000000020510342851533115 * c_q12;
+        let x121 = Self::mul_add(-x110, s_q12, Self::mul_add(x102, x119, x101 * c_q12));
+        let x122 = Self::mul_add(-x110, c_q12, Self::mul_add(-x101, s_q12, x102 * x120));
+        let x123 = Self::mul_add(-0.36, Self::mul_add(x101, x110, x108), x106);
+        let x124 = Self::mul_add(
             -0.36,
-            x114 - x109,
-            Self::mul_add(-s_q11, x105, c_q11 * x106),
+            x112 - x107,
+            Self::mul_add(-s_q11, x103, c_q11 * x104),
         );
-        let x127 = Self::mul_add(0.36, Self::mul_add(x104, x104, x113), x107);
-        let x128 = Self::mul_add(-s_q12, x127, Self::mul_add(x121, x126, c_q12 * x125));
-        let x129 = Self::mul_add(-c_q12, x127, Self::mul_add(-s_q12, x125, x122 * x126));
-        let x130 = Self::mul_add(-0.00000000020510342851533115, x127, x126);
-        let x131 = Self::mul_add(
+        let x125 = Self::mul_add(0.36, Self::mul_add(x102, x102, x111), x105);
+        let x126 = Self::mul_add(-s_q12, x125, Self::mul_add(x119, x124, c_q12 * x123));
+        let x127 = Self::mul_add(-c_q12, x125, Self::mul_add(-s_q12, x123, x120 * x124));
+        let x128 = Self::mul_add(-0.00000000020510342851533115, x125, x124);
+        let x129 = Self::mul_add(
             v[11],
-            x124,
-            Self::mul_add(-x111, s_q12, Self::mul_add(x110, x121, x109 * c_q12)),
+            x122,
+            Self::mul_add(-x109, s_q12, Self::mul_add(x108, x119, x107 * c_q12)),
         );
-        let x132 = Self::mul_add(
+        let x130 = Self::mul_add(
             -v[11],
-            x123,
-            Self::mul_add(-x111, c_q12, Self::mul_add(-x109, s_q12, x110 * x122)),
+            x121,
+            Self::mul_add(-x109, c_q12, Self::mul_add(-x107, s_q12, x108 * x120)),
         );
-        let x133 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x110);
-        let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x112, x104);
-        let x135 = x124 * x124;
-        let x136 = x134 * x134;
-        let x137 = x123 * x124;
-        let x138 = x137 - x133;
-        let x139 = x123 * x134;
-        let x140 = x123 * x123;
-        let x141 = x136 + x140;
-        let x142 = x124 * x134;
-        let x143 = x131 + x142;
-        let x144 = Self::mul_add(-0.809539999555672, x134, -1.9877000000000002 * x124);
-        let x145 = Self::mul_add(
+        let x131 = a[11] + Self::mul_add(-0.00000000020510342851533115, x109, x108);
+        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x110, x102);
+        let x133 = x122 * x122;
+        let x134 = x132 * x132;
+        let x135 = x121 * x122;
+        let x136 = x135 - x131;
+        let x137 = x121 * x132;
+        let x138 = x121 * x121;
+        let x139 = x134 + x138;
+        let x140 = x122 * x132;
+        let x141 = x129 + x140;
+        let x142 = Self::mul_add(-0.809539999555672, x132, -1.9877000000000002 * x122);
+        let x143 = Self::mul_add(
             -2.741639999592316,
-            x134,
-            Self::mul_add(-5.252920330000002, x124, -1.9877000000000002 * x123),
+            x132,
+            Self::mul_add(-5.252920330000002, x122, -1.9877000000000002 * x121),
         );
-        let x146 = Self::mul_add(
+        let x144 = Self::mul_add(
             9.740442170000001,
-            x134,
-            Self::mul_add(-2.7416399995923166, x124, -0.809539999555672 * x123),
+            x132,
+            Self::mul_add(-2.7416399995923166, x122, -0.809539999555672 * x121),
         );
-        let x147 = Self::mul_add(
-            x130,
+        let x145 = Self::mul_add(
+            x128,
             -3.6140000000000003,
             Self::mul_add(
                 -2.741639999592316,
-                x133,
-                Self::mul_add(-5.252920330000002, x132, -1.9877000000000002 * x131),
-            ) + Self::mul_add(-x123, x146, x134 * x144),
+                x131,
+                Self::mul_add(-5.252920330000002, x130, -1.9877000000000002 * x129),
+            ) + Self::mul_add(-x121, x144, x132 * x142),
         );
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x149 = -0.00000000020510342851533115 * c_q13;
-        let x150 = -0.00000000020510342851533115 * s_q13;
-        let x151 = Self::mul_add(-x134, c_q13, Self::mul_add(x124, s_q13, x123 * x149));
-        let x152 = Self::mul_add(x134, s_q13, Self::mul_add(-x123, x150, x124 * c_q13));
-        let x153 = x128 + Self::mul_add(0.16, x132 + x139, 0.55 * x138);
-        let x154 = x130 + Self::mul_add(-0.16, x135 + x140, 0.55 * x143);
-        let x155 = Self::mul_add(
+        let x147 = -0.00000000020510342851533115 * c_q13;
+        let x148 = -0.00000000020510342851533115 * s_q13;
+        let x149 = Self::mul_add(-x132, c_q13, Self::mul_add(x122, s_q13, x121 * x147));
+        let x150 = Self::mul_add(x132, s_q13, Self::mul_add(-x121, x148, x122 * c_q13));
+        let x151 = x126 + Self::mul_add(0.16, x130 + x137, 0.55 * x136);
+        let x152 = x128 + Self::mul_add(-0.16, x133 + x138, 0.55 * x141);
+        let x153 = Self::mul_add(
             -c_q13,
-            x154,
+            x152,
             Self::mul_add(
                 s_q13,
-                x129 + Self::mul_add(-0.55, x141, 0.16 * (x142 - x131)),
-                x149 * x153,
+                x127 + Self::mul_add(-0.55, x139, 0.16 * (x140 - x129)),
+                x147 * x151,
             ),
         );
-        let x156 = Self::mul_add(
+        let x154 = Self::mul_add(
             v[12],
-            x152,
-            Self::mul_add(-x133, c_q13, Self::mul_add(x132, s_q13, x131 * x149)),
+            x150,
+            Self::mul_add(-x131, c_q13, Self::mul_add(x130, s_q13, x129 * x147)),
         );
-        let x157 = Self::mul_add(
+        let x155 = Self::mul_add(
             -v[12],
-            x151,
-            Self::mul_add(x133, s_q13, Self::mul_add(-x131, x150, x132 * c_q13)),
+            x149,
+            Self::mul_add(x131, s_q13, Self::mul_add(-x129, x148, x130 * c_q13)),
         );
-        let x158 = a[12] + Self::mul_add(-0.00000000020510342851533115, x133, x131);
-        let x159 = v[12] + Self::mul_add(-0.00000000020510342851533115, x134, x123);
-        let x160 = 4.806620000000001 * Self::mul_add(x151, x152, -x158);
-        let x161 = 4.806620000000001 * Self::mul_add(x151, x151, x159 * x159);
-        let x162 = 4.806620000000001 * Self::mul_add(x152, x159, x156);
-        let x163 = Self::mul_add(-0.0145, x159, 0.000781 * x152);
+        let x156 = a[12] + Self::mul_add(-0.00000000020510342851533115, x131, x129);
+        let x157 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x121);
+        let x158 = 4.806620000000001 * Self::mul_add(x149, x150, -x156);
+        let x159 = 4.806620000000001 * Self::mul_add(x149, x149, x157 * x157);
+        let x160 = 4.806620000000001 * Self::mul_add(x150, x157, x154);
+        let x161 = Self::mul_add(-0.0145, x157, 0.000781 * x150);
+        let x162 = Self::mul_add(
+            -0.9614610000000001,
+            x157,
+            Self::mul_add(-1.2025609200000003, x150, 0.000781 * x149),
+        );
+        let x163 = Self::mul_add(
+            1.4135609200000003,
+            x157,
+            Self::mul_add(-0.9614610000000001, x150, -0.0145 * x149),
+        );
         let x164 = Self::mul_add(
             -0.9614610000000001,
-            x159,
-            Self::mul_add(-1.2025609200000003, x152, 0.000781 * x151),
-        );
+            x156,
+            Self::mul_add(-1.2025609200000003, x155, 0.000781 * x154),
+        ) + Self::mul_add(-x149, x163, x157 * x161);
         let x165 = Self::mul_add(
-            1.4135609200000003,
-            x159,
-            Self::mul_add(-0.9614610000000001, x152, -0.0145 * x151),
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x152, x151),
+            Self::mul_add(-0.0145, x156, 0.000781 * x155)
+                + Self::mul_add(-x157, x162, x150 * x163),
         );
         let x166 = Self::mul_add(
-            -0.9614610000000001,
-            x158,
-            Self::mul_add(-1.2025609200000003, x157, 0.000781 * x156),
-        ) + Self::mul_add(-x151, x165, x159 * x163);
-        let x167 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x154, x153),
-            Self::mul_add(-0.0145, x158, 0.000781 * x157)
-                + Self::mul_add(-x159, x164, x152 * x165),
-        );
-        let x168 = Self::mul_add(
-            x155,
+            x153,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x158,
-                Self::mul_add(-0.9614610000000001, x157, -0.0145 * x156),
-            ) + Self::mul_add(-x152, x163, x151 * x164),
+                x156,
+                Self::mul_add(-0.9614610000000001, x155, -0.0145 * x154),
+            ) + Self::mul_add(-x150, x161, x149 * x162),
         );
-        let x169 = x162 + Self::mul_add(x150, x161, x149 * x160);
-        let x170 = Self::mul_add(-c_q13, x161, s_q13 * x160);
-        let x171 = Self::mul_add(
+        let x167 = x160 + Self::mul_add(x148, x159, x147 * x158);
+        let x168 = Self::mul_add(-c_q13, x159, s_q13 * x158);
+        let x169 = Self::mul_add(
             -0.00000000020510342851533115,
-            x162,
-            -Self::mul_add(s_q13, x161, c_q13 * x160),
+            x160,
+            -Self::mul_add(s_q13, x159, c_q13 * x158),
         );
-        let x172 = Self::mul_add(
-            x169,
+        let x170 = Self::mul_add(
+            x167,
             -0.55,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x168,
-                Self::mul_add(-c_q13, x167, s_q13 * x166),
+                x166,
+                Self::mul_add(-c_q13, x165, s_q13 * x164),
             ),
         );
-        let x173 = Self::mul_add(
+        let x171 = Self::mul_add(
             -3.6140000000000003,
-            x135 + x136,
-            17.135250000000003 * x138,
+            x133 + x134,
+            17.135250000000003 * x136,
+        ) + x167;
+        let x172 = Self::mul_add(
+            -17.135250000000003,
+            x139,
+            3.6140000000000003 * (x131 + x135),
+        ) + x168;
+        let x173 = Self::mul_add(
+            17.135250000000003,
+            x141,
+            3.6140000000000003 * (x137 - x130),
         ) + x169;
         let x174 = Self::mul_add(
-            -17.135250000000003,
-            x141,
-            3.6140000000000003 * (x133 + x137),
-        ) + x170;
-        let x175 = Self::mul_add(
             17.135250000000003,
-            x143,
-            3.6140000000000003 * (x139 - x132),
-        ) + x171;
-        let x176 = Self::mul_add(
-            17.135250000000003,
-            x130,
-            Self::mul_add(-0.809539999555672, x133, -1.9877000000000002 * x132)
-                + Self::mul_add(-x134, x145, x124 * x146),
+            x128,
+            Self::mul_add(-0.809539999555672, x131, -1.9877000000000002 * x130)
+                + Self::mul_add(-x132, x143, x122 * x144),
         )
-            + (x168 + Self::mul_add(-x150, x166, x149 * x167)
-                + Self::mul_add(0.55, x171, -0.16 * x170));
-        let x177 = x147
-            + Self::mul_add(0.16, x169, Self::mul_add(c_q13, x166, s_q13 * x167));
-        let x178 = Self::mul_add(
+            + (x166 + Self::mul_add(-x148, x164, x147 * x165)
+                + Self::mul_add(0.55, x169, -0.16 * x168));
+        let x175 = x145
+            + Self::mul_add(0.16, x167, Self::mul_add(c_q13, x164, s_q13 * x165));
+        let x176 = Self::mul_add(
             9.740442170000001,
-            x133,
-            Self::mul_add(-2.7416399995923166, x132, -0.809539999555672 * x131),
-        ) + Self::mul_add(-x124, x144, x123 * x145)
-            + Self::mul_add(3.6140000000000003, x129, x128 * -17.135250000000003) + x172;
-        let x179 = Self::mul_add(-s_q12, x174, c_q12 * x173);
-        let x180 = x175 + Self::mul_add(x122, x174, x121 * x173);
+            x131,
+            Self::mul_add(-2.7416399995923166, x130, -0.809539999555672 * x129),
+        ) + Self::mul_add(-x122, x142, x121 * x143)
+            + Self::mul_add(3.6140000000000003, x127, x126 * -17.135250000000003) + x170;
+        let x177 = Self::mul_add(-s_q12, x172, c_q12 * x171);
+        let x178 = x173 + Self::mul_add(x120, x172, x119 * x171);
+        let x179 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x101, x102, -x109),
+            x177,
+        );
+        let x180 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x110, x110, x111),
+            x178,
+        );
         let x181 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x103, x104, -x111),
-            x179,
-        );
-        let x182 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x112, x112, x113),
-            x180,
-        );
-        let x183 = Self::mul_add(
-            7.078399999258757,
-            x109 + x114,
+            x107 + x112,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x175,
-                -Self::mul_add(c_q12, x174, s_q12 * x173),
+                x173,
+                -Self::mul_add(c_q12, x172, s_q12 * x171),
             ),
         );
-        let x184 = x118
-            + Self::mul_add(x180, 0.36, Self::mul_add(-s_q12, x177, c_q12 * x176));
-        let x185 = Self::mul_add(2.5482240016099564, x111, -9.142025249762803 * x110)
-            + Self::mul_add(-x103, x117, x112 * x115)
-            + Self::mul_add(-0.36, x179, x178 + Self::mul_add(x122, x177, x121 * x176));
-        let x186 = x119
+        let x182 = x116
+            + Self::mul_add(x178, 0.36, Self::mul_add(-s_q12, x175, c_q12 * x174));
+        let x183 = Self::mul_add(2.5482240016099564, x109, -9.142025249762803 * x108)
+            + Self::mul_add(-x101, x115, x110 * x113)
+            + Self::mul_add(-0.36, x177, x176 + Self::mul_add(x120, x175, x119 * x174));
+        let x184 = x117
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x178,
-                -Self::mul_add(c_q12, x177, s_q12 * x176),
+                x176,
+                -Self::mul_add(c_q12, x175, s_q12 * x174),
             );
-        let x187 = Self::mul_add(-s_q11, x182, c_q11 * x181);
-        let x188 = Self::mul_add(c_q11, x182, s_q11 * x181);
-        let x189 = Self::mul_add(-45.1584, x92, x187);
-        let x190 = Self::mul_add(45.1584, x94, x188);
-        let x191 = Self::mul_add(-45.1584, x96, x183);
-        let x192 = x100
-            + (Self::mul_add(-s_q11, x185, c_q11 * x184)
-                + Self::mul_add(-0.63, x183, 0.275 * x188));
-        let x193 = Self::mul_add(-24.35164200091464, x90, -24.4950615 * x89)
-            + Self::mul_add(-x82, x99, x91 * x97)
-            + Self::mul_add(-0.275, x187, Self::mul_add(c_q11, x185, s_q11 * x184));
-        let x194 = x101 + Self::mul_add(x187, 0.63, x186);
-        let x195 = Self::mul_add(-s_q10, x190, c_q10 * x189);
-        let x196 = Self::mul_add(-81.53205, x73, x195);
-        let x197 = Self::mul_add(
+        let x185 = Self::mul_add(-s_q11, x180, c_q11 * x179);
+        let x186 = Self::mul_add(c_q11, x180, s_q11 * x179);
+        let x187 = Self::mul_add(-45.1584, x90, x185);
+        let x188 = Self::mul_add(45.1584, x92, x186);
+        let x189 = Self::mul_add(-45.1584, x94, x181);
+        let x190 = x98
+            + (Self::mul_add(-s_q11, x183, c_q11 * x182)
+                + Self::mul_add(-0.63, x181, 0.275 * x186));
+        let x191 = Self::mul_add(-24.35164200091464, x88, -24.4950615 * x87)
+            + Self::mul_add(-x80, x97, x89 * x95)
+            + Self::mul_add(-0.275, x185, Self::mul_add(c_q11, x183, s_q11 * x182));
+        let x192 = x99 + Self::mul_add(x185, 0.63, x184);
+        let x193 = Self::mul_add(-s_q10, x188, c_q10 * x187);
+        let x194 = Self::mul_add(-81.53205, x71, x193);
+        let x195 = Self::mul_add(
             81.53205,
-            x74,
-            Self::mul_add(c_q10, x190, s_q10 * x189),
+            x72,
+            Self::mul_add(c_q10, x188, s_q10 * x187),
         );
-        let x198 = Self::mul_add(-81.53205, x75, x191);
-        let x199 = x79
-            + Self::mul_add(-0.87, x191, Self::mul_add(-s_q10, x193, c_q10 * x192));
-        let x200 = Self::mul_add(-36.18604050126307, x71, -63.36336825000001 * x70)
-            + Self::mul_add(-x62, x78, x72 * x76)
-            + Self::mul_add(c_q10, x193, s_q10 * x192);
-        let x201 = x80 + Self::mul_add(x195, 0.87, x194);
-        let x202 = Self::mul_add(
+        let x196 = Self::mul_add(-81.53205, x73, x189);
+        let x197 = x77
+            + Self::mul_add(-0.87, x189, Self::mul_add(-s_q10, x191, c_q10 * x190));
+        let x198 = Self::mul_add(-36.18604050126307, x69, -63.36336825000001 * x68)
+            + Self::mul_add(-x60, x76, x70 * x74)
+            + Self::mul_add(c_q10, x191, s_q10 * x190);
+        let x199 = x78 + Self::mul_add(x193, 0.87, x192);
+        let x200 = Self::mul_add(
             0.00000000020510342851533115,
-            x198,
-            Self::mul_add(x59, x197, x58 * x196),
+            x196,
+            Self::mul_add(c_q9, x195, s_q9 * x194),
         );
-        let x203 = x198 + Self::mul_add(x61, x197, x60 * x196);
-        let x204 = Self::mul_add(
+        let x201 = x196 + Self::mul_add(x59, x195, x58 * x194);
+        let x202 = Self::mul_add(
             -0.00000000020510342851533115,
-            x198,
-            Self::mul_add(-s_q9, x197, c_q9 * x196),
+            x196,
+            Self::mul_add(-s_q9, x195, c_q9 * x194),
         );
-        let x205 = Self::mul_add(
+        let x203 = Self::mul_add(
             -0.275,
-            x202,
+            x200,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x201,
-                Self::mul_add(-s_q9, x200, c_q9 * x199),
+                x199,
+                Self::mul_add(-s_q9, x198, c_q9 * x197),
             ),
         );
-        let x206 = Self::mul_add(
+        let x204 = Self::mul_add(
             0.000000008530897668050218,
             x44 + x45,
             -12.701650001451807 * x47,
-        ) + x202;
-        let x207 = Self::mul_add(
+        ) + x200;
+        let x205 = Self::mul_add(
             12.701650001451807,
             x50,
             -0.000000008530897668050218 * (x42 + x46),
-        ) + x203;
-        let x208 = Self::mul_add(
+        ) + x201;
+        let x206 = Self::mul_add(
             -12.701650001451807,
             x52,
             -0.000000008530897668050218 * (x48 - x41),
-        ) + x204;
-        let x209 = Self::mul_add(
+        ) + x202;
+        let x207 = Self::mul_add(
             -12.701650001451807,
             x39,
-            Self::mul_add(-0.0021399965876409276, x42, -0.0000000234896432582596 * x41)
+            Self::mul_add(-0.002139996587640933, x42, -0.0000000234896432582596 * x41)
                 + Self::mul_add(-x43, x54, x33 * x55),
         )
             + (Self::mul_add(
                 0.00000000020510342851533115,
-                x201,
-                Self::mul_add(x59, x200, x58 * x199),
-            ) + Self::mul_add(0.275, x204, x203 * -0.4));
-        let x210 = x56
-            + Self::mul_add(0.4, x202, x201 + Self::mul_add(x61, x200, x60 * x199));
-        let x211 = Self::mul_add(
+                x199,
+                Self::mul_add(c_q9, x198, s_q9 * x197),
+            ) + Self::mul_add(0.275, x202, x201 * -0.4));
+        let x208 = x56
+            + Self::mul_add(0.4, x200, x199 + Self::mul_add(x59, x198, x58 * x197));
+        let x209 = Self::mul_add(
             113.3918902508081,
             x42,
-            Self::mul_add(5.080660024070366, x41, -0.0021399965876409276 * x40),
+            Self::mul_add(5.080660024070366, x41, -0.002139996587640933 * x40),
         ) + Self::mul_add(-x33, x53, x32 * x54)
             + Self::mul_add(-0.000000008530897668050218, x38, x37 * 12.701650001451807)
-            + x205;
-        let x212 = x208 + Self::mul_add(-x31, x207, x30 * x206);
-        let x213 = Self::mul_add(c_q8, x207, s_q8 * x206);
-        let x214 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x212);
-        let x215 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x213);
-        let x216 = Self::mul_add(
+            + x203;
+        let x210 = x206 + Self::mul_add(-x31, x205, x30 * x204);
+        let x211 = Self::mul_add(c_q8, x205, s_q8 * x204);
+        let x212 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x210);
+        let x213 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x211);
+        let x214 = Self::mul_add(
             48.0240000085309,
             x23 - x19,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x208,
-                Self::mul_add(-c_q8, x206, s_q8 * x207),
+                x206,
+                Self::mul_add(-c_q8, x204, s_q8 * x205),
             ),
         );
-        let x217 = Self::mul_add(-16.80768997608804, x20, -0.07309 * x19)
+        let x215 = Self::mul_add(-16.80768997608804, x20, -0.07309 * x19)
             + Self::mul_add(-x21, x25, x5 * x26)
-            + Self::mul_add(x213, -0.35, x211 + Self::mul_add(-x31, x210, x30 * x209));
-        let x218 = x27
-            + Self::mul_add(0.35, x212, Self::mul_add(c_q8, x210, s_q8 * x209));
-        let x219 = x28
+            + Self::mul_add(x211, -0.35, x209 + Self::mul_add(-x31, x208, x30 * x207));
+        let x216 = x27
+            + Self::mul_add(0.35, x210, Self::mul_add(c_q8, x208, s_q8 * x207));
+        let x217 = x28
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x211,
-                Self::mul_add(-c_q8, x209, s_q8 * x210),
+                x209,
+                Self::mul_add(-c_q8, x207, s_q8 * x208),
             );
-        let x220 = Self::mul_add(-s_q7, x215, c_q7 * x214);
-        let x221 = Self::mul_add(c_q7, x215, s_q7 * x214);
-        let x222 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x223 = 1466.4506062283303 * v[4];
-        let x224 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x225 = x220
+        let x218 = Self::mul_add(-s_q7, x213, c_q7 * x212);
+        let x219 = Self::mul_add(c_q7, x213, s_q7 * x212);
+        let x220 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x221 = 1466.4506062283303 * v[4];
+        let x222 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x223 = x218
             + Self::mul_add(
                 1170.07,
                 x0,
                 Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
             );
-        let x226 = x221
+        let x224 = x219
             + Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x11, 110.5455 * x10),
             );
-        let x227 = x216
+        let x225 = x214
             + Self::mul_add(
                 1170.07,
                 x2,
                 Self::mul_add(-180.9502499901501, x13, 110.5455 * x12),
             );
-        let x228 = Self::mul_add(x221, -0.75, Self::mul_add(-s_q7, x218, c_q7 * x217))
+        let x226 = Self::mul_add(x219, -0.75, Self::mul_add(-s_q7, x216, c_q7 * x215))
             + Self::mul_add(
                 x1,
                 -180.9502499901501,
                 Self::mul_add(-117.61766249359756, a[5], 1394.5960312283303 * a[3])
-                    + Self::mul_add(-v[5], x223, v[4] * x224),
+                    + Self::mul_add(-v[5], x221, v[4] * x222),
             );
-        let x229 = Self::mul_add(c_q7, x218, s_q7 * x217)
-            + Self::mul_add(x216, -0.65, 0.75 * x220)
+        let x227 = Self::mul_add(c_q7, x216, s_q7 * x215)
+            + Self::mul_add(x214, -0.65, 0.75 * x218)
             + (Self::mul_add(
                 1466.4506062283303,
                 a[4],
-                Self::mul_add(-v[3], x224, v[5] * x222),
+                Self::mul_add(-v[3], x222, v[5] * x220),
             ) + Self::mul_add(x2, -110.5455, 180.9502499901501 * x0));
-        let x230 = Self::mul_add(0.65, x221, x219)
+        let x228 = Self::mul_add(0.65, x219, x217)
             + Self::mul_add(
                 110.5455,
                 x1,
                 Self::mul_add(1271.854575, a[5], -117.61766249359758 * a[3])
-                    + Self::mul_add(-v[4], x222, v[3] * x223),
+                    + Self::mul_add(-v[4], x220, v[3] * x221),
             );
-        [x225, x226, x227, x228, x229, x230, x219, x211, x201, x194, x186, x178, x168]
+        [x223, x224, x225, x226, x227, x228, x217, x209, x199, x192, x184, x176, x166]
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
-    /// Methods: forward `aba`: 1619 mul, 1279 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 988 fused where the target has FMA.
+    /// Methods: forward `aba`: 1613 mul, 1277 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
         let x0 = Self::mul_add(
@@ -2712,7 +2685,7 @@ impl FreeFloating7 {
         let x39 = Self::mul_add(
             -12.701650001451807,
             x33,
-            Self::mul_add(-0.0021399965876409276, x38, -0.0000000234896432582596 * x28),
+            Self::mul_add(-0.002139996587640933, x38, -0.0000000234896432582596 * x28),
         );
         let x40 = Self::mul_add(
             x33,
@@ -2726,7 +2699,7 @@ impl FreeFloating7 {
         let x41 = Self::mul_add(
             113.3918902508081,
             x38,
-            Self::mul_add(5.080660024070366, x28, -0.0021399965876409276 * x27),
+            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
         ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
         let x42 = -12.701650001451807 * x38;
         let x43 = x38 * 0.000000008530897668050218;
@@ -2736,956 +2709,4115 @@ impl FreeFloating7 {
             x27 * 12.701650001451807,
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x46 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x47 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x48 = Self::mul_add(
+        let x46 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x49 = Self::mul_add(
+        let x47 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x50 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x48, x27 * x46));
-        let x51 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x49, x27 * x47));
-        let x52 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
-        let x53 = Self::mul_add(-0.4, x27, x32);
-        let x54 = Self::mul_add(0.275, x27, x33);
-        let x55 = Self::mul_add(c_q9, x54, Self::mul_add(x48, x53, x46 * x52));
-        let x56 = Self::mul_add(-s_q9, x54, Self::mul_add(x49, x53, x47 * x52));
-        let x57 = Self::mul_add(
+        let x48 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x46, x27 * s_q9));
+        let x49 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x47, x27 * c_q9));
+        let x50 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
+        let x51 = Self::mul_add(-0.4, x27, x32);
+        let x52 = Self::mul_add(0.275, x27, x33);
+        let x53 = Self::mul_add(c_q9, x52, Self::mul_add(x46, x51, s_q9 * x50));
+        let x54 = Self::mul_add(-s_q9, x52, Self::mul_add(x47, x51, c_q9 * x50));
+        let x55 = Self::mul_add(
             -0.00000000020510342851533115,
-            x54,
-            Self::mul_add(0.00000000020510342851533115, x52, x53),
+            x52,
+            Self::mul_add(0.00000000020510342851533115, x50, x51),
         );
-        let x58 = v[8] * x51;
-        let x59 = v[8] * x50;
-        let x60 = v[8] * x56;
-        let x61 = v[8] * x55;
-        let x62 = v[8]
+        let x56 = v[8] * x49;
+        let x57 = v[8] * x48;
+        let x58 = v[8] * x54;
+        let x59 = v[8] * x53;
+        let x60 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x38,
                 Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x63 = Self::mul_add(-36.18604050126307, x62, -63.36336825000001 * x51);
-        let x64 = Self::mul_add(-81.53205, x57, -0.00214 * x62);
-        let x65 = Self::mul_add(
-            x55,
+        let x61 = Self::mul_add(-36.18604050126307, x60, -63.36336825000001 * x49);
+        let x62 = Self::mul_add(-81.53205, x55, -0.00214 * x60);
+        let x63 = Self::mul_add(
+            x53,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x62,
-                Self::mul_add(-36.18604050126307, x51, -0.00214 * x50),
+                x60,
+                Self::mul_add(-36.18604050126307, x49, -0.00214 * x48),
             ),
         );
-        let x66 = -81.53205 * x62;
-        let x67 = x50 * 81.53205;
+        let x64 = -81.53205 * x60;
+        let x65 = x48 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
-        let x70 = Self::mul_add(-x50, s_q10, x51 * c_q10);
-        let x71 = Self::mul_add(0.87, x62, x55);
-        let x72 = Self::mul_add(x50, -0.87, x57);
-        let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
-        let x74 = Self::mul_add(-s_q10, x71, x56 * c_q10);
-        let x75 = v[9] * x70;
-        let x76 = v[9] * x69;
-        let x77 = v[9] * x74;
-        let x78 = v[9] * x73;
-        let x79 = v[9] + x62;
-        let x80 = Self::mul_add(-24.35164200091464, x79, -24.4950615 * x70);
-        let x81 = Self::mul_add(-45.1584, x72, -0.6328 * x79);
-        let x82 = Self::mul_add(
-            x73,
+        let x67 = Self::mul_add(x49, s_q10, x48 * c_q10);
+        let x68 = Self::mul_add(-x48, s_q10, x49 * c_q10);
+        let x69 = Self::mul_add(0.87, x60, x53);
+        let x70 = Self::mul_add(x48, -0.87, x55);
+        let x71 = Self::mul_add(x54, s_q10, c_q10 * x69);
+        let x72 = Self::mul_add(-s_q10, x69, x54 * c_q10);
+        let x73 = v[9] * x68;
+        let x74 = v[9] * x67;
+        let x75 = v[9] * x72;
+        let x76 = v[9] * x71;
+        let x77 = v[9] + x60;
+        let x78 = Self::mul_add(-24.35164200091464, x77, -24.4950615 * x68);
+        let x79 = Self::mul_add(-45.1584, x70, -0.6328 * x77);
+        let x80 = Self::mul_add(
+            x71,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x79,
-                Self::mul_add(-24.351642000914637, x70, -0.6328 * x69),
+                x77,
+                Self::mul_add(-24.351642000914637, x68, -0.6328 * x67),
             ),
         );
-        let x83 = -45.1584 * x79;
-        let x84 = x69 * 45.1584;
+        let x81 = -45.1584 * x77;
+        let x82 = x67 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x86 = Self::mul_add(x70, s_q11, x69 * c_q11);
-        let x87 = Self::mul_add(-x69, s_q11, x70 * c_q11);
-        let x88 = x73 - Self::mul_add(-0.63, x79, 0.275 * x70);
-        let x89 = Self::mul_add(0.275, x69, x74);
-        let x90 = Self::mul_add(x69, -0.63, x72);
-        let x91 = Self::mul_add(s_q11, x89, c_q11 * x88);
-        let x92 = Self::mul_add(-s_q11, x88, c_q11 * x89);
-        let x93 = v[10] * x87;
-        let x94 = v[10] * x86;
-        let x95 = v[10] * x92;
-        let x96 = v[10] * x91;
-        let x97 = v[10] + x79;
-        let x98 = Self::mul_add(2.5482240016099564, x97, -9.142025249762803 * x87);
-        let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
-        let x100 = Self::mul_add(
-            x91,
+        let x84 = Self::mul_add(x68, s_q11, x67 * c_q11);
+        let x85 = Self::mul_add(-x67, s_q11, x68 * c_q11);
+        let x86 = x71 - Self::mul_add(-0.63, x77, 0.275 * x68);
+        let x87 = Self::mul_add(0.275, x67, x72);
+        let x88 = Self::mul_add(x67, -0.63, x70);
+        let x89 = Self::mul_add(s_q11, x87, c_q11 * x86);
+        let x90 = Self::mul_add(-s_q11, x86, c_q11 * x87);
+        let x91 = v[10] * x85;
+        let x92 = v[10] * x84;
+        let x93 = v[10] * x90;
+        let x94 = v[10] * x89;
+        let x95 = v[10] + x77;
+        let x96 = Self::mul_add(2.5482240016099564, x95, -9.142025249762803 * x85);
+        let x97 = Self::mul_add(7.078399999258757, x88, 0.01675 * x95);
+        let x98 = Self::mul_add(
+            x89,
             -7.078399999258757,
             Self::mul_add(
                 9.223235249762805,
-                x97,
-                Self::mul_add(2.5482240016099564, x87, 0.01675 * x86),
+                x95,
+                Self::mul_add(2.5482240016099564, x85, 0.01675 * x84),
             ),
         );
-        let x101 = 7.078399999258757 * x97;
-        let x102 = x86 * -7.078399999258757;
+        let x99 = 7.078399999258757 * x95;
+        let x100 = x84 * -7.078399999258757;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x104 = -0.00000000020510342851533115 * s_q12;
-        let x105 = -0.00000000020510342851533115 * c_q12;
-        let x106 = Self::mul_add(-x97, s_q12, Self::mul_add(x87, x104, x86 * c_q12));
-        let x107 = Self::mul_add(-x97, c_q12, Self::mul_add(-x86, s_q12, x87 * x105));
-        let x108 = Self::mul_add(x87, -0.36, x91);
-        let x109 = Self::mul_add(0.36, x86, x92);
-        let x110 = Self::mul_add(-x90, s_q12, Self::mul_add(x104, x109, c_q12 * x108));
-        let x111 = Self::mul_add(-x90, c_q12, Self::mul_add(-s_q12, x108, x105 * x109));
-        let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
-        let x113 = v[11] * x107;
-        let x114 = v[11] * x106;
-        let x115 = v[11] * x111;
-        let x116 = v[11] * x110;
-        let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
-        let x118 = Self::mul_add(
+        let x102 = -0.00000000020510342851533115 * s_q12;
+        let x103 = -0.00000000020510342851533115 * c_q12;
+        let x104 = Self::mul_add(-x95, s_q12, Self::mul_add(x85, x102, x84 * c_q12));
+        let x105 = Self::mul_add(-x95, c_q12, Self::mul_add(-x84, s_q12, x85 * x103));
+        let x106 = Self::mul_add(x85, -0.36, x89);
+        let x107 = Self::mul_add(0.36, x84, x90);
+        let x108 = Self::mul_add(-x88, s_q12, Self::mul_add(x102, x107, c_q12 * x106));
+        let x109 = Self::mul_add(-x88, c_q12, Self::mul_add(-s_q12, x106, x103 * x107));
+        let x110 = Self::mul_add(-0.00000000020510342851533115, x88, x107);
+        let x111 = v[11] * x105;
+        let x112 = v[11] * x104;
+        let x113 = v[11] * x109;
+        let x114 = v[11] * x108;
+        let x115 = v[11] + Self::mul_add(-0.00000000020510342851533115, x95, x85);
+        let x116 = Self::mul_add(
             17.135250000000003,
-            x112,
-            Self::mul_add(-0.809539999555672, x117, -1.9877000000000002 * x107),
+            x110,
+            Self::mul_add(-0.809539999555672, x115, -1.9877000000000002 * x105),
         );
-        let x119 = Self::mul_add(
-            x112,
+        let x117 = Self::mul_add(
+            x110,
             -3.6140000000000003,
             Self::mul_add(
                 -2.741639999592316,
-                x117,
-                Self::mul_add(-5.252920330000002, x107, -1.9877000000000002 * x106),
+                x115,
+                Self::mul_add(-5.252920330000002, x105, -1.9877000000000002 * x104),
             ),
         );
-        let x120 = Self::mul_add(
+        let x118 = Self::mul_add(
             9.740442170000001,
-            x117,
-            Self::mul_add(-2.7416399995923166, x107, -0.809539999555672 * x106),
-        ) + Self::mul_add(3.6140000000000003, x111, x110 * -17.135250000000003);
-        let x121 = 17.135250000000003 * x117;
-        let x122 = x117 * -3.6140000000000003;
-        let x123 = Self::mul_add(3.6140000000000003, x107, x106 * -17.135250000000003);
+            x115,
+            Self::mul_add(-2.7416399995923166, x105, -0.809539999555672 * x104),
+        ) + Self::mul_add(3.6140000000000003, x109, x108 * -17.135250000000003);
+        let x119 = 17.135250000000003 * x115;
+        let x120 = x115 * -3.6140000000000003;
+        let x121 = Self::mul_add(3.6140000000000003, x105, x104 * -17.135250000000003);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x125 = -0.00000000020510342851533115 * c_q13;
-        let x126 = -0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(-x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
-        let x128 = Self::mul_add(x117, s_q13, Self::mul_add(-x106, x126, x107 * c_q13));
-        let x129 = x110 - Self::mul_add(0.55, x117, -0.16 * x107);
-        let x130 = Self::mul_add(-0.16, x106, x111);
-        let x131 = Self::mul_add(x106, 0.55, x112);
-        let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
-        let x133 = Self::mul_add(s_q13, x131, Self::mul_add(-x126, x129, c_q13 * x130));
-        let x134 = Self::mul_add(-0.00000000020510342851533115, x131, x129);
-        let x135 = v[12] * x128;
-        let x136 = v[12] * x127;
-        let x137 = v[12] * x133;
-        let x138 = v[12] + Self::mul_add(-0.00000000020510342851533115, x117, x106);
-        let x139 = Self::mul_add(
+        let x123 = -0.00000000020510342851533115 * c_q13;
+        let x124 = -0.00000000020510342851533115 * s_q13;
+        let x125 = Self::mul_add(-x115, c_q13, Self::mul_add(x105, s_q13, x104 * x123));
+        let x126 = Self::mul_add(x115, s_q13, Self::mul_add(-x104, x124, x105 * c_q13));
+        let x127 = x108 - Self::mul_add(0.55, x115, -0.16 * x105);
+        let x128 = Self::mul_add(-0.16, x104, x109);
+        let x129 = Self::mul_add(x104, 0.55, x110);
+        let x130 = Self::mul_add(-c_q13, x129, Self::mul_add(s_q13, x128, x123 * x127));
+        let x131 = Self::mul_add(s_q13, x129, Self::mul_add(-x124, x127, c_q13 * x128));
+        let x132 = Self::mul_add(-0.00000000020510342851533115, x129, x127);
+        let x133 = v[12] * x126;
+        let x134 = v[12] * x125;
+        let x135 = v[12] * x131;
+        let x136 = v[12] + Self::mul_add(-0.00000000020510342851533115, x115, x104);
+        let x137 = Self::mul_add(
             -0.9614610000000001,
-            x138,
-            Self::mul_add(-1.2025609200000003, x128, 0.000781 * x127),
+            x136,
+            Self::mul_add(-1.2025609200000003, x126, 0.000781 * x125),
         );
-        let x140 = Self::mul_add(
+        let x138 = Self::mul_add(
             4.806620000000001,
-            x134,
-            Self::mul_add(-0.0145, x138, 0.000781 * x128),
-        );
-        let x141 = Self::mul_add(
             x132,
+            Self::mul_add(-0.0145, x136, 0.000781 * x126),
+        );
+        let x139 = Self::mul_add(
+            x130,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x138,
-                Self::mul_add(-0.9614610000000001, x128, -0.0145 * x127),
+                x136,
+                Self::mul_add(-0.9614610000000001, x126, -0.0145 * x125),
             ),
         );
-        let x142 = 4.806620000000001 * x138;
-        let x143 = x127 * -4.806620000000001;
-        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x128, x140, x127 * x139));
-        let x145 = Self::mul_add(-x138, x142, x127 * x143);
-        let x146 = tau[6] - x144;
-        let x147 = Self::mul_add(
-            -x128,
-            x143,
+        let x140 = 4.806620000000001 * x136;
+        let x141 = x125 * -4.806620000000001;
+        let x142 = Self::mul_add(x131, x140, Self::mul_add(-x126, x138, x125 * x137));
+        let x143 = Self::mul_add(-x136, x140, x125 * x141);
+        let x144 = tau[6] - x142;
+        let x145 = Self::mul_add(
+            -x126,
+            x141,
             Self::mul_add(
-                x137,
+                x135,
                 -16.344251950881606,
-                Self::mul_add(x136, 3.2693162398830324, x135 * -0.049305260929256585),
+                Self::mul_add(x134, 3.2693162398830324, x133 * -0.049305260929256585),
             ),
         );
-        let x148 = Self::mul_add(4.806620000000001, x135, x128 * x142);
-        let x149 = Self::mul_add(
-            x146,
+        let x146 = Self::mul_add(4.806620000000001, x133, x126 * x140);
+        let x147 = Self::mul_add(
+            x144,
             -0.010257782169020348,
-            Self::mul_add(-x133, x143, Self::mul_add(-x138, x139, x128 * x141))
+            Self::mul_add(-x131, x141, Self::mul_add(-x136, x137, x126 * x139))
                 + Self::mul_add(
-                    x137,
+                    x135,
                     -0.049305260929256585,
                     Self::mul_add(
-                        x136,
+                        x134,
                         0.009081457502008472,
-                        x135 * -0.00014873784145079505,
+                        x133 * -0.00014873784145079505,
                     ),
                 ),
         );
-        let x150 = Self::mul_add(
-            x146,
+        let x148 = Self::mul_add(
+            x144,
             -0.6801694828971361,
-            Self::mul_add(-x127, x141, x138 * x140)
-                + Self::mul_add(-x134, x142, x132 * x143)
+            Self::mul_add(-x125, x139, x136 * x138)
+                + Self::mul_add(-x132, x140, x130 * x141)
                 + Self::mul_add(
-                    x137,
+                    x135,
                     -3.2693162398830324,
-                    Self::mul_add(x136, 1.8565173511957638, x135 * -0.009081457502008472),
+                    Self::mul_add(x134, 1.8565173511957638, x133 * -0.009081457502008472),
                 ),
         );
-        let x151 = x144 + x146;
-        let x152 = Self::mul_add(x146, -3.4003628227073506, x147);
-        let x153 = c_q13 * -0.009081457502008472;
-        let x154 = Self::mul_add(s_q13, -0.00014873784145079505, x153);
-        let x155 = s_q13 * -0.009081457502008472;
-        let x156 = Self::mul_add(c_q13, 0.00014873784145079505, x155);
-        let x157 = Self::mul_add(c_q13, -1.8565173511957638, x155);
-        let x158 = Self::mul_add(s_q13, -1.8565173511957638, -x153);
-        let x159 = Self::mul_add(x125, -0.049305260929256585, 4.806620000000001);
-        let x160 = s_q13 * -0.049305260929256585;
-        let x161 = Self::mul_add(
+        let x149 = x142 + x144;
+        let x150 = Self::mul_add(x144, -3.4003628227073506, x145);
+        let x151 = c_q13 * -0.009081457502008472;
+        let x152 = Self::mul_add(s_q13, -0.00014873784145079505, x151);
+        let x153 = s_q13 * -0.009081457502008472;
+        let x154 = Self::mul_add(c_q13, 0.00014873784145079505, x153);
+        let x155 = Self::mul_add(c_q13, -1.8565173511957638, x153);
+        let x156 = Self::mul_add(s_q13, -1.8565173511957638, -x151);
+        let x157 = Self::mul_add(x123, -0.049305260929256585, 4.806620000000001);
+        let x158 = s_q13 * -0.049305260929256585;
+        let x159 = Self::mul_add(
             c_q13,
             0.049305260929256585,
             -0.0000000009858542415703612,
         );
-        let x162 = x125 * -3.2693162398830324;
-        let x163 = s_q13 * -3.2693162398830324;
-        let x164 = c_q13 * -3.2693162398830324;
-        let x165 = Self::mul_add(-x126, x162, x125 * x159);
-        let x166 = Self::mul_add(-x126, x163, x125 * x160);
-        let x167 = Self::mul_add(x126, x164, x125 * x161);
-        let x168 = Self::mul_add(c_q13, x162, s_q13 * x159);
-        let x169 = Self::mul_add(-c_q13, x159, s_q13 * x162);
-        let x170 = s_q13 * -16.344251950881606;
-        let x171 = c_q13 * -16.344251950881606;
-        let x172 = x125 * (x125 * -16.344251950881606);
-        let x173 = x125 * x170;
-        let x174 = x125 * x171;
-        let x175 = s_q13 * x170;
-        let x176 = s_q13 * x171;
-        let x177 = c_q13 * x171;
-        let x178 = x166 + Self::mul_add(-0.55, x176, -0.16 * x175);
-        let x179 = x167 + Self::mul_add(0.16, x176, 0.55 * x177);
-        let x180 = Self::mul_add(0.16, x172, x168);
-        let x181 = Self::mul_add(0.16, x173, Self::mul_add(c_q13, x163, s_q13 * x160));
-        let x182 = Self::mul_add(-0.16, x174, Self::mul_add(-c_q13, x164, s_q13 * x161));
-        let x183 = Self::mul_add(-0.55, x172, x169);
-        let x184 = Self::mul_add(-0.55, x173, Self::mul_add(-c_q13, x160, s_q13 * x163));
-        let x185 = Self::mul_add(-0.55, x174, Self::mul_add(s_q13, x164, c_q13 * x161));
-        let x186 = Self::mul_add(
+        let x160 = x123 * -3.2693162398830324;
+        let x161 = s_q13 * -3.2693162398830324;
+        let x162 = c_q13 * -3.2693162398830324;
+        let x163 = Self::mul_add(-x124, x160, x123 * x157);
+        let x164 = Self::mul_add(-x124, x161, x123 * x158);
+        let x165 = Self::mul_add(x124, x162, x123 * x159);
+        let x166 = Self::mul_add(c_q13, x160, s_q13 * x157);
+        let x167 = Self::mul_add(-c_q13, x157, s_q13 * x160);
+        let x168 = s_q13 * -16.344251950881606;
+        let x169 = c_q13 * -16.344251950881606;
+        let x170 = x123 * (x123 * -16.344251950881606);
+        let x171 = x123 * x168;
+        let x172 = x123 * x169;
+        let x173 = s_q13 * x168;
+        let x174 = s_q13 * x169;
+        let x175 = c_q13 * x169;
+        let x176 = x164 + Self::mul_add(-0.55, x174, -0.16 * x173);
+        let x177 = x165 + Self::mul_add(0.16, x174, 0.55 * x175);
+        let x178 = Self::mul_add(0.16, x170, x166);
+        let x179 = Self::mul_add(0.16, x171, Self::mul_add(c_q13, x161, s_q13 * x158));
+        let x180 = Self::mul_add(-0.16, x172, Self::mul_add(-c_q13, x162, s_q13 * x159));
+        let x181 = Self::mul_add(-0.55, x170, x167);
+        let x182 = Self::mul_add(-0.55, x171, Self::mul_add(-c_q13, x158, s_q13 * x161));
+        let x183 = Self::mul_add(-0.55, x172, Self::mul_add(s_q13, x162, c_q13 * x159));
+        let x184 = Self::mul_add(
             0.16,
-            x168,
-            Self::mul_add(0.16, x180, Self::mul_add(c_q13, x157, s_q13 * x154)),
+            x166,
+            Self::mul_add(0.16, x178, Self::mul_add(c_q13, x155, s_q13 * x152)),
         );
-        let x187 = Self::mul_add(
+        let x185 = Self::mul_add(
             -0.55,
-            x168,
-            Self::mul_add(0.16, x183, Self::mul_add(c_q13, x158, s_q13 * x156)),
+            x166,
+            Self::mul_add(0.16, x181, Self::mul_add(c_q13, x156, s_q13 * x154)),
         );
-        let x188 = Self::mul_add(
+        let x186 = Self::mul_add(
             -0.55,
-            x169,
-            Self::mul_add(-0.55, x183, Self::mul_add(-c_q13, x156, s_q13 * x158)),
+            x167,
+            Self::mul_add(-0.55, x181, Self::mul_add(-c_q13, x154, s_q13 * x156)),
         );
-        let x189 = x148 + Self::mul_add(-x126, x145, x125 * x152);
-        let x190 = Self::mul_add(c_q13, x145, s_q13 * x152);
-        let x191 = Self::mul_add(
+        let x187 = x146 + Self::mul_add(-x124, x143, x123 * x150);
+        let x188 = Self::mul_add(c_q13, x143, s_q13 * x150);
+        let x189 = Self::mul_add(
             -0.00000000020510342851533115,
-            x148,
-            Self::mul_add(-c_q13, x152, s_q13 * x145),
+            x146,
+            Self::mul_add(-c_q13, x150, s_q13 * x143),
         );
-        let x192 = Self::mul_add(
+        let x190 = Self::mul_add(
             -0.55,
-            x189,
+            x187,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x151,
-                Self::mul_add(-c_q13, x149, s_q13 * x150),
+                x149,
+                Self::mul_add(-c_q13, x147, s_q13 * x148),
             ),
         );
-        let x193 = -0.809539999555672
+        let x191 = -0.809539999555672
             + Self::mul_add(
                 -0.55,
-                x165,
-                Self::mul_add(-x126, x158, x125 * x156)
-                    + Self::mul_add(-0.55, x185, -0.16 * x184),
+                x163,
+                Self::mul_add(-x124, x156, x123 * x154)
+                    + Self::mul_add(-0.55, x183, -0.16 * x182),
             );
-        let x194 = -2.741639999592316 + x187;
-        let x195 = 9.740442170000001 + x188;
-        let x196 = -17.135250000000003 + x183;
-        let x197 = 3.6140000000000003 + x184;
-        let x198 = Self::mul_add(-x107, x118, x106 * x119)
-            + Self::mul_add(-x110, x122, x111 * x121) + x192;
-        let x199 = 1.0 / x195;
-        let x200 = tau[5] - x198;
-        let x201 = x193 * x199;
-        let x202 = x194 * x199;
-        let x203 = x196 * x199;
-        let x204 = x197 * x199;
-        let x205 = x185 * x199;
-        let x206 = Self::mul_add(
-            -x193,
-            x201,
-            Self::mul_add(0.55, x167, -0.16 * x166)
+        let x192 = -2.741639999592316 + x185;
+        let x193 = 9.740442170000001 + x186;
+        let x194 = -17.135250000000003 + x181;
+        let x195 = 3.6140000000000003 + x182;
+        let x196 = Self::mul_add(-x105, x116, x104 * x117)
+            + Self::mul_add(-x108, x120, x109 * x119) + x190;
+        let x197 = 1.0 / x193;
+        let x198 = tau[5] - x196;
+        let x199 = x191 * x197;
+        let x200 = x192 * x197;
+        let x201 = x194 * x197;
+        let x202 = x195 * x197;
+        let x203 = x183 * x197;
+        let x204 = Self::mul_add(
+            -x191,
+            x199,
+            Self::mul_add(0.55, x165, -0.16 * x164)
                 + (Self::mul_add(
-                    -x126,
+                    -x124,
                     Self::mul_add(
-                        x126,
+                        x124,
                         1.8565173511957638,
-                        x125 * -0.009081457502008472,
+                        x123 * -0.009081457502008472,
                     ),
-                    x125
+                    x123
                         * Self::mul_add(
-                            x126,
+                            x124,
                             0.009081457502008472,
-                            x125 * -0.00014873784145079505,
+                            x123 * -0.00014873784145079505,
                         ),
-                ) + Self::mul_add(0.55, x179, -0.16 * x178)),
+                ) + Self::mul_add(0.55, x177, -0.16 * x176)),
         );
-        let x207 = Self::mul_add(
-            -x193,
-            x202,
+        let x205 = Self::mul_add(
+            -x191,
+            x200,
             -1.9877000000000002
                 + Self::mul_add(
                     0.16,
-                    x165,
-                    Self::mul_add(-x126, x157, x125 * x154)
-                        + Self::mul_add(0.55, x182, -0.16 * x181),
+                    x163,
+                    Self::mul_add(-x124, x155, x123 * x152)
+                        + Self::mul_add(0.55, x180, -0.16 * x179),
                 ),
         );
-        let x208 = Self::mul_add(-x194, x202, -5.252920330000002 + x186);
-        let x209 = Self::mul_add(
-            -x193,
-            x203,
-            x165 + Self::mul_add(-0.55, x174, -0.16 * x173),
-        );
-        let x210 = Self::mul_add(-x193, x204, x178);
-        let x211 = Self::mul_add(x193, x205, 17.135250000000003 + x179);
-        let x212 = Self::mul_add(-x194, x203, x180);
-        let x213 = Self::mul_add(-x194, x204, x181);
-        let x214 = Self::mul_add(x194, x205, -3.6140000000000003 + x182);
-        let x215 = Self::mul_add(-x196, x203, x172);
-        let x216 = Self::mul_add(-x196, x204, x173);
-        let x217 = Self::mul_add(x196, x205, -x174);
-        let x218 = Self::mul_add(-x197, x204, x175);
-        let x219 = Self::mul_add(x197, x205, -x176);
-        let x220 = Self::mul_add(-x185, x205, x177);
-        let x221 = Self::mul_add(
-            x200,
+        let x206 = Self::mul_add(-x192, x200, -5.252920330000002 + x184);
+        let x207 = Self::mul_add(
+            -x191,
             x201,
-            Self::mul_add(-x117, x119, x107 * x120)
-                + Self::mul_add(-x111, x123, x112 * x122)
-                + (x151 + Self::mul_add(-x126, x150, x125 * x149)
-                    + Self::mul_add(0.55, x191, -0.16 * x190))
-                + (Self::mul_add(-x114, x207, x113 * x206)
-                    + Self::mul_add(-x116, x210, x115 * x209)),
+            x163 + Self::mul_add(-0.55, x172, -0.16 * x171),
+        );
+        let x208 = Self::mul_add(-x191, x202, x176);
+        let x209 = Self::mul_add(x191, x203, 17.135250000000003 + x177);
+        let x210 = Self::mul_add(-x192, x201, x178);
+        let x211 = Self::mul_add(-x192, x202, x179);
+        let x212 = Self::mul_add(x192, x203, -3.6140000000000003 + x180);
+        let x213 = Self::mul_add(-x194, x201, x170);
+        let x214 = Self::mul_add(-x194, x202, x171);
+        let x215 = Self::mul_add(x194, x203, -x172);
+        let x216 = Self::mul_add(-x195, x202, x173);
+        let x217 = Self::mul_add(x195, x203, -x174);
+        let x218 = Self::mul_add(-x183, x203, x175);
+        let x219 = Self::mul_add(
+            x198,
+            x199,
+            Self::mul_add(-x115, x117, x105 * x118)
+                + Self::mul_add(-x109, x121, x110 * x120)
+                + (x149 + Self::mul_add(-x124, x148, x123 * x147)
+                    + Self::mul_add(0.55, x189, -0.16 * x188))
+                + (Self::mul_add(-x112, x205, x111 * x204)
+                    + Self::mul_add(-x114, x208, x113 * x207)),
+        );
+        let x220 = Self::mul_add(
+            x198,
+            x200,
+            Self::mul_add(-x104, x118, x115 * x116)
+                + Self::mul_add(-x110, x119, x108 * x121)
+                + Self::mul_add(0.16, x187, Self::mul_add(c_q13, x148, s_q13 * x147))
+                + (Self::mul_add(-x112, x206, x111 * x205)
+                    + Self::mul_add(-x114, x211, x113 * x210)),
+        );
+        let x221 = Self::mul_add(x198, x193 * x197, x196);
+        let x222 = Self::mul_add(
+            x198,
+            x201,
+            Self::mul_add(-x105, x121, x115 * x120) + x187
+                + (Self::mul_add(-x112, x210, x111 * x207)
+                    + Self::mul_add(-x114, x214, x113 * x213)),
+        );
+        let x223 = Self::mul_add(
+            x198,
+            x202,
+            Self::mul_add(-x115, x119, x104 * x121) + x188
+                + (Self::mul_add(-x112, x211, x111 * x208)
+                    + Self::mul_add(-x114, x216, x113 * x214)),
+        );
+        let x224 = Self::mul_add(
+            -x198,
+            x203,
+            Self::mul_add(-x104, x120, x105 * x119) + x189
+                + (Self::mul_add(-x112, x212, x111 * x209)
+                    + Self::mul_add(-x114, x217, x113 * x215)),
+        );
+        let x225 = s_q12 * x205;
+        let x226 = Self::mul_add(x103, x205, x102 * x204);
+        let x227 = c_q12 * x205;
+        let x228 = Self::mul_add(s_q12, x204, x227);
+        let x229 = Self::mul_add(x103, x206, x102 * x205);
+        let x230 = Self::mul_add(c_q12, x206, x225);
+        let x231 = Self::mul_add(-s_q12, x208, c_q12 * x207);
+        let x232 = x209 + Self::mul_add(x103, x208, x102 * x207);
+        let x233 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x209,
+            -Self::mul_add(c_q12, x208, s_q12 * x207),
+        );
+        let x234 = Self::mul_add(-s_q12, x211, c_q12 * x210);
+        let x235 = x212 + Self::mul_add(x103, x211, x102 * x210);
+        let x236 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x212,
+            -Self::mul_add(c_q12, x211, s_q12 * x210),
+        );
+        let x237 = Self::mul_add(-s_q12, x234, c_q12 * x231);
+        let x238 = Self::mul_add(-s_q12, x235, c_q12 * x232);
+        let x239 = Self::mul_add(x103, x234, x102 * x231);
+        let x240 = Self::mul_add(c_q12, x234, s_q12 * x231);
+        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
+        let x242 = Self::mul_add(c_q12, x236, s_q12 * x233);
+        let x243 = s_q12 * x214;
+        let x244 = x215 + Self::mul_add(x103, x214, x102 * x213);
+        let x245 = c_q12 * x214;
+        let x246 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x215,
+            -Self::mul_add(s_q12, x213, x245),
+        );
+        let x247 = x217 + Self::mul_add(x103, x216, x102 * x214);
+        let x248 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x217,
+            -Self::mul_add(c_q12, x216, x243),
+        );
+        let x249 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x218,
+            -Self::mul_add(c_q12, x217, s_q12 * x215),
+        );
+        let x250 = Self::mul_add(
+            -s_q12,
+            Self::mul_add(-s_q12, x216, x245),
+            c_q12 * Self::mul_add(c_q12, x213, -x243),
+        );
+        let x251 = Self::mul_add(-s_q12, x247, c_q12 * x244);
+        let x252 = Self::mul_add(-s_q12, x248, c_q12 * x246);
+        let x253 = x218 + Self::mul_add(x103, x217, x102 * x215)
+            + Self::mul_add(x103, x247, x102 * x244);
+        let x254 = x249 + Self::mul_add(x103, x248, x102 * x246);
+        let x255 = Self::mul_add(0.36, x253, x238);
+        let x256 = Self::mul_add(-0.36, x250, x239);
+        let x257 = Self::mul_add(-0.36, x251, Self::mul_add(x103, x235, x102 * x232));
+        let x258 = Self::mul_add(
+            0.36,
+            x255,
+            Self::mul_add(
+                -s_q12,
+                Self::mul_add(-s_q12, x206, x227),
+                c_q12 * Self::mul_add(c_q12, x204, -x225),
+            ),
+        );
+        let x259 = Self::mul_add(
+            -0.36,
+            x237,
+            Self::mul_add(0.36, x257, Self::mul_add(-s_q12, x229, c_q12 * x226)),
+        );
+        let x260 = Self::mul_add(
+            -0.36,
+            x239,
+            Self::mul_add(-0.36, x256, Self::mul_add(x103, x229, x102 * x226)),
+        );
+        let x261 = Self::mul_add(-s_q12, x223, c_q12 * x222);
+        let x262 = x224 + Self::mul_add(x103, x223, x102 * x222);
+        let x263 = 0.01675
+            + Self::mul_add(-0.36, x241, Self::mul_add(-c_q12, x228, s_q12 * x230));
+        let x264 = 2.5482240016099564
+            - Self::mul_add(-0.36, x240, Self::mul_add(x103, x230, x102 * x228));
+        let x265 = 9.223235249762805 + Self::mul_add(c_q12, x230, s_q12 * x228);
+        let x266 = -7.078399999258757 - x240;
+        let x267 = Self::mul_add(x90, x99, Self::mul_add(-x85, x97, x84 * x96))
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x221,
+                -Self::mul_add(c_q12, x220, s_q12 * x219),
+            );
+        let x268 = Self::mul_add(
+            x85,
+            x99,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x224,
+                -Self::mul_add(c_q12, x223, s_q12 * x222),
+            ),
+        );
+        let x269 = 1.0 / x265;
+        let x270 = tau[4] - x267;
+        let x271 = x263 * x269;
+        let x272 = x264 * x269;
+        let x273 = x266 * x269;
+        let x274 = x241 * x269;
+        let x275 = x242 * x269;
+        let x276 = Self::mul_add(-x263, x271, Self::mul_add(0.36, x238, x258));
+        let x277 = Self::mul_add(-x263, x272, x259);
+        let x278 = Self::mul_add(-x264, x272, -9.142025249762803 + x260);
+        let x279 = Self::mul_add(-x263, x273, Self::mul_add(0.36, x251, x237));
+        let x280 = Self::mul_add(x263, x274, x255);
+        let x281 = Self::mul_add(
+            x263,
+            x275,
+            7.078399999258757
+                + Self::mul_add(0.36, x254, Self::mul_add(-s_q12, x236, c_q12 * x233)),
+        );
+        let x282 = Self::mul_add(-x264, x273, x256);
+        let x283 = Self::mul_add(x264, x274, x257);
+        let x284 = Self::mul_add(
+            x264,
+            x275,
+            Self::mul_add(-0.36, x252, Self::mul_add(x103, x236, x102 * x233)),
+        );
+        let x285 = Self::mul_add(-x266, x273, x250);
+        let x286 = Self::mul_add(x266, x274, x251);
+        let x287 = Self::mul_add(x266, x275, x252);
+        let x288 = Self::mul_add(-x241, x274, x253);
+        let x289 = Self::mul_add(-x241, x275, x254);
+        let x290 = Self::mul_add(
+            -x242,
+            x275,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x249,
+                -Self::mul_add(c_q12, x248, s_q12 * x246),
+            ),
+        );
+        let x291 = Self::mul_add(
+            x270,
+            x271,
+            Self::mul_add(-x90, x100, Self::mul_add(-x95, x96, x85 * x98))
+                + Self::mul_add(0.36, x262, Self::mul_add(-s_q12, x220, c_q12 * x219))
+                + (Self::mul_add(-x92, x277, x91 * x276)
+                    + Self::mul_add(-x94, x280, x93 * x279)),
+        );
+        let x292 = Self::mul_add(
+            x270,
+            x272,
+            Self::mul_add(-x84, x98, x95 * x97) + Self::mul_add(-x88, x99, x89 * x100)
+                + Self::mul_add(
+                    -0.36,
+                    x261,
+                    x221 + Self::mul_add(x103, x220, x102 * x219),
+                )
+                + (Self::mul_add(-x92, x278, x91 * x277)
+                    + Self::mul_add(-x94, x283, x93 * x282)),
+        );
+        let x293 = Self::mul_add(
+            x270,
+            x273,
+            Self::mul_add(-x85, x100, x261)
+                + (Self::mul_add(-x92, x282, x91 * x279)
+                    + Self::mul_add(-x94, x286, x93 * x285)),
+        );
+        let x294 = Self::mul_add(
+            -x270,
+            x274,
+            Self::mul_add(-x95, x99, x84 * x100) + x262
+                + (Self::mul_add(-x92, x283, x91 * x280)
+                    + Self::mul_add(-x94, x288, x93 * x286)),
+        );
+        let x295 = Self::mul_add(
+            -x270,
+            x275,
+            x268
+                + (Self::mul_add(-x92, x284, x91 * x281)
+                    + Self::mul_add(-x94, x289, x93 * x287)),
+        );
+        let x296 = s_q11 * x277;
+        let x297 = c_q11 * x277;
+        let x298 = Self::mul_add(s_q11, x276, x297);
+        let x299 = Self::mul_add(c_q11, x278, x296);
+        let x300 = Self::mul_add(-s_q11, x280, c_q11 * x279);
+        let x301 = Self::mul_add(c_q11, x280, s_q11 * x279);
+        let x302 = Self::mul_add(-s_q11, x283, c_q11 * x282);
+        let x303 = Self::mul_add(c_q11, x283, s_q11 * x282);
+        let x304 = Self::mul_add(-s_q11, x302, c_q11 * x300);
+        let x305 = Self::mul_add(-s_q11, x303, c_q11 * x301);
+        let x306 = Self::mul_add(-s_q11, x284, c_q11 * x281);
+        let x307 = Self::mul_add(c_q11, x302, s_q11 * x300);
+        let x308 = s_q11 * x286;
+        let x309 = c_q11 * x286;
+        let x310 = Self::mul_add(s_q11, x285, x309);
+        let x311 = Self::mul_add(c_q11, x288, x308);
+        let x312 = Self::mul_add(-s_q11, x289, c_q11 * x287);
+        let x313 = Self::mul_add(c_q11, x289, s_q11 * x287);
+        let x314 = Self::mul_add(
+            -s_q11,
+            Self::mul_add(-s_q11, x288, x309),
+            c_q11 * Self::mul_add(c_q11, x285, -x308),
+        );
+        let x315 = Self::mul_add(-s_q11, x311, c_q11 * x310);
+        let x316 = Self::mul_add(c_q11, x311, s_q11 * x310);
+        let x317 = 0.63 * x314;
+        let x318 = 0.63 * x315;
+        let x319 = 0.63 * x312;
+        let x320 = x305 + Self::mul_add(-0.63, x313, 0.275 * x316);
+        let x321 = x306 + Self::mul_add(-0.63, x290, 0.275 * x313);
+        let x322 = Self::mul_add(-0.275, x314, x307);
+        let x323 = Self::mul_add(-0.275, x315, Self::mul_add(c_q11, x303, s_q11 * x301));
+        let x324 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x284, s_q11 * x281));
+        let x325 = Self::mul_add(
+            -0.275,
+            x307,
+            Self::mul_add(-0.275, x322, Self::mul_add(c_q11, x299, s_q11 * x298)),
+        );
+        let x326 = Self::mul_add(-s_q11, x294, c_q11 * x293);
+        let x327 = Self::mul_add(c_q11, x294, s_q11 * x293);
+        let x328 = -0.6328
+            + Self::mul_add(0.63, x304, Self::mul_add(-0.63, x319, 0.275 * x318));
+        let x329 = -24.35164200091464 + Self::mul_add(0.63, x307, -0.275 * x317);
+        let x330 = Self::mul_add(0.63, x317, 28.2393615);
+        let x331 = 45.1584 + x317;
+        let x332 = Self::mul_add(x72, x81, Self::mul_add(-x68, x79, x67 * x78))
+            + Self::mul_add(0.63, x326, Self::mul_add(x270, x265 * x269, x267));
+        let x333 = 1.0 / x330;
+        let x334 = tau[3] - x332;
+        let x335 = x328 * x333;
+        let x336 = x329 * x333;
+        let x337 = x331 * x333;
+        let x338 = x318 * x333;
+        let x339 = x319 * x333;
+        let x340 = Self::mul_add(
+            -x328,
+            x335,
+            Self::mul_add(-0.63, x306, 0.275 * x305)
+                + (Self::mul_add(
+                    -s_q11,
+                    Self::mul_add(-s_q11, x278, x297),
+                    c_q11 * Self::mul_add(c_q11, x276, -x296),
+                ) + Self::mul_add(-0.63, x321, 0.275 * x320)),
+        );
+        let x341 = Self::mul_add(
+            -x328,
+            x336,
+            Self::mul_add(
+                -0.275,
+                x304,
+                Self::mul_add(-s_q11, x299, c_q11 * x298)
+                    + Self::mul_add(-0.63, x324, 0.275 * x323),
+            ),
+        );
+        let x342 = Self::mul_add(-x329, x336, -24.4950615 + x325);
+        let x343 = Self::mul_add(
+            -x328,
+            x337,
+            x304 + Self::mul_add(-0.63, x312, 0.275 * x315),
+        );
+        let x344 = Self::mul_add(-x328, x338, x320);
+        let x345 = Self::mul_add(-x328, x339, -45.1584 + x321);
+        let x346 = Self::mul_add(-x329, x337, x322);
+        let x347 = Self::mul_add(-x329, x338, x323);
+        let x348 = Self::mul_add(-x329, x339, x324);
+        let x349 = Self::mul_add(-x331, x337, x314);
+        let x350 = Self::mul_add(-x331, x338, x315);
+        let x351 = Self::mul_add(-x331, x339, x312);
+        let x352 = Self::mul_add(-x318, x338, x316);
+        let x353 = Self::mul_add(-x318, x339, x313);
+        let x354 = Self::mul_add(-x319, x339, x290);
+        let x355 = Self::mul_add(
+            x334,
+            x335,
+            Self::mul_add(-x72, x82, Self::mul_add(-x77, x78, x68 * x80))
+                + (Self::mul_add(-s_q11, x292, c_q11 * x291)
+                    + Self::mul_add(-0.63, x295, 0.275 * x327))
+                + (Self::mul_add(-x74, x341, x73 * x340)
+                    + Self::mul_add(-x76, x344, x75 * x343)),
+        );
+        let x356 = Self::mul_add(
+            x334,
+            x336,
+            Self::mul_add(-x67, x80, x77 * x79) + Self::mul_add(-x70, x81, x71 * x82)
+                + Self::mul_add(-0.275, x326, Self::mul_add(c_q11, x292, s_q11 * x291))
+                + (Self::mul_add(-x74, x342, x73 * x341)
+                    + Self::mul_add(-x76, x347, x75 * x346)),
+        );
+        let x357 = Self::mul_add(
+            x334,
+            x337,
+            Self::mul_add(-x68, x82, x326)
+                + (Self::mul_add(-x74, x346, x73 * x343)
+                    + Self::mul_add(-x76, x350, x75 * x349)),
+        );
+        let x358 = Self::mul_add(
+            x334,
+            x338,
+            Self::mul_add(-x77, x81, x67 * x82) + x327
+                + (Self::mul_add(-x74, x347, x73 * x344)
+                    + Self::mul_add(-x76, x352, x75 * x350)),
+        );
+        let x359 = Self::mul_add(
+            x334,
+            x339,
+            Self::mul_add(x68, x81, x295)
+                + (Self::mul_add(-x74, x348, x73 * x345)
+                    + Self::mul_add(-x76, x353, x75 * x351)),
+        );
+        let x360 = s_q10 * x341;
+        let x361 = c_q10 * x341;
+        let x362 = Self::mul_add(s_q10, x340, x361);
+        let x363 = Self::mul_add(c_q10, x342, x360);
+        let x364 = Self::mul_add(-s_q10, x344, c_q10 * x343);
+        let x365 = Self::mul_add(c_q10, x344, s_q10 * x343);
+        let x366 = Self::mul_add(-s_q10, x347, c_q10 * x346);
+        let x367 = Self::mul_add(c_q10, x347, s_q10 * x346);
+        let x368 = Self::mul_add(-s_q10, x366, c_q10 * x364);
+        let x369 = Self::mul_add(-s_q10, x348, c_q10 * x345);
+        let x370 = Self::mul_add(c_q10, x366, s_q10 * x364);
+        let x371 = Self::mul_add(c_q10, x348, s_q10 * x345);
+        let x372 = s_q10 * x350;
+        let x373 = c_q10 * x350;
+        let x374 = Self::mul_add(s_q10, x349, x373);
+        let x375 = Self::mul_add(c_q10, x352, x372);
+        let x376 = Self::mul_add(-s_q10, x353, c_q10 * x351);
+        let x377 = Self::mul_add(c_q10, x353, s_q10 * x351);
+        let x378 = Self::mul_add(
+            -s_q10,
+            Self::mul_add(-s_q10, x352, x373),
+            c_q10 * Self::mul_add(c_q10, x349, -x372),
+        );
+        let x379 = Self::mul_add(-s_q10, x375, c_q10 * x374);
+        let x380 = 0.87 * x378;
+        let x381 = 0.87 * x379;
+        let x382 = 0.87 * x376;
+        let x383 = Self::mul_add(-0.87, x354, x369);
+        let x384 = Self::mul_add(
+            -0.87,
+            x383,
+            Self::mul_add(
+                -s_q10,
+                Self::mul_add(-s_q10, x342, x361),
+                c_q10 * Self::mul_add(c_q10, x340, -x360),
+            ),
+        );
+        let x385 = Self::mul_add(-s_q10, x358, c_q10 * x357);
+        let x386 = -0.00214 + Self::mul_add(0.87, x368, -0.87 * x382);
+        let x387 = Self::mul_add(0.87, x370, -36.18604050126307);
+        let x388 = Self::mul_add(0.87, x380, 69.99836825);
+        let x389 = 81.53205 + x380;
+        let x390 = Self::mul_add(x54, x64, Self::mul_add(-x49, x62, x48 * x61))
+            + Self::mul_add(0.87, x385, Self::mul_add(x334, x330 * x333, x332));
+        let x391 = 1.0 / x388;
+        let x392 = tau[2] - x390;
+        let x393 = x386 * x391;
+        let x394 = x387 * x391;
+        let x395 = x389 * x391;
+        let x396 = x381 * x391;
+        let x397 = x382 * x391;
+        let x398 = Self::mul_add(-x386, x393, Self::mul_add(-0.87, x369, x384));
+        let x399 = Self::mul_add(
+            -x386,
+            x394,
+            Self::mul_add(-0.87, x371, Self::mul_add(-s_q10, x363, c_q10 * x362)),
+        );
+        let x400 = Self::mul_add(
+            -x387,
+            x394,
+            -63.36336825000001 + Self::mul_add(c_q10, x363, s_q10 * x362),
+        );
+        let x401 = Self::mul_add(-x386, x395, Self::mul_add(-0.87, x376, x368));
+        let x402 = Self::mul_add(
+            -x386,
+            x396,
+            Self::mul_add(-0.87, x377, Self::mul_add(-s_q10, x367, c_q10 * x365)),
+        );
+        let x403 = Self::mul_add(-x386, x397, -81.53205 + x383);
+        let x404 = Self::mul_add(-x387, x395, x370);
+        let x405 = Self::mul_add(-x387, x396, Self::mul_add(c_q10, x367, s_q10 * x365));
+        let x406 = Self::mul_add(-x387, x397, x371);
+        let x407 = Self::mul_add(-x389, x395, x378);
+        let x408 = Self::mul_add(-x389, x396, x379);
+        let x409 = Self::mul_add(-x389, x397, x376);
+        let x410 = Self::mul_add(-x381, x396, Self::mul_add(c_q10, x375, s_q10 * x374));
+        let x411 = Self::mul_add(-x381, x397, x377);
+        let x412 = Self::mul_add(-x382, x397, x354);
+        let x413 = Self::mul_add(
+            x392,
+            x393,
+            Self::mul_add(-x54, x65, Self::mul_add(-x60, x61, x49 * x63))
+                + Self::mul_add(-0.87, x359, Self::mul_add(-s_q10, x356, c_q10 * x355))
+                + (Self::mul_add(-x57, x399, x56 * x398)
+                    + Self::mul_add(-x59, x402, x58 * x401)),
+        );
+        let x414 = Self::mul_add(
+            x392,
+            x394,
+            Self::mul_add(-x48, x63, x60 * x62) + Self::mul_add(-x55, x64, x53 * x65)
+                + Self::mul_add(c_q10, x356, s_q10 * x355)
+                + (Self::mul_add(-x57, x400, x56 * x399)
+                    + Self::mul_add(-x59, x405, x58 * x404)),
+        );
+        let x415 = Self::mul_add(x392, x388 * x391, x390);
+        let x416 = Self::mul_add(
+            x392,
+            x395,
+            Self::mul_add(-x49, x65, x385)
+                + (Self::mul_add(-x57, x404, x56 * x401)
+                    + Self::mul_add(-x59, x408, x58 * x407)),
+        );
+        let x417 = Self::mul_add(
+            x392,
+            x396,
+            Self::mul_add(-x60, x64, x48 * x65)
+                + Self::mul_add(c_q10, x358, s_q10 * x357)
+                + (Self::mul_add(-x57, x405, x56 * x402)
+                    + Self::mul_add(-x59, x410, x58 * x408)),
+        );
+        let x418 = Self::mul_add(
+            x392,
+            x397,
+            Self::mul_add(x49, x64, x359)
+                + (Self::mul_add(-x57, x406, x56 * x403)
+                    + Self::mul_add(-x59, x411, x58 * x409)),
+        );
+        let x419 = c_q9 * x399;
+        let x420 = Self::mul_add(x47, x399, x46 * x398);
+        let x421 = s_q9 * x399;
+        let x422 = Self::mul_add(c_q9, x398, -x421);
+        let x423 = Self::mul_add(x47, x400, x46 * x399);
+        let x424 = Self::mul_add(-s_q9, x400, x419);
+        let x425 = Self::mul_add(
+            0.00000000020510342851533115,
+            x403,
+            Self::mul_add(c_q9, x402, s_q9 * x401),
+        );
+        let x426 = x403 + Self::mul_add(x47, x402, x46 * x401);
+        let x427 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x403,
+            Self::mul_add(-s_q9, x402, c_q9 * x401),
+        );
+        let x428 = Self::mul_add(
+            0.00000000020510342851533115,
+            x406,
+            Self::mul_add(c_q9, x405, s_q9 * x404),
+        );
+        let x429 = x406 + Self::mul_add(x47, x405, x46 * x404);
+        let x430 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x406,
+            Self::mul_add(-s_q9, x405, c_q9 * x404),
+        );
+        let x431 = Self::mul_add(c_q9, x428, s_q9 * x425);
+        let x432 = Self::mul_add(c_q9, x429, s_q9 * x426);
+        let x433 = Self::mul_add(c_q9, x430, s_q9 * x427);
+        let x434 = Self::mul_add(x47, x428, x46 * x425);
+        let x435 = Self::mul_add(-s_q9, x428, c_q9 * x425);
+        let x436 = c_q9 * x408;
+        let x437 = x409 + Self::mul_add(x47, x408, x46 * x407);
+        let x438 = s_q9 * x408;
+        let x439 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x409,
+            Self::mul_add(c_q9, x407, -x438),
+        );
+        let x440 = x411 + Self::mul_add(x47, x410, x46 * x408);
+        let x441 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x411,
+            Self::mul_add(-s_q9, x410, x436),
+        );
+        let x442 = x412 + Self::mul_add(x47, x411, x46 * x409);
+        let x443 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x412,
+            Self::mul_add(-s_q9, x411, c_q9 * x409),
+        );
+        let x444 = Self::mul_add(
+            c_q9,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x411,
+                Self::mul_add(c_q9, x410, x438),
+            ),
+            s_q9
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x409,
+                    Self::mul_add(s_q9, x407, x436),
+                ),
+        );
+        let x445 = Self::mul_add(
+            0.00000000020510342851533115,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x412,
+                Self::mul_add(c_q9, x411, s_q9 * x409),
+            ),
+            x444,
+        );
+        let x446 = Self::mul_add(
+            0.00000000020510342851533115,
+            x442,
+            Self::mul_add(c_q9, x440, s_q9 * x437),
+        );
+        let x447 = Self::mul_add(
+            0.00000000020510342851533115,
+            x443,
+            Self::mul_add(c_q9, x441, s_q9 * x439),
+        );
+        let x448 = x442 + Self::mul_add(x47, x440, x46 * x437);
+        let x449 = x443 + Self::mul_add(x47, x441, x46 * x439);
+        let x450 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x443,
+            Self::mul_add(-s_q9, x441, c_q9 * x439),
+        );
+        let x451 = x432 + Self::mul_add(0.275, x449, -0.4 * x448);
+        let x452 = x433 + Self::mul_add(0.275, x450, -0.4 * x449);
+        let x453 = Self::mul_add(0.4, x445, x434);
+        let x454 = Self::mul_add(0.4, x446, Self::mul_add(x47, x429, x46 * x426));
+        let x455 = Self::mul_add(0.4, x447, Self::mul_add(x47, x430, x46 * x427));
+        let x456 = Self::mul_add(-0.275, x445, x435);
+        let x457 = Self::mul_add(-0.275, x446, Self::mul_add(-s_q9, x429, c_q9 * x426));
+        let x458 = Self::mul_add(-0.275, x447, Self::mul_add(-s_q9, x430, c_q9 * x427));
+        let x459 = Self::mul_add(
+            0.4,
+            x434,
+            Self::mul_add(0.4, x453, Self::mul_add(x47, x423, x46 * x420)),
+        );
+        let x460 = Self::mul_add(
+            -0.275,
+            x434,
+            Self::mul_add(0.4, x456, Self::mul_add(x47, x424, x46 * x422)),
+        );
+        let x461 = Self::mul_add(
+            -0.275,
+            x435,
+            Self::mul_add(-0.275, x456, Self::mul_add(-s_q9, x424, c_q9 * x422)),
+        );
+        let x462 = Self::mul_add(
+            0.00000000020510342851533115,
+            x418,
+            Self::mul_add(c_q9, x417, s_q9 * x416),
+        );
+        let x463 = x418 + Self::mul_add(x47, x417, x46 * x416);
+        let x464 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x418,
+            Self::mul_add(-s_q9, x417, c_q9 * x416),
+        );
+        let x465 = Self::mul_add(
+            -0.275,
+            x462,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x415,
+                Self::mul_add(-s_q9, x414, c_q9 * x413),
+            ),
+        );
+        let x466 = -0.002139996587640933
+            + Self::mul_add(
+                -0.275,
+                x431,
+                Self::mul_add(c_q9, x424, s_q9 * x422)
+                    + Self::mul_add(0.275, x458, -0.4 * x457),
+            );
+        let x467 = 5.080660024070365 + x460;
+        let x468 = 113.3918902508081 + x461;
+        let x469 = 12.701650001451807 + x456;
+        let x470 = -0.000000008530897668050218 + x457;
+        let x471 = Self::mul_add(-x28, x39, x27 * x40)
+            + Self::mul_add(-x31, x43, x32 * x42) + x465;
+        let x472 = 1.0 / x468;
+        let x473 = tau[1] - x471;
+        let x474 = x466 * x472;
+        let x475 = x467 * x472;
+        let x476 = x469 * x472;
+        let x477 = x470 * x472;
+        let x478 = x458 * x472;
+        let x479 = Self::mul_add(
+            -x466,
+            x474,
+            Self::mul_add(0.275, x433, -0.4 * x432)
+                + (Self::mul_add(
+                    c_q9,
+                    Self::mul_add(c_q9, x400, x421),
+                    s_q9 * Self::mul_add(s_q9, x398, x419),
+                ) + Self::mul_add(0.275, x452, -0.4 * x451)),
+        );
+        let x480 = Self::mul_add(
+            -x466,
+            x475,
+            -0.0000000234896432582596
+                + Self::mul_add(
+                    0.4,
+                    x431,
+                    Self::mul_add(c_q9, x423, s_q9 * x420)
+                        + Self::mul_add(0.275, x455, -0.4 * x454),
+                ),
+        );
+        let x481 = Self::mul_add(-x467, x475, -111.7548902508081 + x459);
+        let x482 = Self::mul_add(
+            -x466,
+            x476,
+            x431 + Self::mul_add(0.275, x447, -0.4 * x446),
+        );
+        let x483 = Self::mul_add(-x466, x477, x451);
+        let x484 = Self::mul_add(-x466, x478, -12.701650001451807 + x452);
+        let x485 = Self::mul_add(-x467, x476, x453);
+        let x486 = Self::mul_add(-x467, x477, x454);
+        let x487 = Self::mul_add(-x467, x478, 0.000000008530897668050218 + x455);
+        let x488 = Self::mul_add(-x469, x476, x445);
+        let x489 = Self::mul_add(-x469, x477, x446);
+        let x490 = Self::mul_add(-x469, x478, x447);
+        let x491 = Self::mul_add(-x470, x477, x448);
+        let x492 = Self::mul_add(-x470, x478, x449);
+        let x493 = Self::mul_add(-x458, x478, x450);
+        let x494 = Self::mul_add(
+            x473,
+            x474,
+            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
+                + (Self::mul_add(
+                    0.00000000020510342851533115,
+                    x415,
+                    Self::mul_add(c_q9, x414, s_q9 * x413),
+                ) + Self::mul_add(0.275, x464, -0.4 * x463))
+                + (Self::mul_add(-x35, x480, x34 * x479)
+                    + Self::mul_add(-x37, x483, x36 * x482)),
+        );
+        let x495 = Self::mul_add(
+            x473,
+            x475,
+            Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
+                + Self::mul_add(0.4, x462, x415 + Self::mul_add(x47, x414, x46 * x413))
+                + (Self::mul_add(-x35, x481, x34 * x480)
+                    + Self::mul_add(-x37, x486, x36 * x485)),
+        );
+        let x496 = Self::mul_add(x473, x468 * x472, x471);
+        let x497 = Self::mul_add(
+            x473,
+            x476,
+            Self::mul_add(-x28, x44, x38 * x43) + x462
+                + (Self::mul_add(-x35, x485, x34 * x482)
+                    + Self::mul_add(-x37, x489, x36 * x488)),
+        );
+        let x498 = Self::mul_add(
+            x473,
+            x477,
+            Self::mul_add(-x38, x42, x27 * x44) + x463
+                + (Self::mul_add(-x35, x486, x34 * x483)
+                    + Self::mul_add(-x37, x491, x36 * x489)),
+        );
+        let x499 = Self::mul_add(
+            x473,
+            x478,
+            Self::mul_add(-x27, x43, x28 * x42) + x464
+                + (Self::mul_add(-x35, x487, x34 * x484)
+                    + Self::mul_add(-x37, x492, x36 * x490)),
+        );
+        let x500 = c_q8 * x480;
+        let x501 = Self::mul_add(s_q8, x479, x500);
+        let x502 = s_q8 * x480;
+        let x503 = Self::mul_add(-c_q8, x479, x502);
+        let x504 = Self::mul_add(c_q8, x481, x502);
+        let x505 = Self::mul_add(s_q8, x481, -x500);
+        let x506 = x484 + Self::mul_add(-x26, x483, x25 * x482);
+        let x507 = Self::mul_add(c_q8, x483, s_q8 * x482);
+        let x508 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x484,
+            Self::mul_add(-c_q8, x482, s_q8 * x483),
+        );
+        let x509 = x487 + Self::mul_add(-x26, x486, x25 * x485);
+        let x510 = Self::mul_add(c_q8, x486, s_q8 * x485);
+        let x511 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x487,
+            Self::mul_add(-c_q8, x485, s_q8 * x486),
+        );
+        let x512 = Self::mul_add(-x26, x509, x25 * x506);
+        let x513 = Self::mul_add(-x26, x510, x25 * x507);
+        let x514 = Self::mul_add(c_q8, x509, s_q8 * x506);
+        let x515 = Self::mul_add(-c_q8, x506, s_q8 * x509);
+        let x516 = Self::mul_add(-c_q8, x507, s_q8 * x510);
+        let x517 = Self::mul_add(-c_q8, x508, s_q8 * x511);
+        let x518 = c_q8 * x489;
+        let x519 = Self::mul_add(s_q8, x488, x518);
+        let x520 = s_q8 * x489;
+        let x521 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x490,
+            Self::mul_add(-c_q8, x488, x520),
+        );
+        let x522 = Self::mul_add(c_q8, x491, x520);
+        let x523 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x492,
+            Self::mul_add(s_q8, x491, -x518),
+        );
+        let x524 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x493,
+            Self::mul_add(-c_q8, x490, s_q8 * x492),
+        );
+        let x525 = x493 + Self::mul_add(-x26, x492, x25 * x490)
+            + Self::mul_add(
+                -x26,
+                x492 + Self::mul_add(-x26, x491, x25 * x489),
+                x25 * (x490 + Self::mul_add(-x26, x489, x25 * x488)),
+            );
+        let x526 = Self::mul_add(c_q8, x492, s_q8 * x490)
+            + Self::mul_add(-x26, x522, x25 * x519);
+        let x527 = x524 + Self::mul_add(-x26, x523, x25 * x521);
+        let x528 = Self::mul_add(c_q8, x522, s_q8 * x519);
+        let x529 = Self::mul_add(c_q8, x523, s_q8 * x521);
+        let x530 = Self::mul_add(-0.35, x528, x513);
+        let x531 = Self::mul_add(0.35, x525, x514);
+        let x532 = Self::mul_add(0.35, x526, Self::mul_add(c_q8, x510, s_q8 * x507));
+        let x533 = Self::mul_add(
+            -0.35,
+            x530,
+            Self::mul_add(
+                -x26,
+                Self::mul_add(-x26, x481, x25 * x480),
+                x25 * Self::mul_add(-x26, x480, x25 * x479),
+            ),
+        );
+        let x534 = Self::mul_add(
+            0.35,
+            x512,
+            Self::mul_add(-0.35, x532, Self::mul_add(-x26, x504, x25 * x501)),
+        );
+        let x535 = Self::mul_add(
+            0.35,
+            x514,
+            Self::mul_add(0.35, x531, Self::mul_add(c_q8, x504, s_q8 * x501)),
+        );
+        let x536 = x499 + Self::mul_add(-x26, x498, x25 * x497);
+        let x537 = Self::mul_add(c_q8, x498, s_q8 * x497);
+        let x538 = -16.80768997608804
+            + Self::mul_add(-0.35, x516, Self::mul_add(-x26, x505, x25 * x503));
+        let x539 = 0.1132
+            + Self::mul_add(0.35, x515, Self::mul_add(c_q8, x505, s_q8 * x503));
+        let x540 = 132.47349025763282 + Self::mul_add(-c_q8, x503, s_q8 * x505);
+        let x541 = 48.0240000085309 + x516;
+        let x542 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x496,
+                Self::mul_add(-c_q8, x494, s_q8 * x495),
+            );
+        let x543 = Self::mul_add(
+            -x7,
+            x22,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x499,
+                Self::mul_add(-c_q8, x497, s_q8 * x498),
+            ),
+        );
+        let x544 = 1.0 / x540;
+        let x545 = tau[0] - x542;
+        let x546 = x538 * x544;
+        let x547 = x539 * x544;
+        let x548 = x515 * x544;
+        let x549 = x541 * x544;
+        let x550 = x517 * x544;
+        let x551 = Self::mul_add(-x538, x546, Self::mul_add(-0.35, x513, x533));
+        let x552 = Self::mul_add(-x538, x547, -0.07309 + x534);
+        let x553 = Self::mul_add(-x539, x547, 130.43769025763282 + x535);
+        let x554 = Self::mul_add(-x538, x548, Self::mul_add(-0.35, x526, x512));
+        let x555 = Self::mul_add(-x538, x549, x530);
+        let x556 = Self::mul_add(
+            -x538,
+            x550,
+            Self::mul_add(-0.35, x529, Self::mul_add(-x26, x511, x25 * x508)),
+        );
+        let x557 = Self::mul_add(-x539, x548, x531);
+        let x558 = Self::mul_add(-x539, x549, x532);
+        let x559 = Self::mul_add(
+            -x539,
+            x550,
+            -48.0240000085309
+                + Self::mul_add(0.35, x527, Self::mul_add(c_q8, x511, s_q8 * x508)),
+        );
+        let x560 = Self::mul_add(-x515, x548, x525);
+        let x561 = Self::mul_add(-x515, x549, x526);
+        let x562 = Self::mul_add(-x515, x550, x527);
+        let x563 = Self::mul_add(-x541, x549, x528);
+        let x564 = Self::mul_add(-x541, x550, x529);
+        let x565 = Self::mul_add(
+            -x517,
+            x550,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x524,
+                Self::mul_add(-c_q8, x521, s_q8 * x523),
+            ),
+        );
+        let x566 = Self::mul_add(
+            x545,
+            x546,
+            Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
+                + Self::mul_add(
+                    -0.35,
+                    x537,
+                    x496 + Self::mul_add(-x26, x495, x25 * x494),
+                )
+                + (Self::mul_add(-x15, x552, x14 * x551)
+                    + Self::mul_add(-x17, x555, x16 * x554)),
+        );
+        let x567 = Self::mul_add(
+            x545,
+            x547,
+            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19))
+                + Self::mul_add(0.35, x536, Self::mul_add(c_q8, x495, s_q8 * x494))
+                + (Self::mul_add(-x15, x553, x14 * x552)
+                    + Self::mul_add(-x17, x558, x16 * x557)),
+        );
+        let x568 = Self::mul_add(
+            x545,
+            x548,
+            Self::mul_add(-x8, x23, x18 * x22) + x536
+                + (Self::mul_add(-x15, x557, x14 * x554)
+                    + Self::mul_add(-x17, x561, x16 * x560)),
+        );
+        let x569 = Self::mul_add(
+            x545,
+            x549,
+            Self::mul_add(x7, x23, x537)
+                + (Self::mul_add(-x15, x558, x14 * x555)
+                    + Self::mul_add(-x17, x563, x16 * x561)),
+        );
+        let x570 = Self::mul_add(
+            x545,
+            x550,
+            x543
+                + (Self::mul_add(-x15, x559, x14 * x556)
+                    + Self::mul_add(-x17, x564, x16 * x562)),
+        );
+        let x571 = s_q7 * x552;
+        let x572 = c_q7 * x552;
+        let x573 = Self::mul_add(s_q7, x551, x572);
+        let x574 = Self::mul_add(c_q7, x553, x571);
+        let x575 = Self::mul_add(-s_q7, x555, c_q7 * x554);
+        let x576 = Self::mul_add(c_q7, x555, s_q7 * x554);
+        let x577 = Self::mul_add(-s_q7, x558, c_q7 * x557);
+        let x578 = Self::mul_add(c_q7, x558, s_q7 * x557);
+        let x579 = Self::mul_add(-s_q7, x577, c_q7 * x575);
+        let x580 = Self::mul_add(-s_q7, x578, c_q7 * x576);
+        let x581 = Self::mul_add(-s_q7, x559, c_q7 * x556);
+        let x582 = Self::mul_add(c_q7, x577, s_q7 * x575);
+        let x583 = Self::mul_add(c_q7, x578, s_q7 * x576);
+        let x584 = Self::mul_add(c_q7, x559, s_q7 * x556);
+        let x585 = s_q7 * x561;
+        let x586 = c_q7 * x561;
+        let x587 = Self::mul_add(s_q7, x560, x586);
+        let x588 = Self::mul_add(c_q7, x563, x585);
+        let x589 = Self::mul_add(-s_q7, x564, c_q7 * x562);
+        let x590 = Self::mul_add(c_q7, x564, s_q7 * x562);
+        let x591 = Self::mul_add(
+            -s_q7,
+            Self::mul_add(-s_q7, x563, x586),
+            c_q7 * Self::mul_add(c_q7, x560, -x585),
+        );
+        let x592 = Self::mul_add(-s_q7, x588, c_q7 * x587);
+        let x593 = Self::mul_add(c_q7, x588, s_q7 * x587);
+        let x594 = 0.65 * x592;
+        let x595 = 0.65 * x593;
+        let x596 = 0.65 * x590;
+        let x597 = Self::mul_add(-0.75, x592, x579);
+        let x598 = Self::mul_add(-0.75, x593, x580);
+        let x599 = x582 + Self::mul_add(-0.65, x589, 0.75 * x591);
+        let x600 = x583 + Self::mul_add(-0.65, x590, 0.75 * x592);
+        let x601 = x584 + Self::mul_add(-0.65, x565, 0.75 * x589);
+        let x602 = Self::mul_add(
+            -0.75,
+            x598,
+            Self::mul_add(
+                -s_q7,
+                Self::mul_add(-s_q7, x553, x572),
+                c_q7 * Self::mul_add(c_q7, x551, -x571),
+            ),
+        );
+        let x603 = Self::mul_add(-s_q7, x569, c_q7 * x568);
+        let x604 = Self::mul_add(c_q7, x569, s_q7 * x568);
+        let x605 = 180.9502499901501 + x599;
+        let x606 = Self::mul_add(-v[5], x4, v[4] * x5) + x603;
+        let x607 = 1.0 / (1170.07 + x591);
+        let x608 = x592 * x607;
+        let x609 = x589 * x607;
+        let x610 = x597 * x607;
+        let x611 = x605 * x607;
+        let x612 = x594 * x607;
+        let x613 = 1.0 / Self::mul_add(-x592, x608, 1170.07 + x593);
+        let x614 = Self::mul_add(-x592, x609, x590);
+        let x615 = x613 * x614;
+        let x616 = Self::mul_add(-x592, x610, -180.9502499901501 + x598);
+        let x617 = x613 * x616;
+        let x618 = Self::mul_add(-x592, x611, x600);
+        let x619 = x613 * x618;
+        let x620 = Self::mul_add(-x592, x612, 110.5455 + x595);
+        let x621 = x613 * x620;
+        let x622 = 1.0
+            / Self::mul_add(-x614, x615, Self::mul_add(-x589, x609, 1170.07 + x565));
+        let x623 = Self::mul_add(
+            -x614,
+            x617,
+            Self::mul_add(-x589, x610, Self::mul_add(-0.75, x590, x581)),
+        );
+        let x624 = x622 * x623;
+        let x625 = Self::mul_add(
+            -x614,
+            x619,
+            Self::mul_add(-x589, x611, -110.5455 + x601),
+        );
+        let x626 = x622 * x625;
+        let x627 = Self::mul_add(-x614, x621, Self::mul_add(-x589, x612, x596));
+        let x628 = x622 * x627;
+        let x629 = Self::mul_add(
+            -x616,
+            x617,
+            Self::mul_add(
+                -x597,
+                x610,
+                1394.5960312283303 + Self::mul_add(-0.75, x580, x602),
+            ),
+        );
+        let x630 = 1.0 / Self::mul_add(-x623, x624, x629);
+        let x631 = Self::mul_add(
+            -x597,
+            x611,
+            Self::mul_add(-0.65, x581, 0.75 * x579)
+                + Self::mul_add(-0.75, x600, Self::mul_add(-s_q7, x574, c_q7 * x573)),
+        );
+        let x632 = Self::mul_add(-x623, x626, Self::mul_add(-x616, x619, x631));
+        let x633 = x630 * x632;
+        let x634 = Self::mul_add(
+            -x616,
+            x621,
+            Self::mul_add(
+                -x597,
+                x612,
+                -117.61766249359756 + Self::mul_add(0.65, x580, -0.75 * x595),
+            ),
+        );
+        let x635 = Self::mul_add(-x623, x628, x634);
+        let x636 = x630 * x635;
+        let x637 = Self::mul_add(
+            -x618,
+            x619,
+            Self::mul_add(
+                -x605,
+                x611,
+                1466.4506062283303
+                    + (Self::mul_add(-0.65, x584, 0.75 * x582)
+                        + (Self::mul_add(c_q7, x574, s_q7 * x573)
+                            + Self::mul_add(-0.65, x601, 0.75 * x599))),
+            ),
+        );
+        let x638 = 1.0 / Self::mul_add(-x632, x633, Self::mul_add(-x625, x626, x637));
+        let x639 = Self::mul_add(
+            -x605,
+            x612,
+            Self::mul_add(0.65, x583, Self::mul_add(-0.65, x596, 0.75 * x594)),
+        );
+        let x640 = Self::mul_add(
+            -x632,
+            x636,
+            Self::mul_add(-x625, x628, Self::mul_add(-x618, x621, x639)),
+        );
+        let x641 = x638 * x640;
+        let x642 = Self::mul_add(
+            -x620,
+            x621,
+            Self::mul_add(-x594, x612, Self::mul_add(0.65, x595, 1271.854575)),
+        );
+        let x643 = Self::mul_add(
+            -x640,
+            x641,
+            Self::mul_add(-x635, x636, Self::mul_add(-x627, x628, x642)),
+        );
+        let x644 = 1.0 / x643;
+        let x645 = Self::mul_add(
+            x606,
+            x608,
+            -(Self::mul_add(-v[3], x5, v[5] * x3) + x604),
+        );
+        let x646 = Self::mul_add(
+            -x615,
+            x645,
+            Self::mul_add(x606, x609, -(Self::mul_add(-v[4], x3, v[3] * x4) + x570)),
+        );
+        let x647 = Self::mul_add(
+            x606,
+            x610,
+            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
+                + Self::mul_add(-0.75, x604, Self::mul_add(-s_q7, x567, c_q7 * x566))),
+        );
+        let x648 = Self::mul_add(-x624, x646, Self::mul_add(-x617, x645, x647));
+        let x649 = Self::mul_add(
+            -x619,
+            x645,
+            Self::mul_add(
+                x606,
+                x611,
+                -(Self::mul_add(-v[3], x2, v[5] * x0)
+                    + Self::mul_add(-v[0], x5, v[2] * x3)
+                    + (Self::mul_add(c_q7, x567, s_q7 * x566)
+                        + Self::mul_add(-0.65, x570, 0.75 * x603))),
+            ),
+        );
+        let x650 = Self::mul_add(-x633, x648, Self::mul_add(-x626, x646, x649));
+        let x651 = Self::mul_add(
+            x606,
+            x612,
+            -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
+                + Self::mul_add(0.65, x604, Self::mul_add(x545, x540 * x544, x542))),
+        );
+        let x652 = Self::mul_add(
+            -x636,
+            x648,
+            Self::mul_add(-x628, x646, Self::mul_add(-x621, x645, x651)),
+        );
+        let x653 = x644 * Self::mul_add(-x641, x650, x652);
+        let x654 = Self::mul_add(-x641, x653, x638 * x650);
+        let x655 = Self::mul_add(-x636, x653, Self::mul_add(-x633, x654, x630 * x648));
+        let x656 = Self::mul_add(
+            -x628,
+            x653,
+            Self::mul_add(-x626, x654, Self::mul_add(-x624, x655, x622 * x646)),
+        );
+        let x657 = Self::mul_add(
+            -x619,
+            x654,
+            Self::mul_add(-x617, x655, Self::mul_add(-x615, x656, x613 * x645)),
+        );
+        let x658 = Self::mul_add(-x621, x653, x657);
+        let x659 = Self::mul_add(
+            x610,
+            x655,
+            Self::mul_add(x609, x656, Self::mul_add(x608, x658, x606 * x607)),
+        );
+        let x660 = Self::mul_add(x612, x653, Self::mul_add(x611, x654, x659));
+        let x661 = -x660;
+        let x662 = Self::mul_add(-0.75, x654, x660);
+        let x663 = x658 - Self::mul_add(-0.65, x653, 0.75 * x655);
+        let x664 = Self::mul_add(-0.65, x654, x656);
+        let x665 = x14 + Self::mul_add(s_q7, x654, c_q7 * x655);
+        let x666 = Self::mul_add(-s_q7, x655, c_q7 * x654) - x15;
+        let x667 = x16 + Self::mul_add(-c_q7, x662, s_q7 * x663);
+        let x668 = Self::mul_add(c_q7, x663, s_q7 * x662) - x17;
+        let x669 = x544
+            * (x545
+                - (Self::mul_add(x540, x653, Self::mul_add(x539, x666, x538 * x665))
+                    + Self::mul_add(
+                        x517,
+                        x664,
+                        Self::mul_add(x541, x668, x515 * x667),
+                    )));
+        let x670 = x653 + x669;
+        let x671 = Self::mul_add(-0.00000000020510342851533115, x670, x665);
+        let x672 = Self::mul_add(0.35, x666, x667);
+        let x673 = Self::mul_add(-0.35, x665, x668);
+        let x674 = Self::mul_add(-0.00000000020510342851533115, x664, x672);
+        let x675 = x34
+            + Self::mul_add(-c_q8, x670, Self::mul_add(s_q8, x666, x25 * x665));
+        let x676 = Self::mul_add(s_q8, x670, Self::mul_add(-x26, x665, c_q8 * x666))
+            - x35;
+        let x677 = x36
+            + Self::mul_add(-c_q8, x664, Self::mul_add(s_q8, x673, x25 * x672));
+        let x678 = Self::mul_add(s_q8, x664, Self::mul_add(-x26, x672, c_q8 * x673))
+            - x37;
+        let x679 = x472
+            * (x473
+                - (Self::mul_add(x468, x671, Self::mul_add(x467, x676, x466 * x675))
+                    + Self::mul_add(
+                        x458,
+                        x674,
+                        Self::mul_add(x470, x678, x469 * x677),
+                    )));
+        let x680 = x671 + x679;
+        let x681 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x680,
+            Self::mul_add(0.00000000020510342851533115, x675, x676),
+        );
+        let x682 = x677 - Self::mul_add(0.275, x680, -0.4 * x676);
+        let x683 = Self::mul_add(-0.4, x675, x678);
+        let x684 = Self::mul_add(0.275, x675, x674);
+        let x685 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x684,
+            Self::mul_add(0.00000000020510342851533115, x682, x683),
+        );
+        let x686 = x56
+            + Self::mul_add(c_q9, x680, Self::mul_add(x46, x676, s_q9 * x675));
+        let x687 = Self::mul_add(-s_q9, x680, Self::mul_add(x47, x676, c_q9 * x675))
+            - x57;
+        let x688 = x58
+            + Self::mul_add(c_q9, x684, Self::mul_add(x46, x683, s_q9 * x682));
+        let x689 = Self::mul_add(-s_q9, x684, Self::mul_add(x47, x683, c_q9 * x682))
+            - x59;
+        let x690 = x391
+            * (x392
+                - (Self::mul_add(x388, x681, Self::mul_add(x387, x687, x386 * x686))
+                    + Self::mul_add(
+                        x382,
+                        x685,
+                        Self::mul_add(x381, x689, x389 * x688),
+                    )));
+        let x691 = x681 + x690;
+        let x692 = Self::mul_add(0.87, x691, x688);
+        let x693 = Self::mul_add(-0.87, x686, x685);
+        let x694 = x73 + Self::mul_add(s_q10, x687, c_q10 * x686);
+        let x695 = Self::mul_add(-s_q10, x686, c_q10 * x687) - x74;
+        let x696 = x75 + Self::mul_add(s_q10, x689, c_q10 * x692);
+        let x697 = Self::mul_add(-s_q10, x692, c_q10 * x689) - x76;
+        let x698 = x333
+            * (x334
+                - (Self::mul_add(x330, x691, Self::mul_add(x329, x695, x328 * x694))
+                    + Self::mul_add(
+                        x319,
+                        x693,
+                        Self::mul_add(x318, x697, x331 * x696),
+                    )));
+        let x699 = x691 + x698;
+        let x700 = x696 - Self::mul_add(-0.63, x699, 0.275 * x695);
+        let x701 = Self::mul_add(0.275, x694, x697);
+        let x702 = Self::mul_add(-0.63, x694, x693);
+        let x703 = x91 + Self::mul_add(s_q11, x695, c_q11 * x694);
+        let x704 = Self::mul_add(-s_q11, x694, c_q11 * x695) - x92;
+        let x705 = x93 + Self::mul_add(s_q11, x701, c_q11 * x700);
+        let x706 = Self::mul_add(-s_q11, x700, c_q11 * x701) - x94;
+        let x707 = x269
+            * (x270
+                - (Self::mul_add(x265, x699, Self::mul_add(x264, x704, x263 * x703))
+                    + Self::mul_add(
+                        -x242,
+                        x702,
+                        Self::mul_add(-x241, x706, x266 * x705),
+                    )));
+        let x708 = x699 + x707;
+        let x709 = Self::mul_add(-0.00000000020510342851533115, x708, x704);
+        let x710 = Self::mul_add(-0.36, x704, x705);
+        let x711 = Self::mul_add(0.36, x703, x706);
+        let x712 = Self::mul_add(-0.00000000020510342851533115, x702, x711);
+        let x713 = x111
+            + Self::mul_add(-s_q12, x708, Self::mul_add(x102, x704, c_q12 * x703));
+        let x714 = Self::mul_add(-c_q12, x708, Self::mul_add(-s_q12, x703, x103 * x704))
+            - x112;
+        let x715 = x113
+            + Self::mul_add(-s_q12, x702, Self::mul_add(x102, x711, c_q12 * x710));
+        let x716 = Self::mul_add(-c_q12, x702, Self::mul_add(-s_q12, x710, x103 * x711))
+            - x114;
+        let x717 = x197
+            * (x198
+                - (Self::mul_add(x193, x709, Self::mul_add(x192, x714, x191 * x713))
+                    + Self::mul_add(
+                        -x183,
+                        x712,
+                        Self::mul_add(x195, x716, x194 * x715),
+                    )));
+        let x718 = x709 + x717;
+        let x719 = Self::mul_add(
+            -c_q13,
+            Self::mul_add(0.55, x713, x712),
+            Self::mul_add(
+                s_q13,
+                Self::mul_add(-0.16, x713, x716),
+                x123 * (x715 - Self::mul_add(0.55, x718, -0.16 * x714)),
+            ),
+        );
+        let x720 = Self::mul_add(
+            -0.9614610000000001,
+            Self::mul_add(s_q13, x718, Self::mul_add(-x124, x713, c_q13 * x714)) - x134,
+            -0.0145
+                * (x133
+                    + Self::mul_add(
+                        -c_q13,
+                        x718,
+                        Self::mul_add(s_q13, x714, x123 * x713),
+                    )),
+        );
+        let x721 = Self::mul_add(
+            -4.806620000000001,
+            x135 + x719,
+            Self::mul_add(
+                1.4135609200000003,
+                Self::mul_add(-0.00000000020510342851533115, x718, x713),
+                x720,
+            ),
+        );
+        let x722 = 0.707433253035886 * (x144 - x721);
+        [x661, x658, x656, x655, x654, x653, x669, x679, x690, x698, x707, x717, x722]
+    }
+    /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
+    ///
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 1170 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 700 fused where the target has FMA.
+    #[must_use]
+    pub fn mass_matrix_and_nonlinear_effects(
+        q: &[f64; 14],
+        v: &[f64; 13],
+    ) -> ([[f64; 13]; 13], [f64; 13]) {
+        let (s_q7, c_q7) = libm::sincos(q[7]);
+        let (s_q8, c_q8) = libm::sincos(q[8]);
+        let x2 = -0.00000000020510342851533115 * c_q8;
+        let x3 = -0.00000000020510342851533115 * s_q8;
+        let (s_q9, c_q9) = libm::sincos(q[9]);
+        let x5 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            0.00000000020510342851533115 * c_q9,
+        );
+        let x6 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            -0.00000000020510342851533115 * c_q9,
+        );
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x10 = -0.00000000020510342851533115 * s_q12;
+        let x11 = -0.00000000020510342851533115 * c_q12;
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x13 = -0.00000000020510342851533115 * c_q13;
+        let x14 = -0.00000000020510342851533115 * s_q13;
+        let x15 = 4.806620000000001 * x14;
+        let x16 = 4.806620000000001 * c_q13;
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = Self::mul_add(-0.000781, x14, -0.0145);
+        let x19 = -0.9614610000000001
+            + Self::mul_add(1.2025609200000003, x14, 0.000781 * x13);
+        let x20 = 1.4135609200000003
+            + Self::mul_add(0.9614610000000001, x14, -0.0145 * x13);
+        let x21 = 0.000781 * c_q13;
+        let x22 = 0.000781 * s_q13;
+        let x23 = Self::mul_add(-1.2025609200000003, c_q13, x22);
+        let x24 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
+        let x25 = x22 + 0.000000000002973999713472302;
+        let x26 = Self::mul_add(-1.2025609200000003, s_q13, -x21)
+            + 0.00000000019719894748377882;
+        let x27 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
+            + -0.0000000002899261911072858;
+        let x28 = -0.16 * x17;
+        let x29 = 0.55 * x16;
+        let x30 = 0.16 * x17;
+        let x31 = x16 * -0.55;
+        let x32 = Self::mul_add(
+            0.16,
+            x15,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x20,
+                Self::mul_add(-c_q13, x18, s_q13 * x19),
+            ),
+        );
+        let x33 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x24,
+                Self::mul_add(-c_q13, x21, s_q13 * x23),
+            ),
+        );
+        let x34 = x20 + Self::mul_add(-x14, x19, x13 * x18) - (x28 - x29) - (x31 - x30);
+        let x35 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(x17, -0.55, Self::mul_add(c_q13, x26, s_q13 * x25)),
+        );
+        let x36 = 3.6140000000000003 - x15;
+        let x37 = 17.135250000000003 + x16;
+        let x38 = -1.9877000000000002
+            + Self::mul_add(0.55, x15, Self::mul_add(c_q13, x19, s_q13 * x18));
+        let x39 = -0.809539999555672 + x32;
+        let x40 = -1.9877000000000002
+            + Self::mul_add(x15, 0.55, x24 + Self::mul_add(-x14, x23, x13 * x21));
+        let x41 = -5.252920330000002
+            + (Self::mul_add(c_q13, x23, s_q13 * x21) + x30 - x28);
+        let x42 = -2.741639999592316 + Self::mul_add(-0.55, x17, x33);
+        let x43 = -0.809539999555672
+            + Self::mul_add(0.16, x15, x27 + Self::mul_add(-x14, x26, x13 * x25));
+        let x44 = -2.7416399995923166 + x35;
+        let x45 = 9.740442170000001
+            + (x29
+                + (Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x27,
+                    Self::mul_add(-c_q13, x25, s_q13 * x26),
+                ) - x31));
+        let x46 = c_q12 * x36;
+        let x47 = s_q12 * x37;
+        let x48 = x46 - x47;
+        let x49 = x17 + Self::mul_add(x11, x37, x10 * x36);
+        let x50 = Self::mul_add(c_q12, x37, s_q12 * x36);
+        let x51 = Self::mul_add(-0.00000000020510342851533115, x17, -x50);
+        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x34);
+        let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
+        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x39);
+        let x55 = x43 + Self::mul_add(x11, x40, x10 * x34);
+        let x56 = x44 + Self::mul_add(x11, x41, x10 * x38);
+        let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
+        let x58 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x43,
+            -Self::mul_add(c_q12, x40, s_q12 * x34),
+        );
+        let x59 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x44,
+            -Self::mul_add(c_q12, x41, s_q12 * x38),
+        );
+        let x60 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x45,
+            -Self::mul_add(c_q12, x42, s_q12 * x39),
+        );
+        let x61 = x54 + Self::mul_add(x11, x53, x10 * x52);
+        let x62 = Self::mul_add(-s_q12, x56, c_q12 * x55);
+        let x63 = x51 * 0.36;
+        let x64 = -0.36 * x51;
+        let x65 = Self::mul_add(
+            x48,
+            0.36,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x54,
+                -Self::mul_add(c_q12, x53, s_q12 * x52),
+            ),
+        );
+        let x66 = Self::mul_add(
+            0.36,
+            x49,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x57,
+                -Self::mul_add(c_q12, x56, s_q12 * x55),
+            ),
+        );
+        let x67 = x64 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x63);
+        let x68 = 7.078399999258757 + x49;
+        let x69 = 0.01675 + x65;
+        let x70 = -9.142025249762803
+            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x64 - x63);
+        let x71 = 2.5482240016099564 + x66;
+        let x72 = 0.01675
+            + Self::mul_add(0.36, x48, Self::mul_add(-s_q12, x59, c_q12 * x58));
+        let x73 = 2.5482240016099564
+            + Self::mul_add(x49, 0.36, x60 + Self::mul_add(x11, x59, x10 * x58));
+        let x74 = 9.223235249762805
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x60,
+                -Self::mul_add(c_q12, x59, s_q12 * x58),
+            );
+        let x75 = Self::mul_add(-s_q11, x68, c_q11 * x48);
+        let x76 = Self::mul_add(c_q11, x68, s_q11 * x48);
+        let x77 = Self::mul_add(-s_q11, x62, c_q11 * x67);
+        let x78 = Self::mul_add(-s_q11, x70, c_q11 * x61);
+        let x79 = Self::mul_add(c_q11, x62, s_q11 * x67);
+        let x80 = Self::mul_add(c_q11, x70, s_q11 * x61);
+        let x81 = 0.275 * x51;
+        let x82 = -0.63 * x76;
+        let x83 = -0.275 * x51;
+        let x84 = x76 * 0.63;
+        let x85 = Self::mul_add(0.63, x75, Self::mul_add(c_q11, x78, s_q11 * x77));
+        let x86 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x71, c_q11 * x69));
+        let x87 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x71, s_q11 * x69));
+        let x88 = x74 - x84;
+        let x89 = Self::mul_add(-s_q11, x78, c_q11 * x77) - (x81 - x82) - (x84 - x83);
+        let x90 = Self::mul_add(x75, 0.63, Self::mul_add(-s_q11, x80, c_q11 * x79));
+        let x91 = Self::mul_add(
+            0.275,
+            x76,
+            Self::mul_add(x51, 0.63, Self::mul_add(c_q11, x73, s_q11 * x72)),
+        );
+        let x92 = -45.1584 + x76;
+        let x93 = -0.6328 + x86;
+        let x94 = -24.4950615 + (Self::mul_add(c_q11, x80, s_q11 * x79) + x83 - x81);
+        let x95 = -24.35164200091464 + Self::mul_add(0.63, x51, x87);
+        let x96 = -0.6328
+            + Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x73, c_q11 * x72));
+        let x97 = -24.351642000914637 + x91;
+        let x98 = 28.2393615 + (x82 + x88);
+        let x99 = c_q10 * x75;
+        let x100 = Self::mul_add(-s_q10, x92, x99);
+        let x101 = s_q10 * x75;
+        let x102 = Self::mul_add(c_q10, x92, x101);
+        let x103 = Self::mul_add(-s_q10, x90, c_q10 * x89);
+        let x104 = Self::mul_add(-s_q10, x94, c_q10 * x85);
+        let x105 = Self::mul_add(-s_q10, x95, c_q10 * x93);
+        let x106 = Self::mul_add(c_q10, x90, s_q10 * x89);
+        let x107 = Self::mul_add(c_q10, x94, s_q10 * x85);
+        let x108 = Self::mul_add(c_q10, x95, s_q10 * x93);
+        let x109 = -0.87 * x102;
+        let x110 = x102 * 0.87;
+        let x111 = Self::mul_add(0.87, x100, Self::mul_add(c_q10, x104, s_q10 * x103));
+        let x112 = x98 - x110;
+        let x113 = Self::mul_add(-s_q10, x104, c_q10 * x103) + x109 - x110;
+        let x114 = Self::mul_add(x100, 0.87, Self::mul_add(-s_q10, x107, c_q10 * x106));
+        let x115 = -81.53205 + x102;
+        let x116 = -0.00214 + x105;
+        let x117 = -63.36336825000001 + Self::mul_add(c_q10, x107, s_q10 * x106);
+        let x118 = -36.18604050126307 + Self::mul_add(0.87, x51, x108);
+        let x119 = -0.00214 + Self::mul_add(-s_q10, x97, c_q10 * x96);
+        let x120 = -36.18604050126307
+            + Self::mul_add(x51, 0.87, Self::mul_add(c_q10, x97, s_q10 * x96));
+        let x121 = 69.99836825 + (x109 + x112);
+        let x122 = s_q9 * x100;
+        let x123 = Self::mul_add(c_q9, x115, x122);
+        let x124 = Self::mul_add(0.00000000020510342851533115, x51, x123);
+        let x125 = x51 + Self::mul_add(x6, x115, x5 * x100);
+        let x126 = c_q9 * x100;
+        let x127 = Self::mul_add(-s_q9, x115, x126);
+        let x128 = Self::mul_add(-0.00000000020510342851533115, x51, x127);
+        let x129 = Self::mul_add(
+            0.00000000020510342851533115,
+            x119,
+            Self::mul_add(c_q9, x114, s_q9 * x113),
+        );
+        let x130 = Self::mul_add(
+            0.00000000020510342851533115,
+            x120,
+            Self::mul_add(c_q9, x117, s_q9 * x111),
+        );
+        let x131 = Self::mul_add(
+            0.00000000020510342851533115,
+            x121,
+            Self::mul_add(c_q9, x118, s_q9 * x116),
+        );
+        let x132 = x119 + Self::mul_add(x6, x114, x5 * x113);
+        let x133 = x120 + Self::mul_add(x6, x117, x5 * x111);
+        let x134 = x121 + Self::mul_add(x6, x118, x5 * x116);
+        let x135 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x119,
+            Self::mul_add(-s_q9, x114, c_q9 * x113),
+        );
+        let x136 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x120,
+            Self::mul_add(-s_q9, x117, c_q9 * x111),
+        );
+        let x137 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x121,
+            Self::mul_add(-s_q9, x118, c_q9 * x116),
+        );
+        let x138 = x128 * -0.4;
+        let x139 = 0.275 * x125;
+        let x140 = 0.4 * x128;
+        let x141 = -0.275 * x125;
+        let x142 = Self::mul_add(
+            x124,
+            -0.4,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x131,
+                Self::mul_add(-s_q9, x130, c_q9 * x129),
+            ),
+        );
+        let x143 = Self::mul_add(
+            -0.4,
+            x125,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x134,
+                Self::mul_add(-s_q9, x133, c_q9 * x132),
+            ),
+        );
+        let x144 = Self::mul_add(
+            0.00000000020510342851533115,
+            x131,
+            Self::mul_add(c_q9, x130, s_q9 * x129),
+        ) - (x138 - x139) - (x141 - x140);
+        let x145 = Self::mul_add(
+            -0.275,
+            x124,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x134,
+                Self::mul_add(c_q9, x133, s_q9 * x132),
+            ),
+        );
+        let x146 = Self::mul_add(
+            -0.4,
+            x124,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x137,
+                Self::mul_add(c_q9, x136, s_q9 * x135),
+            ),
+        );
+        let x147 = Self::mul_add(
+            x125,
+            -0.4,
+            Self::mul_add(-0.275, x128, x137 + Self::mul_add(x6, x136, x5 * x135)),
+        );
+        let x148 = -0.000000008530897668050218 + x124;
+        let x149 = -12.701650001451807 + x125;
+        let x150 = -0.0000000234896432582596
+            + Self::mul_add(-0.275, x124, x131 + Self::mul_add(x6, x130, x5 * x129));
+        let x151 = -0.002139996587640933 + x142;
+        let x152 = -0.0000000234896432582596 + x145;
+        let x153 = -111.7548902508081
+            + (x134 + Self::mul_add(x6, x133, x5 * x132) + x140 - x138);
+        let x154 = 5.080660024070365 + Self::mul_add(-0.275, x128, x143);
+        let x155 = -0.002139996587640933 + x146;
+        let x156 = 5.080660024070366 + x147;
+        let x157 = 113.3918902508081
+            + (x139
+                + (Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x137,
+                    Self::mul_add(-s_q9, x136, c_q9 * x135),
+                ) - x141));
+        let x158 = x128 + Self::mul_add(-x3, x149, x2 * x148);
+        let x159 = Self::mul_add(c_q8, x149, s_q8 * x148);
+        let x160 = c_q8 * x148;
+        let x161 = s_q8 * x149;
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x128, x161 - x160);
+        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x144);
+        let x164 = x156 + Self::mul_add(-x3, x153, x2 * x150);
+        let x165 = x157 + Self::mul_add(-x3, x154, x2 * x151);
+        let x166 = Self::mul_add(c_q8, x152, s_q8 * x144);
+        let x167 = Self::mul_add(c_q8, x153, s_q8 * x150);
+        let x168 = Self::mul_add(c_q8, x154, s_q8 * x151);
+        let x169 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x157,
+            Self::mul_add(-c_q8, x151, s_q8 * x154),
+        );
+        let x170 = Self::mul_add(
+            -c_q8,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x155,
+                Self::mul_add(-c_q8, x144, s_q8 * x152),
+            ),
+            s_q8
+                * Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x156,
+                    Self::mul_add(-c_q8, x150, s_q8 * x153),
+                ),
+        );
+        let x171 = x162 * -0.35;
+        let x172 = 0.35 * x162;
+        let x173 = Self::mul_add(
+            x158,
+            -0.35,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x165,
+                Self::mul_add(-c_q8, x163, s_q8 * x164),
+            ),
+        );
+        let x174 = Self::mul_add(
+            -0.35,
+            x159,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x168,
+                Self::mul_add(-c_q8, x166, s_q8 * x167),
+            ),
+        );
+        let x175 = x172 + (x165 + Self::mul_add(-x3, x164, x2 * x163) - x171);
+        let x176 = 48.0240000085309 + x158;
+        let x177 = -0.07309 + Self::mul_add(c_q8, x164, s_q8 * x163);
+        let x178 = -16.80768997608804 + x173;
+        let x179 = -0.07309 + (x168 + Self::mul_add(-x3, x167, x2 * x166));
+        let x180 = 130.43769025763282
+            + (Self::mul_add(c_q8, x167, s_q8 * x166) + x172 - x171);
+        let x181 = 0.1132 + x174;
+        let x182 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x169, x170);
+        let x183 = Self::mul_add(-s_q7, x159, c_q7 * x176);
+        let x184 = Self::mul_add(c_q7, x159, s_q7 * x176);
+        let x185 = Self::mul_add(-s_q7, x179, c_q7 * x175);
+        let x186 = Self::mul_add(-s_q7, x180, c_q7 * x177);
+        let x187 = -x184;
+        let x188 = x162 * -0.75;
+        let x189 = 0.75 * x162;
+        let x190 = x183 * -0.65;
+        let x191 = 0.65 * x183;
+        let x192 = Self::mul_add(x183, -0.75, Self::mul_add(-s_q7, x181, c_q7 * x178));
+        let x193 = Self::mul_add(-0.75, x184, Self::mul_add(c_q7, x181, s_q7 * x178));
+        let x194 = x182 + x191;
+        let x195 = Self::mul_add(-0.65, x184, Self::mul_add(c_q7, x186, s_q7 * x185));
+        let x196 = 110.5455 + x183;
+        let x197 = 180.9502499901501 + x162;
+        let x198 = 1394.5960312283303
+            + (x189 + (Self::mul_add(-s_q7, x186, c_q7 * x185) - x188));
+        let x199 = -117.61766249359756 + Self::mul_add(x162, -0.65, x192);
+        let x200 = 1466.4506062283303
+            + (Self::mul_add(
+                c_q7,
+                Self::mul_add(c_q7, x180, s_q7 * x177),
+                s_q7 * Self::mul_add(c_q7, x179, s_q7 * x175),
+            ) - (x190 - x189) - (x188 - x191));
+        let x201 = 1271.854575 + (x194 - x190);
+        let x202 = -x197;
+        let x203 = -x196;
+        let x204 = Self::mul_add(x3, x148, x2 * x149);
+        let x205 = x160 - x161;
+        let x206 = Self::mul_add(-0.35, x205, x165);
+        let x207 = Self::mul_add(-0.35, x204, x168);
+        let x208 = Self::mul_add(s_q7, x205, c_q7 * x204);
+        let x209 = -x208;
+        let x210 = Self::mul_add(-s_q7, x204, c_q7 * x205);
+        let x211 = Self::mul_add(-0.75, x210, Self::mul_add(-s_q7, x207, c_q7 * x206));
+        let x212 = Self::mul_add(c_q7, x207, s_q7 * x206)
+            + Self::mul_add(-0.75, x208, x159 * -0.65);
+        let x213 = Self::mul_add(0.65, x210, x169);
+        let x214 = x6 * x100;
+        let x215 = Self::mul_add(-x5, x115, x214);
+        let x216 = x131 + Self::mul_add(-0.275, x123, -0.4 * x215);
+        let x217 = Self::mul_add(0.4, x127, x134);
+        let x218 = Self::mul_add(-0.275, x127, x137);
+        let x219 = Self::mul_add(-x3, x215, x2 * x127) - x123;
+        let x220 = Self::mul_add(c_q8, x215, s_q8 * x127);
+        let x221 = Self::mul_add(
+            0.00000000020510342851533115,
+            x123,
+            Self::mul_add(-c_q8, x127, s_q8 * x215),
         );
         let x222 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x218,
+            Self::mul_add(-c_q8, x216, s_q8 * x217),
+        );
+        let x223 = Self::mul_add(
+            -0.35,
+            x220,
+            x218 + Self::mul_add(-x3, x217, x2 * x216),
+        );
+        let x224 = Self::mul_add(0.35, x219, Self::mul_add(c_q8, x217, s_q8 * x216));
+        let x225 = Self::mul_add(-s_q7, x220, c_q7 * x219);
+        let x226 = Self::mul_add(c_q7, x220, s_q7 * x219);
+        let x227 = Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x224, c_q7 * x223));
+        let x228 = Self::mul_add(c_q7, x224, s_q7 * x223)
+            + Self::mul_add(-0.65, x221, 0.75 * x225);
+        let x229 = Self::mul_add(0.65, x226, x222);
+        let x230 = Self::mul_add(-s_q9, x102, x126);
+        let x231 = Self::mul_add(-x5, x102, x214);
+        let x232 = Self::mul_add(c_q9, x102, x122);
+        let x233 = Self::mul_add(
+            0.00000000020510342851533115,
+            x112,
+            Self::mul_add(c_q9, x108, s_q9 * x105),
+        ) + Self::mul_add(-0.275, x232, -0.4 * x231);
+        let x234 = Self::mul_add(0.4, x230, x112 + Self::mul_add(x6, x108, x5 * x105));
+        let x235 = Self::mul_add(
+            -0.275,
+            x230,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x112,
+                Self::mul_add(-s_q9, x108, c_q9 * x105),
+            ),
+        );
+        let x236 = Self::mul_add(-x3, x231, x2 * x230) - x232;
+        let x237 = Self::mul_add(c_q8, x231, s_q8 * x230);
+        let x238 = Self::mul_add(
+            0.00000000020510342851533115,
+            x232,
+            Self::mul_add(-c_q8, x230, s_q8 * x231),
+        );
+        let x239 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x235,
+            Self::mul_add(-c_q8, x233, s_q8 * x234),
+        );
+        let x240 = Self::mul_add(
+            -0.35,
+            x237,
+            x235 + Self::mul_add(-x3, x234, x2 * x233),
+        );
+        let x241 = Self::mul_add(0.35, x236, Self::mul_add(c_q8, x234, s_q8 * x233));
+        let x242 = Self::mul_add(-s_q7, x237, c_q7 * x236);
+        let x243 = Self::mul_add(c_q7, x237, s_q7 * x236);
+        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x241, c_q7 * x240));
+        let x245 = Self::mul_add(c_q7, x241, s_q7 * x240)
+            + Self::mul_add(-0.65, x238, 0.75 * x242);
+        let x246 = Self::mul_add(0.65, x243, x239);
+        let x247 = Self::mul_add(c_q10, x76, x101);
+        let x248 = Self::mul_add(-s_q10, x76, x99);
+        let x249 = Self::mul_add(-s_q10, x87, c_q10 * x86);
+        let x250 = Self::mul_add(c_q10, x87, s_q10 * x86);
+        let x251 = Self::mul_add(-0.87, x247, x88);
+        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
+        let x253 = Self::mul_add(-x5, x247, x6 * x248);
+        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
+        let x255 = Self::mul_add(
+            0.00000000020510342851533115,
+            x251,
+            Self::mul_add(c_q9, x250, s_q9 * x249),
+        ) + Self::mul_add(-0.275, x254, -0.4 * x253);
+        let x256 = Self::mul_add(0.4, x252, x251 + Self::mul_add(x6, x250, x5 * x249));
+        let x257 = Self::mul_add(
+            -0.275,
+            x252,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x251,
+                Self::mul_add(-s_q9, x250, c_q9 * x249),
+            ),
+        );
+        let x258 = Self::mul_add(-x3, x253, x2 * x252) - x254;
+        let x259 = Self::mul_add(c_q8, x253, s_q8 * x252);
+        let x260 = Self::mul_add(
+            0.00000000020510342851533115,
+            x254,
+            Self::mul_add(-c_q8, x252, s_q8 * x253),
+        );
+        let x261 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x257,
+            Self::mul_add(-c_q8, x255, s_q8 * x256),
+        );
+        let x262 = Self::mul_add(
+            -0.35,
+            x259,
+            x257 + Self::mul_add(-x3, x256, x2 * x255),
+        );
+        let x263 = Self::mul_add(0.35, x258, Self::mul_add(c_q8, x256, s_q8 * x255));
+        let x264 = Self::mul_add(-s_q7, x259, c_q7 * x258);
+        let x265 = Self::mul_add(c_q7, x259, s_q7 * x258);
+        let x266 = Self::mul_add(-0.75, x265, Self::mul_add(-s_q7, x263, c_q7 * x262));
+        let x267 = Self::mul_add(c_q7, x263, s_q7 * x262)
+            + Self::mul_add(-0.65, x260, 0.75 * x264);
+        let x268 = Self::mul_add(0.65, x265, x261);
+        let x269 = Self::mul_add(-x10, x37, x11 * x36);
+        let x270 = x47 - x46;
+        let x271 = Self::mul_add(0.36, x269, x54);
+        let x272 = Self::mul_add(0.36, x50, x57);
+        let x273 = Self::mul_add(s_q11, x269, c_q11 * x50);
+        let x274 = Self::mul_add(-s_q11, x50, c_q11 * x269);
+        let x275 = Self::mul_add(-s_q11, x272, c_q11 * x271)
+            + Self::mul_add(-0.63, x270, 0.275 * x274);
+        let x276 = Self::mul_add(0.275, x273, Self::mul_add(c_q11, x272, s_q11 * x271));
+        let x277 = Self::mul_add(-0.63, x273, x60);
+        let x278 = Self::mul_add(s_q10, x274, c_q10 * x273);
+        let x279 = Self::mul_add(-s_q10, x273, c_q10 * x274);
+        let x280 = Self::mul_add(c_q10, x276, s_q10 * x275);
+        let x281 = Self::mul_add(-0.87, x270, Self::mul_add(-s_q10, x276, c_q10 * x275));
+        let x282 = Self::mul_add(-0.87, x278, x277);
+        let x283 = Self::mul_add(
+            0.00000000020510342851533115,
+            x270,
+            Self::mul_add(-s_q9, x278, c_q9 * x279),
+        );
+        let x284 = x270 + Self::mul_add(-x5, x278, x6 * x279);
+        let x285 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x270,
+            -Self::mul_add(s_q9, x279, c_q9 * x278),
+        );
+        let x286 = Self::mul_add(
+            0.00000000020510342851533115,
+            x282,
+            Self::mul_add(c_q9, x280, s_q9 * x281),
+        ) + Self::mul_add(0.275, x285, -0.4 * x284);
+        let x287 = Self::mul_add(0.4, x283, x282 + Self::mul_add(x6, x280, x5 * x281));
+        let x288 = Self::mul_add(
+            -0.275,
+            x283,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x282,
+                Self::mul_add(-s_q9, x280, c_q9 * x281),
+            ),
+        );
+        let x289 = x285 + Self::mul_add(-x3, x284, x2 * x283);
+        let x290 = Self::mul_add(c_q8, x284, s_q8 * x283);
+        let x291 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x285,
+            Self::mul_add(-c_q8, x283, s_q8 * x284),
+        );
+        let x292 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x288,
+            Self::mul_add(-c_q8, x286, s_q8 * x287),
+        );
+        let x293 = Self::mul_add(
+            -0.35,
+            x290,
+            x288 + Self::mul_add(-x3, x287, x2 * x286),
+        );
+        let x294 = Self::mul_add(0.35, x289, Self::mul_add(c_q8, x287, s_q8 * x286));
+        let x295 = Self::mul_add(-s_q7, x290, c_q7 * x289);
+        let x296 = Self::mul_add(c_q7, x290, s_q7 * x289);
+        let x297 = Self::mul_add(-0.75, x296, Self::mul_add(-s_q7, x294, c_q7 * x293));
+        let x298 = Self::mul_add(c_q7, x294, s_q7 * x293)
+            + Self::mul_add(-0.65, x291, 0.75 * x295);
+        let x299 = Self::mul_add(0.65, x296, x292);
+        let x300 = x13 * -4.806620000000001;
+        let x301 = s_q13 * -4.806620000000001;
+        let x302 = c_q13 * -4.806620000000001;
+        let x303 = x20 + Self::mul_add(-0.55, x302, -0.16 * x301);
+        let x304 = Self::mul_add(0.16, x300, x24);
+        let x305 = Self::mul_add(-0.55, x300, x27);
+        let x306 = Self::mul_add(-s_q12, x301, c_q12 * x300);
+        let x307 = Self::mul_add(x11, x301, x10 * x300) - x302;
+        let x308 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x302,
+            Self::mul_add(c_q12, x301, s_q12 * x300),
+        );
+        let x309 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x305,
+            -Self::mul_add(c_q12, x304, s_q12 * x303),
+        );
+        let x310 = Self::mul_add(0.36, x307, Self::mul_add(-s_q12, x304, c_q12 * x303));
+        let x311 = Self::mul_add(
+            -0.36,
+            x306,
+            x305 + Self::mul_add(x11, x304, x10 * x303),
+        );
+        let x312 = Self::mul_add(-s_q11, x307, c_q11 * x306);
+        let x313 = Self::mul_add(c_q11, x307, s_q11 * x306);
+        let x314 = Self::mul_add(-s_q11, x311, c_q11 * x310)
+            + Self::mul_add(0.63, x308, 0.275 * x313);
+        let x315 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x311, s_q11 * x310));
+        let x316 = Self::mul_add(0.63, x312, x309);
+        let x317 = Self::mul_add(-s_q10, x313, c_q10 * x312);
+        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
+        let x319 = Self::mul_add(c_q10, x315, s_q10 * x314);
+        let x320 = Self::mul_add(0.87, x308, Self::mul_add(-s_q10, x315, c_q10 * x314));
+        let x321 = Self::mul_add(0.87, x317, x316);
+        let x322 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x308,
+            Self::mul_add(c_q9, x318, s_q9 * x317),
+        );
+        let x323 = Self::mul_add(x6, x318, x5 * x317) - x308;
+        let x324 = Self::mul_add(
+            0.00000000020510342851533115,
+            x308,
+            Self::mul_add(-s_q9, x318, c_q9 * x317),
+        );
+        let x325 = Self::mul_add(
+            0.00000000020510342851533115,
+            x321,
+            Self::mul_add(c_q9, x319, s_q9 * x320),
+        ) + Self::mul_add(0.275, x324, -0.4 * x323);
+        let x326 = Self::mul_add(0.4, x322, x321 + Self::mul_add(x6, x319, x5 * x320));
+        let x327 = Self::mul_add(
+            -0.275,
+            x322,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x321,
+                Self::mul_add(-s_q9, x319, c_q9 * x320),
+            ),
+        );
+        let x328 = x324 + Self::mul_add(-x3, x323, x2 * x322);
+        let x329 = Self::mul_add(c_q8, x323, s_q8 * x322);
+        let x330 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x324,
+            Self::mul_add(-c_q8, x322, s_q8 * x323),
+        );
+        let x331 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x327,
+            Self::mul_add(-c_q8, x325, s_q8 * x326),
+        );
+        let x332 = Self::mul_add(
+            -0.35,
+            x329,
+            x327 + Self::mul_add(-x3, x326, x2 * x325),
+        );
+        let x333 = Self::mul_add(0.35, x328, Self::mul_add(c_q8, x326, s_q8 * x325));
+        let x334 = Self::mul_add(-s_q7, x329, c_q7 * x328);
+        let x335 = Self::mul_add(c_q7, x329, s_q7 * x328);
+        let x336 = Self::mul_add(-0.75, x335, Self::mul_add(-s_q7, x333, c_q7 * x332));
+        let x337 = Self::mul_add(c_q7, x333, s_q7 * x332)
+            + Self::mul_add(-0.65, x330, 0.75 * x334);
+        let x338 = Self::mul_add(0.65, x335, x331);
+        let x339 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
+        let x340 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x341 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
+        let x342 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x343 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x344 = v[4] * v[4];
+        let x345 = Self::mul_add(v[5], v[5], x344);
+        let x346 = v[3] * v[4];
+        let x347 = v[3] * v[5];
+        let x348 = v[4] * v[5];
+        let x349 = Self::mul_add(v[3], v[3], x344);
+        let x350 = x339 + Self::mul_add(-0.65, x345, 0.75 * x347);
+        let x351 = x340 + Self::mul_add(0.75, x348, 0.65 * x346);
+        let x352 = x341 + Self::mul_add(-0.75, x349, 0.65 * x347);
+        let x353 = Self::mul_add(-s_q7, x350, c_q7 * x351);
+        let x354 = v[6] * x343;
+        let x355 = v[6] * x342;
+        let x356 = v[5] + v[6];
+        let x357 = x343 * x343;
+        let x358 = x342 * x356;
+        let x359 = Self::mul_add(-16.80768997608804, x356, -0.07309 * x343);
+        let x360 = Self::mul_add(
+            0.1132,
+            x356,
+            Self::mul_add(130.43769025763282, x343, -0.07309 * x342),
+        );
+        let x361 = Self::mul_add(
+            132.47349025763282,
+            x356,
+            Self::mul_add(0.1132, x343, -16.80768997608804 * x342),
+        );
+        let x362 = Self::mul_add(-c_q8, x356, Self::mul_add(s_q8, x343, x2 * x342));
+        let x363 = Self::mul_add(s_q8, x356, Self::mul_add(-x3, x342, c_q8 * x343));
+        let x364 = Self::mul_add(
+            0.35,
+            x358 - x355,
+            Self::mul_add(s_q7, x351, c_q7 * x350),
+        );
+        let x365 = Self::mul_add(0.35, Self::mul_add(x343, x356, -x354), x353);
+        let x366 = Self::mul_add(-0.35, Self::mul_add(x342, x342, x357), x352);
+        let x367 = Self::mul_add(-c_q8, x366, Self::mul_add(s_q8, x365, x2 * x364));
+        let x368 = Self::mul_add(s_q8, x366, Self::mul_add(-x3, x364, c_q8 * x365));
+        let x369 = Self::mul_add(-0.00000000020510342851533115, x366, x364);
+        let x370 = Self::mul_add(v[7], x363, Self::mul_add(-s_q8, x355, x2 * x354));
+        let x371 = Self::mul_add(v[7], x362, Self::mul_add(c_q8, x355, x3 * x354));
+        let x372 = v[7] + Self::mul_add(-0.00000000020510342851533115, x356, x342);
+        let x373 = x363 * x363;
+        let x374 = x372 * x372;
+        let x375 = x362 * x363;
+        let x376 = x375 - x354;
+        let x377 = x362 * x372;
+        let x378 = x362 * x362;
+        let x379 = x374 + x378;
+        let x380 = x363 * x372;
+        let x381 = x370 + x380;
+        let x382 = Self::mul_add(
+            -0.002139996587640933,
+            x372,
+            -0.0000000234896432582596 * x363,
+        );
+        let x383 = Self::mul_add(
+            5.080660024070365,
+            x372,
+            Self::mul_add(-111.7548902508081, x363, -0.0000000234896432582596 * x362),
+        );
+        let x384 = Self::mul_add(
+            113.3918902508081,
+            x372,
+            Self::mul_add(5.080660024070366, x363, -0.002139996587640933 * x362),
+        );
+        let x385 = Self::mul_add(
+            x369,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x354,
+                Self::mul_add(111.7548902508081, x371, -0.0000000234896432582596 * x370),
+            ) + Self::mul_add(-x362, x384, x372 * x382),
+        );
+        let x386 = Self::mul_add(c_q9, x372, Self::mul_add(x5, x363, s_q9 * x362));
+        let x387 = Self::mul_add(-s_q9, x372, Self::mul_add(x6, x363, c_q9 * x362));
+        let x388 = x367 + Self::mul_add(0.4, x377 - x371, 0.275 * x376);
+        let x389 = x368 + Self::mul_add(-0.275, x379, 0.4 * (x380 - x370));
+        let x390 = x369 + Self::mul_add(-0.4, x373 + x378, 0.275 * x381);
+        let x391 = Self::mul_add(c_q9, x390, Self::mul_add(x5, x389, s_q9 * x388));
+        let x392 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x390,
+            Self::mul_add(0.00000000020510342851533115, x388, x389),
+        );
+        let x393 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x354,
+            Self::mul_add(0.00000000020510342851533115, x370, -x371),
+        );
+        let x394 = Self::mul_add(
+            v[8],
+            x387,
+            Self::mul_add(c_q9, x354, Self::mul_add(-x5, x371, s_q9 * x370)),
+        );
+        let x395 = Self::mul_add(
+            -v[8],
+            x386,
+            Self::mul_add(-s_q9, x354, Self::mul_add(-x6, x371, c_q9 * x370)),
+        );
+        let x396 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x372,
+                Self::mul_add(0.00000000020510342851533115, x362, x363),
+            );
+        let x397 = Self::mul_add(x386, x387, -x393);
+        let x398 = Self::mul_add(x386, x386, x396 * x396);
+        let x399 = Self::mul_add(x387, x396, x394);
+        let x400 = -0.00214 * x396;
+        let x401 = Self::mul_add(-36.18604050126307, x396, -63.36336825000001 * x387);
+        let x402 = Self::mul_add(
+            69.99836825,
+            x396,
+            Self::mul_add(-36.18604050126307, x387, -0.00214 * x386),
+        );
+        let x403 = Self::mul_add(
+            -81.53205,
+            x392,
+            Self::mul_add(-0.00214, x393, Self::mul_add(-x396, x401, x387 * x402)),
+        );
+        let x404 = Self::mul_add(
+            x391,
+            81.53205,
+            Self::mul_add(
+                69.99836825,
+                x393,
+                Self::mul_add(-36.18604050126307, x395, -0.00214 * x394),
+            ) + Self::mul_add(-x387, x400, x386 * x401),
+        );
+        let x405 = Self::mul_add(s_q10, x387, c_q10 * x386);
+        let x406 = Self::mul_add(-s_q10, x386, c_q10 * x387);
+        let x407 = Self::mul_add(-0.87, x397, x391);
+        let x408 = Self::mul_add(
+            0.87,
+            x398,
+            Self::mul_add(-s_q9, x390, Self::mul_add(x6, x389, c_q9 * x388)),
+        );
+        let x409 = Self::mul_add(-0.87, x399, x392);
+        let x410 = Self::mul_add(s_q10, x408, c_q10 * x407);
+        let x411 = Self::mul_add(v[9], x406, Self::mul_add(s_q10, x395, c_q10 * x394));
+        let x412 = Self::mul_add(-v[9], x405, Self::mul_add(-s_q10, x394, c_q10 * x395));
+        let x413 = v[9] + x396;
+        let x414 = Self::mul_add(x405, x406, -x393);
+        let x415 = x405 * x405;
+        let x416 = Self::mul_add(x413, x413, x415);
+        let x417 = x406 * x413;
+        let x418 = x411 + x417;
+        let x419 = -0.6328 * x413;
+        let x420 = Self::mul_add(-24.35164200091464, x413, -24.4950615 * x406);
+        let x421 = Self::mul_add(
+            28.2393615,
+            x413,
+            Self::mul_add(-24.351642000914637, x406, -0.6328 * x405),
+        );
+        let x422 = Self::mul_add(
+            -45.1584,
+            x409,
+            Self::mul_add(-0.6328, x393, Self::mul_add(-x413, x420, x406 * x421)),
+        );
+        let x423 = Self::mul_add(
+            x410,
+            45.1584,
+            Self::mul_add(
+                28.2393615,
+                x393,
+                Self::mul_add(-24.351642000914637, x412, -0.6328 * x411),
+            ) + Self::mul_add(-x406, x419, x405 * x420),
+        );
+        let x424 = Self::mul_add(s_q11, x406, c_q11 * x405);
+        let x425 = Self::mul_add(-s_q11, x405, c_q11 * x406);
+        let x426 = x410
+            + Self::mul_add(-0.275, Self::mul_add(x405, x413, x412), -0.63 * x414);
+        let x427 = Self::mul_add(-s_q10, x407, c_q10 * x408)
+            + Self::mul_add(0.63, x416, -0.275 * (x417 - x411));
+        let x428 = x409
+            + Self::mul_add(0.275, Self::mul_add(x406, x406, x415), -0.63 * x418);
+        let x429 = Self::mul_add(s_q11, x427, c_q11 * x426);
+        let x430 = Self::mul_add(v[10], x425, Self::mul_add(s_q11, x412, c_q11 * x411));
+        let x431 = Self::mul_add(
+            -v[10],
+            x424,
+            Self::mul_add(-s_q11, x411, c_q11 * x412),
+        );
+        let x432 = v[10] + x413;
+        let x433 = x424 * x424;
+        let x434 = x425 * x432;
+        let x435 = 0.01675 * x432;
+        let x436 = Self::mul_add(2.5482240016099564, x432, -9.142025249762803 * x425);
+        let x437 = Self::mul_add(
+            9.223235249762805,
+            x432,
+            Self::mul_add(2.5482240016099564, x425, 0.01675 * x424),
+        );
+        let x438 = Self::mul_add(
+            7.078399999258757,
+            x428,
+            Self::mul_add(0.01675, x393, Self::mul_add(-x432, x436, x425 * x437)),
+        );
+        let x439 = Self::mul_add(
+            x429,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x393,
+                Self::mul_add(2.5482240016099564, x431, 0.01675 * x430),
+            ) + Self::mul_add(-x425, x435, x424 * x436),
+        );
+        let x440 = Self::mul_add(-s_q12, x432, Self::mul_add(x10, x425, c_q12 * x424));
+        let x441 = Self::mul_add(-c_q12, x432, Self::mul_add(-s_q12, x424, x11 * x425));
+        let x442 = Self::mul_add(-0.36, Self::mul_add(x424, x432, x431), x429);
+        let x443 = Self::mul_add(
+            -0.36,
+            x434 - x430,
+            Self::mul_add(-s_q11, x426, c_q11 * x427),
+        );
+        let x444 = Self::mul_add(0.36, Self::mul_add(x425, x425, x433), x428);
+        let x445 = Self::mul_add(-s_q12, x444, Self::mul_add(x10, x443, c_q12 * x442));
+        let x446 = Self::mul_add(-c_q12, x444, Self::mul_add(-s_q12, x442, x11 * x443));
+        let x447 = Self::mul_add(-0.00000000020510342851533115, x444, x443);
+        let x448 = Self::mul_add(-0.00000000020510342851533115, x393, x431);
+        let x449 = Self::mul_add(
+            v[11],
+            x441,
+            Self::mul_add(-s_q12, x393, Self::mul_add(x10, x431, c_q12 * x430)),
+        );
+        let x450 = Self::mul_add(
+            -v[11],
+            x440,
+            Self::mul_add(-c_q12, x393, Self::mul_add(-s_q12, x430, x11 * x431)),
+        );
+        let x451 = v[11] + Self::mul_add(-0.00000000020510342851533115, x432, x425);
+        let x452 = x441 * x441;
+        let x453 = x451 * x451;
+        let x454 = x440 * x441;
+        let x455 = x454 - x448;
+        let x456 = x440 * x451;
+        let x457 = x440 * x440;
+        let x458 = x453 + x457;
+        let x459 = x441 * x451;
+        let x460 = x449 + x459;
+        let x461 = Self::mul_add(-0.809539999555672, x451, -1.9877000000000002 * x441);
+        let x462 = Self::mul_add(
+            -2.741639999592316,
+            x451,
+            Self::mul_add(-5.252920330000002, x441, -1.9877000000000002 * x440),
+        );
+        let x463 = Self::mul_add(
+            9.740442170000001,
+            x451,
+            Self::mul_add(-2.7416399995923166, x441, -0.809539999555672 * x440),
+        );
+        let x464 = Self::mul_add(
+            x447,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x448,
+                Self::mul_add(-5.252920330000002, x450, -1.9877000000000002 * x449),
+            ) + Self::mul_add(-x440, x463, x451 * x461),
+        );
+        let x465 = Self::mul_add(-c_q13, x451, Self::mul_add(s_q13, x441, x13 * x440));
+        let x466 = Self::mul_add(s_q13, x451, Self::mul_add(-x14, x440, c_q13 * x441));
+        let x467 = x445 + Self::mul_add(0.16, x450 + x456, 0.55 * x455);
+        let x468 = x447 + Self::mul_add(-0.16, x452 + x457, 0.55 * x460);
+        let x469 = Self::mul_add(
+            -c_q13,
+            x468,
+            Self::mul_add(
+                s_q13,
+                x446 + Self::mul_add(-0.55, x458, 0.16 * (x459 - x449)),
+                x13 * x467,
+            ),
+        );
+        let x470 = Self::mul_add(-0.00000000020510342851533115, x448, x449);
+        let x471 = Self::mul_add(
+            v[12],
+            x466,
+            Self::mul_add(-c_q13, x448, Self::mul_add(s_q13, x450, x13 * x449)),
+        );
+        let x472 = Self::mul_add(
+            -v[12],
+            x465,
+            Self::mul_add(s_q13, x448, Self::mul_add(-x14, x449, c_q13 * x450)),
+        );
+        let x473 = v[12] + Self::mul_add(-0.00000000020510342851533115, x451, x440);
+        let x474 = 4.806620000000001 * Self::mul_add(x465, x466, -x470);
+        let x475 = 4.806620000000001 * Self::mul_add(x465, x465, x473 * x473);
+        let x476 = 4.806620000000001 * Self::mul_add(x466, x473, x471);
+        let x477 = Self::mul_add(-0.0145, x473, 0.000781 * x466);
+        let x478 = Self::mul_add(
+            -0.9614610000000001,
+            x473,
+            Self::mul_add(-1.2025609200000003, x466, 0.000781 * x465),
+        );
+        let x479 = Self::mul_add(
+            1.4135609200000003,
+            x473,
+            Self::mul_add(-0.9614610000000001, x466, -0.0145 * x465),
+        );
+        let x480 = Self::mul_add(
+            -0.9614610000000001,
+            x470,
+            Self::mul_add(-1.2025609200000003, x472, 0.000781 * x471),
+        ) + Self::mul_add(-x465, x479, x473 * x477);
+        let x481 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x468, x467),
+            Self::mul_add(-0.0145, x470, 0.000781 * x472)
+                + Self::mul_add(-x473, x478, x466 * x479),
+        );
+        let x482 = Self::mul_add(
+            -4.806620000000001,
+            x469,
+            Self::mul_add(
+                1.4135609200000003,
+                x470,
+                Self::mul_add(-0.9614610000000001, x472, -0.0145 * x471),
+            ) + Self::mul_add(-x466, x477, x465 * x478),
+        );
+        let x483 = x476 + Self::mul_add(x14, x475, x13 * x474);
+        let x484 = Self::mul_add(-c_q13, x475, s_q13 * x474);
+        let x485 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x476,
+            -Self::mul_add(s_q13, x475, c_q13 * x474),
+        );
+        let x486 = Self::mul_add(
+            -0.55,
+            x483,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x482,
+                Self::mul_add(-c_q13, x481, s_q13 * x480),
+            ),
+        );
+        let x487 = Self::mul_add(
+            -3.6140000000000003,
+            x452 + x453,
+            17.135250000000003 * x455,
+        ) + x483;
+        let x488 = Self::mul_add(
+            -17.135250000000003,
+            x458,
+            3.6140000000000003 * (x448 + x454),
+        ) + x484;
+        let x489 = Self::mul_add(
+            17.135250000000003,
+            x460,
+            3.6140000000000003 * (x456 - x450),
+        ) + x485;
+        let x490 = Self::mul_add(
+            17.135250000000003,
+            x447,
+            Self::mul_add(-0.809539999555672, x448, -1.9877000000000002 * x450)
+                + Self::mul_add(-x451, x462, x441 * x463),
+        )
+            + (x482 + Self::mul_add(-x14, x480, x13 * x481)
+                + Self::mul_add(0.55, x485, -0.16 * x484));
+        let x491 = x464
+            + Self::mul_add(0.16, x483, Self::mul_add(c_q13, x480, s_q13 * x481));
+        let x492 = Self::mul_add(
+            9.740442170000001,
+            x448,
+            Self::mul_add(-2.7416399995923166, x450, -0.809539999555672 * x449),
+        ) + Self::mul_add(-x441, x461, x440 * x462)
+            + Self::mul_add(3.6140000000000003, x446, x445 * -17.135250000000003) + x486;
+        let x493 = Self::mul_add(-s_q12, x488, c_q12 * x487);
+        let x494 = x489 + Self::mul_add(x11, x488, x10 * x487);
+        let x495 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x424, x425, -x393),
+            x493,
+        );
+        let x496 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x432, x432, x433),
+            x494,
+        );
+        let x497 = Self::mul_add(
+            7.078399999258757,
+            x430 + x434,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x489,
+                -Self::mul_add(c_q12, x488, s_q12 * x487),
+            ),
+        );
+        let x498 = x438
+            + Self::mul_add(0.36, x494, Self::mul_add(-s_q12, x491, c_q12 * x490));
+        let x499 = Self::mul_add(2.5482240016099564, x393, -9.142025249762803 * x431)
+            + Self::mul_add(-x424, x437, x432 * x435)
+            + Self::mul_add(-0.36, x493, x492 + Self::mul_add(x11, x491, x10 * x490));
+        let x500 = x439
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x492,
+                -Self::mul_add(c_q12, x491, s_q12 * x490),
+            );
+        let x501 = Self::mul_add(-s_q11, x496, c_q11 * x495);
+        let x502 = Self::mul_add(c_q11, x496, s_q11 * x495);
+        let x503 = Self::mul_add(-45.1584, x414, x501);
+        let x504 = Self::mul_add(45.1584, x416, x502);
+        let x505 = Self::mul_add(-45.1584, x418, x497);
+        let x506 = x422
+            + (Self::mul_add(-s_q11, x499, c_q11 * x498)
+                + Self::mul_add(-0.63, x497, 0.275 * x502));
+        let x507 = Self::mul_add(-24.35164200091464, x393, -24.4950615 * x412)
+            + Self::mul_add(-x405, x421, x413 * x419)
+            + Self::mul_add(-0.275, x501, Self::mul_add(c_q11, x499, s_q11 * x498));
+        let x508 = x423 + Self::mul_add(0.63, x501, x500);
+        let x509 = Self::mul_add(-s_q10, x504, c_q10 * x503);
+        let x510 = Self::mul_add(-81.53205, x397, x509);
+        let x511 = Self::mul_add(
+            81.53205,
+            x398,
+            Self::mul_add(c_q10, x504, s_q10 * x503),
+        );
+        let x512 = Self::mul_add(-81.53205, x399, x505);
+        let x513 = x403
+            + Self::mul_add(-0.87, x505, Self::mul_add(-s_q10, x507, c_q10 * x506));
+        let x514 = Self::mul_add(-36.18604050126307, x393, -63.36336825000001 * x395)
+            + Self::mul_add(-x386, x402, x396 * x400)
+            + Self::mul_add(c_q10, x507, s_q10 * x506);
+        let x515 = x404 + Self::mul_add(0.87, x509, x508);
+        let x516 = Self::mul_add(
+            0.00000000020510342851533115,
+            x512,
+            Self::mul_add(c_q9, x511, s_q9 * x510),
+        );
+        let x517 = x512 + Self::mul_add(x6, x511, x5 * x510);
+        let x518 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x512,
+            Self::mul_add(-s_q9, x511, c_q9 * x510),
+        );
+        let x519 = Self::mul_add(
+            -0.275,
+            x516,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x515,
+                Self::mul_add(-s_q9, x514, c_q9 * x513),
+            ),
+        );
+        let x520 = Self::mul_add(
+            0.000000008530897668050218,
+            x373 + x374,
+            -12.701650001451807 * x376,
+        ) + x516;
+        let x521 = Self::mul_add(
+            12.701650001451807,
+            x379,
+            -0.000000008530897668050218 * (x354 + x375),
+        ) + x517;
+        let x522 = Self::mul_add(
+            -12.701650001451807,
+            x381,
+            -0.000000008530897668050218 * (x371 + x377),
+        ) + x518;
+        let x523 = Self::mul_add(
+            -12.701650001451807,
+            x369,
+            Self::mul_add(0.0000000234896432582596, x371, -0.002139996587640933 * x354)
+                + Self::mul_add(-x372, x383, x363 * x384),
+        )
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x515,
+                Self::mul_add(c_q9, x514, s_q9 * x513),
+            ) + Self::mul_add(0.275, x518, -0.4 * x517));
+        let x524 = x385
+            + Self::mul_add(0.4, x516, x515 + Self::mul_add(x6, x514, x5 * x513));
+        let x525 = Self::mul_add(
+            113.3918902508081,
+            x354,
+            Self::mul_add(-5.080660024070366, x371, -0.002139996587640933 * x370),
+        ) + Self::mul_add(-x363, x382, x362 * x383)
+            + Self::mul_add(-0.000000008530897668050218, x368, x367 * 12.701650001451807)
+            + x519;
+        let x526 = x522 + Self::mul_add(-x3, x521, x2 * x520);
+        let x527 = Self::mul_add(c_q8, x521, s_q8 * x520);
+        let x528 = Self::mul_add(
+            -48.0240000085309,
+            Self::mul_add(x356, x356, x357),
+            x526,
+        );
+        let x529 = Self::mul_add(48.0240000085309, x342 * x343, x527);
+        let x530 = Self::mul_add(
+            48.0240000085309,
+            x355 + x358,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x522,
+                Self::mul_add(-c_q8, x520, s_q8 * x521),
+            ),
+        );
+        let x531 = Self::mul_add(0.07309, x355, Self::mul_add(-x356, x360, x343 * x361))
+            + Self::mul_add(-0.35, x527, x525 + Self::mul_add(-x3, x524, x2 * x523));
+        let x532 = Self::mul_add(
+            x352,
+            -48.0240000085309,
+            Self::mul_add(-130.43769025763282, x355, -0.07309 * x354)
+                + Self::mul_add(-x342, x361, x356 * x359),
+        ) + Self::mul_add(0.35, x526, Self::mul_add(c_q8, x524, s_q8 * x523));
+        let x533 = Self::mul_add(
+            48.0240000085309,
+            x353,
+            Self::mul_add(-0.1132, x355, -16.80768997608804 * x354)
+                + Self::mul_add(-x343, x359, x342 * x360),
+        )
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x525,
+                Self::mul_add(-c_q8, x523, s_q8 * x524),
+            );
+        let x534 = Self::mul_add(-s_q7, x529, c_q7 * x528);
+        let x535 = Self::mul_add(c_q7, x529, s_q7 * x528);
+        let x536 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x537 = 1466.4506062283303 * v[4];
+        let x538 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x539 = x534
+            + Self::mul_add(
+                1170.07,
+                x339,
+                Self::mul_add(-110.5455, x345, 180.9502499901501 * x347),
+            );
+        let x540 = x535
+            + Self::mul_add(
+                1170.07,
+                x340,
+                Self::mul_add(180.9502499901501, x348, 110.5455 * x346),
+            );
+        let x541 = x530
+            + Self::mul_add(
+                1170.07,
+                x341,
+                Self::mul_add(-180.9502499901501, x349, 110.5455 * x347),
+            );
+        let x542 = Self::mul_add(-0.75, x535, Self::mul_add(-s_q7, x532, c_q7 * x531))
+            + Self::mul_add(
+                x340,
+                -180.9502499901501,
+                Self::mul_add(-v[5], x537, v[4] * x538),
+            );
+        let x543 = Self::mul_add(c_q7, x532, s_q7 * x531)
+            + Self::mul_add(-0.65, x530, 0.75 * x534)
+            + (Self::mul_add(-v[3], x538, v[5] * x536)
+                + Self::mul_add(x341, -110.5455, 180.9502499901501 * x339));
+        let x544 = Self::mul_add(0.65, x535, x533)
+            + Self::mul_add(110.5455, x340, Self::mul_add(-v[4], x536, v[3] * x537));
+        (
+            [
+                [
+                    1170.07,
+                    0.0,
+                    0.0,
+                    0.0,
+                    x197,
+                    x187,
+                    x187,
+                    x209,
+                    x225,
+                    x242,
+                    x264,
+                    x295,
+                    x334,
+                ],
+                [
+                    0.0,
+                    1170.07,
+                    0.0,
+                    x202,
+                    0.0,
+                    x196,
+                    x183,
+                    x210,
+                    x226,
+                    x243,
+                    x265,
+                    x296,
+                    x335,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    1170.07,
+                    x184,
+                    x203,
+                    0.0,
+                    0.0,
+                    x159,
+                    x221,
+                    x238,
+                    x260,
+                    x291,
+                    x330,
+                ],
+                [
+                    0.0,
+                    x202,
+                    x184,
+                    x198,
+                    x195,
+                    x199,
+                    x192,
+                    x211,
+                    x227,
+                    x244,
+                    x266,
+                    x297,
+                    x336,
+                ],
+                [
+                    x197,
+                    0.0,
+                    x203,
+                    x195,
+                    x200,
+                    x193,
+                    x193,
+                    x212,
+                    x228,
+                    x245,
+                    x267,
+                    x298,
+                    x337,
+                ],
+                [
+                    x187,
+                    x196,
+                    0.0,
+                    x199,
+                    x193,
+                    x201,
+                    x194,
+                    x213,
+                    x229,
+                    x246,
+                    x268,
+                    x299,
+                    x338,
+                ],
+                [
+                    x187,
+                    x183,
+                    0.0,
+                    x192,
+                    x193,
+                    x194,
+                    x182,
+                    x169,
+                    x222,
+                    x239,
+                    x261,
+                    x292,
+                    x331,
+                ],
+                [
+                    x209,
+                    x210,
+                    x159,
+                    x211,
+                    x212,
+                    x213,
+                    x169,
+                    x157,
+                    x218,
+                    x235,
+                    x257,
+                    x288,
+                    x327,
+                ],
+                [
+                    x225,
+                    x226,
+                    x221,
+                    x227,
+                    x228,
+                    x229,
+                    x222,
+                    x218,
+                    x121,
+                    x112,
+                    x251,
+                    x282,
+                    x321,
+                ],
+                [
+                    x242,
+                    x243,
+                    x238,
+                    x244,
+                    x245,
+                    x246,
+                    x239,
+                    x235,
+                    x112,
+                    x98,
+                    x88,
+                    x277,
+                    x316,
+                ],
+                [
+                    x264,
+                    x265,
+                    x260,
+                    x266,
+                    x267,
+                    x268,
+                    x261,
+                    x257,
+                    x251,
+                    x88,
+                    x74,
+                    x60,
+                    x309,
+                ],
+                [
+                    x295,
+                    x296,
+                    x291,
+                    x297,
+                    x298,
+                    x299,
+                    x292,
+                    x288,
+                    x282,
+                    x277,
+                    x60,
+                    x45,
+                    x305,
+                ],
+                [
+                    x334,
+                    x335,
+                    x330,
+                    x336,
+                    x337,
+                    x338,
+                    x331,
+                    x327,
+                    x321,
+                    x316,
+                    x309,
+                    x305,
+                    1.4135609200000003,
+                ],
+            ],
+            [
+                x539,
+                x540,
+                x541,
+                x542,
+                x543,
+                x544,
+                x533,
+                x525,
+                x515,
+                x508,
+                x500,
+                x492,
+                x482,
+            ],
+        )
+    }
+    /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
+    ///
+    /// Methods: forward `aba`: 1613 mul, 1325 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 987 fused where the target has FMA.
+    #[must_use]
+    pub fn forward_dynamics_with_wrenches(
+        q: &[f64; 14],
+        v: &[f64; 13],
+        tau: &[f64; 7],
+        f_ext: &[[f64; 6]; 8],
+    ) -> [f64; 13] {
+        let x0 = Self::mul_add(
+            v[1],
+            -180.9502499901501,
+            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
+        );
+        let x1 = Self::mul_add(
+            1466.4506062283303,
+            v[4],
+            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
+        );
+        let x2 = Self::mul_add(
+            110.5455,
+            v[1],
+            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
+        );
+        let x3 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]);
+        let x4 = Self::mul_add(
+            1170.07,
+            v[1],
+            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
+        );
+        let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
+        let (s_q7, c_q7) = libm::sincos(q[7]);
+        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x9 = Self::mul_add(v[4], 0.75, v[0]);
+        let x10 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x11 = Self::mul_add(-0.65, v[4], v[2]);
+        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
+        let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
+        let x14 = v[6] * x8;
+        let x15 = v[6] * x7;
+        let x16 = v[6] * x13;
+        let x17 = v[6] * x12;
+        let x18 = v[5] + v[6];
+        let x19 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x8);
+        let x20 = Self::mul_add(
+            x11,
+            -48.0240000085309,
+            Self::mul_add(
+                0.1132,
+                x18,
+                Self::mul_add(130.43769025763282, x8, -0.07309 * x7),
+            ),
+        );
+        let x21 = Self::mul_add(
+            48.0240000085309,
+            x13,
+            Self::mul_add(
+                132.47349025763282,
+                x18,
+                Self::mul_add(0.1132, x8, -16.80768997608804 * x7),
+            ),
+        );
+        let x22 = x18 * -48.0240000085309;
+        let x23 = 48.0240000085309 * x8;
+        let (s_q8, c_q8) = libm::sincos(q[8]);
+        let x25 = -0.00000000020510342851533115 * c_q8;
+        let x26 = -0.00000000020510342851533115 * s_q8;
+        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x7, x26, x8 * c_q8));
+        let x29 = Self::mul_add(x8, 0.35, x12);
+        let x30 = Self::mul_add(-0.35, x7, x13);
+        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-x26, x29, c_q8 * x30));
+        let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
+        let x34 = v[7] * x28;
+        let x35 = v[7] * x27;
+        let x36 = v[7] * x32;
+        let x37 = v[7] * x31;
+        let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
+        let x39 = Self::mul_add(
+            -12.701650001451807,
+            x33,
+            Self::mul_add(-0.002139996587640933, x38, -0.0000000234896432582596 * x28),
+        );
+        let x40 = Self::mul_add(
+            x33,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x38,
+                Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
+            ),
+        );
+        let x41 = Self::mul_add(
+            113.3918902508081,
+            x38,
+            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
+        ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
+        let x42 = -12.701650001451807 * x38;
+        let x43 = x38 * 0.000000008530897668050218;
+        let x44 = Self::mul_add(
+            -0.000000008530897668050218,
+            x28,
+            x27 * 12.701650001451807,
+        );
+        let (s_q9, c_q9) = libm::sincos(q[9]);
+        let x46 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            0.00000000020510342851533115 * c_q9,
+        );
+        let x47 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            -0.00000000020510342851533115 * c_q9,
+        );
+        let x48 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x46, x27 * s_q9));
+        let x49 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x47, x27 * c_q9));
+        let x50 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
+        let x51 = Self::mul_add(-0.4, x27, x32);
+        let x52 = Self::mul_add(0.275, x27, x33);
+        let x53 = Self::mul_add(c_q9, x52, Self::mul_add(x46, x51, s_q9 * x50));
+        let x54 = Self::mul_add(-s_q9, x52, Self::mul_add(x47, x51, c_q9 * x50));
+        let x55 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x52,
+            Self::mul_add(0.00000000020510342851533115, x50, x51),
+        );
+        let x56 = v[8] * x49;
+        let x57 = v[8] * x48;
+        let x58 = v[8] * x54;
+        let x59 = v[8] * x53;
+        let x60 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x38,
+                Self::mul_add(0.00000000020510342851533115, x27, x28),
+            );
+        let x61 = Self::mul_add(-36.18604050126307, x60, -63.36336825000001 * x49);
+        let x62 = Self::mul_add(-81.53205, x55, -0.00214 * x60);
+        let x63 = Self::mul_add(
+            x53,
+            81.53205,
+            Self::mul_add(
+                69.99836825,
+                x60,
+                Self::mul_add(-36.18604050126307, x49, -0.00214 * x48),
+            ),
+        );
+        let x64 = -81.53205 * x60;
+        let x65 = x48 * 81.53205;
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x67 = Self::mul_add(x49, s_q10, x48 * c_q10);
+        let x68 = Self::mul_add(-x48, s_q10, x49 * c_q10);
+        let x69 = Self::mul_add(0.87, x60, x53);
+        let x70 = Self::mul_add(x48, -0.87, x55);
+        let x71 = Self::mul_add(x54, s_q10, c_q10 * x69);
+        let x72 = Self::mul_add(-s_q10, x69, x54 * c_q10);
+        let x73 = v[9] * x68;
+        let x74 = v[9] * x67;
+        let x75 = v[9] * x72;
+        let x76 = v[9] * x71;
+        let x77 = v[9] + x60;
+        let x78 = Self::mul_add(-24.35164200091464, x77, -24.4950615 * x68);
+        let x79 = Self::mul_add(-45.1584, x70, -0.6328 * x77);
+        let x80 = Self::mul_add(
+            x71,
+            45.1584,
+            Self::mul_add(
+                28.2393615,
+                x77,
+                Self::mul_add(-24.351642000914637, x68, -0.6328 * x67),
+            ),
+        );
+        let x81 = -45.1584 * x77;
+        let x82 = x67 * 45.1584;
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x84 = Self::mul_add(x68, s_q11, x67 * c_q11);
+        let x85 = Self::mul_add(-x67, s_q11, x68 * c_q11);
+        let x86 = x71 - Self::mul_add(-0.63, x77, 0.275 * x68);
+        let x87 = Self::mul_add(0.275, x67, x72);
+        let x88 = Self::mul_add(x67, -0.63, x70);
+        let x89 = Self::mul_add(s_q11, x87, c_q11 * x86);
+        let x90 = Self::mul_add(-s_q11, x86, c_q11 * x87);
+        let x91 = v[10] * x85;
+        let x92 = v[10] * x84;
+        let x93 = v[10] * x90;
+        let x94 = v[10] * x89;
+        let x95 = v[10] + x77;
+        let x96 = Self::mul_add(2.5482240016099564, x95, -9.142025249762803 * x85);
+        let x97 = Self::mul_add(7.078399999258757, x88, 0.01675 * x95);
+        let x98 = Self::mul_add(
+            x89,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x95,
+                Self::mul_add(2.5482240016099564, x85, 0.01675 * x84),
+            ),
+        );
+        let x99 = 7.078399999258757 * x95;
+        let x100 = x84 * -7.078399999258757;
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x102 = -0.00000000020510342851533115 * s_q12;
+        let x103 = -0.00000000020510342851533115 * c_q12;
+        let x104 = Self::mul_add(-x95, s_q12, Self::mul_add(x85, x102, x84 * c_q12));
+        let x105 = Self::mul_add(-x95, c_q12, Self::mul_add(-x84, s_q12, x85 * x103));
+        let x106 = Self::mul_add(x85, -0.36, x89);
+        let x107 = Self::mul_add(0.36, x84, x90);
+        let x108 = Self::mul_add(-x88, s_q12, Self::mul_add(x102, x107, c_q12 * x106));
+        let x109 = Self::mul_add(-x88, c_q12, Self::mul_add(-s_q12, x106, x103 * x107));
+        let x110 = Self::mul_add(-0.00000000020510342851533115, x88, x107);
+        let x111 = v[11] * x105;
+        let x112 = v[11] * x104;
+        let x113 = v[11] * x109;
+        let x114 = v[11] * x108;
+        let x115 = v[11] + Self::mul_add(-0.00000000020510342851533115, x95, x85);
+        let x116 = Self::mul_add(
+            17.135250000000003,
+            x110,
+            Self::mul_add(-0.809539999555672, x115, -1.9877000000000002 * x105),
+        );
+        let x117 = Self::mul_add(
+            x110,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x115,
+                Self::mul_add(-5.252920330000002, x105, -1.9877000000000002 * x104),
+            ),
+        );
+        let x118 = Self::mul_add(
+            9.740442170000001,
+            x115,
+            Self::mul_add(-2.7416399995923166, x105, -0.809539999555672 * x104),
+        ) + Self::mul_add(3.6140000000000003, x109, x108 * -17.135250000000003);
+        let x119 = 17.135250000000003 * x115;
+        let x120 = x115 * -3.6140000000000003;
+        let x121 = Self::mul_add(3.6140000000000003, x105, x104 * -17.135250000000003);
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x123 = -0.00000000020510342851533115 * c_q13;
+        let x124 = -0.00000000020510342851533115 * s_q13;
+        let x125 = Self::mul_add(-x115, c_q13, Self::mul_add(x105, s_q13, x104 * x123));
+        let x126 = Self::mul_add(x115, s_q13, Self::mul_add(-x104, x124, x105 * c_q13));
+        let x127 = x108 - Self::mul_add(0.55, x115, -0.16 * x105);
+        let x128 = Self::mul_add(-0.16, x104, x109);
+        let x129 = Self::mul_add(x104, 0.55, x110);
+        let x130 = Self::mul_add(-c_q13, x129, Self::mul_add(s_q13, x128, x123 * x127));
+        let x131 = Self::mul_add(s_q13, x129, Self::mul_add(-x124, x127, c_q13 * x128));
+        let x132 = Self::mul_add(-0.00000000020510342851533115, x129, x127);
+        let x133 = v[12] * x126;
+        let x134 = v[12] * x125;
+        let x135 = v[12] * x131;
+        let x136 = v[12] + Self::mul_add(-0.00000000020510342851533115, x115, x104);
+        let x137 = Self::mul_add(
+            -0.9614610000000001,
+            x136,
+            Self::mul_add(-1.2025609200000003, x126, 0.000781 * x125),
+        );
+        let x138 = Self::mul_add(
+            4.806620000000001,
+            x132,
+            Self::mul_add(-0.0145, x136, 0.000781 * x126),
+        );
+        let x139 = Self::mul_add(
+            x130,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x136,
+                Self::mul_add(-0.9614610000000001, x126, -0.0145 * x125),
+            ),
+        );
+        let x140 = 4.806620000000001 * x136;
+        let x141 = x125 * -4.806620000000001;
+        let x142 = Self::mul_add(x131, x140, Self::mul_add(-x126, x138, x125 * x137))
+            - f_ext[7][5];
+        let x143 = Self::mul_add(-x136, x140, x125 * x141) - f_ext[7][1];
+        let x144 = tau[6] - x142;
+        let x145 = Self::mul_add(
+            4.806620000000001,
+            x133,
+            Self::mul_add(x126, x140, -f_ext[7][2]),
+        );
+        let x146 = Self::mul_add(
+            x144,
+            -0.010257782169020348,
+            Self::mul_add(-x131, x141, Self::mul_add(-x136, x137, x126 * x139))
+                - f_ext[7][3]
+                + Self::mul_add(
+                    x135,
+                    -0.049305260929256585,
+                    Self::mul_add(
+                        x134,
+                        0.009081457502008472,
+                        x133 * -0.00014873784145079505,
+                    ),
+                ),
+        );
+        let x147 = Self::mul_add(
+            x144,
+            -0.6801694828971361,
+            Self::mul_add(-x125, x139, x136 * x138)
+                + Self::mul_add(-x132, x140, x130 * x141) - f_ext[7][4]
+                + Self::mul_add(
+                    x135,
+                    -3.2693162398830324,
+                    Self::mul_add(x134, 1.8565173511957638, x133 * -0.009081457502008472),
+                ),
+        );
+        let x148 = x142 + x144;
+        let x149 = Self::mul_add(
+            x144,
+            -3.4003628227073506,
+            Self::mul_add(
+                x135,
+                -16.344251950881606,
+                Self::mul_add(x134, 3.2693162398830324, x133 * -0.049305260929256585),
+            ) - Self::mul_add(x126, x141, f_ext[7][0]),
+        );
+        let x150 = c_q13 * -0.009081457502008472;
+        let x151 = Self::mul_add(s_q13, -0.00014873784145079505, x150);
+        let x152 = s_q13 * -0.009081457502008472;
+        let x153 = Self::mul_add(c_q13, 0.00014873784145079505, x152);
+        let x154 = Self::mul_add(c_q13, -1.8565173511957638, x152);
+        let x155 = Self::mul_add(s_q13, -1.8565173511957638, -x150);
+        let x156 = Self::mul_add(x123, -0.049305260929256585, 4.806620000000001);
+        let x157 = s_q13 * -0.049305260929256585;
+        let x158 = Self::mul_add(
+            c_q13,
+            0.049305260929256585,
+            -0.0000000009858542415703612,
+        );
+        let x159 = x123 * -3.2693162398830324;
+        let x160 = s_q13 * -3.2693162398830324;
+        let x161 = c_q13 * -3.2693162398830324;
+        let x162 = Self::mul_add(-x124, x159, x123 * x156);
+        let x163 = Self::mul_add(-x124, x160, x123 * x157);
+        let x164 = Self::mul_add(x124, x161, x123 * x158);
+        let x165 = Self::mul_add(c_q13, x159, s_q13 * x156);
+        let x166 = Self::mul_add(-c_q13, x156, s_q13 * x159);
+        let x167 = s_q13 * -16.344251950881606;
+        let x168 = c_q13 * -16.344251950881606;
+        let x169 = x123 * (x123 * -16.344251950881606);
+        let x170 = x123 * x167;
+        let x171 = x123 * x168;
+        let x172 = s_q13 * x167;
+        let x173 = s_q13 * x168;
+        let x174 = c_q13 * x168;
+        let x175 = x163 + Self::mul_add(-0.55, x173, -0.16 * x172);
+        let x176 = x164 + Self::mul_add(0.16, x173, 0.55 * x174);
+        let x177 = Self::mul_add(0.16, x169, x165);
+        let x178 = Self::mul_add(0.16, x170, Self::mul_add(c_q13, x160, s_q13 * x157));
+        let x179 = Self::mul_add(-0.16, x171, Self::mul_add(-c_q13, x161, s_q13 * x158));
+        let x180 = Self::mul_add(-0.55, x169, x166);
+        let x181 = Self::mul_add(-0.55, x170, Self::mul_add(-c_q13, x157, s_q13 * x160));
+        let x182 = Self::mul_add(-0.55, x171, Self::mul_add(s_q13, x161, c_q13 * x158));
+        let x183 = Self::mul_add(
+            0.16,
+            x165,
+            Self::mul_add(0.16, x177, Self::mul_add(c_q13, x154, s_q13 * x151)),
+        );
+        let x184 = Self::mul_add(
+            -0.55,
+            x165,
+            Self::mul_add(0.16, x180, Self::mul_add(c_q13, x155, s_q13 * x153)),
+        );
+        let x185 = Self::mul_add(
+            -0.55,
+            x166,
+            Self::mul_add(-0.55, x180, Self::mul_add(-c_q13, x153, s_q13 * x155)),
+        );
+        let x186 = x145 + Self::mul_add(-x124, x143, x123 * x149);
+        let x187 = Self::mul_add(c_q13, x143, s_q13 * x149);
+        let x188 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x145,
+            Self::mul_add(-c_q13, x149, s_q13 * x143),
+        );
+        let x189 = Self::mul_add(
+            -0.55,
+            x186,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x148,
+                Self::mul_add(-c_q13, x146, s_q13 * x147),
+            ),
+        );
+        let x190 = -0.809539999555672
+            + Self::mul_add(
+                -0.55,
+                x162,
+                Self::mul_add(-x124, x155, x123 * x153)
+                    + Self::mul_add(-0.55, x182, -0.16 * x181),
+            );
+        let x191 = -2.741639999592316 + x184;
+        let x192 = 9.740442170000001 + x185;
+        let x193 = -17.135250000000003 + x180;
+        let x194 = 3.6140000000000003 + x181;
+        let x195 = Self::mul_add(-x105, x116, x104 * x117)
+            + Self::mul_add(-x108, x120, x109 * x119) - f_ext[6][5] + x189;
+        let x196 = 1.0 / x192;
+        let x197 = tau[5] - x195;
+        let x198 = x190 * x196;
+        let x199 = x191 * x196;
+        let x200 = x193 * x196;
+        let x201 = x194 * x196;
+        let x202 = x182 * x196;
+        let x203 = Self::mul_add(
+            -x190,
+            x198,
+            Self::mul_add(0.55, x164, -0.16 * x163)
+                + (Self::mul_add(
+                    -x124,
+                    Self::mul_add(
+                        x124,
+                        1.8565173511957638,
+                        x123 * -0.009081457502008472,
+                    ),
+                    x123
+                        * Self::mul_add(
+                            x124,
+                            0.009081457502008472,
+                            x123 * -0.00014873784145079505,
+                        ),
+                ) + Self::mul_add(0.55, x176, -0.16 * x175)),
+        );
+        let x204 = Self::mul_add(
+            -x190,
+            x199,
+            -1.9877000000000002
+                + Self::mul_add(
+                    0.16,
+                    x162,
+                    Self::mul_add(-x124, x154, x123 * x151)
+                        + Self::mul_add(0.55, x179, -0.16 * x178),
+                ),
+        );
+        let x205 = Self::mul_add(-x191, x199, -5.252920330000002 + x183);
+        let x206 = Self::mul_add(
+            -x190,
             x200,
+            x162 + Self::mul_add(-0.55, x171, -0.16 * x170),
+        );
+        let x207 = Self::mul_add(-x190, x201, x175);
+        let x208 = Self::mul_add(x190, x202, 17.135250000000003 + x176);
+        let x209 = Self::mul_add(-x191, x200, x177);
+        let x210 = Self::mul_add(-x191, x201, x178);
+        let x211 = Self::mul_add(x191, x202, -3.6140000000000003 + x179);
+        let x212 = Self::mul_add(-x193, x200, x169);
+        let x213 = Self::mul_add(-x193, x201, x170);
+        let x214 = Self::mul_add(x193, x202, -x171);
+        let x215 = Self::mul_add(-x194, x201, x172);
+        let x216 = Self::mul_add(x194, x202, -x173);
+        let x217 = Self::mul_add(-x182, x202, x174);
+        let x218 = Self::mul_add(
+            x197,
+            x198,
+            Self::mul_add(-x115, x117, x105 * x118)
+                + Self::mul_add(-x109, x121, x110 * x120) - f_ext[6][3]
+                + (x148 + Self::mul_add(-x124, x147, x123 * x146)
+                    + Self::mul_add(0.55, x188, -0.16 * x187))
+                + (Self::mul_add(-x112, x204, x111 * x203)
+                    + Self::mul_add(-x114, x207, x113 * x206)),
+        );
+        let x219 = Self::mul_add(
+            x197,
+            x199,
+            Self::mul_add(-x104, x118, x115 * x116)
+                + Self::mul_add(-x110, x119, x108 * x121) - f_ext[6][4]
+                + Self::mul_add(0.16, x186, Self::mul_add(c_q13, x147, s_q13 * x146))
+                + (Self::mul_add(-x112, x205, x111 * x204)
+                    + Self::mul_add(-x114, x210, x113 * x209)),
+        );
+        let x220 = Self::mul_add(x197, x192 * x196, x195);
+        let x221 = Self::mul_add(
+            x197,
+            x200,
+            Self::mul_add(-x105, x121, x115 * x120) - f_ext[6][0] + x186
+                + (Self::mul_add(-x112, x209, x111 * x206)
+                    + Self::mul_add(-x114, x213, x113 * x212)),
+        );
+        let x222 = Self::mul_add(
+            x197,
+            x201,
+            Self::mul_add(-x115, x119, x104 * x121) - f_ext[6][1] + x187
+                + (Self::mul_add(-x112, x210, x111 * x207)
+                    + Self::mul_add(-x114, x215, x113 * x213)),
+        );
+        let x223 = Self::mul_add(
+            -x197,
             x202,
-            Self::mul_add(-x106, x120, x117 * x118)
-                + Self::mul_add(-x112, x121, x110 * x123)
-                + Self::mul_add(0.16, x189, Self::mul_add(c_q13, x150, s_q13 * x149))
-                + (Self::mul_add(-x114, x208, x113 * x207)
-                    + Self::mul_add(-x116, x213, x115 * x212)),
+            Self::mul_add(-x104, x120, x105 * x119) - f_ext[6][2] + x188
+                + (Self::mul_add(-x112, x211, x111 * x208)
+                    + Self::mul_add(-x114, x216, x113 * x214)),
         );
-        let x223 = Self::mul_add(x200, x195 * x199, x198);
-        let x224 = Self::mul_add(
-            x200,
-            x203,
-            Self::mul_add(-x107, x123, x117 * x122) + x189
-                + (Self::mul_add(-x114, x212, x113 * x209)
-                    + Self::mul_add(-x116, x216, x115 * x215)),
+        let x224 = s_q12 * x204;
+        let x225 = Self::mul_add(x103, x204, x102 * x203);
+        let x226 = c_q12 * x204;
+        let x227 = Self::mul_add(s_q12, x203, x226);
+        let x228 = Self::mul_add(x103, x205, x102 * x204);
+        let x229 = Self::mul_add(c_q12, x205, x224);
+        let x230 = Self::mul_add(-s_q12, x207, c_q12 * x206);
+        let x231 = x208 + Self::mul_add(x103, x207, x102 * x206);
+        let x232 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x208,
+            -Self::mul_add(c_q12, x207, s_q12 * x206),
         );
-        let x225 = Self::mul_add(
-            x200,
-            x204,
-            Self::mul_add(-x117, x121, x106 * x123) + x190
-                + (Self::mul_add(-x114, x213, x113 * x210)
-                    + Self::mul_add(-x116, x218, x115 * x216)),
-        );
-        let x226 = Self::mul_add(
-            -x200,
-            x205,
-            Self::mul_add(-x106, x122, x107 * x121) + x191
-                + (Self::mul_add(-x114, x214, x113 * x211)
-                    + Self::mul_add(-x116, x219, x115 * x217)),
-        );
-        let x227 = s_q12 * x207;
-        let x228 = Self::mul_add(x105, x207, x104 * x206);
-        let x229 = c_q12 * x207;
-        let x230 = Self::mul_add(s_q12, x206, x229);
-        let x231 = Self::mul_add(x105, x208, x104 * x207);
-        let x232 = Self::mul_add(c_q12, x208, x227);
         let x233 = Self::mul_add(-s_q12, x210, c_q12 * x209);
-        let x234 = x211 + Self::mul_add(x105, x210, x104 * x209);
+        let x234 = x211 + Self::mul_add(x103, x210, x102 * x209);
         let x235 = Self::mul_add(
             -0.00000000020510342851533115,
             x211,
             -Self::mul_add(c_q12, x210, s_q12 * x209),
         );
-        let x236 = Self::mul_add(-s_q12, x213, c_q12 * x212);
-        let x237 = x214 + Self::mul_add(x105, x213, x104 * x212);
-        let x238 = Self::mul_add(
+        let x236 = Self::mul_add(-s_q12, x233, c_q12 * x230);
+        let x237 = Self::mul_add(-s_q12, x234, c_q12 * x231);
+        let x238 = Self::mul_add(x103, x233, x102 * x230);
+        let x239 = Self::mul_add(c_q12, x233, s_q12 * x230);
+        let x240 = Self::mul_add(c_q12, x234, s_q12 * x231);
+        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
+        let x242 = s_q12 * x213;
+        let x243 = x214 + Self::mul_add(x103, x213, x102 * x212);
+        let x244 = c_q12 * x213;
+        let x245 = Self::mul_add(
             -0.00000000020510342851533115,
             x214,
-            -Self::mul_add(c_q12, x213, s_q12 * x212),
+            -Self::mul_add(s_q12, x212, x244),
         );
-        let x239 = Self::mul_add(-s_q12, x236, c_q12 * x233);
-        let x240 = Self::mul_add(-s_q12, x237, c_q12 * x234);
-        let x241 = Self::mul_add(x105, x236, x104 * x233);
-        let x242 = Self::mul_add(c_q12, x236, s_q12 * x233);
-        let x243 = Self::mul_add(c_q12, x237, s_q12 * x234);
-        let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
-        let x245 = s_q12 * x216;
-        let x246 = x217 + Self::mul_add(x105, x216, x104 * x215);
-        let x247 = c_q12 * x216;
+        let x246 = x216 + Self::mul_add(x103, x215, x102 * x213);
+        let x247 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x216,
+            -Self::mul_add(c_q12, x215, x242),
+        );
         let x248 = Self::mul_add(
             -0.00000000020510342851533115,
             x217,
-            -Self::mul_add(s_q12, x215, x247),
+            -Self::mul_add(c_q12, x216, s_q12 * x214),
         );
-        let x249 = x219 + Self::mul_add(x105, x218, x104 * x216);
-        let x250 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x219,
-            -Self::mul_add(c_q12, x218, x245),
-        );
-        let x251 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x220,
-            -Self::mul_add(c_q12, x219, s_q12 * x217),
-        );
-        let x252 = Self::mul_add(
+        let x249 = Self::mul_add(
             -s_q12,
-            Self::mul_add(-s_q12, x218, x247),
-            c_q12 * Self::mul_add(c_q12, x215, -x245),
+            Self::mul_add(-s_q12, x215, x244),
+            c_q12 * Self::mul_add(c_q12, x212, -x242),
         );
-        let x253 = Self::mul_add(-s_q12, x249, c_q12 * x246);
-        let x254 = Self::mul_add(-s_q12, x250, c_q12 * x248);
-        let x255 = x220 + Self::mul_add(x105, x219, x104 * x217)
-            + Self::mul_add(x105, x249, x104 * x246);
-        let x256 = x251 + Self::mul_add(x105, x250, x104 * x248);
-        let x257 = Self::mul_add(0.36, x255, x240);
-        let x258 = Self::mul_add(-0.36, x252, x241);
-        let x259 = Self::mul_add(-0.36, x253, Self::mul_add(x105, x237, x104 * x234));
-        let x260 = Self::mul_add(
+        let x250 = Self::mul_add(-s_q12, x246, c_q12 * x243);
+        let x251 = Self::mul_add(-s_q12, x247, c_q12 * x245);
+        let x252 = x217 + Self::mul_add(x103, x216, x102 * x214)
+            + Self::mul_add(x103, x246, x102 * x243);
+        let x253 = x248 + Self::mul_add(x103, x247, x102 * x245);
+        let x254 = Self::mul_add(0.36, x252, x237);
+        let x255 = Self::mul_add(-0.36, x249, x238);
+        let x256 = Self::mul_add(-0.36, x250, Self::mul_add(x103, x234, x102 * x231));
+        let x257 = Self::mul_add(
             0.36,
-            x257,
+            x254,
             Self::mul_add(
                 -s_q12,
-                Self::mul_add(-s_q12, x208, x229),
-                c_q12 * Self::mul_add(c_q12, x206, -x227),
+                Self::mul_add(-s_q12, x205, x226),
+                c_q12 * Self::mul_add(c_q12, x203, -x224),
             ),
         );
-        let x261 = Self::mul_add(
+        let x258 = Self::mul_add(
             -0.36,
-            x239,
-            Self::mul_add(0.36, x259, Self::mul_add(-s_q12, x231, c_q12 * x228)),
+            x236,
+            Self::mul_add(0.36, x256, Self::mul_add(-s_q12, x228, c_q12 * x225)),
         );
-        let x262 = Self::mul_add(
+        let x259 = Self::mul_add(
             -0.36,
-            x241,
-            Self::mul_add(-0.36, x258, Self::mul_add(x105, x231, x104 * x228)),
+            x238,
+            Self::mul_add(-0.36, x255, Self::mul_add(x103, x228, x102 * x225)),
         );
-        let x263 = Self::mul_add(-s_q12, x225, c_q12 * x224);
-        let x264 = x226 + Self::mul_add(x105, x225, x104 * x224);
-        let x265 = 0.01675
-            + Self::mul_add(-0.36, x243, Self::mul_add(-c_q12, x230, s_q12 * x232));
-        let x266 = 2.5482240016099564
-            - Self::mul_add(-0.36, x242, Self::mul_add(x105, x232, x104 * x230));
-        let x267 = 9.223235249762805 + Self::mul_add(c_q12, x232, s_q12 * x230);
-        let x268 = -7.078399999258757 - x242;
-        let x269 = Self::mul_add(x92, x101, Self::mul_add(-x87, x99, x86 * x98))
+        let x260 = Self::mul_add(-s_q12, x222, c_q12 * x221);
+        let x261 = x223 + Self::mul_add(x103, x222, x102 * x221);
+        let x262 = 0.01675
+            + Self::mul_add(-0.36, x240, Self::mul_add(-c_q12, x227, s_q12 * x229));
+        let x263 = 2.5482240016099564
+            - Self::mul_add(-0.36, x239, Self::mul_add(x103, x229, x102 * x227));
+        let x264 = 9.223235249762805 + Self::mul_add(c_q12, x229, s_q12 * x227);
+        let x265 = -7.078399999258757 - x239;
+        let x266 = Self::mul_add(x90, x99, Self::mul_add(-x85, x97, x84 * x96))
+            - f_ext[5][5]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x223,
-                -Self::mul_add(c_q12, x222, s_q12 * x221),
+                x220,
+                -Self::mul_add(c_q12, x219, s_q12 * x218),
             );
-        let x270 = Self::mul_add(
-            x87,
-            x101,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x226,
-                -Self::mul_add(c_q12, x225, s_q12 * x224),
-            ),
-        );
-        let x271 = 1.0 / x267;
-        let x272 = tau[4] - x269;
-        let x273 = x265 * x271;
-        let x274 = x266 * x271;
-        let x275 = x268 * x271;
-        let x276 = x243 * x271;
-        let x277 = x244 * x271;
-        let x278 = Self::mul_add(-x265, x273, Self::mul_add(0.36, x240, x260));
-        let x279 = Self::mul_add(-x265, x274, x261);
-        let x280 = Self::mul_add(-x266, x274, -9.142025249762803 + x262);
-        let x281 = Self::mul_add(-x265, x275, Self::mul_add(0.36, x253, x239));
-        let x282 = Self::mul_add(x265, x276, x257);
-        let x283 = Self::mul_add(
-            x265,
-            x277,
-            7.078399999258757
-                + Self::mul_add(0.36, x256, Self::mul_add(-s_q12, x238, c_q12 * x235)),
-        );
-        let x284 = Self::mul_add(-x266, x275, x258);
-        let x285 = Self::mul_add(x266, x276, x259);
-        let x286 = Self::mul_add(
-            x266,
-            x277,
-            Self::mul_add(-0.36, x254, Self::mul_add(x105, x238, x104 * x235)),
-        );
-        let x287 = Self::mul_add(-x268, x275, x252);
-        let x288 = Self::mul_add(x268, x276, x253);
-        let x289 = Self::mul_add(x268, x277, x254);
-        let x290 = Self::mul_add(-x243, x276, x255);
-        let x291 = Self::mul_add(-x243, x277, x256);
-        let x292 = Self::mul_add(
-            -x244,
-            x277,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x251,
-                -Self::mul_add(c_q12, x250, s_q12 * x248),
-            ),
-        );
-        let x293 = Self::mul_add(
-            x272,
+        let x267 = 1.0 / x264;
+        let x268 = tau[4] - x266;
+        let x269 = x262 * x267;
+        let x270 = x263 * x267;
+        let x271 = x265 * x267;
+        let x272 = x240 * x267;
+        let x273 = x241 * x267;
+        let x274 = Self::mul_add(-x262, x269, Self::mul_add(0.36, x237, x257));
+        let x275 = Self::mul_add(-x262, x270, x258);
+        let x276 = Self::mul_add(-x263, x270, -9.142025249762803 + x259);
+        let x277 = Self::mul_add(-x262, x271, Self::mul_add(0.36, x250, x236));
+        let x278 = Self::mul_add(x262, x272, x254);
+        let x279 = Self::mul_add(
+            x262,
             x273,
-            Self::mul_add(-x92, x102, Self::mul_add(-x97, x98, x87 * x100))
-                + Self::mul_add(0.36, x264, Self::mul_add(-s_q12, x222, c_q12 * x221))
-                + (Self::mul_add(-x94, x279, x93 * x278)
-                    + Self::mul_add(-x96, x282, x95 * x281)),
+            7.078399999258757
+                + Self::mul_add(0.36, x253, Self::mul_add(-s_q12, x235, c_q12 * x232)),
         );
-        let x294 = Self::mul_add(
-            x272,
-            x274,
-            Self::mul_add(-x86, x100, x97 * x99) + Self::mul_add(-x90, x101, x91 * x102)
+        let x280 = Self::mul_add(-x263, x271, x255);
+        let x281 = Self::mul_add(x263, x272, x256);
+        let x282 = Self::mul_add(
+            x263,
+            x273,
+            Self::mul_add(-0.36, x251, Self::mul_add(x103, x235, x102 * x232)),
+        );
+        let x283 = Self::mul_add(-x265, x271, x249);
+        let x284 = Self::mul_add(x265, x272, x250);
+        let x285 = Self::mul_add(x265, x273, x251);
+        let x286 = Self::mul_add(-x240, x272, x252);
+        let x287 = Self::mul_add(-x240, x273, x253);
+        let x288 = Self::mul_add(
+            -x241,
+            x273,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x248,
+                -Self::mul_add(c_q12, x247, s_q12 * x245),
+            ),
+        );
+        let x289 = Self::mul_add(
+            x268,
+            x269,
+            Self::mul_add(-x90, x100, Self::mul_add(-x95, x96, x85 * x98)) - f_ext[5][3]
+                + Self::mul_add(0.36, x261, Self::mul_add(-s_q12, x219, c_q12 * x218))
+                + (Self::mul_add(-x92, x275, x91 * x274)
+                    + Self::mul_add(-x94, x278, x93 * x277)),
+        );
+        let x290 = Self::mul_add(
+            x268,
+            x270,
+            Self::mul_add(-x84, x98, x95 * x97) + Self::mul_add(-x88, x99, x89 * x100)
+                - f_ext[5][4]
                 + Self::mul_add(
                     -0.36,
-                    x263,
-                    x223 + Self::mul_add(x105, x222, x104 * x221),
+                    x260,
+                    x220 + Self::mul_add(x103, x219, x102 * x218),
                 )
-                + (Self::mul_add(-x94, x280, x93 * x279)
-                    + Self::mul_add(-x96, x285, x95 * x284)),
+                + (Self::mul_add(-x92, x276, x91 * x275)
+                    + Self::mul_add(-x94, x281, x93 * x280)),
         );
-        let x295 = Self::mul_add(
+        let x291 = Self::mul_add(
+            x268,
+            x271,
+            x260 - Self::mul_add(x85, x100, f_ext[5][0])
+                + (Self::mul_add(-x92, x280, x91 * x277)
+                    + Self::mul_add(-x94, x284, x93 * x283)),
+        );
+        let x292 = Self::mul_add(
+            -x268,
             x272,
-            x275,
-            Self::mul_add(-x87, x102, x263)
-                + (Self::mul_add(-x94, x284, x93 * x281)
-                    + Self::mul_add(-x96, x288, x95 * x287)),
+            Self::mul_add(-x95, x99, x84 * x100) - f_ext[5][1] + x261
+                + (Self::mul_add(-x92, x281, x91 * x278)
+                    + Self::mul_add(-x94, x286, x93 * x284)),
         );
-        let x296 = Self::mul_add(
-            -x272,
-            x276,
-            Self::mul_add(-x97, x101, x86 * x102) + x264
-                + (Self::mul_add(-x94, x285, x93 * x282)
-                    + Self::mul_add(-x96, x290, x95 * x288)),
+        let x293 = Self::mul_add(
+            -x268,
+            x273,
+            Self::mul_add(x85, x99, -f_ext[5][2])
+                + Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x223,
+                    -Self::mul_add(c_q12, x222, s_q12 * x221),
+                )
+                + (Self::mul_add(-x92, x282, x91 * x279)
+                    + Self::mul_add(-x94, x287, x93 * x285)),
         );
-        let x297 = Self::mul_add(
-            -x272,
-            x277,
-            x270
-                + (Self::mul_add(-x94, x286, x93 * x283)
-                    + Self::mul_add(-x96, x291, x95 * x289)),
-        );
-        let x298 = s_q11 * x279;
-        let x299 = c_q11 * x279;
-        let x300 = Self::mul_add(s_q11, x278, x299);
-        let x301 = Self::mul_add(c_q11, x280, x298);
-        let x302 = Self::mul_add(-s_q11, x282, c_q11 * x281);
-        let x303 = Self::mul_add(c_q11, x282, s_q11 * x281);
-        let x304 = Self::mul_add(-s_q11, x285, c_q11 * x284);
-        let x305 = Self::mul_add(c_q11, x285, s_q11 * x284);
-        let x306 = Self::mul_add(-s_q11, x304, c_q11 * x302);
-        let x307 = Self::mul_add(-s_q11, x305, c_q11 * x303);
-        let x308 = Self::mul_add(-s_q11, x286, c_q11 * x283);
-        let x309 = Self::mul_add(c_q11, x304, s_q11 * x302);
-        let x310 = s_q11 * x288;
-        let x311 = c_q11 * x288;
-        let x312 = Self::mul_add(s_q11, x287, x311);
-        let x313 = Self::mul_add(c_q11, x290, x310);
-        let x314 = Self::mul_add(-s_q11, x291, c_q11 * x289);
-        let x315 = Self::mul_add(c_q11, x291, s_q11 * x289);
-        let x316 = Self::mul_add(
+        let x294 = s_q11 * x275;
+        let x295 = c_q11 * x275;
+        let x296 = Self::mul_add(s_q11, x274, x295);
+        let x297 = Self::mul_add(c_q11, x276, x294);
+        let x298 = Self::mul_add(-s_q11, x278, c_q11 * x277);
+        let x299 = Self::mul_add(c_q11, x278, s_q11 * x277);
+        let x300 = Self::mul_add(-s_q11, x281, c_q11 * x280);
+        let x301 = Self::mul_add(c_q11, x281, s_q11 * x280);
+        let x302 = Self::mul_add(-s_q11, x300, c_q11 * x298);
+        let x303 = Self::mul_add(-s_q11, x301, c_q11 * x299);
+        let x304 = Self::mul_add(-s_q11, x282, c_q11 * x279);
+        let x305 = Self::mul_add(c_q11, x300, s_q11 * x298);
+        let x306 = s_q11 * x284;
+        let x307 = c_q11 * x284;
+        let x308 = Self::mul_add(s_q11, x283, x307);
+        let x309 = Self::mul_add(c_q11, x286, x306);
+        let x310 = Self::mul_add(-s_q11, x287, c_q11 * x285);
+        let x311 = Self::mul_add(c_q11, x287, s_q11 * x285);
+        let x312 = Self::mul_add(
             -s_q11,
-            Self::mul_add(-s_q11, x290, x311),
-            c_q11 * Self::mul_add(c_q11, x287, -x310),
+            Self::mul_add(-s_q11, x286, x307),
+            c_q11 * Self::mul_add(c_q11, x283, -x306),
         );
-        let x317 = Self::mul_add(-s_q11, x313, c_q11 * x312);
-        let x318 = Self::mul_add(c_q11, x313, s_q11 * x312);
-        let x319 = 0.63 * x316;
-        let x320 = 0.63 * x317;
-        let x321 = 0.63 * x314;
-        let x322 = x307 + Self::mul_add(-0.63, x315, 0.275 * x318);
-        let x323 = x308 + Self::mul_add(-0.63, x292, 0.275 * x315);
-        let x324 = Self::mul_add(-0.275, x316, x309);
-        let x325 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x305, s_q11 * x303));
-        let x326 = Self::mul_add(-0.275, x314, Self::mul_add(c_q11, x286, s_q11 * x283));
-        let x327 = Self::mul_add(
+        let x313 = Self::mul_add(-s_q11, x309, c_q11 * x308);
+        let x314 = Self::mul_add(c_q11, x309, s_q11 * x308);
+        let x315 = 0.63 * x312;
+        let x316 = 0.63 * x313;
+        let x317 = 0.63 * x310;
+        let x318 = x303 + Self::mul_add(-0.63, x311, 0.275 * x314);
+        let x319 = x304 + Self::mul_add(-0.63, x288, 0.275 * x311);
+        let x320 = Self::mul_add(-0.275, x312, x305);
+        let x321 = Self::mul_add(-0.275, x313, Self::mul_add(c_q11, x301, s_q11 * x299));
+        let x322 = Self::mul_add(-0.275, x310, Self::mul_add(c_q11, x282, s_q11 * x279));
+        let x323 = Self::mul_add(
             -0.275,
-            x309,
-            Self::mul_add(-0.275, x324, Self::mul_add(c_q11, x301, s_q11 * x300)),
+            x305,
+            Self::mul_add(-0.275, x320, Self::mul_add(c_q11, x297, s_q11 * x296)),
         );
-        let x328 = Self::mul_add(-s_q11, x296, c_q11 * x295);
-        let x329 = Self::mul_add(c_q11, x296, s_q11 * x295);
-        let x330 = -0.6328
-            + Self::mul_add(0.63, x306, Self::mul_add(-0.63, x321, 0.275 * x320));
-        let x331 = -24.35164200091464 + Self::mul_add(0.63, x309, -0.275 * x319);
-        let x332 = Self::mul_add(0.63, x319, 28.2393615);
-        let x333 = 45.1584 + x319;
-        let x334 = Self::mul_add(x74, x83, Self::mul_add(-x70, x81, x69 * x80))
-            + Self::mul_add(0.63, x328, Self::mul_add(x272, x267 * x271, x269));
-        let x335 = 1.0 / x332;
-        let x336 = tau[3] - x334;
-        let x337 = x330 * x335;
-        let x338 = x331 * x335;
-        let x339 = x333 * x335;
-        let x340 = x320 * x335;
-        let x341 = x321 * x335;
-        let x342 = Self::mul_add(
-            -x330,
-            x337,
-            Self::mul_add(-0.63, x308, 0.275 * x307)
+        let x324 = Self::mul_add(-s_q11, x292, c_q11 * x291);
+        let x325 = Self::mul_add(c_q11, x292, s_q11 * x291);
+        let x326 = -0.6328
+            + Self::mul_add(0.63, x302, Self::mul_add(-0.63, x317, 0.275 * x316));
+        let x327 = -24.35164200091464 + Self::mul_add(0.63, x305, -0.275 * x315);
+        let x328 = Self::mul_add(0.63, x315, 28.2393615);
+        let x329 = 45.1584 + x315;
+        let x330 = Self::mul_add(x72, x81, Self::mul_add(-x68, x79, x67 * x78))
+            - f_ext[4][5]
+            + Self::mul_add(0.63, x324, Self::mul_add(x268, x264 * x267, x266));
+        let x331 = 1.0 / x328;
+        let x332 = tau[3] - x330;
+        let x333 = x326 * x331;
+        let x334 = x327 * x331;
+        let x335 = x329 * x331;
+        let x336 = x316 * x331;
+        let x337 = x317 * x331;
+        let x338 = Self::mul_add(
+            -x326,
+            x333,
+            Self::mul_add(-0.63, x304, 0.275 * x303)
                 + (Self::mul_add(
                     -s_q11,
-                    Self::mul_add(-s_q11, x280, x299),
-                    c_q11 * Self::mul_add(c_q11, x278, -x298),
-                ) + Self::mul_add(-0.63, x323, 0.275 * x322)),
+                    Self::mul_add(-s_q11, x276, x295),
+                    c_q11 * Self::mul_add(c_q11, x274, -x294),
+                ) + Self::mul_add(-0.63, x319, 0.275 * x318)),
         );
-        let x343 = Self::mul_add(
-            -x330,
-            x338,
+        let x339 = Self::mul_add(
+            -x326,
+            x334,
             Self::mul_add(
                 -0.275,
-                x306,
-                Self::mul_add(-s_q11, x301, c_q11 * x300)
-                    + Self::mul_add(-0.63, x326, 0.275 * x325),
+                x302,
+                Self::mul_add(-s_q11, x297, c_q11 * x296)
+                    + Self::mul_add(-0.63, x322, 0.275 * x321),
             ),
         );
-        let x344 = Self::mul_add(-x331, x338, -24.4950615 + x327);
-        let x345 = Self::mul_add(
-            -x330,
-            x339,
-            x306 + Self::mul_add(-0.63, x314, 0.275 * x317),
+        let x340 = Self::mul_add(-x327, x334, -24.4950615 + x323);
+        let x341 = Self::mul_add(
+            -x326,
+            x335,
+            x302 + Self::mul_add(-0.63, x310, 0.275 * x313),
         );
-        let x346 = Self::mul_add(-x330, x340, x322);
-        let x347 = Self::mul_add(-x330, x341, -45.1584 + x323);
-        let x348 = Self::mul_add(-x331, x339, x324);
-        let x349 = Self::mul_add(-x331, x340, x325);
-        let x350 = Self::mul_add(-x331, x341, x326);
-        let x351 = Self::mul_add(-x333, x339, x316);
-        let x352 = Self::mul_add(-x333, x340, x317);
-        let x353 = Self::mul_add(-x333, x341, x314);
-        let x354 = Self::mul_add(-x320, x340, x318);
-        let x355 = Self::mul_add(-x320, x341, x315);
-        let x356 = Self::mul_add(-x321, x341, x292);
+        let x342 = Self::mul_add(-x326, x336, x318);
+        let x343 = Self::mul_add(-x326, x337, -45.1584 + x319);
+        let x344 = Self::mul_add(-x327, x335, x320);
+        let x345 = Self::mul_add(-x327, x336, x321);
+        let x346 = Self::mul_add(-x327, x337, x322);
+        let x347 = Self::mul_add(-x329, x335, x312);
+        let x348 = Self::mul_add(-x329, x336, x313);
+        let x349 = Self::mul_add(-x329, x337, x310);
+        let x350 = Self::mul_add(-x316, x336, x314);
+        let x351 = Self::mul_add(-x316, x337, x311);
+        let x352 = Self::mul_add(-x317, x337, x288);
+        let x353 = Self::mul_add(
+            x332,
+            x333,
+            Self::mul_add(-x72, x82, Self::mul_add(-x77, x78, x68 * x80)) - f_ext[4][3]
+                + (Self::mul_add(-s_q11, x290, c_q11 * x289)
+                    + Self::mul_add(-0.63, x293, 0.275 * x325))
+                + (Self::mul_add(-x74, x339, x73 * x338)
+                    + Self::mul_add(-x76, x342, x75 * x341)),
+        );
+        let x354 = Self::mul_add(
+            x332,
+            x334,
+            Self::mul_add(-x67, x80, x77 * x79) + Self::mul_add(-x70, x81, x71 * x82)
+                - f_ext[4][4]
+                + Self::mul_add(-0.275, x324, Self::mul_add(c_q11, x290, s_q11 * x289))
+                + (Self::mul_add(-x74, x340, x73 * x339)
+                    + Self::mul_add(-x76, x345, x75 * x344)),
+        );
+        let x355 = Self::mul_add(
+            x332,
+            x335,
+            x324 - Self::mul_add(x68, x82, f_ext[4][0])
+                + (Self::mul_add(-x74, x344, x73 * x341)
+                    + Self::mul_add(-x76, x348, x75 * x347)),
+        );
+        let x356 = Self::mul_add(
+            x332,
+            x336,
+            Self::mul_add(-x77, x81, x67 * x82) - f_ext[4][1] + x325
+                + (Self::mul_add(-x74, x345, x73 * x342)
+                    + Self::mul_add(-x76, x350, x75 * x348)),
+        );
         let x357 = Self::mul_add(
-            x336,
+            x332,
             x337,
-            Self::mul_add(-x74, x84, Self::mul_add(-x79, x80, x70 * x82))
-                + (Self::mul_add(-s_q11, x294, c_q11 * x293)
-                    + Self::mul_add(-0.63, x297, 0.275 * x329))
-                + (Self::mul_add(-x76, x343, x75 * x342)
-                    + Self::mul_add(-x78, x346, x77 * x345)),
+            Self::mul_add(x68, x81, -f_ext[4][2]) + x293
+                + (Self::mul_add(-x74, x346, x73 * x343)
+                    + Self::mul_add(-x76, x351, x75 * x349)),
         );
-        let x358 = Self::mul_add(
-            x336,
-            x338,
-            Self::mul_add(-x69, x82, x79 * x81) + Self::mul_add(-x72, x83, x73 * x84)
-                + Self::mul_add(-0.275, x328, Self::mul_add(c_q11, x294, s_q11 * x293))
-                + (Self::mul_add(-x76, x344, x75 * x343)
-                    + Self::mul_add(-x78, x349, x77 * x348)),
-        );
-        let x359 = Self::mul_add(
-            x336,
-            x339,
-            Self::mul_add(-x70, x84, x328)
-                + (Self::mul_add(-x76, x348, x75 * x345)
-                    + Self::mul_add(-x78, x352, x77 * x351)),
-        );
-        let x360 = Self::mul_add(
-            x336,
-            x340,
-            Self::mul_add(-x79, x83, x69 * x84) + x329
-                + (Self::mul_add(-x76, x349, x75 * x346)
-                    + Self::mul_add(-x78, x354, x77 * x352)),
-        );
-        let x361 = Self::mul_add(
-            x336,
-            x341,
-            Self::mul_add(x70, x83, x297)
-                + (Self::mul_add(-x76, x350, x75 * x347)
-                    + Self::mul_add(-x78, x355, x77 * x353)),
-        );
-        let x362 = s_q10 * x343;
-        let x363 = c_q10 * x343;
-        let x364 = Self::mul_add(s_q10, x342, x363);
-        let x365 = Self::mul_add(c_q10, x344, x362);
-        let x366 = Self::mul_add(-s_q10, x346, c_q10 * x345);
-        let x367 = Self::mul_add(c_q10, x346, s_q10 * x345);
-        let x368 = Self::mul_add(-s_q10, x349, c_q10 * x348);
-        let x369 = Self::mul_add(c_q10, x349, s_q10 * x348);
-        let x370 = Self::mul_add(-s_q10, x368, c_q10 * x366);
-        let x371 = Self::mul_add(-s_q10, x350, c_q10 * x347);
-        let x372 = Self::mul_add(c_q10, x368, s_q10 * x366);
-        let x373 = Self::mul_add(c_q10, x350, s_q10 * x347);
-        let x374 = s_q10 * x352;
-        let x375 = c_q10 * x352;
-        let x376 = Self::mul_add(s_q10, x351, x375);
-        let x377 = Self::mul_add(c_q10, x354, x374);
-        let x378 = Self::mul_add(-s_q10, x355, c_q10 * x353);
-        let x379 = Self::mul_add(c_q10, x355, s_q10 * x353);
-        let x380 = Self::mul_add(
+        let x358 = s_q10 * x339;
+        let x359 = c_q10 * x339;
+        let x360 = Self::mul_add(s_q10, x338, x359);
+        let x361 = Self::mul_add(c_q10, x340, x358);
+        let x362 = Self::mul_add(-s_q10, x342, c_q10 * x341);
+        let x363 = Self::mul_add(c_q10, x342, s_q10 * x341);
+        let x364 = Self::mul_add(-s_q10, x345, c_q10 * x344);
+        let x365 = Self::mul_add(c_q10, x345, s_q10 * x344);
+        let x366 = Self::mul_add(-s_q10, x364, c_q10 * x362);
+        let x367 = Self::mul_add(-s_q10, x346, c_q10 * x343);
+        let x368 = Self::mul_add(c_q10, x364, s_q10 * x362);
+        let x369 = Self::mul_add(c_q10, x346, s_q10 * x343);
+        let x370 = s_q10 * x348;
+        let x371 = c_q10 * x348;
+        let x372 = Self::mul_add(s_q10, x347, x371);
+        let x373 = Self::mul_add(c_q10, x350, x370);
+        let x374 = Self::mul_add(-s_q10, x351, c_q10 * x349);
+        let x375 = Self::mul_add(c_q10, x351, s_q10 * x349);
+        let x376 = Self::mul_add(
             -s_q10,
-            Self::mul_add(-s_q10, x354, x375),
-            c_q10 * Self::mul_add(c_q10, x351, -x374),
+            Self::mul_add(-s_q10, x350, x371),
+            c_q10 * Self::mul_add(c_q10, x347, -x370),
         );
-        let x381 = Self::mul_add(-s_q10, x377, c_q10 * x376);
-        let x382 = 0.87 * x380;
-        let x383 = 0.87 * x381;
-        let x384 = 0.87 * x378;
-        let x385 = Self::mul_add(-0.87, x356, x371);
-        let x386 = Self::mul_add(
+        let x377 = Self::mul_add(-s_q10, x373, c_q10 * x372);
+        let x378 = 0.87 * x376;
+        let x379 = 0.87 * x377;
+        let x380 = 0.87 * x374;
+        let x381 = Self::mul_add(-0.87, x352, x367);
+        let x382 = Self::mul_add(
             -0.87,
-            x385,
+            x381,
             Self::mul_add(
                 -s_q10,
-                Self::mul_add(-s_q10, x344, x363),
-                c_q10 * Self::mul_add(c_q10, x342, -x362),
+                Self::mul_add(-s_q10, x340, x359),
+                c_q10 * Self::mul_add(c_q10, x338, -x358),
             ),
         );
-        let x387 = Self::mul_add(-s_q10, x360, c_q10 * x359);
-        let x388 = -0.00214 + Self::mul_add(0.87, x370, -0.87 * x384);
-        let x389 = Self::mul_add(0.87, x372, -36.18604050126307);
-        let x390 = Self::mul_add(0.87, x382, 69.99836825);
-        let x391 = 81.53205 + x382;
-        let x392 = Self::mul_add(x56, x66, Self::mul_add(-x51, x64, x50 * x63))
-            + Self::mul_add(0.87, x387, Self::mul_add(x336, x332 * x335, x334));
-        let x393 = 1.0 / x390;
-        let x394 = tau[2] - x392;
-        let x395 = x388 * x393;
-        let x396 = x389 * x393;
-        let x397 = x391 * x393;
-        let x398 = x383 * x393;
-        let x399 = x384 * x393;
-        let x400 = Self::mul_add(-x388, x395, Self::mul_add(-0.87, x371, x386));
-        let x401 = Self::mul_add(
-            -x388,
-            x396,
-            Self::mul_add(-0.87, x373, Self::mul_add(-s_q10, x365, c_q10 * x364)),
+        let x383 = Self::mul_add(-s_q10, x356, c_q10 * x355);
+        let x384 = -0.00214 + Self::mul_add(0.87, x366, -0.87 * x380);
+        let x385 = Self::mul_add(0.87, x368, -36.18604050126307);
+        let x386 = Self::mul_add(0.87, x378, 69.99836825);
+        let x387 = 81.53205 + x378;
+        let x388 = Self::mul_add(x54, x64, Self::mul_add(-x49, x62, x48 * x61))
+            - f_ext[3][5]
+            + Self::mul_add(0.87, x383, Self::mul_add(x332, x328 * x331, x330));
+        let x389 = 1.0 / x386;
+        let x390 = tau[2] - x388;
+        let x391 = x384 * x389;
+        let x392 = x385 * x389;
+        let x393 = x387 * x389;
+        let x394 = x379 * x389;
+        let x395 = x380 * x389;
+        let x396 = Self::mul_add(-x384, x391, Self::mul_add(-0.87, x367, x382));
+        let x397 = Self::mul_add(
+            -x384,
+            x392,
+            Self::mul_add(-0.87, x369, Self::mul_add(-s_q10, x361, c_q10 * x360)),
         );
-        let x402 = Self::mul_add(
-            -x389,
-            x396,
-            -63.36336825000001 + Self::mul_add(c_q10, x365, s_q10 * x364),
+        let x398 = Self::mul_add(
+            -x385,
+            x392,
+            -63.36336825000001 + Self::mul_add(c_q10, x361, s_q10 * x360),
         );
-        let x403 = Self::mul_add(-x388, x397, Self::mul_add(-0.87, x378, x370));
-        let x404 = Self::mul_add(
-            -x388,
-            x398,
-            Self::mul_add(-0.87, x379, Self::mul_add(-s_q10, x369, c_q10 * x367)),
-        );
-        let x405 = Self::mul_add(-x388, x399, -81.53205 + x385);
-        let x406 = Self::mul_add(-x389, x397, x372);
-        let x407 = Self::mul_add(-x389, x398, Self::mul_add(c_q10, x369, s_q10 * x367));
-        let x408 = Self::mul_add(-x389, x399, x373);
-        let x409 = Self::mul_add(-x391, x397, x380);
-        let x410 = Self::mul_add(-x391, x398, x381);
-        let x411 = Self::mul_add(-x391, x399, x378);
-        let x412 = Self::mul_add(-x383, x398, Self::mul_add(c_q10, x377, s_q10 * x376));
-        let x413 = Self::mul_add(-x383, x399, x379);
-        let x414 = Self::mul_add(-x384, x399, x356);
-        let x415 = Self::mul_add(
+        let x399 = Self::mul_add(-x384, x393, Self::mul_add(-0.87, x374, x366));
+        let x400 = Self::mul_add(
+            -x384,
             x394,
-            x395,
-            Self::mul_add(-x56, x67, Self::mul_add(-x62, x63, x51 * x65))
-                + Self::mul_add(-0.87, x361, Self::mul_add(-s_q10, x358, c_q10 * x357))
-                + (Self::mul_add(-x59, x401, x58 * x400)
-                    + Self::mul_add(-x61, x404, x60 * x403)),
+            Self::mul_add(-0.87, x375, Self::mul_add(-s_q10, x365, c_q10 * x363)),
+        );
+        let x401 = Self::mul_add(-x384, x395, -81.53205 + x381);
+        let x402 = Self::mul_add(-x385, x393, x368);
+        let x403 = Self::mul_add(-x385, x394, Self::mul_add(c_q10, x365, s_q10 * x363));
+        let x404 = Self::mul_add(-x385, x395, x369);
+        let x405 = Self::mul_add(-x387, x393, x376);
+        let x406 = Self::mul_add(-x387, x394, x377);
+        let x407 = Self::mul_add(-x387, x395, x374);
+        let x408 = Self::mul_add(-x379, x394, Self::mul_add(c_q10, x373, s_q10 * x372));
+        let x409 = Self::mul_add(-x379, x395, x375);
+        let x410 = Self::mul_add(-x380, x395, x352);
+        let x411 = Self::mul_add(
+            x390,
+            x391,
+            Self::mul_add(-x54, x65, Self::mul_add(-x60, x61, x49 * x63)) - f_ext[3][3]
+                + Self::mul_add(-0.87, x357, Self::mul_add(-s_q10, x354, c_q10 * x353))
+                + (Self::mul_add(-x57, x397, x56 * x396)
+                    + Self::mul_add(-x59, x400, x58 * x399)),
+        );
+        let x412 = Self::mul_add(
+            x390,
+            x392,
+            Self::mul_add(-x48, x63, x60 * x62) + Self::mul_add(-x55, x64, x53 * x65)
+                - f_ext[3][4] + Self::mul_add(c_q10, x354, s_q10 * x353)
+                + (Self::mul_add(-x57, x398, x56 * x397)
+                    + Self::mul_add(-x59, x403, x58 * x402)),
+        );
+        let x413 = Self::mul_add(x390, x386 * x389, x388);
+        let x414 = Self::mul_add(
+            x390,
+            x393,
+            x383 - Self::mul_add(x49, x65, f_ext[3][0])
+                + (Self::mul_add(-x57, x402, x56 * x399)
+                    + Self::mul_add(-x59, x406, x58 * x405)),
+        );
+        let x415 = Self::mul_add(
+            x390,
+            x394,
+            Self::mul_add(-x60, x64, x48 * x65) - f_ext[3][1]
+                + Self::mul_add(c_q10, x356, s_q10 * x355)
+                + (Self::mul_add(-x57, x403, x56 * x400)
+                    + Self::mul_add(-x59, x408, x58 * x406)),
         );
         let x416 = Self::mul_add(
-            x394,
-            x396,
-            Self::mul_add(-x50, x65, x62 * x64) + Self::mul_add(-x57, x66, x55 * x67)
-                + Self::mul_add(c_q10, x358, s_q10 * x357)
-                + (Self::mul_add(-x59, x402, x58 * x401)
-                    + Self::mul_add(-x61, x407, x60 * x406)),
+            x390,
+            x395,
+            Self::mul_add(x49, x64, -f_ext[3][2]) + x357
+                + (Self::mul_add(-x57, x404, x56 * x401)
+                    + Self::mul_add(-x59, x409, x58 * x407)),
         );
-        let x417 = Self::mul_add(x394, x390 * x393, x392);
-        let x418 = Self::mul_add(
-            x394,
-            x397,
-            Self::mul_add(-x51, x67, x387)
-                + (Self::mul_add(-x59, x406, x58 * x403)
-                    + Self::mul_add(-x61, x410, x60 * x409)),
+        let x417 = c_q9 * x397;
+        let x418 = Self::mul_add(x47, x397, x46 * x396);
+        let x419 = s_q9 * x397;
+        let x420 = Self::mul_add(c_q9, x396, -x419);
+        let x421 = Self::mul_add(x47, x398, x46 * x397);
+        let x422 = Self::mul_add(-s_q9, x398, x417);
+        let x423 = Self::mul_add(
+            0.00000000020510342851533115,
+            x401,
+            Self::mul_add(c_q9, x400, s_q9 * x399),
         );
-        let x419 = Self::mul_add(
-            x394,
-            x398,
-            Self::mul_add(-x62, x66, x50 * x67)
-                + Self::mul_add(c_q10, x360, s_q10 * x359)
-                + (Self::mul_add(-x59, x407, x58 * x404)
-                    + Self::mul_add(-x61, x412, x60 * x410)),
-        );
-        let x420 = Self::mul_add(
-            x394,
-            x399,
-            Self::mul_add(x51, x66, x361)
-                + (Self::mul_add(-x59, x408, x58 * x405)
-                    + Self::mul_add(-x61, x413, x60 * x411)),
-        );
-        let x421 = Self::mul_add(x49, x401, x48 * x400);
-        let x422 = Self::mul_add(-s_q9, x401, c_q9 * x400);
-        let x423 = Self::mul_add(x49, x402, x48 * x401);
-        let x424 = Self::mul_add(-s_q9, x402, c_q9 * x401);
+        let x424 = x401 + Self::mul_add(x47, x400, x46 * x399);
         let x425 = Self::mul_add(
-            0.00000000020510342851533115,
-            x405,
-            Self::mul_add(x47, x404, x46 * x403),
-        );
-        let x426 = x405 + Self::mul_add(x49, x404, x48 * x403);
-        let x427 = Self::mul_add(
             -0.00000000020510342851533115,
-            x405,
-            Self::mul_add(-s_q9, x404, c_q9 * x403),
+            x401,
+            Self::mul_add(-s_q9, x400, c_q9 * x399),
         );
+        let x426 = Self::mul_add(
+            0.00000000020510342851533115,
+            x404,
+            Self::mul_add(c_q9, x403, s_q9 * x402),
+        );
+        let x427 = x404 + Self::mul_add(x47, x403, x46 * x402);
         let x428 = Self::mul_add(
-            0.00000000020510342851533115,
-            x408,
-            Self::mul_add(x47, x407, x46 * x406),
-        );
-        let x429 = x408 + Self::mul_add(x49, x407, x48 * x406);
-        let x430 = Self::mul_add(
             -0.00000000020510342851533115,
-            x408,
-            Self::mul_add(-s_q9, x407, c_q9 * x406),
+            x404,
+            Self::mul_add(-s_q9, x403, c_q9 * x402),
         );
-        let x431 = Self::mul_add(x47, x428, x46 * x425);
-        let x432 = Self::mul_add(x47, x429, x46 * x426);
-        let x433 = Self::mul_add(x47, x430, x46 * x427);
-        let x434 = Self::mul_add(x49, x428, x48 * x425);
-        let x435 = Self::mul_add(-s_q9, x428, c_q9 * x425);
-        let x436 = x411 + Self::mul_add(x49, x410, x48 * x409);
+        let x429 = Self::mul_add(c_q9, x426, s_q9 * x423);
+        let x430 = Self::mul_add(c_q9, x427, s_q9 * x424);
+        let x431 = Self::mul_add(c_q9, x428, s_q9 * x425);
+        let x432 = Self::mul_add(x47, x426, x46 * x423);
+        let x433 = Self::mul_add(-s_q9, x426, c_q9 * x423);
+        let x434 = c_q9 * x406;
+        let x435 = x407 + Self::mul_add(x47, x406, x46 * x405);
+        let x436 = s_q9 * x406;
         let x437 = Self::mul_add(
             -0.00000000020510342851533115,
-            x411,
-            Self::mul_add(-s_q9, x410, c_q9 * x409),
+            x407,
+            Self::mul_add(c_q9, x405, -x436),
         );
-        let x438 = x413 + Self::mul_add(x49, x412, x48 * x410);
+        let x438 = x409 + Self::mul_add(x47, x408, x46 * x406);
         let x439 = Self::mul_add(
             -0.00000000020510342851533115,
-            x413,
-            Self::mul_add(-s_q9, x412, c_q9 * x410),
+            x409,
+            Self::mul_add(-s_q9, x408, x434),
         );
-        let x440 = x414 + Self::mul_add(x49, x413, x48 * x411);
+        let x440 = x410 + Self::mul_add(x47, x409, x46 * x407);
         let x441 = Self::mul_add(
             -0.00000000020510342851533115,
-            x414,
-            Self::mul_add(-s_q9, x413, c_q9 * x411),
+            x410,
+            Self::mul_add(-s_q9, x409, c_q9 * x407),
         );
         let x442 = Self::mul_add(
-            x47,
+            c_q9,
             Self::mul_add(
                 0.00000000020510342851533115,
-                x413,
-                Self::mul_add(x47, x412, x46 * x410),
+                x409,
+                Self::mul_add(c_q9, x408, x436),
             ),
-            x46
+            s_q9
                 * Self::mul_add(
                     0.00000000020510342851533115,
-                    x411,
-                    Self::mul_add(x47, x410, x46 * x409),
+                    x407,
+                    Self::mul_add(s_q9, x405, x434),
                 ),
         );
         let x443 = Self::mul_add(
             0.00000000020510342851533115,
             Self::mul_add(
                 0.00000000020510342851533115,
-                x414,
-                Self::mul_add(x47, x413, x46 * x411),
+                x410,
+                Self::mul_add(c_q9, x409, s_q9 * x407),
             ),
             x442,
         );
         let x444 = Self::mul_add(
             0.00000000020510342851533115,
             x440,
-            Self::mul_add(x47, x438, x46 * x436),
+            Self::mul_add(c_q9, x438, s_q9 * x435),
         );
         let x445 = Self::mul_add(
             0.00000000020510342851533115,
             x441,
-            Self::mul_add(x47, x439, x46 * x437),
+            Self::mul_add(c_q9, x439, s_q9 * x437),
         );
-        let x446 = x440 + Self::mul_add(x49, x438, x48 * x436);
-        let x447 = x441 + Self::mul_add(x49, x439, x48 * x437);
+        let x446 = x440 + Self::mul_add(x47, x438, x46 * x435);
+        let x447 = x441 + Self::mul_add(x47, x439, x46 * x437);
         let x448 = Self::mul_add(
             -0.00000000020510342851533115,
             x441,
             Self::mul_add(-s_q9, x439, c_q9 * x437),
         );
-        let x449 = x432 + Self::mul_add(0.275, x447, -0.4 * x446);
-        let x450 = x433 + Self::mul_add(0.275, x448, -0.4 * x447);
-        let x451 = Self::mul_add(0.4, x443, x434);
-        let x452 = Self::mul_add(0.4, x444, Self::mul_add(x49, x429, x48 * x426));
-        let x453 = Self::mul_add(0.4, x445, Self::mul_add(x49, x430, x48 * x427));
-        let x454 = Self::mul_add(-0.275, x443, x435);
-        let x455 = Self::mul_add(-0.275, x444, Self::mul_add(-s_q9, x429, c_q9 * x426));
-        let x456 = Self::mul_add(-0.275, x445, Self::mul_add(-s_q9, x430, c_q9 * x427));
+        let x449 = x430 + Self::mul_add(0.275, x447, -0.4 * x446);
+        let x450 = x431 + Self::mul_add(0.275, x448, -0.4 * x447);
+        let x451 = Self::mul_add(0.4, x443, x432);
+        let x452 = Self::mul_add(0.4, x444, Self::mul_add(x47, x427, x46 * x424));
+        let x453 = Self::mul_add(0.4, x445, Self::mul_add(x47, x428, x46 * x425));
+        let x454 = Self::mul_add(-0.275, x443, x433);
+        let x455 = Self::mul_add(-0.275, x444, Self::mul_add(-s_q9, x427, c_q9 * x424));
+        let x456 = Self::mul_add(-0.275, x445, Self::mul_add(-s_q9, x428, c_q9 * x425));
         let x457 = Self::mul_add(
             0.4,
-            x434,
-            Self::mul_add(0.4, x451, Self::mul_add(x49, x423, x48 * x421)),
+            x432,
+            Self::mul_add(0.4, x451, Self::mul_add(x47, x421, x46 * x418)),
         );
         let x458 = Self::mul_add(
             -0.275,
-            x434,
-            Self::mul_add(0.4, x454, Self::mul_add(x49, x424, x48 * x422)),
+            x432,
+            Self::mul_add(0.4, x454, Self::mul_add(x47, x422, x46 * x420)),
         );
         let x459 = Self::mul_add(
             -0.275,
-            x435,
-            Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x424, c_q9 * x422)),
+            x433,
+            Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x422, c_q9 * x420)),
         );
         let x460 = Self::mul_add(
             0.00000000020510342851533115,
-            x420,
-            Self::mul_add(x47, x419, x46 * x418),
+            x416,
+            Self::mul_add(c_q9, x415, s_q9 * x414),
         );
-        let x461 = x420 + Self::mul_add(x49, x419, x48 * x418);
+        let x461 = x416 + Self::mul_add(x47, x415, x46 * x414);
         let x462 = Self::mul_add(
             -0.00000000020510342851533115,
-            x420,
-            Self::mul_add(-s_q9, x419, c_q9 * x418),
+            x416,
+            Self::mul_add(-s_q9, x415, c_q9 * x414),
         );
         let x463 = Self::mul_add(
             -0.275,
             x460,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x417,
-                Self::mul_add(-s_q9, x416, c_q9 * x415),
+                x413,
+                Self::mul_add(-s_q9, x412, c_q9 * x411),
             ),
         );
-        let x464 = -0.0021399965876409276
+        let x464 = -0.002139996587640933
             + Self::mul_add(
                 -0.275,
-                x431,
-                Self::mul_add(x47, x424, x46 * x422)
+                x429,
+                Self::mul_add(c_q9, x422, s_q9 * x420)
                     + Self::mul_add(0.275, x456, -0.4 * x455),
             );
         let x465 = 5.080660024070365 + x458;
@@ -3693,7 +6825,7 @@ impl FreeFloating7 {
         let x467 = 12.701650001451807 + x454;
         let x468 = -0.000000008530897668050218 + x455;
         let x469 = Self::mul_add(-x28, x39, x27 * x40)
-            + Self::mul_add(-x31, x43, x32 * x42) + x463;
+            + Self::mul_add(-x31, x43, x32 * x42) - f_ext[2][5] + x463;
         let x470 = 1.0 / x466;
         let x471 = tau[1] - x469;
         let x472 = x464 * x470;
@@ -3704,11 +6836,11 @@ impl FreeFloating7 {
         let x477 = Self::mul_add(
             -x464,
             x472,
-            Self::mul_add(0.275, x433, -0.4 * x432)
+            Self::mul_add(0.275, x431, -0.4 * x430)
                 + (Self::mul_add(
-                    x47,
-                    Self::mul_add(x47, x402, x46 * x401),
-                    x46 * Self::mul_add(x47, x401, x46 * x400),
+                    c_q9,
+                    Self::mul_add(c_q9, x398, x419),
+                    s_q9 * Self::mul_add(s_q9, x396, x417),
                 ) + Self::mul_add(0.275, x450, -0.4 * x449)),
         );
         let x478 = Self::mul_add(
@@ -3717,8 +6849,8 @@ impl FreeFloating7 {
             -0.0000000234896432582596
                 + Self::mul_add(
                     0.4,
-                    x431,
-                    Self::mul_add(x47, x423, x46 * x421)
+                    x429,
+                    Self::mul_add(c_q9, x421, s_q9 * x418)
                         + Self::mul_add(0.275, x453, -0.4 * x452),
                 ),
         );
@@ -3726,7 +6858,7 @@ impl FreeFloating7 {
         let x480 = Self::mul_add(
             -x464,
             x474,
-            x431 + Self::mul_add(0.275, x445, -0.4 * x444),
+            x429 + Self::mul_add(0.275, x445, -0.4 * x444),
         );
         let x481 = Self::mul_add(-x464, x475, x449);
         let x482 = Self::mul_add(-x464, x476, -12.701650001451807 + x450);
@@ -3743,10 +6875,11 @@ impl FreeFloating7 {
             x471,
             x472,
             Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
+                - f_ext[2][3]
                 + (Self::mul_add(
                     0.00000000020510342851533115,
-                    x417,
-                    Self::mul_add(x47, x416, x46 * x415),
+                    x413,
+                    Self::mul_add(c_q9, x412, s_q9 * x411),
                 ) + Self::mul_add(0.275, x462, -0.4 * x461))
                 + (Self::mul_add(-x35, x478, x34 * x477)
                     + Self::mul_add(-x37, x481, x36 * x480)),
@@ -3755,7 +6888,8 @@ impl FreeFloating7 {
             x471,
             x473,
             Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
-                + Self::mul_add(0.4, x460, x417 + Self::mul_add(x49, x416, x48 * x415))
+                - f_ext[2][4]
+                + Self::mul_add(0.4, x460, x413 + Self::mul_add(x47, x412, x46 * x411))
                 + (Self::mul_add(-x35, x479, x34 * x478)
                     + Self::mul_add(-x37, x484, x36 * x483)),
         );
@@ -3763,21 +6897,21 @@ impl FreeFloating7 {
         let x495 = Self::mul_add(
             x471,
             x474,
-            Self::mul_add(-x28, x44, x38 * x43) + x460
+            Self::mul_add(-x28, x44, x38 * x43) - f_ext[2][0] + x460
                 + (Self::mul_add(-x35, x483, x34 * x480)
                     + Self::mul_add(-x37, x487, x36 * x486)),
         );
         let x496 = Self::mul_add(
             x471,
             x475,
-            Self::mul_add(-x38, x42, x27 * x44) + x461
+            Self::mul_add(-x38, x42, x27 * x44) - f_ext[2][1] + x461
                 + (Self::mul_add(-x35, x484, x34 * x481)
                     + Self::mul_add(-x37, x489, x36 * x487)),
         );
         let x497 = Self::mul_add(
             x471,
             x476,
-            Self::mul_add(-x27, x43, x28 * x42) + x462
+            Self::mul_add(-x27, x43, x28 * x42) - f_ext[2][2] + x462
                 + (Self::mul_add(-x35, x485, x34 * x482)
                     + Self::mul_add(-x37, x490, x36 * x488)),
         );
@@ -3868,3625 +7002,462 @@ impl FreeFloating7 {
         let x538 = 132.47349025763282 + Self::mul_add(-c_q8, x501, s_q8 * x503);
         let x539 = 48.0240000085309 + x514;
         let x540 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
+            - f_ext[1][5]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x494,
                 Self::mul_add(-c_q8, x492, s_q8 * x493),
             );
-        let x541 = Self::mul_add(
-            -x7,
-            x22,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x497,
-                Self::mul_add(-c_q8, x495, s_q8 * x496),
-            ),
-        );
-        let x542 = 1.0 / x538;
-        let x543 = tau[0] - x540;
-        let x544 = x536 * x542;
-        let x545 = x537 * x542;
-        let x546 = x513 * x542;
-        let x547 = x539 * x542;
-        let x548 = x515 * x542;
-        let x549 = Self::mul_add(-x536, x544, Self::mul_add(-0.35, x511, x531));
-        let x550 = Self::mul_add(-x536, x545, -0.07309 + x532);
-        let x551 = Self::mul_add(-x537, x545, 130.43769025763282 + x533);
-        let x552 = Self::mul_add(-x536, x546, Self::mul_add(-0.35, x524, x510));
-        let x553 = Self::mul_add(-x536, x547, x528);
-        let x554 = Self::mul_add(
+        let x541 = 1.0 / x538;
+        let x542 = tau[0] - x540;
+        let x543 = x536 * x541;
+        let x544 = x537 * x541;
+        let x545 = x513 * x541;
+        let x546 = x539 * x541;
+        let x547 = x515 * x541;
+        let x548 = Self::mul_add(-x536, x543, Self::mul_add(-0.35, x511, x531));
+        let x549 = Self::mul_add(-x536, x544, -0.07309 + x532);
+        let x550 = Self::mul_add(-x537, x544, 130.43769025763282 + x533);
+        let x551 = Self::mul_add(-x536, x545, Self::mul_add(-0.35, x524, x510));
+        let x552 = Self::mul_add(-x536, x546, x528);
+        let x553 = Self::mul_add(
             -x536,
-            x548,
+            x547,
             Self::mul_add(-0.35, x527, Self::mul_add(-x26, x509, x25 * x506)),
         );
-        let x555 = Self::mul_add(-x537, x546, x529);
-        let x556 = Self::mul_add(-x537, x547, x530);
-        let x557 = Self::mul_add(
+        let x554 = Self::mul_add(-x537, x545, x529);
+        let x555 = Self::mul_add(-x537, x546, x530);
+        let x556 = Self::mul_add(
             -x537,
-            x548,
+            x547,
             -48.0240000085309
                 + Self::mul_add(0.35, x525, Self::mul_add(c_q8, x509, s_q8 * x506)),
         );
-        let x558 = Self::mul_add(-x513, x546, x523);
-        let x559 = Self::mul_add(-x513, x547, x524);
-        let x560 = Self::mul_add(-x513, x548, x525);
-        let x561 = Self::mul_add(-x539, x547, x526);
-        let x562 = Self::mul_add(-x539, x548, x527);
-        let x563 = Self::mul_add(
+        let x557 = Self::mul_add(-x513, x545, x523);
+        let x558 = Self::mul_add(-x513, x546, x524);
+        let x559 = Self::mul_add(-x513, x547, x525);
+        let x560 = Self::mul_add(-x539, x546, x526);
+        let x561 = Self::mul_add(-x539, x547, x527);
+        let x562 = Self::mul_add(
             -x515,
-            x548,
+            x547,
             Self::mul_add(
                 -0.00000000020510342851533115,
                 x522,
                 Self::mul_add(-c_q8, x519, s_q8 * x521),
             ),
         );
-        let x564 = Self::mul_add(
+        let x563 = Self::mul_add(
+            x542,
             x543,
-            x544,
             Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
+                - f_ext[1][3]
                 + Self::mul_add(
                     -0.35,
                     x535,
                     x494 + Self::mul_add(-x26, x493, x25 * x492),
                 )
+                + (Self::mul_add(-x15, x549, x14 * x548)
+                    + Self::mul_add(-x17, x552, x16 * x551)),
+        );
+        let x564 = Self::mul_add(
+            x542,
+            x544,
+            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19)) - f_ext[1][4]
+                + Self::mul_add(0.35, x534, Self::mul_add(c_q8, x493, s_q8 * x492))
                 + (Self::mul_add(-x15, x550, x14 * x549)
-                    + Self::mul_add(-x17, x553, x16 * x552)),
+                    + Self::mul_add(-x17, x555, x16 * x554)),
         );
         let x565 = Self::mul_add(
-            x543,
+            x542,
             x545,
-            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19))
-                + Self::mul_add(0.35, x534, Self::mul_add(c_q8, x493, s_q8 * x492))
-                + (Self::mul_add(-x15, x551, x14 * x550)
-                    + Self::mul_add(-x17, x556, x16 * x555)),
+            Self::mul_add(-x8, x23, x18 * x22) - f_ext[1][0] + x534
+                + (Self::mul_add(-x15, x554, x14 * x551)
+                    + Self::mul_add(-x17, x558, x16 * x557)),
         );
         let x566 = Self::mul_add(
-            x543,
+            x542,
             x546,
-            Self::mul_add(-x8, x23, x18 * x22) + x534
+            Self::mul_add(x7, x23, -f_ext[1][1]) + x535
                 + (Self::mul_add(-x15, x555, x14 * x552)
-                    + Self::mul_add(-x17, x559, x16 * x558)),
+                    + Self::mul_add(-x17, x560, x16 * x558)),
         );
         let x567 = Self::mul_add(
-            x543,
+            x542,
             x547,
-            Self::mul_add(x7, x23, x535)
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x497,
+                Self::mul_add(-c_q8, x495, s_q8 * x496),
+            ) - Self::mul_add(x7, x22, f_ext[1][2])
                 + (Self::mul_add(-x15, x556, x14 * x553)
                     + Self::mul_add(-x17, x561, x16 * x559)),
         );
-        let x568 = Self::mul_add(
-            x543,
-            x548,
-            x541
-                + (Self::mul_add(-x15, x557, x14 * x554)
-                    + Self::mul_add(-x17, x562, x16 * x560)),
-        );
-        let x569 = s_q7 * x550;
-        let x570 = c_q7 * x550;
-        let x571 = Self::mul_add(s_q7, x549, x570);
-        let x572 = Self::mul_add(c_q7, x551, x569);
-        let x573 = Self::mul_add(-s_q7, x553, c_q7 * x552);
-        let x574 = Self::mul_add(c_q7, x553, s_q7 * x552);
-        let x575 = Self::mul_add(-s_q7, x556, c_q7 * x555);
-        let x576 = Self::mul_add(c_q7, x556, s_q7 * x555);
+        let x568 = s_q7 * x549;
+        let x569 = c_q7 * x549;
+        let x570 = Self::mul_add(s_q7, x548, x569);
+        let x571 = Self::mul_add(c_q7, x550, x568);
+        let x572 = Self::mul_add(-s_q7, x552, c_q7 * x551);
+        let x573 = Self::mul_add(c_q7, x552, s_q7 * x551);
+        let x574 = Self::mul_add(-s_q7, x555, c_q7 * x554);
+        let x575 = Self::mul_add(c_q7, x555, s_q7 * x554);
+        let x576 = Self::mul_add(-s_q7, x574, c_q7 * x572);
         let x577 = Self::mul_add(-s_q7, x575, c_q7 * x573);
-        let x578 = Self::mul_add(-s_q7, x576, c_q7 * x574);
-        let x579 = Self::mul_add(-s_q7, x557, c_q7 * x554);
+        let x578 = Self::mul_add(-s_q7, x556, c_q7 * x553);
+        let x579 = Self::mul_add(c_q7, x574, s_q7 * x572);
         let x580 = Self::mul_add(c_q7, x575, s_q7 * x573);
-        let x581 = Self::mul_add(c_q7, x576, s_q7 * x574);
-        let x582 = Self::mul_add(c_q7, x557, s_q7 * x554);
-        let x583 = s_q7 * x559;
-        let x584 = c_q7 * x559;
-        let x585 = Self::mul_add(s_q7, x558, x584);
-        let x586 = Self::mul_add(c_q7, x561, x583);
-        let x587 = Self::mul_add(-s_q7, x562, c_q7 * x560);
-        let x588 = Self::mul_add(c_q7, x562, s_q7 * x560);
-        let x589 = Self::mul_add(
+        let x581 = Self::mul_add(c_q7, x556, s_q7 * x553);
+        let x582 = s_q7 * x558;
+        let x583 = c_q7 * x558;
+        let x584 = Self::mul_add(s_q7, x557, x583);
+        let x585 = Self::mul_add(c_q7, x560, x582);
+        let x586 = Self::mul_add(-s_q7, x561, c_q7 * x559);
+        let x587 = Self::mul_add(c_q7, x561, s_q7 * x559);
+        let x588 = Self::mul_add(
             -s_q7,
-            Self::mul_add(-s_q7, x561, x584),
-            c_q7 * Self::mul_add(c_q7, x558, -x583),
+            Self::mul_add(-s_q7, x560, x583),
+            c_q7 * Self::mul_add(c_q7, x557, -x582),
         );
-        let x590 = Self::mul_add(-s_q7, x586, c_q7 * x585);
-        let x591 = Self::mul_add(c_q7, x586, s_q7 * x585);
+        let x589 = Self::mul_add(-s_q7, x585, c_q7 * x584);
+        let x590 = Self::mul_add(c_q7, x585, s_q7 * x584);
+        let x591 = 0.65 * x589;
         let x592 = 0.65 * x590;
-        let x593 = 0.65 * x591;
-        let x594 = 0.65 * x588;
+        let x593 = 0.65 * x587;
+        let x594 = Self::mul_add(-0.75, x589, x576);
         let x595 = Self::mul_add(-0.75, x590, x577);
-        let x596 = Self::mul_add(-0.75, x591, x578);
+        let x596 = x579 + Self::mul_add(-0.65, x586, 0.75 * x588);
         let x597 = x580 + Self::mul_add(-0.65, x587, 0.75 * x589);
-        let x598 = x581 + Self::mul_add(-0.65, x588, 0.75 * x590);
-        let x599 = x582 + Self::mul_add(-0.65, x563, 0.75 * x587);
-        let x600 = Self::mul_add(
+        let x598 = x581 + Self::mul_add(-0.65, x562, 0.75 * x586);
+        let x599 = Self::mul_add(
             -0.75,
-            x596,
+            x595,
             Self::mul_add(
                 -s_q7,
-                Self::mul_add(-s_q7, x551, x570),
-                c_q7 * Self::mul_add(c_q7, x549, -x569),
+                Self::mul_add(-s_q7, x550, x569),
+                c_q7 * Self::mul_add(c_q7, x548, -x568),
             ),
         );
-        let x601 = Self::mul_add(-s_q7, x567, c_q7 * x566);
-        let x602 = Self::mul_add(c_q7, x567, s_q7 * x566);
-        let x603 = 180.9502499901501 + x597;
-        let x604 = Self::mul_add(-v[5], x4, v[4] * x5) + x601;
-        let x605 = 1.0 / (1170.07 + x589);
-        let x606 = x590 * x605;
-        let x607 = x587 * x605;
-        let x608 = x595 * x605;
-        let x609 = x603 * x605;
-        let x610 = x592 * x605;
-        let x611 = 1.0 / Self::mul_add(-x590, x606, 1170.07 + x591);
-        let x612 = Self::mul_add(-x590, x607, x588);
-        let x613 = x611 * x612;
-        let x614 = Self::mul_add(-x590, x608, -180.9502499901501 + x596);
-        let x615 = x611 * x614;
-        let x616 = Self::mul_add(-x590, x609, x598);
-        let x617 = x611 * x616;
-        let x618 = Self::mul_add(-x590, x610, 110.5455 + x593);
-        let x619 = x611 * x618;
-        let x620 = 1.0
-            / Self::mul_add(-x612, x613, Self::mul_add(-x587, x607, 1170.07 + x563));
-        let x621 = Self::mul_add(
-            -x612,
-            x615,
-            Self::mul_add(-x587, x608, Self::mul_add(-0.75, x588, x579)),
-        );
-        let x622 = x620 * x621;
-        let x623 = Self::mul_add(
-            -x612,
-            x617,
-            Self::mul_add(-x587, x609, -110.5455 + x599),
-        );
-        let x624 = x620 * x623;
-        let x625 = Self::mul_add(-x612, x619, Self::mul_add(-x587, x610, x594));
-        let x626 = x620 * x625;
-        let x627 = Self::mul_add(
-            -x614,
-            x615,
-            Self::mul_add(
-                -x595,
-                x608,
-                1394.5960312283303 + Self::mul_add(-0.75, x578, x600),
-            ),
-        );
-        let x628 = 1.0 / Self::mul_add(-x621, x622, x627);
-        let x629 = Self::mul_add(
-            -x595,
-            x609,
-            Self::mul_add(-0.65, x579, 0.75 * x577)
-                + Self::mul_add(-0.75, x598, Self::mul_add(-s_q7, x572, c_q7 * x571)),
-        );
-        let x630 = Self::mul_add(-x621, x624, Self::mul_add(-x614, x617, x629));
-        let x631 = x628 * x630;
-        let x632 = Self::mul_add(
-            -x614,
-            x619,
-            Self::mul_add(
-                -x595,
-                x610,
-                -117.61766249359756 + Self::mul_add(0.65, x578, -0.75 * x593),
-            ),
-        );
-        let x633 = Self::mul_add(-x621, x626, x632);
-        let x634 = x628 * x633;
-        let x635 = Self::mul_add(
-            -x616,
-            x617,
-            Self::mul_add(
-                -x603,
-                x609,
-                1466.4506062283303
-                    + (Self::mul_add(-0.65, x582, 0.75 * x580)
-                        + (Self::mul_add(c_q7, x572, s_q7 * x571)
-                            + Self::mul_add(-0.65, x599, 0.75 * x597))),
-            ),
-        );
-        let x636 = 1.0 / Self::mul_add(-x630, x631, Self::mul_add(-x623, x624, x635));
-        let x637 = Self::mul_add(
-            -x603,
-            x610,
-            Self::mul_add(0.65, x581, Self::mul_add(-0.65, x594, 0.75 * x592)),
-        );
-        let x638 = Self::mul_add(
-            -x630,
-            x634,
-            Self::mul_add(-x623, x626, Self::mul_add(-x616, x619, x637)),
-        );
-        let x639 = x636 * x638;
-        let x640 = Self::mul_add(
-            -x618,
-            x619,
-            Self::mul_add(-x592, x610, Self::mul_add(0.65, x593, 1271.854575)),
-        );
-        let x641 = Self::mul_add(
-            -x638,
-            x639,
-            Self::mul_add(-x633, x634, Self::mul_add(-x625, x626, x640)),
-        );
-        let x642 = 1.0 / x641;
-        let x643 = Self::mul_add(
-            x604,
-            x606,
-            -(Self::mul_add(-v[3], x5, v[5] * x3) + x602),
-        );
-        let x644 = Self::mul_add(
-            -x613,
-            x643,
-            Self::mul_add(x604, x607, -(Self::mul_add(-v[4], x3, v[3] * x4) + x568)),
-        );
-        let x645 = Self::mul_add(
-            x604,
-            x608,
-            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
-                + Self::mul_add(-0.75, x602, Self::mul_add(-s_q7, x565, c_q7 * x564))),
-        );
-        let x646 = Self::mul_add(-x622, x644, Self::mul_add(-x615, x643, x645));
-        let x647 = Self::mul_add(
-            -x617,
-            x643,
-            Self::mul_add(
-                x604,
-                x609,
-                -(Self::mul_add(-v[3], x2, v[5] * x0)
-                    + Self::mul_add(-v[0], x5, v[2] * x3)
-                    + (Self::mul_add(c_q7, x565, s_q7 * x564)
-                        + Self::mul_add(-0.65, x568, 0.75 * x601))),
-            ),
-        );
-        let x648 = Self::mul_add(-x631, x646, Self::mul_add(-x624, x644, x647));
-        let x649 = Self::mul_add(
-            x604,
-            x610,
-            -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
-                + Self::mul_add(0.65, x602, Self::mul_add(x543, x538 * x542, x540))),
-        );
-        let x650 = Self::mul_add(
-            -x634,
-            x646,
-            Self::mul_add(-x626, x644, Self::mul_add(-x619, x643, x649)),
-        );
-        let x651 = x642 * Self::mul_add(-x639, x648, x650);
-        let x652 = Self::mul_add(-x639, x651, x636 * x648);
-        let x653 = Self::mul_add(-x634, x651, Self::mul_add(-x631, x652, x628 * x646));
-        let x654 = Self::mul_add(
-            -x626,
-            x651,
-            Self::mul_add(-x624, x652, Self::mul_add(-x622, x653, x620 * x644)),
-        );
-        let x655 = Self::mul_add(
-            -x617,
-            x652,
-            Self::mul_add(-x615, x653, Self::mul_add(-x613, x654, x611 * x643)),
-        );
-        let x656 = Self::mul_add(-x619, x651, x655);
-        let x657 = Self::mul_add(
-            x608,
-            x653,
-            Self::mul_add(x607, x654, Self::mul_add(x606, x656, x604 * x605)),
-        );
-        let x658 = Self::mul_add(x610, x651, Self::mul_add(x609, x652, x657));
-        let x659 = -x658;
-        let x660 = Self::mul_add(-0.75, x652, x658);
-        let x661 = x656 - Self::mul_add(-0.65, x651, 0.75 * x653);
-        let x662 = Self::mul_add(-0.65, x652, x654);
-        let x663 = x14 + Self::mul_add(s_q7, x652, c_q7 * x653);
-        let x664 = Self::mul_add(-s_q7, x653, c_q7 * x652) - x15;
-        let x665 = x16 + Self::mul_add(-c_q7, x660, s_q7 * x661);
-        let x666 = Self::mul_add(c_q7, x661, s_q7 * x660) - x17;
-        let x667 = x542
-            * (x543
-                - (Self::mul_add(x538, x651, Self::mul_add(x537, x664, x536 * x663))
-                    + Self::mul_add(
-                        x515,
-                        x662,
-                        Self::mul_add(x539, x666, x513 * x665),
-                    )));
-        let x668 = x651 + x667;
-        let x669 = Self::mul_add(-0.00000000020510342851533115, x668, x663);
-        let x670 = Self::mul_add(0.35, x664, x665);
-        let x671 = Self::mul_add(-0.35, x663, x666);
-        let x672 = Self::mul_add(-0.00000000020510342851533115, x662, x670);
-        let x673 = x34
-            + Self::mul_add(-c_q8, x668, Self::mul_add(s_q8, x664, x25 * x663));
-        let x674 = Self::mul_add(s_q8, x668, Self::mul_add(-x26, x663, c_q8 * x664))
-            - x35;
-        let x675 = x36
-            + Self::mul_add(-c_q8, x662, Self::mul_add(s_q8, x671, x25 * x670));
-        let x676 = Self::mul_add(s_q8, x662, Self::mul_add(-x26, x670, c_q8 * x671))
-            - x37;
-        let x677 = x470
-            * (x471
-                - (Self::mul_add(x466, x669, Self::mul_add(x465, x674, x464 * x673))
-                    + Self::mul_add(
-                        x456,
-                        x672,
-                        Self::mul_add(x468, x676, x467 * x675),
-                    )));
-        let x678 = x669 + x677;
-        let x679 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x678,
-            Self::mul_add(0.00000000020510342851533115, x673, x674),
-        );
-        let x680 = x675 - Self::mul_add(0.275, x678, -0.4 * x674);
-        let x681 = Self::mul_add(-0.4, x673, x676);
-        let x682 = Self::mul_add(0.275, x673, x672);
-        let x683 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x682,
-            Self::mul_add(0.00000000020510342851533115, x680, x681),
-        );
-        let x684 = x58 + Self::mul_add(c_q9, x678, Self::mul_add(x48, x674, x46 * x673));
-        let x685 = Self::mul_add(-s_q9, x678, Self::mul_add(x49, x674, x47 * x673))
-            - x59;
-        let x686 = x60 + Self::mul_add(c_q9, x682, Self::mul_add(x48, x681, x46 * x680));
-        let x687 = Self::mul_add(-s_q9, x682, Self::mul_add(x49, x681, x47 * x680))
-            - x61;
-        let x688 = x393
-            * (x394
-                - (Self::mul_add(x390, x679, Self::mul_add(x389, x685, x388 * x684))
-                    + Self::mul_add(
-                        x384,
-                        x683,
-                        Self::mul_add(x383, x687, x391 * x686),
-                    )));
-        let x689 = x679 + x688;
-        let x690 = Self::mul_add(0.87, x689, x686);
-        let x691 = Self::mul_add(-0.87, x684, x683);
-        let x692 = x75 + Self::mul_add(s_q10, x685, c_q10 * x684);
-        let x693 = Self::mul_add(-s_q10, x684, c_q10 * x685) - x76;
-        let x694 = x77 + Self::mul_add(s_q10, x687, c_q10 * x690);
-        let x695 = Self::mul_add(-s_q10, x690, c_q10 * x687) - x78;
-        let x696 = x335
-            * (x336
-                - (Self::mul_add(x332, x689, Self::mul_add(x331, x693, x330 * x692))
-                    + Self::mul_add(
-                        x321,
-                        x691,
-                        Self::mul_add(x320, x695, x333 * x694),
-                    )));
-        let x697 = x689 + x696;
-        let x698 = x694 - Self::mul_add(-0.63, x697, 0.275 * x693);
-        let x699 = Self::mul_add(0.275, x692, x695);
-        let x700 = Self::mul_add(-0.63, x692, x691);
-        let x701 = x93 + Self::mul_add(s_q11, x693, c_q11 * x692);
-        let x702 = Self::mul_add(-s_q11, x692, c_q11 * x693) - x94;
-        let x703 = x95 + Self::mul_add(s_q11, x699, c_q11 * x698);
-        let x704 = Self::mul_add(-s_q11, x698, c_q11 * x699) - x96;
-        let x705 = x271
-            * (x272
-                - (Self::mul_add(x267, x697, Self::mul_add(x266, x702, x265 * x701))
-                    + Self::mul_add(
-                        -x244,
-                        x700,
-                        Self::mul_add(-x243, x704, x268 * x703),
-                    )));
-        let x706 = x697 + x705;
-        let x707 = Self::mul_add(-0.00000000020510342851533115, x706, x702);
-        let x708 = Self::mul_add(-0.36, x702, x703);
-        let x709 = Self::mul_add(0.36, x701, x704);
-        let x710 = Self::mul_add(-0.00000000020510342851533115, x700, x709);
-        let x711 = x113
-            + Self::mul_add(-s_q12, x706, Self::mul_add(x104, x702, c_q12 * x701));
-        let x712 = Self::mul_add(-c_q12, x706, Self::mul_add(-s_q12, x701, x105 * x702))
-            - x114;
-        let x713 = x115
-            + Self::mul_add(-s_q12, x700, Self::mul_add(x104, x709, c_q12 * x708));
-        let x714 = Self::mul_add(-c_q12, x700, Self::mul_add(-s_q12, x708, x105 * x709))
-            - x116;
-        let x715 = x199
-            * (x200
-                - (Self::mul_add(x195, x707, Self::mul_add(x194, x712, x193 * x711))
-                    + Self::mul_add(
-                        -x185,
-                        x710,
-                        Self::mul_add(x197, x714, x196 * x713),
-                    )));
-        let x716 = x707 + x715;
-        let x717 = Self::mul_add(
-            -c_q13,
-            Self::mul_add(0.55, x711, x710),
-            Self::mul_add(
-                s_q13,
-                Self::mul_add(-0.16, x711, x714),
-                x125 * (x713 - Self::mul_add(0.55, x716, -0.16 * x712)),
-            ),
-        );
-        let x718 = Self::mul_add(
-            -0.9614610000000001,
-            Self::mul_add(s_q13, x716, Self::mul_add(-x126, x711, c_q13 * x712)) - x136,
-            -0.0145
-                * (x135
-                    + Self::mul_add(
-                        -c_q13,
-                        x716,
-                        Self::mul_add(s_q13, x712, x125 * x711),
-                    )),
-        );
-        let x719 = Self::mul_add(
-            -4.806620000000001,
-            x137 + x717,
-            Self::mul_add(
-                1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x716, x711),
-                x718,
-            ),
-        );
-        let x720 = 0.707433253035886 * (x146 - x719);
-        [x659, x656, x654, x653, x652, x651, x667, x677, x688, x696, x705, x715, x720]
-    }
-    /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
-    ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1176 mul, 971 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 704 fused where the target has FMA.
-    #[must_use]
-    pub fn mass_matrix_and_nonlinear_effects(
-        q: &[f64; 14],
-        v: &[f64; 13],
-    ) -> ([[f64; 13]; 13], [f64; 13]) {
-        let (s_q7, c_q7) = libm::sincos(q[7]);
-        let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
-        let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x6 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x7 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x8 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(-0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x16, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x16, -0.0145 * x15);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(-1.2025609200000003, c_q13, x24);
-        let x26 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(-1.2025609200000003, s_q13, -x23)
-            + 0.00000000019719894748377882;
-        let x29 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
-            + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = Self::mul_add(
-            0.16,
-            x17,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x22,
-                Self::mul_add(-c_q13, x20, s_q13 * x21),
-            ),
-        );
-        let x35 = Self::mul_add(
-            -0.16,
-            x18,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x26,
-                Self::mul_add(-c_q13, x23, s_q13 * x25),
-            ),
-        );
-        let x36 = x22 + Self::mul_add(-x16, x21, x15 * x20) - (x30 - x31) - (x33 - x32);
-        let x37 = Self::mul_add(
-            -0.16,
-            x18,
-            Self::mul_add(x19, -0.55, Self::mul_add(c_q13, x28, s_q13 * x27)),
-        );
-        let x38 = 3.6140000000000003 - x17;
-        let x39 = 17.135250000000003 + x18;
-        let x40 = -1.9877000000000002
-            + Self::mul_add(0.55, x17, Self::mul_add(c_q13, x21, s_q13 * x20));
-        let x41 = -0.809539999555672 + x34;
-        let x42 = -1.9877000000000002
-            + Self::mul_add(x17, 0.55, x26 + Self::mul_add(-x16, x25, x15 * x23));
-        let x43 = -5.252920330000002
-            + (Self::mul_add(c_q13, x25, s_q13 * x23) + x32 - x30);
-        let x44 = -2.741639999592316 + Self::mul_add(-0.55, x19, x35);
-        let x45 = -0.809539999555672
-            + Self::mul_add(0.16, x17, x29 + Self::mul_add(-x16, x28, x15 * x27));
-        let x46 = -2.7416399995923166 + x37;
-        let x47 = 9.740442170000001
-            + (x31
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) - x33));
-        let x48 = c_q12 * x38;
-        let x49 = s_q12 * x39;
-        let x50 = x48 - x49;
-        let x51 = x19 + Self::mul_add(x13, x39, x12 * x38);
-        let x52 = Self::mul_add(c_q12, x39, s_q12 * x38);
-        let x53 = Self::mul_add(-0.00000000020510342851533115, x19, -x52);
-        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x36);
-        let x55 = Self::mul_add(-s_q12, x43, c_q12 * x40);
-        let x56 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x57 = x45 + Self::mul_add(x13, x42, x12 * x36);
-        let x58 = x46 + Self::mul_add(x13, x43, x12 * x40);
-        let x59 = x47 + Self::mul_add(x13, x44, x12 * x41);
-        let x60 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x45,
-            -Self::mul_add(c_q12, x42, s_q12 * x36),
-        );
-        let x61 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x46,
-            -Self::mul_add(c_q12, x43, s_q12 * x40),
-        );
-        let x62 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x47,
-            -Self::mul_add(c_q12, x44, s_q12 * x41),
-        );
-        let x63 = x56 + Self::mul_add(x13, x55, x12 * x54);
-        let x64 = Self::mul_add(-s_q12, x58, c_q12 * x57);
-        let x65 = x53 * 0.36;
-        let x66 = -0.36 * x53;
-        let x67 = Self::mul_add(
-            x50,
-            0.36,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x56,
-                -Self::mul_add(c_q12, x55, s_q12 * x54),
-            ),
-        );
-        let x68 = Self::mul_add(
-            0.36,
-            x51,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x59,
-                -Self::mul_add(c_q12, x58, s_q12 * x57),
-            ),
-        );
-        let x69 = x66 + (Self::mul_add(-s_q12, x55, c_q12 * x54) - x65);
-        let x70 = 7.078399999258757 + x51;
-        let x71 = 0.01675 + x67;
-        let x72 = -9.142025249762803
-            + (x59 + Self::mul_add(x13, x58, x12 * x57) + x66 - x65);
-        let x73 = 2.5482240016099564 + x68;
-        let x74 = 0.01675
-            + Self::mul_add(0.36, x50, Self::mul_add(-s_q12, x61, c_q12 * x60));
-        let x75 = 2.5482240016099564
-            + Self::mul_add(x51, 0.36, x62 + Self::mul_add(x13, x61, x12 * x60));
-        let x76 = 9.223235249762805
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x62,
-                -Self::mul_add(c_q12, x61, s_q12 * x60),
-            );
-        let x77 = Self::mul_add(-s_q11, x70, c_q11 * x50);
-        let x78 = Self::mul_add(c_q11, x70, s_q11 * x50);
-        let x79 = Self::mul_add(-s_q11, x64, c_q11 * x69);
-        let x80 = Self::mul_add(-s_q11, x72, c_q11 * x63);
-        let x81 = Self::mul_add(c_q11, x64, s_q11 * x69);
-        let x82 = Self::mul_add(c_q11, x72, s_q11 * x63);
-        let x83 = 0.275 * x53;
-        let x84 = -0.63 * x78;
-        let x85 = -0.275 * x53;
-        let x86 = x78 * 0.63;
-        let x87 = Self::mul_add(0.63, x77, Self::mul_add(c_q11, x80, s_q11 * x79));
-        let x88 = Self::mul_add(0.275, x77, Self::mul_add(-s_q11, x73, c_q11 * x71));
-        let x89 = Self::mul_add(0.275, x78, Self::mul_add(c_q11, x73, s_q11 * x71));
-        let x90 = x76 - x86;
-        let x91 = Self::mul_add(-s_q11, x80, c_q11 * x79) - (x83 - x84) - (x86 - x85);
-        let x92 = Self::mul_add(x77, 0.63, Self::mul_add(-s_q11, x82, c_q11 * x81));
-        let x93 = Self::mul_add(
-            0.275,
-            x78,
-            Self::mul_add(x53, 0.63, Self::mul_add(c_q11, x75, s_q11 * x74)),
-        );
-        let x94 = -45.1584 + x78;
-        let x95 = -0.6328 + x88;
-        let x96 = -24.4950615 + (Self::mul_add(c_q11, x82, s_q11 * x81) + x85 - x83);
-        let x97 = -24.35164200091464 + Self::mul_add(0.63, x53, x89);
-        let x98 = -0.6328
-            + Self::mul_add(0.275, x77, Self::mul_add(-s_q11, x75, c_q11 * x74));
-        let x99 = -24.351642000914637 + x93;
-        let x100 = 28.2393615 + (x84 + x90);
-        let x101 = c_q10 * x77;
-        let x102 = Self::mul_add(-s_q10, x94, x101);
-        let x103 = s_q10 * x77;
-        let x104 = Self::mul_add(c_q10, x94, x103);
-        let x105 = Self::mul_add(-s_q10, x92, c_q10 * x91);
-        let x106 = Self::mul_add(-s_q10, x96, c_q10 * x87);
-        let x107 = Self::mul_add(-s_q10, x97, c_q10 * x95);
-        let x108 = Self::mul_add(c_q10, x92, s_q10 * x91);
-        let x109 = Self::mul_add(c_q10, x96, s_q10 * x87);
-        let x110 = Self::mul_add(c_q10, x97, s_q10 * x95);
-        let x111 = -0.87 * x104;
-        let x112 = x104 * 0.87;
-        let x113 = Self::mul_add(0.87, x102, Self::mul_add(c_q10, x106, s_q10 * x105));
-        let x114 = x100 - x112;
-        let x115 = Self::mul_add(-s_q10, x106, c_q10 * x105) + x111 - x112;
-        let x116 = Self::mul_add(x102, 0.87, Self::mul_add(-s_q10, x109, c_q10 * x108));
-        let x117 = -81.53205 + x104;
-        let x118 = -0.00214 + x107;
-        let x119 = -63.36336825000001 + Self::mul_add(c_q10, x109, s_q10 * x108);
-        let x120 = -36.18604050126307 + Self::mul_add(0.87, x53, x110);
-        let x121 = -0.00214 + Self::mul_add(-s_q10, x99, c_q10 * x98);
-        let x122 = -36.18604050126307
-            + Self::mul_add(x53, 0.87, Self::mul_add(c_q10, x99, s_q10 * x98));
-        let x123 = 69.99836825 + (x111 + x114);
-        let x124 = Self::mul_add(
-            0.00000000020510342851533115,
-            x53,
-            Self::mul_add(x6, x117, x5 * x102),
-        );
-        let x125 = x53 + Self::mul_add(x8, x117, x7 * x102);
-        let x126 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x53,
-            Self::mul_add(-s_q9, x117, c_q9 * x102),
-        );
-        let x127 = Self::mul_add(
-            0.00000000020510342851533115,
-            x121,
-            Self::mul_add(x6, x116, x5 * x115),
-        );
-        let x128 = Self::mul_add(
-            0.00000000020510342851533115,
-            x122,
-            Self::mul_add(x6, x119, x5 * x113),
-        );
-        let x129 = Self::mul_add(
-            0.00000000020510342851533115,
-            x123,
-            Self::mul_add(x6, x120, x5 * x118),
-        );
-        let x130 = x121 + Self::mul_add(x8, x116, x7 * x115);
-        let x131 = x122 + Self::mul_add(x8, x119, x7 * x113);
-        let x132 = x123 + Self::mul_add(x8, x120, x7 * x118);
-        let x133 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x121,
-            Self::mul_add(-s_q9, x116, c_q9 * x115),
-        );
-        let x134 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x122,
-            Self::mul_add(-s_q9, x119, c_q9 * x113),
-        );
-        let x135 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x123,
-            Self::mul_add(-s_q9, x120, c_q9 * x118),
-        );
-        let x136 = x126 * -0.4;
-        let x137 = 0.275 * x125;
-        let x138 = 0.4 * x126;
-        let x139 = -0.275 * x125;
-        let x140 = Self::mul_add(
-            x124,
-            -0.4,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x129,
-                Self::mul_add(-s_q9, x128, c_q9 * x127),
-            ),
-        );
-        let x141 = Self::mul_add(
-            -0.4,
-            x125,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x132,
-                Self::mul_add(-s_q9, x131, c_q9 * x130),
-            ),
-        );
-        let x142 = Self::mul_add(
-            0.00000000020510342851533115,
-            x129,
-            Self::mul_add(x6, x128, x5 * x127),
-        ) - (x136 - x137) - (x139 - x138);
-        let x143 = Self::mul_add(
-            -0.275,
-            x124,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x132,
-                Self::mul_add(x6, x131, x5 * x130),
-            ),
-        );
-        let x144 = Self::mul_add(
-            -0.4,
-            x124,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x135,
-                Self::mul_add(x6, x134, x5 * x133),
-            ),
-        );
-        let x145 = Self::mul_add(
-            x125,
-            -0.4,
-            Self::mul_add(-0.275, x126, x135 + Self::mul_add(x8, x134, x7 * x133)),
-        );
-        let x146 = -0.000000008530897668050218 + x124;
-        let x147 = -12.701650001451807 + x125;
-        let x148 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x124, x129 + Self::mul_add(x8, x128, x7 * x127));
-        let x149 = -0.0021399965876409276 + x140;
-        let x150 = -0.0000000234896432582596 + x143;
-        let x151 = -111.7548902508081
-            + (x132 + Self::mul_add(x8, x131, x7 * x130) + x138 - x136);
-        let x152 = 5.080660024070365 + Self::mul_add(-0.275, x126, x141);
-        let x153 = -0.0021399965876409276 + x144;
-        let x154 = 5.080660024070366 + x145;
-        let x155 = 113.3918902508081
-            + (x137
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x135,
-                    Self::mul_add(-s_q9, x134, c_q9 * x133),
-                ) - x139));
-        let x156 = x126 + Self::mul_add(-x3, x147, x2 * x146);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x146);
-        let x158 = c_q8 * x146;
-        let x159 = s_q8 * x147;
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x126, x159 - x158);
-        let x161 = x153 + Self::mul_add(-x3, x150, x2 * x142);
-        let x162 = x154 + Self::mul_add(-x3, x151, x2 * x148);
-        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x149);
-        let x164 = Self::mul_add(c_q8, x150, s_q8 * x142);
-        let x165 = Self::mul_add(c_q8, x151, s_q8 * x148);
-        let x166 = Self::mul_add(c_q8, x152, s_q8 * x149);
-        let x167 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x155,
-            Self::mul_add(-c_q8, x149, s_q8 * x152),
-        );
-        let x168 = Self::mul_add(
-            -c_q8,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x153,
-                Self::mul_add(-c_q8, x142, s_q8 * x150),
-            ),
-            s_q8
-                * Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x154,
-                    Self::mul_add(-c_q8, x148, s_q8 * x151),
-                ),
-        );
-        let x169 = x160 * -0.35;
-        let x170 = 0.35 * x160;
-        let x171 = Self::mul_add(
-            x156,
-            -0.35,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x163,
-                Self::mul_add(-c_q8, x161, s_q8 * x162),
-            ),
-        );
-        let x172 = Self::mul_add(
-            -0.35,
-            x157,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x166,
-                Self::mul_add(-c_q8, x164, s_q8 * x165),
-            ),
-        );
-        let x173 = x170 + (x163 + Self::mul_add(-x3, x162, x2 * x161) - x169);
-        let x174 = 48.0240000085309 + x156;
-        let x175 = -0.07309 + Self::mul_add(c_q8, x162, s_q8 * x161);
-        let x176 = -16.80768997608804 + x171;
-        let x177 = -0.07309 + (x166 + Self::mul_add(-x3, x165, x2 * x164));
-        let x178 = 130.43769025763282
-            + (Self::mul_add(c_q8, x165, s_q8 * x164) + x170 - x169);
-        let x179 = 0.1132 + x172;
-        let x180 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x167, x168);
-        let x181 = Self::mul_add(-s_q7, x157, c_q7 * x174);
-        let x182 = Self::mul_add(c_q7, x157, s_q7 * x174);
-        let x183 = Self::mul_add(-s_q7, x177, c_q7 * x173);
-        let x184 = Self::mul_add(-s_q7, x178, c_q7 * x175);
-        let x185 = -x182;
-        let x186 = x160 * -0.75;
-        let x187 = 0.75 * x160;
-        let x188 = x181 * -0.65;
-        let x189 = 0.65 * x181;
-        let x190 = Self::mul_add(x181, -0.75, Self::mul_add(-s_q7, x179, c_q7 * x176));
-        let x191 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x179, s_q7 * x176));
-        let x192 = x180 + x189;
-        let x193 = Self::mul_add(-0.65, x182, Self::mul_add(c_q7, x184, s_q7 * x183));
-        let x194 = 110.5455 + x181;
-        let x195 = 180.9502499901501 + x160;
-        let x196 = 1394.5960312283303
-            + (x187 + (Self::mul_add(-s_q7, x184, c_q7 * x183) - x186));
-        let x197 = -117.61766249359756 + Self::mul_add(x160, -0.65, x190);
-        let x198 = 1466.4506062283303
-            + (Self::mul_add(
-                c_q7,
-                Self::mul_add(c_q7, x178, s_q7 * x175),
-                s_q7 * Self::mul_add(c_q7, x177, s_q7 * x173),
-            ) - (x188 - x187) - (x186 - x189));
-        let x199 = 1271.854575 + (x192 - x188);
-        let x200 = -x195;
-        let x201 = -x194;
-        let x202 = Self::mul_add(x3, x146, x2 * x147);
-        let x203 = x158 - x159;
-        let x204 = Self::mul_add(-0.35, x203, x163);
-        let x205 = Self::mul_add(-0.35, x202, x166);
-        let x206 = Self::mul_add(s_q7, x203, c_q7 * x202);
-        let x207 = -x206;
-        let x208 = Self::mul_add(-s_q7, x202, c_q7 * x203);
-        let x209 = Self::mul_add(-0.75, x208, Self::mul_add(-s_q7, x205, c_q7 * x204));
-        let x210 = Self::mul_add(c_q7, x205, s_q7 * x204)
-            + Self::mul_add(-0.75, x206, x157 * -0.65);
-        let x211 = Self::mul_add(0.65, x208, x167);
-        let x212 = x6 * x102;
-        let x213 = Self::mul_add(-x5, x117, x212);
-        let x214 = x8 * x102;
-        let x215 = Self::mul_add(-x7, x117, x214);
-        let x216 = s_q9 * x102;
-        let x217 = Self::mul_add(c_q9, x117, x216);
-        let x218 = x129 + Self::mul_add(-0.275, x217, -0.4 * x215);
-        let x219 = Self::mul_add(0.4, x213, x132);
-        let x220 = Self::mul_add(-0.275, x213, x135);
-        let x221 = Self::mul_add(-x3, x215, x2 * x213) - x217;
-        let x222 = Self::mul_add(c_q8, x215, s_q8 * x213);
-        let x223 = Self::mul_add(
-            0.00000000020510342851533115,
-            x217,
-            Self::mul_add(-c_q8, x213, s_q8 * x215),
-        );
-        let x224 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x220,
-            Self::mul_add(-c_q8, x218, s_q8 * x219),
-        );
-        let x225 = Self::mul_add(
-            -0.35,
-            x222,
-            x220 + Self::mul_add(-x3, x219, x2 * x218),
-        );
-        let x226 = Self::mul_add(0.35, x221, Self::mul_add(c_q8, x219, s_q8 * x218));
-        let x227 = Self::mul_add(-s_q7, x222, c_q7 * x221);
-        let x228 = Self::mul_add(c_q7, x222, s_q7 * x221);
-        let x229 = Self::mul_add(-0.75, x228, Self::mul_add(-s_q7, x226, c_q7 * x225));
-        let x230 = Self::mul_add(c_q7, x226, s_q7 * x225)
-            + Self::mul_add(-0.65, x223, 0.75 * x227);
-        let x231 = Self::mul_add(0.65, x228, x224);
-        let x232 = Self::mul_add(-x5, x104, x212);
-        let x233 = Self::mul_add(-x7, x104, x214);
-        let x234 = Self::mul_add(c_q9, x104, x216);
-        let x235 = Self::mul_add(
-            0.00000000020510342851533115,
-            x114,
-            Self::mul_add(x6, x110, x5 * x107),
-        ) + Self::mul_add(-0.275, x234, -0.4 * x233);
-        let x236 = Self::mul_add(0.4, x232, x114 + Self::mul_add(x8, x110, x7 * x107));
-        let x237 = Self::mul_add(
-            -0.275,
-            x232,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x114,
-                Self::mul_add(-s_q9, x110, c_q9 * x107),
-            ),
-        );
-        let x238 = Self::mul_add(-x3, x233, x2 * x232) - x234;
-        let x239 = Self::mul_add(c_q8, x233, s_q8 * x232);
-        let x240 = Self::mul_add(
-            0.00000000020510342851533115,
-            x234,
-            Self::mul_add(-c_q8, x232, s_q8 * x233),
-        );
-        let x241 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x237,
-            Self::mul_add(-c_q8, x235, s_q8 * x236),
-        );
-        let x242 = Self::mul_add(
-            -0.35,
-            x239,
-            x237 + Self::mul_add(-x3, x236, x2 * x235),
-        );
-        let x243 = Self::mul_add(0.35, x238, Self::mul_add(c_q8, x236, s_q8 * x235));
-        let x244 = Self::mul_add(-s_q7, x239, c_q7 * x238);
-        let x245 = Self::mul_add(c_q7, x239, s_q7 * x238);
-        let x246 = Self::mul_add(-0.75, x245, Self::mul_add(-s_q7, x243, c_q7 * x242));
-        let x247 = Self::mul_add(c_q7, x243, s_q7 * x242)
-            + Self::mul_add(-0.65, x240, 0.75 * x244);
-        let x248 = Self::mul_add(0.65, x245, x241);
-        let x249 = Self::mul_add(c_q10, x78, x103);
-        let x250 = Self::mul_add(-s_q10, x78, x101);
-        let x251 = Self::mul_add(-s_q10, x89, c_q10 * x88);
-        let x252 = Self::mul_add(c_q10, x89, s_q10 * x88);
-        let x253 = Self::mul_add(-0.87, x249, x90);
-        let x254 = Self::mul_add(-x5, x249, x6 * x250);
-        let x255 = Self::mul_add(-x7, x249, x8 * x250);
-        let x256 = Self::mul_add(s_q9, x250, c_q9 * x249);
-        let x257 = Self::mul_add(
-            0.00000000020510342851533115,
-            x253,
-            Self::mul_add(x6, x252, x5 * x251),
-        ) + Self::mul_add(-0.275, x256, -0.4 * x255);
-        let x258 = Self::mul_add(0.4, x254, x253 + Self::mul_add(x8, x252, x7 * x251));
-        let x259 = Self::mul_add(
-            -0.275,
-            x254,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x253,
-                Self::mul_add(-s_q9, x252, c_q9 * x251),
-            ),
-        );
-        let x260 = Self::mul_add(-x3, x255, x2 * x254) - x256;
-        let x261 = Self::mul_add(c_q8, x255, s_q8 * x254);
-        let x262 = Self::mul_add(
-            0.00000000020510342851533115,
-            x256,
-            Self::mul_add(-c_q8, x254, s_q8 * x255),
-        );
-        let x263 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x259,
-            Self::mul_add(-c_q8, x257, s_q8 * x258),
-        );
-        let x264 = Self::mul_add(
-            -0.35,
-            x261,
-            x259 + Self::mul_add(-x3, x258, x2 * x257),
-        );
-        let x265 = Self::mul_add(0.35, x260, Self::mul_add(c_q8, x258, s_q8 * x257));
-        let x266 = Self::mul_add(-s_q7, x261, c_q7 * x260);
-        let x267 = Self::mul_add(c_q7, x261, s_q7 * x260);
-        let x268 = Self::mul_add(-0.75, x267, Self::mul_add(-s_q7, x265, c_q7 * x264));
-        let x269 = Self::mul_add(c_q7, x265, s_q7 * x264)
-            + Self::mul_add(-0.65, x262, 0.75 * x266);
-        let x270 = Self::mul_add(0.65, x267, x263);
-        let x271 = Self::mul_add(-x12, x39, x13 * x38);
-        let x272 = x49 - x48;
-        let x273 = Self::mul_add(0.36, x271, x56);
-        let x274 = Self::mul_add(0.36, x52, x59);
-        let x275 = Self::mul_add(s_q11, x271, c_q11 * x52);
-        let x276 = Self::mul_add(-s_q11, x52, c_q11 * x271);
-        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
-            + Self::mul_add(-0.63, x272, 0.275 * x276);
-        let x278 = Self::mul_add(0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
-        let x279 = Self::mul_add(-0.63, x275, x62);
-        let x280 = Self::mul_add(s_q10, x276, c_q10 * x275);
-        let x281 = Self::mul_add(-s_q10, x275, c_q10 * x276);
-        let x282 = Self::mul_add(c_q10, x278, s_q10 * x277);
-        let x283 = Self::mul_add(-0.87, x272, Self::mul_add(-s_q10, x278, c_q10 * x277));
-        let x284 = Self::mul_add(-0.87, x280, x279);
-        let x285 = Self::mul_add(
-            0.00000000020510342851533115,
-            x272,
-            Self::mul_add(-x5, x280, x6 * x281),
-        );
-        let x286 = x272 + Self::mul_add(-x7, x280, x8 * x281);
-        let x287 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x272,
-            -Self::mul_add(s_q9, x281, c_q9 * x280),
-        );
-        let x288 = Self::mul_add(
-            0.00000000020510342851533115,
-            x284,
-            Self::mul_add(x6, x282, x5 * x283),
-        ) + Self::mul_add(0.275, x287, -0.4 * x286);
-        let x289 = Self::mul_add(0.4, x285, x284 + Self::mul_add(x8, x282, x7 * x283));
-        let x290 = Self::mul_add(
-            -0.275,
-            x285,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x284,
-                Self::mul_add(-s_q9, x282, c_q9 * x283),
-            ),
-        );
-        let x291 = x287 + Self::mul_add(-x3, x286, x2 * x285);
-        let x292 = Self::mul_add(c_q8, x286, s_q8 * x285);
-        let x293 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x287,
-            Self::mul_add(-c_q8, x285, s_q8 * x286),
-        );
-        let x294 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x290,
-            Self::mul_add(-c_q8, x288, s_q8 * x289),
-        );
-        let x295 = Self::mul_add(
-            -0.35,
-            x292,
-            x290 + Self::mul_add(-x3, x289, x2 * x288),
-        );
-        let x296 = Self::mul_add(0.35, x291, Self::mul_add(c_q8, x289, s_q8 * x288));
-        let x297 = Self::mul_add(-s_q7, x292, c_q7 * x291);
-        let x298 = Self::mul_add(c_q7, x292, s_q7 * x291);
-        let x299 = Self::mul_add(-0.75, x298, Self::mul_add(-s_q7, x296, c_q7 * x295));
-        let x300 = Self::mul_add(c_q7, x296, s_q7 * x295)
-            + Self::mul_add(-0.65, x293, 0.75 * x297);
-        let x301 = Self::mul_add(0.65, x298, x294);
-        let x302 = x15 * -4.806620000000001;
-        let x303 = s_q13 * -4.806620000000001;
-        let x304 = c_q13 * -4.806620000000001;
-        let x305 = x22 + Self::mul_add(-0.55, x304, -0.16 * x303);
-        let x306 = Self::mul_add(0.16, x302, x26);
-        let x307 = Self::mul_add(-0.55, x302, x29);
-        let x308 = Self::mul_add(-s_q12, x303, c_q12 * x302);
-        let x309 = Self::mul_add(x13, x303, x12 * x302) - x304;
-        let x310 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x304,
-            Self::mul_add(c_q12, x303, s_q12 * x302),
-        );
-        let x311 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x307,
-            -Self::mul_add(c_q12, x306, s_q12 * x305),
-        );
-        let x312 = Self::mul_add(0.36, x309, Self::mul_add(-s_q12, x306, c_q12 * x305));
-        let x313 = Self::mul_add(
-            -0.36,
-            x308,
-            x307 + Self::mul_add(x13, x306, x12 * x305),
-        );
-        let x314 = Self::mul_add(-s_q11, x309, c_q11 * x308);
-        let x315 = Self::mul_add(c_q11, x309, s_q11 * x308);
-        let x316 = Self::mul_add(-s_q11, x313, c_q11 * x312)
-            + Self::mul_add(0.63, x310, 0.275 * x315);
-        let x317 = Self::mul_add(-0.275, x314, Self::mul_add(c_q11, x313, s_q11 * x312));
-        let x318 = Self::mul_add(0.63, x314, x311);
-        let x319 = Self::mul_add(-s_q10, x315, c_q10 * x314);
-        let x320 = Self::mul_add(c_q10, x315, s_q10 * x314);
-        let x321 = Self::mul_add(c_q10, x317, s_q10 * x316);
-        let x322 = Self::mul_add(0.87, x310, Self::mul_add(-s_q10, x317, c_q10 * x316));
-        let x323 = Self::mul_add(0.87, x319, x318);
-        let x324 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x310,
-            Self::mul_add(x6, x320, x5 * x319),
-        );
-        let x325 = Self::mul_add(x8, x320, x7 * x319) - x310;
-        let x326 = Self::mul_add(
-            0.00000000020510342851533115,
-            x310,
-            Self::mul_add(-s_q9, x320, c_q9 * x319),
-        );
-        let x327 = Self::mul_add(
-            0.00000000020510342851533115,
-            x323,
-            Self::mul_add(x6, x321, x5 * x322),
-        ) + Self::mul_add(0.275, x326, -0.4 * x325);
-        let x328 = Self::mul_add(0.4, x324, x323 + Self::mul_add(x8, x321, x7 * x322));
-        let x329 = Self::mul_add(
-            -0.275,
-            x324,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x323,
-                Self::mul_add(-s_q9, x321, c_q9 * x322),
-            ),
-        );
-        let x330 = x326 + Self::mul_add(-x3, x325, x2 * x324);
-        let x331 = Self::mul_add(c_q8, x325, s_q8 * x324);
-        let x332 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x326,
-            Self::mul_add(-c_q8, x324, s_q8 * x325),
-        );
-        let x333 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x329,
-            Self::mul_add(-c_q8, x327, s_q8 * x328),
-        );
-        let x334 = Self::mul_add(
-            -0.35,
-            x331,
-            x329 + Self::mul_add(-x3, x328, x2 * x327),
-        );
-        let x335 = Self::mul_add(0.35, x330, Self::mul_add(c_q8, x328, s_q8 * x327));
-        let x336 = Self::mul_add(-s_q7, x331, c_q7 * x330);
-        let x337 = Self::mul_add(c_q7, x331, s_q7 * x330);
-        let x338 = Self::mul_add(-0.75, x337, Self::mul_add(-s_q7, x335, c_q7 * x334));
-        let x339 = Self::mul_add(c_q7, x335, s_q7 * x334)
-            + Self::mul_add(-0.65, x332, 0.75 * x336);
-        let x340 = Self::mul_add(0.65, x337, x333);
-        let x341 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x342 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x343 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x344 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x345 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x346 = v[4] * v[4];
-        let x347 = Self::mul_add(v[5], v[5], x346);
-        let x348 = v[3] * v[4];
-        let x349 = v[3] * v[5];
-        let x350 = v[4] * v[5];
-        let x351 = Self::mul_add(v[3], v[3], x346);
-        let x352 = x341 + Self::mul_add(-0.65, x347, 0.75 * x349);
-        let x353 = x342 + Self::mul_add(0.75, x350, 0.65 * x348);
-        let x354 = x343 + Self::mul_add(-0.75, x351, 0.65 * x349);
-        let x355 = Self::mul_add(-s_q7, x352, c_q7 * x353);
-        let x356 = v[6] * x345;
-        let x357 = v[6] * x344;
-        let x358 = v[5] + v[6];
-        let x359 = x345 * x345;
-        let x360 = x344 * x358;
-        let x361 = Self::mul_add(-16.80768997608804, x358, -0.07309 * x345);
-        let x362 = Self::mul_add(
-            0.1132,
-            x358,
-            Self::mul_add(130.43769025763282, x345, -0.07309 * x344),
-        );
-        let x363 = Self::mul_add(
-            132.47349025763282,
-            x358,
-            Self::mul_add(0.1132, x345, -16.80768997608804 * x344),
-        );
-        let x364 = Self::mul_add(-c_q8, x358, Self::mul_add(s_q8, x345, x2 * x344));
-        let x365 = Self::mul_add(s_q8, x358, Self::mul_add(-x3, x344, c_q8 * x345));
-        let x366 = Self::mul_add(
-            0.35,
-            x360 - x357,
-            Self::mul_add(s_q7, x353, c_q7 * x352),
-        );
-        let x367 = Self::mul_add(0.35, Self::mul_add(x345, x358, -x356), x355);
-        let x368 = Self::mul_add(-0.35, Self::mul_add(x344, x344, x359), x354);
-        let x369 = Self::mul_add(-c_q8, x368, Self::mul_add(s_q8, x367, x2 * x366));
-        let x370 = Self::mul_add(s_q8, x368, Self::mul_add(-x3, x366, c_q8 * x367));
-        let x371 = Self::mul_add(-0.00000000020510342851533115, x368, x366);
-        let x372 = Self::mul_add(v[7], x365, Self::mul_add(-s_q8, x357, x2 * x356));
-        let x373 = Self::mul_add(v[7], x364, Self::mul_add(c_q8, x357, x3 * x356));
-        let x374 = v[7] + Self::mul_add(-0.00000000020510342851533115, x358, x344);
-        let x375 = x365 * x365;
-        let x376 = x374 * x374;
-        let x377 = x364 * x365;
-        let x378 = x377 - x356;
-        let x379 = x364 * x374;
-        let x380 = x364 * x364;
-        let x381 = x376 + x380;
-        let x382 = x365 * x374;
-        let x383 = x372 + x382;
-        let x384 = Self::mul_add(
-            -0.0021399965876409276,
-            x374,
-            -0.0000000234896432582596 * x365,
-        );
-        let x385 = Self::mul_add(
-            5.080660024070365,
-            x374,
-            Self::mul_add(-111.7548902508081, x365, -0.0000000234896432582596 * x364),
-        );
-        let x386 = Self::mul_add(
-            113.3918902508081,
-            x374,
-            Self::mul_add(5.080660024070366, x365, -0.0021399965876409276 * x364),
-        );
-        let x387 = Self::mul_add(
-            x371,
-            0.000000008530897668050218,
-            Self::mul_add(
-                5.080660024070365,
-                x356,
-                Self::mul_add(111.7548902508081, x373, -0.0000000234896432582596 * x372),
-            ) + Self::mul_add(-x364, x386, x374 * x384),
-        );
-        let x388 = Self::mul_add(c_q9, x374, Self::mul_add(x7, x365, x5 * x364));
-        let x389 = Self::mul_add(-s_q9, x374, Self::mul_add(x8, x365, x6 * x364));
-        let x390 = x369 + Self::mul_add(0.4, x379 - x373, 0.275 * x378);
-        let x391 = x370 + Self::mul_add(-0.275, x381, 0.4 * (x382 - x372));
-        let x392 = x371 + Self::mul_add(-0.4, x375 + x380, 0.275 * x383);
-        let x393 = Self::mul_add(c_q9, x392, Self::mul_add(x7, x391, x5 * x390));
-        let x394 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x392,
-            Self::mul_add(0.00000000020510342851533115, x390, x391),
-        );
-        let x395 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x356,
-            Self::mul_add(0.00000000020510342851533115, x372, -x373),
-        );
-        let x396 = Self::mul_add(
-            v[8],
-            x389,
-            Self::mul_add(c_q9, x356, Self::mul_add(-x7, x373, x5 * x372)),
-        );
-        let x397 = Self::mul_add(
-            -v[8],
-            x388,
-            Self::mul_add(-s_q9, x356, Self::mul_add(-x8, x373, x6 * x372)),
-        );
-        let x398 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x374,
-                Self::mul_add(0.00000000020510342851533115, x364, x365),
-            );
-        let x399 = Self::mul_add(x388, x389, -x395);
-        let x400 = Self::mul_add(x388, x388, x398 * x398);
-        let x401 = Self::mul_add(x389, x398, x396);
-        let x402 = -0.00214 * x398;
-        let x403 = Self::mul_add(-36.18604050126307, x398, -63.36336825000001 * x389);
-        let x404 = Self::mul_add(
-            69.99836825,
-            x398,
-            Self::mul_add(-36.18604050126307, x389, -0.00214 * x388),
-        );
-        let x405 = Self::mul_add(
-            -81.53205,
-            x394,
-            Self::mul_add(-0.00214, x395, Self::mul_add(-x398, x403, x389 * x404)),
-        );
-        let x406 = Self::mul_add(
-            x393,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x395,
-                Self::mul_add(-36.18604050126307, x397, -0.00214 * x396),
-            ) + Self::mul_add(-x389, x402, x388 * x403),
-        );
-        let x407 = Self::mul_add(s_q10, x389, c_q10 * x388);
-        let x408 = Self::mul_add(-s_q10, x388, c_q10 * x389);
-        let x409 = Self::mul_add(-0.87, x399, x393);
-        let x410 = Self::mul_add(
-            0.87,
-            x400,
-            Self::mul_add(-s_q9, x392, Self::mul_add(x8, x391, x6 * x390)),
-        );
-        let x411 = Self::mul_add(-0.87, x401, x394);
-        let x412 = Self::mul_add(s_q10, x410, c_q10 * x409);
-        let x413 = Self::mul_add(v[9], x408, Self::mul_add(s_q10, x397, c_q10 * x396));
-        let x414 = Self::mul_add(-v[9], x407, Self::mul_add(-s_q10, x396, c_q10 * x397));
-        let x415 = v[9] + x398;
-        let x416 = Self::mul_add(x407, x408, -x395);
-        let x417 = x407 * x407;
-        let x418 = Self::mul_add(x415, x415, x417);
-        let x419 = x408 * x415;
-        let x420 = x413 + x419;
-        let x421 = -0.6328 * x415;
-        let x422 = Self::mul_add(-24.35164200091464, x415, -24.4950615 * x408);
-        let x423 = Self::mul_add(
-            28.2393615,
-            x415,
-            Self::mul_add(-24.351642000914637, x408, -0.6328 * x407),
-        );
-        let x424 = Self::mul_add(
-            -45.1584,
-            x411,
-            Self::mul_add(-0.6328, x395, Self::mul_add(-x415, x422, x408 * x423)),
-        );
-        let x425 = Self::mul_add(
-            x412,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x395,
-                Self::mul_add(-24.351642000914637, x414, -0.6328 * x413),
-            ) + Self::mul_add(-x408, x421, x407 * x422),
-        );
-        let x426 = Self::mul_add(s_q11, x408, c_q11 * x407);
-        let x427 = Self::mul_add(-s_q11, x407, c_q11 * x408);
-        let x428 = x412
-            + Self::mul_add(-0.275, Self::mul_add(x407, x415, x414), -0.63 * x416);
-        let x429 = Self::mul_add(-s_q10, x409, c_q10 * x410)
-            + Self::mul_add(0.63, x418, -0.275 * (x419 - x413));
-        let x430 = x411
-            + Self::mul_add(0.275, Self::mul_add(x408, x408, x417), -0.63 * x420);
-        let x431 = Self::mul_add(s_q11, x429, c_q11 * x428);
-        let x432 = Self::mul_add(v[10], x427, Self::mul_add(s_q11, x414, c_q11 * x413));
-        let x433 = Self::mul_add(
-            -v[10],
-            x426,
-            Self::mul_add(-s_q11, x413, c_q11 * x414),
-        );
-        let x434 = v[10] + x415;
-        let x435 = x426 * x426;
-        let x436 = x427 * x434;
-        let x437 = 0.01675 * x434;
-        let x438 = Self::mul_add(2.5482240016099564, x434, -9.142025249762803 * x427);
-        let x439 = Self::mul_add(
-            9.223235249762805,
-            x434,
-            Self::mul_add(2.5482240016099564, x427, 0.01675 * x426),
-        );
-        let x440 = Self::mul_add(
-            7.078399999258757,
-            x430,
-            Self::mul_add(0.01675, x395, Self::mul_add(-x434, x438, x427 * x439)),
-        );
-        let x441 = Self::mul_add(
-            x431,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x395,
-                Self::mul_add(2.5482240016099564, x433, 0.01675 * x432),
-            ) + Self::mul_add(-x427, x437, x426 * x438),
-        );
-        let x442 = Self::mul_add(-s_q12, x434, Self::mul_add(x12, x427, c_q12 * x426));
-        let x443 = Self::mul_add(-c_q12, x434, Self::mul_add(-s_q12, x426, x13 * x427));
-        let x444 = Self::mul_add(-0.36, Self::mul_add(x426, x434, x433), x431);
-        let x445 = Self::mul_add(
-            -0.36,
-            x436 - x432,
-            Self::mul_add(-s_q11, x428, c_q11 * x429),
-        );
-        let x446 = Self::mul_add(0.36, Self::mul_add(x427, x427, x435), x430);
-        let x447 = Self::mul_add(-s_q12, x446, Self::mul_add(x12, x445, c_q12 * x444));
-        let x448 = Self::mul_add(-c_q12, x446, Self::mul_add(-s_q12, x444, x13 * x445));
-        let x449 = Self::mul_add(-0.00000000020510342851533115, x446, x445);
-        let x450 = Self::mul_add(-0.00000000020510342851533115, x395, x433);
-        let x451 = Self::mul_add(
-            v[11],
-            x443,
-            Self::mul_add(-s_q12, x395, Self::mul_add(x12, x433, c_q12 * x432)),
-        );
-        let x452 = Self::mul_add(
-            -v[11],
-            x442,
-            Self::mul_add(-c_q12, x395, Self::mul_add(-s_q12, x432, x13 * x433)),
-        );
-        let x453 = v[11] + Self::mul_add(-0.00000000020510342851533115, x434, x427);
-        let x454 = x443 * x443;
-        let x455 = x453 * x453;
-        let x456 = x442 * x443;
-        let x457 = x456 - x450;
-        let x458 = x442 * x453;
-        let x459 = x442 * x442;
-        let x460 = x455 + x459;
-        let x461 = x443 * x453;
-        let x462 = x451 + x461;
-        let x463 = Self::mul_add(-0.809539999555672, x453, -1.9877000000000002 * x443);
-        let x464 = Self::mul_add(
-            -2.741639999592316,
-            x453,
-            Self::mul_add(-5.252920330000002, x443, -1.9877000000000002 * x442),
-        );
-        let x465 = Self::mul_add(
-            9.740442170000001,
-            x453,
-            Self::mul_add(-2.7416399995923166, x443, -0.809539999555672 * x442),
-        );
-        let x466 = Self::mul_add(
-            x449,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x450,
-                Self::mul_add(-5.252920330000002, x452, -1.9877000000000002 * x451),
-            ) + Self::mul_add(-x442, x465, x453 * x463),
-        );
-        let x467 = Self::mul_add(-c_q13, x453, Self::mul_add(s_q13, x443, x15 * x442));
-        let x468 = Self::mul_add(s_q13, x453, Self::mul_add(-x16, x442, c_q13 * x443));
-        let x469 = x447 + Self::mul_add(0.16, x452 + x458, 0.55 * x457);
-        let x470 = x449 + Self::mul_add(-0.16, x454 + x459, 0.55 * x462);
-        let x471 = Self::mul_add(
-            -c_q13,
-            x470,
-            Self::mul_add(
-                s_q13,
-                x448 + Self::mul_add(-0.55, x460, 0.16 * (x461 - x451)),
-                x15 * x469,
-            ),
-        );
-        let x472 = Self::mul_add(-0.00000000020510342851533115, x450, x451);
-        let x473 = Self::mul_add(
-            v[12],
-            x468,
-            Self::mul_add(-c_q13, x450, Self::mul_add(s_q13, x452, x15 * x451)),
-        );
-        let x474 = Self::mul_add(
-            -v[12],
-            x467,
-            Self::mul_add(s_q13, x450, Self::mul_add(-x16, x451, c_q13 * x452)),
-        );
-        let x475 = v[12] + Self::mul_add(-0.00000000020510342851533115, x453, x442);
-        let x476 = 4.806620000000001 * Self::mul_add(x467, x468, -x472);
-        let x477 = 4.806620000000001 * Self::mul_add(x467, x467, x475 * x475);
-        let x478 = 4.806620000000001 * Self::mul_add(x468, x475, x473);
-        let x479 = Self::mul_add(-0.0145, x475, 0.000781 * x468);
-        let x480 = Self::mul_add(
-            -0.9614610000000001,
-            x475,
-            Self::mul_add(-1.2025609200000003, x468, 0.000781 * x467),
-        );
-        let x481 = Self::mul_add(
-            1.4135609200000003,
-            x475,
-            Self::mul_add(-0.9614610000000001, x468, -0.0145 * x467),
-        );
-        let x482 = Self::mul_add(
-            -0.9614610000000001,
-            x472,
-            Self::mul_add(-1.2025609200000003, x474, 0.000781 * x473),
-        ) + Self::mul_add(-x467, x481, x475 * x479);
-        let x483 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x470, x469),
-            Self::mul_add(-0.0145, x472, 0.000781 * x474)
-                + Self::mul_add(-x475, x480, x468 * x481),
-        );
-        let x484 = Self::mul_add(
-            -4.806620000000001,
-            x471,
-            Self::mul_add(
-                1.4135609200000003,
-                x472,
-                Self::mul_add(-0.9614610000000001, x474, -0.0145 * x473),
-            ) + Self::mul_add(-x468, x479, x467 * x480),
-        );
-        let x485 = x478 + Self::mul_add(x16, x477, x15 * x476);
-        let x486 = Self::mul_add(-c_q13, x477, s_q13 * x476);
-        let x487 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x478,
-            -Self::mul_add(s_q13, x477, c_q13 * x476),
-        );
-        let x488 = Self::mul_add(
-            -0.55,
-            x485,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x484,
-                Self::mul_add(-c_q13, x483, s_q13 * x482),
-            ),
-        );
-        let x489 = Self::mul_add(
-            -3.6140000000000003,
-            x454 + x455,
-            17.135250000000003 * x457,
-        ) + x485;
-        let x490 = Self::mul_add(
-            -17.135250000000003,
-            x460,
-            3.6140000000000003 * (x450 + x456),
-        ) + x486;
-        let x491 = Self::mul_add(
-            17.135250000000003,
-            x462,
-            3.6140000000000003 * (x458 - x452),
-        ) + x487;
-        let x492 = Self::mul_add(
-            17.135250000000003,
-            x449,
-            Self::mul_add(-0.809539999555672, x450, -1.9877000000000002 * x452)
-                + Self::mul_add(-x453, x464, x443 * x465),
-        )
-            + (x484 + Self::mul_add(-x16, x482, x15 * x483)
-                + Self::mul_add(0.55, x487, -0.16 * x486));
-        let x493 = x466
-            + Self::mul_add(0.16, x485, Self::mul_add(c_q13, x482, s_q13 * x483));
-        let x494 = Self::mul_add(
-            9.740442170000001,
-            x450,
-            Self::mul_add(-2.7416399995923166, x452, -0.809539999555672 * x451),
-        ) + Self::mul_add(-x443, x463, x442 * x464)
-            + Self::mul_add(3.6140000000000003, x448, x447 * -17.135250000000003) + x488;
-        let x495 = Self::mul_add(-s_q12, x490, c_q12 * x489);
-        let x496 = x491 + Self::mul_add(x13, x490, x12 * x489);
-        let x497 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x426, x427, -x395),
-            x495,
-        );
-        let x498 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x434, x434, x435),
-            x496,
-        );
-        let x499 = Self::mul_add(
-            7.078399999258757,
-            x432 + x436,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x491,
-                -Self::mul_add(c_q12, x490, s_q12 * x489),
-            ),
-        );
-        let x500 = x440
-            + Self::mul_add(0.36, x496, Self::mul_add(-s_q12, x493, c_q12 * x492));
-        let x501 = Self::mul_add(2.5482240016099564, x395, -9.142025249762803 * x433)
-            + Self::mul_add(-x426, x439, x434 * x437)
-            + Self::mul_add(-0.36, x495, x494 + Self::mul_add(x13, x493, x12 * x492));
-        let x502 = x441
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x494,
-                -Self::mul_add(c_q12, x493, s_q12 * x492),
-            );
-        let x503 = Self::mul_add(-s_q11, x498, c_q11 * x497);
-        let x504 = Self::mul_add(c_q11, x498, s_q11 * x497);
-        let x505 = Self::mul_add(-45.1584, x416, x503);
-        let x506 = Self::mul_add(45.1584, x418, x504);
-        let x507 = Self::mul_add(-45.1584, x420, x499);
-        let x508 = x424
-            + (Self::mul_add(-s_q11, x501, c_q11 * x500)
-                + Self::mul_add(-0.63, x499, 0.275 * x504));
-        let x509 = Self::mul_add(-24.35164200091464, x395, -24.4950615 * x414)
-            + Self::mul_add(-x407, x423, x415 * x421)
-            + Self::mul_add(-0.275, x503, Self::mul_add(c_q11, x501, s_q11 * x500));
-        let x510 = x425 + Self::mul_add(0.63, x503, x502);
-        let x511 = Self::mul_add(-s_q10, x506, c_q10 * x505);
-        let x512 = Self::mul_add(-81.53205, x399, x511);
-        let x513 = Self::mul_add(
-            81.53205,
-            x400,
-            Self::mul_add(c_q10, x506, s_q10 * x505),
-        );
-        let x514 = Self::mul_add(-81.53205, x401, x507);
-        let x515 = x405
-            + Self::mul_add(-0.87, x507, Self::mul_add(-s_q10, x509, c_q10 * x508));
-        let x516 = Self::mul_add(-36.18604050126307, x395, -63.36336825000001 * x397)
-            + Self::mul_add(-x388, x404, x398 * x402)
-            + Self::mul_add(c_q10, x509, s_q10 * x508);
-        let x517 = x406 + Self::mul_add(0.87, x511, x510);
-        let x518 = Self::mul_add(
-            0.00000000020510342851533115,
-            x514,
-            Self::mul_add(x6, x513, x5 * x512),
-        );
-        let x519 = x514 + Self::mul_add(x8, x513, x7 * x512);
-        let x520 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x514,
-            Self::mul_add(-s_q9, x513, c_q9 * x512),
-        );
-        let x521 = Self::mul_add(
-            -0.275,
-            x518,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x517,
-                Self::mul_add(-s_q9, x516, c_q9 * x515),
-            ),
-        );
-        let x522 = Self::mul_add(
-            0.000000008530897668050218,
-            x375 + x376,
-            -12.701650001451807 * x378,
-        ) + x518;
-        let x523 = Self::mul_add(
-            12.701650001451807,
-            x381,
-            -0.000000008530897668050218 * (x356 + x377),
-        ) + x519;
-        let x524 = Self::mul_add(
-            -12.701650001451807,
-            x383,
-            -0.000000008530897668050218 * (x373 + x379),
-        ) + x520;
-        let x525 = Self::mul_add(
-            -12.701650001451807,
-            x371,
-            Self::mul_add(0.0000000234896432582596, x373, -0.0021399965876409276 * x356)
-                + Self::mul_add(-x374, x385, x365 * x386),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x517,
-                Self::mul_add(x6, x516, x5 * x515),
-            ) + Self::mul_add(0.275, x520, -0.4 * x519));
-        let x526 = x387
-            + Self::mul_add(0.4, x518, x517 + Self::mul_add(x8, x516, x7 * x515));
-        let x527 = Self::mul_add(
-            113.3918902508081,
-            x356,
-            Self::mul_add(-5.080660024070366, x373, -0.0021399965876409276 * x372),
-        ) + Self::mul_add(-x365, x384, x364 * x385)
-            + Self::mul_add(-0.000000008530897668050218, x370, x369 * 12.701650001451807)
-            + x521;
-        let x528 = x524 + Self::mul_add(-x3, x523, x2 * x522);
-        let x529 = Self::mul_add(c_q8, x523, s_q8 * x522);
-        let x530 = Self::mul_add(
-            -48.0240000085309,
-            Self::mul_add(x358, x358, x359),
-            x528,
-        );
-        let x531 = Self::mul_add(48.0240000085309, x344 * x345, x529);
-        let x532 = Self::mul_add(
-            48.0240000085309,
-            x357 + x360,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x524,
-                Self::mul_add(-c_q8, x522, s_q8 * x523),
-            ),
-        );
-        let x533 = Self::mul_add(0.07309, x357, Self::mul_add(-x358, x362, x345 * x363))
-            + Self::mul_add(-0.35, x529, x527 + Self::mul_add(-x3, x526, x2 * x525));
-        let x534 = Self::mul_add(
-            x354,
-            -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x357, -0.07309 * x356)
-                + Self::mul_add(-x344, x363, x358 * x361),
-        ) + Self::mul_add(0.35, x528, Self::mul_add(c_q8, x526, s_q8 * x525));
-        let x535 = Self::mul_add(
-            48.0240000085309,
-            x355,
-            Self::mul_add(-0.1132, x357, -16.80768997608804 * x356)
-                + Self::mul_add(-x345, x361, x344 * x362),
-        )
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x527,
-                Self::mul_add(-c_q8, x525, s_q8 * x526),
-            );
-        let x536 = Self::mul_add(-s_q7, x531, c_q7 * x530);
-        let x537 = Self::mul_add(c_q7, x531, s_q7 * x530);
-        let x538 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x539 = 1466.4506062283303 * v[4];
-        let x540 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x541 = x536
-            + Self::mul_add(
-                1170.07,
-                x341,
-                Self::mul_add(-110.5455, x347, 180.9502499901501 * x349),
-            );
-        let x542 = x537
-            + Self::mul_add(
-                1170.07,
-                x342,
-                Self::mul_add(180.9502499901501, x350, 110.5455 * x348),
-            );
-        let x543 = x532
-            + Self::mul_add(
-                1170.07,
-                x343,
-                Self::mul_add(-180.9502499901501, x351, 110.5455 * x349),
-            );
-        let x544 = Self::mul_add(-0.75, x537, Self::mul_add(-s_q7, x534, c_q7 * x533))
-            + Self::mul_add(
-                x342,
-                -180.9502499901501,
-                Self::mul_add(-v[5], x539, v[4] * x540),
-            );
-        let x545 = Self::mul_add(c_q7, x534, s_q7 * x533)
-            + Self::mul_add(-0.65, x532, 0.75 * x536)
-            + (Self::mul_add(-v[3], x540, v[5] * x538)
-                + Self::mul_add(x343, -110.5455, 180.9502499901501 * x341));
-        let x546 = Self::mul_add(0.65, x537, x535)
-            + Self::mul_add(110.5455, x342, Self::mul_add(-v[4], x538, v[3] * x539));
-        (
-            [
-                [
-                    1170.07,
-                    0.0,
-                    0.0,
-                    0.0,
-                    x195,
-                    x185,
-                    x185,
-                    x207,
-                    x227,
-                    x244,
-                    x266,
-                    x297,
-                    x336,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x200,
-                    0.0,
-                    x194,
-                    x181,
-                    x208,
-                    x228,
-                    x245,
-                    x267,
-                    x298,
-                    x337,
-                ],
-                [
-                    0.0,
-                    0.0,
-                    1170.07,
-                    x182,
-                    x201,
-                    0.0,
-                    0.0,
-                    x157,
-                    x223,
-                    x240,
-                    x262,
-                    x293,
-                    x332,
-                ],
-                [
-                    0.0,
-                    x200,
-                    x182,
-                    x196,
-                    x193,
-                    x197,
-                    x190,
-                    x209,
-                    x229,
-                    x246,
-                    x268,
-                    x299,
-                    x338,
-                ],
-                [
-                    x195,
-                    0.0,
-                    x201,
-                    x193,
-                    x198,
-                    x191,
-                    x191,
-                    x210,
-                    x230,
-                    x247,
-                    x269,
-                    x300,
-                    x339,
-                ],
-                [
-                    x185,
-                    x194,
-                    0.0,
-                    x197,
-                    x191,
-                    x199,
-                    x192,
-                    x211,
-                    x231,
-                    x248,
-                    x270,
-                    x301,
-                    x340,
-                ],
-                [
-                    x185,
-                    x181,
-                    0.0,
-                    x190,
-                    x191,
-                    x192,
-                    x180,
-                    x167,
-                    x224,
-                    x241,
-                    x263,
-                    x294,
-                    x333,
-                ],
-                [
-                    x207,
-                    x208,
-                    x157,
-                    x209,
-                    x210,
-                    x211,
-                    x167,
-                    x155,
-                    x220,
-                    x237,
-                    x259,
-                    x290,
-                    x329,
-                ],
-                [
-                    x227,
-                    x228,
-                    x223,
-                    x229,
-                    x230,
-                    x231,
-                    x224,
-                    x220,
-                    x123,
-                    x114,
-                    x253,
-                    x284,
-                    x323,
-                ],
-                [
-                    x244,
-                    x245,
-                    x240,
-                    x246,
-                    x247,
-                    x248,
-                    x241,
-                    x237,
-                    x114,
-                    x100,
-                    x90,
-                    x279,
-                    x318,
-                ],
-                [
-                    x266,
-                    x267,
-                    x262,
-                    x268,
-                    x269,
-                    x270,
-                    x263,
-                    x259,
-                    x253,
-                    x90,
-                    x76,
-                    x62,
-                    x311,
-                ],
-                [
-                    x297,
-                    x298,
-                    x293,
-                    x299,
-                    x300,
-                    x301,
-                    x294,
-                    x290,
-                    x284,
-                    x279,
-                    x62,
-                    x47,
-                    x307,
-                ],
-                [
-                    x336,
-                    x337,
-                    x332,
-                    x338,
-                    x339,
-                    x340,
-                    x333,
-                    x329,
-                    x323,
-                    x318,
-                    x311,
-                    x307,
-                    1.4135609200000003,
-                ],
-            ],
-            [
-                x541,
-                x542,
-                x543,
-                x544,
-                x545,
-                x546,
-                x535,
-                x527,
-                x517,
-                x510,
-                x502,
-                x494,
-                x484,
-            ],
-        )
-    }
-    /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
-    ///
-    /// Methods: forward `aba`: 1619 mul, 1327 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 989 fused where the target has FMA.
-    #[must_use]
-    pub fn forward_dynamics_with_wrenches(
-        q: &[f64; 14],
-        v: &[f64; 13],
-        tau: &[f64; 7],
-        f_ext: &[[f64; 6]; 8],
-    ) -> [f64; 13] {
-        let x0 = Self::mul_add(
-            v[1],
-            -180.9502499901501,
-            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
-        );
-        let x1 = Self::mul_add(
-            1466.4506062283303,
-            v[4],
-            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
-        );
-        let x2 = Self::mul_add(
-            110.5455,
-            v[1],
-            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
-        );
-        let x3 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]);
-        let x4 = Self::mul_add(
-            1170.07,
-            v[1],
-            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
-        );
-        let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
-        let (s_q7, c_q7) = libm::sincos(q[7]);
-        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x9 = Self::mul_add(v[4], 0.75, v[0]);
-        let x10 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
-        let x11 = Self::mul_add(-0.65, v[4], v[2]);
-        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
-        let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
-        let x14 = v[6] * x8;
-        let x15 = v[6] * x7;
-        let x16 = v[6] * x13;
-        let x17 = v[6] * x12;
-        let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x8);
-        let x20 = Self::mul_add(
-            x11,
-            -48.0240000085309,
-            Self::mul_add(
-                0.1132,
-                x18,
-                Self::mul_add(130.43769025763282, x8, -0.07309 * x7),
-            ),
-        );
-        let x21 = Self::mul_add(
-            48.0240000085309,
-            x13,
-            Self::mul_add(
-                132.47349025763282,
-                x18,
-                Self::mul_add(0.1132, x8, -16.80768997608804 * x7),
-            ),
-        );
-        let x22 = x18 * -48.0240000085309;
-        let x23 = 48.0240000085309 * x8;
-        let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x25 = -0.00000000020510342851533115 * c_q8;
-        let x26 = -0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x7, x26, x8 * c_q8));
-        let x29 = Self::mul_add(x8, 0.35, x12);
-        let x30 = Self::mul_add(-0.35, x7, x13);
-        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-x26, x29, c_q8 * x30));
-        let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
-        let x34 = v[7] * x28;
-        let x35 = v[7] * x27;
-        let x36 = v[7] * x32;
-        let x37 = v[7] * x31;
-        let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
-        let x39 = Self::mul_add(
-            -12.701650001451807,
-            x33,
-            Self::mul_add(-0.0021399965876409276, x38, -0.0000000234896432582596 * x28),
-        );
-        let x40 = Self::mul_add(
-            x33,
-            0.000000008530897668050218,
-            Self::mul_add(
-                5.080660024070365,
-                x38,
-                Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
-            ),
-        );
-        let x41 = Self::mul_add(
-            113.3918902508081,
-            x38,
-            Self::mul_add(5.080660024070366, x28, -0.0021399965876409276 * x27),
-        ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
-        let x42 = -12.701650001451807 * x38;
-        let x43 = x38 * 0.000000008530897668050218;
-        let x44 = Self::mul_add(
-            -0.000000008530897668050218,
-            x28,
-            x27 * 12.701650001451807,
-        );
-        let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x46 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x47 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x48 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x49 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x50 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x48, x27 * x46));
-        let x51 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x49, x27 * x47));
-        let x52 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
-        let x53 = Self::mul_add(-0.4, x27, x32);
-        let x54 = Self::mul_add(0.275, x27, x33);
-        let x55 = Self::mul_add(c_q9, x54, Self::mul_add(x48, x53, x46 * x52));
-        let x56 = Self::mul_add(-s_q9, x54, Self::mul_add(x49, x53, x47 * x52));
-        let x57 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x54,
-            Self::mul_add(0.00000000020510342851533115, x52, x53),
-        );
-        let x58 = v[8] * x51;
-        let x59 = v[8] * x50;
-        let x60 = v[8] * x56;
-        let x61 = v[8] * x55;
-        let x62 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x38,
-                Self::mul_add(0.00000000020510342851533115, x27, x28),
-            );
-        let x63 = Self::mul_add(-36.18604050126307, x62, -63.36336825000001 * x51);
-        let x64 = Self::mul_add(-81.53205, x57, -0.00214 * x62);
-        let x65 = Self::mul_add(
-            x55,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x62,
-                Self::mul_add(-36.18604050126307, x51, -0.00214 * x50),
-            ),
-        );
-        let x66 = -81.53205 * x62;
-        let x67 = x50 * 81.53205;
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
-        let x70 = Self::mul_add(-x50, s_q10, x51 * c_q10);
-        let x71 = Self::mul_add(0.87, x62, x55);
-        let x72 = Self::mul_add(x50, -0.87, x57);
-        let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
-        let x74 = Self::mul_add(-s_q10, x71, x56 * c_q10);
-        let x75 = v[9] * x70;
-        let x76 = v[9] * x69;
-        let x77 = v[9] * x74;
-        let x78 = v[9] * x73;
-        let x79 = v[9] + x62;
-        let x80 = Self::mul_add(-24.35164200091464, x79, -24.4950615 * x70);
-        let x81 = Self::mul_add(-45.1584, x72, -0.6328 * x79);
-        let x82 = Self::mul_add(
-            x73,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x79,
-                Self::mul_add(-24.351642000914637, x70, -0.6328 * x69),
-            ),
-        );
-        let x83 = -45.1584 * x79;
-        let x84 = x69 * 45.1584;
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x86 = Self::mul_add(x70, s_q11, x69 * c_q11);
-        let x87 = Self::mul_add(-x69, s_q11, x70 * c_q11);
-        let x88 = x73 - Self::mul_add(-0.63, x79, 0.275 * x70);
-        let x89 = Self::mul_add(0.275, x69, x74);
-        let x90 = Self::mul_add(x69, -0.63, x72);
-        let x91 = Self::mul_add(s_q11, x89, c_q11 * x88);
-        let x92 = Self::mul_add(-s_q11, x88, c_q11 * x89);
-        let x93 = v[10] * x87;
-        let x94 = v[10] * x86;
-        let x95 = v[10] * x92;
-        let x96 = v[10] * x91;
-        let x97 = v[10] + x79;
-        let x98 = Self::mul_add(2.5482240016099564, x97, -9.142025249762803 * x87);
-        let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
-        let x100 = Self::mul_add(
-            x91,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x97,
-                Self::mul_add(2.5482240016099564, x87, 0.01675 * x86),
-            ),
-        );
-        let x101 = 7.078399999258757 * x97;
-        let x102 = x86 * -7.078399999258757;
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x104 = -0.00000000020510342851533115 * s_q12;
-        let x105 = -0.00000000020510342851533115 * c_q12;
-        let x106 = Self::mul_add(-x97, s_q12, Self::mul_add(x87, x104, x86 * c_q12));
-        let x107 = Self::mul_add(-x97, c_q12, Self::mul_add(-x86, s_q12, x87 * x105));
-        let x108 = Self::mul_add(x87, -0.36, x91);
-        let x109 = Self::mul_add(0.36, x86, x92);
-        let x110 = Self::mul_add(-x90, s_q12, Self::mul_add(x104, x109, c_q12 * x108));
-        let x111 = Self::mul_add(-x90, c_q12, Self::mul_add(-s_q12, x108, x105 * x109));
-        let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
-        let x113 = v[11] * x107;
-        let x114 = v[11] * x106;
-        let x115 = v[11] * x111;
-        let x116 = v[11] * x110;
-        let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
-        let x118 = Self::mul_add(
-            17.135250000000003,
-            x112,
-            Self::mul_add(-0.809539999555672, x117, -1.9877000000000002 * x107),
-        );
-        let x119 = Self::mul_add(
-            x112,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x117,
-                Self::mul_add(-5.252920330000002, x107, -1.9877000000000002 * x106),
-            ),
-        );
-        let x120 = Self::mul_add(
-            9.740442170000001,
-            x117,
-            Self::mul_add(-2.7416399995923166, x107, -0.809539999555672 * x106),
-        ) + Self::mul_add(3.6140000000000003, x111, x110 * -17.135250000000003);
-        let x121 = 17.135250000000003 * x117;
-        let x122 = x117 * -3.6140000000000003;
-        let x123 = Self::mul_add(3.6140000000000003, x107, x106 * -17.135250000000003);
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x125 = -0.00000000020510342851533115 * c_q13;
-        let x126 = -0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(-x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
-        let x128 = Self::mul_add(x117, s_q13, Self::mul_add(-x106, x126, x107 * c_q13));
-        let x129 = x110 - Self::mul_add(0.55, x117, -0.16 * x107);
-        let x130 = Self::mul_add(-0.16, x106, x111);
-        let x131 = Self::mul_add(x106, 0.55, x112);
-        let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
-        let x133 = Self::mul_add(s_q13, x131, Self::mul_add(-x126, x129, c_q13 * x130));
-        let x134 = Self::mul_add(-0.00000000020510342851533115, x131, x129);
-        let x135 = v[12] * x128;
-        let x136 = v[12] * x127;
-        let x137 = v[12] * x133;
-        let x138 = v[12] + Self::mul_add(-0.00000000020510342851533115, x117, x106);
-        let x139 = Self::mul_add(
-            -0.9614610000000001,
-            x138,
-            Self::mul_add(-1.2025609200000003, x128, 0.000781 * x127),
-        );
-        let x140 = Self::mul_add(
-            4.806620000000001,
-            x134,
-            Self::mul_add(-0.0145, x138, 0.000781 * x128),
-        );
-        let x141 = Self::mul_add(
-            x132,
-            -4.806620000000001,
-            Self::mul_add(
-                1.4135609200000003,
-                x138,
-                Self::mul_add(-0.9614610000000001, x128, -0.0145 * x127),
-            ),
-        );
-        let x142 = 4.806620000000001 * x138;
-        let x143 = x127 * -4.806620000000001;
-        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x128, x140, x127 * x139))
-            - f_ext[7][5];
-        let x145 = Self::mul_add(-x138, x142, x127 * x143) - f_ext[7][1];
-        let x146 = tau[6] - x144;
-        let x147 = Self::mul_add(
-            4.806620000000001,
-            x135,
-            Self::mul_add(x128, x142, -f_ext[7][2]),
-        );
-        let x148 = Self::mul_add(
-            x146,
-            -0.010257782169020348,
-            Self::mul_add(-x133, x143, Self::mul_add(-x138, x139, x128 * x141))
-                - f_ext[7][3]
-                + Self::mul_add(
-                    x137,
-                    -0.049305260929256585,
-                    Self::mul_add(
-                        x136,
-                        0.009081457502008472,
-                        x135 * -0.00014873784145079505,
-                    ),
-                ),
-        );
-        let x149 = Self::mul_add(
-            x146,
-            -0.6801694828971361,
-            Self::mul_add(-x127, x141, x138 * x140)
-                + Self::mul_add(-x134, x142, x132 * x143) - f_ext[7][4]
-                + Self::mul_add(
-                    x137,
-                    -3.2693162398830324,
-                    Self::mul_add(x136, 1.8565173511957638, x135 * -0.009081457502008472),
-                ),
-        );
-        let x150 = x144 + x146;
-        let x151 = Self::mul_add(
-            x146,
-            -3.4003628227073506,
-            Self::mul_add(
-                x137,
-                -16.344251950881606,
-                Self::mul_add(x136, 3.2693162398830324, x135 * -0.049305260929256585),
-            ) - Self::mul_add(x128, x143, f_ext[7][0]),
-        );
-        let x152 = c_q13 * -0.009081457502008472;
-        let x153 = Self::mul_add(s_q13, -0.00014873784145079505, x152);
-        let x154 = s_q13 * -0.009081457502008472;
-        let x155 = Self::mul_add(c_q13, 0.00014873784145079505, x154);
-        let x156 = Self::mul_add(c_q13, -1.8565173511957638, x154);
-        let x157 = Self::mul_add(s_q13, -1.8565173511957638, -x152);
-        let x158 = Self::mul_add(x125, -0.049305260929256585, 4.806620000000001);
-        let x159 = s_q13 * -0.049305260929256585;
-        let x160 = Self::mul_add(
-            c_q13,
-            0.049305260929256585,
-            -0.0000000009858542415703612,
-        );
-        let x161 = x125 * -3.2693162398830324;
-        let x162 = s_q13 * -3.2693162398830324;
-        let x163 = c_q13 * -3.2693162398830324;
-        let x164 = Self::mul_add(-x126, x161, x125 * x158);
-        let x165 = Self::mul_add(-x126, x162, x125 * x159);
-        let x166 = Self::mul_add(x126, x163, x125 * x160);
-        let x167 = Self::mul_add(c_q13, x161, s_q13 * x158);
-        let x168 = Self::mul_add(-c_q13, x158, s_q13 * x161);
-        let x169 = s_q13 * -16.344251950881606;
-        let x170 = c_q13 * -16.344251950881606;
-        let x171 = x125 * (x125 * -16.344251950881606);
-        let x172 = x125 * x169;
-        let x173 = x125 * x170;
-        let x174 = s_q13 * x169;
-        let x175 = s_q13 * x170;
-        let x176 = c_q13 * x170;
-        let x177 = x165 + Self::mul_add(-0.55, x175, -0.16 * x174);
-        let x178 = x166 + Self::mul_add(0.16, x175, 0.55 * x176);
-        let x179 = Self::mul_add(0.16, x171, x167);
-        let x180 = Self::mul_add(0.16, x172, Self::mul_add(c_q13, x162, s_q13 * x159));
-        let x181 = Self::mul_add(-0.16, x173, Self::mul_add(-c_q13, x163, s_q13 * x160));
-        let x182 = Self::mul_add(-0.55, x171, x168);
-        let x183 = Self::mul_add(-0.55, x172, Self::mul_add(-c_q13, x159, s_q13 * x162));
-        let x184 = Self::mul_add(-0.55, x173, Self::mul_add(s_q13, x163, c_q13 * x160));
-        let x185 = Self::mul_add(
-            0.16,
-            x167,
-            Self::mul_add(0.16, x179, Self::mul_add(c_q13, x156, s_q13 * x153)),
-        );
-        let x186 = Self::mul_add(
-            -0.55,
-            x167,
-            Self::mul_add(0.16, x182, Self::mul_add(c_q13, x157, s_q13 * x155)),
-        );
-        let x187 = Self::mul_add(
-            -0.55,
-            x168,
-            Self::mul_add(-0.55, x182, Self::mul_add(-c_q13, x155, s_q13 * x157)),
-        );
-        let x188 = x147 + Self::mul_add(-x126, x145, x125 * x151);
-        let x189 = Self::mul_add(c_q13, x145, s_q13 * x151);
-        let x190 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x147,
-            Self::mul_add(-c_q13, x151, s_q13 * x145),
-        );
-        let x191 = Self::mul_add(
-            -0.55,
-            x188,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x150,
-                Self::mul_add(-c_q13, x148, s_q13 * x149),
-            ),
-        );
-        let x192 = -0.809539999555672
-            + Self::mul_add(
-                -0.55,
-                x164,
-                Self::mul_add(-x126, x157, x125 * x155)
-                    + Self::mul_add(-0.55, x184, -0.16 * x183),
-            );
-        let x193 = -2.741639999592316 + x186;
-        let x194 = 9.740442170000001 + x187;
-        let x195 = -17.135250000000003 + x182;
-        let x196 = 3.6140000000000003 + x183;
-        let x197 = Self::mul_add(-x107, x118, x106 * x119)
-            + Self::mul_add(-x110, x122, x111 * x121) - f_ext[6][5] + x191;
-        let x198 = 1.0 / x194;
-        let x199 = tau[5] - x197;
-        let x200 = x192 * x198;
-        let x201 = x193 * x198;
-        let x202 = x195 * x198;
-        let x203 = x196 * x198;
-        let x204 = x184 * x198;
-        let x205 = Self::mul_add(
-            -x192,
-            x200,
-            Self::mul_add(0.55, x166, -0.16 * x165)
-                + (Self::mul_add(
-                    -x126,
-                    Self::mul_add(
-                        x126,
-                        1.8565173511957638,
-                        x125 * -0.009081457502008472,
-                    ),
-                    x125
-                        * Self::mul_add(
-                            x126,
-                            0.009081457502008472,
-                            x125 * -0.00014873784145079505,
-                        ),
-                ) + Self::mul_add(0.55, x178, -0.16 * x177)),
-        );
-        let x206 = Self::mul_add(
-            -x192,
-            x201,
-            -1.9877000000000002
-                + Self::mul_add(
-                    0.16,
-                    x164,
-                    Self::mul_add(-x126, x156, x125 * x153)
-                        + Self::mul_add(0.55, x181, -0.16 * x180),
-                ),
-        );
-        let x207 = Self::mul_add(-x193, x201, -5.252920330000002 + x185);
-        let x208 = Self::mul_add(
-            -x192,
-            x202,
-            x164 + Self::mul_add(-0.55, x173, -0.16 * x172),
-        );
-        let x209 = Self::mul_add(-x192, x203, x177);
-        let x210 = Self::mul_add(x192, x204, 17.135250000000003 + x178);
-        let x211 = Self::mul_add(-x193, x202, x179);
-        let x212 = Self::mul_add(-x193, x203, x180);
-        let x213 = Self::mul_add(x193, x204, -3.6140000000000003 + x181);
-        let x214 = Self::mul_add(-x195, x202, x171);
-        let x215 = Self::mul_add(-x195, x203, x172);
-        let x216 = Self::mul_add(x195, x204, -x173);
-        let x217 = Self::mul_add(-x196, x203, x174);
-        let x218 = Self::mul_add(x196, x204, -x175);
-        let x219 = Self::mul_add(-x184, x204, x176);
-        let x220 = Self::mul_add(
-            x199,
-            x200,
-            Self::mul_add(-x117, x119, x107 * x120)
-                + Self::mul_add(-x111, x123, x112 * x122) - f_ext[6][3]
-                + (x150 + Self::mul_add(-x126, x149, x125 * x148)
-                    + Self::mul_add(0.55, x190, -0.16 * x189))
-                + (Self::mul_add(-x114, x206, x113 * x205)
-                    + Self::mul_add(-x116, x209, x115 * x208)),
-        );
-        let x221 = Self::mul_add(
-            x199,
-            x201,
-            Self::mul_add(-x106, x120, x117 * x118)
-                + Self::mul_add(-x112, x121, x110 * x123) - f_ext[6][4]
-                + Self::mul_add(0.16, x188, Self::mul_add(c_q13, x149, s_q13 * x148))
-                + (Self::mul_add(-x114, x207, x113 * x206)
-                    + Self::mul_add(-x116, x212, x115 * x211)),
-        );
-        let x222 = Self::mul_add(x199, x194 * x198, x197);
-        let x223 = Self::mul_add(
-            x199,
-            x202,
-            Self::mul_add(-x107, x123, x117 * x122) - f_ext[6][0] + x188
-                + (Self::mul_add(-x114, x211, x113 * x208)
-                    + Self::mul_add(-x116, x215, x115 * x214)),
-        );
-        let x224 = Self::mul_add(
-            x199,
-            x203,
-            Self::mul_add(-x117, x121, x106 * x123) - f_ext[6][1] + x189
-                + (Self::mul_add(-x114, x212, x113 * x209)
-                    + Self::mul_add(-x116, x217, x115 * x215)),
-        );
-        let x225 = Self::mul_add(
-            -x199,
-            x204,
-            Self::mul_add(-x106, x122, x107 * x121) - f_ext[6][2] + x190
-                + (Self::mul_add(-x114, x213, x113 * x210)
-                    + Self::mul_add(-x116, x218, x115 * x216)),
-        );
-        let x226 = s_q12 * x206;
-        let x227 = Self::mul_add(x105, x206, x104 * x205);
-        let x228 = c_q12 * x206;
-        let x229 = Self::mul_add(s_q12, x205, x228);
-        let x230 = Self::mul_add(x105, x207, x104 * x206);
-        let x231 = Self::mul_add(c_q12, x207, x226);
-        let x232 = Self::mul_add(-s_q12, x209, c_q12 * x208);
-        let x233 = x210 + Self::mul_add(x105, x209, x104 * x208);
-        let x234 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x210,
-            -Self::mul_add(c_q12, x209, s_q12 * x208),
-        );
-        let x235 = Self::mul_add(-s_q12, x212, c_q12 * x211);
-        let x236 = x213 + Self::mul_add(x105, x212, x104 * x211);
-        let x237 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x213,
-            -Self::mul_add(c_q12, x212, s_q12 * x211),
-        );
-        let x238 = Self::mul_add(-s_q12, x235, c_q12 * x232);
-        let x239 = Self::mul_add(-s_q12, x236, c_q12 * x233);
-        let x240 = Self::mul_add(x105, x235, x104 * x232);
-        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
-        let x242 = Self::mul_add(c_q12, x236, s_q12 * x233);
-        let x243 = Self::mul_add(c_q12, x237, s_q12 * x234);
-        let x244 = s_q12 * x215;
-        let x245 = x216 + Self::mul_add(x105, x215, x104 * x214);
-        let x246 = c_q12 * x215;
-        let x247 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x216,
-            -Self::mul_add(s_q12, x214, x246),
-        );
-        let x248 = x218 + Self::mul_add(x105, x217, x104 * x215);
-        let x249 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x218,
-            -Self::mul_add(c_q12, x217, x244),
-        );
-        let x250 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x219,
-            -Self::mul_add(c_q12, x218, s_q12 * x216),
-        );
-        let x251 = Self::mul_add(
-            -s_q12,
-            Self::mul_add(-s_q12, x217, x246),
-            c_q12 * Self::mul_add(c_q12, x214, -x244),
-        );
-        let x252 = Self::mul_add(-s_q12, x248, c_q12 * x245);
-        let x253 = Self::mul_add(-s_q12, x249, c_q12 * x247);
-        let x254 = x219 + Self::mul_add(x105, x218, x104 * x216)
-            + Self::mul_add(x105, x248, x104 * x245);
-        let x255 = x250 + Self::mul_add(x105, x249, x104 * x247);
-        let x256 = Self::mul_add(0.36, x254, x239);
-        let x257 = Self::mul_add(-0.36, x251, x240);
-        let x258 = Self::mul_add(-0.36, x252, Self::mul_add(x105, x236, x104 * x233));
-        let x259 = Self::mul_add(
-            0.36,
-            x256,
-            Self::mul_add(
-                -s_q12,
-                Self::mul_add(-s_q12, x207, x228),
-                c_q12 * Self::mul_add(c_q12, x205, -x226),
-            ),
-        );
-        let x260 = Self::mul_add(
-            -0.36,
-            x238,
-            Self::mul_add(0.36, x258, Self::mul_add(-s_q12, x230, c_q12 * x227)),
-        );
-        let x261 = Self::mul_add(
-            -0.36,
-            x240,
-            Self::mul_add(-0.36, x257, Self::mul_add(x105, x230, x104 * x227)),
-        );
-        let x262 = Self::mul_add(-s_q12, x224, c_q12 * x223);
-        let x263 = x225 + Self::mul_add(x105, x224, x104 * x223);
-        let x264 = 0.01675
-            + Self::mul_add(-0.36, x242, Self::mul_add(-c_q12, x229, s_q12 * x231));
-        let x265 = 2.5482240016099564
-            - Self::mul_add(-0.36, x241, Self::mul_add(x105, x231, x104 * x229));
-        let x266 = 9.223235249762805 + Self::mul_add(c_q12, x231, s_q12 * x229);
-        let x267 = -7.078399999258757 - x241;
-        let x268 = Self::mul_add(x92, x101, Self::mul_add(-x87, x99, x86 * x98))
-            - f_ext[5][5]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x222,
-                -Self::mul_add(c_q12, x221, s_q12 * x220),
-            );
-        let x269 = 1.0 / x266;
-        let x270 = tau[4] - x268;
-        let x271 = x264 * x269;
-        let x272 = x265 * x269;
-        let x273 = x267 * x269;
-        let x274 = x242 * x269;
-        let x275 = x243 * x269;
-        let x276 = Self::mul_add(-x264, x271, Self::mul_add(0.36, x239, x259));
-        let x277 = Self::mul_add(-x264, x272, x260);
-        let x278 = Self::mul_add(-x265, x272, -9.142025249762803 + x261);
-        let x279 = Self::mul_add(-x264, x273, Self::mul_add(0.36, x252, x238));
-        let x280 = Self::mul_add(x264, x274, x256);
-        let x281 = Self::mul_add(
-            x264,
-            x275,
-            7.078399999258757
-                + Self::mul_add(0.36, x255, Self::mul_add(-s_q12, x237, c_q12 * x234)),
-        );
-        let x282 = Self::mul_add(-x265, x273, x257);
-        let x283 = Self::mul_add(x265, x274, x258);
-        let x284 = Self::mul_add(
-            x265,
-            x275,
-            Self::mul_add(-0.36, x253, Self::mul_add(x105, x237, x104 * x234)),
-        );
-        let x285 = Self::mul_add(-x267, x273, x251);
-        let x286 = Self::mul_add(x267, x274, x252);
-        let x287 = Self::mul_add(x267, x275, x253);
-        let x288 = Self::mul_add(-x242, x274, x254);
-        let x289 = Self::mul_add(-x242, x275, x255);
-        let x290 = Self::mul_add(
-            -x243,
-            x275,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x250,
-                -Self::mul_add(c_q12, x249, s_q12 * x247),
-            ),
-        );
-        let x291 = Self::mul_add(
-            x270,
-            x271,
-            Self::mul_add(-x92, x102, Self::mul_add(-x97, x98, x87 * x100)) - f_ext[5][3]
-                + Self::mul_add(0.36, x263, Self::mul_add(-s_q12, x221, c_q12 * x220))
-                + (Self::mul_add(-x94, x277, x93 * x276)
-                    + Self::mul_add(-x96, x280, x95 * x279)),
-        );
-        let x292 = Self::mul_add(
-            x270,
-            x272,
-            Self::mul_add(-x86, x100, x97 * x99) + Self::mul_add(-x90, x101, x91 * x102)
-                - f_ext[5][4]
-                + Self::mul_add(
-                    -0.36,
-                    x262,
-                    x222 + Self::mul_add(x105, x221, x104 * x220),
-                )
-                + (Self::mul_add(-x94, x278, x93 * x277)
-                    + Self::mul_add(-x96, x283, x95 * x282)),
-        );
-        let x293 = Self::mul_add(
-            x270,
-            x273,
-            x262 - Self::mul_add(x87, x102, f_ext[5][0])
-                + (Self::mul_add(-x94, x282, x93 * x279)
-                    + Self::mul_add(-x96, x286, x95 * x285)),
-        );
-        let x294 = Self::mul_add(
-            -x270,
-            x274,
-            Self::mul_add(-x97, x101, x86 * x102) - f_ext[5][1] + x263
-                + (Self::mul_add(-x94, x283, x93 * x280)
-                    + Self::mul_add(-x96, x288, x95 * x286)),
-        );
-        let x295 = Self::mul_add(
-            -x270,
-            x275,
-            Self::mul_add(x87, x101, -f_ext[5][2])
-                + Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x225,
-                    -Self::mul_add(c_q12, x224, s_q12 * x223),
-                )
-                + (Self::mul_add(-x94, x284, x93 * x281)
-                    + Self::mul_add(-x96, x289, x95 * x287)),
-        );
-        let x296 = s_q11 * x277;
-        let x297 = c_q11 * x277;
-        let x298 = Self::mul_add(s_q11, x276, x297);
-        let x299 = Self::mul_add(c_q11, x278, x296);
-        let x300 = Self::mul_add(-s_q11, x280, c_q11 * x279);
-        let x301 = Self::mul_add(c_q11, x280, s_q11 * x279);
-        let x302 = Self::mul_add(-s_q11, x283, c_q11 * x282);
-        let x303 = Self::mul_add(c_q11, x283, s_q11 * x282);
-        let x304 = Self::mul_add(-s_q11, x302, c_q11 * x300);
-        let x305 = Self::mul_add(-s_q11, x303, c_q11 * x301);
-        let x306 = Self::mul_add(-s_q11, x284, c_q11 * x281);
-        let x307 = Self::mul_add(c_q11, x302, s_q11 * x300);
-        let x308 = s_q11 * x286;
-        let x309 = c_q11 * x286;
-        let x310 = Self::mul_add(s_q11, x285, x309);
-        let x311 = Self::mul_add(c_q11, x288, x308);
-        let x312 = Self::mul_add(-s_q11, x289, c_q11 * x287);
-        let x313 = Self::mul_add(c_q11, x289, s_q11 * x287);
-        let x314 = Self::mul_add(
-            -s_q11,
-            Self::mul_add(-s_q11, x288, x309),
-            c_q11 * Self::mul_add(c_q11, x285, -x308),
-        );
-        let x315 = Self::mul_add(-s_q11, x311, c_q11 * x310);
-        let x316 = Self::mul_add(c_q11, x311, s_q11 * x310);
-        let x317 = 0.63 * x314;
-        let x318 = 0.63 * x315;
-        let x319 = 0.63 * x312;
-        let x320 = x305 + Self::mul_add(-0.63, x313, 0.275 * x316);
-        let x321 = x306 + Self::mul_add(-0.63, x290, 0.275 * x313);
-        let x322 = Self::mul_add(-0.275, x314, x307);
-        let x323 = Self::mul_add(-0.275, x315, Self::mul_add(c_q11, x303, s_q11 * x301));
-        let x324 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x284, s_q11 * x281));
-        let x325 = Self::mul_add(
-            -0.275,
-            x307,
-            Self::mul_add(-0.275, x322, Self::mul_add(c_q11, x299, s_q11 * x298)),
-        );
-        let x326 = Self::mul_add(-s_q11, x294, c_q11 * x293);
-        let x327 = Self::mul_add(c_q11, x294, s_q11 * x293);
-        let x328 = -0.6328
-            + Self::mul_add(0.63, x304, Self::mul_add(-0.63, x319, 0.275 * x318));
-        let x329 = -24.35164200091464 + Self::mul_add(0.63, x307, -0.275 * x317);
-        let x330 = Self::mul_add(0.63, x317, 28.2393615);
-        let x331 = 45.1584 + x317;
-        let x332 = Self::mul_add(x74, x83, Self::mul_add(-x70, x81, x69 * x80))
-            - f_ext[4][5]
-            + Self::mul_add(0.63, x326, Self::mul_add(x270, x266 * x269, x268));
-        let x333 = 1.0 / x330;
-        let x334 = tau[3] - x332;
-        let x335 = x328 * x333;
-        let x336 = x329 * x333;
-        let x337 = x331 * x333;
-        let x338 = x318 * x333;
-        let x339 = x319 * x333;
-        let x340 = Self::mul_add(
-            -x328,
-            x335,
-            Self::mul_add(-0.63, x306, 0.275 * x305)
-                + (Self::mul_add(
-                    -s_q11,
-                    Self::mul_add(-s_q11, x278, x297),
-                    c_q11 * Self::mul_add(c_q11, x276, -x296),
-                ) + Self::mul_add(-0.63, x321, 0.275 * x320)),
-        );
-        let x341 = Self::mul_add(
-            -x328,
-            x336,
-            Self::mul_add(
-                -0.275,
-                x304,
-                Self::mul_add(-s_q11, x299, c_q11 * x298)
-                    + Self::mul_add(-0.63, x324, 0.275 * x323),
-            ),
-        );
-        let x342 = Self::mul_add(-x329, x336, -24.4950615 + x325);
-        let x343 = Self::mul_add(
-            -x328,
-            x337,
-            x304 + Self::mul_add(-0.63, x312, 0.275 * x315),
-        );
-        let x344 = Self::mul_add(-x328, x338, x320);
-        let x345 = Self::mul_add(-x328, x339, -45.1584 + x321);
-        let x346 = Self::mul_add(-x329, x337, x322);
-        let x347 = Self::mul_add(-x329, x338, x323);
-        let x348 = Self::mul_add(-x329, x339, x324);
-        let x349 = Self::mul_add(-x331, x337, x314);
-        let x350 = Self::mul_add(-x331, x338, x315);
-        let x351 = Self::mul_add(-x331, x339, x312);
-        let x352 = Self::mul_add(-x318, x338, x316);
-        let x353 = Self::mul_add(-x318, x339, x313);
-        let x354 = Self::mul_add(-x319, x339, x290);
-        let x355 = Self::mul_add(
-            x334,
-            x335,
-            Self::mul_add(-x74, x84, Self::mul_add(-x79, x80, x70 * x82)) - f_ext[4][3]
-                + (Self::mul_add(-s_q11, x292, c_q11 * x291)
-                    + Self::mul_add(-0.63, x295, 0.275 * x327))
-                + (Self::mul_add(-x76, x341, x75 * x340)
-                    + Self::mul_add(-x78, x344, x77 * x343)),
-        );
-        let x356 = Self::mul_add(
-            x334,
-            x336,
-            Self::mul_add(-x69, x82, x79 * x81) + Self::mul_add(-x72, x83, x73 * x84)
-                - f_ext[4][4]
-                + Self::mul_add(-0.275, x326, Self::mul_add(c_q11, x292, s_q11 * x291))
-                + (Self::mul_add(-x76, x342, x75 * x341)
-                    + Self::mul_add(-x78, x347, x77 * x346)),
-        );
-        let x357 = Self::mul_add(
-            x334,
-            x337,
-            x326 - Self::mul_add(x70, x84, f_ext[4][0])
-                + (Self::mul_add(-x76, x346, x75 * x343)
-                    + Self::mul_add(-x78, x350, x77 * x349)),
-        );
-        let x358 = Self::mul_add(
-            x334,
-            x338,
-            Self::mul_add(-x79, x83, x69 * x84) - f_ext[4][1] + x327
-                + (Self::mul_add(-x76, x347, x75 * x344)
-                    + Self::mul_add(-x78, x352, x77 * x350)),
-        );
-        let x359 = Self::mul_add(
-            x334,
-            x339,
-            Self::mul_add(x70, x83, -f_ext[4][2]) + x295
-                + (Self::mul_add(-x76, x348, x75 * x345)
-                    + Self::mul_add(-x78, x353, x77 * x351)),
-        );
-        let x360 = s_q10 * x341;
-        let x361 = c_q10 * x341;
-        let x362 = Self::mul_add(s_q10, x340, x361);
-        let x363 = Self::mul_add(c_q10, x342, x360);
-        let x364 = Self::mul_add(-s_q10, x344, c_q10 * x343);
-        let x365 = Self::mul_add(c_q10, x344, s_q10 * x343);
-        let x366 = Self::mul_add(-s_q10, x347, c_q10 * x346);
-        let x367 = Self::mul_add(c_q10, x347, s_q10 * x346);
-        let x368 = Self::mul_add(-s_q10, x366, c_q10 * x364);
-        let x369 = Self::mul_add(-s_q10, x348, c_q10 * x345);
-        let x370 = Self::mul_add(c_q10, x366, s_q10 * x364);
-        let x371 = Self::mul_add(c_q10, x348, s_q10 * x345);
-        let x372 = s_q10 * x350;
-        let x373 = c_q10 * x350;
-        let x374 = Self::mul_add(s_q10, x349, x373);
-        let x375 = Self::mul_add(c_q10, x352, x372);
-        let x376 = Self::mul_add(-s_q10, x353, c_q10 * x351);
-        let x377 = Self::mul_add(c_q10, x353, s_q10 * x351);
-        let x378 = Self::mul_add(
-            -s_q10,
-            Self::mul_add(-s_q10, x352, x373),
-            c_q10 * Self::mul_add(c_q10, x349, -x372),
-        );
-        let x379 = Self::mul_add(-s_q10, x375, c_q10 * x374);
-        let x380 = 0.87 * x378;
-        let x381 = 0.87 * x379;
-        let x382 = 0.87 * x376;
-        let x383 = Self::mul_add(-0.87, x354, x369);
-        let x384 = Self::mul_add(
-            -0.87,
-            x383,
-            Self::mul_add(
-                -s_q10,
-                Self::mul_add(-s_q10, x342, x361),
-                c_q10 * Self::mul_add(c_q10, x340, -x360),
-            ),
-        );
-        let x385 = Self::mul_add(-s_q10, x358, c_q10 * x357);
-        let x386 = -0.00214 + Self::mul_add(0.87, x368, -0.87 * x382);
-        let x387 = Self::mul_add(0.87, x370, -36.18604050126307);
-        let x388 = Self::mul_add(0.87, x380, 69.99836825);
-        let x389 = 81.53205 + x380;
-        let x390 = Self::mul_add(x56, x66, Self::mul_add(-x51, x64, x50 * x63))
-            - f_ext[3][5]
-            + Self::mul_add(0.87, x385, Self::mul_add(x334, x330 * x333, x332));
-        let x391 = 1.0 / x388;
-        let x392 = tau[2] - x390;
-        let x393 = x386 * x391;
-        let x394 = x387 * x391;
-        let x395 = x389 * x391;
-        let x396 = x381 * x391;
-        let x397 = x382 * x391;
-        let x398 = Self::mul_add(-x386, x393, Self::mul_add(-0.87, x369, x384));
-        let x399 = Self::mul_add(
-            -x386,
-            x394,
-            Self::mul_add(-0.87, x371, Self::mul_add(-s_q10, x363, c_q10 * x362)),
-        );
-        let x400 = Self::mul_add(
-            -x387,
-            x394,
-            -63.36336825000001 + Self::mul_add(c_q10, x363, s_q10 * x362),
-        );
-        let x401 = Self::mul_add(-x386, x395, Self::mul_add(-0.87, x376, x368));
-        let x402 = Self::mul_add(
-            -x386,
-            x396,
-            Self::mul_add(-0.87, x377, Self::mul_add(-s_q10, x367, c_q10 * x365)),
-        );
-        let x403 = Self::mul_add(-x386, x397, -81.53205 + x383);
-        let x404 = Self::mul_add(-x387, x395, x370);
-        let x405 = Self::mul_add(-x387, x396, Self::mul_add(c_q10, x367, s_q10 * x365));
-        let x406 = Self::mul_add(-x387, x397, x371);
-        let x407 = Self::mul_add(-x389, x395, x378);
-        let x408 = Self::mul_add(-x389, x396, x379);
-        let x409 = Self::mul_add(-x389, x397, x376);
-        let x410 = Self::mul_add(-x381, x396, Self::mul_add(c_q10, x375, s_q10 * x374));
-        let x411 = Self::mul_add(-x381, x397, x377);
-        let x412 = Self::mul_add(-x382, x397, x354);
-        let x413 = Self::mul_add(
-            x392,
-            x393,
-            Self::mul_add(-x56, x67, Self::mul_add(-x62, x63, x51 * x65)) - f_ext[3][3]
-                + Self::mul_add(-0.87, x359, Self::mul_add(-s_q10, x356, c_q10 * x355))
-                + (Self::mul_add(-x59, x399, x58 * x398)
-                    + Self::mul_add(-x61, x402, x60 * x401)),
-        );
-        let x414 = Self::mul_add(
-            x392,
-            x394,
-            Self::mul_add(-x50, x65, x62 * x64) + Self::mul_add(-x57, x66, x55 * x67)
-                - f_ext[3][4] + Self::mul_add(c_q10, x356, s_q10 * x355)
-                + (Self::mul_add(-x59, x400, x58 * x399)
-                    + Self::mul_add(-x61, x405, x60 * x404)),
-        );
-        let x415 = Self::mul_add(x392, x388 * x391, x390);
-        let x416 = Self::mul_add(
-            x392,
-            x395,
-            x385 - Self::mul_add(x51, x67, f_ext[3][0])
-                + (Self::mul_add(-x59, x404, x58 * x401)
-                    + Self::mul_add(-x61, x408, x60 * x407)),
-        );
-        let x417 = Self::mul_add(
-            x392,
-            x396,
-            Self::mul_add(-x62, x66, x50 * x67) - f_ext[3][1]
-                + Self::mul_add(c_q10, x358, s_q10 * x357)
-                + (Self::mul_add(-x59, x405, x58 * x402)
-                    + Self::mul_add(-x61, x410, x60 * x408)),
-        );
-        let x418 = Self::mul_add(
-            x392,
-            x397,
-            Self::mul_add(x51, x66, -f_ext[3][2]) + x359
-                + (Self::mul_add(-x59, x406, x58 * x403)
-                    + Self::mul_add(-x61, x411, x60 * x409)),
-        );
-        let x419 = Self::mul_add(x49, x399, x48 * x398);
-        let x420 = Self::mul_add(-s_q9, x399, c_q9 * x398);
-        let x421 = Self::mul_add(x49, x400, x48 * x399);
-        let x422 = Self::mul_add(-s_q9, x400, c_q9 * x399);
-        let x423 = Self::mul_add(
-            0.00000000020510342851533115,
-            x403,
-            Self::mul_add(x47, x402, x46 * x401),
-        );
-        let x424 = x403 + Self::mul_add(x49, x402, x48 * x401);
-        let x425 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x403,
-            Self::mul_add(-s_q9, x402, c_q9 * x401),
-        );
-        let x426 = Self::mul_add(
-            0.00000000020510342851533115,
-            x406,
-            Self::mul_add(x47, x405, x46 * x404),
-        );
-        let x427 = x406 + Self::mul_add(x49, x405, x48 * x404);
-        let x428 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x406,
-            Self::mul_add(-s_q9, x405, c_q9 * x404),
-        );
-        let x429 = Self::mul_add(x47, x426, x46 * x423);
-        let x430 = Self::mul_add(x47, x427, x46 * x424);
-        let x431 = Self::mul_add(x47, x428, x46 * x425);
-        let x432 = Self::mul_add(x49, x426, x48 * x423);
-        let x433 = Self::mul_add(-s_q9, x426, c_q9 * x423);
-        let x434 = x409 + Self::mul_add(x49, x408, x48 * x407);
-        let x435 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x409,
-            Self::mul_add(-s_q9, x408, c_q9 * x407),
-        );
-        let x436 = x411 + Self::mul_add(x49, x410, x48 * x408);
-        let x437 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x411,
-            Self::mul_add(-s_q9, x410, c_q9 * x408),
-        );
-        let x438 = x412 + Self::mul_add(x49, x411, x48 * x409);
-        let x439 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x412,
-            Self::mul_add(-s_q9, x411, c_q9 * x409),
-        );
-        let x440 = Self::mul_add(
-            x47,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x411,
-                Self::mul_add(x47, x410, x46 * x408),
-            ),
-            x46
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x409,
-                    Self::mul_add(x47, x408, x46 * x407),
-                ),
-        );
-        let x441 = Self::mul_add(
-            0.00000000020510342851533115,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x412,
-                Self::mul_add(x47, x411, x46 * x409),
-            ),
-            x440,
-        );
-        let x442 = Self::mul_add(
-            0.00000000020510342851533115,
-            x438,
-            Self::mul_add(x47, x436, x46 * x434),
-        );
-        let x443 = Self::mul_add(
-            0.00000000020510342851533115,
-            x439,
-            Self::mul_add(x47, x437, x46 * x435),
-        );
-        let x444 = x438 + Self::mul_add(x49, x436, x48 * x434);
-        let x445 = x439 + Self::mul_add(x49, x437, x48 * x435);
-        let x446 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x439,
-            Self::mul_add(-s_q9, x437, c_q9 * x435),
-        );
-        let x447 = x430 + Self::mul_add(0.275, x445, -0.4 * x444);
-        let x448 = x431 + Self::mul_add(0.275, x446, -0.4 * x445);
-        let x449 = Self::mul_add(0.4, x441, x432);
-        let x450 = Self::mul_add(0.4, x442, Self::mul_add(x49, x427, x48 * x424));
-        let x451 = Self::mul_add(0.4, x443, Self::mul_add(x49, x428, x48 * x425));
-        let x452 = Self::mul_add(-0.275, x441, x433);
-        let x453 = Self::mul_add(-0.275, x442, Self::mul_add(-s_q9, x427, c_q9 * x424));
-        let x454 = Self::mul_add(-0.275, x443, Self::mul_add(-s_q9, x428, c_q9 * x425));
-        let x455 = Self::mul_add(
-            0.4,
-            x432,
-            Self::mul_add(0.4, x449, Self::mul_add(x49, x421, x48 * x419)),
-        );
-        let x456 = Self::mul_add(
-            -0.275,
-            x432,
-            Self::mul_add(0.4, x452, Self::mul_add(x49, x422, x48 * x420)),
-        );
-        let x457 = Self::mul_add(
-            -0.275,
-            x433,
-            Self::mul_add(-0.275, x452, Self::mul_add(-s_q9, x422, c_q9 * x420)),
-        );
-        let x458 = Self::mul_add(
-            0.00000000020510342851533115,
-            x418,
-            Self::mul_add(x47, x417, x46 * x416),
-        );
-        let x459 = x418 + Self::mul_add(x49, x417, x48 * x416);
-        let x460 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x418,
-            Self::mul_add(-s_q9, x417, c_q9 * x416),
-        );
-        let x461 = Self::mul_add(
-            -0.275,
-            x458,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x415,
-                Self::mul_add(-s_q9, x414, c_q9 * x413),
-            ),
-        );
-        let x462 = -0.0021399965876409276
-            + Self::mul_add(
-                -0.275,
-                x429,
-                Self::mul_add(x47, x422, x46 * x420)
-                    + Self::mul_add(0.275, x454, -0.4 * x453),
-            );
-        let x463 = 5.080660024070365 + x456;
-        let x464 = 113.3918902508081 + x457;
-        let x465 = 12.701650001451807 + x452;
-        let x466 = -0.000000008530897668050218 + x453;
-        let x467 = Self::mul_add(-x28, x39, x27 * x40)
-            + Self::mul_add(-x31, x43, x32 * x42) - f_ext[2][5] + x461;
-        let x468 = 1.0 / x464;
-        let x469 = tau[1] - x467;
-        let x470 = x462 * x468;
-        let x471 = x463 * x468;
-        let x472 = x465 * x468;
-        let x473 = x466 * x468;
-        let x474 = x454 * x468;
-        let x475 = Self::mul_add(
-            -x462,
-            x470,
-            Self::mul_add(0.275, x431, -0.4 * x430)
-                + (Self::mul_add(
-                    x47,
-                    Self::mul_add(x47, x400, x46 * x399),
-                    x46 * Self::mul_add(x47, x399, x46 * x398),
-                ) + Self::mul_add(0.275, x448, -0.4 * x447)),
-        );
-        let x476 = Self::mul_add(
-            -x462,
-            x471,
-            -0.0000000234896432582596
-                + Self::mul_add(
-                    0.4,
-                    x429,
-                    Self::mul_add(x47, x421, x46 * x419)
-                        + Self::mul_add(0.275, x451, -0.4 * x450),
-                ),
-        );
-        let x477 = Self::mul_add(-x463, x471, -111.7548902508081 + x455);
-        let x478 = Self::mul_add(
-            -x462,
-            x472,
-            x429 + Self::mul_add(0.275, x443, -0.4 * x442),
-        );
-        let x479 = Self::mul_add(-x462, x473, x447);
-        let x480 = Self::mul_add(-x462, x474, -12.701650001451807 + x448);
-        let x481 = Self::mul_add(-x463, x472, x449);
-        let x482 = Self::mul_add(-x463, x473, x450);
-        let x483 = Self::mul_add(-x463, x474, 0.000000008530897668050218 + x451);
-        let x484 = Self::mul_add(-x465, x472, x441);
-        let x485 = Self::mul_add(-x465, x473, x442);
-        let x486 = Self::mul_add(-x465, x474, x443);
-        let x487 = Self::mul_add(-x466, x473, x444);
-        let x488 = Self::mul_add(-x466, x474, x445);
-        let x489 = Self::mul_add(-x454, x474, x446);
-        let x490 = Self::mul_add(
-            x469,
-            x470,
-            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
-                - f_ext[2][3]
-                + (Self::mul_add(
-                    0.00000000020510342851533115,
-                    x415,
-                    Self::mul_add(x47, x414, x46 * x413),
-                ) + Self::mul_add(0.275, x460, -0.4 * x459))
-                + (Self::mul_add(-x35, x476, x34 * x475)
-                    + Self::mul_add(-x37, x479, x36 * x478)),
-        );
-        let x491 = Self::mul_add(
-            x469,
-            x471,
-            Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
-                - f_ext[2][4]
-                + Self::mul_add(0.4, x458, x415 + Self::mul_add(x49, x414, x48 * x413))
-                + (Self::mul_add(-x35, x477, x34 * x476)
-                    + Self::mul_add(-x37, x482, x36 * x481)),
-        );
-        let x492 = Self::mul_add(x469, x464 * x468, x467);
-        let x493 = Self::mul_add(
-            x469,
-            x472,
-            Self::mul_add(-x28, x44, x38 * x43) - f_ext[2][0] + x458
-                + (Self::mul_add(-x35, x481, x34 * x478)
-                    + Self::mul_add(-x37, x485, x36 * x484)),
-        );
-        let x494 = Self::mul_add(
-            x469,
-            x473,
-            Self::mul_add(-x38, x42, x27 * x44) - f_ext[2][1] + x459
-                + (Self::mul_add(-x35, x482, x34 * x479)
-                    + Self::mul_add(-x37, x487, x36 * x485)),
-        );
-        let x495 = Self::mul_add(
-            x469,
-            x474,
-            Self::mul_add(-x27, x43, x28 * x42) - f_ext[2][2] + x460
-                + (Self::mul_add(-x35, x483, x34 * x480)
-                    + Self::mul_add(-x37, x488, x36 * x486)),
-        );
-        let x496 = c_q8 * x476;
-        let x497 = Self::mul_add(s_q8, x475, x496);
-        let x498 = s_q8 * x476;
-        let x499 = Self::mul_add(-c_q8, x475, x498);
-        let x500 = Self::mul_add(c_q8, x477, x498);
-        let x501 = Self::mul_add(s_q8, x477, -x496);
-        let x502 = x480 + Self::mul_add(-x26, x479, x25 * x478);
-        let x503 = Self::mul_add(c_q8, x479, s_q8 * x478);
-        let x504 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x480,
-            Self::mul_add(-c_q8, x478, s_q8 * x479),
-        );
-        let x505 = x483 + Self::mul_add(-x26, x482, x25 * x481);
-        let x506 = Self::mul_add(c_q8, x482, s_q8 * x481);
-        let x507 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x483,
-            Self::mul_add(-c_q8, x481, s_q8 * x482),
-        );
-        let x508 = Self::mul_add(-x26, x505, x25 * x502);
-        let x509 = Self::mul_add(-x26, x506, x25 * x503);
-        let x510 = Self::mul_add(c_q8, x505, s_q8 * x502);
-        let x511 = Self::mul_add(-c_q8, x502, s_q8 * x505);
-        let x512 = Self::mul_add(-c_q8, x503, s_q8 * x506);
-        let x513 = Self::mul_add(-c_q8, x504, s_q8 * x507);
-        let x514 = c_q8 * x485;
-        let x515 = Self::mul_add(s_q8, x484, x514);
-        let x516 = s_q8 * x485;
-        let x517 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x486,
-            Self::mul_add(-c_q8, x484, x516),
-        );
-        let x518 = Self::mul_add(c_q8, x487, x516);
-        let x519 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x488,
-            Self::mul_add(s_q8, x487, -x514),
-        );
-        let x520 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x489,
-            Self::mul_add(-c_q8, x486, s_q8 * x488),
-        );
-        let x521 = x489 + Self::mul_add(-x26, x488, x25 * x486)
-            + Self::mul_add(
-                -x26,
-                x488 + Self::mul_add(-x26, x487, x25 * x485),
-                x25 * (x486 + Self::mul_add(-x26, x485, x25 * x484)),
-            );
-        let x522 = Self::mul_add(c_q8, x488, s_q8 * x486)
-            + Self::mul_add(-x26, x518, x25 * x515);
-        let x523 = x520 + Self::mul_add(-x26, x519, x25 * x517);
-        let x524 = Self::mul_add(c_q8, x518, s_q8 * x515);
-        let x525 = Self::mul_add(c_q8, x519, s_q8 * x517);
-        let x526 = Self::mul_add(-0.35, x524, x509);
-        let x527 = Self::mul_add(0.35, x521, x510);
-        let x528 = Self::mul_add(0.35, x522, Self::mul_add(c_q8, x506, s_q8 * x503));
-        let x529 = Self::mul_add(
-            -0.35,
-            x526,
-            Self::mul_add(
-                -x26,
-                Self::mul_add(-x26, x477, x25 * x476),
-                x25 * Self::mul_add(-x26, x476, x25 * x475),
-            ),
-        );
-        let x530 = Self::mul_add(
-            0.35,
-            x508,
-            Self::mul_add(-0.35, x528, Self::mul_add(-x26, x500, x25 * x497)),
-        );
-        let x531 = Self::mul_add(
-            0.35,
-            x510,
-            Self::mul_add(0.35, x527, Self::mul_add(c_q8, x500, s_q8 * x497)),
-        );
-        let x532 = x495 + Self::mul_add(-x26, x494, x25 * x493);
-        let x533 = Self::mul_add(c_q8, x494, s_q8 * x493);
-        let x534 = -16.80768997608804
-            + Self::mul_add(-0.35, x512, Self::mul_add(-x26, x501, x25 * x499));
-        let x535 = 0.1132
-            + Self::mul_add(0.35, x511, Self::mul_add(c_q8, x501, s_q8 * x499));
-        let x536 = 132.47349025763282 + Self::mul_add(-c_q8, x499, s_q8 * x501);
-        let x537 = 48.0240000085309 + x512;
-        let x538 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
-            - f_ext[1][5]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x492,
-                Self::mul_add(-c_q8, x490, s_q8 * x491),
-            );
-        let x539 = 1.0 / x536;
-        let x540 = tau[0] - x538;
-        let x541 = x534 * x539;
-        let x542 = x535 * x539;
-        let x543 = x511 * x539;
-        let x544 = x537 * x539;
-        let x545 = x513 * x539;
-        let x546 = Self::mul_add(-x534, x541, Self::mul_add(-0.35, x509, x529));
-        let x547 = Self::mul_add(-x534, x542, -0.07309 + x530);
-        let x548 = Self::mul_add(-x535, x542, 130.43769025763282 + x531);
-        let x549 = Self::mul_add(-x534, x543, Self::mul_add(-0.35, x522, x508));
-        let x550 = Self::mul_add(-x534, x544, x526);
-        let x551 = Self::mul_add(
-            -x534,
-            x545,
-            Self::mul_add(-0.35, x525, Self::mul_add(-x26, x507, x25 * x504)),
-        );
-        let x552 = Self::mul_add(-x535, x543, x527);
-        let x553 = Self::mul_add(-x535, x544, x528);
-        let x554 = Self::mul_add(
-            -x535,
-            x545,
-            -48.0240000085309
-                + Self::mul_add(0.35, x523, Self::mul_add(c_q8, x507, s_q8 * x504)),
-        );
-        let x555 = Self::mul_add(-x511, x543, x521);
-        let x556 = Self::mul_add(-x511, x544, x522);
-        let x557 = Self::mul_add(-x511, x545, x523);
-        let x558 = Self::mul_add(-x537, x544, x524);
-        let x559 = Self::mul_add(-x537, x545, x525);
-        let x560 = Self::mul_add(
-            -x513,
-            x545,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x520,
-                Self::mul_add(-c_q8, x517, s_q8 * x519),
-            ),
-        );
-        let x561 = Self::mul_add(
-            x540,
-            x541,
-            Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
-                - f_ext[1][3]
-                + Self::mul_add(
-                    -0.35,
-                    x533,
-                    x492 + Self::mul_add(-x26, x491, x25 * x490),
-                )
-                + (Self::mul_add(-x15, x547, x14 * x546)
-                    + Self::mul_add(-x17, x550, x16 * x549)),
-        );
-        let x562 = Self::mul_add(
-            x540,
-            x542,
-            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19)) - f_ext[1][4]
-                + Self::mul_add(0.35, x532, Self::mul_add(c_q8, x491, s_q8 * x490))
-                + (Self::mul_add(-x15, x548, x14 * x547)
-                    + Self::mul_add(-x17, x553, x16 * x552)),
-        );
-        let x563 = Self::mul_add(
-            x540,
-            x543,
-            Self::mul_add(-x8, x23, x18 * x22) - f_ext[1][0] + x532
-                + (Self::mul_add(-x15, x552, x14 * x549)
-                    + Self::mul_add(-x17, x556, x16 * x555)),
-        );
-        let x564 = Self::mul_add(
-            x540,
-            x544,
-            Self::mul_add(x7, x23, -f_ext[1][1]) + x533
-                + (Self::mul_add(-x15, x553, x14 * x550)
-                    + Self::mul_add(-x17, x558, x16 * x556)),
-        );
-        let x565 = Self::mul_add(
-            x540,
-            x545,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x495,
-                Self::mul_add(-c_q8, x493, s_q8 * x494),
-            ) - Self::mul_add(x7, x22, f_ext[1][2])
-                + (Self::mul_add(-x15, x554, x14 * x551)
-                    + Self::mul_add(-x17, x559, x16 * x557)),
-        );
-        let x566 = s_q7 * x547;
-        let x567 = c_q7 * x547;
-        let x568 = Self::mul_add(s_q7, x546, x567);
-        let x569 = Self::mul_add(c_q7, x548, x566);
-        let x570 = Self::mul_add(-s_q7, x550, c_q7 * x549);
-        let x571 = Self::mul_add(c_q7, x550, s_q7 * x549);
-        let x572 = Self::mul_add(-s_q7, x553, c_q7 * x552);
-        let x573 = Self::mul_add(c_q7, x553, s_q7 * x552);
-        let x574 = Self::mul_add(-s_q7, x572, c_q7 * x570);
-        let x575 = Self::mul_add(-s_q7, x573, c_q7 * x571);
-        let x576 = Self::mul_add(-s_q7, x554, c_q7 * x551);
-        let x577 = Self::mul_add(c_q7, x572, s_q7 * x570);
-        let x578 = Self::mul_add(c_q7, x573, s_q7 * x571);
-        let x579 = Self::mul_add(c_q7, x554, s_q7 * x551);
-        let x580 = s_q7 * x556;
-        let x581 = c_q7 * x556;
-        let x582 = Self::mul_add(s_q7, x555, x581);
-        let x583 = Self::mul_add(c_q7, x558, x580);
-        let x584 = Self::mul_add(-s_q7, x559, c_q7 * x557);
-        let x585 = Self::mul_add(c_q7, x559, s_q7 * x557);
-        let x586 = Self::mul_add(
-            -s_q7,
-            Self::mul_add(-s_q7, x558, x581),
-            c_q7 * Self::mul_add(c_q7, x555, -x580),
-        );
-        let x587 = Self::mul_add(-s_q7, x583, c_q7 * x582);
-        let x588 = Self::mul_add(c_q7, x583, s_q7 * x582);
-        let x589 = 0.65 * x587;
-        let x590 = 0.65 * x588;
-        let x591 = 0.65 * x585;
-        let x592 = Self::mul_add(-0.75, x587, x574);
-        let x593 = Self::mul_add(-0.75, x588, x575);
-        let x594 = x577 + Self::mul_add(-0.65, x584, 0.75 * x586);
-        let x595 = x578 + Self::mul_add(-0.65, x585, 0.75 * x587);
-        let x596 = x579 + Self::mul_add(-0.65, x560, 0.75 * x584);
-        let x597 = Self::mul_add(
-            -0.75,
-            x593,
-            Self::mul_add(
-                -s_q7,
-                Self::mul_add(-s_q7, x548, x567),
-                c_q7 * Self::mul_add(c_q7, x546, -x566),
-            ),
-        );
-        let x598 = Self::mul_add(-s_q7, x564, c_q7 * x563);
-        let x599 = Self::mul_add(c_q7, x564, s_q7 * x563);
-        let x600 = 180.9502499901501 + x594;
-        let x601 = Self::mul_add(-v[5], x4, v[4] * x5) - f_ext[0][0] + x598;
-        let x602 = 1.0 / (1170.07 + x586);
-        let x603 = x587 * x602;
-        let x604 = x584 * x602;
-        let x605 = x592 * x602;
-        let x606 = x600 * x602;
-        let x607 = x589 * x602;
-        let x608 = 1.0 / Self::mul_add(-x587, x603, 1170.07 + x588);
-        let x609 = Self::mul_add(-x587, x604, x585);
-        let x610 = x608 * x609;
-        let x611 = Self::mul_add(-x587, x605, -180.9502499901501 + x593);
-        let x612 = x608 * x611;
-        let x613 = Self::mul_add(-x587, x606, x595);
-        let x614 = x608 * x613;
-        let x615 = Self::mul_add(-x587, x607, 110.5455 + x590);
-        let x616 = x608 * x615;
-        let x617 = 1.0
-            / Self::mul_add(-x609, x610, Self::mul_add(-x584, x604, 1170.07 + x560));
-        let x618 = Self::mul_add(
-            -x609,
-            x612,
-            Self::mul_add(-x584, x605, Self::mul_add(-0.75, x585, x576)),
-        );
-        let x619 = x617 * x618;
+        let x600 = Self::mul_add(-s_q7, x566, c_q7 * x565);
+        let x601 = Self::mul_add(c_q7, x566, s_q7 * x565);
+        let x602 = 180.9502499901501 + x596;
+        let x603 = Self::mul_add(-v[5], x4, v[4] * x5) - f_ext[0][0] + x600;
+        let x604 = 1.0 / (1170.07 + x588);
+        let x605 = x589 * x604;
+        let x606 = x586 * x604;
+        let x607 = x594 * x604;
+        let x608 = x602 * x604;
+        let x609 = x591 * x604;
+        let x610 = 1.0 / Self::mul_add(-x589, x605, 1170.07 + x590);
+        let x611 = Self::mul_add(-x589, x606, x587);
+        let x612 = x610 * x611;
+        let x613 = Self::mul_add(-x589, x607, -180.9502499901501 + x595);
+        let x614 = x610 * x613;
+        let x615 = Self::mul_add(-x589, x608, x597);
+        let x616 = x610 * x615;
+        let x617 = Self::mul_add(-x589, x609, 110.5455 + x592);
+        let x618 = x610 * x617;
+        let x619 = 1.0
+            / Self::mul_add(-x611, x612, Self::mul_add(-x586, x606, 1170.07 + x562));
         let x620 = Self::mul_add(
-            -x609,
-            x614,
-            Self::mul_add(-x584, x606, -110.5455 + x596),
-        );
-        let x621 = x617 * x620;
-        let x622 = Self::mul_add(-x609, x616, Self::mul_add(-x584, x607, x591));
-        let x623 = x617 * x622;
-        let x624 = Self::mul_add(
             -x611,
-            x612,
-            Self::mul_add(
-                -x592,
-                x605,
-                1394.5960312283303 + Self::mul_add(-0.75, x575, x597),
-            ),
+            x614,
+            Self::mul_add(-x586, x607, Self::mul_add(-0.75, x587, x578)),
         );
-        let x625 = 1.0 / Self::mul_add(-x618, x619, x624);
-        let x626 = Self::mul_add(
-            -x592,
-            x606,
-            Self::mul_add(-0.65, x576, 0.75 * x574)
-                + Self::mul_add(-0.75, x595, Self::mul_add(-s_q7, x569, c_q7 * x568)),
-        );
-        let x627 = Self::mul_add(-x618, x621, Self::mul_add(-x611, x614, x626));
-        let x628 = x625 * x627;
-        let x629 = Self::mul_add(
+        let x621 = x619 * x620;
+        let x622 = Self::mul_add(
             -x611,
             x616,
-            Self::mul_add(
-                -x592,
-                x607,
-                -117.61766249359756 + Self::mul_add(0.65, x575, -0.75 * x590),
-            ),
+            Self::mul_add(-x586, x608, -110.5455 + x598),
         );
-        let x630 = Self::mul_add(-x618, x623, x629);
-        let x631 = x625 * x630;
-        let x632 = Self::mul_add(
+        let x623 = x619 * x622;
+        let x624 = Self::mul_add(-x611, x618, Self::mul_add(-x586, x609, x593));
+        let x625 = x619 * x624;
+        let x626 = Self::mul_add(
             -x613,
             x614,
             Self::mul_add(
-                -x600,
-                x606,
-                1466.4506062283303
-                    + (Self::mul_add(-0.65, x579, 0.75 * x577)
-                        + (Self::mul_add(c_q7, x569, s_q7 * x568)
-                            + Self::mul_add(-0.65, x596, 0.75 * x594))),
+                -x594,
+                x607,
+                1394.5960312283303 + Self::mul_add(-0.75, x577, x599),
             ),
         );
-        let x633 = 1.0 / Self::mul_add(-x627, x628, Self::mul_add(-x620, x621, x632));
+        let x627 = 1.0 / Self::mul_add(-x620, x621, x626);
+        let x628 = Self::mul_add(
+            -x594,
+            x608,
+            Self::mul_add(-0.65, x578, 0.75 * x576)
+                + Self::mul_add(-0.75, x597, Self::mul_add(-s_q7, x571, c_q7 * x570)),
+        );
+        let x629 = Self::mul_add(-x620, x623, Self::mul_add(-x613, x616, x628));
+        let x630 = x627 * x629;
+        let x631 = Self::mul_add(
+            -x613,
+            x618,
+            Self::mul_add(
+                -x594,
+                x609,
+                -117.61766249359756 + Self::mul_add(0.65, x577, -0.75 * x592),
+            ),
+        );
+        let x632 = Self::mul_add(-x620, x625, x631);
+        let x633 = x627 * x632;
         let x634 = Self::mul_add(
-            -x600,
-            x607,
-            Self::mul_add(0.65, x578, Self::mul_add(-0.65, x591, 0.75 * x589)),
-        );
-        let x635 = Self::mul_add(
-            -x627,
-            x631,
-            Self::mul_add(-x620, x623, Self::mul_add(-x613, x616, x634)),
-        );
-        let x636 = x633 * x635;
-        let x637 = Self::mul_add(
             -x615,
             x616,
-            Self::mul_add(-x589, x607, Self::mul_add(0.65, x590, 1271.854575)),
-        );
-        let x638 = Self::mul_add(
-            -x635,
-            x636,
-            Self::mul_add(-x630, x631, Self::mul_add(-x622, x623, x637)),
-        );
-        let x639 = 1.0 / x638;
-        let x640 = Self::mul_add(
-            x601,
-            x603,
-            -(Self::mul_add(-v[3], x5, v[5] * x3) - f_ext[0][1] + x599),
-        );
-        let x641 = Self::mul_add(
-            -x610,
-            x640,
             Self::mul_add(
-                x601,
-                x604,
-                -(Self::mul_add(-v[4], x3, v[3] * x4) - f_ext[0][2] + x565),
+                -x602,
+                x608,
+                1466.4506062283303
+                    + (Self::mul_add(-0.65, x581, 0.75 * x579)
+                        + (Self::mul_add(c_q7, x571, s_q7 * x570)
+                            + Self::mul_add(-0.65, x598, 0.75 * x596))),
             ),
         );
+        let x635 = 1.0 / Self::mul_add(-x629, x630, Self::mul_add(-x622, x623, x634));
+        let x636 = Self::mul_add(
+            -x602,
+            x609,
+            Self::mul_add(0.65, x580, Self::mul_add(-0.65, x593, 0.75 * x591)),
+        );
+        let x637 = Self::mul_add(
+            -x629,
+            x633,
+            Self::mul_add(-x622, x625, Self::mul_add(-x615, x618, x636)),
+        );
+        let x638 = x635 * x637;
+        let x639 = Self::mul_add(
+            -x617,
+            x618,
+            Self::mul_add(-x591, x609, Self::mul_add(0.65, x592, 1271.854575)),
+        );
+        let x640 = Self::mul_add(
+            -x637,
+            x638,
+            Self::mul_add(-x632, x633, Self::mul_add(-x624, x625, x639)),
+        );
+        let x641 = 1.0 / x640;
         let x642 = Self::mul_add(
-            x601,
+            x603,
             x605,
+            -(Self::mul_add(-v[3], x5, v[5] * x3) - f_ext[0][1] + x601),
+        );
+        let x643 = Self::mul_add(
+            -x612,
+            x642,
+            Self::mul_add(
+                x603,
+                x606,
+                -(Self::mul_add(-v[4], x3, v[3] * x4) - f_ext[0][2] + x567),
+            ),
+        );
+        let x644 = Self::mul_add(
+            x603,
+            x607,
             -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
                 - f_ext[0][3]
-                + Self::mul_add(-0.75, x599, Self::mul_add(-s_q7, x562, c_q7 * x561))),
+                + Self::mul_add(-0.75, x601, Self::mul_add(-s_q7, x564, c_q7 * x563))),
         );
-        let x643 = Self::mul_add(-x619, x641, Self::mul_add(-x612, x640, x642));
-        let x644 = Self::mul_add(
-            -x614,
-            x640,
+        let x645 = Self::mul_add(-x621, x643, Self::mul_add(-x614, x642, x644));
+        let x646 = Self::mul_add(
+            -x616,
+            x642,
             Self::mul_add(
-                x601,
-                x606,
+                x603,
+                x608,
                 -(Self::mul_add(-v[3], x2, v[5] * x0)
                     + Self::mul_add(-v[0], x5, v[2] * x3) - f_ext[0][4]
-                    + (Self::mul_add(c_q7, x562, s_q7 * x561)
-                        + Self::mul_add(-0.65, x565, 0.75 * x598))),
+                    + (Self::mul_add(c_q7, x564, s_q7 * x563)
+                        + Self::mul_add(-0.65, x567, 0.75 * x600))),
             ),
         );
-        let x645 = Self::mul_add(-x628, x643, Self::mul_add(-x621, x641, x644));
-        let x646 = Self::mul_add(
-            x601,
-            x607,
+        let x647 = Self::mul_add(-x630, x645, Self::mul_add(-x623, x643, x646));
+        let x648 = Self::mul_add(
+            x603,
+            x609,
             -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
                 - f_ext[0][5]
-                + Self::mul_add(0.65, x599, Self::mul_add(x540, x536 * x539, x538))),
+                + Self::mul_add(0.65, x601, Self::mul_add(x542, x538 * x541, x540))),
         );
-        let x647 = Self::mul_add(
-            -x631,
-            x643,
-            Self::mul_add(-x623, x641, Self::mul_add(-x616, x640, x646)),
+        let x649 = Self::mul_add(
+            -x633,
+            x645,
+            Self::mul_add(-x625, x643, Self::mul_add(-x618, x642, x648)),
         );
-        let x648 = x639 * Self::mul_add(-x636, x645, x647);
-        let x649 = Self::mul_add(-x636, x648, x633 * x645);
-        let x650 = Self::mul_add(-x631, x648, Self::mul_add(-x628, x649, x625 * x643));
-        let x651 = Self::mul_add(
-            -x623,
-            x648,
-            Self::mul_add(-x621, x649, Self::mul_add(-x619, x650, x617 * x641)),
-        );
-        let x652 = Self::mul_add(
-            -x614,
-            x649,
-            Self::mul_add(-x612, x650, Self::mul_add(-x610, x651, x608 * x640)),
-        );
-        let x653 = Self::mul_add(-x616, x648, x652);
-        let x654 = Self::mul_add(
-            x605,
+        let x650 = x641 * Self::mul_add(-x638, x647, x649);
+        let x651 = Self::mul_add(-x638, x650, x635 * x647);
+        let x652 = Self::mul_add(-x633, x650, Self::mul_add(-x630, x651, x627 * x645));
+        let x653 = Self::mul_add(
+            -x625,
             x650,
-            Self::mul_add(x604, x651, Self::mul_add(x603, x653, x601 * x602)),
+            Self::mul_add(-x623, x651, Self::mul_add(-x621, x652, x619 * x643)),
         );
-        let x655 = Self::mul_add(x607, x648, Self::mul_add(x606, x649, x654));
-        let x656 = -x655;
-        let x657 = Self::mul_add(-0.75, x649, x655);
-        let x658 = x653 - Self::mul_add(-0.65, x648, 0.75 * x650);
-        let x659 = Self::mul_add(-0.65, x649, x651);
-        let x660 = x14 + Self::mul_add(s_q7, x649, c_q7 * x650);
-        let x661 = Self::mul_add(-s_q7, x650, c_q7 * x649) - x15;
-        let x662 = x16 + Self::mul_add(-c_q7, x657, s_q7 * x658);
-        let x663 = Self::mul_add(c_q7, x658, s_q7 * x657) - x17;
-        let x664 = x539
-            * (x540
-                - (Self::mul_add(x536, x648, Self::mul_add(x535, x661, x534 * x660))
+        let x654 = Self::mul_add(
+            -x616,
+            x651,
+            Self::mul_add(-x614, x652, Self::mul_add(-x612, x653, x610 * x642)),
+        );
+        let x655 = Self::mul_add(-x618, x650, x654);
+        let x656 = Self::mul_add(
+            x607,
+            x652,
+            Self::mul_add(x606, x653, Self::mul_add(x605, x655, x603 * x604)),
+        );
+        let x657 = Self::mul_add(x609, x650, Self::mul_add(x608, x651, x656));
+        let x658 = -x657;
+        let x659 = Self::mul_add(-0.75, x651, x657);
+        let x660 = x655 - Self::mul_add(-0.65, x650, 0.75 * x652);
+        let x661 = Self::mul_add(-0.65, x651, x653);
+        let x662 = x14 + Self::mul_add(s_q7, x651, c_q7 * x652);
+        let x663 = Self::mul_add(-s_q7, x652, c_q7 * x651) - x15;
+        let x664 = x16 + Self::mul_add(-c_q7, x659, s_q7 * x660);
+        let x665 = Self::mul_add(c_q7, x660, s_q7 * x659) - x17;
+        let x666 = x541
+            * (x542
+                - (Self::mul_add(x538, x650, Self::mul_add(x537, x663, x536 * x662))
                     + Self::mul_add(
-                        x513,
-                        x659,
-                        Self::mul_add(x537, x663, x511 * x662),
+                        x515,
+                        x661,
+                        Self::mul_add(x539, x665, x513 * x664),
                     )));
-        let x665 = x648 + x664;
-        let x666 = Self::mul_add(-0.00000000020510342851533115, x665, x660);
-        let x667 = Self::mul_add(0.35, x661, x662);
-        let x668 = Self::mul_add(-0.35, x660, x663);
-        let x669 = Self::mul_add(-0.00000000020510342851533115, x659, x667);
-        let x670 = x34
-            + Self::mul_add(-c_q8, x665, Self::mul_add(s_q8, x661, x25 * x660));
-        let x671 = Self::mul_add(s_q8, x665, Self::mul_add(-x26, x660, c_q8 * x661))
+        let x667 = x650 + x666;
+        let x668 = Self::mul_add(-0.00000000020510342851533115, x667, x662);
+        let x669 = Self::mul_add(0.35, x663, x664);
+        let x670 = Self::mul_add(-0.35, x662, x665);
+        let x671 = Self::mul_add(-0.00000000020510342851533115, x661, x669);
+        let x672 = x34
+            + Self::mul_add(-c_q8, x667, Self::mul_add(s_q8, x663, x25 * x662));
+        let x673 = Self::mul_add(s_q8, x667, Self::mul_add(-x26, x662, c_q8 * x663))
             - x35;
-        let x672 = x36
-            + Self::mul_add(-c_q8, x659, Self::mul_add(s_q8, x668, x25 * x667));
-        let x673 = Self::mul_add(s_q8, x659, Self::mul_add(-x26, x667, c_q8 * x668))
+        let x674 = x36
+            + Self::mul_add(-c_q8, x661, Self::mul_add(s_q8, x670, x25 * x669));
+        let x675 = Self::mul_add(s_q8, x661, Self::mul_add(-x26, x669, c_q8 * x670))
             - x37;
-        let x674 = x468
-            * (x469
-                - (Self::mul_add(x464, x666, Self::mul_add(x463, x671, x462 * x670))
+        let x676 = x470
+            * (x471
+                - (Self::mul_add(x466, x668, Self::mul_add(x465, x673, x464 * x672))
                     + Self::mul_add(
-                        x454,
-                        x669,
-                        Self::mul_add(x466, x673, x465 * x672),
+                        x456,
+                        x671,
+                        Self::mul_add(x468, x675, x467 * x674),
                     )));
-        let x675 = x666 + x674;
-        let x676 = Self::mul_add(
+        let x677 = x668 + x676;
+        let x678 = Self::mul_add(
             -0.00000000020510342851533115,
-            x675,
-            Self::mul_add(0.00000000020510342851533115, x670, x671),
+            x677,
+            Self::mul_add(0.00000000020510342851533115, x672, x673),
         );
-        let x677 = x672 - Self::mul_add(0.275, x675, -0.4 * x671);
-        let x678 = Self::mul_add(-0.4, x670, x673);
-        let x679 = Self::mul_add(0.275, x670, x669);
-        let x680 = Self::mul_add(
+        let x679 = x674 - Self::mul_add(0.275, x677, -0.4 * x673);
+        let x680 = Self::mul_add(-0.4, x672, x675);
+        let x681 = Self::mul_add(0.275, x672, x671);
+        let x682 = Self::mul_add(
             -0.00000000020510342851533115,
-            x679,
-            Self::mul_add(0.00000000020510342851533115, x677, x678),
+            x681,
+            Self::mul_add(0.00000000020510342851533115, x679, x680),
         );
-        let x681 = x58 + Self::mul_add(c_q9, x675, Self::mul_add(x48, x671, x46 * x670));
-        let x682 = Self::mul_add(-s_q9, x675, Self::mul_add(x49, x671, x47 * x670))
+        let x683 = x56
+            + Self::mul_add(c_q9, x677, Self::mul_add(x46, x673, s_q9 * x672));
+        let x684 = Self::mul_add(-s_q9, x677, Self::mul_add(x47, x673, c_q9 * x672))
+            - x57;
+        let x685 = x58
+            + Self::mul_add(c_q9, x681, Self::mul_add(x46, x680, s_q9 * x679));
+        let x686 = Self::mul_add(-s_q9, x681, Self::mul_add(x47, x680, c_q9 * x679))
             - x59;
-        let x683 = x60 + Self::mul_add(c_q9, x679, Self::mul_add(x48, x678, x46 * x677));
-        let x684 = Self::mul_add(-s_q9, x679, Self::mul_add(x49, x678, x47 * x677))
-            - x61;
-        let x685 = x391
-            * (x392
-                - (Self::mul_add(x388, x676, Self::mul_add(x387, x682, x386 * x681))
+        let x687 = x389
+            * (x390
+                - (Self::mul_add(x386, x678, Self::mul_add(x385, x684, x384 * x683))
                     + Self::mul_add(
-                        x382,
-                        x680,
-                        Self::mul_add(x381, x684, x389 * x683),
+                        x380,
+                        x682,
+                        Self::mul_add(x379, x686, x387 * x685),
                     )));
-        let x686 = x676 + x685;
-        let x687 = Self::mul_add(0.87, x686, x683);
-        let x688 = Self::mul_add(-0.87, x681, x680);
-        let x689 = x75 + Self::mul_add(s_q10, x682, c_q10 * x681);
-        let x690 = Self::mul_add(-s_q10, x681, c_q10 * x682) - x76;
-        let x691 = x77 + Self::mul_add(s_q10, x684, c_q10 * x687);
-        let x692 = Self::mul_add(-s_q10, x687, c_q10 * x684) - x78;
-        let x693 = x333
-            * (x334
-                - (Self::mul_add(x330, x686, Self::mul_add(x329, x690, x328 * x689))
+        let x688 = x678 + x687;
+        let x689 = Self::mul_add(0.87, x688, x685);
+        let x690 = Self::mul_add(-0.87, x683, x682);
+        let x691 = x73 + Self::mul_add(s_q10, x684, c_q10 * x683);
+        let x692 = Self::mul_add(-s_q10, x683, c_q10 * x684) - x74;
+        let x693 = x75 + Self::mul_add(s_q10, x686, c_q10 * x689);
+        let x694 = Self::mul_add(-s_q10, x689, c_q10 * x686) - x76;
+        let x695 = x331
+            * (x332
+                - (Self::mul_add(x328, x688, Self::mul_add(x327, x692, x326 * x691))
                     + Self::mul_add(
-                        x319,
-                        x688,
-                        Self::mul_add(x318, x692, x331 * x691),
+                        x317,
+                        x690,
+                        Self::mul_add(x316, x694, x329 * x693),
                     )));
-        let x694 = x686 + x693;
-        let x695 = x691 - Self::mul_add(-0.63, x694, 0.275 * x690);
-        let x696 = Self::mul_add(0.275, x689, x692);
-        let x697 = Self::mul_add(-0.63, x689, x688);
-        let x698 = x93 + Self::mul_add(s_q11, x690, c_q11 * x689);
-        let x699 = Self::mul_add(-s_q11, x689, c_q11 * x690) - x94;
-        let x700 = x95 + Self::mul_add(s_q11, x696, c_q11 * x695);
-        let x701 = Self::mul_add(-s_q11, x695, c_q11 * x696) - x96;
-        let x702 = x269
-            * (x270
-                - (Self::mul_add(x266, x694, Self::mul_add(x265, x699, x264 * x698))
+        let x696 = x688 + x695;
+        let x697 = x693 - Self::mul_add(-0.63, x696, 0.275 * x692);
+        let x698 = Self::mul_add(0.275, x691, x694);
+        let x699 = Self::mul_add(-0.63, x691, x690);
+        let x700 = x91 + Self::mul_add(s_q11, x692, c_q11 * x691);
+        let x701 = Self::mul_add(-s_q11, x691, c_q11 * x692) - x92;
+        let x702 = x93 + Self::mul_add(s_q11, x698, c_q11 * x697);
+        let x703 = Self::mul_add(-s_q11, x697, c_q11 * x698) - x94;
+        let x704 = x267
+            * (x268
+                - (Self::mul_add(x264, x696, Self::mul_add(x263, x701, x262 * x700))
                     + Self::mul_add(
-                        -x243,
-                        x697,
-                        Self::mul_add(-x242, x701, x267 * x700),
+                        -x241,
+                        x699,
+                        Self::mul_add(-x240, x703, x265 * x702),
                     )));
-        let x703 = x694 + x702;
-        let x704 = Self::mul_add(-0.00000000020510342851533115, x703, x699);
-        let x705 = Self::mul_add(-0.36, x699, x700);
-        let x706 = Self::mul_add(0.36, x698, x701);
-        let x707 = Self::mul_add(-0.00000000020510342851533115, x697, x706);
-        let x708 = x113
-            + Self::mul_add(-s_q12, x703, Self::mul_add(x104, x699, c_q12 * x698));
-        let x709 = Self::mul_add(-c_q12, x703, Self::mul_add(-s_q12, x698, x105 * x699))
+        let x705 = x696 + x704;
+        let x706 = Self::mul_add(-0.00000000020510342851533115, x705, x701);
+        let x707 = Self::mul_add(-0.36, x701, x702);
+        let x708 = Self::mul_add(0.36, x700, x703);
+        let x709 = Self::mul_add(-0.00000000020510342851533115, x699, x708);
+        let x710 = x111
+            + Self::mul_add(-s_q12, x705, Self::mul_add(x102, x701, c_q12 * x700));
+        let x711 = Self::mul_add(-c_q12, x705, Self::mul_add(-s_q12, x700, x103 * x701))
+            - x112;
+        let x712 = x113
+            + Self::mul_add(-s_q12, x699, Self::mul_add(x102, x708, c_q12 * x707));
+        let x713 = Self::mul_add(-c_q12, x699, Self::mul_add(-s_q12, x707, x103 * x708))
             - x114;
-        let x710 = x115
-            + Self::mul_add(-s_q12, x697, Self::mul_add(x104, x706, c_q12 * x705));
-        let x711 = Self::mul_add(-c_q12, x697, Self::mul_add(-s_q12, x705, x105 * x706))
-            - x116;
-        let x712 = x198
-            * (x199
-                - (Self::mul_add(x194, x704, Self::mul_add(x193, x709, x192 * x708))
+        let x714 = x196
+            * (x197
+                - (Self::mul_add(x192, x706, Self::mul_add(x191, x711, x190 * x710))
                     + Self::mul_add(
-                        -x184,
-                        x707,
-                        Self::mul_add(x196, x711, x195 * x710),
+                        -x182,
+                        x709,
+                        Self::mul_add(x194, x713, x193 * x712),
                     )));
-        let x713 = x704 + x712;
-        let x714 = Self::mul_add(
+        let x715 = x706 + x714;
+        let x716 = Self::mul_add(
             -c_q13,
-            Self::mul_add(0.55, x708, x707),
+            Self::mul_add(0.55, x710, x709),
             Self::mul_add(
                 s_q13,
-                Self::mul_add(-0.16, x708, x711),
-                x125 * (x710 - Self::mul_add(0.55, x713, -0.16 * x709)),
+                Self::mul_add(-0.16, x710, x713),
+                x123 * (x712 - Self::mul_add(0.55, x715, -0.16 * x711)),
             ),
         );
-        let x715 = Self::mul_add(
+        let x717 = Self::mul_add(
             -0.9614610000000001,
-            Self::mul_add(s_q13, x713, Self::mul_add(-x126, x708, c_q13 * x709)) - x136,
+            Self::mul_add(s_q13, x715, Self::mul_add(-x124, x710, c_q13 * x711)) - x134,
             -0.0145
-                * (x135
+                * (x133
                     + Self::mul_add(
                         -c_q13,
-                        x713,
-                        Self::mul_add(s_q13, x709, x125 * x708),
+                        x715,
+                        Self::mul_add(s_q13, x711, x123 * x710),
                     )),
         );
-        let x716 = Self::mul_add(
+        let x718 = Self::mul_add(
             -4.806620000000001,
-            x137 + x714,
+            x135 + x716,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x713, x708),
-                x715,
+                Self::mul_add(-0.00000000020510342851533115, x715, x710),
+                x717,
             ),
         );
-        let x717 = 0.707433253035886 * (x146 - x716);
-        [x656, x653, x651, x650, x649, x648, x664, x674, x685, x693, x702, x712, x717]
+        let x719 = 0.707433253035886 * (x144 - x718);
+        [x658, x655, x653, x652, x651, x650, x666, x676, x687, x695, x704, x714, x719]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
-    /// : 356 mul, 285 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 223 fused where the target has FMA.
+    /// : 354 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 221 fused where the target has FMA.
     #[must_use]
     pub fn momentum(q: &[f64; 14], v: &[f64; 13]) -> [f64; 6] {
         let x0 = q[6] * 2.0;
@@ -7528,76 +7499,74 @@ impl FreeFloating7 {
         let x36 = Self::mul_add(-0.00000000020510342851533115, x24, x32);
         let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x26, x20);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x39 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x40 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x41 = Self::mul_add(
+        let x39 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x42 = Self::mul_add(
+        let x40 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x43 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x41, x30 * x39));
-        let x44 = Self::mul_add(-x37, s_q9, Self::mul_add(x31, x42, x30 * x40));
-        let x45 = x34 - Self::mul_add(0.275, x37, x31 * -0.4);
-        let x46 = Self::mul_add(-0.4, x30, x35);
-        let x47 = Self::mul_add(0.275, x30, x36);
-        let x48 = Self::mul_add(c_q9, x47, Self::mul_add(x41, x46, x39 * x45));
-        let x49 = Self::mul_add(-s_q9, x47, Self::mul_add(x42, x46, x40 * x45));
-        let x50 = Self::mul_add(
+        let x41 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x39, x30 * s_q9));
+        let x42 = Self::mul_add(-x37, s_q9, Self::mul_add(x31, x40, x30 * c_q9));
+        let x43 = x34 - Self::mul_add(0.275, x37, x31 * -0.4);
+        let x44 = Self::mul_add(-0.4, x30, x35);
+        let x45 = Self::mul_add(0.275, x30, x36);
+        let x46 = Self::mul_add(c_q9, x45, Self::mul_add(x39, x44, s_q9 * x43));
+        let x47 = Self::mul_add(-s_q9, x45, Self::mul_add(x40, x44, c_q9 * x43));
+        let x48 = Self::mul_add(
             -0.00000000020510342851533115,
-            x47,
-            Self::mul_add(0.00000000020510342851533115, x45, x46),
+            x45,
+            Self::mul_add(0.00000000020510342851533115, x43, x44),
         );
-        let x51 = v[8]
+        let x49 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
                 Self::mul_add(0.00000000020510342851533115, x30, x31),
             );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x53 = Self::mul_add(x44, s_q10, x43 * c_q10);
-        let x54 = Self::mul_add(-x43, s_q10, x44 * c_q10);
-        let x55 = Self::mul_add(0.87, x51, x48);
-        let x56 = Self::mul_add(x43, -0.87, x50);
-        let x57 = Self::mul_add(x49, s_q10, c_q10 * x55);
-        let x58 = v[9] + x51;
+        let x51 = Self::mul_add(x42, s_q10, x41 * c_q10);
+        let x52 = Self::mul_add(-x41, s_q10, x42 * c_q10);
+        let x53 = Self::mul_add(0.87, x49, x46);
+        let x54 = Self::mul_add(x41, -0.87, x48);
+        let x55 = Self::mul_add(x47, s_q10, c_q10 * x53);
+        let x56 = v[9] + x49;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x60 = Self::mul_add(x54, s_q11, x53 * c_q11);
-        let x61 = Self::mul_add(-x53, s_q11, x54 * c_q11);
-        let x62 = x57 - Self::mul_add(-0.63, x58, 0.275 * x54);
-        let x63 = Self::mul_add(0.275, x53, Self::mul_add(-s_q10, x55, x49 * c_q10));
-        let x64 = Self::mul_add(x53, -0.63, x56);
-        let x65 = Self::mul_add(s_q11, x63, c_q11 * x62);
-        let x66 = v[10] + x58;
+        let x58 = Self::mul_add(x52, s_q11, x51 * c_q11);
+        let x59 = Self::mul_add(-x51, s_q11, x52 * c_q11);
+        let x60 = x55 - Self::mul_add(-0.63, x56, 0.275 * x52);
+        let x61 = Self::mul_add(0.275, x51, Self::mul_add(-s_q10, x53, x47 * c_q10));
+        let x62 = Self::mul_add(x51, -0.63, x54);
+        let x63 = Self::mul_add(s_q11, x61, c_q11 * x60);
+        let x64 = v[10] + x56;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x68 = -0.00000000020510342851533115 * s_q12;
-        let x69 = -0.00000000020510342851533115 * c_q12;
-        let x70 = Self::mul_add(-x66, s_q12, Self::mul_add(x61, x68, x60 * c_q12));
-        let x71 = Self::mul_add(-x66, c_q12, Self::mul_add(-x60, s_q12, x61 * x69));
-        let x72 = Self::mul_add(x61, -0.36, x65);
-        let x73 = Self::mul_add(0.36, x60, Self::mul_add(-s_q11, x62, c_q11 * x63));
-        let x74 = Self::mul_add(-x64, s_q12, Self::mul_add(x68, x73, c_q12 * x72));
-        let x75 = Self::mul_add(-x64, c_q12, Self::mul_add(-s_q12, x72, x69 * x73));
-        let x76 = Self::mul_add(-0.00000000020510342851533115, x64, x73);
-        let x77 = v[11] + Self::mul_add(-0.00000000020510342851533115, x66, x61);
+        let x66 = -0.00000000020510342851533115 * s_q12;
+        let x67 = -0.00000000020510342851533115 * c_q12;
+        let x68 = Self::mul_add(-x64, s_q12, Self::mul_add(x59, x66, x58 * c_q12));
+        let x69 = Self::mul_add(-x64, c_q12, Self::mul_add(-x58, s_q12, x59 * x67));
+        let x70 = Self::mul_add(x59, -0.36, x63);
+        let x71 = Self::mul_add(0.36, x58, Self::mul_add(-s_q11, x60, c_q11 * x61));
+        let x72 = Self::mul_add(-x62, s_q12, Self::mul_add(x66, x71, c_q12 * x70));
+        let x73 = Self::mul_add(-x62, c_q12, Self::mul_add(-s_q12, x70, x67 * x71));
+        let x74 = Self::mul_add(-0.00000000020510342851533115, x62, x71);
+        let x75 = v[11] + Self::mul_add(-0.00000000020510342851533115, x64, x59);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x79 = -0.00000000020510342851533115 * c_q13;
-        let x80 = -0.00000000020510342851533115 * s_q13;
-        let x81 = Self::mul_add(-x77, c_q13, Self::mul_add(x71, s_q13, x70 * x79));
-        let x82 = Self::mul_add(x77, s_q13, Self::mul_add(-x70, x80, x71 * c_q13));
-        let x83 = x74 - Self::mul_add(0.55, x77, -0.16 * x71);
-        let x84 = Self::mul_add(x70, 0.55, x76);
-        let x85 = Self::mul_add(
+        let x77 = -0.00000000020510342851533115 * c_q13;
+        let x78 = -0.00000000020510342851533115 * s_q13;
+        let x79 = Self::mul_add(-x75, c_q13, Self::mul_add(x69, s_q13, x68 * x77));
+        let x80 = Self::mul_add(x75, s_q13, Self::mul_add(-x68, x78, x69 * c_q13));
+        let x81 = x72 - Self::mul_add(0.55, x75, -0.16 * x69);
+        let x82 = Self::mul_add(x68, 0.55, x74);
+        let x83 = Self::mul_add(
             -c_q13,
-            x84,
-            Self::mul_add(s_q13, Self::mul_add(-0.16, x70, x75), x79 * x83),
+            x82,
+            Self::mul_add(s_q13, Self::mul_add(-0.16, x68, x73), x77 * x81),
         );
-        let x86 = v[12] + Self::mul_add(-0.00000000020510342851533115, x77, x70);
-        let x87 = Self::mul_add(
+        let x84 = v[12] + Self::mul_add(-0.00000000020510342851533115, x75, x68);
+        let x85 = Self::mul_add(
             x24,
             -48.0240000085309,
             Self::mul_add(
@@ -7606,7 +7575,7 @@ impl FreeFloating7 {
                 Self::mul_add(130.43769025763282, x21, -0.07309 * x20),
             ),
         );
-        let x88 = Self::mul_add(
+        let x86 = Self::mul_add(
             48.0240000085309,
             x25,
             Self::mul_add(
@@ -7615,7 +7584,7 @@ impl FreeFloating7 {
                 Self::mul_add(0.1132, x21, -16.80768997608804 * x20),
             ),
         );
-        let x89 = Self::mul_add(
+        let x87 = Self::mul_add(
             x36,
             0.000000008530897668050218,
             Self::mul_add(
@@ -7624,245 +7593,245 @@ impl FreeFloating7 {
                 Self::mul_add(-111.7548902508081, x31, -0.0000000234896432582596 * x30),
             ),
         );
-        let x90 = Self::mul_add(
-            x48,
+        let x88 = Self::mul_add(
+            x46,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x51,
-                Self::mul_add(-36.18604050126307, x44, -0.00214 * x43),
+                x49,
+                Self::mul_add(-36.18604050126307, x42, -0.00214 * x41),
             ),
         );
-        let x91 = Self::mul_add(
-            x57,
+        let x89 = Self::mul_add(
+            x55,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x58,
-                Self::mul_add(-24.351642000914637, x54, -0.6328 * x53),
+                x56,
+                Self::mul_add(-24.351642000914637, x52, -0.6328 * x51),
             ),
         );
-        let x92 = Self::mul_add(
-            x65,
+        let x90 = Self::mul_add(
+            x63,
             -7.078399999258757,
             Self::mul_add(
                 9.223235249762805,
-                x66,
-                Self::mul_add(2.5482240016099564, x61, 0.01675 * x60),
+                x64,
+                Self::mul_add(2.5482240016099564, x59, 0.01675 * x58),
             ),
         );
-        let x93 = Self::mul_add(
-            x76,
+        let x91 = Self::mul_add(
+            x74,
             -3.6140000000000003,
             Self::mul_add(
                 -2.741639999592316,
-                x77,
-                Self::mul_add(-5.252920330000002, x71, -1.9877000000000002 * x70),
+                x75,
+                Self::mul_add(-5.252920330000002, x69, -1.9877000000000002 * x68),
             ),
         );
-        let x94 = Self::mul_add(
+        let x92 = Self::mul_add(
             -0.9614610000000001,
-            x86,
-            Self::mul_add(-1.2025609200000003, x82, 0.000781 * x81),
+            x84,
+            Self::mul_add(-1.2025609200000003, x80, 0.000781 * x79),
         );
-        let x95 = Self::mul_add(
+        let x93 = Self::mul_add(
             4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x84, x83),
-            Self::mul_add(-0.0145, x86, 0.000781 * x82),
+            Self::mul_add(-0.00000000020510342851533115, x82, x81),
+            Self::mul_add(-0.0145, x84, 0.000781 * x80),
         );
-        let x96 = Self::mul_add(
-            x85,
+        let x94 = Self::mul_add(
+            x83,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x86,
-                Self::mul_add(-0.9614610000000001, x82, -0.0145 * x81),
+                x84,
+                Self::mul_add(-0.9614610000000001, x80, -0.0145 * x79),
             ),
         );
-        let x97 = 4.806620000000001 * x86;
-        let x98 = x81 * -4.806620000000001;
-        let x99 = Self::mul_add(x79, x97, x98);
-        let x100 = s_q13 * x97;
-        let x101 = Self::mul_add(0.00000000020510342851533115, x98, c_q13 * x97);
-        let x102 = Self::mul_add(
+        let x95 = 4.806620000000001 * x84;
+        let x96 = x79 * -4.806620000000001;
+        let x97 = Self::mul_add(x77, x95, x96);
+        let x98 = s_q13 * x95;
+        let x99 = Self::mul_add(0.00000000020510342851533115, x96, c_q13 * x95);
+        let x100 = Self::mul_add(
             0.55,
-            x99,
+            x97,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x96,
-                Self::mul_add(-c_q13, x95, s_q13 * x94),
+                x94,
+                Self::mul_add(-c_q13, x93, s_q13 * x92),
             ),
         );
-        let x103 = Self::mul_add(
+        let x101 = Self::mul_add(
             17.135250000000003,
-            x76,
-            Self::mul_add(-0.809539999555672, x77, -1.9877000000000002 * x71),
+            x74,
+            Self::mul_add(-0.809539999555672, x75, -1.9877000000000002 * x69),
         )
-            + (x96 + Self::mul_add(-x80, x94, x79 * x95)
-                + Self::mul_add(0.16, x100, 0.55 * x101));
-        let x104 = x93
-            + Self::mul_add(-0.16, x99, Self::mul_add(c_q13, x94, s_q13 * x95));
-        let x105 = Self::mul_add(
+            + (x94 + Self::mul_add(-x78, x92, x77 * x93)
+                + Self::mul_add(0.16, x98, 0.55 * x99));
+        let x102 = x91
+            + Self::mul_add(-0.16, x97, Self::mul_add(c_q13, x92, s_q13 * x93));
+        let x103 = Self::mul_add(
             9.740442170000001,
-            x77,
-            Self::mul_add(-2.7416399995923166, x71, -0.809539999555672 * x70),
-        ) + Self::mul_add(3.6140000000000003, x75, x74 * -17.135250000000003) + x102;
-        let x106 = Self::mul_add(17.135250000000003, x77, x99);
-        let x107 = Self::mul_add(x77, -3.6140000000000003, x100);
-        let x108 = x101
-            - Self::mul_add(3.6140000000000003, x71, x70 * -17.135250000000003);
-        let x109 = Self::mul_add(-c_q12, x106, s_q12 * x107);
-        let x110 = x108 - Self::mul_add(x69, x107, x68 * x106);
-        let x111 = Self::mul_add(7.078399999258757, x64, 0.01675 * x66)
-            + Self::mul_add(0.36, x110, Self::mul_add(-s_q12, x104, c_q12 * x103));
-        let x112 = Self::mul_add(2.5482240016099564, x66, -9.142025249762803 * x61)
-            + Self::mul_add(-0.36, x109, x105 + Self::mul_add(x69, x104, x68 * x103));
-        let x113 = Self::mul_add(-7.078399999258757, x66, x109);
-        let x114 = Self::mul_add(
-            x60,
+            x75,
+            Self::mul_add(-2.7416399995923166, x69, -0.809539999555672 * x68),
+        ) + Self::mul_add(3.6140000000000003, x73, x72 * -17.135250000000003) + x100;
+        let x104 = Self::mul_add(17.135250000000003, x75, x97);
+        let x105 = Self::mul_add(x75, -3.6140000000000003, x98);
+        let x106 = x99
+            - Self::mul_add(3.6140000000000003, x69, x68 * -17.135250000000003);
+        let x107 = Self::mul_add(-c_q12, x104, s_q12 * x105);
+        let x108 = x106 - Self::mul_add(x67, x105, x66 * x104);
+        let x109 = Self::mul_add(7.078399999258757, x62, 0.01675 * x64)
+            + Self::mul_add(0.36, x108, Self::mul_add(-s_q12, x102, c_q12 * x101));
+        let x110 = Self::mul_add(2.5482240016099564, x64, -9.142025249762803 * x59)
+            + Self::mul_add(-0.36, x107, x103 + Self::mul_add(x67, x102, x66 * x101));
+        let x111 = Self::mul_add(-7.078399999258757, x64, x107);
+        let x112 = Self::mul_add(
+            x58,
             7.078399999258757,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x108,
-                Self::mul_add(c_q12, x107, s_q12 * x106),
+                x106,
+                Self::mul_add(c_q12, x105, s_q12 * x104),
             ),
         );
-        let x115 = Self::mul_add(-s_q11, x110, c_q11 * x113);
-        let x116 = Self::mul_add(c_q11, x110, s_q11 * x113);
-        let x117 = Self::mul_add(
+        let x113 = Self::mul_add(-s_q11, x108, c_q11 * x111);
+        let x114 = Self::mul_add(c_q11, x108, s_q11 * x111);
+        let x115 = Self::mul_add(
             0.63,
-            x115,
-            x92
+            x113,
+            x90
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x105,
-                    -Self::mul_add(c_q12, x104, s_q12 * x103),
+                    x103,
+                    -Self::mul_add(c_q12, x102, s_q12 * x101),
                 ),
         );
-        let x118 = Self::mul_add(-45.1584, x56, -0.6328 * x58)
-            + (Self::mul_add(-s_q11, x112, c_q11 * x111)
-                + Self::mul_add(-0.63, x114, 0.275 * x116));
-        let x119 = Self::mul_add(-24.35164200091464, x58, -24.4950615 * x54)
-            + Self::mul_add(-0.275, x115, Self::mul_add(c_q11, x112, s_q11 * x111));
-        let x120 = Self::mul_add(45.1584, x58, x115);
-        let x121 = Self::mul_add(x53, -45.1584, x114);
-        let x122 = Self::mul_add(-s_q10, x116, c_q10 * x120);
-        let x123 = Self::mul_add(c_q10, x116, s_q10 * x120);
-        let x124 = Self::mul_add(-81.53205, x50, -0.00214 * x51)
-            + Self::mul_add(-0.87, x121, Self::mul_add(-s_q10, x119, c_q10 * x118));
-        let x125 = Self::mul_add(-36.18604050126307, x51, -63.36336825000001 * x44)
-            + Self::mul_add(c_q10, x119, s_q10 * x118);
-        let x126 = x90 + Self::mul_add(0.87, x122, x91 + x117);
-        let x127 = Self::mul_add(81.53205, x51, x122);
-        let x128 = Self::mul_add(x43, -81.53205, x121);
-        let x129 = Self::mul_add(
+        let x116 = Self::mul_add(-45.1584, x54, -0.6328 * x56)
+            + (Self::mul_add(-s_q11, x110, c_q11 * x109)
+                + Self::mul_add(-0.63, x112, 0.275 * x114));
+        let x117 = Self::mul_add(-24.35164200091464, x56, -24.4950615 * x52)
+            + Self::mul_add(-0.275, x113, Self::mul_add(c_q11, x110, s_q11 * x109));
+        let x118 = Self::mul_add(45.1584, x56, x113);
+        let x119 = Self::mul_add(x51, -45.1584, x112);
+        let x120 = Self::mul_add(-s_q10, x114, c_q10 * x118);
+        let x121 = Self::mul_add(c_q10, x114, s_q10 * x118);
+        let x122 = Self::mul_add(-81.53205, x48, -0.00214 * x49)
+            + Self::mul_add(-0.87, x119, Self::mul_add(-s_q10, x117, c_q10 * x116));
+        let x123 = Self::mul_add(-36.18604050126307, x49, -63.36336825000001 * x42)
+            + Self::mul_add(c_q10, x117, s_q10 * x116);
+        let x124 = x88 + Self::mul_add(0.87, x120, x89 + x115);
+        let x125 = Self::mul_add(81.53205, x49, x120);
+        let x126 = Self::mul_add(x41, -81.53205, x119);
+        let x127 = Self::mul_add(
             0.00000000020510342851533115,
-            x128,
-            Self::mul_add(x40, x123, x39 * x127),
+            x126,
+            Self::mul_add(c_q9, x121, s_q9 * x125),
         );
-        let x130 = x128 + Self::mul_add(x42, x123, x41 * x127);
-        let x131 = Self::mul_add(
+        let x128 = x126 + Self::mul_add(x40, x121, x39 * x125);
+        let x129 = Self::mul_add(
             -0.00000000020510342851533115,
-            x128,
-            Self::mul_add(-s_q9, x123, c_q9 * x127),
+            x126,
+            Self::mul_add(-s_q9, x121, c_q9 * x125),
         );
-        let x132 = Self::mul_add(
+        let x130 = Self::mul_add(
             -0.275,
-            x129,
+            x127,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x126,
-                Self::mul_add(-s_q9, x125, c_q9 * x124),
+                x124,
+                Self::mul_add(-s_q9, x123, c_q9 * x122),
             ),
         );
-        let x133 = Self::mul_add(
+        let x131 = Self::mul_add(
             -12.701650001451807,
             x36,
-            Self::mul_add(-0.0021399965876409276, x37, -0.0000000234896432582596 * x31),
+            Self::mul_add(-0.002139996587640933, x37, -0.0000000234896432582596 * x31),
         )
             + (Self::mul_add(
                 0.00000000020510342851533115,
-                x126,
-                Self::mul_add(x40, x125, x39 * x124),
-            ) + Self::mul_add(0.275, x131, -0.4 * x130));
-        let x134 = x89
-            + Self::mul_add(0.4, x129, x126 + Self::mul_add(x42, x125, x41 * x124));
-        let x135 = Self::mul_add(
+                x124,
+                Self::mul_add(c_q9, x123, s_q9 * x122),
+            ) + Self::mul_add(0.275, x129, -0.4 * x128));
+        let x132 = x87
+            + Self::mul_add(0.4, x127, x124 + Self::mul_add(x40, x123, x39 * x122));
+        let x133 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(5.080660024070366, x31, -0.0021399965876409276 * x30),
+            Self::mul_add(5.080660024070366, x31, -0.002139996587640933 * x30),
         ) + Self::mul_add(-0.000000008530897668050218, x35, x34 * 12.701650001451807)
-            + x132;
-        let x136 = Self::mul_add(12.701650001451807, x37, x129);
-        let x137 = Self::mul_add(x37, -0.000000008530897668050218, x130);
-        let x138 = x131
+            + x130;
+        let x134 = Self::mul_add(12.701650001451807, x37, x127);
+        let x135 = Self::mul_add(x37, -0.000000008530897668050218, x128);
+        let x136 = x129
             - Self::mul_add(-0.000000008530897668050218, x31, x30 * 12.701650001451807);
-        let x139 = x138 + Self::mul_add(-x29, x137, x28 * x136);
-        let x140 = Self::mul_add(c_q8, x137, s_q8 * x136);
-        let x141 = Self::mul_add(-16.80768997608804, x26, -0.07309 * x21)
-            + Self::mul_add(-0.35, x140, x135 + Self::mul_add(-x29, x134, x28 * x133));
-        let x142 = x87
-            + Self::mul_add(0.35, x139, Self::mul_add(c_q8, x134, s_q8 * x133));
-        let x143 = Self::mul_add(x26, 48.0240000085309, x140);
-        let x144 = Self::mul_add(
+        let x137 = x136 + Self::mul_add(-x29, x135, x28 * x134);
+        let x138 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x139 = Self::mul_add(-16.80768997608804, x26, -0.07309 * x21)
+            + Self::mul_add(-0.35, x138, x133 + Self::mul_add(-x29, x132, x28 * x131));
+        let x140 = x85
+            + Self::mul_add(0.35, x137, Self::mul_add(c_q8, x132, s_q8 * x131));
+        let x141 = Self::mul_add(x26, 48.0240000085309, x138);
+        let x142 = Self::mul_add(
             -48.0240000085309,
             x21,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x138,
-                Self::mul_add(-c_q8, x136, s_q8 * x137),
+                x136,
+                Self::mul_add(-c_q8, x134, s_q8 * x135),
             ),
         );
-        let x145 = Self::mul_add(-s_q7, x143, c_q7 * x139);
-        let x146 = Self::mul_add(c_q7, x143, s_q7 * x139);
-        let x147 = Self::mul_add(
+        let x143 = Self::mul_add(-s_q7, x141, c_q7 * x137);
+        let x144 = Self::mul_add(c_q7, x141, s_q7 * x137);
+        let x145 = Self::mul_add(
             0.65,
-            x146,
-            x88
+            x144,
+            x86
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x135,
-                    Self::mul_add(-c_q8, x133, s_q8 * x134),
+                    x133,
+                    Self::mul_add(-c_q8, x131, s_q8 * x132),
                 ),
         );
-        let x148 = Self::mul_add(
+        let x146 = Self::mul_add(
             v[1],
             -180.9502499901501,
             Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
-        ) + Self::mul_add(-0.75, x146, Self::mul_add(-s_q7, x142, c_q7 * x141));
-        let x149 = Self::mul_add(
+        ) + Self::mul_add(-0.75, x144, Self::mul_add(-s_q7, x140, c_q7 * x139));
+        let x147 = Self::mul_add(
             1466.4506062283303,
             v[4],
             Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
         )
-            + (Self::mul_add(c_q7, x142, s_q7 * x141)
-                + Self::mul_add(-0.65, x144, 0.75 * x145));
-        let x150 = Self::mul_add(
+            + (Self::mul_add(c_q7, x140, s_q7 * x139)
+                + Self::mul_add(-0.65, x142, 0.75 * x143));
+        let x148 = Self::mul_add(
             110.5455,
             v[1],
             Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
-        ) + x147;
-        let x151 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]) + x145;
-        let x152 = Self::mul_add(
+        ) + x145;
+        let x149 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]) + x143;
+        let x150 = Self::mul_add(
             1170.07,
             v[1],
             -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
-        ) + x146;
-        let x153 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x144;
-        let x154 = Self::mul_add(x12, x153, Self::mul_add(x11, x152, x10 * x151));
-        let x155 = Self::mul_add(x15, x153, Self::mul_add(x14, x152, x13 * x151));
-        let x156 = Self::mul_add(x18, x153, Self::mul_add(x17, x152, x16 * x151));
-        let x157 = Self::mul_add(x12, x150, Self::mul_add(x11, x149, x10 * x148))
-            + Self::mul_add(-q[2], x155, q[1] * x156);
-        let x158 = Self::mul_add(x15, x150, Self::mul_add(x14, x149, x13 * x148))
-            + Self::mul_add(-q[0], x156, q[2] * x154);
-        let x159 = Self::mul_add(x18, x150, Self::mul_add(x17, x149, x16 * x148))
-            + Self::mul_add(-q[1], x154, q[0] * x155);
-        [x154, x155, x156, x157, x158, x159]
+        ) + x144;
+        let x151 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x142;
+        let x152 = Self::mul_add(x12, x151, Self::mul_add(x11, x150, x10 * x149));
+        let x153 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149));
+        let x154 = Self::mul_add(x18, x151, Self::mul_add(x17, x150, x16 * x149));
+        let x155 = Self::mul_add(x12, x148, Self::mul_add(x11, x147, x10 * x146))
+            + Self::mul_add(-q[2], x153, q[1] * x154);
+        let x156 = Self::mul_add(x15, x148, Self::mul_add(x14, x147, x13 * x146))
+            + Self::mul_add(-q[0], x154, q[2] * x152);
+        let x157 = Self::mul_add(x18, x148, Self::mul_add(x17, x147, x16 * x146))
+            + Self::mul_add(-q[1], x152, q[0] * x153);
+        [x152, x153, x154, x155, x156, x157]
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
-    /// Methods: bias `recurrent`: 694 mul, 568 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 434 fused where the target has FMA.
+    /// Methods: bias `recurrent`: 692 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 432 fused where the target has FMA.
     #[must_use]
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
@@ -7960,532 +7929,529 @@ impl FreeFloating7 {
         let x48 = Self::mul_add(x29, 6.0, 30.0 * x32);
         let x49 = Self::mul_add(-6.0, x28, 30.0 * x33);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x51 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x52 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x53 = Self::mul_add(
+        let x51 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x54 = Self::mul_add(
+        let x52 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x55 = Self::mul_add(x35, c_q9, Self::mul_add(x29, x53, x28 * x51));
-        let x56 = Self::mul_add(-x35, s_q9, Self::mul_add(x29, x54, x28 * x52));
-        let x57 = x32 - Self::mul_add(0.275, x35, x29 * -0.4);
-        let x58 = Self::mul_add(-0.4, x28, x33);
-        let x59 = Self::mul_add(0.275, x28, x34);
-        let x60 = Self::mul_add(c_q9, x59, Self::mul_add(x53, x58, x51 * x57));
-        let x61 = Self::mul_add(-s_q9, x59, Self::mul_add(x54, x58, x52 * x57));
-        let x62 = Self::mul_add(
+        let x53 = Self::mul_add(x35, c_q9, Self::mul_add(x29, x51, x28 * s_q9));
+        let x54 = Self::mul_add(-x35, s_q9, Self::mul_add(x29, x52, x28 * c_q9));
+        let x55 = x32 - Self::mul_add(0.275, x35, x29 * -0.4);
+        let x56 = Self::mul_add(-0.4, x28, x33);
+        let x57 = Self::mul_add(0.275, x28, x34);
+        let x58 = Self::mul_add(c_q9, x57, Self::mul_add(x51, x56, s_q9 * x55));
+        let x59 = Self::mul_add(-s_q9, x57, Self::mul_add(x52, x56, c_q9 * x55));
+        let x60 = Self::mul_add(
             -0.00000000020510342851533115,
-            x59,
-            Self::mul_add(0.00000000020510342851533115, x57, x58),
+            x57,
+            Self::mul_add(0.00000000020510342851533115, x55, x56),
         );
-        let x63 = v[8]
+        let x61 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x35,
                 Self::mul_add(0.00000000020510342851533115, x28, x29),
             );
-        let x64 = x42 - Self::mul_add(0.275, x39, x41 * -0.4);
-        let x65 = Self::mul_add(-0.4, x40, x43);
-        let x66 = Self::mul_add(0.275, x40, x38);
-        let x67 = Self::mul_add(
+        let x62 = x42 - Self::mul_add(0.275, x39, x41 * -0.4);
+        let x63 = Self::mul_add(-0.4, x40, x43);
+        let x64 = Self::mul_add(0.275, x40, x38);
+        let x65 = Self::mul_add(
             -0.00000000020510342851533115,
-            x66,
-            Self::mul_add(0.00000000020510342851533115, x64, x65),
+            x64,
+            Self::mul_add(0.00000000020510342851533115, x62, x63),
         );
-        let x68 = a[8]
+        let x66 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x39,
                 Self::mul_add(0.00000000020510342851533115, x40, x41),
             );
+        let x67 = Self::mul_add(
+            v[8],
+            x54,
+            Self::mul_add(x39, c_q9, Self::mul_add(x41, x51, x40 * s_q9)),
+        );
+        let x68 = Self::mul_add(
+            -v[8],
+            x53,
+            Self::mul_add(-x39, s_q9, Self::mul_add(x41, x52, x40 * c_q9)),
+        );
         let x69 = Self::mul_add(
             v[8],
-            x56,
-            Self::mul_add(x39, c_q9, Self::mul_add(x41, x53, x40 * x51)),
+            x59,
+            Self::mul_add(c_q9, x64, Self::mul_add(x51, x63, s_q9 * x62)),
         );
         let x70 = Self::mul_add(
             -v[8],
-            x55,
-            Self::mul_add(-x39, s_q9, Self::mul_add(x41, x54, x40 * x52)),
+            x58,
+            Self::mul_add(-s_q9, x64, Self::mul_add(x52, x63, c_q9 * x62)),
         );
-        let x71 = Self::mul_add(
-            v[8],
-            x61,
-            Self::mul_add(c_q9, x66, Self::mul_add(x53, x65, x51 * x64)),
-        );
+        let x71 = 3.378 * x54;
         let x72 = Self::mul_add(
-            -v[8],
-            x60,
-            Self::mul_add(-s_q9, x66, Self::mul_add(x54, x65, x52 * x64)),
-        );
-        let x73 = 3.378 * x56;
-        let x74 = Self::mul_add(
             -9.87015,
-            x62,
-            Self::mul_add(-0.00214, x63, 4.395515250000001 * x55),
-        );
-        let x75 = Self::mul_add(
             x60,
+            Self::mul_add(-0.00214, x61, 4.395515250000001 * x53),
+        );
+        let x73 = Self::mul_add(
+            x58,
             9.87015,
-            Self::mul_add(7.65251525, x63, -0.00214 * x55),
+            Self::mul_add(7.65251525, x61, -0.00214 * x53),
         );
-        let x76 = 22.69 * x61;
-        let x77 = Self::mul_add(9.87015, x63, 22.69 * x60);
-        let x78 = Self::mul_add(x55, -9.87015, 22.69 * x62);
+        let x74 = 22.69 * x59;
+        let x75 = Self::mul_add(9.87015, x61, 22.69 * x58);
+        let x76 = Self::mul_add(x53, -9.87015, 22.69 * x60);
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x80 = Self::mul_add(x56, s_q10, x55 * c_q10);
-        let x81 = Self::mul_add(-x55, s_q10, x56 * c_q10);
-        let x82 = Self::mul_add(0.87, x63, x60);
-        let x83 = Self::mul_add(x55, -0.87, x62);
-        let x84 = Self::mul_add(x61, s_q10, c_q10 * x82);
-        let x85 = Self::mul_add(-s_q10, x82, x61 * c_q10);
-        let x86 = v[9] + x63;
-        let x87 = Self::mul_add(0.87, x68, x71);
-        let x88 = Self::mul_add(x69, -0.87, x67);
-        let x89 = a[9] + x68;
-        let x90 = Self::mul_add(v[9], x81, Self::mul_add(x70, s_q10, x69 * c_q10));
-        let x91 = Self::mul_add(-v[9], x80, Self::mul_add(-x69, s_q10, x70 * c_q10));
-        let x92 = Self::mul_add(v[9], x85, Self::mul_add(x72, s_q10, c_q10 * x87));
-        let x93 = Self::mul_add(-v[9], x84, Self::mul_add(-s_q10, x87, x72 * c_q10));
+        let x78 = Self::mul_add(x54, s_q10, x53 * c_q10);
+        let x79 = Self::mul_add(-x53, s_q10, x54 * c_q10);
+        let x80 = Self::mul_add(0.87, x61, x58);
+        let x81 = Self::mul_add(x53, -0.87, x60);
+        let x82 = Self::mul_add(x59, s_q10, c_q10 * x80);
+        let x83 = Self::mul_add(-s_q10, x80, x59 * c_q10);
+        let x84 = v[9] + x61;
+        let x85 = Self::mul_add(0.87, x66, x69);
+        let x86 = Self::mul_add(x67, -0.87, x65);
+        let x87 = a[9] + x66;
+        let x88 = Self::mul_add(v[9], x79, Self::mul_add(x68, s_q10, x67 * c_q10));
+        let x89 = Self::mul_add(-v[9], x78, Self::mul_add(-x67, s_q10, x68 * c_q10));
+        let x90 = Self::mul_add(v[9], x83, Self::mul_add(x70, s_q10, c_q10 * x85));
+        let x91 = Self::mul_add(-v[9], x82, Self::mul_add(-s_q10, x85, x70 * c_q10));
+        let x92 = Self::mul_add(
+            x90,
+            6.7347,
+            Self::mul_add(4.0324305, x87, Self::mul_add(-1.8520425, x89, -0.6328 * x88)),
+        );
+        let x93 = Self::mul_add(-0.6328, x84, 4.170993 * x78)
+            + Self::mul_add(-6.7347, x81, x83 * 5.8795);
         let x94 = Self::mul_add(
-            x92,
-            6.7347,
-            Self::mul_add(4.0324305, x89, Self::mul_add(-1.8520425, x91, -0.6328 * x90)),
-        );
-        let x95 = Self::mul_add(-0.6328, x86, 4.170993 * x80)
-            + Self::mul_add(-6.7347, x83, x85 * 5.8795);
-        let x96 = Self::mul_add(
             -5.8795,
-            x84,
-            Self::mul_add(-1.8520425, x86, 3.8828625 * x81),
+            x82,
+            Self::mul_add(-1.8520425, x84, 3.8828625 * x79),
         );
-        let x97 = Self::mul_add(
-            x84,
+        let x95 = Self::mul_add(
+            x82,
             6.7347,
-            Self::mul_add(4.0324305, x86, Self::mul_add(-1.8520425, x81, -0.6328 * x80)),
+            Self::mul_add(4.0324305, x84, Self::mul_add(-1.8520425, x79, -0.6328 * x78)),
         );
-        let x98 = Self::mul_add(21.38, x84, -Self::mul_add(-6.7347, x86, x81 * 5.8795));
-        let x99 = Self::mul_add(5.8795, x80, 21.38 * x85);
-        let x100 = Self::mul_add(x80, -6.7347, 21.38 * x83);
+        let x96 = Self::mul_add(21.38, x82, -Self::mul_add(-6.7347, x84, x79 * 5.8795));
+        let x97 = Self::mul_add(5.8795, x78, 21.38 * x83);
+        let x98 = Self::mul_add(x78, -6.7347, 21.38 * x81);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x102 = Self::mul_add(x81, s_q11, x80 * c_q11);
-        let x103 = Self::mul_add(-x80, s_q11, x81 * c_q11);
-        let x104 = x84 - Self::mul_add(-0.63, x86, 0.275 * x81);
-        let x105 = Self::mul_add(0.275, x80, x85);
-        let x106 = Self::mul_add(x80, -0.63, x83);
-        let x107 = Self::mul_add(s_q11, x105, c_q11 * x104);
-        let x108 = Self::mul_add(-s_q11, x104, c_q11 * x105);
-        let x109 = v[10] + x86;
-        let x110 = x92 - Self::mul_add(-0.63, x89, 0.275 * x91);
-        let x111 = Self::mul_add(0.275, x90, x93);
-        let x112 = Self::mul_add(x90, -0.63, x88);
-        let x113 = a[10] + x89;
-        let x114 = Self::mul_add(v[10], x103, Self::mul_add(x91, s_q11, x90 * c_q11));
-        let x115 = Self::mul_add(-v[10], x102, Self::mul_add(-x90, s_q11, x91 * c_q11));
-        let x116 = Self::mul_add(v[10], x108, Self::mul_add(s_q11, x111, c_q11 * x110));
-        let x117 = Self::mul_add(
+        let x100 = Self::mul_add(x79, s_q11, x78 * c_q11);
+        let x101 = Self::mul_add(-x78, s_q11, x79 * c_q11);
+        let x102 = x82 - Self::mul_add(-0.63, x84, 0.275 * x79);
+        let x103 = Self::mul_add(0.275, x78, x83);
+        let x104 = Self::mul_add(x78, -0.63, x81);
+        let x105 = Self::mul_add(s_q11, x103, c_q11 * x102);
+        let x106 = Self::mul_add(-s_q11, x102, c_q11 * x103);
+        let x107 = v[10] + x84;
+        let x108 = x90 - Self::mul_add(-0.63, x87, 0.275 * x89);
+        let x109 = Self::mul_add(0.275, x88, x91);
+        let x110 = Self::mul_add(x88, -0.63, x86);
+        let x111 = a[10] + x87;
+        let x112 = Self::mul_add(v[10], x101, Self::mul_add(x89, s_q11, x88 * c_q11));
+        let x113 = Self::mul_add(-v[10], x100, Self::mul_add(-x88, s_q11, x89 * c_q11));
+        let x114 = Self::mul_add(v[10], x106, Self::mul_add(s_q11, x109, c_q11 * x108));
+        let x115 = Self::mul_add(
             -v[10],
-            x107,
-            Self::mul_add(-s_q11, x110, c_q11 * x111),
+            x105,
+            Self::mul_add(-s_q11, x108, c_q11 * x109),
         );
-        let x118 = Self::mul_add(0.07271, x109, 0.01675 * x102);
-        let x119 = Self::mul_add(
-            x108,
+        let x116 = Self::mul_add(0.07271, x107, 0.01675 * x100);
+        let x117 = Self::mul_add(
+            x106,
             3.0149999999999997,
-            Self::mul_add(0.01675, x109, 0.9304999999999999 * x102),
+            Self::mul_add(0.01675, x107, 0.9304999999999999 * x100),
         );
-        let x120 = Self::mul_add(-3.0149999999999997, x107, 0.939 * x103);
-        let x121 = 16.75 * x106;
-        let x122 = Self::mul_add(x103, -3.0149999999999997, 16.75 * x107);
-        let x123 = Self::mul_add(3.0149999999999997, x102, 16.75 * x108);
+        let x118 = Self::mul_add(-3.0149999999999997, x105, 0.939 * x101);
+        let x119 = 16.75 * x104;
+        let x120 = Self::mul_add(x101, -3.0149999999999997, 16.75 * x105);
+        let x121 = Self::mul_add(3.0149999999999997, x100, 16.75 * x106);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x125 = -0.00000000020510342851533115 * s_q12;
-        let x126 = -0.00000000020510342851533115 * c_q12;
-        let x127 = Self::mul_add(-x109, s_q12, Self::mul_add(x103, x125, x102 * c_q12));
-        let x128 = Self::mul_add(-x109, c_q12, Self::mul_add(-x102, s_q12, x103 * x126));
-        let x129 = Self::mul_add(x103, -0.36, x107);
-        let x130 = Self::mul_add(0.36, x102, x108);
-        let x131 = Self::mul_add(-x106, s_q12, Self::mul_add(x125, x130, c_q12 * x129));
-        let x132 = Self::mul_add(-x106, c_q12, Self::mul_add(-s_q12, x129, x126 * x130));
-        let x133 = Self::mul_add(-0.00000000020510342851533115, x106, x130);
-        let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x109, x103);
-        let x135 = Self::mul_add(x115, -0.36, x116);
-        let x136 = Self::mul_add(0.36, x114, x117);
-        let x137 = Self::mul_add(-0.00000000020510342851533115, x112, x136);
-        let x138 = a[11] + Self::mul_add(-0.00000000020510342851533115, x113, x115);
+        let x123 = -0.00000000020510342851533115 * s_q12;
+        let x124 = -0.00000000020510342851533115 * c_q12;
+        let x125 = Self::mul_add(-x107, s_q12, Self::mul_add(x101, x123, x100 * c_q12));
+        let x126 = Self::mul_add(-x107, c_q12, Self::mul_add(-x100, s_q12, x101 * x124));
+        let x127 = Self::mul_add(x101, -0.36, x105);
+        let x128 = Self::mul_add(0.36, x100, x106);
+        let x129 = Self::mul_add(-x104, s_q12, Self::mul_add(x123, x128, c_q12 * x127));
+        let x130 = Self::mul_add(-x104, c_q12, Self::mul_add(-s_q12, x127, x124 * x128));
+        let x131 = Self::mul_add(-0.00000000020510342851533115, x104, x128);
+        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x107, x101);
+        let x133 = Self::mul_add(x113, -0.36, x114);
+        let x134 = Self::mul_add(0.36, x112, x115);
+        let x135 = Self::mul_add(-0.00000000020510342851533115, x110, x134);
+        let x136 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x113);
+        let x137 = Self::mul_add(
+            v[11],
+            x126,
+            Self::mul_add(-x111, s_q12, Self::mul_add(x113, x123, x112 * c_q12)),
+        );
+        let x138 = Self::mul_add(
+            -v[11],
+            x125,
+            Self::mul_add(-x111, c_q12, Self::mul_add(-x112, s_q12, x113 * x124)),
+        );
         let x139 = Self::mul_add(
             v[11],
-            x128,
-            Self::mul_add(-x113, s_q12, Self::mul_add(x115, x125, x114 * c_q12)),
+            x130,
+            Self::mul_add(-x110, s_q12, Self::mul_add(x123, x134, c_q12 * x133)),
         );
         let x140 = Self::mul_add(
             -v[11],
-            x127,
-            Self::mul_add(-x113, c_q12, Self::mul_add(-x114, s_q12, x115 * x126)),
+            x129,
+            Self::mul_add(-x110, c_q12, Self::mul_add(-s_q12, x133, x124 * x134)),
         );
         let x141 = Self::mul_add(
-            v[11],
-            x132,
-            Self::mul_add(-x112, s_q12, Self::mul_add(x125, x136, c_q12 * x135)),
+            x139,
+            -7.196750000000001,
+            Self::mul_add(
+                2.1079062500000005,
+                x136,
+                Self::mul_add(-1.1514800000000003, x138, -0.2313 * x137),
+            ),
         );
-        let x142 = Self::mul_add(
-            -v[11],
-            x131,
-            Self::mul_add(-x112, c_q12, Self::mul_add(-s_q12, x135, x126 * x136)),
-        );
+        let x142 = Self::mul_add(-0.2313, x132, 3.2217582500000006 * x125)
+            + Self::mul_add(7.196750000000001, x131, x130 * -4.187200000000001);
         let x143 = Self::mul_add(
-            x141,
-            -7.196750000000001,
-            Self::mul_add(
-                2.1079062500000005,
-                x138,
-                Self::mul_add(-1.1514800000000003, x140, -0.2313 * x139),
-            ),
-        );
-        let x144 = Self::mul_add(-0.2313, x134, 3.2217582500000006 * x127)
-            + Self::mul_add(7.196750000000001, x133, x132 * -4.187200000000001);
-        let x145 = Self::mul_add(
             4.187200000000001,
-            x131,
-            Self::mul_add(-1.1514800000000003, x134, 1.2686520000000001 * x128),
+            x129,
+            Self::mul_add(-1.1514800000000003, x132, 1.2686520000000001 * x126),
         );
-        let x146 = Self::mul_add(
-            x131,
+        let x144 = Self::mul_add(
+            x129,
             -7.196750000000001,
             Self::mul_add(
                 2.1079062500000005,
-                x134,
-                Self::mul_add(-1.1514800000000003, x128, -0.2313 * x127),
+                x132,
+                Self::mul_add(-1.1514800000000003, x126, -0.2313 * x125),
             ),
         );
-        let x147 = Self::mul_add(
+        let x145 = Self::mul_add(
             26.17,
-            x131,
-            -Self::mul_add(7.196750000000001, x134, x128 * -4.187200000000001),
+            x129,
+            -Self::mul_add(7.196750000000001, x132, x126 * -4.187200000000001),
         );
-        let x148 = Self::mul_add(-4.187200000000001, x127, 26.17 * x132);
-        let x149 = Self::mul_add(x127, 7.196750000000001, 26.17 * x133);
+        let x146 = Self::mul_add(-4.187200000000001, x125, 26.17 * x130);
+        let x147 = Self::mul_add(x125, 7.196750000000001, 26.17 * x131);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x151 = -0.00000000020510342851533115 * c_q13;
-        let x152 = -0.00000000020510342851533115 * s_q13;
-        let x153 = Self::mul_add(-x134, c_q13, Self::mul_add(x128, s_q13, x127 * x151));
-        let x154 = Self::mul_add(x134, s_q13, Self::mul_add(-x127, x152, x128 * c_q13));
-        let x155 = x131 - Self::mul_add(0.55, x134, -0.16 * x128);
-        let x156 = Self::mul_add(-0.16, x127, x132);
-        let x157 = Self::mul_add(x127, 0.55, x133);
-        let x158 = Self::mul_add(-c_q13, x157, Self::mul_add(s_q13, x156, x151 * x155));
-        let x159 = Self::mul_add(s_q13, x157, Self::mul_add(-x152, x155, c_q13 * x156));
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x157, x155);
-        let x161 = v[12] + Self::mul_add(-0.00000000020510342851533115, x134, x127);
-        let x162 = x141 - Self::mul_add(0.55, x138, -0.16 * x140);
-        let x163 = Self::mul_add(-0.16, x139, x142);
-        let x164 = Self::mul_add(x139, 0.55, x137);
-        let x165 = Self::mul_add(-0.00000000020510342851533115, x164, x162);
-        let x166 = a[12] + Self::mul_add(-0.00000000020510342851533115, x138, x139);
+        let x149 = -0.00000000020510342851533115 * c_q13;
+        let x150 = -0.00000000020510342851533115 * s_q13;
+        let x151 = Self::mul_add(-x132, c_q13, Self::mul_add(x126, s_q13, x125 * x149));
+        let x152 = Self::mul_add(x132, s_q13, Self::mul_add(-x125, x150, x126 * c_q13));
+        let x153 = x129 - Self::mul_add(0.55, x132, -0.16 * x126);
+        let x154 = Self::mul_add(-0.16, x125, x130);
+        let x155 = Self::mul_add(x125, 0.55, x131);
+        let x156 = Self::mul_add(-c_q13, x155, Self::mul_add(s_q13, x154, x149 * x153));
+        let x157 = Self::mul_add(s_q13, x155, Self::mul_add(-x150, x153, c_q13 * x154));
+        let x158 = Self::mul_add(-0.00000000020510342851533115, x155, x153);
+        let x159 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x125);
+        let x160 = x139 - Self::mul_add(0.55, x136, -0.16 * x138);
+        let x161 = Self::mul_add(-0.16, x137, x140);
+        let x162 = Self::mul_add(x137, 0.55, x135);
+        let x163 = Self::mul_add(-0.00000000020510342851533115, x162, x160);
+        let x164 = a[12] + Self::mul_add(-0.00000000020510342851533115, x136, x137);
+        let x165 = Self::mul_add(
+            v[12],
+            x152,
+            Self::mul_add(-x136, c_q13, Self::mul_add(x138, s_q13, x137 * x149)),
+        );
+        let x166 = Self::mul_add(
+            -v[12],
+            x151,
+            Self::mul_add(x136, s_q13, Self::mul_add(-x137, x150, x138 * c_q13)),
+        );
         let x167 = Self::mul_add(
             v[12],
-            x154,
-            Self::mul_add(-x138, c_q13, Self::mul_add(x140, s_q13, x139 * x151)),
+            x157,
+            Self::mul_add(-c_q13, x162, Self::mul_add(s_q13, x161, x149 * x160)),
         );
         let x168 = Self::mul_add(
             -v[12],
-            x153,
-            Self::mul_add(x138, s_q13, Self::mul_add(-x139, x152, x140 * c_q13)),
+            x156,
+            Self::mul_add(s_q13, x162, Self::mul_add(-x150, x160, c_q13 * x161)),
         );
         let x169 = Self::mul_add(
-            v[12],
-            x159,
-            Self::mul_add(-c_q13, x164, Self::mul_add(s_q13, x163, x151 * x162)),
-        );
-        let x170 = Self::mul_add(
-            -v[12],
-            x158,
-            Self::mul_add(s_q13, x164, Self::mul_add(-x152, x162, c_q13 * x163)),
-        );
-        let x171 = Self::mul_add(
             3.6140000000000003,
-            x169,
+            x167,
             Self::mul_add(
                 -0.9614610000000001,
-                x166,
-                Self::mul_add(0.9638000000000001, x168, 0.000781 * x167),
+                x164,
+                Self::mul_add(0.9638000000000001, x166, 0.000781 * x165),
             ),
         );
-        let x172 = Self::mul_add(
-            x169,
+        let x170 = Self::mul_add(
+            x167,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x166,
-                Self::mul_add(-0.9614610000000001, x168, -0.0145 * x167),
+                x164,
+                Self::mul_add(-0.9614610000000001, x166, -0.0145 * x165),
+            ),
+        );
+        let x171 = Self::mul_add(
+            -0.0145,
+            x159,
+            Self::mul_add(0.000781, x152, 2.1663609200000002 * x151),
+        ) + Self::mul_add(4.806620000000001, x158, x157 * -3.6140000000000003);
+        let x172 = Self::mul_add(
+            3.6140000000000003,
+            x156,
+            Self::mul_add(
+                -0.9614610000000001,
+                x159,
+                Self::mul_add(0.9638000000000001, x152, 0.000781 * x151),
             ),
         );
         let x173 = Self::mul_add(
-            -0.0145,
-            x161,
-            Self::mul_add(0.000781, x154, 2.1663609200000002 * x153),
-        ) + Self::mul_add(4.806620000000001, x160, x159 * -3.6140000000000003);
-        let x174 = Self::mul_add(
-            3.6140000000000003,
-            x158,
-            Self::mul_add(
-                -0.9614610000000001,
-                x161,
-                Self::mul_add(0.9638000000000001, x154, 0.000781 * x153),
-            ),
-        );
-        let x175 = Self::mul_add(
-            x158,
+            x156,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x161,
-                Self::mul_add(-0.9614610000000001, x154, -0.0145 * x153),
+                x159,
+                Self::mul_add(-0.9614610000000001, x152, -0.0145 * x151),
             ),
         );
-        let x176 = Self::mul_add(
+        let x174 = Self::mul_add(
             18.07,
-            x158,
-            -Self::mul_add(4.806620000000001, x161, x154 * -3.6140000000000003),
+            x156,
+            -Self::mul_add(4.806620000000001, x159, x152 * -3.6140000000000003),
         );
-        let x177 = Self::mul_add(-3.6140000000000003, x153, 18.07 * x159);
-        let x178 = Self::mul_add(x153, 4.806620000000001, 18.07 * x160);
-        let x179 = Self::mul_add(
+        let x175 = Self::mul_add(-3.6140000000000003, x151, 18.07 * x157);
+        let x176 = Self::mul_add(x151, 4.806620000000001, 18.07 * x158);
+        let x177 = Self::mul_add(
             -0.0145,
-            x166,
-            Self::mul_add(0.000781, x168, 2.1663609200000002 * x167),
-        ) + Self::mul_add(4.806620000000001, x165, x170 * -3.6140000000000003)
-            + (Self::mul_add(-x161, x174, x154 * x175)
-                + Self::mul_add(-x160, x177, x159 * x178));
-        let x180 = x171
-            + (Self::mul_add(-x153, x175, x161 * x173)
-                + Self::mul_add(-x158, x178, x160 * x176));
-        let x181 = x172
-            + (Self::mul_add(-x154, x173, x153 * x174)
-                + Self::mul_add(-x159, x176, x158 * x177));
-        let x182 = Self::mul_add(
+            x164,
+            Self::mul_add(0.000781, x166, 2.1663609200000002 * x165),
+        ) + Self::mul_add(4.806620000000001, x163, x168 * -3.6140000000000003)
+            + (Self::mul_add(-x159, x172, x152 * x173)
+                + Self::mul_add(-x158, x175, x157 * x176));
+        let x178 = x169
+            + (Self::mul_add(-x151, x173, x159 * x171)
+                + Self::mul_add(-x156, x176, x158 * x174));
+        let x179 = x170
+            + (Self::mul_add(-x152, x171, x151 * x172)
+                + Self::mul_add(-x157, x174, x156 * x175));
+        let x180 = Self::mul_add(
             18.07,
-            x169,
-            -Self::mul_add(4.806620000000001, x166, x168 * -3.6140000000000003),
-        ) + Self::mul_add(-x161, x177, x154 * x178);
-        let x183 = Self::mul_add(-3.6140000000000003, x167, 18.07 * x170)
-            + Self::mul_add(-x153, x178, x161 * x176);
-        let x184 = Self::mul_add(x167, 4.806620000000001, 18.07 * x165)
-            + Self::mul_add(-x154, x176, x153 * x177);
-        let x185 = x184 + Self::mul_add(-x152, x183, x151 * x182);
-        let x186 = Self::mul_add(c_q13, x183, s_q13 * x182);
-        let x187 = Self::mul_add(
+            x167,
+            -Self::mul_add(4.806620000000001, x164, x166 * -3.6140000000000003),
+        ) + Self::mul_add(-x159, x175, x152 * x176);
+        let x181 = Self::mul_add(-3.6140000000000003, x165, 18.07 * x168)
+            + Self::mul_add(-x151, x176, x159 * x174);
+        let x182 = Self::mul_add(x165, 4.806620000000001, 18.07 * x163)
+            + Self::mul_add(-x152, x174, x151 * x175);
+        let x183 = x182 + Self::mul_add(-x150, x181, x149 * x180);
+        let x184 = Self::mul_add(c_q13, x181, s_q13 * x180);
+        let x185 = Self::mul_add(
             -0.00000000020510342851533115,
-            x184,
-            Self::mul_add(-c_q13, x182, s_q13 * x183),
+            x182,
+            Self::mul_add(-c_q13, x180, s_q13 * x181),
         );
-        let x188 = Self::mul_add(
+        let x186 = Self::mul_add(
             -0.55,
-            x185,
+            x183,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x181,
-                Self::mul_add(-c_q13, x179, s_q13 * x180),
+                x179,
+                Self::mul_add(-c_q13, x177, s_q13 * x178),
             ),
         );
-        let x189 = Self::mul_add(-0.2313, x138, 3.2217582500000006 * x139)
-            + Self::mul_add(7.196750000000001, x137, x142 * -4.187200000000001)
-            + (Self::mul_add(-x134, x145, x128 * x146)
-                + Self::mul_add(-x133, x148, x132 * x149))
-            + (x181 + Self::mul_add(-x152, x180, x151 * x179)
-                + Self::mul_add(0.55, x187, -0.16 * x186));
-        let x190 = Self::mul_add(
+        let x187 = Self::mul_add(-0.2313, x136, 3.2217582500000006 * x137)
+            + Self::mul_add(7.196750000000001, x135, x140 * -4.187200000000001)
+            + (Self::mul_add(-x132, x143, x126 * x144)
+                + Self::mul_add(-x131, x146, x130 * x147))
+            + (x179 + Self::mul_add(-x150, x178, x149 * x177)
+                + Self::mul_add(0.55, x185, -0.16 * x184));
+        let x188 = Self::mul_add(
             4.187200000000001,
-            x141,
-            Self::mul_add(-1.1514800000000003, x138, 1.2686520000000001 * x140),
+            x139,
+            Self::mul_add(-1.1514800000000003, x136, 1.2686520000000001 * x138),
         )
-            + (Self::mul_add(-x127, x146, x134 * x144)
-                + Self::mul_add(-x131, x149, x133 * x147))
-            + Self::mul_add(0.16, x185, Self::mul_add(c_q13, x180, s_q13 * x179));
-        let x191 = x143
-            + (Self::mul_add(-x128, x144, x127 * x145)
-                + Self::mul_add(-x132, x147, x131 * x148)) + x188;
-        let x192 = Self::mul_add(
+            + (Self::mul_add(-x125, x144, x132 * x142)
+                + Self::mul_add(-x129, x147, x131 * x145))
+            + Self::mul_add(0.16, x183, Self::mul_add(c_q13, x178, s_q13 * x177));
+        let x189 = x141
+            + (Self::mul_add(-x126, x142, x125 * x143)
+                + Self::mul_add(-x130, x145, x129 * x146)) + x186;
+        let x190 = Self::mul_add(
             26.17,
-            x141,
-            -Self::mul_add(7.196750000000001, x138, x140 * -4.187200000000001),
-        ) + Self::mul_add(-x134, x148, x128 * x149) + x185;
-        let x193 = Self::mul_add(-4.187200000000001, x139, 26.17 * x142)
-            + Self::mul_add(-x127, x149, x134 * x147) + x186;
-        let x194 = Self::mul_add(x139, 7.196750000000001, 26.17 * x137)
-            + Self::mul_add(-x128, x147, x127 * x148) + x187;
-        let x195 = Self::mul_add(-s_q12, x193, c_q12 * x192);
-        let x196 = x194 + Self::mul_add(x126, x193, x125 * x192);
-        let x197 = Self::mul_add(
-            x117,
+            x139,
+            -Self::mul_add(7.196750000000001, x136, x138 * -4.187200000000001),
+        ) + Self::mul_add(-x132, x146, x126 * x147) + x183;
+        let x191 = Self::mul_add(-4.187200000000001, x137, 26.17 * x140)
+            + Self::mul_add(-x125, x147, x132 * x145) + x184;
+        let x192 = Self::mul_add(x137, 7.196750000000001, 26.17 * x135)
+            + Self::mul_add(-x126, x145, x125 * x146) + x185;
+        let x193 = Self::mul_add(-s_q12, x191, c_q12 * x190);
+        let x194 = x192 + Self::mul_add(x124, x191, x123 * x190);
+        let x195 = Self::mul_add(
+            x115,
             3.0149999999999997,
-            Self::mul_add(0.01675, x113, 0.9304999999999999 * x114),
+            Self::mul_add(0.01675, x111, 0.9304999999999999 * x112),
         )
-            + (Self::mul_add(-x109, x120, x103 * x118)
-                + Self::mul_add(-x106, x123, x108 * x121))
-            + Self::mul_add(0.36, x196, Self::mul_add(-s_q12, x190, c_q12 * x189));
-        let x198 = Self::mul_add(-3.0149999999999997, x116, 0.939 * x115)
-            + (Self::mul_add(-x102, x118, x109 * x119)
-                + Self::mul_add(-x107, x121, x106 * x122))
-            + Self::mul_add(-0.36, x195, x191 + Self::mul_add(x126, x190, x125 * x189));
-        let x199 = Self::mul_add(x115, -3.0149999999999997, 16.75 * x116)
-            + Self::mul_add(-x109, x123, x103 * x121) + x195;
-        let x200 = Self::mul_add(3.0149999999999997, x114, 16.75 * x117)
-            + Self::mul_add(-x102, x121, x109 * x122) + x196;
-        let x201 = Self::mul_add(16.75, x112, Self::mul_add(-x103, x122, x102 * x123))
+            + (Self::mul_add(-x107, x118, x101 * x116)
+                + Self::mul_add(-x104, x121, x106 * x119))
+            + Self::mul_add(0.36, x194, Self::mul_add(-s_q12, x188, c_q12 * x187));
+        let x196 = Self::mul_add(-3.0149999999999997, x114, 0.939 * x113)
+            + (Self::mul_add(-x100, x116, x107 * x117)
+                + Self::mul_add(-x105, x119, x104 * x120))
+            + Self::mul_add(-0.36, x193, x189 + Self::mul_add(x124, x188, x123 * x187));
+        let x197 = Self::mul_add(x113, -3.0149999999999997, 16.75 * x114)
+            + Self::mul_add(-x107, x121, x101 * x119) + x193;
+        let x198 = Self::mul_add(3.0149999999999997, x112, 16.75 * x115)
+            + Self::mul_add(-x100, x119, x107 * x120) + x194;
+        let x199 = Self::mul_add(16.75, x110, Self::mul_add(-x101, x120, x100 * x121))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x194,
-                -Self::mul_add(c_q12, x193, s_q12 * x192),
+                x192,
+                -Self::mul_add(c_q12, x191, s_q12 * x190),
             );
-        let x202 = Self::mul_add(-s_q11, x200, c_q11 * x199);
-        let x203 = Self::mul_add(c_q11, x200, s_q11 * x199);
-        let x204 = Self::mul_add(
+        let x200 = Self::mul_add(-s_q11, x198, c_q11 * x197);
+        let x201 = Self::mul_add(c_q11, x198, s_q11 * x197);
+        let x202 = Self::mul_add(
             0.63,
-            x202,
-            Self::mul_add(0.07271, x113, 0.01675 * x114)
-                + (Self::mul_add(-x103, x119, x102 * x120)
-                    + Self::mul_add(-x108, x122, x107 * x123))
+            x200,
+            Self::mul_add(0.07271, x111, 0.01675 * x112)
+                + (Self::mul_add(-x101, x117, x100 * x118)
+                    + Self::mul_add(-x106, x120, x105 * x121))
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x191,
-                    -Self::mul_add(c_q12, x190, s_q12 * x189),
+                    x189,
+                    -Self::mul_add(c_q12, x188, s_q12 * x187),
                 ),
         );
-        let x205 = Self::mul_add(-0.6328, x89, 4.170993 * x90)
-            + Self::mul_add(-6.7347, x88, x93 * 5.8795)
-            + (Self::mul_add(-x86, x96, x81 * x97)
-                + Self::mul_add(-x83, x99, x85 * x100))
-            + (Self::mul_add(-s_q11, x198, c_q11 * x197)
-                + Self::mul_add(-0.63, x201, 0.275 * x203));
-        let x206 = Self::mul_add(
+        let x203 = Self::mul_add(-0.6328, x87, 4.170993 * x88)
+            + Self::mul_add(-6.7347, x86, x91 * 5.8795)
+            + (Self::mul_add(-x84, x94, x79 * x95) + Self::mul_add(-x81, x97, x83 * x98))
+            + (Self::mul_add(-s_q11, x196, c_q11 * x195)
+                + Self::mul_add(-0.63, x199, 0.275 * x201));
+        let x204 = Self::mul_add(
             -5.8795,
-            x92,
-            Self::mul_add(-1.8520425, x89, 3.8828625 * x91),
-        ) + (Self::mul_add(-x80, x97, x86 * x95) + Self::mul_add(-x84, x100, x83 * x98))
-            + Self::mul_add(-0.275, x202, Self::mul_add(c_q11, x198, s_q11 * x197));
-        let x207 = Self::mul_add(21.38, x92, -Self::mul_add(-6.7347, x89, x91 * 5.8795))
-            + Self::mul_add(-x86, x99, x81 * x100) + x202;
-        let x208 = Self::mul_add(5.8795, x90, 21.38 * x93)
-            + Self::mul_add(-x80, x100, x86 * x98) + x203;
-        let x209 = Self::mul_add(x90, -6.7347, 21.38 * x88)
-            + Self::mul_add(-x81, x98, x80 * x99) + x201;
-        let x210 = Self::mul_add(-s_q10, x208, c_q10 * x207);
-        let x211 = Self::mul_add(
+            x90,
+            Self::mul_add(-1.8520425, x87, 3.8828625 * x89),
+        ) + (Self::mul_add(-x78, x95, x84 * x93) + Self::mul_add(-x82, x98, x81 * x96))
+            + Self::mul_add(-0.275, x200, Self::mul_add(c_q11, x196, s_q11 * x195));
+        let x205 = Self::mul_add(21.38, x90, -Self::mul_add(-6.7347, x87, x89 * 5.8795))
+            + Self::mul_add(-x84, x97, x79 * x98) + x200;
+        let x206 = Self::mul_add(5.8795, x88, 21.38 * x91)
+            + Self::mul_add(-x78, x98, x84 * x96) + x201;
+        let x207 = Self::mul_add(x88, -6.7347, 21.38 * x86)
+            + Self::mul_add(-x79, x96, x78 * x97) + x199;
+        let x208 = Self::mul_add(-s_q10, x206, c_q10 * x205);
+        let x209 = Self::mul_add(
             -9.87015,
-            x67,
-            Self::mul_add(-0.00214, x68, 4.395515250000001 * x69),
-        ) + (Self::mul_add(-x63, x73, x56 * x75) + Self::mul_add(-x62, x76, x61 * x78))
-            + Self::mul_add(-0.87, x209, Self::mul_add(-s_q10, x206, c_q10 * x205));
-        let x212 = Self::mul_add(
+            x65,
+            Self::mul_add(-0.00214, x66, 4.395515250000001 * x67),
+        ) + (Self::mul_add(-x61, x71, x54 * x73) + Self::mul_add(-x60, x74, x59 * x76))
+            + Self::mul_add(-0.87, x207, Self::mul_add(-s_q10, x204, c_q10 * x203));
+        let x210 = Self::mul_add(
             3.378,
-            x70,
-            Self::mul_add(-x55, x75, x63 * x74) + Self::mul_add(-x60, x78, x62 * x77),
-        ) + Self::mul_add(c_q10, x206, s_q10 * x205);
-        let x213 = Self::mul_add(
-            x71,
+            x68,
+            Self::mul_add(-x53, x73, x61 * x72) + Self::mul_add(-x58, x76, x60 * x75),
+        ) + Self::mul_add(c_q10, x204, s_q10 * x203);
+        let x211 = Self::mul_add(
+            x69,
             9.87015,
-            Self::mul_add(7.65251525, x68, -0.00214 * x69),
-        ) + (Self::mul_add(-x56, x74, x55 * x73) + Self::mul_add(-x61, x77, x60 * x76))
+            Self::mul_add(7.65251525, x66, -0.00214 * x67),
+        ) + (Self::mul_add(-x54, x72, x53 * x71) + Self::mul_add(-x59, x75, x58 * x74))
             + Self::mul_add(
                 0.87,
-                x210,
-                x94
-                    + (Self::mul_add(-x81, x95, x80 * x96)
-                        + Self::mul_add(-x85, x98, x84 * x99)) + x204,
+                x208,
+                x92
+                    + (Self::mul_add(-x79, x93, x78 * x94)
+                        + Self::mul_add(-x83, x96, x82 * x97)) + x202,
             );
-        let x214 = Self::mul_add(9.87015, x68, 22.69 * x71)
-            + Self::mul_add(-x63, x76, x56 * x78) + x210;
-        let x215 = Self::mul_add(22.69, x72, Self::mul_add(-x55, x78, x63 * x77))
-            + Self::mul_add(c_q10, x208, s_q10 * x207);
-        let x216 = Self::mul_add(x69, -9.87015, 22.69 * x67)
-            + Self::mul_add(-x56, x77, x55 * x76) + x209;
-        let x217 = Self::mul_add(
+        let x212 = Self::mul_add(9.87015, x66, 22.69 * x69)
+            + Self::mul_add(-x61, x74, x54 * x76) + x208;
+        let x213 = Self::mul_add(22.69, x70, Self::mul_add(-x53, x76, x61 * x75))
+            + Self::mul_add(c_q10, x206, s_q10 * x205);
+        let x214 = Self::mul_add(x67, -9.87015, 22.69 * x65)
+            + Self::mul_add(-x54, x75, x53 * x74) + x207;
+        let x215 = Self::mul_add(
             0.00000000020510342851533115,
-            x216,
-            Self::mul_add(x52, x215, x51 * x214),
+            x214,
+            Self::mul_add(c_q9, x213, s_q9 * x212),
         );
-        let x218 = x216 + Self::mul_add(x54, x215, x53 * x214);
-        let x219 = Self::mul_add(
+        let x216 = x214 + Self::mul_add(x52, x213, x51 * x212);
+        let x217 = Self::mul_add(
             -0.00000000020510342851533115,
-            x216,
-            Self::mul_add(-s_q9, x215, c_q9 * x214),
+            x214,
+            Self::mul_add(-s_q9, x213, c_q9 * x212),
         );
-        let x220 = Self::mul_add(
+        let x218 = Self::mul_add(
             -0.275,
-            x217,
+            x215,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x213,
-                Self::mul_add(-s_q9, x212, c_q9 * x211),
+                x211,
+                Self::mul_add(-s_q9, x210, c_q9 * x209),
             ),
         );
-        let x221 = Self::mul_add(
+        let x219 = Self::mul_add(
             x43,
             -6.0,
             Self::mul_add(-0.00214, x39, 3.3000000000000003 * x40),
         ) + (Self::mul_add(-x35, x46, x29 * x44) + Self::mul_add(-x34, x49, x33 * x47))
             + (Self::mul_add(
                 0.00000000020510342851533115,
-                x213,
-                Self::mul_add(x52, x212, x51 * x211),
-            ) + Self::mul_add(0.275, x219, -0.4 * x218));
-        let x222 = Self::mul_add(6.0, x42, 2.5780000000000003 * x41)
+                x211,
+                Self::mul_add(c_q9, x210, s_q9 * x209),
+            ) + Self::mul_add(0.275, x217, -0.4 * x216));
+        let x220 = Self::mul_add(6.0, x42, 2.5780000000000003 * x41)
             + (Self::mul_add(-x28, x44, x35 * x45) + Self::mul_add(-x32, x47, x34 * x48))
-            + Self::mul_add(0.4, x217, x213 + Self::mul_add(x54, x212, x53 * x211));
-        let x223 = Self::mul_add(2.359, x39, -0.00214 * x40)
+            + Self::mul_add(0.4, x215, x211 + Self::mul_add(x52, x210, x51 * x209));
+        let x221 = Self::mul_add(2.359, x39, -0.00214 * x40)
             + (Self::mul_add(-x29, x45, x28 * x46) + Self::mul_add(-x33, x48, x32 * x49))
-            + x220;
-        let x224 = Self::mul_add(x41, 6.0, 30.0 * x42)
-            + Self::mul_add(-x35, x49, x29 * x47) + x217;
-        let x225 = Self::mul_add(-6.0, x40, 30.0 * x43)
-            + Self::mul_add(-x28, x47, x35 * x48) + x218;
-        let x226 = Self::mul_add(30.0, x38, Self::mul_add(-x29, x48, x28 * x49)) + x219;
-        let x227 = x226 + Self::mul_add(-x27, x225, x26 * x224);
-        let x228 = Self::mul_add(c_q8, x225, s_q8 * x224);
-        let x229 = x17
+            + x218;
+        let x222 = Self::mul_add(x41, 6.0, 30.0 * x42)
+            + Self::mul_add(-x35, x49, x29 * x47) + x215;
+        let x223 = Self::mul_add(-6.0, x40, 30.0 * x43)
+            + Self::mul_add(-x28, x47, x35 * x48) + x216;
+        let x224 = Self::mul_add(30.0, x38, Self::mul_add(-x29, x48, x28 * x49)) + x217;
+        let x225 = x224 + Self::mul_add(-x27, x223, x26 * x222);
+        let x226 = Self::mul_add(c_q8, x223, s_q8 * x222);
+        let x227 = x17
             + (Self::mul_add(-x8, x21, x2 * x19) + Self::mul_add(-x5, x24, x7 * x22))
-            + Self::mul_add(-0.35, x228, x223 + Self::mul_add(-x27, x222, x26 * x221));
-        let x230 = x18
+            + Self::mul_add(-0.35, x226, x221 + Self::mul_add(-x27, x220, x26 * x219));
+        let x228 = x18
             + (Self::mul_add(-x1, x19, x8 * x20) + Self::mul_add(-x6, x22, x5 * x23))
-            + Self::mul_add(0.35, x227, Self::mul_add(c_q8, x222, s_q8 * x221));
-        let x231 = Self::mul_add(x14, 6.1267499999999995, 35.01 * x15)
-            + Self::mul_add(-x8, x24, x2 * x22) + x227;
-        let x232 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
-            + Self::mul_add(-x1, x22, x8 * x23) + x228;
-        let x233 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x23, x1 * x24))
+            + Self::mul_add(0.35, x225, Self::mul_add(c_q8, x220, s_q8 * x219));
+        let x229 = Self::mul_add(x14, 6.1267499999999995, 35.01 * x15)
+            + Self::mul_add(-x8, x24, x2 * x22) + x225;
+        let x230 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
+            + Self::mul_add(-x1, x22, x8 * x23) + x226;
+        let x231 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x23, x1 * x24))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x226,
-                Self::mul_add(-c_q8, x224, s_q8 * x225),
+                x224,
+                Self::mul_add(-c_q8, x222, s_q8 * x223),
             );
-        let x234 = Self::mul_add(-s_q7, x232, c_q7 * x231);
-        let x235 = Self::mul_add(c_q7, x232, s_q7 * x231);
-        let x236 = Self::mul_add(
+        let x232 = Self::mul_add(-s_q7, x230, c_q7 * x229);
+        let x233 = Self::mul_add(c_q7, x230, s_q7 * x229);
+        let x234 = Self::mul_add(
             0.65,
-            x235,
+            x233,
             Self::mul_add(1.331, x12, Self::mul_add(0.1132, x14, 0.00071 * x13))
                 + (Self::mul_add(-x2, x20, x1 * x21) + Self::mul_add(-x7, x23, x6 * x24))
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x223,
-                    Self::mul_add(-c_q8, x221, s_q8 * x222),
+                    x221,
+                    Self::mul_add(-c_q8, x219, s_q8 * x220),
                 ),
         );
-        let x237 = -x234;
-        let x238 = -x235;
-        let x239 = -x233;
-        let x240 = -Self::mul_add(-0.75, x235, Self::mul_add(-s_q7, x230, c_q7 * x229));
-        let x241 = -(Self::mul_add(c_q7, x230, s_q7 * x229)
-            + Self::mul_add(-0.65, x233, 0.75 * x234));
-        let x242 = -x236;
-        [x237, x238, x239, x240, x241, x242]
+        let x235 = -x232;
+        let x236 = -x233;
+        let x237 = -x231;
+        let x238 = -Self::mul_add(-0.75, x233, Self::mul_add(-s_q7, x228, c_q7 * x227));
+        let x239 = -(Self::mul_add(c_q7, x228, s_q7 * x227)
+            + Self::mul_add(-0.65, x231, 0.75 * x232));
+        let x240 = -x234;
+        [x235, x236, x237, x238, x239, x240]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

@@ -26,6 +26,7 @@ struct Input {
     fma_path: Option<syn::Path>,
     target_fma: bool,
     regroup: bool,
+    snap: Option<f64>,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -65,6 +66,7 @@ impl Parse for Input {
             fma_path: None,
             target_fma: true,
             regroup: true,
+            snap: None,
         };
         let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
@@ -114,6 +116,17 @@ impl Parse for Input {
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
                 "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
+                "snap" => {
+                    let e: Expr = input.parse()?;
+                    let x = float(&e)?;
+                    if !(0.0..0.1).contains(&x) {
+                        return Err(syn::Error::new_spanned(
+                            e,
+                            format!("snap tolerance {x} is not in [0, 0.1)"),
+                        ));
+                    }
+                    out.snap = Some(x);
+                }
                 "fma_path" => {
                     out.fma_path = Some(input.parse::<syn::Path>()?);
                     fma_path_key = Some(key);
@@ -123,7 +136,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, target_fma, regroup)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap)"
                         ),
                     ))
                 }
@@ -174,6 +187,9 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.fma = input.fma;
     opts.regroup = input.regroup;
     opts.target_fma = input.target_fma;
+    if let Some(snap) = input.snap {
+        opts.snap = snap;
+    }
     opts.fma_path = input
         .fma_path
         .as_ref()
