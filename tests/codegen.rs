@@ -7,7 +7,9 @@ use kanegen::dynamics::Params;
 use kanegen::dynamics::{BiasMethod, Loads, MassMatrixMethod, Methods};
 use kanegen::model::random::{random_vec, rng};
 use kanegen::model::Model;
-use kanegen_generated::{srms::Srms, ssrms::Ssrms, ssrms6::Ssrms6};
+use kanegen_generated::{
+    srms::Srms, ssrms::Ssrms, ssrms6::Ssrms6, ssrms_recurrent::SsrmsRecurrent,
+};
 use std::path::Path;
 
 fn root() -> &'static Path {
@@ -173,6 +175,66 @@ fn generated_code_equals_interpreted_algorithms() {
         compare(&model, f, 11);
     }
     assert_eq!((Ssrms::N, Ssrms6::N, Srms::N), (7, 6, 6));
+}
+
+/// `--algorithm recurrent` forces the paper's algorithm: every function with a mass-matrix or
+/// bias method traces it alone and says so (one candidate, the header's line), its code equals
+/// the interpreted recurrent algorithm and the cheapest generated code (other algorithms) to
+/// 1e-12, and it costs more operations than the cheapest; on a tree it is refused by name.
+#[test]
+fn the_recurrent_algorithm_can_be_forced() {
+    let g = GENERATED
+        .iter()
+        .find(|g| g.type_name == "SsrmsRecurrent")
+        .unwrap();
+    assert_eq!(g.algorithm, Some("recurrent"));
+    let model = g.model(root()).unwrap();
+    compare(&model, &fns!(SsrmsRecurrent), 12);
+    for e in SsrmsRecurrent::OP_COUNTS {
+        let uses = e.mass_matrix_method.is_some() || e.bias_method.is_some();
+        if uses {
+            assert!(
+                e.mass_matrix_method.is_none_or(|m| m == "recurrent")
+                    && e.bias_method.is_none_or(|b| b == "recurrent"),
+                "{}",
+                e.function
+            );
+            let n = SsrmsRecurrent::CANDIDATES
+                .iter()
+                .filter(|c| c.function == e.function)
+                .count();
+            assert_eq!(n, 1, "{}", e.function);
+            let cheapest = Ssrms::OP_COUNTS
+                .iter()
+                .find(|c| c.function == e.function)
+                .unwrap();
+            assert!(
+                cheapest.mul + cheapest.add < e.mul + e.add,
+                "{}",
+                e.function
+            );
+        }
+    }
+    let mut r = rng(5);
+    for _ in 0..10 {
+        let q: [f64; 7] = random_vec(&mut r, 7, 3.0).try_into().unwrap();
+        let qd: [f64; 7] = random_vec(&mut r, 7, 1.0).try_into().unwrap();
+        let (m1, c1) = SsrmsRecurrent::mass_matrix_and_nonlinear_effects(&q, &qd);
+        let (m2, c2) = Ssrms::mass_matrix_and_nonlinear_effects(&q, &qd);
+        assert!(rel_err(m1.as_flattened(), m2.as_flattened()) < 1e-12);
+        assert!(rel_err(&c1, &c2) < 1e-12);
+    }
+    let src = std::fs::read_to_string(root().join(g.file)).unwrap();
+    assert!(src.contains("//! Algorithm: forced to `recurrent`"));
+    let panda = kanegen::model::io::load_model(&root().join("tests/data/erd/panda.urdf")).unwrap();
+    let mut o = kanegen::codegen::Options::new("Panda");
+    o.algorithm = Some(kanegen::codegen::forced_algorithm("recurrent").unwrap());
+    let e = kanegen::codegen::generate_items(&panda, &o)
+        .err()
+        .unwrap()
+        .to_string();
+    assert!(e.contains("`recurrent` handles serial chains only"), "{e}");
+    assert!(kanegen::codegen::forced_algorithm("fastest").is_err());
 }
 
 /// Locking the shoulder roll (index 0) at `v`: A and b of the 6-dof model are those of the

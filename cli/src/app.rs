@@ -27,6 +27,10 @@ pub struct Cli {
     command: Command,
 }
 
+fn parse_forced(s: &str) -> Result<Methods, String> {
+    kanegen_codegen::forced_algorithm(s).map_err(|e| e.0)
+}
+
 fn parse_algorithm(s: &str) -> Result<Methods, String> {
     Methods::from_name(s).ok_or_else(|| {
         let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
@@ -161,6 +165,10 @@ enum Command {
         /// `rpy = 1.570796325`); the header says what was snapped.
         #[arg(long, default_value_t = kanegen_model::canonical::DEFAULT_SNAP, value_name = "TOL")]
         snap: f64,
+        /// Force one algorithm (recurrent, recurrent-r1, kane-direct, crba-base, spatial, aba)
+        /// instead of the cheapest candidate per function.
+        #[arg(long, value_parser = parse_forced)]
+        algorithm: Option<Methods>,
         /// Accept inertia tensors that violate the triangle inequality.
         #[arg(long)]
         allow_nonphysical: bool,
@@ -427,6 +435,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             scalar,
             fma,
             snap,
+            algorithm,
             allow_nonphysical,
             allow_large,
         } => {
@@ -463,6 +472,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             opts.float = scalar;
             opts.fma = fma;
             opts.snap = snap;
+            opts.algorithm = algorithm;
             let progress = Progress::spinner(
                 interactive.0,
                 &format!(

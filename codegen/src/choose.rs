@@ -148,7 +148,8 @@ pub fn can_win(f: Function, m: Methods, n: usize) -> bool {
     mass_ok && bias_ok
 }
 
-/// Traces every candidate of `f` that [`can_win`] and keeps the cheapest.
+/// Traces every candidate of `f` that [`can_win`] and keeps the cheapest; with
+/// [`Options::algorithm`], traces that one for a function with a mass-matrix or bias method.
 ///
 /// # Errors
 /// As [`trace`].
@@ -164,7 +165,11 @@ pub fn choose(
     };
     let mut best: Option<(u64, Methods, Traced)> = None;
     let mut traced = Vec::new();
-    let all = candidates(f, mass, model.is_chain());
+    let all = match opts.algorithm {
+        // Forced: the one algorithm for whatever it computes, the others as usual.
+        Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
+        _ => candidates(f, mass, model.is_chain()),
+    };
     let n = model.dof();
     let kept: Vec<Methods> = all.iter().copied().filter(|m| can_win(f, *m, n)).collect();
     for m in if kept.is_empty() { all } else { kept } {

@@ -105,6 +105,15 @@ pub fn lines(
                 snap.largest_snap
             )
         },
+        match opts.algorithm {
+            None => "Algorithm: per function the cheapest candidate (below).".into(),
+            Some(m) => format!(
+                "Algorithm: forced to `{}` (`algorithm` option) for every function with a \
+                 mass-matrix, bias or forward method; without it each takes the cheapest \
+                 candidate.",
+                m.name()
+            ),
+        },
     ];
     let total: u64 = fmas.iter().sum();
     let per = choices

@@ -36,7 +36,7 @@ mod options;
 
 pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
-pub use options::{Error, Float, Options, VERSION};
+pub use options::{forced_algorithm, Error, Float, Options, VERSION};
 
 use kanegen_model::{BaseKind, Model};
 use kanegen_trace::{Arg, Function};
@@ -488,6 +488,7 @@ fn format_body(tokens: &TokenStream) -> Result<String, Error> {
 }
 
 /// The model crate, re-exported for the proc-macro (readers, validation).
+pub use kanegen_dynamics;
 pub use kanegen_model;
 /// The private `mul_add` of [`Options::target_fma`]: one fused instruction where the build
 /// targets it, `a·b + c` (two roundings, bit-identical to unfused code) elsewhere.
@@ -515,8 +516,10 @@ fn mul_add_fn(float: Float) -> TokenStream {
     quote! {
         /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
         /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-        /// elsewhere.
+        /// elsewhere. The intrinsic is the one `unsafe` call of the file (no safe fused
+        /// multiply-add exists in `core`), allowed here for crates that deny `unsafe_code`.
         #[inline(always)]
+        #[allow(unsafe_code)]
         fn mul_add(a: #ty, b: #ty, c: #ty) -> #ty {
             #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
             {

@@ -1,6 +1,7 @@
 //! Generator options: the generated type's name, gravity, a runtime payload, the precision, and
 //! the paths the emitted code calls.
 
+use kanegen_dynamics::{ForwardMethod, Methods};
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
@@ -60,6 +61,28 @@ pub struct Options {
     /// `rpy = 1.570796325` (4.9e-12) and changes the robot by that much. The header says what
     /// was snapped.
     pub snap: f64,
+    /// Force one algorithm for every function that has a mass-matrix, bias or forward method
+    /// instead of the cheapest candidate: a preset of [`Methods::PRESETS`] (`recurrent`, the
+    /// paper's; `recurrent-r1`, `kane-direct`, `crba-base`, `spatial`) or [`Methods::ABA`]
+    /// (`aba`), by [`forced_algorithm`]. Default `None`: the cheapest. The header says which.
+    pub algorithm: Option<Methods>,
+}
+
+/// The methods `algorithm = NAME` forces ([`Options::algorithm`]).
+///
+/// # Errors
+/// For a name that is neither a preset nor `aba`, listing the names.
+pub fn forced_algorithm(name: &str) -> Result<Methods, Error> {
+    if name == ForwardMethod::Aba.name() {
+        return Ok(Methods::ABA);
+    }
+    Methods::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Methods::PRESETS.iter().map(|(n, _)| *n).collect();
+        Error(format!(
+            "unknown algorithm `{name}` (expected {}, or aba)",
+            names.join(", ")
+        ))
+    })
 }
 
 /// Floating-point type of the emitted code.
@@ -133,6 +156,7 @@ impl Options {
             target_fma: true,
             regroup: true,
             snap: kanegen_model::canonical::DEFAULT_SNAP,
+            algorithm: None,
         }
     }
 }

@@ -16,10 +16,13 @@
 //! | [`ssrms_f32`] | `SsrmsF32` | SSRMS in `f32` | `--name SsrmsF32 --scalar f32 -o generated/src/ssrms_f32.rs` |
 //! | [`ssrms_fma`] | `SsrmsFma` | SSRMS with fused multiply-adds (`libm::fma`) | `--name SsrmsFma --fma -o generated/src/ssrms_fma.rs` |
 //! | [`free_floating_7dof`] | `FreeFloating7` | the 7-dof bMSd arm on its free-floating 1000 kg base (`tests/data/reference/bmsd_7dof_free_floating.urdf`; Pinocchio's free-flyer layout `q` (7 + 7), `v` (6 + 7)) | `--name FreeFloating7 --base free-floating --allow-nonphysical -o generated/src/free_floating_7dof.rs` |
+//! | [`ssrms_recurrent`] | `SsrmsRecurrent` | SSRMS by the paper's recurrent algorithm, forced (for the speed comparison in `kanegen bench`) | `--name SsrmsRecurrent --algorithm recurrent -o generated/src/ssrms_recurrent.rs` |
 //!
 //! The files are checked by the root crate's tests: regenerated and compared byte for byte.
 #![no_std]
-#![forbid(unsafe_code)]
+// Denied, not forbidden: each file's private `mul_add` allows its one intrinsic call (the fused
+// multiply-add, compiled only where the build targets FMA).
+#![deny(unsafe_code)]
 #![warn(missing_docs)]
 
 // The files are written by prettyplease; rustfmt leaves them as generated.
@@ -35,3 +38,5 @@ pub mod ssrms6;
 pub mod ssrms_f32;
 #[rustfmt::skip]
 pub mod ssrms_fma;
+#[rustfmt::skip]
+pub mod ssrms_recurrent;

@@ -8,6 +8,7 @@
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
+//! Algorithm: per function the cheapest candidate (below).
 //! Fused multiply-adds where the target has them: 1079 (`mass_matrix` 79, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 267, `mass_matrix_and_nonlinear_effects` 202, `forward_dynamics_with_wrenches` 274), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
@@ -2272,8 +2273,10 @@ impl Srms {
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations
-    /// elsewhere.
+    /// elsewhere. The intrinsic is the one `unsafe` call of the file (no safe fused
+    /// multiply-add exists in `core`), allowed here for crates that deny `unsafe_code`.
     #[inline(always)]
+    #[allow(unsafe_code)]
     fn mul_add(a: f64, b: f64, c: f64) -> f64 {
         #[cfg(all(target_arch = "x86_64", target_feature = "fma"))]
         {

@@ -27,6 +27,7 @@ struct Input {
     target_fma: bool,
     regroup: bool,
     snap: Option<f64>,
+    algorithm: Option<kanegen_codegen::kanegen_dynamics::Methods>,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -67,6 +68,7 @@ impl Parse for Input {
             target_fma: true,
             regroup: true,
             snap: None,
+            algorithm: None,
         };
         let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
@@ -116,6 +118,13 @@ impl Parse for Input {
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
                 "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
+                "algorithm" => {
+                    let name: LitStr = input.parse()?;
+                    out.algorithm = Some(
+                        kanegen_codegen::forced_algorithm(&name.value())
+                            .map_err(|e| syn::Error::new(name.span(), e.0))?,
+                    );
+                }
                 "snap" => {
                     let e: Expr = input.parse()?;
                     let x = float(&e)?;
@@ -136,7 +145,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap, algorithm)"
                         ),
                     ))
                 }
@@ -187,6 +196,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.fma = input.fma;
     opts.regroup = input.regroup;
     opts.target_fma = input.target_fma;
+    opts.algorithm = input.algorithm;
     if let Some(snap) = input.snap {
         opts.snap = snap;
     }

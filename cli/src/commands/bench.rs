@@ -52,6 +52,7 @@ pub const SSRMS_URDF: &str =
 pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
     use kanegen_dynamics::{Loads, Methods, Params};
     use kanegen_generated::ssrms::Ssrms;
+    use kanegen_generated::ssrms_recurrent::SsrmsRecurrent;
     let model = kanegen_model::io::parse_urdf(SSRMS_URDF)?;
     let p = Params::<f64>::new(&model);
     let n = model.dof();
@@ -63,6 +64,14 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
         "M+c".into(),
         Box::new(move |q, qd| {
             let (m, nle) = Ssrms::mass_matrix_and_nonlinear_effects(&arr(q), &arr(qd));
+            m[0][0] + m[6][6] + nle[0] + nle[6]
+        }),
+    ));
+    c.push((
+        "generated recurrent".into(),
+        "M+c".into(),
+        Box::new(move |q, qd| {
+            let (m, nle) = SsrmsRecurrent::mass_matrix_and_nonlinear_effects(&arr(q), &arr(qd));
             m[0][0] + m[6][6] + nle[0] + nle[6]
         }),
     ));
@@ -87,6 +96,11 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
         "forward_dynamics".into(),
         Box::new(move |q, qd| Ssrms::forward_dynamics(&arr(q), &arr(qd), &zero)[6]),
     ));
+    c.push((
+        "generated recurrent".into(),
+        "forward_dynamics".into(),
+        Box::new(move |q, qd| SsrmsRecurrent::forward_dynamics(&arr(q), &arr(qd), &zero)[6]),
+    ));
     for (name, methods) in fast {
         let p = &p;
         c.push((
@@ -99,6 +113,11 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
         "generated".into(),
         "inverse_dynamics".into(),
         Box::new(move |q, qd| Ssrms::inverse_dynamics(&arr(q), &arr(qd), &arr(qd))[6]),
+    ));
+    c.push((
+        "generated recurrent".into(),
+        "inverse_dynamics".into(),
+        Box::new(move |q, qd| SsrmsRecurrent::inverse_dynamics(&arr(q), &arr(qd), &arr(qd))[6]),
     ));
     for (name, methods) in fast {
         let p = &p;

@@ -82,12 +82,14 @@ pub struct GeneratedFile {
     pub base: Option<BaseKind>,
     /// Accept published inertias that violate the triangle inequality (`--allow-nonphysical`).
     pub allow_nonphysical: bool,
+    /// The forced algorithm (`--algorithm`; `None`: the cheapest per function).
+    pub algorithm: Option<&'static str>,
 }
 
 /// The files of `generated/src/`, each reproducible with
 /// `kanegen generate MODEL --name TYPE [--lock INDEX=VALUE] [--scalar f32] [--fma]
-/// [--base free-floating] [--allow-nonphysical] -o FILE`.
-pub const GENERATED: [GeneratedFile; 6] = [
+/// [--base free-floating] [--allow-nonphysical] [--algorithm NAME] -o FILE`.
+pub const GENERATED: [GeneratedFile; 7] = [
     GeneratedFile {
         file: "generated/src/ssrms.rs",
         model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
@@ -97,6 +99,7 @@ pub const GENERATED: [GeneratedFile; 6] = [
         fma: false,
         base: None,
         allow_nonphysical: false,
+        algorithm: None,
     },
     GeneratedFile {
         file: "generated/src/ssrms6.rs",
@@ -107,6 +110,7 @@ pub const GENERATED: [GeneratedFile; 6] = [
         fma: false,
         base: None,
         allow_nonphysical: false,
+        algorithm: None,
     },
     GeneratedFile {
         file: "generated/src/srms.rs",
@@ -117,6 +121,7 @@ pub const GENERATED: [GeneratedFile; 6] = [
         fma: false,
         base: None,
         allow_nonphysical: false,
+        algorithm: None,
     },
     GeneratedFile {
         file: "generated/src/ssrms_f32.rs",
@@ -127,6 +132,7 @@ pub const GENERATED: [GeneratedFile; 6] = [
         fma: false,
         base: None,
         allow_nonphysical: false,
+        algorithm: None,
     },
     GeneratedFile {
         file: "generated/src/ssrms_fma.rs",
@@ -137,6 +143,7 @@ pub const GENERATED: [GeneratedFile; 6] = [
         fma: true,
         base: None,
         allow_nonphysical: false,
+        algorithm: None,
     },
     GeneratedFile {
         file: "generated/src/free_floating_7dof.rs",
@@ -147,6 +154,18 @@ pub const GENERATED: [GeneratedFile; 6] = [
         fma: false,
         base: Some(BaseKind::FreeFloating),
         allow_nonphysical: true,
+        algorithm: None,
+    },
+    GeneratedFile {
+        file: "generated/src/ssrms_recurrent.rs",
+        model: "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+        type_name: "SsrmsRecurrent",
+        lock: None,
+        float: Float::F64,
+        fma: false,
+        base: None,
+        allow_nonphysical: false,
+        algorithm: Some("recurrent"),
     },
 ];
 
@@ -185,6 +204,9 @@ impl GeneratedFile {
         if self.allow_nonphysical {
             c += " --allow-nonphysical";
         }
+        if let Some(a) = self.algorithm {
+            c += &format!(" --algorithm {a}");
+        }
         c + &format!(" -o {}", self.file)
     }
 
@@ -195,6 +217,9 @@ impl GeneratedFile {
         o.float = self.float;
         o.fma = self.fma;
         o.base = self.base;
+        o.algorithm = self
+            .algorithm
+            .map(|a| kanegen_codegen::forced_algorithm(a).expect("a known algorithm"));
         o
     }
 

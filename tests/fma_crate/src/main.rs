@@ -1,5 +1,7 @@
 //! Prints `M(q)` (upper triangle) and `c(q, q̇)` of the SSRMS at the states on stdin, one line of
-//! `f64` bit patterns (hex) per state: `q` and `q̇` come as 14 numbers per line.
+//! `f64` bit patterns (hex) per state: `q` and `q̇` come as 14 numbers per line. It also checks that
+//! the checked-in `kanegen-generated` SSRMS (the same code, in a crate that denies unsafe code)
+//! builds with FMA and gives the same bits.
 
 use std::io::BufRead;
 
@@ -15,6 +17,11 @@ fn main() {
         let q: [f64; 7] = core::array::from_fn(|i| x[i]);
         let qd: [f64; 7] = core::array::from_fn(|i| x[7 + i]);
         let (m, c) = Ssrms::mass_matrix_and_nonlinear_effects(&q, &qd);
+        // The checked-in file is the same code: the same bits.
+        assert_eq!(
+            kanegen_generated::ssrms::Ssrms::mass_matrix_and_nonlinear_effects(&q, &qd),
+            (m, c)
+        );
         let out: Vec<String> = (0..7)
             .flat_map(|i| (i..7).map(move |j| (i, j)))
             .map(|(i, j)| m[i][j])

@@ -1,0 +1,3 @@
+kanegen::dynamics!(Arm, "bad/negative_mass.toml", algorithm = "fastest");
+
+fn main() {}
