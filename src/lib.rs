@@ -22,8 +22,8 @@ extern crate std;
 ///
 /// `dynamics!(Name, "path/to/model.urdf" [, base = "free-floating"] [, gravity = [x, y, z]]
 /// [, allow_nonphysical = true] [, runtime_payload = true] [, scalar = f32] [, fma = true]
-/// [, fma_path = f64::mul_add] [, target_fma = false] [, regroup = false] [, snap = 1e-9])`
-/// defines `pub struct Name;` with the associated constants `N`,
+/// [, fma_path = f64::mul_add] [, target_fma = false] [, regroup = false] [, snap = 1e-9]
+/// [, algorithm = "recurrent"])` defines `pub struct Name;` with the associated constants `N`,
 /// `JOINTS`, `FRAMES`, `OP_COUNTS`, `CANDIDATES` and, on `&[f64; N]` arrays, the functions of
 /// `M(q) q̈ + c(q, q̇) = τ`: `mass_matrix(q)`, `nonlinear_effects(q, qd)`,
 /// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)`,
@@ -51,7 +51,11 @@ extern crate std;
 /// what moved). `snap = TOL` (default 1e-15, `0.0` off) snaps float noise in the model before
 /// tracing: rotations within `TOL` of a signed permutation become it, smaller offsets and
 /// inertia entries 0 (Panda's `cos(π/2) = 6.1e-17` residues: (M, c) in 1455 operations instead
-/// of 2122); the header says how many numbers moved and by how much.
+/// of 2122); the header says how many numbers moved and by how much. `algorithm = NAME` forces
+/// one algorithm (`recurrent`, the paper's; `recurrent-r1`, `kane-direct`, `crba-base`,
+/// `spatial`, `aba`) for every function with a mass-matrix, bias or forward method instead of
+/// the cheapest candidate; a chain-only algorithm on a tree is a compile error naming the
+/// branching joint.
 ///
 /// The path is relative to the calling crate's `CARGO_MANIFEST_DIR`; the crate is rebuilt when
 /// the file changes. A missing, malformed or non-physical model is a compile error at the path.
