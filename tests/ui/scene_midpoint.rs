@@ -1,0 +1,3 @@
+kanegen::scene!(Bad, "bad/scene_midpoint.toml");
+
+fn main() {}
