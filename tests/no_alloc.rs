@@ -1,5 +1,6 @@
 //! The generated functions allocate nothing: a counting global allocator is read before and
-//! after many calls of every function (generated crate and `dynamics!` output).
+//! after many calls of every function (generated crate and `dynamics!` output), and around whole
+//! runs of `scene!` simulators (RK4 with a tabulated wrench, dopri5 on a free-floating base).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -38,8 +39,27 @@ kanegen::dynamics!(
 
 use kanegen_generated::ssrms::Ssrms;
 
+kanegen::scene!(SsrmsEffects, "scenes/ssrms_effects.toml");
+kanegen::scene!(FreeFloating7, "scenes/free_floating_7dof.toml");
+
+/// The scene runs (called from the one test: the counter is global, a second test thread's
+/// allocations would count).
+fn scene_runs_do_not_allocate() {
+    let mut acc = 0.0;
+    let before = ALLOCATIONS.load(Ordering::SeqCst);
+    let a = SsrmsEffects::run(|t, s| acc += t + s.q[0]).unwrap();
+    let b = FreeFloating7::run(|t, s| acc += t + s.v[0]).unwrap();
+    let mut st = SsrmsEffects::initial_state();
+    SsrmsEffects::step(0.5, &mut st, 0.01);
+    let d = FreeFloating7::rhs(0.0, &FreeFloating7::initial_state());
+    assert_eq!(ALLOCATIONS.load(Ordering::SeqCst), before);
+    assert!(a.steps == 1000 && b.steps > 0 && acc.is_finite() && st.q[0].is_finite());
+    assert!(d.q[3].is_finite());
+}
+
 #[test]
 fn generated_functions_do_not_allocate() {
+    scene_runs_do_not_allocate();
     // The counter itself works: a Vec allocates.
     let before = ALLOCATIONS.load(Ordering::SeqCst);
     let v = std::hint::black_box(vec![1.0f64; 16]);
