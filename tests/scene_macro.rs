@@ -1,20 +1,25 @@
 //! `kanegen::scene!` against the interpreted simulator (`kanegen::sim`), on every example scene
 //! of `scenes/` (all five are supported: none uses the midpoint integrator or wrenches with a
-//! computed-torque drive, the two features `scene!` rejects):
+//! computed-torque drive, the two features `scene!` rejects) and on two test scenes with the
+//! effects the examples lack (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base, constant
+//! and tabulated body-frame wrenches on one body, constant drives; `floating_wrenches.toml`,
+//! free-floating under gravity, wrenches on the base in both frames and on two links, constant
+//! drives, damping):
 //!
 //! - the compiled run samples at the same times as the interpreted one, and every state
 //!   component agrees to `|x_c − x_i| ≤ 1e-9 (1 + |x_i|)` at every sample — the same integrator
 //!   and step (RK4) or tolerance (dopri5) on right-hand sides equal to rounding; measured worst
-//!   9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), the fixed-base scenes ≤ 3.8e-16,
-//!   Dextre 7.2e-15;
+//!   9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.2e-15, the test scenes
+//!   2.4e-14 and 2.4e-15, the other fixed-base scenes ≤ 3.8e-16;
 //! - on the free-floating 7-dof scene, the compiled run conserves linear and angular momentum
 //!   (`NameDynamics::momentum`) as the interpreted one does (its summary's drift): measured
 //!   drifts 5.6e-11 (linear) and 3.49e-10 (angular) relative, interpreted 5.6e-11 and 3.48e-10;
 //! - the compiled right-hand side and one RK4 step ([`SsrmsEffects::step`]) off the equilibrium
 //!   are the interpreted ones.
 //!
-//! The checks see a wrong effect: the inertial-frame wrench rotated by `R` instead of `Rᵀ` moves
-//! the SSRMS effects scene by 3.1e-2 (relative) and fails the first and last.
+//! The checks see a wrong effect: the SSRMS wrist wrench rotated by `R` instead of `Rᵀ` moves the
+//! SSRMS effects scene by 3.1e-2 (relative) and fails the first and last; the base's
+//! inertial-frame wrench left unrotated moves `floating_wrenches` by 2.4e-2.
 
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, Run};
@@ -25,6 +30,8 @@ kanegen::scene!(SsrmsPayload, "scenes/ssrms_payload_fixed.toml");
 kanegen::scene!(Srms, "scenes/srms.toml");
 kanegen::scene!(FreeFloating7, "scenes/free_floating_7dof.toml");
 kanegen::scene!(Dextre, "scenes/dextre_free_floating.toml");
+kanegen::scene!(GravityWrench, "tests/data/scenes/gravity_wrench.toml");
+kanegen::scene!(FloatingWrenches, "tests/data/scenes/floating_wrenches.toml");
 
 fn interpreted(file: &str) -> (Scene, Run) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
@@ -94,6 +101,16 @@ agree!(
     "scenes/free_floating_7dof.toml"
 );
 agree!(dextre_agrees, Dextre, "scenes/dextre_free_floating.toml");
+agree!(
+    gravity_wrench_agrees,
+    GravityWrench,
+    "tests/data/scenes/gravity_wrench.toml"
+);
+agree!(
+    floating_wrenches_agrees,
+    FloatingWrenches,
+    "tests/data/scenes/floating_wrenches.toml"
+);
 
 /// The compiled free-floating run conserves momentum as the interpreted one does.
 #[test]
