@@ -81,17 +81,20 @@ macro_rules! dynamics {
 ///   `initial_state()`, `rhs(t, &state)` (the derivative, same layout; only the effects the
 ///   scene names: its drives — constant, PD or computed torque —, joint damping, constant or
 ///   tabulated wrenches in the body or inertial frame, gravity), `step(t, &mut state, h)` (one
-///   fixed RK4 step, the quaternion renormalized) and `run(|t, &state| …)`, which integrates
-///   over the scene's duration with the scene's integrator — fixed-step RK4, or for
-///   `integrator = "dopri5"` the adaptive Dormand–Prince 5(4) with the scene's tolerance and its
-///   dense output ([`ode`]) — calling the observer at the scene's output times.
+///   step of the scene's fixed-step integrator: RK4, the quaternion renormalized, or the implicit
+///   midpoint rule; RK4 for a dopri5 scene) and `run(|t, &state| …)`, which integrates over the
+///   scene's duration with the scene's integrator — fixed-step RK4, the Lie-group implicit
+///   midpoint rule, or for `integrator = "dopri5"` the adaptive Dormand–Prince 5(4) with the
+///   scene's tolerance and its dense output ([`ode`]) — calling the observer at the scene's
+///   output times.
 ///
 /// The code is allocation-free, panic-free and `no_std`, and agrees with the interpreted
 /// simulator to the rounding of the right-hand side (`tests/scene_macro.rs`). The scene's
 /// `simulation.algorithm` only selects how the interpreted simulator evaluates the dynamics: the
-/// generated functions use the cheapest method (the same values to rounding). Scene features the
-/// generated simulator does not reproduce — the `midpoint` integrator, wrenches together with a
-/// computed-torque drive — and every scene error are compile errors naming the key and the file.
+/// generated functions use the cheapest method (the same values to rounding). The one scene
+/// feature the generated simulator does not reproduce — wrenches together with a computed-torque
+/// drive, whose inverse dynamics would need them — and every scene error are compile errors
+/// naming the key and the file.
 ///
 /// ```
 /// kanegen::scene!(Srms, "scenes/srms.toml");

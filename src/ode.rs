@@ -1,7 +1,8 @@
 //! Allocation-free, `no_std` integrators over fixed-size states `[f64; D]`, for the simulators
 //! that [`scene!`](crate::scene!) generates: one classical Runge–Kutta 4 step ([`rk4_step`]),
-//! fixed-step RK4 runs ([`rk4`]) and adaptive Dormand–Prince 5(4) runs with dense output
-//! ([`dopri5`]).
+//! fixed-step RK4 runs ([`rk4`]), adaptive Dormand–Prince 5(4) runs with dense output
+//! ([`dopri5`]), and the fixed-step Lie-group implicit midpoint rule ([`midpoint_step`],
+//! [`midpoint`]; Hairer, Lubich & Wanner, *Geometric Numerical Integration*).
 //!
 //! They mirror the interpreted simulator's integrators (`kanegen::sim::integrate`, `std`) step
 //! for step — the same step counts and times, the same tableau (Hairer, Nørsett & Wanner,
@@ -49,6 +50,13 @@ pub enum Stop {
         /// Work done.
         stats: Stats,
     },
+    /// The fixed-point iterations of an implicit midpoint step did not converge.
+    NotConverged {
+        /// Time of the step.
+        t: f64,
+        /// Work done.
+        stats: Stats,
+    },
 }
 
 /// The number of RK4 steps from `t0` to `t1` with step about `h`, and the step actually taken:
@@ -83,7 +91,7 @@ pub fn rk4_step<const D: usize>(
     core::array::from_fn(|i| x[i] + (h6 * k1[i] + h3 * k2[i] + h3 * k3[i] + h6 * k4[i]))
 }
 
-/// Options of [`rk4`].
+/// Options of [`rk4`] and [`midpoint`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Rk4Options {
     /// Step (shortened so that a whole number of steps ends at `t1`, [`fixed_steps`]).
@@ -388,4 +396,144 @@ pub fn quintic(t: f64, duration: f64) -> (f64, f64, f64) {
     let ds = 30.0 * tau * tau * (1.0 - tau) * (1.0 - tau);
     let dds = 60.0 * tau * (1.0 - tau) * (1.0 - 2.0 * tau);
     (s, ds / duration, dds / (duration * duration))
+}
+
+/// Iteration limit of a [`midpoint_step`] (as the interpreted simulator's).
+pub const MIDPOINT_MAX_ITER: usize = 60;
+
+/// The additive update `x + h f` (the `advance` of a state without a Lie-group part).
+#[must_use]
+pub fn advance_additive<const D: usize>(
+    x: &[f64; D],
+    h: f64,
+    _at: &[f64; D],
+    f: &[f64; D],
+) -> [f64; D] {
+    core::array::from_fn(|i| x[i] + h * f[i])
+}
+
+/// The update of a free-floating state `[p₀, quat, q, v_b, ω_b, q̇]` with `n` joints: additive,
+/// except the quaternion `x[3..7]`, which becomes `quat ⊗ exp(h ω_b(at) / 2)` (exponential map,
+/// unit by construction, symmetric in `h`), as the interpreted `SceneSystem::advance`.
+#[must_use]
+pub fn advance_floating<const D: usize>(
+    x: &[f64; D],
+    h: f64,
+    at: &[f64; D],
+    f: &[f64; D],
+) -> [f64; D] {
+    let mut out = advance_additive(x, h, at, f);
+    // D = 13 + 2n: ω_b at 10 + n.
+    let n = (D - 13) / 2;
+    let om = [at[10 + n], at[11 + n], at[12 + n]];
+    let w_norm = libm::sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);
+    let half = 0.5 * h * w_norm;
+    let s = if libm::fabs(half) < 1e-8 {
+        0.5 * h * (1.0 - half * half / 6.0)
+    } else {
+        libm::sin(half) / w_norm
+    };
+    let (rho, rw) = ([s * om[0], s * om[1], s * om[2]], libm::cos(half));
+    let (u, w) = ([x[3], x[4], x[5]], x[6]);
+    let cross = [
+        u[1] * rho[2] - u[2] * rho[1],
+        u[2] * rho[0] - u[0] * rho[2],
+        u[0] * rho[1] - u[1] * rho[0],
+    ];
+    for i in 0..3 {
+        out[3 + i] = w * rho[i] + rw * u[i] + cross[i];
+    }
+    out[6] = w * rw - (u[0] * rho[0] + u[1] * rho[1] + u[2] * rho[2]);
+    out
+}
+
+/// One step of the implicit midpoint rule from `(t, x)`: `x_m = x ⊕ (h/2) f(t + h/2, x_m)`
+/// solved by fixed-point iteration from the explicit-Euler predictor until the max-norm update
+/// is ≤ `1e-14 (1 + |x|∞)`, then `x ⊕ h f(t + h/2, x_m)`; `⊕` is `advance` ([`advance_additive`]
+/// or [`advance_floating`]). As `kanegen::sim::integrate::midpoint`. `stats` counts the
+/// evaluations.
+///
+/// # Errors
+/// [`Stop::NonFinite`] when an iterate or the result is not finite, [`Stop::NotConverged`]
+/// after [`MIDPOINT_MAX_ITER`] iterations.
+pub fn midpoint_step<const D: usize>(
+    f: &mut impl FnMut(f64, &[f64; D]) -> [f64; D],
+    advance: impl Fn(&[f64; D], f64, &[f64; D], &[f64; D]) -> [f64; D],
+    t: f64,
+    x: &[f64; D],
+    h: f64,
+    stats: &mut Stats,
+) -> Result<[f64; D], Stop> {
+    let tm = t + 0.5 * h;
+    let mut fx = f(t, x);
+    stats.evals += 1;
+    let mut xm = advance(x, 0.5 * h, x, &fx);
+    let scale = 1.0 + x.iter().fold(0.0_f64, |m, v| m.max(libm::fabs(*v)));
+    let mut converged = false;
+    for _ in 0..MIDPOINT_MAX_ITER {
+        fx = f(tm, &xm);
+        stats.evals += 1;
+        let next = advance(x, 0.5 * h, &xm, &fx);
+        let diff = xm
+            .iter()
+            .zip(&next)
+            .fold(0.0_f64, |m, (a, b)| m.max(libm::fabs(a - b)));
+        xm = next;
+        if !diff.is_finite() {
+            let index = non_finite(&xm).unwrap_or(0);
+            return Err(Stop::NonFinite {
+                t,
+                index,
+                stats: *stats,
+            });
+        }
+        if diff <= 1e-14 * scale {
+            converged = true;
+            break;
+        }
+    }
+    if !converged {
+        return Err(Stop::NotConverged { t, stats: *stats });
+    }
+    let out = advance(x, h, &xm, &fx);
+    if let Some(index) = non_finite(&out) {
+        return Err(Stop::NonFinite {
+            t: t + h,
+            index,
+            stats: *stats,
+        });
+    }
+    Ok(out)
+}
+
+/// The fixed-step implicit midpoint rule from `t0` to `t1` ([`fixed_steps`], [`midpoint_step`]);
+/// no projection; `observe(t, x)` at `t0`, after every `output_every`-th step and after the
+/// last.
+///
+/// # Errors
+/// The first failed step's [`Stop`] (`x` keeps the last accepted state).
+pub fn midpoint<const D: usize>(
+    f: &mut impl FnMut(f64, &[f64; D]) -> [f64; D],
+    advance: impl Fn(&[f64; D], f64, &[f64; D], &[f64; D]) -> [f64; D],
+    t0: f64,
+    t1: f64,
+    opts: &Rk4Options,
+    x: &mut [f64; D],
+    mut observe: impl FnMut(f64, &[f64; D]),
+) -> Result<Stats, Stop> {
+    let (n, h) = fixed_steps(t0, t1, opts.step);
+    let every = opts.output_every.max(1);
+    let mut stats = Stats::default();
+    observe(t0, x);
+    for step in 1..=n {
+        let t = t0 + (step - 1) as f64 * h;
+        let next = midpoint_step(f, &advance, t, x, h, &mut stats)?;
+        *x = next;
+        stats.steps += 1;
+        if step % every == 0 || step == n {
+            let t = if step == n { t1 } else { t0 + step as f64 * h };
+            observe(t, x);
+        }
+    }
+    Ok(stats)
 }

@@ -50,7 +50,7 @@ fn scene_runs_do_not_allocate() {
     let a = SsrmsEffects::run(|t, s| acc += t + s.q[0]).unwrap();
     let b = FreeFloating7::run(|t, s| acc += t + s.v[0]).unwrap();
     let mut st = SsrmsEffects::initial_state();
-    SsrmsEffects::step(0.5, &mut st, 0.01);
+    SsrmsEffects::step(0.5, &mut st, 0.01).unwrap();
     let d = FreeFloating7::rhs(0.0, &FreeFloating7::initial_state());
     assert_eq!(ALLOCATIONS.load(Ordering::SeqCst), before);
     assert!(a.steps == 1000 && b.steps > 0 && acc.is_finite() && st.q[0].is_finite());

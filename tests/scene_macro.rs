@@ -1,21 +1,23 @@
 //! `kanegen::scene!` against the interpreted simulator (`kanegen::sim`), on every example scene
-//! of `scenes/` (all five are supported: none uses the midpoint integrator or wrenches with a
-//! computed-torque drive, the two features `scene!` rejects) and on two test scenes with the
-//! effects the examples lack (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base, constant
-//! and tabulated body-frame wrenches on one body, constant drives; `floating_wrenches.toml`,
-//! free-floating under gravity, wrenches on the base in both frames and on two links, constant
-//! drives, damping):
+//! of `scenes/` (all five are supported: none has wrenches with a computed-torque drive, the one
+//! feature `scene!` rejects) and on three test scenes with what the examples lack
+//! (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base, constant and tabulated body-frame
+//! wrenches on one body, constant drives; `floating_wrenches.toml`, free-floating under
+//! gravity, wrenches on the base in both frames and on two links, constant drives, damping;
+//! `floating_midpoint.toml`, a tumbling free-floating base under PD drives, implicit midpoint):
 //!
 //! - the compiled run samples at the same times as the interpreted one, and every state
 //!   component agrees to `|x_c − x_i| ≤ 1e-9 (1 + |x_i|)` at every sample — the same integrator
-//!   and step (RK4) or tolerance (dopri5) on right-hand sides equal to rounding; measured worst
-//!   9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.2e-15, the test scenes
-//!   2.4e-14 and 2.4e-15, the other fixed-base scenes ≤ 3.8e-16;
+//!   and step (RK4, midpoint) or tolerance (dopri5) on right-hand sides equal to rounding;
+//!   measured worst 9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.2e-15,
+//!   the test scenes 2.4e-14, 2.4e-15 and 5.2e-16 (midpoint), the other fixed-base scenes
+//!   ≤ 3.8e-16;
 //! - on the free-floating 7-dof scene, the compiled run conserves linear and angular momentum
 //!   (`NameDynamics::momentum`) as the interpreted one does (its summary's drift): measured
 //!   drifts 5.6e-11 (linear) and 3.49e-10 (angular) relative, interpreted 5.6e-11 and 3.48e-10;
 //! - the compiled right-hand side and one RK4 step ([`SsrmsEffects::step`]) off the equilibrium
-//!   are the interpreted ones.
+//!   are the interpreted ones; ten midpoint steps ([`FloatingMidpoint::step`]) are the run's
+//!   state at its first output sample.
 //!
 //! The checks see a wrong effect: the SSRMS wrist wrench rotated by `R` instead of `Rᵀ` moves the
 //! SSRMS effects scene by 3.1e-2 (relative) and fails the first and last; the base's
@@ -32,6 +34,7 @@ kanegen::scene!(FreeFloating7, "scenes/free_floating_7dof.toml");
 kanegen::scene!(Dextre, "scenes/dextre_free_floating.toml");
 kanegen::scene!(GravityWrench, "tests/data/scenes/gravity_wrench.toml");
 kanegen::scene!(FloatingWrenches, "tests/data/scenes/floating_wrenches.toml");
+kanegen::scene!(FloatingMidpoint, "tests/data/scenes/floating_midpoint.toml");
 
 fn interpreted(file: &str) -> (Scene, Run) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
@@ -111,6 +114,11 @@ agree!(
     FloatingWrenches,
     "tests/data/scenes/floating_wrenches.toml"
 );
+agree!(
+    floating_midpoint_agrees,
+    FloatingMidpoint,
+    "tests/data/scenes/floating_midpoint.toml"
+);
 
 /// The compiled free-floating run conserves momentum as the interpreted one does.
 #[test]
@@ -161,9 +169,28 @@ fn one_step_matches_interpreted_rk4() {
     for (a, b) in d.iter().zip(&di) {
         assert!((a - b).abs() <= 1e-10 * (1.0 + b.abs()), "rhs {a} vs {b}");
     }
-    SsrmsEffects::step(t, &mut st, h);
+    SsrmsEffects::step(t, &mut st, h).unwrap();
     rk4(&mut sys, t, t + h, h, &mut x, |_, _, _| ()).unwrap();
     for (a, b) in st.to_array().iter().zip(&x) {
         assert!((a - b).abs() <= 1e-12 * (1.0 + b.abs()), "step {a} vs {b}");
     }
+}
+
+/// `step` of a midpoint scene is the run's step: ten of them reach the first output sample.
+#[test]
+fn midpoint_steps_are_the_run() {
+    let mut st = FloatingMidpoint::initial_state();
+    for k in 0..10 {
+        FloatingMidpoint::step(f64::from(k) * 0.01, &mut st, 0.01).unwrap();
+    }
+    let mut first = None;
+    FloatingMidpoint::run(|t, s| {
+        if first.is_none() && t > 0.0 {
+            first = Some(*s);
+        }
+    })
+    .unwrap();
+    assert_eq!(first.unwrap(), st);
+    let norm: f64 = st.q[3..7].iter().map(|x| x * x).sum();
+    assert!((norm - 1.0).abs() < 1e-14, "|quat|² − 1 = {}", norm - 1.0);
 }

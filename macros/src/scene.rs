@@ -6,8 +6,8 @@
 //! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
 //! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
 //! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
-//! `kanegen_sim::integrate`. Scene features the generated simulator does not reproduce are
-//! compile errors naming the key and the scene file.
+//! `kanegen_sim::integrate`. Scene features the generated simulator does not reproduce (wrenches
+//! with a computed-torque drive) are compile errors naming the key and the scene file.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
 use kanegen_sim::scene::{BaseSpec, Drives, Integrator, Scene, WrenchProfile};
@@ -51,12 +51,6 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         ))
     };
     let sim = &scene.simulation;
-    if sim.integrator == Integrator::Midpoint {
-        unsupported(
-            "simulation.integrator = \"midpoint\"",
-            "the generated simulators integrate with rk4 or dopri5",
-        )?;
-    }
     if matches!(scene.drives, Drives::ComputedTorque { .. }) && !scene.wrenches.is_empty() {
         unsupported(
             "effects.wrench with drives.type = \"computed-torque\"",
@@ -310,16 +304,42 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         .concat(),
     };
     let (q0, v0) = (arr(&x0[..nq]), arr(&x0[nq..]));
-    let (project, project_step) = if floating {
-        (
-            quote!(#runtime::ode::normalize_quaternion::<#dim>),
-            quote! {
-                let mut x = x;
-                #runtime::ode::normalize_quaternion(&mut x);
-            },
-        )
+    let project = if floating {
+        quote!(#runtime::ode::normalize_quaternion::<#dim>)
     } else {
-        (quote!(|_: &mut [f64; #dim]| {}), quote!())
+        quote!(|_: &mut [f64; #dim]| {})
+    };
+    let advance = if floating {
+        quote!(#runtime::ode::advance_floating::<#dim>)
+    } else {
+        quote!(#runtime::ode::advance_additive::<#dim>)
+    };
+    let step_body = if sim.integrator == Integrator::Midpoint {
+        quote! {
+            let mut stats = #runtime::ode::Stats::default();
+            let x = #runtime::ode::midpoint_step(
+                &mut f, #advance, t, &state.to_array(), h, &mut stats,
+            )?;
+        }
+    } else {
+        let first = if floating {
+            quote! {
+                let mut x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);
+                #runtime::ode::normalize_quaternion(&mut x);
+            }
+        } else {
+            quote!(let x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);)
+        };
+        quote! {
+            #first
+            if let Some(index) = x.iter().position(|v| !v.is_finite()) {
+                return Err(#runtime::ode::Stop::NonFinite {
+                    t: t + h,
+                    index,
+                    stats: #runtime::ode::Stats { steps: 0, rejected_steps: 0, evals: 4 },
+                });
+            }
+        }
     };
     let (duration, step, tolerance, max_step) = (
         lit(sim.duration),
@@ -338,12 +358,19 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             };
             #runtime::ode::dopri5(&mut f, #project, 0.0, Self::DURATION, &opts, &mut x, obs)
         },
-        _ => quote! {
+        Integrator::Rk4 => quote! {
             let opts = #runtime::ode::Rk4Options {
                 step: Self::STEP,
                 output_every: Self::OUTPUT_EVERY,
             };
             #runtime::ode::rk4(&mut f, #project, 0.0, Self::DURATION, &opts, &mut x, obs)
+        },
+        Integrator::Midpoint => quote! {
+            let opts = #runtime::ode::Rk4Options {
+                step: Self::STEP,
+                output_every: Self::OUTPUT_EVERY,
+            };
+            #runtime::ode::midpoint(&mut f, #advance, 0.0, Self::DURATION, &opts, &mut x, obs)
         },
     };
     let integrator_doc = match sim.integrator {
@@ -355,11 +382,22 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             sim.step,
             sim.step * sim.output_every as f64
         ),
-        _ => format!(
+        Integrator::Rk4 => format!(
             " The scene's integrator: fixed-step RK4 (`kanegen::ode::rk4`), step {} s, a sample \
              every {} steps.",
             sim.step, sim.output_every
         ),
+        Integrator::Midpoint => format!(
+            " The scene's integrator: the fixed-step Lie-group implicit midpoint rule \
+             (`kanegen::ode::midpoint`), step {} s, a sample every {} steps.",
+            sim.step, sim.output_every
+        ),
+    };
+    let step_doc = if sim.integrator == Integrator::Midpoint {
+        " One implicit midpoint step of size `h` from `(t, state)` (the scene's integrator)."
+    } else {
+        " One fixed RK4 step of size `h` from `(t, state)`, then the projection (the quaternion \
+         renormalized on a free-floating base)."
     };
     let effects = {
         let mut e = Vec::new();
@@ -484,15 +522,22 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 #derivative
             }
 
-            /// One fixed RK4 step of size `h` from `(t, state)`, then the projection (the
-            /// quaternion renormalized on a free-floating base).
-            pub fn step(t: f64, state: &mut #state_ty, h: f64) {
+            #[doc = #step_doc]
+            ///
+            /// # Errors
+            /// A `kanegen::ode::Stop` when the new state is not finite (or the midpoint
+            /// iterations do not converge); `state` is then unchanged.
+            pub fn step(
+                t: f64,
+                state: &mut #state_ty,
+                h: f64,
+            ) -> Result<(), #runtime::ode::Stop> {
                 let mut f = |t: f64, x: &[f64; #dim]| {
                     Self::rhs(t, &#state_ty::from_array(x)).to_array()
                 };
-                let x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);
-                #project_step
+                #step_body
                 *state = #state_ty::from_array(&x);
+                Ok(())
             }
 
             /// Integrates the scene from its initial state over its duration with its

@@ -1,3 +1,0 @@
-kanegen::scene!(Bad, "bad/scene_midpoint.toml");
-
-fn main() {}
