@@ -72,7 +72,8 @@ macro_rules! dynamics {
 /// (`kanegen::sim::scene`) and defines:
 ///
 /// - `NameDynamics`, the [`dynamics!`] of the scene's model with the scene's base, gravity and
-///   payload (plus one frame `scene_wrench_K` on each body loaded by an inertial-frame wrench);
+///   payload (plus one frame `scene_wrench_K` on each body loaded by an inertial-frame wrench,
+///   or by any wrench with a computed-torque drive);
 /// - `NameState`, the state in fixed-size arrays: `q` and `qd` (`N` each) on a fixed base; on a
 ///   free-floating base the free-flyer layout `q = [p₀, quaternion x y z w, joints]`,
 ///   `v = [v_b, ω_b, q̇]` (base coordinates), with `to_array`/`from_array` for the flat vector
@@ -91,10 +92,11 @@ macro_rules! dynamics {
 /// The code is allocation-free, panic-free and `no_std`, and agrees with the interpreted
 /// simulator to the rounding of the right-hand side (`tests/scene_macro.rs`). The scene's
 /// `simulation.algorithm` only selects how the interpreted simulator evaluates the dynamics: the
-/// generated functions use the cheapest method (the same values to rounding). The one scene
-/// feature the generated simulator does not reproduce — wrenches together with a computed-torque
-/// drive, whose inverse dynamics would need them — and every scene error are compile errors
-/// naming the key and the file.
+/// generated functions use the cheapest method (the same values to rounding). A computed-torque
+/// drive compensates constant wrenches through the generated Jacobians (`τ −= Jᵀ w`). The one
+/// scene feature the generated simulator does not reproduce — a tabulated wrench with a
+/// computed-torque drive, which the interpreted controller compensates at its `t = 0` value — and
+/// every scene error are compile errors naming the key and the file.
 ///
 /// ```
 /// kanegen::scene!(Srms, "scenes/srms.toml");

@@ -6,8 +6,9 @@
 //! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
 //! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
 //! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
-//! `kanegen_sim::integrate`. Scene features the generated simulator does not reproduce (wrenches
-//! with a computed-torque drive) are compile errors naming the key and the scene file.
+//! `kanegen_sim::integrate`. The scene feature the generated simulator does not reproduce (a
+//! tabulated wrench with a computed-torque drive) is a compile error naming the key and the
+//! scene file.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
 use kanegen_sim::scene::{BaseSpec, Drives, Integrator, Scene, WrenchProfile};
@@ -51,16 +52,21 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         ))
     };
     let sim = &scene.simulation;
-    if matches!(scene.drives, Drives::ComputedTorque { .. }) && !scene.wrenches.is_empty() {
-        unsupported(
-            "effects.wrench with drives.type = \"computed-torque\"",
-            "the generated inverse dynamics of the controller takes no wrenches",
-        )?;
+    let computed_torque = matches!(scene.drives, Drives::ComputedTorque { .. });
+    if computed_torque {
+        if let Some(k) = scene.wrenches.iter().position(|w| w.is_tabulated()) {
+            unsupported(
+                &format!("effects.wrench[{k}].time with drives.type = \"computed-torque\""),
+                "the interpreted controller compensates a tabulated wrench at its t = 0 value; \
+                 constant wrenches are supported",
+            )?;
+        }
     }
 
     // The model: the scene's payload is merged already; its base kind and inertial are the
     // scene's; one identity frame on each body loaded by an inertial-frame wrench gives the
-    // body's rotation (its generated `<frame>_placement`).
+    // body's rotation (its generated `<frame>_placement`); with a computed-torque drive every
+    // wrench gets one, whose Jacobian maps the wrench to the joints.
     let floating = scene.is_floating();
     let mut model = scene.model.clone();
     if let BaseSpec::FreeFloating { inertial, .. } = &scene.base {
@@ -81,7 +87,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let mut frames: Vec<Frame> = model.frames().to_vec();
     let mut wrench_frames = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {
-        let needs = w.frame == kanegen_dynamics::LoadFrame::Base
+        let needs = (w.frame == kanegen_dynamics::LoadFrame::Base || computed_torque)
             && w.body != kanegen_dynamics::base::BASE_BODY;
         if needs {
             let fname = format!("scene_wrench_{k}");
@@ -90,7 +96,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 parent: Some(w.body),
                 placement: Placement::default(),
             });
-            wrench_frames.push(Some(format_ident!("{}_placement", fname)));
+            wrench_frames.push(Some(fname));
         } else {
             wrench_frames.push(None);
         }
@@ -133,6 +139,46 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         (quote!(let qj = s.q;), quote!(let qdj = s.qd;))
     };
 
+    // A computed-torque drive compensates the (constant) wrenches as the interpreted inverse
+    // dynamics does: `τ −= J_vᵀ f + J_ωᵀ m`, force and moment in base axes at the body origin
+    // (fixed base only: the scene rejects computed torque on a free-floating base).
+    let mut compensate = Vec::new();
+    if computed_torque {
+        for (k, w) in scene.wrenches.iter().enumerate() {
+            let WrenchProfile::Constant { force, moment } = &w.profile else {
+                continue;
+            };
+            let Some(fname) = &wrench_frames[k] else {
+                return Err(format!("{rel}: effects.wrench[{k}]: no frame"));
+            };
+            let (pl, jac) = (
+                format_ident!("{}_placement", fname),
+                format_ident!("{}_jacobian", fname),
+            );
+            let (f, m) = (arr(force), arr(moment));
+            let to_base = if w.frame == kanegen_dynamics::LoadFrame::Body {
+                quote! {
+                    let r = #dyn_ty::#pl(&qj).1;
+                    let (f, m): ([f64; 3], [f64; 3]) = (
+                        core::array::from_fn(|i| r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2]),
+                        core::array::from_fn(|i| r[i][0] * m[0] + r[i][1] * m[1] + r[i][2] * m[2]),
+                    );
+                }
+            } else {
+                quote!()
+            };
+            compensate.push(quote! {{
+                let (f, m): ([f64; 3], [f64; 3]) = (#f, #m);
+                #to_base
+                let jac = #dyn_ty::#jac(&qj);
+                for j in 0..#nl {
+                    tau[j] -= jac[0][j] * f[0] + jac[1][j] * f[1] + jac[2][j] * f[2]
+                        + jac[3][j] * m[0] + jac[4][j] * m[1] + jac[5][j] * m[2];
+                }
+            }});
+        }
+    }
+
     // Drives and damping: τ as the interpreted `SceneSystem::torques`.
     let drives = match &scene.drives {
         Drives::None => quote!(let mut tau = [0.0f64; #nl];),
@@ -169,6 +215,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                     ddsq * di + KD[i] * (dsq * di - qdj[i]) + KP[i] * ((Q0[i] + sq * di) - qj[i])
                 });
                 let mut tau: [f64; #nl] = #dyn_ty::inverse_dynamics(&qj, &qdj, &cmd);
+                #(#compensate)*
             }
         }
     };
@@ -219,7 +266,10 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         // Body-to-reference rotation of an inertial-frame wrench.
         let rot = match (&wrench_frames[k], is_base, w.frame) {
             (_, _, kanegen_dynamics::LoadFrame::Body) => None,
-            (Some(pl), _, _) => Some(quote!(#dyn_ty::#pl(&s.q).1)),
+            (Some(fname), _, _) => {
+                let pl = format_ident!("{}_placement", fname);
+                Some(quote!(#dyn_ty::#pl(&s.q).1))
+            }
             (None, true, _) => Some(quote!(#runtime::ode::quat_to_matrix(&[
                 s.q[3], s.q[4], s.q[5], s.q[6]
             ]))),
