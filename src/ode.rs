@@ -414,7 +414,8 @@ pub fn advance_additive<const D: usize>(
 
 /// The update of a free-floating state `[p₀, quat, q, v_b, ω_b, q̇]` with `n` joints: additive,
 /// except the quaternion `x[3..7]`, which becomes `quat ⊗ exp(h ω_b(at) / 2)` (exponential map,
-/// unit by construction, symmetric in `h`), as the interpreted `SceneSystem::advance`.
+/// unit by construction, symmetric in `h`), as the interpreted `SceneSystem::advance`. `D` is
+/// `13 + 2n`.
 #[must_use]
 pub fn advance_floating<const D: usize>(
     x: &[f64; D],
@@ -423,7 +424,10 @@ pub fn advance_floating<const D: usize>(
     f: &[f64; D],
 ) -> [f64; D] {
     let mut out = advance_additive(x, h, at, f);
-    // D = 13 + 2n: ω_b at 10 + n.
+    // D = 13 + 2n: ω_b at 10 + n (a shorter state has no base: additive).
+    if D < 13 {
+        return out;
+    }
     let n = (D - 13) / 2;
     let om = [at[10 + n], at[11 + n], at[12 + n]];
     let w_norm = libm::sqrt(om[0] * om[0] + om[1] * om[1] + om[2] * om[2]);

@@ -466,6 +466,8 @@ fn format_body(tokens: &TokenStream) -> Result<String, Error> {
     Ok(body[..end].concat())
 }
 
+/// The dynamics crate, re-exported for the proc-macro (`scene!`: wrench frames, the base body).
+pub use kanegen_dynamics;
 /// The model crate, re-exported for the proc-macro (readers, validation).
 pub use kanegen_model;
 /// The private `mul_add` of [`Options::target_fma`]: one fused instruction where the build

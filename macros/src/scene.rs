@@ -87,8 +87,9 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let mut frames: Vec<Frame> = model.frames().to_vec();
     let mut wrench_frames = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {
-        let needs = (w.frame == kanegen_dynamics::LoadFrame::Base || computed_torque)
-            && w.body != kanegen_dynamics::base::BASE_BODY;
+        let needs = (w.frame == kanegen_codegen::kanegen_dynamics::LoadFrame::Base
+            || computed_torque)
+            && w.body != kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
         if needs {
             let fname = format!("scene_wrench_{k}");
             frames.push(Frame {
@@ -156,7 +157,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 format_ident!("{}_jacobian", fname),
             );
             let (f, m) = (arr(force), arr(moment));
-            let to_base = if w.frame == kanegen_dynamics::LoadFrame::Body {
+            let to_base = if w.frame == kanegen_codegen::kanegen_dynamics::LoadFrame::Body {
                 quote! {
                     let r = #dyn_ty::#pl(&qj).1;
                     let (f, m): ([f64; 3], [f64; 3]) = (
@@ -257,7 +258,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 }}
             }
         };
-        let is_base = w.body == kanegen_dynamics::base::BASE_BODY;
+        let is_base = w.body == kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
         let row = Literal::usize_unsuffixed(if is_base {
             0
         } else {
@@ -265,7 +266,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         });
         // Body-to-reference rotation of an inertial-frame wrench.
         let rot = match (&wrench_frames[k], is_base, w.frame) {
-            (_, _, kanegen_dynamics::LoadFrame::Body) => None,
+            (_, _, kanegen_codegen::kanegen_dynamics::LoadFrame::Body) => None,
             (Some(fname), _, _) => {
                 let pl = format_ident!("{}_placement", fname);
                 Some(quote!(#dyn_ty::#pl(&s.q).1))
