@@ -6,7 +6,8 @@
 //! (`simulate_to`, its `recurrent` algorithm, samples to a sink that drops them); the compiled
 //! run calls an observer that does nothing.
 //!
-//! Run: `cargo bench --bench scene`. Compare within one run; the machines are shared.
+//! Run: `cargo bench --bench scene`. Compare within one run; the machines are shared. Measured
+//! (two runs): compiled 1.67 / 1.44 ms, interpreted 20.5 / 18.3 ms per run, 12.3× / 12.7×.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use kanegen::sim::scene::Scene;
