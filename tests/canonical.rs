@@ -104,7 +104,7 @@ fn pinocchio_robots_keep_their_dynamics_and_lose_their_noise() {
         .collect();
     urdfs.sort();
     assert!(urdfs.len() >= 15, "{} URDFs", urdfs.len());
-    let (mut worst, mut snapped, mut loose_snapped) = (0.0_f64, 0, 0);
+    let (mut worst, mut snapped, mut loose_snapped, mut snapped_alone) = (0.0_f64, 0, 0, 0);
     for (i, path) in urdfs.iter().enumerate() {
         let m = load_model(path).unwrap();
         // A loose tolerance also takes `rpy = 1.570796325`'s 4.9e-12 residues, and changes the
@@ -122,6 +122,23 @@ fn pinocchio_robots_keep_their_dynamics_and_lose_their_noise() {
         let c = m.canonical();
         assert!(c.report.largest_snap <= DEFAULT_SNAP);
         snapped += c.report.snapped;
+        // Snapping alone (what the code generator applies): no frame turned, every joint's axis
+        // and placement within the tolerance of the file's, the same dynamics.
+        let s = m.snapped(DEFAULT_SNAP);
+        assert_eq!(s.report.turned, 0);
+        assert!(s.report.largest_snap <= DEFAULT_SNAP);
+        snapped_alone += s.report.snapped;
+        for (a, b) in m.joints().iter().zip(s.model.joints()) {
+            let near =
+                |x: &[f64], y: &[f64]| x.iter().zip(y).all(|(p, q)| (p - q).abs() <= DEFAULT_SNAP);
+            assert!(near(&a.axis, &b.axis) && near(&a.origin.translation, &b.origin.translation));
+            assert!(near(
+                a.origin.rotation.as_flattened(),
+                b.origin.rotation.as_flattened()
+            ));
+        }
+        let d = compare(&m, &s.model, i as u64);
+        assert!(d < TOL, "{} snapped: {d:e}", path.display());
         let d = compare(&m, &c.model, i as u64);
         worst = worst.max(d);
         assert!(d < TOL, "{}: {d:e}", path.display());
@@ -136,6 +153,7 @@ fn pinocchio_robots_keep_their_dynamics_and_lose_their_noise() {
     println!("15 robots: worst {worst:.1e}, {snapped} numbers snapped ({loose_snapped} at 1e-9)");
     // `rpy = 1.5707963267948966` leaves cos = 6.1e-17 (Panda), `1.570796325` 4.9e-12 (UR).
     assert!(snapped > 0, "the URDFs carry representation residues");
+    assert!(snapped_alone > 0 && snapped_alone <= snapped);
     assert!(loose_snapped > snapped);
 }
 

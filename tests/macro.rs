@@ -400,6 +400,47 @@ fn f32_fma_payload_gravity_through_the_macro() {
 }
 
 kanegen::dynamics!(
+    SsrmsUnfused,
+    "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
+    gravity = [0.0, 0.0, -9.81],
+    target_fma = false,
+);
+
+/// `target_fma = false` writes products and sums out: no fused count, the same operations, and
+/// (on a build without FMA, as the test profile is) the same bits as the fused-where-available
+/// default; with FMA the two differ by rounding only.
+#[test]
+fn target_fma_off_writes_every_operation_out() {
+    for (off, on) in SsrmsUnfused::OP_COUNTS
+        .iter()
+        .zip(SsrmsRegrouped::OP_COUNTS)
+    {
+        assert_eq!(off.function, on.function);
+        assert_eq!(
+            (off.fma, off.mul, off.add),
+            (0, on.mul, on.add),
+            "{}",
+            on.function
+        );
+        assert!(on.fma > 0, "{}", on.function);
+    }
+    let fused = cfg!(all(target_arch = "x86_64", target_feature = "fma"))
+        || cfg!(all(target_arch = "aarch64", target_feature = "neon"));
+    let mut worst = 0.0_f64;
+    for [q, qd, _, _] in ssrms_states(20) {
+        let (a, b) = (
+            SsrmsUnfused::nonlinear_effects(&q, &qd),
+            SsrmsRegrouped::nonlinear_effects(&q, &qd),
+        );
+        if !fused {
+            assert_eq!(a, b);
+        }
+        worst = worst.max(rel_err(&a, &b));
+    }
+    assert!(worst < 1e-13, "{worst:e}");
+}
+
+kanegen::dynamics!(
     SsrmsOwnInertia,
     "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
     gravity = [0.0, 0.0, -9.81],

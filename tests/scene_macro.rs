@@ -11,8 +11,8 @@
 //! - the compiled run samples at the same times as the interpreted one, and every state
 //!   component agrees to `|x_c − x_i| ≤ 1e-9 (1 + |x_i|)` at every sample — the same integrator
 //!   and step (RK4, midpoint) or tolerance (dopri5) on right-hand sides equal to rounding;
-//!   measured worst 9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.2e-15,
-//!   the test scenes 2.4e-14, 2.4e-15, 5.2e-16 (midpoint) and 1.3e-16 (computed torque), the
+//!   measured worst 9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.0e-15,
+//!   the test scenes 2.4e-14, 2.5e-15, 5.0e-16 (midpoint) and 1.3e-16 (computed torque), the
 //!   other fixed-base scenes ≤ 3.8e-16;
 //! - on the free-floating 7-dof scene, the compiled run conserves linear and angular momentum
 //!   (`NameDynamics::momentum`) as the interpreted one does (its summary's drift): measured

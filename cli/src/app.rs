@@ -157,6 +157,10 @@ enum Command {
         /// Fuse each single-use product into its sum as one `libm::fma` call.
         #[arg(long)]
         fma: bool,
+        /// Snap float noise below TOL to exact 0 or ±1 before tracing (0: off; 1e-9 also catches
+        /// `rpy = 1.570796325`); the header says what was snapped.
+        #[arg(long, default_value_t = kanegen_model::canonical::DEFAULT_SNAP, value_name = "TOL")]
+        snap: f64,
         /// Accept inertia tensors that violate the triangle inequality.
         #[arg(long)]
         allow_nonphysical: bool,
@@ -422,6 +426,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             lock,
             scalar,
             fma,
+            snap,
             allow_nonphysical,
             allow_large,
         } => {
@@ -457,6 +462,7 @@ pub fn run(cli: Cli, out: &mut dyn Write, interactive: Interactive) -> Result<()
             opts.runtime_payload = runtime_payload;
             opts.float = scalar;
             opts.fma = fma;
+            opts.snap = snap;
             let progress = Progress::spinner(
                 interactive.0,
                 &format!(

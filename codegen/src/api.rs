@@ -9,7 +9,7 @@
 //! | `nonlinear_effects(q, qd)` | `c(q, q̇)`: velocity products, plus gravity when generated with it (Pinocchio's `nonLinearEffects`) |
 //! | `gravity(q)` | `g(q)`, the gravity part of `c` (only when generated with gravity) |
 //! | `inverse_dynamics(q, qd, qdd)` | `τ = M q̈ + c`, one Newton–Euler pass |
-//! | `forward_dynamics(q, qd, tau)` | `q̈ = M⁻¹ (τ − c)`, unrolled branch-free LDLᵀ |
+//! | `forward_dynamics(q, qd, tau)` | `q̈ = M⁻¹ (τ − c)`, unrolled: branch-free LDLᵀ on `M` and `c`, or the articulated-body algorithm, whichever is cheaper |
 //! | `forward_dynamics_with_wrenches(q, qd, tau, f_ext)` | the same with a wrench on every body |
 //! | `mass_matrix_and_nonlinear_effects(q, qd)` | `(M, c)` sharing sines, cosines and kinematics |
 //! | `<frame>_placement(q)`, `<frame>_jacobian(q)` | each named frame's pose and geometric Jacobian |
@@ -21,6 +21,7 @@
 
 use crate::emit::Shape;
 use crate::options::Options;
+use kanegen_dynamics::ForwardMethod;
 use kanegen_model::{BaseKind, Model};
 use kanegen_trace::Function;
 
@@ -99,9 +100,10 @@ pub fn shape(f: Function, n: usize, floating: bool) -> Shape {
     }
 }
 
-/// The first line of a generated function's documentation.
+/// The first line of a generated function's documentation; `forward`: the forward method of
+/// the emitted candidate (read for forward dynamics only).
 #[must_use]
-pub fn doc(f: Function, floating: bool) -> String {
+pub fn doc(f: Function, floating: bool, forward: ForwardMethod) -> String {
     let speeds = if floating {
         "`v̇ = [v̇_b, ω̇_b, q̈]`"
     } else {
@@ -124,10 +126,16 @@ pub fn doc(f: Function, floating: bool) -> String {
         Function::InverseDynamics => {
             "Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.".into()
         }
-        Function::ForwardDynamics => format!(
-            "Forward dynamics: {speeds} from the joint drives, `M⁻¹ (τ − c)`, by an unrolled \
-             branch-free LDLᵀ."
-        ),
+        Function::ForwardDynamics => match forward {
+            ForwardMethod::Ldlt => format!(
+                "Forward dynamics: {speeds} from the joint drives, `M⁻¹ (τ − c)`, by an unrolled \
+                 branch-free LDLᵀ."
+            ),
+            ForwardMethod::Aba => format!(
+                "Forward dynamics: {speeds} from the joint drives, `M⁻¹ (τ − c)`, by an unrolled \
+                 articulated-body algorithm (no `M` is formed)."
+            ),
+        },
         Function::ForwardDynamicsWithWrenches => {
             format!(
             "Forward dynamics {speeds} with an external wrench on every body: `f_ext[i]` = force \

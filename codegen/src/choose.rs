@@ -1,8 +1,10 @@
 //! Which methods a generated function uses: every candidate is traced and the one with the
-//! fewest emitted operations (`mul + add`) wins, the first in report order on ties.
+//! fewest emitted operations (`mul + add`) wins, the first in report order on ties. Forward
+//! dynamics has two kinds of candidate: LDLᵀ on `M` and `c` (one per bias method) and the
+//! articulated-body algorithm ([`Methods::ABA`], which uses neither), last.
 
 use crate::options::Options;
-use kanegen_dynamics::{BiasMethod, MassMatrixMethod, Methods};
+use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
 use kanegen_model::{BaseKind, Model};
 use kanegen_trace::{trace, Base, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
 
@@ -28,18 +30,30 @@ impl Choice {
             .unwrap_or_default()
     }
 
-    /// The mass-matrix method's name when the function uses one.
+    /// The mass-matrix method's name when the candidate `m` uses one (forward dynamics by the
+    /// articulated-body algorithm does not).
     #[must_use]
     pub fn mass_matrix_method(&self, m: Methods) -> Option<&'static str> {
-        self.function
-            .uses_mass_matrix()
-            .then(|| m.mass_matrix.name())
+        (self.function.uses_mass_matrix() && !self.is_aba(m)).then(|| m.mass_matrix.name())
     }
 
-    /// The bias method's name when the function uses one.
+    /// The bias method's name when the candidate `m` uses one (forward dynamics by the
+    /// articulated-body algorithm does not).
     #[must_use]
     pub fn bias_method(&self, m: Methods) -> Option<&'static str> {
-        self.function.uses_bias().then(|| m.bias.name())
+        (self.function.uses_bias() && !self.is_aba(m)).then(|| m.bias.name())
+    }
+
+    /// The forward method's name (`ldlt`, `aba`) for forward dynamics, `None` otherwise.
+    #[must_use]
+    pub fn forward_method(&self, m: Methods) -> Option<&'static str> {
+        self.function
+            .is_forward_dynamics()
+            .then(|| m.forward.name())
+    }
+
+    fn is_aba(&self, m: Methods) -> bool {
+        self.function.is_forward_dynamics() && m.forward == ForwardMethod::Aba
     }
 }
 
@@ -59,8 +73,10 @@ pub fn spec(model: &Model, opts: &Options) -> Spec {
 }
 
 /// The candidates of `f`: every mass-matrix method for `M`; every bias method (with the chosen
-/// mass-matrix method `mass`) for a function with a bias; the chosen method alone for the others.
-/// On a tree only the local-frame methods (`crba`, `rnea`, `newton-euler`) are candidates: the paper's
+/// mass-matrix method `mass`) for a function with a bias, and for forward dynamics then the
+/// articulated-body algorithm ([`Methods::ABA`]); the chosen method alone for the others.
+/// On a tree only the local-frame methods (`crba`, `rnea`, `newton-euler`, `aba`) are
+/// candidates: the paper's
 /// base-frame algorithms handle serial chains only.
 #[must_use]
 pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Methods> {
@@ -80,20 +96,27 @@ pub fn candidates(f: Function, mass: MassMatrixMethod, chain: bool) -> Vec<Metho
             .map(|&mass_matrix| Methods {
                 mass_matrix,
                 bias: BiasMethod::Rnea,
+                forward: ForwardMethod::Ldlt,
             })
             .collect()
     } else if f.uses_bias() {
-        bias_methods
+        let mut c: Vec<Methods> = bias_methods
             .iter()
             .map(|&bias| Methods {
                 mass_matrix: mass,
                 bias,
+                forward: ForwardMethod::Ldlt,
             })
-            .collect()
+            .collect();
+        if f.is_forward_dynamics() {
+            c.push(Methods::ABA);
+        }
+        c
     } else {
         vec![Methods {
             mass_matrix: mass,
             bias: BiasMethod::Rnea,
+            forward: ForwardMethod::Ldlt,
         }]
     }
 }

@@ -14,8 +14,10 @@
 //! The generated type has `OP_COUNTS`, one entry per emitted function, and `CANDIDATES`, one per
 //! traced candidate, both of a generated struct (`OpCount` in files from [`generate_file`],
 //! `NameOpCount` from the `dynamics!` macro) with the fields `function`, `mass_matrix_method`,
-//! `bias_method` (`None` when unused), `mul`, `add`, `div`, `sqrt`, `sincos` and `fma` (fused
-//! multiply-adds formed; only emitted code forms them, so `CANDIDATES` lists 0).
+//! `bias_method` (`None` when unused), `forward_method` (`ldlt` or `aba` for forward dynamics,
+//! `None` otherwise; `aba` uses no mass-matrix or bias method), `mul`, `add`, `div`, `sqrt`,
+//! `sincos` and `fma` (fused multiply-adds formed; only emitted code forms them, so
+//! `CANDIDATES` lists 0).
 //!
 //! ```
 //! use kanegen_codegen::{generate_file, Options};
@@ -87,6 +89,14 @@ fn generate_items_with(
         }
         _ => model,
     };
+    if !(opts.snap.is_finite() && (0.0..0.1).contains(&opts.snap)) {
+        return Err(Error(format!(
+            "snap tolerance {} is not in [0, 0.1)",
+            opts.snap
+        )));
+    }
+    let snapped = model.snapped(opts.snap);
+    let model = &snapped.model;
     let floating = model.base_kind() == BaseKind::FreeFloating;
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
@@ -174,7 +184,7 @@ fn generate_items_with(
             Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
         };
         let c = choice.counts();
-        let doc1 = format!(" {}", api::doc(f, floating));
+        let doc1 = format!(" {}", api::doc(f, floating, choice.chosen.forward));
         let fused = if opts.fma {
             format!(", of which {k} fused multiply-adds")
         } else if opts.target_fma && k > 0 {
@@ -189,6 +199,9 @@ fn generate_items_with(
             choice
                 .bias_method(choice.chosen)
                 .map(|m| format!("bias `{m}`")),
+            choice
+                .forward_method(choice.chosen)
+                .map(|m| format!("forward `{m}`")),
         ]
         .into_iter()
         .flatten()
@@ -222,12 +235,17 @@ fn generate_items_with(
             Some(s) => quote!(Some(#s)),
             None => quote!(None),
         };
-        let (mm, bm) = (opt(ch.mass_matrix_method(m)), opt(ch.bias_method(m)));
+        let (mm, bm, fm) = (
+            opt(ch.mass_matrix_method(m)),
+            opt(ch.bias_method(m)),
+            opt(ch.forward_method(m)),
+        );
         let (mul, add, div, sqrt, sincos) = (c.mul, c.add, c.div, c.sqrt, c.sincos);
         quote!(#op_ty {
             function: #function,
             mass_matrix_method: #mm,
             bias_method: #bm,
+            forward_method: #fm,
             mul: #mul,
             add: #add,
             div: #div,
@@ -245,7 +263,7 @@ fn generate_items_with(
         .flat_map(|ch| ch.candidates.iter().map(|(m, c)| entry(ch, *m, *c, 0)));
     let n_fns = Literal::usize_unsuffixed(choices.len());
 
-    let header = header::lines(model, opts, &choices, &fmas);
+    let header = header::lines(model, opts, &choices, &fmas, &snapped.report);
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())
@@ -304,6 +322,9 @@ fn generate_items_with(
             pub mass_matrix_method: Option<&'static str>,
             /// Its bias method.
             pub bias_method: Option<&'static str>,
+            /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+            /// the articulated-body algorithm, which uses neither), for forward dynamics.
+            pub forward_method: Option<&'static str>,
             /// Multiplications.
             pub mul: u64,
             /// Additions and subtractions.

@@ -51,6 +51,15 @@ pub struct Options {
     /// same joint-space results in fewer operations. Default `true`; the base reaction always
     /// reads the model's own numbers.
     pub regroup: bool,
+    /// Snap float noise in the model before tracing ([`kanegen_model::Model::snapped`]):
+    /// rotations within `snap` of a signed permutation become it exactly, and translations,
+    /// axis components, centres of mass and relative inertia entries below `snap` become 0, so
+    /// `rpy = 1.5707963267948966`'s `cos = 6.1e-17` costs no multiplication. Default
+    /// [`kanegen_model::canonical::DEFAULT_SNAP`] (1e-15: representation residues only, the
+    /// dynamics stay within 1e-15 of the file's); `0.0` snaps nothing; `1e-9` also catches
+    /// `rpy = 1.570796325` (4.9e-12) and changes the robot by that much. The header says what
+    /// was snapped.
+    pub snap: f64,
 }
 
 /// Floating-point type of the emitted code.
@@ -123,6 +132,7 @@ impl Options {
             fma_path: None,
             target_fma: true,
             regroup: true,
+            snap: kanegen_model::canonical::DEFAULT_SNAP,
         }
     }
 }

@@ -22,6 +22,10 @@ pub struct JointParams<S> {
     pub upsilon: Mat3<S>,
     /// Unit joint axis in the joint frame.
     pub axis: Vec3<S>,
+    /// `Some(k)` when `axis` is exactly a signed coordinate axis `±e_k` (model structure, like
+    /// `kind`: [`crate::algorithms::aba`] then writes the exact zeros of `I^a_j S_j = 0` instead
+    /// of computing round-off); `None` for any other axis or a symbolic one.
+    pub coordinate_axis: Option<usize>,
     /// `m_j`.
     pub mass: S,
     /// `d^{(j)}_j`: centre of mass in the body frame.
@@ -41,6 +45,16 @@ impl<S: Scalar> JointParams<S> {
         self.mass = mass;
         self.com = com;
         self.inertia_com = inertia_com;
+    }
+}
+
+/// `Some(k)` when `axis` is `±e_k`: exactly one non-zero component.
+#[must_use]
+pub fn coordinate_axis(axis: [f64; 3]) -> Option<usize> {
+    let mut nonzero = (0..3).filter(|&k| axis[k] != 0.0);
+    match (nonzero.next(), nonzero.next()) {
+        (Some(k), None) => Some(k),
+        _ => None,
     }
 }
 
@@ -84,6 +98,7 @@ impl<S: Scalar> Params<S> {
                         l: Vec3::from_f64(j.origin.translation),
                         upsilon: Mat3::from_f64(j.origin.rotation),
                         axis: Vec3::from_f64(j.axis),
+                        coordinate_axis: coordinate_axis(j.axis),
                         inertia: RbInertia::from_com(&mass, &com, &inertia_com),
                         mass,
                         com,

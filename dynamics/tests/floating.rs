@@ -685,6 +685,7 @@ fn floating_dynamics_traces_on_sym() {
                             l: Vec3(j.l.0.map(Sym::constant)),
                             upsilon: Mat3(j.upsilon.0.map(|r| r.map(Sym::constant))),
                             axis: Vec3(j.axis.0.map(Sym::constant)),
+                            coordinate_axis: j.coordinate_axis,
                             inertia: kanegen_dynamics::spatial::RbInertia::from_com(
                                 &mass,
                                 &com,

@@ -890,8 +890,8 @@ fn check_names_the_method_and_the_first_branching_joint() {
         .iter()
         .all(|m| m.supports_trees() == (*m == MassMatrixMethod::Crba)));
     let e = Methods {
-        mass_matrix: MassMatrixMethod::Crba,
         bias: BiasMethod::KaneDirect,
+        ..Methods::SPATIAL
     }
     .check(&p)
     .unwrap_err();

@@ -7,42 +7,45 @@
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
-//! Fused multiply-adds where the target has them: 4640 (`mass_matrix` 383, `nonlinear_effects` 325, `inverse_dynamics` 340, `forward_dynamics` 1114, `mass_matrix_and_nonlinear_effects` 704, `forward_dynamics_with_wrenches` 1117, `momentum` 223, `base_reaction` 434), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Float noise: 1 numbers snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
+//! Fused multiply-adds where the target has them: 4366 (`mass_matrix` 379, `nonlinear_effects` 323, `inverse_dynamics` 338, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 700, `forward_dynamics_with_wrenches` 987, `momentum` 221, `base_reaction` 432), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 1831 | 2489 | 0 | 0 | 7 | 4320 |
-//! | `mass_matrix` | `recurrent-r1` | — | 2110 | 2558 | 0 | 0 | 7 | 4668 |
-//! | `mass_matrix` | `kane-direct` | — | 3460 | 2896 | 0 | 0 | 7 | 6356 |
-//! | `mass_matrix` | `crba-base` | — | 1309 | 1040 | 0 | 0 | 7 | 2349 |
-//! | `mass_matrix` * | `crba` | — | 654 | 545 | 0 | 0 | 7 | 1199 |
-//! | `nonlinear_effects` | — | `recurrent` | 1153 | 884 | 0 | 0 | 7 | 2037 |
-//! | `nonlinear_effects` | — | `kane-direct` | 1570 | 1279 | 0 | 0 | 7 | 2849 |
-//! | `nonlinear_effects` | — | `rnea` | 637 | 504 | 0 | 0 | 7 | 1141 |
-//! | `nonlinear_effects` * | — | `newton-euler` | 534 | 430 | 0 | 0 | 7 | 964 |
-//! | `inverse_dynamics` | — | `recurrent` | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` | — | `kane-direct` | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` | — | `rnea` | 676 | 550 | 0 | 0 | 7 | 1226 |
-//! | `inverse_dynamics` * | — | `newton-euler` | 549 | 460 | 0 | 0 | 7 | 1009 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 2307 | 1868 | 10 | 0 | 7 | 4175 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 2724 | 2263 | 10 | 0 | 7 | 4987 |
-//! | `forward_dynamics` | `crba` | `rnea` | 1779 | 1484 | 10 | 0 | 7 | 3263 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | 1676 | 1410 | 10 | 0 | 7 | 3086 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 1807 | 1429 | 0 | 0 | 7 | 3236 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 2224 | 1824 | 0 | 0 | 7 | 4048 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 1279 | 1045 | 0 | 0 | 7 | 2324 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 1176 | 971 | 0 | 0 | 7 | 2147 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 2451 | 2012 | 10 | 0 | 7 | 4463 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 2868 | 2407 | 10 | 0 | 7 | 5275 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 1779 | 1532 | 10 | 0 | 7 | 3311 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 1676 | 1458 | 10 | 0 | 7 | 3134 |
-//! | `momentum` * | — | — | 356 | 285 | 0 | 0 | 7 | 641 |
-//! | `base_reaction` * | — | `recurrent` | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `kane-direct` | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `rnea` | 694 | 568 | 0 | 0 | 7 | 1262 |
-//! | `base_reaction` | — | `newton-euler` | 694 | 568 | 0 | 0 | 7 | 1262 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 1828 | 2486 | 0 | 0 | 7 | 4314 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 2107 | 2555 | 0 | 0 | 7 | 4662 |
+//! | `mass_matrix` | `kane-direct` | — | — | 3457 | 2893 | 0 | 0 | 7 | 6350 |
+//! | `mass_matrix` | `crba-base` | — | — | 1306 | 1037 | 0 | 0 | 7 | 2343 |
+//! | `mass_matrix` * | `crba` | — | — | 648 | 541 | 0 | 0 | 7 | 1189 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 1150 | 881 | 0 | 0 | 7 | 2031 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 1567 | 1276 | 0 | 0 | 7 | 2843 |
+//! | `nonlinear_effects` | — | `rnea` | — | 635 | 502 | 0 | 0 | 7 | 1137 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | 532 | 428 | 0 | 0 | 7 | 960 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `rnea` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | 547 | 458 | 0 | 0 | 7 | 1005 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 2298 | 1861 | 10 | 0 | 7 | 4159 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 2715 | 2256 | 10 | 0 | 7 | 4971 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 1773 | 1480 | 10 | 0 | 7 | 3253 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | 1670 | 1406 | 10 | 0 | 7 | 3076 |
+//! | `forward_dynamics` * | — | — | `aba` | 1613 | 1277 | 12 | 0 | 7 | 2890 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 1798 | 1422 | 0 | 0 | 7 | 3220 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 2215 | 1817 | 0 | 0 | 7 | 4032 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 1273 | 1041 | 0 | 0 | 7 | 2314 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 1170 | 967 | 0 | 0 | 7 | 2137 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 2442 | 2005 | 10 | 0 | 7 | 4447 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 2859 | 2400 | 10 | 0 | 7 | 5259 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 1773 | 1528 | 10 | 0 | 7 | 3301 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | 1670 | 1454 | 10 | 0 | 7 | 3124 |
+//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | 1613 | 1325 | 12 | 0 | 7 | 2938 |
+//! | `momentum` * | — | — | — | 354 | 283 | 0 | 0 | 7 | 637 |
+//! | `base_reaction` * | — | `recurrent` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `kane-direct` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `rnea` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `newton-euler` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -55,6 +58,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -104,89 +110,97 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 654u64,
-            add: 545u64,
+            forward_method: None,
+            mul: 648u64,
+            add: 541u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 383u64,
+            fma: 379u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
-            mul: 534u64,
-            add: 430u64,
+            forward_method: None,
+            mul: 532u64,
+            add: 428u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 325u64,
+            fma: 323u64,
         },
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
-            mul: 549u64,
-            add: 460u64,
+            forward_method: None,
+            mul: 547u64,
+            add: 458u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 340u64,
+            fma: 338u64,
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
-            mul: 1676u64,
-            add: 1410u64,
-            div: 10u64,
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1613u64,
+            add: 1277u64,
+            div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 1114u64,
+            fma: 986u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
-            mul: 1176u64,
-            add: 971u64,
+            forward_method: None,
+            mul: 1170u64,
+            add: 967u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 704u64,
+            fma: 700u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
-            mul: 1676u64,
-            add: 1458u64,
-            div: 10u64,
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1613u64,
+            add: 1325u64,
+            div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 1117u64,
+            fma: 987u64,
         },
         OpCount {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
-            mul: 356u64,
-            add: 285u64,
+            forward_method: None,
+            mul: 354u64,
+            add: 283u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 223u64,
+            fma: 221u64,
         },
         OpCount {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 694u64,
-            add: 568u64,
+            forward_method: None,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 434u64,
+            fma: 432u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -195,8 +209,9 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
-            mul: 1831u64,
-            add: 2489u64,
+            forward_method: None,
+            mul: 1828u64,
+            add: 2486u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -206,8 +221,9 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
-            mul: 2110u64,
-            add: 2558u64,
+            forward_method: None,
+            mul: 2107u64,
+            add: 2555u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -217,8 +233,9 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
-            mul: 3460u64,
-            add: 2896u64,
+            forward_method: None,
+            mul: 3457u64,
+            add: 2893u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -228,8 +245,9 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
-            mul: 1309u64,
-            add: 1040u64,
+            forward_method: None,
+            mul: 1306u64,
+            add: 1037u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -239,8 +257,9 @@ impl FreeFloating7 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
-            mul: 654u64,
-            add: 545u64,
+            forward_method: None,
+            mul: 648u64,
+            add: 541u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -250,8 +269,9 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 1153u64,
-            add: 884u64,
+            forward_method: None,
+            mul: 1150u64,
+            add: 881u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -261,8 +281,9 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 1570u64,
-            add: 1279u64,
+            forward_method: None,
+            mul: 1567u64,
+            add: 1276u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -272,8 +293,9 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 637u64,
-            add: 504u64,
+            forward_method: None,
+            mul: 635u64,
+            add: 502u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -283,8 +305,9 @@ impl FreeFloating7 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
-            mul: 534u64,
-            add: 430u64,
+            forward_method: None,
+            mul: 532u64,
+            add: 428u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -294,8 +317,9 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 676u64,
-            add: 550u64,
+            forward_method: None,
+            mul: 674u64,
+            add: 548u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -305,8 +329,9 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 676u64,
-            add: 550u64,
+            forward_method: None,
+            mul: 674u64,
+            add: 548u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -316,8 +341,9 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 676u64,
-            add: 550u64,
+            forward_method: None,
+            mul: 674u64,
+            add: 548u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -327,8 +353,9 @@ impl FreeFloating7 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
-            mul: 549u64,
-            add: 460u64,
+            forward_method: None,
+            mul: 547u64,
+            add: 458u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -338,8 +365,9 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 2307u64,
-            add: 1868u64,
+            forward_method: Some("ldlt"),
+            mul: 2298u64,
+            add: 1861u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -349,8 +377,9 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 2724u64,
-            add: 2263u64,
+            forward_method: Some("ldlt"),
+            mul: 2715u64,
+            add: 2256u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -360,8 +389,9 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1779u64,
-            add: 1484u64,
+            forward_method: Some("ldlt"),
+            mul: 1773u64,
+            add: 1480u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -371,9 +401,22 @@ impl FreeFloating7 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
-            mul: 1676u64,
-            add: 1410u64,
+            forward_method: Some("ldlt"),
+            mul: 1670u64,
+            add: 1406u64,
             div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1613u64,
+            add: 1277u64,
+            div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -382,8 +425,9 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 1807u64,
-            add: 1429u64,
+            forward_method: None,
+            mul: 1798u64,
+            add: 1422u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -393,8 +437,9 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 2224u64,
-            add: 1824u64,
+            forward_method: None,
+            mul: 2215u64,
+            add: 1817u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -404,8 +449,9 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1279u64,
-            add: 1045u64,
+            forward_method: None,
+            mul: 1273u64,
+            add: 1041u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -415,8 +461,9 @@ impl FreeFloating7 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
-            mul: 1176u64,
-            add: 971u64,
+            forward_method: None,
+            mul: 1170u64,
+            add: 967u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -426,8 +473,9 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
-            mul: 2451u64,
-            add: 2012u64,
+            forward_method: Some("ldlt"),
+            mul: 2442u64,
+            add: 2005u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -437,8 +485,9 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
-            mul: 2868u64,
-            add: 2407u64,
+            forward_method: Some("ldlt"),
+            mul: 2859u64,
+            add: 2400u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -448,8 +497,9 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
-            mul: 1779u64,
-            add: 1532u64,
+            forward_method: Some("ldlt"),
+            mul: 1773u64,
+            add: 1528u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -459,9 +509,22 @@ impl FreeFloating7 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
-            mul: 1676u64,
-            add: 1458u64,
+            forward_method: Some("ldlt"),
+            mul: 1670u64,
+            add: 1454u64,
             div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 1613u64,
+            add: 1325u64,
+            div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -470,8 +533,9 @@ impl FreeFloating7 {
             function: "momentum",
             mass_matrix_method: None,
             bias_method: None,
-            mul: 356u64,
-            add: 285u64,
+            forward_method: None,
+            mul: 354u64,
+            add: 283u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -481,8 +545,9 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
-            mul: 694u64,
-            add: 568u64,
+            forward_method: None,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -492,8 +557,9 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
-            mul: 694u64,
-            add: 568u64,
+            forward_method: None,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -503,8 +569,9 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
-            mul: 694u64,
-            add: 568u64,
+            forward_method: None,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -514,8 +581,9 @@ impl FreeFloating7 {
             function: "base_reaction",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
-            mul: 694u64,
-            add: 568u64,
+            forward_method: None,
+            mul: 692u64,
+            add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -524,7 +592,7 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 654 mul, 545 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 383 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 648 mul, 541 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 379 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
@@ -532,14 +600,12 @@ impl FreeFloating7 {
         let x2 = -0.00000000020510342851533115 * c_q8;
         let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x6 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x7 = Self::mul_add(
+        let x5 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x8 = Self::mul_add(
+        let x6 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
@@ -547,846 +613,827 @@ impl FreeFloating7 {
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let (s_q11, c_q11) = libm::sincos(q[11]);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
+        let x10 = -0.00000000020510342851533115 * s_q12;
+        let x11 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(-0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x16, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x16, -0.0145 * x15);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(-1.2025609200000003, c_q13, x24);
-        let x26 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(-1.2025609200000003, s_q13, -x23)
+        let x13 = -0.00000000020510342851533115 * c_q13;
+        let x14 = -0.00000000020510342851533115 * s_q13;
+        let x15 = 4.806620000000001 * x14;
+        let x16 = 4.806620000000001 * c_q13;
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = Self::mul_add(-0.000781, x14, -0.0145);
+        let x19 = -0.9614610000000001
+            + Self::mul_add(1.2025609200000003, x14, 0.000781 * x13);
+        let x20 = 1.4135609200000003
+            + Self::mul_add(0.9614610000000001, x14, -0.0145 * x13);
+        let x21 = 0.000781 * c_q13;
+        let x22 = 0.000781 * s_q13;
+        let x23 = Self::mul_add(-1.2025609200000003, c_q13, x22);
+        let x24 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
+        let x25 = x22 + 0.000000000002973999713472302;
+        let x26 = Self::mul_add(-1.2025609200000003, s_q13, -x21)
             + 0.00000000019719894748377882;
-        let x29 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
+        let x27 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
             + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = x22 + Self::mul_add(-x16, x21, x15 * x20) - (x30 - x31) - (x33 - x32);
-        let x35 = 3.6140000000000003 - x17;
-        let x36 = 17.135250000000003 + x18;
-        let x37 = -1.9877000000000002
-            + Self::mul_add(0.55, x17, Self::mul_add(c_q13, x21, s_q13 * x20));
-        let x38 = -0.809539999555672
-            + Self::mul_add(
-                0.16,
-                x17,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x22,
-                    Self::mul_add(-c_q13, x20, s_q13 * x21),
-                ),
-            );
-        let x39 = -1.9877000000000002
-            + Self::mul_add(x17, 0.55, x26 + Self::mul_add(-x16, x25, x15 * x23));
-        let x40 = -5.252920330000002
-            + (Self::mul_add(c_q13, x25, s_q13 * x23) + x32 - x30);
-        let x41 = -2.741639999592316
-            + Self::mul_add(
-                -0.55,
-                x19,
-                Self::mul_add(
-                    -0.16,
-                    x18,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x26,
-                        Self::mul_add(-c_q13, x23, s_q13 * x25),
-                    ),
-                ),
-            );
-        let x42 = -0.809539999555672
-            + Self::mul_add(0.16, x17, x29 + Self::mul_add(-x16, x28, x15 * x27));
-        let x43 = -2.7416399995923166
-            + Self::mul_add(
-                -0.16,
-                x18,
-                Self::mul_add(x19, -0.55, Self::mul_add(c_q13, x28, s_q13 * x27)),
-            );
-        let x44 = 9.740442170000001
-            + (x31
+        let x28 = -0.16 * x17;
+        let x29 = 0.55 * x16;
+        let x30 = 0.16 * x17;
+        let x31 = x16 * -0.55;
+        let x32 = Self::mul_add(
+            0.16,
+            x15,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x20,
+                Self::mul_add(-c_q13, x18, s_q13 * x19),
+            ),
+        );
+        let x33 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x24,
+                Self::mul_add(-c_q13, x21, s_q13 * x23),
+            ),
+        );
+        let x34 = x20 + Self::mul_add(-x14, x19, x13 * x18) - (x28 - x29) - (x31 - x30);
+        let x35 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(x17, -0.55, Self::mul_add(c_q13, x26, s_q13 * x25)),
+        );
+        let x36 = 3.6140000000000003 - x15;
+        let x37 = 17.135250000000003 + x16;
+        let x38 = -1.9877000000000002
+            + Self::mul_add(0.55, x15, Self::mul_add(c_q13, x19, s_q13 * x18));
+        let x39 = -0.809539999555672 + x32;
+        let x40 = -1.9877000000000002
+            + Self::mul_add(x15, 0.55, x24 + Self::mul_add(-x14, x23, x13 * x21));
+        let x41 = -5.252920330000002
+            + (Self::mul_add(c_q13, x23, s_q13 * x21) + x30 - x28);
+        let x42 = -2.741639999592316 + Self::mul_add(-0.55, x17, x33);
+        let x43 = -0.809539999555672
+            + Self::mul_add(0.16, x15, x27 + Self::mul_add(-x14, x26, x13 * x25));
+        let x44 = -2.7416399995923166 + x35;
+        let x45 = 9.740442170000001
+            + (x29
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) - x33));
-        let x45 = c_q12 * x35;
-        let x46 = s_q12 * x36;
-        let x47 = x45 - x46;
-        let x48 = x19 + Self::mul_add(x13, x36, x12 * x35);
-        let x49 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x50 = Self::mul_add(-0.00000000020510342851533115, x19, -x49);
-        let x51 = Self::mul_add(-s_q12, x39, c_q12 * x34);
-        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x37);
+                    x27,
+                    Self::mul_add(-c_q13, x25, s_q13 * x26),
+                ) - x31));
+        let x46 = c_q12 * x36;
+        let x47 = s_q12 * x37;
+        let x48 = x46 - x47;
+        let x49 = x17 + Self::mul_add(x11, x37, x10 * x36);
+        let x50 = Self::mul_add(c_q12, x37, s_q12 * x36);
+        let x51 = Self::mul_add(-0.00000000020510342851533115, x17, -x50);
+        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x34);
         let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
-        let x54 = x42 + Self::mul_add(x13, x39, x12 * x34);
-        let x55 = x43 + Self::mul_add(x13, x40, x12 * x37);
-        let x56 = x44 + Self::mul_add(x13, x41, x12 * x38);
-        let x57 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x42,
-            -Self::mul_add(c_q12, x39, s_q12 * x34),
-        );
+        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x39);
+        let x55 = x43 + Self::mul_add(x11, x40, x10 * x34);
+        let x56 = x44 + Self::mul_add(x11, x41, x10 * x38);
+        let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
         let x58 = Self::mul_add(
             -0.00000000020510342851533115,
             x43,
-            -Self::mul_add(c_q12, x40, s_q12 * x37),
+            -Self::mul_add(c_q12, x40, s_q12 * x34),
         );
         let x59 = Self::mul_add(
             -0.00000000020510342851533115,
             x44,
             -Self::mul_add(c_q12, x41, s_q12 * x38),
         );
-        let x60 = x53 + Self::mul_add(x13, x52, x12 * x51);
-        let x61 = Self::mul_add(-s_q12, x55, c_q12 * x54);
-        let x62 = x50 * 0.36;
-        let x63 = -0.36 * x50;
-        let x64 = x63 + (Self::mul_add(-s_q12, x52, c_q12 * x51) - x62);
-        let x65 = 7.078399999258757 + x48;
-        let x66 = 0.01675
-            + Self::mul_add(
-                x47,
-                0.36,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x53,
-                    -Self::mul_add(c_q12, x52, s_q12 * x51),
-                ),
-            );
-        let x67 = -9.142025249762803
-            + (x56 + Self::mul_add(x13, x55, x12 * x54) + x63 - x62);
-        let x68 = 2.5482240016099564
-            + Self::mul_add(
-                0.36,
-                x48,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x56,
-                    -Self::mul_add(c_q12, x55, s_q12 * x54),
-                ),
-            );
-        let x69 = 0.01675
-            + Self::mul_add(0.36, x47, Self::mul_add(-s_q12, x58, c_q12 * x57));
-        let x70 = 2.5482240016099564
-            + Self::mul_add(x48, 0.36, x59 + Self::mul_add(x13, x58, x12 * x57));
-        let x71 = 9.223235249762805
+        let x60 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x45,
+            -Self::mul_add(c_q12, x42, s_q12 * x39),
+        );
+        let x61 = x54 + Self::mul_add(x11, x53, x10 * x52);
+        let x62 = Self::mul_add(-s_q12, x56, c_q12 * x55);
+        let x63 = x51 * 0.36;
+        let x64 = -0.36 * x51;
+        let x65 = Self::mul_add(
+            x48,
+            0.36,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x54,
+                -Self::mul_add(c_q12, x53, s_q12 * x52),
+            ),
+        );
+        let x66 = Self::mul_add(
+            0.36,
+            x49,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x57,
+                -Self::mul_add(c_q12, x56, s_q12 * x55),
+            ),
+        );
+        let x67 = x64 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x63);
+        let x68 = 7.078399999258757 + x49;
+        let x69 = 0.01675 + x65;
+        let x70 = -9.142025249762803
+            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x64 - x63);
+        let x71 = 2.5482240016099564 + x66;
+        let x72 = 0.01675
+            + Self::mul_add(0.36, x48, Self::mul_add(-s_q12, x59, c_q12 * x58));
+        let x73 = 2.5482240016099564
+            + Self::mul_add(x49, 0.36, x60 + Self::mul_add(x11, x59, x10 * x58));
+        let x74 = 9.223235249762805
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x59,
-                -Self::mul_add(c_q12, x58, s_q12 * x57),
+                x60,
+                -Self::mul_add(c_q12, x59, s_q12 * x58),
             );
-        let x72 = Self::mul_add(-s_q11, x65, c_q11 * x47);
-        let x73 = Self::mul_add(c_q11, x65, s_q11 * x47);
-        let x74 = Self::mul_add(-s_q11, x61, c_q11 * x64);
-        let x75 = Self::mul_add(-s_q11, x67, c_q11 * x60);
-        let x76 = Self::mul_add(c_q11, x61, s_q11 * x64);
-        let x77 = Self::mul_add(c_q11, x67, s_q11 * x60);
-        let x78 = 0.275 * x50;
-        let x79 = -0.63 * x73;
-        let x80 = -0.275 * x50;
-        let x81 = x73 * 0.63;
-        let x82 = Self::mul_add(0.63, x72, Self::mul_add(c_q11, x75, s_q11 * x74));
-        let x83 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x68, c_q11 * x66));
-        let x84 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x68, s_q11 * x66));
-        let x85 = x71 - x81;
-        let x86 = Self::mul_add(-s_q11, x75, c_q11 * x74) - (x78 - x79) - (x81 - x80);
-        let x87 = Self::mul_add(x72, 0.63, Self::mul_add(-s_q11, x77, c_q11 * x76));
-        let x88 = -45.1584 + x73;
-        let x89 = -0.6328 + x83;
-        let x90 = -24.4950615 + (Self::mul_add(c_q11, x77, s_q11 * x76) + x80 - x78);
-        let x91 = -24.35164200091464 + Self::mul_add(0.63, x50, x84);
-        let x92 = -0.6328
-            + Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x70, c_q11 * x69));
-        let x93 = -24.351642000914637
-            + Self::mul_add(
-                0.275,
-                x73,
-                Self::mul_add(x50, 0.63, Self::mul_add(c_q11, x70, s_q11 * x69)),
-            );
-        let x94 = 28.2393615 + (x79 + x85);
-        let x95 = c_q10 * x72;
-        let x96 = Self::mul_add(-s_q10, x88, x95);
-        let x97 = s_q10 * x72;
-        let x98 = Self::mul_add(c_q10, x88, x97);
-        let x99 = Self::mul_add(-s_q10, x87, c_q10 * x86);
-        let x100 = Self::mul_add(-s_q10, x90, c_q10 * x82);
-        let x101 = Self::mul_add(-s_q10, x91, c_q10 * x89);
-        let x102 = Self::mul_add(c_q10, x87, s_q10 * x86);
-        let x103 = Self::mul_add(c_q10, x90, s_q10 * x82);
-        let x104 = Self::mul_add(c_q10, x91, s_q10 * x89);
-        let x105 = -0.87 * x98;
-        let x106 = x98 * 0.87;
-        let x107 = Self::mul_add(0.87, x96, Self::mul_add(c_q10, x100, s_q10 * x99));
-        let x108 = x94 - x106;
-        let x109 = Self::mul_add(-s_q10, x100, c_q10 * x99) + x105 - x106;
-        let x110 = Self::mul_add(x96, 0.87, Self::mul_add(-s_q10, x103, c_q10 * x102));
-        let x111 = -81.53205 + x98;
-        let x112 = -0.00214 + x101;
-        let x113 = -63.36336825000001 + Self::mul_add(c_q10, x103, s_q10 * x102);
-        let x114 = -36.18604050126307 + Self::mul_add(0.87, x50, x104);
-        let x115 = -0.00214 + Self::mul_add(-s_q10, x93, c_q10 * x92);
-        let x116 = -36.18604050126307
-            + Self::mul_add(x50, 0.87, Self::mul_add(c_q10, x93, s_q10 * x92));
-        let x117 = 69.99836825 + (x105 + x108);
-        let x118 = Self::mul_add(
-            0.00000000020510342851533115,
-            x50,
-            Self::mul_add(x6, x111, x5 * x96),
+        let x75 = Self::mul_add(-s_q11, x68, c_q11 * x48);
+        let x76 = Self::mul_add(c_q11, x68, s_q11 * x48);
+        let x77 = Self::mul_add(-s_q11, x62, c_q11 * x67);
+        let x78 = Self::mul_add(-s_q11, x70, c_q11 * x61);
+        let x79 = Self::mul_add(c_q11, x62, s_q11 * x67);
+        let x80 = Self::mul_add(c_q11, x70, s_q11 * x61);
+        let x81 = 0.275 * x51;
+        let x82 = -0.63 * x76;
+        let x83 = -0.275 * x51;
+        let x84 = x76 * 0.63;
+        let x85 = Self::mul_add(0.63, x75, Self::mul_add(c_q11, x78, s_q11 * x77));
+        let x86 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x71, c_q11 * x69));
+        let x87 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x71, s_q11 * x69));
+        let x88 = x74 - x84;
+        let x89 = Self::mul_add(-s_q11, x78, c_q11 * x77) - (x81 - x82) - (x84 - x83);
+        let x90 = Self::mul_add(x75, 0.63, Self::mul_add(-s_q11, x80, c_q11 * x79));
+        let x91 = Self::mul_add(
+            0.275,
+            x76,
+            Self::mul_add(x51, 0.63, Self::mul_add(c_q11, x73, s_q11 * x72)),
         );
-        let x119 = x50 + Self::mul_add(x8, x111, x7 * x96);
-        let x120 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x50,
-            Self::mul_add(-s_q9, x111, c_q9 * x96),
-        );
-        let x121 = Self::mul_add(
-            0.00000000020510342851533115,
-            x115,
-            Self::mul_add(x6, x110, x5 * x109),
-        );
-        let x122 = Self::mul_add(
-            0.00000000020510342851533115,
-            x116,
-            Self::mul_add(x6, x113, x5 * x107),
-        );
-        let x123 = Self::mul_add(
-            0.00000000020510342851533115,
-            x117,
-            Self::mul_add(x6, x114, x5 * x112),
-        );
-        let x124 = x115 + Self::mul_add(x8, x110, x7 * x109);
-        let x125 = x116 + Self::mul_add(x8, x113, x7 * x107);
-        let x126 = x117 + Self::mul_add(x8, x114, x7 * x112);
-        let x127 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x115,
-            Self::mul_add(-s_q9, x110, c_q9 * x109),
-        );
-        let x128 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x116,
-            Self::mul_add(-s_q9, x113, c_q9 * x107),
-        );
+        let x92 = -45.1584 + x76;
+        let x93 = -0.6328 + x86;
+        let x94 = -24.4950615 + (Self::mul_add(c_q11, x80, s_q11 * x79) + x83 - x81);
+        let x95 = -24.35164200091464 + Self::mul_add(0.63, x51, x87);
+        let x96 = -0.6328
+            + Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x73, c_q11 * x72));
+        let x97 = -24.351642000914637 + x91;
+        let x98 = 28.2393615 + (x82 + x88);
+        let x99 = c_q10 * x75;
+        let x100 = Self::mul_add(-s_q10, x92, x99);
+        let x101 = s_q10 * x75;
+        let x102 = Self::mul_add(c_q10, x92, x101);
+        let x103 = Self::mul_add(-s_q10, x90, c_q10 * x89);
+        let x104 = Self::mul_add(-s_q10, x94, c_q10 * x85);
+        let x105 = Self::mul_add(-s_q10, x95, c_q10 * x93);
+        let x106 = Self::mul_add(c_q10, x90, s_q10 * x89);
+        let x107 = Self::mul_add(c_q10, x94, s_q10 * x85);
+        let x108 = Self::mul_add(c_q10, x95, s_q10 * x93);
+        let x109 = -0.87 * x102;
+        let x110 = x102 * 0.87;
+        let x111 = Self::mul_add(0.87, x100, Self::mul_add(c_q10, x104, s_q10 * x103));
+        let x112 = x98 - x110;
+        let x113 = Self::mul_add(-s_q10, x104, c_q10 * x103) + x109 - x110;
+        let x114 = Self::mul_add(x100, 0.87, Self::mul_add(-s_q10, x107, c_q10 * x106));
+        let x115 = -81.53205 + x102;
+        let x116 = -0.00214 + x105;
+        let x117 = -63.36336825000001 + Self::mul_add(c_q10, x107, s_q10 * x106);
+        let x118 = -36.18604050126307 + Self::mul_add(0.87, x51, x108);
+        let x119 = -0.00214 + Self::mul_add(-s_q10, x97, c_q10 * x96);
+        let x120 = -36.18604050126307
+            + Self::mul_add(x51, 0.87, Self::mul_add(c_q10, x97, s_q10 * x96));
+        let x121 = 69.99836825 + (x109 + x112);
+        let x122 = s_q9 * x100;
+        let x123 = Self::mul_add(c_q9, x115, x122);
+        let x124 = Self::mul_add(0.00000000020510342851533115, x51, x123);
+        let x125 = x51 + Self::mul_add(x6, x115, x5 * x100);
+        let x126 = c_q9 * x100;
+        let x127 = Self::mul_add(-s_q9, x115, x126);
+        let x128 = Self::mul_add(-0.00000000020510342851533115, x51, x127);
         let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x117,
-            Self::mul_add(-s_q9, x114, c_q9 * x112),
-        );
-        let x130 = x120 * -0.4;
-        let x131 = 0.275 * x119;
-        let x132 = 0.4 * x120;
-        let x133 = -0.275 * x119;
-        let x134 = Self::mul_add(
             0.00000000020510342851533115,
-            x123,
-            Self::mul_add(x6, x122, x5 * x121),
-        ) - (x130 - x131) - (x133 - x132);
-        let x135 = -0.000000008530897668050218 + x118;
-        let x136 = -12.701650001451807 + x119;
-        let x137 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x118, x123 + Self::mul_add(x8, x122, x7 * x121));
-        let x138 = -0.0021399965876409276
-            + Self::mul_add(
-                x118,
-                -0.4,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x123,
-                    Self::mul_add(-s_q9, x122, c_q9 * x121),
-                ),
-            );
-        let x139 = -0.0000000234896432582596
-            + Self::mul_add(
-                -0.275,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x126,
-                    Self::mul_add(x6, x125, x5 * x124),
-                ),
-            );
-        let x140 = -111.7548902508081
-            + (x126 + Self::mul_add(x8, x125, x7 * x124) + x132 - x130);
-        let x141 = 5.080660024070365
-            + Self::mul_add(
-                -0.275,
-                x120,
-                Self::mul_add(
-                    -0.4,
-                    x119,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x126,
-                        Self::mul_add(-s_q9, x125, c_q9 * x124),
-                    ),
-                ),
-            );
-        let x142 = -0.0021399965876409276
-            + Self::mul_add(
-                -0.4,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(x6, x128, x5 * x127),
-                ),
-            );
-        let x143 = 5.080660024070366
-            + Self::mul_add(
-                x119,
-                -0.4,
-                Self::mul_add(-0.275, x120, x129 + Self::mul_add(x8, x128, x7 * x127)),
-            );
-        let x144 = 113.3918902508081
-            + (x131
+            x119,
+            Self::mul_add(c_q9, x114, s_q9 * x113),
+        );
+        let x130 = Self::mul_add(
+            0.00000000020510342851533115,
+            x120,
+            Self::mul_add(c_q9, x117, s_q9 * x111),
+        );
+        let x131 = Self::mul_add(
+            0.00000000020510342851533115,
+            x121,
+            Self::mul_add(c_q9, x118, s_q9 * x116),
+        );
+        let x132 = x119 + Self::mul_add(x6, x114, x5 * x113);
+        let x133 = x120 + Self::mul_add(x6, x117, x5 * x111);
+        let x134 = x121 + Self::mul_add(x6, x118, x5 * x116);
+        let x135 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x119,
+            Self::mul_add(-s_q9, x114, c_q9 * x113),
+        );
+        let x136 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x120,
+            Self::mul_add(-s_q9, x117, c_q9 * x111),
+        );
+        let x137 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x121,
+            Self::mul_add(-s_q9, x118, c_q9 * x116),
+        );
+        let x138 = x128 * -0.4;
+        let x139 = 0.275 * x125;
+        let x140 = 0.4 * x128;
+        let x141 = -0.275 * x125;
+        let x142 = Self::mul_add(
+            x124,
+            -0.4,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x131,
+                Self::mul_add(-s_q9, x130, c_q9 * x129),
+            ),
+        );
+        let x143 = Self::mul_add(
+            -0.4,
+            x125,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x134,
+                Self::mul_add(-s_q9, x133, c_q9 * x132),
+            ),
+        );
+        let x144 = Self::mul_add(
+            0.00000000020510342851533115,
+            x131,
+            Self::mul_add(c_q9, x130, s_q9 * x129),
+        ) - (x138 - x139) - (x141 - x140);
+        let x145 = Self::mul_add(
+            -0.275,
+            x124,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x134,
+                Self::mul_add(c_q9, x133, s_q9 * x132),
+            ),
+        );
+        let x146 = Self::mul_add(
+            -0.4,
+            x124,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x137,
+                Self::mul_add(c_q9, x136, s_q9 * x135),
+            ),
+        );
+        let x147 = Self::mul_add(
+            x125,
+            -0.4,
+            Self::mul_add(-0.275, x128, x137 + Self::mul_add(x6, x136, x5 * x135)),
+        );
+        let x148 = -0.000000008530897668050218 + x124;
+        let x149 = -12.701650001451807 + x125;
+        let x150 = -0.0000000234896432582596
+            + Self::mul_add(-0.275, x124, x131 + Self::mul_add(x6, x130, x5 * x129));
+        let x151 = -0.002139996587640933 + x142;
+        let x152 = -0.0000000234896432582596 + x145;
+        let x153 = -111.7548902508081
+            + (x134 + Self::mul_add(x6, x133, x5 * x132) + x140 - x138);
+        let x154 = 5.080660024070365 + Self::mul_add(-0.275, x128, x143);
+        let x155 = -0.002139996587640933 + x146;
+        let x156 = 5.080660024070366 + x147;
+        let x157 = 113.3918902508081
+            + (x139
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(-s_q9, x128, c_q9 * x127),
-                ) - x133));
-        let x145 = x120 + Self::mul_add(-x3, x136, x2 * x135);
-        let x146 = Self::mul_add(c_q8, x136, s_q8 * x135);
-        let x147 = c_q8 * x135;
-        let x148 = s_q8 * x136;
-        let x149 = Self::mul_add(-0.00000000020510342851533115, x120, x148 - x147);
-        let x150 = x142 + Self::mul_add(-x3, x139, x2 * x134);
-        let x151 = x143 + Self::mul_add(-x3, x140, x2 * x137);
-        let x152 = x144 + Self::mul_add(-x3, x141, x2 * x138);
-        let x153 = Self::mul_add(c_q8, x139, s_q8 * x134);
-        let x154 = Self::mul_add(c_q8, x140, s_q8 * x137);
-        let x155 = Self::mul_add(c_q8, x141, s_q8 * x138);
-        let x156 = Self::mul_add(
+                    x137,
+                    Self::mul_add(-s_q9, x136, c_q9 * x135),
+                ) - x141));
+        let x158 = x128 + Self::mul_add(-x3, x149, x2 * x148);
+        let x159 = Self::mul_add(c_q8, x149, s_q8 * x148);
+        let x160 = c_q8 * x148;
+        let x161 = s_q8 * x149;
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x128, x161 - x160);
+        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x144);
+        let x164 = x156 + Self::mul_add(-x3, x153, x2 * x150);
+        let x165 = x157 + Self::mul_add(-x3, x154, x2 * x151);
+        let x166 = Self::mul_add(c_q8, x152, s_q8 * x144);
+        let x167 = Self::mul_add(c_q8, x153, s_q8 * x150);
+        let x168 = Self::mul_add(c_q8, x154, s_q8 * x151);
+        let x169 = Self::mul_add(
             -0.00000000020510342851533115,
-            x144,
-            Self::mul_add(-c_q8, x138, s_q8 * x141),
+            x157,
+            Self::mul_add(-c_q8, x151, s_q8 * x154),
         );
-        let x157 = x149 * -0.35;
-        let x158 = 0.35 * x149;
-        let x159 = x158 + (x152 + Self::mul_add(-x3, x151, x2 * x150) - x157);
-        let x160 = 48.0240000085309 + x145;
-        let x161 = -0.07309 + Self::mul_add(c_q8, x151, s_q8 * x150);
-        let x162 = -16.80768997608804
-            + Self::mul_add(
-                x145,
-                -0.35,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x152,
-                    Self::mul_add(-c_q8, x150, s_q8 * x151),
-                ),
-            );
-        let x163 = -0.07309 + (x155 + Self::mul_add(-x3, x154, x2 * x153));
-        let x164 = 130.43769025763282
-            + (Self::mul_add(c_q8, x154, s_q8 * x153) + x158 - x157);
-        let x165 = 0.1132
-            + Self::mul_add(
-                -0.35,
-                x146,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x155,
-                    Self::mul_add(-c_q8, x153, s_q8 * x154),
-                ),
-            );
-        let x166 = 132.47349025763282
-            + Self::mul_add(
+        let x170 = Self::mul_add(
+            -c_q8,
+            Self::mul_add(
                 -0.00000000020510342851533115,
-                x156,
-                Self::mul_add(
-                    -c_q8,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x142,
-                        Self::mul_add(-c_q8, x134, s_q8 * x139),
-                    ),
-                    s_q8
-                        * Self::mul_add(
-                            -0.00000000020510342851533115,
-                            x143,
-                            Self::mul_add(-c_q8, x137, s_q8 * x140),
-                        ),
+                x155,
+                Self::mul_add(-c_q8, x144, s_q8 * x152),
+            ),
+            s_q8
+                * Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x156,
+                    Self::mul_add(-c_q8, x150, s_q8 * x153),
                 ),
-            );
-        let x167 = Self::mul_add(-s_q7, x146, c_q7 * x160);
-        let x168 = Self::mul_add(c_q7, x146, s_q7 * x160);
-        let x169 = Self::mul_add(-s_q7, x163, c_q7 * x159);
-        let x170 = Self::mul_add(-s_q7, x164, c_q7 * x161);
-        let x171 = -x168;
-        let x172 = x149 * -0.75;
-        let x173 = 0.75 * x149;
-        let x174 = x167 * -0.65;
-        let x175 = 0.65 * x167;
-        let x176 = Self::mul_add(x167, -0.75, Self::mul_add(-s_q7, x165, c_q7 * x162));
-        let x177 = Self::mul_add(-0.75, x168, Self::mul_add(c_q7, x165, s_q7 * x162));
-        let x178 = x166 + x175;
-        let x179 = Self::mul_add(-0.65, x168, Self::mul_add(c_q7, x170, s_q7 * x169));
-        let x180 = 110.5455 + x167;
-        let x181 = 180.9502499901501 + x149;
-        let x182 = 1394.5960312283303
-            + (x173 + (Self::mul_add(-s_q7, x170, c_q7 * x169) - x172));
-        let x183 = -117.61766249359756 + Self::mul_add(x149, -0.65, x176);
-        let x184 = 1466.4506062283303
+        );
+        let x171 = x162 * -0.35;
+        let x172 = 0.35 * x162;
+        let x173 = Self::mul_add(
+            x158,
+            -0.35,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x165,
+                Self::mul_add(-c_q8, x163, s_q8 * x164),
+            ),
+        );
+        let x174 = Self::mul_add(
+            -0.35,
+            x159,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x168,
+                Self::mul_add(-c_q8, x166, s_q8 * x167),
+            ),
+        );
+        let x175 = x172 + (x165 + Self::mul_add(-x3, x164, x2 * x163) - x171);
+        let x176 = 48.0240000085309 + x158;
+        let x177 = -0.07309 + Self::mul_add(c_q8, x164, s_q8 * x163);
+        let x178 = -16.80768997608804 + x173;
+        let x179 = -0.07309 + (x168 + Self::mul_add(-x3, x167, x2 * x166));
+        let x180 = 130.43769025763282
+            + (Self::mul_add(c_q8, x167, s_q8 * x166) + x172 - x171);
+        let x181 = 0.1132 + x174;
+        let x182 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x169, x170);
+        let x183 = Self::mul_add(-s_q7, x159, c_q7 * x176);
+        let x184 = Self::mul_add(c_q7, x159, s_q7 * x176);
+        let x185 = Self::mul_add(-s_q7, x179, c_q7 * x175);
+        let x186 = Self::mul_add(-s_q7, x180, c_q7 * x177);
+        let x187 = -x184;
+        let x188 = x162 * -0.75;
+        let x189 = 0.75 * x162;
+        let x190 = x183 * -0.65;
+        let x191 = 0.65 * x183;
+        let x192 = Self::mul_add(x183, -0.75, Self::mul_add(-s_q7, x181, c_q7 * x178));
+        let x193 = Self::mul_add(-0.75, x184, Self::mul_add(c_q7, x181, s_q7 * x178));
+        let x194 = x182 + x191;
+        let x195 = Self::mul_add(-0.65, x184, Self::mul_add(c_q7, x186, s_q7 * x185));
+        let x196 = 110.5455 + x183;
+        let x197 = 180.9502499901501 + x162;
+        let x198 = 1394.5960312283303
+            + (x189 + (Self::mul_add(-s_q7, x186, c_q7 * x185) - x188));
+        let x199 = -117.61766249359756 + Self::mul_add(x162, -0.65, x192);
+        let x200 = 1466.4506062283303
             + (Self::mul_add(
                 c_q7,
-                Self::mul_add(c_q7, x164, s_q7 * x161),
-                s_q7 * Self::mul_add(c_q7, x163, s_q7 * x159),
-            ) - (x174 - x173) - (x172 - x175));
-        let x185 = 1271.854575 + (x178 - x174);
-        let x186 = -x181;
-        let x187 = -x180;
-        let x188 = Self::mul_add(x3, x135, x2 * x136);
-        let x189 = x147 - x148;
-        let x190 = Self::mul_add(-0.35, x189, x152);
-        let x191 = Self::mul_add(-0.35, x188, x155);
-        let x192 = Self::mul_add(s_q7, x189, c_q7 * x188);
-        let x193 = -x192;
-        let x194 = Self::mul_add(-s_q7, x188, c_q7 * x189);
-        let x195 = Self::mul_add(-0.75, x194, Self::mul_add(-s_q7, x191, c_q7 * x190));
-        let x196 = Self::mul_add(c_q7, x191, s_q7 * x190)
-            + Self::mul_add(-0.75, x192, x146 * -0.65);
-        let x197 = Self::mul_add(0.65, x194, x156);
-        let x198 = x6 * x96;
-        let x199 = Self::mul_add(-x5, x111, x198);
-        let x200 = x8 * x96;
-        let x201 = Self::mul_add(-x7, x111, x200);
-        let x202 = s_q9 * x96;
-        let x203 = Self::mul_add(c_q9, x111, x202);
-        let x204 = x123 + Self::mul_add(-0.275, x203, -0.4 * x201);
-        let x205 = Self::mul_add(0.4, x199, x126);
-        let x206 = Self::mul_add(-0.275, x199, x129);
-        let x207 = Self::mul_add(-x3, x201, x2 * x199) - x203;
-        let x208 = Self::mul_add(c_q8, x201, s_q8 * x199);
-        let x209 = Self::mul_add(
-            0.00000000020510342851533115,
-            x203,
-            Self::mul_add(-c_q8, x199, s_q8 * x201),
-        );
-        let x210 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x206,
-            Self::mul_add(-c_q8, x204, s_q8 * x205),
-        );
-        let x211 = Self::mul_add(
-            -0.35,
-            x208,
-            x206 + Self::mul_add(-x3, x205, x2 * x204),
-        );
-        let x212 = Self::mul_add(0.35, x207, Self::mul_add(c_q8, x205, s_q8 * x204));
-        let x213 = Self::mul_add(-s_q7, x208, c_q7 * x207);
-        let x214 = Self::mul_add(c_q7, x208, s_q7 * x207);
-        let x215 = Self::mul_add(-0.75, x214, Self::mul_add(-s_q7, x212, c_q7 * x211));
-        let x216 = Self::mul_add(c_q7, x212, s_q7 * x211)
-            + Self::mul_add(-0.65, x209, 0.75 * x213);
-        let x217 = Self::mul_add(0.65, x214, x210);
-        let x218 = Self::mul_add(-x5, x98, x198);
-        let x219 = Self::mul_add(-x7, x98, x200);
-        let x220 = Self::mul_add(c_q9, x98, x202);
+                Self::mul_add(c_q7, x180, s_q7 * x177),
+                s_q7 * Self::mul_add(c_q7, x179, s_q7 * x175),
+            ) - (x190 - x189) - (x188 - x191));
+        let x201 = 1271.854575 + (x194 - x190);
+        let x202 = -x197;
+        let x203 = -x196;
+        let x204 = Self::mul_add(x3, x148, x2 * x149);
+        let x205 = x160 - x161;
+        let x206 = Self::mul_add(-0.35, x205, x165);
+        let x207 = Self::mul_add(-0.35, x204, x168);
+        let x208 = Self::mul_add(s_q7, x205, c_q7 * x204);
+        let x209 = -x208;
+        let x210 = Self::mul_add(-s_q7, x204, c_q7 * x205);
+        let x211 = Self::mul_add(-0.75, x210, Self::mul_add(-s_q7, x207, c_q7 * x206));
+        let x212 = Self::mul_add(c_q7, x207, s_q7 * x206)
+            + Self::mul_add(-0.75, x208, x159 * -0.65);
+        let x213 = Self::mul_add(0.65, x210, x169);
+        let x214 = x6 * x100;
+        let x215 = Self::mul_add(-x5, x115, x214);
+        let x216 = x131 + Self::mul_add(-0.275, x123, -0.4 * x215);
+        let x217 = Self::mul_add(0.4, x127, x134);
+        let x218 = Self::mul_add(-0.275, x127, x137);
+        let x219 = Self::mul_add(-x3, x215, x2 * x127) - x123;
+        let x220 = Self::mul_add(c_q8, x215, s_q8 * x127);
         let x221 = Self::mul_add(
             0.00000000020510342851533115,
-            x108,
-            Self::mul_add(x6, x104, x5 * x101),
-        ) + Self::mul_add(-0.275, x220, -0.4 * x219);
-        let x222 = Self::mul_add(0.4, x218, x108 + Self::mul_add(x8, x104, x7 * x101));
-        let x223 = Self::mul_add(
-            -0.275,
+            x123,
+            Self::mul_add(-c_q8, x127, s_q8 * x215),
+        );
+        let x222 = Self::mul_add(
+            -0.00000000020510342851533115,
             x218,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x108,
-                Self::mul_add(-s_q9, x104, c_q9 * x101),
-            ),
+            Self::mul_add(-c_q8, x216, s_q8 * x217),
         );
-        let x224 = Self::mul_add(-x3, x219, x2 * x218) - x220;
-        let x225 = Self::mul_add(c_q8, x219, s_q8 * x218);
-        let x226 = Self::mul_add(
-            0.00000000020510342851533115,
+        let x223 = Self::mul_add(
+            -0.35,
             x220,
-            Self::mul_add(-c_q8, x218, s_q8 * x219),
+            x218 + Self::mul_add(-x3, x217, x2 * x216),
         );
-        let x227 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x223,
-            Self::mul_add(-c_q8, x221, s_q8 * x222),
-        );
-        let x228 = Self::mul_add(
-            -0.35,
-            x225,
-            x223 + Self::mul_add(-x3, x222, x2 * x221),
-        );
-        let x229 = Self::mul_add(0.35, x224, Self::mul_add(c_q8, x222, s_q8 * x221));
-        let x230 = Self::mul_add(-s_q7, x225, c_q7 * x224);
-        let x231 = Self::mul_add(c_q7, x225, s_q7 * x224);
-        let x232 = Self::mul_add(-0.75, x231, Self::mul_add(-s_q7, x229, c_q7 * x228));
-        let x233 = Self::mul_add(c_q7, x229, s_q7 * x228)
-            + Self::mul_add(-0.65, x226, 0.75 * x230);
-        let x234 = Self::mul_add(0.65, x231, x227);
-        let x235 = Self::mul_add(c_q10, x73, x97);
-        let x236 = Self::mul_add(-s_q10, x73, x95);
-        let x237 = Self::mul_add(-s_q10, x84, c_q10 * x83);
-        let x238 = Self::mul_add(c_q10, x84, s_q10 * x83);
-        let x239 = Self::mul_add(-0.87, x235, x85);
-        let x240 = Self::mul_add(-x5, x235, x6 * x236);
-        let x241 = Self::mul_add(-x7, x235, x8 * x236);
-        let x242 = Self::mul_add(s_q9, x236, c_q9 * x235);
-        let x243 = Self::mul_add(
+        let x224 = Self::mul_add(0.35, x219, Self::mul_add(c_q8, x217, s_q8 * x216));
+        let x225 = Self::mul_add(-s_q7, x220, c_q7 * x219);
+        let x226 = Self::mul_add(c_q7, x220, s_q7 * x219);
+        let x227 = Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x224, c_q7 * x223));
+        let x228 = Self::mul_add(c_q7, x224, s_q7 * x223)
+            + Self::mul_add(-0.65, x221, 0.75 * x225);
+        let x229 = Self::mul_add(0.65, x226, x222);
+        let x230 = Self::mul_add(-s_q9, x102, x126);
+        let x231 = Self::mul_add(-x5, x102, x214);
+        let x232 = Self::mul_add(c_q9, x102, x122);
+        let x233 = Self::mul_add(
             0.00000000020510342851533115,
-            x239,
-            Self::mul_add(x6, x238, x5 * x237),
-        ) + Self::mul_add(-0.275, x242, -0.4 * x241);
-        let x244 = Self::mul_add(0.4, x240, x239 + Self::mul_add(x8, x238, x7 * x237));
-        let x245 = Self::mul_add(
+            x112,
+            Self::mul_add(c_q9, x108, s_q9 * x105),
+        ) + Self::mul_add(-0.275, x232, -0.4 * x231);
+        let x234 = Self::mul_add(0.4, x230, x112 + Self::mul_add(x6, x108, x5 * x105));
+        let x235 = Self::mul_add(
             -0.275,
-            x240,
+            x230,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x239,
-                Self::mul_add(-s_q9, x238, c_q9 * x237),
+                x112,
+                Self::mul_add(-s_q9, x108, c_q9 * x105),
             ),
         );
-        let x246 = Self::mul_add(-x3, x241, x2 * x240) - x242;
-        let x247 = Self::mul_add(c_q8, x241, s_q8 * x240);
-        let x248 = Self::mul_add(
+        let x236 = Self::mul_add(-x3, x231, x2 * x230) - x232;
+        let x237 = Self::mul_add(c_q8, x231, s_q8 * x230);
+        let x238 = Self::mul_add(
             0.00000000020510342851533115,
-            x242,
-            Self::mul_add(-c_q8, x240, s_q8 * x241),
+            x232,
+            Self::mul_add(-c_q8, x230, s_q8 * x231),
         );
-        let x249 = Self::mul_add(
+        let x239 = Self::mul_add(
             -0.00000000020510342851533115,
-            x245,
-            Self::mul_add(-c_q8, x243, s_q8 * x244),
+            x235,
+            Self::mul_add(-c_q8, x233, s_q8 * x234),
         );
-        let x250 = Self::mul_add(
+        let x240 = Self::mul_add(
             -0.35,
-            x247,
-            x245 + Self::mul_add(-x3, x244, x2 * x243),
+            x237,
+            x235 + Self::mul_add(-x3, x234, x2 * x233),
         );
-        let x251 = Self::mul_add(0.35, x246, Self::mul_add(c_q8, x244, s_q8 * x243));
-        let x252 = Self::mul_add(-s_q7, x247, c_q7 * x246);
-        let x253 = Self::mul_add(c_q7, x247, s_q7 * x246);
-        let x254 = Self::mul_add(-0.75, x253, Self::mul_add(-s_q7, x251, c_q7 * x250));
-        let x255 = Self::mul_add(c_q7, x251, s_q7 * x250)
-            + Self::mul_add(-0.65, x248, 0.75 * x252);
-        let x256 = Self::mul_add(0.65, x253, x249);
-        let x257 = Self::mul_add(-x12, x36, x13 * x35);
-        let x258 = x46 - x45;
-        let x259 = Self::mul_add(0.36, x257, x53);
-        let x260 = Self::mul_add(0.36, x49, x56);
-        let x261 = Self::mul_add(s_q11, x257, c_q11 * x49);
-        let x262 = Self::mul_add(-s_q11, x49, c_q11 * x257);
-        let x263 = Self::mul_add(-s_q11, x260, c_q11 * x259)
-            + Self::mul_add(-0.63, x258, 0.275 * x262);
-        let x264 = Self::mul_add(0.275, x261, Self::mul_add(c_q11, x260, s_q11 * x259));
-        let x265 = Self::mul_add(-0.63, x261, x59);
-        let x266 = Self::mul_add(s_q10, x262, c_q10 * x261);
-        let x267 = Self::mul_add(-s_q10, x261, c_q10 * x262);
-        let x268 = Self::mul_add(c_q10, x264, s_q10 * x263);
-        let x269 = Self::mul_add(-0.87, x258, Self::mul_add(-s_q10, x264, c_q10 * x263));
-        let x270 = Self::mul_add(-0.87, x266, x265);
-        let x271 = Self::mul_add(
+        let x241 = Self::mul_add(0.35, x236, Self::mul_add(c_q8, x234, s_q8 * x233));
+        let x242 = Self::mul_add(-s_q7, x237, c_q7 * x236);
+        let x243 = Self::mul_add(c_q7, x237, s_q7 * x236);
+        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x241, c_q7 * x240));
+        let x245 = Self::mul_add(c_q7, x241, s_q7 * x240)
+            + Self::mul_add(-0.65, x238, 0.75 * x242);
+        let x246 = Self::mul_add(0.65, x243, x239);
+        let x247 = Self::mul_add(c_q10, x76, x101);
+        let x248 = Self::mul_add(-s_q10, x76, x99);
+        let x249 = Self::mul_add(-s_q10, x87, c_q10 * x86);
+        let x250 = Self::mul_add(c_q10, x87, s_q10 * x86);
+        let x251 = Self::mul_add(-0.87, x247, x88);
+        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
+        let x253 = Self::mul_add(-x5, x247, x6 * x248);
+        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
+        let x255 = Self::mul_add(
             0.00000000020510342851533115,
-            x258,
-            Self::mul_add(-x5, x266, x6 * x267),
+            x251,
+            Self::mul_add(c_q9, x250, s_q9 * x249),
+        ) + Self::mul_add(-0.275, x254, -0.4 * x253);
+        let x256 = Self::mul_add(0.4, x252, x251 + Self::mul_add(x6, x250, x5 * x249));
+        let x257 = Self::mul_add(
+            -0.275,
+            x252,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x251,
+                Self::mul_add(-s_q9, x250, c_q9 * x249),
+            ),
         );
-        let x272 = x258 + Self::mul_add(-x7, x266, x8 * x267);
-        let x273 = Self::mul_add(
+        let x258 = Self::mul_add(-x3, x253, x2 * x252) - x254;
+        let x259 = Self::mul_add(c_q8, x253, s_q8 * x252);
+        let x260 = Self::mul_add(
+            0.00000000020510342851533115,
+            x254,
+            Self::mul_add(-c_q8, x252, s_q8 * x253),
+        );
+        let x261 = Self::mul_add(
             -0.00000000020510342851533115,
-            x258,
-            -Self::mul_add(s_q9, x267, c_q9 * x266),
+            x257,
+            Self::mul_add(-c_q8, x255, s_q8 * x256),
         );
-        let x274 = Self::mul_add(
+        let x262 = Self::mul_add(
+            -0.35,
+            x259,
+            x257 + Self::mul_add(-x3, x256, x2 * x255),
+        );
+        let x263 = Self::mul_add(0.35, x258, Self::mul_add(c_q8, x256, s_q8 * x255));
+        let x264 = Self::mul_add(-s_q7, x259, c_q7 * x258);
+        let x265 = Self::mul_add(c_q7, x259, s_q7 * x258);
+        let x266 = Self::mul_add(-0.75, x265, Self::mul_add(-s_q7, x263, c_q7 * x262));
+        let x267 = Self::mul_add(c_q7, x263, s_q7 * x262)
+            + Self::mul_add(-0.65, x260, 0.75 * x264);
+        let x268 = Self::mul_add(0.65, x265, x261);
+        let x269 = Self::mul_add(-x10, x37, x11 * x36);
+        let x270 = x47 - x46;
+        let x271 = Self::mul_add(0.36, x269, x54);
+        let x272 = Self::mul_add(0.36, x50, x57);
+        let x273 = Self::mul_add(s_q11, x269, c_q11 * x50);
+        let x274 = Self::mul_add(-s_q11, x50, c_q11 * x269);
+        let x275 = Self::mul_add(-s_q11, x272, c_q11 * x271)
+            + Self::mul_add(-0.63, x270, 0.275 * x274);
+        let x276 = Self::mul_add(0.275, x273, Self::mul_add(c_q11, x272, s_q11 * x271));
+        let x277 = Self::mul_add(-0.63, x273, x60);
+        let x278 = Self::mul_add(s_q10, x274, c_q10 * x273);
+        let x279 = Self::mul_add(-s_q10, x273, c_q10 * x274);
+        let x280 = Self::mul_add(c_q10, x276, s_q10 * x275);
+        let x281 = Self::mul_add(-0.87, x270, Self::mul_add(-s_q10, x276, c_q10 * x275));
+        let x282 = Self::mul_add(-0.87, x278, x277);
+        let x283 = Self::mul_add(
             0.00000000020510342851533115,
             x270,
-            Self::mul_add(x6, x268, x5 * x269),
-        ) + Self::mul_add(0.275, x273, -0.4 * x272);
-        let x275 = Self::mul_add(0.4, x271, x270 + Self::mul_add(x8, x268, x7 * x269));
-        let x276 = Self::mul_add(
+            Self::mul_add(-s_q9, x278, c_q9 * x279),
+        );
+        let x284 = x270 + Self::mul_add(-x5, x278, x6 * x279);
+        let x285 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x270,
+            -Self::mul_add(s_q9, x279, c_q9 * x278),
+        );
+        let x286 = Self::mul_add(
+            0.00000000020510342851533115,
+            x282,
+            Self::mul_add(c_q9, x280, s_q9 * x281),
+        ) + Self::mul_add(0.275, x285, -0.4 * x284);
+        let x287 = Self::mul_add(0.4, x283, x282 + Self::mul_add(x6, x280, x5 * x281));
+        let x288 = Self::mul_add(
             -0.275,
-            x271,
+            x283,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x270,
-                Self::mul_add(-s_q9, x268, c_q9 * x269),
+                x282,
+                Self::mul_add(-s_q9, x280, c_q9 * x281),
             ),
         );
-        let x277 = x273 + Self::mul_add(-x3, x272, x2 * x271);
-        let x278 = Self::mul_add(c_q8, x272, s_q8 * x271);
-        let x279 = Self::mul_add(
+        let x289 = x285 + Self::mul_add(-x3, x284, x2 * x283);
+        let x290 = Self::mul_add(c_q8, x284, s_q8 * x283);
+        let x291 = Self::mul_add(
             -0.00000000020510342851533115,
-            x273,
-            Self::mul_add(-c_q8, x271, s_q8 * x272),
+            x285,
+            Self::mul_add(-c_q8, x283, s_q8 * x284),
         );
-        let x280 = Self::mul_add(
+        let x292 = Self::mul_add(
             -0.00000000020510342851533115,
-            x276,
-            Self::mul_add(-c_q8, x274, s_q8 * x275),
+            x288,
+            Self::mul_add(-c_q8, x286, s_q8 * x287),
         );
-        let x281 = Self::mul_add(
+        let x293 = Self::mul_add(
             -0.35,
-            x278,
-            x276 + Self::mul_add(-x3, x275, x2 * x274),
-        );
-        let x282 = Self::mul_add(0.35, x277, Self::mul_add(c_q8, x275, s_q8 * x274));
-        let x283 = Self::mul_add(-s_q7, x278, c_q7 * x277);
-        let x284 = Self::mul_add(c_q7, x278, s_q7 * x277);
-        let x285 = Self::mul_add(-0.75, x284, Self::mul_add(-s_q7, x282, c_q7 * x281));
-        let x286 = Self::mul_add(c_q7, x282, s_q7 * x281)
-            + Self::mul_add(-0.65, x279, 0.75 * x283);
-        let x287 = Self::mul_add(0.65, x284, x280);
-        let x288 = x15 * -4.806620000000001;
-        let x289 = s_q13 * -4.806620000000001;
-        let x290 = c_q13 * -4.806620000000001;
-        let x291 = x22 + Self::mul_add(-0.55, x290, -0.16 * x289);
-        let x292 = Self::mul_add(0.16, x288, x26);
-        let x293 = Self::mul_add(-0.55, x288, x29);
-        let x294 = Self::mul_add(-s_q12, x289, c_q12 * x288);
-        let x295 = Self::mul_add(x13, x289, x12 * x288) - x290;
-        let x296 = Self::mul_add(
-            -0.00000000020510342851533115,
             x290,
-            Self::mul_add(c_q12, x289, s_q12 * x288),
+            x288 + Self::mul_add(-x3, x287, x2 * x286),
         );
-        let x297 = Self::mul_add(
+        let x294 = Self::mul_add(0.35, x289, Self::mul_add(c_q8, x287, s_q8 * x286));
+        let x295 = Self::mul_add(-s_q7, x290, c_q7 * x289);
+        let x296 = Self::mul_add(c_q7, x290, s_q7 * x289);
+        let x297 = Self::mul_add(-0.75, x296, Self::mul_add(-s_q7, x294, c_q7 * x293));
+        let x298 = Self::mul_add(c_q7, x294, s_q7 * x293)
+            + Self::mul_add(-0.65, x291, 0.75 * x295);
+        let x299 = Self::mul_add(0.65, x296, x292);
+        let x300 = x13 * -4.806620000000001;
+        let x301 = s_q13 * -4.806620000000001;
+        let x302 = c_q13 * -4.806620000000001;
+        let x303 = x20 + Self::mul_add(-0.55, x302, -0.16 * x301);
+        let x304 = Self::mul_add(0.16, x300, x24);
+        let x305 = Self::mul_add(-0.55, x300, x27);
+        let x306 = Self::mul_add(-s_q12, x301, c_q12 * x300);
+        let x307 = Self::mul_add(x11, x301, x10 * x300) - x302;
+        let x308 = Self::mul_add(
             -0.00000000020510342851533115,
-            x293,
-            -Self::mul_add(c_q12, x292, s_q12 * x291),
+            x302,
+            Self::mul_add(c_q12, x301, s_q12 * x300),
         );
-        let x298 = Self::mul_add(0.36, x295, Self::mul_add(-s_q12, x292, c_q12 * x291));
-        let x299 = Self::mul_add(
+        let x309 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x305,
+            -Self::mul_add(c_q12, x304, s_q12 * x303),
+        );
+        let x310 = Self::mul_add(0.36, x307, Self::mul_add(-s_q12, x304, c_q12 * x303));
+        let x311 = Self::mul_add(
             -0.36,
-            x294,
-            x293 + Self::mul_add(x13, x292, x12 * x291),
+            x306,
+            x305 + Self::mul_add(x11, x304, x10 * x303),
         );
-        let x300 = Self::mul_add(-s_q11, x295, c_q11 * x294);
-        let x301 = Self::mul_add(c_q11, x295, s_q11 * x294);
-        let x302 = Self::mul_add(-s_q11, x299, c_q11 * x298)
-            + Self::mul_add(0.63, x296, 0.275 * x301);
-        let x303 = Self::mul_add(-0.275, x300, Self::mul_add(c_q11, x299, s_q11 * x298));
-        let x304 = Self::mul_add(0.63, x300, x297);
-        let x305 = Self::mul_add(-s_q10, x301, c_q10 * x300);
-        let x306 = Self::mul_add(c_q10, x301, s_q10 * x300);
-        let x307 = Self::mul_add(c_q10, x303, s_q10 * x302);
-        let x308 = Self::mul_add(0.87, x296, Self::mul_add(-s_q10, x303, c_q10 * x302));
-        let x309 = Self::mul_add(0.87, x305, x304);
-        let x310 = Self::mul_add(
+        let x312 = Self::mul_add(-s_q11, x307, c_q11 * x306);
+        let x313 = Self::mul_add(c_q11, x307, s_q11 * x306);
+        let x314 = Self::mul_add(-s_q11, x311, c_q11 * x310)
+            + Self::mul_add(0.63, x308, 0.275 * x313);
+        let x315 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x311, s_q11 * x310));
+        let x316 = Self::mul_add(0.63, x312, x309);
+        let x317 = Self::mul_add(-s_q10, x313, c_q10 * x312);
+        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
+        let x319 = Self::mul_add(c_q10, x315, s_q10 * x314);
+        let x320 = Self::mul_add(0.87, x308, Self::mul_add(-s_q10, x315, c_q10 * x314));
+        let x321 = Self::mul_add(0.87, x317, x316);
+        let x322 = Self::mul_add(
             -0.00000000020510342851533115,
-            x296,
-            Self::mul_add(x6, x306, x5 * x305),
+            x308,
+            Self::mul_add(c_q9, x318, s_q9 * x317),
         );
-        let x311 = Self::mul_add(x8, x306, x7 * x305) - x296;
-        let x312 = Self::mul_add(
+        let x323 = Self::mul_add(x6, x318, x5 * x317) - x308;
+        let x324 = Self::mul_add(
             0.00000000020510342851533115,
-            x296,
-            Self::mul_add(-s_q9, x306, c_q9 * x305),
+            x308,
+            Self::mul_add(-s_q9, x318, c_q9 * x317),
         );
-        let x313 = Self::mul_add(
+        let x325 = Self::mul_add(
             0.00000000020510342851533115,
-            x309,
-            Self::mul_add(x6, x307, x5 * x308),
-        ) + Self::mul_add(0.275, x312, -0.4 * x311);
-        let x314 = Self::mul_add(0.4, x310, x309 + Self::mul_add(x8, x307, x7 * x308));
-        let x315 = Self::mul_add(
+            x321,
+            Self::mul_add(c_q9, x319, s_q9 * x320),
+        ) + Self::mul_add(0.275, x324, -0.4 * x323);
+        let x326 = Self::mul_add(0.4, x322, x321 + Self::mul_add(x6, x319, x5 * x320));
+        let x327 = Self::mul_add(
             -0.275,
-            x310,
+            x322,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x309,
-                Self::mul_add(-s_q9, x307, c_q9 * x308),
+                x321,
+                Self::mul_add(-s_q9, x319, c_q9 * x320),
             ),
         );
-        let x316 = x312 + Self::mul_add(-x3, x311, x2 * x310);
-        let x317 = Self::mul_add(c_q8, x311, s_q8 * x310);
-        let x318 = Self::mul_add(
+        let x328 = x324 + Self::mul_add(-x3, x323, x2 * x322);
+        let x329 = Self::mul_add(c_q8, x323, s_q8 * x322);
+        let x330 = Self::mul_add(
             -0.00000000020510342851533115,
-            x312,
-            Self::mul_add(-c_q8, x310, s_q8 * x311),
+            x324,
+            Self::mul_add(-c_q8, x322, s_q8 * x323),
         );
-        let x319 = Self::mul_add(
+        let x331 = Self::mul_add(
             -0.00000000020510342851533115,
-            x315,
-            Self::mul_add(-c_q8, x313, s_q8 * x314),
+            x327,
+            Self::mul_add(-c_q8, x325, s_q8 * x326),
         );
-        let x320 = Self::mul_add(
+        let x332 = Self::mul_add(
             -0.35,
-            x317,
-            x315 + Self::mul_add(-x3, x314, x2 * x313),
+            x329,
+            x327 + Self::mul_add(-x3, x326, x2 * x325),
         );
-        let x321 = Self::mul_add(0.35, x316, Self::mul_add(c_q8, x314, s_q8 * x313));
-        let x322 = Self::mul_add(-s_q7, x317, c_q7 * x316);
-        let x323 = Self::mul_add(c_q7, x317, s_q7 * x316);
-        let x324 = Self::mul_add(-0.75, x323, Self::mul_add(-s_q7, x321, c_q7 * x320));
-        let x325 = Self::mul_add(c_q7, x321, s_q7 * x320)
-            + Self::mul_add(-0.65, x318, 0.75 * x322);
-        let x326 = Self::mul_add(0.65, x323, x319);
+        let x333 = Self::mul_add(0.35, x328, Self::mul_add(c_q8, x326, s_q8 * x325));
+        let x334 = Self::mul_add(-s_q7, x329, c_q7 * x328);
+        let x335 = Self::mul_add(c_q7, x329, s_q7 * x328);
+        let x336 = Self::mul_add(-0.75, x335, Self::mul_add(-s_q7, x333, c_q7 * x332));
+        let x337 = Self::mul_add(c_q7, x333, s_q7 * x332)
+            + Self::mul_add(-0.65, x330, 0.75 * x334);
+        let x338 = Self::mul_add(0.65, x335, x331);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x181,
-                x171,
-                x171,
-                x193,
-                x213,
-                x230,
-                x252,
-                x283,
-                x322,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x186,
-                0.0,
-                x180,
-                x167,
-                x194,
-                x214,
-                x231,
-                x253,
-                x284,
-                x323,
-            ],
-            [
-                0.0,
-                0.0,
-                1170.07,
-                x168,
+                x197,
                 x187,
-                0.0,
-                0.0,
-                x146,
+                x187,
                 x209,
+                x225,
+                x242,
+                x264,
+                x295,
+                x334,
+            ],
+            [
+                0.0,
+                1170.07,
+                0.0,
+                x202,
+                0.0,
+                x196,
+                x183,
+                x210,
                 x226,
-                x248,
-                x279,
-                x318,
+                x243,
+                x265,
+                x296,
+                x335,
             ],
             [
                 0.0,
-                x186,
-                x168,
-                x182,
-                x179,
-                x183,
-                x176,
-                x195,
-                x215,
-                x232,
-                x254,
-                x285,
-                x324,
-            ],
-            [
-                x181,
                 0.0,
-                x187,
-                x179,
+                1170.07,
                 x184,
-                x177,
-                x177,
-                x196,
-                x216,
-                x233,
-                x255,
-                x286,
-                x325,
+                x203,
+                0.0,
+                0.0,
+                x159,
+                x221,
+                x238,
+                x260,
+                x291,
+                x330,
             ],
             [
-                x171,
-                x180,
                 0.0,
-                x183,
-                x177,
-                x185,
-                x178,
-                x197,
-                x217,
-                x234,
-                x256,
-                x287,
-                x326,
-            ],
-            [
-                x171,
-                x167,
-                0.0,
-                x176,
-                x177,
-                x178,
-                x166,
-                x156,
-                x210,
+                x202,
+                x184,
+                x198,
+                x195,
+                x199,
+                x192,
+                x211,
                 x227,
-                x249,
-                x280,
-                x319,
+                x244,
+                x266,
+                x297,
+                x336,
             ],
             [
+                x197,
+                0.0,
+                x203,
+                x195,
+                x200,
+                x193,
+                x193,
+                x212,
+                x228,
+                x245,
+                x267,
+                x298,
+                x337,
+            ],
+            [
+                x187,
+                x196,
+                0.0,
+                x199,
+                x193,
+                x201,
+                x194,
+                x213,
+                x229,
+                x246,
+                x268,
+                x299,
+                x338,
+            ],
+            [
+                x187,
+                x183,
+                0.0,
+                x192,
                 x193,
                 x194,
-                x146,
-                x195,
-                x196,
-                x197,
-                x156,
-                x144,
-                x206,
-                x223,
-                x245,
-                x276,
-                x315,
-            ],
-            [
-                x213,
-                x214,
-                x209,
-                x215,
-                x216,
-                x217,
-                x210,
-                x206,
-                x117,
-                x108,
+                x182,
+                x169,
+                x222,
                 x239,
-                x270,
-                x309,
+                x261,
+                x292,
+                x331,
             ],
-            [x230, x231, x226, x232, x233, x234, x227, x223, x108, x94, x85, x265, x304],
-            [x252, x253, x248, x254, x255, x256, x249, x245, x239, x85, x71, x59, x297],
-            [x283, x284, x279, x285, x286, x287, x280, x276, x270, x265, x59, x44, x293],
             [
-                x322,
-                x323,
-                x318,
-                x324,
-                x325,
-                x326,
-                x319,
-                x315,
+                x209,
+                x210,
+                x159,
+                x211,
+                x212,
+                x213,
+                x169,
+                x157,
+                x218,
+                x235,
+                x257,
+                x288,
+                x327,
+            ],
+            [
+                x225,
+                x226,
+                x221,
+                x227,
+                x228,
+                x229,
+                x222,
+                x218,
+                x121,
+                x112,
+                x251,
+                x282,
+                x321,
+            ],
+            [x242, x243, x238, x244, x245, x246, x239, x235, x112, x98, x88, x277, x316],
+            [x264, x265, x260, x266, x267, x268, x261, x257, x251, x88, x74, x60, x309],
+            [x295, x296, x291, x297, x298, x299, x292, x288, x282, x277, x60, x45, x305],
+            [
+                x334,
+                x335,
+                x330,
+                x336,
+                x337,
+                x338,
+                x331,
+                x327,
+                x321,
+                x316,
                 x309,
-                x304,
-                x297,
-                x293,
+                x305,
                 1.4135609200000003,
             ],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 534 mul, 430 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 325 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 532 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 323 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
         let x0 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
@@ -1445,7 +1492,7 @@ impl FreeFloating7 {
         let x45 = x28 * x37;
         let x46 = x35 + x45;
         let x47 = Self::mul_add(
-            -0.0021399965876409276,
+            -0.002139996587640933,
             x37,
             -0.0000000234896432582596 * x28,
         );
@@ -1457,397 +1504,9 @@ impl FreeFloating7 {
         let x49 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(5.080660024070366, x28, -0.0021399965876409276 * x27),
+            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
         );
-        let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x51 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x52 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x53 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x54 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x55 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x53, x27 * x51));
-        let x56 = Self::mul_add(-x37, s_q9, Self::mul_add(x28, x54, x27 * x52));
-        let x57 = x32 + Self::mul_add(0.4, x42 - x36, 0.275 * x41);
-        let x58 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
-        let x59 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
-        let x60 = Self::mul_add(c_q9, x59, Self::mul_add(x53, x58, x51 * x57));
-        let x61 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x59,
-            Self::mul_add(0.00000000020510342851533115, x57, x58),
-        );
-        let x62 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x16,
-            Self::mul_add(0.00000000020510342851533115, x35, -x36),
-        );
-        let x63 = Self::mul_add(
-            v[8],
-            x56,
-            Self::mul_add(x16, c_q9, Self::mul_add(-x36, x53, x35 * x51)),
-        );
-        let x64 = Self::mul_add(
-            -v[8],
-            x55,
-            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x54, x35 * x52)),
-        );
-        let x65 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x37,
-                Self::mul_add(0.00000000020510342851533115, x27, x28),
-            );
-        let x66 = Self::mul_add(x55, x56, -x62);
-        let x67 = Self::mul_add(x55, x55, x65 * x65);
-        let x68 = Self::mul_add(x56, x65, x63);
-        let x69 = -0.00214 * x65;
-        let x70 = Self::mul_add(-36.18604050126307, x65, -63.36336825000001 * x56);
-        let x71 = Self::mul_add(
-            69.99836825,
-            x65,
-            Self::mul_add(-36.18604050126307, x56, -0.00214 * x55),
-        );
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x73 = Self::mul_add(x56, s_q10, x55 * c_q10);
-        let x74 = Self::mul_add(-x55, s_q10, x56 * c_q10);
-        let x75 = Self::mul_add(-0.87, x66, x60);
-        let x76 = Self::mul_add(
-            0.87,
-            x67,
-            Self::mul_add(-s_q9, x59, Self::mul_add(x54, x58, x52 * x57)),
-        );
-        let x77 = Self::mul_add(-0.87, x68, x61);
-        let x78 = Self::mul_add(s_q10, x76, c_q10 * x75);
-        let x79 = Self::mul_add(v[9], x74, Self::mul_add(x64, s_q10, x63 * c_q10));
-        let x80 = Self::mul_add(-v[9], x73, Self::mul_add(-x63, s_q10, x64 * c_q10));
-        let x81 = v[9] + x65;
-        let x82 = Self::mul_add(x73, x74, -x62);
-        let x83 = x73 * x73;
-        let x84 = Self::mul_add(x81, x81, x83);
-        let x85 = x74 * x81;
-        let x86 = x79 + x85;
-        let x87 = -0.6328 * x81;
-        let x88 = Self::mul_add(-24.35164200091464, x81, -24.4950615 * x74);
-        let x89 = Self::mul_add(
-            28.2393615,
-            x81,
-            Self::mul_add(-24.351642000914637, x74, -0.6328 * x73),
-        );
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x91 = Self::mul_add(x74, s_q11, x73 * c_q11);
-        let x92 = Self::mul_add(-x73, s_q11, x74 * c_q11);
-        let x93 = x78 + Self::mul_add(-0.275, Self::mul_add(x73, x81, x80), -0.63 * x82);
-        let x94 = Self::mul_add(-s_q10, x75, c_q10 * x76)
-            + Self::mul_add(0.63, x84, -0.275 * (x85 - x79));
-        let x95 = x77 + Self::mul_add(0.275, Self::mul_add(x74, x74, x83), -0.63 * x86);
-        let x96 = Self::mul_add(s_q11, x94, c_q11 * x93);
-        let x97 = Self::mul_add(v[10], x92, Self::mul_add(x80, s_q11, x79 * c_q11));
-        let x98 = Self::mul_add(-v[10], x91, Self::mul_add(-x79, s_q11, x80 * c_q11));
-        let x99 = v[10] + x81;
-        let x100 = x91 * x91;
-        let x101 = x92 * x99;
-        let x102 = 0.01675 * x99;
-        let x103 = Self::mul_add(2.5482240016099564, x99, -9.142025249762803 * x92);
-        let x104 = Self::mul_add(
-            9.223235249762805,
-            x99,
-            Self::mul_add(2.5482240016099564, x92, 0.01675 * x91),
-        );
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x106 = -0.00000000020510342851533115 * s_q12;
-        let x107 = -0.00000000020510342851533115 * c_q12;
-        let x108 = Self::mul_add(-x99, s_q12, Self::mul_add(x92, x106, x91 * c_q12));
-        let x109 = Self::mul_add(-x99, c_q12, Self::mul_add(-x91, s_q12, x92 * x107));
-        let x110 = Self::mul_add(-0.36, Self::mul_add(x91, x99, x98), x96);
-        let x111 = Self::mul_add(
-            -0.36,
-            x101 - x97,
-            Self::mul_add(-s_q11, x93, c_q11 * x94),
-        );
-        let x112 = Self::mul_add(0.36, Self::mul_add(x92, x92, x100), x95);
-        let x113 = Self::mul_add(-s_q12, x112, Self::mul_add(x106, x111, c_q12 * x110));
-        let x114 = Self::mul_add(-c_q12, x112, Self::mul_add(-s_q12, x110, x107 * x111));
-        let x115 = Self::mul_add(-0.00000000020510342851533115, x112, x111);
-        let x116 = Self::mul_add(-0.00000000020510342851533115, x62, x98);
-        let x117 = Self::mul_add(
-            v[11],
-            x109,
-            Self::mul_add(-x62, s_q12, Self::mul_add(x98, x106, x97 * c_q12)),
-        );
-        let x118 = Self::mul_add(
-            -v[11],
-            x108,
-            Self::mul_add(-x62, c_q12, Self::mul_add(-x97, s_q12, x98 * x107)),
-        );
-        let x119 = v[11] + Self::mul_add(-0.00000000020510342851533115, x99, x92);
-        let x120 = x109 * x109;
-        let x121 = x119 * x119;
-        let x122 = x108 * x109;
-        let x123 = x122 - x116;
-        let x124 = x108 * x119;
-        let x125 = x108 * x108;
-        let x126 = x121 + x125;
-        let x127 = x109 * x119;
-        let x128 = x117 + x127;
-        let x129 = Self::mul_add(-0.809539999555672, x119, -1.9877000000000002 * x109);
-        let x130 = Self::mul_add(
-            -2.741639999592316,
-            x119,
-            Self::mul_add(-5.252920330000002, x109, -1.9877000000000002 * x108),
-        );
-        let x131 = Self::mul_add(
-            9.740442170000001,
-            x119,
-            Self::mul_add(-2.7416399995923166, x109, -0.809539999555672 * x108),
-        );
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x133 = -0.00000000020510342851533115 * c_q13;
-        let x134 = -0.00000000020510342851533115 * s_q13;
-        let x135 = Self::mul_add(-x119, c_q13, Self::mul_add(x109, s_q13, x108 * x133));
-        let x136 = Self::mul_add(x119, s_q13, Self::mul_add(-x108, x134, x109 * c_q13));
-        let x137 = x113 + Self::mul_add(0.16, x118 + x124, 0.55 * x123);
-        let x138 = x115 + Self::mul_add(-0.16, x120 + x125, 0.55 * x128);
-        let x139 = Self::mul_add(-0.00000000020510342851533115, x116, x117);
-        let x140 = Self::mul_add(
-            v[12],
-            x136,
-            Self::mul_add(-x116, c_q13, Self::mul_add(x118, s_q13, x117 * x133)),
-        );
-        let x141 = Self::mul_add(
-            -v[12],
-            x135,
-            Self::mul_add(x116, s_q13, Self::mul_add(-x117, x134, x118 * c_q13)),
-        );
-        let x142 = v[12] + Self::mul_add(-0.00000000020510342851533115, x119, x108);
-        let x143 = 4.806620000000001 * Self::mul_add(x135, x136, -x139);
-        let x144 = 4.806620000000001 * Self::mul_add(x135, x135, x142 * x142);
-        let x145 = 4.806620000000001 * Self::mul_add(x136, x142, x140);
-        let x146 = Self::mul_add(-0.0145, x142, 0.000781 * x136);
-        let x147 = Self::mul_add(
-            -0.9614610000000001,
-            x142,
-            Self::mul_add(-1.2025609200000003, x136, 0.000781 * x135),
-        );
-        let x148 = Self::mul_add(
-            1.4135609200000003,
-            x142,
-            Self::mul_add(-0.9614610000000001, x136, -0.0145 * x135),
-        );
-        let x149 = Self::mul_add(
-            -0.9614610000000001,
-            x139,
-            Self::mul_add(-1.2025609200000003, x141, 0.000781 * x140),
-        ) + Self::mul_add(-x135, x148, x142 * x146);
-        let x150 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x138, x137),
-            Self::mul_add(-0.0145, x139, 0.000781 * x141)
-                + Self::mul_add(-x142, x147, x136 * x148),
-        );
-        let x151 = Self::mul_add(
-            Self::mul_add(
-                -c_q13,
-                x138,
-                Self::mul_add(
-                    s_q13,
-                    x114 + Self::mul_add(-0.55, x126, 0.16 * (x127 - x117)),
-                    x133 * x137,
-                ),
-            ),
-            -4.806620000000001,
-            Self::mul_add(
-                1.4135609200000003,
-                x139,
-                Self::mul_add(-0.9614610000000001, x141, -0.0145 * x140),
-            ) + Self::mul_add(-x136, x146, x135 * x147),
-        );
-        let x152 = x145 + Self::mul_add(x134, x144, x133 * x143);
-        let x153 = Self::mul_add(-c_q13, x144, s_q13 * x143);
-        let x154 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x145,
-            -Self::mul_add(s_q13, x144, c_q13 * x143),
-        );
-        let x155 = Self::mul_add(
-            -3.6140000000000003,
-            x120 + x121,
-            17.135250000000003 * x123,
-        ) + x152;
-        let x156 = Self::mul_add(
-            -17.135250000000003,
-            x126,
-            3.6140000000000003 * (x116 + x122),
-        ) + x153;
-        let x157 = Self::mul_add(
-            17.135250000000003,
-            x128,
-            3.6140000000000003 * (x124 - x118),
-        ) + x154;
-        let x158 = Self::mul_add(
-            17.135250000000003,
-            x115,
-            Self::mul_add(-0.809539999555672, x116, -1.9877000000000002 * x118)
-                + Self::mul_add(-x119, x130, x109 * x131),
-        )
-            + (x151 + Self::mul_add(-x134, x149, x133 * x150)
-                + Self::mul_add(0.55, x154, -0.16 * x153));
-        let x159 = Self::mul_add(
-            x115,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x116,
-                Self::mul_add(-5.252920330000002, x118, -1.9877000000000002 * x117),
-            ) + Self::mul_add(-x108, x131, x119 * x129),
-        ) + Self::mul_add(0.16, x152, Self::mul_add(c_q13, x149, s_q13 * x150));
-        let x160 = Self::mul_add(
-            9.740442170000001,
-            x116,
-            Self::mul_add(-2.7416399995923166, x118, -0.809539999555672 * x117),
-        ) + Self::mul_add(-x109, x129, x108 * x130)
-            + Self::mul_add(3.6140000000000003, x114, x113 * -17.135250000000003)
-            + Self::mul_add(
-                x152,
-                -0.55,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x151,
-                    Self::mul_add(-c_q13, x150, s_q13 * x149),
-                ),
-            );
-        let x161 = Self::mul_add(-s_q12, x156, c_q12 * x155);
-        let x162 = x157 + Self::mul_add(x107, x156, x106 * x155);
-        let x163 = Self::mul_add(7.078399999258757, Self::mul_add(x91, x92, -x62), x161);
-        let x164 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x99, x99, x100),
-            x162,
-        );
-        let x165 = Self::mul_add(
-            7.078399999258757,
-            x97 + x101,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x157,
-                -Self::mul_add(c_q12, x156, s_q12 * x155),
-            ),
-        );
-        let x166 = Self::mul_add(
-            7.078399999258757,
-            x95,
-            Self::mul_add(0.01675, x62, Self::mul_add(-x99, x103, x92 * x104)),
-        ) + Self::mul_add(x162, 0.36, Self::mul_add(-s_q12, x159, c_q12 * x158));
-        let x167 = Self::mul_add(2.5482240016099564, x62, -9.142025249762803 * x98)
-            + Self::mul_add(-x91, x104, x99 * x102)
-            + Self::mul_add(-0.36, x161, x160 + Self::mul_add(x107, x159, x106 * x158));
-        let x168 = Self::mul_add(
-            x96,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x62,
-                Self::mul_add(2.5482240016099564, x98, 0.01675 * x97),
-            ) + Self::mul_add(-x92, x102, x91 * x103),
-        )
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x160,
-                -Self::mul_add(c_q12, x159, s_q12 * x158),
-            );
-        let x169 = Self::mul_add(-s_q11, x164, c_q11 * x163);
-        let x170 = Self::mul_add(c_q11, x164, s_q11 * x163);
-        let x171 = Self::mul_add(-45.1584, x82, x169);
-        let x172 = Self::mul_add(45.1584, x84, x170);
-        let x173 = Self::mul_add(-45.1584, x86, x165);
-        let x174 = Self::mul_add(
-            -45.1584,
-            x77,
-            Self::mul_add(-0.6328, x62, Self::mul_add(-x81, x88, x74 * x89)),
-        )
-            + (Self::mul_add(-s_q11, x167, c_q11 * x166)
-                + Self::mul_add(-0.63, x165, 0.275 * x170));
-        let x175 = Self::mul_add(-24.35164200091464, x62, -24.4950615 * x80)
-            + Self::mul_add(-x73, x89, x81 * x87)
-            + Self::mul_add(-0.275, x169, Self::mul_add(c_q11, x167, s_q11 * x166));
-        let x176 = Self::mul_add(
-            x78,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x62,
-                Self::mul_add(-24.351642000914637, x80, -0.6328 * x79),
-            ) + Self::mul_add(-x74, x87, x73 * x88),
-        ) + Self::mul_add(x169, 0.63, x168);
-        let x177 = Self::mul_add(-s_q10, x172, c_q10 * x171);
-        let x178 = Self::mul_add(-81.53205, x66, x177);
-        let x179 = Self::mul_add(
-            81.53205,
-            x67,
-            Self::mul_add(c_q10, x172, s_q10 * x171),
-        );
-        let x180 = Self::mul_add(-81.53205, x68, x173);
-        let x181 = Self::mul_add(
-            -81.53205,
-            x61,
-            Self::mul_add(-0.00214, x62, Self::mul_add(-x65, x70, x56 * x71)),
-        ) + Self::mul_add(-0.87, x173, Self::mul_add(-s_q10, x175, c_q10 * x174));
-        let x182 = Self::mul_add(-36.18604050126307, x62, -63.36336825000001 * x64)
-            + Self::mul_add(-x55, x71, x65 * x69)
-            + Self::mul_add(c_q10, x175, s_q10 * x174);
-        let x183 = Self::mul_add(
-            x60,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x62,
-                Self::mul_add(-36.18604050126307, x64, -0.00214 * x63),
-            ) + Self::mul_add(-x56, x69, x55 * x70),
-        ) + Self::mul_add(x177, 0.87, x176);
-        let x184 = Self::mul_add(
-            0.00000000020510342851533115,
-            x180,
-            Self::mul_add(x52, x179, x51 * x178),
-        );
-        let x185 = x180 + Self::mul_add(x54, x179, x53 * x178);
-        let x186 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x180,
-            Self::mul_add(-s_q9, x179, c_q9 * x178),
-        );
-        let x187 = Self::mul_add(
-            0.000000008530897668050218,
-            x38 + x39,
-            -12.701650001451807 * x41,
-        ) + x184;
-        let x188 = Self::mul_add(
-            12.701650001451807,
-            x44,
-            -0.000000008530897668050218 * (x16 + x40),
-        ) + x185;
-        let x189 = Self::mul_add(
-            -12.701650001451807,
-            x46,
-            -0.000000008530897668050218 * (x36 + x42),
-        ) + x186;
-        let x190 = Self::mul_add(
-            -12.701650001451807,
-            x34,
-            Self::mul_add(0.0000000234896432582596, x36, -0.0021399965876409276 * x16)
-                + Self::mul_add(-x37, x48, x28 * x49),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x183,
-                Self::mul_add(x52, x182, x51 * x181),
-            ) + Self::mul_add(0.275, x186, x185 * -0.4));
-        let x191 = Self::mul_add(
+        let x50 = Self::mul_add(
             x34,
             0.000000008530897668050218,
             Self::mul_add(
@@ -1855,44 +1514,444 @@ impl FreeFloating7 {
                 x16,
                 Self::mul_add(111.7548902508081, x36, -0.0000000234896432582596 * x35),
             ) + Self::mul_add(-x27, x49, x37 * x47),
-        ) + Self::mul_add(0.4, x184, x183 + Self::mul_add(x54, x182, x53 * x181));
+        );
+        let (s_q9, c_q9) = libm::sincos(q[9]);
+        let x52 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            0.00000000020510342851533115 * c_q9,
+        );
+        let x53 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            -0.00000000020510342851533115 * c_q9,
+        );
+        let x54 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x52, x27 * s_q9));
+        let x55 = Self::mul_add(-x37, s_q9, Self::mul_add(x28, x53, x27 * c_q9));
+        let x56 = x32 + Self::mul_add(0.4, x42 - x36, 0.275 * x41);
+        let x57 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
+        let x58 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
+        let x59 = Self::mul_add(c_q9, x58, Self::mul_add(x52, x57, s_q9 * x56));
+        let x60 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x58,
+            Self::mul_add(0.00000000020510342851533115, x56, x57),
+        );
+        let x61 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x16,
+            Self::mul_add(0.00000000020510342851533115, x35, -x36),
+        );
+        let x62 = Self::mul_add(
+            v[8],
+            x55,
+            Self::mul_add(x16, c_q9, Self::mul_add(-x36, x52, x35 * s_q9)),
+        );
+        let x63 = Self::mul_add(
+            -v[8],
+            x54,
+            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x53, x35 * c_q9)),
+        );
+        let x64 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x37,
+                Self::mul_add(0.00000000020510342851533115, x27, x28),
+            );
+        let x65 = Self::mul_add(x54, x55, -x61);
+        let x66 = Self::mul_add(x54, x54, x64 * x64);
+        let x67 = Self::mul_add(x55, x64, x62);
+        let x68 = -0.00214 * x64;
+        let x69 = Self::mul_add(-36.18604050126307, x64, -63.36336825000001 * x55);
+        let x70 = Self::mul_add(
+            69.99836825,
+            x64,
+            Self::mul_add(-36.18604050126307, x55, -0.00214 * x54),
+        );
+        let x71 = Self::mul_add(
+            -81.53205,
+            x60,
+            Self::mul_add(-0.00214, x61, Self::mul_add(-x64, x69, x55 * x70)),
+        );
+        let x72 = Self::mul_add(
+            x59,
+            81.53205,
+            Self::mul_add(
+                69.99836825,
+                x61,
+                Self::mul_add(-36.18604050126307, x63, -0.00214 * x62),
+            ) + Self::mul_add(-x55, x68, x54 * x69),
+        );
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x74 = Self::mul_add(x55, s_q10, x54 * c_q10);
+        let x75 = Self::mul_add(-x54, s_q10, x55 * c_q10);
+        let x76 = Self::mul_add(-0.87, x65, x59);
+        let x77 = Self::mul_add(
+            0.87,
+            x66,
+            Self::mul_add(-s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56)),
+        );
+        let x78 = Self::mul_add(-0.87, x67, x60);
+        let x79 = Self::mul_add(s_q10, x77, c_q10 * x76);
+        let x80 = Self::mul_add(v[9], x75, Self::mul_add(x63, s_q10, x62 * c_q10));
+        let x81 = Self::mul_add(-v[9], x74, Self::mul_add(-x62, s_q10, x63 * c_q10));
+        let x82 = v[9] + x64;
+        let x83 = Self::mul_add(x74, x75, -x61);
+        let x84 = x74 * x74;
+        let x85 = Self::mul_add(x82, x82, x84);
+        let x86 = x75 * x82;
+        let x87 = x80 + x86;
+        let x88 = -0.6328 * x82;
+        let x89 = Self::mul_add(-24.35164200091464, x82, -24.4950615 * x75);
+        let x90 = Self::mul_add(
+            28.2393615,
+            x82,
+            Self::mul_add(-24.351642000914637, x75, -0.6328 * x74),
+        );
+        let x91 = Self::mul_add(
+            -45.1584,
+            x78,
+            Self::mul_add(-0.6328, x61, Self::mul_add(-x82, x89, x75 * x90)),
+        );
+        let x92 = Self::mul_add(
+            x79,
+            45.1584,
+            Self::mul_add(
+                28.2393615,
+                x61,
+                Self::mul_add(-24.351642000914637, x81, -0.6328 * x80),
+            ) + Self::mul_add(-x75, x88, x74 * x89),
+        );
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x94 = Self::mul_add(x75, s_q11, x74 * c_q11);
+        let x95 = Self::mul_add(-x74, s_q11, x75 * c_q11);
+        let x96 = x79 + Self::mul_add(-0.275, Self::mul_add(x74, x82, x81), -0.63 * x83);
+        let x97 = Self::mul_add(-s_q10, x76, c_q10 * x77)
+            + Self::mul_add(0.63, x85, -0.275 * (x86 - x80));
+        let x98 = x78 + Self::mul_add(0.275, Self::mul_add(x75, x75, x84), -0.63 * x87);
+        let x99 = Self::mul_add(s_q11, x97, c_q11 * x96);
+        let x100 = Self::mul_add(v[10], x95, Self::mul_add(x81, s_q11, x80 * c_q11));
+        let x101 = Self::mul_add(-v[10], x94, Self::mul_add(-x80, s_q11, x81 * c_q11));
+        let x102 = v[10] + x82;
+        let x103 = x94 * x94;
+        let x104 = x95 * x102;
+        let x105 = 0.01675 * x102;
+        let x106 = Self::mul_add(2.5482240016099564, x102, -9.142025249762803 * x95);
+        let x107 = Self::mul_add(
+            9.223235249762805,
+            x102,
+            Self::mul_add(2.5482240016099564, x95, 0.01675 * x94),
+        );
+        let x108 = Self::mul_add(
+            7.078399999258757,
+            x98,
+            Self::mul_add(0.01675, x61, Self::mul_add(-x102, x106, x95 * x107)),
+        );
+        let x109 = Self::mul_add(
+            x99,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x61,
+                Self::mul_add(2.5482240016099564, x101, 0.01675 * x100),
+            ) + Self::mul_add(-x95, x105, x94 * x106),
+        );
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x111 = -0.00000000020510342851533115 * s_q12;
+        let x112 = -0.00000000020510342851533115 * c_q12;
+        let x113 = Self::mul_add(-x102, s_q12, Self::mul_add(x95, x111, x94 * c_q12));
+        let x114 = Self::mul_add(-x102, c_q12, Self::mul_add(-x94, s_q12, x95 * x112));
+        let x115 = Self::mul_add(-0.36, Self::mul_add(x94, x102, x101), x99);
+        let x116 = Self::mul_add(
+            -0.36,
+            x104 - x100,
+            Self::mul_add(-s_q11, x96, c_q11 * x97),
+        );
+        let x117 = Self::mul_add(0.36, Self::mul_add(x95, x95, x103), x98);
+        let x118 = Self::mul_add(-s_q12, x117, Self::mul_add(x111, x116, c_q12 * x115));
+        let x119 = Self::mul_add(-c_q12, x117, Self::mul_add(-s_q12, x115, x112 * x116));
+        let x120 = Self::mul_add(-0.00000000020510342851533115, x117, x116);
+        let x121 = Self::mul_add(-0.00000000020510342851533115, x61, x101);
+        let x122 = Self::mul_add(
+            v[11],
+            x114,
+            Self::mul_add(-x61, s_q12, Self::mul_add(x101, x111, x100 * c_q12)),
+        );
+        let x123 = Self::mul_add(
+            -v[11],
+            x113,
+            Self::mul_add(-x61, c_q12, Self::mul_add(-x100, s_q12, x101 * x112)),
+        );
+        let x124 = v[11] + Self::mul_add(-0.00000000020510342851533115, x102, x95);
+        let x125 = x114 * x114;
+        let x126 = x124 * x124;
+        let x127 = x113 * x114;
+        let x128 = x127 - x121;
+        let x129 = x113 * x124;
+        let x130 = x113 * x113;
+        let x131 = x126 + x130;
+        let x132 = x114 * x124;
+        let x133 = x122 + x132;
+        let x134 = Self::mul_add(-0.809539999555672, x124, -1.9877000000000002 * x114);
+        let x135 = Self::mul_add(
+            -2.741639999592316,
+            x124,
+            Self::mul_add(-5.252920330000002, x114, -1.9877000000000002 * x113),
+        );
+        let x136 = Self::mul_add(
+            9.740442170000001,
+            x124,
+            Self::mul_add(-2.7416399995923166, x114, -0.809539999555672 * x113),
+        );
+        let x137 = Self::mul_add(
+            x120,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x121,
+                Self::mul_add(-5.252920330000002, x123, -1.9877000000000002 * x122),
+            ) + Self::mul_add(-x113, x136, x124 * x134),
+        );
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x139 = -0.00000000020510342851533115 * c_q13;
+        let x140 = -0.00000000020510342851533115 * s_q13;
+        let x141 = Self::mul_add(-x124, c_q13, Self::mul_add(x114, s_q13, x113 * x139));
+        let x142 = Self::mul_add(x124, s_q13, Self::mul_add(-x113, x140, x114 * c_q13));
+        let x143 = x118 + Self::mul_add(0.16, x123 + x129, 0.55 * x128);
+        let x144 = x120 + Self::mul_add(-0.16, x125 + x130, 0.55 * x133);
+        let x145 = Self::mul_add(
+            -c_q13,
+            x144,
+            Self::mul_add(
+                s_q13,
+                x119 + Self::mul_add(-0.55, x131, 0.16 * (x132 - x122)),
+                x139 * x143,
+            ),
+        );
+        let x146 = Self::mul_add(-0.00000000020510342851533115, x121, x122);
+        let x147 = Self::mul_add(
+            v[12],
+            x142,
+            Self::mul_add(-x121, c_q13, Self::mul_add(x123, s_q13, x122 * x139)),
+        );
+        let x148 = Self::mul_add(
+            -v[12],
+            x141,
+            Self::mul_add(x121, s_q13, Self::mul_add(-x122, x140, x123 * c_q13)),
+        );
+        let x149 = v[12] + Self::mul_add(-0.00000000020510342851533115, x124, x113);
+        let x150 = 4.806620000000001 * Self::mul_add(x141, x142, -x146);
+        let x151 = 4.806620000000001 * Self::mul_add(x141, x141, x149 * x149);
+        let x152 = 4.806620000000001 * Self::mul_add(x142, x149, x147);
+        let x153 = Self::mul_add(-0.0145, x149, 0.000781 * x142);
+        let x154 = Self::mul_add(
+            -0.9614610000000001,
+            x149,
+            Self::mul_add(-1.2025609200000003, x142, 0.000781 * x141),
+        );
+        let x155 = Self::mul_add(
+            1.4135609200000003,
+            x149,
+            Self::mul_add(-0.9614610000000001, x142, -0.0145 * x141),
+        );
+        let x156 = Self::mul_add(
+            -0.9614610000000001,
+            x146,
+            Self::mul_add(-1.2025609200000003, x148, 0.000781 * x147),
+        ) + Self::mul_add(-x141, x155, x149 * x153);
+        let x157 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x144, x143),
+            Self::mul_add(-0.0145, x146, 0.000781 * x148)
+                + Self::mul_add(-x149, x154, x142 * x155),
+        );
+        let x158 = Self::mul_add(
+            x145,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x146,
+                Self::mul_add(-0.9614610000000001, x148, -0.0145 * x147),
+            ) + Self::mul_add(-x142, x153, x141 * x154),
+        );
+        let x159 = x152 + Self::mul_add(x140, x151, x139 * x150);
+        let x160 = Self::mul_add(-c_q13, x151, s_q13 * x150);
+        let x161 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x152,
+            -Self::mul_add(s_q13, x151, c_q13 * x150),
+        );
+        let x162 = Self::mul_add(
+            x159,
+            -0.55,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x158,
+                Self::mul_add(-c_q13, x157, s_q13 * x156),
+            ),
+        );
+        let x163 = Self::mul_add(
+            -3.6140000000000003,
+            x125 + x126,
+            17.135250000000003 * x128,
+        ) + x159;
+        let x164 = Self::mul_add(
+            -17.135250000000003,
+            x131,
+            3.6140000000000003 * (x121 + x127),
+        ) + x160;
+        let x165 = Self::mul_add(
+            17.135250000000003,
+            x133,
+            3.6140000000000003 * (x129 - x123),
+        ) + x161;
+        let x166 = Self::mul_add(
+            17.135250000000003,
+            x120,
+            Self::mul_add(-0.809539999555672, x121, -1.9877000000000002 * x123)
+                + Self::mul_add(-x124, x135, x114 * x136),
+        )
+            + (x158 + Self::mul_add(-x140, x156, x139 * x157)
+                + Self::mul_add(0.55, x161, -0.16 * x160));
+        let x167 = x137
+            + Self::mul_add(0.16, x159, Self::mul_add(c_q13, x156, s_q13 * x157));
+        let x168 = Self::mul_add(
+            9.740442170000001,
+            x121,
+            Self::mul_add(-2.7416399995923166, x123, -0.809539999555672 * x122),
+        ) + Self::mul_add(-x114, x134, x113 * x135)
+            + Self::mul_add(3.6140000000000003, x119, x118 * -17.135250000000003) + x162;
+        let x169 = Self::mul_add(-s_q12, x164, c_q12 * x163);
+        let x170 = x165 + Self::mul_add(x112, x164, x111 * x163);
+        let x171 = Self::mul_add(7.078399999258757, Self::mul_add(x94, x95, -x61), x169);
+        let x172 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x102, x102, x103),
+            x170,
+        );
+        let x173 = Self::mul_add(
+            7.078399999258757,
+            x100 + x104,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x165,
+                -Self::mul_add(c_q12, x164, s_q12 * x163),
+            ),
+        );
+        let x174 = x108
+            + Self::mul_add(x170, 0.36, Self::mul_add(-s_q12, x167, c_q12 * x166));
+        let x175 = Self::mul_add(2.5482240016099564, x61, -9.142025249762803 * x101)
+            + Self::mul_add(-x94, x107, x102 * x105)
+            + Self::mul_add(-0.36, x169, x168 + Self::mul_add(x112, x167, x111 * x166));
+        let x176 = x109
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x168,
+                -Self::mul_add(c_q12, x167, s_q12 * x166),
+            );
+        let x177 = Self::mul_add(-s_q11, x172, c_q11 * x171);
+        let x178 = Self::mul_add(c_q11, x172, s_q11 * x171);
+        let x179 = Self::mul_add(-45.1584, x83, x177);
+        let x180 = Self::mul_add(45.1584, x85, x178);
+        let x181 = Self::mul_add(-45.1584, x87, x173);
+        let x182 = x91
+            + (Self::mul_add(-s_q11, x175, c_q11 * x174)
+                + Self::mul_add(-0.63, x173, 0.275 * x178));
+        let x183 = Self::mul_add(-24.35164200091464, x61, -24.4950615 * x81)
+            + Self::mul_add(-x74, x90, x82 * x88)
+            + Self::mul_add(-0.275, x177, Self::mul_add(c_q11, x175, s_q11 * x174));
+        let x184 = x92 + Self::mul_add(x177, 0.63, x176);
+        let x185 = Self::mul_add(-s_q10, x180, c_q10 * x179);
+        let x186 = Self::mul_add(-81.53205, x65, x185);
+        let x187 = Self::mul_add(
+            81.53205,
+            x66,
+            Self::mul_add(c_q10, x180, s_q10 * x179),
+        );
+        let x188 = Self::mul_add(-81.53205, x67, x181);
+        let x189 = x71
+            + Self::mul_add(-0.87, x181, Self::mul_add(-s_q10, x183, c_q10 * x182));
+        let x190 = Self::mul_add(-36.18604050126307, x61, -63.36336825000001 * x63)
+            + Self::mul_add(-x54, x70, x64 * x68)
+            + Self::mul_add(c_q10, x183, s_q10 * x182);
+        let x191 = x72 + Self::mul_add(x185, 0.87, x184);
         let x192 = Self::mul_add(
+            0.00000000020510342851533115,
+            x188,
+            Self::mul_add(c_q9, x187, s_q9 * x186),
+        );
+        let x193 = x188 + Self::mul_add(x53, x187, x52 * x186);
+        let x194 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x188,
+            Self::mul_add(-s_q9, x187, c_q9 * x186),
+        );
+        let x195 = Self::mul_add(
+            -0.275,
+            x192,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x191,
+                Self::mul_add(-s_q9, x190, c_q9 * x189),
+            ),
+        );
+        let x196 = Self::mul_add(
+            0.000000008530897668050218,
+            x38 + x39,
+            -12.701650001451807 * x41,
+        ) + x192;
+        let x197 = Self::mul_add(
+            12.701650001451807,
+            x44,
+            -0.000000008530897668050218 * (x16 + x40),
+        ) + x193;
+        let x198 = Self::mul_add(
+            -12.701650001451807,
+            x46,
+            -0.000000008530897668050218 * (x36 + x42),
+        ) + x194;
+        let x199 = Self::mul_add(
+            -12.701650001451807,
+            x34,
+            Self::mul_add(0.0000000234896432582596, x36, -0.002139996587640933 * x16)
+                + Self::mul_add(-x37, x48, x28 * x49),
+        )
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x191,
+                Self::mul_add(c_q9, x190, s_q9 * x189),
+            ) + Self::mul_add(0.275, x194, x193 * -0.4));
+        let x200 = x50
+            + Self::mul_add(0.4, x192, x191 + Self::mul_add(x53, x190, x52 * x189));
+        let x201 = Self::mul_add(
             113.3918902508081,
             x16,
-            Self::mul_add(-5.080660024070366, x36, -0.0021399965876409276 * x35),
+            Self::mul_add(-5.080660024070366, x36, -0.002139996587640933 * x35),
         ) + Self::mul_add(-x28, x47, x27 * x48)
             + Self::mul_add(-0.000000008530897668050218, x33, x32 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x184,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x183,
-                    Self::mul_add(-s_q9, x182, c_q9 * x181),
-                ),
-            );
-        let x193 = x189 + Self::mul_add(-x26, x188, x25 * x187);
-        let x194 = Self::mul_add(c_q8, x188, s_q8 * x187);
-        let x195 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x193);
-        let x196 = Self::mul_add(48.0240000085309, x4 * x5, x194);
-        let x197 = Self::mul_add(
+            + x195;
+        let x202 = x198 + Self::mul_add(-x26, x197, x25 * x196);
+        let x203 = Self::mul_add(c_q8, x197, s_q8 * x196);
+        let x204 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x202);
+        let x205 = Self::mul_add(48.0240000085309, x4 * x5, x203);
+        let x206 = Self::mul_add(
             48.0240000085309,
             x17 + x20,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x189,
-                Self::mul_add(-c_q8, x187, s_q8 * x188),
+                x198,
+                Self::mul_add(-c_q8, x196, s_q8 * x197),
             ),
         );
-        let x198 = Self::mul_add(0.07309, x17, Self::mul_add(-x18, x22, x5 * x23))
-            + Self::mul_add(x194, -0.35, x192 + Self::mul_add(-x26, x191, x25 * x190));
-        let x199 = Self::mul_add(
+        let x207 = Self::mul_add(0.07309, x17, Self::mul_add(-x18, x22, x5 * x23))
+            + Self::mul_add(x203, -0.35, x201 + Self::mul_add(-x26, x200, x25 * x199));
+        let x208 = Self::mul_add(
             x14,
             -48.0240000085309,
             Self::mul_add(-130.43769025763282, x17, -0.07309 * x16)
                 + Self::mul_add(-x4, x23, x18 * x21),
-        ) + Self::mul_add(0.35, x193, Self::mul_add(c_q8, x191, s_q8 * x190));
-        let x200 = Self::mul_add(
+        ) + Self::mul_add(0.35, x202, Self::mul_add(c_q8, x200, s_q8 * x199));
+        let x209 = Self::mul_add(
             48.0240000085309,
             x15,
             Self::mul_add(-0.1132, x17, -16.80768997608804 * x16)
@@ -1900,49 +1959,49 @@ impl FreeFloating7 {
         )
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x192,
-                Self::mul_add(-c_q8, x190, s_q8 * x191),
+                x201,
+                Self::mul_add(-c_q8, x199, s_q8 * x200),
             );
-        let x201 = Self::mul_add(-s_q7, x196, c_q7 * x195);
-        let x202 = Self::mul_add(c_q7, x196, s_q7 * x195);
-        let x203 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x204 = 1466.4506062283303 * v[4];
-        let x205 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x206 = x201
+        let x210 = Self::mul_add(-s_q7, x205, c_q7 * x204);
+        let x211 = Self::mul_add(c_q7, x205, s_q7 * x204);
+        let x212 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x213 = 1466.4506062283303 * v[4];
+        let x214 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x215 = x210
             + Self::mul_add(
                 1170.07,
                 x0,
                 Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
             );
-        let x207 = x202
+        let x216 = x211
             + Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x10, 110.5455 * x8),
             );
-        let x208 = x197
+        let x217 = x206
             + Self::mul_add(
                 1170.07,
                 x2,
                 Self::mul_add(-180.9502499901501, x11, 110.5455 * x9),
             );
-        let x209 = Self::mul_add(x202, -0.75, Self::mul_add(-s_q7, x199, c_q7 * x198))
+        let x218 = Self::mul_add(x211, -0.75, Self::mul_add(-s_q7, x208, c_q7 * x207))
             + Self::mul_add(
                 x1,
                 -180.9502499901501,
-                Self::mul_add(-v[5], x204, v[4] * x205),
+                Self::mul_add(-v[5], x213, v[4] * x214),
             );
-        let x210 = Self::mul_add(c_q7, x199, s_q7 * x198)
-            + Self::mul_add(x197, -0.65, 0.75 * x201)
-            + (Self::mul_add(-v[3], x205, v[5] * x203)
+        let x219 = Self::mul_add(c_q7, x208, s_q7 * x207)
+            + Self::mul_add(x206, -0.65, 0.75 * x210)
+            + (Self::mul_add(-v[3], x214, v[5] * x212)
                 + Self::mul_add(x2, -110.5455, 180.9502499901501 * x0));
-        let x211 = Self::mul_add(0.65, x202, x200)
-            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x203, v[3] * x204));
-        [x206, x207, x208, x209, x210, x211, x200, x192, x183, x176, x168, x160, x151]
+        let x220 = Self::mul_add(0.65, x211, x209)
+            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x212, v[3] * x213));
+        [x215, x216, x217, x218, x219, x220, x209, x201, x191, x184, x176, x168, x158]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
-    /// Methods: bias `newton-euler`: 549 mul, 460 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 340 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 547 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 338 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
         let x0 = a[0] + Self::mul_add(-v[1], v[5], v[2] * v[4]);
@@ -1980,489 +2039,7 @@ impl FreeFloating7 {
             x21,
             Self::mul_add(0.1132, x5, -16.80768997608804 * x4),
         );
-        let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x28 = -0.00000000020510342851533115 * c_q8;
-        let x29 = -0.00000000020510342851533115 * s_q8;
-        let x30 = Self::mul_add(-x21, c_q8, Self::mul_add(x5, s_q8, x4 * x28));
-        let x31 = Self::mul_add(x21, s_q8, Self::mul_add(-x4, x29, x5 * c_q8));
-        let x32 = Self::mul_add(0.35, x19 + x23, Self::mul_add(s_q7, x15, c_q7 * x14));
-        let x33 = Self::mul_add(0.35, Self::mul_add(x5, x21, -x18), x17);
-        let x34 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x22), x16);
-        let x35 = Self::mul_add(-c_q8, x34, Self::mul_add(s_q8, x33, x28 * x32));
-        let x36 = Self::mul_add(s_q8, x34, Self::mul_add(-x29, x32, c_q8 * x33));
-        let x37 = Self::mul_add(-0.00000000020510342851533115, x34, x32);
-        let x38 = Self::mul_add(
-            v[7],
-            x31,
-            Self::mul_add(-x20, c_q8, Self::mul_add(x19, s_q8, x18 * x28)),
-        );
-        let x39 = Self::mul_add(
-            -v[7],
-            x30,
-            Self::mul_add(x20, s_q8, Self::mul_add(-x18, x29, x19 * c_q8)),
-        );
-        let x40 = a[7] + Self::mul_add(-0.00000000020510342851533115, x20, x18);
-        let x41 = v[7] + Self::mul_add(-0.00000000020510342851533115, x21, x4);
-        let x42 = x31 * x31;
-        let x43 = x41 * x41;
-        let x44 = x30 * x31;
-        let x45 = x44 - x40;
-        let x46 = x30 * x41;
-        let x47 = x30 * x30;
-        let x48 = x43 + x47;
-        let x49 = x31 * x41;
-        let x50 = x38 + x49;
-        let x51 = Self::mul_add(
-            -0.0021399965876409276,
-            x41,
-            -0.0000000234896432582596 * x31,
-        );
-        let x52 = Self::mul_add(
-            5.080660024070365,
-            x41,
-            Self::mul_add(-111.7548902508081, x31, -0.0000000234896432582596 * x30),
-        );
-        let x53 = Self::mul_add(
-            113.3918902508081,
-            x41,
-            Self::mul_add(5.080660024070366, x31, -0.0021399965876409276 * x30),
-        );
-        let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x55 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x56 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x57 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x58 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x59 = Self::mul_add(x41, c_q9, Self::mul_add(x31, x57, x30 * x55));
-        let x60 = Self::mul_add(-x41, s_q9, Self::mul_add(x31, x58, x30 * x56));
-        let x61 = x35 + Self::mul_add(0.4, x39 + x46, 0.275 * x45);
-        let x62 = x36 + Self::mul_add(-0.275, x48, 0.4 * (x49 - x38));
-        let x63 = x37 + Self::mul_add(-0.4, x42 + x47, 0.275 * x50);
-        let x64 = Self::mul_add(c_q9, x63, Self::mul_add(x57, x62, x55 * x61));
-        let x65 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x63,
-            Self::mul_add(0.00000000020510342851533115, x61, x62),
-        );
-        let x66 = Self::mul_add(
-            v[8],
-            x60,
-            Self::mul_add(x40, c_q9, Self::mul_add(x39, x57, x38 * x55)),
-        );
-        let x67 = Self::mul_add(
-            -v[8],
-            x59,
-            Self::mul_add(-x40, s_q9, Self::mul_add(x39, x58, x38 * x56)),
-        );
-        let x68 = a[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x40,
-                Self::mul_add(0.00000000020510342851533115, x38, x39),
-            );
-        let x69 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x41,
-                Self::mul_add(0.00000000020510342851533115, x30, x31),
-            );
-        let x70 = Self::mul_add(x59, x60, -x68);
-        let x71 = Self::mul_add(x59, x59, x69 * x69);
-        let x72 = Self::mul_add(x60, x69, x66);
-        let x73 = -0.00214 * x69;
-        let x74 = Self::mul_add(-36.18604050126307, x69, -63.36336825000001 * x60);
-        let x75 = Self::mul_add(
-            69.99836825,
-            x69,
-            Self::mul_add(-36.18604050126307, x60, -0.00214 * x59),
-        );
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x77 = Self::mul_add(x60, s_q10, x59 * c_q10);
-        let x78 = Self::mul_add(-x59, s_q10, x60 * c_q10);
-        let x79 = Self::mul_add(-0.87, x70, x64);
-        let x80 = Self::mul_add(
-            0.87,
-            x71,
-            Self::mul_add(-s_q9, x63, Self::mul_add(x58, x62, x56 * x61)),
-        );
-        let x81 = Self::mul_add(-0.87, x72, x65);
-        let x82 = Self::mul_add(s_q10, x80, c_q10 * x79);
-        let x83 = Self::mul_add(v[9], x78, Self::mul_add(x67, s_q10, x66 * c_q10));
-        let x84 = Self::mul_add(-v[9], x77, Self::mul_add(-x66, s_q10, x67 * c_q10));
-        let x85 = a[9] + x68;
-        let x86 = v[9] + x69;
-        let x87 = Self::mul_add(x77, x78, -x85);
-        let x88 = x77 * x77;
-        let x89 = Self::mul_add(x86, x86, x88);
-        let x90 = x78 * x86;
-        let x91 = x83 + x90;
-        let x92 = -0.6328 * x86;
-        let x93 = Self::mul_add(-24.35164200091464, x86, -24.4950615 * x78);
-        let x94 = Self::mul_add(
-            28.2393615,
-            x86,
-            Self::mul_add(-24.351642000914637, x78, -0.6328 * x77),
-        );
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x96 = Self::mul_add(x78, s_q11, x77 * c_q11);
-        let x97 = Self::mul_add(-x77, s_q11, x78 * c_q11);
-        let x98 = x82 + Self::mul_add(-0.275, Self::mul_add(x77, x86, x84), -0.63 * x87);
-        let x99 = Self::mul_add(-s_q10, x79, c_q10 * x80)
-            + Self::mul_add(0.63, x89, -0.275 * (x90 - x83));
-        let x100 = x81 + Self::mul_add(0.275, Self::mul_add(x78, x78, x88), -0.63 * x91);
-        let x101 = Self::mul_add(s_q11, x99, c_q11 * x98);
-        let x102 = Self::mul_add(v[10], x97, Self::mul_add(x84, s_q11, x83 * c_q11));
-        let x103 = Self::mul_add(-v[10], x96, Self::mul_add(-x83, s_q11, x84 * c_q11));
-        let x104 = a[10] + x85;
-        let x105 = v[10] + x86;
-        let x106 = x96 * x96;
-        let x107 = x97 * x105;
-        let x108 = 0.01675 * x105;
-        let x109 = Self::mul_add(2.5482240016099564, x105, -9.142025249762803 * x97);
-        let x110 = Self::mul_add(
-            9.223235249762805,
-            x105,
-            Self::mul_add(2.5482240016099564, x97, 0.01675 * x96),
-        );
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x112 = -0.00000000020510342851533115 * s_q12;
-        let x113 = -0.00000000020510342851533115 * c_q12;
-        let x114 = Self::mul_add(-x105, s_q12, Self::mul_add(x97, x112, x96 * c_q12));
-        let x115 = Self::mul_add(-x105, c_q12, Self::mul_add(-x96, s_q12, x97 * x113));
-        let x116 = Self::mul_add(-0.36, Self::mul_add(x96, x105, x103), x101);
-        let x117 = Self::mul_add(
-            -0.36,
-            x107 - x102,
-            Self::mul_add(-s_q11, x98, c_q11 * x99),
-        );
-        let x118 = Self::mul_add(0.36, Self::mul_add(x97, x97, x106), x100);
-        let x119 = Self::mul_add(-s_q12, x118, Self::mul_add(x112, x117, c_q12 * x116));
-        let x120 = Self::mul_add(-c_q12, x118, Self::mul_add(-s_q12, x116, x113 * x117));
-        let x121 = Self::mul_add(-0.00000000020510342851533115, x118, x117);
-        let x122 = Self::mul_add(
-            v[11],
-            x115,
-            Self::mul_add(-x104, s_q12, Self::mul_add(x103, x112, x102 * c_q12)),
-        );
-        let x123 = Self::mul_add(
-            -v[11],
-            x114,
-            Self::mul_add(-x104, c_q12, Self::mul_add(-x102, s_q12, x103 * x113)),
-        );
-        let x124 = a[11] + Self::mul_add(-0.00000000020510342851533115, x104, x103);
-        let x125 = v[11] + Self::mul_add(-0.00000000020510342851533115, x105, x97);
-        let x126 = x115 * x115;
-        let x127 = x125 * x125;
-        let x128 = x114 * x115;
-        let x129 = x128 - x124;
-        let x130 = x114 * x125;
-        let x131 = x114 * x114;
-        let x132 = x127 + x131;
-        let x133 = x115 * x125;
-        let x134 = x122 + x133;
-        let x135 = Self::mul_add(-0.809539999555672, x125, -1.9877000000000002 * x115);
-        let x136 = Self::mul_add(
-            -2.741639999592316,
-            x125,
-            Self::mul_add(-5.252920330000002, x115, -1.9877000000000002 * x114),
-        );
-        let x137 = Self::mul_add(
-            9.740442170000001,
-            x125,
-            Self::mul_add(-2.7416399995923166, x115, -0.809539999555672 * x114),
-        );
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x139 = -0.00000000020510342851533115 * c_q13;
-        let x140 = -0.00000000020510342851533115 * s_q13;
-        let x141 = Self::mul_add(-x125, c_q13, Self::mul_add(x115, s_q13, x114 * x139));
-        let x142 = Self::mul_add(x125, s_q13, Self::mul_add(-x114, x140, x115 * c_q13));
-        let x143 = x119 + Self::mul_add(0.16, x123 + x130, 0.55 * x129);
-        let x144 = x121 + Self::mul_add(-0.16, x126 + x131, 0.55 * x134);
-        let x145 = Self::mul_add(
-            v[12],
-            x142,
-            Self::mul_add(-x124, c_q13, Self::mul_add(x123, s_q13, x122 * x139)),
-        );
-        let x146 = Self::mul_add(
-            -v[12],
-            x141,
-            Self::mul_add(x124, s_q13, Self::mul_add(-x122, x140, x123 * c_q13)),
-        );
-        let x147 = a[12] + Self::mul_add(-0.00000000020510342851533115, x124, x122);
-        let x148 = v[12] + Self::mul_add(-0.00000000020510342851533115, x125, x114);
-        let x149 = 4.806620000000001 * Self::mul_add(x141, x142, -x147);
-        let x150 = 4.806620000000001 * Self::mul_add(x141, x141, x148 * x148);
-        let x151 = 4.806620000000001 * Self::mul_add(x142, x148, x145);
-        let x152 = Self::mul_add(-0.0145, x148, 0.000781 * x142);
-        let x153 = Self::mul_add(
-            -0.9614610000000001,
-            x148,
-            Self::mul_add(-1.2025609200000003, x142, 0.000781 * x141),
-        );
-        let x154 = Self::mul_add(
-            1.4135609200000003,
-            x148,
-            Self::mul_add(-0.9614610000000001, x142, -0.0145 * x141),
-        );
-        let x155 = Self::mul_add(
-            -0.9614610000000001,
-            x147,
-            Self::mul_add(-1.2025609200000003, x146, 0.000781 * x145),
-        ) + Self::mul_add(-x141, x154, x148 * x152);
-        let x156 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x144, x143),
-            Self::mul_add(-0.0145, x147, 0.000781 * x146)
-                + Self::mul_add(-x148, x153, x142 * x154),
-        );
-        let x157 = Self::mul_add(
-            Self::mul_add(
-                -c_q13,
-                x144,
-                Self::mul_add(
-                    s_q13,
-                    x120 + Self::mul_add(-0.55, x132, 0.16 * (x133 - x122)),
-                    x139 * x143,
-                ),
-            ),
-            -4.806620000000001,
-            Self::mul_add(
-                1.4135609200000003,
-                x147,
-                Self::mul_add(-0.9614610000000001, x146, -0.0145 * x145),
-            ) + Self::mul_add(-x142, x152, x141 * x153),
-        );
-        let x158 = x151 + Self::mul_add(x140, x150, x139 * x149);
-        let x159 = Self::mul_add(-c_q13, x150, s_q13 * x149);
-        let x160 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x151,
-            -Self::mul_add(s_q13, x150, c_q13 * x149),
-        );
-        let x161 = Self::mul_add(
-            -3.6140000000000003,
-            x126 + x127,
-            17.135250000000003 * x129,
-        ) + x158;
-        let x162 = Self::mul_add(
-            -17.135250000000003,
-            x132,
-            3.6140000000000003 * (x124 + x128),
-        ) + x159;
-        let x163 = Self::mul_add(
-            17.135250000000003,
-            x134,
-            3.6140000000000003 * (x130 - x123),
-        ) + x160;
-        let x164 = Self::mul_add(
-            17.135250000000003,
-            x121,
-            Self::mul_add(-0.809539999555672, x124, -1.9877000000000002 * x123)
-                + Self::mul_add(-x125, x136, x115 * x137),
-        )
-            + (x157 + Self::mul_add(-x140, x155, x139 * x156)
-                + Self::mul_add(0.55, x160, -0.16 * x159));
-        let x165 = Self::mul_add(
-            x121,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x124,
-                Self::mul_add(-5.252920330000002, x123, -1.9877000000000002 * x122),
-            ) + Self::mul_add(-x114, x137, x125 * x135),
-        ) + Self::mul_add(0.16, x158, Self::mul_add(c_q13, x155, s_q13 * x156));
-        let x166 = Self::mul_add(
-            9.740442170000001,
-            x124,
-            Self::mul_add(-2.7416399995923166, x123, -0.809539999555672 * x122),
-        ) + Self::mul_add(-x115, x135, x114 * x136)
-            + Self::mul_add(3.6140000000000003, x120, x119 * -17.135250000000003)
-            + Self::mul_add(
-                x158,
-                -0.55,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x157,
-                    Self::mul_add(-c_q13, x156, s_q13 * x155),
-                ),
-            );
-        let x167 = Self::mul_add(-s_q12, x162, c_q12 * x161);
-        let x168 = x163 + Self::mul_add(x113, x162, x112 * x161);
-        let x169 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x96, x97, -x104),
-            x167,
-        );
-        let x170 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x105, x105, x106),
-            x168,
-        );
-        let x171 = Self::mul_add(
-            7.078399999258757,
-            x102 + x107,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x163,
-                -Self::mul_add(c_q12, x162, s_q12 * x161),
-            ),
-        );
-        let x172 = Self::mul_add(
-            7.078399999258757,
-            x100,
-            Self::mul_add(0.01675, x104, Self::mul_add(-x105, x109, x97 * x110)),
-        ) + Self::mul_add(x168, 0.36, Self::mul_add(-s_q12, x165, c_q12 * x164));
-        let x173 = Self::mul_add(2.5482240016099564, x104, -9.142025249762803 * x103)
-            + Self::mul_add(-x96, x110, x105 * x108)
-            + Self::mul_add(-0.36, x167, x166 + Self::mul_add(x113, x165, x112 * x164));
-        let x174 = Self::mul_add(
-            x101,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x104,
-                Self::mul_add(2.5482240016099564, x103, 0.01675 * x102),
-            ) + Self::mul_add(-x97, x108, x96 * x109),
-        )
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x166,
-                -Self::mul_add(c_q12, x165, s_q12 * x164),
-            );
-        let x175 = Self::mul_add(-s_q11, x170, c_q11 * x169);
-        let x176 = Self::mul_add(c_q11, x170, s_q11 * x169);
-        let x177 = Self::mul_add(-45.1584, x87, x175);
-        let x178 = Self::mul_add(45.1584, x89, x176);
-        let x179 = Self::mul_add(-45.1584, x91, x171);
-        let x180 = Self::mul_add(
-            -45.1584,
-            x81,
-            Self::mul_add(-0.6328, x85, Self::mul_add(-x86, x93, x78 * x94)),
-        )
-            + (Self::mul_add(-s_q11, x173, c_q11 * x172)
-                + Self::mul_add(-0.63, x171, 0.275 * x176));
-        let x181 = Self::mul_add(-24.35164200091464, x85, -24.4950615 * x84)
-            + Self::mul_add(-x77, x94, x86 * x92)
-            + Self::mul_add(-0.275, x175, Self::mul_add(c_q11, x173, s_q11 * x172));
-        let x182 = Self::mul_add(
-            x82,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x85,
-                Self::mul_add(-24.351642000914637, x84, -0.6328 * x83),
-            ) + Self::mul_add(-x78, x92, x77 * x93),
-        ) + Self::mul_add(x175, 0.63, x174);
-        let x183 = Self::mul_add(-s_q10, x178, c_q10 * x177);
-        let x184 = Self::mul_add(-81.53205, x70, x183);
-        let x185 = Self::mul_add(
-            81.53205,
-            x71,
-            Self::mul_add(c_q10, x178, s_q10 * x177),
-        );
-        let x186 = Self::mul_add(-81.53205, x72, x179);
-        let x187 = Self::mul_add(
-            -81.53205,
-            x65,
-            Self::mul_add(-0.00214, x68, Self::mul_add(-x69, x74, x60 * x75)),
-        ) + Self::mul_add(-0.87, x179, Self::mul_add(-s_q10, x181, c_q10 * x180));
-        let x188 = Self::mul_add(-36.18604050126307, x68, -63.36336825000001 * x67)
-            + Self::mul_add(-x59, x75, x69 * x73)
-            + Self::mul_add(c_q10, x181, s_q10 * x180);
-        let x189 = Self::mul_add(
-            x64,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x68,
-                Self::mul_add(-36.18604050126307, x67, -0.00214 * x66),
-            ) + Self::mul_add(-x60, x73, x59 * x74),
-        ) + Self::mul_add(x183, 0.87, x182);
-        let x190 = Self::mul_add(
-            0.00000000020510342851533115,
-            x186,
-            Self::mul_add(x56, x185, x55 * x184),
-        );
-        let x191 = x186 + Self::mul_add(x58, x185, x57 * x184);
-        let x192 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x186,
-            Self::mul_add(-s_q9, x185, c_q9 * x184),
-        );
-        let x193 = Self::mul_add(
-            0.000000008530897668050218,
-            x42 + x43,
-            -12.701650001451807 * x45,
-        ) + x190;
-        let x194 = Self::mul_add(
-            12.701650001451807,
-            x48,
-            -0.000000008530897668050218 * (x40 + x44),
-        ) + x191;
-        let x195 = Self::mul_add(
-            -12.701650001451807,
-            x50,
-            -0.000000008530897668050218 * (x46 - x39),
-        ) + x192;
-        let x196 = Self::mul_add(
-            -12.701650001451807,
-            x37,
-            Self::mul_add(-0.0021399965876409276, x40, -0.0000000234896432582596 * x39)
-                + Self::mul_add(-x41, x52, x31 * x53),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x189,
-                Self::mul_add(x56, x188, x55 * x187),
-            ) + Self::mul_add(0.275, x192, x191 * -0.4));
-        let x197 = Self::mul_add(
-            x37,
-            0.000000008530897668050218,
-            Self::mul_add(
-                5.080660024070365,
-                x40,
-                Self::mul_add(-111.7548902508081, x39, -0.0000000234896432582596 * x38),
-            ) + Self::mul_add(-x30, x53, x41 * x51),
-        ) + Self::mul_add(0.4, x190, x189 + Self::mul_add(x58, x188, x57 * x187));
-        let x198 = Self::mul_add(
-            113.3918902508081,
-            x40,
-            Self::mul_add(5.080660024070366, x39, -0.0021399965876409276 * x38),
-        ) + Self::mul_add(-x31, x51, x30 * x52)
-            + Self::mul_add(-0.000000008530897668050218, x36, x35 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x190,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x189,
-                    Self::mul_add(-s_q9, x188, c_q9 * x187),
-                ),
-            );
-        let x199 = x195 + Self::mul_add(-x29, x194, x28 * x193);
-        let x200 = Self::mul_add(c_q8, x194, s_q8 * x193);
-        let x201 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x199);
-        let x202 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x200);
-        let x203 = Self::mul_add(
-            48.0240000085309,
-            x23 - x19,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x195,
-                Self::mul_add(-c_q8, x193, s_q8 * x194),
-            ),
-        );
-        let x204 = Self::mul_add(-16.80768997608804, x20, -0.07309 * x19)
-            + Self::mul_add(-x21, x25, x5 * x26)
-            + Self::mul_add(x200, -0.35, x198 + Self::mul_add(-x29, x197, x28 * x196));
-        let x205 = Self::mul_add(
+        let x27 = Self::mul_add(
             x16,
             -48.0240000085309,
             Self::mul_add(
@@ -2470,8 +2047,8 @@ impl FreeFloating7 {
                 x20,
                 Self::mul_add(130.43769025763282, x19, -0.07309 * x18),
             ) + Self::mul_add(-x4, x26, x21 * x24),
-        ) + Self::mul_add(0.35, x199, Self::mul_add(c_q8, x197, s_q8 * x196));
-        let x206 = Self::mul_add(
+        );
+        let x28 = Self::mul_add(
             48.0240000085309,
             x17,
             Self::mul_add(
@@ -2479,2731 +2056,2246 @@ impl FreeFloating7 {
                 x20,
                 Self::mul_add(0.1132, x19, -16.80768997608804 * x18),
             ) + Self::mul_add(-x5, x24, x4 * x25),
-        )
+        );
+        let (s_q8, c_q8) = libm::sincos(q[8]);
+        let x30 = -0.00000000020510342851533115 * c_q8;
+        let x31 = -0.00000000020510342851533115 * s_q8;
+        let x32 = Self::mul_add(-x21, c_q8, Self::mul_add(x5, s_q8, x4 * x30));
+        let x33 = Self::mul_add(x21, s_q8, Self::mul_add(-x4, x31, x5 * c_q8));
+        let x34 = Self::mul_add(0.35, x19 + x23, Self::mul_add(s_q7, x15, c_q7 * x14));
+        let x35 = Self::mul_add(0.35, Self::mul_add(x5, x21, -x18), x17);
+        let x36 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x22), x16);
+        let x37 = Self::mul_add(-c_q8, x36, Self::mul_add(s_q8, x35, x30 * x34));
+        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(-x31, x34, c_q8 * x35));
+        let x39 = Self::mul_add(-0.00000000020510342851533115, x36, x34);
+        let x40 = Self::mul_add(
+            v[7],
+            x33,
+            Self::mul_add(-x20, c_q8, Self::mul_add(x19, s_q8, x18 * x30)),
+        );
+        let x41 = Self::mul_add(
+            -v[7],
+            x32,
+            Self::mul_add(x20, s_q8, Self::mul_add(-x18, x31, x19 * c_q8)),
+        );
+        let x42 = a[7] + Self::mul_add(-0.00000000020510342851533115, x20, x18);
+        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x21, x4);
+        let x44 = x33 * x33;
+        let x45 = x43 * x43;
+        let x46 = x32 * x33;
+        let x47 = x46 - x42;
+        let x48 = x32 * x43;
+        let x49 = x32 * x32;
+        let x50 = x45 + x49;
+        let x51 = x33 * x43;
+        let x52 = x40 + x51;
+        let x53 = Self::mul_add(
+            -0.002139996587640933,
+            x43,
+            -0.0000000234896432582596 * x33,
+        );
+        let x54 = Self::mul_add(
+            5.080660024070365,
+            x43,
+            Self::mul_add(-111.7548902508081, x33, -0.0000000234896432582596 * x32),
+        );
+        let x55 = Self::mul_add(
+            113.3918902508081,
+            x43,
+            Self::mul_add(5.080660024070366, x33, -0.002139996587640933 * x32),
+        );
+        let x56 = Self::mul_add(
+            x39,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x42,
+                Self::mul_add(-111.7548902508081, x41, -0.0000000234896432582596 * x40),
+            ) + Self::mul_add(-x32, x55, x43 * x53),
+        );
+        let (s_q9, c_q9) = libm::sincos(q[9]);
+        let x58 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            0.00000000020510342851533115 * c_q9,
+        );
+        let x59 = Self::mul_add(
+            -0.00000000020510342851533115,
+            s_q9,
+            -0.00000000020510342851533115 * c_q9,
+        );
+        let x60 = Self::mul_add(x43, c_q9, Self::mul_add(x33, x58, x32 * s_q9));
+        let x61 = Self::mul_add(-x43, s_q9, Self::mul_add(x33, x59, x32 * c_q9));
+        let x62 = x37 + Self::mul_add(0.4, x41 + x48, 0.275 * x47);
+        let x63 = x38 + Self::mul_add(-0.275, x50, 0.4 * (x51 - x40));
+        let x64 = x39 + Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
+        let x65 = Self::mul_add(c_q9, x64, Self::mul_add(x58, x63, s_q9 * x62));
+        let x66 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x64,
+            Self::mul_add(0.00000000020510342851533115, x62, x63),
+        );
+        let x67 = Self::mul_add(
+            v[8],
+            x61,
+            Self::mul_add(x42, c_q9, Self::mul_add(x41, x58, x40 * s_q9)),
+        );
+        let x68 = Self::mul_add(
+            -v[8],
+            x60,
+            Self::mul_add(-x42, s_q9, Self::mul_add(x41, x59, x40 * c_q9)),
+        );
+        let x69 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x198,
-                Self::mul_add(-c_q8, x196, s_q8 * x197),
+                x42,
+                Self::mul_add(0.00000000020510342851533115, x40, x41),
             );
-        let x207 = Self::mul_add(-s_q7, x202, c_q7 * x201);
-        let x208 = Self::mul_add(c_q7, x202, s_q7 * x201);
-        let x209 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x210 = 1466.4506062283303 * v[4];
-        let x211 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x212 = x207
+        let x70 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x43,
+                Self::mul_add(0.00000000020510342851533115, x32, x33),
+            );
+        let x71 = Self::mul_add(x60, x61, -x69);
+        let x72 = Self::mul_add(x60, x60, x70 * x70);
+        let x73 = Self::mul_add(x61, x70, x67);
+        let x74 = -0.00214 * x70;
+        let x75 = Self::mul_add(-36.18604050126307, x70, -63.36336825000001 * x61);
+        let x76 = Self::mul_add(
+            69.99836825,
+            x70,
+            Self::mul_add(-36.18604050126307, x61, -0.00214 * x60),
+        );
+        let x77 = Self::mul_add(
+            -81.53205,
+            x66,
+            Self::mul_add(-0.00214, x69, Self::mul_add(-x70, x75, x61 * x76)),
+        );
+        let x78 = Self::mul_add(
+            x65,
+            81.53205,
+            Self::mul_add(
+                69.99836825,
+                x69,
+                Self::mul_add(-36.18604050126307, x68, -0.00214 * x67),
+            ) + Self::mul_add(-x61, x74, x60 * x75),
+        );
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x80 = Self::mul_add(x61, s_q10, x60 * c_q10);
+        let x81 = Self::mul_add(-x60, s_q10, x61 * c_q10);
+        let x82 = Self::mul_add(-0.87, x71, x65);
+        let x83 = Self::mul_add(
+            0.87,
+            x72,
+            Self::mul_add(-s_q9, x64, Self::mul_add(x59, x63, c_q9 * x62)),
+        );
+        let x84 = Self::mul_add(-0.87, x73, x66);
+        let x85 = Self::mul_add(s_q10, x83, c_q10 * x82);
+        let x86 = Self::mul_add(v[9], x81, Self::mul_add(x68, s_q10, x67 * c_q10));
+        let x87 = Self::mul_add(-v[9], x80, Self::mul_add(-x67, s_q10, x68 * c_q10));
+        let x88 = a[9] + x69;
+        let x89 = v[9] + x70;
+        let x90 = Self::mul_add(x80, x81, -x88);
+        let x91 = x80 * x80;
+        let x92 = Self::mul_add(x89, x89, x91);
+        let x93 = x81 * x89;
+        let x94 = x86 + x93;
+        let x95 = -0.6328 * x89;
+        let x96 = Self::mul_add(-24.35164200091464, x89, -24.4950615 * x81);
+        let x97 = Self::mul_add(
+            28.2393615,
+            x89,
+            Self::mul_add(-24.351642000914637, x81, -0.6328 * x80),
+        );
+        let x98 = Self::mul_add(
+            -45.1584,
+            x84,
+            Self::mul_add(-0.6328, x88, Self::mul_add(-x89, x96, x81 * x97)),
+        );
+        let x99 = Self::mul_add(
+            x85,
+            45.1584,
+            Self::mul_add(
+                28.2393615,
+                x88,
+                Self::mul_add(-24.351642000914637, x87, -0.6328 * x86),
+            ) + Self::mul_add(-x81, x95, x80 * x96),
+        );
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x101 = Self::mul_add(x81, s_q11, x80 * c_q11);
+        let x102 = Self::mul_add(-x80, s_q11, x81 * c_q11);
+        let x103 = x85
+            + Self::mul_add(-0.275, Self::mul_add(x80, x89, x87), -0.63 * x90);
+        let x104 = Self::mul_add(-s_q10, x82, c_q10 * x83)
+            + Self::mul_add(0.63, x92, -0.275 * (x93 - x86));
+        let x105 = x84 + Self::mul_add(0.275, Self::mul_add(x81, x81, x91), -0.63 * x94);
+        let x106 = Self::mul_add(s_q11, x104, c_q11 * x103);
+        let x107 = Self::mul_add(v[10], x102, Self::mul_add(x87, s_q11, x86 * c_q11));
+        let x108 = Self::mul_add(-v[10], x101, Self::mul_add(-x86, s_q11, x87 * c_q11));
+        let x109 = a[10] + x88;
+        let x110 = v[10] + x89;
+        let x111 = x101 * x101;
+        let x112 = x102 * x110;
+        let x113 = 0.01675 * x110;
+        let x114 = Self::mul_add(2.5482240016099564, x110, -9.142025249762803 * x102);
+        let x115 = Self::mul_add(
+            9.223235249762805,
+            x110,
+            Self::mul_add(2.5482240016099564, x102, 0.01675 * x101),
+        );
+        let x116 = Self::mul_add(
+            7.078399999258757,
+            x105,
+            Self::mul_add(0.01675, x109, Self::mul_add(-x110, x114, x102 * x115)),
+        );
+        let x117 = Self::mul_add(
+            x106,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x109,
+                Self::mul_add(2.5482240016099564, x108, 0.01675 * x107),
+            ) + Self::mul_add(-x102, x113, x101 * x114),
+        );
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x119 = -0.00000000020510342851533115 * s_q12;
+        let x120 = -0.00000000020510342851533115 * c_q12;
+        let x121 = Self::mul_add(-x110, s_q12, Self::mul_add(x102, x119, x101 * c_q12));
+        let x122 = Self::mul_add(-x110, c_q12, Self::mul_add(-x101, s_q12, x102 * x120));
+        let x123 = Self::mul_add(-0.36, Self::mul_add(x101, x110, x108), x106);
+        let x124 = Self::mul_add(
+            -0.36,
+            x112 - x107,
+            Self::mul_add(-s_q11, x103, c_q11 * x104),
+        );
+        let x125 = Self::mul_add(0.36, Self::mul_add(x102, x102, x111), x105);
+        let x126 = Self::mul_add(-s_q12, x125, Self::mul_add(x119, x124, c_q12 * x123));
+        let x127 = Self::mul_add(-c_q12, x125, Self::mul_add(-s_q12, x123, x120 * x124));
+        let x128 = Self::mul_add(-0.00000000020510342851533115, x125, x124);
+        let x129 = Self::mul_add(
+            v[11],
+            x122,
+            Self::mul_add(-x109, s_q12, Self::mul_add(x108, x119, x107 * c_q12)),
+        );
+        let x130 = Self::mul_add(
+            -v[11],
+            x121,
+            Self::mul_add(-x109, c_q12, Self::mul_add(-x107, s_q12, x108 * x120)),
+        );
+        let x131 = a[11] + Self::mul_add(-0.00000000020510342851533115, x109, x108);
+        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x110, x102);
+        let x133 = x122 * x122;
+        let x134 = x132 * x132;
+        let x135 = x121 * x122;
+        let x136 = x135 - x131;
+        let x137 = x121 * x132;
+        let x138 = x121 * x121;
+        let x139 = x134 + x138;
+        let x140 = x122 * x132;
+        let x141 = x129 + x140;
+        let x142 = Self::mul_add(-0.809539999555672, x132, -1.9877000000000002 * x122);
+        let x143 = Self::mul_add(
+            -2.741639999592316,
+            x132,
+            Self::mul_add(-5.252920330000002, x122, -1.9877000000000002 * x121),
+        );
+        let x144 = Self::mul_add(
+            9.740442170000001,
+            x132,
+            Self::mul_add(-2.7416399995923166, x122, -0.809539999555672 * x121),
+        );
+        let x145 = Self::mul_add(
+            x128,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x131,
+                Self::mul_add(-5.252920330000002, x130, -1.9877000000000002 * x129),
+            ) + Self::mul_add(-x121, x144, x132 * x142),
+        );
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x147 = -0.00000000020510342851533115 * c_q13;
+        let x148 = -0.00000000020510342851533115 * s_q13;
+        let x149 = Self::mul_add(-x132, c_q13, Self::mul_add(x122, s_q13, x121 * x147));
+        let x150 = Self::mul_add(x132, s_q13, Self::mul_add(-x121, x148, x122 * c_q13));
+        let x151 = x126 + Self::mul_add(0.16, x130 + x137, 0.55 * x136);
+        let x152 = x128 + Self::mul_add(-0.16, x133 + x138, 0.55 * x141);
+        let x153 = Self::mul_add(
+            -c_q13,
+            x152,
+            Self::mul_add(
+                s_q13,
+                x127 + Self::mul_add(-0.55, x139, 0.16 * (x140 - x129)),
+                x147 * x151,
+            ),
+        );
+        let x154 = Self::mul_add(
+            v[12],
+            x150,
+            Self::mul_add(-x131, c_q13, Self::mul_add(x130, s_q13, x129 * x147)),
+        );
+        let x155 = Self::mul_add(
+            -v[12],
+            x149,
+            Self::mul_add(x131, s_q13, Self::mul_add(-x129, x148, x130 * c_q13)),
+        );
+        let x156 = a[12] + Self::mul_add(-0.00000000020510342851533115, x131, x129);
+        let x157 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x121);
+        let x158 = 4.806620000000001 * Self::mul_add(x149, x150, -x156);
+        let x159 = 4.806620000000001 * Self::mul_add(x149, x149, x157 * x157);
+        let x160 = 4.806620000000001 * Self::mul_add(x150, x157, x154);
+        let x161 = Self::mul_add(-0.0145, x157, 0.000781 * x150);
+        let x162 = Self::mul_add(
+            -0.9614610000000001,
+            x157,
+            Self::mul_add(-1.2025609200000003, x150, 0.000781 * x149),
+        );
+        let x163 = Self::mul_add(
+            1.4135609200000003,
+            x157,
+            Self::mul_add(-0.9614610000000001, x150, -0.0145 * x149),
+        );
+        let x164 = Self::mul_add(
+            -0.9614610000000001,
+            x156,
+            Self::mul_add(-1.2025609200000003, x155, 0.000781 * x154),
+        ) + Self::mul_add(-x149, x163, x157 * x161);
+        let x165 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x152, x151),
+            Self::mul_add(-0.0145, x156, 0.000781 * x155)
+                + Self::mul_add(-x157, x162, x150 * x163),
+        );
+        let x166 = Self::mul_add(
+            x153,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x156,
+                Self::mul_add(-0.9614610000000001, x155, -0.0145 * x154),
+            ) + Self::mul_add(-x150, x161, x149 * x162),
+        );
+        let x167 = x160 + Self::mul_add(x148, x159, x147 * x158);
+        let x168 = Self::mul_add(-c_q13, x159, s_q13 * x158);
+        let x169 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x160,
+            -Self::mul_add(s_q13, x159, c_q13 * x158),
+        );
+        let x170 = Self::mul_add(
+            x167,
+            -0.55,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x166,
+                Self::mul_add(-c_q13, x165, s_q13 * x164),
+            ),
+        );
+        let x171 = Self::mul_add(
+            -3.6140000000000003,
+            x133 + x134,
+            17.135250000000003 * x136,
+        ) + x167;
+        let x172 = Self::mul_add(
+            -17.135250000000003,
+            x139,
+            3.6140000000000003 * (x131 + x135),
+        ) + x168;
+        let x173 = Self::mul_add(
+            17.135250000000003,
+            x141,
+            3.6140000000000003 * (x137 - x130),
+        ) + x169;
+        let x174 = Self::mul_add(
+            17.135250000000003,
+            x128,
+            Self::mul_add(-0.809539999555672, x131, -1.9877000000000002 * x130)
+                + Self::mul_add(-x132, x143, x122 * x144),
+        )
+            + (x166 + Self::mul_add(-x148, x164, x147 * x165)
+                + Self::mul_add(0.55, x169, -0.16 * x168));
+        let x175 = x145
+            + Self::mul_add(0.16, x167, Self::mul_add(c_q13, x164, s_q13 * x165));
+        let x176 = Self::mul_add(
+            9.740442170000001,
+            x131,
+            Self::mul_add(-2.7416399995923166, x130, -0.809539999555672 * x129),
+        ) + Self::mul_add(-x122, x142, x121 * x143)
+            + Self::mul_add(3.6140000000000003, x127, x126 * -17.135250000000003) + x170;
+        let x177 = Self::mul_add(-s_q12, x172, c_q12 * x171);
+        let x178 = x173 + Self::mul_add(x120, x172, x119 * x171);
+        let x179 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x101, x102, -x109),
+            x177,
+        );
+        let x180 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x110, x110, x111),
+            x178,
+        );
+        let x181 = Self::mul_add(
+            7.078399999258757,
+            x107 + x112,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x173,
+                -Self::mul_add(c_q12, x172, s_q12 * x171),
+            ),
+        );
+        let x182 = x116
+            + Self::mul_add(x178, 0.36, Self::mul_add(-s_q12, x175, c_q12 * x174));
+        let x183 = Self::mul_add(2.5482240016099564, x109, -9.142025249762803 * x108)
+            + Self::mul_add(-x101, x115, x110 * x113)
+            + Self::mul_add(-0.36, x177, x176 + Self::mul_add(x120, x175, x119 * x174));
+        let x184 = x117
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x176,
+                -Self::mul_add(c_q12, x175, s_q12 * x174),
+            );
+        let x185 = Self::mul_add(-s_q11, x180, c_q11 * x179);
+        let x186 = Self::mul_add(c_q11, x180, s_q11 * x179);
+        let x187 = Self::mul_add(-45.1584, x90, x185);
+        let x188 = Self::mul_add(45.1584, x92, x186);
+        let x189 = Self::mul_add(-45.1584, x94, x181);
+        let x190 = x98
+            + (Self::mul_add(-s_q11, x183, c_q11 * x182)
+                + Self::mul_add(-0.63, x181, 0.275 * x186));
+        let x191 = Self::mul_add(-24.35164200091464, x88, -24.4950615 * x87)
+            + Self::mul_add(-x80, x97, x89 * x95)
+            + Self::mul_add(-0.275, x185, Self::mul_add(c_q11, x183, s_q11 * x182));
+        let x192 = x99 + Self::mul_add(x185, 0.63, x184);
+        let x193 = Self::mul_add(-s_q10, x188, c_q10 * x187);
+        let x194 = Self::mul_add(-81.53205, x71, x193);
+        let x195 = Self::mul_add(
+            81.53205,
+            x72,
+            Self::mul_add(c_q10, x188, s_q10 * x187),
+        );
+        let x196 = Self::mul_add(-81.53205, x73, x189);
+        let x197 = x77
+            + Self::mul_add(-0.87, x189, Self::mul_add(-s_q10, x191, c_q10 * x190));
+        let x198 = Self::mul_add(-36.18604050126307, x69, -63.36336825000001 * x68)
+            + Self::mul_add(-x60, x76, x70 * x74)
+            + Self::mul_add(c_q10, x191, s_q10 * x190);
+        let x199 = x78 + Self::mul_add(x193, 0.87, x192);
+        let x200 = Self::mul_add(
+            0.00000000020510342851533115,
+            x196,
+            Self::mul_add(c_q9, x195, s_q9 * x194),
+        );
+        let x201 = x196 + Self::mul_add(x59, x195, x58 * x194);
+        let x202 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x196,
+            Self::mul_add(-s_q9, x195, c_q9 * x194),
+        );
+        let x203 = Self::mul_add(
+            -0.275,
+            x200,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x199,
+                Self::mul_add(-s_q9, x198, c_q9 * x197),
+            ),
+        );
+        let x204 = Self::mul_add(
+            0.000000008530897668050218,
+            x44 + x45,
+            -12.701650001451807 * x47,
+        ) + x200;
+        let x205 = Self::mul_add(
+            12.701650001451807,
+            x50,
+            -0.000000008530897668050218 * (x42 + x46),
+        ) + x201;
+        let x206 = Self::mul_add(
+            -12.701650001451807,
+            x52,
+            -0.000000008530897668050218 * (x48 - x41),
+        ) + x202;
+        let x207 = Self::mul_add(
+            -12.701650001451807,
+            x39,
+            Self::mul_add(-0.002139996587640933, x42, -0.0000000234896432582596 * x41)
+                + Self::mul_add(-x43, x54, x33 * x55),
+        )
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x199,
+                Self::mul_add(c_q9, x198, s_q9 * x197),
+            ) + Self::mul_add(0.275, x202, x201 * -0.4));
+        let x208 = x56
+            + Self::mul_add(0.4, x200, x199 + Self::mul_add(x59, x198, x58 * x197));
+        let x209 = Self::mul_add(
+            113.3918902508081,
+            x42,
+            Self::mul_add(5.080660024070366, x41, -0.002139996587640933 * x40),
+        ) + Self::mul_add(-x33, x53, x32 * x54)
+            + Self::mul_add(-0.000000008530897668050218, x38, x37 * 12.701650001451807)
+            + x203;
+        let x210 = x206 + Self::mul_add(-x31, x205, x30 * x204);
+        let x211 = Self::mul_add(c_q8, x205, s_q8 * x204);
+        let x212 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x210);
+        let x213 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x211);
+        let x214 = Self::mul_add(
+            48.0240000085309,
+            x23 - x19,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x206,
+                Self::mul_add(-c_q8, x204, s_q8 * x205),
+            ),
+        );
+        let x215 = Self::mul_add(-16.80768997608804, x20, -0.07309 * x19)
+            + Self::mul_add(-x21, x25, x5 * x26)
+            + Self::mul_add(x211, -0.35, x209 + Self::mul_add(-x31, x208, x30 * x207));
+        let x216 = x27
+            + Self::mul_add(0.35, x210, Self::mul_add(c_q8, x208, s_q8 * x207));
+        let x217 = x28
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x209,
+                Self::mul_add(-c_q8, x207, s_q8 * x208),
+            );
+        let x218 = Self::mul_add(-s_q7, x213, c_q7 * x212);
+        let x219 = Self::mul_add(c_q7, x213, s_q7 * x212);
+        let x220 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x221 = 1466.4506062283303 * v[4];
+        let x222 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x223 = x218
             + Self::mul_add(
                 1170.07,
                 x0,
                 Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
             );
-        let x213 = x208
+        let x224 = x219
             + Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x11, 110.5455 * x10),
             );
-        let x214 = x203
+        let x225 = x214
             + Self::mul_add(
                 1170.07,
                 x2,
                 Self::mul_add(-180.9502499901501, x13, 110.5455 * x12),
             );
-        let x215 = Self::mul_add(x208, -0.75, Self::mul_add(-s_q7, x205, c_q7 * x204))
+        let x226 = Self::mul_add(x219, -0.75, Self::mul_add(-s_q7, x216, c_q7 * x215))
             + Self::mul_add(
                 x1,
                 -180.9502499901501,
                 Self::mul_add(-117.61766249359756, a[5], 1394.5960312283303 * a[3])
-                    + Self::mul_add(-v[5], x210, v[4] * x211),
+                    + Self::mul_add(-v[5], x221, v[4] * x222),
             );
-        let x216 = Self::mul_add(c_q7, x205, s_q7 * x204)
-            + Self::mul_add(x203, -0.65, 0.75 * x207)
+        let x227 = Self::mul_add(c_q7, x216, s_q7 * x215)
+            + Self::mul_add(x214, -0.65, 0.75 * x218)
             + (Self::mul_add(
                 1466.4506062283303,
                 a[4],
-                Self::mul_add(-v[3], x211, v[5] * x209),
+                Self::mul_add(-v[3], x222, v[5] * x220),
             ) + Self::mul_add(x2, -110.5455, 180.9502499901501 * x0));
-        let x217 = Self::mul_add(0.65, x208, x206)
+        let x228 = Self::mul_add(0.65, x219, x217)
             + Self::mul_add(
                 110.5455,
                 x1,
                 Self::mul_add(1271.854575, a[5], -117.61766249359758 * a[3])
-                    + Self::mul_add(-v[4], x209, v[3] * x210),
+                    + Self::mul_add(-v[4], x220, v[3] * x221),
             );
-        [x212, x213, x214, x215, x216, x217, x206, x198, x189, x182, x174, x166, x157]
+        [x223, x224, x225, x226, x227, x228, x217, x209, x199, x192, x184, x176, x166]
     }
-    /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
+    /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1676 mul, 1410 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1114 fused where the target has FMA.
+    /// Methods: forward `aba`: 1613 mul, 1277 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
+        let x0 = Self::mul_add(
+            v[1],
+            -180.9502499901501,
+            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
+        );
+        let x1 = Self::mul_add(
+            1466.4506062283303,
+            v[4],
+            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
+        );
+        let x2 = Self::mul_add(
+            110.5455,
+            v[1],
+            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
+        );
+        let x3 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]);
+        let x4 = Self::mul_add(
+            1170.07,
+            v[1],
+            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
+        );
+        let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
+        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x9 = Self::mul_add(v[4], 0.75, v[0]);
+        let x10 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x11 = Self::mul_add(-0.65, v[4], v[2]);
+        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
+        let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
+        let x14 = v[6] * x8;
+        let x15 = v[6] * x7;
+        let x16 = v[6] * x13;
+        let x17 = v[6] * x12;
+        let x18 = v[5] + v[6];
+        let x19 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x8);
+        let x20 = Self::mul_add(
+            x11,
+            -48.0240000085309,
+            Self::mul_add(
+                0.1132,
+                x18,
+                Self::mul_add(130.43769025763282, x8, -0.07309 * x7),
+            ),
+        );
+        let x21 = Self::mul_add(
+            48.0240000085309,
+            x13,
+            Self::mul_add(
+                132.47349025763282,
+                x18,
+                Self::mul_add(0.1132, x8, -16.80768997608804 * x7),
+            ),
+        );
+        let x22 = x18 * -48.0240000085309;
+        let x23 = 48.0240000085309 * x8;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
+        let x25 = -0.00000000020510342851533115 * c_q8;
+        let x26 = -0.00000000020510342851533115 * s_q8;
+        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x7, x26, x8 * c_q8));
+        let x29 = Self::mul_add(x8, 0.35, x12);
+        let x30 = Self::mul_add(-0.35, x7, x13);
+        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-x26, x29, c_q8 * x30));
+        let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
+        let x34 = v[7] * x28;
+        let x35 = v[7] * x27;
+        let x36 = v[7] * x32;
+        let x37 = v[7] * x31;
+        let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
+        let x39 = Self::mul_add(
+            -12.701650001451807,
+            x33,
+            Self::mul_add(-0.002139996587640933, x38, -0.0000000234896432582596 * x28),
+        );
+        let x40 = Self::mul_add(
+            x33,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x38,
+                Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
+            ),
+        );
+        let x41 = Self::mul_add(
+            113.3918902508081,
+            x38,
+            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
+        ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
+        let x42 = -12.701650001451807 * x38;
+        let x43 = x38 * 0.000000008530897668050218;
+        let x44 = Self::mul_add(
+            -0.000000008530897668050218,
+            x28,
+            x27 * 12.701650001451807,
+        );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x6 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x7 = Self::mul_add(
+        let x46 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x8 = Self::mul_add(
+        let x47 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(-0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x16, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x16, -0.0145 * x15);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(-1.2025609200000003, c_q13, x24);
-        let x26 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(-1.2025609200000003, s_q13, -x23)
-            + 0.00000000019719894748377882;
-        let x29 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
-            + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = x22 + Self::mul_add(-x16, x21, x15 * x20) - (x30 - x31) - (x33 - x32);
-        let x35 = 3.6140000000000003 - x17;
-        let x36 = 17.135250000000003 + x18;
-        let x37 = -1.9877000000000002
-            + Self::mul_add(0.55, x17, Self::mul_add(c_q13, x21, s_q13 * x20));
-        let x38 = -0.809539999555672
-            + Self::mul_add(
-                0.16,
-                x17,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x22,
-                    Self::mul_add(-c_q13, x20, s_q13 * x21),
-                ),
-            );
-        let x39 = -1.9877000000000002
-            + Self::mul_add(x17, 0.55, x26 + Self::mul_add(-x16, x25, x15 * x23));
-        let x40 = -5.252920330000002
-            + (Self::mul_add(c_q13, x25, s_q13 * x23) + x32 - x30);
-        let x41 = -2.741639999592316
-            + Self::mul_add(
-                -0.55,
-                x19,
-                Self::mul_add(
-                    -0.16,
-                    x18,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x26,
-                        Self::mul_add(-c_q13, x23, s_q13 * x25),
-                    ),
-                ),
-            );
-        let x42 = -0.809539999555672
-            + Self::mul_add(0.16, x17, x29 + Self::mul_add(-x16, x28, x15 * x27));
-        let x43 = -2.7416399995923166
-            + Self::mul_add(
-                -0.16,
-                x18,
-                Self::mul_add(x19, -0.55, Self::mul_add(c_q13, x28, s_q13 * x27)),
-            );
-        let x44 = 9.740442170000001
-            + (x31
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) - x33));
-        let x45 = c_q12 * x35;
-        let x46 = s_q12 * x36;
-        let x47 = x45 - x46;
-        let x48 = x19 + Self::mul_add(x13, x36, x12 * x35);
-        let x49 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x50 = Self::mul_add(-0.00000000020510342851533115, x19, -x49);
-        let x51 = Self::mul_add(-s_q12, x39, c_q12 * x34);
-        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x37);
-        let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
-        let x54 = x42 + Self::mul_add(x13, x39, x12 * x34);
-        let x55 = x43 + Self::mul_add(x13, x40, x12 * x37);
-        let x56 = x44 + Self::mul_add(x13, x41, x12 * x38);
-        let x57 = Self::mul_add(
+        let x48 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x46, x27 * s_q9));
+        let x49 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x47, x27 * c_q9));
+        let x50 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
+        let x51 = Self::mul_add(-0.4, x27, x32);
+        let x52 = Self::mul_add(0.275, x27, x33);
+        let x53 = Self::mul_add(c_q9, x52, Self::mul_add(x46, x51, s_q9 * x50));
+        let x54 = Self::mul_add(-s_q9, x52, Self::mul_add(x47, x51, c_q9 * x50));
+        let x55 = Self::mul_add(
             -0.00000000020510342851533115,
-            x42,
-            -Self::mul_add(c_q12, x39, s_q12 * x34),
+            x52,
+            Self::mul_add(0.00000000020510342851533115, x50, x51),
         );
-        let x58 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x43,
-            -Self::mul_add(c_q12, x40, s_q12 * x37),
-        );
-        let x59 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x44,
-            -Self::mul_add(c_q12, x41, s_q12 * x38),
-        );
-        let x60 = x53 + Self::mul_add(x13, x52, x12 * x51);
-        let x61 = Self::mul_add(-s_q12, x55, c_q12 * x54);
-        let x62 = x50 * 0.36;
-        let x63 = -0.36 * x50;
-        let x64 = x63 + (Self::mul_add(-s_q12, x52, c_q12 * x51) - x62);
-        let x65 = 7.078399999258757 + x48;
-        let x66 = 0.01675
-            + Self::mul_add(
-                x47,
-                0.36,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x53,
-                    -Self::mul_add(c_q12, x52, s_q12 * x51),
-                ),
-            );
-        let x67 = -9.142025249762803
-            + (x56 + Self::mul_add(x13, x55, x12 * x54) + x63 - x62);
-        let x68 = 2.5482240016099564
-            + Self::mul_add(
-                0.36,
-                x48,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x56,
-                    -Self::mul_add(c_q12, x55, s_q12 * x54),
-                ),
-            );
-        let x69 = 0.01675
-            + Self::mul_add(0.36, x47, Self::mul_add(-s_q12, x58, c_q12 * x57));
-        let x70 = 2.5482240016099564
-            + Self::mul_add(x48, 0.36, x59 + Self::mul_add(x13, x58, x12 * x57));
-        let x71 = 9.223235249762805
+        let x56 = v[8] * x49;
+        let x57 = v[8] * x48;
+        let x58 = v[8] * x54;
+        let x59 = v[8] * x53;
+        let x60 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x59,
-                -Self::mul_add(c_q12, x58, s_q12 * x57),
+                x38,
+                Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x72 = Self::mul_add(-s_q11, x65, c_q11 * x47);
-        let x73 = Self::mul_add(c_q11, x65, s_q11 * x47);
-        let x74 = Self::mul_add(-s_q11, x61, c_q11 * x64);
-        let x75 = Self::mul_add(-s_q11, x67, c_q11 * x60);
-        let x76 = Self::mul_add(c_q11, x61, s_q11 * x64);
-        let x77 = Self::mul_add(c_q11, x67, s_q11 * x60);
-        let x78 = 0.275 * x50;
-        let x79 = -0.63 * x73;
-        let x80 = -0.275 * x50;
-        let x81 = x73 * 0.63;
-        let x82 = Self::mul_add(0.63, x72, Self::mul_add(c_q11, x75, s_q11 * x74));
-        let x83 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x68, c_q11 * x66));
-        let x84 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x68, s_q11 * x66));
-        let x85 = x71 - x81;
-        let x86 = Self::mul_add(-s_q11, x75, c_q11 * x74) - (x78 - x79) - (x81 - x80);
-        let x87 = Self::mul_add(x72, 0.63, Self::mul_add(-s_q11, x77, c_q11 * x76));
-        let x88 = -45.1584 + x73;
-        let x89 = -0.6328 + x83;
-        let x90 = -24.4950615 + (Self::mul_add(c_q11, x77, s_q11 * x76) + x80 - x78);
-        let x91 = -24.35164200091464 + Self::mul_add(0.63, x50, x84);
-        let x92 = -0.6328
-            + Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x70, c_q11 * x69));
-        let x93 = -24.351642000914637
-            + Self::mul_add(
-                0.275,
-                x73,
-                Self::mul_add(x50, 0.63, Self::mul_add(c_q11, x70, s_q11 * x69)),
-            );
-        let x94 = 28.2393615 + (x79 + x85);
-        let x95 = c_q10 * x72;
-        let x96 = Self::mul_add(-s_q10, x88, x95);
-        let x97 = s_q10 * x72;
-        let x98 = Self::mul_add(c_q10, x88, x97);
-        let x99 = Self::mul_add(-s_q10, x87, c_q10 * x86);
-        let x100 = Self::mul_add(-s_q10, x90, c_q10 * x82);
-        let x101 = Self::mul_add(-s_q10, x91, c_q10 * x89);
-        let x102 = Self::mul_add(c_q10, x87, s_q10 * x86);
-        let x103 = Self::mul_add(c_q10, x90, s_q10 * x82);
-        let x104 = Self::mul_add(c_q10, x91, s_q10 * x89);
-        let x105 = -0.87 * x98;
-        let x106 = x98 * 0.87;
-        let x107 = Self::mul_add(0.87, x96, Self::mul_add(c_q10, x100, s_q10 * x99));
-        let x108 = x94 - x106;
-        let x109 = Self::mul_add(-s_q10, x100, c_q10 * x99) + x105 - x106;
-        let x110 = Self::mul_add(x96, 0.87, Self::mul_add(-s_q10, x103, c_q10 * x102));
-        let x111 = -81.53205 + x98;
-        let x112 = -0.00214 + x101;
-        let x113 = -63.36336825000001 + Self::mul_add(c_q10, x103, s_q10 * x102);
-        let x114 = -36.18604050126307 + Self::mul_add(0.87, x50, x104);
-        let x115 = -0.00214 + Self::mul_add(-s_q10, x93, c_q10 * x92);
-        let x116 = -36.18604050126307
-            + Self::mul_add(x50, 0.87, Self::mul_add(c_q10, x93, s_q10 * x92));
-        let x117 = 69.99836825 + (x105 + x108);
-        let x118 = Self::mul_add(
-            0.00000000020510342851533115,
-            x50,
-            Self::mul_add(x6, x111, x5 * x96),
-        );
-        let x119 = x50 + Self::mul_add(x8, x111, x7 * x96);
-        let x120 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x50,
-            Self::mul_add(-s_q9, x111, c_q9 * x96),
-        );
-        let x121 = Self::mul_add(
-            0.00000000020510342851533115,
-            x115,
-            Self::mul_add(x6, x110, x5 * x109),
-        );
-        let x122 = Self::mul_add(
-            0.00000000020510342851533115,
-            x116,
-            Self::mul_add(x6, x113, x5 * x107),
-        );
-        let x123 = Self::mul_add(
-            0.00000000020510342851533115,
-            x117,
-            Self::mul_add(x6, x114, x5 * x112),
-        );
-        let x124 = x115 + Self::mul_add(x8, x110, x7 * x109);
-        let x125 = x116 + Self::mul_add(x8, x113, x7 * x107);
-        let x126 = x117 + Self::mul_add(x8, x114, x7 * x112);
-        let x127 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x115,
-            Self::mul_add(-s_q9, x110, c_q9 * x109),
-        );
-        let x128 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x116,
-            Self::mul_add(-s_q9, x113, c_q9 * x107),
-        );
-        let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x117,
-            Self::mul_add(-s_q9, x114, c_q9 * x112),
-        );
-        let x130 = x120 * -0.4;
-        let x131 = 0.275 * x119;
-        let x132 = 0.4 * x120;
-        let x133 = -0.275 * x119;
-        let x134 = Self::mul_add(
-            0.00000000020510342851533115,
-            x123,
-            Self::mul_add(x6, x122, x5 * x121),
-        ) - (x130 - x131) - (x133 - x132);
-        let x135 = -0.000000008530897668050218 + x118;
-        let x136 = -12.701650001451807 + x119;
-        let x137 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x118, x123 + Self::mul_add(x8, x122, x7 * x121));
-        let x138 = -0.0021399965876409276
-            + Self::mul_add(
-                x118,
-                -0.4,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x123,
-                    Self::mul_add(-s_q9, x122, c_q9 * x121),
-                ),
-            );
-        let x139 = -0.0000000234896432582596
-            + Self::mul_add(
-                -0.275,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x126,
-                    Self::mul_add(x6, x125, x5 * x124),
-                ),
-            );
-        let x140 = -111.7548902508081
-            + (x126 + Self::mul_add(x8, x125, x7 * x124) + x132 - x130);
-        let x141 = 5.080660024070365
-            + Self::mul_add(
-                -0.275,
-                x120,
-                Self::mul_add(
-                    -0.4,
-                    x119,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x126,
-                        Self::mul_add(-s_q9, x125, c_q9 * x124),
-                    ),
-                ),
-            );
-        let x142 = -0.0021399965876409276
-            + Self::mul_add(
-                -0.4,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(x6, x128, x5 * x127),
-                ),
-            );
-        let x143 = 5.080660024070366
-            + Self::mul_add(
-                x119,
-                -0.4,
-                Self::mul_add(-0.275, x120, x129 + Self::mul_add(x8, x128, x7 * x127)),
-            );
-        let x144 = 113.3918902508081
-            + (x131
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(-s_q9, x128, c_q9 * x127),
-                ) - x133));
-        let x145 = x120 + Self::mul_add(-x3, x136, x2 * x135);
-        let x146 = Self::mul_add(c_q8, x136, s_q8 * x135);
-        let x147 = c_q8 * x135;
-        let x148 = s_q8 * x136;
-        let x149 = Self::mul_add(-0.00000000020510342851533115, x120, x148 - x147);
-        let x150 = x142 + Self::mul_add(-x3, x139, x2 * x134);
-        let x151 = x143 + Self::mul_add(-x3, x140, x2 * x137);
-        let x152 = x144 + Self::mul_add(-x3, x141, x2 * x138);
-        let x153 = Self::mul_add(c_q8, x139, s_q8 * x134);
-        let x154 = Self::mul_add(c_q8, x140, s_q8 * x137);
-        let x155 = Self::mul_add(c_q8, x141, s_q8 * x138);
-        let x156 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x144,
-            Self::mul_add(-c_q8, x138, s_q8 * x141),
-        );
-        let x157 = x149 * -0.35;
-        let x158 = 0.35 * x149;
-        let x159 = x158 + (x152 + Self::mul_add(-x3, x151, x2 * x150) - x157);
-        let x160 = 48.0240000085309 + x145;
-        let x161 = -0.07309 + Self::mul_add(c_q8, x151, s_q8 * x150);
-        let x162 = -16.80768997608804
-            + Self::mul_add(
-                x145,
-                -0.35,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x152,
-                    Self::mul_add(-c_q8, x150, s_q8 * x151),
-                ),
-            );
-        let x163 = -0.07309 + (x155 + Self::mul_add(-x3, x154, x2 * x153));
-        let x164 = 130.43769025763282
-            + (Self::mul_add(c_q8, x154, s_q8 * x153) + x158 - x157);
-        let x165 = 0.1132
-            + Self::mul_add(
-                -0.35,
-                x146,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x155,
-                    Self::mul_add(-c_q8, x153, s_q8 * x154),
-                ),
-            );
-        let x166 = 132.47349025763282
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x156,
-                Self::mul_add(
-                    -c_q8,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x142,
-                        Self::mul_add(-c_q8, x134, s_q8 * x139),
-                    ),
-                    s_q8
-                        * Self::mul_add(
-                            -0.00000000020510342851533115,
-                            x143,
-                            Self::mul_add(-c_q8, x137, s_q8 * x140),
-                        ),
-                ),
-            );
-        let x167 = Self::mul_add(-s_q7, x146, c_q7 * x160);
-        let x168 = Self::mul_add(c_q7, x146, s_q7 * x160);
-        let x169 = Self::mul_add(-s_q7, x163, c_q7 * x159);
-        let x170 = Self::mul_add(-s_q7, x164, c_q7 * x161);
-        let x171 = x149 * -0.75;
-        let x172 = 0.75 * x149;
-        let x173 = x167 * -0.65;
-        let x174 = 0.65 * x167;
-        let x175 = Self::mul_add(x167, -0.75, Self::mul_add(-s_q7, x165, c_q7 * x162));
-        let x176 = x166 + x174;
-        let x177 = 110.5455 + x167;
-        let x178 = 180.9502499901501 + x149;
-        let x179 = Self::mul_add(x3, x135, x2 * x136);
-        let x180 = x147 - x148;
-        let x181 = Self::mul_add(-0.35, x180, x152);
-        let x182 = Self::mul_add(-0.35, x179, x155);
-        let x183 = Self::mul_add(s_q7, x180, c_q7 * x179);
-        let x184 = Self::mul_add(-s_q7, x179, c_q7 * x180);
-        let x185 = x6 * x96;
-        let x186 = Self::mul_add(-x5, x111, x185);
-        let x187 = x8 * x96;
-        let x188 = Self::mul_add(-x7, x111, x187);
-        let x189 = s_q9 * x96;
-        let x190 = Self::mul_add(c_q9, x111, x189);
-        let x191 = x123 + Self::mul_add(-0.275, x190, -0.4 * x188);
-        let x192 = Self::mul_add(0.4, x186, x126);
-        let x193 = Self::mul_add(-0.275, x186, x129);
-        let x194 = Self::mul_add(-x3, x188, x2 * x186) - x190;
-        let x195 = Self::mul_add(c_q8, x188, s_q8 * x186);
-        let x196 = Self::mul_add(
-            0.00000000020510342851533115,
-            x190,
-            Self::mul_add(-c_q8, x186, s_q8 * x188),
-        );
-        let x197 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x193,
-            Self::mul_add(-c_q8, x191, s_q8 * x192),
-        );
-        let x198 = Self::mul_add(
-            -0.35,
-            x195,
-            x193 + Self::mul_add(-x3, x192, x2 * x191),
-        );
-        let x199 = Self::mul_add(0.35, x194, Self::mul_add(c_q8, x192, s_q8 * x191));
-        let x200 = Self::mul_add(-s_q7, x195, c_q7 * x194);
-        let x201 = Self::mul_add(c_q7, x195, s_q7 * x194);
-        let x202 = Self::mul_add(-x5, x98, x185);
-        let x203 = Self::mul_add(-x7, x98, x187);
-        let x204 = Self::mul_add(c_q9, x98, x189);
-        let x205 = Self::mul_add(
-            0.00000000020510342851533115,
-            x108,
-            Self::mul_add(x6, x104, x5 * x101),
-        ) + Self::mul_add(-0.275, x204, -0.4 * x203);
-        let x206 = Self::mul_add(0.4, x202, x108 + Self::mul_add(x8, x104, x7 * x101));
-        let x207 = Self::mul_add(
-            -0.275,
-            x202,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x108,
-                Self::mul_add(-s_q9, x104, c_q9 * x101),
-            ),
-        );
-        let x208 = Self::mul_add(-x3, x203, x2 * x202) - x204;
-        let x209 = Self::mul_add(c_q8, x203, s_q8 * x202);
-        let x210 = Self::mul_add(
-            0.00000000020510342851533115,
-            x204,
-            Self::mul_add(-c_q8, x202, s_q8 * x203),
-        );
-        let x211 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x207,
-            Self::mul_add(-c_q8, x205, s_q8 * x206),
-        );
-        let x212 = Self::mul_add(
-            -0.35,
-            x209,
-            x207 + Self::mul_add(-x3, x206, x2 * x205),
-        );
-        let x213 = Self::mul_add(0.35, x208, Self::mul_add(c_q8, x206, s_q8 * x205));
-        let x214 = Self::mul_add(-s_q7, x209, c_q7 * x208);
-        let x215 = Self::mul_add(c_q7, x209, s_q7 * x208);
-        let x216 = Self::mul_add(c_q10, x73, x97);
-        let x217 = Self::mul_add(-s_q10, x73, x95);
-        let x218 = Self::mul_add(-s_q10, x84, c_q10 * x83);
-        let x219 = Self::mul_add(c_q10, x84, s_q10 * x83);
-        let x220 = Self::mul_add(-0.87, x216, x85);
-        let x221 = Self::mul_add(-x5, x216, x6 * x217);
-        let x222 = Self::mul_add(-x7, x216, x8 * x217);
-        let x223 = Self::mul_add(s_q9, x217, c_q9 * x216);
-        let x224 = Self::mul_add(
-            0.00000000020510342851533115,
-            x220,
-            Self::mul_add(x6, x219, x5 * x218),
-        ) + Self::mul_add(-0.275, x223, -0.4 * x222);
-        let x225 = Self::mul_add(0.4, x221, x220 + Self::mul_add(x8, x219, x7 * x218));
-        let x226 = Self::mul_add(
-            -0.275,
-            x221,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x220,
-                Self::mul_add(-s_q9, x219, c_q9 * x218),
-            ),
-        );
-        let x227 = Self::mul_add(-x3, x222, x2 * x221) - x223;
-        let x228 = Self::mul_add(c_q8, x222, s_q8 * x221);
-        let x229 = Self::mul_add(
-            0.00000000020510342851533115,
-            x223,
-            Self::mul_add(-c_q8, x221, s_q8 * x222),
-        );
-        let x230 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x226,
-            Self::mul_add(-c_q8, x224, s_q8 * x225),
-        );
-        let x231 = Self::mul_add(
-            -0.35,
-            x228,
-            x226 + Self::mul_add(-x3, x225, x2 * x224),
-        );
-        let x232 = Self::mul_add(0.35, x227, Self::mul_add(c_q8, x225, s_q8 * x224));
-        let x233 = Self::mul_add(-s_q7, x228, c_q7 * x227);
-        let x234 = Self::mul_add(c_q7, x228, s_q7 * x227);
-        let x235 = Self::mul_add(-x12, x36, x13 * x35);
-        let x236 = x46 - x45;
-        let x237 = Self::mul_add(0.36, x235, x53);
-        let x238 = Self::mul_add(0.36, x49, x56);
-        let x239 = Self::mul_add(s_q11, x235, c_q11 * x49);
-        let x240 = Self::mul_add(-s_q11, x49, c_q11 * x235);
-        let x241 = Self::mul_add(-s_q11, x238, c_q11 * x237)
-            + Self::mul_add(-0.63, x236, 0.275 * x240);
-        let x242 = Self::mul_add(0.275, x239, Self::mul_add(c_q11, x238, s_q11 * x237));
-        let x243 = Self::mul_add(-0.63, x239, x59);
-        let x244 = Self::mul_add(s_q10, x240, c_q10 * x239);
-        let x245 = Self::mul_add(-s_q10, x239, c_q10 * x240);
-        let x246 = Self::mul_add(c_q10, x242, s_q10 * x241);
-        let x247 = Self::mul_add(-0.87, x236, Self::mul_add(-s_q10, x242, c_q10 * x241));
-        let x248 = Self::mul_add(-0.87, x244, x243);
-        let x249 = Self::mul_add(
-            0.00000000020510342851533115,
-            x236,
-            Self::mul_add(-x5, x244, x6 * x245),
-        );
-        let x250 = x236 + Self::mul_add(-x7, x244, x8 * x245);
-        let x251 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x236,
-            -Self::mul_add(s_q9, x245, c_q9 * x244),
-        );
-        let x252 = Self::mul_add(
-            0.00000000020510342851533115,
-            x248,
-            Self::mul_add(x6, x246, x5 * x247),
-        ) + Self::mul_add(0.275, x251, -0.4 * x250);
-        let x253 = Self::mul_add(0.4, x249, x248 + Self::mul_add(x8, x246, x7 * x247));
-        let x254 = Self::mul_add(
-            -0.275,
-            x249,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x248,
-                Self::mul_add(-s_q9, x246, c_q9 * x247),
-            ),
-        );
-        let x255 = x251 + Self::mul_add(-x3, x250, x2 * x249);
-        let x256 = Self::mul_add(c_q8, x250, s_q8 * x249);
-        let x257 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x251,
-            Self::mul_add(-c_q8, x249, s_q8 * x250),
-        );
-        let x258 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x254,
-            Self::mul_add(-c_q8, x252, s_q8 * x253),
-        );
-        let x259 = Self::mul_add(
-            -0.35,
-            x256,
-            x254 + Self::mul_add(-x3, x253, x2 * x252),
-        );
-        let x260 = Self::mul_add(0.35, x255, Self::mul_add(c_q8, x253, s_q8 * x252));
-        let x261 = Self::mul_add(-s_q7, x256, c_q7 * x255);
-        let x262 = Self::mul_add(c_q7, x256, s_q7 * x255);
-        let x263 = x15 * -4.806620000000001;
-        let x264 = s_q13 * -4.806620000000001;
-        let x265 = c_q13 * -4.806620000000001;
-        let x266 = x22 + Self::mul_add(-0.55, x265, -0.16 * x264);
-        let x267 = Self::mul_add(0.16, x263, x26);
-        let x268 = Self::mul_add(-0.55, x263, x29);
-        let x269 = Self::mul_add(-s_q12, x264, c_q12 * x263);
-        let x270 = Self::mul_add(x13, x264, x12 * x263) - x265;
-        let x271 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x265,
-            Self::mul_add(c_q12, x264, s_q12 * x263),
-        );
-        let x272 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x268,
-            -Self::mul_add(c_q12, x267, s_q12 * x266),
-        );
-        let x273 = Self::mul_add(0.36, x270, Self::mul_add(-s_q12, x267, c_q12 * x266));
-        let x274 = Self::mul_add(
-            -0.36,
-            x269,
-            x268 + Self::mul_add(x13, x267, x12 * x266),
-        );
-        let x275 = Self::mul_add(-s_q11, x270, c_q11 * x269);
-        let x276 = Self::mul_add(c_q11, x270, s_q11 * x269);
-        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
-            + Self::mul_add(0.63, x271, 0.275 * x276);
-        let x278 = Self::mul_add(-0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
-        let x279 = Self::mul_add(0.63, x275, x272);
-        let x280 = Self::mul_add(-s_q10, x276, c_q10 * x275);
-        let x281 = Self::mul_add(c_q10, x276, s_q10 * x275);
-        let x282 = Self::mul_add(c_q10, x278, s_q10 * x277);
-        let x283 = Self::mul_add(0.87, x271, Self::mul_add(-s_q10, x278, c_q10 * x277));
-        let x284 = Self::mul_add(0.87, x280, x279);
-        let x285 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x271,
-            Self::mul_add(x6, x281, x5 * x280),
-        );
-        let x286 = Self::mul_add(x8, x281, x7 * x280) - x271;
-        let x287 = Self::mul_add(
-            0.00000000020510342851533115,
-            x271,
-            Self::mul_add(-s_q9, x281, c_q9 * x280),
-        );
-        let x288 = Self::mul_add(
-            0.00000000020510342851533115,
-            x284,
-            Self::mul_add(x6, x282, x5 * x283),
-        ) + Self::mul_add(0.275, x287, -0.4 * x286);
-        let x289 = Self::mul_add(0.4, x285, x284 + Self::mul_add(x8, x282, x7 * x283));
-        let x290 = Self::mul_add(
-            -0.275,
-            x285,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x284,
-                Self::mul_add(-s_q9, x282, c_q9 * x283),
-            ),
-        );
-        let x291 = x287 + Self::mul_add(-x3, x286, x2 * x285);
-        let x292 = Self::mul_add(c_q8, x286, s_q8 * x285);
-        let x293 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x287,
-            Self::mul_add(-c_q8, x285, s_q8 * x286),
-        );
-        let x294 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x290,
-            Self::mul_add(-c_q8, x288, s_q8 * x289),
-        );
-        let x295 = Self::mul_add(
-            -0.35,
-            x292,
-            x290 + Self::mul_add(-x3, x289, x2 * x288),
-        );
-        let x296 = Self::mul_add(0.35, x291, Self::mul_add(c_q8, x289, s_q8 * x288));
-        let x297 = Self::mul_add(-s_q7, x292, c_q7 * x291);
-        let x298 = Self::mul_add(c_q7, x292, s_q7 * x291);
-        let x299 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x300 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x301 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x302 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x303 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x304 = v[4] * v[4];
-        let x305 = Self::mul_add(v[5], v[5], x304);
-        let x306 = v[3] * v[4];
-        let x307 = v[3] * v[5];
-        let x308 = v[4] * v[5];
-        let x309 = Self::mul_add(v[3], v[3], x304);
-        let x310 = x299 + Self::mul_add(-0.65, x305, 0.75 * x307);
-        let x311 = x300 + Self::mul_add(0.75, x308, 0.65 * x306);
-        let x312 = x301 + Self::mul_add(-0.75, x309, 0.65 * x307);
-        let x313 = Self::mul_add(-s_q7, x310, c_q7 * x311);
-        let x314 = v[6] * x303;
-        let x315 = v[6] * x302;
-        let x316 = v[5] + v[6];
-        let x317 = x303 * x303;
-        let x318 = x302 * x316;
-        let x319 = Self::mul_add(-16.80768997608804, x316, -0.07309 * x303);
-        let x320 = Self::mul_add(
-            0.1132,
-            x316,
-            Self::mul_add(130.43769025763282, x303, -0.07309 * x302),
-        );
-        let x321 = Self::mul_add(
-            132.47349025763282,
-            x316,
-            Self::mul_add(0.1132, x303, -16.80768997608804 * x302),
-        );
-        let x322 = Self::mul_add(-c_q8, x316, Self::mul_add(s_q8, x303, x2 * x302));
-        let x323 = Self::mul_add(s_q8, x316, Self::mul_add(-x3, x302, c_q8 * x303));
-        let x324 = Self::mul_add(
-            0.35,
-            x318 - x315,
-            Self::mul_add(s_q7, x311, c_q7 * x310),
-        );
-        let x325 = Self::mul_add(0.35, Self::mul_add(x303, x316, -x314), x313);
-        let x326 = Self::mul_add(-0.35, Self::mul_add(x302, x302, x317), x312);
-        let x327 = Self::mul_add(-c_q8, x326, Self::mul_add(s_q8, x325, x2 * x324));
-        let x328 = Self::mul_add(s_q8, x326, Self::mul_add(-x3, x324, c_q8 * x325));
-        let x329 = Self::mul_add(-0.00000000020510342851533115, x326, x324);
-        let x330 = Self::mul_add(v[7], x323, Self::mul_add(-s_q8, x315, x2 * x314));
-        let x331 = Self::mul_add(v[7], x322, Self::mul_add(c_q8, x315, x3 * x314));
-        let x332 = v[7] + Self::mul_add(-0.00000000020510342851533115, x316, x302);
-        let x333 = x323 * x323;
-        let x334 = x332 * x332;
-        let x335 = x322 * x323;
-        let x336 = x335 - x314;
-        let x337 = x322 * x332;
-        let x338 = x322 * x322;
-        let x339 = x334 + x338;
-        let x340 = x323 * x332;
-        let x341 = x330 + x340;
-        let x342 = Self::mul_add(
-            -0.0021399965876409276,
-            x332,
-            -0.0000000234896432582596 * x323,
-        );
-        let x343 = Self::mul_add(
-            5.080660024070365,
-            x332,
-            Self::mul_add(-111.7548902508081, x323, -0.0000000234896432582596 * x322),
-        );
-        let x344 = Self::mul_add(
-            113.3918902508081,
-            x332,
-            Self::mul_add(5.080660024070366, x323, -0.0021399965876409276 * x322),
-        );
-        let x345 = Self::mul_add(c_q9, x332, Self::mul_add(x7, x323, x5 * x322));
-        let x346 = Self::mul_add(-s_q9, x332, Self::mul_add(x8, x323, x6 * x322));
-        let x347 = x327 + Self::mul_add(0.4, x337 - x331, 0.275 * x336);
-        let x348 = x328 + Self::mul_add(-0.275, x339, 0.4 * (x340 - x330));
-        let x349 = x329 + Self::mul_add(-0.4, x333 + x338, 0.275 * x341);
-        let x350 = Self::mul_add(c_q9, x349, Self::mul_add(x7, x348, x5 * x347));
-        let x351 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x349,
-            Self::mul_add(0.00000000020510342851533115, x347, x348),
-        );
-        let x352 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x314,
-            Self::mul_add(0.00000000020510342851533115, x330, -x331),
-        );
-        let x353 = Self::mul_add(
-            v[8],
-            x346,
-            Self::mul_add(c_q9, x314, Self::mul_add(-x7, x331, x5 * x330)),
-        );
-        let x354 = Self::mul_add(
-            -v[8],
-            x345,
-            Self::mul_add(-s_q9, x314, Self::mul_add(-x8, x331, x6 * x330)),
-        );
-        let x355 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x332,
-                Self::mul_add(0.00000000020510342851533115, x322, x323),
-            );
-        let x356 = Self::mul_add(x345, x346, -x352);
-        let x357 = Self::mul_add(x345, x345, x355 * x355);
-        let x358 = Self::mul_add(x346, x355, x353);
-        let x359 = -0.00214 * x355;
-        let x360 = Self::mul_add(-36.18604050126307, x355, -63.36336825000001 * x346);
-        let x361 = Self::mul_add(
-            69.99836825,
-            x355,
-            Self::mul_add(-36.18604050126307, x346, -0.00214 * x345),
-        );
-        let x362 = Self::mul_add(s_q10, x346, c_q10 * x345);
-        let x363 = Self::mul_add(-s_q10, x345, c_q10 * x346);
-        let x364 = Self::mul_add(-0.87, x356, x350);
-        let x365 = Self::mul_add(
-            0.87,
-            x357,
-            Self::mul_add(-s_q9, x349, Self::mul_add(x8, x348, x6 * x347)),
-        );
-        let x366 = Self::mul_add(-0.87, x358, x351);
-        let x367 = Self::mul_add(s_q10, x365, c_q10 * x364);
-        let x368 = Self::mul_add(v[9], x363, Self::mul_add(s_q10, x354, c_q10 * x353));
-        let x369 = Self::mul_add(-v[9], x362, Self::mul_add(-s_q10, x353, c_q10 * x354));
-        let x370 = v[9] + x355;
-        let x371 = Self::mul_add(x362, x363, -x352);
-        let x372 = x362 * x362;
-        let x373 = Self::mul_add(x370, x370, x372);
-        let x374 = x363 * x370;
-        let x375 = x368 + x374;
-        let x376 = -0.6328 * x370;
-        let x377 = Self::mul_add(-24.35164200091464, x370, -24.4950615 * x363);
-        let x378 = Self::mul_add(
-            28.2393615,
-            x370,
-            Self::mul_add(-24.351642000914637, x363, -0.6328 * x362),
-        );
-        let x379 = Self::mul_add(s_q11, x363, c_q11 * x362);
-        let x380 = Self::mul_add(-s_q11, x362, c_q11 * x363);
-        let x381 = x367
-            + Self::mul_add(-0.275, Self::mul_add(x362, x370, x369), -0.63 * x371);
-        let x382 = Self::mul_add(-s_q10, x364, c_q10 * x365)
-            + Self::mul_add(0.63, x373, -0.275 * (x374 - x368));
-        let x383 = x366
-            + Self::mul_add(0.275, Self::mul_add(x363, x363, x372), -0.63 * x375);
-        let x384 = Self::mul_add(s_q11, x382, c_q11 * x381);
-        let x385 = Self::mul_add(v[10], x380, Self::mul_add(s_q11, x369, c_q11 * x368));
-        let x386 = Self::mul_add(
-            -v[10],
-            x379,
-            Self::mul_add(-s_q11, x368, c_q11 * x369),
-        );
-        let x387 = v[10] + x370;
-        let x388 = x379 * x379;
-        let x389 = x380 * x387;
-        let x390 = 0.01675 * x387;
-        let x391 = Self::mul_add(2.5482240016099564, x387, -9.142025249762803 * x380);
-        let x392 = Self::mul_add(
-            9.223235249762805,
-            x387,
-            Self::mul_add(2.5482240016099564, x380, 0.01675 * x379),
-        );
-        let x393 = Self::mul_add(-s_q12, x387, Self::mul_add(x12, x380, c_q12 * x379));
-        let x394 = Self::mul_add(-c_q12, x387, Self::mul_add(-s_q12, x379, x13 * x380));
-        let x395 = Self::mul_add(-0.36, Self::mul_add(x379, x387, x386), x384);
-        let x396 = Self::mul_add(
-            -0.36,
-            x389 - x385,
-            Self::mul_add(-s_q11, x381, c_q11 * x382),
-        );
-        let x397 = Self::mul_add(0.36, Self::mul_add(x380, x380, x388), x383);
-        let x398 = Self::mul_add(-s_q12, x397, Self::mul_add(x12, x396, c_q12 * x395));
-        let x399 = Self::mul_add(-c_q12, x397, Self::mul_add(-s_q12, x395, x13 * x396));
-        let x400 = Self::mul_add(-0.00000000020510342851533115, x397, x396);
-        let x401 = Self::mul_add(-0.00000000020510342851533115, x352, x386);
-        let x402 = Self::mul_add(
-            v[11],
-            x394,
-            Self::mul_add(-s_q12, x352, Self::mul_add(x12, x386, c_q12 * x385)),
-        );
-        let x403 = Self::mul_add(
-            -v[11],
-            x393,
-            Self::mul_add(-c_q12, x352, Self::mul_add(-s_q12, x385, x13 * x386)),
-        );
-        let x404 = v[11] + Self::mul_add(-0.00000000020510342851533115, x387, x380);
-        let x405 = x394 * x394;
-        let x406 = x404 * x404;
-        let x407 = x393 * x394;
-        let x408 = x407 - x401;
-        let x409 = x393 * x404;
-        let x410 = x393 * x393;
-        let x411 = x406 + x410;
-        let x412 = x394 * x404;
-        let x413 = x402 + x412;
-        let x414 = Self::mul_add(-0.809539999555672, x404, -1.9877000000000002 * x394);
-        let x415 = Self::mul_add(
-            -2.741639999592316,
-            x404,
-            Self::mul_add(-5.252920330000002, x394, -1.9877000000000002 * x393),
-        );
-        let x416 = Self::mul_add(
-            9.740442170000001,
-            x404,
-            Self::mul_add(-2.7416399995923166, x394, -0.809539999555672 * x393),
-        );
-        let x417 = Self::mul_add(-c_q13, x404, Self::mul_add(s_q13, x394, x15 * x393));
-        let x418 = Self::mul_add(s_q13, x404, Self::mul_add(-x16, x393, c_q13 * x394));
-        let x419 = x398 + Self::mul_add(0.16, x403 + x409, 0.55 * x408);
-        let x420 = x400 + Self::mul_add(-0.16, x405 + x410, 0.55 * x413);
-        let x421 = Self::mul_add(-0.00000000020510342851533115, x401, x402);
-        let x422 = Self::mul_add(
-            v[12],
-            x418,
-            Self::mul_add(-c_q13, x401, Self::mul_add(s_q13, x403, x15 * x402)),
-        );
-        let x423 = Self::mul_add(
-            -v[12],
-            x417,
-            Self::mul_add(s_q13, x401, Self::mul_add(-x16, x402, c_q13 * x403)),
-        );
-        let x424 = v[12] + Self::mul_add(-0.00000000020510342851533115, x404, x393);
-        let x425 = 4.806620000000001 * Self::mul_add(x417, x418, -x421);
-        let x426 = 4.806620000000001 * Self::mul_add(x417, x417, x424 * x424);
-        let x427 = 4.806620000000001 * Self::mul_add(x418, x424, x422);
-        let x428 = Self::mul_add(-0.0145, x424, 0.000781 * x418);
-        let x429 = Self::mul_add(
-            -0.9614610000000001,
-            x424,
-            Self::mul_add(-1.2025609200000003, x418, 0.000781 * x417),
-        );
-        let x430 = Self::mul_add(
-            1.4135609200000003,
-            x424,
-            Self::mul_add(-0.9614610000000001, x418, -0.0145 * x417),
-        );
-        let x431 = Self::mul_add(
-            -0.9614610000000001,
-            x421,
-            Self::mul_add(-1.2025609200000003, x423, 0.000781 * x422),
-        ) + Self::mul_add(-x417, x430, x424 * x428);
-        let x432 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x420, x419),
-            Self::mul_add(-0.0145, x421, 0.000781 * x423)
-                + Self::mul_add(-x424, x429, x418 * x430),
-        );
-        let x433 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(
-                -c_q13,
-                x420,
-                Self::mul_add(
-                    s_q13,
-                    x399 + Self::mul_add(-0.55, x411, 0.16 * (x412 - x402)),
-                    x15 * x419,
-                ),
-            ),
-            Self::mul_add(
-                1.4135609200000003,
-                x421,
-                Self::mul_add(-0.9614610000000001, x423, -0.0145 * x422),
-            ) + Self::mul_add(-x418, x428, x417 * x429),
-        );
-        let x434 = x427 + Self::mul_add(x16, x426, x15 * x425);
-        let x435 = Self::mul_add(-c_q13, x426, s_q13 * x425);
-        let x436 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x427,
-            -Self::mul_add(s_q13, x426, c_q13 * x425),
-        );
-        let x437 = Self::mul_add(
-            -3.6140000000000003,
-            x405 + x406,
-            17.135250000000003 * x408,
-        ) + x434;
-        let x438 = Self::mul_add(
-            -17.135250000000003,
-            x411,
-            3.6140000000000003 * (x401 + x407),
-        ) + x435;
-        let x439 = Self::mul_add(
-            17.135250000000003,
-            x413,
-            3.6140000000000003 * (x409 - x403),
-        ) + x436;
-        let x440 = Self::mul_add(
-            17.135250000000003,
-            x400,
-            Self::mul_add(-0.809539999555672, x401, -1.9877000000000002 * x403)
-                + Self::mul_add(-x404, x415, x394 * x416),
-        )
-            + (x433 + Self::mul_add(-x16, x431, x15 * x432)
-                + Self::mul_add(0.55, x436, -0.16 * x435));
-        let x441 = Self::mul_add(
-            x400,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x401,
-                Self::mul_add(-5.252920330000002, x403, -1.9877000000000002 * x402),
-            ) + Self::mul_add(-x393, x416, x404 * x414),
-        ) + Self::mul_add(0.16, x434, Self::mul_add(c_q13, x431, s_q13 * x432));
-        let x442 = Self::mul_add(
-            9.740442170000001,
-            x401,
-            Self::mul_add(-2.7416399995923166, x403, -0.809539999555672 * x402),
-        ) + Self::mul_add(-x394, x414, x393 * x415)
-            + Self::mul_add(3.6140000000000003, x399, x398 * -17.135250000000003)
-            + Self::mul_add(
-                -0.55,
-                x434,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x433,
-                    Self::mul_add(-c_q13, x432, s_q13 * x431),
-                ),
-            );
-        let x443 = Self::mul_add(-s_q12, x438, c_q12 * x437);
-        let x444 = x439 + Self::mul_add(x13, x438, x12 * x437);
-        let x445 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x379, x380, -x352),
-            x443,
-        );
-        let x446 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x387, x387, x388),
-            x444,
-        );
-        let x447 = Self::mul_add(
-            7.078399999258757,
-            x385 + x389,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x439,
-                -Self::mul_add(c_q12, x438, s_q12 * x437),
-            ),
-        );
-        let x448 = Self::mul_add(
-            7.078399999258757,
-            x383,
-            Self::mul_add(0.01675, x352, Self::mul_add(-x387, x391, x380 * x392)),
-        ) + Self::mul_add(0.36, x444, Self::mul_add(-s_q12, x441, c_q12 * x440));
-        let x449 = Self::mul_add(2.5482240016099564, x352, -9.142025249762803 * x386)
-            + Self::mul_add(-x379, x392, x387 * x390)
-            + Self::mul_add(-0.36, x443, x442 + Self::mul_add(x13, x441, x12 * x440));
-        let x450 = Self::mul_add(
-            x384,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x352,
-                Self::mul_add(2.5482240016099564, x386, 0.01675 * x385),
-            ) + Self::mul_add(-x380, x390, x379 * x391),
-        )
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x442,
-                -Self::mul_add(c_q12, x441, s_q12 * x440),
-            );
-        let x451 = Self::mul_add(-s_q11, x446, c_q11 * x445);
-        let x452 = Self::mul_add(c_q11, x446, s_q11 * x445);
-        let x453 = Self::mul_add(-45.1584, x371, x451);
-        let x454 = Self::mul_add(45.1584, x373, x452);
-        let x455 = Self::mul_add(-45.1584, x375, x447);
-        let x456 = Self::mul_add(
-            -45.1584,
-            x366,
-            Self::mul_add(-0.6328, x352, Self::mul_add(-x370, x377, x363 * x378)),
-        )
-            + (Self::mul_add(-s_q11, x449, c_q11 * x448)
-                + Self::mul_add(-0.63, x447, 0.275 * x452));
-        let x457 = Self::mul_add(-24.35164200091464, x352, -24.4950615 * x369)
-            + Self::mul_add(-x362, x378, x370 * x376)
-            + Self::mul_add(-0.275, x451, Self::mul_add(c_q11, x449, s_q11 * x448));
-        let x458 = Self::mul_add(
-            x367,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x352,
-                Self::mul_add(-24.351642000914637, x369, -0.6328 * x368),
-            ) + Self::mul_add(-x363, x376, x362 * x377),
-        ) + Self::mul_add(0.63, x451, x450);
-        let x459 = Self::mul_add(-s_q10, x454, c_q10 * x453);
-        let x460 = Self::mul_add(-81.53205, x356, x459);
-        let x461 = Self::mul_add(
-            81.53205,
-            x357,
-            Self::mul_add(c_q10, x454, s_q10 * x453),
-        );
-        let x462 = Self::mul_add(-81.53205, x358, x455);
-        let x463 = Self::mul_add(
-            -81.53205,
-            x351,
-            Self::mul_add(-0.00214, x352, Self::mul_add(-x355, x360, x346 * x361)),
-        ) + Self::mul_add(-0.87, x455, Self::mul_add(-s_q10, x457, c_q10 * x456));
-        let x464 = Self::mul_add(-36.18604050126307, x352, -63.36336825000001 * x354)
-            + Self::mul_add(-x345, x361, x355 * x359)
-            + Self::mul_add(c_q10, x457, s_q10 * x456);
-        let x465 = Self::mul_add(
-            x350,
+        let x61 = Self::mul_add(-36.18604050126307, x60, -63.36336825000001 * x49);
+        let x62 = Self::mul_add(-81.53205, x55, -0.00214 * x60);
+        let x63 = Self::mul_add(
+            x53,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x352,
-                Self::mul_add(-36.18604050126307, x354, -0.00214 * x353),
-            ) + Self::mul_add(-x346, x359, x345 * x360),
-        ) + Self::mul_add(0.87, x459, x458);
-        let x466 = Self::mul_add(
-            0.00000000020510342851533115,
-            x462,
-            Self::mul_add(x6, x461, x5 * x460),
+                x60,
+                Self::mul_add(-36.18604050126307, x49, -0.00214 * x48),
+            ),
         );
-        let x467 = x462 + Self::mul_add(x8, x461, x7 * x460);
-        let x468 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x462,
-            Self::mul_add(-s_q9, x461, c_q9 * x460),
-        );
-        let x469 = Self::mul_add(
-            0.000000008530897668050218,
-            x333 + x334,
-            -12.701650001451807 * x336,
-        ) + x466;
-        let x470 = Self::mul_add(
-            12.701650001451807,
-            x339,
-            -0.000000008530897668050218 * (x314 + x335),
-        ) + x467;
-        let x471 = Self::mul_add(
-            -12.701650001451807,
-            x341,
-            -0.000000008530897668050218 * (x331 + x337),
-        ) + x468;
-        let x472 = Self::mul_add(
-            -12.701650001451807,
-            x329,
-            Self::mul_add(0.0000000234896432582596, x331, -0.0021399965876409276 * x314)
-                + Self::mul_add(-x332, x343, x323 * x344),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x465,
-                Self::mul_add(x6, x464, x5 * x463),
-            ) + Self::mul_add(0.275, x468, -0.4 * x467));
-        let x473 = Self::mul_add(
-            x329,
-            0.000000008530897668050218,
+        let x64 = -81.53205 * x60;
+        let x65 = x48 * 81.53205;
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x67 = Self::mul_add(x49, s_q10, x48 * c_q10);
+        let x68 = Self::mul_add(-x48, s_q10, x49 * c_q10);
+        let x69 = Self::mul_add(0.87, x60, x53);
+        let x70 = Self::mul_add(x48, -0.87, x55);
+        let x71 = Self::mul_add(x54, s_q10, c_q10 * x69);
+        let x72 = Self::mul_add(-s_q10, x69, x54 * c_q10);
+        let x73 = v[9] * x68;
+        let x74 = v[9] * x67;
+        let x75 = v[9] * x72;
+        let x76 = v[9] * x71;
+        let x77 = v[9] + x60;
+        let x78 = Self::mul_add(-24.35164200091464, x77, -24.4950615 * x68);
+        let x79 = Self::mul_add(-45.1584, x70, -0.6328 * x77);
+        let x80 = Self::mul_add(
+            x71,
+            45.1584,
             Self::mul_add(
-                5.080660024070365,
-                x314,
-                Self::mul_add(111.7548902508081, x331, -0.0000000234896432582596 * x330),
-            ) + Self::mul_add(-x322, x344, x332 * x342),
-        ) + Self::mul_add(0.4, x466, x465 + Self::mul_add(x8, x464, x7 * x463));
-        let x474 = Self::mul_add(
-            113.3918902508081,
-            x314,
-            Self::mul_add(-5.080660024070366, x331, -0.0021399965876409276 * x330),
-        ) + Self::mul_add(-x323, x342, x322 * x343)
-            + Self::mul_add(-0.000000008530897668050218, x328, x327 * 12.701650001451807)
+                28.2393615,
+                x77,
+                Self::mul_add(-24.351642000914637, x68, -0.6328 * x67),
+            ),
+        );
+        let x81 = -45.1584 * x77;
+        let x82 = x67 * 45.1584;
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x84 = Self::mul_add(x68, s_q11, x67 * c_q11);
+        let x85 = Self::mul_add(-x67, s_q11, x68 * c_q11);
+        let x86 = x71 - Self::mul_add(-0.63, x77, 0.275 * x68);
+        let x87 = Self::mul_add(0.275, x67, x72);
+        let x88 = Self::mul_add(x67, -0.63, x70);
+        let x89 = Self::mul_add(s_q11, x87, c_q11 * x86);
+        let x90 = Self::mul_add(-s_q11, x86, c_q11 * x87);
+        let x91 = v[10] * x85;
+        let x92 = v[10] * x84;
+        let x93 = v[10] * x90;
+        let x94 = v[10] * x89;
+        let x95 = v[10] + x77;
+        let x96 = Self::mul_add(2.5482240016099564, x95, -9.142025249762803 * x85);
+        let x97 = Self::mul_add(7.078399999258757, x88, 0.01675 * x95);
+        let x98 = Self::mul_add(
+            x89,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x95,
+                Self::mul_add(2.5482240016099564, x85, 0.01675 * x84),
+            ),
+        );
+        let x99 = 7.078399999258757 * x95;
+        let x100 = x84 * -7.078399999258757;
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x102 = -0.00000000020510342851533115 * s_q12;
+        let x103 = -0.00000000020510342851533115 * c_q12;
+        let x104 = Self::mul_add(-x95, s_q12, Self::mul_add(x85, x102, x84 * c_q12));
+        let x105 = Self::mul_add(-x95, c_q12, Self::mul_add(-x84, s_q12, x85 * x103));
+        let x106 = Self::mul_add(x85, -0.36, x89);
+        let x107 = Self::mul_add(0.36, x84, x90);
+        let x108 = Self::mul_add(-x88, s_q12, Self::mul_add(x102, x107, c_q12 * x106));
+        let x109 = Self::mul_add(-x88, c_q12, Self::mul_add(-s_q12, x106, x103 * x107));
+        let x110 = Self::mul_add(-0.00000000020510342851533115, x88, x107);
+        let x111 = v[11] * x105;
+        let x112 = v[11] * x104;
+        let x113 = v[11] * x109;
+        let x114 = v[11] * x108;
+        let x115 = v[11] + Self::mul_add(-0.00000000020510342851533115, x95, x85);
+        let x116 = Self::mul_add(
+            17.135250000000003,
+            x110,
+            Self::mul_add(-0.809539999555672, x115, -1.9877000000000002 * x105),
+        );
+        let x117 = Self::mul_add(
+            x110,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x115,
+                Self::mul_add(-5.252920330000002, x105, -1.9877000000000002 * x104),
+            ),
+        );
+        let x118 = Self::mul_add(
+            9.740442170000001,
+            x115,
+            Self::mul_add(-2.7416399995923166, x105, -0.809539999555672 * x104),
+        ) + Self::mul_add(3.6140000000000003, x109, x108 * -17.135250000000003);
+        let x119 = 17.135250000000003 * x115;
+        let x120 = x115 * -3.6140000000000003;
+        let x121 = Self::mul_add(3.6140000000000003, x105, x104 * -17.135250000000003);
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x123 = -0.00000000020510342851533115 * c_q13;
+        let x124 = -0.00000000020510342851533115 * s_q13;
+        let x125 = Self::mul_add(-x115, c_q13, Self::mul_add(x105, s_q13, x104 * x123));
+        let x126 = Self::mul_add(x115, s_q13, Self::mul_add(-x104, x124, x105 * c_q13));
+        let x127 = x108 - Self::mul_add(0.55, x115, -0.16 * x105);
+        let x128 = Self::mul_add(-0.16, x104, x109);
+        let x129 = Self::mul_add(x104, 0.55, x110);
+        let x130 = Self::mul_add(-c_q13, x129, Self::mul_add(s_q13, x128, x123 * x127));
+        let x131 = Self::mul_add(s_q13, x129, Self::mul_add(-x124, x127, c_q13 * x128));
+        let x132 = Self::mul_add(-0.00000000020510342851533115, x129, x127);
+        let x133 = v[12] * x126;
+        let x134 = v[12] * x125;
+        let x135 = v[12] * x131;
+        let x136 = v[12] + Self::mul_add(-0.00000000020510342851533115, x115, x104);
+        let x137 = Self::mul_add(
+            -0.9614610000000001,
+            x136,
+            Self::mul_add(-1.2025609200000003, x126, 0.000781 * x125),
+        );
+        let x138 = Self::mul_add(
+            4.806620000000001,
+            x132,
+            Self::mul_add(-0.0145, x136, 0.000781 * x126),
+        );
+        let x139 = Self::mul_add(
+            x130,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x136,
+                Self::mul_add(-0.9614610000000001, x126, -0.0145 * x125),
+            ),
+        );
+        let x140 = 4.806620000000001 * x136;
+        let x141 = x125 * -4.806620000000001;
+        let x142 = Self::mul_add(x131, x140, Self::mul_add(-x126, x138, x125 * x137));
+        let x143 = Self::mul_add(-x136, x140, x125 * x141);
+        let x144 = tau[6] - x142;
+        let x145 = Self::mul_add(
+            -x126,
+            x141,
+            Self::mul_add(
+                x135,
+                -16.344251950881606,
+                Self::mul_add(x134, 3.2693162398830324, x133 * -0.049305260929256585),
+            ),
+        );
+        let x146 = Self::mul_add(4.806620000000001, x133, x126 * x140);
+        let x147 = Self::mul_add(
+            x144,
+            -0.010257782169020348,
+            Self::mul_add(-x131, x141, Self::mul_add(-x136, x137, x126 * x139))
+                + Self::mul_add(
+                    x135,
+                    -0.049305260929256585,
+                    Self::mul_add(
+                        x134,
+                        0.009081457502008472,
+                        x133 * -0.00014873784145079505,
+                    ),
+                ),
+        );
+        let x148 = Self::mul_add(
+            x144,
+            -0.6801694828971361,
+            Self::mul_add(-x125, x139, x136 * x138)
+                + Self::mul_add(-x132, x140, x130 * x141)
+                + Self::mul_add(
+                    x135,
+                    -3.2693162398830324,
+                    Self::mul_add(x134, 1.8565173511957638, x133 * -0.009081457502008472),
+                ),
+        );
+        let x149 = x142 + x144;
+        let x150 = Self::mul_add(x144, -3.4003628227073506, x145);
+        let x151 = c_q13 * -0.009081457502008472;
+        let x152 = Self::mul_add(s_q13, -0.00014873784145079505, x151);
+        let x153 = s_q13 * -0.009081457502008472;
+        let x154 = Self::mul_add(c_q13, 0.00014873784145079505, x153);
+        let x155 = Self::mul_add(c_q13, -1.8565173511957638, x153);
+        let x156 = Self::mul_add(s_q13, -1.8565173511957638, -x151);
+        let x157 = Self::mul_add(x123, -0.049305260929256585, 4.806620000000001);
+        let x158 = s_q13 * -0.049305260929256585;
+        let x159 = Self::mul_add(
+            c_q13,
+            0.049305260929256585,
+            -0.0000000009858542415703612,
+        );
+        let x160 = x123 * -3.2693162398830324;
+        let x161 = s_q13 * -3.2693162398830324;
+        let x162 = c_q13 * -3.2693162398830324;
+        let x163 = Self::mul_add(-x124, x160, x123 * x157);
+        let x164 = Self::mul_add(-x124, x161, x123 * x158);
+        let x165 = Self::mul_add(x124, x162, x123 * x159);
+        let x166 = Self::mul_add(c_q13, x160, s_q13 * x157);
+        let x167 = Self::mul_add(-c_q13, x157, s_q13 * x160);
+        let x168 = s_q13 * -16.344251950881606;
+        let x169 = c_q13 * -16.344251950881606;
+        let x170 = x123 * (x123 * -16.344251950881606);
+        let x171 = x123 * x168;
+        let x172 = x123 * x169;
+        let x173 = s_q13 * x168;
+        let x174 = s_q13 * x169;
+        let x175 = c_q13 * x169;
+        let x176 = x164 + Self::mul_add(-0.55, x174, -0.16 * x173);
+        let x177 = x165 + Self::mul_add(0.16, x174, 0.55 * x175);
+        let x178 = Self::mul_add(0.16, x170, x166);
+        let x179 = Self::mul_add(0.16, x171, Self::mul_add(c_q13, x161, s_q13 * x158));
+        let x180 = Self::mul_add(-0.16, x172, Self::mul_add(-c_q13, x162, s_q13 * x159));
+        let x181 = Self::mul_add(-0.55, x170, x167);
+        let x182 = Self::mul_add(-0.55, x171, Self::mul_add(-c_q13, x158, s_q13 * x161));
+        let x183 = Self::mul_add(-0.55, x172, Self::mul_add(s_q13, x162, c_q13 * x159));
+        let x184 = Self::mul_add(
+            0.16,
+            x166,
+            Self::mul_add(0.16, x178, Self::mul_add(c_q13, x155, s_q13 * x152)),
+        );
+        let x185 = Self::mul_add(
+            -0.55,
+            x166,
+            Self::mul_add(0.16, x181, Self::mul_add(c_q13, x156, s_q13 * x154)),
+        );
+        let x186 = Self::mul_add(
+            -0.55,
+            x167,
+            Self::mul_add(-0.55, x181, Self::mul_add(-c_q13, x154, s_q13 * x156)),
+        );
+        let x187 = x146 + Self::mul_add(-x124, x143, x123 * x150);
+        let x188 = Self::mul_add(c_q13, x143, s_q13 * x150);
+        let x189 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x146,
+            Self::mul_add(-c_q13, x150, s_q13 * x143),
+        );
+        let x190 = Self::mul_add(
+            -0.55,
+            x187,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x149,
+                Self::mul_add(-c_q13, x147, s_q13 * x148),
+            ),
+        );
+        let x191 = -0.809539999555672
+            + Self::mul_add(
+                -0.55,
+                x163,
+                Self::mul_add(-x124, x156, x123 * x154)
+                    + Self::mul_add(-0.55, x183, -0.16 * x182),
+            );
+        let x192 = -2.741639999592316 + x185;
+        let x193 = 9.740442170000001 + x186;
+        let x194 = -17.135250000000003 + x181;
+        let x195 = 3.6140000000000003 + x182;
+        let x196 = Self::mul_add(-x105, x116, x104 * x117)
+            + Self::mul_add(-x108, x120, x109 * x119) + x190;
+        let x197 = 1.0 / x193;
+        let x198 = tau[5] - x196;
+        let x199 = x191 * x197;
+        let x200 = x192 * x197;
+        let x201 = x194 * x197;
+        let x202 = x195 * x197;
+        let x203 = x183 * x197;
+        let x204 = Self::mul_add(
+            -x191,
+            x199,
+            Self::mul_add(0.55, x165, -0.16 * x164)
+                + (Self::mul_add(
+                    -x124,
+                    Self::mul_add(
+                        x124,
+                        1.8565173511957638,
+                        x123 * -0.009081457502008472,
+                    ),
+                    x123
+                        * Self::mul_add(
+                            x124,
+                            0.009081457502008472,
+                            x123 * -0.00014873784145079505,
+                        ),
+                ) + Self::mul_add(0.55, x177, -0.16 * x176)),
+        );
+        let x205 = Self::mul_add(
+            -x191,
+            x200,
+            -1.9877000000000002
+                + Self::mul_add(
+                    0.16,
+                    x163,
+                    Self::mul_add(-x124, x155, x123 * x152)
+                        + Self::mul_add(0.55, x180, -0.16 * x179),
+                ),
+        );
+        let x206 = Self::mul_add(-x192, x200, -5.252920330000002 + x184);
+        let x207 = Self::mul_add(
+            -x191,
+            x201,
+            x163 + Self::mul_add(-0.55, x172, -0.16 * x171),
+        );
+        let x208 = Self::mul_add(-x191, x202, x176);
+        let x209 = Self::mul_add(x191, x203, 17.135250000000003 + x177);
+        let x210 = Self::mul_add(-x192, x201, x178);
+        let x211 = Self::mul_add(-x192, x202, x179);
+        let x212 = Self::mul_add(x192, x203, -3.6140000000000003 + x180);
+        let x213 = Self::mul_add(-x194, x201, x170);
+        let x214 = Self::mul_add(-x194, x202, x171);
+        let x215 = Self::mul_add(x194, x203, -x172);
+        let x216 = Self::mul_add(-x195, x202, x173);
+        let x217 = Self::mul_add(x195, x203, -x174);
+        let x218 = Self::mul_add(-x183, x203, x175);
+        let x219 = Self::mul_add(
+            x198,
+            x199,
+            Self::mul_add(-x115, x117, x105 * x118)
+                + Self::mul_add(-x109, x121, x110 * x120)
+                + (x149 + Self::mul_add(-x124, x148, x123 * x147)
+                    + Self::mul_add(0.55, x189, -0.16 * x188))
+                + (Self::mul_add(-x112, x205, x111 * x204)
+                    + Self::mul_add(-x114, x208, x113 * x207)),
+        );
+        let x220 = Self::mul_add(
+            x198,
+            x200,
+            Self::mul_add(-x104, x118, x115 * x116)
+                + Self::mul_add(-x110, x119, x108 * x121)
+                + Self::mul_add(0.16, x187, Self::mul_add(c_q13, x148, s_q13 * x147))
+                + (Self::mul_add(-x112, x206, x111 * x205)
+                    + Self::mul_add(-x114, x211, x113 * x210)),
+        );
+        let x221 = Self::mul_add(x198, x193 * x197, x196);
+        let x222 = Self::mul_add(
+            x198,
+            x201,
+            Self::mul_add(-x105, x121, x115 * x120) + x187
+                + (Self::mul_add(-x112, x210, x111 * x207)
+                    + Self::mul_add(-x114, x214, x113 * x213)),
+        );
+        let x223 = Self::mul_add(
+            x198,
+            x202,
+            Self::mul_add(-x115, x119, x104 * x121) + x188
+                + (Self::mul_add(-x112, x211, x111 * x208)
+                    + Self::mul_add(-x114, x216, x113 * x214)),
+        );
+        let x224 = Self::mul_add(
+            -x198,
+            x203,
+            Self::mul_add(-x104, x120, x105 * x119) + x189
+                + (Self::mul_add(-x112, x212, x111 * x209)
+                    + Self::mul_add(-x114, x217, x113 * x215)),
+        );
+        let x225 = s_q12 * x205;
+        let x226 = Self::mul_add(x103, x205, x102 * x204);
+        let x227 = c_q12 * x205;
+        let x228 = Self::mul_add(s_q12, x204, x227);
+        let x229 = Self::mul_add(x103, x206, x102 * x205);
+        let x230 = Self::mul_add(c_q12, x206, x225);
+        let x231 = Self::mul_add(-s_q12, x208, c_q12 * x207);
+        let x232 = x209 + Self::mul_add(x103, x208, x102 * x207);
+        let x233 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x209,
+            -Self::mul_add(c_q12, x208, s_q12 * x207),
+        );
+        let x234 = Self::mul_add(-s_q12, x211, c_q12 * x210);
+        let x235 = x212 + Self::mul_add(x103, x211, x102 * x210);
+        let x236 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x212,
+            -Self::mul_add(c_q12, x211, s_q12 * x210),
+        );
+        let x237 = Self::mul_add(-s_q12, x234, c_q12 * x231);
+        let x238 = Self::mul_add(-s_q12, x235, c_q12 * x232);
+        let x239 = Self::mul_add(x103, x234, x102 * x231);
+        let x240 = Self::mul_add(c_q12, x234, s_q12 * x231);
+        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
+        let x242 = Self::mul_add(c_q12, x236, s_q12 * x233);
+        let x243 = s_q12 * x214;
+        let x244 = x215 + Self::mul_add(x103, x214, x102 * x213);
+        let x245 = c_q12 * x214;
+        let x246 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x215,
+            -Self::mul_add(s_q12, x213, x245),
+        );
+        let x247 = x217 + Self::mul_add(x103, x216, x102 * x214);
+        let x248 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x217,
+            -Self::mul_add(c_q12, x216, x243),
+        );
+        let x249 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x218,
+            -Self::mul_add(c_q12, x217, s_q12 * x215),
+        );
+        let x250 = Self::mul_add(
+            -s_q12,
+            Self::mul_add(-s_q12, x216, x245),
+            c_q12 * Self::mul_add(c_q12, x213, -x243),
+        );
+        let x251 = Self::mul_add(-s_q12, x247, c_q12 * x244);
+        let x252 = Self::mul_add(-s_q12, x248, c_q12 * x246);
+        let x253 = x218 + Self::mul_add(x103, x217, x102 * x215)
+            + Self::mul_add(x103, x247, x102 * x244);
+        let x254 = x249 + Self::mul_add(x103, x248, x102 * x246);
+        let x255 = Self::mul_add(0.36, x253, x238);
+        let x256 = Self::mul_add(-0.36, x250, x239);
+        let x257 = Self::mul_add(-0.36, x251, Self::mul_add(x103, x235, x102 * x232));
+        let x258 = Self::mul_add(
+            0.36,
+            x255,
+            Self::mul_add(
+                -s_q12,
+                Self::mul_add(-s_q12, x206, x227),
+                c_q12 * Self::mul_add(c_q12, x204, -x225),
+            ),
+        );
+        let x259 = Self::mul_add(
+            -0.36,
+            x237,
+            Self::mul_add(0.36, x257, Self::mul_add(-s_q12, x229, c_q12 * x226)),
+        );
+        let x260 = Self::mul_add(
+            -0.36,
+            x239,
+            Self::mul_add(-0.36, x256, Self::mul_add(x103, x229, x102 * x226)),
+        );
+        let x261 = Self::mul_add(-s_q12, x223, c_q12 * x222);
+        let x262 = x224 + Self::mul_add(x103, x223, x102 * x222);
+        let x263 = 0.01675
+            + Self::mul_add(-0.36, x241, Self::mul_add(-c_q12, x228, s_q12 * x230));
+        let x264 = 2.5482240016099564
+            - Self::mul_add(-0.36, x240, Self::mul_add(x103, x230, x102 * x228));
+        let x265 = 9.223235249762805 + Self::mul_add(c_q12, x230, s_q12 * x228);
+        let x266 = -7.078399999258757 - x240;
+        let x267 = Self::mul_add(x90, x99, Self::mul_add(-x85, x97, x84 * x96))
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x221,
+                -Self::mul_add(c_q12, x220, s_q12 * x219),
+            );
+        let x268 = Self::mul_add(
+            x85,
+            x99,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x224,
+                -Self::mul_add(c_q12, x223, s_q12 * x222),
+            ),
+        );
+        let x269 = 1.0 / x265;
+        let x270 = tau[4] - x267;
+        let x271 = x263 * x269;
+        let x272 = x264 * x269;
+        let x273 = x266 * x269;
+        let x274 = x241 * x269;
+        let x275 = x242 * x269;
+        let x276 = Self::mul_add(-x263, x271, Self::mul_add(0.36, x238, x258));
+        let x277 = Self::mul_add(-x263, x272, x259);
+        let x278 = Self::mul_add(-x264, x272, -9.142025249762803 + x260);
+        let x279 = Self::mul_add(-x263, x273, Self::mul_add(0.36, x251, x237));
+        let x280 = Self::mul_add(x263, x274, x255);
+        let x281 = Self::mul_add(
+            x263,
+            x275,
+            7.078399999258757
+                + Self::mul_add(0.36, x254, Self::mul_add(-s_q12, x236, c_q12 * x233)),
+        );
+        let x282 = Self::mul_add(-x264, x273, x256);
+        let x283 = Self::mul_add(x264, x274, x257);
+        let x284 = Self::mul_add(
+            x264,
+            x275,
+            Self::mul_add(-0.36, x252, Self::mul_add(x103, x236, x102 * x233)),
+        );
+        let x285 = Self::mul_add(-x266, x273, x250);
+        let x286 = Self::mul_add(x266, x274, x251);
+        let x287 = Self::mul_add(x266, x275, x252);
+        let x288 = Self::mul_add(-x241, x274, x253);
+        let x289 = Self::mul_add(-x241, x275, x254);
+        let x290 = Self::mul_add(
+            -x242,
+            x275,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x249,
+                -Self::mul_add(c_q12, x248, s_q12 * x246),
+            ),
+        );
+        let x291 = Self::mul_add(
+            x270,
+            x271,
+            Self::mul_add(-x90, x100, Self::mul_add(-x95, x96, x85 * x98))
+                + Self::mul_add(0.36, x262, Self::mul_add(-s_q12, x220, c_q12 * x219))
+                + (Self::mul_add(-x92, x277, x91 * x276)
+                    + Self::mul_add(-x94, x280, x93 * x279)),
+        );
+        let x292 = Self::mul_add(
+            x270,
+            x272,
+            Self::mul_add(-x84, x98, x95 * x97) + Self::mul_add(-x88, x99, x89 * x100)
+                + Self::mul_add(
+                    -0.36,
+                    x261,
+                    x221 + Self::mul_add(x103, x220, x102 * x219),
+                )
+                + (Self::mul_add(-x92, x278, x91 * x277)
+                    + Self::mul_add(-x94, x283, x93 * x282)),
+        );
+        let x293 = Self::mul_add(
+            x270,
+            x273,
+            Self::mul_add(-x85, x100, x261)
+                + (Self::mul_add(-x92, x282, x91 * x279)
+                    + Self::mul_add(-x94, x286, x93 * x285)),
+        );
+        let x294 = Self::mul_add(
+            -x270,
+            x274,
+            Self::mul_add(-x95, x99, x84 * x100) + x262
+                + (Self::mul_add(-x92, x283, x91 * x280)
+                    + Self::mul_add(-x94, x288, x93 * x286)),
+        );
+        let x295 = Self::mul_add(
+            -x270,
+            x275,
+            x268
+                + (Self::mul_add(-x92, x284, x91 * x281)
+                    + Self::mul_add(-x94, x289, x93 * x287)),
+        );
+        let x296 = s_q11 * x277;
+        let x297 = c_q11 * x277;
+        let x298 = Self::mul_add(s_q11, x276, x297);
+        let x299 = Self::mul_add(c_q11, x278, x296);
+        let x300 = Self::mul_add(-s_q11, x280, c_q11 * x279);
+        let x301 = Self::mul_add(c_q11, x280, s_q11 * x279);
+        let x302 = Self::mul_add(-s_q11, x283, c_q11 * x282);
+        let x303 = Self::mul_add(c_q11, x283, s_q11 * x282);
+        let x304 = Self::mul_add(-s_q11, x302, c_q11 * x300);
+        let x305 = Self::mul_add(-s_q11, x303, c_q11 * x301);
+        let x306 = Self::mul_add(-s_q11, x284, c_q11 * x281);
+        let x307 = Self::mul_add(c_q11, x302, s_q11 * x300);
+        let x308 = s_q11 * x286;
+        let x309 = c_q11 * x286;
+        let x310 = Self::mul_add(s_q11, x285, x309);
+        let x311 = Self::mul_add(c_q11, x288, x308);
+        let x312 = Self::mul_add(-s_q11, x289, c_q11 * x287);
+        let x313 = Self::mul_add(c_q11, x289, s_q11 * x287);
+        let x314 = Self::mul_add(
+            -s_q11,
+            Self::mul_add(-s_q11, x288, x309),
+            c_q11 * Self::mul_add(c_q11, x285, -x308),
+        );
+        let x315 = Self::mul_add(-s_q11, x311, c_q11 * x310);
+        let x316 = Self::mul_add(c_q11, x311, s_q11 * x310);
+        let x317 = 0.63 * x314;
+        let x318 = 0.63 * x315;
+        let x319 = 0.63 * x312;
+        let x320 = x305 + Self::mul_add(-0.63, x313, 0.275 * x316);
+        let x321 = x306 + Self::mul_add(-0.63, x290, 0.275 * x313);
+        let x322 = Self::mul_add(-0.275, x314, x307);
+        let x323 = Self::mul_add(-0.275, x315, Self::mul_add(c_q11, x303, s_q11 * x301));
+        let x324 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x284, s_q11 * x281));
+        let x325 = Self::mul_add(
+            -0.275,
+            x307,
+            Self::mul_add(-0.275, x322, Self::mul_add(c_q11, x299, s_q11 * x298)),
+        );
+        let x326 = Self::mul_add(-s_q11, x294, c_q11 * x293);
+        let x327 = Self::mul_add(c_q11, x294, s_q11 * x293);
+        let x328 = -0.6328
+            + Self::mul_add(0.63, x304, Self::mul_add(-0.63, x319, 0.275 * x318));
+        let x329 = -24.35164200091464 + Self::mul_add(0.63, x307, -0.275 * x317);
+        let x330 = Self::mul_add(0.63, x317, 28.2393615);
+        let x331 = 45.1584 + x317;
+        let x332 = Self::mul_add(x72, x81, Self::mul_add(-x68, x79, x67 * x78))
+            + Self::mul_add(0.63, x326, Self::mul_add(x270, x265 * x269, x267));
+        let x333 = 1.0 / x330;
+        let x334 = tau[3] - x332;
+        let x335 = x328 * x333;
+        let x336 = x329 * x333;
+        let x337 = x331 * x333;
+        let x338 = x318 * x333;
+        let x339 = x319 * x333;
+        let x340 = Self::mul_add(
+            -x328,
+            x335,
+            Self::mul_add(-0.63, x306, 0.275 * x305)
+                + (Self::mul_add(
+                    -s_q11,
+                    Self::mul_add(-s_q11, x278, x297),
+                    c_q11 * Self::mul_add(c_q11, x276, -x296),
+                ) + Self::mul_add(-0.63, x321, 0.275 * x320)),
+        );
+        let x341 = Self::mul_add(
+            -x328,
+            x336,
+            Self::mul_add(
+                -0.275,
+                x304,
+                Self::mul_add(-s_q11, x299, c_q11 * x298)
+                    + Self::mul_add(-0.63, x324, 0.275 * x323),
+            ),
+        );
+        let x342 = Self::mul_add(-x329, x336, -24.4950615 + x325);
+        let x343 = Self::mul_add(
+            -x328,
+            x337,
+            x304 + Self::mul_add(-0.63, x312, 0.275 * x315),
+        );
+        let x344 = Self::mul_add(-x328, x338, x320);
+        let x345 = Self::mul_add(-x328, x339, -45.1584 + x321);
+        let x346 = Self::mul_add(-x329, x337, x322);
+        let x347 = Self::mul_add(-x329, x338, x323);
+        let x348 = Self::mul_add(-x329, x339, x324);
+        let x349 = Self::mul_add(-x331, x337, x314);
+        let x350 = Self::mul_add(-x331, x338, x315);
+        let x351 = Self::mul_add(-x331, x339, x312);
+        let x352 = Self::mul_add(-x318, x338, x316);
+        let x353 = Self::mul_add(-x318, x339, x313);
+        let x354 = Self::mul_add(-x319, x339, x290);
+        let x355 = Self::mul_add(
+            x334,
+            x335,
+            Self::mul_add(-x72, x82, Self::mul_add(-x77, x78, x68 * x80))
+                + (Self::mul_add(-s_q11, x292, c_q11 * x291)
+                    + Self::mul_add(-0.63, x295, 0.275 * x327))
+                + (Self::mul_add(-x74, x341, x73 * x340)
+                    + Self::mul_add(-x76, x344, x75 * x343)),
+        );
+        let x356 = Self::mul_add(
+            x334,
+            x336,
+            Self::mul_add(-x67, x80, x77 * x79) + Self::mul_add(-x70, x81, x71 * x82)
+                + Self::mul_add(-0.275, x326, Self::mul_add(c_q11, x292, s_q11 * x291))
+                + (Self::mul_add(-x74, x342, x73 * x341)
+                    + Self::mul_add(-x76, x347, x75 * x346)),
+        );
+        let x357 = Self::mul_add(
+            x334,
+            x337,
+            Self::mul_add(-x68, x82, x326)
+                + (Self::mul_add(-x74, x346, x73 * x343)
+                    + Self::mul_add(-x76, x350, x75 * x349)),
+        );
+        let x358 = Self::mul_add(
+            x334,
+            x338,
+            Self::mul_add(-x77, x81, x67 * x82) + x327
+                + (Self::mul_add(-x74, x347, x73 * x344)
+                    + Self::mul_add(-x76, x352, x75 * x350)),
+        );
+        let x359 = Self::mul_add(
+            x334,
+            x339,
+            Self::mul_add(x68, x81, x295)
+                + (Self::mul_add(-x74, x348, x73 * x345)
+                    + Self::mul_add(-x76, x353, x75 * x351)),
+        );
+        let x360 = s_q10 * x341;
+        let x361 = c_q10 * x341;
+        let x362 = Self::mul_add(s_q10, x340, x361);
+        let x363 = Self::mul_add(c_q10, x342, x360);
+        let x364 = Self::mul_add(-s_q10, x344, c_q10 * x343);
+        let x365 = Self::mul_add(c_q10, x344, s_q10 * x343);
+        let x366 = Self::mul_add(-s_q10, x347, c_q10 * x346);
+        let x367 = Self::mul_add(c_q10, x347, s_q10 * x346);
+        let x368 = Self::mul_add(-s_q10, x366, c_q10 * x364);
+        let x369 = Self::mul_add(-s_q10, x348, c_q10 * x345);
+        let x370 = Self::mul_add(c_q10, x366, s_q10 * x364);
+        let x371 = Self::mul_add(c_q10, x348, s_q10 * x345);
+        let x372 = s_q10 * x350;
+        let x373 = c_q10 * x350;
+        let x374 = Self::mul_add(s_q10, x349, x373);
+        let x375 = Self::mul_add(c_q10, x352, x372);
+        let x376 = Self::mul_add(-s_q10, x353, c_q10 * x351);
+        let x377 = Self::mul_add(c_q10, x353, s_q10 * x351);
+        let x378 = Self::mul_add(
+            -s_q10,
+            Self::mul_add(-s_q10, x352, x373),
+            c_q10 * Self::mul_add(c_q10, x349, -x372),
+        );
+        let x379 = Self::mul_add(-s_q10, x375, c_q10 * x374);
+        let x380 = 0.87 * x378;
+        let x381 = 0.87 * x379;
+        let x382 = 0.87 * x376;
+        let x383 = Self::mul_add(-0.87, x354, x369);
+        let x384 = Self::mul_add(
+            -0.87,
+            x383,
+            Self::mul_add(
+                -s_q10,
+                Self::mul_add(-s_q10, x342, x361),
+                c_q10 * Self::mul_add(c_q10, x340, -x360),
+            ),
+        );
+        let x385 = Self::mul_add(-s_q10, x358, c_q10 * x357);
+        let x386 = -0.00214 + Self::mul_add(0.87, x368, -0.87 * x382);
+        let x387 = Self::mul_add(0.87, x370, -36.18604050126307);
+        let x388 = Self::mul_add(0.87, x380, 69.99836825);
+        let x389 = 81.53205 + x380;
+        let x390 = Self::mul_add(x54, x64, Self::mul_add(-x49, x62, x48 * x61))
+            + Self::mul_add(0.87, x385, Self::mul_add(x334, x330 * x333, x332));
+        let x391 = 1.0 / x388;
+        let x392 = tau[2] - x390;
+        let x393 = x386 * x391;
+        let x394 = x387 * x391;
+        let x395 = x389 * x391;
+        let x396 = x381 * x391;
+        let x397 = x382 * x391;
+        let x398 = Self::mul_add(-x386, x393, Self::mul_add(-0.87, x369, x384));
+        let x399 = Self::mul_add(
+            -x386,
+            x394,
+            Self::mul_add(-0.87, x371, Self::mul_add(-s_q10, x363, c_q10 * x362)),
+        );
+        let x400 = Self::mul_add(
+            -x387,
+            x394,
+            -63.36336825000001 + Self::mul_add(c_q10, x363, s_q10 * x362),
+        );
+        let x401 = Self::mul_add(-x386, x395, Self::mul_add(-0.87, x376, x368));
+        let x402 = Self::mul_add(
+            -x386,
+            x396,
+            Self::mul_add(-0.87, x377, Self::mul_add(-s_q10, x367, c_q10 * x365)),
+        );
+        let x403 = Self::mul_add(-x386, x397, -81.53205 + x383);
+        let x404 = Self::mul_add(-x387, x395, x370);
+        let x405 = Self::mul_add(-x387, x396, Self::mul_add(c_q10, x367, s_q10 * x365));
+        let x406 = Self::mul_add(-x387, x397, x371);
+        let x407 = Self::mul_add(-x389, x395, x378);
+        let x408 = Self::mul_add(-x389, x396, x379);
+        let x409 = Self::mul_add(-x389, x397, x376);
+        let x410 = Self::mul_add(-x381, x396, Self::mul_add(c_q10, x375, s_q10 * x374));
+        let x411 = Self::mul_add(-x381, x397, x377);
+        let x412 = Self::mul_add(-x382, x397, x354);
+        let x413 = Self::mul_add(
+            x392,
+            x393,
+            Self::mul_add(-x54, x65, Self::mul_add(-x60, x61, x49 * x63))
+                + Self::mul_add(-0.87, x359, Self::mul_add(-s_q10, x356, c_q10 * x355))
+                + (Self::mul_add(-x57, x399, x56 * x398)
+                    + Self::mul_add(-x59, x402, x58 * x401)),
+        );
+        let x414 = Self::mul_add(
+            x392,
+            x394,
+            Self::mul_add(-x48, x63, x60 * x62) + Self::mul_add(-x55, x64, x53 * x65)
+                + Self::mul_add(c_q10, x356, s_q10 * x355)
+                + (Self::mul_add(-x57, x400, x56 * x399)
+                    + Self::mul_add(-x59, x405, x58 * x404)),
+        );
+        let x415 = Self::mul_add(x392, x388 * x391, x390);
+        let x416 = Self::mul_add(
+            x392,
+            x395,
+            Self::mul_add(-x49, x65, x385)
+                + (Self::mul_add(-x57, x404, x56 * x401)
+                    + Self::mul_add(-x59, x408, x58 * x407)),
+        );
+        let x417 = Self::mul_add(
+            x392,
+            x396,
+            Self::mul_add(-x60, x64, x48 * x65)
+                + Self::mul_add(c_q10, x358, s_q10 * x357)
+                + (Self::mul_add(-x57, x405, x56 * x402)
+                    + Self::mul_add(-x59, x410, x58 * x408)),
+        );
+        let x418 = Self::mul_add(
+            x392,
+            x397,
+            Self::mul_add(x49, x64, x359)
+                + (Self::mul_add(-x57, x406, x56 * x403)
+                    + Self::mul_add(-x59, x411, x58 * x409)),
+        );
+        let x419 = c_q9 * x399;
+        let x420 = Self::mul_add(x47, x399, x46 * x398);
+        let x421 = s_q9 * x399;
+        let x422 = Self::mul_add(c_q9, x398, -x421);
+        let x423 = Self::mul_add(x47, x400, x46 * x399);
+        let x424 = Self::mul_add(-s_q9, x400, x419);
+        let x425 = Self::mul_add(
+            0.00000000020510342851533115,
+            x403,
+            Self::mul_add(c_q9, x402, s_q9 * x401),
+        );
+        let x426 = x403 + Self::mul_add(x47, x402, x46 * x401);
+        let x427 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x403,
+            Self::mul_add(-s_q9, x402, c_q9 * x401),
+        );
+        let x428 = Self::mul_add(
+            0.00000000020510342851533115,
+            x406,
+            Self::mul_add(c_q9, x405, s_q9 * x404),
+        );
+        let x429 = x406 + Self::mul_add(x47, x405, x46 * x404);
+        let x430 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x406,
+            Self::mul_add(-s_q9, x405, c_q9 * x404),
+        );
+        let x431 = Self::mul_add(c_q9, x428, s_q9 * x425);
+        let x432 = Self::mul_add(c_q9, x429, s_q9 * x426);
+        let x433 = Self::mul_add(c_q9, x430, s_q9 * x427);
+        let x434 = Self::mul_add(x47, x428, x46 * x425);
+        let x435 = Self::mul_add(-s_q9, x428, c_q9 * x425);
+        let x436 = c_q9 * x408;
+        let x437 = x409 + Self::mul_add(x47, x408, x46 * x407);
+        let x438 = s_q9 * x408;
+        let x439 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x409,
+            Self::mul_add(c_q9, x407, -x438),
+        );
+        let x440 = x411 + Self::mul_add(x47, x410, x46 * x408);
+        let x441 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x411,
+            Self::mul_add(-s_q9, x410, x436),
+        );
+        let x442 = x412 + Self::mul_add(x47, x411, x46 * x409);
+        let x443 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x412,
+            Self::mul_add(-s_q9, x411, c_q9 * x409),
+        );
+        let x444 = Self::mul_add(
+            c_q9,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x411,
+                Self::mul_add(c_q9, x410, x438),
+            ),
+            s_q9
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x409,
+                    Self::mul_add(s_q9, x407, x436),
+                ),
+        );
+        let x445 = Self::mul_add(
+            0.00000000020510342851533115,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x412,
+                Self::mul_add(c_q9, x411, s_q9 * x409),
+            ),
+            x444,
+        );
+        let x446 = Self::mul_add(
+            0.00000000020510342851533115,
+            x442,
+            Self::mul_add(c_q9, x440, s_q9 * x437),
+        );
+        let x447 = Self::mul_add(
+            0.00000000020510342851533115,
+            x443,
+            Self::mul_add(c_q9, x441, s_q9 * x439),
+        );
+        let x448 = x442 + Self::mul_add(x47, x440, x46 * x437);
+        let x449 = x443 + Self::mul_add(x47, x441, x46 * x439);
+        let x450 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x443,
+            Self::mul_add(-s_q9, x441, c_q9 * x439),
+        );
+        let x451 = x432 + Self::mul_add(0.275, x449, -0.4 * x448);
+        let x452 = x433 + Self::mul_add(0.275, x450, -0.4 * x449);
+        let x453 = Self::mul_add(0.4, x445, x434);
+        let x454 = Self::mul_add(0.4, x446, Self::mul_add(x47, x429, x46 * x426));
+        let x455 = Self::mul_add(0.4, x447, Self::mul_add(x47, x430, x46 * x427));
+        let x456 = Self::mul_add(-0.275, x445, x435);
+        let x457 = Self::mul_add(-0.275, x446, Self::mul_add(-s_q9, x429, c_q9 * x426));
+        let x458 = Self::mul_add(-0.275, x447, Self::mul_add(-s_q9, x430, c_q9 * x427));
+        let x459 = Self::mul_add(
+            0.4,
+            x434,
+            Self::mul_add(0.4, x453, Self::mul_add(x47, x423, x46 * x420)),
+        );
+        let x460 = Self::mul_add(
+            -0.275,
+            x434,
+            Self::mul_add(0.4, x456, Self::mul_add(x47, x424, x46 * x422)),
+        );
+        let x461 = Self::mul_add(
+            -0.275,
+            x435,
+            Self::mul_add(-0.275, x456, Self::mul_add(-s_q9, x424, c_q9 * x422)),
+        );
+        let x462 = Self::mul_add(
+            0.00000000020510342851533115,
+            x418,
+            Self::mul_add(c_q9, x417, s_q9 * x416),
+        );
+        let x463 = x418 + Self::mul_add(x47, x417, x46 * x416);
+        let x464 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x418,
+            Self::mul_add(-s_q9, x417, c_q9 * x416),
+        );
+        let x465 = Self::mul_add(
+            -0.275,
+            x462,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x415,
+                Self::mul_add(-s_q9, x414, c_q9 * x413),
+            ),
+        );
+        let x466 = -0.002139996587640933
             + Self::mul_add(
                 -0.275,
-                x466,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x465,
-                    Self::mul_add(-s_q9, x464, c_q9 * x463),
-                ),
+                x431,
+                Self::mul_add(c_q9, x424, s_q9 * x422)
+                    + Self::mul_add(0.275, x458, -0.4 * x457),
             );
-        let x475 = x471 + Self::mul_add(-x3, x470, x2 * x469);
-        let x476 = Self::mul_add(c_q8, x470, s_q8 * x469);
-        let x477 = Self::mul_add(
-            -48.0240000085309,
-            Self::mul_add(x316, x316, x317),
-            x475,
-        );
-        let x478 = Self::mul_add(48.0240000085309, x302 * x303, x476);
+        let x467 = 5.080660024070365 + x460;
+        let x468 = 113.3918902508081 + x461;
+        let x469 = 12.701650001451807 + x456;
+        let x470 = -0.000000008530897668050218 + x457;
+        let x471 = Self::mul_add(-x28, x39, x27 * x40)
+            + Self::mul_add(-x31, x43, x32 * x42) + x465;
+        let x472 = 1.0 / x468;
+        let x473 = tau[1] - x471;
+        let x474 = x466 * x472;
+        let x475 = x467 * x472;
+        let x476 = x469 * x472;
+        let x477 = x470 * x472;
+        let x478 = x458 * x472;
         let x479 = Self::mul_add(
-            48.0240000085309,
-            x315 + x318,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x471,
-                Self::mul_add(-c_q8, x469, s_q8 * x470),
-            ),
+            -x466,
+            x474,
+            Self::mul_add(0.275, x433, -0.4 * x432)
+                + (Self::mul_add(
+                    c_q9,
+                    Self::mul_add(c_q9, x400, x421),
+                    s_q9 * Self::mul_add(s_q9, x398, x419),
+                ) + Self::mul_add(0.275, x452, -0.4 * x451)),
         );
-        let x480 = Self::mul_add(0.07309, x315, Self::mul_add(-x316, x320, x303 * x321))
-            + Self::mul_add(-0.35, x476, x474 + Self::mul_add(-x3, x473, x2 * x472));
-        let x481 = Self::mul_add(
-            x312,
-            -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x315, -0.07309 * x314)
-                + Self::mul_add(-x302, x321, x316 * x319),
-        ) + Self::mul_add(0.35, x475, Self::mul_add(c_q8, x473, s_q8 * x472));
+        let x480 = Self::mul_add(
+            -x466,
+            x475,
+            -0.0000000234896432582596
+                + Self::mul_add(
+                    0.4,
+                    x431,
+                    Self::mul_add(c_q9, x423, s_q9 * x420)
+                        + Self::mul_add(0.275, x455, -0.4 * x454),
+                ),
+        );
+        let x481 = Self::mul_add(-x467, x475, -111.7548902508081 + x459);
         let x482 = Self::mul_add(
-            48.0240000085309,
-            x313,
-            Self::mul_add(-0.1132, x315, -16.80768997608804 * x314)
-                + Self::mul_add(-x303, x319, x302 * x320),
-        )
+            -x466,
+            x476,
+            x431 + Self::mul_add(0.275, x447, -0.4 * x446),
+        );
+        let x483 = Self::mul_add(-x466, x477, x451);
+        let x484 = Self::mul_add(-x466, x478, -12.701650001451807 + x452);
+        let x485 = Self::mul_add(-x467, x476, x453);
+        let x486 = Self::mul_add(-x467, x477, x454);
+        let x487 = Self::mul_add(-x467, x478, 0.000000008530897668050218 + x455);
+        let x488 = Self::mul_add(-x469, x476, x445);
+        let x489 = Self::mul_add(-x469, x477, x446);
+        let x490 = Self::mul_add(-x469, x478, x447);
+        let x491 = Self::mul_add(-x470, x477, x448);
+        let x492 = Self::mul_add(-x470, x478, x449);
+        let x493 = Self::mul_add(-x458, x478, x450);
+        let x494 = Self::mul_add(
+            x473,
+            x474,
+            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
+                + (Self::mul_add(
+                    0.00000000020510342851533115,
+                    x415,
+                    Self::mul_add(c_q9, x414, s_q9 * x413),
+                ) + Self::mul_add(0.275, x464, -0.4 * x463))
+                + (Self::mul_add(-x35, x480, x34 * x479)
+                    + Self::mul_add(-x37, x483, x36 * x482)),
+        );
+        let x495 = Self::mul_add(
+            x473,
+            x475,
+            Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
+                + Self::mul_add(0.4, x462, x415 + Self::mul_add(x47, x414, x46 * x413))
+                + (Self::mul_add(-x35, x481, x34 * x480)
+                    + Self::mul_add(-x37, x486, x36 * x485)),
+        );
+        let x496 = Self::mul_add(x473, x468 * x472, x471);
+        let x497 = Self::mul_add(
+            x473,
+            x476,
+            Self::mul_add(-x28, x44, x38 * x43) + x462
+                + (Self::mul_add(-x35, x485, x34 * x482)
+                    + Self::mul_add(-x37, x489, x36 * x488)),
+        );
+        let x498 = Self::mul_add(
+            x473,
+            x477,
+            Self::mul_add(-x38, x42, x27 * x44) + x463
+                + (Self::mul_add(-x35, x486, x34 * x483)
+                    + Self::mul_add(-x37, x491, x36 * x489)),
+        );
+        let x499 = Self::mul_add(
+            x473,
+            x478,
+            Self::mul_add(-x27, x43, x28 * x42) + x464
+                + (Self::mul_add(-x35, x487, x34 * x484)
+                    + Self::mul_add(-x37, x492, x36 * x490)),
+        );
+        let x500 = c_q8 * x480;
+        let x501 = Self::mul_add(s_q8, x479, x500);
+        let x502 = s_q8 * x480;
+        let x503 = Self::mul_add(-c_q8, x479, x502);
+        let x504 = Self::mul_add(c_q8, x481, x502);
+        let x505 = Self::mul_add(s_q8, x481, -x500);
+        let x506 = x484 + Self::mul_add(-x26, x483, x25 * x482);
+        let x507 = Self::mul_add(c_q8, x483, s_q8 * x482);
+        let x508 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x484,
+            Self::mul_add(-c_q8, x482, s_q8 * x483),
+        );
+        let x509 = x487 + Self::mul_add(-x26, x486, x25 * x485);
+        let x510 = Self::mul_add(c_q8, x486, s_q8 * x485);
+        let x511 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x487,
+            Self::mul_add(-c_q8, x485, s_q8 * x486),
+        );
+        let x512 = Self::mul_add(-x26, x509, x25 * x506);
+        let x513 = Self::mul_add(-x26, x510, x25 * x507);
+        let x514 = Self::mul_add(c_q8, x509, s_q8 * x506);
+        let x515 = Self::mul_add(-c_q8, x506, s_q8 * x509);
+        let x516 = Self::mul_add(-c_q8, x507, s_q8 * x510);
+        let x517 = Self::mul_add(-c_q8, x508, s_q8 * x511);
+        let x518 = c_q8 * x489;
+        let x519 = Self::mul_add(s_q8, x488, x518);
+        let x520 = s_q8 * x489;
+        let x521 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x490,
+            Self::mul_add(-c_q8, x488, x520),
+        );
+        let x522 = Self::mul_add(c_q8, x491, x520);
+        let x523 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x492,
+            Self::mul_add(s_q8, x491, -x518),
+        );
+        let x524 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x493,
+            Self::mul_add(-c_q8, x490, s_q8 * x492),
+        );
+        let x525 = x493 + Self::mul_add(-x26, x492, x25 * x490)
+            + Self::mul_add(
+                -x26,
+                x492 + Self::mul_add(-x26, x491, x25 * x489),
+                x25 * (x490 + Self::mul_add(-x26, x489, x25 * x488)),
+            );
+        let x526 = Self::mul_add(c_q8, x492, s_q8 * x490)
+            + Self::mul_add(-x26, x522, x25 * x519);
+        let x527 = x524 + Self::mul_add(-x26, x523, x25 * x521);
+        let x528 = Self::mul_add(c_q8, x522, s_q8 * x519);
+        let x529 = Self::mul_add(c_q8, x523, s_q8 * x521);
+        let x530 = Self::mul_add(-0.35, x528, x513);
+        let x531 = Self::mul_add(0.35, x525, x514);
+        let x532 = Self::mul_add(0.35, x526, Self::mul_add(c_q8, x510, s_q8 * x507));
+        let x533 = Self::mul_add(
+            -0.35,
+            x530,
+            Self::mul_add(
+                -x26,
+                Self::mul_add(-x26, x481, x25 * x480),
+                x25 * Self::mul_add(-x26, x480, x25 * x479),
+            ),
+        );
+        let x534 = Self::mul_add(
+            0.35,
+            x512,
+            Self::mul_add(-0.35, x532, Self::mul_add(-x26, x504, x25 * x501)),
+        );
+        let x535 = Self::mul_add(
+            0.35,
+            x514,
+            Self::mul_add(0.35, x531, Self::mul_add(c_q8, x504, s_q8 * x501)),
+        );
+        let x536 = x499 + Self::mul_add(-x26, x498, x25 * x497);
+        let x537 = Self::mul_add(c_q8, x498, s_q8 * x497);
+        let x538 = -16.80768997608804
+            + Self::mul_add(-0.35, x516, Self::mul_add(-x26, x505, x25 * x503));
+        let x539 = 0.1132
+            + Self::mul_add(0.35, x515, Self::mul_add(c_q8, x505, s_q8 * x503));
+        let x540 = 132.47349025763282 + Self::mul_add(-c_q8, x503, s_q8 * x505);
+        let x541 = 48.0240000085309 + x516;
+        let x542 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x474,
-                Self::mul_add(-c_q8, x472, s_q8 * x473),
+                x496,
+                Self::mul_add(-c_q8, x494, s_q8 * x495),
             );
-        let x483 = Self::mul_add(-s_q7, x478, c_q7 * x477);
-        let x484 = Self::mul_add(c_q7, x478, s_q7 * x477);
-        let x485 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x486 = 1466.4506062283303 * v[4];
-        let x487 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x488 = x483
-            + Self::mul_add(
-                1170.07,
-                x299,
-                Self::mul_add(-110.5455, x305, 180.9502499901501 * x307),
-            );
-        let x489 = x484
-            + Self::mul_add(
-                1170.07,
-                x300,
-                Self::mul_add(180.9502499901501, x308, 110.5455 * x306),
-            );
-        let x490 = x479
-            + Self::mul_add(
-                1170.07,
-                x301,
-                Self::mul_add(-180.9502499901501, x309, 110.5455 * x307),
-            );
-        let x491 = x178 * 0.0008546497218115156;
-        let x492 = x168 * 0.0008546497218115156;
-        let x493 = x183 * 0.0008546497218115156;
-        let x494 = x200 * 0.0008546497218115156;
-        let x495 = x214 * 0.0008546497218115156;
-        let x496 = x233 * 0.0008546497218115156;
-        let x497 = x261 * 0.0008546497218115156;
-        let x498 = x297 * 0.0008546497218115156;
-        let x499 = x177 * 0.0008546497218115156;
-        let x500 = x167 * 0.0008546497218115156;
-        let x501 = x184 * 0.0008546497218115156;
-        let x502 = x201 * 0.0008546497218115156;
-        let x503 = x215 * 0.0008546497218115156;
-        let x504 = x234 * 0.0008546497218115156;
-        let x505 = x262 * 0.0008546497218115156;
-        let x506 = x298 * 0.0008546497218115156;
-        let x507 = x146 * 0.0008546497218115156;
-        let x508 = x196 * 0.0008546497218115156;
-        let x509 = x210 * 0.0008546497218115156;
-        let x510 = x229 * 0.0008546497218115156;
-        let x511 = x257 * 0.0008546497218115156;
-        let x512 = x293 * 0.0008546497218115156;
-        let x513 = x178 * x491;
-        let x514 = x168 * x492;
-        let x515 = 1.0
-            / (1394.5960312283303
-                + (x172 + (Self::mul_add(-s_q7, x170, c_q7 * x169) - x171)) - x513
-                - x514);
-        let x516 = Self::mul_add(
-            x168,
-            x499,
-            Self::mul_add(-0.65, x168, Self::mul_add(c_q7, x170, s_q7 * x169)),
-        );
-        let x517 = x515 * x516;
-        let x518 = Self::mul_add(
-            x178,
-            x499,
-            -117.61766249359756 + Self::mul_add(x149, -0.65, x175),
-        );
-        let x519 = x515 * x518;
-        let x520 = Self::mul_add(x178, x500, x175);
-        let x521 = x515 * x520;
-        let x522 = Self::mul_add(
-            -x168,
-            x507,
-            Self::mul_add(
-                x178,
-                x501,
-                Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x182, c_q7 * x181)),
-            ),
-        );
-        let x523 = x515 * x522;
-        let x524 = Self::mul_add(
-            -x168,
-            x508,
-            Self::mul_add(
-                x178,
-                x502,
-                Self::mul_add(-0.75, x201, Self::mul_add(-s_q7, x199, c_q7 * x198)),
-            ),
-        );
-        let x525 = x515 * x524;
-        let x526 = Self::mul_add(
-            -x168,
-            x509,
-            Self::mul_add(
-                x178,
-                x503,
-                Self::mul_add(-0.75, x215, Self::mul_add(-s_q7, x213, c_q7 * x212)),
-            ),
-        );
-        let x527 = x515 * x526;
-        let x528 = Self::mul_add(
-            -x168,
-            x510,
-            Self::mul_add(
-                x178,
-                x504,
-                Self::mul_add(-0.75, x234, Self::mul_add(-s_q7, x232, c_q7 * x231)),
-            ),
-        );
-        let x529 = x515 * x528;
-        let x530 = Self::mul_add(
-            -x168,
-            x511,
-            Self::mul_add(
-                x178,
-                x505,
-                Self::mul_add(-0.75, x262, Self::mul_add(-s_q7, x260, c_q7 * x259)),
-            ),
-        );
-        let x531 = x515 * x530;
-        let x532 = Self::mul_add(
-            -x168,
-            x512,
-            Self::mul_add(
-                x178,
-                x506,
-                Self::mul_add(-0.75, x298, Self::mul_add(-s_q7, x296, c_q7 * x295)),
-            ),
-        );
-        let x533 = x515 * x532;
-        let x534 = x177 * x499;
-        let x535 = 1.0
-            / Self::mul_add(
-                -x516,
-                x517,
-                1466.4506062283303
-                    + (Self::mul_add(
-                        c_q7,
-                        Self::mul_add(c_q7, x164, s_q7 * x161),
-                        s_q7 * Self::mul_add(c_q7, x163, s_q7 * x159),
-                    ) - (x173 - x172) - (x171 - x174)) - x513 - x534,
-            );
-        let x536 = Self::mul_add(
-            x178,
-            x492,
-            Self::mul_add(-0.75, x168, Self::mul_add(c_q7, x165, s_q7 * x162)),
-        );
-        let x537 = Self::mul_add(-x516, x519, x536);
-        let x538 = x535 * x537;
-        let x539 = Self::mul_add(-x516, x521, x536);
-        let x540 = x535 * x539;
-        let x541 = Self::mul_add(
-            -x516,
-            x523,
-            Self::mul_add(
-                x177,
-                x507,
-                Self::mul_add(
-                    x178,
-                    x493,
-                    Self::mul_add(c_q7, x182, s_q7 * x181)
-                        + Self::mul_add(-0.75, x183, x146 * -0.65),
-                ),
-            ),
-        );
-        let x542 = x535 * x541;
         let x543 = Self::mul_add(
-            -x516,
-            x525,
+            -x7,
+            x22,
             Self::mul_add(
-                x177,
-                x508,
-                Self::mul_add(
-                    -x178,
-                    x494,
-                    Self::mul_add(c_q7, x199, s_q7 * x198)
-                        + Self::mul_add(-0.65, x196, 0.75 * x200),
-                ),
+                -0.00000000020510342851533115,
+                x499,
+                Self::mul_add(-c_q8, x497, s_q8 * x498),
             ),
         );
-        let x544 = x535 * x543;
-        let x545 = Self::mul_add(
-            -x516,
-            x527,
-            Self::mul_add(
-                x177,
-                x509,
-                Self::mul_add(
-                    -x178,
-                    x495,
-                    Self::mul_add(c_q7, x213, s_q7 * x212)
-                        + Self::mul_add(-0.65, x210, 0.75 * x214),
-                ),
-            ),
+        let x544 = 1.0 / x540;
+        let x545 = tau[0] - x542;
+        let x546 = x538 * x544;
+        let x547 = x539 * x544;
+        let x548 = x515 * x544;
+        let x549 = x541 * x544;
+        let x550 = x517 * x544;
+        let x551 = Self::mul_add(-x538, x546, Self::mul_add(-0.35, x513, x533));
+        let x552 = Self::mul_add(-x538, x547, -0.07309 + x534);
+        let x553 = Self::mul_add(-x539, x547, 130.43769025763282 + x535);
+        let x554 = Self::mul_add(-x538, x548, Self::mul_add(-0.35, x526, x512));
+        let x555 = Self::mul_add(-x538, x549, x530);
+        let x556 = Self::mul_add(
+            -x538,
+            x550,
+            Self::mul_add(-0.35, x529, Self::mul_add(-x26, x511, x25 * x508)),
         );
-        let x546 = x535 * x545;
-        let x547 = Self::mul_add(
-            -x516,
-            x529,
-            Self::mul_add(
-                x177,
-                x510,
-                Self::mul_add(
-                    -x178,
-                    x496,
-                    Self::mul_add(c_q7, x232, s_q7 * x231)
-                        + Self::mul_add(-0.65, x229, 0.75 * x233),
-                ),
-            ),
+        let x557 = Self::mul_add(-x539, x548, x531);
+        let x558 = Self::mul_add(-x539, x549, x532);
+        let x559 = Self::mul_add(
+            -x539,
+            x550,
+            -48.0240000085309
+                + Self::mul_add(0.35, x527, Self::mul_add(c_q8, x511, s_q8 * x508)),
         );
-        let x548 = x535 * x547;
-        let x549 = Self::mul_add(
-            -x516,
-            x531,
-            Self::mul_add(
-                x177,
-                x511,
-                Self::mul_add(
-                    -x178,
-                    x497,
-                    Self::mul_add(c_q7, x260, s_q7 * x259)
-                        + Self::mul_add(-0.65, x257, 0.75 * x261),
-                ),
-            ),
-        );
-        let x550 = x535 * x549;
-        let x551 = Self::mul_add(
-            -x516,
-            x533,
-            Self::mul_add(
-                x177,
-                x512,
-                Self::mul_add(
-                    -x178,
-                    x498,
-                    Self::mul_add(c_q7, x296, s_q7 * x295)
-                        + Self::mul_add(-0.65, x293, 0.75 * x297),
-                ),
-            ),
-        );
-        let x552 = x535 * x551;
-        let x553 = 1.0
-            / Self::mul_add(
-                -x537,
-                x538,
-                Self::mul_add(-x518, x519, 1271.854575 + (x176 - x173) - x514 - x534),
-            );
-        let x554 = Self::mul_add(
-            -x537,
-            x540,
-            Self::mul_add(-x518, x521, Self::mul_add(-x177, x500, x176 - x514)),
-        );
-        let x555 = x553 * x554;
-        let x556 = x168 * x493;
-        let x557 = Self::mul_add(
-            -x537,
-            x542,
-            Self::mul_add(
-                -x518,
-                x523,
-                Self::mul_add(-x177, x501, Self::mul_add(0.65, x184, x156) - x556),
-            ),
-        );
-        let x558 = x553 * x557;
-        let x559 = x168 * x494;
-        let x560 = Self::mul_add(
-            -x537,
-            x544,
-            Self::mul_add(
-                -x518,
-                x525,
-                Self::mul_add(-x177, x502, Self::mul_add(0.65, x201, x197) + x559),
-            ),
-        );
-        let x561 = x553 * x560;
-        let x562 = x168 * x495;
-        let x563 = Self::mul_add(
-            -x537,
-            x546,
-            Self::mul_add(
-                -x518,
-                x527,
-                Self::mul_add(-x177, x503, Self::mul_add(0.65, x215, x211) + x562),
-            ),
-        );
-        let x564 = x553 * x563;
-        let x565 = x168 * x496;
-        let x566 = Self::mul_add(
-            -x537,
-            x548,
-            Self::mul_add(
-                -x518,
-                x529,
-                Self::mul_add(-x177, x504, Self::mul_add(0.65, x234, x230) + x565),
-            ),
-        );
-        let x567 = x553 * x566;
-        let x568 = x168 * x497;
-        let x569 = Self::mul_add(
-            -x537,
+        let x560 = Self::mul_add(-x515, x548, x525);
+        let x561 = Self::mul_add(-x515, x549, x526);
+        let x562 = Self::mul_add(-x515, x550, x527);
+        let x563 = Self::mul_add(-x541, x549, x528);
+        let x564 = Self::mul_add(-x541, x550, x529);
+        let x565 = Self::mul_add(
+            -x517,
             x550,
             Self::mul_add(
-                -x518,
-                x531,
-                Self::mul_add(-x177, x505, Self::mul_add(0.65, x262, x258) + x568),
+                -0.00000000020510342851533115,
+                x524,
+                Self::mul_add(-c_q8, x521, s_q8 * x523),
             ),
         );
-        let x570 = x553 * x569;
-        let x571 = x168 * x498;
-        let x572 = Self::mul_add(
-            -x537,
-            x552,
+        let x566 = Self::mul_add(
+            x545,
+            x546,
+            Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
+                + Self::mul_add(
+                    -0.35,
+                    x537,
+                    x496 + Self::mul_add(-x26, x495, x25 * x494),
+                )
+                + (Self::mul_add(-x15, x552, x14 * x551)
+                    + Self::mul_add(-x17, x555, x16 * x554)),
+        );
+        let x567 = Self::mul_add(
+            x545,
+            x547,
+            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19))
+                + Self::mul_add(0.35, x536, Self::mul_add(c_q8, x495, s_q8 * x494))
+                + (Self::mul_add(-x15, x553, x14 * x552)
+                    + Self::mul_add(-x17, x558, x16 * x557)),
+        );
+        let x568 = Self::mul_add(
+            x545,
+            x548,
+            Self::mul_add(-x8, x23, x18 * x22) + x536
+                + (Self::mul_add(-x15, x557, x14 * x554)
+                    + Self::mul_add(-x17, x561, x16 * x560)),
+        );
+        let x569 = Self::mul_add(
+            x545,
+            x549,
+            Self::mul_add(x7, x23, x537)
+                + (Self::mul_add(-x15, x558, x14 * x555)
+                    + Self::mul_add(-x17, x563, x16 * x561)),
+        );
+        let x570 = Self::mul_add(
+            x545,
+            x550,
+            x543
+                + (Self::mul_add(-x15, x559, x14 * x556)
+                    + Self::mul_add(-x17, x564, x16 * x562)),
+        );
+        let x571 = s_q7 * x552;
+        let x572 = c_q7 * x552;
+        let x573 = Self::mul_add(s_q7, x551, x572);
+        let x574 = Self::mul_add(c_q7, x553, x571);
+        let x575 = Self::mul_add(-s_q7, x555, c_q7 * x554);
+        let x576 = Self::mul_add(c_q7, x555, s_q7 * x554);
+        let x577 = Self::mul_add(-s_q7, x558, c_q7 * x557);
+        let x578 = Self::mul_add(c_q7, x558, s_q7 * x557);
+        let x579 = Self::mul_add(-s_q7, x577, c_q7 * x575);
+        let x580 = Self::mul_add(-s_q7, x578, c_q7 * x576);
+        let x581 = Self::mul_add(-s_q7, x559, c_q7 * x556);
+        let x582 = Self::mul_add(c_q7, x577, s_q7 * x575);
+        let x583 = Self::mul_add(c_q7, x578, s_q7 * x576);
+        let x584 = Self::mul_add(c_q7, x559, s_q7 * x556);
+        let x585 = s_q7 * x561;
+        let x586 = c_q7 * x561;
+        let x587 = Self::mul_add(s_q7, x560, x586);
+        let x588 = Self::mul_add(c_q7, x563, x585);
+        let x589 = Self::mul_add(-s_q7, x564, c_q7 * x562);
+        let x590 = Self::mul_add(c_q7, x564, s_q7 * x562);
+        let x591 = Self::mul_add(
+            -s_q7,
+            Self::mul_add(-s_q7, x563, x586),
+            c_q7 * Self::mul_add(c_q7, x560, -x585),
+        );
+        let x592 = Self::mul_add(-s_q7, x588, c_q7 * x587);
+        let x593 = Self::mul_add(c_q7, x588, s_q7 * x587);
+        let x594 = 0.65 * x592;
+        let x595 = 0.65 * x593;
+        let x596 = 0.65 * x590;
+        let x597 = Self::mul_add(-0.75, x592, x579);
+        let x598 = Self::mul_add(-0.75, x593, x580);
+        let x599 = x582 + Self::mul_add(-0.65, x589, 0.75 * x591);
+        let x600 = x583 + Self::mul_add(-0.65, x590, 0.75 * x592);
+        let x601 = x584 + Self::mul_add(-0.65, x565, 0.75 * x589);
+        let x602 = Self::mul_add(
+            -0.75,
+            x598,
             Self::mul_add(
-                -x518,
-                x533,
-                Self::mul_add(-x177, x506, Self::mul_add(0.65, x298, x294) + x571),
+                -s_q7,
+                Self::mul_add(-s_q7, x553, x572),
+                c_q7 * Self::mul_add(c_q7, x551, -x571),
             ),
         );
-        let x573 = x553 * x572;
-        let x574 = 1.0
-            / Self::mul_add(
-                -x554,
-                x555,
-                Self::mul_add(
-                    -x539,
-                    x540,
-                    Self::mul_add(-x520, x521, Self::mul_add(-x167, x500, x166 - x514)),
-                ),
-            );
-        let x575 = Self::mul_add(
-            -x554,
-            x558,
-            Self::mul_add(
-                -x539,
-                x542,
-                Self::mul_add(-x520, x523, Self::mul_add(-x167, x501, x156 - x556)),
-            ),
-        );
-        let x576 = x574 * x575;
-        let x577 = Self::mul_add(
-            -x554,
-            x561,
-            Self::mul_add(
-                -x539,
-                x544,
-                Self::mul_add(-x520, x525, Self::mul_add(-x167, x502, x197 + x559)),
-            ),
-        );
-        let x578 = x574 * x577;
-        let x579 = Self::mul_add(
-            -x554,
-            x564,
-            Self::mul_add(
-                -x539,
-                x546,
-                Self::mul_add(-x520, x527, Self::mul_add(-x167, x503, x211 + x562)),
-            ),
-        );
-        let x580 = x574 * x579;
-        let x581 = Self::mul_add(
-            -x554,
-            x567,
-            Self::mul_add(
-                -x539,
-                x548,
-                Self::mul_add(-x520, x529, Self::mul_add(-x167, x504, x230 + x565)),
-            ),
-        );
-        let x582 = x574 * x581;
-        let x583 = Self::mul_add(
-            -x554,
-            x570,
-            Self::mul_add(
-                -x539,
-                x550,
-                Self::mul_add(-x520, x531, Self::mul_add(-x167, x505, x258 + x568)),
-            ),
-        );
-        let x584 = x574 * x583;
-        let x585 = Self::mul_add(
-            -x554,
-            x573,
-            Self::mul_add(
-                -x539,
-                x552,
-                Self::mul_add(-x520, x533, Self::mul_add(-x167, x506, x294 + x571)),
-            ),
-        );
-        let x586 = x574 * x585;
-        let x587 = 1.0
-            / Self::mul_add(
-                -x575,
-                x576,
-                Self::mul_add(
-                    -x557,
-                    x558,
-                    Self::mul_add(
-                        -x541,
-                        x542,
-                        Self::mul_add(
-                            -x522,
-                            x523,
-                            Self::mul_add(
-                                -x146,
-                                x507,
-                                Self::mul_add(-x184, x501, Self::mul_add(-x183, x493, x144)),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x588 = Self::mul_add(
-            -x575,
-            x578,
-            Self::mul_add(
-                -x557,
-                x561,
-                Self::mul_add(
-                    -x541,
-                    x544,
-                    Self::mul_add(
-                        -x522,
-                        x525,
-                        Self::mul_add(
-                            -x146,
-                            x508,
-                            Self::mul_add(-x184, x502, Self::mul_add(x183, x494, x193)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x589 = x587 * x588;
-        let x590 = Self::mul_add(
-            -x575,
-            x580,
-            Self::mul_add(
-                -x557,
-                x564,
-                Self::mul_add(
-                    -x541,
-                    x546,
-                    Self::mul_add(
-                        -x522,
-                        x527,
-                        Self::mul_add(
-                            -x146,
-                            x509,
-                            Self::mul_add(-x184, x503, Self::mul_add(x183, x495, x207)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x591 = x587 * x590;
-        let x592 = Self::mul_add(
-            -x575,
-            x582,
-            Self::mul_add(
-                -x557,
-                x567,
-                Self::mul_add(
-                    -x541,
-                    x548,
-                    Self::mul_add(
-                        -x522,
-                        x529,
-                        Self::mul_add(
-                            -x146,
-                            x510,
-                            Self::mul_add(-x184, x504, Self::mul_add(x183, x496, x226)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x593 = x587 * x592;
-        let x594 = Self::mul_add(
-            -x575,
-            x584,
-            Self::mul_add(
-                -x557,
-                x570,
-                Self::mul_add(
-                    -x541,
-                    x550,
-                    Self::mul_add(
-                        -x522,
-                        x531,
-                        Self::mul_add(
-                            -x146,
-                            x511,
-                            Self::mul_add(-x184, x505, Self::mul_add(x183, x497, x254)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x595 = x587 * x594;
-        let x596 = Self::mul_add(
-            -x575,
-            x586,
-            Self::mul_add(
-                -x557,
-                x573,
-                Self::mul_add(
-                    -x541,
-                    x552,
-                    Self::mul_add(
-                        -x522,
-                        x533,
-                        Self::mul_add(
-                            -x146,
-                            x512,
-                            Self::mul_add(-x184, x506, Self::mul_add(x183, x498, x290)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x597 = x587 * x596;
-        let x598 = 1.0
-            / Self::mul_add(
-                -x588,
-                x589,
-                Self::mul_add(
-                    -x577,
-                    x578,
-                    Self::mul_add(
-                        -x560,
-                        x561,
-                        Self::mul_add(
-                            -x543,
-                            x544,
-                            Self::mul_add(
-                                -x524,
-                                x525,
-                                Self::mul_add(
-                                    -x196,
-                                    x508,
-                                    Self::mul_add(-x201, x502, Self::mul_add(-x200, x494, x117)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x599 = Self::mul_add(
-            -x588,
-            x591,
-            Self::mul_add(
-                -x577,
-                x580,
-                Self::mul_add(
-                    -x560,
-                    x564,
-                    Self::mul_add(
-                        -x543,
-                        x546,
-                        Self::mul_add(
-                            -x524,
-                            x527,
-                            Self::mul_add(
-                                -x196,
-                                x509,
-                                Self::mul_add(-x201, x503, Self::mul_add(-x200, x495, x108)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x600 = x598 * x599;
-        let x601 = Self::mul_add(
-            -x588,
-            x593,
-            Self::mul_add(
-                -x577,
-                x582,
-                Self::mul_add(
-                    -x560,
-                    x567,
-                    Self::mul_add(
-                        -x543,
-                        x548,
-                        Self::mul_add(
-                            -x524,
-                            x529,
-                            Self::mul_add(
-                                -x196,
-                                x510,
-                                Self::mul_add(-x201, x504, Self::mul_add(-x200, x496, x220)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x602 = x598 * x601;
-        let x603 = Self::mul_add(
-            -x588,
-            x595,
-            Self::mul_add(
-                -x577,
-                x584,
-                Self::mul_add(
-                    -x560,
-                    x570,
-                    Self::mul_add(
-                        -x543,
-                        x550,
-                        Self::mul_add(
-                            -x524,
-                            x531,
-                            Self::mul_add(
-                                -x196,
-                                x511,
-                                Self::mul_add(-x201, x505, Self::mul_add(-x200, x497, x248)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x604 = x598 * x603;
-        let x605 = Self::mul_add(
-            -x588,
-            x597,
-            Self::mul_add(
-                -x577,
-                x586,
-                Self::mul_add(
-                    -x560,
-                    x573,
-                    Self::mul_add(
-                        -x543,
-                        x552,
-                        Self::mul_add(
-                            -x524,
-                            x533,
-                            Self::mul_add(
-                                -x196,
-                                x512,
-                                Self::mul_add(-x201, x506, Self::mul_add(-x200, x498, x284)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x606 = x598 * x605;
-        let x607 = 1.0
-            / Self::mul_add(
-                -x599,
-                x600,
-                Self::mul_add(
-                    -x590,
-                    x591,
-                    Self::mul_add(
-                        -x579,
-                        x580,
-                        Self::mul_add(
-                            -x563,
-                            x564,
-                            Self::mul_add(
-                                -x545,
-                                x546,
-                                Self::mul_add(
-                                    -x526,
-                                    x527,
-                                    Self::mul_add(
-                                        -x210,
-                                        x509,
-                                        Self::mul_add(-x215, x503, Self::mul_add(-x214, x495, x94)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x608 = Self::mul_add(
-            -x599,
-            x602,
-            Self::mul_add(
-                -x590,
-                x593,
-                Self::mul_add(
-                    -x579,
-                    x582,
-                    Self::mul_add(
-                        -x563,
-                        x567,
-                        Self::mul_add(
-                            -x545,
-                            x548,
-                            Self::mul_add(
-                                -x526,
-                                x529,
-                                Self::mul_add(
-                                    -x210,
-                                    x510,
-                                    Self::mul_add(-x215, x504, Self::mul_add(-x214, x496, x85)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x609 = x607 * x608;
-        let x610 = Self::mul_add(
-            -x599,
-            x604,
-            Self::mul_add(
-                -x590,
-                x595,
-                Self::mul_add(
-                    -x579,
-                    x584,
-                    Self::mul_add(
-                        -x563,
-                        x570,
-                        Self::mul_add(
-                            -x545,
-                            x550,
-                            Self::mul_add(
-                                -x526,
-                                x531,
-                                Self::mul_add(
-                                    -x210,
-                                    x511,
-                                    Self::mul_add(-x215, x505, Self::mul_add(-x214, x497, x243)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x611 = x607 * x610;
-        let x612 = Self::mul_add(
-            -x599,
-            x606,
-            Self::mul_add(
-                -x590,
-                x597,
-                Self::mul_add(
-                    -x579,
-                    x586,
-                    Self::mul_add(
-                        -x563,
-                        x573,
-                        Self::mul_add(
-                            -x545,
-                            x552,
-                            Self::mul_add(
-                                -x526,
-                                x533,
-                                Self::mul_add(
-                                    -x210,
-                                    x512,
-                                    Self::mul_add(-x215, x506, Self::mul_add(-x214, x498, x279)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x613 = x607 * x612;
-        let x614 = 1.0
-            / Self::mul_add(
-                -x608,
-                x609,
-                Self::mul_add(
-                    -x601,
-                    x602,
-                    Self::mul_add(
-                        -x592,
-                        x593,
-                        Self::mul_add(
-                            -x581,
-                            x582,
-                            Self::mul_add(
-                                -x566,
-                                x567,
-                                Self::mul_add(
-                                    -x547,
-                                    x548,
-                                    Self::mul_add(
-                                        -x528,
-                                        x529,
-                                        Self::mul_add(
-                                            -x229,
-                                            x510,
-                                            Self::mul_add(-x234, x504, Self::mul_add(-x233, x496, x71)),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x615 = Self::mul_add(
-            -x608,
-            x611,
-            Self::mul_add(
-                -x601,
-                x604,
-                Self::mul_add(
-                    -x592,
-                    x595,
-                    Self::mul_add(
-                        -x581,
-                        x584,
-                        Self::mul_add(
-                            -x566,
-                            x570,
-                            Self::mul_add(
-                                -x547,
-                                x550,
-                                Self::mul_add(
-                                    -x528,
-                                    x531,
-                                    Self::mul_add(
-                                        -x229,
-                                        x511,
-                                        Self::mul_add(-x234, x505, Self::mul_add(-x233, x497, x59)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x616 = x614 * x615;
-        let x617 = Self::mul_add(
-            -x608,
-            x613,
-            Self::mul_add(
-                -x601,
-                x606,
-                Self::mul_add(
-                    -x592,
-                    x597,
-                    Self::mul_add(
-                        -x581,
-                        x586,
-                        Self::mul_add(
-                            -x566,
-                            x573,
-                            Self::mul_add(
-                                -x547,
-                                x552,
-                                Self::mul_add(
-                                    -x528,
-                                    x533,
-                                    Self::mul_add(
-                                        -x229,
-                                        x512,
-                                        Self::mul_add(-x234, x506, Self::mul_add(-x233, x498, x272)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x618 = x614 * x617;
-        let x619 = 1.0
-            / Self::mul_add(
-                -x615,
-                x616,
-                Self::mul_add(
-                    -x610,
-                    x611,
-                    Self::mul_add(
-                        -x603,
-                        x604,
-                        Self::mul_add(
-                            -x594,
-                            x595,
-                            Self::mul_add(
-                                -x583,
-                                x584,
-                                Self::mul_add(
-                                    -x569,
-                                    x570,
-                                    Self::mul_add(
-                                        -x549,
-                                        x550,
-                                        Self::mul_add(
-                                            -x530,
-                                            x531,
-                                            Self::mul_add(
-                                                -x257,
-                                                x511,
-                                                Self::mul_add(-x262, x505, Self::mul_add(-x261, x497, x44)),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x620 = Self::mul_add(
-            -x615,
-            x618,
-            Self::mul_add(
-                -x610,
-                x613,
-                Self::mul_add(
-                    -x603,
-                    x606,
-                    Self::mul_add(
-                        -x594,
-                        x597,
-                        Self::mul_add(
-                            -x583,
-                            x586,
-                            Self::mul_add(
-                                -x569,
-                                x573,
-                                Self::mul_add(
-                                    -x549,
-                                    x552,
-                                    Self::mul_add(
-                                        -x530,
-                                        x533,
-                                        Self::mul_add(
-                                            -x257,
-                                            x512,
-                                            Self::mul_add(-x262, x506, Self::mul_add(-x261, x498, x268)),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x621 = x619 * x620;
+        let x603 = Self::mul_add(-s_q7, x569, c_q7 * x568);
+        let x604 = Self::mul_add(c_q7, x569, s_q7 * x568);
+        let x605 = 180.9502499901501 + x599;
+        let x606 = Self::mul_add(-v[5], x4, v[4] * x5) + x603;
+        let x607 = 1.0 / (1170.07 + x591);
+        let x608 = x592 * x607;
+        let x609 = x589 * x607;
+        let x610 = x597 * x607;
+        let x611 = x605 * x607;
+        let x612 = x594 * x607;
+        let x613 = 1.0 / Self::mul_add(-x592, x608, 1170.07 + x593);
+        let x614 = Self::mul_add(-x592, x609, x590);
+        let x615 = x613 * x614;
+        let x616 = Self::mul_add(-x592, x610, -180.9502499901501 + x598);
+        let x617 = x613 * x616;
+        let x618 = Self::mul_add(-x592, x611, x600);
+        let x619 = x613 * x618;
+        let x620 = Self::mul_add(-x592, x612, 110.5455 + x595);
+        let x621 = x613 * x620;
         let x622 = 1.0
-            / Self::mul_add(
-                -x620,
-                x621,
-                Self::mul_add(
-                    -x617,
-                    x618,
-                    Self::mul_add(
-                        -x612,
-                        x613,
-                        Self::mul_add(
-                            -x605,
-                            x606,
-                            Self::mul_add(
-                                -x596,
-                                x597,
-                                Self::mul_add(
-                                    -x585,
-                                    x586,
-                                    Self::mul_add(
-                                        -x572,
-                                        x573,
-                                        Self::mul_add(
-                                            -x551,
-                                            x552,
-                                            Self::mul_add(
-                                                -x532,
-                                                x533,
-                                                Self::mul_add(
-                                                    -x293,
-                                                    x512,
-                                                    Self::mul_add(
-                                                        -x298,
-                                                        x506,
-                                                        Self::mul_add(-x297, x498, 1.4135609200000003),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            / Self::mul_add(-x614, x615, Self::mul_add(-x589, x609, 1170.07 + x565));
         let x623 = Self::mul_add(
-            x490,
-            x492,
-            -Self::mul_add(
-                x489,
-                x491,
-                Self::mul_add(-0.75, x484, Self::mul_add(-s_q7, x481, c_q7 * x480))
-                    + Self::mul_add(
-                        x300,
-                        -180.9502499901501,
-                        Self::mul_add(-v[5], x486, v[4] * x487),
-                    ),
-            ),
+            -x614,
+            x617,
+            Self::mul_add(-x589, x610, Self::mul_add(-0.75, x590, x581)),
         );
-        let x624 = Self::mul_add(
-            -x517,
-            x623,
-            Self::mul_add(
-                -x490,
-                x499,
-                Self::mul_add(
-                    x488,
-                    x491,
-                    -(Self::mul_add(c_q7, x481, s_q7 * x480)
-                        + Self::mul_add(-0.65, x479, 0.75 * x483)
-                        + (Self::mul_add(-v[3], x487, v[5] * x485)
-                            + Self::mul_add(x301, -110.5455, 180.9502499901501 * x299))),
-                ),
-            ),
+        let x624 = x622 * x623;
+        let x625 = Self::mul_add(
+            -x614,
+            x619,
+            Self::mul_add(-x589, x611, -110.5455 + x601),
         );
-        let x625 = x488 * x492;
-        let x626 = Self::mul_add(
-            -x538,
-            x624,
-            Self::mul_add(
-                -x519,
-                x623,
-                Self::mul_add(
-                    x489,
-                    x499,
-                    -(Self::mul_add(0.65, x484, x482)
-                        + Self::mul_add(
-                            110.5455,
-                            x300,
-                            Self::mul_add(-v[4], x485, v[3] * x486),
-                        ) + x625),
-                ),
-            ),
-        );
-        let x627 = Self::mul_add(
-            -x555,
-            x626,
-            Self::mul_add(
-                -x540,
-                x624,
-                Self::mul_add(
-                    -x521,
-                    x623,
-                    Self::mul_add(x489, x500, tau[0] - x482 - x625),
-                ),
-            ),
-        );
-        let x628 = Self::mul_add(
-            -x576,
-            x627,
-            Self::mul_add(
-                -x558,
-                x626,
-                Self::mul_add(
-                    -x542,
-                    x624,
-                    Self::mul_add(
-                        -x523,
-                        x623,
-                        Self::mul_add(
-                            x490,
-                            x507,
-                            Self::mul_add(
-                                x489,
-                                x501,
-                                Self::mul_add(-x488, x493, tau[1] - x474),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
+        let x626 = x622 * x625;
+        let x627 = Self::mul_add(-x614, x621, Self::mul_add(-x589, x612, x596));
+        let x628 = x622 * x627;
         let x629 = Self::mul_add(
-            -x589,
-            x628,
-            Self::mul_add(
-                -x578,
-                x627,
-                Self::mul_add(
-                    -x561,
-                    x626,
-                    Self::mul_add(
-                        -x544,
-                        x624,
-                        Self::mul_add(
-                            -x525,
-                            x623,
-                            Self::mul_add(
-                                x490,
-                                x508,
-                                Self::mul_add(
-                                    x489,
-                                    x502,
-                                    Self::mul_add(x488, x494, tau[2] - x465),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x630 = Self::mul_add(
-            -x600,
-            x629,
-            Self::mul_add(
-                -x591,
-                x628,
-                Self::mul_add(
-                    -x580,
-                    x627,
-                    Self::mul_add(
-                        -x564,
-                        x626,
-                        Self::mul_add(
-                            -x546,
-                            x624,
-                            Self::mul_add(
-                                -x527,
-                                x623,
-                                Self::mul_add(
-                                    x490,
-                                    x509,
-                                    Self::mul_add(
-                                        x489,
-                                        x503,
-                                        Self::mul_add(x488, x495, tau[3] - x458),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x631 = Self::mul_add(
-            -x609,
-            x630,
-            Self::mul_add(
-                -x602,
-                x629,
-                Self::mul_add(
-                    -x593,
-                    x628,
-                    Self::mul_add(
-                        -x582,
-                        x627,
-                        Self::mul_add(
-                            -x567,
-                            x626,
-                            Self::mul_add(
-                                -x548,
-                                x624,
-                                Self::mul_add(
-                                    -x529,
-                                    x623,
-                                    Self::mul_add(
-                                        x490,
-                                        x510,
-                                        Self::mul_add(
-                                            x489,
-                                            x504,
-                                            Self::mul_add(x488, x496, tau[4] - x450),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x632 = Self::mul_add(
             -x616,
-            x631,
+            x617,
             Self::mul_add(
-                -x611,
-                x630,
-                Self::mul_add(
-                    -x604,
-                    x629,
-                    Self::mul_add(
-                        -x595,
-                        x628,
-                        Self::mul_add(
-                            -x584,
-                            x627,
-                            Self::mul_add(
-                                -x570,
-                                x626,
-                                Self::mul_add(
-                                    -x550,
-                                    x624,
-                                    Self::mul_add(
-                                        -x531,
-                                        x623,
-                                        Self::mul_add(
-                                            x490,
-                                            x511,
-                                            Self::mul_add(
-                                                x489,
-                                                x505,
-                                                Self::mul_add(x488, x497, tau[5] - x442),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                -x597,
+                x610,
+                1394.5960312283303 + Self::mul_add(-0.75, x580, x602),
             ),
         );
-        let x633 = x622
-            * Self::mul_add(
-                -x621,
-                x632,
-                Self::mul_add(
-                    -x618,
-                    x631,
-                    Self::mul_add(
-                        -x613,
-                        x630,
-                        Self::mul_add(
-                            -x606,
-                            x629,
-                            Self::mul_add(
-                                -x597,
-                                x628,
-                                Self::mul_add(
-                                    -x586,
-                                    x627,
-                                    Self::mul_add(
-                                        -x573,
-                                        x626,
-                                        Self::mul_add(
-                                            -x552,
-                                            x624,
-                                            Self::mul_add(
-                                                -x533,
-                                                x623,
-                                                Self::mul_add(
-                                                    x490,
-                                                    x512,
-                                                    Self::mul_add(
-                                                        x489,
-                                                        x506,
-                                                        Self::mul_add(x488, x498, tau[6] - x433),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x634 = Self::mul_add(-x621, x633, x619 * x632);
-        let x635 = Self::mul_add(-x618, x633, Self::mul_add(-x616, x634, x614 * x631));
-        let x636 = Self::mul_add(
-            -x613,
-            x633,
-            Self::mul_add(-x611, x634, Self::mul_add(-x609, x635, x607 * x630)),
-        );
-        let x637 = Self::mul_add(
-            -x606,
-            x633,
-            Self::mul_add(
-                -x604,
-                x634,
-                Self::mul_add(-x602, x635, Self::mul_add(-x600, x636, x598 * x629)),
-            ),
-        );
-        let x638 = Self::mul_add(
+        let x630 = 1.0 / Self::mul_add(-x623, x624, x629);
+        let x631 = Self::mul_add(
             -x597,
-            x633,
+            x611,
+            Self::mul_add(-0.65, x581, 0.75 * x579)
+                + Self::mul_add(-0.75, x600, Self::mul_add(-s_q7, x574, c_q7 * x573)),
+        );
+        let x632 = Self::mul_add(-x623, x626, Self::mul_add(-x616, x619, x631));
+        let x633 = x630 * x632;
+        let x634 = Self::mul_add(
+            -x616,
+            x621,
             Self::mul_add(
-                -x595,
-                x634,
-                Self::mul_add(
-                    -x593,
-                    x635,
-                    Self::mul_add(-x591, x636, Self::mul_add(-x589, x637, x587 * x628)),
-                ),
+                -x597,
+                x612,
+                -117.61766249359756 + Self::mul_add(0.65, x580, -0.75 * x595),
             ),
         );
-        let x639 = Self::mul_add(
-            -x586,
-            x633,
+        let x635 = Self::mul_add(-x623, x628, x634);
+        let x636 = x630 * x635;
+        let x637 = Self::mul_add(
+            -x618,
+            x619,
             Self::mul_add(
-                -x584,
-                x634,
-                Self::mul_add(
-                    -x582,
-                    x635,
-                    Self::mul_add(
-                        -x580,
-                        x636,
-                        Self::mul_add(
-                            -x578,
-                            x637,
-                            Self::mul_add(-x576, x638, x574 * x627),
-                        ),
-                    ),
-                ),
+                -x605,
+                x611,
+                1466.4506062283303
+                    + (Self::mul_add(-0.65, x584, 0.75 * x582)
+                        + (Self::mul_add(c_q7, x574, s_q7 * x573)
+                            + Self::mul_add(-0.65, x601, 0.75 * x599))),
             ),
+        );
+        let x638 = 1.0 / Self::mul_add(-x632, x633, Self::mul_add(-x625, x626, x637));
+        let x639 = Self::mul_add(
+            -x605,
+            x612,
+            Self::mul_add(0.65, x583, Self::mul_add(-0.65, x596, 0.75 * x594)),
         );
         let x640 = Self::mul_add(
-            -x573,
-            x633,
-            Self::mul_add(
-                -x570,
-                x634,
-                Self::mul_add(
-                    -x567,
-                    x635,
-                    Self::mul_add(
-                        -x564,
-                        x636,
-                        Self::mul_add(
-                            -x561,
-                            x637,
-                            Self::mul_add(
-                                -x558,
-                                x638,
-                                Self::mul_add(-x555, x639, x553 * x626),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            -x632,
+            x636,
+            Self::mul_add(-x625, x628, Self::mul_add(-x618, x621, x639)),
         );
-        let x641 = Self::mul_add(
-            -x552,
-            x633,
-            Self::mul_add(
-                -x550,
-                x634,
-                Self::mul_add(
-                    -x548,
-                    x635,
-                    Self::mul_add(
-                        -x546,
-                        x636,
-                        Self::mul_add(
-                            -x544,
-                            x637,
-                            Self::mul_add(
-                                -x542,
-                                x638,
-                                Self::mul_add(
-                                    -x540,
-                                    x639,
-                                    Self::mul_add(-x538, x640, x535 * x624),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
+        let x641 = x638 * x640;
         let x642 = Self::mul_add(
-            -x533,
-            x633,
-            Self::mul_add(
-                -x531,
-                x634,
-                Self::mul_add(
-                    -x529,
-                    x635,
-                    Self::mul_add(
-                        -x527,
-                        x636,
-                        Self::mul_add(
-                            -x525,
-                            x637,
-                            Self::mul_add(
-                                -x523,
-                                x638,
-                                Self::mul_add(
-                                    -x521,
-                                    x639,
-                                    Self::mul_add(
-                                        -x519,
-                                        x640,
-                                        Self::mul_add(-x517, x641, x515 * x623),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            -x620,
+            x621,
+            Self::mul_add(-x594, x612, Self::mul_add(0.65, x595, 1271.854575)),
         );
         let x643 = Self::mul_add(
-            -x512,
-            x633,
-            Self::mul_add(
-                -x511,
-                x634,
-                Self::mul_add(
-                    -x510,
-                    x635,
-                    Self::mul_add(
-                        -x509,
-                        x636,
-                        Self::mul_add(
-                            -x508,
-                            x637,
-                            Self::mul_add(
-                                -x507,
-                                x638,
-                                Self::mul_add(
-                                    x499,
-                                    x641,
-                                    -Self::mul_add(x492, x642, x490 * 0.0008546497218115156),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            -x640,
+            x641,
+            Self::mul_add(-x635, x636, Self::mul_add(-x627, x628, x642)),
         );
-        let x644 = Self::mul_add(
-            -x506,
-            x633,
-            Self::mul_add(
-                -x505,
-                x634,
-                Self::mul_add(
-                    -x504,
-                    x635,
-                    Self::mul_add(
-                        -x503,
-                        x636,
-                        Self::mul_add(
-                            -x502,
-                            x637,
-                            Self::mul_add(
-                                -x501,
-                                x638,
-                                Self::mul_add(
-                                    -x500,
-                                    x639,
-                                    Self::mul_add(
-                                        -x499,
-                                        x640,
-                                        Self::mul_add(x489, -0.0008546497218115156, x491 * x642),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
+        let x644 = 1.0 / x643;
         let x645 = Self::mul_add(
-            -x498,
-            x633,
+            x606,
+            x608,
+            -(Self::mul_add(-v[3], x5, v[5] * x3) + x604),
+        );
+        let x646 = Self::mul_add(
+            -x615,
+            x645,
+            Self::mul_add(x606, x609, -(Self::mul_add(-v[4], x3, v[3] * x4) + x570)),
+        );
+        let x647 = Self::mul_add(
+            x606,
+            x610,
+            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
+                + Self::mul_add(-0.75, x604, Self::mul_add(-s_q7, x567, c_q7 * x566))),
+        );
+        let x648 = Self::mul_add(-x624, x646, Self::mul_add(-x617, x645, x647));
+        let x649 = Self::mul_add(
+            -x619,
+            x645,
             Self::mul_add(
-                -x497,
-                x634,
-                Self::mul_add(
-                    -x496,
-                    x635,
-                    Self::mul_add(
-                        -x495,
-                        x636,
-                        Self::mul_add(
-                            -x494,
-                            x637,
-                            Self::mul_add(
-                                x493,
-                                x638,
-                                Self::mul_add(
-                                    x492,
-                                    x639,
-                                    Self::mul_add(
-                                        x492,
-                                        x640,
-                                        -Self::mul_add(x491, x641, x488 * 0.0008546497218115156),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                x606,
+                x611,
+                -(Self::mul_add(-v[3], x2, v[5] * x0)
+                    + Self::mul_add(-v[0], x5, v[2] * x3)
+                    + (Self::mul_add(c_q7, x567, s_q7 * x566)
+                        + Self::mul_add(-0.65, x570, 0.75 * x603))),
             ),
         );
-        [x645, x644, x643, x642, x641, x640, x639, x638, x637, x636, x635, x634, x633]
+        let x650 = Self::mul_add(-x633, x648, Self::mul_add(-x626, x646, x649));
+        let x651 = Self::mul_add(
+            x606,
+            x612,
+            -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
+                + Self::mul_add(0.65, x604, Self::mul_add(x545, x540 * x544, x542))),
+        );
+        let x652 = Self::mul_add(
+            -x636,
+            x648,
+            Self::mul_add(-x628, x646, Self::mul_add(-x621, x645, x651)),
+        );
+        let x653 = x644 * Self::mul_add(-x641, x650, x652);
+        let x654 = Self::mul_add(-x641, x653, x638 * x650);
+        let x655 = Self::mul_add(-x636, x653, Self::mul_add(-x633, x654, x630 * x648));
+        let x656 = Self::mul_add(
+            -x628,
+            x653,
+            Self::mul_add(-x626, x654, Self::mul_add(-x624, x655, x622 * x646)),
+        );
+        let x657 = Self::mul_add(
+            -x619,
+            x654,
+            Self::mul_add(-x617, x655, Self::mul_add(-x615, x656, x613 * x645)),
+        );
+        let x658 = Self::mul_add(-x621, x653, x657);
+        let x659 = Self::mul_add(
+            x610,
+            x655,
+            Self::mul_add(x609, x656, Self::mul_add(x608, x658, x606 * x607)),
+        );
+        let x660 = Self::mul_add(x612, x653, Self::mul_add(x611, x654, x659));
+        let x661 = -x660;
+        let x662 = Self::mul_add(-0.75, x654, x660);
+        let x663 = x658 - Self::mul_add(-0.65, x653, 0.75 * x655);
+        let x664 = Self::mul_add(-0.65, x654, x656);
+        let x665 = x14 + Self::mul_add(s_q7, x654, c_q7 * x655);
+        let x666 = Self::mul_add(-s_q7, x655, c_q7 * x654) - x15;
+        let x667 = x16 + Self::mul_add(-c_q7, x662, s_q7 * x663);
+        let x668 = Self::mul_add(c_q7, x663, s_q7 * x662) - x17;
+        let x669 = x544
+            * (x545
+                - (Self::mul_add(x540, x653, Self::mul_add(x539, x666, x538 * x665))
+                    + Self::mul_add(
+                        x517,
+                        x664,
+                        Self::mul_add(x541, x668, x515 * x667),
+                    )));
+        let x670 = x653 + x669;
+        let x671 = Self::mul_add(-0.00000000020510342851533115, x670, x665);
+        let x672 = Self::mul_add(0.35, x666, x667);
+        let x673 = Self::mul_add(-0.35, x665, x668);
+        let x674 = Self::mul_add(-0.00000000020510342851533115, x664, x672);
+        let x675 = x34
+            + Self::mul_add(-c_q8, x670, Self::mul_add(s_q8, x666, x25 * x665));
+        let x676 = Self::mul_add(s_q8, x670, Self::mul_add(-x26, x665, c_q8 * x666))
+            - x35;
+        let x677 = x36
+            + Self::mul_add(-c_q8, x664, Self::mul_add(s_q8, x673, x25 * x672));
+        let x678 = Self::mul_add(s_q8, x664, Self::mul_add(-x26, x672, c_q8 * x673))
+            - x37;
+        let x679 = x472
+            * (x473
+                - (Self::mul_add(x468, x671, Self::mul_add(x467, x676, x466 * x675))
+                    + Self::mul_add(
+                        x458,
+                        x674,
+                        Self::mul_add(x470, x678, x469 * x677),
+                    )));
+        let x680 = x671 + x679;
+        let x681 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x680,
+            Self::mul_add(0.00000000020510342851533115, x675, x676),
+        );
+        let x682 = x677 - Self::mul_add(0.275, x680, -0.4 * x676);
+        let x683 = Self::mul_add(-0.4, x675, x678);
+        let x684 = Self::mul_add(0.275, x675, x674);
+        let x685 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x684,
+            Self::mul_add(0.00000000020510342851533115, x682, x683),
+        );
+        let x686 = x56
+            + Self::mul_add(c_q9, x680, Self::mul_add(x46, x676, s_q9 * x675));
+        let x687 = Self::mul_add(-s_q9, x680, Self::mul_add(x47, x676, c_q9 * x675))
+            - x57;
+        let x688 = x58
+            + Self::mul_add(c_q9, x684, Self::mul_add(x46, x683, s_q9 * x682));
+        let x689 = Self::mul_add(-s_q9, x684, Self::mul_add(x47, x683, c_q9 * x682))
+            - x59;
+        let x690 = x391
+            * (x392
+                - (Self::mul_add(x388, x681, Self::mul_add(x387, x687, x386 * x686))
+                    + Self::mul_add(
+                        x382,
+                        x685,
+                        Self::mul_add(x381, x689, x389 * x688),
+                    )));
+        let x691 = x681 + x690;
+        let x692 = Self::mul_add(0.87, x691, x688);
+        let x693 = Self::mul_add(-0.87, x686, x685);
+        let x694 = x73 + Self::mul_add(s_q10, x687, c_q10 * x686);
+        let x695 = Self::mul_add(-s_q10, x686, c_q10 * x687) - x74;
+        let x696 = x75 + Self::mul_add(s_q10, x689, c_q10 * x692);
+        let x697 = Self::mul_add(-s_q10, x692, c_q10 * x689) - x76;
+        let x698 = x333
+            * (x334
+                - (Self::mul_add(x330, x691, Self::mul_add(x329, x695, x328 * x694))
+                    + Self::mul_add(
+                        x319,
+                        x693,
+                        Self::mul_add(x318, x697, x331 * x696),
+                    )));
+        let x699 = x691 + x698;
+        let x700 = x696 - Self::mul_add(-0.63, x699, 0.275 * x695);
+        let x701 = Self::mul_add(0.275, x694, x697);
+        let x702 = Self::mul_add(-0.63, x694, x693);
+        let x703 = x91 + Self::mul_add(s_q11, x695, c_q11 * x694);
+        let x704 = Self::mul_add(-s_q11, x694, c_q11 * x695) - x92;
+        let x705 = x93 + Self::mul_add(s_q11, x701, c_q11 * x700);
+        let x706 = Self::mul_add(-s_q11, x700, c_q11 * x701) - x94;
+        let x707 = x269
+            * (x270
+                - (Self::mul_add(x265, x699, Self::mul_add(x264, x704, x263 * x703))
+                    + Self::mul_add(
+                        -x242,
+                        x702,
+                        Self::mul_add(-x241, x706, x266 * x705),
+                    )));
+        let x708 = x699 + x707;
+        let x709 = Self::mul_add(-0.00000000020510342851533115, x708, x704);
+        let x710 = Self::mul_add(-0.36, x704, x705);
+        let x711 = Self::mul_add(0.36, x703, x706);
+        let x712 = Self::mul_add(-0.00000000020510342851533115, x702, x711);
+        let x713 = x111
+            + Self::mul_add(-s_q12, x708, Self::mul_add(x102, x704, c_q12 * x703));
+        let x714 = Self::mul_add(-c_q12, x708, Self::mul_add(-s_q12, x703, x103 * x704))
+            - x112;
+        let x715 = x113
+            + Self::mul_add(-s_q12, x702, Self::mul_add(x102, x711, c_q12 * x710));
+        let x716 = Self::mul_add(-c_q12, x702, Self::mul_add(-s_q12, x710, x103 * x711))
+            - x114;
+        let x717 = x197
+            * (x198
+                - (Self::mul_add(x193, x709, Self::mul_add(x192, x714, x191 * x713))
+                    + Self::mul_add(
+                        -x183,
+                        x712,
+                        Self::mul_add(x195, x716, x194 * x715),
+                    )));
+        let x718 = x709 + x717;
+        let x719 = Self::mul_add(
+            -c_q13,
+            Self::mul_add(0.55, x713, x712),
+            Self::mul_add(
+                s_q13,
+                Self::mul_add(-0.16, x713, x716),
+                x123 * (x715 - Self::mul_add(0.55, x718, -0.16 * x714)),
+            ),
+        );
+        let x720 = Self::mul_add(
+            -0.9614610000000001,
+            Self::mul_add(s_q13, x718, Self::mul_add(-x124, x713, c_q13 * x714)) - x134,
+            -0.0145
+                * (x133
+                    + Self::mul_add(
+                        -c_q13,
+                        x718,
+                        Self::mul_add(s_q13, x714, x123 * x713),
+                    )),
+        );
+        let x721 = Self::mul_add(
+            -4.806620000000001,
+            x135 + x719,
+            Self::mul_add(
+                1.4135609200000003,
+                Self::mul_add(-0.00000000020510342851533115, x718, x713),
+                x720,
+            ),
+        );
+        let x722 = 0.707433253035886 * (x144 - x721);
+        [x661, x658, x656, x655, x654, x653, x669, x679, x690, x698, x707, x717, x722]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1176 mul, 971 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 704 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 1170 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 700 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -5214,14 +4306,12 @@ impl FreeFloating7 {
         let x2 = -0.00000000020510342851533115 * c_q8;
         let x3 = -0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x6 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x7 = Self::mul_add(
+        let x5 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x8 = Self::mul_add(
+        let x6 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
@@ -5229,1229 +4319,1224 @@ impl FreeFloating7 {
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let (s_q11, c_q11) = libm::sincos(q[11]);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
+        let x10 = -0.00000000020510342851533115 * s_q12;
+        let x11 = -0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(-0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x16, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x16, -0.0145 * x15);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(-1.2025609200000003, c_q13, x24);
-        let x26 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(-1.2025609200000003, s_q13, -x23)
+        let x13 = -0.00000000020510342851533115 * c_q13;
+        let x14 = -0.00000000020510342851533115 * s_q13;
+        let x15 = 4.806620000000001 * x14;
+        let x16 = 4.806620000000001 * c_q13;
+        let x17 = 4.806620000000001 * s_q13;
+        let x18 = Self::mul_add(-0.000781, x14, -0.0145);
+        let x19 = -0.9614610000000001
+            + Self::mul_add(1.2025609200000003, x14, 0.000781 * x13);
+        let x20 = 1.4135609200000003
+            + Self::mul_add(0.9614610000000001, x14, -0.0145 * x13);
+        let x21 = 0.000781 * c_q13;
+        let x22 = 0.000781 * s_q13;
+        let x23 = Self::mul_add(-1.2025609200000003, c_q13, x22);
+        let x24 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
+        let x25 = x22 + 0.000000000002973999713472302;
+        let x26 = Self::mul_add(-1.2025609200000003, s_q13, -x21)
             + 0.00000000019719894748377882;
-        let x29 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
+        let x27 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
             + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = x22 + Self::mul_add(-x16, x21, x15 * x20) - (x30 - x31) - (x33 - x32);
-        let x35 = 3.6140000000000003 - x17;
-        let x36 = 17.135250000000003 + x18;
-        let x37 = -1.9877000000000002
-            + Self::mul_add(0.55, x17, Self::mul_add(c_q13, x21, s_q13 * x20));
-        let x38 = -0.809539999555672
-            + Self::mul_add(
-                0.16,
-                x17,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x22,
-                    Self::mul_add(-c_q13, x20, s_q13 * x21),
-                ),
-            );
-        let x39 = -1.9877000000000002
-            + Self::mul_add(x17, 0.55, x26 + Self::mul_add(-x16, x25, x15 * x23));
-        let x40 = -5.252920330000002
-            + (Self::mul_add(c_q13, x25, s_q13 * x23) + x32 - x30);
-        let x41 = -2.741639999592316
-            + Self::mul_add(
-                -0.55,
-                x19,
-                Self::mul_add(
-                    -0.16,
-                    x18,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x26,
-                        Self::mul_add(-c_q13, x23, s_q13 * x25),
-                    ),
-                ),
-            );
-        let x42 = -0.809539999555672
-            + Self::mul_add(0.16, x17, x29 + Self::mul_add(-x16, x28, x15 * x27));
-        let x43 = -2.7416399995923166
-            + Self::mul_add(
-                -0.16,
-                x18,
-                Self::mul_add(x19, -0.55, Self::mul_add(c_q13, x28, s_q13 * x27)),
-            );
-        let x44 = 9.740442170000001
-            + (x31
+        let x28 = -0.16 * x17;
+        let x29 = 0.55 * x16;
+        let x30 = 0.16 * x17;
+        let x31 = x16 * -0.55;
+        let x32 = Self::mul_add(
+            0.16,
+            x15,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x20,
+                Self::mul_add(-c_q13, x18, s_q13 * x19),
+            ),
+        );
+        let x33 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x24,
+                Self::mul_add(-c_q13, x21, s_q13 * x23),
+            ),
+        );
+        let x34 = x20 + Self::mul_add(-x14, x19, x13 * x18) - (x28 - x29) - (x31 - x30);
+        let x35 = Self::mul_add(
+            -0.16,
+            x16,
+            Self::mul_add(x17, -0.55, Self::mul_add(c_q13, x26, s_q13 * x25)),
+        );
+        let x36 = 3.6140000000000003 - x15;
+        let x37 = 17.135250000000003 + x16;
+        let x38 = -1.9877000000000002
+            + Self::mul_add(0.55, x15, Self::mul_add(c_q13, x19, s_q13 * x18));
+        let x39 = -0.809539999555672 + x32;
+        let x40 = -1.9877000000000002
+            + Self::mul_add(x15, 0.55, x24 + Self::mul_add(-x14, x23, x13 * x21));
+        let x41 = -5.252920330000002
+            + (Self::mul_add(c_q13, x23, s_q13 * x21) + x30 - x28);
+        let x42 = -2.741639999592316 + Self::mul_add(-0.55, x17, x33);
+        let x43 = -0.809539999555672
+            + Self::mul_add(0.16, x15, x27 + Self::mul_add(-x14, x26, x13 * x25));
+        let x44 = -2.7416399995923166 + x35;
+        let x45 = 9.740442170000001
+            + (x29
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) - x33));
-        let x45 = c_q12 * x35;
-        let x46 = s_q12 * x36;
-        let x47 = x45 - x46;
-        let x48 = x19 + Self::mul_add(x13, x36, x12 * x35);
-        let x49 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x50 = Self::mul_add(-0.00000000020510342851533115, x19, -x49);
-        let x51 = Self::mul_add(-s_q12, x39, c_q12 * x34);
-        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x37);
+                    x27,
+                    Self::mul_add(-c_q13, x25, s_q13 * x26),
+                ) - x31));
+        let x46 = c_q12 * x36;
+        let x47 = s_q12 * x37;
+        let x48 = x46 - x47;
+        let x49 = x17 + Self::mul_add(x11, x37, x10 * x36);
+        let x50 = Self::mul_add(c_q12, x37, s_q12 * x36);
+        let x51 = Self::mul_add(-0.00000000020510342851533115, x17, -x50);
+        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x34);
         let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
-        let x54 = x42 + Self::mul_add(x13, x39, x12 * x34);
-        let x55 = x43 + Self::mul_add(x13, x40, x12 * x37);
-        let x56 = x44 + Self::mul_add(x13, x41, x12 * x38);
-        let x57 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x42,
-            -Self::mul_add(c_q12, x39, s_q12 * x34),
-        );
+        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x39);
+        let x55 = x43 + Self::mul_add(x11, x40, x10 * x34);
+        let x56 = x44 + Self::mul_add(x11, x41, x10 * x38);
+        let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
         let x58 = Self::mul_add(
             -0.00000000020510342851533115,
             x43,
-            -Self::mul_add(c_q12, x40, s_q12 * x37),
+            -Self::mul_add(c_q12, x40, s_q12 * x34),
         );
         let x59 = Self::mul_add(
             -0.00000000020510342851533115,
             x44,
             -Self::mul_add(c_q12, x41, s_q12 * x38),
         );
-        let x60 = x53 + Self::mul_add(x13, x52, x12 * x51);
-        let x61 = Self::mul_add(-s_q12, x55, c_q12 * x54);
-        let x62 = x50 * 0.36;
-        let x63 = -0.36 * x50;
-        let x64 = x63 + (Self::mul_add(-s_q12, x52, c_q12 * x51) - x62);
-        let x65 = 7.078399999258757 + x48;
-        let x66 = 0.01675
-            + Self::mul_add(
-                x47,
-                0.36,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x53,
-                    -Self::mul_add(c_q12, x52, s_q12 * x51),
-                ),
-            );
-        let x67 = -9.142025249762803
-            + (x56 + Self::mul_add(x13, x55, x12 * x54) + x63 - x62);
-        let x68 = 2.5482240016099564
-            + Self::mul_add(
-                0.36,
-                x48,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x56,
-                    -Self::mul_add(c_q12, x55, s_q12 * x54),
-                ),
-            );
-        let x69 = 0.01675
-            + Self::mul_add(0.36, x47, Self::mul_add(-s_q12, x58, c_q12 * x57));
-        let x70 = 2.5482240016099564
-            + Self::mul_add(x48, 0.36, x59 + Self::mul_add(x13, x58, x12 * x57));
-        let x71 = 9.223235249762805
+        let x60 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x45,
+            -Self::mul_add(c_q12, x42, s_q12 * x39),
+        );
+        let x61 = x54 + Self::mul_add(x11, x53, x10 * x52);
+        let x62 = Self::mul_add(-s_q12, x56, c_q12 * x55);
+        let x63 = x51 * 0.36;
+        let x64 = -0.36 * x51;
+        let x65 = Self::mul_add(
+            x48,
+            0.36,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x54,
+                -Self::mul_add(c_q12, x53, s_q12 * x52),
+            ),
+        );
+        let x66 = Self::mul_add(
+            0.36,
+            x49,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x57,
+                -Self::mul_add(c_q12, x56, s_q12 * x55),
+            ),
+        );
+        let x67 = x64 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x63);
+        let x68 = 7.078399999258757 + x49;
+        let x69 = 0.01675 + x65;
+        let x70 = -9.142025249762803
+            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x64 - x63);
+        let x71 = 2.5482240016099564 + x66;
+        let x72 = 0.01675
+            + Self::mul_add(0.36, x48, Self::mul_add(-s_q12, x59, c_q12 * x58));
+        let x73 = 2.5482240016099564
+            + Self::mul_add(x49, 0.36, x60 + Self::mul_add(x11, x59, x10 * x58));
+        let x74 = 9.223235249762805
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x59,
-                -Self::mul_add(c_q12, x58, s_q12 * x57),
+                x60,
+                -Self::mul_add(c_q12, x59, s_q12 * x58),
             );
-        let x72 = Self::mul_add(-s_q11, x65, c_q11 * x47);
-        let x73 = Self::mul_add(c_q11, x65, s_q11 * x47);
-        let x74 = Self::mul_add(-s_q11, x61, c_q11 * x64);
-        let x75 = Self::mul_add(-s_q11, x67, c_q11 * x60);
-        let x76 = Self::mul_add(c_q11, x61, s_q11 * x64);
-        let x77 = Self::mul_add(c_q11, x67, s_q11 * x60);
-        let x78 = 0.275 * x50;
-        let x79 = -0.63 * x73;
-        let x80 = -0.275 * x50;
-        let x81 = x73 * 0.63;
-        let x82 = Self::mul_add(0.63, x72, Self::mul_add(c_q11, x75, s_q11 * x74));
-        let x83 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x68, c_q11 * x66));
-        let x84 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x68, s_q11 * x66));
-        let x85 = x71 - x81;
-        let x86 = Self::mul_add(-s_q11, x75, c_q11 * x74) - (x78 - x79) - (x81 - x80);
-        let x87 = Self::mul_add(x72, 0.63, Self::mul_add(-s_q11, x77, c_q11 * x76));
-        let x88 = -45.1584 + x73;
-        let x89 = -0.6328 + x83;
-        let x90 = -24.4950615 + (Self::mul_add(c_q11, x77, s_q11 * x76) + x80 - x78);
-        let x91 = -24.35164200091464 + Self::mul_add(0.63, x50, x84);
-        let x92 = -0.6328
-            + Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x70, c_q11 * x69));
-        let x93 = -24.351642000914637
-            + Self::mul_add(
-                0.275,
-                x73,
-                Self::mul_add(x50, 0.63, Self::mul_add(c_q11, x70, s_q11 * x69)),
-            );
-        let x94 = 28.2393615 + (x79 + x85);
-        let x95 = c_q10 * x72;
-        let x96 = Self::mul_add(-s_q10, x88, x95);
-        let x97 = s_q10 * x72;
-        let x98 = Self::mul_add(c_q10, x88, x97);
-        let x99 = Self::mul_add(-s_q10, x87, c_q10 * x86);
-        let x100 = Self::mul_add(-s_q10, x90, c_q10 * x82);
-        let x101 = Self::mul_add(-s_q10, x91, c_q10 * x89);
-        let x102 = Self::mul_add(c_q10, x87, s_q10 * x86);
-        let x103 = Self::mul_add(c_q10, x90, s_q10 * x82);
-        let x104 = Self::mul_add(c_q10, x91, s_q10 * x89);
-        let x105 = -0.87 * x98;
-        let x106 = x98 * 0.87;
-        let x107 = Self::mul_add(0.87, x96, Self::mul_add(c_q10, x100, s_q10 * x99));
-        let x108 = x94 - x106;
-        let x109 = Self::mul_add(-s_q10, x100, c_q10 * x99) + x105 - x106;
-        let x110 = Self::mul_add(x96, 0.87, Self::mul_add(-s_q10, x103, c_q10 * x102));
-        let x111 = -81.53205 + x98;
-        let x112 = -0.00214 + x101;
-        let x113 = -63.36336825000001 + Self::mul_add(c_q10, x103, s_q10 * x102);
-        let x114 = -36.18604050126307 + Self::mul_add(0.87, x50, x104);
-        let x115 = -0.00214 + Self::mul_add(-s_q10, x93, c_q10 * x92);
-        let x116 = -36.18604050126307
-            + Self::mul_add(x50, 0.87, Self::mul_add(c_q10, x93, s_q10 * x92));
-        let x117 = 69.99836825 + (x105 + x108);
-        let x118 = Self::mul_add(
-            0.00000000020510342851533115,
-            x50,
-            Self::mul_add(x6, x111, x5 * x96),
+        let x75 = Self::mul_add(-s_q11, x68, c_q11 * x48);
+        let x76 = Self::mul_add(c_q11, x68, s_q11 * x48);
+        let x77 = Self::mul_add(-s_q11, x62, c_q11 * x67);
+        let x78 = Self::mul_add(-s_q11, x70, c_q11 * x61);
+        let x79 = Self::mul_add(c_q11, x62, s_q11 * x67);
+        let x80 = Self::mul_add(c_q11, x70, s_q11 * x61);
+        let x81 = 0.275 * x51;
+        let x82 = -0.63 * x76;
+        let x83 = -0.275 * x51;
+        let x84 = x76 * 0.63;
+        let x85 = Self::mul_add(0.63, x75, Self::mul_add(c_q11, x78, s_q11 * x77));
+        let x86 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x71, c_q11 * x69));
+        let x87 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x71, s_q11 * x69));
+        let x88 = x74 - x84;
+        let x89 = Self::mul_add(-s_q11, x78, c_q11 * x77) - (x81 - x82) - (x84 - x83);
+        let x90 = Self::mul_add(x75, 0.63, Self::mul_add(-s_q11, x80, c_q11 * x79));
+        let x91 = Self::mul_add(
+            0.275,
+            x76,
+            Self::mul_add(x51, 0.63, Self::mul_add(c_q11, x73, s_q11 * x72)),
         );
-        let x119 = x50 + Self::mul_add(x8, x111, x7 * x96);
-        let x120 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x50,
-            Self::mul_add(-s_q9, x111, c_q9 * x96),
-        );
-        let x121 = Self::mul_add(
-            0.00000000020510342851533115,
-            x115,
-            Self::mul_add(x6, x110, x5 * x109),
-        );
-        let x122 = Self::mul_add(
-            0.00000000020510342851533115,
-            x116,
-            Self::mul_add(x6, x113, x5 * x107),
-        );
-        let x123 = Self::mul_add(
-            0.00000000020510342851533115,
-            x117,
-            Self::mul_add(x6, x114, x5 * x112),
-        );
-        let x124 = x115 + Self::mul_add(x8, x110, x7 * x109);
-        let x125 = x116 + Self::mul_add(x8, x113, x7 * x107);
-        let x126 = x117 + Self::mul_add(x8, x114, x7 * x112);
-        let x127 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x115,
-            Self::mul_add(-s_q9, x110, c_q9 * x109),
-        );
-        let x128 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x116,
-            Self::mul_add(-s_q9, x113, c_q9 * x107),
-        );
+        let x92 = -45.1584 + x76;
+        let x93 = -0.6328 + x86;
+        let x94 = -24.4950615 + (Self::mul_add(c_q11, x80, s_q11 * x79) + x83 - x81);
+        let x95 = -24.35164200091464 + Self::mul_add(0.63, x51, x87);
+        let x96 = -0.6328
+            + Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x73, c_q11 * x72));
+        let x97 = -24.351642000914637 + x91;
+        let x98 = 28.2393615 + (x82 + x88);
+        let x99 = c_q10 * x75;
+        let x100 = Self::mul_add(-s_q10, x92, x99);
+        let x101 = s_q10 * x75;
+        let x102 = Self::mul_add(c_q10, x92, x101);
+        let x103 = Self::mul_add(-s_q10, x90, c_q10 * x89);
+        let x104 = Self::mul_add(-s_q10, x94, c_q10 * x85);
+        let x105 = Self::mul_add(-s_q10, x95, c_q10 * x93);
+        let x106 = Self::mul_add(c_q10, x90, s_q10 * x89);
+        let x107 = Self::mul_add(c_q10, x94, s_q10 * x85);
+        let x108 = Self::mul_add(c_q10, x95, s_q10 * x93);
+        let x109 = -0.87 * x102;
+        let x110 = x102 * 0.87;
+        let x111 = Self::mul_add(0.87, x100, Self::mul_add(c_q10, x104, s_q10 * x103));
+        let x112 = x98 - x110;
+        let x113 = Self::mul_add(-s_q10, x104, c_q10 * x103) + x109 - x110;
+        let x114 = Self::mul_add(x100, 0.87, Self::mul_add(-s_q10, x107, c_q10 * x106));
+        let x115 = -81.53205 + x102;
+        let x116 = -0.00214 + x105;
+        let x117 = -63.36336825000001 + Self::mul_add(c_q10, x107, s_q10 * x106);
+        let x118 = -36.18604050126307 + Self::mul_add(0.87, x51, x108);
+        let x119 = -0.00214 + Self::mul_add(-s_q10, x97, c_q10 * x96);
+        let x120 = -36.18604050126307
+            + Self::mul_add(x51, 0.87, Self::mul_add(c_q10, x97, s_q10 * x96));
+        let x121 = 69.99836825 + (x109 + x112);
+        let x122 = s_q9 * x100;
+        let x123 = Self::mul_add(c_q9, x115, x122);
+        let x124 = Self::mul_add(0.00000000020510342851533115, x51, x123);
+        let x125 = x51 + Self::mul_add(x6, x115, x5 * x100);
+        let x126 = c_q9 * x100;
+        let x127 = Self::mul_add(-s_q9, x115, x126);
+        let x128 = Self::mul_add(-0.00000000020510342851533115, x51, x127);
         let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x117,
-            Self::mul_add(-s_q9, x114, c_q9 * x112),
-        );
-        let x130 = x120 * -0.4;
-        let x131 = 0.275 * x119;
-        let x132 = 0.4 * x120;
-        let x133 = -0.275 * x119;
-        let x134 = Self::mul_add(
             0.00000000020510342851533115,
-            x123,
-            Self::mul_add(x6, x122, x5 * x121),
-        ) - (x130 - x131) - (x133 - x132);
-        let x135 = -0.000000008530897668050218 + x118;
-        let x136 = -12.701650001451807 + x119;
-        let x137 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x118, x123 + Self::mul_add(x8, x122, x7 * x121));
-        let x138 = -0.0021399965876409276
-            + Self::mul_add(
-                x118,
-                -0.4,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x123,
-                    Self::mul_add(-s_q9, x122, c_q9 * x121),
-                ),
-            );
-        let x139 = -0.0000000234896432582596
-            + Self::mul_add(
-                -0.275,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x126,
-                    Self::mul_add(x6, x125, x5 * x124),
-                ),
-            );
-        let x140 = -111.7548902508081
-            + (x126 + Self::mul_add(x8, x125, x7 * x124) + x132 - x130);
-        let x141 = 5.080660024070365
-            + Self::mul_add(
-                -0.275,
-                x120,
-                Self::mul_add(
-                    -0.4,
-                    x119,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x126,
-                        Self::mul_add(-s_q9, x125, c_q9 * x124),
-                    ),
-                ),
-            );
-        let x142 = -0.0021399965876409276
-            + Self::mul_add(
-                -0.4,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(x6, x128, x5 * x127),
-                ),
-            );
-        let x143 = 5.080660024070366
-            + Self::mul_add(
-                x119,
-                -0.4,
-                Self::mul_add(-0.275, x120, x129 + Self::mul_add(x8, x128, x7 * x127)),
-            );
-        let x144 = 113.3918902508081
-            + (x131
+            x119,
+            Self::mul_add(c_q9, x114, s_q9 * x113),
+        );
+        let x130 = Self::mul_add(
+            0.00000000020510342851533115,
+            x120,
+            Self::mul_add(c_q9, x117, s_q9 * x111),
+        );
+        let x131 = Self::mul_add(
+            0.00000000020510342851533115,
+            x121,
+            Self::mul_add(c_q9, x118, s_q9 * x116),
+        );
+        let x132 = x119 + Self::mul_add(x6, x114, x5 * x113);
+        let x133 = x120 + Self::mul_add(x6, x117, x5 * x111);
+        let x134 = x121 + Self::mul_add(x6, x118, x5 * x116);
+        let x135 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x119,
+            Self::mul_add(-s_q9, x114, c_q9 * x113),
+        );
+        let x136 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x120,
+            Self::mul_add(-s_q9, x117, c_q9 * x111),
+        );
+        let x137 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x121,
+            Self::mul_add(-s_q9, x118, c_q9 * x116),
+        );
+        let x138 = x128 * -0.4;
+        let x139 = 0.275 * x125;
+        let x140 = 0.4 * x128;
+        let x141 = -0.275 * x125;
+        let x142 = Self::mul_add(
+            x124,
+            -0.4,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x131,
+                Self::mul_add(-s_q9, x130, c_q9 * x129),
+            ),
+        );
+        let x143 = Self::mul_add(
+            -0.4,
+            x125,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x134,
+                Self::mul_add(-s_q9, x133, c_q9 * x132),
+            ),
+        );
+        let x144 = Self::mul_add(
+            0.00000000020510342851533115,
+            x131,
+            Self::mul_add(c_q9, x130, s_q9 * x129),
+        ) - (x138 - x139) - (x141 - x140);
+        let x145 = Self::mul_add(
+            -0.275,
+            x124,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x134,
+                Self::mul_add(c_q9, x133, s_q9 * x132),
+            ),
+        );
+        let x146 = Self::mul_add(
+            -0.4,
+            x124,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x137,
+                Self::mul_add(c_q9, x136, s_q9 * x135),
+            ),
+        );
+        let x147 = Self::mul_add(
+            x125,
+            -0.4,
+            Self::mul_add(-0.275, x128, x137 + Self::mul_add(x6, x136, x5 * x135)),
+        );
+        let x148 = -0.000000008530897668050218 + x124;
+        let x149 = -12.701650001451807 + x125;
+        let x150 = -0.0000000234896432582596
+            + Self::mul_add(-0.275, x124, x131 + Self::mul_add(x6, x130, x5 * x129));
+        let x151 = -0.002139996587640933 + x142;
+        let x152 = -0.0000000234896432582596 + x145;
+        let x153 = -111.7548902508081
+            + (x134 + Self::mul_add(x6, x133, x5 * x132) + x140 - x138);
+        let x154 = 5.080660024070365 + Self::mul_add(-0.275, x128, x143);
+        let x155 = -0.002139996587640933 + x146;
+        let x156 = 5.080660024070366 + x147;
+        let x157 = 113.3918902508081
+            + (x139
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(-s_q9, x128, c_q9 * x127),
-                ) - x133));
-        let x145 = x120 + Self::mul_add(-x3, x136, x2 * x135);
-        let x146 = Self::mul_add(c_q8, x136, s_q8 * x135);
-        let x147 = c_q8 * x135;
-        let x148 = s_q8 * x136;
-        let x149 = Self::mul_add(-0.00000000020510342851533115, x120, x148 - x147);
-        let x150 = x142 + Self::mul_add(-x3, x139, x2 * x134);
-        let x151 = x143 + Self::mul_add(-x3, x140, x2 * x137);
-        let x152 = x144 + Self::mul_add(-x3, x141, x2 * x138);
-        let x153 = Self::mul_add(c_q8, x139, s_q8 * x134);
-        let x154 = Self::mul_add(c_q8, x140, s_q8 * x137);
-        let x155 = Self::mul_add(c_q8, x141, s_q8 * x138);
-        let x156 = Self::mul_add(
+                    x137,
+                    Self::mul_add(-s_q9, x136, c_q9 * x135),
+                ) - x141));
+        let x158 = x128 + Self::mul_add(-x3, x149, x2 * x148);
+        let x159 = Self::mul_add(c_q8, x149, s_q8 * x148);
+        let x160 = c_q8 * x148;
+        let x161 = s_q8 * x149;
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x128, x161 - x160);
+        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x144);
+        let x164 = x156 + Self::mul_add(-x3, x153, x2 * x150);
+        let x165 = x157 + Self::mul_add(-x3, x154, x2 * x151);
+        let x166 = Self::mul_add(c_q8, x152, s_q8 * x144);
+        let x167 = Self::mul_add(c_q8, x153, s_q8 * x150);
+        let x168 = Self::mul_add(c_q8, x154, s_q8 * x151);
+        let x169 = Self::mul_add(
             -0.00000000020510342851533115,
-            x144,
-            Self::mul_add(-c_q8, x138, s_q8 * x141),
+            x157,
+            Self::mul_add(-c_q8, x151, s_q8 * x154),
         );
-        let x157 = x149 * -0.35;
-        let x158 = 0.35 * x149;
-        let x159 = x158 + (x152 + Self::mul_add(-x3, x151, x2 * x150) - x157);
-        let x160 = 48.0240000085309 + x145;
-        let x161 = -0.07309 + Self::mul_add(c_q8, x151, s_q8 * x150);
-        let x162 = -16.80768997608804
-            + Self::mul_add(
-                x145,
-                -0.35,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x152,
-                    Self::mul_add(-c_q8, x150, s_q8 * x151),
-                ),
-            );
-        let x163 = -0.07309 + (x155 + Self::mul_add(-x3, x154, x2 * x153));
-        let x164 = 130.43769025763282
-            + (Self::mul_add(c_q8, x154, s_q8 * x153) + x158 - x157);
-        let x165 = 0.1132
-            + Self::mul_add(
-                -0.35,
-                x146,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x155,
-                    Self::mul_add(-c_q8, x153, s_q8 * x154),
-                ),
-            );
-        let x166 = 132.47349025763282
-            + Self::mul_add(
+        let x170 = Self::mul_add(
+            -c_q8,
+            Self::mul_add(
                 -0.00000000020510342851533115,
-                x156,
-                Self::mul_add(
-                    -c_q8,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x142,
-                        Self::mul_add(-c_q8, x134, s_q8 * x139),
-                    ),
-                    s_q8
-                        * Self::mul_add(
-                            -0.00000000020510342851533115,
-                            x143,
-                            Self::mul_add(-c_q8, x137, s_q8 * x140),
-                        ),
+                x155,
+                Self::mul_add(-c_q8, x144, s_q8 * x152),
+            ),
+            s_q8
+                * Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x156,
+                    Self::mul_add(-c_q8, x150, s_q8 * x153),
                 ),
-            );
-        let x167 = Self::mul_add(-s_q7, x146, c_q7 * x160);
-        let x168 = Self::mul_add(c_q7, x146, s_q7 * x160);
-        let x169 = Self::mul_add(-s_q7, x163, c_q7 * x159);
-        let x170 = Self::mul_add(-s_q7, x164, c_q7 * x161);
-        let x171 = -x168;
-        let x172 = x149 * -0.75;
-        let x173 = 0.75 * x149;
-        let x174 = x167 * -0.65;
-        let x175 = 0.65 * x167;
-        let x176 = Self::mul_add(x167, -0.75, Self::mul_add(-s_q7, x165, c_q7 * x162));
-        let x177 = Self::mul_add(-0.75, x168, Self::mul_add(c_q7, x165, s_q7 * x162));
-        let x178 = x166 + x175;
-        let x179 = Self::mul_add(-0.65, x168, Self::mul_add(c_q7, x170, s_q7 * x169));
-        let x180 = 110.5455 + x167;
-        let x181 = 180.9502499901501 + x149;
-        let x182 = 1394.5960312283303
-            + (x173 + (Self::mul_add(-s_q7, x170, c_q7 * x169) - x172));
-        let x183 = -117.61766249359756 + Self::mul_add(x149, -0.65, x176);
-        let x184 = 1466.4506062283303
+        );
+        let x171 = x162 * -0.35;
+        let x172 = 0.35 * x162;
+        let x173 = Self::mul_add(
+            x158,
+            -0.35,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x165,
+                Self::mul_add(-c_q8, x163, s_q8 * x164),
+            ),
+        );
+        let x174 = Self::mul_add(
+            -0.35,
+            x159,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x168,
+                Self::mul_add(-c_q8, x166, s_q8 * x167),
+            ),
+        );
+        let x175 = x172 + (x165 + Self::mul_add(-x3, x164, x2 * x163) - x171);
+        let x176 = 48.0240000085309 + x158;
+        let x177 = -0.07309 + Self::mul_add(c_q8, x164, s_q8 * x163);
+        let x178 = -16.80768997608804 + x173;
+        let x179 = -0.07309 + (x168 + Self::mul_add(-x3, x167, x2 * x166));
+        let x180 = 130.43769025763282
+            + (Self::mul_add(c_q8, x167, s_q8 * x166) + x172 - x171);
+        let x181 = 0.1132 + x174;
+        let x182 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x169, x170);
+        let x183 = Self::mul_add(-s_q7, x159, c_q7 * x176);
+        let x184 = Self::mul_add(c_q7, x159, s_q7 * x176);
+        let x185 = Self::mul_add(-s_q7, x179, c_q7 * x175);
+        let x186 = Self::mul_add(-s_q7, x180, c_q7 * x177);
+        let x187 = -x184;
+        let x188 = x162 * -0.75;
+        let x189 = 0.75 * x162;
+        let x190 = x183 * -0.65;
+        let x191 = 0.65 * x183;
+        let x192 = Self::mul_add(x183, -0.75, Self::mul_add(-s_q7, x181, c_q7 * x178));
+        let x193 = Self::mul_add(-0.75, x184, Self::mul_add(c_q7, x181, s_q7 * x178));
+        let x194 = x182 + x191;
+        let x195 = Self::mul_add(-0.65, x184, Self::mul_add(c_q7, x186, s_q7 * x185));
+        let x196 = 110.5455 + x183;
+        let x197 = 180.9502499901501 + x162;
+        let x198 = 1394.5960312283303
+            + (x189 + (Self::mul_add(-s_q7, x186, c_q7 * x185) - x188));
+        let x199 = -117.61766249359756 + Self::mul_add(x162, -0.65, x192);
+        let x200 = 1466.4506062283303
             + (Self::mul_add(
                 c_q7,
-                Self::mul_add(c_q7, x164, s_q7 * x161),
-                s_q7 * Self::mul_add(c_q7, x163, s_q7 * x159),
-            ) - (x174 - x173) - (x172 - x175));
-        let x185 = 1271.854575 + (x178 - x174);
-        let x186 = -x181;
-        let x187 = -x180;
-        let x188 = Self::mul_add(x3, x135, x2 * x136);
-        let x189 = x147 - x148;
-        let x190 = Self::mul_add(-0.35, x189, x152);
-        let x191 = Self::mul_add(-0.35, x188, x155);
-        let x192 = Self::mul_add(s_q7, x189, c_q7 * x188);
-        let x193 = -x192;
-        let x194 = Self::mul_add(-s_q7, x188, c_q7 * x189);
-        let x195 = Self::mul_add(-0.75, x194, Self::mul_add(-s_q7, x191, c_q7 * x190));
-        let x196 = Self::mul_add(c_q7, x191, s_q7 * x190)
-            + Self::mul_add(-0.75, x192, x146 * -0.65);
-        let x197 = Self::mul_add(0.65, x194, x156);
-        let x198 = x6 * x96;
-        let x199 = Self::mul_add(-x5, x111, x198);
-        let x200 = x8 * x96;
-        let x201 = Self::mul_add(-x7, x111, x200);
-        let x202 = s_q9 * x96;
-        let x203 = Self::mul_add(c_q9, x111, x202);
-        let x204 = x123 + Self::mul_add(-0.275, x203, -0.4 * x201);
-        let x205 = Self::mul_add(0.4, x199, x126);
-        let x206 = Self::mul_add(-0.275, x199, x129);
-        let x207 = Self::mul_add(-x3, x201, x2 * x199) - x203;
-        let x208 = Self::mul_add(c_q8, x201, s_q8 * x199);
-        let x209 = Self::mul_add(
-            0.00000000020510342851533115,
-            x203,
-            Self::mul_add(-c_q8, x199, s_q8 * x201),
-        );
-        let x210 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x206,
-            Self::mul_add(-c_q8, x204, s_q8 * x205),
-        );
-        let x211 = Self::mul_add(
-            -0.35,
-            x208,
-            x206 + Self::mul_add(-x3, x205, x2 * x204),
-        );
-        let x212 = Self::mul_add(0.35, x207, Self::mul_add(c_q8, x205, s_q8 * x204));
-        let x213 = Self::mul_add(-s_q7, x208, c_q7 * x207);
-        let x214 = Self::mul_add(c_q7, x208, s_q7 * x207);
-        let x215 = Self::mul_add(-0.75, x214, Self::mul_add(-s_q7, x212, c_q7 * x211));
-        let x216 = Self::mul_add(c_q7, x212, s_q7 * x211)
-            + Self::mul_add(-0.65, x209, 0.75 * x213);
-        let x217 = Self::mul_add(0.65, x214, x210);
-        let x218 = Self::mul_add(-x5, x98, x198);
-        let x219 = Self::mul_add(-x7, x98, x200);
-        let x220 = Self::mul_add(c_q9, x98, x202);
+                Self::mul_add(c_q7, x180, s_q7 * x177),
+                s_q7 * Self::mul_add(c_q7, x179, s_q7 * x175),
+            ) - (x190 - x189) - (x188 - x191));
+        let x201 = 1271.854575 + (x194 - x190);
+        let x202 = -x197;
+        let x203 = -x196;
+        let x204 = Self::mul_add(x3, x148, x2 * x149);
+        let x205 = x160 - x161;
+        let x206 = Self::mul_add(-0.35, x205, x165);
+        let x207 = Self::mul_add(-0.35, x204, x168);
+        let x208 = Self::mul_add(s_q7, x205, c_q7 * x204);
+        let x209 = -x208;
+        let x210 = Self::mul_add(-s_q7, x204, c_q7 * x205);
+        let x211 = Self::mul_add(-0.75, x210, Self::mul_add(-s_q7, x207, c_q7 * x206));
+        let x212 = Self::mul_add(c_q7, x207, s_q7 * x206)
+            + Self::mul_add(-0.75, x208, x159 * -0.65);
+        let x213 = Self::mul_add(0.65, x210, x169);
+        let x214 = x6 * x100;
+        let x215 = Self::mul_add(-x5, x115, x214);
+        let x216 = x131 + Self::mul_add(-0.275, x123, -0.4 * x215);
+        let x217 = Self::mul_add(0.4, x127, x134);
+        let x218 = Self::mul_add(-0.275, x127, x137);
+        let x219 = Self::mul_add(-x3, x215, x2 * x127) - x123;
+        let x220 = Self::mul_add(c_q8, x215, s_q8 * x127);
         let x221 = Self::mul_add(
             0.00000000020510342851533115,
-            x108,
-            Self::mul_add(x6, x104, x5 * x101),
-        ) + Self::mul_add(-0.275, x220, -0.4 * x219);
-        let x222 = Self::mul_add(0.4, x218, x108 + Self::mul_add(x8, x104, x7 * x101));
-        let x223 = Self::mul_add(
-            -0.275,
+            x123,
+            Self::mul_add(-c_q8, x127, s_q8 * x215),
+        );
+        let x222 = Self::mul_add(
+            -0.00000000020510342851533115,
             x218,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x108,
-                Self::mul_add(-s_q9, x104, c_q9 * x101),
-            ),
+            Self::mul_add(-c_q8, x216, s_q8 * x217),
         );
-        let x224 = Self::mul_add(-x3, x219, x2 * x218) - x220;
-        let x225 = Self::mul_add(c_q8, x219, s_q8 * x218);
-        let x226 = Self::mul_add(
-            0.00000000020510342851533115,
+        let x223 = Self::mul_add(
+            -0.35,
             x220,
-            Self::mul_add(-c_q8, x218, s_q8 * x219),
+            x218 + Self::mul_add(-x3, x217, x2 * x216),
         );
-        let x227 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x223,
-            Self::mul_add(-c_q8, x221, s_q8 * x222),
-        );
-        let x228 = Self::mul_add(
-            -0.35,
-            x225,
-            x223 + Self::mul_add(-x3, x222, x2 * x221),
-        );
-        let x229 = Self::mul_add(0.35, x224, Self::mul_add(c_q8, x222, s_q8 * x221));
-        let x230 = Self::mul_add(-s_q7, x225, c_q7 * x224);
-        let x231 = Self::mul_add(c_q7, x225, s_q7 * x224);
-        let x232 = Self::mul_add(-0.75, x231, Self::mul_add(-s_q7, x229, c_q7 * x228));
-        let x233 = Self::mul_add(c_q7, x229, s_q7 * x228)
-            + Self::mul_add(-0.65, x226, 0.75 * x230);
-        let x234 = Self::mul_add(0.65, x231, x227);
-        let x235 = Self::mul_add(c_q10, x73, x97);
-        let x236 = Self::mul_add(-s_q10, x73, x95);
-        let x237 = Self::mul_add(-s_q10, x84, c_q10 * x83);
-        let x238 = Self::mul_add(c_q10, x84, s_q10 * x83);
-        let x239 = Self::mul_add(-0.87, x235, x85);
-        let x240 = Self::mul_add(-x5, x235, x6 * x236);
-        let x241 = Self::mul_add(-x7, x235, x8 * x236);
-        let x242 = Self::mul_add(s_q9, x236, c_q9 * x235);
-        let x243 = Self::mul_add(
+        let x224 = Self::mul_add(0.35, x219, Self::mul_add(c_q8, x217, s_q8 * x216));
+        let x225 = Self::mul_add(-s_q7, x220, c_q7 * x219);
+        let x226 = Self::mul_add(c_q7, x220, s_q7 * x219);
+        let x227 = Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x224, c_q7 * x223));
+        let x228 = Self::mul_add(c_q7, x224, s_q7 * x223)
+            + Self::mul_add(-0.65, x221, 0.75 * x225);
+        let x229 = Self::mul_add(0.65, x226, x222);
+        let x230 = Self::mul_add(-s_q9, x102, x126);
+        let x231 = Self::mul_add(-x5, x102, x214);
+        let x232 = Self::mul_add(c_q9, x102, x122);
+        let x233 = Self::mul_add(
             0.00000000020510342851533115,
-            x239,
-            Self::mul_add(x6, x238, x5 * x237),
-        ) + Self::mul_add(-0.275, x242, -0.4 * x241);
-        let x244 = Self::mul_add(0.4, x240, x239 + Self::mul_add(x8, x238, x7 * x237));
-        let x245 = Self::mul_add(
+            x112,
+            Self::mul_add(c_q9, x108, s_q9 * x105),
+        ) + Self::mul_add(-0.275, x232, -0.4 * x231);
+        let x234 = Self::mul_add(0.4, x230, x112 + Self::mul_add(x6, x108, x5 * x105));
+        let x235 = Self::mul_add(
             -0.275,
-            x240,
+            x230,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x239,
-                Self::mul_add(-s_q9, x238, c_q9 * x237),
+                x112,
+                Self::mul_add(-s_q9, x108, c_q9 * x105),
             ),
         );
-        let x246 = Self::mul_add(-x3, x241, x2 * x240) - x242;
-        let x247 = Self::mul_add(c_q8, x241, s_q8 * x240);
-        let x248 = Self::mul_add(
+        let x236 = Self::mul_add(-x3, x231, x2 * x230) - x232;
+        let x237 = Self::mul_add(c_q8, x231, s_q8 * x230);
+        let x238 = Self::mul_add(
             0.00000000020510342851533115,
-            x242,
-            Self::mul_add(-c_q8, x240, s_q8 * x241),
+            x232,
+            Self::mul_add(-c_q8, x230, s_q8 * x231),
         );
-        let x249 = Self::mul_add(
+        let x239 = Self::mul_add(
             -0.00000000020510342851533115,
-            x245,
-            Self::mul_add(-c_q8, x243, s_q8 * x244),
+            x235,
+            Self::mul_add(-c_q8, x233, s_q8 * x234),
         );
-        let x250 = Self::mul_add(
+        let x240 = Self::mul_add(
             -0.35,
-            x247,
-            x245 + Self::mul_add(-x3, x244, x2 * x243),
+            x237,
+            x235 + Self::mul_add(-x3, x234, x2 * x233),
         );
-        let x251 = Self::mul_add(0.35, x246, Self::mul_add(c_q8, x244, s_q8 * x243));
-        let x252 = Self::mul_add(-s_q7, x247, c_q7 * x246);
-        let x253 = Self::mul_add(c_q7, x247, s_q7 * x246);
-        let x254 = Self::mul_add(-0.75, x253, Self::mul_add(-s_q7, x251, c_q7 * x250));
-        let x255 = Self::mul_add(c_q7, x251, s_q7 * x250)
-            + Self::mul_add(-0.65, x248, 0.75 * x252);
-        let x256 = Self::mul_add(0.65, x253, x249);
-        let x257 = Self::mul_add(-x12, x36, x13 * x35);
-        let x258 = x46 - x45;
-        let x259 = Self::mul_add(0.36, x257, x53);
-        let x260 = Self::mul_add(0.36, x49, x56);
-        let x261 = Self::mul_add(s_q11, x257, c_q11 * x49);
-        let x262 = Self::mul_add(-s_q11, x49, c_q11 * x257);
-        let x263 = Self::mul_add(-s_q11, x260, c_q11 * x259)
-            + Self::mul_add(-0.63, x258, 0.275 * x262);
-        let x264 = Self::mul_add(0.275, x261, Self::mul_add(c_q11, x260, s_q11 * x259));
-        let x265 = Self::mul_add(-0.63, x261, x59);
-        let x266 = Self::mul_add(s_q10, x262, c_q10 * x261);
-        let x267 = Self::mul_add(-s_q10, x261, c_q10 * x262);
-        let x268 = Self::mul_add(c_q10, x264, s_q10 * x263);
-        let x269 = Self::mul_add(-0.87, x258, Self::mul_add(-s_q10, x264, c_q10 * x263));
-        let x270 = Self::mul_add(-0.87, x266, x265);
-        let x271 = Self::mul_add(
+        let x241 = Self::mul_add(0.35, x236, Self::mul_add(c_q8, x234, s_q8 * x233));
+        let x242 = Self::mul_add(-s_q7, x237, c_q7 * x236);
+        let x243 = Self::mul_add(c_q7, x237, s_q7 * x236);
+        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x241, c_q7 * x240));
+        let x245 = Self::mul_add(c_q7, x241, s_q7 * x240)
+            + Self::mul_add(-0.65, x238, 0.75 * x242);
+        let x246 = Self::mul_add(0.65, x243, x239);
+        let x247 = Self::mul_add(c_q10, x76, x101);
+        let x248 = Self::mul_add(-s_q10, x76, x99);
+        let x249 = Self::mul_add(-s_q10, x87, c_q10 * x86);
+        let x250 = Self::mul_add(c_q10, x87, s_q10 * x86);
+        let x251 = Self::mul_add(-0.87, x247, x88);
+        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
+        let x253 = Self::mul_add(-x5, x247, x6 * x248);
+        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
+        let x255 = Self::mul_add(
             0.00000000020510342851533115,
-            x258,
-            Self::mul_add(-x5, x266, x6 * x267),
+            x251,
+            Self::mul_add(c_q9, x250, s_q9 * x249),
+        ) + Self::mul_add(-0.275, x254, -0.4 * x253);
+        let x256 = Self::mul_add(0.4, x252, x251 + Self::mul_add(x6, x250, x5 * x249));
+        let x257 = Self::mul_add(
+            -0.275,
+            x252,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x251,
+                Self::mul_add(-s_q9, x250, c_q9 * x249),
+            ),
         );
-        let x272 = x258 + Self::mul_add(-x7, x266, x8 * x267);
-        let x273 = Self::mul_add(
+        let x258 = Self::mul_add(-x3, x253, x2 * x252) - x254;
+        let x259 = Self::mul_add(c_q8, x253, s_q8 * x252);
+        let x260 = Self::mul_add(
+            0.00000000020510342851533115,
+            x254,
+            Self::mul_add(-c_q8, x252, s_q8 * x253),
+        );
+        let x261 = Self::mul_add(
             -0.00000000020510342851533115,
-            x258,
-            -Self::mul_add(s_q9, x267, c_q9 * x266),
+            x257,
+            Self::mul_add(-c_q8, x255, s_q8 * x256),
         );
-        let x274 = Self::mul_add(
+        let x262 = Self::mul_add(
+            -0.35,
+            x259,
+            x257 + Self::mul_add(-x3, x256, x2 * x255),
+        );
+        let x263 = Self::mul_add(0.35, x258, Self::mul_add(c_q8, x256, s_q8 * x255));
+        let x264 = Self::mul_add(-s_q7, x259, c_q7 * x258);
+        let x265 = Self::mul_add(c_q7, x259, s_q7 * x258);
+        let x266 = Self::mul_add(-0.75, x265, Self::mul_add(-s_q7, x263, c_q7 * x262));
+        let x267 = Self::mul_add(c_q7, x263, s_q7 * x262)
+            + Self::mul_add(-0.65, x260, 0.75 * x264);
+        let x268 = Self::mul_add(0.65, x265, x261);
+        let x269 = Self::mul_add(-x10, x37, x11 * x36);
+        let x270 = x47 - x46;
+        let x271 = Self::mul_add(0.36, x269, x54);
+        let x272 = Self::mul_add(0.36, x50, x57);
+        let x273 = Self::mul_add(s_q11, x269, c_q11 * x50);
+        let x274 = Self::mul_add(-s_q11, x50, c_q11 * x269);
+        let x275 = Self::mul_add(-s_q11, x272, c_q11 * x271)
+            + Self::mul_add(-0.63, x270, 0.275 * x274);
+        let x276 = Self::mul_add(0.275, x273, Self::mul_add(c_q11, x272, s_q11 * x271));
+        let x277 = Self::mul_add(-0.63, x273, x60);
+        let x278 = Self::mul_add(s_q10, x274, c_q10 * x273);
+        let x279 = Self::mul_add(-s_q10, x273, c_q10 * x274);
+        let x280 = Self::mul_add(c_q10, x276, s_q10 * x275);
+        let x281 = Self::mul_add(-0.87, x270, Self::mul_add(-s_q10, x276, c_q10 * x275));
+        let x282 = Self::mul_add(-0.87, x278, x277);
+        let x283 = Self::mul_add(
             0.00000000020510342851533115,
             x270,
-            Self::mul_add(x6, x268, x5 * x269),
-        ) + Self::mul_add(0.275, x273, -0.4 * x272);
-        let x275 = Self::mul_add(0.4, x271, x270 + Self::mul_add(x8, x268, x7 * x269));
-        let x276 = Self::mul_add(
+            Self::mul_add(-s_q9, x278, c_q9 * x279),
+        );
+        let x284 = x270 + Self::mul_add(-x5, x278, x6 * x279);
+        let x285 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x270,
+            -Self::mul_add(s_q9, x279, c_q9 * x278),
+        );
+        let x286 = Self::mul_add(
+            0.00000000020510342851533115,
+            x282,
+            Self::mul_add(c_q9, x280, s_q9 * x281),
+        ) + Self::mul_add(0.275, x285, -0.4 * x284);
+        let x287 = Self::mul_add(0.4, x283, x282 + Self::mul_add(x6, x280, x5 * x281));
+        let x288 = Self::mul_add(
             -0.275,
-            x271,
+            x283,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x270,
-                Self::mul_add(-s_q9, x268, c_q9 * x269),
+                x282,
+                Self::mul_add(-s_q9, x280, c_q9 * x281),
             ),
         );
-        let x277 = x273 + Self::mul_add(-x3, x272, x2 * x271);
-        let x278 = Self::mul_add(c_q8, x272, s_q8 * x271);
-        let x279 = Self::mul_add(
+        let x289 = x285 + Self::mul_add(-x3, x284, x2 * x283);
+        let x290 = Self::mul_add(c_q8, x284, s_q8 * x283);
+        let x291 = Self::mul_add(
             -0.00000000020510342851533115,
-            x273,
-            Self::mul_add(-c_q8, x271, s_q8 * x272),
+            x285,
+            Self::mul_add(-c_q8, x283, s_q8 * x284),
         );
-        let x280 = Self::mul_add(
+        let x292 = Self::mul_add(
             -0.00000000020510342851533115,
-            x276,
-            Self::mul_add(-c_q8, x274, s_q8 * x275),
+            x288,
+            Self::mul_add(-c_q8, x286, s_q8 * x287),
         );
-        let x281 = Self::mul_add(
+        let x293 = Self::mul_add(
             -0.35,
-            x278,
-            x276 + Self::mul_add(-x3, x275, x2 * x274),
-        );
-        let x282 = Self::mul_add(0.35, x277, Self::mul_add(c_q8, x275, s_q8 * x274));
-        let x283 = Self::mul_add(-s_q7, x278, c_q7 * x277);
-        let x284 = Self::mul_add(c_q7, x278, s_q7 * x277);
-        let x285 = Self::mul_add(-0.75, x284, Self::mul_add(-s_q7, x282, c_q7 * x281));
-        let x286 = Self::mul_add(c_q7, x282, s_q7 * x281)
-            + Self::mul_add(-0.65, x279, 0.75 * x283);
-        let x287 = Self::mul_add(0.65, x284, x280);
-        let x288 = x15 * -4.806620000000001;
-        let x289 = s_q13 * -4.806620000000001;
-        let x290 = c_q13 * -4.806620000000001;
-        let x291 = x22 + Self::mul_add(-0.55, x290, -0.16 * x289);
-        let x292 = Self::mul_add(0.16, x288, x26);
-        let x293 = Self::mul_add(-0.55, x288, x29);
-        let x294 = Self::mul_add(-s_q12, x289, c_q12 * x288);
-        let x295 = Self::mul_add(x13, x289, x12 * x288) - x290;
-        let x296 = Self::mul_add(
-            -0.00000000020510342851533115,
             x290,
-            Self::mul_add(c_q12, x289, s_q12 * x288),
+            x288 + Self::mul_add(-x3, x287, x2 * x286),
         );
-        let x297 = Self::mul_add(
+        let x294 = Self::mul_add(0.35, x289, Self::mul_add(c_q8, x287, s_q8 * x286));
+        let x295 = Self::mul_add(-s_q7, x290, c_q7 * x289);
+        let x296 = Self::mul_add(c_q7, x290, s_q7 * x289);
+        let x297 = Self::mul_add(-0.75, x296, Self::mul_add(-s_q7, x294, c_q7 * x293));
+        let x298 = Self::mul_add(c_q7, x294, s_q7 * x293)
+            + Self::mul_add(-0.65, x291, 0.75 * x295);
+        let x299 = Self::mul_add(0.65, x296, x292);
+        let x300 = x13 * -4.806620000000001;
+        let x301 = s_q13 * -4.806620000000001;
+        let x302 = c_q13 * -4.806620000000001;
+        let x303 = x20 + Self::mul_add(-0.55, x302, -0.16 * x301);
+        let x304 = Self::mul_add(0.16, x300, x24);
+        let x305 = Self::mul_add(-0.55, x300, x27);
+        let x306 = Self::mul_add(-s_q12, x301, c_q12 * x300);
+        let x307 = Self::mul_add(x11, x301, x10 * x300) - x302;
+        let x308 = Self::mul_add(
             -0.00000000020510342851533115,
-            x293,
-            -Self::mul_add(c_q12, x292, s_q12 * x291),
+            x302,
+            Self::mul_add(c_q12, x301, s_q12 * x300),
         );
-        let x298 = Self::mul_add(0.36, x295, Self::mul_add(-s_q12, x292, c_q12 * x291));
-        let x299 = Self::mul_add(
+        let x309 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x305,
+            -Self::mul_add(c_q12, x304, s_q12 * x303),
+        );
+        let x310 = Self::mul_add(0.36, x307, Self::mul_add(-s_q12, x304, c_q12 * x303));
+        let x311 = Self::mul_add(
             -0.36,
-            x294,
-            x293 + Self::mul_add(x13, x292, x12 * x291),
+            x306,
+            x305 + Self::mul_add(x11, x304, x10 * x303),
         );
-        let x300 = Self::mul_add(-s_q11, x295, c_q11 * x294);
-        let x301 = Self::mul_add(c_q11, x295, s_q11 * x294);
-        let x302 = Self::mul_add(-s_q11, x299, c_q11 * x298)
-            + Self::mul_add(0.63, x296, 0.275 * x301);
-        let x303 = Self::mul_add(-0.275, x300, Self::mul_add(c_q11, x299, s_q11 * x298));
-        let x304 = Self::mul_add(0.63, x300, x297);
-        let x305 = Self::mul_add(-s_q10, x301, c_q10 * x300);
-        let x306 = Self::mul_add(c_q10, x301, s_q10 * x300);
-        let x307 = Self::mul_add(c_q10, x303, s_q10 * x302);
-        let x308 = Self::mul_add(0.87, x296, Self::mul_add(-s_q10, x303, c_q10 * x302));
-        let x309 = Self::mul_add(0.87, x305, x304);
-        let x310 = Self::mul_add(
+        let x312 = Self::mul_add(-s_q11, x307, c_q11 * x306);
+        let x313 = Self::mul_add(c_q11, x307, s_q11 * x306);
+        let x314 = Self::mul_add(-s_q11, x311, c_q11 * x310)
+            + Self::mul_add(0.63, x308, 0.275 * x313);
+        let x315 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x311, s_q11 * x310));
+        let x316 = Self::mul_add(0.63, x312, x309);
+        let x317 = Self::mul_add(-s_q10, x313, c_q10 * x312);
+        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
+        let x319 = Self::mul_add(c_q10, x315, s_q10 * x314);
+        let x320 = Self::mul_add(0.87, x308, Self::mul_add(-s_q10, x315, c_q10 * x314));
+        let x321 = Self::mul_add(0.87, x317, x316);
+        let x322 = Self::mul_add(
             -0.00000000020510342851533115,
-            x296,
-            Self::mul_add(x6, x306, x5 * x305),
+            x308,
+            Self::mul_add(c_q9, x318, s_q9 * x317),
         );
-        let x311 = Self::mul_add(x8, x306, x7 * x305) - x296;
-        let x312 = Self::mul_add(
+        let x323 = Self::mul_add(x6, x318, x5 * x317) - x308;
+        let x324 = Self::mul_add(
             0.00000000020510342851533115,
-            x296,
-            Self::mul_add(-s_q9, x306, c_q9 * x305),
+            x308,
+            Self::mul_add(-s_q9, x318, c_q9 * x317),
         );
-        let x313 = Self::mul_add(
+        let x325 = Self::mul_add(
             0.00000000020510342851533115,
-            x309,
-            Self::mul_add(x6, x307, x5 * x308),
-        ) + Self::mul_add(0.275, x312, -0.4 * x311);
-        let x314 = Self::mul_add(0.4, x310, x309 + Self::mul_add(x8, x307, x7 * x308));
-        let x315 = Self::mul_add(
+            x321,
+            Self::mul_add(c_q9, x319, s_q9 * x320),
+        ) + Self::mul_add(0.275, x324, -0.4 * x323);
+        let x326 = Self::mul_add(0.4, x322, x321 + Self::mul_add(x6, x319, x5 * x320));
+        let x327 = Self::mul_add(
             -0.275,
-            x310,
+            x322,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x309,
-                Self::mul_add(-s_q9, x307, c_q9 * x308),
+                x321,
+                Self::mul_add(-s_q9, x319, c_q9 * x320),
             ),
         );
-        let x316 = x312 + Self::mul_add(-x3, x311, x2 * x310);
-        let x317 = Self::mul_add(c_q8, x311, s_q8 * x310);
-        let x318 = Self::mul_add(
+        let x328 = x324 + Self::mul_add(-x3, x323, x2 * x322);
+        let x329 = Self::mul_add(c_q8, x323, s_q8 * x322);
+        let x330 = Self::mul_add(
             -0.00000000020510342851533115,
-            x312,
-            Self::mul_add(-c_q8, x310, s_q8 * x311),
+            x324,
+            Self::mul_add(-c_q8, x322, s_q8 * x323),
         );
-        let x319 = Self::mul_add(
+        let x331 = Self::mul_add(
             -0.00000000020510342851533115,
-            x315,
-            Self::mul_add(-c_q8, x313, s_q8 * x314),
+            x327,
+            Self::mul_add(-c_q8, x325, s_q8 * x326),
         );
-        let x320 = Self::mul_add(
+        let x332 = Self::mul_add(
             -0.35,
-            x317,
-            x315 + Self::mul_add(-x3, x314, x2 * x313),
+            x329,
+            x327 + Self::mul_add(-x3, x326, x2 * x325),
         );
-        let x321 = Self::mul_add(0.35, x316, Self::mul_add(c_q8, x314, s_q8 * x313));
-        let x322 = Self::mul_add(-s_q7, x317, c_q7 * x316);
-        let x323 = Self::mul_add(c_q7, x317, s_q7 * x316);
-        let x324 = Self::mul_add(-0.75, x323, Self::mul_add(-s_q7, x321, c_q7 * x320));
-        let x325 = Self::mul_add(c_q7, x321, s_q7 * x320)
-            + Self::mul_add(-0.65, x318, 0.75 * x322);
-        let x326 = Self::mul_add(0.65, x323, x319);
-        let x327 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x328 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x329 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x330 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x331 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x332 = v[4] * v[4];
-        let x333 = Self::mul_add(v[5], v[5], x332);
-        let x334 = v[3] * v[4];
-        let x335 = v[3] * v[5];
-        let x336 = v[4] * v[5];
-        let x337 = Self::mul_add(v[3], v[3], x332);
-        let x338 = x327 + Self::mul_add(-0.65, x333, 0.75 * x335);
-        let x339 = x328 + Self::mul_add(0.75, x336, 0.65 * x334);
-        let x340 = x329 + Self::mul_add(-0.75, x337, 0.65 * x335);
-        let x341 = Self::mul_add(-s_q7, x338, c_q7 * x339);
-        let x342 = v[6] * x331;
-        let x343 = v[6] * x330;
-        let x344 = v[5] + v[6];
-        let x345 = x331 * x331;
-        let x346 = x330 * x344;
-        let x347 = Self::mul_add(-16.80768997608804, x344, -0.07309 * x331);
-        let x348 = Self::mul_add(
+        let x333 = Self::mul_add(0.35, x328, Self::mul_add(c_q8, x326, s_q8 * x325));
+        let x334 = Self::mul_add(-s_q7, x329, c_q7 * x328);
+        let x335 = Self::mul_add(c_q7, x329, s_q7 * x328);
+        let x336 = Self::mul_add(-0.75, x335, Self::mul_add(-s_q7, x333, c_q7 * x332));
+        let x337 = Self::mul_add(c_q7, x333, s_q7 * x332)
+            + Self::mul_add(-0.65, x330, 0.75 * x334);
+        let x338 = Self::mul_add(0.65, x335, x331);
+        let x339 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
+        let x340 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x341 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
+        let x342 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x343 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x344 = v[4] * v[4];
+        let x345 = Self::mul_add(v[5], v[5], x344);
+        let x346 = v[3] * v[4];
+        let x347 = v[3] * v[5];
+        let x348 = v[4] * v[5];
+        let x349 = Self::mul_add(v[3], v[3], x344);
+        let x350 = x339 + Self::mul_add(-0.65, x345, 0.75 * x347);
+        let x351 = x340 + Self::mul_add(0.75, x348, 0.65 * x346);
+        let x352 = x341 + Self::mul_add(-0.75, x349, 0.65 * x347);
+        let x353 = Self::mul_add(-s_q7, x350, c_q7 * x351);
+        let x354 = v[6] * x343;
+        let x355 = v[6] * x342;
+        let x356 = v[5] + v[6];
+        let x357 = x343 * x343;
+        let x358 = x342 * x356;
+        let x359 = Self::mul_add(-16.80768997608804, x356, -0.07309 * x343);
+        let x360 = Self::mul_add(
             0.1132,
-            x344,
-            Self::mul_add(130.43769025763282, x331, -0.07309 * x330),
+            x356,
+            Self::mul_add(130.43769025763282, x343, -0.07309 * x342),
         );
-        let x349 = Self::mul_add(
+        let x361 = Self::mul_add(
             132.47349025763282,
-            x344,
-            Self::mul_add(0.1132, x331, -16.80768997608804 * x330),
+            x356,
+            Self::mul_add(0.1132, x343, -16.80768997608804 * x342),
         );
-        let x350 = Self::mul_add(-c_q8, x344, Self::mul_add(s_q8, x331, x2 * x330));
-        let x351 = Self::mul_add(s_q8, x344, Self::mul_add(-x3, x330, c_q8 * x331));
-        let x352 = Self::mul_add(
+        let x362 = Self::mul_add(-c_q8, x356, Self::mul_add(s_q8, x343, x2 * x342));
+        let x363 = Self::mul_add(s_q8, x356, Self::mul_add(-x3, x342, c_q8 * x343));
+        let x364 = Self::mul_add(
             0.35,
-            x346 - x343,
-            Self::mul_add(s_q7, x339, c_q7 * x338),
+            x358 - x355,
+            Self::mul_add(s_q7, x351, c_q7 * x350),
         );
-        let x353 = Self::mul_add(0.35, Self::mul_add(x331, x344, -x342), x341);
-        let x354 = Self::mul_add(-0.35, Self::mul_add(x330, x330, x345), x340);
-        let x355 = Self::mul_add(-c_q8, x354, Self::mul_add(s_q8, x353, x2 * x352));
-        let x356 = Self::mul_add(s_q8, x354, Self::mul_add(-x3, x352, c_q8 * x353));
-        let x357 = Self::mul_add(-0.00000000020510342851533115, x354, x352);
-        let x358 = Self::mul_add(v[7], x351, Self::mul_add(-s_q8, x343, x2 * x342));
-        let x359 = Self::mul_add(v[7], x350, Self::mul_add(c_q8, x343, x3 * x342));
-        let x360 = v[7] + Self::mul_add(-0.00000000020510342851533115, x344, x330);
-        let x361 = x351 * x351;
-        let x362 = x360 * x360;
-        let x363 = x350 * x351;
-        let x364 = x363 - x342;
-        let x365 = x350 * x360;
-        let x366 = x350 * x350;
-        let x367 = x362 + x366;
-        let x368 = x351 * x360;
-        let x369 = x358 + x368;
-        let x370 = Self::mul_add(
-            -0.0021399965876409276,
-            x360,
-            -0.0000000234896432582596 * x351,
-        );
-        let x371 = Self::mul_add(
-            5.080660024070365,
-            x360,
-            Self::mul_add(-111.7548902508081, x351, -0.0000000234896432582596 * x350),
-        );
-        let x372 = Self::mul_add(
-            113.3918902508081,
-            x360,
-            Self::mul_add(5.080660024070366, x351, -0.0021399965876409276 * x350),
-        );
-        let x373 = Self::mul_add(c_q9, x360, Self::mul_add(x7, x351, x5 * x350));
-        let x374 = Self::mul_add(-s_q9, x360, Self::mul_add(x8, x351, x6 * x350));
-        let x375 = x355 + Self::mul_add(0.4, x365 - x359, 0.275 * x364);
-        let x376 = x356 + Self::mul_add(-0.275, x367, 0.4 * (x368 - x358));
-        let x377 = x357 + Self::mul_add(-0.4, x361 + x366, 0.275 * x369);
-        let x378 = Self::mul_add(c_q9, x377, Self::mul_add(x7, x376, x5 * x375));
-        let x379 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x377,
-            Self::mul_add(0.00000000020510342851533115, x375, x376),
-        );
-        let x380 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x342,
-            Self::mul_add(0.00000000020510342851533115, x358, -x359),
-        );
-        let x381 = Self::mul_add(
-            v[8],
-            x374,
-            Self::mul_add(c_q9, x342, Self::mul_add(-x7, x359, x5 * x358)),
-        );
+        let x365 = Self::mul_add(0.35, Self::mul_add(x343, x356, -x354), x353);
+        let x366 = Self::mul_add(-0.35, Self::mul_add(x342, x342, x357), x352);
+        let x367 = Self::mul_add(-c_q8, x366, Self::mul_add(s_q8, x365, x2 * x364));
+        let x368 = Self::mul_add(s_q8, x366, Self::mul_add(-x3, x364, c_q8 * x365));
+        let x369 = Self::mul_add(-0.00000000020510342851533115, x366, x364);
+        let x370 = Self::mul_add(v[7], x363, Self::mul_add(-s_q8, x355, x2 * x354));
+        let x371 = Self::mul_add(v[7], x362, Self::mul_add(c_q8, x355, x3 * x354));
+        let x372 = v[7] + Self::mul_add(-0.00000000020510342851533115, x356, x342);
+        let x373 = x363 * x363;
+        let x374 = x372 * x372;
+        let x375 = x362 * x363;
+        let x376 = x375 - x354;
+        let x377 = x362 * x372;
+        let x378 = x362 * x362;
+        let x379 = x374 + x378;
+        let x380 = x363 * x372;
+        let x381 = x370 + x380;
         let x382 = Self::mul_add(
-            -v[8],
-            x373,
-            Self::mul_add(-s_q9, x342, Self::mul_add(-x8, x359, x6 * x358)),
+            -0.002139996587640933,
+            x372,
+            -0.0000000234896432582596 * x363,
         );
-        let x383 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x360,
-                Self::mul_add(0.00000000020510342851533115, x350, x351),
-            );
-        let x384 = Self::mul_add(x373, x374, -x380);
-        let x385 = Self::mul_add(x373, x373, x383 * x383);
-        let x386 = Self::mul_add(x374, x383, x381);
-        let x387 = -0.00214 * x383;
-        let x388 = Self::mul_add(-36.18604050126307, x383, -63.36336825000001 * x374);
-        let x389 = Self::mul_add(
-            69.99836825,
-            x383,
-            Self::mul_add(-36.18604050126307, x374, -0.00214 * x373),
+        let x383 = Self::mul_add(
+            5.080660024070365,
+            x372,
+            Self::mul_add(-111.7548902508081, x363, -0.0000000234896432582596 * x362),
         );
-        let x390 = Self::mul_add(s_q10, x374, c_q10 * x373);
-        let x391 = Self::mul_add(-s_q10, x373, c_q10 * x374);
-        let x392 = Self::mul_add(-0.87, x384, x378);
-        let x393 = Self::mul_add(
-            0.87,
-            x385,
-            Self::mul_add(-s_q9, x377, Self::mul_add(x8, x376, x6 * x375)),
+        let x384 = Self::mul_add(
+            113.3918902508081,
+            x372,
+            Self::mul_add(5.080660024070366, x363, -0.002139996587640933 * x362),
         );
-        let x394 = Self::mul_add(-0.87, x386, x379);
-        let x395 = Self::mul_add(s_q10, x393, c_q10 * x392);
-        let x396 = Self::mul_add(v[9], x391, Self::mul_add(s_q10, x382, c_q10 * x381));
-        let x397 = Self::mul_add(-v[9], x390, Self::mul_add(-s_q10, x381, c_q10 * x382));
-        let x398 = v[9] + x383;
-        let x399 = Self::mul_add(x390, x391, -x380);
-        let x400 = x390 * x390;
-        let x401 = Self::mul_add(x398, x398, x400);
-        let x402 = x391 * x398;
-        let x403 = x396 + x402;
-        let x404 = -0.6328 * x398;
-        let x405 = Self::mul_add(-24.35164200091464, x398, -24.4950615 * x391);
-        let x406 = Self::mul_add(
-            28.2393615,
-            x398,
-            Self::mul_add(-24.351642000914637, x391, -0.6328 * x390),
-        );
-        let x407 = Self::mul_add(s_q11, x391, c_q11 * x390);
-        let x408 = Self::mul_add(-s_q11, x390, c_q11 * x391);
-        let x409 = x395
-            + Self::mul_add(-0.275, Self::mul_add(x390, x398, x397), -0.63 * x399);
-        let x410 = Self::mul_add(-s_q10, x392, c_q10 * x393)
-            + Self::mul_add(0.63, x401, -0.275 * (x402 - x396));
-        let x411 = x394
-            + Self::mul_add(0.275, Self::mul_add(x391, x391, x400), -0.63 * x403);
-        let x412 = Self::mul_add(s_q11, x410, c_q11 * x409);
-        let x413 = Self::mul_add(v[10], x408, Self::mul_add(s_q11, x397, c_q11 * x396));
-        let x414 = Self::mul_add(
-            -v[10],
-            x407,
-            Self::mul_add(-s_q11, x396, c_q11 * x397),
-        );
-        let x415 = v[10] + x398;
-        let x416 = x407 * x407;
-        let x417 = x408 * x415;
-        let x418 = 0.01675 * x415;
-        let x419 = Self::mul_add(2.5482240016099564, x415, -9.142025249762803 * x408);
-        let x420 = Self::mul_add(
-            9.223235249762805,
-            x415,
-            Self::mul_add(2.5482240016099564, x408, 0.01675 * x407),
-        );
-        let x421 = Self::mul_add(-s_q12, x415, Self::mul_add(x12, x408, c_q12 * x407));
-        let x422 = Self::mul_add(-c_q12, x415, Self::mul_add(-s_q12, x407, x13 * x408));
-        let x423 = Self::mul_add(-0.36, Self::mul_add(x407, x415, x414), x412);
-        let x424 = Self::mul_add(
-            -0.36,
-            x417 - x413,
-            Self::mul_add(-s_q11, x409, c_q11 * x410),
-        );
-        let x425 = Self::mul_add(0.36, Self::mul_add(x408, x408, x416), x411);
-        let x426 = Self::mul_add(-s_q12, x425, Self::mul_add(x12, x424, c_q12 * x423));
-        let x427 = Self::mul_add(-c_q12, x425, Self::mul_add(-s_q12, x423, x13 * x424));
-        let x428 = Self::mul_add(-0.00000000020510342851533115, x425, x424);
-        let x429 = Self::mul_add(-0.00000000020510342851533115, x380, x414);
-        let x430 = Self::mul_add(
-            v[11],
-            x422,
-            Self::mul_add(-s_q12, x380, Self::mul_add(x12, x414, c_q12 * x413)),
-        );
-        let x431 = Self::mul_add(
-            -v[11],
-            x421,
-            Self::mul_add(-c_q12, x380, Self::mul_add(-s_q12, x413, x13 * x414)),
-        );
-        let x432 = v[11] + Self::mul_add(-0.00000000020510342851533115, x415, x408);
-        let x433 = x422 * x422;
-        let x434 = x432 * x432;
-        let x435 = x421 * x422;
-        let x436 = x435 - x429;
-        let x437 = x421 * x432;
-        let x438 = x421 * x421;
-        let x439 = x434 + x438;
-        let x440 = x422 * x432;
-        let x441 = x430 + x440;
-        let x442 = Self::mul_add(-0.809539999555672, x432, -1.9877000000000002 * x422);
-        let x443 = Self::mul_add(
-            -2.741639999592316,
-            x432,
-            Self::mul_add(-5.252920330000002, x422, -1.9877000000000002 * x421),
-        );
-        let x444 = Self::mul_add(
-            9.740442170000001,
-            x432,
-            Self::mul_add(-2.7416399995923166, x422, -0.809539999555672 * x421),
-        );
-        let x445 = Self::mul_add(-c_q13, x432, Self::mul_add(s_q13, x422, x15 * x421));
-        let x446 = Self::mul_add(s_q13, x432, Self::mul_add(-x16, x421, c_q13 * x422));
-        let x447 = x426 + Self::mul_add(0.16, x431 + x437, 0.55 * x436);
-        let x448 = x428 + Self::mul_add(-0.16, x433 + x438, 0.55 * x441);
-        let x449 = Self::mul_add(-0.00000000020510342851533115, x429, x430);
-        let x450 = Self::mul_add(
-            v[12],
-            x446,
-            Self::mul_add(-c_q13, x429, Self::mul_add(s_q13, x431, x15 * x430)),
-        );
-        let x451 = Self::mul_add(
-            -v[12],
-            x445,
-            Self::mul_add(s_q13, x429, Self::mul_add(-x16, x430, c_q13 * x431)),
-        );
-        let x452 = v[12] + Self::mul_add(-0.00000000020510342851533115, x432, x421);
-        let x453 = 4.806620000000001 * Self::mul_add(x445, x446, -x449);
-        let x454 = 4.806620000000001 * Self::mul_add(x445, x445, x452 * x452);
-        let x455 = 4.806620000000001 * Self::mul_add(x446, x452, x450);
-        let x456 = Self::mul_add(-0.0145, x452, 0.000781 * x446);
-        let x457 = Self::mul_add(
-            -0.9614610000000001,
-            x452,
-            Self::mul_add(-1.2025609200000003, x446, 0.000781 * x445),
-        );
-        let x458 = Self::mul_add(
-            1.4135609200000003,
-            x452,
-            Self::mul_add(-0.9614610000000001, x446, -0.0145 * x445),
-        );
-        let x459 = Self::mul_add(
-            -0.9614610000000001,
-            x449,
-            Self::mul_add(-1.2025609200000003, x451, 0.000781 * x450),
-        ) + Self::mul_add(-x445, x458, x452 * x456);
-        let x460 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x448, x447),
-            Self::mul_add(-0.0145, x449, 0.000781 * x451)
-                + Self::mul_add(-x452, x457, x446 * x458),
-        );
-        let x461 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(
-                -c_q13,
-                x448,
-                Self::mul_add(
-                    s_q13,
-                    x427 + Self::mul_add(-0.55, x439, 0.16 * (x440 - x430)),
-                    x15 * x447,
-                ),
-            ),
-            Self::mul_add(
-                1.4135609200000003,
-                x449,
-                Self::mul_add(-0.9614610000000001, x451, -0.0145 * x450),
-            ) + Self::mul_add(-x446, x456, x445 * x457),
-        );
-        let x462 = x455 + Self::mul_add(x16, x454, x15 * x453);
-        let x463 = Self::mul_add(-c_q13, x454, s_q13 * x453);
-        let x464 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x455,
-            -Self::mul_add(s_q13, x454, c_q13 * x453),
-        );
-        let x465 = Self::mul_add(
-            -3.6140000000000003,
-            x433 + x434,
-            17.135250000000003 * x436,
-        ) + x462;
-        let x466 = Self::mul_add(
-            -17.135250000000003,
-            x439,
-            3.6140000000000003 * (x429 + x435),
-        ) + x463;
-        let x467 = Self::mul_add(
-            17.135250000000003,
-            x441,
-            3.6140000000000003 * (x437 - x431),
-        ) + x464;
-        let x468 = Self::mul_add(
-            17.135250000000003,
-            x428,
-            Self::mul_add(-0.809539999555672, x429, -1.9877000000000002 * x431)
-                + Self::mul_add(-x432, x443, x422 * x444),
-        )
-            + (x461 + Self::mul_add(-x16, x459, x15 * x460)
-                + Self::mul_add(0.55, x464, -0.16 * x463));
-        let x469 = Self::mul_add(
-            x428,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x429,
-                Self::mul_add(-5.252920330000002, x431, -1.9877000000000002 * x430),
-            ) + Self::mul_add(-x421, x444, x432 * x442),
-        ) + Self::mul_add(0.16, x462, Self::mul_add(c_q13, x459, s_q13 * x460));
-        let x470 = Self::mul_add(
-            9.740442170000001,
-            x429,
-            Self::mul_add(-2.7416399995923166, x431, -0.809539999555672 * x430),
-        ) + Self::mul_add(-x422, x442, x421 * x443)
-            + Self::mul_add(3.6140000000000003, x427, x426 * -17.135250000000003)
-            + Self::mul_add(
-                -0.55,
-                x462,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x461,
-                    Self::mul_add(-c_q13, x460, s_q13 * x459),
-                ),
-            );
-        let x471 = Self::mul_add(-s_q12, x466, c_q12 * x465);
-        let x472 = x467 + Self::mul_add(x13, x466, x12 * x465);
-        let x473 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x407, x408, -x380),
-            x471,
-        );
-        let x474 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x415, x415, x416),
-            x472,
-        );
-        let x475 = Self::mul_add(
-            7.078399999258757,
-            x413 + x417,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x467,
-                -Self::mul_add(c_q12, x466, s_q12 * x465),
-            ),
-        );
-        let x476 = Self::mul_add(
-            7.078399999258757,
-            x411,
-            Self::mul_add(0.01675, x380, Self::mul_add(-x415, x419, x408 * x420)),
-        ) + Self::mul_add(0.36, x472, Self::mul_add(-s_q12, x469, c_q12 * x468));
-        let x477 = Self::mul_add(2.5482240016099564, x380, -9.142025249762803 * x414)
-            + Self::mul_add(-x407, x420, x415 * x418)
-            + Self::mul_add(-0.36, x471, x470 + Self::mul_add(x13, x469, x12 * x468));
-        let x478 = Self::mul_add(
-            x412,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x380,
-                Self::mul_add(2.5482240016099564, x414, 0.01675 * x413),
-            ) + Self::mul_add(-x408, x418, x407 * x419),
-        )
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x470,
-                -Self::mul_add(c_q12, x469, s_q12 * x468),
-            );
-        let x479 = Self::mul_add(-s_q11, x474, c_q11 * x473);
-        let x480 = Self::mul_add(c_q11, x474, s_q11 * x473);
-        let x481 = Self::mul_add(-45.1584, x399, x479);
-        let x482 = Self::mul_add(45.1584, x401, x480);
-        let x483 = Self::mul_add(-45.1584, x403, x475);
-        let x484 = Self::mul_add(
-            -45.1584,
-            x394,
-            Self::mul_add(-0.6328, x380, Self::mul_add(-x398, x405, x391 * x406)),
-        )
-            + (Self::mul_add(-s_q11, x477, c_q11 * x476)
-                + Self::mul_add(-0.63, x475, 0.275 * x480));
-        let x485 = Self::mul_add(-24.35164200091464, x380, -24.4950615 * x397)
-            + Self::mul_add(-x390, x406, x398 * x404)
-            + Self::mul_add(-0.275, x479, Self::mul_add(c_q11, x477, s_q11 * x476));
-        let x486 = Self::mul_add(
-            x395,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x380,
-                Self::mul_add(-24.351642000914637, x397, -0.6328 * x396),
-            ) + Self::mul_add(-x391, x404, x390 * x405),
-        ) + Self::mul_add(0.63, x479, x478);
-        let x487 = Self::mul_add(-s_q10, x482, c_q10 * x481);
-        let x488 = Self::mul_add(-81.53205, x384, x487);
-        let x489 = Self::mul_add(
-            81.53205,
-            x385,
-            Self::mul_add(c_q10, x482, s_q10 * x481),
-        );
-        let x490 = Self::mul_add(-81.53205, x386, x483);
-        let x491 = Self::mul_add(
-            -81.53205,
-            x379,
-            Self::mul_add(-0.00214, x380, Self::mul_add(-x383, x388, x374 * x389)),
-        ) + Self::mul_add(-0.87, x483, Self::mul_add(-s_q10, x485, c_q10 * x484));
-        let x492 = Self::mul_add(-36.18604050126307, x380, -63.36336825000001 * x382)
-            + Self::mul_add(-x373, x389, x383 * x387)
-            + Self::mul_add(c_q10, x485, s_q10 * x484);
-        let x493 = Self::mul_add(
-            x378,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x380,
-                Self::mul_add(-36.18604050126307, x382, -0.00214 * x381),
-            ) + Self::mul_add(-x374, x387, x373 * x388),
-        ) + Self::mul_add(0.87, x487, x486);
-        let x494 = Self::mul_add(
-            0.00000000020510342851533115,
-            x490,
-            Self::mul_add(x6, x489, x5 * x488),
-        );
-        let x495 = x490 + Self::mul_add(x8, x489, x7 * x488);
-        let x496 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x490,
-            Self::mul_add(-s_q9, x489, c_q9 * x488),
-        );
-        let x497 = Self::mul_add(
-            0.000000008530897668050218,
-            x361 + x362,
-            -12.701650001451807 * x364,
-        ) + x494;
-        let x498 = Self::mul_add(
-            12.701650001451807,
-            x367,
-            -0.000000008530897668050218 * (x342 + x363),
-        ) + x495;
-        let x499 = Self::mul_add(
-            -12.701650001451807,
+        let x385 = Self::mul_add(
             x369,
-            -0.000000008530897668050218 * (x359 + x365),
-        ) + x496;
-        let x500 = Self::mul_add(
-            -12.701650001451807,
-            x357,
-            Self::mul_add(0.0000000234896432582596, x359, -0.0021399965876409276 * x342)
-                + Self::mul_add(-x360, x371, x351 * x372),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x493,
-                Self::mul_add(x6, x492, x5 * x491),
-            ) + Self::mul_add(0.275, x496, -0.4 * x495));
-        let x501 = Self::mul_add(
-            x357,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x342,
-                Self::mul_add(111.7548902508081, x359, -0.0000000234896432582596 * x358),
-            ) + Self::mul_add(-x350, x372, x360 * x370),
-        ) + Self::mul_add(0.4, x494, x493 + Self::mul_add(x8, x492, x7 * x491));
-        let x502 = Self::mul_add(
-            113.3918902508081,
-            x342,
-            Self::mul_add(-5.080660024070366, x359, -0.0021399965876409276 * x358),
-        ) + Self::mul_add(-x351, x370, x350 * x371)
-            + Self::mul_add(-0.000000008530897668050218, x356, x355 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x494,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x493,
-                    Self::mul_add(-s_q9, x492, c_q9 * x491),
-                ),
-            );
-        let x503 = x499 + Self::mul_add(-x3, x498, x2 * x497);
-        let x504 = Self::mul_add(c_q8, x498, s_q8 * x497);
-        let x505 = Self::mul_add(
-            -48.0240000085309,
-            Self::mul_add(x344, x344, x345),
-            x503,
+                x354,
+                Self::mul_add(111.7548902508081, x371, -0.0000000234896432582596 * x370),
+            ) + Self::mul_add(-x362, x384, x372 * x382),
         );
-        let x506 = Self::mul_add(48.0240000085309, x330 * x331, x504);
-        let x507 = Self::mul_add(
-            48.0240000085309,
-            x343 + x346,
-            Self::mul_add(
+        let x386 = Self::mul_add(c_q9, x372, Self::mul_add(x5, x363, s_q9 * x362));
+        let x387 = Self::mul_add(-s_q9, x372, Self::mul_add(x6, x363, c_q9 * x362));
+        let x388 = x367 + Self::mul_add(0.4, x377 - x371, 0.275 * x376);
+        let x389 = x368 + Self::mul_add(-0.275, x379, 0.4 * (x380 - x370));
+        let x390 = x369 + Self::mul_add(-0.4, x373 + x378, 0.275 * x381);
+        let x391 = Self::mul_add(c_q9, x390, Self::mul_add(x5, x389, s_q9 * x388));
+        let x392 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x390,
+            Self::mul_add(0.00000000020510342851533115, x388, x389),
+        );
+        let x393 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x354,
+            Self::mul_add(0.00000000020510342851533115, x370, -x371),
+        );
+        let x394 = Self::mul_add(
+            v[8],
+            x387,
+            Self::mul_add(c_q9, x354, Self::mul_add(-x5, x371, s_q9 * x370)),
+        );
+        let x395 = Self::mul_add(
+            -v[8],
+            x386,
+            Self::mul_add(-s_q9, x354, Self::mul_add(-x6, x371, c_q9 * x370)),
+        );
+        let x396 = v[8]
+            + Self::mul_add(
                 -0.00000000020510342851533115,
-                x499,
-                Self::mul_add(-c_q8, x497, s_q8 * x498),
+                x372,
+                Self::mul_add(0.00000000020510342851533115, x362, x363),
+            );
+        let x397 = Self::mul_add(x386, x387, -x393);
+        let x398 = Self::mul_add(x386, x386, x396 * x396);
+        let x399 = Self::mul_add(x387, x396, x394);
+        let x400 = -0.00214 * x396;
+        let x401 = Self::mul_add(-36.18604050126307, x396, -63.36336825000001 * x387);
+        let x402 = Self::mul_add(
+            69.99836825,
+            x396,
+            Self::mul_add(-36.18604050126307, x387, -0.00214 * x386),
+        );
+        let x403 = Self::mul_add(
+            -81.53205,
+            x392,
+            Self::mul_add(-0.00214, x393, Self::mul_add(-x396, x401, x387 * x402)),
+        );
+        let x404 = Self::mul_add(
+            x391,
+            81.53205,
+            Self::mul_add(
+                69.99836825,
+                x393,
+                Self::mul_add(-36.18604050126307, x395, -0.00214 * x394),
+            ) + Self::mul_add(-x387, x400, x386 * x401),
+        );
+        let x405 = Self::mul_add(s_q10, x387, c_q10 * x386);
+        let x406 = Self::mul_add(-s_q10, x386, c_q10 * x387);
+        let x407 = Self::mul_add(-0.87, x397, x391);
+        let x408 = Self::mul_add(
+            0.87,
+            x398,
+            Self::mul_add(-s_q9, x390, Self::mul_add(x6, x389, c_q9 * x388)),
+        );
+        let x409 = Self::mul_add(-0.87, x399, x392);
+        let x410 = Self::mul_add(s_q10, x408, c_q10 * x407);
+        let x411 = Self::mul_add(v[9], x406, Self::mul_add(s_q10, x395, c_q10 * x394));
+        let x412 = Self::mul_add(-v[9], x405, Self::mul_add(-s_q10, x394, c_q10 * x395));
+        let x413 = v[9] + x396;
+        let x414 = Self::mul_add(x405, x406, -x393);
+        let x415 = x405 * x405;
+        let x416 = Self::mul_add(x413, x413, x415);
+        let x417 = x406 * x413;
+        let x418 = x411 + x417;
+        let x419 = -0.6328 * x413;
+        let x420 = Self::mul_add(-24.35164200091464, x413, -24.4950615 * x406);
+        let x421 = Self::mul_add(
+            28.2393615,
+            x413,
+            Self::mul_add(-24.351642000914637, x406, -0.6328 * x405),
+        );
+        let x422 = Self::mul_add(
+            -45.1584,
+            x409,
+            Self::mul_add(-0.6328, x393, Self::mul_add(-x413, x420, x406 * x421)),
+        );
+        let x423 = Self::mul_add(
+            x410,
+            45.1584,
+            Self::mul_add(
+                28.2393615,
+                x393,
+                Self::mul_add(-24.351642000914637, x412, -0.6328 * x411),
+            ) + Self::mul_add(-x406, x419, x405 * x420),
+        );
+        let x424 = Self::mul_add(s_q11, x406, c_q11 * x405);
+        let x425 = Self::mul_add(-s_q11, x405, c_q11 * x406);
+        let x426 = x410
+            + Self::mul_add(-0.275, Self::mul_add(x405, x413, x412), -0.63 * x414);
+        let x427 = Self::mul_add(-s_q10, x407, c_q10 * x408)
+            + Self::mul_add(0.63, x416, -0.275 * (x417 - x411));
+        let x428 = x409
+            + Self::mul_add(0.275, Self::mul_add(x406, x406, x415), -0.63 * x418);
+        let x429 = Self::mul_add(s_q11, x427, c_q11 * x426);
+        let x430 = Self::mul_add(v[10], x425, Self::mul_add(s_q11, x412, c_q11 * x411));
+        let x431 = Self::mul_add(
+            -v[10],
+            x424,
+            Self::mul_add(-s_q11, x411, c_q11 * x412),
+        );
+        let x432 = v[10] + x413;
+        let x433 = x424 * x424;
+        let x434 = x425 * x432;
+        let x435 = 0.01675 * x432;
+        let x436 = Self::mul_add(2.5482240016099564, x432, -9.142025249762803 * x425);
+        let x437 = Self::mul_add(
+            9.223235249762805,
+            x432,
+            Self::mul_add(2.5482240016099564, x425, 0.01675 * x424),
+        );
+        let x438 = Self::mul_add(
+            7.078399999258757,
+            x428,
+            Self::mul_add(0.01675, x393, Self::mul_add(-x432, x436, x425 * x437)),
+        );
+        let x439 = Self::mul_add(
+            x429,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x393,
+                Self::mul_add(2.5482240016099564, x431, 0.01675 * x430),
+            ) + Self::mul_add(-x425, x435, x424 * x436),
+        );
+        let x440 = Self::mul_add(-s_q12, x432, Self::mul_add(x10, x425, c_q12 * x424));
+        let x441 = Self::mul_add(-c_q12, x432, Self::mul_add(-s_q12, x424, x11 * x425));
+        let x442 = Self::mul_add(-0.36, Self::mul_add(x424, x432, x431), x429);
+        let x443 = Self::mul_add(
+            -0.36,
+            x434 - x430,
+            Self::mul_add(-s_q11, x426, c_q11 * x427),
+        );
+        let x444 = Self::mul_add(0.36, Self::mul_add(x425, x425, x433), x428);
+        let x445 = Self::mul_add(-s_q12, x444, Self::mul_add(x10, x443, c_q12 * x442));
+        let x446 = Self::mul_add(-c_q12, x444, Self::mul_add(-s_q12, x442, x11 * x443));
+        let x447 = Self::mul_add(-0.00000000020510342851533115, x444, x443);
+        let x448 = Self::mul_add(-0.00000000020510342851533115, x393, x431);
+        let x449 = Self::mul_add(
+            v[11],
+            x441,
+            Self::mul_add(-s_q12, x393, Self::mul_add(x10, x431, c_q12 * x430)),
+        );
+        let x450 = Self::mul_add(
+            -v[11],
+            x440,
+            Self::mul_add(-c_q12, x393, Self::mul_add(-s_q12, x430, x11 * x431)),
+        );
+        let x451 = v[11] + Self::mul_add(-0.00000000020510342851533115, x432, x425);
+        let x452 = x441 * x441;
+        let x453 = x451 * x451;
+        let x454 = x440 * x441;
+        let x455 = x454 - x448;
+        let x456 = x440 * x451;
+        let x457 = x440 * x440;
+        let x458 = x453 + x457;
+        let x459 = x441 * x451;
+        let x460 = x449 + x459;
+        let x461 = Self::mul_add(-0.809539999555672, x451, -1.9877000000000002 * x441);
+        let x462 = Self::mul_add(
+            -2.741639999592316,
+            x451,
+            Self::mul_add(-5.252920330000002, x441, -1.9877000000000002 * x440),
+        );
+        let x463 = Self::mul_add(
+            9.740442170000001,
+            x451,
+            Self::mul_add(-2.7416399995923166, x441, -0.809539999555672 * x440),
+        );
+        let x464 = Self::mul_add(
+            x447,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x448,
+                Self::mul_add(-5.252920330000002, x450, -1.9877000000000002 * x449),
+            ) + Self::mul_add(-x440, x463, x451 * x461),
+        );
+        let x465 = Self::mul_add(-c_q13, x451, Self::mul_add(s_q13, x441, x13 * x440));
+        let x466 = Self::mul_add(s_q13, x451, Self::mul_add(-x14, x440, c_q13 * x441));
+        let x467 = x445 + Self::mul_add(0.16, x450 + x456, 0.55 * x455);
+        let x468 = x447 + Self::mul_add(-0.16, x452 + x457, 0.55 * x460);
+        let x469 = Self::mul_add(
+            -c_q13,
+            x468,
+            Self::mul_add(
+                s_q13,
+                x446 + Self::mul_add(-0.55, x458, 0.16 * (x459 - x449)),
+                x13 * x467,
             ),
         );
-        let x508 = Self::mul_add(0.07309, x343, Self::mul_add(-x344, x348, x331 * x349))
-            + Self::mul_add(-0.35, x504, x502 + Self::mul_add(-x3, x501, x2 * x500));
-        let x509 = Self::mul_add(
-            x340,
+        let x470 = Self::mul_add(-0.00000000020510342851533115, x448, x449);
+        let x471 = Self::mul_add(
+            v[12],
+            x466,
+            Self::mul_add(-c_q13, x448, Self::mul_add(s_q13, x450, x13 * x449)),
+        );
+        let x472 = Self::mul_add(
+            -v[12],
+            x465,
+            Self::mul_add(s_q13, x448, Self::mul_add(-x14, x449, c_q13 * x450)),
+        );
+        let x473 = v[12] + Self::mul_add(-0.00000000020510342851533115, x451, x440);
+        let x474 = 4.806620000000001 * Self::mul_add(x465, x466, -x470);
+        let x475 = 4.806620000000001 * Self::mul_add(x465, x465, x473 * x473);
+        let x476 = 4.806620000000001 * Self::mul_add(x466, x473, x471);
+        let x477 = Self::mul_add(-0.0145, x473, 0.000781 * x466);
+        let x478 = Self::mul_add(
+            -0.9614610000000001,
+            x473,
+            Self::mul_add(-1.2025609200000003, x466, 0.000781 * x465),
+        );
+        let x479 = Self::mul_add(
+            1.4135609200000003,
+            x473,
+            Self::mul_add(-0.9614610000000001, x466, -0.0145 * x465),
+        );
+        let x480 = Self::mul_add(
+            -0.9614610000000001,
+            x470,
+            Self::mul_add(-1.2025609200000003, x472, 0.000781 * x471),
+        ) + Self::mul_add(-x465, x479, x473 * x477);
+        let x481 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x468, x467),
+            Self::mul_add(-0.0145, x470, 0.000781 * x472)
+                + Self::mul_add(-x473, x478, x466 * x479),
+        );
+        let x482 = Self::mul_add(
+            -4.806620000000001,
+            x469,
+            Self::mul_add(
+                1.4135609200000003,
+                x470,
+                Self::mul_add(-0.9614610000000001, x472, -0.0145 * x471),
+            ) + Self::mul_add(-x466, x477, x465 * x478),
+        );
+        let x483 = x476 + Self::mul_add(x14, x475, x13 * x474);
+        let x484 = Self::mul_add(-c_q13, x475, s_q13 * x474);
+        let x485 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x476,
+            -Self::mul_add(s_q13, x475, c_q13 * x474),
+        );
+        let x486 = Self::mul_add(
+            -0.55,
+            x483,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x482,
+                Self::mul_add(-c_q13, x481, s_q13 * x480),
+            ),
+        );
+        let x487 = Self::mul_add(
+            -3.6140000000000003,
+            x452 + x453,
+            17.135250000000003 * x455,
+        ) + x483;
+        let x488 = Self::mul_add(
+            -17.135250000000003,
+            x458,
+            3.6140000000000003 * (x448 + x454),
+        ) + x484;
+        let x489 = Self::mul_add(
+            17.135250000000003,
+            x460,
+            3.6140000000000003 * (x456 - x450),
+        ) + x485;
+        let x490 = Self::mul_add(
+            17.135250000000003,
+            x447,
+            Self::mul_add(-0.809539999555672, x448, -1.9877000000000002 * x450)
+                + Self::mul_add(-x451, x462, x441 * x463),
+        )
+            + (x482 + Self::mul_add(-x14, x480, x13 * x481)
+                + Self::mul_add(0.55, x485, -0.16 * x484));
+        let x491 = x464
+            + Self::mul_add(0.16, x483, Self::mul_add(c_q13, x480, s_q13 * x481));
+        let x492 = Self::mul_add(
+            9.740442170000001,
+            x448,
+            Self::mul_add(-2.7416399995923166, x450, -0.809539999555672 * x449),
+        ) + Self::mul_add(-x441, x461, x440 * x462)
+            + Self::mul_add(3.6140000000000003, x446, x445 * -17.135250000000003) + x486;
+        let x493 = Self::mul_add(-s_q12, x488, c_q12 * x487);
+        let x494 = x489 + Self::mul_add(x11, x488, x10 * x487);
+        let x495 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x424, x425, -x393),
+            x493,
+        );
+        let x496 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x432, x432, x433),
+            x494,
+        );
+        let x497 = Self::mul_add(
+            7.078399999258757,
+            x430 + x434,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x489,
+                -Self::mul_add(c_q12, x488, s_q12 * x487),
+            ),
+        );
+        let x498 = x438
+            + Self::mul_add(0.36, x494, Self::mul_add(-s_q12, x491, c_q12 * x490));
+        let x499 = Self::mul_add(2.5482240016099564, x393, -9.142025249762803 * x431)
+            + Self::mul_add(-x424, x437, x432 * x435)
+            + Self::mul_add(-0.36, x493, x492 + Self::mul_add(x11, x491, x10 * x490));
+        let x500 = x439
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x492,
+                -Self::mul_add(c_q12, x491, s_q12 * x490),
+            );
+        let x501 = Self::mul_add(-s_q11, x496, c_q11 * x495);
+        let x502 = Self::mul_add(c_q11, x496, s_q11 * x495);
+        let x503 = Self::mul_add(-45.1584, x414, x501);
+        let x504 = Self::mul_add(45.1584, x416, x502);
+        let x505 = Self::mul_add(-45.1584, x418, x497);
+        let x506 = x422
+            + (Self::mul_add(-s_q11, x499, c_q11 * x498)
+                + Self::mul_add(-0.63, x497, 0.275 * x502));
+        let x507 = Self::mul_add(-24.35164200091464, x393, -24.4950615 * x412)
+            + Self::mul_add(-x405, x421, x413 * x419)
+            + Self::mul_add(-0.275, x501, Self::mul_add(c_q11, x499, s_q11 * x498));
+        let x508 = x423 + Self::mul_add(0.63, x501, x500);
+        let x509 = Self::mul_add(-s_q10, x504, c_q10 * x503);
+        let x510 = Self::mul_add(-81.53205, x397, x509);
+        let x511 = Self::mul_add(
+            81.53205,
+            x398,
+            Self::mul_add(c_q10, x504, s_q10 * x503),
+        );
+        let x512 = Self::mul_add(-81.53205, x399, x505);
+        let x513 = x403
+            + Self::mul_add(-0.87, x505, Self::mul_add(-s_q10, x507, c_q10 * x506));
+        let x514 = Self::mul_add(-36.18604050126307, x393, -63.36336825000001 * x395)
+            + Self::mul_add(-x386, x402, x396 * x400)
+            + Self::mul_add(c_q10, x507, s_q10 * x506);
+        let x515 = x404 + Self::mul_add(0.87, x509, x508);
+        let x516 = Self::mul_add(
+            0.00000000020510342851533115,
+            x512,
+            Self::mul_add(c_q9, x511, s_q9 * x510),
+        );
+        let x517 = x512 + Self::mul_add(x6, x511, x5 * x510);
+        let x518 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x512,
+            Self::mul_add(-s_q9, x511, c_q9 * x510),
+        );
+        let x519 = Self::mul_add(
+            -0.275,
+            x516,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x515,
+                Self::mul_add(-s_q9, x514, c_q9 * x513),
+            ),
+        );
+        let x520 = Self::mul_add(
+            0.000000008530897668050218,
+            x373 + x374,
+            -12.701650001451807 * x376,
+        ) + x516;
+        let x521 = Self::mul_add(
+            12.701650001451807,
+            x379,
+            -0.000000008530897668050218 * (x354 + x375),
+        ) + x517;
+        let x522 = Self::mul_add(
+            -12.701650001451807,
+            x381,
+            -0.000000008530897668050218 * (x371 + x377),
+        ) + x518;
+        let x523 = Self::mul_add(
+            -12.701650001451807,
+            x369,
+            Self::mul_add(0.0000000234896432582596, x371, -0.002139996587640933 * x354)
+                + Self::mul_add(-x372, x383, x363 * x384),
+        )
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x515,
+                Self::mul_add(c_q9, x514, s_q9 * x513),
+            ) + Self::mul_add(0.275, x518, -0.4 * x517));
+        let x524 = x385
+            + Self::mul_add(0.4, x516, x515 + Self::mul_add(x6, x514, x5 * x513));
+        let x525 = Self::mul_add(
+            113.3918902508081,
+            x354,
+            Self::mul_add(-5.080660024070366, x371, -0.002139996587640933 * x370),
+        ) + Self::mul_add(-x363, x382, x362 * x383)
+            + Self::mul_add(-0.000000008530897668050218, x368, x367 * 12.701650001451807)
+            + x519;
+        let x526 = x522 + Self::mul_add(-x3, x521, x2 * x520);
+        let x527 = Self::mul_add(c_q8, x521, s_q8 * x520);
+        let x528 = Self::mul_add(
             -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x343, -0.07309 * x342)
-                + Self::mul_add(-x330, x349, x344 * x347),
-        ) + Self::mul_add(0.35, x503, Self::mul_add(c_q8, x501, s_q8 * x500));
-        let x510 = Self::mul_add(
+            Self::mul_add(x356, x356, x357),
+            x526,
+        );
+        let x529 = Self::mul_add(48.0240000085309, x342 * x343, x527);
+        let x530 = Self::mul_add(
             48.0240000085309,
-            x341,
-            Self::mul_add(-0.1132, x343, -16.80768997608804 * x342)
-                + Self::mul_add(-x331, x347, x330 * x348),
+            x355 + x358,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x522,
+                Self::mul_add(-c_q8, x520, s_q8 * x521),
+            ),
+        );
+        let x531 = Self::mul_add(0.07309, x355, Self::mul_add(-x356, x360, x343 * x361))
+            + Self::mul_add(-0.35, x527, x525 + Self::mul_add(-x3, x524, x2 * x523));
+        let x532 = Self::mul_add(
+            x352,
+            -48.0240000085309,
+            Self::mul_add(-130.43769025763282, x355, -0.07309 * x354)
+                + Self::mul_add(-x342, x361, x356 * x359),
+        ) + Self::mul_add(0.35, x526, Self::mul_add(c_q8, x524, s_q8 * x523));
+        let x533 = Self::mul_add(
+            48.0240000085309,
+            x353,
+            Self::mul_add(-0.1132, x355, -16.80768997608804 * x354)
+                + Self::mul_add(-x343, x359, x342 * x360),
         )
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x502,
-                Self::mul_add(-c_q8, x500, s_q8 * x501),
+                x525,
+                Self::mul_add(-c_q8, x523, s_q8 * x524),
             );
-        let x511 = Self::mul_add(-s_q7, x506, c_q7 * x505);
-        let x512 = Self::mul_add(c_q7, x506, s_q7 * x505);
-        let x513 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x514 = 1466.4506062283303 * v[4];
-        let x515 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x516 = x511
+        let x534 = Self::mul_add(-s_q7, x529, c_q7 * x528);
+        let x535 = Self::mul_add(c_q7, x529, s_q7 * x528);
+        let x536 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x537 = 1466.4506062283303 * v[4];
+        let x538 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x539 = x534
             + Self::mul_add(
                 1170.07,
-                x327,
-                Self::mul_add(-110.5455, x333, 180.9502499901501 * x335),
+                x339,
+                Self::mul_add(-110.5455, x345, 180.9502499901501 * x347),
             );
-        let x517 = x512
+        let x540 = x535
             + Self::mul_add(
                 1170.07,
-                x328,
-                Self::mul_add(180.9502499901501, x336, 110.5455 * x334),
+                x340,
+                Self::mul_add(180.9502499901501, x348, 110.5455 * x346),
             );
-        let x518 = x507
+        let x541 = x530
             + Self::mul_add(
                 1170.07,
-                x329,
-                Self::mul_add(-180.9502499901501, x337, 110.5455 * x335),
+                x341,
+                Self::mul_add(-180.9502499901501, x349, 110.5455 * x347),
             );
-        let x519 = Self::mul_add(-0.75, x512, Self::mul_add(-s_q7, x509, c_q7 * x508))
+        let x542 = Self::mul_add(-0.75, x535, Self::mul_add(-s_q7, x532, c_q7 * x531))
             + Self::mul_add(
-                x328,
+                x340,
                 -180.9502499901501,
-                Self::mul_add(-v[5], x514, v[4] * x515),
+                Self::mul_add(-v[5], x537, v[4] * x538),
             );
-        let x520 = Self::mul_add(c_q7, x509, s_q7 * x508)
-            + Self::mul_add(-0.65, x507, 0.75 * x511)
-            + (Self::mul_add(-v[3], x515, v[5] * x513)
-                + Self::mul_add(x329, -110.5455, 180.9502499901501 * x327));
-        let x521 = Self::mul_add(0.65, x512, x510)
-            + Self::mul_add(110.5455, x328, Self::mul_add(-v[4], x513, v[3] * x514));
+        let x543 = Self::mul_add(c_q7, x532, s_q7 * x531)
+            + Self::mul_add(-0.65, x530, 0.75 * x534)
+            + (Self::mul_add(-v[3], x538, v[5] * x536)
+                + Self::mul_add(x341, -110.5455, 180.9502499901501 * x339));
+        let x544 = Self::mul_add(0.65, x535, x533)
+            + Self::mul_add(110.5455, x340, Self::mul_add(-v[4], x536, v[3] * x537));
         (
             [
                 [
@@ -6459,217 +5544,217 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x181,
-                    x171,
-                    x171,
-                    x193,
-                    x213,
-                    x230,
-                    x252,
-                    x283,
-                    x322,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x186,
-                    0.0,
-                    x180,
-                    x167,
-                    x194,
-                    x214,
-                    x231,
-                    x253,
-                    x284,
-                    x323,
-                ],
-                [
-                    0.0,
-                    0.0,
-                    1170.07,
-                    x168,
+                    x197,
                     x187,
-                    0.0,
-                    0.0,
-                    x146,
+                    x187,
                     x209,
-                    x226,
-                    x248,
-                    x279,
-                    x318,
+                    x225,
+                    x242,
+                    x264,
+                    x295,
+                    x334,
                 ],
                 [
                     0.0,
-                    x186,
-                    x168,
-                    x182,
-                    x179,
+                    1170.07,
+                    0.0,
+                    x202,
+                    0.0,
+                    x196,
                     x183,
-                    x176,
-                    x195,
-                    x215,
-                    x232,
-                    x254,
-                    x285,
-                    x324,
+                    x210,
+                    x226,
+                    x243,
+                    x265,
+                    x296,
+                    x335,
                 ],
                 [
-                    x181,
                     0.0,
-                    x187,
-                    x179,
+                    0.0,
+                    1170.07,
                     x184,
-                    x177,
-                    x177,
-                    x196,
-                    x216,
-                    x233,
-                    x255,
-                    x286,
-                    x325,
+                    x203,
+                    0.0,
+                    0.0,
+                    x159,
+                    x221,
+                    x238,
+                    x260,
+                    x291,
+                    x330,
                 ],
                 [
-                    x171,
-                    x180,
                     0.0,
-                    x183,
-                    x177,
-                    x185,
-                    x178,
-                    x197,
-                    x217,
-                    x234,
-                    x256,
-                    x287,
-                    x326,
-                ],
-                [
-                    x171,
-                    x167,
-                    0.0,
-                    x176,
-                    x177,
-                    x178,
-                    x166,
-                    x156,
-                    x210,
+                    x202,
+                    x184,
+                    x198,
+                    x195,
+                    x199,
+                    x192,
+                    x211,
                     x227,
-                    x249,
-                    x280,
-                    x319,
+                    x244,
+                    x266,
+                    x297,
+                    x336,
                 ],
                 [
+                    x197,
+                    0.0,
+                    x203,
+                    x195,
+                    x200,
+                    x193,
+                    x193,
+                    x212,
+                    x228,
+                    x245,
+                    x267,
+                    x298,
+                    x337,
+                ],
+                [
+                    x187,
+                    x196,
+                    0.0,
+                    x199,
+                    x193,
+                    x201,
+                    x194,
+                    x213,
+                    x229,
+                    x246,
+                    x268,
+                    x299,
+                    x338,
+                ],
+                [
+                    x187,
+                    x183,
+                    0.0,
+                    x192,
                     x193,
                     x194,
-                    x146,
-                    x195,
-                    x196,
-                    x197,
-                    x156,
-                    x144,
-                    x206,
-                    x223,
-                    x245,
-                    x276,
-                    x315,
+                    x182,
+                    x169,
+                    x222,
+                    x239,
+                    x261,
+                    x292,
+                    x331,
                 ],
                 [
-                    x213,
-                    x214,
                     x209,
-                    x215,
-                    x216,
-                    x217,
                     x210,
-                    x206,
-                    x117,
-                    x108,
-                    x239,
-                    x270,
-                    x309,
+                    x159,
+                    x211,
+                    x212,
+                    x213,
+                    x169,
+                    x157,
+                    x218,
+                    x235,
+                    x257,
+                    x288,
+                    x327,
                 ],
                 [
-                    x230,
-                    x231,
+                    x225,
                     x226,
-                    x232,
-                    x233,
-                    x234,
+                    x221,
                     x227,
-                    x223,
-                    x108,
-                    x94,
-                    x85,
-                    x265,
-                    x304,
+                    x228,
+                    x229,
+                    x222,
+                    x218,
+                    x121,
+                    x112,
+                    x251,
+                    x282,
+                    x321,
                 ],
                 [
-                    x252,
-                    x253,
-                    x248,
-                    x254,
-                    x255,
-                    x256,
-                    x249,
+                    x242,
+                    x243,
+                    x238,
+                    x244,
                     x245,
+                    x246,
                     x239,
-                    x85,
-                    x71,
-                    x59,
-                    x297,
+                    x235,
+                    x112,
+                    x98,
+                    x88,
+                    x277,
+                    x316,
                 ],
                 [
-                    x283,
-                    x284,
-                    x279,
-                    x285,
-                    x286,
-                    x287,
-                    x280,
-                    x276,
-                    x270,
+                    x264,
                     x265,
-                    x59,
-                    x44,
-                    x293,
+                    x260,
+                    x266,
+                    x267,
+                    x268,
+                    x261,
+                    x257,
+                    x251,
+                    x88,
+                    x74,
+                    x60,
+                    x309,
                 ],
                 [
-                    x322,
-                    x323,
-                    x318,
-                    x324,
-                    x325,
-                    x326,
-                    x319,
-                    x315,
-                    x309,
-                    x304,
+                    x295,
+                    x296,
+                    x291,
                     x297,
-                    x293,
+                    x298,
+                    x299,
+                    x292,
+                    x288,
+                    x282,
+                    x277,
+                    x60,
+                    x45,
+                    x305,
+                ],
+                [
+                    x334,
+                    x335,
+                    x330,
+                    x336,
+                    x337,
+                    x338,
+                    x331,
+                    x327,
+                    x321,
+                    x316,
+                    x309,
+                    x305,
                     1.4135609200000003,
                 ],
             ],
             [
-                x516,
-                x517,
-                x518,
-                x519,
-                x520,
-                x521,
-                x510,
-                x502,
-                x493,
-                x486,
-                x478,
-                x470,
-                x461,
+                x539,
+                x540,
+                x541,
+                x542,
+                x543,
+                x544,
+                x533,
+                x525,
+                x515,
+                x508,
+                x500,
+                x492,
+                x482,
             ],
         )
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1676 mul, 1458 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1117 fused where the target has FMA.
+    /// Methods: forward `aba`: 1613 mul, 1325 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 987 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -6677,2688 +5762,1702 @@ impl FreeFloating7 {
         tau: &[f64; 7],
         f_ext: &[[f64; 6]; 8],
     ) -> [f64; 13] {
+        let x0 = Self::mul_add(
+            v[1],
+            -180.9502499901501,
+            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
+        );
+        let x1 = Self::mul_add(
+            1466.4506062283303,
+            v[4],
+            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
+        );
+        let x2 = Self::mul_add(
+            110.5455,
+            v[1],
+            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
+        );
+        let x3 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]);
+        let x4 = Self::mul_add(
+            1170.07,
+            v[1],
+            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
+        );
+        let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
+        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x9 = Self::mul_add(v[4], 0.75, v[0]);
+        let x10 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x11 = Self::mul_add(-0.65, v[4], v[2]);
+        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
+        let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
+        let x14 = v[6] * x8;
+        let x15 = v[6] * x7;
+        let x16 = v[6] * x13;
+        let x17 = v[6] * x12;
+        let x18 = v[5] + v[6];
+        let x19 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x8);
+        let x20 = Self::mul_add(
+            x11,
+            -48.0240000085309,
+            Self::mul_add(
+                0.1132,
+                x18,
+                Self::mul_add(130.43769025763282, x8, -0.07309 * x7),
+            ),
+        );
+        let x21 = Self::mul_add(
+            48.0240000085309,
+            x13,
+            Self::mul_add(
+                132.47349025763282,
+                x18,
+                Self::mul_add(0.1132, x8, -16.80768997608804 * x7),
+            ),
+        );
+        let x22 = x18 * -48.0240000085309;
+        let x23 = 48.0240000085309 * x8;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
+        let x25 = -0.00000000020510342851533115 * c_q8;
+        let x26 = -0.00000000020510342851533115 * s_q8;
+        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x7, x26, x8 * c_q8));
+        let x29 = Self::mul_add(x8, 0.35, x12);
+        let x30 = Self::mul_add(-0.35, x7, x13);
+        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-x26, x29, c_q8 * x30));
+        let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
+        let x34 = v[7] * x28;
+        let x35 = v[7] * x27;
+        let x36 = v[7] * x32;
+        let x37 = v[7] * x31;
+        let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
+        let x39 = Self::mul_add(
+            -12.701650001451807,
+            x33,
+            Self::mul_add(-0.002139996587640933, x38, -0.0000000234896432582596 * x28),
+        );
+        let x40 = Self::mul_add(
+            x33,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x38,
+                Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
+            ),
+        );
+        let x41 = Self::mul_add(
+            113.3918902508081,
+            x38,
+            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
+        ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
+        let x42 = -12.701650001451807 * x38;
+        let x43 = x38 * 0.000000008530897668050218;
+        let x44 = Self::mul_add(
+            -0.000000008530897668050218,
+            x28,
+            x27 * 12.701650001451807,
+        );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x6 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x7 = Self::mul_add(
+        let x46 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x8 = Self::mul_add(
+        let x47 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let (s_q10, c_q10) = libm::sincos(q[10]);
-        let (s_q11, c_q11) = libm::sincos(q[11]);
-        let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x12 = -0.00000000020510342851533115 * s_q12;
-        let x13 = -0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x15 = -0.00000000020510342851533115 * c_q13;
-        let x16 = -0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(-0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x16, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x16, -0.0145 * x15);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(-1.2025609200000003, c_q13, x24);
-        let x26 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(-1.2025609200000003, s_q13, -x23)
-            + 0.00000000019719894748377882;
-        let x29 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
-            + -0.0000000002899261911072858;
-        let x30 = -0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = 0.16 * x19;
-        let x33 = x18 * -0.55;
-        let x34 = x22 + Self::mul_add(-x16, x21, x15 * x20) - (x30 - x31) - (x33 - x32);
-        let x35 = 3.6140000000000003 - x17;
-        let x36 = 17.135250000000003 + x18;
-        let x37 = -1.9877000000000002
-            + Self::mul_add(0.55, x17, Self::mul_add(c_q13, x21, s_q13 * x20));
-        let x38 = -0.809539999555672
-            + Self::mul_add(
-                0.16,
-                x17,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x22,
-                    Self::mul_add(-c_q13, x20, s_q13 * x21),
-                ),
-            );
-        let x39 = -1.9877000000000002
-            + Self::mul_add(x17, 0.55, x26 + Self::mul_add(-x16, x25, x15 * x23));
-        let x40 = -5.252920330000002
-            + (Self::mul_add(c_q13, x25, s_q13 * x23) + x32 - x30);
-        let x41 = -2.741639999592316
-            + Self::mul_add(
-                -0.55,
-                x19,
-                Self::mul_add(
-                    -0.16,
-                    x18,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x26,
-                        Self::mul_add(-c_q13, x23, s_q13 * x25),
-                    ),
-                ),
-            );
-        let x42 = -0.809539999555672
-            + Self::mul_add(0.16, x17, x29 + Self::mul_add(-x16, x28, x15 * x27));
-        let x43 = -2.7416399995923166
-            + Self::mul_add(
-                -0.16,
-                x18,
-                Self::mul_add(x19, -0.55, Self::mul_add(c_q13, x28, s_q13 * x27)),
-            );
-        let x44 = 9.740442170000001
-            + (x31
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) - x33));
-        let x45 = c_q12 * x35;
-        let x46 = s_q12 * x36;
-        let x47 = x45 - x46;
-        let x48 = x19 + Self::mul_add(x13, x36, x12 * x35);
-        let x49 = Self::mul_add(c_q12, x36, s_q12 * x35);
-        let x50 = Self::mul_add(-0.00000000020510342851533115, x19, -x49);
-        let x51 = Self::mul_add(-s_q12, x39, c_q12 * x34);
-        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x37);
-        let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
-        let x54 = x42 + Self::mul_add(x13, x39, x12 * x34);
-        let x55 = x43 + Self::mul_add(x13, x40, x12 * x37);
-        let x56 = x44 + Self::mul_add(x13, x41, x12 * x38);
-        let x57 = Self::mul_add(
+        let x48 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x46, x27 * s_q9));
+        let x49 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x47, x27 * c_q9));
+        let x50 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
+        let x51 = Self::mul_add(-0.4, x27, x32);
+        let x52 = Self::mul_add(0.275, x27, x33);
+        let x53 = Self::mul_add(c_q9, x52, Self::mul_add(x46, x51, s_q9 * x50));
+        let x54 = Self::mul_add(-s_q9, x52, Self::mul_add(x47, x51, c_q9 * x50));
+        let x55 = Self::mul_add(
             -0.00000000020510342851533115,
-            x42,
-            -Self::mul_add(c_q12, x39, s_q12 * x34),
+            x52,
+            Self::mul_add(0.00000000020510342851533115, x50, x51),
         );
-        let x58 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x43,
-            -Self::mul_add(c_q12, x40, s_q12 * x37),
-        );
-        let x59 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x44,
-            -Self::mul_add(c_q12, x41, s_q12 * x38),
-        );
-        let x60 = x53 + Self::mul_add(x13, x52, x12 * x51);
-        let x61 = Self::mul_add(-s_q12, x55, c_q12 * x54);
-        let x62 = x50 * 0.36;
-        let x63 = -0.36 * x50;
-        let x64 = x63 + (Self::mul_add(-s_q12, x52, c_q12 * x51) - x62);
-        let x65 = 7.078399999258757 + x48;
-        let x66 = 0.01675
-            + Self::mul_add(
-                x47,
-                0.36,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x53,
-                    -Self::mul_add(c_q12, x52, s_q12 * x51),
-                ),
-            );
-        let x67 = -9.142025249762803
-            + (x56 + Self::mul_add(x13, x55, x12 * x54) + x63 - x62);
-        let x68 = 2.5482240016099564
-            + Self::mul_add(
-                0.36,
-                x48,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x56,
-                    -Self::mul_add(c_q12, x55, s_q12 * x54),
-                ),
-            );
-        let x69 = 0.01675
-            + Self::mul_add(0.36, x47, Self::mul_add(-s_q12, x58, c_q12 * x57));
-        let x70 = 2.5482240016099564
-            + Self::mul_add(x48, 0.36, x59 + Self::mul_add(x13, x58, x12 * x57));
-        let x71 = 9.223235249762805
+        let x56 = v[8] * x49;
+        let x57 = v[8] * x48;
+        let x58 = v[8] * x54;
+        let x59 = v[8] * x53;
+        let x60 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x59,
-                -Self::mul_add(c_q12, x58, s_q12 * x57),
+                x38,
+                Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x72 = Self::mul_add(-s_q11, x65, c_q11 * x47);
-        let x73 = Self::mul_add(c_q11, x65, s_q11 * x47);
-        let x74 = Self::mul_add(-s_q11, x61, c_q11 * x64);
-        let x75 = Self::mul_add(-s_q11, x67, c_q11 * x60);
-        let x76 = Self::mul_add(c_q11, x61, s_q11 * x64);
-        let x77 = Self::mul_add(c_q11, x67, s_q11 * x60);
-        let x78 = 0.275 * x50;
-        let x79 = -0.63 * x73;
-        let x80 = -0.275 * x50;
-        let x81 = x73 * 0.63;
-        let x82 = Self::mul_add(0.63, x72, Self::mul_add(c_q11, x75, s_q11 * x74));
-        let x83 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x68, c_q11 * x66));
-        let x84 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x68, s_q11 * x66));
-        let x85 = x71 - x81;
-        let x86 = Self::mul_add(-s_q11, x75, c_q11 * x74) - (x78 - x79) - (x81 - x80);
-        let x87 = Self::mul_add(x72, 0.63, Self::mul_add(-s_q11, x77, c_q11 * x76));
-        let x88 = -45.1584 + x73;
-        let x89 = -0.6328 + x83;
-        let x90 = -24.4950615 + (Self::mul_add(c_q11, x77, s_q11 * x76) + x80 - x78);
-        let x91 = -24.35164200091464 + Self::mul_add(0.63, x50, x84);
-        let x92 = -0.6328
-            + Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x70, c_q11 * x69));
-        let x93 = -24.351642000914637
-            + Self::mul_add(
-                0.275,
-                x73,
-                Self::mul_add(x50, 0.63, Self::mul_add(c_q11, x70, s_q11 * x69)),
-            );
-        let x94 = 28.2393615 + (x79 + x85);
-        let x95 = c_q10 * x72;
-        let x96 = Self::mul_add(-s_q10, x88, x95);
-        let x97 = s_q10 * x72;
-        let x98 = Self::mul_add(c_q10, x88, x97);
-        let x99 = Self::mul_add(-s_q10, x87, c_q10 * x86);
-        let x100 = Self::mul_add(-s_q10, x90, c_q10 * x82);
-        let x101 = Self::mul_add(-s_q10, x91, c_q10 * x89);
-        let x102 = Self::mul_add(c_q10, x87, s_q10 * x86);
-        let x103 = Self::mul_add(c_q10, x90, s_q10 * x82);
-        let x104 = Self::mul_add(c_q10, x91, s_q10 * x89);
-        let x105 = -0.87 * x98;
-        let x106 = x98 * 0.87;
-        let x107 = Self::mul_add(0.87, x96, Self::mul_add(c_q10, x100, s_q10 * x99));
-        let x108 = x94 - x106;
-        let x109 = Self::mul_add(-s_q10, x100, c_q10 * x99) + x105 - x106;
-        let x110 = Self::mul_add(x96, 0.87, Self::mul_add(-s_q10, x103, c_q10 * x102));
-        let x111 = -81.53205 + x98;
-        let x112 = -0.00214 + x101;
-        let x113 = -63.36336825000001 + Self::mul_add(c_q10, x103, s_q10 * x102);
-        let x114 = -36.18604050126307 + Self::mul_add(0.87, x50, x104);
-        let x115 = -0.00214 + Self::mul_add(-s_q10, x93, c_q10 * x92);
-        let x116 = -36.18604050126307
-            + Self::mul_add(x50, 0.87, Self::mul_add(c_q10, x93, s_q10 * x92));
-        let x117 = 69.99836825 + (x105 + x108);
-        let x118 = Self::mul_add(
-            0.00000000020510342851533115,
-            x50,
-            Self::mul_add(x6, x111, x5 * x96),
-        );
-        let x119 = x50 + Self::mul_add(x8, x111, x7 * x96);
-        let x120 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x50,
-            Self::mul_add(-s_q9, x111, c_q9 * x96),
-        );
-        let x121 = Self::mul_add(
-            0.00000000020510342851533115,
-            x115,
-            Self::mul_add(x6, x110, x5 * x109),
-        );
-        let x122 = Self::mul_add(
-            0.00000000020510342851533115,
-            x116,
-            Self::mul_add(x6, x113, x5 * x107),
-        );
-        let x123 = Self::mul_add(
-            0.00000000020510342851533115,
-            x117,
-            Self::mul_add(x6, x114, x5 * x112),
-        );
-        let x124 = x115 + Self::mul_add(x8, x110, x7 * x109);
-        let x125 = x116 + Self::mul_add(x8, x113, x7 * x107);
-        let x126 = x117 + Self::mul_add(x8, x114, x7 * x112);
-        let x127 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x115,
-            Self::mul_add(-s_q9, x110, c_q9 * x109),
-        );
-        let x128 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x116,
-            Self::mul_add(-s_q9, x113, c_q9 * x107),
-        );
-        let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x117,
-            Self::mul_add(-s_q9, x114, c_q9 * x112),
-        );
-        let x130 = x120 * -0.4;
-        let x131 = 0.275 * x119;
-        let x132 = 0.4 * x120;
-        let x133 = -0.275 * x119;
-        let x134 = Self::mul_add(
-            0.00000000020510342851533115,
-            x123,
-            Self::mul_add(x6, x122, x5 * x121),
-        ) - (x130 - x131) - (x133 - x132);
-        let x135 = -0.000000008530897668050218 + x118;
-        let x136 = -12.701650001451807 + x119;
-        let x137 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x118, x123 + Self::mul_add(x8, x122, x7 * x121));
-        let x138 = -0.0021399965876409276
-            + Self::mul_add(
-                x118,
-                -0.4,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x123,
-                    Self::mul_add(-s_q9, x122, c_q9 * x121),
-                ),
-            );
-        let x139 = -0.0000000234896432582596
-            + Self::mul_add(
-                -0.275,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x126,
-                    Self::mul_add(x6, x125, x5 * x124),
-                ),
-            );
-        let x140 = -111.7548902508081
-            + (x126 + Self::mul_add(x8, x125, x7 * x124) + x132 - x130);
-        let x141 = 5.080660024070365
-            + Self::mul_add(
-                -0.275,
-                x120,
-                Self::mul_add(
-                    -0.4,
-                    x119,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x126,
-                        Self::mul_add(-s_q9, x125, c_q9 * x124),
-                    ),
-                ),
-            );
-        let x142 = -0.0021399965876409276
-            + Self::mul_add(
-                -0.4,
-                x118,
-                Self::mul_add(
-                    0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(x6, x128, x5 * x127),
-                ),
-            );
-        let x143 = 5.080660024070366
-            + Self::mul_add(
-                x119,
-                -0.4,
-                Self::mul_add(-0.275, x120, x129 + Self::mul_add(x8, x128, x7 * x127)),
-            );
-        let x144 = 113.3918902508081
-            + (x131
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x129,
-                    Self::mul_add(-s_q9, x128, c_q9 * x127),
-                ) - x133));
-        let x145 = x120 + Self::mul_add(-x3, x136, x2 * x135);
-        let x146 = Self::mul_add(c_q8, x136, s_q8 * x135);
-        let x147 = c_q8 * x135;
-        let x148 = s_q8 * x136;
-        let x149 = Self::mul_add(-0.00000000020510342851533115, x120, x148 - x147);
-        let x150 = x142 + Self::mul_add(-x3, x139, x2 * x134);
-        let x151 = x143 + Self::mul_add(-x3, x140, x2 * x137);
-        let x152 = x144 + Self::mul_add(-x3, x141, x2 * x138);
-        let x153 = Self::mul_add(c_q8, x139, s_q8 * x134);
-        let x154 = Self::mul_add(c_q8, x140, s_q8 * x137);
-        let x155 = Self::mul_add(c_q8, x141, s_q8 * x138);
-        let x156 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x144,
-            Self::mul_add(-c_q8, x138, s_q8 * x141),
-        );
-        let x157 = x149 * -0.35;
-        let x158 = 0.35 * x149;
-        let x159 = x158 + (x152 + Self::mul_add(-x3, x151, x2 * x150) - x157);
-        let x160 = 48.0240000085309 + x145;
-        let x161 = -0.07309 + Self::mul_add(c_q8, x151, s_q8 * x150);
-        let x162 = -16.80768997608804
-            + Self::mul_add(
-                x145,
-                -0.35,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x152,
-                    Self::mul_add(-c_q8, x150, s_q8 * x151),
-                ),
-            );
-        let x163 = -0.07309 + (x155 + Self::mul_add(-x3, x154, x2 * x153));
-        let x164 = 130.43769025763282
-            + (Self::mul_add(c_q8, x154, s_q8 * x153) + x158 - x157);
-        let x165 = 0.1132
-            + Self::mul_add(
-                -0.35,
-                x146,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x155,
-                    Self::mul_add(-c_q8, x153, s_q8 * x154),
-                ),
-            );
-        let x166 = 132.47349025763282
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x156,
-                Self::mul_add(
-                    -c_q8,
-                    Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x142,
-                        Self::mul_add(-c_q8, x134, s_q8 * x139),
-                    ),
-                    s_q8
-                        * Self::mul_add(
-                            -0.00000000020510342851533115,
-                            x143,
-                            Self::mul_add(-c_q8, x137, s_q8 * x140),
-                        ),
-                ),
-            );
-        let x167 = Self::mul_add(-s_q7, x146, c_q7 * x160);
-        let x168 = Self::mul_add(c_q7, x146, s_q7 * x160);
-        let x169 = Self::mul_add(-s_q7, x163, c_q7 * x159);
-        let x170 = Self::mul_add(-s_q7, x164, c_q7 * x161);
-        let x171 = x149 * -0.75;
-        let x172 = 0.75 * x149;
-        let x173 = x167 * -0.65;
-        let x174 = 0.65 * x167;
-        let x175 = Self::mul_add(x167, -0.75, Self::mul_add(-s_q7, x165, c_q7 * x162));
-        let x176 = x166 + x174;
-        let x177 = 110.5455 + x167;
-        let x178 = 180.9502499901501 + x149;
-        let x179 = Self::mul_add(x3, x135, x2 * x136);
-        let x180 = x147 - x148;
-        let x181 = Self::mul_add(-0.35, x180, x152);
-        let x182 = Self::mul_add(-0.35, x179, x155);
-        let x183 = Self::mul_add(s_q7, x180, c_q7 * x179);
-        let x184 = Self::mul_add(-s_q7, x179, c_q7 * x180);
-        let x185 = x6 * x96;
-        let x186 = Self::mul_add(-x5, x111, x185);
-        let x187 = x8 * x96;
-        let x188 = Self::mul_add(-x7, x111, x187);
-        let x189 = s_q9 * x96;
-        let x190 = Self::mul_add(c_q9, x111, x189);
-        let x191 = x123 + Self::mul_add(-0.275, x190, -0.4 * x188);
-        let x192 = Self::mul_add(0.4, x186, x126);
-        let x193 = Self::mul_add(-0.275, x186, x129);
-        let x194 = Self::mul_add(-x3, x188, x2 * x186) - x190;
-        let x195 = Self::mul_add(c_q8, x188, s_q8 * x186);
-        let x196 = Self::mul_add(
-            0.00000000020510342851533115,
-            x190,
-            Self::mul_add(-c_q8, x186, s_q8 * x188),
-        );
-        let x197 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x193,
-            Self::mul_add(-c_q8, x191, s_q8 * x192),
-        );
-        let x198 = Self::mul_add(
-            -0.35,
-            x195,
-            x193 + Self::mul_add(-x3, x192, x2 * x191),
-        );
-        let x199 = Self::mul_add(0.35, x194, Self::mul_add(c_q8, x192, s_q8 * x191));
-        let x200 = Self::mul_add(-s_q7, x195, c_q7 * x194);
-        let x201 = Self::mul_add(c_q7, x195, s_q7 * x194);
-        let x202 = Self::mul_add(-x5, x98, x185);
-        let x203 = Self::mul_add(-x7, x98, x187);
-        let x204 = Self::mul_add(c_q9, x98, x189);
-        let x205 = Self::mul_add(
-            0.00000000020510342851533115,
-            x108,
-            Self::mul_add(x6, x104, x5 * x101),
-        ) + Self::mul_add(-0.275, x204, -0.4 * x203);
-        let x206 = Self::mul_add(0.4, x202, x108 + Self::mul_add(x8, x104, x7 * x101));
-        let x207 = Self::mul_add(
-            -0.275,
-            x202,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x108,
-                Self::mul_add(-s_q9, x104, c_q9 * x101),
-            ),
-        );
-        let x208 = Self::mul_add(-x3, x203, x2 * x202) - x204;
-        let x209 = Self::mul_add(c_q8, x203, s_q8 * x202);
-        let x210 = Self::mul_add(
-            0.00000000020510342851533115,
-            x204,
-            Self::mul_add(-c_q8, x202, s_q8 * x203),
-        );
-        let x211 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x207,
-            Self::mul_add(-c_q8, x205, s_q8 * x206),
-        );
-        let x212 = Self::mul_add(
-            -0.35,
-            x209,
-            x207 + Self::mul_add(-x3, x206, x2 * x205),
-        );
-        let x213 = Self::mul_add(0.35, x208, Self::mul_add(c_q8, x206, s_q8 * x205));
-        let x214 = Self::mul_add(-s_q7, x209, c_q7 * x208);
-        let x215 = Self::mul_add(c_q7, x209, s_q7 * x208);
-        let x216 = Self::mul_add(c_q10, x73, x97);
-        let x217 = Self::mul_add(-s_q10, x73, x95);
-        let x218 = Self::mul_add(-s_q10, x84, c_q10 * x83);
-        let x219 = Self::mul_add(c_q10, x84, s_q10 * x83);
-        let x220 = Self::mul_add(-0.87, x216, x85);
-        let x221 = Self::mul_add(-x5, x216, x6 * x217);
-        let x222 = Self::mul_add(-x7, x216, x8 * x217);
-        let x223 = Self::mul_add(s_q9, x217, c_q9 * x216);
-        let x224 = Self::mul_add(
-            0.00000000020510342851533115,
-            x220,
-            Self::mul_add(x6, x219, x5 * x218),
-        ) + Self::mul_add(-0.275, x223, -0.4 * x222);
-        let x225 = Self::mul_add(0.4, x221, x220 + Self::mul_add(x8, x219, x7 * x218));
-        let x226 = Self::mul_add(
-            -0.275,
-            x221,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x220,
-                Self::mul_add(-s_q9, x219, c_q9 * x218),
-            ),
-        );
-        let x227 = Self::mul_add(-x3, x222, x2 * x221) - x223;
-        let x228 = Self::mul_add(c_q8, x222, s_q8 * x221);
-        let x229 = Self::mul_add(
-            0.00000000020510342851533115,
-            x223,
-            Self::mul_add(-c_q8, x221, s_q8 * x222),
-        );
-        let x230 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x226,
-            Self::mul_add(-c_q8, x224, s_q8 * x225),
-        );
-        let x231 = Self::mul_add(
-            -0.35,
-            x228,
-            x226 + Self::mul_add(-x3, x225, x2 * x224),
-        );
-        let x232 = Self::mul_add(0.35, x227, Self::mul_add(c_q8, x225, s_q8 * x224));
-        let x233 = Self::mul_add(-s_q7, x228, c_q7 * x227);
-        let x234 = Self::mul_add(c_q7, x228, s_q7 * x227);
-        let x235 = Self::mul_add(-x12, x36, x13 * x35);
-        let x236 = x46 - x45;
-        let x237 = Self::mul_add(0.36, x235, x53);
-        let x238 = Self::mul_add(0.36, x49, x56);
-        let x239 = Self::mul_add(s_q11, x235, c_q11 * x49);
-        let x240 = Self::mul_add(-s_q11, x49, c_q11 * x235);
-        let x241 = Self::mul_add(-s_q11, x238, c_q11 * x237)
-            + Self::mul_add(-0.63, x236, 0.275 * x240);
-        let x242 = Self::mul_add(0.275, x239, Self::mul_add(c_q11, x238, s_q11 * x237));
-        let x243 = Self::mul_add(-0.63, x239, x59);
-        let x244 = Self::mul_add(s_q10, x240, c_q10 * x239);
-        let x245 = Self::mul_add(-s_q10, x239, c_q10 * x240);
-        let x246 = Self::mul_add(c_q10, x242, s_q10 * x241);
-        let x247 = Self::mul_add(-0.87, x236, Self::mul_add(-s_q10, x242, c_q10 * x241));
-        let x248 = Self::mul_add(-0.87, x244, x243);
-        let x249 = Self::mul_add(
-            0.00000000020510342851533115,
-            x236,
-            Self::mul_add(-x5, x244, x6 * x245),
-        );
-        let x250 = x236 + Self::mul_add(-x7, x244, x8 * x245);
-        let x251 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x236,
-            -Self::mul_add(s_q9, x245, c_q9 * x244),
-        );
-        let x252 = Self::mul_add(
-            0.00000000020510342851533115,
-            x248,
-            Self::mul_add(x6, x246, x5 * x247),
-        ) + Self::mul_add(0.275, x251, -0.4 * x250);
-        let x253 = Self::mul_add(0.4, x249, x248 + Self::mul_add(x8, x246, x7 * x247));
-        let x254 = Self::mul_add(
-            -0.275,
-            x249,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x248,
-                Self::mul_add(-s_q9, x246, c_q9 * x247),
-            ),
-        );
-        let x255 = x251 + Self::mul_add(-x3, x250, x2 * x249);
-        let x256 = Self::mul_add(c_q8, x250, s_q8 * x249);
-        let x257 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x251,
-            Self::mul_add(-c_q8, x249, s_q8 * x250),
-        );
-        let x258 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x254,
-            Self::mul_add(-c_q8, x252, s_q8 * x253),
-        );
-        let x259 = Self::mul_add(
-            -0.35,
-            x256,
-            x254 + Self::mul_add(-x3, x253, x2 * x252),
-        );
-        let x260 = Self::mul_add(0.35, x255, Self::mul_add(c_q8, x253, s_q8 * x252));
-        let x261 = Self::mul_add(-s_q7, x256, c_q7 * x255);
-        let x262 = Self::mul_add(c_q7, x256, s_q7 * x255);
-        let x263 = x15 * -4.806620000000001;
-        let x264 = s_q13 * -4.806620000000001;
-        let x265 = c_q13 * -4.806620000000001;
-        let x266 = x22 + Self::mul_add(-0.55, x265, -0.16 * x264);
-        let x267 = Self::mul_add(0.16, x263, x26);
-        let x268 = Self::mul_add(-0.55, x263, x29);
-        let x269 = Self::mul_add(-s_q12, x264, c_q12 * x263);
-        let x270 = Self::mul_add(x13, x264, x12 * x263) - x265;
-        let x271 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x265,
-            Self::mul_add(c_q12, x264, s_q12 * x263),
-        );
-        let x272 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x268,
-            -Self::mul_add(c_q12, x267, s_q12 * x266),
-        );
-        let x273 = Self::mul_add(0.36, x270, Self::mul_add(-s_q12, x267, c_q12 * x266));
-        let x274 = Self::mul_add(
-            -0.36,
-            x269,
-            x268 + Self::mul_add(x13, x267, x12 * x266),
-        );
-        let x275 = Self::mul_add(-s_q11, x270, c_q11 * x269);
-        let x276 = Self::mul_add(c_q11, x270, s_q11 * x269);
-        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
-            + Self::mul_add(0.63, x271, 0.275 * x276);
-        let x278 = Self::mul_add(-0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
-        let x279 = Self::mul_add(0.63, x275, x272);
-        let x280 = Self::mul_add(-s_q10, x276, c_q10 * x275);
-        let x281 = Self::mul_add(c_q10, x276, s_q10 * x275);
-        let x282 = Self::mul_add(c_q10, x278, s_q10 * x277);
-        let x283 = Self::mul_add(0.87, x271, Self::mul_add(-s_q10, x278, c_q10 * x277));
-        let x284 = Self::mul_add(0.87, x280, x279);
-        let x285 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x271,
-            Self::mul_add(x6, x281, x5 * x280),
-        );
-        let x286 = Self::mul_add(x8, x281, x7 * x280) - x271;
-        let x287 = Self::mul_add(
-            0.00000000020510342851533115,
-            x271,
-            Self::mul_add(-s_q9, x281, c_q9 * x280),
-        );
-        let x288 = Self::mul_add(
-            0.00000000020510342851533115,
-            x284,
-            Self::mul_add(x6, x282, x5 * x283),
-        ) + Self::mul_add(0.275, x287, -0.4 * x286);
-        let x289 = Self::mul_add(0.4, x285, x284 + Self::mul_add(x8, x282, x7 * x283));
-        let x290 = Self::mul_add(
-            -0.275,
-            x285,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x284,
-                Self::mul_add(-s_q9, x282, c_q9 * x283),
-            ),
-        );
-        let x291 = x287 + Self::mul_add(-x3, x286, x2 * x285);
-        let x292 = Self::mul_add(c_q8, x286, s_q8 * x285);
-        let x293 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x287,
-            Self::mul_add(-c_q8, x285, s_q8 * x286),
-        );
-        let x294 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x290,
-            Self::mul_add(-c_q8, x288, s_q8 * x289),
-        );
-        let x295 = Self::mul_add(
-            -0.35,
-            x292,
-            x290 + Self::mul_add(-x3, x289, x2 * x288),
-        );
-        let x296 = Self::mul_add(0.35, x291, Self::mul_add(c_q8, x289, s_q8 * x288));
-        let x297 = Self::mul_add(-s_q7, x292, c_q7 * x291);
-        let x298 = Self::mul_add(c_q7, x292, s_q7 * x291);
-        let x299 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x300 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x301 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x302 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x303 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x304 = v[4] * v[4];
-        let x305 = Self::mul_add(v[5], v[5], x304);
-        let x306 = v[3] * v[4];
-        let x307 = v[3] * v[5];
-        let x308 = v[4] * v[5];
-        let x309 = Self::mul_add(v[3], v[3], x304);
-        let x310 = x299 + Self::mul_add(-0.65, x305, 0.75 * x307);
-        let x311 = x300 + Self::mul_add(0.75, x308, 0.65 * x306);
-        let x312 = x301 + Self::mul_add(-0.75, x309, 0.65 * x307);
-        let x313 = Self::mul_add(-s_q7, x310, c_q7 * x311);
-        let x314 = v[6] * x303;
-        let x315 = v[6] * x302;
-        let x316 = v[5] + v[6];
-        let x317 = x303 * x303;
-        let x318 = x302 * x316;
-        let x319 = Self::mul_add(-16.80768997608804, x316, -0.07309 * x303);
-        let x320 = Self::mul_add(
-            0.1132,
-            x316,
-            Self::mul_add(130.43769025763282, x303, -0.07309 * x302),
-        );
-        let x321 = Self::mul_add(
-            132.47349025763282,
-            x316,
-            Self::mul_add(0.1132, x303, -16.80768997608804 * x302),
-        );
-        let x322 = Self::mul_add(-c_q8, x316, Self::mul_add(s_q8, x303, x2 * x302));
-        let x323 = Self::mul_add(s_q8, x316, Self::mul_add(-x3, x302, c_q8 * x303));
-        let x324 = Self::mul_add(
-            0.35,
-            x318 - x315,
-            Self::mul_add(s_q7, x311, c_q7 * x310),
-        );
-        let x325 = Self::mul_add(0.35, Self::mul_add(x303, x316, -x314), x313);
-        let x326 = Self::mul_add(-0.35, Self::mul_add(x302, x302, x317), x312);
-        let x327 = Self::mul_add(-c_q8, x326, Self::mul_add(s_q8, x325, x2 * x324));
-        let x328 = Self::mul_add(s_q8, x326, Self::mul_add(-x3, x324, c_q8 * x325));
-        let x329 = Self::mul_add(-0.00000000020510342851533115, x326, x324);
-        let x330 = Self::mul_add(v[7], x323, Self::mul_add(-s_q8, x315, x2 * x314));
-        let x331 = Self::mul_add(v[7], x322, Self::mul_add(c_q8, x315, x3 * x314));
-        let x332 = v[7] + Self::mul_add(-0.00000000020510342851533115, x316, x302);
-        let x333 = x323 * x323;
-        let x334 = x332 * x332;
-        let x335 = x322 * x323;
-        let x336 = x335 - x314;
-        let x337 = x322 * x332;
-        let x338 = x322 * x322;
-        let x339 = x334 + x338;
-        let x340 = x323 * x332;
-        let x341 = x330 + x340;
-        let x342 = Self::mul_add(
-            -0.0021399965876409276,
-            x332,
-            -0.0000000234896432582596 * x323,
-        );
-        let x343 = Self::mul_add(
-            5.080660024070365,
-            x332,
-            Self::mul_add(-111.7548902508081, x323, -0.0000000234896432582596 * x322),
-        );
-        let x344 = Self::mul_add(
-            113.3918902508081,
-            x332,
-            Self::mul_add(5.080660024070366, x323, -0.0021399965876409276 * x322),
-        );
-        let x345 = Self::mul_add(c_q9, x332, Self::mul_add(x7, x323, x5 * x322));
-        let x346 = Self::mul_add(-s_q9, x332, Self::mul_add(x8, x323, x6 * x322));
-        let x347 = x327 + Self::mul_add(0.4, x337 - x331, 0.275 * x336);
-        let x348 = x328 + Self::mul_add(-0.275, x339, 0.4 * (x340 - x330));
-        let x349 = x329 + Self::mul_add(-0.4, x333 + x338, 0.275 * x341);
-        let x350 = Self::mul_add(c_q9, x349, Self::mul_add(x7, x348, x5 * x347));
-        let x351 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x349,
-            Self::mul_add(0.00000000020510342851533115, x347, x348),
-        );
-        let x352 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x314,
-            Self::mul_add(0.00000000020510342851533115, x330, -x331),
-        );
-        let x353 = Self::mul_add(
-            v[8],
-            x346,
-            Self::mul_add(c_q9, x314, Self::mul_add(-x7, x331, x5 * x330)),
-        );
-        let x354 = Self::mul_add(
-            -v[8],
-            x345,
-            Self::mul_add(-s_q9, x314, Self::mul_add(-x8, x331, x6 * x330)),
-        );
-        let x355 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x332,
-                Self::mul_add(0.00000000020510342851533115, x322, x323),
-            );
-        let x356 = Self::mul_add(x345, x346, -x352);
-        let x357 = Self::mul_add(x345, x345, x355 * x355);
-        let x358 = Self::mul_add(x346, x355, x353);
-        let x359 = -0.00214 * x355;
-        let x360 = Self::mul_add(-36.18604050126307, x355, -63.36336825000001 * x346);
-        let x361 = Self::mul_add(
-            69.99836825,
-            x355,
-            Self::mul_add(-36.18604050126307, x346, -0.00214 * x345),
-        );
-        let x362 = Self::mul_add(s_q10, x346, c_q10 * x345);
-        let x363 = Self::mul_add(-s_q10, x345, c_q10 * x346);
-        let x364 = Self::mul_add(-0.87, x356, x350);
-        let x365 = Self::mul_add(
-            0.87,
-            x357,
-            Self::mul_add(-s_q9, x349, Self::mul_add(x8, x348, x6 * x347)),
-        );
-        let x366 = Self::mul_add(-0.87, x358, x351);
-        let x367 = Self::mul_add(s_q10, x365, c_q10 * x364);
-        let x368 = Self::mul_add(v[9], x363, Self::mul_add(s_q10, x354, c_q10 * x353));
-        let x369 = Self::mul_add(-v[9], x362, Self::mul_add(-s_q10, x353, c_q10 * x354));
-        let x370 = v[9] + x355;
-        let x371 = Self::mul_add(x362, x363, -x352);
-        let x372 = x362 * x362;
-        let x373 = Self::mul_add(x370, x370, x372);
-        let x374 = x363 * x370;
-        let x375 = x368 + x374;
-        let x376 = -0.6328 * x370;
-        let x377 = Self::mul_add(-24.35164200091464, x370, -24.4950615 * x363);
-        let x378 = Self::mul_add(
-            28.2393615,
-            x370,
-            Self::mul_add(-24.351642000914637, x363, -0.6328 * x362),
-        );
-        let x379 = Self::mul_add(s_q11, x363, c_q11 * x362);
-        let x380 = Self::mul_add(-s_q11, x362, c_q11 * x363);
-        let x381 = x367
-            + Self::mul_add(-0.275, Self::mul_add(x362, x370, x369), -0.63 * x371);
-        let x382 = Self::mul_add(-s_q10, x364, c_q10 * x365)
-            + Self::mul_add(0.63, x373, -0.275 * (x374 - x368));
-        let x383 = x366
-            + Self::mul_add(0.275, Self::mul_add(x363, x363, x372), -0.63 * x375);
-        let x384 = Self::mul_add(s_q11, x382, c_q11 * x381);
-        let x385 = Self::mul_add(v[10], x380, Self::mul_add(s_q11, x369, c_q11 * x368));
-        let x386 = Self::mul_add(
-            -v[10],
-            x379,
-            Self::mul_add(-s_q11, x368, c_q11 * x369),
-        );
-        let x387 = v[10] + x370;
-        let x388 = x379 * x379;
-        let x389 = x380 * x387;
-        let x390 = 0.01675 * x387;
-        let x391 = Self::mul_add(2.5482240016099564, x387, -9.142025249762803 * x380);
-        let x392 = Self::mul_add(
-            9.223235249762805,
-            x387,
-            Self::mul_add(2.5482240016099564, x380, 0.01675 * x379),
-        );
-        let x393 = Self::mul_add(-s_q12, x387, Self::mul_add(x12, x380, c_q12 * x379));
-        let x394 = Self::mul_add(-c_q12, x387, Self::mul_add(-s_q12, x379, x13 * x380));
-        let x395 = Self::mul_add(-0.36, Self::mul_add(x379, x387, x386), x384);
-        let x396 = Self::mul_add(
-            -0.36,
-            x389 - x385,
-            Self::mul_add(-s_q11, x381, c_q11 * x382),
-        );
-        let x397 = Self::mul_add(0.36, Self::mul_add(x380, x380, x388), x383);
-        let x398 = Self::mul_add(-s_q12, x397, Self::mul_add(x12, x396, c_q12 * x395));
-        let x399 = Self::mul_add(-c_q12, x397, Self::mul_add(-s_q12, x395, x13 * x396));
-        let x400 = Self::mul_add(-0.00000000020510342851533115, x397, x396);
-        let x401 = Self::mul_add(-0.00000000020510342851533115, x352, x386);
-        let x402 = Self::mul_add(
-            v[11],
-            x394,
-            Self::mul_add(-s_q12, x352, Self::mul_add(x12, x386, c_q12 * x385)),
-        );
-        let x403 = Self::mul_add(
-            -v[11],
-            x393,
-            Self::mul_add(-c_q12, x352, Self::mul_add(-s_q12, x385, x13 * x386)),
-        );
-        let x404 = v[11] + Self::mul_add(-0.00000000020510342851533115, x387, x380);
-        let x405 = x394 * x394;
-        let x406 = x404 * x404;
-        let x407 = x393 * x394;
-        let x408 = x407 - x401;
-        let x409 = x393 * x404;
-        let x410 = x393 * x393;
-        let x411 = x406 + x410;
-        let x412 = x394 * x404;
-        let x413 = x402 + x412;
-        let x414 = Self::mul_add(-0.809539999555672, x404, -1.9877000000000002 * x394);
-        let x415 = Self::mul_add(
-            -2.741639999592316,
-            x404,
-            Self::mul_add(-5.252920330000002, x394, -1.9877000000000002 * x393),
-        );
-        let x416 = Self::mul_add(
-            9.740442170000001,
-            x404,
-            Self::mul_add(-2.7416399995923166, x394, -0.809539999555672 * x393),
-        );
-        let x417 = Self::mul_add(-c_q13, x404, Self::mul_add(s_q13, x394, x15 * x393));
-        let x418 = Self::mul_add(s_q13, x404, Self::mul_add(-x16, x393, c_q13 * x394));
-        let x419 = x398 + Self::mul_add(0.16, x403 + x409, 0.55 * x408);
-        let x420 = x400 + Self::mul_add(-0.16, x405 + x410, 0.55 * x413);
-        let x421 = Self::mul_add(-0.00000000020510342851533115, x401, x402);
-        let x422 = Self::mul_add(
-            v[12],
-            x418,
-            Self::mul_add(-c_q13, x401, Self::mul_add(s_q13, x403, x15 * x402)),
-        );
-        let x423 = Self::mul_add(
-            -v[12],
-            x417,
-            Self::mul_add(s_q13, x401, Self::mul_add(-x16, x402, c_q13 * x403)),
-        );
-        let x424 = v[12] + Self::mul_add(-0.00000000020510342851533115, x404, x393);
-        let x425 = Self::mul_add(-0.0145, x424, 0.000781 * x418);
-        let x426 = Self::mul_add(
-            -0.9614610000000001,
-            x424,
-            Self::mul_add(-1.2025609200000003, x418, 0.000781 * x417),
-        );
-        let x427 = Self::mul_add(
-            1.4135609200000003,
-            x424,
-            Self::mul_add(-0.9614610000000001, x418, -0.0145 * x417),
-        );
-        let x428 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x417, x418, -x421),
-            -f_ext[7][0],
-        );
-        let x429 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x417, x417, x424 * x424),
-            f_ext[7][1],
-        );
-        let x430 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(x418, x424, x422),
-            -f_ext[7][2],
-        );
-        let x431 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x420, x419),
-            Self::mul_add(-0.0145, x421, 0.000781 * x423)
-                + Self::mul_add(-x424, x426, x418 * x427),
-        ) - f_ext[7][3];
-        let x432 = Self::mul_add(
-            -0.9614610000000001,
-            x421,
-            Self::mul_add(-1.2025609200000003, x423, 0.000781 * x422),
-        ) + Self::mul_add(-x417, x427, x424 * x425) - f_ext[7][4];
-        let x433 = Self::mul_add(
-            -4.806620000000001,
-            Self::mul_add(
-                -c_q13,
-                x420,
-                Self::mul_add(
-                    s_q13,
-                    x399 + Self::mul_add(-0.55, x411, 0.16 * (x412 - x402)),
-                    x15 * x419,
-                ),
-            ),
-            Self::mul_add(
-                1.4135609200000003,
-                x421,
-                Self::mul_add(-0.9614610000000001, x423, -0.0145 * x422),
-            ) + Self::mul_add(-x418, x425, x417 * x426),
-        ) - f_ext[7][5];
-        let x434 = x430 + Self::mul_add(x16, x429, x15 * x428);
-        let x435 = Self::mul_add(-c_q13, x429, s_q13 * x428);
-        let x436 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x430,
-            -Self::mul_add(s_q13, x429, c_q13 * x428),
-        );
-        let x437 = Self::mul_add(
-            -3.6140000000000003,
-            x405 + x406,
-            17.135250000000003 * x408,
-        ) - f_ext[6][0] + x434;
-        let x438 = Self::mul_add(
-            -17.135250000000003,
-            x411,
-            3.6140000000000003 * (x401 + x407),
-        ) - f_ext[6][1] + x435;
-        let x439 = Self::mul_add(
-            17.135250000000003,
-            x413,
-            3.6140000000000003 * (x409 - x403),
-        ) - f_ext[6][2] + x436;
-        let x440 = Self::mul_add(
-            17.135250000000003,
-            x400,
-            Self::mul_add(-0.809539999555672, x401, -1.9877000000000002 * x403)
-                + Self::mul_add(-x404, x415, x394 * x416),
-        ) - f_ext[6][3]
-            + (x433 + Self::mul_add(-x16, x432, x15 * x431)
-                + Self::mul_add(0.55, x436, -0.16 * x435));
-        let x441 = Self::mul_add(
-            x400,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x401,
-                Self::mul_add(-5.252920330000002, x403, -1.9877000000000002 * x402),
-            ) + Self::mul_add(-x393, x416, x404 * x414),
-        ) - f_ext[6][4]
-            + Self::mul_add(0.16, x434, Self::mul_add(c_q13, x432, s_q13 * x431));
-        let x442 = Self::mul_add(
-            9.740442170000001,
-            x401,
-            Self::mul_add(-2.7416399995923166, x403, -0.809539999555672 * x402),
-        ) + Self::mul_add(-x394, x414, x393 * x415)
-            + Self::mul_add(3.6140000000000003, x399, x398 * -17.135250000000003)
-            - f_ext[6][5]
-            + Self::mul_add(
-                -0.55,
-                x434,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x433,
-                    Self::mul_add(-c_q13, x431, s_q13 * x432),
-                ),
-            );
-        let x443 = Self::mul_add(-s_q12, x438, c_q12 * x437);
-        let x444 = x439 + Self::mul_add(x13, x438, x12 * x437);
-        let x445 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x379, x380, -x352),
-            -f_ext[5][0],
-        ) + x443;
-        let x446 = x444
-            - Self::mul_add(
-                7.078399999258757,
-                Self::mul_add(x387, x387, x388),
-                f_ext[5][1],
-            );
-        let x447 = Self::mul_add(7.078399999258757, x385 + x389, -f_ext[5][2])
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x439,
-                -Self::mul_add(c_q12, x438, s_q12 * x437),
-            );
-        let x448 = Self::mul_add(
-            7.078399999258757,
-            x383,
-            Self::mul_add(0.01675, x352, Self::mul_add(-x387, x391, x380 * x392)),
-        ) - f_ext[5][3]
-            + Self::mul_add(0.36, x444, Self::mul_add(-s_q12, x441, c_q12 * x440));
-        let x449 = Self::mul_add(2.5482240016099564, x352, -9.142025249762803 * x386)
-            + Self::mul_add(-x379, x392, x387 * x390) - f_ext[5][4]
-            + Self::mul_add(-0.36, x443, x442 + Self::mul_add(x13, x441, x12 * x440));
-        let x450 = Self::mul_add(
-            x384,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x352,
-                Self::mul_add(2.5482240016099564, x386, 0.01675 * x385),
-            ) + Self::mul_add(-x380, x390, x379 * x391),
-        ) - f_ext[5][5]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x442,
-                -Self::mul_add(c_q12, x441, s_q12 * x440),
-            );
-        let x451 = Self::mul_add(-s_q11, x446, c_q11 * x445);
-        let x452 = Self::mul_add(c_q11, x446, s_q11 * x445);
-        let x453 = Self::mul_add(-45.1584, x371, -f_ext[4][0]) + x451;
-        let x454 = x452 - Self::mul_add(-45.1584, x373, f_ext[4][1]);
-        let x455 = Self::mul_add(-45.1584, x375, -f_ext[4][2]) + x447;
-        let x456 = Self::mul_add(
-            -45.1584,
-            x366,
-            Self::mul_add(-0.6328, x352, Self::mul_add(-x370, x377, x363 * x378)),
-        ) - f_ext[4][3]
-            + (Self::mul_add(-s_q11, x449, c_q11 * x448)
-                + Self::mul_add(-0.63, x447, 0.275 * x452));
-        let x457 = Self::mul_add(-24.35164200091464, x352, -24.4950615 * x369)
-            + Self::mul_add(-x362, x378, x370 * x376) - f_ext[4][4]
-            + Self::mul_add(-0.275, x451, Self::mul_add(c_q11, x449, s_q11 * x448));
-        let x458 = Self::mul_add(
-            x367,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x352,
-                Self::mul_add(-24.351642000914637, x369, -0.6328 * x368),
-            ) + Self::mul_add(-x363, x376, x362 * x377),
-        ) - f_ext[4][5] + Self::mul_add(0.63, x451, x450);
-        let x459 = Self::mul_add(-s_q10, x454, c_q10 * x453);
-        let x460 = Self::mul_add(-81.53205, x356, -f_ext[3][0]) + x459;
-        let x461 = Self::mul_add(c_q10, x454, s_q10 * x453)
-            - Self::mul_add(-81.53205, x357, f_ext[3][1]);
-        let x462 = Self::mul_add(-81.53205, x358, -f_ext[3][2]) + x455;
-        let x463 = Self::mul_add(
-            -81.53205,
-            x351,
-            Self::mul_add(-0.00214, x352, Self::mul_add(-x355, x360, x346 * x361)),
-        ) - f_ext[3][3]
-            + Self::mul_add(-0.87, x455, Self::mul_add(-s_q10, x457, c_q10 * x456));
-        let x464 = Self::mul_add(-36.18604050126307, x352, -63.36336825000001 * x354)
-            + Self::mul_add(-x345, x361, x355 * x359) - f_ext[3][4]
-            + Self::mul_add(c_q10, x457, s_q10 * x456);
-        let x465 = Self::mul_add(
-            x350,
+        let x61 = Self::mul_add(-36.18604050126307, x60, -63.36336825000001 * x49);
+        let x62 = Self::mul_add(-81.53205, x55, -0.00214 * x60);
+        let x63 = Self::mul_add(
+            x53,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x352,
-                Self::mul_add(-36.18604050126307, x354, -0.00214 * x353),
-            ) + Self::mul_add(-x346, x359, x345 * x360),
-        ) - f_ext[3][5] + Self::mul_add(0.87, x459, x458);
-        let x466 = Self::mul_add(
-            0.00000000020510342851533115,
-            x462,
-            Self::mul_add(x6, x461, x5 * x460),
+                x60,
+                Self::mul_add(-36.18604050126307, x49, -0.00214 * x48),
+            ),
         );
-        let x467 = x462 + Self::mul_add(x8, x461, x7 * x460);
-        let x468 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x462,
-            Self::mul_add(-s_q9, x461, c_q9 * x460),
-        );
-        let x469 = Self::mul_add(
-            0.000000008530897668050218,
-            x333 + x334,
-            -12.701650001451807 * x336,
-        ) - f_ext[2][0] + x466;
-        let x470 = Self::mul_add(
-            12.701650001451807,
-            x339,
-            -0.000000008530897668050218 * (x314 + x335),
-        ) - f_ext[2][1] + x467;
-        let x471 = Self::mul_add(
-            -12.701650001451807,
-            x341,
-            -0.000000008530897668050218 * (x331 + x337),
-        ) - f_ext[2][2] + x468;
-        let x472 = Self::mul_add(
-            -12.701650001451807,
-            x329,
-            Self::mul_add(0.0000000234896432582596, x331, -0.0021399965876409276 * x314)
-                + Self::mul_add(-x332, x343, x323 * x344),
-        ) - f_ext[2][3]
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x465,
-                Self::mul_add(x6, x464, x5 * x463),
-            ) + Self::mul_add(0.275, x468, -0.4 * x467));
-        let x473 = Self::mul_add(
-            x329,
-            0.000000008530897668050218,
+        let x64 = -81.53205 * x60;
+        let x65 = x48 * 81.53205;
+        let (s_q10, c_q10) = libm::sincos(q[10]);
+        let x67 = Self::mul_add(x49, s_q10, x48 * c_q10);
+        let x68 = Self::mul_add(-x48, s_q10, x49 * c_q10);
+        let x69 = Self::mul_add(0.87, x60, x53);
+        let x70 = Self::mul_add(x48, -0.87, x55);
+        let x71 = Self::mul_add(x54, s_q10, c_q10 * x69);
+        let x72 = Self::mul_add(-s_q10, x69, x54 * c_q10);
+        let x73 = v[9] * x68;
+        let x74 = v[9] * x67;
+        let x75 = v[9] * x72;
+        let x76 = v[9] * x71;
+        let x77 = v[9] + x60;
+        let x78 = Self::mul_add(-24.35164200091464, x77, -24.4950615 * x68);
+        let x79 = Self::mul_add(-45.1584, x70, -0.6328 * x77);
+        let x80 = Self::mul_add(
+            x71,
+            45.1584,
             Self::mul_add(
-                5.080660024070365,
-                x314,
-                Self::mul_add(111.7548902508081, x331, -0.0000000234896432582596 * x330),
-            ) + Self::mul_add(-x322, x344, x332 * x342),
-        ) - f_ext[2][4]
-            + Self::mul_add(0.4, x466, x465 + Self::mul_add(x8, x464, x7 * x463));
-        let x474 = Self::mul_add(
-            113.3918902508081,
-            x314,
-            Self::mul_add(-5.080660024070366, x331, -0.0021399965876409276 * x330),
-        ) + Self::mul_add(-x323, x342, x322 * x343)
-            + Self::mul_add(-0.000000008530897668050218, x328, x327 * 12.701650001451807)
-            - f_ext[2][5]
+                28.2393615,
+                x77,
+                Self::mul_add(-24.351642000914637, x68, -0.6328 * x67),
+            ),
+        );
+        let x81 = -45.1584 * x77;
+        let x82 = x67 * 45.1584;
+        let (s_q11, c_q11) = libm::sincos(q[11]);
+        let x84 = Self::mul_add(x68, s_q11, x67 * c_q11);
+        let x85 = Self::mul_add(-x67, s_q11, x68 * c_q11);
+        let x86 = x71 - Self::mul_add(-0.63, x77, 0.275 * x68);
+        let x87 = Self::mul_add(0.275, x67, x72);
+        let x88 = Self::mul_add(x67, -0.63, x70);
+        let x89 = Self::mul_add(s_q11, x87, c_q11 * x86);
+        let x90 = Self::mul_add(-s_q11, x86, c_q11 * x87);
+        let x91 = v[10] * x85;
+        let x92 = v[10] * x84;
+        let x93 = v[10] * x90;
+        let x94 = v[10] * x89;
+        let x95 = v[10] + x77;
+        let x96 = Self::mul_add(2.5482240016099564, x95, -9.142025249762803 * x85);
+        let x97 = Self::mul_add(7.078399999258757, x88, 0.01675 * x95);
+        let x98 = Self::mul_add(
+            x89,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x95,
+                Self::mul_add(2.5482240016099564, x85, 0.01675 * x84),
+            ),
+        );
+        let x99 = 7.078399999258757 * x95;
+        let x100 = x84 * -7.078399999258757;
+        let (s_q12, c_q12) = libm::sincos(q[12]);
+        let x102 = -0.00000000020510342851533115 * s_q12;
+        let x103 = -0.00000000020510342851533115 * c_q12;
+        let x104 = Self::mul_add(-x95, s_q12, Self::mul_add(x85, x102, x84 * c_q12));
+        let x105 = Self::mul_add(-x95, c_q12, Self::mul_add(-x84, s_q12, x85 * x103));
+        let x106 = Self::mul_add(x85, -0.36, x89);
+        let x107 = Self::mul_add(0.36, x84, x90);
+        let x108 = Self::mul_add(-x88, s_q12, Self::mul_add(x102, x107, c_q12 * x106));
+        let x109 = Self::mul_add(-x88, c_q12, Self::mul_add(-s_q12, x106, x103 * x107));
+        let x110 = Self::mul_add(-0.00000000020510342851533115, x88, x107);
+        let x111 = v[11] * x105;
+        let x112 = v[11] * x104;
+        let x113 = v[11] * x109;
+        let x114 = v[11] * x108;
+        let x115 = v[11] + Self::mul_add(-0.00000000020510342851533115, x95, x85);
+        let x116 = Self::mul_add(
+            17.135250000000003,
+            x110,
+            Self::mul_add(-0.809539999555672, x115, -1.9877000000000002 * x105),
+        );
+        let x117 = Self::mul_add(
+            x110,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x115,
+                Self::mul_add(-5.252920330000002, x105, -1.9877000000000002 * x104),
+            ),
+        );
+        let x118 = Self::mul_add(
+            9.740442170000001,
+            x115,
+            Self::mul_add(-2.7416399995923166, x105, -0.809539999555672 * x104),
+        ) + Self::mul_add(3.6140000000000003, x109, x108 * -17.135250000000003);
+        let x119 = 17.135250000000003 * x115;
+        let x120 = x115 * -3.6140000000000003;
+        let x121 = Self::mul_add(3.6140000000000003, x105, x104 * -17.135250000000003);
+        let (s_q13, c_q13) = libm::sincos(q[13]);
+        let x123 = -0.00000000020510342851533115 * c_q13;
+        let x124 = -0.00000000020510342851533115 * s_q13;
+        let x125 = Self::mul_add(-x115, c_q13, Self::mul_add(x105, s_q13, x104 * x123));
+        let x126 = Self::mul_add(x115, s_q13, Self::mul_add(-x104, x124, x105 * c_q13));
+        let x127 = x108 - Self::mul_add(0.55, x115, -0.16 * x105);
+        let x128 = Self::mul_add(-0.16, x104, x109);
+        let x129 = Self::mul_add(x104, 0.55, x110);
+        let x130 = Self::mul_add(-c_q13, x129, Self::mul_add(s_q13, x128, x123 * x127));
+        let x131 = Self::mul_add(s_q13, x129, Self::mul_add(-x124, x127, c_q13 * x128));
+        let x132 = Self::mul_add(-0.00000000020510342851533115, x129, x127);
+        let x133 = v[12] * x126;
+        let x134 = v[12] * x125;
+        let x135 = v[12] * x131;
+        let x136 = v[12] + Self::mul_add(-0.00000000020510342851533115, x115, x104);
+        let x137 = Self::mul_add(
+            -0.9614610000000001,
+            x136,
+            Self::mul_add(-1.2025609200000003, x126, 0.000781 * x125),
+        );
+        let x138 = Self::mul_add(
+            4.806620000000001,
+            x132,
+            Self::mul_add(-0.0145, x136, 0.000781 * x126),
+        );
+        let x139 = Self::mul_add(
+            x130,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x136,
+                Self::mul_add(-0.9614610000000001, x126, -0.0145 * x125),
+            ),
+        );
+        let x140 = 4.806620000000001 * x136;
+        let x141 = x125 * -4.806620000000001;
+        let x142 = Self::mul_add(x131, x140, Self::mul_add(-x126, x138, x125 * x137))
+            - f_ext[7][5];
+        let x143 = Self::mul_add(-x136, x140, x125 * x141) - f_ext[7][1];
+        let x144 = tau[6] - x142;
+        let x145 = Self::mul_add(
+            4.806620000000001,
+            x133,
+            Self::mul_add(x126, x140, -f_ext[7][2]),
+        );
+        let x146 = Self::mul_add(
+            x144,
+            -0.010257782169020348,
+            Self::mul_add(-x131, x141, Self::mul_add(-x136, x137, x126 * x139))
+                - f_ext[7][3]
+                + Self::mul_add(
+                    x135,
+                    -0.049305260929256585,
+                    Self::mul_add(
+                        x134,
+                        0.009081457502008472,
+                        x133 * -0.00014873784145079505,
+                    ),
+                ),
+        );
+        let x147 = Self::mul_add(
+            x144,
+            -0.6801694828971361,
+            Self::mul_add(-x125, x139, x136 * x138)
+                + Self::mul_add(-x132, x140, x130 * x141) - f_ext[7][4]
+                + Self::mul_add(
+                    x135,
+                    -3.2693162398830324,
+                    Self::mul_add(x134, 1.8565173511957638, x133 * -0.009081457502008472),
+                ),
+        );
+        let x148 = x142 + x144;
+        let x149 = Self::mul_add(
+            x144,
+            -3.4003628227073506,
+            Self::mul_add(
+                x135,
+                -16.344251950881606,
+                Self::mul_add(x134, 3.2693162398830324, x133 * -0.049305260929256585),
+            ) - Self::mul_add(x126, x141, f_ext[7][0]),
+        );
+        let x150 = c_q13 * -0.009081457502008472;
+        let x151 = Self::mul_add(s_q13, -0.00014873784145079505, x150);
+        let x152 = s_q13 * -0.009081457502008472;
+        let x153 = Self::mul_add(c_q13, 0.00014873784145079505, x152);
+        let x154 = Self::mul_add(c_q13, -1.8565173511957638, x152);
+        let x155 = Self::mul_add(s_q13, -1.8565173511957638, -x150);
+        let x156 = Self::mul_add(x123, -0.049305260929256585, 4.806620000000001);
+        let x157 = s_q13 * -0.049305260929256585;
+        let x158 = Self::mul_add(
+            c_q13,
+            0.049305260929256585,
+            -0.0000000009858542415703612,
+        );
+        let x159 = x123 * -3.2693162398830324;
+        let x160 = s_q13 * -3.2693162398830324;
+        let x161 = c_q13 * -3.2693162398830324;
+        let x162 = Self::mul_add(-x124, x159, x123 * x156);
+        let x163 = Self::mul_add(-x124, x160, x123 * x157);
+        let x164 = Self::mul_add(x124, x161, x123 * x158);
+        let x165 = Self::mul_add(c_q13, x159, s_q13 * x156);
+        let x166 = Self::mul_add(-c_q13, x156, s_q13 * x159);
+        let x167 = s_q13 * -16.344251950881606;
+        let x168 = c_q13 * -16.344251950881606;
+        let x169 = x123 * (x123 * -16.344251950881606);
+        let x170 = x123 * x167;
+        let x171 = x123 * x168;
+        let x172 = s_q13 * x167;
+        let x173 = s_q13 * x168;
+        let x174 = c_q13 * x168;
+        let x175 = x163 + Self::mul_add(-0.55, x173, -0.16 * x172);
+        let x176 = x164 + Self::mul_add(0.16, x173, 0.55 * x174);
+        let x177 = Self::mul_add(0.16, x169, x165);
+        let x178 = Self::mul_add(0.16, x170, Self::mul_add(c_q13, x160, s_q13 * x157));
+        let x179 = Self::mul_add(-0.16, x171, Self::mul_add(-c_q13, x161, s_q13 * x158));
+        let x180 = Self::mul_add(-0.55, x169, x166);
+        let x181 = Self::mul_add(-0.55, x170, Self::mul_add(-c_q13, x157, s_q13 * x160));
+        let x182 = Self::mul_add(-0.55, x171, Self::mul_add(s_q13, x161, c_q13 * x158));
+        let x183 = Self::mul_add(
+            0.16,
+            x165,
+            Self::mul_add(0.16, x177, Self::mul_add(c_q13, x154, s_q13 * x151)),
+        );
+        let x184 = Self::mul_add(
+            -0.55,
+            x165,
+            Self::mul_add(0.16, x180, Self::mul_add(c_q13, x155, s_q13 * x153)),
+        );
+        let x185 = Self::mul_add(
+            -0.55,
+            x166,
+            Self::mul_add(-0.55, x180, Self::mul_add(-c_q13, x153, s_q13 * x155)),
+        );
+        let x186 = x145 + Self::mul_add(-x124, x143, x123 * x149);
+        let x187 = Self::mul_add(c_q13, x143, s_q13 * x149);
+        let x188 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x145,
+            Self::mul_add(-c_q13, x149, s_q13 * x143),
+        );
+        let x189 = Self::mul_add(
+            -0.55,
+            x186,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x148,
+                Self::mul_add(-c_q13, x146, s_q13 * x147),
+            ),
+        );
+        let x190 = -0.809539999555672
+            + Self::mul_add(
+                -0.55,
+                x162,
+                Self::mul_add(-x124, x155, x123 * x153)
+                    + Self::mul_add(-0.55, x182, -0.16 * x181),
+            );
+        let x191 = -2.741639999592316 + x184;
+        let x192 = 9.740442170000001 + x185;
+        let x193 = -17.135250000000003 + x180;
+        let x194 = 3.6140000000000003 + x181;
+        let x195 = Self::mul_add(-x105, x116, x104 * x117)
+            + Self::mul_add(-x108, x120, x109 * x119) - f_ext[6][5] + x189;
+        let x196 = 1.0 / x192;
+        let x197 = tau[5] - x195;
+        let x198 = x190 * x196;
+        let x199 = x191 * x196;
+        let x200 = x193 * x196;
+        let x201 = x194 * x196;
+        let x202 = x182 * x196;
+        let x203 = Self::mul_add(
+            -x190,
+            x198,
+            Self::mul_add(0.55, x164, -0.16 * x163)
+                + (Self::mul_add(
+                    -x124,
+                    Self::mul_add(
+                        x124,
+                        1.8565173511957638,
+                        x123 * -0.009081457502008472,
+                    ),
+                    x123
+                        * Self::mul_add(
+                            x124,
+                            0.009081457502008472,
+                            x123 * -0.00014873784145079505,
+                        ),
+                ) + Self::mul_add(0.55, x176, -0.16 * x175)),
+        );
+        let x204 = Self::mul_add(
+            -x190,
+            x199,
+            -1.9877000000000002
+                + Self::mul_add(
+                    0.16,
+                    x162,
+                    Self::mul_add(-x124, x154, x123 * x151)
+                        + Self::mul_add(0.55, x179, -0.16 * x178),
+                ),
+        );
+        let x205 = Self::mul_add(-x191, x199, -5.252920330000002 + x183);
+        let x206 = Self::mul_add(
+            -x190,
+            x200,
+            x162 + Self::mul_add(-0.55, x171, -0.16 * x170),
+        );
+        let x207 = Self::mul_add(-x190, x201, x175);
+        let x208 = Self::mul_add(x190, x202, 17.135250000000003 + x176);
+        let x209 = Self::mul_add(-x191, x200, x177);
+        let x210 = Self::mul_add(-x191, x201, x178);
+        let x211 = Self::mul_add(x191, x202, -3.6140000000000003 + x179);
+        let x212 = Self::mul_add(-x193, x200, x169);
+        let x213 = Self::mul_add(-x193, x201, x170);
+        let x214 = Self::mul_add(x193, x202, -x171);
+        let x215 = Self::mul_add(-x194, x201, x172);
+        let x216 = Self::mul_add(x194, x202, -x173);
+        let x217 = Self::mul_add(-x182, x202, x174);
+        let x218 = Self::mul_add(
+            x197,
+            x198,
+            Self::mul_add(-x115, x117, x105 * x118)
+                + Self::mul_add(-x109, x121, x110 * x120) - f_ext[6][3]
+                + (x148 + Self::mul_add(-x124, x147, x123 * x146)
+                    + Self::mul_add(0.55, x188, -0.16 * x187))
+                + (Self::mul_add(-x112, x204, x111 * x203)
+                    + Self::mul_add(-x114, x207, x113 * x206)),
+        );
+        let x219 = Self::mul_add(
+            x197,
+            x199,
+            Self::mul_add(-x104, x118, x115 * x116)
+                + Self::mul_add(-x110, x119, x108 * x121) - f_ext[6][4]
+                + Self::mul_add(0.16, x186, Self::mul_add(c_q13, x147, s_q13 * x146))
+                + (Self::mul_add(-x112, x205, x111 * x204)
+                    + Self::mul_add(-x114, x210, x113 * x209)),
+        );
+        let x220 = Self::mul_add(x197, x192 * x196, x195);
+        let x221 = Self::mul_add(
+            x197,
+            x200,
+            Self::mul_add(-x105, x121, x115 * x120) - f_ext[6][0] + x186
+                + (Self::mul_add(-x112, x209, x111 * x206)
+                    + Self::mul_add(-x114, x213, x113 * x212)),
+        );
+        let x222 = Self::mul_add(
+            x197,
+            x201,
+            Self::mul_add(-x115, x119, x104 * x121) - f_ext[6][1] + x187
+                + (Self::mul_add(-x112, x210, x111 * x207)
+                    + Self::mul_add(-x114, x215, x113 * x213)),
+        );
+        let x223 = Self::mul_add(
+            -x197,
+            x202,
+            Self::mul_add(-x104, x120, x105 * x119) - f_ext[6][2] + x188
+                + (Self::mul_add(-x112, x211, x111 * x208)
+                    + Self::mul_add(-x114, x216, x113 * x214)),
+        );
+        let x224 = s_q12 * x204;
+        let x225 = Self::mul_add(x103, x204, x102 * x203);
+        let x226 = c_q12 * x204;
+        let x227 = Self::mul_add(s_q12, x203, x226);
+        let x228 = Self::mul_add(x103, x205, x102 * x204);
+        let x229 = Self::mul_add(c_q12, x205, x224);
+        let x230 = Self::mul_add(-s_q12, x207, c_q12 * x206);
+        let x231 = x208 + Self::mul_add(x103, x207, x102 * x206);
+        let x232 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x208,
+            -Self::mul_add(c_q12, x207, s_q12 * x206),
+        );
+        let x233 = Self::mul_add(-s_q12, x210, c_q12 * x209);
+        let x234 = x211 + Self::mul_add(x103, x210, x102 * x209);
+        let x235 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x211,
+            -Self::mul_add(c_q12, x210, s_q12 * x209),
+        );
+        let x236 = Self::mul_add(-s_q12, x233, c_q12 * x230);
+        let x237 = Self::mul_add(-s_q12, x234, c_q12 * x231);
+        let x238 = Self::mul_add(x103, x233, x102 * x230);
+        let x239 = Self::mul_add(c_q12, x233, s_q12 * x230);
+        let x240 = Self::mul_add(c_q12, x234, s_q12 * x231);
+        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
+        let x242 = s_q12 * x213;
+        let x243 = x214 + Self::mul_add(x103, x213, x102 * x212);
+        let x244 = c_q12 * x213;
+        let x245 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x214,
+            -Self::mul_add(s_q12, x212, x244),
+        );
+        let x246 = x216 + Self::mul_add(x103, x215, x102 * x213);
+        let x247 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x216,
+            -Self::mul_add(c_q12, x215, x242),
+        );
+        let x248 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x217,
+            -Self::mul_add(c_q12, x216, s_q12 * x214),
+        );
+        let x249 = Self::mul_add(
+            -s_q12,
+            Self::mul_add(-s_q12, x215, x244),
+            c_q12 * Self::mul_add(c_q12, x212, -x242),
+        );
+        let x250 = Self::mul_add(-s_q12, x246, c_q12 * x243);
+        let x251 = Self::mul_add(-s_q12, x247, c_q12 * x245);
+        let x252 = x217 + Self::mul_add(x103, x216, x102 * x214)
+            + Self::mul_add(x103, x246, x102 * x243);
+        let x253 = x248 + Self::mul_add(x103, x247, x102 * x245);
+        let x254 = Self::mul_add(0.36, x252, x237);
+        let x255 = Self::mul_add(-0.36, x249, x238);
+        let x256 = Self::mul_add(-0.36, x250, Self::mul_add(x103, x234, x102 * x231));
+        let x257 = Self::mul_add(
+            0.36,
+            x254,
+            Self::mul_add(
+                -s_q12,
+                Self::mul_add(-s_q12, x205, x226),
+                c_q12 * Self::mul_add(c_q12, x203, -x224),
+            ),
+        );
+        let x258 = Self::mul_add(
+            -0.36,
+            x236,
+            Self::mul_add(0.36, x256, Self::mul_add(-s_q12, x228, c_q12 * x225)),
+        );
+        let x259 = Self::mul_add(
+            -0.36,
+            x238,
+            Self::mul_add(-0.36, x255, Self::mul_add(x103, x228, x102 * x225)),
+        );
+        let x260 = Self::mul_add(-s_q12, x222, c_q12 * x221);
+        let x261 = x223 + Self::mul_add(x103, x222, x102 * x221);
+        let x262 = 0.01675
+            + Self::mul_add(-0.36, x240, Self::mul_add(-c_q12, x227, s_q12 * x229));
+        let x263 = 2.5482240016099564
+            - Self::mul_add(-0.36, x239, Self::mul_add(x103, x229, x102 * x227));
+        let x264 = 9.223235249762805 + Self::mul_add(c_q12, x229, s_q12 * x227);
+        let x265 = -7.078399999258757 - x239;
+        let x266 = Self::mul_add(x90, x99, Self::mul_add(-x85, x97, x84 * x96))
+            - f_ext[5][5]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x220,
+                -Self::mul_add(c_q12, x219, s_q12 * x218),
+            );
+        let x267 = 1.0 / x264;
+        let x268 = tau[4] - x266;
+        let x269 = x262 * x267;
+        let x270 = x263 * x267;
+        let x271 = x265 * x267;
+        let x272 = x240 * x267;
+        let x273 = x241 * x267;
+        let x274 = Self::mul_add(-x262, x269, Self::mul_add(0.36, x237, x257));
+        let x275 = Self::mul_add(-x262, x270, x258);
+        let x276 = Self::mul_add(-x263, x270, -9.142025249762803 + x259);
+        let x277 = Self::mul_add(-x262, x271, Self::mul_add(0.36, x250, x236));
+        let x278 = Self::mul_add(x262, x272, x254);
+        let x279 = Self::mul_add(
+            x262,
+            x273,
+            7.078399999258757
+                + Self::mul_add(0.36, x253, Self::mul_add(-s_q12, x235, c_q12 * x232)),
+        );
+        let x280 = Self::mul_add(-x263, x271, x255);
+        let x281 = Self::mul_add(x263, x272, x256);
+        let x282 = Self::mul_add(
+            x263,
+            x273,
+            Self::mul_add(-0.36, x251, Self::mul_add(x103, x235, x102 * x232)),
+        );
+        let x283 = Self::mul_add(-x265, x271, x249);
+        let x284 = Self::mul_add(x265, x272, x250);
+        let x285 = Self::mul_add(x265, x273, x251);
+        let x286 = Self::mul_add(-x240, x272, x252);
+        let x287 = Self::mul_add(-x240, x273, x253);
+        let x288 = Self::mul_add(
+            -x241,
+            x273,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x248,
+                -Self::mul_add(c_q12, x247, s_q12 * x245),
+            ),
+        );
+        let x289 = Self::mul_add(
+            x268,
+            x269,
+            Self::mul_add(-x90, x100, Self::mul_add(-x95, x96, x85 * x98)) - f_ext[5][3]
+                + Self::mul_add(0.36, x261, Self::mul_add(-s_q12, x219, c_q12 * x218))
+                + (Self::mul_add(-x92, x275, x91 * x274)
+                    + Self::mul_add(-x94, x278, x93 * x277)),
+        );
+        let x290 = Self::mul_add(
+            x268,
+            x270,
+            Self::mul_add(-x84, x98, x95 * x97) + Self::mul_add(-x88, x99, x89 * x100)
+                - f_ext[5][4]
+                + Self::mul_add(
+                    -0.36,
+                    x260,
+                    x220 + Self::mul_add(x103, x219, x102 * x218),
+                )
+                + (Self::mul_add(-x92, x276, x91 * x275)
+                    + Self::mul_add(-x94, x281, x93 * x280)),
+        );
+        let x291 = Self::mul_add(
+            x268,
+            x271,
+            x260 - Self::mul_add(x85, x100, f_ext[5][0])
+                + (Self::mul_add(-x92, x280, x91 * x277)
+                    + Self::mul_add(-x94, x284, x93 * x283)),
+        );
+        let x292 = Self::mul_add(
+            -x268,
+            x272,
+            Self::mul_add(-x95, x99, x84 * x100) - f_ext[5][1] + x261
+                + (Self::mul_add(-x92, x281, x91 * x278)
+                    + Self::mul_add(-x94, x286, x93 * x284)),
+        );
+        let x293 = Self::mul_add(
+            -x268,
+            x273,
+            Self::mul_add(x85, x99, -f_ext[5][2])
+                + Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x223,
+                    -Self::mul_add(c_q12, x222, s_q12 * x221),
+                )
+                + (Self::mul_add(-x92, x282, x91 * x279)
+                    + Self::mul_add(-x94, x287, x93 * x285)),
+        );
+        let x294 = s_q11 * x275;
+        let x295 = c_q11 * x275;
+        let x296 = Self::mul_add(s_q11, x274, x295);
+        let x297 = Self::mul_add(c_q11, x276, x294);
+        let x298 = Self::mul_add(-s_q11, x278, c_q11 * x277);
+        let x299 = Self::mul_add(c_q11, x278, s_q11 * x277);
+        let x300 = Self::mul_add(-s_q11, x281, c_q11 * x280);
+        let x301 = Self::mul_add(c_q11, x281, s_q11 * x280);
+        let x302 = Self::mul_add(-s_q11, x300, c_q11 * x298);
+        let x303 = Self::mul_add(-s_q11, x301, c_q11 * x299);
+        let x304 = Self::mul_add(-s_q11, x282, c_q11 * x279);
+        let x305 = Self::mul_add(c_q11, x300, s_q11 * x298);
+        let x306 = s_q11 * x284;
+        let x307 = c_q11 * x284;
+        let x308 = Self::mul_add(s_q11, x283, x307);
+        let x309 = Self::mul_add(c_q11, x286, x306);
+        let x310 = Self::mul_add(-s_q11, x287, c_q11 * x285);
+        let x311 = Self::mul_add(c_q11, x287, s_q11 * x285);
+        let x312 = Self::mul_add(
+            -s_q11,
+            Self::mul_add(-s_q11, x286, x307),
+            c_q11 * Self::mul_add(c_q11, x283, -x306),
+        );
+        let x313 = Self::mul_add(-s_q11, x309, c_q11 * x308);
+        let x314 = Self::mul_add(c_q11, x309, s_q11 * x308);
+        let x315 = 0.63 * x312;
+        let x316 = 0.63 * x313;
+        let x317 = 0.63 * x310;
+        let x318 = x303 + Self::mul_add(-0.63, x311, 0.275 * x314);
+        let x319 = x304 + Self::mul_add(-0.63, x288, 0.275 * x311);
+        let x320 = Self::mul_add(-0.275, x312, x305);
+        let x321 = Self::mul_add(-0.275, x313, Self::mul_add(c_q11, x301, s_q11 * x299));
+        let x322 = Self::mul_add(-0.275, x310, Self::mul_add(c_q11, x282, s_q11 * x279));
+        let x323 = Self::mul_add(
+            -0.275,
+            x305,
+            Self::mul_add(-0.275, x320, Self::mul_add(c_q11, x297, s_q11 * x296)),
+        );
+        let x324 = Self::mul_add(-s_q11, x292, c_q11 * x291);
+        let x325 = Self::mul_add(c_q11, x292, s_q11 * x291);
+        let x326 = -0.6328
+            + Self::mul_add(0.63, x302, Self::mul_add(-0.63, x317, 0.275 * x316));
+        let x327 = -24.35164200091464 + Self::mul_add(0.63, x305, -0.275 * x315);
+        let x328 = Self::mul_add(0.63, x315, 28.2393615);
+        let x329 = 45.1584 + x315;
+        let x330 = Self::mul_add(x72, x81, Self::mul_add(-x68, x79, x67 * x78))
+            - f_ext[4][5]
+            + Self::mul_add(0.63, x324, Self::mul_add(x268, x264 * x267, x266));
+        let x331 = 1.0 / x328;
+        let x332 = tau[3] - x330;
+        let x333 = x326 * x331;
+        let x334 = x327 * x331;
+        let x335 = x329 * x331;
+        let x336 = x316 * x331;
+        let x337 = x317 * x331;
+        let x338 = Self::mul_add(
+            -x326,
+            x333,
+            Self::mul_add(-0.63, x304, 0.275 * x303)
+                + (Self::mul_add(
+                    -s_q11,
+                    Self::mul_add(-s_q11, x276, x295),
+                    c_q11 * Self::mul_add(c_q11, x274, -x294),
+                ) + Self::mul_add(-0.63, x319, 0.275 * x318)),
+        );
+        let x339 = Self::mul_add(
+            -x326,
+            x334,
+            Self::mul_add(
+                -0.275,
+                x302,
+                Self::mul_add(-s_q11, x297, c_q11 * x296)
+                    + Self::mul_add(-0.63, x322, 0.275 * x321),
+            ),
+        );
+        let x340 = Self::mul_add(-x327, x334, -24.4950615 + x323);
+        let x341 = Self::mul_add(
+            -x326,
+            x335,
+            x302 + Self::mul_add(-0.63, x310, 0.275 * x313),
+        );
+        let x342 = Self::mul_add(-x326, x336, x318);
+        let x343 = Self::mul_add(-x326, x337, -45.1584 + x319);
+        let x344 = Self::mul_add(-x327, x335, x320);
+        let x345 = Self::mul_add(-x327, x336, x321);
+        let x346 = Self::mul_add(-x327, x337, x322);
+        let x347 = Self::mul_add(-x329, x335, x312);
+        let x348 = Self::mul_add(-x329, x336, x313);
+        let x349 = Self::mul_add(-x329, x337, x310);
+        let x350 = Self::mul_add(-x316, x336, x314);
+        let x351 = Self::mul_add(-x316, x337, x311);
+        let x352 = Self::mul_add(-x317, x337, x288);
+        let x353 = Self::mul_add(
+            x332,
+            x333,
+            Self::mul_add(-x72, x82, Self::mul_add(-x77, x78, x68 * x80)) - f_ext[4][3]
+                + (Self::mul_add(-s_q11, x290, c_q11 * x289)
+                    + Self::mul_add(-0.63, x293, 0.275 * x325))
+                + (Self::mul_add(-x74, x339, x73 * x338)
+                    + Self::mul_add(-x76, x342, x75 * x341)),
+        );
+        let x354 = Self::mul_add(
+            x332,
+            x334,
+            Self::mul_add(-x67, x80, x77 * x79) + Self::mul_add(-x70, x81, x71 * x82)
+                - f_ext[4][4]
+                + Self::mul_add(-0.275, x324, Self::mul_add(c_q11, x290, s_q11 * x289))
+                + (Self::mul_add(-x74, x340, x73 * x339)
+                    + Self::mul_add(-x76, x345, x75 * x344)),
+        );
+        let x355 = Self::mul_add(
+            x332,
+            x335,
+            x324 - Self::mul_add(x68, x82, f_ext[4][0])
+                + (Self::mul_add(-x74, x344, x73 * x341)
+                    + Self::mul_add(-x76, x348, x75 * x347)),
+        );
+        let x356 = Self::mul_add(
+            x332,
+            x336,
+            Self::mul_add(-x77, x81, x67 * x82) - f_ext[4][1] + x325
+                + (Self::mul_add(-x74, x345, x73 * x342)
+                    + Self::mul_add(-x76, x350, x75 * x348)),
+        );
+        let x357 = Self::mul_add(
+            x332,
+            x337,
+            Self::mul_add(x68, x81, -f_ext[4][2]) + x293
+                + (Self::mul_add(-x74, x346, x73 * x343)
+                    + Self::mul_add(-x76, x351, x75 * x349)),
+        );
+        let x358 = s_q10 * x339;
+        let x359 = c_q10 * x339;
+        let x360 = Self::mul_add(s_q10, x338, x359);
+        let x361 = Self::mul_add(c_q10, x340, x358);
+        let x362 = Self::mul_add(-s_q10, x342, c_q10 * x341);
+        let x363 = Self::mul_add(c_q10, x342, s_q10 * x341);
+        let x364 = Self::mul_add(-s_q10, x345, c_q10 * x344);
+        let x365 = Self::mul_add(c_q10, x345, s_q10 * x344);
+        let x366 = Self::mul_add(-s_q10, x364, c_q10 * x362);
+        let x367 = Self::mul_add(-s_q10, x346, c_q10 * x343);
+        let x368 = Self::mul_add(c_q10, x364, s_q10 * x362);
+        let x369 = Self::mul_add(c_q10, x346, s_q10 * x343);
+        let x370 = s_q10 * x348;
+        let x371 = c_q10 * x348;
+        let x372 = Self::mul_add(s_q10, x347, x371);
+        let x373 = Self::mul_add(c_q10, x350, x370);
+        let x374 = Self::mul_add(-s_q10, x351, c_q10 * x349);
+        let x375 = Self::mul_add(c_q10, x351, s_q10 * x349);
+        let x376 = Self::mul_add(
+            -s_q10,
+            Self::mul_add(-s_q10, x350, x371),
+            c_q10 * Self::mul_add(c_q10, x347, -x370),
+        );
+        let x377 = Self::mul_add(-s_q10, x373, c_q10 * x372);
+        let x378 = 0.87 * x376;
+        let x379 = 0.87 * x377;
+        let x380 = 0.87 * x374;
+        let x381 = Self::mul_add(-0.87, x352, x367);
+        let x382 = Self::mul_add(
+            -0.87,
+            x381,
+            Self::mul_add(
+                -s_q10,
+                Self::mul_add(-s_q10, x340, x359),
+                c_q10 * Self::mul_add(c_q10, x338, -x358),
+            ),
+        );
+        let x383 = Self::mul_add(-s_q10, x356, c_q10 * x355);
+        let x384 = -0.00214 + Self::mul_add(0.87, x366, -0.87 * x380);
+        let x385 = Self::mul_add(0.87, x368, -36.18604050126307);
+        let x386 = Self::mul_add(0.87, x378, 69.99836825);
+        let x387 = 81.53205 + x378;
+        let x388 = Self::mul_add(x54, x64, Self::mul_add(-x49, x62, x48 * x61))
+            - f_ext[3][5]
+            + Self::mul_add(0.87, x383, Self::mul_add(x332, x328 * x331, x330));
+        let x389 = 1.0 / x386;
+        let x390 = tau[2] - x388;
+        let x391 = x384 * x389;
+        let x392 = x385 * x389;
+        let x393 = x387 * x389;
+        let x394 = x379 * x389;
+        let x395 = x380 * x389;
+        let x396 = Self::mul_add(-x384, x391, Self::mul_add(-0.87, x367, x382));
+        let x397 = Self::mul_add(
+            -x384,
+            x392,
+            Self::mul_add(-0.87, x369, Self::mul_add(-s_q10, x361, c_q10 * x360)),
+        );
+        let x398 = Self::mul_add(
+            -x385,
+            x392,
+            -63.36336825000001 + Self::mul_add(c_q10, x361, s_q10 * x360),
+        );
+        let x399 = Self::mul_add(-x384, x393, Self::mul_add(-0.87, x374, x366));
+        let x400 = Self::mul_add(
+            -x384,
+            x394,
+            Self::mul_add(-0.87, x375, Self::mul_add(-s_q10, x365, c_q10 * x363)),
+        );
+        let x401 = Self::mul_add(-x384, x395, -81.53205 + x381);
+        let x402 = Self::mul_add(-x385, x393, x368);
+        let x403 = Self::mul_add(-x385, x394, Self::mul_add(c_q10, x365, s_q10 * x363));
+        let x404 = Self::mul_add(-x385, x395, x369);
+        let x405 = Self::mul_add(-x387, x393, x376);
+        let x406 = Self::mul_add(-x387, x394, x377);
+        let x407 = Self::mul_add(-x387, x395, x374);
+        let x408 = Self::mul_add(-x379, x394, Self::mul_add(c_q10, x373, s_q10 * x372));
+        let x409 = Self::mul_add(-x379, x395, x375);
+        let x410 = Self::mul_add(-x380, x395, x352);
+        let x411 = Self::mul_add(
+            x390,
+            x391,
+            Self::mul_add(-x54, x65, Self::mul_add(-x60, x61, x49 * x63)) - f_ext[3][3]
+                + Self::mul_add(-0.87, x357, Self::mul_add(-s_q10, x354, c_q10 * x353))
+                + (Self::mul_add(-x57, x397, x56 * x396)
+                    + Self::mul_add(-x59, x400, x58 * x399)),
+        );
+        let x412 = Self::mul_add(
+            x390,
+            x392,
+            Self::mul_add(-x48, x63, x60 * x62) + Self::mul_add(-x55, x64, x53 * x65)
+                - f_ext[3][4] + Self::mul_add(c_q10, x354, s_q10 * x353)
+                + (Self::mul_add(-x57, x398, x56 * x397)
+                    + Self::mul_add(-x59, x403, x58 * x402)),
+        );
+        let x413 = Self::mul_add(x390, x386 * x389, x388);
+        let x414 = Self::mul_add(
+            x390,
+            x393,
+            x383 - Self::mul_add(x49, x65, f_ext[3][0])
+                + (Self::mul_add(-x57, x402, x56 * x399)
+                    + Self::mul_add(-x59, x406, x58 * x405)),
+        );
+        let x415 = Self::mul_add(
+            x390,
+            x394,
+            Self::mul_add(-x60, x64, x48 * x65) - f_ext[3][1]
+                + Self::mul_add(c_q10, x356, s_q10 * x355)
+                + (Self::mul_add(-x57, x403, x56 * x400)
+                    + Self::mul_add(-x59, x408, x58 * x406)),
+        );
+        let x416 = Self::mul_add(
+            x390,
+            x395,
+            Self::mul_add(x49, x64, -f_ext[3][2]) + x357
+                + (Self::mul_add(-x57, x404, x56 * x401)
+                    + Self::mul_add(-x59, x409, x58 * x407)),
+        );
+        let x417 = c_q9 * x397;
+        let x418 = Self::mul_add(x47, x397, x46 * x396);
+        let x419 = s_q9 * x397;
+        let x420 = Self::mul_add(c_q9, x396, -x419);
+        let x421 = Self::mul_add(x47, x398, x46 * x397);
+        let x422 = Self::mul_add(-s_q9, x398, x417);
+        let x423 = Self::mul_add(
+            0.00000000020510342851533115,
+            x401,
+            Self::mul_add(c_q9, x400, s_q9 * x399),
+        );
+        let x424 = x401 + Self::mul_add(x47, x400, x46 * x399);
+        let x425 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x401,
+            Self::mul_add(-s_q9, x400, c_q9 * x399),
+        );
+        let x426 = Self::mul_add(
+            0.00000000020510342851533115,
+            x404,
+            Self::mul_add(c_q9, x403, s_q9 * x402),
+        );
+        let x427 = x404 + Self::mul_add(x47, x403, x46 * x402);
+        let x428 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x404,
+            Self::mul_add(-s_q9, x403, c_q9 * x402),
+        );
+        let x429 = Self::mul_add(c_q9, x426, s_q9 * x423);
+        let x430 = Self::mul_add(c_q9, x427, s_q9 * x424);
+        let x431 = Self::mul_add(c_q9, x428, s_q9 * x425);
+        let x432 = Self::mul_add(x47, x426, x46 * x423);
+        let x433 = Self::mul_add(-s_q9, x426, c_q9 * x423);
+        let x434 = c_q9 * x406;
+        let x435 = x407 + Self::mul_add(x47, x406, x46 * x405);
+        let x436 = s_q9 * x406;
+        let x437 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x407,
+            Self::mul_add(c_q9, x405, -x436),
+        );
+        let x438 = x409 + Self::mul_add(x47, x408, x46 * x406);
+        let x439 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x409,
+            Self::mul_add(-s_q9, x408, x434),
+        );
+        let x440 = x410 + Self::mul_add(x47, x409, x46 * x407);
+        let x441 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x410,
+            Self::mul_add(-s_q9, x409, c_q9 * x407),
+        );
+        let x442 = Self::mul_add(
+            c_q9,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x409,
+                Self::mul_add(c_q9, x408, x436),
+            ),
+            s_q9
+                * Self::mul_add(
+                    0.00000000020510342851533115,
+                    x407,
+                    Self::mul_add(s_q9, x405, x434),
+                ),
+        );
+        let x443 = Self::mul_add(
+            0.00000000020510342851533115,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x410,
+                Self::mul_add(c_q9, x409, s_q9 * x407),
+            ),
+            x442,
+        );
+        let x444 = Self::mul_add(
+            0.00000000020510342851533115,
+            x440,
+            Self::mul_add(c_q9, x438, s_q9 * x435),
+        );
+        let x445 = Self::mul_add(
+            0.00000000020510342851533115,
+            x441,
+            Self::mul_add(c_q9, x439, s_q9 * x437),
+        );
+        let x446 = x440 + Self::mul_add(x47, x438, x46 * x435);
+        let x447 = x441 + Self::mul_add(x47, x439, x46 * x437);
+        let x448 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x441,
+            Self::mul_add(-s_q9, x439, c_q9 * x437),
+        );
+        let x449 = x430 + Self::mul_add(0.275, x447, -0.4 * x446);
+        let x450 = x431 + Self::mul_add(0.275, x448, -0.4 * x447);
+        let x451 = Self::mul_add(0.4, x443, x432);
+        let x452 = Self::mul_add(0.4, x444, Self::mul_add(x47, x427, x46 * x424));
+        let x453 = Self::mul_add(0.4, x445, Self::mul_add(x47, x428, x46 * x425));
+        let x454 = Self::mul_add(-0.275, x443, x433);
+        let x455 = Self::mul_add(-0.275, x444, Self::mul_add(-s_q9, x427, c_q9 * x424));
+        let x456 = Self::mul_add(-0.275, x445, Self::mul_add(-s_q9, x428, c_q9 * x425));
+        let x457 = Self::mul_add(
+            0.4,
+            x432,
+            Self::mul_add(0.4, x451, Self::mul_add(x47, x421, x46 * x418)),
+        );
+        let x458 = Self::mul_add(
+            -0.275,
+            x432,
+            Self::mul_add(0.4, x454, Self::mul_add(x47, x422, x46 * x420)),
+        );
+        let x459 = Self::mul_add(
+            -0.275,
+            x433,
+            Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x422, c_q9 * x420)),
+        );
+        let x460 = Self::mul_add(
+            0.00000000020510342851533115,
+            x416,
+            Self::mul_add(c_q9, x415, s_q9 * x414),
+        );
+        let x461 = x416 + Self::mul_add(x47, x415, x46 * x414);
+        let x462 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x416,
+            Self::mul_add(-s_q9, x415, c_q9 * x414),
+        );
+        let x463 = Self::mul_add(
+            -0.275,
+            x460,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x413,
+                Self::mul_add(-s_q9, x412, c_q9 * x411),
+            ),
+        );
+        let x464 = -0.002139996587640933
             + Self::mul_add(
                 -0.275,
-                x466,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x465,
-                    Self::mul_add(-s_q9, x464, c_q9 * x463),
+                x429,
+                Self::mul_add(c_q9, x422, s_q9 * x420)
+                    + Self::mul_add(0.275, x456, -0.4 * x455),
+            );
+        let x465 = 5.080660024070365 + x458;
+        let x466 = 113.3918902508081 + x459;
+        let x467 = 12.701650001451807 + x454;
+        let x468 = -0.000000008530897668050218 + x455;
+        let x469 = Self::mul_add(-x28, x39, x27 * x40)
+            + Self::mul_add(-x31, x43, x32 * x42) - f_ext[2][5] + x463;
+        let x470 = 1.0 / x466;
+        let x471 = tau[1] - x469;
+        let x472 = x464 * x470;
+        let x473 = x465 * x470;
+        let x474 = x467 * x470;
+        let x475 = x468 * x470;
+        let x476 = x456 * x470;
+        let x477 = Self::mul_add(
+            -x464,
+            x472,
+            Self::mul_add(0.275, x431, -0.4 * x430)
+                + (Self::mul_add(
+                    c_q9,
+                    Self::mul_add(c_q9, x398, x419),
+                    s_q9 * Self::mul_add(s_q9, x396, x417),
+                ) + Self::mul_add(0.275, x450, -0.4 * x449)),
+        );
+        let x478 = Self::mul_add(
+            -x464,
+            x473,
+            -0.0000000234896432582596
+                + Self::mul_add(
+                    0.4,
+                    x429,
+                    Self::mul_add(c_q9, x421, s_q9 * x418)
+                        + Self::mul_add(0.275, x453, -0.4 * x452),
                 ),
-            );
-        let x475 = x471 + Self::mul_add(-x3, x470, x2 * x469);
-        let x476 = Self::mul_add(c_q8, x470, s_q8 * x469);
-        let x477 = x475
-            - Self::mul_add(
-                48.0240000085309,
-                Self::mul_add(x316, x316, x317),
-                f_ext[1][0],
-            );
-        let x478 = Self::mul_add(48.0240000085309, x302 * x303, -f_ext[1][1]) + x476;
-        let x479 = Self::mul_add(48.0240000085309, x315 + x318, -f_ext[1][2])
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x471,
-                Self::mul_add(-c_q8, x469, s_q8 * x470),
-            );
-        let x480 = Self::mul_add(0.07309, x315, Self::mul_add(-x316, x320, x303 * x321))
-            - f_ext[1][3]
-            + Self::mul_add(-0.35, x476, x474 + Self::mul_add(-x3, x473, x2 * x472));
-        let x481 = Self::mul_add(
-            x312,
-            -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x315, -0.07309 * x314)
-                + Self::mul_add(-x302, x321, x316 * x319),
-        ) - f_ext[1][4]
-            + Self::mul_add(0.35, x475, Self::mul_add(c_q8, x473, s_q8 * x472));
-        let x482 = Self::mul_add(
-            48.0240000085309,
-            x313,
-            Self::mul_add(-0.1132, x315, -16.80768997608804 * x314)
-                + Self::mul_add(-x303, x319, x302 * x320),
-        ) - f_ext[1][5]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x474,
-                Self::mul_add(-c_q8, x472, s_q8 * x473),
-            );
-        let x483 = Self::mul_add(-s_q7, x478, c_q7 * x477);
-        let x484 = Self::mul_add(c_q7, x478, s_q7 * x477);
-        let x485 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x486 = 1466.4506062283303 * v[4];
-        let x487 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x488 = x483
-            + (Self::mul_add(
-                1170.07,
-                x299,
-                Self::mul_add(-110.5455, x305, 180.9502499901501 * x307),
-            ) - f_ext[0][0]);
-        let x489 = x484
-            + (Self::mul_add(
-                1170.07,
-                x300,
-                Self::mul_add(180.9502499901501, x308, 110.5455 * x306),
-            ) - f_ext[0][1]);
-        let x490 = x479
-            + (Self::mul_add(
-                1170.07,
-                x301,
-                Self::mul_add(-180.9502499901501, x309, 110.5455 * x307),
-            ) - f_ext[0][2]);
-        let x491 = x178 * 0.0008546497218115156;
-        let x492 = x168 * 0.0008546497218115156;
-        let x493 = x183 * 0.0008546497218115156;
-        let x494 = x200 * 0.0008546497218115156;
-        let x495 = x214 * 0.0008546497218115156;
-        let x496 = x233 * 0.0008546497218115156;
-        let x497 = x261 * 0.0008546497218115156;
-        let x498 = x297 * 0.0008546497218115156;
-        let x499 = x177 * 0.0008546497218115156;
-        let x500 = x167 * 0.0008546497218115156;
-        let x501 = x184 * 0.0008546497218115156;
-        let x502 = x201 * 0.0008546497218115156;
-        let x503 = x215 * 0.0008546497218115156;
-        let x504 = x234 * 0.0008546497218115156;
-        let x505 = x262 * 0.0008546497218115156;
-        let x506 = x298 * 0.0008546497218115156;
-        let x507 = x146 * 0.0008546497218115156;
-        let x508 = x196 * 0.0008546497218115156;
-        let x509 = x210 * 0.0008546497218115156;
-        let x510 = x229 * 0.0008546497218115156;
-        let x511 = x257 * 0.0008546497218115156;
-        let x512 = x293 * 0.0008546497218115156;
-        let x513 = x178 * x491;
-        let x514 = x168 * x492;
-        let x515 = 1.0
-            / (1394.5960312283303
-                + (x172 + (Self::mul_add(-s_q7, x170, c_q7 * x169) - x171)) - x513
-                - x514);
-        let x516 = Self::mul_add(
-            x168,
-            x499,
-            Self::mul_add(-0.65, x168, Self::mul_add(c_q7, x170, s_q7 * x169)),
         );
-        let x517 = x515 * x516;
-        let x518 = Self::mul_add(
-            x178,
-            x499,
-            -117.61766249359756 + Self::mul_add(x149, -0.65, x175),
+        let x479 = Self::mul_add(-x465, x473, -111.7548902508081 + x457);
+        let x480 = Self::mul_add(
+            -x464,
+            x474,
+            x429 + Self::mul_add(0.275, x445, -0.4 * x444),
         );
-        let x519 = x515 * x518;
-        let x520 = Self::mul_add(x178, x500, x175);
-        let x521 = x515 * x520;
+        let x481 = Self::mul_add(-x464, x475, x449);
+        let x482 = Self::mul_add(-x464, x476, -12.701650001451807 + x450);
+        let x483 = Self::mul_add(-x465, x474, x451);
+        let x484 = Self::mul_add(-x465, x475, x452);
+        let x485 = Self::mul_add(-x465, x476, 0.000000008530897668050218 + x453);
+        let x486 = Self::mul_add(-x467, x474, x443);
+        let x487 = Self::mul_add(-x467, x475, x444);
+        let x488 = Self::mul_add(-x467, x476, x445);
+        let x489 = Self::mul_add(-x468, x475, x446);
+        let x490 = Self::mul_add(-x468, x476, x447);
+        let x491 = Self::mul_add(-x456, x476, x448);
+        let x492 = Self::mul_add(
+            x471,
+            x472,
+            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
+                - f_ext[2][3]
+                + (Self::mul_add(
+                    0.00000000020510342851533115,
+                    x413,
+                    Self::mul_add(c_q9, x412, s_q9 * x411),
+                ) + Self::mul_add(0.275, x462, -0.4 * x461))
+                + (Self::mul_add(-x35, x478, x34 * x477)
+                    + Self::mul_add(-x37, x481, x36 * x480)),
+        );
+        let x493 = Self::mul_add(
+            x471,
+            x473,
+            Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
+                - f_ext[2][4]
+                + Self::mul_add(0.4, x460, x413 + Self::mul_add(x47, x412, x46 * x411))
+                + (Self::mul_add(-x35, x479, x34 * x478)
+                    + Self::mul_add(-x37, x484, x36 * x483)),
+        );
+        let x494 = Self::mul_add(x471, x466 * x470, x469);
+        let x495 = Self::mul_add(
+            x471,
+            x474,
+            Self::mul_add(-x28, x44, x38 * x43) - f_ext[2][0] + x460
+                + (Self::mul_add(-x35, x483, x34 * x480)
+                    + Self::mul_add(-x37, x487, x36 * x486)),
+        );
+        let x496 = Self::mul_add(
+            x471,
+            x475,
+            Self::mul_add(-x38, x42, x27 * x44) - f_ext[2][1] + x461
+                + (Self::mul_add(-x35, x484, x34 * x481)
+                    + Self::mul_add(-x37, x489, x36 * x487)),
+        );
+        let x497 = Self::mul_add(
+            x471,
+            x476,
+            Self::mul_add(-x27, x43, x28 * x42) - f_ext[2][2] + x462
+                + (Self::mul_add(-x35, x485, x34 * x482)
+                    + Self::mul_add(-x37, x490, x36 * x488)),
+        );
+        let x498 = c_q8 * x478;
+        let x499 = Self::mul_add(s_q8, x477, x498);
+        let x500 = s_q8 * x478;
+        let x501 = Self::mul_add(-c_q8, x477, x500);
+        let x502 = Self::mul_add(c_q8, x479, x500);
+        let x503 = Self::mul_add(s_q8, x479, -x498);
+        let x504 = x482 + Self::mul_add(-x26, x481, x25 * x480);
+        let x505 = Self::mul_add(c_q8, x481, s_q8 * x480);
+        let x506 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x482,
+            Self::mul_add(-c_q8, x480, s_q8 * x481),
+        );
+        let x507 = x485 + Self::mul_add(-x26, x484, x25 * x483);
+        let x508 = Self::mul_add(c_q8, x484, s_q8 * x483);
+        let x509 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x485,
+            Self::mul_add(-c_q8, x483, s_q8 * x484),
+        );
+        let x510 = Self::mul_add(-x26, x507, x25 * x504);
+        let x511 = Self::mul_add(-x26, x508, x25 * x505);
+        let x512 = Self::mul_add(c_q8, x507, s_q8 * x504);
+        let x513 = Self::mul_add(-c_q8, x504, s_q8 * x507);
+        let x514 = Self::mul_add(-c_q8, x505, s_q8 * x508);
+        let x515 = Self::mul_add(-c_q8, x506, s_q8 * x509);
+        let x516 = c_q8 * x487;
+        let x517 = Self::mul_add(s_q8, x486, x516);
+        let x518 = s_q8 * x487;
+        let x519 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x488,
+            Self::mul_add(-c_q8, x486, x518),
+        );
+        let x520 = Self::mul_add(c_q8, x489, x518);
+        let x521 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x490,
+            Self::mul_add(s_q8, x489, -x516),
+        );
         let x522 = Self::mul_add(
-            -x168,
-            x507,
+            -0.00000000020510342851533115,
+            x491,
+            Self::mul_add(-c_q8, x488, s_q8 * x490),
+        );
+        let x523 = x491 + Self::mul_add(-x26, x490, x25 * x488)
+            + Self::mul_add(
+                -x26,
+                x490 + Self::mul_add(-x26, x489, x25 * x487),
+                x25 * (x488 + Self::mul_add(-x26, x487, x25 * x486)),
+            );
+        let x524 = Self::mul_add(c_q8, x490, s_q8 * x488)
+            + Self::mul_add(-x26, x520, x25 * x517);
+        let x525 = x522 + Self::mul_add(-x26, x521, x25 * x519);
+        let x526 = Self::mul_add(c_q8, x520, s_q8 * x517);
+        let x527 = Self::mul_add(c_q8, x521, s_q8 * x519);
+        let x528 = Self::mul_add(-0.35, x526, x511);
+        let x529 = Self::mul_add(0.35, x523, x512);
+        let x530 = Self::mul_add(0.35, x524, Self::mul_add(c_q8, x508, s_q8 * x505));
+        let x531 = Self::mul_add(
+            -0.35,
+            x528,
             Self::mul_add(
-                x178,
-                x501,
-                Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x182, c_q7 * x181)),
+                -x26,
+                Self::mul_add(-x26, x479, x25 * x478),
+                x25 * Self::mul_add(-x26, x478, x25 * x477),
             ),
         );
-        let x523 = x515 * x522;
-        let x524 = Self::mul_add(
-            -x168,
-            x508,
-            Self::mul_add(
-                x178,
-                x502,
-                Self::mul_add(-0.75, x201, Self::mul_add(-s_q7, x199, c_q7 * x198)),
-            ),
-        );
-        let x525 = x515 * x524;
-        let x526 = Self::mul_add(
-            -x168,
-            x509,
-            Self::mul_add(
-                x178,
-                x503,
-                Self::mul_add(-0.75, x215, Self::mul_add(-s_q7, x213, c_q7 * x212)),
-            ),
-        );
-        let x527 = x515 * x526;
-        let x528 = Self::mul_add(
-            -x168,
-            x510,
-            Self::mul_add(
-                x178,
-                x504,
-                Self::mul_add(-0.75, x234, Self::mul_add(-s_q7, x232, c_q7 * x231)),
-            ),
-        );
-        let x529 = x515 * x528;
-        let x530 = Self::mul_add(
-            -x168,
-            x511,
-            Self::mul_add(
-                x178,
-                x505,
-                Self::mul_add(-0.75, x262, Self::mul_add(-s_q7, x260, c_q7 * x259)),
-            ),
-        );
-        let x531 = x515 * x530;
         let x532 = Self::mul_add(
-            -x168,
+            0.35,
+            x510,
+            Self::mul_add(-0.35, x530, Self::mul_add(-x26, x502, x25 * x499)),
+        );
+        let x533 = Self::mul_add(
+            0.35,
             x512,
-            Self::mul_add(
-                x178,
-                x506,
-                Self::mul_add(-0.75, x298, Self::mul_add(-s_q7, x296, c_q7 * x295)),
-            ),
+            Self::mul_add(0.35, x529, Self::mul_add(c_q8, x502, s_q8 * x499)),
         );
-        let x533 = x515 * x532;
-        let x534 = x177 * x499;
-        let x535 = 1.0
-            / Self::mul_add(
-                -x516,
-                x517,
-                1466.4506062283303
-                    + (Self::mul_add(
-                        c_q7,
-                        Self::mul_add(c_q7, x164, s_q7 * x161),
-                        s_q7 * Self::mul_add(c_q7, x163, s_q7 * x159),
-                    ) - (x173 - x172) - (x171 - x174)) - x513 - x534,
+        let x534 = x497 + Self::mul_add(-x26, x496, x25 * x495);
+        let x535 = Self::mul_add(c_q8, x496, s_q8 * x495);
+        let x536 = -16.80768997608804
+            + Self::mul_add(-0.35, x514, Self::mul_add(-x26, x503, x25 * x501));
+        let x537 = 0.1132
+            + Self::mul_add(0.35, x513, Self::mul_add(c_q8, x503, s_q8 * x501));
+        let x538 = 132.47349025763282 + Self::mul_add(-c_q8, x501, s_q8 * x503);
+        let x539 = 48.0240000085309 + x514;
+        let x540 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
+            - f_ext[1][5]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x494,
+                Self::mul_add(-c_q8, x492, s_q8 * x493),
             );
-        let x536 = Self::mul_add(
-            x178,
-            x492,
-            Self::mul_add(-0.75, x168, Self::mul_add(c_q7, x165, s_q7 * x162)),
+        let x541 = 1.0 / x538;
+        let x542 = tau[0] - x540;
+        let x543 = x536 * x541;
+        let x544 = x537 * x541;
+        let x545 = x513 * x541;
+        let x546 = x539 * x541;
+        let x547 = x515 * x541;
+        let x548 = Self::mul_add(-x536, x543, Self::mul_add(-0.35, x511, x531));
+        let x549 = Self::mul_add(-x536, x544, -0.07309 + x532);
+        let x550 = Self::mul_add(-x537, x544, 130.43769025763282 + x533);
+        let x551 = Self::mul_add(-x536, x545, Self::mul_add(-0.35, x524, x510));
+        let x552 = Self::mul_add(-x536, x546, x528);
+        let x553 = Self::mul_add(
+            -x536,
+            x547,
+            Self::mul_add(-0.35, x527, Self::mul_add(-x26, x509, x25 * x506)),
         );
-        let x537 = Self::mul_add(-x516, x519, x536);
-        let x538 = x535 * x537;
-        let x539 = Self::mul_add(-x516, x521, x536);
-        let x540 = x535 * x539;
-        let x541 = Self::mul_add(
-            -x516,
-            x523,
-            Self::mul_add(
-                x177,
-                x507,
-                Self::mul_add(
-                    x178,
-                    x493,
-                    Self::mul_add(c_q7, x182, s_q7 * x181)
-                        + Self::mul_add(-0.75, x183, x146 * -0.65),
-                ),
-            ),
-        );
-        let x542 = x535 * x541;
-        let x543 = Self::mul_add(
-            -x516,
-            x525,
-            Self::mul_add(
-                x177,
-                x508,
-                Self::mul_add(
-                    -x178,
-                    x494,
-                    Self::mul_add(c_q7, x199, s_q7 * x198)
-                        + Self::mul_add(-0.65, x196, 0.75 * x200),
-                ),
-            ),
-        );
-        let x544 = x535 * x543;
-        let x545 = Self::mul_add(
-            -x516,
-            x527,
-            Self::mul_add(
-                x177,
-                x509,
-                Self::mul_add(
-                    -x178,
-                    x495,
-                    Self::mul_add(c_q7, x213, s_q7 * x212)
-                        + Self::mul_add(-0.65, x210, 0.75 * x214),
-                ),
-            ),
-        );
-        let x546 = x535 * x545;
-        let x547 = Self::mul_add(
-            -x516,
-            x529,
-            Self::mul_add(
-                x177,
-                x510,
-                Self::mul_add(
-                    -x178,
-                    x496,
-                    Self::mul_add(c_q7, x232, s_q7 * x231)
-                        + Self::mul_add(-0.65, x229, 0.75 * x233),
-                ),
-            ),
-        );
-        let x548 = x535 * x547;
-        let x549 = Self::mul_add(
-            -x516,
-            x531,
-            Self::mul_add(
-                x177,
-                x511,
-                Self::mul_add(
-                    -x178,
-                    x497,
-                    Self::mul_add(c_q7, x260, s_q7 * x259)
-                        + Self::mul_add(-0.65, x257, 0.75 * x261),
-                ),
-            ),
-        );
-        let x550 = x535 * x549;
-        let x551 = Self::mul_add(
-            -x516,
-            x533,
-            Self::mul_add(
-                x177,
-                x512,
-                Self::mul_add(
-                    -x178,
-                    x498,
-                    Self::mul_add(c_q7, x296, s_q7 * x295)
-                        + Self::mul_add(-0.65, x293, 0.75 * x297),
-                ),
-            ),
-        );
-        let x552 = x535 * x551;
-        let x553 = 1.0
-            / Self::mul_add(
-                -x537,
-                x538,
-                Self::mul_add(-x518, x519, 1271.854575 + (x176 - x173) - x514 - x534),
-            );
-        let x554 = Self::mul_add(
+        let x554 = Self::mul_add(-x537, x545, x529);
+        let x555 = Self::mul_add(-x537, x546, x530);
+        let x556 = Self::mul_add(
             -x537,
-            x540,
-            Self::mul_add(-x518, x521, Self::mul_add(-x177, x500, x176 - x514)),
+            x547,
+            -48.0240000085309
+                + Self::mul_add(0.35, x525, Self::mul_add(c_q8, x509, s_q8 * x506)),
         );
-        let x555 = x553 * x554;
-        let x556 = x168 * x493;
-        let x557 = Self::mul_add(
-            -x537,
-            x542,
+        let x557 = Self::mul_add(-x513, x545, x523);
+        let x558 = Self::mul_add(-x513, x546, x524);
+        let x559 = Self::mul_add(-x513, x547, x525);
+        let x560 = Self::mul_add(-x539, x546, x526);
+        let x561 = Self::mul_add(-x539, x547, x527);
+        let x562 = Self::mul_add(
+            -x515,
+            x547,
             Self::mul_add(
-                -x518,
-                x523,
-                Self::mul_add(-x177, x501, Self::mul_add(0.65, x184, x156) - x556),
+                -0.00000000020510342851533115,
+                x522,
+                Self::mul_add(-c_q8, x519, s_q8 * x521),
             ),
         );
-        let x558 = x553 * x557;
-        let x559 = x168 * x494;
-        let x560 = Self::mul_add(
-            -x537,
-            x544,
-            Self::mul_add(
-                -x518,
-                x525,
-                Self::mul_add(-x177, x502, Self::mul_add(0.65, x201, x197) + x559),
-            ),
-        );
-        let x561 = x553 * x560;
-        let x562 = x168 * x495;
         let x563 = Self::mul_add(
-            -x537,
-            x546,
-            Self::mul_add(
-                -x518,
-                x527,
-                Self::mul_add(-x177, x503, Self::mul_add(0.65, x215, x211) + x562),
-            ),
+            x542,
+            x543,
+            Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
+                - f_ext[1][3]
+                + Self::mul_add(
+                    -0.35,
+                    x535,
+                    x494 + Self::mul_add(-x26, x493, x25 * x492),
+                )
+                + (Self::mul_add(-x15, x549, x14 * x548)
+                    + Self::mul_add(-x17, x552, x16 * x551)),
         );
-        let x564 = x553 * x563;
-        let x565 = x168 * x496;
+        let x564 = Self::mul_add(
+            x542,
+            x544,
+            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19)) - f_ext[1][4]
+                + Self::mul_add(0.35, x534, Self::mul_add(c_q8, x493, s_q8 * x492))
+                + (Self::mul_add(-x15, x550, x14 * x549)
+                    + Self::mul_add(-x17, x555, x16 * x554)),
+        );
+        let x565 = Self::mul_add(
+            x542,
+            x545,
+            Self::mul_add(-x8, x23, x18 * x22) - f_ext[1][0] + x534
+                + (Self::mul_add(-x15, x554, x14 * x551)
+                    + Self::mul_add(-x17, x558, x16 * x557)),
+        );
         let x566 = Self::mul_add(
-            -x537,
-            x548,
-            Self::mul_add(
-                -x518,
-                x529,
-                Self::mul_add(-x177, x504, Self::mul_add(0.65, x234, x230) + x565),
-            ),
+            x542,
+            x546,
+            Self::mul_add(x7, x23, -f_ext[1][1]) + x535
+                + (Self::mul_add(-x15, x555, x14 * x552)
+                    + Self::mul_add(-x17, x560, x16 * x558)),
         );
-        let x567 = x553 * x566;
-        let x568 = x168 * x497;
-        let x569 = Self::mul_add(
-            -x537,
-            x550,
+        let x567 = Self::mul_add(
+            x542,
+            x547,
             Self::mul_add(
-                -x518,
-                x531,
-                Self::mul_add(-x177, x505, Self::mul_add(0.65, x262, x258) + x568),
-            ),
+                -0.00000000020510342851533115,
+                x497,
+                Self::mul_add(-c_q8, x495, s_q8 * x496),
+            ) - Self::mul_add(x7, x22, f_ext[1][2])
+                + (Self::mul_add(-x15, x556, x14 * x553)
+                    + Self::mul_add(-x17, x561, x16 * x559)),
         );
-        let x570 = x553 * x569;
-        let x571 = x168 * x498;
-        let x572 = Self::mul_add(
-            -x537,
-            x552,
-            Self::mul_add(
-                -x518,
-                x533,
-                Self::mul_add(-x177, x506, Self::mul_add(0.65, x298, x294) + x571),
-            ),
-        );
-        let x573 = x553 * x572;
-        let x574 = 1.0
-            / Self::mul_add(
-                -x554,
-                x555,
-                Self::mul_add(
-                    -x539,
-                    x540,
-                    Self::mul_add(-x520, x521, Self::mul_add(-x167, x500, x166 - x514)),
-                ),
-            );
-        let x575 = Self::mul_add(
-            -x554,
-            x558,
-            Self::mul_add(
-                -x539,
-                x542,
-                Self::mul_add(-x520, x523, Self::mul_add(-x167, x501, x156 - x556)),
-            ),
-        );
-        let x576 = x574 * x575;
-        let x577 = Self::mul_add(
-            -x554,
-            x561,
-            Self::mul_add(
-                -x539,
-                x544,
-                Self::mul_add(-x520, x525, Self::mul_add(-x167, x502, x197 + x559)),
-            ),
-        );
-        let x578 = x574 * x577;
-        let x579 = Self::mul_add(
-            -x554,
-            x564,
-            Self::mul_add(
-                -x539,
-                x546,
-                Self::mul_add(-x520, x527, Self::mul_add(-x167, x503, x211 + x562)),
-            ),
-        );
-        let x580 = x574 * x579;
-        let x581 = Self::mul_add(
-            -x554,
-            x567,
-            Self::mul_add(
-                -x539,
-                x548,
-                Self::mul_add(-x520, x529, Self::mul_add(-x167, x504, x230 + x565)),
-            ),
-        );
-        let x582 = x574 * x581;
-        let x583 = Self::mul_add(
-            -x554,
-            x570,
-            Self::mul_add(
-                -x539,
-                x550,
-                Self::mul_add(-x520, x531, Self::mul_add(-x167, x505, x258 + x568)),
-            ),
-        );
-        let x584 = x574 * x583;
-        let x585 = Self::mul_add(
-            -x554,
-            x573,
-            Self::mul_add(
-                -x539,
-                x552,
-                Self::mul_add(-x520, x533, Self::mul_add(-x167, x506, x294 + x571)),
-            ),
-        );
-        let x586 = x574 * x585;
-        let x587 = 1.0
-            / Self::mul_add(
-                -x575,
-                x576,
-                Self::mul_add(
-                    -x557,
-                    x558,
-                    Self::mul_add(
-                        -x541,
-                        x542,
-                        Self::mul_add(
-                            -x522,
-                            x523,
-                            Self::mul_add(
-                                -x146,
-                                x507,
-                                Self::mul_add(-x184, x501, Self::mul_add(-x183, x493, x144)),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+        let x568 = s_q7 * x549;
+        let x569 = c_q7 * x549;
+        let x570 = Self::mul_add(s_q7, x548, x569);
+        let x571 = Self::mul_add(c_q7, x550, x568);
+        let x572 = Self::mul_add(-s_q7, x552, c_q7 * x551);
+        let x573 = Self::mul_add(c_q7, x552, s_q7 * x551);
+        let x574 = Self::mul_add(-s_q7, x555, c_q7 * x554);
+        let x575 = Self::mul_add(c_q7, x555, s_q7 * x554);
+        let x576 = Self::mul_add(-s_q7, x574, c_q7 * x572);
+        let x577 = Self::mul_add(-s_q7, x575, c_q7 * x573);
+        let x578 = Self::mul_add(-s_q7, x556, c_q7 * x553);
+        let x579 = Self::mul_add(c_q7, x574, s_q7 * x572);
+        let x580 = Self::mul_add(c_q7, x575, s_q7 * x573);
+        let x581 = Self::mul_add(c_q7, x556, s_q7 * x553);
+        let x582 = s_q7 * x558;
+        let x583 = c_q7 * x558;
+        let x584 = Self::mul_add(s_q7, x557, x583);
+        let x585 = Self::mul_add(c_q7, x560, x582);
+        let x586 = Self::mul_add(-s_q7, x561, c_q7 * x559);
+        let x587 = Self::mul_add(c_q7, x561, s_q7 * x559);
         let x588 = Self::mul_add(
-            -x575,
-            x578,
-            Self::mul_add(
-                -x557,
-                x561,
-                Self::mul_add(
-                    -x541,
-                    x544,
-                    Self::mul_add(
-                        -x522,
-                        x525,
-                        Self::mul_add(
-                            -x146,
-                            x508,
-                            Self::mul_add(-x184, x502, Self::mul_add(x183, x494, x193)),
-                        ),
-                    ),
-                ),
-            ),
+            -s_q7,
+            Self::mul_add(-s_q7, x560, x583),
+            c_q7 * Self::mul_add(c_q7, x557, -x582),
         );
-        let x589 = x587 * x588;
-        let x590 = Self::mul_add(
-            -x575,
-            x580,
-            Self::mul_add(
-                -x557,
-                x564,
-                Self::mul_add(
-                    -x541,
-                    x546,
-                    Self::mul_add(
-                        -x522,
-                        x527,
-                        Self::mul_add(
-                            -x146,
-                            x509,
-                            Self::mul_add(-x184, x503, Self::mul_add(x183, x495, x207)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x591 = x587 * x590;
-        let x592 = Self::mul_add(
-            -x575,
-            x582,
-            Self::mul_add(
-                -x557,
-                x567,
-                Self::mul_add(
-                    -x541,
-                    x548,
-                    Self::mul_add(
-                        -x522,
-                        x529,
-                        Self::mul_add(
-                            -x146,
-                            x510,
-                            Self::mul_add(-x184, x504, Self::mul_add(x183, x496, x226)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x593 = x587 * x592;
-        let x594 = Self::mul_add(
-            -x575,
-            x584,
-            Self::mul_add(
-                -x557,
-                x570,
-                Self::mul_add(
-                    -x541,
-                    x550,
-                    Self::mul_add(
-                        -x522,
-                        x531,
-                        Self::mul_add(
-                            -x146,
-                            x511,
-                            Self::mul_add(-x184, x505, Self::mul_add(x183, x497, x254)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x595 = x587 * x594;
-        let x596 = Self::mul_add(
-            -x575,
-            x586,
-            Self::mul_add(
-                -x557,
-                x573,
-                Self::mul_add(
-                    -x541,
-                    x552,
-                    Self::mul_add(
-                        -x522,
-                        x533,
-                        Self::mul_add(
-                            -x146,
-                            x512,
-                            Self::mul_add(-x184, x506, Self::mul_add(x183, x498, x290)),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x597 = x587 * x596;
-        let x598 = 1.0
-            / Self::mul_add(
-                -x588,
-                x589,
-                Self::mul_add(
-                    -x577,
-                    x578,
-                    Self::mul_add(
-                        -x560,
-                        x561,
-                        Self::mul_add(
-                            -x543,
-                            x544,
-                            Self::mul_add(
-                                -x524,
-                                x525,
-                                Self::mul_add(
-                                    -x196,
-                                    x508,
-                                    Self::mul_add(-x201, x502, Self::mul_add(-x200, x494, x117)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+        let x589 = Self::mul_add(-s_q7, x585, c_q7 * x584);
+        let x590 = Self::mul_add(c_q7, x585, s_q7 * x584);
+        let x591 = 0.65 * x589;
+        let x592 = 0.65 * x590;
+        let x593 = 0.65 * x587;
+        let x594 = Self::mul_add(-0.75, x589, x576);
+        let x595 = Self::mul_add(-0.75, x590, x577);
+        let x596 = x579 + Self::mul_add(-0.65, x586, 0.75 * x588);
+        let x597 = x580 + Self::mul_add(-0.65, x587, 0.75 * x589);
+        let x598 = x581 + Self::mul_add(-0.65, x562, 0.75 * x586);
         let x599 = Self::mul_add(
-            -x588,
-            x591,
-            Self::mul_add(
-                -x577,
-                x580,
-                Self::mul_add(
-                    -x560,
-                    x564,
-                    Self::mul_add(
-                        -x543,
-                        x546,
-                        Self::mul_add(
-                            -x524,
-                            x527,
-                            Self::mul_add(
-                                -x196,
-                                x509,
-                                Self::mul_add(-x201, x503, Self::mul_add(-x200, x495, x108)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x600 = x598 * x599;
-        let x601 = Self::mul_add(
-            -x588,
-            x593,
-            Self::mul_add(
-                -x577,
-                x582,
-                Self::mul_add(
-                    -x560,
-                    x567,
-                    Self::mul_add(
-                        -x543,
-                        x548,
-                        Self::mul_add(
-                            -x524,
-                            x529,
-                            Self::mul_add(
-                                -x196,
-                                x510,
-                                Self::mul_add(-x201, x504, Self::mul_add(-x200, x496, x220)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x602 = x598 * x601;
-        let x603 = Self::mul_add(
-            -x588,
+            -0.75,
             x595,
             Self::mul_add(
-                -x577,
-                x584,
-                Self::mul_add(
-                    -x560,
-                    x570,
-                    Self::mul_add(
-                        -x543,
-                        x550,
-                        Self::mul_add(
-                            -x524,
-                            x531,
-                            Self::mul_add(
-                                -x196,
-                                x511,
-                                Self::mul_add(-x201, x505, Self::mul_add(-x200, x497, x248)),
-                            ),
-                        ),
-                    ),
-                ),
+                -s_q7,
+                Self::mul_add(-s_q7, x550, x569),
+                c_q7 * Self::mul_add(c_q7, x548, -x568),
             ),
         );
-        let x604 = x598 * x603;
-        let x605 = Self::mul_add(
-            -x588,
-            x597,
-            Self::mul_add(
-                -x577,
-                x586,
-                Self::mul_add(
-                    -x560,
-                    x573,
-                    Self::mul_add(
-                        -x543,
-                        x552,
-                        Self::mul_add(
-                            -x524,
-                            x533,
-                            Self::mul_add(
-                                -x196,
-                                x512,
-                                Self::mul_add(-x201, x506, Self::mul_add(-x200, x498, x284)),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x606 = x598 * x605;
-        let x607 = 1.0
-            / Self::mul_add(
-                -x599,
-                x600,
-                Self::mul_add(
-                    -x590,
-                    x591,
-                    Self::mul_add(
-                        -x579,
-                        x580,
-                        Self::mul_add(
-                            -x563,
-                            x564,
-                            Self::mul_add(
-                                -x545,
-                                x546,
-                                Self::mul_add(
-                                    -x526,
-                                    x527,
-                                    Self::mul_add(
-                                        -x210,
-                                        x509,
-                                        Self::mul_add(-x215, x503, Self::mul_add(-x214, x495, x94)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x608 = Self::mul_add(
-            -x599,
-            x602,
-            Self::mul_add(
-                -x590,
-                x593,
-                Self::mul_add(
-                    -x579,
-                    x582,
-                    Self::mul_add(
-                        -x563,
-                        x567,
-                        Self::mul_add(
-                            -x545,
-                            x548,
-                            Self::mul_add(
-                                -x526,
-                                x529,
-                                Self::mul_add(
-                                    -x210,
-                                    x510,
-                                    Self::mul_add(-x215, x504, Self::mul_add(-x214, x496, x85)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x609 = x607 * x608;
-        let x610 = Self::mul_add(
-            -x599,
-            x604,
-            Self::mul_add(
-                -x590,
-                x595,
-                Self::mul_add(
-                    -x579,
-                    x584,
-                    Self::mul_add(
-                        -x563,
-                        x570,
-                        Self::mul_add(
-                            -x545,
-                            x550,
-                            Self::mul_add(
-                                -x526,
-                                x531,
-                                Self::mul_add(
-                                    -x210,
-                                    x511,
-                                    Self::mul_add(-x215, x505, Self::mul_add(-x214, x497, x243)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x611 = x607 * x610;
-        let x612 = Self::mul_add(
-            -x599,
-            x606,
-            Self::mul_add(
-                -x590,
-                x597,
-                Self::mul_add(
-                    -x579,
-                    x586,
-                    Self::mul_add(
-                        -x563,
-                        x573,
-                        Self::mul_add(
-                            -x545,
-                            x552,
-                            Self::mul_add(
-                                -x526,
-                                x533,
-                                Self::mul_add(
-                                    -x210,
-                                    x512,
-                                    Self::mul_add(-x215, x506, Self::mul_add(-x214, x498, x279)),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x613 = x607 * x612;
-        let x614 = 1.0
-            / Self::mul_add(
-                -x608,
-                x609,
-                Self::mul_add(
-                    -x601,
-                    x602,
-                    Self::mul_add(
-                        -x592,
-                        x593,
-                        Self::mul_add(
-                            -x581,
-                            x582,
-                            Self::mul_add(
-                                -x566,
-                                x567,
-                                Self::mul_add(
-                                    -x547,
-                                    x548,
-                                    Self::mul_add(
-                                        -x528,
-                                        x529,
-                                        Self::mul_add(
-                                            -x229,
-                                            x510,
-                                            Self::mul_add(-x234, x504, Self::mul_add(-x233, x496, x71)),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x615 = Self::mul_add(
-            -x608,
-            x611,
-            Self::mul_add(
-                -x601,
-                x604,
-                Self::mul_add(
-                    -x592,
-                    x595,
-                    Self::mul_add(
-                        -x581,
-                        x584,
-                        Self::mul_add(
-                            -x566,
-                            x570,
-                            Self::mul_add(
-                                -x547,
-                                x550,
-                                Self::mul_add(
-                                    -x528,
-                                    x531,
-                                    Self::mul_add(
-                                        -x229,
-                                        x511,
-                                        Self::mul_add(-x234, x505, Self::mul_add(-x233, x497, x59)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x616 = x614 * x615;
-        let x617 = Self::mul_add(
-            -x608,
-            x613,
-            Self::mul_add(
-                -x601,
-                x606,
-                Self::mul_add(
-                    -x592,
-                    x597,
-                    Self::mul_add(
-                        -x581,
-                        x586,
-                        Self::mul_add(
-                            -x566,
-                            x573,
-                            Self::mul_add(
-                                -x547,
-                                x552,
-                                Self::mul_add(
-                                    -x528,
-                                    x533,
-                                    Self::mul_add(
-                                        -x229,
-                                        x512,
-                                        Self::mul_add(-x234, x506, Self::mul_add(-x233, x498, x272)),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x618 = x614 * x617;
+        let x600 = Self::mul_add(-s_q7, x566, c_q7 * x565);
+        let x601 = Self::mul_add(c_q7, x566, s_q7 * x565);
+        let x602 = 180.9502499901501 + x596;
+        let x603 = Self::mul_add(-v[5], x4, v[4] * x5) - f_ext[0][0] + x600;
+        let x604 = 1.0 / (1170.07 + x588);
+        let x605 = x589 * x604;
+        let x606 = x586 * x604;
+        let x607 = x594 * x604;
+        let x608 = x602 * x604;
+        let x609 = x591 * x604;
+        let x610 = 1.0 / Self::mul_add(-x589, x605, 1170.07 + x590);
+        let x611 = Self::mul_add(-x589, x606, x587);
+        let x612 = x610 * x611;
+        let x613 = Self::mul_add(-x589, x607, -180.9502499901501 + x595);
+        let x614 = x610 * x613;
+        let x615 = Self::mul_add(-x589, x608, x597);
+        let x616 = x610 * x615;
+        let x617 = Self::mul_add(-x589, x609, 110.5455 + x592);
+        let x618 = x610 * x617;
         let x619 = 1.0
-            / Self::mul_add(
-                -x615,
-                x616,
-                Self::mul_add(
-                    -x610,
-                    x611,
-                    Self::mul_add(
-                        -x603,
-                        x604,
-                        Self::mul_add(
-                            -x594,
-                            x595,
-                            Self::mul_add(
-                                -x583,
-                                x584,
-                                Self::mul_add(
-                                    -x569,
-                                    x570,
-                                    Self::mul_add(
-                                        -x549,
-                                        x550,
-                                        Self::mul_add(
-                                            -x530,
-                                            x531,
-                                            Self::mul_add(
-                                                -x257,
-                                                x511,
-                                                Self::mul_add(-x262, x505, Self::mul_add(-x261, x497, x44)),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
+            / Self::mul_add(-x611, x612, Self::mul_add(-x586, x606, 1170.07 + x562));
         let x620 = Self::mul_add(
-            -x615,
-            x618,
-            Self::mul_add(
-                -x610,
-                x613,
-                Self::mul_add(
-                    -x603,
-                    x606,
-                    Self::mul_add(
-                        -x594,
-                        x597,
-                        Self::mul_add(
-                            -x583,
-                            x586,
-                            Self::mul_add(
-                                -x569,
-                                x573,
-                                Self::mul_add(
-                                    -x549,
-                                    x552,
-                                    Self::mul_add(
-                                        -x530,
-                                        x533,
-                                        Self::mul_add(
-                                            -x257,
-                                            x512,
-                                            Self::mul_add(-x262, x506, Self::mul_add(-x261, x498, x268)),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            -x611,
+            x614,
+            Self::mul_add(-x586, x607, Self::mul_add(-0.75, x587, x578)),
         );
         let x621 = x619 * x620;
-        let x622 = 1.0
-            / Self::mul_add(
-                -x620,
-                x621,
-                Self::mul_add(
-                    -x617,
-                    x618,
-                    Self::mul_add(
-                        -x612,
-                        x613,
-                        Self::mul_add(
-                            -x605,
-                            x606,
-                            Self::mul_add(
-                                -x596,
-                                x597,
-                                Self::mul_add(
-                                    -x585,
-                                    x586,
-                                    Self::mul_add(
-                                        -x572,
-                                        x573,
-                                        Self::mul_add(
-                                            -x551,
-                                            x552,
-                                            Self::mul_add(
-                                                -x532,
-                                                x533,
-                                                Self::mul_add(
-                                                    -x293,
-                                                    x512,
-                                                    Self::mul_add(
-                                                        -x298,
-                                                        x506,
-                                                        Self::mul_add(-x297, x498, 1.4135609200000003),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x623 = Self::mul_add(
-            x490,
-            x492,
-            -Self::mul_add(
-                x489,
-                x491,
-                Self::mul_add(-0.75, x484, Self::mul_add(-s_q7, x481, c_q7 * x480))
-                    + (Self::mul_add(
-                        x300,
-                        -180.9502499901501,
-                        Self::mul_add(-v[5], x486, v[4] * x487),
-                    ) - f_ext[0][3]),
-            ),
+        let x622 = Self::mul_add(
+            -x611,
+            x616,
+            Self::mul_add(-x586, x608, -110.5455 + x598),
         );
-        let x624 = Self::mul_add(
-            -x517,
-            x623,
-            Self::mul_add(
-                -x490,
-                x499,
-                Self::mul_add(
-                    x488,
-                    x491,
-                    -(Self::mul_add(c_q7, x481, s_q7 * x480)
-                        + Self::mul_add(-0.65, x479, 0.75 * x483)
-                        + (Self::mul_add(-v[3], x487, v[5] * x485)
-                            + Self::mul_add(x301, -110.5455, 180.9502499901501 * x299)
-                            - f_ext[0][4])),
-                ),
-            ),
-        );
-        let x625 = x488 * x492;
+        let x623 = x619 * x622;
+        let x624 = Self::mul_add(-x611, x618, Self::mul_add(-x586, x609, x593));
+        let x625 = x619 * x624;
         let x626 = Self::mul_add(
-            -x538,
-            x624,
+            -x613,
+            x614,
             Self::mul_add(
-                -x519,
-                x623,
-                Self::mul_add(
-                    x489,
-                    x499,
-                    -(Self::mul_add(0.65, x484, x482)
-                        + (Self::mul_add(
-                            110.5455,
-                            x300,
-                            Self::mul_add(-v[4], x485, v[3] * x486),
-                        ) - f_ext[0][5]) + x625),
-                ),
+                -x594,
+                x607,
+                1394.5960312283303 + Self::mul_add(-0.75, x577, x599),
             ),
         );
-        let x627 = Self::mul_add(
-            -x555,
-            x626,
-            Self::mul_add(
-                -x540,
-                x624,
-                Self::mul_add(
-                    -x521,
-                    x623,
-                    Self::mul_add(x489, x500, tau[0] - x482 - x625),
-                ),
-            ),
-        );
+        let x627 = 1.0 / Self::mul_add(-x620, x621, x626);
         let x628 = Self::mul_add(
-            -x576,
-            x627,
-            Self::mul_add(
-                -x558,
-                x626,
-                Self::mul_add(
-                    -x542,
-                    x624,
-                    Self::mul_add(
-                        -x523,
-                        x623,
-                        Self::mul_add(
-                            x490,
-                            x507,
-                            Self::mul_add(
-                                x489,
-                                x501,
-                                Self::mul_add(-x488, x493, tau[1] - x474),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            -x594,
+            x608,
+            Self::mul_add(-0.65, x578, 0.75 * x576)
+                + Self::mul_add(-0.75, x597, Self::mul_add(-s_q7, x571, c_q7 * x570)),
         );
-        let x629 = Self::mul_add(
-            -x589,
-            x628,
-            Self::mul_add(
-                -x578,
-                x627,
-                Self::mul_add(
-                    -x561,
-                    x626,
-                    Self::mul_add(
-                        -x544,
-                        x624,
-                        Self::mul_add(
-                            -x525,
-                            x623,
-                            Self::mul_add(
-                                x490,
-                                x508,
-                                Self::mul_add(
-                                    x489,
-                                    x502,
-                                    Self::mul_add(x488, x494, tau[2] - x465),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x630 = Self::mul_add(
-            -x600,
-            x629,
-            Self::mul_add(
-                -x591,
-                x628,
-                Self::mul_add(
-                    -x580,
-                    x627,
-                    Self::mul_add(
-                        -x564,
-                        x626,
-                        Self::mul_add(
-                            -x546,
-                            x624,
-                            Self::mul_add(
-                                -x527,
-                                x623,
-                                Self::mul_add(
-                                    x490,
-                                    x509,
-                                    Self::mul_add(
-                                        x489,
-                                        x503,
-                                        Self::mul_add(x488, x495, tau[3] - x458),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
+        let x629 = Self::mul_add(-x620, x623, Self::mul_add(-x613, x616, x628));
+        let x630 = x627 * x629;
         let x631 = Self::mul_add(
-            -x609,
-            x630,
+            -x613,
+            x618,
+            Self::mul_add(
+                -x594,
+                x609,
+                -117.61766249359756 + Self::mul_add(0.65, x577, -0.75 * x592),
+            ),
+        );
+        let x632 = Self::mul_add(-x620, x625, x631);
+        let x633 = x627 * x632;
+        let x634 = Self::mul_add(
+            -x615,
+            x616,
             Self::mul_add(
                 -x602,
-                x629,
-                Self::mul_add(
-                    -x593,
-                    x628,
-                    Self::mul_add(
-                        -x582,
-                        x627,
-                        Self::mul_add(
-                            -x567,
-                            x626,
-                            Self::mul_add(
-                                -x548,
-                                x624,
-                                Self::mul_add(
-                                    -x529,
-                                    x623,
-                                    Self::mul_add(
-                                        x490,
-                                        x510,
-                                        Self::mul_add(
-                                            x489,
-                                            x504,
-                                            Self::mul_add(x488, x496, tau[4] - x450),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                x608,
+                1466.4506062283303
+                    + (Self::mul_add(-0.65, x581, 0.75 * x579)
+                        + (Self::mul_add(c_q7, x571, s_q7 * x570)
+                            + Self::mul_add(-0.65, x598, 0.75 * x596))),
             ),
         );
-        let x632 = Self::mul_add(
-            -x616,
-            x631,
-            Self::mul_add(
-                -x611,
-                x630,
-                Self::mul_add(
-                    -x604,
-                    x629,
-                    Self::mul_add(
-                        -x595,
-                        x628,
-                        Self::mul_add(
-                            -x584,
-                            x627,
-                            Self::mul_add(
-                                -x570,
-                                x626,
-                                Self::mul_add(
-                                    -x550,
-                                    x624,
-                                    Self::mul_add(
-                                        -x531,
-                                        x623,
-                                        Self::mul_add(
-                                            x490,
-                                            x511,
-                                            Self::mul_add(
-                                                x489,
-                                                x505,
-                                                Self::mul_add(x488, x497, tau[5] - x442),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
-        let x633 = x622
-            * Self::mul_add(
-                -x621,
-                x632,
-                Self::mul_add(
-                    -x618,
-                    x631,
-                    Self::mul_add(
-                        -x613,
-                        x630,
-                        Self::mul_add(
-                            -x606,
-                            x629,
-                            Self::mul_add(
-                                -x597,
-                                x628,
-                                Self::mul_add(
-                                    -x586,
-                                    x627,
-                                    Self::mul_add(
-                                        -x573,
-                                        x626,
-                                        Self::mul_add(
-                                            -x552,
-                                            x624,
-                                            Self::mul_add(
-                                                -x533,
-                                                x623,
-                                                Self::mul_add(
-                                                    x490,
-                                                    x512,
-                                                    Self::mul_add(
-                                                        x489,
-                                                        x506,
-                                                        Self::mul_add(x488, x498, tau[6] - x433),
-                                                    ),
-                                                ),
-                                            ),
-                                        ),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            );
-        let x634 = Self::mul_add(-x621, x633, x619 * x632);
-        let x635 = Self::mul_add(-x618, x633, Self::mul_add(-x616, x634, x614 * x631));
+        let x635 = 1.0 / Self::mul_add(-x629, x630, Self::mul_add(-x622, x623, x634));
         let x636 = Self::mul_add(
-            -x613,
-            x633,
-            Self::mul_add(-x611, x634, Self::mul_add(-x609, x635, x607 * x630)),
+            -x602,
+            x609,
+            Self::mul_add(0.65, x580, Self::mul_add(-0.65, x593, 0.75 * x591)),
         );
         let x637 = Self::mul_add(
-            -x606,
+            -x629,
             x633,
-            Self::mul_add(
-                -x604,
-                x634,
-                Self::mul_add(-x602, x635, Self::mul_add(-x600, x636, x598 * x629)),
-            ),
+            Self::mul_add(-x622, x625, Self::mul_add(-x615, x618, x636)),
         );
-        let x638 = Self::mul_add(
-            -x597,
-            x633,
-            Self::mul_add(
-                -x595,
-                x634,
-                Self::mul_add(
-                    -x593,
-                    x635,
-                    Self::mul_add(-x591, x636, Self::mul_add(-x589, x637, x587 * x628)),
-                ),
-            ),
-        );
+        let x638 = x635 * x637;
         let x639 = Self::mul_add(
-            -x586,
-            x633,
-            Self::mul_add(
-                -x584,
-                x634,
-                Self::mul_add(
-                    -x582,
-                    x635,
-                    Self::mul_add(
-                        -x580,
-                        x636,
-                        Self::mul_add(
-                            -x578,
-                            x637,
-                            Self::mul_add(-x576, x638, x574 * x627),
-                        ),
-                    ),
-                ),
-            ),
+            -x617,
+            x618,
+            Self::mul_add(-x591, x609, Self::mul_add(0.65, x592, 1271.854575)),
         );
         let x640 = Self::mul_add(
-            -x573,
-            x633,
-            Self::mul_add(
-                -x570,
-                x634,
-                Self::mul_add(
-                    -x567,
-                    x635,
-                    Self::mul_add(
-                        -x564,
-                        x636,
-                        Self::mul_add(
-                            -x561,
-                            x637,
-                            Self::mul_add(
-                                -x558,
-                                x638,
-                                Self::mul_add(-x555, x639, x553 * x626),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            -x637,
+            x638,
+            Self::mul_add(-x632, x633, Self::mul_add(-x624, x625, x639)),
         );
-        let x641 = Self::mul_add(
-            -x552,
-            x633,
-            Self::mul_add(
-                -x550,
-                x634,
-                Self::mul_add(
-                    -x548,
-                    x635,
-                    Self::mul_add(
-                        -x546,
-                        x636,
-                        Self::mul_add(
-                            -x544,
-                            x637,
-                            Self::mul_add(
-                                -x542,
-                                x638,
-                                Self::mul_add(
-                                    -x540,
-                                    x639,
-                                    Self::mul_add(-x538, x640, x535 * x624),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
-        );
+        let x641 = 1.0 / x640;
         let x642 = Self::mul_add(
-            -x533,
-            x633,
-            Self::mul_add(
-                -x531,
-                x634,
-                Self::mul_add(
-                    -x529,
-                    x635,
-                    Self::mul_add(
-                        -x527,
-                        x636,
-                        Self::mul_add(
-                            -x525,
-                            x637,
-                            Self::mul_add(
-                                -x523,
-                                x638,
-                                Self::mul_add(
-                                    -x521,
-                                    x639,
-                                    Self::mul_add(
-                                        -x519,
-                                        x640,
-                                        Self::mul_add(-x517, x641, x515 * x623),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
-            ),
+            x603,
+            x605,
+            -(Self::mul_add(-v[3], x5, v[5] * x3) - f_ext[0][1] + x601),
         );
         let x643 = Self::mul_add(
-            -x512,
-            x633,
+            -x612,
+            x642,
             Self::mul_add(
-                -x511,
-                x634,
-                Self::mul_add(
-                    -x510,
-                    x635,
-                    Self::mul_add(
-                        -x509,
-                        x636,
-                        Self::mul_add(
-                            -x508,
-                            x637,
-                            Self::mul_add(
-                                -x507,
-                                x638,
-                                Self::mul_add(
-                                    x499,
-                                    x641,
-                                    -Self::mul_add(x492, x642, x490 * 0.0008546497218115156),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                x603,
+                x606,
+                -(Self::mul_add(-v[4], x3, v[3] * x4) - f_ext[0][2] + x567),
             ),
         );
         let x644 = Self::mul_add(
-            -x506,
-            x633,
+            x603,
+            x607,
+            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
+                - f_ext[0][3]
+                + Self::mul_add(-0.75, x601, Self::mul_add(-s_q7, x564, c_q7 * x563))),
+        );
+        let x645 = Self::mul_add(-x621, x643, Self::mul_add(-x614, x642, x644));
+        let x646 = Self::mul_add(
+            -x616,
+            x642,
             Self::mul_add(
-                -x505,
-                x634,
-                Self::mul_add(
-                    -x504,
-                    x635,
-                    Self::mul_add(
-                        -x503,
-                        x636,
-                        Self::mul_add(
-                            -x502,
-                            x637,
-                            Self::mul_add(
-                                -x501,
-                                x638,
-                                Self::mul_add(
-                                    -x500,
-                                    x639,
-                                    Self::mul_add(
-                                        -x499,
-                                        x640,
-                                        Self::mul_add(x489, -0.0008546497218115156, x491 * x642),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                x603,
+                x608,
+                -(Self::mul_add(-v[3], x2, v[5] * x0)
+                    + Self::mul_add(-v[0], x5, v[2] * x3) - f_ext[0][4]
+                    + (Self::mul_add(c_q7, x564, s_q7 * x563)
+                        + Self::mul_add(-0.65, x567, 0.75 * x600))),
             ),
         );
-        let x645 = Self::mul_add(
-            -x498,
-            x633,
+        let x647 = Self::mul_add(-x630, x645, Self::mul_add(-x623, x643, x646));
+        let x648 = Self::mul_add(
+            x603,
+            x609,
+            -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
+                - f_ext[0][5]
+                + Self::mul_add(0.65, x601, Self::mul_add(x542, x538 * x541, x540))),
+        );
+        let x649 = Self::mul_add(
+            -x633,
+            x645,
+            Self::mul_add(-x625, x643, Self::mul_add(-x618, x642, x648)),
+        );
+        let x650 = x641 * Self::mul_add(-x638, x647, x649);
+        let x651 = Self::mul_add(-x638, x650, x635 * x647);
+        let x652 = Self::mul_add(-x633, x650, Self::mul_add(-x630, x651, x627 * x645));
+        let x653 = Self::mul_add(
+            -x625,
+            x650,
+            Self::mul_add(-x623, x651, Self::mul_add(-x621, x652, x619 * x643)),
+        );
+        let x654 = Self::mul_add(
+            -x616,
+            x651,
+            Self::mul_add(-x614, x652, Self::mul_add(-x612, x653, x610 * x642)),
+        );
+        let x655 = Self::mul_add(-x618, x650, x654);
+        let x656 = Self::mul_add(
+            x607,
+            x652,
+            Self::mul_add(x606, x653, Self::mul_add(x605, x655, x603 * x604)),
+        );
+        let x657 = Self::mul_add(x609, x650, Self::mul_add(x608, x651, x656));
+        let x658 = -x657;
+        let x659 = Self::mul_add(-0.75, x651, x657);
+        let x660 = x655 - Self::mul_add(-0.65, x650, 0.75 * x652);
+        let x661 = Self::mul_add(-0.65, x651, x653);
+        let x662 = x14 + Self::mul_add(s_q7, x651, c_q7 * x652);
+        let x663 = Self::mul_add(-s_q7, x652, c_q7 * x651) - x15;
+        let x664 = x16 + Self::mul_add(-c_q7, x659, s_q7 * x660);
+        let x665 = Self::mul_add(c_q7, x660, s_q7 * x659) - x17;
+        let x666 = x541
+            * (x542
+                - (Self::mul_add(x538, x650, Self::mul_add(x537, x663, x536 * x662))
+                    + Self::mul_add(
+                        x515,
+                        x661,
+                        Self::mul_add(x539, x665, x513 * x664),
+                    )));
+        let x667 = x650 + x666;
+        let x668 = Self::mul_add(-0.00000000020510342851533115, x667, x662);
+        let x669 = Self::mul_add(0.35, x663, x664);
+        let x670 = Self::mul_add(-0.35, x662, x665);
+        let x671 = Self::mul_add(-0.00000000020510342851533115, x661, x669);
+        let x672 = x34
+            + Self::mul_add(-c_q8, x667, Self::mul_add(s_q8, x663, x25 * x662));
+        let x673 = Self::mul_add(s_q8, x667, Self::mul_add(-x26, x662, c_q8 * x663))
+            - x35;
+        let x674 = x36
+            + Self::mul_add(-c_q8, x661, Self::mul_add(s_q8, x670, x25 * x669));
+        let x675 = Self::mul_add(s_q8, x661, Self::mul_add(-x26, x669, c_q8 * x670))
+            - x37;
+        let x676 = x470
+            * (x471
+                - (Self::mul_add(x466, x668, Self::mul_add(x465, x673, x464 * x672))
+                    + Self::mul_add(
+                        x456,
+                        x671,
+                        Self::mul_add(x468, x675, x467 * x674),
+                    )));
+        let x677 = x668 + x676;
+        let x678 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x677,
+            Self::mul_add(0.00000000020510342851533115, x672, x673),
+        );
+        let x679 = x674 - Self::mul_add(0.275, x677, -0.4 * x673);
+        let x680 = Self::mul_add(-0.4, x672, x675);
+        let x681 = Self::mul_add(0.275, x672, x671);
+        let x682 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x681,
+            Self::mul_add(0.00000000020510342851533115, x679, x680),
+        );
+        let x683 = x56
+            + Self::mul_add(c_q9, x677, Self::mul_add(x46, x673, s_q9 * x672));
+        let x684 = Self::mul_add(-s_q9, x677, Self::mul_add(x47, x673, c_q9 * x672))
+            - x57;
+        let x685 = x58
+            + Self::mul_add(c_q9, x681, Self::mul_add(x46, x680, s_q9 * x679));
+        let x686 = Self::mul_add(-s_q9, x681, Self::mul_add(x47, x680, c_q9 * x679))
+            - x59;
+        let x687 = x389
+            * (x390
+                - (Self::mul_add(x386, x678, Self::mul_add(x385, x684, x384 * x683))
+                    + Self::mul_add(
+                        x380,
+                        x682,
+                        Self::mul_add(x379, x686, x387 * x685),
+                    )));
+        let x688 = x678 + x687;
+        let x689 = Self::mul_add(0.87, x688, x685);
+        let x690 = Self::mul_add(-0.87, x683, x682);
+        let x691 = x73 + Self::mul_add(s_q10, x684, c_q10 * x683);
+        let x692 = Self::mul_add(-s_q10, x683, c_q10 * x684) - x74;
+        let x693 = x75 + Self::mul_add(s_q10, x686, c_q10 * x689);
+        let x694 = Self::mul_add(-s_q10, x689, c_q10 * x686) - x76;
+        let x695 = x331
+            * (x332
+                - (Self::mul_add(x328, x688, Self::mul_add(x327, x692, x326 * x691))
+                    + Self::mul_add(
+                        x317,
+                        x690,
+                        Self::mul_add(x316, x694, x329 * x693),
+                    )));
+        let x696 = x688 + x695;
+        let x697 = x693 - Self::mul_add(-0.63, x696, 0.275 * x692);
+        let x698 = Self::mul_add(0.275, x691, x694);
+        let x699 = Self::mul_add(-0.63, x691, x690);
+        let x700 = x91 + Self::mul_add(s_q11, x692, c_q11 * x691);
+        let x701 = Self::mul_add(-s_q11, x691, c_q11 * x692) - x92;
+        let x702 = x93 + Self::mul_add(s_q11, x698, c_q11 * x697);
+        let x703 = Self::mul_add(-s_q11, x697, c_q11 * x698) - x94;
+        let x704 = x267
+            * (x268
+                - (Self::mul_add(x264, x696, Self::mul_add(x263, x701, x262 * x700))
+                    + Self::mul_add(
+                        -x241,
+                        x699,
+                        Self::mul_add(-x240, x703, x265 * x702),
+                    )));
+        let x705 = x696 + x704;
+        let x706 = Self::mul_add(-0.00000000020510342851533115, x705, x701);
+        let x707 = Self::mul_add(-0.36, x701, x702);
+        let x708 = Self::mul_add(0.36, x700, x703);
+        let x709 = Self::mul_add(-0.00000000020510342851533115, x699, x708);
+        let x710 = x111
+            + Self::mul_add(-s_q12, x705, Self::mul_add(x102, x701, c_q12 * x700));
+        let x711 = Self::mul_add(-c_q12, x705, Self::mul_add(-s_q12, x700, x103 * x701))
+            - x112;
+        let x712 = x113
+            + Self::mul_add(-s_q12, x699, Self::mul_add(x102, x708, c_q12 * x707));
+        let x713 = Self::mul_add(-c_q12, x699, Self::mul_add(-s_q12, x707, x103 * x708))
+            - x114;
+        let x714 = x196
+            * (x197
+                - (Self::mul_add(x192, x706, Self::mul_add(x191, x711, x190 * x710))
+                    + Self::mul_add(
+                        -x182,
+                        x709,
+                        Self::mul_add(x194, x713, x193 * x712),
+                    )));
+        let x715 = x706 + x714;
+        let x716 = Self::mul_add(
+            -c_q13,
+            Self::mul_add(0.55, x710, x709),
             Self::mul_add(
-                -x497,
-                x634,
-                Self::mul_add(
-                    -x496,
-                    x635,
-                    Self::mul_add(
-                        -x495,
-                        x636,
-                        Self::mul_add(
-                            -x494,
-                            x637,
-                            Self::mul_add(
-                                x493,
-                                x638,
-                                Self::mul_add(
-                                    x492,
-                                    x639,
-                                    Self::mul_add(
-                                        x492,
-                                        x640,
-                                        -Self::mul_add(x491, x641, x488 * 0.0008546497218115156),
-                                    ),
-                                ),
-                            ),
-                        ),
-                    ),
-                ),
+                s_q13,
+                Self::mul_add(-0.16, x710, x713),
+                x123 * (x712 - Self::mul_add(0.55, x715, -0.16 * x711)),
             ),
         );
-        [x645, x644, x643, x642, x641, x640, x639, x638, x637, x636, x635, x634, x633]
+        let x717 = Self::mul_add(
+            -0.9614610000000001,
+            Self::mul_add(s_q13, x715, Self::mul_add(-x124, x710, c_q13 * x711)) - x134,
+            -0.0145
+                * (x133
+                    + Self::mul_add(
+                        -c_q13,
+                        x715,
+                        Self::mul_add(s_q13, x711, x123 * x710),
+                    )),
+        );
+        let x718 = Self::mul_add(
+            -4.806620000000001,
+            x135 + x716,
+            Self::mul_add(
+                1.4135609200000003,
+                Self::mul_add(-0.00000000020510342851533115, x715, x710),
+                x717,
+            ),
+        );
+        let x719 = 0.707433253035886 * (x144 - x718);
+        [x658, x655, x653, x652, x651, x650, x666, x676, x687, x695, x704, x714, x719]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
-    /// : 356 mul, 285 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 223 fused where the target has FMA.
+    /// : 354 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 221 fused where the target has FMA.
     #[must_use]
     pub fn momentum(q: &[f64; 14], v: &[f64; 13]) -> [f64; 6] {
         let x0 = q[6] * 2.0;
@@ -9400,258 +7499,74 @@ impl FreeFloating7 {
         let x36 = Self::mul_add(-0.00000000020510342851533115, x24, x32);
         let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x26, x20);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x39 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x40 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
-        let x41 = Self::mul_add(
+        let x39 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             0.00000000020510342851533115 * c_q9,
         );
-        let x42 = Self::mul_add(
+        let x40 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x43 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x41, x30 * x39));
-        let x44 = Self::mul_add(-x37, s_q9, Self::mul_add(x31, x42, x30 * x40));
-        let x45 = x34 - Self::mul_add(0.275, x37, x31 * -0.4);
-        let x46 = Self::mul_add(-0.4, x30, x35);
-        let x47 = Self::mul_add(0.275, x30, x36);
-        let x48 = Self::mul_add(c_q9, x47, Self::mul_add(x41, x46, x39 * x45));
-        let x49 = Self::mul_add(-s_q9, x47, Self::mul_add(x42, x46, x40 * x45));
-        let x50 = Self::mul_add(
+        let x41 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x39, x30 * s_q9));
+        let x42 = Self::mul_add(-x37, s_q9, Self::mul_add(x31, x40, x30 * c_q9));
+        let x43 = x34 - Self::mul_add(0.275, x37, x31 * -0.4);
+        let x44 = Self::mul_add(-0.4, x30, x35);
+        let x45 = Self::mul_add(0.275, x30, x36);
+        let x46 = Self::mul_add(c_q9, x45, Self::mul_add(x39, x44, s_q9 * x43));
+        let x47 = Self::mul_add(-s_q9, x45, Self::mul_add(x40, x44, c_q9 * x43));
+        let x48 = Self::mul_add(
             -0.00000000020510342851533115,
-            x47,
-            Self::mul_add(0.00000000020510342851533115, x45, x46),
+            x45,
+            Self::mul_add(0.00000000020510342851533115, x43, x44),
         );
-        let x51 = v[8]
+        let x49 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
                 Self::mul_add(0.00000000020510342851533115, x30, x31),
             );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x53 = Self::mul_add(x44, s_q10, x43 * c_q10);
-        let x54 = Self::mul_add(-x43, s_q10, x44 * c_q10);
-        let x55 = Self::mul_add(0.87, x51, x48);
-        let x56 = Self::mul_add(x43, -0.87, x50);
-        let x57 = Self::mul_add(x49, s_q10, c_q10 * x55);
-        let x58 = v[9] + x51;
+        let x51 = Self::mul_add(x42, s_q10, x41 * c_q10);
+        let x52 = Self::mul_add(-x41, s_q10, x42 * c_q10);
+        let x53 = Self::mul_add(0.87, x49, x46);
+        let x54 = Self::mul_add(x41, -0.87, x48);
+        let x55 = Self::mul_add(x47, s_q10, c_q10 * x53);
+        let x56 = v[9] + x49;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x60 = Self::mul_add(x54, s_q11, x53 * c_q11);
-        let x61 = Self::mul_add(-x53, s_q11, x54 * c_q11);
-        let x62 = x57 - Self::mul_add(-0.63, x58, 0.275 * x54);
-        let x63 = Self::mul_add(0.275, x53, Self::mul_add(-s_q10, x55, x49 * c_q10));
-        let x64 = Self::mul_add(x53, -0.63, x56);
-        let x65 = Self::mul_add(s_q11, x63, c_q11 * x62);
-        let x66 = v[10] + x58;
+        let x58 = Self::mul_add(x52, s_q11, x51 * c_q11);
+        let x59 = Self::mul_add(-x51, s_q11, x52 * c_q11);
+        let x60 = x55 - Self::mul_add(-0.63, x56, 0.275 * x52);
+        let x61 = Self::mul_add(0.275, x51, Self::mul_add(-s_q10, x53, x47 * c_q10));
+        let x62 = Self::mul_add(x51, -0.63, x54);
+        let x63 = Self::mul_add(s_q11, x61, c_q11 * x60);
+        let x64 = v[10] + x56;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x68 = -0.00000000020510342851533115 * s_q12;
-        let x69 = -0.00000000020510342851533115 * c_q12;
-        let x70 = Self::mul_add(-x66, s_q12, Self::mul_add(x61, x68, x60 * c_q12));
-        let x71 = Self::mul_add(-x66, c_q12, Self::mul_add(-x60, s_q12, x61 * x69));
-        let x72 = Self::mul_add(x61, -0.36, x65);
-        let x73 = Self::mul_add(0.36, x60, Self::mul_add(-s_q11, x62, c_q11 * x63));
-        let x74 = Self::mul_add(-x64, s_q12, Self::mul_add(x68, x73, c_q12 * x72));
-        let x75 = Self::mul_add(-x64, c_q12, Self::mul_add(-s_q12, x72, x69 * x73));
-        let x76 = Self::mul_add(-0.00000000020510342851533115, x64, x73);
-        let x77 = v[11] + Self::mul_add(-0.00000000020510342851533115, x66, x61);
+        let x66 = -0.00000000020510342851533115 * s_q12;
+        let x67 = -0.00000000020510342851533115 * c_q12;
+        let x68 = Self::mul_add(-x64, s_q12, Self::mul_add(x59, x66, x58 * c_q12));
+        let x69 = Self::mul_add(-x64, c_q12, Self::mul_add(-x58, s_q12, x59 * x67));
+        let x70 = Self::mul_add(x59, -0.36, x63);
+        let x71 = Self::mul_add(0.36, x58, Self::mul_add(-s_q11, x60, c_q11 * x61));
+        let x72 = Self::mul_add(-x62, s_q12, Self::mul_add(x66, x71, c_q12 * x70));
+        let x73 = Self::mul_add(-x62, c_q12, Self::mul_add(-s_q12, x70, x67 * x71));
+        let x74 = Self::mul_add(-0.00000000020510342851533115, x62, x71);
+        let x75 = v[11] + Self::mul_add(-0.00000000020510342851533115, x64, x59);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x79 = -0.00000000020510342851533115 * c_q13;
-        let x80 = -0.00000000020510342851533115 * s_q13;
-        let x81 = Self::mul_add(-x77, c_q13, Self::mul_add(x71, s_q13, x70 * x79));
-        let x82 = Self::mul_add(x77, s_q13, Self::mul_add(-x70, x80, x71 * c_q13));
-        let x83 = x74 - Self::mul_add(0.55, x77, -0.16 * x71);
-        let x84 = Self::mul_add(x70, 0.55, x76);
-        let x85 = v[12] + Self::mul_add(-0.00000000020510342851533115, x77, x70);
-        let x86 = Self::mul_add(
-            -0.9614610000000001,
-            x85,
-            Self::mul_add(-1.2025609200000003, x82, 0.000781 * x81),
+        let x77 = -0.00000000020510342851533115 * c_q13;
+        let x78 = -0.00000000020510342851533115 * s_q13;
+        let x79 = Self::mul_add(-x75, c_q13, Self::mul_add(x69, s_q13, x68 * x77));
+        let x80 = Self::mul_add(x75, s_q13, Self::mul_add(-x68, x78, x69 * c_q13));
+        let x81 = x72 - Self::mul_add(0.55, x75, -0.16 * x69);
+        let x82 = Self::mul_add(x68, 0.55, x74);
+        let x83 = Self::mul_add(
+            -c_q13,
+            x82,
+            Self::mul_add(s_q13, Self::mul_add(-0.16, x68, x73), x77 * x81),
         );
-        let x87 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x84, x83),
-            Self::mul_add(-0.0145, x85, 0.000781 * x82),
-        );
-        let x88 = Self::mul_add(
-            Self::mul_add(
-                -c_q13,
-                x84,
-                Self::mul_add(s_q13, Self::mul_add(-0.16, x70, x75), x79 * x83),
-            ),
-            -4.806620000000001,
-            Self::mul_add(
-                1.4135609200000003,
-                x85,
-                Self::mul_add(-0.9614610000000001, x82, -0.0145 * x81),
-            ),
-        );
-        let x89 = 4.806620000000001 * x85;
-        let x90 = x81 * -4.806620000000001;
-        let x91 = Self::mul_add(x79, x89, x90);
-        let x92 = s_q13 * x89;
-        let x93 = Self::mul_add(0.00000000020510342851533115, x90, c_q13 * x89);
-        let x94 = Self::mul_add(
-            17.135250000000003,
-            x76,
-            Self::mul_add(-0.809539999555672, x77, -1.9877000000000002 * x71),
-        )
-            + (x88 + Self::mul_add(-x80, x86, x79 * x87)
-                + Self::mul_add(0.16, x92, 0.55 * x93));
-        let x95 = Self::mul_add(
-            x76,
-            -3.6140000000000003,
-            Self::mul_add(
-                -2.741639999592316,
-                x77,
-                Self::mul_add(-5.252920330000002, x71, -1.9877000000000002 * x70),
-            ),
-        ) + Self::mul_add(-0.16, x91, Self::mul_add(c_q13, x86, s_q13 * x87));
-        let x96 = Self::mul_add(
-            9.740442170000001,
-            x77,
-            Self::mul_add(-2.7416399995923166, x71, -0.809539999555672 * x70),
-        ) + Self::mul_add(3.6140000000000003, x75, x74 * -17.135250000000003)
-            + Self::mul_add(
-                0.55,
-                x91,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x88,
-                    Self::mul_add(-c_q13, x87, s_q13 * x86),
-                ),
-            );
-        let x97 = Self::mul_add(17.135250000000003, x77, x91);
-        let x98 = Self::mul_add(x77, -3.6140000000000003, x92);
-        let x99 = x93
-            - Self::mul_add(3.6140000000000003, x71, x70 * -17.135250000000003);
-        let x100 = Self::mul_add(-c_q12, x97, s_q12 * x98);
-        let x101 = x99 - Self::mul_add(x69, x98, x68 * x97);
-        let x102 = Self::mul_add(7.078399999258757, x64, 0.01675 * x66)
-            + Self::mul_add(0.36, x101, Self::mul_add(-s_q12, x95, c_q12 * x94));
-        let x103 = Self::mul_add(2.5482240016099564, x66, -9.142025249762803 * x61)
-            + Self::mul_add(-0.36, x100, x96 + Self::mul_add(x69, x95, x68 * x94));
-        let x104 = Self::mul_add(-7.078399999258757, x66, x100);
-        let x105 = Self::mul_add(
-            x60,
-            7.078399999258757,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x99,
-                Self::mul_add(c_q12, x98, s_q12 * x97),
-            ),
-        );
-        let x106 = Self::mul_add(-s_q11, x101, c_q11 * x104);
-        let x107 = Self::mul_add(c_q11, x101, s_q11 * x104);
-        let x108 = Self::mul_add(-45.1584, x56, -0.6328 * x58)
-            + (Self::mul_add(-s_q11, x103, c_q11 * x102)
-                + Self::mul_add(-0.63, x105, 0.275 * x107));
-        let x109 = Self::mul_add(-24.35164200091464, x58, -24.4950615 * x54)
-            + Self::mul_add(-0.275, x106, Self::mul_add(c_q11, x103, s_q11 * x102));
-        let x110 = Self::mul_add(45.1584, x58, x106);
-        let x111 = Self::mul_add(x53, -45.1584, x105);
-        let x112 = Self::mul_add(-s_q10, x107, c_q10 * x110);
-        let x113 = Self::mul_add(c_q10, x107, s_q10 * x110);
-        let x114 = Self::mul_add(-81.53205, x50, -0.00214 * x51)
-            + Self::mul_add(-0.87, x111, Self::mul_add(-s_q10, x109, c_q10 * x108));
-        let x115 = Self::mul_add(-36.18604050126307, x51, -63.36336825000001 * x44)
-            + Self::mul_add(c_q10, x109, s_q10 * x108);
-        let x116 = Self::mul_add(
-            x48,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x51,
-                Self::mul_add(-36.18604050126307, x44, -0.00214 * x43),
-            ),
-        )
-            + Self::mul_add(
-                0.87,
-                x112,
-                Self::mul_add(
-                    x57,
-                    45.1584,
-                    Self::mul_add(
-                        28.2393615,
-                        x58,
-                        Self::mul_add(-24.351642000914637, x54, -0.6328 * x53),
-                    ),
-                )
-                    + Self::mul_add(
-                        0.63,
-                        x106,
-                        Self::mul_add(
-                            x65,
-                            -7.078399999258757,
-                            Self::mul_add(
-                                9.223235249762805,
-                                x66,
-                                Self::mul_add(2.5482240016099564, x61, 0.01675 * x60),
-                            ),
-                        )
-                            + Self::mul_add(
-                                -0.00000000020510342851533115,
-                                x96,
-                                -Self::mul_add(c_q12, x95, s_q12 * x94),
-                            ),
-                    ),
-            );
-        let x117 = Self::mul_add(81.53205, x51, x112);
-        let x118 = Self::mul_add(x43, -81.53205, x111);
-        let x119 = Self::mul_add(
-            0.00000000020510342851533115,
-            x118,
-            Self::mul_add(x40, x113, x39 * x117),
-        );
-        let x120 = x118 + Self::mul_add(x42, x113, x41 * x117);
-        let x121 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x118,
-            Self::mul_add(-s_q9, x113, c_q9 * x117),
-        );
-        let x122 = Self::mul_add(
-            -12.701650001451807,
-            x36,
-            Self::mul_add(-0.0021399965876409276, x37, -0.0000000234896432582596 * x31),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x116,
-                Self::mul_add(x40, x115, x39 * x114),
-            ) + Self::mul_add(0.275, x121, -0.4 * x120));
-        let x123 = Self::mul_add(
-            x36,
-            0.000000008530897668050218,
-            Self::mul_add(
-                5.080660024070365,
-                x37,
-                Self::mul_add(-111.7548902508081, x31, -0.0000000234896432582596 * x30),
-            ),
-        ) + Self::mul_add(0.4, x119, x116 + Self::mul_add(x42, x115, x41 * x114));
-        let x124 = Self::mul_add(
-            113.3918902508081,
-            x37,
-            Self::mul_add(5.080660024070366, x31, -0.0021399965876409276 * x30),
-        ) + Self::mul_add(-0.000000008530897668050218, x35, x34 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x119,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x116,
-                    Self::mul_add(-s_q9, x115, c_q9 * x114),
-                ),
-            );
-        let x125 = Self::mul_add(12.701650001451807, x37, x119);
-        let x126 = Self::mul_add(x37, -0.000000008530897668050218, x120);
-        let x127 = x121
-            - Self::mul_add(-0.000000008530897668050218, x31, x30 * 12.701650001451807);
-        let x128 = x127 + Self::mul_add(-x29, x126, x28 * x125);
-        let x129 = Self::mul_add(c_q8, x126, s_q8 * x125);
-        let x130 = Self::mul_add(-16.80768997608804, x26, -0.07309 * x21)
-            + Self::mul_add(-0.35, x129, x124 + Self::mul_add(-x29, x123, x28 * x122));
-        let x131 = Self::mul_add(
+        let x84 = v[12] + Self::mul_add(-0.00000000020510342851533115, x75, x68);
+        let x85 = Self::mul_add(
             x24,
             -48.0240000085309,
             Self::mul_add(
@@ -9659,75 +7574,264 @@ impl FreeFloating7 {
                 x26,
                 Self::mul_add(130.43769025763282, x21, -0.07309 * x20),
             ),
-        ) + Self::mul_add(0.35, x128, Self::mul_add(c_q8, x123, s_q8 * x122));
-        let x132 = Self::mul_add(x26, 48.0240000085309, x129);
+        );
+        let x86 = Self::mul_add(
+            48.0240000085309,
+            x25,
+            Self::mul_add(
+                132.47349025763282,
+                x26,
+                Self::mul_add(0.1132, x21, -16.80768997608804 * x20),
+            ),
+        );
+        let x87 = Self::mul_add(
+            x36,
+            0.000000008530897668050218,
+            Self::mul_add(
+                5.080660024070365,
+                x37,
+                Self::mul_add(-111.7548902508081, x31, -0.0000000234896432582596 * x30),
+            ),
+        );
+        let x88 = Self::mul_add(
+            x46,
+            81.53205,
+            Self::mul_add(
+                69.99836825,
+                x49,
+                Self::mul_add(-36.18604050126307, x42, -0.00214 * x41),
+            ),
+        );
+        let x89 = Self::mul_add(
+            x55,
+            45.1584,
+            Self::mul_add(
+                28.2393615,
+                x56,
+                Self::mul_add(-24.351642000914637, x52, -0.6328 * x51),
+            ),
+        );
+        let x90 = Self::mul_add(
+            x63,
+            -7.078399999258757,
+            Self::mul_add(
+                9.223235249762805,
+                x64,
+                Self::mul_add(2.5482240016099564, x59, 0.01675 * x58),
+            ),
+        );
+        let x91 = Self::mul_add(
+            x74,
+            -3.6140000000000003,
+            Self::mul_add(
+                -2.741639999592316,
+                x75,
+                Self::mul_add(-5.252920330000002, x69, -1.9877000000000002 * x68),
+            ),
+        );
+        let x92 = Self::mul_add(
+            -0.9614610000000001,
+            x84,
+            Self::mul_add(-1.2025609200000003, x80, 0.000781 * x79),
+        );
+        let x93 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x82, x81),
+            Self::mul_add(-0.0145, x84, 0.000781 * x80),
+        );
+        let x94 = Self::mul_add(
+            x83,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x84,
+                Self::mul_add(-0.9614610000000001, x80, -0.0145 * x79),
+            ),
+        );
+        let x95 = 4.806620000000001 * x84;
+        let x96 = x79 * -4.806620000000001;
+        let x97 = Self::mul_add(x77, x95, x96);
+        let x98 = s_q13 * x95;
+        let x99 = Self::mul_add(0.00000000020510342851533115, x96, c_q13 * x95);
+        let x100 = Self::mul_add(
+            0.55,
+            x97,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x94,
+                Self::mul_add(-c_q13, x93, s_q13 * x92),
+            ),
+        );
+        let x101 = Self::mul_add(
+            17.135250000000003,
+            x74,
+            Self::mul_add(-0.809539999555672, x75, -1.9877000000000002 * x69),
+        )
+            + (x94 + Self::mul_add(-x78, x92, x77 * x93)
+                + Self::mul_add(0.16, x98, 0.55 * x99));
+        let x102 = x91
+            + Self::mul_add(-0.16, x97, Self::mul_add(c_q13, x92, s_q13 * x93));
+        let x103 = Self::mul_add(
+            9.740442170000001,
+            x75,
+            Self::mul_add(-2.7416399995923166, x69, -0.809539999555672 * x68),
+        ) + Self::mul_add(3.6140000000000003, x73, x72 * -17.135250000000003) + x100;
+        let x104 = Self::mul_add(17.135250000000003, x75, x97);
+        let x105 = Self::mul_add(x75, -3.6140000000000003, x98);
+        let x106 = x99
+            - Self::mul_add(3.6140000000000003, x69, x68 * -17.135250000000003);
+        let x107 = Self::mul_add(-c_q12, x104, s_q12 * x105);
+        let x108 = x106 - Self::mul_add(x67, x105, x66 * x104);
+        let x109 = Self::mul_add(7.078399999258757, x62, 0.01675 * x64)
+            + Self::mul_add(0.36, x108, Self::mul_add(-s_q12, x102, c_q12 * x101));
+        let x110 = Self::mul_add(2.5482240016099564, x64, -9.142025249762803 * x59)
+            + Self::mul_add(-0.36, x107, x103 + Self::mul_add(x67, x102, x66 * x101));
+        let x111 = Self::mul_add(-7.078399999258757, x64, x107);
+        let x112 = Self::mul_add(
+            x58,
+            7.078399999258757,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x106,
+                Self::mul_add(c_q12, x105, s_q12 * x104),
+            ),
+        );
+        let x113 = Self::mul_add(-s_q11, x108, c_q11 * x111);
+        let x114 = Self::mul_add(c_q11, x108, s_q11 * x111);
+        let x115 = Self::mul_add(
+            0.63,
+            x113,
+            x90
+                + Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x103,
+                    -Self::mul_add(c_q12, x102, s_q12 * x101),
+                ),
+        );
+        let x116 = Self::mul_add(-45.1584, x54, -0.6328 * x56)
+            + (Self::mul_add(-s_q11, x110, c_q11 * x109)
+                + Self::mul_add(-0.63, x112, 0.275 * x114));
+        let x117 = Self::mul_add(-24.35164200091464, x56, -24.4950615 * x52)
+            + Self::mul_add(-0.275, x113, Self::mul_add(c_q11, x110, s_q11 * x109));
+        let x118 = Self::mul_add(45.1584, x56, x113);
+        let x119 = Self::mul_add(x51, -45.1584, x112);
+        let x120 = Self::mul_add(-s_q10, x114, c_q10 * x118);
+        let x121 = Self::mul_add(c_q10, x114, s_q10 * x118);
+        let x122 = Self::mul_add(-81.53205, x48, -0.00214 * x49)
+            + Self::mul_add(-0.87, x119, Self::mul_add(-s_q10, x117, c_q10 * x116));
+        let x123 = Self::mul_add(-36.18604050126307, x49, -63.36336825000001 * x42)
+            + Self::mul_add(c_q10, x117, s_q10 * x116);
+        let x124 = x88 + Self::mul_add(0.87, x120, x89 + x115);
+        let x125 = Self::mul_add(81.53205, x49, x120);
+        let x126 = Self::mul_add(x41, -81.53205, x119);
+        let x127 = Self::mul_add(
+            0.00000000020510342851533115,
+            x126,
+            Self::mul_add(c_q9, x121, s_q9 * x125),
+        );
+        let x128 = x126 + Self::mul_add(x40, x121, x39 * x125);
+        let x129 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x126,
+            Self::mul_add(-s_q9, x121, c_q9 * x125),
+        );
+        let x130 = Self::mul_add(
+            -0.275,
+            x127,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x124,
+                Self::mul_add(-s_q9, x123, c_q9 * x122),
+            ),
+        );
+        let x131 = Self::mul_add(
+            -12.701650001451807,
+            x36,
+            Self::mul_add(-0.002139996587640933, x37, -0.0000000234896432582596 * x31),
+        )
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x124,
+                Self::mul_add(c_q9, x123, s_q9 * x122),
+            ) + Self::mul_add(0.275, x129, -0.4 * x128));
+        let x132 = x87
+            + Self::mul_add(0.4, x127, x124 + Self::mul_add(x40, x123, x39 * x122));
         let x133 = Self::mul_add(
+            113.3918902508081,
+            x37,
+            Self::mul_add(5.080660024070366, x31, -0.002139996587640933 * x30),
+        ) + Self::mul_add(-0.000000008530897668050218, x35, x34 * 12.701650001451807)
+            + x130;
+        let x134 = Self::mul_add(12.701650001451807, x37, x127);
+        let x135 = Self::mul_add(x37, -0.000000008530897668050218, x128);
+        let x136 = x129
+            - Self::mul_add(-0.000000008530897668050218, x31, x30 * 12.701650001451807);
+        let x137 = x136 + Self::mul_add(-x29, x135, x28 * x134);
+        let x138 = Self::mul_add(c_q8, x135, s_q8 * x134);
+        let x139 = Self::mul_add(-16.80768997608804, x26, -0.07309 * x21)
+            + Self::mul_add(-0.35, x138, x133 + Self::mul_add(-x29, x132, x28 * x131));
+        let x140 = x85
+            + Self::mul_add(0.35, x137, Self::mul_add(c_q8, x132, s_q8 * x131));
+        let x141 = Self::mul_add(x26, 48.0240000085309, x138);
+        let x142 = Self::mul_add(
             -48.0240000085309,
             x21,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x127,
-                Self::mul_add(-c_q8, x125, s_q8 * x126),
+                x136,
+                Self::mul_add(-c_q8, x134, s_q8 * x135),
             ),
         );
-        let x134 = Self::mul_add(-s_q7, x132, c_q7 * x128);
-        let x135 = Self::mul_add(c_q7, x132, s_q7 * x128);
-        let x136 = Self::mul_add(
+        let x143 = Self::mul_add(-s_q7, x141, c_q7 * x137);
+        let x144 = Self::mul_add(c_q7, x141, s_q7 * x137);
+        let x145 = Self::mul_add(
+            0.65,
+            x144,
+            x86
+                + Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x133,
+                    Self::mul_add(-c_q8, x131, s_q8 * x132),
+                ),
+        );
+        let x146 = Self::mul_add(
             v[1],
             -180.9502499901501,
             Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
-        ) + Self::mul_add(-0.75, x135, Self::mul_add(-s_q7, x131, c_q7 * x130));
-        let x137 = Self::mul_add(
+        ) + Self::mul_add(-0.75, x144, Self::mul_add(-s_q7, x140, c_q7 * x139));
+        let x147 = Self::mul_add(
             1466.4506062283303,
             v[4],
             Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
         )
-            + (Self::mul_add(c_q7, x131, s_q7 * x130)
-                + Self::mul_add(-0.65, x133, 0.75 * x134));
-        let x138 = Self::mul_add(
+            + (Self::mul_add(c_q7, x140, s_q7 * x139)
+                + Self::mul_add(-0.65, x142, 0.75 * x143));
+        let x148 = Self::mul_add(
             110.5455,
             v[1],
             Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
-        )
-            + Self::mul_add(
-                0.65,
-                x135,
-                Self::mul_add(
-                    48.0240000085309,
-                    x25,
-                    Self::mul_add(
-                        132.47349025763282,
-                        x26,
-                        Self::mul_add(0.1132, x21, -16.80768997608804 * x20),
-                    ),
-                )
-                    + Self::mul_add(
-                        -0.00000000020510342851533115,
-                        x124,
-                        Self::mul_add(-c_q8, x122, s_q8 * x123),
-                    ),
-            );
-        let x139 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]) + x134;
-        let x140 = Self::mul_add(
+        ) + x145;
+        let x149 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]) + x143;
+        let x150 = Self::mul_add(
             1170.07,
             v[1],
             -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
-        ) + x135;
-        let x141 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x133;
-        let x142 = Self::mul_add(x12, x141, Self::mul_add(x11, x140, x10 * x139));
-        let x143 = Self::mul_add(x15, x141, Self::mul_add(x14, x140, x13 * x139));
-        let x144 = Self::mul_add(x18, x141, Self::mul_add(x17, x140, x16 * x139));
-        let x145 = Self::mul_add(x12, x138, Self::mul_add(x11, x137, x10 * x136))
-            + Self::mul_add(-q[2], x143, q[1] * x144);
-        let x146 = Self::mul_add(x15, x138, Self::mul_add(x14, x137, x13 * x136))
-            + Self::mul_add(-q[0], x144, q[2] * x142);
-        let x147 = Self::mul_add(x18, x138, Self::mul_add(x17, x137, x16 * x136))
-            + Self::mul_add(-q[1], x142, q[0] * x143);
-        [x142, x143, x144, x145, x146, x147]
+        ) + x144;
+        let x151 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x142;
+        let x152 = Self::mul_add(x12, x151, Self::mul_add(x11, x150, x10 * x149));
+        let x153 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149));
+        let x154 = Self::mul_add(x18, x151, Self::mul_add(x17, x150, x16 * x149));
+        let x155 = Self::mul_add(x12, x148, Self::mul_add(x11, x147, x10 * x146))
+            + Self::mul_add(-q[2], x153, q[1] * x154);
+        let x156 = Self::mul_add(x15, x148, Self::mul_add(x14, x147, x13 * x146))
+            + Self::mul_add(-q[0], x154, q[2] * x152);
+        let x157 = Self::mul_add(x18, x148, Self::mul_add(x17, x147, x16 * x146))
+            + Self::mul_add(-q[1], x152, q[0] * x153);
+        [x152, x153, x154, x155, x156, x157]
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
-    /// Methods: bias `recurrent`: 694 mul, 568 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 434 fused where the target has FMA.
+    /// Methods: bias `recurrent`: 692 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 432 fused where the target has FMA.
     #[must_use]
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
@@ -9747,13 +7851,27 @@ impl FreeFloating7 {
         let x14 = Self::mul_add(-v[6], x1, Self::mul_add(-a[3], s_q7, a[4] * c_q7));
         let x15 = Self::mul_add(v[6], x7, Self::mul_add(s_q7, x10, c_q7 * x9));
         let x16 = Self::mul_add(-v[6], x6, Self::mul_add(-s_q7, x9, c_q7 * x10));
-        let x17 = Self::mul_add(1.331, x8, Self::mul_add(0.1132, x2, 0.00071 * x1));
+        let x17 = Self::mul_add(
+            x16,
+            -6.1267499999999995,
+            Self::mul_add(0.00071, x12, Self::mul_add(-0.07309, x14, 2.29018125 * x13)),
+        );
         let x18 = Self::mul_add(
+            6.1267499999999995,
+            x15,
+            Self::mul_add(
+                0.1132,
+                x12,
+                Self::mul_add(1.5853812499999997, x14, -0.07309 * x13),
+            ),
+        );
+        let x19 = Self::mul_add(1.331, x8, Self::mul_add(0.1132, x2, 0.00071 * x1));
+        let x20 = Self::mul_add(
             x7,
             -6.1267499999999995,
             Self::mul_add(0.00071, x8, Self::mul_add(-0.07309, x2, 2.29018125 * x1)),
         );
-        let x19 = Self::mul_add(
+        let x21 = Self::mul_add(
             6.1267499999999995,
             x6,
             Self::mul_add(
@@ -9762,57 +7880,55 @@ impl FreeFloating7 {
                 Self::mul_add(1.5853812499999997, x2, -0.07309 * x1),
             ),
         );
-        let x20 = 35.01 * x5;
-        let x21 = Self::mul_add(x2, 6.1267499999999995, 35.01 * x6);
-        let x22 = Self::mul_add(-6.1267499999999995, x1, 35.01 * x7);
+        let x22 = 35.01 * x5;
+        let x23 = Self::mul_add(x2, 6.1267499999999995, 35.01 * x6);
+        let x24 = Self::mul_add(-6.1267499999999995, x1, 35.01 * x7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x24 = -0.00000000020510342851533115 * c_q8;
-        let x25 = -0.00000000020510342851533115 * s_q8;
-        let x26 = Self::mul_add(-x8, c_q8, Self::mul_add(x2, s_q8, x1 * x24));
-        let x27 = Self::mul_add(x8, s_q8, Self::mul_add(-x1, x25, x2 * c_q8));
-        let x28 = Self::mul_add(x2, 0.35, x6);
-        let x29 = Self::mul_add(-0.35, x1, x7);
-        let x30 = Self::mul_add(-x5, c_q8, Self::mul_add(s_q8, x29, x24 * x28));
-        let x31 = Self::mul_add(x5, s_q8, Self::mul_add(-x25, x28, c_q8 * x29));
-        let x32 = Self::mul_add(-0.00000000020510342851533115, x5, x28);
-        let x33 = v[7] + Self::mul_add(-0.00000000020510342851533115, x8, x1);
-        let x34 = Self::mul_add(x14, 0.35, x15);
-        let x35 = Self::mul_add(-0.35, x13, x16);
-        let x36 = Self::mul_add(-0.00000000020510342851533115, x11, x34);
-        let x37 = a[7] + Self::mul_add(-0.00000000020510342851533115, x12, x13);
-        let x38 = Self::mul_add(
-            v[7],
-            x27,
-            Self::mul_add(-x12, c_q8, Self::mul_add(x14, s_q8, x13 * x24)),
-        );
-        let x39 = Self::mul_add(
-            -v[7],
-            x26,
-            Self::mul_add(x12, s_q8, Self::mul_add(-x13, x25, x14 * c_q8)),
-        );
+        let x26 = -0.00000000020510342851533115 * c_q8;
+        let x27 = -0.00000000020510342851533115 * s_q8;
+        let x28 = Self::mul_add(-x8, c_q8, Self::mul_add(x2, s_q8, x1 * x26));
+        let x29 = Self::mul_add(x8, s_q8, Self::mul_add(-x1, x27, x2 * c_q8));
+        let x30 = Self::mul_add(x2, 0.35, x6);
+        let x31 = Self::mul_add(-0.35, x1, x7);
+        let x32 = Self::mul_add(-x5, c_q8, Self::mul_add(s_q8, x31, x26 * x30));
+        let x33 = Self::mul_add(x5, s_q8, Self::mul_add(-x27, x30, c_q8 * x31));
+        let x34 = Self::mul_add(-0.00000000020510342851533115, x5, x30);
+        let x35 = v[7] + Self::mul_add(-0.00000000020510342851533115, x8, x1);
+        let x36 = Self::mul_add(x14, 0.35, x15);
+        let x37 = Self::mul_add(-0.35, x13, x16);
+        let x38 = Self::mul_add(-0.00000000020510342851533115, x11, x36);
+        let x39 = a[7] + Self::mul_add(-0.00000000020510342851533115, x12, x13);
         let x40 = Self::mul_add(
             v[7],
-            x31,
-            Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x35, x24 * x34)),
+            x29,
+            Self::mul_add(-x12, c_q8, Self::mul_add(x14, s_q8, x13 * x26)),
         );
         let x41 = Self::mul_add(
             -v[7],
-            x30,
-            Self::mul_add(x11, s_q8, Self::mul_add(-x25, x34, c_q8 * x35)),
+            x28,
+            Self::mul_add(x12, s_q8, Self::mul_add(-x13, x27, x14 * c_q8)),
         );
-        let x42 = Self::mul_add(2.359, x33, -0.00214 * x26);
+        let x42 = Self::mul_add(
+            v[7],
+            x33,
+            Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x37, x26 * x36)),
+        );
         let x43 = Self::mul_add(
-            x31,
-            -6.0,
-            Self::mul_add(-0.00214, x33, 3.3000000000000003 * x26),
+            -v[7],
+            x32,
+            Self::mul_add(x11, s_q8, Self::mul_add(-x27, x36, c_q8 * x37)),
         );
-        let x44 = Self::mul_add(6.0, x30, 2.5780000000000003 * x27);
-        let x45 = 30.0 * x32;
-        let x46 = Self::mul_add(x27, 6.0, 30.0 * x30);
-        let x47 = Self::mul_add(-6.0, x26, 30.0 * x31);
+        let x44 = Self::mul_add(2.359, x35, -0.00214 * x28);
+        let x45 = Self::mul_add(
+            x33,
+            -6.0,
+            Self::mul_add(-0.00214, x35, 3.3000000000000003 * x28),
+        );
+        let x46 = Self::mul_add(6.0, x32, 2.5780000000000003 * x29);
+        let x47 = 30.0 * x34;
+        let x48 = Self::mul_add(x29, 6.0, 30.0 * x32);
+        let x49 = Self::mul_add(-6.0, x28, 30.0 * x33);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x49 = Self::mul_add(0.000000000000000000042067416388743556, c_q9, s_q9);
-        let x50 = Self::mul_add(-0.000000000000000000042067416388743556, s_q9, c_q9);
         let x51 = Self::mul_add(
             -0.00000000020510342851533115,
             s_q9,
@@ -9823,13 +7939,13 @@ impl FreeFloating7 {
             s_q9,
             -0.00000000020510342851533115 * c_q9,
         );
-        let x53 = Self::mul_add(x33, c_q9, Self::mul_add(x27, x51, x26 * x49));
-        let x54 = Self::mul_add(-x33, s_q9, Self::mul_add(x27, x52, x26 * x50));
-        let x55 = x30 - Self::mul_add(0.275, x33, x27 * -0.4);
-        let x56 = Self::mul_add(-0.4, x26, x31);
-        let x57 = Self::mul_add(0.275, x26, x32);
-        let x58 = Self::mul_add(c_q9, x57, Self::mul_add(x51, x56, x49 * x55));
-        let x59 = Self::mul_add(-s_q9, x57, Self::mul_add(x52, x56, x50 * x55));
+        let x53 = Self::mul_add(x35, c_q9, Self::mul_add(x29, x51, x28 * s_q9));
+        let x54 = Self::mul_add(-x35, s_q9, Self::mul_add(x29, x52, x28 * c_q9));
+        let x55 = x32 - Self::mul_add(0.275, x35, x29 * -0.4);
+        let x56 = Self::mul_add(-0.4, x28, x33);
+        let x57 = Self::mul_add(0.275, x28, x34);
+        let x58 = Self::mul_add(c_q9, x57, Self::mul_add(x51, x56, s_q9 * x55));
+        let x59 = Self::mul_add(-s_q9, x57, Self::mul_add(x52, x56, c_q9 * x55));
         let x60 = Self::mul_add(
             -0.00000000020510342851533115,
             x57,
@@ -9838,12 +7954,12 @@ impl FreeFloating7 {
         let x61 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x33,
-                Self::mul_add(0.00000000020510342851533115, x26, x27),
+                x35,
+                Self::mul_add(0.00000000020510342851533115, x28, x29),
             );
-        let x62 = x40 - Self::mul_add(0.275, x37, x39 * -0.4);
-        let x63 = Self::mul_add(-0.4, x38, x41);
-        let x64 = Self::mul_add(0.275, x38, x36);
+        let x62 = x42 - Self::mul_add(0.275, x39, x41 * -0.4);
+        let x63 = Self::mul_add(-0.4, x40, x43);
+        let x64 = Self::mul_add(0.275, x40, x38);
         let x65 = Self::mul_add(
             -0.00000000020510342851533115,
             x64,
@@ -9852,28 +7968,28 @@ impl FreeFloating7 {
         let x66 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x37,
-                Self::mul_add(0.00000000020510342851533115, x38, x39),
+                x39,
+                Self::mul_add(0.00000000020510342851533115, x40, x41),
             );
         let x67 = Self::mul_add(
             v[8],
             x54,
-            Self::mul_add(x37, c_q9, Self::mul_add(x39, x51, x38 * x49)),
+            Self::mul_add(x39, c_q9, Self::mul_add(x41, x51, x40 * s_q9)),
         );
         let x68 = Self::mul_add(
             -v[8],
             x53,
-            Self::mul_add(-x37, s_q9, Self::mul_add(x39, x52, x38 * x50)),
+            Self::mul_add(-x39, s_q9, Self::mul_add(x41, x52, x40 * c_q9)),
         );
         let x69 = Self::mul_add(
             v[8],
             x59,
-            Self::mul_add(c_q9, x64, Self::mul_add(x51, x63, x49 * x62)),
+            Self::mul_add(c_q9, x64, Self::mul_add(x51, x63, s_q9 * x62)),
         );
         let x70 = Self::mul_add(
             -v[8],
             x58,
-            Self::mul_add(-s_q9, x64, Self::mul_add(x52, x63, x50 * x62)),
+            Self::mul_add(-s_q9, x64, Self::mul_add(x52, x63, c_q9 * x62)),
         );
         let x71 = 3.378 * x54;
         let x72 = Self::mul_add(
@@ -9904,446 +8020,438 @@ impl FreeFloating7 {
         let x89 = Self::mul_add(-v[9], x78, Self::mul_add(-x67, s_q10, x68 * c_q10));
         let x90 = Self::mul_add(v[9], x83, Self::mul_add(x70, s_q10, c_q10 * x85));
         let x91 = Self::mul_add(-v[9], x82, Self::mul_add(-s_q10, x85, x70 * c_q10));
-        let x92 = Self::mul_add(-0.6328, x84, 4.170993 * x78)
+        let x92 = Self::mul_add(
+            x90,
+            6.7347,
+            Self::mul_add(4.0324305, x87, Self::mul_add(-1.8520425, x89, -0.6328 * x88)),
+        );
+        let x93 = Self::mul_add(-0.6328, x84, 4.170993 * x78)
             + Self::mul_add(-6.7347, x81, x83 * 5.8795);
-        let x93 = Self::mul_add(
+        let x94 = Self::mul_add(
             -5.8795,
             x82,
             Self::mul_add(-1.8520425, x84, 3.8828625 * x79),
         );
-        let x94 = Self::mul_add(
+        let x95 = Self::mul_add(
             x82,
             6.7347,
             Self::mul_add(4.0324305, x84, Self::mul_add(-1.8520425, x79, -0.6328 * x78)),
         );
-        let x95 = Self::mul_add(21.38, x82, -Self::mul_add(-6.7347, x84, x79 * 5.8795));
-        let x96 = Self::mul_add(5.8795, x78, 21.38 * x83);
-        let x97 = Self::mul_add(x78, -6.7347, 21.38 * x81);
+        let x96 = Self::mul_add(21.38, x82, -Self::mul_add(-6.7347, x84, x79 * 5.8795));
+        let x97 = Self::mul_add(5.8795, x78, 21.38 * x83);
+        let x98 = Self::mul_add(x78, -6.7347, 21.38 * x81);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x99 = Self::mul_add(x79, s_q11, x78 * c_q11);
-        let x100 = Self::mul_add(-x78, s_q11, x79 * c_q11);
-        let x101 = x82 - Self::mul_add(-0.63, x84, 0.275 * x79);
-        let x102 = Self::mul_add(0.275, x78, x83);
-        let x103 = Self::mul_add(x78, -0.63, x81);
-        let x104 = Self::mul_add(s_q11, x102, c_q11 * x101);
-        let x105 = Self::mul_add(-s_q11, x101, c_q11 * x102);
-        let x106 = v[10] + x84;
-        let x107 = x90 - Self::mul_add(-0.63, x87, 0.275 * x89);
-        let x108 = Self::mul_add(0.275, x88, x91);
-        let x109 = Self::mul_add(x88, -0.63, x86);
-        let x110 = a[10] + x87;
-        let x111 = Self::mul_add(v[10], x100, Self::mul_add(x89, s_q11, x88 * c_q11));
-        let x112 = Self::mul_add(-v[10], x99, Self::mul_add(-x88, s_q11, x89 * c_q11));
-        let x113 = Self::mul_add(v[10], x105, Self::mul_add(s_q11, x108, c_q11 * x107));
-        let x114 = Self::mul_add(
+        let x100 = Self::mul_add(x79, s_q11, x78 * c_q11);
+        let x101 = Self::mul_add(-x78, s_q11, x79 * c_q11);
+        let x102 = x82 - Self::mul_add(-0.63, x84, 0.275 * x79);
+        let x103 = Self::mul_add(0.275, x78, x83);
+        let x104 = Self::mul_add(x78, -0.63, x81);
+        let x105 = Self::mul_add(s_q11, x103, c_q11 * x102);
+        let x106 = Self::mul_add(-s_q11, x102, c_q11 * x103);
+        let x107 = v[10] + x84;
+        let x108 = x90 - Self::mul_add(-0.63, x87, 0.275 * x89);
+        let x109 = Self::mul_add(0.275, x88, x91);
+        let x110 = Self::mul_add(x88, -0.63, x86);
+        let x111 = a[10] + x87;
+        let x112 = Self::mul_add(v[10], x101, Self::mul_add(x89, s_q11, x88 * c_q11));
+        let x113 = Self::mul_add(-v[10], x100, Self::mul_add(-x88, s_q11, x89 * c_q11));
+        let x114 = Self::mul_add(v[10], x106, Self::mul_add(s_q11, x109, c_q11 * x108));
+        let x115 = Self::mul_add(
             -v[10],
-            x104,
-            Self::mul_add(-s_q11, x107, c_q11 * x108),
-        );
-        let x115 = Self::mul_add(0.07271, x106, 0.01675 * x99);
-        let x116 = Self::mul_add(
             x105,
+            Self::mul_add(-s_q11, x108, c_q11 * x109),
+        );
+        let x116 = Self::mul_add(0.07271, x107, 0.01675 * x100);
+        let x117 = Self::mul_add(
+            x106,
             3.0149999999999997,
-            Self::mul_add(0.01675, x106, 0.9304999999999999 * x99),
+            Self::mul_add(0.01675, x107, 0.9304999999999999 * x100),
         );
-        let x117 = Self::mul_add(-3.0149999999999997, x104, 0.939 * x100);
-        let x118 = 16.75 * x103;
-        let x119 = Self::mul_add(x100, -3.0149999999999997, 16.75 * x104);
-        let x120 = Self::mul_add(3.0149999999999997, x99, 16.75 * x105);
+        let x118 = Self::mul_add(-3.0149999999999997, x105, 0.939 * x101);
+        let x119 = 16.75 * x104;
+        let x120 = Self::mul_add(x101, -3.0149999999999997, 16.75 * x105);
+        let x121 = Self::mul_add(3.0149999999999997, x100, 16.75 * x106);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x122 = -0.00000000020510342851533115 * s_q12;
-        let x123 = -0.00000000020510342851533115 * c_q12;
-        let x124 = Self::mul_add(-x106, s_q12, Self::mul_add(x100, x122, x99 * c_q12));
-        let x125 = Self::mul_add(-x106, c_q12, Self::mul_add(-x99, s_q12, x100 * x123));
-        let x126 = Self::mul_add(x100, -0.36, x104);
-        let x127 = Self::mul_add(0.36, x99, x105);
-        let x128 = Self::mul_add(-x103, s_q12, Self::mul_add(x122, x127, c_q12 * x126));
-        let x129 = Self::mul_add(-x103, c_q12, Self::mul_add(-s_q12, x126, x123 * x127));
-        let x130 = Self::mul_add(-0.00000000020510342851533115, x103, x127);
-        let x131 = v[11] + Self::mul_add(-0.00000000020510342851533115, x106, x100);
-        let x132 = Self::mul_add(x112, -0.36, x113);
-        let x133 = Self::mul_add(0.36, x111, x114);
-        let x134 = Self::mul_add(-0.00000000020510342851533115, x109, x133);
-        let x135 = a[11] + Self::mul_add(-0.00000000020510342851533115, x110, x112);
-        let x136 = Self::mul_add(
-            v[11],
-            x125,
-            Self::mul_add(-x110, s_q12, Self::mul_add(x112, x122, x111 * c_q12)),
-        );
+        let x123 = -0.00000000020510342851533115 * s_q12;
+        let x124 = -0.00000000020510342851533115 * c_q12;
+        let x125 = Self::mul_add(-x107, s_q12, Self::mul_add(x101, x123, x100 * c_q12));
+        let x126 = Self::mul_add(-x107, c_q12, Self::mul_add(-x100, s_q12, x101 * x124));
+        let x127 = Self::mul_add(x101, -0.36, x105);
+        let x128 = Self::mul_add(0.36, x100, x106);
+        let x129 = Self::mul_add(-x104, s_q12, Self::mul_add(x123, x128, c_q12 * x127));
+        let x130 = Self::mul_add(-x104, c_q12, Self::mul_add(-s_q12, x127, x124 * x128));
+        let x131 = Self::mul_add(-0.00000000020510342851533115, x104, x128);
+        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x107, x101);
+        let x133 = Self::mul_add(x113, -0.36, x114);
+        let x134 = Self::mul_add(0.36, x112, x115);
+        let x135 = Self::mul_add(-0.00000000020510342851533115, x110, x134);
+        let x136 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x113);
         let x137 = Self::mul_add(
-            -v[11],
-            x124,
-            Self::mul_add(-x110, c_q12, Self::mul_add(-x111, s_q12, x112 * x123)),
+            v[11],
+            x126,
+            Self::mul_add(-x111, s_q12, Self::mul_add(x113, x123, x112 * c_q12)),
         );
         let x138 = Self::mul_add(
-            v[11],
-            x129,
-            Self::mul_add(-x109, s_q12, Self::mul_add(x122, x133, c_q12 * x132)),
+            -v[11],
+            x125,
+            Self::mul_add(-x111, c_q12, Self::mul_add(-x112, s_q12, x113 * x124)),
         );
         let x139 = Self::mul_add(
+            v[11],
+            x130,
+            Self::mul_add(-x110, s_q12, Self::mul_add(x123, x134, c_q12 * x133)),
+        );
+        let x140 = Self::mul_add(
             -v[11],
-            x128,
-            Self::mul_add(-x109, c_q12, Self::mul_add(-s_q12, x132, x123 * x133)),
+            x129,
+            Self::mul_add(-x110, c_q12, Self::mul_add(-s_q12, x133, x124 * x134)),
         );
-        let x140 = Self::mul_add(-0.2313, x131, 3.2217582500000006 * x124)
-            + Self::mul_add(7.196750000000001, x130, x129 * -4.187200000000001);
         let x141 = Self::mul_add(
-            4.187200000000001,
-            x128,
-            Self::mul_add(-1.1514800000000003, x131, 1.2686520000000001 * x125),
-        );
-        let x142 = Self::mul_add(
-            x128,
+            x139,
             -7.196750000000001,
             Self::mul_add(
                 2.1079062500000005,
-                x131,
-                Self::mul_add(-1.1514800000000003, x125, -0.2313 * x124),
+                x136,
+                Self::mul_add(-1.1514800000000003, x138, -0.2313 * x137),
             ),
         );
+        let x142 = Self::mul_add(-0.2313, x132, 3.2217582500000006 * x125)
+            + Self::mul_add(7.196750000000001, x131, x130 * -4.187200000000001);
         let x143 = Self::mul_add(
+            4.187200000000001,
+            x129,
+            Self::mul_add(-1.1514800000000003, x132, 1.2686520000000001 * x126),
+        );
+        let x144 = Self::mul_add(
+            x129,
+            -7.196750000000001,
+            Self::mul_add(
+                2.1079062500000005,
+                x132,
+                Self::mul_add(-1.1514800000000003, x126, -0.2313 * x125),
+            ),
+        );
+        let x145 = Self::mul_add(
             26.17,
-            x128,
-            -Self::mul_add(7.196750000000001, x131, x125 * -4.187200000000001),
+            x129,
+            -Self::mul_add(7.196750000000001, x132, x126 * -4.187200000000001),
         );
-        let x144 = Self::mul_add(-4.187200000000001, x124, 26.17 * x129);
-        let x145 = Self::mul_add(x124, 7.196750000000001, 26.17 * x130);
+        let x146 = Self::mul_add(-4.187200000000001, x125, 26.17 * x130);
+        let x147 = Self::mul_add(x125, 7.196750000000001, 26.17 * x131);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x147 = -0.00000000020510342851533115 * c_q13;
-        let x148 = -0.00000000020510342851533115 * s_q13;
-        let x149 = Self::mul_add(-x131, c_q13, Self::mul_add(x125, s_q13, x124 * x147));
-        let x150 = Self::mul_add(x131, s_q13, Self::mul_add(-x124, x148, x125 * c_q13));
-        let x151 = x128 - Self::mul_add(0.55, x131, -0.16 * x125);
-        let x152 = Self::mul_add(-0.16, x124, x129);
-        let x153 = Self::mul_add(x124, 0.55, x130);
-        let x154 = Self::mul_add(-c_q13, x153, Self::mul_add(s_q13, x152, x147 * x151));
-        let x155 = Self::mul_add(s_q13, x153, Self::mul_add(-x148, x151, c_q13 * x152));
-        let x156 = Self::mul_add(-0.00000000020510342851533115, x153, x151);
-        let x157 = v[12] + Self::mul_add(-0.00000000020510342851533115, x131, x124);
-        let x158 = x138 - Self::mul_add(0.55, x135, -0.16 * x137);
-        let x159 = Self::mul_add(-0.16, x136, x139);
-        let x160 = Self::mul_add(x136, 0.55, x134);
-        let x161 = Self::mul_add(-0.00000000020510342851533115, x160, x158);
-        let x162 = a[12] + Self::mul_add(-0.00000000020510342851533115, x135, x136);
-        let x163 = Self::mul_add(
-            v[12],
-            x150,
-            Self::mul_add(-x135, c_q13, Self::mul_add(x137, s_q13, x136 * x147)),
-        );
-        let x164 = Self::mul_add(
-            -v[12],
-            x149,
-            Self::mul_add(x135, s_q13, Self::mul_add(-x136, x148, x137 * c_q13)),
-        );
+        let x149 = -0.00000000020510342851533115 * c_q13;
+        let x150 = -0.00000000020510342851533115 * s_q13;
+        let x151 = Self::mul_add(-x132, c_q13, Self::mul_add(x126, s_q13, x125 * x149));
+        let x152 = Self::mul_add(x132, s_q13, Self::mul_add(-x125, x150, x126 * c_q13));
+        let x153 = x129 - Self::mul_add(0.55, x132, -0.16 * x126);
+        let x154 = Self::mul_add(-0.16, x125, x130);
+        let x155 = Self::mul_add(x125, 0.55, x131);
+        let x156 = Self::mul_add(-c_q13, x155, Self::mul_add(s_q13, x154, x149 * x153));
+        let x157 = Self::mul_add(s_q13, x155, Self::mul_add(-x150, x153, c_q13 * x154));
+        let x158 = Self::mul_add(-0.00000000020510342851533115, x155, x153);
+        let x159 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x125);
+        let x160 = x139 - Self::mul_add(0.55, x136, -0.16 * x138);
+        let x161 = Self::mul_add(-0.16, x137, x140);
+        let x162 = Self::mul_add(x137, 0.55, x135);
+        let x163 = Self::mul_add(-0.00000000020510342851533115, x162, x160);
+        let x164 = a[12] + Self::mul_add(-0.00000000020510342851533115, x136, x137);
         let x165 = Self::mul_add(
             v[12],
-            x155,
-            Self::mul_add(-c_q13, x160, Self::mul_add(s_q13, x159, x147 * x158)),
+            x152,
+            Self::mul_add(-x136, c_q13, Self::mul_add(x138, s_q13, x137 * x149)),
         );
         let x166 = Self::mul_add(
             -v[12],
-            x154,
-            Self::mul_add(s_q13, x160, Self::mul_add(-x148, x158, c_q13 * x159)),
+            x151,
+            Self::mul_add(x136, s_q13, Self::mul_add(-x137, x150, x138 * c_q13)),
         );
         let x167 = Self::mul_add(
-            -0.0145,
+            v[12],
             x157,
-            Self::mul_add(0.000781, x150, 2.1663609200000002 * x149),
-        ) + Self::mul_add(4.806620000000001, x156, x155 * -3.6140000000000003);
+            Self::mul_add(-c_q13, x162, Self::mul_add(s_q13, x161, x149 * x160)),
+        );
         let x168 = Self::mul_add(
-            3.6140000000000003,
-            x154,
-            Self::mul_add(
-                -0.9614610000000001,
-                x157,
-                Self::mul_add(0.9638000000000001, x150, 0.000781 * x149),
-            ),
+            -v[12],
+            x156,
+            Self::mul_add(s_q13, x162, Self::mul_add(-x150, x160, c_q13 * x161)),
         );
         let x169 = Self::mul_add(
-            x154,
-            -4.806620000000001,
+            3.6140000000000003,
+            x167,
             Self::mul_add(
-                1.4135609200000003,
-                x157,
-                Self::mul_add(-0.9614610000000001, x150, -0.0145 * x149),
+                -0.9614610000000001,
+                x164,
+                Self::mul_add(0.9638000000000001, x166, 0.000781 * x165),
             ),
         );
         let x170 = Self::mul_add(
-            18.07,
-            x154,
-            -Self::mul_add(4.806620000000001, x157, x150 * -3.6140000000000003),
-        );
-        let x171 = Self::mul_add(-3.6140000000000003, x149, 18.07 * x155);
-        let x172 = Self::mul_add(x149, 4.806620000000001, 18.07 * x156);
-        let x173 = Self::mul_add(
-            -0.0145,
-            x162,
-            Self::mul_add(0.000781, x164, 2.1663609200000002 * x163),
-        ) + Self::mul_add(4.806620000000001, x161, x166 * -3.6140000000000003)
-            + (Self::mul_add(-x157, x168, x150 * x169)
-                + Self::mul_add(-x156, x171, x155 * x172));
-        let x174 = Self::mul_add(
-            3.6140000000000003,
-            x165,
-            Self::mul_add(
-                -0.9614610000000001,
-                x162,
-                Self::mul_add(0.9638000000000001, x164, 0.000781 * x163),
-            ),
-        )
-            + (Self::mul_add(-x149, x169, x157 * x167)
-                + Self::mul_add(-x154, x172, x156 * x170));
-        let x175 = Self::mul_add(
-            x165,
+            x167,
             -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x162,
-                Self::mul_add(-0.9614610000000001, x164, -0.0145 * x163),
+                x164,
+                Self::mul_add(-0.9614610000000001, x166, -0.0145 * x165),
             ),
-        )
-            + (Self::mul_add(-x150, x167, x149 * x168)
-                + Self::mul_add(-x155, x170, x154 * x171));
-        let x176 = Self::mul_add(
-            18.07,
-            x165,
-            -Self::mul_add(4.806620000000001, x162, x164 * -3.6140000000000003),
-        ) + Self::mul_add(-x157, x171, x150 * x172);
-        let x177 = Self::mul_add(-3.6140000000000003, x163, 18.07 * x166)
-            + Self::mul_add(-x149, x172, x157 * x170);
-        let x178 = Self::mul_add(x163, 4.806620000000001, 18.07 * x161)
-            + Self::mul_add(-x150, x170, x149 * x171);
-        let x179 = x178 + Self::mul_add(-x148, x177, x147 * x176);
-        let x180 = Self::mul_add(c_q13, x177, s_q13 * x176);
-        let x181 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x178,
-            Self::mul_add(-c_q13, x176, s_q13 * x177),
         );
-        let x182 = Self::mul_add(-0.2313, x135, 3.2217582500000006 * x136)
-            + Self::mul_add(7.196750000000001, x134, x139 * -4.187200000000001)
-            + (Self::mul_add(-x131, x141, x125 * x142)
-                + Self::mul_add(-x130, x144, x129 * x145))
-            + (x175 + Self::mul_add(-x148, x174, x147 * x173)
-                + Self::mul_add(0.55, x181, -0.16 * x180));
-        let x183 = Self::mul_add(
-            4.187200000000001,
-            x138,
-            Self::mul_add(-1.1514800000000003, x135, 1.2686520000000001 * x137),
-        )
-            + (Self::mul_add(-x124, x142, x131 * x140)
-                + Self::mul_add(-x128, x145, x130 * x143))
-            + Self::mul_add(0.16, x179, Self::mul_add(c_q13, x174, s_q13 * x173));
-        let x184 = Self::mul_add(
-            x138,
-            -7.196750000000001,
+        let x171 = Self::mul_add(
+            -0.0145,
+            x159,
+            Self::mul_add(0.000781, x152, 2.1663609200000002 * x151),
+        ) + Self::mul_add(4.806620000000001, x158, x157 * -3.6140000000000003);
+        let x172 = Self::mul_add(
+            3.6140000000000003,
+            x156,
             Self::mul_add(
-                2.1079062500000005,
-                x135,
-                Self::mul_add(-1.1514800000000003, x137, -0.2313 * x136),
+                -0.9614610000000001,
+                x159,
+                Self::mul_add(0.9638000000000001, x152, 0.000781 * x151),
             ),
-        )
-            + (Self::mul_add(-x125, x140, x124 * x141)
-                + Self::mul_add(-x129, x143, x128 * x144))
-            + Self::mul_add(
-                -0.55,
-                x179,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x175,
-                    Self::mul_add(-c_q13, x173, s_q13 * x174),
-                ),
-            );
+        );
+        let x173 = Self::mul_add(
+            x156,
+            -4.806620000000001,
+            Self::mul_add(
+                1.4135609200000003,
+                x159,
+                Self::mul_add(-0.9614610000000001, x152, -0.0145 * x151),
+            ),
+        );
+        let x174 = Self::mul_add(
+            18.07,
+            x156,
+            -Self::mul_add(4.806620000000001, x159, x152 * -3.6140000000000003),
+        );
+        let x175 = Self::mul_add(-3.6140000000000003, x151, 18.07 * x157);
+        let x176 = Self::mul_add(x151, 4.806620000000001, 18.07 * x158);
+        let x177 = Self::mul_add(
+            -0.0145,
+            x164,
+            Self::mul_add(0.000781, x166, 2.1663609200000002 * x165),
+        ) + Self::mul_add(4.806620000000001, x163, x168 * -3.6140000000000003)
+            + (Self::mul_add(-x159, x172, x152 * x173)
+                + Self::mul_add(-x158, x175, x157 * x176));
+        let x178 = x169
+            + (Self::mul_add(-x151, x173, x159 * x171)
+                + Self::mul_add(-x156, x176, x158 * x174));
+        let x179 = x170
+            + (Self::mul_add(-x152, x171, x151 * x172)
+                + Self::mul_add(-x157, x174, x156 * x175));
+        let x180 = Self::mul_add(
+            18.07,
+            x167,
+            -Self::mul_add(4.806620000000001, x164, x166 * -3.6140000000000003),
+        ) + Self::mul_add(-x159, x175, x152 * x176);
+        let x181 = Self::mul_add(-3.6140000000000003, x165, 18.07 * x168)
+            + Self::mul_add(-x151, x176, x159 * x174);
+        let x182 = Self::mul_add(x165, 4.806620000000001, 18.07 * x163)
+            + Self::mul_add(-x152, x174, x151 * x175);
+        let x183 = x182 + Self::mul_add(-x150, x181, x149 * x180);
+        let x184 = Self::mul_add(c_q13, x181, s_q13 * x180);
         let x185 = Self::mul_add(
-            26.17,
-            x138,
-            -Self::mul_add(7.196750000000001, x135, x137 * -4.187200000000001),
-        ) + Self::mul_add(-x131, x144, x125 * x145) + x179;
-        let x186 = Self::mul_add(-4.187200000000001, x136, 26.17 * x139)
-            + Self::mul_add(-x124, x145, x131 * x143) + x180;
-        let x187 = Self::mul_add(x136, 7.196750000000001, 26.17 * x134)
-            + Self::mul_add(-x125, x143, x124 * x144) + x181;
-        let x188 = Self::mul_add(-s_q12, x186, c_q12 * x185);
-        let x189 = x187 + Self::mul_add(x123, x186, x122 * x185);
-        let x190 = Self::mul_add(
-            x114,
-            3.0149999999999997,
-            Self::mul_add(0.01675, x110, 0.9304999999999999 * x111),
+            -0.00000000020510342851533115,
+            x182,
+            Self::mul_add(-c_q13, x180, s_q13 * x181),
+        );
+        let x186 = Self::mul_add(
+            -0.55,
+            x183,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x179,
+                Self::mul_add(-c_q13, x177, s_q13 * x178),
+            ),
+        );
+        let x187 = Self::mul_add(-0.2313, x136, 3.2217582500000006 * x137)
+            + Self::mul_add(7.196750000000001, x135, x140 * -4.187200000000001)
+            + (Self::mul_add(-x132, x143, x126 * x144)
+                + Self::mul_add(-x131, x146, x130 * x147))
+            + (x179 + Self::mul_add(-x150, x178, x149 * x177)
+                + Self::mul_add(0.55, x185, -0.16 * x184));
+        let x188 = Self::mul_add(
+            4.187200000000001,
+            x139,
+            Self::mul_add(-1.1514800000000003, x136, 1.2686520000000001 * x138),
         )
-            + (Self::mul_add(-x106, x117, x100 * x115)
-                + Self::mul_add(-x103, x120, x105 * x118))
-            + Self::mul_add(0.36, x189, Self::mul_add(-s_q12, x183, c_q12 * x182));
-        let x191 = Self::mul_add(-3.0149999999999997, x113, 0.939 * x112)
-            + (Self::mul_add(-x99, x115, x106 * x116)
-                + Self::mul_add(-x104, x118, x103 * x119))
-            + Self::mul_add(-0.36, x188, x184 + Self::mul_add(x123, x183, x122 * x182));
-        let x192 = Self::mul_add(x112, -3.0149999999999997, 16.75 * x113)
-            + Self::mul_add(-x106, x120, x100 * x118) + x188;
-        let x193 = Self::mul_add(3.0149999999999997, x111, 16.75 * x114)
-            + Self::mul_add(-x99, x118, x106 * x119) + x189;
-        let x194 = Self::mul_add(16.75, x109, Self::mul_add(-x100, x119, x99 * x120))
+            + (Self::mul_add(-x125, x144, x132 * x142)
+                + Self::mul_add(-x129, x147, x131 * x145))
+            + Self::mul_add(0.16, x183, Self::mul_add(c_q13, x178, s_q13 * x177));
+        let x189 = x141
+            + (Self::mul_add(-x126, x142, x125 * x143)
+                + Self::mul_add(-x130, x145, x129 * x146)) + x186;
+        let x190 = Self::mul_add(
+            26.17,
+            x139,
+            -Self::mul_add(7.196750000000001, x136, x138 * -4.187200000000001),
+        ) + Self::mul_add(-x132, x146, x126 * x147) + x183;
+        let x191 = Self::mul_add(-4.187200000000001, x137, 26.17 * x140)
+            + Self::mul_add(-x125, x147, x132 * x145) + x184;
+        let x192 = Self::mul_add(x137, 7.196750000000001, 26.17 * x135)
+            + Self::mul_add(-x126, x145, x125 * x146) + x185;
+        let x193 = Self::mul_add(-s_q12, x191, c_q12 * x190);
+        let x194 = x192 + Self::mul_add(x124, x191, x123 * x190);
+        let x195 = Self::mul_add(
+            x115,
+            3.0149999999999997,
+            Self::mul_add(0.01675, x111, 0.9304999999999999 * x112),
+        )
+            + (Self::mul_add(-x107, x118, x101 * x116)
+                + Self::mul_add(-x104, x121, x106 * x119))
+            + Self::mul_add(0.36, x194, Self::mul_add(-s_q12, x188, c_q12 * x187));
+        let x196 = Self::mul_add(-3.0149999999999997, x114, 0.939 * x113)
+            + (Self::mul_add(-x100, x116, x107 * x117)
+                + Self::mul_add(-x105, x119, x104 * x120))
+            + Self::mul_add(-0.36, x193, x189 + Self::mul_add(x124, x188, x123 * x187));
+        let x197 = Self::mul_add(x113, -3.0149999999999997, 16.75 * x114)
+            + Self::mul_add(-x107, x121, x101 * x119) + x193;
+        let x198 = Self::mul_add(3.0149999999999997, x112, 16.75 * x115)
+            + Self::mul_add(-x100, x119, x107 * x120) + x194;
+        let x199 = Self::mul_add(16.75, x110, Self::mul_add(-x101, x120, x100 * x121))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x187,
-                -Self::mul_add(c_q12, x186, s_q12 * x185),
+                x192,
+                -Self::mul_add(c_q12, x191, s_q12 * x190),
             );
-        let x195 = Self::mul_add(-s_q11, x193, c_q11 * x192);
-        let x196 = Self::mul_add(c_q11, x193, s_q11 * x192);
-        let x197 = Self::mul_add(-0.6328, x87, 4.170993 * x88)
+        let x200 = Self::mul_add(-s_q11, x198, c_q11 * x197);
+        let x201 = Self::mul_add(c_q11, x198, s_q11 * x197);
+        let x202 = Self::mul_add(
+            0.63,
+            x200,
+            Self::mul_add(0.07271, x111, 0.01675 * x112)
+                + (Self::mul_add(-x101, x117, x100 * x118)
+                    + Self::mul_add(-x106, x120, x105 * x121))
+                + Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x189,
+                    -Self::mul_add(c_q12, x188, s_q12 * x187),
+                ),
+        );
+        let x203 = Self::mul_add(-0.6328, x87, 4.170993 * x88)
             + Self::mul_add(-6.7347, x86, x91 * 5.8795)
-            + (Self::mul_add(-x84, x93, x79 * x94) + Self::mul_add(-x81, x96, x83 * x97))
-            + (Self::mul_add(-s_q11, x191, c_q11 * x190)
-                + Self::mul_add(-0.63, x194, 0.275 * x196));
-        let x198 = Self::mul_add(
+            + (Self::mul_add(-x84, x94, x79 * x95) + Self::mul_add(-x81, x97, x83 * x98))
+            + (Self::mul_add(-s_q11, x196, c_q11 * x195)
+                + Self::mul_add(-0.63, x199, 0.275 * x201));
+        let x204 = Self::mul_add(
             -5.8795,
             x90,
             Self::mul_add(-1.8520425, x87, 3.8828625 * x89),
-        ) + (Self::mul_add(-x78, x94, x84 * x92) + Self::mul_add(-x82, x97, x81 * x95))
-            + Self::mul_add(-0.275, x195, Self::mul_add(c_q11, x191, s_q11 * x190));
-        let x199 = Self::mul_add(21.38, x90, -Self::mul_add(-6.7347, x87, x89 * 5.8795))
-            + Self::mul_add(-x84, x96, x79 * x97) + x195;
-        let x200 = Self::mul_add(5.8795, x88, 21.38 * x91)
-            + Self::mul_add(-x78, x97, x84 * x95) + x196;
-        let x201 = Self::mul_add(x88, -6.7347, 21.38 * x86)
-            + Self::mul_add(-x79, x95, x78 * x96) + x194;
-        let x202 = Self::mul_add(-s_q10, x200, c_q10 * x199);
-        let x203 = Self::mul_add(
+        ) + (Self::mul_add(-x78, x95, x84 * x93) + Self::mul_add(-x82, x98, x81 * x96))
+            + Self::mul_add(-0.275, x200, Self::mul_add(c_q11, x196, s_q11 * x195));
+        let x205 = Self::mul_add(21.38, x90, -Self::mul_add(-6.7347, x87, x89 * 5.8795))
+            + Self::mul_add(-x84, x97, x79 * x98) + x200;
+        let x206 = Self::mul_add(5.8795, x88, 21.38 * x91)
+            + Self::mul_add(-x78, x98, x84 * x96) + x201;
+        let x207 = Self::mul_add(x88, -6.7347, 21.38 * x86)
+            + Self::mul_add(-x79, x96, x78 * x97) + x199;
+        let x208 = Self::mul_add(-s_q10, x206, c_q10 * x205);
+        let x209 = Self::mul_add(
             -9.87015,
             x65,
             Self::mul_add(-0.00214, x66, 4.395515250000001 * x67),
         ) + (Self::mul_add(-x61, x71, x54 * x73) + Self::mul_add(-x60, x74, x59 * x76))
-            + Self::mul_add(-0.87, x201, Self::mul_add(-s_q10, x198, c_q10 * x197));
-        let x204 = Self::mul_add(
+            + Self::mul_add(-0.87, x207, Self::mul_add(-s_q10, x204, c_q10 * x203));
+        let x210 = Self::mul_add(
             3.378,
             x68,
             Self::mul_add(-x53, x73, x61 * x72) + Self::mul_add(-x58, x76, x60 * x75),
-        ) + Self::mul_add(c_q10, x198, s_q10 * x197);
-        let x205 = Self::mul_add(
+        ) + Self::mul_add(c_q10, x204, s_q10 * x203);
+        let x211 = Self::mul_add(
             x69,
             9.87015,
             Self::mul_add(7.65251525, x66, -0.00214 * x67),
         ) + (Self::mul_add(-x54, x72, x53 * x71) + Self::mul_add(-x59, x75, x58 * x74))
             + Self::mul_add(
                 0.87,
-                x202,
-                Self::mul_add(
-                    x90,
-                    6.7347,
-                    Self::mul_add(
-                        4.0324305,
-                        x87,
-                        Self::mul_add(-1.8520425, x89, -0.6328 * x88),
-                    ),
-                )
-                    + (Self::mul_add(-x79, x92, x78 * x93)
-                        + Self::mul_add(-x83, x95, x82 * x96))
-                    + Self::mul_add(
-                        0.63,
-                        x195,
-                        Self::mul_add(0.07271, x110, 0.01675 * x111)
-                            + (Self::mul_add(-x100, x116, x99 * x117)
-                                + Self::mul_add(-x105, x119, x104 * x120))
-                            + Self::mul_add(
-                                -0.00000000020510342851533115,
-                                x184,
-                                -Self::mul_add(c_q12, x183, s_q12 * x182),
-                            ),
-                    ),
+                x208,
+                x92
+                    + (Self::mul_add(-x79, x93, x78 * x94)
+                        + Self::mul_add(-x83, x96, x82 * x97)) + x202,
             );
-        let x206 = Self::mul_add(9.87015, x66, 22.69 * x69)
-            + Self::mul_add(-x61, x74, x54 * x76) + x202;
-        let x207 = Self::mul_add(22.69, x70, Self::mul_add(-x53, x76, x61 * x75))
-            + Self::mul_add(c_q10, x200, s_q10 * x199);
-        let x208 = Self::mul_add(x67, -9.87015, 22.69 * x65)
-            + Self::mul_add(-x54, x75, x53 * x74) + x201;
-        let x209 = Self::mul_add(
+        let x212 = Self::mul_add(9.87015, x66, 22.69 * x69)
+            + Self::mul_add(-x61, x74, x54 * x76) + x208;
+        let x213 = Self::mul_add(22.69, x70, Self::mul_add(-x53, x76, x61 * x75))
+            + Self::mul_add(c_q10, x206, s_q10 * x205);
+        let x214 = Self::mul_add(x67, -9.87015, 22.69 * x65)
+            + Self::mul_add(-x54, x75, x53 * x74) + x207;
+        let x215 = Self::mul_add(
             0.00000000020510342851533115,
-            x208,
-            Self::mul_add(x50, x207, x49 * x206),
+            x214,
+            Self::mul_add(c_q9, x213, s_q9 * x212),
         );
-        let x210 = x208 + Self::mul_add(x52, x207, x51 * x206);
-        let x211 = Self::mul_add(
+        let x216 = x214 + Self::mul_add(x52, x213, x51 * x212);
+        let x217 = Self::mul_add(
             -0.00000000020510342851533115,
-            x208,
-            Self::mul_add(-s_q9, x207, c_q9 * x206),
+            x214,
+            Self::mul_add(-s_q9, x213, c_q9 * x212),
         );
-        let x212 = Self::mul_add(
-            x41,
+        let x218 = Self::mul_add(
+            -0.275,
+            x215,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x211,
+                Self::mul_add(-s_q9, x210, c_q9 * x209),
+            ),
+        );
+        let x219 = Self::mul_add(
+            x43,
             -6.0,
-            Self::mul_add(-0.00214, x37, 3.3000000000000003 * x38),
-        ) + (Self::mul_add(-x33, x44, x27 * x42) + Self::mul_add(-x32, x47, x31 * x45))
+            Self::mul_add(-0.00214, x39, 3.3000000000000003 * x40),
+        ) + (Self::mul_add(-x35, x46, x29 * x44) + Self::mul_add(-x34, x49, x33 * x47))
             + (Self::mul_add(
                 0.00000000020510342851533115,
-                x205,
-                Self::mul_add(x50, x204, x49 * x203),
-            ) + Self::mul_add(0.275, x211, -0.4 * x210));
-        let x213 = Self::mul_add(6.0, x40, 2.5780000000000003 * x39)
-            + (Self::mul_add(-x26, x42, x33 * x43) + Self::mul_add(-x30, x45, x32 * x46))
-            + Self::mul_add(0.4, x209, x205 + Self::mul_add(x52, x204, x51 * x203));
-        let x214 = Self::mul_add(2.359, x37, -0.00214 * x38)
-            + (Self::mul_add(-x27, x43, x26 * x44) + Self::mul_add(-x31, x46, x30 * x47))
-            + Self::mul_add(
-                -0.275,
-                x209,
-                Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x205,
-                    Self::mul_add(-s_q9, x204, c_q9 * x203),
-                ),
-            );
-        let x215 = Self::mul_add(x39, 6.0, 30.0 * x40)
-            + Self::mul_add(-x33, x47, x27 * x45) + x209;
-        let x216 = Self::mul_add(-6.0, x38, 30.0 * x41)
-            + Self::mul_add(-x26, x45, x33 * x46) + x210;
-        let x217 = Self::mul_add(30.0, x36, Self::mul_add(-x27, x46, x26 * x47)) + x211;
-        let x218 = x217 + Self::mul_add(-x25, x216, x24 * x215);
-        let x219 = Self::mul_add(c_q8, x216, s_q8 * x215);
-        let x220 = Self::mul_add(
-            x16,
-            -6.1267499999999995,
-            Self::mul_add(0.00071, x12, Self::mul_add(-0.07309, x14, 2.29018125 * x13)),
-        ) + (Self::mul_add(-x8, x19, x2 * x17) + Self::mul_add(-x5, x22, x7 * x20))
-            + Self::mul_add(-0.35, x219, x214 + Self::mul_add(-x25, x213, x24 * x212));
-        let x221 = Self::mul_add(
-            6.1267499999999995,
-            x15,
-            Self::mul_add(
-                0.1132,
-                x12,
-                Self::mul_add(1.5853812499999997, x14, -0.07309 * x13),
-            ),
-        ) + (Self::mul_add(-x1, x17, x8 * x18) + Self::mul_add(-x6, x20, x5 * x21))
-            + Self::mul_add(0.35, x218, Self::mul_add(c_q8, x213, s_q8 * x212));
-        let x222 = Self::mul_add(x14, 6.1267499999999995, 35.01 * x15)
-            + Self::mul_add(-x8, x22, x2 * x20) + x218;
-        let x223 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
-            + Self::mul_add(-x1, x20, x8 * x21) + x219;
-        let x224 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x21, x1 * x22))
+                x211,
+                Self::mul_add(c_q9, x210, s_q9 * x209),
+            ) + Self::mul_add(0.275, x217, -0.4 * x216));
+        let x220 = Self::mul_add(6.0, x42, 2.5780000000000003 * x41)
+            + (Self::mul_add(-x28, x44, x35 * x45) + Self::mul_add(-x32, x47, x34 * x48))
+            + Self::mul_add(0.4, x215, x211 + Self::mul_add(x52, x210, x51 * x209));
+        let x221 = Self::mul_add(2.359, x39, -0.00214 * x40)
+            + (Self::mul_add(-x29, x45, x28 * x46) + Self::mul_add(-x33, x48, x32 * x49))
+            + x218;
+        let x222 = Self::mul_add(x41, 6.0, 30.0 * x42)
+            + Self::mul_add(-x35, x49, x29 * x47) + x215;
+        let x223 = Self::mul_add(-6.0, x40, 30.0 * x43)
+            + Self::mul_add(-x28, x47, x35 * x48) + x216;
+        let x224 = Self::mul_add(30.0, x38, Self::mul_add(-x29, x48, x28 * x49)) + x217;
+        let x225 = x224 + Self::mul_add(-x27, x223, x26 * x222);
+        let x226 = Self::mul_add(c_q8, x223, s_q8 * x222);
+        let x227 = x17
+            + (Self::mul_add(-x8, x21, x2 * x19) + Self::mul_add(-x5, x24, x7 * x22))
+            + Self::mul_add(-0.35, x226, x221 + Self::mul_add(-x27, x220, x26 * x219));
+        let x228 = x18
+            + (Self::mul_add(-x1, x19, x8 * x20) + Self::mul_add(-x6, x22, x5 * x23))
+            + Self::mul_add(0.35, x225, Self::mul_add(c_q8, x220, s_q8 * x219));
+        let x229 = Self::mul_add(x14, 6.1267499999999995, 35.01 * x15)
+            + Self::mul_add(-x8, x24, x2 * x22) + x225;
+        let x230 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
+            + Self::mul_add(-x1, x22, x8 * x23) + x226;
+        let x231 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x23, x1 * x24))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x217,
-                Self::mul_add(-c_q8, x215, s_q8 * x216),
+                x224,
+                Self::mul_add(-c_q8, x222, s_q8 * x223),
             );
-        let x225 = Self::mul_add(-s_q7, x223, c_q7 * x222);
-        let x226 = Self::mul_add(c_q7, x223, s_q7 * x222);
-        let x227 = -x225;
-        let x228 = -x226;
-        let x229 = -x224;
-        let x230 = -Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x221, c_q7 * x220));
-        let x231 = -(Self::mul_add(c_q7, x221, s_q7 * x220)
-            + Self::mul_add(-0.65, x224, 0.75 * x225));
-        let x232 = -Self::mul_add(
+        let x232 = Self::mul_add(-s_q7, x230, c_q7 * x229);
+        let x233 = Self::mul_add(c_q7, x230, s_q7 * x229);
+        let x234 = Self::mul_add(
             0.65,
-            x226,
+            x233,
             Self::mul_add(1.331, x12, Self::mul_add(0.1132, x14, 0.00071 * x13))
-                + (Self::mul_add(-x2, x18, x1 * x19) + Self::mul_add(-x7, x21, x6 * x22))
+                + (Self::mul_add(-x2, x20, x1 * x21) + Self::mul_add(-x7, x23, x6 * x24))
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x214,
-                    Self::mul_add(-c_q8, x212, s_q8 * x213),
+                    x221,
+                    Self::mul_add(-c_q8, x219, s_q8 * x220),
                 ),
         );
-        [x227, x228, x229, x230, x231, x232]
+        let x235 = -x232;
+        let x236 = -x233;
+        let x237 = -x231;
+        let x238 = -Self::mul_add(-0.75, x233, Self::mul_add(-s_q7, x228, c_q7 * x227));
+        let x239 = -(Self::mul_add(c_q7, x228, s_q7 * x227)
+            + Self::mul_add(-0.65, x231, 0.75 * x232));
+        let x240 = -x234;
+        [x235, x236, x237, x238, x239, x240]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

@@ -7,37 +7,40 @@
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Fused multiply-adds where the target has them: 1079 (`mass_matrix` 79, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 267, `mass_matrix_and_nonlinear_effects` 202, `forward_dynamics_with_wrenches` 274), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 468 | 392 | 0 | 0 | 6 | 860 |
-//! | `mass_matrix` | `recurrent-r1` | — | 519 | 422 | 0 | 0 | 6 | 941 |
-//! | `mass_matrix` | `kane-direct` | — | 505 | 352 | 0 | 0 | 6 | 857 |
-//! | `mass_matrix` | `crba-base` | — | 450 | 339 | 0 | 0 | 6 | 789 |
-//! | `mass_matrix` * | `crba` | — | 157 | 128 | 0 | 0 | 5 | 285 |
-//! | `nonlinear_effects` | — | `recurrent` | 537 | 386 | 0 | 0 | 6 | 923 |
-//! | `nonlinear_effects` | — | `kane-direct` | 580 | 428 | 0 | 0 | 6 | 1008 |
-//! | `nonlinear_effects` | — | `rnea` | 254 | 181 | 0 | 0 | 5 | 435 |
-//! | `nonlinear_effects` * | — | `newton-euler` | 220 | 157 | 0 | 0 | 5 | 377 |
-//! | `inverse_dynamics` | — | `recurrent` | 728 | 550 | 0 | 0 | 6 | 1278 |
-//! | `inverse_dynamics` | — | `kane-direct` | 771 | 592 | 0 | 0 | 6 | 1363 |
-//! | `inverse_dynamics` | — | `rnea` | 278 | 207 | 0 | 0 | 5 | 485 |
-//! | `inverse_dynamics` * | — | `newton-euler` | 232 | 178 | 0 | 0 | 5 | 410 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 780 | 585 | 6 | 0 | 6 | 1365 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 823 | 627 | 6 | 0 | 6 | 1450 |
-//! | `forward_dynamics` | `crba` | `rnea` | 497 | 380 | 6 | 0 | 5 | 877 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | 463 | 356 | 6 | 0 | 5 | 819 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 694 | 514 | 0 | 0 | 6 | 1208 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 737 | 556 | 0 | 0 | 6 | 1293 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 411 | 309 | 0 | 0 | 5 | 720 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 377 | 285 | 0 | 0 | 5 | 662 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 856 | 662 | 6 | 0 | 6 | 1518 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 899 | 704 | 6 | 0 | 6 | 1603 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 503 | 412 | 6 | 0 | 5 | 915 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 469 | 388 | 6 | 0 | 5 | 857 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 468 | 392 | 0 | 0 | 6 | 860 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 519 | 422 | 0 | 0 | 6 | 941 |
+//! | `mass_matrix` | `kane-direct` | — | — | 505 | 352 | 0 | 0 | 6 | 857 |
+//! | `mass_matrix` | `crba-base` | — | — | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` * | `crba` | — | — | 157 | 128 | 0 | 0 | 5 | 285 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 537 | 386 | 0 | 0 | 6 | 923 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 580 | 428 | 0 | 0 | 6 | 1008 |
+//! | `nonlinear_effects` | — | `rnea` | — | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | 220 | 157 | 0 | 0 | 5 | 377 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 728 | 550 | 0 | 0 | 6 | 1278 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 771 | 592 | 0 | 0 | 6 | 1363 |
+//! | `inverse_dynamics` | — | `rnea` | — | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | 232 | 178 | 0 | 0 | 5 | 410 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 780 | 585 | 6 | 0 | 6 | 1365 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 823 | 627 | 6 | 0 | 6 | 1450 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 497 | 380 | 6 | 0 | 5 | 877 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | 463 | 356 | 6 | 0 | 5 | 819 |
+//! | `forward_dynamics` | — | — | `aba` | 570 | 411 | 5 | 0 | 5 | 981 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 694 | 514 | 0 | 0 | 6 | 1208 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 737 | 556 | 0 | 0 | 6 | 1293 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 411 | 309 | 0 | 0 | 5 | 720 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 377 | 285 | 0 | 0 | 5 | 662 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 856 | 662 | 6 | 0 | 6 | 1518 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 899 | 704 | 6 | 0 | 6 | 1603 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 503 | 412 | 6 | 0 | 5 | 915 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | 469 | 388 | 6 | 0 | 5 | 857 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 576 | 443 | 5 | 0 | 5 | 1019 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -50,6 +53,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -94,6 +100,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 157u64,
             add: 128u64,
             div: 0u64,
@@ -105,6 +112,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 220u64,
             add: 157u64,
             div: 0u64,
@@ -116,6 +124,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 232u64,
             add: 178u64,
             div: 0u64,
@@ -127,6 +136,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 463u64,
             add: 356u64,
             div: 6u64,
@@ -138,6 +148,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 377u64,
             add: 285u64,
             div: 0u64,
@@ -149,6 +160,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 469u64,
             add: 388u64,
             div: 6u64,
@@ -163,6 +175,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 468u64,
             add: 392u64,
             div: 0u64,
@@ -174,6 +187,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 519u64,
             add: 422u64,
             div: 0u64,
@@ -185,6 +199,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 505u64,
             add: 352u64,
             div: 0u64,
@@ -196,6 +211,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 450u64,
             add: 339u64,
             div: 0u64,
@@ -207,6 +223,7 @@ impl Srms {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 157u64,
             add: 128u64,
             div: 0u64,
@@ -218,6 +235,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 537u64,
             add: 386u64,
             div: 0u64,
@@ -229,6 +247,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 580u64,
             add: 428u64,
             div: 0u64,
@@ -240,6 +259,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 254u64,
             add: 181u64,
             div: 0u64,
@@ -251,6 +271,7 @@ impl Srms {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 220u64,
             add: 157u64,
             div: 0u64,
@@ -262,6 +283,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 728u64,
             add: 550u64,
             div: 0u64,
@@ -273,6 +295,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 771u64,
             add: 592u64,
             div: 0u64,
@@ -284,6 +307,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 278u64,
             add: 207u64,
             div: 0u64,
@@ -295,6 +319,7 @@ impl Srms {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 232u64,
             add: 178u64,
             div: 0u64,
@@ -306,6 +331,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 780u64,
             add: 585u64,
             div: 6u64,
@@ -317,6 +343,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 823u64,
             add: 627u64,
             div: 6u64,
@@ -328,6 +355,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 497u64,
             add: 380u64,
             div: 6u64,
@@ -339,6 +367,7 @@ impl Srms {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 463u64,
             add: 356u64,
             div: 6u64,
@@ -347,9 +376,22 @@ impl Srms {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 570u64,
+            add: 411u64,
+            div: 5u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 694u64,
             add: 514u64,
             div: 0u64,
@@ -361,6 +403,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 737u64,
             add: 556u64,
             div: 0u64,
@@ -372,6 +415,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 411u64,
             add: 309u64,
             div: 0u64,
@@ -383,6 +427,7 @@ impl Srms {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 377u64,
             add: 285u64,
             div: 0u64,
@@ -394,6 +439,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 856u64,
             add: 662u64,
             div: 6u64,
@@ -405,6 +451,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 899u64,
             add: 704u64,
             div: 6u64,
@@ -416,6 +463,7 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 503u64,
             add: 412u64,
             div: 6u64,
@@ -427,9 +475,22 @@ impl Srms {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 469u64,
             add: 388u64,
             div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 576u64,
+            add: 443u64,
+            div: 5u64,
             sqrt: 0u64,
             sincos: 5u64,
             fma: 0u64,
@@ -495,123 +556,113 @@ impl Srms {
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x53 = 703.3878000000001 + x36;
-        let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x57 = 103.41030072000001
-            + Self::mul_add(
-                x37,
-                7.06,
-                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-            );
-        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x59 = 103.41030072000002
-            + Self::mul_add(
-                0.1524,
-                x36,
-                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
-            );
-        let x60 = -0.08 + (x43 + x51);
-        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
-        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
-        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
-        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
-        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
-        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
-        let x69 = 0.1524 * x62;
-        let x70 = -0.1524 * x62;
-        let x71 = x61 * -6.377;
-        let x72 = 6.377 * x61;
-        let x73 = 8609.573807858 + (x58 - (x71 - x70) - (x69 - x72));
-        let x74 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x64),
-            c_q1 * (-0.0302 + (x51 + x67)),
+        let x52 = Self::mul_add(
+            x37,
+            7.06,
+            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
         );
-        let x75 = 14222.257549666001
-            + Self::mul_add(
+        let x53 = Self::mul_add(
+            0.1524,
+            x36,
+            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+        );
+        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
+        let x55 = 703.3878000000001 + x36;
+        let x56 = -15.183612000000002 - x37;
+        let x57 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
+        let x59 = 103.41030072000001 + x52;
+        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x61 = 103.41030072000002 + x53;
+        let x62 = -0.08 + (x43 + x51);
+        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
+        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
+        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
+        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
+        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
+        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
+        let x71 = 0.1524 * x64;
+        let x72 = -0.1524 * x64;
+        let x73 = x63 * -6.377;
+        let x74 = 6.377 * x63;
+        let x75 = Self::mul_add(
+            x64,
+            -6.377,
+            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
+        );
+        let x76 = Self::mul_add(
+            0.1524,
+            x63,
+            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+        );
+        let x77 = 8609.573807858 + (x60 - (x73 - x72) - (x71 - x74));
+        let x78 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x66),
+            c_q1 * (-0.0302 + (x51 + x69)),
+        );
+        let x79 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(
                 -s_q1,
-                Self::mul_add(
+                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
+                c_q1 * (190.97044034000004 + x76),
+            ),
+            c_q1
+                * Self::mul_add(
                     -s_q1,
-                    -8596.210051042
-                        + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
-                    c_q1
-                        * (190.97044034000004
-                            + Self::mul_add(
-                                0.1524,
-                                x61,
-                                Self::mul_add(
-                                    -6.377,
-                                    x62,
-                                    Self::mul_add(s_q2, x68, c_q2 * x66),
-                                ),
-                            )),
+                    190.97044034 + x75,
+                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
                 ),
-                c_q1
-                    * Self::mul_add(
-                        -s_q1,
-                        190.97044034
-                            + Self::mul_add(
-                                x62,
-                                -6.377,
-                                Self::mul_add(
-                                    0.1524,
-                                    x61,
-                                    Self::mul_add(-s_q2, x63, c_q2 * x65),
-                                ),
-                            ),
-                        c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
-                    ),
-            );
-        let x76 = x58 + (x70 - x71);
-        let x77 = Self::mul_add(-s_q1, x64, c_q1 * x67);
-        let x78 = x50
+        );
+        let x80 = 14222.257549666001 + x79;
+        let x81 = x60 + (x72 - x73);
+        let x82 = Self::mul_add(-s_q1, x66, c_q1 * x69);
+        let x83 = x50
             + Self::mul_add(
                 0.1524,
                 Self::mul_add(s_q2, x36, c_q2 * x37),
                 -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
             );
-        let x79 = Self::mul_add(
+        let x84 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x43, c_q2 * x39),
             c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
         );
-        let x80 = c_q3 * x16;
-        let x81 = s_q3 * x16;
-        let x82 = x15 * 0.1524;
-        let x83 = Self::mul_add(s_q3, x30, x40) + x82;
-        let x84 = x25 + Self::mul_add(0.1524, x80, -7.06 * x81);
-        let x85 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x86 = x84
+        let x85 = c_q3 * x16;
+        let x86 = s_q3 * x16;
+        let x87 = x15 * 0.1524;
+        let x88 = Self::mul_add(s_q3, x30, x40) + x87;
+        let x89 = x25 + Self::mul_add(0.1524, x85, -7.06 * x86);
+        let x90 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
+        let x91 = x89
             + Self::mul_add(
                 -6.377,
-                Self::mul_add(c_q2, x81, s_q2 * x80),
-                -0.1524 * Self::mul_add(-c_q2, x80, s_q2 * x81),
+                Self::mul_add(c_q2, x86, s_q2 * x85),
+                -0.1524 * Self::mul_add(-c_q2, x85, s_q2 * x86),
             );
-        let x87 = Self::mul_add(
+        let x92 = Self::mul_add(
             -s_q1,
-            x82 + Self::mul_add(s_q2, x85, c_q2 * x83),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x83, c_q2 * x85)),
+            x87 + Self::mul_add(s_q2, x90, c_q2 * x88),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x88, c_q2 * x90)),
         );
-        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x90 = Self::mul_add(
+        let x93 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x94 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x95 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x89, c_q2 * x88),
-            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
+            Self::mul_add(s_q2, x94, c_q2 * x93),
+            c_q1 * Self::mul_add(-s_q2, x93, c_q2 * x94),
         );
         [
-            [x75, x74, x77, x79, x87, x90],
-            [x74, x73, x76, x78, x86, x23],
-            [x77, x76, x58, x50, x84, x23],
-            [x79, x78, x50, x35, x25, x23],
-            [x87, x86, x84, x25, x14, x9],
-            [x90, x23, x23, x23, x9, 1.903],
+            [x80, x78, x82, x84, x92, x95],
+            [x78, x77, x81, x83, x91, x23],
+            [x82, x81, x60, x50, x89, x23],
+            [x84, x83, x50, x35, x25, x23],
+            [x92, x91, x89, x25, x14, x9],
+            [x95, x23, x23, x23, x9, 1.903],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -665,122 +716,124 @@ impl Srms {
             Self::mul_add(-0.8021, x11, 5601.1318504688 * x20),
         );
         let x29 = Self::mul_add(-103.41030072000002, x11, -0.08 * x20);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x31 = Self::mul_add(x12, s_q3, x11 * c_q3);
-        let x32 = Self::mul_add(-x11, s_q3, x12 * c_q3);
-        let x33 = x16 - Self::mul_add(-0.1524, x23, 7.06 * x22);
-        let x34 = x14 + Self::mul_add(-7.06, x24, -0.1524 * x25);
-        let x35 = x17 + Self::mul_add(-0.1524, x26, 7.06 * x23);
-        let x36 = Self::mul_add(-c_q3, x35, s_q3 * x33);
-        let x37 = Self::mul_add(-qd[3], x32, Self::mul_add(x19, s_q3, x18 * c_q3));
-        let x38 = Self::mul_add(-qd[3], x31, Self::mul_add(-x19, c_q3, x18 * s_q3));
-        let x39 = qd[3] + x20;
-        let x40 = Self::mul_add(x32, x32, x39 * x39);
-        let x41 = x31 * x32;
-        let x42 = Self::mul_add(-x31, x39, x38);
-        let x43 = -18.957952216000002 * x31;
-        let x44 = 19.863252216000003 * x39;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x46 = Self::mul_add(-x31, c_q4, x39 * s_q4);
-        let x47 = Self::mul_add(x39, c_q4, x31 * s_q4);
-        let x48 = Self::mul_add(qd[4], x47, x37 * c_q4);
-        let x49 = Self::mul_add(qd[4], x46, x37 * s_q4);
-        let x50 = qd[4] + x32;
-        let x51 = 34.45002 * Self::mul_add(x50, x50, x47 * x47);
-        let x52 = 34.45002 * Self::mul_add(x46, x47, x38);
-        let x53 = 34.45002 * Self::mul_add(x46, x50, x49);
-        let x54 = 34.33891524 * x47;
-        let x55 = 34.74691524 * x50;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x57 = Self::mul_add(x50, s_q5, x47 * c_q5);
-        let x58 = Self::mul_add(-x47, s_q5, x50 * c_q5);
-        let x59 = Self::mul_add(qd[5], x58, Self::mul_add(-x49, c_q5, x38 * s_q5));
-        let x60 = Self::mul_add(-qd[5], x57, Self::mul_add(x38, c_q5, x49 * s_q5));
-        let x61 = qd[5] + x46;
-        let x62 = Self::mul_add(0.966, x58, Self::mul_add(0.385, x57, 1.903 * x61));
-        let x63 = Self::mul_add(0.353, x58, 0.385 * x61);
-        let x64 = Self::mul_add(
-            -0.9929999999999999,
-            x58,
-            Self::mul_add(0.353, x57, 0.966 * x61),
+        let x30 = Self::mul_add(
+            703.3878000000001,
+            x14,
+            Self::mul_add(103.41030072000002, x18, -Self::mul_add(x11, x28, x20 * x27)),
         );
-        let x65 = Self::mul_add(0.966, x60, Self::mul_add(0.385, x59, 1.903 * x48))
-            + Self::mul_add(-x58, x63, x57 * x64);
-        let x66 = Self::mul_add(0.353, x60, 0.385 * x48)
-            + Self::mul_add(-x61, x64, x58 * x62);
-        let x67 = Self::mul_add(
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x32 = Self::mul_add(x12, s_q3, x11 * c_q3);
+        let x33 = Self::mul_add(-x11, s_q3, x12 * c_q3);
+        let x34 = x16 - Self::mul_add(-0.1524, x23, 7.06 * x22);
+        let x35 = x14 + Self::mul_add(-7.06, x24, -0.1524 * x25);
+        let x36 = x17 + Self::mul_add(-0.1524, x26, 7.06 * x23);
+        let x37 = Self::mul_add(-c_q3, x36, s_q3 * x34);
+        let x38 = Self::mul_add(-qd[3], x33, Self::mul_add(x19, s_q3, x18 * c_q3));
+        let x39 = Self::mul_add(-qd[3], x32, Self::mul_add(-x19, c_q3, x18 * s_q3));
+        let x40 = qd[3] + x20;
+        let x41 = Self::mul_add(x33, x33, x40 * x40);
+        let x42 = x32 * x33;
+        let x43 = Self::mul_add(-x32, x40, x39);
+        let x44 = -18.957952216000002 * x32;
+        let x45 = 19.863252216000003 * x40;
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x47 = Self::mul_add(-x32, c_q4, x40 * s_q4);
+        let x48 = Self::mul_add(x40, c_q4, x32 * s_q4);
+        let x49 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(-0.4572, x41, Self::mul_add(s_q3, x36, c_q3 * x34)),
+            c_q4 * Self::mul_add(0.4572, x43, x35),
+        );
+        let x50 = Self::mul_add(qd[4], x48, x38 * c_q4);
+        let x51 = Self::mul_add(qd[4], x47, x38 * s_q4);
+        let x52 = qd[4] + x33;
+        let x53 = 34.45002 * Self::mul_add(x52, x52, x48 * x48);
+        let x54 = 34.45002 * Self::mul_add(x47, x48, x39);
+        let x55 = 34.45002 * Self::mul_add(x47, x52, x51);
+        let x56 = 34.33891524 * x48;
+        let x57 = 34.74691524 * x52;
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x59 = Self::mul_add(x52, s_q5, x48 * c_q5);
+        let x60 = Self::mul_add(-x48, s_q5, x52 * c_q5);
+        let x61 = Self::mul_add(qd[5], x60, Self::mul_add(-x51, c_q5, x39 * s_q5));
+        let x62 = Self::mul_add(-qd[5], x59, Self::mul_add(x39, c_q5, x51 * s_q5));
+        let x63 = qd[5] + x47;
+        let x64 = Self::mul_add(0.966, x60, Self::mul_add(0.385, x59, 1.903 * x63));
+        let x65 = Self::mul_add(0.353, x60, 0.385 * x63);
+        let x66 = Self::mul_add(
             -0.9929999999999999,
             x60,
-            Self::mul_add(0.353, x59, 0.966 * x48),
-        ) + Self::mul_add(-x57, x62, x61 * x63);
-        let x68 = Self::mul_add(-x50, x54, x47 * x55) + x65;
+            Self::mul_add(0.353, x59, 0.966 * x63),
+        );
+        let x67 = Self::mul_add(0.966, x62, Self::mul_add(0.385, x61, 1.903 * x50))
+            + Self::mul_add(-x60, x65, x59 * x66);
+        let x68 = Self::mul_add(0.353, x62, 0.385 * x50)
+            + Self::mul_add(-x63, x66, x60 * x64);
         let x69 = Self::mul_add(
-            Self::mul_add(-0.4572, x41, x36),
+            -0.9929999999999999,
+            x62,
+            Self::mul_add(0.353, x61, 0.966 * x50),
+        ) + Self::mul_add(-x59, x64, x63 * x65);
+        let x70 = Self::mul_add(-x52, x56, x48 * x57) + x67;
+        let x71 = Self::mul_add(
+            Self::mul_add(-0.4572, x42, x37),
             -34.45002,
-            -Self::mul_add(x46, x55, 34.33891524 * x49),
-        ) + Self::mul_add(-s_q5, x67, c_q5 * x66);
-        let x70 = Self::mul_add(
+            -Self::mul_add(x47, x57, 34.33891524 * x51),
+        ) + Self::mul_add(-s_q5, x69, c_q5 * x68);
+        let x72 = Self::mul_add(
             34.45002,
-            Self::mul_add(
-                -s_q4,
-                Self::mul_add(-0.4572, x40, Self::mul_add(s_q3, x35, c_q3 * x33)),
-                c_q4 * Self::mul_add(0.4572, x42, x34),
-            ),
-            Self::mul_add(x46, x54, 34.74691524 * x38),
-        ) + Self::mul_add(c_q5, x67, s_q5 * x66);
-        let x71 = Self::mul_add(-s_q4, x51, c_q4 * x52);
-        let x72 = Self::mul_add(41.67378, x40, Self::mul_add(s_q4, x52, c_q4 * x51));
-        let x73 = Self::mul_add(41.67378, x42, x71);
-        let x74 = Self::mul_add(-41.67378, x41, x53);
-        let x75 = Self::mul_add(-x32, x44, -18.957952216000002 * x37)
-            + Self::mul_add(-s_q4, x69, c_q4 * x68);
-        let x76 = Self::mul_add(-x32, x43, x36 * -41.67378)
-            + Self::mul_add(x53, -0.4572, Self::mul_add(c_q4, x69, s_q4 * x68));
-        let x77 = Self::mul_add(41.67378, x34, Self::mul_add(-x31, x44, x39 * x43))
-            + Self::mul_add(0.4572, x71, x70);
-        let x78 = Self::mul_add(-c_q3, x72, s_q3 * x74);
-        let x79 = Self::mul_add(c_q3, x74, s_q3 * x72);
-        let x80 = x78 - Self::mul_add(-15.183612000000002, x23, 703.3878000000001 * x22);
-        let x81 = Self::mul_add(-703.3878000000001, x24, -15.183612000000002 * x25)
-            + x73;
-        let x82 = x79 - Self::mul_add(-15.183612000000002, x26, 703.3878000000001 * x23);
-        let x83 = Self::mul_add(
+            x49,
+            Self::mul_add(x47, x56, 34.74691524 * x39),
+        ) + Self::mul_add(c_q5, x69, s_q5 * x68);
+        let x73 = Self::mul_add(-s_q4, x53, c_q4 * x54);
+        let x74 = Self::mul_add(41.67378, x41, Self::mul_add(s_q4, x54, c_q4 * x53));
+        let x75 = Self::mul_add(41.67378, x43, x73);
+        let x76 = Self::mul_add(-41.67378, x42, x55);
+        let x77 = Self::mul_add(-x33, x45, -18.957952216000002 * x38)
+            + Self::mul_add(-s_q4, x71, c_q4 * x70);
+        let x78 = Self::mul_add(-x33, x44, x37 * -41.67378)
+            + Self::mul_add(x55, -0.4572, Self::mul_add(c_q4, x71, s_q4 * x70));
+        let x79 = Self::mul_add(41.67378, x35, Self::mul_add(-x32, x45, x40 * x44))
+            + Self::mul_add(0.4572, x73, x72);
+        let x80 = Self::mul_add(-c_q3, x74, s_q3 * x76);
+        let x81 = Self::mul_add(c_q3, x76, s_q3 * x74);
+        let x82 = x80 - Self::mul_add(-15.183612000000002, x23, 703.3878000000001 * x22);
+        let x83 = Self::mul_add(-703.3878000000001, x24, -15.183612000000002 * x25)
+            + x75;
+        let x84 = x81 - Self::mul_add(-15.183612000000002, x26, 703.3878000000001 * x23);
+        let x85 = Self::mul_add(
             x14,
             15.183612000000002,
             Self::mul_add(-103.41030072000001, x19, -5594.523885531201 * x18)
                 + Self::mul_add(-x12, x28, x20 * x29),
-        ) + Self::mul_add(x73, 0.1524, Self::mul_add(s_q3, x77, c_q3 * x75));
-        let x84 = Self::mul_add(0.08, x19, 0.8021 * x18)
+        ) + Self::mul_add(x75, 0.1524, Self::mul_add(s_q3, x79, c_q3 * x77));
+        let x86 = Self::mul_add(0.08, x19, 0.8021 * x18)
             + Self::mul_add(x11, x29, x12 * x27)
             + Self::mul_add(x17, 703.3878000000001, -15.183612000000002 * x16)
-            + (x76 + Self::mul_add(x79, -7.06, -0.1524 * x78));
-        let x85 = Self::mul_add(
-            703.3878000000001,
-            x14,
-            Self::mul_add(103.41030072000002, x18, -Self::mul_add(x11, x28, x20 * x27)),
-        ) + Self::mul_add(7.06, x73, Self::mul_add(-s_q3, x75, c_q3 * x77));
-        let x86 = Self::mul_add(x1, x9, x2 * x7)
+            + (x78 + Self::mul_add(x81, -7.06, -0.1524 * x80));
+        let x87 = x30 + Self::mul_add(7.06, x75, Self::mul_add(-s_q3, x77, c_q3 * x79));
+        let x88 = Self::mul_add(x1, x9, x2 * x7)
             - Self::mul_add(-0.0302, x4, -1.928 * x3)
-            + (x84
+            + (x86
                 + Self::mul_add(
-                    Self::mul_add(-s_q2, x80, c_q2 * x82),
+                    Self::mul_add(-s_q2, x82, c_q2 * x84),
                     -6.377,
-                    -0.1524 * Self::mul_add(s_q2, x82, c_q2 * x80),
+                    -0.1524 * Self::mul_add(s_q2, x84, c_q2 * x82),
                 ));
-        let x87 = Self::mul_add(
+        let x89 = Self::mul_add(
             -s_q1,
             Self::mul_add(-x2, x8, qd[1] * x9)
                 - Self::mul_add(190.97044034, x4, -8596.210051042 * x3)
-                + Self::mul_add(0.1524, x81, Self::mul_add(s_q2, x85, c_q2 * x83)),
+                + Self::mul_add(0.1524, x83, Self::mul_add(s_q2, x87, c_q2 * x85)),
             c_q1
-                * (Self::mul_add(6.377, x81, Self::mul_add(-s_q2, x83, c_q2 * x85))
+                * (Self::mul_add(6.377, x83, Self::mul_add(-s_q2, x85, c_q2 * x87))
                     - Self::mul_add(
                         190.97044034000004,
                         x3,
                         Self::mul_add(x1, x8, qd[1] * x7),
                     )),
         );
-        [x87, x86, x84, x76, x70, x65]
+        [x89, x88, x86, x78, x72, x67]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -846,92 +899,7 @@ impl Srms {
             Self::mul_add(-0.8021, x13, 5601.1318504688 * x23),
         );
         let x34 = Self::mul_add(-103.41030072000002, x13, -0.08 * x23);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x36 = Self::mul_add(x14, s_q3, x13 * c_q3);
-        let x37 = Self::mul_add(-x13, s_q3, x14 * c_q3);
-        let x38 = x18 + Self::mul_add(-7.06, x25, -0.1524 * x27);
-        let x39 = x16 + Self::mul_add(-0.1524, x29, 7.06 * x28);
-        let x40 = x19 - Self::mul_add(-0.1524, x31, 7.06 * x30);
-        let x41 = Self::mul_add(c_q3, x40, s_q3 * x38);
-        let x42 = Self::mul_add(qd[3], x37, Self::mul_add(x21, s_q3, x20 * c_q3));
-        let x43 = Self::mul_add(-qd[3], x36, Self::mul_add(-x20, s_q3, x21 * c_q3));
-        let x44 = qdd[3] + x22;
-        let x45 = qd[3] + x23;
-        let x46 = Self::mul_add(x37, x37, x45 * x45);
-        let x47 = Self::mul_add(-x36, x45, x43);
-        let x48 = Self::mul_add(x36, x37, x44);
-        let x49 = -18.957952216000002 * x36;
-        let x50 = 19.863252216000003 * x45;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x52 = Self::mul_add(-x36, c_q4, x45 * s_q4);
-        let x53 = Self::mul_add(x45, c_q4, x36 * s_q4);
-        let x54 = Self::mul_add(-qd[4], x52, Self::mul_add(x44, c_q4, x42 * s_q4));
-        let x55 = qdd[4] + x43;
-        let x56 = qd[4] + x37;
-        let x57 = 34.45002 * Self::mul_add(x56, x56, x53 * x53);
-        let x58 = 34.45002 * Self::mul_add(x52, x53, x55);
-        let x59 = 34.45002 * Self::mul_add(x52, x56, -x54);
-        let x60 = 34.33891524 * x53;
-        let x61 = 34.74691524 * x56;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x63 = Self::mul_add(x56, s_q5, x53 * c_q5);
-        let x64 = Self::mul_add(-x53, s_q5, x56 * c_q5);
-        let x65 = Self::mul_add(qd[5], x64, Self::mul_add(x55, s_q5, x54 * c_q5));
-        let x66 = Self::mul_add(-qd[5], x63, Self::mul_add(-x54, s_q5, x55 * c_q5));
-        let x67 = qdd[5]
-            + Self::mul_add(qd[4], x53, Self::mul_add(-x42, c_q4, x44 * s_q4));
-        let x68 = qd[5] + x52;
-        let x69 = Self::mul_add(0.966, x64, Self::mul_add(0.385, x63, 1.903 * x68));
-        let x70 = Self::mul_add(0.353, x64, 0.385 * x68);
-        let x71 = Self::mul_add(
-            -0.9929999999999999,
-            x64,
-            Self::mul_add(0.353, x63, 0.966 * x68),
-        );
-        let x72 = Self::mul_add(0.966, x66, Self::mul_add(0.385, x65, 1.903 * x67))
-            + Self::mul_add(-x64, x70, x63 * x71);
-        let x73 = Self::mul_add(0.353, x66, 0.385 * x67)
-            + Self::mul_add(-x68, x71, x64 * x69);
-        let x74 = Self::mul_add(
-            -0.9929999999999999,
-            x66,
-            Self::mul_add(0.353, x65, 0.966 * x67),
-        ) + Self::mul_add(-x63, x69, x68 * x70);
-        let x75 = Self::mul_add(-x56, x60, x53 * x61) + x72;
-        let x76 = Self::mul_add(
-            Self::mul_add(-0.4572, x48, x41),
-            -34.45002,
-            Self::mul_add(-x52, x61, 34.33891524 * x54),
-        ) + Self::mul_add(-s_q5, x74, c_q5 * x73);
-        let x77 = Self::mul_add(
-            34.45002,
-            Self::mul_add(
-                -s_q4,
-                Self::mul_add(-0.4572, x46, Self::mul_add(-s_q3, x40, c_q3 * x38)),
-                c_q4 * Self::mul_add(0.4572, x47, x39),
-            ),
-            Self::mul_add(x52, x60, 34.74691524 * x55),
-        ) + Self::mul_add(c_q5, x74, s_q5 * x73);
-        let x78 = Self::mul_add(-s_q4, x57, c_q4 * x58);
-        let x79 = Self::mul_add(41.67378, x46, Self::mul_add(s_q4, x58, c_q4 * x57));
-        let x80 = Self::mul_add(41.67378, x47, x78);
-        let x81 = Self::mul_add(-41.67378, x48, x59);
-        let x82 = Self::mul_add(-s_q4, x76, c_q4 * x75)
-            - Self::mul_add(x37, x50, -18.957952216000002 * x42);
-        let x83 = Self::mul_add(
-            x41,
-            -41.67378,
-            Self::mul_add(-x37, x49, 19.863252216000003 * x44),
-        ) + Self::mul_add(x59, -0.4572, Self::mul_add(c_q4, x76, s_q4 * x75));
-        let x84 = Self::mul_add(41.67378, x39, Self::mul_add(-x36, x50, x45 * x49))
-            + Self::mul_add(0.4572, x78, x77);
-        let x85 = Self::mul_add(-c_q3, x79, s_q3 * x81);
-        let x86 = Self::mul_add(c_q3, x81, s_q3 * x79);
-        let x87 = Self::mul_add(-703.3878000000001, x25, -15.183612000000002 * x27)
-            + x85;
-        let x88 = Self::mul_add(-15.183612000000002, x29, 703.3878000000001 * x28) + x80;
-        let x89 = x86 - Self::mul_add(-15.183612000000002, x31, 703.3878000000001 * x30);
-        let x90 = Self::mul_add(
+        let x35 = Self::mul_add(
             x16,
             15.183612000000002,
             Self::mul_add(
@@ -939,57 +907,137 @@ impl Srms {
                 x21,
                 Self::mul_add(5594.523885531201, x20, 0.8021 * x22),
             ) + Self::mul_add(-x14, x33, x23 * x34),
-        ) + Self::mul_add(x80, 0.1524, Self::mul_add(s_q3, x84, c_q3 * x82));
-        let x91 = Self::mul_add(
+        );
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x37 = Self::mul_add(x14, s_q3, x13 * c_q3);
+        let x38 = Self::mul_add(-x13, s_q3, x14 * c_q3);
+        let x39 = x18 + Self::mul_add(-7.06, x25, -0.1524 * x27);
+        let x40 = x16 + Self::mul_add(-0.1524, x29, 7.06 * x28);
+        let x41 = x19 - Self::mul_add(-0.1524, x31, 7.06 * x30);
+        let x42 = Self::mul_add(c_q3, x41, s_q3 * x39);
+        let x43 = Self::mul_add(qd[3], x38, Self::mul_add(x21, s_q3, x20 * c_q3));
+        let x44 = Self::mul_add(-qd[3], x37, Self::mul_add(-x20, s_q3, x21 * c_q3));
+        let x45 = qdd[3] + x22;
+        let x46 = qd[3] + x23;
+        let x47 = Self::mul_add(x38, x38, x46 * x46);
+        let x48 = Self::mul_add(-x37, x46, x44);
+        let x49 = Self::mul_add(x37, x38, x45);
+        let x50 = -18.957952216000002 * x37;
+        let x51 = 19.863252216000003 * x46;
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x53 = Self::mul_add(-x37, c_q4, x46 * s_q4);
+        let x54 = Self::mul_add(x46, c_q4, x37 * s_q4);
+        let x55 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(-0.4572, x47, Self::mul_add(-s_q3, x41, c_q3 * x39)),
+            c_q4 * Self::mul_add(0.4572, x48, x40),
+        );
+        let x56 = Self::mul_add(-qd[4], x53, Self::mul_add(x45, c_q4, x43 * s_q4));
+        let x57 = qdd[4] + x44;
+        let x58 = qd[4] + x38;
+        let x59 = 34.45002 * Self::mul_add(x58, x58, x54 * x54);
+        let x60 = 34.45002 * Self::mul_add(x53, x54, x57);
+        let x61 = 34.45002 * Self::mul_add(x53, x58, -x56);
+        let x62 = 34.33891524 * x54;
+        let x63 = 34.74691524 * x58;
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x65 = Self::mul_add(x58, s_q5, x54 * c_q5);
+        let x66 = Self::mul_add(-x54, s_q5, x58 * c_q5);
+        let x67 = Self::mul_add(qd[5], x66, Self::mul_add(x57, s_q5, x56 * c_q5));
+        let x68 = Self::mul_add(-qd[5], x65, Self::mul_add(-x56, s_q5, x57 * c_q5));
+        let x69 = qdd[5]
+            + Self::mul_add(qd[4], x54, Self::mul_add(-x43, c_q4, x45 * s_q4));
+        let x70 = qd[5] + x53;
+        let x71 = Self::mul_add(0.966, x66, Self::mul_add(0.385, x65, 1.903 * x70));
+        let x72 = Self::mul_add(0.353, x66, 0.385 * x70);
+        let x73 = Self::mul_add(
+            -0.9929999999999999,
+            x66,
+            Self::mul_add(0.353, x65, 0.966 * x70),
+        );
+        let x74 = Self::mul_add(0.966, x68, Self::mul_add(0.385, x67, 1.903 * x69))
+            + Self::mul_add(-x66, x72, x65 * x73);
+        let x75 = Self::mul_add(0.353, x68, 0.385 * x69)
+            + Self::mul_add(-x70, x73, x66 * x71);
+        let x76 = Self::mul_add(
+            -0.9929999999999999,
+            x68,
+            Self::mul_add(0.353, x67, 0.966 * x69),
+        ) + Self::mul_add(-x65, x71, x70 * x72);
+        let x77 = Self::mul_add(-x58, x62, x54 * x63) + x74;
+        let x78 = Self::mul_add(
+            Self::mul_add(-0.4572, x49, x42),
+            -34.45002,
+            Self::mul_add(-x53, x63, 34.33891524 * x56),
+        ) + Self::mul_add(-s_q5, x76, c_q5 * x75);
+        let x79 = Self::mul_add(
+            34.45002,
+            x55,
+            Self::mul_add(x53, x62, 34.74691524 * x57),
+        ) + Self::mul_add(c_q5, x76, s_q5 * x75);
+        let x80 = Self::mul_add(-s_q4, x59, c_q4 * x60);
+        let x81 = Self::mul_add(41.67378, x47, Self::mul_add(s_q4, x60, c_q4 * x59));
+        let x82 = Self::mul_add(41.67378, x48, x80);
+        let x83 = Self::mul_add(-41.67378, x49, x61);
+        let x84 = Self::mul_add(-s_q4, x78, c_q4 * x77)
+            - Self::mul_add(x38, x51, -18.957952216000002 * x43);
+        let x85 = Self::mul_add(
+            x42,
+            -41.67378,
+            Self::mul_add(-x38, x50, 19.863252216000003 * x45),
+        ) + Self::mul_add(x61, -0.4572, Self::mul_add(c_q4, x78, s_q4 * x77));
+        let x86 = Self::mul_add(41.67378, x40, Self::mul_add(-x37, x51, x46 * x50))
+            + Self::mul_add(0.4572, x80, x79);
+        let x87 = Self::mul_add(-c_q3, x81, s_q3 * x83);
+        let x88 = Self::mul_add(c_q3, x83, s_q3 * x81);
+        let x89 = Self::mul_add(-703.3878000000001, x25, -15.183612000000002 * x27)
+            + x87;
+        let x90 = Self::mul_add(-15.183612000000002, x29, 703.3878000000001 * x28) + x82;
+        let x91 = x88 - Self::mul_add(-15.183612000000002, x31, 703.3878000000001 * x30);
+        let x92 = x35 + Self::mul_add(x82, 0.1524, Self::mul_add(s_q3, x86, c_q3 * x84));
+        let x93 = Self::mul_add(
             -0.08,
             x21,
             Self::mul_add(-0.8021, x20, 5601.1318504688 * x22),
         ) + Self::mul_add(x13, x34, x14 * x32)
             + Self::mul_add(x19, -703.3878000000001, -15.183612000000002 * x18)
-            + (x83 + Self::mul_add(x86, -7.06, -0.1524 * x85));
-        let x92 = Self::mul_add(
+            + (x85 + Self::mul_add(x88, -7.06, -0.1524 * x87));
+        let x94 = Self::mul_add(
             703.3878000000001,
             x16,
             Self::mul_add(-103.41030072000002, x20, -0.08 * x22)
                 - Self::mul_add(x13, x33, x23 * x32),
-        ) + Self::mul_add(7.06, x80, Self::mul_add(-s_q3, x82, c_q3 * x84));
-        let x93 = Self::mul_add(
+        ) + Self::mul_add(7.06, x82, Self::mul_add(-s_q3, x84, c_q3 * x86));
+        let x95 = Self::mul_add(
             -0.0302,
             x6,
             Self::mul_add(1.928, x5, 8609.573807858 * qdd[1]),
         ) + Self::mul_add(x1, x11, x2 * x9)
-            + (x91
+            + (x93
                 + Self::mul_add(
-                    Self::mul_add(-s_q2, x87, c_q2 * x89),
+                    Self::mul_add(-s_q2, x89, c_q2 * x91),
                     -6.377,
-                    -0.1524 * Self::mul_add(s_q2, x89, c_q2 * x87),
+                    -0.1524 * Self::mul_add(s_q2, x91, c_q2 * x89),
                 ));
-        let x94 = Self::mul_add(
-            14222.257549666001,
-            qdd[0],
+        let x96 = Self::mul_add(
+            -s_q1,
             Self::mul_add(
-                -s_q1,
-                Self::mul_add(
-                    190.97044034,
-                    x6,
-                    Self::mul_add(8596.210051042, x5, -1.928 * qdd[1]),
-                ) + Self::mul_add(-x2, x10, qd[1] * x11)
-                    + Self::mul_add(0.1524, x88, Self::mul_add(s_q2, x92, c_q2 * x90)),
-                c_q1
-                    * (Self::mul_add(-190.97044034000004, x5, -0.0302 * qdd[1])
-                        - Self::mul_add(x1, x10, qd[1] * x9)
-                        + Self::mul_add(
-                            6.377,
-                            x88,
-                            Self::mul_add(-s_q2, x90, c_q2 * x92),
-                        )),
-            ),
+                190.97044034,
+                x6,
+                Self::mul_add(8596.210051042, x5, -1.928 * qdd[1]),
+            ) + Self::mul_add(-x2, x10, qd[1] * x11)
+                + Self::mul_add(0.1524, x90, Self::mul_add(s_q2, x94, c_q2 * x92)),
+            c_q1
+                * (Self::mul_add(-190.97044034000004, x5, -0.0302 * qdd[1])
+                    - Self::mul_add(x1, x10, qd[1] * x9)
+                    + Self::mul_add(6.377, x90, Self::mul_add(-s_q2, x92, c_q2 * x94))),
         );
-        [x94, x93, x91, x83, x77, x72]
+        let x97 = Self::mul_add(14222.257549666001, qdd[0], x96);
+        [x97, x95, x93, x85, x79, x74]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 463 mul, 356 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 267 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 463 mul, 356 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 267 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1047,282 +1095,266 @@ impl Srms {
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x53 = 703.3878000000001 + x36;
-        let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x57 = 103.41030072000001
-            + Self::mul_add(
-                x37,
-                7.06,
-                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-            );
-        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x59 = 103.41030072000002
-            + Self::mul_add(
-                0.1524,
-                x36,
-                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
-            );
-        let x60 = -0.08 + (x43 + x51);
-        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
-        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
-        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
-        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
-        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
-        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
-        let x69 = 0.1524 * x62;
-        let x70 = -0.1524 * x62;
-        let x71 = x61 * -6.377;
-        let x72 = 6.377 * x61;
-        let x73 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x64),
-            c_q1 * (-0.0302 + (x51 + x67)),
+        let x52 = Self::mul_add(
+            x37,
+            7.06,
+            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
         );
-        let x74 = Self::mul_add(-s_q1, x64, c_q1 * x67);
+        let x53 = Self::mul_add(
+            0.1524,
+            x36,
+            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+        );
+        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
+        let x55 = 703.3878000000001 + x36;
+        let x56 = -15.183612000000002 - x37;
+        let x57 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
+        let x59 = 103.41030072000001 + x52;
+        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x61 = 103.41030072000002 + x53;
+        let x62 = -0.08 + (x43 + x51);
+        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
+        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
+        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
+        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
+        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
+        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
+        let x71 = 0.1524 * x64;
+        let x72 = -0.1524 * x64;
+        let x73 = x63 * -6.377;
+        let x74 = 6.377 * x63;
         let x75 = Self::mul_add(
+            x64,
+            -6.377,
+            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
+        );
+        let x76 = Self::mul_add(
+            0.1524,
+            x63,
+            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+        );
+        let x77 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x66),
+            c_q1 * (-0.0302 + (x51 + x69)),
+        );
+        let x78 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(
+                -s_q1,
+                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
+                c_q1 * (190.97044034000004 + x76),
+            ),
+            c_q1
+                * Self::mul_add(
+                    -s_q1,
+                    190.97044034 + x75,
+                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
+                ),
+        );
+        let x79 = Self::mul_add(-s_q1, x66, c_q1 * x69);
+        let x80 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x43, c_q2 * x39),
             c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
         );
-        let x76 = c_q3 * x16;
-        let x77 = s_q3 * x16;
-        let x78 = x15 * 0.1524;
-        let x79 = Self::mul_add(s_q3, x30, x40) + x78;
-        let x80 = x25 + Self::mul_add(0.1524, x76, -7.06 * x77);
-        let x81 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x82 = Self::mul_add(
+        let x81 = c_q3 * x16;
+        let x82 = s_q3 * x16;
+        let x83 = x15 * 0.1524;
+        let x84 = Self::mul_add(s_q3, x30, x40) + x83;
+        let x85 = x25 + Self::mul_add(0.1524, x81, -7.06 * x82);
+        let x86 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
+        let x87 = Self::mul_add(
             -s_q1,
-            x78 + Self::mul_add(s_q2, x81, c_q2 * x79),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x79, c_q2 * x81)),
+            x83 + Self::mul_add(s_q2, x86, c_q2 * x84),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x84, c_q2 * x86)),
         );
-        let x83 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x84 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x85 = Self::mul_add(
+        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x90 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x84, c_q2 * x83),
-            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x84),
+            Self::mul_add(s_q2, x89, c_q2 * x88),
+            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
         );
-        let x86 = qd[0] * s_q1;
-        let x87 = qd[0] * c_q1;
-        let x88 = qd[1] * x87;
-        let x89 = qd[1] * x86;
-        let x90 = qd[1] * qd[1];
-        let x91 = x86 * x87;
-        let x92 = Self::mul_add(
+        let x91 = qd[0] * s_q1;
+        let x92 = qd[0] * c_q1;
+        let x93 = qd[1] * x92;
+        let x94 = qd[1] * x91;
+        let x95 = qd[1] * qd[1];
+        let x96 = x91 * x92;
+        let x97 = Self::mul_add(
             190.97044034,
-            x87,
-            Self::mul_add(8596.210051042, x86, -1.928 * qd[1]),
+            x92,
+            Self::mul_add(8596.210051042, x91, -1.928 * qd[1]),
         );
-        let x93 = Self::mul_add(
+        let x98 = Self::mul_add(
             -0.0302,
-            x87,
-            Self::mul_add(1.928, x86, 8609.573807858 * qd[1]),
+            x92,
+            Self::mul_add(1.928, x91, 8609.573807858 * qd[1]),
         );
-        let x94 = Self::mul_add(-190.97044034000004, x86, -0.0302 * qd[1]);
-        let x95 = Self::mul_add(s_q2, x87, c_q2 * x86);
-        let x96 = Self::mul_add(-s_q2, x86, c_q2 * x87);
-        let x97 = Self::mul_add(-0.1524, x91, 6.377 * Self::mul_add(x87, x87, x90));
-        let x98 = Self::mul_add(-6.377, x89 + x89, -0.1524 * (x88 + x88));
-        let x99 = Self::mul_add(-0.1524, Self::mul_add(x86, x86, x90), 6.377 * x91);
-        let x100 = Self::mul_add(-c_q2, x97, s_q2 * x99);
-        let x101 = Self::mul_add(c_q2, x99, s_q2 * x97);
-        let x102 = Self::mul_add(-qd[2], x96, Self::mul_add(-c_q2, x88, s_q2 * x89));
-        let x103 = Self::mul_add(qd[2], x95, Self::mul_add(c_q2, x89, s_q2 * x88));
-        let x104 = qd[1] + qd[2];
-        let x105 = x104 * x104;
-        let x106 = Self::mul_add(x96, x96, x105);
-        let x107 = x95 * x96;
-        let x108 = Self::mul_add(x95, x104, x103);
-        let x109 = Self::mul_add(x96, x104, -x102);
-        let x110 = Self::mul_add(x95, x95, x105);
-        let x111 = Self::mul_add(
+        let x99 = Self::mul_add(-190.97044034000004, x91, -0.0302 * qd[1]);
+        let x100 = Self::mul_add(s_q2, x92, c_q2 * x91);
+        let x101 = Self::mul_add(-s_q2, x91, c_q2 * x92);
+        let x102 = Self::mul_add(-0.1524, x96, 6.377 * Self::mul_add(x92, x92, x95));
+        let x103 = Self::mul_add(-6.377, x94 + x94, -0.1524 * (x93 + x93));
+        let x104 = Self::mul_add(-0.1524, Self::mul_add(x91, x91, x95), 6.377 * x96);
+        let x105 = Self::mul_add(-c_q2, x102, s_q2 * x104);
+        let x106 = Self::mul_add(c_q2, x104, s_q2 * x102);
+        let x107 = Self::mul_add(-qd[2], x101, Self::mul_add(-c_q2, x93, s_q2 * x94));
+        let x108 = Self::mul_add(qd[2], x100, Self::mul_add(c_q2, x94, s_q2 * x93));
+        let x109 = qd[1] + qd[2];
+        let x110 = x109 * x109;
+        let x111 = Self::mul_add(x101, x101, x110);
+        let x112 = x100 * x101;
+        let x113 = Self::mul_add(x100, x109, x108);
+        let x114 = Self::mul_add(x101, x109, -x107);
+        let x115 = Self::mul_add(x100, x100, x110);
+        let x116 = Self::mul_add(
             103.41030072000001,
-            x96,
-            Self::mul_add(5594.523885531201, x95, 0.8021 * x104),
+            x101,
+            Self::mul_add(5594.523885531201, x100, 0.8021 * x109),
         );
-        let x112 = Self::mul_add(
+        let x117 = Self::mul_add(
             -0.08,
-            x96,
-            Self::mul_add(-0.8021, x95, 5601.1318504688 * x104),
+            x101,
+            Self::mul_add(-0.8021, x100, 5601.1318504688 * x109),
         );
-        let x113 = Self::mul_add(-103.41030072000002, x95, -0.08 * x104);
-        let x114 = Self::mul_add(s_q3, x96, c_q3 * x95);
-        let x115 = Self::mul_add(-s_q3, x95, c_q3 * x96);
-        let x116 = x100 - Self::mul_add(-0.1524, x107, 7.06 * x106);
-        let x117 = x98 + Self::mul_add(-7.06, x108, -0.1524 * x109);
-        let x118 = x101 + Self::mul_add(-0.1524, x110, 7.06 * x107);
-        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
-        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x103, c_q3 * x102));
-        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x103, s_q3 * x102));
-        let x122 = qd[3] + x104;
-        let x123 = Self::mul_add(x115, x115, x122 * x122);
-        let x124 = x114 * x115;
-        let x125 = Self::mul_add(-x114, x122, x121);
-        let x126 = -18.957952216000002 * x114;
-        let x127 = 19.863252216000003 * x122;
-        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
-        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
-        let x130 = Self::mul_add(qd[4], x129, c_q4 * x120);
-        let x131 = Self::mul_add(qd[4], x128, s_q4 * x120);
-        let x132 = qd[4] + x115;
-        let x133 = 34.45002 * Self::mul_add(x132, x132, x129 * x129);
-        let x134 = 34.45002 * Self::mul_add(x128, x129, x121);
-        let x135 = 34.45002 * Self::mul_add(x128, x132, x131);
-        let x136 = 34.33891524 * x129;
-        let x137 = 34.74691524 * x132;
-        let x138 = Self::mul_add(s_q5, x132, c_q5 * x129);
-        let x139 = Self::mul_add(-s_q5, x129, c_q5 * x132);
-        let x140 = Self::mul_add(qd[5], x139, Self::mul_add(-c_q5, x131, s_q5 * x121));
-        let x141 = Self::mul_add(-qd[5], x138, Self::mul_add(c_q5, x121, s_q5 * x131));
-        let x142 = qd[5] + x128;
-        let x143 = Self::mul_add(0.966, x139, Self::mul_add(0.385, x138, 1.903 * x142));
-        let x144 = Self::mul_add(0.353, x139, 0.385 * x142);
-        let x145 = Self::mul_add(
-            -0.9929999999999999,
-            x139,
-            Self::mul_add(0.353, x138, 0.966 * x142),
-        );
-        let x146 = Self::mul_add(0.966, x141, Self::mul_add(0.385, x140, 1.903 * x130))
-            + Self::mul_add(-x139, x144, x138 * x145);
-        let x147 = Self::mul_add(0.353, x141, 0.385 * x130)
-            + Self::mul_add(-x142, x145, x139 * x143);
-        let x148 = Self::mul_add(
-            -0.9929999999999999,
-            x141,
-            Self::mul_add(0.353, x140, 0.966 * x130),
-        ) + Self::mul_add(-x138, x143, x142 * x144);
-        let x149 = Self::mul_add(-x132, x136, x129 * x137) + x146;
-        let x150 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x124, x119),
-            -Self::mul_add(x128, x137, 34.33891524 * x131),
-        ) + Self::mul_add(-s_q5, x148, c_q5 * x147);
-        let x151 = Self::mul_add(
-            34.45002,
-            Self::mul_add(
-                -s_q4,
-                Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
-                c_q4 * Self::mul_add(0.4572, x125, x117),
-            ),
-            Self::mul_add(x128, x136, 34.74691524 * x121),
-        ) + Self::mul_add(c_q5, x148, s_q5 * x147);
-        let x152 = Self::mul_add(-s_q4, x133, c_q4 * x134);
-        let x153 = Self::mul_add(41.67378, x123, Self::mul_add(s_q4, x134, c_q4 * x133));
-        let x154 = Self::mul_add(41.67378, x125, x152);
-        let x155 = Self::mul_add(-41.67378, x124, x135);
-        let x156 = Self::mul_add(-x115, x127, -18.957952216000002 * x120)
-            + Self::mul_add(-s_q4, x150, c_q4 * x149);
-        let x157 = Self::mul_add(-x115, x126, x119 * -41.67378)
-            + Self::mul_add(-0.4572, x135, Self::mul_add(c_q4, x150, s_q4 * x149));
-        let x158 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
-            + Self::mul_add(0.4572, x152, x151);
-        let x159 = Self::mul_add(-c_q3, x153, s_q3 * x155);
-        let x160 = Self::mul_add(c_q3, x155, s_q3 * x153);
-        let x161 = x159
-            - Self::mul_add(-15.183612000000002, x107, 703.3878000000001 * x106);
-        let x162 = Self::mul_add(-703.3878000000001, x108, -15.183612000000002 * x109)
-            + x154;
-        let x163 = x160
-            - Self::mul_add(-15.183612000000002, x110, 703.3878000000001 * x107);
-        let x164 = Self::mul_add(
-            x98,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x103, -5594.523885531201 * x102)
-                + Self::mul_add(-x96, x112, x104 * x113),
-        ) + Self::mul_add(0.1524, x154, Self::mul_add(s_q3, x158, c_q3 * x156));
-        let x165 = Self::mul_add(0.08, x103, 0.8021 * x102)
-            + Self::mul_add(x95, x113, x96 * x111)
-            + Self::mul_add(x101, 703.3878000000001, -15.183612000000002 * x100)
-            + (x157 + Self::mul_add(-7.06, x160, -0.1524 * x159));
-        let x166 = Self::mul_add(
+        let x118 = Self::mul_add(-103.41030072000002, x100, -0.08 * x109);
+        let x119 = Self::mul_add(
             703.3878000000001,
-            x98,
+            x103,
             Self::mul_add(
                 103.41030072000002,
-                x102,
-                -Self::mul_add(x95, x112, x104 * x111),
+                x107,
+                -Self::mul_add(x100, x117, x109 * x116),
             ),
-        ) + Self::mul_add(7.06, x154, Self::mul_add(-s_q3, x156, c_q3 * x158));
-        let x167 = tau[0]
-            - Self::mul_add(
-                -s_q1,
-                Self::mul_add(-x87, x93, qd[1] * x94)
-                    - Self::mul_add(190.97044034, x89, -8596.210051042 * x88)
-                    + Self::mul_add(
-                        0.1524,
-                        x162,
-                        Self::mul_add(s_q2, x166, c_q2 * x164),
-                    ),
-                c_q1
-                    * (Self::mul_add(
-                        6.377,
-                        x162,
-                        Self::mul_add(-s_q2, x164, c_q2 * x166),
-                    )
-                        - Self::mul_add(
-                            190.97044034000004,
-                            x88,
-                            Self::mul_add(x86, x93, qd[1] * x92),
-                        )),
-            );
-        let x168 = 1.0
-            / (14222.257549666001
-                + Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(
-                        -s_q1,
-                        -8596.210051042
-                            + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
-                        c_q1
-                            * (190.97044034000004
-                                + Self::mul_add(
-                                    0.1524,
-                                    x61,
-                                    Self::mul_add(
-                                        -6.377,
-                                        x62,
-                                        Self::mul_add(s_q2, x68, c_q2 * x66),
-                                    ),
-                                )),
-                    ),
-                    c_q1
-                        * Self::mul_add(
-                            -s_q1,
-                            190.97044034
-                                + Self::mul_add(
-                                    x62,
-                                    -6.377,
-                                    Self::mul_add(
-                                        0.1524,
-                                        x61,
-                                        Self::mul_add(-s_q2, x63, c_q2 * x65),
-                                    ),
-                                ),
-                            c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
-                        ),
-                ));
-        let x169 = x73 * x168;
-        let x170 = x74 * x168;
-        let x171 = x75 * x168;
-        let x172 = x82 * x168;
-        let x173 = x85 * x168;
-        let x174 = 1.0
+        );
+        let x120 = Self::mul_add(s_q3, x101, c_q3 * x100);
+        let x121 = Self::mul_add(-s_q3, x100, c_q3 * x101);
+        let x122 = x105 - Self::mul_add(-0.1524, x112, 7.06 * x111);
+        let x123 = x103 + Self::mul_add(-7.06, x113, -0.1524 * x114);
+        let x124 = x106 + Self::mul_add(-0.1524, x115, 7.06 * x112);
+        let x125 = Self::mul_add(-c_q3, x124, s_q3 * x122);
+        let x126 = Self::mul_add(-qd[3], x121, Self::mul_add(s_q3, x108, c_q3 * x107));
+        let x127 = Self::mul_add(-qd[3], x120, Self::mul_add(-c_q3, x108, s_q3 * x107));
+        let x128 = qd[3] + x109;
+        let x129 = Self::mul_add(x121, x121, x128 * x128);
+        let x130 = x120 * x121;
+        let x131 = Self::mul_add(-x120, x128, x127);
+        let x132 = -18.957952216000002 * x120;
+        let x133 = 19.863252216000003 * x128;
+        let x134 = Self::mul_add(-c_q4, x120, s_q4 * x128);
+        let x135 = Self::mul_add(c_q4, x128, s_q4 * x120);
+        let x136 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(-0.4572, x129, Self::mul_add(s_q3, x124, c_q3 * x122)),
+            c_q4 * Self::mul_add(0.4572, x131, x123),
+        );
+        let x137 = Self::mul_add(qd[4], x135, c_q4 * x126);
+        let x138 = Self::mul_add(qd[4], x134, s_q4 * x126);
+        let x139 = qd[4] + x121;
+        let x140 = 34.45002 * Self::mul_add(x139, x139, x135 * x135);
+        let x141 = 34.45002 * Self::mul_add(x134, x135, x127);
+        let x142 = 34.45002 * Self::mul_add(x134, x139, x138);
+        let x143 = 34.33891524 * x135;
+        let x144 = 34.74691524 * x139;
+        let x145 = Self::mul_add(s_q5, x139, c_q5 * x135);
+        let x146 = Self::mul_add(-s_q5, x135, c_q5 * x139);
+        let x147 = Self::mul_add(qd[5], x146, Self::mul_add(-c_q5, x138, s_q5 * x127));
+        let x148 = Self::mul_add(-qd[5], x145, Self::mul_add(c_q5, x127, s_q5 * x138));
+        let x149 = qd[5] + x134;
+        let x150 = Self::mul_add(0.966, x146, Self::mul_add(0.385, x145, 1.903 * x149));
+        let x151 = Self::mul_add(0.353, x146, 0.385 * x149);
+        let x152 = Self::mul_add(
+            -0.9929999999999999,
+            x146,
+            Self::mul_add(0.353, x145, 0.966 * x149),
+        );
+        let x153 = Self::mul_add(0.966, x148, Self::mul_add(0.385, x147, 1.903 * x137))
+            + Self::mul_add(-x146, x151, x145 * x152);
+        let x154 = Self::mul_add(0.353, x148, 0.385 * x137)
+            + Self::mul_add(-x149, x152, x146 * x150);
+        let x155 = Self::mul_add(
+            -0.9929999999999999,
+            x148,
+            Self::mul_add(0.353, x147, 0.966 * x137),
+        ) + Self::mul_add(-x145, x150, x149 * x151);
+        let x156 = Self::mul_add(-x139, x143, x135 * x144) + x153;
+        let x157 = Self::mul_add(
+            -34.45002,
+            Self::mul_add(-0.4572, x130, x125),
+            -Self::mul_add(x134, x144, 34.33891524 * x138),
+        ) + Self::mul_add(-s_q5, x155, c_q5 * x154);
+        let x158 = Self::mul_add(
+            34.45002,
+            x136,
+            Self::mul_add(x134, x143, 34.74691524 * x127),
+        ) + Self::mul_add(c_q5, x155, s_q5 * x154);
+        let x159 = Self::mul_add(-s_q4, x140, c_q4 * x141);
+        let x160 = Self::mul_add(41.67378, x129, Self::mul_add(s_q4, x141, c_q4 * x140));
+        let x161 = Self::mul_add(41.67378, x131, x159);
+        let x162 = Self::mul_add(-41.67378, x130, x142);
+        let x163 = Self::mul_add(-x121, x133, -18.957952216000002 * x126)
+            + Self::mul_add(-s_q4, x157, c_q4 * x156);
+        let x164 = Self::mul_add(-x121, x132, x125 * -41.67378)
+            + Self::mul_add(-0.4572, x142, Self::mul_add(c_q4, x157, s_q4 * x156));
+        let x165 = Self::mul_add(41.67378, x123, Self::mul_add(-x120, x133, x128 * x132))
+            + Self::mul_add(0.4572, x159, x158);
+        let x166 = Self::mul_add(-c_q3, x160, s_q3 * x162);
+        let x167 = Self::mul_add(c_q3, x162, s_q3 * x160);
+        let x168 = x166
+            - Self::mul_add(-15.183612000000002, x112, 703.3878000000001 * x111);
+        let x169 = Self::mul_add(-703.3878000000001, x113, -15.183612000000002 * x114)
+            + x161;
+        let x170 = x167
+            - Self::mul_add(-15.183612000000002, x115, 703.3878000000001 * x112);
+        let x171 = Self::mul_add(
+            x103,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x108, -5594.523885531201 * x107)
+                + Self::mul_add(-x101, x117, x109 * x118),
+        ) + Self::mul_add(0.1524, x161, Self::mul_add(s_q3, x165, c_q3 * x163));
+        let x172 = Self::mul_add(0.08, x108, 0.8021 * x107)
+            + Self::mul_add(x100, x118, x101 * x116)
+            + Self::mul_add(x106, 703.3878000000001, -15.183612000000002 * x105)
+            + (x164 + Self::mul_add(-7.06, x167, -0.1524 * x166));
+        let x173 = x119
+            + Self::mul_add(7.06, x161, Self::mul_add(-s_q3, x163, c_q3 * x165));
+        let x174 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-x92, x98, qd[1] * x99)
+                - Self::mul_add(190.97044034, x94, -8596.210051042 * x93)
+                + Self::mul_add(0.1524, x169, Self::mul_add(s_q2, x173, c_q2 * x171)),
+            c_q1
+                * (Self::mul_add(6.377, x169, Self::mul_add(-s_q2, x171, c_q2 * x173))
+                    - Self::mul_add(
+                        190.97044034000004,
+                        x93,
+                        Self::mul_add(x91, x98, qd[1] * x97),
+                    )),
+        );
+        let x175 = tau[0] - x174;
+        let x176 = 1.0 / (14222.257549666001 + x78);
+        let x177 = x77 * x176;
+        let x178 = x79 * x176;
+        let x179 = x80 * x176;
+        let x180 = x87 * x176;
+        let x181 = x90 * x176;
+        let x182 = 1.0
             / Self::mul_add(
-                -x73,
-                x169,
-                8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)),
+                -x77,
+                x177,
+                8609.573807858 + (x60 - (x73 - x72) - (x71 - x74)),
             );
-        let x175 = Self::mul_add(-x73, x170, x58 + (x70 - x71));
-        let x176 = x174 * x175;
-        let x177 = Self::mul_add(
-            -x73,
-            x171,
+        let x183 = Self::mul_add(-x77, x178, x60 + (x72 - x73));
+        let x184 = x182 * x183;
+        let x185 = Self::mul_add(
+            -x77,
+            x179,
             x50
                 + Self::mul_add(
                     0.1524,
@@ -1330,155 +1362,115 @@ impl Srms {
                     -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
                 ),
         );
-        let x178 = x174 * x177;
-        let x179 = Self::mul_add(
-            -x73,
-            x172,
-            x80
+        let x186 = x182 * x185;
+        let x187 = Self::mul_add(
+            -x77,
+            x180,
+            x85
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(c_q2, x77, s_q2 * x76),
-                    -0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
+                    Self::mul_add(c_q2, x82, s_q2 * x81),
+                    -0.1524 * Self::mul_add(-c_q2, x81, s_q2 * x82),
                 ),
         );
-        let x180 = x174 * x179;
-        let x181 = Self::mul_add(-x73, x173, x23);
-        let x182 = x174 * x181;
-        let x183 = 1.0 / Self::mul_add(-x175, x176, Self::mul_add(-x74, x170, x58));
-        let x184 = Self::mul_add(-x175, x178, Self::mul_add(-x74, x171, x50));
-        let x185 = x183 * x184;
-        let x186 = Self::mul_add(-x175, x180, Self::mul_add(-x74, x172, x80));
-        let x187 = x183 * x186;
-        let x188 = Self::mul_add(-x175, x182, Self::mul_add(-x74, x173, x23));
-        let x189 = x183 * x188;
-        let x190 = 1.0
-            / Self::mul_add(
-                -x184,
-                x185,
-                Self::mul_add(-x177, x178, Self::mul_add(-x75, x171, x35)),
-            );
-        let x191 = Self::mul_add(
-            -x184,
-            x187,
-            Self::mul_add(-x177, x180, Self::mul_add(-x75, x172, x25)),
+        let x188 = x182 * x187;
+        let x189 = Self::mul_add(-x77, x181, x23);
+        let x190 = x182 * x189;
+        let x191 = 1.0 / Self::mul_add(-x183, x184, Self::mul_add(-x79, x178, x60));
+        let x192 = Self::mul_add(-x183, x186, Self::mul_add(-x79, x179, x50));
+        let x193 = x191 * x192;
+        let x194 = Self::mul_add(-x183, x188, Self::mul_add(-x79, x180, x85));
+        let x195 = x191 * x194;
+        let x196 = Self::mul_add(-x183, x190, Self::mul_add(-x79, x181, x23));
+        let x197 = x191 * x196;
+        let x198 = Self::mul_add(
+            -x192,
+            x193,
+            Self::mul_add(-x185, x186, Self::mul_add(-x80, x179, x35)),
         );
-        let x192 = x190 * x191;
-        let x193 = Self::mul_add(
-            -x184,
-            x189,
-            Self::mul_add(-x177, x182, Self::mul_add(-x75, x173, x23)),
+        let x199 = 1.0 / x198;
+        let x200 = Self::mul_add(
+            -x192,
+            x195,
+            Self::mul_add(-x185, x188, Self::mul_add(-x80, x180, x25)),
         );
-        let x194 = x190 * x193;
-        let x195 = 1.0
-            / Self::mul_add(
-                -x191,
-                x192,
-                Self::mul_add(
-                    -x186,
-                    x187,
-                    Self::mul_add(-x179, x180, Self::mul_add(-x82, x172, x14)),
-                ),
-            );
-        let x196 = Self::mul_add(
-            -x191,
-            x194,
-            Self::mul_add(
-                -x186,
-                x189,
-                Self::mul_add(-x179, x182, Self::mul_add(-x82, x173, x9)),
-            ),
-        );
-        let x197 = x195 * x196;
-        let x198 = 1.0
-            / Self::mul_add(
-                -x196,
-                x197,
-                Self::mul_add(
-                    -x193,
-                    x194,
-                    Self::mul_add(
-                        -x188,
-                        x189,
-                        Self::mul_add(-x181, x182, Self::mul_add(-x85, x173, 1.903)),
-                    ),
-                ),
-            );
-        let x199 = Self::mul_add(
-            -x167,
-            x169,
-            tau[1]
-                - (Self::mul_add(x86, x94, x87 * x92)
-                    - Self::mul_add(-0.0302, x89, -1.928 * x88)
-                    + (x165
-                        + Self::mul_add(
-                            -6.377,
-                            Self::mul_add(-s_q2, x161, c_q2 * x163),
-                            -0.1524 * Self::mul_add(s_q2, x163, c_q2 * x161),
-                        ))),
-        );
-        let x200 = Self::mul_add(-x176, x199, Self::mul_add(-x167, x170, tau[2] - x165));
-        let x201 = Self::mul_add(
-            -x185,
-            x200,
-            Self::mul_add(-x178, x199, Self::mul_add(-x167, x171, tau[3] - x157)),
-        );
+        let x201 = x199 * x200;
         let x202 = Self::mul_add(
             -x192,
-            x201,
-            Self::mul_add(
-                -x187,
-                x200,
-                Self::mul_add(-x180, x199, Self::mul_add(-x167, x172, tau[4] - x151)),
-            ),
+            x197,
+            Self::mul_add(-x185, x190, Self::mul_add(-x80, x181, x23)),
         );
-        let x203 = x198
-            * Self::mul_add(
-                -x197,
-                x202,
-                Self::mul_add(
-                    -x194,
-                    x201,
-                    Self::mul_add(
-                        -x189,
-                        x200,
-                        Self::mul_add(
-                            -x182,
-                            x199,
-                            Self::mul_add(-x167, x173, tau[5] - x146),
-                        ),
-                    ),
-                ),
-            );
-        let x204 = Self::mul_add(-x197, x203, x195 * x202);
-        let x205 = Self::mul_add(-x194, x203, Self::mul_add(-x192, x204, x190 * x201));
+        let x203 = x199 * x202;
+        let x204 = Self::mul_add(
+            -x194,
+            x195,
+            Self::mul_add(-x187, x188, Self::mul_add(-x87, x180, x14)),
+        );
+        let x205 = 1.0 / Self::mul_add(-x200, x201, x204);
         let x206 = Self::mul_add(
-            -x189,
-            x203,
-            Self::mul_add(-x187, x204, Self::mul_add(-x185, x205, x183 * x200)),
+            -x194,
+            x197,
+            Self::mul_add(-x187, x190, Self::mul_add(-x87, x181, x9)),
         );
-        let x207 = Self::mul_add(
-            -x182,
-            x203,
-            Self::mul_add(
-                -x180,
-                x204,
-                Self::mul_add(-x178, x205, Self::mul_add(-x176, x206, x174 * x199)),
-            ),
+        let x207 = Self::mul_add(-x200, x203, x206);
+        let x208 = x205 * x207;
+        let x209 = Self::mul_add(
+            -x196,
+            x197,
+            Self::mul_add(-x189, x190, Self::mul_add(-x90, x181, 1.903)),
         );
-        let x208 = Self::mul_add(
-            -x173,
-            x203,
-            Self::mul_add(
-                -x172,
-                x204,
-                Self::mul_add(
-                    -x171,
-                    x205,
-                    Self::mul_add(-x170, x206, Self::mul_add(-x169, x207, x167 * x168)),
-                ),
-            ),
+        let x210 = 1.0 / Self::mul_add(-x207, x208, Self::mul_add(-x202, x203, x209));
+        let x211 = Self::mul_add(
+            -x175,
+            x177,
+            tau[1]
+                - (Self::mul_add(x91, x99, x92 * x97)
+                    - Self::mul_add(-0.0302, x94, -1.928 * x93)
+                    + (x172
+                        + Self::mul_add(
+                            -6.377,
+                            Self::mul_add(-s_q2, x168, c_q2 * x170),
+                            -0.1524 * Self::mul_add(s_q2, x170, c_q2 * x168),
+                        ))),
         );
-        [x208, x207, x206, x205, x204, x203]
+        let x212 = Self::mul_add(-x184, x211, Self::mul_add(-x175, x178, tau[2] - x172));
+        let x213 = Self::mul_add(
+            -x193,
+            x212,
+            Self::mul_add(-x186, x211, Self::mul_add(-x175, x179, tau[3] - x164)),
+        );
+        let x214 = Self::mul_add(
+            -x195,
+            x212,
+            Self::mul_add(-x188, x211, Self::mul_add(-x175, x180, tau[4] - x158)),
+        );
+        let x215 = Self::mul_add(-x201, x213, x214);
+        let x216 = Self::mul_add(
+            -x197,
+            x212,
+            Self::mul_add(-x190, x211, Self::mul_add(-x175, x181, tau[5] - x153)),
+        );
+        let x217 = x210 * Self::mul_add(-x208, x215, Self::mul_add(-x203, x213, x216));
+        let x218 = Self::mul_add(-x208, x217, x205 * x215);
+        let x219 = Self::mul_add(-x203, x217, Self::mul_add(-x201, x218, x199 * x213));
+        let x220 = Self::mul_add(
+            -x197,
+            x217,
+            Self::mul_add(-x195, x218, Self::mul_add(-x193, x219, x191 * x212)),
+        );
+        let x221 = Self::mul_add(
+            -x188,
+            x218,
+            Self::mul_add(-x186, x219, Self::mul_add(-x184, x220, x182 * x211)),
+        );
+        let x222 = Self::mul_add(-x190, x217, x221);
+        let x223 = Self::mul_add(
+            -x179,
+            x219,
+            Self::mul_add(-x178, x220, Self::mul_add(-x177, x222, x175 * x176)),
+        );
+        let x224 = Self::mul_add(-x181, x217, Self::mul_add(-x180, x218, x223));
+        [x224, x222, x220, x219, x218, x217]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -1543,293 +1535,286 @@ impl Srms {
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x53 = 703.3878000000001 + x36;
-        let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x57 = 103.41030072000001
-            + Self::mul_add(
-                x37,
-                7.06,
-                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-            );
-        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x59 = 103.41030072000002
-            + Self::mul_add(
-                0.1524,
-                x36,
-                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
-            );
-        let x60 = -0.08 + (x43 + x51);
-        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
-        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
-        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
-        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
-        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
-        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
-        let x69 = 0.1524 * x62;
-        let x70 = -0.1524 * x62;
-        let x71 = x61 * -6.377;
-        let x72 = 6.377 * x61;
-        let x73 = 8609.573807858 + (x58 - (x71 - x70) - (x69 - x72));
-        let x74 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x64),
-            c_q1 * (-0.0302 + (x51 + x67)),
+        let x52 = Self::mul_add(
+            x37,
+            7.06,
+            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
         );
-        let x75 = 14222.257549666001
-            + Self::mul_add(
+        let x53 = Self::mul_add(
+            0.1524,
+            x36,
+            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+        );
+        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
+        let x55 = 703.3878000000001 + x36;
+        let x56 = -15.183612000000002 - x37;
+        let x57 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
+        let x59 = 103.41030072000001 + x52;
+        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x61 = 103.41030072000002 + x53;
+        let x62 = -0.08 + (x43 + x51);
+        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
+        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
+        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
+        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
+        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
+        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
+        let x71 = 0.1524 * x64;
+        let x72 = -0.1524 * x64;
+        let x73 = x63 * -6.377;
+        let x74 = 6.377 * x63;
+        let x75 = Self::mul_add(
+            x64,
+            -6.377,
+            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
+        );
+        let x76 = Self::mul_add(
+            0.1524,
+            x63,
+            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+        );
+        let x77 = 8609.573807858 + (x60 - (x73 - x72) - (x71 - x74));
+        let x78 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x66),
+            c_q1 * (-0.0302 + (x51 + x69)),
+        );
+        let x79 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(
                 -s_q1,
-                Self::mul_add(
+                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
+                c_q1 * (190.97044034000004 + x76),
+            ),
+            c_q1
+                * Self::mul_add(
                     -s_q1,
-                    -8596.210051042
-                        + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
-                    c_q1
-                        * (190.97044034000004
-                            + Self::mul_add(
-                                0.1524,
-                                x61,
-                                Self::mul_add(
-                                    -6.377,
-                                    x62,
-                                    Self::mul_add(s_q2, x68, c_q2 * x66),
-                                ),
-                            )),
+                    190.97044034 + x75,
+                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
                 ),
-                c_q1
-                    * Self::mul_add(
-                        -s_q1,
-                        190.97044034
-                            + Self::mul_add(
-                                x62,
-                                -6.377,
-                                Self::mul_add(
-                                    0.1524,
-                                    x61,
-                                    Self::mul_add(-s_q2, x63, c_q2 * x65),
-                                ),
-                            ),
-                        c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
-                    ),
-            );
-        let x76 = x58 + (x70 - x71);
-        let x77 = Self::mul_add(-s_q1, x64, c_q1 * x67);
-        let x78 = x50
+        );
+        let x80 = 14222.257549666001 + x79;
+        let x81 = x60 + (x72 - x73);
+        let x82 = Self::mul_add(-s_q1, x66, c_q1 * x69);
+        let x83 = x50
             + Self::mul_add(
                 0.1524,
                 Self::mul_add(s_q2, x36, c_q2 * x37),
                 -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
             );
-        let x79 = Self::mul_add(
+        let x84 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x43, c_q2 * x39),
             c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
         );
-        let x80 = c_q3 * x16;
-        let x81 = s_q3 * x16;
-        let x82 = x15 * 0.1524;
-        let x83 = Self::mul_add(s_q3, x30, x40) + x82;
-        let x84 = x25 + Self::mul_add(0.1524, x80, -7.06 * x81);
-        let x85 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x86 = x84
+        let x85 = c_q3 * x16;
+        let x86 = s_q3 * x16;
+        let x87 = x15 * 0.1524;
+        let x88 = Self::mul_add(s_q3, x30, x40) + x87;
+        let x89 = x25 + Self::mul_add(0.1524, x85, -7.06 * x86);
+        let x90 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
+        let x91 = x89
             + Self::mul_add(
                 -6.377,
-                Self::mul_add(c_q2, x81, s_q2 * x80),
-                -0.1524 * Self::mul_add(-c_q2, x80, s_q2 * x81),
+                Self::mul_add(c_q2, x86, s_q2 * x85),
+                -0.1524 * Self::mul_add(-c_q2, x85, s_q2 * x86),
             );
-        let x87 = Self::mul_add(
+        let x92 = Self::mul_add(
             -s_q1,
-            x82 + Self::mul_add(s_q2, x85, c_q2 * x83),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x83, c_q2 * x85)),
+            x87 + Self::mul_add(s_q2, x90, c_q2 * x88),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x88, c_q2 * x90)),
         );
-        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x90 = Self::mul_add(
+        let x93 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x94 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x95 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x89, c_q2 * x88),
-            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
+            Self::mul_add(s_q2, x94, c_q2 * x93),
+            c_q1 * Self::mul_add(-s_q2, x93, c_q2 * x94),
         );
-        let x91 = qd[0] * s_q1;
-        let x92 = qd[0] * c_q1;
-        let x93 = qd[1] * x92;
-        let x94 = qd[1] * x91;
-        let x95 = qd[1] * qd[1];
-        let x96 = x91 * x92;
-        let x97 = Self::mul_add(
+        let x96 = qd[0] * s_q1;
+        let x97 = qd[0] * c_q1;
+        let x98 = qd[1] * x97;
+        let x99 = qd[1] * x96;
+        let x100 = qd[1] * qd[1];
+        let x101 = x96 * x97;
+        let x102 = Self::mul_add(
             190.97044034,
-            x92,
-            Self::mul_add(8596.210051042, x91, -1.928 * qd[1]),
+            x97,
+            Self::mul_add(8596.210051042, x96, -1.928 * qd[1]),
         );
-        let x98 = Self::mul_add(
+        let x103 = Self::mul_add(
             -0.0302,
-            x92,
-            Self::mul_add(1.928, x91, 8609.573807858 * qd[1]),
+            x97,
+            Self::mul_add(1.928, x96, 8609.573807858 * qd[1]),
         );
-        let x99 = Self::mul_add(-190.97044034000004, x91, -0.0302 * qd[1]);
-        let x100 = Self::mul_add(s_q2, x92, c_q2 * x91);
-        let x101 = Self::mul_add(-s_q2, x91, c_q2 * x92);
-        let x102 = Self::mul_add(-0.1524, x96, 6.377 * Self::mul_add(x92, x92, x95));
-        let x103 = Self::mul_add(-6.377, x94 + x94, -0.1524 * (x93 + x93));
-        let x104 = Self::mul_add(-0.1524, Self::mul_add(x91, x91, x95), 6.377 * x96);
-        let x105 = Self::mul_add(-c_q2, x102, s_q2 * x104);
-        let x106 = Self::mul_add(c_q2, x104, s_q2 * x102);
-        let x107 = Self::mul_add(-qd[2], x101, Self::mul_add(-c_q2, x93, s_q2 * x94));
-        let x108 = Self::mul_add(qd[2], x100, Self::mul_add(c_q2, x94, s_q2 * x93));
-        let x109 = qd[1] + qd[2];
-        let x110 = x109 * x109;
-        let x111 = Self::mul_add(x101, x101, x110);
-        let x112 = x100 * x101;
-        let x113 = Self::mul_add(x100, x109, x108);
-        let x114 = Self::mul_add(x101, x109, -x107);
-        let x115 = Self::mul_add(x100, x100, x110);
-        let x116 = Self::mul_add(
+        let x104 = Self::mul_add(-190.97044034000004, x96, -0.0302 * qd[1]);
+        let x105 = Self::mul_add(s_q2, x97, c_q2 * x96);
+        let x106 = Self::mul_add(-s_q2, x96, c_q2 * x97);
+        let x107 = Self::mul_add(-0.1524, x101, 6.377 * Self::mul_add(x97, x97, x100));
+        let x108 = Self::mul_add(-6.377, x99 + x99, -0.1524 * (x98 + x98));
+        let x109 = Self::mul_add(-0.1524, Self::mul_add(x96, x96, x100), 6.377 * x101);
+        let x110 = Self::mul_add(-c_q2, x107, s_q2 * x109);
+        let x111 = Self::mul_add(c_q2, x109, s_q2 * x107);
+        let x112 = Self::mul_add(-qd[2], x106, Self::mul_add(-c_q2, x98, s_q2 * x99));
+        let x113 = Self::mul_add(qd[2], x105, Self::mul_add(c_q2, x99, s_q2 * x98));
+        let x114 = qd[1] + qd[2];
+        let x115 = x114 * x114;
+        let x116 = Self::mul_add(x106, x106, x115);
+        let x117 = x105 * x106;
+        let x118 = Self::mul_add(x105, x114, x113);
+        let x119 = Self::mul_add(x106, x114, -x112);
+        let x120 = Self::mul_add(x105, x105, x115);
+        let x121 = Self::mul_add(
             103.41030072000001,
-            x101,
-            Self::mul_add(5594.523885531201, x100, 0.8021 * x109),
+            x106,
+            Self::mul_add(5594.523885531201, x105, 0.8021 * x114),
         );
-        let x117 = Self::mul_add(
+        let x122 = Self::mul_add(
             -0.08,
-            x101,
-            Self::mul_add(-0.8021, x100, 5601.1318504688 * x109),
+            x106,
+            Self::mul_add(-0.8021, x105, 5601.1318504688 * x114),
         );
-        let x118 = Self::mul_add(-103.41030072000002, x100, -0.08 * x109);
-        let x119 = Self::mul_add(s_q3, x101, c_q3 * x100);
-        let x120 = Self::mul_add(-s_q3, x100, c_q3 * x101);
-        let x121 = x105 - Self::mul_add(-0.1524, x112, 7.06 * x111);
-        let x122 = x103 + Self::mul_add(-7.06, x113, -0.1524 * x114);
-        let x123 = x106 + Self::mul_add(-0.1524, x115, 7.06 * x112);
-        let x124 = Self::mul_add(-c_q3, x123, s_q3 * x121);
-        let x125 = Self::mul_add(-qd[3], x120, Self::mul_add(s_q3, x108, c_q3 * x107));
-        let x126 = Self::mul_add(-qd[3], x119, Self::mul_add(-c_q3, x108, s_q3 * x107));
-        let x127 = qd[3] + x109;
-        let x128 = Self::mul_add(x120, x120, x127 * x127);
-        let x129 = x119 * x120;
-        let x130 = Self::mul_add(-x119, x127, x126);
-        let x131 = -18.957952216000002 * x119;
-        let x132 = 19.863252216000003 * x127;
-        let x133 = Self::mul_add(-c_q4, x119, s_q4 * x127);
-        let x134 = Self::mul_add(c_q4, x127, s_q4 * x119);
-        let x135 = Self::mul_add(qd[4], x134, c_q4 * x125);
-        let x136 = Self::mul_add(qd[4], x133, s_q4 * x125);
-        let x137 = qd[4] + x120;
-        let x138 = 34.45002 * Self::mul_add(x137, x137, x134 * x134);
-        let x139 = 34.45002 * Self::mul_add(x133, x134, x126);
-        let x140 = 34.45002 * Self::mul_add(x133, x137, x136);
-        let x141 = 34.33891524 * x134;
-        let x142 = 34.74691524 * x137;
-        let x143 = Self::mul_add(s_q5, x137, c_q5 * x134);
-        let x144 = Self::mul_add(-s_q5, x134, c_q5 * x137);
-        let x145 = Self::mul_add(qd[5], x144, Self::mul_add(-c_q5, x136, s_q5 * x126));
-        let x146 = Self::mul_add(-qd[5], x143, Self::mul_add(c_q5, x126, s_q5 * x136));
-        let x147 = qd[5] + x133;
-        let x148 = Self::mul_add(0.966, x144, Self::mul_add(0.385, x143, 1.903 * x147));
-        let x149 = Self::mul_add(0.353, x144, 0.385 * x147);
-        let x150 = Self::mul_add(
-            -0.9929999999999999,
-            x144,
-            Self::mul_add(0.353, x143, 0.966 * x147),
-        );
-        let x151 = Self::mul_add(0.966, x146, Self::mul_add(0.385, x145, 1.903 * x135))
-            + Self::mul_add(-x144, x149, x143 * x150);
-        let x152 = Self::mul_add(0.353, x146, 0.385 * x135)
-            + Self::mul_add(-x147, x150, x144 * x148);
-        let x153 = Self::mul_add(
-            -0.9929999999999999,
-            x146,
-            Self::mul_add(0.353, x145, 0.966 * x135),
-        ) + Self::mul_add(-x143, x148, x147 * x149);
-        let x154 = Self::mul_add(-x137, x141, x134 * x142) + x151;
-        let x155 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x129, x124),
-            -Self::mul_add(x133, x142, 34.33891524 * x136),
-        ) + Self::mul_add(-s_q5, x153, c_q5 * x152);
-        let x156 = Self::mul_add(
-            34.45002,
-            Self::mul_add(
-                -s_q4,
-                Self::mul_add(-0.4572, x128, Self::mul_add(s_q3, x123, c_q3 * x121)),
-                c_q4 * Self::mul_add(0.4572, x130, x122),
-            ),
-            Self::mul_add(x133, x141, 34.74691524 * x126),
-        ) + Self::mul_add(c_q5, x153, s_q5 * x152);
-        let x157 = Self::mul_add(-s_q4, x138, c_q4 * x139);
-        let x158 = Self::mul_add(41.67378, x128, Self::mul_add(s_q4, x139, c_q4 * x138));
-        let x159 = Self::mul_add(41.67378, x130, x157);
-        let x160 = Self::mul_add(-41.67378, x129, x140);
-        let x161 = Self::mul_add(-x120, x132, -18.957952216000002 * x125)
-            + Self::mul_add(-s_q4, x155, c_q4 * x154);
-        let x162 = Self::mul_add(-x120, x131, x124 * -41.67378)
-            + Self::mul_add(-0.4572, x140, Self::mul_add(c_q4, x155, s_q4 * x154));
-        let x163 = Self::mul_add(41.67378, x122, Self::mul_add(-x119, x132, x127 * x131))
-            + Self::mul_add(0.4572, x157, x156);
-        let x164 = Self::mul_add(-c_q3, x158, s_q3 * x160);
-        let x165 = Self::mul_add(c_q3, x160, s_q3 * x158);
-        let x166 = x164
-            - Self::mul_add(-15.183612000000002, x112, 703.3878000000001 * x111);
-        let x167 = Self::mul_add(-703.3878000000001, x113, -15.183612000000002 * x114)
-            + x159;
-        let x168 = x165
-            - Self::mul_add(-15.183612000000002, x115, 703.3878000000001 * x112);
-        let x169 = Self::mul_add(
-            x103,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x108, -5594.523885531201 * x107)
-                + Self::mul_add(-x101, x117, x109 * x118),
-        ) + Self::mul_add(0.1524, x159, Self::mul_add(s_q3, x163, c_q3 * x161));
-        let x170 = Self::mul_add(0.08, x108, 0.8021 * x107)
-            + Self::mul_add(x100, x118, x101 * x116)
-            + Self::mul_add(x106, 703.3878000000001, -15.183612000000002 * x105)
-            + (x162 + Self::mul_add(-7.06, x165, -0.1524 * x164));
-        let x171 = Self::mul_add(
+        let x123 = Self::mul_add(-103.41030072000002, x105, -0.08 * x114);
+        let x124 = Self::mul_add(
             703.3878000000001,
-            x103,
+            x108,
             Self::mul_add(
                 103.41030072000002,
-                x107,
-                -Self::mul_add(x100, x117, x109 * x116),
+                x112,
+                -Self::mul_add(x105, x122, x114 * x121),
             ),
-        ) + Self::mul_add(7.06, x159, Self::mul_add(-s_q3, x161, c_q3 * x163));
-        let x172 = Self::mul_add(x91, x99, x92 * x97)
-            - Self::mul_add(-0.0302, x94, -1.928 * x93)
-            + (x170
+        );
+        let x125 = Self::mul_add(s_q3, x106, c_q3 * x105);
+        let x126 = Self::mul_add(-s_q3, x105, c_q3 * x106);
+        let x127 = x110 - Self::mul_add(-0.1524, x117, 7.06 * x116);
+        let x128 = x108 + Self::mul_add(-7.06, x118, -0.1524 * x119);
+        let x129 = x111 + Self::mul_add(-0.1524, x120, 7.06 * x117);
+        let x130 = Self::mul_add(-c_q3, x129, s_q3 * x127);
+        let x131 = Self::mul_add(-qd[3], x126, Self::mul_add(s_q3, x113, c_q3 * x112));
+        let x132 = Self::mul_add(-qd[3], x125, Self::mul_add(-c_q3, x113, s_q3 * x112));
+        let x133 = qd[3] + x114;
+        let x134 = Self::mul_add(x126, x126, x133 * x133);
+        let x135 = x125 * x126;
+        let x136 = Self::mul_add(-x125, x133, x132);
+        let x137 = -18.957952216000002 * x125;
+        let x138 = 19.863252216000003 * x133;
+        let x139 = Self::mul_add(-c_q4, x125, s_q4 * x133);
+        let x140 = Self::mul_add(c_q4, x133, s_q4 * x125);
+        let x141 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(-0.4572, x134, Self::mul_add(s_q3, x129, c_q3 * x127)),
+            c_q4 * Self::mul_add(0.4572, x136, x128),
+        );
+        let x142 = Self::mul_add(qd[4], x140, c_q4 * x131);
+        let x143 = Self::mul_add(qd[4], x139, s_q4 * x131);
+        let x144 = qd[4] + x126;
+        let x145 = 34.45002 * Self::mul_add(x144, x144, x140 * x140);
+        let x146 = 34.45002 * Self::mul_add(x139, x140, x132);
+        let x147 = 34.45002 * Self::mul_add(x139, x144, x143);
+        let x148 = 34.33891524 * x140;
+        let x149 = 34.74691524 * x144;
+        let x150 = Self::mul_add(s_q5, x144, c_q5 * x140);
+        let x151 = Self::mul_add(-s_q5, x140, c_q5 * x144);
+        let x152 = Self::mul_add(qd[5], x151, Self::mul_add(-c_q5, x143, s_q5 * x132));
+        let x153 = Self::mul_add(-qd[5], x150, Self::mul_add(c_q5, x132, s_q5 * x143));
+        let x154 = qd[5] + x139;
+        let x155 = Self::mul_add(0.966, x151, Self::mul_add(0.385, x150, 1.903 * x154));
+        let x156 = Self::mul_add(0.353, x151, 0.385 * x154);
+        let x157 = Self::mul_add(
+            -0.9929999999999999,
+            x151,
+            Self::mul_add(0.353, x150, 0.966 * x154),
+        );
+        let x158 = Self::mul_add(0.966, x153, Self::mul_add(0.385, x152, 1.903 * x142))
+            + Self::mul_add(-x151, x156, x150 * x157);
+        let x159 = Self::mul_add(0.353, x153, 0.385 * x142)
+            + Self::mul_add(-x154, x157, x151 * x155);
+        let x160 = Self::mul_add(
+            -0.9929999999999999,
+            x153,
+            Self::mul_add(0.353, x152, 0.966 * x142),
+        ) + Self::mul_add(-x150, x155, x154 * x156);
+        let x161 = Self::mul_add(-x144, x148, x140 * x149) + x158;
+        let x162 = Self::mul_add(
+            -34.45002,
+            Self::mul_add(-0.4572, x135, x130),
+            -Self::mul_add(x139, x149, 34.33891524 * x143),
+        ) + Self::mul_add(-s_q5, x160, c_q5 * x159);
+        let x163 = Self::mul_add(
+            34.45002,
+            x141,
+            Self::mul_add(x139, x148, 34.74691524 * x132),
+        ) + Self::mul_add(c_q5, x160, s_q5 * x159);
+        let x164 = Self::mul_add(-s_q4, x145, c_q4 * x146);
+        let x165 = Self::mul_add(41.67378, x134, Self::mul_add(s_q4, x146, c_q4 * x145));
+        let x166 = Self::mul_add(41.67378, x136, x164);
+        let x167 = Self::mul_add(-41.67378, x135, x147);
+        let x168 = Self::mul_add(-x126, x138, -18.957952216000002 * x131)
+            + Self::mul_add(-s_q4, x162, c_q4 * x161);
+        let x169 = Self::mul_add(-x126, x137, x130 * -41.67378)
+            + Self::mul_add(-0.4572, x147, Self::mul_add(c_q4, x162, s_q4 * x161));
+        let x170 = Self::mul_add(41.67378, x128, Self::mul_add(-x125, x138, x133 * x137))
+            + Self::mul_add(0.4572, x164, x163);
+        let x171 = Self::mul_add(-c_q3, x165, s_q3 * x167);
+        let x172 = Self::mul_add(c_q3, x167, s_q3 * x165);
+        let x173 = x171
+            - Self::mul_add(-15.183612000000002, x117, 703.3878000000001 * x116);
+        let x174 = Self::mul_add(-703.3878000000001, x118, -15.183612000000002 * x119)
+            + x166;
+        let x175 = x172
+            - Self::mul_add(-15.183612000000002, x120, 703.3878000000001 * x117);
+        let x176 = Self::mul_add(
+            x108,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x113, -5594.523885531201 * x112)
+                + Self::mul_add(-x106, x122, x114 * x123),
+        ) + Self::mul_add(0.1524, x166, Self::mul_add(s_q3, x170, c_q3 * x168));
+        let x177 = Self::mul_add(0.08, x113, 0.8021 * x112)
+            + Self::mul_add(x105, x123, x106 * x121)
+            + Self::mul_add(x111, 703.3878000000001, -15.183612000000002 * x110)
+            + (x169 + Self::mul_add(-7.06, x172, -0.1524 * x171));
+        let x178 = x124
+            + Self::mul_add(7.06, x166, Self::mul_add(-s_q3, x168, c_q3 * x170));
+        let x179 = Self::mul_add(x96, x104, x97 * x102)
+            - Self::mul_add(-0.0302, x99, -1.928 * x98)
+            + (x177
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(-s_q2, x166, c_q2 * x168),
-                    -0.1524 * Self::mul_add(s_q2, x168, c_q2 * x166),
+                    Self::mul_add(-s_q2, x173, c_q2 * x175),
+                    -0.1524 * Self::mul_add(s_q2, x175, c_q2 * x173),
                 ));
-        let x173 = Self::mul_add(
+        let x180 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x92, x98, qd[1] * x99)
-                - Self::mul_add(190.97044034, x94, -8596.210051042 * x93)
-                + Self::mul_add(0.1524, x167, Self::mul_add(s_q2, x171, c_q2 * x169)),
+            Self::mul_add(-x97, x103, qd[1] * x104)
+                - Self::mul_add(190.97044034, x99, -8596.210051042 * x98)
+                + Self::mul_add(0.1524, x174, Self::mul_add(s_q2, x178, c_q2 * x176)),
             c_q1
-                * (Self::mul_add(6.377, x167, Self::mul_add(-s_q2, x169, c_q2 * x171))
+                * (Self::mul_add(6.377, x174, Self::mul_add(-s_q2, x176, c_q2 * x178))
                     - Self::mul_add(
                         190.97044034000004,
-                        x93,
-                        Self::mul_add(x91, x98, qd[1] * x97),
+                        x98,
+                        Self::mul_add(x96, x103, qd[1] * x102),
                     )),
         );
         (
             [
-                [x75, x74, x77, x79, x87, x90],
-                [x74, x73, x76, x78, x86, x23],
-                [x77, x76, x58, x50, x84, x23],
-                [x79, x78, x50, x35, x25, x23],
-                [x87, x86, x84, x25, x14, x9],
-                [x90, x23, x23, x23, x9, 1.903],
+                [x80, x78, x82, x84, x92, x95],
+                [x78, x77, x81, x83, x91, x23],
+                [x82, x81, x60, x50, x89, x23],
+                [x84, x83, x50, x35, x25, x23],
+                [x92, x91, x89, x25, x14, x9],
+                [x95, x23, x23, x23, x9, 1.903],
             ],
-            [x173, x172, x170, x162, x156, x151],
+            [x180, x179, x177, x169, x163, x158],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 469 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 274 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 469 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 274 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1892,300 +1877,282 @@ impl Srms {
         let x49 = 7.06 * x36;
         let x50 = x35 - (x47 + x48);
         let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x53 = 703.3878000000001 + x36;
-        let x54 = -15.183612000000002 - x37;
-        let x55 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x56 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x57 = 103.41030072000001
-            + Self::mul_add(
-                x37,
-                7.06,
-                Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-            );
-        let x58 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x59 = 103.41030072000002
-            + Self::mul_add(
-                0.1524,
-                x36,
-                Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
-            );
-        let x60 = -0.08 + (x43 + x51);
-        let x61 = Self::mul_add(s_q2, x54, c_q2 * x53);
-        let x62 = Self::mul_add(-s_q2, x53, c_q2 * x54);
-        let x63 = Self::mul_add(s_q2, x59, c_q2 * x55);
-        let x64 = Self::mul_add(s_q2, x60, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x52, c_q2 * x57);
-        let x66 = Self::mul_add(-s_q2, x55, c_q2 * x59);
-        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x60);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x52);
-        let x69 = 0.1524 * x62;
-        let x70 = -0.1524 * x62;
-        let x71 = x61 * -6.377;
-        let x72 = 6.377 * x61;
-        let x73 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x64),
-            c_q1 * (-0.0302 + (x51 + x67)),
+        let x52 = Self::mul_add(
+            x37,
+            7.06,
+            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
         );
-        let x74 = Self::mul_add(-s_q1, x64, c_q1 * x67);
+        let x53 = Self::mul_add(
+            0.1524,
+            x36,
+            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+        );
+        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
+        let x55 = 703.3878000000001 + x36;
+        let x56 = -15.183612000000002 - x37;
+        let x57 = -5594.523885531201
+            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
+        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
+        let x59 = 103.41030072000001 + x52;
+        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
+        let x61 = 103.41030072000002 + x53;
+        let x62 = -0.08 + (x43 + x51);
+        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
+        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
+        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
+        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
+        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
+        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
+        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
+        let x71 = 0.1524 * x64;
+        let x72 = -0.1524 * x64;
+        let x73 = x63 * -6.377;
+        let x74 = 6.377 * x63;
         let x75 = Self::mul_add(
+            x64,
+            -6.377,
+            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
+        );
+        let x76 = Self::mul_add(
+            0.1524,
+            x63,
+            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+        );
+        let x77 = Self::mul_add(
+            -s_q1,
+            -1.928 + Self::mul_add(-6.377, x16, x66),
+            c_q1 * (-0.0302 + (x51 + x69)),
+        );
+        let x78 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(
+                -s_q1,
+                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
+                c_q1 * (190.97044034000004 + x76),
+            ),
+            c_q1
+                * Self::mul_add(
+                    -s_q1,
+                    190.97044034 + x75,
+                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
+                ),
+        );
+        let x79 = Self::mul_add(-s_q1, x66, c_q1 * x69);
+        let x80 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x43, c_q2 * x39),
             c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
         );
-        let x76 = c_q3 * x16;
-        let x77 = s_q3 * x16;
-        let x78 = x15 * 0.1524;
-        let x79 = Self::mul_add(s_q3, x30, x40) + x78;
-        let x80 = x25 + Self::mul_add(0.1524, x76, -7.06 * x77);
-        let x81 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x82 = Self::mul_add(
+        let x81 = c_q3 * x16;
+        let x82 = s_q3 * x16;
+        let x83 = x15 * 0.1524;
+        let x84 = Self::mul_add(s_q3, x30, x40) + x83;
+        let x85 = x25 + Self::mul_add(0.1524, x81, -7.06 * x82);
+        let x86 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
+        let x87 = Self::mul_add(
             -s_q1,
-            x78 + Self::mul_add(s_q2, x81, c_q2 * x79),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x79, c_q2 * x81)),
+            x83 + Self::mul_add(s_q2, x86, c_q2 * x84),
+            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x84, c_q2 * x86)),
         );
-        let x83 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x84 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x85 = Self::mul_add(
+        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
+        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
+        let x90 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x84, c_q2 * x83),
-            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x84),
+            Self::mul_add(s_q2, x89, c_q2 * x88),
+            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
         );
-        let x86 = qd[0] * s_q1;
-        let x87 = qd[0] * c_q1;
-        let x88 = qd[1] * x87;
-        let x89 = qd[1] * x86;
-        let x90 = qd[1] * qd[1];
-        let x91 = x86 * x87;
-        let x92 = Self::mul_add(
+        let x91 = qd[0] * s_q1;
+        let x92 = qd[0] * c_q1;
+        let x93 = qd[1] * x92;
+        let x94 = qd[1] * x91;
+        let x95 = qd[1] * qd[1];
+        let x96 = x91 * x92;
+        let x97 = Self::mul_add(
             190.97044034,
-            x87,
-            Self::mul_add(8596.210051042, x86, -1.928 * qd[1]),
+            x92,
+            Self::mul_add(8596.210051042, x91, -1.928 * qd[1]),
         );
-        let x93 = Self::mul_add(
+        let x98 = Self::mul_add(
             -0.0302,
-            x87,
-            Self::mul_add(1.928, x86, 8609.573807858 * qd[1]),
+            x92,
+            Self::mul_add(1.928, x91, 8609.573807858 * qd[1]),
         );
-        let x94 = Self::mul_add(-190.97044034000004, x86, -0.0302 * qd[1]);
-        let x95 = Self::mul_add(s_q2, x87, c_q2 * x86);
-        let x96 = Self::mul_add(-s_q2, x86, c_q2 * x87);
-        let x97 = Self::mul_add(-0.1524, x91, 6.377 * Self::mul_add(x87, x87, x90));
-        let x98 = Self::mul_add(-6.377, x89 + x89, -0.1524 * (x88 + x88));
-        let x99 = Self::mul_add(-0.1524, Self::mul_add(x86, x86, x90), 6.377 * x91);
-        let x100 = Self::mul_add(-c_q2, x97, s_q2 * x99);
-        let x101 = Self::mul_add(c_q2, x99, s_q2 * x97);
-        let x102 = Self::mul_add(-qd[2], x96, Self::mul_add(-c_q2, x88, s_q2 * x89));
-        let x103 = Self::mul_add(qd[2], x95, Self::mul_add(c_q2, x89, s_q2 * x88));
-        let x104 = qd[1] + qd[2];
-        let x105 = x104 * x104;
-        let x106 = Self::mul_add(x96, x96, x105);
-        let x107 = x95 * x96;
-        let x108 = Self::mul_add(x95, x104, x103);
-        let x109 = Self::mul_add(x96, x104, -x102);
-        let x110 = Self::mul_add(x95, x95, x105);
-        let x111 = Self::mul_add(
+        let x99 = Self::mul_add(-190.97044034000004, x91, -0.0302 * qd[1]);
+        let x100 = Self::mul_add(s_q2, x92, c_q2 * x91);
+        let x101 = Self::mul_add(-s_q2, x91, c_q2 * x92);
+        let x102 = Self::mul_add(-0.1524, x96, 6.377 * Self::mul_add(x92, x92, x95));
+        let x103 = Self::mul_add(-6.377, x94 + x94, -0.1524 * (x93 + x93));
+        let x104 = Self::mul_add(-0.1524, Self::mul_add(x91, x91, x95), 6.377 * x96);
+        let x105 = Self::mul_add(-c_q2, x102, s_q2 * x104);
+        let x106 = Self::mul_add(c_q2, x104, s_q2 * x102);
+        let x107 = Self::mul_add(-qd[2], x101, Self::mul_add(-c_q2, x93, s_q2 * x94));
+        let x108 = Self::mul_add(qd[2], x100, Self::mul_add(c_q2, x94, s_q2 * x93));
+        let x109 = qd[1] + qd[2];
+        let x110 = x109 * x109;
+        let x111 = Self::mul_add(x101, x101, x110);
+        let x112 = x100 * x101;
+        let x113 = Self::mul_add(x100, x109, x108);
+        let x114 = Self::mul_add(x101, x109, -x107);
+        let x115 = Self::mul_add(x100, x100, x110);
+        let x116 = Self::mul_add(
             103.41030072000001,
-            x96,
-            Self::mul_add(5594.523885531201, x95, 0.8021 * x104),
+            x101,
+            Self::mul_add(5594.523885531201, x100, 0.8021 * x109),
         );
-        let x112 = Self::mul_add(
+        let x117 = Self::mul_add(
             -0.08,
-            x96,
-            Self::mul_add(-0.8021, x95, 5601.1318504688 * x104),
+            x101,
+            Self::mul_add(-0.8021, x100, 5601.1318504688 * x109),
         );
-        let x113 = Self::mul_add(-103.41030072000002, x95, -0.08 * x104);
-        let x114 = Self::mul_add(s_q3, x96, c_q3 * x95);
-        let x115 = Self::mul_add(-s_q3, x95, c_q3 * x96);
-        let x116 = x100 - Self::mul_add(-0.1524, x107, 7.06 * x106);
-        let x117 = x98 + Self::mul_add(-7.06, x108, -0.1524 * x109);
-        let x118 = x101 + Self::mul_add(-0.1524, x110, 7.06 * x107);
-        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
-        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x103, c_q3 * x102));
-        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x103, s_q3 * x102));
-        let x122 = qd[3] + x104;
-        let x123 = Self::mul_add(x115, x115, x122 * x122);
-        let x124 = x114 * x115;
-        let x125 = Self::mul_add(-x114, x122, x121);
-        let x126 = -18.957952216000002 * x114;
-        let x127 = 19.863252216000003 * x122;
-        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
-        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
-        let x130 = Self::mul_add(qd[4], x129, c_q4 * x120);
-        let x131 = Self::mul_add(qd[4], x128, s_q4 * x120);
-        let x132 = qd[4] + x115;
-        let x133 = 34.33891524 * x129;
-        let x134 = 34.74691524 * x132;
-        let x135 = Self::mul_add(s_q5, x132, c_q5 * x129);
-        let x136 = Self::mul_add(-s_q5, x129, c_q5 * x132);
-        let x137 = Self::mul_add(qd[5], x136, Self::mul_add(-c_q5, x131, s_q5 * x121));
-        let x138 = Self::mul_add(-qd[5], x135, Self::mul_add(c_q5, x121, s_q5 * x131));
-        let x139 = qd[5] + x128;
-        let x140 = Self::mul_add(0.966, x136, Self::mul_add(0.385, x135, 1.903 * x139));
-        let x141 = Self::mul_add(0.353, x136, 0.385 * x139);
-        let x142 = Self::mul_add(
-            -0.9929999999999999,
-            x136,
-            Self::mul_add(0.353, x135, 0.966 * x139),
-        );
-        let x143 = Self::mul_add(0.966, x138, Self::mul_add(0.385, x137, 1.903 * x130))
-            + Self::mul_add(-x136, x141, x135 * x142) - f_ext[5][3];
-        let x144 = Self::mul_add(0.353, x138, 0.385 * x130)
-            + Self::mul_add(-x139, x142, x136 * x140) - f_ext[5][4];
-        let x145 = Self::mul_add(
-            -0.9929999999999999,
-            x138,
-            Self::mul_add(0.353, x137, 0.966 * x130),
-        ) + Self::mul_add(-x135, x140, x139 * x141) - f_ext[5][5];
-        let x146 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
-        let x147 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x148 = f_ext[5][0]
-            + Self::mul_add(
-                34.45002,
-                Self::mul_add(x132, x132, x129 * x129),
-                f_ext[4][0],
-            );
-        let x149 = Self::mul_add(34.45002, Self::mul_add(x128, x129, x121), -f_ext[4][1])
-            + x146;
-        let x150 = Self::mul_add(34.45002, Self::mul_add(x128, x132, x131), -f_ext[4][2])
-            - x147;
-        let x151 = Self::mul_add(-x132, x133, x129 * x134) - f_ext[4][3] + x143;
-        let x152 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x124, x119),
-            -Self::mul_add(x128, x134, 34.33891524 * x131),
-        ) - f_ext[4][4]
-            + Self::mul_add(0.762, x147, Self::mul_add(-s_q5, x145, c_q5 * x144));
-        let x153 = Self::mul_add(
-            34.45002,
-            Self::mul_add(
-                -s_q4,
-                Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
-                c_q4 * Self::mul_add(0.4572, x125, x117),
-            ),
-            Self::mul_add(x128, x133, 34.74691524 * x121),
-        ) - f_ext[4][5]
-            + Self::mul_add(0.762, x146, Self::mul_add(c_q5, x145, s_q5 * x144));
-        let x154 = Self::mul_add(-s_q4, x148, c_q4 * x149);
-        let x155 = Self::mul_add(41.67378, x123, f_ext[3][0])
-            + Self::mul_add(s_q4, x149, c_q4 * x148);
-        let x156 = Self::mul_add(41.67378, x125, -f_ext[3][1]) + x154;
-        let x157 = x150 - Self::mul_add(41.67378, x124, f_ext[3][2]);
-        let x158 = Self::mul_add(-x115, x127, -18.957952216000002 * x120) - f_ext[3][3]
-            + Self::mul_add(-s_q4, x152, c_q4 * x151);
-        let x159 = Self::mul_add(-x115, x126, x119 * -41.67378) - f_ext[3][4]
-            + Self::mul_add(-0.4572, x150, Self::mul_add(c_q4, x152, s_q4 * x151));
-        let x160 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
-            - f_ext[3][5] + Self::mul_add(0.4572, x154, x153);
-        let x161 = Self::mul_add(-c_q3, x155, s_q3 * x157);
-        let x162 = Self::mul_add(c_q3, x157, s_q3 * x155);
-        let x163 = x161
-            - (f_ext[2][0]
-                + Self::mul_add(-15.183612000000002, x107, 703.3878000000001 * x106));
-        let x164 = Self::mul_add(-703.3878000000001, x108, -15.183612000000002 * x109)
-            - f_ext[2][1] + x156;
-        let x165 = x162
-            - (f_ext[2][2]
-                + Self::mul_add(-15.183612000000002, x110, 703.3878000000001 * x107));
-        let x166 = Self::mul_add(
-            x98,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x103, -5594.523885531201 * x102)
-                + Self::mul_add(-x96, x112, x104 * x113),
-        ) - f_ext[2][3]
-            + Self::mul_add(0.1524, x156, Self::mul_add(s_q3, x160, c_q3 * x158));
-        let x167 = Self::mul_add(0.08, x103, 0.8021 * x102)
-            + Self::mul_add(x95, x113, x96 * x111)
-            + Self::mul_add(x101, 703.3878000000001, -15.183612000000002 * x100)
-            - f_ext[2][4] + (x159 + Self::mul_add(-7.06, x162, -0.1524 * x161));
-        let x168 = Self::mul_add(
+        let x118 = Self::mul_add(-103.41030072000002, x100, -0.08 * x109);
+        let x119 = Self::mul_add(
             703.3878000000001,
-            x98,
+            x103,
             Self::mul_add(
                 103.41030072000002,
-                x102,
-                -Self::mul_add(x95, x112, x104 * x111),
+                x107,
+                -Self::mul_add(x100, x117, x109 * x116),
             ),
-        ) - f_ext[2][5]
-            + Self::mul_add(7.06, x156, Self::mul_add(-s_q3, x158, c_q3 * x160));
-        let x169 = tau[0]
-            - (Self::mul_add(
-                -s_q1,
-                Self::mul_add(-x87, x93, qd[1] * x94)
-                    - Self::mul_add(190.97044034, x89, -8596.210051042 * x88)
-                    - f_ext[1][3]
-                    + Self::mul_add(
-                        0.1524,
-                        x164,
-                        Self::mul_add(s_q2, x168, c_q2 * x166),
-                    ),
-                c_q1
-                    * (Self::mul_add(
-                        6.377,
-                        x164,
-                        Self::mul_add(-s_q2, x166, c_q2 * x168),
-                    )
-                        - (f_ext[1][5]
-                            + Self::mul_add(
-                                190.97044034000004,
-                                x88,
-                                Self::mul_add(x86, x93, qd[1] * x92),
-                            ))),
-            ) - f_ext[0][5]);
-        let x170 = 1.0
-            / (14222.257549666001
-                + Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(
-                        -s_q1,
-                        -8596.210051042
-                            + (x70 + (Self::mul_add(s_q2, x65, c_q2 * x63) - x69)),
-                        c_q1
-                            * (190.97044034000004
-                                + Self::mul_add(
-                                    0.1524,
-                                    x61,
-                                    Self::mul_add(
-                                        -6.377,
-                                        x62,
-                                        Self::mul_add(s_q2, x68, c_q2 * x66),
-                                    ),
-                                )),
-                    ),
-                    c_q1
-                        * Self::mul_add(
-                            -s_q1,
-                            190.97044034
-                                + Self::mul_add(
-                                    x62,
-                                    -6.377,
-                                    Self::mul_add(
-                                        0.1524,
-                                        x61,
-                                        Self::mul_add(-s_q2, x63, c_q2 * x65),
-                                    ),
-                                ),
-                            c_q1 * (Self::mul_add(-s_q2, x66, c_q2 * x68) + x72 - x71),
-                        ),
-                ));
-        let x171 = x73 * x170;
-        let x172 = x74 * x170;
-        let x173 = x75 * x170;
-        let x174 = x82 * x170;
-        let x175 = x85 * x170;
-        let x176 = 1.0
-            / Self::mul_add(
-                -x73,
-                x171,
-                8609.573807858 + (x58 - (x71 - x70) - (x69 - x72)),
+        );
+        let x120 = Self::mul_add(s_q3, x101, c_q3 * x100);
+        let x121 = Self::mul_add(-s_q3, x100, c_q3 * x101);
+        let x122 = x105 - Self::mul_add(-0.1524, x112, 7.06 * x111);
+        let x123 = x103 + Self::mul_add(-7.06, x113, -0.1524 * x114);
+        let x124 = x106 + Self::mul_add(-0.1524, x115, 7.06 * x112);
+        let x125 = Self::mul_add(-c_q3, x124, s_q3 * x122);
+        let x126 = Self::mul_add(-qd[3], x121, Self::mul_add(s_q3, x108, c_q3 * x107));
+        let x127 = Self::mul_add(-qd[3], x120, Self::mul_add(-c_q3, x108, s_q3 * x107));
+        let x128 = qd[3] + x109;
+        let x129 = Self::mul_add(x121, x121, x128 * x128);
+        let x130 = x120 * x121;
+        let x131 = Self::mul_add(-x120, x128, x127);
+        let x132 = -18.957952216000002 * x120;
+        let x133 = 19.863252216000003 * x128;
+        let x134 = Self::mul_add(-c_q4, x120, s_q4 * x128);
+        let x135 = Self::mul_add(c_q4, x128, s_q4 * x120);
+        let x136 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(-0.4572, x129, Self::mul_add(s_q3, x124, c_q3 * x122)),
+            c_q4 * Self::mul_add(0.4572, x131, x123),
+        );
+        let x137 = Self::mul_add(qd[4], x135, c_q4 * x126);
+        let x138 = Self::mul_add(qd[4], x134, s_q4 * x126);
+        let x139 = qd[4] + x121;
+        let x140 = 34.33891524 * x135;
+        let x141 = 34.74691524 * x139;
+        let x142 = Self::mul_add(s_q5, x139, c_q5 * x135);
+        let x143 = Self::mul_add(-s_q5, x135, c_q5 * x139);
+        let x144 = Self::mul_add(qd[5], x143, Self::mul_add(-c_q5, x138, s_q5 * x127));
+        let x145 = Self::mul_add(-qd[5], x142, Self::mul_add(c_q5, x127, s_q5 * x138));
+        let x146 = qd[5] + x134;
+        let x147 = Self::mul_add(0.966, x143, Self::mul_add(0.385, x142, 1.903 * x146));
+        let x148 = Self::mul_add(0.353, x143, 0.385 * x146);
+        let x149 = Self::mul_add(
+            -0.9929999999999999,
+            x143,
+            Self::mul_add(0.353, x142, 0.966 * x146),
+        );
+        let x150 = Self::mul_add(0.966, x145, Self::mul_add(0.385, x144, 1.903 * x137))
+            + Self::mul_add(-x143, x148, x142 * x149) - f_ext[5][3];
+        let x151 = Self::mul_add(0.353, x145, 0.385 * x137)
+            + Self::mul_add(-x146, x149, x143 * x147) - f_ext[5][4];
+        let x152 = Self::mul_add(
+            -0.9929999999999999,
+            x145,
+            Self::mul_add(0.353, x144, 0.966 * x137),
+        ) + Self::mul_add(-x142, x147, x146 * x148) - f_ext[5][5];
+        let x153 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
+        let x154 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x155 = f_ext[5][0]
+            + Self::mul_add(
+                34.45002,
+                Self::mul_add(x139, x139, x135 * x135),
+                f_ext[4][0],
             );
-        let x177 = Self::mul_add(-x73, x172, x58 + (x70 - x71));
-        let x178 = x176 * x177;
-        let x179 = Self::mul_add(
-            -x73,
-            x173,
+        let x156 = Self::mul_add(34.45002, Self::mul_add(x134, x135, x127), -f_ext[4][1])
+            + x153;
+        let x157 = Self::mul_add(34.45002, Self::mul_add(x134, x139, x138), -f_ext[4][2])
+            - x154;
+        let x158 = Self::mul_add(-x139, x140, x135 * x141) - f_ext[4][3] + x150;
+        let x159 = Self::mul_add(
+            -34.45002,
+            Self::mul_add(-0.4572, x130, x125),
+            -Self::mul_add(x134, x141, 34.33891524 * x138),
+        ) - f_ext[4][4]
+            + Self::mul_add(0.762, x154, Self::mul_add(-s_q5, x152, c_q5 * x151));
+        let x160 = Self::mul_add(
+            34.45002,
+            x136,
+            Self::mul_add(x134, x140, 34.74691524 * x127),
+        ) - f_ext[4][5]
+            + Self::mul_add(0.762, x153, Self::mul_add(c_q5, x152, s_q5 * x151));
+        let x161 = Self::mul_add(-s_q4, x155, c_q4 * x156);
+        let x162 = Self::mul_add(41.67378, x129, f_ext[3][0])
+            + Self::mul_add(s_q4, x156, c_q4 * x155);
+        let x163 = Self::mul_add(41.67378, x131, -f_ext[3][1]) + x161;
+        let x164 = x157 - Self::mul_add(41.67378, x130, f_ext[3][2]);
+        let x165 = Self::mul_add(-x121, x133, -18.957952216000002 * x126) - f_ext[3][3]
+            + Self::mul_add(-s_q4, x159, c_q4 * x158);
+        let x166 = Self::mul_add(-x121, x132, x125 * -41.67378) - f_ext[3][4]
+            + Self::mul_add(-0.4572, x157, Self::mul_add(c_q4, x159, s_q4 * x158));
+        let x167 = Self::mul_add(41.67378, x123, Self::mul_add(-x120, x133, x128 * x132))
+            - f_ext[3][5] + Self::mul_add(0.4572, x161, x160);
+        let x168 = Self::mul_add(-c_q3, x162, s_q3 * x164);
+        let x169 = Self::mul_add(c_q3, x164, s_q3 * x162);
+        let x170 = x168
+            - (f_ext[2][0]
+                + Self::mul_add(-15.183612000000002, x112, 703.3878000000001 * x111));
+        let x171 = Self::mul_add(-703.3878000000001, x113, -15.183612000000002 * x114)
+            - f_ext[2][1] + x163;
+        let x172 = x169
+            - (f_ext[2][2]
+                + Self::mul_add(-15.183612000000002, x115, 703.3878000000001 * x112));
+        let x173 = Self::mul_add(
+            x103,
+            15.183612000000002,
+            Self::mul_add(-103.41030072000001, x108, -5594.523885531201 * x107)
+                + Self::mul_add(-x101, x117, x109 * x118),
+        ) - f_ext[2][3]
+            + Self::mul_add(0.1524, x163, Self::mul_add(s_q3, x167, c_q3 * x165));
+        let x174 = Self::mul_add(0.08, x108, 0.8021 * x107)
+            + Self::mul_add(x100, x118, x101 * x116)
+            + Self::mul_add(x106, 703.3878000000001, -15.183612000000002 * x105)
+            - f_ext[2][4] + (x166 + Self::mul_add(-7.06, x169, -0.1524 * x168));
+        let x175 = x119 - f_ext[2][5]
+            + Self::mul_add(7.06, x163, Self::mul_add(-s_q3, x165, c_q3 * x167));
+        let x176 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-x92, x98, qd[1] * x99)
+                - Self::mul_add(190.97044034, x94, -8596.210051042 * x93) - f_ext[1][3]
+                + Self::mul_add(0.1524, x171, Self::mul_add(s_q2, x175, c_q2 * x173)),
+            c_q1
+                * (Self::mul_add(6.377, x171, Self::mul_add(-s_q2, x173, c_q2 * x175))
+                    - (f_ext[1][5]
+                        + Self::mul_add(
+                            190.97044034000004,
+                            x93,
+                            Self::mul_add(x91, x98, qd[1] * x97),
+                        ))),
+        );
+        let x177 = tau[0] - (x176 - f_ext[0][5]);
+        let x178 = 1.0 / (14222.257549666001 + x78);
+        let x179 = x77 * x178;
+        let x180 = x79 * x178;
+        let x181 = x80 * x178;
+        let x182 = x87 * x178;
+        let x183 = x90 * x178;
+        let x184 = 1.0
+            / Self::mul_add(
+                -x77,
+                x179,
+                8609.573807858 + (x60 - (x73 - x72) - (x71 - x74)),
+            );
+        let x185 = Self::mul_add(-x77, x180, x60 + (x72 - x73));
+        let x186 = x184 * x185;
+        let x187 = Self::mul_add(
+            -x77,
+            x181,
             x50
                 + Self::mul_add(
                     0.1524,
@@ -2193,155 +2160,115 @@ impl Srms {
                     -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
                 ),
         );
-        let x180 = x176 * x179;
-        let x181 = Self::mul_add(
-            -x73,
-            x174,
-            x80
+        let x188 = x184 * x187;
+        let x189 = Self::mul_add(
+            -x77,
+            x182,
+            x85
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(c_q2, x77, s_q2 * x76),
-                    -0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
+                    Self::mul_add(c_q2, x82, s_q2 * x81),
+                    -0.1524 * Self::mul_add(-c_q2, x81, s_q2 * x82),
                 ),
         );
-        let x182 = x176 * x181;
-        let x183 = Self::mul_add(-x73, x175, x23);
-        let x184 = x176 * x183;
-        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x74, x172, x58));
-        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x74, x173, x50));
-        let x187 = x185 * x186;
-        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x74, x174, x80));
-        let x189 = x185 * x188;
-        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x74, x175, x23));
-        let x191 = x185 * x190;
-        let x192 = 1.0
-            / Self::mul_add(
-                -x186,
-                x187,
-                Self::mul_add(-x179, x180, Self::mul_add(-x75, x173, x35)),
-            );
-        let x193 = Self::mul_add(
-            -x186,
-            x189,
-            Self::mul_add(-x179, x182, Self::mul_add(-x75, x174, x25)),
+        let x190 = x184 * x189;
+        let x191 = Self::mul_add(-x77, x183, x23);
+        let x192 = x184 * x191;
+        let x193 = 1.0 / Self::mul_add(-x185, x186, Self::mul_add(-x79, x180, x60));
+        let x194 = Self::mul_add(-x185, x188, Self::mul_add(-x79, x181, x50));
+        let x195 = x193 * x194;
+        let x196 = Self::mul_add(-x185, x190, Self::mul_add(-x79, x182, x85));
+        let x197 = x193 * x196;
+        let x198 = Self::mul_add(-x185, x192, Self::mul_add(-x79, x183, x23));
+        let x199 = x193 * x198;
+        let x200 = Self::mul_add(
+            -x194,
+            x195,
+            Self::mul_add(-x187, x188, Self::mul_add(-x80, x181, x35)),
         );
-        let x194 = x192 * x193;
-        let x195 = Self::mul_add(
-            -x186,
-            x191,
-            Self::mul_add(-x179, x184, Self::mul_add(-x75, x175, x23)),
+        let x201 = 1.0 / x200;
+        let x202 = Self::mul_add(
+            -x194,
+            x197,
+            Self::mul_add(-x187, x190, Self::mul_add(-x80, x182, x25)),
         );
-        let x196 = x192 * x195;
-        let x197 = 1.0
-            / Self::mul_add(
-                -x193,
-                x194,
-                Self::mul_add(
-                    -x188,
-                    x189,
-                    Self::mul_add(-x181, x182, Self::mul_add(-x82, x174, x14)),
-                ),
-            );
-        let x198 = Self::mul_add(
-            -x193,
-            x196,
-            Self::mul_add(
-                -x188,
-                x191,
-                Self::mul_add(-x181, x184, Self::mul_add(-x82, x175, x9)),
-            ),
-        );
-        let x199 = x197 * x198;
-        let x200 = 1.0
-            / Self::mul_add(
-                -x198,
-                x199,
-                Self::mul_add(
-                    -x195,
-                    x196,
-                    Self::mul_add(
-                        -x190,
-                        x191,
-                        Self::mul_add(-x183, x184, Self::mul_add(-x85, x175, 1.903)),
-                    ),
-                ),
-            );
-        let x201 = Self::mul_add(
-            -x169,
-            x171,
-            tau[1]
-                - (Self::mul_add(x86, x94, x87 * x92)
-                    - Self::mul_add(-0.0302, x89, -1.928 * x88) - f_ext[1][4]
-                    + (x167
-                        + Self::mul_add(
-                            -6.377,
-                            Self::mul_add(-s_q2, x163, c_q2 * x165),
-                            -0.1524 * Self::mul_add(s_q2, x165, c_q2 * x163),
-                        ))),
-        );
-        let x202 = Self::mul_add(-x178, x201, Self::mul_add(-x169, x172, tau[2] - x167));
-        let x203 = Self::mul_add(
-            -x187,
-            x202,
-            Self::mul_add(-x180, x201, Self::mul_add(-x169, x173, tau[3] - x159)),
-        );
+        let x203 = x201 * x202;
         let x204 = Self::mul_add(
             -x194,
-            x203,
-            Self::mul_add(
-                -x189,
-                x202,
-                Self::mul_add(-x182, x201, Self::mul_add(-x169, x174, tau[4] - x153)),
-            ),
+            x199,
+            Self::mul_add(-x187, x192, Self::mul_add(-x80, x183, x23)),
         );
-        let x205 = x200
-            * Self::mul_add(
-                -x199,
-                x204,
-                Self::mul_add(
-                    -x196,
-                    x203,
-                    Self::mul_add(
-                        -x191,
-                        x202,
-                        Self::mul_add(
-                            -x184,
-                            x201,
-                            Self::mul_add(-x169, x175, tau[5] - x143),
-                        ),
-                    ),
-                ),
-            );
-        let x206 = Self::mul_add(-x199, x205, x197 * x204);
-        let x207 = Self::mul_add(-x196, x205, Self::mul_add(-x194, x206, x192 * x203));
+        let x205 = x201 * x204;
+        let x206 = Self::mul_add(
+            -x196,
+            x197,
+            Self::mul_add(-x189, x190, Self::mul_add(-x87, x182, x14)),
+        );
+        let x207 = 1.0 / Self::mul_add(-x202, x203, x206);
         let x208 = Self::mul_add(
-            -x191,
-            x205,
-            Self::mul_add(-x189, x206, Self::mul_add(-x187, x207, x185 * x202)),
+            -x196,
+            x199,
+            Self::mul_add(-x189, x192, Self::mul_add(-x87, x183, x9)),
         );
-        let x209 = Self::mul_add(
-            -x184,
-            x205,
-            Self::mul_add(
-                -x182,
-                x206,
-                Self::mul_add(-x180, x207, Self::mul_add(-x178, x208, x176 * x201)),
-            ),
+        let x209 = Self::mul_add(-x202, x205, x208);
+        let x210 = x207 * x209;
+        let x211 = Self::mul_add(
+            -x198,
+            x199,
+            Self::mul_add(-x191, x192, Self::mul_add(-x90, x183, 1.903)),
         );
-        let x210 = Self::mul_add(
-            -x175,
-            x205,
-            Self::mul_add(
-                -x174,
-                x206,
-                Self::mul_add(
-                    -x173,
-                    x207,
-                    Self::mul_add(-x172, x208, Self::mul_add(-x171, x209, x169 * x170)),
-                ),
-            ),
+        let x212 = 1.0 / Self::mul_add(-x209, x210, Self::mul_add(-x204, x205, x211));
+        let x213 = Self::mul_add(
+            -x177,
+            x179,
+            tau[1]
+                - (Self::mul_add(x91, x99, x92 * x97)
+                    - Self::mul_add(-0.0302, x94, -1.928 * x93) - f_ext[1][4]
+                    + (x174
+                        + Self::mul_add(
+                            -6.377,
+                            Self::mul_add(-s_q2, x170, c_q2 * x172),
+                            -0.1524 * Self::mul_add(s_q2, x172, c_q2 * x170),
+                        ))),
         );
-        [x210, x209, x208, x207, x206, x205]
+        let x214 = Self::mul_add(-x186, x213, Self::mul_add(-x177, x180, tau[2] - x174));
+        let x215 = Self::mul_add(
+            -x195,
+            x214,
+            Self::mul_add(-x188, x213, Self::mul_add(-x177, x181, tau[3] - x166)),
+        );
+        let x216 = Self::mul_add(
+            -x197,
+            x214,
+            Self::mul_add(-x190, x213, Self::mul_add(-x177, x182, tau[4] - x160)),
+        );
+        let x217 = Self::mul_add(-x203, x215, x216);
+        let x218 = Self::mul_add(
+            -x199,
+            x214,
+            Self::mul_add(-x192, x213, Self::mul_add(-x177, x183, tau[5] - x150)),
+        );
+        let x219 = x212 * Self::mul_add(-x210, x217, Self::mul_add(-x205, x215, x218));
+        let x220 = Self::mul_add(-x210, x219, x207 * x217);
+        let x221 = Self::mul_add(-x205, x219, Self::mul_add(-x203, x220, x201 * x215));
+        let x222 = Self::mul_add(
+            -x199,
+            x219,
+            Self::mul_add(-x197, x220, Self::mul_add(-x195, x221, x193 * x214)),
+        );
+        let x223 = Self::mul_add(
+            -x190,
+            x220,
+            Self::mul_add(-x188, x221, Self::mul_add(-x186, x222, x184 * x213)),
+        );
+        let x224 = Self::mul_add(-x192, x219, x223);
+        let x225 = Self::mul_add(
+            -x181,
+            x221,
+            Self::mul_add(-x180, x222, Self::mul_add(-x179, x224, x177 * x178)),
+        );
+        let x226 = Self::mul_add(-x183, x219, Self::mul_add(-x182, x220, x225));
+        [x226, x224, x222, x221, x220, x219]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

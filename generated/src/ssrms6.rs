@@ -7,37 +7,40 @@
 //! Gravity: none (space).
 //! Runtime payload: no (every model number is a constant).
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
+//! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Fused multiply-adds where the target has them: 761 (`mass_matrix` 52, `nonlinear_effects` 80, `inverse_dynamics` 97, `forward_dynamics` 193, `mass_matrix_and_nonlinear_effects` 132, `forward_dynamics_with_wrenches` 207), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
-//! | function | mass matrix | bias | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | 429 | 352 | 0 | 0 | 6 | 781 |
-//! | `mass_matrix` | `recurrent-r1` | — | 469 | 372 | 0 | 0 | 6 | 841 |
-//! | `mass_matrix` | `kane-direct` | — | 442 | 295 | 0 | 0 | 6 | 737 |
-//! | `mass_matrix` | `crba-base` | — | 412 | 299 | 0 | 0 | 6 | 711 |
-//! | `mass_matrix` * | `crba` | — | 102 | 71 | 0 | 0 | 4 | 173 |
-//! | `nonlinear_effects` | — | `recurrent` | 493 | 340 | 0 | 0 | 6 | 833 |
-//! | `nonlinear_effects` | — | `kane-direct` | 534 | 376 | 0 | 0 | 6 | 910 |
-//! | `nonlinear_effects` | — | `rnea` | 189 | 124 | 0 | 0 | 5 | 313 |
-//! | `nonlinear_effects` * | — | `newton-euler` | 155 | 99 | 0 | 0 | 5 | 254 |
-//! | `inverse_dynamics` | — | `recurrent` | 621 | 439 | 0 | 0 | 6 | 1060 |
-//! | `inverse_dynamics` | — | `kane-direct` | 662 | 475 | 0 | 0 | 6 | 1137 |
-//! | `inverse_dynamics` | — | `rnea` | 208 | 146 | 0 | 0 | 5 | 354 |
-//! | `inverse_dynamics` * | — | `newton-euler` | 172 | 124 | 0 | 0 | 5 | 296 |
-//! | `forward_dynamics` | `crba` | `recurrent` | 681 | 478 | 6 | 0 | 6 | 1159 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | 722 | 514 | 6 | 0 | 6 | 1236 |
-//! | `forward_dynamics` | `crba` | `rnea` | 377 | 262 | 6 | 0 | 5 | 639 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | 343 | 237 | 6 | 0 | 5 | 580 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | 595 | 411 | 0 | 0 | 6 | 1006 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | 636 | 447 | 0 | 0 | 6 | 1083 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | 291 | 195 | 0 | 0 | 5 | 486 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | 257 | 170 | 0 | 0 | 5 | 427 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | 763 | 561 | 6 | 0 | 6 | 1324 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | 804 | 597 | 6 | 0 | 6 | 1401 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | 389 | 300 | 6 | 0 | 5 | 689 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | 355 | 275 | 6 | 0 | 5 | 630 |
+//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | 429 | 352 | 0 | 0 | 6 | 781 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | 469 | 372 | 0 | 0 | 6 | 841 |
+//! | `mass_matrix` | `kane-direct` | — | — | 442 | 295 | 0 | 0 | 6 | 737 |
+//! | `mass_matrix` | `crba-base` | — | — | 412 | 299 | 0 | 0 | 6 | 711 |
+//! | `mass_matrix` * | `crba` | — | — | 102 | 71 | 0 | 0 | 4 | 173 |
+//! | `nonlinear_effects` | — | `recurrent` | — | 493 | 340 | 0 | 0 | 6 | 833 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | 534 | 376 | 0 | 0 | 6 | 910 |
+//! | `nonlinear_effects` | — | `rnea` | — | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | 155 | 99 | 0 | 0 | 5 | 254 |
+//! | `inverse_dynamics` | — | `recurrent` | — | 621 | 439 | 0 | 0 | 6 | 1060 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | 662 | 475 | 0 | 0 | 6 | 1137 |
+//! | `inverse_dynamics` | — | `rnea` | — | 208 | 146 | 0 | 0 | 5 | 354 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | 172 | 124 | 0 | 0 | 5 | 296 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 681 | 478 | 6 | 0 | 6 | 1159 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 722 | 514 | 6 | 0 | 6 | 1236 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 377 | 262 | 6 | 0 | 5 | 639 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | 343 | 237 | 6 | 0 | 5 | 580 |
+//! | `forward_dynamics` | — | — | `aba` | 422 | 292 | 4 | 0 | 5 | 714 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 595 | 411 | 0 | 0 | 6 | 1006 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 636 | 447 | 0 | 0 | 6 | 1083 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 291 | 195 | 0 | 0 | 5 | 486 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 257 | 170 | 0 | 0 | 5 | 427 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 763 | 561 | 6 | 0 | 6 | 1324 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 804 | 597 | 6 | 0 | 6 | 1401 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 389 | 300 | 6 | 0 | 5 | 689 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | 355 | 275 | 6 | 0 | 5 | 630 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 434 | 331 | 4 | 0 | 5 | 765 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
@@ -50,6 +53,9 @@ pub struct OpCount {
     pub mass_matrix_method: Option<&'static str>,
     /// Its bias method.
     pub bias_method: Option<&'static str>,
+    /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
+    /// the articulated-body algorithm, which uses neither), for forward dynamics.
+    pub forward_method: Option<&'static str>,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -94,6 +100,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 102u64,
             add: 71u64,
             div: 0u64,
@@ -105,6 +112,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 155u64,
             add: 99u64,
             div: 0u64,
@@ -116,6 +124,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 172u64,
             add: 124u64,
             div: 0u64,
@@ -127,6 +136,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 343u64,
             add: 237u64,
             div: 6u64,
@@ -138,6 +148,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 257u64,
             add: 170u64,
             div: 0u64,
@@ -149,6 +160,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 355u64,
             add: 275u64,
             div: 6u64,
@@ -163,6 +175,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
+            forward_method: None,
             mul: 429u64,
             add: 352u64,
             div: 0u64,
@@ -174,6 +187,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
+            forward_method: None,
             mul: 469u64,
             add: 372u64,
             div: 0u64,
@@ -185,6 +199,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
+            forward_method: None,
             mul: 442u64,
             add: 295u64,
             div: 0u64,
@@ -196,6 +211,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
+            forward_method: None,
             mul: 412u64,
             add: 299u64,
             div: 0u64,
@@ -207,6 +223,7 @@ impl Ssrms6 {
             function: "mass_matrix",
             mass_matrix_method: Some("crba"),
             bias_method: None,
+            forward_method: None,
             mul: 102u64,
             add: 71u64,
             div: 0u64,
@@ -218,6 +235,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 493u64,
             add: 340u64,
             div: 0u64,
@@ -229,6 +247,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 534u64,
             add: 376u64,
             div: 0u64,
@@ -240,6 +259,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 189u64,
             add: 124u64,
             div: 0u64,
@@ -251,6 +271,7 @@ impl Ssrms6 {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 155u64,
             add: 99u64,
             div: 0u64,
@@ -262,6 +283,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 621u64,
             add: 439u64,
             div: 0u64,
@@ -273,6 +295,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 662u64,
             add: 475u64,
             div: 0u64,
@@ -284,6 +307,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 208u64,
             add: 146u64,
             div: 0u64,
@@ -295,6 +319,7 @@ impl Ssrms6 {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 172u64,
             add: 124u64,
             div: 0u64,
@@ -306,6 +331,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 681u64,
             add: 478u64,
             div: 6u64,
@@ -317,6 +343,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 722u64,
             add: 514u64,
             div: 6u64,
@@ -328,6 +355,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 377u64,
             add: 262u64,
             div: 6u64,
@@ -339,6 +367,7 @@ impl Ssrms6 {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 343u64,
             add: 237u64,
             div: 6u64,
@@ -347,9 +376,22 @@ impl Ssrms6 {
             fma: 0u64,
         },
         OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 422u64,
+            add: 292u64,
+            div: 4u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: None,
             mul: 595u64,
             add: 411u64,
             div: 0u64,
@@ -361,6 +403,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: None,
             mul: 636u64,
             add: 447u64,
             div: 0u64,
@@ -372,6 +415,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: None,
             mul: 291u64,
             add: 195u64,
             div: 0u64,
@@ -383,6 +427,7 @@ impl Ssrms6 {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: None,
             mul: 257u64,
             add: 170u64,
             div: 0u64,
@@ -394,6 +439,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
             mul: 763u64,
             add: 561u64,
             div: 6u64,
@@ -405,6 +451,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
             mul: 804u64,
             add: 597u64,
             div: 6u64,
@@ -416,6 +463,7 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
             mul: 389u64,
             add: 300u64,
             div: 6u64,
@@ -427,9 +475,22 @@ impl Ssrms6 {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             mul: 355u64,
             add: 275u64,
             div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            mul: 434u64,
+            add: 331u64,
+            div: 4u64,
             sqrt: 0u64,
             sincos: 5u64,
             fma: 0u64,
@@ -484,64 +545,56 @@ impl Ssrms6 {
         let x41 = x27 - x38;
         let x42 = 39241.404122 + (x39 + x41);
         let x43 = c_q1 * x31;
-        let x44 = c_q1 * Self::mul_add(x31, 0.475, Self::mul_add(-s_q2, x26, x36));
-        let x45 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, 5224.5702 + x29, x43),
-            Self::mul_add(-s_q1, 3946.18812068 + x40, x44),
+        let x44 = Self::mul_add(
+            -s_q1,
+            -39234.47412200001 + Self::mul_add(s_q2, x34, c_q2 * x32),
+            c_q1 * Self::mul_add(-7.11, x31, Self::mul_add(s_q2, x37, c_q2 * x35)),
         );
-        let x46 = 65697.3302265768
-            + Self::mul_add(
-                -s_q1,
-                Self::mul_add(
-                    -s_q1,
-                    -39234.47412200001 + Self::mul_add(s_q2, x34, c_q2 * x32),
-                    c_q1
-                        * Self::mul_add(-7.11, x31, Self::mul_add(s_q2, x37, c_q2 * x35)),
-                ),
-                c_q1
-                    * Self::mul_add(
-                        -s_q1,
-                        Self::mul_add(-7.11, x31, Self::mul_add(-s_q2, x32, c_q2 * x34)),
-                        c_q1 * (Self::mul_add(-s_q2, x35, c_q2 * x37) + x39 - x38),
-                    ),
-            );
+        let x45 = c_q1 * Self::mul_add(x31, 0.475, Self::mul_add(-s_q2, x26, x36));
+        let x46 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-7.11, x31, Self::mul_add(-s_q2, x32, c_q2 * x34)),
+            c_q1 * (Self::mul_add(-s_q2, x35, c_q2 * x37) + x39 - x38),
+        );
         let x47 = Self::mul_add(
             0.5692,
-            Self::mul_add(-s_q1, x29, x43),
-            Self::mul_add(-s_q1, x40, x44),
+            Self::mul_add(-s_q1, 5224.5702 + x29, x43),
+            Self::mul_add(-s_q1, 3946.18812068 + x40, x45),
         );
-        let x48 = Self::mul_add(-s_q2, x10, x30);
-        let x49 = Self::mul_add(c_q2, x10, x28);
-        let x50 = Self::mul_add(7.11, x49, x20);
-        let x51 = Self::mul_add(
+        let x48 = 65697.3302265768 + Self::mul_add(-s_q1, x44, c_q1 * x46);
+        let x49 = Self::mul_add(
             0.5692,
-            Self::mul_add(-s_q1, x49, c_q1 * x48),
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(0.475, x49, Self::mul_add(c_q2, x13, x33)),
-                c_q1 * Self::mul_add(0.475, x48, Self::mul_add(-s_q2, x13, x36)),
-            ),
+            Self::mul_add(-s_q1, x29, x43),
+            Self::mul_add(-s_q1, x40, x45),
         );
-        let x52 = Self::mul_add(
+        let x50 = Self::mul_add(-s_q2, x10, x30);
+        let x51 = Self::mul_add(c_q2, x10, x28);
+        let x52 = Self::mul_add(7.11, x51, x20);
+        let x53 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(0.475, x51, Self::mul_add(c_q2, x13, x33)),
+            c_q1 * Self::mul_add(0.475, x50, Self::mul_add(-s_q2, x13, x36)),
+        );
+        let x54 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x51, c_q1 * x50), x53);
+        let x55 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x17, c_q2 * x14),
             c_q1 * Self::mul_add(-s_q2, x14, c_q2 * x17),
         );
-        let x53 = c_q3 * x4;
-        let x54 = s_q3 * x4;
-        let x55 = -Self::mul_add(
+        let x56 = c_q3 * x4;
+        let x57 = s_q3 * x4;
+        let x58 = -Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x54, s_q2 * x53),
-            s_q1 * Self::mul_add(-s_q2, x54, c_q2 * x53),
+            Self::mul_add(c_q2, x57, s_q2 * x56),
+            s_q1 * Self::mul_add(-s_q2, x57, c_q2 * x56),
         );
         [
-            [x46, x45, x47, x51, x52, x55],
-            [x45, x42, x41, x50, 0.0, x6],
-            [x47, x41, x27, x20, 0.0, x6],
-            [x51, x50, x20, x9, 0.0, x6],
-            [x52, 0.0, 0.0, 0.0, 47.471, 0.0],
-            [x55, x6, x6, x6, 0.0, 9.336],
+            [x48, x47, x49, x54, x55, x58],
+            [x47, x42, x41, x52, 0.0, x6],
+            [x49, x41, x27, x20, 0.0, x6],
+            [x54, x52, x20, x9, 0.0, x6],
+            [x55, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x58, x6, x6, x6, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -579,88 +632,87 @@ impl Ssrms6 {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x27 = Self::mul_add(x13, s_q3, x12 * c_q3);
         let x28 = Self::mul_add(-x12, s_q3, x13 * c_q3);
-        let x29 = Self::mul_add(-qd[3], x28, Self::mul_add(x19, s_q3, x18 * c_q3));
-        let x30 = Self::mul_add(-qd[3], x27, Self::mul_add(-x19, c_q3, x18 * s_q3));
-        let x31 = qd[3] + x20;
-        let x32 = -171.195516 * (x27 * x28);
-        let x33 = -171.195516 * Self::mul_add(x28, x31, -x29);
-        let x34 = -171.195516 * Self::mul_add(x27, x27, x31 * x31);
-        let x35 = 132.6783695416 * x27;
-        let x36 = Self::mul_add(-97.44448770720001, x28, 135.4729695416 * x31);
-        let x37 = -97.44448770720001 * x31;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x39 = Self::mul_add(-x27, c_q4, x31 * s_q4);
-        let x40 = Self::mul_add(x31, c_q4, x27 * s_q4);
-        let x41 = qd[4] + x28;
-        let x42 = 44.41 * x40;
-        let x43 = 47.471 * x41;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x45 = 9.336 * Self::mul_add(qd[4], x40, x29 * c_q4);
-        let x46 = 9.336 * (qd[5] + x39);
-        let x47 = Self::mul_add(-x40, s_q5, x41 * c_q5) * x46;
-        let x48 = Self::mul_add(x41, s_q5, x40 * c_q5) * x46;
-        let x49 = Self::mul_add(-x41, x42, x40 * x43) + x45;
-        let x50 = Self::mul_add(s_q5, x48, c_q5 * x47)
-            - Self::mul_add(x39, x43, 44.41 * Self::mul_add(qd[4], x39, x29 * s_q4));
-        let x51 = Self::mul_add(x39, x42, 47.471 * x30)
-            + Self::mul_add(-c_q5, x48, s_q5 * x47);
-        let x52 = Self::mul_add(
+        let x29 = Self::mul_add(
+            s_q3,
+            Self::mul_add(7.11, x22, x17),
+            c_q3 * Self::mul_add(-7.11, x21, Self::mul_add(-c_q2, x14, s_q2 * x15)),
+        );
+        let x30 = Self::mul_add(-qd[3], x28, Self::mul_add(x19, s_q3, x18 * c_q3));
+        let x31 = Self::mul_add(-qd[3], x27, Self::mul_add(-x19, c_q3, x18 * s_q3));
+        let x32 = qd[3] + x20;
+        let x33 = -171.195516 * (x27 * x28);
+        let x34 = -171.195516 * Self::mul_add(x28, x32, -x30);
+        let x35 = -171.195516 * Self::mul_add(x27, x27, x32 * x32);
+        let x36 = 132.6783695416 * x27;
+        let x37 = Self::mul_add(-97.44448770720001, x28, 135.4729695416 * x32);
+        let x38 = -97.44448770720001 * x32;
+        let x39 = Self::mul_add(
             Self::mul_add(7.11, x23, x16),
             -171.195516,
-            Self::mul_add(132.6783695416, x29, Self::mul_add(-x28, x36, x31 * x37)),
-        ) + Self::mul_add(-s_q4, x50, c_q4 * x49);
-        let x53 = Self::mul_add(
+            Self::mul_add(132.6783695416, x30, Self::mul_add(-x28, x37, x32 * x38)),
+        );
+        let x40 = Self::mul_add(
             -171.195516,
-            Self::mul_add(
-                s_q3,
-                Self::mul_add(7.11, x22, x17),
-                c_q3 * Self::mul_add(-7.11, x21, Self::mul_add(-c_q2, x14, s_q2 * x15)),
-            ),
-            Self::mul_add(-97.44448770720001, x30, Self::mul_add(-x28, x35, x27 * x37)),
-        ) + Self::mul_add(c_q4, x50, s_q4 * x49);
-        let x54 = Self::mul_add(-x27, x36, x31 * x35) + x51;
-        let x55 = Self::mul_add(-c_q3, x34, s_q3 * x32);
-        let x56 = Self::mul_add(3239.4582, x21, Self::mul_add(s_q3, x34, c_q3 * x32));
-        let x57 = Self::mul_add(-3239.4582, x22, x55);
-        let x58 = Self::mul_add(-x13, x25, -24989.305802 * x18)
-            + Self::mul_add(s_q3, x54, c_q3 * x52);
-        let x59 = Self::mul_add(
+            x29,
+            Self::mul_add(-97.44448770720001, x31, Self::mul_add(-x28, x36, x27 * x38)),
+        );
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x42 = Self::mul_add(-x27, c_q4, x32 * s_q4);
+        let x43 = Self::mul_add(x32, c_q4, x27 * s_q4);
+        let x44 = qd[4] + x28;
+        let x45 = 44.41 * x43;
+        let x46 = 47.471 * x44;
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x48 = 9.336 * Self::mul_add(qd[4], x43, x30 * c_q4);
+        let x49 = 9.336 * (qd[5] + x42);
+        let x50 = Self::mul_add(-x43, s_q5, x44 * c_q5) * x49;
+        let x51 = Self::mul_add(x44, s_q5, x43 * c_q5) * x49;
+        let x52 = Self::mul_add(-x44, x45, x43 * x46) + x48;
+        let x53 = Self::mul_add(s_q5, x51, c_q5 * x50)
+            - Self::mul_add(x42, x46, 44.41 * Self::mul_add(qd[4], x42, x30 * s_q4));
+        let x54 = Self::mul_add(x42, x45, 47.471 * x31)
+            + Self::mul_add(-c_q5, x51, s_q5 * x50);
+        let x55 = x39 + Self::mul_add(-s_q4, x53, c_q4 * x52);
+        let x56 = x40 + Self::mul_add(c_q4, x53, s_q4 * x52);
+        let x57 = Self::mul_add(-x27, x37, x32 * x36) + x54;
+        let x58 = Self::mul_add(-c_q3, x35, s_q3 * x33);
+        let x59 = Self::mul_add(3239.4582, x21, Self::mul_add(s_q3, x35, c_q3 * x33));
+        let x60 = Self::mul_add(-3239.4582, x22, x58);
+        let x61 = Self::mul_add(-x13, x25, -24989.305802 * x18)
+            + Self::mul_add(s_q3, x57, c_q3 * x55);
+        let x62 = Self::mul_add(
             x17,
             3239.4582,
             Self::mul_add(x13, x24, 1375.0472756800002 * x18),
-        ) + Self::mul_add(x55, -7.11, x53);
-        let x60 = Self::mul_add(7.11, x33, Self::mul_add(-s_q3, x52, c_q3 * x54))
+        ) + Self::mul_add(x58, -7.11, x56);
+        let x63 = Self::mul_add(7.11, x34, Self::mul_add(-s_q3, x55, c_q3 * x57))
             - Self::mul_add(3239.4582, x16, Self::mul_add(x12, x25, x20 * x24));
-        let x61 = Self::mul_add(-c_q2, x56, s_q2 * x57);
-        let x62 = Self::mul_add(c_q2, x57, s_q2 * x56);
-        let x63 = Self::mul_add(-3946.1881206800003, x4, x2 * x9)
-            + Self::mul_add(-7.11, x62, x59);
-        let x64 = Self::mul_add(
+        let x64 = Self::mul_add(-c_q2, x59, s_q2 * x60);
+        let x65 = Self::mul_add(c_q2, x60, s_q2 * x59);
+        let x66 = Self::mul_add(-3946.1881206800003, x4, x2 * x9)
+            + Self::mul_add(-7.11, x65, x62);
+        let x67 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-0.475, x65, Self::mul_add(s_q2, x63, c_q2 * x61))
+                - Self::mul_add(x2, x10, -39234.47412200001 * x4),
+            c_q1
+                * (Self::mul_add(-s_q2, x61, c_q2 * x63)
+                    + Self::mul_add(
+                        7.11,
+                        Self::mul_add(-3239.4582, x23, x34),
+                        x64 * 0.475,
+                    ) - Self::mul_add(5224.5702, x3, Self::mul_add(x1, x10, qd[1] * x9))),
+        );
+        let x68 = Self::mul_add(
             0.5692,
             Self::mul_add(
                 s_q1,
-                Self::mul_add(-5224.5702, x8, x62),
-                c_q1 * Self::mul_add(-5224.5702, x7, x61),
+                Self::mul_add(-5224.5702, x8, x65),
+                c_q1 * Self::mul_add(-5224.5702, x7, x64),
             ),
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(-0.475, x62, Self::mul_add(s_q2, x60, c_q2 * x58))
-                    - Self::mul_add(x2, x10, -39234.47412200001 * x4),
-                c_q1
-                    * (Self::mul_add(-s_q2, x58, c_q2 * x60)
-                        + Self::mul_add(
-                            7.11,
-                            Self::mul_add(-3239.4582, x23, x33),
-                            x61 * 0.475,
-                        )
-                        - Self::mul_add(
-                            5224.5702,
-                            x3,
-                            Self::mul_add(x1, x10, qd[1] * x9),
-                        )),
-            ),
+            x67,
         );
-        [x64, x63, x59, x53, x51, x45]
+        [x68, x66, x62, x56, x54, x48]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -682,99 +734,7 @@ impl Ssrms6 {
         let x12 = Self::mul_add(x1, x2, qdd[1]);
         let x13 = Self::mul_add(39234.47412200001, x1, 3946.18812068 * qd[1]);
         let x14 = Self::mul_add(-3946.1881206800003, x1, 39241.404122 * qd[1]);
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x16 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x17 = Self::mul_add(-x1, s_q2, x2 * c_q2);
-        let x18 = Self::mul_add(c_q1, x3, Self::mul_add(-0.475, x7 + x9, 7.11 * x11));
-        let x19 = Self::mul_add(0.475, Self::mul_add(x1, x1, x10), 7.11 * (x9 - x7))
-            - x4;
-        let x20 = Self::mul_add(-7.11, x12, -0.475 * (x6 - x8)) - x5;
-        let x21 = Self::mul_add(-s_q2, x18, c_q2 * x20);
-        let x22 = Self::mul_add(qd[2], x17, Self::mul_add(x9, s_q2, x8 * c_q2));
-        let x23 = Self::mul_add(-qd[2], x16, Self::mul_add(-x8, s_q2, x9 * c_q2));
-        let x24 = qdd[1] + qdd[2];
-        let x25 = qd[1] + qd[2];
-        let x26 = Self::mul_add(x17, x17, x25 * x25);
-        let x27 = Self::mul_add(-x16, x25, x23);
-        let x28 = Self::mul_add(x16, x17, x24);
-        let x29 = Self::mul_add(24989.305802, x16, 1375.0472756800002 * x25);
-        let x30 = Self::mul_add(-1375.0472756800002, x16, 24998.827802 * x25);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x32 = Self::mul_add(x17, s_q3, x16 * c_q3);
-        let x33 = Self::mul_add(-x16, s_q3, x17 * c_q3);
-        let x34 = Self::mul_add(qd[3], x33, Self::mul_add(x23, s_q3, x22 * c_q3));
-        let x35 = Self::mul_add(-qd[3], x32, Self::mul_add(-x22, s_q3, x23 * c_q3));
-        let x36 = qdd[3] + x24;
-        let x37 = qd[3] + x25;
-        let x38 = -171.195516 * Self::mul_add(-x32, x33, x36);
-        let x39 = -171.195516 * Self::mul_add(x33, x37, x34);
-        let x40 = -171.195516 * Self::mul_add(x32, x32, x37 * x37);
-        let x41 = 132.6783695416 * x32;
-        let x42 = Self::mul_add(-97.44448770720001, x33, 135.4729695416 * x37);
-        let x43 = -97.44448770720001 * x37;
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x45 = Self::mul_add(-x32, c_q4, x37 * s_q4);
-        let x46 = Self::mul_add(x37, c_q4, x32 * s_q4);
-        let x47 = qd[4] + x33;
-        let x48 = 44.41 * x46;
-        let x49 = 47.471 * x47;
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x51 = 9.336
-            * (qdd[5]
-                + Self::mul_add(qd[4], x46, Self::mul_add(-x34, c_q4, x36 * s_q4)));
-        let x52 = 9.336 * (qd[5] + x45);
-        let x53 = Self::mul_add(-x46, s_q5, x47 * c_q5) * x52;
-        let x54 = Self::mul_add(x47, s_q5, x46 * c_q5) * x52;
-        let x55 = Self::mul_add(-x47, x48, x46 * x49) + x51;
-        let x56 = Self::mul_add(
-            -x45,
-            x49,
-            44.41 * Self::mul_add(-qd[4], x45, Self::mul_add(x36, c_q4, x34 * s_q4)),
-        ) + Self::mul_add(s_q5, x54, c_q5 * x53);
-        let x57 = Self::mul_add(x45, x48, 47.471 * (qdd[4] + x35))
-            + Self::mul_add(-c_q5, x54, s_q5 * x53);
-        let x58 = Self::mul_add(
-            Self::mul_add(7.11, x27, x19),
-            171.195516,
-            Self::mul_add(-132.6783695416, x34, Self::mul_add(-x33, x42, x37 * x43)),
-        ) + Self::mul_add(-s_q4, x56, c_q4 * x55);
-        let x59 = Self::mul_add(
-            171.195516,
-            Self::mul_add(
-                s_q3,
-                Self::mul_add(-7.11, x28, x21),
-                c_q3 * Self::mul_add(7.11, x26, Self::mul_add(s_q2, x20, c_q2 * x18)),
-            ),
-            Self::mul_add(-97.44448770720001, x35, 135.4729695416 * x36)
-                + Self::mul_add(-x33, x41, x32 * x43),
-        ) + Self::mul_add(c_q4, x56, s_q4 * x55);
-        let x60 = Self::mul_add(
-            -97.44448770720001,
-            x36,
-            Self::mul_add(-x32, x42, x37 * x41),
-        ) + x57;
-        let x61 = Self::mul_add(c_q3, x40, s_q3 * x38);
-        let x62 = Self::mul_add(-3239.4582, x26, Self::mul_add(-s_q3, x40, c_q3 * x38));
-        let x63 = Self::mul_add(3239.4582, x28, x61);
-        let x64 = Self::mul_add(
-            -x17,
-            x30,
-            Self::mul_add(24989.305802, x22, 1375.0472756800002 * x24),
-        ) + Self::mul_add(s_q3, x60, c_q3 * x58);
-        let x65 = Self::mul_add(
-            x21,
-            -3239.4582,
-            Self::mul_add(
-                x17,
-                x29,
-                Self::mul_add(-1375.0472756800002, x22, 24998.827802 * x24),
-            ),
-        ) + Self::mul_add(x61, 7.11, x59);
-        let x66 = Self::mul_add(3239.4582, x19, -Self::mul_add(x16, x30, x25 * x29))
-            + Self::mul_add(7.11, x39, Self::mul_add(-s_q3, x58, c_q3 * x60));
-        let x67 = Self::mul_add(-s_q2, x63, c_q2 * x62);
-        let x68 = Self::mul_add(c_q2, x63, s_q2 * x62);
-        let x69 = Self::mul_add(
+        let x15 = Self::mul_add(
             x5,
             5224.5702,
             Self::mul_add(
@@ -782,44 +742,135 @@ impl Ssrms6 {
                 x13,
                 Self::mul_add(-3946.1881206800003, x8, 39241.404122 * qdd[1]),
             ),
-        ) + Self::mul_add(7.11, x68, x65);
-        let x70 = Self::mul_add(
-            65697.3302265768,
-            qdd[0],
+        );
+        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let x17 = Self::mul_add(x2, s_q2, x1 * c_q2);
+        let x18 = Self::mul_add(-x1, s_q2, x2 * c_q2);
+        let x19 = Self::mul_add(c_q1, x3, Self::mul_add(-0.475, x7 + x9, 7.11 * x11));
+        let x20 = Self::mul_add(0.475, Self::mul_add(x1, x1, x10), 7.11 * (x9 - x7))
+            - x4;
+        let x21 = Self::mul_add(-7.11, x12, -0.475 * (x6 - x8)) - x5;
+        let x22 = Self::mul_add(-s_q2, x19, c_q2 * x21);
+        let x23 = Self::mul_add(qd[2], x18, Self::mul_add(x9, s_q2, x8 * c_q2));
+        let x24 = Self::mul_add(-qd[2], x17, Self::mul_add(-x8, s_q2, x9 * c_q2));
+        let x25 = qdd[1] + qdd[2];
+        let x26 = qd[1] + qd[2];
+        let x27 = Self::mul_add(x18, x18, x26 * x26);
+        let x28 = Self::mul_add(-x17, x26, x24);
+        let x29 = Self::mul_add(x17, x18, x25);
+        let x30 = Self::mul_add(24989.305802, x17, 1375.0472756800002 * x26);
+        let x31 = Self::mul_add(-1375.0472756800002, x17, 24998.827802 * x26);
+        let x32 = Self::mul_add(
+            x22,
+            -3239.4582,
             Self::mul_add(
-                0.5692,
-                Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(5224.5702, x12, x68),
-                    c_q1 * Self::mul_add(-5224.5702, x11, x67),
-                ),
-                Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(
-                        -x2,
-                        x14,
-                        Self::mul_add(39234.47412200001, x8, 3946.18812068 * qdd[1]),
-                    ) + Self::mul_add(0.475, x68, Self::mul_add(s_q2, x66, c_q2 * x64)),
-                    c_q1
-                        * (Self::mul_add(-s_q2, x64, c_q2 * x66)
-                            + Self::mul_add(
-                                7.11,
-                                Self::mul_add(3239.4582, x27, x39),
-                                x67 * 0.475,
-                            )
-                            - Self::mul_add(
-                                5224.5702,
-                                x4,
-                                Self::mul_add(x1, x14, qd[1] * x13),
-                            )),
-                ),
+                x18,
+                x30,
+                Self::mul_add(-1375.0472756800002, x23, 24998.827802 * x25),
             ),
         );
-        [x70, x69, x65, x59, x57, x51]
+        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let x34 = Self::mul_add(x18, s_q3, x17 * c_q3);
+        let x35 = Self::mul_add(-x17, s_q3, x18 * c_q3);
+        let x36 = Self::mul_add(
+            s_q3,
+            Self::mul_add(-7.11, x29, x22),
+            c_q3 * Self::mul_add(7.11, x27, Self::mul_add(s_q2, x21, c_q2 * x19)),
+        );
+        let x37 = Self::mul_add(qd[3], x35, Self::mul_add(x24, s_q3, x23 * c_q3));
+        let x38 = Self::mul_add(-qd[3], x34, Self::mul_add(-x23, s_q3, x24 * c_q3));
+        let x39 = qdd[3] + x25;
+        let x40 = qd[3] + x26;
+        let x41 = -171.195516 * Self::mul_add(-x34, x35, x39);
+        let x42 = -171.195516 * Self::mul_add(x35, x40, x37);
+        let x43 = -171.195516 * Self::mul_add(x34, x34, x40 * x40);
+        let x44 = 132.6783695416 * x34;
+        let x45 = Self::mul_add(-97.44448770720001, x35, 135.4729695416 * x40);
+        let x46 = -97.44448770720001 * x40;
+        let x47 = Self::mul_add(
+            Self::mul_add(7.11, x28, x20),
+            171.195516,
+            Self::mul_add(-132.6783695416, x37, Self::mul_add(-x35, x45, x40 * x46)),
+        );
+        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let x49 = Self::mul_add(-x34, c_q4, x40 * s_q4);
+        let x50 = Self::mul_add(x40, c_q4, x34 * s_q4);
+        let x51 = qd[4] + x35;
+        let x52 = 44.41 * x50;
+        let x53 = 47.471 * x51;
+        let x54 = Self::mul_add(
+            -x49,
+            x53,
+            44.41 * Self::mul_add(-qd[4], x49, Self::mul_add(x39, c_q4, x37 * s_q4)),
+        );
+        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let x56 = 9.336
+            * (qdd[5]
+                + Self::mul_add(qd[4], x50, Self::mul_add(-x37, c_q4, x39 * s_q4)));
+        let x57 = 9.336 * (qd[5] + x49);
+        let x58 = Self::mul_add(-x50, s_q5, x51 * c_q5) * x57;
+        let x59 = Self::mul_add(x51, s_q5, x50 * c_q5) * x57;
+        let x60 = Self::mul_add(-x51, x52, x50 * x53) + x56;
+        let x61 = x54 + Self::mul_add(s_q5, x59, c_q5 * x58);
+        let x62 = Self::mul_add(x49, x52, 47.471 * (qdd[4] + x38))
+            + Self::mul_add(-c_q5, x59, s_q5 * x58);
+        let x63 = x47 + Self::mul_add(-s_q4, x61, c_q4 * x60);
+        let x64 = Self::mul_add(
+            171.195516,
+            x36,
+            Self::mul_add(-97.44448770720001, x38, 135.4729695416 * x39)
+                + Self::mul_add(-x35, x44, x34 * x46),
+        ) + Self::mul_add(c_q4, x61, s_q4 * x60);
+        let x65 = Self::mul_add(
+            -97.44448770720001,
+            x39,
+            Self::mul_add(-x34, x45, x40 * x44),
+        ) + x62;
+        let x66 = Self::mul_add(c_q3, x43, s_q3 * x41);
+        let x67 = Self::mul_add(-3239.4582, x27, Self::mul_add(-s_q3, x43, c_q3 * x41));
+        let x68 = Self::mul_add(3239.4582, x29, x66);
+        let x69 = Self::mul_add(
+            -x18,
+            x31,
+            Self::mul_add(24989.305802, x23, 1375.0472756800002 * x25),
+        ) + Self::mul_add(s_q3, x65, c_q3 * x63);
+        let x70 = x32 + Self::mul_add(x66, 7.11, x64);
+        let x71 = Self::mul_add(3239.4582, x20, -Self::mul_add(x17, x31, x26 * x30))
+            + Self::mul_add(7.11, x42, Self::mul_add(-s_q3, x63, c_q3 * x65));
+        let x72 = Self::mul_add(-s_q2, x68, c_q2 * x67);
+        let x73 = Self::mul_add(c_q2, x68, s_q2 * x67);
+        let x74 = x15 + Self::mul_add(7.11, x73, x70);
+        let x75 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(
+                -x2,
+                x14,
+                Self::mul_add(39234.47412200001, x8, 3946.18812068 * qdd[1]),
+            ) + Self::mul_add(0.475, x73, Self::mul_add(s_q2, x71, c_q2 * x69)),
+            c_q1
+                * (Self::mul_add(-s_q2, x69, c_q2 * x71)
+                    + Self::mul_add(
+                        7.11,
+                        Self::mul_add(3239.4582, x28, x42),
+                        x72 * 0.475,
+                    )
+                    - Self::mul_add(5224.5702, x4, Self::mul_add(x1, x14, qd[1] * x13))),
+        );
+        let x76 = Self::mul_add(
+            0.5692,
+            Self::mul_add(
+                -s_q1,
+                Self::mul_add(5224.5702, x12, x73),
+                c_q1 * Self::mul_add(-5224.5702, x11, x72),
+            ),
+            x75,
+        );
+        let x77 = Self::mul_add(65697.3302265768, qdd[0], x76);
+        [x77, x74, x70, x64, x62, x56]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 343 mul, 237 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 193 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 343 mul, 237 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 193 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -866,305 +917,255 @@ impl Ssrms6 {
         let x41 = Self::mul_add(0.475, x30, Self::mul_add(c_q2, x27, x34));
         let x42 = x28 - x39;
         let x43 = c_q1 * x32;
-        let x44 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
-        let x45 = Self::mul_add(
+        let x44 = Self::mul_add(
+            -s_q1,
+            -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
+            c_q1 * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
+        );
+        let x45 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
+        let x46 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
+            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
+        );
+        let x47 = Self::mul_add(
             0.5692,
             Self::mul_add(-s_q1, 5224.5702 + x30, x43),
-            Self::mul_add(-s_q1, 3946.18812068 + x41, x44),
+            Self::mul_add(-s_q1, 3946.18812068 + x41, x45),
         );
-        let x46 = Self::mul_add(
+        let x48 = Self::mul_add(
             0.5692,
             Self::mul_add(-s_q1, x30, x43),
-            Self::mul_add(-s_q1, x41, x44),
+            Self::mul_add(-s_q1, x41, x45),
         );
-        let x47 = Self::mul_add(-s_q2, x11, x31);
-        let x48 = Self::mul_add(c_q2, x11, x29);
-        let x49 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x48, c_q1 * x47),
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(0.475, x48, Self::mul_add(c_q2, x14, x34)),
-                c_q1 * Self::mul_add(0.475, x47, Self::mul_add(-s_q2, x14, x37)),
-            ),
+        let x49 = Self::mul_add(-s_q2, x11, x31);
+        let x50 = Self::mul_add(c_q2, x11, x29);
+        let x51 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(0.475, x50, Self::mul_add(c_q2, x14, x34)),
+            c_q1 * Self::mul_add(0.475, x49, Self::mul_add(-s_q2, x14, x37)),
         );
-        let x50 = Self::mul_add(
+        let x52 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x50, c_q1 * x49), x51);
+        let x53 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x18, c_q2 * x15),
             c_q1 * Self::mul_add(-s_q2, x15, c_q2 * x18),
         );
-        let x51 = c_q3 * x5;
-        let x52 = s_q3 * x5;
-        let x53 = Self::mul_add(
+        let x54 = c_q3 * x5;
+        let x55 = s_q3 * x5;
+        let x56 = Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x52, s_q2 * x51),
-            s_q1 * Self::mul_add(-s_q2, x52, c_q2 * x51),
+            Self::mul_add(c_q2, x55, s_q2 * x54),
+            s_q1 * Self::mul_add(-s_q2, x55, c_q2 * x54),
         );
-        let x54 = qd[0] * s_q1;
-        let x55 = qd[0] * c_q1;
-        let x56 = -0.5692 * (qd[0] * qd[0]);
-        let x57 = qd[1] * x55;
-        let x58 = qd[1] * x54;
-        let x59 = x55 * x55;
-        let x60 = Self::mul_add(qd[1], qd[1], x59);
-        let x61 = x54 * x55;
-        let x62 = Self::mul_add(39234.47412200001, x54, 3946.18812068 * qd[1]);
-        let x63 = Self::mul_add(-3946.1881206800003, x54, 39241.404122 * qd[1]);
-        let x64 = Self::mul_add(s_q2, x55, c_q2 * x54);
-        let x65 = Self::mul_add(-s_q2, x54, c_q2 * x55);
-        let x66 = 7.11 * x60;
-        let x67 = 7.11 * x61;
-        let x68 = x56
-            + Self::mul_add(-0.475, Self::mul_add(x54, x54, x59), 7.11 * (x58 + x58));
-        let x69 = Self::mul_add(c_q2, x67, s_q2 * x66);
-        let x70 = Self::mul_add(-qd[2], x65, Self::mul_add(-c_q2, x57, s_q2 * x58));
-        let x71 = Self::mul_add(qd[2], x64, Self::mul_add(c_q2, x58, s_q2 * x57));
-        let x72 = qd[1] + qd[2];
-        let x73 = Self::mul_add(x65, x65, x72 * x72);
-        let x74 = x64 * x65;
-        let x75 = Self::mul_add(x64, x72, x71);
-        let x76 = Self::mul_add(24989.305802, x64, 1375.0472756800002 * x72);
-        let x77 = Self::mul_add(-1375.0472756800002, x64, 24998.827802 * x72);
-        let x78 = Self::mul_add(s_q3, x65, c_q3 * x64);
-        let x79 = Self::mul_add(-s_q3, x64, c_q3 * x65);
-        let x80 = Self::mul_add(-qd[3], x79, Self::mul_add(s_q3, x71, c_q3 * x70));
-        let x81 = Self::mul_add(-qd[3], x78, Self::mul_add(-c_q3, x71, s_q3 * x70));
-        let x82 = qd[3] + x72;
-        let x83 = -171.195516 * (x78 * x79);
-        let x84 = -171.195516 * Self::mul_add(x79, x82, -x80);
-        let x85 = -171.195516 * Self::mul_add(x78, x78, x82 * x82);
-        let x86 = 132.6783695416 * x78;
-        let x87 = Self::mul_add(-97.44448770720001, x79, 135.4729695416 * x82);
-        let x88 = -97.44448770720001 * x82;
-        let x89 = Self::mul_add(-c_q4, x78, s_q4 * x82);
-        let x90 = Self::mul_add(c_q4, x82, s_q4 * x78);
-        let x91 = qd[4] + x79;
-        let x92 = 44.41 * x90;
-        let x93 = 47.471 * x91;
-        let x94 = 9.336 * Self::mul_add(qd[4], x90, c_q4 * x80);
-        let x95 = 9.336 * (qd[5] + x89);
-        let x96 = Self::mul_add(-s_q5, x90, c_q5 * x91) * x95;
-        let x97 = Self::mul_add(s_q5, x91, c_q5 * x90) * x95;
-        let x98 = Self::mul_add(-x91, x92, x90 * x93) + x94;
-        let x99 = Self::mul_add(s_q5, x97, c_q5 * x96)
-            - Self::mul_add(x89, x93, 44.41 * Self::mul_add(qd[4], x89, s_q4 * x80));
-        let x100 = Self::mul_add(x89, x92, 47.471 * x81)
-            + Self::mul_add(-c_q5, x97, s_q5 * x96);
-        let x101 = Self::mul_add(
+        let x57 = qd[0] * s_q1;
+        let x58 = qd[0] * c_q1;
+        let x59 = -0.5692 * (qd[0] * qd[0]);
+        let x60 = qd[1] * x58;
+        let x61 = qd[1] * x57;
+        let x62 = x58 * x58;
+        let x63 = Self::mul_add(qd[1], qd[1], x62);
+        let x64 = x57 * x58;
+        let x65 = Self::mul_add(39234.47412200001, x57, 3946.18812068 * qd[1]);
+        let x66 = Self::mul_add(-3946.1881206800003, x57, 39241.404122 * qd[1]);
+        let x67 = Self::mul_add(s_q2, x58, c_q2 * x57);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x58);
+        let x69 = 7.11 * x63;
+        let x70 = 7.11 * x64;
+        let x71 = x59
+            + Self::mul_add(-0.475, Self::mul_add(x57, x57, x62), 7.11 * (x61 + x61));
+        let x72 = Self::mul_add(c_q2, x70, s_q2 * x69);
+        let x73 = Self::mul_add(-qd[2], x68, Self::mul_add(-c_q2, x60, s_q2 * x61));
+        let x74 = Self::mul_add(qd[2], x67, Self::mul_add(c_q2, x61, s_q2 * x60));
+        let x75 = qd[1] + qd[2];
+        let x76 = Self::mul_add(x68, x68, x75 * x75);
+        let x77 = x67 * x68;
+        let x78 = Self::mul_add(x67, x75, x74);
+        let x79 = Self::mul_add(24989.305802, x67, 1375.0472756800002 * x75);
+        let x80 = Self::mul_add(-1375.0472756800002, x67, 24998.827802 * x75);
+        let x81 = Self::mul_add(s_q3, x68, c_q3 * x67);
+        let x82 = Self::mul_add(-s_q3, x67, c_q3 * x68);
+        let x83 = Self::mul_add(
+            s_q3,
+            Self::mul_add(7.11, x77, x72),
+            c_q3 * Self::mul_add(-7.11, x76, Self::mul_add(-c_q2, x69, s_q2 * x70)),
+        );
+        let x84 = Self::mul_add(-qd[3], x82, Self::mul_add(s_q3, x74, c_q3 * x73));
+        let x85 = Self::mul_add(-qd[3], x81, Self::mul_add(-c_q3, x74, s_q3 * x73));
+        let x86 = qd[3] + x75;
+        let x87 = -171.195516 * (x81 * x82);
+        let x88 = -171.195516 * Self::mul_add(x82, x86, -x84);
+        let x89 = -171.195516 * Self::mul_add(x81, x81, x86 * x86);
+        let x90 = 132.6783695416 * x81;
+        let x91 = Self::mul_add(-97.44448770720001, x82, 135.4729695416 * x86);
+        let x92 = -97.44448770720001 * x86;
+        let x93 = Self::mul_add(
             -171.195516,
-            Self::mul_add(7.11, x75, x68),
-            Self::mul_add(132.6783695416, x80, Self::mul_add(-x79, x87, x82 * x88)),
-        ) + Self::mul_add(-s_q4, x99, c_q4 * x98);
-        let x102 = Self::mul_add(
+            Self::mul_add(7.11, x78, x71),
+            Self::mul_add(132.6783695416, x84, Self::mul_add(-x82, x91, x86 * x92)),
+        );
+        let x94 = Self::mul_add(
             -171.195516,
-            Self::mul_add(
-                s_q3,
-                Self::mul_add(7.11, x74, x69),
-                c_q3 * Self::mul_add(-7.11, x73, Self::mul_add(-c_q2, x66, s_q2 * x67)),
-            ),
-            Self::mul_add(-97.44448770720001, x81, Self::mul_add(-x79, x86, x78 * x88)),
-        ) + Self::mul_add(c_q4, x99, s_q4 * x98);
-        let x103 = Self::mul_add(-x78, x87, x82 * x86) + x100;
-        let x104 = Self::mul_add(-c_q3, x85, s_q3 * x83);
-        let x105 = Self::mul_add(3239.4582, x73, Self::mul_add(s_q3, x85, c_q3 * x83));
-        let x106 = Self::mul_add(-3239.4582, x74, x104);
-        let x107 = Self::mul_add(-x65, x77, -24989.305802 * x70)
-            + Self::mul_add(s_q3, x103, c_q3 * x101);
-        let x108 = Self::mul_add(
-            x69,
+            x83,
+            Self::mul_add(-97.44448770720001, x85, Self::mul_add(-x82, x90, x81 * x92)),
+        );
+        let x95 = Self::mul_add(-c_q4, x81, s_q4 * x86);
+        let x96 = Self::mul_add(c_q4, x86, s_q4 * x81);
+        let x97 = qd[4] + x82;
+        let x98 = 44.41 * x96;
+        let x99 = 47.471 * x97;
+        let x100 = 9.336 * Self::mul_add(qd[4], x96, c_q4 * x84);
+        let x101 = 9.336 * (qd[5] + x95);
+        let x102 = Self::mul_add(-s_q5, x96, c_q5 * x97) * x101;
+        let x103 = Self::mul_add(s_q5, x97, c_q5 * x96) * x101;
+        let x104 = Self::mul_add(-x97, x98, x96 * x99) + x100;
+        let x105 = Self::mul_add(s_q5, x103, c_q5 * x102)
+            - Self::mul_add(x95, x99, 44.41 * Self::mul_add(qd[4], x95, s_q4 * x84));
+        let x106 = Self::mul_add(x95, x98, 47.471 * x85)
+            + Self::mul_add(-c_q5, x103, s_q5 * x102);
+        let x107 = x93 + Self::mul_add(-s_q4, x105, c_q4 * x104);
+        let x108 = x94 + Self::mul_add(c_q4, x105, s_q4 * x104);
+        let x109 = Self::mul_add(-x81, x91, x86 * x90) + x106;
+        let x110 = Self::mul_add(-c_q3, x89, s_q3 * x87);
+        let x111 = Self::mul_add(3239.4582, x76, Self::mul_add(s_q3, x89, c_q3 * x87));
+        let x112 = Self::mul_add(-3239.4582, x77, x110);
+        let x113 = Self::mul_add(-x68, x80, -24989.305802 * x73)
+            + Self::mul_add(s_q3, x109, c_q3 * x107);
+        let x114 = Self::mul_add(
+            x72,
             3239.4582,
-            Self::mul_add(x65, x76, 1375.0472756800002 * x70),
-        ) + Self::mul_add(-7.11, x104, x102);
-        let x109 = Self::mul_add(7.11, x84, Self::mul_add(-s_q3, x101, c_q3 * x103))
-            - Self::mul_add(3239.4582, x68, Self::mul_add(x64, x77, x72 * x76));
-        let x110 = Self::mul_add(-c_q2, x105, s_q2 * x106);
-        let x111 = Self::mul_add(c_q2, x106, s_q2 * x105);
-        let x112 = tau[0]
-            - Self::mul_add(
-                0.5692,
-                Self::mul_add(
-                    s_q1,
-                    Self::mul_add(-5224.5702, x61, x111),
-                    c_q1 * Self::mul_add(-5224.5702, x60, x110),
-                ),
-                Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(-0.475, x111, Self::mul_add(s_q2, x109, c_q2 * x107))
-                        - Self::mul_add(x55, x63, -39234.47412200001 * x57),
-                    c_q1
-                        * (Self::mul_add(-s_q2, x107, c_q2 * x109)
-                            + Self::mul_add(
-                                7.11,
-                                Self::mul_add(-3239.4582, x75, x84),
-                                0.475 * x110,
-                            )
-                            - Self::mul_add(
-                                5224.5702,
-                                x56,
-                                Self::mul_add(x54, x63, qd[1] * x62),
-                            )),
-                ),
-            );
-        let x113 = 1.0
-            / (65697.3302265768
-                + Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(
-                        -s_q1,
-                        -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
-                        c_q1
-                            * Self::mul_add(
-                                -7.11,
-                                x32,
-                                Self::mul_add(s_q2, x38, c_q2 * x36),
-                            ),
-                    ),
-                    c_q1
-                        * Self::mul_add(
-                            -s_q1,
-                            Self::mul_add(
-                                -7.11,
-                                x32,
-                                Self::mul_add(-s_q2, x33, c_q2 * x35),
-                            ),
-                            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
-                        ),
-                ));
-        let x114 = x45 * x113;
-        let x115 = x46 * x113;
-        let x116 = x49 * x113;
-        let x117 = x50 * x113;
-        let x118 = x53 * x113;
-        let x119 = 1.0 / Self::mul_add(-x45, x114, 39241.404122 + (x40 + x42));
-        let x120 = Self::mul_add(-x45, x115, x42);
-        let x121 = x119 * x120;
-        let x122 = Self::mul_add(-x45, x116, Self::mul_add(7.11, x48, x21));
-        let x123 = x119 * x122;
-        let x124 = x45 * x117;
-        let x125 = x119 * x124;
-        let x126 = Self::mul_add(x45, x118, x7);
-        let x127 = x119 * x126;
-        let x128 = 1.0 / Self::mul_add(-x120, x121, Self::mul_add(-x46, x115, x28));
-        let x129 = Self::mul_add(-x120, x123, Self::mul_add(-x46, x116, x21));
-        let x130 = x128 * x129;
-        let x131 = Self::mul_add(-x46, x117, x120 * x125);
-        let x132 = x128 * x131;
-        let x133 = Self::mul_add(-x120, x127, Self::mul_add(x46, x118, x7));
-        let x134 = x128 * x133;
-        let x135 = 1.0
-            / Self::mul_add(
-                -x129,
-                x130,
-                Self::mul_add(-x122, x123, Self::mul_add(-x49, x116, x10)),
-            );
-        let x136 = Self::mul_add(-x129, x132, Self::mul_add(-x49, x117, x122 * x125));
-        let x137 = x135 * x136;
-        let x138 = Self::mul_add(
-            -x129,
-            x134,
-            Self::mul_add(-x122, x127, Self::mul_add(x49, x118, x7)),
+            Self::mul_add(x68, x79, 1375.0472756800002 * x73),
+        ) + Self::mul_add(-7.11, x110, x108);
+        let x115 = Self::mul_add(7.11, x88, Self::mul_add(-s_q3, x107, c_q3 * x109))
+            - Self::mul_add(3239.4582, x71, Self::mul_add(x67, x80, x75 * x79));
+        let x116 = Self::mul_add(-c_q2, x111, s_q2 * x112);
+        let x117 = Self::mul_add(c_q2, x112, s_q2 * x111);
+        let x118 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-0.475, x117, Self::mul_add(s_q2, x115, c_q2 * x113))
+                - Self::mul_add(x58, x66, -39234.47412200001 * x60),
+            c_q1
+                * (Self::mul_add(-s_q2, x113, c_q2 * x115)
+                    + Self::mul_add(
+                        7.11,
+                        Self::mul_add(-3239.4582, x78, x88),
+                        0.475 * x116,
+                    )
+                    - Self::mul_add(
+                        5224.5702,
+                        x59,
+                        Self::mul_add(x57, x66, qd[1] * x65),
+                    )),
         );
-        let x139 = x135 * x138;
-        let x140 = 1.0
-            / Self::mul_add(
-                -x136,
-                x137,
-                Self::mul_add(
-                    -x131,
-                    x132,
-                    Self::mul_add(-x124, x125, Self::mul_add(-x50, x117, 47.471)),
-                ),
-            );
-        let x141 = Self::mul_add(
-            -x136,
-            x139,
-            Self::mul_add(-x131, x134, Self::mul_add(x124, x127, x50 * x118)),
+        let x119 = Self::mul_add(
+            0.5692,
+            Self::mul_add(
+                s_q1,
+                Self::mul_add(-5224.5702, x64, x117),
+                c_q1 * Self::mul_add(-5224.5702, x63, x116),
+            ),
+            x118,
         );
-        let x142 = x140 * x141;
-        let x143 = 1.0
-            / Self::mul_add(
-                -x141,
-                x142,
-                Self::mul_add(
-                    -x138,
-                    x139,
-                    Self::mul_add(
-                        -x133,
-                        x134,
-                        Self::mul_add(-x126, x127, Self::mul_add(-x53, x118, 9.336)),
-                    ),
-                ),
-            );
-        let x144 = Self::mul_add(
-            -x112,
-            x114,
-            tau[1]
-                - (Self::mul_add(-3946.1881206800003, x57, x55 * x62)
-                    + Self::mul_add(-7.11, x111, x108)),
+        let x120 = tau[0] - x119;
+        let x121 = 1.0 / (65697.3302265768 + Self::mul_add(-s_q1, x44, c_q1 * x46));
+        let x122 = x47 * x121;
+        let x123 = x48 * x121;
+        let x124 = x52 * x121;
+        let x125 = x53 * x121;
+        let x126 = x56 * x121;
+        let x127 = 1.0 / Self::mul_add(-x47, x122, 39241.404122 + (x40 + x42));
+        let x128 = Self::mul_add(-x47, x123, x42);
+        let x129 = x127 * x128;
+        let x130 = Self::mul_add(-x47, x124, Self::mul_add(7.11, x50, x21));
+        let x131 = x127 * x130;
+        let x132 = x47 * x125;
+        let x133 = x127 * x132;
+        let x134 = Self::mul_add(x47, x126, x7);
+        let x135 = x127 * x134;
+        let x136 = 1.0 / Self::mul_add(-x128, x129, Self::mul_add(-x48, x123, x28));
+        let x137 = Self::mul_add(-x128, x131, Self::mul_add(-x48, x124, x21));
+        let x138 = x136 * x137;
+        let x139 = Self::mul_add(-x48, x125, x128 * x133);
+        let x140 = x136 * x139;
+        let x141 = Self::mul_add(-x128, x135, Self::mul_add(x48, x126, x7));
+        let x142 = x136 * x141;
+        let x143 = Self::mul_add(
+            -x137,
+            x138,
+            Self::mul_add(-x130, x131, Self::mul_add(-x52, x124, x10)),
         );
-        let x145 = Self::mul_add(-x121, x144, Self::mul_add(-x112, x115, tau[2] - x108));
-        let x146 = Self::mul_add(
-            -x130,
-            x145,
-            Self::mul_add(-x123, x144, Self::mul_add(-x112, x116, tau[3] - x102)),
-        );
+        let x144 = 1.0 / x143;
+        let x145 = Self::mul_add(-x137, x140, Self::mul_add(-x52, x125, x130 * x133));
+        let x146 = x144 * x145;
         let x147 = Self::mul_add(
             -x137,
-            x146,
-            Self::mul_add(
-                -x132,
-                x145,
-                Self::mul_add(x125, x144, Self::mul_add(-x112, x117, tau[4] - x100)),
-            ),
+            x142,
+            Self::mul_add(-x130, x135, Self::mul_add(x52, x126, x7)),
         );
-        let x148 = x143
-            * Self::mul_add(
-                -x142,
-                x147,
-                Self::mul_add(
-                    -x139,
-                    x146,
-                    Self::mul_add(
-                        -x134,
-                        x145,
-                        Self::mul_add(
-                            -x127,
-                            x144,
-                            Self::mul_add(x112, x118, tau[5] - x94),
-                        ),
-                    ),
-                ),
-            );
-        let x149 = Self::mul_add(-x142, x148, x140 * x147);
-        let x150 = Self::mul_add(-x139, x148, Self::mul_add(-x137, x149, x135 * x146));
+        let x148 = x144 * x147;
+        let x149 = Self::mul_add(
+            -x139,
+            x140,
+            Self::mul_add(-x132, x133, Self::mul_add(-x53, x125, 47.471)),
+        );
+        let x150 = 1.0 / Self::mul_add(-x145, x146, x149);
         let x151 = Self::mul_add(
-            -x134,
+            -x145,
             x148,
-            Self::mul_add(-x132, x149, Self::mul_add(-x130, x150, x128 * x145)),
+            Self::mul_add(-x139, x142, Self::mul_add(x132, x135, x53 * x126)),
         );
-        let x152 = Self::mul_add(
-            -x127,
-            x148,
-            Self::mul_add(
-                x125,
-                x149,
-                Self::mul_add(-x123, x150, Self::mul_add(-x121, x151, x119 * x144)),
-            ),
-        );
+        let x152 = x150 * x151;
         let x153 = Self::mul_add(
-            x118,
-            x148,
-            Self::mul_add(
-                -x117,
-                x149,
-                Self::mul_add(
-                    -x116,
-                    x150,
-                    Self::mul_add(-x115, x151, Self::mul_add(-x114, x152, x112 * x113)),
-                ),
-            ),
+            -x141,
+            x142,
+            Self::mul_add(-x134, x135, Self::mul_add(-x56, x126, 9.336)),
         );
-        [x153, x152, x151, x150, x149, x148]
+        let x154 = 1.0 / Self::mul_add(-x151, x152, Self::mul_add(-x147, x148, x153));
+        let x155 = Self::mul_add(
+            -x120,
+            x122,
+            tau[1]
+                - (Self::mul_add(-3946.1881206800003, x60, x58 * x65)
+                    + Self::mul_add(-7.11, x117, x114)),
+        );
+        let x156 = Self::mul_add(-x129, x155, Self::mul_add(-x120, x123, tau[2] - x114));
+        let x157 = Self::mul_add(
+            -x138,
+            x156,
+            Self::mul_add(-x131, x155, Self::mul_add(-x120, x124, tau[3] - x108)),
+        );
+        let x158 = Self::mul_add(
+            -x140,
+            x156,
+            Self::mul_add(x133, x155, Self::mul_add(-x120, x125, tau[4] - x106)),
+        );
+        let x159 = Self::mul_add(-x146, x157, x158);
+        let x160 = Self::mul_add(
+            -x142,
+            x156,
+            Self::mul_add(-x135, x155, Self::mul_add(x120, x126, tau[5] - x100)),
+        );
+        let x161 = x154 * Self::mul_add(-x152, x159, Self::mul_add(-x148, x157, x160));
+        let x162 = Self::mul_add(-x152, x161, x150 * x159);
+        let x163 = Self::mul_add(-x148, x161, Self::mul_add(-x146, x162, x144 * x157));
+        let x164 = Self::mul_add(
+            -x142,
+            x161,
+            Self::mul_add(-x140, x162, Self::mul_add(-x138, x163, x136 * x156)),
+        );
+        let x165 = Self::mul_add(
+            x133,
+            x162,
+            Self::mul_add(-x131, x163, Self::mul_add(-x129, x164, x127 * x155)),
+        );
+        let x166 = Self::mul_add(-x135, x161, x165);
+        let x167 = Self::mul_add(
+            -x124,
+            x163,
+            Self::mul_add(-x123, x164, Self::mul_add(-x122, x166, x120 * x121)),
+        );
+        let x168 = Self::mul_add(x126, x161, Self::mul_add(-x125, x162, x167));
+        [x168, x166, x164, x163, x162, x161]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
@@ -1219,178 +1220,174 @@ impl Ssrms6 {
         let x42 = x28 - x39;
         let x43 = 39241.404122 + (x40 + x42);
         let x44 = c_q1 * x32;
-        let x45 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
-        let x46 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, 5224.5702 + x30, x44),
-            Self::mul_add(-s_q1, 3946.18812068 + x41, x45),
+        let x45 = Self::mul_add(
+            -s_q1,
+            -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
+            c_q1 * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
         );
-        let x47 = 65697.3302265768
-            + Self::mul_add(
-                -s_q1,
-                Self::mul_add(
-                    -s_q1,
-                    -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
-                    c_q1
-                        * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
-                ),
-                c_q1
-                    * Self::mul_add(
-                        -s_q1,
-                        Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
-                        c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
-                    ),
-            );
+        let x46 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
+        let x47 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
+            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
+        );
         let x48 = Self::mul_add(
             0.5692,
-            Self::mul_add(-s_q1, x30, x44),
-            Self::mul_add(-s_q1, x41, x45),
+            Self::mul_add(-s_q1, 5224.5702 + x30, x44),
+            Self::mul_add(-s_q1, 3946.18812068 + x41, x46),
         );
-        let x49 = Self::mul_add(-s_q2, x11, x31);
-        let x50 = Self::mul_add(c_q2, x11, x29);
-        let x51 = Self::mul_add(7.11, x50, x21);
-        let x52 = Self::mul_add(
+        let x49 = 65697.3302265768 + Self::mul_add(-s_q1, x45, c_q1 * x47);
+        let x50 = Self::mul_add(
             0.5692,
-            Self::mul_add(-s_q1, x50, c_q1 * x49),
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(0.475, x50, Self::mul_add(c_q2, x14, x34)),
-                c_q1 * Self::mul_add(0.475, x49, Self::mul_add(-s_q2, x14, x37)),
-            ),
+            Self::mul_add(-s_q1, x30, x44),
+            Self::mul_add(-s_q1, x41, x46),
         );
-        let x53 = Self::mul_add(
+        let x51 = Self::mul_add(-s_q2, x11, x31);
+        let x52 = Self::mul_add(c_q2, x11, x29);
+        let x53 = Self::mul_add(7.11, x52, x21);
+        let x54 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(0.475, x52, Self::mul_add(c_q2, x14, x34)),
+            c_q1 * Self::mul_add(0.475, x51, Self::mul_add(-s_q2, x14, x37)),
+        );
+        let x55 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x52, c_q1 * x51), x54);
+        let x56 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x18, c_q2 * x15),
             c_q1 * Self::mul_add(-s_q2, x15, c_q2 * x18),
         );
-        let x54 = c_q3 * x5;
-        let x55 = s_q3 * x5;
-        let x56 = -Self::mul_add(
+        let x57 = c_q3 * x5;
+        let x58 = s_q3 * x5;
+        let x59 = -Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x55, s_q2 * x54),
-            s_q1 * Self::mul_add(-s_q2, x55, c_q2 * x54),
+            Self::mul_add(c_q2, x58, s_q2 * x57),
+            s_q1 * Self::mul_add(-s_q2, x58, c_q2 * x57),
         );
-        let x57 = qd[0] * s_q1;
-        let x58 = qd[0] * c_q1;
-        let x59 = -0.5692 * (qd[0] * qd[0]);
-        let x60 = qd[1] * x58;
-        let x61 = qd[1] * x57;
-        let x62 = x58 * x58;
-        let x63 = Self::mul_add(qd[1], qd[1], x62);
-        let x64 = x57 * x58;
-        let x65 = Self::mul_add(39234.47412200001, x57, 3946.18812068 * qd[1]);
-        let x66 = Self::mul_add(-3946.1881206800003, x57, 39241.404122 * qd[1]);
-        let x67 = Self::mul_add(s_q2, x58, c_q2 * x57);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x58);
-        let x69 = 7.11 * x63;
-        let x70 = 7.11 * x64;
-        let x71 = x59
-            + Self::mul_add(-0.475, Self::mul_add(x57, x57, x62), 7.11 * (x61 + x61));
-        let x72 = Self::mul_add(c_q2, x70, s_q2 * x69);
-        let x73 = Self::mul_add(-qd[2], x68, Self::mul_add(-c_q2, x60, s_q2 * x61));
-        let x74 = Self::mul_add(qd[2], x67, Self::mul_add(c_q2, x61, s_q2 * x60));
-        let x75 = qd[1] + qd[2];
-        let x76 = Self::mul_add(x68, x68, x75 * x75);
-        let x77 = x67 * x68;
-        let x78 = Self::mul_add(x67, x75, x74);
-        let x79 = Self::mul_add(24989.305802, x67, 1375.0472756800002 * x75);
-        let x80 = Self::mul_add(-1375.0472756800002, x67, 24998.827802 * x75);
-        let x81 = Self::mul_add(s_q3, x68, c_q3 * x67);
-        let x82 = Self::mul_add(-s_q3, x67, c_q3 * x68);
-        let x83 = Self::mul_add(-qd[3], x82, Self::mul_add(s_q3, x74, c_q3 * x73));
-        let x84 = Self::mul_add(-qd[3], x81, Self::mul_add(-c_q3, x74, s_q3 * x73));
-        let x85 = qd[3] + x75;
-        let x86 = -171.195516 * (x81 * x82);
-        let x87 = -171.195516 * Self::mul_add(x82, x85, -x83);
-        let x88 = -171.195516 * Self::mul_add(x81, x81, x85 * x85);
-        let x89 = 132.6783695416 * x81;
-        let x90 = Self::mul_add(-97.44448770720001, x82, 135.4729695416 * x85);
-        let x91 = -97.44448770720001 * x85;
-        let x92 = Self::mul_add(-c_q4, x81, s_q4 * x85);
-        let x93 = Self::mul_add(c_q4, x85, s_q4 * x81);
-        let x94 = qd[4] + x82;
-        let x95 = 44.41 * x93;
-        let x96 = 47.471 * x94;
-        let x97 = 9.336 * Self::mul_add(qd[4], x93, c_q4 * x83);
-        let x98 = 9.336 * (qd[5] + x92);
-        let x99 = Self::mul_add(-s_q5, x93, c_q5 * x94) * x98;
-        let x100 = Self::mul_add(s_q5, x94, c_q5 * x93) * x98;
-        let x101 = Self::mul_add(-x94, x95, x93 * x96) + x97;
-        let x102 = Self::mul_add(s_q5, x100, c_q5 * x99)
-            - Self::mul_add(x92, x96, 44.41 * Self::mul_add(qd[4], x92, s_q4 * x83));
-        let x103 = Self::mul_add(x92, x95, 47.471 * x84)
-            + Self::mul_add(-c_q5, x100, s_q5 * x99);
-        let x104 = Self::mul_add(
+        let x60 = qd[0] * s_q1;
+        let x61 = qd[0] * c_q1;
+        let x62 = -0.5692 * (qd[0] * qd[0]);
+        let x63 = qd[1] * x61;
+        let x64 = qd[1] * x60;
+        let x65 = x61 * x61;
+        let x66 = Self::mul_add(qd[1], qd[1], x65);
+        let x67 = x60 * x61;
+        let x68 = Self::mul_add(39234.47412200001, x60, 3946.18812068 * qd[1]);
+        let x69 = Self::mul_add(-3946.1881206800003, x60, 39241.404122 * qd[1]);
+        let x70 = Self::mul_add(s_q2, x61, c_q2 * x60);
+        let x71 = Self::mul_add(-s_q2, x60, c_q2 * x61);
+        let x72 = 7.11 * x66;
+        let x73 = 7.11 * x67;
+        let x74 = x62
+            + Self::mul_add(-0.475, Self::mul_add(x60, x60, x65), 7.11 * (x64 + x64));
+        let x75 = Self::mul_add(c_q2, x73, s_q2 * x72);
+        let x76 = Self::mul_add(-qd[2], x71, Self::mul_add(-c_q2, x63, s_q2 * x64));
+        let x77 = Self::mul_add(qd[2], x70, Self::mul_add(c_q2, x64, s_q2 * x63));
+        let x78 = qd[1] + qd[2];
+        let x79 = Self::mul_add(x71, x71, x78 * x78);
+        let x80 = x70 * x71;
+        let x81 = Self::mul_add(x70, x78, x77);
+        let x82 = Self::mul_add(24989.305802, x70, 1375.0472756800002 * x78);
+        let x83 = Self::mul_add(-1375.0472756800002, x70, 24998.827802 * x78);
+        let x84 = Self::mul_add(s_q3, x71, c_q3 * x70);
+        let x85 = Self::mul_add(-s_q3, x70, c_q3 * x71);
+        let x86 = Self::mul_add(
+            s_q3,
+            Self::mul_add(7.11, x80, x75),
+            c_q3 * Self::mul_add(-7.11, x79, Self::mul_add(-c_q2, x72, s_q2 * x73)),
+        );
+        let x87 = Self::mul_add(-qd[3], x85, Self::mul_add(s_q3, x77, c_q3 * x76));
+        let x88 = Self::mul_add(-qd[3], x84, Self::mul_add(-c_q3, x77, s_q3 * x76));
+        let x89 = qd[3] + x78;
+        let x90 = -171.195516 * (x84 * x85);
+        let x91 = -171.195516 * Self::mul_add(x85, x89, -x87);
+        let x92 = -171.195516 * Self::mul_add(x84, x84, x89 * x89);
+        let x93 = 132.6783695416 * x84;
+        let x94 = Self::mul_add(-97.44448770720001, x85, 135.4729695416 * x89);
+        let x95 = -97.44448770720001 * x89;
+        let x96 = Self::mul_add(
             -171.195516,
-            Self::mul_add(7.11, x78, x71),
-            Self::mul_add(132.6783695416, x83, Self::mul_add(-x82, x90, x85 * x91)),
-        ) + Self::mul_add(-s_q4, x102, c_q4 * x101);
-        let x105 = Self::mul_add(
+            Self::mul_add(7.11, x81, x74),
+            Self::mul_add(132.6783695416, x87, Self::mul_add(-x85, x94, x89 * x95)),
+        );
+        let x97 = Self::mul_add(
             -171.195516,
-            Self::mul_add(
-                s_q3,
-                Self::mul_add(7.11, x77, x72),
-                c_q3 * Self::mul_add(-7.11, x76, Self::mul_add(-c_q2, x69, s_q2 * x70)),
-            ),
-            Self::mul_add(-97.44448770720001, x84, Self::mul_add(-x82, x89, x81 * x91)),
-        ) + Self::mul_add(c_q4, x102, s_q4 * x101);
-        let x106 = Self::mul_add(-x81, x90, x85 * x89) + x103;
-        let x107 = Self::mul_add(-c_q3, x88, s_q3 * x86);
-        let x108 = Self::mul_add(3239.4582, x76, Self::mul_add(s_q3, x88, c_q3 * x86));
-        let x109 = Self::mul_add(-3239.4582, x77, x107);
-        let x110 = Self::mul_add(-x68, x80, -24989.305802 * x73)
-            + Self::mul_add(s_q3, x106, c_q3 * x104);
-        let x111 = Self::mul_add(
-            x72,
+            x86,
+            Self::mul_add(-97.44448770720001, x88, Self::mul_add(-x85, x93, x84 * x95)),
+        );
+        let x98 = Self::mul_add(-c_q4, x84, s_q4 * x89);
+        let x99 = Self::mul_add(c_q4, x89, s_q4 * x84);
+        let x100 = qd[4] + x85;
+        let x101 = 44.41 * x99;
+        let x102 = 47.471 * x100;
+        let x103 = 9.336 * Self::mul_add(qd[4], x99, c_q4 * x87);
+        let x104 = 9.336 * (qd[5] + x98);
+        let x105 = Self::mul_add(-s_q5, x99, c_q5 * x100) * x104;
+        let x106 = Self::mul_add(s_q5, x100, c_q5 * x99) * x104;
+        let x107 = Self::mul_add(-x100, x101, x99 * x102) + x103;
+        let x108 = Self::mul_add(s_q5, x106, c_q5 * x105)
+            - Self::mul_add(x98, x102, 44.41 * Self::mul_add(qd[4], x98, s_q4 * x87));
+        let x109 = Self::mul_add(x98, x101, 47.471 * x88)
+            + Self::mul_add(-c_q5, x106, s_q5 * x105);
+        let x110 = x96 + Self::mul_add(-s_q4, x108, c_q4 * x107);
+        let x111 = x97 + Self::mul_add(c_q4, x108, s_q4 * x107);
+        let x112 = Self::mul_add(-x84, x94, x89 * x93) + x109;
+        let x113 = Self::mul_add(-c_q3, x92, s_q3 * x90);
+        let x114 = Self::mul_add(3239.4582, x79, Self::mul_add(s_q3, x92, c_q3 * x90));
+        let x115 = Self::mul_add(-3239.4582, x80, x113);
+        let x116 = Self::mul_add(-x71, x83, -24989.305802 * x76)
+            + Self::mul_add(s_q3, x112, c_q3 * x110);
+        let x117 = Self::mul_add(
+            x75,
             3239.4582,
-            Self::mul_add(x68, x79, 1375.0472756800002 * x73),
-        ) + Self::mul_add(-7.11, x107, x105);
-        let x112 = Self::mul_add(7.11, x87, Self::mul_add(-s_q3, x104, c_q3 * x106))
-            - Self::mul_add(3239.4582, x71, Self::mul_add(x67, x80, x75 * x79));
-        let x113 = Self::mul_add(-c_q2, x108, s_q2 * x109);
-        let x114 = Self::mul_add(c_q2, x109, s_q2 * x108);
-        let x115 = Self::mul_add(-3946.1881206800003, x60, x58 * x65)
-            + Self::mul_add(-7.11, x114, x111);
-        let x116 = Self::mul_add(
+            Self::mul_add(x71, x82, 1375.0472756800002 * x76),
+        ) + Self::mul_add(-7.11, x113, x111);
+        let x118 = Self::mul_add(7.11, x91, Self::mul_add(-s_q3, x110, c_q3 * x112))
+            - Self::mul_add(3239.4582, x74, Self::mul_add(x70, x83, x78 * x82));
+        let x119 = Self::mul_add(-c_q2, x114, s_q2 * x115);
+        let x120 = Self::mul_add(c_q2, x115, s_q2 * x114);
+        let x121 = Self::mul_add(-3946.1881206800003, x63, x61 * x68)
+            + Self::mul_add(-7.11, x120, x117);
+        let x122 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-0.475, x120, Self::mul_add(s_q2, x118, c_q2 * x116))
+                - Self::mul_add(x61, x69, -39234.47412200001 * x63),
+            c_q1
+                * (Self::mul_add(-s_q2, x116, c_q2 * x118)
+                    + Self::mul_add(
+                        7.11,
+                        Self::mul_add(-3239.4582, x81, x91),
+                        0.475 * x119,
+                    )
+                    - Self::mul_add(
+                        5224.5702,
+                        x62,
+                        Self::mul_add(x60, x69, qd[1] * x68),
+                    )),
+        );
+        let x123 = Self::mul_add(
             0.5692,
             Self::mul_add(
                 s_q1,
-                Self::mul_add(-5224.5702, x64, x114),
-                c_q1 * Self::mul_add(-5224.5702, x63, x113),
+                Self::mul_add(-5224.5702, x67, x120),
+                c_q1 * Self::mul_add(-5224.5702, x66, x119),
             ),
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(-0.475, x114, Self::mul_add(s_q2, x112, c_q2 * x110))
-                    - Self::mul_add(x58, x66, -39234.47412200001 * x60),
-                c_q1
-                    * (Self::mul_add(-s_q2, x110, c_q2 * x112)
-                        + Self::mul_add(
-                            7.11,
-                            Self::mul_add(-3239.4582, x78, x87),
-                            0.475 * x113,
-                        )
-                        - Self::mul_add(
-                            5224.5702,
-                            x59,
-                            Self::mul_add(x57, x66, qd[1] * x65),
-                        )),
-            ),
+            x122,
         );
         (
             [
-                [x47, x46, x48, x52, x53, x56],
-                [x46, x43, x42, x51, 0.0, x7],
-                [x48, x42, x28, x21, 0.0, x7],
-                [x52, x51, x21, x10, 0.0, x7],
-                [x53, 0.0, 0.0, 0.0, 47.471, 0.0],
-                [x56, x7, x7, x7, 0.0, 9.336],
+                [x49, x48, x50, x55, x56, x59],
+                [x48, x43, x42, x53, 0.0, x7],
+                [x50, x42, x28, x21, 0.0, x7],
+                [x55, x53, x21, x10, 0.0, x7],
+                [x56, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x59, x7, x7, x7, 0.0, 9.336],
             ],
-            [x116, x115, x111, x105, x103, x97],
+            [x123, x121, x117, x111, x109, x103],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 355 mul, 275 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 207 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 355 mul, 275 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 207 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1442,342 +1439,291 @@ impl Ssrms6 {
         let x41 = Self::mul_add(0.475, x30, Self::mul_add(c_q2, x27, x34));
         let x42 = x28 - x39;
         let x43 = c_q1 * x32;
-        let x44 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
-        let x45 = Self::mul_add(
+        let x44 = Self::mul_add(
+            -s_q1,
+            -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
+            c_q1 * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
+        );
+        let x45 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
+        let x46 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
+            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
+        );
+        let x47 = Self::mul_add(
             0.5692,
             Self::mul_add(-s_q1, 5224.5702 + x30, x43),
-            Self::mul_add(-s_q1, 3946.18812068 + x41, x44),
+            Self::mul_add(-s_q1, 3946.18812068 + x41, x45),
         );
-        let x46 = Self::mul_add(
+        let x48 = Self::mul_add(
             0.5692,
             Self::mul_add(-s_q1, x30, x43),
-            Self::mul_add(-s_q1, x41, x44),
+            Self::mul_add(-s_q1, x41, x45),
         );
-        let x47 = Self::mul_add(-s_q2, x11, x31);
-        let x48 = Self::mul_add(c_q2, x11, x29);
-        let x49 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x48, c_q1 * x47),
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(0.475, x48, Self::mul_add(c_q2, x14, x34)),
-                c_q1 * Self::mul_add(0.475, x47, Self::mul_add(-s_q2, x14, x37)),
-            ),
+        let x49 = Self::mul_add(-s_q2, x11, x31);
+        let x50 = Self::mul_add(c_q2, x11, x29);
+        let x51 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(0.475, x50, Self::mul_add(c_q2, x14, x34)),
+            c_q1 * Self::mul_add(0.475, x49, Self::mul_add(-s_q2, x14, x37)),
         );
-        let x50 = Self::mul_add(
+        let x52 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x50, c_q1 * x49), x51);
+        let x53 = Self::mul_add(
             -s_q1,
             Self::mul_add(s_q2, x18, c_q2 * x15),
             c_q1 * Self::mul_add(-s_q2, x15, c_q2 * x18),
         );
-        let x51 = c_q3 * x5;
-        let x52 = s_q3 * x5;
-        let x53 = Self::mul_add(
+        let x54 = c_q3 * x5;
+        let x55 = s_q3 * x5;
+        let x56 = Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x52, s_q2 * x51),
-            s_q1 * Self::mul_add(-s_q2, x52, c_q2 * x51),
+            Self::mul_add(c_q2, x55, s_q2 * x54),
+            s_q1 * Self::mul_add(-s_q2, x55, c_q2 * x54),
         );
-        let x54 = qd[0] * s_q1;
-        let x55 = qd[0] * c_q1;
-        let x56 = -0.5692 * (qd[0] * qd[0]);
-        let x57 = qd[1] * x55;
-        let x58 = qd[1] * x54;
-        let x59 = x55 * x55;
-        let x60 = Self::mul_add(qd[1], qd[1], x59);
-        let x61 = x54 * x55;
-        let x62 = Self::mul_add(39234.47412200001, x54, 3946.18812068 * qd[1]);
-        let x63 = Self::mul_add(-3946.1881206800003, x54, 39241.404122 * qd[1]);
-        let x64 = Self::mul_add(s_q2, x55, c_q2 * x54);
-        let x65 = Self::mul_add(-s_q2, x54, c_q2 * x55);
-        let x66 = 7.11 * x60;
-        let x67 = 7.11 * x61;
-        let x68 = x56
-            + Self::mul_add(-0.475, Self::mul_add(x54, x54, x59), 7.11 * (x58 + x58));
-        let x69 = Self::mul_add(c_q2, x67, s_q2 * x66);
-        let x70 = Self::mul_add(-qd[2], x65, Self::mul_add(-c_q2, x57, s_q2 * x58));
-        let x71 = Self::mul_add(qd[2], x64, Self::mul_add(c_q2, x58, s_q2 * x57));
-        let x72 = qd[1] + qd[2];
-        let x73 = Self::mul_add(x65, x65, x72 * x72);
-        let x74 = x64 * x65;
-        let x75 = Self::mul_add(x64, x72, x71);
-        let x76 = Self::mul_add(24989.305802, x64, 1375.0472756800002 * x72);
-        let x77 = Self::mul_add(-1375.0472756800002, x64, 24998.827802 * x72);
-        let x78 = Self::mul_add(s_q3, x65, c_q3 * x64);
-        let x79 = Self::mul_add(-s_q3, x64, c_q3 * x65);
-        let x80 = Self::mul_add(-qd[3], x79, Self::mul_add(s_q3, x71, c_q3 * x70));
-        let x81 = Self::mul_add(-qd[3], x78, Self::mul_add(-c_q3, x71, s_q3 * x70));
-        let x82 = qd[3] + x72;
-        let x83 = 132.6783695416 * x78;
-        let x84 = Self::mul_add(-97.44448770720001, x79, 135.4729695416 * x82);
-        let x85 = -97.44448770720001 * x82;
-        let x86 = Self::mul_add(-c_q4, x78, s_q4 * x82);
-        let x87 = Self::mul_add(c_q4, x82, s_q4 * x78);
-        let x88 = qd[4] + x79;
-        let x89 = 44.41 * x87;
-        let x90 = 47.471 * x88;
-        let x91 = 9.336 * (qd[5] + x86);
-        let x92 = Self::mul_add(
+        let x57 = qd[0] * s_q1;
+        let x58 = qd[0] * c_q1;
+        let x59 = -0.5692 * (qd[0] * qd[0]);
+        let x60 = qd[1] * x58;
+        let x61 = qd[1] * x57;
+        let x62 = x58 * x58;
+        let x63 = Self::mul_add(qd[1], qd[1], x62);
+        let x64 = x57 * x58;
+        let x65 = Self::mul_add(39234.47412200001, x57, 3946.18812068 * qd[1]);
+        let x66 = Self::mul_add(-3946.1881206800003, x57, 39241.404122 * qd[1]);
+        let x67 = Self::mul_add(s_q2, x58, c_q2 * x57);
+        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x58);
+        let x69 = 7.11 * x63;
+        let x70 = 7.11 * x64;
+        let x71 = x59
+            + Self::mul_add(-0.475, Self::mul_add(x57, x57, x62), 7.11 * (x61 + x61));
+        let x72 = Self::mul_add(c_q2, x70, s_q2 * x69);
+        let x73 = Self::mul_add(-qd[2], x68, Self::mul_add(-c_q2, x60, s_q2 * x61));
+        let x74 = Self::mul_add(qd[2], x67, Self::mul_add(c_q2, x61, s_q2 * x60));
+        let x75 = qd[1] + qd[2];
+        let x76 = Self::mul_add(x68, x68, x75 * x75);
+        let x77 = x67 * x68;
+        let x78 = Self::mul_add(x67, x75, x74);
+        let x79 = Self::mul_add(24989.305802, x67, 1375.0472756800002 * x75);
+        let x80 = Self::mul_add(-1375.0472756800002, x67, 24998.827802 * x75);
+        let x81 = Self::mul_add(s_q3, x68, c_q3 * x67);
+        let x82 = Self::mul_add(-s_q3, x67, c_q3 * x68);
+        let x83 = Self::mul_add(
+            s_q3,
+            Self::mul_add(7.11, x77, x72),
+            c_q3 * Self::mul_add(-7.11, x76, Self::mul_add(-c_q2, x69, s_q2 * x70)),
+        );
+        let x84 = Self::mul_add(-qd[3], x82, Self::mul_add(s_q3, x74, c_q3 * x73));
+        let x85 = Self::mul_add(-qd[3], x81, Self::mul_add(-c_q3, x74, s_q3 * x73));
+        let x86 = qd[3] + x75;
+        let x87 = 132.6783695416 * x81;
+        let x88 = Self::mul_add(-97.44448770720001, x82, 135.4729695416 * x86);
+        let x89 = -97.44448770720001 * x86;
+        let x90 = Self::mul_add(
+            -171.195516,
+            Self::mul_add(7.11, x78, x71),
+            Self::mul_add(132.6783695416, x84, Self::mul_add(-x82, x88, x86 * x89)),
+        );
+        let x91 = Self::mul_add(
+            -171.195516,
+            x83,
+            Self::mul_add(-97.44448770720001, x85, Self::mul_add(-x82, x87, x81 * x89)),
+        );
+        let x92 = Self::mul_add(-c_q4, x81, s_q4 * x86);
+        let x93 = Self::mul_add(c_q4, x86, s_q4 * x81);
+        let x94 = qd[4] + x82;
+        let x95 = 44.41 * x93;
+        let x96 = 47.471 * x94;
+        let x97 = 9.336 * (qd[5] + x92);
+        let x98 = Self::mul_add(
             9.336,
-            Self::mul_add(qd[4], x87, c_q4 * x80),
+            Self::mul_add(qd[4], x93, c_q4 * x84),
             -f_ext[5][3],
         );
-        let x93 = Self::mul_add(
-            Self::mul_add(-s_q5, x87, c_q5 * x88),
-            x91,
+        let x99 = Self::mul_add(
+            Self::mul_add(-s_q5, x93, c_q5 * x94),
+            x97,
             -f_ext[5][4],
         );
-        let x94 = Self::mul_add(Self::mul_add(s_q5, x88, c_q5 * x87), x91, f_ext[5][5]);
-        let x95 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
-        let x96 = f_ext[4][0] + f_ext[5][0];
-        let x97 = x95 - f_ext[4][1];
-        let x98 = f_ext[4][2] + Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x99 = Self::mul_add(-x88, x89, x87 * x90) - f_ext[4][3]
-            + Self::mul_add(0.7026, x95, x92);
-        let x100 = Self::mul_add(
+        let x100 = Self::mul_add(Self::mul_add(s_q5, x94, c_q5 * x93), x97, f_ext[5][5]);
+        let x101 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
+        let x102 = f_ext[4][0] + f_ext[5][0];
+        let x103 = x101 - f_ext[4][1];
+        let x104 = f_ext[4][2] + Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x105 = Self::mul_add(-x94, x95, x93 * x96) - f_ext[4][3]
+            + Self::mul_add(0.7026, x101, x98);
+        let x106 = Self::mul_add(
             0.7026,
             f_ext[5][0],
-            Self::mul_add(s_q5, x94, c_q5 * x93),
+            Self::mul_add(s_q5, x100, c_q5 * x99),
         )
             - (f_ext[4][4]
                 + Self::mul_add(
-                    x86,
-                    x90,
-                    44.41 * Self::mul_add(qd[4], x86, s_q4 * x80),
+                    x92,
+                    x96,
+                    44.41 * Self::mul_add(qd[4], x92, s_q4 * x84),
                 ));
-        let x101 = Self::mul_add(x86, x89, 47.471 * x81) - f_ext[4][5]
-            + Self::mul_add(-c_q5, x94, s_q5 * x93);
-        let x102 = Self::mul_add(s_q4, x97, c_q4 * x96);
-        let x103 = Self::mul_add(-171.195516, x78 * x79, f_ext[3][0]) + x102;
-        let x104 = Self::mul_add(
+        let x107 = Self::mul_add(x92, x95, 47.471 * x85) - f_ext[4][5]
+            + Self::mul_add(-c_q5, x100, s_q5 * x99);
+        let x108 = Self::mul_add(s_q4, x103, c_q4 * x102);
+        let x109 = Self::mul_add(-171.195516, x81 * x82, f_ext[3][0]) + x108;
+        let x110 = Self::mul_add(
             -171.195516,
-            Self::mul_add(x79, x82, -x80),
+            Self::mul_add(x82, x86, -x84),
             -f_ext[3][1],
-        ) + Self::mul_add(-s_q4, x96, c_q4 * x97);
-        let x105 = Self::mul_add(
+        ) + Self::mul_add(-s_q4, x102, c_q4 * x103);
+        let x111 = Self::mul_add(
             -171.195516,
-            Self::mul_add(x78, x78, x82 * x82),
+            Self::mul_add(x81, x81, x86 * x86),
             f_ext[3][2],
-        ) + x98;
-        let x106 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(7.11, x75, x68),
-            Self::mul_add(132.6783695416, x80, Self::mul_add(-x79, x84, x82 * x85)),
-        ) - f_ext[3][3]
-            + Self::mul_add(0.5692, x98, Self::mul_add(-s_q4, x100, c_q4 * x99));
-        let x107 = Self::mul_add(
-            -171.195516,
-            Self::mul_add(
-                s_q3,
-                Self::mul_add(7.11, x74, x69),
-                c_q3 * Self::mul_add(-7.11, x73, Self::mul_add(-c_q2, x66, s_q2 * x67)),
-            ),
-            Self::mul_add(-97.44448770720001, x81, Self::mul_add(-x79, x83, x78 * x85)),
-        ) - f_ext[3][4] + Self::mul_add(c_q4, x100, s_q4 * x99);
-        let x108 = Self::mul_add(-x78, x84, x82 * x83) - f_ext[3][5]
-            + Self::mul_add(-0.5692, x102, x101);
-        let x109 = Self::mul_add(-c_q3, x105, s_q3 * x103);
-        let x110 = Self::mul_add(3239.4582, x73, f_ext[2][0])
-            + Self::mul_add(s_q3, x105, c_q3 * x103);
-        let x111 = x109 - Self::mul_add(3239.4582, x74, f_ext[2][2]);
-        let x112 = Self::mul_add(-x65, x77, -24989.305802 * x70) - f_ext[2][3]
-            + Self::mul_add(s_q3, x108, c_q3 * x106);
-        let x113 = Self::mul_add(
-            x69,
+        ) + x104;
+        let x112 = x90 - f_ext[3][3]
+            + Self::mul_add(0.5692, x104, Self::mul_add(-s_q4, x106, c_q4 * x105));
+        let x113 = x91 - f_ext[3][4] + Self::mul_add(c_q4, x106, s_q4 * x105);
+        let x114 = Self::mul_add(-x81, x88, x86 * x87) - f_ext[3][5]
+            + Self::mul_add(-0.5692, x108, x107);
+        let x115 = Self::mul_add(-c_q3, x111, s_q3 * x109);
+        let x116 = Self::mul_add(3239.4582, x76, f_ext[2][0])
+            + Self::mul_add(s_q3, x111, c_q3 * x109);
+        let x117 = x115 - Self::mul_add(3239.4582, x77, f_ext[2][2]);
+        let x118 = Self::mul_add(-x68, x80, -24989.305802 * x73) - f_ext[2][3]
+            + Self::mul_add(s_q3, x114, c_q3 * x112);
+        let x119 = Self::mul_add(
+            x72,
             3239.4582,
-            Self::mul_add(x65, x76, 1375.0472756800002 * x70),
-        ) - f_ext[2][4] + Self::mul_add(-7.11, x109, x107);
-        let x114 = Self::mul_add(7.11, x104, Self::mul_add(-s_q3, x106, c_q3 * x108))
+            Self::mul_add(x68, x79, 1375.0472756800002 * x73),
+        ) - f_ext[2][4] + Self::mul_add(-7.11, x115, x113);
+        let x120 = Self::mul_add(7.11, x110, Self::mul_add(-s_q3, x112, c_q3 * x114))
             - (f_ext[2][5]
-                + Self::mul_add(3239.4582, x68, Self::mul_add(x64, x77, x72 * x76)));
-        let x115 = Self::mul_add(-c_q2, x110, s_q2 * x111);
-        let x116 = Self::mul_add(c_q2, x111, s_q2 * x110);
-        let x117 = tau[0]
-            - (Self::mul_add(
-                0.5692,
-                Self::mul_add(
-                    s_q1,
-                    x116 - Self::mul_add(5224.5702, x61, f_ext[1][2]),
-                    c_q1 * (x115 - Self::mul_add(5224.5702, x60, f_ext[1][0])),
-                ),
-                Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(-0.475, x116, Self::mul_add(s_q2, x114, c_q2 * x112))
-                        - (f_ext[1][3]
-                            + Self::mul_add(x55, x63, -39234.47412200001 * x57)),
-                    c_q1
-                        * (Self::mul_add(-s_q2, x112, c_q2 * x114)
-                            + Self::mul_add(
-                                7.11,
-                                x104 - Self::mul_add(3239.4582, x75, f_ext[2][1]),
-                                0.475 * x115,
-                            )
-                            - (f_ext[1][5]
-                                + Self::mul_add(
-                                    5224.5702,
-                                    x56,
-                                    Self::mul_add(x54, x63, qd[1] * x62),
-                                ))),
-                ),
-            ) - f_ext[0][5]);
-        let x118 = 1.0
-            / (65697.3302265768
-                + Self::mul_add(
-                    -s_q1,
-                    Self::mul_add(
-                        -s_q1,
-                        -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
-                        c_q1
-                            * Self::mul_add(
-                                -7.11,
-                                x32,
-                                Self::mul_add(s_q2, x38, c_q2 * x36),
-                            ),
-                    ),
-                    c_q1
-                        * Self::mul_add(
-                            -s_q1,
-                            Self::mul_add(
-                                -7.11,
-                                x32,
-                                Self::mul_add(-s_q2, x33, c_q2 * x35),
-                            ),
-                            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
-                        ),
-                ));
-        let x119 = x45 * x118;
-        let x120 = x46 * x118;
-        let x121 = x49 * x118;
-        let x122 = x50 * x118;
-        let x123 = x53 * x118;
-        let x124 = 1.0 / Self::mul_add(-x45, x119, 39241.404122 + (x40 + x42));
-        let x125 = Self::mul_add(-x45, x120, x42);
-        let x126 = x124 * x125;
-        let x127 = Self::mul_add(-x45, x121, Self::mul_add(7.11, x48, x21));
-        let x128 = x124 * x127;
-        let x129 = x45 * x122;
-        let x130 = x124 * x129;
-        let x131 = Self::mul_add(x45, x123, x7);
-        let x132 = x124 * x131;
-        let x133 = 1.0 / Self::mul_add(-x125, x126, Self::mul_add(-x46, x120, x28));
-        let x134 = Self::mul_add(-x125, x128, Self::mul_add(-x46, x121, x21));
-        let x135 = x133 * x134;
-        let x136 = Self::mul_add(-x46, x122, x125 * x130);
-        let x137 = x133 * x136;
-        let x138 = Self::mul_add(-x125, x132, Self::mul_add(x46, x123, x7));
-        let x139 = x133 * x138;
-        let x140 = 1.0
-            / Self::mul_add(
-                -x134,
-                x135,
-                Self::mul_add(-x127, x128, Self::mul_add(-x49, x121, x10)),
-            );
-        let x141 = Self::mul_add(-x134, x137, Self::mul_add(-x49, x122, x127 * x130));
-        let x142 = x140 * x141;
-        let x143 = Self::mul_add(
-            -x134,
-            x139,
-            Self::mul_add(-x127, x132, Self::mul_add(x49, x123, x7)),
+                + Self::mul_add(3239.4582, x71, Self::mul_add(x67, x80, x75 * x79)));
+        let x121 = Self::mul_add(-c_q2, x116, s_q2 * x117);
+        let x122 = Self::mul_add(c_q2, x117, s_q2 * x116);
+        let x123 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(-0.475, x122, Self::mul_add(s_q2, x120, c_q2 * x118))
+                - (f_ext[1][3] + Self::mul_add(x58, x66, -39234.47412200001 * x60)),
+            c_q1
+                * (Self::mul_add(-s_q2, x118, c_q2 * x120)
+                    + Self::mul_add(
+                        7.11,
+                        x110 - Self::mul_add(3239.4582, x78, f_ext[2][1]),
+                        0.475 * x121,
+                    )
+                    - (f_ext[1][5]
+                        + Self::mul_add(
+                            5224.5702,
+                            x59,
+                            Self::mul_add(x57, x66, qd[1] * x65),
+                        ))),
         );
-        let x144 = x140 * x143;
-        let x145 = 1.0
-            / Self::mul_add(
-                -x141,
-                x142,
-                Self::mul_add(
-                    -x136,
-                    x137,
-                    Self::mul_add(-x129, x130, Self::mul_add(-x50, x122, 47.471)),
-                ),
-            );
-        let x146 = Self::mul_add(
-            -x141,
-            x144,
-            Self::mul_add(-x136, x139, Self::mul_add(x129, x132, x50 * x123)),
+        let x124 = Self::mul_add(
+            0.5692,
+            Self::mul_add(
+                s_q1,
+                x122 - Self::mul_add(5224.5702, x64, f_ext[1][2]),
+                c_q1 * (x121 - Self::mul_add(5224.5702, x63, f_ext[1][0])),
+            ),
+            x123,
         );
-        let x147 = x145 * x146;
-        let x148 = 1.0
-            / Self::mul_add(
-                -x146,
-                x147,
-                Self::mul_add(
-                    -x143,
-                    x144,
-                    Self::mul_add(
-                        -x138,
-                        x139,
-                        Self::mul_add(-x131, x132, Self::mul_add(-x53, x123, 9.336)),
-                    ),
-                ),
-            );
-        let x149 = Self::mul_add(
-            -x117,
-            x119,
-            tau[1]
-                - (Self::mul_add(-3946.1881206800003, x57, x55 * x62) - f_ext[1][4]
-                    + Self::mul_add(-7.11, x116, x113)),
+        let x125 = tau[0] - (x124 - f_ext[0][5]);
+        let x126 = 1.0 / (65697.3302265768 + Self::mul_add(-s_q1, x44, c_q1 * x46));
+        let x127 = x47 * x126;
+        let x128 = x48 * x126;
+        let x129 = x52 * x126;
+        let x130 = x53 * x126;
+        let x131 = x56 * x126;
+        let x132 = 1.0 / Self::mul_add(-x47, x127, 39241.404122 + (x40 + x42));
+        let x133 = Self::mul_add(-x47, x128, x42);
+        let x134 = x132 * x133;
+        let x135 = Self::mul_add(-x47, x129, Self::mul_add(7.11, x50, x21));
+        let x136 = x132 * x135;
+        let x137 = x47 * x130;
+        let x138 = x132 * x137;
+        let x139 = Self::mul_add(x47, x131, x7);
+        let x140 = x132 * x139;
+        let x141 = 1.0 / Self::mul_add(-x133, x134, Self::mul_add(-x48, x128, x28));
+        let x142 = Self::mul_add(-x133, x136, Self::mul_add(-x48, x129, x21));
+        let x143 = x141 * x142;
+        let x144 = Self::mul_add(-x48, x130, x133 * x138);
+        let x145 = x141 * x144;
+        let x146 = Self::mul_add(-x133, x140, Self::mul_add(x48, x131, x7));
+        let x147 = x141 * x146;
+        let x148 = Self::mul_add(
+            -x142,
+            x143,
+            Self::mul_add(-x135, x136, Self::mul_add(-x52, x129, x10)),
         );
-        let x150 = Self::mul_add(-x126, x149, Self::mul_add(-x117, x120, tau[2] - x113));
-        let x151 = Self::mul_add(
-            -x135,
-            x150,
-            Self::mul_add(-x128, x149, Self::mul_add(-x117, x121, tau[3] - x107)),
-        );
+        let x149 = 1.0 / x148;
+        let x150 = Self::mul_add(-x142, x145, Self::mul_add(-x52, x130, x135 * x138));
+        let x151 = x149 * x150;
         let x152 = Self::mul_add(
             -x142,
-            x151,
-            Self::mul_add(
-                -x137,
-                x150,
-                Self::mul_add(x130, x149, Self::mul_add(-x117, x122, tau[4] - x101)),
-            ),
+            x147,
+            Self::mul_add(-x135, x140, Self::mul_add(x52, x131, x7)),
         );
-        let x153 = x148
-            * Self::mul_add(
-                -x147,
-                x152,
-                Self::mul_add(
-                    -x144,
-                    x151,
-                    Self::mul_add(
-                        -x139,
-                        x150,
-                        Self::mul_add(
-                            -x132,
-                            x149,
-                            Self::mul_add(x117, x123, tau[5] - x92),
-                        ),
-                    ),
-                ),
-            );
-        let x154 = Self::mul_add(-x147, x153, x145 * x152);
-        let x155 = Self::mul_add(-x144, x153, Self::mul_add(-x142, x154, x140 * x151));
+        let x153 = x149 * x152;
+        let x154 = Self::mul_add(
+            -x144,
+            x145,
+            Self::mul_add(-x137, x138, Self::mul_add(-x53, x130, 47.471)),
+        );
+        let x155 = 1.0 / Self::mul_add(-x150, x151, x154);
         let x156 = Self::mul_add(
-            -x139,
+            -x150,
             x153,
-            Self::mul_add(-x137, x154, Self::mul_add(-x135, x155, x133 * x150)),
+            Self::mul_add(-x144, x147, Self::mul_add(x137, x140, x53 * x131)),
         );
-        let x157 = Self::mul_add(
-            -x132,
-            x153,
-            Self::mul_add(
-                x130,
-                x154,
-                Self::mul_add(-x128, x155, Self::mul_add(-x126, x156, x124 * x149)),
-            ),
-        );
+        let x157 = x155 * x156;
         let x158 = Self::mul_add(
-            x123,
-            x153,
-            Self::mul_add(
-                -x122,
-                x154,
-                Self::mul_add(
-                    -x121,
-                    x155,
-                    Self::mul_add(-x120, x156, Self::mul_add(-x119, x157, x117 * x118)),
-                ),
-            ),
+            -x146,
+            x147,
+            Self::mul_add(-x139, x140, Self::mul_add(-x56, x131, 9.336)),
         );
-        [x158, x157, x156, x155, x154, x153]
+        let x159 = 1.0 / Self::mul_add(-x156, x157, Self::mul_add(-x152, x153, x158));
+        let x160 = Self::mul_add(
+            -x125,
+            x127,
+            tau[1]
+                - (Self::mul_add(-3946.1881206800003, x60, x58 * x65) - f_ext[1][4]
+                    + Self::mul_add(-7.11, x122, x119)),
+        );
+        let x161 = Self::mul_add(-x134, x160, Self::mul_add(-x125, x128, tau[2] - x119));
+        let x162 = Self::mul_add(
+            -x143,
+            x161,
+            Self::mul_add(-x136, x160, Self::mul_add(-x125, x129, tau[3] - x113)),
+        );
+        let x163 = Self::mul_add(
+            -x145,
+            x161,
+            Self::mul_add(x138, x160, Self::mul_add(-x125, x130, tau[4] - x107)),
+        );
+        let x164 = Self::mul_add(-x151, x162, x163);
+        let x165 = Self::mul_add(
+            -x147,
+            x161,
+            Self::mul_add(-x140, x160, Self::mul_add(x125, x131, tau[5] - x98)),
+        );
+        let x166 = x159 * Self::mul_add(-x157, x164, Self::mul_add(-x153, x162, x165));
+        let x167 = Self::mul_add(-x157, x166, x155 * x164);
+        let x168 = Self::mul_add(-x153, x166, Self::mul_add(-x151, x167, x149 * x162));
+        let x169 = Self::mul_add(
+            -x147,
+            x166,
+            Self::mul_add(-x145, x167, Self::mul_add(-x143, x168, x141 * x161)),
+        );
+        let x170 = Self::mul_add(
+            x138,
+            x167,
+            Self::mul_add(-x136, x168, Self::mul_add(-x134, x169, x132 * x160)),
+        );
+        let x171 = Self::mul_add(-x140, x166, x170);
+        let x172 = Self::mul_add(
+            -x129,
+            x168,
+            Self::mul_add(-x128, x169, Self::mul_add(-x127, x171, x125 * x126)),
+        );
+        let x173 = Self::mul_add(x131, x166, Self::mul_add(-x130, x167, x172));
+        [x173, x171, x169, x168, x167, x166]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

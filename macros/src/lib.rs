@@ -28,7 +28,9 @@ struct Input {
     float: kanegen_codegen::Float,
     fma: bool,
     fma_path: Option<syn::Path>,
+    target_fma: bool,
     regroup: bool,
+    snap: Option<f64>,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -66,7 +68,9 @@ impl Parse for Input {
             float: kanegen_codegen::Float::F64,
             fma: false,
             fma_path: None,
+            target_fma: true,
             regroup: true,
+            snap: None,
         };
         let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
@@ -115,6 +119,18 @@ impl Parse for Input {
                 }
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
+                "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
+                "snap" => {
+                    let e: Expr = input.parse()?;
+                    let x = float(&e)?;
+                    if !(0.0..0.1).contains(&x) {
+                        return Err(syn::Error::new_spanned(
+                            e,
+                            format!("snap tolerance {x} is not in [0, 0.1)"),
+                        ));
+                    }
+                    out.snap = Some(x);
+                }
                 "fma_path" => {
                     out.fma_path = Some(input.parse::<syn::Path>()?);
                     fma_path_key = Some(key);
@@ -124,7 +140,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, regroup)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap)"
                         ),
                     ))
                 }
@@ -174,6 +190,10 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.float = input.float;
     opts.fma = input.fma;
     opts.regroup = input.regroup;
+    opts.target_fma = input.target_fma;
+    if let Some(snap) = input.snap {
+        opts.snap = snap;
+    }
     opts.fma_path = input
         .fma_path
         .as_ref()

@@ -32,7 +32,7 @@
 
 use crate::inertial::rotate_inertia;
 use crate::placement::{mat_mul, mat_vec, transpose, Placement, M3, V3};
-use crate::{Frame, Inertial, Model, Validation};
+use crate::{Frame, Inertial, Joint, Model, Validation};
 
 /// The snap tolerance of [`Model::canonical`]: representation residues only (`cos(π/2)` in
 /// `f64` is 6.1e-17, `sin(π)` 1.2e-16).
@@ -141,30 +141,74 @@ impl Model {
         self.canonical_with(DEFAULT_SNAP)
     }
 
-    /// [`Model::canonical`] with the snap tolerance `tol` (0 snaps nothing).
+    /// The same robot with float noise snapped and its frames left as they are: the snapping of
+    /// [`Model::canonical_with`] alone (`turned` is 0). A rotation is made an exact signed
+    /// permutation only when all its entries are within `tol` of 0 or ±1, so it stays
+    /// orthonormal; elsewhere only entries below `tol` become 0 (a change of at most `tol`).
     #[must_use]
-    pub fn canonical_with(&self, tol: f64) -> Canonical {
+    pub fn snapped(&self, tol: f64) -> Canonical {
         let mut rep = CanonicalReport::default();
+        let (joints, frames, base_inertial) = self.snap_parts(tol, &mut rep);
+        let model = self
+            .rebuilt(joints, frames, base_inertial)
+            .expect("snapping keeps a valid model valid");
+        Canonical { model, report: rep }
+    }
+
+    /// Joints, frames and base inertial with float noise below `tol` snapped.
+    fn snap_parts(
+        &self,
+        tol: f64,
+        rep: &mut CanonicalReport,
+    ) -> (Vec<Joint>, Vec<Frame>, Option<Inertial>) {
         let mut joints = self.joints().to_vec();
         let mut frames = self.frames().to_vec();
         let mut base_inertial = self.base_inertial().cloned();
         if let Some(b) = base_inertial.as_mut() {
-            snap_inertial(b, tol, &mut rep);
+            snap_inertial(b, tol, rep);
         }
         for j in &mut joints {
-            snap_rotation(&mut j.origin.rotation, tol, &mut rep);
-            snap_small(&mut j.origin.translation, tol, &mut rep);
-            snap_inertial(&mut j.inertial, tol, &mut rep);
+            snap_rotation(&mut j.origin.rotation, tol, rep);
+            snap_small(&mut j.origin.translation, tol, rep);
+            snap_inertial(&mut j.inertial, tol, rep);
             let mut axis = j.axis;
-            snap_small(&mut axis, tol, &mut rep);
+            snap_small(&mut axis, tol, rep);
             if let Some(u) = normalized(axis) {
                 j.axis = u;
             }
         }
         for f in &mut frames {
-            snap_rotation(&mut f.placement.rotation, tol, &mut rep);
-            snap_small(&mut f.placement.translation, tol, &mut rep);
+            snap_rotation(&mut f.placement.rotation, tol, rep);
+            snap_small(&mut f.placement.translation, tol, rep);
         }
+        (joints, frames, base_inertial)
+    }
+
+    /// This model's name, base and base kind with other joints, frames and base inertial.
+    fn rebuilt(
+        &self,
+        joints: Vec<Joint>,
+        frames: Vec<Frame>,
+        base_inertial: Option<Inertial>,
+    ) -> Result<Model, crate::ModelError> {
+        Model::new_with(
+            self.name(),
+            self.base(),
+            base_inertial,
+            joints,
+            Validation {
+                allow_nonphysical_inertia: true,
+            },
+        )
+        .and_then(|m| m.with_frames(frames))
+        .and_then(|m| m.with_base_kind(self.base_kind()))
+    }
+
+    /// [`Model::canonical`] with the snap tolerance `tol` (0 snaps nothing).
+    #[must_use]
+    pub fn canonical_with(&self, tol: f64) -> Canonical {
+        let mut rep = CanonicalReport::default();
+        let (mut joints, frames, base_inertial) = self.snap_parts(tol, &mut rep);
         // R_j for every body: z along the axis, x along the common normal to the first child's
         // axis (as seen in this body's original frame: Υ_c u_c).
         let rot: Vec<M3> = (0..joints.len())
@@ -214,18 +258,9 @@ impl Model {
                 }
             })
             .collect();
-        let model = Model::new_with(
-            self.name(),
-            self.base(),
-            base_inertial,
-            joints,
-            Validation {
-                allow_nonphysical_inertia: true,
-            },
-        )
-        .and_then(|m| m.with_frames(frames))
-        .and_then(|m| m.with_base_kind(self.base_kind()))
-        .expect("turning body frames keeps a valid model valid");
+        let model = self
+            .rebuilt(joints, frames, base_inertial)
+            .expect("turning body frames keeps a valid model valid");
         Canonical { model, report: rep }
     }
 }

@@ -67,6 +67,7 @@ fn with_bias(bias: BiasMethod) -> Methods {
     Methods {
         mass_matrix: MassMatrixMethod::Crba,
         bias,
+        ..Methods::SPATIAL
     }
 }
 
@@ -90,7 +91,7 @@ pub fn count_lines(
     for &m in mass {
         let methods = Methods {
             mass_matrix: m,
-            bias: BiasMethod::Rnea,
+            ..Methods::SPATIAL
         };
         let t = trace(Subject::Model(model), Function::MassMatrix, methods, spec)?;
         push("mass_matrix", m.name(), &t);

@@ -526,6 +526,7 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
                 l,
                 upsilon,
                 axis,
+                coordinate_axis: None,
                 mass,
                 com,
                 inertia_com,

@@ -151,7 +151,20 @@ impl Function {
         }
     }
 
-    /// Whether its result involves the mass matrix (and so a mass-matrix method).
+    /// Whether it is forward dynamics ([`Function::ForwardDynamics`],
+    /// [`Function::ForwardDynamicsWithWrenches`]), and so has a forward method
+    /// (`kanegen_dynamics::ForwardMethod`: LDLᵀ on `M` and `c`, or the articulated-body
+    /// algorithm, which uses neither).
+    #[must_use]
+    pub fn is_forward_dynamics(self) -> bool {
+        matches!(
+            self,
+            Function::ForwardDynamics | Function::ForwardDynamicsWithWrenches
+        )
+    }
+
+    /// Whether its result involves the mass matrix (and so a mass-matrix method; with LDLᵀ for
+    /// forward dynamics).
     #[must_use]
     pub fn uses_mass_matrix(self) -> bool {
         matches!(
@@ -164,7 +177,8 @@ impl Function {
         )
     }
 
-    /// Whether its result involves the bias forces (and so a bias method).
+    /// Whether its result involves the bias forces (and so a bias method; with LDLᵀ for forward
+    /// dynamics).
     #[must_use]
     pub fn uses_bias(self) -> bool {
         matches!(

@@ -64,8 +64,8 @@
 use crate::algorithms::kinematics::{
     self, floating_base_frame, floating_motion, BodyKinematics, BodyMotion,
 };
-use crate::algorithms::methods::{BiasMethod, Dynamics, MassMatrixMethod, Methods};
-use crate::algorithms::{crba, kane_direct, newton_euler, recurrent, rnea};
+use crate::algorithms::methods::{BiasMethod, Dynamics, ForwardMethod, MassMatrixMethod, Methods};
+use crate::algorithms::{aba, crba, kane_direct, newton_euler, recurrent, rnea};
 use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
 use crate::linalg::Vec3;
 use crate::loads::{ExternalWrench, Loads};
@@ -184,7 +184,9 @@ pub fn dynamics<S: Scalar>(
     }
 }
 
-/// Forward dynamics `ν̇ = A⁻¹ b` by the branch-free LDLᵀ of [`crate::ldlt`].
+/// Forward dynamics `ν̇ = A⁻¹ b` (`[v̇_b; ω̇_b; q̈]`): by the branch-free LDLᵀ of
+/// [`crate::ldlt`] on [`dynamics`] ([`ForwardMethod::Ldlt`]), or by the floating-base
+/// articulated-body algorithm ([`ForwardMethod::Aba`], [`aba::floating`]; any tree).
 pub fn forward_dynamics<S: Scalar>(
     methods: Methods,
     p: &Params<S>,
@@ -194,8 +196,13 @@ pub fn forward_dynamics<S: Scalar>(
     qd: &[S],
     loads: &Loads<S>,
 ) -> Vec<S> {
-    let d = dynamics(methods, p, base, state, q, qd, loads);
-    crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+    match methods.forward {
+        ForwardMethod::Ldlt => {
+            let d = dynamics(methods, p, base, state, q, qd, loads);
+            crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+        }
+        ForwardMethod::Aba => aba::floating(p, base, state, q, qd, loads),
+    }
 }
 
 /// Positions (inertial frame, from the inertial origin) of the frame origins of the extended

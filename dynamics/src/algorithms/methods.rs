@@ -16,9 +16,15 @@
 //! | `rnea` | `rnea.rs` | Featherstone's recursive Newton–Euler algorithm in local frames |
 //! | `newton-euler` | `newton_euler.rs` | the classical Newton–Euler algorithm in local frames (3-vectors) |
 //!
-//! The CLI's `--algorithm` names are presets of both ([`Methods::PRESETS`]).
+//! | forward method | file | what |
+//! |---|---|---|
+//! | `ldlt` | `ldlt.rs` | `q̈ = A⁻¹ b` by a branch-free LDLᵀ of the mass-matrix method's `A` |
+//! | `aba` | `aba.rs` | Featherstone's articulated-body algorithm, O(N), no `A` at all |
 //!
-//! **Trees.** Only the local-frame methods (`crba`, `rnea`, `newton-euler`) take a
+//! The CLI's `--algorithm` names are presets of the first two ([`Methods::PRESETS`]), all with
+//! `ldlt`; [`Methods::ABA`] is the articulated-body algorithm.
+//!
+//! **Trees.** Only the local-frame methods (`crba`, `rnea`, `newton-euler`, and `aba`) take a
 //! kinematic tree; the paper's base-frame methods are serial-chain only
 //! ([`MassMatrixMethod::supports_trees`], [`BiasMethod::supports_trees`]). [`Methods::check`]
 //! tells a caller before it runs them; the methods themselves panic with the same message.
@@ -34,7 +40,7 @@
 //! ```
 
 use crate::algorithms::kinematics::{self, BodyKinematics};
-use crate::algorithms::{crba, crba_base, kane_direct, newton_euler, recurrent, rnea};
+use crate::algorithms::{aba, crba, crba_base, kane_direct, newton_euler, recurrent, rnea};
 use crate::loads::Loads;
 pub use crate::params::MethodError;
 use crate::params::Params;
@@ -222,13 +228,46 @@ impl BiasMethod {
     }
 }
 
-/// A mass-matrix method and a bias method.
+/// How forward dynamics `q̈ = A⁻¹ b` is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum ForwardMethod {
+    /// `A` and `b` by the mass-matrix and bias methods, then the branch-free LDLᵀ of
+    /// [`crate::ldlt`].
+    Ldlt,
+    /// Featherstone's articulated-body algorithm ([`aba`], RBDA Table 7.1): O(N), reads neither
+    /// the mass-matrix nor the bias method; any kinematic tree.
+    Aba,
+}
+
+impl ForwardMethod {
+    /// All methods, in report order.
+    pub const ALL: [ForwardMethod; 2] = [ForwardMethod::Ldlt, ForwardMethod::Aba];
+
+    /// Its name in reports and generated headers.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            ForwardMethod::Ldlt => "ldlt",
+            ForwardMethod::Aba => "aba",
+        }
+    }
+
+    /// The method called `name` ([`ForwardMethod::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|m| m.name() == name)
+    }
+}
+
+/// A mass-matrix method, a bias method and a forward-dynamics method.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Methods {
     /// How `A` is computed.
     pub mass_matrix: MassMatrixMethod,
     /// How `b` is computed.
     pub bias: BiasMethod,
+    /// How forward dynamics is computed ([`ForwardMethod::Ldlt`] in every preset).
+    pub forward: ForwardMethod,
 }
 
 impl Methods {
@@ -236,26 +275,39 @@ impl Methods {
     pub const RECURRENT: Methods = Methods {
         mass_matrix: MassMatrixMethod::Recurrent,
         bias: BiasMethod::Recurrent,
+        forward: ForwardMethod::Ldlt,
     };
     /// `recurrent-r1`: (14b) as R1, with the paper's bias recursion.
     pub const RECURRENT_R1: Methods = Methods {
         mass_matrix: MassMatrixMethod::RecurrentR1,
         bias: BiasMethod::Recurrent,
+        forward: ForwardMethod::Ldlt,
     };
     /// `kane-direct`: the direct sums (9) and (10).
     pub const KANE_DIRECT: Methods = Methods {
         mass_matrix: MassMatrixMethod::KaneDirect,
         bias: BiasMethod::KaneDirect,
+        forward: ForwardMethod::Ldlt,
     };
     /// `crba-base`: base-frame composite rigid bodies, with the paper's bias recursion.
     pub const CRBA_BASE: Methods = Methods {
         mass_matrix: MassMatrixMethod::CrbaBase,
         bias: BiasMethod::Recurrent,
+        forward: ForwardMethod::Ldlt,
     };
     /// `spatial`: Featherstone's CRBA and RNEA in local frames.
     pub const SPATIAL: Methods = Methods {
         mass_matrix: MassMatrixMethod::Crba,
         bias: BiasMethod::Rnea,
+        forward: ForwardMethod::Ldlt,
+    };
+
+    /// `aba`: forward dynamics by the articulated-body algorithm; `A` and `b`, when asked for,
+    /// by the CRBA and the RNEA (as [`Methods::SPATIAL`]). Not a preset.
+    pub const ABA: Methods = Methods {
+        mass_matrix: MassMatrixMethod::Crba,
+        bias: BiasMethod::Rnea,
+        forward: ForwardMethod::Aba,
     };
 
     /// The presets, by the CLI's `--algorithm` names, in report order.
@@ -301,13 +353,25 @@ impl Methods {
         self.bias.check(p)
     }
 
-    /// The preset's name, or `mass+bias` for a combination that is no preset.
+    /// The preset's name, or `mass+bias` for a combination that is no preset; `aba` for
+    /// [`Methods::ABA`], and `…+aba` for another pair with [`ForwardMethod::Aba`].
     #[must_use]
     pub fn name(self) -> String {
-        Self::PRESETS.iter().find(|(_, m)| *m == self).map_or_else(
+        if self == Methods::ABA {
+            return ForwardMethod::Aba.name().to_string();
+        }
+        let pair = Methods {
+            forward: ForwardMethod::Ldlt,
+            ..self
+        };
+        let name = Self::PRESETS.iter().find(|(_, m)| *m == pair).map_or_else(
             || format!("{}+{}", self.mass_matrix.name(), self.bias.name()),
             |(n, _)| (*n).to_string(),
-        )
+        );
+        match self.forward {
+            ForwardMethod::Ldlt => name,
+            ForwardMethod::Aba => format!("{name}+{}", ForwardMethod::Aba.name()),
+        }
     }
 
     /// `A` and `b` together, fixed base.
@@ -324,7 +388,9 @@ impl Methods {
         }
     }
 
-    /// Forward dynamics `q̈ = A⁻¹ b`, by the branch-free LDLᵀ of [`crate::ldlt`].
+    /// Forward dynamics `q̈ = A⁻¹ b`, fixed base: by the branch-free LDLᵀ of [`crate::ldlt`] on
+    /// this pair's `A` and `b` ([`ForwardMethod::Ldlt`]), or by the articulated-body algorithm
+    /// ([`ForwardMethod::Aba`], [`aba::forward_dynamics`]).
     pub fn forward_dynamics<S: Scalar>(
         self,
         p: &Params<S>,
@@ -332,8 +398,13 @@ impl Methods {
         qd: &[S],
         loads: &Loads<S>,
     ) -> Vec<S> {
-        let d = self.dynamics(p, q, qd, loads);
-        crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+        match self.forward {
+            ForwardMethod::Ldlt => {
+                let d = self.dynamics(p, q, qd, loads);
+                crate::ldlt::solve(&crate::ldlt::ldlt(&d.a), &d.b)
+            }
+            ForwardMethod::Aba => aba::forward_dynamics(p, q, qd, loads),
+        }
     }
 
     /// Inverse dynamics: the joint drives `τ` for which `A q̈ = b(q, q̇, τ)` holds (`loads.tau` is

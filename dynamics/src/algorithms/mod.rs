@@ -14,12 +14,13 @@
 //! | [`crba`] | Featherstone's local-frame CRBA (fixed and floating base) |
 //! | [`rnea`] | Featherstone's local-frame RNEA: bias forces and O(N) inverse dynamics (fixed and floating base) |
 //! | [`newton_euler`] | the classical local-frame Newton–Euler with 3-vectors (Luh–Walker–Paul, Khalil): the same, no linear velocities |
+//! | [`aba`] | Featherstone's articulated-body algorithm: O(N) forward dynamics (fixed and floating base) |
 //! | [`frames`] | placements and Jacobians of frames on bodies, the generalized Jacobian |
 //! | [`momentum`] | total momentum and kinetic energy of a free-floating system |
 //! | [`floating`] | a free-floating base: the dispatch, and the base-frame algorithms on six virtual joints |
 //! | [`methods`] | the choice of mass-matrix and bias method, and the fixed-base dispatch |
 //!
-//! **Trees.** `crba`, `rnea`, `newton_euler`, `frames` and `momentum` take any kinematic tree
+//! **Trees.** `crba`, `rnea`, `newton_euler`, `aba`, `frames` and `momentum` take any kinematic tree
 //! (`λ(i)` = [`crate::JointParams::parent`]); the paper's base-frame algorithms (`kinematics`,
 //! `recurrent`, `kane_direct`, `crba_base`, and the virtual-joint extension of `floating`) are
 //! serial-chain only and panic on a tree ([`crate::Params::assert_chain`];
@@ -27,8 +28,9 @@
 //!
 //! Module dependencies run one way: `methods` and `floating` use the algorithm files, which use
 //! `kinematics` and the crate's leaf modules; no algorithm file uses `methods` or `floating`
-//! (`frames` uses `crba` for the generalized Jacobian).
+//! (`frames` uses `crba` for the generalized Jacobian, `aba` applies loads with `rnea`'s helper).
 
+pub mod aba;
 pub mod crba;
 pub mod crba_base;
 pub mod floating;

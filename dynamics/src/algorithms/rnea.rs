@@ -48,8 +48,9 @@ struct Start<S> {
 }
 
 /// `−f^x`: the external wrenches on `body`, in the coordinates of that body (`e0`: rotation from
-/// the wrenches' base frame to the body), subtracted one by one from `f`.
-fn subtract_external<S: Scalar>(
+/// the wrenches' base frame to the body), subtracted one by one from `f` (shared with
+/// [`crate::algorithms::aba`], which applies the loads exactly as the RNEA does).
+pub(crate) fn subtract_external<S: Scalar>(
     mut f: Force<S>,
     loads: &Loads<S>,
     body: usize,

@@ -1,0 +1,480 @@
+//! The articulated-body algorithm in local body coordinates (R. Featherstone, *Rigid Body
+//! Dynamics Algorithms*, 2008, "RBDA", §7.3, Table 7.1; spatial_v2 `FDab`): forward dynamics
+//! `q̈ = H⁻¹ (τ − C(q, q̇, f_ext))` in three O(N) passes, with no mass matrix and no
+//! factorization. On a free-floating base (RBDA ch. 9; spatial_v2 `FDfb`), [`floating`] returns
+//! `ν̇ = [v̇_b; ω̇_b; q̈]` for the same loads as [`crate::algorithms::floating::forward_dynamics`].
+//! Spatial algebra and conventions: [`crate::spatial`]; joints: [`crate::joint`].
+//!
+//! Any kinematic tree (`λ(i)` = [`crate::JointParams::parent`]), revolute and prismatic joints.
+//!
+//! - **Pass 1** (root to leaves): `Xup_i`, `v_i = Xup_i v_λ(i) + vJ_i`, the velocity-product
+//!   acceleration `c_i = v_i ×ₘ vJ_i` (`cJ = 0`), and `I^A_i = I_i`,
+//!   `p^A_i = v_i ×* I_i v_i − f^x_i`.
+//! - **Pass 2** (leaves to root): `U_i = I^A_i S_i`, `D_i = S_iᵀ U_i`, `u_i = τ_i − S_iᵀ p^A_i`,
+//!   then `I^a_i = I^A_i − U_i D_i⁻¹ U_iᵀ` and `p^a_i = p^A_i + I^a_i c_i + U_i D_i⁻¹ u_i`
+//!   carried to the parent: `I^A_λ += Xup_iᵀ I^a_i Xup_i`, `p^A_λ += Xup_iᵀ p^a_i`.
+//! - **Pass 3** (root to leaves): `a'_i = Xup_i a_λ(i) + c_i`,
+//!   `q̈_i = D_i⁻¹ (u_i − U_iᵀ a'_i)`, `a_i = a'_i + S_i q̈_i`.
+//!
+//! **Loads** exactly as [`crate::algorithms::rnea`] takes them: gravity as the fictitious base
+//! acceleration `a_0 = −a_grav = [0; −g]` (RBDA §5.3), external wrenches as `−f^x_i` in `p^A_i`
+//! (base-frame ones rotated by `E_0i = E_i E_0λ(i)` along the body's own path), `τ` the drives.
+//!
+//! **Inertias** are read only as the local-frame algorithms read them: the body's spatial inertia
+//! about its origin, [`crate::JointParams::inertia`] (and [`FloatingBase::inertia`]). Regrouped
+//! parameters ([`crate::regroup`]) give the same `H` and `C`, hence the same `q̈`: the
+//! articulated inertias differ, the joint-space result does not (`dynamics/tests/aba.rs`).
+//!
+//! # Articulated inertias: three 3×3 blocks
+//!
+//! `I^A = [A B; Bᵀ C]` (moment rows first, like [`crate::spatial::Force`]) with `A`, `C`
+//! symmetric: 21 numbers, of which only the upper triangles of `A` and `C` are computed (the
+//! lower ones are the same values). A rigid body is `A = Ī`, `B = h̃`, `C = m 1`, so its
+//! literal zeros fold away in a trace, and a leaf body's `I^a` is a constant of the model.
+//! `Xup_iᵀ I^a Xup_i` is a rotation of the three blocks by `E` (`EᵀAE`, `EᵀBE`, `EᵀCE`), then a
+//! shift by `r`: `C'' = C'`, `B'' = B' + r̃ C'`, `A'' = A' + r̃ B''ᵀ + (r̃ B'ᵀ)ᵀ`
+//! (`= A' − B' r̃ + r̃ B'ᵀ − r̃ C' r̃`). A joint on a fixed base carries nothing to it, so its
+//! `I^a`, `p^a` are not formed, nor is `S_i q̈_i` added to a leaf's acceleration. One division
+//! per joint (`D_i⁻¹`, a constant for a leaf), and on a free-floating base six more in the
+//! LDLᵀ of the base's `6×6` articulated inertia ([`crate::ldlt`]).
+//!
+//! # Cost against LDLᵀ on the mass matrix
+//!
+//! Emitted operations (`mul + add` after folding, common-subexpression and dead-code
+//! elimination; divisions apart) of the generated `forward_dynamics`: fixed base, no gravity,
+//! regrouped parameters (`kanegen_codegen`'s defaults). LDLᵀ on the CRBA's `M` and the RNEA's
+//! `c`; LDLᵀ as the generator pairs it, with its cheapest mass-matrix method and its cheapest
+//! bias method (on the random chains the classical Newton–Euler at N = 4, the base-frame CRBA
+//! and the paper's bias recursion from N = 8); this algorithm. The random chains are `random_chain(N, seed 1000 + N)` of
+//! `benches/data` (general geometry: dense rotations, skew axes). `codegen/tests/aba.rs` measures
+//! them again and fails when this table is stale.
+//!
+//! | model | N | LDLᵀ, CRBA + RNEA | LDLᵀ, cheapest | ABA | div (cheapest LDLᵀ / ABA) | emitted |
+//! |---|---:|---:|---:|---:|---:|---|
+//! | SSRMS (Nguyen & Hughes 1994) | 7 | 945 | 862 | 944 | 7 / 5 | LDLᵀ |
+//! | random chain | 4 | 1896 | 1764 | 2418 | 4 / 3 | LDLᵀ |
+//! | random chain | 8 | 5316 | 4401 | 5710 | 8 / 7 | LDLᵀ |
+//! | random chain | 16 | 15548 | 11513 | 12294 | 16 / 15 | LDLᵀ |
+//! | random chain | 32 | 53164 | 37129 | 25462 | 32 / 31 | ABA |
+//! | random chain | 64 | 225676 | 162601 | 51798 | 64 / 63 | ABA |
+//!
+//! On the random chains ABA costs `823 N − 874` exactly (823 per joint, of which 324 carry
+//! `I^a` to the parent through a dense rotation), LDLᵀ grows like `N³/6` on top of the mass
+//! matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is cheaper than LDLᵀ on
+//! the CRBA and the RNEA from **N = 10** (7356 against 7426), and than the generator's cheapest
+//! LDLᵀ from **N = 19** (14763 against 15016), which is where generated code switches to it;
+//! at N = 64 it needs 3.1× fewer operations. SSRMS is close already at N = 7 (ABA 944 against
+//! 945 for LDLᵀ on the CRBA and the RNEA), but LDLᵀ with the classical Newton–Euler bias costs
+//! 862 and is emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
+//! and its joint placements signed permutations and offsets along one axis, which fold. A
+//! free-floating base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: the 7-dof
+//! free-flyer of `kanegen-generated` emits ABA (2898 against 3086 for its cheapest LDLᵀ, its
+//! axes being coordinate axes too). The
+//! leaf's `D` is a constant of the model, hence `N − 1` divisions.
+//!
+//! ```
+//! use kanegen_dynamics::algorithms::aba;
+//! use kanegen_dynamics::{Loads, Methods, Params};
+//! use kanegen_model::random::{random_tree, ChainSpec};
+//! let tree = random_tree(&ChainSpec { n: 5, prismatic_fraction: 0.4, ..Default::default() }, 3);
+//! let p = Params::<f64>::new(&tree);
+//! let (q, qd) = ([0.1, -0.4, 0.9, 0.3, -1.2], [0.5, 0.2, -0.3, 0.1, 0.7]);
+//! let loads = Loads { tau: Some(vec![1.0, -2.0, 0.5, 0.0, 3.0]), ..Loads::default() };
+//! // The same q̈ as LDLᵀ on the CRBA mass matrix and the RNEA bias.
+//! let qdd = aba::forward_dynamics(&p, &q, &qd, &loads);
+//! let want = Methods::SPATIAL.forward_dynamics(&p, &q, &qd, &loads);
+//! assert!(qdd.iter().zip(&want).all(|(x, y)| (x - y).abs() < 1e-9 * (1.0 + y.abs())));
+//! ```
+
+use crate::algorithms::rnea::subtract_external;
+use crate::base::{FloatingBase, FloatingState, BASE_BODY, FLOATING_BASE_DOF};
+use crate::joint::{s_times, s_tr, xup};
+use crate::linalg::{Mat3, Vec3};
+use crate::loads::{LoadFrame, Loads};
+use crate::params::{JointParams, Params};
+use crate::scalar::Scalar;
+use crate::spatial::{Force, Motion, RbInertia, Xform};
+use kanegen_model::JointKind;
+
+/// A symmetric 3×3 matrix from its upper triangle `f(r, c)`, `r ≤ c` (mirrored, not recomputed).
+fn symmetric<S: Scalar>(f: impl Fn(usize, usize) -> S) -> Mat3<S> {
+    let mut m = Mat3::zero();
+    for r in 0..3 {
+        for c in r..3 {
+            let x = f(r, c);
+            m.0[c][r] = x.clone();
+            m.0[r][c] = x;
+        }
+    }
+    m
+}
+
+/// An articulated-body inertia `[A B; Bᵀ C]` (`A`, `C` symmetric), acting on a motion `[ω; v]`
+/// as `[A ω + B v; Bᵀ ω + C v]` (RBDA §7.1).
+#[derive(Clone, Debug)]
+struct Articulated<S> {
+    a: Mat3<S>,
+    b: Mat3<S>,
+    c: Mat3<S>,
+}
+
+impl<S: Scalar> Articulated<S> {
+    /// A rigid body's inertia: `A = Ī`, `B = h̃`, `C = m 1` (RBDA eq. (2.63)).
+    fn rigid(i: &RbInertia<S>) -> Self {
+        Articulated {
+            a: i.ibar.clone(),
+            b: Mat3::skew(&i.h),
+            c: Mat3::identity().scale(&i.m),
+        }
+    }
+
+    /// `I^A m`.
+    fn mul(&self, m: &Motion<S>) -> Force<S> {
+        Force {
+            ang: self.a.mul_vec(&m.ang) + self.b.mul_vec(&m.lin),
+            lin: self.b.tr_mul_vec(&m.ang) + self.c.mul_vec(&m.lin),
+        }
+    }
+
+    /// `I^A S_j` (only the non-zero half of `S_j` is multiplied).
+    fn times_s(&self, jp: &JointParams<S>) -> Force<S> {
+        let x = &jp.axis;
+        match jp.kind {
+            JointKind::Revolute => Force {
+                ang: self.a.mul_vec(x),
+                lin: self.b.tr_mul_vec(x),
+            },
+            JointKind::Prismatic => Force {
+                ang: self.b.mul_vec(x),
+                lin: self.c.mul_vec(x),
+            },
+        }
+    }
+
+    /// `I^a = I^A − U Wᵀ` for `W = U D⁻¹` (symmetric: `U Wᵀ = U Uᵀ D⁻¹`). `I^a S = 0`
+    /// exactly; when `S` is a coordinate axis `e_k` of `[ω; v]` (`k` of 0..6:
+    /// [`crate::JointParams::coordinate_axis`], `+ 3` for a prismatic joint), its row and
+    /// column are those zeros, written as such.
+    fn minus_outer(&self, u: &Force<S>, w: &Force<S>, zero: Option<usize>) -> Self {
+        let z = |r: usize, c: usize| zero.is_some_and(|k| k == r || k == c);
+        let entry = |z: bool, x: &S, ur: S, wc: S| if z { S::zero() } else { x.clone() - ur * wc };
+        Articulated {
+            a: symmetric(|r, c| entry(z(r, c), &self.a.0[r][c], u.ang.at(r), w.ang.at(c))),
+            b: Mat3(core::array::from_fn(|r| {
+                core::array::from_fn(|c| {
+                    entry(z(r, c + 3), &self.b.0[r][c], u.ang.at(r), w.lin.at(c))
+                })
+            })),
+            c: symmetric(|r, c| entry(z(r + 3, c + 3), &self.c.0[r][c], u.lin.at(r), w.lin.at(c))),
+        }
+    }
+
+    /// `Xᵀ I^A X`: from the child's coordinates to the parent's, `X = Xup = [E 0; −E r̃ E]`.
+    /// Rotation `M' = Eᵀ M E` of each block, then the shift by `r` (module docs).
+    fn carried(&self, x: &Xform<S>) -> Self {
+        let e = &x.e;
+        let ae = self.a.mul_mat(e);
+        let a1 = symmetric(|r, c| e.col(r).dot(&ae.col(c)));
+        let be = self.b.mul_mat(e);
+        let b1 = Mat3(core::array::from_fn(|r| {
+            core::array::from_fn(|c| e.col(r).dot(&be.col(c)))
+        }));
+        let ce = self.c.mul_mat(e);
+        let c1 = symmetric(|r, c| e.col(r).dot(&ce.col(c)));
+        // B'' = B' + r̃ C' (column by column: r × C'_c).
+        let rc: [Vec3<S>; 3] = core::array::from_fn(|c| x.r.cross(&c1.col(c)));
+        let b2 = Mat3(core::array::from_fn(|r| {
+            core::array::from_fn(|c| b1.at(r, c) + rc[c].at(r))
+        }));
+        // A'' = A' + r̃ B''ᵀ + (r̃ B'ᵀ)ᵀ: entry (r, c) = A'_rc + (r × B''_row c)_r + (r × B'_row r)_c.
+        let rb2: [Vec3<S>; 3] = core::array::from_fn(|k| x.r.cross(&b2.row(k)));
+        let rb1: [Vec3<S>; 3] = core::array::from_fn(|k| x.r.cross(&b1.row(k)));
+        let a2 = symmetric(|r, c| a1.at(r, c) + rb2[c].at(r) + rb1[r].at(c));
+        Articulated {
+            a: a2,
+            b: b2,
+            c: c1,
+        }
+    }
+}
+
+impl<S: Scalar> core::ops::Add for Articulated<S> {
+    type Output = Self;
+    fn add(self, o: Self) -> Self {
+        // Symmetric blocks: add the upper triangles, mirror.
+        Articulated {
+            a: symmetric(|r, c| self.a.at(r, c) + o.a.at(r, c)),
+            b: self.b + o.b,
+            c: symmetric(|r, c| self.c.at(r, c) + o.c.at(r, c)),
+        }
+    }
+}
+
+/// `Fᵀ m`: a force's power on a motion (`U_iᵀ a'_i`).
+fn power<S: Scalar>(f: &Force<S>, m: &Motion<S>) -> S {
+    f.ang.dot(&m.ang) + f.lin.dot(&m.lin)
+}
+
+/// A floating base's articulated inertia and bias force `(I^A_0, p^A_0)`.
+type Body0<S> = (Articulated<S>, Force<S>);
+
+/// What "body −1" (the fixed or floating base) hands the passes: its velocity, the rotation
+/// `E_0` of base-frame wrenches into its coordinates, and, on a floating base, its own
+/// articulated inertia and bias force (which the joints on the base are added to).
+struct Root<S> {
+    v: Motion<S>,
+    e0: Mat3<S>,
+    floating: Option<Body0<S>>,
+}
+
+/// Pass 1 and 2 results of one joint.
+struct Joint<S> {
+    xup: Xform<S>,
+    c: Motion<S>,
+    u_vec: Force<S>,
+    d_inv: S,
+    u: S,
+}
+
+/// Passes 1 and 2 over the tree: per joint `(Xup, c, U, D⁻¹, u)`, and the root's articulated
+/// inertia and bias force when it is floating.
+fn backward<S: Scalar>(
+    p: &Params<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+    root: Root<S>,
+) -> (Vec<Joint<S>>, Option<Body0<S>>) {
+    let n = p.dof();
+    assert_eq!(q.len(), n, "q has the wrong length");
+    assert_eq!(qd.len(), n, "qd has the wrong length");
+    if let Some(tau) = &loads.tau {
+        assert_eq!(tau.len(), n, "loads.tau has the wrong length");
+    }
+    assert!(
+        loads
+            .external
+            .iter()
+            .all(|e| e.body < n || e.body == BASE_BODY),
+        "an external wrench names a body past the end of the chain"
+    );
+    let need_rot = loads.external.iter().any(|e| e.frame == LoadFrame::Base);
+    let mut xups: Vec<Xform<S>> = Vec::with_capacity(n);
+    let mut vs: Vec<Motion<S>> = Vec::with_capacity(n);
+    let mut cs: Vec<Motion<S>> = Vec::with_capacity(n);
+    let mut e0s: Vec<Mat3<S>> = Vec::with_capacity(if need_rot { n } else { 0 });
+    let mut ia: Vec<Articulated<S>> = Vec::with_capacity(n);
+    let mut pa: Vec<Force<S>> = Vec::with_capacity(n);
+    // Pass 1 (RBDA Table 7.1, first loop).
+    for (j, (jp, (qj, qdj))) in p.joints.iter().zip(q.iter().zip(qd)).enumerate() {
+        let v_parent = jp.parent.map_or(&root.v, |l| &vs[l]);
+        // Xup_j = XJ(q_j) Xtree_j (RBDA §4.4, `jcalc`)
+        let x = xup(jp, qj);
+        // vJ = S_j q̇_j
+        let vj = s_times(jp, qdj);
+        // v_j = Xup_j v_λ + vJ (RBDA eq. (7.34))
+        let carried = x.apply(v_parent);
+        // c_j = cJ + v_j ×ₘ vJ with cJ = 0 (RBDA eq. (7.35)), as (Xup_j v_λ) ×ₘ vJ: vJ ×ₘ vJ = 0
+        cs.push(carried.crm(&vj));
+        let v = carried + vj;
+        // I^A_j = I_j, p^A_j = v_j ×* I_j v_j − f^x_j (RBDA Table 7.1)
+        let inertia = &jp.inertia;
+        let pj = v.crf(&inertia.mul(&v));
+        if need_rot {
+            // E_0j = E_j E_0λ
+            let e0_parent = jp.parent.map_or(&root.e0, |l| &e0s[l]);
+            e0s.push(x.e.mul_mat(e0_parent));
+        }
+        let e0 = if need_rot { &e0s[j] } else { &root.e0 };
+        pa.push(subtract_external(pj, loads, j, e0));
+        ia.push(Articulated::rigid(inertia));
+        vs.push(v);
+        xups.push(x);
+    }
+    let mut base = root.floating;
+    // Pass 2 (RBDA Table 7.1, second loop), leaves first.
+    let mut out: Vec<Option<Joint<S>>> = (0..n).map(|_| None).collect();
+    for j in (0..n).rev() {
+        let jp = &p.joints[j];
+        // U_j = I^A_j S_j (RBDA eq. (7.43))
+        let u_vec = ia[j].times_s(jp);
+        // D_j = S_jᵀ U_j (RBDA eq. (7.44)), inverted once.
+        let d_inv = S::one() / s_tr(jp, &u_vec);
+        // u_j = τ_j − S_jᵀ p^A_j (RBDA eq. (7.45))
+        let spa = s_tr(jp, &pa[j]);
+        let u = match &loads.tau {
+            Some(tau) => tau[j].clone() - spa,
+            None => -spa,
+        };
+        let x = &xups[j];
+        if jp.parent.is_some() || base.is_some() {
+            // W = U_j D_j⁻¹
+            let w = Force {
+                ang: u_vec.ang.scale(&d_inv),
+                lin: u_vec.lin.scale(&d_inv),
+            };
+            // I^a_j = I^A_j − U_j D_j⁻¹ U_jᵀ (RBDA eq. (7.47))
+            let zero = jp.coordinate_axis.map(|k| match jp.kind {
+                JointKind::Revolute => k,
+                JointKind::Prismatic => k + 3,
+            });
+            let i_small = ia[j].minus_outer(&u_vec, &w, zero);
+            // p^a_j = p^A_j + I^a_j c_j + U_j D_j⁻¹ u_j (RBDA eq. (7.48))
+            let p_small = pa[j].clone()
+                + i_small.mul(&cs[j])
+                + Force {
+                    ang: w.ang.scale(&u),
+                    lin: w.lin.scale(&u),
+                };
+            // I^A_λ += Xup_jᵀ I^a_j Xup_j, p^A_λ += Xup_jᵀ p^a_j (RBDA eq. (7.47), (7.48))
+            let (i_up, p_up) = (i_small.carried(x), x.tr_apply(&p_small));
+            match jp.parent {
+                Some(l) => {
+                    ia[l] = ia[l].clone() + i_up;
+                    pa[l] = pa[l].clone() + p_up;
+                }
+                None => {
+                    let (i0, p0) = base.take().expect("a floating root");
+                    base = Some((i0 + i_up, p0 + p_up));
+                }
+            }
+        }
+        out[j] = Some(Joint {
+            xup: xups[j].clone(),
+            c: cs[j].clone(),
+            u_vec,
+            d_inv,
+            u,
+        });
+    }
+    (
+        out.into_iter()
+            .map(|j| j.expect("every joint passed"))
+            .collect(),
+        base,
+    )
+}
+
+/// Pass 3 (RBDA Table 7.1, third loop): `q̈` from the roots' acceleration `a_root`.
+fn accelerations<S: Scalar>(p: &Params<S>, joints: &[Joint<S>], a_root: &Motion<S>) -> Vec<S> {
+    let n = p.dof();
+    let mut has_child = vec![false; n];
+    for jp in &p.joints {
+        if let Some(l) = jp.parent {
+            has_child[l] = true;
+        }
+    }
+    let mut acc: Vec<Motion<S>> = Vec::with_capacity(n);
+    let mut qdd: Vec<S> = Vec::with_capacity(n);
+    for (j, (jp, b)) in p.joints.iter().zip(joints).enumerate() {
+        let a_parent = jp.parent.map_or(a_root, |l| &acc[l]);
+        // a'_j = Xup_j a_λ + c_j
+        let a = b.xup.apply(a_parent) + b.c.clone();
+        // q̈_j = D_j⁻¹ (u_j − U_jᵀ a'_j) (RBDA eq. (7.46))
+        let qj = b.d_inv.clone() * (b.u.clone() - power(&b.u_vec, &a));
+        // a_j = a'_j + S_j q̈_j (only where a child reads it)
+        acc.push(if has_child[j] {
+            a + s_times(jp, &qj)
+        } else {
+            a
+        });
+        qdd.push(qj);
+    }
+    qdd
+}
+
+/// Forward dynamics on a fixed base by the articulated-body algorithm: the joint accelerations
+/// `q̈ = H⁻¹ (τ − C(q, q̇, f_ext))` (the paper's `A⁻¹ b`).
+///
+/// `p`: the model's parameters (any tree; the bodies' [`crate::JointParams::inertia`] is read);
+/// `q`, `q̇`: joint positions and velocities, length `N`; `loads`: the drives `τ` (zero when
+/// absent), gravity `g` in the base frame (the base acceleration `a_0 = [0; −g]`) and external
+/// wrenches (force at `O_j`, moment about `O_j`, in the body's or the base frame), as
+/// [`crate::algorithms::rnea::bias`] takes them. One division per joint. Section `"spatial:aba"`.
+pub fn forward_dynamics<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    S::section("spatial:aba");
+    let root = Root {
+        v: Motion::zero(),
+        e0: Mat3::identity(),
+        floating: None,
+    };
+    let (joints, _) = backward(p, q, qd, loads, root);
+    // a_0 = −a_grav (RBDA §5.3)
+    let a0 = match &loads.gravity {
+        Some(g) => Motion {
+            ang: Vec3::zero(),
+            lin: -g.clone(),
+        },
+        None => Motion::zero(),
+    };
+    accelerations(p, &joints, &a0)
+}
+
+/// Forward dynamics of the tree `p` on the free-floating base `base` by the articulated-body
+/// algorithm (RBDA ch. 9; spatial_v2 `FDfb`): `ν̇ = [v̇_b (3); ω̇_b (3); q̈ (N)] = A⁻¹ b`, the
+/// same layout and conventions as [`crate::algorithms::floating::forward_dynamics`]
+/// ([`crate::base`]: `v̇_b`, `ω̇_b` are the time derivatives of the base-coordinate components
+/// of `v_b` and `ω_b`, i.e. the base's spatial acceleration in base coordinates).
+///
+/// The base is body 0 with a 6-dof joint: `v_0 = [ω_b; v_b]`, `I^A_0 = I_0` (its
+/// [`FloatingBase::inertia`]), `p^A_0 = v_0 ×* I_0 v_0 − f^x_0`; the joints on the base carry
+/// their `I^a`, `p^a` onto it, and `a'_0 = −(I^A_0)⁻¹ p^A_0` by a 6×6 LDLᵀ. Gravity is left
+/// out of the passes (every `a'_i = a_i − a_grav` obeys the same recursion) and put back on the
+/// base: `a_0 = a'_0 + [0; R₀ᵀ g]`. Loads as [`crate::algorithms::rnea::floating_bias`] takes
+/// them (inertial-frame wrenches rotated into body coordinates with `E_0j R₀ᵀ`).
+/// Section `"spatial:aba"`.
+pub fn floating<S: Scalar>(
+    p: &Params<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+) -> Vec<S> {
+    S::section("spatial:aba");
+    let e0 = state.rotation.transpose();
+    let v0 = Motion {
+        ang: state.omega_b.clone(),
+        lin: state.v_b.clone(),
+    };
+    let i0 = base.inertia.clone();
+    // p^A_0 = v_0 ×* I_0 v_0 − f^x_0
+    let p0 = subtract_external(v0.crf(&i0.mul(&v0)), loads, BASE_BODY, &e0);
+    let root = Root {
+        v: v0,
+        e0: e0.clone(),
+        floating: Some((Articulated::rigid(&i0), p0)),
+    };
+    let (joints, base_ab) = backward(p, q, qd, loads, root);
+    let (ia0, pa0) = base_ab.expect("a floating root");
+    // I^A_0 a'_0 = −p^A_0, rows and columns in the order [lin; ang] of ν_b.
+    let ang_lin = |r: usize, c: usize| -> S {
+        match (r < 3, c < 3) {
+            (true, true) => ia0.c.at(r, c),
+            (true, false) => ia0.b.at(c - 3, r),
+            (false, true) => ia0.b.at(r - 3, c),
+            (false, false) => ia0.a.at(r - 3, c - 3),
+        }
+    };
+    let m6: Vec<Vec<S>> = (0..FLOATING_BASE_DOF)
+        .map(|r| (0..FLOATING_BASE_DOF).map(|c| ang_lin(r, c)).collect())
+        .collect();
+    let rhs: Vec<S> = crate::spatial::base_rows(&pa0)
+        .into_iter()
+        .map(|x| -x)
+        .collect();
+    let x = crate::ldlt::solve(&crate::ldlt::ldlt(&m6), &rhs);
+    let a0 = Motion {
+        ang: Vec3::new(x[3].clone(), x[4].clone(), x[5].clone()),
+        lin: Vec3::new(x[0].clone(), x[1].clone(), x[2].clone()),
+    };
+    let qdd = accelerations(p, &joints, &a0);
+    // a_0 = a'_0 + a_grav, a_grav = [0; R₀ᵀ g] in base coordinates.
+    let lin = match &loads.gravity {
+        Some(g) => a0.lin + e0.mul_vec(g),
+        None => a0.lin,
+    };
+    let mut out: Vec<S> = lin.0.into_iter().chain(a0.ang.0).collect();
+    out.extend(qdd);
+    out
+}
