@@ -6,7 +6,7 @@
 //!
 //! | feature | what it adds |
 //! |---|---|
-//! | (none) | [`dynamics!`] and its runtime support (`libm`): builds for `#![no_std]` targets |
+//! | (none) | [`dynamics!`], [`scene!`] and their runtime support (`libm`, [`ode`]): builds for `#![no_std]` targets |
 //! | `std` | the library crates: [`model`] (robots as plain data, URDF/TOML readers), [`dynamics`] (algorithms generic over the scalar), [`trace`] (the counting tracer, Table 1), [`codegen`] (the emitter), [`sim`] (scenes, integrators) |
 //! | `nalgebra` | [`nalgebra`](crate::nalgebra) conversions of generated arrays (f64 and f32) |
 //! | `cli` (default) | the `kanegen` command line, and [`cli`] |
@@ -78,10 +78,57 @@ macro_rules! dynamics {
     };
 }
 
-/// Support for the code emitted by [`dynamics!`]; not a public API.
+/// A simulator specialized at compile time for one scene file (README, "Simulation scenes").
+///
+/// `scene!(Name, "scenes/x.toml")` reads the scene as `kanegen simulate` does
+/// (`kanegen::sim::scene`) and defines:
+///
+/// - `NameDynamics`, the [`dynamics!`] of the scene's model with the scene's base, gravity and
+///   payload (plus one frame `scene_wrench_K` on each body loaded by an inertial-frame wrench,
+///   or by any wrench with a computed-torque drive);
+/// - `NameState`, the state in fixed-size arrays: `q` and `qd` (`N` each) on a fixed base; on a
+///   free-floating base the free-flyer layout `q = [p₀, quaternion x y z w, joints]`,
+///   `v = [v_b, ω_b, q̇]` (base coordinates), with `to_array`/`from_array` for the flat vector
+///   `[q, v]` of the interpreted simulator;
+/// - `pub struct Name;` with `N`, `DIM`, `DURATION`, `STEP`, `TOLERANCE`, `OUTPUT_EVERY`,
+///   `initial_state()`, `rhs(t, &state)` (the derivative, same layout; only the effects the
+///   scene names: its drives — constant, PD or computed torque —, joint damping, constant or
+///   tabulated wrenches in the body or inertial frame, gravity), `step(t, &mut state, h)` (one
+///   step of the scene's fixed-step integrator: RK4, the quaternion renormalized, or the implicit
+///   midpoint rule; RK4 for a dopri5 scene) and `run(|t, &state| …)`, which integrates over the
+///   scene's duration with the scene's integrator — fixed-step RK4, the Lie-group implicit
+///   midpoint rule, or for `integrator = "dopri5"` the adaptive Dormand–Prince 5(4) with the
+///   scene's tolerance and its dense output ([`ode`]) — calling the observer at the scene's
+///   output times.
+///
+/// The code is allocation-free, panic-free and `no_std`, and agrees with the interpreted
+/// simulator to the rounding of the right-hand side (`tests/scene_macro.rs`). The scene's
+/// `simulation.algorithm` only selects how the interpreted simulator evaluates the dynamics: the
+/// generated functions use the cheapest method (the same values to rounding). A computed-torque
+/// drive compensates constant wrenches through the generated Jacobians (`τ −= Jᵀ w`). The one
+/// scene feature the generated simulator does not reproduce — a tabulated wrench with a
+/// computed-torque drive, which the interpreted controller compensates at its `t = 0` value — and
+/// every scene error are compile errors naming the key and the file.
+///
+/// ```
+/// kanegen::scene!(Srms, "scenes/srms.toml");
+/// let mut last = Srms::initial_state();
+/// let stats = Srms::run(|_t, s| last = *s).unwrap();
+/// assert!(stats.steps > 0 && (last.q[0] - 0.4).abs() < 0.05);
+/// ```
+#[macro_export]
+macro_rules! scene {
+    ($($input:tt)*) => {
+        $crate::__private::scene!($crate; $($input)*);
+    };
+}
+
+pub mod ode;
+
+/// Support for the code emitted by [`dynamics!`] and [`scene!`]; not a public API.
 #[doc(hidden)]
 pub mod __private {
-    pub use kanegen_macros::dynamics;
+    pub use kanegen_macros::{dynamics, scene};
     pub use libm;
 }
 

@@ -1,9 +1,13 @@
 //! `dynamics!` rejects bad models at compile time with the reader's message at the path literal,
-//! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`, `algorithm = "fastest"`, an unknown key) at the option.
+//! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`,
+//! `algorithm = "fastest"`, an unknown key) at the option; `scene!` rejects a bad scene key (the
+//! scene reader's message) and a feature it does not generate (a tabulated wrench with a
+//! computed-torque drive), naming the key and the scene file, at the path literal.
 //!
 //! trybuild compiles each case in its own project, `<target>/tests/trybuild/kanegen`, whose
 //! `CARGO_MANIFEST_DIR` is that directory: the bad models of `tests/data/codegen/bad/` are copied
-//! there first, and the cases name them relative to it (`bad/…`).
+//! there first, and the cases name them relative to it (`bad/…`); the scenes there name
+//! `models/two_link.toml`, copied next to `bad/`.
 
 use std::path::Path;
 
@@ -19,6 +23,12 @@ fn dynamics_macro_errors() {
         let e = e.unwrap();
         std::fs::copy(e.path(), project.join(e.file_name())).unwrap();
     }
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    std::fs::copy(
+        root.join("models/two_link.toml"),
+        project.parent().unwrap().join("two_link.toml"),
+    )
+    .unwrap();
     let t = trybuild::TestCases::new();
     t.compile_fail("tests/ui/*.rs");
 }

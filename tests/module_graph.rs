@@ -1,8 +1,9 @@
 //! The structure shows the pipeline: dependencies run one way.
 //!
 //! - **Crates** (`cargo metadata`): each library crate depends only on the crates before it in
-//!   model → dynamics → trace → codegen → macros, with the simulator beside the tracer; only the
-//!   facade depends on the CLI (an optional dependency, for the `kanegen` binary).
+//!   model → dynamics → trace → codegen → macros, with the simulator beside the tracer (the
+//!   macros read scenes through it); only the facade depends on the CLI (an optional
+//!   dependency, for the `kanegen` binary).
 //! - **Modules**: within every crate, no module uses a module that uses it back. Every path that
 //!   starts with `crate::`, `super::` or `self::` — in `use` items and in code — is resolved to
 //!   the longest module path it names; a `mod` declaration is not a use, and the crate root
@@ -39,7 +40,8 @@ fn allowed(name: &str) -> &'static [&'static str] {
         "kanegen-dynamics" => &["kanegen-model"],
         "kanegen-trace" | "kanegen-sim" => &["kanegen-model", "kanegen-dynamics"],
         "kanegen-codegen" => &["kanegen-model", "kanegen-dynamics", "kanegen-trace"],
-        "kanegen-macros" => &["kanegen-codegen"],
+        // `scene!` reads scenes with the simulator's parser (sim comes before macros).
+        "kanegen-macros" => &["kanegen-codegen", "kanegen-sim"],
         "kanegen-cli" => &[
             "kanegen-model",
             "kanegen-dynamics",

@@ -1,6 +1,6 @@
 //! The `kanegen` facade without default features is `no_std`: its normal dependencies are only
-//! the macro crate and `libm`, and a `#![no_std]` crate with one `dynamics!` builds — for the
-//! host, and for `thumbv7em-none-eabihf` (no standard library exists there) when that target is
+//! the macro crate and `libm`, and a `#![no_std]` crate with one `dynamics!` and one `scene!`
+//! builds — for the host, and for `thumbv7em-none-eabihf` (no standard library exists there) when that target is
 //! installed (`.ci/run` installs it; without it the cross build is skipped with a printed reason).
 
 use std::path::{Path, PathBuf};

@@ -487,9 +487,11 @@ fn format_body(tokens: &TokenStream) -> Result<String, Error> {
     Ok(body[..end].concat())
 }
 
-/// The model crate, re-exported for the proc-macro (readers, validation).
+/// The dynamics crate, re-exported for the proc-macro (`scene!`: wrench frames, the base body).
 pub use kanegen_dynamics;
+/// The model crate, re-exported for the proc-macro (readers, validation).
 pub use kanegen_model;
+
 /// The private `mul_add` of [`Options::target_fma`]: one fused instruction where the build
 /// targets it, `a·b + c` (two roundings, bit-identical to unfused code) elsewhere.
 fn mul_add_fn(float: Float) -> TokenStream {

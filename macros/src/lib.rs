@@ -1,10 +1,14 @@
 //! # kanegen-macros
 //!
 //! The `dynamics!` proc-macro: unrolled, allocation-free dynamics code for a fixed model, emitted
-//! at compile time by [`kanegen_codegen`]. Use it through the `kanegen` facade
-//! (`kanegen::dynamics!`), a `macro_rules!` wrapper that passes its own path (`$crate`) first,
-//! so the generated code calls the facade's `libm` however the user names the dependency.
+//! at compile time by [`kanegen_codegen`]; and `scene!`, a simulator specialized for one scene
+//! file (`scene`). Use them through the `kanegen` facade (`kanegen::dynamics!`,
+//! `kanegen::scene!`), `macro_rules!` wrappers that pass the facade's path (`$crate`) first, so
+//! the generated code calls the facade's `libm` and integrators however the user names the
+//! dependency.
 #![warn(missing_docs)]
+
+mod scene;
 
 use proc_macro::TokenStream;
 use proc_macro2::Span;
@@ -211,4 +215,44 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
         const _: &[u8] = include_bytes!(#abs_lit);
         #items
     })
+}
+
+struct SceneInput {
+    runtime: syn::Path,
+    name: Ident,
+    path: LitStr,
+}
+
+impl Parse for SceneInput {
+    fn parse(input: ParseStream) -> syn::Result<Self> {
+        let runtime: syn::Path = input.parse()?;
+        input.parse::<Token![;]>()?;
+        let name: Ident = input.parse()?;
+        input.parse::<Token![,]>()?;
+        let path: LitStr = input.parse()?;
+        input.parse::<Option<Token![,]>>()?;
+        if !input.is_empty() {
+            return Err(input.error(
+                "scene! takes a type name and a scene path only (the scene file holds the options)",
+            ));
+        }
+        Ok(SceneInput {
+            runtime,
+            name,
+            path,
+        })
+    }
+}
+
+/// The implementation of `kanegen::scene!` (documented there): `scene!(RUNTIME; Name,
+/// "path")`, where `RUNTIME` is the path of the `kanegen` facade.
+#[proc_macro]
+pub fn scene(input: TokenStream) -> TokenStream {
+    let input = syn::parse_macro_input!(input as SceneInput);
+    match scene::expand(&input.runtime, &input.name, &input.path.value()) {
+        Ok(ts) => ts.into(),
+        Err(msg) => syn::Error::new(input.path.span(), msg)
+            .to_compile_error()
+            .into(),
+    }
 }

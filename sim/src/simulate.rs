@@ -19,6 +19,24 @@ use serde::Serialize;
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
 
+/// The progress bar of a run: `indicatif`'s with the `progress` feature (default).
+#[cfg(feature = "progress")]
+pub use indicatif::ProgressBar;
+
+/// Without the `progress` feature there is no progress bar: this type has no values, so
+/// [`Control::progress`] and the argument of [`simulate`] can only be `None`.
+#[cfg(not(feature = "progress"))]
+#[derive(Debug)]
+pub enum ProgressBar {}
+
+#[cfg(not(feature = "progress"))]
+impl ProgressBar {
+    /// Never called (there is no value to call it on).
+    pub fn set_position(&self, _pos: u64) {
+        match *self {}
+    }
+}
+
 /// A scene as a first-order system for the integrators.
 pub struct SceneSystem<'a> {
     scene: &'a Scene,
@@ -448,7 +466,7 @@ impl<F: FnMut(&Sample) -> Result<()>> Sink for F {
 #[derive(Clone, Copy, Default)]
 pub struct Control<'a> {
     /// Advanced to the simulated time in milliseconds.
-    pub progress: Option<&'a indicatif::ProgressBar>,
+    pub progress: Option<&'a ProgressBar>,
     /// When set (by a Ctrl-C handler), the run stops after the current step and the summary says
     /// `complete: false`, `stopped: "interrupted"`.
     pub stop: Option<&'a AtomicBool>,
@@ -657,7 +675,7 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
 ///
 /// # Errors
 /// If the run did not complete (the integrator's error).
-pub fn simulate(scene: &Scene, progress: Option<&indicatif::ProgressBar>) -> Result<Run> {
+pub fn simulate(scene: &Scene, progress: Option<&ProgressBar>) -> Result<Run> {
     let mut samples: Vec<Sample> = Vec::new();
     let mut sink = |s: &Sample| -> Result<()> {
         samples.push(s.clone());

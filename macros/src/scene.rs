@@ -1,0 +1,614 @@
+//! The expansion of `kanegen::scene!`: a simulator specialized at compile time for one scene file
+//! (`kanegen_sim::scene`, the parser the interpreted simulator uses).
+//!
+//! It emits the scene model's generated dynamics ([`kanegen_codegen::generate_items`], type
+//! `NameDynamics`, with the scene's base, gravity and payload), a state type `NameState` and
+//! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
+//! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
+//! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
+//! `kanegen_sim::integrate`. The scene feature the generated simulator does not reproduce (a
+//! tabulated wrench with a computed-torque drive) is a compile error naming the key and the
+//! scene file.
+
+use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
+use kanegen_sim::scene::{BaseSpec, Drives, Integrator, Scene, WrenchProfile};
+use proc_macro2::{Literal, Span, TokenStream};
+use quote::{format_ident, quote};
+use syn::{Ident, LitStr};
+
+/// `f64` literal.
+fn lit(x: f64) -> Literal {
+    Literal::f64_suffixed(x)
+}
+
+fn arr(v: &[f64]) -> TokenStream {
+    let v = v.iter().map(|x| lit(*x));
+    quote!([#(#v),*])
+}
+
+fn rows(v: &[[f64; 3]]) -> TokenStream {
+    let v = v.iter().map(|r| arr(r));
+    quote!([#(#v),*])
+}
+
+/// The items of `scene!(runtime; name, "rel")`; `Err` is the compile error's message.
+pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStream, String> {
+    let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
+    let path = std::path::Path::new(&dir).join(rel);
+    let abs = path.display().to_string();
+    let scene_dir = path.parent().unwrap_or(std::path::Path::new("."));
+    let clean = |s: String| {
+        s.replace(&abs, rel)
+            .replace(&format!("{}/", scene_dir.display()), "")
+    };
+    let scene = Scene::load(&path).map_err(|e| clean(format!("{e:#}")))?;
+    let text = std::fs::read_to_string(&path).map_err(|e| format!("{rel}: {e}"))?;
+    let model_path = Scene::model_path(&text, scene_dir)
+        .ok_or_else(|| format!("{rel}: model: no model path"))?;
+    let unsupported = |key: &str, why: &str| -> Result<(), String> {
+        Err(format!(
+            "{rel}: `{key}` is not supported by scene! ({why}); run this scene with \
+             `kanegen simulate {rel}`"
+        ))
+    };
+    let sim = &scene.simulation;
+    let computed_torque = matches!(scene.drives, Drives::ComputedTorque { .. });
+    if computed_torque {
+        if let Some(k) = scene.wrenches.iter().position(|w| w.is_tabulated()) {
+            unsupported(
+                &format!("effects.wrench[{k}].time with drives.type = \"computed-torque\""),
+                "the interpreted controller compensates a tabulated wrench at its t = 0 value; \
+                 constant wrenches are supported",
+            )?;
+        }
+    }
+
+    // The model: the scene's payload is merged already; its base kind and inertial are the
+    // scene's; one identity frame on each body loaded by an inertial-frame wrench gives the
+    // body's rotation (its generated `<frame>_placement`); with a computed-torque drive every
+    // wrench gets one, whose Jacobian maps the wrench to the joints.
+    let floating = scene.is_floating();
+    let mut model = scene.model.clone();
+    if let BaseSpec::FreeFloating { inertial, .. } = &scene.base {
+        if model.base_inertial() != Some(inertial) {
+            model = model
+                .with_base_inertial(inertial.clone())
+                .map_err(|e| format!("{rel}: base: {e}"))?;
+        }
+    }
+    let kind = if floating {
+        BaseKind::FreeFloating
+    } else {
+        BaseKind::Fixed
+    };
+    model = model
+        .with_base_kind(kind)
+        .map_err(|e| format!("{rel}: base: {e}"))?;
+    let mut frames: Vec<Frame> = model.frames().to_vec();
+    let mut wrench_frames = Vec::new();
+    for (k, w) in scene.wrenches.iter().enumerate() {
+        let needs = (w.frame == kanegen_codegen::kanegen_dynamics::LoadFrame::Base
+            || computed_torque)
+            && w.body != kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
+        if needs {
+            let fname = format!("scene_wrench_{k}");
+            frames.push(Frame {
+                name: fname.clone(),
+                parent: Some(w.body),
+                placement: Placement::default(),
+            });
+            wrench_frames.push(Some(fname));
+        } else {
+            wrench_frames.push(None);
+        }
+    }
+    let model = model
+        .with_frames(frames)
+        .map_err(|e| format!("{rel}: model frames: {e}"))?;
+
+    let dyn_name = format!("{name}Dynamics");
+    let dyn_ty = format_ident!("{}", dyn_name);
+    let mut opts = kanegen_codegen::Options::new(dyn_name.clone());
+    opts.gravity = scene.gravity;
+    opts.base = Some(kind);
+    opts.libm_path = "kanegen::__private::libm".into();
+    opts.libm_tokens = Some(quote!(#runtime::__private::libm));
+    opts.payload_name = format!("{dyn_name}Payload");
+    opts.op_count_name = format!("{dyn_name}OpCount");
+    let g = kanegen_codegen::generate_items(&model, &opts).map_err(|e| format!("{rel}: {e}"))?;
+    let dyn_items = g.items;
+
+    let n = model.dof();
+    let nl = Literal::usize_unsuffixed(n);
+    let state_ty = format_ident!("{}State", name);
+    let (nq, nv) = if floating { (n + 7, n + 6) } else { (n, n) };
+    let (nql, nvl) = (Literal::usize_unsuffixed(nq), Literal::usize_unsuffixed(nv));
+    let dim = Literal::usize_unsuffixed(nq + nv);
+    let vname = if floating {
+        format_ident!("v")
+    } else {
+        format_ident!("qd")
+    };
+
+    // Joint positions and rates inside `rhs` (`s` the state).
+    let (qj, qdj) = if floating {
+        (
+            quote!(let qj: [f64; #nl] = core::array::from_fn(|i| s.q[7 + i]);),
+            quote!(let qdj: [f64; #nl] = core::array::from_fn(|i| s.v[6 + i]);),
+        )
+    } else {
+        (quote!(let qj = s.q;), quote!(let qdj = s.qd;))
+    };
+
+    // A computed-torque drive compensates the (constant) wrenches as the interpreted inverse
+    // dynamics does: `τ −= J_vᵀ f + J_ωᵀ m`, force and moment in base axes at the body origin
+    // (fixed base only: the scene rejects computed torque on a free-floating base).
+    let mut compensate = Vec::new();
+    if computed_torque {
+        for (k, w) in scene.wrenches.iter().enumerate() {
+            let WrenchProfile::Constant { force, moment } = &w.profile else {
+                continue;
+            };
+            let Some(fname) = &wrench_frames[k] else {
+                return Err(format!("{rel}: effects.wrench[{k}]: no frame"));
+            };
+            let (pl, jac) = (
+                format_ident!("{}_placement", fname),
+                format_ident!("{}_jacobian", fname),
+            );
+            let (f, m) = (arr(force), arr(moment));
+            let to_base = if w.frame == kanegen_codegen::kanegen_dynamics::LoadFrame::Body {
+                quote! {
+                    let r = #dyn_ty::#pl(&qj).1;
+                    let (f, m): ([f64; 3], [f64; 3]) = (
+                        core::array::from_fn(|i| r[i][0] * f[0] + r[i][1] * f[1] + r[i][2] * f[2]),
+                        core::array::from_fn(|i| r[i][0] * m[0] + r[i][1] * m[1] + r[i][2] * m[2]),
+                    );
+                }
+            } else {
+                quote!()
+            };
+            compensate.push(quote! {{
+                let (f, m): ([f64; 3], [f64; 3]) = (#f, #m);
+                #to_base
+                let jac = #dyn_ty::#jac(&qj);
+                for j in 0..#nl {
+                    tau[j] -= jac[0][j] * f[0] + jac[1][j] * f[1] + jac[2][j] * f[2]
+                        + jac[3][j] * m[0] + jac[4][j] * m[1] + jac[5][j] * m[2];
+                }
+            }});
+        }
+    }
+
+    // Drives and damping: τ as the interpreted `SceneSystem::torques`.
+    let drives = match &scene.drives {
+        Drives::None => quote!(let mut tau = [0.0f64; #nl];),
+        Drives::Constant { tau } => {
+            let t = arr(tau);
+            quote!(let mut tau: [f64; #nl] = #t;)
+        }
+        Drives::Pd { kp, kd, target } => {
+            let (kp, kd, target) = (arr(kp), arr(kd), arr(target));
+            quote! {
+                const KP: [f64; #nl] = #kp;
+                const KD: [f64; #nl] = #kd;
+                const TARGET: [f64; #nl] = #target;
+                let mut tau: [f64; #nl] =
+                    core::array::from_fn(|i| KP[i] * (TARGET[i] - qj[i]) - KD[i] * qdj[i]);
+            }
+        }
+        Drives::ComputedTorque {
+            kp,
+            kd,
+            target,
+            duration,
+        } => {
+            let (kp, kd, target, q0) = (arr(kp), arr(kd), arr(target), arr(&scene.q0));
+            let d = lit(*duration);
+            quote! {
+                const KP: [f64; #nl] = #kp;
+                const KD: [f64; #nl] = #kd;
+                const TARGET: [f64; #nl] = #target;
+                const Q0: [f64; #nl] = #q0;
+                let (sq, dsq, ddsq) = #runtime::ode::quintic(t, #d);
+                let cmd: [f64; #nl] = core::array::from_fn(|i| {
+                    let di = TARGET[i] - Q0[i];
+                    ddsq * di + KD[i] * (dsq * di - qdj[i]) + KP[i] * ((Q0[i] + sq * di) - qj[i])
+                });
+                let mut tau: [f64; #nl] = #dyn_ty::inverse_dynamics(&qj, &qdj, &cmd);
+                #(#compensate)*
+            }
+        }
+    };
+    let damping = match &scene.damping {
+        None => quote!(),
+        Some(c) => {
+            let c = arr(c);
+            quote! {
+                const DAMPING: [f64; #nl] = #c;
+                for i in 0..#nl {
+                    tau[i] -= DAMPING[i] * qdj[i];
+                }
+            }
+        }
+    };
+
+    // Wrenches: each in its body's frame at the body origin, summed per body (`f_ext` row; on a
+    // free-floating base row 0 is the base's).
+    let rows_n = Literal::usize_unsuffixed(n + usize::from(floating));
+    let mut wrench_code = Vec::new();
+    for (k, w) in scene.wrenches.iter().enumerate() {
+        let value = match &w.profile {
+            WrenchProfile::Constant { force, moment } => {
+                let (f, m) = (arr(force), arr(moment));
+                quote!((#f, #m))
+            }
+            WrenchProfile::Table {
+                time,
+                force,
+                moment,
+            } => {
+                let kl = Literal::usize_unsuffixed(time.len());
+                let (tt, f, m) = (arr(time), rows(force), rows(moment));
+                quote! {{
+                    const TIME: [f64; #kl] = #tt;
+                    const FORCE: [[f64; 3]; #kl] = #f;
+                    const MOMENT: [[f64; 3]; #kl] = #m;
+                    #runtime::ode::table(t, &TIME, &FORCE, &MOMENT)
+                }}
+            }
+        };
+        let is_base = w.body == kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
+        let row = Literal::usize_unsuffixed(if is_base {
+            0
+        } else {
+            w.body + usize::from(floating)
+        });
+        // Body-to-reference rotation of an inertial-frame wrench.
+        let rot = match (&wrench_frames[k], is_base, w.frame) {
+            (_, _, kanegen_codegen::kanegen_dynamics::LoadFrame::Body) => None,
+            (Some(fname), _, _) => {
+                let pl = format_ident!("{}_placement", fname);
+                Some(quote!(#dyn_ty::#pl(&s.q).1))
+            }
+            (None, true, _) => Some(quote!(#runtime::ode::quat_to_matrix(&[
+                s.q[3], s.q[4], s.q[5], s.q[6]
+            ]))),
+            (None, false, _) => return Err(format!("{rel}: effects.wrench[{k}]: no frame")),
+        };
+        let apply = match rot {
+            None => quote! {
+                for i in 0..3 {
+                    f_ext[#row][i] += f[i];
+                    f_ext[#row][3 + i] += m[i];
+                }
+            },
+            Some(r) => quote! {
+                let r: [[f64; 3]; 3] = #r;
+                for i in 0..3 {
+                    f_ext[#row][i] += r[0][i] * f[0] + r[1][i] * f[1] + r[2][i] * f[2];
+                    f_ext[#row][3 + i] += r[0][i] * m[0] + r[1][i] * m[1] + r[2][i] * m[2];
+                }
+            },
+        };
+        wrench_code.push(quote! {{
+            let (f, m): ([f64; 3], [f64; 3]) = #value;
+            #apply
+        }});
+    }
+    let accel = if scene.wrenches.is_empty() {
+        quote!(#dyn_ty::forward_dynamics(&s.q, &s.#vname, &tau))
+    } else {
+        quote! {{
+            let mut f_ext = [[0.0f64; 6]; #rows_n];
+            #(#wrench_code)*
+            #dyn_ty::forward_dynamics_with_wrenches(&s.q, &s.#vname, &tau, &f_ext)
+        }}
+    };
+    let derivative = if floating {
+        quote! {
+            let a = #accel;
+            let r = #runtime::ode::quat_to_matrix(&[s.q[3], s.q[4], s.q[5], s.q[6]]);
+            let (u, w, om) = ([s.q[3], s.q[4], s.q[5]], s.q[6], [s.v[3], s.v[4], s.v[5]]);
+            let mut dq = [0.0f64; #nql];
+            for i in 0..3 {
+                dq[i] = r[i][0] * s.v[0] + r[i][1] * s.v[1] + r[i][2] * s.v[2];
+            }
+            // q̇uat = ½ quat ⊗ (ω, 0): u̇ = ½ (w ω + u × ω), ẇ = −½ u · ω.
+            let cross = [
+                u[1] * om[2] - u[2] * om[1],
+                u[2] * om[0] - u[0] * om[2],
+                u[0] * om[1] - u[1] * om[0],
+            ];
+            for i in 0..3 {
+                dq[3 + i] = 0.5 * (om[i] * w + cross[i]);
+            }
+            dq[6] = -0.5 * (u[0] * om[0] + u[1] * om[1] + u[2] * om[2]);
+            for i in 0..#nl {
+                dq[7 + i] = qdj[i];
+            }
+            #state_ty { q: dq, v: a }
+        }
+    } else {
+        quote! {
+            let a = #accel;
+            #state_ty { q: s.qd, qd: a }
+        }
+    };
+
+    let x0: Vec<f64> = match &scene.base {
+        BaseSpec::Fixed => [scene.q0.as_slice(), &scene.qd0].concat(),
+        BaseSpec::FreeFloating {
+            position,
+            quaternion,
+            v,
+            omega,
+            ..
+        } => [
+            position.as_slice(),
+            quaternion,
+            &scene.q0,
+            v,
+            omega,
+            &scene.qd0,
+        ]
+        .concat(),
+    };
+    let (q0, v0) = (arr(&x0[..nq]), arr(&x0[nq..]));
+    let project = if floating {
+        quote!(#runtime::ode::normalize_quaternion::<#dim>)
+    } else {
+        quote!(|_: &mut [f64; #dim]| {})
+    };
+    let advance = if floating {
+        quote!(#runtime::ode::advance_floating::<#dim>)
+    } else {
+        quote!(#runtime::ode::advance_additive::<#dim>)
+    };
+    let step_body = if sim.integrator == Integrator::Midpoint {
+        quote! {
+            let mut stats = #runtime::ode::Stats::default();
+            let x = #runtime::ode::midpoint_step(
+                &mut f, #advance, t, &state.to_array(), h, &mut stats,
+            )?;
+        }
+    } else {
+        let first = if floating {
+            quote! {
+                let mut x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);
+                #runtime::ode::normalize_quaternion(&mut x);
+            }
+        } else {
+            quote!(let x = #runtime::ode::rk4_step(&mut f, t, &state.to_array(), h);)
+        };
+        quote! {
+            #first
+            if let Some(index) = x.iter().position(|v| !v.is_finite()) {
+                return Err(#runtime::ode::Stop::NonFinite {
+                    t: t + h,
+                    index,
+                    stats: #runtime::ode::Stats { steps: 0, rejected_steps: 0, evals: 4 },
+                });
+            }
+        }
+    };
+    let (duration, step, tolerance, max_step) = (
+        lit(sim.duration),
+        lit(sim.step),
+        lit(sim.tolerance),
+        lit(sim.max_step),
+    );
+    let every = Literal::usize_unsuffixed(sim.output_every);
+    let run_body = match sim.integrator {
+        Integrator::Dopri5 => quote! {
+            let opts = #runtime::ode::Dopri5Options {
+                tolerance: Self::TOLERANCE,
+                max_step: #max_step,
+                initial_step: Self::STEP,
+                output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
+            };
+            #runtime::ode::dopri5(&mut f, #project, 0.0, Self::DURATION, &opts, &mut x, obs)
+        },
+        Integrator::Rk4 => quote! {
+            let opts = #runtime::ode::Rk4Options {
+                step: Self::STEP,
+                output_every: Self::OUTPUT_EVERY,
+            };
+            #runtime::ode::rk4(&mut f, #project, 0.0, Self::DURATION, &opts, &mut x, obs)
+        },
+        Integrator::Midpoint => quote! {
+            let opts = #runtime::ode::Rk4Options {
+                step: Self::STEP,
+                output_every: Self::OUTPUT_EVERY,
+            };
+            #runtime::ode::midpoint(&mut f, #advance, 0.0, Self::DURATION, &opts, &mut x, obs)
+        },
+    };
+    let integrator_doc = match sim.integrator {
+        Integrator::Dopri5 => format!(
+            " The scene's integrator: adaptive Dormand–Prince 5(4) (`kanegen::ode::dopri5`, \
+             tolerance {:e}, first step {} s, dense output every {} s). [`{name}::step`] is one \
+             fixed RK4 step (an adaptive step has no fixed size).",
+            sim.tolerance,
+            sim.step,
+            sim.step * sim.output_every as f64
+        ),
+        Integrator::Rk4 => format!(
+            " The scene's integrator: fixed-step RK4 (`kanegen::ode::rk4`), step {} s, a sample \
+             every {} steps.",
+            sim.step, sim.output_every
+        ),
+        Integrator::Midpoint => format!(
+            " The scene's integrator: the fixed-step Lie-group implicit midpoint rule \
+             (`kanegen::ode::midpoint`), step {} s, a sample every {} steps.",
+            sim.step, sim.output_every
+        ),
+    };
+    let step_doc = if sim.integrator == Integrator::Midpoint {
+        " One implicit midpoint step of size `h` from `(t, state)` (the scene's integrator)."
+    } else {
+        " One fixed RK4 step of size `h` from `(t, state)`, then the projection (the quaternion \
+         renormalized on a free-floating base)."
+    };
+    let effects = {
+        let mut e = Vec::new();
+        if let Some(g) = scene.gravity {
+            e.push(format!("gravity {g:?}"));
+        }
+        e.push(
+            match &scene.drives {
+                Drives::None => "no drives",
+                Drives::Constant { .. } => "constant drive torques",
+                Drives::Pd { .. } => "joint PD drives",
+                Drives::ComputedTorque { .. } => "computed-torque drives along a quintic",
+            }
+            .to_string(),
+        );
+        if scene.damping.is_some() {
+            e.push("joint viscous damping".into());
+        }
+        if !scene.wrenches.is_empty() {
+            e.push(format!("{} external wrench(es)", scene.wrenches.len()));
+        }
+        e.join(", ")
+    };
+    let struct_doc = format!(
+        " The simulator of scene `{rel}` (model `{}`, N = {n}, {} base): {effects}.",
+        kanegen_codegen::header::doc_safe(model.name()),
+        if floating { "free-floating" } else { "fixed" },
+    );
+    let state_doc = if floating {
+        format!(
+            " The state of [`{name}`]: `q = [p₀ (3), quaternion x y z w (4), joints ({n})]` and \
+             `v = [v_b (3), ω_b (3), q̇ ({n})]` (base coordinates), the free-flyer layout of \
+             [`{dyn_name}`]. A derivative has the same layout (`q` holds `[ṗ₀, q̇uat, q̇]`)."
+        )
+    } else {
+        format!(
+            " The state of [`{name}`]: joint positions `q` and rates `qd` ({n} each). A \
+             derivative has the same layout."
+        )
+    };
+    let vdoc = if floating {
+        " Base linear and angular velocity (base coordinates), joint rates."
+    } else {
+        " Joint rates."
+    };
+    let scene_lit = LitStr::new(&abs, Span::call_site());
+    let model_lit = LitStr::new(&model_path.display().to_string(), Span::call_site());
+    let rel_lit = LitStr::new(rel, Span::call_site());
+    let dim_doc = format!(" Length of the flat state vector ({nq} + {nv}).");
+
+    Ok(quote! {
+        const _: &[u8] = include_bytes!(#scene_lit);
+        const _: &[u8] = include_bytes!(#model_lit);
+
+        #dyn_items
+
+        #[doc = #state_doc]
+        #[derive(Clone, Copy, Debug, PartialEq)]
+        pub struct #state_ty {
+            /// Positions.
+            pub q: [f64; #nql],
+            #[doc = #vdoc]
+            pub #vname: [f64; #nvl],
+        }
+
+        impl #state_ty {
+            /// The state as one vector `[q, v]` (the interpreted simulator's layout).
+            #[must_use]
+            pub fn to_array(&self) -> [f64; #dim] {
+                core::array::from_fn(|i| if i < #nql { self.q[i] } else { self.#vname[i - #nql] })
+            }
+
+            /// The state of a vector `[q, v]`.
+            #[must_use]
+            pub fn from_array(x: &[f64; #dim]) -> Self {
+                #state_ty {
+                    q: core::array::from_fn(|i| x[i]),
+                    #vname: core::array::from_fn(|i| x[#nql + i]),
+                }
+            }
+        }
+
+        #[doc = #struct_doc]
+        #[doc = ""]
+        #[doc = #integrator_doc]
+        #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+        pub struct #name;
+
+        #[allow(clippy::too_many_lines, clippy::unreadable_literal, clippy::excessive_precision)]
+        impl #name {
+            /// Joint degrees of freedom.
+            pub const N: usize = #nl;
+            #[doc = #dim_doc]
+            pub const DIM: usize = #dim;
+            /// The scene file (relative to the crate).
+            pub const SCENE: &'static str = #rel_lit;
+            /// Simulated duration, s.
+            pub const DURATION: f64 = #duration;
+            /// Step (RK4), or first step tried (dopri5), s.
+            pub const STEP: f64 = #step;
+            /// dopri5 tolerance (`rtol = atol`; unused by RK4 scenes).
+            pub const TOLERANCE: f64 = #tolerance;
+            /// An output sample every this many steps (RK4), or every `OUTPUT_EVERY · STEP`
+            /// seconds (dopri5).
+            pub const OUTPUT_EVERY: usize = #every;
+
+            /// The scene's initial state.
+            #[must_use]
+            pub fn initial_state() -> #state_ty {
+                #state_ty { q: #q0, #vname: #v0 }
+            }
+
+            /// The right-hand side `ẋ = f(t, x)` with the scene's effects only.
+            #[must_use]
+            pub fn rhs(t: f64, s: &#state_ty) -> #state_ty {
+                let _ = t;
+                #qj
+                #qdj
+                let _ = (&qj, &qdj);
+                #drives
+                #damping
+                #derivative
+            }
+
+            #[doc = #step_doc]
+            ///
+            /// # Errors
+            /// A `kanegen::ode::Stop` when the new state is not finite (or the midpoint
+            /// iterations do not converge); `state` is then unchanged.
+            pub fn step(
+                t: f64,
+                state: &mut #state_ty,
+                h: f64,
+            ) -> Result<(), #runtime::ode::Stop> {
+                let mut f = |t: f64, x: &[f64; #dim]| {
+                    Self::rhs(t, &#state_ty::from_array(x)).to_array()
+                };
+                #step_body
+                *state = #state_ty::from_array(&x);
+                Ok(())
+            }
+
+            /// Integrates the scene from its initial state over its duration with its
+            /// integrator, calling `observe(t, &state)` at the scene's output times (the
+            /// interpreted simulator's samples), and returns the work done.
+            ///
+            /// # Errors
+            /// A `kanegen::ode::Stop` when the state becomes non-finite (or, dopri5, the step
+            /// size underflows or its error estimate overflows); the observer has seen every
+            /// sample up to there.
+            pub fn run(
+                mut observe: impl FnMut(f64, &#state_ty),
+            ) -> Result<#runtime::ode::Stats, #runtime::ode::Stop> {
+                let mut f = |t: f64, x: &[f64; #dim]| {
+                    Self::rhs(t, &#state_ty::from_array(x)).to_array()
+                };
+                let mut x = Self::initial_state().to_array();
+                let obs = |t: f64, x: &[f64; #dim]| observe(t, &#state_ty::from_array(x));
+                #run_body
+            }
+        }
+    })
+}

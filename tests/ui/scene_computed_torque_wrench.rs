@@ -1,0 +1,3 @@
+kanegen::scene!(Bad, "bad/scene_computed_torque_wrench.toml");
+
+fn main() {}

@@ -1,0 +1,3 @@
+kanegen::scene!(Bad, "bad/scene_unknown_key.toml");
+
+fn main() {}
