@@ -1,5 +1,6 @@
 //! `dynamics!` rejects bad models at compile time with the reader's message at the path literal,
-//! and bad options (`scalar = f16`, `fma_path` without `fma = true`) at the option.
+//! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `form = "rolled"`) at the
+//! option.
 //!
 //! trybuild compiles each case in its own project, `<target>/tests/trybuild/kanegen`, whose
 //! `CARGO_MANIFEST_DIR` is that directory: the bad models of `tests/data/codegen/bad/` are copied

@@ -28,13 +28,14 @@
 
 pub mod api;
 pub mod choose;
+pub mod compact;
 pub mod emit;
 pub mod header;
 mod options;
 
 pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
-pub use options::{Error, Float, Options, VERSION};
+pub use options::{Error, Float, Form, Options, VERSION};
 
 use kanegen_model::{BaseKind, Model};
 use kanegen_trace::{Arg, Function};
@@ -95,6 +96,8 @@ fn generate_items_with(
     let op_ty = ident("op-count name", &opts.op_count_name)?;
     let emitter = Emitter::new(opts)?;
     let fl = opts.float.ty();
+    let decision = form_decision(model, opts)?;
+    let compact = decision.form == Form::Compact;
 
     let mut fns = Vec::new();
     let mut choices = Vec::new();
@@ -108,12 +111,26 @@ fn generate_items_with(
             mass = choice.chosen.mass_matrix;
         }
         let shape = api::shape(f, n, floating);
+        let compact_body = if compact {
+            compact::body(f, opts, n)
+        } else {
+            None
+        };
         let Body {
             tokens: body,
             fmas: k,
-        } = match bodies.as_deref_mut() {
-            None => emit::emit_body(&traced, &emitter, shape),
-            Some(texts) => {
+        } = match (bodies.as_deref_mut(), compact_body.clone()) {
+            (None, Some(tokens)) => Body { tokens, fmas: 0 },
+            (Some(texts), Some(tokens)) => {
+                texts.push(format_body(&tokens)?);
+                let placeholder = format_ident!("__kanegen_body_{}", texts.len() - 1);
+                Body {
+                    tokens: quote!(#placeholder()),
+                    fmas: 0,
+                }
+            }
+            (None, None) => emit::emit_body(&traced, &emitter, shape),
+            (Some(texts), None) => {
                 let mut text = String::new();
                 let mut failed = None;
                 let mut b =
@@ -196,7 +213,13 @@ fn generate_items_with(
         .join(", ");
         let doc2 = format!(
             " {}{methods}: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted){fused}.",
-            if methods.is_empty() { "" } else { "Methods: " },
+            match (compact_body.is_some(), methods.is_empty()) {
+                (true, _) =>
+                    "Compact form: loops over the model's constant tables (RBDA); \
+                              the unrolled form would emit, with ",
+                (false, true) => "",
+                (false, false) => "Methods: ",
+            },
             c.mul,
             c.add,
             c.div,
@@ -245,7 +268,13 @@ fn generate_items_with(
         .flat_map(|ch| ch.candidates.iter().map(|(m, c)| entry(ch, *m, *c, 0)));
     let n_fns = Literal::usize_unsuffixed(choices.len());
 
-    let header = header::lines(model, opts, &choices, &fmas);
+    let mut header = header::lines(model, opts, &choices, &fmas);
+    // The form line after the model's description, before the table of counts.
+    let at = header
+        .iter()
+        .position(|l| l.starts_with("Emitted operation counts per candidate"))
+        .map_or(header.len(), |k| k.saturating_sub(1));
+    header.insert(at, decision.line.clone());
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())
@@ -283,6 +312,11 @@ fn generate_items_with(
         opts.type_name
     );
 
+    let compact_items = if compact {
+        compact::items(model, opts)?
+    } else {
+        quote!()
+    };
     let mul_add_item = if !opts.fma && opts.target_fma && fmas.iter().any(|k| *k > 0) {
         mul_add_fn(opts.float)
     } else {
@@ -327,6 +361,7 @@ fn generate_items_with(
             clippy::many_single_char_names,
             clippy::similar_names,
             clippy::type_complexity,
+            clippy::needless_range_loop,
             unused_parens
         )]
         impl #ty {
@@ -345,6 +380,8 @@ fn generate_items_with(
             #(#fns)*
 
             #mul_add_item
+
+            #compact_items
         }
     };
     Ok(Generated {
@@ -353,6 +390,22 @@ fn generate_items_with(
         choices,
         fmas,
     })
+}
+
+/// The form to emit ([`compact::decide`]): for [`Form::Auto`] from the emitted operations of the
+/// cheapest unrolled `mass_matrix_and_nonlinear_effects`.
+fn form_decision(model: &Model, opts: &Options) -> Result<compact::Decision, Error> {
+    let ops = match (opts.form, compact::unsupported(model, opts)) {
+        (Form::Auto, None) => {
+            let f = Function::MassMatrixAndNonlinearEffects;
+            let (choice, _) =
+                choose::choose(model, f, kanegen_dynamics::MassMatrixMethod::Crba, opts)
+                    .map_err(|e| Error(e.to_string()))?;
+            choice.counts().total()
+        }
+        _ => 0,
+    };
+    compact::decide(model, opts, ops)
 }
 
 /// The payload struct (the last body's mass properties) and its nominal value.

@@ -51,6 +51,45 @@ pub struct Options {
     /// same joint-space results in fewer operations. Default `true`; the base reaction always
     /// reads the model's own numbers.
     pub regroup: bool,
+    /// Straight-line or compact code ([`Form`], default [`Form::Auto`]: chosen by size, see
+    /// [`crate::compact`]).
+    pub form: Form,
+}
+
+/// Which form of the generated functions to emit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Form {
+    /// Compact code when the unrolled code would exceed `compact::AUTO_LIMIT` emitted operations and the
+    /// model is supported (`compact::unsupported`), straight-line code otherwise (default).
+    #[default]
+    Auto,
+    /// Straight-line code from traced graphs (`emit`).
+    Unrolled,
+    /// Loops over constant tables (`compact`).
+    Compact,
+}
+
+impl Form {
+    /// `auto`, `unrolled` or `compact`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Form::Auto => "auto",
+            Form::Unrolled => "unrolled",
+            Form::Compact => "compact",
+        }
+    }
+
+    /// The form of a name ([`Form::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "auto" => Some(Form::Auto),
+            "unrolled" => Some(Form::Unrolled),
+            "compact" => Some(Form::Compact),
+            _ => None,
+        }
+    }
 }
 
 /// Floating-point type of the emitted code.
@@ -123,6 +162,7 @@ impl Options {
             fma_path: None,
             target_fma: true,
             regroup: true,
+            form: Form::Auto,
         }
     }
 }

@@ -25,6 +25,7 @@ struct Input {
     fma: bool,
     fma_path: Option<syn::Path>,
     regroup: bool,
+    form: kanegen_codegen::Form,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -63,6 +64,7 @@ impl Parse for Input {
             fma: false,
             fma_path: None,
             regroup: true,
+            form: kanegen_codegen::Form::Auto,
         };
         let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
@@ -111,6 +113,18 @@ impl Parse for Input {
                 }
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
+                "form" => {
+                    let lit: LitStr = input.parse()?;
+                    out.form = kanegen_codegen::Form::from_name(&lit.value()).ok_or_else(|| {
+                        syn::Error::new(
+                            lit.span(),
+                            format!(
+                                "unknown form `{}`: expected \"auto\", \"unrolled\" or \"compact\"",
+                                lit.value()
+                            ),
+                        )
+                    })?;
+                }
                 "fma_path" => {
                     out.fma_path = Some(input.parse::<syn::Path>()?);
                     fma_path_key = Some(key);
@@ -120,7 +134,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, regroup)"
+                             runtime_payload, scalar, fma, fma_path, regroup, form)"
                         ),
                     ))
                 }
@@ -170,6 +184,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.float = input.float;
     opts.fma = input.fma;
     opts.regroup = input.regroup;
+    opts.form = input.form;
     opts.fma_path = input
         .fma_path
         .as_ref()
