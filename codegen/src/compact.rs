@@ -44,7 +44,7 @@ use quote::quote;
 /// [`Form::Auto`] emits compact code when the unrolled `mass_matrix_and_nonlinear_effects` would
 /// have more emitted operations (`mul + add`) than this (see the README section "Compact
 /// code" for the measurement it comes from).
-pub const AUTO_LIMIT: u64 = 10_000;
+pub const AUTO_LIMIT: u64 = 6_000;
 
 /// Why the compact form cannot be emitted for `model` under `opts`, or `None` when it can.
 #[must_use]

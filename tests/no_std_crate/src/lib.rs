@@ -11,3 +11,12 @@ pub fn computed_torque(q: &[f64; 2], qd: &[f64; 2], q_ref: &[f64; 2]) -> [f64; 2
     let a: [f64; 2] = core::array::from_fn(|i| kp * (q_ref[i] - q[i]) - kd * qd[i]);
     TwoLink::inverse_dynamics(q, qd, &a)
 }
+
+// The compact form (loops over constant tables) of the same model: `no_std` as well.
+kanegen::dynamics!(TwoLinkCompact, "../../models/two_link.toml", form = "compact");
+
+/// Forward dynamics through the compact form.
+#[must_use]
+pub fn compact_forward_dynamics(q: &[f64; 2], qd: &[f64; 2], tau: &[f64; 2]) -> [f64; 2] {
+    TwoLinkCompact::forward_dynamics(q, qd, tau)
+}
