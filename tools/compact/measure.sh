@@ -75,3 +75,5 @@ RS
   bin="$CARGO_TARGET_DIR/release/m_${form}_${stem//[^a-zA-Z0-9_]/_}"
   echo "$form $stem compile wall ${wall}s user ${user}s $("$bin")"
 done
+# Re-timing without rebuilding: run the built binaries in alternation, e.g.
+#   for p in 1 2 3; do for b in target/compact-measure/target/release/m_*; do echo "$b $($b)"; done; done
