@@ -45,8 +45,8 @@ extern crate std;
 /// Kleinfinger's base parameters: the same `M`, `c` and `τ` in fewer operations; the header says
 /// what moved).
 ///
-/// `form = "auto"` (default) emits straight-line code for small models and, above 6,000
-/// emitted operations in the unrolled `M + c` (about N = 10 with general geometry), compact code:
+/// `form = "auto"` (default) emits straight-line code for small models and, above 4,000
+/// emitted operations in the unrolled `M + c` (N ≥ 8 with general geometry), compact code:
 /// loops over constant tables of the model's numbers (CRBA, RNEA, ABA), which builds in seconds
 /// at N = 64 and runs faster there (README, "Compact code"); `form = "unrolled"` and
 /// `form = "compact"` force one (compact: fixed base without a runtime payload). The header

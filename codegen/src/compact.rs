@@ -33,7 +33,27 @@
 //!
 //! # Measured: when compact code wins
 //!
-//! See [`AUTO_LIMIT`] and the README section "Compact code".
+//! `tools/compact/measure.sh` (one crate with one `dynamics!` per form and model, release build;
+//! ns per call: the lowest of three alternating runs of the median of five rounds; rebuild: user
+//! CPU seconds of `cargo build --release` of that crate; a shared 2-core machine):
+//!
+//! | N (random chain) | unrolled M + c ops | M + c unrolled / compact (ns) | FD unrolled / compact (ns) | rebuild, user CPU s: unrolled / compact |
+//! |---:|---:|---:|---:|---:|
+//! | 2 | 525 | 79 / 227 | 109 / 256 | 0.7 / 0.8 |
+//! | 4 | 1,706 | 205 / 570 | 354 / 602 | 1.0 / 0.8 |
+//! | 8 | 4,632 | 1,426 / 1,142 | 1,274 / 1,011 | 2.2 / 1.2 |
+//! | 12 | 8,310 | 2,468 / 1,777 | 2,480 / 1,897 | 3.6 / 0.8 |
+//! | 16 | 12,740 | 3,171 / 2,412 | 3,600 / 2,742 | 4.0–5.4 / 1.1–1.2 |
+//! | 24 | 23,856 | 6,107 / 3,900 | 7,148 / 3,786 | 10.0 / 1.5 |
+//! | 32 | 37,980 | 10,164 / 5,985 | 12,555 / 6,549 | 14.5–17.9 / 1.2–1.4 |
+//! | 48 | 75,252 | 22,472 / 6,898 | 32,151 / 6,561 | 67 / 1.8 |
+//! | 64 | 124,556 | 43,513 / 11,059 | 92,134 / 7,094 | 183–223 / 2.4–2.7 |
+//! | SSRMS (7) | 635 | 97 / 962 | 265 / 1,048 | 0.7 / 0.9 |
+//!
+//! Compact code loses below a few thousand operations (its loops, table reads and branches on
+//! the kind cost more than the folded constants of straight-line code: 4–10× for SSRMS) and
+//! wins from random N = 8 on, by 4–13× at N = 64; it builds in seconds at any N. Hence
+//! [`AUTO_LIMIT`], on the emitted operations of the unrolled `M + c`.
 
 use crate::options::{Error, Float, Form, Options};
 use kanegen_model::{BaseKind, JointKind, Model};
@@ -42,9 +62,9 @@ use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 /// [`Form::Auto`] emits compact code when the unrolled `mass_matrix_and_nonlinear_effects` would
-/// have more emitted operations (`mul + add`) than this (see the README section "Compact
-/// code" for the measurement it comes from).
-pub const AUTO_LIMIT: u64 = 6_000;
+/// have more emitted operations (`mul + add`) than this: measured ([module docs](self)), compact
+/// code is slower at random N = 4 (1,706 operations) and faster from N = 8 (4,632) on.
+pub const AUTO_LIMIT: u64 = 4_000;
 
 /// Why the compact form cannot be emitted for `model` under `opts`, or `None` when it can.
 #[must_use]

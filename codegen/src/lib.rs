@@ -191,7 +191,13 @@ fn generate_items_with(
             Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
         };
         let c = choice.counts();
-        let doc1 = format!(" {}", api::doc(f, floating));
+        let mut doc1 = format!(" {}", api::doc(f, floating));
+        if compact_body.is_some() {
+            doc1 = doc1.replace(
+                "by an unrolled branch-free LDLᵀ",
+                "by the articulated-body algorithm (RBDA Table 7.1)",
+            );
+        }
         let fused = if opts.fma {
             format!(", of which {k} fused multiply-adds")
         } else if opts.target_fma && k > 0 {

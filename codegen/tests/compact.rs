@@ -79,7 +79,8 @@ fn compact_source_loops_without_allocation_or_panics() {
 }
 
 /// `Form::Auto` picks by the emitted operations of the unrolled `M + c`: compact for a random
-/// chain of 64 joints, unrolled for SSRMS and for random N = 8; the header says which and why.
+/// chain of 8 and of 64 joints, unrolled for SSRMS and for random N = 4; the header says which
+/// and why.
 /// Fails when the rule's inputs (the limit, the traced counts) move across these models.
 #[test]
 fn auto_picks_compact_for_large_models_only() {
@@ -90,7 +91,9 @@ fn auto_picks_compact_for_large_models_only() {
         line.starts_with("Form: compact") && line.contains("auto: unrolled M + c would be"),
         "{line}"
     );
-    let small = generate_items(&chain_default(8), &auto).unwrap();
+    let eight = generate_items(&chain_default(8), &auto).unwrap();
+    assert!(form_line(&eight.header).starts_with("Form: compact"));
+    let small = generate_items(&chain_default(4), &auto).unwrap();
     assert!(form_line(&small.header).starts_with("Form: unrolled straight-line code (auto: "));
     let ssrms = kanegen_model::io::load_model(
         &Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -109,7 +112,8 @@ fn auto_picks_compact_for_large_models_only() {
             .counts()
             .total()
     };
-    assert!(mc(&small) <= AUTO_LIMIT && mc(&g) <= AUTO_LIMIT && mc(&big) > AUTO_LIMIT);
+    assert!(mc(&small) <= AUTO_LIMIT && mc(&g) <= AUTO_LIMIT);
+    assert!(mc(&eight) > AUTO_LIMIT && mc(&big) > AUTO_LIMIT);
 }
 
 fn chain_default(n: usize) -> Model {
