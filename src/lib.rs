@@ -49,7 +49,7 @@ extern crate std;
 /// emitted operations in the unrolled `M + c` (N ≥ 8 with general geometry), compact code:
 /// loops over constant tables of the model's numbers (CRBA, RNEA, ABA), which builds in seconds
 /// at N = 64 and runs faster there (README, "Compact code"); `form = "unrolled"` and
-/// `form = "compact"` force one (compact: fixed base without a runtime payload). The header
+/// `form = "compact"` force one (compact: fixed base only). The header
 /// says which form was emitted and why.
 ///
 /// The path is relative to the calling crate's `CARGO_MANIFEST_DIR`; the crate is rebuilt when

@@ -95,6 +95,72 @@ kanegen::dynamics!(
 );
 kanegen::dynamics!(Tree10U, "tests/data/compact/tree10.toml", form = "unrolled");
 
+kanegen::dynamics!(
+    Tree7PC,
+    "tests/data/compact/tree7.toml",
+    form = "compact",
+    runtime_payload = true,
+    gravity = [0.3, -1.2, -9.81]
+);
+kanegen::dynamics!(
+    Tree7PU,
+    "tests/data/compact/tree7.toml",
+    form = "unrolled",
+    runtime_payload = true,
+    gravity = [0.3, -1.2, -9.81]
+);
+
+/// A runtime payload other than the nominal one: the compact form reads it like the unrolled.
+#[test]
+fn compact_runtime_payload_equals_unrolled() {
+    let pc = Tree7PCPayload {
+        mass: 7.5,
+        com: [0.1, -0.2, 0.3],
+        inertia: [[0.4, 0.01, -0.02], [0.01, 0.5, 0.03], [-0.02, 0.03, 0.6]],
+    };
+    let pu = Tree7PUPayload {
+        mass: pc.mass,
+        com: pc.com,
+        inertia: pc.inertia,
+    };
+    let mut r = rng(9);
+    let q: [f64; 7] = arr(random_vec(&mut r, 7, 2.0));
+    let qd: [f64; 7] = arr(random_vec(&mut r, 7, 1.0));
+    let tau: [f64; 7] = arr(random_vec(&mut r, 7, 20.0));
+    close(
+        "M",
+        &flat(&Tree7PC::mass_matrix(&q, &pc)),
+        &flat(&Tree7PU::mass_matrix(&q, &pu)),
+        1e-12,
+    );
+    close(
+        "c",
+        &Tree7PC::nonlinear_effects(&q, &qd, &pc),
+        &Tree7PU::nonlinear_effects(&q, &qd, &pu),
+        1e-12,
+    );
+    close(
+        "ID",
+        &Tree7PC::inverse_dynamics(&q, &qd, &tau, &pc),
+        &Tree7PU::inverse_dynamics(&q, &qd, &tau, &pu),
+        1e-12,
+    );
+    close(
+        "FD",
+        &Tree7PC::forward_dynamics(&q, &qd, &tau, &pc),
+        &Tree7PU::forward_dynamics(&q, &qd, &tau, &pu),
+        1e-10,
+    );
+    // And the payload matters.
+    let nominal = Tree7PCPayload::NOMINAL;
+    assert!(
+        rel_err(
+            &Tree7PC::nonlinear_effects(&q, &qd, &nominal),
+            &Tree7PC::nonlinear_effects(&q, &qd, &pc)
+        ) > 1e-3
+    );
+}
+
 fn load(stem: &str) -> Model {
     kanegen::model::io::load_model(
         &Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/data/compact/{stem}.toml")),

@@ -19,9 +19,10 @@
 //! path, and `f32` works as `f64`. The frame functions (`<frame>_placement`, `<frame>_jacobian`)
 //! stay straight-line code: their cost grows with one path of the tree, not with its size.
 //!
-//! Supported: a fixed base, chains and trees, `f64` and `f32`, gravity, with or without
-//! regrouping. Not supported (the generator keeps the unrolled form, and `form = "compact"` is an
-//! error): a free-floating base and a runtime payload.
+//! Supported: a fixed base, chains and trees, `f64` and `f32`, gravity, a runtime payload (the
+//! last body's inertia built from it at each call), with or without regrouping. Not supported
+//! (the generator keeps the unrolled form, and `form = "compact"` is an error): a free-floating
+//! base.
 //!
 //! # The joint transform in three constant matrices
 //!
@@ -69,13 +70,8 @@ pub const AUTO_LIMIT: u64 = 4_000;
 /// Why the compact form cannot be emitted for `model` under `opts`, or `None` when it can.
 #[must_use]
 pub fn unsupported(model: &Model, opts: &Options) -> Option<&'static str> {
-    if model.base_kind() == BaseKind::FreeFloating {
-        Some("a free-floating base")
-    } else if opts.runtime_payload {
-        Some("a runtime payload")
-    } else {
-        None
-    }
+    let _ = opts;
+    (model.base_kind() == BaseKind::FreeFloating).then_some("a free-floating base")
 }
 
 /// The form emitted and why, as the header says it.
@@ -189,8 +185,10 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let sincos = float.libm_fn("sincos");
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
+    // The payload body neither gives nor receives (its inertia is a runtime input).
+    let keep: &[usize] = if opts.runtime_payload { &[n - 1] } else { &[] };
     let p = if opts.regroup {
-        kanegen_dynamics::regroup::regrouped::<f64>(model, None, &[]).params
+        kanegen_dynamics::regroup::regrouped::<f64>(model, None, keep).params
     } else {
         kanegen_dynamics::Params::<f64>::new(model)
     };
@@ -261,6 +259,37 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         }
         None => quote!([0.0; 6]),
     };
+    let payload_fn = if opts.runtime_payload {
+        let ty = syn::parse_str::<syn::Ident>(&opts.payload_name)
+            .map_err(|e| Error(format!("payload name `{}`: {e}", opts.payload_name)))?;
+        quote! {
+            /// Compact form: the inertia table with the payload's spatial inertia as the last
+            /// body's, `h = m c`, `Ī = I_c + m (|c|² 1 − c cᵀ)` (RBDA eq. (2.63), parallel axes).
+            #[inline(always)]
+            fn cx_inertia(payload: &#ty) -> [[#fl; 10]; #nl] {
+                let mut t = Self::CX_INERTIA;
+                let (m, c, ic) = (payload.mass, &payload.com, &payload.inertia);
+                let cc = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
+                if let Some(last) = t.last_mut() {
+                    *last = [
+                        m,
+                        m * c[0],
+                        m * c[1],
+                        m * c[2],
+                        ic[0][0] + m * (cc - c[0] * c[0]),
+                        ic[0][1] - m * c[0] * c[1],
+                        ic[0][2] - m * c[0] * c[2],
+                        ic[1][1] + m * (cc - c[1] * c[1]),
+                        ic[1][2] - m * c[1] * c[2],
+                        ic[2][2] + m * (cc - c[2] * c[2]),
+                    ];
+                }
+                t
+            }
+        }
+    } else {
+        quote!()
+    };
     Ok(quote! {
         /// Compact form: each joint's parent body `λ(j) < j` (`None`: the base).
         const CX_PARENT: [Option<usize>; #nl] = [#(#par),*];
@@ -283,6 +312,8 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         const CX_INERTIA: [[#fl; 10]; #nl] = [#(#ti),*];
         /// Compact form: the base's spatial acceleration `a₀ = [0; −g]` (RBDA §5.3).
         const CX_A0: [#fl; 6] = #a0;
+
+        #payload_fn
 
         /// Compact form: `(E_j, r_j)` of `Xup_j = XJ(q_j) Xtree_j` for every joint (RBDA §4.4).
         #[inline(always)]
@@ -469,6 +500,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         #[inline(always)]
         fn cx_world(
             x: &[([[#fl; 3]; 3], [#fl; 3]); #nl],
+            inertia: &[[#fl; 10]; #nl],
         ) -> (
             [([[#fl; 3]; 3], [#fl; 3]); #nl],
             [[#fl; 6]; #nl],
@@ -498,7 +530,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
                 let v = Self::cx_rot_tr(e0, &[s[3], s[4], s[5]]);
                 let pw = Self::cx_cross(p0, &w);
                 s0[i] = [w[0], w[1], w[2], v[0] + pw[0], v[1] + pw[1], v[2] + pw[2]];
-                i0[i] = Self::cx_inertia_tr(&x0[i], &Self::CX_INERTIA[i]);
+                i0[i] = Self::cx_inertia_tr(&x0[i], &inertia[i]);
             }
             (x0, s0, i0)
         }
@@ -508,8 +540,11 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         /// leaves first (one frame, no transform), then `F = IC_i S_i` and
         /// `H_ij = H_ji = S_jᵀ F` for `j = i` and each ancestor `j` of `i`.
         #[inline]
-        fn cx_crba(x: &[([[#fl; 3]; 3], [#fl; 3]); #nl]) -> [[#fl; #nl]; #nl] {
-            let (_, s0, mut ic) = Self::cx_world(x);
+        fn cx_crba(
+            x: &[([[#fl; 3]; 3], [#fl; 3]); #nl],
+            inertia: &[[#fl; 10]; #nl],
+        ) -> [[#fl; #nl]; #nl] {
+            let (_, s0, mut ic) = Self::cx_world(x, inertia);
             for i in (0..#nl).rev() {
                 if let Some(l) = Self::CX_PARENT[i] {
                     let child = ic[i];
@@ -549,6 +584,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         #[inline]
         fn cx_rnea(
             x: &[([[#fl; 3]; 3], [#fl; 3]); #nl],
+            inertia: &[[#fl; 10]; #nl],
             qd: &[#fl; #nl],
             qdd: &[#fl; #nl],
             a0: &[#fl; 6],
@@ -566,9 +602,9 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
                 v[i] = Self::cx_add(&Self::cx_apply(&x[i], &vp), &vj);
                 let ai = Self::cx_axpy(&Self::cx_apply(&x[i], &ap), qdd[i], &Self::CX_S[i]);
                 a[i] = Self::cx_add(&ai, &Self::cx_crm(&v[i], &vj));
-                let iv = Self::cx_inertia_mul(&Self::CX_INERTIA[i], &v[i]);
+                let iv = Self::cx_inertia_mul(&inertia[i], &v[i]);
                 let fi = Self::cx_add(
-                    &Self::cx_inertia_mul(&Self::CX_INERTIA[i], &a[i]),
+                    &Self::cx_inertia_mul(&inertia[i], &a[i]),
                     &Self::cx_crf(&v[i], &iv),
                 );
                 let e = &f_ext[i];
@@ -604,13 +640,14 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
         /// `a₀ = [0; −g]`. `f_ext[i] = [force; moment]` in body `i`'s frame at its origin.
         #[inline]
         fn cx_aba(
+            inertia: &[[#fl; 10]; #nl],
             q: &[#fl; #nl],
             qd: &[#fl; #nl],
             tau: &[#fl; #nl],
             f_ext: &[[#fl; 6]; #nl],
         ) -> [#fl; #nl] {
             let x = Self::cx_transforms(q);
-            let (x0, s0, i0) = Self::cx_world(&x);
+            let (x0, s0, i0) = Self::cx_world(&x, inertia);
             let mut v = [[0.0; 6]; #nl];
             let mut c = [[0.0; 6]; #nl];
             let mut ia = [[[0.0; 6]; 6]; #nl];
@@ -709,28 +746,34 @@ pub fn body(f: Function, opts: &Options, n: usize) -> Option<TokenStream> {
     };
     let zero = quote!(&[0.0; #nl]);
     let no_ext = quote!(&[[0.0; 6]; #nl]);
+    let i = if opts.runtime_payload {
+        quote!(&Self::cx_inertia(payload))
+    } else {
+        quote!(&Self::CX_INERTIA)
+    };
     Some(match f {
         Function::MassMatrix => quote! {
-            Self::cx_crba(&Self::cx_transforms(q))
+            Self::cx_crba(&Self::cx_transforms(q), #i)
         },
         Function::NonlinearEffects => quote! {
-            Self::cx_rnea(&Self::cx_transforms(q), qd, #zero, #a0, #no_ext)
+            Self::cx_rnea(&Self::cx_transforms(q), #i, qd, #zero, #a0, #no_ext)
         },
         Function::Gravity => quote! {
-            Self::cx_rnea(&Self::cx_transforms(q), #zero, #zero, &Self::CX_A0, #no_ext)
+            Self::cx_rnea(&Self::cx_transforms(q), #i, #zero, #zero, &Self::CX_A0, #no_ext)
         },
         Function::InverseDynamics => quote! {
-            Self::cx_rnea(&Self::cx_transforms(q), qd, qdd, #a0, #no_ext)
+            Self::cx_rnea(&Self::cx_transforms(q), #i, qd, qdd, #a0, #no_ext)
         },
         Function::MassMatrixAndNonlinearEffects => quote! {
             let x = Self::cx_transforms(q);
-            (Self::cx_crba(&x), Self::cx_rnea(&x, qd, #zero, #a0, #no_ext))
+            let inertia = #i;
+            (Self::cx_crba(&x, inertia), Self::cx_rnea(&x, inertia, qd, #zero, #a0, #no_ext))
         },
         Function::ForwardDynamics => quote! {
-            Self::cx_aba(q, qd, tau, #no_ext)
+            Self::cx_aba(#i, q, qd, tau, #no_ext)
         },
         Function::ForwardDynamicsWithWrenches => quote! {
-            Self::cx_aba(q, qd, tau, f_ext)
+            Self::cx_aba(#i, q, qd, tau, f_ext)
         },
         _ => return None,
     })
