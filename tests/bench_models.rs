@@ -6,7 +6,7 @@ use kanegen::model::io::to_toml;
 use kanegen::model::random::{random_chain, ChainSpec};
 
 /// Sizes of the benchmarked random chains.
-pub const SIZES: [usize; 5] = [2, 4, 8, 16, 32];
+pub const SIZES: [usize; 9] = [2, 4, 8, 12, 16, 24, 32, 48, 64];
 
 #[test]
 fn bench_models_are_current() {

@@ -1,8 +1,8 @@
 //! `dynamics!` rejects bad models at compile time with the reader's message at the path literal,
 //! and bad options (`scalar = f16`, `fma_path` without `fma = true`, `snap = 0.5`,
-//! `algorithm = "fastest"`, an unknown key) at the option; `scene!` rejects a bad scene key (the
-//! scene reader's message) and a feature it does not generate (a tabulated wrench with a
-//! computed-torque drive), naming the key and the scene file, at the path literal.
+//! `algorithm = "fastest"`, `form = "rolled"`, an unknown key) at the option; `scene!` rejects a
+//! bad scene key (the scene reader's message) and a feature it does not generate (a tabulated
+//! wrench with a computed-torque drive), naming the key and the scene file, at the path literal.
 //!
 //! trybuild compiles each case in its own project, `<target>/tests/trybuild/kanegen`, whose
 //! `CARGO_MANIFEST_DIR` is that directory: the bad models of `tests/data/codegen/bad/` are copied

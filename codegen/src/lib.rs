@@ -30,13 +30,14 @@
 
 pub mod api;
 pub mod choose;
+pub mod compact;
 pub mod emit;
 pub mod header;
 mod options;
 
 pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
-pub use options::{forced_algorithm, Error, Float, Options, VERSION};
+pub use options::{forced_algorithm, Error, Float, Form, Options, VERSION};
 
 use kanegen_model::{BaseKind, Model};
 use kanegen_trace::{Arg, Function};
@@ -105,6 +106,8 @@ fn generate_items_with(
     let op_ty = ident("op-count name", &opts.op_count_name)?;
     let emitter = Emitter::new(opts)?;
     let fl = opts.float.ty();
+    let decision = form_decision(model, opts)?;
+    let compact = decision.form == Form::Compact;
 
     let mut fns = Vec::new();
     let mut choices = Vec::new();
@@ -118,12 +121,26 @@ fn generate_items_with(
             mass = choice.chosen.mass_matrix;
         }
         let shape = api::shape(f, n, floating);
+        let compact_body = if compact {
+            compact::body(f, opts, n)
+        } else {
+            None
+        };
         let Body {
             tokens: body,
             fmas: k,
-        } = match bodies.as_deref_mut() {
-            None => emit::emit_body(&traced, &emitter, shape),
-            Some(texts) => {
+        } = match (bodies.as_deref_mut(), compact_body.clone()) {
+            (None, Some(tokens)) => Body { tokens, fmas: 0 },
+            (Some(texts), Some(tokens)) => {
+                texts.push(format_body(&tokens)?);
+                let placeholder = format_ident!("__kanegen_body_{}", texts.len() - 1);
+                Body {
+                    tokens: quote!(#placeholder()),
+                    fmas: 0,
+                }
+            }
+            (None, None) => emit::emit_body(&traced, &emitter, shape),
+            (Some(texts), None) => {
                 let mut text = String::new();
                 let mut failed = None;
                 let mut b =
@@ -184,7 +201,18 @@ fn generate_items_with(
             Shape::Placement => quote!(([#fl; 3], [[#fl; 3]; 3])),
         };
         let c = choice.counts();
-        let doc1 = format!(" {}", api::doc(f, floating, choice.chosen.forward));
+        let mut doc1 = format!(" {}", api::doc(f, floating, choice.chosen.forward));
+        if compact_body.is_some() {
+            for unrolled in [
+                "by an unrolled branch-free LDLᵀ",
+                "by an unrolled articulated-body algorithm",
+            ] {
+                doc1 = doc1.replace(
+                    unrolled,
+                    "by the articulated-body algorithm (RBDA Table 7.1) in loops",
+                );
+            }
+        }
         let fused = if opts.fma {
             format!(", of which {k} fused multiply-adds")
         } else if opts.target_fma && k > 0 {
@@ -209,7 +237,13 @@ fn generate_items_with(
         .join(", ");
         let doc2 = format!(
             " {}{methods}: {} mul, {} add, {} div, {} sqrt, {} sincos (emitted){fused}.",
-            if methods.is_empty() { "" } else { "Methods: " },
+            match (compact_body.is_some(), methods.is_empty()) {
+                (true, _) =>
+                    "Compact form: loops over the model's constant tables (RBDA); \
+                              the unrolled form would emit, with ",
+                (false, true) => "",
+                (false, false) => "Methods: ",
+            },
             c.mul,
             c.add,
             c.div,
@@ -263,7 +297,13 @@ fn generate_items_with(
         .flat_map(|ch| ch.candidates.iter().map(|(m, c)| entry(ch, *m, *c, 0)));
     let n_fns = Literal::usize_unsuffixed(choices.len());
 
-    let header = header::lines(model, opts, &choices, &fmas, &snapped.report);
+    let mut header = header::lines(model, opts, &choices, &fmas, &snapped.report);
+    // The form line after the model's description, before the table of counts.
+    let at = header
+        .iter()
+        .position(|l| l.starts_with("Emitted operation counts per candidate"))
+        .map_or(header.len(), |k| k.saturating_sub(1));
+    header.insert(at, decision.line.clone());
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())
@@ -301,6 +341,11 @@ fn generate_items_with(
         opts.type_name
     );
 
+    let compact_items = if compact {
+        compact::items(model, opts)?
+    } else {
+        quote!()
+    };
     let mul_add_item = if !opts.fma && opts.target_fma && fmas.iter().any(|k| *k > 0) {
         mul_add_fn(opts.float)
     } else {
@@ -348,6 +393,7 @@ fn generate_items_with(
             clippy::many_single_char_names,
             clippy::similar_names,
             clippy::type_complexity,
+            clippy::needless_range_loop,
             unused_parens
         )]
         impl #ty {
@@ -366,6 +412,8 @@ fn generate_items_with(
             #(#fns)*
 
             #mul_add_item
+
+            #compact_items
         }
     };
     Ok(Generated {
@@ -374,6 +422,22 @@ fn generate_items_with(
         choices,
         fmas,
     })
+}
+
+/// The form to emit ([`compact::decide`]): for [`Form::Auto`] from the emitted operations of the
+/// cheapest unrolled `mass_matrix_and_nonlinear_effects`.
+fn form_decision(model: &Model, opts: &Options) -> Result<compact::Decision, Error> {
+    let ops = match (opts.form, compact::unsupported(model, opts)) {
+        (Form::Auto, None) => {
+            let f = Function::MassMatrixAndNonlinearEffects;
+            let (choice, _) =
+                choose::choose(model, f, kanegen_dynamics::MassMatrixMethod::Crba, opts)
+                    .map_err(|e| Error(e.to_string()))?;
+            choice.counts().total()
+        }
+        _ => 0,
+    };
+    compact::decide(model, opts, ops)
 }
 
 /// The payload struct (the last body's mass properties) and its nominal value.
@@ -652,8 +716,11 @@ mod tests {
             opts.float = float;
             opts.fma = fuse == Fuse::Libm;
             opts.target_fma = fuse == Fuse::Target;
+            opts.form = Form::Unrolled;
             let g = generate_items(&chain, &opts).unwrap();
-            let fns = count_ops(g.items);
+            let mut fns = count_ops(g.items);
+            // The private `Self::mul_add` helper is not a generated function.
+            fns.remove("mul_add");
             assert_eq!(fns.len(), 7, "all functions, gravity included");
             if fuse != Fuse::None {
                 assert!(fns.values().all(|c| c.fma > 0), "every function fuses");

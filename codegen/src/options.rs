@@ -66,6 +66,9 @@ pub struct Options {
     /// paper's; `recurrent-r1`, `kane-direct`, `crba-base`, `spatial`) or [`Methods::ABA`]
     /// (`aba`), by [`forced_algorithm`]. Default `None`: the cheapest. The header says which.
     pub algorithm: Option<Methods>,
+    /// Straight-line or compact code ([`Form`], default [`Form::Auto`]: chosen by size, see
+    /// [`crate::compact`]).
+    pub form: Form,
 }
 
 /// The methods `algorithm = NAME` forces ([`Options::algorithm`]).
@@ -83,6 +86,42 @@ pub fn forced_algorithm(name: &str) -> Result<Methods, Error> {
             names.join(", ")
         ))
     })
+}
+
+/// Which form of the generated functions to emit.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum Form {
+    /// Compact code when the unrolled code would exceed `compact::AUTO_LIMIT` emitted operations and the
+    /// model is supported (`compact::unsupported`), straight-line code otherwise (default).
+    #[default]
+    Auto,
+    /// Straight-line code from traced graphs (`emit`).
+    Unrolled,
+    /// Loops over constant tables (`compact`).
+    Compact,
+}
+
+impl Form {
+    /// `auto`, `unrolled` or `compact`.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Form::Auto => "auto",
+            Form::Unrolled => "unrolled",
+            Form::Compact => "compact",
+        }
+    }
+
+    /// The form of a name ([`Form::name`]).
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "auto" => Some(Form::Auto),
+            "unrolled" => Some(Form::Unrolled),
+            "compact" => Some(Form::Compact),
+            _ => None,
+        }
+    }
 }
 
 /// Floating-point type of the emitted code.
@@ -157,6 +196,7 @@ impl Options {
             regroup: true,
             snap: kanegen_model::canonical::DEFAULT_SNAP,
             algorithm: None,
+            form: Form::Auto,
         }
     }
 }

@@ -10,6 +10,7 @@
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
 //! Fused multiply-adds where the target has them: 4366 (`mass_matrix` 379, `nonlinear_effects` 323, `inverse_dynamics` 338, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 700, `forward_dynamics_with_wrenches` 987, `momentum` 221, `base_reaction` 432), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
@@ -84,6 +85,7 @@ pub struct OpCount {
     clippy::many_single_char_names,
     clippy::similar_names,
     clippy::type_complexity,
+    clippy::needless_range_loop,
     unused_parens
 )]
 impl FreeFloating7 {

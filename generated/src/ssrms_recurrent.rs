@@ -10,6 +10,7 @@
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: forced to `recurrent` (`algorithm` option) for every function with a mass-matrix, bias or forward method; without it each takes the cheapest candidate.
 //! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
 //!
@@ -58,6 +59,7 @@ pub struct OpCount {
     clippy::many_single_char_names,
     clippy::similar_names,
     clippy::type_complexity,
+    clippy::needless_range_loop,
     unused_parens
 )]
 impl SsrmsRecurrent {

@@ -32,6 +32,7 @@ struct Input {
     regroup: bool,
     snap: Option<f64>,
     algorithm: Option<kanegen_codegen::kanegen_dynamics::Methods>,
+    form: kanegen_codegen::Form,
 }
 
 fn float(e: &Expr) -> syn::Result<f64> {
@@ -73,6 +74,7 @@ impl Parse for Input {
             regroup: true,
             snap: None,
             algorithm: None,
+            form: kanegen_codegen::Form::Auto,
         };
         let mut fma_path_key: Option<Ident> = None;
         while input.parse::<Option<Token![,]>>()?.is_some() {
@@ -140,6 +142,18 @@ impl Parse for Input {
                     }
                     out.snap = Some(x);
                 }
+                "form" => {
+                    let lit: LitStr = input.parse()?;
+                    out.form = kanegen_codegen::Form::from_name(&lit.value()).ok_or_else(|| {
+                        syn::Error::new(
+                            lit.span(),
+                            format!(
+                                "unknown form `{}`: expected \"auto\", \"unrolled\" or \"compact\"",
+                                lit.value()
+                            ),
+                        )
+                    })?;
+                }
                 "fma_path" => {
                     out.fma_path = Some(input.parse::<syn::Path>()?);
                     fma_path_key = Some(key);
@@ -149,7 +163,7 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap, algorithm)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap, algorithm, form)"
                         ),
                     ))
                 }
@@ -204,6 +218,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     if let Some(snap) = input.snap {
         opts.snap = snap;
     }
+    opts.form = input.form;
     opts.fma_path = input
         .fma_path
         .as_ref()

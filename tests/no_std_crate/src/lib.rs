@@ -23,3 +23,12 @@ pub fn ssrms_final_q() -> Option<[f64; 7]> {
     SsrmsEffects::run(|_, s| last = *s).ok()?;
     Some(last.q)
 }
+
+// The compact form (loops over constant tables) of the same model: `no_std` as well.
+kanegen::dynamics!(TwoLinkCompact, "../../models/two_link.toml", form = "compact");
+
+/// Forward dynamics through the compact form.
+#[must_use]
+pub fn compact_forward_dynamics(q: &[f64; 2], qd: &[f64; 2], tau: &[f64; 2]) -> [f64; 2] {
+    TwoLinkCompact::forward_dynamics(q, qd, tau)
+}

@@ -1,0 +1,167 @@
+//! The compact form at the source level: what `generate_file` writes with `Form::Compact`
+//! (loops, no allocation, no panicking call), which form `Form::Auto` picks, and what it refuses.
+
+use kanegen_codegen::compact::AUTO_LIMIT;
+use kanegen_codegen::{generate_file, generate_items, Float, Form, Options};
+use kanegen_model::random::{random_chain, random_tree, ChainSpec};
+use kanegen_model::{BaseKind, Model};
+use std::path::Path;
+
+fn chain(n: usize, seed: u64) -> Model {
+    random_chain(
+        &ChainSpec {
+            n,
+            prismatic_fraction: 0.3,
+            ..Default::default()
+        },
+        seed,
+    )
+}
+
+fn compact_opts() -> Options {
+    let mut o = Options::new("Arm");
+    o.form = Form::Compact;
+    o
+}
+
+/// The source without comments and doc attributes: the code itself.
+fn code(src: &str) -> String {
+    src.lines()
+        .filter(|l| {
+            let t = l.trim_start();
+            !t.starts_with("//") && !t.starts_with("#[doc") && !t.starts_with("#![doc")
+        })
+        .collect::<Vec<_>>()
+        .join("\n")
+}
+
+#[test]
+fn compact_source_loops_without_allocation_or_panics() {
+    for (model, gravity, float) in [
+        (chain(5, 1), Some([0.0, 0.0, -9.81]), Float::F64),
+        (random_tree(&ChainSpec::default(), 2), None, Float::F32),
+    ] {
+        let mut o = compact_opts();
+        o.gravity = gravity;
+        o.float = float;
+        let src = generate_file(&model, &o).unwrap();
+        assert!(
+            src.contains("//! Form: compact: loops over constant tables"),
+            "{src}"
+        );
+        let body = code(&src);
+        for word in [
+            "alloc",
+            "Vec",
+            "Box",
+            "unwrap",
+            "expect(",
+            "panic",
+            "unreachable",
+            "todo!",
+            "String",
+        ] {
+            assert!(!body.contains(word), "`{word}` in the compact source");
+        }
+        assert!(body.contains("for i in 0..") && body.contains("const CX_INERTIA"));
+        assert!(body.contains(if float == Float::F32 {
+            "libm::sincosf("
+        } else {
+            "libm::sincos("
+        }));
+        if float == Float::F32 {
+            assert!(!body.contains("f64"), "f32 code names no f64");
+        }
+        // Straight-line bodies are `let` chains; compact ones call the loops.
+        assert!(src.contains("Self::cx_crba(&Self::cx_transforms(q), &Self::CX_INERTIA)"));
+        assert!(src.contains("Compact form: loops over the model's constant tables"));
+    }
+}
+
+/// `Form::Auto` picks by the emitted operations of the unrolled `M + c`: compact for a random
+/// chain of 8 and of 64 joints, unrolled for SSRMS and for random N = 4; the header says which
+/// and why.
+/// Fails when the rule's inputs (the limit, the traced counts) move across these models.
+#[test]
+fn auto_picks_compact_for_large_models_only() {
+    let auto = Options::new("Arm");
+    let big = generate_items(&chain_default(64), &auto).unwrap();
+    let line = form_line(&big.header);
+    assert!(
+        line.starts_with("Form: compact") && line.contains("auto: unrolled M + c would be"),
+        "{line}"
+    );
+    let eight = generate_items(&chain_default(8), &auto).unwrap();
+    assert!(form_line(&eight.header).starts_with("Form: compact"));
+    let small = generate_items(&chain_default(4), &auto).unwrap();
+    assert!(form_line(&small.header).starts_with("Form: unrolled straight-line code (auto: "));
+    let ssrms = kanegen_model::io::load_model(
+        &Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/data/reference/ssrms_nguyen_hughes_1994.urdf"),
+    )
+    .unwrap();
+    let g = generate_items(&ssrms, &auto).unwrap();
+    let line = form_line(&g.header);
+    assert!(line.starts_with("Form: unrolled"), "{line}");
+    // The limit sits between the measured crossovers (README "Compact code").
+    let mc = |g: &kanegen_codegen::Generated| {
+        g.choices
+            .iter()
+            .find(|c| c.function.name() == "mass_matrix_and_nonlinear_effects")
+            .unwrap()
+            .counts()
+            .total()
+    };
+    assert!(mc(&small) <= AUTO_LIMIT && mc(&g) <= AUTO_LIMIT);
+    assert!(mc(&eight) > AUTO_LIMIT && mc(&big) > AUTO_LIMIT);
+}
+
+fn chain_default(n: usize) -> Model {
+    random_chain(
+        &ChainSpec {
+            n,
+            ..Default::default()
+        },
+        1000 + n as u64,
+    )
+}
+
+fn form_line(header: &[String]) -> String {
+    header
+        .iter()
+        .find(|l| l.starts_with("Form: "))
+        .cloned()
+        .unwrap_or_default()
+}
+
+/// A free-floating base keeps the unrolled form under `Auto`, saying why, and is an error under
+/// `Compact`; a runtime payload is compact; `Unrolled` is obeyed at any size.
+#[test]
+fn unsupported_models_stay_unrolled() {
+    let ssrms = kanegen_model::io::load_model(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join("../models/ssrms.toml"),
+    )
+    .unwrap();
+    let mut o = Options::new("Arm");
+    o.base = Some(BaseKind::FreeFloating);
+    let g = generate_items(&ssrms, &o).unwrap();
+    assert_eq!(
+        form_line(&g.header),
+        "Form: unrolled straight-line code (auto: the compact form does not support a \
+         free-floating base yet)."
+    );
+    o.form = Form::Compact;
+    assert!(generate_items(&ssrms, &o).is_err());
+    // A runtime payload is supported: the last body's inertia is built from it per call.
+    let mut o = compact_opts();
+    o.runtime_payload = true;
+    let src = generate_file(&chain(3, 5), &o).unwrap();
+    assert!(src.contains("Self::cx_crba(&Self::cx_transforms(q), &Self::cx_inertia(payload))"));
+    let mut o = Options::new("Arm");
+    o.form = Form::Unrolled;
+    let g = generate_items(&chain_default(64), &o).unwrap();
+    assert_eq!(
+        form_line(&g.header),
+        "Form: unrolled straight-line code (asked for)."
+    );
+}

@@ -1,0 +1,323 @@
+//! The compact form (`form = "compact"`: loops over constant tables) equals the unrolled form
+//! and the interpreted algorithms on random chains and trees with prismatic joints, with and
+//! without gravity, in f64 (1e-12 relative) and f32.
+
+use kanegen::model::io::to_toml;
+use kanegen::model::random::{random_chain, random_tree, ChainSpec};
+use kanegen::model::Model;
+use std::path::Path;
+
+/// The committed test models: `(file stem, model)`.
+fn models() -> Vec<(String, Model)> {
+    let spec = |n| ChainSpec {
+        n,
+        prismatic_fraction: 0.3,
+        ..Default::default()
+    };
+    vec![
+        ("chain3".into(), random_chain(&spec(3), 3)),
+        ("chain12".into(), random_chain(&spec(12), 12)),
+        ("tree7".into(), random_tree(&spec(7), 7)),
+        ("tree10".into(), random_tree(&spec(10), 10)),
+    ]
+}
+
+#[test]
+fn compact_models_are_current() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/data/compact");
+    let bless = std::env::var_os("KANEGEN_BLESS").is_some();
+    for (stem, model) in models() {
+        let text = to_toml(&model);
+        let path = dir.join(format!("{stem}.toml"));
+        if bless {
+            std::fs::write(&path, &text).unwrap();
+        }
+        let committed = std::fs::read_to_string(&path).unwrap_or_default();
+        assert!(
+            committed == text,
+            "{} is stale: rerun with KANEGEN_BLESS=1",
+            path.display()
+        );
+    }
+}
+
+use kanegen::dynamics::metrics::rel_err;
+use kanegen::dynamics::{linalg::Vec3, Loads, Methods, Params};
+use kanegen::model::random::{random_vec, rng};
+
+const G: [f64; 3] = [0.3, -1.2, -9.81];
+
+kanegen::dynamics!(
+    Chain3C,
+    "tests/data/compact/chain3.toml",
+    form = "compact",
+    gravity = [0.3, -1.2, -9.81]
+);
+kanegen::dynamics!(
+    Chain3U,
+    "tests/data/compact/chain3.toml",
+    form = "unrolled",
+    gravity = [0.3, -1.2, -9.81]
+);
+kanegen::dynamics!(
+    Chain12C,
+    "tests/data/compact/chain12.toml",
+    form = "compact"
+);
+kanegen::dynamics!(
+    Chain12U,
+    "tests/data/compact/chain12.toml",
+    form = "unrolled"
+);
+kanegen::dynamics!(
+    Chain12F32,
+    "tests/data/compact/chain12.toml",
+    form = "compact",
+    scalar = f32
+);
+kanegen::dynamics!(
+    Tree7C,
+    "tests/data/compact/tree7.toml",
+    form = "compact",
+    gravity = [0.3, -1.2, -9.81]
+);
+kanegen::dynamics!(
+    Tree7U,
+    "tests/data/compact/tree7.toml",
+    form = "unrolled",
+    gravity = [0.3, -1.2, -9.81]
+);
+kanegen::dynamics!(
+    Tree10C,
+    "tests/data/compact/tree10.toml",
+    form = "compact",
+    regroup = false
+);
+kanegen::dynamics!(Tree10U, "tests/data/compact/tree10.toml", form = "unrolled");
+
+kanegen::dynamics!(
+    Tree7PC,
+    "tests/data/compact/tree7.toml",
+    form = "compact",
+    runtime_payload = true,
+    gravity = [0.3, -1.2, -9.81]
+);
+kanegen::dynamics!(
+    Tree7PU,
+    "tests/data/compact/tree7.toml",
+    form = "unrolled",
+    runtime_payload = true,
+    gravity = [0.3, -1.2, -9.81]
+);
+
+/// A runtime payload other than the nominal one: the compact form reads it like the unrolled.
+#[test]
+fn compact_runtime_payload_equals_unrolled() {
+    let pc = Tree7PCPayload {
+        mass: 7.5,
+        com: [0.1, -0.2, 0.3],
+        inertia: [[0.4, 0.01, -0.02], [0.01, 0.5, 0.03], [-0.02, 0.03, 0.6]],
+    };
+    let pu = Tree7PUPayload {
+        mass: pc.mass,
+        com: pc.com,
+        inertia: pc.inertia,
+    };
+    let mut r = rng(9);
+    let q: [f64; 7] = arr(random_vec(&mut r, 7, 2.0));
+    let qd: [f64; 7] = arr(random_vec(&mut r, 7, 1.0));
+    let tau: [f64; 7] = arr(random_vec(&mut r, 7, 20.0));
+    close(
+        "M",
+        &flat(&Tree7PC::mass_matrix(&q, &pc)),
+        &flat(&Tree7PU::mass_matrix(&q, &pu)),
+        1e-12,
+    );
+    close(
+        "c",
+        &Tree7PC::nonlinear_effects(&q, &qd, &pc),
+        &Tree7PU::nonlinear_effects(&q, &qd, &pu),
+        1e-12,
+    );
+    close(
+        "ID",
+        &Tree7PC::inverse_dynamics(&q, &qd, &tau, &pc),
+        &Tree7PU::inverse_dynamics(&q, &qd, &tau, &pu),
+        1e-12,
+    );
+    close(
+        "FD",
+        &Tree7PC::forward_dynamics(&q, &qd, &tau, &pc),
+        &Tree7PU::forward_dynamics(&q, &qd, &tau, &pu),
+        1e-10,
+    );
+    // And the payload matters.
+    let nominal = Tree7PCPayload::NOMINAL;
+    assert!(
+        rel_err(
+            &Tree7PC::nonlinear_effects(&q, &qd, &nominal),
+            &Tree7PC::nonlinear_effects(&q, &qd, &pc)
+        ) > 1e-3
+    );
+}
+
+fn load(stem: &str) -> Model {
+    kanegen::model::io::load_model(
+        &Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("tests/data/compact/{stem}.toml")),
+    )
+    .unwrap()
+}
+
+fn arr<const N: usize>(v: Vec<f64>) -> [f64; N] {
+    core::array::from_fn(|i| v[i])
+}
+
+fn flat<const N: usize>(a: &[[f64; N]; N]) -> Vec<f64> {
+    a.iter().flatten().copied().collect()
+}
+
+/// `(compact, reference)` pairs must agree to `tol` relative.
+fn close(what: &str, x: &[f64], y: &[f64], tol: f64) {
+    let e = rel_err(x, y);
+    assert!(e < tol, "{what}: relative error {e:e}\n{x:?}\n{y:?}");
+}
+
+macro_rules! compare {
+    ($c:ident, $u:ident, $n:literal, $stem:literal, $gravity:expr) => {{
+        let model = load($stem);
+        let p = Params::<f64>::new(&model);
+        let gravity: Option<[f64; 3]> = $gravity;
+        let loads = Loads {
+            gravity: gravity.map(|g| Vec3::new(g[0], g[1], g[2])),
+            ..Loads::default()
+        };
+        let alg = Methods::SPATIAL;
+        for seed in 0..10 {
+            let mut r = rng(seed);
+            let q: [f64; $n] = arr(random_vec(&mut r, $n, 2.0));
+            let qd: [f64; $n] = arr(random_vec(&mut r, $n, 1.0));
+            let qdd: [f64; $n] = arr(random_vec(&mut r, $n, 1.0));
+            let tau: [f64; $n] = arr(random_vec(&mut r, $n, 20.0));
+            let f_ext: [[f64; 6]; $n] = core::array::from_fn(|_| arr(random_vec(&mut r, 6, 3.0)));
+            let m = $c::mass_matrix(&q);
+            close(
+                "M vs unrolled",
+                &flat(&m),
+                &flat(&$u::mass_matrix(&q)),
+                1e-12,
+            );
+            let mi: Vec<f64> = alg
+                .mass_matrix
+                .mass_matrix(&p, &q)
+                .into_iter()
+                .flatten()
+                .collect();
+            close("M vs interpreted", &flat(&m), &mi, 1e-12);
+            let c = $c::nonlinear_effects(&q, &qd);
+            close("c vs unrolled", &c, &$u::nonlinear_effects(&q, &qd), 1e-12);
+            let ci: Vec<f64> = alg
+                .bias
+                .bias(&p, &q, &qd, &loads)
+                .iter()
+                .map(|b| -b)
+                .collect();
+            close("c vs interpreted", &c, &ci, 1e-12);
+            let (m2, c2) = $c::mass_matrix_and_nonlinear_effects(&q, &qd);
+            assert_eq!((m2, c2), (m, c), "M + c in one call");
+            let id = $c::inverse_dynamics(&q, &qd, &qdd);
+            close(
+                "ID vs unrolled",
+                &id,
+                &$u::inverse_dynamics(&q, &qd, &qdd),
+                1e-12,
+            );
+            let idi = alg.inverse_dynamics(&p, &q, &qd, &qdd, &loads);
+            close("ID vs interpreted", &id, &idi, 1e-12);
+            let fd = $c::forward_dynamics(&q, &qd, &tau);
+            close(
+                "FD vs unrolled",
+                &fd,
+                &$u::forward_dynamics(&q, &qd, &tau),
+                1e-10,
+            );
+            let with_tau = Loads {
+                tau: Some(tau.to_vec()),
+                ..loads.clone()
+            };
+            close(
+                "FD vs interpreted",
+                &fd,
+                &alg.forward_dynamics(&p, &q, &qd, &with_tau),
+                1e-10,
+            );
+            // M q̈ + c = τ at the ABA's q̈.
+            let back: Vec<f64> = (0..$n)
+                .map(|i| (0..$n).map(|j| m[i][j] * fd[j]).sum::<f64>() + c[i])
+                .collect();
+            close("M FD + c = τ", &back, &tau, 1e-10);
+            let fw = $c::forward_dynamics_with_wrenches(&q, &qd, &tau, &f_ext);
+            let fwu = $u::forward_dynamics_with_wrenches(&q, &qd, &tau, &f_ext);
+            close("FD with wrenches vs unrolled", &fw, &fwu, 1e-10);
+        }
+    }};
+}
+
+#[test]
+fn compact_chain_with_gravity_equals_unrolled_and_interpreted() {
+    compare!(Chain3C, Chain3U, 3, "chain3", Some(G));
+    let q = [0.3, -0.2, 1.1];
+    close(
+        "gravity",
+        &Chain3C::gravity(&q),
+        &Chain3U::gravity(&q),
+        1e-12,
+    );
+    close(
+        "gravity = c(q̇ = 0)",
+        &Chain3C::gravity(&q),
+        &Chain3C::nonlinear_effects(&q, &[0.0; 3]),
+        1e-15,
+    );
+}
+
+#[test]
+fn compact_chain_in_space_equals_unrolled_and_interpreted() {
+    compare!(Chain12C, Chain12U, 12, "chain12", None);
+}
+
+#[test]
+fn compact_trees_equal_unrolled_and_interpreted() {
+    compare!(Tree7C, Tree7U, 7, "tree7", Some(G));
+    compare!(Tree10C, Tree10U, 10, "tree10", None);
+}
+
+#[test]
+fn compact_f32_is_close_to_f64() {
+    let mut r = rng(5);
+    let q: [f64; 12] = arr(random_vec(&mut r, 12, 2.0));
+    let qd: [f64; 12] = arr(random_vec(&mut r, 12, 1.0));
+    let tau: [f64; 12] = arr(random_vec(&mut r, 12, 20.0));
+    let (q32, qd32, tau32) = (
+        q.map(|x| x as f32),
+        qd.map(|x| x as f32),
+        tau.map(|x| x as f32),
+    );
+    let up = |v: &[f32]| v.iter().map(|x| f64::from(*x)).collect::<Vec<_>>();
+    let m: Vec<f64> = Chain12F32::mass_matrix(&q32)
+        .iter()
+        .flat_map(|r| up(r))
+        .collect();
+    close("M f32", &m, &flat(&Chain12C::mass_matrix(&q)), 1e-4);
+    close(
+        "c f32",
+        &up(&Chain12F32::nonlinear_effects(&q32, &qd32)),
+        &Chain12C::nonlinear_effects(&q, &qd),
+        1e-4,
+    );
+    close(
+        "FD f32",
+        &up(&Chain12F32::forward_dynamics(&q32, &qd32, &tau32)),
+        &Chain12C::forward_dynamics(&q, &qd, &tau),
+        1e-3,
+    );
+}
