@@ -39,6 +39,8 @@ kanegen::scene!(GravityWrench, "tests/data/scenes/gravity_wrench.toml");
 kanegen::scene!(FloatingWrenches, "tests/data/scenes/floating_wrenches.toml");
 kanegen::scene!(FloatingMidpoint, "tests/data/scenes/floating_midpoint.toml");
 kanegen::scene!(CtWrench, "tests/data/scenes/computed_torque_wrench.toml");
+kanegen::scene!(SsrmsDrives, "scenes/ssrms_drives.toml");
+kanegen::scene!(RotorWrench, "tests/data/scenes/rotor_wrench.toml");
 
 fn interpreted(file: &str) -> (Scene, Run) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
@@ -122,6 +124,12 @@ agree!(
     floating_midpoint_agrees,
     FloatingMidpoint,
     "tests/data/scenes/floating_midpoint.toml"
+);
+agree!(ssrms_drives_agrees, SsrmsDrives, "scenes/ssrms_drives.toml");
+agree!(
+    rotor_wrench_agrees,
+    RotorWrench,
+    "tests/data/scenes/rotor_wrench.toml"
 );
 agree!(
     computed_torque_wrench_agrees,
