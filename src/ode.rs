@@ -541,3 +541,64 @@ pub fn midpoint<const D: usize>(
     }
     Ok(stats)
 }
+
+/// Solves `A x = b` for a symmetric positive definite `A` by a fixed-size LDLᵀ factorization
+/// (only the lower triangle is read), in place of `b`: no allocation, no panic. `None` when a
+/// pivot is not positive (or not finite): `A` is not positive definite. Used by `scene!` for
+/// `(M + diag(I_m n²)) q̈ = τ − c` with rotor inertia.
+#[must_use]
+#[allow(clippy::needless_range_loop)]
+pub fn solve_spd<const N: usize>(a: &[[f64; N]; N], b: &[f64; N]) -> Option<[f64; N]> {
+    // l[i][k] for k < i; w[i][k] = L_ik D_k.
+    let mut l = [[0.0f64; N]; N];
+    let mut w = [[0.0f64; N]; N];
+    let mut d_inv = [0.0f64; N];
+    for j in 0..N {
+        let mut dj = a[j][j];
+        for k in 0..j {
+            dj -= l[j][k] * w[j][k];
+        }
+        // `!(dj > 0)` also catches NaN.
+        if !(dj > 0.0 && dj.is_finite()) {
+            return None;
+        }
+        let inv = 1.0 / dj;
+        d_inv[j] = inv;
+        for i in (j + 1)..N {
+            let mut s = a[i][j];
+            for k in 0..j {
+                s -= l[i][k] * w[j][k];
+            }
+            l[i][j] = s * inv;
+            w[i][j] = s;
+        }
+    }
+    let mut x = *b;
+    for i in 0..N {
+        for k in 0..i {
+            x[i] -= l[i][k] * x[k];
+        }
+    }
+    for i in 0..N {
+        x[i] *= d_inv[i];
+    }
+    for i in (0..N).rev() {
+        for k in (i + 1)..N {
+            x[i] -= l[k][i] * x[k];
+        }
+    }
+    Some(x)
+}
+
+#[cfg(test)]
+mod solve_spd_tests {
+    #[test]
+    fn solves_and_refuses_indefinite() {
+        let a = [[4.0, 2.0], [2.0, 3.0]];
+        let x = super::solve_spd(&a, &[2.0, 1.0]).unwrap();
+        assert!((4.0 * x[0] + 2.0 * x[1] - 2.0).abs() < 1e-15);
+        assert!((2.0 * x[0] + 3.0 * x[1] - 1.0).abs() < 1e-15);
+        assert!(super::solve_spd(&[[1.0, 2.0], [2.0, 1.0]], &[1.0, 1.0]).is_none());
+        assert!(super::solve_spd(&[[f64::NAN]], &[1.0]).is_none());
+    }
+}

@@ -1,19 +1,22 @@
 //! `kanegen::scene!` against the interpreted simulator (`kanegen::sim`), on every example scene
-//! of `scenes/` (all five are supported: none has a tabulated wrench with a computed-torque
-//! drive, the one feature `scene!` rejects) and on four test scenes with what the examples lack
+//! of `scenes/` (all six are supported: none has a tabulated wrench with a computed-torque
+//! drive, the one feature `scene!` rejects) and on six test scenes with what the examples lack
 //! (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base, constant and tabulated body-frame
 //! wrenches on one body, constant drives; `floating_wrenches.toml`, free-floating under
 //! gravity, wrenches on the base in both frames and on two links, constant drives, damping;
 //! `floating_midpoint.toml`, a tumbling free-floating base under PD drives, implicit midpoint;
 //! `computed_torque_wrench.toml`, constant wrenches in both frames compensated by a
-//! computed-torque drive):
+//! computed-torque drive; `rotor_wrench.toml`, rotor inertia and Coulomb friction with gravity,
+//! an inertial-frame and a tabulated wrench, dopri5; `floating_friction.toml`, drive friction
+//! on the tumbling free-floating arm):
 //!
 //! - the compiled run samples at the same times as the interpreted one, and every state
 //!   component agrees to `|x_c − x_i| ≤ 1e-9 (1 + |x_i|)` at every sample — the same integrator
 //!   and step (RK4, midpoint) or tolerance (dopri5) on right-hand sides equal to rounding;
 //!   measured worst 9.3e-13 (`free_floating_7dof`, dopri5 at tolerance 1e-10), Dextre 7.0e-15,
-//!   the test scenes 2.4e-14, 2.5e-15, 5.0e-16 (midpoint) and 1.3e-16 (computed torque), the
-//!   other fixed-base scenes ≤ 3.8e-16;
+//!   the test scenes 2.4e-14, 2.5e-15, 5.0e-16 (midpoint), 1.3e-16 (computed torque),
+//!   4.1e-14 (rotor with wrenches) and 1.6e-12 (friction, free-floating), the other fixed-base
+//!   scenes ≤ 3.8e-16 (`ssrms_drives`, rotor inertia and friction, 1.1e-16);
 //! - on the free-floating 7-dof scene, the compiled run conserves linear and angular momentum
 //!   (`NameDynamics::momentum`) as the interpreted one does (its summary's drift): measured
 //!   drifts 5.6e-11 (linear) and 3.49e-10 (angular) relative, interpreted 5.6e-11 and 3.48e-10;
@@ -24,7 +27,8 @@
 //! The checks see a wrong effect: the SSRMS wrist wrench rotated by `R` instead of `Rᵀ` moves the
 //! SSRMS effects scene by 3.1e-2 (relative) and fails the first and last; the base's
 //! inertial-frame wrench left unrotated moves `floating_wrenches` by 2.4e-2; the wrench
-//! compensation of the computed-torque drive with the wrong sign moves its scene by 9.6e-2.
+//! compensation of the computed-torque drive with the wrong sign moves its scene by 9.6e-2;
+//! Coulomb friction added instead of subtracted and half the rotor inertia (both at once) move `ssrms_drives` by 9.0e-2 and `rotor_wrench` by 4.8e-1.
 
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, Run};
@@ -39,6 +43,9 @@ kanegen::scene!(GravityWrench, "tests/data/scenes/gravity_wrench.toml");
 kanegen::scene!(FloatingWrenches, "tests/data/scenes/floating_wrenches.toml");
 kanegen::scene!(FloatingMidpoint, "tests/data/scenes/floating_midpoint.toml");
 kanegen::scene!(CtWrench, "tests/data/scenes/computed_torque_wrench.toml");
+kanegen::scene!(SsrmsDrives, "scenes/ssrms_drives.toml");
+kanegen::scene!(RotorWrench, "tests/data/scenes/rotor_wrench.toml");
+kanegen::scene!(FloatingFriction, "tests/data/scenes/floating_friction.toml");
 
 fn interpreted(file: &str) -> (Scene, Run) {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(file);
@@ -122,6 +129,17 @@ agree!(
     floating_midpoint_agrees,
     FloatingMidpoint,
     "tests/data/scenes/floating_midpoint.toml"
+);
+agree!(ssrms_drives_agrees, SsrmsDrives, "scenes/ssrms_drives.toml");
+agree!(
+    rotor_wrench_agrees,
+    RotorWrench,
+    "tests/data/scenes/rotor_wrench.toml"
+);
+agree!(
+    floating_friction_agrees,
+    FloatingFriction,
+    "tests/data/scenes/floating_friction.toml"
 );
 agree!(
     computed_torque_wrench_agrees,

@@ -233,6 +233,20 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         }
     };
 
+    // Coulomb drive friction, on the applied side as the interpreted `SceneSystem::torques`.
+    let coulomb = match &scene.coulomb {
+        None => quote!(),
+        Some(c) => {
+            let (tc, inv) = (arr(&c.tau_c), lit(1.0 / c.v_s));
+            quote! {
+                const COULOMB: [f64; #nl] = #tc;
+                for i in 0..#nl {
+                    tau[i] -= COULOMB[i] * #runtime::__private::libm::tanh(qdj[i] * #inv);
+                }
+            }
+        }
+    };
+
     // Wrenches: each in its body's frame at the body origin, summed per body (`f_ext` row; on a
     // free-floating base row 0 is the base's).
     let rows_n = Literal::usize_unsuffixed(n + usize::from(floating));
@@ -296,7 +310,41 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             #apply
         }});
     }
-    let accel = if scene.wrenches.is_empty() {
+    let accel = if let Some(r) = &scene.rotor {
+        // (M + diag(I_m n²)) q̈ = τ − c by a fixed-size LDLᵀ (fixed base only: the scene rejects
+        // rotor inertia on a free-floating base). With wrenches, τ + Jᵀf − c = M a_w, a_w the
+        // generated forward dynamics with the wrenches. A non-positive pivot gives a NaN
+        // acceleration, so the step stops with `Stop::NonFinite`.
+        let refl = arr(&r.reflected);
+        let rhs = if scene.wrenches.is_empty() {
+            quote! {
+                let (mut m, c) = #dyn_ty::mass_matrix_and_nonlinear_effects(&s.q, &s.qd);
+                let b: [f64; #nl] = core::array::from_fn(|i| tau[i] - c[i]);
+            }
+        } else {
+            quote! {
+                let mut f_ext = [[0.0f64; 6]; #rows_n];
+                #(#wrench_code)*
+                let a_w = #dyn_ty::forward_dynamics_with_wrenches(&s.q, &s.qd, &tau, &f_ext);
+                let mut m = #dyn_ty::mass_matrix(&s.q);
+                let b: [f64; #nl] = core::array::from_fn(|i| {
+                    let mut x = 0.0;
+                    for j in 0..#nl {
+                        x += m[i][j] * a_w[j];
+                    }
+                    x
+                });
+            }
+        };
+        quote! {{
+            const ROTOR: [f64; #nl] = #refl;
+            #rhs
+            for i in 0..#nl {
+                m[i][i] += ROTOR[i];
+            }
+            #runtime::ode::solve_spd(&m, &b).unwrap_or([f64::NAN; #nl])
+        }}
+    } else if scene.wrenches.is_empty() {
         quote!(#dyn_ty::forward_dynamics(&s.q, &s.#vname, &tau))
     } else {
         quote! {{
@@ -467,6 +515,12 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         if scene.damping.is_some() {
             e.push("joint viscous damping".into());
         }
+        if scene.coulomb.is_some() {
+            e.push("Coulomb drive friction".into());
+        }
+        if scene.rotor.is_some() {
+            e.push("reflected rotor inertia".into());
+        }
         if !scene.wrenches.is_empty() {
             e.push(format!("{} external wrench(es)", scene.wrenches.len()));
         }
@@ -570,6 +624,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 let _ = (&qj, &qdj);
                 #drives
                 #damping
+                #coulomb
                 #derivative
             }
 

@@ -73,6 +73,60 @@ struct RawEffects {
     damping: Option<Vec<f64>>,
     #[serde(default)]
     wrench: Vec<RawWrench>,
+    rotor: Option<toml::Spanned<RawRotor>>,
+    friction: Option<toml::Spanned<RawFriction>>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawRotor {
+    inertia: Vec<f64>,
+    gear_ratio: Vec<f64>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawFriction {
+    viscous: Option<Vec<f64>>,
+    coulomb: Option<Vec<f64>>,
+    v_s: Option<f64>,
+}
+
+/// Default regularization speed of Coulomb friction, rad/s (or m/s for a prismatic joint).
+pub const DEFAULT_V_S: f64 = 1e-3;
+
+/// Motor rotor inertia reflected through a rigid gear: `I_m,i n_i²` added to `M_ii`.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Rotor {
+    /// Rotor inertia about its axis `I_m,i`, kg·m² (`>= 0`).
+    pub inertia: Vec<f64>,
+    /// Gear ratio `n_i` (motor turns per joint turn, `!= 0`).
+    pub gear_ratio: Vec<f64>,
+    /// `I_m,i n_i²`, kg·m².
+    pub reflected: Vec<f64>,
+}
+
+/// Regularized Coulomb drive friction `τ_c,i tanh(q̇_i / v_s)`, subtracted from the drive
+/// torque (the viscous part of `[effects] friction` is `damping`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Coulomb {
+    /// Coulomb friction torques `τ_c,i`, N·m (`>= 0`).
+    pub tau_c: Vec<f64>,
+    /// Regularization speed `v_s > 0`.
+    pub v_s: f64,
+}
+
+impl Coulomb {
+    /// The friction torque of joint `i` at rate `qd` (`τ_c,i tanh(q̇ / v_s)`).
+    #[must_use]
+    pub fn torque(&self, i: usize, qd: f64) -> f64 {
+        self.tau_c[i] * (qd * (1.0 / self.v_s)).tanh()
+    }
+}
+
+/// 1-based line of byte offset `at` in `text`.
+fn line_of(text: &str, at: usize) -> usize {
+    text[..at.min(text.len())].matches('\n').count() + 1
 }
 
 #[derive(Deserialize)]
@@ -405,6 +459,10 @@ pub struct Scene {
     /// External wrenches, constant or tabulated in time ([`BASE_BODY`] for the free-floating base
     /// body).
     pub wrenches: Vec<SceneWrench>,
+    /// Reflected rotor inertia (`[effects] rotor`), fixed base only.
+    pub rotor: Option<Rotor>,
+    /// Regularized Coulomb drive friction (`[effects] friction.coulomb`).
+    pub coulomb: Option<Coulomb>,
     /// The joint drives.
     pub drives: Drives,
     /// Initial joint positions.
@@ -642,6 +700,86 @@ impl Scene {
             });
         }
 
+        let mut damping = e.damping;
+        let rotor = match e.rotor {
+            None => None,
+            Some(r) => {
+                let line = line_of(text, r.span().start);
+                let r = r.into_inner();
+                let key = |k: &str| format!("effects.rotor.{k} (line {line})");
+                if floating {
+                    bail!(
+                        "effects.rotor (line {line}): rotor inertia is supported on a fixed base only"
+                    );
+                }
+                check_len(&key("inertia"), &r.inertia, n, GAIN)?;
+                check_len(&key("gear_ratio"), &r.gear_ratio, n, GAIN)?;
+                if r.inertia.iter().any(|x| *x < 0.0) {
+                    bail!("{}: must be >= 0", key("inertia"));
+                }
+                if r.gear_ratio.contains(&0.0) {
+                    bail!("{}: must be non-zero", key("gear_ratio"));
+                }
+                let reflected: Vec<f64> = r
+                    .inertia
+                    .iter()
+                    .zip(&r.gear_ratio)
+                    .map(|(i, g)| i * g * g)
+                    .collect();
+                check_bound(&key("inertia"), &reflected, GAIN)?;
+                Some(Rotor {
+                    inertia: r.inertia,
+                    gear_ratio: r.gear_ratio,
+                    reflected,
+                })
+            }
+        };
+        let coulomb = match e.friction {
+            None => None,
+            Some(f) => {
+                let line = line_of(text, f.span().start);
+                let f = f.into_inner();
+                let key = |k: &str| format!("effects.friction.{k} (line {line})");
+                if f.viscous.is_none() && f.coulomb.is_none() {
+                    bail!(
+                        "effects.friction (line {line}): give `viscous` and/or `coulomb` coefficients"
+                    );
+                }
+                if let Some(b) = f.viscous {
+                    if damping.is_some() {
+                        bail!(
+                            "{}: viscous friction is `effects.damping`; give it once",
+                            key("viscous")
+                        );
+                    }
+                    check_len(&key("viscous"), &b, n, GAIN)?;
+                    if b.iter().any(|x| *x < 0.0) {
+                        bail!("{}: coefficients must be >= 0", key("viscous"));
+                    }
+                    damping = Some(b);
+                }
+                match f.coulomb {
+                    None => {
+                        if f.v_s.is_some() {
+                            bail!("{}: only with `coulomb`", key("v_s"));
+                        }
+                        None
+                    }
+                    Some(c) => {
+                        check_len(&key("coulomb"), &c, n, FORCE)?;
+                        if c.iter().any(|x| *x < 0.0) {
+                            bail!("{}: friction torques must be >= 0", key("coulomb"));
+                        }
+                        let v_s = f.v_s.unwrap_or(DEFAULT_V_S);
+                        if !(v_s.is_finite() && v_s > 0.0) {
+                            bail!("{}: must be > 0", key("v_s"));
+                        }
+                        Some(Coulomb { tau_c: c, v_s })
+                    }
+                }
+            }
+        };
+
         let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
         check_len("initial.q", &q0, n, POSITION)?;
         let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
@@ -818,8 +956,10 @@ impl Scene {
             model: chain,
             base,
             gravity: e.gravity,
-            damping: e.damping,
+            damping,
             wrenches,
+            rotor,
+            coulomb,
             drives,
             q0,
             qd0,

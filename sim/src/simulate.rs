@@ -168,7 +168,9 @@ impl<'a> SceneSystem<'a> {
         (&x[7..7 + n], &x[13 + n..13 + 2 * n], Some(st))
     }
 
-    /// The joint drive + damping torques at `(t, q, q̇)`; `None` when the scene has neither.
+    /// The joint drive torques minus damping (viscous friction) and Coulomb friction at
+    /// `(t, q, q̇)`: `τ_applied = τ_drive − b q̇ − τ_c tanh(q̇ / v_s)`; `None` when the scene has
+    /// none of them.
     #[must_use]
     pub fn torques(&self, t: f64, q: &[f64], qd: &[f64]) -> Option<Vec<f64>> {
         let s = self.scene;
@@ -205,6 +207,12 @@ impl<'a> SceneSystem<'a> {
                 t[i] -= c[i] * qd[i];
             }
         }
+        if let Some(c) = &s.coulomb {
+            let t = tau.get_or_insert_with(|| vec![0.0; self.n]);
+            for i in 0..self.n {
+                t[i] -= c.torque(i, qd[i]);
+            }
+        }
         tau
     }
 
@@ -227,10 +235,17 @@ impl<'a> SceneSystem<'a> {
                     .algorithm
                     .mass_matrix
                     .mass_matrix(&self.params, q);
-                let t = 0.5
+                let mut t = 0.5
                     * (0..self.n)
                         .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
                         .sum::<f64>();
+                // The rotors' kinetic energy ½ I_m n² q̇².
+                if let Some(r) = &self.scene.rotor {
+                    t += 0.5
+                        * (0..self.n)
+                            .map(|i| r.reflected[i] * qd[i] * qd[i])
+                            .sum::<f64>();
+                }
                 // Gravitational potential: −g · Σ m_k x_k over the bodies' centres of mass.
                 let v = match self.scene.gravity {
                     None => 0.0,
@@ -303,7 +318,18 @@ impl System for SceneSystem<'_> {
                 dx[7 + n..].copy_from_slice(&nu_dot);
             }
             _ => {
-                let qdd = alg.forward_dynamics(&self.params, q, qd, &loads);
+                let qdd = match &self.scene.rotor {
+                    None => alg.forward_dynamics(&self.params, q, qd, &loads),
+                    // (M + diag(I_m n²)) q̈ = τ − c: the reflected rotor inertia on M's
+                    // diagonal before the LDLᵀ solve.
+                    Some(r) => {
+                        let mut d = alg.dynamics(&self.params, q, qd, &loads);
+                        for i in 0..n {
+                            d.a[i][i] += r.reflected[i];
+                        }
+                        kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
+                    }
+                };
                 dx[..n].copy_from_slice(qd);
                 dx[n..].copy_from_slice(&qdd);
             }
@@ -436,6 +462,7 @@ fn rel(x: f64, x0: f64) -> f64 {
 pub fn conserves_energy(scene: &Scene) -> bool {
     matches!(scene.drives, Drives::None)
         && scene.damping.is_none()
+        && scene.coulomb.is_none()
         && scene.wrenches.is_empty()
         && !(scene.is_floating() && scene.gravity.is_some())
 }

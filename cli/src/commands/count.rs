@@ -198,8 +198,53 @@ pub fn count_scene(
         .into(),
         n: scene.model.dof(),
         counts: count_lines(&scene.model, &mass, &bias, &spec)?,
-        effects: effect_lines(&scene.model, &bias, &spec)?,
+        effects: {
+            let mut e = effect_lines(&scene.model, &bias, &spec)?;
+            e.extend(drive_effect_lines(scene, &bias));
+            e
+        },
     })
+}
+
+/// The drive effects outside the traced `A` and `b` (the viscous part of `friction` is
+/// `damping`, traced with `b`), counted from their formulas, per bias method (the same for
+/// each) and convention: `coulomb` subtracts `τ_c,i tanh(q̇_i · (1/v_s))` from `b` (2 mul,
+/// 1 add and one `tanh` per joint); `rotor` adds the constant `I_m,i n_i²` to `A_ii` (1 add per
+/// joint) before the solve. `emitted` leaves out the joints whose coefficient is 0 (folded
+/// away), `paper` counts every joint.
+fn drive_effect_lines(scene: &Scene, bias: &[BiasMethod]) -> Vec<EffectLine> {
+    let nonzero = |v: &[f64]| v.iter().filter(|x| **x != 0.0).count() as i64;
+    let n = scene.model.dof() as i64;
+    let mut lines = Vec::new();
+    let effects: Vec<(&str, &[f64], i64)> = [
+        scene
+            .coulomb
+            .as_ref()
+            .map(|c| ("coulomb", c.tau_c.as_slice(), 2)),
+        scene
+            .rotor
+            .as_ref()
+            .map(|r| ("rotor", r.reflected.as_slice(), 0)),
+    ]
+    .into_iter()
+    .flatten()
+    .collect();
+    for b in bias {
+        for &(effect, coef, mul_per_joint) in &effects {
+            for conv in ["emitted", "paper"] {
+                let k = if conv == "paper" { n } else { nonzero(coef) };
+                lines.push(EffectLine {
+                    effect: effect.into(),
+                    method: b.name().into(),
+                    convention: conv.into(),
+                    mul: mul_per_joint * k,
+                    add: k,
+                    div: 0,
+                });
+            }
+        }
+    }
+    lines
 }
 
 /// Human-readable rendering of [`SceneCountReport`].
@@ -244,6 +289,13 @@ pub fn render_scene_text(r: &SceneCountReport) -> String {
                 e.add,
                 e.mul + e.add,
                 e.div
+            );
+        }
+        if names.iter().any(|e| e == "coulomb" || e == "rotor") {
+            let _ = writeln!(
+                s,
+                "\ncoulomb and rotor are counted from their formulas: coulomb also takes one tanh \
+                 per joint; rotor adds to A's diagonal (before the solve), not to b"
             );
         }
     }
