@@ -184,8 +184,9 @@ impl Model {
         (joints, frames, base_inertial)
     }
 
-    /// This model's name, base and base kind with other joints, frames and base inertial.
-    fn rebuilt(
+    /// This model's name, base and base kind with other joints, frames and base inertial
+    /// (inertias already validated where they came from; also [`Model::lock_joint`]'s).
+    pub(crate) fn rebuilt(
         &self,
         joints: Vec<Joint>,
         frames: Vec<Frame>,

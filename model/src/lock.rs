@@ -1,7 +1,7 @@
 //! Locking a joint: the model with one joint turned into a fixed placement.
 
 use crate::placement::{axis_rotation, mat_mul, mat_vec, Placement};
-use crate::{Frame, JointKind, Model, ModelError, Validation};
+use crate::{Frame, JointKind, Model, ModelError};
 
 impl Model {
     /// The model with joint `index` locked at `value` (rad or m): the joint becomes a fixed
@@ -83,16 +83,6 @@ impl Model {
             })
             .collect();
         joints.remove(index);
-        Model::new_with(
-            self.name(),
-            self.base(),
-            base_inertial,
-            joints,
-            Validation {
-                allow_nonphysical_inertia: true,
-            },
-        )?
-        .with_frames(frames)?
-        .with_base_kind(self.base_kind())
+        self.rebuilt(joints, frames, base_inertial)
     }
 }
