@@ -106,7 +106,7 @@ fn generate_items_with(
     let op_ty = ident("op-count name", &opts.op_count_name)?;
     let emitter = Emitter::new(opts)?;
     let fl = opts.float.ty();
-    let decision = form_decision(model, opts)?;
+    let (decision, mut decided) = form_decision(model, opts)?;
     let compact = decision.form == Form::Compact;
 
     let mut fns = Vec::new();
@@ -115,8 +115,11 @@ fn generate_items_with(
     let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
     let mut names = std::collections::HashSet::new();
     for f in api::functions(model, opts) {
-        let (choice, traced) =
-            choose::choose(model, f, mass, opts).map_err(|e| Error(e.to_string()))?;
+        // `M` and `(M, c)` were traced for the form decision, with the same methods.
+        let (choice, traced) = match decided.iter().position(|(c, _)| c.function == f) {
+            Some(k) => decided.swap_remove(k),
+            None => choose::choose(model, f, mass, opts).map_err(|e| Error(e.to_string()))?,
+        };
         if f == Function::MassMatrix {
             mass = choice.chosen.mass_matrix;
         }
@@ -425,19 +428,30 @@ fn generate_items_with(
 }
 
 /// The form to emit ([`compact::decide`]): for [`Form::Auto`] from the emitted operations of the
-/// cheapest unrolled `mass_matrix_and_nonlinear_effects`.
-fn form_decision(model: &Model, opts: &Options) -> Result<compact::Decision, Error> {
+/// cheapest unrolled `mass_matrix_and_nonlinear_effects` — with the mass-matrix method `M`
+/// chooses, as the unrolled code would emit it. The choices traced for it (`M`, then `(M, c)`)
+/// are returned for the emitter to use rather than trace again.
+fn form_decision(
+    model: &Model,
+    opts: &Options,
+) -> Result<(compact::Decision, Vec<(Choice, kanegen_trace::Traced)>), Error> {
+    let mut traced = Vec::new();
     let ops = match (opts.form, compact::unsupported(model, opts)) {
         (Form::Auto, None) => {
-            let f = Function::MassMatrixAndNonlinearEffects;
-            let (choice, _) =
-                choose::choose(model, f, kanegen_dynamics::MassMatrixMethod::Crba, opts)
-                    .map_err(|e| Error(e.to_string()))?;
-            choice.counts().total()
+            let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
+            for f in [
+                Function::MassMatrix,
+                Function::MassMatrixAndNonlinearEffects,
+            ] {
+                let c = choose::choose(model, f, mass, opts).map_err(|e| Error(e.to_string()))?;
+                mass = c.0.chosen.mass_matrix;
+                traced.push(c);
+            }
+            traced.last().map_or(0, |(c, _)| c.counts().total())
         }
         _ => 0,
     };
-    compact::decide(model, opts, ops)
+    Ok((compact::decide(model, opts, ops)?, traced))
 }
 
 /// The payload struct (the last body's mass properties) and its nominal value.
