@@ -7,6 +7,7 @@
 //! Times are not compared: they come from a shared, noisy machine.
 
 use kanegen::cli::commands::accuracy::{figure_name, render_markdown, run, Cost, DEFAULT_INPUTS};
+use kanegen::cli::reports::accuracy::integration::IntegrationRow;
 use kanegen::cli::reports::accuracy::{AccuracyReport, Options};
 use std::path::PathBuf;
 
@@ -53,11 +54,38 @@ fn docs_accuracy_md_renders_docs_accuracy_json() {
     }
 }
 
+const STALE: &str =
+    "docs/accuracy.json is stale: run `cargo run --release -- accuracy --out docs --force`";
+
+/// A committed integration run `a` and a fresh one `b` agree: same setting, final errors within
+/// a factor 2 (or both below 1e-12), steps within 2 %.
+fn same_run(subject: &str, a: &IntegrationRow, b: &IntegrationRow) {
+    assert_eq!(
+        (&a.integrator, &a.setting),
+        (&b.integrator, &b.setting),
+        "{STALE}"
+    );
+    match (a.final_error, b.final_error) {
+        (Some(x), Some(y)) => assert!(
+            close(x, y, 2.0) || x.max(y) < 1e-12,
+            "{subject} {} {}: {x:e} vs {y:e}; {STALE}",
+            a.integrator,
+            a.setting
+        ),
+        (x, y) => assert_eq!(x.is_none(), y.is_none(), "{STALE}"),
+    }
+    let (s, t) = (a.steps as f64, b.steps as f64);
+    assert!(
+        (s - t).abs() <= 0.02 * s.max(t) + 2.0,
+        "{subject} {} steps {s} vs {t}; {STALE}",
+        a.setting
+    );
+}
+
 #[test]
 fn docs_accuracy_json_is_fresh() {
     let (old, new) = (committed(), fresh());
-    let stale =
-        "docs/accuracy.json is stale: run `cargo run --release -- accuracy --out docs --force`";
+    let stale = STALE;
     assert_eq!(old.len(), new.len(), "{stale}");
     for (o, n) in old.iter().zip(&new) {
         assert_eq!(
@@ -91,27 +119,12 @@ fn docs_accuracy_json_is_fresh() {
         }
         assert_eq!(o.integration.len(), n.integration.len(), "{stale}");
         for (a, b) in o.integration.iter().zip(&n.integration) {
-            assert_eq!(
-                (&a.integrator, &a.setting),
-                (&b.integrator, &b.setting),
-                "{stale}"
-            );
-            match (a.final_error, b.final_error) {
-                (Some(x), Some(y)) => assert!(
-                    close(x, y, 2.0) || x.max(y) < 1e-12,
-                    "{} {} {}: {x:e} vs {y:e}; {stale}",
-                    o.subject,
-                    a.integrator,
-                    a.setting
-                ),
-                (x, y) => assert_eq!(x.is_none(), y.is_none(), "{stale}"),
-            }
-            let (s, t) = (a.steps as f64, b.steps as f64);
-            assert!(
-                (s - t).abs() <= 0.02 * s.max(t) + 2.0,
-                "{} steps {s} vs {t}; {stale}",
-                a.setting
-            );
+            same_run(&o.subject, a, b);
+        }
+        assert_eq!(o.friction.len(), n.friction.len(), "{STALE}");
+        for (a, b) in o.friction.iter().zip(&n.friction) {
+            assert_eq!((a.v_s, a.scene), (b.v_s, b.scene), "{STALE}");
+            same_run(&o.subject, &a.run, &b.run);
         }
         assert_eq!(o.effects.len(), n.effects.len(), "{stale}");
         for (a, b) in o.effects.iter().zip(&n.effects) {
@@ -193,6 +206,9 @@ fn the_rows_say_what_they_should() {
         }
         // Fixed-step integrators: halving the step divides the error by about 2^p while above
         // the reference's floor (RK4 p = 4, midpoint p = 2); checked on the two finest steps.
+        // With Coulomb friction the steps of the ladder are not yet in the asymptotic range
+        // (the slope τ_c / v_s of tanh is 2e5 N·m·s on ssrms_drives: RK4 measured 8.7 there),
+        // so the error must fall at least at the order, not at exactly it.
         for (name, p) in [("rk4", 4.0), ("midpoint", 2.0)] {
             let errs: Vec<f64> = r
                 .integration
@@ -203,13 +219,41 @@ fn the_rows_say_what_they_should() {
             if let [.., a, b] = errs[..] {
                 if b > 1e3 * r.integration_reference_error.unwrap() {
                     let order = (a / b).log2();
-                    assert!(
-                        (order - p).abs() < 0.5,
-                        "{} {name}: order {order:.2}",
-                        r.subject
-                    );
+                    let ok = if r.friction.is_empty() {
+                        (order - p).abs() < 0.5
+                    } else {
+                        order > p - 0.5
+                    };
+                    assert!(ok, "{} {name}: order {order:.2}", r.subject);
                 }
             }
+        }
+        // Coulomb regularization: a finer v_s comes closer to the finest (the error falls,
+        // measured 2.4e-2, 2.2e-2, 8.2e-3, 1.2e-3 on ssrms_drives), and costs more steps
+        // (229, 413, 886, 4010, 37424).
+        for w in r.friction.windows(2) {
+            assert!(
+                w[0].v_s > w[1].v_s,
+                "{}: ladder not coarse to fine",
+                r.subject
+            );
+            assert!(
+                w[1].run.steps > w[0].run.steps,
+                "{}: v_s {:e} no dearer",
+                r.subject,
+                w[1].v_s
+            );
+            if let (Some(a), Some(b)) = (w[0].run.final_error, w[1].run.final_error) {
+                assert!(b < a, "{}: v_s {:e} no closer", r.subject, w[1].v_s);
+            }
+        }
+        if let Some(last) = r.friction.last() {
+            assert_eq!(last.run.final_error, Some(0.0), "{}", r.subject);
+            assert!(
+                r.friction.iter().filter(|f| f.scene).count() == 1,
+                "{}",
+                r.subject
+            );
         }
         for e in &r.effects {
             assert!(e.ops > 0, "{}: {} costs nothing", r.subject, e.effect);

@@ -10,12 +10,14 @@ use std::path::{Path, PathBuf};
 
 /// What `kanegen accuracy` reports on when given no input (and what `docs/accuracy.md` holds):
 /// SSRMS as a model (with its generated code), SSRMS slewing 116 t, the free-floating 7-dof arm,
-/// and SSRMS with every effect kind.
-pub const DEFAULT_INPUTS: [&str; 4] = [
+/// SSRMS with every traced effect kind, and SSRMS with its drives modelled (rotor inertia and
+/// friction).
+pub const DEFAULT_INPUTS: [&str; 5] = [
     "tests/data/reference/ssrms_nguyen_hughes_1994.urdf",
     "scenes/ssrms_payload_fixed.toml",
     "scenes/free_floating_7dof.toml",
     "scenes/ssrms_effects.toml",
+    "scenes/ssrms_drives.toml",
 ];
 
 /// Generated variants of a chain that has checked-in generated code (SSRMS).
@@ -196,10 +198,22 @@ pub fn render_markdown(reports: &[AccuracyReport], timing: bool) -> Result<Strin
                 .iter()
                 .map(|e| serde_json::json!({"effect": e.effect, "ops": e.ops, "change": sci(e.trajectory_change)}))
                 .collect();
+            let friction: Vec<serde_json::Value> = r
+                .friction
+                .iter()
+                .zip(&r.friction_sentences)
+                .map(|(f, s)| {
+                    serde_json::json!({"v_s": format!("{:e}", f.v_s), "scene": f.scene,
+                        "error": f.run.final_error.map_or("failed".into(), sci),
+                        "wall": time(format!("{:.2e}", f.run.wall_s)), "steps": f.run.steps,
+                        "evals": f.run.evals, "sentence": if timing { s.clone() } else { "—".into() }})
+                })
+                .collect();
             serde_json::json!({"subject": r.subject, "kind": r.kind, "base": r.base, "n": r.n,
                 "algorithm": r.algorithm, "cond_a": format!("{:.3e}", r.cond_a),
                 "reference_check": r.reference_check,
                 "evaluation": evaluation, "integration": integration, "effects": effects,
+                "friction": friction, "friction_tolerance": sci(crate::reports::accuracy::friction::TOLERANCE),
                 "duration": r.duration, "reference_error": r.integration_reference_error.map_or("—".into(), sci),
                 "figure": figure_name(r, Cost::Wall), "figure_evals": figure_name(r, Cost::Evals)})
         })

@@ -52,7 +52,12 @@ pub const STEPS: [f64; 5] = [0.1, 0.05, 0.025, 0.0125, 0.00625];
 pub const TOLERANCES: [f64; 5] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12];
 
 /// The scene with another integrator setting, sampling only its first and last state.
-fn with_setting(scene: &Scene, integrator: Integrator, step: f64, tolerance: f64) -> Scene {
+pub(crate) fn with_setting(
+    scene: &Scene,
+    integrator: Integrator,
+    step: f64,
+    tolerance: f64,
+) -> Scene {
     let mut s = scene.clone();
     let sim = &mut s.simulation;
     sim.integrator = integrator;
@@ -68,11 +73,11 @@ fn with_setting(scene: &Scene, integrator: Integrator, step: f64, tolerance: f64
 }
 
 /// What one run gives: the final state (or why there is none), wall time, steps, evaluations.
-struct Outcome {
-    x: std::result::Result<Vec<f64>, String>,
-    wall_s: f64,
-    steps: usize,
-    evals: usize,
+pub(crate) struct Outcome {
+    pub(crate) x: std::result::Result<Vec<f64>, String>,
+    pub(crate) wall_s: f64,
+    pub(crate) steps: usize,
+    pub(crate) evals: usize,
 }
 
 /// Runs `scene`; a failed or non-finite run is an outcome, not an error.
@@ -98,6 +103,19 @@ fn run(scene: &Scene) -> Outcome {
             evals: 0,
         },
     }
+}
+
+/// Runs `scene` `repeats` times (at least once): the first run's outcome with the median wall
+/// time (runs of a few milliseconds on a shared machine are noisy).
+pub(crate) fn run_scene(scene: &Scene, repeats: usize) -> Outcome {
+    let mut o = run(scene);
+    let mut walls = vec![o.wall_s];
+    for _ in 1..repeats {
+        walls.push(run(scene).wall_s);
+    }
+    walls.sort_by(f64::total_cmp);
+    o.wall_s = walls[walls.len() / 2];
+    o
 }
 
 /// `max |x − r| / max |r|`.
@@ -139,14 +157,7 @@ pub fn integration_report(scene: &Scene, repeats: usize) -> Result<IntegrationRe
             } else {
                 (v, 1e-8, format!("h = {v}"))
             };
-            let setting_scene = with_setting(scene, integrator, step, tol);
-            let mut o = run(&setting_scene);
-            let mut walls = vec![o.wall_s];
-            for _ in 1..repeats {
-                walls.push(run(&setting_scene).wall_s);
-            }
-            walls.sort_by(f64::total_cmp);
-            o.wall_s = walls[walls.len() / 2];
+            let o = run_scene(&with_setting(scene, integrator, step, tol), repeats);
             rows.push(IntegrationRow {
                 integrator: name.into(),
                 setting,

@@ -1,20 +1,23 @@
 //! `kanegen accuracy`: what accuracy costs in time (issue #6).
 //!
-//! For a model or a scene, three tables: **evaluation** (`A`, `b`, `q̈` in `f32`, `f64`, fused
+//! For a model or a scene, three tables (four for a scene with Coulomb friction): **evaluation** (`A`, `b`, `q̈` in `f32`, `f64`, fused
 //! multiply-add and double-double, generated and interpreted: error against the wide reference
 //! and ns per call), **integration** (every integrator over a ladder of steps or tolerances:
 //! final-state error against a tight reference and wall time, the work–precision diagram), and
 //! **effects** (for each effect a scene enables: operations added and how far the trajectory
-//! moves without it). Each row carries a sentence on what its next digit costs.
+//! moves without it), and **friction** (the regularization speed of Coulomb friction: error
+//! against a finer one and steps, [`friction`]). Each row carries a sentence on what its next digit costs.
 
 pub mod effects;
 pub mod evaluation;
+pub mod friction;
 pub mod generated;
 pub mod integration;
 
 use anyhow::Result;
 use effects::{effects_report, EffectRow};
 use evaluation::{evaluation_report, random_states, EvalRow, GeneratedFns, Subject};
+use friction::{friction_report, friction_sentences, FrictionRow};
 use integration::{integration_report, IntegrationRow};
 use serde::{Deserialize, Serialize};
 
@@ -43,6 +46,13 @@ pub struct AccuracyReport {
     pub integration_reference_error: Option<f64>,
     /// Effects rows (scenes only).
     pub effects: Vec<EffectRow>,
+    /// The Coulomb-friction regularization ladder (scenes with `friction.coulomb` only),
+    /// coarse to fine ([`friction`]).
+    #[serde(default)]
+    pub friction: Vec<FrictionRow>,
+    /// One sentence per friction row.
+    #[serde(default)]
+    pub friction_sentences: Vec<String>,
     /// One sentence per evaluation row, then per integration row: what the next digit costs.
     pub sentences: Vec<String>,
     /// How the double-double reference was checked against exact rational arithmetic.
@@ -192,6 +202,8 @@ pub fn model_report(
         duration: None,
         integration_reference_error: None,
         effects: Vec::new(),
+        friction: Vec::new(),
+        friction_sentences: Vec::new(),
         sentences,
         reference_check,
     }
@@ -238,7 +250,9 @@ pub fn scene_report(
     let subject = Subject::scene(scene);
     let states = random_states(scene.model.dof(), STATES, 6);
     let ev = evaluation_report(&subject, alg, &[], &states, opts.timing);
-    let integ = integration_report(scene, if opts.timing { 5 } else { 1 })?;
+    let repeats = if opts.timing { 5 } else { 1 };
+    let integ = integration_report(scene, repeats)?;
+    let friction = friction_report(scene, repeats)?;
     let mut sentences = eval_sentences(&ev.rows, opts.timing);
     let reference_check = reference_sentence(&ev.rows);
     sentences.extend(integration_sentences(&integ.rows));
@@ -259,6 +273,8 @@ pub fn scene_report(
         duration: Some(integ.duration),
         integration_reference_error: Some(integ.reference_error),
         effects: effects_report(scene)?,
+        friction_sentences: friction_sentences(&friction),
+        friction,
         sentences,
         reference_check,
     })
