@@ -1,5 +1,5 @@
 //! Unrolled against compact generated code (`form = "unrolled"` / `"compact"`), side by side in
-//! one process: `M`, `M + c` and forward dynamics on the random chains N = 2 … 32 of
+//! one process: `M`, `M + c`, `c`, inverse and forward dynamics on the random chains N = 2 … 32 of
 //! `benches/data/` and on SSRMS. N = 48 and 64 (whose unrolled build takes minutes) are timed by
 //! `tools/compact/measure.sh`, which also times the builds.
 //!
@@ -51,6 +51,18 @@ macro_rules! forms {
             });
             g.bench_function("M+c/compact", |b| {
                 b.iter(|| $c::mass_matrix_and_nonlinear_effects(black_box(&q), black_box(&qd)))
+            });
+            g.bench_function("c/unrolled", |b| {
+                b.iter(|| $u::nonlinear_effects(black_box(&q), black_box(&qd)))
+            });
+            g.bench_function("c/compact", |b| {
+                b.iter(|| $c::nonlinear_effects(black_box(&q), black_box(&qd)))
+            });
+            g.bench_function("ID/unrolled", |b| {
+                b.iter(|| $u::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qd)))
+            });
+            g.bench_function("ID/compact", |b| {
+                b.iter(|| $c::inverse_dynamics(black_box(&q), black_box(&qd), black_box(&qd)))
             });
             g.bench_function("FD/unrolled", |b| {
                 b.iter(|| $u::forward_dynamics(black_box(&q), black_box(&qd), black_box(&qd)))

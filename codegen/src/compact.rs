@@ -54,7 +54,9 @@
 //! Compact code loses below a few thousand operations (its loops, table reads and branches on
 //! the kind cost more than the folded constants of straight-line code: 4–10× for SSRMS) and
 //! wins from random N = 8 on, by 4–13× at N = 64; it builds in seconds at any N. Hence
-//! [`AUTO_LIMIT`], on the emitted operations of the unrolled `M + c`.
+//! [`AUTO_LIMIT`], on the emitted operations of the unrolled `M + c`. The O(N) Newton–Euler
+//! functions cross over later (at about 4,300 operations of their own, random N = 16), so a
+//! compact model keeps them straight-line below [`LINEAR_AUTO_LIMIT`] ([`keeps_unrolled`]).
 
 use crate::options::{Error, Float, Form, Options};
 use kanegen_model::{BaseKind, JointKind, Model};
@@ -66,6 +68,28 @@ use quote::quote;
 /// have more emitted operations (`mul + add`) than this: measured ([module docs](self)), compact
 /// code is slower at random N = 4 (1,706 operations) and faster from N = 8 (4,077) on.
 pub const AUTO_LIMIT: u64 = 4_000;
+
+/// Under [`Form::Auto`], a compact model keeps the unrolled body of its O(N) Newton–Euler
+/// functions (`nonlinear_effects`, `gravity`, `inverse_dynamics`) while that body has at most
+/// this many emitted operations. They grow like N, not N², so they cross over later than
+/// `M + c`: measured side by side (`cargo bench --bench compact`, random chains), unrolled `c`
+/// and inverse dynamics are 12 % and 19 % faster than compact at N = 8 (2,012 and 2,099
+/// operations), tie at N = 16 (4,292 and 4,427) and are 13 % and 26 % slower at N = 32 (8,852
+/// and 9,083).
+pub const LINEAR_AUTO_LIMIT: u64 = 4_000;
+
+/// Whether `f` keeps its unrolled body in a model that [`decide`] made compact: under
+/// [`Form::Auto`], an O(N) Newton–Euler function whose unrolled body has `ops` (`mul + add`)
+/// within [`LINEAR_AUTO_LIMIT`].
+#[must_use]
+pub fn keeps_unrolled(opts: &Options, f: Function, ops: u64) -> bool {
+    opts.form == Form::Auto
+        && matches!(
+            f,
+            Function::NonlinearEffects | Function::Gravity | Function::InverseDynamics
+        )
+        && ops <= LINEAR_AUTO_LIMIT
+}
 
 /// Why the compact form cannot be emitted for `model` under `opts`, or `None` when it can.
 #[must_use]

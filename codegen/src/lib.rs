@@ -114,6 +114,7 @@ fn generate_items_with(
     let mut fmas = Vec::new();
     let mut mass = kanegen_dynamics::MassMatrixMethod::Crba;
     let mut names = std::collections::HashSet::new();
+    let mut kept_unrolled = Vec::new();
     for f in api::functions(model, opts) {
         // `M` and `(M, c)` were traced for the form decision, with the same methods.
         let (choice, traced) = match decided.iter().position(|(c, _)| c.function == f) {
@@ -124,9 +125,13 @@ fn generate_items_with(
             mass = choice.chosen.mass_matrix;
         }
         let shape = api::shape(f, n, floating);
-        let compact_body = if compact {
+        let ops = choice.counts().total();
+        let compact_body = if compact && !compact::keeps_unrolled(opts, f, ops) {
             compact::body(f, opts, n)
         } else {
+            if compact && compact::has_body(f) {
+                kept_unrolled.push(format!("`{}` ({ops})", f.name()));
+            }
             None
         };
         let Body {
@@ -306,7 +311,16 @@ fn generate_items_with(
         .iter()
         .position(|l| l.starts_with("Emitted operation counts per candidate"))
         .map_or(header.len(), |k| k.saturating_sub(1));
-    header.insert(at, decision.line.clone());
+    let mut line = decision.line.clone();
+    if !kept_unrolled.is_empty() {
+        line.push_str(&format!(
+            " Straight-line all the same: {} (an O(N) function within {} emitted operations \
+             measured faster unrolled).",
+            kept_unrolled.join(", "),
+            compact::LINEAR_AUTO_LIMIT
+        ));
+    }
+    header.insert(at, line);
     let short = [format!(
         "Dynamics of `{}` (N = {n}); see the module documentation.",
         header::doc_safe(model.name())

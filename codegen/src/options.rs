@@ -92,7 +92,9 @@ pub fn forced_algorithm(name: &str) -> Result<Methods, Error> {
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum Form {
     /// Compact code when the unrolled code would exceed `compact::AUTO_LIMIT` emitted operations and the
-    /// model is supported (`compact::unsupported`), straight-line code otherwise (default).
+    /// model is supported (`compact::unsupported`), straight-line code otherwise (default). In
+    /// compact code, the O(N) Newton–Euler functions stay straight-line within
+    /// `compact::LINEAR_AUTO_LIMIT` operations of their own (`compact::keeps_unrolled`).
     #[default]
     Auto,
     /// Straight-line code from traced graphs (`emit`).

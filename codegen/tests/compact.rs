@@ -1,7 +1,7 @@
 //! The compact form at the source level: what `generate_file` writes with `Form::Compact`
 //! (loops, no allocation, no panicking call), which form `Form::Auto` picks, and what it refuses.
 
-use kanegen_codegen::compact::AUTO_LIMIT;
+use kanegen_codegen::compact::{AUTO_LIMIT, LINEAR_AUTO_LIMIT};
 use kanegen_codegen::{generate_file, generate_items, Float, Form, Options};
 use kanegen_model::random::{random_chain, random_tree, ChainSpec};
 use kanegen_model::{BaseKind, Model};
@@ -93,6 +93,47 @@ fn auto_picks_compact_for_large_models_only() {
     );
     let eight = generate_items(&chain_default(8), &auto).unwrap();
     assert!(form_line(&eight.header).starts_with("Form: compact"));
+    // The O(N) Newton–Euler functions of a compact model stay straight-line within
+    // LINEAR_AUTO_LIMIT (N = 8: 2012 and 2099 operations), not at N = 64; the body says so.
+    let fn_body = |g: &kanegen_codegen::Generated, name: &str| {
+        let src = g.items.to_string().replace(' ', "");
+        let at = src.find(&format!("pubfn{name}(")).unwrap();
+        src[at..at + 400].to_string()
+    };
+    let ops = |g: &kanegen_codegen::Generated, name: &str| {
+        let c = g
+            .choices
+            .iter()
+            .find(|c| c.function.name() == name)
+            .unwrap();
+        c.counts().total()
+    };
+    for name in ["nonlinear_effects", "inverse_dynamics"] {
+        assert!(ops(&eight, name) <= LINEAR_AUTO_LIMIT && ops(&big, name) > LINEAR_AUTO_LIMIT);
+        assert!(
+            fn_body(&eight, name).contains("letx0="),
+            "{name} unrolled at N = 8"
+        );
+        assert!(
+            !fn_body(&big, name).contains("letx0="),
+            "{name} compact at N = 64"
+        );
+        assert!(form_line(&eight.header).contains(&format!("`{name}` (")));
+    }
+    assert!(!fn_body(&eight, "mass_matrix").contains("letx0="));
+    assert!(!form_line(&big.header).contains("Straight-line all the same"));
+    let forced = generate_items(
+        &chain_default(8),
+        &Options {
+            form: Form::Compact,
+            ..auto.clone()
+        },
+    )
+    .unwrap();
+    assert!(
+        !fn_body(&forced, "nonlinear_effects").contains("letx0="),
+        "forced compact"
+    );
     let small = generate_items(&chain_default(4), &auto).unwrap();
     assert!(form_line(&small.header).starts_with("Form: unrolled straight-line code (auto: "));
     let ssrms = kanegen_model::io::load_model(
