@@ -350,13 +350,22 @@ fn solve_with_armature(mut d: kanegen_dynamics::Dynamics<f64>, a: &[f64]) -> Vec
 /// The workspace path ([`aba::forward_dynamics_in`], [`aba::floating_in`]) with an armature
 /// (reflected rotor inertia `a_i`, here 0.05…2, the order of the bodies' own inertias) against
 /// LDLᵀ on `A + diag(a)` and the RNEA's `b`, fixed and free-floating, on the random trees and
-/// chains: measured worst 1.7e-14 (fixed) and 3.5e-14 (floating) relative, bound 1e-12. One
-/// workspace serves every state of a model, and a call after another state gives bit for bit
-/// the allocating function's result (nothing carries over); without armature, the same.
+/// chains and on SSRMS (coordinate axes): measured worst 1.7e-14 (fixed) and 3.5e-14 (floating)
+/// relative on the random models, bound 1e-12; SSRMS on a light random base 1.1e-12, bound 1e-11
+/// (its `A` is far worse conditioned). Without the armature's exception to the coordinate axes'
+/// zero rows of `I^a`, SSRMS is off by 7.7e-3. One workspace serves every state of a model, and a
+/// call after another state gives bit for bit the allocating function's result (nothing carries
+/// over); without armature, the same.
 #[test]
 fn workspace_with_armature_equals_ldlt_on_the_augmented_mass_matrix() {
     let mut worst = (0.0_f64, 0.0_f64);
-    for (k, m) in models().iter().enumerate() {
+    // SSRMS too: its coordinate axes' zero rows of `I^a` do not hold with an armature.
+    let ssrms = kanegen_model::io::load_model(
+        &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../tests/data/reference/ssrms_nguyen_hughes_1994.urdf"),
+    )
+    .unwrap();
+    for (k, m) in models().iter().chain([&ssrms]).enumerate() {
         let p = Params::<f64>::new(m);
         let n = p.dof();
         let base = FloatingBase::<f64>::from_inertial(&base_inertial(700 + k as u64));
@@ -399,7 +408,13 @@ fn workspace_with_armature_equals_ldlt_on_the_augmented_mass_matrix() {
             let d = floating::dynamics(Methods::SPATIAL, &p, &base, &s, &q, &qd, &l);
             let want = solve_with_armature(d, &armature);
             let e = rel_err(&nu, &want);
-            assert!(e < TOL, "{} variant {variant}: floating {e:e}", m.name());
+            // SSRMS on a light random base: A's condition number is ~100× the random trees'.
+            let tol = if m.name().starts_with("ssrms") {
+                1e-11
+            } else {
+                TOL
+            };
+            assert!(e < tol, "{} variant {variant}: floating {e:e}", m.name());
             worst.1 = worst.1.max(e);
             aba::floating_in(&p, &mut ws, &base, &s, &q, &qd, &l, None, &mut nu);
             assert_eq!(nu, aba::floating(&p, &base, &s, &q, &qd, &l));

@@ -388,11 +388,15 @@ fn backward<S: Scalar>(
                 ang: u_vec.ang.scale(&d_inv),
                 lin: u_vec.lin.scale(&d_inv),
             };
-            // I^a_j = I^A_j − U_j D_j⁻¹ U_jᵀ (RBDA eq. (7.47))
-            let zero = jp.coordinate_axis.map(|k| match jp.kind {
-                JointKind::Revolute => k,
-                JointKind::Prismatic => k + 3,
-            });
+            // I^a_j = I^A_j − U_j D_j⁻¹ U_jᵀ (RBDA eq. (7.47)); its zero row and column
+            // `I^a S = U (1 − SᵀU / D) = 0` hold without armature only.
+            let zero = jp
+                .coordinate_axis
+                .filter(|_| armature.is_none())
+                .map(|k| match jp.kind {
+                    JointKind::Revolute => k,
+                    JointKind::Prismatic => k + 3,
+                });
             let i_small = ws.ia[j].minus_outer(&u_vec, &w, zero);
             // p^a_j = p^A_j + I^a_j c_j + U_j D_j⁻¹ u_j (RBDA eq. (7.48))
             let p_small = ws.pa[j].clone()
