@@ -72,6 +72,27 @@
 //! axes being coordinate axes too). The
 //! leaf's `D` is a constant of the model, hence `N − 1` divisions.
 //!
+//! # The run-time path: a workspace
+//!
+//! [`Workspace`] holds every per-body quantity of the passes (Pinocchio's `Data`; [`Params`] is
+//! its `Model`), allocated once; [`forward_dynamics_in`] and [`floating_in`] overwrite it and the
+//! caller's output and allocate nothing. The allocating [`forward_dynamics`] and [`floating`]
+//! make a workspace and call them, so the symbolic trace is that of one algorithm. An
+//! `armature` (the reflected rotor inertia `I_m n²` of a geared motor, Pinocchio's
+//! `Model::armature`) adds `a_i q̈_i` to joint `i`'s torque: `D_i = S_iᵀ U_i + a_i`, all else
+//! unchanged, so `q̈ = (H + diag(a))⁻¹ (τ − C)` with no mass matrix (`dynamics/tests/aba.rs`).
+//! This is what `kanegen simulate` evaluates per right-hand side when the scene names no
+//! algorithm. Measured side by side with numeric Pinocchio 4.1 (`benches/peers`, `CASADI_SIDE=0
+//! RANDOM_N="7 8 16 32 64"`, 3 passes, thread CPU time, default `RUSTFLAGS` against g++ -O3
+//! -march=native): SSRMS 1215 ns against 2049 ns for Pinocchio's faster `aba` (WORLD), random
+//! chains N = 7, 16, 64: 1223, 2924, 12127 ns against 2098, 5118, 19913: 1.64–1.75× faster from
+//! N = 6 to 64 on all ten models. Generated code is 1.6–1.7× faster still on the random chains
+//! and 4–8× on the robots. An ABA in base coordinates (Pinocchio's WORLD convention: nothing
+//! carried child to parent, each body's inertia turned into base coordinates instead) measured
+//! 1.08–1.15× slower than this one in the same run, and evaluating the model's own trace as a
+//! flat tape of `f64` registers 4× slower on SSRMS and about 20× on the random chains
+//! (`examples/runtime_fd.rs`); neither is kept.
+//!
 //! ```
 //! use kanegen_dynamics::algorithms::aba;
 //! use kanegen_dynamics::{Loads, Methods, Params};
@@ -358,7 +379,11 @@ fn backward<S: Scalar>(
             ws.e0[j] = e0;
         }
         let e0 = if need_rot { &ws.e0[j] } else { &root.e0 };
-        ws.pa[j] = subtract_external(pj, loads, j, e0);
+        ws.pa[j] = if loads.external.is_empty() {
+            pj
+        } else {
+            subtract_external(pj, loads, j, e0)
+        };
         ws.ia[j] = Articulated::rigid(inertia);
         ws.v[j] = v;
         ws.xup[j] = x;
