@@ -3,8 +3,10 @@
 //! drives, joint damping, a tabulated inertial-frame wrench at the wrist; RK4, 1000 steps of
 //! 0.01 s), side by side in one run: each benchmark integrates the whole scene, so the time per
 //! step is the reported time / 1000. The interpreted run is the `kanegen simulate` loop
-//! (`simulate_to`, its `recurrent` algorithm, samples to a sink that drops them); the compiled
-//! run calls an observer that does nothing.
+//! (`simulate_to`, samples to a sink that drops them) on its run-time fast path (the workspace
+//! ABA), and on the LDLᵀ path with the `recurrent` algorithm it used before
+//! (`SimulationSpec::forward = Ldlt`, what naming an algorithm selects); the compiled run calls
+//! an observer that does nothing.
 //!
 //! Run: `cargo bench --bench scene`. Compare within one run; the machines are shared. Measured
 //! (two runs): compiled 1.67 / 1.44 ms, interpreted 20.5 / 18.3 ms per run, 12.3× / 12.7×.
@@ -28,15 +30,23 @@ fn scene_run(c: &mut Criterion) {
             black_box(last)
         })
     });
-    g.bench_function("interpreted", |b| {
-        b.iter(|| {
-            let mut sink = |s: &Sample| -> anyhow::Result<()> {
-                black_box(s.x[0]);
-                Ok(())
-            };
-            simulate_to(black_box(&scene), &mut sink, Control::default()).unwrap()
-        })
-    });
+    // The run-time fast path (the scene names no algorithm) and the LDLᵀ path it replaced.
+    let mut ldlt = scene.clone();
+    ldlt.simulation.forward = kanegen::dynamics::ForwardMethod::Ldlt;
+    for (name, s) in [
+        ("interpreted", &scene),
+        ("interpreted LDLᵀ recurrent", &ldlt),
+    ] {
+        g.bench_function(name, |b| {
+            b.iter(|| {
+                let mut sink = |s: &Sample| -> anyhow::Result<()> {
+                    black_box(s.x[0]);
+                    Ok(())
+                };
+                simulate_to(black_box(s), &mut sink, Control::default()).unwrap()
+            })
+        });
+    }
     g.finish();
 }
 

@@ -1,7 +1,9 @@
 //! The generated functions allocate nothing: a global allocator counting each thread's
 //! allocations is read (on the test's thread) before and
 //! after many calls of every function (generated crate and `dynamics!` output), and around whole
-//! runs of `scene!` simulators (RK4 with a tabulated wrench, dopri5 on a free-floating base).
+//! runs of `scene!` simulators (RK4 with a tabulated wrench, dopri5 on a free-floating base),
+//! and around the interpreted simulator's right-hand side on its run-time fast path (the
+//! workspace ABA: a tabulated wrench, rotor inertia and friction, a free-floating base).
 
 use std::alloc::{GlobalAlloc, Layout, System};
 
@@ -71,9 +73,33 @@ fn scene_runs_do_not_allocate() {
     assert!(d.q[3].is_finite());
 }
 
+/// The interpreted simulator's right-hand side on the run-time fast path, once its
+/// `SceneSystem` is built (called from the one test, as above).
+fn runtime_fast_path_does_not_allocate() {
+    use kanegen::sim::integrate::System;
+    let root = std::path::Path::new(env!("CARGO_MANIFEST_DIR"));
+    for name in [
+        "scenes/ssrms_effects.toml",
+        "scenes/ssrms_drives.toml",
+        "scenes/free_floating_7dof.toml",
+    ] {
+        let scene = kanegen::sim::scene::Scene::load(&root.join(name)).unwrap();
+        let mut sys = kanegen::sim::simulate::SceneSystem::new(&scene);
+        let x = sys.initial_state();
+        let mut dx = vec![0.0; x.len()];
+        let before = allocations();
+        for k in 0..100 {
+            sys.deriv(0.03 * f64::from(k), &x, &mut dx);
+        }
+        assert_eq!(allocations(), before, "{name}");
+        assert!(dx.iter().all(|v| v.is_finite()));
+    }
+}
+
 #[test]
 fn generated_functions_do_not_allocate() {
     scene_runs_do_not_allocate();
+    runtime_fast_path_does_not_allocate();
     // The counter itself works: a Vec allocates.
     let before = allocations();
     let v = std::hint::black_box(vec![1.0f64; 16]);

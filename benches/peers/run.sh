@@ -25,6 +25,8 @@
 #                     no LLVM), to split the compile time
 #   CASADI_EXTRA=""   more CasADi variants to generate, compile and time: plain, simp
 #   WORLD=1           CasADi and Pinocchio also in Convention::WORLD (M_world, aba_world)
+#   CASADI_SIDE=1     0: no CasADi side (no tracing, no gcc of generated C): Pinocchio and kanegen
+#                     only, e.g. for the run-time path against numeric Pinocchio
 #   TIMING_ONLY=0     1: reuse everything an earlier complete run built in PEERS_WORK (models,
 #                     binaries, compile times) and redo only validation, timing and report
 #   KANEGEN_DIR       the kanegen checkout (default: the project this script is in); for a copy
@@ -59,6 +61,7 @@ CHECK_SPLIT=${CHECK_SPLIT:-1}
 TIMING_ONLY=${TIMING_ONLY:-0}
 CASADI_EXTRA=${CASADI_EXTRA:-}
 WORLD=${WORLD:-1}
+CASADI_SIDE=${CASADI_SIDE:-1}
 CC=${CC:-gcc}
 CXX=${CXX:-g++}
 COPT=${COPT:-"-O3 -march=native"}
@@ -156,12 +159,16 @@ cached_build() {  # cached_build OUT SRC CMD: rebuild when the command or the so
   fi
 }
 GEN_CMD="$CXX -std=c++17 -O1 -DNDEBUG -w $CXXDEF -DCASADI_SNPRINTF=snprintf -DCASADI_WITH_THREADSAFE_SYMBOLICS -DCASADI_WITH_THREAD -I$PREFIX/include -I$PREFIX/include/eigen3 -I$CASADI/include src/pin_casadi_gen.cpp -o build/pin_casadi_gen -L$CASADI -lcasadi -ldl -Wl,-rpath,$CASADI"
-cached_build build/pin_casadi_gen src/pin_casadi_gen.cpp "$GEN_CMD"
+[ "$CASADI_SIDE" = 1 ] && cached_build build/pin_casadi_gen src/pin_casadi_gen.cpp "$GEN_CMD"
 PIN_HDR_CMD="$CXX -std=c++17 $COPT -DNDEBUG -w $CXXDEF -I$PREFIX/include -I$PREFIX/include/eigen3 src/pin_numeric.cpp -o build/pin_numeric_hdr"
 cached_build build/pin_numeric_hdr src/pin_numeric.cpp "$PIN_HDR_CMD"
 PIN_LABELS="hdr"
 
 # ------------------------------------------------------------------ 4. Pinocchio<SX> -> CasADi -> C
+if [ "$CASADI_SIDE" != 1 ]; then
+  stamp "CASADI_SIDE=$CASADI_SIDE: no CasADi side"
+  for m in $NAMES; do CLABELS[$m]=""; done
+else
 stamp "tracing + CasADi codegen (variants: cse${CASADI_EXTRA:+ $CASADI_EXTRA}; cse_clean where the clean model differs)"
 rm -rf gen
 for m in $NAMES; do
@@ -226,6 +233,8 @@ for m in $NAMES; do
   done
 done
 
+fi  # CASADI_SIDE
+
 # ------------------------------------------------------------------ 6. kanegen bench crate
 # One crate build per model and build kind, so that a build's wall time is that of one
 # dynamics! (expansion + rustc of the emitted code), dependencies already compiled.
@@ -243,6 +252,9 @@ publish = false
 
 [dependencies]
 kanegen = { path = "$KANEGEN_DIR", default-features = false }
+# the run-time path (aba_runtime): the model read from its URDF, the workspace ABA
+kanegen-dynamics = { path = "$KANEGEN_DIR/dynamics" }
+kanegen-model = { path = "$KANEGEN_DIR/model" }
 
 [workspace]
 EOF

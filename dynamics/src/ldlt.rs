@@ -32,59 +32,88 @@ pub struct Ldlt<S> {
 /// Factorizes a symmetric positive definite `a` (only the lower triangle is read).
 pub fn ldlt<S: Scalar>(a: &[Vec<S>]) -> Ldlt<S> {
     let n = a.len();
-    let mut l: Vec<Vec<S>> = (0..n).map(|i| Vec::with_capacity(i)).collect();
-    let mut d: Vec<S> = Vec::with_capacity(n);
-    let mut d_inv: Vec<S> = Vec::with_capacity(n);
-    // Working copy of w[i][k] = L_ik D_k, to avoid recomputing products.
-    let mut w: Vec<Vec<S>> = (0..n).map(|i| Vec::with_capacity(i)).collect();
+    let mut m: Vec<S> = a.iter().flat_map(|row| row[..n].iter().cloned()).collect();
+    let mut d_inv: Vec<S> = (0..n).map(|_| S::zero()).collect();
+    factor_in_place(&mut m, n, &mut d_inv);
+    Ldlt {
+        l: (0..n)
+            .map(|i| (0..i).map(|k| m[i * n + k].clone()).collect())
+            .collect(),
+        d: (0..n).map(|j| m[j * n + j].clone()).collect(),
+        d_inv,
+    }
+}
+
+/// [`ldlt`] in place, allocating nothing: `a` is the row-major `n × n` matrix (lower triangle
+/// read). On return its strict lower triangle holds `L`, its diagonal the pivots `D_j`, its
+/// strict upper triangle the products `L_ik D_k` (at `(k, i)`), and `d_inv` the `1 / D_j`.
+/// The operations, in order, of [`ldlt`] (which calls it).
+pub fn factor_in_place<S: Scalar>(a: &mut [S], n: usize, d_inv: &mut [S]) {
+    assert!(
+        a.len() >= n * n && d_inv.len() >= n,
+        "ldlt: buffers too short"
+    );
     for j in 0..n {
         // D_j = A_jj − Σ_{k<j} L_jk (L_jk D_k)
-        let mut dj = a[j][j].clone();
+        let mut dj = a[j * n + j].clone();
         for k in 0..j {
-            dj = dj - l[j][k].clone() * w[j][k].clone();
+            dj = dj - a[j * n + k].clone() * a[k * n + j].clone();
         }
         let inv = S::one() / dj.clone();
         for i in (j + 1)..n {
             // L_ij D_j = A_ij − Σ_{k<j} L_ik (L_jk D_k)
-            let mut s = a[i][j].clone();
+            let mut s = a[i * n + j].clone();
             for k in 0..j {
-                s = s - l[i][k].clone() * w[j][k].clone();
+                s = s - a[i * n + k].clone() * a[k * n + j].clone();
             }
-            l[i].push(s.clone() * inv.clone());
-            w[i].push(s);
+            a[i * n + j] = s.clone() * inv.clone();
+            a[j * n + i] = s;
         }
-        d.push(dj);
-        d_inv.push(inv);
+        a[j * n + j] = dj;
+        d_inv[j] = inv;
     }
-    Ldlt { l, d, d_inv }
 }
 
 /// Solves `A x = b` with a factorization of `A`.
 pub fn solve<S: Scalar>(f: &Ldlt<S>, b: &[S]) -> Vec<S> {
     let n = f.d.len();
     assert_eq!(b.len(), n, "right-hand side has the wrong length");
-    // L y = b
-    let mut y: Vec<S> = Vec::with_capacity(n);
-    for i in 0..n {
-        let mut s = b[i].clone();
-        for k in 0..i {
-            s = s - f.l[i][k].clone() * y[k].clone();
+    let mut m: Vec<S> = (0..n * n).map(|_| S::zero()).collect();
+    for (i, row) in f.l.iter().enumerate() {
+        for (k, x) in row.iter().enumerate() {
+            m[i * n + k] = x.clone();
         }
-        y.push(s);
     }
-    // D z = y, Lᵀ x = z
-    let mut x: Vec<S> = y
-        .into_iter()
-        .zip(&f.d_inv)
-        .map(|(yi, di)| yi * di.clone())
-        .collect();
-    for i in (0..n).rev() {
-        for k in (i + 1)..n {
-            let t = f.l[k][i].clone() * x[k].clone();
+    let mut x = b.to_vec();
+    solve_in_place(&m, n, &f.d_inv, &mut x);
+    x
+}
+
+/// [`solve`] in place, allocating nothing: `x` holds `b` on entry and `A⁻¹ b` on return; `l` and
+/// `d_inv` as [`factor_in_place`] leaves them (only the strict lower triangle of `l` is read).
+/// The operations, in order, of [`solve`] (which calls it).
+pub fn solve_in_place<S: Scalar>(l: &[S], n: usize, d_inv: &[S], x: &mut [S]) {
+    assert!(
+        l.len() >= n * n && d_inv.len() >= n && x.len() == n,
+        "ldlt: buffers too short"
+    );
+    // L y = b
+    for i in 0..n {
+        for k in 0..i {
+            let t = l[i * n + k].clone() * x[k].clone();
             x[i] = x[i].clone() - t;
         }
     }
-    x
+    // D z = y, Lᵀ x = z
+    for i in 0..n {
+        x[i] = x[i].clone() * d_inv[i].clone();
+    }
+    for i in (0..n).rev() {
+        for k in (i + 1)..n {
+            let t = l[k * n + i].clone() * x[k].clone();
+            x[i] = x[i].clone() - t;
+        }
+    }
 }
 
 #[cfg(test)]

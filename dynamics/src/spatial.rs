@@ -32,6 +32,17 @@ pub struct Force<S> {
     pub lin: Vec3<S>,
 }
 
+impl<S: Scalar> Force<S> {
+    /// The zero force.
+    #[must_use]
+    pub fn zero() -> Self {
+        Force {
+            ang: Vec3::zero(),
+            lin: Vec3::zero(),
+        }
+    }
+}
+
 impl<S: Scalar> Motion<S> {
     /// The zero motion.
     pub fn zero() -> Self {
@@ -96,6 +107,14 @@ pub struct Xform<S> {
 }
 
 impl<S: Scalar> Xform<S> {
+    /// The identity transform.
+    #[must_use]
+    pub fn identity() -> Self {
+        Xform {
+            e: Mat3::identity(),
+            r: Vec3::zero(),
+        }
+    }
     /// `X m = [E ω; E (v − r × ω)]`.
     pub fn apply(&self, m: &Motion<S>) -> Motion<S> {
         Motion {

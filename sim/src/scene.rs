@@ -19,7 +19,7 @@
 use anyhow::{anyhow, bail, Context, Result};
 use kanegen_dynamics::base::BASE_BODY;
 use kanegen_dynamics::linalg::Vec3;
-use kanegen_dynamics::{ExternalWrench, LoadFrame, Methods};
+use kanegen_dynamics::{ExternalWrench, ForwardMethod, LoadFrame, Methods};
 use kanegen_model::bounds::{Bound, FORCE, GAIN, GRAVITY, LENGTH, POSITION, RATE};
 use kanegen_model::io::InertiaSpec;
 use kanegen_model::{Inertial, Model, Validation};
@@ -271,8 +271,15 @@ pub struct SimulationSpec {
     /// Output every k-th RK4 or midpoint step; dopri5 samples its dense output every `output_every · step`
     /// seconds (default 10).
     pub output_every: usize,
-    /// The dynamics algorithm evaluating `A`, `b` (default `recurrent`).
+    /// The dynamics algorithm evaluating `A`, `b` (default `recurrent` on a chain, `spatial` on
+    /// a tree).
     pub algorithm: Methods,
+    /// How the interpreted simulator solves for the accelerations: without
+    /// `simulation.algorithm`, [`ForwardMethod::Aba`] (the run-time fast path: the
+    /// articulated-body algorithm in a preallocated workspace, allocation-free, reflected rotor
+    /// inertia as Pinocchio's armature); with a named algorithm, [`ForwardMethod::Ldlt`] (`A` and
+    /// `b` by that algorithm, then LDLᵀ), so that a scene can compare the methods.
+    pub forward: ForwardMethod,
     /// Whether more than [`MAX_STEPS`] steps or output samples were allowed
     /// (`allow_long = true`, or [`SceneOptions::allow_long`]).
     pub allow_long: bool,
@@ -922,6 +929,11 @@ impl Scene {
             );
         }
         // The paper's algorithms handle serial chains; a tree takes the local-frame ones.
+        let forward = if s.algorithm.is_some() {
+            ForwardMethod::Ldlt
+        } else {
+            ForwardMethod::Aba
+        };
         let algorithm = match s.algorithm {
             None if chain.is_chain() => Methods::RECURRENT,
             None => Methods::SPATIAL,
@@ -971,6 +983,7 @@ impl Scene {
                 max_step,
                 output_every,
                 algorithm,
+                forward,
                 allow_long,
             },
         })

@@ -10,11 +10,12 @@
 use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, System};
 use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench};
 use anyhow::Result;
+use kanegen_dynamics::algorithms::aba::{self, Workspace};
 use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
 use kanegen_dynamics::algorithms::frames;
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
-use kanegen_dynamics::{FrameParams, Loads, Params};
+use kanegen_dynamics::{ForwardMethod, FrameParams, Loads, Params};
 use serde::Serialize;
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -49,6 +50,20 @@ pub struct SceneSystem<'a> {
     n: usize,
     /// Set (by a Ctrl-C handler) to stop the run at the next step.
     stop: Option<&'a AtomicBool>,
+    /// The run-time fast path ([`crate::scene::SimulationSpec::forward`] is
+    /// [`ForwardMethod::Aba`]): the workspace of the articulated-body algorithm, and the loads
+    /// and the accelerations of `deriv`, allocated once.
+    fast: Option<FastPath>,
+}
+
+/// The preallocated data of the run-time fast path.
+struct FastPath {
+    ws: Workspace<f64>,
+    /// The passive loads with `tau = Some(N zeros)`: `deriv` writes the torques and, when
+    /// tabulated, the wrenches in place.
+    loads: Loads<f64>,
+    /// `q̈` (fixed base) or `ν̇` (free-floating).
+    acc: Vec<f64>,
 }
 
 /// Quintic time scaling `s(τ) = 10τ³ − 15τ⁴ + 6τ⁵` and its first two derivatives, `τ ∈ [0, 1]`.
@@ -102,7 +117,34 @@ impl<'a> SceneSystem<'a> {
             time_varying: scene.wrenches.iter().any(SceneWrench::is_tabulated),
             n: scene.model.dof(),
             stop: None,
+            fast: None,
         }
+        .with_forward(scene.simulation.forward)
+    }
+
+    /// The system solving for the accelerations by `forward`: [`ForwardMethod::Aba`] is the
+    /// run-time fast path (workspace ABA, no allocation unless the drive is computed torque),
+    /// [`ForwardMethod::Ldlt`] `A` and `b` by the scene's algorithm then LDLᵀ (the default is
+    /// the scene's [`crate::scene::SimulationSpec::forward`]). Both give the same right-hand
+    /// side to rounding (`sim` tests).
+    #[must_use]
+    pub fn with_forward(mut self, forward: ForwardMethod) -> Self {
+        self.fast = match forward {
+            ForwardMethod::Ldlt => None,
+            ForwardMethod::Aba => {
+                let n = self.n;
+                let base = if self.base.is_some() { 6 } else { 0 };
+                Some(FastPath {
+                    ws: Workspace::new(&self.params),
+                    loads: Loads {
+                        tau: Some(vec![0.0; n]),
+                        ..self.passive.clone()
+                    },
+                    acc: vec![0.0; base + n],
+                })
+            }
+        };
+        self
     }
 
     /// The system, stopped at the next step once `stop` is set ([`System::interrupted`]).
@@ -173,15 +215,26 @@ impl<'a> SceneSystem<'a> {
     /// none of them.
     #[must_use]
     pub fn torques(&self, t: f64, q: &[f64], qd: &[f64]) -> Option<Vec<f64>> {
+        let mut tau = vec![0.0; self.n];
+        self.torques_into(t, q, qd, &mut tau).then_some(tau)
+    }
+
+    /// [`SceneSystem::torques`] into `tau` (length `N`; zeros when the scene has none of them,
+    /// then `false`). Allocates nothing except for a computed-torque drive.
+    pub fn torques_into(&self, t: f64, q: &[f64], qd: &[f64], tau: &mut [f64]) -> bool {
         let s = self.scene;
-        let mut tau = match &s.drives {
-            Drives::None => None,
-            Drives::Constant { tau } => Some(tau.clone()),
-            Drives::Pd { kp, kd, target } => Some(
-                (0..self.n)
-                    .map(|i| kp[i] * (target[i] - q[i]) - kd[i] * qd[i])
-                    .collect(),
-            ),
+        let mut any = true;
+        match &s.drives {
+            Drives::None => {
+                tau.fill(0.0);
+                any = false;
+            }
+            Drives::Constant { tau: c } => tau.copy_from_slice(c),
+            Drives::Pd { kp, kd, target } => {
+                for i in 0..self.n {
+                    tau[i] = kp[i] * (target[i] - q[i]) - kd[i] * qd[i];
+                }
+            }
             Drives::ComputedTorque {
                 kp,
                 kd,
@@ -192,28 +245,28 @@ impl<'a> SceneSystem<'a> {
                 let cmd: Vec<f64> = (0..self.n)
                     .map(|i| qddr[i] + kd[i] * (qdr[i] - qd[i]) + kp[i] * (qr[i] - q[i]))
                     .collect();
-                Some(s.simulation.algorithm.inverse_dynamics(
+                tau.copy_from_slice(&s.simulation.algorithm.inverse_dynamics(
                     &self.params,
                     q,
                     qd,
                     &cmd,
                     &self.passive,
-                ))
+                ));
             }
-        };
+        }
         if let Some(c) = &s.damping {
-            let t = tau.get_or_insert_with(|| vec![0.0; self.n]);
+            any = true;
             for i in 0..self.n {
-                t[i] -= c[i] * qd[i];
+                tau[i] -= c[i] * qd[i];
             }
         }
         if let Some(c) = &s.coulomb {
-            let t = tau.get_or_insert_with(|| vec![0.0; self.n]);
+            any = true;
             for i in 0..self.n {
-                t[i] -= c.torque(i, qd[i]);
+                tau[i] -= c.torque(i, qd[i]);
             }
         }
-        tau
+        any
     }
 
     /// Total energy: kinetic, plus the gravitational potential `−g · Σ m_k x_{c,k}` on a fixed
@@ -283,6 +336,69 @@ impl<'a> SceneSystem<'a> {
     }
 }
 
+impl SceneSystem<'_> {
+    /// [`System::deriv`] on the run-time fast path: the workspace ABA, the reflected rotor
+    /// inertia as its armature (`D_i += I_m n²`), the loads written in place.
+    fn deriv_fast(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
+        let mut fast = self.fast.take().expect("the fast path");
+        let n = self.n;
+        let (q, qd, st) = self.split(x);
+        let tau = fast.loads.tau.as_mut().expect("tau is preallocated");
+        self.torques_into(t, q, qd, tau);
+        if self.time_varying {
+            for (l, w) in fast.loads.external.iter_mut().zip(&self.scene.wrenches) {
+                *l = w.at(t);
+            }
+        }
+        let armature = self.scene.rotor.as_ref().map(|r| r.reflected.as_slice());
+        match (&self.base, st) {
+            (Some(b), Some(st)) => {
+                aba::floating_in(
+                    &self.params,
+                    &mut fast.ws,
+                    b,
+                    &st,
+                    q,
+                    qd,
+                    &fast.loads,
+                    armature,
+                    &mut fast.acc,
+                );
+                floating_kinematics(n, x, &st, qd, dx);
+                dx[7 + n..].copy_from_slice(&fast.acc);
+            }
+            _ => {
+                aba::forward_dynamics_in(
+                    &self.params,
+                    &mut fast.ws,
+                    q,
+                    qd,
+                    &fast.loads,
+                    armature,
+                    &mut fast.acc,
+                );
+                dx[..n].copy_from_slice(qd);
+                dx[n..].copy_from_slice(&fast.acc);
+            }
+        }
+        self.fast = Some(fast);
+    }
+}
+
+/// The kinematic part of a free-floating state's derivative: `ṗ₀ = R₀ v_b`, `q̇uat`, `q̇`
+/// (`dx[..7 + N]`).
+fn floating_kinematics(n: usize, x: &[f64], st: &FloatingState<f64>, qd: &[f64], dx: &mut [f64]) {
+    let pd = st.rotation.mul_vec(&st.v_b);
+    dx[..3].copy_from_slice(&pd.0);
+    // q̇uat = ½ quat ⊗ (ω, 0): u̇ = ½ (w ω + u × ω), ẇ = −½ u · ω.
+    let (u, w) = (Vec3::new(x[3], x[4], x[5]), x[6]);
+    let om = &st.omega_b;
+    let ud = (om.scale(&w) + u.cross(om)).scale(&0.5);
+    dx[3..6].copy_from_slice(&ud.0);
+    dx[6] = -0.5 * u.dot(om);
+    dx[7..7 + n].copy_from_slice(qd);
+}
+
 impl System for SceneSystem<'_> {
     fn dim(&self) -> usize {
         if self.base.is_some() {
@@ -293,6 +409,9 @@ impl System for SceneSystem<'_> {
     }
 
     fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
+        if self.fast.is_some() {
+            return self.deriv_fast(t, x, dx);
+        }
         let n = self.n;
         let (q, qd, st) = self.split(x);
         let mut loads = Loads {
@@ -306,15 +425,7 @@ impl System for SceneSystem<'_> {
         match (&self.base, st) {
             (Some(b), Some(st)) => {
                 let nu_dot = floating::forward_dynamics(alg, &self.params, b, &st, q, qd, &loads);
-                let pd = st.rotation.mul_vec(&st.v_b);
-                dx[..3].copy_from_slice(&pd.0);
-                // q̇uat = ½ quat ⊗ (ω, 0): u̇ = ½ (w ω + u × ω), ẇ = −½ u · ω.
-                let (u, w) = (Vec3::new(x[3], x[4], x[5]), x[6]);
-                let om = &st.omega_b;
-                let ud = (om.scale(&w) + u.cross(om)).scale(&0.5);
-                dx[3..6].copy_from_slice(&ud.0);
-                dx[6] = -0.5 * u.dot(om);
-                dx[7..7 + n].copy_from_slice(qd);
+                floating_kinematics(n, x, &st, qd, dx);
                 dx[7 + n..].copy_from_slice(&nu_dot);
             }
             _ => {

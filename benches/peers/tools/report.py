@@ -177,6 +177,44 @@ L.extend([f"- {s}" for s in slower] or ["- nowhere in the headline table."])
 L.append("\n(Ties, within 0.5 %, are not listed. CasADi and Pinocchio at their faster convention.)")
 L.append("")
 
+# ------------------------------------------------------------------ run-time path
+R["runtime"] = []
+if any(ns("kanegen", "default", m, "aba_runtime") for m in models):
+    L.append("## Run-time path (no compilation): forward dynamics vs numeric Pinocchio `aba`\n")
+    L.append("kanegen run-time = `aba_runtime`: the model read from its URDF when the bench starts, "
+             "`kanegen_dynamics::algorithms::aba::forward_dynamics_in` with a workspace allocated once "
+             "(what `kanegen simulate` evaluates per right-hand side; no code generated or compiled), checked "
+             "against the generated `forward_dynamics` at every state before timing. Pinocchio: numeric "
+             "`pinocchio::aba` (LOCAL and WORLD conventions). Generated: kanegen's `dynamics!` "
+             "`forward_dynamics`. Run-time native: the same in the `-C target-cpu=native` build (NATIVE=1), as "
+             "Pinocchio is compiled with -march=native. **Ratio = Pinocchio ns / run-time ns** (at least 1: the "
+             "run-time path is at most as slow as Pinocchio's aba).\n")
+    L.append("| model | n | kanegen run-time ns | run-time native ns "
+             "| Pinocchio aba ns | Pinocchio aba WORLD ns "
+             "| generated kanegen ns | Pinocchio (faster) / run-time | Pinocchio (faster) / run-time native "
+             "| run-time / generated |")
+    L.append("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
+    for model in models:
+        n = MODELS[model]["n"]
+        rt = ns("kanegen", "default", model, "aba_runtime")
+        if rt is None:
+            continue
+        rtn = ns("kanegen", "native", model, "aba_runtime")
+        pl, pw = ns("pinocchio", "hdr", model, "aba"), ns("pinocchio", "hdr", model, "aba_world")
+        pb = min(x for x in (pl, pw) if x is not None) if (pl or pw) else None
+        gen = ns("kanegen", "default", model, "aba")
+        rg = ratio(rt, gen)
+        L.append(f"| {model} | {n} | {fmt_ns(rt)} | {fmt_ns(rtn)} | "
+                 f"{fmt_ns(pl)} | {fmt_ns(pw)} | {fmt_ns(gen)} | "
+                 f"{fmt_ratio(ratio(pb, rt))} | {fmt_ratio(ratio(pb, rtn))} | "
+                 f"{f'{rg:.1f}×' if rg else '–'} |")
+        R["runtime"].append({"model": model, "n": n, "kanegen_runtime_ns": rt, "kanegen_runtime_native_ns": rtn,
+                             "pinocchio_aba_ns": pl, "pinocchio_aba_world_ns": pw, "generated_ns": gen,
+                             "pinocchio_over_runtime": ratio(pb, rt),
+                             "pinocchio_over_runtime_native": ratio(pb, rtn),
+                             "spread": spread.get(("kanegen", "default", model, "aba_runtime"))})
+    L.append("")
+
 # ------------------------------------------------------------------ compile times
 L.append("## Compile times (s, wall)\n")
 L.append("kanegen: `cargo build --release` of the bench crate with **one** `dynamics!` (its model), the "
@@ -263,7 +301,7 @@ L.append("## Every side and label (median ns per call; spread = max/min − 1 ov
 L.append("`sincos_n`: n sincos calls on q alone (C: glibc `sincos`, which gcc also makes of the generated "
          "sin/cos pairs; Rust: `libm::sincos`, which kanegen's code calls). Pinocchio `M_nle` = crba + "
          "nonLinearEffects (two calls); `M`, `M_world`: crba + mirror of the upper triangle.\n")
-cols = ["M", "M_world", "nle", "M_nle", "rnea", "aba", "aba_world", "sincos_n"]
+cols = ["M", "M_world", "nle", "M_nle", "rnea", "aba", "aba_world", "aba_runtime", "sincos_n"]
 L.append("| model | side / label | " + " | ".join(cols) + " | spread |")
 L.append("|---|---|" + "---:|" * (len(cols) + 1))
 for model in models:

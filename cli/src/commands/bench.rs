@@ -109,6 +109,21 @@ pub fn bench_ssrms(rounds: usize, calls: usize) -> anyhow::Result<BenchReport> {
             Box::new(move |q, qd| methods.forward_dynamics(p, q, qd, &Loads::default())[6]),
         ));
     }
+    // The run-time fast path of `kanegen simulate`: ABA in a workspace allocated once.
+    let mut ws = kanegen_dynamics::algorithms::aba::Workspace::new(&p);
+    let mut qdd = vec![0.0; n];
+    let pr = &p;
+    c.push((
+        "interpreted aba workspace".into(),
+        "forward_dynamics".into(),
+        Box::new(move |q, qd| {
+            let l = Loads::default();
+            kanegen_dynamics::algorithms::aba::forward_dynamics_in(
+                pr, &mut ws, q, qd, &l, None, &mut qdd,
+            );
+            qdd[6]
+        }),
+    ));
     c.push((
         "generated".into(),
         "inverse_dynamics".into(),

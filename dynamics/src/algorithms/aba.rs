@@ -72,6 +72,27 @@
 //! axes being coordinate axes too). The
 //! leaf's `D` is a constant of the model, hence `N − 1` divisions.
 //!
+//! # The run-time path: a workspace
+//!
+//! [`Workspace`] holds every per-body quantity of the passes (Pinocchio's `Data`; [`Params`] is
+//! its `Model`), allocated once; [`forward_dynamics_in`] and [`floating_in`] overwrite it and the
+//! caller's output and allocate nothing. The allocating [`forward_dynamics`] and [`floating`]
+//! make a workspace and call them, so the symbolic trace is that of one algorithm. An
+//! `armature` (the reflected rotor inertia `I_m n²` of a geared motor, Pinocchio's
+//! `Model::armature`) adds `a_i q̈_i` to joint `i`'s torque: `D_i = S_iᵀ U_i + a_i`, all else
+//! unchanged, so `q̈ = (H + diag(a))⁻¹ (τ − C)` with no mass matrix (`dynamics/tests/aba.rs`).
+//! This is what `kanegen simulate` evaluates per right-hand side when the scene names no
+//! algorithm. Measured side by side with numeric Pinocchio 4.1 (`benches/peers`, `CASADI_SIDE=0
+//! RANDOM_N="7 8 16 32 64"`, 3 passes, thread CPU time, default `RUSTFLAGS` against g++ -O3
+//! -march=native): SSRMS 1215 ns against 2049 ns for Pinocchio's faster `aba` (WORLD), random
+//! chains N = 7, 16, 64: 1223, 2924, 12127 ns against 2098, 5118, 19913: 1.64–1.75× faster from
+//! N = 6 to 64 on all ten models. Generated code is 1.6–1.7× faster still on the random chains
+//! and 4–8× on the robots. An ABA in base coordinates (Pinocchio's WORLD convention: nothing
+//! carried child to parent, each body's inertia turned into base coordinates instead) measured
+//! 1.08–1.15× slower than this one in the same run, and evaluating the model's own trace as a
+//! flat tape of `f64` registers 4× slower on SSRMS and about 20× on the random chains
+//! (`examples/runtime_fd.rs`); neither is kept.
+//!
 //! ```
 //! use kanegen_dynamics::algorithms::aba;
 //! use kanegen_dynamics::{Loads, Methods, Params};
@@ -227,29 +248,91 @@ struct Root<S> {
     floating: Option<Body0<S>>,
 }
 
-/// Pass 1 and 2 results of one joint.
-struct Joint<S> {
-    xup: Xform<S>,
-    c: Motion<S>,
-    u_vec: Force<S>,
-    d_inv: S,
-    u: S,
+/// The data of the articulated-body algorithm for one model: every per-body quantity of the
+/// three passes, allocated once by [`Workspace::new`] and overwritten by each call of
+/// [`forward_dynamics_in`] or [`floating_in`], which then allocate nothing (Pinocchio's
+/// `Model`/`Data` split: [`Params`] is the model, this is the data). A workspace fits the models
+/// with its number of joints; the allocating [`forward_dynamics`] and [`floating`] make one per
+/// call.
+#[derive(Clone, Debug)]
+pub struct Workspace<S> {
+    /// `Xup_i`.
+    xup: Vec<Xform<S>>,
+    /// `v_i`.
+    v: Vec<Motion<S>>,
+    /// `c_i`.
+    c: Vec<Motion<S>>,
+    /// `E_0i` (when some wrench is in the base frame).
+    e0: Vec<Mat3<S>>,
+    /// `I^A_i`.
+    ia: Vec<Articulated<S>>,
+    /// `p^A_i`.
+    pa: Vec<Force<S>>,
+    /// `U_i`.
+    u_vec: Vec<Force<S>>,
+    /// `D_i⁻¹`.
+    d_inv: Vec<S>,
+    /// `u_i`.
+    u: Vec<S>,
+    /// `a_i`.
+    acc: Vec<Motion<S>>,
+    /// Whether body `i` has a child (its `a_i` is read).
+    has_child: Vec<bool>,
 }
 
-/// Passes 1 and 2 over the tree: per joint `(Xup, c, U, D⁻¹, u)`, and the root's articulated
-/// inertia and bias force when it is floating.
-fn backward<S: Scalar>(
+impl<S: Scalar> Workspace<S> {
+    /// The workspace of `p` (any model with `p.dof()` joints).
+    #[must_use]
+    pub fn new(p: &Params<S>) -> Self {
+        let n = p.dof();
+        let (motion, force) = (Motion::zero(), Force::zero());
+        Workspace {
+            xup: vec![Xform::identity(); n],
+            v: vec![motion.clone(); n],
+            c: vec![motion.clone(); n],
+            e0: vec![Mat3::identity(); n],
+            ia: vec![
+                Articulated {
+                    a: Mat3::zero(),
+                    b: Mat3::zero(),
+                    c: Mat3::zero(),
+                };
+                n
+            ],
+            pa: vec![force.clone(); n],
+            u_vec: vec![force; n],
+            d_inv: vec![S::zero(); n],
+            u: vec![S::zero(); n],
+            acc: vec![motion; n],
+            has_child: vec![false; n],
+        }
+    }
+
+    /// The number of joints it fits.
+    #[must_use]
+    pub fn dof(&self) -> usize {
+        self.xup.len()
+    }
+}
+
+/// Checks the lengths of a call's arguments against the model (panics naming the argument).
+fn check_args<S: Scalar>(
     p: &Params<S>,
+    ws: &Workspace<S>,
     q: &[S],
     qd: &[S],
     loads: &Loads<S>,
-    root: Root<S>,
-) -> (Vec<Joint<S>>, Option<Body0<S>>) {
+    armature: Option<&[S]>,
+) {
     let n = p.dof();
+    assert_eq!(ws.dof(), n, "the workspace was made for another model");
     assert_eq!(q.len(), n, "q has the wrong length");
     assert_eq!(qd.len(), n, "qd has the wrong length");
     if let Some(tau) = &loads.tau {
         assert_eq!(tau.len(), n, "loads.tau has the wrong length");
+    }
+    if let Some(a) = armature {
+        assert_eq!(a.len(), n, "armature has the wrong length");
     }
     assert!(
         loads
@@ -258,16 +341,26 @@ fn backward<S: Scalar>(
             .all(|e| e.body < n || e.body == BASE_BODY),
         "an external wrench names a body past the end of the chain"
     );
+}
+
+/// Passes 1 and 2 over the tree into `ws` (per joint `Xup, c, U, D⁻¹, u`); the root's
+/// articulated inertia and bias force when it is floating. `armature` (Pinocchio's name; the
+/// reflected rotor inertia `I_m n²` of a geared motor) adds `a_i q̈_i` to joint `i`'s
+/// generalized force: `D_i = S_iᵀ U_i + a_i`, everything else as without it.
+fn backward<S: Scalar>(
+    p: &Params<S>,
+    ws: &mut Workspace<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+    armature: Option<&[S]>,
+    root: Root<S>,
+) -> Option<Body0<S>> {
+    let n = p.dof();
     let need_rot = loads.external.iter().any(|e| e.frame == LoadFrame::Base);
-    let mut xups: Vec<Xform<S>> = Vec::with_capacity(n);
-    let mut vs: Vec<Motion<S>> = Vec::with_capacity(n);
-    let mut cs: Vec<Motion<S>> = Vec::with_capacity(n);
-    let mut e0s: Vec<Mat3<S>> = Vec::with_capacity(if need_rot { n } else { 0 });
-    let mut ia: Vec<Articulated<S>> = Vec::with_capacity(n);
-    let mut pa: Vec<Force<S>> = Vec::with_capacity(n);
     // Pass 1 (RBDA Table 7.1, first loop).
     for (j, (jp, (qj, qdj))) in p.joints.iter().zip(q.iter().zip(qd)).enumerate() {
-        let v_parent = jp.parent.map_or(&root.v, |l| &vs[l]);
+        let v_parent = jp.parent.map_or(&root.v, |l| &ws.v[l]);
         // Xup_j = XJ(q_j) Xtree_j (RBDA §4.4, `jcalc`)
         let x = xup(jp, qj);
         // vJ = S_j q̇_j
@@ -275,63 +368,75 @@ fn backward<S: Scalar>(
         // v_j = Xup_j v_λ + vJ (RBDA eq. (7.34))
         let carried = x.apply(v_parent);
         // c_j = cJ + v_j ×ₘ vJ with cJ = 0 (RBDA eq. (7.35)), as (Xup_j v_λ) ×ₘ vJ: vJ ×ₘ vJ = 0
-        cs.push(carried.crm(&vj));
+        ws.c[j] = carried.crm(&vj);
         let v = carried + vj;
         // I^A_j = I_j, p^A_j = v_j ×* I_j v_j − f^x_j (RBDA Table 7.1)
         let inertia = &jp.inertia;
         let pj = v.crf(&inertia.mul(&v));
         if need_rot {
             // E_0j = E_j E_0λ
-            let e0_parent = jp.parent.map_or(&root.e0, |l| &e0s[l]);
-            e0s.push(x.e.mul_mat(e0_parent));
+            let e0 = x.e.mul_mat(jp.parent.map_or(&root.e0, |l| &ws.e0[l]));
+            ws.e0[j] = e0;
         }
-        let e0 = if need_rot { &e0s[j] } else { &root.e0 };
-        pa.push(subtract_external(pj, loads, j, e0));
-        ia.push(Articulated::rigid(inertia));
-        vs.push(v);
-        xups.push(x);
+        let e0 = if need_rot { &ws.e0[j] } else { &root.e0 };
+        ws.pa[j] = if loads.external.is_empty() {
+            pj
+        } else {
+            subtract_external(pj, loads, j, e0)
+        };
+        ws.ia[j] = Articulated::rigid(inertia);
+        ws.v[j] = v;
+        ws.xup[j] = x;
     }
     let mut base = root.floating;
     // Pass 2 (RBDA Table 7.1, second loop), leaves first.
-    let mut out: Vec<Option<Joint<S>>> = (0..n).map(|_| None).collect();
     for j in (0..n).rev() {
         let jp = &p.joints[j];
         // U_j = I^A_j S_j (RBDA eq. (7.43))
-        let u_vec = ia[j].times_s(jp);
-        // D_j = S_jᵀ U_j (RBDA eq. (7.44)), inverted once.
-        let d_inv = S::one() / s_tr(jp, &u_vec);
+        let u_vec = ws.ia[j].times_s(jp);
+        // D_j = S_jᵀ U_j (RBDA eq. (7.44)), plus the armature, inverted once.
+        let d = s_tr(jp, &u_vec);
+        let d = match armature {
+            Some(a) => d + a[j].clone(),
+            None => d,
+        };
+        let d_inv = S::one() / d;
         // u_j = τ_j − S_jᵀ p^A_j (RBDA eq. (7.45))
-        let spa = s_tr(jp, &pa[j]);
+        let spa = s_tr(jp, &ws.pa[j]);
         let u = match &loads.tau {
             Some(tau) => tau[j].clone() - spa,
             None => -spa,
         };
-        let x = &xups[j];
         if jp.parent.is_some() || base.is_some() {
             // W = U_j D_j⁻¹
             let w = Force {
                 ang: u_vec.ang.scale(&d_inv),
                 lin: u_vec.lin.scale(&d_inv),
             };
-            // I^a_j = I^A_j − U_j D_j⁻¹ U_jᵀ (RBDA eq. (7.47))
-            let zero = jp.coordinate_axis.map(|k| match jp.kind {
-                JointKind::Revolute => k,
-                JointKind::Prismatic => k + 3,
-            });
-            let i_small = ia[j].minus_outer(&u_vec, &w, zero);
+            // I^a_j = I^A_j − U_j D_j⁻¹ U_jᵀ (RBDA eq. (7.47)); its zero row and column
+            // `I^a S = U (1 − SᵀU / D) = 0` hold without armature only.
+            let zero = jp
+                .coordinate_axis
+                .filter(|_| armature.is_none())
+                .map(|k| match jp.kind {
+                    JointKind::Revolute => k,
+                    JointKind::Prismatic => k + 3,
+                });
+            let i_small = ws.ia[j].minus_outer(&u_vec, &w, zero);
             // p^a_j = p^A_j + I^a_j c_j + U_j D_j⁻¹ u_j (RBDA eq. (7.48))
-            let p_small = pa[j].clone()
-                + i_small.mul(&cs[j])
+            let p_small = ws.pa[j].clone()
+                + i_small.mul(&ws.c[j])
                 + Force {
                     ang: w.ang.scale(&u),
                     lin: w.lin.scale(&u),
                 };
             // I^A_λ += Xup_jᵀ I^a_j Xup_j, p^A_λ += Xup_jᵀ p^a_j (RBDA eq. (7.47), (7.48))
+            let x = &ws.xup[j];
             let (i_up, p_up) = (i_small.carried(x), x.tr_apply(&p_small));
             match jp.parent {
                 Some(l) => {
-                    ia[l] = ia[l].clone() + i_up;
-                    pa[l] = pa[l].clone() + p_up;
+                    ws.ia[l] = ws.ia[l].clone() + i_up;
+                    ws.pa[l] = ws.pa[l].clone() + p_up;
                 }
                 None => {
                     let (i0, p0) = base.take().expect("a floating root");
@@ -339,48 +444,40 @@ fn backward<S: Scalar>(
                 }
             }
         }
-        out[j] = Some(Joint {
-            xup: xups[j].clone(),
-            c: cs[j].clone(),
-            u_vec,
-            d_inv,
-            u,
-        });
+        ws.u_vec[j] = u_vec;
+        ws.d_inv[j] = d_inv;
+        ws.u[j] = u;
     }
-    (
-        out.into_iter()
-            .map(|j| j.expect("every joint passed"))
-            .collect(),
-        base,
-    )
+    base
 }
 
-/// Pass 3 (RBDA Table 7.1, third loop): `q̈` from the roots' acceleration `a_root`.
-fn accelerations<S: Scalar>(p: &Params<S>, joints: &[Joint<S>], a_root: &Motion<S>) -> Vec<S> {
-    let n = p.dof();
-    let mut has_child = vec![false; n];
+/// Pass 3 (RBDA Table 7.1, third loop): `q̈` from the roots' acceleration `a_root`, into `qdd`.
+fn accelerations<S: Scalar>(
+    p: &Params<S>,
+    ws: &mut Workspace<S>,
+    a_root: &Motion<S>,
+    qdd: &mut [S],
+) {
+    ws.has_child.iter_mut().for_each(|h| *h = false);
     for jp in &p.joints {
         if let Some(l) = jp.parent {
-            has_child[l] = true;
+            ws.has_child[l] = true;
         }
     }
-    let mut acc: Vec<Motion<S>> = Vec::with_capacity(n);
-    let mut qdd: Vec<S> = Vec::with_capacity(n);
-    for (j, (jp, b)) in p.joints.iter().zip(joints).enumerate() {
-        let a_parent = jp.parent.map_or(a_root, |l| &acc[l]);
+    for (j, jp) in p.joints.iter().enumerate() {
+        let a_parent = jp.parent.map_or(a_root, |l| &ws.acc[l]);
         // a'_j = Xup_j a_λ + c_j
-        let a = b.xup.apply(a_parent) + b.c.clone();
+        let a = ws.xup[j].apply(a_parent) + ws.c[j].clone();
         // q̈_j = D_j⁻¹ (u_j − U_jᵀ a'_j) (RBDA eq. (7.46))
-        let qj = b.d_inv.clone() * (b.u.clone() - power(&b.u_vec, &a));
+        let qj = ws.d_inv[j].clone() * (ws.u[j].clone() - power(&ws.u_vec[j], &a));
         // a_j = a'_j + S_j q̈_j (only where a child reads it)
-        acc.push(if has_child[j] {
+        ws.acc[j] = if ws.has_child[j] {
             a + s_times(jp, &qj)
         } else {
             a
-        });
-        qdd.push(qj);
+        };
+        qdd[j] = qj;
     }
-    qdd
 }
 
 /// Forward dynamics on a fixed base by the articulated-body algorithm: the joint accelerations
@@ -391,14 +488,39 @@ fn accelerations<S: Scalar>(p: &Params<S>, joints: &[Joint<S>], a_root: &Motion<
 /// absent), gravity `g` in the base frame (the base acceleration `a_0 = [0; −g]`) and external
 /// wrenches (force at `O_j`, moment about `O_j`, in the body's or the base frame), as
 /// [`crate::algorithms::rnea::bias`] takes them. One division per joint. Section `"spatial:aba"`.
+/// Allocates a [`Workspace`] and calls [`forward_dynamics_in`].
 pub fn forward_dynamics<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loads<S>) -> Vec<S> {
+    let mut ws = Workspace::new(p);
+    let mut qdd: Vec<S> = (0..p.dof()).map(|_| S::zero()).collect();
+    forward_dynamics_in(p, &mut ws, q, qd, loads, None, &mut qdd);
+    qdd
+}
+
+/// [`forward_dynamics`] into `qdd` (length `N`) with the workspace `ws` of the model, allocating
+/// nothing; `armature`: `a_i ≥ 0` per joint (the reflected rotor inertia `I_m n²`), solving
+/// `(H + diag(a)) q̈ = τ − C` (Pinocchio's `Model::armature`). Section `"spatial:aba"`.
+///
+/// # Panics
+/// When a length disagrees with the model (`q`, `qd`, `loads.tau`, `armature`, `qdd`, the
+/// workspace's) or a wrench names a body past the end of the chain.
+pub fn forward_dynamics_in<S: Scalar>(
+    p: &Params<S>,
+    ws: &mut Workspace<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+    armature: Option<&[S]>,
+    qdd: &mut [S],
+) {
     S::section("spatial:aba");
+    check_args(p, ws, q, qd, loads, armature);
+    assert_eq!(qdd.len(), p.dof(), "qdd has the wrong length");
     let root = Root {
         v: Motion::zero(),
         e0: Mat3::identity(),
         floating: None,
     };
-    let (joints, _) = backward(p, q, qd, loads, root);
+    backward(p, ws, q, qd, loads, armature, root);
     // a_0 = −a_grav (RBDA §5.3)
     let a0 = match &loads.gravity {
         Some(g) => Motion {
@@ -407,7 +529,7 @@ pub fn forward_dynamics<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loa
         },
         None => Motion::zero(),
     };
-    accelerations(p, &joints, &a0)
+    accelerations(p, ws, &a0, qdd);
 }
 
 /// Forward dynamics of the tree `p` on the free-floating base `base` by the articulated-body
@@ -422,7 +544,7 @@ pub fn forward_dynamics<S: Scalar>(p: &Params<S>, q: &[S], qd: &[S], loads: &Loa
 /// out of the passes (every `a'_i = a_i − a_grav` obeys the same recursion) and put back on the
 /// base: `a_0 = a'_0 + [0; R₀ᵀ g]`. Loads as [`crate::algorithms::rnea::floating_bias`] takes
 /// them (inertial-frame wrenches rotated into body coordinates with `E_0j R₀ᵀ`).
-/// Section `"spatial:aba"`.
+/// Section `"spatial:aba"`. Allocates a [`Workspace`] and calls [`floating_in`].
 pub fn floating<S: Scalar>(
     p: &Params<S>,
     base: &FloatingBase<S>,
@@ -431,7 +553,38 @@ pub fn floating<S: Scalar>(
     qd: &[S],
     loads: &Loads<S>,
 ) -> Vec<S> {
+    let mut ws = Workspace::new(p);
+    let mut out: Vec<S> = (0..FLOATING_BASE_DOF + p.dof())
+        .map(|_| S::zero())
+        .collect();
+    floating_in(p, &mut ws, base, state, q, qd, loads, None, &mut out);
+    out
+}
+
+/// [`floating`] into `nu_dot` (length `6 + N`) with the workspace `ws` of the model, allocating
+/// nothing; `armature` as in [`forward_dynamics_in`] (joints only). Section `"spatial:aba"`.
+///
+/// # Panics
+/// As [`forward_dynamics_in`].
+#[allow(clippy::too_many_arguments)]
+pub fn floating_in<S: Scalar>(
+    p: &Params<S>,
+    ws: &mut Workspace<S>,
+    base: &FloatingBase<S>,
+    state: &FloatingState<S>,
+    q: &[S],
+    qd: &[S],
+    loads: &Loads<S>,
+    armature: Option<&[S]>,
+    nu_dot: &mut [S],
+) {
     S::section("spatial:aba");
+    check_args(p, ws, q, qd, loads, armature);
+    assert_eq!(
+        nu_dot.len(),
+        FLOATING_BASE_DOF + p.dof(),
+        "nu_dot has the wrong length"
+    );
     let e0 = state.rotation.transpose();
     let v0 = Motion {
         ang: state.omega_b.clone(),
@@ -445,8 +598,7 @@ pub fn floating<S: Scalar>(
         e0: e0.clone(),
         floating: Some((Articulated::rigid(&i0), p0)),
     };
-    let (joints, base_ab) = backward(p, q, qd, loads, root);
-    let (ia0, pa0) = base_ab.expect("a floating root");
+    let (ia0, pa0) = backward(p, ws, q, qd, loads, armature, root).expect("a floating root");
     // I^A_0 a'_0 = −p^A_0, rows and columns in the order [lin; ang] of ν_b.
     let ang_lin = |r: usize, c: usize| -> S {
         match (r < 3, c < 3) {
@@ -456,25 +608,25 @@ pub fn floating<S: Scalar>(
             (false, false) => ia0.a.at(r - 3, c - 3),
         }
     };
-    let m6: Vec<Vec<S>> = (0..FLOATING_BASE_DOF)
-        .map(|r| (0..FLOATING_BASE_DOF).map(|c| ang_lin(r, c)).collect())
-        .collect();
-    let rhs: Vec<S> = crate::spatial::base_rows(&pa0)
-        .into_iter()
-        .map(|x| -x)
-        .collect();
-    let x = crate::ldlt::solve(&crate::ldlt::ldlt(&m6), &rhs);
+    const B: usize = FLOATING_BASE_DOF;
+    let mut m6: [S; B * B] = core::array::from_fn(|k| ang_lin(k / B, k % B));
+    let mut d_inv: [S; B] = core::array::from_fn(|_| S::zero());
+    crate::ldlt::factor_in_place(&mut m6, B, &mut d_inv);
+    let mut x = crate::spatial::base_rows(&pa0).map(|x| -x);
+    crate::ldlt::solve_in_place(&m6, B, &d_inv, &mut x);
+    let [x0, x1, x2, x3, x4, x5] = x;
     let a0 = Motion {
-        ang: Vec3::new(x[3].clone(), x[4].clone(), x[5].clone()),
-        lin: Vec3::new(x[0].clone(), x[1].clone(), x[2].clone()),
+        ang: Vec3::new(x3, x4, x5),
+        lin: Vec3::new(x0, x1, x2),
     };
-    let qdd = accelerations(p, &joints, &a0);
+    let (head, qdd) = nu_dot.split_at_mut(B);
+    accelerations(p, ws, &a0, qdd);
     // a_0 = a'_0 + a_grav, a_grav = [0; R₀ᵀ g] in base coordinates.
     let lin = match &loads.gravity {
         Some(g) => a0.lin + e0.mul_vec(g),
         None => a0.lin,
     };
-    let mut out: Vec<S> = lin.0.into_iter().chain(a0.ang.0).collect();
-    out.extend(qdd);
-    out
+    for (o, x) in head.iter_mut().zip(lin.0.into_iter().chain(a0.ang.0)) {
+        *o = x;
+    }
 }
