@@ -6,9 +6,8 @@
 //! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
 //! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
 //! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
-//! `kanegen_sim::integrate`. The scene feature the generated simulator does not reproduce (a
-//! tabulated wrench with a computed-torque drive) is a compile error naming the key and the
-//! scene file.
+//! `kanegen_sim::integrate`. A scene error is a compile error naming the key and the scene
+//! file.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
 use kanegen_sim::scene::{BaseSpec, Drives, Integrator, Scene, WrenchProfile};
@@ -31,6 +30,31 @@ fn rows(v: &[[f64; 3]]) -> TokenStream {
     quote!([#(#v),*])
 }
 
+/// The expression of a wrench's `(force, moment)` at time `t`: constant, or interpolated in
+/// its table (`kanegen::ode::table`, as the interpreted `SceneWrench::value_at`).
+fn wrench_value(runtime: &syn::Path, profile: &WrenchProfile) -> TokenStream {
+    match profile {
+        WrenchProfile::Constant { force, moment } => {
+            let (f, m) = (arr(force), arr(moment));
+            quote!((#f, #m))
+        }
+        WrenchProfile::Table {
+            time,
+            force,
+            moment,
+        } => {
+            let kl = Literal::usize_unsuffixed(time.len());
+            let (tt, f, m) = (arr(time), rows(force), rows(moment));
+            quote! {{
+                const TIME: [f64; #kl] = #tt;
+                const FORCE: [[f64; 3]; #kl] = #f;
+                const MOMENT: [[f64; 3]; #kl] = #m;
+                #runtime::ode::table(t, &TIME, &FORCE, &MOMENT)
+            }}
+        }
+    }
+}
+
 /// The items of `scene!(runtime; name, "rel")`; `Err` is the compile error's message.
 pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStream, String> {
     let dir = std::env::var("CARGO_MANIFEST_DIR").unwrap_or_else(|_| ".".into());
@@ -45,23 +69,8 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let text = std::fs::read_to_string(&path).map_err(|e| format!("{rel}: {e}"))?;
     let model_path = Scene::model_path(&text, scene_dir)
         .ok_or_else(|| format!("{rel}: model: no model path"))?;
-    let unsupported = |key: &str, why: &str| -> Result<(), String> {
-        Err(format!(
-            "{rel}: `{key}` is not supported by scene! ({why}); run this scene with \
-             `kanegen simulate {rel}`"
-        ))
-    };
     let sim = &scene.simulation;
     let computed_torque = matches!(scene.drives, Drives::ComputedTorque { .. });
-    if computed_torque {
-        if let Some(k) = scene.wrenches.iter().position(|w| w.is_tabulated()) {
-            unsupported(
-                &format!("effects.wrench[{k}].time with drives.type = \"computed-torque\""),
-                "the interpreted controller compensates a tabulated wrench at its t = 0 value; \
-                 constant wrenches are supported",
-            )?;
-        }
-    }
 
     // The model: the scene's payload is merged already; its base kind and inertial are the
     // scene's; one identity frame on each body loaded by an inertial-frame wrench gives the
@@ -140,15 +149,13 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         (quote!(let qj = s.q;), quote!(let qdj = s.qd;))
     };
 
-    // A computed-torque drive compensates the (constant) wrenches as the interpreted inverse
+    // A computed-torque drive compensates the wrenches (at `t`) as the interpreted inverse
     // dynamics does: `τ −= J_vᵀ f + J_ωᵀ m`, force and moment in base axes at the body origin
     // (fixed base only: the scene rejects computed torque on a free-floating base).
     let mut compensate = Vec::new();
     if computed_torque {
         for (k, w) in scene.wrenches.iter().enumerate() {
-            let WrenchProfile::Constant { force, moment } = &w.profile else {
-                continue;
-            };
+            let value = wrench_value(runtime, &w.profile);
             let Some(fname) = &wrench_frames[k] else {
                 return Err(format!("{rel}: effects.wrench[{k}]: no frame"));
             };
@@ -156,7 +163,6 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 format_ident!("{}_placement", fname),
                 format_ident!("{}_jacobian", fname),
             );
-            let (f, m) = (arr(force), arr(moment));
             let to_base = if w.frame == kanegen_codegen::kanegen_dynamics::LoadFrame::Body {
                 quote! {
                     let r = #dyn_ty::#pl(&qj).1;
@@ -169,7 +175,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 quote!()
             };
             compensate.push(quote! {{
-                let (f, m): ([f64; 3], [f64; 3]) = (#f, #m);
+                let (f, m): ([f64; 3], [f64; 3]) = #value;
                 #to_base
                 let jac = #dyn_ty::#jac(&qj);
                 for j in 0..#nl {
@@ -252,26 +258,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let rows_n = Literal::usize_unsuffixed(n + usize::from(floating));
     let mut wrench_code = Vec::new();
     for (k, w) in scene.wrenches.iter().enumerate() {
-        let value = match &w.profile {
-            WrenchProfile::Constant { force, moment } => {
-                let (f, m) = (arr(force), arr(moment));
-                quote!((#f, #m))
-            }
-            WrenchProfile::Table {
-                time,
-                force,
-                moment,
-            } => {
-                let kl = Literal::usize_unsuffixed(time.len());
-                let (tt, f, m) = (arr(time), rows(force), rows(moment));
-                quote! {{
-                    const TIME: [f64; #kl] = #tt;
-                    const FORCE: [[f64; 3]; #kl] = #f;
-                    const MOMENT: [[f64; 3]; #kl] = #m;
-                    #runtime::ode::table(t, &TIME, &FORCE, &MOMENT)
-                }}
-            }
-        };
+        let value = wrench_value(runtime, &w.profile);
         let is_base = w.body == kanegen_codegen::kanegen_dynamics::base::BASE_BODY;
         let row = Literal::usize_unsuffixed(if is_base {
             0

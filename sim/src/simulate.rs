@@ -245,12 +245,23 @@ impl<'a> SceneSystem<'a> {
                 let cmd: Vec<f64> = (0..self.n)
                     .map(|i| qddr[i] + kd[i] * (qdr[i] - qd[i]) + kp[i] * (qr[i] - q[i]))
                     .collect();
+                // The controller compensates the scene's loads as they are at `t`.
+                let at_t;
+                let loads = if self.time_varying {
+                    at_t = Loads {
+                        external: s.wrenches.iter().map(|w| w.at(t)).collect(),
+                        ..self.passive.clone()
+                    };
+                    &at_t
+                } else {
+                    &self.passive
+                };
                 tau.copy_from_slice(&s.simulation.algorithm.inverse_dynamics(
                     &self.params,
                     q,
                     qd,
                     &cmd,
-                    &self.passive,
+                    loads,
                 ));
             }
         }

@@ -1,3 +1,0 @@
-kanegen::scene!(Bad, "bad/scene_computed_torque_wrench.toml");
-
-fn main() {}
