@@ -7,6 +7,7 @@
 //! equations. Plots and files are the CLI's.
 #![warn(missing_docs)]
 
+pub mod events;
 pub mod integrate;
 pub mod scene;
 pub mod simulate;
