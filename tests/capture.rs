@@ -314,3 +314,62 @@ fn bad_events_are_errors_naming_the_key() {
         "{e}"
     );
 }
+
+fn count_json(scene: &str) -> serde_json::Value {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
+        .args(["count", "--json", "--algorithm", "recurrent", scene])
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_slice(&out.stdout).unwrap()
+}
+
+/// `count SCENE` lists a capture's one-time cost: two `A` evaluations (the table's line) plus
+/// the impulse algebra on `n_v = 13` speeds, counted here by hand: `H ν` 169 mul 156 add,
+/// `h_p` 30 mul 18 add, `J_pᵀ h_p` 78 and 78, LDLᵀ factor `C(14, 3) = 364` mul and add and 78
+/// div, solve 156 mul and add and 13 div — 797 mul, 772 add, 91 div (+14 add of armature with
+/// rotors); a release costs nothing; a scene without events has no `events` lines.
+#[test]
+fn count_lists_the_capture_cost() {
+    for (scene, armature) in [
+        ("scenes/capture_free_floating.toml", 0),
+        ("tests/data/scenes/capture_rotor_rk4.toml", 14),
+    ] {
+        let r = count_json(scene);
+        let a = r["counts"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|c| c["function"] == "mass_matrix" && c["convention"] == "emitted")
+            .unwrap()
+            .clone();
+        let ev = r["events"].as_array().unwrap();
+        let cap = ev
+            .iter()
+            .find(|e| e["effect"] == "capture" && e["convention"] == "emitted")
+            .unwrap();
+        let int = |v: &serde_json::Value| v.as_i64().unwrap();
+        assert_eq!(int(&cap["mul"]), 2 * int(&a["mul"]) + 797, "{scene}");
+        assert_eq!(
+            int(&cap["add"]),
+            2 * int(&a["add"]) + 772 + armature,
+            "{scene}"
+        );
+        assert_eq!(int(&cap["div"]), 91, "{scene}");
+        let rel = ev.iter().find(|e| e["effect"] == "release").unwrap();
+        assert_eq!((int(&rel["mul"]), int(&rel["add"])), (0, 0));
+    }
+    let r = count_json("scenes/free_floating_7dof.toml");
+    assert!(r.get("events").is_none());
+    let r = count_json("tests/data/scenes/floating_rotor.toml");
+    assert!(r["effects"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|e| e["effect"] == "rotor"));
+}

@@ -869,7 +869,26 @@ pub fn render_text(s: &Summary) -> String {
         f(s.max_angular_momentum_drift_rel),
         s.final_state.q,
         s.final_state.qd,
-    )
+    ) + &events_text(s)
+}
+
+/// One line per payload event of a summary (empty without events).
+fn events_text(s: &Summary) -> String {
+    s.events
+        .iter()
+        .map(|e| {
+            format!(
+                "\nevent at t = {}: {} by {}, momentum error through it (rel) {:.3e} linear, \
+                 {:.3e} angular, kinetic energy change {:.6e} J",
+                e.t,
+                e.kind,
+                e.body,
+                e.linear_momentum_error_rel,
+                e.angular_momentum_error_rel,
+                e.energy_change
+            )
+        })
+        .collect()
 }
 
 /// The CSV header of a scene's trajectory: `t`, `q_<joint>`…, `qd_<joint>`…, and for a
