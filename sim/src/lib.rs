@@ -11,3 +11,4 @@ pub mod events;
 pub mod integrate;
 pub mod scene;
 pub mod simulate;
+pub mod singularity;
