@@ -6,7 +6,9 @@
 //! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
 //! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
 //! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
-//! `kanegen_sim::integrate`. The scene feature the generated simulator does not reproduce (a
+//! `kanegen_sim::integrate`. Payload captures and releases (`[[events]]`) are in
+//! [`crate::scene_events`]: one dynamics type per model phase, a run segment by segment, and the
+//! capture impulse. The scene feature the generated simulator does not reproduce (a
 //! tabulated wrench with a computed-torque drive) is a compile error naming the key and the
 //! scene file.
 

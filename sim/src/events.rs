@@ -39,12 +39,11 @@
 //! jump `E⁺ − E⁻` of each event (the plastic loss, or the kinetic energy the released payload
 //! carries away).
 
-use crate::scene::{Event, EventKind};
-use crate::simulate::SceneSystem;
 use kanegen_dynamics::algorithms::{floating, frames};
-use kanegen_dynamics::base::FLOATING_BASE_DOF;
+use kanegen_dynamics::base::{FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
-use kanegen_dynamics::{FrameParams, Params};
+use kanegen_dynamics::{FrameParams, MassMatrixMethod, Params};
+use kanegen_model::Inertial;
 use serde::Serialize;
 
 /// What one event did, in the summary of a run.
@@ -73,7 +72,9 @@ pub struct EventReport {
     pub payload_angular_momentum: [f64; 3],
 }
 
-fn rel_diff(a: &[f64; 3], b: &[f64; 3]) -> f64 {
+/// `|a − b| / |b|` (absolute when `b = 0`).
+#[must_use]
+pub fn rel_diff(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     let d = (0..3).map(|i| (a[i] - b[i]).powi(2)).sum::<f64>().sqrt();
     let n = b.iter().map(|x| x * x).sum::<f64>().sqrt();
     if n == 0.0 {
@@ -83,101 +84,71 @@ fn rel_diff(a: &[f64; 3], b: &[f64; 3]) -> f64 {
     }
 }
 
-fn add(a: &[f64; 3], b: &[f64; 3], sign: f64) -> [f64; 3] {
+/// `a + sign · b`.
+#[must_use]
+pub fn add(a: &[f64; 3], b: &[f64; 3], sign: f64) -> [f64; 3] {
     [0, 1, 2].map(|i| a[i] + sign * b[i])
 }
 
-impl SceneSystem<'_> {
-    /// Applies `event` at state `x` (free-floating): switches the model to `event.model` and, for
-    /// a capture, replaces `ν` by the post-capture velocity of the module doc's impulse equation
-    /// (LDLᵀ solve of `H'`, with the armature of `[effects] rotor` on both mass matrices).
-    ///
-    /// # Panics
-    /// On a fixed base (the scene parser rejects events there).
-    pub fn apply_event(&mut self, event: &Event, x: &mut [f64]) -> EventReport {
-        let n = self.n();
-        let alg = self.scene().simulation.algorithm;
-        let before = self.momentum(x).expect("events need a free-floating base");
-        let e_before = self.kinetic_energy(x);
-        let new_params = Params::new(&event.model);
-        let (kind, pay) = match &event.kind {
-            EventKind::Capture { payload, v, omega } => {
-                let (q, _, st) = self.split(x);
-                let st = st.expect("free-floating");
-                let base = self.floating_base().expect("free-floating").clone();
-                let nu: Vec<f64> = x[7 + n..].to_vec();
-                let mut h = floating::mass_matrix(alg.mass_matrix, self.params(), &base, &st, q);
-                self.add_armature(&mut h);
-                let mut p: Vec<f64> = h
-                    .iter()
-                    .map(|row| row.iter().zip(&nu).map(|(a, b)| a * b).sum())
-                    .collect();
-                // The payload's centre-of-mass frame on the capturing body, its Jacobian and
-                // placement (inertial frame).
-                let frame = FrameParams {
-                    parent: Some(event.body),
-                    translation: Vec3::from_f64(payload.com),
-                    rotation: Mat3::identity(),
-                };
-                let jp = frames::floating_jacobian(self.params(), &st, q, &frame);
-                let (xc, r) = frames::floating_placement(self.params(), &st, q, &frame);
-                let m = payload.mass;
-                // Spin momentum R I_p Rᵀ ω_p about the payload's centre of mass.
-                let i_body = Mat3::from_f64(payload.inertia);
-                let spin =
-                    r.mul_vec(&i_body.mul_vec(&r.transpose().mul_vec(&Vec3::from_f64(*omega))));
-                let lin = Vec3::from_f64(*v).scale(&m);
-                let hp: Vec<f64> = lin.0.iter().chain(&spin.0).copied().collect();
-                for (col, pk) in p.iter_mut().enumerate() {
-                    *pk += (0..6).map(|row| jp[row][col] * hp[row]).sum::<f64>();
-                }
-                let mut h_new = floating::mass_matrix(alg.mass_matrix, &new_params, &base, &st, q);
-                self.add_armature(&mut h_new);
-                let nu_new =
-                    kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&h_new), &p);
-                debug_assert_eq!(nu_new.len(), FLOATING_BASE_DOF + n);
-                x[7 + n..].copy_from_slice(&nu_new);
-                self.set_params(new_params);
-                let ang = xc.cross(&lin) + spin;
-                ("capture", (lin.into_array(), ang.into_array()))
-            }
-            EventKind::Release { .. } => {
-                self.set_params(new_params);
-                let after = self.momentum(x).expect("free-floating");
-                (
-                    "release",
-                    (
-                        add(&before.0, &after.0, -1.0),
-                        add(&before.1, &after.1, -1.0),
-                    ),
-                )
-            }
-        };
-        let after = self.momentum(x).expect("free-floating");
-        // System and payload, before and after: the payload is free before a capture and after
-        // a release.
-        let (total_before, total_after) = if kind == "capture" {
-            (
-                (add(&before.0, &pay.0, 1.0), add(&before.1, &pay.1, 1.0)),
-                after,
-            )
-        } else {
-            (
-                before,
-                (add(&after.0, &pay.0, 1.0), add(&after.1, &pay.1, 1.0)),
-            )
-        };
-        EventReport {
-            t: event.time,
-            kind,
-            body: self.scene().model.joints()[event.body].body.clone(),
-            linear_momentum_before: total_before.0,
-            angular_momentum_before: total_before.1,
-            linear_momentum_error_rel: rel_diff(&total_after.0, &total_before.0),
-            angular_momentum_error_rel: rel_diff(&total_after.1, &total_before.1),
-            energy_change: self.kinetic_energy(x) - e_before,
-            payload_linear_momentum: pay.0,
-            payload_angular_momentum: pay.1,
-        }
+/// What a capture needs of the system: the mass-matrix method, the base body, its pose, the arm
+/// positions, and the armature to add to a mass matrix.
+pub struct CaptureSystem<'a> {
+    /// How `H` is computed.
+    pub method: MassMatrixMethod,
+    /// The free-floating base body.
+    pub base: &'a FloatingBase<f64>,
+    /// The base pose and twist at the event.
+    pub state: &'a FloatingState<f64>,
+    /// Arm positions at the event.
+    pub q: &'a [f64],
+    /// Adds `[effects] rotor`'s armature to a `(6+N)` mass matrix (nothing without).
+    pub armature: &'a dyn Fn(&mut [Vec<f64>]),
+}
+
+/// The post-capture generalized velocity `ν⁺` of the module doc's impulse equation (LDLᵀ
+/// solve of `H'`) and the payload's momentum `(m v_p, x_c × m v_p + R I_p Rᵀ ω_p)` (inertial
+/// frame, about the inertial origin), for a payload `payload` (in body `body`'s frame) moving
+/// with `v`, `omega` (inertial) caught by body `body` of the system `before` (→ `after` with
+/// the payload) at velocity `nu`.
+#[must_use]
+#[allow(clippy::too_many_arguments)]
+pub fn capture(
+    sys: &CaptureSystem<'_>,
+    before: &Params<f64>,
+    after: &Params<f64>,
+    nu: &[f64],
+    body: usize,
+    payload: &Inertial,
+    v: [f64; 3],
+    omega: [f64; 3],
+) -> (Vec<f64>, ([f64; 3], [f64; 3])) {
+    let (q, st) = (sys.q, sys.state);
+    let mut h = floating::mass_matrix(sys.method, before, sys.base, st, q);
+    (sys.armature)(&mut h);
+    let mut p: Vec<f64> = h
+        .iter()
+        .map(|row| row.iter().zip(nu).map(|(a, b)| a * b).sum())
+        .collect();
+    // The payload's centre-of-mass frame on the capturing body, its Jacobian and placement
+    // (inertial frame).
+    let frame = FrameParams {
+        parent: Some(body),
+        translation: Vec3::from_f64(payload.com),
+        rotation: Mat3::identity(),
+    };
+    let jp = frames::floating_jacobian(before, st, q, &frame);
+    let (xc, r) = frames::floating_placement(before, st, q, &frame);
+    // Spin momentum R I_p Rᵀ ω_p about the payload's centre of mass.
+    let i_body = Mat3::from_f64(payload.inertia);
+    let spin = r.mul_vec(&i_body.mul_vec(&r.transpose().mul_vec(&Vec3::from_f64(omega))));
+    let lin = Vec3::from_f64(v).scale(&payload.mass);
+    let hp: Vec<f64> = lin.0.iter().chain(&spin.0).copied().collect();
+    for (col, pk) in p.iter_mut().enumerate() {
+        *pk += (0..6).map(|row| jp[row][col] * hp[row]).sum::<f64>();
     }
+    let mut h_new = floating::mass_matrix(sys.method, after, sys.base, st, q);
+    (sys.armature)(&mut h_new);
+    let nu_new = kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&h_new), &p);
+    let ang = xc.cross(&lin) + spin;
+    (nu_new, (lin.into_array(), ang.into_array()))
 }

@@ -7,9 +7,11 @@
 //! after every accepted step ([`System::project`]); the implicit midpoint rule updates it by the
 //! exponential map ([`System::advance`]) and needs no projection.
 
-use crate::events::EventReport;
+use crate::events::{self, CaptureSystem, EventReport};
 use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, Stats, System};
-use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench, SimulationSpec};
+use crate::scene::{
+    BaseSpec, Drives, Event, EventKind, Integrator, Scene, SceneWrench, SimulationSpec,
+};
 use anyhow::Result;
 use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
 use kanegen_dynamics::algorithms::frames;
@@ -335,6 +337,90 @@ impl<'a> SceneSystem<'a> {
         let (b, st) = (self.base.as_ref()?, st?);
         let (l, a) = momentum(&self.params, b, &st, q, qd);
         Some((l.into_array(), a.into_array()))
+    }
+}
+
+impl SceneSystem<'_> {
+    /// Applies `event` at state `x` (free-floating): switches the model to `event.model` and, for
+    /// a capture, replaces `ν` by the post-capture velocity of the plastic-impact equation
+    /// ([`events::capture`], with the armature of `[effects] rotor` on both mass matrices).
+    ///
+    /// # Panics
+    /// On a fixed base (the scene parser rejects events there).
+    pub fn apply_event(&mut self, event: &Event, x: &mut [f64]) -> EventReport {
+        let n = self.n;
+        let before = self.momentum(x).expect("events need a free-floating base");
+        let e_before = self.kinetic_energy(x);
+        let new_params = Params::new(&event.model);
+        let (kind, pay) = match &event.kind {
+            EventKind::Capture { payload, v, omega } => {
+                let (q, _, st) = self.split(x);
+                let st = st.expect("free-floating");
+                let armature = |a: &mut [Vec<f64>]| self.add_armature(a);
+                let sys = CaptureSystem {
+                    method: self.scene.simulation.algorithm.mass_matrix,
+                    base: self.base.as_ref().expect("free-floating"),
+                    state: &st,
+                    q,
+                    armature: &armature,
+                };
+                let (nu, pay) = events::capture(
+                    &sys,
+                    &self.params,
+                    &new_params,
+                    &x[7 + n..],
+                    event.body,
+                    payload,
+                    *v,
+                    *omega,
+                );
+                x[7 + n..].copy_from_slice(&nu);
+                ("capture", pay)
+            }
+            EventKind::Release { .. } => ("release", (before.0, before.1)),
+        };
+        self.params = new_params;
+        let after = self.momentum(x).expect("free-floating");
+        // The released payload's momentum: the system's with it minus without it.
+        let pay = if kind == "release" {
+            (
+                events::add(&pay.0, &after.0, -1.0),
+                events::add(&pay.1, &after.1, -1.0),
+            )
+        } else {
+            pay
+        };
+        // System and payload, before and after: the payload is free before a capture and after
+        // a release.
+        let (total_before, total_after) = if kind == "capture" {
+            (
+                (
+                    events::add(&before.0, &pay.0, 1.0),
+                    events::add(&before.1, &pay.1, 1.0),
+                ),
+                after,
+            )
+        } else {
+            (
+                before,
+                (
+                    events::add(&after.0, &pay.0, 1.0),
+                    events::add(&after.1, &pay.1, 1.0),
+                ),
+            )
+        };
+        EventReport {
+            t: event.time,
+            kind,
+            body: self.scene.model.joints()[event.body].body.clone(),
+            linear_momentum_before: total_before.0,
+            angular_momentum_before: total_before.1,
+            linear_momentum_error_rel: events::rel_diff(&total_after.0, &total_before.0),
+            angular_momentum_error_rel: events::rel_diff(&total_after.1, &total_before.1),
+            energy_change: self.kinetic_energy(x) - e_before,
+            payload_linear_momentum: pay.0,
+            payload_angular_momentum: pay.1,
+        }
     }
 }
 
