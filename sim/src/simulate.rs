@@ -886,7 +886,7 @@ fn integrate_segment(
 ) -> Result<Stats, IntegrateError> {
     let total = (((t1 - t0) / sim.step) - 1e-9).ceil().max(1.0) as usize;
     let mut every = |k: usize, t: f64, x: &[f64]| {
-        if k % sim.output_every == 0 || k == total {
+        if k.is_multiple_of(sim.output_every) || k == total {
             record(t, x)
         } else {
             ControlFlow::Continue(())
