@@ -780,8 +780,13 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     // One integration per segment between events: each ends exactly at its event time (the
     // state at t_e⁻ is sampled), the event switches the model and jumps ν, and the next segment
     // starts with a sample at t_e⁺.
-    let ends: Vec<f64> = scene
+    // Events at or after the end (a scene whose duration was shortened) do not happen.
+    let events: Vec<&Event> = scene
         .events
+        .iter()
+        .filter(|e| e.time < sim.duration)
+        .collect();
+    let ends: Vec<f64> = events
         .iter()
         .map(|e| e.time)
         .chain([sim.duration])
@@ -792,7 +797,7 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     let mut result: Result<(), IntegrateError> = Ok(());
     for (seg, &t1) in ends.iter().enumerate() {
         if seg > 0 {
-            let event = &scene.events[seg - 1];
+            let event = events[seg - 1];
             let report = sys.apply_event(event, &mut x);
             monitor.borrow_mut().set_params(sys.params().clone());
             if let Some(e) = e0.get() {
