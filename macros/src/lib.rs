@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 mod scene;
+mod scene_events;
 
 use proc_macro::TokenStream;
 use proc_macro2::Span;

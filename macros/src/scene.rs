@@ -6,11 +6,12 @@
 //! `Name`, whose right-hand side holds only the effects the scene names — drives, joint damping,
 //! external wrenches — written as the interpreted `kanegen_sim::simulate::SceneSystem` writes
 //! them, and whose `run` calls the facade's fixed-size integrators (`kanegen::ode`), which mirror
-//! `kanegen_sim::integrate`. A scene error is a compile error naming the key and the scene
-//! file.
+//! `kanegen_sim::integrate`. Payload captures and releases (`[[events]]`) are in
+//! [`crate::scene_events`]: one dynamics type per model phase, a run segment by segment, and the
+//! capture impulse. A scene error is a compile error naming the key and the scene file.
 
 use kanegen_codegen::kanegen_model::{BaseKind, Frame, Placement};
-use kanegen_sim::scene::{BaseSpec, Drives, Integrator, Scene, WrenchProfile};
+use kanegen_sim::scene::{BaseSpec, Drives, EventKind, Integrator, Scene, WrenchProfile};
 use proc_macro2::{Literal, Span, TokenStream};
 use quote::{format_ident, quote};
 use syn::{Ident, LitStr};
@@ -111,6 +112,20 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             wrench_frames.push(None);
         }
     }
+    // One frame at each captured payload's centre of mass: its generated Jacobian and
+    // placement give the capture impulse `J_pᵀ h_p`.
+    for (k, e) in scene.events.iter().enumerate() {
+        if let EventKind::Capture { payload, .. } = &e.kind {
+            frames.push(Frame {
+                name: format!("scene_capture_{k}"),
+                parent: Some(e.body),
+                placement: Placement {
+                    translation: payload.com,
+                    ..Placement::default()
+                },
+            });
+        }
+    }
     let model = model
         .with_frames(frames)
         .map_err(|e| format!("{rel}: model frames: {e}"))?;
@@ -126,6 +141,8 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     opts.op_count_name = format!("{dyn_name}OpCount");
     let g = kanegen_codegen::generate_items(&model, &opts).map_err(|e| format!("{rel}: {e}"))?;
     let dyn_items = g.items;
+    let (phase_tys, phase_items) =
+        crate::scene_events::phase_dynamics(&scene, &opts, &dyn_name, rel)?;
 
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
@@ -297,48 +314,72 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             #apply
         }});
     }
-    let accel = if let Some(r) = &scene.rotor {
-        // (M + diag(I_m n²)) q̈ = τ − c by a fixed-size LDLᵀ (fixed base only: the scene rejects
-        // rotor inertia on a free-floating base). With wrenches, τ + Jᵀf − c = M a_w, a_w the
-        // generated forward dynamics with the wrenches. A non-positive pivot gives a NaN
-        // acceleration, so the step stops with `Stop::NonFinite`.
-        let refl = arr(&r.reflected);
-        let rhs = if scene.wrenches.is_empty() {
-            quote! {
-                let (mut m, c) = #dyn_ty::mass_matrix_and_nonlinear_effects(&s.q, &s.qd);
-                let b: [f64; #nl] = core::array::from_fn(|i| tau[i] - c[i]);
-            }
+    // The acceleration with the dynamics type `dy` (one per model phase of a scene with
+    // events; phase 0 is `NameDynamics`).
+    let off = Literal::usize_unsuffixed(nv - n);
+    let accel_for = |dy: &Ident| -> TokenStream {
+        if let Some(r) = &scene.rotor {
+            // (M + diag(I_m n²)) a = τ − c by a fixed-size LDLᵀ: the armature on the joint
+            // diagonal (`M[6+i][6+i]` on a free-floating base). With wrenches, τ + Jᵀf − c =
+            // M a_w, a_w the generated forward dynamics with the wrenches. A non-positive pivot
+            // gives a NaN acceleration, so the step stops with `Stop::NonFinite`.
+            let refl = arr(&r.reflected);
+            let tau_v = if floating {
+                quote! {
+                    let tau_v: [f64; #nvl] =
+                        core::array::from_fn(|i| if i < 6 { 0.0 } else { tau[i - 6] });
+                }
+            } else {
+                quote!(let tau_v = tau;)
+            };
+            let rhs = if scene.wrenches.is_empty() {
+                quote! {
+                    let (mut m, c) = #dy::mass_matrix_and_nonlinear_effects(&s.q, &s.#vname);
+                    #tau_v
+                    let b: [f64; #nvl] = core::array::from_fn(|i| tau_v[i] - c[i]);
+                }
+            } else {
+                quote! {
+                    let mut f_ext = [[0.0f64; 6]; #rows_n];
+                    #(#wrench_code)*
+                    let a_w = #dy::forward_dynamics_with_wrenches(&s.q, &s.#vname, &tau, &f_ext);
+                    let mut m = #dy::mass_matrix(&s.q);
+                    let b: [f64; #nvl] = core::array::from_fn(|i| {
+                        let mut x = 0.0;
+                        for j in 0..#nvl {
+                            x += m[i][j] * a_w[j];
+                        }
+                        x
+                    });
+                }
+            };
+            quote! {{
+                const ROTOR: [f64; #nl] = #refl;
+                #rhs
+                for i in 0..#nl {
+                    m[#off + i][#off + i] += ROTOR[i];
+                }
+                #runtime::ode::solve_spd(&m, &b).unwrap_or([f64::NAN; #nvl])
+            }}
+        } else if scene.wrenches.is_empty() {
+            quote!(#dy::forward_dynamics(&s.q, &s.#vname, &tau))
         } else {
-            quote! {
+            quote! {{
                 let mut f_ext = [[0.0f64; 6]; #rows_n];
                 #(#wrench_code)*
-                let a_w = #dyn_ty::forward_dynamics_with_wrenches(&s.q, &s.qd, &tau, &f_ext);
-                let mut m = #dyn_ty::mass_matrix(&s.q);
-                let b: [f64; #nl] = core::array::from_fn(|i| {
-                    let mut x = 0.0;
-                    for j in 0..#nl {
-                        x += m[i][j] * a_w[j];
-                    }
-                    x
-                });
-            }
-        };
-        quote! {{
-            const ROTOR: [f64; #nl] = #refl;
-            #rhs
-            for i in 0..#nl {
-                m[i][i] += ROTOR[i];
-            }
-            #runtime::ode::solve_spd(&m, &b).unwrap_or([f64::NAN; #nl])
-        }}
-    } else if scene.wrenches.is_empty() {
-        quote!(#dyn_ty::forward_dynamics(&s.q, &s.#vname, &tau))
+                #dy::forward_dynamics_with_wrenches(&s.q, &s.#vname, &tau, &f_ext)
+            }}
+        }
+    };
+    let accel = if scene.events.is_empty() {
+        accel_for(&dyn_ty)
     } else {
-        quote! {{
-            let mut f_ext = [[0.0f64; 6]; #rows_n];
-            #(#wrench_code)*
-            #dyn_ty::forward_dynamics_with_wrenches(&s.q, &s.#vname, &tau, &f_ext)
-        }}
+        let arms = phase_tys.iter().enumerate().map(|(k, ty)| {
+            let a = accel_for(ty);
+            let k = Literal::usize_unsuffixed(k);
+            quote!(#k => #a,)
+        });
+        quote!(match phase { #(#arms)* _ => [f64::NAN; #nvl] })
     };
     let derivative = if floating {
         quote! {
@@ -434,7 +475,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         lit(sim.max_step),
     );
     let every = Literal::usize_unsuffixed(sim.output_every);
-    let run_body = match sim.integrator {
+    let integrate = |t0: TokenStream, t1: TokenStream, obs: TokenStream| match sim.integrator {
         Integrator::Dopri5 => quote! {
             let opts = #runtime::ode::Dopri5Options {
                 tolerance: Self::TOLERANCE,
@@ -442,22 +483,50 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 initial_step: Self::STEP,
                 output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
             };
-            #runtime::ode::dopri5(&mut f, #project, 0.0, Self::DURATION, &opts, &mut x, obs)
+            #runtime::ode::dopri5(&mut f, #project, #t0, #t1, &opts, &mut x, #obs)
         },
         Integrator::Rk4 => quote! {
             let opts = #runtime::ode::Rk4Options {
                 step: Self::STEP,
                 output_every: Self::OUTPUT_EVERY,
             };
-            #runtime::ode::rk4(&mut f, #project, 0.0, Self::DURATION, &opts, &mut x, obs)
+            #runtime::ode::rk4(&mut f, #project, #t0, #t1, &opts, &mut x, #obs)
         },
         Integrator::Midpoint => quote! {
             let opts = #runtime::ode::Rk4Options {
                 step: Self::STEP,
                 output_every: Self::OUTPUT_EVERY,
             };
-            #runtime::ode::midpoint(&mut f, #advance, 0.0, Self::DURATION, &opts, &mut x, obs)
+            #runtime::ode::midpoint(&mut f, #advance, #t0, #t1, &opts, &mut x, #obs)
         },
+    };
+    let run_body = if scene.events.is_empty() {
+        let call = integrate(quote!(0.0), quote!(Self::DURATION), quote!(obs));
+        quote! {
+            let mut f = |t: f64, x: &[f64; #dim]| {
+                Self::rhs(t, &#state_ty::from_array(x)).to_array()
+            };
+            #call
+        }
+    } else {
+        let call = integrate(quote!(t0), quote!(t1), quote!(&mut obs));
+        crate::scene_events::run_segments(runtime, &state_ty, &dim, &call)
+    };
+    let events =
+        crate::scene_events::event_items(runtime, &scene, &state_ty, &dyn_ty, &phase_tys, nv, n);
+    let rhs_sig = if scene.events.is_empty() {
+        quote! {
+            /// The right-hand side `ẋ = f(t, x)` with the scene's effects only.
+            #[must_use]
+            pub fn rhs(t: f64, s: &#state_ty) -> #state_ty
+        }
+    } else {
+        quote! {
+            /// The right-hand side `ẋ = f(t, x)` with the scene's effects only, with the model
+            /// of `phase` (0 before the first event, `k` after event `k − 1`).
+            #[must_use]
+            pub fn rhs_in(phase: usize, t: f64, s: &#state_ty) -> #state_ty
+        }
     };
     let integrator_doc = match sim.integrator {
         Integrator::Dopri5 => format!(
@@ -545,6 +614,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         const _: &[u8] = include_bytes!(#model_lit);
 
         #dyn_items
+        #phase_items
 
         #[doc = #state_doc]
         #[derive(Clone, Copy, Debug, PartialEq)]
@@ -602,9 +672,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
                 #state_ty { q: #q0, #vname: #v0 }
             }
 
-            /// The right-hand side `ẋ = f(t, x)` with the scene's effects only.
-            #[must_use]
-            pub fn rhs(t: f64, s: &#state_ty) -> #state_ty {
+            #rhs_sig {
                 let _ = t;
                 #qj
                 #qdj
@@ -644,13 +712,13 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             pub fn run(
                 mut observe: impl FnMut(f64, &#state_ty),
             ) -> Result<#runtime::ode::Stats, #runtime::ode::Stop> {
-                let mut f = |t: f64, x: &[f64; #dim]| {
-                    Self::rhs(t, &#state_ty::from_array(x)).to_array()
-                };
                 let mut x = Self::initial_state().to_array();
-                let obs = |t: f64, x: &[f64; #dim]| observe(t, &#state_ty::from_array(x));
+                #[allow(unused_mut)]
+                let mut obs = |t: f64, x: &[f64; #dim]| observe(t, &#state_ty::from_array(x));
                 #run_body
             }
+
+            #events
         }
     })
 }

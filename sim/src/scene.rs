@@ -1,6 +1,7 @@
 //! Simulation scenes: a TOML file naming a model, the base (fixed or free-floating),
 //! an optional payload, the effects (gravity, joint damping, constant or tabulated wrenches), the joint
-//! drives, the initial state and the integrator. See README.md, "Simulation scenes".
+//! drives, the initial state, the integrator, and payload captures and releases at given times
+//! (`[[events]]`, free-floating base; see [`crate::events`]). See README.md, "Simulation scenes".
 //!
 //! Every table rejects unknown keys, and every validation error names its key
 //! (`simulation.tolerance: must be > 0`). "Effects decide the code": only the effects a scene
@@ -40,6 +41,8 @@ struct RawScene {
     #[serde(default)]
     initial: RawInitial,
     simulation: RawSimulation,
+    #[serde(default)]
+    events: Vec<toml::Spanned<RawEvent>>,
 }
 
 #[derive(Deserialize)]
@@ -64,6 +67,20 @@ struct RawPayload {
     mass: f64,
     com: [f64; 3],
     inertia: InertiaSpec,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawEvent {
+    #[serde(rename = "type")]
+    kind: String,
+    time: f64,
+    body: Option<String>,
+    mass: Option<f64>,
+    com: Option<[f64; 3]>,
+    inertia: Option<InertiaSpec>,
+    v: Option<[f64; 3]>,
+    omega: Option<[f64; 3]>,
 }
 
 #[derive(Deserialize, Default)]
@@ -452,6 +469,41 @@ fn wrench_profile(
     })
 }
 
+/// What happens at a scene event (`[[events]]`).
+#[derive(Clone, Debug, PartialEq)]
+pub enum EventKind {
+    /// A free payload is captured by a body: perfectly plastic, it moves with the body from the
+    /// event on.
+    Capture {
+        /// The payload's mass properties in the capturing body's frame (like `[payload]`).
+        payload: Inertial,
+        /// Velocity of the payload's centre of mass just before the capture, inertial frame.
+        v: [f64; 3],
+        /// Angular velocity of the payload just before the capture, inertial frame.
+        omega: [f64; 3],
+    },
+    /// A payload the body holds (the static `[payload]` or a captured one) is let go with the
+    /// body's velocity; it then flies ballistically.
+    Release {
+        /// The payload's mass properties in the body's frame.
+        payload: Inertial,
+    },
+}
+
+/// A payload capture or release at a given time (free-floating base only), see
+/// `simulate::SceneSystem::apply_event`.
+#[derive(Clone, Debug)]
+pub struct Event {
+    /// Event time, s (`0 < time < duration`, strictly increasing over the events).
+    pub time: f64,
+    /// The body that captures or releases (joint index of its inboard joint).
+    pub body: usize,
+    /// Capture or release.
+    pub kind: EventKind,
+    /// The model from the event on (payloads held then merged into their bodies).
+    pub model: Model,
+}
+
 /// A validated scene.
 #[derive(Clone, Debug)]
 pub struct Scene {
@@ -466,7 +518,8 @@ pub struct Scene {
     /// External wrenches, constant or tabulated in time ([`BASE_BODY`] for the free-floating base
     /// body).
     pub wrenches: Vec<SceneWrench>,
-    /// Reflected rotor inertia (`[effects] rotor`), fixed base only.
+    /// Reflected rotor inertia (`[effects] rotor`): the armature model, on a fixed or a
+    /// free-floating base.
     pub rotor: Option<Rotor>,
     /// Regularized Coulomb drive friction (`[effects] friction.coulomb`).
     pub coulomb: Option<Coulomb>,
@@ -478,6 +531,9 @@ pub struct Scene {
     pub qd0: Vec<f64>,
     /// Integrator settings.
     pub simulation: SimulationSpec,
+    /// Payload captures and releases (`[[events]]`), in time order; empty when the scene has
+    /// none.
+    pub events: Vec<Event>,
 }
 
 fn check_len(key: &str, v: &[f64], n: usize, b: Bound) -> Result<()> {
@@ -515,6 +571,155 @@ fn gain(key: &str, g: Option<RawGain>, n: usize) -> Result<Vec<f64>> {
     }
     check_bound(key, &v, GAIN)?;
     Ok(v)
+}
+
+/// The index of the moving body `name` (the joint whose outboard body it is).
+fn body_index(chain: &Model, name: &str) -> Option<usize> {
+    chain.joints().iter().position(|j| j.body == name)
+}
+
+/// The moving bodies' names, comma-separated (error messages).
+fn body_names(chain: &Model) -> String {
+    let names: Vec<&str> = chain.joints().iter().map(|j| j.body.as_str()).collect();
+    names.join(", ")
+}
+
+/// `chain` with each payload `(body, inertial)` merged into its body, in order.
+fn with_payloads(
+    chain: &Model,
+    payloads: &[(usize, Inertial)],
+    validation: Validation,
+) -> Result<Model> {
+    if payloads.is_empty() {
+        return Ok(chain.clone());
+    }
+    let mut joints = chain.joints().to_vec();
+    for (body, pay) in payloads {
+        joints[*body].inertial = joints[*body].inertial.merge(pay);
+    }
+    Model::new_with(
+        chain.name(),
+        chain.base(),
+        chain.base_inertial().cloned(),
+        joints,
+        validation,
+    )
+    .map_err(|e| anyhow!("{e}"))
+}
+
+/// Validates `[[events]]` (times inside the run and increasing, known bodies, positive mass, a
+/// physical inertia, a release only of a payload the body holds) and builds the model after each.
+fn parse_events(
+    raw: Vec<toml::Spanned<RawEvent>>,
+    text: &str,
+    chain0: &Model,
+    mut attached: Vec<(usize, Inertial)>,
+    floating: bool,
+    duration: f64,
+    validation: Validation,
+) -> Result<Vec<Event>> {
+    let mut events: Vec<Event> = Vec::new();
+    for (k, e) in raw.into_iter().enumerate() {
+        let line = line_of(text, e.span().start);
+        let e = e.into_inner();
+        let key = |f: &str| format!("events[{k}].{f} (line {line})");
+        if !floating {
+            bail!(
+                "events[{k}] (line {line}): payload capture and release need a free-floating \
+                 base (base.type = \"free-floating\"), where the impulse conserves momentum"
+            );
+        }
+        if !(e.time.is_finite() && e.time > 0.0 && e.time < duration) {
+            bail!(
+                "{}: must be inside the run (0 < time < simulation.duration = {duration})",
+                key("time")
+            );
+        }
+        if let Some(prev) = events.last() {
+            if e.time <= prev.time {
+                bail!(
+                    "{}: events must be in strictly increasing time order ({} after {})",
+                    key("time"),
+                    e.time,
+                    prev.time
+                );
+            }
+        }
+        let body = match &e.body {
+            None => None,
+            Some(name) => Some(body_index(chain0, name).ok_or_else(|| {
+                anyhow!(
+                    "{}: unknown body `{name}` (moving bodies: {})",
+                    key("body"),
+                    body_names(chain0)
+                )
+            })?),
+        };
+        let kind = match e.kind.as_str() {
+            "capture" => {
+                let mass = e.mass.ok_or_else(|| anyhow!("{}: required", key("mass")))?;
+                if !(mass.is_finite() && mass > 0.0) {
+                    bail!("{}: must be > 0", key("mass"));
+                }
+                let com = e.com.unwrap_or([0.0; 3]);
+                check_bound(&key("com"), &com, LENGTH)?;
+                let inertia = e
+                    .inertia
+                    .ok_or_else(|| anyhow!("{}: required", key("inertia")))?
+                    .0;
+                let payload = Inertial { mass, com, inertia };
+                kanegen_model::validate_inertial_with("payload", "inertia", &payload, validation)
+                    .map_err(|err| anyhow!("{}: {err}", key("inertia")))?;
+                let v = e.v.unwrap_or([0.0; 3]);
+                let omega = e.omega.unwrap_or([0.0; 3]);
+                check_bound(&key("v"), &v, RATE)?;
+                check_bound(&key("omega"), &omega, RATE)?;
+                let body = body.unwrap_or(chain0.dof() - 1);
+                attached.push((body, payload.clone()));
+                (body, EventKind::Capture { payload, v, omega })
+            }
+            "release" => {
+                for (f, given) in [
+                    ("mass", e.mass.is_some()),
+                    ("com", e.com.is_some()),
+                    ("inertia", e.inertia.is_some()),
+                    ("v", e.v.is_some()),
+                    ("omega", e.omega.is_some()),
+                ] {
+                    if given {
+                        bail!(
+                            "{}: not used by a release (it lets go of the payload the body holds)",
+                            key(f)
+                        );
+                    }
+                }
+                let at = attached
+                    .iter()
+                    .rposition(|(b, _)| body.is_none_or(|bb| bb == *b))
+                    .ok_or_else(|| {
+                        anyhow!(
+                            "{}: no payload held then (give a [payload] or capture one first)",
+                            key("body")
+                        )
+                    })?;
+                let (body, payload) = attached.remove(at);
+                (body, EventKind::Release { payload })
+            }
+            other => bail!(
+                "{}: unknown event type `{other}` (expected \"capture\" or \"release\")",
+                key("type")
+            ),
+        };
+        let model = with_payloads(chain0, &attached, validation)
+            .map_err(|err| anyhow!("events[{k}] (line {line}): {err}"))?;
+        events.push(Event {
+            time: e.time,
+            body: kind.0,
+            kind: kind.1,
+            model,
+        });
+    }
+    Ok(events)
 }
 
 impl Scene {
@@ -555,8 +760,9 @@ impl Scene {
             .map_err(|e| anyhow!("model: `{}`: {e}", model_path.display()))?;
         let n = chain.dof();
 
-        let chain = match raw.payload {
-            None => chain,
+        let chain0 = chain;
+        let static_payload = match raw.payload {
+            None => None,
             Some(p) => {
                 if !(p.mass.is_finite() && p.mass > 0.0) {
                     bail!("payload.mass: must be > 0");
@@ -569,30 +775,21 @@ impl Scene {
                 };
                 kanegen_model::validate_inertial_with("payload", "inertia", &pay, validation)
                     .map_err(|e| anyhow!("payload.inertia: {e}"))?;
-                let mut joints = chain.joints().to_vec();
                 let holder = match &p.body {
-                    None => joints.last_mut().expect("a chain has a joint"),
-                    Some(name) => {
-                        let names: Vec<String> = joints.iter().map(|j| j.body.clone()).collect();
-                        joints.iter_mut().find(|j| &j.body == name).ok_or_else(|| {
-                            anyhow!(
-                                "payload.body: unknown body `{name}` (moving bodies: {})",
-                                names.join(", ")
-                            )
-                        })?
-                    }
+                    None => n - 1,
+                    Some(name) => body_index(&chain0, name).ok_or_else(|| {
+                        anyhow!(
+                            "payload.body: unknown body `{name}` (moving bodies: {})",
+                            body_names(&chain0)
+                        )
+                    })?,
                 };
-                holder.inertial = holder.inertial.merge(&pay);
-                Model::new_with(
-                    chain.name(),
-                    chain.base(),
-                    chain.base_inertial().cloned(),
-                    joints,
-                    validation,
-                )
-                .map_err(|e| anyhow!("payload: {e}"))?
+                Some((holder, pay))
             }
         };
+        let attached: Vec<(usize, Inertial)> = static_payload.into_iter().collect();
+        let chain =
+            with_payloads(&chain0, &attached, validation).map_err(|e| anyhow!("payload: {e}"))?;
 
         let base = match raw.base {
             None => BaseSpec::Fixed,
@@ -714,11 +911,6 @@ impl Scene {
                 let line = line_of(text, r.span().start);
                 let r = r.into_inner();
                 let key = |k: &str| format!("effects.rotor.{k} (line {line})");
-                if floating {
-                    bail!(
-                        "effects.rotor (line {line}): rotor inertia is supported on a fixed base only"
-                    );
-                }
                 check_len(&key("inertia"), &r.inertia, n, GAIN)?;
                 check_len(&key("gear_ratio"), &r.gear_ratio, n, GAIN)?;
                 if r.inertia.iter().any(|x| *x < 0.0) {
@@ -964,7 +1156,12 @@ impl Scene {
             }
         }
 
+        let events = parse_events(
+            raw.events, text, &chain0, attached, floating, s.duration, validation,
+        )?;
+
         Ok(Scene {
+            events,
             model: chain,
             base,
             gravity: e.gravity,

@@ -7,8 +7,11 @@
 //! after every accepted step ([`System::project`]); the implicit midpoint rule updates it by the
 //! exponential map ([`System::advance`]) and needs no projection.
 
-use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, System};
-use crate::scene::{BaseSpec, Drives, Integrator, Scene, SceneWrench};
+use crate::events::{self, CaptureSystem, EventReport};
+use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, Stats, System};
+use crate::scene::{
+    BaseSpec, Drives, Event, EventKind, Integrator, Scene, SceneWrench, SimulationSpec,
+};
 use anyhow::Result;
 use kanegen_dynamics::algorithms::aba::{self, Workspace};
 use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
@@ -17,6 +20,7 @@ use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
 use kanegen_dynamics::{ForwardMethod, FrameParams, Loads, Params};
 use serde::Serialize;
+use std::cell::{Cell, RefCell};
 use std::ops::ControlFlow;
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -284,13 +288,84 @@ impl<'a> SceneSystem<'a> {
     /// base with gravity. `None` for a free-floating base under gravity (not monitored).
     #[must_use]
     pub fn energy(&self, x: &[f64]) -> Option<f64> {
+        let t = self.kinetic_energy(x);
+        if self.base.is_some() {
+            return self.scene.gravity.is_none().then_some(t);
+        }
+        let q = &x[..self.n];
+        // Gravitational potential: −g · Σ m_k x_k over the bodies' centres of mass.
+        let v = match self.scene.gravity {
+            None => 0.0,
+            Some(g) => {
+                let g = Vec3::from_f64(g);
+                self.params
+                    .joints
+                    .iter()
+                    .enumerate()
+                    .map(|(k, jp)| {
+                        let com = FrameParams {
+                            parent: Some(k),
+                            translation: jp.com.clone(),
+                            rotation: Mat3::identity(),
+                        };
+                        let (x, _) = frames::placement(&self.params, q, &com);
+                        -jp.mass * g.dot(&x)
+                    })
+                    .sum()
+            }
+        };
+        Some(t + v)
+    }
+
+    /// The scene.
+    #[must_use]
+    pub fn scene(&self) -> &Scene {
+        self.scene
+    }
+
+    /// Joint degrees of freedom `N`.
+    #[must_use]
+    pub fn n(&self) -> usize {
+        self.n
+    }
+
+    /// The model's numbers the dynamics read now (the scene's model, or the model after the last
+    /// [`SceneSystem::apply_event`]).
+    #[must_use]
+    pub fn params(&self) -> &Params<f64> {
+        &self.params
+    }
+
+    /// Replaces the model's numbers (a payload captured or released).
+    pub fn set_params(&mut self, params: Params<f64>) {
+        self.params = params;
+    }
+
+    /// The free-floating base body, `None` on a fixed base.
+    #[must_use]
+    pub fn floating_base(&self) -> Option<&FloatingBase<f64>> {
+        self.base.as_ref()
+    }
+
+    /// Adds the armature `I_m,i n_i²` of `[effects] rotor` to the joint diagonal of a mass
+    /// matrix (`N × N`, or `(6+N) × (6+N)` on a free-floating base: `H[6+i][6+i]`); nothing
+    /// without a rotor.
+    pub fn add_armature(&self, a: &mut [Vec<f64>]) {
+        if let Some(r) = &self.scene.rotor {
+            let off = a.len() - self.n;
+            for (i, ri) in r.reflected.iter().enumerate() {
+                a[off + i][off + i] += ri;
+            }
+        }
+    }
+
+    /// Kinetic energy of bodies and rotors (no potential), on either base.
+    #[must_use]
+    pub fn kinetic_energy(&self, x: &[f64]) -> f64 {
         let (q, qd, st) = self.split(x);
         match (&self.base, st) {
             (Some(b), Some(st)) => {
-                if self.scene.gravity.is_some() {
-                    return None;
-                }
-                Some(kinetic_energy(&self.params, b, &st, q, qd))
+                kinetic_energy(&self.params, b, &st, q, qd) + self.rotor_energy(qd)
             }
             _ => {
                 let a = self
@@ -299,45 +374,27 @@ impl<'a> SceneSystem<'a> {
                     .algorithm
                     .mass_matrix
                     .mass_matrix(&self.params, q);
-                let mut t = 0.5
-                    * (0..self.n)
-                        .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
-                        .sum::<f64>();
-                // The rotors' kinetic energy ½ I_m n² q̇².
-                if let Some(r) = &self.scene.rotor {
-                    t += 0.5
-                        * (0..self.n)
-                            .map(|i| r.reflected[i] * qd[i] * qd[i])
-                            .sum::<f64>();
-                }
-                // Gravitational potential: −g · Σ m_k x_k over the bodies' centres of mass.
-                let v = match self.scene.gravity {
-                    None => 0.0,
-                    Some(g) => {
-                        let g = Vec3::from_f64(g);
-                        self.params
-                            .joints
-                            .iter()
-                            .enumerate()
-                            .map(|(k, jp)| {
-                                let com = FrameParams {
-                                    parent: Some(k),
-                                    translation: jp.com.clone(),
-                                    rotation: Mat3::identity(),
-                                };
-                                let (x, _) = frames::placement(&self.params, q, &com);
-                                -jp.mass * g.dot(&x)
-                            })
-                            .sum()
-                    }
-                };
-                Some(t + v)
+                0.5 * (0..self.n)
+                    .map(|i| qd[i] * (0..self.n).map(|j| a[i][j] * qd[j]).sum::<f64>())
+                    .sum::<f64>()
+                    + self.rotor_energy(qd)
             }
         }
     }
 
+    /// The rotors' kinetic energy `½ Σ I_m,i n_i² q̇_i²` of the armature model (0 without
+    /// `[effects] rotor`).
+    fn rotor_energy(&self, qd: &[f64]) -> f64 {
+        self.scene.rotor.as_ref().map_or(0.0, |r| {
+            0.5 * (0..self.n)
+                .map(|i| r.reflected[i] * qd[i] * qd[i])
+                .sum::<f64>()
+        })
+    }
+
     /// Linear and angular momentum (inertial frame, about the inertial origin) of a free-floating
-    /// system; `None` on a fixed base.
+    /// system; `None` on a fixed base. With `[effects] rotor` this is the momentum of the bodies,
+    /// which the armature model conserves (see [`crate::events`] and README, "rotor").
     #[must_use]
     pub fn momentum(&self, x: &[f64]) -> Option<([f64; 3], [f64; 3])> {
         let (q, qd, st) = self.split(x);
@@ -410,6 +467,90 @@ fn floating_kinematics(n: usize, x: &[f64], st: &FloatingState<f64>, qd: &[f64],
     dx[7..7 + n].copy_from_slice(qd);
 }
 
+impl SceneSystem<'_> {
+    /// Applies `event` at state `x` (free-floating): switches the model to `event.model` and, for
+    /// a capture, replaces `ν` by the post-capture velocity of the plastic-impact equation
+    /// ([`events::capture`], with the armature of `[effects] rotor` on both mass matrices).
+    ///
+    /// # Panics
+    /// On a fixed base (the scene parser rejects events there).
+    pub fn apply_event(&mut self, event: &Event, x: &mut [f64]) -> EventReport {
+        let n = self.n;
+        let before = self.momentum(x).expect("events need a free-floating base");
+        let e_before = self.kinetic_energy(x);
+        let new_params = Params::new(&event.model);
+        let (kind, pay) = match &event.kind {
+            EventKind::Capture { payload, v, omega } => {
+                let (q, _, st) = self.split(x);
+                let st = st.expect("free-floating");
+                let armature = |a: &mut [Vec<f64>]| self.add_armature(a);
+                let sys = CaptureSystem {
+                    method: self.scene.simulation.algorithm.mass_matrix,
+                    base: self.base.as_ref().expect("free-floating"),
+                    state: &st,
+                    q,
+                    armature: &armature,
+                };
+                let (nu, pay) = events::capture(
+                    &sys,
+                    &self.params,
+                    &new_params,
+                    &x[7 + n..],
+                    event.body,
+                    payload,
+                    *v,
+                    *omega,
+                );
+                x[7 + n..].copy_from_slice(&nu);
+                ("capture", pay)
+            }
+            EventKind::Release { .. } => ("release", (before.0, before.1)),
+        };
+        self.params = new_params;
+        let after = self.momentum(x).expect("free-floating");
+        // The released payload's momentum: the system's with it minus without it.
+        let pay = if kind == "release" {
+            (
+                events::add(&pay.0, &after.0, -1.0),
+                events::add(&pay.1, &after.1, -1.0),
+            )
+        } else {
+            pay
+        };
+        // System and payload, before and after: the payload is free before a capture and after
+        // a release.
+        let (total_before, total_after) = if kind == "capture" {
+            (
+                (
+                    events::add(&before.0, &pay.0, 1.0),
+                    events::add(&before.1, &pay.1, 1.0),
+                ),
+                after,
+            )
+        } else {
+            (
+                before,
+                (
+                    events::add(&after.0, &pay.0, 1.0),
+                    events::add(&after.1, &pay.1, 1.0),
+                ),
+            )
+        };
+        EventReport {
+            t: event.time,
+            kind,
+            body: self.scene.model.joints()[event.body].body.clone(),
+            linear_momentum_before: total_before.0,
+            angular_momentum_before: total_before.1,
+            linear_momentum_error_rel: events::rel_diff(&total_after.0, &total_before.0),
+            angular_momentum_error_rel: events::rel_diff(&total_after.1, &total_before.1),
+            energy_change: self.kinetic_energy(x) - e_before,
+            payload_linear_momentum: pay.0,
+            payload_angular_momentum: pay.1,
+        }
+    }
+}
+
 impl System for SceneSystem<'_> {
     fn dim(&self) -> usize {
         if self.base.is_some() {
@@ -435,7 +576,16 @@ impl System for SceneSystem<'_> {
         let alg = self.scene.simulation.algorithm;
         match (&self.base, st) {
             (Some(b), Some(st)) => {
-                let nu_dot = floating::forward_dynamics(alg, &self.params, b, &st, q, qd, &loads);
+                let nu_dot = match &self.scene.rotor {
+                    None => floating::forward_dynamics(alg, &self.params, b, &st, q, qd, &loads),
+                    // The armature model on a free-floating base: I_m n² on the joint diagonal
+                    // H[6+i][6+i] of the (6+N) mass matrix before the LDLᵀ solve.
+                    Some(_) => {
+                        let mut d = floating::dynamics(alg, &self.params, b, &st, q, qd, &loads);
+                        self.add_armature(&mut d.a);
+                        kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
+                    }
+                };
                 floating_kinematics(n, x, &st, qd, dx);
                 dx[7 + n..].copy_from_slice(&nu_dot);
             }
@@ -444,11 +594,9 @@ impl System for SceneSystem<'_> {
                     None => alg.forward_dynamics(&self.params, q, qd, &loads),
                     // (M + diag(I_m n²)) q̈ = τ − c: the reflected rotor inertia on M's
                     // diagonal before the LDLᵀ solve.
-                    Some(r) => {
+                    Some(_) => {
                         let mut d = alg.dynamics(&self.params, q, qd, &loads);
-                        for i in 0..n {
-                            d.a[i][i] += r.reflected[i];
-                        }
+                        self.add_armature(&mut d.a);
                         kanegen_dynamics::ldlt::solve(&kanegen_dynamics::ldlt::ldlt(&d.a), &d.b)
                     }
                 };
@@ -543,6 +691,11 @@ pub struct Summary {
     /// Why an incomplete run stopped: `interrupted`, or the integrator's error; `null` when
     /// complete.
     pub stopped: Option<String>,
+    /// What each payload capture or release did (`[[events]]`; absent from the JSON when the
+    /// scene has none): the momentum of system and payload before, its error through the event,
+    /// and the jump of kinetic energy.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<EventReport>,
 }
 
 /// One output sample.
@@ -698,19 +851,23 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     let sim = &scene.simulation;
     let energy_on = conserves_energy(scene);
     let momentum_on = conserves_momentum(scene);
-    let e0 = if energy_on { sys.energy(&x) } else { None };
-    let p0 = if momentum_on { sys.momentum(&x) } else { None };
-    let monitor = SceneSystem::new(scene);
-    let mut max_e: Option<f64> = e0.map(|_| 0.0);
-    let mut max_p: Option<(f64, f64)> = p0.map(|_| (0.0, 0.0));
+    // The baselines move at the events (see `crate::events`, "Monitors").
+    let e0 = Cell::new(if energy_on { sys.energy(&x) } else { None });
+    let p0 = Cell::new(if momentum_on { sys.momentum(&x) } else { None });
+    let monitor = RefCell::new(SceneSystem::new(scene));
+    let mut max_e: Option<f64> = e0.get().map(|_| 0.0);
+    let mut max_p: Option<(f64, f64)> = p0.get().map(|_| (0.0, 0.0));
     let mut sink_error: Option<anyhow::Error> = None;
-    let last_t = std::cell::Cell::new(f64::NAN);
+    let last_t = Cell::new(f64::NAN);
     let mut record = |t: f64, x: &[f64]| -> ControlFlow<()> {
         if sink_error.is_some() {
             return ControlFlow::Break(());
         }
-        let energy_drift = e0.and_then(|e0| monitor.energy(x).map(|e| rel(e - e0, e0)));
-        let momentum_drift = p0.and_then(|(l0, a0)| {
+        let monitor = monitor.borrow();
+        let energy_drift = e0
+            .get()
+            .and_then(|e0| monitor.energy(x).map(|e| rel(e - e0, e0)));
+        let momentum_drift = p0.get().and_then(|(l0, a0)| {
             monitor.momentum(x).map(|(l, a)| {
                 let dl: Vec<f64> = (0..3).map(|i| l[i] - l0[i]).collect();
                 let da: Vec<f64> = (0..3).map(|i| a[i] - a0[i]).collect();
@@ -742,40 +899,56 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
         }
     };
     let start = std::time::Instant::now();
-    let result = match sim.integrator {
-        Integrator::Rk4 => {
-            let total = ((sim.duration / sim.step) - 1e-9).ceil().max(1.0) as usize;
-            rk4(&mut sys, 0.0, sim.duration, sim.step, &mut x, |k, t, x| {
-                if k % sim.output_every == 0 || k == total {
-                    record(t, x)
-                } else {
-                    ControlFlow::Continue(())
-                }
-            })
+    // One integration per segment between events: each ends exactly at its event time (the
+    // state at t_e⁻ is sampled), the event switches the model and jumps ν, and the next segment
+    // starts with a sample at t_e⁺.
+    // Events at or after the end (a scene whose duration was shortened) do not happen.
+    let events: Vec<&Event> = scene
+        .events
+        .iter()
+        .filter(|e| e.time < sim.duration)
+        .collect();
+    let ends: Vec<f64> = events
+        .iter()
+        .map(|e| e.time)
+        .chain([sim.duration])
+        .collect();
+    let mut stats = Stats::default();
+    let mut reports = Vec::new();
+    let mut t0 = 0.0;
+    let mut result: Result<(), IntegrateError> = Ok(());
+    for (seg, &t1) in ends.iter().enumerate() {
+        if seg > 0 {
+            let event = events[seg - 1];
+            let report = sys.apply_event(event, &mut x);
+            monitor.borrow_mut().set_params(sys.params().clone());
+            if let Some(e) = e0.get() {
+                e0.set(Some(e + report.energy_change));
+            }
+            if let Some((l, a)) = p0.get() {
+                let sign = if report.kind == "capture" { 1.0 } else { -1.0 };
+                let shift = |v: [f64; 3], d: [f64; 3]| [0, 1, 2].map(|i| v[i] + sign * d[i]);
+                p0.set(Some((
+                    shift(l, report.payload_linear_momentum),
+                    shift(a, report.payload_angular_momentum),
+                )));
+            }
+            reports.push(report);
         }
-        Integrator::Midpoint => {
-            let total = ((sim.duration / sim.step) - 1e-9).ceil().max(1.0) as usize;
-            midpoint(&mut sys, 0.0, sim.duration, sim.step, &mut x, |k, t, x| {
-                if k % sim.output_every == 0 || k == total {
-                    record(t, x)
-                } else {
-                    ControlFlow::Continue(())
-                }
-            })
+        let segment = integrate_segment(&mut sys, sim, t0, t1, &mut x, &mut record);
+        match segment {
+            Ok(s) => accumulate(&mut stats, s),
+            Err(e) => {
+                accumulate(&mut stats, e.stats());
+                result = Err(e);
+                break;
+            }
         }
-        Integrator::Dopri5 => {
-            let opts = Dopri5Options {
-                tolerance: sim.tolerance,
-                max_step: sim.max_step,
-                initial_step: sim.step,
-                output_interval: sim.step * sim.output_every as f64,
-            };
-            dopri5(&mut sys, 0.0, sim.duration, &opts, &mut x, &mut record)
-        }
-    };
+        t0 = t1;
+    }
     let wall_s = start.elapsed().as_secs_f64();
-    let (stats, t_end, stopped) = match &result {
-        Ok(stats) => (*stats, sim.duration, None),
+    let (t_end, stopped) = match &result {
+        Ok(()) => (sim.duration, None),
         Err(e) => {
             let why = match e {
                 IntegrateError::Interrupted { .. } => "interrupted".to_string(),
@@ -786,7 +959,7 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
                 ),
                 other => other.to_string(),
             };
-            (e.stats(), e.t(), Some(why))
+            (e.t(), Some(why))
         }
     };
     // An early stop: the state reached (the last accepted one) ends the samples.
@@ -817,7 +990,48 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
         complete: result.is_ok(),
         t_end,
         stopped,
+        events: reports,
     })
+}
+
+fn accumulate(total: &mut Stats, s: Stats) {
+    total.steps += s.steps;
+    total.rejected_steps += s.rejected_steps;
+    total.evals += s.evals;
+}
+
+/// Integrates `sys` from `t0` to `t1` (ending exactly at `t1`) with the scene's integrator,
+/// sampling through `record` as [`simulate_to`] describes (the segment's first and last states
+/// included).
+fn integrate_segment(
+    sys: &mut SceneSystem<'_>,
+    sim: &SimulationSpec,
+    t0: f64,
+    t1: f64,
+    x: &mut [f64],
+    record: &mut impl FnMut(f64, &[f64]) -> ControlFlow<()>,
+) -> Result<Stats, IntegrateError> {
+    let total = (((t1 - t0) / sim.step) - 1e-9).ceil().max(1.0) as usize;
+    let mut every = |k: usize, t: f64, x: &[f64]| {
+        if k.is_multiple_of(sim.output_every) || k == total {
+            record(t, x)
+        } else {
+            ControlFlow::Continue(())
+        }
+    };
+    match sim.integrator {
+        Integrator::Rk4 => rk4(sys, t0, t1, sim.step, x, &mut every),
+        Integrator::Midpoint => midpoint(sys, t0, t1, sim.step, x, &mut every),
+        Integrator::Dopri5 => {
+            let opts = Dopri5Options {
+                tolerance: sim.tolerance,
+                max_step: sim.max_step,
+                initial_step: sim.step,
+                output_interval: sim.step * sim.output_every as f64,
+            };
+            dopri5(sys, t0, t1, &opts, x, record)
+        }
+    }
 }
 
 /// [`simulate_to`] keeping every sample in memory (tests and short runs).
@@ -868,7 +1082,26 @@ pub fn render_text(s: &Summary) -> String {
         f(s.max_angular_momentum_drift_rel),
         s.final_state.q,
         s.final_state.qd,
-    )
+    ) + &events_text(s)
+}
+
+/// One line per payload event of a summary (empty without events).
+fn events_text(s: &Summary) -> String {
+    s.events
+        .iter()
+        .map(|e| {
+            format!(
+                "\nevent at t = {}: {} by {}, momentum error through it (rel) {:.3e} linear, \
+                 {:.3e} angular, kinetic energy change {:.6e} J",
+                e.t,
+                e.kind,
+                e.body,
+                e.linear_momentum_error_rel,
+                e.angular_momentum_error_rel,
+                e.energy_change
+            )
+        })
+        .collect()
 }
 
 /// The CSV header of a scene's trajectory: `t`, `q_<joint>`…, `qd_<joint>`…, and for a

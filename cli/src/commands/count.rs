@@ -176,6 +176,11 @@ pub struct SceneCountReport {
     pub counts: Vec<CountLine>,
     /// Per effect, bias method and convention (`emitted`, `paper`): the operations it adds.
     pub effects: Vec<EffectLine>,
+    /// Per payload event kind (`capture`, `release`), mass-matrix method and convention: the
+    /// operations of one event (`method` is the mass-matrix method; see
+    /// [`crate::commands::count_events`]); absent when the scene has no `[[events]]`.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub events: Vec<EffectLine>,
 }
 
 /// Counts of the scene's `A` and `b` and the cost of each effect, for the methods of `presets`.
@@ -189,6 +194,7 @@ pub fn count_scene(
 ) -> Result<SceneCountReport, TraceError> {
     let (mass, bias) = methods_of(presets);
     let spec = scene_spec::spec(scene);
+    let counts = count_lines(&scene.model, &mass, &bias, &spec)?;
     Ok(SceneCountReport {
         scene: name.into(),
         base: match scene.base {
@@ -197,12 +203,13 @@ pub fn count_scene(
         }
         .into(),
         n: scene.model.dof(),
-        counts: count_lines(&scene.model, &mass, &bias, &spec)?,
         effects: {
             let mut e = effect_lines(&scene.model, &bias, &spec)?;
             e.extend(drive_effect_lines(scene, &bias));
             e
         },
+        events: crate::commands::count_events::event_effect_lines(scene, &mass, &counts),
+        counts,
     })
 }
 
@@ -247,6 +254,24 @@ fn drive_effect_lines(scene: &Scene, bias: &[BiasMethod]) -> Vec<EffectLine> {
     lines
 }
 
+/// Appends one row per effect line to `s`.
+fn write_effect_rows(s: &mut String, lines: &[EffectLine]) {
+    use std::fmt::Write;
+    for e in lines {
+        let _ = writeln!(
+            s,
+            "{:<12} {:<14} {:<9} {:>8} {:>8} {:>8} {:>5}",
+            e.effect,
+            e.method,
+            e.convention,
+            e.mul,
+            e.add,
+            e.mul + e.add,
+            e.div
+        );
+    }
+}
+
 /// Human-readable rendering of [`SceneCountReport`].
 #[must_use]
 pub fn render_scene_text(r: &SceneCountReport) -> String {
@@ -278,19 +303,7 @@ pub fn render_scene_text(r: &SceneCountReport) -> String {
             "\noperations each effect adds to b (all effects minus all but that one)\n\n{:<12} {:<14} {:<9} {:>8} {:>8} {:>8} {:>5}",
             "effect", "method", "conv.", "mul", "add", "m+a", "div"
         );
-        for e in &r.effects {
-            let _ = writeln!(
-                s,
-                "{:<12} {:<14} {:<9} {:>8} {:>8} {:>8} {:>5}",
-                e.effect,
-                e.method,
-                e.convention,
-                e.mul,
-                e.add,
-                e.mul + e.add,
-                e.div
-            );
-        }
+        write_effect_rows(&mut s, &r.effects);
         if names.iter().any(|e| e == "coulomb" || e == "rotor") {
             let _ = writeln!(
                 s,
@@ -298,6 +311,16 @@ pub fn render_scene_text(r: &SceneCountReport) -> String {
                  per joint; rotor adds to A's diagonal (before the solve), not to b"
             );
         }
+    }
+    if !r.events.is_empty() {
+        let _ = writeln!(
+            s,
+            "\noperations of one payload event (once per event, not per step: a capture \
+             evaluates A before and after and solves the impulse equation; a release switches \
+             the model)\n\n{:<12} {:<14} {:<9} {:>8} {:>8} {:>8} {:>5}",
+            "event", "A method", "conv.", "mul", "add", "m+a", "div"
+        );
+        write_effect_rows(&mut s, &r.events);
     }
     s
 }

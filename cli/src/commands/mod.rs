@@ -3,6 +3,7 @@
 pub mod accuracy;
 pub mod bench;
 pub mod count;
+pub mod count_events;
 pub mod eval;
 pub mod generate;
 pub mod simulate;

@@ -1,0 +1,213 @@
+//! Payload capture and release (`[[events]]`) in `kanegen::scene!`, as the interpreted
+//! simulator does them (`kanegen_sim::events`): one generated dynamics type per distinct model
+//! phase, a run integrated segment by segment between the event times, and at a capture the
+//! impulse `H' ν⁺ = H ν⁻ + J_pᵀ h_p` from the generated mass matrices of the phases before and
+//! after and the generated Jacobian and placement of a frame at the payload's centre of mass.
+
+use kanegen_codegen::kanegen_model::{BaseKind, Model};
+use kanegen_sim::scene::{BaseSpec, EventKind, Scene};
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+use syn::Ident;
+
+fn lit(x: f64) -> Literal {
+    Literal::f64_suffixed(x)
+}
+
+fn arr(v: &[f64]) -> TokenStream {
+    let v = v.iter().map(|x| lit(*x));
+    quote!([#(#v),*])
+}
+
+/// The dynamics type of each phase (phase 0 is `NameDynamics`, phase `k` follows event
+/// `k − 1`; a phase whose model is an earlier phase's reuses its type) and the items of the
+/// types it adds (no frames, the scene's base and gravity).
+pub fn phase_dynamics(
+    scene: &Scene,
+    opts: &kanegen_codegen::Options,
+    dyn_name: &str,
+    rel: &str,
+) -> Result<(Vec<Ident>, TokenStream), String> {
+    let mut tys = vec![format_ident!("{}", dyn_name)];
+    let mut models: Vec<&Model> = vec![&scene.model];
+    let mut items = TokenStream::new();
+    for (k, e) in scene.events.iter().enumerate() {
+        if let Some(j) = models.iter().position(|m| **m == e.model) {
+            tys.push(tys[j].clone());
+            models.push(&e.model);
+            continue;
+        }
+        let mut model = e.model.clone();
+        if let BaseSpec::FreeFloating { inertial, .. } = &scene.base {
+            if model.base_inertial() != Some(inertial) {
+                model = model
+                    .with_base_inertial(inertial.clone())
+                    .map_err(|err| format!("{rel}: base: {err}"))?;
+            }
+        }
+        let model = model
+            .with_base_kind(BaseKind::FreeFloating)
+            .and_then(|m| m.with_frames(Vec::new()))
+            .map_err(|err| format!("{rel}: events[{k}]: {err}"))?;
+        let name = format!("{dyn_name}Phase{}", k + 1);
+        let mut o = opts.clone();
+        o.type_name = name.clone();
+        o.payload_name = format!("{name}Payload");
+        o.op_count_name = format!("{name}OpCount");
+        let g = kanegen_codegen::generate_items(&model, &o)
+            .map_err(|err| format!("{rel}: events[{k}]: {err}"))?;
+        items.extend(g.items);
+        tys.push(format_ident!("{}", name));
+        models.push(&e.model);
+    }
+    Ok((tys, items))
+}
+
+/// The body of `run` for a scene with events: one integration (`call`, from `t0` to `t1` with
+/// `f` and `x`) per segment between the event times, the event applied between segments.
+pub fn run_segments(
+    runtime: &syn::Path,
+    state_ty: &Ident,
+    dim: &Literal,
+    call: &TokenStream,
+) -> TokenStream {
+    quote! {
+        let mut stats = #runtime::ode::Stats::default();
+        let mut t0 = 0.0;
+        for phase in 0..=Self::EVENT_TIMES.len() {
+            let t1 = if phase < Self::EVENT_TIMES.len() {
+                Self::EVENT_TIMES[phase]
+            } else {
+                Self::DURATION
+            };
+            if phase > 0 {
+                let mut st = #state_ty::from_array(&x);
+                Self::apply_event(phase - 1, &mut st);
+                x = st.to_array();
+            }
+            let mut f = |t: f64, x: &[f64; #dim]| {
+                Self::rhs_in(phase, t, &#state_ty::from_array(x)).to_array()
+            };
+            let s = { #call }?;
+            stats.steps += s.steps;
+            stats.rejected_steps += s.rejected_steps;
+            stats.evals += s.evals;
+            t0 = t1;
+        }
+        Ok(stats)
+    }
+}
+
+/// `EVENT_TIMES`, `phase_at`, `rhs` (through `rhs_in`) and `apply_event` of a scene with events
+/// (nothing without).
+pub fn event_items(
+    runtime: &syn::Path,
+    scene: &Scene,
+    state_ty: &Ident,
+    dyn_ty: &Ident,
+    phase_tys: &[Ident],
+    nv: usize,
+    n: usize,
+) -> TokenStream {
+    if scene.events.is_empty() {
+        return TokenStream::new();
+    }
+    let times: Vec<f64> = scene.events.iter().map(|e| e.time).collect();
+    let count = Literal::usize_unsuffixed(times.len());
+    let times = arr(&times);
+    let nvl = Literal::usize_unsuffixed(nv);
+    let armature = scene.rotor.as_ref().map(|r| {
+        let refl = arr(&r.reflected);
+        let nl = Literal::usize_unsuffixed(n);
+        let off = Literal::usize_unsuffixed(nv - n);
+        quote! {
+            const ROTOR: [f64; #nl] = #refl;
+            for i in 0..#nl {
+                h[#off + i][#off + i] += ROTOR[i];
+                h_new[#off + i][#off + i] += ROTOR[i];
+            }
+        }
+    });
+    let arms = scene.events.iter().enumerate().map(|(k, e)| {
+        let kl = Literal::usize_unsuffixed(k);
+        match &e.kind {
+            EventKind::Release { .. } => quote!(#kl => {}),
+            EventKind::Capture { payload, v, omega } => {
+                let (before, after) = (&phase_tys[k], &phase_tys[k + 1]);
+                let frame = format!("scene_capture_{k}");
+                let (jac, pl) = (
+                    format_ident!("{}_jacobian", frame),
+                    format_ident!("{}_placement", frame),
+                );
+                let (m, v, w) = (lit(payload.mass), arr(v), arr(omega));
+                let rows = payload.inertia.iter().map(|r| arr(r));
+                quote!(#kl => {
+                    const MASS: f64 = #m;
+                    const V: [f64; 3] = #v;
+                    const OMEGA: [f64; 3] = #w;
+                    const INERTIA: [[f64; 3]; 3] = [#(#rows),*];
+                    let mut h = #before::mass_matrix(&s.q);
+                    let mut h_new = #after::mass_matrix(&s.q);
+                    #armature
+                    // h_p = [m v_p; R I_p Rᵀ ω_p] (inertial frame).
+                    let r = #dyn_ty::#pl(&s.q).1;
+                    let wb: [f64; 3] = core::array::from_fn(|i| {
+                        r[0][i] * OMEGA[0] + r[1][i] * OMEGA[1] + r[2][i] * OMEGA[2]
+                    });
+                    let iw: [f64; 3] = core::array::from_fn(|i| {
+                        INERTIA[i][0] * wb[0] + INERTIA[i][1] * wb[1] + INERTIA[i][2] * wb[2]
+                    });
+                    let hp = [
+                        MASS * V[0],
+                        MASS * V[1],
+                        MASS * V[2],
+                        r[0][0] * iw[0] + r[0][1] * iw[1] + r[0][2] * iw[2],
+                        r[1][0] * iw[0] + r[1][1] * iw[1] + r[1][2] * iw[2],
+                        r[2][0] * iw[0] + r[2][1] * iw[1] + r[2][2] * iw[2],
+                    ];
+                    let jp = #dyn_ty::#jac(&s.q);
+                    let p: [f64; #nvl] = core::array::from_fn(|i| {
+                        let mut x = 0.0;
+                        for j in 0..#nvl {
+                            x += h[i][j] * s.v[j];
+                        }
+                        for row in 0..6 {
+                            x += jp[row][i] * hp[row];
+                        }
+                        x
+                    });
+                    s.v = #runtime::ode::solve_spd(&h_new, &p).unwrap_or([f64::NAN; #nvl]);
+                })
+            }
+        }
+    });
+    quote! {
+        /// The event times (`[[events]]`), s.
+        pub const EVENT_TIMES: [f64; #count] = #times;
+
+        /// The model phase at `t`: the number of events at or before `t` (at an event time, the
+        /// model after it).
+        #[must_use]
+        pub fn phase_at(t: f64) -> usize {
+            Self::EVENT_TIMES.iter().filter(|te| **te <= t).count()
+        }
+
+        /// The right-hand side `ẋ = f(t, x)` with the scene's effects only, with the model of
+        /// [`Self::phase_at`]`(t)`.
+        #[must_use]
+        pub fn rhs(t: f64, s: &#state_ty) -> #state_ty {
+            Self::rhs_in(Self::phase_at(t), t, s)
+        }
+
+        /// Applies event `k` to the state at its time: a capture replaces `v` by the solution
+        /// of the plastic-impact equation `H' v⁺ = H v⁻ + J_pᵀ h_p` (total linear and angular
+        /// momentum conserved); a release keeps the state (the model of the next phase lets
+        /// go of the payload).
+        pub fn apply_event(k: usize, s: &mut #state_ty) {
+            match k {
+                #(#arms)*
+                _ => {}
+            }
+        }
+    }
+}
