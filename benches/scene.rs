@@ -19,7 +19,6 @@
 //! (one run, the machine busy with a build): compiled 6.1 ms (3.8–7.1), interpreted 129 ms
 //! (124–134) per run, 21× (about 10 µs against 210 µs per dopri5 step).
 
-
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate_to, Control, Sample};

@@ -289,3 +289,17 @@ fn empty_and_garbage_files() {
         }
     }
 }
+
+/// A case proptest found (`adversarial_models`): a prismatic joint of mass 5e-324, whose q̈
+/// overflows `f64`. `accuracy` printed `inf` in its reference-check sentence; it says
+/// `overflow`, as its tables do.
+#[test]
+fn accuracy_of_a_denormal_mass_prints_no_inf() {
+    let model = file(
+        "model.toml",
+        "name = \"fuzz\"\n\n[[joint]]\nname = \"j0\"\ntype = \"prismatic\"\nxyz = [0.1, 0.2, 0.3]\n\
+         axis = [0.0, 0.0, 1.0]\n[joint.body]\nmass = 5e-324\ncom = [0.1, 0.0, 0.0]\n\
+         inertia = { ixx = 0.5, iyy = 0.6, izz = 0.7 }\n",
+    );
+    check(&[s("accuracy"), model.display().to_string()]).unwrap();
+}

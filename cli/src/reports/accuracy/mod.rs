@@ -227,14 +227,23 @@ fn eval_sentences(rows: &[EvalRow], timing: bool) -> Vec<String> {
 /// The sentence on the reference's own accuracy (the `wide` row: double-double against exact
 /// rationals).
 fn reference_sentence(rows: &[EvalRow]) -> String {
+    // An error that overflowed (q̈ itself beyond f64, as with a mass of 5e-324) says so, as the
+    // tables do.
+    let e = |x: f64| {
+        if x.is_finite() {
+            format!("{x:.1e}")
+        } else {
+            "overflow".into()
+        }
+    };
     match rows.iter().find(|r| r.precision == "wide") {
         Some(w) if !w.rel_err_qdd.is_nan() => format!(
             "double-double against exact rationals at {} states with rational joint sines and \
-             cosines: A {:.1e}, b {:.1e}, q̈ {:.1e}",
+             cosines: A {}, b {}, q̈ {}",
             evaluation::EXACT_STATES,
-            w.rel_err_a,
-            w.rel_err_b,
-            w.rel_err_qdd
+            e(w.rel_err_a),
+            e(w.rel_err_b),
+            e(w.rel_err_qdd)
         ),
         _ => "double-double not checked against exact rationals (exactness lost)".into(),
     }
