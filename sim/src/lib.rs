@@ -7,6 +7,8 @@
 //! equations. Plots and files are the CLI's.
 #![warn(missing_docs)]
 
+pub mod flexible;
 pub mod integrate;
+pub mod rosenbrock;
 pub mod scene;
 pub mod simulate;
