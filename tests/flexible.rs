@@ -160,7 +160,7 @@ output_every = 10
     );
     assert!(drift < 1e-8, "energy drift {drift:e}");
     assert!(swing > 1e4 * drift, "motor+spring energy swing {swing:e}");
-    assert_eq!(run.summary.max_energy_drift_rel.is_some(), true);
+    assert!(run.summary.max_energy_drift_rel.is_some());
 }
 
 /// `scenes/ssrms_flexible.toml` (K = 1e8 N·m/rad): Rodas4 at tolerance 1e-8 reaches the final

@@ -28,6 +28,9 @@
 //!
 //! [`dopri5`]: crate::integrate::dopri5
 
+// Index loops over stages and matrix entries, in the same order in both mirrors.
+#![allow(clippy::needless_range_loop)]
+
 use crate::integrate::{Dopri5Options, Flow, IntegrateError, Stats, System};
 
 /// Options of [`rosenbrock`]: the same fields as [`dopri5`](crate::integrate::dopri5)'s

@@ -6,6 +6,9 @@
 //! of their right-hand sides (amplified by the difference quotients of `J`; well inside the
 //! tolerance).
 
+// Index loops over stages and matrix entries, in the same order in both mirrors.
+#![allow(clippy::needless_range_loop)]
+
 use super::{libm, non_finite, Dopri5Options, Stats, Stop};
 
 /// Options of [`rosenbrock`]: the fields of [`Dopri5Options`] (`output_interval`: the spacing of
