@@ -2,8 +2,9 @@
 //!
 //! The evaluate stage for motion: scene files (a model, its base, the effects it names, drives,
 //! initial state and integrator settings, [`scene`]), the integrators ([`integrate`]: RK4,
-//! Dormand–Prince 5(4), the Lie-group implicit midpoint rule), and the simulation loop with its
-//! energy and momentum monitors ([`simulate`]). Only the effects a scene names enter the
+//! Dormand–Prince 5(4), the Lie-group implicit midpoint rule; [`rosenbrock`]: the stiff Rodas4),
+//! flexible joints ([`flexible`], Spong 1987), and the simulation loop with its energy and
+//! momentum monitors ([`simulate`]). Only the effects a scene names enter the
 //! equations. Plots and files are the CLI's.
 #![warn(missing_docs)]
 

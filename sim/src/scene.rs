@@ -275,11 +275,11 @@ pub struct SimulationSpec {
     pub duration: f64,
     /// The integrator.
     pub integrator: Integrator,
-    /// RK4 and midpoint step; for dopri5 the first step tried (default 0.01 s).
+    /// RK4 and midpoint step; for dopri5 and rosenbrock the first step tried (default 0.01 s).
     pub step: f64,
-    /// dopri5 tolerance (default 1e-8).
+    /// dopri5 and rosenbrock tolerance (default 1e-8).
     pub tolerance: f64,
-    /// dopri5 largest step (default: the duration).
+    /// dopri5 and rosenbrock largest step (default: the duration).
     pub max_step: f64,
     /// Output every k-th RK4 or midpoint step; dopri5 samples its dense output every `output_every · step`
     /// seconds (default 10).
