@@ -19,6 +19,11 @@
 //! land on every output time `t0 + k · output_interval` (no dense output); after an accepted
 //! step the state is projected ([`System::project`]).
 //!
+//! Rosenbrock methods take `J` into their order conditions: with the difference quotients'
+//! `~√ε` relative error the method keeps its order down to tolerances of about 1e-10, and below
+//! that its steps multiply (flexible two-link arm, K = 1e6, 2 s: 2742 steps at 1e-10, 32621 at
+//! 1e-12, `tests/flexible.rs`) — tight tolerances are dopri5's.
+//!
 //! Hand-written rather than taken from a crate: `diffsol` (BDF, SDIRK) brings its own matrix
 //! and equation traits and a sizeable dependency tree, `russell_ode` needs a system BLAS/LAPACK,
 //! `ode_solvers` is explicit only; and the compiled simulators of `scene!` need the same method

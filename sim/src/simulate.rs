@@ -4,9 +4,10 @@
 //! State vector: fixed base `[q (N), q̇ (N)]`; free-floating base
 //! `[p₀ (3), quat (4: x, y, z, w), q (N), v_b (3), ω_b (3), q̇ (N)]` with `ṗ₀ = R₀ v_b` and
 //! `q̇uat = ½ quat ⊗ (ω_b, 0)` (body-frame `ω_b`); with flexible joints (fixed base)
-//! `[q (N), q̇ (N), θ (N), θ̇ (N)]`, the motor coordinates last ([`crate::flexible`]); RK4 and dopri5 renormalize the quaternion
-//! after every accepted step ([`System::project`]); the implicit midpoint rule updates it by the
-//! exponential map ([`System::advance`]) and needs no projection.
+//! `[q (N), q̇ (N), θ (N), θ̇ (N)]`, the motor coordinates last ([`crate::flexible`]). RK4,
+//! dopri5 and rosenbrock renormalize the quaternion after every accepted step
+//! ([`System::project`]); the implicit midpoint rule updates it by the exponential map
+//! ([`System::advance`]) and needs no projection.
 
 use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, System};
 use crate::rosenbrock::rosenbrock;
