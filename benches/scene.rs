@@ -41,8 +41,8 @@ fn scene_run(c: &mut Criterion) {
     g.finish();
 }
 
-/// The flexible-joint SSRMS (`scenes/ssrms_flexible.toml`, 30 s, Rodas4 at 1e-8: 688 steps
-/// interpreted, 694 compiled, each with a difference-quotient Jacobian of 28 + 2 evaluations,
+/// The flexible-joint SSRMS (`scenes/ssrms_flexible.toml`, 30 s, Rodas4 at 1e-8: 527 steps
+/// interpreted, 528 compiled, each with a difference-quotient Jacobian of 2·28 + 2 evaluations,
 /// one 28×28 LU and 5 more evaluations): time per step = reported time / steps. Measured (one
 /// run): compiled 15.8 ms (22.7 µs per step), interpreted 170 ms (247 µs per step), 10.8×.
 fn flexible_run(c: &mut Criterion) {

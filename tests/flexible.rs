@@ -114,7 +114,7 @@ fn bad_flexible_values_name_the_key() {
 /// With no drives and no damping anywhere, the total energy — link kinetic, motor kinetic
 /// `½ Σ B θ̇²` and spring potential `½ Σ K (θ − q)²` — is conserved: SSRMS with K = 1e5 N·m/rad,
 /// moving from rest-length springs, 2 s under Rodas4 at tolerance 1e-11 keeps it to a measured
-/// 3.2e-11 relative (bound 1e-8), while the motor-plus-spring part alone swings by a measured
+/// 3.8e-15 relative (bound 1e-8), while the motor-plus-spring part alone swings by a measured
 /// 3.2e-3 of the total (bound: at least 1e4 × the drift) — energy flows through the springs and
 /// back, and the monitor sees it.
 #[test]
@@ -164,12 +164,11 @@ output_every = 10
 }
 
 /// `scenes/ssrms_flexible.toml` (K = 1e8 N·m/rad): Rodas4 at tolerance 1e-8 reaches the final
-/// state within a measured 2.2e-8 (bound 1e-7) of Rodas4 at 1e-12 — checked against an
-/// independent method over the first 2 s, RK4 at h = 1e-4 (agreement measured 8.7e-10, bound
-/// 1e-8) — with an
-/// average step of 4.4e-2 s (688 steps over 30 s); RK4 at a step 100× smaller than that average
-/// diverges within the first second (its largest stable step, measured by bisection over 2 s,
-/// is between 2.5e-4 and 3e-4 s: about 150× below the Rodas4 average).
+/// state within a measured 1.8e-10 (bound 1e-7) of Rodas4 at 1e-12 — checked against an
+/// independent method over the first 2 s, RK4 at h = 1e-4 (agreement measured 5.7e-12, bound
+/// 1e-8) — with an average step of 5.7e-2 s (527 steps over 30 s); RK4 at a step 100× smaller
+/// than that average diverges within the first second (its largest stable step, measured by
+/// bisection over 2 s, is between 2.5e-4 and 3e-4 s: about 200× below the Rodas4 average).
 #[test]
 fn stiff_integrator_beats_rk4_by_100x() {
     let base = load("scenes/ssrms_flexible.toml");
@@ -217,10 +216,10 @@ fn stiff_integrator_beats_rk4_by_100x() {
 }
 
 /// The compiled scene (`scene!`, `kanegen::ode::rosenbrock`) samples at the interpreted run's
-/// times and agrees with it to within the integrator tolerance: measured 3.7e-10 relative
-/// (bound 1e-7). The step sequences are the same method's but not identical (694 compiled
-/// steps, 688 interpreted): the right-hand sides differ by rounding, which the difference
-/// quotients of the Jacobian amplify to ~1e-8 relative in `J`, enough to move a step-size
+/// times and agrees with it to within the integrator tolerance: measured 9.8e-11 relative
+/// (bound 1e-7). The step sequences are the same method's but not identical (528 compiled
+/// steps, 527 interpreted): the right-hand sides differ by rounding, which the difference
+/// quotients of the Jacobian amplify (to ~1e-11 relative in `J`), enough to move a step-size
 /// decision; each run still meets the tolerance.
 #[test]
 fn compiled_ssrms_flexible_matches_interpreted() {
@@ -239,10 +238,10 @@ fn compiled_ssrms_flexible_matches_interpreted() {
 /// Hard case: stiffness 1e3 … 1e8 N·m/rad on the two-link arm under gravity (PD drives on the
 /// motors, 10 s, Rodas4 at 1e-8), interpreted and compiled:
 ///
-/// - every run completes (250–2760 steps), bounded (|x| ≤ 10), compiled and interpreted
-///   agreeing to a measured ≤ 7.8e-11 relative (bound 1e-6);
+/// - every run completes (251–279 steps), bounded (|x| ≤ 10), compiled and interpreted
+///   agreeing to a measured ≤ 5.6e-13 relative (bound 1e-6);
 /// - the run settles to the static deflection `θ − q = G(q) / K` (`G` the gravity torque, the
-///   inverse dynamics at rest): measured ≤ 2e-11 relative to `|G|/K` (bound 1e-3);
+///   inverse dynamics at rest): measured ≤ 3e-11 relative to `|G|/K` (bound 1e-3);
 /// - infinite-stiffness limit: the link coordinates tend to the rigid arm with rotor inertia `B`
 ///   on `M`'s diagonal (`[effects] rotor`, same drives, dopri5 at 1e-11): `|q_K − q_rigid|` at
 ///   the end is measured 1.0e-1 at K = 1e3 and 1.1e-6 at 1e8, `K · gap` constant to 7 %
@@ -368,11 +367,9 @@ fn count_lists_flexible() {
 
 /// The work–precision report gives a flexible scene the stiff integrator's ladder beside RK4,
 /// midpoint and dopri5 (two-link arm, K = 1e6, first 2 s): every rosenbrock row completes and
-/// its error falls with the tolerance, within 10× of it down to 1e-10 (measured 3.9e-5, 5.0e-7,
-/// 4.9e-9, 2.1e-10 relative at 1e-4 … 1e-10 in 23, 68, 309, 2742 steps); at 1e-12 the
-/// difference-quotient Jacobian (~1e-8 relative) limits it — measured 1.5e-11 in 32621 steps
-/// (bound 1e-10): tight tolerances are dopri5's. At 1e-8 it takes fewer steps than dopri5 (measured
-/// 309 against 3233).
+/// its error stays within 10× of the tolerance (measured 4.0e-5, 5.6e-7, 6.6e-9, 6.5e-11, 1.5e-12
+/// relative at 1e-4 … 1e-12, in 23, 68, 213, 693, 2937 steps; bound 10 × max(tol, 1e-11)). At
+/// 1e-8 it takes fewer steps than dopri5 (measured 213 against 3233).
 #[test]
 fn accuracy_report_has_the_stiff_ladder() {
     use kanegen::cli::reports::accuracy::integration::{integration_report, TOLERANCES};
