@@ -44,7 +44,8 @@ fn scene_run(c: &mut Criterion) {
 /// The flexible-joint SSRMS (`scenes/ssrms_flexible.toml`, 30 s, Rodas4 at 1e-8: 527 steps
 /// interpreted, 528 compiled, each with a difference-quotient Jacobian of 2·28 + 2 evaluations,
 /// one 28×28 LU and 5 more evaluations): time per step = reported time / steps. Measured (one
-/// run): compiled 15.8 ms (22.7 µs per step), interpreted 170 ms (247 µs per step), 10.8×.
+/// run, beside another build): compiled 20.3 ms (38.5 µs per step), interpreted 270 ms
+/// (512 µs per step), 13.3×.
 fn flexible_run(c: &mut Criterion) {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/ssrms_flexible.toml");
     let scene = Scene::load(&path).unwrap();
