@@ -25,18 +25,25 @@
 //! `motor_inertia` `I_m` (kg·m², `> 0`), `gear_ratio` `n` (`!= 0`, default 1). Fixed base only;
 //! not with `[effects] rotor` (the motor inertia is given here).
 
-use crate::scene::{check_len, RawGain};
-use anyhow::{bail, Result};
+use anyhow::{anyhow, bail, Result};
 use kanegen_model::bounds::GAIN;
 use serde::Deserialize;
+
+/// One number for every joint, or one per joint.
+#[derive(Deserialize)]
+#[serde(untagged)]
+pub(crate) enum RawValues {
+    Scalar(f64),
+    Vector(Vec<f64>),
+}
 
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct RawFlexible {
-    stiffness: RawGain,
-    damping: Option<RawGain>,
-    motor_inertia: RawGain,
-    gear_ratio: Option<RawGain>,
+    stiffness: RawValues,
+    damping: Option<RawValues>,
+    motor_inertia: RawValues,
+    gear_ratio: Option<RawValues>,
 }
 
 /// Validated flexible-joint parameters (see the module doc).
@@ -54,13 +61,25 @@ pub struct Flexible {
     pub reflected: Vec<f64>,
 }
 
-fn values(key: &str, g: RawGain, n: usize) -> Result<Vec<f64>> {
-    let v = match g {
-        RawGain::Scalar(x) => vec![x; n],
-        RawGain::Vector(v) => v,
-    };
-    check_len(key, &v, n, GAIN)?;
+/// `n` values, finite and within [`GAIN`] (the scene's `check_len` messages; this module does
+/// not use `scene`, which uses it).
+fn checked(key: &str, v: Vec<f64>, n: usize) -> Result<Vec<f64>> {
+    if v.len() != n {
+        bail!(
+            "{key}: expected {n} values (the model's degrees of freedom), got {}",
+            v.len()
+        );
+    }
+    GAIN.check(&v).map_err(|e| anyhow!("{key}: {e}"))?;
     Ok(v)
+}
+
+fn values(key: &str, g: RawValues, n: usize) -> Result<Vec<f64>> {
+    let v = match g {
+        RawValues::Scalar(x) => vec![x; n],
+        RawValues::Vector(v) => v,
+    };
+    checked(key, v, n)
 }
 
 impl Flexible {
@@ -97,7 +116,7 @@ impl Flexible {
             .zip(&gear_ratio)
             .map(|(i, g)| i * g * g)
             .collect();
-        check_len(&key("motor_inertia"), &reflected, n, GAIN)?;
+        let reflected = checked(&key("motor_inertia"), reflected, n)?;
         Ok(Flexible {
             stiffness,
             damping,

@@ -151,7 +151,7 @@ enum RawProfile {
 
 #[derive(Deserialize)]
 #[serde(untagged)]
-pub(crate) enum RawGain {
+enum RawGain {
     Scalar(f64),
     Vector(Vec<f64>),
 }
@@ -489,7 +489,7 @@ pub struct Scene {
     pub simulation: SimulationSpec,
 }
 
-pub(crate) fn check_len(key: &str, v: &[f64], n: usize, b: Bound) -> Result<()> {
+fn check_len(key: &str, v: &[f64], n: usize, b: Bound) -> Result<()> {
     if v.len() != n {
         bail!(
             "{key}: expected {n} values (the model's degrees of freedom), got {}",
