@@ -13,6 +13,9 @@
 
 use crate::__private::libm;
 
+mod rosenbrock;
+pub use rosenbrock::{rosenbrock, rosenbrock_step, RosenbrockOptions};
+
 /// Work counters of a run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Stats {

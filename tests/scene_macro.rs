@@ -1,5 +1,7 @@
 //! `kanegen::scene!` against the interpreted simulator (`kanegen::sim`), on every example scene
-//! of `scenes/` and on seven test scenes with what the examples lack
+//! of `scenes/` with rigid joints (`ssrms_flexible.toml`, with flexible joints and the stiff
+//! integrator, is compared in `tests/flexible.rs`) and on seven test scenes with what the
+//! examples lack
 //! (`tests/data/scenes/`: `gravity_wrench.toml`, fixed base, constant and tabulated body-frame
 //! wrenches on one body, constant drives; `floating_wrenches.toml`, free-floating under
 //! gravity, wrenches on the base in both frames and on two links, constant drives, damping;

@@ -149,7 +149,10 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let state_ty = format_ident!("{}State", name);
     let (nq, nv) = if floating { (n + 7, n + 6) } else { (n, n) };
     let (nql, nvl) = (Literal::usize_unsuffixed(nq), Literal::usize_unsuffixed(nv));
-    let dim = Literal::usize_unsuffixed(nq + nv);
+    // Flexible joints (fixed base, the scene checks) add the motor positions and rates.
+    let flexible = scene.flexible.as_ref();
+    let dim_n = nq + nv + if flexible.is_some() { 2 * n } else { 0 };
+    let dim = Literal::usize_unsuffixed(dim_n);
     let vname = if floating {
         format_ident!("v")
     } else {
@@ -157,7 +160,10 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     };
 
     // Joint positions and rates inside `rhs` (`s` the state).
-    let (qj, qdj) = if floating {
+    let (qj, qdj) = if flexible.is_some() {
+        // The drives, damping and friction act on the motors.
+        (quote!(let qj = s.theta;), quote!(let qdj = s.thetad;))
+    } else if floating {
         (
             quote!(let qj: [f64; #nl] = core::array::from_fn(|i| s.q[7 + i]);),
             quote!(let qdj: [f64; #nl] = core::array::from_fn(|i| s.v[6 + i]);),
@@ -381,7 +387,36 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         });
         quote!(match phase { #(#arms)* _ => [f64::NAN; #nvl] })
     };
-    let derivative = if floating {
+    // Spong's model: the spring-damper torque drives the links, `tau` (the motor torque) the
+    // motors, as the interpreted `SceneSystem::deriv`.
+    let spring = match flexible {
+        None => quote!(),
+        Some(f) => {
+            let (k, d, b) = (arr(&f.stiffness), arr(&f.damping), arr(&f.reflected));
+            quote! {
+                    const STIFFNESS: [f64; #nl] = #k;
+                    const SPRING_DAMPING: [f64; #nl] = #d;
+                    const MOTOR: [f64; #nl] = #b;
+                    let tau_m = tau;
+                    let tau: [f64; #nl] = core::array::from_fn(|i| {
+                        STIFFNESS[i] * (s.theta[i] - s.q[i])
+                            + SPRING_DAMPING[i] * (s.thetad[i] - s.qd[i])
+                    });
+            }
+        }
+    };
+    let derivative = if flexible.is_some() {
+        quote! {
+            #spring
+            let a = #accel;
+            #state_ty {
+                q: s.qd,
+                qd: a,
+                theta: s.thetad,
+                thetad: core::array::from_fn(|i| (tau_m[i] - tau[i]) / MOTOR[i]),
+            }
+        }
+    } else if floating {
         quote! {
             let a = #accel;
             let r = #runtime::ode::quat_to_matrix(&[s.q[3], s.q[4], s.q[5], s.q[6]]);
@@ -413,6 +448,9 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     };
 
     let x0: Vec<f64> = match &scene.base {
+        BaseSpec::Fixed if flexible.is_some() => {
+            [scene.q0.as_slice(), &scene.qd0, &scene.q0, &scene.qd0].concat()
+        }
         BaseSpec::Fixed => [scene.q0.as_slice(), &scene.qd0].concat(),
         BaseSpec::FreeFloating {
             position,
@@ -430,7 +468,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         ]
         .concat(),
     };
-    let (q0, v0) = (arr(&x0[..nq]), arr(&x0[nq..]));
+    let (q0, v0) = (arr(&x0[..nq]), arr(&x0[nq..nq + nv]));
     let project = if floating {
         quote!(#runtime::ode::normalize_quaternion::<#dim>)
     } else {
@@ -441,7 +479,12 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     } else {
         quote!(#runtime::ode::advance_additive::<#dim>)
     };
-    let step_body = if sim.integrator == Integrator::Midpoint {
+    let step_body = if sim.integrator == Integrator::Rosenbrock {
+        quote! {
+            let mut stats = #runtime::ode::Stats::default();
+            let x = #runtime::ode::rosenbrock_step(&mut f, t, &state.to_array(), h, &mut stats)?;
+        }
+    } else if sim.integrator == Integrator::Midpoint {
         quote! {
             let mut stats = #runtime::ode::Stats::default();
             let x = #runtime::ode::midpoint_step(
@@ -476,15 +519,22 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     );
     let every = Literal::usize_unsuffixed(sim.output_every);
     let integrate = |t0: TokenStream, t1: TokenStream, obs: TokenStream| match sim.integrator {
-        Integrator::Dopri5 => quote! {
-            let opts = #runtime::ode::Dopri5Options {
-                tolerance: Self::TOLERANCE,
-                max_step: #max_step,
-                initial_step: Self::STEP,
-                output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
+        Integrator::Dopri5 | Integrator::Rosenbrock => {
+            let method = if sim.integrator == Integrator::Dopri5 {
+                format_ident!("dopri5")
+            } else {
+                format_ident!("rosenbrock")
             };
-            #runtime::ode::dopri5(&mut f, #project, #t0, #t1, &opts, &mut x, #obs)
-        },
+            quote! {
+                let opts = #runtime::ode::Dopri5Options {
+                    tolerance: Self::TOLERANCE,
+                    max_step: #max_step,
+                    initial_step: Self::STEP,
+                    output_interval: Self::STEP * Self::OUTPUT_EVERY as f64,
+                };
+                #runtime::ode::#method(&mut f, #project, #t0, #t1, &opts, &mut x, #obs)
+            }
+        }
         Integrator::Rk4 => quote! {
             let opts = #runtime::ode::Rk4Options {
                 step: Self::STEP,
@@ -537,6 +587,14 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             sim.step,
             sim.step * sim.output_every as f64
         ),
+        Integrator::Rosenbrock => format!(
+            " The scene's integrator: adaptive Rodas4, the stiff Rosenbrock method \
+             (`kanegen::ode::rosenbrock`, tolerance {:e}, first step {} s, steps landing on the \
+             output times every {} s). [`{name}::step`] is one Rodas4 step with no step control.",
+            sim.tolerance,
+            sim.step,
+            sim.step * sim.output_every as f64
+        ),
         Integrator::Rk4 => format!(
             " The scene's integrator: fixed-step RK4 (`kanegen::ode::rk4`), step {} s, a sample \
              every {} steps.",
@@ -548,7 +606,9 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             sim.step, sim.output_every
         ),
     };
-    let step_doc = if sim.integrator == Integrator::Midpoint {
+    let step_doc = if sim.integrator == Integrator::Rosenbrock {
+        " One Rodas4 step of size `h` from `(t, state)` (no step control)."
+    } else if sim.integrator == Integrator::Midpoint {
         " One implicit midpoint step of size `h` from `(t, state)` (the scene's integrator)."
     } else {
         " One fixed RK4 step of size `h` from `(t, state)`, then the projection (the quaternion \
@@ -577,6 +637,9 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         if scene.rotor.is_some() {
             e.push("reflected rotor inertia".into());
         }
+        if scene.flexible.is_some() {
+            e.push("flexible joints (Spong)".into());
+        }
         if !scene.wrenches.is_empty() {
             e.push(format!("{} external wrench(es)", scene.wrenches.len()));
         }
@@ -587,7 +650,13 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
         kanegen_codegen::header::doc_safe(model.name()),
         if floating { "free-floating" } else { "fixed" },
     );
-    let state_doc = if floating {
+    let state_doc = if flexible.is_some() {
+        format!(
+            " The state of [`{name}`]: link positions `q` and rates `qd`, motor positions \
+             `theta` and rates `thetad` ({n} each; Spong's flexible joints). A derivative has \
+             the same layout."
+        )
+    } else if floating {
         format!(
             " The state of [`{name}`]: `q = [p₀ (3), quaternion x y z w (4), joints ({n})]` and \
              `v = [v_b (3), ω_b (3), q̇ ({n})]` (base coordinates), the free-flyer layout of \
@@ -607,7 +676,58 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
     let scene_lit = LitStr::new(&abs, Span::call_site());
     let model_lit = LitStr::new(&model_path.display().to_string(), Span::call_site());
     let rel_lit = LitStr::new(rel, Span::call_site());
-    let dim_doc = format!(" Length of the flat state vector ({nq} + {nv}).");
+    let dim_doc = if flexible.is_some() {
+        format!(" Length of the flat state vector ({nq} + {nv} + {n} + {n}).")
+    } else {
+        format!(" Length of the flat state vector ({nq} + {nv}).")
+    };
+    let motor_fields = if flexible.is_some() {
+        quote! {
+            /// Motor positions (link side, `θ`).
+            pub theta: [f64; #nl],
+            /// Motor rates.
+            pub thetad: [f64; #nl],
+        }
+    } else {
+        quote!()
+    };
+    let (to_array, from_array, init_motor) = if flexible.is_some() {
+        let two = Literal::usize_unsuffixed(2 * n);
+        let three = Literal::usize_unsuffixed(3 * n);
+        (
+            quote! {
+                core::array::from_fn(|i| match i / #nl {
+                    0 => self.q[i],
+                    1 => self.qd[i - #nl],
+                    2 => self.theta[i - #two],
+                    _ => self.thetad[i - #three],
+                })
+            },
+            quote! {
+                #state_ty {
+                    q: core::array::from_fn(|i| x[i]),
+                    qd: core::array::from_fn(|i| x[#nl + i]),
+                    theta: core::array::from_fn(|i| x[#two + i]),
+                    thetad: core::array::from_fn(|i| x[#three + i]),
+                }
+            },
+            {
+                let (t0, td0) = (arr(&scene.q0), arr(&scene.qd0));
+                quote!(, theta: #t0, thetad: #td0)
+            },
+        )
+    } else {
+        (
+            quote!(core::array::from_fn(|i| if i < #nql { self.q[i] } else { self.#vname[i - #nql] })),
+            quote! {
+                #state_ty {
+                    q: core::array::from_fn(|i| x[i]),
+                    #vname: core::array::from_fn(|i| x[#nql + i]),
+                }
+            },
+            quote!(),
+        )
+    };
 
     Ok(quote! {
         const _: &[u8] = include_bytes!(#scene_lit);
@@ -623,22 +743,20 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             pub q: [f64; #nql],
             #[doc = #vdoc]
             pub #vname: [f64; #nvl],
+            #motor_fields
         }
 
         impl #state_ty {
             /// The state as one vector `[q, v]` (the interpreted simulator's layout).
             #[must_use]
             pub fn to_array(&self) -> [f64; #dim] {
-                core::array::from_fn(|i| if i < #nql { self.q[i] } else { self.#vname[i - #nql] })
+                #to_array
             }
 
             /// The state of a vector `[q, v]`.
             #[must_use]
             pub fn from_array(x: &[f64; #dim]) -> Self {
-                #state_ty {
-                    q: core::array::from_fn(|i| x[i]),
-                    #vname: core::array::from_fn(|i| x[#nql + i]),
-                }
+                #from_array
             }
         }
 
@@ -669,7 +787,7 @@ pub fn expand(runtime: &syn::Path, name: &Ident, rel: &str) -> Result<TokenStrea
             /// The scene's initial state.
             #[must_use]
             pub fn initial_state() -> #state_ty {
-                #state_ty { q: #q0, #vname: #v0 }
+                #state_ty { q: #q0, #vname: #v0 #init_motor }
             }
 
             #rhs_sig {

@@ -92,6 +92,7 @@ struct RawEffects {
     wrench: Vec<RawWrench>,
     rotor: Option<toml::Spanned<RawRotor>>,
     friction: Option<toml::Spanned<RawFriction>>,
+    flexible: Option<toml::Spanned<crate::flexible::RawFlexible>>,
 }
 
 #[derive(Deserialize)]
@@ -270,6 +271,18 @@ pub enum Integrator {
     /// Fixed-step Lie-group implicit midpoint rule with the scene's `step` (long runs: bounded
     /// energy error, unit quaternion without projection; see `integrate::midpoint`).
     Midpoint,
+    /// Adaptive Rodas4, the stiffly accurate L-stable Rosenbrock method (`integrator =
+    /// "rosenbrock"`, [`crate::rosenbrock`]) with `rtol = atol = tolerance`, for stiff scenes
+    /// (flexible joints); its steps land on the output times.
+    Rosenbrock,
+}
+
+impl Integrator {
+    /// Whether the integrator adapts its step to `tolerance` (dopri5, rosenbrock).
+    #[must_use]
+    pub fn is_adaptive(self) -> bool {
+        matches!(self, Integrator::Dopri5 | Integrator::Rosenbrock)
+    }
 }
 
 /// The `[simulation]` table, validated.
@@ -279,11 +292,11 @@ pub struct SimulationSpec {
     pub duration: f64,
     /// The integrator.
     pub integrator: Integrator,
-    /// RK4 and midpoint step; for dopri5 the first step tried (default 0.01 s).
+    /// RK4 and midpoint step; for dopri5 and rosenbrock the first step tried (default 0.01 s).
     pub step: f64,
-    /// dopri5 tolerance (default 1e-8).
+    /// dopri5 and rosenbrock tolerance (default 1e-8).
     pub tolerance: f64,
-    /// dopri5 largest step (default: the duration).
+    /// dopri5 and rosenbrock largest step (default: the duration).
     pub max_step: f64,
     /// Output every k-th RK4 or midpoint step; dopri5 samples its dense output every `output_every · step`
     /// seconds (default 10).
@@ -523,6 +536,9 @@ pub struct Scene {
     pub rotor: Option<Rotor>,
     /// Regularized Coulomb drive friction (`[effects] friction.coulomb`).
     pub coulomb: Option<Coulomb>,
+    /// Flexible joints (`[effects] flexible`, Spong 1987), fixed base only: the state gains the
+    /// motor positions and rates, and the drives, damping and friction act on the motors.
+    pub flexible: Option<crate::flexible::Flexible>,
     /// The joint drives.
     pub drives: Drives,
     /// Initial joint positions.
@@ -979,6 +995,31 @@ impl Scene {
             }
         };
 
+        let flexible = match e.flexible {
+            None => None,
+            Some(f) => {
+                let line = line_of(text, f.span().start);
+                if floating {
+                    bail!(
+                        "effects.flexible (line {line}): flexible joints are supported on a fixed \
+                         base only"
+                    );
+                }
+                if rotor.is_some() {
+                    bail!(
+                        "effects.flexible (line {line}): `motor_inertia` and `gear_ratio` give the \
+                         motor inertia of a flexible joint; `effects.rotor` (the rigid-gear \
+                         model) cannot be given with it"
+                    );
+                }
+                Some(crate::flexible::Flexible::from_raw(
+                    f.into_inner(),
+                    n,
+                    line,
+                )?)
+            }
+        };
+
         let q0 = raw.initial.q.unwrap_or_else(|| vec![0.0; n]);
         check_len("initial.q", &q0, n, POSITION)?;
         let qd0 = raw.initial.qd.unwrap_or_else(|| vec![0.0; n]);
@@ -1066,10 +1107,11 @@ impl Scene {
             "rk4" => Integrator::Rk4,
             "dopri5" => Integrator::Dopri5,
             "midpoint" => Integrator::Midpoint,
+            "rosenbrock" => Integrator::Rosenbrock,
             other => {
                 bail!(
                     "simulation.integrator: unknown integrator `{other}` \
-                     (expected rk4, dopri5 or midpoint)"
+                     (expected rk4, dopri5, midpoint or rosenbrock)"
                 )
             }
         };
@@ -1108,7 +1150,7 @@ impl Scene {
             " (set allow_long = true in [simulation], or pass --allow-long, to run it)"
         };
         let samples = s.duration / (step * output_every as f64);
-        if integrator != Integrator::Dopri5 && s.duration / step > limit {
+        if !integrator.is_adaptive() && s.duration / step > limit {
             bail!(
                 "simulation.step: duration / step = {:.3e} steps exceeds the limit {limit:.0e}{hint}",
                 s.duration / step
@@ -1147,12 +1189,12 @@ impl Scene {
                 );
             }
         }
-        if integrator != Integrator::Dopri5 {
+        if !integrator.is_adaptive() {
             if s.tolerance.is_some() {
-                bail!("simulation.tolerance: only for integrator = \"dopri5\"");
+                bail!("simulation.tolerance: only for integrator = \"dopri5\" or \"rosenbrock\"");
             }
             if s.max_step.is_some() {
-                bail!("simulation.max_step: only for integrator = \"dopri5\"");
+                bail!("simulation.max_step: only for integrator = \"dopri5\" or \"rosenbrock\"");
             }
         }
 
@@ -1169,6 +1211,7 @@ impl Scene {
             wrenches,
             rotor,
             coulomb,
+            flexible,
             drives,
             q0,
             qd0,

@@ -3,12 +3,15 @@
 //!
 //! State vector: fixed base `[q (N), q̇ (N)]`; free-floating base
 //! `[p₀ (3), quat (4: x, y, z, w), q (N), v_b (3), ω_b (3), q̇ (N)]` with `ṗ₀ = R₀ v_b` and
-//! `q̇uat = ½ quat ⊗ (ω_b, 0)` (body-frame `ω_b`); RK4 and dopri5 renormalize the quaternion
-//! after every accepted step ([`System::project`]); the implicit midpoint rule updates it by the
-//! exponential map ([`System::advance`]) and needs no projection.
+//! `q̇uat = ½ quat ⊗ (ω_b, 0)` (body-frame `ω_b`); with flexible joints (fixed base)
+//! `[q (N), q̇ (N), θ (N), θ̇ (N)]`, the motor coordinates last ([`crate::flexible`]). RK4,
+//! dopri5 and rosenbrock renormalize the quaternion after every accepted step
+//! ([`System::project`]); the implicit midpoint rule updates it by the exponential map
+//! ([`System::advance`]) and needs no projection.
 
 use crate::events::{self, CaptureSystem, EventReport};
 use crate::integrate::{dopri5, midpoint, rk4, Dopri5Options, IntegrateError, Stats, System};
+use crate::rosenbrock::rosenbrock;
 use crate::scene::{
     BaseSpec, Drives, Event, EventKind, Integrator, Scene, SceneWrench, SimulationSpec,
 };
@@ -165,10 +168,11 @@ impl<'a> SceneSystem<'a> {
         let joint = |k: usize| self.scene.model.joints()[k].name.clone();
         let xyz = ["x", "y", "z"];
         if self.base.is_none() {
-            return if i < n {
-                format!("q_{}", joint(i))
-            } else {
-                format!("qd_{}", joint(i - n))
+            return match i / n {
+                0 => format!("q_{}", joint(i)),
+                1 => format!("qd_{}", joint(i - n)),
+                2 => format!("theta_{}", joint(i - 2 * n)),
+                _ => format!("thetad_{}", joint(i - 3 * n)),
             };
         }
         match i {
@@ -186,6 +190,9 @@ impl<'a> SceneSystem<'a> {
     pub fn initial_state(&self) -> Vec<f64> {
         let s = self.scene;
         match &s.base {
+            BaseSpec::Fixed if s.flexible.is_some() => {
+                [s.q0.as_slice(), &s.qd0, &s.q0, &s.qd0].concat()
+            }
             BaseSpec::Fixed => [s.q0.as_slice(), &s.qd0].concat(),
             BaseSpec::FreeFloating {
                 position,
@@ -293,6 +300,14 @@ impl<'a> SceneSystem<'a> {
             return self.scene.gravity.is_none().then_some(t);
         }
         let q = &x[..self.n];
+        // The motors' kinetic and the springs' potential energy.
+        let t = match &self.scene.flexible {
+            Some(f) => {
+                let n = self.n;
+                t + f.energy(q, &x[2 * n..3 * n], &x[3 * n..4 * n])
+            }
+            None => t,
+        };
         // Gravitational potential: −g · Σ m_k x_k over the bodies' centres of mass.
         let v = match self.scene.gravity {
             None => 0.0,
@@ -555,17 +570,44 @@ impl System for SceneSystem<'_> {
     fn dim(&self) -> usize {
         if self.base.is_some() {
             13 + 2 * self.n
+        } else if self.scene.flexible.is_some() {
+            4 * self.n
         } else {
             2 * self.n
         }
     }
 
     fn deriv(&mut self, t: f64, x: &[f64], dx: &mut [f64]) {
+        let n = self.n;
+        let (q, qd, st) = self.split(x);
+        // Flexible joints first: their state is `[q, q̇, θ, θ̇]`, which the fast path does not
+        // know (it evaluates the link side by the scene's algorithm).
+        if let Some(f) = &self.scene.flexible {
+            // Spong's model: the spring loads the links, the drives act on the motors.
+            let (th, thd) = (&x[2 * n..3 * n], &x[3 * n..4 * n]);
+            let tau_s = f.spring_torque(q, qd, th, thd);
+            let tau_m = self.torques(t, th, thd);
+            let mut loads = Loads {
+                tau: Some(tau_s.clone()),
+                ..self.passive.clone()
+            };
+            if self.time_varying {
+                loads.external = self.scene.wrenches.iter().map(|w| w.at(t)).collect();
+            }
+            let alg = self.scene.simulation.algorithm;
+            let qdd = alg.forward_dynamics(&self.params, q, qd, &loads);
+            dx[..n].copy_from_slice(qd);
+            dx[n..2 * n].copy_from_slice(&qdd);
+            dx[2 * n..3 * n].copy_from_slice(thd);
+            for i in 0..n {
+                let tm = tau_m.as_ref().map_or(0.0, |v| v[i]);
+                dx[3 * n + i] = (tm - tau_s[i]) / f.reflected[i];
+            }
+            return;
+        }
         if self.fast.is_some() {
             return self.deriv_fast(t, x, dx);
         }
-        let n = self.n;
-        let (q, qd, st) = self.split(x);
         let mut loads = Loads {
             tau: self.torques(t, q, qd),
             ..self.passive.clone()
@@ -738,6 +780,10 @@ pub fn conserves_energy(scene: &Scene) -> bool {
     matches!(scene.drives, Drives::None)
         && scene.damping.is_none()
         && scene.coulomb.is_none()
+        && !scene
+            .flexible
+            .as_ref()
+            .is_some_and(crate::flexible::Flexible::dissipates)
         && scene.wrenches.is_empty()
         && !(scene.is_floating() && scene.gravity.is_some())
 }
@@ -1022,14 +1068,18 @@ fn integrate_segment(
     match sim.integrator {
         Integrator::Rk4 => rk4(sys, t0, t1, sim.step, x, &mut every),
         Integrator::Midpoint => midpoint(sys, t0, t1, sim.step, x, &mut every),
-        Integrator::Dopri5 => {
+        Integrator::Dopri5 | Integrator::Rosenbrock => {
             let opts = Dopri5Options {
                 tolerance: sim.tolerance,
                 max_step: sim.max_step,
                 initial_step: sim.step,
                 output_interval: sim.step * sim.output_every as f64,
             };
-            dopri5(sys, t0, t1, &opts, x, record)
+            if sim.integrator == Integrator::Dopri5 {
+                dopri5(sys, t0, t1, &opts, x, record)
+            } else {
+                rosenbrock(sys, t0, t1, &opts, x, record)
+            }
         }
     }
 }
@@ -1117,6 +1167,10 @@ pub fn csv_header(scene: &Scene) -> Vec<String> {
     let mut h = vec!["t".to_string()];
     h.extend(names.iter().map(|n| format!("q_{n}")));
     h.extend(names.iter().map(|n| format!("qd_{n}")));
+    if scene.flexible.is_some() {
+        h.extend(names.iter().map(|n| format!("theta_{n}")));
+        h.extend(names.iter().map(|n| format!("thetad_{n}")));
+    }
     if scene.is_floating() {
         for (p, comps) in [
             ("p0", &["x", "y", "z"][..]),

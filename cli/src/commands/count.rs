@@ -217,8 +217,10 @@ pub fn count_scene(
 /// `damping`, traced with `b`), counted from their formulas, per bias method (the same for
 /// each) and convention: `coulomb` subtracts `τ_c,i tanh(q̇_i · (1/v_s))` from `b` (2 mul,
 /// 1 add and one `tanh` per joint); `rotor` adds the constant `I_m,i n_i²` to `A_ii` (1 add per
-/// joint) before the solve. `emitted` leaves out the joints whose coefficient is 0 (folded
-/// away), `paper` counts every joint.
+/// joint) before the solve; `flexible` (Spong's joints) forms the spring-damper torque
+/// `K_i (θ_i − q_i) + D_i (θ̇_i − q̇_i)` (2 mul, 3 add; 1 mul, 1 add without `D_i`) and the
+/// motor acceleration `(τ_m,i − τ_s,i) / B_i` (1 add, 1 div) per joint. `emitted` leaves out the
+/// joints whose coefficient is 0 (folded away), `paper` counts every joint.
 fn drive_effect_lines(scene: &Scene, bias: &[BiasMethod]) -> Vec<EffectLine> {
     let nonzero = |v: &[f64]| v.iter().filter(|x| **x != 0.0).count() as i64;
     let n = scene.model.dof() as i64;
@@ -247,6 +249,20 @@ fn drive_effect_lines(scene: &Scene, bias: &[BiasMethod]) -> Vec<EffectLine> {
                     mul: mul_per_joint * k,
                     add: k,
                     div: 0,
+                });
+            }
+        }
+        if let Some(f) = &scene.flexible {
+            let damped = nonzero(&f.damping);
+            for conv in ["emitted", "paper"] {
+                let d = if conv == "paper" { n } else { damped };
+                lines.push(EffectLine {
+                    effect: "flexible".into(),
+                    method: b.name().into(),
+                    convention: conv.into(),
+                    mul: n + d,
+                    add: 2 * n + 2 * d,
+                    div: n,
                 });
             }
         }
@@ -309,6 +325,13 @@ pub fn render_scene_text(r: &SceneCountReport) -> String {
                 s,
                 "\ncoulomb and rotor are counted from their formulas: coulomb also takes one tanh \
                  per joint; rotor adds to A's diagonal (before the solve), not to b"
+            );
+        }
+        if names.iter().any(|e| e == "flexible") {
+            let _ = writeln!(
+                s,
+                "\nflexible is counted from its formulas: the spring-damper torque (the links' τ) \
+                 and the motor accelerations (τ_m − τ_s) / B; the drives act on the motors"
             );
         }
     }

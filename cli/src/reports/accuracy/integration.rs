@@ -2,6 +2,10 @@
 //! tolerances, the final-state error against a tight reference solution versus wall time (the
 //! classic work–precision diagram).
 //!
+//! A scene with flexible joints (`[effects] flexible`) also gets the stiff integrator's ladder
+//! (`rosenbrock`, Rodas4, over [`TOLERANCES`]) and finer fixed steps ([`STIFF_STEPS`]): its
+//! spring modes bound an explicit method's step by stability.
+//!
 //! The reference is dopri5 at tolerance [`REFERENCE_TOLERANCE`]; its own error is estimated by
 //! comparing it with dopri5 at 100× that tolerance, and reported, so that no error below it is
 //! read as meaningful.
@@ -17,7 +21,7 @@ pub const REFERENCE_TOLERANCE: f64 = 1e-13;
 /// One integrator setting of the ladder.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct IntegrationRow {
-    /// `rk4`, `midpoint` or `dopri5`.
+    /// `rk4`, `midpoint`, `dopri5` or `rosenbrock`.
     pub integrator: String,
     /// `h = 0.01` or `tol = 1e-8`.
     pub setting: String,
@@ -48,7 +52,9 @@ pub struct IntegrationReport {
 
 /// Steps of the fixed-step ladders, s.
 pub const STEPS: [f64; 5] = [0.1, 0.05, 0.025, 0.0125, 0.00625];
-/// Tolerances of the dopri5 ladder.
+/// Steps of the fixed-step ladders of a scene with flexible joints, s.
+pub const STIFF_STEPS: [f64; 5] = [1e-3, 5e-4, 2.5e-4, 1.25e-4, 6.25e-5];
+/// Tolerances of the dopri5 and rosenbrock ladders.
 pub const TOLERANCES: [f64; 5] = [1e-4, 1e-6, 1e-8, 1e-10, 1e-12];
 
 /// The scene with another integrator setting, sampling only its first and last state.
@@ -62,7 +68,7 @@ pub(crate) fn with_setting(
     let sim = &mut s.simulation;
     sim.integrator = integrator;
     sim.tolerance = tolerance;
-    if integrator == Integrator::Dopri5 {
+    if integrator.is_adaptive() {
         sim.step = 1e-3;
         sim.max_step = scene.simulation.duration;
     } else {
@@ -145,14 +151,19 @@ pub fn integration_report(scene: &Scene, repeats: usize) -> Result<IntegrationRe
     let xref = reference(REFERENCE_TOLERANCE)?;
     let reference_error = state_error(&reference(100.0 * REFERENCE_TOLERANCE)?, &xref);
     let mut rows = Vec::new();
-    let ladders: [(Integrator, &str, &[f64]); 3] = [
-        (Integrator::Rk4, "rk4", &STEPS),
-        (Integrator::Midpoint, "midpoint", &STEPS),
+    let stiff = scene.flexible.is_some();
+    let steps: &[f64] = if stiff { &STIFF_STEPS } else { &STEPS };
+    let mut ladders: Vec<(Integrator, &str, &[f64])> = vec![
+        (Integrator::Rk4, "rk4", steps),
+        (Integrator::Midpoint, "midpoint", steps),
         (Integrator::Dopri5, "dopri5", &TOLERANCES),
     ];
+    if stiff {
+        ladders.push((Integrator::Rosenbrock, "rosenbrock", &TOLERANCES));
+    }
     for (integrator, name, values) in ladders {
         for &v in values {
-            let (step, tol, setting) = if integrator == Integrator::Dopri5 {
+            let (step, tol, setting) = if integrator.is_adaptive() {
                 (0.0, v, format!("tol = {v:e}"))
             } else {
                 (v, 1e-8, format!("h = {v}"))
