@@ -20,8 +20,8 @@
 //!
 //! | case | what | measured | bound |
 //! |---|---|---|---|
-//! | F1 | `σ_min(J*)` of the Jacobi eigenvalue helper vs nalgebra's SVD, 11 states on the way: `\|Δσ²\| / σ_max²` | 7.6e-17 | 1e-14 |
-//! | F1 | `σ_min(J*)` at the target (helper; SVD) | 1.8e-8; 2.6e-8 | < 1e-7 |
+//! | F1 | `σ_min(J*)` (nalgebra's SVD) squared vs `λ_min(J* J*ᵀ)` (symmetric eigensolver), 11 states on the way: `\|Δσ²\| / σ_max²` | 2.4e-16 | 1e-14 |
+//! | F1 | `σ_min(J*)` at the target (SVD) | 2.6e-8 | < 1e-7 |
 //! | F1 | the watch (threshold 2e-2), interpreted and compiled | below in [3.3, 3.8], [4.7, 5.8], [6.6, 10] s; smallest 3.9e-4 at t = 10 s (both) | reported; compiled minimum within 1e-6 |
 //! | F1 | base position / quaternion error, tolerance 1e-8 vs 1e-12 | 9.7e-10 m / 1.1e-9 | 1e-8 (9×) |
 //! | F1 | compiled vs interpreted state, every sample | 3.0e-11 | 1e-9 (1 + \|x\|) |
@@ -42,7 +42,7 @@ use kanegen::dynamics::{FrameParams, Loads, Methods, Params, Real, Scalar};
 use kanegen::model::random::{random_vec, rng};
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, simulate_to, Control, Run, Sample, SceneSystem};
-use kanegen::sim::singularity::{sigma_min, SingularityWatch};
+use kanegen::sim::singularity::SingularityWatch;
 use nalgebra::DMatrix;
 use std::path::Path;
 
@@ -104,23 +104,30 @@ fn f1_dynamic_singularity_is_reported_not_a_nan() {
         let sv = m.singular_values();
         let svd = sv.iter().copied().fold(f64::INFINITY, f64::min);
         let smax = sv.iter().copied().fold(0.0, f64::max);
-        let mine = sigma_min(&monitor, &x, &tip()).unwrap();
-        // σ² is resolved to the rounding of J* J*ᵀ: |Δσ²| ≲ ε σ_max².
-        worst_svd = worst_svd.max((mine * mine - svd * svd).abs() / (smax * smax));
+        let mine = monitor.sigma_min(&x, &tip()).unwrap();
+        assert_eq!(mine, svd, "the watch's σ_min is the SVD's");
+        // An independent check of the SVD: λ_min of J* J*ᵀ (symmetric eigensolver), resolved
+        // to the rounding of that product, |Δσ²| ≲ ε σ_max².
+        let lmin = (&m * m.transpose())
+            .symmetric_eigenvalues()
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min);
+        worst_svd = worst_svd.max((lmin - svd * svd).abs() / (smax * smax));
         if k == 10 {
-            eprintln!("σ_min(J*) at the target: {mine:.2e} (SVD {svd:.2e})");
+            eprintln!("σ_min(J*) at the target: {mine:.2e} (λ_min(J* J*ᵀ) {lmin:.2e})");
             assert!(mine < 1e-7);
         }
     }
-    eprintln!("σ_min helper vs SVD: |Δσ²|/σ_max² ≤ {worst_svd:.1e}");
+    eprintln!("σ_min² (SVD) vs λ_min(J* J*ᵀ): |Δσ²|/σ_max² ≤ {worst_svd:.1e}");
     assert!(worst_svd <= 1e-14);
 
     // The run: completes, finite, the singularity reported.
     let threshold = 2e-2;
-    let mut watch = SingularityWatch::new(tip(), threshold);
+    let mut watch = SingularityWatch::new(threshold);
     let mut samples: Vec<Sample> = Vec::new();
     let mut sink = |s: &Sample| -> anyhow::Result<()> {
-        watch.observe(&monitor, s.t, &s.x);
+        watch.observe(s.t, monitor.sigma_min(&s.x, &tip()).unwrap());
         samples.push(s.clone());
         Ok(())
     };
@@ -128,6 +135,23 @@ fn f1_dynamic_singularity_is_reported_not_a_nan() {
     assert!(summary.complete);
     assert!(samples.iter().all(|s| s.x.iter().all(|v| v.is_finite())));
     let report = watch.report().expect("the singularity is reported");
+    // The summary reports the smallest σ_min(J*) of the last body's frame, as the watch would.
+    let last = summary
+        .singularity
+        .as_ref()
+        .expect("a free-floating scene of 7 joints");
+    let frame = FrameParams {
+        parent: Some(6),
+        translation: Vec3::zero(),
+        rotation: Mat3::identity(),
+    };
+    let mut own = SingularityWatch::new(threshold);
+    for s in &samples {
+        own.observe(s.t, monitor.sigma_min(&s.x, &frame).unwrap());
+    }
+    eprintln!("summary: {last:?}");
+    assert_eq!((last.sigma_min, last.t), own.min);
+    assert!(last.sigma_min.is_finite() && last.sigma_min > 0.0);
     eprintln!("{report}");
     assert!(watch.min.0 < threshold && watch.min.0 > 0.0);
     let (l, a) = (
@@ -162,9 +186,9 @@ fn f1_dynamic_singularity_is_reported_not_a_nan() {
         samples: samples.clone(),
     };
     let w = worst(&c, &run);
-    let mut watch_c = SingularityWatch::new(tip(), threshold);
+    let mut watch_c = SingularityWatch::new(threshold);
     for (t, x) in &c {
-        watch_c.observe(&monitor, *t, x);
+        watch_c.observe(*t, monitor.sigma_min(x, &tip()).unwrap());
     }
     eprintln!(
         "compiled vs interpreted {w:.1e}; compiled smallest σ_min {:.3e} at t = {}",

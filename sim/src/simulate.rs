@@ -15,6 +15,7 @@ use crate::rosenbrock::rosenbrock;
 use crate::scene::{
     BaseSpec, Drives, Event, EventKind, Integrator, Scene, SceneWrench, SimulationSpec,
 };
+use crate::singularity;
 use anyhow::Result;
 use kanegen_dynamics::algorithms::aba::{self, Workspace};
 use kanegen_dynamics::algorithms::floating::{self, kinetic_energy, momentum};
@@ -360,6 +361,23 @@ impl<'a> SceneSystem<'a> {
     #[must_use]
     pub fn floating_base(&self) -> Option<&FloatingBase<f64>> {
         self.base.as_ref()
+    }
+
+    /// `σ_min(J*)` of `frame` at state `x` ([`singularity::sigma_min`]); `None` on a fixed base
+    /// or with fewer than 6 joints.
+    #[must_use]
+    pub fn sigma_min(&self, x: &[f64], frame: &FrameParams<f64>) -> Option<f64> {
+        let (q, _, st) = self.split(x);
+        singularity::sigma_min(&self.params, self.base.as_ref()?, &st?, q, frame)
+    }
+
+    /// The origin frame of the last body (the frame whose `σ_min(J*)` the summary reports).
+    fn last_body_frame(&self) -> FrameParams<f64> {
+        FrameParams {
+            parent: Some(self.n - 1),
+            translation: Vec3::zero(),
+            rotation: Mat3::identity(),
+        }
     }
 
     /// Adds the armature `I_m,i n_i²` of `[effects] rotor` to the joint diagonal of a mass
@@ -738,6 +756,23 @@ pub struct Summary {
     /// and the jump of kinetic energy.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub events: Vec<EventReport>,
+    /// The smallest `σ_min` of the generalized Jacobian `J*` of the last body's frame over the
+    /// output samples, with its time: how close the run came to a dynamic singularity
+    /// ([`crate::singularity`]). Free-floating scenes with at least 6 joints only (absent from
+    /// the JSON otherwise).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub singularity: Option<SigmaMin>,
+}
+
+/// The smallest `σ_min(J*)` of a run ([`Summary::singularity`]).
+#[derive(Clone, Debug, Serialize)]
+pub struct SigmaMin {
+    /// The body whose origin frame `J*` maps to.
+    pub body: String,
+    /// The smallest `σ_min(J*)` over the output samples (m/rad-mixed units of `J*`).
+    pub sigma_min: f64,
+    /// Its time, s.
+    pub t: f64,
 }
 
 /// One output sample.
@@ -905,11 +940,18 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
     let mut max_p: Option<(f64, f64)> = p0.get().map(|_| (0.0, 0.0));
     let mut sink_error: Option<anyhow::Error> = None;
     let last_t = Cell::new(f64::NAN);
+    let frame = sys.last_body_frame();
+    let mut sigma: Option<(f64, f64)> = None;
     let mut record = |t: f64, x: &[f64]| -> ControlFlow<()> {
         if sink_error.is_some() {
             return ControlFlow::Break(());
         }
         let monitor = monitor.borrow();
+        if let Some(s) = monitor.sigma_min(x, &frame) {
+            if sigma.is_none_or(|(m, _)| s < m) {
+                sigma = Some((s, t));
+            }
+        }
         let energy_drift = e0
             .get()
             .and_then(|e0| monitor.energy(x).map(|e| rel(e - e0, e0)));
@@ -1037,6 +1079,11 @@ pub fn simulate_to(scene: &Scene, sink: &mut dyn Sink, control: Control<'_>) -> 
         t_end,
         stopped,
         events: reports,
+        singularity: sigma.map(|(sigma_min, t)| SigmaMin {
+            body: scene.model.joints()[scene.model.dof() - 1].body.clone(),
+            sigma_min,
+            t,
+        }),
     })
 }
 
@@ -1133,6 +1180,12 @@ pub fn render_text(s: &Summary) -> String {
         s.final_state.q,
         s.final_state.qd,
     ) + &events_text(s)
+        + &s.singularity.as_ref().map_or(String::new(), |m| {
+            format!(
+                "\nsmallest σ_min of J* ({}): {:.3e} at t = {} s",
+                m.body, m.sigma_min, m.t
+            )
+        })
 }
 
 /// One line per payload event of a summary (empty without events).
