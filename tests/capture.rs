@@ -28,15 +28,9 @@ use kanegen::dynamics::linalg::{Mat3, Vec3};
 use kanegen::dynamics::{FrameParams, Methods, Params};
 use kanegen::sim::scene::{Event, EventKind, Scene};
 use kanegen::sim::simulate::{simulate, Run, SceneSystem};
-use std::path::Path;
 
-fn root() -> &'static Path {
-    Path::new(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn load(file: &str) -> Scene {
-    Scene::load(&root().join(file)).unwrap()
-}
+mod common;
+use common::{load, max_abs_diff, root};
 
 fn run(scene: &Scene) -> Run {
     simulate(scene, None).unwrap()
@@ -242,11 +236,7 @@ fn floating_rotor_is_the_armature_model() {
     };
     let run_f = run(&free);
     let (a, b) = (&run_r.summary.final_state.q, &run_f.summary.final_state.q);
-    let diff = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let diff = max_abs_diff(a, b);
     eprintln!("rotor vs none: final q differs by {diff:.2e}");
     assert!(diff > 1e-2);
 }

@@ -15,23 +15,11 @@
 
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, SceneSystem};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn scene(text: &str) -> Scene {
-    Scene::parse(text, &root()).unwrap_or_else(|e| panic!("{e:#}"))
-}
-
-fn scene_err(text: &str) -> String {
-    match Scene::parse(text, &root()) {
-        Ok(_) => panic!("scene accepted:\n{text}"),
-        Err(e) => format!("{e:#}"),
-    }
-}
+mod common;
+use common::{root, scene, scene_err};
 
 /// The fixed-base SSRMS, no gravity, moving, no drives, with `effects`.
 fn ssrms(effects: &str) -> String {
@@ -101,11 +89,7 @@ fn rotor_inertia_conserves_the_energy_with_the_rotor_term() {
         &without.samples.last().unwrap().x,
         &with.samples.last().unwrap().x,
     );
-    let d = a
-        .iter()
-        .zip(b)
-        .map(|(x, y)| (x - y).abs())
-        .fold(0.0, f64::max);
+    let d = common::max_abs_diff(a, b);
     eprintln!("rotor: final state moved by {d:.2e}");
     assert!(d > 1e-2);
 }

@@ -5,7 +5,9 @@
 use kanegen::dynamics::{Loads, Params};
 use kanegen::sim::scene::{Integrator, Scene};
 use kanegen::sim::simulate::{simulate, Run, SceneSystem};
-use std::path::PathBuf;
+
+mod common;
+use common::{load, max_abs_diff, root, scene, scene_err, worst};
 
 kanegen::scene!(SsrmsFlexible, "scenes/ssrms_flexible.toml");
 kanegen::scene!(FlexK1e3, "tests/data/scenes/flex_k1e3.toml");
@@ -15,52 +17,9 @@ kanegen::scene!(FlexK1e6, "tests/data/scenes/flex_k1e6.toml");
 kanegen::scene!(FlexK1e7, "tests/data/scenes/flex_k1e7.toml");
 kanegen::scene!(FlexK1e8, "tests/data/scenes/flex_k1e8.toml");
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
-}
-
-fn load(file: &str) -> Scene {
-    Scene::load(&root().join(file)).unwrap_or_else(|e| panic!("{e:#}"))
-}
-
-fn scene(text: &str) -> Scene {
-    Scene::parse(text, &root()).unwrap_or_else(|e| panic!("{e:#}"))
-}
-
-fn scene_err(text: &str) -> String {
-    match Scene::parse(text, &root()) {
-        Ok(_) => panic!("scene accepted:\n{text}"),
-        Err(e) => format!("{e:#}"),
-    }
-}
-
 fn final_state(s: &Scene) -> (Vec<f64>, Run) {
     let run = simulate(s, None).unwrap_or_else(|e| panic!("{e:#}"));
     (run.samples.last().unwrap().x.clone(), run)
-}
-
-fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
-    a.iter()
-        .zip(b)
-        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
-}
-
-/// Worst `|x_c − x_i| / (1 + |x_i|)` over the samples of a compiled and an interpreted run,
-/// after checking they sample at the same times.
-fn worst<const D: usize>(name: &str, c: &[(f64, [f64; D])], i: &Run) -> f64 {
-    assert_eq!(c.len(), i.samples.len(), "{name}: number of samples");
-    let mut w: f64 = 0.0;
-    for ((tc, xc), s) in c.iter().zip(&i.samples) {
-        assert!(
-            (tc - s.t).abs() <= 1e-12 * (1.0 + s.t),
-            "{name}: t {tc} vs {}",
-            s.t
-        );
-        for (a, b) in xc.iter().zip(&s.x) {
-            w = w.max((a - b).abs() / (1.0 + b.abs()));
-        }
-    }
-    w
 }
 
 /// Bad `[effects] flexible` values and combinations are errors naming the key.

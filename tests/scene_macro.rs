@@ -43,6 +43,8 @@ use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, Run};
 use std::path::Path;
 
+mod common;
+
 kanegen::scene!(SsrmsEffects, "scenes/ssrms_effects.toml");
 kanegen::scene!(SsrmsPayload, "scenes/ssrms_payload_fixed.toml");
 kanegen::scene!(Srms, "scenes/srms.toml");
@@ -80,21 +82,9 @@ fn compiled<const D: usize>(
     out
 }
 
-/// Worst `|x_c − x_i| / (1 + |x_i|)` over the samples, after checking the sample times agree.
+/// Worst `|x_c − x_i| / (1 + |x_i|)` over the samples ([`common::worst`]), printed.
 fn worst<const D: usize>(name: &str, c: &[(f64, [f64; D])], i: &Run) -> f64 {
-    assert_eq!(c.len(), i.samples.len(), "{name}: number of samples");
-    let mut w: f64 = 0.0;
-    for ((tc, xc), s) in c.iter().zip(&i.samples) {
-        assert!(
-            (tc - s.t).abs() <= 1e-12 * (1.0 + s.t),
-            "{name}: t {tc} vs {}",
-            s.t
-        );
-        assert_eq!(s.x.len(), D);
-        for (a, b) in xc.iter().zip(&s.x) {
-            w = w.max((a - b).abs() / (1.0 + b.abs()));
-        }
-    }
+    let w = common::worst(name, c, i);
     eprintln!(
         "{name}: {} samples, worst relative difference {w:.2e}",
         c.len()

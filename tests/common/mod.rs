@@ -1,0 +1,57 @@
+//! Helpers shared by the scene tests (`mod common;`): the project root, scene files and texts,
+//! and the comparison of a compiled run (`kanegen::scene!`) with an interpreted one.
+// Each test crate uses some of them.
+#![allow(dead_code)]
+
+use kanegen::sim::scene::Scene;
+use kanegen::sim::simulate::Run;
+use std::path::PathBuf;
+
+/// The project root.
+pub fn root() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+}
+
+/// The scene file `file` (relative to the root).
+pub fn load(file: &str) -> Scene {
+    Scene::load(&root().join(file)).unwrap_or_else(|e| panic!("{file}: {e:#}"))
+}
+
+/// A scene from its text (paths relative to the root).
+pub fn scene(text: &str) -> Scene {
+    Scene::parse(text, &root()).unwrap_or_else(|e| panic!("{e:#}"))
+}
+
+/// The error a scene text gives (panics when it is accepted).
+pub fn scene_err(text: &str) -> String {
+    match Scene::parse(text, &root()) {
+        Ok(_) => panic!("scene accepted:\n{text}"),
+        Err(e) => format!("{e:#}"),
+    }
+}
+
+/// `max |a_i − b_i|`.
+pub fn max_abs_diff(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .fold(0.0_f64, |m, (x, y)| m.max((x - y).abs()))
+}
+
+/// Worst `|x_c − x_i| / (1 + |x_i|)` over the samples of a compiled (`c`) and an interpreted
+/// (`i`) run, after checking they sample at the same times.
+pub fn worst<const D: usize>(name: &str, c: &[(f64, [f64; D])], i: &Run) -> f64 {
+    assert_eq!(c.len(), i.samples.len(), "{name}: number of samples");
+    let mut w: f64 = 0.0;
+    for ((tc, xc), s) in c.iter().zip(&i.samples) {
+        assert!(
+            (tc - s.t).abs() <= 1e-12 * (1.0 + s.t),
+            "{name}: t {tc} vs {}",
+            s.t
+        );
+        assert_eq!(s.x.len(), D, "{name}: state length");
+        for (a, b) in xc.iter().zip(&s.x) {
+            w = w.max((a - b).abs() / (1.0 + b.abs()));
+        }
+    }
+    w
+}
