@@ -306,16 +306,7 @@ fn bad_events_are_errors_naming_the_key() {
 }
 
 fn count_json(scene: &str) -> serde_json::Value {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
-        .args(["count", "--json", "--algorithm", "recurrent", scene])
-        .current_dir(root())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::kanegen(&["count", "--json", "--algorithm", "recurrent", scene]);
     serde_json::from_slice(&out.stdout).unwrap()
 }
 

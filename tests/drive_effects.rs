@@ -16,10 +16,9 @@
 use kanegen::sim::scene::Scene;
 use kanegen::sim::simulate::{simulate, SceneSystem};
 use std::path::Path;
-use std::process::Command;
 
 mod common;
-use common::{root, scene, scene_err};
+use common::{kanegen, root, scene, scene_err};
 
 /// The fixed-base SSRMS, no gravity, moving, no drives, with `effects`.
 fn ssrms(effects: &str) -> String {
@@ -117,20 +116,6 @@ fn friction_dissipates_at_every_sample() {
     let e = energies(&s);
     assert!(e.windows(2).all(|w| w[1] <= w[0] + 1e-12 * e[0]));
     assert!(*e.last().unwrap() < 0.9 * e[0]);
-}
-
-fn kanegen(args: &[&str]) -> std::process::Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_kanegen"))
-        .args(args)
-        .current_dir(root())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
 }
 
 /// The numbers of a trajectory CSV (header skipped).

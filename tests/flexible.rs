@@ -7,7 +7,7 @@ use kanegen::sim::scene::{Integrator, Scene};
 use kanegen::sim::simulate::{simulate, Run, SceneSystem};
 
 mod common;
-use common::{load, max_abs_diff, root, scene, scene_err, worst};
+use common::{load, max_abs_diff, scene, scene_err, worst};
 
 kanegen::scene!(SsrmsFlexible, "scenes/ssrms_flexible.toml");
 kanegen::scene!(FlexK1e3, "tests/data/scenes/flex_k1e3.toml");
@@ -297,16 +297,7 @@ output_every = 100
 /// (`tests/drive_effects.rs::scenes_without_the_effects_are_unchanged`).
 #[test]
 fn count_lists_flexible() {
-    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
-        .args(["count", "scenes/ssrms_flexible.toml", "--json"])
-        .current_dir(root())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let out = common::kanegen(&["count", "scenes/ssrms_flexible.toml", "--json"]);
     let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
     let lines: Vec<_> = v["effects"]
         .as_array()

@@ -1,5 +1,5 @@
 //! Helpers shared by the scene tests (`mod common;`): the project root, scene files and texts,
-//! and the comparison of a compiled run (`kanegen::scene!`) with an interpreted one.
+//! the binary, and the comparison of a compiled run (`kanegen::scene!`) with an interpreted one.
 // Each test crate uses some of them.
 #![allow(dead_code)]
 
@@ -28,6 +28,22 @@ pub fn scene_err(text: &str) -> String {
         Ok(_) => panic!("scene accepted:\n{text}"),
         Err(e) => format!("{e:#}"),
     }
+}
+
+/// Runs the `kanegen` binary with `args` in the project root and returns its output, after
+/// checking it succeeded (its stderr is the failure message).
+pub fn kanegen(args: &[&str]) -> std::process::Output {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_kanegen"))
+        .args(args)
+        .current_dir(root())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
 }
 
 /// `max |a_i − b_i|`.
