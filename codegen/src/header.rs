@@ -157,23 +157,26 @@ pub fn lines(
         String::new(),
         "Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward \
          dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which \
-         uses neither):"
+         uses neither; frames: the model's own body frames, or its canonical ones, every joint \
+         axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):"
             .into(),
         String::new(),
-        "| function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |"
+        "| function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |"
             .into(),
-        "|---|---|---|---|---:|---:|---:|---:|---:|---:|".into(),
+        "|---|---|---|---|---|---:|---:|---:|---:|---:|---:|".into(),
     ]);
     for ch in choices {
-        for (m, c) in &ch.candidates {
-            let star = if *m == ch.chosen { " *" } else { "" };
+        for cand in &ch.candidates {
+            let (m, c) = (&cand.methods, &cand.counts);
+            let star = if ch.is_chosen(cand) { " *" } else { "" };
             let name = |x: Option<&str>| x.map_or_else(|| "—".to_string(), |x| format!("`{x}`"));
             h.push(format!(
-                "| `{}`{star} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| `{}`{star} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 crate::api::fn_name(ch.function, model),
                 name(ch.mass_matrix_method(*m)),
                 name(ch.bias_method(*m)),
                 name(ch.forward_method(*m)),
+                cand.frames.name(),
                 c.mul,
                 c.add,
                 c.div,

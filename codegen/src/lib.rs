@@ -271,7 +271,8 @@ fn generate_items_with(
         choices.push(choice);
     }
 
-    let entry = |ch: &Choice, m: kanegen_dynamics::Methods, c: kanegen_trace::Counts, fma: u64| {
+    let entry = |ch: &Choice, cand: &choose::Candidate, fma: u64| {
+        let (m, c, frames) = (cand.methods, cand.counts, cand.frames.name());
         let function = api::fn_name(ch.function, model);
         let opt = |x: Option<&str>| match x {
             Some(s) => quote!(Some(#s)),
@@ -288,6 +289,7 @@ fn generate_items_with(
             mass_matrix_method: #mm,
             bias_method: #bm,
             forward_method: #fm,
+            frames: #frames,
             mul: #mul,
             add: #add,
             div: #div,
@@ -296,13 +298,17 @@ fn generate_items_with(
             fma: #fma,
         })
     };
-    let emitted = choices
-        .iter()
-        .zip(&fmas)
-        .map(|(ch, k)| entry(ch, ch.chosen, ch.counts(), *k));
+    let emitted = choices.iter().zip(&fmas).map(|(ch, k)| {
+        let chosen = ch
+            .candidates
+            .iter()
+            .find(|c| ch.is_chosen(c))
+            .expect("the chosen candidate was traced");
+        entry(ch, chosen, *k)
+    });
     let all = choices
         .iter()
-        .flat_map(|ch| ch.candidates.iter().map(|(m, c)| entry(ch, *m, *c, 0)));
+        .flat_map(|ch| ch.candidates.iter().map(|c| entry(ch, c, 0)));
     let n_fns = Literal::usize_unsuffixed(choices.len());
 
     let mut header = header::lines(model, opts, &choices, &fmas, &snapped.report);
@@ -387,6 +393,9 @@ fn generate_items_with(
             /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
             /// the articulated-body algorithm, which uses neither), for forward dynamics.
             pub forward_method: Option<&'static str>,
+            /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
+            /// joint axis z, modified-DH x; the same joint-space results).
+            pub frames: &'static str,
             /// Multiplications.
             pub mul: u64,
             /// Additions and subtractions.
@@ -764,7 +773,7 @@ mod tests {
                     "{} (N = {n})",
                     ch.function.name()
                 );
-                let best = ch.candidates.iter().map(|(_, c)| c.total()).min();
+                let best = ch.candidates.iter().map(|c| c.counts.total()).min();
                 assert_eq!(Some(want.total()), best);
             }
         }

@@ -61,6 +61,9 @@ pub struct Options {
     /// `rpy = 1.570796325` (4.9e-12) and changes the robot by that much. The header says what
     /// was snapped.
     pub snap: f64,
+    /// Trace the joint-space functions in the model's canonical frames too
+    /// ([`crate::choose::BodyFrames`]) and emit whichever is cheaper. Default `true`.
+    pub canonical: bool,
     /// Force one algorithm for every function that has a mass-matrix, bias or forward method
     /// instead of the cheapest candidate: a preset of [`Methods::PRESETS`] (`recurrent`, the
     /// paper's; `recurrent-r1`, `kane-direct`, `crba-base`, `spatial`) or [`Methods::ABA`]
@@ -197,6 +200,7 @@ impl Options {
             target_fma: true,
             regroup: true,
             snap: kanegen_model::canonical::DEFAULT_SNAP,
+            canonical: true,
             algorithm: None,
             form: Form::Auto,
         }

@@ -14,6 +14,15 @@ use kanegen_model::JointKind;
 
 /// `Xup_j = XJ(q_j) Xtree_j` (RBDA §4.4; spatial_v2 `jcalc` and `Xtree`).
 pub fn xup<S: Scalar>(jp: &JointParams<S>, q: &S) -> Xform<S> {
+    xup_trig(jp, q).0
+}
+
+/// `Xup_j` with `(sin q_j, cos q_j)` for a revolute joint (`None` for a prismatic one).
+pub type XupTrig<S> = (Xform<S>, Option<(S, S)>);
+
+/// [`xup`], and `(sin q_j, cos q_j)` for a revolute joint (`None` for a prismatic one), for
+/// callers that use them again ([`carry_inertia`]) without a second `sin_cos`.
+pub fn xup_trig<S: Scalar>(jp: &JointParams<S>, q: &S) -> XupTrig<S> {
     match jp.kind {
         JointKind::Revolute => {
             let (s, c) = q.clone().sin_cos();
@@ -22,13 +31,44 @@ pub fn xup<S: Scalar>(jp: &JointParams<S>, q: &S) -> Xform<S> {
                 .upsilon
                 .mul_mat(&axis_rotation(&jp.axis, &s, &c))
                 .transpose();
-            Xform { e, r: jp.l.clone() }
+            (Xform { e, r: jp.l.clone() }, Some((s, c)))
         }
         // E = Υᵀ, r = l + Υ (q axis).
-        JointKind::Prismatic => Xform {
-            e: jp.upsilon.transpose(),
-            r: &jp.l + &jp.upsilon.mul_vec(&jp.axis.scale(q)),
-        },
+        JointKind::Prismatic => (
+            Xform {
+                e: jp.upsilon.transpose(),
+                r: &jp.l + &jp.upsilon.mul_vec(&jp.axis.scale(q)),
+            },
+            None,
+        ),
+    }
+}
+
+/// `Xup_jᵀ I Xup_j`: the inertia `i` of body `j` (its frame) carried to its parent's frame
+/// (RBDA Table 2.5, the backward loop of Table 6.2). `(x, trig)` is [`xup_trig`] of `q_j`. A
+/// revolute joint about
+/// a coordinate axis ([`JointParams::coordinate_axis`]) placed by a signed permutation
+/// ([`JointParams::placement_permutation`]) goes in two steps, `Xtreeᵀ (XJᵀ I XJ) Xtree`: the
+/// joint's own turn in double-angle form ([`RbInertia::turned_about_axis`], sharing `q`'s sine
+/// and cosine with `x`), then the placement, which only permutes axes; any other joint through
+/// `x` at once (measured: after a dense placement the two steps cost more, as the products of
+/// the double-angle terms with the placement's numbers are not shared).
+pub fn carry_inertia<S: Scalar>(
+    jp: &JointParams<S>,
+    (x, trig): &XupTrig<S>,
+    i: &RbInertia<S>,
+) -> RbInertia<S> {
+    match (trig, jp.coordinate_axis) {
+        (Some((s, c)), Some(k)) if jp.placement_permutation => {
+            // The axis is ±e_k exactly: s·u_k is ±s.
+            let turned = i.turned_about_axis(k, &(s.clone() * jp.axis.at(k)), c);
+            let tree = Xform {
+                e: jp.upsilon.transpose(),
+                r: jp.l.clone(),
+            };
+            tree.tr_inertia(&turned)
+        }
+        _ => x.tr_inertia(i),
     }
 }
 

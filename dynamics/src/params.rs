@@ -26,6 +26,10 @@ pub struct JointParams<S> {
     /// `kind`: [`crate::algorithms::aba`] then writes the exact zeros of `I^a_j S_j = 0` instead
     /// of computing round-off); `None` for any other axis or a symbolic one.
     pub coordinate_axis: Option<usize>,
+    /// Whether `upsilon` is exactly a signed permutation (model structure, like `kind`): the
+    /// joint placement then turns nothing but axes, and [`crate::joint::carry_inertia`] carries
+    /// inertias through the joint in two steps; `false` for any other rotation or a symbolic one.
+    pub placement_permutation: bool,
     /// `m_j`.
     pub mass: S,
     /// `d^{(j)}_j`: centre of mass in the body frame.
@@ -46,6 +50,15 @@ impl<S: Scalar> JointParams<S> {
         self.com = com;
         self.inertia_com = inertia_com;
     }
+}
+
+/// Whether every row of `r` has exactly one non-zero entry, and it is ±1.
+#[must_use]
+pub fn is_signed_permutation(r: &[[f64; 3]; 3]) -> bool {
+    r.iter().all(|row| {
+        row.iter().filter(|x| **x != 0.0).count() == 1
+            && row.iter().all(|x| [0.0, 1.0, -1.0].contains(x))
+    })
 }
 
 /// `Some(k)` when `axis` is `±e_k`: exactly one non-zero component.
@@ -99,6 +112,7 @@ impl<S: Scalar> Params<S> {
                         upsilon: Mat3::from_f64(j.origin.rotation),
                         axis: Vec3::from_f64(j.axis),
                         coordinate_axis: coordinate_axis(j.axis),
+                        placement_permutation: is_signed_permutation(&j.origin.rotation),
                         inertia: RbInertia::from_com(&mass, &com, &inertia_com),
                         mass,
                         com,

@@ -148,6 +148,55 @@ impl<S: Scalar> Xform<S> {
     }
 }
 
+impl<S: Scalar> RbInertia<S> {
+    /// `(m, Θ h, Θ Ī Θᵀ)`: the inertia turned by `Θ`, the rotation by the angle whose sine and
+    /// cosine are `s` and `c` about the coordinate axis `e_k` (RBDA Table 2.5 with `E = Θᵀ`,
+    /// `r = 0`; `−e_k` is `e_k` with `−s`). The axes `(a, b) = (k + 1, k + 2) mod 3` turn; the
+    /// planar block of `Ī` is written in double-angle form, as in Khalil and Kleinfinger's
+    /// customized symbolic models: with `u = s²`, `w = c s`, `d = Ī_aa − Ī_bb`, `e = 2 Ī_ab` and
+    /// `t = u d + w e`, `Ī'_aa = Ī_aa − t`, `Ī'_bb = Ī_bb + t` and `Ī'_ab = Ī_ab + w d − u e`
+    /// (by `c² = 1 − u`): four products where the congruence `Θ Ī Θᵀ` takes twelve, and none
+    /// when the block is isotropic (`d = e = 0`), where the congruence still computes
+    /// `k c² + k s²`.
+    #[must_use]
+    pub fn turned_about_axis(&self, k: usize, s: &S, c: &S) -> RbInertia<S> {
+        let (a, b) = ((k + 1) % 3, (k + 2) % 3);
+        let i = &self.ibar;
+        // A vector's turned components: (c x_a − s x_b, s x_a + c x_b).
+        let turn = |xa: S, xb: S| {
+            (
+                c.clone() * xa.clone() - s.clone() * xb.clone(),
+                s.clone() * xa + c.clone() * xb,
+            )
+        };
+        let u = s.clone() * s.clone();
+        let w = c.clone() * s.clone();
+        let d = i.at(a, a) - i.at(b, b);
+        let e = i.at(a, b) + i.at(a, b);
+        let t = u.clone() * d.clone() + w.clone() * e.clone();
+        let mut ibar = i.clone();
+        ibar.0[a][a] = i.at(a, a) - t.clone();
+        ibar.0[b][b] = i.at(b, b) + t;
+        let ab = i.at(a, b) + (w * d - u * e);
+        ibar.0[a][b] = ab.clone();
+        ibar.0[b][a] = ab;
+        let (ak, bk) = turn(i.at(a, k), i.at(b, k));
+        ibar.0[a][k] = ak.clone();
+        ibar.0[k][a] = ak;
+        ibar.0[b][k] = bk.clone();
+        ibar.0[k][b] = bk;
+        let mut h = self.h.clone();
+        let (ha, hb) = turn(self.h.at(a), self.h.at(b));
+        h.0[a] = ha;
+        h.0[b] = hb;
+        RbInertia {
+            m: self.m.clone(),
+            h,
+            ibar,
+        }
+    }
+}
+
 /// A rigid-body spatial inertia about the frame origin: mass `m`, first moment `h = m c` and
 /// rotational inertia `Ī` about the origin (RBDA eq. (2.63)).
 #[derive(Clone, Debug)]
@@ -199,6 +248,48 @@ impl<S: Scalar> core::ops::Add for RbInertia<S> {
             m: self.m + o.m,
             h: self.h + o.h,
             ibar: self.ibar + o.ibar,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::linalg::axis_rotation;
+
+    /// The double-angle turn equals the congruence it replaces, about every coordinate axis and
+    /// both signs, on a general inertia (all products of inertia non-zero).
+    #[test]
+    fn turned_about_axis_is_the_congruence() {
+        let i = RbInertia {
+            m: 3.7,
+            h: Vec3::new(0.4, -1.1, 0.9),
+            ibar: Mat3([[2.0, 0.3, -0.7], [0.3, 1.4, 0.25], [-0.7, 0.25, 3.1]]),
+        };
+        for k in 0..3 {
+            for sign in [1.0, -1.0] {
+                for q in [0.0, 0.3, -2.2, 3.0] {
+                    let (s, c) = f64::sin_cos(q);
+                    let mut u = Vec3::zero();
+                    u.0[k] = sign;
+                    let theta = axis_rotation(&u, &s, &c);
+                    // (m, Θ h, Θ Ī Θᵀ) is Xᵀ I X with E = Θᵀ, r = 0.
+                    let want = Xform {
+                        e: theta.transpose(),
+                        r: Vec3::zero(),
+                    }
+                    .tr_inertia(&i);
+                    let have = i.turned_about_axis(k, &(sign * s), &c);
+                    for r in 0..3 {
+                        assert!((have.h.at(r) - want.h.at(r)).abs() < 1e-14, "k {k} q {q}");
+                        for col in 0..3 {
+                            let (a, b) = (have.ibar.at(r, col), want.ibar.at(r, col));
+                            assert!((a - b).abs() < 1e-14, "k {k} sign {sign} q {q}: {a} {b}");
+                        }
+                    }
+                    assert_eq!(have.m, i.m);
+                }
+            }
         }
     }
 }

@@ -686,6 +686,7 @@ fn floating_dynamics_traces_on_sym() {
                             upsilon: Mat3(j.upsilon.0.map(|r| r.map(Sym::constant))),
                             axis: Vec3(j.axis.0.map(Sym::constant)),
                             coordinate_axis: j.coordinate_axis,
+                            placement_permutation: j.placement_permutation,
                             inertia: kanegen_dynamics::spatial::RbInertia::from_com(
                                 &mass,
                                 &com,

@@ -9,45 +9,67 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 4366 (`mass_matrix` 379, `nonlinear_effects` 323, `inverse_dynamics` 338, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 700, `forward_dynamics_with_wrenches` 987, `momentum` 221, `base_reaction` 432), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4304 (`mass_matrix` 348, `nonlinear_effects` 323, `inverse_dynamics` 338, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 669, `forward_dynamics_with_wrenches` 987, `momentum` 221, `base_reaction` 432), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | — | 1828 | 2486 | 0 | 0 | 7 | 4314 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | 2107 | 2555 | 0 | 0 | 7 | 4662 |
-//! | `mass_matrix` | `kane-direct` | — | — | 3457 | 2893 | 0 | 0 | 7 | 6350 |
-//! | `mass_matrix` | `crba-base` | — | — | 1306 | 1037 | 0 | 0 | 7 | 2343 |
-//! | `mass_matrix` * | `crba` | — | — | 648 | 541 | 0 | 0 | 7 | 1189 |
-//! | `nonlinear_effects` | — | `recurrent` | — | 1150 | 881 | 0 | 0 | 7 | 2031 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | 1567 | 1276 | 0 | 0 | 7 | 2843 |
-//! | `nonlinear_effects` | — | `rnea` | — | 635 | 502 | 0 | 0 | 7 | 1137 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | 532 | 428 | 0 | 0 | 7 | 960 |
-//! | `inverse_dynamics` | — | `recurrent` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `rnea` | — | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | 547 | 458 | 0 | 0 | 7 | 1005 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 2298 | 1861 | 10 | 0 | 7 | 4159 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 2715 | 2256 | 10 | 0 | 7 | 4971 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 1773 | 1480 | 10 | 0 | 7 | 3253 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | 1670 | 1406 | 10 | 0 | 7 | 3076 |
-//! | `forward_dynamics` * | — | — | `aba` | 1613 | 1277 | 12 | 0 | 7 | 2890 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 1798 | 1422 | 0 | 0 | 7 | 3220 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 2215 | 1817 | 0 | 0 | 7 | 4032 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 1273 | 1041 | 0 | 0 | 7 | 2314 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 1170 | 967 | 0 | 0 | 7 | 2137 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 2442 | 2005 | 10 | 0 | 7 | 4447 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 2859 | 2400 | 10 | 0 | 7 | 5259 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 1773 | 1528 | 10 | 0 | 7 | 3301 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | 1670 | 1454 | 10 | 0 | 7 | 3124 |
-//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | 1613 | 1325 | 12 | 0 | 7 | 2938 |
-//! | `momentum` * | — | — | — | 354 | 283 | 0 | 0 | 7 | 637 |
-//! | `base_reaction` * | — | `recurrent` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
-//! | `base_reaction` | — | `kane-direct` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
-//! | `base_reaction` | — | `rnea` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
-//! | `base_reaction` | — | `newton-euler` | — | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | model | 1828 | 2486 | 0 | 0 | 7 | 4314 |
+//! | `mass_matrix` | `recurrent` | — | — | canonical | 1843 | 2501 | 0 | 0 | 7 | 4344 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | model | 2107 | 2555 | 0 | 0 | 7 | 4662 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 2122 | 2570 | 0 | 0 | 7 | 4692 |
+//! | `mass_matrix` | `kane-direct` | — | — | model | 3457 | 2893 | 0 | 0 | 7 | 6350 |
+//! | `mass_matrix` | `kane-direct` | — | — | canonical | 3472 | 2908 | 0 | 0 | 7 | 6380 |
+//! | `mass_matrix` | `crba-base` | — | — | model | 1306 | 1037 | 0 | 0 | 7 | 2343 |
+//! | `mass_matrix` | `crba-base` | — | — | canonical | 1321 | 1052 | 0 | 0 | 7 | 2373 |
+//! | `mass_matrix` * | `crba` | — | — | model | 598 | 517 | 0 | 0 | 7 | 1115 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 604 | 529 | 0 | 0 | 7 | 1133 |
+//! | `nonlinear_effects` | — | `recurrent` | — | model | 1150 | 881 | 0 | 0 | 7 | 2031 |
+//! | `nonlinear_effects` | — | `recurrent` | — | canonical | 1165 | 896 | 0 | 0 | 7 | 2061 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | model | 1567 | 1276 | 0 | 0 | 7 | 2843 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 1582 | 1291 | 0 | 0 | 7 | 2873 |
+//! | `nonlinear_effects` | — | `rnea` | — | model | 635 | 502 | 0 | 0 | 7 | 1137 |
+//! | `nonlinear_effects` | — | `rnea` | — | canonical | 635 | 502 | 0 | 0 | 7 | 1137 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 532 | 428 | 0 | 0 | 7 | 960 |
+//! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 532 | 428 | 0 | 0 | 7 | 960 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `rnea` | — | model | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` | — | `rnea` | — | canonical | 674 | 548 | 0 | 0 | 7 | 1222 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | model | 547 | 458 | 0 | 0 | 7 | 1005 |
+//! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 547 | 458 | 0 | 0 | 7 | 1005 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2248 | 1837 | 10 | 0 | 7 | 4085 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2280 | 1865 | 10 | 0 | 7 | 4145 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2665 | 2232 | 10 | 0 | 7 | 4897 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2697 | 2260 | 10 | 0 | 7 | 4957 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1723 | 1456 | 10 | 0 | 7 | 3179 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1740 | 1469 | 10 | 0 | 7 | 3209 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1620 | 1382 | 10 | 0 | 7 | 3002 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1637 | 1395 | 10 | 0 | 7 | 3032 |
+//! | `forward_dynamics` * | — | — | `aba` | model | 1613 | 1277 | 12 | 0 | 7 | 2890 |
+//! | `forward_dynamics` | — | — | `aba` | canonical | 1615 | 1280 | 12 | 0 | 7 | 2895 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1748 | 1398 | 0 | 0 | 7 | 3146 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1769 | 1425 | 0 | 0 | 7 | 3194 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2165 | 1793 | 0 | 0 | 7 | 3958 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2186 | 1820 | 0 | 0 | 7 | 4006 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1223 | 1017 | 0 | 0 | 7 | 2240 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1229 | 1029 | 0 | 0 | 7 | 2258 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1120 | 943 | 0 | 0 | 7 | 2063 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1126 | 955 | 0 | 0 | 7 | 2081 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2392 | 1981 | 10 | 0 | 7 | 4373 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2809 | 2376 | 10 | 0 | 7 | 5185 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1723 | 1504 | 10 | 0 | 7 | 3227 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | model | 1620 | 1430 | 10 | 0 | 7 | 3050 |
+//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | model | 1613 | 1325 | 12 | 0 | 7 | 2938 |
+//! | `momentum` * | — | — | — | model | 354 | 283 | 0 | 0 | 7 | 637 |
+//! | `base_reaction` * | — | `recurrent` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `kane-direct` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `rnea` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `base_reaction` | — | `newton-euler` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -63,6 +85,9 @@ pub struct OpCount {
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
+    /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
+    /// joint axis z, modified-DH x; the same joint-space results).
+    pub frames: &'static str,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -114,18 +139,20 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 648u64,
-            add: 541u64,
+            frames: "model",
+            mul: 598u64,
+            add: 517u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 379u64,
+            fma: 348u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 532u64,
             add: 428u64,
             div: 0u64,
@@ -138,6 +165,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 547u64,
             add: 458u64,
             div: 0u64,
@@ -150,6 +178,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 1613u64,
             add: 1277u64,
             div: 12u64,
@@ -162,18 +191,20 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 1170u64,
-            add: 967u64,
+            frames: "model",
+            mul: 1120u64,
+            add: 943u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 700u64,
+            fma: 669u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 1613u64,
             add: 1325u64,
             div: 12u64,
@@ -186,6 +217,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 354u64,
             add: 283u64,
             div: 0u64,
@@ -198,6 +230,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 692u64,
             add: 566u64,
             div: 0u64,
@@ -213,8 +246,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 1828u64,
             add: 2486u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 1843u64,
+            add: 2501u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -225,8 +272,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 2107u64,
             add: 2555u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 2122u64,
+            add: 2570u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -237,8 +298,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 3457u64,
             add: 2893u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 3472u64,
+            add: 2908u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -249,8 +324,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 1306u64,
             add: 1037u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 1321u64,
+            add: 1052u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -261,8 +350,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 648u64,
-            add: 541u64,
+            frames: "model",
+            mul: 598u64,
+            add: 517u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 604u64,
+            add: 529u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -273,6 +376,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 1150u64,
             add: 881u64,
             div: 0u64,
@@ -283,8 +387,22 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1165u64,
+            add: 896u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
+            frames: "model",
             mul: 1567u64,
             add: 1276u64,
             div: 0u64,
@@ -295,8 +413,35 @@ impl FreeFloating7 {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1582u64,
+            add: 1291u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
+            mul: 635u64,
+            add: 502u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
             mul: 635u64,
             add: 502u64,
             div: 0u64,
@@ -309,6 +454,20 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
+            mul: 532u64,
+            add: 428u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
             mul: 532u64,
             add: 428u64,
             div: 0u64,
@@ -321,6 +480,20 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
+            mul: 674u64,
+            add: 548u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
             mul: 674u64,
             add: 548u64,
             div: 0u64,
@@ -333,6 +506,20 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
+            frames: "model",
+            mul: 674u64,
+            add: 548u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
             mul: 674u64,
             add: 548u64,
             div: 0u64,
@@ -345,6 +532,20 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
+            mul: 674u64,
+            add: 548u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
             mul: 674u64,
             add: 548u64,
             div: 0u64,
@@ -357,6 +558,20 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
+            mul: 547u64,
+            add: 458u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
             mul: 547u64,
             add: 458u64,
             div: 0u64,
@@ -369,8 +584,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 2298u64,
-            add: 1861u64,
+            frames: "model",
+            mul: 2248u64,
+            add: 1837u64,
+            div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 2280u64,
+            add: 1865u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -381,8 +610,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 2715u64,
-            add: 2256u64,
+            frames: "model",
+            mul: 2665u64,
+            add: 2232u64,
+            div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 2697u64,
+            add: 2260u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -393,8 +636,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 1773u64,
-            add: 1480u64,
+            frames: "model",
+            mul: 1723u64,
+            add: 1456u64,
+            div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 1740u64,
+            add: 1469u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -405,8 +662,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 1670u64,
-            add: 1406u64,
+            frames: "model",
+            mul: 1620u64,
+            add: 1382u64,
+            div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 1637u64,
+            add: 1395u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -417,8 +688,22 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 1613u64,
             add: 1277u64,
+            div: 12u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            frames: "canonical",
+            mul: 1615u64,
+            add: 1280u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -429,8 +714,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 1798u64,
-            add: 1422u64,
+            frames: "model",
+            mul: 1748u64,
+            add: 1398u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1769u64,
+            add: 1425u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -441,8 +740,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 2215u64,
-            add: 1817u64,
+            frames: "model",
+            mul: 2165u64,
+            add: 1793u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 2186u64,
+            add: 1820u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -453,8 +766,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 1273u64,
-            add: 1041u64,
+            frames: "model",
+            mul: 1223u64,
+            add: 1017u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1229u64,
+            add: 1029u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -465,8 +792,22 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 1170u64,
-            add: 967u64,
+            frames: "model",
+            mul: 1120u64,
+            add: 943u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1126u64,
+            add: 955u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -477,8 +818,9 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 2442u64,
-            add: 2005u64,
+            frames: "model",
+            mul: 2392u64,
+            add: 1981u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -489,8 +831,9 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 2859u64,
-            add: 2400u64,
+            frames: "model",
+            mul: 2809u64,
+            add: 2376u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -501,8 +844,9 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 1773u64,
-            add: 1528u64,
+            frames: "model",
+            mul: 1723u64,
+            add: 1504u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -513,8 +857,9 @@ impl FreeFloating7 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 1670u64,
-            add: 1454u64,
+            frames: "model",
+            mul: 1620u64,
+            add: 1430u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -525,6 +870,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 1613u64,
             add: 1325u64,
             div: 12u64,
@@ -537,6 +883,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 354u64,
             add: 283u64,
             div: 0u64,
@@ -549,6 +896,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 692u64,
             add: 566u64,
             div: 0u64,
@@ -561,6 +909,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
+            frames: "model",
             mul: 692u64,
             add: 566u64,
             div: 0u64,
@@ -573,6 +922,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
             mul: 692u64,
             add: 566u64,
             div: 0u64,
@@ -585,6 +935,7 @@ impl FreeFloating7 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 692u64,
             add: 566u64,
             div: 0u64,
@@ -595,7 +946,7 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 648 mul, 541 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 379 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 598 mul, 517 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 348 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
@@ -700,24 +1051,27 @@ impl FreeFloating7 {
         let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
         let x58 = Self::mul_add(
             -0.00000000020510342851533115,
-            x43,
-            -Self::mul_add(c_q12, x40, s_q12 * x34),
-        );
-        let x59 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x44,
-            -Self::mul_add(c_q12, x41, s_q12 * x38),
-        );
-        let x60 = Self::mul_add(
-            -0.00000000020510342851533115,
             x45,
             -Self::mul_add(c_q12, x42, s_q12 * x39),
         );
-        let x61 = x54 + Self::mul_add(x11, x53, x10 * x52);
-        let x62 = Self::mul_add(-s_q12, x56, c_q12 * x55);
-        let x63 = x51 * 0.36;
-        let x64 = -0.36 * x51;
-        let x65 = Self::mul_add(
+        let x59 = x54 + Self::mul_add(x11, x53, x10 * x52);
+        let x60 = Self::mul_add(
+            c_q12,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x44,
+                -Self::mul_add(c_q12, x41, s_q12 * x38),
+            ),
+            s_q12
+                * Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x43,
+                    -Self::mul_add(c_q12, x40, s_q12 * x34),
+                ),
+        );
+        let x61 = x51 * 0.36;
+        let x62 = -0.36 * x51;
+        let x63 = Self::mul_add(
             x48,
             0.36,
             Self::mul_add(
@@ -726,7 +1080,7 @@ impl FreeFloating7 {
                 -Self::mul_add(c_q12, x53, s_q12 * x52),
             ),
         );
-        let x66 = Self::mul_add(
+        let x64 = Self::mul_add(
             0.36,
             x49,
             Self::mul_add(
@@ -735,589 +1089,543 @@ impl FreeFloating7 {
                 -Self::mul_add(c_q12, x56, s_q12 * x55),
             ),
         );
-        let x67 = x64 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x63);
-        let x68 = 7.078399999258757 + x49;
-        let x69 = 0.01675 + x65;
-        let x70 = -9.142025249762803
-            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x64 - x63);
-        let x71 = 2.5482240016099564 + x66;
-        let x72 = 0.01675
-            + Self::mul_add(0.36, x48, Self::mul_add(-s_q12, x59, c_q12 * x58));
-        let x73 = 2.5482240016099564
-            + Self::mul_add(x49, 0.36, x60 + Self::mul_add(x11, x59, x10 * x58));
-        let x74 = 9.223235249762805
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x60,
-                -Self::mul_add(c_q12, x59, s_q12 * x58),
-            );
-        let x75 = Self::mul_add(-s_q11, x68, c_q11 * x48);
-        let x76 = Self::mul_add(c_q11, x68, s_q11 * x48);
-        let x77 = Self::mul_add(-s_q11, x62, c_q11 * x67);
-        let x78 = Self::mul_add(-s_q11, x70, c_q11 * x61);
-        let x79 = Self::mul_add(c_q11, x62, s_q11 * x67);
-        let x80 = Self::mul_add(c_q11, x70, s_q11 * x61);
-        let x81 = 0.275 * x51;
-        let x82 = -0.63 * x76;
-        let x83 = -0.275 * x51;
-        let x84 = x76 * 0.63;
-        let x85 = Self::mul_add(0.63, x75, Self::mul_add(c_q11, x78, s_q11 * x77));
-        let x86 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x71, c_q11 * x69));
-        let x87 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x71, s_q11 * x69));
-        let x88 = x74 - x84;
-        let x89 = Self::mul_add(-s_q11, x78, c_q11 * x77) - (x81 - x82) - (x84 - x83);
-        let x90 = Self::mul_add(x75, 0.63, Self::mul_add(-s_q11, x80, c_q11 * x79));
-        let x91 = Self::mul_add(
-            0.275,
-            x76,
-            Self::mul_add(x51, 0.63, Self::mul_add(c_q11, x73, s_q11 * x72)),
-        );
-        let x92 = -45.1584 + x76;
-        let x93 = -0.6328 + x86;
-        let x94 = -24.4950615 + (Self::mul_add(c_q11, x80, s_q11 * x79) + x83 - x81);
-        let x95 = -24.35164200091464 + Self::mul_add(0.63, x51, x87);
-        let x96 = -0.6328
-            + Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x73, c_q11 * x72));
-        let x97 = -24.351642000914637 + x91;
-        let x98 = 28.2393615 + (x82 + x88);
-        let x99 = c_q10 * x75;
-        let x100 = Self::mul_add(-s_q10, x92, x99);
-        let x101 = s_q10 * x75;
-        let x102 = Self::mul_add(c_q10, x92, x101);
-        let x103 = Self::mul_add(-s_q10, x90, c_q10 * x89);
-        let x104 = Self::mul_add(-s_q10, x94, c_q10 * x85);
-        let x105 = Self::mul_add(-s_q10, x95, c_q10 * x93);
-        let x106 = Self::mul_add(c_q10, x90, s_q10 * x89);
-        let x107 = Self::mul_add(c_q10, x94, s_q10 * x85);
-        let x108 = Self::mul_add(c_q10, x95, s_q10 * x93);
-        let x109 = -0.87 * x102;
-        let x110 = x102 * 0.87;
-        let x111 = Self::mul_add(0.87, x100, Self::mul_add(c_q10, x104, s_q10 * x103));
-        let x112 = x98 - x110;
-        let x113 = Self::mul_add(-s_q10, x104, c_q10 * x103) + x109 - x110;
-        let x114 = Self::mul_add(x100, 0.87, Self::mul_add(-s_q10, x107, c_q10 * x106));
-        let x115 = -81.53205 + x102;
-        let x116 = -0.00214 + x105;
-        let x117 = -63.36336825000001 + Self::mul_add(c_q10, x107, s_q10 * x106);
-        let x118 = -36.18604050126307 + Self::mul_add(0.87, x51, x108);
-        let x119 = -0.00214 + Self::mul_add(-s_q10, x97, c_q10 * x96);
-        let x120 = -36.18604050126307
-            + Self::mul_add(x51, 0.87, Self::mul_add(c_q10, x97, s_q10 * x96));
-        let x121 = 69.99836825 + (x109 + x112);
-        let x122 = s_q9 * x100;
-        let x123 = Self::mul_add(c_q9, x115, x122);
-        let x124 = Self::mul_add(0.00000000020510342851533115, x51, x123);
-        let x125 = x51 + Self::mul_add(x6, x115, x5 * x100);
-        let x126 = c_q9 * x100;
-        let x127 = Self::mul_add(-s_q9, x115, x126);
-        let x128 = Self::mul_add(-0.00000000020510342851533115, x51, x127);
-        let x129 = Self::mul_add(
+        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x61);
+        let x66 = 7.078399999258757 + x49;
+        let x67 = 0.01675 + x63;
+        let x68 = -9.142025249762803
+            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x62 - x61);
+        let x69 = 2.5482240016099564 + x64;
+        let x70 = 9.223235249762805
+            + Self::mul_add(-0.00000000020510342851533115, x58, -x60);
+        let x71 = s_q11 * s_q11;
+        let x72 = s_q11 * c_q11;
+        let x73 = x65 - x68;
+        let x74 = x59 + x59;
+        let x75 = Self::mul_add(x72, x74, x71 * x73);
+        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
+        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
+        let x78 = 0.275 * x51;
+        let x79 = -0.63 * x77;
+        let x80 = -0.275 * x51;
+        let x81 = x77 * 0.63;
+        let x82 = Self::mul_add(0.63, x76, x59 + Self::mul_add(-x71, x74, x72 * x73));
+        let x83 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
+        let x84 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
+        let x85 = x70 - x81;
+        let x86 = x65 - x75 - (x78 - x79) - (x81 - x80);
+        let x87 = -45.1584 + x77;
+        let x88 = -0.6328 + x83;
+        let x89 = -24.4950615 + (x68 + x75 + x80 - x78);
+        let x90 = -24.35164200091464 + Self::mul_add(0.63, x51, x84);
+        let x91 = 28.2393615 + (x79 + x85);
+        let x92 = s_q10 * s_q10;
+        let x93 = s_q10 * c_q10;
+        let x94 = x86 - x89;
+        let x95 = x82 + x82;
+        let x96 = Self::mul_add(x93, x95, x92 * x94);
+        let x97 = x82 + Self::mul_add(-x92, x95, x93 * x94);
+        let x98 = Self::mul_add(-s_q10, x90, c_q10 * x88);
+        let x99 = Self::mul_add(c_q10, x90, s_q10 * x88);
+        let x100 = c_q10 * x76;
+        let x101 = Self::mul_add(-s_q10, x87, x100);
+        let x102 = s_q10 * x76;
+        let x103 = Self::mul_add(c_q10, x87, x102);
+        let x104 = -0.87 * x103;
+        let x105 = x103 * 0.87;
+        let x106 = Self::mul_add(0.87, x101, x97);
+        let x107 = x91 - x105;
+        let x108 = x86 - x96 + x104 - x105;
+        let x109 = Self::mul_add(x101, 0.87, x97);
+        let x110 = -81.53205 + x103;
+        let x111 = -0.00214 + x98;
+        let x112 = -63.36336825000001 + (x89 + x96);
+        let x113 = -36.18604050126307 + Self::mul_add(0.87, x51, x99);
+        let x114 = -36.18604050126307 + Self::mul_add(x51, 0.87, x99);
+        let x115 = 69.99836825 + (x104 + x107);
+        let x116 = s_q9 * x101;
+        let x117 = Self::mul_add(c_q9, x110, x116);
+        let x118 = Self::mul_add(0.00000000020510342851533115, x51, x117);
+        let x119 = x51 + Self::mul_add(x6, x110, x5 * x101);
+        let x120 = c_q9 * x101;
+        let x121 = Self::mul_add(-s_q9, x110, x120);
+        let x122 = Self::mul_add(-0.00000000020510342851533115, x51, x121);
+        let x123 = Self::mul_add(
             0.00000000020510342851533115,
-            x119,
-            Self::mul_add(c_q9, x114, s_q9 * x113),
+            x111,
+            Self::mul_add(c_q9, x109, s_q9 * x108),
+        );
+        let x124 = Self::mul_add(
+            0.00000000020510342851533115,
+            x114,
+            Self::mul_add(c_q9, x112, s_q9 * x106),
+        );
+        let x125 = Self::mul_add(
+            0.00000000020510342851533115,
+            x115,
+            Self::mul_add(c_q9, x113, s_q9 * x111),
+        );
+        let x126 = x111 + Self::mul_add(x6, x109, x5 * x108);
+        let x127 = x114 + Self::mul_add(x6, x112, x5 * x106);
+        let x128 = x115 + Self::mul_add(x6, x113, x5 * x111);
+        let x129 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x111,
+            Self::mul_add(-s_q9, x109, c_q9 * x108),
         );
         let x130 = Self::mul_add(
-            0.00000000020510342851533115,
-            x120,
-            Self::mul_add(c_q9, x117, s_q9 * x111),
+            -0.00000000020510342851533115,
+            x114,
+            Self::mul_add(-s_q9, x112, c_q9 * x106),
         );
         let x131 = Self::mul_add(
-            0.00000000020510342851533115,
-            x121,
-            Self::mul_add(c_q9, x118, s_q9 * x116),
-        );
-        let x132 = x119 + Self::mul_add(x6, x114, x5 * x113);
-        let x133 = x120 + Self::mul_add(x6, x117, x5 * x111);
-        let x134 = x121 + Self::mul_add(x6, x118, x5 * x116);
-        let x135 = Self::mul_add(
             -0.00000000020510342851533115,
-            x119,
-            Self::mul_add(-s_q9, x114, c_q9 * x113),
+            x115,
+            Self::mul_add(-s_q9, x113, c_q9 * x111),
         );
+        let x132 = x122 * -0.4;
+        let x133 = 0.275 * x119;
+        let x134 = 0.4 * x122;
+        let x135 = -0.275 * x119;
         let x136 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x120,
-            Self::mul_add(-s_q9, x117, c_q9 * x111),
+            x118,
+            -0.4,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x125,
+                Self::mul_add(-s_q9, x124, c_q9 * x123),
+            ),
         );
         let x137 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x121,
-            Self::mul_add(-s_q9, x118, c_q9 * x116),
-        );
-        let x138 = x128 * -0.4;
-        let x139 = 0.275 * x125;
-        let x140 = 0.4 * x128;
-        let x141 = -0.275 * x125;
-        let x142 = Self::mul_add(
-            x124,
             -0.4,
+            x119,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x131,
-                Self::mul_add(-s_q9, x130, c_q9 * x129),
+                x128,
+                Self::mul_add(-s_q9, x127, c_q9 * x126),
             ),
         );
-        let x143 = Self::mul_add(
-            -0.4,
-            x125,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x134,
-                Self::mul_add(-s_q9, x133, c_q9 * x132),
-            ),
-        );
-        let x144 = Self::mul_add(
+        let x138 = Self::mul_add(
             0.00000000020510342851533115,
-            x131,
-            Self::mul_add(c_q9, x130, s_q9 * x129),
-        ) - (x138 - x139) - (x141 - x140);
-        let x145 = Self::mul_add(
-            -0.275,
-            x124,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x134,
-                Self::mul_add(c_q9, x133, s_q9 * x132),
-            ),
-        );
-        let x146 = Self::mul_add(
-            -0.4,
-            x124,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x137,
-                Self::mul_add(c_q9, x136, s_q9 * x135),
-            ),
-        );
-        let x147 = Self::mul_add(
             x125,
-            -0.4,
-            Self::mul_add(-0.275, x128, x137 + Self::mul_add(x6, x136, x5 * x135)),
+            Self::mul_add(c_q9, x124, s_q9 * x123),
+        ) - (x132 - x133) - (x135 - x134);
+        let x139 = Self::mul_add(
+            -0.275,
+            x118,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x128,
+                Self::mul_add(c_q9, x127, s_q9 * x126),
+            ),
         );
-        let x148 = -0.000000008530897668050218 + x124;
-        let x149 = -12.701650001451807 + x125;
-        let x150 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x124, x131 + Self::mul_add(x6, x130, x5 * x129));
-        let x151 = -0.002139996587640933 + x142;
-        let x152 = -0.0000000234896432582596 + x145;
-        let x153 = -111.7548902508081
-            + (x134 + Self::mul_add(x6, x133, x5 * x132) + x140 - x138);
-        let x154 = 5.080660024070365 + Self::mul_add(-0.275, x128, x143);
-        let x155 = -0.002139996587640933 + x146;
-        let x156 = 5.080660024070366 + x147;
-        let x157 = 113.3918902508081
-            + (x139
+        let x140 = Self::mul_add(
+            -0.4,
+            x118,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x131,
+                Self::mul_add(c_q9, x130, s_q9 * x129),
+            ),
+        );
+        let x141 = Self::mul_add(
+            x119,
+            -0.4,
+            Self::mul_add(-0.275, x122, x131 + Self::mul_add(x6, x130, x5 * x129)),
+        );
+        let x142 = -0.000000008530897668050218 + x118;
+        let x143 = -12.701650001451807 + x119;
+        let x144 = -0.0000000234896432582596
+            + Self::mul_add(-0.275, x118, x125 + Self::mul_add(x6, x124, x5 * x123));
+        let x145 = -0.002139996587640933 + x136;
+        let x146 = -0.0000000234896432582596 + x139;
+        let x147 = -111.7548902508081
+            + (x128 + Self::mul_add(x6, x127, x5 * x126) + x134 - x132);
+        let x148 = 5.080660024070365 + Self::mul_add(-0.275, x122, x137);
+        let x149 = -0.002139996587640933 + x140;
+        let x150 = 5.080660024070366 + x141;
+        let x151 = 113.3918902508081
+            + (x133
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x137,
-                    Self::mul_add(-s_q9, x136, c_q9 * x135),
-                ) - x141));
-        let x158 = x128 + Self::mul_add(-x3, x149, x2 * x148);
-        let x159 = Self::mul_add(c_q8, x149, s_q8 * x148);
-        let x160 = c_q8 * x148;
-        let x161 = s_q8 * x149;
-        let x162 = Self::mul_add(-0.00000000020510342851533115, x128, x161 - x160);
-        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x144);
-        let x164 = x156 + Self::mul_add(-x3, x153, x2 * x150);
-        let x165 = x157 + Self::mul_add(-x3, x154, x2 * x151);
-        let x166 = Self::mul_add(c_q8, x152, s_q8 * x144);
-        let x167 = Self::mul_add(c_q8, x153, s_q8 * x150);
-        let x168 = Self::mul_add(c_q8, x154, s_q8 * x151);
-        let x169 = Self::mul_add(
+                    x131,
+                    Self::mul_add(-s_q9, x130, c_q9 * x129),
+                ) - x135));
+        let x152 = x122 + Self::mul_add(-x3, x143, x2 * x142);
+        let x153 = Self::mul_add(c_q8, x143, s_q8 * x142);
+        let x154 = c_q8 * x142;
+        let x155 = s_q8 * x143;
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x122, x155 - x154);
+        let x157 = x149 + Self::mul_add(-x3, x146, x2 * x138);
+        let x158 = x150 + Self::mul_add(-x3, x147, x2 * x144);
+        let x159 = x151 + Self::mul_add(-x3, x148, x2 * x145);
+        let x160 = Self::mul_add(c_q8, x146, s_q8 * x138);
+        let x161 = Self::mul_add(c_q8, x147, s_q8 * x144);
+        let x162 = Self::mul_add(c_q8, x148, s_q8 * x145);
+        let x163 = Self::mul_add(
             -0.00000000020510342851533115,
-            x157,
-            Self::mul_add(-c_q8, x151, s_q8 * x154),
+            x151,
+            Self::mul_add(-c_q8, x145, s_q8 * x148),
         );
-        let x170 = Self::mul_add(
+        let x164 = Self::mul_add(
             -c_q8,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x155,
-                Self::mul_add(-c_q8, x144, s_q8 * x152),
+                x149,
+                Self::mul_add(-c_q8, x138, s_q8 * x146),
             ),
             s_q8
                 * Self::mul_add(
                     -0.00000000020510342851533115,
-                    x156,
-                    Self::mul_add(-c_q8, x150, s_q8 * x153),
+                    x150,
+                    Self::mul_add(-c_q8, x144, s_q8 * x147),
                 ),
         );
-        let x171 = x162 * -0.35;
-        let x172 = 0.35 * x162;
-        let x173 = Self::mul_add(
-            x158,
+        let x165 = x156 * -0.35;
+        let x166 = 0.35 * x156;
+        let x167 = Self::mul_add(
+            x152,
             -0.35,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x165,
-                Self::mul_add(-c_q8, x163, s_q8 * x164),
+                x159,
+                Self::mul_add(-c_q8, x157, s_q8 * x158),
             ),
         );
-        let x174 = Self::mul_add(
+        let x168 = Self::mul_add(
             -0.35,
-            x159,
+            x153,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x168,
-                Self::mul_add(-c_q8, x166, s_q8 * x167),
+                x162,
+                Self::mul_add(-c_q8, x160, s_q8 * x161),
             ),
         );
-        let x175 = x172 + (x165 + Self::mul_add(-x3, x164, x2 * x163) - x171);
-        let x176 = 48.0240000085309 + x158;
-        let x177 = -0.07309 + Self::mul_add(c_q8, x164, s_q8 * x163);
-        let x178 = -16.80768997608804 + x173;
-        let x179 = -0.07309 + (x168 + Self::mul_add(-x3, x167, x2 * x166));
-        let x180 = 130.43769025763282
-            + (Self::mul_add(c_q8, x167, s_q8 * x166) + x172 - x171);
-        let x181 = 0.1132 + x174;
-        let x182 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x169, x170);
-        let x183 = Self::mul_add(-s_q7, x159, c_q7 * x176);
-        let x184 = Self::mul_add(c_q7, x159, s_q7 * x176);
-        let x185 = Self::mul_add(-s_q7, x179, c_q7 * x175);
-        let x186 = Self::mul_add(-s_q7, x180, c_q7 * x177);
-        let x187 = -x184;
-        let x188 = x162 * -0.75;
-        let x189 = 0.75 * x162;
-        let x190 = x183 * -0.65;
-        let x191 = 0.65 * x183;
-        let x192 = Self::mul_add(x183, -0.75, Self::mul_add(-s_q7, x181, c_q7 * x178));
-        let x193 = Self::mul_add(-0.75, x184, Self::mul_add(c_q7, x181, s_q7 * x178));
-        let x194 = x182 + x191;
-        let x195 = Self::mul_add(-0.65, x184, Self::mul_add(c_q7, x186, s_q7 * x185));
-        let x196 = 110.5455 + x183;
-        let x197 = 180.9502499901501 + x162;
-        let x198 = 1394.5960312283303
-            + (x189 + (Self::mul_add(-s_q7, x186, c_q7 * x185) - x188));
-        let x199 = -117.61766249359756 + Self::mul_add(x162, -0.65, x192);
-        let x200 = 1466.4506062283303
-            + (Self::mul_add(
-                c_q7,
-                Self::mul_add(c_q7, x180, s_q7 * x177),
-                s_q7 * Self::mul_add(c_q7, x179, s_q7 * x175),
-            ) - (x190 - x189) - (x188 - x191));
-        let x201 = 1271.854575 + (x194 - x190);
-        let x202 = -x197;
-        let x203 = -x196;
-        let x204 = Self::mul_add(x3, x148, x2 * x149);
-        let x205 = x160 - x161;
-        let x206 = Self::mul_add(-0.35, x205, x165);
-        let x207 = Self::mul_add(-0.35, x204, x168);
-        let x208 = Self::mul_add(s_q7, x205, c_q7 * x204);
-        let x209 = -x208;
-        let x210 = Self::mul_add(-s_q7, x204, c_q7 * x205);
-        let x211 = Self::mul_add(-0.75, x210, Self::mul_add(-s_q7, x207, c_q7 * x206));
-        let x212 = Self::mul_add(c_q7, x207, s_q7 * x206)
-            + Self::mul_add(-0.75, x208, x159 * -0.65);
-        let x213 = Self::mul_add(0.65, x210, x169);
-        let x214 = x6 * x100;
-        let x215 = Self::mul_add(-x5, x115, x214);
-        let x216 = x131 + Self::mul_add(-0.275, x123, -0.4 * x215);
-        let x217 = Self::mul_add(0.4, x127, x134);
-        let x218 = Self::mul_add(-0.275, x127, x137);
-        let x219 = Self::mul_add(-x3, x215, x2 * x127) - x123;
-        let x220 = Self::mul_add(c_q8, x215, s_q8 * x127);
-        let x221 = Self::mul_add(
+        let x169 = x166 + (x159 + Self::mul_add(-x3, x158, x2 * x157) - x165);
+        let x170 = 48.0240000085309 + x152;
+        let x171 = -0.07309 + Self::mul_add(c_q8, x158, s_q8 * x157);
+        let x172 = -16.80768997608804 + x167;
+        let x173 = 130.43769025763282
+            + (Self::mul_add(c_q8, x161, s_q8 * x160) + x166 - x165);
+        let x174 = 0.1132 + x168;
+        let x175 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x163, x164);
+        let x176 = s_q7 * s_q7;
+        let x177 = s_q7 * c_q7;
+        let x178 = x169 - x173;
+        let x179 = x171 + x171;
+        let x180 = Self::mul_add(x177, x179, x176 * x178);
+        let x181 = Self::mul_add(-s_q7, x153, c_q7 * x170);
+        let x182 = Self::mul_add(c_q7, x153, s_q7 * x170);
+        let x183 = -x182;
+        let x184 = x156 * -0.75;
+        let x185 = 0.75 * x156;
+        let x186 = x181 * -0.65;
+        let x187 = 0.65 * x181;
+        let x188 = Self::mul_add(x181, -0.75, Self::mul_add(-s_q7, x174, c_q7 * x172));
+        let x189 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x174, s_q7 * x172));
+        let x190 = x175 + x187;
+        let x191 = Self::mul_add(
+            -0.65,
+            x182,
+            x171 + Self::mul_add(-x176, x179, x177 * x178),
+        );
+        let x192 = 110.5455 + x181;
+        let x193 = 180.9502499901501 + x156;
+        let x194 = 1394.5960312283303 + (x185 + (x169 - x180 - x184));
+        let x195 = -117.61766249359756 + Self::mul_add(x156, -0.65, x188);
+        let x196 = 1466.4506062283303 + (x173 + x180 - (x186 - x185) - (x184 - x187));
+        let x197 = 1271.854575 + (x190 - x186);
+        let x198 = -x193;
+        let x199 = -x192;
+        let x200 = Self::mul_add(x3, x142, x2 * x143);
+        let x201 = x154 - x155;
+        let x202 = Self::mul_add(-0.35, x201, x159);
+        let x203 = Self::mul_add(-0.35, x200, x162);
+        let x204 = Self::mul_add(s_q7, x201, c_q7 * x200);
+        let x205 = -x204;
+        let x206 = Self::mul_add(-s_q7, x200, c_q7 * x201);
+        let x207 = Self::mul_add(-0.75, x206, Self::mul_add(-s_q7, x203, c_q7 * x202));
+        let x208 = Self::mul_add(c_q7, x203, s_q7 * x202)
+            + Self::mul_add(-0.75, x204, x153 * -0.65);
+        let x209 = Self::mul_add(0.65, x206, x163);
+        let x210 = x6 * x101;
+        let x211 = Self::mul_add(-x5, x110, x210);
+        let x212 = x125 + Self::mul_add(-0.275, x117, -0.4 * x211);
+        let x213 = Self::mul_add(0.4, x121, x128);
+        let x214 = Self::mul_add(-0.275, x121, x131);
+        let x215 = Self::mul_add(-x3, x211, x2 * x121) - x117;
+        let x216 = Self::mul_add(c_q8, x211, s_q8 * x121);
+        let x217 = Self::mul_add(
             0.00000000020510342851533115,
-            x123,
-            Self::mul_add(-c_q8, x127, s_q8 * x215),
+            x117,
+            Self::mul_add(-c_q8, x121, s_q8 * x211),
         );
-        let x222 = Self::mul_add(
+        let x218 = Self::mul_add(
             -0.00000000020510342851533115,
-            x218,
-            Self::mul_add(-c_q8, x216, s_q8 * x217),
+            x214,
+            Self::mul_add(-c_q8, x212, s_q8 * x213),
         );
-        let x223 = Self::mul_add(
+        let x219 = Self::mul_add(
             -0.35,
-            x220,
-            x218 + Self::mul_add(-x3, x217, x2 * x216),
+            x216,
+            x214 + Self::mul_add(-x3, x213, x2 * x212),
         );
-        let x224 = Self::mul_add(0.35, x219, Self::mul_add(c_q8, x217, s_q8 * x216));
-        let x225 = Self::mul_add(-s_q7, x220, c_q7 * x219);
-        let x226 = Self::mul_add(c_q7, x220, s_q7 * x219);
-        let x227 = Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x224, c_q7 * x223));
-        let x228 = Self::mul_add(c_q7, x224, s_q7 * x223)
-            + Self::mul_add(-0.65, x221, 0.75 * x225);
-        let x229 = Self::mul_add(0.65, x226, x222);
-        let x230 = Self::mul_add(-s_q9, x102, x126);
-        let x231 = Self::mul_add(-x5, x102, x214);
-        let x232 = Self::mul_add(c_q9, x102, x122);
-        let x233 = Self::mul_add(
+        let x220 = Self::mul_add(0.35, x215, Self::mul_add(c_q8, x213, s_q8 * x212));
+        let x221 = Self::mul_add(-s_q7, x216, c_q7 * x215);
+        let x222 = Self::mul_add(c_q7, x216, s_q7 * x215);
+        let x223 = Self::mul_add(-0.75, x222, Self::mul_add(-s_q7, x220, c_q7 * x219));
+        let x224 = Self::mul_add(c_q7, x220, s_q7 * x219)
+            + Self::mul_add(-0.65, x217, 0.75 * x221);
+        let x225 = Self::mul_add(0.65, x222, x218);
+        let x226 = Self::mul_add(-s_q9, x103, x120);
+        let x227 = Self::mul_add(-x5, x103, x210);
+        let x228 = Self::mul_add(c_q9, x103, x116);
+        let x229 = Self::mul_add(
             0.00000000020510342851533115,
-            x112,
-            Self::mul_add(c_q9, x108, s_q9 * x105),
-        ) + Self::mul_add(-0.275, x232, -0.4 * x231);
-        let x234 = Self::mul_add(0.4, x230, x112 + Self::mul_add(x6, x108, x5 * x105));
+            x107,
+            Self::mul_add(c_q9, x99, s_q9 * x98),
+        ) + Self::mul_add(-0.275, x228, -0.4 * x227);
+        let x230 = Self::mul_add(0.4, x226, x107 + Self::mul_add(x6, x99, x5 * x98));
+        let x231 = Self::mul_add(
+            -0.275,
+            x226,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x107,
+                Self::mul_add(-s_q9, x99, c_q9 * x98),
+            ),
+        );
+        let x232 = Self::mul_add(-x3, x227, x2 * x226) - x228;
+        let x233 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x234 = Self::mul_add(
+            0.00000000020510342851533115,
+            x228,
+            Self::mul_add(-c_q8, x226, s_q8 * x227),
+        );
         let x235 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x231,
+            Self::mul_add(-c_q8, x229, s_q8 * x230),
+        );
+        let x236 = Self::mul_add(
+            -0.35,
+            x233,
+            x231 + Self::mul_add(-x3, x230, x2 * x229),
+        );
+        let x237 = Self::mul_add(0.35, x232, Self::mul_add(c_q8, x230, s_q8 * x229));
+        let x238 = Self::mul_add(-s_q7, x233, c_q7 * x232);
+        let x239 = Self::mul_add(c_q7, x233, s_q7 * x232);
+        let x240 = Self::mul_add(-0.75, x239, Self::mul_add(-s_q7, x237, c_q7 * x236));
+        let x241 = Self::mul_add(c_q7, x237, s_q7 * x236)
+            + Self::mul_add(-0.65, x234, 0.75 * x238);
+        let x242 = Self::mul_add(0.65, x239, x235);
+        let x243 = Self::mul_add(c_q10, x77, x102);
+        let x244 = Self::mul_add(-s_q10, x77, x100);
+        let x245 = Self::mul_add(-s_q10, x84, c_q10 * x83);
+        let x246 = Self::mul_add(c_q10, x84, s_q10 * x83);
+        let x247 = Self::mul_add(-0.87, x243, x85);
+        let x248 = Self::mul_add(-s_q9, x243, c_q9 * x244);
+        let x249 = Self::mul_add(-x5, x243, x6 * x244);
+        let x250 = Self::mul_add(s_q9, x244, c_q9 * x243);
+        let x251 = Self::mul_add(
+            0.00000000020510342851533115,
+            x247,
+            Self::mul_add(c_q9, x246, s_q9 * x245),
+        ) + Self::mul_add(-0.275, x250, -0.4 * x249);
+        let x252 = Self::mul_add(0.4, x248, x247 + Self::mul_add(x6, x246, x5 * x245));
+        let x253 = Self::mul_add(
             -0.275,
-            x230,
+            x248,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x112,
-                Self::mul_add(-s_q9, x108, c_q9 * x105),
+                x247,
+                Self::mul_add(-s_q9, x246, c_q9 * x245),
             ),
         );
-        let x236 = Self::mul_add(-x3, x231, x2 * x230) - x232;
-        let x237 = Self::mul_add(c_q8, x231, s_q8 * x230);
-        let x238 = Self::mul_add(
+        let x254 = Self::mul_add(-x3, x249, x2 * x248) - x250;
+        let x255 = Self::mul_add(c_q8, x249, s_q8 * x248);
+        let x256 = Self::mul_add(
             0.00000000020510342851533115,
-            x232,
-            Self::mul_add(-c_q8, x230, s_q8 * x231),
+            x250,
+            Self::mul_add(-c_q8, x248, s_q8 * x249),
         );
-        let x239 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x235,
-            Self::mul_add(-c_q8, x233, s_q8 * x234),
-        );
-        let x240 = Self::mul_add(
-            -0.35,
-            x237,
-            x235 + Self::mul_add(-x3, x234, x2 * x233),
-        );
-        let x241 = Self::mul_add(0.35, x236, Self::mul_add(c_q8, x234, s_q8 * x233));
-        let x242 = Self::mul_add(-s_q7, x237, c_q7 * x236);
-        let x243 = Self::mul_add(c_q7, x237, s_q7 * x236);
-        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x241, c_q7 * x240));
-        let x245 = Self::mul_add(c_q7, x241, s_q7 * x240)
-            + Self::mul_add(-0.65, x238, 0.75 * x242);
-        let x246 = Self::mul_add(0.65, x243, x239);
-        let x247 = Self::mul_add(c_q10, x76, x101);
-        let x248 = Self::mul_add(-s_q10, x76, x99);
-        let x249 = Self::mul_add(-s_q10, x87, c_q10 * x86);
-        let x250 = Self::mul_add(c_q10, x87, s_q10 * x86);
-        let x251 = Self::mul_add(-0.87, x247, x88);
-        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
-        let x253 = Self::mul_add(-x5, x247, x6 * x248);
-        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
-        let x255 = Self::mul_add(
-            0.00000000020510342851533115,
-            x251,
-            Self::mul_add(c_q9, x250, s_q9 * x249),
-        ) + Self::mul_add(-0.275, x254, -0.4 * x253);
-        let x256 = Self::mul_add(0.4, x252, x251 + Self::mul_add(x6, x250, x5 * x249));
         let x257 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x253,
+            Self::mul_add(-c_q8, x251, s_q8 * x252),
+        );
+        let x258 = Self::mul_add(
+            -0.35,
+            x255,
+            x253 + Self::mul_add(-x3, x252, x2 * x251),
+        );
+        let x259 = Self::mul_add(0.35, x254, Self::mul_add(c_q8, x252, s_q8 * x251));
+        let x260 = Self::mul_add(-s_q7, x255, c_q7 * x254);
+        let x261 = Self::mul_add(c_q7, x255, s_q7 * x254);
+        let x262 = Self::mul_add(-0.75, x261, Self::mul_add(-s_q7, x259, c_q7 * x258));
+        let x263 = Self::mul_add(c_q7, x259, s_q7 * x258)
+            + Self::mul_add(-0.65, x256, 0.75 * x260);
+        let x264 = Self::mul_add(0.65, x261, x257);
+        let x265 = Self::mul_add(-x10, x37, x11 * x36);
+        let x266 = x47 - x46;
+        let x267 = Self::mul_add(0.36, x265, x54);
+        let x268 = Self::mul_add(0.36, x50, x57);
+        let x269 = Self::mul_add(s_q11, x265, c_q11 * x50);
+        let x270 = Self::mul_add(-s_q11, x50, c_q11 * x265);
+        let x271 = Self::mul_add(-s_q11, x268, c_q11 * x267)
+            + Self::mul_add(-0.63, x266, 0.275 * x270);
+        let x272 = Self::mul_add(0.275, x269, Self::mul_add(c_q11, x268, s_q11 * x267));
+        let x273 = Self::mul_add(-0.63, x269, x58);
+        let x274 = Self::mul_add(s_q10, x270, c_q10 * x269);
+        let x275 = Self::mul_add(-s_q10, x269, c_q10 * x270);
+        let x276 = Self::mul_add(c_q10, x272, s_q10 * x271);
+        let x277 = Self::mul_add(-0.87, x266, Self::mul_add(-s_q10, x272, c_q10 * x271));
+        let x278 = Self::mul_add(-0.87, x274, x273);
+        let x279 = Self::mul_add(
+            0.00000000020510342851533115,
+            x266,
+            Self::mul_add(-s_q9, x274, c_q9 * x275),
+        );
+        let x280 = x266 + Self::mul_add(-x5, x274, x6 * x275);
+        let x281 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x266,
+            -Self::mul_add(s_q9, x275, c_q9 * x274),
+        );
+        let x282 = Self::mul_add(
+            0.00000000020510342851533115,
+            x278,
+            Self::mul_add(c_q9, x276, s_q9 * x277),
+        ) + Self::mul_add(0.275, x281, -0.4 * x280);
+        let x283 = Self::mul_add(0.4, x279, x278 + Self::mul_add(x6, x276, x5 * x277));
+        let x284 = Self::mul_add(
             -0.275,
-            x252,
+            x279,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x251,
-                Self::mul_add(-s_q9, x250, c_q9 * x249),
+                x278,
+                Self::mul_add(-s_q9, x276, c_q9 * x277),
             ),
         );
-        let x258 = Self::mul_add(-x3, x253, x2 * x252) - x254;
-        let x259 = Self::mul_add(c_q8, x253, s_q8 * x252);
-        let x260 = Self::mul_add(
-            0.00000000020510342851533115,
-            x254,
-            Self::mul_add(-c_q8, x252, s_q8 * x253),
-        );
-        let x261 = Self::mul_add(
+        let x285 = x281 + Self::mul_add(-x3, x280, x2 * x279);
+        let x286 = Self::mul_add(c_q8, x280, s_q8 * x279);
+        let x287 = Self::mul_add(
             -0.00000000020510342851533115,
-            x257,
-            Self::mul_add(-c_q8, x255, s_q8 * x256),
+            x281,
+            Self::mul_add(-c_q8, x279, s_q8 * x280),
         );
-        let x262 = Self::mul_add(
-            -0.35,
-            x259,
-            x257 + Self::mul_add(-x3, x256, x2 * x255),
-        );
-        let x263 = Self::mul_add(0.35, x258, Self::mul_add(c_q8, x256, s_q8 * x255));
-        let x264 = Self::mul_add(-s_q7, x259, c_q7 * x258);
-        let x265 = Self::mul_add(c_q7, x259, s_q7 * x258);
-        let x266 = Self::mul_add(-0.75, x265, Self::mul_add(-s_q7, x263, c_q7 * x262));
-        let x267 = Self::mul_add(c_q7, x263, s_q7 * x262)
-            + Self::mul_add(-0.65, x260, 0.75 * x264);
-        let x268 = Self::mul_add(0.65, x265, x261);
-        let x269 = Self::mul_add(-x10, x37, x11 * x36);
-        let x270 = x47 - x46;
-        let x271 = Self::mul_add(0.36, x269, x54);
-        let x272 = Self::mul_add(0.36, x50, x57);
-        let x273 = Self::mul_add(s_q11, x269, c_q11 * x50);
-        let x274 = Self::mul_add(-s_q11, x50, c_q11 * x269);
-        let x275 = Self::mul_add(-s_q11, x272, c_q11 * x271)
-            + Self::mul_add(-0.63, x270, 0.275 * x274);
-        let x276 = Self::mul_add(0.275, x273, Self::mul_add(c_q11, x272, s_q11 * x271));
-        let x277 = Self::mul_add(-0.63, x273, x60);
-        let x278 = Self::mul_add(s_q10, x274, c_q10 * x273);
-        let x279 = Self::mul_add(-s_q10, x273, c_q10 * x274);
-        let x280 = Self::mul_add(c_q10, x276, s_q10 * x275);
-        let x281 = Self::mul_add(-0.87, x270, Self::mul_add(-s_q10, x276, c_q10 * x275));
-        let x282 = Self::mul_add(-0.87, x278, x277);
-        let x283 = Self::mul_add(
-            0.00000000020510342851533115,
-            x270,
-            Self::mul_add(-s_q9, x278, c_q9 * x279),
-        );
-        let x284 = x270 + Self::mul_add(-x5, x278, x6 * x279);
-        let x285 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x270,
-            -Self::mul_add(s_q9, x279, c_q9 * x278),
-        );
-        let x286 = Self::mul_add(
-            0.00000000020510342851533115,
-            x282,
-            Self::mul_add(c_q9, x280, s_q9 * x281),
-        ) + Self::mul_add(0.275, x285, -0.4 * x284);
-        let x287 = Self::mul_add(0.4, x283, x282 + Self::mul_add(x6, x280, x5 * x281));
         let x288 = Self::mul_add(
-            -0.275,
-            x283,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x282,
-                Self::mul_add(-s_q9, x280, c_q9 * x281),
-            ),
-        );
-        let x289 = x285 + Self::mul_add(-x3, x284, x2 * x283);
-        let x290 = Self::mul_add(c_q8, x284, s_q8 * x283);
-        let x291 = Self::mul_add(
             -0.00000000020510342851533115,
-            x285,
-            Self::mul_add(-c_q8, x283, s_q8 * x284),
+            x284,
+            Self::mul_add(-c_q8, x282, s_q8 * x283),
         );
-        let x292 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x288,
-            Self::mul_add(-c_q8, x286, s_q8 * x287),
-        );
-        let x293 = Self::mul_add(
+        let x289 = Self::mul_add(
             -0.35,
-            x290,
-            x288 + Self::mul_add(-x3, x287, x2 * x286),
+            x286,
+            x284 + Self::mul_add(-x3, x283, x2 * x282),
         );
-        let x294 = Self::mul_add(0.35, x289, Self::mul_add(c_q8, x287, s_q8 * x286));
-        let x295 = Self::mul_add(-s_q7, x290, c_q7 * x289);
-        let x296 = Self::mul_add(c_q7, x290, s_q7 * x289);
-        let x297 = Self::mul_add(-0.75, x296, Self::mul_add(-s_q7, x294, c_q7 * x293));
-        let x298 = Self::mul_add(c_q7, x294, s_q7 * x293)
-            + Self::mul_add(-0.65, x291, 0.75 * x295);
-        let x299 = Self::mul_add(0.65, x296, x292);
-        let x300 = x13 * -4.806620000000001;
-        let x301 = s_q13 * -4.806620000000001;
-        let x302 = c_q13 * -4.806620000000001;
-        let x303 = x20 + Self::mul_add(-0.55, x302, -0.16 * x301);
-        let x304 = Self::mul_add(0.16, x300, x24);
-        let x305 = Self::mul_add(-0.55, x300, x27);
-        let x306 = Self::mul_add(-s_q12, x301, c_q12 * x300);
-        let x307 = Self::mul_add(x11, x301, x10 * x300) - x302;
-        let x308 = Self::mul_add(
+        let x290 = Self::mul_add(0.35, x285, Self::mul_add(c_q8, x283, s_q8 * x282));
+        let x291 = Self::mul_add(-s_q7, x286, c_q7 * x285);
+        let x292 = Self::mul_add(c_q7, x286, s_q7 * x285);
+        let x293 = Self::mul_add(-0.75, x292, Self::mul_add(-s_q7, x290, c_q7 * x289));
+        let x294 = Self::mul_add(c_q7, x290, s_q7 * x289)
+            + Self::mul_add(-0.65, x287, 0.75 * x291);
+        let x295 = Self::mul_add(0.65, x292, x288);
+        let x296 = x13 * -4.806620000000001;
+        let x297 = s_q13 * -4.806620000000001;
+        let x298 = c_q13 * -4.806620000000001;
+        let x299 = x20 + Self::mul_add(-0.55, x298, -0.16 * x297);
+        let x300 = Self::mul_add(0.16, x296, x24);
+        let x301 = Self::mul_add(-0.55, x296, x27);
+        let x302 = Self::mul_add(-s_q12, x297, c_q12 * x296);
+        let x303 = Self::mul_add(x11, x297, x10 * x296) - x298;
+        let x304 = Self::mul_add(
             -0.00000000020510342851533115,
-            x302,
-            Self::mul_add(c_q12, x301, s_q12 * x300),
+            x298,
+            Self::mul_add(c_q12, x297, s_q12 * x296),
         );
-        let x309 = Self::mul_add(
+        let x305 = Self::mul_add(
             -0.00000000020510342851533115,
-            x305,
-            -Self::mul_add(c_q12, x304, s_q12 * x303),
+            x301,
+            -Self::mul_add(c_q12, x300, s_q12 * x299),
         );
-        let x310 = Self::mul_add(0.36, x307, Self::mul_add(-s_q12, x304, c_q12 * x303));
-        let x311 = Self::mul_add(
+        let x306 = Self::mul_add(0.36, x303, Self::mul_add(-s_q12, x300, c_q12 * x299));
+        let x307 = Self::mul_add(
             -0.36,
-            x306,
-            x305 + Self::mul_add(x11, x304, x10 * x303),
+            x302,
+            x301 + Self::mul_add(x11, x300, x10 * x299),
         );
-        let x312 = Self::mul_add(-s_q11, x307, c_q11 * x306);
-        let x313 = Self::mul_add(c_q11, x307, s_q11 * x306);
-        let x314 = Self::mul_add(-s_q11, x311, c_q11 * x310)
-            + Self::mul_add(0.63, x308, 0.275 * x313);
-        let x315 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x311, s_q11 * x310));
-        let x316 = Self::mul_add(0.63, x312, x309);
-        let x317 = Self::mul_add(-s_q10, x313, c_q10 * x312);
-        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
-        let x319 = Self::mul_add(c_q10, x315, s_q10 * x314);
-        let x320 = Self::mul_add(0.87, x308, Self::mul_add(-s_q10, x315, c_q10 * x314));
-        let x321 = Self::mul_add(0.87, x317, x316);
-        let x322 = Self::mul_add(
+        let x308 = Self::mul_add(-s_q11, x303, c_q11 * x302);
+        let x309 = Self::mul_add(c_q11, x303, s_q11 * x302);
+        let x310 = Self::mul_add(-s_q11, x307, c_q11 * x306)
+            + Self::mul_add(0.63, x304, 0.275 * x309);
+        let x311 = Self::mul_add(-0.275, x308, Self::mul_add(c_q11, x307, s_q11 * x306));
+        let x312 = Self::mul_add(0.63, x308, x305);
+        let x313 = Self::mul_add(-s_q10, x309, c_q10 * x308);
+        let x314 = Self::mul_add(c_q10, x309, s_q10 * x308);
+        let x315 = Self::mul_add(c_q10, x311, s_q10 * x310);
+        let x316 = Self::mul_add(0.87, x304, Self::mul_add(-s_q10, x311, c_q10 * x310));
+        let x317 = Self::mul_add(0.87, x313, x312);
+        let x318 = Self::mul_add(
             -0.00000000020510342851533115,
-            x308,
-            Self::mul_add(c_q9, x318, s_q9 * x317),
+            x304,
+            Self::mul_add(c_q9, x314, s_q9 * x313),
         );
-        let x323 = Self::mul_add(x6, x318, x5 * x317) - x308;
-        let x324 = Self::mul_add(
+        let x319 = Self::mul_add(x6, x314, x5 * x313) - x304;
+        let x320 = Self::mul_add(
             0.00000000020510342851533115,
-            x308,
-            Self::mul_add(-s_q9, x318, c_q9 * x317),
+            x304,
+            Self::mul_add(-s_q9, x314, c_q9 * x313),
         );
-        let x325 = Self::mul_add(
+        let x321 = Self::mul_add(
             0.00000000020510342851533115,
-            x321,
-            Self::mul_add(c_q9, x319, s_q9 * x320),
-        ) + Self::mul_add(0.275, x324, -0.4 * x323);
-        let x326 = Self::mul_add(0.4, x322, x321 + Self::mul_add(x6, x319, x5 * x320));
-        let x327 = Self::mul_add(
+            x317,
+            Self::mul_add(c_q9, x315, s_q9 * x316),
+        ) + Self::mul_add(0.275, x320, -0.4 * x319);
+        let x322 = Self::mul_add(0.4, x318, x317 + Self::mul_add(x6, x315, x5 * x316));
+        let x323 = Self::mul_add(
             -0.275,
-            x322,
+            x318,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x321,
-                Self::mul_add(-s_q9, x319, c_q9 * x320),
+                x317,
+                Self::mul_add(-s_q9, x315, c_q9 * x316),
             ),
         );
-        let x328 = x324 + Self::mul_add(-x3, x323, x2 * x322);
-        let x329 = Self::mul_add(c_q8, x323, s_q8 * x322);
-        let x330 = Self::mul_add(
+        let x324 = x320 + Self::mul_add(-x3, x319, x2 * x318);
+        let x325 = Self::mul_add(c_q8, x319, s_q8 * x318);
+        let x326 = Self::mul_add(
             -0.00000000020510342851533115,
-            x324,
-            Self::mul_add(-c_q8, x322, s_q8 * x323),
+            x320,
+            Self::mul_add(-c_q8, x318, s_q8 * x319),
         );
-        let x331 = Self::mul_add(
+        let x327 = Self::mul_add(
             -0.00000000020510342851533115,
-            x327,
-            Self::mul_add(-c_q8, x325, s_q8 * x326),
+            x323,
+            Self::mul_add(-c_q8, x321, s_q8 * x322),
         );
-        let x332 = Self::mul_add(
+        let x328 = Self::mul_add(
             -0.35,
-            x329,
-            x327 + Self::mul_add(-x3, x326, x2 * x325),
+            x325,
+            x323 + Self::mul_add(-x3, x322, x2 * x321),
         );
-        let x333 = Self::mul_add(0.35, x328, Self::mul_add(c_q8, x326, s_q8 * x325));
-        let x334 = Self::mul_add(-s_q7, x329, c_q7 * x328);
-        let x335 = Self::mul_add(c_q7, x329, s_q7 * x328);
-        let x336 = Self::mul_add(-0.75, x335, Self::mul_add(-s_q7, x333, c_q7 * x332));
-        let x337 = Self::mul_add(c_q7, x333, s_q7 * x332)
-            + Self::mul_add(-0.65, x330, 0.75 * x334);
-        let x338 = Self::mul_add(0.65, x335, x331);
+        let x329 = Self::mul_add(0.35, x324, Self::mul_add(c_q8, x322, s_q8 * x321));
+        let x330 = Self::mul_add(-s_q7, x325, c_q7 * x324);
+        let x331 = Self::mul_add(c_q7, x325, s_q7 * x324);
+        let x332 = Self::mul_add(-0.75, x331, Self::mul_add(-s_q7, x329, c_q7 * x328));
+        let x333 = Self::mul_add(c_q7, x329, s_q7 * x328)
+            + Self::mul_add(-0.65, x326, 0.75 * x330);
+        let x334 = Self::mul_add(0.65, x331, x327);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x197,
-                x187,
-                x187,
-                x209,
-                x225,
-                x242,
-                x264,
-                x295,
-                x334,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x202,
-                0.0,
-                x196,
+                x193,
                 x183,
-                x210,
-                x226,
-                x243,
-                x265,
-                x296,
-                x335,
-            ],
-            [
-                0.0,
-                0.0,
-                1170.07,
-                x184,
-                x203,
-                0.0,
-                0.0,
-                x159,
+                x183,
+                x205,
                 x221,
                 x238,
                 x260,
@@ -1326,58 +1634,13 @@ impl FreeFloating7 {
             ],
             [
                 0.0,
-                x202,
-                x184,
+                1170.07,
+                0.0,
                 x198,
-                x195,
-                x199,
-                x192,
-                x211,
-                x227,
-                x244,
-                x266,
-                x297,
-                x336,
-            ],
-            [
-                x197,
-                0.0,
-                x203,
-                x195,
-                x200,
-                x193,
-                x193,
-                x212,
-                x228,
-                x245,
-                x267,
-                x298,
-                x337,
-            ],
-            [
-                x187,
-                x196,
-                0.0,
-                x199,
-                x193,
-                x201,
-                x194,
-                x213,
-                x229,
-                x246,
-                x268,
-                x299,
-                x338,
-            ],
-            [
-                x187,
-                x183,
                 0.0,
                 x192,
-                x193,
-                x194,
-                x182,
-                x169,
+                x181,
+                x206,
                 x222,
                 x239,
                 x261,
@@ -1385,14 +1648,74 @@ impl FreeFloating7 {
                 x331,
             ],
             [
+                0.0,
+                0.0,
+                1170.07,
+                x182,
+                x199,
+                0.0,
+                0.0,
+                x153,
+                x217,
+                x234,
+                x256,
+                x287,
+                x326,
+            ],
+            [
+                0.0,
+                x198,
+                x182,
+                x194,
+                x191,
+                x195,
+                x188,
+                x207,
+                x223,
+                x240,
+                x262,
+                x293,
+                x332,
+            ],
+            [
+                x193,
+                0.0,
+                x199,
+                x191,
+                x196,
+                x189,
+                x189,
+                x208,
+                x224,
+                x241,
+                x263,
+                x294,
+                x333,
+            ],
+            [
+                x183,
+                x192,
+                0.0,
+                x195,
+                x189,
+                x197,
+                x190,
                 x209,
-                x210,
-                x159,
-                x211,
-                x212,
-                x213,
-                x169,
-                x157,
+                x225,
+                x242,
+                x264,
+                x295,
+                x334,
+            ],
+            [
+                x183,
+                x181,
+                0.0,
+                x188,
+                x189,
+                x190,
+                x175,
+                x163,
                 x218,
                 x235,
                 x257,
@@ -1400,36 +1723,51 @@ impl FreeFloating7 {
                 x327,
             ],
             [
-                x225,
-                x226,
-                x221,
-                x227,
-                x228,
-                x229,
-                x222,
-                x218,
-                x121,
-                x112,
-                x251,
-                x282,
-                x321,
+                x205,
+                x206,
+                x153,
+                x207,
+                x208,
+                x209,
+                x163,
+                x151,
+                x214,
+                x231,
+                x253,
+                x284,
+                x323,
             ],
-            [x242, x243, x238, x244, x245, x246, x239, x235, x112, x98, x88, x277, x316],
-            [x264, x265, x260, x266, x267, x268, x261, x257, x251, x88, x74, x60, x309],
-            [x295, x296, x291, x297, x298, x299, x292, x288, x282, x277, x60, x45, x305],
             [
-                x334,
-                x335,
+                x221,
+                x222,
+                x217,
+                x223,
+                x224,
+                x225,
+                x218,
+                x214,
+                x115,
+                x107,
+                x247,
+                x278,
+                x317,
+            ],
+            [x238, x239, x234, x240, x241, x242, x235, x231, x107, x91, x85, x273, x312],
+            [x260, x261, x256, x262, x263, x264, x257, x253, x247, x85, x70, x58, x305],
+            [x291, x292, x287, x293, x294, x295, x288, x284, x278, x273, x58, x45, x301],
+            [
                 x330,
-                x336,
-                x337,
-                x338,
                 x331,
+                x326,
+                x332,
+                x333,
+                x334,
                 x327,
-                x321,
-                x316,
-                x309,
+                x323,
+                x317,
+                x312,
                 x305,
+                x301,
                 1.4135609200000003,
             ],
         ]
@@ -4298,7 +4636,7 @@ impl FreeFloating7 {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1170 mul, 967 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 700 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 1120 mul, 943 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 669 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -4406,24 +4744,27 @@ impl FreeFloating7 {
         let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
         let x58 = Self::mul_add(
             -0.00000000020510342851533115,
-            x43,
-            -Self::mul_add(c_q12, x40, s_q12 * x34),
-        );
-        let x59 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x44,
-            -Self::mul_add(c_q12, x41, s_q12 * x38),
-        );
-        let x60 = Self::mul_add(
-            -0.00000000020510342851533115,
             x45,
             -Self::mul_add(c_q12, x42, s_q12 * x39),
         );
-        let x61 = x54 + Self::mul_add(x11, x53, x10 * x52);
-        let x62 = Self::mul_add(-s_q12, x56, c_q12 * x55);
-        let x63 = x51 * 0.36;
-        let x64 = -0.36 * x51;
-        let x65 = Self::mul_add(
+        let x59 = x54 + Self::mul_add(x11, x53, x10 * x52);
+        let x60 = Self::mul_add(
+            c_q12,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x44,
+                -Self::mul_add(c_q12, x41, s_q12 * x38),
+            ),
+            s_q12
+                * Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x43,
+                    -Self::mul_add(c_q12, x40, s_q12 * x34),
+                ),
+        );
+        let x61 = x51 * 0.36;
+        let x62 = -0.36 * x51;
+        let x63 = Self::mul_add(
             x48,
             0.36,
             Self::mul_add(
@@ -4432,7 +4773,7 @@ impl FreeFloating7 {
                 -Self::mul_add(c_q12, x53, s_q12 * x52),
             ),
         );
-        let x66 = Self::mul_add(
+        let x64 = Self::mul_add(
             0.36,
             x49,
             Self::mul_add(
@@ -4441,1105 +4782,1089 @@ impl FreeFloating7 {
                 -Self::mul_add(c_q12, x56, s_q12 * x55),
             ),
         );
-        let x67 = x64 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x63);
-        let x68 = 7.078399999258757 + x49;
-        let x69 = 0.01675 + x65;
-        let x70 = -9.142025249762803
-            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x64 - x63);
-        let x71 = 2.5482240016099564 + x66;
-        let x72 = 0.01675
-            + Self::mul_add(0.36, x48, Self::mul_add(-s_q12, x59, c_q12 * x58));
-        let x73 = 2.5482240016099564
-            + Self::mul_add(x49, 0.36, x60 + Self::mul_add(x11, x59, x10 * x58));
-        let x74 = 9.223235249762805
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x60,
-                -Self::mul_add(c_q12, x59, s_q12 * x58),
-            );
-        let x75 = Self::mul_add(-s_q11, x68, c_q11 * x48);
-        let x76 = Self::mul_add(c_q11, x68, s_q11 * x48);
-        let x77 = Self::mul_add(-s_q11, x62, c_q11 * x67);
-        let x78 = Self::mul_add(-s_q11, x70, c_q11 * x61);
-        let x79 = Self::mul_add(c_q11, x62, s_q11 * x67);
-        let x80 = Self::mul_add(c_q11, x70, s_q11 * x61);
-        let x81 = 0.275 * x51;
-        let x82 = -0.63 * x76;
-        let x83 = -0.275 * x51;
-        let x84 = x76 * 0.63;
-        let x85 = Self::mul_add(0.63, x75, Self::mul_add(c_q11, x78, s_q11 * x77));
-        let x86 = Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x71, c_q11 * x69));
-        let x87 = Self::mul_add(0.275, x76, Self::mul_add(c_q11, x71, s_q11 * x69));
-        let x88 = x74 - x84;
-        let x89 = Self::mul_add(-s_q11, x78, c_q11 * x77) - (x81 - x82) - (x84 - x83);
-        let x90 = Self::mul_add(x75, 0.63, Self::mul_add(-s_q11, x80, c_q11 * x79));
-        let x91 = Self::mul_add(
-            0.275,
-            x76,
-            Self::mul_add(x51, 0.63, Self::mul_add(c_q11, x73, s_q11 * x72)),
-        );
-        let x92 = -45.1584 + x76;
-        let x93 = -0.6328 + x86;
-        let x94 = -24.4950615 + (Self::mul_add(c_q11, x80, s_q11 * x79) + x83 - x81);
-        let x95 = -24.35164200091464 + Self::mul_add(0.63, x51, x87);
-        let x96 = -0.6328
-            + Self::mul_add(0.275, x75, Self::mul_add(-s_q11, x73, c_q11 * x72));
-        let x97 = -24.351642000914637 + x91;
-        let x98 = 28.2393615 + (x82 + x88);
-        let x99 = c_q10 * x75;
-        let x100 = Self::mul_add(-s_q10, x92, x99);
-        let x101 = s_q10 * x75;
-        let x102 = Self::mul_add(c_q10, x92, x101);
-        let x103 = Self::mul_add(-s_q10, x90, c_q10 * x89);
-        let x104 = Self::mul_add(-s_q10, x94, c_q10 * x85);
-        let x105 = Self::mul_add(-s_q10, x95, c_q10 * x93);
-        let x106 = Self::mul_add(c_q10, x90, s_q10 * x89);
-        let x107 = Self::mul_add(c_q10, x94, s_q10 * x85);
-        let x108 = Self::mul_add(c_q10, x95, s_q10 * x93);
-        let x109 = -0.87 * x102;
-        let x110 = x102 * 0.87;
-        let x111 = Self::mul_add(0.87, x100, Self::mul_add(c_q10, x104, s_q10 * x103));
-        let x112 = x98 - x110;
-        let x113 = Self::mul_add(-s_q10, x104, c_q10 * x103) + x109 - x110;
-        let x114 = Self::mul_add(x100, 0.87, Self::mul_add(-s_q10, x107, c_q10 * x106));
-        let x115 = -81.53205 + x102;
-        let x116 = -0.00214 + x105;
-        let x117 = -63.36336825000001 + Self::mul_add(c_q10, x107, s_q10 * x106);
-        let x118 = -36.18604050126307 + Self::mul_add(0.87, x51, x108);
-        let x119 = -0.00214 + Self::mul_add(-s_q10, x97, c_q10 * x96);
-        let x120 = -36.18604050126307
-            + Self::mul_add(x51, 0.87, Self::mul_add(c_q10, x97, s_q10 * x96));
-        let x121 = 69.99836825 + (x109 + x112);
-        let x122 = s_q9 * x100;
-        let x123 = Self::mul_add(c_q9, x115, x122);
-        let x124 = Self::mul_add(0.00000000020510342851533115, x51, x123);
-        let x125 = x51 + Self::mul_add(x6, x115, x5 * x100);
-        let x126 = c_q9 * x100;
-        let x127 = Self::mul_add(-s_q9, x115, x126);
-        let x128 = Self::mul_add(-0.00000000020510342851533115, x51, x127);
-        let x129 = Self::mul_add(
+        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x61);
+        let x66 = 7.078399999258757 + x49;
+        let x67 = 0.01675 + x63;
+        let x68 = -9.142025249762803
+            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x62 - x61);
+        let x69 = 2.5482240016099564 + x64;
+        let x70 = 9.223235249762805
+            + Self::mul_add(-0.00000000020510342851533115, x58, -x60);
+        let x71 = s_q11 * s_q11;
+        let x72 = s_q11 * c_q11;
+        let x73 = x65 - x68;
+        let x74 = x59 + x59;
+        let x75 = Self::mul_add(x72, x74, x71 * x73);
+        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
+        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
+        let x78 = 0.275 * x51;
+        let x79 = -0.63 * x77;
+        let x80 = -0.275 * x51;
+        let x81 = x77 * 0.63;
+        let x82 = Self::mul_add(0.63, x76, x59 + Self::mul_add(-x71, x74, x72 * x73));
+        let x83 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
+        let x84 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
+        let x85 = x70 - x81;
+        let x86 = x65 - x75 - (x78 - x79) - (x81 - x80);
+        let x87 = -45.1584 + x77;
+        let x88 = -0.6328 + x83;
+        let x89 = -24.4950615 + (x68 + x75 + x80 - x78);
+        let x90 = -24.35164200091464 + Self::mul_add(0.63, x51, x84);
+        let x91 = 28.2393615 + (x79 + x85);
+        let x92 = s_q10 * s_q10;
+        let x93 = s_q10 * c_q10;
+        let x94 = x86 - x89;
+        let x95 = x82 + x82;
+        let x96 = Self::mul_add(x93, x95, x92 * x94);
+        let x97 = x82 + Self::mul_add(-x92, x95, x93 * x94);
+        let x98 = Self::mul_add(-s_q10, x90, c_q10 * x88);
+        let x99 = Self::mul_add(c_q10, x90, s_q10 * x88);
+        let x100 = c_q10 * x76;
+        let x101 = Self::mul_add(-s_q10, x87, x100);
+        let x102 = s_q10 * x76;
+        let x103 = Self::mul_add(c_q10, x87, x102);
+        let x104 = -0.87 * x103;
+        let x105 = x103 * 0.87;
+        let x106 = Self::mul_add(0.87, x101, x97);
+        let x107 = x91 - x105;
+        let x108 = x86 - x96 + x104 - x105;
+        let x109 = Self::mul_add(x101, 0.87, x97);
+        let x110 = -81.53205 + x103;
+        let x111 = -0.00214 + x98;
+        let x112 = -63.36336825000001 + (x89 + x96);
+        let x113 = -36.18604050126307 + Self::mul_add(0.87, x51, x99);
+        let x114 = -36.18604050126307 + Self::mul_add(x51, 0.87, x99);
+        let x115 = 69.99836825 + (x104 + x107);
+        let x116 = s_q9 * x101;
+        let x117 = Self::mul_add(c_q9, x110, x116);
+        let x118 = Self::mul_add(0.00000000020510342851533115, x51, x117);
+        let x119 = x51 + Self::mul_add(x6, x110, x5 * x101);
+        let x120 = c_q9 * x101;
+        let x121 = Self::mul_add(-s_q9, x110, x120);
+        let x122 = Self::mul_add(-0.00000000020510342851533115, x51, x121);
+        let x123 = Self::mul_add(
             0.00000000020510342851533115,
-            x119,
-            Self::mul_add(c_q9, x114, s_q9 * x113),
+            x111,
+            Self::mul_add(c_q9, x109, s_q9 * x108),
+        );
+        let x124 = Self::mul_add(
+            0.00000000020510342851533115,
+            x114,
+            Self::mul_add(c_q9, x112, s_q9 * x106),
+        );
+        let x125 = Self::mul_add(
+            0.00000000020510342851533115,
+            x115,
+            Self::mul_add(c_q9, x113, s_q9 * x111),
+        );
+        let x126 = x111 + Self::mul_add(x6, x109, x5 * x108);
+        let x127 = x114 + Self::mul_add(x6, x112, x5 * x106);
+        let x128 = x115 + Self::mul_add(x6, x113, x5 * x111);
+        let x129 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x111,
+            Self::mul_add(-s_q9, x109, c_q9 * x108),
         );
         let x130 = Self::mul_add(
-            0.00000000020510342851533115,
-            x120,
-            Self::mul_add(c_q9, x117, s_q9 * x111),
+            -0.00000000020510342851533115,
+            x114,
+            Self::mul_add(-s_q9, x112, c_q9 * x106),
         );
         let x131 = Self::mul_add(
-            0.00000000020510342851533115,
-            x121,
-            Self::mul_add(c_q9, x118, s_q9 * x116),
-        );
-        let x132 = x119 + Self::mul_add(x6, x114, x5 * x113);
-        let x133 = x120 + Self::mul_add(x6, x117, x5 * x111);
-        let x134 = x121 + Self::mul_add(x6, x118, x5 * x116);
-        let x135 = Self::mul_add(
             -0.00000000020510342851533115,
-            x119,
-            Self::mul_add(-s_q9, x114, c_q9 * x113),
+            x115,
+            Self::mul_add(-s_q9, x113, c_q9 * x111),
         );
+        let x132 = x122 * -0.4;
+        let x133 = 0.275 * x119;
+        let x134 = 0.4 * x122;
+        let x135 = -0.275 * x119;
         let x136 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x120,
-            Self::mul_add(-s_q9, x117, c_q9 * x111),
+            x118,
+            -0.4,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x125,
+                Self::mul_add(-s_q9, x124, c_q9 * x123),
+            ),
         );
         let x137 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x121,
-            Self::mul_add(-s_q9, x118, c_q9 * x116),
-        );
-        let x138 = x128 * -0.4;
-        let x139 = 0.275 * x125;
-        let x140 = 0.4 * x128;
-        let x141 = -0.275 * x125;
-        let x142 = Self::mul_add(
-            x124,
             -0.4,
+            x119,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x131,
-                Self::mul_add(-s_q9, x130, c_q9 * x129),
+                x128,
+                Self::mul_add(-s_q9, x127, c_q9 * x126),
             ),
         );
-        let x143 = Self::mul_add(
-            -0.4,
-            x125,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x134,
-                Self::mul_add(-s_q9, x133, c_q9 * x132),
-            ),
-        );
-        let x144 = Self::mul_add(
+        let x138 = Self::mul_add(
             0.00000000020510342851533115,
-            x131,
-            Self::mul_add(c_q9, x130, s_q9 * x129),
-        ) - (x138 - x139) - (x141 - x140);
-        let x145 = Self::mul_add(
-            -0.275,
-            x124,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x134,
-                Self::mul_add(c_q9, x133, s_q9 * x132),
-            ),
-        );
-        let x146 = Self::mul_add(
-            -0.4,
-            x124,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x137,
-                Self::mul_add(c_q9, x136, s_q9 * x135),
-            ),
-        );
-        let x147 = Self::mul_add(
             x125,
-            -0.4,
-            Self::mul_add(-0.275, x128, x137 + Self::mul_add(x6, x136, x5 * x135)),
+            Self::mul_add(c_q9, x124, s_q9 * x123),
+        ) - (x132 - x133) - (x135 - x134);
+        let x139 = Self::mul_add(
+            -0.275,
+            x118,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x128,
+                Self::mul_add(c_q9, x127, s_q9 * x126),
+            ),
         );
-        let x148 = -0.000000008530897668050218 + x124;
-        let x149 = -12.701650001451807 + x125;
-        let x150 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x124, x131 + Self::mul_add(x6, x130, x5 * x129));
-        let x151 = -0.002139996587640933 + x142;
-        let x152 = -0.0000000234896432582596 + x145;
-        let x153 = -111.7548902508081
-            + (x134 + Self::mul_add(x6, x133, x5 * x132) + x140 - x138);
-        let x154 = 5.080660024070365 + Self::mul_add(-0.275, x128, x143);
-        let x155 = -0.002139996587640933 + x146;
-        let x156 = 5.080660024070366 + x147;
-        let x157 = 113.3918902508081
-            + (x139
+        let x140 = Self::mul_add(
+            -0.4,
+            x118,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x131,
+                Self::mul_add(c_q9, x130, s_q9 * x129),
+            ),
+        );
+        let x141 = Self::mul_add(
+            x119,
+            -0.4,
+            Self::mul_add(-0.275, x122, x131 + Self::mul_add(x6, x130, x5 * x129)),
+        );
+        let x142 = -0.000000008530897668050218 + x118;
+        let x143 = -12.701650001451807 + x119;
+        let x144 = -0.0000000234896432582596
+            + Self::mul_add(-0.275, x118, x125 + Self::mul_add(x6, x124, x5 * x123));
+        let x145 = -0.002139996587640933 + x136;
+        let x146 = -0.0000000234896432582596 + x139;
+        let x147 = -111.7548902508081
+            + (x128 + Self::mul_add(x6, x127, x5 * x126) + x134 - x132);
+        let x148 = 5.080660024070365 + Self::mul_add(-0.275, x122, x137);
+        let x149 = -0.002139996587640933 + x140;
+        let x150 = 5.080660024070366 + x141;
+        let x151 = 113.3918902508081
+            + (x133
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x137,
-                    Self::mul_add(-s_q9, x136, c_q9 * x135),
-                ) - x141));
-        let x158 = x128 + Self::mul_add(-x3, x149, x2 * x148);
-        let x159 = Self::mul_add(c_q8, x149, s_q8 * x148);
-        let x160 = c_q8 * x148;
-        let x161 = s_q8 * x149;
-        let x162 = Self::mul_add(-0.00000000020510342851533115, x128, x161 - x160);
-        let x163 = x155 + Self::mul_add(-x3, x152, x2 * x144);
-        let x164 = x156 + Self::mul_add(-x3, x153, x2 * x150);
-        let x165 = x157 + Self::mul_add(-x3, x154, x2 * x151);
-        let x166 = Self::mul_add(c_q8, x152, s_q8 * x144);
-        let x167 = Self::mul_add(c_q8, x153, s_q8 * x150);
-        let x168 = Self::mul_add(c_q8, x154, s_q8 * x151);
-        let x169 = Self::mul_add(
+                    x131,
+                    Self::mul_add(-s_q9, x130, c_q9 * x129),
+                ) - x135));
+        let x152 = x122 + Self::mul_add(-x3, x143, x2 * x142);
+        let x153 = Self::mul_add(c_q8, x143, s_q8 * x142);
+        let x154 = c_q8 * x142;
+        let x155 = s_q8 * x143;
+        let x156 = Self::mul_add(-0.00000000020510342851533115, x122, x155 - x154);
+        let x157 = x149 + Self::mul_add(-x3, x146, x2 * x138);
+        let x158 = x150 + Self::mul_add(-x3, x147, x2 * x144);
+        let x159 = x151 + Self::mul_add(-x3, x148, x2 * x145);
+        let x160 = Self::mul_add(c_q8, x146, s_q8 * x138);
+        let x161 = Self::mul_add(c_q8, x147, s_q8 * x144);
+        let x162 = Self::mul_add(c_q8, x148, s_q8 * x145);
+        let x163 = Self::mul_add(
             -0.00000000020510342851533115,
-            x157,
-            Self::mul_add(-c_q8, x151, s_q8 * x154),
+            x151,
+            Self::mul_add(-c_q8, x145, s_q8 * x148),
         );
-        let x170 = Self::mul_add(
+        let x164 = Self::mul_add(
             -c_q8,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x155,
-                Self::mul_add(-c_q8, x144, s_q8 * x152),
+                x149,
+                Self::mul_add(-c_q8, x138, s_q8 * x146),
             ),
             s_q8
                 * Self::mul_add(
                     -0.00000000020510342851533115,
-                    x156,
-                    Self::mul_add(-c_q8, x150, s_q8 * x153),
+                    x150,
+                    Self::mul_add(-c_q8, x144, s_q8 * x147),
                 ),
         );
-        let x171 = x162 * -0.35;
-        let x172 = 0.35 * x162;
-        let x173 = Self::mul_add(
-            x158,
+        let x165 = x156 * -0.35;
+        let x166 = 0.35 * x156;
+        let x167 = Self::mul_add(
+            x152,
             -0.35,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x165,
-                Self::mul_add(-c_q8, x163, s_q8 * x164),
+                x159,
+                Self::mul_add(-c_q8, x157, s_q8 * x158),
             ),
         );
-        let x174 = Self::mul_add(
+        let x168 = Self::mul_add(
             -0.35,
-            x159,
+            x153,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x168,
-                Self::mul_add(-c_q8, x166, s_q8 * x167),
+                x162,
+                Self::mul_add(-c_q8, x160, s_q8 * x161),
             ),
         );
-        let x175 = x172 + (x165 + Self::mul_add(-x3, x164, x2 * x163) - x171);
-        let x176 = 48.0240000085309 + x158;
-        let x177 = -0.07309 + Self::mul_add(c_q8, x164, s_q8 * x163);
-        let x178 = -16.80768997608804 + x173;
-        let x179 = -0.07309 + (x168 + Self::mul_add(-x3, x167, x2 * x166));
-        let x180 = 130.43769025763282
-            + (Self::mul_add(c_q8, x167, s_q8 * x166) + x172 - x171);
-        let x181 = 0.1132 + x174;
-        let x182 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x169, x170);
-        let x183 = Self::mul_add(-s_q7, x159, c_q7 * x176);
-        let x184 = Self::mul_add(c_q7, x159, s_q7 * x176);
-        let x185 = Self::mul_add(-s_q7, x179, c_q7 * x175);
-        let x186 = Self::mul_add(-s_q7, x180, c_q7 * x177);
-        let x187 = -x184;
-        let x188 = x162 * -0.75;
-        let x189 = 0.75 * x162;
-        let x190 = x183 * -0.65;
-        let x191 = 0.65 * x183;
-        let x192 = Self::mul_add(x183, -0.75, Self::mul_add(-s_q7, x181, c_q7 * x178));
-        let x193 = Self::mul_add(-0.75, x184, Self::mul_add(c_q7, x181, s_q7 * x178));
-        let x194 = x182 + x191;
-        let x195 = Self::mul_add(-0.65, x184, Self::mul_add(c_q7, x186, s_q7 * x185));
-        let x196 = 110.5455 + x183;
-        let x197 = 180.9502499901501 + x162;
-        let x198 = 1394.5960312283303
-            + (x189 + (Self::mul_add(-s_q7, x186, c_q7 * x185) - x188));
-        let x199 = -117.61766249359756 + Self::mul_add(x162, -0.65, x192);
-        let x200 = 1466.4506062283303
-            + (Self::mul_add(
-                c_q7,
-                Self::mul_add(c_q7, x180, s_q7 * x177),
-                s_q7 * Self::mul_add(c_q7, x179, s_q7 * x175),
-            ) - (x190 - x189) - (x188 - x191));
-        let x201 = 1271.854575 + (x194 - x190);
-        let x202 = -x197;
-        let x203 = -x196;
-        let x204 = Self::mul_add(x3, x148, x2 * x149);
-        let x205 = x160 - x161;
-        let x206 = Self::mul_add(-0.35, x205, x165);
-        let x207 = Self::mul_add(-0.35, x204, x168);
-        let x208 = Self::mul_add(s_q7, x205, c_q7 * x204);
-        let x209 = -x208;
-        let x210 = Self::mul_add(-s_q7, x204, c_q7 * x205);
-        let x211 = Self::mul_add(-0.75, x210, Self::mul_add(-s_q7, x207, c_q7 * x206));
-        let x212 = Self::mul_add(c_q7, x207, s_q7 * x206)
-            + Self::mul_add(-0.75, x208, x159 * -0.65);
-        let x213 = Self::mul_add(0.65, x210, x169);
-        let x214 = x6 * x100;
-        let x215 = Self::mul_add(-x5, x115, x214);
-        let x216 = x131 + Self::mul_add(-0.275, x123, -0.4 * x215);
-        let x217 = Self::mul_add(0.4, x127, x134);
-        let x218 = Self::mul_add(-0.275, x127, x137);
-        let x219 = Self::mul_add(-x3, x215, x2 * x127) - x123;
-        let x220 = Self::mul_add(c_q8, x215, s_q8 * x127);
-        let x221 = Self::mul_add(
+        let x169 = x166 + (x159 + Self::mul_add(-x3, x158, x2 * x157) - x165);
+        let x170 = 48.0240000085309 + x152;
+        let x171 = -0.07309 + Self::mul_add(c_q8, x158, s_q8 * x157);
+        let x172 = -16.80768997608804 + x167;
+        let x173 = 130.43769025763282
+            + (Self::mul_add(c_q8, x161, s_q8 * x160) + x166 - x165);
+        let x174 = 0.1132 + x168;
+        let x175 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x163, x164);
+        let x176 = s_q7 * s_q7;
+        let x177 = s_q7 * c_q7;
+        let x178 = x169 - x173;
+        let x179 = x171 + x171;
+        let x180 = Self::mul_add(x177, x179, x176 * x178);
+        let x181 = Self::mul_add(-s_q7, x153, c_q7 * x170);
+        let x182 = Self::mul_add(c_q7, x153, s_q7 * x170);
+        let x183 = -x182;
+        let x184 = x156 * -0.75;
+        let x185 = 0.75 * x156;
+        let x186 = x181 * -0.65;
+        let x187 = 0.65 * x181;
+        let x188 = Self::mul_add(x181, -0.75, Self::mul_add(-s_q7, x174, c_q7 * x172));
+        let x189 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x174, s_q7 * x172));
+        let x190 = x175 + x187;
+        let x191 = Self::mul_add(
+            -0.65,
+            x182,
+            x171 + Self::mul_add(-x176, x179, x177 * x178),
+        );
+        let x192 = 110.5455 + x181;
+        let x193 = 180.9502499901501 + x156;
+        let x194 = 1394.5960312283303 + (x185 + (x169 - x180 - x184));
+        let x195 = -117.61766249359756 + Self::mul_add(x156, -0.65, x188);
+        let x196 = 1466.4506062283303 + (x173 + x180 - (x186 - x185) - (x184 - x187));
+        let x197 = 1271.854575 + (x190 - x186);
+        let x198 = -x193;
+        let x199 = -x192;
+        let x200 = Self::mul_add(x3, x142, x2 * x143);
+        let x201 = x154 - x155;
+        let x202 = Self::mul_add(-0.35, x201, x159);
+        let x203 = Self::mul_add(-0.35, x200, x162);
+        let x204 = Self::mul_add(s_q7, x201, c_q7 * x200);
+        let x205 = -x204;
+        let x206 = Self::mul_add(-s_q7, x200, c_q7 * x201);
+        let x207 = Self::mul_add(-0.75, x206, Self::mul_add(-s_q7, x203, c_q7 * x202));
+        let x208 = Self::mul_add(c_q7, x203, s_q7 * x202)
+            + Self::mul_add(-0.75, x204, x153 * -0.65);
+        let x209 = Self::mul_add(0.65, x206, x163);
+        let x210 = x6 * x101;
+        let x211 = Self::mul_add(-x5, x110, x210);
+        let x212 = x125 + Self::mul_add(-0.275, x117, -0.4 * x211);
+        let x213 = Self::mul_add(0.4, x121, x128);
+        let x214 = Self::mul_add(-0.275, x121, x131);
+        let x215 = Self::mul_add(-x3, x211, x2 * x121) - x117;
+        let x216 = Self::mul_add(c_q8, x211, s_q8 * x121);
+        let x217 = Self::mul_add(
             0.00000000020510342851533115,
-            x123,
-            Self::mul_add(-c_q8, x127, s_q8 * x215),
+            x117,
+            Self::mul_add(-c_q8, x121, s_q8 * x211),
         );
-        let x222 = Self::mul_add(
+        let x218 = Self::mul_add(
             -0.00000000020510342851533115,
-            x218,
-            Self::mul_add(-c_q8, x216, s_q8 * x217),
+            x214,
+            Self::mul_add(-c_q8, x212, s_q8 * x213),
         );
-        let x223 = Self::mul_add(
+        let x219 = Self::mul_add(
             -0.35,
-            x220,
-            x218 + Self::mul_add(-x3, x217, x2 * x216),
+            x216,
+            x214 + Self::mul_add(-x3, x213, x2 * x212),
         );
-        let x224 = Self::mul_add(0.35, x219, Self::mul_add(c_q8, x217, s_q8 * x216));
-        let x225 = Self::mul_add(-s_q7, x220, c_q7 * x219);
-        let x226 = Self::mul_add(c_q7, x220, s_q7 * x219);
-        let x227 = Self::mul_add(-0.75, x226, Self::mul_add(-s_q7, x224, c_q7 * x223));
-        let x228 = Self::mul_add(c_q7, x224, s_q7 * x223)
-            + Self::mul_add(-0.65, x221, 0.75 * x225);
-        let x229 = Self::mul_add(0.65, x226, x222);
-        let x230 = Self::mul_add(-s_q9, x102, x126);
-        let x231 = Self::mul_add(-x5, x102, x214);
-        let x232 = Self::mul_add(c_q9, x102, x122);
-        let x233 = Self::mul_add(
+        let x220 = Self::mul_add(0.35, x215, Self::mul_add(c_q8, x213, s_q8 * x212));
+        let x221 = Self::mul_add(-s_q7, x216, c_q7 * x215);
+        let x222 = Self::mul_add(c_q7, x216, s_q7 * x215);
+        let x223 = Self::mul_add(-0.75, x222, Self::mul_add(-s_q7, x220, c_q7 * x219));
+        let x224 = Self::mul_add(c_q7, x220, s_q7 * x219)
+            + Self::mul_add(-0.65, x217, 0.75 * x221);
+        let x225 = Self::mul_add(0.65, x222, x218);
+        let x226 = Self::mul_add(-s_q9, x103, x120);
+        let x227 = Self::mul_add(-x5, x103, x210);
+        let x228 = Self::mul_add(c_q9, x103, x116);
+        let x229 = Self::mul_add(
             0.00000000020510342851533115,
-            x112,
-            Self::mul_add(c_q9, x108, s_q9 * x105),
-        ) + Self::mul_add(-0.275, x232, -0.4 * x231);
-        let x234 = Self::mul_add(0.4, x230, x112 + Self::mul_add(x6, x108, x5 * x105));
+            x107,
+            Self::mul_add(c_q9, x99, s_q9 * x98),
+        ) + Self::mul_add(-0.275, x228, -0.4 * x227);
+        let x230 = Self::mul_add(0.4, x226, x107 + Self::mul_add(x6, x99, x5 * x98));
+        let x231 = Self::mul_add(
+            -0.275,
+            x226,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x107,
+                Self::mul_add(-s_q9, x99, c_q9 * x98),
+            ),
+        );
+        let x232 = Self::mul_add(-x3, x227, x2 * x226) - x228;
+        let x233 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x234 = Self::mul_add(
+            0.00000000020510342851533115,
+            x228,
+            Self::mul_add(-c_q8, x226, s_q8 * x227),
+        );
         let x235 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x231,
+            Self::mul_add(-c_q8, x229, s_q8 * x230),
+        );
+        let x236 = Self::mul_add(
+            -0.35,
+            x233,
+            x231 + Self::mul_add(-x3, x230, x2 * x229),
+        );
+        let x237 = Self::mul_add(0.35, x232, Self::mul_add(c_q8, x230, s_q8 * x229));
+        let x238 = Self::mul_add(-s_q7, x233, c_q7 * x232);
+        let x239 = Self::mul_add(c_q7, x233, s_q7 * x232);
+        let x240 = Self::mul_add(-0.75, x239, Self::mul_add(-s_q7, x237, c_q7 * x236));
+        let x241 = Self::mul_add(c_q7, x237, s_q7 * x236)
+            + Self::mul_add(-0.65, x234, 0.75 * x238);
+        let x242 = Self::mul_add(0.65, x239, x235);
+        let x243 = Self::mul_add(c_q10, x77, x102);
+        let x244 = Self::mul_add(-s_q10, x77, x100);
+        let x245 = Self::mul_add(-s_q10, x84, c_q10 * x83);
+        let x246 = Self::mul_add(c_q10, x84, s_q10 * x83);
+        let x247 = Self::mul_add(-0.87, x243, x85);
+        let x248 = Self::mul_add(-s_q9, x243, c_q9 * x244);
+        let x249 = Self::mul_add(-x5, x243, x6 * x244);
+        let x250 = Self::mul_add(s_q9, x244, c_q9 * x243);
+        let x251 = Self::mul_add(
+            0.00000000020510342851533115,
+            x247,
+            Self::mul_add(c_q9, x246, s_q9 * x245),
+        ) + Self::mul_add(-0.275, x250, -0.4 * x249);
+        let x252 = Self::mul_add(0.4, x248, x247 + Self::mul_add(x6, x246, x5 * x245));
+        let x253 = Self::mul_add(
             -0.275,
-            x230,
+            x248,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x112,
-                Self::mul_add(-s_q9, x108, c_q9 * x105),
+                x247,
+                Self::mul_add(-s_q9, x246, c_q9 * x245),
             ),
         );
-        let x236 = Self::mul_add(-x3, x231, x2 * x230) - x232;
-        let x237 = Self::mul_add(c_q8, x231, s_q8 * x230);
-        let x238 = Self::mul_add(
+        let x254 = Self::mul_add(-x3, x249, x2 * x248) - x250;
+        let x255 = Self::mul_add(c_q8, x249, s_q8 * x248);
+        let x256 = Self::mul_add(
             0.00000000020510342851533115,
-            x232,
-            Self::mul_add(-c_q8, x230, s_q8 * x231),
+            x250,
+            Self::mul_add(-c_q8, x248, s_q8 * x249),
         );
-        let x239 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x235,
-            Self::mul_add(-c_q8, x233, s_q8 * x234),
-        );
-        let x240 = Self::mul_add(
-            -0.35,
-            x237,
-            x235 + Self::mul_add(-x3, x234, x2 * x233),
-        );
-        let x241 = Self::mul_add(0.35, x236, Self::mul_add(c_q8, x234, s_q8 * x233));
-        let x242 = Self::mul_add(-s_q7, x237, c_q7 * x236);
-        let x243 = Self::mul_add(c_q7, x237, s_q7 * x236);
-        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x241, c_q7 * x240));
-        let x245 = Self::mul_add(c_q7, x241, s_q7 * x240)
-            + Self::mul_add(-0.65, x238, 0.75 * x242);
-        let x246 = Self::mul_add(0.65, x243, x239);
-        let x247 = Self::mul_add(c_q10, x76, x101);
-        let x248 = Self::mul_add(-s_q10, x76, x99);
-        let x249 = Self::mul_add(-s_q10, x87, c_q10 * x86);
-        let x250 = Self::mul_add(c_q10, x87, s_q10 * x86);
-        let x251 = Self::mul_add(-0.87, x247, x88);
-        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
-        let x253 = Self::mul_add(-x5, x247, x6 * x248);
-        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
-        let x255 = Self::mul_add(
-            0.00000000020510342851533115,
-            x251,
-            Self::mul_add(c_q9, x250, s_q9 * x249),
-        ) + Self::mul_add(-0.275, x254, -0.4 * x253);
-        let x256 = Self::mul_add(0.4, x252, x251 + Self::mul_add(x6, x250, x5 * x249));
         let x257 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x253,
+            Self::mul_add(-c_q8, x251, s_q8 * x252),
+        );
+        let x258 = Self::mul_add(
+            -0.35,
+            x255,
+            x253 + Self::mul_add(-x3, x252, x2 * x251),
+        );
+        let x259 = Self::mul_add(0.35, x254, Self::mul_add(c_q8, x252, s_q8 * x251));
+        let x260 = Self::mul_add(-s_q7, x255, c_q7 * x254);
+        let x261 = Self::mul_add(c_q7, x255, s_q7 * x254);
+        let x262 = Self::mul_add(-0.75, x261, Self::mul_add(-s_q7, x259, c_q7 * x258));
+        let x263 = Self::mul_add(c_q7, x259, s_q7 * x258)
+            + Self::mul_add(-0.65, x256, 0.75 * x260);
+        let x264 = Self::mul_add(0.65, x261, x257);
+        let x265 = Self::mul_add(-x10, x37, x11 * x36);
+        let x266 = x47 - x46;
+        let x267 = Self::mul_add(0.36, x265, x54);
+        let x268 = Self::mul_add(0.36, x50, x57);
+        let x269 = Self::mul_add(s_q11, x265, c_q11 * x50);
+        let x270 = Self::mul_add(-s_q11, x50, c_q11 * x265);
+        let x271 = Self::mul_add(-s_q11, x268, c_q11 * x267)
+            + Self::mul_add(-0.63, x266, 0.275 * x270);
+        let x272 = Self::mul_add(0.275, x269, Self::mul_add(c_q11, x268, s_q11 * x267));
+        let x273 = Self::mul_add(-0.63, x269, x58);
+        let x274 = Self::mul_add(s_q10, x270, c_q10 * x269);
+        let x275 = Self::mul_add(-s_q10, x269, c_q10 * x270);
+        let x276 = Self::mul_add(c_q10, x272, s_q10 * x271);
+        let x277 = Self::mul_add(-0.87, x266, Self::mul_add(-s_q10, x272, c_q10 * x271));
+        let x278 = Self::mul_add(-0.87, x274, x273);
+        let x279 = Self::mul_add(
+            0.00000000020510342851533115,
+            x266,
+            Self::mul_add(-s_q9, x274, c_q9 * x275),
+        );
+        let x280 = x266 + Self::mul_add(-x5, x274, x6 * x275);
+        let x281 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x266,
+            -Self::mul_add(s_q9, x275, c_q9 * x274),
+        );
+        let x282 = Self::mul_add(
+            0.00000000020510342851533115,
+            x278,
+            Self::mul_add(c_q9, x276, s_q9 * x277),
+        ) + Self::mul_add(0.275, x281, -0.4 * x280);
+        let x283 = Self::mul_add(0.4, x279, x278 + Self::mul_add(x6, x276, x5 * x277));
+        let x284 = Self::mul_add(
             -0.275,
-            x252,
+            x279,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x251,
-                Self::mul_add(-s_q9, x250, c_q9 * x249),
+                x278,
+                Self::mul_add(-s_q9, x276, c_q9 * x277),
             ),
         );
-        let x258 = Self::mul_add(-x3, x253, x2 * x252) - x254;
-        let x259 = Self::mul_add(c_q8, x253, s_q8 * x252);
-        let x260 = Self::mul_add(
-            0.00000000020510342851533115,
-            x254,
-            Self::mul_add(-c_q8, x252, s_q8 * x253),
-        );
-        let x261 = Self::mul_add(
+        let x285 = x281 + Self::mul_add(-x3, x280, x2 * x279);
+        let x286 = Self::mul_add(c_q8, x280, s_q8 * x279);
+        let x287 = Self::mul_add(
             -0.00000000020510342851533115,
-            x257,
-            Self::mul_add(-c_q8, x255, s_q8 * x256),
+            x281,
+            Self::mul_add(-c_q8, x279, s_q8 * x280),
         );
-        let x262 = Self::mul_add(
-            -0.35,
-            x259,
-            x257 + Self::mul_add(-x3, x256, x2 * x255),
-        );
-        let x263 = Self::mul_add(0.35, x258, Self::mul_add(c_q8, x256, s_q8 * x255));
-        let x264 = Self::mul_add(-s_q7, x259, c_q7 * x258);
-        let x265 = Self::mul_add(c_q7, x259, s_q7 * x258);
-        let x266 = Self::mul_add(-0.75, x265, Self::mul_add(-s_q7, x263, c_q7 * x262));
-        let x267 = Self::mul_add(c_q7, x263, s_q7 * x262)
-            + Self::mul_add(-0.65, x260, 0.75 * x264);
-        let x268 = Self::mul_add(0.65, x265, x261);
-        let x269 = Self::mul_add(-x10, x37, x11 * x36);
-        let x270 = x47 - x46;
-        let x271 = Self::mul_add(0.36, x269, x54);
-        let x272 = Self::mul_add(0.36, x50, x57);
-        let x273 = Self::mul_add(s_q11, x269, c_q11 * x50);
-        let x274 = Self::mul_add(-s_q11, x50, c_q11 * x269);
-        let x275 = Self::mul_add(-s_q11, x272, c_q11 * x271)
-            + Self::mul_add(-0.63, x270, 0.275 * x274);
-        let x276 = Self::mul_add(0.275, x273, Self::mul_add(c_q11, x272, s_q11 * x271));
-        let x277 = Self::mul_add(-0.63, x273, x60);
-        let x278 = Self::mul_add(s_q10, x274, c_q10 * x273);
-        let x279 = Self::mul_add(-s_q10, x273, c_q10 * x274);
-        let x280 = Self::mul_add(c_q10, x276, s_q10 * x275);
-        let x281 = Self::mul_add(-0.87, x270, Self::mul_add(-s_q10, x276, c_q10 * x275));
-        let x282 = Self::mul_add(-0.87, x278, x277);
-        let x283 = Self::mul_add(
-            0.00000000020510342851533115,
-            x270,
-            Self::mul_add(-s_q9, x278, c_q9 * x279),
-        );
-        let x284 = x270 + Self::mul_add(-x5, x278, x6 * x279);
-        let x285 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x270,
-            -Self::mul_add(s_q9, x279, c_q9 * x278),
-        );
-        let x286 = Self::mul_add(
-            0.00000000020510342851533115,
-            x282,
-            Self::mul_add(c_q9, x280, s_q9 * x281),
-        ) + Self::mul_add(0.275, x285, -0.4 * x284);
-        let x287 = Self::mul_add(0.4, x283, x282 + Self::mul_add(x6, x280, x5 * x281));
         let x288 = Self::mul_add(
-            -0.275,
-            x283,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x282,
-                Self::mul_add(-s_q9, x280, c_q9 * x281),
-            ),
-        );
-        let x289 = x285 + Self::mul_add(-x3, x284, x2 * x283);
-        let x290 = Self::mul_add(c_q8, x284, s_q8 * x283);
-        let x291 = Self::mul_add(
             -0.00000000020510342851533115,
-            x285,
-            Self::mul_add(-c_q8, x283, s_q8 * x284),
+            x284,
+            Self::mul_add(-c_q8, x282, s_q8 * x283),
         );
-        let x292 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x288,
-            Self::mul_add(-c_q8, x286, s_q8 * x287),
-        );
-        let x293 = Self::mul_add(
+        let x289 = Self::mul_add(
             -0.35,
-            x290,
-            x288 + Self::mul_add(-x3, x287, x2 * x286),
+            x286,
+            x284 + Self::mul_add(-x3, x283, x2 * x282),
         );
-        let x294 = Self::mul_add(0.35, x289, Self::mul_add(c_q8, x287, s_q8 * x286));
-        let x295 = Self::mul_add(-s_q7, x290, c_q7 * x289);
-        let x296 = Self::mul_add(c_q7, x290, s_q7 * x289);
-        let x297 = Self::mul_add(-0.75, x296, Self::mul_add(-s_q7, x294, c_q7 * x293));
-        let x298 = Self::mul_add(c_q7, x294, s_q7 * x293)
-            + Self::mul_add(-0.65, x291, 0.75 * x295);
-        let x299 = Self::mul_add(0.65, x296, x292);
-        let x300 = x13 * -4.806620000000001;
-        let x301 = s_q13 * -4.806620000000001;
-        let x302 = c_q13 * -4.806620000000001;
-        let x303 = x20 + Self::mul_add(-0.55, x302, -0.16 * x301);
-        let x304 = Self::mul_add(0.16, x300, x24);
-        let x305 = Self::mul_add(-0.55, x300, x27);
-        let x306 = Self::mul_add(-s_q12, x301, c_q12 * x300);
-        let x307 = Self::mul_add(x11, x301, x10 * x300) - x302;
-        let x308 = Self::mul_add(
+        let x290 = Self::mul_add(0.35, x285, Self::mul_add(c_q8, x283, s_q8 * x282));
+        let x291 = Self::mul_add(-s_q7, x286, c_q7 * x285);
+        let x292 = Self::mul_add(c_q7, x286, s_q7 * x285);
+        let x293 = Self::mul_add(-0.75, x292, Self::mul_add(-s_q7, x290, c_q7 * x289));
+        let x294 = Self::mul_add(c_q7, x290, s_q7 * x289)
+            + Self::mul_add(-0.65, x287, 0.75 * x291);
+        let x295 = Self::mul_add(0.65, x292, x288);
+        let x296 = x13 * -4.806620000000001;
+        let x297 = s_q13 * -4.806620000000001;
+        let x298 = c_q13 * -4.806620000000001;
+        let x299 = x20 + Self::mul_add(-0.55, x298, -0.16 * x297);
+        let x300 = Self::mul_add(0.16, x296, x24);
+        let x301 = Self::mul_add(-0.55, x296, x27);
+        let x302 = Self::mul_add(-s_q12, x297, c_q12 * x296);
+        let x303 = Self::mul_add(x11, x297, x10 * x296) - x298;
+        let x304 = Self::mul_add(
             -0.00000000020510342851533115,
-            x302,
-            Self::mul_add(c_q12, x301, s_q12 * x300),
+            x298,
+            Self::mul_add(c_q12, x297, s_q12 * x296),
         );
-        let x309 = Self::mul_add(
+        let x305 = Self::mul_add(
             -0.00000000020510342851533115,
-            x305,
-            -Self::mul_add(c_q12, x304, s_q12 * x303),
+            x301,
+            -Self::mul_add(c_q12, x300, s_q12 * x299),
         );
-        let x310 = Self::mul_add(0.36, x307, Self::mul_add(-s_q12, x304, c_q12 * x303));
-        let x311 = Self::mul_add(
+        let x306 = Self::mul_add(0.36, x303, Self::mul_add(-s_q12, x300, c_q12 * x299));
+        let x307 = Self::mul_add(
             -0.36,
-            x306,
-            x305 + Self::mul_add(x11, x304, x10 * x303),
+            x302,
+            x301 + Self::mul_add(x11, x300, x10 * x299),
         );
-        let x312 = Self::mul_add(-s_q11, x307, c_q11 * x306);
-        let x313 = Self::mul_add(c_q11, x307, s_q11 * x306);
-        let x314 = Self::mul_add(-s_q11, x311, c_q11 * x310)
-            + Self::mul_add(0.63, x308, 0.275 * x313);
-        let x315 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x311, s_q11 * x310));
-        let x316 = Self::mul_add(0.63, x312, x309);
-        let x317 = Self::mul_add(-s_q10, x313, c_q10 * x312);
-        let x318 = Self::mul_add(c_q10, x313, s_q10 * x312);
-        let x319 = Self::mul_add(c_q10, x315, s_q10 * x314);
-        let x320 = Self::mul_add(0.87, x308, Self::mul_add(-s_q10, x315, c_q10 * x314));
-        let x321 = Self::mul_add(0.87, x317, x316);
-        let x322 = Self::mul_add(
+        let x308 = Self::mul_add(-s_q11, x303, c_q11 * x302);
+        let x309 = Self::mul_add(c_q11, x303, s_q11 * x302);
+        let x310 = Self::mul_add(-s_q11, x307, c_q11 * x306)
+            + Self::mul_add(0.63, x304, 0.275 * x309);
+        let x311 = Self::mul_add(-0.275, x308, Self::mul_add(c_q11, x307, s_q11 * x306));
+        let x312 = Self::mul_add(0.63, x308, x305);
+        let x313 = Self::mul_add(-s_q10, x309, c_q10 * x308);
+        let x314 = Self::mul_add(c_q10, x309, s_q10 * x308);
+        let x315 = Self::mul_add(c_q10, x311, s_q10 * x310);
+        let x316 = Self::mul_add(0.87, x304, Self::mul_add(-s_q10, x311, c_q10 * x310));
+        let x317 = Self::mul_add(0.87, x313, x312);
+        let x318 = Self::mul_add(
             -0.00000000020510342851533115,
-            x308,
-            Self::mul_add(c_q9, x318, s_q9 * x317),
+            x304,
+            Self::mul_add(c_q9, x314, s_q9 * x313),
         );
-        let x323 = Self::mul_add(x6, x318, x5 * x317) - x308;
-        let x324 = Self::mul_add(
+        let x319 = Self::mul_add(x6, x314, x5 * x313) - x304;
+        let x320 = Self::mul_add(
             0.00000000020510342851533115,
-            x308,
-            Self::mul_add(-s_q9, x318, c_q9 * x317),
+            x304,
+            Self::mul_add(-s_q9, x314, c_q9 * x313),
         );
-        let x325 = Self::mul_add(
+        let x321 = Self::mul_add(
             0.00000000020510342851533115,
-            x321,
-            Self::mul_add(c_q9, x319, s_q9 * x320),
-        ) + Self::mul_add(0.275, x324, -0.4 * x323);
-        let x326 = Self::mul_add(0.4, x322, x321 + Self::mul_add(x6, x319, x5 * x320));
-        let x327 = Self::mul_add(
+            x317,
+            Self::mul_add(c_q9, x315, s_q9 * x316),
+        ) + Self::mul_add(0.275, x320, -0.4 * x319);
+        let x322 = Self::mul_add(0.4, x318, x317 + Self::mul_add(x6, x315, x5 * x316));
+        let x323 = Self::mul_add(
             -0.275,
-            x322,
+            x318,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x321,
-                Self::mul_add(-s_q9, x319, c_q9 * x320),
+                x317,
+                Self::mul_add(-s_q9, x315, c_q9 * x316),
             ),
         );
-        let x328 = x324 + Self::mul_add(-x3, x323, x2 * x322);
-        let x329 = Self::mul_add(c_q8, x323, s_q8 * x322);
-        let x330 = Self::mul_add(
+        let x324 = x320 + Self::mul_add(-x3, x319, x2 * x318);
+        let x325 = Self::mul_add(c_q8, x319, s_q8 * x318);
+        let x326 = Self::mul_add(
             -0.00000000020510342851533115,
-            x324,
-            Self::mul_add(-c_q8, x322, s_q8 * x323),
+            x320,
+            Self::mul_add(-c_q8, x318, s_q8 * x319),
         );
-        let x331 = Self::mul_add(
+        let x327 = Self::mul_add(
             -0.00000000020510342851533115,
-            x327,
-            Self::mul_add(-c_q8, x325, s_q8 * x326),
+            x323,
+            Self::mul_add(-c_q8, x321, s_q8 * x322),
         );
-        let x332 = Self::mul_add(
+        let x328 = Self::mul_add(
             -0.35,
-            x329,
-            x327 + Self::mul_add(-x3, x326, x2 * x325),
+            x325,
+            x323 + Self::mul_add(-x3, x322, x2 * x321),
         );
-        let x333 = Self::mul_add(0.35, x328, Self::mul_add(c_q8, x326, s_q8 * x325));
-        let x334 = Self::mul_add(-s_q7, x329, c_q7 * x328);
-        let x335 = Self::mul_add(c_q7, x329, s_q7 * x328);
-        let x336 = Self::mul_add(-0.75, x335, Self::mul_add(-s_q7, x333, c_q7 * x332));
-        let x337 = Self::mul_add(c_q7, x333, s_q7 * x332)
-            + Self::mul_add(-0.65, x330, 0.75 * x334);
-        let x338 = Self::mul_add(0.65, x335, x331);
-        let x339 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x340 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x341 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x342 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x343 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x344 = v[4] * v[4];
-        let x345 = Self::mul_add(v[5], v[5], x344);
-        let x346 = v[3] * v[4];
-        let x347 = v[3] * v[5];
-        let x348 = v[4] * v[5];
-        let x349 = Self::mul_add(v[3], v[3], x344);
-        let x350 = x339 + Self::mul_add(-0.65, x345, 0.75 * x347);
-        let x351 = x340 + Self::mul_add(0.75, x348, 0.65 * x346);
-        let x352 = x341 + Self::mul_add(-0.75, x349, 0.65 * x347);
-        let x353 = Self::mul_add(-s_q7, x350, c_q7 * x351);
-        let x354 = v[6] * x343;
-        let x355 = v[6] * x342;
-        let x356 = v[5] + v[6];
-        let x357 = x343 * x343;
-        let x358 = x342 * x356;
-        let x359 = Self::mul_add(-16.80768997608804, x356, -0.07309 * x343);
-        let x360 = Self::mul_add(
+        let x329 = Self::mul_add(0.35, x324, Self::mul_add(c_q8, x322, s_q8 * x321));
+        let x330 = Self::mul_add(-s_q7, x325, c_q7 * x324);
+        let x331 = Self::mul_add(c_q7, x325, s_q7 * x324);
+        let x332 = Self::mul_add(-0.75, x331, Self::mul_add(-s_q7, x329, c_q7 * x328));
+        let x333 = Self::mul_add(c_q7, x329, s_q7 * x328)
+            + Self::mul_add(-0.65, x326, 0.75 * x330);
+        let x334 = Self::mul_add(0.65, x331, x327);
+        let x335 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
+        let x336 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x337 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
+        let x338 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x339 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x340 = v[4] * v[4];
+        let x341 = Self::mul_add(v[5], v[5], x340);
+        let x342 = v[3] * v[4];
+        let x343 = v[3] * v[5];
+        let x344 = v[4] * v[5];
+        let x345 = Self::mul_add(v[3], v[3], x340);
+        let x346 = x335 + Self::mul_add(-0.65, x341, 0.75 * x343);
+        let x347 = x336 + Self::mul_add(0.75, x344, 0.65 * x342);
+        let x348 = x337 + Self::mul_add(-0.75, x345, 0.65 * x343);
+        let x349 = Self::mul_add(-s_q7, x346, c_q7 * x347);
+        let x350 = v[6] * x339;
+        let x351 = v[6] * x338;
+        let x352 = v[5] + v[6];
+        let x353 = x339 * x339;
+        let x354 = x338 * x352;
+        let x355 = Self::mul_add(-16.80768997608804, x352, -0.07309 * x339);
+        let x356 = Self::mul_add(
             0.1132,
-            x356,
-            Self::mul_add(130.43769025763282, x343, -0.07309 * x342),
+            x352,
+            Self::mul_add(130.43769025763282, x339, -0.07309 * x338),
         );
-        let x361 = Self::mul_add(
+        let x357 = Self::mul_add(
             132.47349025763282,
-            x356,
-            Self::mul_add(0.1132, x343, -16.80768997608804 * x342),
+            x352,
+            Self::mul_add(0.1132, x339, -16.80768997608804 * x338),
         );
-        let x362 = Self::mul_add(-c_q8, x356, Self::mul_add(s_q8, x343, x2 * x342));
-        let x363 = Self::mul_add(s_q8, x356, Self::mul_add(-x3, x342, c_q8 * x343));
-        let x364 = Self::mul_add(
+        let x358 = Self::mul_add(-c_q8, x352, Self::mul_add(s_q8, x339, x2 * x338));
+        let x359 = Self::mul_add(s_q8, x352, Self::mul_add(-x3, x338, c_q8 * x339));
+        let x360 = Self::mul_add(
             0.35,
-            x358 - x355,
-            Self::mul_add(s_q7, x351, c_q7 * x350),
+            x354 - x351,
+            Self::mul_add(s_q7, x347, c_q7 * x346),
         );
-        let x365 = Self::mul_add(0.35, Self::mul_add(x343, x356, -x354), x353);
-        let x366 = Self::mul_add(-0.35, Self::mul_add(x342, x342, x357), x352);
-        let x367 = Self::mul_add(-c_q8, x366, Self::mul_add(s_q8, x365, x2 * x364));
-        let x368 = Self::mul_add(s_q8, x366, Self::mul_add(-x3, x364, c_q8 * x365));
-        let x369 = Self::mul_add(-0.00000000020510342851533115, x366, x364);
-        let x370 = Self::mul_add(v[7], x363, Self::mul_add(-s_q8, x355, x2 * x354));
-        let x371 = Self::mul_add(v[7], x362, Self::mul_add(c_q8, x355, x3 * x354));
-        let x372 = v[7] + Self::mul_add(-0.00000000020510342851533115, x356, x342);
-        let x373 = x363 * x363;
-        let x374 = x372 * x372;
-        let x375 = x362 * x363;
-        let x376 = x375 - x354;
-        let x377 = x362 * x372;
-        let x378 = x362 * x362;
-        let x379 = x374 + x378;
-        let x380 = x363 * x372;
-        let x381 = x370 + x380;
-        let x382 = Self::mul_add(
+        let x361 = Self::mul_add(0.35, Self::mul_add(x339, x352, -x350), x349);
+        let x362 = Self::mul_add(-0.35, Self::mul_add(x338, x338, x353), x348);
+        let x363 = Self::mul_add(-c_q8, x362, Self::mul_add(s_q8, x361, x2 * x360));
+        let x364 = Self::mul_add(s_q8, x362, Self::mul_add(-x3, x360, c_q8 * x361));
+        let x365 = Self::mul_add(-0.00000000020510342851533115, x362, x360);
+        let x366 = Self::mul_add(v[7], x359, Self::mul_add(-s_q8, x351, x2 * x350));
+        let x367 = Self::mul_add(v[7], x358, Self::mul_add(c_q8, x351, x3 * x350));
+        let x368 = v[7] + Self::mul_add(-0.00000000020510342851533115, x352, x338);
+        let x369 = x359 * x359;
+        let x370 = x368 * x368;
+        let x371 = x358 * x359;
+        let x372 = x371 - x350;
+        let x373 = x358 * x368;
+        let x374 = x358 * x358;
+        let x375 = x370 + x374;
+        let x376 = x359 * x368;
+        let x377 = x366 + x376;
+        let x378 = Self::mul_add(
             -0.002139996587640933,
-            x372,
-            -0.0000000234896432582596 * x363,
+            x368,
+            -0.0000000234896432582596 * x359,
         );
-        let x383 = Self::mul_add(
+        let x379 = Self::mul_add(
             5.080660024070365,
-            x372,
-            Self::mul_add(-111.7548902508081, x363, -0.0000000234896432582596 * x362),
+            x368,
+            Self::mul_add(-111.7548902508081, x359, -0.0000000234896432582596 * x358),
         );
-        let x384 = Self::mul_add(
+        let x380 = Self::mul_add(
             113.3918902508081,
-            x372,
-            Self::mul_add(5.080660024070366, x363, -0.002139996587640933 * x362),
+            x368,
+            Self::mul_add(5.080660024070366, x359, -0.002139996587640933 * x358),
         );
-        let x385 = Self::mul_add(
-            x369,
+        let x381 = Self::mul_add(
+            x365,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x354,
-                Self::mul_add(111.7548902508081, x371, -0.0000000234896432582596 * x370),
-            ) + Self::mul_add(-x362, x384, x372 * x382),
+                x350,
+                Self::mul_add(111.7548902508081, x367, -0.0000000234896432582596 * x366),
+            ) + Self::mul_add(-x358, x380, x368 * x378),
         );
-        let x386 = Self::mul_add(c_q9, x372, Self::mul_add(x5, x363, s_q9 * x362));
-        let x387 = Self::mul_add(-s_q9, x372, Self::mul_add(x6, x363, c_q9 * x362));
-        let x388 = x367 + Self::mul_add(0.4, x377 - x371, 0.275 * x376);
-        let x389 = x368 + Self::mul_add(-0.275, x379, 0.4 * (x380 - x370));
-        let x390 = x369 + Self::mul_add(-0.4, x373 + x378, 0.275 * x381);
-        let x391 = Self::mul_add(c_q9, x390, Self::mul_add(x5, x389, s_q9 * x388));
-        let x392 = Self::mul_add(
+        let x382 = Self::mul_add(c_q9, x368, Self::mul_add(x5, x359, s_q9 * x358));
+        let x383 = Self::mul_add(-s_q9, x368, Self::mul_add(x6, x359, c_q9 * x358));
+        let x384 = x363 + Self::mul_add(0.4, x373 - x367, 0.275 * x372);
+        let x385 = x364 + Self::mul_add(-0.275, x375, 0.4 * (x376 - x366));
+        let x386 = x365 + Self::mul_add(-0.4, x369 + x374, 0.275 * x377);
+        let x387 = Self::mul_add(c_q9, x386, Self::mul_add(x5, x385, s_q9 * x384));
+        let x388 = Self::mul_add(
             -0.00000000020510342851533115,
-            x390,
-            Self::mul_add(0.00000000020510342851533115, x388, x389),
-        );
-        let x393 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x354,
-            Self::mul_add(0.00000000020510342851533115, x370, -x371),
-        );
-        let x394 = Self::mul_add(
-            v[8],
-            x387,
-            Self::mul_add(c_q9, x354, Self::mul_add(-x5, x371, s_q9 * x370)),
-        );
-        let x395 = Self::mul_add(
-            -v[8],
             x386,
-            Self::mul_add(-s_q9, x354, Self::mul_add(-x6, x371, c_q9 * x370)),
+            Self::mul_add(0.00000000020510342851533115, x384, x385),
         );
-        let x396 = v[8]
+        let x389 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x350,
+            Self::mul_add(0.00000000020510342851533115, x366, -x367),
+        );
+        let x390 = Self::mul_add(
+            v[8],
+            x383,
+            Self::mul_add(c_q9, x350, Self::mul_add(-x5, x367, s_q9 * x366)),
+        );
+        let x391 = Self::mul_add(
+            -v[8],
+            x382,
+            Self::mul_add(-s_q9, x350, Self::mul_add(-x6, x367, c_q9 * x366)),
+        );
+        let x392 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x372,
-                Self::mul_add(0.00000000020510342851533115, x362, x363),
+                x368,
+                Self::mul_add(0.00000000020510342851533115, x358, x359),
             );
-        let x397 = Self::mul_add(x386, x387, -x393);
-        let x398 = Self::mul_add(x386, x386, x396 * x396);
-        let x399 = Self::mul_add(x387, x396, x394);
-        let x400 = -0.00214 * x396;
-        let x401 = Self::mul_add(-36.18604050126307, x396, -63.36336825000001 * x387);
-        let x402 = Self::mul_add(
+        let x393 = Self::mul_add(x382, x383, -x389);
+        let x394 = Self::mul_add(x382, x382, x392 * x392);
+        let x395 = Self::mul_add(x383, x392, x390);
+        let x396 = -0.00214 * x392;
+        let x397 = Self::mul_add(-36.18604050126307, x392, -63.36336825000001 * x383);
+        let x398 = Self::mul_add(
             69.99836825,
-            x396,
-            Self::mul_add(-36.18604050126307, x387, -0.00214 * x386),
-        );
-        let x403 = Self::mul_add(
-            -81.53205,
             x392,
-            Self::mul_add(-0.00214, x393, Self::mul_add(-x396, x401, x387 * x402)),
+            Self::mul_add(-36.18604050126307, x383, -0.00214 * x382),
         );
-        let x404 = Self::mul_add(
-            x391,
+        let x399 = Self::mul_add(
+            -81.53205,
+            x388,
+            Self::mul_add(-0.00214, x389, Self::mul_add(-x392, x397, x383 * x398)),
+        );
+        let x400 = Self::mul_add(
+            x387,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x393,
-                Self::mul_add(-36.18604050126307, x395, -0.00214 * x394),
-            ) + Self::mul_add(-x387, x400, x386 * x401),
+                x389,
+                Self::mul_add(-36.18604050126307, x391, -0.00214 * x390),
+            ) + Self::mul_add(-x383, x396, x382 * x397),
         );
-        let x405 = Self::mul_add(s_q10, x387, c_q10 * x386);
-        let x406 = Self::mul_add(-s_q10, x386, c_q10 * x387);
-        let x407 = Self::mul_add(-0.87, x397, x391);
-        let x408 = Self::mul_add(
+        let x401 = Self::mul_add(s_q10, x383, c_q10 * x382);
+        let x402 = Self::mul_add(-s_q10, x382, c_q10 * x383);
+        let x403 = Self::mul_add(-0.87, x393, x387);
+        let x404 = Self::mul_add(
             0.87,
-            x398,
-            Self::mul_add(-s_q9, x390, Self::mul_add(x6, x389, c_q9 * x388)),
+            x394,
+            Self::mul_add(-s_q9, x386, Self::mul_add(x6, x385, c_q9 * x384)),
         );
-        let x409 = Self::mul_add(-0.87, x399, x392);
-        let x410 = Self::mul_add(s_q10, x408, c_q10 * x407);
-        let x411 = Self::mul_add(v[9], x406, Self::mul_add(s_q10, x395, c_q10 * x394));
-        let x412 = Self::mul_add(-v[9], x405, Self::mul_add(-s_q10, x394, c_q10 * x395));
-        let x413 = v[9] + x396;
-        let x414 = Self::mul_add(x405, x406, -x393);
-        let x415 = x405 * x405;
-        let x416 = Self::mul_add(x413, x413, x415);
-        let x417 = x406 * x413;
-        let x418 = x411 + x417;
-        let x419 = -0.6328 * x413;
-        let x420 = Self::mul_add(-24.35164200091464, x413, -24.4950615 * x406);
-        let x421 = Self::mul_add(
+        let x405 = Self::mul_add(-0.87, x395, x388);
+        let x406 = Self::mul_add(s_q10, x404, c_q10 * x403);
+        let x407 = Self::mul_add(v[9], x402, Self::mul_add(s_q10, x391, c_q10 * x390));
+        let x408 = Self::mul_add(-v[9], x401, Self::mul_add(-s_q10, x390, c_q10 * x391));
+        let x409 = v[9] + x392;
+        let x410 = Self::mul_add(x401, x402, -x389);
+        let x411 = x401 * x401;
+        let x412 = Self::mul_add(x409, x409, x411);
+        let x413 = x402 * x409;
+        let x414 = x407 + x413;
+        let x415 = -0.6328 * x409;
+        let x416 = Self::mul_add(-24.35164200091464, x409, -24.4950615 * x402);
+        let x417 = Self::mul_add(
             28.2393615,
-            x413,
-            Self::mul_add(-24.351642000914637, x406, -0.6328 * x405),
-        );
-        let x422 = Self::mul_add(
-            -45.1584,
             x409,
-            Self::mul_add(-0.6328, x393, Self::mul_add(-x413, x420, x406 * x421)),
+            Self::mul_add(-24.351642000914637, x402, -0.6328 * x401),
         );
-        let x423 = Self::mul_add(
-            x410,
+        let x418 = Self::mul_add(
+            -45.1584,
+            x405,
+            Self::mul_add(-0.6328, x389, Self::mul_add(-x409, x416, x402 * x417)),
+        );
+        let x419 = Self::mul_add(
+            x406,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x393,
-                Self::mul_add(-24.351642000914637, x412, -0.6328 * x411),
-            ) + Self::mul_add(-x406, x419, x405 * x420),
+                x389,
+                Self::mul_add(-24.351642000914637, x408, -0.6328 * x407),
+            ) + Self::mul_add(-x402, x415, x401 * x416),
         );
-        let x424 = Self::mul_add(s_q11, x406, c_q11 * x405);
-        let x425 = Self::mul_add(-s_q11, x405, c_q11 * x406);
-        let x426 = x410
-            + Self::mul_add(-0.275, Self::mul_add(x405, x413, x412), -0.63 * x414);
-        let x427 = Self::mul_add(-s_q10, x407, c_q10 * x408)
-            + Self::mul_add(0.63, x416, -0.275 * (x417 - x411));
-        let x428 = x409
-            + Self::mul_add(0.275, Self::mul_add(x406, x406, x415), -0.63 * x418);
-        let x429 = Self::mul_add(s_q11, x427, c_q11 * x426);
-        let x430 = Self::mul_add(v[10], x425, Self::mul_add(s_q11, x412, c_q11 * x411));
-        let x431 = Self::mul_add(
+        let x420 = Self::mul_add(s_q11, x402, c_q11 * x401);
+        let x421 = Self::mul_add(-s_q11, x401, c_q11 * x402);
+        let x422 = x406
+            + Self::mul_add(-0.275, Self::mul_add(x401, x409, x408), -0.63 * x410);
+        let x423 = Self::mul_add(-s_q10, x403, c_q10 * x404)
+            + Self::mul_add(0.63, x412, -0.275 * (x413 - x407));
+        let x424 = x405
+            + Self::mul_add(0.275, Self::mul_add(x402, x402, x411), -0.63 * x414);
+        let x425 = Self::mul_add(s_q11, x423, c_q11 * x422);
+        let x426 = Self::mul_add(v[10], x421, Self::mul_add(s_q11, x408, c_q11 * x407));
+        let x427 = Self::mul_add(
             -v[10],
-            x424,
-            Self::mul_add(-s_q11, x411, c_q11 * x412),
+            x420,
+            Self::mul_add(-s_q11, x407, c_q11 * x408),
         );
-        let x432 = v[10] + x413;
-        let x433 = x424 * x424;
-        let x434 = x425 * x432;
-        let x435 = 0.01675 * x432;
-        let x436 = Self::mul_add(2.5482240016099564, x432, -9.142025249762803 * x425);
-        let x437 = Self::mul_add(
+        let x428 = v[10] + x409;
+        let x429 = x420 * x420;
+        let x430 = x421 * x428;
+        let x431 = 0.01675 * x428;
+        let x432 = Self::mul_add(2.5482240016099564, x428, -9.142025249762803 * x421);
+        let x433 = Self::mul_add(
             9.223235249762805,
-            x432,
-            Self::mul_add(2.5482240016099564, x425, 0.01675 * x424),
-        );
-        let x438 = Self::mul_add(
-            7.078399999258757,
             x428,
-            Self::mul_add(0.01675, x393, Self::mul_add(-x432, x436, x425 * x437)),
+            Self::mul_add(2.5482240016099564, x421, 0.01675 * x420),
         );
-        let x439 = Self::mul_add(
-            x429,
+        let x434 = Self::mul_add(
+            7.078399999258757,
+            x424,
+            Self::mul_add(0.01675, x389, Self::mul_add(-x428, x432, x421 * x433)),
+        );
+        let x435 = Self::mul_add(
+            x425,
             -7.078399999258757,
             Self::mul_add(
                 9.223235249762805,
-                x393,
-                Self::mul_add(2.5482240016099564, x431, 0.01675 * x430),
-            ) + Self::mul_add(-x425, x435, x424 * x436),
+                x389,
+                Self::mul_add(2.5482240016099564, x427, 0.01675 * x426),
+            ) + Self::mul_add(-x421, x431, x420 * x432),
         );
-        let x440 = Self::mul_add(-s_q12, x432, Self::mul_add(x10, x425, c_q12 * x424));
-        let x441 = Self::mul_add(-c_q12, x432, Self::mul_add(-s_q12, x424, x11 * x425));
-        let x442 = Self::mul_add(-0.36, Self::mul_add(x424, x432, x431), x429);
-        let x443 = Self::mul_add(
+        let x436 = Self::mul_add(-s_q12, x428, Self::mul_add(x10, x421, c_q12 * x420));
+        let x437 = Self::mul_add(-c_q12, x428, Self::mul_add(-s_q12, x420, x11 * x421));
+        let x438 = Self::mul_add(-0.36, Self::mul_add(x420, x428, x427), x425);
+        let x439 = Self::mul_add(
             -0.36,
-            x434 - x430,
-            Self::mul_add(-s_q11, x426, c_q11 * x427),
+            x430 - x426,
+            Self::mul_add(-s_q11, x422, c_q11 * x423),
         );
-        let x444 = Self::mul_add(0.36, Self::mul_add(x425, x425, x433), x428);
-        let x445 = Self::mul_add(-s_q12, x444, Self::mul_add(x10, x443, c_q12 * x442));
-        let x446 = Self::mul_add(-c_q12, x444, Self::mul_add(-s_q12, x442, x11 * x443));
-        let x447 = Self::mul_add(-0.00000000020510342851533115, x444, x443);
-        let x448 = Self::mul_add(-0.00000000020510342851533115, x393, x431);
-        let x449 = Self::mul_add(
+        let x440 = Self::mul_add(0.36, Self::mul_add(x421, x421, x429), x424);
+        let x441 = Self::mul_add(-s_q12, x440, Self::mul_add(x10, x439, c_q12 * x438));
+        let x442 = Self::mul_add(-c_q12, x440, Self::mul_add(-s_q12, x438, x11 * x439));
+        let x443 = Self::mul_add(-0.00000000020510342851533115, x440, x439);
+        let x444 = Self::mul_add(-0.00000000020510342851533115, x389, x427);
+        let x445 = Self::mul_add(
             v[11],
-            x441,
-            Self::mul_add(-s_q12, x393, Self::mul_add(x10, x431, c_q12 * x430)),
+            x437,
+            Self::mul_add(-s_q12, x389, Self::mul_add(x10, x427, c_q12 * x426)),
         );
-        let x450 = Self::mul_add(
+        let x446 = Self::mul_add(
             -v[11],
-            x440,
-            Self::mul_add(-c_q12, x393, Self::mul_add(-s_q12, x430, x11 * x431)),
+            x436,
+            Self::mul_add(-c_q12, x389, Self::mul_add(-s_q12, x426, x11 * x427)),
         );
-        let x451 = v[11] + Self::mul_add(-0.00000000020510342851533115, x432, x425);
-        let x452 = x441 * x441;
-        let x453 = x451 * x451;
-        let x454 = x440 * x441;
-        let x455 = x454 - x448;
-        let x456 = x440 * x451;
-        let x457 = x440 * x440;
-        let x458 = x453 + x457;
-        let x459 = x441 * x451;
-        let x460 = x449 + x459;
-        let x461 = Self::mul_add(-0.809539999555672, x451, -1.9877000000000002 * x441);
-        let x462 = Self::mul_add(
+        let x447 = v[11] + Self::mul_add(-0.00000000020510342851533115, x428, x421);
+        let x448 = x437 * x437;
+        let x449 = x447 * x447;
+        let x450 = x436 * x437;
+        let x451 = x450 - x444;
+        let x452 = x436 * x447;
+        let x453 = x436 * x436;
+        let x454 = x449 + x453;
+        let x455 = x437 * x447;
+        let x456 = x445 + x455;
+        let x457 = Self::mul_add(-0.809539999555672, x447, -1.9877000000000002 * x437);
+        let x458 = Self::mul_add(
             -2.741639999592316,
-            x451,
-            Self::mul_add(-5.252920330000002, x441, -1.9877000000000002 * x440),
-        );
-        let x463 = Self::mul_add(
-            9.740442170000001,
-            x451,
-            Self::mul_add(-2.7416399995923166, x441, -0.809539999555672 * x440),
-        );
-        let x464 = Self::mul_add(
             x447,
+            Self::mul_add(-5.252920330000002, x437, -1.9877000000000002 * x436),
+        );
+        let x459 = Self::mul_add(
+            9.740442170000001,
+            x447,
+            Self::mul_add(-2.7416399995923166, x437, -0.809539999555672 * x436),
+        );
+        let x460 = Self::mul_add(
+            x443,
             -3.6140000000000003,
             Self::mul_add(
                 -2.741639999592316,
-                x448,
-                Self::mul_add(-5.252920330000002, x450, -1.9877000000000002 * x449),
-            ) + Self::mul_add(-x440, x463, x451 * x461),
+                x444,
+                Self::mul_add(-5.252920330000002, x446, -1.9877000000000002 * x445),
+            ) + Self::mul_add(-x436, x459, x447 * x457),
         );
-        let x465 = Self::mul_add(-c_q13, x451, Self::mul_add(s_q13, x441, x13 * x440));
-        let x466 = Self::mul_add(s_q13, x451, Self::mul_add(-x14, x440, c_q13 * x441));
-        let x467 = x445 + Self::mul_add(0.16, x450 + x456, 0.55 * x455);
-        let x468 = x447 + Self::mul_add(-0.16, x452 + x457, 0.55 * x460);
-        let x469 = Self::mul_add(
+        let x461 = Self::mul_add(-c_q13, x447, Self::mul_add(s_q13, x437, x13 * x436));
+        let x462 = Self::mul_add(s_q13, x447, Self::mul_add(-x14, x436, c_q13 * x437));
+        let x463 = x441 + Self::mul_add(0.16, x446 + x452, 0.55 * x451);
+        let x464 = x443 + Self::mul_add(-0.16, x448 + x453, 0.55 * x456);
+        let x465 = Self::mul_add(
             -c_q13,
-            x468,
+            x464,
             Self::mul_add(
                 s_q13,
-                x446 + Self::mul_add(-0.55, x458, 0.16 * (x459 - x449)),
-                x13 * x467,
+                x442 + Self::mul_add(-0.55, x454, 0.16 * (x455 - x445)),
+                x13 * x463,
             ),
         );
-        let x470 = Self::mul_add(-0.00000000020510342851533115, x448, x449);
-        let x471 = Self::mul_add(
+        let x466 = Self::mul_add(-0.00000000020510342851533115, x444, x445);
+        let x467 = Self::mul_add(
             v[12],
-            x466,
-            Self::mul_add(-c_q13, x448, Self::mul_add(s_q13, x450, x13 * x449)),
+            x462,
+            Self::mul_add(-c_q13, x444, Self::mul_add(s_q13, x446, x13 * x445)),
         );
-        let x472 = Self::mul_add(
+        let x468 = Self::mul_add(
             -v[12],
-            x465,
-            Self::mul_add(s_q13, x448, Self::mul_add(-x14, x449, c_q13 * x450)),
+            x461,
+            Self::mul_add(s_q13, x444, Self::mul_add(-x14, x445, c_q13 * x446)),
         );
-        let x473 = v[12] + Self::mul_add(-0.00000000020510342851533115, x451, x440);
-        let x474 = 4.806620000000001 * Self::mul_add(x465, x466, -x470);
-        let x475 = 4.806620000000001 * Self::mul_add(x465, x465, x473 * x473);
-        let x476 = 4.806620000000001 * Self::mul_add(x466, x473, x471);
-        let x477 = Self::mul_add(-0.0145, x473, 0.000781 * x466);
-        let x478 = Self::mul_add(
+        let x469 = v[12] + Self::mul_add(-0.00000000020510342851533115, x447, x436);
+        let x470 = 4.806620000000001 * Self::mul_add(x461, x462, -x466);
+        let x471 = 4.806620000000001 * Self::mul_add(x461, x461, x469 * x469);
+        let x472 = 4.806620000000001 * Self::mul_add(x462, x469, x467);
+        let x473 = Self::mul_add(-0.0145, x469, 0.000781 * x462);
+        let x474 = Self::mul_add(
             -0.9614610000000001,
-            x473,
-            Self::mul_add(-1.2025609200000003, x466, 0.000781 * x465),
-        );
-        let x479 = Self::mul_add(
-            1.4135609200000003,
-            x473,
-            Self::mul_add(-0.9614610000000001, x466, -0.0145 * x465),
-        );
-        let x480 = Self::mul_add(
-            -0.9614610000000001,
-            x470,
-            Self::mul_add(-1.2025609200000003, x472, 0.000781 * x471),
-        ) + Self::mul_add(-x465, x479, x473 * x477);
-        let x481 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x468, x467),
-            Self::mul_add(-0.0145, x470, 0.000781 * x472)
-                + Self::mul_add(-x473, x478, x466 * x479),
-        );
-        let x482 = Self::mul_add(
-            -4.806620000000001,
             x469,
+            Self::mul_add(-1.2025609200000003, x462, 0.000781 * x461),
+        );
+        let x475 = Self::mul_add(
+            1.4135609200000003,
+            x469,
+            Self::mul_add(-0.9614610000000001, x462, -0.0145 * x461),
+        );
+        let x476 = Self::mul_add(
+            -0.9614610000000001,
+            x466,
+            Self::mul_add(-1.2025609200000003, x468, 0.000781 * x467),
+        ) + Self::mul_add(-x461, x475, x469 * x473);
+        let x477 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x464, x463),
+            Self::mul_add(-0.0145, x466, 0.000781 * x468)
+                + Self::mul_add(-x469, x474, x462 * x475),
+        );
+        let x478 = Self::mul_add(
+            -4.806620000000001,
+            x465,
             Self::mul_add(
                 1.4135609200000003,
-                x470,
-                Self::mul_add(-0.9614610000000001, x472, -0.0145 * x471),
-            ) + Self::mul_add(-x466, x477, x465 * x478),
+                x466,
+                Self::mul_add(-0.9614610000000001, x468, -0.0145 * x467),
+            ) + Self::mul_add(-x462, x473, x461 * x474),
         );
-        let x483 = x476 + Self::mul_add(x14, x475, x13 * x474);
-        let x484 = Self::mul_add(-c_q13, x475, s_q13 * x474);
-        let x485 = Self::mul_add(
+        let x479 = x472 + Self::mul_add(x14, x471, x13 * x470);
+        let x480 = Self::mul_add(-c_q13, x471, s_q13 * x470);
+        let x481 = Self::mul_add(
             -0.00000000020510342851533115,
-            x476,
-            -Self::mul_add(s_q13, x475, c_q13 * x474),
+            x472,
+            -Self::mul_add(s_q13, x471, c_q13 * x470),
         );
-        let x486 = Self::mul_add(
+        let x482 = Self::mul_add(
             -0.55,
-            x483,
+            x479,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x482,
-                Self::mul_add(-c_q13, x481, s_q13 * x480),
+                x478,
+                Self::mul_add(-c_q13, x477, s_q13 * x476),
             ),
         );
-        let x487 = Self::mul_add(
+        let x483 = Self::mul_add(
             -3.6140000000000003,
-            x452 + x453,
-            17.135250000000003 * x455,
-        ) + x483;
-        let x488 = Self::mul_add(
+            x448 + x449,
+            17.135250000000003 * x451,
+        ) + x479;
+        let x484 = Self::mul_add(
             -17.135250000000003,
-            x458,
-            3.6140000000000003 * (x448 + x454),
-        ) + x484;
-        let x489 = Self::mul_add(
+            x454,
+            3.6140000000000003 * (x444 + x450),
+        ) + x480;
+        let x485 = Self::mul_add(
             17.135250000000003,
-            x460,
-            3.6140000000000003 * (x456 - x450),
-        ) + x485;
-        let x490 = Self::mul_add(
+            x456,
+            3.6140000000000003 * (x452 - x446),
+        ) + x481;
+        let x486 = Self::mul_add(
             17.135250000000003,
-            x447,
-            Self::mul_add(-0.809539999555672, x448, -1.9877000000000002 * x450)
-                + Self::mul_add(-x451, x462, x441 * x463),
+            x443,
+            Self::mul_add(-0.809539999555672, x444, -1.9877000000000002 * x446)
+                + Self::mul_add(-x447, x458, x437 * x459),
         )
-            + (x482 + Self::mul_add(-x14, x480, x13 * x481)
-                + Self::mul_add(0.55, x485, -0.16 * x484));
-        let x491 = x464
-            + Self::mul_add(0.16, x483, Self::mul_add(c_q13, x480, s_q13 * x481));
-        let x492 = Self::mul_add(
+            + (x478 + Self::mul_add(-x14, x476, x13 * x477)
+                + Self::mul_add(0.55, x481, -0.16 * x480));
+        let x487 = x460
+            + Self::mul_add(0.16, x479, Self::mul_add(c_q13, x476, s_q13 * x477));
+        let x488 = Self::mul_add(
             9.740442170000001,
-            x448,
-            Self::mul_add(-2.7416399995923166, x450, -0.809539999555672 * x449),
-        ) + Self::mul_add(-x441, x461, x440 * x462)
-            + Self::mul_add(3.6140000000000003, x446, x445 * -17.135250000000003) + x486;
-        let x493 = Self::mul_add(-s_q12, x488, c_q12 * x487);
-        let x494 = x489 + Self::mul_add(x11, x488, x10 * x487);
-        let x495 = Self::mul_add(
+            x444,
+            Self::mul_add(-2.7416399995923166, x446, -0.809539999555672 * x445),
+        ) + Self::mul_add(-x437, x457, x436 * x458)
+            + Self::mul_add(3.6140000000000003, x442, x441 * -17.135250000000003) + x482;
+        let x489 = Self::mul_add(-s_q12, x484, c_q12 * x483);
+        let x490 = x485 + Self::mul_add(x11, x484, x10 * x483);
+        let x491 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x424, x425, -x393),
-            x493,
+            Self::mul_add(x420, x421, -x389),
+            x489,
         );
-        let x496 = Self::mul_add(
+        let x492 = Self::mul_add(
             -7.078399999258757,
-            Self::mul_add(x432, x432, x433),
-            x494,
+            Self::mul_add(x428, x428, x429),
+            x490,
         );
-        let x497 = Self::mul_add(
+        let x493 = Self::mul_add(
             7.078399999258757,
-            x430 + x434,
+            x426 + x430,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x489,
-                -Self::mul_add(c_q12, x488, s_q12 * x487),
+                x485,
+                -Self::mul_add(c_q12, x484, s_q12 * x483),
             ),
         );
-        let x498 = x438
-            + Self::mul_add(0.36, x494, Self::mul_add(-s_q12, x491, c_q12 * x490));
-        let x499 = Self::mul_add(2.5482240016099564, x393, -9.142025249762803 * x431)
-            + Self::mul_add(-x424, x437, x432 * x435)
-            + Self::mul_add(-0.36, x493, x492 + Self::mul_add(x11, x491, x10 * x490));
-        let x500 = x439
+        let x494 = x434
+            + Self::mul_add(0.36, x490, Self::mul_add(-s_q12, x487, c_q12 * x486));
+        let x495 = Self::mul_add(2.5482240016099564, x389, -9.142025249762803 * x427)
+            + Self::mul_add(-x420, x433, x428 * x431)
+            + Self::mul_add(-0.36, x489, x488 + Self::mul_add(x11, x487, x10 * x486));
+        let x496 = x435
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x492,
-                -Self::mul_add(c_q12, x491, s_q12 * x490),
+                x488,
+                -Self::mul_add(c_q12, x487, s_q12 * x486),
             );
-        let x501 = Self::mul_add(-s_q11, x496, c_q11 * x495);
-        let x502 = Self::mul_add(c_q11, x496, s_q11 * x495);
-        let x503 = Self::mul_add(-45.1584, x414, x501);
-        let x504 = Self::mul_add(45.1584, x416, x502);
-        let x505 = Self::mul_add(-45.1584, x418, x497);
-        let x506 = x422
-            + (Self::mul_add(-s_q11, x499, c_q11 * x498)
-                + Self::mul_add(-0.63, x497, 0.275 * x502));
-        let x507 = Self::mul_add(-24.35164200091464, x393, -24.4950615 * x412)
-            + Self::mul_add(-x405, x421, x413 * x419)
-            + Self::mul_add(-0.275, x501, Self::mul_add(c_q11, x499, s_q11 * x498));
-        let x508 = x423 + Self::mul_add(0.63, x501, x500);
-        let x509 = Self::mul_add(-s_q10, x504, c_q10 * x503);
-        let x510 = Self::mul_add(-81.53205, x397, x509);
-        let x511 = Self::mul_add(
+        let x497 = Self::mul_add(-s_q11, x492, c_q11 * x491);
+        let x498 = Self::mul_add(c_q11, x492, s_q11 * x491);
+        let x499 = Self::mul_add(-45.1584, x410, x497);
+        let x500 = Self::mul_add(45.1584, x412, x498);
+        let x501 = Self::mul_add(-45.1584, x414, x493);
+        let x502 = x418
+            + (Self::mul_add(-s_q11, x495, c_q11 * x494)
+                + Self::mul_add(-0.63, x493, 0.275 * x498));
+        let x503 = Self::mul_add(-24.35164200091464, x389, -24.4950615 * x408)
+            + Self::mul_add(-x401, x417, x409 * x415)
+            + Self::mul_add(-0.275, x497, Self::mul_add(c_q11, x495, s_q11 * x494));
+        let x504 = x419 + Self::mul_add(0.63, x497, x496);
+        let x505 = Self::mul_add(-s_q10, x500, c_q10 * x499);
+        let x506 = Self::mul_add(-81.53205, x393, x505);
+        let x507 = Self::mul_add(
             81.53205,
-            x398,
-            Self::mul_add(c_q10, x504, s_q10 * x503),
+            x394,
+            Self::mul_add(c_q10, x500, s_q10 * x499),
         );
-        let x512 = Self::mul_add(-81.53205, x399, x505);
-        let x513 = x403
-            + Self::mul_add(-0.87, x505, Self::mul_add(-s_q10, x507, c_q10 * x506));
-        let x514 = Self::mul_add(-36.18604050126307, x393, -63.36336825000001 * x395)
-            + Self::mul_add(-x386, x402, x396 * x400)
-            + Self::mul_add(c_q10, x507, s_q10 * x506);
-        let x515 = x404 + Self::mul_add(0.87, x509, x508);
-        let x516 = Self::mul_add(
+        let x508 = Self::mul_add(-81.53205, x395, x501);
+        let x509 = x399
+            + Self::mul_add(-0.87, x501, Self::mul_add(-s_q10, x503, c_q10 * x502));
+        let x510 = Self::mul_add(-36.18604050126307, x389, -63.36336825000001 * x391)
+            + Self::mul_add(-x382, x398, x392 * x396)
+            + Self::mul_add(c_q10, x503, s_q10 * x502);
+        let x511 = x400 + Self::mul_add(0.87, x505, x504);
+        let x512 = Self::mul_add(
             0.00000000020510342851533115,
-            x512,
-            Self::mul_add(c_q9, x511, s_q9 * x510),
+            x508,
+            Self::mul_add(c_q9, x507, s_q9 * x506),
         );
-        let x517 = x512 + Self::mul_add(x6, x511, x5 * x510);
-        let x518 = Self::mul_add(
+        let x513 = x508 + Self::mul_add(x6, x507, x5 * x506);
+        let x514 = Self::mul_add(
             -0.00000000020510342851533115,
-            x512,
-            Self::mul_add(-s_q9, x511, c_q9 * x510),
+            x508,
+            Self::mul_add(-s_q9, x507, c_q9 * x506),
         );
-        let x519 = Self::mul_add(
+        let x515 = Self::mul_add(
             -0.275,
-            x516,
+            x512,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x515,
-                Self::mul_add(-s_q9, x514, c_q9 * x513),
+                x511,
+                Self::mul_add(-s_q9, x510, c_q9 * x509),
             ),
         );
-        let x520 = Self::mul_add(
+        let x516 = Self::mul_add(
             0.000000008530897668050218,
-            x373 + x374,
-            -12.701650001451807 * x376,
-        ) + x516;
-        let x521 = Self::mul_add(
+            x369 + x370,
+            -12.701650001451807 * x372,
+        ) + x512;
+        let x517 = Self::mul_add(
             12.701650001451807,
-            x379,
-            -0.000000008530897668050218 * (x354 + x375),
-        ) + x517;
-        let x522 = Self::mul_add(
+            x375,
+            -0.000000008530897668050218 * (x350 + x371),
+        ) + x513;
+        let x518 = Self::mul_add(
             -12.701650001451807,
-            x381,
-            -0.000000008530897668050218 * (x371 + x377),
-        ) + x518;
-        let x523 = Self::mul_add(
+            x377,
+            -0.000000008530897668050218 * (x367 + x373),
+        ) + x514;
+        let x519 = Self::mul_add(
             -12.701650001451807,
-            x369,
-            Self::mul_add(0.0000000234896432582596, x371, -0.002139996587640933 * x354)
-                + Self::mul_add(-x372, x383, x363 * x384),
+            x365,
+            Self::mul_add(0.0000000234896432582596, x367, -0.002139996587640933 * x350)
+                + Self::mul_add(-x368, x379, x359 * x380),
         )
             + (Self::mul_add(
                 0.00000000020510342851533115,
-                x515,
-                Self::mul_add(c_q9, x514, s_q9 * x513),
-            ) + Self::mul_add(0.275, x518, -0.4 * x517));
-        let x524 = x385
-            + Self::mul_add(0.4, x516, x515 + Self::mul_add(x6, x514, x5 * x513));
-        let x525 = Self::mul_add(
+                x511,
+                Self::mul_add(c_q9, x510, s_q9 * x509),
+            ) + Self::mul_add(0.275, x514, -0.4 * x513));
+        let x520 = x381
+            + Self::mul_add(0.4, x512, x511 + Self::mul_add(x6, x510, x5 * x509));
+        let x521 = Self::mul_add(
             113.3918902508081,
-            x354,
-            Self::mul_add(-5.080660024070366, x371, -0.002139996587640933 * x370),
-        ) + Self::mul_add(-x363, x382, x362 * x383)
-            + Self::mul_add(-0.000000008530897668050218, x368, x367 * 12.701650001451807)
-            + x519;
-        let x526 = x522 + Self::mul_add(-x3, x521, x2 * x520);
-        let x527 = Self::mul_add(c_q8, x521, s_q8 * x520);
-        let x528 = Self::mul_add(
+            x350,
+            Self::mul_add(-5.080660024070366, x367, -0.002139996587640933 * x366),
+        ) + Self::mul_add(-x359, x378, x358 * x379)
+            + Self::mul_add(-0.000000008530897668050218, x364, x363 * 12.701650001451807)
+            + x515;
+        let x522 = x518 + Self::mul_add(-x3, x517, x2 * x516);
+        let x523 = Self::mul_add(c_q8, x517, s_q8 * x516);
+        let x524 = Self::mul_add(
             -48.0240000085309,
-            Self::mul_add(x356, x356, x357),
-            x526,
+            Self::mul_add(x352, x352, x353),
+            x522,
         );
-        let x529 = Self::mul_add(48.0240000085309, x342 * x343, x527);
-        let x530 = Self::mul_add(
+        let x525 = Self::mul_add(48.0240000085309, x338 * x339, x523);
+        let x526 = Self::mul_add(
             48.0240000085309,
-            x355 + x358,
+            x351 + x354,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x522,
-                Self::mul_add(-c_q8, x520, s_q8 * x521),
+                x518,
+                Self::mul_add(-c_q8, x516, s_q8 * x517),
             ),
         );
-        let x531 = Self::mul_add(0.07309, x355, Self::mul_add(-x356, x360, x343 * x361))
-            + Self::mul_add(-0.35, x527, x525 + Self::mul_add(-x3, x524, x2 * x523));
-        let x532 = Self::mul_add(
-            x352,
+        let x527 = Self::mul_add(0.07309, x351, Self::mul_add(-x352, x356, x339 * x357))
+            + Self::mul_add(-0.35, x523, x521 + Self::mul_add(-x3, x520, x2 * x519));
+        let x528 = Self::mul_add(
+            x348,
             -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x355, -0.07309 * x354)
-                + Self::mul_add(-x342, x361, x356 * x359),
-        ) + Self::mul_add(0.35, x526, Self::mul_add(c_q8, x524, s_q8 * x523));
-        let x533 = Self::mul_add(
+            Self::mul_add(-130.43769025763282, x351, -0.07309 * x350)
+                + Self::mul_add(-x338, x357, x352 * x355),
+        ) + Self::mul_add(0.35, x522, Self::mul_add(c_q8, x520, s_q8 * x519));
+        let x529 = Self::mul_add(
             48.0240000085309,
-            x353,
-            Self::mul_add(-0.1132, x355, -16.80768997608804 * x354)
-                + Self::mul_add(-x343, x359, x342 * x360),
+            x349,
+            Self::mul_add(-0.1132, x351, -16.80768997608804 * x350)
+                + Self::mul_add(-x339, x355, x338 * x356),
         )
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x525,
-                Self::mul_add(-c_q8, x523, s_q8 * x524),
+                x521,
+                Self::mul_add(-c_q8, x519, s_q8 * x520),
             );
-        let x534 = Self::mul_add(-s_q7, x529, c_q7 * x528);
-        let x535 = Self::mul_add(c_q7, x529, s_q7 * x528);
-        let x536 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x537 = 1466.4506062283303 * v[4];
-        let x538 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x539 = x534
+        let x530 = Self::mul_add(-s_q7, x525, c_q7 * x524);
+        let x531 = Self::mul_add(c_q7, x525, s_q7 * x524);
+        let x532 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
+        let x533 = 1466.4506062283303 * v[4];
+        let x534 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
+        let x535 = x530
             + Self::mul_add(
                 1170.07,
-                x339,
-                Self::mul_add(-110.5455, x345, 180.9502499901501 * x347),
+                x335,
+                Self::mul_add(-110.5455, x341, 180.9502499901501 * x343),
             );
-        let x540 = x535
+        let x536 = x531
             + Self::mul_add(
                 1170.07,
-                x340,
-                Self::mul_add(180.9502499901501, x348, 110.5455 * x346),
+                x336,
+                Self::mul_add(180.9502499901501, x344, 110.5455 * x342),
             );
-        let x541 = x530
+        let x537 = x526
             + Self::mul_add(
                 1170.07,
-                x341,
-                Self::mul_add(-180.9502499901501, x349, 110.5455 * x347),
+                x337,
+                Self::mul_add(-180.9502499901501, x345, 110.5455 * x343),
             );
-        let x542 = Self::mul_add(-0.75, x535, Self::mul_add(-s_q7, x532, c_q7 * x531))
+        let x538 = Self::mul_add(-0.75, x531, Self::mul_add(-s_q7, x528, c_q7 * x527))
             + Self::mul_add(
-                x340,
+                x336,
                 -180.9502499901501,
-                Self::mul_add(-v[5], x537, v[4] * x538),
+                Self::mul_add(-v[5], x533, v[4] * x534),
             );
-        let x543 = Self::mul_add(c_q7, x532, s_q7 * x531)
-            + Self::mul_add(-0.65, x530, 0.75 * x534)
-            + (Self::mul_add(-v[3], x538, v[5] * x536)
-                + Self::mul_add(x341, -110.5455, 180.9502499901501 * x339));
-        let x544 = Self::mul_add(0.65, x535, x533)
-            + Self::mul_add(110.5455, x340, Self::mul_add(-v[4], x536, v[3] * x537));
+        let x539 = Self::mul_add(c_q7, x528, s_q7 * x527)
+            + Self::mul_add(-0.65, x526, 0.75 * x530)
+            + (Self::mul_add(-v[3], x534, v[5] * x532)
+                + Self::mul_add(x337, -110.5455, 180.9502499901501 * x335));
+        let x540 = Self::mul_add(0.65, x531, x529)
+            + Self::mul_add(110.5455, x336, Self::mul_add(-v[4], x532, v[3] * x533));
         (
             [
                 [
@@ -5547,40 +5872,10 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x197,
-                    x187,
-                    x187,
-                    x209,
-                    x225,
-                    x242,
-                    x264,
-                    x295,
-                    x334,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x202,
-                    0.0,
-                    x196,
+                    x193,
                     x183,
-                    x210,
-                    x226,
-                    x243,
-                    x265,
-                    x296,
-                    x335,
-                ],
-                [
-                    0.0,
-                    0.0,
-                    1170.07,
-                    x184,
-                    x203,
-                    0.0,
-                    0.0,
-                    x159,
+                    x183,
+                    x205,
                     x221,
                     x238,
                     x260,
@@ -5589,169 +5884,199 @@ impl FreeFloating7 {
                 ],
                 [
                     0.0,
-                    x202,
-                    x184,
+                    1170.07,
+                    0.0,
                     x198,
-                    x195,
-                    x199,
-                    x192,
-                    x211,
-                    x227,
-                    x244,
-                    x266,
-                    x297,
-                    x336,
-                ],
-                [
-                    x197,
-                    0.0,
-                    x203,
-                    x195,
-                    x200,
-                    x193,
-                    x193,
-                    x212,
-                    x228,
-                    x245,
-                    x267,
-                    x298,
-                    x337,
-                ],
-                [
-                    x187,
-                    x196,
-                    0.0,
-                    x199,
-                    x193,
-                    x201,
-                    x194,
-                    x213,
-                    x229,
-                    x246,
-                    x268,
-                    x299,
-                    x338,
-                ],
-                [
-                    x187,
-                    x183,
                     0.0,
                     x192,
-                    x193,
-                    x194,
+                    x181,
+                    x206,
+                    x222,
+                    x239,
+                    x261,
+                    x292,
+                    x331,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    1170.07,
                     x182,
-                    x169,
-                    x222,
-                    x239,
-                    x261,
-                    x292,
-                    x331,
+                    x199,
+                    0.0,
+                    0.0,
+                    x153,
+                    x217,
+                    x234,
+                    x256,
+                    x287,
+                    x326,
                 ],
                 [
+                    0.0,
+                    x198,
+                    x182,
+                    x194,
+                    x191,
+                    x195,
+                    x188,
+                    x207,
+                    x223,
+                    x240,
+                    x262,
+                    x293,
+                    x332,
+                ],
+                [
+                    x193,
+                    0.0,
+                    x199,
+                    x191,
+                    x196,
+                    x189,
+                    x189,
+                    x208,
+                    x224,
+                    x241,
+                    x263,
+                    x294,
+                    x333,
+                ],
+                [
+                    x183,
+                    x192,
+                    0.0,
+                    x195,
+                    x189,
+                    x197,
+                    x190,
                     x209,
-                    x210,
-                    x159,
-                    x211,
-                    x212,
-                    x213,
-                    x169,
-                    x157,
-                    x218,
-                    x235,
-                    x257,
-                    x288,
-                    x327,
-                ],
-                [
                     x225,
-                    x226,
-                    x221,
-                    x227,
-                    x228,
-                    x229,
-                    x222,
-                    x218,
-                    x121,
-                    x112,
-                    x251,
-                    x282,
-                    x321,
-                ],
-                [
                     x242,
-                    x243,
-                    x238,
-                    x244,
-                    x245,
-                    x246,
-                    x239,
-                    x235,
-                    x112,
-                    x98,
-                    x88,
-                    x277,
-                    x316,
-                ],
-                [
                     x264,
-                    x265,
-                    x260,
-                    x266,
-                    x267,
-                    x268,
-                    x261,
-                    x257,
-                    x251,
-                    x88,
-                    x74,
-                    x60,
-                    x309,
-                ],
-                [
                     x295,
-                    x296,
-                    x291,
-                    x297,
-                    x298,
-                    x299,
-                    x292,
+                    x334,
+                ],
+                [
+                    x183,
+                    x181,
+                    0.0,
+                    x188,
+                    x189,
+                    x190,
+                    x175,
+                    x163,
+                    x218,
+                    x235,
+                    x257,
                     x288,
-                    x282,
-                    x277,
-                    x60,
-                    x45,
+                    x327,
+                ],
+                [
+                    x205,
+                    x206,
+                    x153,
+                    x207,
+                    x208,
+                    x209,
+                    x163,
+                    x151,
+                    x214,
+                    x231,
+                    x253,
+                    x284,
+                    x323,
+                ],
+                [
+                    x221,
+                    x222,
+                    x217,
+                    x223,
+                    x224,
+                    x225,
+                    x218,
+                    x214,
+                    x115,
+                    x107,
+                    x247,
+                    x278,
+                    x317,
+                ],
+                [
+                    x238,
+                    x239,
+                    x234,
+                    x240,
+                    x241,
+                    x242,
+                    x235,
+                    x231,
+                    x107,
+                    x91,
+                    x85,
+                    x273,
+                    x312,
+                ],
+                [
+                    x260,
+                    x261,
+                    x256,
+                    x262,
+                    x263,
+                    x264,
+                    x257,
+                    x253,
+                    x247,
+                    x85,
+                    x70,
+                    x58,
                     x305,
                 ],
                 [
-                    x334,
-                    x335,
+                    x291,
+                    x292,
+                    x287,
+                    x293,
+                    x294,
+                    x295,
+                    x288,
+                    x284,
+                    x278,
+                    x273,
+                    x58,
+                    x45,
+                    x301,
+                ],
+                [
                     x330,
-                    x336,
-                    x337,
-                    x338,
                     x331,
+                    x326,
+                    x332,
+                    x333,
+                    x334,
                     x327,
-                    x321,
-                    x316,
-                    x309,
+                    x323,
+                    x317,
+                    x312,
                     x305,
+                    x301,
                     1.4135609200000003,
                 ],
             ],
             [
+                x535,
+                x536,
+                x537,
+                x538,
                 x539,
                 x540,
-                x541,
-                x542,
-                x543,
-                x544,
-                x533,
-                x525,
-                x515,
-                x508,
-                x500,
-                x492,
-                x482,
+                x529,
+                x521,
+                x511,
+                x504,
+                x496,
+                x488,
+                x478,
             ],
         )
     }

@@ -9,40 +9,62 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 1079 (`mass_matrix` 79, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 267, `mass_matrix_and_nonlinear_effects` 202, `forward_dynamics_with_wrenches` 274), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
-//! Form: unrolled straight-line code (auto: 662 emitted operations in M + c, within the 4000 limit).
+//! Fused multiply-adds where the target has them: 971 (`mass_matrix` 52, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 240, `mass_matrix_and_nonlinear_effects` 175, `forward_dynamics_with_wrenches` 247), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: 619 emitted operations in M + c, within the 4000 limit).
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | — | 468 | 392 | 0 | 0 | 6 | 860 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | 519 | 422 | 0 | 0 | 6 | 941 |
-//! | `mass_matrix` | `kane-direct` | — | — | 505 | 352 | 0 | 0 | 6 | 857 |
-//! | `mass_matrix` | `crba-base` | — | — | 450 | 339 | 0 | 0 | 6 | 789 |
-//! | `mass_matrix` * | `crba` | — | — | 157 | 128 | 0 | 0 | 5 | 285 |
-//! | `nonlinear_effects` | — | `recurrent` | — | 537 | 386 | 0 | 0 | 6 | 923 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | 580 | 428 | 0 | 0 | 6 | 1008 |
-//! | `nonlinear_effects` | — | `rnea` | — | 254 | 181 | 0 | 0 | 5 | 435 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | 220 | 157 | 0 | 0 | 5 | 377 |
-//! | `inverse_dynamics` | — | `recurrent` | — | 728 | 550 | 0 | 0 | 6 | 1278 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | 771 | 592 | 0 | 0 | 6 | 1363 |
-//! | `inverse_dynamics` | — | `rnea` | — | 278 | 207 | 0 | 0 | 5 | 485 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | 232 | 178 | 0 | 0 | 5 | 410 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 780 | 585 | 6 | 0 | 6 | 1365 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 823 | 627 | 6 | 0 | 6 | 1450 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 497 | 380 | 6 | 0 | 5 | 877 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | 463 | 356 | 6 | 0 | 5 | 819 |
-//! | `forward_dynamics` | — | — | `aba` | 570 | 411 | 5 | 0 | 5 | 981 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 694 | 514 | 0 | 0 | 6 | 1208 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 737 | 556 | 0 | 0 | 6 | 1293 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 411 | 309 | 0 | 0 | 5 | 720 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 377 | 285 | 0 | 0 | 5 | 662 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 856 | 662 | 6 | 0 | 6 | 1518 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 899 | 704 | 6 | 0 | 6 | 1603 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 503 | 412 | 6 | 0 | 5 | 915 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | 469 | 388 | 6 | 0 | 5 | 857 |
-//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 576 | 443 | 5 | 0 | 5 | 1019 |
+//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | model | 468 | 392 | 0 | 0 | 6 | 860 |
+//! | `mass_matrix` | `recurrent` | — | — | canonical | 468 | 392 | 0 | 0 | 6 | 860 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | model | 519 | 422 | 0 | 0 | 6 | 941 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 519 | 422 | 0 | 0 | 6 | 941 |
+//! | `mass_matrix` | `kane-direct` | — | — | model | 505 | 352 | 0 | 0 | 6 | 857 |
+//! | `mass_matrix` | `kane-direct` | — | — | canonical | 505 | 352 | 0 | 0 | 6 | 857 |
+//! | `mass_matrix` | `crba-base` | — | — | model | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` | `crba-base` | — | — | canonical | 450 | 339 | 0 | 0 | 6 | 789 |
+//! | `mass_matrix` * | `crba` | — | — | model | 123 | 119 | 0 | 0 | 5 | 242 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 126 | 122 | 0 | 0 | 5 | 248 |
+//! | `nonlinear_effects` | — | `recurrent` | — | model | 537 | 386 | 0 | 0 | 6 | 923 |
+//! | `nonlinear_effects` | — | `recurrent` | — | canonical | 537 | 386 | 0 | 0 | 6 | 923 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | model | 580 | 428 | 0 | 0 | 6 | 1008 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 580 | 428 | 0 | 0 | 6 | 1008 |
+//! | `nonlinear_effects` | — | `rnea` | — | model | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `nonlinear_effects` | — | `rnea` | — | canonical | 254 | 181 | 0 | 0 | 5 | 435 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 220 | 157 | 0 | 0 | 5 | 377 |
+//! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 220 | 157 | 0 | 0 | 5 | 377 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 694 | 541 | 0 | 0 | 6 | 1235 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 697 | 544 | 0 | 0 | 6 | 1241 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 737 | 583 | 0 | 0 | 6 | 1320 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 740 | 586 | 0 | 0 | 6 | 1326 |
+//! | `inverse_dynamics` | — | `rnea` | — | model | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `inverse_dynamics` | — | `rnea` | — | canonical | 278 | 207 | 0 | 0 | 5 | 485 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | model | 232 | 178 | 0 | 0 | 5 | 410 |
+//! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 232 | 178 | 0 | 0 | 5 | 410 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 746 | 576 | 6 | 0 | 6 | 1322 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 749 | 579 | 6 | 0 | 6 | 1328 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 789 | 618 | 6 | 0 | 6 | 1407 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 792 | 621 | 6 | 0 | 6 | 1413 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 463 | 371 | 6 | 0 | 5 | 834 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 466 | 374 | 6 | 0 | 5 | 840 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 429 | 347 | 6 | 0 | 5 | 776 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 432 | 350 | 6 | 0 | 5 | 782 |
+//! | `forward_dynamics` | — | — | `aba` | model | 570 | 411 | 5 | 0 | 5 | 981 |
+//! | `forward_dynamics` | — | — | `aba` | canonical | 576 | 414 | 5 | 0 | 5 | 990 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 660 | 505 | 0 | 0 | 6 | 1165 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 663 | 508 | 0 | 0 | 6 | 1171 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 703 | 547 | 0 | 0 | 6 | 1250 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 706 | 550 | 0 | 0 | 6 | 1256 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 377 | 300 | 0 | 0 | 5 | 677 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 380 | 303 | 0 | 0 | 5 | 683 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 343 | 276 | 0 | 0 | 5 | 619 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 346 | 279 | 0 | 0 | 5 | 625 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 822 | 653 | 6 | 0 | 6 | 1475 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 865 | 695 | 6 | 0 | 6 | 1560 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 469 | 403 | 6 | 0 | 5 | 872 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 435 | 379 | 6 | 0 | 5 | 814 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 576 | 443 | 5 | 0 | 5 | 1019 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -58,6 +80,9 @@ pub struct OpCount {
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
+    /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
+    /// joint axis z, modified-DH x; the same joint-space results).
+    pub frames: &'static str,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -104,18 +129,20 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 157u64,
-            add: 128u64,
+            frames: "model",
+            mul: 123u64,
+            add: 119u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 79u64,
+            fma: 52u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 220u64,
             add: 157u64,
             div: 0u64,
@@ -128,6 +155,7 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 232u64,
             add: 178u64,
             div: 0u64,
@@ -140,36 +168,39 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 463u64,
-            add: 356u64,
+            frames: "model",
+            mul: 429u64,
+            add: 347u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 267u64,
+            fma: 240u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 377u64,
-            add: 285u64,
+            frames: "model",
+            mul: 343u64,
+            add: 276u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 202u64,
+            fma: 175u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 469u64,
-            add: 388u64,
+            frames: "model",
+            mul: 435u64,
+            add: 379u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 274u64,
+            fma: 247u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -179,6 +210,20 @@ impl Srms {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
+            mul: 468u64,
+            add: 392u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
             mul: 468u64,
             add: 392u64,
             div: 0u64,
@@ -191,6 +236,20 @@ impl Srms {
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
+            mul: 519u64,
+            add: 422u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
             mul: 519u64,
             add: 422u64,
             div: 0u64,
@@ -203,6 +262,20 @@ impl Srms {
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
+            mul: 505u64,
+            add: 352u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
             mul: 505u64,
             add: 352u64,
             div: 0u64,
@@ -215,6 +288,20 @@ impl Srms {
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
+            mul: 450u64,
+            add: 339u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
             mul: 450u64,
             add: 339u64,
             div: 0u64,
@@ -227,8 +314,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 157u64,
-            add: 128u64,
+            frames: "model",
+            mul: 123u64,
+            add: 119u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 126u64,
+            add: 122u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -239,6 +340,20 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
+            mul: 537u64,
+            add: 386u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
             mul: 537u64,
             add: 386u64,
             div: 0u64,
@@ -251,6 +366,20 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
+            frames: "model",
+            mul: 580u64,
+            add: 428u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
             mul: 580u64,
             add: 428u64,
             div: 0u64,
@@ -263,6 +392,20 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
+            mul: 254u64,
+            add: 181u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
             mul: 254u64,
             add: 181u64,
             div: 0u64,
@@ -275,6 +418,20 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
+            mul: 220u64,
+            add: 157u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
             mul: 220u64,
             add: 157u64,
             div: 0u64,
@@ -287,8 +444,22 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 728u64,
-            add: 550u64,
+            frames: "model",
+            mul: 694u64,
+            add: 541u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 697u64,
+            add: 544u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -299,8 +470,22 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 771u64,
-            add: 592u64,
+            frames: "model",
+            mul: 737u64,
+            add: 583u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 740u64,
+            add: 586u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -311,6 +496,20 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
+            mul: 278u64,
+            add: 207u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
             mul: 278u64,
             add: 207u64,
             div: 0u64,
@@ -323,6 +522,20 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
+            mul: 232u64,
+            add: 178u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
             mul: 232u64,
             add: 178u64,
             div: 0u64,
@@ -335,8 +548,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 780u64,
-            add: 585u64,
+            frames: "model",
+            mul: 746u64,
+            add: 576u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 749u64,
+            add: 579u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -347,8 +574,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 823u64,
-            add: 627u64,
+            frames: "model",
+            mul: 789u64,
+            add: 618u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 792u64,
+            add: 621u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -359,8 +600,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 497u64,
-            add: 380u64,
+            frames: "model",
+            mul: 463u64,
+            add: 371u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 466u64,
+            add: 374u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -371,8 +626,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 463u64,
-            add: 356u64,
+            frames: "model",
+            mul: 429u64,
+            add: 347u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 432u64,
+            add: 350u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -383,8 +652,22 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 570u64,
             add: 411u64,
+            div: 5u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            frames: "canonical",
+            mul: 576u64,
+            add: 414u64,
             div: 5u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -395,8 +678,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 694u64,
-            add: 514u64,
+            frames: "model",
+            mul: 660u64,
+            add: 505u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 663u64,
+            add: 508u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -407,8 +704,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 737u64,
-            add: 556u64,
+            frames: "model",
+            mul: 703u64,
+            add: 547u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 706u64,
+            add: 550u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -419,8 +730,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 411u64,
-            add: 309u64,
+            frames: "model",
+            mul: 377u64,
+            add: 300u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 380u64,
+            add: 303u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -431,8 +756,22 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 377u64,
-            add: 285u64,
+            frames: "model",
+            mul: 343u64,
+            add: 276u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 346u64,
+            add: 279u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -443,8 +782,9 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 856u64,
-            add: 662u64,
+            frames: "model",
+            mul: 822u64,
+            add: 653u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -455,8 +795,9 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 899u64,
-            add: 704u64,
+            frames: "model",
+            mul: 865u64,
+            add: 695u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -467,8 +808,9 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 503u64,
-            add: 412u64,
+            frames: "model",
+            mul: 469u64,
+            add: 403u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -479,8 +821,9 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 469u64,
-            add: 388u64,
+            frames: "model",
+            mul: 435u64,
+            add: 379u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -491,6 +834,7 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 576u64,
             add: 443u64,
             div: 5u64,
@@ -501,7 +845,7 @@ impl Srms {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 157 mul, 128 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 79 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 123 mul, 119 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 52 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -509,163 +853,138 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x6 = 0.353 * s_q5;
-        let x7 = 0.353 * c_q5;
-        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
-        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
-        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
-        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
-        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
-        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
-        let x15 = 34.45002 * c_q4;
-        let x16 = 34.45002 * s_q4;
-        let x17 = s_q4 * x5;
-        let x18 = Self::mul_add(1.903, c_q4, -x17);
-        let x19 = c_q4 * x5;
-        let x20 = Self::mul_add(-s_q4, x13, x19);
-        let x21 = c_q4 * x9;
-        let x22 = Self::mul_add(-s_q4, x11, x21);
-        let x23 = Self::mul_add(1.903, s_q4, x19);
-        let x24 = s_q4 * x9;
-        let x25 = Self::mul_add(c_q4, x11, x24);
-        let x26 = Self::mul_add(-s_q4, x12, x21);
-        let x27 = Self::mul_add(c_q4, x12, x24);
-        let x28 = x15 * -0.4572;
-        let x29 = 0.4572 * x15;
-        let x30 = x14 + x29;
-        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
-        let x32 = x30 - x28;
-        let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
-        let x35 = 19.863252216000003
-            + (x29
-                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
-                    - x28));
-        let x36 = c_q3 * x33;
-        let x37 = s_q3 * x33;
-        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
-        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
-        let x40 = c_q3 * x22;
-        let x41 = Self::mul_add(s_q3, x32, x40);
-        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
-        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
-        let x44 = s_q3 * x22;
-        let x45 = Self::mul_add(c_q3, x32, -x44);
-        let x46 = x37 * 0.1524;
-        let x47 = -0.1524 * x37;
-        let x48 = x36 * -7.06;
-        let x49 = 7.06 * x36;
-        let x50 = x35 - (x47 + x48);
-        let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(
-            x37,
-            7.06,
-            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-        );
-        let x53 = Self::mul_add(
+        let x5 = s_q5 * s_q5;
+        let x6 = s_q5 * c_q5;
+        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
+        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
+        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
+        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x11 = 34.33891524 - x7;
+        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x13 = s_q4 * s_q4;
+        let x14 = s_q4 * c_q4;
+        let x15 = 1.903 - x11;
+        let x16 = x9 + x9;
+        let x17 = Self::mul_add(x14, x16, x13 * x15);
+        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
+        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
+        let x20 = 34.45002 * c_q4;
+        let x21 = 34.45002 * s_q4;
+        let x22 = x20 * -0.4572;
+        let x23 = 0.4572 * x20;
+        let x24 = x12 + x23;
+        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
+        let x26 = x24 - x22;
+        let x27 = 41.67378 + x20;
+        let x28 = -18.957952216000002 + (1.903 - x17);
+        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x30 = s_q3 * s_q3;
+        let x31 = s_q3 * c_q3;
+        let x32 = x26 - x28;
+        let x33 = x18 + x18;
+        let x34 = Self::mul_add(x31, x33, x30 * x32);
+        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
+        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
+        let x37 = s_q3 * x27;
+        let x38 = c_q3 * x27;
+        let x39 = x37 * 0.1524;
+        let x40 = -0.1524 * x37;
+        let x41 = x38 * -7.06;
+        let x42 = 7.06 * x38;
+        let x43 = x29 - (x40 + x41);
+        let x44 = x21 * 0.1524;
+        let x45 = Self::mul_add(
             0.1524,
-            x36,
-            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            x38,
+            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x55 = 703.3878000000001 + x36;
-        let x56 = -15.183612000000002 - x37;
-        let x57 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x59 = 103.41030072000001 + x52;
-        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x61 = 103.41030072000002 + x53;
-        let x62 = -0.08 + (x43 + x51);
-        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
-        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
-        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
-        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
-        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
-        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
-        let x71 = 0.1524 * x64;
-        let x72 = -0.1524 * x64;
-        let x73 = x63 * -6.377;
-        let x74 = 6.377 * x63;
-        let x75 = Self::mul_add(
-            x64,
-            -6.377,
-            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
-        );
-        let x76 = Self::mul_add(
+        let x46 = x26 - x34 + x42 - x41;
+        let x47 = 703.3878000000001 + x38;
+        let x48 = -15.183612000000002 - x37;
+        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
+        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
+        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
+        let x52 = 103.41030072000002 + x45;
+        let x53 = -0.08 + (x35 + x44);
+        let x54 = s_q2 * s_q2;
+        let x55 = s_q2 * c_q2;
+        let x56 = x46 - x49;
+        let x57 = x52 + x52;
+        let x58 = Self::mul_add(x55, x57, x54 * x56);
+        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
+        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
+        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
+        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
+        let x63 = 0.1524 * x61;
+        let x64 = -0.1524 * x61;
+        let x65 = x62 * -6.377;
+        let x66 = 6.377 * x62;
+        let x67 = Self::mul_add(
             0.1524,
-            x63,
-            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+            x62,
+            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
         );
-        let x77 = 8609.573807858 + (x60 - (x73 - x72) - (x71 - x74));
-        let x78 = Self::mul_add(
+        let x68 = x46 - x58 + x66 - x65;
+        let x69 = 8609.573807858 + (x51 - (x65 - x64) - (x63 - x66));
+        let x70 = 190.97044034000004 + x67;
+        let x71 = Self::mul_add(
             -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x66),
-            c_q1 * (-0.0302 + (x51 + x69)),
+            -1.928 + Self::mul_add(-6.377, x21, x60),
+            c_q1 * (-0.0302 + (x44 + x59)),
         );
-        let x79 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                -s_q1,
-                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
-                c_q1 * (190.97044034000004 + x76),
-            ),
-            c_q1
-                * Self::mul_add(
-                    -s_q1,
-                    190.97044034 + x75,
-                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
-                ),
-        );
-        let x80 = 14222.257549666001 + x79;
-        let x81 = x60 + (x72 - x73);
-        let x82 = Self::mul_add(-s_q1, x66, c_q1 * x69);
-        let x83 = x50
+        let x72 = 14222.257549666001
+            + (x68
+                - Self::mul_add(
+                    s_q1 * c_q1,
+                    x70 + x70,
+                    s_q1 * s_q1 * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                ));
+        let x73 = x51 + (x64 - x65);
+        let x74 = Self::mul_add(-s_q1, x60, c_q1 * x59);
+        let x75 = x43
             + Self::mul_add(
                 0.1524,
-                Self::mul_add(s_q2, x36, c_q2 * x37),
-                -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+                Self::mul_add(s_q2, x38, c_q2 * x37),
+                -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
+            );
+        let x76 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x35, c_q2 * x36),
+            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
+        );
+        let x77 = c_q3 * x21;
+        let x78 = s_q3 * x21;
+        let x79 = x20 * 0.1524;
+        let x80 = Self::mul_add(s_q3, x24, c_q3 * x18) + x79;
+        let x81 = x19 + Self::mul_add(0.1524, x77, -7.06 * x78);
+        let x82 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
+        let x83 = x81
+            + Self::mul_add(
+                -6.377,
+                Self::mul_add(c_q2, x78, s_q2 * x77),
+                -0.1524 * Self::mul_add(-c_q2, x77, s_q2 * x78),
             );
         let x84 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x43, c_q2 * x39),
-            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+            x79 + Self::mul_add(s_q2, x82, c_q2 * x80),
+            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x80, c_q2 * x82)),
         );
-        let x85 = c_q3 * x16;
-        let x86 = s_q3 * x16;
-        let x87 = x15 * 0.1524;
-        let x88 = Self::mul_add(s_q3, x30, x40) + x87;
-        let x89 = x25 + Self::mul_add(0.1524, x85, -7.06 * x86);
-        let x90 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x91 = x89
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(c_q2, x86, s_q2 * x85),
-                -0.1524 * Self::mul_add(-c_q2, x85, s_q2 * x86),
-            );
-        let x92 = Self::mul_add(
+        let x85 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
+        let x86 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x87 = Self::mul_add(s_q3, x10, c_q3 * x85);
+        let x88 = Self::mul_add(-s_q3, x85, c_q3 * x10);
+        let x89 = Self::mul_add(
             -s_q1,
-            x87 + Self::mul_add(s_q2, x90, c_q2 * x88),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x88, c_q2 * x90)),
-        );
-        let x93 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x94 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x95 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x94, c_q2 * x93),
-            c_q1 * Self::mul_add(-s_q2, x93, c_q2 * x94),
+            Self::mul_add(s_q2, x88, c_q2 * x87),
+            c_q1 * Self::mul_add(-s_q2, x87, c_q2 * x88),
         );
         [
-            [x80, x78, x82, x84, x92, x95],
-            [x78, x77, x81, x83, x91, x23],
-            [x82, x81, x60, x50, x89, x23],
-            [x84, x83, x50, x35, x25, x23],
-            [x92, x91, x89, x25, x14, x9],
-            [x95, x23, x23, x23, x9, 1.903],
+            [x72, x71, x74, x76, x84, x89],
+            [x71, x69, x73, x75, x83, x86],
+            [x74, x73, x51, x43, x81, x86],
+            [x76, x75, x43, x29, x19, x86],
+            [x84, x83, x81, x19, x12, x10],
+            [x89, x86, x86, x86, x10, 1.903],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -1040,7 +1359,7 @@ impl Srms {
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 463 mul, 356 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 267 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 429 mul, 347 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1048,436 +1367,413 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x6 = 0.353 * s_q5;
-        let x7 = 0.353 * c_q5;
-        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
-        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
-        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
-        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
-        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
-        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
-        let x15 = 34.45002 * c_q4;
-        let x16 = 34.45002 * s_q4;
-        let x17 = s_q4 * x5;
-        let x18 = Self::mul_add(1.903, c_q4, -x17);
-        let x19 = c_q4 * x5;
-        let x20 = Self::mul_add(-s_q4, x13, x19);
-        let x21 = c_q4 * x9;
-        let x22 = Self::mul_add(-s_q4, x11, x21);
-        let x23 = Self::mul_add(1.903, s_q4, x19);
-        let x24 = s_q4 * x9;
-        let x25 = Self::mul_add(c_q4, x11, x24);
-        let x26 = Self::mul_add(-s_q4, x12, x21);
-        let x27 = Self::mul_add(c_q4, x12, x24);
-        let x28 = x15 * -0.4572;
-        let x29 = 0.4572 * x15;
-        let x30 = x14 + x29;
-        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
-        let x32 = x30 - x28;
-        let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
-        let x35 = 19.863252216000003
-            + (x29
-                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
-                    - x28));
-        let x36 = c_q3 * x33;
-        let x37 = s_q3 * x33;
-        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
-        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
-        let x40 = c_q3 * x22;
-        let x41 = Self::mul_add(s_q3, x32, x40);
-        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
-        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
-        let x44 = s_q3 * x22;
-        let x45 = Self::mul_add(c_q3, x32, -x44);
-        let x46 = x37 * 0.1524;
-        let x47 = -0.1524 * x37;
-        let x48 = x36 * -7.06;
-        let x49 = 7.06 * x36;
-        let x50 = x35 - (x47 + x48);
-        let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(
-            x37,
-            7.06,
-            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-        );
-        let x53 = Self::mul_add(
+        let x5 = s_q5 * s_q5;
+        let x6 = s_q5 * c_q5;
+        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
+        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
+        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
+        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x11 = 34.33891524 - x7;
+        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x13 = s_q4 * s_q4;
+        let x14 = s_q4 * c_q4;
+        let x15 = 1.903 - x11;
+        let x16 = x9 + x9;
+        let x17 = Self::mul_add(x14, x16, x13 * x15);
+        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
+        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
+        let x20 = 34.45002 * c_q4;
+        let x21 = 34.45002 * s_q4;
+        let x22 = x20 * -0.4572;
+        let x23 = 0.4572 * x20;
+        let x24 = x12 + x23;
+        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
+        let x26 = x24 - x22;
+        let x27 = 41.67378 + x20;
+        let x28 = -18.957952216000002 + (1.903 - x17);
+        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x30 = s_q3 * s_q3;
+        let x31 = s_q3 * c_q3;
+        let x32 = x26 - x28;
+        let x33 = x18 + x18;
+        let x34 = Self::mul_add(x31, x33, x30 * x32);
+        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
+        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
+        let x37 = s_q3 * x27;
+        let x38 = c_q3 * x27;
+        let x39 = x37 * 0.1524;
+        let x40 = -0.1524 * x37;
+        let x41 = x38 * -7.06;
+        let x42 = 7.06 * x38;
+        let x43 = x29 - (x40 + x41);
+        let x44 = x21 * 0.1524;
+        let x45 = Self::mul_add(
             0.1524,
-            x36,
-            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            x38,
+            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x55 = 703.3878000000001 + x36;
-        let x56 = -15.183612000000002 - x37;
-        let x57 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x59 = 103.41030072000001 + x52;
-        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x61 = 103.41030072000002 + x53;
-        let x62 = -0.08 + (x43 + x51);
-        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
-        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
-        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
-        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
-        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
-        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
-        let x71 = 0.1524 * x64;
-        let x72 = -0.1524 * x64;
-        let x73 = x63 * -6.377;
-        let x74 = 6.377 * x63;
-        let x75 = Self::mul_add(
-            x64,
-            -6.377,
-            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
-        );
-        let x76 = Self::mul_add(
+        let x46 = x26 - x34 + x42 - x41;
+        let x47 = 703.3878000000001 + x38;
+        let x48 = -15.183612000000002 - x37;
+        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
+        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
+        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
+        let x52 = 103.41030072000002 + x45;
+        let x53 = -0.08 + (x35 + x44);
+        let x54 = s_q2 * s_q2;
+        let x55 = s_q2 * c_q2;
+        let x56 = x46 - x49;
+        let x57 = x52 + x52;
+        let x58 = Self::mul_add(x55, x57, x54 * x56);
+        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
+        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
+        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
+        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
+        let x63 = 0.1524 * x61;
+        let x64 = -0.1524 * x61;
+        let x65 = x62 * -6.377;
+        let x66 = 6.377 * x62;
+        let x67 = Self::mul_add(
             0.1524,
-            x63,
-            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+            x62,
+            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
         );
-        let x77 = Self::mul_add(
+        let x68 = x46 - x58 + x66 - x65;
+        let x69 = 190.97044034000004 + x67;
+        let x70 = Self::mul_add(
             -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x66),
-            c_q1 * (-0.0302 + (x51 + x69)),
+            -1.928 + Self::mul_add(-6.377, x21, x60),
+            c_q1 * (-0.0302 + (x44 + x59)),
         );
-        let x78 = Self::mul_add(
+        let x71 = Self::mul_add(-s_q1, x60, c_q1 * x59);
+        let x72 = Self::mul_add(
             -s_q1,
-            Self::mul_add(
-                -s_q1,
-                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
-                c_q1 * (190.97044034000004 + x76),
-            ),
-            c_q1
-                * Self::mul_add(
-                    -s_q1,
-                    190.97044034 + x75,
-                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
-                ),
+            Self::mul_add(s_q2, x35, c_q2 * x36),
+            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
         );
-        let x79 = Self::mul_add(-s_q1, x66, c_q1 * x69);
-        let x80 = Self::mul_add(
+        let x73 = c_q3 * x21;
+        let x74 = s_q3 * x21;
+        let x75 = x20 * 0.1524;
+        let x76 = Self::mul_add(s_q3, x24, c_q3 * x18) + x75;
+        let x77 = x19 + Self::mul_add(0.1524, x73, -7.06 * x74);
+        let x78 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
+        let x79 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x43, c_q2 * x39),
-            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+            x75 + Self::mul_add(s_q2, x78, c_q2 * x76),
+            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x76, c_q2 * x78)),
         );
-        let x81 = c_q3 * x16;
-        let x82 = s_q3 * x16;
-        let x83 = x15 * 0.1524;
-        let x84 = Self::mul_add(s_q3, x30, x40) + x83;
-        let x85 = x25 + Self::mul_add(0.1524, x81, -7.06 * x82);
-        let x86 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x87 = Self::mul_add(
+        let x80 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
+        let x81 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x82 = Self::mul_add(s_q3, x10, c_q3 * x80);
+        let x83 = Self::mul_add(-s_q3, x80, c_q3 * x10);
+        let x84 = Self::mul_add(
             -s_q1,
-            x83 + Self::mul_add(s_q2, x86, c_q2 * x84),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x84, c_q2 * x86)),
+            Self::mul_add(s_q2, x83, c_q2 * x82),
+            c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x83),
         );
-        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x90 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x89, c_q2 * x88),
-            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
-        );
-        let x91 = qd[0] * s_q1;
-        let x92 = qd[0] * c_q1;
-        let x93 = qd[1] * x92;
-        let x94 = qd[1] * x91;
-        let x95 = qd[1] * qd[1];
-        let x96 = x91 * x92;
-        let x97 = Self::mul_add(
+        let x85 = qd[0] * s_q1;
+        let x86 = qd[0] * c_q1;
+        let x87 = qd[1] * x86;
+        let x88 = qd[1] * x85;
+        let x89 = qd[1] * qd[1];
+        let x90 = x85 * x86;
+        let x91 = Self::mul_add(
             190.97044034,
-            x92,
-            Self::mul_add(8596.210051042, x91, -1.928 * qd[1]),
+            x86,
+            Self::mul_add(8596.210051042, x85, -1.928 * qd[1]),
         );
-        let x98 = Self::mul_add(
+        let x92 = Self::mul_add(
             -0.0302,
-            x92,
-            Self::mul_add(1.928, x91, 8609.573807858 * qd[1]),
+            x86,
+            Self::mul_add(1.928, x85, 8609.573807858 * qd[1]),
         );
-        let x99 = Self::mul_add(-190.97044034000004, x91, -0.0302 * qd[1]);
-        let x100 = Self::mul_add(s_q2, x92, c_q2 * x91);
-        let x101 = Self::mul_add(-s_q2, x91, c_q2 * x92);
-        let x102 = Self::mul_add(-0.1524, x96, 6.377 * Self::mul_add(x92, x92, x95));
-        let x103 = Self::mul_add(-6.377, x94 + x94, -0.1524 * (x93 + x93));
-        let x104 = Self::mul_add(-0.1524, Self::mul_add(x91, x91, x95), 6.377 * x96);
-        let x105 = Self::mul_add(-c_q2, x102, s_q2 * x104);
-        let x106 = Self::mul_add(c_q2, x104, s_q2 * x102);
-        let x107 = Self::mul_add(-qd[2], x101, Self::mul_add(-c_q2, x93, s_q2 * x94));
-        let x108 = Self::mul_add(qd[2], x100, Self::mul_add(c_q2, x94, s_q2 * x93));
-        let x109 = qd[1] + qd[2];
-        let x110 = x109 * x109;
-        let x111 = Self::mul_add(x101, x101, x110);
-        let x112 = x100 * x101;
-        let x113 = Self::mul_add(x100, x109, x108);
-        let x114 = Self::mul_add(x101, x109, -x107);
-        let x115 = Self::mul_add(x100, x100, x110);
-        let x116 = Self::mul_add(
+        let x93 = Self::mul_add(-190.97044034000004, x85, -0.0302 * qd[1]);
+        let x94 = Self::mul_add(s_q2, x86, c_q2 * x85);
+        let x95 = Self::mul_add(-s_q2, x85, c_q2 * x86);
+        let x96 = Self::mul_add(-0.1524, x90, 6.377 * Self::mul_add(x86, x86, x89));
+        let x97 = Self::mul_add(-6.377, x88 + x88, -0.1524 * (x87 + x87));
+        let x98 = Self::mul_add(-0.1524, Self::mul_add(x85, x85, x89), 6.377 * x90);
+        let x99 = Self::mul_add(-c_q2, x96, s_q2 * x98);
+        let x100 = Self::mul_add(c_q2, x98, s_q2 * x96);
+        let x101 = Self::mul_add(-qd[2], x95, Self::mul_add(-c_q2, x87, s_q2 * x88));
+        let x102 = Self::mul_add(qd[2], x94, Self::mul_add(c_q2, x88, s_q2 * x87));
+        let x103 = qd[1] + qd[2];
+        let x104 = x103 * x103;
+        let x105 = Self::mul_add(x95, x95, x104);
+        let x106 = x94 * x95;
+        let x107 = Self::mul_add(x94, x103, x102);
+        let x108 = Self::mul_add(x95, x103, -x101);
+        let x109 = Self::mul_add(x94, x94, x104);
+        let x110 = Self::mul_add(
             103.41030072000001,
-            x101,
-            Self::mul_add(5594.523885531201, x100, 0.8021 * x109),
+            x95,
+            Self::mul_add(5594.523885531201, x94, 0.8021 * x103),
         );
-        let x117 = Self::mul_add(
+        let x111 = Self::mul_add(
             -0.08,
-            x101,
-            Self::mul_add(-0.8021, x100, 5601.1318504688 * x109),
+            x95,
+            Self::mul_add(-0.8021, x94, 5601.1318504688 * x103),
         );
-        let x118 = Self::mul_add(-103.41030072000002, x100, -0.08 * x109);
-        let x119 = Self::mul_add(
+        let x112 = Self::mul_add(-103.41030072000002, x94, -0.08 * x103);
+        let x113 = Self::mul_add(
             703.3878000000001,
-            x103,
+            x97,
             Self::mul_add(
                 103.41030072000002,
-                x107,
-                -Self::mul_add(x100, x117, x109 * x116),
+                x101,
+                -Self::mul_add(x94, x111, x103 * x110),
             ),
         );
-        let x120 = Self::mul_add(s_q3, x101, c_q3 * x100);
-        let x121 = Self::mul_add(-s_q3, x100, c_q3 * x101);
-        let x122 = x105 - Self::mul_add(-0.1524, x112, 7.06 * x111);
-        let x123 = x103 + Self::mul_add(-7.06, x113, -0.1524 * x114);
-        let x124 = x106 + Self::mul_add(-0.1524, x115, 7.06 * x112);
-        let x125 = Self::mul_add(-c_q3, x124, s_q3 * x122);
-        let x126 = Self::mul_add(-qd[3], x121, Self::mul_add(s_q3, x108, c_q3 * x107));
-        let x127 = Self::mul_add(-qd[3], x120, Self::mul_add(-c_q3, x108, s_q3 * x107));
-        let x128 = qd[3] + x109;
-        let x129 = Self::mul_add(x121, x121, x128 * x128);
-        let x130 = x120 * x121;
-        let x131 = Self::mul_add(-x120, x128, x127);
-        let x132 = -18.957952216000002 * x120;
-        let x133 = 19.863252216000003 * x128;
-        let x134 = Self::mul_add(-c_q4, x120, s_q4 * x128);
-        let x135 = Self::mul_add(c_q4, x128, s_q4 * x120);
-        let x136 = Self::mul_add(
+        let x114 = Self::mul_add(s_q3, x95, c_q3 * x94);
+        let x115 = Self::mul_add(-s_q3, x94, c_q3 * x95);
+        let x116 = x99 - Self::mul_add(-0.1524, x106, 7.06 * x105);
+        let x117 = x97 + Self::mul_add(-7.06, x107, -0.1524 * x108);
+        let x118 = x100 + Self::mul_add(-0.1524, x109, 7.06 * x106);
+        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
+        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x102, c_q3 * x101));
+        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x102, s_q3 * x101));
+        let x122 = qd[3] + x103;
+        let x123 = Self::mul_add(x115, x115, x122 * x122);
+        let x124 = x114 * x115;
+        let x125 = Self::mul_add(-x114, x122, x121);
+        let x126 = -18.957952216000002 * x114;
+        let x127 = 19.863252216000003 * x122;
+        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
+        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
+        let x130 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x129, Self::mul_add(s_q3, x124, c_q3 * x122)),
-            c_q4 * Self::mul_add(0.4572, x131, x123),
+            Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
+            c_q4 * Self::mul_add(0.4572, x125, x117),
         );
-        let x137 = Self::mul_add(qd[4], x135, c_q4 * x126);
-        let x138 = Self::mul_add(qd[4], x134, s_q4 * x126);
-        let x139 = qd[4] + x121;
-        let x140 = 34.45002 * Self::mul_add(x139, x139, x135 * x135);
-        let x141 = 34.45002 * Self::mul_add(x134, x135, x127);
-        let x142 = 34.45002 * Self::mul_add(x134, x139, x138);
-        let x143 = 34.33891524 * x135;
-        let x144 = 34.74691524 * x139;
-        let x145 = Self::mul_add(s_q5, x139, c_q5 * x135);
-        let x146 = Self::mul_add(-s_q5, x135, c_q5 * x139);
-        let x147 = Self::mul_add(qd[5], x146, Self::mul_add(-c_q5, x138, s_q5 * x127));
-        let x148 = Self::mul_add(-qd[5], x145, Self::mul_add(c_q5, x127, s_q5 * x138));
-        let x149 = qd[5] + x134;
-        let x150 = Self::mul_add(0.966, x146, Self::mul_add(0.385, x145, 1.903 * x149));
-        let x151 = Self::mul_add(0.353, x146, 0.385 * x149);
-        let x152 = Self::mul_add(
+        let x131 = Self::mul_add(qd[4], x129, c_q4 * x120);
+        let x132 = Self::mul_add(qd[4], x128, s_q4 * x120);
+        let x133 = qd[4] + x115;
+        let x134 = 34.45002 * Self::mul_add(x133, x133, x129 * x129);
+        let x135 = 34.45002 * Self::mul_add(x128, x129, x121);
+        let x136 = 34.45002 * Self::mul_add(x128, x133, x132);
+        let x137 = 34.33891524 * x129;
+        let x138 = 34.74691524 * x133;
+        let x139 = Self::mul_add(s_q5, x133, c_q5 * x129);
+        let x140 = Self::mul_add(-s_q5, x129, c_q5 * x133);
+        let x141 = Self::mul_add(qd[5], x140, Self::mul_add(-c_q5, x132, s_q5 * x121));
+        let x142 = Self::mul_add(-qd[5], x139, Self::mul_add(c_q5, x121, s_q5 * x132));
+        let x143 = qd[5] + x128;
+        let x144 = Self::mul_add(0.966, x140, Self::mul_add(0.385, x139, 1.903 * x143));
+        let x145 = Self::mul_add(0.353, x140, 0.385 * x143);
+        let x146 = Self::mul_add(
             -0.9929999999999999,
-            x146,
-            Self::mul_add(0.353, x145, 0.966 * x149),
+            x140,
+            Self::mul_add(0.353, x139, 0.966 * x143),
         );
-        let x153 = Self::mul_add(0.966, x148, Self::mul_add(0.385, x147, 1.903 * x137))
-            + Self::mul_add(-x146, x151, x145 * x152);
-        let x154 = Self::mul_add(0.353, x148, 0.385 * x137)
-            + Self::mul_add(-x149, x152, x146 * x150);
-        let x155 = Self::mul_add(
+        let x147 = Self::mul_add(0.966, x142, Self::mul_add(0.385, x141, 1.903 * x131))
+            + Self::mul_add(-x140, x145, x139 * x146);
+        let x148 = Self::mul_add(0.353, x142, 0.385 * x131)
+            + Self::mul_add(-x143, x146, x140 * x144);
+        let x149 = Self::mul_add(
             -0.9929999999999999,
-            x148,
-            Self::mul_add(0.353, x147, 0.966 * x137),
-        ) + Self::mul_add(-x145, x150, x149 * x151);
-        let x156 = Self::mul_add(-x139, x143, x135 * x144) + x153;
-        let x157 = Self::mul_add(
+            x142,
+            Self::mul_add(0.353, x141, 0.966 * x131),
+        ) + Self::mul_add(-x139, x144, x143 * x145);
+        let x150 = Self::mul_add(-x133, x137, x129 * x138) + x147;
+        let x151 = Self::mul_add(
             -34.45002,
-            Self::mul_add(-0.4572, x130, x125),
-            -Self::mul_add(x134, x144, 34.33891524 * x138),
-        ) + Self::mul_add(-s_q5, x155, c_q5 * x154);
-        let x158 = Self::mul_add(
+            Self::mul_add(-0.4572, x124, x119),
+            -Self::mul_add(x128, x138, 34.33891524 * x132),
+        ) + Self::mul_add(-s_q5, x149, c_q5 * x148);
+        let x152 = Self::mul_add(
             34.45002,
-            x136,
-            Self::mul_add(x134, x143, 34.74691524 * x127),
-        ) + Self::mul_add(c_q5, x155, s_q5 * x154);
-        let x159 = Self::mul_add(-s_q4, x140, c_q4 * x141);
-        let x160 = Self::mul_add(41.67378, x129, Self::mul_add(s_q4, x141, c_q4 * x140));
-        let x161 = Self::mul_add(41.67378, x131, x159);
-        let x162 = Self::mul_add(-41.67378, x130, x142);
-        let x163 = Self::mul_add(-x121, x133, -18.957952216000002 * x126)
-            + Self::mul_add(-s_q4, x157, c_q4 * x156);
-        let x164 = Self::mul_add(-x121, x132, x125 * -41.67378)
-            + Self::mul_add(-0.4572, x142, Self::mul_add(c_q4, x157, s_q4 * x156));
-        let x165 = Self::mul_add(41.67378, x123, Self::mul_add(-x120, x133, x128 * x132))
-            + Self::mul_add(0.4572, x159, x158);
-        let x166 = Self::mul_add(-c_q3, x160, s_q3 * x162);
-        let x167 = Self::mul_add(c_q3, x162, s_q3 * x160);
-        let x168 = x166
-            - Self::mul_add(-15.183612000000002, x112, 703.3878000000001 * x111);
-        let x169 = Self::mul_add(-703.3878000000001, x113, -15.183612000000002 * x114)
-            + x161;
-        let x170 = x167
-            - Self::mul_add(-15.183612000000002, x115, 703.3878000000001 * x112);
-        let x171 = Self::mul_add(
-            x103,
+            x130,
+            Self::mul_add(x128, x137, 34.74691524 * x121),
+        ) + Self::mul_add(c_q5, x149, s_q5 * x148);
+        let x153 = Self::mul_add(-s_q4, x134, c_q4 * x135);
+        let x154 = Self::mul_add(41.67378, x123, Self::mul_add(s_q4, x135, c_q4 * x134));
+        let x155 = Self::mul_add(41.67378, x125, x153);
+        let x156 = Self::mul_add(-41.67378, x124, x136);
+        let x157 = Self::mul_add(-x115, x127, -18.957952216000002 * x120)
+            + Self::mul_add(-s_q4, x151, c_q4 * x150);
+        let x158 = Self::mul_add(-x115, x126, x119 * -41.67378)
+            + Self::mul_add(-0.4572, x136, Self::mul_add(c_q4, x151, s_q4 * x150));
+        let x159 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
+            + Self::mul_add(0.4572, x153, x152);
+        let x160 = Self::mul_add(-c_q3, x154, s_q3 * x156);
+        let x161 = Self::mul_add(c_q3, x156, s_q3 * x154);
+        let x162 = x160
+            - Self::mul_add(-15.183612000000002, x106, 703.3878000000001 * x105);
+        let x163 = Self::mul_add(-703.3878000000001, x107, -15.183612000000002 * x108)
+            + x155;
+        let x164 = x161
+            - Self::mul_add(-15.183612000000002, x109, 703.3878000000001 * x106);
+        let x165 = Self::mul_add(
+            x97,
             15.183612000000002,
-            Self::mul_add(-103.41030072000001, x108, -5594.523885531201 * x107)
-                + Self::mul_add(-x101, x117, x109 * x118),
-        ) + Self::mul_add(0.1524, x161, Self::mul_add(s_q3, x165, c_q3 * x163));
-        let x172 = Self::mul_add(0.08, x108, 0.8021 * x107)
-            + Self::mul_add(x100, x118, x101 * x116)
-            + Self::mul_add(x106, 703.3878000000001, -15.183612000000002 * x105)
-            + (x164 + Self::mul_add(-7.06, x167, -0.1524 * x166));
-        let x173 = x119
-            + Self::mul_add(7.06, x161, Self::mul_add(-s_q3, x163, c_q3 * x165));
-        let x174 = Self::mul_add(
+            Self::mul_add(-103.41030072000001, x102, -5594.523885531201 * x101)
+                + Self::mul_add(-x95, x111, x103 * x112),
+        ) + Self::mul_add(0.1524, x155, Self::mul_add(s_q3, x159, c_q3 * x157));
+        let x166 = Self::mul_add(0.08, x102, 0.8021 * x101)
+            + Self::mul_add(x94, x112, x95 * x110)
+            + Self::mul_add(x100, 703.3878000000001, -15.183612000000002 * x99)
+            + (x158 + Self::mul_add(-7.06, x161, -0.1524 * x160));
+        let x167 = x113
+            + Self::mul_add(7.06, x155, Self::mul_add(-s_q3, x157, c_q3 * x159));
+        let x168 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x92, x98, qd[1] * x99)
-                - Self::mul_add(190.97044034, x94, -8596.210051042 * x93)
-                + Self::mul_add(0.1524, x169, Self::mul_add(s_q2, x173, c_q2 * x171)),
+            Self::mul_add(-x86, x92, qd[1] * x93)
+                - Self::mul_add(190.97044034, x88, -8596.210051042 * x87)
+                + Self::mul_add(0.1524, x163, Self::mul_add(s_q2, x167, c_q2 * x165)),
             c_q1
-                * (Self::mul_add(6.377, x169, Self::mul_add(-s_q2, x171, c_q2 * x173))
+                * (Self::mul_add(6.377, x163, Self::mul_add(-s_q2, x165, c_q2 * x167))
                     - Self::mul_add(
                         190.97044034000004,
-                        x93,
-                        Self::mul_add(x91, x98, qd[1] * x97),
+                        x87,
+                        Self::mul_add(x85, x92, qd[1] * x91),
                     )),
         );
-        let x175 = tau[0] - x174;
-        let x176 = 1.0 / (14222.257549666001 + x78);
-        let x177 = x77 * x176;
-        let x178 = x79 * x176;
-        let x179 = x80 * x176;
-        let x180 = x87 * x176;
-        let x181 = x90 * x176;
-        let x182 = 1.0
+        let x169 = tau[0] - x168;
+        let x170 = 1.0
+            / (14222.257549666001
+                + (x68
+                    - Self::mul_add(
+                        s_q1 * c_q1,
+                        x69 + x69,
+                        s_q1 * s_q1
+                            * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                    )));
+        let x171 = x70 * x170;
+        let x172 = x71 * x170;
+        let x173 = x72 * x170;
+        let x174 = x79 * x170;
+        let x175 = x84 * x170;
+        let x176 = 1.0
             / Self::mul_add(
-                -x77,
-                x177,
-                8609.573807858 + (x60 - (x73 - x72) - (x71 - x74)),
+                -x70,
+                x171,
+                8609.573807858 + (x51 - (x65 - x64) - (x63 - x66)),
             );
-        let x183 = Self::mul_add(-x77, x178, x60 + (x72 - x73));
-        let x184 = x182 * x183;
-        let x185 = Self::mul_add(
-            -x77,
-            x179,
-            x50
+        let x177 = Self::mul_add(-x70, x172, x51 + (x64 - x65));
+        let x178 = x176 * x177;
+        let x179 = Self::mul_add(
+            -x70,
+            x173,
+            x43
                 + Self::mul_add(
                     0.1524,
-                    Self::mul_add(s_q2, x36, c_q2 * x37),
-                    -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+                    Self::mul_add(s_q2, x38, c_q2 * x37),
+                    -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
                 ),
         );
-        let x186 = x182 * x185;
-        let x187 = Self::mul_add(
-            -x77,
-            x180,
-            x85
+        let x180 = x176 * x179;
+        let x181 = Self::mul_add(
+            -x70,
+            x174,
+            x77
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(c_q2, x82, s_q2 * x81),
-                    -0.1524 * Self::mul_add(-c_q2, x81, s_q2 * x82),
+                    Self::mul_add(c_q2, x74, s_q2 * x73),
+                    -0.1524 * Self::mul_add(-c_q2, x73, s_q2 * x74),
                 ),
         );
-        let x188 = x182 * x187;
-        let x189 = Self::mul_add(-x77, x181, x23);
-        let x190 = x182 * x189;
-        let x191 = 1.0 / Self::mul_add(-x183, x184, Self::mul_add(-x79, x178, x60));
-        let x192 = Self::mul_add(-x183, x186, Self::mul_add(-x79, x179, x50));
-        let x193 = x191 * x192;
-        let x194 = Self::mul_add(-x183, x188, Self::mul_add(-x79, x180, x85));
-        let x195 = x191 * x194;
-        let x196 = Self::mul_add(-x183, x190, Self::mul_add(-x79, x181, x23));
-        let x197 = x191 * x196;
+        let x182 = x176 * x181;
+        let x183 = Self::mul_add(-x70, x175, x81);
+        let x184 = x176 * x183;
+        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x71, x172, x51));
+        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x71, x173, x43));
+        let x187 = x185 * x186;
+        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x71, x174, x77));
+        let x189 = x185 * x188;
+        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x71, x175, x81));
+        let x191 = x185 * x190;
+        let x192 = Self::mul_add(
+            -x186,
+            x187,
+            Self::mul_add(-x179, x180, Self::mul_add(-x72, x173, x29)),
+        );
+        let x193 = 1.0 / x192;
+        let x194 = Self::mul_add(
+            -x186,
+            x189,
+            Self::mul_add(-x179, x182, Self::mul_add(-x72, x174, x19)),
+        );
+        let x195 = x193 * x194;
+        let x196 = Self::mul_add(
+            -x186,
+            x191,
+            Self::mul_add(-x179, x184, Self::mul_add(-x72, x175, x81)),
+        );
+        let x197 = x193 * x196;
         let x198 = Self::mul_add(
-            -x192,
-            x193,
-            Self::mul_add(-x185, x186, Self::mul_add(-x80, x179, x35)),
+            -x188,
+            x189,
+            Self::mul_add(-x181, x182, Self::mul_add(-x79, x174, x12)),
         );
-        let x199 = 1.0 / x198;
+        let x199 = 1.0 / Self::mul_add(-x194, x195, x198);
         let x200 = Self::mul_add(
-            -x192,
-            x195,
-            Self::mul_add(-x185, x188, Self::mul_add(-x80, x180, x25)),
+            -x188,
+            x191,
+            Self::mul_add(-x181, x184, Self::mul_add(-x79, x175, x10)),
         );
-        let x201 = x199 * x200;
-        let x202 = Self::mul_add(
-            -x192,
-            x197,
-            Self::mul_add(-x185, x190, Self::mul_add(-x80, x181, x23)),
+        let x201 = Self::mul_add(-x194, x197, x200);
+        let x202 = x199 * x201;
+        let x203 = Self::mul_add(
+            -x190,
+            x191,
+            Self::mul_add(-x183, x184, Self::mul_add(-x84, x175, 1.903)),
         );
-        let x203 = x199 * x202;
-        let x204 = Self::mul_add(
-            -x194,
-            x195,
-            Self::mul_add(-x187, x188, Self::mul_add(-x87, x180, x14)),
-        );
-        let x205 = 1.0 / Self::mul_add(-x200, x201, x204);
-        let x206 = Self::mul_add(
-            -x194,
-            x197,
-            Self::mul_add(-x187, x190, Self::mul_add(-x87, x181, x9)),
-        );
-        let x207 = Self::mul_add(-x200, x203, x206);
-        let x208 = x205 * x207;
-        let x209 = Self::mul_add(
-            -x196,
-            x197,
-            Self::mul_add(-x189, x190, Self::mul_add(-x90, x181, 1.903)),
-        );
-        let x210 = 1.0 / Self::mul_add(-x207, x208, Self::mul_add(-x202, x203, x209));
-        let x211 = Self::mul_add(
-            -x175,
-            x177,
+        let x204 = 1.0 / Self::mul_add(-x201, x202, Self::mul_add(-x196, x197, x203));
+        let x205 = Self::mul_add(
+            -x169,
+            x171,
             tau[1]
-                - (Self::mul_add(x91, x99, x92 * x97)
-                    - Self::mul_add(-0.0302, x94, -1.928 * x93)
-                    + (x172
+                - (Self::mul_add(x85, x93, x86 * x91)
+                    - Self::mul_add(-0.0302, x88, -1.928 * x87)
+                    + (x166
                         + Self::mul_add(
                             -6.377,
-                            Self::mul_add(-s_q2, x168, c_q2 * x170),
-                            -0.1524 * Self::mul_add(s_q2, x170, c_q2 * x168),
+                            Self::mul_add(-s_q2, x162, c_q2 * x164),
+                            -0.1524 * Self::mul_add(s_q2, x164, c_q2 * x162),
                         ))),
         );
-        let x212 = Self::mul_add(-x184, x211, Self::mul_add(-x175, x178, tau[2] - x172));
-        let x213 = Self::mul_add(
-            -x193,
-            x212,
-            Self::mul_add(-x186, x211, Self::mul_add(-x175, x179, tau[3] - x164)),
+        let x206 = Self::mul_add(-x178, x205, Self::mul_add(-x169, x172, tau[2] - x166));
+        let x207 = Self::mul_add(
+            -x187,
+            x206,
+            Self::mul_add(-x180, x205, Self::mul_add(-x169, x173, tau[3] - x158)),
         );
+        let x208 = Self::mul_add(
+            -x189,
+            x206,
+            Self::mul_add(-x182, x205, Self::mul_add(-x169, x174, tau[4] - x152)),
+        );
+        let x209 = Self::mul_add(-x195, x207, x208);
+        let x210 = Self::mul_add(
+            -x191,
+            x206,
+            Self::mul_add(-x184, x205, Self::mul_add(-x169, x175, tau[5] - x147)),
+        );
+        let x211 = x204 * Self::mul_add(-x202, x209, Self::mul_add(-x197, x207, x210));
+        let x212 = Self::mul_add(-x202, x211, x199 * x209);
+        let x213 = Self::mul_add(-x197, x211, Self::mul_add(-x195, x212, x193 * x207));
         let x214 = Self::mul_add(
-            -x195,
+            -x191,
+            x211,
+            Self::mul_add(-x189, x212, Self::mul_add(-x187, x213, x185 * x206)),
+        );
+        let x215 = Self::mul_add(
+            -x182,
             x212,
-            Self::mul_add(-x188, x211, Self::mul_add(-x175, x180, tau[4] - x158)),
+            Self::mul_add(-x180, x213, Self::mul_add(-x178, x214, x176 * x205)),
         );
-        let x215 = Self::mul_add(-x201, x213, x214);
-        let x216 = Self::mul_add(
-            -x197,
-            x212,
-            Self::mul_add(-x190, x211, Self::mul_add(-x175, x181, tau[5] - x153)),
+        let x216 = Self::mul_add(-x184, x211, x215);
+        let x217 = Self::mul_add(
+            -x173,
+            x213,
+            Self::mul_add(-x172, x214, Self::mul_add(-x171, x216, x169 * x170)),
         );
-        let x217 = x210 * Self::mul_add(-x208, x215, Self::mul_add(-x203, x213, x216));
-        let x218 = Self::mul_add(-x208, x217, x205 * x215);
-        let x219 = Self::mul_add(-x203, x217, Self::mul_add(-x201, x218, x199 * x213));
-        let x220 = Self::mul_add(
-            -x197,
-            x217,
-            Self::mul_add(-x195, x218, Self::mul_add(-x193, x219, x191 * x212)),
-        );
-        let x221 = Self::mul_add(
-            -x188,
-            x218,
-            Self::mul_add(-x186, x219, Self::mul_add(-x184, x220, x182 * x211)),
-        );
-        let x222 = Self::mul_add(-x190, x217, x221);
-        let x223 = Self::mul_add(
-            -x179,
-            x219,
-            Self::mul_add(-x178, x220, Self::mul_add(-x177, x222, x175 * x176)),
-        );
-        let x224 = Self::mul_add(-x181, x217, Self::mul_add(-x180, x218, x223));
-        [x224, x222, x220, x219, x218, x217]
+        let x218 = Self::mul_add(-x175, x211, Self::mul_add(-x174, x212, x217));
+        [x218, x216, x214, x213, x212, x211]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 285 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 202 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 343 mul, 276 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1488,336 +1784,311 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x6 = 0.353 * s_q5;
-        let x7 = 0.353 * c_q5;
-        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
-        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
-        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
-        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
-        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
-        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
-        let x15 = 34.45002 * c_q4;
-        let x16 = 34.45002 * s_q4;
-        let x17 = s_q4 * x5;
-        let x18 = Self::mul_add(1.903, c_q4, -x17);
-        let x19 = c_q4 * x5;
-        let x20 = Self::mul_add(-s_q4, x13, x19);
-        let x21 = c_q4 * x9;
-        let x22 = Self::mul_add(-s_q4, x11, x21);
-        let x23 = Self::mul_add(1.903, s_q4, x19);
-        let x24 = s_q4 * x9;
-        let x25 = Self::mul_add(c_q4, x11, x24);
-        let x26 = Self::mul_add(-s_q4, x12, x21);
-        let x27 = Self::mul_add(c_q4, x12, x24);
-        let x28 = x15 * -0.4572;
-        let x29 = 0.4572 * x15;
-        let x30 = x14 + x29;
-        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
-        let x32 = x30 - x28;
-        let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
-        let x35 = 19.863252216000003
-            + (x29
-                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
-                    - x28));
-        let x36 = c_q3 * x33;
-        let x37 = s_q3 * x33;
-        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
-        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
-        let x40 = c_q3 * x22;
-        let x41 = Self::mul_add(s_q3, x32, x40);
-        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
-        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
-        let x44 = s_q3 * x22;
-        let x45 = Self::mul_add(c_q3, x32, -x44);
-        let x46 = x37 * 0.1524;
-        let x47 = -0.1524 * x37;
-        let x48 = x36 * -7.06;
-        let x49 = 7.06 * x36;
-        let x50 = x35 - (x47 + x48);
-        let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(
-            x37,
-            7.06,
-            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-        );
-        let x53 = Self::mul_add(
+        let x5 = s_q5 * s_q5;
+        let x6 = s_q5 * c_q5;
+        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
+        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
+        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
+        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x11 = 34.33891524 - x7;
+        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x13 = s_q4 * s_q4;
+        let x14 = s_q4 * c_q4;
+        let x15 = 1.903 - x11;
+        let x16 = x9 + x9;
+        let x17 = Self::mul_add(x14, x16, x13 * x15);
+        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
+        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
+        let x20 = 34.45002 * c_q4;
+        let x21 = 34.45002 * s_q4;
+        let x22 = x20 * -0.4572;
+        let x23 = 0.4572 * x20;
+        let x24 = x12 + x23;
+        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
+        let x26 = x24 - x22;
+        let x27 = 41.67378 + x20;
+        let x28 = -18.957952216000002 + (1.903 - x17);
+        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x30 = s_q3 * s_q3;
+        let x31 = s_q3 * c_q3;
+        let x32 = x26 - x28;
+        let x33 = x18 + x18;
+        let x34 = Self::mul_add(x31, x33, x30 * x32);
+        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
+        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
+        let x37 = s_q3 * x27;
+        let x38 = c_q3 * x27;
+        let x39 = x37 * 0.1524;
+        let x40 = -0.1524 * x37;
+        let x41 = x38 * -7.06;
+        let x42 = 7.06 * x38;
+        let x43 = x29 - (x40 + x41);
+        let x44 = x21 * 0.1524;
+        let x45 = Self::mul_add(
             0.1524,
-            x36,
-            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            x38,
+            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x55 = 703.3878000000001 + x36;
-        let x56 = -15.183612000000002 - x37;
-        let x57 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x59 = 103.41030072000001 + x52;
-        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x61 = 103.41030072000002 + x53;
-        let x62 = -0.08 + (x43 + x51);
-        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
-        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
-        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
-        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
-        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
-        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
-        let x71 = 0.1524 * x64;
-        let x72 = -0.1524 * x64;
-        let x73 = x63 * -6.377;
-        let x74 = 6.377 * x63;
-        let x75 = Self::mul_add(
-            x64,
-            -6.377,
-            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
-        );
-        let x76 = Self::mul_add(
+        let x46 = x26 - x34 + x42 - x41;
+        let x47 = 703.3878000000001 + x38;
+        let x48 = -15.183612000000002 - x37;
+        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
+        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
+        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
+        let x52 = 103.41030072000002 + x45;
+        let x53 = -0.08 + (x35 + x44);
+        let x54 = s_q2 * s_q2;
+        let x55 = s_q2 * c_q2;
+        let x56 = x46 - x49;
+        let x57 = x52 + x52;
+        let x58 = Self::mul_add(x55, x57, x54 * x56);
+        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
+        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
+        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
+        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
+        let x63 = 0.1524 * x61;
+        let x64 = -0.1524 * x61;
+        let x65 = x62 * -6.377;
+        let x66 = 6.377 * x62;
+        let x67 = Self::mul_add(
             0.1524,
-            x63,
-            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+            x62,
+            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
         );
-        let x77 = 8609.573807858 + (x60 - (x73 - x72) - (x71 - x74));
-        let x78 = Self::mul_add(
+        let x68 = x46 - x58 + x66 - x65;
+        let x69 = 8609.573807858 + (x51 - (x65 - x64) - (x63 - x66));
+        let x70 = 190.97044034000004 + x67;
+        let x71 = Self::mul_add(
             -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x66),
-            c_q1 * (-0.0302 + (x51 + x69)),
+            -1.928 + Self::mul_add(-6.377, x21, x60),
+            c_q1 * (-0.0302 + (x44 + x59)),
         );
-        let x79 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                -s_q1,
-                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
-                c_q1 * (190.97044034000004 + x76),
-            ),
-            c_q1
-                * Self::mul_add(
-                    -s_q1,
-                    190.97044034 + x75,
-                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
-                ),
-        );
-        let x80 = 14222.257549666001 + x79;
-        let x81 = x60 + (x72 - x73);
-        let x82 = Self::mul_add(-s_q1, x66, c_q1 * x69);
-        let x83 = x50
+        let x72 = 14222.257549666001
+            + (x68
+                - Self::mul_add(
+                    s_q1 * c_q1,
+                    x70 + x70,
+                    s_q1 * s_q1 * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                ));
+        let x73 = x51 + (x64 - x65);
+        let x74 = Self::mul_add(-s_q1, x60, c_q1 * x59);
+        let x75 = x43
             + Self::mul_add(
                 0.1524,
-                Self::mul_add(s_q2, x36, c_q2 * x37),
-                -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+                Self::mul_add(s_q2, x38, c_q2 * x37),
+                -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
+            );
+        let x76 = Self::mul_add(
+            -s_q1,
+            Self::mul_add(s_q2, x35, c_q2 * x36),
+            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
+        );
+        let x77 = c_q3 * x21;
+        let x78 = s_q3 * x21;
+        let x79 = x20 * 0.1524;
+        let x80 = Self::mul_add(s_q3, x24, c_q3 * x18) + x79;
+        let x81 = x19 + Self::mul_add(0.1524, x77, -7.06 * x78);
+        let x82 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
+        let x83 = x81
+            + Self::mul_add(
+                -6.377,
+                Self::mul_add(c_q2, x78, s_q2 * x77),
+                -0.1524 * Self::mul_add(-c_q2, x77, s_q2 * x78),
             );
         let x84 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x43, c_q2 * x39),
-            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+            x79 + Self::mul_add(s_q2, x82, c_q2 * x80),
+            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x80, c_q2 * x82)),
         );
-        let x85 = c_q3 * x16;
-        let x86 = s_q3 * x16;
-        let x87 = x15 * 0.1524;
-        let x88 = Self::mul_add(s_q3, x30, x40) + x87;
-        let x89 = x25 + Self::mul_add(0.1524, x85, -7.06 * x86);
-        let x90 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x91 = x89
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(c_q2, x86, s_q2 * x85),
-                -0.1524 * Self::mul_add(-c_q2, x85, s_q2 * x86),
-            );
-        let x92 = Self::mul_add(
+        let x85 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
+        let x86 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x87 = Self::mul_add(s_q3, x10, c_q3 * x85);
+        let x88 = Self::mul_add(-s_q3, x85, c_q3 * x10);
+        let x89 = Self::mul_add(
             -s_q1,
-            x87 + Self::mul_add(s_q2, x90, c_q2 * x88),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x88, c_q2 * x90)),
+            Self::mul_add(s_q2, x88, c_q2 * x87),
+            c_q1 * Self::mul_add(-s_q2, x87, c_q2 * x88),
         );
-        let x93 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x94 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x95 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x94, c_q2 * x93),
-            c_q1 * Self::mul_add(-s_q2, x93, c_q2 * x94),
-        );
-        let x96 = qd[0] * s_q1;
-        let x97 = qd[0] * c_q1;
-        let x98 = qd[1] * x97;
-        let x99 = qd[1] * x96;
-        let x100 = qd[1] * qd[1];
-        let x101 = x96 * x97;
-        let x102 = Self::mul_add(
+        let x90 = qd[0] * s_q1;
+        let x91 = qd[0] * c_q1;
+        let x92 = qd[1] * x91;
+        let x93 = qd[1] * x90;
+        let x94 = qd[1] * qd[1];
+        let x95 = x90 * x91;
+        let x96 = Self::mul_add(
             190.97044034,
-            x97,
-            Self::mul_add(8596.210051042, x96, -1.928 * qd[1]),
+            x91,
+            Self::mul_add(8596.210051042, x90, -1.928 * qd[1]),
         );
-        let x103 = Self::mul_add(
+        let x97 = Self::mul_add(
             -0.0302,
-            x97,
-            Self::mul_add(1.928, x96, 8609.573807858 * qd[1]),
+            x91,
+            Self::mul_add(1.928, x90, 8609.573807858 * qd[1]),
         );
-        let x104 = Self::mul_add(-190.97044034000004, x96, -0.0302 * qd[1]);
-        let x105 = Self::mul_add(s_q2, x97, c_q2 * x96);
-        let x106 = Self::mul_add(-s_q2, x96, c_q2 * x97);
-        let x107 = Self::mul_add(-0.1524, x101, 6.377 * Self::mul_add(x97, x97, x100));
-        let x108 = Self::mul_add(-6.377, x99 + x99, -0.1524 * (x98 + x98));
-        let x109 = Self::mul_add(-0.1524, Self::mul_add(x96, x96, x100), 6.377 * x101);
-        let x110 = Self::mul_add(-c_q2, x107, s_q2 * x109);
-        let x111 = Self::mul_add(c_q2, x109, s_q2 * x107);
-        let x112 = Self::mul_add(-qd[2], x106, Self::mul_add(-c_q2, x98, s_q2 * x99));
-        let x113 = Self::mul_add(qd[2], x105, Self::mul_add(c_q2, x99, s_q2 * x98));
-        let x114 = qd[1] + qd[2];
-        let x115 = x114 * x114;
-        let x116 = Self::mul_add(x106, x106, x115);
-        let x117 = x105 * x106;
-        let x118 = Self::mul_add(x105, x114, x113);
-        let x119 = Self::mul_add(x106, x114, -x112);
-        let x120 = Self::mul_add(x105, x105, x115);
-        let x121 = Self::mul_add(
+        let x98 = Self::mul_add(-190.97044034000004, x90, -0.0302 * qd[1]);
+        let x99 = Self::mul_add(s_q2, x91, c_q2 * x90);
+        let x100 = Self::mul_add(-s_q2, x90, c_q2 * x91);
+        let x101 = Self::mul_add(-0.1524, x95, 6.377 * Self::mul_add(x91, x91, x94));
+        let x102 = Self::mul_add(-6.377, x93 + x93, -0.1524 * (x92 + x92));
+        let x103 = Self::mul_add(-0.1524, Self::mul_add(x90, x90, x94), 6.377 * x95);
+        let x104 = Self::mul_add(-c_q2, x101, s_q2 * x103);
+        let x105 = Self::mul_add(c_q2, x103, s_q2 * x101);
+        let x106 = Self::mul_add(-qd[2], x100, Self::mul_add(-c_q2, x92, s_q2 * x93));
+        let x107 = Self::mul_add(qd[2], x99, Self::mul_add(c_q2, x93, s_q2 * x92));
+        let x108 = qd[1] + qd[2];
+        let x109 = x108 * x108;
+        let x110 = Self::mul_add(x100, x100, x109);
+        let x111 = x99 * x100;
+        let x112 = Self::mul_add(x99, x108, x107);
+        let x113 = Self::mul_add(x100, x108, -x106);
+        let x114 = Self::mul_add(x99, x99, x109);
+        let x115 = Self::mul_add(
             103.41030072000001,
-            x106,
-            Self::mul_add(5594.523885531201, x105, 0.8021 * x114),
+            x100,
+            Self::mul_add(5594.523885531201, x99, 0.8021 * x108),
         );
-        let x122 = Self::mul_add(
+        let x116 = Self::mul_add(
             -0.08,
-            x106,
-            Self::mul_add(-0.8021, x105, 5601.1318504688 * x114),
+            x100,
+            Self::mul_add(-0.8021, x99, 5601.1318504688 * x108),
         );
-        let x123 = Self::mul_add(-103.41030072000002, x105, -0.08 * x114);
-        let x124 = Self::mul_add(
+        let x117 = Self::mul_add(-103.41030072000002, x99, -0.08 * x108);
+        let x118 = Self::mul_add(
             703.3878000000001,
-            x108,
+            x102,
             Self::mul_add(
                 103.41030072000002,
-                x112,
-                -Self::mul_add(x105, x122, x114 * x121),
+                x106,
+                -Self::mul_add(x99, x116, x108 * x115),
             ),
         );
-        let x125 = Self::mul_add(s_q3, x106, c_q3 * x105);
-        let x126 = Self::mul_add(-s_q3, x105, c_q3 * x106);
-        let x127 = x110 - Self::mul_add(-0.1524, x117, 7.06 * x116);
-        let x128 = x108 + Self::mul_add(-7.06, x118, -0.1524 * x119);
-        let x129 = x111 + Self::mul_add(-0.1524, x120, 7.06 * x117);
-        let x130 = Self::mul_add(-c_q3, x129, s_q3 * x127);
-        let x131 = Self::mul_add(-qd[3], x126, Self::mul_add(s_q3, x113, c_q3 * x112));
-        let x132 = Self::mul_add(-qd[3], x125, Self::mul_add(-c_q3, x113, s_q3 * x112));
-        let x133 = qd[3] + x114;
-        let x134 = Self::mul_add(x126, x126, x133 * x133);
-        let x135 = x125 * x126;
-        let x136 = Self::mul_add(-x125, x133, x132);
-        let x137 = -18.957952216000002 * x125;
-        let x138 = 19.863252216000003 * x133;
-        let x139 = Self::mul_add(-c_q4, x125, s_q4 * x133);
-        let x140 = Self::mul_add(c_q4, x133, s_q4 * x125);
-        let x141 = Self::mul_add(
+        let x119 = Self::mul_add(s_q3, x100, c_q3 * x99);
+        let x120 = Self::mul_add(-s_q3, x99, c_q3 * x100);
+        let x121 = x104 - Self::mul_add(-0.1524, x111, 7.06 * x110);
+        let x122 = x102 + Self::mul_add(-7.06, x112, -0.1524 * x113);
+        let x123 = x105 + Self::mul_add(-0.1524, x114, 7.06 * x111);
+        let x124 = Self::mul_add(-c_q3, x123, s_q3 * x121);
+        let x125 = Self::mul_add(-qd[3], x120, Self::mul_add(s_q3, x107, c_q3 * x106));
+        let x126 = Self::mul_add(-qd[3], x119, Self::mul_add(-c_q3, x107, s_q3 * x106));
+        let x127 = qd[3] + x108;
+        let x128 = Self::mul_add(x120, x120, x127 * x127);
+        let x129 = x119 * x120;
+        let x130 = Self::mul_add(-x119, x127, x126);
+        let x131 = -18.957952216000002 * x119;
+        let x132 = 19.863252216000003 * x127;
+        let x133 = Self::mul_add(-c_q4, x119, s_q4 * x127);
+        let x134 = Self::mul_add(c_q4, x127, s_q4 * x119);
+        let x135 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x134, Self::mul_add(s_q3, x129, c_q3 * x127)),
-            c_q4 * Self::mul_add(0.4572, x136, x128),
+            Self::mul_add(-0.4572, x128, Self::mul_add(s_q3, x123, c_q3 * x121)),
+            c_q4 * Self::mul_add(0.4572, x130, x122),
         );
-        let x142 = Self::mul_add(qd[4], x140, c_q4 * x131);
-        let x143 = Self::mul_add(qd[4], x139, s_q4 * x131);
-        let x144 = qd[4] + x126;
-        let x145 = 34.45002 * Self::mul_add(x144, x144, x140 * x140);
-        let x146 = 34.45002 * Self::mul_add(x139, x140, x132);
-        let x147 = 34.45002 * Self::mul_add(x139, x144, x143);
-        let x148 = 34.33891524 * x140;
-        let x149 = 34.74691524 * x144;
-        let x150 = Self::mul_add(s_q5, x144, c_q5 * x140);
-        let x151 = Self::mul_add(-s_q5, x140, c_q5 * x144);
-        let x152 = Self::mul_add(qd[5], x151, Self::mul_add(-c_q5, x143, s_q5 * x132));
-        let x153 = Self::mul_add(-qd[5], x150, Self::mul_add(c_q5, x132, s_q5 * x143));
-        let x154 = qd[5] + x139;
-        let x155 = Self::mul_add(0.966, x151, Self::mul_add(0.385, x150, 1.903 * x154));
-        let x156 = Self::mul_add(0.353, x151, 0.385 * x154);
-        let x157 = Self::mul_add(
+        let x136 = Self::mul_add(qd[4], x134, c_q4 * x125);
+        let x137 = Self::mul_add(qd[4], x133, s_q4 * x125);
+        let x138 = qd[4] + x120;
+        let x139 = 34.45002 * Self::mul_add(x138, x138, x134 * x134);
+        let x140 = 34.45002 * Self::mul_add(x133, x134, x126);
+        let x141 = 34.45002 * Self::mul_add(x133, x138, x137);
+        let x142 = 34.33891524 * x134;
+        let x143 = 34.74691524 * x138;
+        let x144 = Self::mul_add(s_q5, x138, c_q5 * x134);
+        let x145 = Self::mul_add(-s_q5, x134, c_q5 * x138);
+        let x146 = Self::mul_add(qd[5], x145, Self::mul_add(-c_q5, x137, s_q5 * x126));
+        let x147 = Self::mul_add(-qd[5], x144, Self::mul_add(c_q5, x126, s_q5 * x137));
+        let x148 = qd[5] + x133;
+        let x149 = Self::mul_add(0.966, x145, Self::mul_add(0.385, x144, 1.903 * x148));
+        let x150 = Self::mul_add(0.353, x145, 0.385 * x148);
+        let x151 = Self::mul_add(
             -0.9929999999999999,
-            x151,
-            Self::mul_add(0.353, x150, 0.966 * x154),
+            x145,
+            Self::mul_add(0.353, x144, 0.966 * x148),
         );
-        let x158 = Self::mul_add(0.966, x153, Self::mul_add(0.385, x152, 1.903 * x142))
-            + Self::mul_add(-x151, x156, x150 * x157);
-        let x159 = Self::mul_add(0.353, x153, 0.385 * x142)
-            + Self::mul_add(-x154, x157, x151 * x155);
-        let x160 = Self::mul_add(
+        let x152 = Self::mul_add(0.966, x147, Self::mul_add(0.385, x146, 1.903 * x136))
+            + Self::mul_add(-x145, x150, x144 * x151);
+        let x153 = Self::mul_add(0.353, x147, 0.385 * x136)
+            + Self::mul_add(-x148, x151, x145 * x149);
+        let x154 = Self::mul_add(
             -0.9929999999999999,
-            x153,
-            Self::mul_add(0.353, x152, 0.966 * x142),
-        ) + Self::mul_add(-x150, x155, x154 * x156);
-        let x161 = Self::mul_add(-x144, x148, x140 * x149) + x158;
-        let x162 = Self::mul_add(
+            x147,
+            Self::mul_add(0.353, x146, 0.966 * x136),
+        ) + Self::mul_add(-x144, x149, x148 * x150);
+        let x155 = Self::mul_add(-x138, x142, x134 * x143) + x152;
+        let x156 = Self::mul_add(
             -34.45002,
-            Self::mul_add(-0.4572, x135, x130),
-            -Self::mul_add(x139, x149, 34.33891524 * x143),
-        ) + Self::mul_add(-s_q5, x160, c_q5 * x159);
-        let x163 = Self::mul_add(
+            Self::mul_add(-0.4572, x129, x124),
+            -Self::mul_add(x133, x143, 34.33891524 * x137),
+        ) + Self::mul_add(-s_q5, x154, c_q5 * x153);
+        let x157 = Self::mul_add(
             34.45002,
-            x141,
-            Self::mul_add(x139, x148, 34.74691524 * x132),
-        ) + Self::mul_add(c_q5, x160, s_q5 * x159);
-        let x164 = Self::mul_add(-s_q4, x145, c_q4 * x146);
-        let x165 = Self::mul_add(41.67378, x134, Self::mul_add(s_q4, x146, c_q4 * x145));
-        let x166 = Self::mul_add(41.67378, x136, x164);
-        let x167 = Self::mul_add(-41.67378, x135, x147);
-        let x168 = Self::mul_add(-x126, x138, -18.957952216000002 * x131)
-            + Self::mul_add(-s_q4, x162, c_q4 * x161);
-        let x169 = Self::mul_add(-x126, x137, x130 * -41.67378)
-            + Self::mul_add(-0.4572, x147, Self::mul_add(c_q4, x162, s_q4 * x161));
-        let x170 = Self::mul_add(41.67378, x128, Self::mul_add(-x125, x138, x133 * x137))
-            + Self::mul_add(0.4572, x164, x163);
-        let x171 = Self::mul_add(-c_q3, x165, s_q3 * x167);
-        let x172 = Self::mul_add(c_q3, x167, s_q3 * x165);
-        let x173 = x171
-            - Self::mul_add(-15.183612000000002, x117, 703.3878000000001 * x116);
-        let x174 = Self::mul_add(-703.3878000000001, x118, -15.183612000000002 * x119)
-            + x166;
-        let x175 = x172
-            - Self::mul_add(-15.183612000000002, x120, 703.3878000000001 * x117);
-        let x176 = Self::mul_add(
-            x108,
+            x135,
+            Self::mul_add(x133, x142, 34.74691524 * x126),
+        ) + Self::mul_add(c_q5, x154, s_q5 * x153);
+        let x158 = Self::mul_add(-s_q4, x139, c_q4 * x140);
+        let x159 = Self::mul_add(41.67378, x128, Self::mul_add(s_q4, x140, c_q4 * x139));
+        let x160 = Self::mul_add(41.67378, x130, x158);
+        let x161 = Self::mul_add(-41.67378, x129, x141);
+        let x162 = Self::mul_add(-x120, x132, -18.957952216000002 * x125)
+            + Self::mul_add(-s_q4, x156, c_q4 * x155);
+        let x163 = Self::mul_add(-x120, x131, x124 * -41.67378)
+            + Self::mul_add(-0.4572, x141, Self::mul_add(c_q4, x156, s_q4 * x155));
+        let x164 = Self::mul_add(41.67378, x122, Self::mul_add(-x119, x132, x127 * x131))
+            + Self::mul_add(0.4572, x158, x157);
+        let x165 = Self::mul_add(-c_q3, x159, s_q3 * x161);
+        let x166 = Self::mul_add(c_q3, x161, s_q3 * x159);
+        let x167 = x165
+            - Self::mul_add(-15.183612000000002, x111, 703.3878000000001 * x110);
+        let x168 = Self::mul_add(-703.3878000000001, x112, -15.183612000000002 * x113)
+            + x160;
+        let x169 = x166
+            - Self::mul_add(-15.183612000000002, x114, 703.3878000000001 * x111);
+        let x170 = Self::mul_add(
+            x102,
             15.183612000000002,
-            Self::mul_add(-103.41030072000001, x113, -5594.523885531201 * x112)
-                + Self::mul_add(-x106, x122, x114 * x123),
-        ) + Self::mul_add(0.1524, x166, Self::mul_add(s_q3, x170, c_q3 * x168));
-        let x177 = Self::mul_add(0.08, x113, 0.8021 * x112)
-            + Self::mul_add(x105, x123, x106 * x121)
-            + Self::mul_add(x111, 703.3878000000001, -15.183612000000002 * x110)
-            + (x169 + Self::mul_add(-7.06, x172, -0.1524 * x171));
-        let x178 = x124
-            + Self::mul_add(7.06, x166, Self::mul_add(-s_q3, x168, c_q3 * x170));
-        let x179 = Self::mul_add(x96, x104, x97 * x102)
-            - Self::mul_add(-0.0302, x99, -1.928 * x98)
-            + (x177
+            Self::mul_add(-103.41030072000001, x107, -5594.523885531201 * x106)
+                + Self::mul_add(-x100, x116, x108 * x117),
+        ) + Self::mul_add(0.1524, x160, Self::mul_add(s_q3, x164, c_q3 * x162));
+        let x171 = Self::mul_add(0.08, x107, 0.8021 * x106)
+            + Self::mul_add(x99, x117, x100 * x115)
+            + Self::mul_add(x105, 703.3878000000001, -15.183612000000002 * x104)
+            + (x163 + Self::mul_add(-7.06, x166, -0.1524 * x165));
+        let x172 = x118
+            + Self::mul_add(7.06, x160, Self::mul_add(-s_q3, x162, c_q3 * x164));
+        let x173 = Self::mul_add(x90, x98, x91 * x96)
+            - Self::mul_add(-0.0302, x93, -1.928 * x92)
+            + (x171
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(-s_q2, x173, c_q2 * x175),
-                    -0.1524 * Self::mul_add(s_q2, x175, c_q2 * x173),
+                    Self::mul_add(-s_q2, x167, c_q2 * x169),
+                    -0.1524 * Self::mul_add(s_q2, x169, c_q2 * x167),
                 ));
-        let x180 = Self::mul_add(
+        let x174 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x97, x103, qd[1] * x104)
-                - Self::mul_add(190.97044034, x99, -8596.210051042 * x98)
-                + Self::mul_add(0.1524, x174, Self::mul_add(s_q2, x178, c_q2 * x176)),
+            Self::mul_add(-x91, x97, qd[1] * x98)
+                - Self::mul_add(190.97044034, x93, -8596.210051042 * x92)
+                + Self::mul_add(0.1524, x168, Self::mul_add(s_q2, x172, c_q2 * x170)),
             c_q1
-                * (Self::mul_add(6.377, x174, Self::mul_add(-s_q2, x176, c_q2 * x178))
+                * (Self::mul_add(6.377, x168, Self::mul_add(-s_q2, x170, c_q2 * x172))
                     - Self::mul_add(
                         190.97044034000004,
-                        x98,
-                        Self::mul_add(x96, x103, qd[1] * x102),
+                        x92,
+                        Self::mul_add(x90, x97, qd[1] * x96),
                     )),
         );
         (
             [
-                [x80, x78, x82, x84, x92, x95],
-                [x78, x77, x81, x83, x91, x23],
-                [x82, x81, x60, x50, x89, x23],
-                [x84, x83, x50, x35, x25, x23],
-                [x92, x91, x89, x25, x14, x9],
-                [x95, x23, x23, x23, x9, 1.903],
+                [x72, x71, x74, x76, x84, x89],
+                [x71, x69, x73, x75, x83, x86],
+                [x74, x73, x51, x43, x81, x86],
+                [x76, x75, x43, x29, x19, x86],
+                [x84, x83, x81, x19, x12, x10],
+                [x89, x86, x86, x86, x10, 1.903],
             ],
-            [x180, x179, x177, x169, x163, x158],
+            [x174, x173, x171, x163, x157, x152],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 469 mul, 388 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 274 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 435 mul, 379 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1830,448 +2101,425 @@ impl Srms {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
-        let x6 = 0.353 * s_q5;
-        let x7 = 0.353 * c_q5;
-        let x8 = Self::mul_add(0.9929999999999999, s_q5, x7);
-        let x9 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x10 = Self::mul_add(-0.9929999999999999, c_q5, x6);
-        let x11 = Self::mul_add(-s_q5, x6, c_q5 * x8);
-        let x12 = Self::mul_add(-s_q5, x10, c_q5 * x7);
-        let x13 = 34.33891524 - Self::mul_add(s_q5, x8, c_q5 * x6);
-        let x14 = 34.74691524 + Self::mul_add(c_q5, x10, s_q5 * x7);
-        let x15 = 34.45002 * c_q4;
-        let x16 = 34.45002 * s_q4;
-        let x17 = s_q4 * x5;
-        let x18 = Self::mul_add(1.903, c_q4, -x17);
-        let x19 = c_q4 * x5;
-        let x20 = Self::mul_add(-s_q4, x13, x19);
-        let x21 = c_q4 * x9;
-        let x22 = Self::mul_add(-s_q4, x11, x21);
-        let x23 = Self::mul_add(1.903, s_q4, x19);
-        let x24 = s_q4 * x9;
-        let x25 = Self::mul_add(c_q4, x11, x24);
-        let x26 = Self::mul_add(-s_q4, x12, x21);
-        let x27 = Self::mul_add(c_q4, x12, x24);
-        let x28 = x15 * -0.4572;
-        let x29 = 0.4572 * x15;
-        let x30 = x14 + x29;
-        let x31 = Self::mul_add(-0.4572, x16, Self::mul_add(c_q4, x20, s_q4 * x18));
-        let x32 = x30 - x28;
-        let x33 = 41.67378 + x15;
-        let x34 = -18.957952216000002 + Self::mul_add(-s_q4, x20, c_q4 * x18);
-        let x35 = 19.863252216000003
-            + (x29
-                + (Self::mul_add(c_q4, Self::mul_add(c_q4, x13, x17), s_q4 * x23)
-                    - x28));
-        let x36 = c_q3 * x33;
-        let x37 = s_q3 * x33;
-        let x38 = Self::mul_add(s_q3, x26, c_q3 * x34);
-        let x39 = Self::mul_add(s_q3, x27, c_q3 * x31);
-        let x40 = c_q3 * x22;
-        let x41 = Self::mul_add(s_q3, x32, x40);
-        let x42 = Self::mul_add(-s_q3, x34, c_q3 * x26);
-        let x43 = Self::mul_add(-s_q3, x31, c_q3 * x27);
-        let x44 = s_q3 * x22;
-        let x45 = Self::mul_add(c_q3, x32, -x44);
-        let x46 = x37 * 0.1524;
-        let x47 = -0.1524 * x37;
-        let x48 = x36 * -7.06;
-        let x49 = 7.06 * x36;
-        let x50 = x35 - (x47 + x48);
-        let x51 = x16 * 0.1524;
-        let x52 = Self::mul_add(
-            x37,
-            7.06,
-            Self::mul_add(x36, 0.1524, Self::mul_add(-s_q3, x38, c_q3 * x41)),
-        );
-        let x53 = Self::mul_add(
+        let x5 = s_q5 * s_q5;
+        let x6 = s_q5 * c_q5;
+        let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
+        let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
+        let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
+        let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
+        let x11 = 34.33891524 - x7;
+        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x13 = s_q4 * s_q4;
+        let x14 = s_q4 * c_q4;
+        let x15 = 1.903 - x11;
+        let x16 = x9 + x9;
+        let x17 = Self::mul_add(x14, x16, x13 * x15);
+        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
+        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
+        let x20 = 34.45002 * c_q4;
+        let x21 = 34.45002 * s_q4;
+        let x22 = x20 * -0.4572;
+        let x23 = 0.4572 * x20;
+        let x24 = x12 + x23;
+        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
+        let x26 = x24 - x22;
+        let x27 = 41.67378 + x20;
+        let x28 = -18.957952216000002 + (1.903 - x17);
+        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x30 = s_q3 * s_q3;
+        let x31 = s_q3 * c_q3;
+        let x32 = x26 - x28;
+        let x33 = x18 + x18;
+        let x34 = Self::mul_add(x31, x33, x30 * x32);
+        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
+        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
+        let x37 = s_q3 * x27;
+        let x38 = c_q3 * x27;
+        let x39 = x37 * 0.1524;
+        let x40 = -0.1524 * x37;
+        let x41 = x38 * -7.06;
+        let x42 = 7.06 * x38;
+        let x43 = x29 - (x40 + x41);
+        let x44 = x21 * 0.1524;
+        let x45 = Self::mul_add(
             0.1524,
-            x36,
-            Self::mul_add(7.06, x37, Self::mul_add(s_q3, x45, c_q3 * x42)),
+            x38,
+            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x54 = Self::mul_add(-s_q3, x42, c_q3 * x45) + x49 - x48;
-        let x55 = 703.3878000000001 + x36;
-        let x56 = -15.183612000000002 - x37;
-        let x57 = -5594.523885531201
-            + (Self::mul_add(s_q3, x41, c_q3 * x38) + x46 - x47);
-        let x58 = 0.8021 + Self::mul_add(-7.06, x16, x39);
-        let x59 = 103.41030072000001 + x52;
-        let x60 = 5601.1318504688 + (x50 + (x46 + x49));
-        let x61 = 103.41030072000002 + x53;
-        let x62 = -0.08 + (x43 + x51);
-        let x63 = Self::mul_add(s_q2, x56, c_q2 * x55);
-        let x64 = Self::mul_add(-s_q2, x55, c_q2 * x56);
-        let x65 = Self::mul_add(s_q2, x61, c_q2 * x57);
-        let x66 = Self::mul_add(s_q2, x62, c_q2 * x58);
-        let x67 = Self::mul_add(s_q2, x54, c_q2 * x59);
-        let x68 = Self::mul_add(-s_q2, x57, c_q2 * x61);
-        let x69 = Self::mul_add(-s_q2, x58, c_q2 * x62);
-        let x70 = Self::mul_add(-s_q2, x59, c_q2 * x54);
-        let x71 = 0.1524 * x64;
-        let x72 = -0.1524 * x64;
-        let x73 = x63 * -6.377;
-        let x74 = 6.377 * x63;
-        let x75 = Self::mul_add(
-            x64,
-            -6.377,
-            Self::mul_add(0.1524, x63, Self::mul_add(-s_q2, x65, c_q2 * x67)),
-        );
-        let x76 = Self::mul_add(
+        let x46 = x26 - x34 + x42 - x41;
+        let x47 = 703.3878000000001 + x38;
+        let x48 = -15.183612000000002 - x37;
+        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
+        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
+        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
+        let x52 = 103.41030072000002 + x45;
+        let x53 = -0.08 + (x35 + x44);
+        let x54 = s_q2 * s_q2;
+        let x55 = s_q2 * c_q2;
+        let x56 = x46 - x49;
+        let x57 = x52 + x52;
+        let x58 = Self::mul_add(x55, x57, x54 * x56);
+        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
+        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
+        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
+        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
+        let x63 = 0.1524 * x61;
+        let x64 = -0.1524 * x61;
+        let x65 = x62 * -6.377;
+        let x66 = 6.377 * x62;
+        let x67 = Self::mul_add(
             0.1524,
-            x63,
-            Self::mul_add(-6.377, x64, Self::mul_add(s_q2, x70, c_q2 * x68)),
+            x62,
+            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
         );
-        let x77 = Self::mul_add(
+        let x68 = x46 - x58 + x66 - x65;
+        let x69 = 190.97044034000004 + x67;
+        let x70 = Self::mul_add(
             -s_q1,
-            -1.928 + Self::mul_add(-6.377, x16, x66),
-            c_q1 * (-0.0302 + (x51 + x69)),
+            -1.928 + Self::mul_add(-6.377, x21, x60),
+            c_q1 * (-0.0302 + (x44 + x59)),
         );
-        let x78 = Self::mul_add(
+        let x71 = Self::mul_add(-s_q1, x60, c_q1 * x59);
+        let x72 = Self::mul_add(
             -s_q1,
-            Self::mul_add(
-                -s_q1,
-                -8596.210051042 + (x72 + (Self::mul_add(s_q2, x67, c_q2 * x65) - x71)),
-                c_q1 * (190.97044034000004 + x76),
-            ),
-            c_q1
-                * Self::mul_add(
-                    -s_q1,
-                    190.97044034 + x75,
-                    c_q1 * (Self::mul_add(-s_q2, x68, c_q2 * x70) + x74 - x73),
-                ),
+            Self::mul_add(s_q2, x35, c_q2 * x36),
+            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
         );
-        let x79 = Self::mul_add(-s_q1, x66, c_q1 * x69);
-        let x80 = Self::mul_add(
+        let x73 = c_q3 * x21;
+        let x74 = s_q3 * x21;
+        let x75 = x20 * 0.1524;
+        let x76 = Self::mul_add(s_q3, x24, c_q3 * x18) + x75;
+        let x77 = x19 + Self::mul_add(0.1524, x73, -7.06 * x74);
+        let x78 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
+        let x79 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x43, c_q2 * x39),
-            c_q1 * Self::mul_add(-s_q2, x39, c_q2 * x43),
+            x75 + Self::mul_add(s_q2, x78, c_q2 * x76),
+            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x76, c_q2 * x78)),
         );
-        let x81 = c_q3 * x16;
-        let x82 = s_q3 * x16;
-        let x83 = x15 * 0.1524;
-        let x84 = Self::mul_add(s_q3, x30, x40) + x83;
-        let x85 = x25 + Self::mul_add(0.1524, x81, -7.06 * x82);
-        let x86 = Self::mul_add(7.06, x15, Self::mul_add(c_q3, x30, -x44));
-        let x87 = Self::mul_add(
+        let x80 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
+        let x81 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x82 = Self::mul_add(s_q3, x10, c_q3 * x80);
+        let x83 = Self::mul_add(-s_q3, x80, c_q3 * x10);
+        let x84 = Self::mul_add(
             -s_q1,
-            x83 + Self::mul_add(s_q2, x86, c_q2 * x84),
-            c_q1 * Self::mul_add(6.377, x15, Self::mul_add(-s_q2, x84, c_q2 * x86)),
+            Self::mul_add(s_q2, x83, c_q2 * x82),
+            c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x83),
         );
-        let x88 = Self::mul_add(s_q3, x9, c_q3 * x18);
-        let x89 = Self::mul_add(-s_q3, x18, c_q3 * x9);
-        let x90 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x89, c_q2 * x88),
-            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x89),
-        );
-        let x91 = qd[0] * s_q1;
-        let x92 = qd[0] * c_q1;
-        let x93 = qd[1] * x92;
-        let x94 = qd[1] * x91;
-        let x95 = qd[1] * qd[1];
-        let x96 = x91 * x92;
-        let x97 = Self::mul_add(
+        let x85 = qd[0] * s_q1;
+        let x86 = qd[0] * c_q1;
+        let x87 = qd[1] * x86;
+        let x88 = qd[1] * x85;
+        let x89 = qd[1] * qd[1];
+        let x90 = x85 * x86;
+        let x91 = Self::mul_add(
             190.97044034,
-            x92,
-            Self::mul_add(8596.210051042, x91, -1.928 * qd[1]),
+            x86,
+            Self::mul_add(8596.210051042, x85, -1.928 * qd[1]),
         );
-        let x98 = Self::mul_add(
+        let x92 = Self::mul_add(
             -0.0302,
-            x92,
-            Self::mul_add(1.928, x91, 8609.573807858 * qd[1]),
+            x86,
+            Self::mul_add(1.928, x85, 8609.573807858 * qd[1]),
         );
-        let x99 = Self::mul_add(-190.97044034000004, x91, -0.0302 * qd[1]);
-        let x100 = Self::mul_add(s_q2, x92, c_q2 * x91);
-        let x101 = Self::mul_add(-s_q2, x91, c_q2 * x92);
-        let x102 = Self::mul_add(-0.1524, x96, 6.377 * Self::mul_add(x92, x92, x95));
-        let x103 = Self::mul_add(-6.377, x94 + x94, -0.1524 * (x93 + x93));
-        let x104 = Self::mul_add(-0.1524, Self::mul_add(x91, x91, x95), 6.377 * x96);
-        let x105 = Self::mul_add(-c_q2, x102, s_q2 * x104);
-        let x106 = Self::mul_add(c_q2, x104, s_q2 * x102);
-        let x107 = Self::mul_add(-qd[2], x101, Self::mul_add(-c_q2, x93, s_q2 * x94));
-        let x108 = Self::mul_add(qd[2], x100, Self::mul_add(c_q2, x94, s_q2 * x93));
-        let x109 = qd[1] + qd[2];
-        let x110 = x109 * x109;
-        let x111 = Self::mul_add(x101, x101, x110);
-        let x112 = x100 * x101;
-        let x113 = Self::mul_add(x100, x109, x108);
-        let x114 = Self::mul_add(x101, x109, -x107);
-        let x115 = Self::mul_add(x100, x100, x110);
-        let x116 = Self::mul_add(
+        let x93 = Self::mul_add(-190.97044034000004, x85, -0.0302 * qd[1]);
+        let x94 = Self::mul_add(s_q2, x86, c_q2 * x85);
+        let x95 = Self::mul_add(-s_q2, x85, c_q2 * x86);
+        let x96 = Self::mul_add(-0.1524, x90, 6.377 * Self::mul_add(x86, x86, x89));
+        let x97 = Self::mul_add(-6.377, x88 + x88, -0.1524 * (x87 + x87));
+        let x98 = Self::mul_add(-0.1524, Self::mul_add(x85, x85, x89), 6.377 * x90);
+        let x99 = Self::mul_add(-c_q2, x96, s_q2 * x98);
+        let x100 = Self::mul_add(c_q2, x98, s_q2 * x96);
+        let x101 = Self::mul_add(-qd[2], x95, Self::mul_add(-c_q2, x87, s_q2 * x88));
+        let x102 = Self::mul_add(qd[2], x94, Self::mul_add(c_q2, x88, s_q2 * x87));
+        let x103 = qd[1] + qd[2];
+        let x104 = x103 * x103;
+        let x105 = Self::mul_add(x95, x95, x104);
+        let x106 = x94 * x95;
+        let x107 = Self::mul_add(x94, x103, x102);
+        let x108 = Self::mul_add(x95, x103, -x101);
+        let x109 = Self::mul_add(x94, x94, x104);
+        let x110 = Self::mul_add(
             103.41030072000001,
-            x101,
-            Self::mul_add(5594.523885531201, x100, 0.8021 * x109),
+            x95,
+            Self::mul_add(5594.523885531201, x94, 0.8021 * x103),
         );
-        let x117 = Self::mul_add(
+        let x111 = Self::mul_add(
             -0.08,
-            x101,
-            Self::mul_add(-0.8021, x100, 5601.1318504688 * x109),
+            x95,
+            Self::mul_add(-0.8021, x94, 5601.1318504688 * x103),
         );
-        let x118 = Self::mul_add(-103.41030072000002, x100, -0.08 * x109);
-        let x119 = Self::mul_add(
+        let x112 = Self::mul_add(-103.41030072000002, x94, -0.08 * x103);
+        let x113 = Self::mul_add(
             703.3878000000001,
-            x103,
+            x97,
             Self::mul_add(
                 103.41030072000002,
-                x107,
-                -Self::mul_add(x100, x117, x109 * x116),
+                x101,
+                -Self::mul_add(x94, x111, x103 * x110),
             ),
         );
-        let x120 = Self::mul_add(s_q3, x101, c_q3 * x100);
-        let x121 = Self::mul_add(-s_q3, x100, c_q3 * x101);
-        let x122 = x105 - Self::mul_add(-0.1524, x112, 7.06 * x111);
-        let x123 = x103 + Self::mul_add(-7.06, x113, -0.1524 * x114);
-        let x124 = x106 + Self::mul_add(-0.1524, x115, 7.06 * x112);
-        let x125 = Self::mul_add(-c_q3, x124, s_q3 * x122);
-        let x126 = Self::mul_add(-qd[3], x121, Self::mul_add(s_q3, x108, c_q3 * x107));
-        let x127 = Self::mul_add(-qd[3], x120, Self::mul_add(-c_q3, x108, s_q3 * x107));
-        let x128 = qd[3] + x109;
-        let x129 = Self::mul_add(x121, x121, x128 * x128);
-        let x130 = x120 * x121;
-        let x131 = Self::mul_add(-x120, x128, x127);
-        let x132 = -18.957952216000002 * x120;
-        let x133 = 19.863252216000003 * x128;
-        let x134 = Self::mul_add(-c_q4, x120, s_q4 * x128);
-        let x135 = Self::mul_add(c_q4, x128, s_q4 * x120);
-        let x136 = Self::mul_add(
+        let x114 = Self::mul_add(s_q3, x95, c_q3 * x94);
+        let x115 = Self::mul_add(-s_q3, x94, c_q3 * x95);
+        let x116 = x99 - Self::mul_add(-0.1524, x106, 7.06 * x105);
+        let x117 = x97 + Self::mul_add(-7.06, x107, -0.1524 * x108);
+        let x118 = x100 + Self::mul_add(-0.1524, x109, 7.06 * x106);
+        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
+        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x102, c_q3 * x101));
+        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x102, s_q3 * x101));
+        let x122 = qd[3] + x103;
+        let x123 = Self::mul_add(x115, x115, x122 * x122);
+        let x124 = x114 * x115;
+        let x125 = Self::mul_add(-x114, x122, x121);
+        let x126 = -18.957952216000002 * x114;
+        let x127 = 19.863252216000003 * x122;
+        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
+        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
+        let x130 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x129, Self::mul_add(s_q3, x124, c_q3 * x122)),
-            c_q4 * Self::mul_add(0.4572, x131, x123),
+            Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
+            c_q4 * Self::mul_add(0.4572, x125, x117),
         );
-        let x137 = Self::mul_add(qd[4], x135, c_q4 * x126);
-        let x138 = Self::mul_add(qd[4], x134, s_q4 * x126);
-        let x139 = qd[4] + x121;
-        let x140 = 34.33891524 * x135;
-        let x141 = 34.74691524 * x139;
-        let x142 = Self::mul_add(s_q5, x139, c_q5 * x135);
-        let x143 = Self::mul_add(-s_q5, x135, c_q5 * x139);
-        let x144 = Self::mul_add(qd[5], x143, Self::mul_add(-c_q5, x138, s_q5 * x127));
-        let x145 = Self::mul_add(-qd[5], x142, Self::mul_add(c_q5, x127, s_q5 * x138));
-        let x146 = qd[5] + x134;
-        let x147 = Self::mul_add(0.966, x143, Self::mul_add(0.385, x142, 1.903 * x146));
-        let x148 = Self::mul_add(0.353, x143, 0.385 * x146);
-        let x149 = Self::mul_add(
+        let x131 = Self::mul_add(qd[4], x129, c_q4 * x120);
+        let x132 = Self::mul_add(qd[4], x128, s_q4 * x120);
+        let x133 = qd[4] + x115;
+        let x134 = 34.33891524 * x129;
+        let x135 = 34.74691524 * x133;
+        let x136 = Self::mul_add(s_q5, x133, c_q5 * x129);
+        let x137 = Self::mul_add(-s_q5, x129, c_q5 * x133);
+        let x138 = Self::mul_add(qd[5], x137, Self::mul_add(-c_q5, x132, s_q5 * x121));
+        let x139 = Self::mul_add(-qd[5], x136, Self::mul_add(c_q5, x121, s_q5 * x132));
+        let x140 = qd[5] + x128;
+        let x141 = Self::mul_add(0.966, x137, Self::mul_add(0.385, x136, 1.903 * x140));
+        let x142 = Self::mul_add(0.353, x137, 0.385 * x140);
+        let x143 = Self::mul_add(
             -0.9929999999999999,
-            x143,
-            Self::mul_add(0.353, x142, 0.966 * x146),
+            x137,
+            Self::mul_add(0.353, x136, 0.966 * x140),
         );
-        let x150 = Self::mul_add(0.966, x145, Self::mul_add(0.385, x144, 1.903 * x137))
-            + Self::mul_add(-x143, x148, x142 * x149) - f_ext[5][3];
-        let x151 = Self::mul_add(0.353, x145, 0.385 * x137)
-            + Self::mul_add(-x146, x149, x143 * x147) - f_ext[5][4];
-        let x152 = Self::mul_add(
+        let x144 = Self::mul_add(0.966, x139, Self::mul_add(0.385, x138, 1.903 * x131))
+            + Self::mul_add(-x137, x142, x136 * x143) - f_ext[5][3];
+        let x145 = Self::mul_add(0.353, x139, 0.385 * x131)
+            + Self::mul_add(-x140, x143, x137 * x141) - f_ext[5][4];
+        let x146 = Self::mul_add(
             -0.9929999999999999,
-            x145,
-            Self::mul_add(0.353, x144, 0.966 * x137),
-        ) + Self::mul_add(-x142, x147, x146 * x148) - f_ext[5][5];
-        let x153 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
-        let x154 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x155 = f_ext[5][0]
+            x139,
+            Self::mul_add(0.353, x138, 0.966 * x131),
+        ) + Self::mul_add(-x136, x141, x140 * x142) - f_ext[5][5];
+        let x147 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
+        let x148 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x149 = f_ext[5][0]
             + Self::mul_add(
                 34.45002,
-                Self::mul_add(x139, x139, x135 * x135),
+                Self::mul_add(x133, x133, x129 * x129),
                 f_ext[4][0],
             );
-        let x156 = Self::mul_add(34.45002, Self::mul_add(x134, x135, x127), -f_ext[4][1])
-            + x153;
-        let x157 = Self::mul_add(34.45002, Self::mul_add(x134, x139, x138), -f_ext[4][2])
-            - x154;
-        let x158 = Self::mul_add(-x139, x140, x135 * x141) - f_ext[4][3] + x150;
-        let x159 = Self::mul_add(
+        let x150 = Self::mul_add(34.45002, Self::mul_add(x128, x129, x121), -f_ext[4][1])
+            + x147;
+        let x151 = Self::mul_add(34.45002, Self::mul_add(x128, x133, x132), -f_ext[4][2])
+            - x148;
+        let x152 = Self::mul_add(-x133, x134, x129 * x135) - f_ext[4][3] + x144;
+        let x153 = Self::mul_add(
             -34.45002,
-            Self::mul_add(-0.4572, x130, x125),
-            -Self::mul_add(x134, x141, 34.33891524 * x138),
+            Self::mul_add(-0.4572, x124, x119),
+            -Self::mul_add(x128, x135, 34.33891524 * x132),
         ) - f_ext[4][4]
-            + Self::mul_add(0.762, x154, Self::mul_add(-s_q5, x152, c_q5 * x151));
-        let x160 = Self::mul_add(
+            + Self::mul_add(0.762, x148, Self::mul_add(-s_q5, x146, c_q5 * x145));
+        let x154 = Self::mul_add(
             34.45002,
-            x136,
-            Self::mul_add(x134, x140, 34.74691524 * x127),
+            x130,
+            Self::mul_add(x128, x134, 34.74691524 * x121),
         ) - f_ext[4][5]
-            + Self::mul_add(0.762, x153, Self::mul_add(c_q5, x152, s_q5 * x151));
-        let x161 = Self::mul_add(-s_q4, x155, c_q4 * x156);
-        let x162 = Self::mul_add(41.67378, x129, f_ext[3][0])
-            + Self::mul_add(s_q4, x156, c_q4 * x155);
-        let x163 = Self::mul_add(41.67378, x131, -f_ext[3][1]) + x161;
-        let x164 = x157 - Self::mul_add(41.67378, x130, f_ext[3][2]);
-        let x165 = Self::mul_add(-x121, x133, -18.957952216000002 * x126) - f_ext[3][3]
-            + Self::mul_add(-s_q4, x159, c_q4 * x158);
-        let x166 = Self::mul_add(-x121, x132, x125 * -41.67378) - f_ext[3][4]
-            + Self::mul_add(-0.4572, x157, Self::mul_add(c_q4, x159, s_q4 * x158));
-        let x167 = Self::mul_add(41.67378, x123, Self::mul_add(-x120, x133, x128 * x132))
-            - f_ext[3][5] + Self::mul_add(0.4572, x161, x160);
-        let x168 = Self::mul_add(-c_q3, x162, s_q3 * x164);
-        let x169 = Self::mul_add(c_q3, x164, s_q3 * x162);
-        let x170 = x168
+            + Self::mul_add(0.762, x147, Self::mul_add(c_q5, x146, s_q5 * x145));
+        let x155 = Self::mul_add(-s_q4, x149, c_q4 * x150);
+        let x156 = Self::mul_add(41.67378, x123, f_ext[3][0])
+            + Self::mul_add(s_q4, x150, c_q4 * x149);
+        let x157 = Self::mul_add(41.67378, x125, -f_ext[3][1]) + x155;
+        let x158 = x151 - Self::mul_add(41.67378, x124, f_ext[3][2]);
+        let x159 = Self::mul_add(-x115, x127, -18.957952216000002 * x120) - f_ext[3][3]
+            + Self::mul_add(-s_q4, x153, c_q4 * x152);
+        let x160 = Self::mul_add(-x115, x126, x119 * -41.67378) - f_ext[3][4]
+            + Self::mul_add(-0.4572, x151, Self::mul_add(c_q4, x153, s_q4 * x152));
+        let x161 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
+            - f_ext[3][5] + Self::mul_add(0.4572, x155, x154);
+        let x162 = Self::mul_add(-c_q3, x156, s_q3 * x158);
+        let x163 = Self::mul_add(c_q3, x158, s_q3 * x156);
+        let x164 = x162
             - (f_ext[2][0]
-                + Self::mul_add(-15.183612000000002, x112, 703.3878000000001 * x111));
-        let x171 = Self::mul_add(-703.3878000000001, x113, -15.183612000000002 * x114)
-            - f_ext[2][1] + x163;
-        let x172 = x169
+                + Self::mul_add(-15.183612000000002, x106, 703.3878000000001 * x105));
+        let x165 = Self::mul_add(-703.3878000000001, x107, -15.183612000000002 * x108)
+            - f_ext[2][1] + x157;
+        let x166 = x163
             - (f_ext[2][2]
-                + Self::mul_add(-15.183612000000002, x115, 703.3878000000001 * x112));
-        let x173 = Self::mul_add(
-            x103,
+                + Self::mul_add(-15.183612000000002, x109, 703.3878000000001 * x106));
+        let x167 = Self::mul_add(
+            x97,
             15.183612000000002,
-            Self::mul_add(-103.41030072000001, x108, -5594.523885531201 * x107)
-                + Self::mul_add(-x101, x117, x109 * x118),
+            Self::mul_add(-103.41030072000001, x102, -5594.523885531201 * x101)
+                + Self::mul_add(-x95, x111, x103 * x112),
         ) - f_ext[2][3]
-            + Self::mul_add(0.1524, x163, Self::mul_add(s_q3, x167, c_q3 * x165));
-        let x174 = Self::mul_add(0.08, x108, 0.8021 * x107)
-            + Self::mul_add(x100, x118, x101 * x116)
-            + Self::mul_add(x106, 703.3878000000001, -15.183612000000002 * x105)
-            - f_ext[2][4] + (x166 + Self::mul_add(-7.06, x169, -0.1524 * x168));
-        let x175 = x119 - f_ext[2][5]
-            + Self::mul_add(7.06, x163, Self::mul_add(-s_q3, x165, c_q3 * x167));
-        let x176 = Self::mul_add(
+            + Self::mul_add(0.1524, x157, Self::mul_add(s_q3, x161, c_q3 * x159));
+        let x168 = Self::mul_add(0.08, x102, 0.8021 * x101)
+            + Self::mul_add(x94, x112, x95 * x110)
+            + Self::mul_add(x100, 703.3878000000001, -15.183612000000002 * x99)
+            - f_ext[2][4] + (x160 + Self::mul_add(-7.06, x163, -0.1524 * x162));
+        let x169 = x113 - f_ext[2][5]
+            + Self::mul_add(7.06, x157, Self::mul_add(-s_q3, x159, c_q3 * x161));
+        let x170 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x92, x98, qd[1] * x99)
-                - Self::mul_add(190.97044034, x94, -8596.210051042 * x93) - f_ext[1][3]
-                + Self::mul_add(0.1524, x171, Self::mul_add(s_q2, x175, c_q2 * x173)),
+            Self::mul_add(-x86, x92, qd[1] * x93)
+                - Self::mul_add(190.97044034, x88, -8596.210051042 * x87) - f_ext[1][3]
+                + Self::mul_add(0.1524, x165, Self::mul_add(s_q2, x169, c_q2 * x167)),
             c_q1
-                * (Self::mul_add(6.377, x171, Self::mul_add(-s_q2, x173, c_q2 * x175))
+                * (Self::mul_add(6.377, x165, Self::mul_add(-s_q2, x167, c_q2 * x169))
                     - (f_ext[1][5]
                         + Self::mul_add(
                             190.97044034000004,
-                            x93,
-                            Self::mul_add(x91, x98, qd[1] * x97),
+                            x87,
+                            Self::mul_add(x85, x92, qd[1] * x91),
                         ))),
         );
-        let x177 = tau[0] - (x176 - f_ext[0][5]);
-        let x178 = 1.0 / (14222.257549666001 + x78);
-        let x179 = x77 * x178;
-        let x180 = x79 * x178;
-        let x181 = x80 * x178;
-        let x182 = x87 * x178;
-        let x183 = x90 * x178;
-        let x184 = 1.0
+        let x171 = tau[0] - (x170 - f_ext[0][5]);
+        let x172 = 1.0
+            / (14222.257549666001
+                + (x68
+                    - Self::mul_add(
+                        s_q1 * c_q1,
+                        x69 + x69,
+                        s_q1 * s_q1
+                            * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                    )));
+        let x173 = x70 * x172;
+        let x174 = x71 * x172;
+        let x175 = x72 * x172;
+        let x176 = x79 * x172;
+        let x177 = x84 * x172;
+        let x178 = 1.0
             / Self::mul_add(
-                -x77,
-                x179,
-                8609.573807858 + (x60 - (x73 - x72) - (x71 - x74)),
+                -x70,
+                x173,
+                8609.573807858 + (x51 - (x65 - x64) - (x63 - x66)),
             );
-        let x185 = Self::mul_add(-x77, x180, x60 + (x72 - x73));
-        let x186 = x184 * x185;
-        let x187 = Self::mul_add(
-            -x77,
-            x181,
-            x50
+        let x179 = Self::mul_add(-x70, x174, x51 + (x64 - x65));
+        let x180 = x178 * x179;
+        let x181 = Self::mul_add(
+            -x70,
+            x175,
+            x43
                 + Self::mul_add(
                     0.1524,
-                    Self::mul_add(s_q2, x36, c_q2 * x37),
-                    -6.377 * Self::mul_add(-c_q2, x36, s_q2 * x37),
+                    Self::mul_add(s_q2, x38, c_q2 * x37),
+                    -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
                 ),
         );
-        let x188 = x184 * x187;
-        let x189 = Self::mul_add(
-            -x77,
-            x182,
-            x85
+        let x182 = x178 * x181;
+        let x183 = Self::mul_add(
+            -x70,
+            x176,
+            x77
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(c_q2, x82, s_q2 * x81),
-                    -0.1524 * Self::mul_add(-c_q2, x81, s_q2 * x82),
+                    Self::mul_add(c_q2, x74, s_q2 * x73),
+                    -0.1524 * Self::mul_add(-c_q2, x73, s_q2 * x74),
                 ),
         );
-        let x190 = x184 * x189;
-        let x191 = Self::mul_add(-x77, x183, x23);
-        let x192 = x184 * x191;
-        let x193 = 1.0 / Self::mul_add(-x185, x186, Self::mul_add(-x79, x180, x60));
-        let x194 = Self::mul_add(-x185, x188, Self::mul_add(-x79, x181, x50));
-        let x195 = x193 * x194;
-        let x196 = Self::mul_add(-x185, x190, Self::mul_add(-x79, x182, x85));
-        let x197 = x193 * x196;
-        let x198 = Self::mul_add(-x185, x192, Self::mul_add(-x79, x183, x23));
-        let x199 = x193 * x198;
+        let x184 = x178 * x183;
+        let x185 = Self::mul_add(-x70, x177, x81);
+        let x186 = x178 * x185;
+        let x187 = 1.0 / Self::mul_add(-x179, x180, Self::mul_add(-x71, x174, x51));
+        let x188 = Self::mul_add(-x179, x182, Self::mul_add(-x71, x175, x43));
+        let x189 = x187 * x188;
+        let x190 = Self::mul_add(-x179, x184, Self::mul_add(-x71, x176, x77));
+        let x191 = x187 * x190;
+        let x192 = Self::mul_add(-x179, x186, Self::mul_add(-x71, x177, x81));
+        let x193 = x187 * x192;
+        let x194 = Self::mul_add(
+            -x188,
+            x189,
+            Self::mul_add(-x181, x182, Self::mul_add(-x72, x175, x29)),
+        );
+        let x195 = 1.0 / x194;
+        let x196 = Self::mul_add(
+            -x188,
+            x191,
+            Self::mul_add(-x181, x184, Self::mul_add(-x72, x176, x19)),
+        );
+        let x197 = x195 * x196;
+        let x198 = Self::mul_add(
+            -x188,
+            x193,
+            Self::mul_add(-x181, x186, Self::mul_add(-x72, x177, x81)),
+        );
+        let x199 = x195 * x198;
         let x200 = Self::mul_add(
-            -x194,
-            x195,
-            Self::mul_add(-x187, x188, Self::mul_add(-x80, x181, x35)),
+            -x190,
+            x191,
+            Self::mul_add(-x183, x184, Self::mul_add(-x79, x176, x12)),
         );
-        let x201 = 1.0 / x200;
+        let x201 = 1.0 / Self::mul_add(-x196, x197, x200);
         let x202 = Self::mul_add(
-            -x194,
-            x197,
-            Self::mul_add(-x187, x190, Self::mul_add(-x80, x182, x25)),
+            -x190,
+            x193,
+            Self::mul_add(-x183, x186, Self::mul_add(-x79, x177, x10)),
         );
-        let x203 = x201 * x202;
-        let x204 = Self::mul_add(
-            -x194,
-            x199,
-            Self::mul_add(-x187, x192, Self::mul_add(-x80, x183, x23)),
+        let x203 = Self::mul_add(-x196, x199, x202);
+        let x204 = x201 * x203;
+        let x205 = Self::mul_add(
+            -x192,
+            x193,
+            Self::mul_add(-x185, x186, Self::mul_add(-x84, x177, 1.903)),
         );
-        let x205 = x201 * x204;
-        let x206 = Self::mul_add(
-            -x196,
-            x197,
-            Self::mul_add(-x189, x190, Self::mul_add(-x87, x182, x14)),
-        );
-        let x207 = 1.0 / Self::mul_add(-x202, x203, x206);
-        let x208 = Self::mul_add(
-            -x196,
-            x199,
-            Self::mul_add(-x189, x192, Self::mul_add(-x87, x183, x9)),
-        );
-        let x209 = Self::mul_add(-x202, x205, x208);
-        let x210 = x207 * x209;
-        let x211 = Self::mul_add(
-            -x198,
-            x199,
-            Self::mul_add(-x191, x192, Self::mul_add(-x90, x183, 1.903)),
-        );
-        let x212 = 1.0 / Self::mul_add(-x209, x210, Self::mul_add(-x204, x205, x211));
-        let x213 = Self::mul_add(
-            -x177,
-            x179,
+        let x206 = 1.0 / Self::mul_add(-x203, x204, Self::mul_add(-x198, x199, x205));
+        let x207 = Self::mul_add(
+            -x171,
+            x173,
             tau[1]
-                - (Self::mul_add(x91, x99, x92 * x97)
-                    - Self::mul_add(-0.0302, x94, -1.928 * x93) - f_ext[1][4]
-                    + (x174
+                - (Self::mul_add(x85, x93, x86 * x91)
+                    - Self::mul_add(-0.0302, x88, -1.928 * x87) - f_ext[1][4]
+                    + (x168
                         + Self::mul_add(
                             -6.377,
-                            Self::mul_add(-s_q2, x170, c_q2 * x172),
-                            -0.1524 * Self::mul_add(s_q2, x172, c_q2 * x170),
+                            Self::mul_add(-s_q2, x164, c_q2 * x166),
+                            -0.1524 * Self::mul_add(s_q2, x166, c_q2 * x164),
                         ))),
         );
-        let x214 = Self::mul_add(-x186, x213, Self::mul_add(-x177, x180, tau[2] - x174));
-        let x215 = Self::mul_add(
-            -x195,
-            x214,
-            Self::mul_add(-x188, x213, Self::mul_add(-x177, x181, tau[3] - x166)),
+        let x208 = Self::mul_add(-x180, x207, Self::mul_add(-x171, x174, tau[2] - x168));
+        let x209 = Self::mul_add(
+            -x189,
+            x208,
+            Self::mul_add(-x182, x207, Self::mul_add(-x171, x175, tau[3] - x160)),
         );
+        let x210 = Self::mul_add(
+            -x191,
+            x208,
+            Self::mul_add(-x184, x207, Self::mul_add(-x171, x176, tau[4] - x154)),
+        );
+        let x211 = Self::mul_add(-x197, x209, x210);
+        let x212 = Self::mul_add(
+            -x193,
+            x208,
+            Self::mul_add(-x186, x207, Self::mul_add(-x171, x177, tau[5] - x144)),
+        );
+        let x213 = x206 * Self::mul_add(-x204, x211, Self::mul_add(-x199, x209, x212));
+        let x214 = Self::mul_add(-x204, x213, x201 * x211);
+        let x215 = Self::mul_add(-x199, x213, Self::mul_add(-x197, x214, x195 * x209));
         let x216 = Self::mul_add(
-            -x197,
+            -x193,
+            x213,
+            Self::mul_add(-x191, x214, Self::mul_add(-x189, x215, x187 * x208)),
+        );
+        let x217 = Self::mul_add(
+            -x184,
             x214,
-            Self::mul_add(-x190, x213, Self::mul_add(-x177, x182, tau[4] - x160)),
+            Self::mul_add(-x182, x215, Self::mul_add(-x180, x216, x178 * x207)),
         );
-        let x217 = Self::mul_add(-x203, x215, x216);
-        let x218 = Self::mul_add(
-            -x199,
-            x214,
-            Self::mul_add(-x192, x213, Self::mul_add(-x177, x183, tau[5] - x150)),
+        let x218 = Self::mul_add(-x186, x213, x217);
+        let x219 = Self::mul_add(
+            -x175,
+            x215,
+            Self::mul_add(-x174, x216, Self::mul_add(-x173, x218, x171 * x172)),
         );
-        let x219 = x212 * Self::mul_add(-x210, x217, Self::mul_add(-x205, x215, x218));
-        let x220 = Self::mul_add(-x210, x219, x207 * x217);
-        let x221 = Self::mul_add(-x205, x219, Self::mul_add(-x203, x220, x201 * x215));
-        let x222 = Self::mul_add(
-            -x199,
-            x219,
-            Self::mul_add(-x197, x220, Self::mul_add(-x195, x221, x193 * x214)),
-        );
-        let x223 = Self::mul_add(
-            -x190,
-            x220,
-            Self::mul_add(-x188, x221, Self::mul_add(-x186, x222, x184 * x213)),
-        );
-        let x224 = Self::mul_add(-x192, x219, x223);
-        let x225 = Self::mul_add(
-            -x181,
-            x221,
-            Self::mul_add(-x180, x222, Self::mul_add(-x179, x224, x177 * x178)),
-        );
-        let x226 = Self::mul_add(-x183, x219, Self::mul_add(-x182, x220, x225));
-        [x226, x224, x222, x221, x220, x219]
+        let x220 = Self::mul_add(-x177, x213, Self::mul_add(-x176, x214, x219));
+        [x220, x218, x216, x215, x214, x213]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

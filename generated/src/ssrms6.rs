@@ -9,40 +9,62 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 761 (`mass_matrix` 52, `nonlinear_effects` 80, `inverse_dynamics` 97, `forward_dynamics` 193, `mass_matrix_and_nonlinear_effects` 132, `forward_dynamics_with_wrenches` 207), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
-//! Form: unrolled straight-line code (auto: 427 emitted operations in M + c, within the 4000 limit).
+//! Fused multiply-adds where the target has them: 691 (`mass_matrix` 35, `nonlinear_effects` 80, `inverse_dynamics` 95, `forward_dynamics` 176, `mass_matrix_and_nonlinear_effects` 115, `forward_dynamics_with_wrenches` 190), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: 399 emitted operations in M + c, within the 4000 limit).
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | — | 429 | 352 | 0 | 0 | 6 | 781 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | 469 | 372 | 0 | 0 | 6 | 841 |
-//! | `mass_matrix` | `kane-direct` | — | — | 442 | 295 | 0 | 0 | 6 | 737 |
-//! | `mass_matrix` | `crba-base` | — | — | 412 | 299 | 0 | 0 | 6 | 711 |
-//! | `mass_matrix` * | `crba` | — | — | 102 | 71 | 0 | 0 | 4 | 173 |
-//! | `nonlinear_effects` | — | `recurrent` | — | 493 | 340 | 0 | 0 | 6 | 833 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | 534 | 376 | 0 | 0 | 6 | 910 |
-//! | `nonlinear_effects` | — | `rnea` | — | 189 | 124 | 0 | 0 | 5 | 313 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | 155 | 99 | 0 | 0 | 5 | 254 |
-//! | `inverse_dynamics` | — | `recurrent` | — | 621 | 439 | 0 | 0 | 6 | 1060 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | 662 | 475 | 0 | 0 | 6 | 1137 |
-//! | `inverse_dynamics` | — | `rnea` | — | 208 | 146 | 0 | 0 | 5 | 354 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | 172 | 124 | 0 | 0 | 5 | 296 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 681 | 478 | 6 | 0 | 6 | 1159 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 722 | 514 | 6 | 0 | 6 | 1236 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 377 | 262 | 6 | 0 | 5 | 639 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | 343 | 237 | 6 | 0 | 5 | 580 |
-//! | `forward_dynamics` | — | — | `aba` | 422 | 292 | 4 | 0 | 5 | 714 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 595 | 411 | 0 | 0 | 6 | 1006 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 636 | 447 | 0 | 0 | 6 | 1083 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 291 | 195 | 0 | 0 | 5 | 486 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 257 | 170 | 0 | 0 | 5 | 427 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 763 | 561 | 6 | 0 | 6 | 1324 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 804 | 597 | 6 | 0 | 6 | 1401 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 389 | 300 | 6 | 0 | 5 | 689 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | 355 | 275 | 6 | 0 | 5 | 630 |
-//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 434 | 331 | 4 | 0 | 5 | 765 |
+//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | model | 429 | 352 | 0 | 0 | 6 | 781 |
+//! | `mass_matrix` | `recurrent` | — | — | canonical | 431 | 352 | 0 | 0 | 6 | 783 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | model | 469 | 372 | 0 | 0 | 6 | 841 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 473 | 372 | 0 | 0 | 6 | 845 |
+//! | `mass_matrix` | `kane-direct` | — | — | model | 442 | 295 | 0 | 0 | 6 | 737 |
+//! | `mass_matrix` | `kane-direct` | — | — | canonical | 444 | 295 | 0 | 0 | 6 | 739 |
+//! | `mass_matrix` | `crba-base` | — | — | model | 412 | 299 | 0 | 0 | 6 | 711 |
+//! | `mass_matrix` | `crba-base` | — | — | canonical | 416 | 300 | 0 | 0 | 6 | 716 |
+//! | `mass_matrix` * | `crba` | — | — | model | 78 | 67 | 0 | 0 | 4 | 145 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 83 | 66 | 0 | 0 | 4 | 149 |
+//! | `nonlinear_effects` | — | `recurrent` | — | model | 493 | 340 | 0 | 0 | 6 | 833 |
+//! | `nonlinear_effects` | — | `recurrent` | — | canonical | 495 | 340 | 0 | 0 | 6 | 835 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | model | 534 | 376 | 0 | 0 | 6 | 910 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 536 | 376 | 0 | 0 | 6 | 912 |
+//! | `nonlinear_effects` | — | `rnea` | — | model | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `nonlinear_effects` | — | `rnea` | — | canonical | 189 | 124 | 0 | 0 | 5 | 313 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 155 | 99 | 0 | 0 | 5 | 254 |
+//! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 155 | 99 | 0 | 0 | 5 | 254 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 597 | 435 | 0 | 0 | 6 | 1032 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 604 | 434 | 0 | 0 | 6 | 1038 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 638 | 471 | 0 | 0 | 6 | 1109 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 645 | 470 | 0 | 0 | 6 | 1115 |
+//! | `inverse_dynamics` | — | `rnea` | — | model | 208 | 146 | 0 | 0 | 5 | 354 |
+//! | `inverse_dynamics` | — | `rnea` | — | canonical | 207 | 145 | 0 | 0 | 5 | 352 |
+//! | `inverse_dynamics` | — | `newton-euler` | — | model | 172 | 124 | 0 | 0 | 5 | 296 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | canonical | 171 | 123 | 0 | 0 | 5 | 294 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 657 | 474 | 6 | 0 | 6 | 1131 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 664 | 473 | 6 | 0 | 6 | 1137 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 698 | 510 | 6 | 0 | 6 | 1208 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 705 | 509 | 6 | 0 | 6 | 1214 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 353 | 258 | 6 | 0 | 5 | 611 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 358 | 257 | 6 | 0 | 5 | 615 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 319 | 233 | 6 | 0 | 5 | 552 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 324 | 232 | 6 | 0 | 5 | 556 |
+//! | `forward_dynamics` | — | — | `aba` | model | 422 | 292 | 4 | 0 | 5 | 714 |
+//! | `forward_dynamics` | — | — | `aba` | canonical | 424 | 294 | 4 | 0 | 5 | 718 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 571 | 407 | 0 | 0 | 6 | 978 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 578 | 406 | 0 | 0 | 6 | 984 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 612 | 443 | 0 | 0 | 6 | 1055 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 619 | 442 | 0 | 0 | 6 | 1061 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 267 | 191 | 0 | 0 | 5 | 458 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 272 | 190 | 0 | 0 | 5 | 462 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 233 | 166 | 0 | 0 | 5 | 399 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 238 | 165 | 0 | 0 | 5 | 403 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 739 | 557 | 6 | 0 | 6 | 1296 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 780 | 593 | 6 | 0 | 6 | 1373 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 365 | 296 | 6 | 0 | 5 | 661 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 331 | 271 | 6 | 0 | 5 | 602 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 434 | 331 | 4 | 0 | 5 | 765 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Ssrms6;
@@ -58,6 +80,9 @@ pub struct OpCount {
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
+    /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
+    /// joint axis z, modified-DH x; the same joint-space results).
+    pub frames: &'static str,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -104,18 +129,20 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 102u64,
-            add: 71u64,
+            frames: "model",
+            mul: 78u64,
+            add: 67u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 4u64,
-            fma: 52u64,
+            fma: 35u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 155u64,
             add: 99u64,
             div: 0u64,
@@ -128,48 +155,52 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 172u64,
-            add: 124u64,
+            frames: "canonical",
+            mul: 171u64,
+            add: 123u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 97u64,
+            fma: 95u64,
         },
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 343u64,
-            add: 237u64,
+            frames: "model",
+            mul: 319u64,
+            add: 233u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 193u64,
+            fma: 176u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 257u64,
-            add: 170u64,
+            frames: "model",
+            mul: 233u64,
+            add: 166u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 132u64,
+            fma: 115u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 355u64,
-            add: 275u64,
+            frames: "model",
+            mul: 331u64,
+            add: 271u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 207u64,
+            fma: 190u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -179,7 +210,21 @@ impl Ssrms6 {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 429u64,
+            add: 352u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 431u64,
             add: 352u64,
             div: 0u64,
             sqrt: 0u64,
@@ -191,7 +236,21 @@ impl Ssrms6 {
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 469u64,
+            add: 372u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 473u64,
             add: 372u64,
             div: 0u64,
             sqrt: 0u64,
@@ -203,7 +262,21 @@ impl Ssrms6 {
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 442u64,
+            add: 295u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 444u64,
             add: 295u64,
             div: 0u64,
             sqrt: 0u64,
@@ -215,8 +288,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 412u64,
             add: 299u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 416u64,
+            add: 300u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -227,8 +314,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 102u64,
-            add: 71u64,
+            frames: "model",
+            mul: 78u64,
+            add: 67u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 4u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 83u64,
+            add: 66u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 4u64,
@@ -239,7 +340,21 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 493u64,
+            add: 340u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 495u64,
             add: 340u64,
             div: 0u64,
             sqrt: 0u64,
@@ -251,7 +366,21 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
+            frames: "model",
             mul: 534u64,
+            add: 376u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 536u64,
             add: 376u64,
             div: 0u64,
             sqrt: 0u64,
@@ -263,6 +392,20 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
+            mul: 189u64,
+            add: 124u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
             mul: 189u64,
             add: 124u64,
             div: 0u64,
@@ -275,6 +418,20 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
+            mul: 155u64,
+            add: 99u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
             mul: 155u64,
             add: 99u64,
             div: 0u64,
@@ -287,8 +444,22 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 621u64,
-            add: 439u64,
+            frames: "model",
+            mul: 597u64,
+            add: 435u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 604u64,
+            add: 434u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -299,8 +470,22 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 662u64,
-            add: 475u64,
+            frames: "model",
+            mul: 638u64,
+            add: 471u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 645u64,
+            add: 470u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -311,6 +496,7 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
             mul: 208u64,
             add: 146u64,
             div: 0u64,
@@ -321,10 +507,37 @@ impl Ssrms6 {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 207u64,
+            add: 145u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 172u64,
             add: 124u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 171u64,
+            add: 123u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -335,8 +548,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 681u64,
-            add: 478u64,
+            frames: "model",
+            mul: 657u64,
+            add: 474u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 664u64,
+            add: 473u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -347,8 +574,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 722u64,
-            add: 514u64,
+            frames: "model",
+            mul: 698u64,
+            add: 510u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 705u64,
+            add: 509u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -359,8 +600,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 377u64,
-            add: 262u64,
+            frames: "model",
+            mul: 353u64,
+            add: 258u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 358u64,
+            add: 257u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -371,8 +626,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 343u64,
-            add: 237u64,
+            frames: "model",
+            mul: 319u64,
+            add: 233u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 324u64,
+            add: 232u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -383,8 +652,22 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 422u64,
             add: 292u64,
+            div: 4u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            frames: "canonical",
+            mul: 424u64,
+            add: 294u64,
             div: 4u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -395,8 +678,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 595u64,
-            add: 411u64,
+            frames: "model",
+            mul: 571u64,
+            add: 407u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 578u64,
+            add: 406u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -407,8 +704,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 636u64,
-            add: 447u64,
+            frames: "model",
+            mul: 612u64,
+            add: 443u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 619u64,
+            add: 442u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -419,8 +730,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 291u64,
-            add: 195u64,
+            frames: "model",
+            mul: 267u64,
+            add: 191u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 272u64,
+            add: 190u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -431,8 +756,22 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 257u64,
-            add: 170u64,
+            frames: "model",
+            mul: 233u64,
+            add: 166u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 238u64,
+            add: 165u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -443,8 +782,9 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 763u64,
-            add: 561u64,
+            frames: "model",
+            mul: 739u64,
+            add: 557u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -455,8 +795,9 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 804u64,
-            add: 597u64,
+            frames: "model",
+            mul: 780u64,
+            add: 593u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -467,8 +808,9 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 389u64,
-            add: 300u64,
+            frames: "model",
+            mul: 365u64,
+            add: 296u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -479,8 +821,9 @@ impl Ssrms6 {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 355u64,
-            add: 275u64,
+            frames: "model",
+            mul: 331u64,
+            add: 271u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -491,6 +834,7 @@ impl Ssrms6 {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 434u64,
             add: 331u64,
             div: 4u64,
@@ -501,103 +845,101 @@ impl Ssrms6 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 102 mul, 71 add, 0 div, 0 sqrt, 4 sincos (emitted), of which 52 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 78 mul, 67 add, 0 div, 0 sqrt, 4 sincos (emitted), of which 35 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x4 = 9.336 * c_q4;
-        let x5 = 44.41 * s_q4;
-        let x6 = 9.336 * s_q4;
-        let x7 = Self::mul_add(-c_q4, x5, s_q4 * x4);
-        let x8 = 132.6783695416 + Self::mul_add(s_q4, x5, c_q4 * x4);
-        let x9 = 135.4729695416 + Self::mul_add(c_q4, 44.41 * c_q4, s_q4 * x6);
-        let x10 = -171.195516 * s_q3;
-        let x11 = -171.195516 * c_q3;
-        let x12 = c_q3 * x8;
-        let x13 = Self::mul_add(-97.44448770720001, s_q3, c_q3 * x7);
-        let x14 = 47.471 * s_q3;
-        let x15 = s_q3 * x8;
-        let x16 = Self::mul_add(-s_q3, x7, -97.44448770720001 * c_q3);
-        let x17 = 47.471 * c_q3;
-        let x18 = x10 * -7.11;
-        let x19 = 7.11 * x10;
-        let x20 = x9 - x18;
-        let x21 = Self::mul_add(-7.11, x11, Self::mul_add(-c_q3, x15, s_q3 * x17));
-        let x22 = Self::mul_add(x11, -7.11, Self::mul_add(-s_q3, x12, c_q3 * x14));
-        let x23 = Self::mul_add(c_q3, x17, s_q3 * x15) + x19 - x18;
-        let x24 = 3239.4582 + x10;
-        let x25 = -24989.305802 + Self::mul_add(s_q3, x14, c_q3 * x12);
-        let x26 = 1375.0472756800002 + x13;
-        let x27 = 24998.827802 + (x19 + x20);
-        let x28 = s_q2 * x11;
-        let x29 = Self::mul_add(c_q2, x24, x28);
-        let x30 = c_q2 * x11;
-        let x31 = Self::mul_add(-s_q2, x24, x30);
-        let x32 = Self::mul_add(s_q2, x21, c_q2 * x25);
-        let x33 = s_q2 * x16;
-        let x34 = Self::mul_add(s_q2, x23, c_q2 * x22);
-        let x35 = Self::mul_add(-s_q2, x25, c_q2 * x21);
-        let x36 = c_q2 * x16;
-        let x37 = Self::mul_add(-s_q2, x22, c_q2 * x23);
-        let x38 = -7.11 * x29;
-        let x39 = 7.11 * x29;
-        let x40 = Self::mul_add(0.475, x29, Self::mul_add(c_q2, x26, x33));
-        let x41 = x27 - x38;
-        let x42 = 39241.404122 + (x39 + x41);
-        let x43 = c_q1 * x31;
-        let x44 = Self::mul_add(
-            -s_q1,
-            -39234.47412200001 + Self::mul_add(s_q2, x34, c_q2 * x32),
-            c_q1 * Self::mul_add(-7.11, x31, Self::mul_add(s_q2, x37, c_q2 * x35)),
-        );
-        let x45 = c_q1 * Self::mul_add(x31, 0.475, Self::mul_add(-s_q2, x26, x36));
-        let x46 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-7.11, x31, Self::mul_add(-s_q2, x32, c_q2 * x34)),
-            c_q1 * (Self::mul_add(-s_q2, x35, c_q2 * x37) + x39 - x38),
-        );
-        let x47 = Self::mul_add(
+        let x4 = s_q4 * s_q4 * -35.074;
+        let x5 = s_q4 * c_q4 * -35.074;
+        let x6 = 132.6783695416 + (9.336 - x4);
+        let x7 = 135.4729695416 + (44.41 + x4);
+        let x8 = 47.471 - x6;
+        let x9 = s_q3 * s_q3 * x8;
+        let x10 = Self::mul_add(-s_q3, x5, -97.44448770720001 * c_q3);
+        let x11 = Self::mul_add(c_q3, x5, -97.44448770720001 * s_q3);
+        let x12 = -171.195516 * c_q3;
+        let x13 = -171.195516 * s_q3;
+        let x14 = x13 * -7.11;
+        let x15 = 7.11 * x13;
+        let x16 = x7 - x14;
+        let x17 = Self::mul_add(-7.11, x12, s_q3 * c_q3 * x8);
+        let x18 = 47.471 - x9 + x15 - x14;
+        let x19 = 3239.4582 + x13;
+        let x20 = -24989.305802 + (x6 + x9);
+        let x21 = 1375.0472756800002 + x11;
+        let x22 = 24998.827802 + (x15 + x16);
+        let x23 = s_q2 * s_q2;
+        let x24 = s_q2 * c_q2;
+        let x25 = x18 - x20;
+        let x26 = x17 + x17;
+        let x27 = Self::mul_add(x24, x26, x23 * x25);
+        let x28 = c_q2 * x10;
+        let x29 = s_q2 * x10;
+        let x30 = c_q2 * x12;
+        let x31 = Self::mul_add(-s_q2, x19, x30);
+        let x32 = s_q2 * x12;
+        let x33 = Self::mul_add(c_q2, x19, x32);
+        let x34 = -7.11 * x33;
+        let x35 = 7.11 * x33;
+        let x36 = Self::mul_add(0.475, x33, Self::mul_add(c_q2, x21, x29));
+        let x37 = x22 - x34;
+        let x38 = Self::mul_add(-7.11, x31, x17 + Self::mul_add(-x23, x26, x24 * x25));
+        let x39 = x18 - x27 + x35 - x34;
+        let x40 = 39241.404122 + (x35 + x37);
+        let x41 = c_q1 * Self::mul_add(x31, 0.475, Self::mul_add(-s_q2, x21, x28));
+        let x42 = c_q1 * x31;
+        let x43 = Self::mul_add(
             0.5692,
-            Self::mul_add(-s_q1, 5224.5702 + x29, x43),
-            Self::mul_add(-s_q1, 3946.18812068 + x40, x45),
+            Self::mul_add(-s_q1, 5224.5702 + x33, x42),
+            Self::mul_add(-s_q1, 3946.18812068 + x36, x41),
         );
-        let x48 = 65697.3302265768 + Self::mul_add(-s_q1, x44, c_q1 * x46);
+        let x44 = 65697.3302265768
+            + (x39
+                - Self::mul_add(
+                    s_q1 * c_q1,
+                    x38 + x38,
+                    s_q1 * s_q1 * (x39 - (-39234.47412200001 + (x20 + x27))),
+                ));
+        let x45 = Self::mul_add(
+            0.5692,
+            Self::mul_add(-s_q1, x33, x42),
+            Self::mul_add(-s_q1, x36, x41),
+        );
+        let x46 = Self::mul_add(-s_q2, x13, x30);
+        let x47 = Self::mul_add(c_q2, x13, x32);
+        let x48 = Self::mul_add(7.11, x47, x16);
         let x49 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x29, x43),
-            Self::mul_add(-s_q1, x40, x45),
+            -s_q1,
+            Self::mul_add(0.475, x47, Self::mul_add(c_q2, x11, x29)),
+            c_q1 * Self::mul_add(0.475, x46, Self::mul_add(-s_q2, x11, x28)),
         );
-        let x50 = Self::mul_add(-s_q2, x10, x30);
-        let x51 = Self::mul_add(c_q2, x10, x28);
-        let x52 = Self::mul_add(7.11, x51, x20);
+        let x50 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x47, c_q1 * x46), x49);
+        let x51 = 47.471 * s_q3;
+        let x52 = 47.471 * c_q3;
         let x53 = Self::mul_add(
             -s_q1,
-            Self::mul_add(0.475, x51, Self::mul_add(c_q2, x13, x33)),
-            c_q1 * Self::mul_add(0.475, x50, Self::mul_add(-s_q2, x13, x36)),
+            Self::mul_add(s_q2, x52, c_q2 * x51),
+            c_q1 * Self::mul_add(-s_q2, x51, c_q2 * x52),
         );
-        let x54 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x51, c_q1 * x50), x53);
-        let x55 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x17, c_q2 * x14),
-            c_q1 * Self::mul_add(-s_q2, x14, c_q2 * x17),
-        );
-        let x56 = c_q3 * x4;
-        let x57 = s_q3 * x4;
+        let x54 = 9.336 * c_q4;
+        let x55 = 9.336 * s_q4;
+        let x56 = c_q3 * x54;
+        let x57 = s_q3 * x54;
         let x58 = -Self::mul_add(
             c_q1,
             Self::mul_add(c_q2, x57, s_q2 * x56),
             s_q1 * Self::mul_add(-s_q2, x57, c_q2 * x56),
         );
         [
-            [x48, x47, x49, x54, x55, x58],
-            [x47, x42, x41, x52, 0.0, x6],
-            [x49, x41, x27, x20, 0.0, x6],
-            [x54, x52, x20, x9, 0.0, x6],
-            [x55, 0.0, 0.0, 0.0, 47.471, 0.0],
-            [x58, x6, x6, x6, 0.0, 9.336],
+            [x44, x43, x45, x50, x53, x58],
+            [x43, x40, x37, x48, 0.0, x55],
+            [x45, x37, x22, x16, 0.0, x55],
+            [x50, x48, x16, x7, 0.0, x55],
+            [x53, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x58, x55, x55, x55, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -719,161 +1061,161 @@ impl Ssrms6 {
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 172 mul, 124 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 97 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 171 mul, 123 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 95 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * s_q1;
         let x2 = qd[0] * c_q1;
-        let x3 = -0.5692 * qdd[0];
-        let x4 = -0.5692 * (qd[0] * qd[0]);
+        let x3 = 0.5692 * qdd[0];
+        let x4 = 0.5692 * (qd[0] * qd[0]);
         let x5 = s_q1 * x3;
         let x6 = qd[1] * x2;
         let x7 = qd[1] * x1;
         let x8 = Self::mul_add(qdd[0], s_q1, x6);
-        let x9 = Self::mul_add(qdd[0], c_q1, -x7);
+        let x9 = Self::mul_add(-qdd[0], c_q1, x7);
         let x10 = x2 * x2;
         let x11 = Self::mul_add(qd[1], qd[1], x10);
         let x12 = Self::mul_add(x1, x2, qdd[1]);
-        let x13 = Self::mul_add(39234.47412200001, x1, 3946.18812068 * qd[1]);
-        let x14 = Self::mul_add(-3946.1881206800003, x1, 39241.404122 * qd[1]);
-        let x15 = Self::mul_add(
-            x5,
-            5224.5702,
-            Self::mul_add(
-                x2,
-                x13,
-                Self::mul_add(-3946.1881206800003, x8, 39241.404122 * qdd[1]),
-            ),
+        let x13 = 3946.18812068 * qd[1];
+        let x14 = 39234.474122 * x2;
+        let x15 = Self::mul_add(-3946.1881206800003, x1, 39241.404122 * qd[1]);
+        let x16 = Self::mul_add(
+            x4,
+            -5224.5702,
+            Self::mul_add(39234.474122, x9, Self::mul_add(x1, x15, qd[1] * x13)),
         );
         let (s_q2, c_q2) = libm::sincos(q[2]);
-        let x17 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x18 = Self::mul_add(-x1, s_q2, x2 * c_q2);
-        let x19 = Self::mul_add(c_q1, x3, Self::mul_add(-0.475, x7 + x9, 7.11 * x11));
-        let x20 = Self::mul_add(0.475, Self::mul_add(x1, x1, x10), 7.11 * (x9 - x7))
-            - x4;
-        let x21 = Self::mul_add(-7.11, x12, -0.475 * (x6 - x8)) - x5;
-        let x22 = Self::mul_add(-s_q2, x19, c_q2 * x21);
-        let x23 = Self::mul_add(qd[2], x18, Self::mul_add(x9, s_q2, x8 * c_q2));
-        let x24 = Self::mul_add(-qd[2], x17, Self::mul_add(-x8, s_q2, x9 * c_q2));
-        let x25 = qdd[1] + qdd[2];
-        let x26 = qd[1] + qd[2];
-        let x27 = Self::mul_add(x18, x18, x26 * x26);
-        let x28 = Self::mul_add(-x17, x26, x24);
-        let x29 = Self::mul_add(x17, x18, x25);
-        let x30 = Self::mul_add(24989.305802, x17, 1375.0472756800002 * x26);
-        let x31 = Self::mul_add(-1375.0472756800002, x17, 24998.827802 * x26);
-        let x32 = Self::mul_add(
+        let x18 = Self::mul_add(x2, s_q2, x1 * c_q2);
+        let x19 = Self::mul_add(-x2, c_q2, x1 * s_q2);
+        let x20 = Self::mul_add(c_q1, x3, Self::mul_add(-7.11, x11, -0.475 * (x9 - x7)));
+        let x21 = Self::mul_add(-0.475, x8 - x6, 7.11 * x12) - x5;
+        let x22 = x4
+            - Self::mul_add(-0.475, Self::mul_add(x1, x1, x10), 7.11 * (x7 + x9));
+        let x23 = Self::mul_add(-s_q2, x20, c_q2 * x21);
+        let x24 = Self::mul_add(qd[2], x19, Self::mul_add(-x8, c_q2, x9 * s_q2));
+        let x25 = Self::mul_add(qd[2], x18, Self::mul_add(x9, c_q2, x8 * s_q2));
+        let x26 = qdd[1] + qdd[2];
+        let x27 = qd[1] + qd[2];
+        let x28 = Self::mul_add(x27, x27, x19 * x19);
+        let x29 = Self::mul_add(-x18, x19, x26);
+        let x30 = Self::mul_add(x18, x27, x25);
+        let x31 = 1375.0472756800002 * x27;
+        let x32 = 24989.305802 * x19;
+        let x33 = Self::mul_add(-1375.0472756800002, x18, 24998.827802 * x27);
+        let x34 = Self::mul_add(
             x22,
             -3239.4582,
-            Self::mul_add(
-                x18,
-                x30,
-                Self::mul_add(-1375.0472756800002, x23, 24998.827802 * x25),
-            ),
+            Self::mul_add(24989.305802, x25, Self::mul_add(x18, x33, x27 * x31)),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x34 = Self::mul_add(x18, s_q3, x17 * c_q3);
-        let x35 = Self::mul_add(-x17, s_q3, x18 * c_q3);
-        let x36 = Self::mul_add(
+        let x36 = Self::mul_add(-x18, c_q3, x19 * s_q3);
+        let x37 = Self::mul_add(x19, c_q3, x18 * s_q3);
+        let x38 = Self::mul_add(
             s_q3,
-            Self::mul_add(-7.11, x29, x22),
-            c_q3 * Self::mul_add(7.11, x27, Self::mul_add(s_q2, x21, c_q2 * x19)),
+            Self::mul_add(7.11, x29, x23),
+            c_q3 * Self::mul_add(-7.11, x28, Self::mul_add(s_q2, x21, c_q2 * x20)),
         );
-        let x37 = Self::mul_add(qd[3], x35, Self::mul_add(x24, s_q3, x23 * c_q3));
-        let x38 = Self::mul_add(-qd[3], x34, Self::mul_add(-x23, s_q3, x24 * c_q3));
-        let x39 = qdd[3] + x25;
-        let x40 = qd[3] + x26;
-        let x41 = -171.195516 * Self::mul_add(-x34, x35, x39);
-        let x42 = -171.195516 * Self::mul_add(x35, x40, x37);
-        let x43 = -171.195516 * Self::mul_add(x34, x34, x40 * x40);
-        let x44 = 132.6783695416 * x34;
-        let x45 = Self::mul_add(-97.44448770720001, x35, 135.4729695416 * x40);
-        let x46 = -97.44448770720001 * x40;
-        let x47 = Self::mul_add(
-            Self::mul_add(7.11, x28, x20),
-            171.195516,
-            Self::mul_add(-132.6783695416, x37, Self::mul_add(-x35, x45, x40 * x46)),
+        let x39 = Self::mul_add(qd[3], x37, Self::mul_add(x25, s_q3, x24 * c_q3));
+        let x40 = Self::mul_add(-qd[3], x36, Self::mul_add(-x24, s_q3, x25 * c_q3));
+        let x41 = qdd[3] + x26;
+        let x42 = qd[3] + x27;
+        let x43 = 171.195516 * Self::mul_add(x36, x37, -x41);
+        let x44 = 171.195516 * Self::mul_add(x36, x36, x42 * x42);
+        let x45 = 171.195516 * Self::mul_add(x37, x42, x39);
+        let x46 = Self::mul_add(97.44448770720001, x42, -177.0883695416 * x37);
+        let x47 = Self::mul_add(179.8829695416, x42, 97.44448770720001 * x37);
+        let x48 = Self::mul_add(
+            x38,
+            -171.195516,
+            Self::mul_add(
+                x36,
+                x46,
+                Self::mul_add(179.8829695416, x41, 97.44448770720001 * x40),
+            ),
         );
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x49 = Self::mul_add(-x34, c_q4, x40 * s_q4);
-        let x50 = Self::mul_add(x40, c_q4, x34 * s_q4);
-        let x51 = qd[4] + x35;
-        let x52 = 44.41 * x50;
-        let x53 = 47.471 * x51;
-        let x54 = Self::mul_add(
-            -x49,
-            x53,
-            44.41 * Self::mul_add(-qd[4], x49, Self::mul_add(x39, c_q4, x37 * s_q4)),
-        );
+        let x50 = Self::mul_add(-x36, s_q4, x42 * c_q4);
+        let x51 = Self::mul_add(x42, s_q4, x36 * c_q4);
+        let x52 = Self::mul_add(qd[4], x50, Self::mul_add(x41, s_q4, x39 * c_q4));
+        let x53 = qd[4] - x37;
+        let x54 = -44.41 * x51;
+        let x55 = 47.471 * x53;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x56 = 9.336
-            * (qdd[5]
-                + Self::mul_add(qd[4], x50, Self::mul_add(-x37, c_q4, x39 * s_q4)));
-        let x57 = 9.336 * (qd[5] + x49);
-        let x58 = Self::mul_add(-x50, s_q5, x51 * c_q5) * x57;
-        let x59 = Self::mul_add(x51, s_q5, x50 * c_q5) * x57;
-        let x60 = Self::mul_add(-x51, x52, x50 * x53) + x56;
-        let x61 = x54 + Self::mul_add(s_q5, x59, c_q5 * x58);
-        let x62 = Self::mul_add(x49, x52, 47.471 * (qdd[4] + x38))
-            + Self::mul_add(-c_q5, x59, s_q5 * x58);
-        let x63 = x47 + Self::mul_add(-s_q4, x61, c_q4 * x60);
+        let x57 = 9.336 * (qdd[5] + x52);
+        let x58 = 9.336 * (qd[5] + x51);
+        let x59 = Self::mul_add(-x50, s_q5, x53 * c_q5) * x58;
+        let x60 = Self::mul_add(x53, s_q5, x50 * c_q5) * x58;
+        let x61 = Self::mul_add(-x51, x55, x53 * x54)
+            + Self::mul_add(s_q5, x60, c_q5 * x59);
+        let x62 = Self::mul_add(x50, x55, -44.41 * x52) + x57;
+        let x63 = Self::mul_add(-x50, x54, 47.471 * (qdd[4] - x40))
+            + Self::mul_add(-c_q5, x60, s_q5 * x59);
         let x64 = Self::mul_add(
             171.195516,
-            x36,
-            Self::mul_add(-97.44448770720001, x38, 135.4729695416 * x39)
-                + Self::mul_add(-x35, x44, x34 * x46),
-        ) + Self::mul_add(c_q4, x61, s_q4 * x60);
+            Self::mul_add(-7.11, x30, x22),
+            Self::mul_add(-x42, x46, x37 * x47),
+        ) + Self::mul_add(-s_q4, x61, c_q4 * x62);
         let x65 = Self::mul_add(
-            -97.44448770720001,
-            x39,
-            Self::mul_add(-x34, x45, x40 * x44),
-        ) + x62;
-        let x66 = Self::mul_add(c_q3, x43, s_q3 * x41);
-        let x67 = Self::mul_add(-3239.4582, x27, Self::mul_add(-s_q3, x43, c_q3 * x41));
-        let x68 = Self::mul_add(3239.4582, x29, x66);
-        let x69 = Self::mul_add(
-            -x18,
-            x31,
-            Self::mul_add(24989.305802, x23, 1375.0472756800002 * x25),
-        ) + Self::mul_add(s_q3, x65, c_q3 * x63);
-        let x70 = x32 + Self::mul_add(x66, 7.11, x64);
-        let x71 = Self::mul_add(3239.4582, x20, -Self::mul_add(x17, x31, x26 * x30))
-            + Self::mul_add(7.11, x42, Self::mul_add(-s_q3, x63, c_q3 * x65));
-        let x72 = Self::mul_add(-s_q2, x68, c_q2 * x67);
-        let x73 = Self::mul_add(c_q2, x68, s_q2 * x67);
-        let x74 = x15 + Self::mul_add(7.11, x73, x70);
+            -x36,
+            x47,
+            Self::mul_add(97.44448770720001, x41, -177.0883695416 * x40),
+        ) - x63;
+        let x66 = x48 + Self::mul_add(s_q4, x62, c_q4 * x61);
+        let x67 = Self::mul_add(-c_q3, x44, s_q3 * x43);
+        let x68 = Self::mul_add(-3239.4582, x28, Self::mul_add(s_q3, x44, c_q3 * x43));
+        let x69 = Self::mul_add(3239.4582, x29, x67);
+        let x70 = Self::mul_add(
+            1375.0472756800002,
+            x26,
+            Self::mul_add(-x27, x32, x19 * x33),
+        ) + Self::mul_add(-s_q3, x65, c_q3 * x64);
+        let x71 = x34 + Self::mul_add(x45, -7.11, Self::mul_add(c_q3, x65, s_q3 * x64));
+        let x72 = Self::mul_add(
+            3239.4582,
+            x23,
+            Self::mul_add(24998.827802, x26, 1375.0472756800002 * x24)
+                - Self::mul_add(x18, x32, x19 * x31),
+        ) + Self::mul_add(7.11, x67, x66);
+        let x73 = Self::mul_add(-s_q2, x69, c_q2 * x68);
+        let x74 = Self::mul_add(c_q2, x69, s_q2 * x68);
         let x75 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                -x2,
-                x14,
-                Self::mul_add(39234.47412200001, x8, 3946.18812068 * qdd[1]),
-            ) + Self::mul_add(0.475, x73, Self::mul_add(s_q2, x71, c_q2 * x69)),
-            c_q1
-                * (Self::mul_add(-s_q2, x69, c_q2 * x71)
-                    + Self::mul_add(
-                        7.11,
-                        Self::mul_add(3239.4582, x28, x42),
-                        x72 * 0.475,
-                    )
-                    - Self::mul_add(5224.5702, x4, Self::mul_add(x1, x14, qd[1] * x13))),
-        );
+            -5224.5702,
+            x5,
+            Self::mul_add(-3946.1881206800003, x8, 39241.404122 * qdd[1])
+                + Self::mul_add(x1, x14, x2 * x13),
+        ) + Self::mul_add(7.11, x74, x72);
         let x76 = Self::mul_add(
-            0.5692,
-            Self::mul_add(
-                -s_q1,
-                Self::mul_add(5224.5702, x12, x73),
-                c_q1 * Self::mul_add(-5224.5702, x11, x72),
-            ),
-            x75,
+            c_q1,
+            x16
+                + (Self::mul_add(c_q2, x71, s_q2 * x70)
+                    + Self::mul_add(
+                        -7.11,
+                        Self::mul_add(-3239.4582, x30, x45),
+                        -0.475 * x73,
+                    )),
+            s_q1
+                * (Self::mul_add(
+                    3946.18812068,
+                    qdd[1],
+                    Self::mul_add(-x2, x15, qd[1] * x14),
+                ) + Self::mul_add(x74, 0.475, Self::mul_add(-s_q2, x71, c_q2 * x70))),
         );
-        let x77 = Self::mul_add(65697.3302265768, qdd[0], x76);
-        [x77, x74, x70, x64, x62, x56]
+        let x77 = Self::mul_add(
+            -0.5692,
+            Self::mul_add(
+                -c_q1,
+                Self::mul_add(-5224.5702, x11, x73),
+                s_q1 * Self::mul_add(5224.5702, x12, x74),
+            ),
+            -x76,
+        );
+        let x78 = Self::mul_add(1650.6386721183999, qdd[0], x77);
+        [x78, x75, x72, x66, x63, x57]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 343 mul, 237 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 193 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 319 mul, 233 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 176 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -881,81 +1223,73 @@ impl Ssrms6 {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 9.336 * c_q4;
-        let x6 = 44.41 * s_q4;
-        let x7 = 9.336 * s_q4;
-        let x8 = Self::mul_add(-c_q4, x6, s_q4 * x5);
-        let x9 = 132.6783695416 + Self::mul_add(s_q4, x6, c_q4 * x5);
-        let x10 = 135.4729695416 + Self::mul_add(c_q4, 44.41 * c_q4, s_q4 * x7);
-        let x11 = -171.195516 * s_q3;
-        let x12 = -171.195516 * c_q3;
-        let x13 = c_q3 * x9;
-        let x14 = Self::mul_add(-97.44448770720001, s_q3, c_q3 * x8);
-        let x15 = 47.471 * s_q3;
-        let x16 = s_q3 * x9;
-        let x17 = Self::mul_add(-s_q3, x8, -97.44448770720001 * c_q3);
-        let x18 = 47.471 * c_q3;
-        let x19 = x11 * -7.11;
-        let x20 = 7.11 * x11;
-        let x21 = x10 - x19;
-        let x22 = Self::mul_add(-7.11, x12, Self::mul_add(-c_q3, x16, s_q3 * x18));
-        let x23 = Self::mul_add(x12, -7.11, Self::mul_add(-s_q3, x13, c_q3 * x15));
-        let x24 = Self::mul_add(c_q3, x18, s_q3 * x16) + x20 - x19;
-        let x25 = 3239.4582 + x11;
-        let x26 = -24989.305802 + Self::mul_add(s_q3, x15, c_q3 * x13);
-        let x27 = 1375.0472756800002 + x14;
-        let x28 = 24998.827802 + (x20 + x21);
-        let x29 = s_q2 * x12;
-        let x30 = Self::mul_add(c_q2, x25, x29);
-        let x31 = c_q2 * x12;
-        let x32 = Self::mul_add(-s_q2, x25, x31);
-        let x33 = Self::mul_add(s_q2, x22, c_q2 * x26);
-        let x34 = s_q2 * x17;
-        let x35 = Self::mul_add(s_q2, x24, c_q2 * x23);
-        let x36 = Self::mul_add(-s_q2, x26, c_q2 * x22);
-        let x37 = c_q2 * x17;
-        let x38 = Self::mul_add(-s_q2, x23, c_q2 * x24);
-        let x39 = -7.11 * x30;
-        let x40 = 7.11 * x30;
-        let x41 = Self::mul_add(0.475, x30, Self::mul_add(c_q2, x27, x34));
-        let x42 = x28 - x39;
-        let x43 = c_q1 * x32;
+        let x5 = s_q4 * s_q4 * -35.074;
+        let x6 = s_q4 * c_q4 * -35.074;
+        let x7 = 132.6783695416 + (9.336 - x5);
+        let x8 = 135.4729695416 + (44.41 + x5);
+        let x9 = 47.471 - x7;
+        let x10 = s_q3 * s_q3 * x9;
+        let x11 = Self::mul_add(-s_q3, x6, -97.44448770720001 * c_q3);
+        let x12 = Self::mul_add(c_q3, x6, -97.44448770720001 * s_q3);
+        let x13 = -171.195516 * c_q3;
+        let x14 = -171.195516 * s_q3;
+        let x15 = x14 * -7.11;
+        let x16 = 7.11 * x14;
+        let x17 = x8 - x15;
+        let x18 = Self::mul_add(-7.11, x13, s_q3 * c_q3 * x9);
+        let x19 = 47.471 - x10 + x16 - x15;
+        let x20 = 3239.4582 + x14;
+        let x21 = -24989.305802 + (x7 + x10);
+        let x22 = 1375.0472756800002 + x12;
+        let x23 = 24998.827802 + (x16 + x17);
+        let x24 = s_q2 * s_q2;
+        let x25 = s_q2 * c_q2;
+        let x26 = x19 - x21;
+        let x27 = x18 + x18;
+        let x28 = Self::mul_add(x25, x27, x24 * x26);
+        let x29 = c_q2 * x11;
+        let x30 = s_q2 * x11;
+        let x31 = c_q2 * x13;
+        let x32 = Self::mul_add(-s_q2, x20, x31);
+        let x33 = s_q2 * x13;
+        let x34 = Self::mul_add(c_q2, x20, x33);
+        let x35 = -7.11 * x34;
+        let x36 = 7.11 * x34;
+        let x37 = Self::mul_add(0.475, x34, Self::mul_add(c_q2, x22, x30));
+        let x38 = x23 - x35;
+        let x39 = Self::mul_add(-7.11, x32, x18 + Self::mul_add(-x24, x27, x25 * x26));
+        let x40 = x19 - x28 + x36 - x35;
+        let x41 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x22, x29));
+        let x42 = c_q1 * x32;
+        let x43 = Self::mul_add(
+            0.5692,
+            Self::mul_add(-s_q1, 5224.5702 + x34, x42),
+            Self::mul_add(-s_q1, 3946.18812068 + x37, x41),
+        );
         let x44 = Self::mul_add(
-            -s_q1,
-            -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
-            c_q1 * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
+            0.5692,
+            Self::mul_add(-s_q1, x34, x42),
+            Self::mul_add(-s_q1, x37, x41),
         );
-        let x45 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
-        let x46 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
-            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
-        );
+        let x45 = Self::mul_add(-s_q2, x14, x31);
+        let x46 = Self::mul_add(c_q2, x14, x33);
         let x47 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, 5224.5702 + x30, x43),
-            Self::mul_add(-s_q1, 3946.18812068 + x41, x45),
+            -s_q1,
+            Self::mul_add(0.475, x46, Self::mul_add(c_q2, x12, x30)),
+            c_q1 * Self::mul_add(0.475, x45, Self::mul_add(-s_q2, x12, x29)),
         );
-        let x48 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x30, x43),
-            Self::mul_add(-s_q1, x41, x45),
-        );
-        let x49 = Self::mul_add(-s_q2, x11, x31);
-        let x50 = Self::mul_add(c_q2, x11, x29);
+        let x48 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x46, c_q1 * x45), x47);
+        let x49 = 47.471 * s_q3;
+        let x50 = 47.471 * c_q3;
         let x51 = Self::mul_add(
             -s_q1,
-            Self::mul_add(0.475, x50, Self::mul_add(c_q2, x14, x34)),
-            c_q1 * Self::mul_add(0.475, x49, Self::mul_add(-s_q2, x14, x37)),
+            Self::mul_add(s_q2, x50, c_q2 * x49),
+            c_q1 * Self::mul_add(-s_q2, x49, c_q2 * x50),
         );
-        let x52 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x50, c_q1 * x49), x51);
-        let x53 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x18, c_q2 * x15),
-            c_q1 * Self::mul_add(-s_q2, x15, c_q2 * x18),
-        );
-        let x54 = c_q3 * x5;
-        let x55 = s_q3 * x5;
+        let x52 = 9.336 * c_q4;
+        let x53 = 9.336 * s_q4;
+        let x54 = c_q3 * x52;
+        let x55 = s_q3 * x52;
         let x56 = Self::mul_add(
             c_q1,
             Self::mul_add(c_q2, x55, s_q2 * x54),
@@ -1070,52 +1404,59 @@ impl Ssrms6 {
             x118,
         );
         let x120 = tau[0] - x119;
-        let x121 = 1.0 / (65697.3302265768 + Self::mul_add(-s_q1, x44, c_q1 * x46));
-        let x122 = x47 * x121;
-        let x123 = x48 * x121;
-        let x124 = x52 * x121;
-        let x125 = x53 * x121;
+        let x121 = 1.0
+            / (65697.3302265768
+                + (x40
+                    - Self::mul_add(
+                        s_q1 * c_q1,
+                        x39 + x39,
+                        s_q1 * s_q1 * (x40 - (-39234.47412200001 + (x21 + x28))),
+                    )));
+        let x122 = x43 * x121;
+        let x123 = x44 * x121;
+        let x124 = x48 * x121;
+        let x125 = x51 * x121;
         let x126 = x56 * x121;
-        let x127 = 1.0 / Self::mul_add(-x47, x122, 39241.404122 + (x40 + x42));
-        let x128 = Self::mul_add(-x47, x123, x42);
+        let x127 = 1.0 / Self::mul_add(-x43, x122, 39241.404122 + (x36 + x38));
+        let x128 = Self::mul_add(-x43, x123, x38);
         let x129 = x127 * x128;
-        let x130 = Self::mul_add(-x47, x124, Self::mul_add(7.11, x50, x21));
+        let x130 = Self::mul_add(-x43, x124, Self::mul_add(7.11, x46, x17));
         let x131 = x127 * x130;
-        let x132 = x47 * x125;
+        let x132 = x43 * x125;
         let x133 = x127 * x132;
-        let x134 = Self::mul_add(x47, x126, x7);
+        let x134 = Self::mul_add(x43, x126, x53);
         let x135 = x127 * x134;
-        let x136 = 1.0 / Self::mul_add(-x128, x129, Self::mul_add(-x48, x123, x28));
-        let x137 = Self::mul_add(-x128, x131, Self::mul_add(-x48, x124, x21));
+        let x136 = 1.0 / Self::mul_add(-x128, x129, Self::mul_add(-x44, x123, x23));
+        let x137 = Self::mul_add(-x128, x131, Self::mul_add(-x44, x124, x17));
         let x138 = x136 * x137;
-        let x139 = Self::mul_add(-x48, x125, x128 * x133);
+        let x139 = Self::mul_add(-x44, x125, x128 * x133);
         let x140 = x136 * x139;
-        let x141 = Self::mul_add(-x128, x135, Self::mul_add(x48, x126, x7));
+        let x141 = Self::mul_add(-x128, x135, Self::mul_add(x44, x126, x53));
         let x142 = x136 * x141;
         let x143 = Self::mul_add(
             -x137,
             x138,
-            Self::mul_add(-x130, x131, Self::mul_add(-x52, x124, x10)),
+            Self::mul_add(-x130, x131, Self::mul_add(-x48, x124, x8)),
         );
         let x144 = 1.0 / x143;
-        let x145 = Self::mul_add(-x137, x140, Self::mul_add(-x52, x125, x130 * x133));
+        let x145 = Self::mul_add(-x137, x140, Self::mul_add(-x48, x125, x130 * x133));
         let x146 = x144 * x145;
         let x147 = Self::mul_add(
             -x137,
             x142,
-            Self::mul_add(-x130, x135, Self::mul_add(x52, x126, x7)),
+            Self::mul_add(-x130, x135, Self::mul_add(x48, x126, x53)),
         );
         let x148 = x144 * x147;
         let x149 = Self::mul_add(
             -x139,
             x140,
-            Self::mul_add(-x132, x133, Self::mul_add(-x53, x125, 47.471)),
+            Self::mul_add(-x132, x133, Self::mul_add(-x51, x125, 47.471)),
         );
         let x150 = 1.0 / Self::mul_add(-x145, x146, x149);
         let x151 = Self::mul_add(
             -x145,
             x148,
-            Self::mul_add(-x139, x142, Self::mul_add(x132, x135, x53 * x126)),
+            Self::mul_add(-x139, x142, Self::mul_add(x132, x135, x51 * x126)),
         );
         let x152 = x150 * x151;
         let x153 = Self::mul_add(
@@ -1172,7 +1513,7 @@ impl Ssrms6 {
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 257 mul, 170 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 132 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 233 mul, 166 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 115 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1183,84 +1524,82 @@ impl Ssrms6 {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 9.336 * c_q4;
-        let x6 = 44.41 * s_q4;
-        let x7 = 9.336 * s_q4;
-        let x8 = Self::mul_add(-c_q4, x6, s_q4 * x5);
-        let x9 = 132.6783695416 + Self::mul_add(s_q4, x6, c_q4 * x5);
-        let x10 = 135.4729695416 + Self::mul_add(c_q4, 44.41 * c_q4, s_q4 * x7);
-        let x11 = -171.195516 * s_q3;
-        let x12 = -171.195516 * c_q3;
-        let x13 = c_q3 * x9;
-        let x14 = Self::mul_add(-97.44448770720001, s_q3, c_q3 * x8);
-        let x15 = 47.471 * s_q3;
-        let x16 = s_q3 * x9;
-        let x17 = Self::mul_add(-s_q3, x8, -97.44448770720001 * c_q3);
-        let x18 = 47.471 * c_q3;
-        let x19 = x11 * -7.11;
-        let x20 = 7.11 * x11;
-        let x21 = x10 - x19;
-        let x22 = Self::mul_add(-7.11, x12, Self::mul_add(-c_q3, x16, s_q3 * x18));
-        let x23 = Self::mul_add(x12, -7.11, Self::mul_add(-s_q3, x13, c_q3 * x15));
-        let x24 = Self::mul_add(c_q3, x18, s_q3 * x16) + x20 - x19;
-        let x25 = 3239.4582 + x11;
-        let x26 = -24989.305802 + Self::mul_add(s_q3, x15, c_q3 * x13);
-        let x27 = 1375.0472756800002 + x14;
-        let x28 = 24998.827802 + (x20 + x21);
-        let x29 = s_q2 * x12;
-        let x30 = Self::mul_add(c_q2, x25, x29);
-        let x31 = c_q2 * x12;
-        let x32 = Self::mul_add(-s_q2, x25, x31);
-        let x33 = Self::mul_add(s_q2, x22, c_q2 * x26);
-        let x34 = s_q2 * x17;
-        let x35 = Self::mul_add(s_q2, x24, c_q2 * x23);
-        let x36 = Self::mul_add(-s_q2, x26, c_q2 * x22);
-        let x37 = c_q2 * x17;
-        let x38 = Self::mul_add(-s_q2, x23, c_q2 * x24);
-        let x39 = -7.11 * x30;
-        let x40 = 7.11 * x30;
-        let x41 = Self::mul_add(0.475, x30, Self::mul_add(c_q2, x27, x34));
-        let x42 = x28 - x39;
-        let x43 = 39241.404122 + (x40 + x42);
-        let x44 = c_q1 * x32;
-        let x45 = Self::mul_add(
-            -s_q1,
-            -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
-            c_q1 * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
-        );
-        let x46 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
-        let x47 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
-            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
-        );
-        let x48 = Self::mul_add(
+        let x5 = s_q4 * s_q4 * -35.074;
+        let x6 = s_q4 * c_q4 * -35.074;
+        let x7 = 132.6783695416 + (9.336 - x5);
+        let x8 = 135.4729695416 + (44.41 + x5);
+        let x9 = 47.471 - x7;
+        let x10 = s_q3 * s_q3 * x9;
+        let x11 = Self::mul_add(-s_q3, x6, -97.44448770720001 * c_q3);
+        let x12 = Self::mul_add(c_q3, x6, -97.44448770720001 * s_q3);
+        let x13 = -171.195516 * c_q3;
+        let x14 = -171.195516 * s_q3;
+        let x15 = x14 * -7.11;
+        let x16 = 7.11 * x14;
+        let x17 = x8 - x15;
+        let x18 = Self::mul_add(-7.11, x13, s_q3 * c_q3 * x9);
+        let x19 = 47.471 - x10 + x16 - x15;
+        let x20 = 3239.4582 + x14;
+        let x21 = -24989.305802 + (x7 + x10);
+        let x22 = 1375.0472756800002 + x12;
+        let x23 = 24998.827802 + (x16 + x17);
+        let x24 = s_q2 * s_q2;
+        let x25 = s_q2 * c_q2;
+        let x26 = x19 - x21;
+        let x27 = x18 + x18;
+        let x28 = Self::mul_add(x25, x27, x24 * x26);
+        let x29 = c_q2 * x11;
+        let x30 = s_q2 * x11;
+        let x31 = c_q2 * x13;
+        let x32 = Self::mul_add(-s_q2, x20, x31);
+        let x33 = s_q2 * x13;
+        let x34 = Self::mul_add(c_q2, x20, x33);
+        let x35 = -7.11 * x34;
+        let x36 = 7.11 * x34;
+        let x37 = Self::mul_add(0.475, x34, Self::mul_add(c_q2, x22, x30));
+        let x38 = x23 - x35;
+        let x39 = Self::mul_add(-7.11, x32, x18 + Self::mul_add(-x24, x27, x25 * x26));
+        let x40 = x19 - x28 + x36 - x35;
+        let x41 = 39241.404122 + (x36 + x38);
+        let x42 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x22, x29));
+        let x43 = c_q1 * x32;
+        let x44 = Self::mul_add(
             0.5692,
-            Self::mul_add(-s_q1, 5224.5702 + x30, x44),
-            Self::mul_add(-s_q1, 3946.18812068 + x41, x46),
+            Self::mul_add(-s_q1, 5224.5702 + x34, x43),
+            Self::mul_add(-s_q1, 3946.18812068 + x37, x42),
         );
-        let x49 = 65697.3302265768 + Self::mul_add(-s_q1, x45, c_q1 * x47);
+        let x45 = 65697.3302265768
+            + (x40
+                - Self::mul_add(
+                    s_q1 * c_q1,
+                    x39 + x39,
+                    s_q1 * s_q1 * (x40 - (-39234.47412200001 + (x21 + x28))),
+                ));
+        let x46 = Self::mul_add(
+            0.5692,
+            Self::mul_add(-s_q1, x34, x43),
+            Self::mul_add(-s_q1, x37, x42),
+        );
+        let x47 = Self::mul_add(-s_q2, x14, x31);
+        let x48 = Self::mul_add(c_q2, x14, x33);
+        let x49 = Self::mul_add(7.11, x48, x17);
         let x50 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x30, x44),
-            Self::mul_add(-s_q1, x41, x46),
+            -s_q1,
+            Self::mul_add(0.475, x48, Self::mul_add(c_q2, x12, x30)),
+            c_q1 * Self::mul_add(0.475, x47, Self::mul_add(-s_q2, x12, x29)),
         );
-        let x51 = Self::mul_add(-s_q2, x11, x31);
-        let x52 = Self::mul_add(c_q2, x11, x29);
-        let x53 = Self::mul_add(7.11, x52, x21);
+        let x51 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x48, c_q1 * x47), x50);
+        let x52 = 47.471 * s_q3;
+        let x53 = 47.471 * c_q3;
         let x54 = Self::mul_add(
             -s_q1,
-            Self::mul_add(0.475, x52, Self::mul_add(c_q2, x14, x34)),
-            c_q1 * Self::mul_add(0.475, x51, Self::mul_add(-s_q2, x14, x37)),
+            Self::mul_add(s_q2, x53, c_q2 * x52),
+            c_q1 * Self::mul_add(-s_q2, x52, c_q2 * x53),
         );
-        let x55 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x52, c_q1 * x51), x54);
-        let x56 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x18, c_q2 * x15),
-            c_q1 * Self::mul_add(-s_q2, x15, c_q2 * x18),
-        );
-        let x57 = c_q3 * x5;
-        let x58 = s_q3 * x5;
+        let x55 = 9.336 * c_q4;
+        let x56 = 9.336 * s_q4;
+        let x57 = c_q3 * x55;
+        let x58 = s_q3 * x55;
         let x59 = -Self::mul_add(
             c_q1,
             Self::mul_add(c_q2, x58, s_q2 * x57),
@@ -1378,19 +1717,19 @@ impl Ssrms6 {
         );
         (
             [
-                [x49, x48, x50, x55, x56, x59],
-                [x48, x43, x42, x53, 0.0, x7],
-                [x50, x42, x28, x21, 0.0, x7],
-                [x55, x53, x21, x10, 0.0, x7],
-                [x56, 0.0, 0.0, 0.0, 47.471, 0.0],
-                [x59, x7, x7, x7, 0.0, 9.336],
+                [x45, x44, x46, x51, x54, x59],
+                [x44, x41, x38, x49, 0.0, x56],
+                [x46, x38, x23, x17, 0.0, x56],
+                [x51, x49, x17, x8, 0.0, x56],
+                [x54, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x59, x56, x56, x56, 0.0, 9.336],
             ],
             [x123, x121, x117, x111, x109, x103],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 355 mul, 275 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 207 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 331 mul, 271 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 190 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -1403,81 +1742,73 @@ impl Ssrms6 {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 9.336 * c_q4;
-        let x6 = 44.41 * s_q4;
-        let x7 = 9.336 * s_q4;
-        let x8 = Self::mul_add(-c_q4, x6, s_q4 * x5);
-        let x9 = 132.6783695416 + Self::mul_add(s_q4, x6, c_q4 * x5);
-        let x10 = 135.4729695416 + Self::mul_add(c_q4, 44.41 * c_q4, s_q4 * x7);
-        let x11 = -171.195516 * s_q3;
-        let x12 = -171.195516 * c_q3;
-        let x13 = c_q3 * x9;
-        let x14 = Self::mul_add(-97.44448770720001, s_q3, c_q3 * x8);
-        let x15 = 47.471 * s_q3;
-        let x16 = s_q3 * x9;
-        let x17 = Self::mul_add(-s_q3, x8, -97.44448770720001 * c_q3);
-        let x18 = 47.471 * c_q3;
-        let x19 = x11 * -7.11;
-        let x20 = 7.11 * x11;
-        let x21 = x10 - x19;
-        let x22 = Self::mul_add(-7.11, x12, Self::mul_add(-c_q3, x16, s_q3 * x18));
-        let x23 = Self::mul_add(x12, -7.11, Self::mul_add(-s_q3, x13, c_q3 * x15));
-        let x24 = Self::mul_add(c_q3, x18, s_q3 * x16) + x20 - x19;
-        let x25 = 3239.4582 + x11;
-        let x26 = -24989.305802 + Self::mul_add(s_q3, x15, c_q3 * x13);
-        let x27 = 1375.0472756800002 + x14;
-        let x28 = 24998.827802 + (x20 + x21);
-        let x29 = s_q2 * x12;
-        let x30 = Self::mul_add(c_q2, x25, x29);
-        let x31 = c_q2 * x12;
-        let x32 = Self::mul_add(-s_q2, x25, x31);
-        let x33 = Self::mul_add(s_q2, x22, c_q2 * x26);
-        let x34 = s_q2 * x17;
-        let x35 = Self::mul_add(s_q2, x24, c_q2 * x23);
-        let x36 = Self::mul_add(-s_q2, x26, c_q2 * x22);
-        let x37 = c_q2 * x17;
-        let x38 = Self::mul_add(-s_q2, x23, c_q2 * x24);
-        let x39 = -7.11 * x30;
-        let x40 = 7.11 * x30;
-        let x41 = Self::mul_add(0.475, x30, Self::mul_add(c_q2, x27, x34));
-        let x42 = x28 - x39;
-        let x43 = c_q1 * x32;
+        let x5 = s_q4 * s_q4 * -35.074;
+        let x6 = s_q4 * c_q4 * -35.074;
+        let x7 = 132.6783695416 + (9.336 - x5);
+        let x8 = 135.4729695416 + (44.41 + x5);
+        let x9 = 47.471 - x7;
+        let x10 = s_q3 * s_q3 * x9;
+        let x11 = Self::mul_add(-s_q3, x6, -97.44448770720001 * c_q3);
+        let x12 = Self::mul_add(c_q3, x6, -97.44448770720001 * s_q3);
+        let x13 = -171.195516 * c_q3;
+        let x14 = -171.195516 * s_q3;
+        let x15 = x14 * -7.11;
+        let x16 = 7.11 * x14;
+        let x17 = x8 - x15;
+        let x18 = Self::mul_add(-7.11, x13, s_q3 * c_q3 * x9);
+        let x19 = 47.471 - x10 + x16 - x15;
+        let x20 = 3239.4582 + x14;
+        let x21 = -24989.305802 + (x7 + x10);
+        let x22 = 1375.0472756800002 + x12;
+        let x23 = 24998.827802 + (x16 + x17);
+        let x24 = s_q2 * s_q2;
+        let x25 = s_q2 * c_q2;
+        let x26 = x19 - x21;
+        let x27 = x18 + x18;
+        let x28 = Self::mul_add(x25, x27, x24 * x26);
+        let x29 = c_q2 * x11;
+        let x30 = s_q2 * x11;
+        let x31 = c_q2 * x13;
+        let x32 = Self::mul_add(-s_q2, x20, x31);
+        let x33 = s_q2 * x13;
+        let x34 = Self::mul_add(c_q2, x20, x33);
+        let x35 = -7.11 * x34;
+        let x36 = 7.11 * x34;
+        let x37 = Self::mul_add(0.475, x34, Self::mul_add(c_q2, x22, x30));
+        let x38 = x23 - x35;
+        let x39 = Self::mul_add(-7.11, x32, x18 + Self::mul_add(-x24, x27, x25 * x26));
+        let x40 = x19 - x28 + x36 - x35;
+        let x41 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x22, x29));
+        let x42 = c_q1 * x32;
+        let x43 = Self::mul_add(
+            0.5692,
+            Self::mul_add(-s_q1, 5224.5702 + x34, x42),
+            Self::mul_add(-s_q1, 3946.18812068 + x37, x41),
+        );
         let x44 = Self::mul_add(
-            -s_q1,
-            -39234.47412200001 + Self::mul_add(s_q2, x35, c_q2 * x33),
-            c_q1 * Self::mul_add(-7.11, x32, Self::mul_add(s_q2, x38, c_q2 * x36)),
+            0.5692,
+            Self::mul_add(-s_q1, x34, x42),
+            Self::mul_add(-s_q1, x37, x41),
         );
-        let x45 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(-s_q2, x27, x37));
-        let x46 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-7.11, x32, Self::mul_add(-s_q2, x33, c_q2 * x35)),
-            c_q1 * (Self::mul_add(-s_q2, x36, c_q2 * x38) + x40 - x39),
-        );
+        let x45 = Self::mul_add(-s_q2, x14, x31);
+        let x46 = Self::mul_add(c_q2, x14, x33);
         let x47 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, 5224.5702 + x30, x43),
-            Self::mul_add(-s_q1, 3946.18812068 + x41, x45),
+            -s_q1,
+            Self::mul_add(0.475, x46, Self::mul_add(c_q2, x12, x30)),
+            c_q1 * Self::mul_add(0.475, x45, Self::mul_add(-s_q2, x12, x29)),
         );
-        let x48 = Self::mul_add(
-            0.5692,
-            Self::mul_add(-s_q1, x30, x43),
-            Self::mul_add(-s_q1, x41, x45),
-        );
-        let x49 = Self::mul_add(-s_q2, x11, x31);
-        let x50 = Self::mul_add(c_q2, x11, x29);
+        let x48 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x46, c_q1 * x45), x47);
+        let x49 = 47.471 * s_q3;
+        let x50 = 47.471 * c_q3;
         let x51 = Self::mul_add(
             -s_q1,
-            Self::mul_add(0.475, x50, Self::mul_add(c_q2, x14, x34)),
-            c_q1 * Self::mul_add(0.475, x49, Self::mul_add(-s_q2, x14, x37)),
+            Self::mul_add(s_q2, x50, c_q2 * x49),
+            c_q1 * Self::mul_add(-s_q2, x49, c_q2 * x50),
         );
-        let x52 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x50, c_q1 * x49), x51);
-        let x53 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x18, c_q2 * x15),
-            c_q1 * Self::mul_add(-s_q2, x15, c_q2 * x18),
-        );
-        let x54 = c_q3 * x5;
-        let x55 = s_q3 * x5;
+        let x52 = 9.336 * c_q4;
+        let x53 = 9.336 * s_q4;
+        let x54 = c_q3 * x52;
+        let x55 = s_q3 * x52;
         let x56 = Self::mul_add(
             c_q1,
             Self::mul_add(c_q2, x55, s_q2 * x54),
@@ -1628,52 +1959,59 @@ impl Ssrms6 {
             x123,
         );
         let x125 = tau[0] - (x124 - f_ext[0][5]);
-        let x126 = 1.0 / (65697.3302265768 + Self::mul_add(-s_q1, x44, c_q1 * x46));
-        let x127 = x47 * x126;
-        let x128 = x48 * x126;
-        let x129 = x52 * x126;
-        let x130 = x53 * x126;
+        let x126 = 1.0
+            / (65697.3302265768
+                + (x40
+                    - Self::mul_add(
+                        s_q1 * c_q1,
+                        x39 + x39,
+                        s_q1 * s_q1 * (x40 - (-39234.47412200001 + (x21 + x28))),
+                    )));
+        let x127 = x43 * x126;
+        let x128 = x44 * x126;
+        let x129 = x48 * x126;
+        let x130 = x51 * x126;
         let x131 = x56 * x126;
-        let x132 = 1.0 / Self::mul_add(-x47, x127, 39241.404122 + (x40 + x42));
-        let x133 = Self::mul_add(-x47, x128, x42);
+        let x132 = 1.0 / Self::mul_add(-x43, x127, 39241.404122 + (x36 + x38));
+        let x133 = Self::mul_add(-x43, x128, x38);
         let x134 = x132 * x133;
-        let x135 = Self::mul_add(-x47, x129, Self::mul_add(7.11, x50, x21));
+        let x135 = Self::mul_add(-x43, x129, Self::mul_add(7.11, x46, x17));
         let x136 = x132 * x135;
-        let x137 = x47 * x130;
+        let x137 = x43 * x130;
         let x138 = x132 * x137;
-        let x139 = Self::mul_add(x47, x131, x7);
+        let x139 = Self::mul_add(x43, x131, x53);
         let x140 = x132 * x139;
-        let x141 = 1.0 / Self::mul_add(-x133, x134, Self::mul_add(-x48, x128, x28));
-        let x142 = Self::mul_add(-x133, x136, Self::mul_add(-x48, x129, x21));
+        let x141 = 1.0 / Self::mul_add(-x133, x134, Self::mul_add(-x44, x128, x23));
+        let x142 = Self::mul_add(-x133, x136, Self::mul_add(-x44, x129, x17));
         let x143 = x141 * x142;
-        let x144 = Self::mul_add(-x48, x130, x133 * x138);
+        let x144 = Self::mul_add(-x44, x130, x133 * x138);
         let x145 = x141 * x144;
-        let x146 = Self::mul_add(-x133, x140, Self::mul_add(x48, x131, x7));
+        let x146 = Self::mul_add(-x133, x140, Self::mul_add(x44, x131, x53));
         let x147 = x141 * x146;
         let x148 = Self::mul_add(
             -x142,
             x143,
-            Self::mul_add(-x135, x136, Self::mul_add(-x52, x129, x10)),
+            Self::mul_add(-x135, x136, Self::mul_add(-x48, x129, x8)),
         );
         let x149 = 1.0 / x148;
-        let x150 = Self::mul_add(-x142, x145, Self::mul_add(-x52, x130, x135 * x138));
+        let x150 = Self::mul_add(-x142, x145, Self::mul_add(-x48, x130, x135 * x138));
         let x151 = x149 * x150;
         let x152 = Self::mul_add(
             -x142,
             x147,
-            Self::mul_add(-x135, x140, Self::mul_add(x52, x131, x7)),
+            Self::mul_add(-x135, x140, Self::mul_add(x48, x131, x53)),
         );
         let x153 = x149 * x152;
         let x154 = Self::mul_add(
             -x144,
             x145,
-            Self::mul_add(-x137, x138, Self::mul_add(-x53, x130, 47.471)),
+            Self::mul_add(-x137, x138, Self::mul_add(-x51, x130, 47.471)),
         );
         let x155 = 1.0 / Self::mul_add(-x150, x151, x154);
         let x156 = Self::mul_add(
             -x150,
             x153,
-            Self::mul_add(-x144, x147, Self::mul_add(x137, x140, x53 * x131)),
+            Self::mul_add(-x144, x147, Self::mul_add(x137, x140, x51 * x131)),
         );
         let x157 = x155 * x156;
         let x158 = Self::mul_add(

@@ -10,40 +10,62 @@
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
 //! Precision: `f64`.
-//! Fused multiply-adds: 1158 (`mass_matrix` 93, `nonlinear_effects` 115, `inverse_dynamics` 124, `forward_dynamics` 302, `mass_matrix_and_nonlinear_effects` 208, `forward_dynamics_with_wrenches` 316), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
-//! Form: unrolled straight-line code (auto: 635 emitted operations in M + c, within the 4000 limit).
+//! Fused multiply-adds: 1026 (`mass_matrix` 61, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 270, `mass_matrix_and_nonlinear_effects` 176, `forward_dynamics_with_wrenches` 284), each `libm::fma(a, b, c)` = a·b + c rounded once; the counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: 573 emitted operations in M + c, within the 4000 limit).
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | — | 681 | 661 | 0 | 0 | 7 | 1342 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | 778 | 703 | 0 | 0 | 7 | 1481 |
-//! | `mass_matrix` | `kane-direct` | — | — | 709 | 510 | 0 | 0 | 7 | 1219 |
-//! | `mass_matrix` | `crba-base` | — | — | 577 | 454 | 0 | 0 | 7 | 1031 |
-//! | `mass_matrix` * | `crba` | — | — | 170 | 116 | 0 | 0 | 5 | 286 |
-//! | `nonlinear_effects` | — | `recurrent` | — | 618 | 450 | 0 | 0 | 7 | 1068 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | 708 | 536 | 0 | 0 | 7 | 1244 |
-//! | `nonlinear_effects` | — | `rnea` | — | 256 | 176 | 0 | 0 | 6 | 432 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | 207 | 142 | 0 | 0 | 6 | 349 |
-//! | `inverse_dynamics` | — | `recurrent` | — | 827 | 607 | 0 | 0 | 7 | 1434 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | 917 | 693 | 0 | 0 | 7 | 1610 |
-//! | `inverse_dynamics` | — | `rnea` | — | 268 | 191 | 0 | 0 | 6 | 459 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | 217 | 157 | 0 | 0 | 6 | 374 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | 914 | 667 | 7 | 0 | 7 | 1581 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | 1004 | 753 | 7 | 0 | 7 | 1757 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | 552 | 393 | 7 | 0 | 6 | 945 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | 503 | 359 | 7 | 0 | 6 | 862 |
-//! | `forward_dynamics` | — | — | `aba` | 556 | 388 | 5 | 0 | 6 | 944 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | 788 | 566 | 0 | 0 | 7 | 1354 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | 878 | 652 | 0 | 0 | 7 | 1530 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | 426 | 292 | 0 | 0 | 6 | 718 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | 377 | 258 | 0 | 0 | 6 | 635 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | 1018 | 772 | 7 | 0 | 7 | 1790 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | 1108 | 858 | 7 | 0 | 7 | 1966 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | 564 | 437 | 7 | 0 | 6 | 1001 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | 515 | 403 | 7 | 0 | 6 | 918 |
-//! | `forward_dynamics_with_wrenches` | — | — | `aba` | 568 | 433 | 5 | 0 | 6 | 1001 |
+//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` | `recurrent` | — | — | model | 681 | 661 | 0 | 0 | 7 | 1342 |
+//! | `mass_matrix` | `recurrent` | — | — | canonical | 684 | 661 | 0 | 0 | 7 | 1345 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | model | 778 | 703 | 0 | 0 | 7 | 1481 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 785 | 705 | 0 | 0 | 7 | 1490 |
+//! | `mass_matrix` | `kane-direct` | — | — | model | 709 | 510 | 0 | 0 | 7 | 1219 |
+//! | `mass_matrix` | `kane-direct` | — | — | canonical | 716 | 511 | 0 | 0 | 7 | 1227 |
+//! | `mass_matrix` | `crba-base` | — | — | model | 577 | 454 | 0 | 0 | 7 | 1031 |
+//! | `mass_matrix` | `crba-base` | — | — | canonical | 586 | 457 | 0 | 0 | 7 | 1043 |
+//! | `mass_matrix` * | `crba` | — | — | model | 124 | 100 | 0 | 0 | 5 | 224 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 130 | 102 | 0 | 0 | 5 | 232 |
+//! | `nonlinear_effects` | — | `recurrent` | — | model | 618 | 450 | 0 | 0 | 7 | 1068 |
+//! | `nonlinear_effects` | — | `recurrent` | — | canonical | 621 | 450 | 0 | 0 | 7 | 1071 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | model | 708 | 536 | 0 | 0 | 7 | 1244 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 715 | 537 | 0 | 0 | 7 | 1252 |
+//! | `nonlinear_effects` | — | `rnea` | — | model | 256 | 176 | 0 | 0 | 6 | 432 |
+//! | `nonlinear_effects` | — | `rnea` | — | canonical | 253 | 174 | 0 | 0 | 6 | 427 |
+//! | `nonlinear_effects` | — | `newton-euler` | — | model | 207 | 142 | 0 | 0 | 6 | 349 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | canonical | 206 | 141 | 0 | 0 | 6 | 347 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 781 | 591 | 0 | 0 | 7 | 1372 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 790 | 593 | 0 | 0 | 7 | 1383 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 871 | 677 | 0 | 0 | 7 | 1548 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 884 | 680 | 0 | 0 | 7 | 1564 |
+//! | `inverse_dynamics` | — | `rnea` | — | model | 268 | 191 | 0 | 0 | 6 | 459 |
+//! | `inverse_dynamics` | — | `rnea` | — | canonical | 265 | 189 | 0 | 0 | 6 | 454 |
+//! | `inverse_dynamics` | — | `newton-euler` | — | model | 217 | 157 | 0 | 0 | 6 | 374 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | canonical | 216 | 156 | 0 | 0 | 6 | 372 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 868 | 651 | 7 | 0 | 7 | 1519 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 877 | 653 | 7 | 0 | 7 | 1530 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 958 | 737 | 7 | 0 | 7 | 1695 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 971 | 740 | 7 | 0 | 7 | 1711 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 506 | 377 | 7 | 0 | 6 | 883 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 509 | 377 | 7 | 0 | 6 | 886 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 457 | 343 | 7 | 0 | 6 | 800 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 462 | 344 | 7 | 0 | 6 | 806 |
+//! | `forward_dynamics` | — | — | `aba` | model | 556 | 388 | 5 | 0 | 6 | 944 |
+//! | `forward_dynamics` | — | — | `aba` | canonical | 556 | 389 | 5 | 0 | 6 | 945 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 742 | 550 | 0 | 0 | 7 | 1292 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 751 | 552 | 0 | 0 | 7 | 1303 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 832 | 636 | 0 | 0 | 7 | 1468 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 845 | 639 | 0 | 0 | 7 | 1484 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 380 | 276 | 0 | 0 | 6 | 656 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 383 | 276 | 0 | 0 | 6 | 659 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 331 | 242 | 0 | 0 | 6 | 573 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 336 | 243 | 0 | 0 | 6 | 579 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 972 | 756 | 7 | 0 | 7 | 1728 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 1062 | 842 | 7 | 0 | 7 | 1904 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 518 | 421 | 7 | 0 | 6 | 939 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 469 | 387 | 7 | 0 | 6 | 856 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 568 | 433 | 5 | 0 | 6 | 1001 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsFma;
@@ -59,6 +81,9 @@ pub struct OpCount {
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
+    /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
+    /// joint axis z, modified-DH x; the same joint-space results).
+    pub frames: &'static str,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -106,72 +131,78 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 170u64,
-            add: 116u64,
+            frames: "model",
+            mul: 124u64,
+            add: 100u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 93u64,
+            fma: 61u64,
         },
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 207u64,
-            add: 142u64,
+            frames: "canonical",
+            mul: 206u64,
+            add: 141u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 115u64,
+            fma: 113u64,
         },
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 217u64,
-            add: 157u64,
+            frames: "canonical",
+            mul: 216u64,
+            add: 156u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 124u64,
+            fma: 122u64,
         },
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 503u64,
-            add: 359u64,
+            frames: "model",
+            mul: 457u64,
+            add: 343u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 302u64,
+            fma: 270u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 377u64,
-            add: 258u64,
+            frames: "model",
+            mul: 331u64,
+            add: 242u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 208u64,
+            fma: 176u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 515u64,
-            add: 403u64,
+            frames: "model",
+            mul: 469u64,
+            add: 387u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 316u64,
+            fma: 284u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -181,7 +212,21 @@ impl SsrmsFma {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 681u64,
+            add: 661u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 684u64,
             add: 661u64,
             div: 0u64,
             sqrt: 0u64,
@@ -193,8 +238,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("recurrent-r1"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 778u64,
             add: 703u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("recurrent-r1"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 785u64,
+            add: 705u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -205,8 +264,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("kane-direct"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 709u64,
             add: 510u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("kane-direct"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 716u64,
+            add: 511u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -217,8 +290,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba-base"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 577u64,
             add: 454u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 586u64,
+            add: 457u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -229,8 +316,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            mul: 170u64,
-            add: 116u64,
+            frames: "model",
+            mul: 124u64,
+            add: 100u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix",
+            mass_matrix_method: Some("crba"),
+            bias_method: None,
+            forward_method: None,
+            frames: "canonical",
+            mul: 130u64,
+            add: 102u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -241,7 +342,21 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 618u64,
+            add: 450u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 621u64,
             add: 450u64,
             div: 0u64,
             sqrt: 0u64,
@@ -253,6 +368,7 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
+            frames: "model",
             mul: 708u64,
             add: 536u64,
             div: 0u64,
@@ -263,8 +379,22 @@ impl SsrmsFma {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 715u64,
+            add: 537u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
             mul: 256u64,
             add: 176u64,
             div: 0u64,
@@ -275,10 +405,37 @@ impl SsrmsFma {
         OpCount {
             function: "nonlinear_effects",
             mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 253u64,
+            add: 174u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 207u64,
             add: 142u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "nonlinear_effects",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 206u64,
+            add: 141u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -289,8 +446,22 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 827u64,
-            add: 607u64,
+            frames: "model",
+            mul: 781u64,
+            add: 591u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 790u64,
+            add: 593u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -301,8 +472,22 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 917u64,
-            add: 693u64,
+            frames: "model",
+            mul: 871u64,
+            add: 677u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 884u64,
+            add: 680u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -313,6 +498,7 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: Some("rnea"),
             forward_method: None,
+            frames: "model",
             mul: 268u64,
             add: 191u64,
             div: 0u64,
@@ -323,10 +509,37 @@ impl SsrmsFma {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 265u64,
+            add: 189u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
             bias_method: Some("newton-euler"),
             forward_method: None,
+            frames: "model",
             mul: 217u64,
             add: 157u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 216u64,
+            add: 156u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -337,8 +550,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 914u64,
-            add: 667u64,
+            frames: "model",
+            mul: 868u64,
+            add: 651u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 877u64,
+            add: 653u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -349,8 +576,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 1004u64,
-            add: 753u64,
+            frames: "model",
+            mul: 958u64,
+            add: 737u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 971u64,
+            add: 740u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -361,8 +602,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 552u64,
-            add: 393u64,
+            frames: "model",
+            mul: 506u64,
+            add: 377u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 509u64,
+            add: 377u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -373,8 +628,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 503u64,
-            add: 359u64,
+            frames: "model",
+            mul: 457u64,
+            add: 343u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 462u64,
+            add: 344u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -385,8 +654,22 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 556u64,
             add: 388u64,
+            div: 5u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: None,
+            bias_method: None,
+            forward_method: Some("aba"),
+            frames: "canonical",
+            mul: 556u64,
+            add: 389u64,
             div: 5u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -397,8 +680,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: None,
-            mul: 788u64,
-            add: 566u64,
+            frames: "model",
+            mul: 742u64,
+            add: 550u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 751u64,
+            add: 552u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -409,8 +706,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: None,
-            mul: 878u64,
-            add: 652u64,
+            frames: "model",
+            mul: 832u64,
+            add: 636u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 845u64,
+            add: 639u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -421,8 +732,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: None,
-            mul: 426u64,
-            add: 292u64,
+            frames: "model",
+            mul: 380u64,
+            add: 276u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 383u64,
+            add: 276u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -433,8 +758,22 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            mul: 377u64,
-            add: 258u64,
+            frames: "model",
+            mul: 331u64,
+            add: 242u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 336u64,
+            add: 243u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -445,8 +784,9 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            mul: 1018u64,
-            add: 772u64,
+            frames: "model",
+            mul: 972u64,
+            add: 756u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -457,8 +797,9 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            mul: 1108u64,
-            add: 858u64,
+            frames: "model",
+            mul: 1062u64,
+            add: 842u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -469,8 +810,9 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            mul: 564u64,
-            add: 437u64,
+            frames: "model",
+            mul: 518u64,
+            add: 421u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -481,8 +823,9 @@ impl SsrmsFma {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            mul: 515u64,
-            add: 403u64,
+            frames: "model",
+            mul: 469u64,
+            add: 387u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -493,6 +836,7 @@ impl SsrmsFma {
             mass_matrix_method: None,
             bias_method: None,
             forward_method: Some("aba"),
+            frames: "model",
             mul: 568u64,
             add: 433u64,
             div: 5u64,
@@ -503,7 +847,7 @@ impl SsrmsFma {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 170 mul, 116 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 93 fused multiply-adds.
+    /// Methods: mass matrix `crba`: 124 mul, 100 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 61 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -511,473 +855,466 @@ impl SsrmsFma {
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x5 = 9.336 * c_q5;
-        let x6 = 44.41 * s_q5;
-        let x7 = 9.336 * s_q5;
-        let x8 = 44.41 * c_q5;
-        let x9 = libm::fma(-c_q5, x6, s_q5 * x5);
-        let x10 = libm::fma(-s_q5, x8, c_q5 * x7);
-        let x11 = 132.6783695416 + libm::fma(s_q5, x6, c_q5 * x5);
-        let x12 = 135.4729695416 + libm::fma(c_q5, x8, s_q5 * x7);
-        let x13 = -171.195516 * s_q4;
-        let x14 = -171.195516 * c_q4;
-        let x15 = c_q4 * x11;
-        let x16 = -97.44448770720001 * s_q4;
-        let x17 = libm::fma(c_q4, x9, x16);
-        let x18 = 47.471 * s_q4;
-        let x19 = s_q4 * x11;
-        let x20 = -97.44448770720001 * c_q4;
-        let x21 = libm::fma(-s_q4, x9, x20);
-        let x22 = 47.471 * c_q4;
-        let x23 = libm::fma(-s_q4, x10, x20);
-        let x24 = x13 * -7.11;
-        let x25 = 7.11 * x13;
-        let x26 = x12 - x24;
-        let x27 = libm::fma(-7.11, x14, libm::fma(-c_q4, x19, s_q4 * x22));
-        let x28 = libm::fma(x14, -7.11, libm::fma(-s_q4, x15, c_q4 * x18));
-        let x29 = libm::fma(c_q4, x22, s_q4 * x19) + x25 - x24;
-        let x30 = 3239.4582 + x13;
-        let x31 = -24989.305802 + libm::fma(s_q4, x18, c_q4 * x15);
-        let x32 = 1375.0472756800002 + x17;
-        let x33 = 1375.0472756800002 + libm::fma(c_q4, x10, x16);
-        let x34 = 24998.827802 + (x25 + x26);
-        let x35 = s_q3 * x14;
-        let x36 = libm::fma(c_q3, x30, x35);
-        let x37 = c_q3 * x14;
-        let x38 = libm::fma(-s_q3, x30, x37);
-        let x39 = libm::fma(s_q3, x27, c_q3 * x31);
-        let x40 = s_q3 * x21;
-        let x41 = libm::fma(s_q3, x29, c_q3 * x28);
-        let x42 = libm::fma(-s_q3, x31, c_q3 * x27);
-        let x43 = c_q3 * x21;
-        let x44 = libm::fma(-s_q3, x28, c_q3 * x29);
-        let x45 = -7.11 * x36;
-        let x46 = 7.11 * x36;
-        let x47 = libm::fma(0.475, x36, libm::fma(c_q3, x32, x40));
-        let x48 = x34 - x45;
-        let x49 = libm::fma(-7.11, x38, libm::fma(s_q3, x44, c_q3 * x42));
-        let x50 = libm::fma(x38, 0.475, libm::fma(-s_q3, x32, x43));
-        let x51 = libm::fma(-7.11, x38, libm::fma(-s_q3, x39, c_q3 * x41));
-        let x52 = libm::fma(0.475, x38, libm::fma(-s_q3, x33, c_q3 * x23));
-        let x53 = libm::fma(-s_q3, x42, c_q3 * x44) + x46 - x45;
-        let x54 = 5224.5702 + x36;
-        let x55 = -39234.47412200001 + libm::fma(s_q3, x41, c_q3 * x39);
-        let x56 = 3946.18812068 + x47;
-        let x57 = 3946.1881206800003
-            + libm::fma(x36, 0.475, libm::fma(s_q3, x23, c_q3 * x33));
-        let x58 = 39241.404122 + (x46 + x48);
-        let x59 = s_q2 * x38;
-        let x60 = libm::fma(c_q2, x54, x59);
-        let x61 = c_q2 * x38;
-        let x62 = libm::fma(-s_q2, x54, x61);
-        let x63 = libm::fma(s_q2, x49, c_q2 * x55);
-        let x64 = s_q2 * x50;
-        let x65 = libm::fma(s_q2, x53, c_q2 * x51);
-        let x66 = c_q2 * x50;
-        let x67 = libm::fma(0.5692, x62, libm::fma(-s_q2, x56, x66));
-        let x68 = 65697.3302265768
-            + libm::fma(
-                -s_q2,
-                libm::fma(-s_q2, x55, c_q2 * x49),
-                c_q2 * libm::fma(-s_q2, x51, c_q2 * x53),
-            );
-        let x69 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x60, libm::fma(s_q2, x52, c_q2 * x57)),
-            c_q1 * libm::fma(s_q2, x65, c_q2 * x63),
-        );
-        let x70 = c_q1 * libm::fma(0.5692, x60, libm::fma(c_q2, x56, x64));
-        let x71 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x62, libm::fma(-s_q2, x57, c_q2 * x52)),
-            c_q1 * libm::fma(-s_q2, x63, c_q2 * x65),
-        );
-        let x72 = libm::fma(
+        let x5 = s_q5 * s_q5 * -35.074;
+        let x6 = s_q5 * c_q5 * -35.074;
+        let x7 = 132.6783695416 + (9.336 - x5);
+        let x8 = 135.4729695416 + (44.41 + x5);
+        let x9 = 47.471 - x7;
+        let x10 = s_q4 * s_q4 * x9;
+        let x11 = libm::fma(-s_q4, x6, -97.44448770720001 * c_q4);
+        let x12 = libm::fma(c_q4, x6, -97.44448770720001 * s_q4);
+        let x13 = -171.195516 * c_q4;
+        let x14 = -171.195516 * s_q4;
+        let x15 = x14 * -7.11;
+        let x16 = 7.11 * x14;
+        let x17 = x8 - x15;
+        let x18 = libm::fma(-7.11, x13, s_q4 * c_q4 * x9);
+        let x19 = 47.471 - x10 + x16 - x15;
+        let x20 = 3239.4582 + x14;
+        let x21 = -24989.305802 + (x7 + x10);
+        let x22 = 1375.0472756800002 + x12;
+        let x23 = 24998.827802 + (x16 + x17);
+        let x24 = s_q3 * s_q3;
+        let x25 = s_q3 * c_q3;
+        let x26 = x19 - x21;
+        let x27 = x18 + x18;
+        let x28 = libm::fma(x25, x27, x24 * x26);
+        let x29 = c_q3 * x11;
+        let x30 = s_q3 * x11;
+        let x31 = c_q3 * x13;
+        let x32 = libm::fma(-s_q3, x20, x31);
+        let x33 = s_q3 * x13;
+        let x34 = libm::fma(c_q3, x20, x33);
+        let x35 = -7.11 * x34;
+        let x36 = 7.11 * x34;
+        let x37 = libm::fma(0.475, x34, libm::fma(c_q3, x22, x30));
+        let x38 = x23 - x35;
+        let x39 = libm::fma(-7.11, x32, x18 + libm::fma(-x24, x27, x25 * x26));
+        let x40 = libm::fma(x32, 0.475, libm::fma(-s_q3, x22, x29));
+        let x41 = x19 - x28 + x36 - x35;
+        let x42 = 5224.5702 + x34;
+        let x43 = -39234.47412200001 + (x21 + x28);
+        let x44 = 3946.18812068 + x37;
+        let x45 = 39241.404122 + (x36 + x38);
+        let x46 = s_q2 * s_q2;
+        let x47 = s_q2 * c_q2;
+        let x48 = x41 - x43;
+        let x49 = x39 + x39;
+        let x50 = libm::fma(x47, x49, x46 * x48);
+        let x51 = x43 + x50;
+        let x52 = c_q2 * x40;
+        let x53 = libm::fma(-s_q2, x44, x52);
+        let x54 = s_q2 * x40;
+        let x55 = c_q2 * x32;
+        let x56 = libm::fma(-s_q2, x42, x55);
+        let x57 = s_q2 * x32;
+        let x58 = libm::fma(c_q2, x42, x57);
+        let x59 = libm::fma(0.5692, x58, libm::fma(c_q2, x44, x54));
+        let x60 = libm::fma(0.5692, x56, x53);
+        let x61 = 65697.3302265768 + (x41 - x50);
+        let x62 = libm::fma(
             0.7026,
-            x62,
-            libm::fma(-s_q1, libm::fma(-s_q1, -65693.9112265768 + x58, x70), c_q1 * x69),
+            x56,
+            libm::fma(
+                0.7026,
+                x56,
+                x51
+                    - libm::fma(
+                        s_q1 * c_q1,
+                        x59 + x59,
+                        s_q1 * s_q1 * (x51 - (-65693.9112265768 + x45)),
+                    ),
+            ),
         );
-        let x73 = 66279.65991417361 + libm::fma(0.7026, x62, x72);
-        let x74 = libm::fma(
+        let x63 = 66279.65991417361 + x62;
+        let x64 = libm::fma(
             -0.7026,
-            libm::fma(s_q1, 1145.5438279999998, c_q1 * x60),
-            x71,
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x58),
+            libm::fma(
+                -s_q1,
+                libm::fma(0.5692, x56, x53),
+                c_q1 * (x39 + libm::fma(-x46, x49, x47 * x48)),
+            ),
         );
-        let x75 = libm::fma(-0.7026, s_q1 * x62, libm::fma(-s_q1, x58, x70));
-        let x76 = libm::fma(-s_q2, x36, x61);
-        let x77 = libm::fma(0.5692, x76, libm::fma(-s_q2, x47, x66));
-        let x78 = libm::fma(
+        let x65 = libm::fma(-0.7026, s_q1 * x56, libm::fma(-s_q1, x45, c_q1 * x59));
+        let x66 = libm::fma(-s_q2, x34, x55);
+        let x67 = libm::fma(0.5692, x66, libm::fma(-s_q2, x37, x52));
+        let x68 = libm::fma(
             -s_q1,
-            x48,
+            x38,
             c_q1
-                * libm::fma(0.5692, libm::fma(c_q2, x36, x59), libm::fma(c_q2, x47, x64)),
+                * libm::fma(0.5692, libm::fma(c_q2, x34, x57), libm::fma(c_q2, x37, x54)),
         );
-        let x79 = libm::fma(-0.7026, s_q1 * x76, x78);
-        let x80 = libm::fma(-s_q3, x13, x37);
-        let x81 = libm::fma(c_q3, x13, x35);
-        let x82 = libm::fma(0.475, x81, libm::fma(c_q3, x17, x40));
-        let x83 = libm::fma(7.11, x81, x26);
-        let x84 = libm::fma(0.475, x80, libm::fma(-s_q3, x17, x43));
-        let x85 = libm::fma(-s_q2, x81, c_q2 * x80);
-        let x86 = libm::fma(0.5692, x85, libm::fma(-s_q2, x82, c_q2 * x84));
-        let x87 = libm::fma(
+        let x69 = libm::fma(-0.7026, s_q1 * x66, x68);
+        let x70 = libm::fma(-s_q3, x14, x31);
+        let x71 = libm::fma(c_q3, x14, x33);
+        let x72 = libm::fma(0.475, x71, libm::fma(c_q3, x12, x30));
+        let x73 = libm::fma(7.11, x71, x17);
+        let x74 = libm::fma(0.475, x70, libm::fma(-s_q3, x12, x29));
+        let x75 = libm::fma(-s_q2, x71, c_q2 * x70);
+        let x76 = libm::fma(0.5692, x75, libm::fma(-s_q2, x72, c_q2 * x74));
+        let x77 = libm::fma(
             -s_q1,
-            x83,
+            x73,
             c_q1
                 * libm::fma(
                     0.5692,
-                    libm::fma(c_q2, x81, s_q2 * x80),
-                    libm::fma(s_q2, x84, c_q2 * x82),
+                    libm::fma(c_q2, x71, s_q2 * x70),
+                    libm::fma(s_q2, x74, c_q2 * x72),
                 ),
         );
-        let x88 = libm::fma(-0.7026, s_q1 * x85, x87);
-        let x89 = libm::fma(s_q3, x22, c_q3 * x18);
-        let x90 = libm::fma(-s_q3, x18, c_q3 * x22);
-        let x91 = libm::fma(-s_q2, x89, c_q2 * x90);
-        let x92 = c_q1 * libm::fma(s_q2, x90, c_q2 * x89);
-        let x93 = c_q4 * x5;
-        let x94 = s_q4 * x5;
-        let x95 = libm::fma(-s_q3, x94, c_q3 * x93);
-        let x96 = libm::fma(c_q3, x94, s_q3 * x93);
-        let x97 = -libm::fma(c_q2, x96, s_q2 * x95);
-        let x98 = libm::fma(-s_q1, x7, c_q1 * libm::fma(-s_q2, x96, c_q2 * x95));
+        let x78 = libm::fma(-0.7026, s_q1 * x75, x77);
+        let x79 = 47.471 * s_q4;
+        let x80 = 47.471 * c_q4;
+        let x81 = libm::fma(s_q3, x80, c_q3 * x79);
+        let x82 = libm::fma(-s_q3, x79, c_q3 * x80);
+        let x83 = libm::fma(-s_q2, x81, c_q2 * x82);
+        let x84 = c_q1 * libm::fma(s_q2, x82, c_q2 * x81);
+        let x85 = 9.336 * c_q5;
+        let x86 = 9.336 * s_q5;
+        let x87 = c_q4 * x85;
+        let x88 = s_q4 * x85;
+        let x89 = libm::fma(-s_q3, x88, c_q3 * x87);
+        let x90 = libm::fma(c_q3, x88, s_q3 * x87);
+        let x91 = -libm::fma(c_q2, x90, s_q2 * x89);
+        let x92 = libm::fma(-s_q1, x86, c_q1 * libm::fma(-s_q2, x90, c_q2 * x89));
         [
-            [x73, x74, x75, x79, x88, x92, x98],
-            [x74, x68, x67, x77, x86, x91, x97],
-            [x75, x67, x58, x48, x83, 0.0, x7],
-            [x79, x77, x48, x34, x26, 0.0, x7],
-            [x88, x86, x83, x26, x12, 0.0, x7],
-            [x92, x91, 0.0, 0.0, 0.0, 47.471, 0.0],
-            [x98, x97, x7, x7, x7, 0.0, 9.336],
+            [x63, x64, x65, x69, x78, x84, x92],
+            [x64, x61, x60, x67, x76, x83, x91],
+            [x65, x60, x45, x38, x73, 0.0, x86],
+            [x69, x67, x38, x23, x17, 0.0, x86],
+            [x78, x76, x73, x17, x8, 0.0, x86],
+            [x84, x83, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x92, x91, x86, x86, x86, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 207 mul, 142 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 115 fused multiply-adds.
+    /// Methods: bias `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused multiply-adds.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * (qd[0] * qd[0]);
+        let x3 = -0.7026 * (qd[0] * qd[0]);
         let x4 = qd[1] * x2;
         let x5 = qd[1] * x1;
         let x6 = x1 * x2;
         let x7 = libm::fma(x1, x1, qd[1] * qd[1]);
-        let x8 = -65693.9112265768 * x2;
-        let x9 = 65697.3302265768 * qd[1];
+        let x8 = -1647.2196721184 * x2;
+        let x9 = 1650.6386721183999 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x11 = libm::fma(-qd[1], s_q2, x1 * c_q2);
         let x12 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x13 = -0.5692 * x6;
-        let x14 = -0.5692 * x7;
-        let x15 = libm::fma(-0.5692, x4 + x4, x3);
+        let x13 = 0.5692 * x6;
+        let x14 = 0.5692 * x7;
+        let x15 = libm::fma(0.5692, x4 + x4, x3);
         let x16 = libm::fma(c_q2, x15, s_q2 * x13);
         let x17 = libm::fma(qd[2], x12, x4 * c_q2);
-        let x18 = libm::fma(-x4, s_q2, qd[2] * x11);
+        let x18 = libm::fma(-qd[2], x11, x4 * s_q2);
         let x19 = qd[2] - x2;
         let x20 = x12 * x12;
         let x21 = libm::fma(x19, x19, x20);
         let x22 = x11 * x19;
-        let x23 = x18 + x22;
-        let x24 = libm::fma(x11, x12, x5);
-        let x25 = libm::fma(3946.18812068, x19, -39234.47412200001 * x11);
-        let x26 = libm::fma(39241.404122, x19, 3946.1881206800003 * x11);
-        let x27 = libm::fma(
-            x16,
-            5224.5702,
-            libm::fma(x12, x25, -libm::fma(39241.404122, x5, 3946.1881206800003 * x17)),
+        let x23 = libm::fma(x11, x12, x5);
+        let x24 = x22 - x18;
+        let x25 = 3946.18812068 * x19;
+        let x26 = 39234.474122 * x12;
+        let x27 = libm::fma(39241.404122, x19, 3946.1881206800003 * x11);
+        let x28 = libm::fma(
+            x14,
+            -5224.5702,
+            libm::fma(39234.474122, x18, libm::fma(-x11, x27, x19 * x25)),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x29 = libm::fma(-x12, s_q3, x11 * c_q3);
-        let x30 = libm::fma(x12, c_q3, x11 * s_q3);
-        let x31 = libm::fma(-c_q2, x13, s_q2 * x15)
-            + libm::fma(-7.11, x21, -0.475 * (x22 - x18));
-        let x32 = libm::fma(0.475, libm::fma(x11, x11, x20), 7.11 * x23) - x14;
-        let x33 = libm::fma(-0.475, libm::fma(x12, x19, -x17), 7.11 * x24) - x16;
-        let x34 = libm::fma(c_q3, x33, s_q3 * x31);
-        let x35 = libm::fma(qd[3], x30, libm::fma(x18, s_q3, x17 * c_q3));
-        let x36 = libm::fma(qd[3], x29, libm::fma(-x17, s_q3, x18 * c_q3));
-        let x37 = qd[3] + x19;
-        let x38 = libm::fma(x30, x30, x37 * x37);
-        let x39 = libm::fma(x29, x37, x36);
-        let x40 = libm::fma(x29, x30, x5);
-        let x41 = libm::fma(1375.0472756800002, x37, -24989.305802 * x29);
-        let x42 = libm::fma(24998.827802, x37, 1375.0472756800002 * x29);
-        let x43 = libm::fma(
+        let x30 = libm::fma(-x12, s_q3, x11 * c_q3);
+        let x31 = libm::fma(x12, c_q3, x11 * s_q3);
+        let x32 = libm::fma(-s_q2, x15, c_q2 * x13)
+            + libm::fma(-7.11, x21, -0.475 * (x18 + x22));
+        let x33 = libm::fma(-7.11, x23, -0.475 * libm::fma(-x12, x19, x17)) - x16;
+        let x34 = x14 + libm::fma(0.475, libm::fma(x11, x11, x20), 7.11 * x24);
+        let x35 = libm::fma(-s_q3, x32, c_q3 * x33);
+        let x36 = libm::fma(-qd[3], x31, libm::fma(-x17, c_q3, x18 * s_q3));
+        let x37 = libm::fma(-qd[3], x30, libm::fma(x18, c_q3, x17 * s_q3));
+        let x38 = qd[3] + x19;
+        let x39 = libm::fma(x38, x38, x31 * x31);
+        let x40 = libm::fma(x30, x31, x5);
+        let x41 = libm::fma(x30, x38, -x37);
+        let x42 = 1375.0472756800002 * x38;
+        let x43 = 24989.305802 * x31;
+        let x44 = libm::fma(24998.827802, x38, 1375.0472756800002 * x30);
+        let x45 = libm::fma(
             x34,
             -3239.4582,
-            libm::fma(x30, x41, -libm::fma(24998.827802, x5, 1375.0472756800002 * x35)),
+            libm::fma(24989.305802, x37, libm::fma(-x30, x44, x38 * x42)),
         );
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x45 = libm::fma(-x30, s_q4, x29 * c_q4);
-        let x46 = libm::fma(x30, c_q4, x29 * s_q4);
-        let x47 = libm::fma(
-            -s_q4,
-            libm::fma(7.11, x40, x34),
-            c_q4 * libm::fma(-7.11, x38, libm::fma(-s_q3, x33, c_q3 * x31)),
+        let x47 = libm::fma(-x31, s_q4, x30 * c_q4);
+        let x48 = libm::fma(x31, c_q4, x30 * s_q4);
+        let x49 = libm::fma(
+            s_q4,
+            libm::fma(-7.11, x40, x35),
+            c_q4 * libm::fma(-7.11, x39, libm::fma(s_q3, x33, c_q3 * x32)),
         );
-        let x48 = libm::fma(qd[4], x46, libm::fma(x36, s_q4, x35 * c_q4));
-        let x49 = libm::fma(qd[4], x45, libm::fma(-x35, s_q4, x36 * c_q4));
-        let x50 = qd[4] + x37;
-        let x51 = -171.195516 * libm::fma(x45, x46, -x5);
-        let x52 = -171.195516 * libm::fma(x46, x50, x48);
-        let x53 = -171.195516 * libm::fma(x45, x45, x50 * x50);
-        let x54 = 132.6783695416 * x45;
-        let x55 = libm::fma(-97.44448770720001, x46, 135.4729695416 * x50);
-        let x56 = -97.44448770720001 * x50;
-        let x57 = libm::fma(
-            libm::fma(7.11, x39, x32),
-            171.195516,
-            libm::fma(-132.6783695416, x48, libm::fma(-x46, x55, x50 * x56)),
+        let x50 = libm::fma(-qd[4], x48, libm::fma(x37, s_q4, x36 * c_q4));
+        let x51 = libm::fma(-qd[4], x47, libm::fma(-x36, s_q4, x37 * c_q4));
+        let x52 = qd[4] + x38;
+        let x53 = 171.195516 * libm::fma(-x47, x48, x5);
+        let x54 = 171.195516 * libm::fma(x47, x47, x52 * x52);
+        let x55 = 171.195516 * libm::fma(-x48, x52, x50);
+        let x56 = libm::fma(177.0883695416, x48, 97.44448770720001 * x52);
+        let x57 = libm::fma(-97.44448770720001, x48, 179.8829695416 * x52);
+        let x58 = libm::fma(
+            x49,
+            -171.195516,
+            libm::fma(x47, x56, libm::fma(-179.8829695416, x5, 97.44448770720001 * x51)),
         );
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x59 = libm::fma(x50, s_q5, x45 * c_q5);
-        let x60 = libm::fma(-x45, s_q5, x50 * c_q5);
-        let x61 = qd[5] + x46;
-        let x62 = 44.41 * x60;
-        let x63 = 47.471 * x61;
-        let x64 = libm::fma(
-            -x59,
-            x63,
-            44.41 * libm::fma(-qd[5], x59, libm::fma(-x5, c_q5, x48 * s_q5)),
-        );
+        let x60 = libm::fma(-x47, s_q5, x52 * c_q5);
+        let x61 = libm::fma(x52, s_q5, x47 * c_q5);
+        let x62 = libm::fma(-qd[5], x60, libm::fma(-x50, c_q5, x5 * s_q5));
+        let x63 = qd[5] + x48;
+        let x64 = -44.41 * x61;
+        let x65 = 47.471 * x63;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x66 = 9.336 * libm::fma(qd[5], x60, -libm::fma(x5, s_q5, x48 * c_q5));
-        let x67 = 9.336 * (qd[6] + x59);
-        let x68 = libm::fma(-x60, s_q6, x61 * c_q6) * x67;
-        let x69 = libm::fma(x61, s_q6, x60 * c_q6) * x67;
-        let x70 = libm::fma(-x61, x62, x60 * x63) + x66;
-        let x71 = x64 + libm::fma(s_q6, x69, c_q6 * x68);
-        let x72 = libm::fma(x59, x62, 47.471 * x49) + libm::fma(-c_q6, x69, s_q6 * x68);
-        let x73 = x57 + libm::fma(-s_q5, x71, c_q5 * x70);
-        let x74 = libm::fma(
-            -171.195516,
-            x47,
-            libm::fma(-135.4729695416, x5, -97.44448770720001 * x49)
-                + libm::fma(-x45, x56, x46 * x54),
-        ) + libm::fma(c_q5, x71, s_q5 * x70);
-        let x75 = libm::fma(97.44448770720001, x5, libm::fma(-x50, x54, x45 * x55))
-            + x72;
-        let x76 = libm::fma(c_q4, x53, s_q4 * x51);
-        let x77 = libm::fma(-3239.4582, x38, libm::fma(-s_q4, x53, c_q4 * x51));
-        let x78 = libm::fma(3239.4582, x39, x52);
-        let x79 = libm::fma(3239.4582, x40, -x76);
-        let x80 = libm::fma(s_q4, x75, c_q4 * x73)
-            - libm::fma(
-                x30,
-                x42,
-                libm::fma(1375.0472756800002, x5, -24989.305802 * x35),
-            );
-        let x81 = x43 + libm::fma(x76, 7.11, x74);
-        let x82 = libm::fma(3239.4582, x32, libm::fma(-x37, x41, x29 * x42))
-            + libm::fma(7.11, x52, libm::fma(-s_q4, x73, c_q4 * x75));
-        let x83 = libm::fma(s_q3, x79, c_q3 * x77);
-        let x84 = libm::fma(-s_q3, x77, c_q3 * x79);
-        let x85 = libm::fma(-5224.5702, x21, x83);
-        let x86 = libm::fma(5224.5702, x24, x84);
-        let x87 = libm::fma(-0.475, x84, libm::fma(s_q3, x82, c_q3 * x80))
-            - libm::fma(
-                x12,
-                x26,
-                libm::fma(3946.18812068, x5, -39234.47412200001 * x17),
-            );
-        let x88 = x27 + libm::fma(-7.11, x84, x81);
-        let x89 = libm::fma(-5224.5702, x14, libm::fma(-x19, x25, x11 * x26))
-            + (libm::fma(-s_q3, x80, c_q3 * x82) + libm::fma(7.11, x78, x83 * 0.475));
-        let x90 = libm::fma(s_q2, x86, c_q2 * x85);
+        let x67 = 9.336 * x62;
+        let x68 = -x67;
+        let x69 = 9.336 * (qd[6] + x61);
+        let x70 = libm::fma(-x60, s_q6, x63 * c_q6) * x69;
+        let x71 = libm::fma(x63, s_q6, x60 * c_q6) * x69;
+        let x72 = libm::fma(-x61, x65, x63 * x64) + libm::fma(s_q6, x71, c_q6 * x70);
+        let x73 = libm::fma(-x60, x65, -44.41 * x62) + x67;
+        let x74 = libm::fma(-c_q6, x71, s_q6 * x70) - libm::fma(x60, x64, 47.471 * x51);
+        let x75 = libm::fma(
+            171.195516,
+            libm::fma(7.11, x41, x34),
+            -libm::fma(x48, x57, x52 * x56),
+        ) - libm::fma(c_q5, x73, s_q5 * x72);
+        let x76 = libm::fma(
+            -x47,
+            x57,
+            libm::fma(-97.44448770720001, x5, -177.0883695416 * x51),
+        ) - x74;
+        let x77 = x58 + libm::fma(-s_q5, x73, c_q5 * x72);
+        let x78 = libm::fma(-c_q4, x54, s_q4 * x53);
+        let x79 = libm::fma(-3239.4582, x39, libm::fma(s_q4, x54, c_q4 * x53));
+        let x80 = libm::fma(-3239.4582, x40, x78);
+        let x81 = libm::fma(3239.4582, x41, x55);
+        let x82 = libm::fma(-1375.0472756800002, x5, libm::fma(-x31, x44, x38 * x43))
+            + libm::fma(-s_q4, x76, c_q4 * x75);
+        let x83 = x45 + libm::fma(x55, -7.11, libm::fma(c_q4, x76, s_q4 * x75));
+        let x84 = libm::fma(
+            3239.4582,
+            x35,
+            libm::fma(-24998.827802, x5, 1375.0472756800002 * x36)
+                + libm::fma(-x30, x43, x31 * x42),
+        ) + libm::fma(7.11, x78, x77);
+        let x85 = libm::fma(-s_q3, x80, c_q3 * x79);
+        let x86 = libm::fma(c_q3, x80, s_q3 * x79);
+        let x87 = libm::fma(-5224.5702, x21, x85);
+        let x88 = libm::fma(-5224.5702, x23, x86);
+        let x89 = libm::fma(-3946.18812068, x5, libm::fma(-x12, x27, x19 * x26))
+            + libm::fma(x86, 0.475, libm::fma(-s_q3, x83, c_q3 * x82));
+        let x90 = x28
+            + (libm::fma(c_q3, x83, s_q3 * x82) + libm::fma(-7.11, x81, -0.475 * x85));
         let x91 = libm::fma(
+            -5224.5702,
+            x16,
+            libm::fma(-x11, x26, x12 * x25)
+                - libm::fma(39241.404122, x5, 3946.1881206800003 * x17),
+        ) + libm::fma(7.11, x86, x84);
+        let x92 = libm::fma(-c_q2, x87, s_q2 * x88);
+        let x93 = libm::fma(
             -x1,
             x8,
-            libm::fma(0.5692, x90, libm::fma(-s_q2, x87, c_q2 * x89)),
+            libm::fma(-0.5692, x92, -libm::fma(c_q2, x90, s_q2 * x89)),
         );
-        let x92 = libm::fma(
-            c_q1,
-            libm::fma(1145.5438279999998, x7, libm::fma(5224.5702, x23, x78)),
-            s_q1 * libm::fma(1145.5438279999998, x6, x90),
+        let x94 = libm::fma(
+            -c_q1,
+            libm::fma(1145.5438279999998, x7, libm::fma(5224.5702, x24, x81)),
+            s_q1 * libm::fma(-1145.5438279999998, x6, x92),
         );
-        let x93 = libm::fma(
-            -s_q1,
-            x88 - libm::fma(x1, x9, -65693.9112265768 * x5),
-            c_q1
-                * (libm::fma(1145.5438279999998, x3, libm::fma(-x2, x9, qd[1] * x8))
-                    + libm::fma(
-                        -0.5692,
-                        libm::fma(-s_q2, x85, c_q2 * x86),
-                        libm::fma(s_q2, x89, c_q2 * x87),
-                    )),
+        let x95 = libm::fma(
+            -c_q1,
+            libm::fma(1145.5438279999998, x3, libm::fma(-qd[1], x8, x2 * x9))
+                + libm::fma(
+                    -0.5692,
+                    libm::fma(c_q2, x88, s_q2 * x87),
+                    libm::fma(-c_q2, x89, s_q2 * x90),
+                ),
+            s_q1 * (libm::fma(x1, x9, -1647.2196721184 * x5) - x91),
         );
-        let x94 = libm::fma(-0.7026, x92, x93);
-        [x94, x91, x88, x81, x74, x72, x66]
+        let x96 = libm::fma(0.7026, x94, x95);
+        [x96, x93, x91, x84, x77, x74, x68]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
-    /// Methods: bias `newton-euler`: 217 mul, 157 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 124 fused multiply-adds.
+    /// Methods: bias `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused multiply-adds.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
-        let x3 = 0.7026 * qdd[0];
-        let x4 = 0.7026 * (qd[0] * qd[0]);
+        let x3 = -0.7026 * qdd[0];
+        let x4 = -0.7026 * (qd[0] * qd[0]);
         let x5 = s_q1 * x3;
         let x6 = qd[1] * x2;
-        let x7 = libm::fma(qdd[0], c_q1, -x6);
+        let x7 = libm::fma(-qdd[0], c_q1, x6);
         let x8 = libm::fma(qd[1], x1, qdd[0] * s_q1);
         let x9 = libm::fma(x1, x2, qdd[1]);
         let x10 = libm::fma(x1, x1, qd[1] * qd[1]);
-        let x11 = -65693.9112265768 * x2;
-        let x12 = 65697.3302265768 * qd[1];
+        let x11 = -1647.2196721184 * x2;
+        let x12 = 1650.6386721183999 * qd[1];
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x14 = libm::fma(-qd[1], s_q2, x1 * c_q2);
         let x15 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x16 = libm::fma(-0.5692, x9, x5);
-        let x17 = libm::fma(-0.5692, x10, c_q1 * x3);
-        let x18 = libm::fma(-0.5692, x7 - x6, -x4);
-        let x19 = libm::fma(-s_q2, x16, c_q2 * x18);
-        let x20 = libm::fma(-qd[2], x15, libm::fma(-qdd[1], s_q2, x7 * c_q2));
-        let x21 = libm::fma(qd[2], x14, libm::fma(qdd[1], c_q2, x7 * s_q2));
+        let x16 = libm::fma(0.5692, x9, x5);
+        let x17 = libm::fma(0.5692, x10, c_q1 * x3);
+        let x18 = libm::fma(0.5692, x6 + x7, x4);
+        let x19 = libm::fma(c_q2, x18, s_q2 * x16);
+        let x20 = libm::fma(qd[2], x15, libm::fma(qdd[1], s_q2, x7 * c_q2));
+        let x21 = libm::fma(-qd[2], x14, libm::fma(-qdd[1], c_q2, x7 * s_q2));
         let x22 = qdd[2] - x8;
         let x23 = qd[2] - x2;
         let x24 = x15 * x15;
         let x25 = libm::fma(x23, x23, x24);
         let x26 = x14 * x23;
-        let x27 = x21 + x26;
-        let x28 = libm::fma(x14, x15, -x22);
-        let x29 = libm::fma(3946.18812068, x23, -39234.47412200001 * x14);
-        let x30 = libm::fma(39241.404122, x23, 3946.1881206800003 * x14);
-        let x31 = libm::fma(
-            x19,
+        let x27 = libm::fma(-x14, x15, x22);
+        let x28 = x26 - x21;
+        let x29 = 3946.18812068 * x23;
+        let x30 = 39234.474122 * x15;
+        let x31 = libm::fma(39241.404122, x23, 3946.1881206800003 * x14);
+        let x32 = libm::fma(
+            x17,
             -5224.5702,
-            libm::fma(x15, x29, libm::fma(39241.404122, x22, 3946.1881206800003 * x20)),
+            libm::fma(39234.474122, x21, libm::fma(-x14, x31, x23 * x29)),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x33 = libm::fma(-x15, s_q3, x14 * c_q3);
-        let x34 = libm::fma(x15, c_q3, x14 * s_q3);
-        let x35 = libm::fma(-7.11, x25, -0.475 * (x26 - x21))
-            - libm::fma(s_q2, x18, c_q2 * x16);
-        let x36 = libm::fma(0.475, libm::fma(x14, x14, x24), 7.11 * x27) - x17;
-        let x37 = x19 + libm::fma(-0.475, libm::fma(x15, x23, x20), 7.11 * x28);
-        let x38 = libm::fma(c_q3, x37, s_q3 * x35);
-        let x39 = libm::fma(-qd[3], x34, libm::fma(-x21, s_q3, x20 * c_q3));
-        let x40 = libm::fma(qd[3], x33, libm::fma(x21, c_q3, x20 * s_q3));
-        let x41 = qdd[3] + x22;
-        let x42 = qd[3] + x23;
-        let x43 = libm::fma(x34, x34, x42 * x42);
-        let x44 = libm::fma(x33, x42, x40);
-        let x45 = libm::fma(x33, x34, -x41);
-        let x46 = libm::fma(1375.0472756800002, x42, -24989.305802 * x33);
-        let x47 = libm::fma(24998.827802, x42, 1375.0472756800002 * x33);
-        let x48 = libm::fma(
+        let x34 = libm::fma(-x15, s_q3, x14 * c_q3);
+        let x35 = libm::fma(x15, c_q3, x14 * s_q3);
+        let x36 = libm::fma(-s_q2, x18, c_q2 * x16)
+            + libm::fma(-7.11, x25, -0.475 * (x21 + x26));
+        let x37 = libm::fma(-0.475, libm::fma(-x15, x23, x20), 7.11 * x27) - x19;
+        let x38 = x17 + libm::fma(0.475, libm::fma(x14, x14, x24), 7.11 * x28);
+        let x39 = libm::fma(-s_q3, x36, c_q3 * x37);
+        let x40 = libm::fma(-qd[3], x35, libm::fma(-x20, c_q3, x21 * s_q3));
+        let x41 = libm::fma(-qd[3], x34, libm::fma(x21, c_q3, x20 * s_q3));
+        let x42 = qdd[3] + x22;
+        let x43 = qd[3] + x23;
+        let x44 = libm::fma(x43, x43, x35 * x35);
+        let x45 = libm::fma(-x34, x35, x42);
+        let x46 = libm::fma(x34, x43, -x41);
+        let x47 = 1375.0472756800002 * x43;
+        let x48 = 24989.305802 * x35;
+        let x49 = libm::fma(24998.827802, x43, 1375.0472756800002 * x34);
+        let x50 = libm::fma(
             x38,
             -3239.4582,
-            libm::fma(x34, x46, libm::fma(24998.827802, x41, 1375.0472756800002 * x39)),
+            libm::fma(24989.305802, x41, libm::fma(-x34, x49, x43 * x47)),
         );
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x50 = libm::fma(-x34, s_q4, x33 * c_q4);
-        let x51 = libm::fma(x34, c_q4, x33 * s_q4);
-        let x52 = libm::fma(
-            -s_q4,
-            libm::fma(7.11, x45, x38),
-            c_q4 * libm::fma(-7.11, x43, libm::fma(-s_q3, x37, c_q3 * x35)),
+        let x52 = libm::fma(-x35, s_q4, x34 * c_q4);
+        let x53 = libm::fma(x35, c_q4, x34 * s_q4);
+        let x54 = libm::fma(
+            s_q4,
+            libm::fma(7.11, x45, x39),
+            c_q4 * libm::fma(-7.11, x44, libm::fma(s_q3, x37, c_q3 * x36)),
         );
-        let x53 = libm::fma(-qd[4], x51, libm::fma(-x40, s_q4, x39 * c_q4));
-        let x54 = libm::fma(qd[4], x50, libm::fma(x40, c_q4, x39 * s_q4));
-        let x55 = qdd[4] + x41;
-        let x56 = qd[4] + x42;
-        let x57 = -171.195516 * libm::fma(x50, x51, x55);
-        let x58 = -171.195516 * libm::fma(x51, x56, -x53);
-        let x59 = -171.195516 * libm::fma(x50, x50, x56 * x56);
-        let x60 = 132.6783695416 * x50;
-        let x61 = libm::fma(-97.44448770720001, x51, 135.4729695416 * x56);
-        let x62 = -97.44448770720001 * x56;
-        let x63 = libm::fma(
-            libm::fma(7.11, x44, x36),
-            171.195516,
-            libm::fma(132.6783695416, x53, libm::fma(-x51, x61, x56 * x62)),
+        let x55 = libm::fma(-qd[4], x53, libm::fma(x41, s_q4, x40 * c_q4));
+        let x56 = libm::fma(-qd[4], x52, libm::fma(-x40, s_q4, x41 * c_q4));
+        let x57 = qdd[4] + x42;
+        let x58 = qd[4] + x43;
+        let x59 = 171.195516 * libm::fma(x52, x53, x57);
+        let x60 = 171.195516 * libm::fma(x52, x52, x58 * x58);
+        let x61 = 171.195516 * libm::fma(-x53, x58, x55);
+        let x62 = libm::fma(177.0883695416, x53, 97.44448770720001 * x58);
+        let x63 = libm::fma(-97.44448770720001, x53, 179.8829695416 * x58);
+        let x64 = libm::fma(
+            x54,
+            -171.195516,
+            libm::fma(x52, x62, libm::fma(179.8829695416, x57, 97.44448770720001 * x56)),
         );
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x65 = libm::fma(x56, s_q5, x50 * c_q5);
-        let x66 = libm::fma(-x50, s_q5, x56 * c_q5);
-        let x67 = qd[5] + x51;
-        let x68 = 44.41 * x66;
-        let x69 = 47.471 * x67;
-        let x70 = libm::fma(
-            -x65,
-            x69,
-            44.41 * libm::fma(-qd[5], x65, libm::fma(-x53, s_q5, x55 * c_q5)),
-        );
+        let x66 = libm::fma(-x52, s_q5, x58 * c_q5);
+        let x67 = libm::fma(x58, s_q5, x52 * c_q5);
+        let x68 = libm::fma(qd[5], x66, libm::fma(x57, s_q5, x55 * c_q5));
+        let x69 = qd[5] + x53;
+        let x70 = -44.41 * x67;
+        let x71 = 47.471 * x69;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x72 = 9.336
-            * (qdd[6] + libm::fma(qd[5], x66, libm::fma(x55, s_q5, x53 * c_q5)));
-        let x73 = 9.336 * (qd[6] + x65);
-        let x74 = libm::fma(-x66, s_q6, x67 * c_q6) * x73;
-        let x75 = libm::fma(x67, s_q6, x66 * c_q6) * x73;
-        let x76 = libm::fma(-x67, x68, x66 * x69) + x72;
-        let x77 = x70 + libm::fma(s_q6, x75, c_q6 * x74);
-        let x78 = libm::fma(x65, x68, 47.471 * (qdd[5] + x54))
-            + libm::fma(-c_q6, x75, s_q6 * x74);
-        let x79 = x63 + libm::fma(-s_q5, x77, c_q5 * x76);
+        let x73 = 9.336 * (qdd[6] + x68);
+        let x74 = 9.336 * (qd[6] + x67);
+        let x75 = libm::fma(-x66, s_q6, x69 * c_q6) * x74;
+        let x76 = libm::fma(x69, s_q6, x66 * c_q6) * x74;
+        let x77 = libm::fma(-x67, x71, x69 * x70) + libm::fma(s_q6, x76, c_q6 * x75);
+        let x78 = libm::fma(x66, x71, -44.41 * x68) + x73;
+        let x79 = libm::fma(-x66, x70, 47.471 * (qdd[5] - x56))
+            + libm::fma(-c_q6, x76, s_q6 * x75);
         let x80 = libm::fma(
-            -171.195516,
-            x52,
-            libm::fma(-97.44448770720001, x54, 135.4729695416 * x55)
-                + libm::fma(-x50, x62, x51 * x60),
-        ) + libm::fma(c_q5, x77, s_q5 * x76);
-        let x81 = libm::fma(-97.44448770720001, x55, libm::fma(-x56, x60, x50 * x61))
-            + x78;
-        let x82 = libm::fma(c_q4, x59, s_q4 * x57);
-        let x83 = libm::fma(-3239.4582, x43, libm::fma(-s_q4, x59, c_q4 * x57));
-        let x84 = libm::fma(3239.4582, x44, x58);
-        let x85 = libm::fma(3239.4582, x45, -x82);
-        let x86 = libm::fma(
-            -x34,
-            x47,
-            libm::fma(1375.0472756800002, x41, -24989.305802 * x39),
-        ) + libm::fma(s_q4, x81, c_q4 * x79);
-        let x87 = x48 + libm::fma(x82, 7.11, x80);
-        let x88 = libm::fma(3239.4582, x36, libm::fma(-x42, x46, x33 * x47))
-            + libm::fma(7.11, x58, libm::fma(-s_q4, x79, c_q4 * x81));
-        let x89 = libm::fma(s_q3, x85, c_q3 * x83);
-        let x90 = libm::fma(-s_q3, x83, c_q3 * x85);
-        let x91 = libm::fma(-5224.5702, x25, x89);
-        let x92 = libm::fma(5224.5702, x28, x90);
-        let x93 = libm::fma(
-            -x15,
-            x30,
-            libm::fma(3946.18812068, x22, -39234.47412200001 * x20),
-        ) + libm::fma(-0.475, x90, libm::fma(s_q3, x88, c_q3 * x86));
-        let x94 = x31 + libm::fma(-7.11, x90, x87);
-        let x95 = libm::fma(-5224.5702, x17, libm::fma(-x23, x29, x14 * x30))
-            + (libm::fma(-s_q3, x86, c_q3 * x88) + libm::fma(7.11, x84, x89 * 0.475));
-        let x96 = libm::fma(s_q2, x92, c_q2 * x91);
-        let x97 = libm::fma(
-            x5,
-            -1145.5438279999998,
-            libm::fma(-x1, x11, 65697.3302265768 * qdd[1]),
-        ) + libm::fma(0.5692, x96, libm::fma(-s_q2, x93, c_q2 * x95));
+            171.195516,
+            libm::fma(7.11, x46, x38),
+            -libm::fma(x53, x63, x58 * x62),
+        ) + libm::fma(-s_q5, x77, c_q5 * x78);
+        let x81 = libm::fma(
+            -x52,
+            x63,
+            libm::fma(97.44448770720001, x57, -177.0883695416 * x56),
+        ) - x79;
+        let x82 = x64 + libm::fma(s_q5, x78, c_q5 * x77);
+        let x83 = libm::fma(c_q4, x60, s_q4 * x59);
+        let x84 = libm::fma(-3239.4582, x44, libm::fma(-c_q4, x59, s_q4 * x60));
+        let x85 = libm::fma(3239.4582, x45, -x83);
+        let x86 = libm::fma(3239.4582, x46, x61);
+        let x87 = libm::fma(1375.0472756800002, x42, libm::fma(-x35, x49, x43 * x48))
+            + libm::fma(-s_q4, x81, c_q4 * x80);
+        let x88 = x50 + libm::fma(x61, -7.11, libm::fma(c_q4, x81, s_q4 * x80));
+        let x89 = libm::fma(
+            3239.4582,
+            x39,
+            libm::fma(24998.827802, x42, 1375.0472756800002 * x40)
+                + libm::fma(-x34, x48, x35 * x47),
+        ) + libm::fma(-7.11, x83, x82);
+        let x90 = libm::fma(-s_q3, x85, c_q3 * x84);
+        let x91 = libm::fma(c_q3, x85, s_q3 * x84);
+        let x92 = libm::fma(-5224.5702, x25, x90);
+        let x93 = libm::fma(5224.5702, x27, x91);
+        let x94 = libm::fma(3946.18812068, x22, libm::fma(-x15, x31, x23 * x30))
+            + libm::fma(x91, 0.475, libm::fma(-s_q3, x88, c_q3 * x87));
+        let x95 = x32
+            + (libm::fma(c_q3, x88, s_q3 * x87) + libm::fma(-7.11, x86, -0.475 * x90));
+        let x96 = libm::fma(
+            -5224.5702,
+            x19,
+            libm::fma(-3946.1881206800003, x20, 39241.404122 * x22)
+                + libm::fma(-x14, x30, x15 * x29),
+        ) + libm::fma(7.11, x91, x89);
+        let x97 = libm::fma(-c_q2, x92, s_q2 * x93);
         let x98 = libm::fma(
-            c_q1,
-            libm::fma(1145.5438279999998, x10, libm::fma(5224.5702, x27, x84)),
-            s_q1 * libm::fma(1145.5438279999998, x9, x96),
-        );
+            x5,
+            1145.5438279999998,
+            libm::fma(-x1, x11, 1650.6386721183999 * qdd[1]),
+        ) + libm::fma(-0.5692, x97, -libm::fma(c_q2, x95, s_q2 * x94));
         let x99 = libm::fma(
-            -s_q1,
-            x94 - libm::fma(x1, x12, -65693.9112265768 * x8),
-            c_q1
-                * (libm::fma(1145.5438279999998, x4, libm::fma(-x2, x12, qd[1] * x11))
-                    + libm::fma(
-                        -0.5692,
-                        libm::fma(-s_q2, x91, c_q2 * x92),
-                        libm::fma(s_q2, x95, c_q2 * x93),
-                    )),
+            -c_q1,
+            libm::fma(1145.5438279999998, x10, libm::fma(5224.5702, x28, x86)),
+            s_q1 * libm::fma(-1145.5438279999998, x9, x97),
         );
-        let x100 = libm::fma(66279.65991417361, qdd[0], libm::fma(-0.7026, x98, x99));
-        [x100, x97, x94, x87, x80, x78, x72]
+        let x100 = libm::fma(
+            -c_q1,
+            libm::fma(1145.5438279999998, x4, libm::fma(-qd[1], x11, x2 * x12))
+                + libm::fma(
+                    -0.5692,
+                    libm::fma(c_q2, x93, s_q2 * x92),
+                    libm::fma(-c_q2, x94, s_q2 * x95),
+                ),
+            s_q1 * (libm::fma(x1, x12, -1647.2196721184 * x8) - x96),
+        );
+        let x101 = libm::fma(2232.9683597151998, qdd[0], libm::fma(0.7026, x99, x100));
+        [x101, x98, x96, x89, x82, x79, x73]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 503 mul, 359 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 302 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 457 mul, 343 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 270 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -986,460 +1323,440 @@ impl SsrmsFma {
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x6 = 9.336 * c_q5;
-        let x7 = 44.41 * s_q5;
-        let x8 = 9.336 * s_q5;
-        let x9 = 44.41 * c_q5;
-        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
-        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
-        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
-        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
-        let x14 = -171.195516 * s_q4;
-        let x15 = -171.195516 * c_q4;
-        let x16 = c_q4 * x12;
-        let x17 = -97.44448770720001 * s_q4;
-        let x18 = libm::fma(c_q4, x10, x17);
-        let x19 = 47.471 * s_q4;
-        let x20 = s_q4 * x12;
-        let x21 = -97.44448770720001 * c_q4;
-        let x22 = libm::fma(-s_q4, x10, x21);
-        let x23 = 47.471 * c_q4;
-        let x24 = libm::fma(-s_q4, x11, x21);
-        let x25 = x14 * -7.11;
-        let x26 = 7.11 * x14;
-        let x27 = x13 - x25;
-        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
-        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
-        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
-        let x31 = 3239.4582 + x14;
-        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
-        let x33 = 1375.0472756800002 + x18;
-        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
-        let x35 = 24998.827802 + (x26 + x27);
-        let x36 = s_q3 * x15;
-        let x37 = libm::fma(c_q3, x31, x36);
-        let x38 = c_q3 * x15;
-        let x39 = libm::fma(-s_q3, x31, x38);
-        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
-        let x41 = s_q3 * x22;
-        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
-        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
-        let x44 = c_q3 * x22;
-        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
-        let x46 = -7.11 * x37;
-        let x47 = 7.11 * x37;
-        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
-        let x49 = x35 - x46;
-        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
-        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
-        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
-        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
-        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
-        let x55 = 5224.5702 + x37;
-        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
-        let x57 = 3946.18812068 + x48;
-        let x58 = 3946.1881206800003
-            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
-        let x59 = 39241.404122 + (x47 + x49);
-        let x60 = s_q2 * x39;
-        let x61 = libm::fma(c_q2, x55, x60);
-        let x62 = c_q2 * x39;
-        let x63 = libm::fma(-s_q2, x55, x62);
-        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
-        let x65 = s_q2 * x51;
-        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
-        let x67 = c_q2 * x51;
-        let x68 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
-            c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
-        );
-        let x69 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
-        let x70 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
-            c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
-        );
-        let x71 = libm::fma(
+        let x6 = s_q5 * s_q5 * -35.074;
+        let x7 = s_q5 * c_q5 * -35.074;
+        let x8 = 132.6783695416 + (9.336 - x6);
+        let x9 = 135.4729695416 + (44.41 + x6);
+        let x10 = 47.471 - x8;
+        let x11 = s_q4 * s_q4 * x10;
+        let x12 = libm::fma(-s_q4, x7, -97.44448770720001 * c_q4);
+        let x13 = libm::fma(c_q4, x7, -97.44448770720001 * s_q4);
+        let x14 = -171.195516 * c_q4;
+        let x15 = -171.195516 * s_q4;
+        let x16 = x15 * -7.11;
+        let x17 = 7.11 * x15;
+        let x18 = x9 - x16;
+        let x19 = libm::fma(-7.11, x14, s_q4 * c_q4 * x10);
+        let x20 = 47.471 - x11 + x17 - x16;
+        let x21 = 3239.4582 + x15;
+        let x22 = -24989.305802 + (x8 + x11);
+        let x23 = 1375.0472756800002 + x13;
+        let x24 = 24998.827802 + (x17 + x18);
+        let x25 = s_q3 * s_q3;
+        let x26 = s_q3 * c_q3;
+        let x27 = x20 - x22;
+        let x28 = x19 + x19;
+        let x29 = libm::fma(x26, x28, x25 * x27);
+        let x30 = c_q3 * x12;
+        let x31 = s_q3 * x12;
+        let x32 = c_q3 * x14;
+        let x33 = libm::fma(-s_q3, x21, x32);
+        let x34 = s_q3 * x14;
+        let x35 = libm::fma(c_q3, x21, x34);
+        let x36 = -7.11 * x35;
+        let x37 = 7.11 * x35;
+        let x38 = libm::fma(0.475, x35, libm::fma(c_q3, x23, x31));
+        let x39 = x24 - x36;
+        let x40 = libm::fma(-7.11, x33, x19 + libm::fma(-x25, x28, x26 * x27));
+        let x41 = libm::fma(x33, 0.475, libm::fma(-s_q3, x23, x30));
+        let x42 = x20 - x29 + x37 - x36;
+        let x43 = 5224.5702 + x35;
+        let x44 = -39234.47412200001 + (x22 + x29);
+        let x45 = 3946.18812068 + x38;
+        let x46 = 39241.404122 + (x37 + x39);
+        let x47 = s_q2 * s_q2;
+        let x48 = s_q2 * c_q2;
+        let x49 = x42 - x44;
+        let x50 = x40 + x40;
+        let x51 = libm::fma(x48, x50, x47 * x49);
+        let x52 = x44 + x51;
+        let x53 = c_q2 * x41;
+        let x54 = libm::fma(-s_q2, x45, x53);
+        let x55 = s_q2 * x41;
+        let x56 = c_q2 * x33;
+        let x57 = libm::fma(-s_q2, x43, x56);
+        let x58 = s_q2 * x33;
+        let x59 = libm::fma(c_q2, x43, x58);
+        let x60 = libm::fma(0.5692, x59, libm::fma(c_q2, x45, x55));
+        let x61 = libm::fma(
             0.7026,
-            x63,
-            libm::fma(-s_q1, libm::fma(-s_q1, -65693.9112265768 + x59, x69), c_q1 * x68),
+            x57,
+            libm::fma(
+                0.7026,
+                x57,
+                x52
+                    - libm::fma(
+                        s_q1 * c_q1,
+                        x60 + x60,
+                        s_q1 * s_q1 * (x52 - (-65693.9112265768 + x46)),
+                    ),
+            ),
         );
-        let x72 = libm::fma(
+        let x62 = libm::fma(
             -0.7026,
-            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
-            x70,
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x59),
+            libm::fma(
+                -s_q1,
+                libm::fma(0.5692, x57, x54),
+                c_q1 * (x40 + libm::fma(-x47, x50, x48 * x49)),
+            ),
         );
-        let x73 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x69));
-        let x74 = libm::fma(-s_q2, x37, x62);
-        let x75 = libm::fma(
+        let x63 = libm::fma(-0.7026, s_q1 * x57, libm::fma(-s_q1, x46, c_q1 * x60));
+        let x64 = libm::fma(-s_q2, x35, x56);
+        let x65 = libm::fma(
             -s_q1,
-            x49,
+            x39,
             c_q1
-                * libm::fma(0.5692, libm::fma(c_q2, x37, x60), libm::fma(c_q2, x48, x65)),
+                * libm::fma(0.5692, libm::fma(c_q2, x35, x58), libm::fma(c_q2, x38, x55)),
         );
-        let x76 = libm::fma(-0.7026, s_q1 * x74, x75);
-        let x77 = libm::fma(-s_q3, x14, x38);
-        let x78 = libm::fma(c_q3, x14, x36);
-        let x79 = libm::fma(0.475, x78, libm::fma(c_q3, x18, x41));
-        let x80 = libm::fma(7.11, x78, x27);
-        let x81 = libm::fma(0.475, x77, libm::fma(-s_q3, x18, x44));
-        let x82 = libm::fma(-s_q2, x78, c_q2 * x77);
-        let x83 = libm::fma(
+        let x66 = libm::fma(-0.7026, s_q1 * x64, x65);
+        let x67 = libm::fma(-s_q3, x15, x32);
+        let x68 = libm::fma(c_q3, x15, x34);
+        let x69 = libm::fma(0.475, x68, libm::fma(c_q3, x13, x31));
+        let x70 = libm::fma(7.11, x68, x18);
+        let x71 = libm::fma(0.475, x67, libm::fma(-s_q3, x13, x30));
+        let x72 = libm::fma(-s_q2, x68, c_q2 * x67);
+        let x73 = libm::fma(
             -s_q1,
-            x80,
+            x70,
             c_q1
                 * libm::fma(
                     0.5692,
-                    libm::fma(c_q2, x78, s_q2 * x77),
-                    libm::fma(s_q2, x81, c_q2 * x79),
+                    libm::fma(c_q2, x68, s_q2 * x67),
+                    libm::fma(s_q2, x71, c_q2 * x69),
                 ),
         );
-        let x84 = libm::fma(-0.7026, s_q1 * x82, x83);
-        let x85 = libm::fma(s_q3, x23, c_q3 * x19);
-        let x86 = libm::fma(-s_q3, x19, c_q3 * x23);
-        let x87 = c_q1 * libm::fma(s_q2, x86, c_q2 * x85);
-        let x88 = c_q4 * x6;
-        let x89 = s_q4 * x6;
-        let x90 = libm::fma(-s_q3, x89, c_q3 * x88);
-        let x91 = libm::fma(c_q3, x89, s_q3 * x88);
-        let x92 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x91, c_q2 * x90));
-        let x93 = qd[0] * c_q1;
-        let x94 = qd[0] * s_q1;
-        let x95 = 0.7026 * (qd[0] * qd[0]);
-        let x96 = qd[1] * x94;
-        let x97 = qd[1] * x93;
-        let x98 = x93 * x94;
-        let x99 = libm::fma(x93, x93, qd[1] * qd[1]);
-        let x100 = -65693.9112265768 * x94;
-        let x101 = 65697.3302265768 * qd[1];
-        let x102 = libm::fma(-qd[1], s_q2, c_q2 * x93);
-        let x103 = libm::fma(qd[1], c_q2, s_q2 * x93);
-        let x104 = -0.5692 * x98;
-        let x105 = -0.5692 * x99;
-        let x106 = libm::fma(-0.5692, x96 + x96, x95);
-        let x107 = libm::fma(c_q2, x106, s_q2 * x104);
-        let x108 = libm::fma(qd[2], x103, c_q2 * x96);
-        let x109 = libm::fma(-s_q2, x96, qd[2] * x102);
-        let x110 = qd[2] - x94;
-        let x111 = x103 * x103;
-        let x112 = libm::fma(x110, x110, x111);
-        let x113 = x102 * x110;
-        let x114 = x109 + x113;
-        let x115 = libm::fma(x102, x103, x97);
-        let x116 = libm::fma(3946.18812068, x110, -39234.47412200001 * x102);
-        let x117 = libm::fma(39241.404122, x110, 3946.1881206800003 * x102);
-        let x118 = libm::fma(
-            x107,
+        let x74 = libm::fma(-0.7026, s_q1 * x72, x73);
+        let x75 = 47.471 * s_q4;
+        let x76 = 47.471 * c_q4;
+        let x77 = libm::fma(s_q3, x76, c_q3 * x75);
+        let x78 = libm::fma(-s_q3, x75, c_q3 * x76);
+        let x79 = c_q1 * libm::fma(s_q2, x78, c_q2 * x77);
+        let x80 = 9.336 * c_q5;
+        let x81 = 9.336 * s_q5;
+        let x82 = c_q4 * x80;
+        let x83 = s_q4 * x80;
+        let x84 = libm::fma(-s_q3, x83, c_q3 * x82);
+        let x85 = libm::fma(c_q3, x83, s_q3 * x82);
+        let x86 = libm::fma(-s_q1, x81, c_q1 * libm::fma(-s_q2, x85, c_q2 * x84));
+        let x87 = qd[0] * c_q1;
+        let x88 = qd[0] * s_q1;
+        let x89 = 0.7026 * (qd[0] * qd[0]);
+        let x90 = qd[1] * x88;
+        let x91 = qd[1] * x87;
+        let x92 = x87 * x88;
+        let x93 = libm::fma(x87, x87, qd[1] * qd[1]);
+        let x94 = -65693.9112265768 * x88;
+        let x95 = 65697.3302265768 * qd[1];
+        let x96 = libm::fma(-qd[1], s_q2, c_q2 * x87);
+        let x97 = libm::fma(qd[1], c_q2, s_q2 * x87);
+        let x98 = -0.5692 * x92;
+        let x99 = -0.5692 * x93;
+        let x100 = libm::fma(-0.5692, x90 + x90, x89);
+        let x101 = libm::fma(c_q2, x100, s_q2 * x98);
+        let x102 = libm::fma(qd[2], x97, c_q2 * x90);
+        let x103 = libm::fma(-s_q2, x90, qd[2] * x96);
+        let x104 = qd[2] - x88;
+        let x105 = x97 * x97;
+        let x106 = libm::fma(x104, x104, x105);
+        let x107 = x96 * x104;
+        let x108 = x103 + x107;
+        let x109 = libm::fma(x96, x97, x91);
+        let x110 = libm::fma(3946.18812068, x104, -39234.47412200001 * x96);
+        let x111 = libm::fma(39241.404122, x104, 3946.1881206800003 * x96);
+        let x112 = libm::fma(
+            x101,
             5224.5702,
             libm::fma(
-                x103,
-                x116,
-                -libm::fma(39241.404122, x97, 3946.1881206800003 * x108),
+                x97,
+                x110,
+                -libm::fma(39241.404122, x91, 3946.1881206800003 * x102),
             ),
         );
-        let x119 = libm::fma(-s_q3, x103, c_q3 * x102);
-        let x120 = libm::fma(c_q3, x103, s_q3 * x102);
-        let x121 = libm::fma(-c_q2, x104, s_q2 * x106)
-            + libm::fma(-7.11, x112, -0.475 * (x113 - x109));
-        let x122 = libm::fma(0.475, libm::fma(x102, x102, x111), 7.11 * x114) - x105;
-        let x123 = libm::fma(-0.475, libm::fma(x103, x110, -x108), 7.11 * x115) - x107;
-        let x124 = libm::fma(c_q3, x123, s_q3 * x121);
-        let x125 = libm::fma(qd[3], x120, libm::fma(s_q3, x109, c_q3 * x108));
-        let x126 = libm::fma(qd[3], x119, libm::fma(-s_q3, x108, c_q3 * x109));
-        let x127 = qd[3] + x110;
-        let x128 = libm::fma(x120, x120, x127 * x127);
-        let x129 = libm::fma(x119, x127, x126);
-        let x130 = libm::fma(x119, x120, x97);
-        let x131 = libm::fma(1375.0472756800002, x127, -24989.305802 * x119);
-        let x132 = libm::fma(24998.827802, x127, 1375.0472756800002 * x119);
-        let x133 = libm::fma(
-            x124,
+        let x113 = libm::fma(-s_q3, x97, c_q3 * x96);
+        let x114 = libm::fma(c_q3, x97, s_q3 * x96);
+        let x115 = libm::fma(-c_q2, x98, s_q2 * x100)
+            + libm::fma(-7.11, x106, -0.475 * (x107 - x103));
+        let x116 = libm::fma(0.475, libm::fma(x96, x96, x105), 7.11 * x108) - x99;
+        let x117 = libm::fma(-0.475, libm::fma(x97, x104, -x102), 7.11 * x109) - x101;
+        let x118 = libm::fma(c_q3, x117, s_q3 * x115);
+        let x119 = libm::fma(qd[3], x114, libm::fma(s_q3, x103, c_q3 * x102));
+        let x120 = libm::fma(qd[3], x113, libm::fma(-s_q3, x102, c_q3 * x103));
+        let x121 = qd[3] + x104;
+        let x122 = libm::fma(x114, x114, x121 * x121);
+        let x123 = libm::fma(x113, x121, x120);
+        let x124 = libm::fma(x113, x114, x91);
+        let x125 = libm::fma(1375.0472756800002, x121, -24989.305802 * x113);
+        let x126 = libm::fma(24998.827802, x121, 1375.0472756800002 * x113);
+        let x127 = libm::fma(
+            x118,
             -3239.4582,
             libm::fma(
-                x120,
-                x131,
-                -libm::fma(24998.827802, x97, 1375.0472756800002 * x125),
+                x114,
+                x125,
+                -libm::fma(24998.827802, x91, 1375.0472756800002 * x119),
             ),
         );
-        let x134 = libm::fma(-s_q4, x120, c_q4 * x119);
-        let x135 = libm::fma(c_q4, x120, s_q4 * x119);
-        let x136 = libm::fma(
+        let x128 = libm::fma(-s_q4, x114, c_q4 * x113);
+        let x129 = libm::fma(c_q4, x114, s_q4 * x113);
+        let x130 = libm::fma(
             -s_q4,
-            libm::fma(7.11, x130, x124),
-            c_q4 * libm::fma(-7.11, x128, libm::fma(-s_q3, x123, c_q3 * x121)),
+            libm::fma(7.11, x124, x118),
+            c_q4 * libm::fma(-7.11, x122, libm::fma(-s_q3, x117, c_q3 * x115)),
         );
-        let x137 = libm::fma(qd[4], x135, libm::fma(s_q4, x126, c_q4 * x125));
-        let x138 = libm::fma(qd[4], x134, libm::fma(-s_q4, x125, c_q4 * x126));
-        let x139 = qd[4] + x127;
-        let x140 = -171.195516 * libm::fma(x134, x135, -x97);
-        let x141 = -171.195516 * libm::fma(x135, x139, x137);
-        let x142 = -171.195516 * libm::fma(x134, x134, x139 * x139);
-        let x143 = 132.6783695416 * x134;
-        let x144 = libm::fma(-97.44448770720001, x135, 135.4729695416 * x139);
-        let x145 = -97.44448770720001 * x139;
-        let x146 = libm::fma(
+        let x131 = libm::fma(qd[4], x129, libm::fma(s_q4, x120, c_q4 * x119));
+        let x132 = libm::fma(qd[4], x128, libm::fma(-s_q4, x119, c_q4 * x120));
+        let x133 = qd[4] + x121;
+        let x134 = -171.195516 * libm::fma(x128, x129, -x91);
+        let x135 = -171.195516 * libm::fma(x129, x133, x131);
+        let x136 = -171.195516 * libm::fma(x128, x128, x133 * x133);
+        let x137 = 132.6783695416 * x128;
+        let x138 = libm::fma(-97.44448770720001, x129, 135.4729695416 * x133);
+        let x139 = -97.44448770720001 * x133;
+        let x140 = libm::fma(
             171.195516,
-            libm::fma(7.11, x129, x122),
-            libm::fma(-132.6783695416, x137, libm::fma(-x135, x144, x139 * x145)),
+            libm::fma(7.11, x123, x116),
+            libm::fma(-132.6783695416, x131, libm::fma(-x129, x138, x133 * x139)),
         );
-        let x147 = libm::fma(s_q5, x139, c_q5 * x134);
-        let x148 = libm::fma(-s_q5, x134, c_q5 * x139);
-        let x149 = qd[5] + x135;
-        let x150 = 44.41 * x148;
-        let x151 = 47.471 * x149;
-        let x152 = libm::fma(
-            -x147,
-            x151,
-            44.41 * libm::fma(-qd[5], x147, libm::fma(-c_q5, x97, s_q5 * x137)),
+        let x141 = libm::fma(s_q5, x133, c_q5 * x128);
+        let x142 = libm::fma(-s_q5, x128, c_q5 * x133);
+        let x143 = qd[5] + x129;
+        let x144 = 44.41 * x142;
+        let x145 = 47.471 * x143;
+        let x146 = libm::fma(
+            -x141,
+            x145,
+            44.41 * libm::fma(-qd[5], x141, libm::fma(-c_q5, x91, s_q5 * x131)),
         );
-        let x153 = 9.336 * libm::fma(qd[5], x148, -libm::fma(s_q5, x97, c_q5 * x137));
-        let x154 = 9.336 * (qd[6] + x147);
-        let x155 = libm::fma(-s_q6, x148, c_q6 * x149) * x154;
-        let x156 = libm::fma(s_q6, x149, c_q6 * x148) * x154;
-        let x157 = libm::fma(-x149, x150, x148 * x151) + x153;
-        let x158 = x152 + libm::fma(s_q6, x156, c_q6 * x155);
-        let x159 = libm::fma(x147, x150, 47.471 * x138)
-            + libm::fma(-c_q6, x156, s_q6 * x155);
-        let x160 = x146 + libm::fma(-s_q5, x158, c_q5 * x157);
-        let x161 = libm::fma(
+        let x147 = 9.336 * libm::fma(qd[5], x142, -libm::fma(s_q5, x91, c_q5 * x131));
+        let x148 = 9.336 * (qd[6] + x141);
+        let x149 = libm::fma(-s_q6, x142, c_q6 * x143) * x148;
+        let x150 = libm::fma(s_q6, x143, c_q6 * x142) * x148;
+        let x151 = libm::fma(-x143, x144, x142 * x145) + x147;
+        let x152 = x146 + libm::fma(s_q6, x150, c_q6 * x149);
+        let x153 = libm::fma(x141, x144, 47.471 * x132)
+            + libm::fma(-c_q6, x150, s_q6 * x149);
+        let x154 = x140 + libm::fma(-s_q5, x152, c_q5 * x151);
+        let x155 = libm::fma(
             -171.195516,
-            x136,
-            libm::fma(-135.4729695416, x97, -97.44448770720001 * x138)
-                + libm::fma(-x134, x145, x135 * x143),
-        ) + libm::fma(c_q5, x158, s_q5 * x157);
-        let x162 = libm::fma(97.44448770720001, x97, libm::fma(-x139, x143, x134 * x144))
-            + x159;
-        let x163 = libm::fma(c_q4, x142, s_q4 * x140);
-        let x164 = libm::fma(-3239.4582, x128, libm::fma(-s_q4, x142, c_q4 * x140));
-        let x165 = libm::fma(3239.4582, x129, x141);
-        let x166 = libm::fma(3239.4582, x130, -x163);
-        let x167 = libm::fma(s_q4, x162, c_q4 * x160)
+            x130,
+            libm::fma(-135.4729695416, x91, -97.44448770720001 * x132)
+                + libm::fma(-x128, x139, x129 * x137),
+        ) + libm::fma(c_q5, x152, s_q5 * x151);
+        let x156 = libm::fma(97.44448770720001, x91, libm::fma(-x133, x137, x128 * x138))
+            + x153;
+        let x157 = libm::fma(c_q4, x136, s_q4 * x134);
+        let x158 = libm::fma(-3239.4582, x122, libm::fma(-s_q4, x136, c_q4 * x134));
+        let x159 = libm::fma(3239.4582, x123, x135);
+        let x160 = libm::fma(3239.4582, x124, -x157);
+        let x161 = libm::fma(s_q4, x156, c_q4 * x154)
             - libm::fma(
-                x120,
-                x132,
-                libm::fma(1375.0472756800002, x97, -24989.305802 * x125),
+                x114,
+                x126,
+                libm::fma(1375.0472756800002, x91, -24989.305802 * x119),
             );
-        let x168 = x133 + libm::fma(7.11, x163, x161);
-        let x169 = libm::fma(3239.4582, x122, libm::fma(-x127, x131, x119 * x132))
-            + libm::fma(7.11, x141, libm::fma(-s_q4, x160, c_q4 * x162));
-        let x170 = libm::fma(s_q3, x166, c_q3 * x164);
-        let x171 = libm::fma(-s_q3, x164, c_q3 * x166);
-        let x172 = libm::fma(-5224.5702, x112, x170);
-        let x173 = libm::fma(5224.5702, x115, x171);
-        let x174 = libm::fma(-0.475, x171, libm::fma(s_q3, x169, c_q3 * x167))
+        let x162 = x127 + libm::fma(7.11, x157, x155);
+        let x163 = libm::fma(3239.4582, x116, libm::fma(-x121, x125, x113 * x126))
+            + libm::fma(7.11, x135, libm::fma(-s_q4, x154, c_q4 * x156));
+        let x164 = libm::fma(s_q3, x160, c_q3 * x158);
+        let x165 = libm::fma(-s_q3, x158, c_q3 * x160);
+        let x166 = libm::fma(-5224.5702, x106, x164);
+        let x167 = libm::fma(5224.5702, x109, x165);
+        let x168 = libm::fma(-0.475, x165, libm::fma(s_q3, x163, c_q3 * x161))
             - libm::fma(
-                x103,
-                x117,
-                libm::fma(3946.18812068, x97, -39234.47412200001 * x108),
+                x97,
+                x111,
+                libm::fma(3946.18812068, x91, -39234.47412200001 * x102),
             );
-        let x175 = x118 + libm::fma(-7.11, x171, x168);
-        let x176 = libm::fma(-5224.5702, x105, libm::fma(-x110, x116, x102 * x117))
-            + (libm::fma(-s_q3, x167, c_q3 * x169)
-                + libm::fma(7.11, x165, 0.475 * x170));
-        let x177 = libm::fma(s_q2, x173, c_q2 * x172);
-        let x178 = libm::fma(
-            -x93,
-            x100,
-            libm::fma(0.5692, x177, libm::fma(-s_q2, x174, c_q2 * x176)),
+        let x169 = x112 + libm::fma(-7.11, x165, x162);
+        let x170 = libm::fma(-5224.5702, x99, libm::fma(-x104, x110, x96 * x111))
+            + (libm::fma(-s_q3, x161, c_q3 * x163)
+                + libm::fma(7.11, x159, 0.475 * x164));
+        let x171 = libm::fma(s_q2, x167, c_q2 * x166);
+        let x172 = libm::fma(
+            -x87,
+            x94,
+            libm::fma(0.5692, x171, libm::fma(-s_q2, x168, c_q2 * x170)),
         );
-        let x179 = libm::fma(
+        let x173 = libm::fma(
             c_q1,
-            libm::fma(1145.5438279999998, x99, libm::fma(5224.5702, x114, x165)),
-            s_q1 * libm::fma(1145.5438279999998, x98, x177),
+            libm::fma(1145.5438279999998, x93, libm::fma(5224.5702, x108, x159)),
+            s_q1 * libm::fma(1145.5438279999998, x92, x171),
         );
-        let x180 = libm::fma(
+        let x174 = libm::fma(
             -s_q1,
-            x175 - libm::fma(x93, x101, -65693.9112265768 * x97),
+            x169 - libm::fma(x87, x95, -65693.9112265768 * x91),
             c_q1
-                * (libm::fma(
-                    1145.5438279999998,
-                    x95,
-                    libm::fma(-x94, x101, qd[1] * x100),
-                )
+                * (libm::fma(1145.5438279999998, x89, libm::fma(-x88, x95, qd[1] * x94))
                     + libm::fma(
                         -0.5692,
-                        libm::fma(-s_q2, x172, c_q2 * x173),
-                        libm::fma(s_q2, x176, c_q2 * x174),
+                        libm::fma(-s_q2, x166, c_q2 * x167),
+                        libm::fma(s_q2, x170, c_q2 * x168),
                     )),
         );
-        let x181 = tau[0] - libm::fma(-0.7026, x179, x180);
-        let x182 = 1.0 / (66279.65991417361 + libm::fma(0.7026, x63, x71));
-        let x183 = x72 * x182;
-        let x184 = x73 * x182;
-        let x185 = x76 * x182;
-        let x186 = x84 * x182;
-        let x187 = x87 * x182;
-        let x188 = x92 * x182;
-        let x189 = libm::fma(
-            -x72,
-            x183,
-            65697.3302265768
-                + libm::fma(
-                    -s_q2,
-                    libm::fma(-s_q2, x56, c_q2 * x50),
-                    c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
-                ),
+        let x175 = tau[0] - libm::fma(-0.7026, x173, x174);
+        let x176 = 1.0 / (66279.65991417361 + x61);
+        let x177 = x62 * x176;
+        let x178 = x63 * x176;
+        let x179 = x66 * x176;
+        let x180 = x74 * x176;
+        let x181 = x79 * x176;
+        let x182 = x86 * x176;
+        let x183 = 1.0 / libm::fma(-x62, x177, 65697.3302265768 + (x42 - x51));
+        let x184 = libm::fma(-x62, x178, libm::fma(0.5692, x57, x54));
+        let x185 = x183 * x184;
+        let x186 = libm::fma(
+            -x62,
+            x179,
+            libm::fma(0.5692, x64, libm::fma(-s_q2, x38, x53)),
         );
-        let x190 = 1.0 / x189;
-        let x191 = libm::fma(
-            -x72,
-            x184,
-            libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
+        let x187 = x183 * x186;
+        let x188 = libm::fma(
+            -x62,
+            x180,
+            libm::fma(0.5692, x72, libm::fma(-s_q2, x69, c_q2 * x71)),
         );
-        let x192 = x190 * x191;
-        let x193 = libm::fma(
-            -x72,
-            x185,
-            libm::fma(0.5692, x74, libm::fma(-s_q2, x48, x67)),
+        let x189 = x183 * x188;
+        let x190 = libm::fma(-x62, x181, libm::fma(-s_q2, x77, c_q2 * x78));
+        let x191 = x183 * x190;
+        let x192 = libm::fma(x62, x182, libm::fma(c_q2, x85, s_q2 * x84));
+        let x193 = x183 * x192;
+        let x194 = 1.0 / libm::fma(-x184, x185, libm::fma(-x63, x178, x46));
+        let x195 = libm::fma(-x184, x187, libm::fma(-x63, x179, x39));
+        let x196 = x194 * x195;
+        let x197 = libm::fma(-x184, x189, libm::fma(-x63, x180, x70));
+        let x198 = x194 * x197;
+        let x199 = libm::fma(x184, x191, x63 * x181);
+        let x200 = x194 * x199;
+        let x201 = libm::fma(x184, x193, libm::fma(-x63, x182, x81));
+        let x202 = x194 * x201;
+        let x203 = libm::fma(
+            -x195,
+            x196,
+            libm::fma(-x186, x187, libm::fma(-x66, x179, x24)),
         );
-        let x194 = x190 * x193;
-        let x195 = libm::fma(
-            -x72,
-            x186,
-            libm::fma(0.5692, x82, libm::fma(-s_q2, x79, c_q2 * x81)),
+        let x204 = 1.0 / x203;
+        let x205 = libm::fma(
+            -x195,
+            x198,
+            libm::fma(-x186, x189, libm::fma(-x66, x180, x18)),
         );
-        let x196 = x190 * x195;
-        let x197 = libm::fma(-x72, x187, libm::fma(-s_q2, x85, c_q2 * x86));
-        let x198 = x190 * x197;
-        let x199 = libm::fma(x72, x188, libm::fma(c_q2, x91, s_q2 * x90));
-        let x200 = x190 * x199;
-        let x201 = 1.0 / libm::fma(-x191, x192, libm::fma(-x73, x184, x59));
-        let x202 = libm::fma(-x191, x194, libm::fma(-x73, x185, x49));
-        let x203 = x201 * x202;
-        let x204 = libm::fma(-x191, x196, libm::fma(-x73, x186, x80));
-        let x205 = x201 * x204;
-        let x206 = libm::fma(x191, x198, x73 * x187);
-        let x207 = x201 * x206;
-        let x208 = libm::fma(x191, x200, libm::fma(-x73, x188, x8));
-        let x209 = x201 * x208;
-        let x210 = libm::fma(
-            -x202,
-            x203,
-            libm::fma(-x193, x194, libm::fma(-x76, x185, x35)),
+        let x206 = x204 * x205;
+        let x207 = libm::fma(x195, x200, -libm::fma(x186, x191, x66 * x181));
+        let x208 = x204 * x207;
+        let x209 = libm::fma(
+            -x195,
+            x202,
+            libm::fma(x186, x193, libm::fma(-x66, x182, x81)),
         );
-        let x211 = 1.0 / x210;
-        let x212 = libm::fma(
-            -x202,
-            x205,
-            libm::fma(-x193, x196, libm::fma(-x76, x186, x27)),
+        let x210 = x204 * x209;
+        let x211 = libm::fma(
+            -x197,
+            x198,
+            libm::fma(-x188, x189, libm::fma(-x74, x180, x9)),
         );
-        let x213 = x211 * x212;
-        let x214 = libm::fma(x202, x207, -libm::fma(x193, x198, x76 * x187));
-        let x215 = x211 * x214;
-        let x216 = libm::fma(
-            -x202,
-            x209,
-            libm::fma(x193, x200, libm::fma(-x76, x188, x8)),
-        );
-        let x217 = x211 * x216;
-        let x218 = libm::fma(
-            -x204,
-            x205,
-            libm::fma(-x195, x196, libm::fma(-x84, x186, x13)),
-        );
-        let x219 = 1.0 / libm::fma(-x212, x213, x218);
-        let x220 = libm::fma(
-            -x212,
-            x215,
-            libm::fma(x204, x207, -libm::fma(x195, x198, x84 * x187)),
-        );
-        let x221 = x219 * x220;
-        let x222 = libm::fma(
-            -x204,
-            x209,
-            libm::fma(x195, x200, libm::fma(-x84, x188, x8)),
-        );
-        let x223 = libm::fma(-x212, x217, x222);
-        let x224 = x219 * x223;
-        let x225 = libm::fma(
-            -x206,
-            x207,
-            libm::fma(-x197, x198, libm::fma(-x87, x187, 47.471)),
-        );
-        let x226 = 1.0 / libm::fma(-x220, x221, libm::fma(-x214, x215, x225));
-        let x227 = libm::fma(
-            -x214,
-            x217,
-            libm::fma(x206, x209, libm::fma(-x87, x188, x197 * x200)),
-        );
-        let x228 = libm::fma(-x220, x224, x227);
-        let x229 = x226 * x228;
-        let x230 = libm::fma(
-            -x208,
-            x209,
-            libm::fma(-x199, x200, libm::fma(-x92, x188, 9.336)),
-        );
-        let x231 = libm::fma(
-            -x228,
-            x229,
-            libm::fma(-x223, x224, libm::fma(-x216, x217, x230)),
-        );
-        let x232 = 1.0 / x231;
-        let x233 = libm::fma(-x181, x183, tau[1] - x178);
-        let x234 = libm::fma(-x192, x233, libm::fma(-x181, x184, tau[2] - x175));
-        let x235 = libm::fma(
-            -x203,
-            x234,
-            libm::fma(-x194, x233, libm::fma(-x181, x185, tau[3] - x168)),
-        );
-        let x236 = libm::fma(
+        let x212 = 1.0 / libm::fma(-x205, x206, x211);
+        let x213 = libm::fma(
             -x205,
-            x234,
-            libm::fma(-x196, x233, libm::fma(-x181, x186, tau[4] - x161)),
+            x208,
+            libm::fma(x197, x200, -libm::fma(x188, x191, x74 * x181)),
         );
-        let x237 = libm::fma(-x213, x235, x236);
-        let x238 = libm::fma(
-            x207,
-            x234,
-            libm::fma(-x198, x233, libm::fma(-x181, x187, tau[5] - x159)),
+        let x214 = x212 * x213;
+        let x215 = libm::fma(
+            -x197,
+            x202,
+            libm::fma(x188, x193, libm::fma(-x74, x182, x81)),
         );
-        let x239 = libm::fma(-x221, x237, libm::fma(-x215, x235, x238));
-        let x240 = libm::fma(
-            -x209,
-            x234,
-            libm::fma(x200, x233, libm::fma(-x181, x188, tau[6] - x153)),
+        let x216 = libm::fma(-x205, x210, x215);
+        let x217 = x212 * x216;
+        let x218 = libm::fma(
+            -x199,
+            x200,
+            libm::fma(-x190, x191, libm::fma(-x79, x181, 47.471)),
         );
-        let x241 = libm::fma(
-            -x229,
-            x239,
-            libm::fma(-x224, x237, libm::fma(-x217, x235, x240)),
+        let x219 = 1.0 / libm::fma(-x213, x214, libm::fma(-x207, x208, x218));
+        let x220 = libm::fma(
+            -x207,
+            x210,
+            libm::fma(x199, x202, libm::fma(-x79, x182, x190 * x193)),
         );
-        let x242 = x232 * x241;
-        let x243 = libm::fma(-x229, x242, x226 * x239);
-        let x244 = libm::fma(-x224, x242, libm::fma(-x221, x243, x219 * x237));
-        let x245 = libm::fma(
-            -x217,
-            x242,
-            libm::fma(-x215, x243, libm::fma(-x213, x244, x211 * x235)),
+        let x221 = libm::fma(-x213, x217, x220);
+        let x222 = x219 * x221;
+        let x223 = libm::fma(
+            -x201,
+            x202,
+            libm::fma(-x192, x193, libm::fma(-x86, x182, 9.336)),
         );
-        let x246 = libm::fma(
-            x207,
-            x243,
-            libm::fma(-x205, x244, libm::fma(-x203, x245, x201 * x234)),
+        let x224 = libm::fma(
+            -x221,
+            x222,
+            libm::fma(-x216, x217, libm::fma(-x209, x210, x223)),
         );
-        let x247 = libm::fma(-x209, x242, x246);
-        let x248 = libm::fma(
+        let x225 = 1.0 / x224;
+        let x226 = libm::fma(-x175, x177, tau[1] - x172);
+        let x227 = libm::fma(-x185, x226, libm::fma(-x175, x178, tau[2] - x169));
+        let x228 = libm::fma(
             -x196,
-            x244,
-            libm::fma(-x194, x245, libm::fma(-x192, x247, x190 * x233)),
+            x227,
+            libm::fma(-x187, x226, libm::fma(-x175, x179, tau[3] - x162)),
         );
-        let x249 = libm::fma(x200, x242, libm::fma(-x198, x243, x248));
-        let x250 = libm::fma(
-            -x185,
-            x245,
-            libm::fma(-x184, x247, libm::fma(-x183, x249, x181 * x182)),
+        let x229 = libm::fma(
+            -x198,
+            x227,
+            libm::fma(-x189, x226, libm::fma(-x175, x180, tau[4] - x155)),
         );
-        let x251 = libm::fma(
-            -x188,
-            x242,
-            libm::fma(-x187, x243, libm::fma(-x186, x244, x250)),
+        let x230 = libm::fma(-x206, x228, x229);
+        let x231 = libm::fma(
+            x200,
+            x227,
+            libm::fma(-x191, x226, libm::fma(-x175, x181, tau[5] - x153)),
         );
-        [x251, x249, x247, x245, x244, x243, x242]
+        let x232 = libm::fma(-x214, x230, libm::fma(-x208, x228, x231));
+        let x233 = libm::fma(
+            -x202,
+            x227,
+            libm::fma(x193, x226, libm::fma(-x175, x182, tau[6] - x147)),
+        );
+        let x234 = libm::fma(
+            -x222,
+            x232,
+            libm::fma(-x217, x230, libm::fma(-x210, x228, x233)),
+        );
+        let x235 = x225 * x234;
+        let x236 = libm::fma(-x222, x235, x219 * x232);
+        let x237 = libm::fma(-x217, x235, libm::fma(-x214, x236, x212 * x230));
+        let x238 = libm::fma(
+            -x210,
+            x235,
+            libm::fma(-x208, x236, libm::fma(-x206, x237, x204 * x228)),
+        );
+        let x239 = libm::fma(
+            x200,
+            x236,
+            libm::fma(-x198, x237, libm::fma(-x196, x238, x194 * x227)),
+        );
+        let x240 = libm::fma(-x202, x235, x239);
+        let x241 = libm::fma(
+            -x189,
+            x237,
+            libm::fma(-x187, x238, libm::fma(-x185, x240, x183 * x226)),
+        );
+        let x242 = libm::fma(x193, x235, libm::fma(-x191, x236, x241));
+        let x243 = libm::fma(
+            -x179,
+            x238,
+            libm::fma(-x178, x240, libm::fma(-x177, x242, x175 * x176)),
+        );
+        let x244 = libm::fma(
+            -x182,
+            x235,
+            libm::fma(-x181, x236, libm::fma(-x180, x237, x243)),
+        );
+        [x244, x242, x240, x238, x237, x236, x235]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 377 mul, 258 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 208 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 331 mul, 242 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 176 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 7],
@@ -1451,315 +1768,305 @@ impl SsrmsFma {
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x6 = 9.336 * c_q5;
-        let x7 = 44.41 * s_q5;
-        let x8 = 9.336 * s_q5;
-        let x9 = 44.41 * c_q5;
-        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
-        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
-        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
-        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
-        let x14 = -171.195516 * s_q4;
-        let x15 = -171.195516 * c_q4;
-        let x16 = c_q4 * x12;
-        let x17 = -97.44448770720001 * s_q4;
-        let x18 = libm::fma(c_q4, x10, x17);
-        let x19 = 47.471 * s_q4;
-        let x20 = s_q4 * x12;
-        let x21 = -97.44448770720001 * c_q4;
-        let x22 = libm::fma(-s_q4, x10, x21);
-        let x23 = 47.471 * c_q4;
-        let x24 = libm::fma(-s_q4, x11, x21);
-        let x25 = x14 * -7.11;
-        let x26 = 7.11 * x14;
-        let x27 = x13 - x25;
-        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
-        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
-        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
-        let x31 = 3239.4582 + x14;
-        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
-        let x33 = 1375.0472756800002 + x18;
-        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
-        let x35 = 24998.827802 + (x26 + x27);
-        let x36 = s_q3 * x15;
-        let x37 = libm::fma(c_q3, x31, x36);
-        let x38 = c_q3 * x15;
-        let x39 = libm::fma(-s_q3, x31, x38);
-        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
-        let x41 = s_q3 * x22;
-        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
-        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
-        let x44 = c_q3 * x22;
-        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
-        let x46 = -7.11 * x37;
-        let x47 = 7.11 * x37;
-        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
-        let x49 = x35 - x46;
-        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
-        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
-        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
-        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
-        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
-        let x55 = 5224.5702 + x37;
-        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
-        let x57 = 3946.18812068 + x48;
-        let x58 = 3946.1881206800003
-            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
-        let x59 = 39241.404122 + (x47 + x49);
-        let x60 = s_q2 * x39;
-        let x61 = libm::fma(c_q2, x55, x60);
-        let x62 = c_q2 * x39;
-        let x63 = libm::fma(-s_q2, x55, x62);
-        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
-        let x65 = s_q2 * x51;
-        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
-        let x67 = c_q2 * x51;
-        let x68 = libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67));
-        let x69 = 65697.3302265768
-            + libm::fma(
-                -s_q2,
-                libm::fma(-s_q2, x56, c_q2 * x50),
-                c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
-            );
-        let x70 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
-            c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
-        );
-        let x71 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
-        let x72 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
-            c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
-        );
-        let x73 = libm::fma(
+        let x6 = s_q5 * s_q5 * -35.074;
+        let x7 = s_q5 * c_q5 * -35.074;
+        let x8 = 132.6783695416 + (9.336 - x6);
+        let x9 = 135.4729695416 + (44.41 + x6);
+        let x10 = 47.471 - x8;
+        let x11 = s_q4 * s_q4 * x10;
+        let x12 = libm::fma(-s_q4, x7, -97.44448770720001 * c_q4);
+        let x13 = libm::fma(c_q4, x7, -97.44448770720001 * s_q4);
+        let x14 = -171.195516 * c_q4;
+        let x15 = -171.195516 * s_q4;
+        let x16 = x15 * -7.11;
+        let x17 = 7.11 * x15;
+        let x18 = x9 - x16;
+        let x19 = libm::fma(-7.11, x14, s_q4 * c_q4 * x10);
+        let x20 = 47.471 - x11 + x17 - x16;
+        let x21 = 3239.4582 + x15;
+        let x22 = -24989.305802 + (x8 + x11);
+        let x23 = 1375.0472756800002 + x13;
+        let x24 = 24998.827802 + (x17 + x18);
+        let x25 = s_q3 * s_q3;
+        let x26 = s_q3 * c_q3;
+        let x27 = x20 - x22;
+        let x28 = x19 + x19;
+        let x29 = libm::fma(x26, x28, x25 * x27);
+        let x30 = c_q3 * x12;
+        let x31 = s_q3 * x12;
+        let x32 = c_q3 * x14;
+        let x33 = libm::fma(-s_q3, x21, x32);
+        let x34 = s_q3 * x14;
+        let x35 = libm::fma(c_q3, x21, x34);
+        let x36 = -7.11 * x35;
+        let x37 = 7.11 * x35;
+        let x38 = libm::fma(0.475, x35, libm::fma(c_q3, x23, x31));
+        let x39 = x24 - x36;
+        let x40 = libm::fma(-7.11, x33, x19 + libm::fma(-x25, x28, x26 * x27));
+        let x41 = libm::fma(x33, 0.475, libm::fma(-s_q3, x23, x30));
+        let x42 = x20 - x29 + x37 - x36;
+        let x43 = 5224.5702 + x35;
+        let x44 = -39234.47412200001 + (x22 + x29);
+        let x45 = 3946.18812068 + x38;
+        let x46 = 39241.404122 + (x37 + x39);
+        let x47 = s_q2 * s_q2;
+        let x48 = s_q2 * c_q2;
+        let x49 = x42 - x44;
+        let x50 = x40 + x40;
+        let x51 = libm::fma(x48, x50, x47 * x49);
+        let x52 = x44 + x51;
+        let x53 = c_q2 * x41;
+        let x54 = libm::fma(-s_q2, x45, x53);
+        let x55 = s_q2 * x41;
+        let x56 = c_q2 * x33;
+        let x57 = libm::fma(-s_q2, x43, x56);
+        let x58 = s_q2 * x33;
+        let x59 = libm::fma(c_q2, x43, x58);
+        let x60 = libm::fma(0.5692, x59, libm::fma(c_q2, x45, x55));
+        let x61 = libm::fma(0.5692, x57, x54);
+        let x62 = 65697.3302265768 + (x42 - x51);
+        let x63 = libm::fma(
             0.7026,
-            x63,
-            libm::fma(-s_q1, libm::fma(-s_q1, -65693.9112265768 + x59, x71), c_q1 * x70),
+            x57,
+            libm::fma(
+                0.7026,
+                x57,
+                x52
+                    - libm::fma(
+                        s_q1 * c_q1,
+                        x60 + x60,
+                        s_q1 * s_q1 * (x52 - (-65693.9112265768 + x46)),
+                    ),
+            ),
         );
-        let x74 = 66279.65991417361 + libm::fma(0.7026, x63, x73);
-        let x75 = libm::fma(
+        let x64 = 66279.65991417361 + x63;
+        let x65 = libm::fma(
             -0.7026,
-            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
-            x72,
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x59),
+            libm::fma(
+                -s_q1,
+                libm::fma(0.5692, x57, x54),
+                c_q1 * (x40 + libm::fma(-x47, x50, x48 * x49)),
+            ),
         );
-        let x76 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x71));
-        let x77 = libm::fma(-s_q2, x37, x62);
-        let x78 = libm::fma(0.5692, x77, libm::fma(-s_q2, x48, x67));
-        let x79 = libm::fma(
+        let x66 = libm::fma(-0.7026, s_q1 * x57, libm::fma(-s_q1, x46, c_q1 * x60));
+        let x67 = libm::fma(-s_q2, x35, x56);
+        let x68 = libm::fma(0.5692, x67, libm::fma(-s_q2, x38, x53));
+        let x69 = libm::fma(
             -s_q1,
-            x49,
+            x39,
             c_q1
-                * libm::fma(0.5692, libm::fma(c_q2, x37, x60), libm::fma(c_q2, x48, x65)),
+                * libm::fma(0.5692, libm::fma(c_q2, x35, x58), libm::fma(c_q2, x38, x55)),
         );
-        let x80 = libm::fma(-0.7026, s_q1 * x77, x79);
-        let x81 = libm::fma(-s_q3, x14, x38);
-        let x82 = libm::fma(c_q3, x14, x36);
-        let x83 = libm::fma(0.475, x82, libm::fma(c_q3, x18, x41));
-        let x84 = libm::fma(7.11, x82, x27);
-        let x85 = libm::fma(0.475, x81, libm::fma(-s_q3, x18, x44));
-        let x86 = libm::fma(-s_q2, x82, c_q2 * x81);
-        let x87 = libm::fma(0.5692, x86, libm::fma(-s_q2, x83, c_q2 * x85));
-        let x88 = libm::fma(
+        let x70 = libm::fma(-0.7026, s_q1 * x67, x69);
+        let x71 = libm::fma(-s_q3, x15, x32);
+        let x72 = libm::fma(c_q3, x15, x34);
+        let x73 = libm::fma(0.475, x72, libm::fma(c_q3, x13, x31));
+        let x74 = libm::fma(7.11, x72, x18);
+        let x75 = libm::fma(0.475, x71, libm::fma(-s_q3, x13, x30));
+        let x76 = libm::fma(-s_q2, x72, c_q2 * x71);
+        let x77 = libm::fma(0.5692, x76, libm::fma(-s_q2, x73, c_q2 * x75));
+        let x78 = libm::fma(
             -s_q1,
-            x84,
+            x74,
             c_q1
                 * libm::fma(
                     0.5692,
-                    libm::fma(c_q2, x82, s_q2 * x81),
-                    libm::fma(s_q2, x85, c_q2 * x83),
+                    libm::fma(c_q2, x72, s_q2 * x71),
+                    libm::fma(s_q2, x75, c_q2 * x73),
                 ),
         );
-        let x89 = libm::fma(-0.7026, s_q1 * x86, x88);
-        let x90 = libm::fma(s_q3, x23, c_q3 * x19);
-        let x91 = libm::fma(-s_q3, x19, c_q3 * x23);
-        let x92 = libm::fma(-s_q2, x90, c_q2 * x91);
-        let x93 = c_q1 * libm::fma(s_q2, x91, c_q2 * x90);
-        let x94 = c_q4 * x6;
-        let x95 = s_q4 * x6;
-        let x96 = libm::fma(-s_q3, x95, c_q3 * x94);
-        let x97 = libm::fma(c_q3, x95, s_q3 * x94);
-        let x98 = -libm::fma(c_q2, x97, s_q2 * x96);
-        let x99 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x97, c_q2 * x96));
-        let x100 = qd[0] * c_q1;
-        let x101 = qd[0] * s_q1;
-        let x102 = 0.7026 * (qd[0] * qd[0]);
-        let x103 = qd[1] * x101;
-        let x104 = qd[1] * x100;
-        let x105 = x100 * x101;
-        let x106 = libm::fma(x100, x100, qd[1] * qd[1]);
-        let x107 = -65693.9112265768 * x101;
-        let x108 = 65697.3302265768 * qd[1];
-        let x109 = libm::fma(-qd[1], s_q2, c_q2 * x100);
-        let x110 = libm::fma(qd[1], c_q2, s_q2 * x100);
-        let x111 = -0.5692 * x105;
-        let x112 = -0.5692 * x106;
-        let x113 = libm::fma(-0.5692, x103 + x103, x102);
-        let x114 = libm::fma(c_q2, x113, s_q2 * x111);
-        let x115 = libm::fma(qd[2], x110, c_q2 * x103);
-        let x116 = libm::fma(-s_q2, x103, qd[2] * x109);
-        let x117 = qd[2] - x101;
-        let x118 = x110 * x110;
-        let x119 = libm::fma(x117, x117, x118);
-        let x120 = x109 * x117;
-        let x121 = x116 + x120;
-        let x122 = libm::fma(x109, x110, x104);
-        let x123 = libm::fma(3946.18812068, x117, -39234.47412200001 * x109);
-        let x124 = libm::fma(39241.404122, x117, 3946.1881206800003 * x109);
-        let x125 = libm::fma(
-            x114,
+        let x79 = libm::fma(-0.7026, s_q1 * x76, x78);
+        let x80 = 47.471 * s_q4;
+        let x81 = 47.471 * c_q4;
+        let x82 = libm::fma(s_q3, x81, c_q3 * x80);
+        let x83 = libm::fma(-s_q3, x80, c_q3 * x81);
+        let x84 = libm::fma(-s_q2, x82, c_q2 * x83);
+        let x85 = c_q1 * libm::fma(s_q2, x83, c_q2 * x82);
+        let x86 = 9.336 * c_q5;
+        let x87 = 9.336 * s_q5;
+        let x88 = c_q4 * x86;
+        let x89 = s_q4 * x86;
+        let x90 = libm::fma(-s_q3, x89, c_q3 * x88);
+        let x91 = libm::fma(c_q3, x89, s_q3 * x88);
+        let x92 = -libm::fma(c_q2, x91, s_q2 * x90);
+        let x93 = libm::fma(-s_q1, x87, c_q1 * libm::fma(-s_q2, x91, c_q2 * x90));
+        let x94 = qd[0] * c_q1;
+        let x95 = qd[0] * s_q1;
+        let x96 = 0.7026 * (qd[0] * qd[0]);
+        let x97 = qd[1] * x95;
+        let x98 = qd[1] * x94;
+        let x99 = x94 * x95;
+        let x100 = libm::fma(x94, x94, qd[1] * qd[1]);
+        let x101 = -65693.9112265768 * x95;
+        let x102 = 65697.3302265768 * qd[1];
+        let x103 = libm::fma(-qd[1], s_q2, c_q2 * x94);
+        let x104 = libm::fma(qd[1], c_q2, s_q2 * x94);
+        let x105 = -0.5692 * x99;
+        let x106 = -0.5692 * x100;
+        let x107 = libm::fma(-0.5692, x97 + x97, x96);
+        let x108 = libm::fma(c_q2, x107, s_q2 * x105);
+        let x109 = libm::fma(qd[2], x104, c_q2 * x97);
+        let x110 = libm::fma(-s_q2, x97, qd[2] * x103);
+        let x111 = qd[2] - x95;
+        let x112 = x104 * x104;
+        let x113 = libm::fma(x111, x111, x112);
+        let x114 = x103 * x111;
+        let x115 = x110 + x114;
+        let x116 = libm::fma(x103, x104, x98);
+        let x117 = libm::fma(3946.18812068, x111, -39234.47412200001 * x103);
+        let x118 = libm::fma(39241.404122, x111, 3946.1881206800003 * x103);
+        let x119 = libm::fma(
+            x108,
             5224.5702,
             libm::fma(
-                x110,
-                x123,
-                -libm::fma(39241.404122, x104, 3946.1881206800003 * x115),
+                x104,
+                x117,
+                -libm::fma(39241.404122, x98, 3946.1881206800003 * x109),
             ),
         );
-        let x126 = libm::fma(-s_q3, x110, c_q3 * x109);
-        let x127 = libm::fma(c_q3, x110, s_q3 * x109);
-        let x128 = libm::fma(-c_q2, x111, s_q2 * x113)
-            + libm::fma(-7.11, x119, -0.475 * (x120 - x116));
-        let x129 = libm::fma(0.475, libm::fma(x109, x109, x118), 7.11 * x121) - x112;
-        let x130 = libm::fma(-0.475, libm::fma(x110, x117, -x115), 7.11 * x122) - x114;
-        let x131 = libm::fma(c_q3, x130, s_q3 * x128);
-        let x132 = libm::fma(qd[3], x127, libm::fma(s_q3, x116, c_q3 * x115));
-        let x133 = libm::fma(qd[3], x126, libm::fma(-s_q3, x115, c_q3 * x116));
-        let x134 = qd[3] + x117;
-        let x135 = libm::fma(x127, x127, x134 * x134);
-        let x136 = libm::fma(x126, x134, x133);
-        let x137 = libm::fma(x126, x127, x104);
-        let x138 = libm::fma(1375.0472756800002, x134, -24989.305802 * x126);
-        let x139 = libm::fma(24998.827802, x134, 1375.0472756800002 * x126);
-        let x140 = libm::fma(
-            x131,
+        let x120 = libm::fma(-s_q3, x104, c_q3 * x103);
+        let x121 = libm::fma(c_q3, x104, s_q3 * x103);
+        let x122 = libm::fma(-c_q2, x105, s_q2 * x107)
+            + libm::fma(-7.11, x113, -0.475 * (x114 - x110));
+        let x123 = libm::fma(0.475, libm::fma(x103, x103, x112), 7.11 * x115) - x106;
+        let x124 = libm::fma(-0.475, libm::fma(x104, x111, -x109), 7.11 * x116) - x108;
+        let x125 = libm::fma(c_q3, x124, s_q3 * x122);
+        let x126 = libm::fma(qd[3], x121, libm::fma(s_q3, x110, c_q3 * x109));
+        let x127 = libm::fma(qd[3], x120, libm::fma(-s_q3, x109, c_q3 * x110));
+        let x128 = qd[3] + x111;
+        let x129 = libm::fma(x121, x121, x128 * x128);
+        let x130 = libm::fma(x120, x128, x127);
+        let x131 = libm::fma(x120, x121, x98);
+        let x132 = libm::fma(1375.0472756800002, x128, -24989.305802 * x120);
+        let x133 = libm::fma(24998.827802, x128, 1375.0472756800002 * x120);
+        let x134 = libm::fma(
+            x125,
             -3239.4582,
             libm::fma(
-                x127,
-                x138,
-                -libm::fma(24998.827802, x104, 1375.0472756800002 * x132),
+                x121,
+                x132,
+                -libm::fma(24998.827802, x98, 1375.0472756800002 * x126),
             ),
         );
-        let x141 = libm::fma(-s_q4, x127, c_q4 * x126);
-        let x142 = libm::fma(c_q4, x127, s_q4 * x126);
-        let x143 = libm::fma(
+        let x135 = libm::fma(-s_q4, x121, c_q4 * x120);
+        let x136 = libm::fma(c_q4, x121, s_q4 * x120);
+        let x137 = libm::fma(
             -s_q4,
-            libm::fma(7.11, x137, x131),
-            c_q4 * libm::fma(-7.11, x135, libm::fma(-s_q3, x130, c_q3 * x128)),
+            libm::fma(7.11, x131, x125),
+            c_q4 * libm::fma(-7.11, x129, libm::fma(-s_q3, x124, c_q3 * x122)),
         );
-        let x144 = libm::fma(qd[4], x142, libm::fma(s_q4, x133, c_q4 * x132));
-        let x145 = libm::fma(qd[4], x141, libm::fma(-s_q4, x132, c_q4 * x133));
-        let x146 = qd[4] + x134;
-        let x147 = -171.195516 * libm::fma(x141, x142, -x104);
-        let x148 = -171.195516 * libm::fma(x142, x146, x144);
-        let x149 = -171.195516 * libm::fma(x141, x141, x146 * x146);
-        let x150 = 132.6783695416 * x141;
-        let x151 = libm::fma(-97.44448770720001, x142, 135.4729695416 * x146);
-        let x152 = -97.44448770720001 * x146;
-        let x153 = libm::fma(
+        let x138 = libm::fma(qd[4], x136, libm::fma(s_q4, x127, c_q4 * x126));
+        let x139 = libm::fma(qd[4], x135, libm::fma(-s_q4, x126, c_q4 * x127));
+        let x140 = qd[4] + x128;
+        let x141 = -171.195516 * libm::fma(x135, x136, -x98);
+        let x142 = -171.195516 * libm::fma(x136, x140, x138);
+        let x143 = -171.195516 * libm::fma(x135, x135, x140 * x140);
+        let x144 = 132.6783695416 * x135;
+        let x145 = libm::fma(-97.44448770720001, x136, 135.4729695416 * x140);
+        let x146 = -97.44448770720001 * x140;
+        let x147 = libm::fma(
             171.195516,
-            libm::fma(7.11, x136, x129),
-            libm::fma(-132.6783695416, x144, libm::fma(-x142, x151, x146 * x152)),
+            libm::fma(7.11, x130, x123),
+            libm::fma(-132.6783695416, x138, libm::fma(-x136, x145, x140 * x146)),
         );
-        let x154 = libm::fma(s_q5, x146, c_q5 * x141);
-        let x155 = libm::fma(-s_q5, x141, c_q5 * x146);
-        let x156 = qd[5] + x142;
-        let x157 = 44.41 * x155;
-        let x158 = 47.471 * x156;
-        let x159 = libm::fma(
-            -x154,
-            x158,
-            44.41 * libm::fma(-qd[5], x154, libm::fma(-c_q5, x104, s_q5 * x144)),
+        let x148 = libm::fma(s_q5, x140, c_q5 * x135);
+        let x149 = libm::fma(-s_q5, x135, c_q5 * x140);
+        let x150 = qd[5] + x136;
+        let x151 = 44.41 * x149;
+        let x152 = 47.471 * x150;
+        let x153 = libm::fma(
+            -x148,
+            x152,
+            44.41 * libm::fma(-qd[5], x148, libm::fma(-c_q5, x98, s_q5 * x138)),
         );
-        let x160 = 9.336 * libm::fma(qd[5], x155, -libm::fma(s_q5, x104, c_q5 * x144));
-        let x161 = 9.336 * (qd[6] + x154);
-        let x162 = libm::fma(-s_q6, x155, c_q6 * x156) * x161;
-        let x163 = libm::fma(s_q6, x156, c_q6 * x155) * x161;
-        let x164 = libm::fma(-x156, x157, x155 * x158) + x160;
-        let x165 = x159 + libm::fma(s_q6, x163, c_q6 * x162);
-        let x166 = libm::fma(x154, x157, 47.471 * x145)
-            + libm::fma(-c_q6, x163, s_q6 * x162);
-        let x167 = x153 + libm::fma(-s_q5, x165, c_q5 * x164);
-        let x168 = libm::fma(
+        let x154 = 9.336 * libm::fma(qd[5], x149, -libm::fma(s_q5, x98, c_q5 * x138));
+        let x155 = 9.336 * (qd[6] + x148);
+        let x156 = libm::fma(-s_q6, x149, c_q6 * x150) * x155;
+        let x157 = libm::fma(s_q6, x150, c_q6 * x149) * x155;
+        let x158 = libm::fma(-x150, x151, x149 * x152) + x154;
+        let x159 = x153 + libm::fma(s_q6, x157, c_q6 * x156);
+        let x160 = libm::fma(x148, x151, 47.471 * x139)
+            + libm::fma(-c_q6, x157, s_q6 * x156);
+        let x161 = x147 + libm::fma(-s_q5, x159, c_q5 * x158);
+        let x162 = libm::fma(
             -171.195516,
-            x143,
-            libm::fma(-135.4729695416, x104, -97.44448770720001 * x145)
-                + libm::fma(-x141, x152, x142 * x150),
-        ) + libm::fma(c_q5, x165, s_q5 * x164);
-        let x169 = libm::fma(
-            97.44448770720001,
-            x104,
-            libm::fma(-x146, x150, x141 * x151),
-        ) + x166;
-        let x170 = libm::fma(c_q4, x149, s_q4 * x147);
-        let x171 = libm::fma(-3239.4582, x135, libm::fma(-s_q4, x149, c_q4 * x147));
-        let x172 = libm::fma(3239.4582, x136, x148);
-        let x173 = libm::fma(3239.4582, x137, -x170);
-        let x174 = libm::fma(s_q4, x169, c_q4 * x167)
+            x137,
+            libm::fma(-135.4729695416, x98, -97.44448770720001 * x139)
+                + libm::fma(-x135, x146, x136 * x144),
+        ) + libm::fma(c_q5, x159, s_q5 * x158);
+        let x163 = libm::fma(97.44448770720001, x98, libm::fma(-x140, x144, x135 * x145))
+            + x160;
+        let x164 = libm::fma(c_q4, x143, s_q4 * x141);
+        let x165 = libm::fma(-3239.4582, x129, libm::fma(-s_q4, x143, c_q4 * x141));
+        let x166 = libm::fma(3239.4582, x130, x142);
+        let x167 = libm::fma(3239.4582, x131, -x164);
+        let x168 = libm::fma(s_q4, x163, c_q4 * x161)
             - libm::fma(
-                x127,
-                x139,
-                libm::fma(1375.0472756800002, x104, -24989.305802 * x132),
+                x121,
+                x133,
+                libm::fma(1375.0472756800002, x98, -24989.305802 * x126),
             );
-        let x175 = x140 + libm::fma(7.11, x170, x168);
-        let x176 = libm::fma(3239.4582, x129, libm::fma(-x134, x138, x126 * x139))
-            + libm::fma(7.11, x148, libm::fma(-s_q4, x167, c_q4 * x169));
-        let x177 = libm::fma(s_q3, x173, c_q3 * x171);
-        let x178 = libm::fma(-s_q3, x171, c_q3 * x173);
-        let x179 = libm::fma(-5224.5702, x119, x177);
-        let x180 = libm::fma(5224.5702, x122, x178);
-        let x181 = libm::fma(-0.475, x178, libm::fma(s_q3, x176, c_q3 * x174))
+        let x169 = x134 + libm::fma(7.11, x164, x162);
+        let x170 = libm::fma(3239.4582, x123, libm::fma(-x128, x132, x120 * x133))
+            + libm::fma(7.11, x142, libm::fma(-s_q4, x161, c_q4 * x163));
+        let x171 = libm::fma(s_q3, x167, c_q3 * x165);
+        let x172 = libm::fma(-s_q3, x165, c_q3 * x167);
+        let x173 = libm::fma(-5224.5702, x113, x171);
+        let x174 = libm::fma(5224.5702, x116, x172);
+        let x175 = libm::fma(-0.475, x172, libm::fma(s_q3, x170, c_q3 * x168))
             - libm::fma(
-                x110,
-                x124,
-                libm::fma(3946.18812068, x104, -39234.47412200001 * x115),
+                x104,
+                x118,
+                libm::fma(3946.18812068, x98, -39234.47412200001 * x109),
             );
-        let x182 = x125 + libm::fma(-7.11, x178, x175);
-        let x183 = libm::fma(-5224.5702, x112, libm::fma(-x117, x123, x109 * x124))
-            + (libm::fma(-s_q3, x174, c_q3 * x176)
-                + libm::fma(7.11, x172, 0.475 * x177));
-        let x184 = libm::fma(s_q2, x180, c_q2 * x179);
-        let x185 = libm::fma(
-            -x100,
-            x107,
-            libm::fma(0.5692, x184, libm::fma(-s_q2, x181, c_q2 * x183)),
+        let x176 = x119 + libm::fma(-7.11, x172, x169);
+        let x177 = libm::fma(-5224.5702, x106, libm::fma(-x111, x117, x103 * x118))
+            + (libm::fma(-s_q3, x168, c_q3 * x170)
+                + libm::fma(7.11, x166, 0.475 * x171));
+        let x178 = libm::fma(s_q2, x174, c_q2 * x173);
+        let x179 = libm::fma(
+            -x94,
+            x101,
+            libm::fma(0.5692, x178, libm::fma(-s_q2, x175, c_q2 * x177)),
         );
-        let x186 = libm::fma(
+        let x180 = libm::fma(
             c_q1,
-            libm::fma(1145.5438279999998, x106, libm::fma(5224.5702, x121, x172)),
-            s_q1 * libm::fma(1145.5438279999998, x105, x184),
+            libm::fma(1145.5438279999998, x100, libm::fma(5224.5702, x115, x166)),
+            s_q1 * libm::fma(1145.5438279999998, x99, x178),
         );
-        let x187 = libm::fma(
+        let x181 = libm::fma(
             -s_q1,
-            x182 - libm::fma(x100, x108, -65693.9112265768 * x104),
+            x176 - libm::fma(x94, x102, -65693.9112265768 * x98),
             c_q1
                 * (libm::fma(
                     1145.5438279999998,
-                    x102,
-                    libm::fma(-x101, x108, qd[1] * x107),
+                    x96,
+                    libm::fma(-x95, x102, qd[1] * x101),
                 )
                     + libm::fma(
                         -0.5692,
-                        libm::fma(-s_q2, x179, c_q2 * x180),
-                        libm::fma(s_q2, x183, c_q2 * x181),
+                        libm::fma(-s_q2, x173, c_q2 * x174),
+                        libm::fma(s_q2, x177, c_q2 * x175),
                     )),
         );
-        let x188 = libm::fma(-0.7026, x186, x187);
+        let x182 = libm::fma(-0.7026, x180, x181);
         (
             [
-                [x74, x75, x76, x80, x89, x93, x99],
-                [x75, x69, x68, x78, x87, x92, x98],
-                [x76, x68, x59, x49, x84, 0.0, x8],
-                [x80, x78, x49, x35, x27, 0.0, x8],
-                [x89, x87, x84, x27, x13, 0.0, x8],
-                [x93, x92, 0.0, 0.0, 0.0, 47.471, 0.0],
-                [x99, x98, x8, x8, x8, 0.0, 9.336],
+                [x64, x65, x66, x70, x79, x85, x93],
+                [x65, x62, x61, x68, x77, x84, x92],
+                [x66, x61, x46, x39, x74, 0.0, x87],
+                [x70, x68, x39, x24, x18, 0.0, x87],
+                [x79, x77, x74, x18, x9, 0.0, x87],
+                [x85, x84, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x93, x92, x87, x87, x87, 0.0, 9.336],
             ],
-            [x188, x185, x182, x175, x168, x166, x160],
+            [x182, x179, x176, x169, x162, x160, x154],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 515 mul, 403 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 316 fused multiply-adds.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 469 mul, 387 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 284 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 7],
@@ -1773,483 +2080,464 @@ impl SsrmsFma {
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x6 = 9.336 * c_q5;
-        let x7 = 44.41 * s_q5;
-        let x8 = 9.336 * s_q5;
-        let x9 = 44.41 * c_q5;
-        let x10 = libm::fma(-c_q5, x7, s_q5 * x6);
-        let x11 = libm::fma(-s_q5, x9, c_q5 * x8);
-        let x12 = 132.6783695416 + libm::fma(s_q5, x7, c_q5 * x6);
-        let x13 = 135.4729695416 + libm::fma(c_q5, x9, s_q5 * x8);
-        let x14 = -171.195516 * s_q4;
-        let x15 = -171.195516 * c_q4;
-        let x16 = c_q4 * x12;
-        let x17 = -97.44448770720001 * s_q4;
-        let x18 = libm::fma(c_q4, x10, x17);
-        let x19 = 47.471 * s_q4;
-        let x20 = s_q4 * x12;
-        let x21 = -97.44448770720001 * c_q4;
-        let x22 = libm::fma(-s_q4, x10, x21);
-        let x23 = 47.471 * c_q4;
-        let x24 = libm::fma(-s_q4, x11, x21);
-        let x25 = x14 * -7.11;
-        let x26 = 7.11 * x14;
-        let x27 = x13 - x25;
-        let x28 = libm::fma(-7.11, x15, libm::fma(-c_q4, x20, s_q4 * x23));
-        let x29 = libm::fma(x15, -7.11, libm::fma(-s_q4, x16, c_q4 * x19));
-        let x30 = libm::fma(c_q4, x23, s_q4 * x20) + x26 - x25;
-        let x31 = 3239.4582 + x14;
-        let x32 = -24989.305802 + libm::fma(s_q4, x19, c_q4 * x16);
-        let x33 = 1375.0472756800002 + x18;
-        let x34 = 1375.0472756800002 + libm::fma(c_q4, x11, x17);
-        let x35 = 24998.827802 + (x26 + x27);
-        let x36 = s_q3 * x15;
-        let x37 = libm::fma(c_q3, x31, x36);
-        let x38 = c_q3 * x15;
-        let x39 = libm::fma(-s_q3, x31, x38);
-        let x40 = libm::fma(s_q3, x28, c_q3 * x32);
-        let x41 = s_q3 * x22;
-        let x42 = libm::fma(s_q3, x30, c_q3 * x29);
-        let x43 = libm::fma(-s_q3, x32, c_q3 * x28);
-        let x44 = c_q3 * x22;
-        let x45 = libm::fma(-s_q3, x29, c_q3 * x30);
-        let x46 = -7.11 * x37;
-        let x47 = 7.11 * x37;
-        let x48 = libm::fma(0.475, x37, libm::fma(c_q3, x33, x41));
-        let x49 = x35 - x46;
-        let x50 = libm::fma(-7.11, x39, libm::fma(s_q3, x45, c_q3 * x43));
-        let x51 = libm::fma(x39, 0.475, libm::fma(-s_q3, x33, x44));
-        let x52 = libm::fma(-7.11, x39, libm::fma(-s_q3, x40, c_q3 * x42));
-        let x53 = libm::fma(0.475, x39, libm::fma(-s_q3, x34, c_q3 * x24));
-        let x54 = libm::fma(-s_q3, x43, c_q3 * x45) + x47 - x46;
-        let x55 = 5224.5702 + x37;
-        let x56 = -39234.47412200001 + libm::fma(s_q3, x42, c_q3 * x40);
-        let x57 = 3946.18812068 + x48;
-        let x58 = 3946.1881206800003
-            + libm::fma(x37, 0.475, libm::fma(s_q3, x24, c_q3 * x34));
-        let x59 = 39241.404122 + (x47 + x49);
-        let x60 = s_q2 * x39;
-        let x61 = libm::fma(c_q2, x55, x60);
-        let x62 = c_q2 * x39;
-        let x63 = libm::fma(-s_q2, x55, x62);
-        let x64 = libm::fma(s_q2, x50, c_q2 * x56);
-        let x65 = s_q2 * x51;
-        let x66 = libm::fma(s_q2, x54, c_q2 * x52);
-        let x67 = c_q2 * x51;
-        let x68 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x61, libm::fma(s_q2, x53, c_q2 * x58)),
-            c_q1 * libm::fma(s_q2, x66, c_q2 * x64),
-        );
-        let x69 = c_q1 * libm::fma(0.5692, x61, libm::fma(c_q2, x57, x65));
-        let x70 = libm::fma(
-            -s_q1,
-            libm::fma(0.5692, x63, libm::fma(-s_q2, x58, c_q2 * x53)),
-            c_q1 * libm::fma(-s_q2, x64, c_q2 * x66),
-        );
-        let x71 = libm::fma(
+        let x6 = s_q5 * s_q5 * -35.074;
+        let x7 = s_q5 * c_q5 * -35.074;
+        let x8 = 132.6783695416 + (9.336 - x6);
+        let x9 = 135.4729695416 + (44.41 + x6);
+        let x10 = 47.471 - x8;
+        let x11 = s_q4 * s_q4 * x10;
+        let x12 = libm::fma(-s_q4, x7, -97.44448770720001 * c_q4);
+        let x13 = libm::fma(c_q4, x7, -97.44448770720001 * s_q4);
+        let x14 = -171.195516 * c_q4;
+        let x15 = -171.195516 * s_q4;
+        let x16 = x15 * -7.11;
+        let x17 = 7.11 * x15;
+        let x18 = x9 - x16;
+        let x19 = libm::fma(-7.11, x14, s_q4 * c_q4 * x10);
+        let x20 = 47.471 - x11 + x17 - x16;
+        let x21 = 3239.4582 + x15;
+        let x22 = -24989.305802 + (x8 + x11);
+        let x23 = 1375.0472756800002 + x13;
+        let x24 = 24998.827802 + (x17 + x18);
+        let x25 = s_q3 * s_q3;
+        let x26 = s_q3 * c_q3;
+        let x27 = x20 - x22;
+        let x28 = x19 + x19;
+        let x29 = libm::fma(x26, x28, x25 * x27);
+        let x30 = c_q3 * x12;
+        let x31 = s_q3 * x12;
+        let x32 = c_q3 * x14;
+        let x33 = libm::fma(-s_q3, x21, x32);
+        let x34 = s_q3 * x14;
+        let x35 = libm::fma(c_q3, x21, x34);
+        let x36 = -7.11 * x35;
+        let x37 = 7.11 * x35;
+        let x38 = libm::fma(0.475, x35, libm::fma(c_q3, x23, x31));
+        let x39 = x24 - x36;
+        let x40 = libm::fma(-7.11, x33, x19 + libm::fma(-x25, x28, x26 * x27));
+        let x41 = libm::fma(x33, 0.475, libm::fma(-s_q3, x23, x30));
+        let x42 = x20 - x29 + x37 - x36;
+        let x43 = 5224.5702 + x35;
+        let x44 = -39234.47412200001 + (x22 + x29);
+        let x45 = 3946.18812068 + x38;
+        let x46 = 39241.404122 + (x37 + x39);
+        let x47 = s_q2 * s_q2;
+        let x48 = s_q2 * c_q2;
+        let x49 = x42 - x44;
+        let x50 = x40 + x40;
+        let x51 = libm::fma(x48, x50, x47 * x49);
+        let x52 = x44 + x51;
+        let x53 = c_q2 * x41;
+        let x54 = libm::fma(-s_q2, x45, x53);
+        let x55 = s_q2 * x41;
+        let x56 = c_q2 * x33;
+        let x57 = libm::fma(-s_q2, x43, x56);
+        let x58 = s_q2 * x33;
+        let x59 = libm::fma(c_q2, x43, x58);
+        let x60 = libm::fma(0.5692, x59, libm::fma(c_q2, x45, x55));
+        let x61 = libm::fma(
             0.7026,
-            x63,
-            libm::fma(-s_q1, libm::fma(-s_q1, -65693.9112265768 + x59, x69), c_q1 * x68),
+            x57,
+            libm::fma(
+                0.7026,
+                x57,
+                x52
+                    - libm::fma(
+                        s_q1 * c_q1,
+                        x60 + x60,
+                        s_q1 * s_q1 * (x52 - (-65693.9112265768 + x46)),
+                    ),
+            ),
         );
-        let x72 = libm::fma(
+        let x62 = libm::fma(
             -0.7026,
-            libm::fma(s_q1, 1145.5438279999998, c_q1 * x61),
-            x70,
+            libm::fma(s_q1, 1145.5438279999998, c_q1 * x59),
+            libm::fma(
+                -s_q1,
+                libm::fma(0.5692, x57, x54),
+                c_q1 * (x40 + libm::fma(-x47, x50, x48 * x49)),
+            ),
         );
-        let x73 = libm::fma(-0.7026, s_q1 * x63, libm::fma(-s_q1, x59, x69));
-        let x74 = libm::fma(-s_q2, x37, x62);
-        let x75 = libm::fma(
+        let x63 = libm::fma(-0.7026, s_q1 * x57, libm::fma(-s_q1, x46, c_q1 * x60));
+        let x64 = libm::fma(-s_q2, x35, x56);
+        let x65 = libm::fma(
             -s_q1,
-            x49,
+            x39,
             c_q1
-                * libm::fma(0.5692, libm::fma(c_q2, x37, x60), libm::fma(c_q2, x48, x65)),
+                * libm::fma(0.5692, libm::fma(c_q2, x35, x58), libm::fma(c_q2, x38, x55)),
         );
-        let x76 = libm::fma(-0.7026, s_q1 * x74, x75);
-        let x77 = libm::fma(-s_q3, x14, x38);
-        let x78 = libm::fma(c_q3, x14, x36);
-        let x79 = libm::fma(0.475, x78, libm::fma(c_q3, x18, x41));
-        let x80 = libm::fma(7.11, x78, x27);
-        let x81 = libm::fma(0.475, x77, libm::fma(-s_q3, x18, x44));
-        let x82 = libm::fma(-s_q2, x78, c_q2 * x77);
-        let x83 = libm::fma(
+        let x66 = libm::fma(-0.7026, s_q1 * x64, x65);
+        let x67 = libm::fma(-s_q3, x15, x32);
+        let x68 = libm::fma(c_q3, x15, x34);
+        let x69 = libm::fma(0.475, x68, libm::fma(c_q3, x13, x31));
+        let x70 = libm::fma(7.11, x68, x18);
+        let x71 = libm::fma(0.475, x67, libm::fma(-s_q3, x13, x30));
+        let x72 = libm::fma(-s_q2, x68, c_q2 * x67);
+        let x73 = libm::fma(
             -s_q1,
-            x80,
+            x70,
             c_q1
                 * libm::fma(
                     0.5692,
-                    libm::fma(c_q2, x78, s_q2 * x77),
-                    libm::fma(s_q2, x81, c_q2 * x79),
+                    libm::fma(c_q2, x68, s_q2 * x67),
+                    libm::fma(s_q2, x71, c_q2 * x69),
                 ),
         );
-        let x84 = libm::fma(-0.7026, s_q1 * x82, x83);
-        let x85 = libm::fma(s_q3, x23, c_q3 * x19);
-        let x86 = libm::fma(-s_q3, x19, c_q3 * x23);
-        let x87 = c_q1 * libm::fma(s_q2, x86, c_q2 * x85);
-        let x88 = c_q4 * x6;
-        let x89 = s_q4 * x6;
-        let x90 = libm::fma(-s_q3, x89, c_q3 * x88);
-        let x91 = libm::fma(c_q3, x89, s_q3 * x88);
-        let x92 = libm::fma(-s_q1, x8, c_q1 * libm::fma(-s_q2, x91, c_q2 * x90));
-        let x93 = qd[0] * c_q1;
-        let x94 = qd[0] * s_q1;
-        let x95 = 0.7026 * (qd[0] * qd[0]);
-        let x96 = qd[1] * x94;
-        let x97 = qd[1] * x93;
-        let x98 = x93 * x94;
-        let x99 = libm::fma(x93, x93, qd[1] * qd[1]);
-        let x100 = -65693.9112265768 * x94;
-        let x101 = 65697.3302265768 * qd[1];
-        let x102 = libm::fma(-qd[1], s_q2, c_q2 * x93);
-        let x103 = libm::fma(qd[1], c_q2, s_q2 * x93);
-        let x104 = -0.5692 * x98;
-        let x105 = -0.5692 * x99;
-        let x106 = libm::fma(-0.5692, x96 + x96, x95);
-        let x107 = libm::fma(c_q2, x106, s_q2 * x104);
-        let x108 = libm::fma(qd[2], x103, c_q2 * x96);
-        let x109 = libm::fma(-s_q2, x96, qd[2] * x102);
-        let x110 = qd[2] - x94;
-        let x111 = x103 * x103;
-        let x112 = libm::fma(x110, x110, x111);
-        let x113 = x102 * x110;
-        let x114 = x109 + x113;
-        let x115 = libm::fma(x102, x103, x97);
-        let x116 = libm::fma(3946.18812068, x110, -39234.47412200001 * x102);
-        let x117 = libm::fma(39241.404122, x110, 3946.1881206800003 * x102);
-        let x118 = libm::fma(
-            x107,
+        let x74 = libm::fma(-0.7026, s_q1 * x72, x73);
+        let x75 = 47.471 * s_q4;
+        let x76 = 47.471 * c_q4;
+        let x77 = libm::fma(s_q3, x76, c_q3 * x75);
+        let x78 = libm::fma(-s_q3, x75, c_q3 * x76);
+        let x79 = c_q1 * libm::fma(s_q2, x78, c_q2 * x77);
+        let x80 = 9.336 * c_q5;
+        let x81 = 9.336 * s_q5;
+        let x82 = c_q4 * x80;
+        let x83 = s_q4 * x80;
+        let x84 = libm::fma(-s_q3, x83, c_q3 * x82);
+        let x85 = libm::fma(c_q3, x83, s_q3 * x82);
+        let x86 = libm::fma(-s_q1, x81, c_q1 * libm::fma(-s_q2, x85, c_q2 * x84));
+        let x87 = qd[0] * c_q1;
+        let x88 = qd[0] * s_q1;
+        let x89 = 0.7026 * (qd[0] * qd[0]);
+        let x90 = qd[1] * x88;
+        let x91 = qd[1] * x87;
+        let x92 = x87 * x88;
+        let x93 = libm::fma(x87, x87, qd[1] * qd[1]);
+        let x94 = -65693.9112265768 * x88;
+        let x95 = 65697.3302265768 * qd[1];
+        let x96 = libm::fma(-qd[1], s_q2, c_q2 * x87);
+        let x97 = libm::fma(qd[1], c_q2, s_q2 * x87);
+        let x98 = -0.5692 * x92;
+        let x99 = -0.5692 * x93;
+        let x100 = libm::fma(-0.5692, x90 + x90, x89);
+        let x101 = libm::fma(c_q2, x100, s_q2 * x98);
+        let x102 = libm::fma(qd[2], x97, c_q2 * x90);
+        let x103 = libm::fma(-s_q2, x90, qd[2] * x96);
+        let x104 = qd[2] - x88;
+        let x105 = x97 * x97;
+        let x106 = libm::fma(x104, x104, x105);
+        let x107 = x96 * x104;
+        let x108 = x103 + x107;
+        let x109 = libm::fma(x96, x97, x91);
+        let x110 = libm::fma(3946.18812068, x104, -39234.47412200001 * x96);
+        let x111 = libm::fma(39241.404122, x104, 3946.1881206800003 * x96);
+        let x112 = libm::fma(
+            x101,
             5224.5702,
             libm::fma(
-                x103,
-                x116,
-                -libm::fma(39241.404122, x97, 3946.1881206800003 * x108),
+                x97,
+                x110,
+                -libm::fma(39241.404122, x91, 3946.1881206800003 * x102),
             ),
         );
-        let x119 = libm::fma(-s_q3, x103, c_q3 * x102);
-        let x120 = libm::fma(c_q3, x103, s_q3 * x102);
-        let x121 = libm::fma(-c_q2, x104, s_q2 * x106)
-            + libm::fma(-7.11, x112, -0.475 * (x113 - x109));
-        let x122 = libm::fma(0.475, libm::fma(x102, x102, x111), 7.11 * x114) - x105;
-        let x123 = libm::fma(-0.475, libm::fma(x103, x110, -x108), 7.11 * x115) - x107;
-        let x124 = libm::fma(c_q3, x123, s_q3 * x121);
-        let x125 = libm::fma(qd[3], x120, libm::fma(s_q3, x109, c_q3 * x108));
-        let x126 = libm::fma(qd[3], x119, libm::fma(-s_q3, x108, c_q3 * x109));
-        let x127 = qd[3] + x110;
-        let x128 = libm::fma(x120, x120, x127 * x127);
-        let x129 = libm::fma(x119, x127, x126);
-        let x130 = libm::fma(x119, x120, x97);
-        let x131 = libm::fma(1375.0472756800002, x127, -24989.305802 * x119);
-        let x132 = libm::fma(24998.827802, x127, 1375.0472756800002 * x119);
-        let x133 = libm::fma(
-            x124,
+        let x113 = libm::fma(-s_q3, x97, c_q3 * x96);
+        let x114 = libm::fma(c_q3, x97, s_q3 * x96);
+        let x115 = libm::fma(-c_q2, x98, s_q2 * x100)
+            + libm::fma(-7.11, x106, -0.475 * (x107 - x103));
+        let x116 = libm::fma(0.475, libm::fma(x96, x96, x105), 7.11 * x108) - x99;
+        let x117 = libm::fma(-0.475, libm::fma(x97, x104, -x102), 7.11 * x109) - x101;
+        let x118 = libm::fma(c_q3, x117, s_q3 * x115);
+        let x119 = libm::fma(qd[3], x114, libm::fma(s_q3, x103, c_q3 * x102));
+        let x120 = libm::fma(qd[3], x113, libm::fma(-s_q3, x102, c_q3 * x103));
+        let x121 = qd[3] + x104;
+        let x122 = libm::fma(x114, x114, x121 * x121);
+        let x123 = libm::fma(x113, x121, x120);
+        let x124 = libm::fma(x113, x114, x91);
+        let x125 = libm::fma(1375.0472756800002, x121, -24989.305802 * x113);
+        let x126 = libm::fma(24998.827802, x121, 1375.0472756800002 * x113);
+        let x127 = libm::fma(
+            x118,
             -3239.4582,
             libm::fma(
-                x120,
-                x131,
-                -libm::fma(24998.827802, x97, 1375.0472756800002 * x125),
+                x114,
+                x125,
+                -libm::fma(24998.827802, x91, 1375.0472756800002 * x119),
             ),
         );
-        let x134 = libm::fma(-s_q4, x120, c_q4 * x119);
-        let x135 = libm::fma(c_q4, x120, s_q4 * x119);
-        let x136 = libm::fma(
+        let x128 = libm::fma(-s_q4, x114, c_q4 * x113);
+        let x129 = libm::fma(c_q4, x114, s_q4 * x113);
+        let x130 = libm::fma(
             -s_q4,
-            libm::fma(7.11, x130, x124),
-            c_q4 * libm::fma(-7.11, x128, libm::fma(-s_q3, x123, c_q3 * x121)),
+            libm::fma(7.11, x124, x118),
+            c_q4 * libm::fma(-7.11, x122, libm::fma(-s_q3, x117, c_q3 * x115)),
         );
-        let x137 = libm::fma(qd[4], x135, libm::fma(s_q4, x126, c_q4 * x125));
-        let x138 = libm::fma(qd[4], x134, libm::fma(-s_q4, x125, c_q4 * x126));
-        let x139 = qd[4] + x127;
-        let x140 = 132.6783695416 * x134;
-        let x141 = libm::fma(-97.44448770720001, x135, 135.4729695416 * x139);
-        let x142 = -97.44448770720001 * x139;
-        let x143 = libm::fma(
+        let x131 = libm::fma(qd[4], x129, libm::fma(s_q4, x120, c_q4 * x119));
+        let x132 = libm::fma(qd[4], x128, libm::fma(-s_q4, x119, c_q4 * x120));
+        let x133 = qd[4] + x121;
+        let x134 = 132.6783695416 * x128;
+        let x135 = libm::fma(-97.44448770720001, x129, 135.4729695416 * x133);
+        let x136 = -97.44448770720001 * x133;
+        let x137 = libm::fma(
             171.195516,
-            libm::fma(7.11, x129, x122),
-            libm::fma(-132.6783695416, x137, libm::fma(-x135, x141, x139 * x142)),
+            libm::fma(7.11, x123, x116),
+            libm::fma(-132.6783695416, x131, libm::fma(-x129, x135, x133 * x136)),
         );
-        let x144 = libm::fma(s_q5, x139, c_q5 * x134);
-        let x145 = libm::fma(-s_q5, x134, c_q5 * x139);
-        let x146 = qd[5] + x135;
-        let x147 = 44.41 * x145;
-        let x148 = 47.471 * x146;
-        let x149 = libm::fma(
-            -x144,
-            x148,
-            44.41 * libm::fma(-qd[5], x144, libm::fma(-c_q5, x97, s_q5 * x137)),
+        let x138 = libm::fma(s_q5, x133, c_q5 * x128);
+        let x139 = libm::fma(-s_q5, x128, c_q5 * x133);
+        let x140 = qd[5] + x129;
+        let x141 = 44.41 * x139;
+        let x142 = 47.471 * x140;
+        let x143 = libm::fma(
+            -x138,
+            x142,
+            44.41 * libm::fma(-qd[5], x138, libm::fma(-c_q5, x91, s_q5 * x131)),
         );
-        let x150 = 9.336 * (qd[6] + x144);
-        let x151 = libm::fma(
+        let x144 = 9.336 * (qd[6] + x138);
+        let x145 = libm::fma(
             9.336,
-            libm::fma(qd[5], x145, -libm::fma(s_q5, x97, c_q5 * x137)),
+            libm::fma(qd[5], x139, -libm::fma(s_q5, x91, c_q5 * x131)),
             -f_ext[6][3],
         );
-        let x152 = libm::fma(libm::fma(-s_q6, x145, c_q6 * x146), x150, -f_ext[6][4]);
-        let x153 = libm::fma(libm::fma(s_q6, x146, c_q6 * x145), x150, f_ext[6][5]);
-        let x154 = libm::fma(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
-        let x155 = f_ext[5][0] + f_ext[6][0];
-        let x156 = x154 - f_ext[5][1];
-        let x157 = f_ext[5][2] + libm::fma(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
-        let x158 = libm::fma(-x146, x147, x145 * x148) - f_ext[5][3]
-            + libm::fma(0.7026, x154, x151);
-        let x159 = x149 - f_ext[5][4]
-            + libm::fma(0.7026, f_ext[6][0], libm::fma(s_q6, x153, c_q6 * x152));
-        let x160 = libm::fma(x144, x147, 47.471 * x138) - f_ext[5][5]
-            + libm::fma(-c_q6, x153, s_q6 * x152);
-        let x161 = libm::fma(s_q5, x156, c_q5 * x155);
-        let x162 = libm::fma(-171.195516, libm::fma(x134, x135, -x97), -f_ext[4][0])
-            - x161;
-        let x163 = libm::fma(-171.195516, libm::fma(x135, x139, x137), -f_ext[4][1])
-            + libm::fma(-s_q5, x155, c_q5 * x156);
-        let x164 = libm::fma(
+        let x146 = libm::fma(libm::fma(-s_q6, x139, c_q6 * x140), x144, -f_ext[6][4]);
+        let x147 = libm::fma(libm::fma(s_q6, x140, c_q6 * x139), x144, f_ext[6][5]);
+        let x148 = libm::fma(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
+        let x149 = f_ext[5][0] + f_ext[6][0];
+        let x150 = x148 - f_ext[5][1];
+        let x151 = f_ext[5][2] + libm::fma(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
+        let x152 = libm::fma(-x140, x141, x139 * x142) - f_ext[5][3]
+            + libm::fma(0.7026, x148, x145);
+        let x153 = x143 - f_ext[5][4]
+            + libm::fma(0.7026, f_ext[6][0], libm::fma(s_q6, x147, c_q6 * x146));
+        let x154 = libm::fma(x138, x141, 47.471 * x132) - f_ext[5][5]
+            + libm::fma(-c_q6, x147, s_q6 * x146);
+        let x155 = libm::fma(s_q5, x150, c_q5 * x149);
+        let x156 = libm::fma(-171.195516, libm::fma(x128, x129, -x91), -f_ext[4][0])
+            - x155;
+        let x157 = libm::fma(-171.195516, libm::fma(x129, x133, x131), -f_ext[4][1])
+            + libm::fma(-s_q5, x149, c_q5 * x150);
+        let x158 = libm::fma(
             -171.195516,
-            libm::fma(x134, x134, x139 * x139),
+            libm::fma(x128, x128, x133 * x133),
             f_ext[4][2],
-        ) + x157;
-        let x165 = x143 - f_ext[4][3]
-            + libm::fma(0.5692, x157, libm::fma(-s_q5, x159, c_q5 * x158));
-        let x166 = libm::fma(
+        ) + x151;
+        let x159 = x137 - f_ext[4][3]
+            + libm::fma(0.5692, x151, libm::fma(-s_q5, x153, c_q5 * x152));
+        let x160 = libm::fma(
             -171.195516,
-            x136,
-            libm::fma(-135.4729695416, x97, -97.44448770720001 * x138)
-                + libm::fma(-x134, x142, x135 * x140),
-        ) - f_ext[4][4] + libm::fma(c_q5, x159, s_q5 * x158);
-        let x167 = libm::fma(97.44448770720001, x97, libm::fma(-x139, x140, x134 * x141))
-            - f_ext[4][5] + libm::fma(-0.5692, x161, x160);
-        let x168 = libm::fma(c_q4, x164, s_q4 * x162);
-        let x169 = libm::fma(-s_q4, x164, c_q4 * x162)
-            - libm::fma(3239.4582, x128, f_ext[3][0]);
-        let x170 = libm::fma(3239.4582, x129, -f_ext[3][1]) + x163;
-        let x171 = libm::fma(3239.4582, x130, -f_ext[3][2]) - x168;
-        let x172 = libm::fma(s_q4, x167, c_q4 * x165)
+            x130,
+            libm::fma(-135.4729695416, x91, -97.44448770720001 * x132)
+                + libm::fma(-x128, x136, x129 * x134),
+        ) - f_ext[4][4] + libm::fma(c_q5, x153, s_q5 * x152);
+        let x161 = libm::fma(97.44448770720001, x91, libm::fma(-x133, x134, x128 * x135))
+            - f_ext[4][5] + libm::fma(-0.5692, x155, x154);
+        let x162 = libm::fma(c_q4, x158, s_q4 * x156);
+        let x163 = libm::fma(-s_q4, x158, c_q4 * x156)
+            - libm::fma(3239.4582, x122, f_ext[3][0]);
+        let x164 = libm::fma(3239.4582, x123, -f_ext[3][1]) + x157;
+        let x165 = libm::fma(3239.4582, x124, -f_ext[3][2]) - x162;
+        let x166 = libm::fma(s_q4, x161, c_q4 * x159)
             - (f_ext[3][3]
                 + libm::fma(
-                    x120,
-                    x132,
-                    libm::fma(1375.0472756800002, x97, -24989.305802 * x125),
+                    x114,
+                    x126,
+                    libm::fma(1375.0472756800002, x91, -24989.305802 * x119),
                 ));
-        let x173 = x133 - f_ext[3][4] + libm::fma(7.11, x168, x166);
-        let x174 = libm::fma(3239.4582, x122, libm::fma(-x127, x131, x119 * x132))
-            - f_ext[3][5] + libm::fma(7.11, x163, libm::fma(-s_q4, x165, c_q4 * x167));
-        let x175 = libm::fma(s_q3, x171, c_q3 * x169);
-        let x176 = libm::fma(-s_q3, x169, c_q3 * x171);
-        let x177 = x175 - libm::fma(5224.5702, x112, f_ext[2][0]);
-        let x178 = libm::fma(5224.5702, x115, -f_ext[2][2]) + x176;
-        let x179 = libm::fma(-0.475, x176, libm::fma(s_q3, x174, c_q3 * x172))
+        let x167 = x127 - f_ext[3][4] + libm::fma(7.11, x162, x160);
+        let x168 = libm::fma(3239.4582, x116, libm::fma(-x121, x125, x113 * x126))
+            - f_ext[3][5] + libm::fma(7.11, x157, libm::fma(-s_q4, x159, c_q4 * x161));
+        let x169 = libm::fma(s_q3, x165, c_q3 * x163);
+        let x170 = libm::fma(-s_q3, x163, c_q3 * x165);
+        let x171 = x169 - libm::fma(5224.5702, x106, f_ext[2][0]);
+        let x172 = libm::fma(5224.5702, x109, -f_ext[2][2]) + x170;
+        let x173 = libm::fma(-0.475, x170, libm::fma(s_q3, x168, c_q3 * x166))
             - (f_ext[2][3]
                 + libm::fma(
-                    x103,
-                    x117,
-                    libm::fma(3946.18812068, x97, -39234.47412200001 * x108),
+                    x97,
+                    x111,
+                    libm::fma(3946.18812068, x91, -39234.47412200001 * x102),
                 ));
-        let x180 = x118 - f_ext[2][4] + libm::fma(-7.11, x176, x173);
-        let x181 = libm::fma(-5224.5702, x105, libm::fma(-x110, x116, x102 * x117))
+        let x174 = x112 - f_ext[2][4] + libm::fma(-7.11, x170, x167);
+        let x175 = libm::fma(-5224.5702, x99, libm::fma(-x104, x110, x96 * x111))
             - f_ext[2][5]
-            + (libm::fma(-s_q3, x172, c_q3 * x174)
-                + libm::fma(7.11, x170, 0.475 * x175));
-        let x182 = libm::fma(s_q2, x178, c_q2 * x177);
-        let x183 = libm::fma(
+            + (libm::fma(-s_q3, x166, c_q3 * x168)
+                + libm::fma(7.11, x164, 0.475 * x169));
+        let x176 = libm::fma(s_q2, x172, c_q2 * x171);
+        let x177 = libm::fma(
             -s_q1,
-            x180 - (f_ext[1][4] + libm::fma(x93, x101, -65693.9112265768 * x97)),
+            x174 - (f_ext[1][4] + libm::fma(x87, x95, -65693.9112265768 * x91)),
             c_q1
-                * (libm::fma(
-                    1145.5438279999998,
-                    x95,
-                    libm::fma(-x94, x101, qd[1] * x100),
-                ) - f_ext[1][3]
+                * (libm::fma(1145.5438279999998, x89, libm::fma(-x88, x95, qd[1] * x94))
+                    - f_ext[1][3]
                     + libm::fma(
                         -0.5692,
-                        libm::fma(-s_q2, x177, c_q2 * x178),
-                        libm::fma(s_q2, x181, c_q2 * x179),
+                        libm::fma(-s_q2, x171, c_q2 * x172),
+                        libm::fma(s_q2, x175, c_q2 * x173),
                     )),
         );
-        let x184 = libm::fma(
+        let x178 = libm::fma(
             -0.7026,
             libm::fma(
                 c_q1,
-                libm::fma(5224.5702, x114, -f_ext[2][1]) + x170
-                    - libm::fma(-1145.5438279999998, x99, f_ext[1][1]),
-                s_q1 * (x182 - libm::fma(-1145.5438279999998, x98, f_ext[1][0])),
+                libm::fma(5224.5702, x108, -f_ext[2][1]) + x164
+                    - libm::fma(-1145.5438279999998, x93, f_ext[1][1]),
+                s_q1 * (x176 - libm::fma(-1145.5438279999998, x92, f_ext[1][0])),
             ),
+            x177,
+        );
+        let x179 = tau[0] - (x178 - f_ext[0][3]);
+        let x180 = 1.0 / (66279.65991417361 + x61);
+        let x181 = x62 * x180;
+        let x182 = x63 * x180;
+        let x183 = x66 * x180;
+        let x184 = x74 * x180;
+        let x185 = x79 * x180;
+        let x186 = x86 * x180;
+        let x187 = 1.0 / libm::fma(-x62, x181, 65697.3302265768 + (x42 - x51));
+        let x188 = libm::fma(-x62, x182, libm::fma(0.5692, x57, x54));
+        let x189 = x187 * x188;
+        let x190 = libm::fma(
+            -x62,
             x183,
+            libm::fma(0.5692, x64, libm::fma(-s_q2, x38, x53)),
         );
-        let x185 = tau[0] - (x184 - f_ext[0][3]);
-        let x186 = 1.0 / (66279.65991417361 + libm::fma(0.7026, x63, x71));
-        let x187 = x72 * x186;
-        let x188 = x73 * x186;
-        let x189 = x76 * x186;
-        let x190 = x84 * x186;
-        let x191 = x87 * x186;
-        let x192 = x92 * x186;
-        let x193 = libm::fma(
-            -x72,
-            x187,
-            65697.3302265768
-                + libm::fma(
-                    -s_q2,
-                    libm::fma(-s_q2, x56, c_q2 * x50),
-                    c_q2 * libm::fma(-s_q2, x52, c_q2 * x54),
-                ),
+        let x191 = x187 * x190;
+        let x192 = libm::fma(
+            -x62,
+            x184,
+            libm::fma(0.5692, x72, libm::fma(-s_q2, x69, c_q2 * x71)),
         );
-        let x194 = 1.0 / x193;
-        let x195 = libm::fma(
-            -x72,
-            x188,
-            libm::fma(0.5692, x63, libm::fma(-s_q2, x57, x67)),
+        let x193 = x187 * x192;
+        let x194 = libm::fma(-x62, x185, libm::fma(-s_q2, x77, c_q2 * x78));
+        let x195 = x187 * x194;
+        let x196 = libm::fma(x62, x186, libm::fma(c_q2, x85, s_q2 * x84));
+        let x197 = x187 * x196;
+        let x198 = 1.0 / libm::fma(-x188, x189, libm::fma(-x63, x182, x46));
+        let x199 = libm::fma(-x188, x191, libm::fma(-x63, x183, x39));
+        let x200 = x198 * x199;
+        let x201 = libm::fma(-x188, x193, libm::fma(-x63, x184, x70));
+        let x202 = x198 * x201;
+        let x203 = libm::fma(x188, x195, x63 * x185);
+        let x204 = x198 * x203;
+        let x205 = libm::fma(x188, x197, libm::fma(-x63, x186, x81));
+        let x206 = x198 * x205;
+        let x207 = libm::fma(
+            -x199,
+            x200,
+            libm::fma(-x190, x191, libm::fma(-x66, x183, x24)),
         );
-        let x196 = x194 * x195;
-        let x197 = libm::fma(
-            -x72,
-            x189,
-            libm::fma(0.5692, x74, libm::fma(-s_q2, x48, x67)),
+        let x208 = 1.0 / x207;
+        let x209 = libm::fma(
+            -x199,
+            x202,
+            libm::fma(-x190, x193, libm::fma(-x66, x184, x18)),
         );
-        let x198 = x194 * x197;
-        let x199 = libm::fma(
-            -x72,
-            x190,
-            libm::fma(0.5692, x82, libm::fma(-s_q2, x79, c_q2 * x81)),
+        let x210 = x208 * x209;
+        let x211 = libm::fma(x199, x204, -libm::fma(x190, x195, x66 * x185));
+        let x212 = x208 * x211;
+        let x213 = libm::fma(
+            -x199,
+            x206,
+            libm::fma(x190, x197, libm::fma(-x66, x186, x81)),
         );
-        let x200 = x194 * x199;
-        let x201 = libm::fma(-x72, x191, libm::fma(-s_q2, x85, c_q2 * x86));
-        let x202 = x194 * x201;
-        let x203 = libm::fma(x72, x192, libm::fma(c_q2, x91, s_q2 * x90));
-        let x204 = x194 * x203;
-        let x205 = 1.0 / libm::fma(-x195, x196, libm::fma(-x73, x188, x59));
-        let x206 = libm::fma(-x195, x198, libm::fma(-x73, x189, x49));
-        let x207 = x205 * x206;
-        let x208 = libm::fma(-x195, x200, libm::fma(-x73, x190, x80));
-        let x209 = x205 * x208;
-        let x210 = libm::fma(x195, x202, x73 * x191);
-        let x211 = x205 * x210;
-        let x212 = libm::fma(x195, x204, libm::fma(-x73, x192, x8));
-        let x213 = x205 * x212;
-        let x214 = libm::fma(
-            -x206,
-            x207,
-            libm::fma(-x197, x198, libm::fma(-x76, x189, x35)),
+        let x214 = x208 * x213;
+        let x215 = libm::fma(
+            -x201,
+            x202,
+            libm::fma(-x192, x193, libm::fma(-x74, x184, x9)),
         );
-        let x215 = 1.0 / x214;
-        let x216 = libm::fma(
-            -x206,
-            x209,
-            libm::fma(-x197, x200, libm::fma(-x76, x190, x27)),
-        );
-        let x217 = x215 * x216;
-        let x218 = libm::fma(x206, x211, -libm::fma(x197, x202, x76 * x191));
-        let x219 = x215 * x218;
-        let x220 = libm::fma(
-            -x206,
-            x213,
-            libm::fma(x197, x204, libm::fma(-x76, x192, x8)),
-        );
-        let x221 = x215 * x220;
-        let x222 = libm::fma(
-            -x208,
-            x209,
-            libm::fma(-x199, x200, libm::fma(-x84, x190, x13)),
-        );
-        let x223 = 1.0 / libm::fma(-x216, x217, x222);
-        let x224 = libm::fma(
-            -x216,
-            x219,
-            libm::fma(x208, x211, -libm::fma(x199, x202, x84 * x191)),
-        );
-        let x225 = x223 * x224;
-        let x226 = libm::fma(
-            -x208,
-            x213,
-            libm::fma(x199, x204, libm::fma(-x84, x192, x8)),
-        );
-        let x227 = libm::fma(-x216, x221, x226);
-        let x228 = x223 * x227;
-        let x229 = libm::fma(
-            -x210,
-            x211,
-            libm::fma(-x201, x202, libm::fma(-x87, x191, 47.471)),
-        );
-        let x230 = 1.0 / libm::fma(-x224, x225, libm::fma(-x218, x219, x229));
-        let x231 = libm::fma(
-            -x218,
-            x221,
-            libm::fma(x210, x213, libm::fma(-x87, x192, x201 * x204)),
-        );
-        let x232 = libm::fma(-x224, x228, x231);
-        let x233 = x230 * x232;
-        let x234 = libm::fma(
-            -x212,
-            x213,
-            libm::fma(-x203, x204, libm::fma(-x92, x192, 9.336)),
-        );
-        let x235 = libm::fma(
-            -x232,
-            x233,
-            libm::fma(-x227, x228, libm::fma(-x220, x221, x234)),
-        );
-        let x236 = 1.0 / x235;
-        let x237 = libm::fma(
-            -x185,
-            x187,
-            tau[1]
-                - (libm::fma(0.5692, x182, libm::fma(-s_q2, x179, c_q2 * x181))
-                    - libm::fma(x93, x100, f_ext[1][5])),
-        );
-        let x238 = libm::fma(-x196, x237, libm::fma(-x185, x188, tau[2] - x180));
-        let x239 = libm::fma(
-            -x207,
-            x238,
-            libm::fma(-x198, x237, libm::fma(-x185, x189, tau[3] - x173)),
-        );
-        let x240 = libm::fma(
+        let x216 = 1.0 / libm::fma(-x209, x210, x215);
+        let x217 = libm::fma(
             -x209,
-            x238,
-            libm::fma(-x200, x237, libm::fma(-x185, x190, tau[4] - x166)),
+            x212,
+            libm::fma(x201, x204, -libm::fma(x192, x195, x74 * x185)),
         );
-        let x241 = libm::fma(-x217, x239, x240);
-        let x242 = libm::fma(
-            x211,
-            x238,
-            libm::fma(-x202, x237, libm::fma(-x185, x191, tau[5] - x160)),
+        let x218 = x216 * x217;
+        let x219 = libm::fma(
+            -x201,
+            x206,
+            libm::fma(x192, x197, libm::fma(-x74, x186, x81)),
         );
-        let x243 = libm::fma(-x225, x241, libm::fma(-x219, x239, x242));
-        let x244 = libm::fma(
-            -x213,
-            x238,
-            libm::fma(x204, x237, libm::fma(-x185, x192, tau[6] - x151)),
+        let x220 = libm::fma(-x209, x214, x219);
+        let x221 = x216 * x220;
+        let x222 = libm::fma(
+            -x203,
+            x204,
+            libm::fma(-x194, x195, libm::fma(-x79, x185, 47.471)),
         );
-        let x245 = libm::fma(
-            -x233,
-            x243,
-            libm::fma(-x228, x241, libm::fma(-x221, x239, x244)),
+        let x223 = 1.0 / libm::fma(-x217, x218, libm::fma(-x211, x212, x222));
+        let x224 = libm::fma(
+            -x211,
+            x214,
+            libm::fma(x203, x206, libm::fma(-x79, x186, x194 * x197)),
         );
-        let x246 = x236 * x245;
-        let x247 = libm::fma(-x233, x246, x230 * x243);
-        let x248 = libm::fma(-x228, x246, libm::fma(-x225, x247, x223 * x241));
-        let x249 = libm::fma(
-            -x221,
-            x246,
-            libm::fma(-x219, x247, libm::fma(-x217, x248, x215 * x239)),
+        let x225 = libm::fma(-x217, x221, x224);
+        let x226 = x223 * x225;
+        let x227 = libm::fma(
+            -x205,
+            x206,
+            libm::fma(-x196, x197, libm::fma(-x86, x186, 9.336)),
         );
-        let x250 = libm::fma(
-            x211,
-            x247,
-            libm::fma(-x209, x248, libm::fma(-x207, x249, x205 * x238)),
+        let x228 = libm::fma(
+            -x225,
+            x226,
+            libm::fma(-x220, x221, libm::fma(-x213, x214, x227)),
         );
-        let x251 = libm::fma(-x213, x246, x250);
-        let x252 = libm::fma(
+        let x229 = 1.0 / x228;
+        let x230 = libm::fma(
+            -x179,
+            x181,
+            tau[1]
+                - (libm::fma(0.5692, x176, libm::fma(-s_q2, x173, c_q2 * x175))
+                    - libm::fma(x87, x94, f_ext[1][5])),
+        );
+        let x231 = libm::fma(-x189, x230, libm::fma(-x179, x182, tau[2] - x174));
+        let x232 = libm::fma(
             -x200,
-            x248,
-            libm::fma(-x198, x249, libm::fma(-x196, x251, x194 * x237)),
+            x231,
+            libm::fma(-x191, x230, libm::fma(-x179, x183, tau[3] - x167)),
         );
-        let x253 = libm::fma(x204, x246, libm::fma(-x202, x247, x252));
-        let x254 = libm::fma(
-            -x189,
-            x249,
-            libm::fma(-x188, x251, libm::fma(-x187, x253, x185 * x186)),
+        let x233 = libm::fma(
+            -x202,
+            x231,
+            libm::fma(-x193, x230, libm::fma(-x179, x184, tau[4] - x160)),
         );
-        let x255 = libm::fma(
-            -x192,
-            x246,
-            libm::fma(-x191, x247, libm::fma(-x190, x248, x254)),
+        let x234 = libm::fma(-x210, x232, x233);
+        let x235 = libm::fma(
+            x204,
+            x231,
+            libm::fma(-x195, x230, libm::fma(-x179, x185, tau[5] - x154)),
         );
-        [x255, x253, x251, x249, x248, x247, x246]
+        let x236 = libm::fma(-x218, x234, libm::fma(-x212, x232, x235));
+        let x237 = libm::fma(
+            -x206,
+            x231,
+            libm::fma(x197, x230, libm::fma(-x179, x186, tau[6] - x145)),
+        );
+        let x238 = libm::fma(
+            -x226,
+            x236,
+            libm::fma(-x221, x234, libm::fma(-x214, x232, x237)),
+        );
+        let x239 = x229 * x238;
+        let x240 = libm::fma(-x226, x239, x223 * x236);
+        let x241 = libm::fma(-x221, x239, libm::fma(-x218, x240, x216 * x234));
+        let x242 = libm::fma(
+            -x214,
+            x239,
+            libm::fma(-x212, x240, libm::fma(-x210, x241, x208 * x232)),
+        );
+        let x243 = libm::fma(
+            x204,
+            x240,
+            libm::fma(-x202, x241, libm::fma(-x200, x242, x198 * x231)),
+        );
+        let x244 = libm::fma(-x206, x239, x243);
+        let x245 = libm::fma(
+            -x193,
+            x241,
+            libm::fma(-x191, x242, libm::fma(-x189, x244, x187 * x230)),
+        );
+        let x246 = libm::fma(x197, x239, libm::fma(-x195, x240, x245));
+        let x247 = libm::fma(
+            -x183,
+            x242,
+            libm::fma(-x182, x244, libm::fma(-x181, x246, x179 * x180)),
+        );
+        let x248 = libm::fma(
+            -x186,
+            x239,
+            libm::fma(-x185, x240, libm::fma(-x184, x241, x247)),
+        );
+        [x248, x246, x244, x242, x241, x240, x239]
     }
 }

@@ -12,16 +12,16 @@
 //! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet).
 //!
-//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither):
+//! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
-//! | function | mass matrix | bias | forward | mul | add | div | sqrt | sincos | mul + add |
-//! |---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` * | `recurrent` | — | — | 681 | 661 | 0 | 0 | 7 | 1342 |
-//! | `nonlinear_effects` * | — | `recurrent` | — | 618 | 450 | 0 | 0 | 7 | 1068 |
-//! | `inverse_dynamics` * | — | `recurrent` | — | 1059 | 1016 | 0 | 0 | 7 | 2075 |
-//! | `forward_dynamics` * | `recurrent` | `recurrent` | `ldlt` | 1138 | 1072 | 7 | 0 | 7 | 2210 |
-//! | `mass_matrix_and_nonlinear_effects` * | `recurrent` | `recurrent` | — | 1012 | 967 | 0 | 0 | 7 | 1979 |
-//! | `forward_dynamics_with_wrenches` * | `recurrent` | `recurrent` | `ldlt` | 1242 | 1177 | 7 | 0 | 7 | 2419 |
+//! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
+//! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
+//! | `mass_matrix` * | `recurrent` | — | — | model | 681 | 661 | 0 | 0 | 7 | 1342 |
+//! | `nonlinear_effects` * | — | `recurrent` | — | model | 618 | 450 | 0 | 0 | 7 | 1068 |
+//! | `inverse_dynamics` * | — | `recurrent` | — | model | 1059 | 1016 | 0 | 0 | 7 | 2075 |
+//! | `forward_dynamics` * | `recurrent` | `recurrent` | `ldlt` | model | 1138 | 1072 | 7 | 0 | 7 | 2210 |
+//! | `mass_matrix_and_nonlinear_effects` * | `recurrent` | `recurrent` | — | model | 1012 | 967 | 0 | 0 | 7 | 1979 |
+//! | `forward_dynamics_with_wrenches` * | `recurrent` | `recurrent` | `ldlt` | model | 1242 | 1177 | 7 | 0 | 7 | 2419 |
 /// Dynamics of `ssrms_nguyen_hughes_1994` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct SsrmsRecurrent;
@@ -37,6 +37,9 @@ pub struct OpCount {
     /// Its forward-dynamics method (`ldlt`: LDLᵀ on the mass matrix and the bias; `aba`:
     /// the articulated-body algorithm, which uses neither), for forward dynamics.
     pub forward_method: Option<&'static str>,
+    /// The body frames it is traced in: `model` (the model's own) or `canonical` (every
+    /// joint axis z, modified-DH x; the same joint-space results).
+    pub frames: &'static str,
     /// Multiplications.
     pub mul: u64,
     /// Additions and subtractions.
@@ -84,6 +87,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 681u64,
             add: 661u64,
             div: 0u64,
@@ -96,6 +100,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 618u64,
             add: 450u64,
             div: 0u64,
@@ -108,6 +113,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 1059u64,
             add: 1016u64,
             div: 0u64,
@@ -120,6 +126,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
+            frames: "model",
             mul: 1138u64,
             add: 1072u64,
             div: 7u64,
@@ -132,6 +139,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 1012u64,
             add: 967u64,
             div: 0u64,
@@ -144,6 +152,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
+            frames: "model",
             mul: 1242u64,
             add: 1177u64,
             div: 7u64,
@@ -159,6 +168,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: None,
             forward_method: None,
+            frames: "model",
             mul: 681u64,
             add: 661u64,
             div: 0u64,
@@ -171,6 +181,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 618u64,
             add: 450u64,
             div: 0u64,
@@ -183,6 +194,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: None,
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 1059u64,
             add: 1016u64,
             div: 0u64,
@@ -195,6 +207,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
+            frames: "model",
             mul: 1138u64,
             add: 1072u64,
             div: 7u64,
@@ -207,6 +220,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: Some("recurrent"),
             forward_method: None,
+            frames: "model",
             mul: 1012u64,
             add: 967u64,
             div: 0u64,
@@ -219,6 +233,7 @@ impl SsrmsRecurrent {
             mass_matrix_method: Some("recurrent"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
+            frames: "model",
             mul: 1242u64,
             add: 1177u64,
             div: 7u64,

@@ -527,6 +527,7 @@ fn generic_params(n: usize, input: &mut impl FnMut(Input) -> Sym) -> Params<Sym>
                 upsilon,
                 axis,
                 coordinate_axis: None,
+                placement_permutation: false,
                 mass,
                 com,
                 inertia_com,

@@ -42,33 +42,34 @@
 //!
 //! Emitted operations (`mul + add` after folding, common-subexpression and dead-code
 //! elimination; divisions apart) of the generated `forward_dynamics`: fixed base, no gravity,
-//! regrouped parameters (`kanegen_codegen`'s defaults). LDLᵀ on the CRBA's `M` and the RNEA's
-//! `c`; LDLᵀ as the generator pairs it, with its cheapest mass-matrix method and its cheapest
-//! bias method (on the random chains the classical Newton–Euler at N = 4, the base-frame CRBA
-//! and the paper's bias recursion from N = 8); this algorithm. The random chains are `random_chain(N, seed 1000 + N)` of
+//! regrouped parameters, in the body frames the generator chose (`kanegen_codegen`'s defaults:
+//! the random chains in canonical frames, every joint axis z). LDLᵀ on the CRBA's `M` and the
+//! RNEA's `c`; LDLᵀ as the generator pairs it, with its cheapest mass-matrix method and its
+//! cheapest bias method (on the random chains up to N = 9 the CRBA and the classical
+//! Newton–Euler); this algorithm. The random chains are `random_chain(N, seed 1000 + N)` of
 //! `benches/data` (general geometry: dense rotations, skew axes). `codegen/tests/aba.rs` measures
 //! them again and fails when this table is stale.
 //!
 //! | model | N | LDLᵀ, CRBA + RNEA | LDLᵀ, cheapest | ABA | div (cheapest LDLᵀ / ABA) | emitted |
 //! |---|---:|---:|---:|---:|---:|---|
-//! | SSRMS (Nguyen & Hughes 1994) | 7 | 945 | 862 | 944 | 7 / 5 | LDLᵀ |
-//! | random chain | 4 | 1896 | 1764 | 2418 | 4 / 3 | LDLᵀ |
-//! | random chain | 8 | 5316 | 4401 | 5710 | 8 / 7 | LDLᵀ |
-//! | random chain | 16 | 15548 | 11513 | 12294 | 16 / 15 | LDLᵀ |
-//! | random chain | 32 | 53164 | 37129 | 25462 | 32 / 31 | ABA |
-//! | random chain | 64 | 225676 | 162601 | 51798 | 64 / 63 | ABA |
+//! | SSRMS (Nguyen & Hughes 1994) | 7 | 883 | 800 | 944 | 7 / 5 | LDLᵀ |
+//! | random chain | 4 | 1074 | 981 | 1328 | 4 / 3 | LDLᵀ |
+//! | random chain | 8 | 3536 | 3279 | 3520 | 8 / 7 | LDLᵀ |
+//! | random chain | 16 | 11420 | 10393 | 7905 | 16 / 15 | ABA |
+//! | random chain | 32 | 42612 | 34889 | 16672 | 32 / 31 | ABA |
+//! | random chain | 64 | 195364 | 158121 | 34209 | 64 / 63 | ABA |
 //!
-//! On the random chains ABA costs `823 N − 874` exactly (823 per joint, of which 324 carry
-//! `I^a` to the parent through a dense rotation), LDLᵀ grows like `N³/6` on top of the mass
-//! matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is cheaper than LDLᵀ on
-//! the CRBA and the RNEA from **N = 10** (7356 against 7426), and than the generator's cheapest
-//! LDLᵀ from **N = 19** (14763 against 15016), which is where generated code switches to it;
-//! at N = 64 it needs 3.1× fewer operations. SSRMS is close already at N = 7 (ABA 944 against
-//! 945 for LDLᵀ on the CRBA and the RNEA), but LDLᵀ with the classical Newton–Euler bias costs
-//! 862 and is emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
+//! On the random chains ABA costs `548 N − 864` (within one operation; in the chains' own
+//! frames, with dense rotations and skew axes, it was `823 N − 874`), LDLᵀ grows like `N³/6` on
+//! top of the mass matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is
+//! cheaper than LDLᵀ on the CRBA and the RNEA from **N = 8** (3520 against 3536), and than the
+//! generator's cheapest LDLᵀ from **N = 10** (4616 against 4774), which is where generated code
+//! switches to it; at N = 64 it needs 4.6× fewer operations. On SSRMS (N = 7) ABA costs 944 against 883 for LDLᵀ
+//! on the CRBA and the RNEA, and LDLᵀ with the classical Newton–Euler bias costs 800 and is
+//! emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
 //! and its joint placements signed permutations and offsets along one axis, which fold. A
 //! free-floating base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: the 7-dof
-//! free-flyer of `kanegen-generated` emits ABA (2898 against 3086 for its cheapest LDLᵀ, its
+//! free-flyer of `kanegen-generated` emits ABA (2890 against 3002 for its cheapest LDLᵀ, its
 //! axes being coordinate axes too). The
 //! leaf's `D` is a constant of the model, hence `N − 1` divisions.
 //!

@@ -20,26 +20,31 @@
 //! ```
 
 use crate::base::{FloatingBase, FLOATING_BASE_DOF};
-use crate::joint::{inertia_s, s_tr, xup};
+use crate::joint::{carry_inertia, inertia_s, s_tr, xup_trig, XupTrig};
 use crate::linalg::Vec3;
 use crate::params::Params;
 use crate::scalar::Scalar;
-use crate::spatial::{base_rows, Motion, RbInertia, Xform};
+use crate::spatial::{base_rows, Motion, RbInertia};
 
-/// `Xup_j` of every joint (one `sin_cos` per revolute joint).
-fn transforms<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Xform<S>> {
+/// `Xup_j` of every joint, with its sine and cosine (one `sin_cos` per revolute joint).
+fn transforms<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<XupTrig<S>> {
     assert_eq!(q.len(), p.dof(), "q has the wrong length");
-    p.joints.iter().zip(q).map(|(jp, qj)| xup(jp, qj)).collect()
+    p.joints
+        .iter()
+        .zip(q)
+        .map(|(jp, qj)| xup_trig(jp, qj))
+        .collect()
 }
 
 /// Composite inertias `IC_i` of the subtrees (RBDA Table 6.2 backward loop):
 /// `IC_i = I_i`, then, for `i = N−1 … 0` with a parent body, `IC_λ(i) += Xup_iᵀ IC_i Xup_i`.
 /// The subtrees hanging from the base are left to the caller.
-fn composite<S: Scalar>(p: &Params<S>, xup: &[Xform<S>]) -> Vec<RbInertia<S>> {
+/// Each carry by [`carry_inertia`].
+fn composite<S: Scalar>(p: &Params<S>, xup: &[XupTrig<S>]) -> Vec<RbInertia<S>> {
     let mut ic: Vec<RbInertia<S>> = p.joints.iter().map(|jp| jp.inertia.clone()).collect();
     for (i, jp) in p.joints.iter().enumerate().rev() {
         if let Some(lambda) = jp.parent {
-            let carried = xup[i].tr_inertia(&ic[i]);
+            let carried = carry_inertia(jp, &xup[i], &ic[i]);
             let parent = ic[lambda].clone();
             ic[lambda] = parent + carried;
         }
@@ -64,7 +69,7 @@ pub fn mass_matrix<S: Scalar>(p: &Params<S>, q: &[S]) -> Vec<Vec<S>> {
         h[i][i] = s_tr(&p.joints[i], &f);
         let mut j = i;
         while let Some(lambda) = p.joints[j].parent {
-            f = xup[j].tr_apply(&f);
+            f = xup[j].0.tr_apply(&f);
             j = lambda;
             let hij = s_tr(&p.joints[j], &f);
             h[j][i] = hij.clone();
@@ -99,7 +104,7 @@ pub fn floating_mass_matrix<S: Scalar>(
     let mut ic0 = i_base;
     for (i, jp) in p.joints.iter().enumerate() {
         if jp.parent.is_none() {
-            ic0 = ic0 + xup[i].tr_inertia(&ic[i]);
+            ic0 = ic0 + carry_inertia(jp, &xup[i], &ic[i]);
         }
     }
     let mut a = vec![vec![S::zero(); nb + n]; nb + n];
@@ -134,7 +139,7 @@ pub fn floating_mass_matrix<S: Scalar>(
         // Over the ancestors as in `mass_matrix`, then from the subtree's root onto the base.
         let mut j = i;
         loop {
-            f = xup[j].tr_apply(&f);
+            f = xup[j].0.tr_apply(&f);
             let Some(lambda) = p.joints[j].parent else {
                 break;
             };
