@@ -9,67 +9,87 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 4304 (`mass_matrix` 348, `nonlinear_effects` 323, `inverse_dynamics` 338, `forward_dynamics` 986, `mass_matrix_and_nonlinear_effects` 669, `forward_dynamics_with_wrenches` 987, `momentum` 221, `base_reaction` 432), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4116 (`mass_matrix` 301, `nonlinear_effects` 317, `inverse_dynamics` 332, `forward_dynamics` 953, `mass_matrix_and_nonlinear_effects` 618, `forward_dynamics_with_wrenches` 954, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
 //! | function | mass matrix | bias | forward | frames | mul | add | div | sqrt | sincos | mul + add |
 //! |---|---|---|---|---|---:|---:|---:|---:|---:|---:|
-//! | `mass_matrix` | `recurrent` | — | — | model | 1828 | 2486 | 0 | 0 | 7 | 4314 |
-//! | `mass_matrix` | `recurrent` | — | — | canonical | 1843 | 2501 | 0 | 0 | 7 | 4344 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | model | 2107 | 2555 | 0 | 0 | 7 | 4662 |
-//! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 2122 | 2570 | 0 | 0 | 7 | 4692 |
-//! | `mass_matrix` | `kane-direct` | — | — | model | 3457 | 2893 | 0 | 0 | 7 | 6350 |
-//! | `mass_matrix` | `kane-direct` | — | — | canonical | 3472 | 2908 | 0 | 0 | 7 | 6380 |
-//! | `mass_matrix` | `crba-base` | — | — | model | 1306 | 1037 | 0 | 0 | 7 | 2343 |
-//! | `mass_matrix` | `crba-base` | — | — | canonical | 1321 | 1052 | 0 | 0 | 7 | 2373 |
-//! | `mass_matrix` * | `crba` | — | — | model | 598 | 517 | 0 | 0 | 7 | 1115 |
-//! | `mass_matrix` | `crba` | — | — | canonical | 604 | 529 | 0 | 0 | 7 | 1133 |
-//! | `nonlinear_effects` | — | `recurrent` | — | model | 1150 | 881 | 0 | 0 | 7 | 2031 |
-//! | `nonlinear_effects` | — | `recurrent` | — | canonical | 1165 | 896 | 0 | 0 | 7 | 2061 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | model | 1567 | 1276 | 0 | 0 | 7 | 2843 |
-//! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 1582 | 1291 | 0 | 0 | 7 | 2873 |
-//! | `nonlinear_effects` | — | `rnea` | — | model | 635 | 502 | 0 | 0 | 7 | 1137 |
-//! | `nonlinear_effects` | — | `rnea` | — | canonical | 635 | 502 | 0 | 0 | 7 | 1137 |
-//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 532 | 428 | 0 | 0 | 7 | 960 |
-//! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 532 | 428 | 0 | 0 | 7 | 960 |
-//! | `inverse_dynamics` | — | `recurrent` | — | model | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | model | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `rnea` | — | model | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` | — | `rnea` | — | canonical | 674 | 548 | 0 | 0 | 7 | 1222 |
-//! | `inverse_dynamics` * | — | `newton-euler` | — | model | 547 | 458 | 0 | 0 | 7 | 1005 |
-//! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 547 | 458 | 0 | 0 | 7 | 1005 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2248 | 1837 | 10 | 0 | 7 | 4085 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2280 | 1865 | 10 | 0 | 7 | 4145 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2665 | 2232 | 10 | 0 | 7 | 4897 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2697 | 2260 | 10 | 0 | 7 | 4957 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1723 | 1456 | 10 | 0 | 7 | 3179 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1740 | 1469 | 10 | 0 | 7 | 3209 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1620 | 1382 | 10 | 0 | 7 | 3002 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1637 | 1395 | 10 | 0 | 7 | 3032 |
-//! | `forward_dynamics` * | — | — | `aba` | model | 1613 | 1277 | 12 | 0 | 7 | 2890 |
-//! | `forward_dynamics` | — | — | `aba` | canonical | 1615 | 1280 | 12 | 0 | 7 | 2895 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1748 | 1398 | 0 | 0 | 7 | 3146 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1769 | 1425 | 0 | 0 | 7 | 3194 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2165 | 1793 | 0 | 0 | 7 | 3958 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2186 | 1820 | 0 | 0 | 7 | 4006 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1223 | 1017 | 0 | 0 | 7 | 2240 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1229 | 1029 | 0 | 0 | 7 | 2258 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1120 | 943 | 0 | 0 | 7 | 2063 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1126 | 955 | 0 | 0 | 7 | 2081 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2392 | 1981 | 10 | 0 | 7 | 4373 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2809 | 2376 | 10 | 0 | 7 | 5185 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1723 | 1504 | 10 | 0 | 7 | 3227 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | model | 1620 | 1430 | 10 | 0 | 7 | 3050 |
-//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | model | 1613 | 1325 | 12 | 0 | 7 | 2938 |
-//! | `momentum` * | — | — | — | model | 354 | 283 | 0 | 0 | 7 | 637 |
-//! | `base_reaction` * | — | `recurrent` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
-//! | `base_reaction` | — | `kane-direct` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
-//! | `base_reaction` | — | `rnea` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
-//! | `base_reaction` | — | `newton-euler` | — | model | 692 | 566 | 0 | 0 | 7 | 1258 |
+//! | `mass_matrix` | `recurrent` | — | — | model | 1825 | 2486 | 0 | 0 | 7 | 4311 |
+//! | `mass_matrix` | `recurrent` | — | — | canonical | 1840 | 2501 | 0 | 0 | 7 | 4341 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | model | 2104 | 2555 | 0 | 0 | 7 | 4659 |
+//! | `mass_matrix` | `recurrent-r1` | — | — | canonical | 2119 | 2570 | 0 | 0 | 7 | 4689 |
+//! | `mass_matrix` | `kane-direct` | — | — | model | 3454 | 2893 | 0 | 0 | 7 | 6347 |
+//! | `mass_matrix` | `kane-direct` | — | — | canonical | 3469 | 2908 | 0 | 0 | 7 | 6377 |
+//! | `mass_matrix` | `crba-base` | — | — | model | 1303 | 1037 | 0 | 0 | 7 | 2340 |
+//! | `mass_matrix` | `crba-base` | — | — | canonical | 1318 | 1052 | 0 | 0 | 7 | 2370 |
+//! | `mass_matrix` * | `crba` | — | — | model | 556 | 509 | 0 | 0 | 7 | 1065 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 572 | 519 | 0 | 0 | 7 | 1091 |
+//! | `nonlinear_effects` | — | `recurrent` | — | model | 1147 | 881 | 0 | 0 | 7 | 2028 |
+//! | `nonlinear_effects` | — | `recurrent` | — | canonical | 1162 | 896 | 0 | 0 | 7 | 2058 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | model | 1564 | 1276 | 0 | 0 | 7 | 2840 |
+//! | `nonlinear_effects` | — | `kane-direct` | — | canonical | 1579 | 1291 | 0 | 0 | 7 | 2870 |
+//! | `nonlinear_effects` | — | `rnea` | — | model | 631 | 502 | 0 | 0 | 7 | 1133 |
+//! | `nonlinear_effects` | — | `rnea` | — | canonical | 633 | 502 | 0 | 0 | 7 | 1135 |
+//! | `nonlinear_effects` * | — | `newton-euler` | — | model | 528 | 428 | 0 | 0 | 7 | 956 |
+//! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 530 | 428 | 0 | 0 | 7 | 958 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 670 | 548 | 0 | 0 | 7 | 1218 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 670 | 548 | 0 | 0 | 7 | 1218 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
+//! | `inverse_dynamics` | — | `rnea` | — | model | 670 | 548 | 0 | 0 | 7 | 1218 |
+//! | `inverse_dynamics` | — | `rnea` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
+//! | `inverse_dynamics` * | — | `newton-euler` | — | model | 543 | 458 | 0 | 0 | 7 | 1001 |
+//! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 545 | 458 | 0 | 0 | 7 | 1003 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2203 | 1829 | 10 | 0 | 7 | 4032 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2245 | 1855 | 10 | 0 | 7 | 4100 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2620 | 2224 | 10 | 0 | 7 | 4844 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2662 | 2250 | 10 | 0 | 7 | 4912 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1679 | 1448 | 10 | 0 | 7 | 3127 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1708 | 1459 | 10 | 0 | 7 | 3167 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1374 | 10 | 0 | 7 | 2950 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1605 | 1385 | 10 | 0 | 7 | 2990 |
+//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 2505 | 2118 | 13 | 0 | 7 | 4623 |
+//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 2520 | 2133 | 13 | 0 | 7 | 4653 |
+//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 2922 | 2513 | 13 | 0 | 7 | 5435 |
+//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 2937 | 2528 | 13 | 0 | 7 | 5465 |
+//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2066 | 13 | 0 | 7 | 4611 |
+//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 2562 | 2081 | 13 | 0 | 7 | 4643 |
+//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 2442 | 1992 | 13 | 0 | 7 | 4434 |
+//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 2459 | 2007 | 13 | 0 | 7 | 4466 |
+//! | `forward_dynamics` * | — | — | `aba` | model | 1592 | 1277 | 12 | 0 | 7 | 2869 |
+//! | `forward_dynamics` | — | — | `aba` | canonical | 1601 | 1280 | 12 | 0 | 7 | 2881 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1703 | 1390 | 0 | 0 | 7 | 3093 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1734 | 1415 | 0 | 0 | 7 | 3149 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2120 | 1785 | 0 | 0 | 7 | 3905 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2151 | 1810 | 0 | 0 | 7 | 3961 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1179 | 1009 | 0 | 0 | 7 | 2188 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1197 | 1019 | 0 | 0 | 7 | 2216 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1076 | 935 | 0 | 0 | 7 | 2011 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1094 | 945 | 0 | 0 | 7 | 2039 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 1894 | 1591 | 0 | 0 | 7 | 3485 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 1909 | 1606 | 0 | 0 | 7 | 3515 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 2311 | 1986 | 0 | 0 | 7 | 4297 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 2326 | 2001 | 0 | 0 | 7 | 4327 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 1934 | 1539 | 0 | 0 | 7 | 3473 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 1951 | 1554 | 0 | 0 | 7 | 3505 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 1831 | 1465 | 0 | 0 | 7 | 3296 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 1848 | 1480 | 0 | 0 | 7 | 3328 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2347 | 1973 | 10 | 0 | 7 | 4320 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2764 | 2368 | 10 | 0 | 7 | 5132 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1679 | 1496 | 10 | 0 | 7 | 3175 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1422 | 10 | 0 | 7 | 2998 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 2649 | 2262 | 13 | 0 | 7 | 4911 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 3066 | 2657 | 13 | 0 | 7 | 5723 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2114 | 13 | 0 | 7 | 4659 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 2442 | 2040 | 13 | 0 | 7 | 4482 |
+//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | model | 1592 | 1325 | 12 | 0 | 7 | 2917 |
+//! | `momentum` * | — | — | — | model | 350 | 283 | 0 | 0 | 7 | 633 |
+//! | `base_reaction` * | — | `recurrent` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
+//! | `base_reaction` | — | `kane-direct` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
+//! | `base_reaction` | — | `rnea` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
+//! | `base_reaction` | — | `newton-euler` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
 /// Dynamics of `bmsd_7dof_free_floating` (N = 7); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct FreeFloating7;
@@ -140,12 +160,12 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 598u64,
-            add: 517u64,
+            mul: 556u64,
+            add: 509u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 348u64,
+            fma: 301u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -153,12 +173,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 532u64,
+            mul: 528u64,
             add: 428u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 323u64,
+            fma: 317u64,
         },
         OpCount {
             function: "inverse_dynamics",
@@ -166,12 +186,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 547u64,
+            mul: 543u64,
             add: 458u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 338u64,
+            fma: 332u64,
         },
         OpCount {
             function: "forward_dynamics",
@@ -179,12 +199,12 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "model",
-            mul: 1613u64,
+            mul: 1592u64,
             add: 1277u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 986u64,
+            fma: 953u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -192,12 +212,12 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1120u64,
-            add: 943u64,
+            mul: 1076u64,
+            add: 935u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 669u64,
+            fma: 618u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -205,12 +225,12 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "model",
-            mul: 1613u64,
+            mul: 1592u64,
             add: 1325u64,
             div: 12u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 987u64,
+            fma: 954u64,
         },
         OpCount {
             function: "momentum",
@@ -218,12 +238,12 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 354u64,
+            mul: 350u64,
             add: 283u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 221u64,
+            fma: 215u64,
         },
         OpCount {
             function: "base_reaction",
@@ -231,12 +251,12 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 692u64,
+            mul: 688u64,
             add: 566u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 432u64,
+            fma: 426u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -247,7 +267,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 1828u64,
+            mul: 1825u64,
             add: 2486u64,
             div: 0u64,
             sqrt: 0u64,
@@ -260,7 +280,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 1843u64,
+            mul: 1840u64,
             add: 2501u64,
             div: 0u64,
             sqrt: 0u64,
@@ -273,7 +293,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 2107u64,
+            mul: 2104u64,
             add: 2555u64,
             div: 0u64,
             sqrt: 0u64,
@@ -286,7 +306,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 2122u64,
+            mul: 2119u64,
             add: 2570u64,
             div: 0u64,
             sqrt: 0u64,
@@ -299,7 +319,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 3457u64,
+            mul: 3454u64,
             add: 2893u64,
             div: 0u64,
             sqrt: 0u64,
@@ -312,7 +332,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 3472u64,
+            mul: 3469u64,
             add: 2908u64,
             div: 0u64,
             sqrt: 0u64,
@@ -325,7 +345,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 1306u64,
+            mul: 1303u64,
             add: 1037u64,
             div: 0u64,
             sqrt: 0u64,
@@ -338,7 +358,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 1321u64,
+            mul: 1318u64,
             add: 1052u64,
             div: 0u64,
             sqrt: 0u64,
@@ -351,8 +371,8 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 598u64,
-            add: 517u64,
+            mul: 556u64,
+            add: 509u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -364,8 +384,8 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 604u64,
-            add: 529u64,
+            mul: 572u64,
+            add: 519u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -377,7 +397,7 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 1150u64,
+            mul: 1147u64,
             add: 881u64,
             div: 0u64,
             sqrt: 0u64,
@@ -390,7 +410,7 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 1165u64,
+            mul: 1162u64,
             add: 896u64,
             div: 0u64,
             sqrt: 0u64,
@@ -403,7 +423,7 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 1567u64,
+            mul: 1564u64,
             add: 1276u64,
             div: 0u64,
             sqrt: 0u64,
@@ -416,7 +436,7 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 1582u64,
+            mul: 1579u64,
             add: 1291u64,
             div: 0u64,
             sqrt: 0u64,
@@ -429,7 +449,7 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 635u64,
+            mul: 631u64,
             add: 502u64,
             div: 0u64,
             sqrt: 0u64,
@@ -442,7 +462,7 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 635u64,
+            mul: 633u64,
             add: 502u64,
             div: 0u64,
             sqrt: 0u64,
@@ -455,7 +475,7 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 532u64,
+            mul: 528u64,
             add: 428u64,
             div: 0u64,
             sqrt: 0u64,
@@ -468,7 +488,7 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 532u64,
+            mul: 530u64,
             add: 428u64,
             div: 0u64,
             sqrt: 0u64,
@@ -481,7 +501,7 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 674u64,
+            mul: 670u64,
             add: 548u64,
             div: 0u64,
             sqrt: 0u64,
@@ -494,7 +514,7 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 674u64,
+            mul: 672u64,
             add: 548u64,
             div: 0u64,
             sqrt: 0u64,
@@ -507,7 +527,7 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 674u64,
+            mul: 670u64,
             add: 548u64,
             div: 0u64,
             sqrt: 0u64,
@@ -520,7 +540,7 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 674u64,
+            mul: 672u64,
             add: 548u64,
             div: 0u64,
             sqrt: 0u64,
@@ -533,7 +553,7 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 674u64,
+            mul: 670u64,
             add: 548u64,
             div: 0u64,
             sqrt: 0u64,
@@ -546,7 +566,7 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 674u64,
+            mul: 672u64,
             add: 548u64,
             div: 0u64,
             sqrt: 0u64,
@@ -559,7 +579,7 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 547u64,
+            mul: 543u64,
             add: 458u64,
             div: 0u64,
             sqrt: 0u64,
@@ -572,7 +592,7 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 547u64,
+            mul: 545u64,
             add: 458u64,
             div: 0u64,
             sqrt: 0u64,
@@ -585,8 +605,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2248u64,
-            add: 1837u64,
+            mul: 2203u64,
+            add: 1829u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -598,8 +618,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 2280u64,
-            add: 1865u64,
+            mul: 2245u64,
+            add: 1855u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -611,8 +631,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2665u64,
-            add: 2232u64,
+            mul: 2620u64,
+            add: 2224u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -624,8 +644,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 2697u64,
-            add: 2260u64,
+            mul: 2662u64,
+            add: 2250u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -637,8 +657,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1723u64,
-            add: 1456u64,
+            mul: 1679u64,
+            add: 1448u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -650,8 +670,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 1740u64,
-            add: 1469u64,
+            mul: 1708u64,
+            add: 1459u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -663,8 +683,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1620u64,
-            add: 1382u64,
+            mul: 1576u64,
+            add: 1374u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -676,9 +696,113 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 1637u64,
-            add: 1395u64,
+            mul: 1605u64,
+            add: 1385u64,
             div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2505u64,
+            add: 2118u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 2520u64,
+            add: 2133u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2922u64,
+            add: 2513u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 2937u64,
+            add: 2528u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2545u64,
+            add: 2066u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 2562u64,
+            add: 2081u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2442u64,
+            add: 1992u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 2459u64,
+            add: 2007u64,
+            div: 13u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -689,7 +813,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "model",
-            mul: 1613u64,
+            mul: 1592u64,
             add: 1277u64,
             div: 12u64,
             sqrt: 0u64,
@@ -702,7 +826,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
-            mul: 1615u64,
+            mul: 1601u64,
             add: 1280u64,
             div: 12u64,
             sqrt: 0u64,
@@ -715,8 +839,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 1748u64,
-            add: 1398u64,
+            mul: 1703u64,
+            add: 1390u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -728,8 +852,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 1769u64,
-            add: 1425u64,
+            mul: 1734u64,
+            add: 1415u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -741,8 +865,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 2165u64,
-            add: 1793u64,
+            mul: 2120u64,
+            add: 1785u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -754,8 +878,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 2186u64,
-            add: 1820u64,
+            mul: 2151u64,
+            add: 1810u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -767,8 +891,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 1223u64,
-            add: 1017u64,
+            mul: 1179u64,
+            add: 1009u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -780,8 +904,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 1229u64,
-            add: 1029u64,
+            mul: 1197u64,
+            add: 1019u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -793,8 +917,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1120u64,
-            add: 943u64,
+            mul: 1076u64,
+            add: 935u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -806,8 +930,112 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 1126u64,
-            add: 955u64,
+            mul: 1094u64,
+            add: 945u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "model",
+            mul: 1894u64,
+            add: 1591u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1909u64,
+            add: 1606u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "model",
+            mul: 2311u64,
+            add: 1986u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 2326u64,
+            add: 2001u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "model",
+            mul: 1934u64,
+            add: 1539u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1951u64,
+            add: 1554u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "model",
+            mul: 1831u64,
+            add: 1465u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 1848u64,
+            add: 1480u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -819,8 +1047,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2392u64,
-            add: 1981u64,
+            mul: 2347u64,
+            add: 1973u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -832,8 +1060,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2809u64,
-            add: 2376u64,
+            mul: 2764u64,
+            add: 2368u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -845,8 +1073,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1723u64,
-            add: 1504u64,
+            mul: 1679u64,
+            add: 1496u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -858,9 +1086,61 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1620u64,
-            add: 1430u64,
+            mul: 1576u64,
+            add: 1422u64,
             div: 10u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2649u64,
+            add: 2262u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 3066u64,
+            add: 2657u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2545u64,
+            add: 2114u64,
+            div: 13u64,
+            sqrt: 0u64,
+            sincos: 7u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 2442u64,
+            add: 2040u64,
+            div: 13u64,
             sqrt: 0u64,
             sincos: 7u64,
             fma: 0u64,
@@ -871,7 +1151,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "model",
-            mul: 1613u64,
+            mul: 1592u64,
             add: 1325u64,
             div: 12u64,
             sqrt: 0u64,
@@ -884,7 +1164,7 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 354u64,
+            mul: 350u64,
             add: 283u64,
             div: 0u64,
             sqrt: 0u64,
@@ -897,7 +1177,7 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 692u64,
+            mul: 688u64,
             add: 566u64,
             div: 0u64,
             sqrt: 0u64,
@@ -910,7 +1190,7 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 692u64,
+            mul: 688u64,
             add: 566u64,
             div: 0u64,
             sqrt: 0u64,
@@ -923,7 +1203,7 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 692u64,
+            mul: 688u64,
             add: 566u64,
             div: 0u64,
             sqrt: 0u64,
@@ -936,7 +1216,7 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 692u64,
+            mul: 688u64,
             add: 566u64,
             div: 0u64,
             sqrt: 0u64,
@@ -946,835 +1226,719 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 598 mul, 517 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 348 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 556 mul, 509 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 301 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
+        let x2 = 0.00000000020510342851533115 * c_q8;
+        let x3 = 0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x6 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
+        let x5 = 0.00000000020510342851533115 * c_q9;
+        let x6 = 0.00000000020510342851533115 * s_q9;
+        let x7 = x5 - x6;
+        let x8 = x5 + x6;
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let (s_q11, c_q11) = libm::sincos(q[11]);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x10 = -0.00000000020510342851533115 * s_q12;
-        let x11 = -0.00000000020510342851533115 * c_q12;
+        let x12 = 0.00000000020510342851533115 * s_q12;
+        let x13 = 0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x13 = -0.00000000020510342851533115 * c_q13;
-        let x14 = -0.00000000020510342851533115 * s_q13;
-        let x15 = 4.806620000000001 * x14;
-        let x16 = 4.806620000000001 * c_q13;
-        let x17 = 4.806620000000001 * s_q13;
-        let x18 = Self::mul_add(-0.000781, x14, -0.0145);
-        let x19 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x14, 0.000781 * x13);
-        let x20 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x14, -0.0145 * x13);
-        let x21 = 0.000781 * c_q13;
-        let x22 = 0.000781 * s_q13;
-        let x23 = Self::mul_add(-1.2025609200000003, c_q13, x22);
-        let x24 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x25 = x22 + 0.000000000002973999713472302;
-        let x26 = Self::mul_add(-1.2025609200000003, s_q13, -x21)
-            + 0.00000000019719894748377882;
-        let x27 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
+        let x15 = 0.00000000020510342851533115 * c_q13;
+        let x16 = 0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = Self::mul_add(0.000781, x16, -0.0145);
+        let x21 = -0.9614610000000001
+            - Self::mul_add(x16, 1.2025609200000003, 0.000781 * x15);
+        let x22 = 1.4135609200000003
+            + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
+        let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = 0.00000000019719894748377882
+            - Self::mul_add(s_q13, 1.2025609200000003, x23);
+        let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
             + -0.0000000002899261911072858;
-        let x28 = -0.16 * x17;
-        let x29 = 0.55 * x16;
-        let x30 = 0.16 * x17;
-        let x31 = x16 * -0.55;
-        let x32 = Self::mul_add(
-            0.16,
-            x15,
-            Self::mul_add(
+        let x30 = 0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = x30 + x31;
+        let x33 = 0.55 * x17;
+        let x34 = 0.16 * x17;
+        let x35 = 0.16 * x18;
+        let x36 = 0.55 * x19;
+        let x37 = x32 + (x22 + Self::mul_add(-x15, x20, x16 * x21) + x32);
+        let x38 = 3.6140000000000003 + x17;
+        let x39 = 17.135250000000003 + x18;
+        let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
+        let x41 = -0.809539999555672
+            + (Self::mul_add(
                 -0.00000000020510342851533115,
-                x20,
-                Self::mul_add(-c_q13, x18, s_q13 * x19),
-            ),
-        );
-        let x33 = Self::mul_add(
-            -0.16,
-            x16,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x24,
-                Self::mul_add(-c_q13, x21, s_q13 * x23),
-            ),
-        );
-        let x34 = x20 + Self::mul_add(-x14, x19, x13 * x18) - (x28 - x29) - (x31 - x30);
-        let x35 = Self::mul_add(
-            -0.16,
-            x16,
-            Self::mul_add(x17, -0.55, Self::mul_add(c_q13, x26, s_q13 * x25)),
-        );
-        let x36 = 3.6140000000000003 - x15;
-        let x37 = 17.135250000000003 + x16;
-        let x38 = -1.9877000000000002
-            + Self::mul_add(0.55, x15, Self::mul_add(c_q13, x19, s_q13 * x18));
-        let x39 = -0.809539999555672 + x32;
-        let x40 = -1.9877000000000002
-            + Self::mul_add(x15, 0.55, x24 + Self::mul_add(-x14, x23, x13 * x21));
-        let x41 = -5.252920330000002
-            + (Self::mul_add(c_q13, x23, s_q13 * x21) + x30 - x28);
-        let x42 = -2.741639999592316 + Self::mul_add(-0.55, x17, x33);
-        let x43 = -0.809539999555672
-            + Self::mul_add(0.16, x15, x27 + Self::mul_add(-x14, x26, x13 * x25));
-        let x44 = -2.7416399995923166 + x35;
-        let x45 = 9.740442170000001
-            + (x29
+                x22,
+                Self::mul_add(-c_q13, x20, s_q13 * x21),
+            ) - x34);
+        let x42 = -1.9877000000000002
+            + (Self::mul_add(-x15, x23, x16 * x25) - x26 - x33);
+        let x43 = -5.252920330000002
+            + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
+        let x44 = -2.741639999592316
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x26,
+                Self::mul_add(-c_q13, x23, s_q13 * x25),
+            ) - x35 - x36);
+        let x45 = -0.809539999555672 + (x29 + Self::mul_add(-x15, x27, x16 * x28) - x34);
+        let x46 = -2.7416399995923166
+            + (Self::mul_add(c_q13, x28, s_q13 * x27) - x36 - x35);
+        let x47 = 9.740442170000001
+            + (x31
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x27,
-                    Self::mul_add(-c_q13, x25, s_q13 * x26),
-                ) - x31));
-        let x46 = c_q12 * x36;
-        let x47 = s_q12 * x37;
-        let x48 = x46 - x47;
-        let x49 = x17 + Self::mul_add(x11, x37, x10 * x36);
-        let x50 = Self::mul_add(c_q12, x37, s_q12 * x36);
-        let x51 = Self::mul_add(-0.00000000020510342851533115, x17, -x50);
-        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x34);
-        let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
-        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x39);
-        let x55 = x43 + Self::mul_add(x11, x40, x10 * x34);
-        let x56 = x44 + Self::mul_add(x11, x41, x10 * x38);
-        let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
-        let x58 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x45,
-            -Self::mul_add(c_q12, x42, s_q12 * x39),
-        );
-        let x59 = x54 + Self::mul_add(x11, x53, x10 * x52);
+                    x29,
+                    Self::mul_add(-c_q13, x27, s_q13 * x28),
+                ) + x31));
+        let x48 = c_q12 * x38;
+        let x49 = s_q12 * x39;
+        let x50 = x48 - x49;
+        let x51 = x19 - Self::mul_add(x13, x39, x12 * x38);
+        let x52 = Self::mul_add(c_q12, x39, s_q12 * x38);
+        let x53 = Self::mul_add(0.00000000020510342851533115, x19, x52);
+        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x37);
+        let x55 = Self::mul_add(-s_q12, x43, c_q12 * x40);
+        let x56 = Self::mul_add(-s_q12, x44, c_q12 * x41);
+        let x57 = x45 - Self::mul_add(x13, x42, x12 * x37);
+        let x58 = x46 - Self::mul_add(x13, x43, x12 * x40);
+        let x59 = x47 - Self::mul_add(x13, x44, x12 * x41);
         let x60 = Self::mul_add(
+            0.00000000020510342851533115,
+            x47,
+            Self::mul_add(c_q12, x44, s_q12 * x41),
+        );
+        let x61 = -x60;
+        let x62 = x56 - Self::mul_add(x13, x55, x12 * x54);
+        let x63 = Self::mul_add(
             c_q12,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x44,
-                -Self::mul_add(c_q12, x41, s_q12 * x38),
+                0.00000000020510342851533115,
+                x46,
+                Self::mul_add(c_q12, x43, s_q12 * x40),
             ),
             s_q12
                 * Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x43,
-                    -Self::mul_add(c_q12, x40, s_q12 * x34),
+                    0.00000000020510342851533115,
+                    x45,
+                    Self::mul_add(c_q12, x42, s_q12 * x37),
                 ),
         );
-        let x61 = x51 * 0.36;
-        let x62 = -0.36 * x51;
-        let x63 = Self::mul_add(
-            x48,
+        let x64 = x53 * 0.36;
+        let x65 = Self::mul_add(
+            x50,
             0.36,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x54,
-                -Self::mul_add(c_q12, x53, s_q12 * x52),
+            -Self::mul_add(
+                0.00000000020510342851533115,
+                x56,
+                Self::mul_add(c_q12, x55, s_q12 * x54),
             ),
         );
-        let x64 = Self::mul_add(
+        let x66 = Self::mul_add(
+            x51,
             0.36,
-            x49,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x57,
-                -Self::mul_add(c_q12, x56, s_q12 * x55),
-            ),
-        );
-        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x61);
-        let x66 = 7.078399999258757 + x49;
-        let x67 = 0.01675 + x63;
-        let x68 = -9.142025249762803
-            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x62 - x61);
-        let x69 = 2.5482240016099564 + x64;
-        let x70 = 9.223235249762805
-            + Self::mul_add(-0.00000000020510342851533115, x58, -x60);
-        let x71 = s_q11 * s_q11;
-        let x72 = s_q11 * c_q11;
-        let x73 = x65 - x68;
-        let x74 = x59 + x59;
-        let x75 = Self::mul_add(x72, x74, x71 * x73);
-        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
-        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
-        let x78 = 0.275 * x51;
-        let x79 = -0.63 * x77;
-        let x80 = -0.275 * x51;
-        let x81 = x77 * 0.63;
-        let x82 = Self::mul_add(0.63, x76, x59 + Self::mul_add(-x71, x74, x72 * x73));
-        let x83 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
-        let x84 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
-        let x85 = x70 - x81;
-        let x86 = x65 - x75 - (x78 - x79) - (x81 - x80);
-        let x87 = -45.1584 + x77;
-        let x88 = -0.6328 + x83;
-        let x89 = -24.4950615 + (x68 + x75 + x80 - x78);
-        let x90 = -24.35164200091464 + Self::mul_add(0.63, x51, x84);
-        let x91 = 28.2393615 + (x79 + x85);
-        let x92 = s_q10 * s_q10;
-        let x93 = s_q10 * c_q10;
-        let x94 = x86 - x89;
-        let x95 = x82 + x82;
-        let x96 = Self::mul_add(x93, x95, x92 * x94);
-        let x97 = x82 + Self::mul_add(-x92, x95, x93 * x94);
-        let x98 = Self::mul_add(-s_q10, x90, c_q10 * x88);
-        let x99 = Self::mul_add(c_q10, x90, s_q10 * x88);
-        let x100 = c_q10 * x76;
-        let x101 = Self::mul_add(-s_q10, x87, x100);
-        let x102 = s_q10 * x76;
-        let x103 = Self::mul_add(c_q10, x87, x102);
-        let x104 = -0.87 * x103;
-        let x105 = x103 * 0.87;
-        let x106 = Self::mul_add(0.87, x101, x97);
-        let x107 = x91 - x105;
-        let x108 = x86 - x96 + x104 - x105;
-        let x109 = Self::mul_add(x101, 0.87, x97);
-        let x110 = -81.53205 + x103;
-        let x111 = -0.00214 + x98;
-        let x112 = -63.36336825000001 + (x89 + x96);
-        let x113 = -36.18604050126307 + Self::mul_add(0.87, x51, x99);
-        let x114 = -36.18604050126307 + Self::mul_add(x51, 0.87, x99);
-        let x115 = 69.99836825 + (x104 + x107);
-        let x116 = s_q9 * x101;
-        let x117 = Self::mul_add(c_q9, x110, x116);
-        let x118 = Self::mul_add(0.00000000020510342851533115, x51, x117);
-        let x119 = x51 + Self::mul_add(x6, x110, x5 * x101);
-        let x120 = c_q9 * x101;
-        let x121 = Self::mul_add(-s_q9, x110, x120);
-        let x122 = Self::mul_add(-0.00000000020510342851533115, x51, x121);
-        let x123 = Self::mul_add(
-            0.00000000020510342851533115,
-            x111,
-            Self::mul_add(c_q9, x109, s_q9 * x108),
-        );
-        let x124 = Self::mul_add(
-            0.00000000020510342851533115,
-            x114,
-            Self::mul_add(c_q9, x112, s_q9 * x106),
-        );
-        let x125 = Self::mul_add(
-            0.00000000020510342851533115,
-            x115,
-            Self::mul_add(c_q9, x113, s_q9 * x111),
-        );
-        let x126 = x111 + Self::mul_add(x6, x109, x5 * x108);
-        let x127 = x114 + Self::mul_add(x6, x112, x5 * x106);
-        let x128 = x115 + Self::mul_add(x6, x113, x5 * x111);
-        let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x111,
-            Self::mul_add(-s_q9, x109, c_q9 * x108),
-        );
-        let x130 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x114,
-            Self::mul_add(-s_q9, x112, c_q9 * x106),
-        );
-        let x131 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x115,
-            Self::mul_add(-s_q9, x113, c_q9 * x111),
-        );
-        let x132 = x122 * -0.4;
-        let x133 = 0.275 * x119;
-        let x134 = 0.4 * x122;
-        let x135 = -0.275 * x119;
-        let x136 = Self::mul_add(
-            x118,
-            -0.4,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x125,
-                Self::mul_add(-s_q9, x124, c_q9 * x123),
-            ),
-        );
-        let x137 = Self::mul_add(
-            -0.4,
-            x119,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x128,
-                Self::mul_add(-s_q9, x127, c_q9 * x126),
-            ),
-        );
-        let x138 = Self::mul_add(
-            0.00000000020510342851533115,
-            x125,
-            Self::mul_add(c_q9, x124, s_q9 * x123),
-        ) - (x132 - x133) - (x135 - x134);
-        let x139 = Self::mul_add(
-            -0.275,
-            x118,
-            Self::mul_add(
+            -Self::mul_add(
                 0.00000000020510342851533115,
-                x128,
-                Self::mul_add(c_q9, x127, s_q9 * x126),
+                x59,
+                Self::mul_add(c_q12, x58, s_q12 * x57),
             ),
         );
-        let x140 = Self::mul_add(
-            -0.4,
-            x118,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x131,
-                Self::mul_add(c_q9, x130, s_q9 * x129),
-            ),
-        );
-        let x141 = Self::mul_add(
-            x119,
-            -0.4,
-            Self::mul_add(-0.275, x122, x131 + Self::mul_add(x6, x130, x5 * x129)),
-        );
-        let x142 = -0.000000008530897668050218 + x118;
-        let x143 = -12.701650001451807 + x119;
-        let x144 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x118, x125 + Self::mul_add(x6, x124, x5 * x123));
-        let x145 = -0.002139996587640933 + x136;
-        let x146 = -0.0000000234896432582596 + x139;
-        let x147 = -111.7548902508081
-            + (x128 + Self::mul_add(x6, x127, x5 * x126) + x134 - x132);
-        let x148 = 5.080660024070365 + Self::mul_add(-0.275, x122, x137);
-        let x149 = -0.002139996587640933 + x140;
-        let x150 = 5.080660024070366 + x141;
-        let x151 = 113.3918902508081
-            + (x133
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x131,
-                    Self::mul_add(-s_q9, x130, c_q9 * x129),
-                ) - x135));
-        let x152 = x122 + Self::mul_add(-x3, x143, x2 * x142);
-        let x153 = Self::mul_add(c_q8, x143, s_q8 * x142);
-        let x154 = c_q8 * x142;
-        let x155 = s_q8 * x143;
-        let x156 = Self::mul_add(-0.00000000020510342851533115, x122, x155 - x154);
-        let x157 = x149 + Self::mul_add(-x3, x146, x2 * x138);
-        let x158 = x150 + Self::mul_add(-x3, x147, x2 * x144);
-        let x159 = x151 + Self::mul_add(-x3, x148, x2 * x145);
-        let x160 = Self::mul_add(c_q8, x146, s_q8 * x138);
-        let x161 = Self::mul_add(c_q8, x147, s_q8 * x144);
-        let x162 = Self::mul_add(c_q8, x148, s_q8 * x145);
-        let x163 = Self::mul_add(
+        let x67 = x64 + (Self::mul_add(-s_q12, x55, c_q12 * x54) + x64);
+        let x68 = 7.078399999258757 + x51;
+        let x69 = 0.01675 + x65;
+        let x70 = -9.142025249762803
+            + (x64 + (x59 - Self::mul_add(x13, x58, x12 * x57) + x64));
+        let x71 = 2.5482240016099564 + x66;
+        let x72 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x60, x63);
+        let x73 = s_q11 * s_q11;
+        let x74 = s_q11 * c_q11;
+        let x75 = x67 - x70;
+        let x76 = x62 + x62;
+        let x77 = Self::mul_add(x74, x76, x73 * x75);
+        let x78 = Self::mul_add(-s_q11, x68, c_q11 * x50);
+        let x79 = Self::mul_add(c_q11, x68, s_q11 * x50);
+        let x80 = 0.275 * x53;
+        let x81 = x79 * 0.63;
+        let x82 = x81 - x80;
+        let x83 = Self::mul_add(x78, 0.63, x62 + Self::mul_add(-x73, x76, x74 * x75));
+        let x84 = Self::mul_add(0.275, x78, Self::mul_add(-s_q11, x71, c_q11 * x69));
+        let x85 = Self::mul_add(0.275, x79, Self::mul_add(c_q11, x71, s_q11 * x69));
+        let x86 = x72 - x81;
+        let x87 = x67 - x77 - x82 - x82;
+        let x88 = -45.1584 + x79;
+        let x89 = -0.6328 + x84;
+        let x90 = -24.4950615 + (x80 + (x70 + x77 + x80));
+        let x91 = -24.35164200091464 + Self::mul_add(x53, -0.63, x85);
+        let x92 = 28.2393615 + (x86 - x81);
+        let x93 = s_q10 * s_q10;
+        let x94 = s_q10 * c_q10;
+        let x95 = x87 - x90;
+        let x96 = x83 + x83;
+        let x97 = Self::mul_add(x94, x96, x93 * x95);
+        let x98 = Self::mul_add(-s_q10, x91, c_q10 * x89);
+        let x99 = Self::mul_add(c_q10, x91, s_q10 * x89);
+        let x100 = c_q10 * x78;
+        let x101 = Self::mul_add(-s_q10, x88, x100);
+        let x102 = s_q10 * x78;
+        let x103 = Self::mul_add(c_q10, x88, x102);
+        let x104 = x103 * 0.87;
+        let x105 = Self::mul_add(x101, 0.87, x83 + Self::mul_add(-x93, x96, x94 * x95));
+        let x106 = x92 - x104;
+        let x107 = x87 - x97 - x104 - x104;
+        let x108 = -81.53205 + x103;
+        let x109 = -0.00214 + x98;
+        let x110 = -63.36336825000001 + (x90 + x97);
+        let x111 = -36.18604050126307 + Self::mul_add(x53, -0.87, x99);
+        let x112 = 69.99836825 + (x106 - x104);
+        let x113 = s_q9 * x101;
+        let x114 = Self::mul_add(c_q9, x108, x113);
+        let x115 = 0.00000000020510342851533115 * x53;
+        let x116 = x114 - x115;
+        let x117 = Self::mul_add(-x8, x108, x7 * x101) - x53;
+        let x118 = c_q9 * x101;
+        let x119 = Self::mul_add(-s_q9, x108, x118);
+        let x120 = x115 + x119;
+        let x121 = c_q9 * x105;
+        let x122 = 0.00000000020510342851533115 * x109;
+        let x123 = Self::mul_add(s_q9, x107, x121) + x122;
+        let x124 = s_q9 * x105;
+        let x125 = 0.00000000020510342851533115 * x111;
+        let x126 = Self::mul_add(c_q9, x110, x124) + x125;
+        let x127 = 0.00000000020510342851533115 * x112;
+        let x128 = Self::mul_add(c_q9, x111, s_q9 * x109) + x127;
+        let x129 = x109 + Self::mul_add(-x8, x105, x7 * x107);
+        let x130 = x111 + Self::mul_add(-x8, x110, x7 * x105);
+        let x131 = x112 + Self::mul_add(-x8, x111, x7 * x109);
+        let x132 = Self::mul_add(c_q9, x107, -x124) - x122;
+        let x133 = Self::mul_add(-s_q9, x110, x121) - x125;
+        let x134 = Self::mul_add(-s_q9, x111, c_q9 * x109) - x127;
+        let x135 = 0.00000000020510342851533115 * x128;
+        let x136 = 0.00000000020510342851533115 * x131;
+        let x137 = 0.00000000020510342851533115 * x134;
+        let x138 = 0.4 * x120;
+        let x139 = 0.275 * x117;
+        let x140 = x138 + x139;
+        let x141 = 0.275 * x116;
+        let x142 = 0.4 * x116;
+        let x143 = 0.4 * x117;
+        let x144 = 0.275 * x120;
+        let x145 = x140 + (Self::mul_add(c_q9, x126, s_q9 * x123) + x135 + x140);
+        let x146 = -0.000000008530897668050218 + x116;
+        let x147 = -12.701650001451807 + x117;
+        let x148 = -0.0000000234896432582596
+            + (x128 + Self::mul_add(-x8, x126, x7 * x123) - x141);
+        let x149 = -0.002139996587640933
+            + (Self::mul_add(-s_q9, x126, c_q9 * x123) - x135 - x142);
+        let x150 = -0.0000000234896432582596
+            + (Self::mul_add(c_q9, x130, s_q9 * x129) + x136 - x141);
+        let x151 = -111.7548902508081
+            + (x138 + (x131 + Self::mul_add(-x8, x130, x7 * x129) + x138));
+        let x152 = 5.080660024070365
+            + (Self::mul_add(-s_q9, x130, c_q9 * x129) - x136 - x143 - x144);
+        let x153 = -0.002139996587640933
+            + (Self::mul_add(c_q9, x133, s_q9 * x132) + x137 - x142);
+        let x154 = 5.080660024070366
+            + (x134 + Self::mul_add(-x8, x133, x7 * x132) - x144 - x143);
+        let x155 = 113.3918902508081
+            + (x139 + (Self::mul_add(-s_q9, x133, c_q9 * x132) - x137 + x139));
+        let x156 = x120 + Self::mul_add(-x2, x146, x3 * x147);
+        let x157 = Self::mul_add(c_q8, x147, s_q8 * x146);
+        let x158 = c_q8 * x146;
+        let x159 = s_q8 * x147;
+        let x160 = Self::mul_add(-0.00000000020510342851533115, x120, x159 - x158);
+        let x161 = x153 + Self::mul_add(-x2, x145, x3 * x150);
+        let x162 = x154 + Self::mul_add(-x2, x148, x3 * x151);
+        let x163 = x155 + Self::mul_add(-x2, x149, x3 * x152);
+        let x164 = Self::mul_add(c_q8, x150, s_q8 * x145);
+        let x165 = Self::mul_add(c_q8, x151, s_q8 * x148);
+        let x166 = Self::mul_add(c_q8, x152, s_q8 * x149);
+        let x167 = Self::mul_add(
             -0.00000000020510342851533115,
-            x151,
-            Self::mul_add(-c_q8, x145, s_q8 * x148),
+            x155,
+            Self::mul_add(-c_q8, x149, s_q8 * x152),
         );
-        let x164 = Self::mul_add(
+        let x168 = Self::mul_add(
             -c_q8,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x149,
-                Self::mul_add(-c_q8, x138, s_q8 * x146),
+                x153,
+                Self::mul_add(-c_q8, x145, s_q8 * x150),
             ),
             s_q8
                 * Self::mul_add(
                     -0.00000000020510342851533115,
-                    x150,
-                    Self::mul_add(-c_q8, x144, s_q8 * x147),
+                    x154,
+                    Self::mul_add(-c_q8, x148, s_q8 * x151),
                 ),
         );
-        let x165 = x156 * -0.35;
-        let x166 = 0.35 * x156;
-        let x167 = Self::mul_add(
-            x152,
+        let x169 = 0.35 * x160;
+        let x170 = Self::mul_add(
             -0.35,
+            x156,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x159,
-                Self::mul_add(-c_q8, x157, s_q8 * x158),
+                x163,
+                Self::mul_add(-c_q8, x161, s_q8 * x162),
             ),
         );
-        let x168 = Self::mul_add(
+        let x171 = Self::mul_add(
             -0.35,
-            x153,
+            x157,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x162,
-                Self::mul_add(-c_q8, x160, s_q8 * x161),
+                x166,
+                Self::mul_add(-c_q8, x164, s_q8 * x165),
             ),
         );
-        let x169 = x166 + (x159 + Self::mul_add(-x3, x158, x2 * x157) - x165);
-        let x170 = 48.0240000085309 + x152;
-        let x171 = -0.07309 + Self::mul_add(c_q8, x158, s_q8 * x157);
-        let x172 = -16.80768997608804 + x167;
-        let x173 = 130.43769025763282
-            + (Self::mul_add(c_q8, x161, s_q8 * x160) + x166 - x165);
-        let x174 = 0.1132 + x168;
-        let x175 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x163, x164);
-        let x176 = s_q7 * s_q7;
-        let x177 = s_q7 * c_q7;
-        let x178 = x169 - x173;
-        let x179 = x171 + x171;
-        let x180 = Self::mul_add(x177, x179, x176 * x178);
-        let x181 = Self::mul_add(-s_q7, x153, c_q7 * x170);
-        let x182 = Self::mul_add(c_q7, x153, s_q7 * x170);
-        let x183 = -x182;
-        let x184 = x156 * -0.75;
-        let x185 = 0.75 * x156;
-        let x186 = x181 * -0.65;
-        let x187 = 0.65 * x181;
-        let x188 = Self::mul_add(x181, -0.75, Self::mul_add(-s_q7, x174, c_q7 * x172));
-        let x189 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x174, s_q7 * x172));
-        let x190 = x175 + x187;
+        let x172 = x169 + (x163 + Self::mul_add(-x2, x161, x3 * x162) + x169);
+        let x173 = 48.0240000085309 + x156;
+        let x174 = -0.07309 + Self::mul_add(c_q8, x162, s_q8 * x161);
+        let x175 = -16.80768997608804 + x170;
+        let x176 = 130.43769025763282
+            + (x169 + (Self::mul_add(c_q8, x165, s_q8 * x164) + x169));
+        let x177 = 0.1132 + x171;
+        let x178 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x167, x168);
+        let x179 = s_q7 * s_q7;
+        let x180 = s_q7 * c_q7;
+        let x181 = x172 - x176;
+        let x182 = x174 + x174;
+        let x183 = Self::mul_add(x180, x182, x179 * x181);
+        let x184 = Self::mul_add(-s_q7, x157, c_q7 * x173);
+        let x185 = Self::mul_add(c_q7, x157, s_q7 * x173);
+        let x186 = -x185;
+        let x187 = 0.75 * x160;
+        let x188 = 0.65 * x184;
+        let x189 = x187 + x188;
+        let x190 = Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x177, c_q7 * x175));
         let x191 = Self::mul_add(
             -0.65,
-            x182,
-            x171 + Self::mul_add(-x176, x179, x177 * x178),
+            x185,
+            x174 + Self::mul_add(-x179, x182, x180 * x181),
         );
-        let x192 = 110.5455 + x181;
-        let x193 = 180.9502499901501 + x156;
-        let x194 = 1394.5960312283303 + (x185 + (x169 - x180 - x184));
-        let x195 = -117.61766249359756 + Self::mul_add(x156, -0.65, x188);
-        let x196 = 1466.4506062283303 + (x173 + x180 - (x186 - x185) - (x184 - x187));
-        let x197 = 1271.854575 + (x190 - x186);
-        let x198 = -x193;
-        let x199 = -x192;
-        let x200 = Self::mul_add(x3, x142, x2 * x143);
-        let x201 = x154 - x155;
-        let x202 = Self::mul_add(-0.35, x201, x159);
-        let x203 = Self::mul_add(-0.35, x200, x162);
-        let x204 = Self::mul_add(s_q7, x201, c_q7 * x200);
-        let x205 = -x204;
-        let x206 = Self::mul_add(-s_q7, x200, c_q7 * x201);
-        let x207 = Self::mul_add(-0.75, x206, Self::mul_add(-s_q7, x203, c_q7 * x202));
-        let x208 = Self::mul_add(c_q7, x203, s_q7 * x202)
-            + Self::mul_add(-0.75, x204, x153 * -0.65);
-        let x209 = Self::mul_add(0.65, x206, x163);
-        let x210 = x6 * x101;
-        let x211 = Self::mul_add(-x5, x110, x210);
-        let x212 = x125 + Self::mul_add(-0.275, x117, -0.4 * x211);
-        let x213 = Self::mul_add(0.4, x121, x128);
-        let x214 = Self::mul_add(-0.275, x121, x131);
-        let x215 = Self::mul_add(-x3, x211, x2 * x121) - x117;
-        let x216 = Self::mul_add(c_q8, x211, s_q8 * x121);
-        let x217 = Self::mul_add(
-            0.00000000020510342851533115,
-            x117,
-            Self::mul_add(-c_q8, x121, s_q8 * x211),
-        );
+        let x192 = Self::mul_add(-0.75, x185, Self::mul_add(c_q7, x177, s_q7 * x175));
+        let x193 = x178 + x188;
+        let x194 = 110.5455 + x184;
+        let x195 = 180.9502499901501 + x160;
+        let x196 = 1394.5960312283303 + (x187 + (x172 - x183 + x187));
+        let x197 = -117.61766249359756 + Self::mul_add(-0.65, x160, x190);
+        let x198 = 1466.4506062283303 + (x189 + (x176 + x183 + x189));
+        let x199 = 1271.854575 + (x188 + x193);
+        let x200 = -x195;
+        let x201 = -x194;
+        let x202 = Self::mul_add(x3, x146, x2 * x147);
+        let x203 = x158 - x159;
+        let x204 = Self::mul_add(-0.35, x203, x163);
+        let x205 = Self::mul_add(0.35, x202, x166);
+        let x206 = Self::mul_add(-s_q7, x203, c_q7 * x202);
+        let x207 = Self::mul_add(c_q7, x203, s_q7 * x202);
+        let x208 = Self::mul_add(-0.75, x207, Self::mul_add(-s_q7, x205, c_q7 * x204));
+        let x209 = Self::mul_add(c_q7, x205, s_q7 * x204)
+            + Self::mul_add(-0.65, x157, 0.75 * x206);
+        let x210 = Self::mul_add(0.65, x207, x167);
+        let x211 = x8 * x101;
+        let x212 = Self::mul_add(x7, x108, x211);
+        let x213 = x128 + Self::mul_add(-0.275, x114, 0.4 * x212);
+        let x214 = Self::mul_add(0.4, x119, x131);
+        let x215 = Self::mul_add(-0.275, x119, x134);
+        let x216 = x114 + Self::mul_add(x3, x212, x2 * x119);
+        let x217 = Self::mul_add(-c_q8, x212, s_q8 * x119);
         let x218 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x214,
-            Self::mul_add(-c_q8, x212, s_q8 * x213),
+            0.00000000020510342851533115,
+            x114,
+            -Self::mul_add(s_q8, x212, c_q8 * x119),
         );
         let x219 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x215,
+            Self::mul_add(-c_q8, x213, s_q8 * x214),
+        );
+        let x220 = Self::mul_add(
             -0.35,
-            x216,
-            x214 + Self::mul_add(-x3, x213, x2 * x212),
+            x217,
+            x215 + Self::mul_add(-x2, x213, x3 * x214),
         );
-        let x220 = Self::mul_add(0.35, x215, Self::mul_add(c_q8, x213, s_q8 * x212));
-        let x221 = Self::mul_add(-s_q7, x216, c_q7 * x215);
-        let x222 = Self::mul_add(c_q7, x216, s_q7 * x215);
-        let x223 = Self::mul_add(-0.75, x222, Self::mul_add(-s_q7, x220, c_q7 * x219));
-        let x224 = Self::mul_add(c_q7, x220, s_q7 * x219)
-            + Self::mul_add(-0.65, x217, 0.75 * x221);
-        let x225 = Self::mul_add(0.65, x222, x218);
-        let x226 = Self::mul_add(-s_q9, x103, x120);
-        let x227 = Self::mul_add(-x5, x103, x210);
-        let x228 = Self::mul_add(c_q9, x103, x116);
-        let x229 = Self::mul_add(
-            0.00000000020510342851533115,
-            x107,
-            Self::mul_add(c_q9, x99, s_q9 * x98),
-        ) + Self::mul_add(-0.275, x228, -0.4 * x227);
-        let x230 = Self::mul_add(0.4, x226, x107 + Self::mul_add(x6, x99, x5 * x98));
-        let x231 = Self::mul_add(
-            -0.275,
-            x226,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x107,
-                Self::mul_add(-s_q9, x99, c_q9 * x98),
-            ),
-        );
-        let x232 = Self::mul_add(-x3, x227, x2 * x226) - x228;
-        let x233 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x221 = Self::mul_add(-0.35, x216, Self::mul_add(c_q8, x214, s_q8 * x213));
+        let x222 = Self::mul_add(s_q7, x217, c_q7 * x216);
+        let x223 = -x222;
+        let x224 = Self::mul_add(-s_q7, x216, c_q7 * x217);
+        let x225 = Self::mul_add(-0.75, x224, Self::mul_add(-s_q7, x221, c_q7 * x220));
+        let x226 = Self::mul_add(c_q7, x221, s_q7 * x220)
+            - Self::mul_add(0.65, x218, 0.75 * x222);
+        let x227 = Self::mul_add(0.65, x224, x219);
+        let x228 = Self::mul_add(-s_q9, x103, x118);
+        let x229 = Self::mul_add(x7, x103, x211);
+        let x230 = Self::mul_add(c_q9, x103, x113);
+        let x231 = 0.00000000020510342851533115 * x106;
+        let x232 = Self::mul_add(c_q9, x99, s_q9 * x98) + x231
+            + Self::mul_add(-0.275, x230, 0.4 * x229);
+        let x233 = Self::mul_add(0.4, x228, x106 + Self::mul_add(-x8, x99, x7 * x98));
         let x234 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.275,
             x228,
-            Self::mul_add(-c_q8, x226, s_q8 * x227),
+            Self::mul_add(-s_q9, x99, c_q9 * x98) - x231,
         );
-        let x235 = Self::mul_add(
+        let x235 = x230 + Self::mul_add(x3, x229, x2 * x228);
+        let x236 = Self::mul_add(-c_q8, x229, s_q8 * x228);
+        let x237 = Self::mul_add(
+            0.00000000020510342851533115,
+            x230,
+            -Self::mul_add(s_q8, x229, c_q8 * x228),
+        );
+        let x238 = Self::mul_add(
             -0.00000000020510342851533115,
-            x231,
-            Self::mul_add(-c_q8, x229, s_q8 * x230),
+            x234,
+            Self::mul_add(-c_q8, x232, s_q8 * x233),
         );
-        let x236 = Self::mul_add(
+        let x239 = Self::mul_add(
             -0.35,
-            x233,
-            x231 + Self::mul_add(-x3, x230, x2 * x229),
+            x236,
+            x234 + Self::mul_add(-x2, x232, x3 * x233),
         );
-        let x237 = Self::mul_add(0.35, x232, Self::mul_add(c_q8, x230, s_q8 * x229));
-        let x238 = Self::mul_add(-s_q7, x233, c_q7 * x232);
-        let x239 = Self::mul_add(c_q7, x233, s_q7 * x232);
-        let x240 = Self::mul_add(-0.75, x239, Self::mul_add(-s_q7, x237, c_q7 * x236));
-        let x241 = Self::mul_add(c_q7, x237, s_q7 * x236)
-            + Self::mul_add(-0.65, x234, 0.75 * x238);
-        let x242 = Self::mul_add(0.65, x239, x235);
-        let x243 = Self::mul_add(c_q10, x77, x102);
-        let x244 = Self::mul_add(-s_q10, x77, x100);
-        let x245 = Self::mul_add(-s_q10, x84, c_q10 * x83);
-        let x246 = Self::mul_add(c_q10, x84, s_q10 * x83);
-        let x247 = Self::mul_add(-0.87, x243, x85);
-        let x248 = Self::mul_add(-s_q9, x243, c_q9 * x244);
-        let x249 = Self::mul_add(-x5, x243, x6 * x244);
-        let x250 = Self::mul_add(s_q9, x244, c_q9 * x243);
-        let x251 = Self::mul_add(
-            0.00000000020510342851533115,
-            x247,
-            Self::mul_add(c_q9, x246, s_q9 * x245),
-        ) + Self::mul_add(-0.275, x250, -0.4 * x249);
-        let x252 = Self::mul_add(0.4, x248, x247 + Self::mul_add(x6, x246, x5 * x245));
-        let x253 = Self::mul_add(
-            -0.275,
-            x248,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x247,
-                Self::mul_add(-s_q9, x246, c_q9 * x245),
-            ),
-        );
-        let x254 = Self::mul_add(-x3, x249, x2 * x248) - x250;
-        let x255 = Self::mul_add(c_q8, x249, s_q8 * x248);
-        let x256 = Self::mul_add(
-            0.00000000020510342851533115,
-            x250,
-            Self::mul_add(-c_q8, x248, s_q8 * x249),
-        );
-        let x257 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x253,
-            Self::mul_add(-c_q8, x251, s_q8 * x252),
-        );
+        let x240 = Self::mul_add(-0.35, x235, Self::mul_add(c_q8, x233, s_q8 * x232));
+        let x241 = Self::mul_add(s_q7, x236, c_q7 * x235);
+        let x242 = -x241;
+        let x243 = Self::mul_add(-s_q7, x235, c_q7 * x236);
+        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x240, c_q7 * x239));
+        let x245 = Self::mul_add(c_q7, x240, s_q7 * x239)
+            - Self::mul_add(0.65, x237, 0.75 * x241);
+        let x246 = Self::mul_add(0.65, x243, x238);
+        let x247 = Self::mul_add(c_q10, x79, x102);
+        let x248 = Self::mul_add(-s_q10, x79, x100);
+        let x249 = Self::mul_add(-s_q10, x85, c_q10 * x84);
+        let x250 = Self::mul_add(c_q10, x85, s_q10 * x84);
+        let x251 = Self::mul_add(-0.87, x247, x86);
+        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
+        let x253 = Self::mul_add(x8, x248, x7 * x247);
+        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
+        let x255 = 0.00000000020510342851533115 * x251;
+        let x256 = Self::mul_add(c_q9, x250, s_q9 * x249) + x255
+            + Self::mul_add(-0.275, x254, 0.4 * x253);
+        let x257 = Self::mul_add(0.4, x252, x251 + Self::mul_add(-x8, x250, x7 * x249));
         let x258 = Self::mul_add(
-            -0.35,
-            x255,
-            x253 + Self::mul_add(-x3, x252, x2 * x251),
-        );
-        let x259 = Self::mul_add(0.35, x254, Self::mul_add(c_q8, x252, s_q8 * x251));
-        let x260 = Self::mul_add(-s_q7, x255, c_q7 * x254);
-        let x261 = Self::mul_add(c_q7, x255, s_q7 * x254);
-        let x262 = Self::mul_add(-0.75, x261, Self::mul_add(-s_q7, x259, c_q7 * x258));
-        let x263 = Self::mul_add(c_q7, x259, s_q7 * x258)
-            + Self::mul_add(-0.65, x256, 0.75 * x260);
-        let x264 = Self::mul_add(0.65, x261, x257);
-        let x265 = Self::mul_add(-x10, x37, x11 * x36);
-        let x266 = x47 - x46;
-        let x267 = Self::mul_add(0.36, x265, x54);
-        let x268 = Self::mul_add(0.36, x50, x57);
-        let x269 = Self::mul_add(s_q11, x265, c_q11 * x50);
-        let x270 = Self::mul_add(-s_q11, x50, c_q11 * x265);
-        let x271 = Self::mul_add(-s_q11, x268, c_q11 * x267)
-            + Self::mul_add(-0.63, x266, 0.275 * x270);
-        let x272 = Self::mul_add(0.275, x269, Self::mul_add(c_q11, x268, s_q11 * x267));
-        let x273 = Self::mul_add(-0.63, x269, x58);
-        let x274 = Self::mul_add(s_q10, x270, c_q10 * x269);
-        let x275 = Self::mul_add(-s_q10, x269, c_q10 * x270);
-        let x276 = Self::mul_add(c_q10, x272, s_q10 * x271);
-        let x277 = Self::mul_add(-0.87, x266, Self::mul_add(-s_q10, x272, c_q10 * x271));
-        let x278 = Self::mul_add(-0.87, x274, x273);
-        let x279 = Self::mul_add(
-            0.00000000020510342851533115,
-            x266,
-            Self::mul_add(-s_q9, x274, c_q9 * x275),
-        );
-        let x280 = x266 + Self::mul_add(-x5, x274, x6 * x275);
-        let x281 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x266,
-            -Self::mul_add(s_q9, x275, c_q9 * x274),
-        );
-        let x282 = Self::mul_add(
-            0.00000000020510342851533115,
-            x278,
-            Self::mul_add(c_q9, x276, s_q9 * x277),
-        ) + Self::mul_add(0.275, x281, -0.4 * x280);
-        let x283 = Self::mul_add(0.4, x279, x278 + Self::mul_add(x6, x276, x5 * x277));
-        let x284 = Self::mul_add(
             -0.275,
-            x279,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x278,
-                Self::mul_add(-s_q9, x276, c_q9 * x277),
-            ),
+            x252,
+            Self::mul_add(-s_q9, x250, c_q9 * x249) - x255,
         );
-        let x285 = x281 + Self::mul_add(-x3, x280, x2 * x279);
-        let x286 = Self::mul_add(c_q8, x280, s_q8 * x279);
-        let x287 = Self::mul_add(
+        let x259 = x254 + Self::mul_add(x3, x253, x2 * x252);
+        let x260 = Self::mul_add(-c_q8, x253, s_q8 * x252);
+        let x261 = Self::mul_add(
+            0.00000000020510342851533115,
+            x254,
+            -Self::mul_add(s_q8, x253, c_q8 * x252),
+        );
+        let x262 = Self::mul_add(
             -0.00000000020510342851533115,
-            x281,
-            Self::mul_add(-c_q8, x279, s_q8 * x280),
+            x258,
+            Self::mul_add(-c_q8, x256, s_q8 * x257),
         );
-        let x288 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x284,
-            Self::mul_add(-c_q8, x282, s_q8 * x283),
-        );
-        let x289 = Self::mul_add(
+        let x263 = Self::mul_add(
             -0.35,
-            x286,
-            x284 + Self::mul_add(-x3, x283, x2 * x282),
+            x260,
+            x258 + Self::mul_add(-x2, x256, x3 * x257),
         );
-        let x290 = Self::mul_add(0.35, x285, Self::mul_add(c_q8, x283, s_q8 * x282));
-        let x291 = Self::mul_add(-s_q7, x286, c_q7 * x285);
-        let x292 = Self::mul_add(c_q7, x286, s_q7 * x285);
-        let x293 = Self::mul_add(-0.75, x292, Self::mul_add(-s_q7, x290, c_q7 * x289));
-        let x294 = Self::mul_add(c_q7, x290, s_q7 * x289)
-            + Self::mul_add(-0.65, x287, 0.75 * x291);
-        let x295 = Self::mul_add(0.65, x292, x288);
-        let x296 = x13 * -4.806620000000001;
-        let x297 = s_q13 * -4.806620000000001;
-        let x298 = c_q13 * -4.806620000000001;
-        let x299 = x20 + Self::mul_add(-0.55, x298, -0.16 * x297);
-        let x300 = Self::mul_add(0.16, x296, x24);
-        let x301 = Self::mul_add(-0.55, x296, x27);
-        let x302 = Self::mul_add(-s_q12, x297, c_q12 * x296);
-        let x303 = Self::mul_add(x11, x297, x10 * x296) - x298;
-        let x304 = Self::mul_add(
+        let x264 = Self::mul_add(-0.35, x259, Self::mul_add(c_q8, x257, s_q8 * x256));
+        let x265 = Self::mul_add(s_q7, x260, c_q7 * x259);
+        let x266 = -x265;
+        let x267 = Self::mul_add(-s_q7, x259, c_q7 * x260);
+        let x268 = Self::mul_add(-0.75, x267, Self::mul_add(-s_q7, x264, c_q7 * x263));
+        let x269 = Self::mul_add(c_q7, x264, s_q7 * x263)
+            - Self::mul_add(0.65, x261, 0.75 * x265);
+        let x270 = Self::mul_add(0.65, x267, x262);
+        let x271 = Self::mul_add(-x13, x38, x12 * x39);
+        let x272 = x49 - x48;
+        let x273 = Self::mul_add(0.36, x271, x56);
+        let x274 = Self::mul_add(x52, 0.36, x59);
+        let x275 = Self::mul_add(s_q11, x271, c_q11 * x52);
+        let x276 = Self::mul_add(-s_q11, x52, c_q11 * x271);
+        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
+            + Self::mul_add(-0.63, x272, 0.275 * x276);
+        let x278 = Self::mul_add(0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
+        let x279 = Self::mul_add(0.63, x275, x60);
+        let x280 = -x279;
+        let x281 = Self::mul_add(s_q10, x276, c_q10 * x275);
+        let x282 = Self::mul_add(-s_q10, x275, c_q10 * x276);
+        let x283 = Self::mul_add(c_q10, x278, s_q10 * x277);
+        let x284 = Self::mul_add(-0.87, x272, Self::mul_add(-s_q10, x278, c_q10 * x277));
+        let x285 = Self::mul_add(0.87, x281, x279);
+        let x286 = -x285;
+        let x287 = 0.00000000020510342851533115 * x272;
+        let x288 = Self::mul_add(-s_q9, x281, c_q9 * x282) + x287;
+        let x289 = x272 - Self::mul_add(x8, x282, x7 * x281);
+        let x290 = x287 + Self::mul_add(s_q9, x282, c_q9 * x281);
+        let x291 = 0.00000000020510342851533115 * x285;
+        let x292 = Self::mul_add(c_q9, x283, s_q9 * x284) - x291
+            - Self::mul_add(0.275, x290, 0.4 * x289);
+        let x293 = Self::mul_add(0.4, x288, Self::mul_add(-x8, x283, x7 * x284) - x285);
+        let x294 = Self::mul_add(
+            -0.275,
+            x288,
+            x291 + Self::mul_add(-s_q9, x283, c_q9 * x284),
+        );
+        let x295 = Self::mul_add(-x2, x288, x3 * x289) - x290;
+        let x296 = Self::mul_add(c_q8, x289, s_q8 * x288);
+        let x297 = Self::mul_add(
+            0.00000000020510342851533115,
+            x290,
+            Self::mul_add(-c_q8, x288, s_q8 * x289),
+        );
+        let x298 = Self::mul_add(
             -0.00000000020510342851533115,
-            x298,
-            Self::mul_add(c_q12, x297, s_q12 * x296),
+            x294,
+            Self::mul_add(-c_q8, x292, s_q8 * x293),
         );
-        let x305 = Self::mul_add(
+        let x299 = Self::mul_add(
+            -0.35,
+            x296,
+            x294 + Self::mul_add(-x2, x292, x3 * x293),
+        );
+        let x300 = Self::mul_add(0.35, x295, Self::mul_add(c_q8, x293, s_q8 * x292));
+        let x301 = Self::mul_add(-s_q7, x296, c_q7 * x295);
+        let x302 = Self::mul_add(c_q7, x296, s_q7 * x295);
+        let x303 = Self::mul_add(-0.75, x302, Self::mul_add(-s_q7, x300, c_q7 * x299));
+        let x304 = Self::mul_add(c_q7, x300, s_q7 * x299)
+            + Self::mul_add(-0.65, x297, 0.75 * x301);
+        let x305 = Self::mul_add(0.65, x302, x298);
+        let x306 = 4.806620000000001 * x15;
+        let x307 = x22 + x32;
+        let x308 = Self::mul_add(0.16, x306, -x26);
+        let x309 = Self::mul_add(-0.55, x306, x29);
+        let x310 = Self::mul_add(s_q12, x19, c_q12 * x306);
+        let x311 = x18 + Self::mul_add(-x12, x306, x13 * x19);
+        let x312 = Self::mul_add(
             -0.00000000020510342851533115,
-            x301,
-            -Self::mul_add(c_q12, x300, s_q12 * x299),
+            x18,
+            Self::mul_add(-s_q12, x306, c_q12 * x19),
         );
-        let x306 = Self::mul_add(0.36, x303, Self::mul_add(-s_q12, x300, c_q12 * x299));
-        let x307 = Self::mul_add(
+        let x313 = Self::mul_add(
+            0.00000000020510342851533115,
+            x309,
+            Self::mul_add(c_q12, x308, s_q12 * x307),
+        );
+        let x314 = -x313;
+        let x315 = Self::mul_add(0.36, x311, Self::mul_add(-s_q12, x308, c_q12 * x307));
+        let x316 = Self::mul_add(
             -0.36,
-            x302,
-            x301 + Self::mul_add(x11, x300, x10 * x299),
+            x310,
+            x309 - Self::mul_add(x13, x308, x12 * x307),
         );
-        let x308 = Self::mul_add(-s_q11, x303, c_q11 * x302);
-        let x309 = Self::mul_add(c_q11, x303, s_q11 * x302);
-        let x310 = Self::mul_add(-s_q11, x307, c_q11 * x306)
-            + Self::mul_add(0.63, x304, 0.275 * x309);
-        let x311 = Self::mul_add(-0.275, x308, Self::mul_add(c_q11, x307, s_q11 * x306));
-        let x312 = Self::mul_add(0.63, x308, x305);
-        let x313 = Self::mul_add(-s_q10, x309, c_q10 * x308);
-        let x314 = Self::mul_add(c_q10, x309, s_q10 * x308);
-        let x315 = Self::mul_add(c_q10, x311, s_q10 * x310);
-        let x316 = Self::mul_add(0.87, x304, Self::mul_add(-s_q10, x311, c_q10 * x310));
-        let x317 = Self::mul_add(0.87, x313, x312);
-        let x318 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x304,
-            Self::mul_add(c_q9, x314, s_q9 * x313),
-        );
-        let x319 = Self::mul_add(x6, x314, x5 * x313) - x304;
-        let x320 = Self::mul_add(
-            0.00000000020510342851533115,
-            x304,
-            Self::mul_add(-s_q9, x314, c_q9 * x313),
-        );
-        let x321 = Self::mul_add(
-            0.00000000020510342851533115,
-            x317,
-            Self::mul_add(c_q9, x315, s_q9 * x316),
-        ) + Self::mul_add(0.275, x320, -0.4 * x319);
-        let x322 = Self::mul_add(0.4, x318, x317 + Self::mul_add(x6, x315, x5 * x316));
-        let x323 = Self::mul_add(
+        let x317 = Self::mul_add(-s_q11, x311, c_q11 * x310);
+        let x318 = Self::mul_add(c_q11, x311, s_q11 * x310);
+        let x319 = Self::mul_add(-s_q11, x316, c_q11 * x315)
+            + Self::mul_add(-0.63, x312, 0.275 * x318);
+        let x320 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x316, s_q11 * x315));
+        let x321 = Self::mul_add(0.63, x317, -x313);
+        let x322 = Self::mul_add(-s_q10, x318, c_q10 * x317);
+        let x323 = Self::mul_add(c_q10, x318, s_q10 * x317);
+        let x324 = Self::mul_add(c_q10, x320, s_q10 * x319);
+        let x325 = Self::mul_add(-0.87, x312, Self::mul_add(-s_q10, x320, c_q10 * x319));
+        let x326 = Self::mul_add(0.87, x322, x321);
+        let x327 = 0.00000000020510342851533115 * x312;
+        let x328 = Self::mul_add(c_q9, x323, s_q9 * x322) + x327;
+        let x329 = x312 + Self::mul_add(-x8, x323, x7 * x322);
+        let x330 = Self::mul_add(-s_q9, x323, c_q9 * x322) - x327;
+        let x331 = 0.00000000020510342851533115 * x326;
+        let x332 = Self::mul_add(c_q9, x324, s_q9 * x325) + x331
+            + Self::mul_add(-0.4, x329, 0.275 * x330);
+        let x333 = Self::mul_add(0.4, x328, x326 + Self::mul_add(-x8, x324, x7 * x325));
+        let x334 = Self::mul_add(
             -0.275,
-            x318,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x317,
-                Self::mul_add(-s_q9, x315, c_q9 * x316),
-            ),
+            x328,
+            Self::mul_add(-s_q9, x324, c_q9 * x325) - x331,
         );
-        let x324 = x320 + Self::mul_add(-x3, x319, x2 * x318);
-        let x325 = Self::mul_add(c_q8, x319, s_q8 * x318);
-        let x326 = Self::mul_add(
+        let x335 = x330 + Self::mul_add(-x2, x328, x3 * x329);
+        let x336 = Self::mul_add(c_q8, x329, s_q8 * x328);
+        let x337 = Self::mul_add(
             -0.00000000020510342851533115,
-            x320,
-            Self::mul_add(-c_q8, x318, s_q8 * x319),
+            x330,
+            Self::mul_add(-c_q8, x328, s_q8 * x329),
         );
-        let x327 = Self::mul_add(
+        let x338 = Self::mul_add(
             -0.00000000020510342851533115,
-            x323,
-            Self::mul_add(-c_q8, x321, s_q8 * x322),
+            x334,
+            Self::mul_add(-c_q8, x332, s_q8 * x333),
         );
-        let x328 = Self::mul_add(
+        let x339 = Self::mul_add(
             -0.35,
-            x325,
-            x323 + Self::mul_add(-x3, x322, x2 * x321),
+            x336,
+            x334 + Self::mul_add(-x2, x332, x3 * x333),
         );
-        let x329 = Self::mul_add(0.35, x324, Self::mul_add(c_q8, x322, s_q8 * x321));
-        let x330 = Self::mul_add(-s_q7, x325, c_q7 * x324);
-        let x331 = Self::mul_add(c_q7, x325, s_q7 * x324);
-        let x332 = Self::mul_add(-0.75, x331, Self::mul_add(-s_q7, x329, c_q7 * x328));
-        let x333 = Self::mul_add(c_q7, x329, s_q7 * x328)
-            + Self::mul_add(-0.65, x326, 0.75 * x330);
-        let x334 = Self::mul_add(0.65, x331, x327);
+        let x340 = Self::mul_add(0.35, x335, Self::mul_add(c_q8, x333, s_q8 * x332));
+        let x341 = Self::mul_add(-s_q7, x336, c_q7 * x335);
+        let x342 = Self::mul_add(c_q7, x336, s_q7 * x335);
+        let x343 = Self::mul_add(-0.75, x342, Self::mul_add(-s_q7, x340, c_q7 * x339));
+        let x344 = Self::mul_add(c_q7, x340, s_q7 * x339)
+            + Self::mul_add(-0.65, x337, 0.75 * x341);
+        let x345 = Self::mul_add(0.65, x342, x338);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x193,
-                x183,
-                x183,
-                x205,
-                x221,
-                x238,
-                x260,
-                x291,
-                x330,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x198,
-                0.0,
-                x192,
-                x181,
+                x195,
+                x186,
+                x186,
                 x206,
-                x222,
-                x239,
-                x261,
-                x292,
-                x331,
+                x223,
+                x242,
+                x266,
+                x301,
+                x341,
+            ],
+            [
+                0.0,
+                1170.07,
+                0.0,
+                x200,
+                0.0,
+                x194,
+                x184,
+                x207,
+                x224,
+                x243,
+                x267,
+                x302,
+                x342,
             ],
             [
                 0.0,
                 0.0,
                 1170.07,
-                x182,
-                x199,
+                x185,
+                x201,
                 0.0,
                 0.0,
-                x153,
-                x217,
-                x234,
-                x256,
-                x287,
-                x326,
+                x157,
+                x218,
+                x237,
+                x261,
+                x297,
+                x337,
             ],
             [
                 0.0,
-                x198,
-                x182,
-                x194,
-                x191,
-                x195,
-                x188,
-                x207,
-                x223,
-                x240,
-                x262,
-                x293,
-                x332,
-            ],
-            [
-                x193,
-                0.0,
-                x199,
-                x191,
+                x200,
+                x185,
                 x196,
-                x189,
-                x189,
-                x208,
-                x224,
-                x241,
-                x263,
-                x294,
-                x333,
-            ],
-            [
-                x183,
-                x192,
-                0.0,
-                x195,
-                x189,
+                x191,
                 x197,
                 x190,
-                x209,
+                x208,
                 x225,
-                x242,
-                x264,
-                x295,
-                x334,
+                x244,
+                x268,
+                x303,
+                x343,
             ],
             [
-                x183,
-                x181,
+                x195,
                 0.0,
-                x188,
-                x189,
-                x190,
-                x175,
-                x163,
-                x218,
-                x235,
-                x257,
-                x288,
-                x327,
+                x201,
+                x191,
+                x198,
+                x192,
+                x192,
+                x209,
+                x226,
+                x245,
+                x269,
+                x304,
+                x344,
             ],
             [
-                x205,
+                x186,
+                x194,
+                0.0,
+                x197,
+                x192,
+                x199,
+                x193,
+                x210,
+                x227,
+                x246,
+                x270,
+                x305,
+                x345,
+            ],
+            [
+                x186,
+                x184,
+                0.0,
+                x190,
+                x192,
+                x193,
+                x178,
+                x167,
+                x219,
+                x238,
+                x262,
+                x298,
+                x338,
+            ],
+            [
                 x206,
-                x153,
                 x207,
+                x157,
                 x208,
                 x209,
-                x163,
-                x151,
-                x214,
-                x231,
-                x253,
-                x284,
-                x323,
+                x210,
+                x167,
+                x155,
+                x215,
+                x234,
+                x258,
+                x294,
+                x334,
             ],
             [
-                x221,
-                x222,
-                x217,
                 x223,
                 x224,
-                x225,
                 x218,
-                x214,
-                x115,
-                x107,
-                x247,
-                x278,
-                x317,
-            ],
-            [x238, x239, x234, x240, x241, x242, x235, x231, x107, x91, x85, x273, x312],
-            [x260, x261, x256, x262, x263, x264, x257, x253, x247, x85, x70, x58, x305],
-            [x291, x292, x287, x293, x294, x295, x288, x284, x278, x273, x58, x45, x301],
-            [
-                x330,
-                x331,
+                x225,
+                x226,
+                x227,
+                x219,
+                x215,
+                x112,
+                x106,
+                x251,
+                x286,
                 x326,
-                x332,
-                x333,
+            ],
+            [x242, x243, x237, x244, x245, x246, x238, x234, x106, x92, x86, x280, x321],
+            [x266, x267, x261, x268, x269, x270, x262, x258, x251, x86, x72, x61, x314],
+            [x301, x302, x297, x303, x304, x305, x298, x294, x286, x280, x61, x47, x309],
+            [
+                x341,
+                x342,
+                x337,
+                x343,
+                x344,
+                x345,
+                x338,
                 x334,
-                x327,
-                x323,
-                x317,
-                x312,
-                x305,
-                x301,
+                x326,
+                x321,
+                x314,
+                x309,
                 1.4135609200000003,
             ],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
     ///
-    /// Methods: bias `newton-euler`: 532 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 323 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 528 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
         let x0 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
@@ -1798,30 +1962,30 @@ impl FreeFloating7 {
         let x18 = v[5] + v[6];
         let x19 = x5 * x5;
         let x20 = x4 * x18;
-        let x21 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x5);
+        let x21 = Self::mul_add(x18, 16.80768997608804, x5 * 0.07309);
         let x22 = Self::mul_add(
             0.1132,
             x18,
-            Self::mul_add(130.43769025763282, x5, -0.07309 * x4),
+            Self::mul_add(x4, -0.07309, 130.43769025763282 * x5),
         );
         let x23 = Self::mul_add(
             132.47349025763282,
             x18,
-            Self::mul_add(0.1132, x5, -16.80768997608804 * x4),
+            Self::mul_add(x4, -16.80768997608804, 0.1132 * x5),
         );
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x25 = -0.00000000020510342851533115 * c_q8;
-        let x26 = -0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x5, s_q8, x4 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x4, x26, x5 * c_q8));
+        let x25 = 0.00000000020510342851533115 * c_q8;
+        let x26 = 0.00000000020510342851533115 * s_q8;
+        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(-x4, x25, x5 * s_q8));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(x5, c_q8, x4 * x26));
         let x29 = Self::mul_add(0.35, x20 - x17, Self::mul_add(s_q7, x13, c_q7 * x12));
         let x30 = Self::mul_add(0.35, Self::mul_add(x5, x18, -x16), x15);
         let x31 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x19), x14);
-        let x32 = Self::mul_add(-c_q8, x31, Self::mul_add(s_q8, x30, x25 * x29));
-        let x33 = Self::mul_add(s_q8, x31, Self::mul_add(-x26, x29, c_q8 * x30));
+        let x32 = Self::mul_add(-c_q8, x31, Self::mul_add(-x25, x29, s_q8 * x30));
+        let x33 = Self::mul_add(s_q8, x31, Self::mul_add(c_q8, x30, x26 * x29));
         let x34 = Self::mul_add(-0.00000000020510342851533115, x31, x29);
-        let x35 = Self::mul_add(v[7], x28, Self::mul_add(-x17, s_q8, x16 * x25));
-        let x36 = Self::mul_add(v[7], x27, Self::mul_add(x17, c_q8, x16 * x26));
+        let x35 = Self::mul_add(v[7], x28, -Self::mul_add(x17, s_q8, x16 * x25));
+        let x36 = Self::mul_add(-v[7], x27, Self::mul_add(-x17, c_q8, x16 * x26));
         let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x4);
         let x38 = x28 * x28;
         let x39 = x37 * x37;
@@ -1833,19 +1997,19 @@ impl FreeFloating7 {
         let x45 = x28 * x37;
         let x46 = x35 + x45;
         let x47 = Self::mul_add(
-            -0.002139996587640933,
             x37,
-            -0.0000000234896432582596 * x28,
+            0.002139996587640933,
+            x28 * 0.0000000234896432582596,
         );
         let x48 = Self::mul_add(
             5.080660024070365,
             x37,
-            Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
+            -Self::mul_add(x28, 111.7548902508081, x27 * 0.0000000234896432582596),
         );
         let x49 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
+            Self::mul_add(x27, -0.002139996587640933, 5.080660024070366 * x28),
         );
         let x50 = Self::mul_add(
             x34,
@@ -1853,496 +2017,483 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x16,
-                Self::mul_add(111.7548902508081, x36, -0.0000000234896432582596 * x35),
-            ) + Self::mul_add(-x27, x49, x37 * x47),
+                -Self::mul_add(x36, 111.7548902508081, x35 * 0.0000000234896432582596),
+            ) - Self::mul_add(x27, x49, x37 * x47),
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x52 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x53 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x54 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x52, x27 * s_q9));
-        let x55 = Self::mul_add(-x37, s_q9, Self::mul_add(x28, x53, x27 * c_q9));
-        let x56 = x32 + Self::mul_add(0.4, x42 - x36, 0.275 * x41);
-        let x57 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
-        let x58 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
-        let x59 = Self::mul_add(c_q9, x58, Self::mul_add(x52, x57, s_q9 * x56));
-        let x60 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x58,
-            Self::mul_add(0.00000000020510342851533115, x56, x57),
-        );
-        let x61 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x16,
-            Self::mul_add(0.00000000020510342851533115, x35, -x36),
-        );
+        let x52 = 0.00000000020510342851533115 * c_q9;
+        let x53 = 0.00000000020510342851533115 * s_q9;
+        let x54 = x52 - x53;
+        let x55 = x52 + x53;
+        let x56 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x54, x27 * s_q9));
+        let x57 = Self::mul_add(-x37, s_q9, Self::mul_add(-x28, x55, x27 * c_q9));
+        let x58 = x32 + Self::mul_add(0.4, x36 + x42, 0.275 * x41);
+        let x59 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
+        let x60 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
+        let x61 = Self::mul_add(c_q9, x60, Self::mul_add(x54, x59, s_q9 * x58));
         let x62 = Self::mul_add(
-            v[8],
-            x55,
-            Self::mul_add(x16, c_q9, Self::mul_add(-x36, x52, x35 * s_q9)),
+            -0.00000000020510342851533115,
+            x60,
+            Self::mul_add(0.00000000020510342851533115, x58, x59),
         );
         let x63 = Self::mul_add(
-            -v[8],
-            x54,
-            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x53, x35 * c_q9)),
+            -0.00000000020510342851533115,
+            x16,
+            Self::mul_add(0.00000000020510342851533115, x35, x36),
         );
-        let x64 = v[8]
+        let x64 = Self::mul_add(
+            v[8],
+            x57,
+            Self::mul_add(x16, c_q9, Self::mul_add(x36, x54, x35 * s_q9)),
+        );
+        let x65 = Self::mul_add(
+            -v[8],
+            x56,
+            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x55, x35 * c_q9)),
+        );
+        let x66 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
                 Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x65 = Self::mul_add(x54, x55, -x61);
-        let x66 = Self::mul_add(x54, x54, x64 * x64);
-        let x67 = Self::mul_add(x55, x64, x62);
-        let x68 = -0.00214 * x64;
-        let x69 = Self::mul_add(-36.18604050126307, x64, -63.36336825000001 * x55);
-        let x70 = Self::mul_add(
-            69.99836825,
-            x64,
-            Self::mul_add(-36.18604050126307, x55, -0.00214 * x54),
-        );
-        let x71 = Self::mul_add(
-            -81.53205,
-            x60,
-            Self::mul_add(-0.00214, x61, Self::mul_add(-x64, x69, x55 * x70)),
-        );
+        let x67 = Self::mul_add(x56, x57, -x63);
+        let x68 = Self::mul_add(x56, x56, x66 * x66);
+        let x69 = Self::mul_add(x57, x66, x64);
+        let x70 = x66 * 0.00214;
+        let x71 = Self::mul_add(x66, 36.18604050126307, x57 * 63.36336825000001);
         let x72 = Self::mul_add(
-            x59,
+            69.99836825,
+            x66,
+            -Self::mul_add(x57, 36.18604050126307, x56 * 0.00214),
+        );
+        let x73 = Self::mul_add(
+            x62,
+            -81.53205,
+            Self::mul_add(x63, -0.00214, Self::mul_add(x57, x72, x66 * x71)),
+        );
+        let x74 = Self::mul_add(
+            x61,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x61,
-                Self::mul_add(-36.18604050126307, x63, -0.00214 * x62),
-            ) + Self::mul_add(-x55, x68, x54 * x69),
+                x63,
+                -Self::mul_add(x65, 36.18604050126307, x64 * 0.00214),
+            ) + Self::mul_add(-x56, x71, x57 * x70),
         );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x74 = Self::mul_add(x55, s_q10, x54 * c_q10);
-        let x75 = Self::mul_add(-x54, s_q10, x55 * c_q10);
-        let x76 = Self::mul_add(-0.87, x65, x59);
-        let x77 = Self::mul_add(
+        let x76 = Self::mul_add(x57, s_q10, x56 * c_q10);
+        let x77 = Self::mul_add(-x56, s_q10, x57 * c_q10);
+        let x78 = Self::mul_add(x67, -0.87, x61);
+        let x79 = Self::mul_add(
+            x68,
             0.87,
-            x66,
-            Self::mul_add(-s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56)),
+            Self::mul_add(-s_q9, x60, Self::mul_add(-x55, x59, c_q9 * x58)),
         );
-        let x78 = Self::mul_add(-0.87, x67, x60);
-        let x79 = Self::mul_add(s_q10, x77, c_q10 * x76);
-        let x80 = Self::mul_add(v[9], x75, Self::mul_add(x63, s_q10, x62 * c_q10));
-        let x81 = Self::mul_add(-v[9], x74, Self::mul_add(-x62, s_q10, x63 * c_q10));
-        let x82 = v[9] + x64;
-        let x83 = Self::mul_add(x74, x75, -x61);
-        let x84 = x74 * x74;
-        let x85 = Self::mul_add(x82, x82, x84);
-        let x86 = x75 * x82;
-        let x87 = x80 + x86;
-        let x88 = -0.6328 * x82;
-        let x89 = Self::mul_add(-24.35164200091464, x82, -24.4950615 * x75);
-        let x90 = Self::mul_add(
-            28.2393615,
-            x82,
-            Self::mul_add(-24.351642000914637, x75, -0.6328 * x74),
-        );
-        let x91 = Self::mul_add(
-            -45.1584,
-            x78,
-            Self::mul_add(-0.6328, x61, Self::mul_add(-x82, x89, x75 * x90)),
-        );
+        let x80 = Self::mul_add(x69, -0.87, x62);
+        let x81 = Self::mul_add(s_q10, x79, c_q10 * x78);
+        let x82 = Self::mul_add(v[9], x77, Self::mul_add(x65, s_q10, x64 * c_q10));
+        let x83 = Self::mul_add(-v[9], x76, Self::mul_add(-x64, s_q10, x65 * c_q10));
+        let x84 = v[9] + x66;
+        let x85 = Self::mul_add(x76, x77, -x63);
+        let x86 = x76 * x76;
+        let x87 = Self::mul_add(x84, x84, x86);
+        let x88 = x77 * x84;
+        let x89 = x82 + x88;
+        let x90 = x84 * 0.6328;
+        let x91 = Self::mul_add(x84, 24.35164200091464, x77 * 24.4950615);
         let x92 = Self::mul_add(
-            x79,
+            28.2393615,
+            x84,
+            -Self::mul_add(x77, 24.351642000914637, x76 * 0.6328),
+        );
+        let x93 = Self::mul_add(
+            x80,
+            -45.1584,
+            Self::mul_add(x63, -0.6328, Self::mul_add(x77, x92, x84 * x91)),
+        );
+        let x94 = Self::mul_add(
+            x81,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x61,
-                Self::mul_add(-24.351642000914637, x81, -0.6328 * x80),
-            ) + Self::mul_add(-x75, x88, x74 * x89),
+                x63,
+                -Self::mul_add(x83, 24.351642000914637, x82 * 0.6328),
+            ) + Self::mul_add(-x76, x91, x77 * x90),
         );
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x94 = Self::mul_add(x75, s_q11, x74 * c_q11);
-        let x95 = Self::mul_add(-x74, s_q11, x75 * c_q11);
-        let x96 = x79 + Self::mul_add(-0.275, Self::mul_add(x74, x82, x81), -0.63 * x83);
-        let x97 = Self::mul_add(-s_q10, x76, c_q10 * x77)
-            + Self::mul_add(0.63, x85, -0.275 * (x86 - x80));
-        let x98 = x78 + Self::mul_add(0.275, Self::mul_add(x75, x75, x84), -0.63 * x87);
-        let x99 = Self::mul_add(s_q11, x97, c_q11 * x96);
-        let x100 = Self::mul_add(v[10], x95, Self::mul_add(x81, s_q11, x80 * c_q11));
-        let x101 = Self::mul_add(-v[10], x94, Self::mul_add(-x80, s_q11, x81 * c_q11));
-        let x102 = v[10] + x82;
-        let x103 = x94 * x94;
-        let x104 = x95 * x102;
-        let x105 = 0.01675 * x102;
-        let x106 = Self::mul_add(2.5482240016099564, x102, -9.142025249762803 * x95);
-        let x107 = Self::mul_add(
-            9.223235249762805,
-            x102,
-            Self::mul_add(2.5482240016099564, x95, 0.01675 * x94),
-        );
-        let x108 = Self::mul_add(
-            7.078399999258757,
-            x98,
-            Self::mul_add(0.01675, x61, Self::mul_add(-x102, x106, x95 * x107)),
-        );
+        let x96 = Self::mul_add(x77, s_q11, x76 * c_q11);
+        let x97 = Self::mul_add(-x76, s_q11, x77 * c_q11);
+        let x98 = x81 - Self::mul_add(0.275, Self::mul_add(x76, x84, x83), x85 * 0.63);
+        let x99 = Self::mul_add(-s_q10, x78, c_q10 * x79)
+            + Self::mul_add(-0.275, x88 - x82, x87 * 0.63);
+        let x100 = x80 + Self::mul_add(x89, -0.63, 0.275 * Self::mul_add(x77, x77, x86));
+        let x101 = Self::mul_add(s_q11, x99, c_q11 * x98);
+        let x102 = Self::mul_add(v[10], x97, Self::mul_add(x83, s_q11, x82 * c_q11));
+        let x103 = Self::mul_add(-v[10], x96, Self::mul_add(-x82, s_q11, x83 * c_q11));
+        let x104 = v[10] + x84;
+        let x105 = x96 * x96;
+        let x106 = x97 * x104;
+        let x107 = 0.01675 * x104;
+        let x108 = Self::mul_add(x97, -9.142025249762803, 2.5482240016099564 * x104);
         let x109 = Self::mul_add(
-            x99,
+            9.223235249762805,
+            x104,
+            Self::mul_add(2.5482240016099564, x97, 0.01675 * x96),
+        );
+        let x110 = Self::mul_add(
+            7.078399999258757,
+            x100,
+            Self::mul_add(0.01675, x63, Self::mul_add(-x104, x108, x97 * x109)),
+        );
+        let x111 = Self::mul_add(
             -7.078399999258757,
+            x101,
             Self::mul_add(
                 9.223235249762805,
-                x61,
-                Self::mul_add(2.5482240016099564, x101, 0.01675 * x100),
-            ) + Self::mul_add(-x95, x105, x94 * x106),
+                x63,
+                Self::mul_add(2.5482240016099564, x103, 0.01675 * x102),
+            ) + Self::mul_add(-x97, x107, x96 * x108),
         );
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x111 = -0.00000000020510342851533115 * s_q12;
-        let x112 = -0.00000000020510342851533115 * c_q12;
-        let x113 = Self::mul_add(-x102, s_q12, Self::mul_add(x95, x111, x94 * c_q12));
-        let x114 = Self::mul_add(-x102, c_q12, Self::mul_add(-x94, s_q12, x95 * x112));
-        let x115 = Self::mul_add(-0.36, Self::mul_add(x94, x102, x101), x99);
-        let x116 = Self::mul_add(
+        let x113 = 0.00000000020510342851533115 * s_q12;
+        let x114 = 0.00000000020510342851533115 * c_q12;
+        let x115 = Self::mul_add(-x104, s_q12, Self::mul_add(-x97, x113, x96 * c_q12));
+        let x116 = Self::mul_add(x104, c_q12, Self::mul_add(x97, x114, x96 * s_q12));
+        let x117 = Self::mul_add(Self::mul_add(x96, x104, x103), -0.36, x101);
+        let x118 = Self::mul_add(
+            x106 - x102,
             -0.36,
-            x104 - x100,
-            Self::mul_add(-s_q11, x96, c_q11 * x97),
+            Self::mul_add(-s_q11, x98, c_q11 * x99),
         );
-        let x117 = Self::mul_add(0.36, Self::mul_add(x95, x95, x103), x98);
-        let x118 = Self::mul_add(-s_q12, x117, Self::mul_add(x111, x116, c_q12 * x115));
-        let x119 = Self::mul_add(-c_q12, x117, Self::mul_add(-s_q12, x115, x112 * x116));
-        let x120 = Self::mul_add(-0.00000000020510342851533115, x117, x116);
-        let x121 = Self::mul_add(-0.00000000020510342851533115, x61, x101);
-        let x122 = Self::mul_add(
-            v[11],
-            x114,
-            Self::mul_add(-x61, s_q12, Self::mul_add(x101, x111, x100 * c_q12)),
-        );
-        let x123 = Self::mul_add(
+        let x119 = Self::mul_add(Self::mul_add(x97, x97, x105), 0.36, x100);
+        let x120 = Self::mul_add(-s_q12, x119, Self::mul_add(-x113, x118, c_q12 * x117));
+        let x121 = Self::mul_add(c_q12, x119, Self::mul_add(x114, x118, s_q12 * x117));
+        let x122 = Self::mul_add(-0.00000000020510342851533115, x119, x118);
+        let x123 = Self::mul_add(-0.00000000020510342851533115, x63, x103);
+        let x124 = Self::mul_add(
             -v[11],
-            x113,
-            Self::mul_add(-x61, c_q12, Self::mul_add(-x100, s_q12, x101 * x112)),
+            x116,
+            Self::mul_add(-x63, s_q12, Self::mul_add(-x103, x113, x102 * c_q12)),
         );
-        let x124 = v[11] + Self::mul_add(-0.00000000020510342851533115, x102, x95);
-        let x125 = x114 * x114;
-        let x126 = x124 * x124;
-        let x127 = x113 * x114;
-        let x128 = x127 - x121;
-        let x129 = x113 * x124;
-        let x130 = x113 * x113;
-        let x131 = x126 + x130;
-        let x132 = x114 * x124;
-        let x133 = x122 + x132;
-        let x134 = Self::mul_add(-0.809539999555672, x124, -1.9877000000000002 * x114);
-        let x135 = Self::mul_add(
-            -2.741639999592316,
-            x124,
-            Self::mul_add(-5.252920330000002, x114, -1.9877000000000002 * x113),
+        let x125 = Self::mul_add(
+            v[11],
+            x115,
+            Self::mul_add(x63, c_q12, Self::mul_add(x103, x114, x102 * s_q12)),
         );
-        let x136 = Self::mul_add(
-            9.740442170000001,
-            x124,
-            Self::mul_add(-2.7416399995923166, x114, -0.809539999555672 * x113),
-        );
+        let x126 = v[11] + Self::mul_add(-0.00000000020510342851533115, x104, x97);
+        let x127 = x116 * x116;
+        let x128 = x126 * x126;
+        let x129 = x115 * x116;
+        let x130 = x123 + x129;
+        let x131 = x115 * x126;
+        let x132 = x115 * x115;
+        let x133 = x128 + x132;
+        let x134 = x116 * x126;
+        let x135 = x124 - x134;
+        let x136 = Self::mul_add(x126, -0.809539999555672, x116 * 1.9877000000000002);
         let x137 = Self::mul_add(
-            x120,
+            x126,
+            -2.741639999592316,
+            Self::mul_add(x115, -1.9877000000000002, x116 * 5.252920330000002),
+        );
+        let x138 = Self::mul_add(
+            9.740442170000001,
+            x126,
+            Self::mul_add(x115, -0.809539999555672, x116 * 2.7416399995923166),
+        );
+        let x139 = Self::mul_add(
             -3.6140000000000003,
+            x122,
             Self::mul_add(
+                x123,
                 -2.741639999592316,
-                x121,
-                Self::mul_add(-5.252920330000002, x123, -1.9877000000000002 * x122),
-            ) + Self::mul_add(-x113, x136, x124 * x134),
+                Self::mul_add(x124, -1.9877000000000002, x125 * 5.252920330000002),
+            ) + Self::mul_add(-x115, x138, x126 * x136),
         );
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x139 = -0.00000000020510342851533115 * c_q13;
-        let x140 = -0.00000000020510342851533115 * s_q13;
-        let x141 = Self::mul_add(-x124, c_q13, Self::mul_add(x114, s_q13, x113 * x139));
-        let x142 = Self::mul_add(x124, s_q13, Self::mul_add(-x113, x140, x114 * c_q13));
-        let x143 = x118 + Self::mul_add(0.16, x123 + x129, 0.55 * x128);
-        let x144 = x120 + Self::mul_add(-0.16, x125 + x130, 0.55 * x133);
-        let x145 = Self::mul_add(
-            -c_q13,
-            x144,
+        let x141 = 0.00000000020510342851533115 * c_q13;
+        let x142 = 0.00000000020510342851533115 * s_q13;
+        let x143 = Self::mul_add(x126, c_q13, Self::mul_add(x116, s_q13, x115 * x141));
+        let x144 = Self::mul_add(x126, s_q13, Self::mul_add(-x116, c_q13, x115 * x142));
+        let x145 = x120 + Self::mul_add(-0.55, x130, 0.16 * (x131 - x125));
+        let x146 = x122 + Self::mul_add(-0.16, x127 + x132, 0.55 * x135);
+        let x147 = Self::mul_add(
+            c_q13,
+            x146,
             Self::mul_add(
                 s_q13,
-                x119 + Self::mul_add(-0.55, x131, 0.16 * (x132 - x122)),
-                x139 * x143,
+                x121 + Self::mul_add(0.16, x124 + x134, 0.55 * x133),
+                x141 * x145,
             ),
         );
-        let x146 = Self::mul_add(-0.00000000020510342851533115, x121, x122);
-        let x147 = Self::mul_add(
+        let x148 = Self::mul_add(-0.00000000020510342851533115, x123, x124);
+        let x149 = Self::mul_add(
             v[12],
-            x142,
-            Self::mul_add(-x121, c_q13, Self::mul_add(x123, s_q13, x122 * x139)),
+            x144,
+            -Self::mul_add(x123, c_q13, Self::mul_add(x125, s_q13, x124 * x141)),
         );
-        let x148 = Self::mul_add(
-            -v[12],
-            x141,
-            Self::mul_add(x121, s_q13, Self::mul_add(-x122, x140, x123 * c_q13)),
+        let x150 = Self::mul_add(
+            v[12],
+            x143,
+            Self::mul_add(x123, s_q13, Self::mul_add(-x125, c_q13, x124 * x142)),
         );
-        let x149 = v[12] + Self::mul_add(-0.00000000020510342851533115, x124, x113);
-        let x150 = 4.806620000000001 * Self::mul_add(x141, x142, -x146);
-        let x151 = 4.806620000000001 * Self::mul_add(x141, x141, x149 * x149);
-        let x152 = 4.806620000000001 * Self::mul_add(x142, x149, x147);
-        let x153 = Self::mul_add(-0.0145, x149, 0.000781 * x142);
-        let x154 = Self::mul_add(
-            -0.9614610000000001,
-            x149,
-            Self::mul_add(-1.2025609200000003, x142, 0.000781 * x141),
-        );
-        let x155 = Self::mul_add(
-            1.4135609200000003,
-            x149,
-            Self::mul_add(-0.9614610000000001, x142, -0.0145 * x141),
-        );
+        let x151 = v[12] + Self::mul_add(-0.00000000020510342851533115, x126, x115);
+        let x152 = 4.806620000000001 * Self::mul_add(x143, x144, x148);
+        let x153 = 4.806620000000001 * Self::mul_add(x143, x143, x151 * x151);
+        let x154 = 4.806620000000001 * Self::mul_add(x144, x151, x149);
+        let x155 = Self::mul_add(x151, -0.0145, 0.000781 * x144);
         let x156 = Self::mul_add(
-            -0.9614610000000001,
-            x146,
-            Self::mul_add(-1.2025609200000003, x148, 0.000781 * x147),
-        ) + Self::mul_add(-x141, x155, x149 * x153);
+            x151,
+            0.9614610000000001,
+            Self::mul_add(x144, 1.2025609200000003, 0.000781 * x143),
+        );
         let x157 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x144, x143),
-            Self::mul_add(-0.0145, x146, 0.000781 * x148)
-                + Self::mul_add(-x149, x154, x142 * x155),
+            1.4135609200000003,
+            x151,
+            Self::mul_add(x144, -0.9614610000000001, x143 * 0.0145),
         );
         let x158 = Self::mul_add(
-            x145,
-            -4.806620000000001,
+            x148,
+            -0.9614610000000001,
+            Self::mul_add(x150, -1.2025609200000003, 0.000781 * x149),
+        ) + Self::mul_add(x143, x157, x151 * x155);
+        let x159 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x146, x145),
+            Self::mul_add(x148, -0.0145, 0.000781 * x150)
+                + Self::mul_add(x144, x157, x151 * x156),
+        );
+        let x160 = Self::mul_add(
+            4.806620000000001,
+            x147,
             Self::mul_add(
                 1.4135609200000003,
-                x146,
-                Self::mul_add(-0.9614610000000001, x148, -0.0145 * x147),
-            ) + Self::mul_add(-x142, x153, x141 * x154),
+                x148,
+                -Self::mul_add(x150, 0.9614610000000001, x149 * 0.0145),
+            ) + Self::mul_add(-x144, x155, x143 * x156),
         );
-        let x159 = x152 + Self::mul_add(x140, x151, x139 * x150);
-        let x160 = Self::mul_add(-c_q13, x151, s_q13 * x150);
-        let x161 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x152,
-            -Self::mul_add(s_q13, x151, c_q13 * x150),
-        );
-        let x162 = Self::mul_add(
-            x159,
-            -0.55,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x158,
-                Self::mul_add(-c_q13, x157, s_q13 * x156),
-            ),
-        );
+        let x161 = x154 + Self::mul_add(-x142, x153, x141 * x152);
+        let x162 = Self::mul_add(c_q13, x153, s_q13 * x152);
         let x163 = Self::mul_add(
-            -3.6140000000000003,
-            x125 + x126,
-            17.135250000000003 * x128,
-        ) + x159;
-        let x164 = Self::mul_add(
-            -17.135250000000003,
-            x131,
-            3.6140000000000003 * (x121 + x127),
-        ) + x160;
-        let x165 = Self::mul_add(
-            17.135250000000003,
-            x133,
-            3.6140000000000003 * (x129 - x123),
-        ) + x161;
-        let x166 = Self::mul_add(
-            17.135250000000003,
-            x120,
-            Self::mul_add(-0.809539999555672, x121, -1.9877000000000002 * x123)
-                + Self::mul_add(-x124, x135, x114 * x136),
-        )
-            + (x158 + Self::mul_add(-x140, x156, x139 * x157)
-                + Self::mul_add(0.55, x161, -0.16 * x160));
-        let x167 = x137
-            + Self::mul_add(0.16, x159, Self::mul_add(c_q13, x156, s_q13 * x157));
-        let x168 = Self::mul_add(
-            9.740442170000001,
-            x121,
-            Self::mul_add(-2.7416399995923166, x123, -0.809539999555672 * x122),
-        ) + Self::mul_add(-x114, x134, x113 * x135)
-            + Self::mul_add(3.6140000000000003, x119, x118 * -17.135250000000003) + x162;
-        let x169 = Self::mul_add(-s_q12, x164, c_q12 * x163);
-        let x170 = x165 + Self::mul_add(x112, x164, x111 * x163);
-        let x171 = Self::mul_add(7.078399999258757, Self::mul_add(x94, x95, -x61), x169);
-        let x172 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x102, x102, x103),
-            x170,
-        );
-        let x173 = Self::mul_add(
-            7.078399999258757,
-            x100 + x104,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x165,
-                -Self::mul_add(c_q12, x164, s_q12 * x163),
-            ),
-        );
-        let x174 = x108
-            + Self::mul_add(x170, 0.36, Self::mul_add(-s_q12, x167, c_q12 * x166));
-        let x175 = Self::mul_add(2.5482240016099564, x61, -9.142025249762803 * x101)
-            + Self::mul_add(-x94, x107, x102 * x105)
-            + Self::mul_add(-0.36, x169, x168 + Self::mul_add(x112, x167, x111 * x166));
-        let x176 = x109
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x168,
-                -Self::mul_add(c_q12, x167, s_q12 * x166),
-            );
-        let x177 = Self::mul_add(-s_q11, x172, c_q11 * x171);
-        let x178 = Self::mul_add(c_q11, x172, s_q11 * x171);
-        let x179 = Self::mul_add(-45.1584, x83, x177);
-        let x180 = Self::mul_add(45.1584, x85, x178);
-        let x181 = Self::mul_add(-45.1584, x87, x173);
-        let x182 = x91
-            + (Self::mul_add(-s_q11, x175, c_q11 * x174)
-                + Self::mul_add(-0.63, x173, 0.275 * x178));
-        let x183 = Self::mul_add(-24.35164200091464, x61, -24.4950615 * x81)
-            + Self::mul_add(-x74, x90, x82 * x88)
-            + Self::mul_add(-0.275, x177, Self::mul_add(c_q11, x175, s_q11 * x174));
-        let x184 = x92 + Self::mul_add(x177, 0.63, x176);
-        let x185 = Self::mul_add(-s_q10, x180, c_q10 * x179);
-        let x186 = Self::mul_add(-81.53205, x65, x185);
-        let x187 = Self::mul_add(
-            81.53205,
-            x66,
-            Self::mul_add(c_q10, x180, s_q10 * x179),
-        );
-        let x188 = Self::mul_add(-81.53205, x67, x181);
-        let x189 = x71
-            + Self::mul_add(-0.87, x181, Self::mul_add(-s_q10, x183, c_q10 * x182));
-        let x190 = Self::mul_add(-36.18604050126307, x61, -63.36336825000001 * x63)
-            + Self::mul_add(-x54, x70, x64 * x68)
-            + Self::mul_add(c_q10, x183, s_q10 * x182);
-        let x191 = x72 + Self::mul_add(x185, 0.87, x184);
-        let x192 = Self::mul_add(
-            0.00000000020510342851533115,
-            x188,
-            Self::mul_add(c_q9, x187, s_q9 * x186),
-        );
-        let x193 = x188 + Self::mul_add(x53, x187, x52 * x186);
-        let x194 = Self::mul_add(
             -0.00000000020510342851533115,
-            x188,
-            Self::mul_add(-s_q9, x187, c_q9 * x186),
+            x154,
+            Self::mul_add(-s_q13, x153, c_q13 * x152),
         );
-        let x195 = Self::mul_add(
-            -0.275,
-            x192,
+        let x164 = Self::mul_add(
+            -0.55,
+            x161,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x191,
-                Self::mul_add(-s_q9, x190, c_q9 * x189),
+                x160,
+                Self::mul_add(-c_q13, x159, s_q13 * x158),
             ),
         );
-        let x196 = Self::mul_add(
-            0.000000008530897668050218,
-            x38 + x39,
-            -12.701650001451807 * x41,
-        ) + x192;
-        let x197 = Self::mul_add(
-            12.701650001451807,
-            x44,
-            -0.000000008530897668050218 * (x16 + x40),
-        ) + x193;
-        let x198 = Self::mul_add(
-            -12.701650001451807,
-            x46,
-            -0.000000008530897668050218 * (x36 + x42),
-        ) + x194;
-        let x199 = Self::mul_add(
-            -12.701650001451807,
-            x34,
-            Self::mul_add(0.0000000234896432582596, x36, -0.002139996587640933 * x16)
-                + Self::mul_add(-x37, x48, x28 * x49),
+        let x165 = x161
+            - Self::mul_add(
+                17.135250000000003,
+                x130,
+                3.6140000000000003 * (x127 + x128),
+            );
+        let x166 = Self::mul_add(
+            -17.135250000000003,
+            x133,
+            3.6140000000000003 * (x123 - x129),
+        ) - x162;
+        let x167 = Self::mul_add(
+            17.135250000000003,
+            x135,
+            3.6140000000000003 * (x125 + x131),
+        ) + x163;
+        let x168 = Self::mul_add(
+            17.135250000000003,
+            x122,
+            Self::mul_add(x123, -0.809539999555672, x125 * 1.9877000000000002)
+                - Self::mul_add(x116, x138, x126 * x137),
         )
-            + (Self::mul_add(
+            + (x160 + Self::mul_add(-x141, x159, x142 * x158)
+                + Self::mul_add(0.55, x163, 0.16 * x162));
+        let x169 = x139
+            + Self::mul_add(0.16, x161, Self::mul_add(c_q13, x158, s_q13 * x159));
+        let x170 = Self::mul_add(
+            9.740442170000001,
+            x123,
+            Self::mul_add(x124, -0.809539999555672, x125 * 2.7416399995923166),
+        ) + Self::mul_add(x115, x137, x116 * x136)
+            - Self::mul_add(3.6140000000000003, x121, 17.135250000000003 * x120) + x164;
+        let x171 = Self::mul_add(-s_q12, x166, c_q12 * x165);
+        let x172 = x167 - Self::mul_add(x114, x166, x113 * x165);
+        let x173 = Self::mul_add(7.078399999258757, Self::mul_add(x96, x97, -x63), x171);
+        let x174 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x104, x104, x105),
+            x172,
+        );
+        let x175 = Self::mul_add(
+            7.078399999258757,
+            x102 + x106,
+            -Self::mul_add(
                 0.00000000020510342851533115,
-                x191,
-                Self::mul_add(c_q9, x190, s_q9 * x189),
-            ) + Self::mul_add(0.275, x194, x193 * -0.4));
-        let x200 = x50
-            + Self::mul_add(0.4, x192, x191 + Self::mul_add(x53, x190, x52 * x189));
-        let x201 = Self::mul_add(
+                x167,
+                Self::mul_add(c_q12, x166, s_q12 * x165),
+            ),
+        );
+        let x176 = x110
+            + Self::mul_add(0.36, x172, Self::mul_add(-s_q12, x169, c_q12 * x168));
+        let x177 = Self::mul_add(x103, -9.142025249762803, 2.5482240016099564 * x63)
+            + Self::mul_add(-x96, x109, x104 * x107)
+            + Self::mul_add(-0.36, x171, x170 - Self::mul_add(x114, x169, x113 * x168));
+        let x178 = x111
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x170,
+                Self::mul_add(c_q12, x169, s_q12 * x168),
+            );
+        let x179 = Self::mul_add(-s_q11, x174, c_q11 * x173);
+        let x180 = Self::mul_add(c_q11, x174, s_q11 * x173);
+        let x181 = Self::mul_add(x85, -45.1584, x179);
+        let x182 = Self::mul_add(45.1584, x87, x180);
+        let x183 = Self::mul_add(-45.1584, x89, x175);
+        let x184 = x93
+            + (Self::mul_add(-s_q11, x177, c_q11 * x176)
+                + Self::mul_add(-0.63, x175, 0.275 * x180));
+        let x185 = Self::mul_add(-0.275, x179, Self::mul_add(c_q11, x177, s_q11 * x176))
+            - (Self::mul_add(x63, 24.35164200091464, x83 * 24.4950615)
+                + Self::mul_add(x76, x92, x84 * x90));
+        let x186 = x94 + Self::mul_add(0.63, x179, x178);
+        let x187 = Self::mul_add(-s_q10, x182, c_q10 * x181);
+        let x188 = Self::mul_add(x67, -81.53205, x187);
+        let x189 = Self::mul_add(
+            81.53205,
+            x68,
+            Self::mul_add(c_q10, x182, s_q10 * x181),
+        );
+        let x190 = Self::mul_add(-81.53205, x69, x183);
+        let x191 = x73
+            + Self::mul_add(-0.87, x183, Self::mul_add(-s_q10, x185, c_q10 * x184));
+        let x192 = Self::mul_add(c_q10, x185, s_q10 * x184)
+            - (Self::mul_add(x63, 36.18604050126307, x65 * 63.36336825000001)
+                + Self::mul_add(x56, x72, x66 * x70));
+        let x193 = x74 + Self::mul_add(0.87, x187, x186);
+        let x194 = 0.00000000020510342851533115 * x190;
+        let x195 = Self::mul_add(c_q9, x189, s_q9 * x188) + x194;
+        let x196 = x190 + Self::mul_add(-x55, x189, x54 * x188);
+        let x197 = Self::mul_add(-s_q9, x189, c_q9 * x188) - x194;
+        let x198 = 0.00000000020510342851533115 * x193;
+        let x199 = Self::mul_add(
+            x41,
+            -12.701650001451807,
+            (x38 + x39) * 0.000000008530897668050218,
+        ) + x195;
+        let x200 = Self::mul_add(
+            -0.000000008530897668050218,
+            x16 + x40,
+            12.701650001451807 * x44,
+        ) + x196;
+        let x201 = x197
+            - Self::mul_add(
+                12.701650001451807,
+                x46,
+                0.000000008530897668050218 * (x42 - x36),
+            );
+        let x202 = Self::mul_add(
+            x34,
+            -12.701650001451807,
+            Self::mul_add(-x37, x48, x28 * x49)
+                - Self::mul_add(
+                    x16,
+                    0.002139996587640933,
+                    x36 * 0.0000000234896432582596,
+                ),
+        )
+            + (Self::mul_add(c_q9, x192, s_q9 * x191) + x198
+                + Self::mul_add(-0.4, x196, 0.275 * x197));
+        let x203 = x50
+            + Self::mul_add(0.4, x195, x193 + Self::mul_add(-x55, x192, x54 * x191));
+        let x204 = Self::mul_add(
             113.3918902508081,
             x16,
-            Self::mul_add(-5.080660024070366, x36, -0.002139996587640933 * x35),
-        ) + Self::mul_add(-x28, x47, x27 * x48)
-            + Self::mul_add(-0.000000008530897668050218, x33, x32 * 12.701650001451807)
-            + x195;
-        let x202 = x198 + Self::mul_add(-x26, x197, x25 * x196);
-        let x203 = Self::mul_add(c_q8, x197, s_q8 * x196);
-        let x204 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x202);
-        let x205 = Self::mul_add(48.0240000085309, x4 * x5, x203);
-        let x206 = Self::mul_add(
+            Self::mul_add(x35, -0.002139996587640933, 5.080660024070366 * x36),
+        ) + Self::mul_add(x27, x48, x28 * x47)
+            + Self::mul_add(x33, -0.000000008530897668050218, x32 * 12.701650001451807)
+            + Self::mul_add(
+                -0.275,
+                x195,
+                Self::mul_add(-s_q9, x192, c_q9 * x191) - x198,
+            );
+        let x205 = x201 + Self::mul_add(-x25, x199, x26 * x200);
+        let x206 = Self::mul_add(c_q8, x200, s_q8 * x199);
+        let x207 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x205);
+        let x208 = Self::mul_add(48.0240000085309, x4 * x5, x206);
+        let x209 = Self::mul_add(
             48.0240000085309,
             x17 + x20,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x198,
-                Self::mul_add(-c_q8, x196, s_q8 * x197),
+                x201,
+                Self::mul_add(-c_q8, x199, s_q8 * x200),
             ),
         );
-        let x207 = Self::mul_add(0.07309, x17, Self::mul_add(-x18, x22, x5 * x23))
-            + Self::mul_add(x203, -0.35, x201 + Self::mul_add(-x26, x200, x25 * x199));
-        let x208 = Self::mul_add(
-            x14,
-            -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x17, -0.07309 * x16)
-                + Self::mul_add(-x4, x23, x18 * x21),
-        ) + Self::mul_add(0.35, x202, Self::mul_add(c_q8, x200, s_q8 * x199));
-        let x209 = Self::mul_add(
+        let x210 = Self::mul_add(x17, 0.07309, Self::mul_add(-x18, x22, x5 * x23))
+            + Self::mul_add(-0.35, x206, x204 + Self::mul_add(-x25, x202, x26 * x203));
+        let x211 = Self::mul_add(0.35, x205, Self::mul_add(c_q8, x203, s_q8 * x202))
+            - Self::mul_add(
+                48.0240000085309,
+                x14,
+                Self::mul_add(130.43769025763282, x17, x16 * 0.07309)
+                    + Self::mul_add(x4, x23, x18 * x21),
+            );
+        let x212 = Self::mul_add(
             48.0240000085309,
             x15,
-            Self::mul_add(-0.1132, x17, -16.80768997608804 * x16)
-                + Self::mul_add(-x5, x21, x4 * x22),
+            Self::mul_add(x4, x22, x5 * x21)
+                - Self::mul_add(0.1132, x17, x16 * 16.80768997608804),
         )
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x201,
-                Self::mul_add(-c_q8, x199, s_q8 * x200),
+                x204,
+                Self::mul_add(-c_q8, x202, s_q8 * x203),
             );
-        let x210 = Self::mul_add(-s_q7, x205, c_q7 * x204);
-        let x211 = Self::mul_add(c_q7, x205, s_q7 * x204);
-        let x212 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x213 = 1466.4506062283303 * v[4];
-        let x214 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x215 = x210
+        let x213 = Self::mul_add(-s_q7, x208, c_q7 * x207);
+        let x214 = Self::mul_add(c_q7, x208, s_q7 * x207);
+        let x215 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x216 = 1466.4506062283303 * v[4];
+        let x217 = Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]);
+        let x218 = x213
             + Self::mul_add(
                 1170.07,
                 x0,
                 Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
             );
-        let x216 = x211
+        let x219 = x214
             + Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x10, 110.5455 * x8),
             );
-        let x217 = x206
+        let x220 = x209
             + Self::mul_add(
                 1170.07,
                 x2,
                 Self::mul_add(-180.9502499901501, x11, 110.5455 * x9),
             );
-        let x218 = Self::mul_add(x211, -0.75, Self::mul_add(-s_q7, x208, c_q7 * x207))
+        let x221 = Self::mul_add(-0.75, x214, Self::mul_add(-s_q7, x211, c_q7 * x210))
             + Self::mul_add(
-                x1,
                 -180.9502499901501,
-                Self::mul_add(-v[5], x213, v[4] * x214),
+                x1,
+                Self::mul_add(-v[5], x216, v[4] * x217),
             );
-        let x219 = Self::mul_add(c_q7, x208, s_q7 * x207)
-            + Self::mul_add(x206, -0.65, 0.75 * x210)
-            + (Self::mul_add(-v[3], x214, v[5] * x212)
-                + Self::mul_add(x2, -110.5455, 180.9502499901501 * x0));
-        let x220 = Self::mul_add(0.65, x211, x209)
-            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x212, v[3] * x213));
-        [x215, x216, x217, x218, x219, x220, x209, x201, x191, x184, x176, x168, x158]
+        let x222 = Self::mul_add(c_q7, x211, s_q7 * x210)
+            + Self::mul_add(-0.65, x209, 0.75 * x213)
+            + (Self::mul_add(-v[3], x217, v[5] * x215)
+                + Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
+        let x223 = Self::mul_add(0.65, x214, x212)
+            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x215, v[3] * x216));
+        [x218, x219, x220, x221, x222, x223, x212, x204, x193, x186, x178, x170, x160]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
-    /// Methods: bias `newton-euler`: 547 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 338 fused where the target has FMA.
+    /// Methods: bias `newton-euler`: 543 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 332 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
         let x0 = a[0] + Self::mul_add(-v[1], v[5], v[2] * v[4]);
@@ -2369,25 +2520,25 @@ impl FreeFloating7 {
         let x21 = v[5] + v[6];
         let x22 = x5 * x5;
         let x23 = x4 * x21;
-        let x24 = Self::mul_add(-16.80768997608804, x21, -0.07309 * x5);
+        let x24 = Self::mul_add(x21, 16.80768997608804, x5 * 0.07309);
         let x25 = Self::mul_add(
             0.1132,
             x21,
-            Self::mul_add(130.43769025763282, x5, -0.07309 * x4),
+            Self::mul_add(x4, -0.07309, 130.43769025763282 * x5),
         );
         let x26 = Self::mul_add(
             132.47349025763282,
             x21,
-            Self::mul_add(0.1132, x5, -16.80768997608804 * x4),
+            Self::mul_add(x4, -16.80768997608804, 0.1132 * x5),
         );
         let x27 = Self::mul_add(
-            x16,
             -48.0240000085309,
+            x16,
             Self::mul_add(
                 0.1132,
                 x20,
-                Self::mul_add(130.43769025763282, x19, -0.07309 * x18),
-            ) + Self::mul_add(-x4, x26, x21 * x24),
+                Self::mul_add(x18, -0.07309, 130.43769025763282 * x19),
+            ) - Self::mul_add(x4, x26, x21 * x24),
         );
         let x28 = Self::mul_add(
             48.0240000085309,
@@ -2395,29 +2546,29 @@ impl FreeFloating7 {
             Self::mul_add(
                 132.47349025763282,
                 x20,
-                Self::mul_add(0.1132, x19, -16.80768997608804 * x18),
-            ) + Self::mul_add(-x5, x24, x4 * x25),
+                Self::mul_add(x18, -16.80768997608804, 0.1132 * x19),
+            ) + Self::mul_add(x4, x25, x5 * x24),
         );
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x30 = -0.00000000020510342851533115 * c_q8;
-        let x31 = -0.00000000020510342851533115 * s_q8;
-        let x32 = Self::mul_add(-x21, c_q8, Self::mul_add(x5, s_q8, x4 * x30));
-        let x33 = Self::mul_add(x21, s_q8, Self::mul_add(-x4, x31, x5 * c_q8));
+        let x30 = 0.00000000020510342851533115 * c_q8;
+        let x31 = 0.00000000020510342851533115 * s_q8;
+        let x32 = Self::mul_add(-x21, c_q8, Self::mul_add(-x4, x30, x5 * s_q8));
+        let x33 = Self::mul_add(x21, s_q8, Self::mul_add(x5, c_q8, x4 * x31));
         let x34 = Self::mul_add(0.35, x19 + x23, Self::mul_add(s_q7, x15, c_q7 * x14));
         let x35 = Self::mul_add(0.35, Self::mul_add(x5, x21, -x18), x17);
         let x36 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x22), x16);
-        let x37 = Self::mul_add(-c_q8, x36, Self::mul_add(s_q8, x35, x30 * x34));
-        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(-x31, x34, c_q8 * x35));
+        let x37 = Self::mul_add(-c_q8, x36, Self::mul_add(-x30, x34, s_q8 * x35));
+        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(c_q8, x35, x31 * x34));
         let x39 = Self::mul_add(-0.00000000020510342851533115, x36, x34);
         let x40 = Self::mul_add(
             v[7],
             x33,
-            Self::mul_add(-x20, c_q8, Self::mul_add(x19, s_q8, x18 * x30)),
+            Self::mul_add(-x20, c_q8, Self::mul_add(-x18, x30, x19 * s_q8)),
         );
         let x41 = Self::mul_add(
             -v[7],
             x32,
-            Self::mul_add(x20, s_q8, Self::mul_add(-x18, x31, x19 * c_q8)),
+            Self::mul_add(x20, s_q8, Self::mul_add(x19, c_q8, x18 * x31)),
         );
         let x42 = a[7] + Self::mul_add(-0.00000000020510342851533115, x20, x18);
         let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x21, x4);
@@ -2431,19 +2582,19 @@ impl FreeFloating7 {
         let x51 = x33 * x43;
         let x52 = x40 + x51;
         let x53 = Self::mul_add(
-            -0.002139996587640933,
             x43,
-            -0.0000000234896432582596 * x33,
+            0.002139996587640933,
+            x33 * 0.0000000234896432582596,
         );
         let x54 = Self::mul_add(
             5.080660024070365,
             x43,
-            Self::mul_add(-111.7548902508081, x33, -0.0000000234896432582596 * x32),
+            -Self::mul_add(x33, 111.7548902508081, x32 * 0.0000000234896432582596),
         );
         let x55 = Self::mul_add(
             113.3918902508081,
             x43,
-            Self::mul_add(5.080660024070366, x33, -0.002139996587640933 * x32),
+            Self::mul_add(x32, -0.002139996587640933, 5.080660024070366 * x33),
         );
         let x56 = Self::mul_add(
             x39,
@@ -2451,534 +2602,519 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x42,
-                Self::mul_add(-111.7548902508081, x41, -0.0000000234896432582596 * x40),
-            ) + Self::mul_add(-x32, x55, x43 * x53),
+                -Self::mul_add(x41, 111.7548902508081, x40 * 0.0000000234896432582596),
+            ) - Self::mul_add(x32, x55, x43 * x53),
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x58 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x59 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x60 = Self::mul_add(x43, c_q9, Self::mul_add(x33, x58, x32 * s_q9));
-        let x61 = Self::mul_add(-x43, s_q9, Self::mul_add(x33, x59, x32 * c_q9));
-        let x62 = x37 + Self::mul_add(0.4, x41 + x48, 0.275 * x47);
-        let x63 = x38 + Self::mul_add(-0.275, x50, 0.4 * (x51 - x40));
-        let x64 = x39 + Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
-        let x65 = Self::mul_add(c_q9, x64, Self::mul_add(x58, x63, s_q9 * x62));
-        let x66 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x64,
-            Self::mul_add(0.00000000020510342851533115, x62, x63),
-        );
-        let x67 = Self::mul_add(
-            v[8],
-            x61,
-            Self::mul_add(x42, c_q9, Self::mul_add(x41, x58, x40 * s_q9)),
-        );
+        let x58 = 0.00000000020510342851533115 * c_q9;
+        let x59 = 0.00000000020510342851533115 * s_q9;
+        let x60 = x58 - x59;
+        let x61 = x58 + x59;
+        let x62 = Self::mul_add(x43, c_q9, Self::mul_add(x33, x60, x32 * s_q9));
+        let x63 = Self::mul_add(-x43, s_q9, Self::mul_add(-x33, x61, x32 * c_q9));
+        let x64 = x37 + Self::mul_add(0.4, x41 + x48, 0.275 * x47);
+        let x65 = x38 + Self::mul_add(-0.275, x50, 0.4 * (x51 - x40));
+        let x66 = x39 + Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
+        let x67 = Self::mul_add(c_q9, x66, Self::mul_add(x60, x65, s_q9 * x64));
         let x68 = Self::mul_add(
-            -v[8],
-            x60,
-            Self::mul_add(-x42, s_q9, Self::mul_add(x41, x59, x40 * c_q9)),
+            -0.00000000020510342851533115,
+            x66,
+            Self::mul_add(0.00000000020510342851533115, x64, x65),
         );
-        let x69 = a[8]
+        let x69 = Self::mul_add(
+            v[8],
+            x63,
+            Self::mul_add(x42, c_q9, Self::mul_add(x41, x60, x40 * s_q9)),
+        );
+        let x70 = Self::mul_add(
+            -v[8],
+            x62,
+            Self::mul_add(-x42, s_q9, Self::mul_add(-x41, x61, x40 * c_q9)),
+        );
+        let x71 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x42,
                 Self::mul_add(0.00000000020510342851533115, x40, x41),
             );
-        let x70 = v[8]
+        let x72 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x43,
                 Self::mul_add(0.00000000020510342851533115, x32, x33),
             );
-        let x71 = Self::mul_add(x60, x61, -x69);
-        let x72 = Self::mul_add(x60, x60, x70 * x70);
-        let x73 = Self::mul_add(x61, x70, x67);
-        let x74 = -0.00214 * x70;
-        let x75 = Self::mul_add(-36.18604050126307, x70, -63.36336825000001 * x61);
-        let x76 = Self::mul_add(
-            69.99836825,
-            x70,
-            Self::mul_add(-36.18604050126307, x61, -0.00214 * x60),
-        );
-        let x77 = Self::mul_add(
-            -81.53205,
-            x66,
-            Self::mul_add(-0.00214, x69, Self::mul_add(-x70, x75, x61 * x76)),
-        );
+        let x73 = Self::mul_add(x62, x63, -x71);
+        let x74 = Self::mul_add(x62, x62, x72 * x72);
+        let x75 = Self::mul_add(x63, x72, x69);
+        let x76 = x72 * 0.00214;
+        let x77 = Self::mul_add(x72, 36.18604050126307, x63 * 63.36336825000001);
         let x78 = Self::mul_add(
-            x65,
+            69.99836825,
+            x72,
+            -Self::mul_add(x63, 36.18604050126307, x62 * 0.00214),
+        );
+        let x79 = Self::mul_add(
+            x68,
+            -81.53205,
+            Self::mul_add(x71, -0.00214, Self::mul_add(x63, x78, x72 * x77)),
+        );
+        let x80 = Self::mul_add(
+            x67,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x69,
-                Self::mul_add(-36.18604050126307, x68, -0.00214 * x67),
-            ) + Self::mul_add(-x61, x74, x60 * x75),
+                x71,
+                -Self::mul_add(x70, 36.18604050126307, x69 * 0.00214),
+            ) + Self::mul_add(-x62, x77, x63 * x76),
         );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x80 = Self::mul_add(x61, s_q10, x60 * c_q10);
-        let x81 = Self::mul_add(-x60, s_q10, x61 * c_q10);
-        let x82 = Self::mul_add(-0.87, x71, x65);
-        let x83 = Self::mul_add(
+        let x82 = Self::mul_add(x63, s_q10, x62 * c_q10);
+        let x83 = Self::mul_add(-x62, s_q10, x63 * c_q10);
+        let x84 = Self::mul_add(x73, -0.87, x67);
+        let x85 = Self::mul_add(
+            x74,
             0.87,
-            x72,
-            Self::mul_add(-s_q9, x64, Self::mul_add(x59, x63, c_q9 * x62)),
+            Self::mul_add(-s_q9, x66, Self::mul_add(-x61, x65, c_q9 * x64)),
         );
-        let x84 = Self::mul_add(-0.87, x73, x66);
-        let x85 = Self::mul_add(s_q10, x83, c_q10 * x82);
-        let x86 = Self::mul_add(v[9], x81, Self::mul_add(x68, s_q10, x67 * c_q10));
-        let x87 = Self::mul_add(-v[9], x80, Self::mul_add(-x67, s_q10, x68 * c_q10));
-        let x88 = a[9] + x69;
-        let x89 = v[9] + x70;
-        let x90 = Self::mul_add(x80, x81, -x88);
-        let x91 = x80 * x80;
-        let x92 = Self::mul_add(x89, x89, x91);
-        let x93 = x81 * x89;
-        let x94 = x86 + x93;
-        let x95 = -0.6328 * x89;
-        let x96 = Self::mul_add(-24.35164200091464, x89, -24.4950615 * x81);
-        let x97 = Self::mul_add(
-            28.2393615,
-            x89,
-            Self::mul_add(-24.351642000914637, x81, -0.6328 * x80),
-        );
-        let x98 = Self::mul_add(
-            -45.1584,
-            x84,
-            Self::mul_add(-0.6328, x88, Self::mul_add(-x89, x96, x81 * x97)),
-        );
+        let x86 = Self::mul_add(x75, -0.87, x68);
+        let x87 = Self::mul_add(s_q10, x85, c_q10 * x84);
+        let x88 = Self::mul_add(v[9], x83, Self::mul_add(x70, s_q10, x69 * c_q10));
+        let x89 = Self::mul_add(-v[9], x82, Self::mul_add(-x69, s_q10, x70 * c_q10));
+        let x90 = a[9] + x71;
+        let x91 = v[9] + x72;
+        let x92 = Self::mul_add(x82, x83, -x90);
+        let x93 = x82 * x82;
+        let x94 = Self::mul_add(x91, x91, x93);
+        let x95 = x83 * x91;
+        let x96 = x88 + x95;
+        let x97 = x91 * 0.6328;
+        let x98 = Self::mul_add(x91, 24.35164200091464, x83 * 24.4950615);
         let x99 = Self::mul_add(
-            x85,
+            28.2393615,
+            x91,
+            -Self::mul_add(x83, 24.351642000914637, x82 * 0.6328),
+        );
+        let x100 = Self::mul_add(
+            x86,
+            -45.1584,
+            Self::mul_add(x90, -0.6328, Self::mul_add(x83, x99, x91 * x98)),
+        );
+        let x101 = Self::mul_add(
+            x87,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x88,
-                Self::mul_add(-24.351642000914637, x87, -0.6328 * x86),
-            ) + Self::mul_add(-x81, x95, x80 * x96),
+                x90,
+                -Self::mul_add(x89, 24.351642000914637, x88 * 0.6328),
+            ) + Self::mul_add(-x82, x98, x83 * x97),
         );
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x101 = Self::mul_add(x81, s_q11, x80 * c_q11);
-        let x102 = Self::mul_add(-x80, s_q11, x81 * c_q11);
-        let x103 = x85
-            + Self::mul_add(-0.275, Self::mul_add(x80, x89, x87), -0.63 * x90);
-        let x104 = Self::mul_add(-s_q10, x82, c_q10 * x83)
-            + Self::mul_add(0.63, x92, -0.275 * (x93 - x86));
-        let x105 = x84 + Self::mul_add(0.275, Self::mul_add(x81, x81, x91), -0.63 * x94);
-        let x106 = Self::mul_add(s_q11, x104, c_q11 * x103);
-        let x107 = Self::mul_add(v[10], x102, Self::mul_add(x87, s_q11, x86 * c_q11));
-        let x108 = Self::mul_add(-v[10], x101, Self::mul_add(-x86, s_q11, x87 * c_q11));
-        let x109 = a[10] + x88;
-        let x110 = v[10] + x89;
-        let x111 = x101 * x101;
-        let x112 = x102 * x110;
-        let x113 = 0.01675 * x110;
-        let x114 = Self::mul_add(2.5482240016099564, x110, -9.142025249762803 * x102);
-        let x115 = Self::mul_add(
-            9.223235249762805,
-            x110,
-            Self::mul_add(2.5482240016099564, x102, 0.01675 * x101),
-        );
-        let x116 = Self::mul_add(
-            7.078399999258757,
-            x105,
-            Self::mul_add(0.01675, x109, Self::mul_add(-x110, x114, x102 * x115)),
-        );
+        let x103 = Self::mul_add(x83, s_q11, x82 * c_q11);
+        let x104 = Self::mul_add(-x82, s_q11, x83 * c_q11);
+        let x105 = x87 - Self::mul_add(0.275, Self::mul_add(x82, x91, x89), x92 * 0.63);
+        let x106 = Self::mul_add(-s_q10, x84, c_q10 * x85)
+            + Self::mul_add(-0.275, x95 - x88, x94 * 0.63);
+        let x107 = x86 + Self::mul_add(x96, -0.63, 0.275 * Self::mul_add(x83, x83, x93));
+        let x108 = Self::mul_add(s_q11, x106, c_q11 * x105);
+        let x109 = Self::mul_add(v[10], x104, Self::mul_add(x89, s_q11, x88 * c_q11));
+        let x110 = Self::mul_add(-v[10], x103, Self::mul_add(-x88, s_q11, x89 * c_q11));
+        let x111 = a[10] + x90;
+        let x112 = v[10] + x91;
+        let x113 = x103 * x103;
+        let x114 = x104 * x112;
+        let x115 = 0.01675 * x112;
+        let x116 = Self::mul_add(x104, -9.142025249762803, 2.5482240016099564 * x112);
         let x117 = Self::mul_add(
-            x106,
+            9.223235249762805,
+            x112,
+            Self::mul_add(2.5482240016099564, x104, 0.01675 * x103),
+        );
+        let x118 = Self::mul_add(
+            7.078399999258757,
+            x107,
+            Self::mul_add(0.01675, x111, Self::mul_add(-x112, x116, x104 * x117)),
+        );
+        let x119 = Self::mul_add(
             -7.078399999258757,
+            x108,
             Self::mul_add(
                 9.223235249762805,
-                x109,
-                Self::mul_add(2.5482240016099564, x108, 0.01675 * x107),
-            ) + Self::mul_add(-x102, x113, x101 * x114),
+                x111,
+                Self::mul_add(2.5482240016099564, x110, 0.01675 * x109),
+            ) + Self::mul_add(-x104, x115, x103 * x116),
         );
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x119 = -0.00000000020510342851533115 * s_q12;
-        let x120 = -0.00000000020510342851533115 * c_q12;
-        let x121 = Self::mul_add(-x110, s_q12, Self::mul_add(x102, x119, x101 * c_q12));
-        let x122 = Self::mul_add(-x110, c_q12, Self::mul_add(-x101, s_q12, x102 * x120));
-        let x123 = Self::mul_add(-0.36, Self::mul_add(x101, x110, x108), x106);
-        let x124 = Self::mul_add(
+        let x121 = 0.00000000020510342851533115 * s_q12;
+        let x122 = 0.00000000020510342851533115 * c_q12;
+        let x123 = Self::mul_add(-x112, s_q12, Self::mul_add(-x104, x121, x103 * c_q12));
+        let x124 = Self::mul_add(x112, c_q12, Self::mul_add(x104, x122, x103 * s_q12));
+        let x125 = Self::mul_add(Self::mul_add(x103, x112, x110), -0.36, x108);
+        let x126 = Self::mul_add(
+            x114 - x109,
             -0.36,
-            x112 - x107,
-            Self::mul_add(-s_q11, x103, c_q11 * x104),
+            Self::mul_add(-s_q11, x105, c_q11 * x106),
         );
-        let x125 = Self::mul_add(0.36, Self::mul_add(x102, x102, x111), x105);
-        let x126 = Self::mul_add(-s_q12, x125, Self::mul_add(x119, x124, c_q12 * x123));
-        let x127 = Self::mul_add(-c_q12, x125, Self::mul_add(-s_q12, x123, x120 * x124));
-        let x128 = Self::mul_add(-0.00000000020510342851533115, x125, x124);
-        let x129 = Self::mul_add(
-            v[11],
-            x122,
-            Self::mul_add(-x109, s_q12, Self::mul_add(x108, x119, x107 * c_q12)),
-        );
-        let x130 = Self::mul_add(
+        let x127 = Self::mul_add(Self::mul_add(x104, x104, x113), 0.36, x107);
+        let x128 = Self::mul_add(-s_q12, x127, Self::mul_add(-x121, x126, c_q12 * x125));
+        let x129 = Self::mul_add(c_q12, x127, Self::mul_add(x122, x126, s_q12 * x125));
+        let x130 = Self::mul_add(-0.00000000020510342851533115, x127, x126);
+        let x131 = Self::mul_add(
             -v[11],
-            x121,
-            Self::mul_add(-x109, c_q12, Self::mul_add(-x107, s_q12, x108 * x120)),
+            x124,
+            Self::mul_add(-x111, s_q12, Self::mul_add(-x110, x121, x109 * c_q12)),
         );
-        let x131 = a[11] + Self::mul_add(-0.00000000020510342851533115, x109, x108);
-        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x110, x102);
-        let x133 = x122 * x122;
-        let x134 = x132 * x132;
-        let x135 = x121 * x122;
-        let x136 = x135 - x131;
-        let x137 = x121 * x132;
-        let x138 = x121 * x121;
-        let x139 = x134 + x138;
-        let x140 = x122 * x132;
-        let x141 = x129 + x140;
-        let x142 = Self::mul_add(-0.809539999555672, x132, -1.9877000000000002 * x122);
-        let x143 = Self::mul_add(
-            -2.741639999592316,
-            x132,
-            Self::mul_add(-5.252920330000002, x122, -1.9877000000000002 * x121),
+        let x132 = Self::mul_add(
+            v[11],
+            x123,
+            Self::mul_add(x111, c_q12, Self::mul_add(x110, x122, x109 * s_q12)),
         );
-        let x144 = Self::mul_add(
-            9.740442170000001,
-            x132,
-            Self::mul_add(-2.7416399995923166, x122, -0.809539999555672 * x121),
-        );
+        let x133 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x110);
+        let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x112, x104);
+        let x135 = x124 * x124;
+        let x136 = x134 * x134;
+        let x137 = x123 * x124;
+        let x138 = x133 + x137;
+        let x139 = x123 * x134;
+        let x140 = x123 * x123;
+        let x141 = x136 + x140;
+        let x142 = x124 * x134;
+        let x143 = x131 - x142;
+        let x144 = Self::mul_add(x134, -0.809539999555672, x124 * 1.9877000000000002);
         let x145 = Self::mul_add(
-            x128,
+            x134,
+            -2.741639999592316,
+            Self::mul_add(x123, -1.9877000000000002, x124 * 5.252920330000002),
+        );
+        let x146 = Self::mul_add(
+            9.740442170000001,
+            x134,
+            Self::mul_add(x123, -0.809539999555672, x124 * 2.7416399995923166),
+        );
+        let x147 = Self::mul_add(
             -3.6140000000000003,
+            x130,
             Self::mul_add(
+                x133,
                 -2.741639999592316,
-                x131,
-                Self::mul_add(-5.252920330000002, x130, -1.9877000000000002 * x129),
-            ) + Self::mul_add(-x121, x144, x132 * x142),
+                Self::mul_add(x131, -1.9877000000000002, x132 * 5.252920330000002),
+            ) + Self::mul_add(-x123, x146, x134 * x144),
         );
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x147 = -0.00000000020510342851533115 * c_q13;
-        let x148 = -0.00000000020510342851533115 * s_q13;
-        let x149 = Self::mul_add(-x132, c_q13, Self::mul_add(x122, s_q13, x121 * x147));
-        let x150 = Self::mul_add(x132, s_q13, Self::mul_add(-x121, x148, x122 * c_q13));
-        let x151 = x126 + Self::mul_add(0.16, x130 + x137, 0.55 * x136);
-        let x152 = x128 + Self::mul_add(-0.16, x133 + x138, 0.55 * x141);
-        let x153 = Self::mul_add(
-            -c_q13,
-            x152,
+        let x149 = 0.00000000020510342851533115 * c_q13;
+        let x150 = 0.00000000020510342851533115 * s_q13;
+        let x151 = Self::mul_add(x134, c_q13, Self::mul_add(x124, s_q13, x123 * x149));
+        let x152 = Self::mul_add(x134, s_q13, Self::mul_add(-x124, c_q13, x123 * x150));
+        let x153 = x128 + Self::mul_add(-0.55, x138, 0.16 * (x139 - x132));
+        let x154 = x130 + Self::mul_add(-0.16, x135 + x140, 0.55 * x143);
+        let x155 = Self::mul_add(
+            c_q13,
+            x154,
             Self::mul_add(
                 s_q13,
-                x127 + Self::mul_add(-0.55, x139, 0.16 * (x140 - x129)),
-                x147 * x151,
+                x129 + Self::mul_add(0.16, x131 + x142, 0.55 * x141),
+                x149 * x153,
             ),
         );
-        let x154 = Self::mul_add(
+        let x156 = Self::mul_add(
             v[12],
-            x150,
-            Self::mul_add(-x131, c_q13, Self::mul_add(x130, s_q13, x129 * x147)),
+            x152,
+            -Self::mul_add(x133, c_q13, Self::mul_add(x132, s_q13, x131 * x149)),
         );
-        let x155 = Self::mul_add(
-            -v[12],
-            x149,
-            Self::mul_add(x131, s_q13, Self::mul_add(-x129, x148, x130 * c_q13)),
+        let x157 = Self::mul_add(
+            v[12],
+            x151,
+            Self::mul_add(x133, s_q13, Self::mul_add(-x132, c_q13, x131 * x150)),
         );
-        let x156 = a[12] + Self::mul_add(-0.00000000020510342851533115, x131, x129);
-        let x157 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x121);
-        let x158 = 4.806620000000001 * Self::mul_add(x149, x150, -x156);
-        let x159 = 4.806620000000001 * Self::mul_add(x149, x149, x157 * x157);
-        let x160 = 4.806620000000001 * Self::mul_add(x150, x157, x154);
-        let x161 = Self::mul_add(-0.0145, x157, 0.000781 * x150);
-        let x162 = Self::mul_add(
-            -0.9614610000000001,
-            x157,
-            Self::mul_add(-1.2025609200000003, x150, 0.000781 * x149),
-        );
-        let x163 = Self::mul_add(
-            1.4135609200000003,
-            x157,
-            Self::mul_add(-0.9614610000000001, x150, -0.0145 * x149),
-        );
+        let x158 = a[12] + Self::mul_add(-0.00000000020510342851533115, x133, x131);
+        let x159 = v[12] + Self::mul_add(-0.00000000020510342851533115, x134, x123);
+        let x160 = 4.806620000000001 * Self::mul_add(x151, x152, x158);
+        let x161 = 4.806620000000001 * Self::mul_add(x151, x151, x159 * x159);
+        let x162 = 4.806620000000001 * Self::mul_add(x152, x159, x156);
+        let x163 = Self::mul_add(x159, -0.0145, 0.000781 * x152);
         let x164 = Self::mul_add(
-            -0.9614610000000001,
-            x156,
-            Self::mul_add(-1.2025609200000003, x155, 0.000781 * x154),
-        ) + Self::mul_add(-x149, x163, x157 * x161);
+            x159,
+            0.9614610000000001,
+            Self::mul_add(x152, 1.2025609200000003, 0.000781 * x151),
+        );
         let x165 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x152, x151),
-            Self::mul_add(-0.0145, x156, 0.000781 * x155)
-                + Self::mul_add(-x157, x162, x150 * x163),
+            1.4135609200000003,
+            x159,
+            Self::mul_add(x152, -0.9614610000000001, x151 * 0.0145),
         );
         let x166 = Self::mul_add(
-            x153,
-            -4.806620000000001,
+            x158,
+            -0.9614610000000001,
+            Self::mul_add(x157, -1.2025609200000003, 0.000781 * x156),
+        ) + Self::mul_add(x151, x165, x159 * x163);
+        let x167 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x154, x153),
+            Self::mul_add(x158, -0.0145, 0.000781 * x157)
+                + Self::mul_add(x152, x165, x159 * x164),
+        );
+        let x168 = Self::mul_add(
+            4.806620000000001,
+            x155,
             Self::mul_add(
                 1.4135609200000003,
-                x156,
-                Self::mul_add(-0.9614610000000001, x155, -0.0145 * x154),
-            ) + Self::mul_add(-x150, x161, x149 * x162),
+                x158,
+                -Self::mul_add(x157, 0.9614610000000001, x156 * 0.0145),
+            ) + Self::mul_add(-x152, x163, x151 * x164),
         );
-        let x167 = x160 + Self::mul_add(x148, x159, x147 * x158);
-        let x168 = Self::mul_add(-c_q13, x159, s_q13 * x158);
-        let x169 = Self::mul_add(
+        let x169 = x162 + Self::mul_add(-x150, x161, x149 * x160);
+        let x170 = Self::mul_add(c_q13, x161, s_q13 * x160);
+        let x171 = Self::mul_add(
             -0.00000000020510342851533115,
-            x160,
-            -Self::mul_add(s_q13, x159, c_q13 * x158),
+            x162,
+            Self::mul_add(-s_q13, x161, c_q13 * x160),
         );
-        let x170 = Self::mul_add(
-            x167,
+        let x172 = Self::mul_add(
             -0.55,
+            x169,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x166,
-                Self::mul_add(-c_q13, x165, s_q13 * x164),
+                x168,
+                Self::mul_add(-c_q13, x167, s_q13 * x166),
             ),
         );
-        let x171 = Self::mul_add(
-            -3.6140000000000003,
-            x133 + x134,
-            17.135250000000003 * x136,
-        ) + x167;
-        let x172 = Self::mul_add(
-            -17.135250000000003,
-            x139,
-            3.6140000000000003 * (x131 + x135),
-        ) + x168;
-        let x173 = Self::mul_add(
-            17.135250000000003,
-            x141,
-            3.6140000000000003 * (x137 - x130),
-        ) + x169;
+        let x173 = x169
+            - Self::mul_add(
+                17.135250000000003,
+                x138,
+                3.6140000000000003 * (x135 + x136),
+            );
         let x174 = Self::mul_add(
+            -17.135250000000003,
+            x141,
+            3.6140000000000003 * (x133 - x137),
+        ) - x170;
+        let x175 = Self::mul_add(
             17.135250000000003,
-            x128,
-            Self::mul_add(-0.809539999555672, x131, -1.9877000000000002 * x130)
-                + Self::mul_add(-x132, x143, x122 * x144),
-        )
-            + (x166 + Self::mul_add(-x148, x164, x147 * x165)
-                + Self::mul_add(0.55, x169, -0.16 * x168));
-        let x175 = x145
-            + Self::mul_add(0.16, x167, Self::mul_add(c_q13, x164, s_q13 * x165));
+            x143,
+            3.6140000000000003 * (x132 + x139),
+        ) + x171;
         let x176 = Self::mul_add(
+            17.135250000000003,
+            x130,
+            Self::mul_add(x133, -0.809539999555672, x132 * 1.9877000000000002)
+                - Self::mul_add(x124, x146, x134 * x145),
+        )
+            + (x168 + Self::mul_add(-x149, x167, x150 * x166)
+                + Self::mul_add(0.55, x171, 0.16 * x170));
+        let x177 = x147
+            + Self::mul_add(0.16, x169, Self::mul_add(c_q13, x166, s_q13 * x167));
+        let x178 = Self::mul_add(
             9.740442170000001,
-            x131,
-            Self::mul_add(-2.7416399995923166, x130, -0.809539999555672 * x129),
-        ) + Self::mul_add(-x122, x142, x121 * x143)
-            + Self::mul_add(3.6140000000000003, x127, x126 * -17.135250000000003) + x170;
-        let x177 = Self::mul_add(-s_q12, x172, c_q12 * x171);
-        let x178 = x173 + Self::mul_add(x120, x172, x119 * x171);
-        let x179 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x101, x102, -x109),
-            x177,
-        );
-        let x180 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x110, x110, x111),
-            x178,
-        );
+            x133,
+            Self::mul_add(x131, -0.809539999555672, x132 * 2.7416399995923166),
+        ) + Self::mul_add(x123, x145, x124 * x144)
+            - Self::mul_add(3.6140000000000003, x129, 17.135250000000003 * x128) + x172;
+        let x179 = Self::mul_add(-s_q12, x174, c_q12 * x173);
+        let x180 = x175 - Self::mul_add(x122, x174, x121 * x173);
         let x181 = Self::mul_add(
             7.078399999258757,
-            x107 + x112,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x173,
-                -Self::mul_add(c_q12, x172, s_q12 * x171),
-            ),
+            Self::mul_add(x103, x104, -x111),
+            x179,
         );
-        let x182 = x116
-            + Self::mul_add(x178, 0.36, Self::mul_add(-s_q12, x175, c_q12 * x174));
-        let x183 = Self::mul_add(2.5482240016099564, x109, -9.142025249762803 * x108)
-            + Self::mul_add(-x101, x115, x110 * x113)
-            + Self::mul_add(-0.36, x177, x176 + Self::mul_add(x120, x175, x119 * x174));
-        let x184 = x117
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x176,
-                -Self::mul_add(c_q12, x175, s_q12 * x174),
-            );
-        let x185 = Self::mul_add(-s_q11, x180, c_q11 * x179);
-        let x186 = Self::mul_add(c_q11, x180, s_q11 * x179);
-        let x187 = Self::mul_add(-45.1584, x90, x185);
-        let x188 = Self::mul_add(45.1584, x92, x186);
-        let x189 = Self::mul_add(-45.1584, x94, x181);
-        let x190 = x98
-            + (Self::mul_add(-s_q11, x183, c_q11 * x182)
-                + Self::mul_add(-0.63, x181, 0.275 * x186));
-        let x191 = Self::mul_add(-24.35164200091464, x88, -24.4950615 * x87)
-            + Self::mul_add(-x80, x97, x89 * x95)
-            + Self::mul_add(-0.275, x185, Self::mul_add(c_q11, x183, s_q11 * x182));
-        let x192 = x99 + Self::mul_add(x185, 0.63, x184);
-        let x193 = Self::mul_add(-s_q10, x188, c_q10 * x187);
-        let x194 = Self::mul_add(-81.53205, x71, x193);
-        let x195 = Self::mul_add(
-            81.53205,
-            x72,
-            Self::mul_add(c_q10, x188, s_q10 * x187),
+        let x182 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x112, x112, x113),
+            x180,
         );
-        let x196 = Self::mul_add(-81.53205, x73, x189);
-        let x197 = x77
-            + Self::mul_add(-0.87, x189, Self::mul_add(-s_q10, x191, c_q10 * x190));
-        let x198 = Self::mul_add(-36.18604050126307, x69, -63.36336825000001 * x68)
-            + Self::mul_add(-x60, x76, x70 * x74)
-            + Self::mul_add(c_q10, x191, s_q10 * x190);
-        let x199 = x78 + Self::mul_add(x193, 0.87, x192);
-        let x200 = Self::mul_add(
-            0.00000000020510342851533115,
-            x196,
-            Self::mul_add(c_q9, x195, s_q9 * x194),
-        );
-        let x201 = x196 + Self::mul_add(x59, x195, x58 * x194);
-        let x202 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x196,
-            Self::mul_add(-s_q9, x195, c_q9 * x194),
-        );
-        let x203 = Self::mul_add(
-            -0.275,
-            x200,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x199,
-                Self::mul_add(-s_q9, x198, c_q9 * x197),
-            ),
-        );
-        let x204 = Self::mul_add(
-            0.000000008530897668050218,
-            x44 + x45,
-            -12.701650001451807 * x47,
-        ) + x200;
-        let x205 = Self::mul_add(
-            12.701650001451807,
-            x50,
-            -0.000000008530897668050218 * (x42 + x46),
-        ) + x201;
-        let x206 = Self::mul_add(
-            -12.701650001451807,
-            x52,
-            -0.000000008530897668050218 * (x48 - x41),
-        ) + x202;
-        let x207 = Self::mul_add(
-            -12.701650001451807,
-            x39,
-            Self::mul_add(-0.002139996587640933, x42, -0.0000000234896432582596 * x41)
-                + Self::mul_add(-x43, x54, x33 * x55),
-        )
-            + (Self::mul_add(
+        let x183 = Self::mul_add(
+            7.078399999258757,
+            x109 + x114,
+            -Self::mul_add(
                 0.00000000020510342851533115,
-                x199,
-                Self::mul_add(c_q9, x198, s_q9 * x197),
-            ) + Self::mul_add(0.275, x202, x201 * -0.4));
-        let x208 = x56
-            + Self::mul_add(0.4, x200, x199 + Self::mul_add(x59, x198, x58 * x197));
-        let x209 = Self::mul_add(
+                x175,
+                Self::mul_add(c_q12, x174, s_q12 * x173),
+            ),
+        );
+        let x184 = x118
+            + Self::mul_add(0.36, x180, Self::mul_add(-s_q12, x177, c_q12 * x176));
+        let x185 = Self::mul_add(x110, -9.142025249762803, 2.5482240016099564 * x111)
+            + Self::mul_add(-x103, x117, x112 * x115)
+            + Self::mul_add(-0.36, x179, x178 - Self::mul_add(x122, x177, x121 * x176));
+        let x186 = x119
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x178,
+                Self::mul_add(c_q12, x177, s_q12 * x176),
+            );
+        let x187 = Self::mul_add(-s_q11, x182, c_q11 * x181);
+        let x188 = Self::mul_add(c_q11, x182, s_q11 * x181);
+        let x189 = Self::mul_add(x92, -45.1584, x187);
+        let x190 = Self::mul_add(45.1584, x94, x188);
+        let x191 = Self::mul_add(-45.1584, x96, x183);
+        let x192 = x100
+            + (Self::mul_add(-s_q11, x185, c_q11 * x184)
+                + Self::mul_add(-0.63, x183, 0.275 * x188));
+        let x193 = Self::mul_add(-0.275, x187, Self::mul_add(c_q11, x185, s_q11 * x184))
+            - (Self::mul_add(x90, 24.35164200091464, x89 * 24.4950615)
+                + Self::mul_add(x82, x99, x91 * x97));
+        let x194 = x101 + Self::mul_add(0.63, x187, x186);
+        let x195 = Self::mul_add(-s_q10, x190, c_q10 * x189);
+        let x196 = Self::mul_add(x73, -81.53205, x195);
+        let x197 = Self::mul_add(
+            81.53205,
+            x74,
+            Self::mul_add(c_q10, x190, s_q10 * x189),
+        );
+        let x198 = Self::mul_add(-81.53205, x75, x191);
+        let x199 = x79
+            + Self::mul_add(-0.87, x191, Self::mul_add(-s_q10, x193, c_q10 * x192));
+        let x200 = Self::mul_add(c_q10, x193, s_q10 * x192)
+            - (Self::mul_add(x71, 36.18604050126307, x70 * 63.36336825000001)
+                + Self::mul_add(x62, x78, x72 * x76));
+        let x201 = x80 + Self::mul_add(0.87, x195, x194);
+        let x202 = 0.00000000020510342851533115 * x198;
+        let x203 = Self::mul_add(c_q9, x197, s_q9 * x196) + x202;
+        let x204 = x198 + Self::mul_add(-x61, x197, x60 * x196);
+        let x205 = Self::mul_add(-s_q9, x197, c_q9 * x196) - x202;
+        let x206 = 0.00000000020510342851533115 * x201;
+        let x207 = Self::mul_add(
+            x47,
+            -12.701650001451807,
+            (x44 + x45) * 0.000000008530897668050218,
+        ) + x203;
+        let x208 = Self::mul_add(
+            -0.000000008530897668050218,
+            x42 + x46,
+            12.701650001451807 * x50,
+        ) + x204;
+        let x209 = x205
+            - Self::mul_add(
+                12.701650001451807,
+                x52,
+                0.000000008530897668050218 * (x48 - x41),
+            );
+        let x210 = Self::mul_add(
+            x39,
+            -12.701650001451807,
+            Self::mul_add(-x43, x54, x33 * x55)
+                - Self::mul_add(
+                    x42,
+                    0.002139996587640933,
+                    x41 * 0.0000000234896432582596,
+                ),
+        )
+            + (Self::mul_add(c_q9, x200, s_q9 * x199) + x206
+                + Self::mul_add(-0.4, x204, 0.275 * x205));
+        let x211 = x56
+            + Self::mul_add(0.4, x203, x201 + Self::mul_add(-x61, x200, x60 * x199));
+        let x212 = Self::mul_add(
             113.3918902508081,
             x42,
-            Self::mul_add(5.080660024070366, x41, -0.002139996587640933 * x40),
-        ) + Self::mul_add(-x33, x53, x32 * x54)
-            + Self::mul_add(-0.000000008530897668050218, x38, x37 * 12.701650001451807)
-            + x203;
-        let x210 = x206 + Self::mul_add(-x31, x205, x30 * x204);
-        let x211 = Self::mul_add(c_q8, x205, s_q8 * x204);
-        let x212 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x210);
-        let x213 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x211);
-        let x214 = Self::mul_add(
+            Self::mul_add(x40, -0.002139996587640933, 5.080660024070366 * x41),
+        ) + Self::mul_add(x32, x54, x33 * x53)
+            + Self::mul_add(x38, -0.000000008530897668050218, x37 * 12.701650001451807)
+            + Self::mul_add(
+                -0.275,
+                x203,
+                Self::mul_add(-s_q9, x200, c_q9 * x199) - x206,
+            );
+        let x213 = x209 + Self::mul_add(-x30, x207, x31 * x208);
+        let x214 = Self::mul_add(c_q8, x208, s_q8 * x207);
+        let x215 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x213);
+        let x216 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x214);
+        let x217 = Self::mul_add(
             48.0240000085309,
             x23 - x19,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x206,
-                Self::mul_add(-c_q8, x204, s_q8 * x205),
-            ),
-        );
-        let x215 = Self::mul_add(-16.80768997608804, x20, -0.07309 * x19)
-            + Self::mul_add(-x21, x25, x5 * x26)
-            + Self::mul_add(x211, -0.35, x209 + Self::mul_add(-x31, x208, x30 * x207));
-        let x216 = x27
-            + Self::mul_add(0.35, x210, Self::mul_add(c_q8, x208, s_q8 * x207));
-        let x217 = x28
-            + Self::mul_add(
-                -0.00000000020510342851533115,
                 x209,
                 Self::mul_add(-c_q8, x207, s_q8 * x208),
+            ),
+        );
+        let x218 = Self::mul_add(-x21, x25, x5 * x26)
+            - Self::mul_add(x20, 16.80768997608804, x19 * 0.07309)
+            + Self::mul_add(-0.35, x214, x212 + Self::mul_add(-x30, x210, x31 * x211));
+        let x219 = x27
+            + Self::mul_add(0.35, x213, Self::mul_add(c_q8, x211, s_q8 * x210));
+        let x220 = x28
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x212,
+                Self::mul_add(-c_q8, x210, s_q8 * x211),
             );
-        let x218 = Self::mul_add(-s_q7, x213, c_q7 * x212);
-        let x219 = Self::mul_add(c_q7, x213, s_q7 * x212);
-        let x220 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x221 = 1466.4506062283303 * v[4];
-        let x222 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x223 = x218
+        let x221 = Self::mul_add(-s_q7, x216, c_q7 * x215);
+        let x222 = Self::mul_add(c_q7, x216, s_q7 * x215);
+        let x223 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x224 = 1466.4506062283303 * v[4];
+        let x225 = Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]);
+        let x226 = x221
             + Self::mul_add(
                 1170.07,
                 x0,
                 Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
             );
-        let x224 = x219
+        let x227 = x222
             + Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x11, 110.5455 * x10),
             );
-        let x225 = x214
+        let x228 = x217
             + Self::mul_add(
                 1170.07,
                 x2,
                 Self::mul_add(-180.9502499901501, x13, 110.5455 * x12),
             );
-        let x226 = Self::mul_add(x219, -0.75, Self::mul_add(-s_q7, x216, c_q7 * x215))
+        let x229 = Self::mul_add(-0.75, x222, Self::mul_add(-s_q7, x219, c_q7 * x218))
             + Self::mul_add(
-                x1,
                 -180.9502499901501,
-                Self::mul_add(-117.61766249359756, a[5], 1394.5960312283303 * a[3])
-                    + Self::mul_add(-v[5], x221, v[4] * x222),
+                x1,
+                Self::mul_add(a[5], -117.61766249359756, 1394.5960312283303 * a[3])
+                    + Self::mul_add(-v[5], x224, v[4] * x225),
             );
-        let x227 = Self::mul_add(c_q7, x216, s_q7 * x215)
-            + Self::mul_add(x214, -0.65, 0.75 * x218)
+        let x230 = Self::mul_add(c_q7, x219, s_q7 * x218)
+            + Self::mul_add(-0.65, x217, 0.75 * x221)
             + (Self::mul_add(
                 1466.4506062283303,
                 a[4],
-                Self::mul_add(-v[3], x222, v[5] * x220),
-            ) + Self::mul_add(x2, -110.5455, 180.9502499901501 * x0));
-        let x228 = Self::mul_add(0.65, x219, x217)
+                Self::mul_add(-v[3], x225, v[5] * x223),
+            ) + Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
+        let x231 = Self::mul_add(0.65, x222, x220)
             + Self::mul_add(
                 110.5455,
                 x1,
-                Self::mul_add(1271.854575, a[5], -117.61766249359758 * a[3])
-                    + Self::mul_add(-v[4], x220, v[3] * x221),
+                Self::mul_add(a[3], -117.61766249359758, 1271.854575 * a[5])
+                    + Self::mul_add(-v[4], x223, v[3] * x224),
             );
-        [x223, x224, x225, x226, x227, x228, x217, x209, x199, x192, x184, x176, x166]
+        [x226, x227, x228, x229, x230, x231, x220, x212, x201, x194, x186, x178, x168]
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
-    /// Methods: forward `aba`: 1613 mul, 1277 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 986 fused where the target has FMA.
+    /// Methods: forward `aba`: 1592 mul, 1277 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 953 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
         let x0 = Self::mul_add(
-            v[1],
             -180.9502499901501,
-            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
+            v[1],
+            Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
         );
         let x1 = Self::mul_add(
             1466.4506062283303,
             v[4],
-            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
+            Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         );
         let x2 = Self::mul_add(
             110.5455,
             v[1],
-            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
+            Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]),
         );
-        let x3 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]);
+        let x3 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
         let x4 = Self::mul_add(
             1170.07,
             v[1],
-            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
+            -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
         );
         let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
         let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x9 = Self::mul_add(v[4], 0.75, v[0]);
-        let x10 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x9 = Self::mul_add(0.75, v[4], v[0]);
+        let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x11 = Self::mul_add(-0.65, v[4], v[2]);
         let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
         let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
@@ -2987,14 +3123,14 @@ impl FreeFloating7 {
         let x16 = v[6] * x13;
         let x17 = v[6] * x12;
         let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x8);
+        let x19 = Self::mul_add(x18, 16.80768997608804, x8 * 0.07309);
         let x20 = Self::mul_add(
-            x11,
             -48.0240000085309,
+            x11,
             Self::mul_add(
                 0.1132,
                 x18,
-                Self::mul_add(130.43769025763282, x8, -0.07309 * x7),
+                Self::mul_add(x7, -0.07309, 130.43769025763282 * x8),
             ),
         );
         let x21 = Self::mul_add(
@@ -3003,20 +3139,20 @@ impl FreeFloating7 {
             Self::mul_add(
                 132.47349025763282,
                 x18,
-                Self::mul_add(0.1132, x8, -16.80768997608804 * x7),
+                Self::mul_add(x7, -16.80768997608804, 0.1132 * x8),
             ),
         );
-        let x22 = x18 * -48.0240000085309;
+        let x22 = 48.0240000085309 * x18;
         let x23 = 48.0240000085309 * x8;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x25 = -0.00000000020510342851533115 * c_q8;
-        let x26 = -0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x7, x26, x8 * c_q8));
-        let x29 = Self::mul_add(x8, 0.35, x12);
+        let x25 = 0.00000000020510342851533115 * c_q8;
+        let x26 = 0.00000000020510342851533115 * s_q8;
+        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(-x7, x25, x8 * s_q8));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(x8, c_q8, x7 * x26));
+        let x29 = Self::mul_add(0.35, x8, x12);
         let x30 = Self::mul_add(-0.35, x7, x13);
-        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-x26, x29, c_q8 * x30));
+        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(-x25, x29, s_q8 * x30));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(c_q8, x30, x26 * x29));
         let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
         let x34 = v[7] * x28;
         let x35 = v[7] * x27;
@@ -3024,9 +3160,9 @@ impl FreeFloating7 {
         let x37 = v[7] * x31;
         let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
         let x39 = Self::mul_add(
-            -12.701650001451807,
             x33,
-            Self::mul_add(-0.002139996587640933, x38, -0.0000000234896432582596 * x28),
+            12.701650001451807,
+            Self::mul_add(x38, 0.002139996587640933, x28 * 0.0000000234896432582596),
         );
         let x40 = Self::mul_add(
             x33,
@@ -3034,1609 +3170,1541 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x38,
-                Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
+                -Self::mul_add(x28, 111.7548902508081, x27 * 0.0000000234896432582596),
             ),
         );
         let x41 = Self::mul_add(
             113.3918902508081,
             x38,
-            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
-        ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
-        let x42 = -12.701650001451807 * x38;
+            Self::mul_add(x27, -0.002139996587640933, 5.080660024070366 * x28),
+        ) + Self::mul_add(x32, -0.000000008530897668050218, x31 * 12.701650001451807);
+        let x42 = x38 * 12.701650001451807;
         let x43 = x38 * 0.000000008530897668050218;
         let x44 = Self::mul_add(
-            -0.000000008530897668050218,
             x28,
+            -0.000000008530897668050218,
             x27 * 12.701650001451807,
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x46 = Self::mul_add(
+        let x46 = 0.00000000020510342851533115 * c_q9;
+        let x47 = 0.00000000020510342851533115 * s_q9;
+        let x48 = x46 - x47;
+        let x49 = x46 + x47;
+        let x50 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x48, x27 * s_q9));
+        let x51 = Self::mul_add(-x38, s_q9, Self::mul_add(-x28, x49, x27 * c_q9));
+        let x52 = x31 - Self::mul_add(-0.4, x28, 0.275 * x38);
+        let x53 = Self::mul_add(-0.4, x27, x32);
+        let x54 = Self::mul_add(0.275, x27, x33);
+        let x55 = Self::mul_add(c_q9, x54, Self::mul_add(x48, x53, s_q9 * x52));
+        let x56 = Self::mul_add(-s_q9, x54, Self::mul_add(-x49, x53, c_q9 * x52));
+        let x57 = Self::mul_add(
             -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
+            x54,
+            Self::mul_add(0.00000000020510342851533115, x52, x53),
         );
-        let x47 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x48 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x46, x27 * s_q9));
-        let x49 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x47, x27 * c_q9));
-        let x50 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
-        let x51 = Self::mul_add(-0.4, x27, x32);
-        let x52 = Self::mul_add(0.275, x27, x33);
-        let x53 = Self::mul_add(c_q9, x52, Self::mul_add(x46, x51, s_q9 * x50));
-        let x54 = Self::mul_add(-s_q9, x52, Self::mul_add(x47, x51, c_q9 * x50));
-        let x55 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x52,
-            Self::mul_add(0.00000000020510342851533115, x50, x51),
-        );
-        let x56 = v[8] * x49;
-        let x57 = v[8] * x48;
-        let x58 = v[8] * x54;
-        let x59 = v[8] * x53;
-        let x60 = v[8]
+        let x58 = v[8] * x51;
+        let x59 = v[8] * x50;
+        let x60 = v[8] * x56;
+        let x61 = v[8] * x55;
+        let x62 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x38,
                 Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x61 = Self::mul_add(-36.18604050126307, x60, -63.36336825000001 * x49);
-        let x62 = Self::mul_add(-81.53205, x55, -0.00214 * x60);
-        let x63 = Self::mul_add(
-            x53,
+        let x63 = Self::mul_add(x62, 36.18604050126307, x51 * 63.36336825000001);
+        let x64 = Self::mul_add(x57, 81.53205, x62 * 0.00214);
+        let x65 = Self::mul_add(
+            x55,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x60,
-                Self::mul_add(-36.18604050126307, x49, -0.00214 * x48),
+                x62,
+                -Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
             ),
         );
-        let x64 = -81.53205 * x60;
-        let x65 = x48 * 81.53205;
+        let x66 = x62 * 81.53205;
+        let x67 = x50 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x67 = Self::mul_add(x49, s_q10, x48 * c_q10);
-        let x68 = Self::mul_add(-x48, s_q10, x49 * c_q10);
-        let x69 = Self::mul_add(0.87, x60, x53);
-        let x70 = Self::mul_add(x48, -0.87, x55);
-        let x71 = Self::mul_add(x54, s_q10, c_q10 * x69);
-        let x72 = Self::mul_add(-s_q10, x69, x54 * c_q10);
-        let x73 = v[9] * x68;
-        let x74 = v[9] * x67;
-        let x75 = v[9] * x72;
-        let x76 = v[9] * x71;
-        let x77 = v[9] + x60;
-        let x78 = Self::mul_add(-24.35164200091464, x77, -24.4950615 * x68);
-        let x79 = Self::mul_add(-45.1584, x70, -0.6328 * x77);
-        let x80 = Self::mul_add(
-            x71,
+        let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
+        let x70 = Self::mul_add(-x50, s_q10, x51 * c_q10);
+        let x71 = Self::mul_add(x62, 0.87, x55);
+        let x72 = Self::mul_add(x50, -0.87, x57);
+        let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
+        let x74 = Self::mul_add(-s_q10, x71, x56 * c_q10);
+        let x75 = v[9] * x70;
+        let x76 = v[9] * x69;
+        let x77 = v[9] * x74;
+        let x78 = v[9] * x73;
+        let x79 = v[9] + x62;
+        let x80 = Self::mul_add(x79, 24.35164200091464, x70 * 24.4950615);
+        let x81 = Self::mul_add(x72, 45.1584, x79 * 0.6328);
+        let x82 = Self::mul_add(
+            x73,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x77,
-                Self::mul_add(-24.351642000914637, x68, -0.6328 * x67),
+                x79,
+                -Self::mul_add(x70, 24.351642000914637, x69 * 0.6328),
             ),
         );
-        let x81 = -45.1584 * x77;
-        let x82 = x67 * 45.1584;
+        let x83 = x79 * 45.1584;
+        let x84 = x69 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x84 = Self::mul_add(x68, s_q11, x67 * c_q11);
-        let x85 = Self::mul_add(-x67, s_q11, x68 * c_q11);
-        let x86 = x71 - Self::mul_add(-0.63, x77, 0.275 * x68);
-        let x87 = Self::mul_add(0.275, x67, x72);
-        let x88 = Self::mul_add(x67, -0.63, x70);
-        let x89 = Self::mul_add(s_q11, x87, c_q11 * x86);
-        let x90 = Self::mul_add(-s_q11, x86, c_q11 * x87);
-        let x91 = v[10] * x85;
-        let x92 = v[10] * x84;
-        let x93 = v[10] * x90;
-        let x94 = v[10] * x89;
-        let x95 = v[10] + x77;
-        let x96 = Self::mul_add(2.5482240016099564, x95, -9.142025249762803 * x85);
-        let x97 = Self::mul_add(7.078399999258757, x88, 0.01675 * x95);
-        let x98 = Self::mul_add(
-            x89,
+        let x86 = Self::mul_add(x70, s_q11, x69 * c_q11);
+        let x87 = Self::mul_add(-x69, s_q11, x70 * c_q11);
+        let x88 = x73 - Self::mul_add(x79, -0.63, 0.275 * x70);
+        let x89 = Self::mul_add(0.275, x69, x74);
+        let x90 = Self::mul_add(x69, -0.63, x72);
+        let x91 = Self::mul_add(s_q11, x89, c_q11 * x88);
+        let x92 = Self::mul_add(-s_q11, x88, c_q11 * x89);
+        let x93 = v[10] * x87;
+        let x94 = v[10] * x86;
+        let x95 = v[10] * x92;
+        let x96 = v[10] * x91;
+        let x97 = v[10] + x79;
+        let x98 = Self::mul_add(x87, -9.142025249762803, 2.5482240016099564 * x97);
+        let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
+        let x100 = Self::mul_add(
             -7.078399999258757,
+            x91,
             Self::mul_add(
                 9.223235249762805,
-                x95,
-                Self::mul_add(2.5482240016099564, x85, 0.01675 * x84),
+                x97,
+                Self::mul_add(2.5482240016099564, x87, 0.01675 * x86),
             ),
         );
-        let x99 = 7.078399999258757 * x95;
-        let x100 = x84 * -7.078399999258757;
+        let x101 = 7.078399999258757 * x97;
+        let x102 = 7.078399999258757 * x86;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x102 = -0.00000000020510342851533115 * s_q12;
-        let x103 = -0.00000000020510342851533115 * c_q12;
-        let x104 = Self::mul_add(-x95, s_q12, Self::mul_add(x85, x102, x84 * c_q12));
-        let x105 = Self::mul_add(-x95, c_q12, Self::mul_add(-x84, s_q12, x85 * x103));
-        let x106 = Self::mul_add(x85, -0.36, x89);
-        let x107 = Self::mul_add(0.36, x84, x90);
-        let x108 = Self::mul_add(-x88, s_q12, Self::mul_add(x102, x107, c_q12 * x106));
-        let x109 = Self::mul_add(-x88, c_q12, Self::mul_add(-s_q12, x106, x103 * x107));
-        let x110 = Self::mul_add(-0.00000000020510342851533115, x88, x107);
-        let x111 = v[11] * x105;
-        let x112 = v[11] * x104;
-        let x113 = v[11] * x109;
-        let x114 = v[11] * x108;
-        let x115 = v[11] + Self::mul_add(-0.00000000020510342851533115, x95, x85);
-        let x116 = Self::mul_add(
+        let x104 = 0.00000000020510342851533115 * s_q12;
+        let x105 = 0.00000000020510342851533115 * c_q12;
+        let x106 = Self::mul_add(-x97, s_q12, Self::mul_add(-x87, x104, x86 * c_q12));
+        let x107 = Self::mul_add(x97, c_q12, Self::mul_add(x87, x105, x86 * s_q12));
+        let x108 = Self::mul_add(x87, -0.36, x91);
+        let x109 = Self::mul_add(x86, 0.36, x92);
+        let x110 = Self::mul_add(-x90, s_q12, Self::mul_add(-x104, x109, c_q12 * x108));
+        let x111 = Self::mul_add(x90, c_q12, Self::mul_add(x105, x109, s_q12 * x108));
+        let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
+        let x113 = v[11] * x107;
+        let x114 = v[11] * x106;
+        let x115 = v[11] * x111;
+        let x116 = v[11] * x110;
+        let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
+        let x118 = Self::mul_add(
             17.135250000000003,
-            x110,
-            Self::mul_add(-0.809539999555672, x115, -1.9877000000000002 * x105),
+            x112,
+            Self::mul_add(x117, -0.809539999555672, x107 * 1.9877000000000002),
         );
-        let x117 = Self::mul_add(
-            x110,
+        let x119 = Self::mul_add(
             -3.6140000000000003,
+            x112,
             Self::mul_add(
+                x117,
                 -2.741639999592316,
-                x115,
-                Self::mul_add(-5.252920330000002, x105, -1.9877000000000002 * x104),
+                Self::mul_add(x106, -1.9877000000000002, x107 * 5.252920330000002),
             ),
         );
-        let x118 = Self::mul_add(
+        let x120 = Self::mul_add(
             9.740442170000001,
-            x115,
-            Self::mul_add(-2.7416399995923166, x105, -0.809539999555672 * x104),
-        ) + Self::mul_add(3.6140000000000003, x109, x108 * -17.135250000000003);
-        let x119 = 17.135250000000003 * x115;
-        let x120 = x115 * -3.6140000000000003;
-        let x121 = Self::mul_add(3.6140000000000003, x105, x104 * -17.135250000000003);
+            x117,
+            Self::mul_add(x106, -0.809539999555672, x107 * 2.7416399995923166),
+        ) - Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
+        let x121 = 17.135250000000003 * x117;
+        let x122 = 3.6140000000000003 * x117;
+        let x123 = Self::mul_add(3.6140000000000003, x107, 17.135250000000003 * x106);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x123 = -0.00000000020510342851533115 * c_q13;
-        let x124 = -0.00000000020510342851533115 * s_q13;
-        let x125 = Self::mul_add(-x115, c_q13, Self::mul_add(x105, s_q13, x104 * x123));
-        let x126 = Self::mul_add(x115, s_q13, Self::mul_add(-x104, x124, x105 * c_q13));
-        let x127 = x108 - Self::mul_add(0.55, x115, -0.16 * x105);
-        let x128 = Self::mul_add(-0.16, x104, x109);
-        let x129 = Self::mul_add(x104, 0.55, x110);
-        let x130 = Self::mul_add(-c_q13, x129, Self::mul_add(s_q13, x128, x123 * x127));
-        let x131 = Self::mul_add(s_q13, x129, Self::mul_add(-x124, x127, c_q13 * x128));
-        let x132 = Self::mul_add(-0.00000000020510342851533115, x129, x127);
-        let x133 = v[12] * x126;
-        let x134 = v[12] * x125;
-        let x135 = v[12] * x131;
-        let x136 = v[12] + Self::mul_add(-0.00000000020510342851533115, x115, x104);
-        let x137 = Self::mul_add(
-            -0.9614610000000001,
-            x136,
-            Self::mul_add(-1.2025609200000003, x126, 0.000781 * x125),
+        let x125 = 0.00000000020510342851533115 * c_q13;
+        let x126 = 0.00000000020510342851533115 * s_q13;
+        let x127 = Self::mul_add(x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
+        let x128 = Self::mul_add(x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
+        let x129 = x110 - Self::mul_add(0.55, x117, 0.16 * x107);
+        let x130 = Self::mul_add(0.16, x106, x111);
+        let x131 = Self::mul_add(0.55, x106, x112);
+        let x132 = Self::mul_add(c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
+        let x133 = Self::mul_add(s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
+        let x134 = Self::mul_add(-0.00000000020510342851533115, x131, x129);
+        let x135 = v[12] * x128;
+        let x136 = v[12] * x127;
+        let x137 = v[12] * x133;
+        let x138 = v[12] + Self::mul_add(-0.00000000020510342851533115, x117, x106);
+        let x139 = Self::mul_add(
+            x138,
+            0.9614610000000001,
+            Self::mul_add(x128, 1.2025609200000003, 0.000781 * x127),
         );
-        let x138 = Self::mul_add(
+        let x140 = Self::mul_add(
+            4.806620000000001,
+            x134,
+            Self::mul_add(x138, -0.0145, 0.000781 * x128),
+        );
+        let x141 = Self::mul_add(
             4.806620000000001,
             x132,
-            Self::mul_add(-0.0145, x136, 0.000781 * x126),
-        );
-        let x139 = Self::mul_add(
-            x130,
-            -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x136,
-                Self::mul_add(-0.9614610000000001, x126, -0.0145 * x125),
+                x138,
+                Self::mul_add(x128, -0.9614610000000001, x127 * 0.0145),
             ),
         );
-        let x140 = 4.806620000000001 * x136;
-        let x141 = x125 * -4.806620000000001;
-        let x142 = Self::mul_add(x131, x140, Self::mul_add(-x126, x138, x125 * x137));
-        let x143 = Self::mul_add(-x136, x140, x125 * x141);
-        let x144 = tau[6] - x142;
-        let x145 = Self::mul_add(
-            -x126,
-            x141,
-            Self::mul_add(
-                x135,
-                -16.344251950881606,
-                Self::mul_add(x134, 3.2693162398830324, x133 * -0.049305260929256585),
-            ),
-        );
-        let x146 = Self::mul_add(4.806620000000001, x133, x126 * x140);
+        let x142 = 4.806620000000001 * x138;
+        let x143 = 4.806620000000001 * x127;
+        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x128, x140, x127 * x139));
+        let x145 = Self::mul_add(x127, x143, x138 * x142);
+        let x146 = tau[6] - x144;
         let x147 = Self::mul_add(
-            x144,
+            x128,
+            x143,
+            Self::mul_add(
+                x137,
+                16.344251950881606,
+                Self::mul_add(x136, 3.2693162398830324, x135 * 0.049305260929256585),
+            ),
+        );
+        let x148 = Self::mul_add(4.806620000000001, x135, x128 * x142);
+        let x149 = Self::mul_add(
+            x146,
             -0.010257782169020348,
-            Self::mul_add(-x131, x141, Self::mul_add(-x136, x137, x126 * x139))
-                + Self::mul_add(
-                    x135,
-                    -0.049305260929256585,
+            Self::mul_add(-x133, x143, Self::mul_add(x128, x141, x138 * x139))
+                - Self::mul_add(
+                    x137,
+                    0.049305260929256585,
                     Self::mul_add(
-                        x134,
+                        x136,
                         0.009081457502008472,
-                        x133 * -0.00014873784145079505,
+                        x135 * 0.00014873784145079505,
                     ),
                 ),
         );
-        let x148 = Self::mul_add(
-            x144,
+        let x150 = Self::mul_add(
+            x146,
             -0.6801694828971361,
-            Self::mul_add(-x125, x139, x136 * x138)
-                + Self::mul_add(-x132, x140, x130 * x141)
-                + Self::mul_add(
-                    x135,
-                    -3.2693162398830324,
-                    Self::mul_add(x134, 1.8565173511957638, x133 * -0.009081457502008472),
+            Self::mul_add(x127, x141, x138 * x140)
+                - Self::mul_add(x132, x143, x134 * x142)
+                - Self::mul_add(
+                    x137,
+                    3.2693162398830324,
+                    Self::mul_add(x136, 1.8565173511957638, x135 * 0.009081457502008472),
                 ),
         );
-        let x149 = x142 + x144;
-        let x150 = Self::mul_add(x144, -3.4003628227073506, x145);
-        let x151 = c_q13 * -0.009081457502008472;
-        let x152 = Self::mul_add(s_q13, -0.00014873784145079505, x151);
-        let x153 = s_q13 * -0.009081457502008472;
-        let x154 = Self::mul_add(c_q13, 0.00014873784145079505, x153);
-        let x155 = Self::mul_add(c_q13, -1.8565173511957638, x153);
-        let x156 = Self::mul_add(s_q13, -1.8565173511957638, -x151);
-        let x157 = Self::mul_add(x123, -0.049305260929256585, 4.806620000000001);
-        let x158 = s_q13 * -0.049305260929256585;
-        let x159 = Self::mul_add(
+        let x151 = x144 + x146;
+        let x152 = Self::mul_add(x146, 3.4003628227073506, x147);
+        let x153 = c_q13 * 0.009081457502008472;
+        let x154 = Self::mul_add(s_q13, 0.00014873784145079505, x153);
+        let x155 = s_q13 * 0.009081457502008472;
+        let x156 = Self::mul_add(c_q13, 0.00014873784145079505, -x155);
+        let x157 = Self::mul_add(c_q13, 1.8565173511957638, x155);
+        let x158 = Self::mul_add(s_q13, -1.8565173511957638, x153);
+        let x159 = Self::mul_add(x125, 0.049305260929256585, 4.806620000000001);
+        let x160 = s_q13 * 0.049305260929256585;
+        let x161 = Self::mul_add(
             c_q13,
             0.049305260929256585,
             -0.0000000009858542415703612,
         );
-        let x160 = x123 * -3.2693162398830324;
-        let x161 = s_q13 * -3.2693162398830324;
-        let x162 = c_q13 * -3.2693162398830324;
-        let x163 = Self::mul_add(-x124, x160, x123 * x157);
-        let x164 = Self::mul_add(-x124, x161, x123 * x158);
-        let x165 = Self::mul_add(x124, x162, x123 * x159);
-        let x166 = Self::mul_add(c_q13, x160, s_q13 * x157);
-        let x167 = Self::mul_add(-c_q13, x157, s_q13 * x160);
-        let x168 = s_q13 * -16.344251950881606;
-        let x169 = c_q13 * -16.344251950881606;
-        let x170 = x123 * (x123 * -16.344251950881606);
-        let x171 = x123 * x168;
-        let x172 = x123 * x169;
-        let x173 = s_q13 * x168;
-        let x174 = s_q13 * x169;
-        let x175 = c_q13 * x169;
-        let x176 = x164 + Self::mul_add(-0.55, x174, -0.16 * x173);
-        let x177 = x165 + Self::mul_add(0.16, x174, 0.55 * x175);
-        let x178 = Self::mul_add(0.16, x170, x166);
-        let x179 = Self::mul_add(0.16, x171, Self::mul_add(c_q13, x161, s_q13 * x158));
-        let x180 = Self::mul_add(-0.16, x172, Self::mul_add(-c_q13, x162, s_q13 * x159));
-        let x181 = Self::mul_add(-0.55, x170, x167);
-        let x182 = Self::mul_add(-0.55, x171, Self::mul_add(-c_q13, x158, s_q13 * x161));
-        let x183 = Self::mul_add(-0.55, x172, Self::mul_add(s_q13, x162, c_q13 * x159));
-        let x184 = Self::mul_add(
+        let x162 = x125 * 3.2693162398830324;
+        let x163 = s_q13 * 3.2693162398830324;
+        let x164 = c_q13 * 3.2693162398830324;
+        let x165 = Self::mul_add(-x125, x159, x126 * x162);
+        let x166 = Self::mul_add(-x126, x163, x125 * x160);
+        let x167 = Self::mul_add(-x125, x161, x126 * x164);
+        let x168 = Self::mul_add(c_q13, x162, s_q13 * x159);
+        let x169 = Self::mul_add(-c_q13, x159, s_q13 * x162);
+        let x170 = s_q13 * 16.344251950881606;
+        let x171 = c_q13 * 16.344251950881606;
+        let x172 = x125 * (x125 * 16.344251950881606);
+        let x173 = x125 * x170;
+        let x174 = x125 * x171;
+        let x175 = s_q13 * x170;
+        let x176 = s_q13 * x171;
+        let x177 = c_q13 * x171;
+        let x178 = 0.16 * x173;
+        let x179 = 0.55 * x174;
+        let x180 = x166 + Self::mul_add(0.55, x176, 0.16 * x175);
+        let x181 = x167 - Self::mul_add(0.55, x177, 0.16 * x176);
+        let x182 = Self::mul_add(-0.16, x172, x168);
+        let x183 = x178 - Self::mul_add(c_q13, x163, s_q13 * x160);
+        let x184 = Self::mul_add(-0.16, x174, Self::mul_add(c_q13, x164, s_q13 * x161));
+        let x185 = Self::mul_add(0.55, x172, x169);
+        let x186 = Self::mul_add(-0.55, x173, Self::mul_add(-s_q13, x163, c_q13 * x160));
+        let x187 = Self::mul_add(-c_q13, x161, s_q13 * x164) + x179;
+        let x188 = Self::mul_add(
             0.16,
-            x166,
-            Self::mul_add(0.16, x178, Self::mul_add(c_q13, x155, s_q13 * x152)),
+            x168,
+            Self::mul_add(0.16, x182, -Self::mul_add(c_q13, x157, s_q13 * x154)),
         );
-        let x185 = Self::mul_add(
-            -0.55,
-            x166,
-            Self::mul_add(0.16, x181, Self::mul_add(c_q13, x156, s_q13 * x154)),
-        );
-        let x186 = Self::mul_add(
-            -0.55,
-            x167,
-            Self::mul_add(-0.55, x181, Self::mul_add(-c_q13, x154, s_q13 * x156)),
-        );
-        let x187 = x146 + Self::mul_add(-x124, x143, x123 * x150);
-        let x188 = Self::mul_add(c_q13, x143, s_q13 * x150);
         let x189 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x146,
-            Self::mul_add(-c_q13, x150, s_q13 * x143),
+            -0.55,
+            x168,
+            Self::mul_add(0.16, x185, Self::mul_add(c_q13, x158, s_q13 * x156)),
         );
         let x190 = Self::mul_add(
             -0.55,
-            x187,
+            x169,
+            Self::mul_add(-0.55, x185, Self::mul_add(-c_q13, x156, s_q13 * x158)),
+        );
+        let x191 = x148 + Self::mul_add(-x126, x145, x125 * x152);
+        let x192 = Self::mul_add(c_q13, x145, s_q13 * x152);
+        let x193 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x148,
+            Self::mul_add(-s_q13, x145, c_q13 * x152),
+        );
+        let x194 = Self::mul_add(
+            -0.55,
+            x191,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x149,
-                Self::mul_add(-c_q13, x147, s_q13 * x148),
+                x151,
+                Self::mul_add(-c_q13, x149, s_q13 * x150),
             ),
         );
-        let x191 = -0.809539999555672
+        let x195 = -0.809539999555672
             + Self::mul_add(
                 -0.55,
-                x163,
-                Self::mul_add(-x124, x156, x123 * x154)
-                    + Self::mul_add(-0.55, x183, -0.16 * x182),
+                x165,
+                Self::mul_add(-x125, x156, x126 * x158)
+                    + Self::mul_add(-0.16, x186, 0.55 * x187),
             );
-        let x192 = -2.741639999592316 + x185;
-        let x193 = 9.740442170000001 + x186;
-        let x194 = -17.135250000000003 + x181;
-        let x195 = 3.6140000000000003 + x182;
-        let x196 = Self::mul_add(-x105, x116, x104 * x117)
-            + Self::mul_add(-x108, x120, x109 * x119) + x190;
-        let x197 = 1.0 / x193;
-        let x198 = tau[5] - x196;
-        let x199 = x191 * x197;
-        let x200 = x192 * x197;
-        let x201 = x194 * x197;
-        let x202 = x195 * x197;
-        let x203 = x183 * x197;
-        let x204 = Self::mul_add(
-            -x191,
-            x199,
-            Self::mul_add(0.55, x165, -0.16 * x164)
+        let x196 = -2.741639999592316 + x189;
+        let x197 = 9.740442170000001 + x190;
+        let x198 = -17.135250000000003 + x185;
+        let x199 = 3.6140000000000003 + x186;
+        let x200 = Self::mul_add(x106, x119, x107 * x118)
+            + Self::mul_add(-x111, x121, x110 * x122) + x194;
+        let x201 = 1.0 / x197;
+        let x202 = tau[5] - x200;
+        let x203 = x195 * x201;
+        let x204 = x196 * x201;
+        let x205 = x198 * x201;
+        let x206 = x199 * x201;
+        let x207 = x187 * x201;
+        let x208 = Self::mul_add(
+            -x195,
+            x203,
+            Self::mul_add(-0.16, x166, 0.55 * x167)
                 + (Self::mul_add(
-                    -x124,
+                    -x125,
                     Self::mul_add(
-                        x124,
-                        1.8565173511957638,
-                        x123 * -0.009081457502008472,
+                        x126,
+                        -0.009081457502008472,
+                        x125 * 0.00014873784145079505,
                     ),
-                    x123
+                    x126
                         * Self::mul_add(
-                            x124,
-                            0.009081457502008472,
-                            x123 * -0.00014873784145079505,
+                            x126,
+                            -1.8565173511957638,
+                            x125 * 0.009081457502008472,
                         ),
-                ) + Self::mul_add(0.55, x177, -0.16 * x176)),
+                ) + Self::mul_add(-0.16, x180, 0.55 * x181)),
         );
-        let x205 = Self::mul_add(
-            -x191,
-            x200,
+        let x209 = Self::mul_add(
+            -x195,
+            x204,
             -1.9877000000000002
                 + Self::mul_add(
                     0.16,
-                    x163,
-                    Self::mul_add(-x124, x155, x123 * x152)
-                        + Self::mul_add(0.55, x180, -0.16 * x179),
+                    x165,
+                    Self::mul_add(-x126, x157, x125 * x154)
+                        + Self::mul_add(-0.16, x183, 0.55 * x184),
                 ),
         );
-        let x206 = Self::mul_add(-x192, x200, -5.252920330000002 + x184);
-        let x207 = Self::mul_add(
-            -x191,
-            x201,
-            x163 + Self::mul_add(-0.55, x172, -0.16 * x171),
-        );
-        let x208 = Self::mul_add(-x191, x202, x176);
-        let x209 = Self::mul_add(x191, x203, 17.135250000000003 + x177);
-        let x210 = Self::mul_add(-x192, x201, x178);
-        let x211 = Self::mul_add(-x192, x202, x179);
-        let x212 = Self::mul_add(x192, x203, -3.6140000000000003 + x180);
-        let x213 = Self::mul_add(-x194, x201, x170);
-        let x214 = Self::mul_add(-x194, x202, x171);
-        let x215 = Self::mul_add(x194, x203, -x172);
-        let x216 = Self::mul_add(-x195, x202, x173);
-        let x217 = Self::mul_add(x195, x203, -x174);
-        let x218 = Self::mul_add(-x183, x203, x175);
-        let x219 = Self::mul_add(
-            x198,
-            x199,
-            Self::mul_add(-x115, x117, x105 * x118)
-                + Self::mul_add(-x109, x121, x110 * x120)
-                + (x149 + Self::mul_add(-x124, x148, x123 * x147)
-                    + Self::mul_add(0.55, x189, -0.16 * x188))
-                + (Self::mul_add(-x112, x205, x111 * x204)
-                    + Self::mul_add(-x114, x208, x113 * x207)),
-        );
-        let x220 = Self::mul_add(
-            x198,
-            x200,
-            Self::mul_add(-x104, x118, x115 * x116)
-                + Self::mul_add(-x110, x119, x108 * x121)
-                + Self::mul_add(0.16, x187, Self::mul_add(c_q13, x148, s_q13 * x147))
-                + (Self::mul_add(-x112, x206, x111 * x205)
-                    + Self::mul_add(-x114, x211, x113 * x210)),
-        );
-        let x221 = Self::mul_add(x198, x193 * x197, x196);
-        let x222 = Self::mul_add(
-            x198,
-            x201,
-            Self::mul_add(-x105, x121, x115 * x120) + x187
-                + (Self::mul_add(-x112, x210, x111 * x207)
-                    + Self::mul_add(-x114, x214, x113 * x213)),
-        );
+        let x210 = Self::mul_add(-x196, x204, -5.252920330000002 + x188);
+        let x211 = Self::mul_add(-x195, x205, x165 - (x178 + x179));
+        let x212 = Self::mul_add(-x195, x206, x180);
+        let x213 = Self::mul_add(-x195, x207, 17.135250000000003 + x181);
+        let x214 = Self::mul_add(-x196, x205, x182);
+        let x215 = Self::mul_add(-x196, x206, x183);
+        let x216 = Self::mul_add(-x196, x207, -3.6140000000000003 + x184);
+        let x217 = Self::mul_add(x198, x205, x172);
+        let x218 = Self::mul_add(-x198, x206, x173);
+        let x219 = Self::mul_add(x198, x207, x174);
+        let x220 = Self::mul_add(x199, x206, x175);
+        let x221 = Self::mul_add(-x199, x207, x176);
+        let x222 = Self::mul_add(x187, x207, x177);
         let x223 = Self::mul_add(
-            x198,
             x202,
-            Self::mul_add(-x115, x119, x104 * x121) + x188
-                + (Self::mul_add(-x112, x211, x111 * x208)
-                    + Self::mul_add(-x114, x216, x113 * x214)),
+            x203,
+            x151 + Self::mul_add(-x125, x149, x126 * x150)
+                + Self::mul_add(0.55, x193, 0.16 * x192)
+                - (Self::mul_add(x107, x120, x117 * x119)
+                    + Self::mul_add(x111, x123, x112 * x122))
+                - (Self::mul_add(x114, x209, x113 * x208)
+                    + Self::mul_add(x116, x212, x115 * x211)),
         );
         let x224 = Self::mul_add(
-            -x198,
-            x203,
-            Self::mul_add(-x104, x120, x105 * x119) + x189
-                + (Self::mul_add(-x112, x212, x111 * x209)
-                    + Self::mul_add(-x114, x217, x113 * x215)),
+            x202,
+            x204,
+            Self::mul_add(-x106, x120, x117 * x118)
+                - Self::mul_add(x110, x123, x112 * x121)
+                + Self::mul_add(0.16, x191, Self::mul_add(c_q13, x150, s_q13 * x149))
+                - (Self::mul_add(x114, x210, x113 * x209)
+                    + Self::mul_add(x116, x215, x115 * x214)),
         );
-        let x225 = s_q12 * x205;
-        let x226 = Self::mul_add(x103, x205, x102 * x204);
-        let x227 = c_q12 * x205;
-        let x228 = Self::mul_add(s_q12, x204, x227);
-        let x229 = Self::mul_add(x103, x206, x102 * x205);
-        let x230 = Self::mul_add(c_q12, x206, x225);
-        let x231 = Self::mul_add(-s_q12, x208, c_q12 * x207);
-        let x232 = x209 + Self::mul_add(x103, x208, x102 * x207);
-        let x233 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x209,
-            -Self::mul_add(c_q12, x208, s_q12 * x207),
+        let x225 = Self::mul_add(x202, x197 * x201, x200);
+        let x226 = Self::mul_add(
+            x202,
+            x205,
+            x191 - Self::mul_add(x107, x123, x117 * x122)
+                + (Self::mul_add(-x116, x218, x115 * x217)
+                    - Self::mul_add(x114, x214, x113 * x211)),
         );
-        let x234 = Self::mul_add(-s_q12, x211, c_q12 * x210);
-        let x235 = x212 + Self::mul_add(x103, x211, x102 * x210);
-        let x236 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x212,
-            -Self::mul_add(c_q12, x211, s_q12 * x210),
+        let x227 = Self::mul_add(
+            x202,
+            x206,
+            Self::mul_add(-x115, x218, x116 * x220)
+                - Self::mul_add(x114, x215, x113 * x212)
+                - (Self::mul_add(x106, x123, x117 * x121) + x192),
         );
-        let x237 = Self::mul_add(-s_q12, x234, c_q12 * x231);
-        let x238 = Self::mul_add(-s_q12, x235, c_q12 * x232);
-        let x239 = Self::mul_add(x103, x234, x102 * x231);
-        let x240 = Self::mul_add(c_q12, x234, s_q12 * x231);
-        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
-        let x242 = Self::mul_add(c_q12, x236, s_q12 * x233);
-        let x243 = s_q12 * x214;
-        let x244 = x215 + Self::mul_add(x103, x214, x102 * x213);
-        let x245 = c_q12 * x214;
-        let x246 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x215,
-            -Self::mul_add(s_q12, x213, x245),
+        let x228 = Self::mul_add(
+            x202,
+            x207,
+            Self::mul_add(-x107, x121, x106 * x122) + x193
+                + (Self::mul_add(-x116, x221, x115 * x219)
+                    - Self::mul_add(x114, x216, x113 * x213)),
         );
-        let x247 = x217 + Self::mul_add(x103, x216, x102 * x214);
-        let x248 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x217,
-            -Self::mul_add(c_q12, x216, x243),
+        let x229 = s_q12 * x209;
+        let x230 = Self::mul_add(x105, x209, x104 * x208);
+        let x231 = c_q12 * x209;
+        let x232 = Self::mul_add(s_q12, x208, x231);
+        let x233 = Self::mul_add(x105, x210, x104 * x209);
+        let x234 = Self::mul_add(c_q12, x210, x229);
+        let x235 = Self::mul_add(-s_q12, x212, c_q12 * x211);
+        let x236 = x213 - Self::mul_add(x105, x212, x104 * x211);
+        let x237 = Self::mul_add(
+            0.00000000020510342851533115,
+            x213,
+            Self::mul_add(c_q12, x212, s_q12 * x211),
         );
-        let x249 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x218,
-            -Self::mul_add(c_q12, x217, s_q12 * x215),
+        let x238 = Self::mul_add(-s_q12, x215, c_q12 * x214);
+        let x239 = x216 - Self::mul_add(x105, x215, x104 * x214);
+        let x240 = Self::mul_add(
+            0.00000000020510342851533115,
+            x216,
+            Self::mul_add(c_q12, x215, s_q12 * x214),
         );
+        let x241 = Self::mul_add(-s_q12, x238, c_q12 * x235);
+        let x242 = Self::mul_add(-s_q12, x239, c_q12 * x236);
+        let x243 = Self::mul_add(x105, x238, x104 * x235);
+        let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
+        let x245 = Self::mul_add(c_q12, x239, s_q12 * x236);
+        let x246 = Self::mul_add(c_q12, x240, s_q12 * x237);
+        let x247 = s_q12 * x218;
+        let x248 = Self::mul_add(-x105, x218, x104 * x217) - x219;
+        let x249 = c_q12 * x218;
         let x250 = Self::mul_add(
-            -s_q12,
-            Self::mul_add(-s_q12, x216, x245),
-            c_q12 * Self::mul_add(c_q12, x213, -x243),
+            0.00000000020510342851533115,
+            x219,
+            Self::mul_add(s_q12, x217, -x249),
         );
-        let x251 = Self::mul_add(-s_q12, x247, c_q12 * x244);
-        let x252 = Self::mul_add(-s_q12, x248, c_q12 * x246);
-        let x253 = x218 + Self::mul_add(x103, x217, x102 * x215)
-            + Self::mul_add(x103, x247, x102 * x244);
-        let x254 = x249 + Self::mul_add(x103, x248, x102 * x246);
-        let x255 = Self::mul_add(0.36, x253, x238);
-        let x256 = Self::mul_add(-0.36, x250, x239);
-        let x257 = Self::mul_add(-0.36, x251, Self::mul_add(x103, x235, x102 * x232));
-        let x258 = Self::mul_add(
+        let x251 = x221 + Self::mul_add(-x104, x218, x105 * x220);
+        let x252 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x221,
+            Self::mul_add(c_q12, x220, -x247),
+        );
+        let x253 = Self::mul_add(
+            0.00000000020510342851533115,
+            x222,
+            Self::mul_add(-c_q12, x221, s_q12 * x219),
+        );
+        let x254 = Self::mul_add(
+            s_q12,
+            Self::mul_add(s_q12, x220, x249),
+            c_q12 * Self::mul_add(c_q12, x217, x247),
+        );
+        let x255 = Self::mul_add(-s_q12, x251, c_q12 * x248);
+        let x256 = Self::mul_add(-s_q12, x252, c_q12 * x250);
+        let x257 = Self::mul_add(-x105, x221, x104 * x219) - x222
+            - Self::mul_add(x105, x251, x104 * x248);
+        let x258 = x253 - Self::mul_add(x105, x252, x104 * x250);
+        let x259 = 0.36 * x255;
+        let x260 = Self::mul_add(0.36, x257, x242);
+        let x261 = Self::mul_add(0.36, x254, -x243);
+        let x262 = Self::mul_add(x105, x239, x104 * x236) + x259;
+        let x263 = Self::mul_add(
             0.36,
-            x255,
+            x260,
             Self::mul_add(
                 -s_q12,
-                Self::mul_add(-s_q12, x206, x227),
-                c_q12 * Self::mul_add(c_q12, x204, -x225),
+                Self::mul_add(-s_q12, x210, x231),
+                c_q12 * Self::mul_add(c_q12, x208, -x229),
             ),
         );
-        let x259 = Self::mul_add(
+        let x264 = Self::mul_add(
             -0.36,
-            x237,
-            Self::mul_add(0.36, x257, Self::mul_add(-s_q12, x229, c_q12 * x226)),
+            x241,
+            Self::mul_add(-0.36, x262, Self::mul_add(-c_q12, x230, s_q12 * x233)),
         );
-        let x260 = Self::mul_add(
-            -0.36,
-            x239,
-            Self::mul_add(-0.36, x256, Self::mul_add(x103, x229, x102 * x226)),
+        let x265 = Self::mul_add(
+            0.36,
+            x243,
+            Self::mul_add(-0.36, x261, Self::mul_add(x105, x233, x104 * x230)),
         );
-        let x261 = Self::mul_add(-s_q12, x223, c_q12 * x222);
-        let x262 = x224 + Self::mul_add(x103, x223, x102 * x222);
-        let x263 = 0.01675
-            + Self::mul_add(-0.36, x241, Self::mul_add(-c_q12, x228, s_q12 * x230));
-        let x264 = 2.5482240016099564
-            - Self::mul_add(-0.36, x240, Self::mul_add(x103, x230, x102 * x228));
-        let x265 = 9.223235249762805 + Self::mul_add(c_q12, x230, s_q12 * x228);
-        let x266 = -7.078399999258757 - x240;
-        let x267 = Self::mul_add(x90, x99, Self::mul_add(-x85, x97, x84 * x96))
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x221,
-                -Self::mul_add(c_q12, x220, s_q12 * x219),
+        let x266 = Self::mul_add(-s_q12, x227, c_q12 * x226);
+        let x267 = x228 - Self::mul_add(x105, x227, x104 * x226);
+        let x268 = 0.01675
+            + Self::mul_add(-0.36, x245, Self::mul_add(-c_q12, x232, s_q12 * x234));
+        let x269 = 2.5482240016099564
+            + Self::mul_add(0.36, x244, Self::mul_add(x105, x234, x104 * x232));
+        let x270 = 9.223235249762805 + Self::mul_add(c_q12, x234, s_q12 * x232);
+        let x271 = -7.078399999258757 - x244;
+        let x272 = Self::mul_add(x92, x101, Self::mul_add(-x87, x99, x86 * x98))
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x225,
+                Self::mul_add(c_q12, x224, s_q12 * x223),
             );
-        let x268 = Self::mul_add(
-            x85,
-            x99,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x224,
-                -Self::mul_add(c_q12, x223, s_q12 * x222),
+        let x273 = Self::mul_add(
+            x87,
+            x101,
+            -Self::mul_add(
+                0.00000000020510342851533115,
+                x228,
+                Self::mul_add(c_q12, x227, s_q12 * x226),
             ),
         );
-        let x269 = 1.0 / x265;
-        let x270 = tau[4] - x267;
-        let x271 = x263 * x269;
-        let x272 = x264 * x269;
-        let x273 = x266 * x269;
-        let x274 = x241 * x269;
-        let x275 = x242 * x269;
-        let x276 = Self::mul_add(-x263, x271, Self::mul_add(0.36, x238, x258));
-        let x277 = Self::mul_add(-x263, x272, x259);
-        let x278 = Self::mul_add(-x264, x272, -9.142025249762803 + x260);
-        let x279 = Self::mul_add(-x263, x273, Self::mul_add(0.36, x251, x237));
-        let x280 = Self::mul_add(x263, x274, x255);
-        let x281 = Self::mul_add(
-            x263,
-            x275,
+        let x274 = 1.0 / x270;
+        let x275 = tau[4] - x272;
+        let x276 = x268 * x274;
+        let x277 = x269 * x274;
+        let x278 = x271 * x274;
+        let x279 = x245 * x274;
+        let x280 = x246 * x274;
+        let x281 = Self::mul_add(-x268, x276, Self::mul_add(0.36, x242, x263));
+        let x282 = Self::mul_add(-x268, x277, x264);
+        let x283 = Self::mul_add(-x269, x277, -9.142025249762803 + x265);
+        let x284 = Self::mul_add(-x268, x278, x241 + x259);
+        let x285 = Self::mul_add(x268, x279, x260);
+        let x286 = Self::mul_add(
+            -x268,
+            x280,
             7.078399999258757
-                + Self::mul_add(0.36, x254, Self::mul_add(-s_q12, x236, c_q12 * x233)),
+                + Self::mul_add(0.36, x258, Self::mul_add(-c_q12, x237, s_q12 * x240)),
         );
-        let x282 = Self::mul_add(-x264, x273, x256);
-        let x283 = Self::mul_add(x264, x274, x257);
-        let x284 = Self::mul_add(
-            x264,
-            x275,
-            Self::mul_add(-0.36, x252, Self::mul_add(x103, x236, x102 * x233)),
+        let x287 = Self::mul_add(-x269, x278, x261);
+        let x288 = Self::mul_add(x269, x279, -x262);
+        let x289 = Self::mul_add(
+            -x269,
+            x280,
+            Self::mul_add(-0.36, x256, Self::mul_add(x105, x240, x104 * x237)),
         );
-        let x285 = Self::mul_add(-x266, x273, x250);
-        let x286 = Self::mul_add(x266, x274, x251);
-        let x287 = Self::mul_add(x266, x275, x252);
-        let x288 = Self::mul_add(-x241, x274, x253);
-        let x289 = Self::mul_add(-x241, x275, x254);
-        let x290 = Self::mul_add(
-            -x242,
-            x275,
+        let x290 = Self::mul_add(x271, x278, x254);
+        let x291 = Self::mul_add(x271, x279, x255);
+        let x292 = Self::mul_add(-x271, x280, x256);
+        let x293 = Self::mul_add(-x245, x279, x257);
+        let x294 = Self::mul_add(x245, x280, x258);
+        let x295 = Self::mul_add(
+            x246,
+            x280,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x249,
-                -Self::mul_add(c_q12, x248, s_q12 * x246),
+                0.00000000020510342851533115,
+                x253,
+                Self::mul_add(c_q12, x252, s_q12 * x250),
             ),
         );
-        let x291 = Self::mul_add(
-            x270,
-            x271,
-            Self::mul_add(-x90, x100, Self::mul_add(-x95, x96, x85 * x98))
-                + Self::mul_add(0.36, x262, Self::mul_add(-s_q12, x220, c_q12 * x219))
-                + (Self::mul_add(-x92, x277, x91 * x276)
-                    + Self::mul_add(-x94, x280, x93 * x279)),
+        let x296 = Self::mul_add(
+            x275,
+            x276,
+            Self::mul_add(x92, x102, Self::mul_add(-x97, x98, x87 * x100))
+                + Self::mul_add(0.36, x267, Self::mul_add(-s_q12, x224, c_q12 * x223))
+                + (Self::mul_add(-x94, x282, x93 * x281)
+                    + Self::mul_add(-x96, x285, x95 * x284)),
         );
-        let x292 = Self::mul_add(
-            x270,
-            x272,
-            Self::mul_add(-x84, x98, x95 * x97) + Self::mul_add(-x88, x99, x89 * x100)
+        let x297 = Self::mul_add(
+            x275,
+            x277,
+            Self::mul_add(-x86, x100, x97 * x99) - Self::mul_add(x91, x102, x90 * x101)
                 + Self::mul_add(
                     -0.36,
-                    x261,
-                    x221 + Self::mul_add(x103, x220, x102 * x219),
+                    x266,
+                    x225 - Self::mul_add(x105, x224, x104 * x223),
                 )
-                + (Self::mul_add(-x92, x278, x91 * x277)
-                    + Self::mul_add(-x94, x283, x93 * x282)),
+                + (Self::mul_add(-x94, x283, x93 * x282)
+                    + Self::mul_add(-x96, x288, x95 * x287)),
         );
-        let x293 = Self::mul_add(
-            x270,
-            x273,
-            Self::mul_add(-x85, x100, x261)
-                + (Self::mul_add(-x92, x282, x91 * x279)
-                    + Self::mul_add(-x94, x286, x93 * x285)),
-        );
-        let x294 = Self::mul_add(
-            -x270,
-            x274,
-            Self::mul_add(-x95, x99, x84 * x100) + x262
-                + (Self::mul_add(-x92, x283, x91 * x280)
-                    + Self::mul_add(-x94, x288, x93 * x286)),
-        );
-        let x295 = Self::mul_add(
-            -x270,
+        let x298 = Self::mul_add(
             x275,
-            x268
-                + (Self::mul_add(-x92, x284, x91 * x281)
-                    + Self::mul_add(-x94, x289, x93 * x287)),
+            x278,
+            Self::mul_add(x87, x102, x266)
+                + (Self::mul_add(-x94, x287, x93 * x284)
+                    - Self::mul_add(x96, x291, x95 * x290)),
         );
-        let x296 = s_q11 * x277;
-        let x297 = c_q11 * x277;
-        let x298 = Self::mul_add(s_q11, x276, x297);
-        let x299 = Self::mul_add(c_q11, x278, x296);
-        let x300 = Self::mul_add(-s_q11, x280, c_q11 * x279);
-        let x301 = Self::mul_add(c_q11, x280, s_q11 * x279);
-        let x302 = Self::mul_add(-s_q11, x283, c_q11 * x282);
-        let x303 = Self::mul_add(c_q11, x283, s_q11 * x282);
-        let x304 = Self::mul_add(-s_q11, x302, c_q11 * x300);
-        let x305 = Self::mul_add(-s_q11, x303, c_q11 * x301);
-        let x306 = Self::mul_add(-s_q11, x284, c_q11 * x281);
-        let x307 = Self::mul_add(c_q11, x302, s_q11 * x300);
-        let x308 = s_q11 * x286;
-        let x309 = c_q11 * x286;
-        let x310 = Self::mul_add(s_q11, x285, x309);
-        let x311 = Self::mul_add(c_q11, x288, x308);
-        let x312 = Self::mul_add(-s_q11, x289, c_q11 * x287);
-        let x313 = Self::mul_add(c_q11, x289, s_q11 * x287);
-        let x314 = Self::mul_add(
-            -s_q11,
-            Self::mul_add(-s_q11, x288, x309),
-            c_q11 * Self::mul_add(c_q11, x285, -x308),
+        let x299 = Self::mul_add(
+            -x275,
+            x279,
+            x267 - Self::mul_add(x86, x102, x97 * x101)
+                + (Self::mul_add(-x94, x288, x93 * x285)
+                    + Self::mul_add(-x96, x293, x95 * x291)),
         );
-        let x315 = Self::mul_add(-s_q11, x311, c_q11 * x310);
-        let x316 = Self::mul_add(c_q11, x311, s_q11 * x310);
-        let x317 = 0.63 * x314;
-        let x318 = 0.63 * x315;
-        let x319 = 0.63 * x312;
-        let x320 = x305 + Self::mul_add(-0.63, x313, 0.275 * x316);
-        let x321 = x306 + Self::mul_add(-0.63, x290, 0.275 * x313);
-        let x322 = Self::mul_add(-0.275, x314, x307);
-        let x323 = Self::mul_add(-0.275, x315, Self::mul_add(c_q11, x303, s_q11 * x301));
-        let x324 = Self::mul_add(-0.275, x312, Self::mul_add(c_q11, x284, s_q11 * x281));
-        let x325 = Self::mul_add(
+        let x300 = Self::mul_add(
+            x275,
+            x280,
+            x273
+                + (Self::mul_add(-x94, x289, x93 * x286)
+                    + Self::mul_add(-x96, x294, x95 * x292)),
+        );
+        let x301 = s_q11 * x282;
+        let x302 = c_q11 * x282;
+        let x303 = Self::mul_add(s_q11, x281, x302);
+        let x304 = Self::mul_add(c_q11, x283, x301);
+        let x305 = Self::mul_add(-s_q11, x285, c_q11 * x284);
+        let x306 = Self::mul_add(c_q11, x285, s_q11 * x284);
+        let x307 = Self::mul_add(-s_q11, x288, c_q11 * x287);
+        let x308 = Self::mul_add(c_q11, x288, s_q11 * x287);
+        let x309 = Self::mul_add(-s_q11, x307, c_q11 * x305);
+        let x310 = Self::mul_add(-s_q11, x308, c_q11 * x306);
+        let x311 = Self::mul_add(-s_q11, x289, c_q11 * x286);
+        let x312 = Self::mul_add(c_q11, x307, s_q11 * x305);
+        let x313 = s_q11 * x291;
+        let x314 = c_q11 * x291;
+        let x315 = Self::mul_add(-s_q11, x290, x314);
+        let x316 = Self::mul_add(c_q11, x293, x313);
+        let x317 = Self::mul_add(-s_q11, x294, c_q11 * x292);
+        let x318 = Self::mul_add(c_q11, x294, s_q11 * x292);
+        let x319 = Self::mul_add(
+            s_q11,
+            Self::mul_add(-s_q11, x293, x314),
+            c_q11 * Self::mul_add(c_q11, x290, x313),
+        );
+        let x320 = Self::mul_add(-s_q11, x316, c_q11 * x315);
+        let x321 = Self::mul_add(c_q11, x316, s_q11 * x315);
+        let x322 = 0.275 * x320;
+        let x323 = 0.63 * x317;
+        let x324 = 0.63 * x319;
+        let x325 = 0.63 * x320;
+        let x326 = x310 + Self::mul_add(-0.63, x318, 0.275 * x321);
+        let x327 = x311 + Self::mul_add(0.63, x295, 0.275 * x318);
+        let x328 = Self::mul_add(0.275, x319, x312);
+        let x329 = Self::mul_add(c_q11, x308, s_q11 * x306) - x322;
+        let x330 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x289, s_q11 * x286));
+        let x331 = Self::mul_add(
             -0.275,
-            x307,
-            Self::mul_add(-0.275, x322, Self::mul_add(c_q11, x299, s_q11 * x298)),
+            x312,
+            Self::mul_add(-0.275, x328, Self::mul_add(c_q11, x304, s_q11 * x303)),
         );
-        let x326 = Self::mul_add(-s_q11, x294, c_q11 * x293);
-        let x327 = Self::mul_add(c_q11, x294, s_q11 * x293);
-        let x328 = -0.6328
-            + Self::mul_add(0.63, x304, Self::mul_add(-0.63, x319, 0.275 * x318));
-        let x329 = -24.35164200091464 + Self::mul_add(0.63, x307, -0.275 * x317);
-        let x330 = Self::mul_add(0.63, x317, 28.2393615);
-        let x331 = 45.1584 + x317;
-        let x332 = Self::mul_add(x72, x81, Self::mul_add(-x68, x79, x67 * x78))
-            + Self::mul_add(0.63, x326, Self::mul_add(x270, x265 * x269, x267));
-        let x333 = 1.0 / x330;
-        let x334 = tau[3] - x332;
-        let x335 = x328 * x333;
-        let x336 = x329 * x333;
-        let x337 = x331 * x333;
-        let x338 = x318 * x333;
-        let x339 = x319 * x333;
-        let x340 = Self::mul_add(
-            -x328,
-            x335,
-            Self::mul_add(-0.63, x306, 0.275 * x305)
+        let x332 = Self::mul_add(-s_q11, x299, c_q11 * x298);
+        let x333 = Self::mul_add(c_q11, x299, s_q11 * x298);
+        let x334 = -0.6328
+            + Self::mul_add(0.63, x309, Self::mul_add(-0.63, x323, 0.275 * x325));
+        let x335 = -24.35164200091464 + Self::mul_add(0.63, x312, 0.275 * x324);
+        let x336 = Self::mul_add(-0.63, x324, 28.2393615);
+        let x337 = 45.1584 - x324;
+        let x338 = Self::mul_add(-x74, x83, Self::mul_add(-x69, x80, x70 * x81))
+            + Self::mul_add(0.63, x332, Self::mul_add(x275, x270 * x274, x272));
+        let x339 = 1.0 / x336;
+        let x340 = tau[3] - x338;
+        let x341 = x334 * x339;
+        let x342 = x335 * x339;
+        let x343 = x337 * x339;
+        let x344 = x325 * x339;
+        let x345 = x323 * x339;
+        let x346 = Self::mul_add(
+            -x334,
+            x341,
+            Self::mul_add(-0.63, x311, 0.275 * x310)
                 + (Self::mul_add(
                     -s_q11,
-                    Self::mul_add(-s_q11, x278, x297),
-                    c_q11 * Self::mul_add(c_q11, x276, -x296),
-                ) + Self::mul_add(-0.63, x321, 0.275 * x320)),
+                    Self::mul_add(-s_q11, x283, x302),
+                    c_q11 * Self::mul_add(c_q11, x281, -x301),
+                ) + Self::mul_add(-0.63, x327, 0.275 * x326)),
         );
-        let x341 = Self::mul_add(
-            -x328,
-            x336,
+        let x347 = Self::mul_add(
+            -x334,
+            x342,
             Self::mul_add(
                 -0.275,
-                x304,
-                Self::mul_add(-s_q11, x299, c_q11 * x298)
-                    + Self::mul_add(-0.63, x324, 0.275 * x323),
+                x309,
+                Self::mul_add(-s_q11, x304, c_q11 * x303)
+                    + Self::mul_add(-0.63, x330, 0.275 * x329),
             ),
         );
-        let x342 = Self::mul_add(-x329, x336, -24.4950615 + x325);
-        let x343 = Self::mul_add(
-            -x328,
-            x337,
-            x304 + Self::mul_add(-0.63, x312, 0.275 * x315),
+        let x348 = Self::mul_add(-x335, x342, -24.4950615 + x331);
+        let x349 = Self::mul_add(-x334, x343, x309 + (x322 - x323));
+        let x350 = Self::mul_add(-x334, x344, x326);
+        let x351 = Self::mul_add(-x334, x345, -45.1584 + x327);
+        let x352 = Self::mul_add(-x335, x343, x328);
+        let x353 = Self::mul_add(-x335, x344, x329);
+        let x354 = Self::mul_add(-x335, x345, x330);
+        let x355 = Self::mul_add(x337, x343, x319);
+        let x356 = Self::mul_add(-x337, x344, x320);
+        let x357 = Self::mul_add(-x337, x345, x317);
+        let x358 = Self::mul_add(-x325, x344, x321);
+        let x359 = Self::mul_add(-x325, x345, x318);
+        let x360 = Self::mul_add(x323, x345, x295);
+        let x361 = Self::mul_add(
+            x340,
+            x341,
+            Self::mul_add(-x74, x84, Self::mul_add(x70, x82, x79 * x80))
+                + (Self::mul_add(-s_q11, x297, c_q11 * x296)
+                    + Self::mul_add(-0.63, x300, 0.275 * x333))
+                + (Self::mul_add(-x76, x347, x75 * x346)
+                    + Self::mul_add(-x78, x350, x77 * x349)),
         );
-        let x344 = Self::mul_add(-x328, x338, x320);
-        let x345 = Self::mul_add(-x328, x339, -45.1584 + x321);
-        let x346 = Self::mul_add(-x329, x337, x322);
-        let x347 = Self::mul_add(-x329, x338, x323);
-        let x348 = Self::mul_add(-x329, x339, x324);
-        let x349 = Self::mul_add(-x331, x337, x314);
-        let x350 = Self::mul_add(-x331, x338, x315);
-        let x351 = Self::mul_add(-x331, x339, x312);
-        let x352 = Self::mul_add(-x318, x338, x316);
-        let x353 = Self::mul_add(-x318, x339, x313);
-        let x354 = Self::mul_add(-x319, x339, x290);
-        let x355 = Self::mul_add(
-            x334,
-            x335,
-            Self::mul_add(-x72, x82, Self::mul_add(-x77, x78, x68 * x80))
-                + (Self::mul_add(-s_q11, x292, c_q11 * x291)
-                    + Self::mul_add(-0.63, x295, 0.275 * x327))
-                + (Self::mul_add(-x74, x341, x73 * x340)
-                    + Self::mul_add(-x76, x344, x75 * x343)),
+        let x362 = Self::mul_add(
+            x340,
+            x342,
+            Self::mul_add(x73, x84, x72 * x83) - Self::mul_add(x69, x82, x79 * x81)
+                + Self::mul_add(-0.275, x332, Self::mul_add(c_q11, x297, s_q11 * x296))
+                + (Self::mul_add(-x76, x348, x75 * x347)
+                    + Self::mul_add(-x78, x353, x77 * x352)),
         );
-        let x356 = Self::mul_add(
-            x334,
-            x336,
-            Self::mul_add(-x67, x80, x77 * x79) + Self::mul_add(-x70, x81, x71 * x82)
-                + Self::mul_add(-0.275, x326, Self::mul_add(c_q11, x292, s_q11 * x291))
-                + (Self::mul_add(-x74, x342, x73 * x341)
-                    + Self::mul_add(-x76, x347, x75 * x346)),
+        let x363 = Self::mul_add(
+            x340,
+            x343,
+            Self::mul_add(-x70, x84, x332)
+                + (Self::mul_add(-x76, x352, x75 * x349)
+                    - Self::mul_add(x78, x356, x77 * x355)),
         );
-        let x357 = Self::mul_add(
-            x334,
-            x337,
-            Self::mul_add(-x68, x82, x326)
-                + (Self::mul_add(-x74, x346, x73 * x343)
-                    + Self::mul_add(-x76, x350, x75 * x349)),
+        let x364 = Self::mul_add(
+            x340,
+            x344,
+            Self::mul_add(x69, x84, x79 * x83) + x333
+                + (Self::mul_add(-x76, x353, x75 * x350)
+                    + Self::mul_add(-x78, x358, x77 * x356)),
         );
-        let x358 = Self::mul_add(
-            x334,
-            x338,
-            Self::mul_add(-x77, x81, x67 * x82) + x327
-                + (Self::mul_add(-x74, x347, x73 * x344)
-                    + Self::mul_add(-x76, x352, x75 * x350)),
+        let x365 = Self::mul_add(
+            x340,
+            x345,
+            Self::mul_add(-x70, x83, x300)
+                + (Self::mul_add(-x76, x354, x75 * x351)
+                    + Self::mul_add(-x78, x359, x77 * x357)),
         );
-        let x359 = Self::mul_add(
-            x334,
-            x339,
-            Self::mul_add(x68, x81, x295)
-                + (Self::mul_add(-x74, x348, x73 * x345)
-                    + Self::mul_add(-x76, x353, x75 * x351)),
-        );
-        let x360 = s_q10 * x341;
-        let x361 = c_q10 * x341;
-        let x362 = Self::mul_add(s_q10, x340, x361);
-        let x363 = Self::mul_add(c_q10, x342, x360);
-        let x364 = Self::mul_add(-s_q10, x344, c_q10 * x343);
-        let x365 = Self::mul_add(c_q10, x344, s_q10 * x343);
-        let x366 = Self::mul_add(-s_q10, x347, c_q10 * x346);
-        let x367 = Self::mul_add(c_q10, x347, s_q10 * x346);
-        let x368 = Self::mul_add(-s_q10, x366, c_q10 * x364);
-        let x369 = Self::mul_add(-s_q10, x348, c_q10 * x345);
-        let x370 = Self::mul_add(c_q10, x366, s_q10 * x364);
-        let x371 = Self::mul_add(c_q10, x348, s_q10 * x345);
-        let x372 = s_q10 * x350;
-        let x373 = c_q10 * x350;
-        let x374 = Self::mul_add(s_q10, x349, x373);
-        let x375 = Self::mul_add(c_q10, x352, x372);
-        let x376 = Self::mul_add(-s_q10, x353, c_q10 * x351);
-        let x377 = Self::mul_add(c_q10, x353, s_q10 * x351);
-        let x378 = Self::mul_add(
-            -s_q10,
-            Self::mul_add(-s_q10, x352, x373),
-            c_q10 * Self::mul_add(c_q10, x349, -x372),
-        );
-        let x379 = Self::mul_add(-s_q10, x375, c_q10 * x374);
-        let x380 = 0.87 * x378;
-        let x381 = 0.87 * x379;
-        let x382 = 0.87 * x376;
-        let x383 = Self::mul_add(-0.87, x354, x369);
+        let x366 = s_q10 * x347;
+        let x367 = c_q10 * x347;
+        let x368 = Self::mul_add(s_q10, x346, x367);
+        let x369 = Self::mul_add(c_q10, x348, x366);
+        let x370 = Self::mul_add(-s_q10, x350, c_q10 * x349);
+        let x371 = Self::mul_add(c_q10, x350, s_q10 * x349);
+        let x372 = Self::mul_add(-s_q10, x353, c_q10 * x352);
+        let x373 = Self::mul_add(c_q10, x353, s_q10 * x352);
+        let x374 = Self::mul_add(-s_q10, x372, c_q10 * x370);
+        let x375 = Self::mul_add(-s_q10, x354, c_q10 * x351);
+        let x376 = Self::mul_add(c_q10, x372, s_q10 * x370);
+        let x377 = Self::mul_add(c_q10, x354, s_q10 * x351);
+        let x378 = s_q10 * x356;
+        let x379 = c_q10 * x356;
+        let x380 = Self::mul_add(-s_q10, x355, x379);
+        let x381 = Self::mul_add(c_q10, x358, x378);
+        let x382 = Self::mul_add(-s_q10, x359, c_q10 * x357);
+        let x383 = Self::mul_add(c_q10, x359, s_q10 * x357);
         let x384 = Self::mul_add(
+            s_q10,
+            Self::mul_add(-s_q10, x358, x379),
+            c_q10 * Self::mul_add(c_q10, x355, x378),
+        );
+        let x385 = Self::mul_add(-s_q10, x381, c_q10 * x380);
+        let x386 = 0.87 * x382;
+        let x387 = 0.87 * x384;
+        let x388 = 0.87 * x385;
+        let x389 = Self::mul_add(0.87, x360, x375);
+        let x390 = Self::mul_add(
             -0.87,
-            x383,
+            x389,
             Self::mul_add(
                 -s_q10,
-                Self::mul_add(-s_q10, x342, x361),
-                c_q10 * Self::mul_add(c_q10, x340, -x360),
+                Self::mul_add(-s_q10, x348, x367),
+                c_q10 * Self::mul_add(c_q10, x346, -x366),
             ),
         );
-        let x385 = Self::mul_add(-s_q10, x358, c_q10 * x357);
-        let x386 = -0.00214 + Self::mul_add(0.87, x368, -0.87 * x382);
-        let x387 = Self::mul_add(0.87, x370, -36.18604050126307);
-        let x388 = Self::mul_add(0.87, x380, 69.99836825);
-        let x389 = 81.53205 + x380;
-        let x390 = Self::mul_add(x54, x64, Self::mul_add(-x49, x62, x48 * x61))
-            + Self::mul_add(0.87, x385, Self::mul_add(x334, x330 * x333, x332));
-        let x391 = 1.0 / x388;
-        let x392 = tau[2] - x390;
-        let x393 = x386 * x391;
-        let x394 = x387 * x391;
-        let x395 = x389 * x391;
-        let x396 = x381 * x391;
-        let x397 = x382 * x391;
-        let x398 = Self::mul_add(-x386, x393, Self::mul_add(-0.87, x369, x384));
-        let x399 = Self::mul_add(
-            -x386,
-            x394,
-            Self::mul_add(-0.87, x371, Self::mul_add(-s_q10, x363, c_q10 * x362)),
+        let x391 = Self::mul_add(-s_q10, x364, c_q10 * x363);
+        let x392 = -0.00214 + Self::mul_add(-0.87, x386, 0.87 * x374);
+        let x393 = Self::mul_add(0.87, x376, -36.18604050126307);
+        let x394 = Self::mul_add(-0.87, x387, 69.99836825);
+        let x395 = 81.53205 - x387;
+        let x396 = Self::mul_add(-x56, x66, Self::mul_add(-x50, x63, x51 * x64))
+            + Self::mul_add(0.87, x391, Self::mul_add(x340, x336 * x339, x338));
+        let x397 = 1.0 / x394;
+        let x398 = tau[2] - x396;
+        let x399 = x392 * x397;
+        let x400 = x393 * x397;
+        let x401 = x395 * x397;
+        let x402 = x388 * x397;
+        let x403 = x386 * x397;
+        let x404 = Self::mul_add(-x392, x399, Self::mul_add(-0.87, x375, x390));
+        let x405 = Self::mul_add(
+            -x392,
+            x400,
+            Self::mul_add(-0.87, x377, Self::mul_add(-s_q10, x369, c_q10 * x368)),
         );
-        let x400 = Self::mul_add(
-            -x387,
-            x394,
-            -63.36336825000001 + Self::mul_add(c_q10, x363, s_q10 * x362),
+        let x406 = Self::mul_add(
+            -x393,
+            x400,
+            -63.36336825000001 + Self::mul_add(c_q10, x369, s_q10 * x368),
         );
-        let x401 = Self::mul_add(-x386, x395, Self::mul_add(-0.87, x376, x368));
-        let x402 = Self::mul_add(
-            -x386,
-            x396,
-            Self::mul_add(-0.87, x377, Self::mul_add(-s_q10, x367, c_q10 * x365)),
+        let x407 = Self::mul_add(-x392, x401, x374 - x386);
+        let x408 = Self::mul_add(
+            -x392,
+            x402,
+            Self::mul_add(-0.87, x383, Self::mul_add(-s_q10, x373, c_q10 * x371)),
         );
-        let x403 = Self::mul_add(-x386, x397, -81.53205 + x383);
-        let x404 = Self::mul_add(-x387, x395, x370);
-        let x405 = Self::mul_add(-x387, x396, Self::mul_add(c_q10, x367, s_q10 * x365));
-        let x406 = Self::mul_add(-x387, x397, x371);
-        let x407 = Self::mul_add(-x389, x395, x378);
-        let x408 = Self::mul_add(-x389, x396, x379);
-        let x409 = Self::mul_add(-x389, x397, x376);
-        let x410 = Self::mul_add(-x381, x396, Self::mul_add(c_q10, x375, s_q10 * x374));
-        let x411 = Self::mul_add(-x381, x397, x377);
-        let x412 = Self::mul_add(-x382, x397, x354);
-        let x413 = Self::mul_add(
-            x392,
-            x393,
-            Self::mul_add(-x54, x65, Self::mul_add(-x60, x61, x49 * x63))
-                + Self::mul_add(-0.87, x359, Self::mul_add(-s_q10, x356, c_q10 * x355))
-                + (Self::mul_add(-x57, x399, x56 * x398)
-                    + Self::mul_add(-x59, x402, x58 * x401)),
+        let x409 = Self::mul_add(-x392, x403, -81.53205 + x389);
+        let x410 = Self::mul_add(-x393, x401, x376);
+        let x411 = Self::mul_add(-x393, x402, Self::mul_add(c_q10, x373, s_q10 * x371));
+        let x412 = Self::mul_add(-x393, x403, x377);
+        let x413 = Self::mul_add(x395, x401, x384);
+        let x414 = Self::mul_add(-x395, x402, x385);
+        let x415 = Self::mul_add(-x395, x403, x382);
+        let x416 = Self::mul_add(-x388, x402, Self::mul_add(c_q10, x381, s_q10 * x380));
+        let x417 = Self::mul_add(-x388, x403, x383);
+        let x418 = Self::mul_add(x386, x403, x360);
+        let x419 = Self::mul_add(
+            x398,
+            x399,
+            Self::mul_add(-x56, x67, Self::mul_add(x51, x65, x62 * x63))
+                + Self::mul_add(-0.87, x365, Self::mul_add(-s_q10, x362, c_q10 * x361))
+                + (Self::mul_add(-x59, x405, x58 * x404)
+                    + Self::mul_add(-x61, x408, x60 * x407)),
         );
-        let x414 = Self::mul_add(
-            x392,
-            x394,
-            Self::mul_add(-x48, x63, x60 * x62) + Self::mul_add(-x55, x64, x53 * x65)
-                + Self::mul_add(c_q10, x356, s_q10 * x355)
-                + (Self::mul_add(-x57, x400, x56 * x399)
-                    + Self::mul_add(-x59, x405, x58 * x404)),
+        let x420 = Self::mul_add(
+            x398,
+            x400,
+            Self::mul_add(x55, x67, x57 * x66) - Self::mul_add(x50, x65, x62 * x64)
+                + Self::mul_add(c_q10, x362, s_q10 * x361)
+                + (Self::mul_add(-x59, x406, x58 * x405)
+                    + Self::mul_add(-x61, x411, x60 * x410)),
         );
-        let x415 = Self::mul_add(x392, x388 * x391, x390);
-        let x416 = Self::mul_add(
-            x392,
-            x395,
-            Self::mul_add(-x49, x65, x385)
-                + (Self::mul_add(-x57, x404, x56 * x401)
-                    + Self::mul_add(-x59, x408, x58 * x407)),
+        let x421 = Self::mul_add(x398, x394 * x397, x396);
+        let x422 = Self::mul_add(
+            x398,
+            x401,
+            Self::mul_add(-x51, x67, x391)
+                + (Self::mul_add(-x59, x410, x58 * x407)
+                    - Self::mul_add(x61, x414, x60 * x413)),
         );
-        let x417 = Self::mul_add(
-            x392,
-            x396,
-            Self::mul_add(-x60, x64, x48 * x65)
-                + Self::mul_add(c_q10, x358, s_q10 * x357)
-                + (Self::mul_add(-x57, x405, x56 * x402)
-                    + Self::mul_add(-x59, x410, x58 * x408)),
+        let x423 = Self::mul_add(
+            x398,
+            x402,
+            Self::mul_add(x50, x67, x62 * x66) + Self::mul_add(c_q10, x364, s_q10 * x363)
+                + (Self::mul_add(-x59, x411, x58 * x408)
+                    + Self::mul_add(-x61, x416, x60 * x414)),
         );
-        let x418 = Self::mul_add(
-            x392,
-            x397,
-            Self::mul_add(x49, x64, x359)
-                + (Self::mul_add(-x57, x406, x56 * x403)
-                    + Self::mul_add(-x59, x411, x58 * x409)),
-        );
-        let x419 = c_q9 * x399;
-        let x420 = Self::mul_add(x47, x399, x46 * x398);
-        let x421 = s_q9 * x399;
-        let x422 = Self::mul_add(c_q9, x398, -x421);
-        let x423 = Self::mul_add(x47, x400, x46 * x399);
-        let x424 = Self::mul_add(-s_q9, x400, x419);
-        let x425 = Self::mul_add(
-            0.00000000020510342851533115,
+        let x424 = Self::mul_add(
+            x398,
             x403,
-            Self::mul_add(c_q9, x402, s_q9 * x401),
+            Self::mul_add(-x51, x66, x365)
+                + (Self::mul_add(-x59, x412, x58 * x409)
+                    + Self::mul_add(-x61, x417, x60 * x415)),
         );
-        let x426 = x403 + Self::mul_add(x47, x402, x46 * x401);
-        let x427 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x403,
-            Self::mul_add(-s_q9, x402, c_q9 * x401),
-        );
-        let x428 = Self::mul_add(
+        let x425 = c_q9 * x405;
+        let x426 = Self::mul_add(-x49, x405, x48 * x404);
+        let x427 = s_q9 * x405;
+        let x428 = Self::mul_add(c_q9, x404, -x427);
+        let x429 = Self::mul_add(-x49, x406, x48 * x405);
+        let x430 = Self::mul_add(-s_q9, x406, x425);
+        let x431 = 0.00000000020510342851533115 * x409;
+        let x432 = Self::mul_add(c_q9, x408, s_q9 * x407) + x431;
+        let x433 = x409 + Self::mul_add(-x49, x408, x48 * x407);
+        let x434 = Self::mul_add(-s_q9, x408, c_q9 * x407) - x431;
+        let x435 = 0.00000000020510342851533115 * x412;
+        let x436 = Self::mul_add(c_q9, x411, s_q9 * x410) + x435;
+        let x437 = x412 + Self::mul_add(-x49, x411, x48 * x410);
+        let x438 = Self::mul_add(-s_q9, x411, c_q9 * x410) - x435;
+        let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
+        let x440 = Self::mul_add(c_q9, x437, s_q9 * x433);
+        let x441 = Self::mul_add(c_q9, x438, s_q9 * x434);
+        let x442 = Self::mul_add(-x49, x436, x48 * x432);
+        let x443 = Self::mul_add(-s_q9, x436, c_q9 * x432);
+        let x444 = c_q9 * x414;
+        let x445 = 0.00000000020510342851533115 * x415;
+        let x446 = x415 - Self::mul_add(x49, x414, x48 * x413);
+        let x447 = s_q9 * x414;
+        let x448 = x445 + Self::mul_add(c_q9, x413, x447);
+        let x449 = 0.00000000020510342851533115 * x417;
+        let x450 = x417 + Self::mul_add(-x49, x416, x48 * x414);
+        let x451 = Self::mul_add(-s_q9, x416, x444) - x449;
+        let x452 = 0.00000000020510342851533115 * x418;
+        let x453 = Self::mul_add(-x49, x417, x48 * x415) - x418;
+        let x454 = x452 + Self::mul_add(-s_q9, x417, c_q9 * x415);
+        let x455 = Self::mul_add(
             0.00000000020510342851533115,
-            x406,
-            Self::mul_add(c_q9, x405, s_q9 * x404),
-        );
-        let x429 = x406 + Self::mul_add(x47, x405, x46 * x404);
-        let x430 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x406,
-            Self::mul_add(-s_q9, x405, c_q9 * x404),
-        );
-        let x431 = Self::mul_add(c_q9, x428, s_q9 * x425);
-        let x432 = Self::mul_add(c_q9, x429, s_q9 * x426);
-        let x433 = Self::mul_add(c_q9, x430, s_q9 * x427);
-        let x434 = Self::mul_add(x47, x428, x46 * x425);
-        let x435 = Self::mul_add(-s_q9, x428, c_q9 * x425);
-        let x436 = c_q9 * x408;
-        let x437 = x409 + Self::mul_add(x47, x408, x46 * x407);
-        let x438 = s_q9 * x408;
-        let x439 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x409,
-            Self::mul_add(c_q9, x407, -x438),
-        );
-        let x440 = x411 + Self::mul_add(x47, x410, x46 * x408);
-        let x441 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x411,
-            Self::mul_add(-s_q9, x410, x436),
-        );
-        let x442 = x412 + Self::mul_add(x47, x411, x46 * x409);
-        let x443 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x412,
-            Self::mul_add(-s_q9, x411, c_q9 * x409),
-        );
-        let x444 = Self::mul_add(
-            c_q9,
+            Self::mul_add(c_q9, x417, s_q9 * x415) - x452,
             Self::mul_add(
-                0.00000000020510342851533115,
-                x411,
-                Self::mul_add(c_q9, x410, x438),
+                c_q9,
+                Self::mul_add(c_q9, x416, x447) + x449,
+                s_q9 * (Self::mul_add(-s_q9, x413, x444) + x445),
             ),
-            s_q9
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x409,
-                    Self::mul_add(s_q9, x407, x436),
-                ),
         );
-        let x445 = Self::mul_add(
+        let x456 = Self::mul_add(
             0.00000000020510342851533115,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x412,
-                Self::mul_add(c_q9, x411, s_q9 * x409),
-            ),
-            x444,
+            x453,
+            Self::mul_add(c_q9, x450, s_q9 * x446),
         );
-        let x446 = Self::mul_add(
-            0.00000000020510342851533115,
-            x442,
-            Self::mul_add(c_q9, x440, s_q9 * x437),
-        );
-        let x447 = Self::mul_add(
-            0.00000000020510342851533115,
-            x443,
-            Self::mul_add(c_q9, x441, s_q9 * x439),
-        );
-        let x448 = x442 + Self::mul_add(x47, x440, x46 * x437);
-        let x449 = x443 + Self::mul_add(x47, x441, x46 * x439);
-        let x450 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x443,
-            Self::mul_add(-s_q9, x441, c_q9 * x439),
-        );
-        let x451 = x432 + Self::mul_add(0.275, x449, -0.4 * x448);
-        let x452 = x433 + Self::mul_add(0.275, x450, -0.4 * x449);
-        let x453 = Self::mul_add(0.4, x445, x434);
-        let x454 = Self::mul_add(0.4, x446, Self::mul_add(x47, x429, x46 * x426));
-        let x455 = Self::mul_add(0.4, x447, Self::mul_add(x47, x430, x46 * x427));
-        let x456 = Self::mul_add(-0.275, x445, x435);
-        let x457 = Self::mul_add(-0.275, x446, Self::mul_add(-s_q9, x429, c_q9 * x426));
-        let x458 = Self::mul_add(-0.275, x447, Self::mul_add(-s_q9, x430, c_q9 * x427));
-        let x459 = Self::mul_add(
+        let x457 = 0.00000000020510342851533115 * x454;
+        let x458 = Self::mul_add(-s_q9, x448, c_q9 * x451) + x457;
+        let x459 = x453 + Self::mul_add(-x49, x450, x48 * x446);
+        let x460 = x454 - Self::mul_add(x49, x451, x48 * x448);
+        let x461 = x457 + Self::mul_add(s_q9, x451, c_q9 * x448);
+        let x462 = 0.4 * x456;
+        let x463 = 0.275 * x458;
+        let x464 = x440 + Self::mul_add(-0.4, x459, 0.275 * x460);
+        let x465 = x441 - Self::mul_add(0.275, x461, 0.4 * x460);
+        let x466 = Self::mul_add(0.4, x455, x442);
+        let x467 = Self::mul_add(-x49, x437, x48 * x433) + x462;
+        let x468 = Self::mul_add(0.4, x458, Self::mul_add(-x49, x438, x48 * x434));
+        let x469 = Self::mul_add(-0.275, x455, x443);
+        let x470 = Self::mul_add(-0.275, x456, Self::mul_add(-s_q9, x437, c_q9 * x433));
+        let x471 = Self::mul_add(-s_q9, x438, c_q9 * x434) - x463;
+        let x472 = Self::mul_add(
             0.4,
-            x434,
-            Self::mul_add(0.4, x453, Self::mul_add(x47, x423, x46 * x420)),
+            x442,
+            Self::mul_add(0.4, x466, Self::mul_add(-x49, x429, x48 * x426)),
         );
-        let x460 = Self::mul_add(
+        let x473 = Self::mul_add(
             -0.275,
-            x434,
-            Self::mul_add(0.4, x456, Self::mul_add(x47, x424, x46 * x422)),
+            x442,
+            Self::mul_add(0.4, x469, Self::mul_add(-x49, x430, x48 * x428)),
         );
-        let x461 = Self::mul_add(
+        let x474 = Self::mul_add(
             -0.275,
-            x435,
-            Self::mul_add(-0.275, x456, Self::mul_add(-s_q9, x424, c_q9 * x422)),
+            x443,
+            Self::mul_add(-0.275, x469, Self::mul_add(-s_q9, x430, c_q9 * x428)),
         );
-        let x462 = Self::mul_add(
-            0.00000000020510342851533115,
-            x418,
-            Self::mul_add(c_q9, x417, s_q9 * x416),
-        );
-        let x463 = x418 + Self::mul_add(x47, x417, x46 * x416);
-        let x464 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x418,
-            Self::mul_add(-s_q9, x417, c_q9 * x416),
-        );
-        let x465 = Self::mul_add(
-            -0.275,
-            x462,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x415,
-                Self::mul_add(-s_q9, x414, c_q9 * x413),
-            ),
-        );
-        let x466 = -0.002139996587640933
+        let x475 = 0.00000000020510342851533115 * x424;
+        let x476 = Self::mul_add(c_q9, x423, s_q9 * x422) + x475;
+        let x477 = x424 + Self::mul_add(-x49, x423, x48 * x422);
+        let x478 = Self::mul_add(-s_q9, x423, c_q9 * x422) - x475;
+        let x479 = 0.00000000020510342851533115 * x421;
+        let x480 = -0.002139996587640933
             + Self::mul_add(
                 -0.275,
-                x431,
-                Self::mul_add(c_q9, x424, s_q9 * x422)
-                    + Self::mul_add(0.275, x458, -0.4 * x457),
+                x439,
+                Self::mul_add(c_q9, x430, s_q9 * x428)
+                    + Self::mul_add(-0.4, x470, 0.275 * x471),
             );
-        let x467 = 5.080660024070365 + x460;
-        let x468 = 113.3918902508081 + x461;
-        let x469 = 12.701650001451807 + x456;
-        let x470 = -0.000000008530897668050218 + x457;
-        let x471 = Self::mul_add(-x28, x39, x27 * x40)
-            + Self::mul_add(-x31, x43, x32 * x42) + x465;
-        let x472 = 1.0 / x468;
-        let x473 = tau[1] - x471;
-        let x474 = x466 * x472;
-        let x475 = x467 * x472;
-        let x476 = x469 * x472;
-        let x477 = x470 * x472;
-        let x478 = x458 * x472;
-        let x479 = Self::mul_add(
-            -x466,
-            x474,
-            Self::mul_add(0.275, x433, -0.4 * x432)
+        let x481 = 5.080660024070365 + x473;
+        let x482 = 113.3918902508081 + x474;
+        let x483 = 12.701650001451807 + x469;
+        let x484 = -0.000000008530897668050218 + x470;
+        let x485 = Self::mul_add(x27, x40, x28 * x39)
+            - Self::mul_add(x31, x43, x32 * x42)
+            + Self::mul_add(
+                -0.275,
+                x476,
+                Self::mul_add(-s_q9, x420, c_q9 * x419) - x479,
+            );
+        let x486 = 1.0 / x482;
+        let x487 = tau[1] - x485;
+        let x488 = x480 * x486;
+        let x489 = x481 * x486;
+        let x490 = x483 * x486;
+        let x491 = x484 * x486;
+        let x492 = x471 * x486;
+        let x493 = Self::mul_add(
+            -x480,
+            x488,
+            Self::mul_add(-0.4, x440, 0.275 * x441)
                 + (Self::mul_add(
                     c_q9,
-                    Self::mul_add(c_q9, x400, x421),
-                    s_q9 * Self::mul_add(s_q9, x398, x419),
-                ) + Self::mul_add(0.275, x452, -0.4 * x451)),
+                    Self::mul_add(c_q9, x406, x427),
+                    s_q9 * Self::mul_add(s_q9, x404, x425),
+                ) + Self::mul_add(-0.4, x464, 0.275 * x465)),
         );
-        let x480 = Self::mul_add(
-            -x466,
-            x475,
+        let x494 = Self::mul_add(
+            -x480,
+            x489,
             -0.0000000234896432582596
                 + Self::mul_add(
                     0.4,
-                    x431,
-                    Self::mul_add(c_q9, x423, s_q9 * x420)
-                        + Self::mul_add(0.275, x455, -0.4 * x454),
+                    x439,
+                    Self::mul_add(c_q9, x429, s_q9 * x426)
+                        + Self::mul_add(-0.4, x467, 0.275 * x468),
                 ),
         );
-        let x481 = Self::mul_add(-x467, x475, -111.7548902508081 + x459);
-        let x482 = Self::mul_add(
-            -x466,
-            x476,
-            x431 + Self::mul_add(0.275, x447, -0.4 * x446),
-        );
-        let x483 = Self::mul_add(-x466, x477, x451);
-        let x484 = Self::mul_add(-x466, x478, -12.701650001451807 + x452);
-        let x485 = Self::mul_add(-x467, x476, x453);
-        let x486 = Self::mul_add(-x467, x477, x454);
-        let x487 = Self::mul_add(-x467, x478, 0.000000008530897668050218 + x455);
-        let x488 = Self::mul_add(-x469, x476, x445);
-        let x489 = Self::mul_add(-x469, x477, x446);
-        let x490 = Self::mul_add(-x469, x478, x447);
-        let x491 = Self::mul_add(-x470, x477, x448);
-        let x492 = Self::mul_add(-x470, x478, x449);
-        let x493 = Self::mul_add(-x458, x478, x450);
-        let x494 = Self::mul_add(
-            x473,
-            x474,
-            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
-                + (Self::mul_add(
-                    0.00000000020510342851533115,
-                    x415,
-                    Self::mul_add(c_q9, x414, s_q9 * x413),
-                ) + Self::mul_add(0.275, x464, -0.4 * x463))
-                + (Self::mul_add(-x35, x480, x34 * x479)
-                    + Self::mul_add(-x37, x483, x36 * x482)),
-        );
-        let x495 = Self::mul_add(
-            x473,
-            x475,
-            Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
-                + Self::mul_add(0.4, x462, x415 + Self::mul_add(x47, x414, x46 * x413))
-                + (Self::mul_add(-x35, x481, x34 * x480)
-                    + Self::mul_add(-x37, x486, x36 * x485)),
-        );
-        let x496 = Self::mul_add(x473, x468 * x472, x471);
-        let x497 = Self::mul_add(
-            x473,
-            x476,
-            Self::mul_add(-x28, x44, x38 * x43) + x462
-                + (Self::mul_add(-x35, x485, x34 * x482)
-                    + Self::mul_add(-x37, x489, x36 * x488)),
-        );
-        let x498 = Self::mul_add(
-            x473,
-            x477,
-            Self::mul_add(-x38, x42, x27 * x44) + x463
-                + (Self::mul_add(-x35, x486, x34 * x483)
-                    + Self::mul_add(-x37, x491, x36 * x489)),
-        );
-        let x499 = Self::mul_add(
-            x473,
-            x478,
-            Self::mul_add(-x27, x43, x28 * x42) + x464
-                + (Self::mul_add(-x35, x487, x34 * x484)
-                    + Self::mul_add(-x37, x492, x36 * x490)),
-        );
-        let x500 = c_q8 * x480;
-        let x501 = Self::mul_add(s_q8, x479, x500);
-        let x502 = s_q8 * x480;
-        let x503 = Self::mul_add(-c_q8, x479, x502);
-        let x504 = Self::mul_add(c_q8, x481, x502);
-        let x505 = Self::mul_add(s_q8, x481, -x500);
-        let x506 = x484 + Self::mul_add(-x26, x483, x25 * x482);
-        let x507 = Self::mul_add(c_q8, x483, s_q8 * x482);
+        let x495 = Self::mul_add(-x481, x489, -111.7548902508081 + x472);
+        let x496 = Self::mul_add(-x480, x490, x439 + (x463 - x462));
+        let x497 = Self::mul_add(-x480, x491, x464);
+        let x498 = Self::mul_add(-x480, x492, -12.701650001451807 + x465);
+        let x499 = Self::mul_add(-x481, x490, x466);
+        let x500 = Self::mul_add(-x481, x491, x467);
+        let x501 = Self::mul_add(-x481, x492, 0.000000008530897668050218 + x468);
+        let x502 = Self::mul_add(-x483, x490, x455);
+        let x503 = Self::mul_add(-x483, x491, x456);
+        let x504 = Self::mul_add(-x483, x492, x458);
+        let x505 = Self::mul_add(-x484, x491, x459);
+        let x506 = Self::mul_add(-x484, x492, x460);
+        let x507 = Self::mul_add(x471, x492, x461);
         let x508 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x484,
-            Self::mul_add(-c_q8, x482, s_q8 * x483),
-        );
-        let x509 = x487 + Self::mul_add(-x26, x486, x25 * x485);
-        let x510 = Self::mul_add(c_q8, x486, s_q8 * x485);
-        let x511 = Self::mul_add(
-            -0.00000000020510342851533115,
             x487,
-            Self::mul_add(-c_q8, x485, s_q8 * x486),
+            x488,
+            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
+                + (Self::mul_add(c_q9, x420, s_q9 * x419) + x479
+                    + Self::mul_add(-0.4, x477, 0.275 * x478))
+                + (Self::mul_add(-x35, x494, x34 * x493)
+                    + Self::mul_add(-x37, x497, x36 * x496)),
         );
-        let x512 = Self::mul_add(-x26, x509, x25 * x506);
-        let x513 = Self::mul_add(-x26, x510, x25 * x507);
-        let x514 = Self::mul_add(c_q8, x509, s_q8 * x506);
-        let x515 = Self::mul_add(-c_q8, x506, s_q8 * x509);
-        let x516 = Self::mul_add(-c_q8, x507, s_q8 * x510);
-        let x517 = Self::mul_add(-c_q8, x508, s_q8 * x511);
-        let x518 = c_q8 * x489;
-        let x519 = Self::mul_add(s_q8, x488, x518);
-        let x520 = s_q8 * x489;
-        let x521 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x509 = Self::mul_add(
+            x487,
+            x489,
+            Self::mul_add(x31, x44, x33 * x42) - Self::mul_add(x27, x41, x38 * x39)
+                + Self::mul_add(0.4, x476, x421 + Self::mul_add(-x49, x420, x48 * x419))
+                + (Self::mul_add(-x35, x495, x34 * x494)
+                    + Self::mul_add(-x37, x500, x36 * x499)),
+        );
+        let x510 = Self::mul_add(x487, x482 * x486, x485);
+        let x511 = Self::mul_add(
+            x487,
             x490,
-            Self::mul_add(-c_q8, x488, x520),
+            Self::mul_add(-x28, x44, x38 * x43) + x476
+                + (Self::mul_add(-x35, x499, x34 * x496)
+                    + Self::mul_add(-x37, x503, x36 * x502)),
         );
-        let x522 = Self::mul_add(c_q8, x491, x520);
-        let x523 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x512 = Self::mul_add(
+            x487,
+            x491,
+            Self::mul_add(x27, x44, x38 * x42) + x477
+                + (Self::mul_add(-x35, x500, x34 * x497)
+                    + Self::mul_add(-x37, x505, x36 * x503)),
+        );
+        let x513 = Self::mul_add(
+            x487,
             x492,
-            Self::mul_add(s_q8, x491, -x518),
+            x478 - Self::mul_add(x27, x43, x28 * x42)
+                + (Self::mul_add(-x35, x501, x34 * x498)
+                    + Self::mul_add(-x37, x506, x36 * x504)),
         );
-        let x524 = Self::mul_add(
+        let x514 = c_q8 * x494;
+        let x515 = Self::mul_add(s_q8, x493, x514);
+        let x516 = s_q8 * x494;
+        let x517 = Self::mul_add(-c_q8, x493, x516);
+        let x518 = Self::mul_add(c_q8, x495, x516);
+        let x519 = Self::mul_add(s_q8, x495, -x514);
+        let x520 = x498 + Self::mul_add(-x25, x496, x26 * x497);
+        let x521 = Self::mul_add(c_q8, x497, s_q8 * x496);
+        let x522 = Self::mul_add(
             -0.00000000020510342851533115,
-            x493,
-            Self::mul_add(-c_q8, x490, s_q8 * x492),
+            x498,
+            Self::mul_add(-c_q8, x496, s_q8 * x497),
         );
-        let x525 = x493 + Self::mul_add(-x26, x492, x25 * x490)
+        let x523 = x501 + Self::mul_add(-x25, x499, x26 * x500);
+        let x524 = Self::mul_add(c_q8, x500, s_q8 * x499);
+        let x525 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x501,
+            Self::mul_add(-c_q8, x499, s_q8 * x500),
+        );
+        let x526 = Self::mul_add(-x25, x520, x26 * x523);
+        let x527 = Self::mul_add(-x25, x521, x26 * x524);
+        let x528 = Self::mul_add(c_q8, x523, s_q8 * x520);
+        let x529 = Self::mul_add(-c_q8, x520, s_q8 * x523);
+        let x530 = Self::mul_add(-c_q8, x521, s_q8 * x524);
+        let x531 = Self::mul_add(-c_q8, x522, s_q8 * x525);
+        let x532 = c_q8 * x503;
+        let x533 = Self::mul_add(s_q8, x502, x532);
+        let x534 = s_q8 * x503;
+        let x535 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x504,
+            Self::mul_add(-c_q8, x502, x534),
+        );
+        let x536 = Self::mul_add(c_q8, x505, x534);
+        let x537 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x506,
+            Self::mul_add(s_q8, x505, -x532),
+        );
+        let x538 = Self::mul_add(
+            0.00000000020510342851533115,
+            x507,
+            Self::mul_add(-c_q8, x504, s_q8 * x506),
+        );
+        let x539 = Self::mul_add(-x25, x504, x26 * x506) - x507
             + Self::mul_add(
-                -x26,
-                x492 + Self::mul_add(-x26, x491, x25 * x489),
-                x25 * (x490 + Self::mul_add(-x26, x489, x25 * x488)),
+                -x25,
+                x504 + Self::mul_add(-x25, x502, x26 * x503),
+                x26 * (x506 + Self::mul_add(-x25, x503, x26 * x505)),
             );
-        let x526 = Self::mul_add(c_q8, x492, s_q8 * x490)
-            + Self::mul_add(-x26, x522, x25 * x519);
-        let x527 = x524 + Self::mul_add(-x26, x523, x25 * x521);
-        let x528 = Self::mul_add(c_q8, x522, s_q8 * x519);
-        let x529 = Self::mul_add(c_q8, x523, s_q8 * x521);
-        let x530 = Self::mul_add(-0.35, x528, x513);
-        let x531 = Self::mul_add(0.35, x525, x514);
-        let x532 = Self::mul_add(0.35, x526, Self::mul_add(c_q8, x510, s_q8 * x507));
-        let x533 = Self::mul_add(
+        let x540 = Self::mul_add(c_q8, x506, s_q8 * x504)
+            + Self::mul_add(-x25, x533, x26 * x536);
+        let x541 = x538 + Self::mul_add(-x25, x535, x26 * x537);
+        let x542 = Self::mul_add(c_q8, x536, s_q8 * x533);
+        let x543 = Self::mul_add(c_q8, x537, s_q8 * x535);
+        let x544 = 0.35 * x540;
+        let x545 = Self::mul_add(-0.35, x542, x527);
+        let x546 = Self::mul_add(0.35, x539, x528);
+        let x547 = Self::mul_add(c_q8, x524, s_q8 * x521) + x544;
+        let x548 = Self::mul_add(
             -0.35,
-            x530,
+            x545,
             Self::mul_add(
-                -x26,
-                Self::mul_add(-x26, x481, x25 * x480),
-                x25 * Self::mul_add(-x26, x480, x25 * x479),
+                -x25,
+                Self::mul_add(-x25, x493, x26 * x494),
+                x26 * Self::mul_add(-x25, x494, x26 * x495),
             ),
         );
-        let x534 = Self::mul_add(
+        let x549 = Self::mul_add(
             0.35,
-            x512,
-            Self::mul_add(-0.35, x532, Self::mul_add(-x26, x504, x25 * x501)),
+            x526,
+            Self::mul_add(-0.35, x547, Self::mul_add(-x25, x515, x26 * x518)),
         );
-        let x535 = Self::mul_add(
+        let x550 = Self::mul_add(
             0.35,
-            x514,
-            Self::mul_add(0.35, x531, Self::mul_add(c_q8, x504, s_q8 * x501)),
+            x528,
+            Self::mul_add(0.35, x546, Self::mul_add(c_q8, x518, s_q8 * x515)),
         );
-        let x536 = x499 + Self::mul_add(-x26, x498, x25 * x497);
-        let x537 = Self::mul_add(c_q8, x498, s_q8 * x497);
-        let x538 = -16.80768997608804
-            + Self::mul_add(-0.35, x516, Self::mul_add(-x26, x505, x25 * x503));
-        let x539 = 0.1132
-            + Self::mul_add(0.35, x515, Self::mul_add(c_q8, x505, s_q8 * x503));
-        let x540 = 132.47349025763282 + Self::mul_add(-c_q8, x503, s_q8 * x505);
-        let x541 = 48.0240000085309 + x516;
-        let x542 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
+        let x551 = x513 + Self::mul_add(-x25, x511, x26 * x512);
+        let x552 = Self::mul_add(c_q8, x512, s_q8 * x511);
+        let x553 = -16.80768997608804
+            + Self::mul_add(-0.35, x530, Self::mul_add(-x25, x517, x26 * x519));
+        let x554 = 0.1132
+            + Self::mul_add(0.35, x529, Self::mul_add(c_q8, x519, s_q8 * x517));
+        let x555 = 132.47349025763282 + Self::mul_add(-c_q8, x517, s_q8 * x519);
+        let x556 = 48.0240000085309 + x530;
+        let x557 = Self::mul_add(x12, x22, Self::mul_add(x7, x20, x8 * x19))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x496,
-                Self::mul_add(-c_q8, x494, s_q8 * x495),
+                x510,
+                Self::mul_add(-c_q8, x508, s_q8 * x509),
             );
-        let x543 = Self::mul_add(
-            -x7,
+        let x558 = Self::mul_add(
+            x7,
             x22,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x499,
-                Self::mul_add(-c_q8, x497, s_q8 * x498),
+                x513,
+                Self::mul_add(-c_q8, x511, s_q8 * x512),
             ),
         );
-        let x544 = 1.0 / x540;
-        let x545 = tau[0] - x542;
-        let x546 = x538 * x544;
-        let x547 = x539 * x544;
-        let x548 = x515 * x544;
-        let x549 = x541 * x544;
-        let x550 = x517 * x544;
-        let x551 = Self::mul_add(-x538, x546, Self::mul_add(-0.35, x513, x533));
-        let x552 = Self::mul_add(-x538, x547, -0.07309 + x534);
-        let x553 = Self::mul_add(-x539, x547, 130.43769025763282 + x535);
-        let x554 = Self::mul_add(-x538, x548, Self::mul_add(-0.35, x526, x512));
-        let x555 = Self::mul_add(-x538, x549, x530);
-        let x556 = Self::mul_add(
-            -x538,
-            x550,
-            Self::mul_add(-0.35, x529, Self::mul_add(-x26, x511, x25 * x508)),
+        let x559 = 1.0 / x555;
+        let x560 = tau[0] - x557;
+        let x561 = x553 * x559;
+        let x562 = x554 * x559;
+        let x563 = x529 * x559;
+        let x564 = x556 * x559;
+        let x565 = x531 * x559;
+        let x566 = Self::mul_add(-x553, x561, Self::mul_add(-0.35, x527, x548));
+        let x567 = Self::mul_add(-x553, x562, -0.07309 + x549);
+        let x568 = Self::mul_add(-x554, x562, 130.43769025763282 + x550);
+        let x569 = Self::mul_add(-x553, x563, x526 - x544);
+        let x570 = Self::mul_add(-x553, x564, x545);
+        let x571 = Self::mul_add(
+            -x553,
+            x565,
+            Self::mul_add(-0.35, x543, Self::mul_add(-x25, x522, x26 * x525)),
         );
-        let x557 = Self::mul_add(-x539, x548, x531);
-        let x558 = Self::mul_add(-x539, x549, x532);
-        let x559 = Self::mul_add(
-            -x539,
-            x550,
+        let x572 = Self::mul_add(-x554, x563, x546);
+        let x573 = Self::mul_add(-x554, x564, x547);
+        let x574 = Self::mul_add(
+            -x554,
+            x565,
             -48.0240000085309
-                + Self::mul_add(0.35, x527, Self::mul_add(c_q8, x511, s_q8 * x508)),
+                + Self::mul_add(0.35, x541, Self::mul_add(c_q8, x525, s_q8 * x522)),
         );
-        let x560 = Self::mul_add(-x515, x548, x525);
-        let x561 = Self::mul_add(-x515, x549, x526);
-        let x562 = Self::mul_add(-x515, x550, x527);
-        let x563 = Self::mul_add(-x541, x549, x528);
-        let x564 = Self::mul_add(-x541, x550, x529);
-        let x565 = Self::mul_add(
-            -x517,
-            x550,
+        let x575 = Self::mul_add(-x529, x563, x539);
+        let x576 = Self::mul_add(-x529, x564, x540);
+        let x577 = Self::mul_add(-x529, x565, x541);
+        let x578 = Self::mul_add(-x556, x564, x542);
+        let x579 = Self::mul_add(-x556, x565, x543);
+        let x580 = Self::mul_add(
+            -x531,
+            x565,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x524,
-                Self::mul_add(-c_q8, x521, s_q8 * x523),
+                x538,
+                Self::mul_add(-c_q8, x535, s_q8 * x537),
             ),
         );
-        let x566 = Self::mul_add(
-            x545,
-            x546,
-            Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
+        let x581 = Self::mul_add(
+            x560,
+            x561,
+            Self::mul_add(-x18, x20, x8 * x21) - Self::mul_add(x13, x23, x11 * x22)
                 + Self::mul_add(
                     -0.35,
-                    x537,
-                    x496 + Self::mul_add(-x26, x495, x25 * x494),
+                    x552,
+                    x510 + Self::mul_add(-x25, x508, x26 * x509),
                 )
-                + (Self::mul_add(-x15, x552, x14 * x551)
-                    + Self::mul_add(-x17, x555, x16 * x554)),
+                + (Self::mul_add(-x15, x567, x14 * x566)
+                    + Self::mul_add(-x17, x570, x16 * x569)),
         );
-        let x567 = Self::mul_add(
-            x545,
-            x547,
-            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19))
-                + Self::mul_add(0.35, x536, Self::mul_add(c_q8, x495, s_q8 * x494))
-                + (Self::mul_add(-x15, x553, x14 * x552)
-                    + Self::mul_add(-x17, x558, x16 * x557)),
+        let x582 = Self::mul_add(
+            x560,
+            x562,
+            Self::mul_add(x12, x23, -Self::mul_add(x7, x21, x18 * x19))
+                + Self::mul_add(0.35, x551, Self::mul_add(c_q8, x509, s_q8 * x508))
+                + (Self::mul_add(-x15, x568, x14 * x567)
+                    + Self::mul_add(-x17, x573, x16 * x572)),
         );
-        let x568 = Self::mul_add(
-            x545,
-            x548,
-            Self::mul_add(-x8, x23, x18 * x22) + x536
-                + (Self::mul_add(-x15, x557, x14 * x554)
-                    + Self::mul_add(-x17, x561, x16 * x560)),
+        let x583 = Self::mul_add(
+            x560,
+            x563,
+            x551 - Self::mul_add(x8, x23, x18 * x22)
+                + (Self::mul_add(-x15, x572, x14 * x569)
+                    + Self::mul_add(-x17, x576, x16 * x575)),
         );
-        let x569 = Self::mul_add(
-            x545,
-            x549,
-            Self::mul_add(x7, x23, x537)
-                + (Self::mul_add(-x15, x558, x14 * x555)
-                    + Self::mul_add(-x17, x563, x16 * x561)),
+        let x584 = Self::mul_add(
+            x560,
+            x564,
+            Self::mul_add(x7, x23, x552)
+                + (Self::mul_add(-x15, x573, x14 * x570)
+                    + Self::mul_add(-x17, x578, x16 * x576)),
         );
-        let x570 = Self::mul_add(
-            x545,
-            x550,
-            x543
-                + (Self::mul_add(-x15, x559, x14 * x556)
-                    + Self::mul_add(-x17, x564, x16 * x562)),
+        let x585 = Self::mul_add(
+            x560,
+            x565,
+            x558
+                + (Self::mul_add(-x15, x574, x14 * x571)
+                    + Self::mul_add(-x17, x579, x16 * x577)),
         );
-        let x571 = s_q7 * x552;
-        let x572 = c_q7 * x552;
-        let x573 = Self::mul_add(s_q7, x551, x572);
-        let x574 = Self::mul_add(c_q7, x553, x571);
-        let x575 = Self::mul_add(-s_q7, x555, c_q7 * x554);
-        let x576 = Self::mul_add(c_q7, x555, s_q7 * x554);
-        let x577 = Self::mul_add(-s_q7, x558, c_q7 * x557);
-        let x578 = Self::mul_add(c_q7, x558, s_q7 * x557);
-        let x579 = Self::mul_add(-s_q7, x577, c_q7 * x575);
-        let x580 = Self::mul_add(-s_q7, x578, c_q7 * x576);
-        let x581 = Self::mul_add(-s_q7, x559, c_q7 * x556);
-        let x582 = Self::mul_add(c_q7, x577, s_q7 * x575);
-        let x583 = Self::mul_add(c_q7, x578, s_q7 * x576);
-        let x584 = Self::mul_add(c_q7, x559, s_q7 * x556);
-        let x585 = s_q7 * x561;
-        let x586 = c_q7 * x561;
-        let x587 = Self::mul_add(s_q7, x560, x586);
-        let x588 = Self::mul_add(c_q7, x563, x585);
-        let x589 = Self::mul_add(-s_q7, x564, c_q7 * x562);
-        let x590 = Self::mul_add(c_q7, x564, s_q7 * x562);
-        let x591 = Self::mul_add(
+        let x586 = s_q7 * x567;
+        let x587 = c_q7 * x567;
+        let x588 = Self::mul_add(s_q7, x566, x587);
+        let x589 = Self::mul_add(c_q7, x568, x586);
+        let x590 = Self::mul_add(-s_q7, x570, c_q7 * x569);
+        let x591 = Self::mul_add(c_q7, x570, s_q7 * x569);
+        let x592 = Self::mul_add(-s_q7, x573, c_q7 * x572);
+        let x593 = Self::mul_add(c_q7, x573, s_q7 * x572);
+        let x594 = Self::mul_add(-s_q7, x592, c_q7 * x590);
+        let x595 = Self::mul_add(-s_q7, x593, c_q7 * x591);
+        let x596 = Self::mul_add(-s_q7, x574, c_q7 * x571);
+        let x597 = Self::mul_add(c_q7, x592, s_q7 * x590);
+        let x598 = Self::mul_add(c_q7, x593, s_q7 * x591);
+        let x599 = Self::mul_add(c_q7, x574, s_q7 * x571);
+        let x600 = s_q7 * x576;
+        let x601 = c_q7 * x576;
+        let x602 = Self::mul_add(s_q7, x575, x601);
+        let x603 = Self::mul_add(c_q7, x578, x600);
+        let x604 = Self::mul_add(-s_q7, x579, c_q7 * x577);
+        let x605 = Self::mul_add(c_q7, x579, s_q7 * x577);
+        let x606 = Self::mul_add(
             -s_q7,
-            Self::mul_add(-s_q7, x563, x586),
-            c_q7 * Self::mul_add(c_q7, x560, -x585),
+            Self::mul_add(-s_q7, x578, x601),
+            c_q7 * Self::mul_add(c_q7, x575, -x600),
         );
-        let x592 = Self::mul_add(-s_q7, x588, c_q7 * x587);
-        let x593 = Self::mul_add(c_q7, x588, s_q7 * x587);
-        let x594 = 0.65 * x592;
-        let x595 = 0.65 * x593;
-        let x596 = 0.65 * x590;
-        let x597 = Self::mul_add(-0.75, x592, x579);
-        let x598 = Self::mul_add(-0.75, x593, x580);
-        let x599 = x582 + Self::mul_add(-0.65, x589, 0.75 * x591);
-        let x600 = x583 + Self::mul_add(-0.65, x590, 0.75 * x592);
-        let x601 = x584 + Self::mul_add(-0.65, x565, 0.75 * x589);
-        let x602 = Self::mul_add(
+        let x607 = Self::mul_add(-s_q7, x603, c_q7 * x602);
+        let x608 = Self::mul_add(c_q7, x603, s_q7 * x602);
+        let x609 = 0.75 * x607;
+        let x610 = 0.65 * x607;
+        let x611 = 0.65 * x605;
+        let x612 = 0.65 * x608;
+        let x613 = x594 - x609;
+        let x614 = Self::mul_add(-0.75, x608, x595);
+        let x615 = x597 + Self::mul_add(-0.65, x604, 0.75 * x606);
+        let x616 = x598 + (x609 - x611);
+        let x617 = x599 + Self::mul_add(-0.65, x580, 0.75 * x604);
+        let x618 = Self::mul_add(
             -0.75,
-            x598,
+            x614,
             Self::mul_add(
                 -s_q7,
-                Self::mul_add(-s_q7, x553, x572),
-                c_q7 * Self::mul_add(c_q7, x551, -x571),
+                Self::mul_add(-s_q7, x568, x587),
+                c_q7 * Self::mul_add(c_q7, x566, -x586),
             ),
         );
-        let x603 = Self::mul_add(-s_q7, x569, c_q7 * x568);
-        let x604 = Self::mul_add(c_q7, x569, s_q7 * x568);
-        let x605 = 180.9502499901501 + x599;
-        let x606 = Self::mul_add(-v[5], x4, v[4] * x5) + x603;
-        let x607 = 1.0 / (1170.07 + x591);
-        let x608 = x592 * x607;
-        let x609 = x589 * x607;
-        let x610 = x597 * x607;
-        let x611 = x605 * x607;
-        let x612 = x594 * x607;
-        let x613 = 1.0 / Self::mul_add(-x592, x608, 1170.07 + x593);
-        let x614 = Self::mul_add(-x592, x609, x590);
-        let x615 = x613 * x614;
-        let x616 = Self::mul_add(-x592, x610, -180.9502499901501 + x598);
-        let x617 = x613 * x616;
-        let x618 = Self::mul_add(-x592, x611, x600);
-        let x619 = x613 * x618;
-        let x620 = Self::mul_add(-x592, x612, 110.5455 + x595);
-        let x621 = x613 * x620;
-        let x622 = 1.0
-            / Self::mul_add(-x614, x615, Self::mul_add(-x589, x609, 1170.07 + x565));
-        let x623 = Self::mul_add(
-            -x614,
-            x617,
-            Self::mul_add(-x589, x610, Self::mul_add(-0.75, x590, x581)),
-        );
-        let x624 = x622 * x623;
-        let x625 = Self::mul_add(
-            -x614,
-            x619,
-            Self::mul_add(-x589, x611, -110.5455 + x601),
-        );
-        let x626 = x622 * x625;
-        let x627 = Self::mul_add(-x614, x621, Self::mul_add(-x589, x612, x596));
-        let x628 = x622 * x627;
-        let x629 = Self::mul_add(
-            -x616,
-            x617,
-            Self::mul_add(
-                -x597,
-                x610,
-                1394.5960312283303 + Self::mul_add(-0.75, x580, x602),
-            ),
-        );
-        let x630 = 1.0 / Self::mul_add(-x623, x624, x629);
-        let x631 = Self::mul_add(
-            -x597,
-            x611,
-            Self::mul_add(-0.65, x581, 0.75 * x579)
-                + Self::mul_add(-0.75, x600, Self::mul_add(-s_q7, x574, c_q7 * x573)),
-        );
-        let x632 = Self::mul_add(-x623, x626, Self::mul_add(-x616, x619, x631));
-        let x633 = x630 * x632;
-        let x634 = Self::mul_add(
-            -x616,
-            x621,
-            Self::mul_add(
-                -x597,
-                x612,
-                -117.61766249359756 + Self::mul_add(0.65, x580, -0.75 * x595),
-            ),
-        );
-        let x635 = Self::mul_add(-x623, x628, x634);
-        let x636 = x630 * x635;
-        let x637 = Self::mul_add(
-            -x618,
-            x619,
-            Self::mul_add(
-                -x605,
-                x611,
-                1466.4506062283303
-                    + (Self::mul_add(-0.65, x584, 0.75 * x582)
-                        + (Self::mul_add(c_q7, x574, s_q7 * x573)
-                            + Self::mul_add(-0.65, x601, 0.75 * x599))),
-            ),
-        );
-        let x638 = 1.0 / Self::mul_add(-x632, x633, Self::mul_add(-x625, x626, x637));
+        let x619 = Self::mul_add(-s_q7, x584, c_q7 * x583);
+        let x620 = Self::mul_add(c_q7, x584, s_q7 * x583);
+        let x621 = 180.9502499901501 + x615;
+        let x622 = Self::mul_add(-v[5], x4, v[4] * x5) + x619;
+        let x623 = 1.0 / (1170.07 + x606);
+        let x624 = x607 * x623;
+        let x625 = x604 * x623;
+        let x626 = x613 * x623;
+        let x627 = x621 * x623;
+        let x628 = x610 * x623;
+        let x629 = 1.0 / Self::mul_add(-x607, x624, 1170.07 + x608);
+        let x630 = Self::mul_add(-x607, x625, x605);
+        let x631 = x629 * x630;
+        let x632 = Self::mul_add(-x607, x626, -180.9502499901501 + x614);
+        let x633 = x629 * x632;
+        let x634 = Self::mul_add(-x607, x627, x616);
+        let x635 = x629 * x634;
+        let x636 = Self::mul_add(-x607, x628, 110.5455 + x612);
+        let x637 = x629 * x636;
+        let x638 = 1.0
+            / Self::mul_add(-x630, x631, Self::mul_add(-x604, x625, 1170.07 + x580));
         let x639 = Self::mul_add(
-            -x605,
-            x612,
-            Self::mul_add(0.65, x583, Self::mul_add(-0.65, x596, 0.75 * x594)),
+            -x630,
+            x633,
+            Self::mul_add(-x604, x626, Self::mul_add(-0.75, x605, x596)),
         );
-        let x640 = Self::mul_add(
-            -x632,
-            x636,
-            Self::mul_add(-x625, x628, Self::mul_add(-x618, x621, x639)),
+        let x640 = x638 * x639;
+        let x641 = Self::mul_add(
+            -x630,
+            x635,
+            Self::mul_add(-x604, x627, -110.5455 + x617),
         );
-        let x641 = x638 * x640;
-        let x642 = Self::mul_add(
-            -x620,
-            x621,
-            Self::mul_add(-x594, x612, Self::mul_add(0.65, x595, 1271.854575)),
-        );
-        let x643 = Self::mul_add(
-            -x640,
-            x641,
-            Self::mul_add(-x635, x636, Self::mul_add(-x627, x628, x642)),
-        );
-        let x644 = 1.0 / x643;
+        let x642 = x638 * x641;
+        let x643 = Self::mul_add(-x630, x637, Self::mul_add(-x604, x628, x611));
+        let x644 = x638 * x643;
         let x645 = Self::mul_add(
-            x606,
-            x608,
-            -(Self::mul_add(-v[3], x5, v[5] * x3) + x604),
-        );
-        let x646 = Self::mul_add(
-            -x615,
-            x645,
-            Self::mul_add(x606, x609, -(Self::mul_add(-v[4], x3, v[3] * x4) + x570)),
-        );
-        let x647 = Self::mul_add(
-            x606,
-            x610,
-            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
-                + Self::mul_add(-0.75, x604, Self::mul_add(-s_q7, x567, c_q7 * x566))),
-        );
-        let x648 = Self::mul_add(-x624, x646, Self::mul_add(-x617, x645, x647));
-        let x649 = Self::mul_add(
-            -x619,
-            x645,
+            -x632,
+            x633,
             Self::mul_add(
-                x606,
-                x611,
+                -x613,
+                x626,
+                1394.5960312283303 + Self::mul_add(-0.75, x595, x618),
+            ),
+        );
+        let x646 = 1.0 / Self::mul_add(-x639, x640, x645);
+        let x647 = Self::mul_add(
+            -x613,
+            x627,
+            Self::mul_add(-0.65, x596, 0.75 * x594)
+                + Self::mul_add(-0.75, x616, Self::mul_add(-s_q7, x589, c_q7 * x588)),
+        );
+        let x648 = Self::mul_add(-x639, x642, Self::mul_add(-x632, x635, x647));
+        let x649 = x646 * x648;
+        let x650 = Self::mul_add(
+            -x632,
+            x637,
+            Self::mul_add(
+                -x613,
+                x628,
+                -117.61766249359756 + Self::mul_add(-0.75, x612, 0.65 * x595),
+            ),
+        );
+        let x651 = Self::mul_add(-x639, x644, x650);
+        let x652 = x646 * x651;
+        let x653 = Self::mul_add(
+            -x634,
+            x635,
+            Self::mul_add(
+                -x621,
+                x627,
+                1466.4506062283303
+                    + (Self::mul_add(-0.65, x599, 0.75 * x597)
+                        + (Self::mul_add(c_q7, x589, s_q7 * x588)
+                            + Self::mul_add(-0.65, x617, 0.75 * x615))),
+            ),
+        );
+        let x654 = 1.0 / Self::mul_add(-x648, x649, Self::mul_add(-x641, x642, x653));
+        let x655 = Self::mul_add(
+            -x621,
+            x628,
+            Self::mul_add(0.65, x598, Self::mul_add(-0.65, x611, 0.75 * x610)),
+        );
+        let x656 = Self::mul_add(
+            -x648,
+            x652,
+            Self::mul_add(-x641, x644, Self::mul_add(-x634, x637, x655)),
+        );
+        let x657 = x654 * x656;
+        let x658 = Self::mul_add(
+            -x636,
+            x637,
+            Self::mul_add(-x610, x628, Self::mul_add(0.65, x612, 1271.854575)),
+        );
+        let x659 = Self::mul_add(
+            -x656,
+            x657,
+            Self::mul_add(-x651, x652, Self::mul_add(-x643, x644, x658)),
+        );
+        let x660 = 1.0 / x659;
+        let x661 = Self::mul_add(
+            x622,
+            x624,
+            -(Self::mul_add(-v[3], x5, v[5] * x3) + x620),
+        );
+        let x662 = Self::mul_add(
+            -x631,
+            x661,
+            Self::mul_add(x622, x625, -(Self::mul_add(-v[4], x3, v[3] * x4) + x585)),
+        );
+        let x663 = Self::mul_add(
+            x622,
+            x626,
+            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
+                + Self::mul_add(-0.75, x620, Self::mul_add(-s_q7, x582, c_q7 * x581))),
+        );
+        let x664 = Self::mul_add(-x640, x662, Self::mul_add(-x633, x661, x663));
+        let x665 = Self::mul_add(
+            -x635,
+            x661,
+            Self::mul_add(
+                x622,
+                x627,
                 -(Self::mul_add(-v[3], x2, v[5] * x0)
                     + Self::mul_add(-v[0], x5, v[2] * x3)
-                    + (Self::mul_add(c_q7, x567, s_q7 * x566)
-                        + Self::mul_add(-0.65, x570, 0.75 * x603))),
+                    + (Self::mul_add(c_q7, x582, s_q7 * x581)
+                        + Self::mul_add(-0.65, x585, 0.75 * x619))),
             ),
         );
-        let x650 = Self::mul_add(-x633, x648, Self::mul_add(-x626, x646, x649));
-        let x651 = Self::mul_add(
-            x606,
-            x612,
+        let x666 = Self::mul_add(-x649, x664, Self::mul_add(-x642, x662, x665));
+        let x667 = Self::mul_add(
+            x622,
+            x628,
             -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
-                + Self::mul_add(0.65, x604, Self::mul_add(x545, x540 * x544, x542))),
+                + Self::mul_add(0.65, x620, Self::mul_add(x560, x555 * x559, x557))),
         );
-        let x652 = Self::mul_add(
-            -x636,
-            x648,
-            Self::mul_add(-x628, x646, Self::mul_add(-x621, x645, x651)),
+        let x668 = Self::mul_add(
+            -x652,
+            x664,
+            Self::mul_add(-x644, x662, Self::mul_add(-x637, x661, x667)),
         );
-        let x653 = x644 * Self::mul_add(-x641, x650, x652);
-        let x654 = Self::mul_add(-x641, x653, x638 * x650);
-        let x655 = Self::mul_add(-x636, x653, Self::mul_add(-x633, x654, x630 * x648));
-        let x656 = Self::mul_add(
-            -x628,
-            x653,
-            Self::mul_add(-x626, x654, Self::mul_add(-x624, x655, x622 * x646)),
+        let x669 = x660 * Self::mul_add(-x657, x666, x668);
+        let x670 = Self::mul_add(-x657, x669, x654 * x666);
+        let x671 = Self::mul_add(-x652, x669, Self::mul_add(-x649, x670, x646 * x664));
+        let x672 = Self::mul_add(
+            -x644,
+            x669,
+            Self::mul_add(-x642, x670, Self::mul_add(-x640, x671, x638 * x662)),
         );
-        let x657 = Self::mul_add(
-            -x619,
-            x654,
-            Self::mul_add(-x617, x655, Self::mul_add(-x615, x656, x613 * x645)),
+        let x673 = Self::mul_add(
+            -x635,
+            x670,
+            Self::mul_add(-x633, x671, Self::mul_add(-x631, x672, x629 * x661)),
         );
-        let x658 = Self::mul_add(-x621, x653, x657);
-        let x659 = Self::mul_add(
-            x610,
-            x655,
-            Self::mul_add(x609, x656, Self::mul_add(x608, x658, x606 * x607)),
+        let x674 = Self::mul_add(-x637, x669, x673);
+        let x675 = Self::mul_add(
+            x626,
+            x671,
+            Self::mul_add(x625, x672, Self::mul_add(x624, x674, x622 * x623)),
         );
-        let x660 = Self::mul_add(x612, x653, Self::mul_add(x611, x654, x659));
-        let x661 = -x660;
-        let x662 = Self::mul_add(-0.75, x654, x660);
-        let x663 = x658 - Self::mul_add(-0.65, x653, 0.75 * x655);
-        let x664 = Self::mul_add(-0.65, x654, x656);
-        let x665 = x14 + Self::mul_add(s_q7, x654, c_q7 * x655);
-        let x666 = Self::mul_add(-s_q7, x655, c_q7 * x654) - x15;
-        let x667 = x16 + Self::mul_add(-c_q7, x662, s_q7 * x663);
-        let x668 = Self::mul_add(c_q7, x663, s_q7 * x662) - x17;
-        let x669 = x544
-            * (x545
-                - (Self::mul_add(x540, x653, Self::mul_add(x539, x666, x538 * x665))
+        let x676 = Self::mul_add(x628, x669, Self::mul_add(x627, x670, x675));
+        let x677 = -x676;
+        let x678 = Self::mul_add(0.75, x670, -x676);
+        let x679 = x674 - Self::mul_add(-0.65, x669, 0.75 * x671);
+        let x680 = Self::mul_add(-0.65, x670, x672);
+        let x681 = x14 + Self::mul_add(s_q7, x670, c_q7 * x671);
+        let x682 = Self::mul_add(-s_q7, x671, c_q7 * x670) - x15;
+        let x683 = x16 + Self::mul_add(s_q7, x679, c_q7 * x678);
+        let x684 = Self::mul_add(-s_q7, x678, c_q7 * x679) - x17;
+        let x685 = x559
+            * (x560
+                - (Self::mul_add(x555, x669, Self::mul_add(x554, x682, x553 * x681))
                     + Self::mul_add(
-                        x517,
-                        x664,
-                        Self::mul_add(x541, x668, x515 * x667),
+                        x531,
+                        x680,
+                        Self::mul_add(x556, x684, x529 * x683),
                     )));
-        let x670 = x653 + x669;
-        let x671 = Self::mul_add(-0.00000000020510342851533115, x670, x665);
-        let x672 = Self::mul_add(0.35, x666, x667);
-        let x673 = Self::mul_add(-0.35, x665, x668);
-        let x674 = Self::mul_add(-0.00000000020510342851533115, x664, x672);
-        let x675 = x34
-            + Self::mul_add(-c_q8, x670, Self::mul_add(s_q8, x666, x25 * x665));
-        let x676 = Self::mul_add(s_q8, x670, Self::mul_add(-x26, x665, c_q8 * x666))
+        let x686 = x669 + x685;
+        let x687 = Self::mul_add(-0.00000000020510342851533115, x686, x681);
+        let x688 = Self::mul_add(0.35, x682, x683);
+        let x689 = Self::mul_add(-0.35, x681, x684);
+        let x690 = Self::mul_add(-0.00000000020510342851533115, x680, x688);
+        let x691 = x34
+            + Self::mul_add(-c_q8, x686, Self::mul_add(-x25, x681, s_q8 * x682));
+        let x692 = Self::mul_add(s_q8, x686, Self::mul_add(c_q8, x682, x26 * x681))
             - x35;
-        let x677 = x36
-            + Self::mul_add(-c_q8, x664, Self::mul_add(s_q8, x673, x25 * x672));
-        let x678 = Self::mul_add(s_q8, x664, Self::mul_add(-x26, x672, c_q8 * x673))
+        let x693 = x36
+            + Self::mul_add(-c_q8, x680, Self::mul_add(-x25, x688, s_q8 * x689));
+        let x694 = Self::mul_add(s_q8, x680, Self::mul_add(c_q8, x689, x26 * x688))
             - x37;
-        let x679 = x472
-            * (x473
-                - (Self::mul_add(x468, x671, Self::mul_add(x467, x676, x466 * x675))
+        let x695 = x486
+            * (x487
+                - (Self::mul_add(x482, x687, Self::mul_add(x481, x692, x480 * x691))
                     + Self::mul_add(
-                        x458,
-                        x674,
-                        Self::mul_add(x470, x678, x469 * x677),
+                        x471,
+                        x690,
+                        Self::mul_add(x484, x694, x483 * x693),
                     )));
-        let x680 = x671 + x679;
-        let x681 = Self::mul_add(
+        let x696 = x687 + x695;
+        let x697 = Self::mul_add(
             -0.00000000020510342851533115,
-            x680,
-            Self::mul_add(0.00000000020510342851533115, x675, x676),
+            x696,
+            Self::mul_add(0.00000000020510342851533115, x691, x692),
         );
-        let x682 = x677 - Self::mul_add(0.275, x680, -0.4 * x676);
-        let x683 = Self::mul_add(-0.4, x675, x678);
-        let x684 = Self::mul_add(0.275, x675, x674);
-        let x685 = Self::mul_add(
+        let x698 = x693 - Self::mul_add(-0.4, x692, 0.275 * x696);
+        let x699 = Self::mul_add(-0.4, x691, x694);
+        let x700 = Self::mul_add(0.275, x691, x690);
+        let x701 = Self::mul_add(
             -0.00000000020510342851533115,
-            x684,
-            Self::mul_add(0.00000000020510342851533115, x682, x683),
+            x700,
+            Self::mul_add(0.00000000020510342851533115, x698, x699),
         );
-        let x686 = x56
-            + Self::mul_add(c_q9, x680, Self::mul_add(x46, x676, s_q9 * x675));
-        let x687 = Self::mul_add(-s_q9, x680, Self::mul_add(x47, x676, c_q9 * x675))
-            - x57;
-        let x688 = x58
-            + Self::mul_add(c_q9, x684, Self::mul_add(x46, x683, s_q9 * x682));
-        let x689 = Self::mul_add(-s_q9, x684, Self::mul_add(x47, x683, c_q9 * x682))
+        let x702 = x58
+            + Self::mul_add(c_q9, x696, Self::mul_add(x48, x692, s_q9 * x691));
+        let x703 = Self::mul_add(-s_q9, x696, Self::mul_add(-x49, x692, c_q9 * x691))
             - x59;
-        let x690 = x391
-            * (x392
-                - (Self::mul_add(x388, x681, Self::mul_add(x387, x687, x386 * x686))
+        let x704 = x60
+            + Self::mul_add(c_q9, x700, Self::mul_add(x48, x699, s_q9 * x698));
+        let x705 = Self::mul_add(-s_q9, x700, Self::mul_add(-x49, x699, c_q9 * x698))
+            - x61;
+        let x706 = x397
+            * (x398
+                - (Self::mul_add(x394, x697, Self::mul_add(x393, x703, x392 * x702))
                     + Self::mul_add(
-                        x382,
-                        x685,
-                        Self::mul_add(x381, x689, x389 * x688),
+                        x386,
+                        x701,
+                        Self::mul_add(x388, x705, x395 * x704),
                     )));
-        let x691 = x681 + x690;
-        let x692 = Self::mul_add(0.87, x691, x688);
-        let x693 = Self::mul_add(-0.87, x686, x685);
-        let x694 = x73 + Self::mul_add(s_q10, x687, c_q10 * x686);
-        let x695 = Self::mul_add(-s_q10, x686, c_q10 * x687) - x74;
-        let x696 = x75 + Self::mul_add(s_q10, x689, c_q10 * x692);
-        let x697 = Self::mul_add(-s_q10, x692, c_q10 * x689) - x76;
-        let x698 = x333
-            * (x334
-                - (Self::mul_add(x330, x691, Self::mul_add(x329, x695, x328 * x694))
+        let x707 = x697 + x706;
+        let x708 = Self::mul_add(0.87, x707, x704);
+        let x709 = Self::mul_add(-0.87, x702, x701);
+        let x710 = x75 + Self::mul_add(s_q10, x703, c_q10 * x702);
+        let x711 = Self::mul_add(-s_q10, x702, c_q10 * x703) - x76;
+        let x712 = x77 + Self::mul_add(s_q10, x705, c_q10 * x708);
+        let x713 = Self::mul_add(-s_q10, x708, c_q10 * x705) - x78;
+        let x714 = x339
+            * (x340
+                - (Self::mul_add(x336, x707, Self::mul_add(x335, x711, x334 * x710))
                     + Self::mul_add(
-                        x319,
-                        x693,
-                        Self::mul_add(x318, x697, x331 * x696),
+                        x323,
+                        x709,
+                        Self::mul_add(x325, x713, x337 * x712),
                     )));
-        let x699 = x691 + x698;
-        let x700 = x696 - Self::mul_add(-0.63, x699, 0.275 * x695);
-        let x701 = Self::mul_add(0.275, x694, x697);
-        let x702 = Self::mul_add(-0.63, x694, x693);
-        let x703 = x91 + Self::mul_add(s_q11, x695, c_q11 * x694);
-        let x704 = Self::mul_add(-s_q11, x694, c_q11 * x695) - x92;
-        let x705 = x93 + Self::mul_add(s_q11, x701, c_q11 * x700);
-        let x706 = Self::mul_add(-s_q11, x700, c_q11 * x701) - x94;
-        let x707 = x269
-            * (x270
-                - (Self::mul_add(x265, x699, Self::mul_add(x264, x704, x263 * x703))
+        let x715 = x707 + x714;
+        let x716 = x712 - Self::mul_add(-0.63, x715, 0.275 * x711);
+        let x717 = Self::mul_add(0.275, x710, x713);
+        let x718 = Self::mul_add(-0.63, x710, x709);
+        let x719 = x93 + Self::mul_add(s_q11, x711, c_q11 * x710);
+        let x720 = Self::mul_add(-s_q11, x710, c_q11 * x711) - x94;
+        let x721 = x95 + Self::mul_add(s_q11, x717, c_q11 * x716);
+        let x722 = Self::mul_add(-s_q11, x716, c_q11 * x717) - x96;
+        let x723 = x274
+            * (x275
+                - (Self::mul_add(x270, x715, Self::mul_add(x269, x720, x268 * x719))
                     + Self::mul_add(
-                        -x242,
-                        x702,
-                        Self::mul_add(-x241, x706, x266 * x705),
+                        x246,
+                        x718,
+                        Self::mul_add(-x245, x722, x271 * x721),
                     )));
-        let x708 = x699 + x707;
-        let x709 = Self::mul_add(-0.00000000020510342851533115, x708, x704);
-        let x710 = Self::mul_add(-0.36, x704, x705);
-        let x711 = Self::mul_add(0.36, x703, x706);
-        let x712 = Self::mul_add(-0.00000000020510342851533115, x702, x711);
-        let x713 = x111
-            + Self::mul_add(-s_q12, x708, Self::mul_add(x102, x704, c_q12 * x703));
-        let x714 = Self::mul_add(-c_q12, x708, Self::mul_add(-s_q12, x703, x103 * x704))
-            - x112;
-        let x715 = x113
-            + Self::mul_add(-s_q12, x702, Self::mul_add(x102, x711, c_q12 * x710));
-        let x716 = Self::mul_add(-c_q12, x702, Self::mul_add(-s_q12, x710, x103 * x711))
-            - x114;
-        let x717 = x197
-            * (x198
-                - (Self::mul_add(x193, x709, Self::mul_add(x192, x714, x191 * x713))
+        let x724 = x715 + x723;
+        let x725 = Self::mul_add(-0.00000000020510342851533115, x724, x720);
+        let x726 = Self::mul_add(-0.36, x720, x721);
+        let x727 = Self::mul_add(0.36, x719, x722);
+        let x728 = Self::mul_add(-0.00000000020510342851533115, x718, x727);
+        let x729 = Self::mul_add(-s_q12, x724, Self::mul_add(-x104, x720, c_q12 * x719))
+            - x113;
+        let x730 = x114
+            + Self::mul_add(c_q12, x724, Self::mul_add(x105, x720, s_q12 * x719));
+        let x731 = Self::mul_add(-s_q12, x718, Self::mul_add(-x104, x727, c_q12 * x726))
+            - x115;
+        let x732 = x116
+            + Self::mul_add(c_q12, x718, Self::mul_add(x105, x727, s_q12 * x726));
+        let x733 = x201
+            * (x202
+                - (Self::mul_add(x197, x725, Self::mul_add(-x196, x730, x195 * x729))
                     + Self::mul_add(
-                        -x183,
-                        x712,
-                        Self::mul_add(x195, x716, x194 * x715),
+                        x187,
+                        x728,
+                        Self::mul_add(-x199, x732, x198 * x731),
                     )));
-        let x718 = x709 + x717;
-        let x719 = Self::mul_add(
-            -c_q13,
-            Self::mul_add(0.55, x713, x712),
+        let x734 = x725 + x733;
+        let x735 = Self::mul_add(
+            c_q13,
+            Self::mul_add(0.55, x729, x728),
             Self::mul_add(
                 s_q13,
-                Self::mul_add(-0.16, x713, x716),
-                x123 * (x715 - Self::mul_add(0.55, x718, -0.16 * x714)),
+                Self::mul_add(0.16, x729, x732),
+                x125 * (x731 - Self::mul_add(0.55, x734, 0.16 * x730)),
             ),
         );
-        let x720 = Self::mul_add(
-            -0.9614610000000001,
-            Self::mul_add(s_q13, x718, Self::mul_add(-x124, x713, c_q13 * x714)) - x134,
-            -0.0145
-                * (x133
-                    + Self::mul_add(
-                        -c_q13,
-                        x718,
-                        Self::mul_add(s_q13, x714, x123 * x713),
+        let x736 = Self::mul_add(
+            0.9614610000000001,
+            x136 + Self::mul_add(s_q13, x734, Self::mul_add(-c_q13, x730, x126 * x729)),
+            0.0145
+                * (x135
+                    - Self::mul_add(
+                        c_q13,
+                        x734,
+                        Self::mul_add(s_q13, x730, x125 * x729),
                     )),
         );
-        let x721 = Self::mul_add(
+        let x737 = Self::mul_add(
             -4.806620000000001,
-            x135 + x719,
+            x137 - x735,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x718, x713),
-                x720,
+                Self::mul_add(-0.00000000020510342851533115, x734, x729),
+                -x736,
             ),
         );
-        let x722 = 0.707433253035886 * (x144 - x721);
-        [x661, x658, x656, x655, x654, x653, x669, x679, x690, x698, x707, x717, x722]
+        let x738 = 0.707433253035886 * (x146 - x737);
+        [x677, x674, x672, x671, x670, x669, x685, x695, x706, x714, x723, x733, x738]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1120 mul, 943 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 669 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 1076 mul, 935 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 618 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -4644,1227 +4712,1104 @@ impl FreeFloating7 {
     ) -> ([[f64; 13]; 13], [f64; 13]) {
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x2 = -0.00000000020510342851533115 * c_q8;
-        let x3 = -0.00000000020510342851533115 * s_q8;
+        let x2 = 0.00000000020510342851533115 * c_q8;
+        let x3 = 0.00000000020510342851533115 * s_q8;
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x5 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
-        );
-        let x6 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
+        let x5 = 0.00000000020510342851533115 * c_q9;
+        let x6 = 0.00000000020510342851533115 * s_q9;
+        let x7 = x5 - x6;
+        let x8 = x5 + x6;
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let (s_q11, c_q11) = libm::sincos(q[11]);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x10 = -0.00000000020510342851533115 * s_q12;
-        let x11 = -0.00000000020510342851533115 * c_q12;
+        let x12 = 0.00000000020510342851533115 * s_q12;
+        let x13 = 0.00000000020510342851533115 * c_q12;
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x13 = -0.00000000020510342851533115 * c_q13;
-        let x14 = -0.00000000020510342851533115 * s_q13;
-        let x15 = 4.806620000000001 * x14;
-        let x16 = 4.806620000000001 * c_q13;
-        let x17 = 4.806620000000001 * s_q13;
-        let x18 = Self::mul_add(-0.000781, x14, -0.0145);
-        let x19 = -0.9614610000000001
-            + Self::mul_add(1.2025609200000003, x14, 0.000781 * x13);
-        let x20 = 1.4135609200000003
-            + Self::mul_add(0.9614610000000001, x14, -0.0145 * x13);
-        let x21 = 0.000781 * c_q13;
-        let x22 = 0.000781 * s_q13;
-        let x23 = Self::mul_add(-1.2025609200000003, c_q13, x22);
-        let x24 = Self::mul_add(-0.9614610000000001, c_q13, -0.0145 * s_q13);
-        let x25 = x22 + 0.000000000002973999713472302;
-        let x26 = Self::mul_add(-1.2025609200000003, s_q13, -x21)
-            + 0.00000000019719894748377882;
-        let x27 = Self::mul_add(0.0145, c_q13, -0.9614610000000001 * s_q13)
+        let x15 = 0.00000000020510342851533115 * c_q13;
+        let x16 = 0.00000000020510342851533115 * s_q13;
+        let x17 = 4.806620000000001 * x16;
+        let x18 = 4.806620000000001 * c_q13;
+        let x19 = 4.806620000000001 * s_q13;
+        let x20 = Self::mul_add(0.000781, x16, -0.0145);
+        let x21 = -0.9614610000000001
+            - Self::mul_add(x16, 1.2025609200000003, 0.000781 * x15);
+        let x22 = 1.4135609200000003
+            + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145);
+        let x23 = 0.000781 * c_q13;
+        let x24 = 0.000781 * s_q13;
+        let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
+        let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x27 = x24 + 0.000000000002973999713472302;
+        let x28 = 0.00000000019719894748377882
+            - Self::mul_add(s_q13, 1.2025609200000003, x23);
+        let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
             + -0.0000000002899261911072858;
-        let x28 = -0.16 * x17;
-        let x29 = 0.55 * x16;
-        let x30 = 0.16 * x17;
-        let x31 = x16 * -0.55;
-        let x32 = Self::mul_add(
-            0.16,
-            x15,
-            Self::mul_add(
+        let x30 = 0.16 * x19;
+        let x31 = 0.55 * x18;
+        let x32 = x30 + x31;
+        let x33 = 0.55 * x17;
+        let x34 = 0.16 * x17;
+        let x35 = 0.16 * x18;
+        let x36 = 0.55 * x19;
+        let x37 = x32 + (x22 + Self::mul_add(-x15, x20, x16 * x21) + x32);
+        let x38 = 3.6140000000000003 + x17;
+        let x39 = 17.135250000000003 + x18;
+        let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
+        let x41 = -0.809539999555672
+            + (Self::mul_add(
                 -0.00000000020510342851533115,
-                x20,
-                Self::mul_add(-c_q13, x18, s_q13 * x19),
-            ),
-        );
-        let x33 = Self::mul_add(
-            -0.16,
-            x16,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x24,
-                Self::mul_add(-c_q13, x21, s_q13 * x23),
-            ),
-        );
-        let x34 = x20 + Self::mul_add(-x14, x19, x13 * x18) - (x28 - x29) - (x31 - x30);
-        let x35 = Self::mul_add(
-            -0.16,
-            x16,
-            Self::mul_add(x17, -0.55, Self::mul_add(c_q13, x26, s_q13 * x25)),
-        );
-        let x36 = 3.6140000000000003 - x15;
-        let x37 = 17.135250000000003 + x16;
-        let x38 = -1.9877000000000002
-            + Self::mul_add(0.55, x15, Self::mul_add(c_q13, x19, s_q13 * x18));
-        let x39 = -0.809539999555672 + x32;
-        let x40 = -1.9877000000000002
-            + Self::mul_add(x15, 0.55, x24 + Self::mul_add(-x14, x23, x13 * x21));
-        let x41 = -5.252920330000002
-            + (Self::mul_add(c_q13, x23, s_q13 * x21) + x30 - x28);
-        let x42 = -2.741639999592316 + Self::mul_add(-0.55, x17, x33);
-        let x43 = -0.809539999555672
-            + Self::mul_add(0.16, x15, x27 + Self::mul_add(-x14, x26, x13 * x25));
-        let x44 = -2.7416399995923166 + x35;
-        let x45 = 9.740442170000001
-            + (x29
+                x22,
+                Self::mul_add(-c_q13, x20, s_q13 * x21),
+            ) - x34);
+        let x42 = -1.9877000000000002
+            + (Self::mul_add(-x15, x23, x16 * x25) - x26 - x33);
+        let x43 = -5.252920330000002
+            + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
+        let x44 = -2.741639999592316
+            + (Self::mul_add(
+                0.00000000020510342851533115,
+                x26,
+                Self::mul_add(-c_q13, x23, s_q13 * x25),
+            ) - x35 - x36);
+        let x45 = -0.809539999555672 + (x29 + Self::mul_add(-x15, x27, x16 * x28) - x34);
+        let x46 = -2.7416399995923166
+            + (Self::mul_add(c_q13, x28, s_q13 * x27) - x36 - x35);
+        let x47 = 9.740442170000001
+            + (x31
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
-                    x27,
-                    Self::mul_add(-c_q13, x25, s_q13 * x26),
-                ) - x31));
-        let x46 = c_q12 * x36;
-        let x47 = s_q12 * x37;
-        let x48 = x46 - x47;
-        let x49 = x17 + Self::mul_add(x11, x37, x10 * x36);
-        let x50 = Self::mul_add(c_q12, x37, s_q12 * x36);
-        let x51 = Self::mul_add(-0.00000000020510342851533115, x17, -x50);
-        let x52 = Self::mul_add(-s_q12, x40, c_q12 * x34);
-        let x53 = Self::mul_add(-s_q12, x41, c_q12 * x38);
-        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x39);
-        let x55 = x43 + Self::mul_add(x11, x40, x10 * x34);
-        let x56 = x44 + Self::mul_add(x11, x41, x10 * x38);
-        let x57 = x45 + Self::mul_add(x11, x42, x10 * x39);
-        let x58 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x45,
-            -Self::mul_add(c_q12, x42, s_q12 * x39),
-        );
-        let x59 = x54 + Self::mul_add(x11, x53, x10 * x52);
+                    x29,
+                    Self::mul_add(-c_q13, x27, s_q13 * x28),
+                ) + x31));
+        let x48 = c_q12 * x38;
+        let x49 = s_q12 * x39;
+        let x50 = x48 - x49;
+        let x51 = x19 - Self::mul_add(x13, x39, x12 * x38);
+        let x52 = Self::mul_add(c_q12, x39, s_q12 * x38);
+        let x53 = Self::mul_add(0.00000000020510342851533115, x19, x52);
+        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x37);
+        let x55 = Self::mul_add(-s_q12, x43, c_q12 * x40);
+        let x56 = Self::mul_add(-s_q12, x44, c_q12 * x41);
+        let x57 = x45 - Self::mul_add(x13, x42, x12 * x37);
+        let x58 = x46 - Self::mul_add(x13, x43, x12 * x40);
+        let x59 = x47 - Self::mul_add(x13, x44, x12 * x41);
         let x60 = Self::mul_add(
+            0.00000000020510342851533115,
+            x47,
+            Self::mul_add(c_q12, x44, s_q12 * x41),
+        );
+        let x61 = -x60;
+        let x62 = x56 - Self::mul_add(x13, x55, x12 * x54);
+        let x63 = Self::mul_add(
             c_q12,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x44,
-                -Self::mul_add(c_q12, x41, s_q12 * x38),
+                0.00000000020510342851533115,
+                x46,
+                Self::mul_add(c_q12, x43, s_q12 * x40),
             ),
             s_q12
                 * Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x43,
-                    -Self::mul_add(c_q12, x40, s_q12 * x34),
+                    0.00000000020510342851533115,
+                    x45,
+                    Self::mul_add(c_q12, x42, s_q12 * x37),
                 ),
         );
-        let x61 = x51 * 0.36;
-        let x62 = -0.36 * x51;
-        let x63 = Self::mul_add(
-            x48,
+        let x64 = x53 * 0.36;
+        let x65 = Self::mul_add(
+            x50,
             0.36,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x54,
-                -Self::mul_add(c_q12, x53, s_q12 * x52),
+            -Self::mul_add(
+                0.00000000020510342851533115,
+                x56,
+                Self::mul_add(c_q12, x55, s_q12 * x54),
             ),
         );
-        let x64 = Self::mul_add(
+        let x66 = Self::mul_add(
+            x51,
             0.36,
-            x49,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x57,
-                -Self::mul_add(c_q12, x56, s_q12 * x55),
-            ),
-        );
-        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) - x61);
-        let x66 = 7.078399999258757 + x49;
-        let x67 = 0.01675 + x63;
-        let x68 = -9.142025249762803
-            + (x57 + Self::mul_add(x11, x56, x10 * x55) + x62 - x61);
-        let x69 = 2.5482240016099564 + x64;
-        let x70 = 9.223235249762805
-            + Self::mul_add(-0.00000000020510342851533115, x58, -x60);
-        let x71 = s_q11 * s_q11;
-        let x72 = s_q11 * c_q11;
-        let x73 = x65 - x68;
-        let x74 = x59 + x59;
-        let x75 = Self::mul_add(x72, x74, x71 * x73);
-        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
-        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
-        let x78 = 0.275 * x51;
-        let x79 = -0.63 * x77;
-        let x80 = -0.275 * x51;
-        let x81 = x77 * 0.63;
-        let x82 = Self::mul_add(0.63, x76, x59 + Self::mul_add(-x71, x74, x72 * x73));
-        let x83 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
-        let x84 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
-        let x85 = x70 - x81;
-        let x86 = x65 - x75 - (x78 - x79) - (x81 - x80);
-        let x87 = -45.1584 + x77;
-        let x88 = -0.6328 + x83;
-        let x89 = -24.4950615 + (x68 + x75 + x80 - x78);
-        let x90 = -24.35164200091464 + Self::mul_add(0.63, x51, x84);
-        let x91 = 28.2393615 + (x79 + x85);
-        let x92 = s_q10 * s_q10;
-        let x93 = s_q10 * c_q10;
-        let x94 = x86 - x89;
-        let x95 = x82 + x82;
-        let x96 = Self::mul_add(x93, x95, x92 * x94);
-        let x97 = x82 + Self::mul_add(-x92, x95, x93 * x94);
-        let x98 = Self::mul_add(-s_q10, x90, c_q10 * x88);
-        let x99 = Self::mul_add(c_q10, x90, s_q10 * x88);
-        let x100 = c_q10 * x76;
-        let x101 = Self::mul_add(-s_q10, x87, x100);
-        let x102 = s_q10 * x76;
-        let x103 = Self::mul_add(c_q10, x87, x102);
-        let x104 = -0.87 * x103;
-        let x105 = x103 * 0.87;
-        let x106 = Self::mul_add(0.87, x101, x97);
-        let x107 = x91 - x105;
-        let x108 = x86 - x96 + x104 - x105;
-        let x109 = Self::mul_add(x101, 0.87, x97);
-        let x110 = -81.53205 + x103;
-        let x111 = -0.00214 + x98;
-        let x112 = -63.36336825000001 + (x89 + x96);
-        let x113 = -36.18604050126307 + Self::mul_add(0.87, x51, x99);
-        let x114 = -36.18604050126307 + Self::mul_add(x51, 0.87, x99);
-        let x115 = 69.99836825 + (x104 + x107);
-        let x116 = s_q9 * x101;
-        let x117 = Self::mul_add(c_q9, x110, x116);
-        let x118 = Self::mul_add(0.00000000020510342851533115, x51, x117);
-        let x119 = x51 + Self::mul_add(x6, x110, x5 * x101);
-        let x120 = c_q9 * x101;
-        let x121 = Self::mul_add(-s_q9, x110, x120);
-        let x122 = Self::mul_add(-0.00000000020510342851533115, x51, x121);
-        let x123 = Self::mul_add(
-            0.00000000020510342851533115,
-            x111,
-            Self::mul_add(c_q9, x109, s_q9 * x108),
-        );
-        let x124 = Self::mul_add(
-            0.00000000020510342851533115,
-            x114,
-            Self::mul_add(c_q9, x112, s_q9 * x106),
-        );
-        let x125 = Self::mul_add(
-            0.00000000020510342851533115,
-            x115,
-            Self::mul_add(c_q9, x113, s_q9 * x111),
-        );
-        let x126 = x111 + Self::mul_add(x6, x109, x5 * x108);
-        let x127 = x114 + Self::mul_add(x6, x112, x5 * x106);
-        let x128 = x115 + Self::mul_add(x6, x113, x5 * x111);
-        let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x111,
-            Self::mul_add(-s_q9, x109, c_q9 * x108),
-        );
-        let x130 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x114,
-            Self::mul_add(-s_q9, x112, c_q9 * x106),
-        );
-        let x131 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x115,
-            Self::mul_add(-s_q9, x113, c_q9 * x111),
-        );
-        let x132 = x122 * -0.4;
-        let x133 = 0.275 * x119;
-        let x134 = 0.4 * x122;
-        let x135 = -0.275 * x119;
-        let x136 = Self::mul_add(
-            x118,
-            -0.4,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x125,
-                Self::mul_add(-s_q9, x124, c_q9 * x123),
-            ),
-        );
-        let x137 = Self::mul_add(
-            -0.4,
-            x119,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x128,
-                Self::mul_add(-s_q9, x127, c_q9 * x126),
-            ),
-        );
-        let x138 = Self::mul_add(
-            0.00000000020510342851533115,
-            x125,
-            Self::mul_add(c_q9, x124, s_q9 * x123),
-        ) - (x132 - x133) - (x135 - x134);
-        let x139 = Self::mul_add(
-            -0.275,
-            x118,
-            Self::mul_add(
+            -Self::mul_add(
                 0.00000000020510342851533115,
-                x128,
-                Self::mul_add(c_q9, x127, s_q9 * x126),
+                x59,
+                Self::mul_add(c_q12, x58, s_q12 * x57),
             ),
         );
-        let x140 = Self::mul_add(
-            -0.4,
-            x118,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x131,
-                Self::mul_add(c_q9, x130, s_q9 * x129),
-            ),
-        );
-        let x141 = Self::mul_add(
-            x119,
-            -0.4,
-            Self::mul_add(-0.275, x122, x131 + Self::mul_add(x6, x130, x5 * x129)),
-        );
-        let x142 = -0.000000008530897668050218 + x118;
-        let x143 = -12.701650001451807 + x119;
-        let x144 = -0.0000000234896432582596
-            + Self::mul_add(-0.275, x118, x125 + Self::mul_add(x6, x124, x5 * x123));
-        let x145 = -0.002139996587640933 + x136;
-        let x146 = -0.0000000234896432582596 + x139;
-        let x147 = -111.7548902508081
-            + (x128 + Self::mul_add(x6, x127, x5 * x126) + x134 - x132);
-        let x148 = 5.080660024070365 + Self::mul_add(-0.275, x122, x137);
-        let x149 = -0.002139996587640933 + x140;
-        let x150 = 5.080660024070366 + x141;
-        let x151 = 113.3918902508081
-            + (x133
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x131,
-                    Self::mul_add(-s_q9, x130, c_q9 * x129),
-                ) - x135));
-        let x152 = x122 + Self::mul_add(-x3, x143, x2 * x142);
-        let x153 = Self::mul_add(c_q8, x143, s_q8 * x142);
-        let x154 = c_q8 * x142;
-        let x155 = s_q8 * x143;
-        let x156 = Self::mul_add(-0.00000000020510342851533115, x122, x155 - x154);
-        let x157 = x149 + Self::mul_add(-x3, x146, x2 * x138);
-        let x158 = x150 + Self::mul_add(-x3, x147, x2 * x144);
-        let x159 = x151 + Self::mul_add(-x3, x148, x2 * x145);
-        let x160 = Self::mul_add(c_q8, x146, s_q8 * x138);
-        let x161 = Self::mul_add(c_q8, x147, s_q8 * x144);
-        let x162 = Self::mul_add(c_q8, x148, s_q8 * x145);
-        let x163 = Self::mul_add(
+        let x67 = x64 + (Self::mul_add(-s_q12, x55, c_q12 * x54) + x64);
+        let x68 = 7.078399999258757 + x51;
+        let x69 = 0.01675 + x65;
+        let x70 = -9.142025249762803
+            + (x64 + (x59 - Self::mul_add(x13, x58, x12 * x57) + x64));
+        let x71 = 2.5482240016099564 + x66;
+        let x72 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x60, x63);
+        let x73 = s_q11 * s_q11;
+        let x74 = s_q11 * c_q11;
+        let x75 = x67 - x70;
+        let x76 = x62 + x62;
+        let x77 = Self::mul_add(x74, x76, x73 * x75);
+        let x78 = Self::mul_add(-s_q11, x68, c_q11 * x50);
+        let x79 = Self::mul_add(c_q11, x68, s_q11 * x50);
+        let x80 = 0.275 * x53;
+        let x81 = x79 * 0.63;
+        let x82 = x81 - x80;
+        let x83 = Self::mul_add(x78, 0.63, x62 + Self::mul_add(-x73, x76, x74 * x75));
+        let x84 = Self::mul_add(0.275, x78, Self::mul_add(-s_q11, x71, c_q11 * x69));
+        let x85 = Self::mul_add(0.275, x79, Self::mul_add(c_q11, x71, s_q11 * x69));
+        let x86 = x72 - x81;
+        let x87 = x67 - x77 - x82 - x82;
+        let x88 = -45.1584 + x79;
+        let x89 = -0.6328 + x84;
+        let x90 = -24.4950615 + (x80 + (x70 + x77 + x80));
+        let x91 = -24.35164200091464 + Self::mul_add(x53, -0.63, x85);
+        let x92 = 28.2393615 + (x86 - x81);
+        let x93 = s_q10 * s_q10;
+        let x94 = s_q10 * c_q10;
+        let x95 = x87 - x90;
+        let x96 = x83 + x83;
+        let x97 = Self::mul_add(x94, x96, x93 * x95);
+        let x98 = Self::mul_add(-s_q10, x91, c_q10 * x89);
+        let x99 = Self::mul_add(c_q10, x91, s_q10 * x89);
+        let x100 = c_q10 * x78;
+        let x101 = Self::mul_add(-s_q10, x88, x100);
+        let x102 = s_q10 * x78;
+        let x103 = Self::mul_add(c_q10, x88, x102);
+        let x104 = x103 * 0.87;
+        let x105 = Self::mul_add(x101, 0.87, x83 + Self::mul_add(-x93, x96, x94 * x95));
+        let x106 = x92 - x104;
+        let x107 = x87 - x97 - x104 - x104;
+        let x108 = -81.53205 + x103;
+        let x109 = -0.00214 + x98;
+        let x110 = -63.36336825000001 + (x90 + x97);
+        let x111 = -36.18604050126307 + Self::mul_add(x53, -0.87, x99);
+        let x112 = 69.99836825 + (x106 - x104);
+        let x113 = s_q9 * x101;
+        let x114 = Self::mul_add(c_q9, x108, x113);
+        let x115 = 0.00000000020510342851533115 * x53;
+        let x116 = x114 - x115;
+        let x117 = Self::mul_add(-x8, x108, x7 * x101) - x53;
+        let x118 = c_q9 * x101;
+        let x119 = Self::mul_add(-s_q9, x108, x118);
+        let x120 = x115 + x119;
+        let x121 = c_q9 * x105;
+        let x122 = 0.00000000020510342851533115 * x109;
+        let x123 = Self::mul_add(s_q9, x107, x121) + x122;
+        let x124 = s_q9 * x105;
+        let x125 = 0.00000000020510342851533115 * x111;
+        let x126 = Self::mul_add(c_q9, x110, x124) + x125;
+        let x127 = 0.00000000020510342851533115 * x112;
+        let x128 = Self::mul_add(c_q9, x111, s_q9 * x109) + x127;
+        let x129 = x109 + Self::mul_add(-x8, x105, x7 * x107);
+        let x130 = x111 + Self::mul_add(-x8, x110, x7 * x105);
+        let x131 = x112 + Self::mul_add(-x8, x111, x7 * x109);
+        let x132 = Self::mul_add(c_q9, x107, -x124) - x122;
+        let x133 = Self::mul_add(-s_q9, x110, x121) - x125;
+        let x134 = Self::mul_add(-s_q9, x111, c_q9 * x109) - x127;
+        let x135 = 0.00000000020510342851533115 * x128;
+        let x136 = 0.00000000020510342851533115 * x131;
+        let x137 = 0.00000000020510342851533115 * x134;
+        let x138 = 0.4 * x120;
+        let x139 = 0.275 * x117;
+        let x140 = x138 + x139;
+        let x141 = 0.275 * x116;
+        let x142 = 0.4 * x116;
+        let x143 = 0.4 * x117;
+        let x144 = 0.275 * x120;
+        let x145 = x140 + (Self::mul_add(c_q9, x126, s_q9 * x123) + x135 + x140);
+        let x146 = -0.000000008530897668050218 + x116;
+        let x147 = -12.701650001451807 + x117;
+        let x148 = -0.0000000234896432582596
+            + (x128 + Self::mul_add(-x8, x126, x7 * x123) - x141);
+        let x149 = -0.002139996587640933
+            + (Self::mul_add(-s_q9, x126, c_q9 * x123) - x135 - x142);
+        let x150 = -0.0000000234896432582596
+            + (Self::mul_add(c_q9, x130, s_q9 * x129) + x136 - x141);
+        let x151 = -111.7548902508081
+            + (x138 + (x131 + Self::mul_add(-x8, x130, x7 * x129) + x138));
+        let x152 = 5.080660024070365
+            + (Self::mul_add(-s_q9, x130, c_q9 * x129) - x136 - x143 - x144);
+        let x153 = -0.002139996587640933
+            + (Self::mul_add(c_q9, x133, s_q9 * x132) + x137 - x142);
+        let x154 = 5.080660024070366
+            + (x134 + Self::mul_add(-x8, x133, x7 * x132) - x144 - x143);
+        let x155 = 113.3918902508081
+            + (x139 + (Self::mul_add(-s_q9, x133, c_q9 * x132) - x137 + x139));
+        let x156 = x120 + Self::mul_add(-x2, x146, x3 * x147);
+        let x157 = Self::mul_add(c_q8, x147, s_q8 * x146);
+        let x158 = c_q8 * x146;
+        let x159 = s_q8 * x147;
+        let x160 = Self::mul_add(-0.00000000020510342851533115, x120, x159 - x158);
+        let x161 = x153 + Self::mul_add(-x2, x145, x3 * x150);
+        let x162 = x154 + Self::mul_add(-x2, x148, x3 * x151);
+        let x163 = x155 + Self::mul_add(-x2, x149, x3 * x152);
+        let x164 = Self::mul_add(c_q8, x150, s_q8 * x145);
+        let x165 = Self::mul_add(c_q8, x151, s_q8 * x148);
+        let x166 = Self::mul_add(c_q8, x152, s_q8 * x149);
+        let x167 = Self::mul_add(
             -0.00000000020510342851533115,
-            x151,
-            Self::mul_add(-c_q8, x145, s_q8 * x148),
+            x155,
+            Self::mul_add(-c_q8, x149, s_q8 * x152),
         );
-        let x164 = Self::mul_add(
+        let x168 = Self::mul_add(
             -c_q8,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x149,
-                Self::mul_add(-c_q8, x138, s_q8 * x146),
+                x153,
+                Self::mul_add(-c_q8, x145, s_q8 * x150),
             ),
             s_q8
                 * Self::mul_add(
                     -0.00000000020510342851533115,
-                    x150,
-                    Self::mul_add(-c_q8, x144, s_q8 * x147),
+                    x154,
+                    Self::mul_add(-c_q8, x148, s_q8 * x151),
                 ),
         );
-        let x165 = x156 * -0.35;
-        let x166 = 0.35 * x156;
-        let x167 = Self::mul_add(
-            x152,
+        let x169 = 0.35 * x160;
+        let x170 = Self::mul_add(
             -0.35,
+            x156,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x159,
-                Self::mul_add(-c_q8, x157, s_q8 * x158),
+                x163,
+                Self::mul_add(-c_q8, x161, s_q8 * x162),
             ),
         );
-        let x168 = Self::mul_add(
+        let x171 = Self::mul_add(
             -0.35,
-            x153,
+            x157,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x162,
-                Self::mul_add(-c_q8, x160, s_q8 * x161),
+                x166,
+                Self::mul_add(-c_q8, x164, s_q8 * x165),
             ),
         );
-        let x169 = x166 + (x159 + Self::mul_add(-x3, x158, x2 * x157) - x165);
-        let x170 = 48.0240000085309 + x152;
-        let x171 = -0.07309 + Self::mul_add(c_q8, x158, s_q8 * x157);
-        let x172 = -16.80768997608804 + x167;
-        let x173 = 130.43769025763282
-            + (Self::mul_add(c_q8, x161, s_q8 * x160) + x166 - x165);
-        let x174 = 0.1132 + x168;
-        let x175 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x163, x164);
-        let x176 = s_q7 * s_q7;
-        let x177 = s_q7 * c_q7;
-        let x178 = x169 - x173;
-        let x179 = x171 + x171;
-        let x180 = Self::mul_add(x177, x179, x176 * x178);
-        let x181 = Self::mul_add(-s_q7, x153, c_q7 * x170);
-        let x182 = Self::mul_add(c_q7, x153, s_q7 * x170);
-        let x183 = -x182;
-        let x184 = x156 * -0.75;
-        let x185 = 0.75 * x156;
-        let x186 = x181 * -0.65;
-        let x187 = 0.65 * x181;
-        let x188 = Self::mul_add(x181, -0.75, Self::mul_add(-s_q7, x174, c_q7 * x172));
-        let x189 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x174, s_q7 * x172));
-        let x190 = x175 + x187;
+        let x172 = x169 + (x163 + Self::mul_add(-x2, x161, x3 * x162) + x169);
+        let x173 = 48.0240000085309 + x156;
+        let x174 = -0.07309 + Self::mul_add(c_q8, x162, s_q8 * x161);
+        let x175 = -16.80768997608804 + x170;
+        let x176 = 130.43769025763282
+            + (x169 + (Self::mul_add(c_q8, x165, s_q8 * x164) + x169));
+        let x177 = 0.1132 + x171;
+        let x178 = 132.47349025763282
+            + Self::mul_add(-0.00000000020510342851533115, x167, x168);
+        let x179 = s_q7 * s_q7;
+        let x180 = s_q7 * c_q7;
+        let x181 = x172 - x176;
+        let x182 = x174 + x174;
+        let x183 = Self::mul_add(x180, x182, x179 * x181);
+        let x184 = Self::mul_add(-s_q7, x157, c_q7 * x173);
+        let x185 = Self::mul_add(c_q7, x157, s_q7 * x173);
+        let x186 = -x185;
+        let x187 = 0.75 * x160;
+        let x188 = 0.65 * x184;
+        let x189 = x187 + x188;
+        let x190 = Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x177, c_q7 * x175));
         let x191 = Self::mul_add(
             -0.65,
-            x182,
-            x171 + Self::mul_add(-x176, x179, x177 * x178),
+            x185,
+            x174 + Self::mul_add(-x179, x182, x180 * x181),
         );
-        let x192 = 110.5455 + x181;
-        let x193 = 180.9502499901501 + x156;
-        let x194 = 1394.5960312283303 + (x185 + (x169 - x180 - x184));
-        let x195 = -117.61766249359756 + Self::mul_add(x156, -0.65, x188);
-        let x196 = 1466.4506062283303 + (x173 + x180 - (x186 - x185) - (x184 - x187));
-        let x197 = 1271.854575 + (x190 - x186);
-        let x198 = -x193;
-        let x199 = -x192;
-        let x200 = Self::mul_add(x3, x142, x2 * x143);
-        let x201 = x154 - x155;
-        let x202 = Self::mul_add(-0.35, x201, x159);
-        let x203 = Self::mul_add(-0.35, x200, x162);
-        let x204 = Self::mul_add(s_q7, x201, c_q7 * x200);
-        let x205 = -x204;
-        let x206 = Self::mul_add(-s_q7, x200, c_q7 * x201);
-        let x207 = Self::mul_add(-0.75, x206, Self::mul_add(-s_q7, x203, c_q7 * x202));
-        let x208 = Self::mul_add(c_q7, x203, s_q7 * x202)
-            + Self::mul_add(-0.75, x204, x153 * -0.65);
-        let x209 = Self::mul_add(0.65, x206, x163);
-        let x210 = x6 * x101;
-        let x211 = Self::mul_add(-x5, x110, x210);
-        let x212 = x125 + Self::mul_add(-0.275, x117, -0.4 * x211);
-        let x213 = Self::mul_add(0.4, x121, x128);
-        let x214 = Self::mul_add(-0.275, x121, x131);
-        let x215 = Self::mul_add(-x3, x211, x2 * x121) - x117;
-        let x216 = Self::mul_add(c_q8, x211, s_q8 * x121);
-        let x217 = Self::mul_add(
-            0.00000000020510342851533115,
-            x117,
-            Self::mul_add(-c_q8, x121, s_q8 * x211),
-        );
+        let x192 = Self::mul_add(-0.75, x185, Self::mul_add(c_q7, x177, s_q7 * x175));
+        let x193 = x178 + x188;
+        let x194 = 110.5455 + x184;
+        let x195 = 180.9502499901501 + x160;
+        let x196 = 1394.5960312283303 + (x187 + (x172 - x183 + x187));
+        let x197 = -117.61766249359756 + Self::mul_add(-0.65, x160, x190);
+        let x198 = 1466.4506062283303 + (x189 + (x176 + x183 + x189));
+        let x199 = 1271.854575 + (x188 + x193);
+        let x200 = -x195;
+        let x201 = -x194;
+        let x202 = Self::mul_add(x3, x146, x2 * x147);
+        let x203 = x158 - x159;
+        let x204 = Self::mul_add(-0.35, x203, x163);
+        let x205 = Self::mul_add(0.35, x202, x166);
+        let x206 = Self::mul_add(-s_q7, x203, c_q7 * x202);
+        let x207 = Self::mul_add(c_q7, x203, s_q7 * x202);
+        let x208 = Self::mul_add(-0.75, x207, Self::mul_add(-s_q7, x205, c_q7 * x204));
+        let x209 = Self::mul_add(c_q7, x205, s_q7 * x204)
+            + Self::mul_add(-0.65, x157, 0.75 * x206);
+        let x210 = Self::mul_add(0.65, x207, x167);
+        let x211 = x8 * x101;
+        let x212 = Self::mul_add(x7, x108, x211);
+        let x213 = x128 + Self::mul_add(-0.275, x114, 0.4 * x212);
+        let x214 = Self::mul_add(0.4, x119, x131);
+        let x215 = Self::mul_add(-0.275, x119, x134);
+        let x216 = x114 + Self::mul_add(x3, x212, x2 * x119);
+        let x217 = Self::mul_add(-c_q8, x212, s_q8 * x119);
         let x218 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x214,
-            Self::mul_add(-c_q8, x212, s_q8 * x213),
+            0.00000000020510342851533115,
+            x114,
+            -Self::mul_add(s_q8, x212, c_q8 * x119),
         );
         let x219 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x215,
+            Self::mul_add(-c_q8, x213, s_q8 * x214),
+        );
+        let x220 = Self::mul_add(
             -0.35,
-            x216,
-            x214 + Self::mul_add(-x3, x213, x2 * x212),
+            x217,
+            x215 + Self::mul_add(-x2, x213, x3 * x214),
         );
-        let x220 = Self::mul_add(0.35, x215, Self::mul_add(c_q8, x213, s_q8 * x212));
-        let x221 = Self::mul_add(-s_q7, x216, c_q7 * x215);
-        let x222 = Self::mul_add(c_q7, x216, s_q7 * x215);
-        let x223 = Self::mul_add(-0.75, x222, Self::mul_add(-s_q7, x220, c_q7 * x219));
-        let x224 = Self::mul_add(c_q7, x220, s_q7 * x219)
-            + Self::mul_add(-0.65, x217, 0.75 * x221);
-        let x225 = Self::mul_add(0.65, x222, x218);
-        let x226 = Self::mul_add(-s_q9, x103, x120);
-        let x227 = Self::mul_add(-x5, x103, x210);
-        let x228 = Self::mul_add(c_q9, x103, x116);
-        let x229 = Self::mul_add(
-            0.00000000020510342851533115,
-            x107,
-            Self::mul_add(c_q9, x99, s_q9 * x98),
-        ) + Self::mul_add(-0.275, x228, -0.4 * x227);
-        let x230 = Self::mul_add(0.4, x226, x107 + Self::mul_add(x6, x99, x5 * x98));
-        let x231 = Self::mul_add(
-            -0.275,
-            x226,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x107,
-                Self::mul_add(-s_q9, x99, c_q9 * x98),
-            ),
-        );
-        let x232 = Self::mul_add(-x3, x227, x2 * x226) - x228;
-        let x233 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x221 = Self::mul_add(-0.35, x216, Self::mul_add(c_q8, x214, s_q8 * x213));
+        let x222 = Self::mul_add(s_q7, x217, c_q7 * x216);
+        let x223 = -x222;
+        let x224 = Self::mul_add(-s_q7, x216, c_q7 * x217);
+        let x225 = Self::mul_add(-0.75, x224, Self::mul_add(-s_q7, x221, c_q7 * x220));
+        let x226 = Self::mul_add(c_q7, x221, s_q7 * x220)
+            - Self::mul_add(0.65, x218, 0.75 * x222);
+        let x227 = Self::mul_add(0.65, x224, x219);
+        let x228 = Self::mul_add(-s_q9, x103, x118);
+        let x229 = Self::mul_add(x7, x103, x211);
+        let x230 = Self::mul_add(c_q9, x103, x113);
+        let x231 = 0.00000000020510342851533115 * x106;
+        let x232 = Self::mul_add(c_q9, x99, s_q9 * x98) + x231
+            + Self::mul_add(-0.275, x230, 0.4 * x229);
+        let x233 = Self::mul_add(0.4, x228, x106 + Self::mul_add(-x8, x99, x7 * x98));
         let x234 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.275,
             x228,
-            Self::mul_add(-c_q8, x226, s_q8 * x227),
+            Self::mul_add(-s_q9, x99, c_q9 * x98) - x231,
         );
-        let x235 = Self::mul_add(
+        let x235 = x230 + Self::mul_add(x3, x229, x2 * x228);
+        let x236 = Self::mul_add(-c_q8, x229, s_q8 * x228);
+        let x237 = Self::mul_add(
+            0.00000000020510342851533115,
+            x230,
+            -Self::mul_add(s_q8, x229, c_q8 * x228),
+        );
+        let x238 = Self::mul_add(
             -0.00000000020510342851533115,
-            x231,
-            Self::mul_add(-c_q8, x229, s_q8 * x230),
+            x234,
+            Self::mul_add(-c_q8, x232, s_q8 * x233),
         );
-        let x236 = Self::mul_add(
+        let x239 = Self::mul_add(
             -0.35,
-            x233,
-            x231 + Self::mul_add(-x3, x230, x2 * x229),
+            x236,
+            x234 + Self::mul_add(-x2, x232, x3 * x233),
         );
-        let x237 = Self::mul_add(0.35, x232, Self::mul_add(c_q8, x230, s_q8 * x229));
-        let x238 = Self::mul_add(-s_q7, x233, c_q7 * x232);
-        let x239 = Self::mul_add(c_q7, x233, s_q7 * x232);
-        let x240 = Self::mul_add(-0.75, x239, Self::mul_add(-s_q7, x237, c_q7 * x236));
-        let x241 = Self::mul_add(c_q7, x237, s_q7 * x236)
-            + Self::mul_add(-0.65, x234, 0.75 * x238);
-        let x242 = Self::mul_add(0.65, x239, x235);
-        let x243 = Self::mul_add(c_q10, x77, x102);
-        let x244 = Self::mul_add(-s_q10, x77, x100);
-        let x245 = Self::mul_add(-s_q10, x84, c_q10 * x83);
-        let x246 = Self::mul_add(c_q10, x84, s_q10 * x83);
-        let x247 = Self::mul_add(-0.87, x243, x85);
-        let x248 = Self::mul_add(-s_q9, x243, c_q9 * x244);
-        let x249 = Self::mul_add(-x5, x243, x6 * x244);
-        let x250 = Self::mul_add(s_q9, x244, c_q9 * x243);
-        let x251 = Self::mul_add(
-            0.00000000020510342851533115,
-            x247,
-            Self::mul_add(c_q9, x246, s_q9 * x245),
-        ) + Self::mul_add(-0.275, x250, -0.4 * x249);
-        let x252 = Self::mul_add(0.4, x248, x247 + Self::mul_add(x6, x246, x5 * x245));
-        let x253 = Self::mul_add(
-            -0.275,
-            x248,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x247,
-                Self::mul_add(-s_q9, x246, c_q9 * x245),
-            ),
-        );
-        let x254 = Self::mul_add(-x3, x249, x2 * x248) - x250;
-        let x255 = Self::mul_add(c_q8, x249, s_q8 * x248);
-        let x256 = Self::mul_add(
-            0.00000000020510342851533115,
-            x250,
-            Self::mul_add(-c_q8, x248, s_q8 * x249),
-        );
-        let x257 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x253,
-            Self::mul_add(-c_q8, x251, s_q8 * x252),
-        );
+        let x240 = Self::mul_add(-0.35, x235, Self::mul_add(c_q8, x233, s_q8 * x232));
+        let x241 = Self::mul_add(s_q7, x236, c_q7 * x235);
+        let x242 = -x241;
+        let x243 = Self::mul_add(-s_q7, x235, c_q7 * x236);
+        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x240, c_q7 * x239));
+        let x245 = Self::mul_add(c_q7, x240, s_q7 * x239)
+            - Self::mul_add(0.65, x237, 0.75 * x241);
+        let x246 = Self::mul_add(0.65, x243, x238);
+        let x247 = Self::mul_add(c_q10, x79, x102);
+        let x248 = Self::mul_add(-s_q10, x79, x100);
+        let x249 = Self::mul_add(-s_q10, x85, c_q10 * x84);
+        let x250 = Self::mul_add(c_q10, x85, s_q10 * x84);
+        let x251 = Self::mul_add(-0.87, x247, x86);
+        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
+        let x253 = Self::mul_add(x8, x248, x7 * x247);
+        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
+        let x255 = 0.00000000020510342851533115 * x251;
+        let x256 = Self::mul_add(c_q9, x250, s_q9 * x249) + x255
+            + Self::mul_add(-0.275, x254, 0.4 * x253);
+        let x257 = Self::mul_add(0.4, x252, x251 + Self::mul_add(-x8, x250, x7 * x249));
         let x258 = Self::mul_add(
-            -0.35,
-            x255,
-            x253 + Self::mul_add(-x3, x252, x2 * x251),
-        );
-        let x259 = Self::mul_add(0.35, x254, Self::mul_add(c_q8, x252, s_q8 * x251));
-        let x260 = Self::mul_add(-s_q7, x255, c_q7 * x254);
-        let x261 = Self::mul_add(c_q7, x255, s_q7 * x254);
-        let x262 = Self::mul_add(-0.75, x261, Self::mul_add(-s_q7, x259, c_q7 * x258));
-        let x263 = Self::mul_add(c_q7, x259, s_q7 * x258)
-            + Self::mul_add(-0.65, x256, 0.75 * x260);
-        let x264 = Self::mul_add(0.65, x261, x257);
-        let x265 = Self::mul_add(-x10, x37, x11 * x36);
-        let x266 = x47 - x46;
-        let x267 = Self::mul_add(0.36, x265, x54);
-        let x268 = Self::mul_add(0.36, x50, x57);
-        let x269 = Self::mul_add(s_q11, x265, c_q11 * x50);
-        let x270 = Self::mul_add(-s_q11, x50, c_q11 * x265);
-        let x271 = Self::mul_add(-s_q11, x268, c_q11 * x267)
-            + Self::mul_add(-0.63, x266, 0.275 * x270);
-        let x272 = Self::mul_add(0.275, x269, Self::mul_add(c_q11, x268, s_q11 * x267));
-        let x273 = Self::mul_add(-0.63, x269, x58);
-        let x274 = Self::mul_add(s_q10, x270, c_q10 * x269);
-        let x275 = Self::mul_add(-s_q10, x269, c_q10 * x270);
-        let x276 = Self::mul_add(c_q10, x272, s_q10 * x271);
-        let x277 = Self::mul_add(-0.87, x266, Self::mul_add(-s_q10, x272, c_q10 * x271));
-        let x278 = Self::mul_add(-0.87, x274, x273);
-        let x279 = Self::mul_add(
-            0.00000000020510342851533115,
-            x266,
-            Self::mul_add(-s_q9, x274, c_q9 * x275),
-        );
-        let x280 = x266 + Self::mul_add(-x5, x274, x6 * x275);
-        let x281 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x266,
-            -Self::mul_add(s_q9, x275, c_q9 * x274),
-        );
-        let x282 = Self::mul_add(
-            0.00000000020510342851533115,
-            x278,
-            Self::mul_add(c_q9, x276, s_q9 * x277),
-        ) + Self::mul_add(0.275, x281, -0.4 * x280);
-        let x283 = Self::mul_add(0.4, x279, x278 + Self::mul_add(x6, x276, x5 * x277));
-        let x284 = Self::mul_add(
             -0.275,
-            x279,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x278,
-                Self::mul_add(-s_q9, x276, c_q9 * x277),
-            ),
+            x252,
+            Self::mul_add(-s_q9, x250, c_q9 * x249) - x255,
         );
-        let x285 = x281 + Self::mul_add(-x3, x280, x2 * x279);
-        let x286 = Self::mul_add(c_q8, x280, s_q8 * x279);
-        let x287 = Self::mul_add(
+        let x259 = x254 + Self::mul_add(x3, x253, x2 * x252);
+        let x260 = Self::mul_add(-c_q8, x253, s_q8 * x252);
+        let x261 = Self::mul_add(
+            0.00000000020510342851533115,
+            x254,
+            -Self::mul_add(s_q8, x253, c_q8 * x252),
+        );
+        let x262 = Self::mul_add(
             -0.00000000020510342851533115,
-            x281,
-            Self::mul_add(-c_q8, x279, s_q8 * x280),
+            x258,
+            Self::mul_add(-c_q8, x256, s_q8 * x257),
         );
-        let x288 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x284,
-            Self::mul_add(-c_q8, x282, s_q8 * x283),
-        );
-        let x289 = Self::mul_add(
+        let x263 = Self::mul_add(
             -0.35,
-            x286,
-            x284 + Self::mul_add(-x3, x283, x2 * x282),
+            x260,
+            x258 + Self::mul_add(-x2, x256, x3 * x257),
         );
-        let x290 = Self::mul_add(0.35, x285, Self::mul_add(c_q8, x283, s_q8 * x282));
-        let x291 = Self::mul_add(-s_q7, x286, c_q7 * x285);
-        let x292 = Self::mul_add(c_q7, x286, s_q7 * x285);
-        let x293 = Self::mul_add(-0.75, x292, Self::mul_add(-s_q7, x290, c_q7 * x289));
-        let x294 = Self::mul_add(c_q7, x290, s_q7 * x289)
-            + Self::mul_add(-0.65, x287, 0.75 * x291);
-        let x295 = Self::mul_add(0.65, x292, x288);
-        let x296 = x13 * -4.806620000000001;
-        let x297 = s_q13 * -4.806620000000001;
-        let x298 = c_q13 * -4.806620000000001;
-        let x299 = x20 + Self::mul_add(-0.55, x298, -0.16 * x297);
-        let x300 = Self::mul_add(0.16, x296, x24);
-        let x301 = Self::mul_add(-0.55, x296, x27);
-        let x302 = Self::mul_add(-s_q12, x297, c_q12 * x296);
-        let x303 = Self::mul_add(x11, x297, x10 * x296) - x298;
-        let x304 = Self::mul_add(
+        let x264 = Self::mul_add(-0.35, x259, Self::mul_add(c_q8, x257, s_q8 * x256));
+        let x265 = Self::mul_add(s_q7, x260, c_q7 * x259);
+        let x266 = -x265;
+        let x267 = Self::mul_add(-s_q7, x259, c_q7 * x260);
+        let x268 = Self::mul_add(-0.75, x267, Self::mul_add(-s_q7, x264, c_q7 * x263));
+        let x269 = Self::mul_add(c_q7, x264, s_q7 * x263)
+            - Self::mul_add(0.65, x261, 0.75 * x265);
+        let x270 = Self::mul_add(0.65, x267, x262);
+        let x271 = Self::mul_add(-x13, x38, x12 * x39);
+        let x272 = x49 - x48;
+        let x273 = Self::mul_add(0.36, x271, x56);
+        let x274 = Self::mul_add(x52, 0.36, x59);
+        let x275 = Self::mul_add(s_q11, x271, c_q11 * x52);
+        let x276 = Self::mul_add(-s_q11, x52, c_q11 * x271);
+        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
+            + Self::mul_add(-0.63, x272, 0.275 * x276);
+        let x278 = Self::mul_add(0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
+        let x279 = Self::mul_add(0.63, x275, x60);
+        let x280 = -x279;
+        let x281 = Self::mul_add(s_q10, x276, c_q10 * x275);
+        let x282 = Self::mul_add(-s_q10, x275, c_q10 * x276);
+        let x283 = Self::mul_add(c_q10, x278, s_q10 * x277);
+        let x284 = Self::mul_add(-0.87, x272, Self::mul_add(-s_q10, x278, c_q10 * x277));
+        let x285 = Self::mul_add(0.87, x281, x279);
+        let x286 = -x285;
+        let x287 = 0.00000000020510342851533115 * x272;
+        let x288 = Self::mul_add(-s_q9, x281, c_q9 * x282) + x287;
+        let x289 = x272 - Self::mul_add(x8, x282, x7 * x281);
+        let x290 = x287 + Self::mul_add(s_q9, x282, c_q9 * x281);
+        let x291 = 0.00000000020510342851533115 * x285;
+        let x292 = Self::mul_add(c_q9, x283, s_q9 * x284) - x291
+            - Self::mul_add(0.275, x290, 0.4 * x289);
+        let x293 = Self::mul_add(0.4, x288, Self::mul_add(-x8, x283, x7 * x284) - x285);
+        let x294 = Self::mul_add(
+            -0.275,
+            x288,
+            x291 + Self::mul_add(-s_q9, x283, c_q9 * x284),
+        );
+        let x295 = Self::mul_add(-x2, x288, x3 * x289) - x290;
+        let x296 = Self::mul_add(c_q8, x289, s_q8 * x288);
+        let x297 = Self::mul_add(
+            0.00000000020510342851533115,
+            x290,
+            Self::mul_add(-c_q8, x288, s_q8 * x289),
+        );
+        let x298 = Self::mul_add(
             -0.00000000020510342851533115,
-            x298,
-            Self::mul_add(c_q12, x297, s_q12 * x296),
+            x294,
+            Self::mul_add(-c_q8, x292, s_q8 * x293),
         );
-        let x305 = Self::mul_add(
+        let x299 = Self::mul_add(
+            -0.35,
+            x296,
+            x294 + Self::mul_add(-x2, x292, x3 * x293),
+        );
+        let x300 = Self::mul_add(0.35, x295, Self::mul_add(c_q8, x293, s_q8 * x292));
+        let x301 = Self::mul_add(-s_q7, x296, c_q7 * x295);
+        let x302 = Self::mul_add(c_q7, x296, s_q7 * x295);
+        let x303 = Self::mul_add(-0.75, x302, Self::mul_add(-s_q7, x300, c_q7 * x299));
+        let x304 = Self::mul_add(c_q7, x300, s_q7 * x299)
+            + Self::mul_add(-0.65, x297, 0.75 * x301);
+        let x305 = Self::mul_add(0.65, x302, x298);
+        let x306 = 4.806620000000001 * x15;
+        let x307 = x22 + x32;
+        let x308 = Self::mul_add(0.16, x306, -x26);
+        let x309 = Self::mul_add(-0.55, x306, x29);
+        let x310 = Self::mul_add(s_q12, x19, c_q12 * x306);
+        let x311 = x18 + Self::mul_add(-x12, x306, x13 * x19);
+        let x312 = Self::mul_add(
             -0.00000000020510342851533115,
-            x301,
-            -Self::mul_add(c_q12, x300, s_q12 * x299),
+            x18,
+            Self::mul_add(-s_q12, x306, c_q12 * x19),
         );
-        let x306 = Self::mul_add(0.36, x303, Self::mul_add(-s_q12, x300, c_q12 * x299));
-        let x307 = Self::mul_add(
+        let x313 = Self::mul_add(
+            0.00000000020510342851533115,
+            x309,
+            Self::mul_add(c_q12, x308, s_q12 * x307),
+        );
+        let x314 = -x313;
+        let x315 = Self::mul_add(0.36, x311, Self::mul_add(-s_q12, x308, c_q12 * x307));
+        let x316 = Self::mul_add(
             -0.36,
-            x302,
-            x301 + Self::mul_add(x11, x300, x10 * x299),
+            x310,
+            x309 - Self::mul_add(x13, x308, x12 * x307),
         );
-        let x308 = Self::mul_add(-s_q11, x303, c_q11 * x302);
-        let x309 = Self::mul_add(c_q11, x303, s_q11 * x302);
-        let x310 = Self::mul_add(-s_q11, x307, c_q11 * x306)
-            + Self::mul_add(0.63, x304, 0.275 * x309);
-        let x311 = Self::mul_add(-0.275, x308, Self::mul_add(c_q11, x307, s_q11 * x306));
-        let x312 = Self::mul_add(0.63, x308, x305);
-        let x313 = Self::mul_add(-s_q10, x309, c_q10 * x308);
-        let x314 = Self::mul_add(c_q10, x309, s_q10 * x308);
-        let x315 = Self::mul_add(c_q10, x311, s_q10 * x310);
-        let x316 = Self::mul_add(0.87, x304, Self::mul_add(-s_q10, x311, c_q10 * x310));
-        let x317 = Self::mul_add(0.87, x313, x312);
-        let x318 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x304,
-            Self::mul_add(c_q9, x314, s_q9 * x313),
-        );
-        let x319 = Self::mul_add(x6, x314, x5 * x313) - x304;
-        let x320 = Self::mul_add(
-            0.00000000020510342851533115,
-            x304,
-            Self::mul_add(-s_q9, x314, c_q9 * x313),
-        );
-        let x321 = Self::mul_add(
-            0.00000000020510342851533115,
-            x317,
-            Self::mul_add(c_q9, x315, s_q9 * x316),
-        ) + Self::mul_add(0.275, x320, -0.4 * x319);
-        let x322 = Self::mul_add(0.4, x318, x317 + Self::mul_add(x6, x315, x5 * x316));
-        let x323 = Self::mul_add(
+        let x317 = Self::mul_add(-s_q11, x311, c_q11 * x310);
+        let x318 = Self::mul_add(c_q11, x311, s_q11 * x310);
+        let x319 = Self::mul_add(-s_q11, x316, c_q11 * x315)
+            + Self::mul_add(-0.63, x312, 0.275 * x318);
+        let x320 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x316, s_q11 * x315));
+        let x321 = Self::mul_add(0.63, x317, -x313);
+        let x322 = Self::mul_add(-s_q10, x318, c_q10 * x317);
+        let x323 = Self::mul_add(c_q10, x318, s_q10 * x317);
+        let x324 = Self::mul_add(c_q10, x320, s_q10 * x319);
+        let x325 = Self::mul_add(-0.87, x312, Self::mul_add(-s_q10, x320, c_q10 * x319));
+        let x326 = Self::mul_add(0.87, x322, x321);
+        let x327 = 0.00000000020510342851533115 * x312;
+        let x328 = Self::mul_add(c_q9, x323, s_q9 * x322) + x327;
+        let x329 = x312 + Self::mul_add(-x8, x323, x7 * x322);
+        let x330 = Self::mul_add(-s_q9, x323, c_q9 * x322) - x327;
+        let x331 = 0.00000000020510342851533115 * x326;
+        let x332 = Self::mul_add(c_q9, x324, s_q9 * x325) + x331
+            + Self::mul_add(-0.4, x329, 0.275 * x330);
+        let x333 = Self::mul_add(0.4, x328, x326 + Self::mul_add(-x8, x324, x7 * x325));
+        let x334 = Self::mul_add(
             -0.275,
-            x318,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x317,
-                Self::mul_add(-s_q9, x315, c_q9 * x316),
-            ),
+            x328,
+            Self::mul_add(-s_q9, x324, c_q9 * x325) - x331,
         );
-        let x324 = x320 + Self::mul_add(-x3, x319, x2 * x318);
-        let x325 = Self::mul_add(c_q8, x319, s_q8 * x318);
-        let x326 = Self::mul_add(
+        let x335 = x330 + Self::mul_add(-x2, x328, x3 * x329);
+        let x336 = Self::mul_add(c_q8, x329, s_q8 * x328);
+        let x337 = Self::mul_add(
             -0.00000000020510342851533115,
-            x320,
-            Self::mul_add(-c_q8, x318, s_q8 * x319),
+            x330,
+            Self::mul_add(-c_q8, x328, s_q8 * x329),
         );
-        let x327 = Self::mul_add(
+        let x338 = Self::mul_add(
             -0.00000000020510342851533115,
-            x323,
-            Self::mul_add(-c_q8, x321, s_q8 * x322),
+            x334,
+            Self::mul_add(-c_q8, x332, s_q8 * x333),
         );
-        let x328 = Self::mul_add(
+        let x339 = Self::mul_add(
             -0.35,
-            x325,
-            x323 + Self::mul_add(-x3, x322, x2 * x321),
+            x336,
+            x334 + Self::mul_add(-x2, x332, x3 * x333),
         );
-        let x329 = Self::mul_add(0.35, x324, Self::mul_add(c_q8, x322, s_q8 * x321));
-        let x330 = Self::mul_add(-s_q7, x325, c_q7 * x324);
-        let x331 = Self::mul_add(c_q7, x325, s_q7 * x324);
-        let x332 = Self::mul_add(-0.75, x331, Self::mul_add(-s_q7, x329, c_q7 * x328));
-        let x333 = Self::mul_add(c_q7, x329, s_q7 * x328)
-            + Self::mul_add(-0.65, x326, 0.75 * x330);
-        let x334 = Self::mul_add(0.65, x331, x327);
-        let x335 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x336 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x337 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x338 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x339 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x340 = v[4] * v[4];
-        let x341 = Self::mul_add(v[5], v[5], x340);
-        let x342 = v[3] * v[4];
-        let x343 = v[3] * v[5];
-        let x344 = v[4] * v[5];
-        let x345 = Self::mul_add(v[3], v[3], x340);
-        let x346 = x335 + Self::mul_add(-0.65, x341, 0.75 * x343);
-        let x347 = x336 + Self::mul_add(0.75, x344, 0.65 * x342);
-        let x348 = x337 + Self::mul_add(-0.75, x345, 0.65 * x343);
-        let x349 = Self::mul_add(-s_q7, x346, c_q7 * x347);
-        let x350 = v[6] * x339;
-        let x351 = v[6] * x338;
-        let x352 = v[5] + v[6];
-        let x353 = x339 * x339;
-        let x354 = x338 * x352;
-        let x355 = Self::mul_add(-16.80768997608804, x352, -0.07309 * x339);
-        let x356 = Self::mul_add(
+        let x340 = Self::mul_add(0.35, x335, Self::mul_add(c_q8, x333, s_q8 * x332));
+        let x341 = Self::mul_add(-s_q7, x336, c_q7 * x335);
+        let x342 = Self::mul_add(c_q7, x336, s_q7 * x335);
+        let x343 = Self::mul_add(-0.75, x342, Self::mul_add(-s_q7, x340, c_q7 * x339));
+        let x344 = Self::mul_add(c_q7, x340, s_q7 * x339)
+            + Self::mul_add(-0.65, x337, 0.75 * x341);
+        let x345 = Self::mul_add(0.65, x342, x338);
+        let x346 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
+        let x347 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x348 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
+        let x349 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x350 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x351 = v[4] * v[4];
+        let x352 = Self::mul_add(v[5], v[5], x351);
+        let x353 = v[3] * v[4];
+        let x354 = v[3] * v[5];
+        let x355 = v[4] * v[5];
+        let x356 = Self::mul_add(v[3], v[3], x351);
+        let x357 = x346 + Self::mul_add(-0.65, x352, 0.75 * x354);
+        let x358 = x347 + Self::mul_add(0.75, x355, 0.65 * x353);
+        let x359 = x348 + Self::mul_add(-0.75, x356, 0.65 * x354);
+        let x360 = Self::mul_add(-s_q7, x357, c_q7 * x358);
+        let x361 = v[6] * x350;
+        let x362 = v[6] * x349;
+        let x363 = v[5] + v[6];
+        let x364 = x350 * x350;
+        let x365 = x349 * x363;
+        let x366 = Self::mul_add(x363, 16.80768997608804, x350 * 0.07309);
+        let x367 = Self::mul_add(
             0.1132,
-            x352,
-            Self::mul_add(130.43769025763282, x339, -0.07309 * x338),
+            x363,
+            Self::mul_add(x349, -0.07309, 130.43769025763282 * x350),
         );
-        let x357 = Self::mul_add(
+        let x368 = Self::mul_add(
             132.47349025763282,
-            x352,
-            Self::mul_add(0.1132, x339, -16.80768997608804 * x338),
+            x363,
+            Self::mul_add(x349, -16.80768997608804, 0.1132 * x350),
         );
-        let x358 = Self::mul_add(-c_q8, x352, Self::mul_add(s_q8, x339, x2 * x338));
-        let x359 = Self::mul_add(s_q8, x352, Self::mul_add(-x3, x338, c_q8 * x339));
-        let x360 = Self::mul_add(
+        let x369 = Self::mul_add(-c_q8, x363, Self::mul_add(-x2, x349, s_q8 * x350));
+        let x370 = Self::mul_add(s_q8, x363, Self::mul_add(c_q8, x350, x3 * x349));
+        let x371 = Self::mul_add(
             0.35,
-            x354 - x351,
-            Self::mul_add(s_q7, x347, c_q7 * x346),
+            x365 - x362,
+            Self::mul_add(s_q7, x358, c_q7 * x357),
         );
-        let x361 = Self::mul_add(0.35, Self::mul_add(x339, x352, -x350), x349);
-        let x362 = Self::mul_add(-0.35, Self::mul_add(x338, x338, x353), x348);
-        let x363 = Self::mul_add(-c_q8, x362, Self::mul_add(s_q8, x361, x2 * x360));
-        let x364 = Self::mul_add(s_q8, x362, Self::mul_add(-x3, x360, c_q8 * x361));
-        let x365 = Self::mul_add(-0.00000000020510342851533115, x362, x360);
-        let x366 = Self::mul_add(v[7], x359, Self::mul_add(-s_q8, x351, x2 * x350));
-        let x367 = Self::mul_add(v[7], x358, Self::mul_add(c_q8, x351, x3 * x350));
-        let x368 = v[7] + Self::mul_add(-0.00000000020510342851533115, x352, x338);
-        let x369 = x359 * x359;
-        let x370 = x368 * x368;
-        let x371 = x358 * x359;
-        let x372 = x371 - x350;
-        let x373 = x358 * x368;
-        let x374 = x358 * x358;
-        let x375 = x370 + x374;
-        let x376 = x359 * x368;
-        let x377 = x366 + x376;
-        let x378 = Self::mul_add(
-            -0.002139996587640933,
-            x368,
-            -0.0000000234896432582596 * x359,
+        let x372 = Self::mul_add(0.35, Self::mul_add(x350, x363, -x361), x360);
+        let x373 = Self::mul_add(-0.35, Self::mul_add(x349, x349, x364), x359);
+        let x374 = Self::mul_add(-c_q8, x373, Self::mul_add(-x2, x371, s_q8 * x372));
+        let x375 = Self::mul_add(s_q8, x373, Self::mul_add(c_q8, x372, x3 * x371));
+        let x376 = Self::mul_add(-0.00000000020510342851533115, x373, x371);
+        let x377 = Self::mul_add(v[7], x370, -Self::mul_add(s_q8, x362, x2 * x361));
+        let x378 = Self::mul_add(-v[7], x369, Self::mul_add(-c_q8, x362, x3 * x361));
+        let x379 = v[7] + Self::mul_add(-0.00000000020510342851533115, x363, x349);
+        let x380 = x370 * x370;
+        let x381 = x379 * x379;
+        let x382 = x369 * x370;
+        let x383 = x382 - x361;
+        let x384 = x369 * x379;
+        let x385 = x369 * x369;
+        let x386 = x381 + x385;
+        let x387 = x370 * x379;
+        let x388 = x377 + x387;
+        let x389 = Self::mul_add(
+            x379,
+            0.002139996587640933,
+            x370 * 0.0000000234896432582596,
         );
-        let x379 = Self::mul_add(
+        let x390 = Self::mul_add(
             5.080660024070365,
-            x368,
-            Self::mul_add(-111.7548902508081, x359, -0.0000000234896432582596 * x358),
+            x379,
+            -Self::mul_add(x370, 111.7548902508081, x369 * 0.0000000234896432582596),
         );
-        let x380 = Self::mul_add(
+        let x391 = Self::mul_add(
             113.3918902508081,
-            x368,
-            Self::mul_add(5.080660024070366, x359, -0.002139996587640933 * x358),
+            x379,
+            Self::mul_add(x369, -0.002139996587640933, 5.080660024070366 * x370),
         );
-        let x381 = Self::mul_add(
-            x365,
+        let x392 = Self::mul_add(
+            x376,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x350,
-                Self::mul_add(111.7548902508081, x367, -0.0000000234896432582596 * x366),
-            ) + Self::mul_add(-x358, x380, x368 * x378),
+                x361,
+                -Self::mul_add(x378, 111.7548902508081, x377 * 0.0000000234896432582596),
+            ) - Self::mul_add(x369, x391, x379 * x389),
         );
-        let x382 = Self::mul_add(c_q9, x368, Self::mul_add(x5, x359, s_q9 * x358));
-        let x383 = Self::mul_add(-s_q9, x368, Self::mul_add(x6, x359, c_q9 * x358));
-        let x384 = x363 + Self::mul_add(0.4, x373 - x367, 0.275 * x372);
-        let x385 = x364 + Self::mul_add(-0.275, x375, 0.4 * (x376 - x366));
-        let x386 = x365 + Self::mul_add(-0.4, x369 + x374, 0.275 * x377);
-        let x387 = Self::mul_add(c_q9, x386, Self::mul_add(x5, x385, s_q9 * x384));
-        let x388 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x386,
-            Self::mul_add(0.00000000020510342851533115, x384, x385),
-        );
-        let x389 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x350,
-            Self::mul_add(0.00000000020510342851533115, x366, -x367),
-        );
-        let x390 = Self::mul_add(
-            v[8],
-            x383,
-            Self::mul_add(c_q9, x350, Self::mul_add(-x5, x367, s_q9 * x366)),
-        );
-        let x391 = Self::mul_add(
-            -v[8],
-            x382,
-            Self::mul_add(-s_q9, x350, Self::mul_add(-x6, x367, c_q9 * x366)),
-        );
-        let x392 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x368,
-                Self::mul_add(0.00000000020510342851533115, x358, x359),
-            );
-        let x393 = Self::mul_add(x382, x383, -x389);
-        let x394 = Self::mul_add(x382, x382, x392 * x392);
-        let x395 = Self::mul_add(x383, x392, x390);
-        let x396 = -0.00214 * x392;
-        let x397 = Self::mul_add(-36.18604050126307, x392, -63.36336825000001 * x383);
-        let x398 = Self::mul_add(
-            69.99836825,
-            x392,
-            Self::mul_add(-36.18604050126307, x383, -0.00214 * x382),
-        );
+        let x393 = Self::mul_add(c_q9, x379, Self::mul_add(x7, x370, s_q9 * x369));
+        let x394 = Self::mul_add(-s_q9, x379, Self::mul_add(-x8, x370, c_q9 * x369));
+        let x395 = x374 + Self::mul_add(0.4, x378 + x384, 0.275 * x383);
+        let x396 = x375 + Self::mul_add(-0.275, x386, 0.4 * (x387 - x377));
+        let x397 = x376 + Self::mul_add(-0.4, x380 + x385, 0.275 * x388);
+        let x398 = Self::mul_add(c_q9, x397, Self::mul_add(x7, x396, s_q9 * x395));
         let x399 = Self::mul_add(
-            -81.53205,
-            x388,
-            Self::mul_add(-0.00214, x389, Self::mul_add(-x392, x397, x383 * x398)),
+            -0.00000000020510342851533115,
+            x397,
+            Self::mul_add(0.00000000020510342851533115, x395, x396),
         );
         let x400 = Self::mul_add(
-            x387,
+            -0.00000000020510342851533115,
+            x361,
+            Self::mul_add(0.00000000020510342851533115, x377, x378),
+        );
+        let x401 = Self::mul_add(
+            v[8],
+            x394,
+            Self::mul_add(c_q9, x361, Self::mul_add(x7, x378, s_q9 * x377)),
+        );
+        let x402 = Self::mul_add(
+            -v[8],
+            x393,
+            Self::mul_add(-s_q9, x361, Self::mul_add(-x8, x378, c_q9 * x377)),
+        );
+        let x403 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x379,
+                Self::mul_add(0.00000000020510342851533115, x369, x370),
+            );
+        let x404 = Self::mul_add(x393, x394, -x400);
+        let x405 = Self::mul_add(x393, x393, x403 * x403);
+        let x406 = Self::mul_add(x394, x403, x401);
+        let x407 = x403 * 0.00214;
+        let x408 = Self::mul_add(x403, 36.18604050126307, x394 * 63.36336825000001);
+        let x409 = Self::mul_add(
+            69.99836825,
+            x403,
+            -Self::mul_add(x394, 36.18604050126307, x393 * 0.00214),
+        );
+        let x410 = Self::mul_add(
+            x399,
+            -81.53205,
+            Self::mul_add(x400, -0.00214, Self::mul_add(x394, x409, x403 * x408)),
+        );
+        let x411 = Self::mul_add(
+            x398,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x389,
-                Self::mul_add(-36.18604050126307, x391, -0.00214 * x390),
-            ) + Self::mul_add(-x383, x396, x382 * x397),
+                x400,
+                -Self::mul_add(x402, 36.18604050126307, x401 * 0.00214),
+            ) + Self::mul_add(-x393, x408, x394 * x407),
         );
-        let x401 = Self::mul_add(s_q10, x383, c_q10 * x382);
-        let x402 = Self::mul_add(-s_q10, x382, c_q10 * x383);
-        let x403 = Self::mul_add(-0.87, x393, x387);
-        let x404 = Self::mul_add(
+        let x412 = Self::mul_add(s_q10, x394, c_q10 * x393);
+        let x413 = Self::mul_add(-s_q10, x393, c_q10 * x394);
+        let x414 = Self::mul_add(-0.87, x404, x398);
+        let x415 = Self::mul_add(
             0.87,
-            x394,
-            Self::mul_add(-s_q9, x386, Self::mul_add(x6, x385, c_q9 * x384)),
-        );
-        let x405 = Self::mul_add(-0.87, x395, x388);
-        let x406 = Self::mul_add(s_q10, x404, c_q10 * x403);
-        let x407 = Self::mul_add(v[9], x402, Self::mul_add(s_q10, x391, c_q10 * x390));
-        let x408 = Self::mul_add(-v[9], x401, Self::mul_add(-s_q10, x390, c_q10 * x391));
-        let x409 = v[9] + x392;
-        let x410 = Self::mul_add(x401, x402, -x389);
-        let x411 = x401 * x401;
-        let x412 = Self::mul_add(x409, x409, x411);
-        let x413 = x402 * x409;
-        let x414 = x407 + x413;
-        let x415 = -0.6328 * x409;
-        let x416 = Self::mul_add(-24.35164200091464, x409, -24.4950615 * x402);
-        let x417 = Self::mul_add(
-            28.2393615,
-            x409,
-            Self::mul_add(-24.351642000914637, x402, -0.6328 * x401),
-        );
-        let x418 = Self::mul_add(
-            -45.1584,
             x405,
-            Self::mul_add(-0.6328, x389, Self::mul_add(-x409, x416, x402 * x417)),
+            Self::mul_add(-s_q9, x397, Self::mul_add(-x8, x396, c_q9 * x395)),
         );
-        let x419 = Self::mul_add(
-            x406,
+        let x416 = Self::mul_add(-0.87, x406, x399);
+        let x417 = Self::mul_add(s_q10, x415, c_q10 * x414);
+        let x418 = Self::mul_add(v[9], x413, Self::mul_add(s_q10, x402, c_q10 * x401));
+        let x419 = Self::mul_add(-v[9], x412, Self::mul_add(-s_q10, x401, c_q10 * x402));
+        let x420 = v[9] + x403;
+        let x421 = Self::mul_add(x412, x413, -x400);
+        let x422 = x412 * x412;
+        let x423 = Self::mul_add(x420, x420, x422);
+        let x424 = x413 * x420;
+        let x425 = x418 + x424;
+        let x426 = x420 * 0.6328;
+        let x427 = Self::mul_add(x420, 24.35164200091464, x413 * 24.4950615);
+        let x428 = Self::mul_add(
+            28.2393615,
+            x420,
+            -Self::mul_add(x413, 24.351642000914637, x412 * 0.6328),
+        );
+        let x429 = Self::mul_add(
+            x416,
+            -45.1584,
+            Self::mul_add(x400, -0.6328, Self::mul_add(x413, x428, x420 * x427)),
+        );
+        let x430 = Self::mul_add(
+            x417,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x389,
-                Self::mul_add(-24.351642000914637, x408, -0.6328 * x407),
-            ) + Self::mul_add(-x402, x415, x401 * x416),
+                x400,
+                -Self::mul_add(x419, 24.351642000914637, x418 * 0.6328),
+            ) + Self::mul_add(-x412, x427, x413 * x426),
         );
-        let x420 = Self::mul_add(s_q11, x402, c_q11 * x401);
-        let x421 = Self::mul_add(-s_q11, x401, c_q11 * x402);
-        let x422 = x406
-            + Self::mul_add(-0.275, Self::mul_add(x401, x409, x408), -0.63 * x410);
-        let x423 = Self::mul_add(-s_q10, x403, c_q10 * x404)
-            + Self::mul_add(0.63, x412, -0.275 * (x413 - x407));
-        let x424 = x405
-            + Self::mul_add(0.275, Self::mul_add(x402, x402, x411), -0.63 * x414);
-        let x425 = Self::mul_add(s_q11, x423, c_q11 * x422);
-        let x426 = Self::mul_add(v[10], x421, Self::mul_add(s_q11, x408, c_q11 * x407));
-        let x427 = Self::mul_add(
+        let x431 = Self::mul_add(s_q11, x413, c_q11 * x412);
+        let x432 = Self::mul_add(-s_q11, x412, c_q11 * x413);
+        let x433 = x417
+            - Self::mul_add(0.275, Self::mul_add(x412, x420, x419), 0.63 * x421);
+        let x434 = Self::mul_add(-s_q10, x414, c_q10 * x415)
+            + Self::mul_add(-0.275, x424 - x418, 0.63 * x423);
+        let x435 = x416
+            + Self::mul_add(-0.63, x425, 0.275 * Self::mul_add(x413, x413, x422));
+        let x436 = Self::mul_add(s_q11, x434, c_q11 * x433);
+        let x437 = Self::mul_add(v[10], x432, Self::mul_add(s_q11, x419, c_q11 * x418));
+        let x438 = Self::mul_add(
             -v[10],
-            x420,
-            Self::mul_add(-s_q11, x407, c_q11 * x408),
+            x431,
+            Self::mul_add(-s_q11, x418, c_q11 * x419),
         );
-        let x428 = v[10] + x409;
-        let x429 = x420 * x420;
-        let x430 = x421 * x428;
-        let x431 = 0.01675 * x428;
-        let x432 = Self::mul_add(2.5482240016099564, x428, -9.142025249762803 * x421);
-        let x433 = Self::mul_add(
+        let x439 = v[10] + x420;
+        let x440 = x431 * x431;
+        let x441 = x432 * x439;
+        let x442 = 0.01675 * x439;
+        let x443 = Self::mul_add(x432, -9.142025249762803, 2.5482240016099564 * x439);
+        let x444 = Self::mul_add(
             9.223235249762805,
-            x428,
-            Self::mul_add(2.5482240016099564, x421, 0.01675 * x420),
+            x439,
+            Self::mul_add(2.5482240016099564, x432, 0.01675 * x431),
         );
-        let x434 = Self::mul_add(
-            7.078399999258757,
-            x424,
-            Self::mul_add(0.01675, x389, Self::mul_add(-x428, x432, x421 * x433)),
-        );
-        let x435 = Self::mul_add(
-            x425,
-            -7.078399999258757,
-            Self::mul_add(
-                9.223235249762805,
-                x389,
-                Self::mul_add(2.5482240016099564, x427, 0.01675 * x426),
-            ) + Self::mul_add(-x421, x431, x420 * x432),
-        );
-        let x436 = Self::mul_add(-s_q12, x428, Self::mul_add(x10, x421, c_q12 * x420));
-        let x437 = Self::mul_add(-c_q12, x428, Self::mul_add(-s_q12, x420, x11 * x421));
-        let x438 = Self::mul_add(-0.36, Self::mul_add(x420, x428, x427), x425);
-        let x439 = Self::mul_add(
-            -0.36,
-            x430 - x426,
-            Self::mul_add(-s_q11, x422, c_q11 * x423),
-        );
-        let x440 = Self::mul_add(0.36, Self::mul_add(x421, x421, x429), x424);
-        let x441 = Self::mul_add(-s_q12, x440, Self::mul_add(x10, x439, c_q12 * x438));
-        let x442 = Self::mul_add(-c_q12, x440, Self::mul_add(-s_q12, x438, x11 * x439));
-        let x443 = Self::mul_add(-0.00000000020510342851533115, x440, x439);
-        let x444 = Self::mul_add(-0.00000000020510342851533115, x389, x427);
         let x445 = Self::mul_add(
-            v[11],
-            x437,
-            Self::mul_add(-s_q12, x389, Self::mul_add(x10, x427, c_q12 * x426)),
+            7.078399999258757,
+            x435,
+            Self::mul_add(0.01675, x400, Self::mul_add(-x439, x443, x432 * x444)),
         );
         let x446 = Self::mul_add(
-            -v[11],
+            -7.078399999258757,
             x436,
-            Self::mul_add(-c_q12, x389, Self::mul_add(-s_q12, x426, x11 * x427)),
-        );
-        let x447 = v[11] + Self::mul_add(-0.00000000020510342851533115, x428, x421);
-        let x448 = x437 * x437;
-        let x449 = x447 * x447;
-        let x450 = x436 * x437;
-        let x451 = x450 - x444;
-        let x452 = x436 * x447;
-        let x453 = x436 * x436;
-        let x454 = x449 + x453;
-        let x455 = x437 * x447;
-        let x456 = x445 + x455;
-        let x457 = Self::mul_add(-0.809539999555672, x447, -1.9877000000000002 * x437);
-        let x458 = Self::mul_add(
-            -2.741639999592316,
-            x447,
-            Self::mul_add(-5.252920330000002, x437, -1.9877000000000002 * x436),
-        );
-        let x459 = Self::mul_add(
-            9.740442170000001,
-            x447,
-            Self::mul_add(-2.7416399995923166, x437, -0.809539999555672 * x436),
-        );
-        let x460 = Self::mul_add(
-            x443,
-            -3.6140000000000003,
             Self::mul_add(
-                -2.741639999592316,
-                x444,
-                Self::mul_add(-5.252920330000002, x446, -1.9877000000000002 * x445),
-            ) + Self::mul_add(-x436, x459, x447 * x457),
+                9.223235249762805,
+                x400,
+                Self::mul_add(2.5482240016099564, x438, 0.01675 * x437),
+            ) + Self::mul_add(-x432, x442, x431 * x443),
         );
-        let x461 = Self::mul_add(-c_q13, x447, Self::mul_add(s_q13, x437, x13 * x436));
-        let x462 = Self::mul_add(s_q13, x447, Self::mul_add(-x14, x436, c_q13 * x437));
-        let x463 = x441 + Self::mul_add(0.16, x446 + x452, 0.55 * x451);
-        let x464 = x443 + Self::mul_add(-0.16, x448 + x453, 0.55 * x456);
-        let x465 = Self::mul_add(
-            -c_q13,
-            x464,
+        let x447 = Self::mul_add(-s_q12, x439, Self::mul_add(-x12, x432, c_q12 * x431));
+        let x448 = Self::mul_add(c_q12, x439, Self::mul_add(x13, x432, s_q12 * x431));
+        let x449 = Self::mul_add(-0.36, Self::mul_add(x431, x439, x438), x436);
+        let x450 = Self::mul_add(
+            -0.36,
+            x441 - x437,
+            Self::mul_add(-s_q11, x433, c_q11 * x434),
+        );
+        let x451 = Self::mul_add(0.36, Self::mul_add(x432, x432, x440), x435);
+        let x452 = Self::mul_add(-s_q12, x451, Self::mul_add(-x12, x450, c_q12 * x449));
+        let x453 = Self::mul_add(c_q12, x451, Self::mul_add(x13, x450, s_q12 * x449));
+        let x454 = Self::mul_add(-0.00000000020510342851533115, x451, x450);
+        let x455 = Self::mul_add(-0.00000000020510342851533115, x400, x438);
+        let x456 = Self::mul_add(
+            -v[11],
+            x448,
+            Self::mul_add(-s_q12, x400, Self::mul_add(-x12, x438, c_q12 * x437)),
+        );
+        let x457 = Self::mul_add(
+            v[11],
+            x447,
+            Self::mul_add(c_q12, x400, Self::mul_add(x13, x438, s_q12 * x437)),
+        );
+        let x458 = v[11] + Self::mul_add(-0.00000000020510342851533115, x439, x432);
+        let x459 = x448 * x448;
+        let x460 = x458 * x458;
+        let x461 = x447 * x448;
+        let x462 = x455 + x461;
+        let x463 = x447 * x458;
+        let x464 = x447 * x447;
+        let x465 = x460 + x464;
+        let x466 = x448 * x458;
+        let x467 = x456 - x466;
+        let x468 = Self::mul_add(x458, -0.809539999555672, x448 * 1.9877000000000002);
+        let x469 = Self::mul_add(
+            x458,
+            -2.741639999592316,
+            Self::mul_add(x447, -1.9877000000000002, x448 * 5.252920330000002),
+        );
+        let x470 = Self::mul_add(
+            9.740442170000001,
+            x458,
+            Self::mul_add(x447, -0.809539999555672, x448 * 2.7416399995923166),
+        );
+        let x471 = Self::mul_add(
+            -3.6140000000000003,
+            x454,
+            Self::mul_add(
+                x455,
+                -2.741639999592316,
+                Self::mul_add(x456, -1.9877000000000002, x457 * 5.252920330000002),
+            ) + Self::mul_add(-x447, x470, x458 * x468),
+        );
+        let x472 = Self::mul_add(c_q13, x458, Self::mul_add(s_q13, x448, x15 * x447));
+        let x473 = Self::mul_add(s_q13, x458, Self::mul_add(-c_q13, x448, x16 * x447));
+        let x474 = x452 + Self::mul_add(-0.55, x462, 0.16 * (x463 - x457));
+        let x475 = x454 + Self::mul_add(-0.16, x459 + x464, 0.55 * x467);
+        let x476 = Self::mul_add(
+            c_q13,
+            x475,
             Self::mul_add(
                 s_q13,
-                x442 + Self::mul_add(-0.55, x454, 0.16 * (x455 - x445)),
-                x13 * x463,
+                x453 + Self::mul_add(0.16, x456 + x466, 0.55 * x465),
+                x15 * x474,
             ),
         );
-        let x466 = Self::mul_add(-0.00000000020510342851533115, x444, x445);
-        let x467 = Self::mul_add(
-            v[12],
-            x462,
-            Self::mul_add(-c_q13, x444, Self::mul_add(s_q13, x446, x13 * x445)),
-        );
-        let x468 = Self::mul_add(
-            -v[12],
-            x461,
-            Self::mul_add(s_q13, x444, Self::mul_add(-x14, x445, c_q13 * x446)),
-        );
-        let x469 = v[12] + Self::mul_add(-0.00000000020510342851533115, x447, x436);
-        let x470 = 4.806620000000001 * Self::mul_add(x461, x462, -x466);
-        let x471 = 4.806620000000001 * Self::mul_add(x461, x461, x469 * x469);
-        let x472 = 4.806620000000001 * Self::mul_add(x462, x469, x467);
-        let x473 = Self::mul_add(-0.0145, x469, 0.000781 * x462);
-        let x474 = Self::mul_add(
-            -0.9614610000000001,
-            x469,
-            Self::mul_add(-1.2025609200000003, x462, 0.000781 * x461),
-        );
-        let x475 = Self::mul_add(
-            1.4135609200000003,
-            x469,
-            Self::mul_add(-0.9614610000000001, x462, -0.0145 * x461),
-        );
-        let x476 = Self::mul_add(
-            -0.9614610000000001,
-            x466,
-            Self::mul_add(-1.2025609200000003, x468, 0.000781 * x467),
-        ) + Self::mul_add(-x461, x475, x469 * x473);
-        let x477 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x464, x463),
-            Self::mul_add(-0.0145, x466, 0.000781 * x468)
-                + Self::mul_add(-x469, x474, x462 * x475),
-        );
+        let x477 = Self::mul_add(-0.00000000020510342851533115, x455, x456);
         let x478 = Self::mul_add(
-            -4.806620000000001,
-            x465,
+            v[12],
+            x473,
+            -Self::mul_add(c_q13, x455, Self::mul_add(s_q13, x457, x15 * x456)),
+        );
+        let x479 = Self::mul_add(
+            v[12],
+            x472,
+            Self::mul_add(s_q13, x455, Self::mul_add(-c_q13, x457, x16 * x456)),
+        );
+        let x480 = v[12] + Self::mul_add(-0.00000000020510342851533115, x458, x447);
+        let x481 = 4.806620000000001 * Self::mul_add(x472, x473, x477);
+        let x482 = 4.806620000000001 * Self::mul_add(x472, x472, x480 * x480);
+        let x483 = 4.806620000000001 * Self::mul_add(x473, x480, x478);
+        let x484 = Self::mul_add(-0.0145, x480, 0.000781 * x473);
+        let x485 = Self::mul_add(
+            0.9614610000000001,
+            x480,
+            Self::mul_add(1.2025609200000003, x473, 0.000781 * x472),
+        );
+        let x486 = Self::mul_add(
+            1.4135609200000003,
+            x480,
+            Self::mul_add(-0.9614610000000001, x473, 0.0145 * x472),
+        );
+        let x487 = Self::mul_add(
+            -0.9614610000000001,
+            x477,
+            Self::mul_add(-1.2025609200000003, x479, 0.000781 * x478),
+        ) + Self::mul_add(x472, x486, x480 * x484);
+        let x488 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x475, x474),
+            Self::mul_add(-0.0145, x477, 0.000781 * x479)
+                + Self::mul_add(x473, x486, x480 * x485),
+        );
+        let x489 = Self::mul_add(
+            4.806620000000001,
+            x476,
             Self::mul_add(
                 1.4135609200000003,
-                x466,
-                Self::mul_add(-0.9614610000000001, x468, -0.0145 * x467),
-            ) + Self::mul_add(-x462, x473, x461 * x474),
+                x477,
+                -Self::mul_add(0.9614610000000001, x479, 0.0145 * x478),
+            ) + Self::mul_add(-x473, x484, x472 * x485),
         );
-        let x479 = x472 + Self::mul_add(x14, x471, x13 * x470);
-        let x480 = Self::mul_add(-c_q13, x471, s_q13 * x470);
-        let x481 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x472,
-            -Self::mul_add(s_q13, x471, c_q13 * x470),
-        );
-        let x482 = Self::mul_add(
-            -0.55,
-            x479,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x478,
-                Self::mul_add(-c_q13, x477, s_q13 * x476),
-            ),
-        );
-        let x483 = Self::mul_add(
-            -3.6140000000000003,
-            x448 + x449,
-            17.135250000000003 * x451,
-        ) + x479;
-        let x484 = Self::mul_add(
-            -17.135250000000003,
-            x454,
-            3.6140000000000003 * (x444 + x450),
-        ) + x480;
-        let x485 = Self::mul_add(
-            17.135250000000003,
-            x456,
-            3.6140000000000003 * (x452 - x446),
-        ) + x481;
-        let x486 = Self::mul_add(
-            17.135250000000003,
-            x443,
-            Self::mul_add(-0.809539999555672, x444, -1.9877000000000002 * x446)
-                + Self::mul_add(-x447, x458, x437 * x459),
-        )
-            + (x478 + Self::mul_add(-x14, x476, x13 * x477)
-                + Self::mul_add(0.55, x481, -0.16 * x480));
-        let x487 = x460
-            + Self::mul_add(0.16, x479, Self::mul_add(c_q13, x476, s_q13 * x477));
-        let x488 = Self::mul_add(
-            9.740442170000001,
-            x444,
-            Self::mul_add(-2.7416399995923166, x446, -0.809539999555672 * x445),
-        ) + Self::mul_add(-x437, x457, x436 * x458)
-            + Self::mul_add(3.6140000000000003, x442, x441 * -17.135250000000003) + x482;
-        let x489 = Self::mul_add(-s_q12, x484, c_q12 * x483);
-        let x490 = x485 + Self::mul_add(x11, x484, x10 * x483);
-        let x491 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x420, x421, -x389),
-            x489,
-        );
+        let x490 = x483 + Self::mul_add(-x16, x482, x15 * x481);
+        let x491 = Self::mul_add(c_q13, x482, s_q13 * x481);
         let x492 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x428, x428, x429),
-            x490,
+            -0.00000000020510342851533115,
+            x483,
+            Self::mul_add(-s_q13, x482, c_q13 * x481),
         );
         let x493 = Self::mul_add(
+            -0.55,
+            x490,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x489,
+                Self::mul_add(-c_q13, x488, s_q13 * x487),
+            ),
+        );
+        let x494 = x490
+            - Self::mul_add(
+                17.135250000000003,
+                x462,
+                3.6140000000000003 * (x459 + x460),
+            );
+        let x495 = Self::mul_add(
+            -17.135250000000003,
+            x465,
+            3.6140000000000003 * (x455 - x461),
+        ) - x491;
+        let x496 = Self::mul_add(
+            17.135250000000003,
+            x467,
+            3.6140000000000003 * (x457 + x463),
+        ) + x492;
+        let x497 = Self::mul_add(
+            17.135250000000003,
+            x454,
+            Self::mul_add(x455, -0.809539999555672, x457 * 1.9877000000000002)
+                - Self::mul_add(x448, x470, x458 * x469),
+        )
+            + (x489 + Self::mul_add(-x15, x488, x16 * x487)
+                + Self::mul_add(0.55, x492, 0.16 * x491));
+        let x498 = x471
+            + Self::mul_add(0.16, x490, Self::mul_add(c_q13, x487, s_q13 * x488));
+        let x499 = Self::mul_add(
+            9.740442170000001,
+            x455,
+            Self::mul_add(x456, -0.809539999555672, x457 * 2.7416399995923166),
+        ) + Self::mul_add(x447, x469, x448 * x468)
+            - Self::mul_add(3.6140000000000003, x453, 17.135250000000003 * x452) + x493;
+        let x500 = Self::mul_add(-s_q12, x495, c_q12 * x494);
+        let x501 = x496 - Self::mul_add(x13, x495, x12 * x494);
+        let x502 = Self::mul_add(
             7.078399999258757,
-            x426 + x430,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x485,
-                -Self::mul_add(c_q12, x484, s_q12 * x483),
-            ),
+            Self::mul_add(x431, x432, -x400),
+            x500,
         );
-        let x494 = x434
-            + Self::mul_add(0.36, x490, Self::mul_add(-s_q12, x487, c_q12 * x486));
-        let x495 = Self::mul_add(2.5482240016099564, x389, -9.142025249762803 * x427)
-            + Self::mul_add(-x420, x433, x428 * x431)
-            + Self::mul_add(-0.36, x489, x488 + Self::mul_add(x11, x487, x10 * x486));
-        let x496 = x435
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x488,
-                -Self::mul_add(c_q12, x487, s_q12 * x486),
-            );
-        let x497 = Self::mul_add(-s_q11, x492, c_q11 * x491);
-        let x498 = Self::mul_add(c_q11, x492, s_q11 * x491);
-        let x499 = Self::mul_add(-45.1584, x410, x497);
-        let x500 = Self::mul_add(45.1584, x412, x498);
-        let x501 = Self::mul_add(-45.1584, x414, x493);
-        let x502 = x418
-            + (Self::mul_add(-s_q11, x495, c_q11 * x494)
-                + Self::mul_add(-0.63, x493, 0.275 * x498));
-        let x503 = Self::mul_add(-24.35164200091464, x389, -24.4950615 * x408)
-            + Self::mul_add(-x401, x417, x409 * x415)
-            + Self::mul_add(-0.275, x497, Self::mul_add(c_q11, x495, s_q11 * x494));
-        let x504 = x419 + Self::mul_add(0.63, x497, x496);
-        let x505 = Self::mul_add(-s_q10, x500, c_q10 * x499);
-        let x506 = Self::mul_add(-81.53205, x393, x505);
-        let x507 = Self::mul_add(
-            81.53205,
-            x394,
-            Self::mul_add(c_q10, x500, s_q10 * x499),
+        let x503 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(x439, x439, x440),
+            x501,
         );
-        let x508 = Self::mul_add(-81.53205, x395, x501);
-        let x509 = x399
-            + Self::mul_add(-0.87, x501, Self::mul_add(-s_q10, x503, c_q10 * x502));
-        let x510 = Self::mul_add(-36.18604050126307, x389, -63.36336825000001 * x391)
-            + Self::mul_add(-x382, x398, x392 * x396)
-            + Self::mul_add(c_q10, x503, s_q10 * x502);
-        let x511 = x400 + Self::mul_add(0.87, x505, x504);
-        let x512 = Self::mul_add(
-            0.00000000020510342851533115,
-            x508,
-            Self::mul_add(c_q9, x507, s_q9 * x506),
-        );
-        let x513 = x508 + Self::mul_add(x6, x507, x5 * x506);
-        let x514 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x508,
-            Self::mul_add(-s_q9, x507, c_q9 * x506),
-        );
-        let x515 = Self::mul_add(
-            -0.275,
-            x512,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x511,
-                Self::mul_add(-s_q9, x510, c_q9 * x509),
-            ),
-        );
-        let x516 = Self::mul_add(
-            0.000000008530897668050218,
-            x369 + x370,
-            -12.701650001451807 * x372,
-        ) + x512;
-        let x517 = Self::mul_add(
-            12.701650001451807,
-            x375,
-            -0.000000008530897668050218 * (x350 + x371),
-        ) + x513;
-        let x518 = Self::mul_add(
-            -12.701650001451807,
-            x377,
-            -0.000000008530897668050218 * (x367 + x373),
-        ) + x514;
-        let x519 = Self::mul_add(
-            -12.701650001451807,
-            x365,
-            Self::mul_add(0.0000000234896432582596, x367, -0.002139996587640933 * x350)
-                + Self::mul_add(-x368, x379, x359 * x380),
-        )
-            + (Self::mul_add(
+        let x504 = Self::mul_add(
+            7.078399999258757,
+            x437 + x441,
+            -Self::mul_add(
                 0.00000000020510342851533115,
-                x511,
-                Self::mul_add(c_q9, x510, s_q9 * x509),
-            ) + Self::mul_add(0.275, x514, -0.4 * x513));
-        let x520 = x381
-            + Self::mul_add(0.4, x512, x511 + Self::mul_add(x6, x510, x5 * x509));
-        let x521 = Self::mul_add(
-            113.3918902508081,
-            x350,
-            Self::mul_add(-5.080660024070366, x367, -0.002139996587640933 * x366),
-        ) + Self::mul_add(-x359, x378, x358 * x379)
-            + Self::mul_add(-0.000000008530897668050218, x364, x363 * 12.701650001451807)
-            + x515;
-        let x522 = x518 + Self::mul_add(-x3, x517, x2 * x516);
-        let x523 = Self::mul_add(c_q8, x517, s_q8 * x516);
-        let x524 = Self::mul_add(
-            -48.0240000085309,
-            Self::mul_add(x352, x352, x353),
-            x522,
-        );
-        let x525 = Self::mul_add(48.0240000085309, x338 * x339, x523);
-        let x526 = Self::mul_add(
-            48.0240000085309,
-            x351 + x354,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x518,
-                Self::mul_add(-c_q8, x516, s_q8 * x517),
+                x496,
+                Self::mul_add(c_q12, x495, s_q12 * x494),
             ),
         );
-        let x527 = Self::mul_add(0.07309, x351, Self::mul_add(-x352, x356, x339 * x357))
-            + Self::mul_add(-0.35, x523, x521 + Self::mul_add(-x3, x520, x2 * x519));
+        let x505 = x445
+            + Self::mul_add(0.36, x501, Self::mul_add(-s_q12, x498, c_q12 * x497));
+        let x506 = Self::mul_add(x438, -9.142025249762803, 2.5482240016099564 * x400)
+            + Self::mul_add(-x431, x444, x439 * x442)
+            + Self::mul_add(-0.36, x500, x499 - Self::mul_add(x13, x498, x12 * x497));
+        let x507 = x446
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x499,
+                Self::mul_add(c_q12, x498, s_q12 * x497),
+            );
+        let x508 = Self::mul_add(-s_q11, x503, c_q11 * x502);
+        let x509 = Self::mul_add(c_q11, x503, s_q11 * x502);
+        let x510 = Self::mul_add(x421, -45.1584, x508);
+        let x511 = Self::mul_add(45.1584, x423, x509);
+        let x512 = Self::mul_add(-45.1584, x425, x504);
+        let x513 = x429
+            + (Self::mul_add(-s_q11, x506, c_q11 * x505)
+                + Self::mul_add(-0.63, x504, 0.275 * x509));
+        let x514 = Self::mul_add(-0.275, x508, Self::mul_add(c_q11, x506, s_q11 * x505))
+            - (Self::mul_add(x400, 24.35164200091464, x419 * 24.4950615)
+                + Self::mul_add(x412, x428, x420 * x426));
+        let x515 = x430 + Self::mul_add(0.63, x508, x507);
+        let x516 = Self::mul_add(-s_q10, x511, c_q10 * x510);
+        let x517 = Self::mul_add(x404, -81.53205, x516);
+        let x518 = Self::mul_add(
+            81.53205,
+            x405,
+            Self::mul_add(c_q10, x511, s_q10 * x510),
+        );
+        let x519 = Self::mul_add(-81.53205, x406, x512);
+        let x520 = x410
+            + Self::mul_add(-0.87, x512, Self::mul_add(-s_q10, x514, c_q10 * x513));
+        let x521 = Self::mul_add(c_q10, x514, s_q10 * x513)
+            - (Self::mul_add(x400, 36.18604050126307, x402 * 63.36336825000001)
+                + Self::mul_add(x393, x409, x403 * x407));
+        let x522 = x411 + Self::mul_add(0.87, x516, x515);
+        let x523 = 0.00000000020510342851533115 * x519;
+        let x524 = Self::mul_add(c_q9, x518, s_q9 * x517) + x523;
+        let x525 = x519 + Self::mul_add(-x8, x518, x7 * x517);
+        let x526 = Self::mul_add(-s_q9, x518, c_q9 * x517) - x523;
+        let x527 = 0.00000000020510342851533115 * x522;
         let x528 = Self::mul_add(
-            x348,
-            -48.0240000085309,
-            Self::mul_add(-130.43769025763282, x351, -0.07309 * x350)
-                + Self::mul_add(-x338, x357, x352 * x355),
-        ) + Self::mul_add(0.35, x522, Self::mul_add(c_q8, x520, s_q8 * x519));
+            x383,
+            -12.701650001451807,
+            (x380 + x381) * 0.000000008530897668050218,
+        ) + x524;
         let x529 = Self::mul_add(
+            -0.000000008530897668050218,
+            x361 + x382,
+            12.701650001451807 * x386,
+        ) + x525;
+        let x530 = x526
+            - Self::mul_add(
+                12.701650001451807,
+                x388,
+                0.000000008530897668050218 * (x384 - x378),
+            );
+        let x531 = Self::mul_add(
+            x376,
+            -12.701650001451807,
+            Self::mul_add(-x379, x390, x370 * x391)
+                - Self::mul_add(
+                    x361,
+                    0.002139996587640933,
+                    x378 * 0.0000000234896432582596,
+                ),
+        )
+            + (Self::mul_add(c_q9, x521, s_q9 * x520) + x527
+                + Self::mul_add(-0.4, x525, 0.275 * x526));
+        let x532 = x392
+            + Self::mul_add(0.4, x524, x522 + Self::mul_add(-x8, x521, x7 * x520));
+        let x533 = Self::mul_add(
+            113.3918902508081,
+            x361,
+            Self::mul_add(x377, -0.002139996587640933, 5.080660024070366 * x378),
+        ) + Self::mul_add(x369, x390, x370 * x389)
+            + Self::mul_add(x375, -0.000000008530897668050218, x374 * 12.701650001451807)
+            + Self::mul_add(
+                -0.275,
+                x524,
+                Self::mul_add(-s_q9, x521, c_q9 * x520) - x527,
+            );
+        let x534 = x530 + Self::mul_add(-x2, x528, x3 * x529);
+        let x535 = Self::mul_add(c_q8, x529, s_q8 * x528);
+        let x536 = Self::mul_add(
+            -48.0240000085309,
+            Self::mul_add(x363, x363, x364),
+            x534,
+        );
+        let x537 = Self::mul_add(48.0240000085309, x349 * x350, x535);
+        let x538 = Self::mul_add(
             48.0240000085309,
-            x349,
-            Self::mul_add(-0.1132, x351, -16.80768997608804 * x350)
-                + Self::mul_add(-x339, x355, x338 * x356),
+            x362 + x365,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x530,
+                Self::mul_add(-c_q8, x528, s_q8 * x529),
+            ),
+        );
+        let x539 = Self::mul_add(x362, 0.07309, Self::mul_add(-x363, x367, x350 * x368))
+            + Self::mul_add(-0.35, x535, x533 + Self::mul_add(-x2, x531, x3 * x532));
+        let x540 = Self::mul_add(0.35, x534, Self::mul_add(c_q8, x532, s_q8 * x531))
+            - Self::mul_add(
+                48.0240000085309,
+                x359,
+                Self::mul_add(130.43769025763282, x362, x361 * 0.07309)
+                    + Self::mul_add(x349, x368, x363 * x366),
+            );
+        let x541 = Self::mul_add(
+            48.0240000085309,
+            x360,
+            Self::mul_add(x349, x367, x350 * x366)
+                - Self::mul_add(0.1132, x362, x361 * 16.80768997608804),
         )
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x521,
-                Self::mul_add(-c_q8, x519, s_q8 * x520),
+                x533,
+                Self::mul_add(-c_q8, x531, s_q8 * x532),
             );
-        let x530 = Self::mul_add(-s_q7, x525, c_q7 * x524);
-        let x531 = Self::mul_add(c_q7, x525, s_q7 * x524);
-        let x532 = Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]);
-        let x533 = 1466.4506062283303 * v[4];
-        let x534 = Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]);
-        let x535 = x530
+        let x542 = Self::mul_add(-s_q7, x537, c_q7 * x536);
+        let x543 = Self::mul_add(c_q7, x537, s_q7 * x536);
+        let x544 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x545 = 1466.4506062283303 * v[4];
+        let x546 = Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]);
+        let x547 = x542
             + Self::mul_add(
                 1170.07,
-                x335,
-                Self::mul_add(-110.5455, x341, 180.9502499901501 * x343),
+                x346,
+                Self::mul_add(-110.5455, x352, 180.9502499901501 * x354),
             );
-        let x536 = x531
+        let x548 = x543
             + Self::mul_add(
                 1170.07,
-                x336,
-                Self::mul_add(180.9502499901501, x344, 110.5455 * x342),
+                x347,
+                Self::mul_add(180.9502499901501, x355, 110.5455 * x353),
             );
-        let x537 = x526
+        let x549 = x538
             + Self::mul_add(
                 1170.07,
-                x337,
-                Self::mul_add(-180.9502499901501, x345, 110.5455 * x343),
+                x348,
+                Self::mul_add(-180.9502499901501, x356, 110.5455 * x354),
             );
-        let x538 = Self::mul_add(-0.75, x531, Self::mul_add(-s_q7, x528, c_q7 * x527))
+        let x550 = Self::mul_add(-0.75, x543, Self::mul_add(-s_q7, x540, c_q7 * x539))
             + Self::mul_add(
-                x336,
                 -180.9502499901501,
-                Self::mul_add(-v[5], x533, v[4] * x534),
+                x347,
+                Self::mul_add(-v[5], x545, v[4] * x546),
             );
-        let x539 = Self::mul_add(c_q7, x528, s_q7 * x527)
-            + Self::mul_add(-0.65, x526, 0.75 * x530)
-            + (Self::mul_add(-v[3], x534, v[5] * x532)
-                + Self::mul_add(x337, -110.5455, 180.9502499901501 * x335));
-        let x540 = Self::mul_add(0.65, x531, x529)
-            + Self::mul_add(110.5455, x336, Self::mul_add(-v[4], x532, v[3] * x533));
+        let x551 = Self::mul_add(c_q7, x540, s_q7 * x539)
+            + Self::mul_add(-0.65, x538, 0.75 * x542)
+            + (Self::mul_add(-v[3], x546, v[5] * x544)
+                + Self::mul_add(-110.5455, x348, 180.9502499901501 * x346));
+        let x552 = Self::mul_add(0.65, x543, x541)
+            + Self::mul_add(110.5455, x347, Self::mul_add(-v[4], x544, v[3] * x545));
         (
             [
                 [
@@ -5872,217 +5817,217 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x193,
-                    x183,
-                    x183,
-                    x205,
-                    x221,
-                    x238,
-                    x260,
-                    x291,
-                    x330,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x198,
-                    0.0,
-                    x192,
-                    x181,
+                    x195,
+                    x186,
+                    x186,
                     x206,
-                    x222,
-                    x239,
-                    x261,
-                    x292,
-                    x331,
+                    x223,
+                    x242,
+                    x266,
+                    x301,
+                    x341,
+                ],
+                [
+                    0.0,
+                    1170.07,
+                    0.0,
+                    x200,
+                    0.0,
+                    x194,
+                    x184,
+                    x207,
+                    x224,
+                    x243,
+                    x267,
+                    x302,
+                    x342,
                 ],
                 [
                     0.0,
                     0.0,
                     1170.07,
-                    x182,
-                    x199,
+                    x185,
+                    x201,
                     0.0,
                     0.0,
-                    x153,
-                    x217,
-                    x234,
-                    x256,
-                    x287,
-                    x326,
+                    x157,
+                    x218,
+                    x237,
+                    x261,
+                    x297,
+                    x337,
                 ],
                 [
                     0.0,
-                    x198,
-                    x182,
-                    x194,
-                    x191,
-                    x195,
-                    x188,
-                    x207,
-                    x223,
-                    x240,
-                    x262,
-                    x293,
-                    x332,
-                ],
-                [
-                    x193,
-                    0.0,
-                    x199,
-                    x191,
+                    x200,
+                    x185,
                     x196,
-                    x189,
-                    x189,
-                    x208,
-                    x224,
-                    x241,
-                    x263,
-                    x294,
-                    x333,
-                ],
-                [
-                    x183,
-                    x192,
-                    0.0,
-                    x195,
-                    x189,
+                    x191,
                     x197,
                     x190,
-                    x209,
+                    x208,
                     x225,
-                    x242,
-                    x264,
-                    x295,
-                    x334,
+                    x244,
+                    x268,
+                    x303,
+                    x343,
                 ],
                 [
-                    x183,
-                    x181,
+                    x195,
                     0.0,
-                    x188,
-                    x189,
-                    x190,
-                    x175,
-                    x163,
-                    x218,
-                    x235,
-                    x257,
-                    x288,
-                    x327,
+                    x201,
+                    x191,
+                    x198,
+                    x192,
+                    x192,
+                    x209,
+                    x226,
+                    x245,
+                    x269,
+                    x304,
+                    x344,
                 ],
                 [
-                    x205,
+                    x186,
+                    x194,
+                    0.0,
+                    x197,
+                    x192,
+                    x199,
+                    x193,
+                    x210,
+                    x227,
+                    x246,
+                    x270,
+                    x305,
+                    x345,
+                ],
+                [
+                    x186,
+                    x184,
+                    0.0,
+                    x190,
+                    x192,
+                    x193,
+                    x178,
+                    x167,
+                    x219,
+                    x238,
+                    x262,
+                    x298,
+                    x338,
+                ],
+                [
                     x206,
-                    x153,
                     x207,
+                    x157,
                     x208,
                     x209,
-                    x163,
-                    x151,
-                    x214,
-                    x231,
-                    x253,
-                    x284,
-                    x323,
+                    x210,
+                    x167,
+                    x155,
+                    x215,
+                    x234,
+                    x258,
+                    x294,
+                    x334,
                 ],
                 [
-                    x221,
-                    x222,
-                    x217,
                     x223,
                     x224,
-                    x225,
                     x218,
-                    x214,
-                    x115,
-                    x107,
-                    x247,
-                    x278,
-                    x317,
-                ],
-                [
-                    x238,
-                    x239,
-                    x234,
-                    x240,
-                    x241,
-                    x242,
-                    x235,
-                    x231,
-                    x107,
-                    x91,
-                    x85,
-                    x273,
-                    x312,
-                ],
-                [
-                    x260,
-                    x261,
-                    x256,
-                    x262,
-                    x263,
-                    x264,
-                    x257,
-                    x253,
-                    x247,
-                    x85,
-                    x70,
-                    x58,
-                    x305,
-                ],
-                [
-                    x291,
-                    x292,
-                    x287,
-                    x293,
-                    x294,
-                    x295,
-                    x288,
-                    x284,
-                    x278,
-                    x273,
-                    x58,
-                    x45,
-                    x301,
-                ],
-                [
-                    x330,
-                    x331,
+                    x225,
+                    x226,
+                    x227,
+                    x219,
+                    x215,
+                    x112,
+                    x106,
+                    x251,
+                    x286,
                     x326,
-                    x332,
-                    x333,
-                    x334,
-                    x327,
-                    x323,
-                    x317,
-                    x312,
-                    x305,
+                ],
+                [
+                    x242,
+                    x243,
+                    x237,
+                    x244,
+                    x245,
+                    x246,
+                    x238,
+                    x234,
+                    x106,
+                    x92,
+                    x86,
+                    x280,
+                    x321,
+                ],
+                [
+                    x266,
+                    x267,
+                    x261,
+                    x268,
+                    x269,
+                    x270,
+                    x262,
+                    x258,
+                    x251,
+                    x86,
+                    x72,
+                    x61,
+                    x314,
+                ],
+                [
                     x301,
+                    x302,
+                    x297,
+                    x303,
+                    x304,
+                    x305,
+                    x298,
+                    x294,
+                    x286,
+                    x280,
+                    x61,
+                    x47,
+                    x309,
+                ],
+                [
+                    x341,
+                    x342,
+                    x337,
+                    x343,
+                    x344,
+                    x345,
+                    x338,
+                    x334,
+                    x326,
+                    x321,
+                    x314,
+                    x309,
                     1.4135609200000003,
                 ],
             ],
             [
-                x535,
-                x536,
-                x537,
-                x538,
-                x539,
-                x540,
-                x529,
-                x521,
-                x511,
-                x504,
-                x496,
-                x488,
-                x478,
+                x547,
+                x548,
+                x549,
+                x550,
+                x551,
+                x552,
+                x541,
+                x533,
+                x522,
+                x515,
+                x507,
+                x499,
+                x489,
             ],
         )
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: forward `aba`: 1613 mul, 1325 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 987 fused where the target has FMA.
+    /// Methods: forward `aba`: 1592 mul, 1325 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 954 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -6091,32 +6036,32 @@ impl FreeFloating7 {
         f_ext: &[[f64; 6]; 8],
     ) -> [f64; 13] {
         let x0 = Self::mul_add(
-            v[1],
             -180.9502499901501,
-            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
+            v[1],
+            Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
         );
         let x1 = Self::mul_add(
             1466.4506062283303,
             v[4],
-            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
+            Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         );
         let x2 = Self::mul_add(
             110.5455,
             v[1],
-            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
+            Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]),
         );
-        let x3 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]);
+        let x3 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
         let x4 = Self::mul_add(
             1170.07,
             v[1],
-            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
+            -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
         );
         let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
         let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x9 = Self::mul_add(v[4], 0.75, v[0]);
-        let x10 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x9 = Self::mul_add(0.75, v[4], v[0]);
+        let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x11 = Self::mul_add(-0.65, v[4], v[2]);
         let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
         let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
@@ -6125,14 +6070,14 @@ impl FreeFloating7 {
         let x16 = v[6] * x13;
         let x17 = v[6] * x12;
         let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(-16.80768997608804, x18, -0.07309 * x8);
+        let x19 = Self::mul_add(x18, 16.80768997608804, x8 * 0.07309);
         let x20 = Self::mul_add(
-            x11,
             -48.0240000085309,
+            x11,
             Self::mul_add(
                 0.1132,
                 x18,
-                Self::mul_add(130.43769025763282, x8, -0.07309 * x7),
+                Self::mul_add(x7, -0.07309, 130.43769025763282 * x8),
             ),
         );
         let x21 = Self::mul_add(
@@ -6141,20 +6086,20 @@ impl FreeFloating7 {
             Self::mul_add(
                 132.47349025763282,
                 x18,
-                Self::mul_add(0.1132, x8, -16.80768997608804 * x7),
+                Self::mul_add(x7, -16.80768997608804, 0.1132 * x8),
             ),
         );
-        let x22 = x18 * -48.0240000085309;
+        let x22 = 48.0240000085309 * x18;
         let x23 = 48.0240000085309 * x8;
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x25 = -0.00000000020510342851533115 * c_q8;
-        let x26 = -0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x7, x26, x8 * c_q8));
-        let x29 = Self::mul_add(x8, 0.35, x12);
+        let x25 = 0.00000000020510342851533115 * c_q8;
+        let x26 = 0.00000000020510342851533115 * s_q8;
+        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(-x7, x25, x8 * s_q8));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(x8, c_q8, x7 * x26));
+        let x29 = Self::mul_add(0.35, x8, x12);
         let x30 = Self::mul_add(-0.35, x7, x13);
-        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-x26, x29, c_q8 * x30));
+        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(-x25, x29, s_q8 * x30));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(c_q8, x30, x26 * x29));
         let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
         let x34 = v[7] * x28;
         let x35 = v[7] * x27;
@@ -6162,9 +6107,9 @@ impl FreeFloating7 {
         let x37 = v[7] * x31;
         let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
         let x39 = Self::mul_add(
-            -12.701650001451807,
             x33,
-            Self::mul_add(-0.002139996587640933, x38, -0.0000000234896432582596 * x28),
+            12.701650001451807,
+            Self::mul_add(x38, 0.002139996587640933, x28 * 0.0000000234896432582596),
         );
         let x40 = Self::mul_add(
             x33,
@@ -6172,1620 +6117,1556 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x38,
-                Self::mul_add(-111.7548902508081, x28, -0.0000000234896432582596 * x27),
+                -Self::mul_add(x28, 111.7548902508081, x27 * 0.0000000234896432582596),
             ),
         );
         let x41 = Self::mul_add(
             113.3918902508081,
             x38,
-            Self::mul_add(5.080660024070366, x28, -0.002139996587640933 * x27),
-        ) + Self::mul_add(-0.000000008530897668050218, x32, x31 * 12.701650001451807);
-        let x42 = -12.701650001451807 * x38;
+            Self::mul_add(x27, -0.002139996587640933, 5.080660024070366 * x28),
+        ) + Self::mul_add(x32, -0.000000008530897668050218, x31 * 12.701650001451807);
+        let x42 = x38 * 12.701650001451807;
         let x43 = x38 * 0.000000008530897668050218;
         let x44 = Self::mul_add(
-            -0.000000008530897668050218,
             x28,
+            -0.000000008530897668050218,
             x27 * 12.701650001451807,
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x46 = Self::mul_add(
+        let x46 = 0.00000000020510342851533115 * c_q9;
+        let x47 = 0.00000000020510342851533115 * s_q9;
+        let x48 = x46 - x47;
+        let x49 = x46 + x47;
+        let x50 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x48, x27 * s_q9));
+        let x51 = Self::mul_add(-x38, s_q9, Self::mul_add(-x28, x49, x27 * c_q9));
+        let x52 = x31 - Self::mul_add(-0.4, x28, 0.275 * x38);
+        let x53 = Self::mul_add(-0.4, x27, x32);
+        let x54 = Self::mul_add(0.275, x27, x33);
+        let x55 = Self::mul_add(c_q9, x54, Self::mul_add(x48, x53, s_q9 * x52));
+        let x56 = Self::mul_add(-s_q9, x54, Self::mul_add(-x49, x53, c_q9 * x52));
+        let x57 = Self::mul_add(
             -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
+            x54,
+            Self::mul_add(0.00000000020510342851533115, x52, x53),
         );
-        let x47 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x48 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x46, x27 * s_q9));
-        let x49 = Self::mul_add(-x38, s_q9, Self::mul_add(x28, x47, x27 * c_q9));
-        let x50 = x31 - Self::mul_add(0.275, x38, x28 * -0.4);
-        let x51 = Self::mul_add(-0.4, x27, x32);
-        let x52 = Self::mul_add(0.275, x27, x33);
-        let x53 = Self::mul_add(c_q9, x52, Self::mul_add(x46, x51, s_q9 * x50));
-        let x54 = Self::mul_add(-s_q9, x52, Self::mul_add(x47, x51, c_q9 * x50));
-        let x55 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x52,
-            Self::mul_add(0.00000000020510342851533115, x50, x51),
-        );
-        let x56 = v[8] * x49;
-        let x57 = v[8] * x48;
-        let x58 = v[8] * x54;
-        let x59 = v[8] * x53;
-        let x60 = v[8]
+        let x58 = v[8] * x51;
+        let x59 = v[8] * x50;
+        let x60 = v[8] * x56;
+        let x61 = v[8] * x55;
+        let x62 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x38,
                 Self::mul_add(0.00000000020510342851533115, x27, x28),
             );
-        let x61 = Self::mul_add(-36.18604050126307, x60, -63.36336825000001 * x49);
-        let x62 = Self::mul_add(-81.53205, x55, -0.00214 * x60);
-        let x63 = Self::mul_add(
-            x53,
+        let x63 = Self::mul_add(x62, 36.18604050126307, x51 * 63.36336825000001);
+        let x64 = Self::mul_add(x57, 81.53205, x62 * 0.00214);
+        let x65 = Self::mul_add(
+            x55,
             81.53205,
             Self::mul_add(
                 69.99836825,
-                x60,
-                Self::mul_add(-36.18604050126307, x49, -0.00214 * x48),
+                x62,
+                -Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
             ),
         );
-        let x64 = -81.53205 * x60;
-        let x65 = x48 * 81.53205;
+        let x66 = x62 * 81.53205;
+        let x67 = x50 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x67 = Self::mul_add(x49, s_q10, x48 * c_q10);
-        let x68 = Self::mul_add(-x48, s_q10, x49 * c_q10);
-        let x69 = Self::mul_add(0.87, x60, x53);
-        let x70 = Self::mul_add(x48, -0.87, x55);
-        let x71 = Self::mul_add(x54, s_q10, c_q10 * x69);
-        let x72 = Self::mul_add(-s_q10, x69, x54 * c_q10);
-        let x73 = v[9] * x68;
-        let x74 = v[9] * x67;
-        let x75 = v[9] * x72;
-        let x76 = v[9] * x71;
-        let x77 = v[9] + x60;
-        let x78 = Self::mul_add(-24.35164200091464, x77, -24.4950615 * x68);
-        let x79 = Self::mul_add(-45.1584, x70, -0.6328 * x77);
-        let x80 = Self::mul_add(
-            x71,
+        let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
+        let x70 = Self::mul_add(-x50, s_q10, x51 * c_q10);
+        let x71 = Self::mul_add(x62, 0.87, x55);
+        let x72 = Self::mul_add(x50, -0.87, x57);
+        let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
+        let x74 = Self::mul_add(-s_q10, x71, x56 * c_q10);
+        let x75 = v[9] * x70;
+        let x76 = v[9] * x69;
+        let x77 = v[9] * x74;
+        let x78 = v[9] * x73;
+        let x79 = v[9] + x62;
+        let x80 = Self::mul_add(x79, 24.35164200091464, x70 * 24.4950615);
+        let x81 = Self::mul_add(x72, 45.1584, x79 * 0.6328);
+        let x82 = Self::mul_add(
+            x73,
             45.1584,
             Self::mul_add(
                 28.2393615,
-                x77,
-                Self::mul_add(-24.351642000914637, x68, -0.6328 * x67),
+                x79,
+                -Self::mul_add(x70, 24.351642000914637, x69 * 0.6328),
             ),
         );
-        let x81 = -45.1584 * x77;
-        let x82 = x67 * 45.1584;
+        let x83 = x79 * 45.1584;
+        let x84 = x69 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x84 = Self::mul_add(x68, s_q11, x67 * c_q11);
-        let x85 = Self::mul_add(-x67, s_q11, x68 * c_q11);
-        let x86 = x71 - Self::mul_add(-0.63, x77, 0.275 * x68);
-        let x87 = Self::mul_add(0.275, x67, x72);
-        let x88 = Self::mul_add(x67, -0.63, x70);
-        let x89 = Self::mul_add(s_q11, x87, c_q11 * x86);
-        let x90 = Self::mul_add(-s_q11, x86, c_q11 * x87);
-        let x91 = v[10] * x85;
-        let x92 = v[10] * x84;
-        let x93 = v[10] * x90;
-        let x94 = v[10] * x89;
-        let x95 = v[10] + x77;
-        let x96 = Self::mul_add(2.5482240016099564, x95, -9.142025249762803 * x85);
-        let x97 = Self::mul_add(7.078399999258757, x88, 0.01675 * x95);
-        let x98 = Self::mul_add(
-            x89,
+        let x86 = Self::mul_add(x70, s_q11, x69 * c_q11);
+        let x87 = Self::mul_add(-x69, s_q11, x70 * c_q11);
+        let x88 = x73 - Self::mul_add(x79, -0.63, 0.275 * x70);
+        let x89 = Self::mul_add(0.275, x69, x74);
+        let x90 = Self::mul_add(x69, -0.63, x72);
+        let x91 = Self::mul_add(s_q11, x89, c_q11 * x88);
+        let x92 = Self::mul_add(-s_q11, x88, c_q11 * x89);
+        let x93 = v[10] * x87;
+        let x94 = v[10] * x86;
+        let x95 = v[10] * x92;
+        let x96 = v[10] * x91;
+        let x97 = v[10] + x79;
+        let x98 = Self::mul_add(x87, -9.142025249762803, 2.5482240016099564 * x97);
+        let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
+        let x100 = Self::mul_add(
             -7.078399999258757,
+            x91,
             Self::mul_add(
                 9.223235249762805,
-                x95,
-                Self::mul_add(2.5482240016099564, x85, 0.01675 * x84),
+                x97,
+                Self::mul_add(2.5482240016099564, x87, 0.01675 * x86),
             ),
         );
-        let x99 = 7.078399999258757 * x95;
-        let x100 = x84 * -7.078399999258757;
+        let x101 = 7.078399999258757 * x97;
+        let x102 = 7.078399999258757 * x86;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x102 = -0.00000000020510342851533115 * s_q12;
-        let x103 = -0.00000000020510342851533115 * c_q12;
-        let x104 = Self::mul_add(-x95, s_q12, Self::mul_add(x85, x102, x84 * c_q12));
-        let x105 = Self::mul_add(-x95, c_q12, Self::mul_add(-x84, s_q12, x85 * x103));
-        let x106 = Self::mul_add(x85, -0.36, x89);
-        let x107 = Self::mul_add(0.36, x84, x90);
-        let x108 = Self::mul_add(-x88, s_q12, Self::mul_add(x102, x107, c_q12 * x106));
-        let x109 = Self::mul_add(-x88, c_q12, Self::mul_add(-s_q12, x106, x103 * x107));
-        let x110 = Self::mul_add(-0.00000000020510342851533115, x88, x107);
-        let x111 = v[11] * x105;
-        let x112 = v[11] * x104;
-        let x113 = v[11] * x109;
-        let x114 = v[11] * x108;
-        let x115 = v[11] + Self::mul_add(-0.00000000020510342851533115, x95, x85);
-        let x116 = Self::mul_add(
+        let x104 = 0.00000000020510342851533115 * s_q12;
+        let x105 = 0.00000000020510342851533115 * c_q12;
+        let x106 = Self::mul_add(-x97, s_q12, Self::mul_add(-x87, x104, x86 * c_q12));
+        let x107 = Self::mul_add(x97, c_q12, Self::mul_add(x87, x105, x86 * s_q12));
+        let x108 = Self::mul_add(x87, -0.36, x91);
+        let x109 = Self::mul_add(x86, 0.36, x92);
+        let x110 = Self::mul_add(-x90, s_q12, Self::mul_add(-x104, x109, c_q12 * x108));
+        let x111 = Self::mul_add(x90, c_q12, Self::mul_add(x105, x109, s_q12 * x108));
+        let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
+        let x113 = v[11] * x107;
+        let x114 = v[11] * x106;
+        let x115 = v[11] * x111;
+        let x116 = v[11] * x110;
+        let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
+        let x118 = Self::mul_add(
             17.135250000000003,
-            x110,
-            Self::mul_add(-0.809539999555672, x115, -1.9877000000000002 * x105),
+            x112,
+            Self::mul_add(x117, -0.809539999555672, x107 * 1.9877000000000002),
         );
-        let x117 = Self::mul_add(
-            x110,
+        let x119 = Self::mul_add(
             -3.6140000000000003,
+            x112,
             Self::mul_add(
+                x117,
                 -2.741639999592316,
-                x115,
-                Self::mul_add(-5.252920330000002, x105, -1.9877000000000002 * x104),
+                Self::mul_add(x106, -1.9877000000000002, x107 * 5.252920330000002),
             ),
         );
-        let x118 = Self::mul_add(
+        let x120 = Self::mul_add(
             9.740442170000001,
-            x115,
-            Self::mul_add(-2.7416399995923166, x105, -0.809539999555672 * x104),
-        ) + Self::mul_add(3.6140000000000003, x109, x108 * -17.135250000000003);
-        let x119 = 17.135250000000003 * x115;
-        let x120 = x115 * -3.6140000000000003;
-        let x121 = Self::mul_add(3.6140000000000003, x105, x104 * -17.135250000000003);
+            x117,
+            Self::mul_add(x106, -0.809539999555672, x107 * 2.7416399995923166),
+        ) - Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
+        let x121 = 17.135250000000003 * x117;
+        let x122 = 3.6140000000000003 * x117;
+        let x123 = Self::mul_add(3.6140000000000003, x107, 17.135250000000003 * x106);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x123 = -0.00000000020510342851533115 * c_q13;
-        let x124 = -0.00000000020510342851533115 * s_q13;
-        let x125 = Self::mul_add(-x115, c_q13, Self::mul_add(x105, s_q13, x104 * x123));
-        let x126 = Self::mul_add(x115, s_q13, Self::mul_add(-x104, x124, x105 * c_q13));
-        let x127 = x108 - Self::mul_add(0.55, x115, -0.16 * x105);
-        let x128 = Self::mul_add(-0.16, x104, x109);
-        let x129 = Self::mul_add(x104, 0.55, x110);
-        let x130 = Self::mul_add(-c_q13, x129, Self::mul_add(s_q13, x128, x123 * x127));
-        let x131 = Self::mul_add(s_q13, x129, Self::mul_add(-x124, x127, c_q13 * x128));
-        let x132 = Self::mul_add(-0.00000000020510342851533115, x129, x127);
-        let x133 = v[12] * x126;
-        let x134 = v[12] * x125;
-        let x135 = v[12] * x131;
-        let x136 = v[12] + Self::mul_add(-0.00000000020510342851533115, x115, x104);
-        let x137 = Self::mul_add(
-            -0.9614610000000001,
-            x136,
-            Self::mul_add(-1.2025609200000003, x126, 0.000781 * x125),
+        let x125 = 0.00000000020510342851533115 * c_q13;
+        let x126 = 0.00000000020510342851533115 * s_q13;
+        let x127 = Self::mul_add(x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
+        let x128 = Self::mul_add(x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
+        let x129 = x110 - Self::mul_add(0.55, x117, 0.16 * x107);
+        let x130 = Self::mul_add(0.16, x106, x111);
+        let x131 = Self::mul_add(0.55, x106, x112);
+        let x132 = Self::mul_add(c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
+        let x133 = Self::mul_add(s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
+        let x134 = Self::mul_add(-0.00000000020510342851533115, x131, x129);
+        let x135 = v[12] * x128;
+        let x136 = v[12] * x127;
+        let x137 = v[12] * x133;
+        let x138 = v[12] + Self::mul_add(-0.00000000020510342851533115, x117, x106);
+        let x139 = Self::mul_add(
+            x138,
+            0.9614610000000001,
+            Self::mul_add(x128, 1.2025609200000003, 0.000781 * x127),
         );
-        let x138 = Self::mul_add(
+        let x140 = Self::mul_add(
+            4.806620000000001,
+            x134,
+            Self::mul_add(x138, -0.0145, 0.000781 * x128),
+        );
+        let x141 = Self::mul_add(
             4.806620000000001,
             x132,
-            Self::mul_add(-0.0145, x136, 0.000781 * x126),
-        );
-        let x139 = Self::mul_add(
-            x130,
-            -4.806620000000001,
             Self::mul_add(
                 1.4135609200000003,
-                x136,
-                Self::mul_add(-0.9614610000000001, x126, -0.0145 * x125),
+                x138,
+                Self::mul_add(x128, -0.9614610000000001, x127 * 0.0145),
             ),
         );
-        let x140 = 4.806620000000001 * x136;
-        let x141 = x125 * -4.806620000000001;
-        let x142 = Self::mul_add(x131, x140, Self::mul_add(-x126, x138, x125 * x137))
+        let x142 = 4.806620000000001 * x138;
+        let x143 = 4.806620000000001 * x127;
+        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x128, x140, x127 * x139))
             - f_ext[7][5];
-        let x143 = Self::mul_add(-x136, x140, x125 * x141) - f_ext[7][1];
-        let x144 = tau[6] - x142;
-        let x145 = Self::mul_add(
+        let x145 = f_ext[7][1] + Self::mul_add(x127, x143, x138 * x142);
+        let x146 = tau[6] - x144;
+        let x147 = Self::mul_add(
             4.806620000000001,
-            x133,
-            Self::mul_add(x126, x140, -f_ext[7][2]),
+            x135,
+            Self::mul_add(x128, x142, -f_ext[7][2]),
         );
-        let x146 = Self::mul_add(
-            x144,
+        let x148 = Self::mul_add(
+            x146,
             -0.010257782169020348,
-            Self::mul_add(-x131, x141, Self::mul_add(-x136, x137, x126 * x139))
+            Self::mul_add(-x133, x143, Self::mul_add(x128, x141, x138 * x139))
                 - f_ext[7][3]
-                + Self::mul_add(
-                    x135,
-                    -0.049305260929256585,
+                - Self::mul_add(
+                    x137,
+                    0.049305260929256585,
                     Self::mul_add(
-                        x134,
+                        x136,
                         0.009081457502008472,
-                        x133 * -0.00014873784145079505,
+                        x135 * 0.00014873784145079505,
                     ),
                 ),
         );
-        let x147 = Self::mul_add(
-            x144,
+        let x149 = Self::mul_add(
+            x146,
             -0.6801694828971361,
-            Self::mul_add(-x125, x139, x136 * x138)
-                + Self::mul_add(-x132, x140, x130 * x141) - f_ext[7][4]
-                + Self::mul_add(
-                    x135,
-                    -3.2693162398830324,
-                    Self::mul_add(x134, 1.8565173511957638, x133 * -0.009081457502008472),
+            Self::mul_add(x127, x141, x138 * x140)
+                - Self::mul_add(x132, x143, x134 * x142) - f_ext[7][4]
+                - Self::mul_add(
+                    x137,
+                    3.2693162398830324,
+                    Self::mul_add(x136, 1.8565173511957638, x135 * 0.009081457502008472),
                 ),
         );
-        let x148 = x142 + x144;
-        let x149 = Self::mul_add(
-            x144,
-            -3.4003628227073506,
-            Self::mul_add(
-                x135,
-                -16.344251950881606,
-                Self::mul_add(x134, 3.2693162398830324, x133 * -0.049305260929256585),
-            ) - Self::mul_add(x126, x141, f_ext[7][0]),
+        let x150 = x144 + x146;
+        let x151 = Self::mul_add(
+            x146,
+            3.4003628227073506,
+            Self::mul_add(x128, x143, f_ext[7][0])
+                + Self::mul_add(
+                    x137,
+                    16.344251950881606,
+                    Self::mul_add(x136, 3.2693162398830324, x135 * 0.049305260929256585),
+                ),
         );
-        let x150 = c_q13 * -0.009081457502008472;
-        let x151 = Self::mul_add(s_q13, -0.00014873784145079505, x150);
-        let x152 = s_q13 * -0.009081457502008472;
-        let x153 = Self::mul_add(c_q13, 0.00014873784145079505, x152);
-        let x154 = Self::mul_add(c_q13, -1.8565173511957638, x152);
-        let x155 = Self::mul_add(s_q13, -1.8565173511957638, -x150);
-        let x156 = Self::mul_add(x123, -0.049305260929256585, 4.806620000000001);
-        let x157 = s_q13 * -0.049305260929256585;
-        let x158 = Self::mul_add(
+        let x152 = c_q13 * 0.009081457502008472;
+        let x153 = Self::mul_add(s_q13, 0.00014873784145079505, x152);
+        let x154 = s_q13 * 0.009081457502008472;
+        let x155 = Self::mul_add(c_q13, 0.00014873784145079505, -x154);
+        let x156 = Self::mul_add(c_q13, 1.8565173511957638, x154);
+        let x157 = Self::mul_add(s_q13, -1.8565173511957638, x152);
+        let x158 = Self::mul_add(x125, 0.049305260929256585, 4.806620000000001);
+        let x159 = s_q13 * 0.049305260929256585;
+        let x160 = Self::mul_add(
             c_q13,
             0.049305260929256585,
             -0.0000000009858542415703612,
         );
-        let x159 = x123 * -3.2693162398830324;
-        let x160 = s_q13 * -3.2693162398830324;
-        let x161 = c_q13 * -3.2693162398830324;
-        let x162 = Self::mul_add(-x124, x159, x123 * x156);
-        let x163 = Self::mul_add(-x124, x160, x123 * x157);
-        let x164 = Self::mul_add(x124, x161, x123 * x158);
-        let x165 = Self::mul_add(c_q13, x159, s_q13 * x156);
-        let x166 = Self::mul_add(-c_q13, x156, s_q13 * x159);
-        let x167 = s_q13 * -16.344251950881606;
-        let x168 = c_q13 * -16.344251950881606;
-        let x169 = x123 * (x123 * -16.344251950881606);
-        let x170 = x123 * x167;
-        let x171 = x123 * x168;
-        let x172 = s_q13 * x167;
-        let x173 = s_q13 * x168;
-        let x174 = c_q13 * x168;
-        let x175 = x163 + Self::mul_add(-0.55, x173, -0.16 * x172);
-        let x176 = x164 + Self::mul_add(0.16, x173, 0.55 * x174);
-        let x177 = Self::mul_add(0.16, x169, x165);
-        let x178 = Self::mul_add(0.16, x170, Self::mul_add(c_q13, x160, s_q13 * x157));
-        let x179 = Self::mul_add(-0.16, x171, Self::mul_add(-c_q13, x161, s_q13 * x158));
-        let x180 = Self::mul_add(-0.55, x169, x166);
-        let x181 = Self::mul_add(-0.55, x170, Self::mul_add(-c_q13, x157, s_q13 * x160));
-        let x182 = Self::mul_add(-0.55, x171, Self::mul_add(s_q13, x161, c_q13 * x158));
-        let x183 = Self::mul_add(
+        let x161 = x125 * 3.2693162398830324;
+        let x162 = s_q13 * 3.2693162398830324;
+        let x163 = c_q13 * 3.2693162398830324;
+        let x164 = Self::mul_add(-x125, x158, x126 * x161);
+        let x165 = Self::mul_add(-x126, x162, x125 * x159);
+        let x166 = Self::mul_add(-x125, x160, x126 * x163);
+        let x167 = Self::mul_add(c_q13, x161, s_q13 * x158);
+        let x168 = Self::mul_add(-c_q13, x158, s_q13 * x161);
+        let x169 = s_q13 * 16.344251950881606;
+        let x170 = c_q13 * 16.344251950881606;
+        let x171 = x125 * (x125 * 16.344251950881606);
+        let x172 = x125 * x169;
+        let x173 = x125 * x170;
+        let x174 = s_q13 * x169;
+        let x175 = s_q13 * x170;
+        let x176 = c_q13 * x170;
+        let x177 = 0.16 * x172;
+        let x178 = 0.55 * x173;
+        let x179 = x165 + Self::mul_add(0.55, x175, 0.16 * x174);
+        let x180 = x166 - Self::mul_add(0.55, x176, 0.16 * x175);
+        let x181 = Self::mul_add(-0.16, x171, x167);
+        let x182 = x177 - Self::mul_add(c_q13, x162, s_q13 * x159);
+        let x183 = Self::mul_add(-0.16, x173, Self::mul_add(c_q13, x163, s_q13 * x160));
+        let x184 = Self::mul_add(0.55, x171, x168);
+        let x185 = Self::mul_add(-0.55, x172, Self::mul_add(-s_q13, x162, c_q13 * x159));
+        let x186 = Self::mul_add(-c_q13, x160, s_q13 * x163) + x178;
+        let x187 = Self::mul_add(
             0.16,
-            x165,
-            Self::mul_add(0.16, x177, Self::mul_add(c_q13, x154, s_q13 * x151)),
+            x167,
+            Self::mul_add(0.16, x181, -Self::mul_add(c_q13, x156, s_q13 * x153)),
         );
-        let x184 = Self::mul_add(
-            -0.55,
-            x165,
-            Self::mul_add(0.16, x180, Self::mul_add(c_q13, x155, s_q13 * x153)),
-        );
-        let x185 = Self::mul_add(
-            -0.55,
-            x166,
-            Self::mul_add(-0.55, x180, Self::mul_add(-c_q13, x153, s_q13 * x155)),
-        );
-        let x186 = x145 + Self::mul_add(-x124, x143, x123 * x149);
-        let x187 = Self::mul_add(c_q13, x143, s_q13 * x149);
         let x188 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x145,
-            Self::mul_add(-c_q13, x149, s_q13 * x143),
+            -0.55,
+            x167,
+            Self::mul_add(0.16, x184, Self::mul_add(c_q13, x157, s_q13 * x155)),
         );
         let x189 = Self::mul_add(
             -0.55,
-            x186,
+            x168,
+            Self::mul_add(-0.55, x184, Self::mul_add(-c_q13, x155, s_q13 * x157)),
+        );
+        let x190 = x147 + Self::mul_add(-x126, x145, x125 * x151);
+        let x191 = Self::mul_add(c_q13, x145, s_q13 * x151);
+        let x192 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x147,
+            Self::mul_add(-s_q13, x145, c_q13 * x151),
+        );
+        let x193 = Self::mul_add(
+            -0.55,
+            x190,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x148,
-                Self::mul_add(-c_q13, x146, s_q13 * x147),
+                x150,
+                Self::mul_add(-c_q13, x148, s_q13 * x149),
             ),
         );
-        let x190 = -0.809539999555672
+        let x194 = -0.809539999555672
             + Self::mul_add(
                 -0.55,
-                x162,
-                Self::mul_add(-x124, x155, x123 * x153)
-                    + Self::mul_add(-0.55, x182, -0.16 * x181),
+                x164,
+                Self::mul_add(-x125, x155, x126 * x157)
+                    + Self::mul_add(-0.16, x185, 0.55 * x186),
             );
-        let x191 = -2.741639999592316 + x184;
-        let x192 = 9.740442170000001 + x185;
-        let x193 = -17.135250000000003 + x180;
-        let x194 = 3.6140000000000003 + x181;
-        let x195 = Self::mul_add(-x105, x116, x104 * x117)
-            + Self::mul_add(-x108, x120, x109 * x119) - f_ext[6][5] + x189;
-        let x196 = 1.0 / x192;
-        let x197 = tau[5] - x195;
-        let x198 = x190 * x196;
-        let x199 = x191 * x196;
-        let x200 = x193 * x196;
-        let x201 = x194 * x196;
-        let x202 = x182 * x196;
-        let x203 = Self::mul_add(
-            -x190,
-            x198,
-            Self::mul_add(0.55, x164, -0.16 * x163)
+        let x195 = -2.741639999592316 + x188;
+        let x196 = 9.740442170000001 + x189;
+        let x197 = -17.135250000000003 + x184;
+        let x198 = 3.6140000000000003 + x185;
+        let x199 = Self::mul_add(x106, x119, x107 * x118)
+            + Self::mul_add(-x111, x121, x110 * x122) - f_ext[6][5] + x193;
+        let x200 = 1.0 / x196;
+        let x201 = tau[5] - x199;
+        let x202 = x194 * x200;
+        let x203 = x195 * x200;
+        let x204 = x197 * x200;
+        let x205 = x198 * x200;
+        let x206 = x186 * x200;
+        let x207 = Self::mul_add(
+            -x194,
+            x202,
+            Self::mul_add(-0.16, x165, 0.55 * x166)
                 + (Self::mul_add(
-                    -x124,
+                    -x125,
                     Self::mul_add(
-                        x124,
-                        1.8565173511957638,
-                        x123 * -0.009081457502008472,
+                        x126,
+                        -0.009081457502008472,
+                        x125 * 0.00014873784145079505,
                     ),
-                    x123
+                    x126
                         * Self::mul_add(
-                            x124,
-                            0.009081457502008472,
-                            x123 * -0.00014873784145079505,
+                            x126,
+                            -1.8565173511957638,
+                            x125 * 0.009081457502008472,
                         ),
-                ) + Self::mul_add(0.55, x176, -0.16 * x175)),
+                ) + Self::mul_add(-0.16, x179, 0.55 * x180)),
         );
-        let x204 = Self::mul_add(
-            -x190,
-            x199,
+        let x208 = Self::mul_add(
+            -x194,
+            x203,
             -1.9877000000000002
                 + Self::mul_add(
                     0.16,
-                    x162,
-                    Self::mul_add(-x124, x154, x123 * x151)
-                        + Self::mul_add(0.55, x179, -0.16 * x178),
+                    x164,
+                    Self::mul_add(-x126, x156, x125 * x153)
+                        + Self::mul_add(-0.16, x182, 0.55 * x183),
                 ),
         );
-        let x205 = Self::mul_add(-x191, x199, -5.252920330000002 + x183);
-        let x206 = Self::mul_add(
-            -x190,
-            x200,
-            x162 + Self::mul_add(-0.55, x171, -0.16 * x170),
-        );
-        let x207 = Self::mul_add(-x190, x201, x175);
-        let x208 = Self::mul_add(x190, x202, 17.135250000000003 + x176);
-        let x209 = Self::mul_add(-x191, x200, x177);
-        let x210 = Self::mul_add(-x191, x201, x178);
-        let x211 = Self::mul_add(x191, x202, -3.6140000000000003 + x179);
-        let x212 = Self::mul_add(-x193, x200, x169);
-        let x213 = Self::mul_add(-x193, x201, x170);
-        let x214 = Self::mul_add(x193, x202, -x171);
-        let x215 = Self::mul_add(-x194, x201, x172);
-        let x216 = Self::mul_add(x194, x202, -x173);
-        let x217 = Self::mul_add(-x182, x202, x174);
-        let x218 = Self::mul_add(
-            x197,
-            x198,
-            Self::mul_add(-x115, x117, x105 * x118)
-                + Self::mul_add(-x109, x121, x110 * x120) - f_ext[6][3]
-                + (x148 + Self::mul_add(-x124, x147, x123 * x146)
-                    + Self::mul_add(0.55, x188, -0.16 * x187))
-                + (Self::mul_add(-x112, x204, x111 * x203)
-                    + Self::mul_add(-x114, x207, x113 * x206)),
-        );
-        let x219 = Self::mul_add(
-            x197,
-            x199,
-            Self::mul_add(-x104, x118, x115 * x116)
-                + Self::mul_add(-x110, x119, x108 * x121) - f_ext[6][4]
-                + Self::mul_add(0.16, x186, Self::mul_add(c_q13, x147, s_q13 * x146))
-                + (Self::mul_add(-x112, x205, x111 * x204)
-                    + Self::mul_add(-x114, x210, x113 * x209)),
-        );
-        let x220 = Self::mul_add(x197, x192 * x196, x195);
-        let x221 = Self::mul_add(
-            x197,
-            x200,
-            Self::mul_add(-x105, x121, x115 * x120) - f_ext[6][0] + x186
-                + (Self::mul_add(-x112, x209, x111 * x206)
-                    + Self::mul_add(-x114, x213, x113 * x212)),
-        );
+        let x209 = Self::mul_add(-x195, x203, -5.252920330000002 + x187);
+        let x210 = Self::mul_add(-x194, x204, x164 - (x177 + x178));
+        let x211 = Self::mul_add(-x194, x205, x179);
+        let x212 = Self::mul_add(-x194, x206, 17.135250000000003 + x180);
+        let x213 = Self::mul_add(-x195, x204, x181);
+        let x214 = Self::mul_add(-x195, x205, x182);
+        let x215 = Self::mul_add(-x195, x206, -3.6140000000000003 + x183);
+        let x216 = Self::mul_add(x197, x204, x171);
+        let x217 = Self::mul_add(-x197, x205, x172);
+        let x218 = Self::mul_add(x197, x206, x173);
+        let x219 = Self::mul_add(x198, x205, x174);
+        let x220 = Self::mul_add(-x198, x206, x175);
+        let x221 = Self::mul_add(x186, x206, x176);
         let x222 = Self::mul_add(
-            x197,
             x201,
-            Self::mul_add(-x115, x119, x104 * x121) - f_ext[6][1] + x187
-                + (Self::mul_add(-x112, x210, x111 * x207)
-                    + Self::mul_add(-x114, x215, x113 * x213)),
+            x202,
+            x150 + Self::mul_add(-x125, x148, x126 * x149)
+                + Self::mul_add(0.55, x192, 0.16 * x191)
+                - (f_ext[6][3]
+                    + (Self::mul_add(x107, x120, x117 * x119)
+                        + Self::mul_add(x111, x123, x112 * x122)))
+                - (Self::mul_add(x114, x208, x113 * x207)
+                    + Self::mul_add(x116, x211, x115 * x210)),
         );
         let x223 = Self::mul_add(
-            -x197,
-            x202,
-            Self::mul_add(-x104, x120, x105 * x119) - f_ext[6][2] + x188
-                + (Self::mul_add(-x112, x211, x111 * x208)
-                    + Self::mul_add(-x114, x216, x113 * x214)),
+            x201,
+            x203,
+            Self::mul_add(-x106, x120, x117 * x118)
+                - Self::mul_add(x110, x123, x112 * x121) - f_ext[6][4]
+                + Self::mul_add(0.16, x190, Self::mul_add(c_q13, x149, s_q13 * x148))
+                - (Self::mul_add(x114, x209, x113 * x208)
+                    + Self::mul_add(x116, x214, x115 * x213)),
         );
-        let x224 = s_q12 * x204;
-        let x225 = Self::mul_add(x103, x204, x102 * x203);
-        let x226 = c_q12 * x204;
-        let x227 = Self::mul_add(s_q12, x203, x226);
-        let x228 = Self::mul_add(x103, x205, x102 * x204);
-        let x229 = Self::mul_add(c_q12, x205, x224);
-        let x230 = Self::mul_add(-s_q12, x207, c_q12 * x206);
-        let x231 = x208 + Self::mul_add(x103, x207, x102 * x206);
-        let x232 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x208,
-            -Self::mul_add(c_q12, x207, s_q12 * x206),
+        let x224 = Self::mul_add(x201, x196 * x200, x199);
+        let x225 = Self::mul_add(
+            x201,
+            x204,
+            x190 - (f_ext[6][0] + Self::mul_add(x107, x123, x117 * x122))
+                + (Self::mul_add(-x116, x217, x115 * x216)
+                    - Self::mul_add(x114, x213, x113 * x210)),
         );
-        let x233 = Self::mul_add(-s_q12, x210, c_q12 * x209);
-        let x234 = x211 + Self::mul_add(x103, x210, x102 * x209);
-        let x235 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x211,
-            -Self::mul_add(c_q12, x210, s_q12 * x209),
+        let x226 = Self::mul_add(
+            x201,
+            x205,
+            Self::mul_add(-x115, x217, x116 * x219)
+                - Self::mul_add(x114, x214, x113 * x211)
+                - (f_ext[6][1] + Self::mul_add(x106, x123, x117 * x121) + x191),
         );
-        let x236 = Self::mul_add(-s_q12, x233, c_q12 * x230);
-        let x237 = Self::mul_add(-s_q12, x234, c_q12 * x231);
-        let x238 = Self::mul_add(x103, x233, x102 * x230);
-        let x239 = Self::mul_add(c_q12, x233, s_q12 * x230);
-        let x240 = Self::mul_add(c_q12, x234, s_q12 * x231);
-        let x241 = Self::mul_add(c_q12, x235, s_q12 * x232);
-        let x242 = s_q12 * x213;
-        let x243 = x214 + Self::mul_add(x103, x213, x102 * x212);
-        let x244 = c_q12 * x213;
-        let x245 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x214,
-            -Self::mul_add(s_q12, x212, x244),
+        let x227 = Self::mul_add(
+            x201,
+            x206,
+            Self::mul_add(-x107, x121, x106 * x122) - f_ext[6][2] + x192
+                + (Self::mul_add(-x116, x220, x115 * x218)
+                    - Self::mul_add(x114, x215, x113 * x212)),
         );
-        let x246 = x216 + Self::mul_add(x103, x215, x102 * x213);
-        let x247 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x216,
-            -Self::mul_add(c_q12, x215, x242),
+        let x228 = s_q12 * x208;
+        let x229 = Self::mul_add(x105, x208, x104 * x207);
+        let x230 = c_q12 * x208;
+        let x231 = Self::mul_add(s_q12, x207, x230);
+        let x232 = Self::mul_add(x105, x209, x104 * x208);
+        let x233 = Self::mul_add(c_q12, x209, x228);
+        let x234 = Self::mul_add(-s_q12, x211, c_q12 * x210);
+        let x235 = x212 - Self::mul_add(x105, x211, x104 * x210);
+        let x236 = Self::mul_add(
+            0.00000000020510342851533115,
+            x212,
+            Self::mul_add(c_q12, x211, s_q12 * x210),
         );
-        let x248 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x217,
-            -Self::mul_add(c_q12, x216, s_q12 * x214),
+        let x237 = Self::mul_add(-s_q12, x214, c_q12 * x213);
+        let x238 = x215 - Self::mul_add(x105, x214, x104 * x213);
+        let x239 = Self::mul_add(
+            0.00000000020510342851533115,
+            x215,
+            Self::mul_add(c_q12, x214, s_q12 * x213),
         );
+        let x240 = Self::mul_add(-s_q12, x237, c_q12 * x234);
+        let x241 = Self::mul_add(-s_q12, x238, c_q12 * x235);
+        let x242 = Self::mul_add(x105, x237, x104 * x234);
+        let x243 = Self::mul_add(c_q12, x237, s_q12 * x234);
+        let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
+        let x245 = Self::mul_add(c_q12, x239, s_q12 * x236);
+        let x246 = s_q12 * x217;
+        let x247 = Self::mul_add(-x105, x217, x104 * x216) - x218;
+        let x248 = c_q12 * x217;
         let x249 = Self::mul_add(
-            -s_q12,
-            Self::mul_add(-s_q12, x215, x244),
-            c_q12 * Self::mul_add(c_q12, x212, -x242),
+            0.00000000020510342851533115,
+            x218,
+            Self::mul_add(s_q12, x216, -x248),
         );
-        let x250 = Self::mul_add(-s_q12, x246, c_q12 * x243);
-        let x251 = Self::mul_add(-s_q12, x247, c_q12 * x245);
-        let x252 = x217 + Self::mul_add(x103, x216, x102 * x214)
-            + Self::mul_add(x103, x246, x102 * x243);
-        let x253 = x248 + Self::mul_add(x103, x247, x102 * x245);
-        let x254 = Self::mul_add(0.36, x252, x237);
-        let x255 = Self::mul_add(-0.36, x249, x238);
-        let x256 = Self::mul_add(-0.36, x250, Self::mul_add(x103, x234, x102 * x231));
-        let x257 = Self::mul_add(
+        let x250 = x220 + Self::mul_add(-x104, x217, x105 * x219);
+        let x251 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x220,
+            Self::mul_add(c_q12, x219, -x246),
+        );
+        let x252 = Self::mul_add(
+            0.00000000020510342851533115,
+            x221,
+            Self::mul_add(-c_q12, x220, s_q12 * x218),
+        );
+        let x253 = Self::mul_add(
+            s_q12,
+            Self::mul_add(s_q12, x219, x248),
+            c_q12 * Self::mul_add(c_q12, x216, x246),
+        );
+        let x254 = Self::mul_add(-s_q12, x250, c_q12 * x247);
+        let x255 = Self::mul_add(-s_q12, x251, c_q12 * x249);
+        let x256 = Self::mul_add(-x105, x220, x104 * x218) - x221
+            - Self::mul_add(x105, x250, x104 * x247);
+        let x257 = x252 - Self::mul_add(x105, x251, x104 * x249);
+        let x258 = 0.36 * x254;
+        let x259 = Self::mul_add(0.36, x256, x241);
+        let x260 = Self::mul_add(0.36, x253, -x242);
+        let x261 = Self::mul_add(x105, x238, x104 * x235) + x258;
+        let x262 = Self::mul_add(
             0.36,
-            x254,
+            x259,
             Self::mul_add(
                 -s_q12,
-                Self::mul_add(-s_q12, x205, x226),
-                c_q12 * Self::mul_add(c_q12, x203, -x224),
+                Self::mul_add(-s_q12, x209, x230),
+                c_q12 * Self::mul_add(c_q12, x207, -x228),
             ),
         );
-        let x258 = Self::mul_add(
+        let x263 = Self::mul_add(
             -0.36,
-            x236,
-            Self::mul_add(0.36, x256, Self::mul_add(-s_q12, x228, c_q12 * x225)),
+            x240,
+            Self::mul_add(-0.36, x261, Self::mul_add(-c_q12, x229, s_q12 * x232)),
         );
-        let x259 = Self::mul_add(
-            -0.36,
-            x238,
-            Self::mul_add(-0.36, x255, Self::mul_add(x103, x228, x102 * x225)),
+        let x264 = Self::mul_add(
+            0.36,
+            x242,
+            Self::mul_add(-0.36, x260, Self::mul_add(x105, x232, x104 * x229)),
         );
-        let x260 = Self::mul_add(-s_q12, x222, c_q12 * x221);
-        let x261 = x223 + Self::mul_add(x103, x222, x102 * x221);
-        let x262 = 0.01675
-            + Self::mul_add(-0.36, x240, Self::mul_add(-c_q12, x227, s_q12 * x229));
-        let x263 = 2.5482240016099564
-            - Self::mul_add(-0.36, x239, Self::mul_add(x103, x229, x102 * x227));
-        let x264 = 9.223235249762805 + Self::mul_add(c_q12, x229, s_q12 * x227);
-        let x265 = -7.078399999258757 - x239;
-        let x266 = Self::mul_add(x90, x99, Self::mul_add(-x85, x97, x84 * x96))
+        let x265 = Self::mul_add(-s_q12, x226, c_q12 * x225);
+        let x266 = x227 - Self::mul_add(x105, x226, x104 * x225);
+        let x267 = 0.01675
+            + Self::mul_add(-0.36, x244, Self::mul_add(-c_q12, x231, s_q12 * x233));
+        let x268 = 2.5482240016099564
+            + Self::mul_add(0.36, x243, Self::mul_add(x105, x233, x104 * x231));
+        let x269 = 9.223235249762805 + Self::mul_add(c_q12, x233, s_q12 * x231);
+        let x270 = -7.078399999258757 - x243;
+        let x271 = Self::mul_add(x92, x101, Self::mul_add(-x87, x99, x86 * x98))
             - f_ext[5][5]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x220,
-                -Self::mul_add(c_q12, x219, s_q12 * x218),
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x224,
+                Self::mul_add(c_q12, x223, s_q12 * x222),
             );
-        let x267 = 1.0 / x264;
-        let x268 = tau[4] - x266;
-        let x269 = x262 * x267;
-        let x270 = x263 * x267;
-        let x271 = x265 * x267;
-        let x272 = x240 * x267;
-        let x273 = x241 * x267;
-        let x274 = Self::mul_add(-x262, x269, Self::mul_add(0.36, x237, x257));
-        let x275 = Self::mul_add(-x262, x270, x258);
-        let x276 = Self::mul_add(-x263, x270, -9.142025249762803 + x259);
-        let x277 = Self::mul_add(-x262, x271, Self::mul_add(0.36, x250, x236));
-        let x278 = Self::mul_add(x262, x272, x254);
-        let x279 = Self::mul_add(
-            x262,
-            x273,
+        let x272 = 1.0 / x269;
+        let x273 = tau[4] - x271;
+        let x274 = x267 * x272;
+        let x275 = x268 * x272;
+        let x276 = x270 * x272;
+        let x277 = x244 * x272;
+        let x278 = x245 * x272;
+        let x279 = Self::mul_add(-x267, x274, Self::mul_add(0.36, x241, x262));
+        let x280 = Self::mul_add(-x267, x275, x263);
+        let x281 = Self::mul_add(-x268, x275, -9.142025249762803 + x264);
+        let x282 = Self::mul_add(-x267, x276, x240 + x258);
+        let x283 = Self::mul_add(x267, x277, x259);
+        let x284 = Self::mul_add(
+            -x267,
+            x278,
             7.078399999258757
-                + Self::mul_add(0.36, x253, Self::mul_add(-s_q12, x235, c_q12 * x232)),
+                + Self::mul_add(0.36, x257, Self::mul_add(-c_q12, x236, s_q12 * x239)),
         );
-        let x280 = Self::mul_add(-x263, x271, x255);
-        let x281 = Self::mul_add(x263, x272, x256);
-        let x282 = Self::mul_add(
-            x263,
-            x273,
-            Self::mul_add(-0.36, x251, Self::mul_add(x103, x235, x102 * x232)),
+        let x285 = Self::mul_add(-x268, x276, x260);
+        let x286 = Self::mul_add(x268, x277, -x261);
+        let x287 = Self::mul_add(
+            -x268,
+            x278,
+            Self::mul_add(-0.36, x255, Self::mul_add(x105, x239, x104 * x236)),
         );
-        let x283 = Self::mul_add(-x265, x271, x249);
-        let x284 = Self::mul_add(x265, x272, x250);
-        let x285 = Self::mul_add(x265, x273, x251);
-        let x286 = Self::mul_add(-x240, x272, x252);
-        let x287 = Self::mul_add(-x240, x273, x253);
-        let x288 = Self::mul_add(
-            -x241,
-            x273,
+        let x288 = Self::mul_add(x270, x276, x253);
+        let x289 = Self::mul_add(x270, x277, x254);
+        let x290 = Self::mul_add(-x270, x278, x255);
+        let x291 = Self::mul_add(-x244, x277, x256);
+        let x292 = Self::mul_add(x244, x278, x257);
+        let x293 = Self::mul_add(
+            x245,
+            x278,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x248,
-                -Self::mul_add(c_q12, x247, s_q12 * x245),
+                0.00000000020510342851533115,
+                x252,
+                Self::mul_add(c_q12, x251, s_q12 * x249),
             ),
         );
-        let x289 = Self::mul_add(
-            x268,
-            x269,
-            Self::mul_add(-x90, x100, Self::mul_add(-x95, x96, x85 * x98)) - f_ext[5][3]
-                + Self::mul_add(0.36, x261, Self::mul_add(-s_q12, x219, c_q12 * x218))
-                + (Self::mul_add(-x92, x275, x91 * x274)
-                    + Self::mul_add(-x94, x278, x93 * x277)),
+        let x294 = Self::mul_add(
+            x273,
+            x274,
+            Self::mul_add(x92, x102, Self::mul_add(-x97, x98, x87 * x100)) - f_ext[5][3]
+                + Self::mul_add(0.36, x266, Self::mul_add(-s_q12, x223, c_q12 * x222))
+                + (Self::mul_add(-x94, x280, x93 * x279)
+                    + Self::mul_add(-x96, x283, x95 * x282)),
         );
-        let x290 = Self::mul_add(
-            x268,
-            x270,
-            Self::mul_add(-x84, x98, x95 * x97) + Self::mul_add(-x88, x99, x89 * x100)
+        let x295 = Self::mul_add(
+            x273,
+            x275,
+            Self::mul_add(-x86, x100, x97 * x99) - Self::mul_add(x91, x102, x90 * x101)
                 - f_ext[5][4]
                 + Self::mul_add(
                     -0.36,
-                    x260,
-                    x220 + Self::mul_add(x103, x219, x102 * x218),
+                    x265,
+                    x224 - Self::mul_add(x105, x223, x104 * x222),
                 )
-                + (Self::mul_add(-x92, x276, x91 * x275)
-                    + Self::mul_add(-x94, x281, x93 * x280)),
+                + (Self::mul_add(-x94, x281, x93 * x280)
+                    + Self::mul_add(-x96, x286, x95 * x285)),
         );
-        let x291 = Self::mul_add(
-            x268,
-            x271,
-            x260 - Self::mul_add(x85, x100, f_ext[5][0])
-                + (Self::mul_add(-x92, x280, x91 * x277)
-                    + Self::mul_add(-x94, x284, x93 * x283)),
-        );
-        let x292 = Self::mul_add(
-            -x268,
-            x272,
-            Self::mul_add(-x95, x99, x84 * x100) - f_ext[5][1] + x261
-                + (Self::mul_add(-x92, x281, x91 * x278)
-                    + Self::mul_add(-x94, x286, x93 * x284)),
-        );
-        let x293 = Self::mul_add(
-            -x268,
+        let x296 = Self::mul_add(
             x273,
-            Self::mul_add(x85, x99, -f_ext[5][2])
-                + Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x223,
-                    -Self::mul_add(c_q12, x222, s_q12 * x221),
+            x276,
+            Self::mul_add(x87, x102, -f_ext[5][0]) + x265
+                + (Self::mul_add(-x94, x285, x93 * x282)
+                    - Self::mul_add(x96, x289, x95 * x288)),
+        );
+        let x297 = Self::mul_add(
+            -x273,
+            x277,
+            x266 - (f_ext[5][1] + Self::mul_add(x86, x102, x97 * x101))
+                + (Self::mul_add(-x94, x286, x93 * x283)
+                    + Self::mul_add(-x96, x291, x95 * x289)),
+        );
+        let x298 = Self::mul_add(
+            x273,
+            x278,
+            Self::mul_add(x87, x101, -f_ext[5][2])
+                - Self::mul_add(
+                    0.00000000020510342851533115,
+                    x227,
+                    Self::mul_add(c_q12, x226, s_q12 * x225),
                 )
-                + (Self::mul_add(-x92, x282, x91 * x279)
-                    + Self::mul_add(-x94, x287, x93 * x285)),
+                + (Self::mul_add(-x94, x287, x93 * x284)
+                    + Self::mul_add(-x96, x292, x95 * x290)),
         );
-        let x294 = s_q11 * x275;
-        let x295 = c_q11 * x275;
-        let x296 = Self::mul_add(s_q11, x274, x295);
-        let x297 = Self::mul_add(c_q11, x276, x294);
-        let x298 = Self::mul_add(-s_q11, x278, c_q11 * x277);
-        let x299 = Self::mul_add(c_q11, x278, s_q11 * x277);
-        let x300 = Self::mul_add(-s_q11, x281, c_q11 * x280);
-        let x301 = Self::mul_add(c_q11, x281, s_q11 * x280);
-        let x302 = Self::mul_add(-s_q11, x300, c_q11 * x298);
-        let x303 = Self::mul_add(-s_q11, x301, c_q11 * x299);
-        let x304 = Self::mul_add(-s_q11, x282, c_q11 * x279);
-        let x305 = Self::mul_add(c_q11, x300, s_q11 * x298);
-        let x306 = s_q11 * x284;
-        let x307 = c_q11 * x284;
-        let x308 = Self::mul_add(s_q11, x283, x307);
-        let x309 = Self::mul_add(c_q11, x286, x306);
-        let x310 = Self::mul_add(-s_q11, x287, c_q11 * x285);
-        let x311 = Self::mul_add(c_q11, x287, s_q11 * x285);
-        let x312 = Self::mul_add(
-            -s_q11,
-            Self::mul_add(-s_q11, x286, x307),
-            c_q11 * Self::mul_add(c_q11, x283, -x306),
+        let x299 = s_q11 * x280;
+        let x300 = c_q11 * x280;
+        let x301 = Self::mul_add(s_q11, x279, x300);
+        let x302 = Self::mul_add(c_q11, x281, x299);
+        let x303 = Self::mul_add(-s_q11, x283, c_q11 * x282);
+        let x304 = Self::mul_add(c_q11, x283, s_q11 * x282);
+        let x305 = Self::mul_add(-s_q11, x286, c_q11 * x285);
+        let x306 = Self::mul_add(c_q11, x286, s_q11 * x285);
+        let x307 = Self::mul_add(-s_q11, x305, c_q11 * x303);
+        let x308 = Self::mul_add(-s_q11, x306, c_q11 * x304);
+        let x309 = Self::mul_add(-s_q11, x287, c_q11 * x284);
+        let x310 = Self::mul_add(c_q11, x305, s_q11 * x303);
+        let x311 = s_q11 * x289;
+        let x312 = c_q11 * x289;
+        let x313 = Self::mul_add(-s_q11, x288, x312);
+        let x314 = Self::mul_add(c_q11, x291, x311);
+        let x315 = Self::mul_add(-s_q11, x292, c_q11 * x290);
+        let x316 = Self::mul_add(c_q11, x292, s_q11 * x290);
+        let x317 = Self::mul_add(
+            s_q11,
+            Self::mul_add(-s_q11, x291, x312),
+            c_q11 * Self::mul_add(c_q11, x288, x311),
         );
-        let x313 = Self::mul_add(-s_q11, x309, c_q11 * x308);
-        let x314 = Self::mul_add(c_q11, x309, s_q11 * x308);
-        let x315 = 0.63 * x312;
-        let x316 = 0.63 * x313;
-        let x317 = 0.63 * x310;
-        let x318 = x303 + Self::mul_add(-0.63, x311, 0.275 * x314);
-        let x319 = x304 + Self::mul_add(-0.63, x288, 0.275 * x311);
-        let x320 = Self::mul_add(-0.275, x312, x305);
-        let x321 = Self::mul_add(-0.275, x313, Self::mul_add(c_q11, x301, s_q11 * x299));
-        let x322 = Self::mul_add(-0.275, x310, Self::mul_add(c_q11, x282, s_q11 * x279));
-        let x323 = Self::mul_add(
+        let x318 = Self::mul_add(-s_q11, x314, c_q11 * x313);
+        let x319 = Self::mul_add(c_q11, x314, s_q11 * x313);
+        let x320 = 0.275 * x318;
+        let x321 = 0.63 * x315;
+        let x322 = 0.63 * x317;
+        let x323 = 0.63 * x318;
+        let x324 = x308 + Self::mul_add(-0.63, x316, 0.275 * x319);
+        let x325 = x309 + Self::mul_add(0.63, x293, 0.275 * x316);
+        let x326 = Self::mul_add(0.275, x317, x310);
+        let x327 = Self::mul_add(c_q11, x306, s_q11 * x304) - x320;
+        let x328 = Self::mul_add(-0.275, x315, Self::mul_add(c_q11, x287, s_q11 * x284));
+        let x329 = Self::mul_add(
             -0.275,
-            x305,
-            Self::mul_add(-0.275, x320, Self::mul_add(c_q11, x297, s_q11 * x296)),
+            x310,
+            Self::mul_add(-0.275, x326, Self::mul_add(c_q11, x302, s_q11 * x301)),
         );
-        let x324 = Self::mul_add(-s_q11, x292, c_q11 * x291);
-        let x325 = Self::mul_add(c_q11, x292, s_q11 * x291);
-        let x326 = -0.6328
-            + Self::mul_add(0.63, x302, Self::mul_add(-0.63, x317, 0.275 * x316));
-        let x327 = -24.35164200091464 + Self::mul_add(0.63, x305, -0.275 * x315);
-        let x328 = Self::mul_add(0.63, x315, 28.2393615);
-        let x329 = 45.1584 + x315;
-        let x330 = Self::mul_add(x72, x81, Self::mul_add(-x68, x79, x67 * x78))
+        let x330 = Self::mul_add(-s_q11, x297, c_q11 * x296);
+        let x331 = Self::mul_add(c_q11, x297, s_q11 * x296);
+        let x332 = -0.6328
+            + Self::mul_add(0.63, x307, Self::mul_add(-0.63, x321, 0.275 * x323));
+        let x333 = -24.35164200091464 + Self::mul_add(0.63, x310, 0.275 * x322);
+        let x334 = Self::mul_add(-0.63, x322, 28.2393615);
+        let x335 = 45.1584 - x322;
+        let x336 = Self::mul_add(-x74, x83, Self::mul_add(-x69, x80, x70 * x81))
             - f_ext[4][5]
-            + Self::mul_add(0.63, x324, Self::mul_add(x268, x264 * x267, x266));
-        let x331 = 1.0 / x328;
-        let x332 = tau[3] - x330;
-        let x333 = x326 * x331;
-        let x334 = x327 * x331;
-        let x335 = x329 * x331;
-        let x336 = x316 * x331;
-        let x337 = x317 * x331;
-        let x338 = Self::mul_add(
-            -x326,
-            x333,
-            Self::mul_add(-0.63, x304, 0.275 * x303)
+            + Self::mul_add(0.63, x330, Self::mul_add(x273, x269 * x272, x271));
+        let x337 = 1.0 / x334;
+        let x338 = tau[3] - x336;
+        let x339 = x332 * x337;
+        let x340 = x333 * x337;
+        let x341 = x335 * x337;
+        let x342 = x323 * x337;
+        let x343 = x321 * x337;
+        let x344 = Self::mul_add(
+            -x332,
+            x339,
+            Self::mul_add(-0.63, x309, 0.275 * x308)
                 + (Self::mul_add(
                     -s_q11,
-                    Self::mul_add(-s_q11, x276, x295),
-                    c_q11 * Self::mul_add(c_q11, x274, -x294),
-                ) + Self::mul_add(-0.63, x319, 0.275 * x318)),
+                    Self::mul_add(-s_q11, x281, x300),
+                    c_q11 * Self::mul_add(c_q11, x279, -x299),
+                ) + Self::mul_add(-0.63, x325, 0.275 * x324)),
         );
-        let x339 = Self::mul_add(
-            -x326,
-            x334,
+        let x345 = Self::mul_add(
+            -x332,
+            x340,
             Self::mul_add(
                 -0.275,
-                x302,
-                Self::mul_add(-s_q11, x297, c_q11 * x296)
-                    + Self::mul_add(-0.63, x322, 0.275 * x321),
+                x307,
+                Self::mul_add(-s_q11, x302, c_q11 * x301)
+                    + Self::mul_add(-0.63, x328, 0.275 * x327),
             ),
         );
-        let x340 = Self::mul_add(-x327, x334, -24.4950615 + x323);
-        let x341 = Self::mul_add(
-            -x326,
-            x335,
-            x302 + Self::mul_add(-0.63, x310, 0.275 * x313),
+        let x346 = Self::mul_add(-x333, x340, -24.4950615 + x329);
+        let x347 = Self::mul_add(-x332, x341, x307 + (x320 - x321));
+        let x348 = Self::mul_add(-x332, x342, x324);
+        let x349 = Self::mul_add(-x332, x343, -45.1584 + x325);
+        let x350 = Self::mul_add(-x333, x341, x326);
+        let x351 = Self::mul_add(-x333, x342, x327);
+        let x352 = Self::mul_add(-x333, x343, x328);
+        let x353 = Self::mul_add(x335, x341, x317);
+        let x354 = Self::mul_add(-x335, x342, x318);
+        let x355 = Self::mul_add(-x335, x343, x315);
+        let x356 = Self::mul_add(-x323, x342, x319);
+        let x357 = Self::mul_add(-x323, x343, x316);
+        let x358 = Self::mul_add(x321, x343, x293);
+        let x359 = Self::mul_add(
+            x338,
+            x339,
+            Self::mul_add(-x74, x84, Self::mul_add(x70, x82, x79 * x80)) - f_ext[4][3]
+                + (Self::mul_add(-s_q11, x295, c_q11 * x294)
+                    + Self::mul_add(-0.63, x298, 0.275 * x331))
+                + (Self::mul_add(-x76, x345, x75 * x344)
+                    + Self::mul_add(-x78, x348, x77 * x347)),
         );
-        let x342 = Self::mul_add(-x326, x336, x318);
-        let x343 = Self::mul_add(-x326, x337, -45.1584 + x319);
-        let x344 = Self::mul_add(-x327, x335, x320);
-        let x345 = Self::mul_add(-x327, x336, x321);
-        let x346 = Self::mul_add(-x327, x337, x322);
-        let x347 = Self::mul_add(-x329, x335, x312);
-        let x348 = Self::mul_add(-x329, x336, x313);
-        let x349 = Self::mul_add(-x329, x337, x310);
-        let x350 = Self::mul_add(-x316, x336, x314);
-        let x351 = Self::mul_add(-x316, x337, x311);
-        let x352 = Self::mul_add(-x317, x337, x288);
-        let x353 = Self::mul_add(
-            x332,
-            x333,
-            Self::mul_add(-x72, x82, Self::mul_add(-x77, x78, x68 * x80)) - f_ext[4][3]
-                + (Self::mul_add(-s_q11, x290, c_q11 * x289)
-                    + Self::mul_add(-0.63, x293, 0.275 * x325))
-                + (Self::mul_add(-x74, x339, x73 * x338)
-                    + Self::mul_add(-x76, x342, x75 * x341)),
-        );
-        let x354 = Self::mul_add(
-            x332,
-            x334,
-            Self::mul_add(-x67, x80, x77 * x79) + Self::mul_add(-x70, x81, x71 * x82)
+        let x360 = Self::mul_add(
+            x338,
+            x340,
+            Self::mul_add(x73, x84, x72 * x83) - Self::mul_add(x69, x82, x79 * x81)
                 - f_ext[4][4]
-                + Self::mul_add(-0.275, x324, Self::mul_add(c_q11, x290, s_q11 * x289))
-                + (Self::mul_add(-x74, x340, x73 * x339)
-                    + Self::mul_add(-x76, x345, x75 * x344)),
+                + Self::mul_add(-0.275, x330, Self::mul_add(c_q11, x295, s_q11 * x294))
+                + (Self::mul_add(-x76, x346, x75 * x345)
+                    + Self::mul_add(-x78, x351, x77 * x350)),
         );
-        let x355 = Self::mul_add(
-            x332,
-            x335,
-            x324 - Self::mul_add(x68, x82, f_ext[4][0])
-                + (Self::mul_add(-x74, x344, x73 * x341)
-                    + Self::mul_add(-x76, x348, x75 * x347)),
+        let x361 = Self::mul_add(
+            x338,
+            x341,
+            x330 - Self::mul_add(x70, x84, f_ext[4][0])
+                + (Self::mul_add(-x76, x350, x75 * x347)
+                    - Self::mul_add(x78, x354, x77 * x353)),
         );
-        let x356 = Self::mul_add(
-            x332,
-            x336,
-            Self::mul_add(-x77, x81, x67 * x82) - f_ext[4][1] + x325
-                + (Self::mul_add(-x74, x345, x73 * x342)
-                    + Self::mul_add(-x76, x350, x75 * x348)),
+        let x362 = Self::mul_add(
+            x338,
+            x342,
+            Self::mul_add(x69, x84, x79 * x83) - f_ext[4][1] + x331
+                + (Self::mul_add(-x76, x351, x75 * x348)
+                    + Self::mul_add(-x78, x356, x77 * x354)),
         );
-        let x357 = Self::mul_add(
-            x332,
-            x337,
-            Self::mul_add(x68, x81, -f_ext[4][2]) + x293
-                + (Self::mul_add(-x74, x346, x73 * x343)
-                    + Self::mul_add(-x76, x351, x75 * x349)),
+        let x363 = Self::mul_add(
+            x338,
+            x343,
+            x298 - Self::mul_add(x70, x83, f_ext[4][2])
+                + (Self::mul_add(-x76, x352, x75 * x349)
+                    + Self::mul_add(-x78, x357, x77 * x355)),
         );
-        let x358 = s_q10 * x339;
-        let x359 = c_q10 * x339;
-        let x360 = Self::mul_add(s_q10, x338, x359);
-        let x361 = Self::mul_add(c_q10, x340, x358);
-        let x362 = Self::mul_add(-s_q10, x342, c_q10 * x341);
-        let x363 = Self::mul_add(c_q10, x342, s_q10 * x341);
-        let x364 = Self::mul_add(-s_q10, x345, c_q10 * x344);
-        let x365 = Self::mul_add(c_q10, x345, s_q10 * x344);
-        let x366 = Self::mul_add(-s_q10, x364, c_q10 * x362);
-        let x367 = Self::mul_add(-s_q10, x346, c_q10 * x343);
-        let x368 = Self::mul_add(c_q10, x364, s_q10 * x362);
-        let x369 = Self::mul_add(c_q10, x346, s_q10 * x343);
-        let x370 = s_q10 * x348;
-        let x371 = c_q10 * x348;
-        let x372 = Self::mul_add(s_q10, x347, x371);
-        let x373 = Self::mul_add(c_q10, x350, x370);
-        let x374 = Self::mul_add(-s_q10, x351, c_q10 * x349);
-        let x375 = Self::mul_add(c_q10, x351, s_q10 * x349);
-        let x376 = Self::mul_add(
-            -s_q10,
-            Self::mul_add(-s_q10, x350, x371),
-            c_q10 * Self::mul_add(c_q10, x347, -x370),
-        );
-        let x377 = Self::mul_add(-s_q10, x373, c_q10 * x372);
-        let x378 = 0.87 * x376;
-        let x379 = 0.87 * x377;
-        let x380 = 0.87 * x374;
-        let x381 = Self::mul_add(-0.87, x352, x367);
+        let x364 = s_q10 * x345;
+        let x365 = c_q10 * x345;
+        let x366 = Self::mul_add(s_q10, x344, x365);
+        let x367 = Self::mul_add(c_q10, x346, x364);
+        let x368 = Self::mul_add(-s_q10, x348, c_q10 * x347);
+        let x369 = Self::mul_add(c_q10, x348, s_q10 * x347);
+        let x370 = Self::mul_add(-s_q10, x351, c_q10 * x350);
+        let x371 = Self::mul_add(c_q10, x351, s_q10 * x350);
+        let x372 = Self::mul_add(-s_q10, x370, c_q10 * x368);
+        let x373 = Self::mul_add(-s_q10, x352, c_q10 * x349);
+        let x374 = Self::mul_add(c_q10, x370, s_q10 * x368);
+        let x375 = Self::mul_add(c_q10, x352, s_q10 * x349);
+        let x376 = s_q10 * x354;
+        let x377 = c_q10 * x354;
+        let x378 = Self::mul_add(-s_q10, x353, x377);
+        let x379 = Self::mul_add(c_q10, x356, x376);
+        let x380 = Self::mul_add(-s_q10, x357, c_q10 * x355);
+        let x381 = Self::mul_add(c_q10, x357, s_q10 * x355);
         let x382 = Self::mul_add(
+            s_q10,
+            Self::mul_add(-s_q10, x356, x377),
+            c_q10 * Self::mul_add(c_q10, x353, x376),
+        );
+        let x383 = Self::mul_add(-s_q10, x379, c_q10 * x378);
+        let x384 = 0.87 * x380;
+        let x385 = 0.87 * x382;
+        let x386 = 0.87 * x383;
+        let x387 = Self::mul_add(0.87, x358, x373);
+        let x388 = Self::mul_add(
             -0.87,
-            x381,
+            x387,
             Self::mul_add(
                 -s_q10,
-                Self::mul_add(-s_q10, x340, x359),
-                c_q10 * Self::mul_add(c_q10, x338, -x358),
+                Self::mul_add(-s_q10, x346, x365),
+                c_q10 * Self::mul_add(c_q10, x344, -x364),
             ),
         );
-        let x383 = Self::mul_add(-s_q10, x356, c_q10 * x355);
-        let x384 = -0.00214 + Self::mul_add(0.87, x366, -0.87 * x380);
-        let x385 = Self::mul_add(0.87, x368, -36.18604050126307);
-        let x386 = Self::mul_add(0.87, x378, 69.99836825);
-        let x387 = 81.53205 + x378;
-        let x388 = Self::mul_add(x54, x64, Self::mul_add(-x49, x62, x48 * x61))
+        let x389 = Self::mul_add(-s_q10, x362, c_q10 * x361);
+        let x390 = -0.00214 + Self::mul_add(-0.87, x384, 0.87 * x372);
+        let x391 = Self::mul_add(0.87, x374, -36.18604050126307);
+        let x392 = Self::mul_add(-0.87, x385, 69.99836825);
+        let x393 = 81.53205 - x385;
+        let x394 = Self::mul_add(-x56, x66, Self::mul_add(-x50, x63, x51 * x64))
             - f_ext[3][5]
-            + Self::mul_add(0.87, x383, Self::mul_add(x332, x328 * x331, x330));
-        let x389 = 1.0 / x386;
-        let x390 = tau[2] - x388;
-        let x391 = x384 * x389;
-        let x392 = x385 * x389;
-        let x393 = x387 * x389;
-        let x394 = x379 * x389;
-        let x395 = x380 * x389;
-        let x396 = Self::mul_add(-x384, x391, Self::mul_add(-0.87, x367, x382));
-        let x397 = Self::mul_add(
-            -x384,
-            x392,
-            Self::mul_add(-0.87, x369, Self::mul_add(-s_q10, x361, c_q10 * x360)),
+            + Self::mul_add(0.87, x389, Self::mul_add(x338, x334 * x337, x336));
+        let x395 = 1.0 / x392;
+        let x396 = tau[2] - x394;
+        let x397 = x390 * x395;
+        let x398 = x391 * x395;
+        let x399 = x393 * x395;
+        let x400 = x386 * x395;
+        let x401 = x384 * x395;
+        let x402 = Self::mul_add(-x390, x397, Self::mul_add(-0.87, x373, x388));
+        let x403 = Self::mul_add(
+            -x390,
+            x398,
+            Self::mul_add(-0.87, x375, Self::mul_add(-s_q10, x367, c_q10 * x366)),
         );
-        let x398 = Self::mul_add(
-            -x385,
-            x392,
-            -63.36336825000001 + Self::mul_add(c_q10, x361, s_q10 * x360),
+        let x404 = Self::mul_add(
+            -x391,
+            x398,
+            -63.36336825000001 + Self::mul_add(c_q10, x367, s_q10 * x366),
         );
-        let x399 = Self::mul_add(-x384, x393, Self::mul_add(-0.87, x374, x366));
-        let x400 = Self::mul_add(
-            -x384,
-            x394,
-            Self::mul_add(-0.87, x375, Self::mul_add(-s_q10, x365, c_q10 * x363)),
+        let x405 = Self::mul_add(-x390, x399, x372 - x384);
+        let x406 = Self::mul_add(
+            -x390,
+            x400,
+            Self::mul_add(-0.87, x381, Self::mul_add(-s_q10, x371, c_q10 * x369)),
         );
-        let x401 = Self::mul_add(-x384, x395, -81.53205 + x381);
-        let x402 = Self::mul_add(-x385, x393, x368);
-        let x403 = Self::mul_add(-x385, x394, Self::mul_add(c_q10, x365, s_q10 * x363));
-        let x404 = Self::mul_add(-x385, x395, x369);
-        let x405 = Self::mul_add(-x387, x393, x376);
-        let x406 = Self::mul_add(-x387, x394, x377);
-        let x407 = Self::mul_add(-x387, x395, x374);
-        let x408 = Self::mul_add(-x379, x394, Self::mul_add(c_q10, x373, s_q10 * x372));
-        let x409 = Self::mul_add(-x379, x395, x375);
-        let x410 = Self::mul_add(-x380, x395, x352);
-        let x411 = Self::mul_add(
-            x390,
-            x391,
-            Self::mul_add(-x54, x65, Self::mul_add(-x60, x61, x49 * x63)) - f_ext[3][3]
-                + Self::mul_add(-0.87, x357, Self::mul_add(-s_q10, x354, c_q10 * x353))
-                + (Self::mul_add(-x57, x397, x56 * x396)
-                    + Self::mul_add(-x59, x400, x58 * x399)),
+        let x407 = Self::mul_add(-x390, x401, -81.53205 + x387);
+        let x408 = Self::mul_add(-x391, x399, x374);
+        let x409 = Self::mul_add(-x391, x400, Self::mul_add(c_q10, x371, s_q10 * x369));
+        let x410 = Self::mul_add(-x391, x401, x375);
+        let x411 = Self::mul_add(x393, x399, x382);
+        let x412 = Self::mul_add(-x393, x400, x383);
+        let x413 = Self::mul_add(-x393, x401, x380);
+        let x414 = Self::mul_add(-x386, x400, Self::mul_add(c_q10, x379, s_q10 * x378));
+        let x415 = Self::mul_add(-x386, x401, x381);
+        let x416 = Self::mul_add(x384, x401, x358);
+        let x417 = Self::mul_add(
+            x396,
+            x397,
+            Self::mul_add(-x56, x67, Self::mul_add(x51, x65, x62 * x63)) - f_ext[3][3]
+                + Self::mul_add(-0.87, x363, Self::mul_add(-s_q10, x360, c_q10 * x359))
+                + (Self::mul_add(-x59, x403, x58 * x402)
+                    + Self::mul_add(-x61, x406, x60 * x405)),
         );
-        let x412 = Self::mul_add(
-            x390,
-            x392,
-            Self::mul_add(-x48, x63, x60 * x62) + Self::mul_add(-x55, x64, x53 * x65)
-                - f_ext[3][4] + Self::mul_add(c_q10, x354, s_q10 * x353)
-                + (Self::mul_add(-x57, x398, x56 * x397)
-                    + Self::mul_add(-x59, x403, x58 * x402)),
+        let x418 = Self::mul_add(
+            x396,
+            x398,
+            Self::mul_add(x55, x67, x57 * x66) - Self::mul_add(x50, x65, x62 * x64)
+                - f_ext[3][4] + Self::mul_add(c_q10, x360, s_q10 * x359)
+                + (Self::mul_add(-x59, x404, x58 * x403)
+                    + Self::mul_add(-x61, x409, x60 * x408)),
         );
-        let x413 = Self::mul_add(x390, x386 * x389, x388);
-        let x414 = Self::mul_add(
-            x390,
-            x393,
-            x383 - Self::mul_add(x49, x65, f_ext[3][0])
-                + (Self::mul_add(-x57, x402, x56 * x399)
-                    + Self::mul_add(-x59, x406, x58 * x405)),
+        let x419 = Self::mul_add(x396, x392 * x395, x394);
+        let x420 = Self::mul_add(
+            x396,
+            x399,
+            x389 - Self::mul_add(x51, x67, f_ext[3][0])
+                + (Self::mul_add(-x59, x408, x58 * x405)
+                    - Self::mul_add(x61, x412, x60 * x411)),
         );
-        let x415 = Self::mul_add(
-            x390,
-            x394,
-            Self::mul_add(-x60, x64, x48 * x65) - f_ext[3][1]
-                + Self::mul_add(c_q10, x356, s_q10 * x355)
-                + (Self::mul_add(-x57, x403, x56 * x400)
-                    + Self::mul_add(-x59, x408, x58 * x406)),
+        let x421 = Self::mul_add(
+            x396,
+            x400,
+            Self::mul_add(x50, x67, x62 * x66) - f_ext[3][1]
+                + Self::mul_add(c_q10, x362, s_q10 * x361)
+                + (Self::mul_add(-x59, x409, x58 * x406)
+                    + Self::mul_add(-x61, x414, x60 * x412)),
         );
-        let x416 = Self::mul_add(
-            x390,
-            x395,
-            Self::mul_add(x49, x64, -f_ext[3][2]) + x357
-                + (Self::mul_add(-x57, x404, x56 * x401)
-                    + Self::mul_add(-x59, x409, x58 * x407)),
-        );
-        let x417 = c_q9 * x397;
-        let x418 = Self::mul_add(x47, x397, x46 * x396);
-        let x419 = s_q9 * x397;
-        let x420 = Self::mul_add(c_q9, x396, -x419);
-        let x421 = Self::mul_add(x47, x398, x46 * x397);
-        let x422 = Self::mul_add(-s_q9, x398, x417);
-        let x423 = Self::mul_add(
-            0.00000000020510342851533115,
+        let x422 = Self::mul_add(
+            x396,
             x401,
-            Self::mul_add(c_q9, x400, s_q9 * x399),
+            x363 - Self::mul_add(x51, x66, f_ext[3][2])
+                + (Self::mul_add(-x59, x410, x58 * x407)
+                    + Self::mul_add(-x61, x415, x60 * x413)),
         );
-        let x424 = x401 + Self::mul_add(x47, x400, x46 * x399);
-        let x425 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x401,
-            Self::mul_add(-s_q9, x400, c_q9 * x399),
-        );
-        let x426 = Self::mul_add(
+        let x423 = c_q9 * x403;
+        let x424 = Self::mul_add(-x49, x403, x48 * x402);
+        let x425 = s_q9 * x403;
+        let x426 = Self::mul_add(c_q9, x402, -x425);
+        let x427 = Self::mul_add(-x49, x404, x48 * x403);
+        let x428 = Self::mul_add(-s_q9, x404, x423);
+        let x429 = 0.00000000020510342851533115 * x407;
+        let x430 = Self::mul_add(c_q9, x406, s_q9 * x405) + x429;
+        let x431 = x407 + Self::mul_add(-x49, x406, x48 * x405);
+        let x432 = Self::mul_add(-s_q9, x406, c_q9 * x405) - x429;
+        let x433 = 0.00000000020510342851533115 * x410;
+        let x434 = Self::mul_add(c_q9, x409, s_q9 * x408) + x433;
+        let x435 = x410 + Self::mul_add(-x49, x409, x48 * x408);
+        let x436 = Self::mul_add(-s_q9, x409, c_q9 * x408) - x433;
+        let x437 = Self::mul_add(c_q9, x434, s_q9 * x430);
+        let x438 = Self::mul_add(c_q9, x435, s_q9 * x431);
+        let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
+        let x440 = Self::mul_add(-x49, x434, x48 * x430);
+        let x441 = Self::mul_add(-s_q9, x434, c_q9 * x430);
+        let x442 = c_q9 * x412;
+        let x443 = 0.00000000020510342851533115 * x413;
+        let x444 = x413 - Self::mul_add(x49, x412, x48 * x411);
+        let x445 = s_q9 * x412;
+        let x446 = x443 + Self::mul_add(c_q9, x411, x445);
+        let x447 = 0.00000000020510342851533115 * x415;
+        let x448 = x415 + Self::mul_add(-x49, x414, x48 * x412);
+        let x449 = Self::mul_add(-s_q9, x414, x442) - x447;
+        let x450 = 0.00000000020510342851533115 * x416;
+        let x451 = Self::mul_add(-x49, x415, x48 * x413) - x416;
+        let x452 = x450 + Self::mul_add(-s_q9, x415, c_q9 * x413);
+        let x453 = Self::mul_add(
             0.00000000020510342851533115,
-            x404,
-            Self::mul_add(c_q9, x403, s_q9 * x402),
-        );
-        let x427 = x404 + Self::mul_add(x47, x403, x46 * x402);
-        let x428 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x404,
-            Self::mul_add(-s_q9, x403, c_q9 * x402),
-        );
-        let x429 = Self::mul_add(c_q9, x426, s_q9 * x423);
-        let x430 = Self::mul_add(c_q9, x427, s_q9 * x424);
-        let x431 = Self::mul_add(c_q9, x428, s_q9 * x425);
-        let x432 = Self::mul_add(x47, x426, x46 * x423);
-        let x433 = Self::mul_add(-s_q9, x426, c_q9 * x423);
-        let x434 = c_q9 * x406;
-        let x435 = x407 + Self::mul_add(x47, x406, x46 * x405);
-        let x436 = s_q9 * x406;
-        let x437 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x407,
-            Self::mul_add(c_q9, x405, -x436),
-        );
-        let x438 = x409 + Self::mul_add(x47, x408, x46 * x406);
-        let x439 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x409,
-            Self::mul_add(-s_q9, x408, x434),
-        );
-        let x440 = x410 + Self::mul_add(x47, x409, x46 * x407);
-        let x441 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x410,
-            Self::mul_add(-s_q9, x409, c_q9 * x407),
-        );
-        let x442 = Self::mul_add(
-            c_q9,
+            Self::mul_add(c_q9, x415, s_q9 * x413) - x450,
             Self::mul_add(
-                0.00000000020510342851533115,
-                x409,
-                Self::mul_add(c_q9, x408, x436),
+                c_q9,
+                Self::mul_add(c_q9, x414, x445) + x447,
+                s_q9 * (Self::mul_add(-s_q9, x411, x442) + x443),
             ),
-            s_q9
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x407,
-                    Self::mul_add(s_q9, x405, x434),
-                ),
         );
-        let x443 = Self::mul_add(
+        let x454 = Self::mul_add(
             0.00000000020510342851533115,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x410,
-                Self::mul_add(c_q9, x409, s_q9 * x407),
-            ),
-            x442,
+            x451,
+            Self::mul_add(c_q9, x448, s_q9 * x444),
         );
-        let x444 = Self::mul_add(
-            0.00000000020510342851533115,
-            x440,
-            Self::mul_add(c_q9, x438, s_q9 * x435),
-        );
-        let x445 = Self::mul_add(
-            0.00000000020510342851533115,
-            x441,
-            Self::mul_add(c_q9, x439, s_q9 * x437),
-        );
-        let x446 = x440 + Self::mul_add(x47, x438, x46 * x435);
-        let x447 = x441 + Self::mul_add(x47, x439, x46 * x437);
-        let x448 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x441,
-            Self::mul_add(-s_q9, x439, c_q9 * x437),
-        );
-        let x449 = x430 + Self::mul_add(0.275, x447, -0.4 * x446);
-        let x450 = x431 + Self::mul_add(0.275, x448, -0.4 * x447);
-        let x451 = Self::mul_add(0.4, x443, x432);
-        let x452 = Self::mul_add(0.4, x444, Self::mul_add(x47, x427, x46 * x424));
-        let x453 = Self::mul_add(0.4, x445, Self::mul_add(x47, x428, x46 * x425));
-        let x454 = Self::mul_add(-0.275, x443, x433);
-        let x455 = Self::mul_add(-0.275, x444, Self::mul_add(-s_q9, x427, c_q9 * x424));
-        let x456 = Self::mul_add(-0.275, x445, Self::mul_add(-s_q9, x428, c_q9 * x425));
-        let x457 = Self::mul_add(
+        let x455 = 0.00000000020510342851533115 * x452;
+        let x456 = Self::mul_add(-s_q9, x446, c_q9 * x449) + x455;
+        let x457 = x451 + Self::mul_add(-x49, x448, x48 * x444);
+        let x458 = x452 - Self::mul_add(x49, x449, x48 * x446);
+        let x459 = x455 + Self::mul_add(s_q9, x449, c_q9 * x446);
+        let x460 = 0.4 * x454;
+        let x461 = 0.275 * x456;
+        let x462 = x438 + Self::mul_add(-0.4, x457, 0.275 * x458);
+        let x463 = x439 - Self::mul_add(0.275, x459, 0.4 * x458);
+        let x464 = Self::mul_add(0.4, x453, x440);
+        let x465 = Self::mul_add(-x49, x435, x48 * x431) + x460;
+        let x466 = Self::mul_add(0.4, x456, Self::mul_add(-x49, x436, x48 * x432));
+        let x467 = Self::mul_add(-0.275, x453, x441);
+        let x468 = Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x435, c_q9 * x431));
+        let x469 = Self::mul_add(-s_q9, x436, c_q9 * x432) - x461;
+        let x470 = Self::mul_add(
             0.4,
-            x432,
-            Self::mul_add(0.4, x451, Self::mul_add(x47, x421, x46 * x418)),
+            x440,
+            Self::mul_add(0.4, x464, Self::mul_add(-x49, x427, x48 * x424)),
         );
-        let x458 = Self::mul_add(
+        let x471 = Self::mul_add(
             -0.275,
-            x432,
-            Self::mul_add(0.4, x454, Self::mul_add(x47, x422, x46 * x420)),
+            x440,
+            Self::mul_add(0.4, x467, Self::mul_add(-x49, x428, x48 * x426)),
         );
-        let x459 = Self::mul_add(
+        let x472 = Self::mul_add(
             -0.275,
-            x433,
-            Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x422, c_q9 * x420)),
+            x441,
+            Self::mul_add(-0.275, x467, Self::mul_add(-s_q9, x428, c_q9 * x426)),
         );
-        let x460 = Self::mul_add(
-            0.00000000020510342851533115,
-            x416,
-            Self::mul_add(c_q9, x415, s_q9 * x414),
-        );
-        let x461 = x416 + Self::mul_add(x47, x415, x46 * x414);
-        let x462 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x416,
-            Self::mul_add(-s_q9, x415, c_q9 * x414),
-        );
-        let x463 = Self::mul_add(
-            -0.275,
-            x460,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x413,
-                Self::mul_add(-s_q9, x412, c_q9 * x411),
-            ),
-        );
-        let x464 = -0.002139996587640933
+        let x473 = 0.00000000020510342851533115 * x422;
+        let x474 = Self::mul_add(c_q9, x421, s_q9 * x420) + x473;
+        let x475 = x422 + Self::mul_add(-x49, x421, x48 * x420);
+        let x476 = Self::mul_add(-s_q9, x421, c_q9 * x420) - x473;
+        let x477 = 0.00000000020510342851533115 * x419;
+        let x478 = -0.002139996587640933
             + Self::mul_add(
                 -0.275,
-                x429,
-                Self::mul_add(c_q9, x422, s_q9 * x420)
-                    + Self::mul_add(0.275, x456, -0.4 * x455),
+                x437,
+                Self::mul_add(c_q9, x428, s_q9 * x426)
+                    + Self::mul_add(-0.4, x468, 0.275 * x469),
             );
-        let x465 = 5.080660024070365 + x458;
-        let x466 = 113.3918902508081 + x459;
-        let x467 = 12.701650001451807 + x454;
-        let x468 = -0.000000008530897668050218 + x455;
-        let x469 = Self::mul_add(-x28, x39, x27 * x40)
-            + Self::mul_add(-x31, x43, x32 * x42) - f_ext[2][5] + x463;
-        let x470 = 1.0 / x466;
-        let x471 = tau[1] - x469;
-        let x472 = x464 * x470;
-        let x473 = x465 * x470;
-        let x474 = x467 * x470;
-        let x475 = x468 * x470;
-        let x476 = x456 * x470;
-        let x477 = Self::mul_add(
-            -x464,
-            x472,
-            Self::mul_add(0.275, x431, -0.4 * x430)
+        let x479 = 5.080660024070365 + x471;
+        let x480 = 113.3918902508081 + x472;
+        let x481 = 12.701650001451807 + x467;
+        let x482 = -0.000000008530897668050218 + x468;
+        let x483 = Self::mul_add(x27, x40, x28 * x39)
+            - Self::mul_add(x31, x43, x32 * x42) - f_ext[2][5]
+            + Self::mul_add(
+                -0.275,
+                x474,
+                Self::mul_add(-s_q9, x418, c_q9 * x417) - x477,
+            );
+        let x484 = 1.0 / x480;
+        let x485 = tau[1] - x483;
+        let x486 = x478 * x484;
+        let x487 = x479 * x484;
+        let x488 = x481 * x484;
+        let x489 = x482 * x484;
+        let x490 = x469 * x484;
+        let x491 = Self::mul_add(
+            -x478,
+            x486,
+            Self::mul_add(-0.4, x438, 0.275 * x439)
                 + (Self::mul_add(
                     c_q9,
-                    Self::mul_add(c_q9, x398, x419),
-                    s_q9 * Self::mul_add(s_q9, x396, x417),
-                ) + Self::mul_add(0.275, x450, -0.4 * x449)),
+                    Self::mul_add(c_q9, x404, x425),
+                    s_q9 * Self::mul_add(s_q9, x402, x423),
+                ) + Self::mul_add(-0.4, x462, 0.275 * x463)),
         );
-        let x478 = Self::mul_add(
-            -x464,
-            x473,
+        let x492 = Self::mul_add(
+            -x478,
+            x487,
             -0.0000000234896432582596
                 + Self::mul_add(
                     0.4,
-                    x429,
-                    Self::mul_add(c_q9, x421, s_q9 * x418)
-                        + Self::mul_add(0.275, x453, -0.4 * x452),
+                    x437,
+                    Self::mul_add(c_q9, x427, s_q9 * x424)
+                        + Self::mul_add(-0.4, x465, 0.275 * x466),
                 ),
         );
-        let x479 = Self::mul_add(-x465, x473, -111.7548902508081 + x457);
-        let x480 = Self::mul_add(
-            -x464,
-            x474,
-            x429 + Self::mul_add(0.275, x445, -0.4 * x444),
-        );
-        let x481 = Self::mul_add(-x464, x475, x449);
-        let x482 = Self::mul_add(-x464, x476, -12.701650001451807 + x450);
-        let x483 = Self::mul_add(-x465, x474, x451);
-        let x484 = Self::mul_add(-x465, x475, x452);
-        let x485 = Self::mul_add(-x465, x476, 0.000000008530897668050218 + x453);
-        let x486 = Self::mul_add(-x467, x474, x443);
-        let x487 = Self::mul_add(-x467, x475, x444);
-        let x488 = Self::mul_add(-x467, x476, x445);
-        let x489 = Self::mul_add(-x468, x475, x446);
-        let x490 = Self::mul_add(-x468, x476, x447);
-        let x491 = Self::mul_add(-x456, x476, x448);
-        let x492 = Self::mul_add(
-            x471,
-            x472,
+        let x493 = Self::mul_add(-x479, x487, -111.7548902508081 + x470);
+        let x494 = Self::mul_add(-x478, x488, x437 + (x461 - x460));
+        let x495 = Self::mul_add(-x478, x489, x462);
+        let x496 = Self::mul_add(-x478, x490, -12.701650001451807 + x463);
+        let x497 = Self::mul_add(-x479, x488, x464);
+        let x498 = Self::mul_add(-x479, x489, x465);
+        let x499 = Self::mul_add(-x479, x490, 0.000000008530897668050218 + x466);
+        let x500 = Self::mul_add(-x481, x488, x453);
+        let x501 = Self::mul_add(-x481, x489, x454);
+        let x502 = Self::mul_add(-x481, x490, x456);
+        let x503 = Self::mul_add(-x482, x489, x457);
+        let x504 = Self::mul_add(-x482, x490, x458);
+        let x505 = Self::mul_add(x469, x490, x459);
+        let x506 = Self::mul_add(
+            x485,
+            x486,
             Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
                 - f_ext[2][3]
-                + (Self::mul_add(
-                    0.00000000020510342851533115,
-                    x413,
-                    Self::mul_add(c_q9, x412, s_q9 * x411),
-                ) + Self::mul_add(0.275, x462, -0.4 * x461))
-                + (Self::mul_add(-x35, x478, x34 * x477)
-                    + Self::mul_add(-x37, x481, x36 * x480)),
+                + (Self::mul_add(c_q9, x418, s_q9 * x417) + x477
+                    + Self::mul_add(-0.4, x475, 0.275 * x476))
+                + (Self::mul_add(-x35, x492, x34 * x491)
+                    + Self::mul_add(-x37, x495, x36 * x494)),
         );
-        let x493 = Self::mul_add(
-            x471,
-            x473,
-            Self::mul_add(-x27, x41, x38 * x39) + Self::mul_add(-x33, x42, x31 * x44)
-                - f_ext[2][4]
-                + Self::mul_add(0.4, x460, x413 + Self::mul_add(x47, x412, x46 * x411))
-                + (Self::mul_add(-x35, x479, x34 * x478)
-                    + Self::mul_add(-x37, x484, x36 * x483)),
-        );
-        let x494 = Self::mul_add(x471, x466 * x470, x469);
-        let x495 = Self::mul_add(
-            x471,
-            x474,
-            Self::mul_add(-x28, x44, x38 * x43) - f_ext[2][0] + x460
-                + (Self::mul_add(-x35, x483, x34 * x480)
-                    + Self::mul_add(-x37, x487, x36 * x486)),
-        );
-        let x496 = Self::mul_add(
-            x471,
-            x475,
-            Self::mul_add(-x38, x42, x27 * x44) - f_ext[2][1] + x461
-                + (Self::mul_add(-x35, x484, x34 * x481)
-                    + Self::mul_add(-x37, x489, x36 * x487)),
-        );
-        let x497 = Self::mul_add(
-            x471,
-            x476,
-            Self::mul_add(-x27, x43, x28 * x42) - f_ext[2][2] + x462
-                + (Self::mul_add(-x35, x485, x34 * x482)
-                    + Self::mul_add(-x37, x490, x36 * x488)),
-        );
-        let x498 = c_q8 * x478;
-        let x499 = Self::mul_add(s_q8, x477, x498);
-        let x500 = s_q8 * x478;
-        let x501 = Self::mul_add(-c_q8, x477, x500);
-        let x502 = Self::mul_add(c_q8, x479, x500);
-        let x503 = Self::mul_add(s_q8, x479, -x498);
-        let x504 = x482 + Self::mul_add(-x26, x481, x25 * x480);
-        let x505 = Self::mul_add(c_q8, x481, s_q8 * x480);
-        let x506 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x482,
-            Self::mul_add(-c_q8, x480, s_q8 * x481),
-        );
-        let x507 = x485 + Self::mul_add(-x26, x484, x25 * x483);
-        let x508 = Self::mul_add(c_q8, x484, s_q8 * x483);
-        let x509 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x507 = Self::mul_add(
             x485,
-            Self::mul_add(-c_q8, x483, s_q8 * x484),
+            x487,
+            Self::mul_add(x31, x44, x33 * x42) - Self::mul_add(x27, x41, x38 * x39)
+                - f_ext[2][4]
+                + Self::mul_add(0.4, x474, x419 + Self::mul_add(-x49, x418, x48 * x417))
+                + (Self::mul_add(-x35, x493, x34 * x492)
+                    + Self::mul_add(-x37, x498, x36 * x497)),
         );
-        let x510 = Self::mul_add(-x26, x507, x25 * x504);
-        let x511 = Self::mul_add(-x26, x508, x25 * x505);
-        let x512 = Self::mul_add(c_q8, x507, s_q8 * x504);
-        let x513 = Self::mul_add(-c_q8, x504, s_q8 * x507);
-        let x514 = Self::mul_add(-c_q8, x505, s_q8 * x508);
-        let x515 = Self::mul_add(-c_q8, x506, s_q8 * x509);
-        let x516 = c_q8 * x487;
-        let x517 = Self::mul_add(s_q8, x486, x516);
-        let x518 = s_q8 * x487;
-        let x519 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x508 = Self::mul_add(x485, x480 * x484, x483);
+        let x509 = Self::mul_add(
+            x485,
             x488,
-            Self::mul_add(-c_q8, x486, x518),
+            Self::mul_add(-x28, x44, x38 * x43) - f_ext[2][0] + x474
+                + (Self::mul_add(-x35, x497, x34 * x494)
+                    + Self::mul_add(-x37, x501, x36 * x500)),
         );
-        let x520 = Self::mul_add(c_q8, x489, x518);
-        let x521 = Self::mul_add(
-            -0.00000000020510342851533115,
+        let x510 = Self::mul_add(
+            x485,
+            x489,
+            Self::mul_add(x27, x44, x38 * x42) - f_ext[2][1] + x475
+                + (Self::mul_add(-x35, x498, x34 * x495)
+                    + Self::mul_add(-x37, x503, x36 * x501)),
+        );
+        let x511 = Self::mul_add(
+            x485,
             x490,
-            Self::mul_add(s_q8, x489, -x516),
+            x476 - (f_ext[2][2] + Self::mul_add(x27, x43, x28 * x42))
+                + (Self::mul_add(-x35, x499, x34 * x496)
+                    + Self::mul_add(-x37, x504, x36 * x502)),
         );
-        let x522 = Self::mul_add(
+        let x512 = c_q8 * x492;
+        let x513 = Self::mul_add(s_q8, x491, x512);
+        let x514 = s_q8 * x492;
+        let x515 = Self::mul_add(-c_q8, x491, x514);
+        let x516 = Self::mul_add(c_q8, x493, x514);
+        let x517 = Self::mul_add(s_q8, x493, -x512);
+        let x518 = x496 + Self::mul_add(-x25, x494, x26 * x495);
+        let x519 = Self::mul_add(c_q8, x495, s_q8 * x494);
+        let x520 = Self::mul_add(
             -0.00000000020510342851533115,
-            x491,
-            Self::mul_add(-c_q8, x488, s_q8 * x490),
+            x496,
+            Self::mul_add(-c_q8, x494, s_q8 * x495),
         );
-        let x523 = x491 + Self::mul_add(-x26, x490, x25 * x488)
+        let x521 = x499 + Self::mul_add(-x25, x497, x26 * x498);
+        let x522 = Self::mul_add(c_q8, x498, s_q8 * x497);
+        let x523 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x499,
+            Self::mul_add(-c_q8, x497, s_q8 * x498),
+        );
+        let x524 = Self::mul_add(-x25, x518, x26 * x521);
+        let x525 = Self::mul_add(-x25, x519, x26 * x522);
+        let x526 = Self::mul_add(c_q8, x521, s_q8 * x518);
+        let x527 = Self::mul_add(-c_q8, x518, s_q8 * x521);
+        let x528 = Self::mul_add(-c_q8, x519, s_q8 * x522);
+        let x529 = Self::mul_add(-c_q8, x520, s_q8 * x523);
+        let x530 = c_q8 * x501;
+        let x531 = Self::mul_add(s_q8, x500, x530);
+        let x532 = s_q8 * x501;
+        let x533 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x502,
+            Self::mul_add(-c_q8, x500, x532),
+        );
+        let x534 = Self::mul_add(c_q8, x503, x532);
+        let x535 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x504,
+            Self::mul_add(s_q8, x503, -x530),
+        );
+        let x536 = Self::mul_add(
+            0.00000000020510342851533115,
+            x505,
+            Self::mul_add(-c_q8, x502, s_q8 * x504),
+        );
+        let x537 = Self::mul_add(-x25, x502, x26 * x504) - x505
             + Self::mul_add(
-                -x26,
-                x490 + Self::mul_add(-x26, x489, x25 * x487),
-                x25 * (x488 + Self::mul_add(-x26, x487, x25 * x486)),
+                -x25,
+                x502 + Self::mul_add(-x25, x500, x26 * x501),
+                x26 * (x504 + Self::mul_add(-x25, x501, x26 * x503)),
             );
-        let x524 = Self::mul_add(c_q8, x490, s_q8 * x488)
-            + Self::mul_add(-x26, x520, x25 * x517);
-        let x525 = x522 + Self::mul_add(-x26, x521, x25 * x519);
-        let x526 = Self::mul_add(c_q8, x520, s_q8 * x517);
-        let x527 = Self::mul_add(c_q8, x521, s_q8 * x519);
-        let x528 = Self::mul_add(-0.35, x526, x511);
-        let x529 = Self::mul_add(0.35, x523, x512);
-        let x530 = Self::mul_add(0.35, x524, Self::mul_add(c_q8, x508, s_q8 * x505));
-        let x531 = Self::mul_add(
+        let x538 = Self::mul_add(c_q8, x504, s_q8 * x502)
+            + Self::mul_add(-x25, x531, x26 * x534);
+        let x539 = x536 + Self::mul_add(-x25, x533, x26 * x535);
+        let x540 = Self::mul_add(c_q8, x534, s_q8 * x531);
+        let x541 = Self::mul_add(c_q8, x535, s_q8 * x533);
+        let x542 = 0.35 * x538;
+        let x543 = Self::mul_add(-0.35, x540, x525);
+        let x544 = Self::mul_add(0.35, x537, x526);
+        let x545 = Self::mul_add(c_q8, x522, s_q8 * x519) + x542;
+        let x546 = Self::mul_add(
             -0.35,
-            x528,
+            x543,
             Self::mul_add(
-                -x26,
-                Self::mul_add(-x26, x479, x25 * x478),
-                x25 * Self::mul_add(-x26, x478, x25 * x477),
+                -x25,
+                Self::mul_add(-x25, x491, x26 * x492),
+                x26 * Self::mul_add(-x25, x492, x26 * x493),
             ),
         );
-        let x532 = Self::mul_add(
+        let x547 = Self::mul_add(
             0.35,
-            x510,
-            Self::mul_add(-0.35, x530, Self::mul_add(-x26, x502, x25 * x499)),
+            x524,
+            Self::mul_add(-0.35, x545, Self::mul_add(-x25, x513, x26 * x516)),
         );
-        let x533 = Self::mul_add(
+        let x548 = Self::mul_add(
             0.35,
-            x512,
-            Self::mul_add(0.35, x529, Self::mul_add(c_q8, x502, s_q8 * x499)),
+            x526,
+            Self::mul_add(0.35, x544, Self::mul_add(c_q8, x516, s_q8 * x513)),
         );
-        let x534 = x497 + Self::mul_add(-x26, x496, x25 * x495);
-        let x535 = Self::mul_add(c_q8, x496, s_q8 * x495);
-        let x536 = -16.80768997608804
-            + Self::mul_add(-0.35, x514, Self::mul_add(-x26, x503, x25 * x501));
-        let x537 = 0.1132
-            + Self::mul_add(0.35, x513, Self::mul_add(c_q8, x503, s_q8 * x501));
-        let x538 = 132.47349025763282 + Self::mul_add(-c_q8, x501, s_q8 * x503);
-        let x539 = 48.0240000085309 + x514;
-        let x540 = Self::mul_add(-x12, x22, Self::mul_add(-x8, x19, x7 * x20))
+        let x549 = x511 + Self::mul_add(-x25, x509, x26 * x510);
+        let x550 = Self::mul_add(c_q8, x510, s_q8 * x509);
+        let x551 = -16.80768997608804
+            + Self::mul_add(-0.35, x528, Self::mul_add(-x25, x515, x26 * x517));
+        let x552 = 0.1132
+            + Self::mul_add(0.35, x527, Self::mul_add(c_q8, x517, s_q8 * x515));
+        let x553 = 132.47349025763282 + Self::mul_add(-c_q8, x515, s_q8 * x517);
+        let x554 = 48.0240000085309 + x528;
+        let x555 = Self::mul_add(x12, x22, Self::mul_add(x7, x20, x8 * x19))
             - f_ext[1][5]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x494,
-                Self::mul_add(-c_q8, x492, s_q8 * x493),
+                x508,
+                Self::mul_add(-c_q8, x506, s_q8 * x507),
             );
-        let x541 = 1.0 / x538;
-        let x542 = tau[0] - x540;
-        let x543 = x536 * x541;
-        let x544 = x537 * x541;
-        let x545 = x513 * x541;
-        let x546 = x539 * x541;
-        let x547 = x515 * x541;
-        let x548 = Self::mul_add(-x536, x543, Self::mul_add(-0.35, x511, x531));
-        let x549 = Self::mul_add(-x536, x544, -0.07309 + x532);
-        let x550 = Self::mul_add(-x537, x544, 130.43769025763282 + x533);
-        let x551 = Self::mul_add(-x536, x545, Self::mul_add(-0.35, x524, x510));
-        let x552 = Self::mul_add(-x536, x546, x528);
-        let x553 = Self::mul_add(
-            -x536,
-            x547,
-            Self::mul_add(-0.35, x527, Self::mul_add(-x26, x509, x25 * x506)),
+        let x556 = 1.0 / x553;
+        let x557 = tau[0] - x555;
+        let x558 = x551 * x556;
+        let x559 = x552 * x556;
+        let x560 = x527 * x556;
+        let x561 = x554 * x556;
+        let x562 = x529 * x556;
+        let x563 = Self::mul_add(-x551, x558, Self::mul_add(-0.35, x525, x546));
+        let x564 = Self::mul_add(-x551, x559, -0.07309 + x547);
+        let x565 = Self::mul_add(-x552, x559, 130.43769025763282 + x548);
+        let x566 = Self::mul_add(-x551, x560, x524 - x542);
+        let x567 = Self::mul_add(-x551, x561, x543);
+        let x568 = Self::mul_add(
+            -x551,
+            x562,
+            Self::mul_add(-0.35, x541, Self::mul_add(-x25, x520, x26 * x523)),
         );
-        let x554 = Self::mul_add(-x537, x545, x529);
-        let x555 = Self::mul_add(-x537, x546, x530);
-        let x556 = Self::mul_add(
-            -x537,
-            x547,
+        let x569 = Self::mul_add(-x552, x560, x544);
+        let x570 = Self::mul_add(-x552, x561, x545);
+        let x571 = Self::mul_add(
+            -x552,
+            x562,
             -48.0240000085309
-                + Self::mul_add(0.35, x525, Self::mul_add(c_q8, x509, s_q8 * x506)),
+                + Self::mul_add(0.35, x539, Self::mul_add(c_q8, x523, s_q8 * x520)),
         );
-        let x557 = Self::mul_add(-x513, x545, x523);
-        let x558 = Self::mul_add(-x513, x546, x524);
-        let x559 = Self::mul_add(-x513, x547, x525);
-        let x560 = Self::mul_add(-x539, x546, x526);
-        let x561 = Self::mul_add(-x539, x547, x527);
-        let x562 = Self::mul_add(
-            -x515,
-            x547,
+        let x572 = Self::mul_add(-x527, x560, x537);
+        let x573 = Self::mul_add(-x527, x561, x538);
+        let x574 = Self::mul_add(-x527, x562, x539);
+        let x575 = Self::mul_add(-x554, x561, x540);
+        let x576 = Self::mul_add(-x554, x562, x541);
+        let x577 = Self::mul_add(
+            -x529,
+            x562,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x522,
-                Self::mul_add(-c_q8, x519, s_q8 * x521),
+                x536,
+                Self::mul_add(-c_q8, x533, s_q8 * x535),
             ),
         );
-        let x563 = Self::mul_add(
-            x542,
-            x543,
-            Self::mul_add(-x18, x20, x8 * x21) + Self::mul_add(-x13, x23, x11 * x22)
+        let x578 = Self::mul_add(
+            x557,
+            x558,
+            Self::mul_add(-x18, x20, x8 * x21) - Self::mul_add(x13, x23, x11 * x22)
                 - f_ext[1][3]
                 + Self::mul_add(
                     -0.35,
-                    x535,
-                    x494 + Self::mul_add(-x26, x493, x25 * x492),
+                    x550,
+                    x508 + Self::mul_add(-x25, x506, x26 * x507),
                 )
-                + (Self::mul_add(-x15, x549, x14 * x548)
-                    + Self::mul_add(-x17, x552, x16 * x551)),
+                + (Self::mul_add(-x15, x564, x14 * x563)
+                    + Self::mul_add(-x17, x567, x16 * x566)),
         );
-        let x564 = Self::mul_add(
-            x542,
-            x544,
-            Self::mul_add(x12, x23, Self::mul_add(-x7, x21, x18 * x19)) - f_ext[1][4]
-                + Self::mul_add(0.35, x534, Self::mul_add(c_q8, x493, s_q8 * x492))
-                + (Self::mul_add(-x15, x550, x14 * x549)
-                    + Self::mul_add(-x17, x555, x16 * x554)),
+        let x579 = Self::mul_add(
+            x557,
+            x559,
+            Self::mul_add(x12, x23, -Self::mul_add(x7, x21, x18 * x19)) - f_ext[1][4]
+                + Self::mul_add(0.35, x549, Self::mul_add(c_q8, x507, s_q8 * x506))
+                + (Self::mul_add(-x15, x565, x14 * x564)
+                    + Self::mul_add(-x17, x570, x16 * x569)),
         );
-        let x565 = Self::mul_add(
-            x542,
-            x545,
-            Self::mul_add(-x8, x23, x18 * x22) - f_ext[1][0] + x534
-                + (Self::mul_add(-x15, x554, x14 * x551)
-                    + Self::mul_add(-x17, x558, x16 * x557)),
+        let x580 = Self::mul_add(
+            x557,
+            x560,
+            x549 - (f_ext[1][0] + Self::mul_add(x8, x23, x18 * x22))
+                + (Self::mul_add(-x15, x569, x14 * x566)
+                    + Self::mul_add(-x17, x573, x16 * x572)),
         );
-        let x566 = Self::mul_add(
-            x542,
-            x546,
-            Self::mul_add(x7, x23, -f_ext[1][1]) + x535
-                + (Self::mul_add(-x15, x555, x14 * x552)
-                    + Self::mul_add(-x17, x560, x16 * x558)),
+        let x581 = Self::mul_add(
+            x557,
+            x561,
+            Self::mul_add(x7, x23, -f_ext[1][1]) + x550
+                + (Self::mul_add(-x15, x570, x14 * x567)
+                    + Self::mul_add(-x17, x575, x16 * x573)),
         );
-        let x567 = Self::mul_add(
-            x542,
-            x547,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x497,
-                Self::mul_add(-c_q8, x495, s_q8 * x496),
-            ) - Self::mul_add(x7, x22, f_ext[1][2])
-                + (Self::mul_add(-x15, x556, x14 * x553)
-                    + Self::mul_add(-x17, x561, x16 * x559)),
+        let x582 = Self::mul_add(
+            x557,
+            x562,
+            Self::mul_add(x7, x22, -f_ext[1][2])
+                + Self::mul_add(
+                    -0.00000000020510342851533115,
+                    x511,
+                    Self::mul_add(-c_q8, x509, s_q8 * x510),
+                )
+                + (Self::mul_add(-x15, x571, x14 * x568)
+                    + Self::mul_add(-x17, x576, x16 * x574)),
         );
-        let x568 = s_q7 * x549;
-        let x569 = c_q7 * x549;
-        let x570 = Self::mul_add(s_q7, x548, x569);
-        let x571 = Self::mul_add(c_q7, x550, x568);
-        let x572 = Self::mul_add(-s_q7, x552, c_q7 * x551);
-        let x573 = Self::mul_add(c_q7, x552, s_q7 * x551);
-        let x574 = Self::mul_add(-s_q7, x555, c_q7 * x554);
-        let x575 = Self::mul_add(c_q7, x555, s_q7 * x554);
-        let x576 = Self::mul_add(-s_q7, x574, c_q7 * x572);
-        let x577 = Self::mul_add(-s_q7, x575, c_q7 * x573);
-        let x578 = Self::mul_add(-s_q7, x556, c_q7 * x553);
-        let x579 = Self::mul_add(c_q7, x574, s_q7 * x572);
-        let x580 = Self::mul_add(c_q7, x575, s_q7 * x573);
-        let x581 = Self::mul_add(c_q7, x556, s_q7 * x553);
-        let x582 = s_q7 * x558;
-        let x583 = c_q7 * x558;
-        let x584 = Self::mul_add(s_q7, x557, x583);
-        let x585 = Self::mul_add(c_q7, x560, x582);
-        let x586 = Self::mul_add(-s_q7, x561, c_q7 * x559);
-        let x587 = Self::mul_add(c_q7, x561, s_q7 * x559);
-        let x588 = Self::mul_add(
+        let x583 = s_q7 * x564;
+        let x584 = c_q7 * x564;
+        let x585 = Self::mul_add(s_q7, x563, x584);
+        let x586 = Self::mul_add(c_q7, x565, x583);
+        let x587 = Self::mul_add(-s_q7, x567, c_q7 * x566);
+        let x588 = Self::mul_add(c_q7, x567, s_q7 * x566);
+        let x589 = Self::mul_add(-s_q7, x570, c_q7 * x569);
+        let x590 = Self::mul_add(c_q7, x570, s_q7 * x569);
+        let x591 = Self::mul_add(-s_q7, x589, c_q7 * x587);
+        let x592 = Self::mul_add(-s_q7, x590, c_q7 * x588);
+        let x593 = Self::mul_add(-s_q7, x571, c_q7 * x568);
+        let x594 = Self::mul_add(c_q7, x589, s_q7 * x587);
+        let x595 = Self::mul_add(c_q7, x590, s_q7 * x588);
+        let x596 = Self::mul_add(c_q7, x571, s_q7 * x568);
+        let x597 = s_q7 * x573;
+        let x598 = c_q7 * x573;
+        let x599 = Self::mul_add(s_q7, x572, x598);
+        let x600 = Self::mul_add(c_q7, x575, x597);
+        let x601 = Self::mul_add(-s_q7, x576, c_q7 * x574);
+        let x602 = Self::mul_add(c_q7, x576, s_q7 * x574);
+        let x603 = Self::mul_add(
             -s_q7,
-            Self::mul_add(-s_q7, x560, x583),
-            c_q7 * Self::mul_add(c_q7, x557, -x582),
+            Self::mul_add(-s_q7, x575, x598),
+            c_q7 * Self::mul_add(c_q7, x572, -x597),
         );
-        let x589 = Self::mul_add(-s_q7, x585, c_q7 * x584);
-        let x590 = Self::mul_add(c_q7, x585, s_q7 * x584);
-        let x591 = 0.65 * x589;
-        let x592 = 0.65 * x590;
-        let x593 = 0.65 * x587;
-        let x594 = Self::mul_add(-0.75, x589, x576);
-        let x595 = Self::mul_add(-0.75, x590, x577);
-        let x596 = x579 + Self::mul_add(-0.65, x586, 0.75 * x588);
-        let x597 = x580 + Self::mul_add(-0.65, x587, 0.75 * x589);
-        let x598 = x581 + Self::mul_add(-0.65, x562, 0.75 * x586);
-        let x599 = Self::mul_add(
+        let x604 = Self::mul_add(-s_q7, x600, c_q7 * x599);
+        let x605 = Self::mul_add(c_q7, x600, s_q7 * x599);
+        let x606 = 0.75 * x604;
+        let x607 = 0.65 * x604;
+        let x608 = 0.65 * x602;
+        let x609 = 0.65 * x605;
+        let x610 = x591 - x606;
+        let x611 = Self::mul_add(-0.75, x605, x592);
+        let x612 = x594 + Self::mul_add(-0.65, x601, 0.75 * x603);
+        let x613 = x595 + (x606 - x608);
+        let x614 = x596 + Self::mul_add(-0.65, x577, 0.75 * x601);
+        let x615 = Self::mul_add(
             -0.75,
-            x595,
+            x611,
             Self::mul_add(
                 -s_q7,
-                Self::mul_add(-s_q7, x550, x569),
-                c_q7 * Self::mul_add(c_q7, x548, -x568),
+                Self::mul_add(-s_q7, x565, x584),
+                c_q7 * Self::mul_add(c_q7, x563, -x583),
             ),
         );
-        let x600 = Self::mul_add(-s_q7, x566, c_q7 * x565);
-        let x601 = Self::mul_add(c_q7, x566, s_q7 * x565);
-        let x602 = 180.9502499901501 + x596;
-        let x603 = Self::mul_add(-v[5], x4, v[4] * x5) - f_ext[0][0] + x600;
-        let x604 = 1.0 / (1170.07 + x588);
-        let x605 = x589 * x604;
-        let x606 = x586 * x604;
-        let x607 = x594 * x604;
-        let x608 = x602 * x604;
-        let x609 = x591 * x604;
-        let x610 = 1.0 / Self::mul_add(-x589, x605, 1170.07 + x590);
-        let x611 = Self::mul_add(-x589, x606, x587);
-        let x612 = x610 * x611;
-        let x613 = Self::mul_add(-x589, x607, -180.9502499901501 + x595);
-        let x614 = x610 * x613;
-        let x615 = Self::mul_add(-x589, x608, x597);
-        let x616 = x610 * x615;
-        let x617 = Self::mul_add(-x589, x609, 110.5455 + x592);
-        let x618 = x610 * x617;
-        let x619 = 1.0
-            / Self::mul_add(-x611, x612, Self::mul_add(-x586, x606, 1170.07 + x562));
-        let x620 = Self::mul_add(
-            -x611,
-            x614,
-            Self::mul_add(-x586, x607, Self::mul_add(-0.75, x587, x578)),
-        );
-        let x621 = x619 * x620;
-        let x622 = Self::mul_add(
-            -x611,
-            x616,
-            Self::mul_add(-x586, x608, -110.5455 + x598),
-        );
-        let x623 = x619 * x622;
-        let x624 = Self::mul_add(-x611, x618, Self::mul_add(-x586, x609, x593));
-        let x625 = x619 * x624;
-        let x626 = Self::mul_add(
-            -x613,
-            x614,
-            Self::mul_add(
-                -x594,
-                x607,
-                1394.5960312283303 + Self::mul_add(-0.75, x577, x599),
-            ),
-        );
-        let x627 = 1.0 / Self::mul_add(-x620, x621, x626);
-        let x628 = Self::mul_add(
-            -x594,
-            x608,
-            Self::mul_add(-0.65, x578, 0.75 * x576)
-                + Self::mul_add(-0.75, x597, Self::mul_add(-s_q7, x571, c_q7 * x570)),
-        );
-        let x629 = Self::mul_add(-x620, x623, Self::mul_add(-x613, x616, x628));
-        let x630 = x627 * x629;
-        let x631 = Self::mul_add(
-            -x613,
-            x618,
-            Self::mul_add(
-                -x594,
-                x609,
-                -117.61766249359756 + Self::mul_add(0.65, x577, -0.75 * x592),
-            ),
-        );
-        let x632 = Self::mul_add(-x620, x625, x631);
-        let x633 = x627 * x632;
-        let x634 = Self::mul_add(
-            -x615,
-            x616,
-            Self::mul_add(
-                -x602,
-                x608,
-                1466.4506062283303
-                    + (Self::mul_add(-0.65, x581, 0.75 * x579)
-                        + (Self::mul_add(c_q7, x571, s_q7 * x570)
-                            + Self::mul_add(-0.65, x598, 0.75 * x596))),
-            ),
-        );
-        let x635 = 1.0 / Self::mul_add(-x629, x630, Self::mul_add(-x622, x623, x634));
+        let x616 = Self::mul_add(-s_q7, x581, c_q7 * x580);
+        let x617 = Self::mul_add(c_q7, x581, s_q7 * x580);
+        let x618 = 180.9502499901501 + x612;
+        let x619 = Self::mul_add(-v[5], x4, v[4] * x5) - f_ext[0][0] + x616;
+        let x620 = 1.0 / (1170.07 + x603);
+        let x621 = x604 * x620;
+        let x622 = x601 * x620;
+        let x623 = x610 * x620;
+        let x624 = x618 * x620;
+        let x625 = x607 * x620;
+        let x626 = 1.0 / Self::mul_add(-x604, x621, 1170.07 + x605);
+        let x627 = Self::mul_add(-x604, x622, x602);
+        let x628 = x626 * x627;
+        let x629 = Self::mul_add(-x604, x623, -180.9502499901501 + x611);
+        let x630 = x626 * x629;
+        let x631 = Self::mul_add(-x604, x624, x613);
+        let x632 = x626 * x631;
+        let x633 = Self::mul_add(-x604, x625, 110.5455 + x609);
+        let x634 = x626 * x633;
+        let x635 = 1.0
+            / Self::mul_add(-x627, x628, Self::mul_add(-x601, x622, 1170.07 + x577));
         let x636 = Self::mul_add(
-            -x602,
-            x609,
-            Self::mul_add(0.65, x580, Self::mul_add(-0.65, x593, 0.75 * x591)),
+            -x627,
+            x630,
+            Self::mul_add(-x601, x623, Self::mul_add(-0.75, x602, x593)),
         );
-        let x637 = Self::mul_add(
-            -x629,
-            x633,
-            Self::mul_add(-x622, x625, Self::mul_add(-x615, x618, x636)),
+        let x637 = x635 * x636;
+        let x638 = Self::mul_add(
+            -x627,
+            x632,
+            Self::mul_add(-x601, x624, -110.5455 + x614),
         );
-        let x638 = x635 * x637;
-        let x639 = Self::mul_add(
-            -x617,
-            x618,
-            Self::mul_add(-x591, x609, Self::mul_add(0.65, x592, 1271.854575)),
-        );
-        let x640 = Self::mul_add(
-            -x637,
-            x638,
-            Self::mul_add(-x632, x633, Self::mul_add(-x624, x625, x639)),
-        );
-        let x641 = 1.0 / x640;
+        let x639 = x635 * x638;
+        let x640 = Self::mul_add(-x627, x634, Self::mul_add(-x601, x625, x608));
+        let x641 = x635 * x640;
         let x642 = Self::mul_add(
-            x603,
-            x605,
-            -(Self::mul_add(-v[3], x5, v[5] * x3) - f_ext[0][1] + x601),
-        );
-        let x643 = Self::mul_add(
-            -x612,
-            x642,
+            -x629,
+            x630,
             Self::mul_add(
-                x603,
-                x606,
-                -(Self::mul_add(-v[4], x3, v[3] * x4) - f_ext[0][2] + x567),
+                -x610,
+                x623,
+                1394.5960312283303 + Self::mul_add(-0.75, x592, x615),
             ),
         );
+        let x643 = 1.0 / Self::mul_add(-x636, x637, x642);
         let x644 = Self::mul_add(
-            x603,
-            x607,
+            -x610,
+            x624,
+            Self::mul_add(-0.65, x593, 0.75 * x591)
+                + Self::mul_add(-0.75, x613, Self::mul_add(-s_q7, x586, c_q7 * x585)),
+        );
+        let x645 = Self::mul_add(-x636, x639, Self::mul_add(-x629, x632, x644));
+        let x646 = x643 * x645;
+        let x647 = Self::mul_add(
+            -x629,
+            x634,
+            Self::mul_add(
+                -x610,
+                x625,
+                -117.61766249359756 + Self::mul_add(-0.75, x609, 0.65 * x592),
+            ),
+        );
+        let x648 = Self::mul_add(-x636, x641, x647);
+        let x649 = x643 * x648;
+        let x650 = Self::mul_add(
+            -x631,
+            x632,
+            Self::mul_add(
+                -x618,
+                x624,
+                1466.4506062283303
+                    + (Self::mul_add(-0.65, x596, 0.75 * x594)
+                        + (Self::mul_add(c_q7, x586, s_q7 * x585)
+                            + Self::mul_add(-0.65, x614, 0.75 * x612))),
+            ),
+        );
+        let x651 = 1.0 / Self::mul_add(-x645, x646, Self::mul_add(-x638, x639, x650));
+        let x652 = Self::mul_add(
+            -x618,
+            x625,
+            Self::mul_add(0.65, x595, Self::mul_add(-0.65, x608, 0.75 * x607)),
+        );
+        let x653 = Self::mul_add(
+            -x645,
+            x649,
+            Self::mul_add(-x638, x641, Self::mul_add(-x631, x634, x652)),
+        );
+        let x654 = x651 * x653;
+        let x655 = Self::mul_add(
+            -x633,
+            x634,
+            Self::mul_add(-x607, x625, Self::mul_add(0.65, x609, 1271.854575)),
+        );
+        let x656 = Self::mul_add(
+            -x653,
+            x654,
+            Self::mul_add(-x648, x649, Self::mul_add(-x640, x641, x655)),
+        );
+        let x657 = 1.0 / x656;
+        let x658 = Self::mul_add(
+            x619,
+            x621,
+            -(Self::mul_add(-v[3], x5, v[5] * x3) - f_ext[0][1] + x617),
+        );
+        let x659 = Self::mul_add(
+            -x628,
+            x658,
+            Self::mul_add(
+                x619,
+                x622,
+                -(Self::mul_add(-v[4], x3, v[3] * x4) - f_ext[0][2] + x582),
+            ),
+        );
+        let x660 = Self::mul_add(
+            x619,
+            x623,
             -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
                 - f_ext[0][3]
-                + Self::mul_add(-0.75, x601, Self::mul_add(-s_q7, x564, c_q7 * x563))),
+                + Self::mul_add(-0.75, x617, Self::mul_add(-s_q7, x579, c_q7 * x578))),
         );
-        let x645 = Self::mul_add(-x621, x643, Self::mul_add(-x614, x642, x644));
-        let x646 = Self::mul_add(
-            -x616,
-            x642,
+        let x661 = Self::mul_add(-x637, x659, Self::mul_add(-x630, x658, x660));
+        let x662 = Self::mul_add(
+            -x632,
+            x658,
             Self::mul_add(
-                x603,
-                x608,
+                x619,
+                x624,
                 -(Self::mul_add(-v[3], x2, v[5] * x0)
                     + Self::mul_add(-v[0], x5, v[2] * x3) - f_ext[0][4]
-                    + (Self::mul_add(c_q7, x564, s_q7 * x563)
-                        + Self::mul_add(-0.65, x567, 0.75 * x600))),
+                    + (Self::mul_add(c_q7, x579, s_q7 * x578)
+                        + Self::mul_add(-0.65, x582, 0.75 * x616))),
             ),
         );
-        let x647 = Self::mul_add(-x630, x645, Self::mul_add(-x623, x643, x646));
-        let x648 = Self::mul_add(
-            x603,
-            x609,
+        let x663 = Self::mul_add(-x646, x661, Self::mul_add(-x639, x659, x662));
+        let x664 = Self::mul_add(
+            x619,
+            x625,
             -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
                 - f_ext[0][5]
-                + Self::mul_add(0.65, x601, Self::mul_add(x542, x538 * x541, x540))),
+                + Self::mul_add(0.65, x617, Self::mul_add(x557, x553 * x556, x555))),
         );
-        let x649 = Self::mul_add(
-            -x633,
-            x645,
-            Self::mul_add(-x625, x643, Self::mul_add(-x618, x642, x648)),
+        let x665 = Self::mul_add(
+            -x649,
+            x661,
+            Self::mul_add(-x641, x659, Self::mul_add(-x634, x658, x664)),
         );
-        let x650 = x641 * Self::mul_add(-x638, x647, x649);
-        let x651 = Self::mul_add(-x638, x650, x635 * x647);
-        let x652 = Self::mul_add(-x633, x650, Self::mul_add(-x630, x651, x627 * x645));
-        let x653 = Self::mul_add(
-            -x625,
-            x650,
-            Self::mul_add(-x623, x651, Self::mul_add(-x621, x652, x619 * x643)),
+        let x666 = x657 * Self::mul_add(-x654, x663, x665);
+        let x667 = Self::mul_add(-x654, x666, x651 * x663);
+        let x668 = Self::mul_add(-x649, x666, Self::mul_add(-x646, x667, x643 * x661));
+        let x669 = Self::mul_add(
+            -x641,
+            x666,
+            Self::mul_add(-x639, x667, Self::mul_add(-x637, x668, x635 * x659)),
         );
-        let x654 = Self::mul_add(
-            -x616,
-            x651,
-            Self::mul_add(-x614, x652, Self::mul_add(-x612, x653, x610 * x642)),
+        let x670 = Self::mul_add(
+            -x632,
+            x667,
+            Self::mul_add(-x630, x668, Self::mul_add(-x628, x669, x626 * x658)),
         );
-        let x655 = Self::mul_add(-x618, x650, x654);
-        let x656 = Self::mul_add(
-            x607,
-            x652,
-            Self::mul_add(x606, x653, Self::mul_add(x605, x655, x603 * x604)),
+        let x671 = Self::mul_add(-x634, x666, x670);
+        let x672 = Self::mul_add(
+            x623,
+            x668,
+            Self::mul_add(x622, x669, Self::mul_add(x621, x671, x619 * x620)),
         );
-        let x657 = Self::mul_add(x609, x650, Self::mul_add(x608, x651, x656));
-        let x658 = -x657;
-        let x659 = Self::mul_add(-0.75, x651, x657);
-        let x660 = x655 - Self::mul_add(-0.65, x650, 0.75 * x652);
-        let x661 = Self::mul_add(-0.65, x651, x653);
-        let x662 = x14 + Self::mul_add(s_q7, x651, c_q7 * x652);
-        let x663 = Self::mul_add(-s_q7, x652, c_q7 * x651) - x15;
-        let x664 = x16 + Self::mul_add(-c_q7, x659, s_q7 * x660);
-        let x665 = Self::mul_add(c_q7, x660, s_q7 * x659) - x17;
-        let x666 = x541
-            * (x542
-                - (Self::mul_add(x538, x650, Self::mul_add(x537, x663, x536 * x662))
+        let x673 = Self::mul_add(x625, x666, Self::mul_add(x624, x667, x672));
+        let x674 = -x673;
+        let x675 = Self::mul_add(0.75, x667, -x673);
+        let x676 = x671 - Self::mul_add(-0.65, x666, 0.75 * x668);
+        let x677 = Self::mul_add(-0.65, x667, x669);
+        let x678 = x14 + Self::mul_add(s_q7, x667, c_q7 * x668);
+        let x679 = Self::mul_add(-s_q7, x668, c_q7 * x667) - x15;
+        let x680 = x16 + Self::mul_add(s_q7, x676, c_q7 * x675);
+        let x681 = Self::mul_add(-s_q7, x675, c_q7 * x676) - x17;
+        let x682 = x556
+            * (x557
+                - (Self::mul_add(x553, x666, Self::mul_add(x552, x679, x551 * x678))
                     + Self::mul_add(
-                        x515,
-                        x661,
-                        Self::mul_add(x539, x665, x513 * x664),
+                        x529,
+                        x677,
+                        Self::mul_add(x554, x681, x527 * x680),
                     )));
-        let x667 = x650 + x666;
-        let x668 = Self::mul_add(-0.00000000020510342851533115, x667, x662);
-        let x669 = Self::mul_add(0.35, x663, x664);
-        let x670 = Self::mul_add(-0.35, x662, x665);
-        let x671 = Self::mul_add(-0.00000000020510342851533115, x661, x669);
-        let x672 = x34
-            + Self::mul_add(-c_q8, x667, Self::mul_add(s_q8, x663, x25 * x662));
-        let x673 = Self::mul_add(s_q8, x667, Self::mul_add(-x26, x662, c_q8 * x663))
+        let x683 = x666 + x682;
+        let x684 = Self::mul_add(-0.00000000020510342851533115, x683, x678);
+        let x685 = Self::mul_add(0.35, x679, x680);
+        let x686 = Self::mul_add(-0.35, x678, x681);
+        let x687 = Self::mul_add(-0.00000000020510342851533115, x677, x685);
+        let x688 = x34
+            + Self::mul_add(-c_q8, x683, Self::mul_add(-x25, x678, s_q8 * x679));
+        let x689 = Self::mul_add(s_q8, x683, Self::mul_add(c_q8, x679, x26 * x678))
             - x35;
-        let x674 = x36
-            + Self::mul_add(-c_q8, x661, Self::mul_add(s_q8, x670, x25 * x669));
-        let x675 = Self::mul_add(s_q8, x661, Self::mul_add(-x26, x669, c_q8 * x670))
+        let x690 = x36
+            + Self::mul_add(-c_q8, x677, Self::mul_add(-x25, x685, s_q8 * x686));
+        let x691 = Self::mul_add(s_q8, x677, Self::mul_add(c_q8, x686, x26 * x685))
             - x37;
-        let x676 = x470
-            * (x471
-                - (Self::mul_add(x466, x668, Self::mul_add(x465, x673, x464 * x672))
+        let x692 = x484
+            * (x485
+                - (Self::mul_add(x480, x684, Self::mul_add(x479, x689, x478 * x688))
                     + Self::mul_add(
-                        x456,
-                        x671,
-                        Self::mul_add(x468, x675, x467 * x674),
+                        x469,
+                        x687,
+                        Self::mul_add(x482, x691, x481 * x690),
                     )));
-        let x677 = x668 + x676;
-        let x678 = Self::mul_add(
+        let x693 = x684 + x692;
+        let x694 = Self::mul_add(
             -0.00000000020510342851533115,
-            x677,
-            Self::mul_add(0.00000000020510342851533115, x672, x673),
+            x693,
+            Self::mul_add(0.00000000020510342851533115, x688, x689),
         );
-        let x679 = x674 - Self::mul_add(0.275, x677, -0.4 * x673);
-        let x680 = Self::mul_add(-0.4, x672, x675);
-        let x681 = Self::mul_add(0.275, x672, x671);
-        let x682 = Self::mul_add(
+        let x695 = x690 - Self::mul_add(-0.4, x689, 0.275 * x693);
+        let x696 = Self::mul_add(-0.4, x688, x691);
+        let x697 = Self::mul_add(0.275, x688, x687);
+        let x698 = Self::mul_add(
             -0.00000000020510342851533115,
-            x681,
-            Self::mul_add(0.00000000020510342851533115, x679, x680),
+            x697,
+            Self::mul_add(0.00000000020510342851533115, x695, x696),
         );
-        let x683 = x56
-            + Self::mul_add(c_q9, x677, Self::mul_add(x46, x673, s_q9 * x672));
-        let x684 = Self::mul_add(-s_q9, x677, Self::mul_add(x47, x673, c_q9 * x672))
-            - x57;
-        let x685 = x58
-            + Self::mul_add(c_q9, x681, Self::mul_add(x46, x680, s_q9 * x679));
-        let x686 = Self::mul_add(-s_q9, x681, Self::mul_add(x47, x680, c_q9 * x679))
+        let x699 = x58
+            + Self::mul_add(c_q9, x693, Self::mul_add(x48, x689, s_q9 * x688));
+        let x700 = Self::mul_add(-s_q9, x693, Self::mul_add(-x49, x689, c_q9 * x688))
             - x59;
-        let x687 = x389
-            * (x390
-                - (Self::mul_add(x386, x678, Self::mul_add(x385, x684, x384 * x683))
+        let x701 = x60
+            + Self::mul_add(c_q9, x697, Self::mul_add(x48, x696, s_q9 * x695));
+        let x702 = Self::mul_add(-s_q9, x697, Self::mul_add(-x49, x696, c_q9 * x695))
+            - x61;
+        let x703 = x395
+            * (x396
+                - (Self::mul_add(x392, x694, Self::mul_add(x391, x700, x390 * x699))
                     + Self::mul_add(
-                        x380,
-                        x682,
-                        Self::mul_add(x379, x686, x387 * x685),
+                        x384,
+                        x698,
+                        Self::mul_add(x386, x702, x393 * x701),
                     )));
-        let x688 = x678 + x687;
-        let x689 = Self::mul_add(0.87, x688, x685);
-        let x690 = Self::mul_add(-0.87, x683, x682);
-        let x691 = x73 + Self::mul_add(s_q10, x684, c_q10 * x683);
-        let x692 = Self::mul_add(-s_q10, x683, c_q10 * x684) - x74;
-        let x693 = x75 + Self::mul_add(s_q10, x686, c_q10 * x689);
-        let x694 = Self::mul_add(-s_q10, x689, c_q10 * x686) - x76;
-        let x695 = x331
-            * (x332
-                - (Self::mul_add(x328, x688, Self::mul_add(x327, x692, x326 * x691))
+        let x704 = x694 + x703;
+        let x705 = Self::mul_add(0.87, x704, x701);
+        let x706 = Self::mul_add(-0.87, x699, x698);
+        let x707 = x75 + Self::mul_add(s_q10, x700, c_q10 * x699);
+        let x708 = Self::mul_add(-s_q10, x699, c_q10 * x700) - x76;
+        let x709 = x77 + Self::mul_add(s_q10, x702, c_q10 * x705);
+        let x710 = Self::mul_add(-s_q10, x705, c_q10 * x702) - x78;
+        let x711 = x337
+            * (x338
+                - (Self::mul_add(x334, x704, Self::mul_add(x333, x708, x332 * x707))
                     + Self::mul_add(
-                        x317,
-                        x690,
-                        Self::mul_add(x316, x694, x329 * x693),
+                        x321,
+                        x706,
+                        Self::mul_add(x323, x710, x335 * x709),
                     )));
-        let x696 = x688 + x695;
-        let x697 = x693 - Self::mul_add(-0.63, x696, 0.275 * x692);
-        let x698 = Self::mul_add(0.275, x691, x694);
-        let x699 = Self::mul_add(-0.63, x691, x690);
-        let x700 = x91 + Self::mul_add(s_q11, x692, c_q11 * x691);
-        let x701 = Self::mul_add(-s_q11, x691, c_q11 * x692) - x92;
-        let x702 = x93 + Self::mul_add(s_q11, x698, c_q11 * x697);
-        let x703 = Self::mul_add(-s_q11, x697, c_q11 * x698) - x94;
-        let x704 = x267
-            * (x268
-                - (Self::mul_add(x264, x696, Self::mul_add(x263, x701, x262 * x700))
+        let x712 = x704 + x711;
+        let x713 = x709 - Self::mul_add(-0.63, x712, 0.275 * x708);
+        let x714 = Self::mul_add(0.275, x707, x710);
+        let x715 = Self::mul_add(-0.63, x707, x706);
+        let x716 = x93 + Self::mul_add(s_q11, x708, c_q11 * x707);
+        let x717 = Self::mul_add(-s_q11, x707, c_q11 * x708) - x94;
+        let x718 = x95 + Self::mul_add(s_q11, x714, c_q11 * x713);
+        let x719 = Self::mul_add(-s_q11, x713, c_q11 * x714) - x96;
+        let x720 = x272
+            * (x273
+                - (Self::mul_add(x269, x712, Self::mul_add(x268, x717, x267 * x716))
                     + Self::mul_add(
-                        -x241,
-                        x699,
-                        Self::mul_add(-x240, x703, x265 * x702),
+                        x245,
+                        x715,
+                        Self::mul_add(-x244, x719, x270 * x718),
                     )));
-        let x705 = x696 + x704;
-        let x706 = Self::mul_add(-0.00000000020510342851533115, x705, x701);
-        let x707 = Self::mul_add(-0.36, x701, x702);
-        let x708 = Self::mul_add(0.36, x700, x703);
-        let x709 = Self::mul_add(-0.00000000020510342851533115, x699, x708);
-        let x710 = x111
-            + Self::mul_add(-s_q12, x705, Self::mul_add(x102, x701, c_q12 * x700));
-        let x711 = Self::mul_add(-c_q12, x705, Self::mul_add(-s_q12, x700, x103 * x701))
-            - x112;
-        let x712 = x113
-            + Self::mul_add(-s_q12, x699, Self::mul_add(x102, x708, c_q12 * x707));
-        let x713 = Self::mul_add(-c_q12, x699, Self::mul_add(-s_q12, x707, x103 * x708))
-            - x114;
-        let x714 = x196
-            * (x197
-                - (Self::mul_add(x192, x706, Self::mul_add(x191, x711, x190 * x710))
+        let x721 = x712 + x720;
+        let x722 = Self::mul_add(-0.00000000020510342851533115, x721, x717);
+        let x723 = Self::mul_add(-0.36, x717, x718);
+        let x724 = Self::mul_add(0.36, x716, x719);
+        let x725 = Self::mul_add(-0.00000000020510342851533115, x715, x724);
+        let x726 = Self::mul_add(-s_q12, x721, Self::mul_add(-x104, x717, c_q12 * x716))
+            - x113;
+        let x727 = x114
+            + Self::mul_add(c_q12, x721, Self::mul_add(x105, x717, s_q12 * x716));
+        let x728 = Self::mul_add(-s_q12, x715, Self::mul_add(-x104, x724, c_q12 * x723))
+            - x115;
+        let x729 = x116
+            + Self::mul_add(c_q12, x715, Self::mul_add(x105, x724, s_q12 * x723));
+        let x730 = x200
+            * (x201
+                - (Self::mul_add(x196, x722, Self::mul_add(-x195, x727, x194 * x726))
                     + Self::mul_add(
-                        -x182,
-                        x709,
-                        Self::mul_add(x194, x713, x193 * x712),
+                        x186,
+                        x725,
+                        Self::mul_add(-x198, x729, x197 * x728),
                     )));
-        let x715 = x706 + x714;
-        let x716 = Self::mul_add(
-            -c_q13,
-            Self::mul_add(0.55, x710, x709),
+        let x731 = x722 + x730;
+        let x732 = Self::mul_add(
+            c_q13,
+            Self::mul_add(0.55, x726, x725),
             Self::mul_add(
                 s_q13,
-                Self::mul_add(-0.16, x710, x713),
-                x123 * (x712 - Self::mul_add(0.55, x715, -0.16 * x711)),
+                Self::mul_add(0.16, x726, x729),
+                x125 * (x728 - Self::mul_add(0.55, x731, 0.16 * x727)),
             ),
         );
-        let x717 = Self::mul_add(
-            -0.9614610000000001,
-            Self::mul_add(s_q13, x715, Self::mul_add(-x124, x710, c_q13 * x711)) - x134,
-            -0.0145
-                * (x133
-                    + Self::mul_add(
-                        -c_q13,
-                        x715,
-                        Self::mul_add(s_q13, x711, x123 * x710),
+        let x733 = Self::mul_add(
+            0.9614610000000001,
+            x136 + Self::mul_add(s_q13, x731, Self::mul_add(-c_q13, x727, x126 * x726)),
+            0.0145
+                * (x135
+                    - Self::mul_add(
+                        c_q13,
+                        x731,
+                        Self::mul_add(s_q13, x727, x125 * x726),
                     )),
         );
-        let x718 = Self::mul_add(
+        let x734 = Self::mul_add(
             -4.806620000000001,
-            x135 + x716,
+            x137 - x732,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x715, x710),
-                x717,
+                Self::mul_add(-0.00000000020510342851533115, x731, x726),
+                -x733,
             ),
         );
-        let x719 = 0.707433253035886 * (x144 - x718);
-        [x658, x655, x653, x652, x651, x650, x666, x676, x687, x695, x704, x714, x719]
+        let x735 = 0.707433253035886 * (x146 - x734);
+        [x674, x671, x669, x668, x667, x666, x682, x692, x703, x711, x720, x730, x735]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
-    /// : 354 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 221 fused where the target has FMA.
+    /// : 350 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 215 fused where the target has FMA.
     #[must_use]
     pub fn momentum(q: &[f64; 14], v: &[f64; 13]) -> [f64; 6] {
         let x0 = q[6] * 2.0;
@@ -7810,369 +7691,352 @@ impl FreeFloating7 {
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x20 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
         let x21 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x22 = Self::mul_add(v[4], 0.75, v[0]);
-        let x23 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x22 = Self::mul_add(0.75, v[4], v[0]);
+        let x23 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x24 = Self::mul_add(-0.65, v[4], v[2]);
         let x25 = Self::mul_add(-s_q7, x22, c_q7 * x23);
         let x26 = v[5] + v[6];
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x28 = -0.00000000020510342851533115 * c_q8;
-        let x29 = -0.00000000020510342851533115 * s_q8;
-        let x30 = Self::mul_add(-x26, c_q8, Self::mul_add(x21, s_q8, x20 * x28));
-        let x31 = Self::mul_add(x26, s_q8, Self::mul_add(-x20, x29, x21 * c_q8));
-        let x32 = Self::mul_add(x21, 0.35, Self::mul_add(s_q7, x23, c_q7 * x22));
+        let x28 = 0.00000000020510342851533115 * c_q8;
+        let x29 = 0.00000000020510342851533115 * s_q8;
+        let x30 = Self::mul_add(-x26, c_q8, Self::mul_add(-x20, x28, x21 * s_q8));
+        let x31 = Self::mul_add(x26, s_q8, Self::mul_add(x21, c_q8, x20 * x29));
+        let x32 = Self::mul_add(0.35, x21, Self::mul_add(s_q7, x23, c_q7 * x22));
         let x33 = Self::mul_add(-0.35, x20, x25);
-        let x34 = Self::mul_add(-x24, c_q8, Self::mul_add(s_q8, x33, x28 * x32));
-        let x35 = Self::mul_add(x24, s_q8, Self::mul_add(-x29, x32, c_q8 * x33));
+        let x34 = Self::mul_add(-x24, c_q8, Self::mul_add(-x28, x32, s_q8 * x33));
+        let x35 = Self::mul_add(x24, s_q8, Self::mul_add(c_q8, x33, x29 * x32));
         let x36 = Self::mul_add(-0.00000000020510342851533115, x24, x32);
         let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x26, x20);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x39 = Self::mul_add(
+        let x39 = 0.00000000020510342851533115 * c_q9;
+        let x40 = 0.00000000020510342851533115 * s_q9;
+        let x41 = x39 - x40;
+        let x42 = x39 + x40;
+        let x43 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x41, x30 * s_q9));
+        let x44 = Self::mul_add(-x37, s_q9, Self::mul_add(-x31, x42, x30 * c_q9));
+        let x45 = x34 - Self::mul_add(-0.4, x31, 0.275 * x37);
+        let x46 = Self::mul_add(-0.4, x30, x35);
+        let x47 = Self::mul_add(0.275, x30, x36);
+        let x48 = Self::mul_add(c_q9, x47, Self::mul_add(x41, x46, s_q9 * x45));
+        let x49 = Self::mul_add(-s_q9, x47, Self::mul_add(-x42, x46, c_q9 * x45));
+        let x50 = Self::mul_add(
             -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
+            x47,
+            Self::mul_add(0.00000000020510342851533115, x45, x46),
         );
-        let x40 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x41 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x39, x30 * s_q9));
-        let x42 = Self::mul_add(-x37, s_q9, Self::mul_add(x31, x40, x30 * c_q9));
-        let x43 = x34 - Self::mul_add(0.275, x37, x31 * -0.4);
-        let x44 = Self::mul_add(-0.4, x30, x35);
-        let x45 = Self::mul_add(0.275, x30, x36);
-        let x46 = Self::mul_add(c_q9, x45, Self::mul_add(x39, x44, s_q9 * x43));
-        let x47 = Self::mul_add(-s_q9, x45, Self::mul_add(x40, x44, c_q9 * x43));
-        let x48 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x45,
-            Self::mul_add(0.00000000020510342851533115, x43, x44),
-        );
-        let x49 = v[8]
+        let x51 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
                 Self::mul_add(0.00000000020510342851533115, x30, x31),
             );
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x51 = Self::mul_add(x42, s_q10, x41 * c_q10);
-        let x52 = Self::mul_add(-x41, s_q10, x42 * c_q10);
-        let x53 = Self::mul_add(0.87, x49, x46);
-        let x54 = Self::mul_add(x41, -0.87, x48);
-        let x55 = Self::mul_add(x47, s_q10, c_q10 * x53);
-        let x56 = v[9] + x49;
+        let x53 = Self::mul_add(x44, s_q10, x43 * c_q10);
+        let x54 = Self::mul_add(-x43, s_q10, x44 * c_q10);
+        let x55 = Self::mul_add(x51, 0.87, x48);
+        let x56 = Self::mul_add(x43, -0.87, x50);
+        let x57 = Self::mul_add(x49, s_q10, c_q10 * x55);
+        let x58 = v[9] + x51;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x58 = Self::mul_add(x52, s_q11, x51 * c_q11);
-        let x59 = Self::mul_add(-x51, s_q11, x52 * c_q11);
-        let x60 = x55 - Self::mul_add(-0.63, x56, 0.275 * x52);
-        let x61 = Self::mul_add(0.275, x51, Self::mul_add(-s_q10, x53, x47 * c_q10));
-        let x62 = Self::mul_add(x51, -0.63, x54);
-        let x63 = Self::mul_add(s_q11, x61, c_q11 * x60);
-        let x64 = v[10] + x56;
+        let x60 = Self::mul_add(x54, s_q11, x53 * c_q11);
+        let x61 = Self::mul_add(-x53, s_q11, x54 * c_q11);
+        let x62 = x57 - Self::mul_add(x58, -0.63, 0.275 * x54);
+        let x63 = Self::mul_add(0.275, x53, Self::mul_add(-s_q10, x55, x49 * c_q10));
+        let x64 = Self::mul_add(x53, -0.63, x56);
+        let x65 = Self::mul_add(s_q11, x63, c_q11 * x62);
+        let x66 = v[10] + x58;
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x66 = -0.00000000020510342851533115 * s_q12;
-        let x67 = -0.00000000020510342851533115 * c_q12;
-        let x68 = Self::mul_add(-x64, s_q12, Self::mul_add(x59, x66, x58 * c_q12));
-        let x69 = Self::mul_add(-x64, c_q12, Self::mul_add(-x58, s_q12, x59 * x67));
-        let x70 = Self::mul_add(x59, -0.36, x63);
-        let x71 = Self::mul_add(0.36, x58, Self::mul_add(-s_q11, x60, c_q11 * x61));
-        let x72 = Self::mul_add(-x62, s_q12, Self::mul_add(x66, x71, c_q12 * x70));
-        let x73 = Self::mul_add(-x62, c_q12, Self::mul_add(-s_q12, x70, x67 * x71));
-        let x74 = Self::mul_add(-0.00000000020510342851533115, x62, x71);
-        let x75 = v[11] + Self::mul_add(-0.00000000020510342851533115, x64, x59);
+        let x68 = 0.00000000020510342851533115 * s_q12;
+        let x69 = 0.00000000020510342851533115 * c_q12;
+        let x70 = Self::mul_add(-x66, s_q12, Self::mul_add(-x61, x68, x60 * c_q12));
+        let x71 = Self::mul_add(x66, c_q12, Self::mul_add(x61, x69, x60 * s_q12));
+        let x72 = Self::mul_add(x61, -0.36, x65);
+        let x73 = Self::mul_add(x60, 0.36, Self::mul_add(-s_q11, x62, c_q11 * x63));
+        let x74 = Self::mul_add(-x64, s_q12, Self::mul_add(-x68, x73, c_q12 * x72));
+        let x75 = Self::mul_add(x64, c_q12, Self::mul_add(x69, x73, s_q12 * x72));
+        let x76 = Self::mul_add(-0.00000000020510342851533115, x64, x73);
+        let x77 = v[11] + Self::mul_add(-0.00000000020510342851533115, x66, x61);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x77 = -0.00000000020510342851533115 * c_q13;
-        let x78 = -0.00000000020510342851533115 * s_q13;
-        let x79 = Self::mul_add(-x75, c_q13, Self::mul_add(x69, s_q13, x68 * x77));
-        let x80 = Self::mul_add(x75, s_q13, Self::mul_add(-x68, x78, x69 * c_q13));
-        let x81 = x72 - Self::mul_add(0.55, x75, -0.16 * x69);
-        let x82 = Self::mul_add(x68, 0.55, x74);
-        let x83 = Self::mul_add(
-            -c_q13,
-            x82,
-            Self::mul_add(s_q13, Self::mul_add(-0.16, x68, x73), x77 * x81),
-        );
-        let x84 = v[12] + Self::mul_add(-0.00000000020510342851533115, x75, x68);
+        let x79 = 0.00000000020510342851533115 * c_q13;
+        let x80 = 0.00000000020510342851533115 * s_q13;
+        let x81 = Self::mul_add(x77, c_q13, Self::mul_add(x71, s_q13, x70 * x79));
+        let x82 = Self::mul_add(x77, s_q13, Self::mul_add(-x71, c_q13, x70 * x80));
+        let x83 = x74 - Self::mul_add(0.55, x77, 0.16 * x71);
+        let x84 = Self::mul_add(0.55, x70, x76);
         let x85 = Self::mul_add(
-            x24,
+            c_q13,
+            x84,
+            Self::mul_add(s_q13, Self::mul_add(0.16, x70, x75), x79 * x83),
+        );
+        let x86 = v[12] + Self::mul_add(-0.00000000020510342851533115, x77, x70);
+        let x87 = Self::mul_add(
             -48.0240000085309,
+            x24,
             Self::mul_add(
                 0.1132,
                 x26,
-                Self::mul_add(130.43769025763282, x21, -0.07309 * x20),
+                Self::mul_add(x20, -0.07309, 130.43769025763282 * x21),
             ),
         );
-        let x86 = Self::mul_add(
+        let x88 = Self::mul_add(
             48.0240000085309,
             x25,
             Self::mul_add(
                 132.47349025763282,
                 x26,
-                Self::mul_add(0.1132, x21, -16.80768997608804 * x20),
+                Self::mul_add(x20, -16.80768997608804, 0.1132 * x21),
             ),
         );
-        let x87 = Self::mul_add(
+        let x89 = Self::mul_add(
             x36,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
                 x37,
-                Self::mul_add(-111.7548902508081, x31, -0.0000000234896432582596 * x30),
-            ),
-        );
-        let x88 = Self::mul_add(
-            x46,
-            81.53205,
-            Self::mul_add(
-                69.99836825,
-                x49,
-                Self::mul_add(-36.18604050126307, x42, -0.00214 * x41),
-            ),
-        );
-        let x89 = Self::mul_add(
-            x55,
-            45.1584,
-            Self::mul_add(
-                28.2393615,
-                x56,
-                Self::mul_add(-24.351642000914637, x52, -0.6328 * x51),
+                -Self::mul_add(x31, 111.7548902508081, x30 * 0.0000000234896432582596),
             ),
         );
         let x90 = Self::mul_add(
-            x63,
-            -7.078399999258757,
+            x48,
+            81.53205,
             Self::mul_add(
-                9.223235249762805,
-                x64,
-                Self::mul_add(2.5482240016099564, x59, 0.01675 * x58),
+                69.99836825,
+                x51,
+                -Self::mul_add(x44, 36.18604050126307, x43 * 0.00214),
             ),
         );
         let x91 = Self::mul_add(
-            x74,
-            -3.6140000000000003,
+            x57,
+            45.1584,
             Self::mul_add(
-                -2.741639999592316,
-                x75,
-                Self::mul_add(-5.252920330000002, x69, -1.9877000000000002 * x68),
+                28.2393615,
+                x58,
+                -Self::mul_add(x54, 24.351642000914637, x53 * 0.6328),
             ),
         );
         let x92 = Self::mul_add(
-            -0.9614610000000001,
-            x84,
-            Self::mul_add(-1.2025609200000003, x80, 0.000781 * x79),
+            -7.078399999258757,
+            x65,
+            Self::mul_add(
+                9.223235249762805,
+                x66,
+                Self::mul_add(2.5482240016099564, x61, 0.01675 * x60),
+            ),
         );
         let x93 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x82, x81),
-            Self::mul_add(-0.0145, x84, 0.000781 * x80),
+            -3.6140000000000003,
+            x76,
+            Self::mul_add(
+                x77,
+                -2.741639999592316,
+                Self::mul_add(x70, -1.9877000000000002, x71 * 5.252920330000002),
+            ),
         );
         let x94 = Self::mul_add(
-            x83,
-            -4.806620000000001,
+            x86,
+            0.9614610000000001,
+            Self::mul_add(x82, 1.2025609200000003, 0.000781 * x81),
+        );
+        let x95 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(-0.00000000020510342851533115, x84, x83),
+            Self::mul_add(x86, -0.0145, 0.000781 * x82),
+        );
+        let x96 = Self::mul_add(
+            4.806620000000001,
+            x85,
             Self::mul_add(
                 1.4135609200000003,
-                x84,
-                Self::mul_add(-0.9614610000000001, x80, -0.0145 * x79),
+                x86,
+                Self::mul_add(x82, -0.9614610000000001, x81 * 0.0145),
             ),
         );
-        let x95 = 4.806620000000001 * x84;
-        let x96 = x79 * -4.806620000000001;
-        let x97 = Self::mul_add(x77, x95, x96);
-        let x98 = s_q13 * x95;
-        let x99 = Self::mul_add(0.00000000020510342851533115, x96, c_q13 * x95);
-        let x100 = Self::mul_add(
+        let x97 = 4.806620000000001 * x86;
+        let x98 = 4.806620000000001 * x81;
+        let x99 = Self::mul_add(x79, x97, -x98);
+        let x100 = s_q13 * x97;
+        let x101 = Self::mul_add(0.00000000020510342851533115, x98, c_q13 * x97);
+        let x102 = Self::mul_add(
             0.55,
-            x97,
+            x99,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x94,
-                Self::mul_add(-c_q13, x93, s_q13 * x92),
+                0.00000000020510342851533115,
+                x96,
+                Self::mul_add(s_q13, x94, c_q13 * x95),
             ),
         );
-        let x101 = Self::mul_add(
-            17.135250000000003,
-            x74,
-            Self::mul_add(-0.809539999555672, x75, -1.9877000000000002 * x69),
-        )
-            + (x94 + Self::mul_add(-x78, x92, x77 * x93)
-                + Self::mul_add(0.16, x98, 0.55 * x99));
-        let x102 = x91
-            + Self::mul_add(-0.16, x97, Self::mul_add(c_q13, x92, s_q13 * x93));
         let x103 = Self::mul_add(
+            17.135250000000003,
+            x76,
+            Self::mul_add(x77, -0.809539999555672, x71 * 1.9877000000000002),
+        )
+            + (x96 - Self::mul_add(x80, x94, x79 * x95)
+                + Self::mul_add(0.55, x101, 0.16 * x100));
+        let x104 = x93
+            + Self::mul_add(0.16, x99, Self::mul_add(-c_q13, x94, s_q13 * x95));
+        let x105 = Self::mul_add(
             9.740442170000001,
-            x75,
-            Self::mul_add(-2.7416399995923166, x69, -0.809539999555672 * x68),
-        ) + Self::mul_add(3.6140000000000003, x73, x72 * -17.135250000000003) + x100;
-        let x104 = Self::mul_add(17.135250000000003, x75, x97);
-        let x105 = Self::mul_add(x75, -3.6140000000000003, x98);
-        let x106 = x99
-            - Self::mul_add(3.6140000000000003, x69, x68 * -17.135250000000003);
-        let x107 = Self::mul_add(-c_q12, x104, s_q12 * x105);
-        let x108 = x106 - Self::mul_add(x67, x105, x66 * x104);
-        let x109 = Self::mul_add(7.078399999258757, x62, 0.01675 * x64)
-            + Self::mul_add(0.36, x108, Self::mul_add(-s_q12, x102, c_q12 * x101));
-        let x110 = Self::mul_add(2.5482240016099564, x64, -9.142025249762803 * x59)
-            + Self::mul_add(-0.36, x107, x103 + Self::mul_add(x67, x102, x66 * x101));
-        let x111 = Self::mul_add(-7.078399999258757, x64, x107);
-        let x112 = Self::mul_add(
-            x58,
+            x77,
+            Self::mul_add(x70, -0.809539999555672, x71 * 2.7416399995923166),
+        ) - Self::mul_add(3.6140000000000003, x75, 17.135250000000003 * x74) - x102;
+        let x106 = Self::mul_add(-17.135250000000003, x77, x99);
+        let x107 = Self::mul_add(3.6140000000000003, x77, -x100);
+        let x108 = Self::mul_add(3.6140000000000003, x71, 17.135250000000003 * x70)
+            + x101;
+        let x109 = Self::mul_add(-s_q12, x107, c_q12 * x106);
+        let x110 = x108 - Self::mul_add(x69, x107, x68 * x106);
+        let x111 = Self::mul_add(7.078399999258757, x64, 0.01675 * x66)
+            + Self::mul_add(0.36, x110, Self::mul_add(-s_q12, x104, c_q12 * x103));
+        let x112 = Self::mul_add(x61, -9.142025249762803, 2.5482240016099564 * x66)
+            + Self::mul_add(-0.36, x109, x105 - Self::mul_add(x69, x104, x68 * x103));
+        let x113 = Self::mul_add(-7.078399999258757, x66, x109);
+        let x114 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x106,
-                Self::mul_add(c_q12, x105, s_q12 * x104),
+            x60,
+            -Self::mul_add(
+                0.00000000020510342851533115,
+                x108,
+                Self::mul_add(c_q12, x107, s_q12 * x106),
             ),
         );
-        let x113 = Self::mul_add(-s_q11, x108, c_q11 * x111);
-        let x114 = Self::mul_add(c_q11, x108, s_q11 * x111);
-        let x115 = Self::mul_add(
+        let x115 = Self::mul_add(-s_q11, x110, c_q11 * x113);
+        let x116 = Self::mul_add(c_q11, x110, s_q11 * x113);
+        let x117 = Self::mul_add(
             0.63,
-            x113,
-            x90
-                + Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x103,
-                    -Self::mul_add(c_q12, x102, s_q12 * x101),
+            x115,
+            x92
+                - Self::mul_add(
+                    0.00000000020510342851533115,
+                    x105,
+                    Self::mul_add(c_q12, x104, s_q12 * x103),
                 ),
         );
-        let x116 = Self::mul_add(-45.1584, x54, -0.6328 * x56)
-            + (Self::mul_add(-s_q11, x110, c_q11 * x109)
-                + Self::mul_add(-0.63, x112, 0.275 * x114));
-        let x117 = Self::mul_add(-24.35164200091464, x56, -24.4950615 * x52)
-            + Self::mul_add(-0.275, x113, Self::mul_add(c_q11, x110, s_q11 * x109));
-        let x118 = Self::mul_add(45.1584, x56, x113);
-        let x119 = Self::mul_add(x51, -45.1584, x112);
-        let x120 = Self::mul_add(-s_q10, x114, c_q10 * x118);
-        let x121 = Self::mul_add(c_q10, x114, s_q10 * x118);
-        let x122 = Self::mul_add(-81.53205, x48, -0.00214 * x49)
-            + Self::mul_add(-0.87, x119, Self::mul_add(-s_q10, x117, c_q10 * x116));
-        let x123 = Self::mul_add(-36.18604050126307, x49, -63.36336825000001 * x42)
-            + Self::mul_add(c_q10, x117, s_q10 * x116);
-        let x124 = x88 + Self::mul_add(0.87, x120, x89 + x115);
-        let x125 = Self::mul_add(81.53205, x49, x120);
-        let x126 = Self::mul_add(x41, -81.53205, x119);
-        let x127 = Self::mul_add(
-            0.00000000020510342851533115,
-            x126,
-            Self::mul_add(c_q9, x121, s_q9 * x125),
-        );
-        let x128 = x126 + Self::mul_add(x40, x121, x39 * x125);
-        let x129 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x126,
-            Self::mul_add(-s_q9, x121, c_q9 * x125),
-        );
-        let x130 = Self::mul_add(
-            -0.275,
-            x127,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x124,
-                Self::mul_add(-s_q9, x123, c_q9 * x122),
-            ),
-        );
-        let x131 = Self::mul_add(
-            -12.701650001451807,
-            x36,
-            Self::mul_add(-0.002139996587640933, x37, -0.0000000234896432582596 * x31),
-        )
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x124,
-                Self::mul_add(c_q9, x123, s_q9 * x122),
-            ) + Self::mul_add(0.275, x129, -0.4 * x128));
-        let x132 = x87
-            + Self::mul_add(0.4, x127, x124 + Self::mul_add(x40, x123, x39 * x122));
-        let x133 = Self::mul_add(
+        let x118 = Self::mul_add(-s_q11, x112, c_q11 * x111)
+            + Self::mul_add(-0.63, x114, 0.275 * x116)
+            - Self::mul_add(x56, 45.1584, x58 * 0.6328);
+        let x119 = Self::mul_add(-0.275, x115, Self::mul_add(c_q11, x112, s_q11 * x111))
+            - Self::mul_add(x58, 24.35164200091464, x54 * 24.4950615);
+        let x120 = Self::mul_add(x58, 45.1584, x115);
+        let x121 = Self::mul_add(x53, -45.1584, x114);
+        let x122 = Self::mul_add(-s_q10, x116, c_q10 * x120);
+        let x123 = Self::mul_add(c_q10, x116, s_q10 * x120);
+        let x124 = Self::mul_add(-0.87, x121, Self::mul_add(-s_q10, x119, c_q10 * x118))
+            - Self::mul_add(x50, 81.53205, x51 * 0.00214);
+        let x125 = Self::mul_add(c_q10, x119, s_q10 * x118)
+            - Self::mul_add(x51, 36.18604050126307, x44 * 63.36336825000001);
+        let x126 = x90 + Self::mul_add(0.87, x122, x91 + x117);
+        let x127 = Self::mul_add(x51, 81.53205, x122);
+        let x128 = Self::mul_add(x43, -81.53205, x121);
+        let x129 = 0.00000000020510342851533115 * x128;
+        let x130 = Self::mul_add(c_q9, x123, s_q9 * x127) + x129;
+        let x131 = x128 + Self::mul_add(-x42, x123, x41 * x127);
+        let x132 = Self::mul_add(-s_q9, x123, c_q9 * x127) - x129;
+        let x133 = 0.00000000020510342851533115 * x126;
+        let x134 = Self::mul_add(c_q9, x125, s_q9 * x124) + x133
+            + Self::mul_add(-0.4, x131, 0.275 * x132)
+            - Self::mul_add(
+                x36,
+                12.701650001451807,
+                Self::mul_add(x37, 0.002139996587640933, x31 * 0.0000000234896432582596),
+            );
+        let x135 = x89
+            + Self::mul_add(0.4, x130, x126 + Self::mul_add(-x42, x125, x41 * x124));
+        let x136 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(5.080660024070366, x31, -0.002139996587640933 * x30),
-        ) + Self::mul_add(-0.000000008530897668050218, x35, x34 * 12.701650001451807)
-            + x130;
-        let x134 = Self::mul_add(12.701650001451807, x37, x127);
-        let x135 = Self::mul_add(x37, -0.000000008530897668050218, x128);
-        let x136 = x129
-            - Self::mul_add(-0.000000008530897668050218, x31, x30 * 12.701650001451807);
-        let x137 = x136 + Self::mul_add(-x29, x135, x28 * x134);
-        let x138 = Self::mul_add(c_q8, x135, s_q8 * x134);
-        let x139 = Self::mul_add(-16.80768997608804, x26, -0.07309 * x21)
-            + Self::mul_add(-0.35, x138, x133 + Self::mul_add(-x29, x132, x28 * x131));
-        let x140 = x85
-            + Self::mul_add(0.35, x137, Self::mul_add(c_q8, x132, s_q8 * x131));
-        let x141 = Self::mul_add(x26, 48.0240000085309, x138);
+            Self::mul_add(x30, -0.002139996587640933, 5.080660024070366 * x31),
+        ) + Self::mul_add(x35, -0.000000008530897668050218, x34 * 12.701650001451807)
+            + Self::mul_add(
+                -0.275,
+                x130,
+                Self::mul_add(-s_q9, x125, c_q9 * x124) - x133,
+            );
+        let x137 = Self::mul_add(x37, 12.701650001451807, x130);
+        let x138 = Self::mul_add(x37, -0.000000008530897668050218, x131);
+        let x139 = x132
+            - Self::mul_add(x31, -0.000000008530897668050218, x30 * 12.701650001451807);
+        let x140 = x139 + Self::mul_add(-x28, x137, x29 * x138);
+        let x141 = Self::mul_add(c_q8, x138, s_q8 * x137);
         let x142 = Self::mul_add(
+            -0.35,
+            x141,
+            x136 + Self::mul_add(-x28, x134, x29 * x135),
+        ) - Self::mul_add(x26, 16.80768997608804, x21 * 0.07309);
+        let x143 = x87
+            + Self::mul_add(0.35, x140, Self::mul_add(c_q8, x135, s_q8 * x134));
+        let x144 = Self::mul_add(48.0240000085309, x26, x141);
+        let x145 = Self::mul_add(
             -48.0240000085309,
             x21,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x136,
-                Self::mul_add(-c_q8, x134, s_q8 * x135),
+                x139,
+                Self::mul_add(-c_q8, x137, s_q8 * x138),
             ),
         );
-        let x143 = Self::mul_add(-s_q7, x141, c_q7 * x137);
-        let x144 = Self::mul_add(c_q7, x141, s_q7 * x137);
-        let x145 = Self::mul_add(
+        let x146 = Self::mul_add(-s_q7, x144, c_q7 * x140);
+        let x147 = Self::mul_add(c_q7, x144, s_q7 * x140);
+        let x148 = Self::mul_add(
             0.65,
-            x144,
-            x86
+            x147,
+            x88
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x133,
-                    Self::mul_add(-c_q8, x131, s_q8 * x132),
+                    x136,
+                    Self::mul_add(-c_q8, x134, s_q8 * x135),
                 ),
         );
-        let x146 = Self::mul_add(
-            v[1],
+        let x149 = Self::mul_add(
             -180.9502499901501,
-            Self::mul_add(-117.61766249359756, v[5], 1394.5960312283303 * v[3]),
-        ) + Self::mul_add(-0.75, x144, Self::mul_add(-s_q7, x140, c_q7 * x139));
-        let x147 = Self::mul_add(
+            v[1],
+            Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
+        ) + Self::mul_add(-0.75, x147, Self::mul_add(-s_q7, x143, c_q7 * x142));
+        let x150 = Self::mul_add(
             1466.4506062283303,
             v[4],
-            Self::mul_add(v[2], -110.5455, 180.9502499901501 * v[0]),
+            Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         )
-            + (Self::mul_add(c_q7, x140, s_q7 * x139)
-                + Self::mul_add(-0.65, x142, 0.75 * x143));
-        let x148 = Self::mul_add(
+            + (Self::mul_add(c_q7, x143, s_q7 * x142)
+                + Self::mul_add(-0.65, x145, 0.75 * x146));
+        let x151 = Self::mul_add(
             110.5455,
             v[1],
-            Self::mul_add(1271.854575, v[5], -117.61766249359758 * v[3]),
-        ) + x145;
-        let x149 = Self::mul_add(v[4], 180.9502499901501, 1170.07 * v[0]) + x143;
-        let x150 = Self::mul_add(
+            Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]),
+        ) + x148;
+        let x152 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]) + x146;
+        let x153 = Self::mul_add(
             1170.07,
             v[1],
-            -Self::mul_add(v[5], -110.5455, 180.9502499901501 * v[3]),
-        ) + x144;
-        let x151 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x142;
-        let x152 = Self::mul_add(x12, x151, Self::mul_add(x11, x150, x10 * x149));
-        let x153 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149));
-        let x154 = Self::mul_add(x18, x151, Self::mul_add(x17, x150, x16 * x149));
-        let x155 = Self::mul_add(x12, x148, Self::mul_add(x11, x147, x10 * x146))
-            + Self::mul_add(-q[2], x153, q[1] * x154);
-        let x156 = Self::mul_add(x15, x148, Self::mul_add(x14, x147, x13 * x146))
-            + Self::mul_add(-q[0], x154, q[2] * x152);
-        let x157 = Self::mul_add(x18, x148, Self::mul_add(x17, x147, x16 * x146))
-            + Self::mul_add(-q[1], x152, q[0] * x153);
-        [x152, x153, x154, x155, x156, x157]
+            -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
+        ) + x147;
+        let x154 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x145;
+        let x155 = Self::mul_add(x12, x154, Self::mul_add(x11, x153, x10 * x152));
+        let x156 = Self::mul_add(x15, x154, Self::mul_add(x14, x153, x13 * x152));
+        let x157 = Self::mul_add(x18, x154, Self::mul_add(x17, x153, x16 * x152));
+        let x158 = Self::mul_add(x12, x151, Self::mul_add(x11, x150, x10 * x149))
+            + Self::mul_add(-q[2], x156, q[1] * x157);
+        let x159 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149))
+            + Self::mul_add(-q[0], x157, q[2] * x155);
+        let x160 = Self::mul_add(x18, x151, Self::mul_add(x17, x150, x16 * x149))
+            + Self::mul_add(-q[1], x155, q[0] * x156);
+        [x155, x156, x157, x158, x159, x160]
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
-    /// Methods: bias `recurrent`: 692 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 432 fused where the target has FMA.
+    /// Methods: bias `recurrent`: 688 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 426 fused where the target has FMA.
     #[must_use]
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x1 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
         let x2 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x3 = Self::mul_add(v[4], 0.75, v[0]);
-        let x4 = v[1] - Self::mul_add(v[5], -0.65, 0.75 * v[3]);
+        let x3 = Self::mul_add(0.75, v[4], v[0]);
+        let x4 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x5 = Self::mul_add(-0.65, v[4], v[2]);
         let x6 = Self::mul_add(s_q7, x4, c_q7 * x3);
         let x7 = Self::mul_add(-s_q7, x3, c_q7 * x4);
         let x8 = v[5] + v[6];
-        let x9 = Self::mul_add(a[4], 0.75, a[0]);
-        let x10 = a[1] - Self::mul_add(a[5], -0.65, 0.75 * a[3]);
+        let x9 = Self::mul_add(0.75, a[4], a[0]);
+        let x10 = a[1] - Self::mul_add(-0.65, a[5], 0.75 * a[3]);
         let x11 = Self::mul_add(-0.65, a[4], a[2]);
         let x12 = a[5] + a[6];
         let x13 = Self::mul_add(v[6], x2, Self::mul_add(a[4], s_q7, a[3] * c_q7));
@@ -8180,9 +8044,9 @@ impl FreeFloating7 {
         let x15 = Self::mul_add(v[6], x7, Self::mul_add(s_q7, x10, c_q7 * x9));
         let x16 = Self::mul_add(-v[6], x6, Self::mul_add(-s_q7, x9, c_q7 * x10));
         let x17 = Self::mul_add(
-            x16,
             -6.1267499999999995,
-            Self::mul_add(0.00071, x12, Self::mul_add(-0.07309, x14, 2.29018125 * x13)),
+            x16,
+            Self::mul_add(0.00071, x12, Self::mul_add(x14, -0.07309, 2.29018125 * x13)),
         );
         let x18 = Self::mul_add(
             6.1267499999999995,
@@ -8190,14 +8054,14 @@ impl FreeFloating7 {
             Self::mul_add(
                 0.1132,
                 x12,
-                Self::mul_add(1.5853812499999997, x14, -0.07309 * x13),
+                Self::mul_add(x13, -0.07309, 1.5853812499999997 * x14),
             ),
         );
         let x19 = Self::mul_add(1.331, x8, Self::mul_add(0.1132, x2, 0.00071 * x1));
         let x20 = Self::mul_add(
-            x7,
             -6.1267499999999995,
-            Self::mul_add(0.00071, x8, Self::mul_add(-0.07309, x2, 2.29018125 * x1)),
+            x7,
+            Self::mul_add(0.00071, x8, Self::mul_add(x2, -0.07309, 2.29018125 * x1)),
         );
         let x21 = Self::mul_add(
             6.1267499999999995,
@@ -8205,581 +8069,562 @@ impl FreeFloating7 {
             Self::mul_add(
                 0.1132,
                 x8,
-                Self::mul_add(1.5853812499999997, x2, -0.07309 * x1),
+                Self::mul_add(x1, -0.07309, 1.5853812499999997 * x2),
             ),
         );
         let x22 = 35.01 * x5;
-        let x23 = Self::mul_add(x2, 6.1267499999999995, 35.01 * x6);
+        let x23 = Self::mul_add(6.1267499999999995, x2, 35.01 * x6);
         let x24 = Self::mul_add(-6.1267499999999995, x1, 35.01 * x7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
-        let x26 = -0.00000000020510342851533115 * c_q8;
-        let x27 = -0.00000000020510342851533115 * s_q8;
-        let x28 = Self::mul_add(-x8, c_q8, Self::mul_add(x2, s_q8, x1 * x26));
-        let x29 = Self::mul_add(x8, s_q8, Self::mul_add(-x1, x27, x2 * c_q8));
-        let x30 = Self::mul_add(x2, 0.35, x6);
+        let x26 = 0.00000000020510342851533115 * c_q8;
+        let x27 = 0.00000000020510342851533115 * s_q8;
+        let x28 = Self::mul_add(-x8, c_q8, Self::mul_add(-x1, x26, x2 * s_q8));
+        let x29 = Self::mul_add(x8, s_q8, Self::mul_add(x2, c_q8, x1 * x27));
+        let x30 = Self::mul_add(0.35, x2, x6);
         let x31 = Self::mul_add(-0.35, x1, x7);
-        let x32 = Self::mul_add(-x5, c_q8, Self::mul_add(s_q8, x31, x26 * x30));
-        let x33 = Self::mul_add(x5, s_q8, Self::mul_add(-x27, x30, c_q8 * x31));
+        let x32 = Self::mul_add(-x5, c_q8, Self::mul_add(-x26, x30, s_q8 * x31));
+        let x33 = Self::mul_add(x5, s_q8, Self::mul_add(c_q8, x31, x27 * x30));
         let x34 = Self::mul_add(-0.00000000020510342851533115, x5, x30);
         let x35 = v[7] + Self::mul_add(-0.00000000020510342851533115, x8, x1);
-        let x36 = Self::mul_add(x14, 0.35, x15);
+        let x36 = Self::mul_add(0.35, x14, x15);
         let x37 = Self::mul_add(-0.35, x13, x16);
         let x38 = Self::mul_add(-0.00000000020510342851533115, x11, x36);
         let x39 = a[7] + Self::mul_add(-0.00000000020510342851533115, x12, x13);
         let x40 = Self::mul_add(
             v[7],
             x29,
-            Self::mul_add(-x12, c_q8, Self::mul_add(x14, s_q8, x13 * x26)),
+            Self::mul_add(-x12, c_q8, Self::mul_add(-x13, x26, x14 * s_q8)),
         );
         let x41 = Self::mul_add(
             -v[7],
             x28,
-            Self::mul_add(x12, s_q8, Self::mul_add(-x13, x27, x14 * c_q8)),
+            Self::mul_add(x12, s_q8, Self::mul_add(x14, c_q8, x13 * x27)),
         );
         let x42 = Self::mul_add(
             v[7],
             x33,
-            Self::mul_add(-x11, c_q8, Self::mul_add(s_q8, x37, x26 * x36)),
+            Self::mul_add(-x11, c_q8, Self::mul_add(-x26, x36, s_q8 * x37)),
         );
         let x43 = Self::mul_add(
             -v[7],
             x32,
-            Self::mul_add(x11, s_q8, Self::mul_add(-x27, x36, c_q8 * x37)),
+            Self::mul_add(x11, s_q8, Self::mul_add(c_q8, x37, x27 * x36)),
         );
-        let x44 = Self::mul_add(2.359, x35, -0.00214 * x28);
+        let x44 = Self::mul_add(x28, -0.00214, 2.359 * x35);
         let x45 = Self::mul_add(
-            x33,
             -6.0,
-            Self::mul_add(-0.00214, x35, 3.3000000000000003 * x28),
+            x33,
+            Self::mul_add(x35, -0.00214, 3.3000000000000003 * x28),
         );
         let x46 = Self::mul_add(6.0, x32, 2.5780000000000003 * x29);
         let x47 = 30.0 * x34;
-        let x48 = Self::mul_add(x29, 6.0, 30.0 * x32);
+        let x48 = Self::mul_add(6.0, x29, 30.0 * x32);
         let x49 = Self::mul_add(-6.0, x28, 30.0 * x33);
         let (s_q9, c_q9) = libm::sincos(q[9]);
-        let x51 = Self::mul_add(
+        let x51 = 0.00000000020510342851533115 * c_q9;
+        let x52 = 0.00000000020510342851533115 * s_q9;
+        let x53 = x51 - x52;
+        let x54 = x51 + x52;
+        let x55 = Self::mul_add(x35, c_q9, Self::mul_add(x29, x53, x28 * s_q9));
+        let x56 = Self::mul_add(-x35, s_q9, Self::mul_add(-x29, x54, x28 * c_q9));
+        let x57 = x32 - Self::mul_add(-0.4, x29, 0.275 * x35);
+        let x58 = Self::mul_add(-0.4, x28, x33);
+        let x59 = Self::mul_add(0.275, x28, x34);
+        let x60 = Self::mul_add(c_q9, x59, Self::mul_add(x53, x58, s_q9 * x57));
+        let x61 = Self::mul_add(-s_q9, x59, Self::mul_add(-x54, x58, c_q9 * x57));
+        let x62 = Self::mul_add(
             -0.00000000020510342851533115,
-            s_q9,
-            0.00000000020510342851533115 * c_q9,
+            x59,
+            Self::mul_add(0.00000000020510342851533115, x57, x58),
         );
-        let x52 = Self::mul_add(
-            -0.00000000020510342851533115,
-            s_q9,
-            -0.00000000020510342851533115 * c_q9,
-        );
-        let x53 = Self::mul_add(x35, c_q9, Self::mul_add(x29, x51, x28 * s_q9));
-        let x54 = Self::mul_add(-x35, s_q9, Self::mul_add(x29, x52, x28 * c_q9));
-        let x55 = x32 - Self::mul_add(0.275, x35, x29 * -0.4);
-        let x56 = Self::mul_add(-0.4, x28, x33);
-        let x57 = Self::mul_add(0.275, x28, x34);
-        let x58 = Self::mul_add(c_q9, x57, Self::mul_add(x51, x56, s_q9 * x55));
-        let x59 = Self::mul_add(-s_q9, x57, Self::mul_add(x52, x56, c_q9 * x55));
-        let x60 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x57,
-            Self::mul_add(0.00000000020510342851533115, x55, x56),
-        );
-        let x61 = v[8]
+        let x63 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x35,
                 Self::mul_add(0.00000000020510342851533115, x28, x29),
             );
-        let x62 = x42 - Self::mul_add(0.275, x39, x41 * -0.4);
-        let x63 = Self::mul_add(-0.4, x40, x43);
-        let x64 = Self::mul_add(0.275, x40, x38);
-        let x65 = Self::mul_add(
+        let x64 = x42 - Self::mul_add(-0.4, x41, 0.275 * x39);
+        let x65 = Self::mul_add(-0.4, x40, x43);
+        let x66 = Self::mul_add(0.275, x40, x38);
+        let x67 = Self::mul_add(
             -0.00000000020510342851533115,
-            x64,
-            Self::mul_add(0.00000000020510342851533115, x62, x63),
+            x66,
+            Self::mul_add(0.00000000020510342851533115, x64, x65),
         );
-        let x66 = a[8]
+        let x68 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x39,
                 Self::mul_add(0.00000000020510342851533115, x40, x41),
             );
-        let x67 = Self::mul_add(
-            v[8],
-            x54,
-            Self::mul_add(x39, c_q9, Self::mul_add(x41, x51, x40 * s_q9)),
-        );
-        let x68 = Self::mul_add(
-            -v[8],
-            x53,
-            Self::mul_add(-x39, s_q9, Self::mul_add(x41, x52, x40 * c_q9)),
-        );
         let x69 = Self::mul_add(
             v[8],
-            x59,
-            Self::mul_add(c_q9, x64, Self::mul_add(x51, x63, s_q9 * x62)),
+            x56,
+            Self::mul_add(x39, c_q9, Self::mul_add(x41, x53, x40 * s_q9)),
         );
         let x70 = Self::mul_add(
             -v[8],
-            x58,
-            Self::mul_add(-s_q9, x64, Self::mul_add(x52, x63, c_q9 * x62)),
+            x55,
+            Self::mul_add(-x39, s_q9, Self::mul_add(-x41, x54, x40 * c_q9)),
         );
-        let x71 = 3.378 * x54;
+        let x71 = Self::mul_add(
+            v[8],
+            x61,
+            Self::mul_add(c_q9, x66, Self::mul_add(x53, x65, s_q9 * x64)),
+        );
         let x72 = Self::mul_add(
-            -9.87015,
+            -v[8],
             x60,
-            Self::mul_add(-0.00214, x61, 4.395515250000001 * x53),
+            Self::mul_add(-s_q9, x66, Self::mul_add(-x54, x65, c_q9 * x64)),
         );
-        let x73 = Self::mul_add(
-            x58,
+        let x73 = 3.378 * x56;
+        let x74 = Self::mul_add(
+            x62,
+            -9.87015,
+            Self::mul_add(-0.00214, x63, 4.395515250000001 * x55),
+        );
+        let x75 = Self::mul_add(
+            x60,
             9.87015,
-            Self::mul_add(7.65251525, x61, -0.00214 * x53),
+            Self::mul_add(-0.00214, x55, 7.65251525 * x63),
         );
-        let x74 = 22.69 * x59;
-        let x75 = Self::mul_add(9.87015, x61, 22.69 * x58);
-        let x76 = Self::mul_add(x53, -9.87015, 22.69 * x60);
+        let x76 = 22.69 * x61;
+        let x77 = Self::mul_add(x63, 9.87015, 22.69 * x60);
+        let x78 = Self::mul_add(x55, -9.87015, 22.69 * x62);
         let (s_q10, c_q10) = libm::sincos(q[10]);
-        let x78 = Self::mul_add(x54, s_q10, x53 * c_q10);
-        let x79 = Self::mul_add(-x53, s_q10, x54 * c_q10);
-        let x80 = Self::mul_add(0.87, x61, x58);
-        let x81 = Self::mul_add(x53, -0.87, x60);
-        let x82 = Self::mul_add(x59, s_q10, c_q10 * x80);
-        let x83 = Self::mul_add(-s_q10, x80, x59 * c_q10);
-        let x84 = v[9] + x61;
-        let x85 = Self::mul_add(0.87, x66, x69);
-        let x86 = Self::mul_add(x67, -0.87, x65);
-        let x87 = a[9] + x66;
-        let x88 = Self::mul_add(v[9], x79, Self::mul_add(x68, s_q10, x67 * c_q10));
-        let x89 = Self::mul_add(-v[9], x78, Self::mul_add(-x67, s_q10, x68 * c_q10));
-        let x90 = Self::mul_add(v[9], x83, Self::mul_add(x70, s_q10, c_q10 * x85));
-        let x91 = Self::mul_add(-v[9], x82, Self::mul_add(-s_q10, x85, x70 * c_q10));
-        let x92 = Self::mul_add(
-            x90,
-            6.7347,
-            Self::mul_add(4.0324305, x87, Self::mul_add(-1.8520425, x89, -0.6328 * x88)),
-        );
-        let x93 = Self::mul_add(-0.6328, x84, 4.170993 * x78)
-            + Self::mul_add(-6.7347, x81, x83 * 5.8795);
+        let x80 = Self::mul_add(x56, s_q10, x55 * c_q10);
+        let x81 = Self::mul_add(-x55, s_q10, x56 * c_q10);
+        let x82 = Self::mul_add(x63, 0.87, x60);
+        let x83 = Self::mul_add(x55, -0.87, x62);
+        let x84 = Self::mul_add(x61, s_q10, c_q10 * x82);
+        let x85 = Self::mul_add(-s_q10, x82, x61 * c_q10);
+        let x86 = v[9] + x63;
+        let x87 = Self::mul_add(x68, 0.87, x71);
+        let x88 = Self::mul_add(x69, -0.87, x67);
+        let x89 = a[9] + x68;
+        let x90 = Self::mul_add(v[9], x81, Self::mul_add(x70, s_q10, x69 * c_q10));
+        let x91 = Self::mul_add(-v[9], x80, Self::mul_add(-x69, s_q10, x70 * c_q10));
+        let x92 = Self::mul_add(v[9], x85, Self::mul_add(x72, s_q10, c_q10 * x87));
+        let x93 = Self::mul_add(-v[9], x84, Self::mul_add(-s_q10, x87, x72 * c_q10));
         let x94 = Self::mul_add(
-            -5.8795,
-            x82,
-            Self::mul_add(-1.8520425, x84, 3.8828625 * x79),
-        );
-        let x95 = Self::mul_add(
-            x82,
+            x92,
             6.7347,
-            Self::mul_add(4.0324305, x84, Self::mul_add(-1.8520425, x79, -0.6328 * x78)),
+            Self::mul_add(4.0324305, x89, -Self::mul_add(x91, 1.8520425, x90 * 0.6328)),
         );
-        let x96 = Self::mul_add(21.38, x82, -Self::mul_add(-6.7347, x84, x79 * 5.8795));
-        let x97 = Self::mul_add(5.8795, x78, 21.38 * x83);
-        let x98 = Self::mul_add(x78, -6.7347, 21.38 * x81);
+        let x95 = Self::mul_add(x86, -0.6328, 4.170993 * x80)
+            + Self::mul_add(x83, -6.7347, x85 * 5.8795);
+        let x96 = Self::mul_add(
+            x84,
+            -5.8795,
+            Self::mul_add(x86, -1.8520425, 3.8828625 * x81),
+        );
+        let x97 = Self::mul_add(
+            x84,
+            6.7347,
+            Self::mul_add(4.0324305, x86, -Self::mul_add(x81, 1.8520425, x80 * 0.6328)),
+        );
+        let x98 = Self::mul_add(21.38, x84, -Self::mul_add(x86, -6.7347, x81 * 5.8795));
+        let x99 = Self::mul_add(x80, 5.8795, 21.38 * x85);
+        let x100 = Self::mul_add(x80, -6.7347, 21.38 * x83);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x100 = Self::mul_add(x79, s_q11, x78 * c_q11);
-        let x101 = Self::mul_add(-x78, s_q11, x79 * c_q11);
-        let x102 = x82 - Self::mul_add(-0.63, x84, 0.275 * x79);
-        let x103 = Self::mul_add(0.275, x78, x83);
-        let x104 = Self::mul_add(x78, -0.63, x81);
-        let x105 = Self::mul_add(s_q11, x103, c_q11 * x102);
-        let x106 = Self::mul_add(-s_q11, x102, c_q11 * x103);
-        let x107 = v[10] + x84;
-        let x108 = x90 - Self::mul_add(-0.63, x87, 0.275 * x89);
-        let x109 = Self::mul_add(0.275, x88, x91);
-        let x110 = Self::mul_add(x88, -0.63, x86);
-        let x111 = a[10] + x87;
-        let x112 = Self::mul_add(v[10], x101, Self::mul_add(x89, s_q11, x88 * c_q11));
-        let x113 = Self::mul_add(-v[10], x100, Self::mul_add(-x88, s_q11, x89 * c_q11));
-        let x114 = Self::mul_add(v[10], x106, Self::mul_add(s_q11, x109, c_q11 * x108));
-        let x115 = Self::mul_add(
-            -v[10],
-            x105,
-            Self::mul_add(-s_q11, x108, c_q11 * x109),
-        );
-        let x116 = Self::mul_add(0.07271, x107, 0.01675 * x100);
+        let x102 = Self::mul_add(x81, s_q11, x80 * c_q11);
+        let x103 = Self::mul_add(-x80, s_q11, x81 * c_q11);
+        let x104 = x84 - Self::mul_add(x86, -0.63, 0.275 * x81);
+        let x105 = Self::mul_add(0.275, x80, x85);
+        let x106 = Self::mul_add(x80, -0.63, x83);
+        let x107 = Self::mul_add(s_q11, x105, c_q11 * x104);
+        let x108 = Self::mul_add(-s_q11, x104, c_q11 * x105);
+        let x109 = v[10] + x86;
+        let x110 = x92 - Self::mul_add(x89, -0.63, 0.275 * x91);
+        let x111 = Self::mul_add(0.275, x90, x93);
+        let x112 = Self::mul_add(x90, -0.63, x88);
+        let x113 = a[10] + x89;
+        let x114 = Self::mul_add(v[10], x103, Self::mul_add(x91, s_q11, x90 * c_q11));
+        let x115 = Self::mul_add(-v[10], x102, Self::mul_add(-x90, s_q11, x91 * c_q11));
+        let x116 = Self::mul_add(v[10], x108, Self::mul_add(s_q11, x111, c_q11 * x110));
         let x117 = Self::mul_add(
-            x106,
+            -v[10],
+            x107,
+            Self::mul_add(-s_q11, x110, c_q11 * x111),
+        );
+        let x118 = Self::mul_add(0.07271, x109, 0.01675 * x102);
+        let x119 = Self::mul_add(
+            x108,
             3.0149999999999997,
-            Self::mul_add(0.01675, x107, 0.9304999999999999 * x100),
+            Self::mul_add(0.01675, x109, 0.9304999999999999 * x102),
         );
-        let x118 = Self::mul_add(-3.0149999999999997, x105, 0.939 * x101);
-        let x119 = 16.75 * x104;
-        let x120 = Self::mul_add(x101, -3.0149999999999997, 16.75 * x105);
-        let x121 = Self::mul_add(3.0149999999999997, x100, 16.75 * x106);
+        let x120 = Self::mul_add(x107, -3.0149999999999997, 0.939 * x103);
+        let x121 = 16.75 * x106;
+        let x122 = Self::mul_add(x103, -3.0149999999999997, 16.75 * x107);
+        let x123 = Self::mul_add(x102, 3.0149999999999997, 16.75 * x108);
         let (s_q12, c_q12) = libm::sincos(q[12]);
-        let x123 = -0.00000000020510342851533115 * s_q12;
-        let x124 = -0.00000000020510342851533115 * c_q12;
-        let x125 = Self::mul_add(-x107, s_q12, Self::mul_add(x101, x123, x100 * c_q12));
-        let x126 = Self::mul_add(-x107, c_q12, Self::mul_add(-x100, s_q12, x101 * x124));
-        let x127 = Self::mul_add(x101, -0.36, x105);
-        let x128 = Self::mul_add(0.36, x100, x106);
-        let x129 = Self::mul_add(-x104, s_q12, Self::mul_add(x123, x128, c_q12 * x127));
-        let x130 = Self::mul_add(-x104, c_q12, Self::mul_add(-s_q12, x127, x124 * x128));
-        let x131 = Self::mul_add(-0.00000000020510342851533115, x104, x128);
-        let x132 = v[11] + Self::mul_add(-0.00000000020510342851533115, x107, x101);
-        let x133 = Self::mul_add(x113, -0.36, x114);
-        let x134 = Self::mul_add(0.36, x112, x115);
-        let x135 = Self::mul_add(-0.00000000020510342851533115, x110, x134);
-        let x136 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x113);
-        let x137 = Self::mul_add(
-            v[11],
-            x126,
-            Self::mul_add(-x111, s_q12, Self::mul_add(x113, x123, x112 * c_q12)),
-        );
-        let x138 = Self::mul_add(
-            -v[11],
-            x125,
-            Self::mul_add(-x111, c_q12, Self::mul_add(-x112, s_q12, x113 * x124)),
-        );
+        let x125 = 0.00000000020510342851533115 * s_q12;
+        let x126 = 0.00000000020510342851533115 * c_q12;
+        let x127 = Self::mul_add(-x109, s_q12, Self::mul_add(-x103, x125, x102 * c_q12));
+        let x128 = Self::mul_add(x109, c_q12, Self::mul_add(x103, x126, x102 * s_q12));
+        let x129 = Self::mul_add(x103, -0.36, x107);
+        let x130 = Self::mul_add(x102, 0.36, x108);
+        let x131 = Self::mul_add(-x106, s_q12, Self::mul_add(-x125, x130, c_q12 * x129));
+        let x132 = Self::mul_add(x106, c_q12, Self::mul_add(x126, x130, s_q12 * x129));
+        let x133 = Self::mul_add(-0.00000000020510342851533115, x106, x130);
+        let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x109, x103);
+        let x135 = Self::mul_add(x115, -0.36, x116);
+        let x136 = Self::mul_add(x114, 0.36, x117);
+        let x137 = Self::mul_add(-0.00000000020510342851533115, x112, x136);
+        let x138 = a[11] + Self::mul_add(-0.00000000020510342851533115, x113, x115);
         let x139 = Self::mul_add(
-            v[11],
-            x130,
-            Self::mul_add(-x110, s_q12, Self::mul_add(x123, x134, c_q12 * x133)),
+            -v[11],
+            x128,
+            Self::mul_add(-x113, s_q12, Self::mul_add(-x115, x125, x114 * c_q12)),
         );
         let x140 = Self::mul_add(
-            -v[11],
-            x129,
-            Self::mul_add(-x110, c_q12, Self::mul_add(-s_q12, x133, x124 * x134)),
+            v[11],
+            x127,
+            Self::mul_add(x113, c_q12, Self::mul_add(x115, x126, x114 * s_q12)),
         );
         let x141 = Self::mul_add(
-            x139,
-            -7.196750000000001,
-            Self::mul_add(
-                2.1079062500000005,
-                x136,
-                Self::mul_add(-1.1514800000000003, x138, -0.2313 * x137),
-            ),
+            -v[11],
+            x132,
+            Self::mul_add(-x112, s_q12, Self::mul_add(-x125, x136, c_q12 * x135)),
         );
-        let x142 = Self::mul_add(-0.2313, x132, 3.2217582500000006 * x125)
-            + Self::mul_add(7.196750000000001, x131, x130 * -4.187200000000001);
+        let x142 = Self::mul_add(
+            v[11],
+            x131,
+            Self::mul_add(x112, c_q12, Self::mul_add(x126, x136, s_q12 * x135)),
+        );
         let x143 = Self::mul_add(
-            4.187200000000001,
-            x129,
-            Self::mul_add(-1.1514800000000003, x132, 1.2686520000000001 * x126),
-        );
-        let x144 = Self::mul_add(
-            x129,
             -7.196750000000001,
+            x141,
             Self::mul_add(
                 2.1079062500000005,
-                x132,
-                Self::mul_add(-1.1514800000000003, x126, -0.2313 * x125),
+                x138,
+                Self::mul_add(x139, -0.2313, x140 * 1.1514800000000003),
             ),
         );
+        let x144 = Self::mul_add(x134, -0.2313, 3.2217582500000006 * x127)
+            + Self::mul_add(7.196750000000001, x133, 4.187200000000001 * x132);
         let x145 = Self::mul_add(
+            4.187200000000001,
+            x131,
+            -Self::mul_add(x134, 1.1514800000000003, 1.2686520000000001 * x128),
+        );
+        let x146 = Self::mul_add(
+            -7.196750000000001,
+            x131,
+            Self::mul_add(
+                2.1079062500000005,
+                x134,
+                Self::mul_add(x127, -0.2313, x128 * 1.1514800000000003),
+            ),
+        );
+        let x147 = Self::mul_add(
             26.17,
-            x129,
-            -Self::mul_add(7.196750000000001, x132, x126 * -4.187200000000001),
+            x131,
+            -Self::mul_add(7.196750000000001, x134, 4.187200000000001 * x128),
         );
-        let x146 = Self::mul_add(-4.187200000000001, x125, 26.17 * x130);
-        let x147 = Self::mul_add(x125, 7.196750000000001, 26.17 * x131);
+        let x148 = Self::mul_add(4.187200000000001, x127, 26.17 * x132);
+        let x149 = Self::mul_add(7.196750000000001, x127, 26.17 * x133);
         let (s_q13, c_q13) = libm::sincos(q[13]);
-        let x149 = -0.00000000020510342851533115 * c_q13;
-        let x150 = -0.00000000020510342851533115 * s_q13;
-        let x151 = Self::mul_add(-x132, c_q13, Self::mul_add(x126, s_q13, x125 * x149));
-        let x152 = Self::mul_add(x132, s_q13, Self::mul_add(-x125, x150, x126 * c_q13));
-        let x153 = x129 - Self::mul_add(0.55, x132, -0.16 * x126);
-        let x154 = Self::mul_add(-0.16, x125, x130);
-        let x155 = Self::mul_add(x125, 0.55, x131);
-        let x156 = Self::mul_add(-c_q13, x155, Self::mul_add(s_q13, x154, x149 * x153));
-        let x157 = Self::mul_add(s_q13, x155, Self::mul_add(-x150, x153, c_q13 * x154));
-        let x158 = Self::mul_add(-0.00000000020510342851533115, x155, x153);
-        let x159 = v[12] + Self::mul_add(-0.00000000020510342851533115, x132, x125);
-        let x160 = x139 - Self::mul_add(0.55, x136, -0.16 * x138);
-        let x161 = Self::mul_add(-0.16, x137, x140);
-        let x162 = Self::mul_add(x137, 0.55, x135);
-        let x163 = Self::mul_add(-0.00000000020510342851533115, x162, x160);
-        let x164 = a[12] + Self::mul_add(-0.00000000020510342851533115, x136, x137);
-        let x165 = Self::mul_add(
-            v[12],
-            x152,
-            Self::mul_add(-x136, c_q13, Self::mul_add(x138, s_q13, x137 * x149)),
-        );
-        let x166 = Self::mul_add(
-            -v[12],
-            x151,
-            Self::mul_add(x136, s_q13, Self::mul_add(-x137, x150, x138 * c_q13)),
-        );
+        let x151 = 0.00000000020510342851533115 * c_q13;
+        let x152 = 0.00000000020510342851533115 * s_q13;
+        let x153 = Self::mul_add(x134, c_q13, Self::mul_add(x128, s_q13, x127 * x151));
+        let x154 = Self::mul_add(x134, s_q13, Self::mul_add(-x128, c_q13, x127 * x152));
+        let x155 = x131 - Self::mul_add(0.55, x134, 0.16 * x128);
+        let x156 = Self::mul_add(0.16, x127, x132);
+        let x157 = Self::mul_add(0.55, x127, x133);
+        let x158 = Self::mul_add(c_q13, x157, Self::mul_add(s_q13, x156, x151 * x155));
+        let x159 = Self::mul_add(s_q13, x157, Self::mul_add(-c_q13, x156, x152 * x155));
+        let x160 = Self::mul_add(-0.00000000020510342851533115, x157, x155);
+        let x161 = v[12] + Self::mul_add(-0.00000000020510342851533115, x134, x127);
+        let x162 = x141 - Self::mul_add(0.55, x138, 0.16 * x140);
+        let x163 = Self::mul_add(0.16, x139, x142);
+        let x164 = Self::mul_add(0.55, x139, x137);
+        let x165 = Self::mul_add(-0.00000000020510342851533115, x164, x162);
+        let x166 = a[12] + Self::mul_add(-0.00000000020510342851533115, x138, x139);
         let x167 = Self::mul_add(
             v[12],
-            x157,
-            Self::mul_add(-c_q13, x162, Self::mul_add(s_q13, x161, x149 * x160)),
+            x154,
+            -Self::mul_add(x138, c_q13, Self::mul_add(x140, s_q13, x139 * x151)),
         );
         let x168 = Self::mul_add(
-            -v[12],
-            x156,
-            Self::mul_add(s_q13, x162, Self::mul_add(-x150, x160, c_q13 * x161)),
+            v[12],
+            x153,
+            Self::mul_add(x138, s_q13, Self::mul_add(-x140, c_q13, x139 * x152)),
         );
         let x169 = Self::mul_add(
-            3.6140000000000003,
-            x167,
-            Self::mul_add(
-                -0.9614610000000001,
-                x164,
-                Self::mul_add(0.9638000000000001, x166, 0.000781 * x165),
-            ),
+            v[12],
+            x159,
+            -Self::mul_add(c_q13, x164, Self::mul_add(s_q13, x163, x151 * x162)),
         );
         let x170 = Self::mul_add(
-            x167,
-            -4.806620000000001,
-            Self::mul_add(
-                1.4135609200000003,
-                x164,
-                Self::mul_add(-0.9614610000000001, x166, -0.0145 * x165),
-            ),
+            v[12],
+            x158,
+            Self::mul_add(s_q13, x164, Self::mul_add(-c_q13, x163, x152 * x162)),
         );
         let x171 = Self::mul_add(
-            -0.0145,
-            x159,
-            Self::mul_add(0.000781, x152, 2.1663609200000002 * x151),
-        ) + Self::mul_add(4.806620000000001, x158, x157 * -3.6140000000000003);
-        let x172 = Self::mul_add(
             3.6140000000000003,
-            x156,
+            x169,
             Self::mul_add(
+                x166,
                 -0.9614610000000001,
-                x159,
-                Self::mul_add(0.9638000000000001, x152, 0.000781 * x151),
+                Self::mul_add(0.9638000000000001, x168, 0.000781 * x167),
+            ),
+        );
+        let x172 = Self::mul_add(
+            -4.806620000000001,
+            x169,
+            Self::mul_add(
+                1.4135609200000003,
+                x166,
+                -Self::mul_add(x168, 0.9614610000000001, x167 * 0.0145),
             ),
         );
         let x173 = Self::mul_add(
-            x156,
-            -4.806620000000001,
+            x161,
+            -0.0145,
+            Self::mul_add(-2.1663609200000002, x153, 0.000781 * x154),
+        ) + Self::mul_add(-3.6140000000000003, x159, 4.806620000000001 * x160);
+        let x174 = Self::mul_add(
+            -3.6140000000000003,
+            x158,
+            Self::mul_add(
+                x161,
+                -0.9614610000000001,
+                Self::mul_add(-0.000781, x153, 0.9638000000000001 * x154),
+            ),
+        );
+        let x175 = Self::mul_add(
+            4.806620000000001,
+            x158,
             Self::mul_add(
                 1.4135609200000003,
-                x159,
-                Self::mul_add(-0.9614610000000001, x152, -0.0145 * x151),
+                x161,
+                Self::mul_add(x154, -0.9614610000000001, x153 * 0.0145),
             ),
         );
-        let x174 = Self::mul_add(
+        let x176 = Self::mul_add(
             18.07,
-            x156,
-            -Self::mul_add(4.806620000000001, x159, x152 * -3.6140000000000003),
+            x158,
+            Self::mul_add(-3.6140000000000003, x154, 4.806620000000001 * x161),
         );
-        let x175 = Self::mul_add(-3.6140000000000003, x151, 18.07 * x157);
-        let x176 = Self::mul_add(x151, 4.806620000000001, 18.07 * x158);
-        let x177 = Self::mul_add(
+        let x177 = Self::mul_add(3.6140000000000003, x153, 18.07 * x159);
+        let x178 = Self::mul_add(-4.806620000000001, x153, 18.07 * x160);
+        let x179 = Self::mul_add(
+            x166,
             -0.0145,
-            x164,
-            Self::mul_add(0.000781, x166, 2.1663609200000002 * x165),
-        ) + Self::mul_add(4.806620000000001, x163, x168 * -3.6140000000000003)
-            + (Self::mul_add(-x159, x172, x152 * x173)
-                + Self::mul_add(-x158, x175, x157 * x176));
-        let x178 = x169
-            + (Self::mul_add(-x151, x173, x159 * x171)
-                + Self::mul_add(-x156, x176, x158 * x174));
-        let x179 = x170
-            + (Self::mul_add(-x152, x171, x151 * x172)
-                + Self::mul_add(-x157, x174, x156 * x175));
-        let x180 = Self::mul_add(
+            Self::mul_add(0.000781, x168, 2.1663609200000002 * x167),
+        ) + Self::mul_add(-3.6140000000000003, x170, 4.806620000000001 * x165)
+            + (Self::mul_add(-x161, x174, x154 * x175)
+                + Self::mul_add(-x160, x177, x159 * x178));
+        let x180 = x171
+            + (Self::mul_add(x153, x175, x161 * x173)
+                + Self::mul_add(-x160, x176, x158 * x178));
+        let x181 = x172
+            + (Self::mul_add(-x158, x177, x159 * x176)
+                - Self::mul_add(x153, x174, x154 * x173));
+        let x182 = Self::mul_add(
             18.07,
-            x167,
-            -Self::mul_add(4.806620000000001, x164, x166 * -3.6140000000000003),
-        ) + Self::mul_add(-x159, x175, x152 * x176);
-        let x181 = Self::mul_add(-3.6140000000000003, x165, 18.07 * x168)
-            + Self::mul_add(-x151, x176, x159 * x174);
-        let x182 = Self::mul_add(x165, 4.806620000000001, 18.07 * x163)
-            + Self::mul_add(-x152, x174, x151 * x175);
-        let x183 = x182 + Self::mul_add(-x150, x181, x149 * x180);
-        let x184 = Self::mul_add(c_q13, x181, s_q13 * x180);
-        let x185 = Self::mul_add(
+            x169,
+            -Self::mul_add(-3.6140000000000003, x168, 4.806620000000001 * x166),
+        ) + Self::mul_add(-x161, x177, x154 * x178);
+        let x183 = Self::mul_add(-3.6140000000000003, x167, 18.07 * x170)
+            + Self::mul_add(-x161, x176, x153 * x178);
+        let x184 = Self::mul_add(4.806620000000001, x167, 18.07 * x165)
+            + Self::mul_add(-x153, x177, x154 * x176);
+        let x185 = x184 + Self::mul_add(-x151, x182, x152 * x183);
+        let x186 = Self::mul_add(c_q13, x183, s_q13 * x182);
+        let x187 = Self::mul_add(
             -0.00000000020510342851533115,
-            x182,
-            Self::mul_add(-c_q13, x180, s_q13 * x181),
+            x184,
+            Self::mul_add(-c_q13, x182, s_q13 * x183),
         );
-        let x186 = Self::mul_add(
+        let x188 = Self::mul_add(
             -0.55,
-            x183,
+            x185,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x179,
-                Self::mul_add(-c_q13, x177, s_q13 * x178),
+                x181,
+                Self::mul_add(-c_q13, x179, s_q13 * x180),
             ),
         );
-        let x187 = Self::mul_add(-0.2313, x136, 3.2217582500000006 * x137)
-            + Self::mul_add(7.196750000000001, x135, x140 * -4.187200000000001)
-            + (Self::mul_add(-x132, x143, x126 * x144)
-                + Self::mul_add(-x131, x146, x130 * x147))
-            + (x179 + Self::mul_add(-x150, x178, x149 * x177)
-                + Self::mul_add(0.55, x185, -0.16 * x184));
-        let x188 = Self::mul_add(
-            4.187200000000001,
-            x139,
-            Self::mul_add(-1.1514800000000003, x136, 1.2686520000000001 * x138),
-        )
-            + (Self::mul_add(-x125, x144, x132 * x142)
-                + Self::mul_add(-x129, x147, x131 * x145))
-            + Self::mul_add(0.16, x183, Self::mul_add(c_q13, x178, s_q13 * x177));
-        let x189 = x141
-            + (Self::mul_add(-x126, x142, x125 * x143)
-                + Self::mul_add(-x130, x145, x129 * x146)) + x186;
+        let x189 = Self::mul_add(x138, -0.2313, 3.2217582500000006 * x139)
+            + Self::mul_add(7.196750000000001, x137, 4.187200000000001 * x142)
+            + (Self::mul_add(-x132, x149, x133 * x148)
+                - Self::mul_add(x128, x146, x134 * x145))
+            + (x181 + Self::mul_add(-x151, x179, x152 * x180)
+                + Self::mul_add(-0.16, x186, 0.55 * x187));
         let x190 = Self::mul_add(
-            26.17,
-            x139,
-            -Self::mul_add(7.196750000000001, x136, x138 * -4.187200000000001),
-        ) + Self::mul_add(-x132, x146, x126 * x147) + x183;
-        let x191 = Self::mul_add(-4.187200000000001, x137, 26.17 * x140)
-            + Self::mul_add(-x125, x147, x132 * x145) + x184;
-        let x192 = Self::mul_add(x137, 7.196750000000001, 26.17 * x135)
-            + Self::mul_add(-x126, x145, x125 * x146) + x185;
-        let x193 = Self::mul_add(-s_q12, x191, c_q12 * x190);
-        let x194 = x192 + Self::mul_add(x124, x191, x123 * x190);
-        let x195 = Self::mul_add(
-            x115,
-            3.0149999999999997,
-            Self::mul_add(0.01675, x111, 0.9304999999999999 * x112),
+            4.187200000000001,
+            x141,
+            -Self::mul_add(x138, 1.1514800000000003, 1.2686520000000001 * x140),
         )
-            + (Self::mul_add(-x107, x118, x101 * x116)
-                + Self::mul_add(-x104, x121, x106 * x119))
-            + Self::mul_add(0.36, x194, Self::mul_add(-s_q12, x188, c_q12 * x187));
-        let x196 = Self::mul_add(-3.0149999999999997, x114, 0.939 * x113)
-            + (Self::mul_add(-x100, x116, x107 * x117)
-                + Self::mul_add(-x105, x119, x104 * x120))
-            + Self::mul_add(-0.36, x193, x189 + Self::mul_add(x124, x188, x123 * x187));
-        let x197 = Self::mul_add(x113, -3.0149999999999997, 16.75 * x114)
-            + Self::mul_add(-x107, x121, x101 * x119) + x193;
-        let x198 = Self::mul_add(3.0149999999999997, x112, 16.75 * x115)
-            + Self::mul_add(-x100, x119, x107 * x120) + x194;
-        let x199 = Self::mul_add(16.75, x110, Self::mul_add(-x101, x120, x100 * x121))
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x192,
-                -Self::mul_add(c_q12, x191, s_q12 * x190),
+            + (Self::mul_add(-x127, x146, x134 * x144)
+                + Self::mul_add(-x131, x149, x133 * x147))
+            + Self::mul_add(0.16, x185, Self::mul_add(c_q13, x180, s_q13 * x179));
+        let x191 = x143
+            + (Self::mul_add(x127, x145, x128 * x144)
+                + Self::mul_add(-x131, x148, x132 * x147)) + x188;
+        let x192 = Self::mul_add(
+            26.17,
+            x141,
+            -Self::mul_add(7.196750000000001, x138, 4.187200000000001 * x140),
+        ) + Self::mul_add(-x128, x149, x134 * x148) + x185;
+        let x193 = Self::mul_add(-x127, x149, x134 * x147)
+            - Self::mul_add(4.187200000000001, x139, 26.17 * x142) + x186;
+        let x194 = Self::mul_add(7.196750000000001, x139, 26.17 * x137)
+            + Self::mul_add(-x127, x148, x128 * x147) + x187;
+        let x195 = Self::mul_add(-s_q12, x193, c_q12 * x192);
+        let x196 = x194 - Self::mul_add(x126, x193, x125 * x192);
+        let x197 = Self::mul_add(
+            x117,
+            3.0149999999999997,
+            Self::mul_add(0.01675, x113, 0.9304999999999999 * x114),
+        )
+            + (Self::mul_add(-x109, x120, x103 * x118)
+                + Self::mul_add(-x106, x123, x108 * x121))
+            + Self::mul_add(0.36, x196, Self::mul_add(-s_q12, x190, c_q12 * x189));
+        let x198 = Self::mul_add(x116, -3.0149999999999997, 0.939 * x115)
+            + (Self::mul_add(-x102, x118, x109 * x119)
+                + Self::mul_add(-x107, x121, x106 * x122))
+            + Self::mul_add(-0.36, x195, x191 - Self::mul_add(x126, x190, x125 * x189));
+        let x199 = Self::mul_add(x115, -3.0149999999999997, 16.75 * x116)
+            + Self::mul_add(-x109, x123, x103 * x121) + x195;
+        let x200 = Self::mul_add(x114, 3.0149999999999997, 16.75 * x117)
+            + Self::mul_add(-x102, x121, x109 * x122) + x196;
+        let x201 = Self::mul_add(16.75, x112, Self::mul_add(-x103, x122, x102 * x123))
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x194,
+                Self::mul_add(c_q12, x193, s_q12 * x192),
             );
-        let x200 = Self::mul_add(-s_q11, x198, c_q11 * x197);
-        let x201 = Self::mul_add(c_q11, x198, s_q11 * x197);
-        let x202 = Self::mul_add(
+        let x202 = Self::mul_add(-s_q11, x200, c_q11 * x199);
+        let x203 = Self::mul_add(c_q11, x200, s_q11 * x199);
+        let x204 = Self::mul_add(
             0.63,
-            x200,
-            Self::mul_add(0.07271, x111, 0.01675 * x112)
-                + (Self::mul_add(-x101, x117, x100 * x118)
-                    + Self::mul_add(-x106, x120, x105 * x121))
-                + Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x189,
-                    -Self::mul_add(c_q12, x188, s_q12 * x187),
+            x202,
+            Self::mul_add(0.07271, x113, 0.01675 * x114)
+                + (Self::mul_add(-x103, x119, x102 * x120)
+                    + Self::mul_add(-x108, x122, x107 * x123))
+                - Self::mul_add(
+                    0.00000000020510342851533115,
+                    x191,
+                    Self::mul_add(c_q12, x190, s_q12 * x189),
                 ),
         );
-        let x203 = Self::mul_add(-0.6328, x87, 4.170993 * x88)
-            + Self::mul_add(-6.7347, x86, x91 * 5.8795)
-            + (Self::mul_add(-x84, x94, x79 * x95) + Self::mul_add(-x81, x97, x83 * x98))
-            + (Self::mul_add(-s_q11, x196, c_q11 * x195)
-                + Self::mul_add(-0.63, x199, 0.275 * x201));
-        let x204 = Self::mul_add(
+        let x205 = Self::mul_add(x89, -0.6328, 4.170993 * x90)
+            + Self::mul_add(x88, -6.7347, x93 * 5.8795)
+            + (Self::mul_add(-x86, x96, x81 * x97)
+                + Self::mul_add(-x83, x99, x85 * x100))
+            + (Self::mul_add(-s_q11, x198, c_q11 * x197)
+                + Self::mul_add(-0.63, x201, 0.275 * x203));
+        let x206 = Self::mul_add(
+            x92,
             -5.8795,
-            x90,
-            Self::mul_add(-1.8520425, x87, 3.8828625 * x89),
-        ) + (Self::mul_add(-x78, x95, x84 * x93) + Self::mul_add(-x82, x98, x81 * x96))
-            + Self::mul_add(-0.275, x200, Self::mul_add(c_q11, x196, s_q11 * x195));
-        let x205 = Self::mul_add(21.38, x90, -Self::mul_add(-6.7347, x87, x89 * 5.8795))
-            + Self::mul_add(-x84, x97, x79 * x98) + x200;
-        let x206 = Self::mul_add(5.8795, x88, 21.38 * x91)
-            + Self::mul_add(-x78, x98, x84 * x96) + x201;
-        let x207 = Self::mul_add(x88, -6.7347, 21.38 * x86)
-            + Self::mul_add(-x79, x96, x78 * x97) + x199;
-        let x208 = Self::mul_add(-s_q10, x206, c_q10 * x205);
-        let x209 = Self::mul_add(
-            -9.87015,
-            x65,
-            Self::mul_add(-0.00214, x66, 4.395515250000001 * x67),
-        ) + (Self::mul_add(-x61, x71, x54 * x73) + Self::mul_add(-x60, x74, x59 * x76))
-            + Self::mul_add(-0.87, x207, Self::mul_add(-s_q10, x204, c_q10 * x203));
-        let x210 = Self::mul_add(
-            3.378,
-            x68,
-            Self::mul_add(-x53, x73, x61 * x72) + Self::mul_add(-x58, x76, x60 * x75),
-        ) + Self::mul_add(c_q10, x204, s_q10 * x203);
+            Self::mul_add(x89, -1.8520425, 3.8828625 * x91),
+        ) + (Self::mul_add(-x80, x97, x86 * x95) + Self::mul_add(-x84, x100, x83 * x98))
+            + Self::mul_add(-0.275, x202, Self::mul_add(c_q11, x198, s_q11 * x197));
+        let x207 = Self::mul_add(21.38, x92, -Self::mul_add(x89, -6.7347, x91 * 5.8795))
+            + Self::mul_add(-x86, x99, x81 * x100) + x202;
+        let x208 = Self::mul_add(x90, 5.8795, 21.38 * x93)
+            + Self::mul_add(-x80, x100, x86 * x98) + x203;
+        let x209 = Self::mul_add(x90, -6.7347, 21.38 * x88)
+            + Self::mul_add(-x81, x98, x80 * x99) + x201;
+        let x210 = Self::mul_add(-s_q10, x208, c_q10 * x207);
         let x211 = Self::mul_add(
-            x69,
+            x67,
+            -9.87015,
+            Self::mul_add(-0.00214, x68, 4.395515250000001 * x69),
+        ) + (Self::mul_add(-x63, x73, x56 * x75) + Self::mul_add(-x62, x76, x61 * x78))
+            + Self::mul_add(-0.87, x209, Self::mul_add(-s_q10, x206, c_q10 * x205));
+        let x212 = Self::mul_add(
+            3.378,
+            x70,
+            Self::mul_add(-x55, x75, x63 * x74) + Self::mul_add(-x60, x78, x62 * x77),
+        ) + Self::mul_add(c_q10, x206, s_q10 * x205);
+        let x213 = Self::mul_add(
+            x71,
             9.87015,
-            Self::mul_add(7.65251525, x66, -0.00214 * x67),
-        ) + (Self::mul_add(-x54, x72, x53 * x71) + Self::mul_add(-x59, x75, x58 * x74))
+            Self::mul_add(-0.00214, x69, 7.65251525 * x68),
+        ) + (Self::mul_add(-x56, x74, x55 * x73) + Self::mul_add(-x61, x77, x60 * x76))
             + Self::mul_add(
                 0.87,
-                x208,
-                x92
-                    + (Self::mul_add(-x79, x93, x78 * x94)
-                        + Self::mul_add(-x83, x96, x82 * x97)) + x202,
+                x210,
+                x94
+                    + (Self::mul_add(-x81, x95, x80 * x96)
+                        + Self::mul_add(-x85, x98, x84 * x99)) + x204,
             );
-        let x212 = Self::mul_add(9.87015, x66, 22.69 * x69)
-            + Self::mul_add(-x61, x74, x54 * x76) + x208;
-        let x213 = Self::mul_add(22.69, x70, Self::mul_add(-x53, x76, x61 * x75))
-            + Self::mul_add(c_q10, x206, s_q10 * x205);
-        let x214 = Self::mul_add(x67, -9.87015, 22.69 * x65)
-            + Self::mul_add(-x54, x75, x53 * x74) + x207;
-        let x215 = Self::mul_add(
-            0.00000000020510342851533115,
-            x214,
-            Self::mul_add(c_q9, x213, s_q9 * x212),
-        );
-        let x216 = x214 + Self::mul_add(x52, x213, x51 * x212);
-        let x217 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x214,
-            Self::mul_add(-s_q9, x213, c_q9 * x212),
-        );
-        let x218 = Self::mul_add(
-            -0.275,
-            x215,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x211,
-                Self::mul_add(-s_q9, x210, c_q9 * x209),
-            ),
-        );
-        let x219 = Self::mul_add(
-            x43,
+        let x214 = Self::mul_add(x68, 9.87015, 22.69 * x71)
+            + Self::mul_add(-x63, x76, x56 * x78) + x210;
+        let x215 = Self::mul_add(22.69, x72, Self::mul_add(-x55, x78, x63 * x77))
+            + Self::mul_add(c_q10, x208, s_q10 * x207);
+        let x216 = Self::mul_add(x69, -9.87015, 22.69 * x67)
+            + Self::mul_add(-x56, x77, x55 * x76) + x209;
+        let x217 = 0.00000000020510342851533115 * x216;
+        let x218 = Self::mul_add(c_q9, x215, s_q9 * x214) + x217;
+        let x219 = x216 + Self::mul_add(-x54, x215, x53 * x214);
+        let x220 = Self::mul_add(-s_q9, x215, c_q9 * x214) - x217;
+        let x221 = 0.00000000020510342851533115 * x213;
+        let x222 = Self::mul_add(
             -6.0,
-            Self::mul_add(-0.00214, x39, 3.3000000000000003 * x40),
+            x43,
+            Self::mul_add(x39, -0.00214, 3.3000000000000003 * x40),
         ) + (Self::mul_add(-x35, x46, x29 * x44) + Self::mul_add(-x34, x49, x33 * x47))
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x211,
-                Self::mul_add(c_q9, x210, s_q9 * x209),
-            ) + Self::mul_add(0.275, x217, -0.4 * x216));
-        let x220 = Self::mul_add(6.0, x42, 2.5780000000000003 * x41)
+            + (Self::mul_add(c_q9, x212, s_q9 * x211) + x221
+                + Self::mul_add(-0.4, x219, 0.275 * x220));
+        let x223 = Self::mul_add(6.0, x42, 2.5780000000000003 * x41)
             + (Self::mul_add(-x28, x44, x35 * x45) + Self::mul_add(-x32, x47, x34 * x48))
-            + Self::mul_add(0.4, x215, x211 + Self::mul_add(x52, x210, x51 * x209));
-        let x221 = Self::mul_add(2.359, x39, -0.00214 * x40)
+            + Self::mul_add(0.4, x218, x213 + Self::mul_add(-x54, x212, x53 * x211));
+        let x224 = Self::mul_add(x40, -0.00214, 2.359 * x39)
             + (Self::mul_add(-x29, x45, x28 * x46) + Self::mul_add(-x33, x48, x32 * x49))
-            + x218;
-        let x222 = Self::mul_add(x41, 6.0, 30.0 * x42)
-            + Self::mul_add(-x35, x49, x29 * x47) + x215;
-        let x223 = Self::mul_add(-6.0, x40, 30.0 * x43)
-            + Self::mul_add(-x28, x47, x35 * x48) + x216;
-        let x224 = Self::mul_add(30.0, x38, Self::mul_add(-x29, x48, x28 * x49)) + x217;
-        let x225 = x224 + Self::mul_add(-x27, x223, x26 * x222);
-        let x226 = Self::mul_add(c_q8, x223, s_q8 * x222);
-        let x227 = x17
+            + Self::mul_add(
+                -0.275,
+                x218,
+                Self::mul_add(-s_q9, x212, c_q9 * x211) - x221,
+            );
+        let x225 = Self::mul_add(6.0, x41, 30.0 * x42)
+            + Self::mul_add(-x35, x49, x29 * x47) + x218;
+        let x226 = Self::mul_add(-6.0, x40, 30.0 * x43)
+            + Self::mul_add(-x28, x47, x35 * x48) + x219;
+        let x227 = Self::mul_add(30.0, x38, Self::mul_add(-x29, x48, x28 * x49)) + x220;
+        let x228 = x227 + Self::mul_add(-x26, x225, x27 * x226);
+        let x229 = Self::mul_add(c_q8, x226, s_q8 * x225);
+        let x230 = x17
             + (Self::mul_add(-x8, x21, x2 * x19) + Self::mul_add(-x5, x24, x7 * x22))
-            + Self::mul_add(-0.35, x226, x221 + Self::mul_add(-x27, x220, x26 * x219));
-        let x228 = x18
+            + Self::mul_add(-0.35, x229, x224 + Self::mul_add(-x26, x222, x27 * x223));
+        let x231 = x18
             + (Self::mul_add(-x1, x19, x8 * x20) + Self::mul_add(-x6, x22, x5 * x23))
-            + Self::mul_add(0.35, x225, Self::mul_add(c_q8, x220, s_q8 * x219));
-        let x229 = Self::mul_add(x14, 6.1267499999999995, 35.01 * x15)
-            + Self::mul_add(-x8, x24, x2 * x22) + x225;
-        let x230 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
-            + Self::mul_add(-x1, x22, x8 * x23) + x226;
-        let x231 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x23, x1 * x24))
+            + Self::mul_add(0.35, x228, Self::mul_add(c_q8, x223, s_q8 * x222));
+        let x232 = Self::mul_add(6.1267499999999995, x14, 35.01 * x15)
+            + Self::mul_add(-x8, x24, x2 * x22) + x228;
+        let x233 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
+            + Self::mul_add(-x1, x22, x8 * x23) + x229;
+        let x234 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x23, x1 * x24))
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x224,
-                Self::mul_add(-c_q8, x222, s_q8 * x223),
+                x227,
+                Self::mul_add(-c_q8, x225, s_q8 * x226),
             );
-        let x232 = Self::mul_add(-s_q7, x230, c_q7 * x229);
-        let x233 = Self::mul_add(c_q7, x230, s_q7 * x229);
-        let x234 = Self::mul_add(
+        let x235 = Self::mul_add(-s_q7, x233, c_q7 * x232);
+        let x236 = Self::mul_add(c_q7, x233, s_q7 * x232);
+        let x237 = Self::mul_add(
             0.65,
-            x233,
+            x236,
             Self::mul_add(1.331, x12, Self::mul_add(0.1132, x14, 0.00071 * x13))
                 + (Self::mul_add(-x2, x20, x1 * x21) + Self::mul_add(-x7, x23, x6 * x24))
                 + Self::mul_add(
                     -0.00000000020510342851533115,
-                    x221,
-                    Self::mul_add(-c_q8, x219, s_q8 * x220),
+                    x224,
+                    Self::mul_add(-c_q8, x222, s_q8 * x223),
                 ),
         );
-        let x235 = -x232;
-        let x236 = -x233;
-        let x237 = -x231;
-        let x238 = -Self::mul_add(-0.75, x233, Self::mul_add(-s_q7, x228, c_q7 * x227));
-        let x239 = -(Self::mul_add(c_q7, x228, s_q7 * x227)
-            + Self::mul_add(-0.65, x231, 0.75 * x232));
+        let x238 = -x235;
+        let x239 = -x236;
         let x240 = -x234;
-        [x235, x236, x237, x238, x239, x240]
+        let x241 = -Self::mul_add(-0.75, x236, Self::mul_add(-s_q7, x231, c_q7 * x230));
+        let x242 = -(Self::mul_add(c_q7, x231, s_q7 * x230)
+            + Self::mul_add(-0.65, x234, 0.75 * x235));
+        let x243 = -x237;
+        [x238, x239, x240, x241, x242, x243]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

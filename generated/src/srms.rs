@@ -9,8 +9,8 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 971 (`mass_matrix` 52, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 240, `mass_matrix_and_nonlinear_effects` 175, `forward_dynamics_with_wrenches` 247), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
-//! Form: unrolled straight-line code (auto: 619 emitted operations in M + c, within the 4000 limit).
+//! Fused multiply-adds where the target has them: 968 (`mass_matrix` 51, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 239, `mass_matrix_and_nonlinear_effects` 174, `forward_dynamics_with_wrenches` 247), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: 610 emitted operations in M + c, within the 4000 limit).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -24,8 +24,8 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 505 | 352 | 0 | 0 | 6 | 857 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 450 | 339 | 0 | 0 | 6 | 789 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 450 | 339 | 0 | 0 | 6 | 789 |
-//! | `mass_matrix` * | `crba` | — | — | model | 123 | 119 | 0 | 0 | 5 | 242 |
-//! | `mass_matrix` | `crba` | — | — | canonical | 126 | 122 | 0 | 0 | 5 | 248 |
+//! | `mass_matrix` | `crba` | — | — | model | 118 | 117 | 0 | 0 | 5 | 235 |
+//! | `mass_matrix` * | `crba` | — | — | canonical | 118 | 115 | 0 | 0 | 5 | 233 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 537 | 386 | 0 | 0 | 6 | 923 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 537 | 386 | 0 | 0 | 6 | 923 |
 //! | `nonlinear_effects` | — | `kane-direct` | — | model | 580 | 428 | 0 | 0 | 6 | 1008 |
@@ -34,37 +34,57 @@
 //! | `nonlinear_effects` | — | `rnea` | — | canonical | 254 | 181 | 0 | 0 | 5 | 435 |
 //! | `nonlinear_effects` * | — | `newton-euler` | — | model | 220 | 157 | 0 | 0 | 5 | 377 |
 //! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 220 | 157 | 0 | 0 | 5 | 377 |
-//! | `inverse_dynamics` | — | `recurrent` | — | model | 694 | 541 | 0 | 0 | 6 | 1235 |
-//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 697 | 544 | 0 | 0 | 6 | 1241 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | model | 737 | 583 | 0 | 0 | 6 | 1320 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 740 | 586 | 0 | 0 | 6 | 1326 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 689 | 539 | 0 | 0 | 6 | 1228 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 689 | 537 | 0 | 0 | 6 | 1226 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 732 | 581 | 0 | 0 | 6 | 1313 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 732 | 579 | 0 | 0 | 6 | 1311 |
 //! | `inverse_dynamics` | — | `rnea` | — | model | 278 | 207 | 0 | 0 | 5 | 485 |
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 278 | 207 | 0 | 0 | 5 | 485 |
 //! | `inverse_dynamics` * | — | `newton-euler` | — | model | 232 | 178 | 0 | 0 | 5 | 410 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 232 | 178 | 0 | 0 | 5 | 410 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 746 | 576 | 6 | 0 | 6 | 1322 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 749 | 579 | 6 | 0 | 6 | 1328 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 789 | 618 | 6 | 0 | 6 | 1407 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 792 | 621 | 6 | 0 | 6 | 1413 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 463 | 371 | 6 | 0 | 5 | 834 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 466 | 374 | 6 | 0 | 5 | 840 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 429 | 347 | 6 | 0 | 5 | 776 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 432 | 350 | 6 | 0 | 5 | 782 |
-//! | `forward_dynamics` | — | — | `aba` | model | 570 | 411 | 5 | 0 | 5 | 981 |
-//! | `forward_dynamics` | — | — | `aba` | canonical | 576 | 414 | 5 | 0 | 5 | 990 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 660 | 505 | 0 | 0 | 6 | 1165 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 663 | 508 | 0 | 0 | 6 | 1171 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 703 | 547 | 0 | 0 | 6 | 1250 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 706 | 550 | 0 | 0 | 6 | 1256 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 377 | 300 | 0 | 0 | 5 | 677 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 380 | 303 | 0 | 0 | 5 | 683 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 343 | 276 | 0 | 0 | 5 | 619 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 346 | 279 | 0 | 0 | 5 | 625 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 822 | 653 | 6 | 0 | 6 | 1475 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 865 | 695 | 6 | 0 | 6 | 1560 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 469 | 403 | 6 | 0 | 5 | 872 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 435 | 379 | 6 | 0 | 5 | 814 |
-//! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 576 | 443 | 5 | 0 | 5 | 1019 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 741 | 574 | 6 | 0 | 6 | 1315 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 741 | 572 | 6 | 0 | 6 | 1313 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 784 | 616 | 6 | 0 | 6 | 1400 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 784 | 614 | 6 | 0 | 6 | 1398 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 458 | 369 | 6 | 0 | 5 | 827 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 458 | 367 | 6 | 0 | 5 | 825 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 424 | 345 | 6 | 0 | 5 | 769 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 424 | 343 | 6 | 0 | 5 | 767 |
+//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 801 | 647 | 6 | 0 | 6 | 1448 |
+//! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 801 | 647 | 6 | 0 | 6 | 1448 |
+//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 844 | 689 | 6 | 0 | 6 | 1533 |
+//! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | canonical | 844 | 689 | 6 | 0 | 6 | 1533 |
+//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | model | 790 | 591 | 6 | 0 | 6 | 1381 |
+//! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 790 | 591 | 6 | 0 | 6 | 1381 |
+//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 756 | 567 | 6 | 0 | 6 | 1323 |
+//! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 756 | 567 | 6 | 0 | 6 | 1323 |
+//! | `forward_dynamics` | — | — | `aba` | model | 567 | 411 | 5 | 0 | 5 | 978 |
+//! | `forward_dynamics` | — | — | `aba` | canonical | 574 | 414 | 5 | 0 | 5 | 988 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 655 | 503 | 0 | 0 | 6 | 1158 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 655 | 501 | 0 | 0 | 6 | 1156 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 698 | 545 | 0 | 0 | 6 | 1243 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 698 | 543 | 0 | 0 | 6 | 1241 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 372 | 298 | 0 | 0 | 5 | 670 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 372 | 296 | 0 | 0 | 5 | 668 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 338 | 274 | 0 | 0 | 5 | 612 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 338 | 272 | 0 | 0 | 5 | 610 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 715 | 576 | 0 | 0 | 6 | 1291 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 715 | 576 | 0 | 0 | 6 | 1291 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 758 | 618 | 0 | 0 | 6 | 1376 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | canonical | 758 | 618 | 0 | 0 | 6 | 1376 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | model | 704 | 520 | 0 | 0 | 6 | 1224 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 704 | 520 | 0 | 0 | 6 | 1224 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 670 | 496 | 0 | 0 | 6 | 1166 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 670 | 496 | 0 | 0 | 6 | 1166 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 817 | 651 | 6 | 0 | 6 | 1468 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 860 | 693 | 6 | 0 | 6 | 1553 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 464 | 401 | 6 | 0 | 5 | 865 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 430 | 377 | 6 | 0 | 5 | 807 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 877 | 724 | 6 | 0 | 6 | 1601 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 920 | 766 | 6 | 0 | 6 | 1686 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 796 | 623 | 6 | 0 | 6 | 1419 |
+//! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 762 | 599 | 6 | 0 | 6 | 1361 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 573 | 443 | 5 | 0 | 5 | 1016 |
 /// Dynamics of `srms_nguyen_hughes_1994` (N = 6); see the module documentation.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct Srms;
@@ -129,13 +149,13 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: None,
             forward_method: None,
-            frames: "model",
-            mul: 123u64,
-            add: 119u64,
+            frames: "canonical",
+            mul: 118u64,
+            add: 115u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 52u64,
+            fma: 51u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -168,26 +188,26 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
-            frames: "model",
-            mul: 429u64,
-            add: 347u64,
+            frames: "canonical",
+            mul: 424u64,
+            add: 343u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 240u64,
+            fma: 239u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
-            frames: "model",
-            mul: 343u64,
-            add: 276u64,
+            frames: "canonical",
+            mul: 338u64,
+            add: 272u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 175u64,
+            fma: 174u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -195,8 +215,8 @@ impl Srms {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 435u64,
-            add: 379u64,
+            mul: 430u64,
+            add: 377u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -315,8 +335,8 @@ impl Srms {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 123u64,
-            add: 119u64,
+            mul: 118u64,
+            add: 117u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -328,8 +348,8 @@ impl Srms {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 126u64,
-            add: 122u64,
+            mul: 118u64,
+            add: 115u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -445,8 +465,8 @@ impl Srms {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 694u64,
-            add: 541u64,
+            mul: 689u64,
+            add: 539u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -458,8 +478,8 @@ impl Srms {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 697u64,
-            add: 544u64,
+            mul: 689u64,
+            add: 537u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -471,8 +491,8 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 737u64,
-            add: 583u64,
+            mul: 732u64,
+            add: 581u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -484,86 +504,86 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 740u64,
-            add: 586u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            forward_method: None,
-            frames: "model",
-            mul: 278u64,
-            add: 207u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            forward_method: None,
-            frames: "canonical",
-            mul: 278u64,
-            add: 207u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
-            forward_method: None,
-            frames: "model",
-            mul: 232u64,
-            add: 178u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
-            forward_method: None,
-            frames: "canonical",
-            mul: 232u64,
-            add: 178u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
-            frames: "model",
-            mul: 746u64,
-            add: 576u64,
-            div: 6u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
-            frames: "canonical",
-            mul: 749u64,
+            mul: 732u64,
             add: 579u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "model",
+            mul: 278u64,
+            add: 207u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 278u64,
+            add: 207u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "model",
+            mul: 232u64,
+            add: 178u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 232u64,
+            add: 178u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 741u64,
+            add: 574u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 741u64,
+            add: 572u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -575,8 +595,8 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 789u64,
-            add: 618u64,
+            mul: 784u64,
+            add: 616u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -588,8 +608,8 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 792u64,
-            add: 621u64,
+            mul: 784u64,
+            add: 614u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -601,8 +621,8 @@ impl Srms {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 463u64,
-            add: 371u64,
+            mul: 458u64,
+            add: 369u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -614,8 +634,8 @@ impl Srms {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 466u64,
-            add: 374u64,
+            mul: 458u64,
+            add: 367u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -627,8 +647,8 @@ impl Srms {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 429u64,
-            add: 347u64,
+            mul: 424u64,
+            add: 345u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -640,11 +660,115 @@ impl Srms {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 432u64,
-            add: 350u64,
+            mul: 424u64,
+            add: 343u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 801u64,
+            add: 647u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 801u64,
+            add: 647u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 844u64,
+            add: 689u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 844u64,
+            add: 689u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 790u64,
+            add: 591u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 790u64,
+            add: 591u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 756u64,
+            add: 567u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 756u64,
+            add: 567u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
             fma: 0u64,
         },
         OpCount {
@@ -653,7 +777,7 @@ impl Srms {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "model",
-            mul: 570u64,
+            mul: 567u64,
             add: 411u64,
             div: 5u64,
             sqrt: 0u64,
@@ -666,7 +790,7 @@ impl Srms {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "canonical",
-            mul: 576u64,
+            mul: 574u64,
             add: 414u64,
             div: 5u64,
             sqrt: 0u64,
@@ -679,8 +803,8 @@ impl Srms {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 660u64,
-            add: 505u64,
+            mul: 655u64,
+            add: 503u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -692,8 +816,8 @@ impl Srms {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 663u64,
-            add: 508u64,
+            mul: 655u64,
+            add: 501u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -705,8 +829,8 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 703u64,
-            add: 547u64,
+            mul: 698u64,
+            add: 545u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -718,8 +842,8 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 706u64,
-            add: 550u64,
+            mul: 698u64,
+            add: 543u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -731,8 +855,8 @@ impl Srms {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 377u64,
-            add: 300u64,
+            mul: 372u64,
+            add: 298u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -744,8 +868,8 @@ impl Srms {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 380u64,
-            add: 303u64,
+            mul: 372u64,
+            add: 296u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -757,8 +881,8 @@ impl Srms {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 343u64,
-            add: 276u64,
+            mul: 338u64,
+            add: 274u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -770,11 +894,115 @@ impl Srms {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 346u64,
-            add: 279u64,
+            mul: 338u64,
+            add: 272u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "model",
+            mul: 715u64,
+            add: 576u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 715u64,
+            add: 576u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "model",
+            mul: 758u64,
+            add: 618u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 758u64,
+            add: 618u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "model",
+            mul: 704u64,
+            add: 520u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 704u64,
+            add: 520u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "model",
+            mul: 670u64,
+            add: 496u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 670u64,
+            add: 496u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
             fma: 0u64,
         },
         OpCount {
@@ -783,8 +1011,8 @@ impl Srms {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 822u64,
-            add: 653u64,
+            mul: 817u64,
+            add: 651u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -796,8 +1024,8 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 865u64,
-            add: 695u64,
+            mul: 860u64,
+            add: 693u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -809,8 +1037,8 @@ impl Srms {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 469u64,
-            add: 403u64,
+            mul: 464u64,
+            add: 401u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -822,11 +1050,63 @@ impl Srms {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 435u64,
-            add: 379u64,
+            mul: 430u64,
+            add: 377u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("recurrent"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 877u64,
+            add: 724u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("kane-direct"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 920u64,
+            add: 766u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 796u64,
+            add: 623u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics_with_wrenches",
+            mass_matrix_method: Some("crba-base"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "model",
+            mul: 762u64,
+            add: 599u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 6u64,
             fma: 0u64,
         },
         OpCount {
@@ -835,7 +1115,7 @@ impl Srms {
             bias_method: None,
             forward_method: Some("aba"),
             frames: "model",
-            mul: 576u64,
+            mul: 573u64,
             add: 443u64,
             div: 5u64,
             sqrt: 0u64,
@@ -845,7 +1125,7 @@ impl Srms {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 123 mul, 119 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 52 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 118 mul, 115 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 51 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -859,131 +1139,131 @@ impl Srms {
         let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
         let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.33891524 - x7;
-        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
-        let x13 = s_q4 * s_q4;
-        let x14 = s_q4 * c_q4;
-        let x15 = 1.903 - x11;
-        let x16 = x9 + x9;
-        let x17 = Self::mul_add(x14, x16, x13 * x15);
-        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
-        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
-        let x20 = 34.45002 * c_q4;
-        let x21 = 34.45002 * s_q4;
-        let x22 = x20 * -0.4572;
-        let x23 = 0.4572 * x20;
-        let x24 = x12 + x23;
-        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
-        let x26 = x24 - x22;
-        let x27 = 41.67378 + x20;
-        let x28 = -18.957952216000002 + (1.903 - x17);
-        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x11 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x12 = s_q4 * s_q4;
+        let x13 = s_q4 * c_q4;
+        let x14 = x7 + -32.43591524;
+        let x15 = x9 + x9;
+        let x16 = Self::mul_add(x13, x15, x12 * x14);
+        let x17 = -32.43591524 - x16;
+        let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
+        let x19 = s_q4 * x8;
+        let x20 = c_q4 * x10;
+        let x21 = x19 - x20;
+        let x22 = s_q4 * 34.45002;
+        let x23 = c_q4 * 34.45002;
+        let x24 = 0.4572 * x23;
+        let x25 = x11 + x24;
+        let x26 = Self::mul_add(0.4572, x22, Self::mul_add(-x13, x14, x12 * x15) - x9);
+        let x27 = 41.67378 + x23;
+        let x28 = -15.380963024 + (x24 + x25);
+        let x29 = 54.202167456 + (x24 + (x16 - x7 + x24));
         let x30 = s_q3 * s_q3;
         let x31 = s_q3 * c_q3;
-        let x32 = x26 - x28;
-        let x33 = x18 + x18;
+        let x32 = x17 - x28;
+        let x33 = x21 + x21;
         let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
-        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
-        let x37 = s_q3 * x27;
-        let x38 = c_q3 * x27;
-        let x39 = x37 * 0.1524;
-        let x40 = -0.1524 * x37;
-        let x41 = x38 * -7.06;
-        let x42 = 7.06 * x38;
-        let x43 = x29 - (x40 + x41);
-        let x44 = x21 * 0.1524;
+        let x35 = Self::mul_add(-c_q3, x26, s_q3 * x18);
+        let x36 = Self::mul_add(c_q3, x18, s_q3 * x26);
+        let x37 = c_q3 * x27;
+        let x38 = s_q3 * x27;
+        let x39 = 0.1524 * x38;
+        let x40 = 7.06 * x37;
+        let x41 = 0.1524 * x22;
+        let x42 = x39 + x40;
+        let x43 = x29 + x42;
+        let x44 = x39 + (x17 - x34 + x39);
         let x45 = Self::mul_add(
-            0.1524,
+            -7.06,
             x38,
-            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
+            Self::mul_add(-0.1524, x37, x21 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x46 = x26 - x34 + x42 - x41;
-        let x47 = 703.3878000000001 + x38;
-        let x48 = -15.183612000000002 - x37;
-        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
-        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
-        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
-        let x52 = 103.41030072000002 + x45;
-        let x53 = -0.08 + (x35 + x44);
-        let x54 = s_q2 * s_q2;
-        let x55 = s_q2 * c_q2;
-        let x56 = x46 - x49;
-        let x57 = x52 + x52;
-        let x58 = Self::mul_add(x55, x57, x54 * x56);
-        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
-        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
-        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
-        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
-        let x63 = 0.1524 * x61;
-        let x64 = -0.1524 * x61;
-        let x65 = x62 * -6.377;
-        let x66 = 6.377 * x62;
-        let x67 = Self::mul_add(
-            0.1524,
-            x62,
-            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
+        let x46 = 703.3878000000001 + x37;
+        let x47 = 15.183612000000002 + x38;
+        let x48 = -103.41030072000001 + x45;
+        let x49 = 0.8021 + Self::mul_add(-7.06, x22, x35);
+        let x50 = 5594.523885531201 + (x40 + (x28 + x34 + x40));
+        let x51 = 0.08 - (x36 + x41);
+        let x52 = 5601.1318504688 + (x42 + x43);
+        let x53 = s_q2 * s_q2;
+        let x54 = s_q2 * c_q2;
+        let x55 = x44 - x50;
+        let x56 = x48 + x48;
+        let x57 = Self::mul_add(x54, x56, x53 * x55);
+        let x58 = Self::mul_add(-s_q2, x51, c_q2 * x49);
+        let x59 = Self::mul_add(c_q2, x51, s_q2 * x49);
+        let x60 = Self::mul_add(-s_q2, x47, c_q2 * x46);
+        let x61 = Self::mul_add(c_q2, x47, s_q2 * x46);
+        let x62 = 0.1524 * x61;
+        let x63 = 6.377 * x60;
+        let x64 = x62 + x63;
+        let x65 = x52 + x64;
+        let x66 = Self::mul_add(
+            -6.377,
+            x61,
+            Self::mul_add(-0.1524, x60, x48 + Self::mul_add(-x53, x56, x54 * x55)),
         );
-        let x68 = x46 - x58 + x66 - x65;
-        let x69 = 8609.573807858 + (x51 - (x65 - x64) - (x63 - x66));
-        let x70 = 190.97044034000004 + x67;
-        let x71 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x21, x60),
-            c_q1 * (-0.0302 + (x44 + x59)),
+        let x67 = -190.97044034 + x66;
+        let x68 = 8596.210051042 + (x63 + (x50 + x57 + x63));
+        let x69 = 8609.573807858 + (x64 + x65);
+        let x70 = -Self::mul_add(
+            c_q1,
+            0.0302 + (x59 - x41),
+            s_q1 * (-1.928 + Self::mul_add(-6.377, x22, x58)),
         );
-        let x72 = 14222.257549666001
+        let x71 = 46.90457611680001
             + (x68
-                - Self::mul_add(
+                + Self::mul_add(
                     s_q1 * c_q1,
-                    x70 + x70,
-                    s_q1 * s_q1 * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                    x67 + x67,
+                    s_q1 * s_q1 * (x62 + (x44 - x57 + x62) - x68),
                 ));
-        let x73 = x51 + (x64 - x65);
-        let x74 = Self::mul_add(-s_q1, x60, c_q1 * x59);
-        let x75 = x43
+        let x72 = -Self::mul_add(c_q1, x59, s_q1 * x58);
+        let x73 = x43
             + Self::mul_add(
-                0.1524,
-                Self::mul_add(s_q2, x38, c_q2 * x37),
-                -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
+                6.377,
+                Self::mul_add(-s_q2, x38, c_q2 * x37),
+                0.1524 * Self::mul_add(s_q2, x37, c_q2 * x38),
             );
-        let x76 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x35, c_q2 * x36),
-            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
+        let x74 = -Self::mul_add(
+            c_q1,
+            Self::mul_add(-c_q2, x36, s_q2 * x35),
+            s_q1 * Self::mul_add(s_q2, x36, c_q2 * x35),
         );
-        let x77 = c_q3 * x21;
-        let x78 = s_q3 * x21;
-        let x79 = x20 * 0.1524;
-        let x80 = Self::mul_add(s_q3, x24, c_q3 * x18) + x79;
-        let x81 = x19 + Self::mul_add(0.1524, x77, -7.06 * x78);
-        let x82 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
-        let x83 = x81
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(c_q2, x78, s_q2 * x77),
-                -0.1524 * Self::mul_add(-c_q2, x77, s_q2 * x78),
+        let x75 = x20 - x19;
+        let x76 = c_q3 * x22;
+        let x77 = s_q3 * x22;
+        let x78 = 0.1524 * x23;
+        let x79 = Self::mul_add(s_q3, x25, c_q3 * x75) + x78;
+        let x80 = Self::mul_add(-7.06, x23, Self::mul_add(-c_q3, x25, s_q3 * x75));
+        let x81 = x18 + Self::mul_add(-7.06, x77, 0.1524 * x76);
+        let x82 = x81
+            - Self::mul_add(
+                6.377,
+                Self::mul_add(c_q2, x77, s_q2 * x76),
+                0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
             );
-        let x84 = Self::mul_add(
-            -s_q1,
-            x79 + Self::mul_add(s_q2, x82, c_q2 * x80),
-            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x80, c_q2 * x82)),
+        let x83 = Self::mul_add(
+            c_q1,
+            Self::mul_add(-6.377, x23, Self::mul_add(c_q2, x80, s_q2 * x79)),
+            s_q1 * (x78 + Self::mul_add(-s_q2, x80, c_q2 * x79)),
         );
+        let x84 = -x83;
         let x85 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x86 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x86 = Self::mul_add(1.903, s_q4, c_q4 * x9);
         let x87 = Self::mul_add(s_q3, x10, c_q3 * x85);
-        let x88 = Self::mul_add(-s_q3, x85, c_q3 * x10);
-        let x89 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x88, c_q2 * x87),
-            c_q1 * Self::mul_add(-s_q2, x87, c_q2 * x88),
+        let x88 = Self::mul_add(-c_q3, x10, s_q3 * x85);
+        let x89 = -Self::mul_add(
+            c_q1,
+            Self::mul_add(c_q2, x88, s_q2 * x87),
+            s_q1 * Self::mul_add(-s_q2, x88, c_q2 * x87),
         );
         [
-            [x72, x71, x74, x76, x84, x89],
-            [x71, x69, x73, x75, x83, x86],
-            [x74, x73, x51, x43, x81, x86],
-            [x76, x75, x43, x29, x19, x86],
-            [x84, x83, x81, x19, x12, x10],
+            [x71, x70, x72, x74, x84, x89],
+            [x70, x69, x65, x73, x82, x86],
+            [x72, x65, x52, x43, x81, x86],
+            [x74, x73, x43, x29, x18, x86],
+            [x84, x82, x81, x18, x11, x10],
             [x89, x86, x86, x86, x10, 1.903],
         ]
     }
@@ -1002,21 +1282,21 @@ impl Srms {
         let x7 = Self::mul_add(
             190.97044034,
             x2,
-            Self::mul_add(8596.210051042, x1, -1.928 * qd[1]),
+            Self::mul_add(qd[1], -1.928, x1 * 8596.210051042),
         );
         let x8 = Self::mul_add(
-            -0.0302,
             x2,
-            Self::mul_add(1.928, x1, 8609.573807858 * qd[1]),
+            -0.0302,
+            Self::mul_add(8609.573807858, qd[1], x1 * 1.928),
         );
-        let x9 = Self::mul_add(-190.97044034000004, x1, -0.0302 * qd[1]);
+        let x9 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x1);
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x11 = Self::mul_add(x2, s_q2, x1 * c_q2);
         let x12 = Self::mul_add(-x1, s_q2, x2 * c_q2);
-        let x13 = Self::mul_add(-0.1524, x6, 6.377 * Self::mul_add(x2, x2, x5));
-        let x14 = Self::mul_add(-6.377, x4 + x4, -0.1524 * (x3 + x3));
-        let x15 = Self::mul_add(-0.1524, Self::mul_add(x1, x1, x5), 6.377 * x6);
-        let x16 = Self::mul_add(-c_q2, x13, s_q2 * x15);
+        let x13 = Self::mul_add(-6.377, Self::mul_add(x2, x2, x5), x6 * 0.1524);
+        let x14 = Self::mul_add(x3 + x3, 0.1524, 6.377 * (x4 + x4));
+        let x15 = Self::mul_add(-6.377, x6, Self::mul_add(x1, x1, x5) * 0.1524);
+        let x16 = Self::mul_add(-s_q2, x15, c_q2 * x13);
         let x17 = Self::mul_add(c_q2, x15, s_q2 * x13);
         let x18 = Self::mul_add(-qd[2], x12, Self::mul_add(-x3, c_q2, x4 * s_q2));
         let x19 = Self::mul_add(qd[2], x11, Self::mul_add(x4, c_q2, x3 * s_q2));
@@ -1030,41 +1310,41 @@ impl Srms {
         let x27 = Self::mul_add(
             103.41030072000001,
             x12,
-            Self::mul_add(5594.523885531201, x11, 0.8021 * x20),
+            Self::mul_add(0.8021, x20, x11 * 5594.523885531201),
         );
         let x28 = Self::mul_add(
             -0.08,
             x12,
             Self::mul_add(-0.8021, x11, 5601.1318504688 * x20),
         );
-        let x29 = Self::mul_add(-103.41030072000002, x11, -0.08 * x20);
+        let x29 = Self::mul_add(0.08, x20, 103.41030072000002 * x11);
         let x30 = Self::mul_add(
-            703.3878000000001,
+            -703.3878000000001,
             x14,
             Self::mul_add(103.41030072000002, x18, -Self::mul_add(x11, x28, x20 * x27)),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x32 = Self::mul_add(x12, s_q3, x11 * c_q3);
         let x33 = Self::mul_add(-x11, s_q3, x12 * c_q3);
-        let x34 = x16 - Self::mul_add(-0.1524, x23, 7.06 * x22);
-        let x35 = x14 + Self::mul_add(-7.06, x24, -0.1524 * x25);
-        let x36 = x17 + Self::mul_add(-0.1524, x26, 7.06 * x23);
-        let x37 = Self::mul_add(-c_q3, x36, s_q3 * x34);
+        let x34 = x16 + Self::mul_add(-7.06, x22, 0.1524 * x23);
+        let x35 = x14 + Self::mul_add(0.1524, x25, 7.06 * x24);
+        let x36 = x17 + Self::mul_add(-7.06, x23, 0.1524 * x26);
+        let x37 = Self::mul_add(c_q3, x36, s_q3 * x34);
         let x38 = Self::mul_add(-qd[3], x33, Self::mul_add(x19, s_q3, x18 * c_q3));
         let x39 = Self::mul_add(-qd[3], x32, Self::mul_add(-x19, c_q3, x18 * s_q3));
         let x40 = qd[3] + x20;
         let x41 = Self::mul_add(x33, x33, x40 * x40);
         let x42 = x32 * x33;
         let x43 = Self::mul_add(-x32, x40, x39);
-        let x44 = -18.957952216000002 * x32;
+        let x44 = x32 * 18.957952216000002;
         let x45 = 19.863252216000003 * x40;
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let x47 = Self::mul_add(-x32, c_q4, x40 * s_q4);
         let x48 = Self::mul_add(x40, c_q4, x32 * s_q4);
         let x49 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x41, Self::mul_add(s_q3, x36, c_q3 * x34)),
-            c_q4 * Self::mul_add(0.4572, x43, x35),
+            Self::mul_add(-0.4572, x41, Self::mul_add(-s_q3, x36, c_q3 * x34)),
+            c_q4 * Self::mul_add(0.4572, x43, -x35),
         );
         let x50 = Self::mul_add(qd[4], x48, x38 * c_q4);
         let x51 = Self::mul_add(qd[4], x47, x38 * s_q4);
@@ -1083,8 +1363,8 @@ impl Srms {
         let x64 = Self::mul_add(0.966, x60, Self::mul_add(0.385, x59, 1.903 * x63));
         let x65 = Self::mul_add(0.353, x60, 0.385 * x63);
         let x66 = Self::mul_add(
-            -0.9929999999999999,
             x60,
+            -0.9929999999999999,
             Self::mul_add(0.353, x59, 0.966 * x63),
         );
         let x67 = Self::mul_add(0.966, x62, Self::mul_add(0.385, x61, 1.903 * x50))
@@ -1092,16 +1372,17 @@ impl Srms {
         let x68 = Self::mul_add(0.353, x62, 0.385 * x50)
             + Self::mul_add(-x63, x66, x60 * x64);
         let x69 = Self::mul_add(
-            -0.9929999999999999,
             x62,
+            -0.9929999999999999,
             Self::mul_add(0.353, x61, 0.966 * x50),
         ) + Self::mul_add(-x59, x64, x63 * x65);
         let x70 = Self::mul_add(-x52, x56, x48 * x57) + x67;
-        let x71 = Self::mul_add(
-            Self::mul_add(-0.4572, x42, x37),
-            -34.45002,
-            -Self::mul_add(x47, x57, 34.33891524 * x51),
-        ) + Self::mul_add(-s_q5, x69, c_q5 * x68);
+        let x71 = Self::mul_add(-s_q5, x69, c_q5 * x68)
+            - Self::mul_add(
+                34.45002,
+                Self::mul_add(-0.4572, x42, x37),
+                Self::mul_add(x47, x57, 34.33891524 * x51),
+            );
         let x72 = Self::mul_add(
             34.45002,
             x49,
@@ -1111,41 +1392,40 @@ impl Srms {
         let x74 = Self::mul_add(41.67378, x41, Self::mul_add(s_q4, x54, c_q4 * x53));
         let x75 = Self::mul_add(41.67378, x43, x73);
         let x76 = Self::mul_add(-41.67378, x42, x55);
-        let x77 = Self::mul_add(-x33, x45, -18.957952216000002 * x38)
-            + Self::mul_add(-s_q4, x71, c_q4 * x70);
-        let x78 = Self::mul_add(-x33, x44, x37 * -41.67378)
-            + Self::mul_add(x55, -0.4572, Self::mul_add(c_q4, x71, s_q4 * x70));
-        let x79 = Self::mul_add(41.67378, x35, Self::mul_add(-x32, x45, x40 * x44))
-            + Self::mul_add(0.4572, x73, x72);
+        let x77 = Self::mul_add(-s_q4, x71, c_q4 * x70)
+            - Self::mul_add(x33, x45, x38 * 18.957952216000002);
+        let x78 = Self::mul_add(-41.67378, x37, x33 * x44)
+            + Self::mul_add(-0.4572, x55, Self::mul_add(c_q4, x71, s_q4 * x70));
+        let x79 = Self::mul_add(0.4572, x73, x72)
+            - Self::mul_add(41.67378, x35, Self::mul_add(x32, x45, x40 * x44));
         let x80 = Self::mul_add(-c_q3, x74, s_q3 * x76);
         let x81 = Self::mul_add(c_q3, x76, s_q3 * x74);
-        let x82 = x80 - Self::mul_add(-15.183612000000002, x23, 703.3878000000001 * x22);
-        let x83 = Self::mul_add(-703.3878000000001, x24, -15.183612000000002 * x25)
-            + x75;
-        let x84 = x81 - Self::mul_add(-15.183612000000002, x26, 703.3878000000001 * x23);
-        let x85 = Self::mul_add(
-            x14,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x19, -5594.523885531201 * x18)
-                + Self::mul_add(-x12, x28, x20 * x29),
-        ) + Self::mul_add(x75, 0.1524, Self::mul_add(s_q3, x79, c_q3 * x77));
+        let x82 = Self::mul_add(-703.3878000000001, x22, x23 * 15.183612000000002) + x80;
+        let x83 = x75 - Self::mul_add(15.183612000000002, x25, 703.3878000000001 * x24);
+        let x84 = Self::mul_add(-703.3878000000001, x23, 15.183612000000002 * x26) + x81;
+        let x85 = Self::mul_add(0.1524, x75, Self::mul_add(s_q3, x79, c_q3 * x77))
+            - Self::mul_add(
+                x14,
+                15.183612000000002,
+                Self::mul_add(103.41030072000001, x19, x18 * 5594.523885531201)
+                    + Self::mul_add(x20, x29, x12 * x28),
+            );
         let x86 = Self::mul_add(0.08, x19, 0.8021 * x18)
-            + Self::mul_add(x11, x29, x12 * x27)
-            + Self::mul_add(x17, 703.3878000000001, -15.183612000000002 * x16)
-            + (x78 + Self::mul_add(x81, -7.06, -0.1524 * x80));
+            + Self::mul_add(-x11, x29, x12 * x27)
+            - Self::mul_add(703.3878000000001, x17, x16 * 15.183612000000002)
+            + (x78 - Self::mul_add(7.06, x81, 0.1524 * x80));
         let x87 = x30 + Self::mul_add(7.06, x75, Self::mul_add(-s_q3, x77, c_q3 * x79));
-        let x88 = Self::mul_add(x1, x9, x2 * x7)
-            - Self::mul_add(-0.0302, x4, -1.928 * x3)
+        let x88 = Self::mul_add(x4, 0.0302, x3 * 1.928) + Self::mul_add(-x1, x9, x2 * x7)
             + (x86
-                + Self::mul_add(
+                - Self::mul_add(
+                    6.377,
                     Self::mul_add(-s_q2, x82, c_q2 * x84),
-                    -6.377,
-                    -0.1524 * Self::mul_add(s_q2, x84, c_q2 * x82),
+                    0.1524 * Self::mul_add(s_q2, x84, c_q2 * x82),
                 ));
         let x89 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x2, x8, qd[1] * x9)
-                - Self::mul_add(190.97044034, x4, -8596.210051042 * x3)
+            Self::mul_add(-190.97044034, x4, x3 * 8596.210051042)
+                - Self::mul_add(qd[1], x9, x2 * x8)
                 + Self::mul_add(0.1524, x83, Self::mul_add(s_q2, x87, c_q2 * x85)),
             c_q1
                 * (Self::mul_add(6.377, x83, Self::mul_add(-s_q2, x85, c_q2 * x87))
@@ -1174,30 +1454,22 @@ impl Srms {
         let x9 = Self::mul_add(
             190.97044034,
             x2,
-            Self::mul_add(8596.210051042, x1, -1.928 * qd[1]),
+            Self::mul_add(qd[1], -1.928, x1 * 8596.210051042),
         );
         let x10 = Self::mul_add(
-            -0.0302,
             x2,
-            Self::mul_add(1.928, x1, 8609.573807858 * qd[1]),
+            -0.0302,
+            Self::mul_add(8609.573807858, qd[1], x1 * 1.928),
         );
-        let x11 = Self::mul_add(-190.97044034000004, x1, -0.0302 * qd[1]);
+        let x11 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x1);
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x13 = Self::mul_add(x2, s_q2, x1 * c_q2);
         let x14 = Self::mul_add(-x1, s_q2, x2 * c_q2);
-        let x15 = Self::mul_add(
-            -6.377,
-            Self::mul_add(x2, x2, x7),
-            -0.1524 * (qdd[1] - x8),
-        );
-        let x16 = Self::mul_add(-0.1524, x3 + x5, 6.377 * (x6 - x4));
-        let x17 = Self::mul_add(
-            -0.1524,
-            Self::mul_add(x1, x1, x7),
-            6.377 * (qdd[1] + x8),
-        );
+        let x15 = Self::mul_add(qdd[1] - x8, 0.1524, 6.377 * Self::mul_add(x2, x2, x7));
+        let x16 = Self::mul_add(x3 + x5, -0.1524, 6.377 * (x6 - x4));
+        let x17 = Self::mul_add(-6.377, qdd[1] + x8, Self::mul_add(x1, x1, x7) * 0.1524);
         let x18 = Self::mul_add(s_q2, x17, c_q2 * x15);
-        let x19 = Self::mul_add(-c_q2, x17, s_q2 * x15);
+        let x19 = Self::mul_add(-s_q2, x15, c_q2 * x17);
         let x20 = Self::mul_add(qd[2], x14, Self::mul_add(x6, s_q2, x5 * c_q2));
         let x21 = Self::mul_add(-qd[2], x13, Self::mul_add(-x5, s_q2, x6 * c_q2));
         let x22 = qdd[1] + qdd[2];
@@ -1213,30 +1485,30 @@ impl Srms {
         let x32 = Self::mul_add(
             103.41030072000001,
             x14,
-            Self::mul_add(5594.523885531201, x13, 0.8021 * x23),
+            Self::mul_add(0.8021, x23, x13 * 5594.523885531201),
         );
         let x33 = Self::mul_add(
             -0.08,
             x14,
             Self::mul_add(-0.8021, x13, 5601.1318504688 * x23),
         );
-        let x34 = Self::mul_add(-103.41030072000002, x13, -0.08 * x23);
+        let x34 = Self::mul_add(0.08, x23, 103.41030072000002 * x13);
         let x35 = Self::mul_add(
             x16,
             15.183612000000002,
             Self::mul_add(
                 103.41030072000001,
                 x21,
-                Self::mul_add(5594.523885531201, x20, 0.8021 * x22),
-            ) + Self::mul_add(-x14, x33, x23 * x34),
+                Self::mul_add(0.8021, x22, x20 * 5594.523885531201),
+            ) - Self::mul_add(x23, x34, x14 * x33),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x37 = Self::mul_add(x14, s_q3, x13 * c_q3);
         let x38 = Self::mul_add(-x13, s_q3, x14 * c_q3);
-        let x39 = x18 + Self::mul_add(-7.06, x25, -0.1524 * x27);
+        let x39 = x18 + Self::mul_add(0.1524, x27, 7.06 * x25);
         let x40 = x16 + Self::mul_add(-0.1524, x29, 7.06 * x28);
-        let x41 = x19 - Self::mul_add(-0.1524, x31, 7.06 * x30);
-        let x42 = Self::mul_add(c_q3, x41, s_q3 * x39);
+        let x41 = x19 + Self::mul_add(-7.06, x30, 0.1524 * x31);
+        let x42 = Self::mul_add(-s_q3, x39, c_q3 * x41);
         let x43 = Self::mul_add(qd[3], x38, Self::mul_add(x21, s_q3, x20 * c_q3));
         let x44 = Self::mul_add(-qd[3], x37, Self::mul_add(-x20, s_q3, x21 * c_q3));
         let x45 = qdd[3] + x22;
@@ -1244,15 +1516,15 @@ impl Srms {
         let x47 = Self::mul_add(x38, x38, x46 * x46);
         let x48 = Self::mul_add(-x37, x46, x44);
         let x49 = Self::mul_add(x37, x38, x45);
-        let x50 = -18.957952216000002 * x37;
+        let x50 = x37 * 18.957952216000002;
         let x51 = 19.863252216000003 * x46;
         let (s_q4, c_q4) = libm::sincos(q[4]);
         let x53 = Self::mul_add(-x37, c_q4, x46 * s_q4);
         let x54 = Self::mul_add(x46, c_q4, x37 * s_q4);
         let x55 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(-0.4572, x47, Self::mul_add(-s_q3, x41, c_q3 * x39)),
-            c_q4 * Self::mul_add(0.4572, x48, x40),
+            c_q4,
+            Self::mul_add(0.4572, x48, x40),
+            s_q4 * Self::mul_add(0.4572, x47, Self::mul_add(s_q3, x41, c_q3 * x39)),
         );
         let x56 = Self::mul_add(-qd[4], x53, Self::mul_add(x45, c_q4, x43 * s_q4));
         let x57 = qdd[4] + x44;
@@ -1273,8 +1545,8 @@ impl Srms {
         let x71 = Self::mul_add(0.966, x66, Self::mul_add(0.385, x65, 1.903 * x70));
         let x72 = Self::mul_add(0.353, x66, 0.385 * x70);
         let x73 = Self::mul_add(
-            -0.9929999999999999,
             x66,
+            -0.9929999999999999,
             Self::mul_add(0.353, x65, 0.966 * x70),
         );
         let x74 = Self::mul_add(0.966, x68, Self::mul_add(0.385, x67, 1.903 * x69))
@@ -1282,14 +1554,14 @@ impl Srms {
         let x75 = Self::mul_add(0.353, x68, 0.385 * x69)
             + Self::mul_add(-x70, x73, x66 * x71);
         let x76 = Self::mul_add(
-            -0.9929999999999999,
             x68,
+            -0.9929999999999999,
             Self::mul_add(0.353, x67, 0.966 * x69),
         ) + Self::mul_add(-x65, x71, x70 * x72);
         let x77 = Self::mul_add(-x58, x62, x54 * x63) + x74;
         let x78 = Self::mul_add(
-            Self::mul_add(-0.4572, x49, x42),
             -34.45002,
+            Self::mul_add(-0.4572, x49, x42),
             Self::mul_add(-x53, x63, 34.33891524 * x56),
         ) + Self::mul_add(-s_q5, x76, c_q5 * x75);
         let x79 = Self::mul_add(
@@ -1301,65 +1573,64 @@ impl Srms {
         let x81 = Self::mul_add(41.67378, x47, Self::mul_add(s_q4, x60, c_q4 * x59));
         let x82 = Self::mul_add(41.67378, x48, x80);
         let x83 = Self::mul_add(-41.67378, x49, x61);
-        let x84 = Self::mul_add(-s_q4, x78, c_q4 * x77)
-            - Self::mul_add(x38, x51, -18.957952216000002 * x43);
+        let x84 = Self::mul_add(-x38, x51, x43 * 18.957952216000002)
+            + Self::mul_add(-s_q4, x78, c_q4 * x77);
         let x85 = Self::mul_add(
-            x42,
             -41.67378,
-            Self::mul_add(-x38, x50, 19.863252216000003 * x45),
-        ) + Self::mul_add(x61, -0.4572, Self::mul_add(c_q4, x78, s_q4 * x77));
-        let x86 = Self::mul_add(41.67378, x40, Self::mul_add(-x37, x51, x46 * x50))
+            x42,
+            Self::mul_add(x38, x50, 19.863252216000003 * x45),
+        ) + Self::mul_add(-0.4572, x61, Self::mul_add(c_q4, x78, s_q4 * x77));
+        let x86 = Self::mul_add(41.67378, x40, -Self::mul_add(x37, x51, x46 * x50))
             + Self::mul_add(0.4572, x80, x79);
         let x87 = Self::mul_add(-c_q3, x81, s_q3 * x83);
         let x88 = Self::mul_add(c_q3, x83, s_q3 * x81);
-        let x89 = Self::mul_add(-703.3878000000001, x25, -15.183612000000002 * x27)
-            + x87;
+        let x89 = x87 - Self::mul_add(x27, 15.183612000000002, 703.3878000000001 * x25);
         let x90 = Self::mul_add(-15.183612000000002, x29, 703.3878000000001 * x28) + x82;
-        let x91 = x88 - Self::mul_add(-15.183612000000002, x31, 703.3878000000001 * x30);
-        let x92 = x35 + Self::mul_add(x82, 0.1524, Self::mul_add(s_q3, x86, c_q3 * x84));
+        let x91 = Self::mul_add(-703.3878000000001, x30, 15.183612000000002 * x31) + x88;
+        let x92 = x35 + Self::mul_add(0.1524, x82, Self::mul_add(s_q3, x86, c_q3 * x84));
         let x93 = Self::mul_add(
             -0.08,
             x21,
             Self::mul_add(-0.8021, x20, 5601.1318504688 * x22),
-        ) + Self::mul_add(x13, x34, x14 * x32)
-            + Self::mul_add(x19, -703.3878000000001, -15.183612000000002 * x18)
-            + (x85 + Self::mul_add(x88, -7.06, -0.1524 * x87));
+        ) + Self::mul_add(-x13, x34, x14 * x32)
+            + Self::mul_add(-703.3878000000001, x19, x18 * 15.183612000000002)
+            + (x85 - Self::mul_add(7.06, x88, 0.1524 * x87));
         let x94 = Self::mul_add(
             703.3878000000001,
             x16,
-            Self::mul_add(-103.41030072000002, x20, -0.08 * x22)
-                - Self::mul_add(x13, x33, x23 * x32),
+            -(Self::mul_add(0.08, x22, 103.41030072000002 * x20)
+                + Self::mul_add(x13, x33, x23 * x32)),
         ) + Self::mul_add(7.06, x82, Self::mul_add(-s_q3, x84, c_q3 * x86));
         let x95 = Self::mul_add(
-            -0.0302,
             x6,
-            Self::mul_add(1.928, x5, 8609.573807858 * qdd[1]),
-        ) + Self::mul_add(x1, x11, x2 * x9)
+            -0.0302,
+            Self::mul_add(8609.573807858, qdd[1], x5 * 1.928),
+        ) + Self::mul_add(-x1, x11, x2 * x9)
             + (x93
-                + Self::mul_add(
+                - Self::mul_add(
+                    6.377,
                     Self::mul_add(-s_q2, x89, c_q2 * x91),
-                    -6.377,
-                    -0.1524 * Self::mul_add(s_q2, x91, c_q2 * x89),
+                    0.1524 * Self::mul_add(s_q2, x91, c_q2 * x89),
                 ));
         let x96 = Self::mul_add(
             -s_q1,
             Self::mul_add(
                 190.97044034,
                 x6,
-                Self::mul_add(8596.210051042, x5, -1.928 * qdd[1]),
-            ) + Self::mul_add(-x2, x10, qd[1] * x11)
+                Self::mul_add(qdd[1], -1.928, x5 * 8596.210051042),
+            ) - Self::mul_add(qd[1], x11, x2 * x10)
                 + Self::mul_add(0.1524, x90, Self::mul_add(s_q2, x94, c_q2 * x92)),
             c_q1
-                * (Self::mul_add(-190.97044034000004, x5, -0.0302 * qdd[1])
-                    - Self::mul_add(x1, x10, qd[1] * x9)
-                    + Self::mul_add(6.377, x90, Self::mul_add(-s_q2, x92, c_q2 * x94))),
+                * (Self::mul_add(6.377, x90, Self::mul_add(-s_q2, x92, c_q2 * x94))
+                    - (Self::mul_add(qdd[1], 0.0302, 190.97044034000004 * x5)
+                        + Self::mul_add(x1, x10, qd[1] * x9))),
         );
         let x97 = Self::mul_add(14222.257549666001, qdd[0], x96);
         [x97, x95, x93, x85, x79, x74]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 429 mul, 347 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 424 mul, 343 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 239 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1373,103 +1644,103 @@ impl Srms {
         let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
         let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.33891524 - x7;
-        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
-        let x13 = s_q4 * s_q4;
-        let x14 = s_q4 * c_q4;
-        let x15 = 1.903 - x11;
-        let x16 = x9 + x9;
-        let x17 = Self::mul_add(x14, x16, x13 * x15);
-        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
-        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
-        let x20 = 34.45002 * c_q4;
-        let x21 = 34.45002 * s_q4;
-        let x22 = x20 * -0.4572;
-        let x23 = 0.4572 * x20;
-        let x24 = x12 + x23;
-        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
-        let x26 = x24 - x22;
-        let x27 = 41.67378 + x20;
-        let x28 = -18.957952216000002 + (1.903 - x17);
-        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x11 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x12 = s_q4 * s_q4;
+        let x13 = s_q4 * c_q4;
+        let x14 = x7 + -32.43591524;
+        let x15 = x9 + x9;
+        let x16 = Self::mul_add(x13, x15, x12 * x14);
+        let x17 = -32.43591524 - x16;
+        let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
+        let x19 = s_q4 * x8;
+        let x20 = c_q4 * x10;
+        let x21 = x19 - x20;
+        let x22 = s_q4 * 34.45002;
+        let x23 = c_q4 * 34.45002;
+        let x24 = 0.4572 * x23;
+        let x25 = x11 + x24;
+        let x26 = Self::mul_add(0.4572, x22, Self::mul_add(-x13, x14, x12 * x15) - x9);
+        let x27 = 41.67378 + x23;
+        let x28 = -15.380963024 + (x24 + x25);
+        let x29 = 54.202167456 + (x24 + (x16 - x7 + x24));
         let x30 = s_q3 * s_q3;
         let x31 = s_q3 * c_q3;
-        let x32 = x26 - x28;
-        let x33 = x18 + x18;
+        let x32 = x17 - x28;
+        let x33 = x21 + x21;
         let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
-        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
-        let x37 = s_q3 * x27;
-        let x38 = c_q3 * x27;
-        let x39 = x37 * 0.1524;
-        let x40 = -0.1524 * x37;
-        let x41 = x38 * -7.06;
-        let x42 = 7.06 * x38;
-        let x43 = x29 - (x40 + x41);
-        let x44 = x21 * 0.1524;
+        let x35 = Self::mul_add(-c_q3, x26, s_q3 * x18);
+        let x36 = Self::mul_add(c_q3, x18, s_q3 * x26);
+        let x37 = c_q3 * x27;
+        let x38 = s_q3 * x27;
+        let x39 = 0.1524 * x38;
+        let x40 = 7.06 * x37;
+        let x41 = 0.1524 * x22;
+        let x42 = x39 + x40;
+        let x43 = x29 + x42;
+        let x44 = x39 + (x17 - x34 + x39);
         let x45 = Self::mul_add(
-            0.1524,
+            -7.06,
             x38,
-            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
+            Self::mul_add(-0.1524, x37, x21 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x46 = x26 - x34 + x42 - x41;
-        let x47 = 703.3878000000001 + x38;
-        let x48 = -15.183612000000002 - x37;
-        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
-        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
-        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
-        let x52 = 103.41030072000002 + x45;
-        let x53 = -0.08 + (x35 + x44);
-        let x54 = s_q2 * s_q2;
-        let x55 = s_q2 * c_q2;
-        let x56 = x46 - x49;
-        let x57 = x52 + x52;
-        let x58 = Self::mul_add(x55, x57, x54 * x56);
-        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
-        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
-        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
-        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
-        let x63 = 0.1524 * x61;
-        let x64 = -0.1524 * x61;
-        let x65 = x62 * -6.377;
-        let x66 = 6.377 * x62;
-        let x67 = Self::mul_add(
-            0.1524,
-            x62,
-            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
+        let x46 = 703.3878000000001 + x37;
+        let x47 = 15.183612000000002 + x38;
+        let x48 = -103.41030072000001 + x45;
+        let x49 = 0.8021 + Self::mul_add(-7.06, x22, x35);
+        let x50 = 5594.523885531201 + (x40 + (x28 + x34 + x40));
+        let x51 = 0.08 - (x36 + x41);
+        let x52 = 5601.1318504688 + (x42 + x43);
+        let x53 = s_q2 * s_q2;
+        let x54 = s_q2 * c_q2;
+        let x55 = x44 - x50;
+        let x56 = x48 + x48;
+        let x57 = Self::mul_add(x54, x56, x53 * x55);
+        let x58 = Self::mul_add(-s_q2, x51, c_q2 * x49);
+        let x59 = Self::mul_add(c_q2, x51, s_q2 * x49);
+        let x60 = Self::mul_add(-s_q2, x47, c_q2 * x46);
+        let x61 = Self::mul_add(c_q2, x47, s_q2 * x46);
+        let x62 = 0.1524 * x61;
+        let x63 = 6.377 * x60;
+        let x64 = x62 + x63;
+        let x65 = x52 + x64;
+        let x66 = Self::mul_add(
+            -6.377,
+            x61,
+            Self::mul_add(-0.1524, x60, x48 + Self::mul_add(-x53, x56, x54 * x55)),
         );
-        let x68 = x46 - x58 + x66 - x65;
-        let x69 = 190.97044034000004 + x67;
-        let x70 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x21, x60),
-            c_q1 * (-0.0302 + (x44 + x59)),
+        let x67 = -190.97044034 + x66;
+        let x68 = 8596.210051042 + (x63 + (x50 + x57 + x63));
+        let x69 = Self::mul_add(
+            c_q1,
+            0.0302 + (x59 - x41),
+            s_q1 * (-1.928 + Self::mul_add(-6.377, x22, x58)),
         );
-        let x71 = Self::mul_add(-s_q1, x60, c_q1 * x59);
-        let x72 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x35, c_q2 * x36),
-            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
+        let x70 = Self::mul_add(c_q1, x59, s_q1 * x58);
+        let x71 = Self::mul_add(
+            c_q1,
+            Self::mul_add(-c_q2, x36, s_q2 * x35),
+            s_q1 * Self::mul_add(s_q2, x36, c_q2 * x35),
         );
-        let x73 = c_q3 * x21;
-        let x74 = s_q3 * x21;
-        let x75 = x20 * 0.1524;
-        let x76 = Self::mul_add(s_q3, x24, c_q3 * x18) + x75;
-        let x77 = x19 + Self::mul_add(0.1524, x73, -7.06 * x74);
-        let x78 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
+        let x72 = x20 - x19;
+        let x73 = c_q3 * x22;
+        let x74 = s_q3 * x22;
+        let x75 = 0.1524 * x23;
+        let x76 = Self::mul_add(s_q3, x25, c_q3 * x72) + x75;
+        let x77 = Self::mul_add(-7.06, x23, Self::mul_add(-c_q3, x25, s_q3 * x72));
+        let x78 = x18 + Self::mul_add(-7.06, x74, 0.1524 * x73);
         let x79 = Self::mul_add(
-            -s_q1,
-            x75 + Self::mul_add(s_q2, x78, c_q2 * x76),
-            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x76, c_q2 * x78)),
+            c_q1,
+            Self::mul_add(-6.377, x23, Self::mul_add(c_q2, x77, s_q2 * x76)),
+            s_q1 * (x75 + Self::mul_add(-s_q2, x77, c_q2 * x76)),
         );
         let x80 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x81 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x81 = Self::mul_add(1.903, s_q4, c_q4 * x9);
         let x82 = Self::mul_add(s_q3, x10, c_q3 * x80);
-        let x83 = Self::mul_add(-s_q3, x80, c_q3 * x10);
+        let x83 = Self::mul_add(-c_q3, x10, s_q3 * x80);
         let x84 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x83, c_q2 * x82),
-            c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x83),
+            c_q1,
+            Self::mul_add(c_q2, x83, s_q2 * x82),
+            s_q1 * Self::mul_add(-s_q2, x83, c_q2 * x82),
         );
         let x85 = qd[0] * s_q1;
         let x86 = qd[0] * c_q1;
@@ -1477,233 +1748,235 @@ impl Srms {
         let x88 = qd[1] * x85;
         let x89 = qd[1] * qd[1];
         let x90 = x85 * x86;
-        let x91 = Self::mul_add(
-            190.97044034,
-            x86,
-            Self::mul_add(8596.210051042, x85, -1.928 * qd[1]),
-        );
+        let x91 = Self::mul_add(qd[1], -1.928, x86 * 190.97044034);
         let x92 = Self::mul_add(
-            -0.0302,
-            x86,
-            Self::mul_add(1.928, x85, 8609.573807858 * qd[1]),
+            0.0302,
+            qd[1],
+            Self::mul_add(-8596.210051042, x86, x85 * 190.97044034000004),
         );
-        let x93 = Self::mul_add(-190.97044034000004, x85, -0.0302 * qd[1]);
+        let x93 = Self::mul_add(
+            8609.573807858,
+            qd[1],
+            Self::mul_add(-0.0302, x86, x85 * 1.928),
+        );
         let x94 = Self::mul_add(s_q2, x86, c_q2 * x85);
-        let x95 = Self::mul_add(-s_q2, x85, c_q2 * x86);
-        let x96 = Self::mul_add(-0.1524, x90, 6.377 * Self::mul_add(x86, x86, x89));
-        let x97 = Self::mul_add(-6.377, x88 + x88, -0.1524 * (x87 + x87));
-        let x98 = Self::mul_add(-0.1524, Self::mul_add(x85, x85, x89), 6.377 * x90);
-        let x99 = Self::mul_add(-c_q2, x96, s_q2 * x98);
-        let x100 = Self::mul_add(c_q2, x98, s_q2 * x96);
-        let x101 = Self::mul_add(-qd[2], x95, Self::mul_add(-c_q2, x87, s_q2 * x88));
+        let x95 = Self::mul_add(-c_q2, x86, s_q2 * x85);
+        let x96 = Self::mul_add(-6.377, Self::mul_add(x86, x86, x89), 0.1524 * x90);
+        let x97 = Self::mul_add(-0.1524, Self::mul_add(x85, x85, x89), 6.377 * x90);
+        let x98 = Self::mul_add(0.1524, x87 + x87, 6.377 * (x88 + x88));
+        let x99 = Self::mul_add(s_q2, x97, c_q2 * x96);
+        let x100 = Self::mul_add(-s_q2, x96, c_q2 * x97);
+        let x101 = Self::mul_add(qd[2], x95, Self::mul_add(-c_q2, x87, s_q2 * x88));
         let x102 = Self::mul_add(qd[2], x94, Self::mul_add(c_q2, x88, s_q2 * x87));
         let x103 = qd[1] + qd[2];
         let x104 = x103 * x103;
         let x105 = Self::mul_add(x95, x95, x104);
         let x106 = x94 * x95;
-        let x107 = Self::mul_add(x94, x103, x102);
-        let x108 = Self::mul_add(x95, x103, -x101);
-        let x109 = Self::mul_add(x94, x94, x104);
-        let x110 = Self::mul_add(
-            103.41030072000001,
-            x95,
-            Self::mul_add(5594.523885531201, x94, 0.8021 * x103),
-        );
+        let x107 = Self::mul_add(x94, x94, x104);
+        let x108 = Self::mul_add(x94, x103, x102);
+        let x109 = Self::mul_add(x95, x103, x101);
+        let x110 = Self::mul_add(x95, -103.41030072000001, 0.8021 * x103);
         let x111 = Self::mul_add(
-            -0.08,
-            x95,
-            Self::mul_add(-0.8021, x94, 5601.1318504688 * x103),
+            0.08,
+            x103,
+            Self::mul_add(5594.523885531201, x95, x94 * 103.41030072000002),
         );
-        let x112 = Self::mul_add(-103.41030072000002, x94, -0.08 * x103);
+        let x112 = Self::mul_add(
+            5601.1318504688,
+            x103,
+            Self::mul_add(-0.8021, x94, 0.08 * x95),
+        );
         let x113 = Self::mul_add(
-            703.3878000000001,
-            x97,
+            -15.183612000000002,
+            x98,
             Self::mul_add(
-                103.41030072000002,
-                x101,
-                -Self::mul_add(x94, x111, x103 * x110),
+                x102,
+                -103.41030072000001,
+                Self::mul_add(-x103, x111, x95 * x112),
             ),
         );
-        let x114 = Self::mul_add(s_q3, x95, c_q3 * x94);
-        let x115 = Self::mul_add(-s_q3, x94, c_q3 * x95);
-        let x116 = x99 - Self::mul_add(-0.1524, x106, 7.06 * x105);
-        let x117 = x97 + Self::mul_add(-7.06, x107, -0.1524 * x108);
-        let x118 = x100 + Self::mul_add(-0.1524, x109, 7.06 * x106);
-        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
-        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x102, c_q3 * x101));
-        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x102, s_q3 * x101));
+        let x114 = Self::mul_add(-c_q3, x94, s_q3 * x95);
+        let x115 = Self::mul_add(c_q3, x95, s_q3 * x94);
+        let x116 = x99 - Self::mul_add(0.1524, x106, 7.06 * x105);
+        let x117 = x100 - Self::mul_add(0.1524, x107, 7.06 * x106);
+        let x118 = Self::mul_add(-7.06, x108, 0.1524 * x109) - x98;
+        let x119 = Self::mul_add(-s_q3, x116, c_q3 * x117);
+        let x120 = Self::mul_add(qd[3], x115, Self::mul_add(s_q3, x102, c_q3 * x101));
+        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-s_q3, x101, c_q3 * x102));
         let x122 = qd[3] + x103;
-        let x123 = Self::mul_add(x115, x115, x122 * x122);
+        let x123 = Self::mul_add(x122, x122, x115 * x115);
         let x124 = x114 * x115;
-        let x125 = Self::mul_add(-x114, x122, x121);
-        let x126 = -18.957952216000002 * x114;
-        let x127 = 19.863252216000003 * x122;
-        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
-        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
+        let x125 = Self::mul_add(x114, x122, -x121);
+        let x126 = x115 * 15.380963024;
+        let x127 = 54.202167456 * x122;
+        let x128 = Self::mul_add(-s_q4, x114, c_q4 * x122);
+        let x129 = Self::mul_add(s_q4, x122, c_q4 * x114);
         let x130 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
-            c_q4 * Self::mul_add(0.4572, x125, x117),
+            Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x117, c_q3 * x116)),
+            c_q4 * Self::mul_add(0.4572, x125, x118),
         );
-        let x131 = Self::mul_add(qd[4], x129, c_q4 * x120);
-        let x132 = Self::mul_add(qd[4], x128, s_q4 * x120);
-        let x133 = qd[4] + x115;
-        let x134 = 34.45002 * Self::mul_add(x133, x133, x129 * x129);
-        let x135 = 34.45002 * Self::mul_add(x128, x129, x121);
-        let x136 = 34.45002 * Self::mul_add(x128, x133, x132);
-        let x137 = 34.33891524 * x129;
+        let x131 = Self::mul_add(qd[4], x129, s_q4 * x120);
+        let x132 = Self::mul_add(qd[4], x128, c_q4 * x120);
+        let x133 = qd[4] - x115;
+        let x134 = 34.45002 * Self::mul_add(-x128, x129, x121);
+        let x135 = 34.45002 * Self::mul_add(x128, x128, x133 * x133);
+        let x136 = 34.45002 * Self::mul_add(x129, x133, x131);
+        let x137 = x129 * 34.33891524;
         let x138 = 34.74691524 * x133;
-        let x139 = Self::mul_add(s_q5, x133, c_q5 * x129);
-        let x140 = Self::mul_add(-s_q5, x129, c_q5 * x133);
-        let x141 = Self::mul_add(qd[5], x140, Self::mul_add(-c_q5, x132, s_q5 * x121));
-        let x142 = Self::mul_add(-qd[5], x139, Self::mul_add(c_q5, x121, s_q5 * x132));
-        let x143 = qd[5] + x128;
-        let x144 = Self::mul_add(0.966, x140, Self::mul_add(0.385, x139, 1.903 * x143));
-        let x145 = Self::mul_add(0.353, x140, 0.385 * x143);
-        let x146 = Self::mul_add(
-            -0.9929999999999999,
-            x140,
-            Self::mul_add(0.353, x139, 0.966 * x143),
+        let x139 = Self::mul_add(s_q5, x133, c_q5 * x128);
+        let x140 = Self::mul_add(-s_q5, x128, c_q5 * x133);
+        let x141 = Self::mul_add(qd[5], x140, -Self::mul_add(s_q5, x121, c_q5 * x131));
+        let x142 = Self::mul_add(-qd[5], x139, Self::mul_add(-c_q5, x121, s_q5 * x131));
+        let x143 = qd[5] + x129;
+        let x144 = Self::mul_add(0.385, x143, 0.353 * x140);
+        let x145 = Self::mul_add(
+            0.966,
+            x143,
+            Self::mul_add(-0.9929999999999999, x140, 0.353 * x139),
         );
-        let x147 = Self::mul_add(0.966, x142, Self::mul_add(0.385, x141, 1.903 * x131))
-            + Self::mul_add(-x140, x145, x139 * x146);
-        let x148 = Self::mul_add(0.353, x142, 0.385 * x131)
-            + Self::mul_add(-x143, x146, x140 * x144);
-        let x149 = Self::mul_add(
-            -0.9929999999999999,
-            x142,
-            Self::mul_add(0.353, x141, 0.966 * x131),
-        ) + Self::mul_add(-x139, x144, x143 * x145);
-        let x150 = Self::mul_add(-x133, x137, x129 * x138) + x147;
-        let x151 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x124, x119),
-            -Self::mul_add(x128, x138, 34.33891524 * x132),
-        ) + Self::mul_add(-s_q5, x149, c_q5 * x148);
+        let x146 = Self::mul_add(1.903, x143, Self::mul_add(0.966, x140, 0.385 * x139));
+        let x147 = Self::mul_add(0.385, x132, 0.353 * x142)
+            + Self::mul_add(-x143, x145, x140 * x146);
+        let x148 = Self::mul_add(
+            0.966,
+            x132,
+            Self::mul_add(-0.9929999999999999, x142, 0.353 * x141),
+        ) + Self::mul_add(-x139, x146, x143 * x144);
+        let x149 = Self::mul_add(1.903, x132, Self::mul_add(0.966, x142, 0.385 * x141))
+            + Self::mul_add(-x140, x144, x139 * x145);
+        let x150 = Self::mul_add(
+            34.45002,
+            Self::mul_add(0.4572, x124, x119),
+            -Self::mul_add(x129, x138, x133 * x137),
+        ) + Self::mul_add(-s_q5, x148, c_q5 * x147);
+        let x151 = Self::mul_add(-x128, x138, x132 * 34.33891524) - x149;
         let x152 = Self::mul_add(
             34.45002,
             x130,
-            Self::mul_add(x128, x137, 34.74691524 * x121),
-        ) + Self::mul_add(c_q5, x149, s_q5 * x148);
-        let x153 = Self::mul_add(-s_q4, x134, c_q4 * x135);
-        let x154 = Self::mul_add(41.67378, x123, Self::mul_add(s_q4, x135, c_q4 * x134));
-        let x155 = Self::mul_add(41.67378, x125, x153);
-        let x156 = Self::mul_add(-41.67378, x124, x136);
-        let x157 = Self::mul_add(-x115, x127, -18.957952216000002 * x120)
-            + Self::mul_add(-s_q4, x151, c_q4 * x150);
-        let x158 = Self::mul_add(-x115, x126, x119 * -41.67378)
-            + Self::mul_add(-0.4572, x136, Self::mul_add(c_q4, x151, s_q4 * x150));
-        let x159 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
-            + Self::mul_add(0.4572, x153, x152);
-        let x160 = Self::mul_add(-c_q3, x154, s_q3 * x156);
-        let x161 = Self::mul_add(c_q3, x156, s_q3 * x154);
+            Self::mul_add(-34.74691524, x121, x128 * x137),
+        ) + Self::mul_add(c_q5, x148, s_q5 * x147);
+        let x153 = Self::mul_add(s_q4, x135, c_q4 * x134);
+        let x154 = Self::mul_add(
+            -41.67378,
+            x123,
+            Self::mul_add(-c_q4, x135, s_q4 * x134),
+        );
+        let x155 = Self::mul_add(41.67378, x124, -x136);
+        let x156 = Self::mul_add(41.67378, x125, -x153);
+        let x157 = Self::mul_add(x115, x127, x122 * x126)
+            - Self::mul_add(c_q4, x151, s_q4 * x150);
+        let x158 = Self::mul_add(0.4572, x153, -x152)
+            - Self::mul_add(
+                41.67378,
+                x118,
+                Self::mul_add(x114, x127, x121 * 15.380963024),
+            );
+        let x159 = Self::mul_add(-x114, x126, 41.67378 * x119)
+            + Self::mul_add(-0.4572, x136, Self::mul_add(-s_q4, x151, c_q4 * x150));
+        let x160 = Self::mul_add(-s_q3, x155, c_q3 * x154);
+        let x161 = Self::mul_add(c_q3, x155, s_q3 * x154);
         let x162 = x160
-            - Self::mul_add(-15.183612000000002, x106, 703.3878000000001 * x105);
-        let x163 = Self::mul_add(-703.3878000000001, x107, -15.183612000000002 * x108)
-            + x155;
-        let x164 = x161
-            - Self::mul_add(-15.183612000000002, x109, 703.3878000000001 * x106);
-        let x165 = Self::mul_add(
-            x97,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x102, -5594.523885531201 * x101)
-                + Self::mul_add(-x95, x111, x103 * x112),
-        ) + Self::mul_add(0.1524, x155, Self::mul_add(s_q3, x159, c_q3 * x157));
-        let x166 = Self::mul_add(0.08, x102, 0.8021 * x101)
-            + Self::mul_add(x94, x112, x95 * x110)
-            + Self::mul_add(x100, 703.3878000000001, -15.183612000000002 * x99)
-            + (x158 + Self::mul_add(-7.06, x161, -0.1524 * x160));
-        let x167 = x113
-            + Self::mul_add(7.06, x155, Self::mul_add(-s_q3, x157, c_q3 * x159));
+            - Self::mul_add(15.183612000000002, x106, 703.3878000000001 * x105);
+        let x163 = x161
+            - Self::mul_add(15.183612000000002, x107, 703.3878000000001 * x106);
+        let x164 = Self::mul_add(-703.3878000000001, x108, 15.183612000000002 * x109)
+            + x156;
+        let x165 = x113
+            + Self::mul_add(0.1524, x156, Self::mul_add(-s_q3, x158, c_q3 * x157));
+        let x166 = Self::mul_add(
+            703.3878000000001,
+            x98,
+            Self::mul_add(x101, -103.41030072000002, 5594.523885531201 * x102)
+                + Self::mul_add(x94, x112, x103 * x110),
+        ) + Self::mul_add(-7.06, x156, Self::mul_add(c_q3, x158, s_q3 * x157));
+        let x167 = Self::mul_add(0.08, x102, 0.8021 * x101)
+            - Self::mul_add(x94, x111, x95 * x110)
+            + Self::mul_add(-15.183612000000002, x99, 703.3878000000001 * x100)
+            + (x159 + Self::mul_add(-0.1524, x160, 7.06 * x161));
         let x168 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-x86, x92, qd[1] * x93)
-                - Self::mul_add(190.97044034, x88, -8596.210051042 * x87)
-                + Self::mul_add(0.1524, x163, Self::mul_add(s_q2, x167, c_q2 * x165)),
-            c_q1
-                * (Self::mul_add(6.377, x163, Self::mul_add(-s_q2, x165, c_q2 * x167))
+            c_q1,
+            Self::mul_add(8596.210051042, x88, x87 * 190.97044034000004)
+                + Self::mul_add(x85, x93, qd[1] * x91)
+                + Self::mul_add(-6.377, x164, Self::mul_add(c_q2, x166, s_q2 * x165)),
+            s_q1
+                * (Self::mul_add(0.1524, x164, Self::mul_add(-s_q2, x166, c_q2 * x165))
                     - Self::mul_add(
-                        190.97044034000004,
-                        x87,
-                        Self::mul_add(x85, x92, qd[1] * x91),
+                        x88,
+                        190.97044034,
+                        Self::mul_add(x86, x93, qd[1] * x92),
                     )),
         );
-        let x169 = tau[0] - x168;
+        let x169 = tau[0] + x168;
         let x170 = 1.0
-            / (14222.257549666001
+            / (46.90457611680001
                 + (x68
-                    - Self::mul_add(
+                    + Self::mul_add(
                         s_q1 * c_q1,
-                        x69 + x69,
-                        s_q1 * s_q1
-                            * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                        x67 + x67,
+                        s_q1 * s_q1 * (x62 + (x44 - x57 + x62) - x68),
                     )));
-        let x171 = x70 * x170;
-        let x172 = x71 * x170;
-        let x173 = x72 * x170;
+        let x171 = x69 * x170;
+        let x172 = x70 * x170;
+        let x173 = x71 * x170;
         let x174 = x79 * x170;
         let x175 = x84 * x170;
-        let x176 = 1.0
-            / Self::mul_add(
-                -x70,
-                x171,
-                8609.573807858 + (x51 - (x65 - x64) - (x63 - x66)),
-            );
-        let x177 = Self::mul_add(-x70, x172, x51 + (x64 - x65));
+        let x176 = 1.0 / Self::mul_add(-x69, x171, 8609.573807858 + (x64 + x65));
+        let x177 = Self::mul_add(-x69, x172, x65);
         let x178 = x176 * x177;
         let x179 = Self::mul_add(
-            -x70,
+            -x69,
             x173,
             x43
                 + Self::mul_add(
-                    0.1524,
-                    Self::mul_add(s_q2, x38, c_q2 * x37),
-                    -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
+                    6.377,
+                    Self::mul_add(-s_q2, x38, c_q2 * x37),
+                    0.1524 * Self::mul_add(s_q2, x37, c_q2 * x38),
                 ),
         );
         let x180 = x176 * x179;
         let x181 = Self::mul_add(
-            -x70,
+            -x69,
             x174,
-            x77
-                + Self::mul_add(
-                    -6.377,
+            x78
+                - Self::mul_add(
+                    6.377,
                     Self::mul_add(c_q2, x74, s_q2 * x73),
-                    -0.1524 * Self::mul_add(-c_q2, x73, s_q2 * x74),
+                    0.1524 * Self::mul_add(-c_q2, x73, s_q2 * x74),
                 ),
         );
         let x182 = x176 * x181;
-        let x183 = Self::mul_add(-x70, x175, x81);
+        let x183 = Self::mul_add(-x69, x175, x81);
         let x184 = x176 * x183;
-        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x71, x172, x51));
-        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x71, x173, x43));
+        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x70, x172, x52));
+        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x70, x173, x43));
         let x187 = x185 * x186;
-        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x71, x174, x77));
+        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x70, x174, x78));
         let x189 = x185 * x188;
-        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x71, x175, x81));
+        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x70, x175, x81));
         let x191 = x185 * x190;
         let x192 = Self::mul_add(
             -x186,
             x187,
-            Self::mul_add(-x179, x180, Self::mul_add(-x72, x173, x29)),
+            Self::mul_add(-x179, x180, Self::mul_add(-x71, x173, x29)),
         );
         let x193 = 1.0 / x192;
         let x194 = Self::mul_add(
             -x186,
             x189,
-            Self::mul_add(-x179, x182, Self::mul_add(-x72, x174, x19)),
+            Self::mul_add(-x179, x182, Self::mul_add(-x71, x174, x18)),
         );
         let x195 = x193 * x194;
         let x196 = Self::mul_add(
             -x186,
             x191,
-            Self::mul_add(-x179, x184, Self::mul_add(-x72, x175, x81)),
+            Self::mul_add(-x179, x184, Self::mul_add(-x71, x175, x81)),
         );
         let x197 = x193 * x196;
         let x198 = Self::mul_add(
             -x188,
             x189,
-            Self::mul_add(-x181, x182, Self::mul_add(-x79, x174, x12)),
+            Self::mul_add(-x181, x182, Self::mul_add(-x79, x174, x11)),
         );
         let x199 = 1.0 / Self::mul_add(-x194, x195, x198);
         let x200 = Self::mul_add(
@@ -1720,34 +1993,34 @@ impl Srms {
         );
         let x204 = 1.0 / Self::mul_add(-x201, x202, Self::mul_add(-x196, x197, x203));
         let x205 = Self::mul_add(
-            -x169,
+            x169,
             x171,
             tau[1]
-                - (Self::mul_add(x85, x93, x86 * x91)
-                    - Self::mul_add(-0.0302, x88, -1.928 * x87)
-                    + (x166
+                - (Self::mul_add(0.0302, x88, x87 * 1.928)
+                    + Self::mul_add(-x85, x92, x86 * x91)
+                    + (x167
                         + Self::mul_add(
-                            -6.377,
-                            Self::mul_add(-s_q2, x162, c_q2 * x164),
-                            -0.1524 * Self::mul_add(s_q2, x164, c_q2 * x162),
+                            -0.1524,
+                            Self::mul_add(-s_q2, x163, c_q2 * x162),
+                            6.377 * Self::mul_add(c_q2, x163, s_q2 * x162),
                         ))),
         );
-        let x206 = Self::mul_add(-x178, x205, Self::mul_add(-x169, x172, tau[2] - x166));
+        let x206 = Self::mul_add(-x178, x205, Self::mul_add(x169, x172, tau[2] - x167));
         let x207 = Self::mul_add(
             -x187,
             x206,
-            Self::mul_add(-x180, x205, Self::mul_add(-x169, x173, tau[3] - x158)),
+            Self::mul_add(-x180, x205, Self::mul_add(x169, x173, tau[3] - x159)),
         );
         let x208 = Self::mul_add(
             -x189,
             x206,
-            Self::mul_add(-x182, x205, Self::mul_add(-x169, x174, tau[4] - x152)),
+            Self::mul_add(-x182, x205, Self::mul_add(x169, x174, tau[4] - x152)),
         );
         let x209 = Self::mul_add(-x195, x207, x208);
         let x210 = Self::mul_add(
             -x191,
             x206,
-            Self::mul_add(-x184, x205, Self::mul_add(-x169, x175, tau[5] - x147)),
+            Self::mul_add(-x184, x205, Self::mul_add(x169, x175, tau[5] - x149)),
         );
         let x211 = x204 * Self::mul_add(-x202, x209, Self::mul_add(-x197, x207, x210));
         let x212 = Self::mul_add(-x202, x211, x199 * x209);
@@ -1764,16 +2037,16 @@ impl Srms {
         );
         let x216 = Self::mul_add(-x184, x211, x215);
         let x217 = Self::mul_add(
-            -x173,
+            x173,
             x213,
-            Self::mul_add(-x172, x214, Self::mul_add(-x171, x216, x169 * x170)),
+            Self::mul_add(x172, x214, Self::mul_add(x171, x216, x169 * x170)),
         );
-        let x218 = Self::mul_add(-x175, x211, Self::mul_add(-x174, x212, x217));
+        let x218 = Self::mul_add(x175, x211, Self::mul_add(x174, x212, x217));
         [x218, x216, x214, x213, x212, x211]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 343 mul, 276 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 338 mul, 272 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 174 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -1790,124 +2063,124 @@ impl Srms {
         let x8 = 0.353 + Self::mul_add(x5, -0.706, x6 * 0.9929999999999999);
         let x9 = Self::mul_add(-0.966, s_q5, 0.385 * c_q5);
         let x10 = Self::mul_add(0.966, c_q5, 0.385 * s_q5);
-        let x11 = 34.33891524 - x7;
-        let x12 = 34.74691524 + (-0.9929999999999999 + x7);
-        let x13 = s_q4 * s_q4;
-        let x14 = s_q4 * c_q4;
-        let x15 = 1.903 - x11;
-        let x16 = x9 + x9;
-        let x17 = Self::mul_add(x14, x16, x13 * x15);
-        let x18 = Self::mul_add(-s_q4, x8, c_q4 * x10);
-        let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
-        let x20 = 34.45002 * c_q4;
-        let x21 = 34.45002 * s_q4;
-        let x22 = x20 * -0.4572;
-        let x23 = 0.4572 * x20;
-        let x24 = x12 + x23;
-        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
-        let x26 = x24 - x22;
-        let x27 = 41.67378 + x20;
-        let x28 = -18.957952216000002 + (1.903 - x17);
-        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
+        let x11 = 34.74691524 + (-0.9929999999999999 + x7);
+        let x12 = s_q4 * s_q4;
+        let x13 = s_q4 * c_q4;
+        let x14 = x7 + -32.43591524;
+        let x15 = x9 + x9;
+        let x16 = Self::mul_add(x13, x15, x12 * x14);
+        let x17 = -32.43591524 - x16;
+        let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
+        let x19 = s_q4 * x8;
+        let x20 = c_q4 * x10;
+        let x21 = x19 - x20;
+        let x22 = s_q4 * 34.45002;
+        let x23 = c_q4 * 34.45002;
+        let x24 = 0.4572 * x23;
+        let x25 = x11 + x24;
+        let x26 = Self::mul_add(0.4572, x22, Self::mul_add(-x13, x14, x12 * x15) - x9);
+        let x27 = 41.67378 + x23;
+        let x28 = -15.380963024 + (x24 + x25);
+        let x29 = 54.202167456 + (x24 + (x16 - x7 + x24));
         let x30 = s_q3 * s_q3;
         let x31 = s_q3 * c_q3;
-        let x32 = x26 - x28;
-        let x33 = x18 + x18;
+        let x32 = x17 - x28;
+        let x33 = x21 + x21;
         let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
-        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
-        let x37 = s_q3 * x27;
-        let x38 = c_q3 * x27;
-        let x39 = x37 * 0.1524;
-        let x40 = -0.1524 * x37;
-        let x41 = x38 * -7.06;
-        let x42 = 7.06 * x38;
-        let x43 = x29 - (x40 + x41);
-        let x44 = x21 * 0.1524;
+        let x35 = Self::mul_add(-c_q3, x26, s_q3 * x18);
+        let x36 = Self::mul_add(c_q3, x18, s_q3 * x26);
+        let x37 = c_q3 * x27;
+        let x38 = s_q3 * x27;
+        let x39 = 0.1524 * x38;
+        let x40 = 7.06 * x37;
+        let x41 = 0.1524 * x22;
+        let x42 = x39 + x40;
+        let x43 = x29 + x42;
+        let x44 = x39 + (x17 - x34 + x39);
         let x45 = Self::mul_add(
-            0.1524,
+            -7.06,
             x38,
-            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
+            Self::mul_add(-0.1524, x37, x21 + Self::mul_add(-x30, x33, x31 * x32)),
         );
-        let x46 = x26 - x34 + x42 - x41;
-        let x47 = 703.3878000000001 + x38;
-        let x48 = -15.183612000000002 - x37;
-        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
-        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
-        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
-        let x52 = 103.41030072000002 + x45;
-        let x53 = -0.08 + (x35 + x44);
-        let x54 = s_q2 * s_q2;
-        let x55 = s_q2 * c_q2;
-        let x56 = x46 - x49;
-        let x57 = x52 + x52;
-        let x58 = Self::mul_add(x55, x57, x54 * x56);
-        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
-        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
-        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
-        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
-        let x63 = 0.1524 * x61;
-        let x64 = -0.1524 * x61;
-        let x65 = x62 * -6.377;
-        let x66 = 6.377 * x62;
-        let x67 = Self::mul_add(
-            0.1524,
-            x62,
-            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
+        let x46 = 703.3878000000001 + x37;
+        let x47 = 15.183612000000002 + x38;
+        let x48 = -103.41030072000001 + x45;
+        let x49 = 0.8021 + Self::mul_add(-7.06, x22, x35);
+        let x50 = 5594.523885531201 + (x40 + (x28 + x34 + x40));
+        let x51 = 0.08 - (x36 + x41);
+        let x52 = 5601.1318504688 + (x42 + x43);
+        let x53 = s_q2 * s_q2;
+        let x54 = s_q2 * c_q2;
+        let x55 = x44 - x50;
+        let x56 = x48 + x48;
+        let x57 = Self::mul_add(x54, x56, x53 * x55);
+        let x58 = Self::mul_add(-s_q2, x51, c_q2 * x49);
+        let x59 = Self::mul_add(c_q2, x51, s_q2 * x49);
+        let x60 = Self::mul_add(-s_q2, x47, c_q2 * x46);
+        let x61 = Self::mul_add(c_q2, x47, s_q2 * x46);
+        let x62 = 0.1524 * x61;
+        let x63 = 6.377 * x60;
+        let x64 = x62 + x63;
+        let x65 = x52 + x64;
+        let x66 = Self::mul_add(
+            -6.377,
+            x61,
+            Self::mul_add(-0.1524, x60, x48 + Self::mul_add(-x53, x56, x54 * x55)),
         );
-        let x68 = x46 - x58 + x66 - x65;
-        let x69 = 8609.573807858 + (x51 - (x65 - x64) - (x63 - x66));
-        let x70 = 190.97044034000004 + x67;
-        let x71 = Self::mul_add(
-            -s_q1,
-            -1.928 + Self::mul_add(-6.377, x21, x60),
-            c_q1 * (-0.0302 + (x44 + x59)),
+        let x67 = -190.97044034 + x66;
+        let x68 = 8596.210051042 + (x63 + (x50 + x57 + x63));
+        let x69 = 8609.573807858 + (x64 + x65);
+        let x70 = -Self::mul_add(
+            c_q1,
+            0.0302 + (x59 - x41),
+            s_q1 * (-1.928 + Self::mul_add(-6.377, x22, x58)),
         );
-        let x72 = 14222.257549666001
+        let x71 = 46.90457611680001
             + (x68
-                - Self::mul_add(
+                + Self::mul_add(
                     s_q1 * c_q1,
-                    x70 + x70,
-                    s_q1 * s_q1 * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                    x67 + x67,
+                    s_q1 * s_q1 * (x62 + (x44 - x57 + x62) - x68),
                 ));
-        let x73 = x51 + (x64 - x65);
-        let x74 = Self::mul_add(-s_q1, x60, c_q1 * x59);
-        let x75 = x43
+        let x72 = -Self::mul_add(c_q1, x59, s_q1 * x58);
+        let x73 = x43
             + Self::mul_add(
-                0.1524,
-                Self::mul_add(s_q2, x38, c_q2 * x37),
-                -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
+                6.377,
+                Self::mul_add(-s_q2, x38, c_q2 * x37),
+                0.1524 * Self::mul_add(s_q2, x37, c_q2 * x38),
             );
-        let x76 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x35, c_q2 * x36),
-            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
+        let x74 = -Self::mul_add(
+            c_q1,
+            Self::mul_add(-c_q2, x36, s_q2 * x35),
+            s_q1 * Self::mul_add(s_q2, x36, c_q2 * x35),
         );
-        let x77 = c_q3 * x21;
-        let x78 = s_q3 * x21;
-        let x79 = x20 * 0.1524;
-        let x80 = Self::mul_add(s_q3, x24, c_q3 * x18) + x79;
-        let x81 = x19 + Self::mul_add(0.1524, x77, -7.06 * x78);
-        let x82 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
-        let x83 = x81
-            + Self::mul_add(
-                -6.377,
-                Self::mul_add(c_q2, x78, s_q2 * x77),
-                -0.1524 * Self::mul_add(-c_q2, x77, s_q2 * x78),
+        let x75 = x20 - x19;
+        let x76 = c_q3 * x22;
+        let x77 = s_q3 * x22;
+        let x78 = 0.1524 * x23;
+        let x79 = Self::mul_add(s_q3, x25, c_q3 * x75) + x78;
+        let x80 = Self::mul_add(-7.06, x23, Self::mul_add(-c_q3, x25, s_q3 * x75));
+        let x81 = x18 + Self::mul_add(-7.06, x77, 0.1524 * x76);
+        let x82 = x81
+            - Self::mul_add(
+                6.377,
+                Self::mul_add(c_q2, x77, s_q2 * x76),
+                0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
             );
-        let x84 = Self::mul_add(
-            -s_q1,
-            x79 + Self::mul_add(s_q2, x82, c_q2 * x80),
-            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x80, c_q2 * x82)),
+        let x83 = Self::mul_add(
+            c_q1,
+            Self::mul_add(-6.377, x23, Self::mul_add(c_q2, x80, s_q2 * x79)),
+            s_q1 * (x78 + Self::mul_add(-s_q2, x80, c_q2 * x79)),
         );
+        let x84 = -x83;
         let x85 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x86 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x86 = Self::mul_add(1.903, s_q4, c_q4 * x9);
         let x87 = Self::mul_add(s_q3, x10, c_q3 * x85);
-        let x88 = Self::mul_add(-s_q3, x85, c_q3 * x10);
-        let x89 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x88, c_q2 * x87),
-            c_q1 * Self::mul_add(-s_q2, x87, c_q2 * x88),
+        let x88 = Self::mul_add(-c_q3, x10, s_q3 * x85);
+        let x89 = -Self::mul_add(
+            c_q1,
+            Self::mul_add(c_q2, x88, s_q2 * x87),
+            s_q1 * Self::mul_add(-s_q2, x88, c_q2 * x87),
         );
         let x90 = qd[0] * s_q1;
         let x91 = qd[0] * c_q1;
@@ -1915,180 +2188,189 @@ impl Srms {
         let x93 = qd[1] * x90;
         let x94 = qd[1] * qd[1];
         let x95 = x90 * x91;
-        let x96 = Self::mul_add(
-            190.97044034,
-            x91,
-            Self::mul_add(8596.210051042, x90, -1.928 * qd[1]),
-        );
+        let x96 = Self::mul_add(qd[1], -1.928, x91 * 190.97044034);
         let x97 = Self::mul_add(
-            -0.0302,
-            x91,
-            Self::mul_add(1.928, x90, 8609.573807858 * qd[1]),
+            0.0302,
+            qd[1],
+            Self::mul_add(-8596.210051042, x91, x90 * 190.97044034000004),
         );
-        let x98 = Self::mul_add(-190.97044034000004, x90, -0.0302 * qd[1]);
+        let x98 = Self::mul_add(
+            8609.573807858,
+            qd[1],
+            Self::mul_add(-0.0302, x91, x90 * 1.928),
+        );
         let x99 = Self::mul_add(s_q2, x91, c_q2 * x90);
-        let x100 = Self::mul_add(-s_q2, x90, c_q2 * x91);
-        let x101 = Self::mul_add(-0.1524, x95, 6.377 * Self::mul_add(x91, x91, x94));
-        let x102 = Self::mul_add(-6.377, x93 + x93, -0.1524 * (x92 + x92));
-        let x103 = Self::mul_add(-0.1524, Self::mul_add(x90, x90, x94), 6.377 * x95);
-        let x104 = Self::mul_add(-c_q2, x101, s_q2 * x103);
-        let x105 = Self::mul_add(c_q2, x103, s_q2 * x101);
-        let x106 = Self::mul_add(-qd[2], x100, Self::mul_add(-c_q2, x92, s_q2 * x93));
+        let x100 = Self::mul_add(-c_q2, x91, s_q2 * x90);
+        let x101 = Self::mul_add(-6.377, Self::mul_add(x91, x91, x94), 0.1524 * x95);
+        let x102 = Self::mul_add(-0.1524, Self::mul_add(x90, x90, x94), 6.377 * x95);
+        let x103 = Self::mul_add(0.1524, x92 + x92, 6.377 * (x93 + x93));
+        let x104 = Self::mul_add(s_q2, x102, c_q2 * x101);
+        let x105 = Self::mul_add(-s_q2, x101, c_q2 * x102);
+        let x106 = Self::mul_add(qd[2], x100, Self::mul_add(-c_q2, x92, s_q2 * x93));
         let x107 = Self::mul_add(qd[2], x99, Self::mul_add(c_q2, x93, s_q2 * x92));
         let x108 = qd[1] + qd[2];
         let x109 = x108 * x108;
         let x110 = Self::mul_add(x100, x100, x109);
         let x111 = x99 * x100;
-        let x112 = Self::mul_add(x99, x108, x107);
-        let x113 = Self::mul_add(x100, x108, -x106);
-        let x114 = Self::mul_add(x99, x99, x109);
-        let x115 = Self::mul_add(
-            103.41030072000001,
-            x100,
-            Self::mul_add(5594.523885531201, x99, 0.8021 * x108),
-        );
+        let x112 = Self::mul_add(x99, x99, x109);
+        let x113 = Self::mul_add(x99, x108, x107);
+        let x114 = Self::mul_add(x100, x108, x106);
+        let x115 = Self::mul_add(x100, -103.41030072000001, 0.8021 * x108);
         let x116 = Self::mul_add(
-            -0.08,
-            x100,
-            Self::mul_add(-0.8021, x99, 5601.1318504688 * x108),
+            0.08,
+            x108,
+            Self::mul_add(5594.523885531201, x100, x99 * 103.41030072000002),
         );
-        let x117 = Self::mul_add(-103.41030072000002, x99, -0.08 * x108);
+        let x117 = Self::mul_add(
+            5601.1318504688,
+            x108,
+            Self::mul_add(-0.8021, x99, 0.08 * x100),
+        );
         let x118 = Self::mul_add(
-            703.3878000000001,
-            x102,
+            -15.183612000000002,
+            x103,
             Self::mul_add(
-                103.41030072000002,
-                x106,
-                -Self::mul_add(x99, x116, x108 * x115),
+                x107,
+                -103.41030072000001,
+                Self::mul_add(-x108, x116, x100 * x117),
             ),
         );
-        let x119 = Self::mul_add(s_q3, x100, c_q3 * x99);
-        let x120 = Self::mul_add(-s_q3, x99, c_q3 * x100);
-        let x121 = x104 - Self::mul_add(-0.1524, x111, 7.06 * x110);
-        let x122 = x102 + Self::mul_add(-7.06, x112, -0.1524 * x113);
-        let x123 = x105 + Self::mul_add(-0.1524, x114, 7.06 * x111);
-        let x124 = Self::mul_add(-c_q3, x123, s_q3 * x121);
-        let x125 = Self::mul_add(-qd[3], x120, Self::mul_add(s_q3, x107, c_q3 * x106));
-        let x126 = Self::mul_add(-qd[3], x119, Self::mul_add(-c_q3, x107, s_q3 * x106));
+        let x119 = Self::mul_add(-c_q3, x99, s_q3 * x100);
+        let x120 = Self::mul_add(c_q3, x100, s_q3 * x99);
+        let x121 = x104 - Self::mul_add(0.1524, x111, 7.06 * x110);
+        let x122 = x105 - Self::mul_add(0.1524, x112, 7.06 * x111);
+        let x123 = Self::mul_add(-7.06, x113, 0.1524 * x114) - x103;
+        let x124 = Self::mul_add(-s_q3, x121, c_q3 * x122);
+        let x125 = Self::mul_add(qd[3], x120, Self::mul_add(s_q3, x107, c_q3 * x106));
+        let x126 = Self::mul_add(-qd[3], x119, Self::mul_add(-s_q3, x106, c_q3 * x107));
         let x127 = qd[3] + x108;
-        let x128 = Self::mul_add(x120, x120, x127 * x127);
+        let x128 = Self::mul_add(x127, x127, x120 * x120);
         let x129 = x119 * x120;
-        let x130 = Self::mul_add(-x119, x127, x126);
-        let x131 = -18.957952216000002 * x119;
-        let x132 = 19.863252216000003 * x127;
-        let x133 = Self::mul_add(-c_q4, x119, s_q4 * x127);
-        let x134 = Self::mul_add(c_q4, x127, s_q4 * x119);
+        let x130 = Self::mul_add(x119, x127, -x126);
+        let x131 = x120 * 15.380963024;
+        let x132 = 54.202167456 * x127;
+        let x133 = Self::mul_add(-s_q4, x119, c_q4 * x127);
+        let x134 = Self::mul_add(s_q4, x127, c_q4 * x119);
         let x135 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x128, Self::mul_add(s_q3, x123, c_q3 * x121)),
-            c_q4 * Self::mul_add(0.4572, x130, x122),
+            Self::mul_add(-0.4572, x128, Self::mul_add(s_q3, x122, c_q3 * x121)),
+            c_q4 * Self::mul_add(0.4572, x130, x123),
         );
-        let x136 = Self::mul_add(qd[4], x134, c_q4 * x125);
-        let x137 = Self::mul_add(qd[4], x133, s_q4 * x125);
-        let x138 = qd[4] + x120;
-        let x139 = 34.45002 * Self::mul_add(x138, x138, x134 * x134);
-        let x140 = 34.45002 * Self::mul_add(x133, x134, x126);
-        let x141 = 34.45002 * Self::mul_add(x133, x138, x137);
-        let x142 = 34.33891524 * x134;
+        let x136 = Self::mul_add(qd[4], x134, s_q4 * x125);
+        let x137 = Self::mul_add(qd[4], x133, c_q4 * x125);
+        let x138 = qd[4] - x120;
+        let x139 = 34.45002 * Self::mul_add(-x133, x134, x126);
+        let x140 = 34.45002 * Self::mul_add(x133, x133, x138 * x138);
+        let x141 = 34.45002 * Self::mul_add(x134, x138, x136);
+        let x142 = x134 * 34.33891524;
         let x143 = 34.74691524 * x138;
-        let x144 = Self::mul_add(s_q5, x138, c_q5 * x134);
-        let x145 = Self::mul_add(-s_q5, x134, c_q5 * x138);
-        let x146 = Self::mul_add(qd[5], x145, Self::mul_add(-c_q5, x137, s_q5 * x126));
-        let x147 = Self::mul_add(-qd[5], x144, Self::mul_add(c_q5, x126, s_q5 * x137));
-        let x148 = qd[5] + x133;
-        let x149 = Self::mul_add(0.966, x145, Self::mul_add(0.385, x144, 1.903 * x148));
-        let x150 = Self::mul_add(0.353, x145, 0.385 * x148);
-        let x151 = Self::mul_add(
-            -0.9929999999999999,
-            x145,
-            Self::mul_add(0.353, x144, 0.966 * x148),
+        let x144 = Self::mul_add(s_q5, x138, c_q5 * x133);
+        let x145 = Self::mul_add(-s_q5, x133, c_q5 * x138);
+        let x146 = Self::mul_add(qd[5], x145, -Self::mul_add(s_q5, x126, c_q5 * x136));
+        let x147 = Self::mul_add(-qd[5], x144, Self::mul_add(-c_q5, x126, s_q5 * x136));
+        let x148 = qd[5] + x134;
+        let x149 = Self::mul_add(0.385, x148, 0.353 * x145);
+        let x150 = Self::mul_add(
+            0.966,
+            x148,
+            Self::mul_add(-0.9929999999999999, x145, 0.353 * x144),
         );
-        let x152 = Self::mul_add(0.966, x147, Self::mul_add(0.385, x146, 1.903 * x136))
-            + Self::mul_add(-x145, x150, x144 * x151);
-        let x153 = Self::mul_add(0.353, x147, 0.385 * x136)
-            + Self::mul_add(-x148, x151, x145 * x149);
-        let x154 = Self::mul_add(
-            -0.9929999999999999,
-            x147,
-            Self::mul_add(0.353, x146, 0.966 * x136),
-        ) + Self::mul_add(-x144, x149, x148 * x150);
-        let x155 = Self::mul_add(-x138, x142, x134 * x143) + x152;
-        let x156 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x129, x124),
-            -Self::mul_add(x133, x143, 34.33891524 * x137),
-        ) + Self::mul_add(-s_q5, x154, c_q5 * x153);
+        let x151 = Self::mul_add(1.903, x148, Self::mul_add(0.966, x145, 0.385 * x144));
+        let x152 = Self::mul_add(0.385, x137, 0.353 * x147)
+            + Self::mul_add(-x148, x150, x145 * x151);
+        let x153 = Self::mul_add(
+            0.966,
+            x137,
+            Self::mul_add(-0.9929999999999999, x147, 0.353 * x146),
+        ) + Self::mul_add(-x144, x151, x148 * x149);
+        let x154 = Self::mul_add(1.903, x137, Self::mul_add(0.966, x147, 0.385 * x146))
+            + Self::mul_add(-x145, x149, x144 * x150);
+        let x155 = Self::mul_add(
+            34.45002,
+            Self::mul_add(0.4572, x129, x124),
+            -Self::mul_add(x134, x143, x138 * x142),
+        ) + Self::mul_add(-s_q5, x153, c_q5 * x152);
+        let x156 = Self::mul_add(-x133, x143, x137 * 34.33891524) - x154;
         let x157 = Self::mul_add(
             34.45002,
             x135,
-            Self::mul_add(x133, x142, 34.74691524 * x126),
-        ) + Self::mul_add(c_q5, x154, s_q5 * x153);
-        let x158 = Self::mul_add(-s_q4, x139, c_q4 * x140);
-        let x159 = Self::mul_add(41.67378, x128, Self::mul_add(s_q4, x140, c_q4 * x139));
-        let x160 = Self::mul_add(41.67378, x130, x158);
-        let x161 = Self::mul_add(-41.67378, x129, x141);
-        let x162 = Self::mul_add(-x120, x132, -18.957952216000002 * x125)
-            + Self::mul_add(-s_q4, x156, c_q4 * x155);
-        let x163 = Self::mul_add(-x120, x131, x124 * -41.67378)
-            + Self::mul_add(-0.4572, x141, Self::mul_add(c_q4, x156, s_q4 * x155));
-        let x164 = Self::mul_add(41.67378, x122, Self::mul_add(-x119, x132, x127 * x131))
-            + Self::mul_add(0.4572, x158, x157);
-        let x165 = Self::mul_add(-c_q3, x159, s_q3 * x161);
-        let x166 = Self::mul_add(c_q3, x161, s_q3 * x159);
+            Self::mul_add(-34.74691524, x126, x133 * x142),
+        ) + Self::mul_add(c_q5, x153, s_q5 * x152);
+        let x158 = Self::mul_add(s_q4, x140, c_q4 * x139);
+        let x159 = Self::mul_add(
+            -41.67378,
+            x128,
+            Self::mul_add(-c_q4, x140, s_q4 * x139),
+        );
+        let x160 = Self::mul_add(41.67378, x129, -x141);
+        let x161 = Self::mul_add(41.67378, x130, -x158);
+        let x162 = Self::mul_add(x120, x132, x127 * x131)
+            - Self::mul_add(c_q4, x156, s_q4 * x155);
+        let x163 = Self::mul_add(0.4572, x158, -x157)
+            - Self::mul_add(
+                41.67378,
+                x123,
+                Self::mul_add(x119, x132, x126 * 15.380963024),
+            );
+        let x164 = Self::mul_add(-x119, x131, 41.67378 * x124)
+            + Self::mul_add(-0.4572, x141, Self::mul_add(-s_q4, x156, c_q4 * x155));
+        let x165 = Self::mul_add(-s_q3, x160, c_q3 * x159);
+        let x166 = Self::mul_add(c_q3, x160, s_q3 * x159);
         let x167 = x165
-            - Self::mul_add(-15.183612000000002, x111, 703.3878000000001 * x110);
-        let x168 = Self::mul_add(-703.3878000000001, x112, -15.183612000000002 * x113)
-            + x160;
-        let x169 = x166
-            - Self::mul_add(-15.183612000000002, x114, 703.3878000000001 * x111);
-        let x170 = Self::mul_add(
-            x102,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x107, -5594.523885531201 * x106)
-                + Self::mul_add(-x100, x116, x108 * x117),
-        ) + Self::mul_add(0.1524, x160, Self::mul_add(s_q3, x164, c_q3 * x162));
-        let x171 = Self::mul_add(0.08, x107, 0.8021 * x106)
-            + Self::mul_add(x99, x117, x100 * x115)
-            + Self::mul_add(x105, 703.3878000000001, -15.183612000000002 * x104)
-            + (x163 + Self::mul_add(-7.06, x166, -0.1524 * x165));
-        let x172 = x118
-            + Self::mul_add(7.06, x160, Self::mul_add(-s_q3, x162, c_q3 * x164));
-        let x173 = Self::mul_add(x90, x98, x91 * x96)
-            - Self::mul_add(-0.0302, x93, -1.928 * x92)
-            + (x171
+            - Self::mul_add(15.183612000000002, x111, 703.3878000000001 * x110);
+        let x168 = x166
+            - Self::mul_add(15.183612000000002, x112, 703.3878000000001 * x111);
+        let x169 = Self::mul_add(-703.3878000000001, x113, 15.183612000000002 * x114)
+            + x161;
+        let x170 = x118
+            + Self::mul_add(0.1524, x161, Self::mul_add(-s_q3, x163, c_q3 * x162));
+        let x171 = Self::mul_add(
+            703.3878000000001,
+            x103,
+            Self::mul_add(x106, -103.41030072000002, 5594.523885531201 * x107)
+                + Self::mul_add(x99, x117, x108 * x115),
+        ) + Self::mul_add(-7.06, x161, Self::mul_add(c_q3, x163, s_q3 * x162));
+        let x172 = Self::mul_add(0.08, x107, 0.8021 * x106)
+            - Self::mul_add(x99, x116, x100 * x115)
+            + Self::mul_add(-15.183612000000002, x104, 703.3878000000001 * x105)
+            + (x164 + Self::mul_add(-0.1524, x165, 7.06 * x166));
+        let x173 = Self::mul_add(0.0302, x93, x92 * 1.928)
+            + Self::mul_add(-x90, x97, x91 * x96)
+            + (x172
                 + Self::mul_add(
-                    -6.377,
-                    Self::mul_add(-s_q2, x167, c_q2 * x169),
-                    -0.1524 * Self::mul_add(s_q2, x169, c_q2 * x167),
+                    -0.1524,
+                    Self::mul_add(-s_q2, x168, c_q2 * x167),
+                    6.377 * Self::mul_add(c_q2, x168, s_q2 * x167),
                 ));
         let x174 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-x91, x97, qd[1] * x98)
-                - Self::mul_add(190.97044034, x93, -8596.210051042 * x92)
-                + Self::mul_add(0.1524, x168, Self::mul_add(s_q2, x172, c_q2 * x170)),
-            c_q1
-                * (Self::mul_add(6.377, x168, Self::mul_add(-s_q2, x170, c_q2 * x172))
+            c_q1,
+            Self::mul_add(8596.210051042, x93, x92 * 190.97044034000004)
+                + Self::mul_add(x90, x98, qd[1] * x96)
+                + Self::mul_add(-6.377, x169, Self::mul_add(c_q2, x171, s_q2 * x170)),
+            s_q1
+                * (Self::mul_add(0.1524, x169, Self::mul_add(-s_q2, x171, c_q2 * x170))
                     - Self::mul_add(
-                        190.97044034000004,
-                        x92,
-                        Self::mul_add(x90, x97, qd[1] * x96),
+                        x93,
+                        190.97044034,
+                        Self::mul_add(x91, x98, qd[1] * x97),
                     )),
         );
+        let x175 = -x174;
         (
             [
-                [x72, x71, x74, x76, x84, x89],
-                [x71, x69, x73, x75, x83, x86],
-                [x74, x73, x51, x43, x81, x86],
-                [x76, x75, x43, x29, x19, x86],
-                [x84, x83, x81, x19, x12, x10],
+                [x71, x70, x72, x74, x84, x89],
+                [x70, x69, x65, x73, x82, x86],
+                [x72, x65, x52, x43, x81, x86],
+                [x74, x73, x43, x29, x18, x86],
+                [x84, x82, x81, x18, x11, x10],
                 [x89, x86, x86, x86, x10, 1.903],
             ],
-            [x174, x173, x171, x163, x157, x152],
+            [x175, x173, x172, x164, x157, x154],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 435 mul, 379 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 430 mul, 377 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -2118,408 +2400,401 @@ impl Srms {
         let x19 = Self::mul_add(c_q4, x8, s_q4 * x10);
         let x20 = 34.45002 * c_q4;
         let x21 = 34.45002 * s_q4;
-        let x22 = x20 * -0.4572;
-        let x23 = 0.4572 * x20;
-        let x24 = x12 + x23;
-        let x25 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
-        let x26 = x24 - x22;
-        let x27 = 41.67378 + x20;
-        let x28 = -18.957952216000002 + (1.903 - x17);
-        let x29 = 19.863252216000003 + (x23 + (x11 + x17 - x22));
-        let x30 = s_q3 * s_q3;
-        let x31 = s_q3 * c_q3;
-        let x32 = x26 - x28;
-        let x33 = x18 + x18;
-        let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-s_q3, x25, c_q3 * x19);
-        let x36 = Self::mul_add(c_q3, x25, s_q3 * x19);
-        let x37 = s_q3 * x27;
-        let x38 = c_q3 * x27;
-        let x39 = x37 * 0.1524;
-        let x40 = -0.1524 * x37;
-        let x41 = x38 * -7.06;
-        let x42 = 7.06 * x38;
-        let x43 = x29 - (x40 + x41);
-        let x44 = x21 * 0.1524;
-        let x45 = Self::mul_add(
+        let x22 = 0.4572 * x20;
+        let x23 = Self::mul_add(-0.4572, x21, x9 + Self::mul_add(-x13, x16, x14 * x15));
+        let x24 = x12 + x22;
+        let x25 = x22 + x24;
+        let x26 = 41.67378 + x20;
+        let x27 = -18.957952216000002 + (1.903 - x17);
+        let x28 = 19.863252216000003 + (x22 + (x11 + x17 + x22));
+        let x29 = s_q3 * s_q3;
+        let x30 = s_q3 * c_q3;
+        let x31 = x25 - x27;
+        let x32 = x18 + x18;
+        let x33 = Self::mul_add(x30, x32, x29 * x31);
+        let x34 = Self::mul_add(-s_q3, x23, c_q3 * x19);
+        let x35 = Self::mul_add(c_q3, x23, s_q3 * x19);
+        let x36 = s_q3 * x26;
+        let x37 = c_q3 * x26;
+        let x38 = x36 * 0.1524;
+        let x39 = 7.06 * x37;
+        let x40 = x38 + x39;
+        let x41 = x21 * 0.1524;
+        let x42 = x28 + x40;
+        let x43 = Self::mul_add(
+            x37,
             0.1524,
-            x38,
-            Self::mul_add(7.06, x37, x18 + Self::mul_add(-x30, x33, x31 * x32)),
+            Self::mul_add(7.06, x36, x18 + Self::mul_add(-x29, x32, x30 * x31)),
         );
-        let x46 = x26 - x34 + x42 - x41;
-        let x47 = 703.3878000000001 + x38;
-        let x48 = -15.183612000000002 - x37;
-        let x49 = -5594.523885531201 + (x28 + x34 + x39 - x40);
-        let x50 = 0.8021 + Self::mul_add(-7.06, x21, x36);
-        let x51 = 5601.1318504688 + (x43 + (x39 + x42));
-        let x52 = 103.41030072000002 + x45;
-        let x53 = -0.08 + (x35 + x44);
-        let x54 = s_q2 * s_q2;
-        let x55 = s_q2 * c_q2;
-        let x56 = x46 - x49;
-        let x57 = x52 + x52;
-        let x58 = Self::mul_add(x55, x57, x54 * x56);
-        let x59 = Self::mul_add(-s_q2, x50, c_q2 * x53);
-        let x60 = Self::mul_add(c_q2, x50, s_q2 * x53);
-        let x61 = Self::mul_add(-s_q2, x47, c_q2 * x48);
-        let x62 = Self::mul_add(c_q2, x47, s_q2 * x48);
-        let x63 = 0.1524 * x61;
-        let x64 = -0.1524 * x61;
-        let x65 = x62 * -6.377;
-        let x66 = 6.377 * x62;
+        let x44 = x39 + (x25 - x33 + x39);
+        let x45 = 703.3878000000001 + x37;
+        let x46 = -15.183612000000002 - x36;
+        let x47 = -5594.523885531201 + (x38 + (x27 + x33 + x38));
+        let x48 = 0.8021 + Self::mul_add(-7.06, x21, x35);
+        let x49 = 5601.1318504688 + (x40 + x42);
+        let x50 = -0.08 + (x34 + x41);
+        let x51 = 103.41030072000002 + x43;
+        let x52 = s_q2 * s_q2;
+        let x53 = s_q2 * c_q2;
+        let x54 = x44 - x47;
+        let x55 = x51 + x51;
+        let x56 = Self::mul_add(x53, x55, x52 * x54);
+        let x57 = Self::mul_add(-s_q2, x48, c_q2 * x50);
+        let x58 = Self::mul_add(c_q2, x48, s_q2 * x50);
+        let x59 = Self::mul_add(-s_q2, x45, c_q2 * x46);
+        let x60 = Self::mul_add(c_q2, x45, s_q2 * x46);
+        let x61 = 0.1524 * x59;
+        let x62 = 6.377 * x60;
+        let x63 = x61 - x62;
+        let x64 = Self::mul_add(
+            0.1524,
+            x60,
+            Self::mul_add(-6.377, x59, x51 + Self::mul_add(-x52, x55, x53 * x54)),
+        );
+        let x65 = x62 + (x44 - x56 + x62);
+        let x66 = 190.97044034000004 + x64;
         let x67 = Self::mul_add(
-            0.1524,
-            x62,
-            Self::mul_add(-6.377, x61, x52 + Self::mul_add(-x54, x57, x55 * x56)),
-        );
-        let x68 = x46 - x58 + x66 - x65;
-        let x69 = 190.97044034000004 + x67;
-        let x70 = Self::mul_add(
             -s_q1,
-            -1.928 + Self::mul_add(-6.377, x21, x60),
-            c_q1 * (-0.0302 + (x44 + x59)),
+            -1.928 + Self::mul_add(-6.377, x21, x58),
+            c_q1 * (-0.0302 + (x41 + x57)),
         );
-        let x71 = Self::mul_add(-s_q1, x60, c_q1 * x59);
-        let x72 = Self::mul_add(
+        let x68 = Self::mul_add(-s_q1, x58, c_q1 * x57);
+        let x69 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x35, c_q2 * x36),
-            c_q1 * Self::mul_add(-s_q2, x36, c_q2 * x35),
+            Self::mul_add(s_q2, x34, c_q2 * x35),
+            c_q1 * Self::mul_add(-s_q2, x35, c_q2 * x34),
         );
-        let x73 = c_q3 * x21;
-        let x74 = s_q3 * x21;
-        let x75 = x20 * 0.1524;
-        let x76 = Self::mul_add(s_q3, x24, c_q3 * x18) + x75;
-        let x77 = x19 + Self::mul_add(0.1524, x73, -7.06 * x74);
-        let x78 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
-        let x79 = Self::mul_add(
+        let x70 = c_q3 * x21;
+        let x71 = s_q3 * x21;
+        let x72 = x20 * 0.1524;
+        let x73 = Self::mul_add(s_q3, x24, c_q3 * x18) + x72;
+        let x74 = x19 + Self::mul_add(-7.06, x71, 0.1524 * x70);
+        let x75 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
+        let x76 = Self::mul_add(
             -s_q1,
-            x75 + Self::mul_add(s_q2, x78, c_q2 * x76),
-            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x76, c_q2 * x78)),
+            x72 + Self::mul_add(s_q2, x75, c_q2 * x73),
+            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x73, c_q2 * x75)),
         );
-        let x80 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x81 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
-        let x82 = Self::mul_add(s_q3, x10, c_q3 * x80);
-        let x83 = Self::mul_add(-s_q3, x80, c_q3 * x10);
-        let x84 = Self::mul_add(
+        let x77 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
+        let x78 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x79 = Self::mul_add(s_q3, x10, c_q3 * x77);
+        let x80 = Self::mul_add(-s_q3, x77, c_q3 * x10);
+        let x81 = Self::mul_add(
             -s_q1,
-            Self::mul_add(s_q2, x83, c_q2 * x82),
-            c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x83),
+            Self::mul_add(s_q2, x80, c_q2 * x79),
+            c_q1 * Self::mul_add(-s_q2, x79, c_q2 * x80),
         );
-        let x85 = qd[0] * s_q1;
-        let x86 = qd[0] * c_q1;
-        let x87 = qd[1] * x86;
-        let x88 = qd[1] * x85;
-        let x89 = qd[1] * qd[1];
-        let x90 = x85 * x86;
-        let x91 = Self::mul_add(
+        let x82 = qd[0] * s_q1;
+        let x83 = qd[0] * c_q1;
+        let x84 = qd[1] * x83;
+        let x85 = qd[1] * x82;
+        let x86 = qd[1] * qd[1];
+        let x87 = x82 * x83;
+        let x88 = Self::mul_add(
             190.97044034,
-            x86,
-            Self::mul_add(8596.210051042, x85, -1.928 * qd[1]),
+            x83,
+            Self::mul_add(qd[1], -1.928, x82 * 8596.210051042),
         );
-        let x92 = Self::mul_add(
+        let x89 = Self::mul_add(
+            x83,
             -0.0302,
-            x86,
-            Self::mul_add(1.928, x85, 8609.573807858 * qd[1]),
+            Self::mul_add(8609.573807858, qd[1], x82 * 1.928),
         );
-        let x93 = Self::mul_add(-190.97044034000004, x85, -0.0302 * qd[1]);
-        let x94 = Self::mul_add(s_q2, x86, c_q2 * x85);
-        let x95 = Self::mul_add(-s_q2, x85, c_q2 * x86);
-        let x96 = Self::mul_add(-0.1524, x90, 6.377 * Self::mul_add(x86, x86, x89));
-        let x97 = Self::mul_add(-6.377, x88 + x88, -0.1524 * (x87 + x87));
-        let x98 = Self::mul_add(-0.1524, Self::mul_add(x85, x85, x89), 6.377 * x90);
-        let x99 = Self::mul_add(-c_q2, x96, s_q2 * x98);
-        let x100 = Self::mul_add(c_q2, x98, s_q2 * x96);
-        let x101 = Self::mul_add(-qd[2], x95, Self::mul_add(-c_q2, x87, s_q2 * x88));
-        let x102 = Self::mul_add(qd[2], x94, Self::mul_add(c_q2, x88, s_q2 * x87));
-        let x103 = qd[1] + qd[2];
-        let x104 = x103 * x103;
-        let x105 = Self::mul_add(x95, x95, x104);
-        let x106 = x94 * x95;
-        let x107 = Self::mul_add(x94, x103, x102);
-        let x108 = Self::mul_add(x95, x103, -x101);
-        let x109 = Self::mul_add(x94, x94, x104);
-        let x110 = Self::mul_add(
+        let x90 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x82);
+        let x91 = Self::mul_add(s_q2, x83, c_q2 * x82);
+        let x92 = Self::mul_add(-s_q2, x82, c_q2 * x83);
+        let x93 = Self::mul_add(-6.377, Self::mul_add(x83, x83, x86), 0.1524 * x87);
+        let x94 = Self::mul_add(0.1524, x84 + x84, 6.377 * (x85 + x85));
+        let x95 = Self::mul_add(-6.377, x87, 0.1524 * Self::mul_add(x82, x82, x86));
+        let x96 = Self::mul_add(-s_q2, x95, c_q2 * x93);
+        let x97 = Self::mul_add(c_q2, x95, s_q2 * x93);
+        let x98 = Self::mul_add(-qd[2], x92, Self::mul_add(-c_q2, x84, s_q2 * x85));
+        let x99 = Self::mul_add(qd[2], x91, Self::mul_add(c_q2, x85, s_q2 * x84));
+        let x100 = qd[1] + qd[2];
+        let x101 = x100 * x100;
+        let x102 = Self::mul_add(x92, x92, x101);
+        let x103 = x91 * x92;
+        let x104 = Self::mul_add(x91, x100, x99);
+        let x105 = Self::mul_add(x92, x100, -x98);
+        let x106 = Self::mul_add(x91, x91, x101);
+        let x107 = Self::mul_add(
             103.41030072000001,
-            x95,
-            Self::mul_add(5594.523885531201, x94, 0.8021 * x103),
+            x92,
+            Self::mul_add(0.8021, x100, x91 * 5594.523885531201),
         );
-        let x111 = Self::mul_add(
+        let x108 = Self::mul_add(
             -0.08,
-            x95,
-            Self::mul_add(-0.8021, x94, 5601.1318504688 * x103),
+            x92,
+            Self::mul_add(-0.8021, x91, 5601.1318504688 * x100),
         );
-        let x112 = Self::mul_add(-103.41030072000002, x94, -0.08 * x103);
-        let x113 = Self::mul_add(
-            703.3878000000001,
-            x97,
+        let x109 = Self::mul_add(0.08, x100, 103.41030072000002 * x91);
+        let x110 = Self::mul_add(
+            -703.3878000000001,
+            x94,
             Self::mul_add(
                 103.41030072000002,
-                x101,
-                -Self::mul_add(x94, x111, x103 * x110),
+                x98,
+                -Self::mul_add(x91, x108, x100 * x107),
             ),
         );
-        let x114 = Self::mul_add(s_q3, x95, c_q3 * x94);
-        let x115 = Self::mul_add(-s_q3, x94, c_q3 * x95);
-        let x116 = x99 - Self::mul_add(-0.1524, x106, 7.06 * x105);
-        let x117 = x97 + Self::mul_add(-7.06, x107, -0.1524 * x108);
-        let x118 = x100 + Self::mul_add(-0.1524, x109, 7.06 * x106);
-        let x119 = Self::mul_add(-c_q3, x118, s_q3 * x116);
-        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(s_q3, x102, c_q3 * x101));
-        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-c_q3, x102, s_q3 * x101));
-        let x122 = qd[3] + x103;
-        let x123 = Self::mul_add(x115, x115, x122 * x122);
-        let x124 = x114 * x115;
-        let x125 = Self::mul_add(-x114, x122, x121);
-        let x126 = -18.957952216000002 * x114;
-        let x127 = 19.863252216000003 * x122;
-        let x128 = Self::mul_add(-c_q4, x114, s_q4 * x122);
-        let x129 = Self::mul_add(c_q4, x122, s_q4 * x114);
-        let x130 = Self::mul_add(
+        let x111 = Self::mul_add(s_q3, x92, c_q3 * x91);
+        let x112 = Self::mul_add(-s_q3, x91, c_q3 * x92);
+        let x113 = x96 + Self::mul_add(-7.06, x102, 0.1524 * x103);
+        let x114 = x94 + Self::mul_add(0.1524, x105, 7.06 * x104);
+        let x115 = x97 + Self::mul_add(-7.06, x103, 0.1524 * x106);
+        let x116 = Self::mul_add(c_q3, x115, s_q3 * x113);
+        let x117 = Self::mul_add(-qd[3], x112, Self::mul_add(s_q3, x99, c_q3 * x98));
+        let x118 = Self::mul_add(-qd[3], x111, Self::mul_add(-c_q3, x99, s_q3 * x98));
+        let x119 = qd[3] + x100;
+        let x120 = Self::mul_add(x112, x112, x119 * x119);
+        let x121 = x111 * x112;
+        let x122 = Self::mul_add(-x111, x119, x118);
+        let x123 = x111 * 18.957952216000002;
+        let x124 = 19.863252216000003 * x119;
+        let x125 = Self::mul_add(-c_q4, x111, s_q4 * x119);
+        let x126 = Self::mul_add(c_q4, x119, s_q4 * x111);
+        let x127 = Self::mul_add(
             -s_q4,
-            Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x118, c_q3 * x116)),
-            c_q4 * Self::mul_add(0.4572, x125, x117),
+            Self::mul_add(-0.4572, x120, Self::mul_add(-s_q3, x115, c_q3 * x113)),
+            c_q4 * Self::mul_add(0.4572, x122, -x114),
         );
-        let x131 = Self::mul_add(qd[4], x129, c_q4 * x120);
-        let x132 = Self::mul_add(qd[4], x128, s_q4 * x120);
-        let x133 = qd[4] + x115;
-        let x134 = 34.33891524 * x129;
-        let x135 = 34.74691524 * x133;
-        let x136 = Self::mul_add(s_q5, x133, c_q5 * x129);
-        let x137 = Self::mul_add(-s_q5, x129, c_q5 * x133);
-        let x138 = Self::mul_add(qd[5], x137, Self::mul_add(-c_q5, x132, s_q5 * x121));
-        let x139 = Self::mul_add(-qd[5], x136, Self::mul_add(c_q5, x121, s_q5 * x132));
-        let x140 = qd[5] + x128;
-        let x141 = Self::mul_add(0.966, x137, Self::mul_add(0.385, x136, 1.903 * x140));
-        let x142 = Self::mul_add(0.353, x137, 0.385 * x140);
+        let x128 = Self::mul_add(qd[4], x126, c_q4 * x117);
+        let x129 = Self::mul_add(qd[4], x125, s_q4 * x117);
+        let x130 = qd[4] + x112;
+        let x131 = 34.33891524 * x126;
+        let x132 = 34.74691524 * x130;
+        let x133 = Self::mul_add(s_q5, x130, c_q5 * x126);
+        let x134 = Self::mul_add(-s_q5, x126, c_q5 * x130);
+        let x135 = Self::mul_add(qd[5], x134, Self::mul_add(-c_q5, x129, s_q5 * x118));
+        let x136 = Self::mul_add(-qd[5], x133, Self::mul_add(c_q5, x118, s_q5 * x129));
+        let x137 = qd[5] + x125;
+        let x138 = Self::mul_add(0.966, x134, Self::mul_add(0.385, x133, 1.903 * x137));
+        let x139 = Self::mul_add(0.353, x134, 0.385 * x137);
+        let x140 = Self::mul_add(
+            -0.9929999999999999,
+            x134,
+            Self::mul_add(0.353, x133, 0.966 * x137),
+        );
+        let x141 = Self::mul_add(0.966, x136, Self::mul_add(0.385, x135, 1.903 * x128))
+            + Self::mul_add(-x134, x139, x133 * x140) - f_ext[5][3];
+        let x142 = Self::mul_add(0.353, x136, 0.385 * x128)
+            + Self::mul_add(-x137, x140, x134 * x138) - f_ext[5][4];
         let x143 = Self::mul_add(
             -0.9929999999999999,
-            x137,
-            Self::mul_add(0.353, x136, 0.966 * x140),
-        );
-        let x144 = Self::mul_add(0.966, x139, Self::mul_add(0.385, x138, 1.903 * x131))
-            + Self::mul_add(-x137, x142, x136 * x143) - f_ext[5][3];
-        let x145 = Self::mul_add(0.353, x139, 0.385 * x131)
-            + Self::mul_add(-x140, x143, x137 * x141) - f_ext[5][4];
-        let x146 = Self::mul_add(
-            -0.9929999999999999,
-            x139,
-            Self::mul_add(0.353, x138, 0.966 * x131),
-        ) + Self::mul_add(-x136, x141, x140 * x142) - f_ext[5][5];
-        let x147 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
-        let x148 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x149 = f_ext[5][0]
+            x136,
+            Self::mul_add(0.353, x135, 0.966 * x128),
+        ) + Self::mul_add(-x133, x138, x137 * x139) - f_ext[5][5];
+        let x144 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
+        let x145 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x146 = f_ext[5][0]
             + Self::mul_add(
                 34.45002,
-                Self::mul_add(x133, x133, x129 * x129),
+                Self::mul_add(x130, x130, x126 * x126),
                 f_ext[4][0],
             );
-        let x150 = Self::mul_add(34.45002, Self::mul_add(x128, x129, x121), -f_ext[4][1])
-            + x147;
-        let x151 = Self::mul_add(34.45002, Self::mul_add(x128, x133, x132), -f_ext[4][2])
-            - x148;
-        let x152 = Self::mul_add(-x133, x134, x129 * x135) - f_ext[4][3] + x144;
-        let x153 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x124, x119),
-            -Self::mul_add(x128, x135, 34.33891524 * x132),
-        ) - f_ext[4][4]
-            + Self::mul_add(0.762, x148, Self::mul_add(-s_q5, x146, c_q5 * x145));
-        let x154 = Self::mul_add(
+        let x147 = Self::mul_add(34.45002, Self::mul_add(x125, x126, x118), -f_ext[4][1])
+            + x144;
+        let x148 = Self::mul_add(34.45002, Self::mul_add(x125, x130, x129), -f_ext[4][2])
+            - x145;
+        let x149 = Self::mul_add(-x130, x131, x126 * x132) - f_ext[4][3] + x141;
+        let x150 = Self::mul_add(0.762, x145, Self::mul_add(-s_q5, x143, c_q5 * x142))
+            - (f_ext[4][4]
+                + Self::mul_add(
+                    34.45002,
+                    Self::mul_add(-0.4572, x121, x116),
+                    Self::mul_add(x125, x132, 34.33891524 * x129),
+                ));
+        let x151 = Self::mul_add(
             34.45002,
-            x130,
-            Self::mul_add(x128, x134, 34.74691524 * x121),
+            x127,
+            Self::mul_add(x125, x131, 34.74691524 * x118),
         ) - f_ext[4][5]
-            + Self::mul_add(0.762, x147, Self::mul_add(c_q5, x146, s_q5 * x145));
-        let x155 = Self::mul_add(-s_q4, x149, c_q4 * x150);
-        let x156 = Self::mul_add(41.67378, x123, f_ext[3][0])
-            + Self::mul_add(s_q4, x150, c_q4 * x149);
-        let x157 = Self::mul_add(41.67378, x125, -f_ext[3][1]) + x155;
-        let x158 = x151 - Self::mul_add(41.67378, x124, f_ext[3][2]);
-        let x159 = Self::mul_add(-x115, x127, -18.957952216000002 * x120) - f_ext[3][3]
-            + Self::mul_add(-s_q4, x153, c_q4 * x152);
-        let x160 = Self::mul_add(-x115, x126, x119 * -41.67378) - f_ext[3][4]
-            + Self::mul_add(-0.4572, x151, Self::mul_add(c_q4, x153, s_q4 * x152));
-        let x161 = Self::mul_add(41.67378, x117, Self::mul_add(-x114, x127, x122 * x126))
-            - f_ext[3][5] + Self::mul_add(0.4572, x155, x154);
-        let x162 = Self::mul_add(-c_q3, x156, s_q3 * x158);
-        let x163 = Self::mul_add(c_q3, x158, s_q3 * x156);
-        let x164 = x162
-            - (f_ext[2][0]
-                + Self::mul_add(-15.183612000000002, x106, 703.3878000000001 * x105));
-        let x165 = Self::mul_add(-703.3878000000001, x107, -15.183612000000002 * x108)
-            - f_ext[2][1] + x157;
-        let x166 = x163
-            - (f_ext[2][2]
-                + Self::mul_add(-15.183612000000002, x109, 703.3878000000001 * x106));
+            + Self::mul_add(0.762, x144, Self::mul_add(c_q5, x143, s_q5 * x142));
+        let x152 = Self::mul_add(-s_q4, x146, c_q4 * x147);
+        let x153 = Self::mul_add(41.67378, x120, f_ext[3][0])
+            + Self::mul_add(s_q4, x147, c_q4 * x146);
+        let x154 = Self::mul_add(41.67378, x122, -f_ext[3][1]) + x152;
+        let x155 = x148 - Self::mul_add(41.67378, x121, f_ext[3][2]);
+        let x156 = Self::mul_add(-s_q4, x150, c_q4 * x149)
+            - (f_ext[3][3] + Self::mul_add(x112, x124, x117 * 18.957952216000002));
+        let x157 = Self::mul_add(-41.67378, x116, x112 * x123) - f_ext[3][4]
+            + Self::mul_add(-0.4572, x148, Self::mul_add(c_q4, x150, s_q4 * x149));
+        let x158 = Self::mul_add(0.4572, x152, x151)
+            - (f_ext[3][5]
+                + Self::mul_add(41.67378, x114, Self::mul_add(x111, x124, x119 * x123)));
+        let x159 = Self::mul_add(-c_q3, x153, s_q3 * x155);
+        let x160 = Self::mul_add(c_q3, x155, s_q3 * x153);
+        let x161 = Self::mul_add(-703.3878000000001, x102, x103 * 15.183612000000002)
+            - f_ext[2][0] + x159;
+        let x162 = x154
+            - (f_ext[2][1]
+                + Self::mul_add(15.183612000000002, x105, 703.3878000000001 * x104));
+        let x163 = Self::mul_add(-703.3878000000001, x103, 15.183612000000002 * x106)
+            - f_ext[2][2] + x160;
+        let x164 = Self::mul_add(0.1524, x154, Self::mul_add(s_q3, x158, c_q3 * x156))
+            - (f_ext[2][3]
+                + Self::mul_add(
+                    x94,
+                    15.183612000000002,
+                    Self::mul_add(103.41030072000001, x99, x98 * 5594.523885531201)
+                        + Self::mul_add(x100, x109, x92 * x108),
+                ));
+        let x165 = Self::mul_add(0.08, x99, 0.8021 * x98)
+            + Self::mul_add(-x91, x109, x92 * x107)
+            - Self::mul_add(703.3878000000001, x97, x96 * 15.183612000000002)
+            - f_ext[2][4] + (x157 - Self::mul_add(7.06, x160, 0.1524 * x159));
+        let x166 = x110 - f_ext[2][5]
+            + Self::mul_add(7.06, x154, Self::mul_add(-s_q3, x156, c_q3 * x158));
         let x167 = Self::mul_add(
-            x97,
-            15.183612000000002,
-            Self::mul_add(-103.41030072000001, x102, -5594.523885531201 * x101)
-                + Self::mul_add(-x95, x111, x103 * x112),
-        ) - f_ext[2][3]
-            + Self::mul_add(0.1524, x157, Self::mul_add(s_q3, x161, c_q3 * x159));
-        let x168 = Self::mul_add(0.08, x102, 0.8021 * x101)
-            + Self::mul_add(x94, x112, x95 * x110)
-            + Self::mul_add(x100, 703.3878000000001, -15.183612000000002 * x99)
-            - f_ext[2][4] + (x160 + Self::mul_add(-7.06, x163, -0.1524 * x162));
-        let x169 = x113 - f_ext[2][5]
-            + Self::mul_add(7.06, x157, Self::mul_add(-s_q3, x159, c_q3 * x161));
-        let x170 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x86, x92, qd[1] * x93)
-                - Self::mul_add(190.97044034, x88, -8596.210051042 * x87) - f_ext[1][3]
-                + Self::mul_add(0.1524, x165, Self::mul_add(s_q2, x169, c_q2 * x167)),
+            Self::mul_add(-190.97044034, x85, x84 * 8596.210051042)
+                - Self::mul_add(qd[1], x90, x83 * x89) - f_ext[1][3]
+                + Self::mul_add(0.1524, x162, Self::mul_add(s_q2, x166, c_q2 * x164)),
             c_q1
-                * (Self::mul_add(6.377, x165, Self::mul_add(-s_q2, x167, c_q2 * x169))
+                * (Self::mul_add(6.377, x162, Self::mul_add(-s_q2, x164, c_q2 * x166))
                     - (f_ext[1][5]
                         + Self::mul_add(
                             190.97044034000004,
-                            x87,
-                            Self::mul_add(x85, x92, qd[1] * x91),
+                            x84,
+                            Self::mul_add(x82, x89, qd[1] * x88),
                         ))),
         );
-        let x171 = tau[0] - (x170 - f_ext[0][5]);
-        let x172 = 1.0
+        let x168 = tau[0] - (x167 - f_ext[0][5]);
+        let x169 = 1.0
             / (14222.257549666001
-                + (x68
+                + (x65
                     - Self::mul_add(
                         s_q1 * c_q1,
-                        x69 + x69,
-                        s_q1 * s_q1
-                            * (x68 - (-8596.210051042 + (x64 + (x49 + x58 - x63)))),
+                        x66 + x66,
+                        s_q1 * s_q1 * (x65 - (-8596.210051042 + (x47 + x56 - x61 - x61))),
                     )));
-        let x173 = x70 * x172;
-        let x174 = x71 * x172;
-        let x175 = x72 * x172;
-        let x176 = x79 * x172;
-        let x177 = x84 * x172;
-        let x178 = 1.0
-            / Self::mul_add(
-                -x70,
-                x173,
-                8609.573807858 + (x51 - (x65 - x64) - (x63 - x66)),
-            );
-        let x179 = Self::mul_add(-x70, x174, x51 + (x64 - x65));
-        let x180 = x178 * x179;
-        let x181 = Self::mul_add(
-            -x70,
-            x175,
-            x43
-                + Self::mul_add(
-                    0.1524,
-                    Self::mul_add(s_q2, x38, c_q2 * x37),
-                    -6.377 * Self::mul_add(-c_q2, x38, s_q2 * x37),
-                ),
-        );
-        let x182 = x178 * x181;
-        let x183 = Self::mul_add(
-            -x70,
-            x176,
-            x77
+        let x170 = x67 * x169;
+        let x171 = x68 * x169;
+        let x172 = x69 * x169;
+        let x173 = x76 * x169;
+        let x174 = x81 * x169;
+        let x175 = 1.0 / Self::mul_add(-x67, x170, 8609.573807858 + (x49 - x63 - x63));
+        let x176 = Self::mul_add(-x67, x171, x49 + (x62 - x61));
+        let x177 = x175 * x176;
+        let x178 = Self::mul_add(
+            -x67,
+            x172,
+            x42
                 + Self::mul_add(
                     -6.377,
-                    Self::mul_add(c_q2, x74, s_q2 * x73),
-                    -0.1524 * Self::mul_add(-c_q2, x73, s_q2 * x74),
+                    Self::mul_add(-c_q2, x37, s_q2 * x36),
+                    0.1524 * Self::mul_add(s_q2, x37, c_q2 * x36),
                 ),
         );
-        let x184 = x178 * x183;
-        let x185 = Self::mul_add(-x70, x177, x81);
-        let x186 = x178 * x185;
-        let x187 = 1.0 / Self::mul_add(-x179, x180, Self::mul_add(-x71, x174, x51));
-        let x188 = Self::mul_add(-x179, x182, Self::mul_add(-x71, x175, x43));
-        let x189 = x187 * x188;
-        let x190 = Self::mul_add(-x179, x184, Self::mul_add(-x71, x176, x77));
-        let x191 = x187 * x190;
-        let x192 = Self::mul_add(-x179, x186, Self::mul_add(-x71, x177, x81));
-        let x193 = x187 * x192;
-        let x194 = Self::mul_add(
-            -x188,
-            x189,
-            Self::mul_add(-x181, x182, Self::mul_add(-x72, x175, x29)),
-        );
-        let x195 = 1.0 / x194;
-        let x196 = Self::mul_add(
-            -x188,
-            x191,
-            Self::mul_add(-x181, x184, Self::mul_add(-x72, x176, x19)),
-        );
-        let x197 = x195 * x196;
-        let x198 = Self::mul_add(
-            -x188,
-            x193,
-            Self::mul_add(-x181, x186, Self::mul_add(-x72, x177, x81)),
-        );
-        let x199 = x195 * x198;
-        let x200 = Self::mul_add(
-            -x190,
-            x191,
-            Self::mul_add(-x183, x184, Self::mul_add(-x79, x176, x12)),
-        );
-        let x201 = 1.0 / Self::mul_add(-x196, x197, x200);
-        let x202 = Self::mul_add(
-            -x190,
-            x193,
-            Self::mul_add(-x183, x186, Self::mul_add(-x79, x177, x10)),
-        );
-        let x203 = Self::mul_add(-x196, x199, x202);
-        let x204 = x201 * x203;
-        let x205 = Self::mul_add(
-            -x192,
-            x193,
-            Self::mul_add(-x185, x186, Self::mul_add(-x84, x177, 1.903)),
-        );
-        let x206 = 1.0 / Self::mul_add(-x203, x204, Self::mul_add(-x198, x199, x205));
-        let x207 = Self::mul_add(
-            -x171,
+        let x179 = x175 * x178;
+        let x180 = Self::mul_add(
+            -x67,
             x173,
+            x74
+                - Self::mul_add(
+                    6.377,
+                    Self::mul_add(c_q2, x71, s_q2 * x70),
+                    0.1524 * Self::mul_add(-c_q2, x70, s_q2 * x71),
+                ),
+        );
+        let x181 = x175 * x180;
+        let x182 = Self::mul_add(-x67, x174, x78);
+        let x183 = x175 * x182;
+        let x184 = 1.0 / Self::mul_add(-x176, x177, Self::mul_add(-x68, x171, x49));
+        let x185 = Self::mul_add(-x176, x179, Self::mul_add(-x68, x172, x42));
+        let x186 = x184 * x185;
+        let x187 = Self::mul_add(-x176, x181, Self::mul_add(-x68, x173, x74));
+        let x188 = x184 * x187;
+        let x189 = Self::mul_add(-x176, x183, Self::mul_add(-x68, x174, x78));
+        let x190 = x184 * x189;
+        let x191 = Self::mul_add(
+            -x185,
+            x186,
+            Self::mul_add(-x178, x179, Self::mul_add(-x69, x172, x28)),
+        );
+        let x192 = 1.0 / x191;
+        let x193 = Self::mul_add(
+            -x185,
+            x188,
+            Self::mul_add(-x178, x181, Self::mul_add(-x69, x173, x19)),
+        );
+        let x194 = x192 * x193;
+        let x195 = Self::mul_add(
+            -x185,
+            x190,
+            Self::mul_add(-x178, x183, Self::mul_add(-x69, x174, x78)),
+        );
+        let x196 = x192 * x195;
+        let x197 = Self::mul_add(
+            -x187,
+            x188,
+            Self::mul_add(-x180, x181, Self::mul_add(-x76, x173, x12)),
+        );
+        let x198 = 1.0 / Self::mul_add(-x193, x194, x197);
+        let x199 = Self::mul_add(
+            -x187,
+            x190,
+            Self::mul_add(-x180, x183, Self::mul_add(-x76, x174, x10)),
+        );
+        let x200 = Self::mul_add(-x193, x196, x199);
+        let x201 = x198 * x200;
+        let x202 = Self::mul_add(
+            -x189,
+            x190,
+            Self::mul_add(-x182, x183, Self::mul_add(-x81, x174, 1.903)),
+        );
+        let x203 = 1.0 / Self::mul_add(-x200, x201, Self::mul_add(-x195, x196, x202));
+        let x204 = Self::mul_add(
+            -x168,
+            x170,
             tau[1]
-                - (Self::mul_add(x85, x93, x86 * x91)
-                    - Self::mul_add(-0.0302, x88, -1.928 * x87) - f_ext[1][4]
-                    + (x168
-                        + Self::mul_add(
-                            -6.377,
-                            Self::mul_add(-s_q2, x164, c_q2 * x166),
-                            -0.1524 * Self::mul_add(s_q2, x166, c_q2 * x164),
+                - (Self::mul_add(x85, 0.0302, x84 * 1.928)
+                    + Self::mul_add(-x82, x90, x83 * x88) - f_ext[1][4]
+                    + (x165
+                        - Self::mul_add(
+                            6.377,
+                            Self::mul_add(-s_q2, x161, c_q2 * x163),
+                            0.1524 * Self::mul_add(s_q2, x163, c_q2 * x161),
                         ))),
         );
-        let x208 = Self::mul_add(-x180, x207, Self::mul_add(-x171, x174, tau[2] - x168));
+        let x205 = Self::mul_add(-x177, x204, Self::mul_add(-x168, x171, tau[2] - x165));
+        let x206 = Self::mul_add(
+            -x186,
+            x205,
+            Self::mul_add(-x179, x204, Self::mul_add(-x168, x172, tau[3] - x157)),
+        );
+        let x207 = Self::mul_add(
+            -x188,
+            x205,
+            Self::mul_add(-x181, x204, Self::mul_add(-x168, x173, tau[4] - x151)),
+        );
+        let x208 = Self::mul_add(-x194, x206, x207);
         let x209 = Self::mul_add(
-            -x189,
-            x208,
-            Self::mul_add(-x182, x207, Self::mul_add(-x171, x175, tau[3] - x160)),
+            -x190,
+            x205,
+            Self::mul_add(-x183, x204, Self::mul_add(-x168, x174, tau[5] - x141)),
         );
-        let x210 = Self::mul_add(
-            -x191,
-            x208,
-            Self::mul_add(-x184, x207, Self::mul_add(-x171, x176, tau[4] - x154)),
+        let x210 = x203 * Self::mul_add(-x201, x208, Self::mul_add(-x196, x206, x209));
+        let x211 = Self::mul_add(-x201, x210, x198 * x208);
+        let x212 = Self::mul_add(-x196, x210, Self::mul_add(-x194, x211, x192 * x206));
+        let x213 = Self::mul_add(
+            -x190,
+            x210,
+            Self::mul_add(-x188, x211, Self::mul_add(-x186, x212, x184 * x205)),
         );
-        let x211 = Self::mul_add(-x197, x209, x210);
-        let x212 = Self::mul_add(
-            -x193,
-            x208,
-            Self::mul_add(-x186, x207, Self::mul_add(-x171, x177, tau[5] - x144)),
+        let x214 = Self::mul_add(
+            -x181,
+            x211,
+            Self::mul_add(-x179, x212, Self::mul_add(-x177, x213, x175 * x204)),
         );
-        let x213 = x206 * Self::mul_add(-x204, x211, Self::mul_add(-x199, x209, x212));
-        let x214 = Self::mul_add(-x204, x213, x201 * x211);
-        let x215 = Self::mul_add(-x199, x213, Self::mul_add(-x197, x214, x195 * x209));
+        let x215 = Self::mul_add(-x183, x210, x214);
         let x216 = Self::mul_add(
-            -x193,
-            x213,
-            Self::mul_add(-x191, x214, Self::mul_add(-x189, x215, x187 * x208)),
+            -x172,
+            x212,
+            Self::mul_add(-x171, x213, Self::mul_add(-x170, x215, x168 * x169)),
         );
-        let x217 = Self::mul_add(
-            -x184,
-            x214,
-            Self::mul_add(-x182, x215, Self::mul_add(-x180, x216, x178 * x207)),
-        );
-        let x218 = Self::mul_add(-x186, x213, x217);
-        let x219 = Self::mul_add(
-            -x175,
-            x215,
-            Self::mul_add(-x174, x216, Self::mul_add(-x173, x218, x171 * x172)),
-        );
-        let x220 = Self::mul_add(-x177, x213, Self::mul_add(-x176, x214, x219));
-        [x220, x218, x216, x215, x214, x213]
+        let x217 = Self::mul_add(-x174, x210, Self::mul_add(-x173, x211, x216));
+        [x217, x215, x213, x212, x211, x210]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

@@ -270,9 +270,9 @@ impl SsrmsRecurrent {
         let x20 = x7 * x11;
         let x21 = x5 * x14;
         let x22 = x7 * x14;
-        let x23 = -0.5692 * s_q1;
-        let x24 = -0.5692 * x5;
-        let x25 = -0.5692 * x7;
+        let x23 = s_q1 * 0.5692;
+        let x24 = x5 * 0.5692;
+        let x25 = x7 * 0.5692;
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x27 = c_q1 * c_q2;
         let x28 = c_q1 * s_q2;
@@ -289,9 +289,9 @@ impl SsrmsRecurrent {
         let x39 = Self::mul_add(49.52, x7, 15.41 * x31);
         let x40 = Self::mul_add(2094.71, x7, 49.52 * x31);
         let x41 = 2103.19 * x32;
-        let x42 = Self::mul_add(0.475, s_q1, 7.11 * x27);
-        let x43 = Self::mul_add(-0.475, x5, 7.11 * x29);
-        let x44 = Self::mul_add(-0.475, x7, 7.11 * x31);
+        let x42 = Self::mul_add(s_q1, 0.475, 7.11 * x27);
+        let x43 = Self::mul_add(x5, -0.475, 7.11 * x29);
+        let x44 = Self::mul_add(x7, -0.475, 7.11 * x31);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x46 = Self::mul_add(-x28, s_q3, x27 * c_q3);
         let x47 = Self::mul_add(x28, c_q3, x27 * s_q3);
@@ -299,14 +299,14 @@ impl SsrmsRecurrent {
         let x49 = Self::mul_add(x30, c_q3, x29 * s_q3);
         let x50 = Self::mul_add(-x32, s_q3, x31 * c_q3);
         let x51 = Self::mul_add(x32, c_q3, x31 * s_q3);
-        let x52 = Self::mul_add(39.95, s_q1, 9.522 * x46);
-        let x53 = Self::mul_add(-1966.28, s_q1, -39.95 * x46);
+        let x52 = Self::mul_add(s_q1, 39.95, 9.522 * x46);
+        let x53 = Self::mul_add(1966.28, s_q1, x46 * 39.95);
         let x54 = 1966.28 * x47;
-        let x55 = Self::mul_add(-39.95, x5, 9.522 * x48);
-        let x56 = Self::mul_add(1966.28, x5, -39.95 * x48);
+        let x55 = Self::mul_add(x5, -39.95, 9.522 * x48);
+        let x56 = Self::mul_add(x48, -39.95, 1966.28 * x5);
         let x57 = 1966.28 * x49;
-        let x58 = Self::mul_add(-39.95, x7, 9.522 * x50);
-        let x59 = Self::mul_add(1966.28, x7, -39.95 * x50);
+        let x58 = Self::mul_add(x7, -39.95, 9.522 * x50);
+        let x59 = Self::mul_add(x50, -39.95, 1966.28 * x7);
         let x60 = 1966.28 * x51;
         let x61 = 7.11 * x46;
         let x62 = 7.11 * x48;
@@ -340,9 +340,9 @@ impl SsrmsRecurrent {
         let x90 = 12.13 * x82;
         let x91 = 12.13 * x83;
         let x92 = 3.061 * x70;
-        let x93 = -0.7026 * x66;
-        let x94 = -0.7026 * x68;
-        let x95 = -0.7026 * x70;
+        let x93 = 0.7026 * x66;
+        let x94 = 0.7026 * x68;
+        let x95 = 0.7026 * x70;
         let (s_q6, c_q6) = libm::sincos(q[6]);
         let x97 = Self::mul_add(-x79, c_q6, x66 * s_q6);
         let x98 = Self::mul_add(x66, c_q6, x79 * s_q6);
@@ -368,32 +368,32 @@ impl SsrmsRecurrent {
         let x118 = Self::mul_add(x98, x111, Self::mul_add(x97, x110, x78 * x109));
         let x119 = Self::mul_add(x100, x111, Self::mul_add(x99, x110, x80 * x109));
         let x120 = Self::mul_add(x102, x111, Self::mul_add(x101, x110, x82 * x109));
-        let x121 = x93 - x23;
+        let x121 = x23 - x93;
         let x122 = x24 + x94;
         let x123 = x25 + x95;
         let x124 = x61 + x121;
-        let x125 = x62 + x122;
-        let x126 = x63 + x123;
+        let x125 = x62 - x122;
+        let x126 = x63 - x123;
         let x127 = x42 + x124;
         let x128 = x43 + x125;
         let x129 = x44 + x126;
-        let x130 = x24 + x128;
-        let x131 = x25 + x129;
-        let x132 = x61 - x23;
-        let x133 = x24 + x62;
-        let x134 = x25 + x63;
+        let x130 = x128 - x24;
+        let x131 = x129 - x25;
+        let x132 = x23 + x61;
+        let x133 = x62 - x24;
+        let x134 = x63 - x25;
         let x135 = x42 + x132;
         let x136 = x43 + x133;
         let x137 = x44 + x134;
-        let x138 = x24 + x136;
-        let x139 = x25 + x137;
+        let x138 = x136 - x24;
+        let x139 = x137 - x25;
         let x140 = x42 + x61;
         let x141 = x43 + x62;
         let x142 = x44 + x63;
-        let x143 = x24 + x141;
-        let x144 = x25 + x142;
-        let x145 = x24 + x43;
-        let x146 = x25 + x44;
+        let x143 = x141 - x24;
+        let x144 = x142 - x25;
+        let x145 = x43 - x24;
+        let x146 = x44 - x25;
         let x147 = 243.66 * x93;
         let x148 = 243.66 * x94;
         let x149 = 243.66 * x95;
@@ -406,7 +406,7 @@ impl SsrmsRecurrent {
         let x156 = 243.66 * x127;
         let x157 = 243.66 * x128;
         let x158 = 243.66 * x129;
-        let x159 = 243.66 * (x127 - x23);
+        let x159 = 243.66 * (x23 + x127);
         let x160 = 243.66 * x130;
         let x161 = 243.66 * x131;
         let x162 = 243.66 * (x130 - x1);
@@ -429,9 +429,9 @@ impl SsrmsRecurrent {
         let x179 = Self::mul_add(x66, x76, Self::mul_add(-s_q1, x14, x65 * x75)) + x170;
         let x180 = Self::mul_add(x68, x76, Self::mul_add(x67, x75, x21)) + x171;
         let x181 = Self::mul_add(x70, x76, Self::mul_add(x69, x75, x22)) + x172;
-        let x182 = Self::mul_add(x47, x54, Self::mul_add(-s_q1, x53, x46 * x52)) + x173;
-        let x183 = Self::mul_add(x49, x54, Self::mul_add(x5, x53, x48 * x52)) + x174;
-        let x184 = Self::mul_add(x51, x54, Self::mul_add(x7, x53, x50 * x52)) + x175;
+        let x182 = Self::mul_add(x47, x54, Self::mul_add(s_q1, x53, x46 * x52)) + x173;
+        let x183 = Self::mul_add(x49, x54, Self::mul_add(-x5, x53, x48 * x52)) + x174;
+        let x184 = Self::mul_add(x51, x54, Self::mul_add(-x7, x53, x50 * x52)) + x175;
         let x185 = Self::mul_add(x47, x57, Self::mul_add(-s_q1, x56, x46 * x55)) + x176;
         let x186 = Self::mul_add(x49, x57, Self::mul_add(x5, x56, x48 * x55)) + x177;
         let x187 = Self::mul_add(x51, x57, Self::mul_add(x7, x56, x50 * x55)) + x178;
@@ -447,7 +447,7 @@ impl SsrmsRecurrent {
         let x197 = Self::mul_add(x28, x41, Self::mul_add(-s_q1, x40, x27 * x39)) + x188;
         let x198 = Self::mul_add(x30, x41, Self::mul_add(x5, x40, x29 * x39)) + x189;
         let x199 = Self::mul_add(x32, x41, Self::mul_add(x7, x40, x31 * x39)) + x190;
-        let x200 = Self::mul_add(-105.98, x23, x150);
+        let x200 = Self::mul_add(105.98, x23, x150);
         let x201 = Self::mul_add(105.98, x24, x151);
         let x202 = Self::mul_add(105.98, x25, x152);
         let x203 = Self::mul_add(105.98, x132, x153);
@@ -465,25 +465,25 @@ impl SsrmsRecurrent {
         let x215 = Self::mul_add(279.2, x42, x212);
         let x216 = Self::mul_add(279.2, x43, x213);
         let x217 = Self::mul_add(279.2, x44, x214);
-        let x218 = Self::mul_add(105.98, x135 - x23, x159);
+        let x218 = Self::mul_add(105.98, x23 + x135, x159);
         let x219 = Self::mul_add(105.98, x138, x160);
         let x220 = Self::mul_add(105.98, x139, x161);
-        let x221 = Self::mul_add(105.98, x140 - x23, x218);
+        let x221 = Self::mul_add(105.98, x23 + x140, x218);
         let x222 = Self::mul_add(105.98, x143, x219);
         let x223 = Self::mul_add(105.98, x144, x220);
-        let x224 = Self::mul_add(279.2, x42 - x23, x221);
+        let x224 = Self::mul_add(279.2, x23 + x42, x221);
         let x225 = Self::mul_add(279.2, x145, x222);
         let x226 = Self::mul_add(279.2, x146, x223);
-        let x227 = Self::mul_add(314.88, x24, x225);
-        let x228 = Self::mul_add(314.88, x25, x226);
+        let x227 = Self::mul_add(-314.88, x24, x225);
+        let x228 = Self::mul_add(-314.88, x25, x226);
         let x229 = Self::mul_add(105.98, x138 - x1, x162);
         let x230 = Self::mul_add(105.98, x2 + x139, x163);
         let x231 = Self::mul_add(105.98, x143 - x1, x229);
         let x232 = Self::mul_add(105.98, x2 + x144, x230);
         let x233 = Self::mul_add(279.2, x145 - x1, x231);
         let x234 = Self::mul_add(279.2, x2 + x146, x232);
-        let x235 = Self::mul_add(314.88, x24 - x1, x233);
-        let x236 = Self::mul_add(314.88, x2 + x25, x234);
+        let x235 = Self::mul_add(-314.88, x1 + x24, x233);
+        let x236 = Self::mul_add(314.88, x2 - x25, x234);
         let x237 = Self::mul_add(x94, x162, x95 * x163);
         let x238 = x93 * x162;
         let x239 = x93 * x163;
@@ -525,11 +525,11 @@ impl SsrmsRecurrent {
         let x275 = x93 * x152;
         let x276 = x94 * x150;
         let x277 = x93 * x150;
-        let x278 = x271 + x277;
+        let x278 = x271 - x277;
         let x279 = x94 * x152;
         let x280 = x95 * x150;
         let x281 = x95 * x151;
-        let x282 = x272 + x277;
+        let x282 = x272 - x277;
         let x283 = x95 * x149;
         let x284 = x94 * x148;
         let x285 = x93 * x147;
@@ -540,14 +540,14 @@ impl SsrmsRecurrent {
         let x290 = x24 * x204;
         let x291 = x23 * x203;
         let x292 = x261 + (x289 + x290);
-        let x293 = Self::mul_add(x23, x204, -x262);
-        let x294 = Self::mul_add(x23, x205, -x263);
+        let x293 = Self::mul_add(-x23, x204, x262);
+        let x294 = Self::mul_add(-x23, x205, x263);
         let x295 = Self::mul_add(x24, x203, x264);
-        let x296 = x266 + (x289 - x291);
+        let x296 = x291 - x289 - x266;
         let x297 = Self::mul_add(x24, x205, x267);
         let x298 = Self::mul_add(x25, x203, x268);
         let x299 = Self::mul_add(x25, x204, x269);
-        let x300 = x270 + (x290 - x291);
+        let x300 = x291 - x290 - x270;
         let x301 = x63 * x208;
         let x302 = x62 * x207;
         let x303 = x61 * x206;
@@ -555,60 +555,60 @@ impl SsrmsRecurrent {
         let x305 = x24 * x210;
         let x306 = x23 * x209;
         let x307 = x249 + (x304 + x305);
-        let x308 = Self::mul_add(x23, x210, -x250);
-        let x309 = Self::mul_add(x23, x211, -x251);
+        let x308 = Self::mul_add(-x23, x210, x250);
+        let x309 = Self::mul_add(-x23, x211, x251);
         let x310 = Self::mul_add(x24, x209, x252);
-        let x311 = x254 + (x304 - x306);
+        let x311 = x306 - x304 - x254;
         let x312 = Self::mul_add(x24, x211, x255);
         let x313 = Self::mul_add(x25, x209, x256);
         let x314 = Self::mul_add(x25, x210, x257);
-        let x315 = x258 + (x305 - x306);
+        let x315 = x306 - x305 - x258;
         let x316 = x63 * x214;
         let x317 = x62 * x213;
         let x318 = x61 * x212;
-        let x319 = x307 + (x316 + x317);
+        let x319 = x316 + x317 - x307;
         let x320 = Self::mul_add(-x61, x213, x308);
         let x321 = Self::mul_add(-x61, x214, x309);
-        let x322 = Self::mul_add(x62, x212, x310);
+        let x322 = Self::mul_add(-x62, x212, x310);
         let x323 = x311 + (x316 + x318);
-        let x324 = Self::mul_add(x62, x214, x312);
-        let x325 = Self::mul_add(x63, x212, x313);
-        let x326 = Self::mul_add(x63, x213, x314);
+        let x324 = Self::mul_add(-x62, x214, x312);
+        let x325 = Self::mul_add(-x63, x212, x313);
+        let x326 = Self::mul_add(-x63, x213, x314);
         let x327 = x315 + (x317 + x318);
         let x328 = x44 * x217;
         let x329 = x43 * x216;
         let x330 = x42 * x215;
         let x331 = x23 * x218;
         let x332 = Self::mul_add(x24, x218, x240);
-        let x333 = x243 + Self::mul_add(x25, x220, -x331);
+        let x333 = Self::mul_add(-x25, x220, x331) - x243;
         let x334 = Self::mul_add(x24, x220, x244);
         let x335 = Self::mul_add(x25, x218, x242);
         let x336 = Self::mul_add(x25, x219, x245);
-        let x337 = x246 + Self::mul_add(x24, x219, -x331);
+        let x337 = Self::mul_add(-x24, x219, x331) - x246;
         let x338 = x61 * x221;
-        let x339 = Self::mul_add(x62, x221, x332);
+        let x339 = Self::mul_add(-x62, x221, x332);
         let x340 = x333 + Self::mul_add(x63, x223, x338);
-        let x341 = Self::mul_add(x62, x223, x334);
-        let x342 = Self::mul_add(x63, x221, x335);
-        let x343 = Self::mul_add(x63, x222, x336);
+        let x341 = Self::mul_add(-x62, x223, x334);
+        let x342 = Self::mul_add(-x63, x221, x335);
+        let x343 = Self::mul_add(-x63, x222, x336);
         let x344 = x337 + Self::mul_add(x62, x222, x338);
         let x345 = x42 * x224;
         let x346 = x340 + Self::mul_add(x44, x226, x345);
-        let x347 = Self::mul_add(x43, x226, x341);
-        let x348 = Self::mul_add(x44, x225, x343);
+        let x347 = Self::mul_add(-x43, x226, x341);
+        let x348 = Self::mul_add(-x44, x225, x343);
         let x349 = x344 + Self::mul_add(x43, x225, x345);
-        let x350 = x23 * Self::mul_add(-314.88, x23, x224);
+        let x350 = x23 * Self::mul_add(314.88, x23, x224);
         let x351 = x237 + Self::mul_add(x24, x229, x25 * x230);
-        let x352 = Self::mul_add(x23, x229, -x238);
-        let x353 = Self::mul_add(x23, x230, -x239);
-        let x354 = x351 + Self::mul_add(x62, x231, x63 * x232);
+        let x352 = Self::mul_add(-x23, x229, x238);
+        let x353 = Self::mul_add(-x23, x230, x239);
+        let x354 = Self::mul_add(x62, x231, x63 * x232) - x351;
         let x355 = Self::mul_add(-x61, x231, x352);
         let x356 = Self::mul_add(-x61, x232, x353);
         let x357 = x354 + Self::mul_add(x43, x233, x44 * x234);
         let x358 = Self::mul_add(-x42, x233, x355);
         let x359 = Self::mul_add(-x42, x234, x356);
         let x360 = 12.19 + (Self::mul_add(c_q1, x8, x16) + x191)
-            + (x357 + Self::mul_add(x24, x235, x25 * x236)
+            + (x357 - Self::mul_add(x24, x235, x25 * x236)
                 + Self::mul_add(
                     -x1,
                     Self::mul_add(-105.98, x1, x235),
@@ -616,8 +616,8 @@ impl SsrmsRecurrent {
                 ));
         let x361 = Self::mul_add(
             -s_q0,
-            Self::mul_add(x4, x8, -x17) + x192 + Self::mul_add(x23, x235, x358),
-            c_q0 * (Self::mul_add(x6, x8, -x18) + x193 + Self::mul_add(x23, x236, x359)),
+            Self::mul_add(x4, x8, -x17) + x192 + Self::mul_add(-x23, x235, x358),
+            c_q0 * (Self::mul_add(x6, x8, -x18) + x193 + Self::mul_add(-x23, x236, x359)),
         );
         let x362 = Self::mul_add(
             x7,
@@ -632,12 +632,12 @@ impl SsrmsRecurrent {
         let x364 = Self::mul_add(
             x7,
             x175 + x353,
-            Self::mul_add(-s_q1, x173 + x351, x5 * (x174 + x352)),
+            Self::mul_add(-s_q1, x173 - x351, x5 * (x174 + x352)),
         );
         let x365 = Self::mul_add(
             x70,
-            x166 - x239,
-            Self::mul_add(x68, x165 - x238, x66 * (x164 + x237)),
+            x166 + x239,
+            Self::mul_add(x68, x165 + x238, x66 * (x164 - x237)),
         );
         let x366 = Self::mul_add(x82, x114, Self::mul_add(x80, x113, x78 * x112));
         let x367 = Self::mul_add(x82, x117, Self::mul_add(x80, x116, x78 * x115));
@@ -645,26 +645,26 @@ impl SsrmsRecurrent {
         let x369 = Self::mul_add(
             -s_q0,
             Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x19)) + x195
-                + (x346 + Self::mul_add(x25, x228, -x350)),
+                + (x346 + Self::mul_add(-x25, x228, x350)),
             c_q0
                 * (Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x20)) + x196
-                    - Self::mul_add(x24, x228, x347)),
+                    + Self::mul_add(x24, x228, x347)),
         );
         let x370 = Self::mul_add(
             -s_q0,
             Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x21)) + x198
-                - Self::mul_add(x25, x227, x348),
+                + Self::mul_add(x25, x227, x348),
             c_q0
                 * (Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x22)) + x199
-                    + (x349 + Self::mul_add(x24, x227, -x350))),
+                    + (x349 + Self::mul_add(-x24, x227, x350))),
         );
         let x371 = Self::mul_add(-s_q0, x369, c_q0 * x370);
         let x372 = Self::mul_add(
             x7,
-            x196 - x347,
+            x196 + x347,
             Self::mul_add(
                 -s_q1,
-                x194 - Self::mul_add(x43, x224, x339),
+                x194 + Self::mul_add(-x43, x224, x339),
                 x5 * (x195 + x346),
             ),
         );
@@ -673,8 +673,8 @@ impl SsrmsRecurrent {
             x199 + x349,
             Self::mul_add(
                 -s_q1,
-                x197 - Self::mul_add(x44, x224, x342),
-                x5 * (x198 - x348),
+                x197 + Self::mul_add(-x44, x224, x342),
+                x5 * (x198 + x348),
             ),
         );
         let x374 = Self::mul_add(-s_q0, x372, c_q0 * x373);
@@ -682,42 +682,42 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 x7,
-                x187 - x341,
-                Self::mul_add(-s_q1, x185 - x339, x5 * (x186 + x340)),
+                x187 + x341,
+                Self::mul_add(-s_q1, x185 + x339, x5 * (x186 + x340)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x190 + x344,
-                    Self::mul_add(-s_q1, x188 - x342, x5 * (x189 - x343)),
+                    Self::mul_add(-s_q1, x188 + x342, x5 * (x189 + x343)),
                 ),
         );
         let x376 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x178 - x334,
-                Self::mul_add(-s_q1, x176 - x332, x5 * (x177 + x333)),
+                x178 + x334,
+                Self::mul_add(-s_q1, x176 + x332, x5 * (x177 + x333)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x181 + x337,
-                    Self::mul_add(-s_q1, x179 - x335, x5 * (x180 - x336)),
+                    Self::mul_add(-s_q1, x179 + x335, x5 * (x180 + x336)),
                 ),
         );
         let x377 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x70,
-                x169 - x244,
-                Self::mul_add(x68, x168 + x243, x66 * (x167 - x240)),
+                x169 + x244,
+                Self::mul_add(x68, x168 - x243, x66 * (x167 + x240)),
             ),
             c_q0
                 * Self::mul_add(
                     x70,
-                    x172 + x246,
-                    Self::mul_add(x68, x171 - x245, x66 * (x170 - x242)),
+                    x172 - x246,
+                    Self::mul_add(x68, x171 + x245, x66 * (x170 + x242)),
                 ),
         );
         let x378 = Self::mul_add(-s_q0, x367, c_q0 * x368);
@@ -732,10 +732,10 @@ impl SsrmsRecurrent {
         );
         let x380 = Self::mul_add(
             x7,
-            x196 - Self::mul_add(x43, x217, x324),
+            x196 + Self::mul_add(-x43, x217, x324),
             Self::mul_add(
                 -s_q1,
-                x194 - Self::mul_add(x43, x215, x322),
+                x194 + Self::mul_add(-x43, x215, x322),
                 x5 * (x195 + (x323 + (x328 + x330))),
             ),
         );
@@ -744,8 +744,8 @@ impl SsrmsRecurrent {
             x199 + (x327 + (x329 + x330)),
             Self::mul_add(
                 -s_q1,
-                x197 - Self::mul_add(x44, x215, x325),
-                x5 * (x198 - Self::mul_add(x44, x216, x326)),
+                x197 + Self::mul_add(-x44, x215, x325),
+                x5 * (x198 + Self::mul_add(-x44, x216, x326)),
             ),
         );
         let x382 = Self::mul_add(x7, x381, Self::mul_add(-s_q1, x379, x5 * x380));
@@ -759,8 +759,8 @@ impl SsrmsRecurrent {
             x5
                 * Self::mul_add(
                     x7,
-                    x187 - x324,
-                    Self::mul_add(-s_q1, x185 - x322, x5 * (x186 + x323)),
+                    x187 + x324,
+                    Self::mul_add(-s_q1, x185 + x322, x5 * (x186 + x323)),
                 ),
         );
         let x384 = Self::mul_add(
@@ -768,7 +768,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x190 + x327,
-                Self::mul_add(-s_q1, x188 - x325, x5 * (x189 - x326)),
+                Self::mul_add(-s_q1, x188 + x325, x5 * (x189 + x326)),
             ),
             x383,
         );
@@ -777,13 +777,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x175 + x309,
-                Self::mul_add(-s_q1, x173 + x307, x5 * (x174 + x308)),
+                Self::mul_add(-s_q1, x173 - x307, x5 * (x174 + x308)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x178 - x312,
-                    Self::mul_add(-s_q1, x176 - x310, x5 * (x177 + x311)),
+                    x178 + x312,
+                    Self::mul_add(-s_q1, x176 + x310, x5 * (x177 + x311)),
                 ),
         );
         let x386 = Self::mul_add(
@@ -791,7 +791,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x181 + x315,
-                Self::mul_add(-s_q1, x179 - x313, x5 * (x180 - x314)),
+                Self::mul_add(-s_q1, x179 + x313, x5 * (x180 + x314)),
             ),
             x385,
         );
@@ -799,22 +799,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x70,
-                x166 - x251,
-                Self::mul_add(x68, x165 - x250, x66 * (x164 + x249)),
+                x166 + x251,
+                Self::mul_add(x68, x165 + x250, x66 * (x164 - x249)),
             ),
             x5
                 * Self::mul_add(
                     x70,
-                    x169 - x255,
-                    Self::mul_add(x68, x168 + x254, x66 * (x167 - x252)),
+                    x169 + x255,
+                    Self::mul_add(x68, x168 - x254, x66 * (x167 + x252)),
                 ),
         );
         let x388 = Self::mul_add(
             x7,
             Self::mul_add(
                 x70,
-                x172 + x258,
-                Self::mul_add(x68, x171 - x257, x66 * (x170 - x256)),
+                x172 - x258,
+                Self::mul_add(x68, x171 + x257, x66 * (x170 + x256)),
             ),
             x387,
         );
@@ -824,16 +824,16 @@ impl SsrmsRecurrent {
             x184 + Self::mul_add(-x61, x208, x294),
             Self::mul_add(
                 -s_q1,
-                x182 + (x292 + (x301 + x302)),
+                x182 + (x301 + x302 - x292),
                 x5 * (x183 + Self::mul_add(-x61, x207, x293)),
             ),
         );
         let x391 = Self::mul_add(
             x7,
-            x187 - Self::mul_add(x62, x208, x297),
+            x187 + Self::mul_add(-x62, x208, x297),
             Self::mul_add(
                 -s_q1,
-                x185 - Self::mul_add(x62, x206, x295),
+                x185 + Self::mul_add(-x62, x206, x295),
                 x5 * (x186 + (x296 + (x301 + x303))),
             ),
         );
@@ -842,8 +842,8 @@ impl SsrmsRecurrent {
             x190 + (x300 + (x302 + x303)),
             Self::mul_add(
                 -s_q1,
-                x188 - Self::mul_add(x63, x206, x298),
-                x5 * (x189 - Self::mul_add(x63, x207, x299)),
+                x188 + Self::mul_add(-x63, x206, x298),
+                x5 * (x189 + Self::mul_add(-x63, x207, x299)),
             ),
         );
         let x393 = Self::mul_add(x7, x392, Self::mul_add(-s_q1, x390, x5 * x391));
@@ -852,13 +852,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x175 + x294,
-                Self::mul_add(-s_q1, x173 + x292, x5 * (x174 + x293)),
+                Self::mul_add(-s_q1, x173 - x292, x5 * (x174 + x293)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x178 - x297,
-                    Self::mul_add(-s_q1, x176 - x295, x5 * (x177 + x296)),
+                    x178 + x297,
+                    Self::mul_add(-s_q1, x176 + x295, x5 * (x177 + x296)),
                 ),
         );
         let x395 = Self::mul_add(
@@ -866,7 +866,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x181 + x300,
-                Self::mul_add(-s_q1, x179 - x298, x5 * (x180 - x299)),
+                Self::mul_add(-s_q1, x179 + x298, x5 * (x180 + x299)),
             ),
             x394,
         );
@@ -874,22 +874,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x70,
-                x166 - x263,
-                Self::mul_add(x68, x165 - x262, x66 * (x164 + x261)),
+                x166 + x263,
+                Self::mul_add(x68, x165 + x262, x66 * (x164 - x261)),
             ),
             x5
                 * Self::mul_add(
                     x70,
-                    x169 - x267,
-                    Self::mul_add(x68, x168 + x266, x66 * (x167 - x264)),
+                    x169 + x267,
+                    Self::mul_add(x68, x168 - x266, x66 * (x167 + x264)),
                 ),
         );
         let x397 = Self::mul_add(
             x7,
             Self::mul_add(
                 x70,
-                x172 + x270,
-                Self::mul_add(x68, x171 - x269, x66 * (x170 - x268)),
+                x172 - x270,
+                Self::mul_add(x68, x171 + x269, x66 * (x170 + x268)),
             ),
             x396,
         );
@@ -907,16 +907,16 @@ impl SsrmsRecurrent {
             x178 - Self::mul_add(x24, x202, x279),
             Self::mul_add(
                 -s_q1,
-                x176 - Self::mul_add(x24, x200, x276),
-                x5 * (x177 + (x278 + (x286 - x288))),
+                x176 + Self::mul_add(x24, x200, x276),
+                x5 * (x177 + (x278 + (x286 + x288))),
             ),
         );
         let x400 = Self::mul_add(
             x7,
-            x181 + (x282 + (x287 - x288)),
+            x181 + (x282 + (x287 + x288)),
             Self::mul_add(
                 -s_q1,
-                x179 - Self::mul_add(x25, x200, x280),
+                x179 + Self::mul_add(x25, x200, x280),
                 x5 * (x180 - Self::mul_add(x25, x201, x281)),
             ),
         );
@@ -932,7 +932,7 @@ impl SsrmsRecurrent {
                 * Self::mul_add(
                     x70,
                     x169 - x279,
-                    Self::mul_add(x68, x168 + x278, x66 * (x167 - x276)),
+                    Self::mul_add(x68, x168 + x278, x66 * (x167 + x276)),
                 ),
         );
         let x403 = Self::mul_add(
@@ -940,7 +940,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x70,
                 x172 + x282,
-                Self::mul_add(x68, x171 - x281, x66 * (x170 - x280)),
+                Self::mul_add(x68, x171 - x281, x66 * (x170 + x280)),
             ),
             x402,
         );
@@ -1020,9 +1020,9 @@ impl SsrmsRecurrent {
         let x28 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x27));
         let x29 = x7 * x14;
         let x30 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x29));
-        let x31 = -0.5692 * s_q1;
-        let x32 = -0.5692 * x5;
-        let x33 = -0.5692 * x7;
+        let x31 = s_q1 * 0.5692;
+        let x32 = x5 * 0.5692;
+        let x33 = x7 * 0.5692;
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x35 = c_q1 * c_q2;
         let x36 = c_q1 * s_q2;
@@ -1048,9 +1048,9 @@ impl SsrmsRecurrent {
         let x56 = Self::mul_add(x36, x49, Self::mul_add(-s_q1, x48, x35 * x47));
         let x57 = Self::mul_add(x38, x49, Self::mul_add(x5, x48, x37 * x47));
         let x58 = Self::mul_add(x40, x49, Self::mul_add(x7, x48, x39 * x47));
-        let x59 = Self::mul_add(0.475, s_q1, 7.11 * x35);
-        let x60 = Self::mul_add(-0.475, x5, 7.11 * x37);
-        let x61 = Self::mul_add(-0.475, x7, 7.11 * x39);
+        let x59 = Self::mul_add(s_q1, 0.475, 7.11 * x35);
+        let x60 = Self::mul_add(x5, -0.475, 7.11 * x37);
+        let x61 = Self::mul_add(x7, -0.475, 7.11 * x39);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x63 = Self::mul_add(-x36, s_q3, x35 * c_q3);
         let x64 = Self::mul_add(x36, c_q3, x35 * s_q3);
@@ -1058,18 +1058,18 @@ impl SsrmsRecurrent {
         let x66 = Self::mul_add(x38, c_q3, x37 * s_q3);
         let x67 = Self::mul_add(-x40, s_q3, x39 * c_q3);
         let x68 = Self::mul_add(x40, c_q3, x39 * s_q3);
-        let x69 = Self::mul_add(39.95, s_q1, 9.522 * x63);
-        let x70 = Self::mul_add(-1966.28, s_q1, -39.95 * x63);
+        let x69 = Self::mul_add(s_q1, 39.95, 9.522 * x63);
+        let x70 = Self::mul_add(1966.28, s_q1, x63 * 39.95);
         let x71 = 1966.28 * x64;
-        let x72 = Self::mul_add(-39.95, x5, 9.522 * x65);
-        let x73 = Self::mul_add(1966.28, x5, -39.95 * x65);
+        let x72 = Self::mul_add(x5, -39.95, 9.522 * x65);
+        let x73 = Self::mul_add(x65, -39.95, 1966.28 * x5);
         let x74 = 1966.28 * x66;
-        let x75 = Self::mul_add(-39.95, x7, 9.522 * x67);
-        let x76 = Self::mul_add(1966.28, x7, -39.95 * x67);
+        let x75 = Self::mul_add(x7, -39.95, 9.522 * x67);
+        let x76 = Self::mul_add(x67, -39.95, 1966.28 * x7);
         let x77 = 1966.28 * x68;
-        let x78 = Self::mul_add(x64, x71, Self::mul_add(-s_q1, x70, x63 * x69));
-        let x79 = Self::mul_add(x66, x71, Self::mul_add(x5, x70, x65 * x69));
-        let x80 = Self::mul_add(x68, x71, Self::mul_add(x7, x70, x67 * x69));
+        let x78 = Self::mul_add(x64, x71, Self::mul_add(s_q1, x70, x63 * x69));
+        let x79 = Self::mul_add(x66, x71, Self::mul_add(-x5, x70, x65 * x69));
+        let x80 = Self::mul_add(x68, x71, Self::mul_add(-x7, x70, x67 * x69));
         let x81 = Self::mul_add(x64, x74, Self::mul_add(-s_q1, x73, x63 * x72));
         let x82 = Self::mul_add(x66, x74, Self::mul_add(x5, x73, x65 * x72));
         let x83 = Self::mul_add(x68, x74, Self::mul_add(x7, x73, x67 * x72));
@@ -1126,9 +1126,9 @@ impl SsrmsRecurrent {
         let x134 = Self::mul_add(x92, x127, Self::mul_add(-x114, x126, x113 * x125));
         let x135 = Self::mul_add(x94, x127, Self::mul_add(x116, x126, x115 * x125));
         let x136 = Self::mul_add(x96, x127, Self::mul_add(x118, x126, x117 * x125));
-        let x137 = -0.7026 * x92;
-        let x138 = -0.7026 * x94;
-        let x139 = -0.7026 * x96;
+        let x137 = 0.7026 * x92;
+        let x138 = 0.7026 * x94;
+        let x139 = 0.7026 * x96;
         let (s_q6, c_q6) = libm::sincos(q[6]);
         let x141 = Self::mul_add(-x114, c_q6, x92 * s_q6);
         let x142 = Self::mul_add(x92, c_q6, x114 * s_q6);
@@ -1170,16 +1170,15 @@ impl SsrmsRecurrent {
         let x178 = x31 * (x175 + x176);
         let x179 = x168
             + Self::mul_add(
-                -x33,
-                x177,
-                Self::mul_add(-x32, x167 + x175, x31 * (x171 + x171)),
-            );
-        let x180 = x169
-            + Self::mul_add(
                 x33,
-                x167 + x176,
-                Self::mul_add(x32, x177, x31 * (x170 + x170)),
+                x177,
+                Self::mul_add(-x31, x171 + x171, x32 * (x167 + x175)),
             );
+        let x180 = Self::mul_add(
+            x33,
+            x167 + x176,
+            Self::mul_add(x32, x177, x31 * (x170 + x170)),
+        ) - x169;
         let x181 = qd[0] - x172;
         let x182 = x173 - x165;
         let x183 = x166 + x174;
@@ -1195,23 +1194,23 @@ impl SsrmsRecurrent {
         let x193 = x181 * x183;
         let x194 = x181 * x181;
         let x195 = x182 * x183;
-        let x196 = x178
-            + Self::mul_add(
-                x61,
-                x193 - x185,
-                Self::mul_add(-x59, x190 + x191, x60 * (x192 - x186)),
-            );
+        let x196 = Self::mul_add(
+            x61,
+            x193 - x185,
+            Self::mul_add(-x59, x190 + x191, x60 * (x192 - x186)),
+        ) - x178;
         let x197 = x179
             + Self::mul_add(
                 x61,
                 x184 + x195,
                 Self::mul_add(-x60, x190 + x194, x59 * (x186 + x192)),
             );
-        let x198 = Self::mul_add(
-            -x61,
-            x191 + x194,
-            Self::mul_add(x60, x195 - x184, x59 * (x185 + x193)),
-        ) - x180;
+        let x198 = x180
+            + Self::mul_add(
+                -x61,
+                x191 + x194,
+                Self::mul_add(x60, x195 - x184, x59 * (x185 + x193)),
+            );
         let x199 = x181 - x187;
         let x200 = x182 + x188;
         let x201 = x183 + x189;
@@ -1261,22 +1260,22 @@ impl SsrmsRecurrent {
         let x230 = x217 * x217;
         let x231 = x218 * x219;
         let x232 = x214
-            + Self::mul_add(
+            - Self::mul_add(
                 x33,
                 x229 - x221,
                 Self::mul_add(x32, x228 - x222, x31 * (x226 + x227)),
             );
         let x233 = x215
             + Self::mul_add(
-                x33,
+                -x33,
                 x231 - x220,
-                -Self::mul_add(x32, x226 + x230, x31 * (x222 + x228)),
+                Self::mul_add(x32, x226 + x230, x31 * (x222 + x228)),
             );
         let x234 = x216
             + Self::mul_add(
-                -x33,
+                x33,
                 x227 + x230,
-                Self::mul_add(-x31, x221 + x229, x32 * (x220 + x231)),
+                Self::mul_add(-x32, x220 + x231, x31 * (x221 + x229)),
             );
         let x235 = x217 + x223;
         let x236 = x218 + x224;
@@ -1329,23 +1328,23 @@ impl SsrmsRecurrent {
         let x271 = 243.66
             * (x232
                 + Self::mul_add(
-                    x139,
+                    -x139,
                     x239 + x247,
-                    Self::mul_add(-x137, x244 + x245, x138 * (x246 - x240)),
+                    Self::mul_add(-x138, x246 - x240, x137 * (x244 + x245)),
                 ));
         let x272 = 243.66
             * (x233
                 + Self::mul_add(
-                    x139,
+                    -x139,
                     x249 - x238,
-                    Self::mul_add(-x138, x244 + x248, x137 * (x240 + x246)),
+                    Self::mul_add(-x137, x240 + x246, x138 * (x244 + x248)),
                 ));
         let x273 = 243.66
             * (x234
                 + Self::mul_add(
-                    -x139,
+                    x139,
                     x245 + x248,
-                    Self::mul_add(x138, x238 + x249, x137 * (x247 - x239)),
+                    -Self::mul_add(x138, x238 + x249, x137 * (x247 - x239)),
                 ));
         let x274 = Self::mul_add(x158, x252, Self::mul_add(x157, x251, x156 * x250));
         let x275 = Self::mul_add(x161, x252, Self::mul_add(x160, x251, x159 * x250));
@@ -1365,30 +1364,30 @@ impl SsrmsRecurrent {
         let x286 = Self::mul_add(279.2, x196, x283);
         let x287 = Self::mul_add(279.2, x197, x284);
         let x288 = Self::mul_add(279.2, x198, x285);
-        let x289 = Self::mul_add(314.88, x178, x286);
+        let x289 = Self::mul_add(314.88, x178, -x286);
         let x290 = Self::mul_add(314.88, x179, x287);
-        let x291 = Self::mul_add(314.88, x180, -x288);
-        let x292 = Self::mul_add(-x138, x273, x139 * x272)
+        let x291 = Self::mul_add(314.88, x180, x288);
+        let x292 = Self::mul_add(-x139, x272, x138 * x273)
             - (Self::mul_add(x130, x240, Self::mul_add(x129, x239, x128 * x238))
                 + Self::mul_add(-x237, x269, x236 * x270) + x277);
-        let x293 = Self::mul_add(-x139, x271, x137 * x273)
+        let x293 = Self::mul_add(-x137, x273, x139 * x271)
             - (Self::mul_add(x133, x240, Self::mul_add(x132, x239, x131 * x238))
                 + Self::mul_add(-x235, x270, x237 * x268) + x278);
-        let x294 = Self::mul_add(-x137, x272, x138 * x271)
+        let x294 = Self::mul_add(-x138, x271, x137 * x272)
             - (Self::mul_add(x136, x240, Self::mul_add(x135, x239, x134 * x238))
                 + Self::mul_add(-x236, x268, x235 * x269) + x279);
         let x295 = x292
             - (Self::mul_add(x105, x222, Self::mul_add(-x104, x221, x103 * x220))
                 + Self::mul_add(-x219, x266, x218 * x267))
-            + Self::mul_add(-x32, x282, x33 * x281);
+            + Self::mul_add(-x33, x281, x32 * x282);
         let x296 = x293
             - (Self::mul_add(x108, x222, Self::mul_add(-x107, x221, x106 * x220))
                 + Self::mul_add(-x217, x267, x219 * x265))
-            - Self::mul_add(x31, x282, x33 * x280);
+            + Self::mul_add(x31, x282, x33 * x280);
         let x297 = x294
             - (Self::mul_add(x111, x222, Self::mul_add(-x110, x221, x109 * x220))
                 + Self::mul_add(-x218, x265, x217 * x266))
-            + Self::mul_add(x31, x281, x32 * x280);
+            - Self::mul_add(x31, x281, x32 * x280);
         let x298 = x295
             - (Self::mul_add(x80, x204, Self::mul_add(-x79, x203, x78 * x202))
                 + Self::mul_add(-x201, x263, x200 * x264))
@@ -1416,10 +1415,10 @@ impl SsrmsRecurrent {
         let x304 = Self::mul_add(x117, x279, Self::mul_add(x115, x278, x113 * x277));
         let x305 = -(Self::mul_add(x20, x171, x18 * x170)
             + Self::mul_add(x165, x258, x166 * x257) + x301
-            + Self::mul_add(x32, x291, x33 * x290)
+            + Self::mul_add(-x33, x290, x32 * x291)
             + Self::mul_add(
                 -x1,
-                Self::mul_add(105.98, x169, x291),
+                Self::mul_add(105.98, x169, -x291),
                 x2 * Self::mul_add(105.98, x168, x290),
             ));
         let x306 = -Self::mul_add(
@@ -1432,7 +1431,7 @@ impl SsrmsRecurrent {
                 * (x303
                     - (Self::mul_add(qd[0], x257, x165 * x256)
                         - Self::mul_add(x30, x171, x28 * x170))
-                    + Self::mul_add(x31, x290, x32 * x289)),
+                    + Self::mul_add(-x31, x290, x32 * x289)),
         );
         let x307 = -Self::mul_add(x7, x303, Self::mul_add(-s_q1, x301, x5 * x302));
         let x308 = -Self::mul_add(x7, x300, Self::mul_add(-s_q1, x298, x5 * x299));
@@ -1477,9 +1476,9 @@ impl SsrmsRecurrent {
         let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
         let x30 = x7 * x14;
         let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = -0.5692 * s_q1;
-        let x33 = -0.5692 * x5;
-        let x34 = -0.5692 * x7;
+        let x32 = s_q1 * 0.5692;
+        let x33 = x5 * 0.5692;
+        let x34 = x7 * 0.5692;
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x36 = c_q1 * c_q2;
         let x37 = c_q1 * s_q2;
@@ -1505,9 +1504,9 @@ impl SsrmsRecurrent {
         let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
         let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
         let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(0.475, s_q1, 7.11 * x36);
-        let x61 = Self::mul_add(-0.475, x5, 7.11 * x38);
-        let x62 = Self::mul_add(-0.475, x7, 7.11 * x40);
+        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
+        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
+        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
         let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
@@ -1515,18 +1514,18 @@ impl SsrmsRecurrent {
         let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
         let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
         let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(39.95, s_q1, 9.522 * x64);
-        let x71 = Self::mul_add(-1966.28, s_q1, -39.95 * x64);
+        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
+        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(-39.95, x5, 9.522 * x66);
-        let x74 = Self::mul_add(1966.28, x5, -39.95 * x66);
+        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
+        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
         let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(-39.95, x7, 9.522 * x68);
-        let x77 = Self::mul_add(1966.28, x7, -39.95 * x68);
+        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
+        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
         let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(-s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(x7, x71, x68 * x70));
+        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
+        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
+        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
         let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
         let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
         let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
@@ -1583,9 +1582,9 @@ impl SsrmsRecurrent {
         let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = -0.7026 * x93;
-        let x139 = -0.7026 * x95;
-        let x140 = -0.7026 * x97;
+        let x138 = 0.7026 * x93;
+        let x139 = 0.7026 * x95;
+        let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
         let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
@@ -1611,32 +1610,32 @@ impl SsrmsRecurrent {
         let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
         let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
         let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x138 - x32;
+        let x166 = x32 - x138;
         let x167 = x33 + x139;
         let x168 = x34 + x140;
         let x169 = x88 + x166;
-        let x170 = x89 + x167;
-        let x171 = x90 + x168;
+        let x170 = x89 - x167;
+        let x171 = x90 - x168;
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x33 + x173;
-        let x176 = x34 + x174;
-        let x177 = x88 - x32;
-        let x178 = x33 + x89;
-        let x179 = x34 + x90;
+        let x175 = x173 - x33;
+        let x176 = x174 - x34;
+        let x177 = x32 + x88;
+        let x178 = x89 - x33;
+        let x179 = x90 - x34;
         let x180 = x60 + x177;
         let x181 = x61 + x178;
         let x182 = x62 + x179;
-        let x183 = x33 + x181;
-        let x184 = x34 + x182;
+        let x183 = x181 - x33;
+        let x184 = x182 - x34;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x33 + x186;
-        let x189 = x34 + x187;
-        let x190 = x33 + x61;
-        let x191 = x34 + x62;
+        let x188 = x186 - x33;
+        let x189 = x187 - x34;
+        let x190 = x61 - x33;
+        let x191 = x62 - x34;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -1649,7 +1648,7 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x172 - x32);
+        let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
         let x207 = 243.66 * (x175 - x1);
@@ -1690,7 +1689,7 @@ impl SsrmsRecurrent {
         let x242 = x57 + x233;
         let x243 = x58 + x234;
         let x244 = x59 + x235;
-        let x245 = Self::mul_add(-105.98, x32, x195);
+        let x245 = Self::mul_add(105.98, x32, x195);
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
@@ -1708,25 +1707,25 @@ impl SsrmsRecurrent {
         let x260 = Self::mul_add(279.2, x60, x257);
         let x261 = Self::mul_add(279.2, x61, x258);
         let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x180 - x32, x204);
+        let x263 = Self::mul_add(105.98, x32 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x185 - x32, x263);
+        let x266 = Self::mul_add(105.98, x32 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x60 - x32, x266);
+        let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
+        let x272 = Self::mul_add(-314.88, x33, x270);
+        let x273 = Self::mul_add(-314.88, x34, x271);
         let x274 = Self::mul_add(105.98, x183 - x1, x207);
         let x275 = Self::mul_add(105.98, x2 + x184, x208);
         let x276 = Self::mul_add(105.98, x188 - x1, x274);
         let x277 = Self::mul_add(105.98, x2 + x189, x275);
         let x278 = Self::mul_add(279.2, x190 - x1, x276);
         let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(314.88, x33 - x1, x278);
-        let x281 = Self::mul_add(314.88, x2 + x34, x279);
+        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x281 = Self::mul_add(314.88, x2 - x34, x279);
         let x282 = Self::mul_add(x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
@@ -1768,11 +1767,11 @@ impl SsrmsRecurrent {
         let x320 = x138 * x197;
         let x321 = x139 * x195;
         let x322 = x138 * x195;
-        let x323 = x316 + x322;
+        let x323 = x316 - x322;
         let x324 = x139 * x197;
         let x325 = x140 * x195;
         let x326 = x140 * x196;
-        let x327 = x317 + x322;
+        let x327 = x317 - x322;
         let x328 = x140 * x194;
         let x329 = x139 * x193;
         let x330 = x138 * x192;
@@ -1783,14 +1782,14 @@ impl SsrmsRecurrent {
         let x335 = x33 * x249;
         let x336 = x32 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(x32, x249, -x307);
-        let x339 = Self::mul_add(x32, x250, -x308);
+        let x338 = Self::mul_add(-x32, x249, x307);
+        let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x311 + (x334 - x336);
+        let x341 = x336 - x334 - x311;
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x315 + (x335 - x336);
+        let x345 = x336 - x335 - x315;
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -1798,53 +1797,53 @@ impl SsrmsRecurrent {
         let x350 = x33 * x255;
         let x351 = x32 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(x32, x255, -x295);
-        let x354 = Self::mul_add(x32, x256, -x296);
+        let x353 = Self::mul_add(-x32, x255, x295);
+        let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x299 + (x349 - x351);
+        let x356 = x351 - x349 - x299;
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x303 + (x350 - x351);
+        let x360 = x351 - x350 - x303;
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x352 + (x361 + x362);
+        let x364 = x361 + x362 - x352;
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(x89, x257, x355);
+        let x367 = Self::mul_add(-x89, x257, x355);
         let x368 = x356 + (x361 + x363);
-        let x369 = Self::mul_add(x89, x259, x357);
-        let x370 = Self::mul_add(x90, x257, x358);
-        let x371 = Self::mul_add(x90, x258, x359);
+        let x369 = Self::mul_add(-x89, x259, x357);
+        let x370 = Self::mul_add(-x90, x257, x358);
+        let x371 = Self::mul_add(-x90, x258, x359);
         let x372 = x360 + (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 + Self::mul_add(x34, x265, -x376);
+        let x378 = Self::mul_add(-x34, x265, x376) - x288;
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 + Self::mul_add(x33, x264, -x376);
+        let x382 = Self::mul_add(-x33, x264, x376) - x291;
         let x383 = x88 * x266;
-        let x384 = Self::mul_add(x89, x266, x377);
+        let x384 = Self::mul_add(-x89, x266, x377);
         let x385 = x378 + Self::mul_add(x90, x268, x383);
-        let x386 = Self::mul_add(x89, x268, x379);
-        let x387 = Self::mul_add(x90, x266, x380);
-        let x388 = Self::mul_add(x90, x267, x381);
+        let x386 = Self::mul_add(-x89, x268, x379);
+        let x387 = Self::mul_add(-x90, x266, x380);
+        let x388 = Self::mul_add(-x90, x267, x381);
         let x389 = x382 + Self::mul_add(x89, x267, x383);
         let x390 = x60 * x269;
         let x391 = x385 + Self::mul_add(x62, x271, x390);
-        let x392 = Self::mul_add(x61, x271, x386);
-        let x393 = Self::mul_add(x62, x270, x388);
+        let x392 = Self::mul_add(-x61, x271, x386);
+        let x393 = Self::mul_add(-x62, x270, x388);
         let x394 = x389 + Self::mul_add(x61, x270, x390);
-        let x395 = x32 * Self::mul_add(-314.88, x32, x269);
+        let x395 = x32 * Self::mul_add(314.88, x32, x269);
         let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
-        let x397 = Self::mul_add(x32, x274, -x283);
-        let x398 = Self::mul_add(x32, x275, -x284);
-        let x399 = x396 + Self::mul_add(x89, x276, x90 * x277);
+        let x397 = Self::mul_add(-x32, x274, x283);
+        let x398 = Self::mul_add(-x32, x275, x284);
+        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
         let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
@@ -1852,8 +1851,8 @@ impl SsrmsRecurrent {
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = Self::mul_add(
             -s_q0,
-            x19 + x237 + Self::mul_add(x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(x32, x281, x404)),
+            x19 + x237 + Self::mul_add(-x32, x280, x403),
+            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
         );
         let x406 = Self::mul_add(
             x7,
@@ -1868,12 +1867,12 @@ impl SsrmsRecurrent {
         let x408 = Self::mul_add(
             x7,
             x220 + x398,
-            Self::mul_add(-s_q1, x218 + x396, x5 * (x219 + x397)),
+            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
         );
         let x409 = Self::mul_add(
             x97,
-            x211 - x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 + x282)),
+            x211 + x284,
+            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
         );
         let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
@@ -1882,22 +1881,22 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(x34, x273, -x395)),
-                c_q0 * (x26 + x241 - Self::mul_add(x33, x273, x392)),
+                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
+                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
             ),
             c_q0
                 * Self::mul_add(
                     -s_q0,
-                    x29 + x243 - Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(x33, x272, -x395))),
+                    x29 + x243 + Self::mul_add(x34, x272, x393),
+                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
                 ),
         );
         let x414 = Self::mul_add(
             x7,
-            x241 - x392,
+            x241 + x392,
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x269, x384),
+                x239 + Self::mul_add(-x61, x269, x384),
                 x5 * (x240 + x391),
             ),
         );
@@ -1906,8 +1905,8 @@ impl SsrmsRecurrent {
             x244 + x394,
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x269, x387),
-                x5 * (x243 - x393),
+                x242 + Self::mul_add(-x62, x269, x387),
+                x5 * (x243 + x393),
             ),
         );
         let x416 = Self::mul_add(-s_q0, x414, c_q0 * x415);
@@ -1915,42 +1914,42 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 x7,
-                x232 - x386,
-                Self::mul_add(-s_q1, x230 - x384, x5 * (x231 + x385)),
+                x232 + x386,
+                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x235 + x389,
-                    Self::mul_add(-s_q1, x233 - x387, x5 * (x234 - x388)),
+                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
                 ),
         );
         let x418 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x223 - x379,
-                Self::mul_add(-s_q1, x221 - x377, x5 * (x222 + x378)),
+                x223 + x379,
+                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x226 + x382,
-                    Self::mul_add(-s_q1, x224 - x380, x5 * (x225 - x381)),
+                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
                 ),
         );
         let x419 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x97,
-                x214 - x289,
-                Self::mul_add(x95, x213 + x288, x93 * (x212 - x285)),
+                x214 + x289,
+                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
             ),
             c_q0
                 * Self::mul_add(
                     x97,
-                    x217 + x291,
-                    Self::mul_add(x95, x216 - x290, x93 * (x215 - x287)),
+                    x217 - x291,
+                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
                 ),
         );
         let x420 = Self::mul_add(-s_q0, x411, c_q0 * x412);
@@ -1965,10 +1964,10 @@ impl SsrmsRecurrent {
         );
         let x422 = Self::mul_add(
             x7,
-            x241 - Self::mul_add(x61, x262, x369),
+            x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x260, x367),
+                x239 + Self::mul_add(-x61, x260, x367),
                 x5 * (x240 + (x368 + (x373 + x375))),
             ),
         );
@@ -1977,8 +1976,8 @@ impl SsrmsRecurrent {
             x244 + (x372 + (x374 + x375)),
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x260, x370),
-                x5 * (x243 - Self::mul_add(x62, x261, x371)),
+                x242 + Self::mul_add(-x62, x260, x370),
+                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
             ),
         );
         let x424 = Self::mul_add(
@@ -1991,8 +1990,8 @@ impl SsrmsRecurrent {
             x5
                 * Self::mul_add(
                     x7,
-                    x232 - x369,
-                    Self::mul_add(-s_q1, x230 - x367, x5 * (x231 + x368)),
+                    x232 + x369,
+                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
                 ),
         );
         let x425 = Self::mul_add(
@@ -2000,7 +1999,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x235 + x372,
-                Self::mul_add(-s_q1, x233 - x370, x5 * (x234 - x371)),
+                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
             ),
             x424,
         );
@@ -2009,13 +2008,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x354,
-                Self::mul_add(-s_q1, x218 + x352, x5 * (x219 + x353)),
+                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x357,
-                    Self::mul_add(-s_q1, x221 - x355, x5 * (x222 + x356)),
+                    x223 + x357,
+                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
                 ),
         );
         let x427 = Self::mul_add(
@@ -2023,7 +2022,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x360,
-                Self::mul_add(-s_q1, x224 - x358, x5 * (x225 - x359)),
+                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
             ),
             x426,
         );
@@ -2031,22 +2030,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x296,
-                Self::mul_add(x95, x210 - x295, x93 * (x209 + x294)),
+                x211 + x296,
+                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x300,
-                    Self::mul_add(x95, x213 + x299, x93 * (x212 - x297)),
+                    x214 + x300,
+                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
                 ),
         );
         let x429 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x303,
-                Self::mul_add(x95, x216 - x302, x93 * (x215 - x301)),
+                x217 - x303,
+                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
             ),
             x428,
         );
@@ -2056,16 +2055,16 @@ impl SsrmsRecurrent {
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
                 -s_q1,
-                x227 + (x337 + (x346 + x347)),
+                x227 + (x346 + x347 - x337),
                 x5 * (x228 + Self::mul_add(-x88, x252, x338)),
             ),
         );
         let x432 = Self::mul_add(
             x7,
-            x232 - Self::mul_add(x89, x253, x342),
+            x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
                 -s_q1,
-                x230 - Self::mul_add(x89, x251, x340),
+                x230 + Self::mul_add(-x89, x251, x340),
                 x5 * (x231 + (x341 + (x346 + x348))),
             ),
         );
@@ -2074,8 +2073,8 @@ impl SsrmsRecurrent {
             x235 + (x345 + (x347 + x348)),
             Self::mul_add(
                 -s_q1,
-                x233 - Self::mul_add(x90, x251, x343),
-                x5 * (x234 - Self::mul_add(x90, x252, x344)),
+                x233 + Self::mul_add(-x90, x251, x343),
+                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
             ),
         );
         let x434 = Self::mul_add(
@@ -2083,13 +2082,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x339,
-                Self::mul_add(-s_q1, x218 + x337, x5 * (x219 + x338)),
+                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x342,
-                    Self::mul_add(-s_q1, x221 - x340, x5 * (x222 + x341)),
+                    x223 + x342,
+                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
                 ),
         );
         let x435 = Self::mul_add(
@@ -2097,7 +2096,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x345,
-                Self::mul_add(-s_q1, x224 - x343, x5 * (x225 - x344)),
+                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
             ),
             x434,
         );
@@ -2105,22 +2104,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x308,
-                Self::mul_add(x95, x210 - x307, x93 * (x209 + x306)),
+                x211 + x308,
+                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x312,
-                    Self::mul_add(x95, x213 + x311, x93 * (x212 - x309)),
+                    x214 + x312,
+                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
                 ),
         );
         let x437 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x315,
-                Self::mul_add(x95, x216 - x314, x93 * (x215 - x313)),
+                x217 - x315,
+                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
             ),
             x436,
         );
@@ -2138,16 +2137,16 @@ impl SsrmsRecurrent {
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
                 -s_q1,
-                x221 - Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 - x333))),
+                x221 + Self::mul_add(x33, x245, x321),
+                x5 * (x222 + (x323 + (x331 + x333))),
             ),
         );
         let x440 = Self::mul_add(
             x7,
-            x226 + (x327 + (x332 - x333)),
+            x226 + (x327 + (x332 + x333)),
             Self::mul_add(
                 -s_q1,
-                x224 - Self::mul_add(x34, x245, x325),
+                x224 + Self::mul_add(x34, x245, x325),
                 x5 * (x225 - Self::mul_add(x34, x246, x326)),
             ),
         );
@@ -2162,7 +2161,7 @@ impl SsrmsRecurrent {
                 * Self::mul_add(
                     x97,
                     x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 - x321)),
+                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
                 ),
         );
         let x442 = Self::mul_add(
@@ -2170,7 +2169,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x97,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 - x325)),
+                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
             ),
             x441,
         );
@@ -2218,16 +2217,15 @@ impl SsrmsRecurrent {
         let x460 = x32 * (x457 + x458);
         let x461 = x450
             + Self::mul_add(
-                -x34,
-                x459,
-                Self::mul_add(-x33, x449 + x457, x32 * (x453 + x453)),
-            );
-        let x462 = x451
-            + Self::mul_add(
                 x34,
-                x449 + x458,
-                Self::mul_add(x33, x459, x32 * (x452 + x452)),
+                x459,
+                Self::mul_add(-x32, x453 + x453, x33 * (x449 + x457)),
             );
+        let x462 = Self::mul_add(
+            x34,
+            x449 + x458,
+            Self::mul_add(x33, x459, x32 * (x452 + x452)),
+        ) - x451;
         let x463 = qd[0] - x454;
         let x464 = x455 - x447;
         let x465 = x448 + x456;
@@ -2243,23 +2241,23 @@ impl SsrmsRecurrent {
         let x475 = x463 * x465;
         let x476 = x463 * x463;
         let x477 = x464 * x465;
-        let x478 = x460
-            + Self::mul_add(
-                x62,
-                x475 - x467,
-                Self::mul_add(-x60, x472 + x473, x61 * (x474 - x468)),
-            );
+        let x478 = Self::mul_add(
+            x62,
+            x475 - x467,
+            Self::mul_add(-x60, x472 + x473, x61 * (x474 - x468)),
+        ) - x460;
         let x479 = x461
             + Self::mul_add(
                 x62,
                 x466 + x477,
                 Self::mul_add(-x61, x472 + x476, x60 * (x468 + x474)),
             );
-        let x480 = Self::mul_add(
-            -x62,
-            x473 + x476,
-            Self::mul_add(x61, x477 - x466, x60 * (x467 + x475)),
-        ) - x462;
+        let x480 = x462
+            + Self::mul_add(
+                -x62,
+                x473 + x476,
+                Self::mul_add(x61, x477 - x466, x60 * (x467 + x475)),
+            );
         let x481 = x463 - x469;
         let x482 = x464 + x470;
         let x483 = x465 + x471;
@@ -2309,22 +2307,22 @@ impl SsrmsRecurrent {
         let x512 = x499 * x499;
         let x513 = x500 * x501;
         let x514 = x496
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x511 - x503,
                 Self::mul_add(x33, x510 - x504, x32 * (x508 + x509)),
             );
         let x515 = x497
             + Self::mul_add(
-                x34,
+                -x34,
                 x513 - x502,
-                -Self::mul_add(x33, x508 + x512, x32 * (x504 + x510)),
+                Self::mul_add(x33, x508 + x512, x32 * (x504 + x510)),
             );
         let x516 = x498
             + Self::mul_add(
-                -x34,
+                x34,
                 x509 + x512,
-                Self::mul_add(-x32, x503 + x511, x33 * (x502 + x513)),
+                Self::mul_add(-x33, x502 + x513, x32 * (x503 + x511)),
             );
         let x517 = x499 + x505;
         let x518 = x500 + x506;
@@ -2373,23 +2371,23 @@ impl SsrmsRecurrent {
         let x553 = 243.66
             * (x514
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x521 + x529,
-                    Self::mul_add(-x138, x526 + x527, x139 * (x528 - x522)),
+                    Self::mul_add(-x139, x528 - x522, x138 * (x526 + x527)),
                 ));
         let x554 = 243.66
             * (x515
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x531 - x520,
-                    Self::mul_add(-x139, x526 + x530, x138 * (x522 + x528)),
+                    Self::mul_add(-x138, x522 + x528, x139 * (x526 + x530)),
                 ));
         let x555 = 243.66
             * (x516
                 + Self::mul_add(
-                    -x140,
+                    x140,
                     x527 + x530,
-                    Self::mul_add(x139, x520 + x531, x138 * (x529 - x521)),
+                    -Self::mul_add(x139, x520 + x531, x138 * (x529 - x521)),
                 ));
         let x556 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532));
         let x557 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532));
@@ -2409,30 +2407,30 @@ impl SsrmsRecurrent {
         let x568 = Self::mul_add(279.2, x478, x565);
         let x569 = Self::mul_add(279.2, x479, x566);
         let x570 = Self::mul_add(279.2, x480, x567);
-        let x571 = Self::mul_add(314.88, x460, x568);
+        let x571 = Self::mul_add(314.88, x460, -x568);
         let x572 = Self::mul_add(314.88, x461, x569);
-        let x573 = Self::mul_add(314.88, x462, -x570);
-        let x574 = Self::mul_add(-x139, x555, x140 * x554)
+        let x573 = Self::mul_add(314.88, x462, x570);
+        let x574 = Self::mul_add(-x140, x554, x139 * x555)
             - (Self::mul_add(x131, x522, Self::mul_add(x130, x521, x129 * x520))
                 + Self::mul_add(-x519, x551, x518 * x552) + x559);
-        let x575 = Self::mul_add(-x140, x553, x138 * x555)
+        let x575 = Self::mul_add(-x138, x555, x140 * x553)
             - (Self::mul_add(x134, x522, Self::mul_add(x133, x521, x132 * x520))
                 + Self::mul_add(-x517, x552, x519 * x550) + x560);
-        let x576 = Self::mul_add(-x138, x554, x139 * x553)
+        let x576 = Self::mul_add(-x139, x553, x138 * x554)
             - (Self::mul_add(x137, x522, Self::mul_add(x136, x521, x135 * x520))
                 + Self::mul_add(-x518, x550, x517 * x551) + x561);
         let x577 = x574
             - (Self::mul_add(x106, x504, Self::mul_add(-x105, x503, x104 * x502))
                 + Self::mul_add(-x501, x548, x500 * x549))
-            + Self::mul_add(-x33, x564, x34 * x563);
+            + Self::mul_add(-x34, x563, x33 * x564);
         let x578 = x575
             - (Self::mul_add(x109, x504, Self::mul_add(-x108, x503, x107 * x502))
                 + Self::mul_add(-x499, x549, x501 * x547))
-            - Self::mul_add(x32, x564, x34 * x562);
+            + Self::mul_add(x32, x564, x34 * x562);
         let x579 = x576
             - (Self::mul_add(x112, x504, Self::mul_add(-x111, x503, x110 * x502))
                 + Self::mul_add(-x500, x547, x499 * x548))
-            + Self::mul_add(x32, x563, x33 * x562);
+            - Self::mul_add(x32, x563, x33 * x562);
         let x580 = x577
             - (Self::mul_add(x81, x486, Self::mul_add(-x80, x485, x79 * x484))
                 + Self::mul_add(-x483, x545, x482 * x546))
@@ -2462,7 +2460,7 @@ impl SsrmsRecurrent {
             x405,
             qdd[0]
                 * (12.19 + (x17 + x236)
-                    + (x402 + Self::mul_add(x33, x280, x34 * x281)
+                    + (x402 - Self::mul_add(x33, x280, x34 * x281)
                         + Self::mul_add(
                             -x1,
                             Self::mul_add(-105.98, x1, x280),
@@ -2477,10 +2475,10 @@ impl SsrmsRecurrent {
         let x588 = Self::mul_add(qdd[6], x410, Self::mul_add(qdd[5], x409, x587))
             - (Self::mul_add(x21, x453, x19 * x452)
                 + Self::mul_add(x447, x540, x448 * x539) + x583
-                + Self::mul_add(x33, x573, x34 * x572)
+                + Self::mul_add(-x34, x572, x33 * x573)
                 + Self::mul_add(
                     -x1,
-                    Self::mul_add(105.98, x451, x573),
+                    Self::mul_add(105.98, x451, -x573),
                     x2 * Self::mul_add(105.98, x450, x572),
                 ));
         let x589 = Self::mul_add(
@@ -2504,7 +2502,7 @@ impl SsrmsRecurrent {
                     * (x585
                         - (Self::mul_add(qd[0], x539, x447 * x538)
                             - Self::mul_add(x31, x453, x29 * x452))
-                        + Self::mul_add(x32, x572, x33 * x571)),
+                        + Self::mul_add(-x32, x572, x33 * x571)),
             );
         let x592 = Self::mul_add(
             qdd[2],
@@ -2601,9 +2599,9 @@ impl SsrmsRecurrent {
         let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
         let x30 = x7 * x14;
         let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = -0.5692 * s_q1;
-        let x33 = -0.5692 * x5;
-        let x34 = -0.5692 * x7;
+        let x32 = s_q1 * 0.5692;
+        let x33 = x5 * 0.5692;
+        let x34 = x7 * 0.5692;
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x36 = c_q1 * c_q2;
         let x37 = c_q1 * s_q2;
@@ -2629,9 +2627,9 @@ impl SsrmsRecurrent {
         let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
         let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
         let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(0.475, s_q1, 7.11 * x36);
-        let x61 = Self::mul_add(-0.475, x5, 7.11 * x38);
-        let x62 = Self::mul_add(-0.475, x7, 7.11 * x40);
+        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
+        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
+        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
         let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
@@ -2639,18 +2637,18 @@ impl SsrmsRecurrent {
         let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
         let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
         let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(39.95, s_q1, 9.522 * x64);
-        let x71 = Self::mul_add(-1966.28, s_q1, -39.95 * x64);
+        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
+        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(-39.95, x5, 9.522 * x66);
-        let x74 = Self::mul_add(1966.28, x5, -39.95 * x66);
+        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
+        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
         let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(-39.95, x7, 9.522 * x68);
-        let x77 = Self::mul_add(1966.28, x7, -39.95 * x68);
+        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
+        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
         let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(-s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(x7, x71, x68 * x70));
+        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
+        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
+        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
         let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
         let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
         let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
@@ -2707,9 +2705,9 @@ impl SsrmsRecurrent {
         let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = -0.7026 * x93;
-        let x139 = -0.7026 * x95;
-        let x140 = -0.7026 * x97;
+        let x138 = 0.7026 * x93;
+        let x139 = 0.7026 * x95;
+        let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
         let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
@@ -2735,32 +2733,32 @@ impl SsrmsRecurrent {
         let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
         let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
         let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x138 - x32;
+        let x166 = x32 - x138;
         let x167 = x33 + x139;
         let x168 = x34 + x140;
         let x169 = x88 + x166;
-        let x170 = x89 + x167;
-        let x171 = x90 + x168;
+        let x170 = x89 - x167;
+        let x171 = x90 - x168;
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x33 + x173;
-        let x176 = x34 + x174;
-        let x177 = x88 - x32;
-        let x178 = x33 + x89;
-        let x179 = x34 + x90;
+        let x175 = x173 - x33;
+        let x176 = x174 - x34;
+        let x177 = x32 + x88;
+        let x178 = x89 - x33;
+        let x179 = x90 - x34;
         let x180 = x60 + x177;
         let x181 = x61 + x178;
         let x182 = x62 + x179;
-        let x183 = x33 + x181;
-        let x184 = x34 + x182;
+        let x183 = x181 - x33;
+        let x184 = x182 - x34;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x33 + x186;
-        let x189 = x34 + x187;
-        let x190 = x33 + x61;
-        let x191 = x34 + x62;
+        let x188 = x186 - x33;
+        let x189 = x187 - x34;
+        let x190 = x61 - x33;
+        let x191 = x62 - x34;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -2773,7 +2771,7 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x172 - x32);
+        let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
         let x207 = 243.66 * (x175 - x1);
@@ -2814,7 +2812,7 @@ impl SsrmsRecurrent {
         let x242 = x57 + x233;
         let x243 = x58 + x234;
         let x244 = x59 + x235;
-        let x245 = Self::mul_add(-105.98, x32, x195);
+        let x245 = Self::mul_add(105.98, x32, x195);
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
@@ -2832,25 +2830,25 @@ impl SsrmsRecurrent {
         let x260 = Self::mul_add(279.2, x60, x257);
         let x261 = Self::mul_add(279.2, x61, x258);
         let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x180 - x32, x204);
+        let x263 = Self::mul_add(105.98, x32 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x185 - x32, x263);
+        let x266 = Self::mul_add(105.98, x32 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x60 - x32, x266);
+        let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
+        let x272 = Self::mul_add(-314.88, x33, x270);
+        let x273 = Self::mul_add(-314.88, x34, x271);
         let x274 = Self::mul_add(105.98, x183 - x1, x207);
         let x275 = Self::mul_add(105.98, x2 + x184, x208);
         let x276 = Self::mul_add(105.98, x188 - x1, x274);
         let x277 = Self::mul_add(105.98, x2 + x189, x275);
         let x278 = Self::mul_add(279.2, x190 - x1, x276);
         let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(314.88, x33 - x1, x278);
-        let x281 = Self::mul_add(314.88, x2 + x34, x279);
+        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x281 = Self::mul_add(314.88, x2 - x34, x279);
         let x282 = Self::mul_add(x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
@@ -2892,11 +2890,11 @@ impl SsrmsRecurrent {
         let x320 = x138 * x197;
         let x321 = x139 * x195;
         let x322 = x138 * x195;
-        let x323 = x316 + x322;
+        let x323 = x316 - x322;
         let x324 = x139 * x197;
         let x325 = x140 * x195;
         let x326 = x140 * x196;
-        let x327 = x317 + x322;
+        let x327 = x317 - x322;
         let x328 = x140 * x194;
         let x329 = x139 * x193;
         let x330 = x138 * x192;
@@ -2907,14 +2905,14 @@ impl SsrmsRecurrent {
         let x335 = x33 * x249;
         let x336 = x32 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(x32, x249, -x307);
-        let x339 = Self::mul_add(x32, x250, -x308);
+        let x338 = Self::mul_add(-x32, x249, x307);
+        let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x311 + (x334 - x336);
+        let x341 = x336 - x334 - x311;
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x315 + (x335 - x336);
+        let x345 = x336 - x335 - x315;
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -2922,53 +2920,53 @@ impl SsrmsRecurrent {
         let x350 = x33 * x255;
         let x351 = x32 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(x32, x255, -x295);
-        let x354 = Self::mul_add(x32, x256, -x296);
+        let x353 = Self::mul_add(-x32, x255, x295);
+        let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x299 + (x349 - x351);
+        let x356 = x351 - x349 - x299;
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x303 + (x350 - x351);
+        let x360 = x351 - x350 - x303;
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x352 + (x361 + x362);
+        let x364 = x361 + x362 - x352;
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(x89, x257, x355);
+        let x367 = Self::mul_add(-x89, x257, x355);
         let x368 = x356 + (x361 + x363);
-        let x369 = Self::mul_add(x89, x259, x357);
-        let x370 = Self::mul_add(x90, x257, x358);
-        let x371 = Self::mul_add(x90, x258, x359);
+        let x369 = Self::mul_add(-x89, x259, x357);
+        let x370 = Self::mul_add(-x90, x257, x358);
+        let x371 = Self::mul_add(-x90, x258, x359);
         let x372 = x360 + (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 + Self::mul_add(x34, x265, -x376);
+        let x378 = Self::mul_add(-x34, x265, x376) - x288;
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 + Self::mul_add(x33, x264, -x376);
+        let x382 = Self::mul_add(-x33, x264, x376) - x291;
         let x383 = x88 * x266;
-        let x384 = Self::mul_add(x89, x266, x377);
+        let x384 = Self::mul_add(-x89, x266, x377);
         let x385 = x378 + Self::mul_add(x90, x268, x383);
-        let x386 = Self::mul_add(x89, x268, x379);
-        let x387 = Self::mul_add(x90, x266, x380);
-        let x388 = Self::mul_add(x90, x267, x381);
+        let x386 = Self::mul_add(-x89, x268, x379);
+        let x387 = Self::mul_add(-x90, x266, x380);
+        let x388 = Self::mul_add(-x90, x267, x381);
         let x389 = x382 + Self::mul_add(x89, x267, x383);
         let x390 = x60 * x269;
         let x391 = x385 + Self::mul_add(x62, x271, x390);
-        let x392 = Self::mul_add(x61, x271, x386);
-        let x393 = Self::mul_add(x62, x270, x388);
+        let x392 = Self::mul_add(-x61, x271, x386);
+        let x393 = Self::mul_add(-x62, x270, x388);
         let x394 = x389 + Self::mul_add(x61, x270, x390);
-        let x395 = x32 * Self::mul_add(-314.88, x32, x269);
+        let x395 = x32 * Self::mul_add(314.88, x32, x269);
         let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
-        let x397 = Self::mul_add(x32, x274, -x283);
-        let x398 = Self::mul_add(x32, x275, -x284);
-        let x399 = x396 + Self::mul_add(x89, x276, x90 * x277);
+        let x397 = Self::mul_add(-x32, x274, x283);
+        let x398 = Self::mul_add(-x32, x275, x284);
+        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
         let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
@@ -2976,8 +2974,8 @@ impl SsrmsRecurrent {
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = Self::mul_add(
             -s_q0,
-            x19 + x237 + Self::mul_add(x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(x32, x281, x404)),
+            x19 + x237 + Self::mul_add(-x32, x280, x403),
+            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
         );
         let x406 = Self::mul_add(
             x7,
@@ -2992,12 +2990,12 @@ impl SsrmsRecurrent {
         let x408 = Self::mul_add(
             x7,
             x220 + x398,
-            Self::mul_add(-s_q1, x218 + x396, x5 * (x219 + x397)),
+            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
         );
         let x409 = Self::mul_add(
             x97,
-            x211 - x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 + x282)),
+            x211 + x284,
+            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
         );
         let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
@@ -3006,22 +3004,22 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(x34, x273, -x395)),
-                c_q0 * (x26 + x241 - Self::mul_add(x33, x273, x392)),
+                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
+                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
             ),
             c_q0
                 * Self::mul_add(
                     -s_q0,
-                    x29 + x243 - Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(x33, x272, -x395))),
+                    x29 + x243 + Self::mul_add(x34, x272, x393),
+                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
                 ),
         );
         let x414 = Self::mul_add(
             x7,
-            x241 - x392,
+            x241 + x392,
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x269, x384),
+                x239 + Self::mul_add(-x61, x269, x384),
                 x5 * (x240 + x391),
             ),
         );
@@ -3030,50 +3028,50 @@ impl SsrmsRecurrent {
             x244 + x394,
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x269, x387),
-                x5 * (x243 - x393),
+                x242 + Self::mul_add(-x62, x269, x387),
+                x5 * (x243 + x393),
             ),
         );
         let x416 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x232 - x386,
-                Self::mul_add(-s_q1, x230 - x384, x5 * (x231 + x385)),
+                x232 + x386,
+                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x235 + x389,
-                    Self::mul_add(-s_q1, x233 - x387, x5 * (x234 - x388)),
+                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
                 ),
         );
         let x417 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x223 - x379,
-                Self::mul_add(-s_q1, x221 - x377, x5 * (x222 + x378)),
+                x223 + x379,
+                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x226 + x382,
-                    Self::mul_add(-s_q1, x224 - x380, x5 * (x225 - x381)),
+                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
                 ),
         );
         let x418 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x97,
-                x214 - x289,
-                Self::mul_add(x95, x213 + x288, x93 * (x212 - x285)),
+                x214 + x289,
+                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
             ),
             c_q0
                 * Self::mul_add(
                     x97,
-                    x217 + x291,
-                    Self::mul_add(x95, x216 - x290, x93 * (x215 - x287)),
+                    x217 - x291,
+                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
                 ),
         );
         let x419 = Self::mul_add(
@@ -3087,10 +3085,10 @@ impl SsrmsRecurrent {
         );
         let x420 = Self::mul_add(
             x7,
-            x241 - Self::mul_add(x61, x262, x369),
+            x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x260, x367),
+                x239 + Self::mul_add(-x61, x260, x367),
                 x5 * (x240 + (x368 + (x373 + x375))),
             ),
         );
@@ -3099,8 +3097,8 @@ impl SsrmsRecurrent {
             x244 + (x372 + (x374 + x375)),
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x260, x370),
-                x5 * (x243 - Self::mul_add(x62, x261, x371)),
+                x242 + Self::mul_add(-x62, x260, x370),
+                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
             ),
         );
         let x422 = Self::mul_add(
@@ -3113,8 +3111,8 @@ impl SsrmsRecurrent {
             x5
                 * Self::mul_add(
                     x7,
-                    x232 - x369,
-                    Self::mul_add(-s_q1, x230 - x367, x5 * (x231 + x368)),
+                    x232 + x369,
+                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
                 ),
         );
         let x423 = Self::mul_add(
@@ -3122,7 +3120,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x235 + x372,
-                Self::mul_add(-s_q1, x233 - x370, x5 * (x234 - x371)),
+                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
             ),
             x422,
         );
@@ -3131,13 +3129,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x354,
-                Self::mul_add(-s_q1, x218 + x352, x5 * (x219 + x353)),
+                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x357,
-                    Self::mul_add(-s_q1, x221 - x355, x5 * (x222 + x356)),
+                    x223 + x357,
+                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
                 ),
         );
         let x425 = Self::mul_add(
@@ -3145,7 +3143,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x360,
-                Self::mul_add(-s_q1, x224 - x358, x5 * (x225 - x359)),
+                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
             ),
             x424,
         );
@@ -3153,22 +3151,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x296,
-                Self::mul_add(x95, x210 - x295, x93 * (x209 + x294)),
+                x211 + x296,
+                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x300,
-                    Self::mul_add(x95, x213 + x299, x93 * (x212 - x297)),
+                    x214 + x300,
+                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
                 ),
         );
         let x427 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x303,
-                Self::mul_add(x95, x216 - x302, x93 * (x215 - x301)),
+                x217 - x303,
+                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
             ),
             x426,
         );
@@ -3178,16 +3176,16 @@ impl SsrmsRecurrent {
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
                 -s_q1,
-                x227 + (x337 + (x346 + x347)),
+                x227 + (x346 + x347 - x337),
                 x5 * (x228 + Self::mul_add(-x88, x252, x338)),
             ),
         );
         let x430 = Self::mul_add(
             x7,
-            x232 - Self::mul_add(x89, x253, x342),
+            x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
                 -s_q1,
-                x230 - Self::mul_add(x89, x251, x340),
+                x230 + Self::mul_add(-x89, x251, x340),
                 x5 * (x231 + (x341 + (x346 + x348))),
             ),
         );
@@ -3196,8 +3194,8 @@ impl SsrmsRecurrent {
             x235 + (x345 + (x347 + x348)),
             Self::mul_add(
                 -s_q1,
-                x233 - Self::mul_add(x90, x251, x343),
-                x5 * (x234 - Self::mul_add(x90, x252, x344)),
+                x233 + Self::mul_add(-x90, x251, x343),
+                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
             ),
         );
         let x432 = Self::mul_add(
@@ -3205,13 +3203,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x339,
-                Self::mul_add(-s_q1, x218 + x337, x5 * (x219 + x338)),
+                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x342,
-                    Self::mul_add(-s_q1, x221 - x340, x5 * (x222 + x341)),
+                    x223 + x342,
+                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
                 ),
         );
         let x433 = Self::mul_add(
@@ -3219,7 +3217,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x345,
-                Self::mul_add(-s_q1, x224 - x343, x5 * (x225 - x344)),
+                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
             ),
             x432,
         );
@@ -3227,22 +3225,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x308,
-                Self::mul_add(x95, x210 - x307, x93 * (x209 + x306)),
+                x211 + x308,
+                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x312,
-                    Self::mul_add(x95, x213 + x311, x93 * (x212 - x309)),
+                    x214 + x312,
+                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
                 ),
         );
         let x435 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x315,
-                Self::mul_add(x95, x216 - x314, x93 * (x215 - x313)),
+                x217 - x315,
+                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
             ),
             x434,
         );
@@ -3260,16 +3258,16 @@ impl SsrmsRecurrent {
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
                 -s_q1,
-                x221 - Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 - x333))),
+                x221 + Self::mul_add(x33, x245, x321),
+                x5 * (x222 + (x323 + (x331 + x333))),
             ),
         );
         let x438 = Self::mul_add(
             x7,
-            x226 + (x327 + (x332 - x333)),
+            x226 + (x327 + (x332 + x333)),
             Self::mul_add(
                 -s_q1,
-                x224 - Self::mul_add(x34, x245, x325),
+                x224 + Self::mul_add(x34, x245, x325),
                 x5 * (x225 - Self::mul_add(x34, x246, x326)),
             ),
         );
@@ -3284,7 +3282,7 @@ impl SsrmsRecurrent {
                 * Self::mul_add(
                     x97,
                     x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 - x321)),
+                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
                 ),
         );
         let x440 = Self::mul_add(
@@ -3292,7 +3290,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x97,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 - x325)),
+                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
             ),
             x439,
         );
@@ -3339,16 +3337,15 @@ impl SsrmsRecurrent {
         let x457 = x32 * (x454 + x455);
         let x458 = x447
             + Self::mul_add(
-                -x34,
-                x456,
-                Self::mul_add(-x33, x446 + x454, x32 * (x450 + x450)),
-            );
-        let x459 = x448
-            + Self::mul_add(
                 x34,
-                x446 + x455,
-                Self::mul_add(x33, x456, x32 * (x449 + x449)),
+                x456,
+                Self::mul_add(-x32, x450 + x450, x33 * (x446 + x454)),
             );
+        let x459 = Self::mul_add(
+            x34,
+            x446 + x455,
+            Self::mul_add(x33, x456, x32 * (x449 + x449)),
+        ) - x448;
         let x460 = qd[0] - x451;
         let x461 = x452 - x444;
         let x462 = x445 + x453;
@@ -3364,23 +3361,23 @@ impl SsrmsRecurrent {
         let x472 = x460 * x462;
         let x473 = x460 * x460;
         let x474 = x461 * x462;
-        let x475 = x457
-            + Self::mul_add(
-                x62,
-                x472 - x464,
-                Self::mul_add(-x60, x469 + x470, x61 * (x471 - x465)),
-            );
+        let x475 = Self::mul_add(
+            x62,
+            x472 - x464,
+            Self::mul_add(-x60, x469 + x470, x61 * (x471 - x465)),
+        ) - x457;
         let x476 = x458
             + Self::mul_add(
                 x62,
                 x463 + x474,
                 Self::mul_add(-x61, x469 + x473, x60 * (x465 + x471)),
             );
-        let x477 = Self::mul_add(
-            -x62,
-            x470 + x473,
-            Self::mul_add(x61, x474 - x463, x60 * (x464 + x472)),
-        ) - x459;
+        let x477 = x459
+            + Self::mul_add(
+                -x62,
+                x470 + x473,
+                Self::mul_add(x61, x474 - x463, x60 * (x464 + x472)),
+            );
         let x478 = x460 - x466;
         let x479 = x461 + x467;
         let x480 = x462 + x468;
@@ -3430,22 +3427,22 @@ impl SsrmsRecurrent {
         let x509 = x496 * x496;
         let x510 = x497 * x498;
         let x511 = x493
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x508 - x500,
                 Self::mul_add(x33, x507 - x501, x32 * (x505 + x506)),
             );
         let x512 = x494
             + Self::mul_add(
-                x34,
+                -x34,
                 x510 - x499,
-                -Self::mul_add(x33, x505 + x509, x32 * (x501 + x507)),
+                Self::mul_add(x33, x505 + x509, x32 * (x501 + x507)),
             );
         let x513 = x495
             + Self::mul_add(
-                -x34,
+                x34,
                 x506 + x509,
-                Self::mul_add(-x32, x500 + x508, x33 * (x499 + x510)),
+                Self::mul_add(-x33, x499 + x510, x32 * (x500 + x508)),
             );
         let x514 = x496 + x502;
         let x515 = x497 + x503;
@@ -3494,23 +3491,23 @@ impl SsrmsRecurrent {
         let x550 = 243.66
             * (x511
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x518 + x526,
-                    Self::mul_add(-x138, x523 + x524, x139 * (x525 - x519)),
+                    Self::mul_add(-x139, x525 - x519, x138 * (x523 + x524)),
                 ));
         let x551 = 243.66
             * (x512
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x528 - x517,
-                    Self::mul_add(-x139, x523 + x527, x138 * (x519 + x525)),
+                    Self::mul_add(-x138, x519 + x525, x139 * (x523 + x527)),
                 ));
         let x552 = 243.66
             * (x513
                 + Self::mul_add(
-                    -x140,
+                    x140,
                     x524 + x527,
-                    Self::mul_add(x139, x517 + x528, x138 * (x526 - x518)),
+                    -Self::mul_add(x139, x517 + x528, x138 * (x526 - x518)),
                 ));
         let x553 = Self::mul_add(x159, x531, Self::mul_add(x158, x530, x157 * x529));
         let x554 = Self::mul_add(x162, x531, Self::mul_add(x161, x530, x160 * x529));
@@ -3530,30 +3527,30 @@ impl SsrmsRecurrent {
         let x565 = Self::mul_add(279.2, x475, x562);
         let x566 = Self::mul_add(279.2, x476, x563);
         let x567 = Self::mul_add(279.2, x477, x564);
-        let x568 = Self::mul_add(314.88, x457, x565);
+        let x568 = Self::mul_add(314.88, x457, -x565);
         let x569 = Self::mul_add(314.88, x458, x566);
-        let x570 = Self::mul_add(314.88, x459, -x567);
-        let x571 = Self::mul_add(-x139, x552, x140 * x551)
+        let x570 = Self::mul_add(314.88, x459, x567);
+        let x571 = Self::mul_add(-x140, x551, x139 * x552)
             - (Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
                 + Self::mul_add(-x516, x548, x515 * x549) + x556);
-        let x572 = Self::mul_add(-x140, x550, x138 * x552)
+        let x572 = Self::mul_add(-x138, x552, x140 * x550)
             - (Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
                 + Self::mul_add(-x514, x549, x516 * x547) + x557);
-        let x573 = Self::mul_add(-x138, x551, x139 * x550)
+        let x573 = Self::mul_add(-x139, x550, x138 * x551)
             - (Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
                 + Self::mul_add(-x515, x547, x514 * x548) + x558);
         let x574 = x571
             - (Self::mul_add(x106, x501, Self::mul_add(-x105, x500, x104 * x499))
                 + Self::mul_add(-x498, x545, x497 * x546))
-            + Self::mul_add(-x33, x561, x34 * x560);
+            + Self::mul_add(-x34, x560, x33 * x561);
         let x575 = x572
             - (Self::mul_add(x109, x501, Self::mul_add(-x108, x500, x107 * x499))
                 + Self::mul_add(-x496, x546, x498 * x544))
-            - Self::mul_add(x32, x561, x34 * x559);
+            + Self::mul_add(x32, x561, x34 * x559);
         let x576 = x573
             - (Self::mul_add(x112, x501, Self::mul_add(-x111, x500, x110 * x499))
                 + Self::mul_add(-x497, x544, x496 * x545))
-            + Self::mul_add(x32, x560, x33 * x559);
+            - Self::mul_add(x32, x560, x33 * x559);
         let x577 = x574
             - (Self::mul_add(x81, x483, Self::mul_add(-x80, x482, x79 * x481))
                 + Self::mul_add(-x480, x542, x479 * x543))
@@ -3581,15 +3578,15 @@ impl SsrmsRecurrent {
         let x583 = tau[0]
             + (Self::mul_add(x21, x450, x19 * x449)
                 + Self::mul_add(x444, x537, x445 * x536) + x580
-                + Self::mul_add(x33, x570, x34 * x569)
+                + Self::mul_add(-x34, x569, x33 * x570)
                 + Self::mul_add(
                     -x1,
-                    Self::mul_add(105.98, x448, x570),
+                    Self::mul_add(105.98, x448, -x570),
                     x2 * Self::mul_add(105.98, x447, x569),
                 ));
         let x584 = 1.0
             / (12.19 + (x17 + x236)
-                + (x402 + Self::mul_add(x33, x280, x34 * x281)
+                + (x402 - Self::mul_add(x33, x280, x34 * x281)
                     + Self::mul_add(
                         -x1,
                         Self::mul_add(-105.98, x1, x280),
@@ -3723,7 +3720,7 @@ impl SsrmsRecurrent {
                         * (x582
                             - (Self::mul_add(qd[0], x536, x444 * x535)
                                 - Self::mul_add(x31, x450, x29 * x449))
-                            + Self::mul_add(x32, x569, x33 * x568)),
+                            + Self::mul_add(-x32, x569, x33 * x568)),
                 ),
         );
         let x640 = Self::mul_add(
@@ -3841,9 +3838,9 @@ impl SsrmsRecurrent {
         let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
         let x30 = x7 * x14;
         let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = -0.5692 * s_q1;
-        let x33 = -0.5692 * x5;
-        let x34 = -0.5692 * x7;
+        let x32 = s_q1 * 0.5692;
+        let x33 = x5 * 0.5692;
+        let x34 = x7 * 0.5692;
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x36 = c_q1 * c_q2;
         let x37 = c_q1 * s_q2;
@@ -3869,9 +3866,9 @@ impl SsrmsRecurrent {
         let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
         let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
         let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(0.475, s_q1, 7.11 * x36);
-        let x61 = Self::mul_add(-0.475, x5, 7.11 * x38);
-        let x62 = Self::mul_add(-0.475, x7, 7.11 * x40);
+        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
+        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
+        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
         let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
@@ -3879,18 +3876,18 @@ impl SsrmsRecurrent {
         let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
         let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
         let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(39.95, s_q1, 9.522 * x64);
-        let x71 = Self::mul_add(-1966.28, s_q1, -39.95 * x64);
+        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
+        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(-39.95, x5, 9.522 * x66);
-        let x74 = Self::mul_add(1966.28, x5, -39.95 * x66);
+        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
+        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
         let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(-39.95, x7, 9.522 * x68);
-        let x77 = Self::mul_add(1966.28, x7, -39.95 * x68);
+        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
+        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
         let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(-s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(x7, x71, x68 * x70));
+        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
+        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
+        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
         let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
         let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
         let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
@@ -3947,9 +3944,9 @@ impl SsrmsRecurrent {
         let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = -0.7026 * x93;
-        let x139 = -0.7026 * x95;
-        let x140 = -0.7026 * x97;
+        let x138 = 0.7026 * x93;
+        let x139 = 0.7026 * x95;
+        let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
         let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
@@ -3975,32 +3972,32 @@ impl SsrmsRecurrent {
         let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
         let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
         let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x138 - x32;
+        let x166 = x32 - x138;
         let x167 = x33 + x139;
         let x168 = x34 + x140;
         let x169 = x88 + x166;
-        let x170 = x89 + x167;
-        let x171 = x90 + x168;
+        let x170 = x89 - x167;
+        let x171 = x90 - x168;
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x33 + x173;
-        let x176 = x34 + x174;
-        let x177 = x88 - x32;
-        let x178 = x33 + x89;
-        let x179 = x34 + x90;
+        let x175 = x173 - x33;
+        let x176 = x174 - x34;
+        let x177 = x32 + x88;
+        let x178 = x89 - x33;
+        let x179 = x90 - x34;
         let x180 = x60 + x177;
         let x181 = x61 + x178;
         let x182 = x62 + x179;
-        let x183 = x33 + x181;
-        let x184 = x34 + x182;
+        let x183 = x181 - x33;
+        let x184 = x182 - x34;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x33 + x186;
-        let x189 = x34 + x187;
-        let x190 = x33 + x61;
-        let x191 = x34 + x62;
+        let x188 = x186 - x33;
+        let x189 = x187 - x34;
+        let x190 = x61 - x33;
+        let x191 = x62 - x34;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -4013,7 +4010,7 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x172 - x32);
+        let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
         let x207 = 243.66 * (x175 - x1);
@@ -4054,7 +4051,7 @@ impl SsrmsRecurrent {
         let x242 = x57 + x233;
         let x243 = x58 + x234;
         let x244 = x59 + x235;
-        let x245 = Self::mul_add(-105.98, x32, x195);
+        let x245 = Self::mul_add(105.98, x32, x195);
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
@@ -4072,25 +4069,25 @@ impl SsrmsRecurrent {
         let x260 = Self::mul_add(279.2, x60, x257);
         let x261 = Self::mul_add(279.2, x61, x258);
         let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x180 - x32, x204);
+        let x263 = Self::mul_add(105.98, x32 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x185 - x32, x263);
+        let x266 = Self::mul_add(105.98, x32 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x60 - x32, x266);
+        let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
+        let x272 = Self::mul_add(-314.88, x33, x270);
+        let x273 = Self::mul_add(-314.88, x34, x271);
         let x274 = Self::mul_add(105.98, x183 - x1, x207);
         let x275 = Self::mul_add(105.98, x2 + x184, x208);
         let x276 = Self::mul_add(105.98, x188 - x1, x274);
         let x277 = Self::mul_add(105.98, x2 + x189, x275);
         let x278 = Self::mul_add(279.2, x190 - x1, x276);
         let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(314.88, x33 - x1, x278);
-        let x281 = Self::mul_add(314.88, x2 + x34, x279);
+        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x281 = Self::mul_add(314.88, x2 - x34, x279);
         let x282 = Self::mul_add(x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
@@ -4132,11 +4129,11 @@ impl SsrmsRecurrent {
         let x320 = x138 * x197;
         let x321 = x139 * x195;
         let x322 = x138 * x195;
-        let x323 = x316 + x322;
+        let x323 = x316 - x322;
         let x324 = x139 * x197;
         let x325 = x140 * x195;
         let x326 = x140 * x196;
-        let x327 = x317 + x322;
+        let x327 = x317 - x322;
         let x328 = x140 * x194;
         let x329 = x139 * x193;
         let x330 = x138 * x192;
@@ -4147,14 +4144,14 @@ impl SsrmsRecurrent {
         let x335 = x33 * x249;
         let x336 = x32 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(x32, x249, -x307);
-        let x339 = Self::mul_add(x32, x250, -x308);
+        let x338 = Self::mul_add(-x32, x249, x307);
+        let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x311 + (x334 - x336);
+        let x341 = x336 - x334 - x311;
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x315 + (x335 - x336);
+        let x345 = x336 - x335 - x315;
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -4162,60 +4159,60 @@ impl SsrmsRecurrent {
         let x350 = x33 * x255;
         let x351 = x32 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(x32, x255, -x295);
-        let x354 = Self::mul_add(x32, x256, -x296);
+        let x353 = Self::mul_add(-x32, x255, x295);
+        let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x299 + (x349 - x351);
+        let x356 = x351 - x349 - x299;
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x303 + (x350 - x351);
+        let x360 = x351 - x350 - x303;
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x352 + (x361 + x362);
+        let x364 = x361 + x362 - x352;
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(x89, x257, x355);
+        let x367 = Self::mul_add(-x89, x257, x355);
         let x368 = x356 + (x361 + x363);
-        let x369 = Self::mul_add(x89, x259, x357);
-        let x370 = Self::mul_add(x90, x257, x358);
-        let x371 = Self::mul_add(x90, x258, x359);
+        let x369 = Self::mul_add(-x89, x259, x357);
+        let x370 = Self::mul_add(-x90, x257, x358);
+        let x371 = Self::mul_add(-x90, x258, x359);
         let x372 = x360 + (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 + Self::mul_add(x34, x265, -x376);
+        let x378 = Self::mul_add(-x34, x265, x376) - x288;
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 + Self::mul_add(x33, x264, -x376);
+        let x382 = Self::mul_add(-x33, x264, x376) - x291;
         let x383 = x88 * x266;
-        let x384 = Self::mul_add(x89, x266, x377);
+        let x384 = Self::mul_add(-x89, x266, x377);
         let x385 = x378 + Self::mul_add(x90, x268, x383);
-        let x386 = Self::mul_add(x89, x268, x379);
-        let x387 = Self::mul_add(x90, x266, x380);
-        let x388 = Self::mul_add(x90, x267, x381);
+        let x386 = Self::mul_add(-x89, x268, x379);
+        let x387 = Self::mul_add(-x90, x266, x380);
+        let x388 = Self::mul_add(-x90, x267, x381);
         let x389 = x382 + Self::mul_add(x89, x267, x383);
         let x390 = x60 * x269;
         let x391 = x385 + Self::mul_add(x62, x271, x390);
-        let x392 = Self::mul_add(x61, x271, x386);
-        let x393 = Self::mul_add(x62, x270, x388);
+        let x392 = Self::mul_add(-x61, x271, x386);
+        let x393 = Self::mul_add(-x62, x270, x388);
         let x394 = x389 + Self::mul_add(x61, x270, x390);
-        let x395 = x32 * Self::mul_add(-314.88, x32, x269);
+        let x395 = x32 * Self::mul_add(314.88, x32, x269);
         let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
-        let x397 = Self::mul_add(x32, x274, -x283);
-        let x398 = Self::mul_add(x32, x275, -x284);
-        let x399 = x396 + Self::mul_add(x89, x276, x90 * x277);
+        let x397 = Self::mul_add(-x32, x274, x283);
+        let x398 = Self::mul_add(-x32, x275, x284);
+        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
         let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
         let x403 = Self::mul_add(-x60, x278, x400);
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = 12.19 + (x17 + x236)
-            + (x402 + Self::mul_add(x33, x280, x34 * x281)
+            + (x402 - Self::mul_add(x33, x280, x34 * x281)
                 + Self::mul_add(
                     -x1,
                     Self::mul_add(-105.98, x1, x280),
@@ -4223,8 +4220,8 @@ impl SsrmsRecurrent {
                 ));
         let x406 = Self::mul_add(
             -s_q0,
-            x19 + x237 + Self::mul_add(x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(x32, x281, x404)),
+            x19 + x237 + Self::mul_add(-x32, x280, x403),
+            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
         );
         let x407 = Self::mul_add(
             x7,
@@ -4239,12 +4236,12 @@ impl SsrmsRecurrent {
         let x409 = Self::mul_add(
             x7,
             x220 + x398,
-            Self::mul_add(-s_q1, x218 + x396, x5 * (x219 + x397)),
+            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
         );
         let x410 = Self::mul_add(
             x97,
-            x211 - x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 + x282)),
+            x211 + x284,
+            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
         );
         let x411 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x412 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
@@ -4253,22 +4250,22 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(x34, x273, -x395)),
-                c_q0 * (x26 + x241 - Self::mul_add(x33, x273, x392)),
+                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
+                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
             ),
             c_q0
                 * Self::mul_add(
                     -s_q0,
-                    x29 + x243 - Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(x33, x272, -x395))),
+                    x29 + x243 + Self::mul_add(x34, x272, x393),
+                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
                 ),
         );
         let x415 = Self::mul_add(
             x7,
-            x241 - x392,
+            x241 + x392,
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x269, x384),
+                x239 + Self::mul_add(-x61, x269, x384),
                 x5 * (x240 + x391),
             ),
         );
@@ -4277,8 +4274,8 @@ impl SsrmsRecurrent {
             x244 + x394,
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x269, x387),
-                x5 * (x243 - x393),
+                x242 + Self::mul_add(-x62, x269, x387),
+                x5 * (x243 + x393),
             ),
         );
         let x417 = Self::mul_add(-s_q0, x415, c_q0 * x416);
@@ -4286,42 +4283,42 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 x7,
-                x232 - x386,
-                Self::mul_add(-s_q1, x230 - x384, x5 * (x231 + x385)),
+                x232 + x386,
+                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x235 + x389,
-                    Self::mul_add(-s_q1, x233 - x387, x5 * (x234 - x388)),
+                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
                 ),
         );
         let x419 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x223 - x379,
-                Self::mul_add(-s_q1, x221 - x377, x5 * (x222 + x378)),
+                x223 + x379,
+                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x226 + x382,
-                    Self::mul_add(-s_q1, x224 - x380, x5 * (x225 - x381)),
+                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
                 ),
         );
         let x420 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x97,
-                x214 - x289,
-                Self::mul_add(x95, x213 + x288, x93 * (x212 - x285)),
+                x214 + x289,
+                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
             ),
             c_q0
                 * Self::mul_add(
                     x97,
-                    x217 + x291,
-                    Self::mul_add(x95, x216 - x290, x93 * (x215 - x287)),
+                    x217 - x291,
+                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
                 ),
         );
         let x421 = Self::mul_add(-s_q0, x412, c_q0 * x413);
@@ -4336,10 +4333,10 @@ impl SsrmsRecurrent {
         );
         let x423 = Self::mul_add(
             x7,
-            x241 - Self::mul_add(x61, x262, x369),
+            x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x260, x367),
+                x239 + Self::mul_add(-x61, x260, x367),
                 x5 * (x240 + (x368 + (x373 + x375))),
             ),
         );
@@ -4348,8 +4345,8 @@ impl SsrmsRecurrent {
             x244 + (x372 + (x374 + x375)),
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x260, x370),
-                x5 * (x243 - Self::mul_add(x62, x261, x371)),
+                x242 + Self::mul_add(-x62, x260, x370),
+                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
             ),
         );
         let x425 = Self::mul_add(x7, x424, Self::mul_add(-s_q1, x422, x5 * x423));
@@ -4363,8 +4360,8 @@ impl SsrmsRecurrent {
             x5
                 * Self::mul_add(
                     x7,
-                    x232 - x369,
-                    Self::mul_add(-s_q1, x230 - x367, x5 * (x231 + x368)),
+                    x232 + x369,
+                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
                 ),
         );
         let x427 = Self::mul_add(
@@ -4372,7 +4369,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x235 + x372,
-                Self::mul_add(-s_q1, x233 - x370, x5 * (x234 - x371)),
+                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
             ),
             x426,
         );
@@ -4381,13 +4378,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x354,
-                Self::mul_add(-s_q1, x218 + x352, x5 * (x219 + x353)),
+                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x357,
-                    Self::mul_add(-s_q1, x221 - x355, x5 * (x222 + x356)),
+                    x223 + x357,
+                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
                 ),
         );
         let x429 = Self::mul_add(
@@ -4395,7 +4392,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x360,
-                Self::mul_add(-s_q1, x224 - x358, x5 * (x225 - x359)),
+                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
             ),
             x428,
         );
@@ -4403,22 +4400,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x296,
-                Self::mul_add(x95, x210 - x295, x93 * (x209 + x294)),
+                x211 + x296,
+                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x300,
-                    Self::mul_add(x95, x213 + x299, x93 * (x212 - x297)),
+                    x214 + x300,
+                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
                 ),
         );
         let x431 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x303,
-                Self::mul_add(x95, x216 - x302, x93 * (x215 - x301)),
+                x217 - x303,
+                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
             ),
             x430,
         );
@@ -4428,16 +4425,16 @@ impl SsrmsRecurrent {
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
                 -s_q1,
-                x227 + (x337 + (x346 + x347)),
+                x227 + (x346 + x347 - x337),
                 x5 * (x228 + Self::mul_add(-x88, x252, x338)),
             ),
         );
         let x434 = Self::mul_add(
             x7,
-            x232 - Self::mul_add(x89, x253, x342),
+            x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
                 -s_q1,
-                x230 - Self::mul_add(x89, x251, x340),
+                x230 + Self::mul_add(-x89, x251, x340),
                 x5 * (x231 + (x341 + (x346 + x348))),
             ),
         );
@@ -4446,8 +4443,8 @@ impl SsrmsRecurrent {
             x235 + (x345 + (x347 + x348)),
             Self::mul_add(
                 -s_q1,
-                x233 - Self::mul_add(x90, x251, x343),
-                x5 * (x234 - Self::mul_add(x90, x252, x344)),
+                x233 + Self::mul_add(-x90, x251, x343),
+                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
             ),
         );
         let x436 = Self::mul_add(x7, x435, Self::mul_add(-s_q1, x433, x5 * x434));
@@ -4456,13 +4453,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x339,
-                Self::mul_add(-s_q1, x218 + x337, x5 * (x219 + x338)),
+                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x342,
-                    Self::mul_add(-s_q1, x221 - x340, x5 * (x222 + x341)),
+                    x223 + x342,
+                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
                 ),
         );
         let x438 = Self::mul_add(
@@ -4470,7 +4467,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x345,
-                Self::mul_add(-s_q1, x224 - x343, x5 * (x225 - x344)),
+                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
             ),
             x437,
         );
@@ -4478,22 +4475,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x308,
-                Self::mul_add(x95, x210 - x307, x93 * (x209 + x306)),
+                x211 + x308,
+                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x312,
-                    Self::mul_add(x95, x213 + x311, x93 * (x212 - x309)),
+                    x214 + x312,
+                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
                 ),
         );
         let x440 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x315,
-                Self::mul_add(x95, x216 - x314, x93 * (x215 - x313)),
+                x217 - x315,
+                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
             ),
             x439,
         );
@@ -4511,16 +4508,16 @@ impl SsrmsRecurrent {
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
                 -s_q1,
-                x221 - Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 - x333))),
+                x221 + Self::mul_add(x33, x245, x321),
+                x5 * (x222 + (x323 + (x331 + x333))),
             ),
         );
         let x443 = Self::mul_add(
             x7,
-            x226 + (x327 + (x332 - x333)),
+            x226 + (x327 + (x332 + x333)),
             Self::mul_add(
                 -s_q1,
-                x224 - Self::mul_add(x34, x245, x325),
+                x224 + Self::mul_add(x34, x245, x325),
                 x5 * (x225 - Self::mul_add(x34, x246, x326)),
             ),
         );
@@ -4536,7 +4533,7 @@ impl SsrmsRecurrent {
                 * Self::mul_add(
                     x97,
                     x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 - x321)),
+                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
                 ),
         );
         let x446 = Self::mul_add(
@@ -4544,7 +4541,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x97,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 - x325)),
+                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
             ),
             x445,
         );
@@ -4594,16 +4591,15 @@ impl SsrmsRecurrent {
         let x466 = x32 * (x463 + x464);
         let x467 = x456
             + Self::mul_add(
-                -x34,
-                x465,
-                Self::mul_add(-x33, x455 + x463, x32 * (x459 + x459)),
-            );
-        let x468 = x457
-            + Self::mul_add(
                 x34,
-                x455 + x464,
-                Self::mul_add(x33, x465, x32 * (x458 + x458)),
+                x465,
+                Self::mul_add(-x32, x459 + x459, x33 * (x455 + x463)),
             );
+        let x468 = Self::mul_add(
+            x34,
+            x455 + x464,
+            Self::mul_add(x33, x465, x32 * (x458 + x458)),
+        ) - x457;
         let x469 = qd[0] - x460;
         let x470 = x461 - x453;
         let x471 = x454 + x462;
@@ -4619,23 +4615,23 @@ impl SsrmsRecurrent {
         let x481 = x469 * x471;
         let x482 = x469 * x469;
         let x483 = x470 * x471;
-        let x484 = x466
-            + Self::mul_add(
-                x62,
-                x481 - x473,
-                Self::mul_add(-x60, x478 + x479, x61 * (x480 - x474)),
-            );
+        let x484 = Self::mul_add(
+            x62,
+            x481 - x473,
+            Self::mul_add(-x60, x478 + x479, x61 * (x480 - x474)),
+        ) - x466;
         let x485 = x467
             + Self::mul_add(
                 x62,
                 x472 + x483,
                 Self::mul_add(-x61, x478 + x482, x60 * (x474 + x480)),
             );
-        let x486 = Self::mul_add(
-            -x62,
-            x479 + x482,
-            Self::mul_add(x61, x483 - x472, x60 * (x473 + x481)),
-        ) - x468;
+        let x486 = x468
+            + Self::mul_add(
+                -x62,
+                x479 + x482,
+                Self::mul_add(x61, x483 - x472, x60 * (x473 + x481)),
+            );
         let x487 = x469 - x475;
         let x488 = x470 + x476;
         let x489 = x471 + x477;
@@ -4685,22 +4681,22 @@ impl SsrmsRecurrent {
         let x518 = x505 * x505;
         let x519 = x506 * x507;
         let x520 = x502
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x517 - x509,
                 Self::mul_add(x33, x516 - x510, x32 * (x514 + x515)),
             );
         let x521 = x503
             + Self::mul_add(
-                x34,
+                -x34,
                 x519 - x508,
-                -Self::mul_add(x33, x514 + x518, x32 * (x510 + x516)),
+                Self::mul_add(x33, x514 + x518, x32 * (x510 + x516)),
             );
         let x522 = x504
             + Self::mul_add(
-                -x34,
+                x34,
                 x515 + x518,
-                Self::mul_add(-x32, x509 + x517, x33 * (x508 + x519)),
+                Self::mul_add(-x33, x508 + x519, x32 * (x509 + x517)),
             );
         let x523 = x505 + x511;
         let x524 = x506 + x512;
@@ -4749,23 +4745,23 @@ impl SsrmsRecurrent {
         let x559 = 243.66
             * (x520
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x527 + x535,
-                    Self::mul_add(-x138, x532 + x533, x139 * (x534 - x528)),
+                    Self::mul_add(-x139, x534 - x528, x138 * (x532 + x533)),
                 ));
         let x560 = 243.66
             * (x521
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x537 - x526,
-                    Self::mul_add(-x139, x532 + x536, x138 * (x528 + x534)),
+                    Self::mul_add(-x138, x528 + x534, x139 * (x532 + x536)),
                 ));
         let x561 = 243.66
             * (x522
                 + Self::mul_add(
-                    -x140,
+                    x140,
                     x533 + x536,
-                    Self::mul_add(x139, x526 + x537, x138 * (x535 - x527)),
+                    -Self::mul_add(x139, x526 + x537, x138 * (x535 - x527)),
                 ));
         let x562 = Self::mul_add(x159, x540, Self::mul_add(x158, x539, x157 * x538));
         let x563 = Self::mul_add(x162, x540, Self::mul_add(x161, x539, x160 * x538));
@@ -4785,30 +4781,30 @@ impl SsrmsRecurrent {
         let x574 = Self::mul_add(279.2, x484, x571);
         let x575 = Self::mul_add(279.2, x485, x572);
         let x576 = Self::mul_add(279.2, x486, x573);
-        let x577 = Self::mul_add(314.88, x466, x574);
+        let x577 = Self::mul_add(314.88, x466, -x574);
         let x578 = Self::mul_add(314.88, x467, x575);
-        let x579 = Self::mul_add(314.88, x468, -x576);
-        let x580 = Self::mul_add(-x139, x561, x140 * x560)
+        let x579 = Self::mul_add(314.88, x468, x576);
+        let x580 = Self::mul_add(-x140, x560, x139 * x561)
             - (Self::mul_add(x131, x528, Self::mul_add(x130, x527, x129 * x526))
                 + Self::mul_add(-x525, x557, x524 * x558) + x565);
-        let x581 = Self::mul_add(-x140, x559, x138 * x561)
+        let x581 = Self::mul_add(-x138, x561, x140 * x559)
             - (Self::mul_add(x134, x528, Self::mul_add(x133, x527, x132 * x526))
                 + Self::mul_add(-x523, x558, x525 * x556) + x566);
-        let x582 = Self::mul_add(-x138, x560, x139 * x559)
+        let x582 = Self::mul_add(-x139, x559, x138 * x560)
             - (Self::mul_add(x137, x528, Self::mul_add(x136, x527, x135 * x526))
                 + Self::mul_add(-x524, x556, x523 * x557) + x567);
         let x583 = x580
             - (Self::mul_add(x106, x510, Self::mul_add(-x105, x509, x104 * x508))
                 + Self::mul_add(-x507, x554, x506 * x555))
-            + Self::mul_add(-x33, x570, x34 * x569);
+            + Self::mul_add(-x34, x569, x33 * x570);
         let x584 = x581
             - (Self::mul_add(x109, x510, Self::mul_add(-x108, x509, x107 * x508))
                 + Self::mul_add(-x505, x555, x507 * x553))
-            - Self::mul_add(x32, x570, x34 * x568);
+            + Self::mul_add(x32, x570, x34 * x568);
         let x585 = x582
             - (Self::mul_add(x112, x510, Self::mul_add(-x111, x509, x110 * x508))
                 + Self::mul_add(-x506, x553, x505 * x554))
-            + Self::mul_add(x32, x569, x33 * x568);
+            - Self::mul_add(x32, x569, x33 * x568);
         let x586 = x583
             - (Self::mul_add(x81, x492, Self::mul_add(-x80, x491, x79 * x490))
                 + Self::mul_add(-x489, x551, x488 * x552))
@@ -4836,10 +4832,10 @@ impl SsrmsRecurrent {
         let x592 = Self::mul_add(x118, x567, Self::mul_add(x116, x566, x114 * x565));
         let x593 = -(Self::mul_add(x21, x459, x19 * x458)
             + Self::mul_add(x453, x546, x454 * x545) + x589
-            + Self::mul_add(x33, x579, x34 * x578)
+            + Self::mul_add(-x34, x578, x33 * x579)
             + Self::mul_add(
                 -x1,
-                Self::mul_add(105.98, x457, x579),
+                Self::mul_add(105.98, x457, -x579),
                 x2 * Self::mul_add(105.98, x456, x578),
             ));
         let x594 = -Self::mul_add(
@@ -4852,7 +4848,7 @@ impl SsrmsRecurrent {
                 * (x591
                     - (Self::mul_add(qd[0], x545, x453 * x544)
                         - Self::mul_add(x31, x459, x29 * x458))
-                    + Self::mul_add(x32, x578, x33 * x577)),
+                    + Self::mul_add(-x32, x578, x33 * x577)),
         );
         let x595 = -Self::mul_add(x7, x591, Self::mul_add(-s_q1, x589, x5 * x590));
         let x596 = -Self::mul_add(x7, x588, Self::mul_add(-s_q1, x586, x5 * x587));
@@ -4913,9 +4909,9 @@ impl SsrmsRecurrent {
         let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
         let x30 = x7 * x14;
         let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = -0.5692 * s_q1;
-        let x33 = -0.5692 * x5;
-        let x34 = -0.5692 * x7;
+        let x32 = s_q1 * 0.5692;
+        let x33 = x5 * 0.5692;
+        let x34 = x7 * 0.5692;
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x36 = c_q1 * c_q2;
         let x37 = c_q1 * s_q2;
@@ -4941,9 +4937,9 @@ impl SsrmsRecurrent {
         let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
         let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
         let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(0.475, s_q1, 7.11 * x36);
-        let x61 = Self::mul_add(-0.475, x5, 7.11 * x38);
-        let x62 = Self::mul_add(-0.475, x7, 7.11 * x40);
+        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
+        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
+        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
         let (s_q3, c_q3) = libm::sincos(q[3]);
         let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
         let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
@@ -4951,18 +4947,18 @@ impl SsrmsRecurrent {
         let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
         let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
         let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(39.95, s_q1, 9.522 * x64);
-        let x71 = Self::mul_add(-1966.28, s_q1, -39.95 * x64);
+        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
+        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(-39.95, x5, 9.522 * x66);
-        let x74 = Self::mul_add(1966.28, x5, -39.95 * x66);
+        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
+        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
         let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(-39.95, x7, 9.522 * x68);
-        let x77 = Self::mul_add(1966.28, x7, -39.95 * x68);
+        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
+        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
         let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(-s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(x7, x71, x68 * x70));
+        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
+        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
+        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
         let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
         let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
         let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
@@ -5019,9 +5015,9 @@ impl SsrmsRecurrent {
         let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = -0.7026 * x93;
-        let x139 = -0.7026 * x95;
-        let x140 = -0.7026 * x97;
+        let x138 = 0.7026 * x93;
+        let x139 = 0.7026 * x95;
+        let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
         let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
@@ -5047,32 +5043,32 @@ impl SsrmsRecurrent {
         let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
         let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
         let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x138 - x32;
+        let x166 = x32 - x138;
         let x167 = x33 + x139;
         let x168 = x34 + x140;
         let x169 = x88 + x166;
-        let x170 = x89 + x167;
-        let x171 = x90 + x168;
+        let x170 = x89 - x167;
+        let x171 = x90 - x168;
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x33 + x173;
-        let x176 = x34 + x174;
-        let x177 = x88 - x32;
-        let x178 = x33 + x89;
-        let x179 = x34 + x90;
+        let x175 = x173 - x33;
+        let x176 = x174 - x34;
+        let x177 = x32 + x88;
+        let x178 = x89 - x33;
+        let x179 = x90 - x34;
         let x180 = x60 + x177;
         let x181 = x61 + x178;
         let x182 = x62 + x179;
-        let x183 = x33 + x181;
-        let x184 = x34 + x182;
+        let x183 = x181 - x33;
+        let x184 = x182 - x34;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x33 + x186;
-        let x189 = x34 + x187;
-        let x190 = x33 + x61;
-        let x191 = x34 + x62;
+        let x188 = x186 - x33;
+        let x189 = x187 - x34;
+        let x190 = x61 - x33;
+        let x191 = x62 - x34;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -5085,7 +5081,7 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x172 - x32);
+        let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
         let x207 = 243.66 * (x175 - x1);
@@ -5126,7 +5122,7 @@ impl SsrmsRecurrent {
         let x242 = x57 + x233;
         let x243 = x58 + x234;
         let x244 = x59 + x235;
-        let x245 = Self::mul_add(-105.98, x32, x195);
+        let x245 = Self::mul_add(105.98, x32, x195);
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
@@ -5144,25 +5140,25 @@ impl SsrmsRecurrent {
         let x260 = Self::mul_add(279.2, x60, x257);
         let x261 = Self::mul_add(279.2, x61, x258);
         let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x180 - x32, x204);
+        let x263 = Self::mul_add(105.98, x32 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x185 - x32, x263);
+        let x266 = Self::mul_add(105.98, x32 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x60 - x32, x266);
+        let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
+        let x272 = Self::mul_add(-314.88, x33, x270);
+        let x273 = Self::mul_add(-314.88, x34, x271);
         let x274 = Self::mul_add(105.98, x183 - x1, x207);
         let x275 = Self::mul_add(105.98, x2 + x184, x208);
         let x276 = Self::mul_add(105.98, x188 - x1, x274);
         let x277 = Self::mul_add(105.98, x2 + x189, x275);
         let x278 = Self::mul_add(279.2, x190 - x1, x276);
         let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(314.88, x33 - x1, x278);
-        let x281 = Self::mul_add(314.88, x2 + x34, x279);
+        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x281 = Self::mul_add(314.88, x2 - x34, x279);
         let x282 = Self::mul_add(x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
@@ -5204,11 +5200,11 @@ impl SsrmsRecurrent {
         let x320 = x138 * x197;
         let x321 = x139 * x195;
         let x322 = x138 * x195;
-        let x323 = x316 + x322;
+        let x323 = x316 - x322;
         let x324 = x139 * x197;
         let x325 = x140 * x195;
         let x326 = x140 * x196;
-        let x327 = x317 + x322;
+        let x327 = x317 - x322;
         let x328 = x140 * x194;
         let x329 = x139 * x193;
         let x330 = x138 * x192;
@@ -5219,14 +5215,14 @@ impl SsrmsRecurrent {
         let x335 = x33 * x249;
         let x336 = x32 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(x32, x249, -x307);
-        let x339 = Self::mul_add(x32, x250, -x308);
+        let x338 = Self::mul_add(-x32, x249, x307);
+        let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x311 + (x334 - x336);
+        let x341 = x336 - x334 - x311;
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x315 + (x335 - x336);
+        let x345 = x336 - x335 - x315;
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -5234,53 +5230,53 @@ impl SsrmsRecurrent {
         let x350 = x33 * x255;
         let x351 = x32 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(x32, x255, -x295);
-        let x354 = Self::mul_add(x32, x256, -x296);
+        let x353 = Self::mul_add(-x32, x255, x295);
+        let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x299 + (x349 - x351);
+        let x356 = x351 - x349 - x299;
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x303 + (x350 - x351);
+        let x360 = x351 - x350 - x303;
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x352 + (x361 + x362);
+        let x364 = x361 + x362 - x352;
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(x89, x257, x355);
+        let x367 = Self::mul_add(-x89, x257, x355);
         let x368 = x356 + (x361 + x363);
-        let x369 = Self::mul_add(x89, x259, x357);
-        let x370 = Self::mul_add(x90, x257, x358);
-        let x371 = Self::mul_add(x90, x258, x359);
+        let x369 = Self::mul_add(-x89, x259, x357);
+        let x370 = Self::mul_add(-x90, x257, x358);
+        let x371 = Self::mul_add(-x90, x258, x359);
         let x372 = x360 + (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 + Self::mul_add(x34, x265, -x376);
+        let x378 = Self::mul_add(-x34, x265, x376) - x288;
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 + Self::mul_add(x33, x264, -x376);
+        let x382 = Self::mul_add(-x33, x264, x376) - x291;
         let x383 = x88 * x266;
-        let x384 = Self::mul_add(x89, x266, x377);
+        let x384 = Self::mul_add(-x89, x266, x377);
         let x385 = x378 + Self::mul_add(x90, x268, x383);
-        let x386 = Self::mul_add(x89, x268, x379);
-        let x387 = Self::mul_add(x90, x266, x380);
-        let x388 = Self::mul_add(x90, x267, x381);
+        let x386 = Self::mul_add(-x89, x268, x379);
+        let x387 = Self::mul_add(-x90, x266, x380);
+        let x388 = Self::mul_add(-x90, x267, x381);
         let x389 = x382 + Self::mul_add(x89, x267, x383);
         let x390 = x60 * x269;
         let x391 = x385 + Self::mul_add(x62, x271, x390);
-        let x392 = Self::mul_add(x61, x271, x386);
-        let x393 = Self::mul_add(x62, x270, x388);
+        let x392 = Self::mul_add(-x61, x271, x386);
+        let x393 = Self::mul_add(-x62, x270, x388);
         let x394 = x389 + Self::mul_add(x61, x270, x390);
-        let x395 = x32 * Self::mul_add(-314.88, x32, x269);
+        let x395 = x32 * Self::mul_add(314.88, x32, x269);
         let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
-        let x397 = Self::mul_add(x32, x274, -x283);
-        let x398 = Self::mul_add(x32, x275, -x284);
-        let x399 = x396 + Self::mul_add(x89, x276, x90 * x277);
+        let x397 = Self::mul_add(-x32, x274, x283);
+        let x398 = Self::mul_add(-x32, x275, x284);
+        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
         let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
@@ -5288,8 +5284,8 @@ impl SsrmsRecurrent {
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = Self::mul_add(
             -s_q0,
-            x19 + x237 + Self::mul_add(x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(x32, x281, x404)),
+            x19 + x237 + Self::mul_add(-x32, x280, x403),
+            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
         );
         let x406 = Self::mul_add(
             x7,
@@ -5304,12 +5300,12 @@ impl SsrmsRecurrent {
         let x408 = Self::mul_add(
             x7,
             x220 + x398,
-            Self::mul_add(-s_q1, x218 + x396, x5 * (x219 + x397)),
+            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
         );
         let x409 = Self::mul_add(
             x97,
-            x211 - x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 + x282)),
+            x211 + x284,
+            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
         );
         let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
@@ -5318,22 +5314,22 @@ impl SsrmsRecurrent {
             -s_q0,
             Self::mul_add(
                 -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(x34, x273, -x395)),
-                c_q0 * (x26 + x241 - Self::mul_add(x33, x273, x392)),
+                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
+                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
             ),
             c_q0
                 * Self::mul_add(
                     -s_q0,
-                    x29 + x243 - Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(x33, x272, -x395))),
+                    x29 + x243 + Self::mul_add(x34, x272, x393),
+                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
                 ),
         );
         let x414 = Self::mul_add(
             x7,
-            x241 - x392,
+            x241 + x392,
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x269, x384),
+                x239 + Self::mul_add(-x61, x269, x384),
                 x5 * (x240 + x391),
             ),
         );
@@ -5342,50 +5338,50 @@ impl SsrmsRecurrent {
             x244 + x394,
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x269, x387),
-                x5 * (x243 - x393),
+                x242 + Self::mul_add(-x62, x269, x387),
+                x5 * (x243 + x393),
             ),
         );
         let x416 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x232 - x386,
-                Self::mul_add(-s_q1, x230 - x384, x5 * (x231 + x385)),
+                x232 + x386,
+                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x235 + x389,
-                    Self::mul_add(-s_q1, x233 - x387, x5 * (x234 - x388)),
+                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
                 ),
         );
         let x417 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x7,
-                x223 - x379,
-                Self::mul_add(-s_q1, x221 - x377, x5 * (x222 + x378)),
+                x223 + x379,
+                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
             ),
             c_q0
                 * Self::mul_add(
                     x7,
                     x226 + x382,
-                    Self::mul_add(-s_q1, x224 - x380, x5 * (x225 - x381)),
+                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
                 ),
         );
         let x418 = Self::mul_add(
             -s_q0,
             Self::mul_add(
                 x97,
-                x214 - x289,
-                Self::mul_add(x95, x213 + x288, x93 * (x212 - x285)),
+                x214 + x289,
+                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
             ),
             c_q0
                 * Self::mul_add(
                     x97,
-                    x217 + x291,
-                    Self::mul_add(x95, x216 - x290, x93 * (x215 - x287)),
+                    x217 - x291,
+                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
                 ),
         );
         let x419 = Self::mul_add(
@@ -5399,10 +5395,10 @@ impl SsrmsRecurrent {
         );
         let x420 = Self::mul_add(
             x7,
-            x241 - Self::mul_add(x61, x262, x369),
+            x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
                 -s_q1,
-                x239 - Self::mul_add(x61, x260, x367),
+                x239 + Self::mul_add(-x61, x260, x367),
                 x5 * (x240 + (x368 + (x373 + x375))),
             ),
         );
@@ -5411,8 +5407,8 @@ impl SsrmsRecurrent {
             x244 + (x372 + (x374 + x375)),
             Self::mul_add(
                 -s_q1,
-                x242 - Self::mul_add(x62, x260, x370),
-                x5 * (x243 - Self::mul_add(x62, x261, x371)),
+                x242 + Self::mul_add(-x62, x260, x370),
+                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
             ),
         );
         let x422 = Self::mul_add(
@@ -5425,8 +5421,8 @@ impl SsrmsRecurrent {
             x5
                 * Self::mul_add(
                     x7,
-                    x232 - x369,
-                    Self::mul_add(-s_q1, x230 - x367, x5 * (x231 + x368)),
+                    x232 + x369,
+                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
                 ),
         );
         let x423 = Self::mul_add(
@@ -5434,7 +5430,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x235 + x372,
-                Self::mul_add(-s_q1, x233 - x370, x5 * (x234 - x371)),
+                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
             ),
             x422,
         );
@@ -5443,13 +5439,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x354,
-                Self::mul_add(-s_q1, x218 + x352, x5 * (x219 + x353)),
+                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x357,
-                    Self::mul_add(-s_q1, x221 - x355, x5 * (x222 + x356)),
+                    x223 + x357,
+                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
                 ),
         );
         let x425 = Self::mul_add(
@@ -5457,7 +5453,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x360,
-                Self::mul_add(-s_q1, x224 - x358, x5 * (x225 - x359)),
+                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
             ),
             x424,
         );
@@ -5465,22 +5461,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x296,
-                Self::mul_add(x95, x210 - x295, x93 * (x209 + x294)),
+                x211 + x296,
+                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x300,
-                    Self::mul_add(x95, x213 + x299, x93 * (x212 - x297)),
+                    x214 + x300,
+                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
                 ),
         );
         let x427 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x303,
-                Self::mul_add(x95, x216 - x302, x93 * (x215 - x301)),
+                x217 - x303,
+                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
             ),
             x426,
         );
@@ -5490,16 +5486,16 @@ impl SsrmsRecurrent {
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
                 -s_q1,
-                x227 + (x337 + (x346 + x347)),
+                x227 + (x346 + x347 - x337),
                 x5 * (x228 + Self::mul_add(-x88, x252, x338)),
             ),
         );
         let x430 = Self::mul_add(
             x7,
-            x232 - Self::mul_add(x89, x253, x342),
+            x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
                 -s_q1,
-                x230 - Self::mul_add(x89, x251, x340),
+                x230 + Self::mul_add(-x89, x251, x340),
                 x5 * (x231 + (x341 + (x346 + x348))),
             ),
         );
@@ -5508,8 +5504,8 @@ impl SsrmsRecurrent {
             x235 + (x345 + (x347 + x348)),
             Self::mul_add(
                 -s_q1,
-                x233 - Self::mul_add(x90, x251, x343),
-                x5 * (x234 - Self::mul_add(x90, x252, x344)),
+                x233 + Self::mul_add(-x90, x251, x343),
+                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
             ),
         );
         let x432 = Self::mul_add(
@@ -5517,13 +5513,13 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x220 + x339,
-                Self::mul_add(-s_q1, x218 + x337, x5 * (x219 + x338)),
+                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
             ),
             x5
                 * Self::mul_add(
                     x7,
-                    x223 - x342,
-                    Self::mul_add(-s_q1, x221 - x340, x5 * (x222 + x341)),
+                    x223 + x342,
+                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
                 ),
         );
         let x433 = Self::mul_add(
@@ -5531,7 +5527,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x7,
                 x226 + x345,
-                Self::mul_add(-s_q1, x224 - x343, x5 * (x225 - x344)),
+                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
             ),
             x432,
         );
@@ -5539,22 +5535,22 @@ impl SsrmsRecurrent {
             -s_q1,
             Self::mul_add(
                 x97,
-                x211 - x308,
-                Self::mul_add(x95, x210 - x307, x93 * (x209 + x306)),
+                x211 + x308,
+                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
             ),
             x5
                 * Self::mul_add(
                     x97,
-                    x214 - x312,
-                    Self::mul_add(x95, x213 + x311, x93 * (x212 - x309)),
+                    x214 + x312,
+                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
                 ),
         );
         let x435 = Self::mul_add(
             x7,
             Self::mul_add(
                 x97,
-                x217 + x315,
-                Self::mul_add(x95, x216 - x314, x93 * (x215 - x313)),
+                x217 - x315,
+                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
             ),
             x434,
         );
@@ -5572,16 +5568,16 @@ impl SsrmsRecurrent {
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
                 -s_q1,
-                x221 - Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 - x333))),
+                x221 + Self::mul_add(x33, x245, x321),
+                x5 * (x222 + (x323 + (x331 + x333))),
             ),
         );
         let x438 = Self::mul_add(
             x7,
-            x226 + (x327 + (x332 - x333)),
+            x226 + (x327 + (x332 + x333)),
             Self::mul_add(
                 -s_q1,
-                x224 - Self::mul_add(x34, x245, x325),
+                x224 + Self::mul_add(x34, x245, x325),
                 x5 * (x225 - Self::mul_add(x34, x246, x326)),
             ),
         );
@@ -5596,7 +5592,7 @@ impl SsrmsRecurrent {
                 * Self::mul_add(
                     x97,
                     x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 - x321)),
+                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
                 ),
         );
         let x440 = Self::mul_add(
@@ -5604,7 +5600,7 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 x97,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 - x325)),
+                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
             ),
             x439,
         );
@@ -5651,16 +5647,15 @@ impl SsrmsRecurrent {
         let x457 = x32 * (x454 + x455);
         let x458 = x447
             + Self::mul_add(
-                -x34,
-                x456,
-                Self::mul_add(-x33, x446 + x454, x32 * (x450 + x450)),
-            );
-        let x459 = x448
-            + Self::mul_add(
                 x34,
-                x446 + x455,
-                Self::mul_add(x33, x456, x32 * (x449 + x449)),
+                x456,
+                Self::mul_add(-x32, x450 + x450, x33 * (x446 + x454)),
             );
+        let x459 = Self::mul_add(
+            x34,
+            x446 + x455,
+            Self::mul_add(x33, x456, x32 * (x449 + x449)),
+        ) - x448;
         let x460 = qd[0] - x451;
         let x461 = x452 - x444;
         let x462 = x445 + x453;
@@ -5676,23 +5671,23 @@ impl SsrmsRecurrent {
         let x472 = x460 * x462;
         let x473 = x460 * x460;
         let x474 = x461 * x462;
-        let x475 = x457
-            + Self::mul_add(
-                x62,
-                x472 - x464,
-                Self::mul_add(-x60, x469 + x470, x61 * (x471 - x465)),
-            );
+        let x475 = Self::mul_add(
+            x62,
+            x472 - x464,
+            Self::mul_add(-x60, x469 + x470, x61 * (x471 - x465)),
+        ) - x457;
         let x476 = x458
             + Self::mul_add(
                 x62,
                 x463 + x474,
                 Self::mul_add(-x61, x469 + x473, x60 * (x465 + x471)),
             );
-        let x477 = Self::mul_add(
-            -x62,
-            x470 + x473,
-            Self::mul_add(x61, x474 - x463, x60 * (x464 + x472)),
-        ) - x459;
+        let x477 = x459
+            + Self::mul_add(
+                -x62,
+                x470 + x473,
+                Self::mul_add(x61, x474 - x463, x60 * (x464 + x472)),
+            );
         let x478 = x460 - x466;
         let x479 = x461 + x467;
         let x480 = x462 + x468;
@@ -5742,22 +5737,22 @@ impl SsrmsRecurrent {
         let x509 = x496 * x496;
         let x510 = x497 * x498;
         let x511 = x493
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x508 - x500,
                 Self::mul_add(x33, x507 - x501, x32 * (x505 + x506)),
             );
         let x512 = x494
             + Self::mul_add(
-                x34,
+                -x34,
                 x510 - x499,
-                -Self::mul_add(x33, x505 + x509, x32 * (x501 + x507)),
+                Self::mul_add(x33, x505 + x509, x32 * (x501 + x507)),
             );
         let x513 = x495
             + Self::mul_add(
-                -x34,
+                x34,
                 x506 + x509,
-                Self::mul_add(-x32, x500 + x508, x33 * (x499 + x510)),
+                Self::mul_add(-x33, x499 + x510, x32 * (x500 + x508)),
             );
         let x514 = x496 + x502;
         let x515 = x497 + x503;
@@ -5813,7 +5808,7 @@ impl SsrmsRecurrent {
         let x541 = Self::mul_add(x56, x462, Self::mul_add(x55, x461, x54 * x460));
         let x542 = Self::mul_add(x59, x462, Self::mul_add(x58, x461, x57 * x460));
         let x543 = Self::mul_add(
-            -314.88,
+            314.88,
             x457,
             Self::mul_add(
                 f_ext[2][2],
@@ -5831,7 +5826,7 @@ impl SsrmsRecurrent {
             ),
         );
         let x545 = Self::mul_add(
-            314.88,
+            -314.88,
             x459,
             Self::mul_add(
                 f_ext[2][2],
@@ -5936,9 +5931,9 @@ impl SsrmsRecurrent {
             -243.66,
             x511
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x518 + x526,
-                    Self::mul_add(-x138, x523 + x524, x139 * (x525 - x519)),
+                    Self::mul_add(-x139, x525 - x519, x138 * (x523 + x524)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
@@ -5950,9 +5945,9 @@ impl SsrmsRecurrent {
             -243.66,
             x512
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x528 - x517,
-                    Self::mul_add(-x139, x523 + x527, x138 * (x519 + x525)),
+                    Self::mul_add(-x138, x519 + x525, x139 * (x523 + x527)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
@@ -5964,9 +5959,9 @@ impl SsrmsRecurrent {
             -243.66,
             x513
                 + Self::mul_add(
-                    -x140,
+                    x140,
                     x524 + x527,
-                    Self::mul_add(x139, x517 + x528, x138 * (x526 - x518)),
+                    -Self::mul_add(x139, x517 + x528, x138 * (x526 - x518)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
@@ -6014,7 +6009,7 @@ impl SsrmsRecurrent {
         )
             - (Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
                 + Self::mul_add(-x516, x559, x515 * x560)) + x570
-            + Self::mul_add(-x140, x568, x139 * x569);
+            + Self::mul_add(-x139, x569, x140 * x568);
         let x586 = Self::mul_add(
             f_ext[5][5],
             x95,
@@ -6022,7 +6017,7 @@ impl SsrmsRecurrent {
         )
             - (Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
                 + Self::mul_add(-x514, x560, x516 * x558)) + x571
-            + Self::mul_add(-x138, x569, x140 * x567);
+            + Self::mul_add(-x140, x567, x138 * x569);
         let x587 = Self::mul_add(
             f_ext[5][5],
             x97,
@@ -6030,7 +6025,7 @@ impl SsrmsRecurrent {
         )
             - (Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
                 + Self::mul_add(-x515, x558, x514 * x559)) + x572
-            + Self::mul_add(-x139, x567, x138 * x568);
+            + Self::mul_add(-x138, x568, x139 * x567);
         let x588 = Self::mul_add(
             f_ext[4][5],
             x93,
@@ -6038,7 +6033,7 @@ impl SsrmsRecurrent {
         )
             - (Self::mul_add(x106, x501, Self::mul_add(-x105, x500, x104 * x499))
                 + Self::mul_add(-x498, x553, x497 * x554)) + x585
-            + Self::mul_add(-x34, x574, x33 * x575);
+            + Self::mul_add(-x33, x575, x34 * x574);
         let x589 = Self::mul_add(
             f_ext[4][5],
             x95,
@@ -6046,7 +6041,7 @@ impl SsrmsRecurrent {
         )
             - (Self::mul_add(x109, x501, Self::mul_add(-x108, x500, x107 * x499))
                 + Self::mul_add(-x496, x554, x498 * x552)) + x586
-            + Self::mul_add(x32, x575, x34 * x573);
+            - Self::mul_add(x32, x575, x34 * x573);
         let x590 = Self::mul_add(
             f_ext[4][5],
             x97,
@@ -6054,7 +6049,7 @@ impl SsrmsRecurrent {
         )
             - (Self::mul_add(x112, x501, Self::mul_add(-x111, x500, x110 * x499))
                 + Self::mul_add(-x497, x552, x496 * x553)) + x587
-            - Self::mul_add(x32, x574, x33 * x573);
+            + Self::mul_add(x32, x574, x33 * x573);
         let x591 = Self::mul_add(
             f_ext[3][5],
             x65,
@@ -6108,7 +6103,7 @@ impl SsrmsRecurrent {
                 + (Self::mul_add(x21, x450, x19 * x449)
                     + Self::mul_add(x444, x537, x445 * x536)
                     + Self::mul_add(-f_ext[1][4], s_q1, f_ext[1][3] * c_q1) + x594
-                    + Self::mul_add(-x34, x583, x33 * x584))
+                    + Self::mul_add(-x33, x584, x34 * x583))
                 - Self::mul_add(x1, x539 + x584, x2 * (x538 + x583)));
         let x598 = Self::mul_add(
             -s_q0,
@@ -6119,7 +6114,7 @@ impl SsrmsRecurrent {
             )
                 - (Self::mul_add(-qd[0], x537, x445 * x535)
                     - Self::mul_add(x26, x450, x24 * x449)) + x595
-                + Self::mul_add(x32, x584, x34 * x582),
+                - Self::mul_add(x32, x584, x34 * x582),
             c_q0
                 * (Self::mul_add(
                     f_ext[1][5],
@@ -6128,11 +6123,11 @@ impl SsrmsRecurrent {
                 )
                     - (Self::mul_add(qd[0], x536, x444 * x535)
                         - Self::mul_add(x31, x450, x29 * x449)) + x596
-                    - Self::mul_add(x32, x583, x33 * x582)),
+                    + Self::mul_add(x32, x583, x33 * x582)),
         );
         let x599 = 1.0
             / (12.19 + (x17 + x236)
-                + (x402 + Self::mul_add(x33, x280, x34 * x281)
+                + (x402 - Self::mul_add(x33, x280, x34 * x281)
                     + Self::mul_add(
                         -x1,
                         Self::mul_add(-105.98, x1, x280),

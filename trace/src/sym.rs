@@ -15,7 +15,8 @@
 //!   reported in [`Counts::neg`] only.
 //! * [`Convention::Folded`] — the operations left after folding at construction: constants fold,
 //!   `0·x`, `1·x`, `−1·x`, `x ± 0`, `0 − x`, `x − x`, `x/1`, `0/x`, `−(−x)` vanish, and signs are
-//!   normalised (`(−a)·b → −(a·b)`, `a + (−b) → a − b`, `(−a) − b → −(a + b)`, …) so that negations
+//!   normalised (`(−a)·b → −(a·b)`, `a·(−k) → −(a·k)` for a constant `k`, `a + (−b) → a − b`,
+//!   `(−a) − b → −(a + b)`, …) so that negations
 //!   float to the top where they are free. Operations that then hit the hash-cons table are still
 //!   counted (no CSE yet).
 //! * [`Convention::Emitted`] — the unique non-leaf nodes reachable from the outputs: folding plus
@@ -460,6 +461,15 @@ impl Graph {
         }
     }
 
+    /// `(negated, id)` with a negative constant turned positive: `a·(−k)` and `a·k` are one
+    /// product and a sign change (which the sums around it absorb), not two products.
+    fn strip_sign(&mut self, id: u32) -> (bool, u32) {
+        match self.cval(id) {
+            Some(x) if x < 0.0 => (true, self.constant(-x)),
+            _ => self.strip(id),
+        }
+    }
+
     fn mul(&mut self, a: u32, b: u32) -> u32 {
         if let (Some(x), Some(y)) = (self.cval(a), self.cval(b)) {
             return self.constant(x * y);
@@ -475,8 +485,8 @@ impl Graph {
                 return self.neg(x);
             }
         }
-        let (na, a) = self.strip(a);
-        let (nb, b) = self.strip(b);
+        let (na, a) = self.strip_sign(a);
+        let (nb, b) = self.strip_sign(b);
         let p = self.mk(Op::Mul(a.min(b), a.max(b)));
         self.sign(na != nb, p)
     }
