@@ -9,7 +9,7 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 55 → 48 non-zero numbers in the spatial inertias, the base included. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 4116 (`mass_matrix` 301, `nonlinear_effects` 317, `inverse_dynamics` 332, `forward_dynamics` 953, `mass_matrix_and_nonlinear_effects` 618, `forward_dynamics_with_wrenches` 954, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4120 (`mass_matrix` 303, `nonlinear_effects` 317, `inverse_dynamics` 332, `forward_dynamics` 953, `mass_matrix_and_nonlinear_effects` 620, `forward_dynamics_with_wrenches` 954, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -24,8 +24,8 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 3469 | 2908 | 0 | 0 | 7 | 6377 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 1303 | 1037 | 0 | 0 | 7 | 2340 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 1318 | 1052 | 0 | 0 | 7 | 2370 |
-//! | `mass_matrix` * | `crba` | — | — | model | 556 | 509 | 0 | 0 | 7 | 1065 |
-//! | `mass_matrix` | `crba` | — | — | canonical | 572 | 519 | 0 | 0 | 7 | 1091 |
+//! | `mass_matrix` * | `crba` | — | — | model | 556 | 507 | 0 | 0 | 7 | 1063 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 567 | 511 | 0 | 0 | 7 | 1078 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 1147 | 881 | 0 | 0 | 7 | 2028 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 1162 | 896 | 0 | 0 | 7 | 2058 |
 //! | `nonlinear_effects` | — | `kane-direct` | — | model | 1564 | 1276 | 0 | 0 | 7 | 2840 |
@@ -42,14 +42,14 @@
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
 //! | `inverse_dynamics` * | — | `newton-euler` | — | model | 543 | 458 | 0 | 0 | 7 | 1001 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 545 | 458 | 0 | 0 | 7 | 1003 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2203 | 1829 | 10 | 0 | 7 | 4032 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2245 | 1855 | 10 | 0 | 7 | 4100 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2620 | 2224 | 10 | 0 | 7 | 4844 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2662 | 2250 | 10 | 0 | 7 | 4912 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1679 | 1448 | 10 | 0 | 7 | 3127 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1708 | 1459 | 10 | 0 | 7 | 3167 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1374 | 10 | 0 | 7 | 2950 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1605 | 1385 | 10 | 0 | 7 | 2990 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2203 | 1827 | 10 | 0 | 7 | 4030 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2229 | 1846 | 10 | 0 | 7 | 4075 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2620 | 2222 | 10 | 0 | 7 | 4842 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2646 | 2241 | 10 | 0 | 7 | 4887 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1679 | 1446 | 10 | 0 | 7 | 3125 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1692 | 1450 | 10 | 0 | 7 | 3142 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1372 | 10 | 0 | 7 | 2948 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1589 | 1376 | 10 | 0 | 7 | 2965 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 2505 | 2118 | 13 | 0 | 7 | 4623 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 2520 | 2133 | 13 | 0 | 7 | 4653 |
 //! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 2922 | 2513 | 13 | 0 | 7 | 5435 |
@@ -60,14 +60,14 @@
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 2459 | 2007 | 13 | 0 | 7 | 4466 |
 //! | `forward_dynamics` * | — | — | `aba` | model | 1592 | 1277 | 12 | 0 | 7 | 2869 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 1601 | 1280 | 12 | 0 | 7 | 2881 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1703 | 1390 | 0 | 0 | 7 | 3093 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1734 | 1415 | 0 | 0 | 7 | 3149 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2120 | 1785 | 0 | 0 | 7 | 3905 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2151 | 1810 | 0 | 0 | 7 | 3961 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1179 | 1009 | 0 | 0 | 7 | 2188 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1197 | 1019 | 0 | 0 | 7 | 2216 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1076 | 935 | 0 | 0 | 7 | 2011 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1094 | 945 | 0 | 0 | 7 | 2039 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1703 | 1388 | 0 | 0 | 7 | 3091 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1729 | 1407 | 0 | 0 | 7 | 3136 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2120 | 1783 | 0 | 0 | 7 | 3903 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2146 | 1802 | 0 | 0 | 7 | 3948 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1179 | 1007 | 0 | 0 | 7 | 2186 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1192 | 1011 | 0 | 0 | 7 | 2203 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1076 | 933 | 0 | 0 | 7 | 2009 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1089 | 937 | 0 | 0 | 7 | 2026 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 1894 | 1591 | 0 | 0 | 7 | 3485 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 1909 | 1606 | 0 | 0 | 7 | 3515 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 2311 | 1986 | 0 | 0 | 7 | 4297 |
@@ -76,10 +76,10 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 1951 | 1554 | 0 | 0 | 7 | 3505 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 1831 | 1465 | 0 | 0 | 7 | 3296 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 1848 | 1480 | 0 | 0 | 7 | 3328 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2347 | 1973 | 10 | 0 | 7 | 4320 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2764 | 2368 | 10 | 0 | 7 | 5132 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1679 | 1496 | 10 | 0 | 7 | 3175 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1422 | 10 | 0 | 7 | 2998 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2347 | 1971 | 10 | 0 | 7 | 4318 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2764 | 2366 | 10 | 0 | 7 | 5130 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1679 | 1494 | 10 | 0 | 7 | 3173 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1420 | 10 | 0 | 7 | 2996 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 2649 | 2262 | 13 | 0 | 7 | 4911 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 3066 | 2657 | 13 | 0 | 7 | 5723 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2114 | 13 | 0 | 7 | 4659 |
@@ -161,11 +161,11 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 556u64,
-            add: 509u64,
+            add: 507u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 301u64,
+            fma: 303u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -213,11 +213,11 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 1076u64,
-            add: 935u64,
+            add: 933u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 618u64,
+            fma: 620u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -372,7 +372,7 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 556u64,
-            add: 509u64,
+            add: 507u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -384,8 +384,8 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 572u64,
-            add: 519u64,
+            mul: 567u64,
+            add: 511u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -606,7 +606,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2203u64,
-            add: 1829u64,
+            add: 1827u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -618,8 +618,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 2245u64,
-            add: 1855u64,
+            mul: 2229u64,
+            add: 1846u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -632,7 +632,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2620u64,
-            add: 2224u64,
+            add: 2222u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -644,8 +644,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 2662u64,
-            add: 2250u64,
+            mul: 2646u64,
+            add: 2241u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -658,7 +658,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1679u64,
-            add: 1448u64,
+            add: 1446u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -670,8 +670,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 1708u64,
-            add: 1459u64,
+            mul: 1692u64,
+            add: 1450u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -684,7 +684,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1576u64,
-            add: 1374u64,
+            add: 1372u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -696,8 +696,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 1605u64,
-            add: 1385u64,
+            mul: 1589u64,
+            add: 1376u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -840,7 +840,7 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 1703u64,
-            add: 1390u64,
+            add: 1388u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -852,8 +852,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 1734u64,
-            add: 1415u64,
+            mul: 1729u64,
+            add: 1407u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -866,7 +866,7 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 2120u64,
-            add: 1785u64,
+            add: 1783u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -878,8 +878,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 2151u64,
-            add: 1810u64,
+            mul: 2146u64,
+            add: 1802u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -892,7 +892,7 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 1179u64,
-            add: 1009u64,
+            add: 1007u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -904,8 +904,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 1197u64,
-            add: 1019u64,
+            mul: 1192u64,
+            add: 1011u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -918,7 +918,7 @@ impl FreeFloating7 {
             forward_method: None,
             frames: "model",
             mul: 1076u64,
-            add: 935u64,
+            add: 933u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -930,8 +930,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 1094u64,
-            add: 945u64,
+            mul: 1089u64,
+            add: 937u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1048,7 +1048,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2347u64,
-            add: 1973u64,
+            add: 1971u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1061,7 +1061,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 2764u64,
-            add: 2368u64,
+            add: 2366u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1074,7 +1074,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1679u64,
-            add: 1496u64,
+            add: 1494u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1087,7 +1087,7 @@ impl FreeFloating7 {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 1576u64,
-            add: 1422u64,
+            add: 1420u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1226,7 +1226,7 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 556 mul, 509 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 301 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 556 mul, 507 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 303 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
@@ -1259,8 +1259,8 @@ impl FreeFloating7 {
         let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
         let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
         let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = 0.00000000019719894748377882
-            - Self::mul_add(s_q13, 1.2025609200000003, x23);
+        let x28 = Self::mul_add(s_q13, 1.2025609200000003, x23)
+            - 0.00000000019719894748377882;
         let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
             + -0.0000000002899261911072858;
         let x30 = 0.16 * x19;
@@ -1270,56 +1270,55 @@ impl FreeFloating7 {
         let x34 = 0.16 * x17;
         let x35 = 0.16 * x18;
         let x36 = 0.55 * x19;
-        let x37 = x32 + (x22 + Self::mul_add(-x15, x20, x16 * x21) + x32);
+        let x37 = x32 + (x22 - Self::mul_add(-x16, x21, x15 * x20) + x32);
         let x38 = 3.6140000000000003 + x17;
         let x39 = 17.135250000000003 + x18;
         let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
         let x41 = -0.809539999555672
-            + (Self::mul_add(
-                -0.00000000020510342851533115,
+            - (Self::mul_add(
+                0.00000000020510342851533115,
                 x22,
-                Self::mul_add(-c_q13, x20, s_q13 * x21),
-            ) - x34);
+                Self::mul_add(-s_q13, x21, c_q13 * x20),
+            ) + x34);
         let x42 = -1.9877000000000002
-            + (Self::mul_add(-x15, x23, x16 * x25) - x26 - x33);
+            - (x26 + Self::mul_add(-x16, x25, x15 * x23) + x33);
         let x43 = -5.252920330000002
             + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
         let x44 = -2.741639999592316
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x26,
-                Self::mul_add(-c_q13, x23, s_q13 * x25),
-            ) - x35 - x36);
-        let x45 = -0.809539999555672 + (x29 + Self::mul_add(-x15, x27, x16 * x28) - x34);
-        let x46 = -2.7416399995923166
-            + (Self::mul_add(c_q13, x28, s_q13 * x27) - x36 - x35);
-        let x47 = 9.740442170000001
-            + (x31
+            - (x36
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
+                    x26,
+                    Self::mul_add(-s_q13, x25, c_q13 * x23),
+                ) + x35));
+        let x45 = -0.809539999555672 + (x29 - Self::mul_add(x16, x28, x15 * x27) - x34);
+        let x46 = -2.7416399995923166
+            - (x35 - (Self::mul_add(-c_q13, x28, s_q13 * x27) - x36));
+        let x47 = 9.740442170000001
+            + (x31
+                - (Self::mul_add(
+                    0.00000000020510342851533115,
                     x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) + x31));
-        let x48 = c_q12 * x38;
-        let x49 = s_q12 * x39;
-        let x50 = x48 - x49;
-        let x51 = x19 - Self::mul_add(x13, x39, x12 * x38);
-        let x52 = Self::mul_add(c_q12, x39, s_q12 * x38);
-        let x53 = Self::mul_add(0.00000000020510342851533115, x19, x52);
-        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x37);
-        let x55 = Self::mul_add(-s_q12, x43, c_q12 * x40);
-        let x56 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x57 = x45 - Self::mul_add(x13, x42, x12 * x37);
-        let x58 = x46 - Self::mul_add(x13, x43, x12 * x40);
-        let x59 = x47 - Self::mul_add(x13, x44, x12 * x41);
-        let x60 = Self::mul_add(
+                    Self::mul_add(s_q13, x28, c_q13 * x27),
+                ) - x31));
+        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
+        let x49 = x19 - Self::mul_add(x13, x39, x12 * x38);
+        let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
+        let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
+        let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
+        let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
+        let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
+        let x55 = x45 - Self::mul_add(x13, x42, x12 * x37);
+        let x56 = x46 - Self::mul_add(x13, x43, x12 * x40);
+        let x57 = x47 - Self::mul_add(x13, x44, x12 * x41);
+        let x58 = Self::mul_add(
             0.00000000020510342851533115,
             x47,
             Self::mul_add(c_q12, x44, s_q12 * x41),
         );
-        let x61 = -x60;
-        let x62 = x56 - Self::mul_add(x13, x55, x12 * x54);
-        let x63 = Self::mul_add(
+        let x59 = -x58;
+        let x60 = x54 - Self::mul_add(x13, x53, x12 * x52);
+        let x61 = Self::mul_add(
             c_q12,
             Self::mul_add(
                 0.00000000020510342851533115,
@@ -1333,605 +1332,603 @@ impl FreeFloating7 {
                     Self::mul_add(c_q12, x42, s_q12 * x37),
                 ),
         );
-        let x64 = x53 * 0.36;
-        let x65 = Self::mul_add(
-            x50,
-            0.36,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x56,
-                Self::mul_add(c_q12, x55, s_q12 * x54),
-            ),
-        );
-        let x66 = Self::mul_add(
-            x51,
-            0.36,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x59,
-                Self::mul_add(c_q12, x58, s_q12 * x57),
-            ),
-        );
-        let x67 = x64 + (Self::mul_add(-s_q12, x55, c_q12 * x54) + x64);
-        let x68 = 7.078399999258757 + x51;
-        let x69 = 0.01675 + x65;
-        let x70 = -9.142025249762803
-            + (x64 + (x59 - Self::mul_add(x13, x58, x12 * x57) + x64));
-        let x71 = 2.5482240016099564 + x66;
-        let x72 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x60, x63);
-        let x73 = s_q11 * s_q11;
-        let x74 = s_q11 * c_q11;
-        let x75 = x67 - x70;
-        let x76 = x62 + x62;
-        let x77 = Self::mul_add(x74, x76, x73 * x75);
-        let x78 = Self::mul_add(-s_q11, x68, c_q11 * x50);
-        let x79 = Self::mul_add(c_q11, x68, s_q11 * x50);
-        let x80 = 0.275 * x53;
-        let x81 = x79 * 0.63;
-        let x82 = x81 - x80;
-        let x83 = Self::mul_add(x78, 0.63, x62 + Self::mul_add(-x73, x76, x74 * x75));
-        let x84 = Self::mul_add(0.275, x78, Self::mul_add(-s_q11, x71, c_q11 * x69));
-        let x85 = Self::mul_add(0.275, x79, Self::mul_add(c_q11, x71, s_q11 * x69));
-        let x86 = x72 - x81;
-        let x87 = x67 - x77 - x82 - x82;
-        let x88 = -45.1584 + x79;
-        let x89 = -0.6328 + x84;
-        let x90 = -24.4950615 + (x80 + (x70 + x77 + x80));
-        let x91 = -24.35164200091464 + Self::mul_add(x53, -0.63, x85);
-        let x92 = 28.2393615 + (x86 - x81);
-        let x93 = s_q10 * s_q10;
-        let x94 = s_q10 * c_q10;
-        let x95 = x87 - x90;
-        let x96 = x83 + x83;
-        let x97 = Self::mul_add(x94, x96, x93 * x95);
-        let x98 = Self::mul_add(-s_q10, x91, c_q10 * x89);
-        let x99 = Self::mul_add(c_q10, x91, s_q10 * x89);
-        let x100 = c_q10 * x78;
-        let x101 = Self::mul_add(-s_q10, x88, x100);
-        let x102 = s_q10 * x78;
-        let x103 = Self::mul_add(c_q10, x88, x102);
-        let x104 = x103 * 0.87;
-        let x105 = Self::mul_add(x101, 0.87, x83 + Self::mul_add(-x93, x96, x94 * x95));
-        let x106 = x92 - x104;
-        let x107 = x87 - x97 - x104 - x104;
-        let x108 = -81.53205 + x103;
-        let x109 = -0.00214 + x98;
-        let x110 = -63.36336825000001 + (x90 + x97);
-        let x111 = -36.18604050126307 + Self::mul_add(x53, -0.87, x99);
-        let x112 = 69.99836825 + (x106 - x104);
-        let x113 = s_q9 * x101;
-        let x114 = Self::mul_add(c_q9, x108, x113);
-        let x115 = 0.00000000020510342851533115 * x53;
-        let x116 = x114 - x115;
-        let x117 = Self::mul_add(-x8, x108, x7 * x101) - x53;
-        let x118 = c_q9 * x101;
-        let x119 = Self::mul_add(-s_q9, x108, x118);
-        let x120 = x115 + x119;
-        let x121 = c_q9 * x105;
-        let x122 = 0.00000000020510342851533115 * x109;
-        let x123 = Self::mul_add(s_q9, x107, x121) + x122;
-        let x124 = s_q9 * x105;
-        let x125 = 0.00000000020510342851533115 * x111;
-        let x126 = Self::mul_add(c_q9, x110, x124) + x125;
-        let x127 = 0.00000000020510342851533115 * x112;
-        let x128 = Self::mul_add(c_q9, x111, s_q9 * x109) + x127;
-        let x129 = x109 + Self::mul_add(-x8, x105, x7 * x107);
-        let x130 = x111 + Self::mul_add(-x8, x110, x7 * x105);
-        let x131 = x112 + Self::mul_add(-x8, x111, x7 * x109);
-        let x132 = Self::mul_add(c_q9, x107, -x124) - x122;
-        let x133 = Self::mul_add(-s_q9, x110, x121) - x125;
-        let x134 = Self::mul_add(-s_q9, x111, c_q9 * x109) - x127;
-        let x135 = 0.00000000020510342851533115 * x128;
-        let x136 = 0.00000000020510342851533115 * x131;
-        let x137 = 0.00000000020510342851533115 * x134;
-        let x138 = 0.4 * x120;
-        let x139 = 0.275 * x117;
-        let x140 = x138 + x139;
-        let x141 = 0.275 * x116;
-        let x142 = 0.4 * x116;
-        let x143 = 0.4 * x117;
-        let x144 = 0.275 * x120;
-        let x145 = x140 + (Self::mul_add(c_q9, x126, s_q9 * x123) + x135 + x140);
-        let x146 = -0.000000008530897668050218 + x116;
-        let x147 = -12.701650001451807 + x117;
-        let x148 = -0.0000000234896432582596
-            + (x128 + Self::mul_add(-x8, x126, x7 * x123) - x141);
-        let x149 = -0.002139996587640933
-            + (Self::mul_add(-s_q9, x126, c_q9 * x123) - x135 - x142);
-        let x150 = -0.0000000234896432582596
-            + (Self::mul_add(c_q9, x130, s_q9 * x129) + x136 - x141);
-        let x151 = -111.7548902508081
-            + (x138 + (x131 + Self::mul_add(-x8, x130, x7 * x129) + x138));
-        let x152 = 5.080660024070365
-            + (Self::mul_add(-s_q9, x130, c_q9 * x129) - x136 - x143 - x144);
-        let x153 = -0.002139996587640933
-            + (Self::mul_add(c_q9, x133, s_q9 * x132) + x137 - x142);
-        let x154 = 5.080660024070366
-            + (x134 + Self::mul_add(-x8, x133, x7 * x132) - x144 - x143);
-        let x155 = 113.3918902508081
-            + (x139 + (Self::mul_add(-s_q9, x133, c_q9 * x132) - x137 + x139));
-        let x156 = x120 + Self::mul_add(-x2, x146, x3 * x147);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x146);
-        let x158 = c_q8 * x146;
-        let x159 = s_q8 * x147;
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x120, x159 - x158);
-        let x161 = x153 + Self::mul_add(-x2, x145, x3 * x150);
-        let x162 = x154 + Self::mul_add(-x2, x148, x3 * x151);
-        let x163 = x155 + Self::mul_add(-x2, x149, x3 * x152);
-        let x164 = Self::mul_add(c_q8, x150, s_q8 * x145);
-        let x165 = Self::mul_add(c_q8, x151, s_q8 * x148);
-        let x166 = Self::mul_add(c_q8, x152, s_q8 * x149);
-        let x167 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x155,
-            Self::mul_add(-c_q8, x149, s_q8 * x152),
-        );
-        let x168 = Self::mul_add(
-            -c_q8,
+        let x62 = x51 * 0.36;
+        let x63 = Self::mul_add(
+            x48,
+            -0.36,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x153,
-                Self::mul_add(-c_q8, x145, s_q8 * x150),
+                0.00000000020510342851533115,
+                x54,
+                Self::mul_add(c_q12, x53, s_q12 * x52),
             ),
-            s_q8
+        );
+        let x64 = Self::mul_add(
+            x49,
+            -0.36,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x57,
+                Self::mul_add(c_q12, x56, s_q12 * x55),
+            ),
+        );
+        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) + x62);
+        let x66 = 7.078399999258757 + x49;
+        let x67 = 0.01675 - x63;
+        let x68 = -9.142025249762803
+            + (x62 + (x57 - Self::mul_add(x13, x56, x12 * x55) + x62));
+        let x69 = 2.5482240016099564 - x64;
+        let x70 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x58, x61);
+        let x71 = s_q11 * s_q11;
+        let x72 = s_q11 * c_q11;
+        let x73 = x65 - x68;
+        let x74 = x60 + x60;
+        let x75 = Self::mul_add(x72, x74, x71 * x73);
+        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
+        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
+        let x78 = 0.275 * x51;
+        let x79 = x77 * 0.63;
+        let x80 = x78 - x79;
+        let x81 = Self::mul_add(x76, 0.63, x60 + Self::mul_add(-x71, x74, x72 * x73));
+        let x82 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
+        let x83 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
+        let x84 = x70 - x79;
+        let x85 = x80 + (x65 - x75 + x80);
+        let x86 = -45.1584 + x77;
+        let x87 = -0.6328 + x82;
+        let x88 = -24.4950615 + (x78 + (x68 + x75 + x78));
+        let x89 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x83);
+        let x90 = 28.2393615 - (x79 - x84);
+        let x91 = s_q10 * s_q10;
+        let x92 = s_q10 * c_q10;
+        let x93 = x85 - x88;
+        let x94 = x81 + x81;
+        let x95 = Self::mul_add(x92, x94, x91 * x93);
+        let x96 = Self::mul_add(-s_q10, x89, c_q10 * x87);
+        let x97 = Self::mul_add(c_q10, x89, s_q10 * x87);
+        let x98 = c_q10 * x76;
+        let x99 = Self::mul_add(-s_q10, x86, x98);
+        let x100 = s_q10 * x76;
+        let x101 = Self::mul_add(c_q10, x86, x100);
+        let x102 = x101 * 0.87;
+        let x103 = Self::mul_add(x99, 0.87, x81 + Self::mul_add(-x91, x94, x92 * x93));
+        let x104 = x90 - x102;
+        let x105 = x102 - (x85 - x95 - x102);
+        let x106 = -81.53205 + x101;
+        let x107 = -0.00214 + x96;
+        let x108 = -63.36336825000001 + (x88 + x95);
+        let x109 = -36.18604050126307 + Self::mul_add(x51, -0.87, x97);
+        let x110 = 69.99836825 - (x102 - x104);
+        let x111 = s_q9 * x99;
+        let x112 = Self::mul_add(c_q9, x106, x111);
+        let x113 = 0.00000000020510342851533115 * x51;
+        let x114 = x112 - x113;
+        let x115 = x51 - Self::mul_add(-x8, x106, x7 * x99);
+        let x116 = c_q9 * x99;
+        let x117 = Self::mul_add(-s_q9, x106, x116);
+        let x118 = x113 + x117;
+        let x119 = c_q9 * x103;
+        let x120 = 0.00000000020510342851533115 * x107;
+        let x121 = Self::mul_add(s_q9, x105, -x119) - x120;
+        let x122 = s_q9 * x103;
+        let x123 = 0.00000000020510342851533115 * x109;
+        let x124 = Self::mul_add(c_q9, x108, x122) + x123;
+        let x125 = 0.00000000020510342851533115 * x110;
+        let x126 = Self::mul_add(c_q9, x109, s_q9 * x107) + x125;
+        let x127 = x107 - Self::mul_add(x8, x103, x7 * x105);
+        let x128 = x109 + Self::mul_add(-x8, x108, x7 * x103);
+        let x129 = x110 + Self::mul_add(-x8, x109, x7 * x107);
+        let x130 = x120 + Self::mul_add(c_q9, x105, x122);
+        let x131 = x123 - Self::mul_add(-s_q9, x108, x119);
+        let x132 = x125 - Self::mul_add(-s_q9, x109, c_q9 * x107);
+        let x133 = 0.00000000020510342851533115 * x126;
+        let x134 = 0.00000000020510342851533115 * x129;
+        let x135 = 0.00000000020510342851533115 * x132;
+        let x136 = 0.4 * x118;
+        let x137 = 0.275 * x115;
+        let x138 = x136 - x137;
+        let x139 = 0.275 * x114;
+        let x140 = 0.4 * x114;
+        let x141 = 0.4 * x115;
+        let x142 = 0.275 * x118;
+        let x143 = x138 - (Self::mul_add(-c_q9, x124, s_q9 * x121) - x133 - x138);
+        let x144 = -0.000000008530897668050218 + x114;
+        let x145 = -12.701650001451807 - x115;
+        let x146 = -0.0000000234896432582596
+            + (x126 - Self::mul_add(x8, x124, x7 * x121) - x139);
+        let x147 = -0.002139996587640933
+            - (x133 + Self::mul_add(s_q9, x124, c_q9 * x121) + x140);
+        let x148 = -0.0000000234896432582596
+            + (Self::mul_add(c_q9, x128, s_q9 * x127) + x134 - x139);
+        let x149 = -111.7548902508081
+            + (x136 + (x129 + Self::mul_add(-x8, x128, x7 * x127) + x136));
+        let x150 = 5.080660024070365
+            - (x142 + (x134 - Self::mul_add(-s_q9, x128, c_q9 * x127) - x141));
+        let x151 = -0.002139996587640933
+            - (Self::mul_add(c_q9, x131, s_q9 * x130) + x135 + x140);
+        let x152 = 5.080660024070366
+            + (x141 - (x132 + Self::mul_add(-x8, x131, x7 * x130) + x142));
+        let x153 = 113.3918902508081
+            - (x137 - (x135 - Self::mul_add(-s_q9, x131, c_q9 * x130) - x137));
+        let x154 = x118 - Self::mul_add(-x3, x145, x2 * x144);
+        let x155 = Self::mul_add(c_q8, x145, s_q8 * x144);
+        let x156 = Self::mul_add(-s_q8, x145, c_q8 * x144);
+        let x157 = Self::mul_add(0.00000000020510342851533115, x118, x156);
+        let x158 = x151 - Self::mul_add(-x3, x148, x2 * x143);
+        let x159 = x152 - Self::mul_add(-x3, x149, x2 * x146);
+        let x160 = x153 - Self::mul_add(-x3, x150, x2 * x147);
+        let x161 = Self::mul_add(c_q8, x148, s_q8 * x143);
+        let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
+        let x163 = Self::mul_add(c_q8, x150, s_q8 * x147);
+        let x164 = Self::mul_add(
+            0.00000000020510342851533115,
+            x153,
+            Self::mul_add(-s_q8, x150, c_q8 * x147),
+        );
+        let x165 = -x164;
+        let x166 = Self::mul_add(
+            -s_q8,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x152,
+                Self::mul_add(-s_q8, x149, c_q8 * x146),
+            ),
+            c_q8
                 * Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x154,
-                    Self::mul_add(-c_q8, x148, s_q8 * x151),
+                    0.00000000020510342851533115,
+                    x151,
+                    Self::mul_add(-s_q8, x148, c_q8 * x143),
                 ),
         );
-        let x169 = 0.35 * x160;
-        let x170 = Self::mul_add(
-            -0.35,
-            x156,
+        let x167 = 0.35 * x157;
+        let x168 = Self::mul_add(
+            0.35,
+            x154,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
+                x160,
+                Self::mul_add(-s_q8, x159, c_q8 * x158),
+            ),
+        );
+        let x169 = Self::mul_add(
+            0.35,
+            x155,
+            Self::mul_add(
+                0.00000000020510342851533115,
                 x163,
-                Self::mul_add(-c_q8, x161, s_q8 * x162),
+                Self::mul_add(-s_q8, x162, c_q8 * x161),
             ),
         );
-        let x171 = Self::mul_add(
-            -0.35,
-            x157,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x166,
-                Self::mul_add(-c_q8, x164, s_q8 * x165),
-            ),
-        );
-        let x172 = x169 + (x163 + Self::mul_add(-x2, x161, x3 * x162) + x169);
-        let x173 = 48.0240000085309 + x156;
-        let x174 = -0.07309 + Self::mul_add(c_q8, x162, s_q8 * x161);
-        let x175 = -16.80768997608804 + x170;
-        let x176 = 130.43769025763282
-            + (x169 + (Self::mul_add(c_q8, x165, s_q8 * x164) + x169));
-        let x177 = 0.1132 + x171;
-        let x178 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x167, x168);
-        let x179 = s_q7 * s_q7;
-        let x180 = s_q7 * c_q7;
-        let x181 = x172 - x176;
-        let x182 = x174 + x174;
-        let x183 = Self::mul_add(x180, x182, x179 * x181);
-        let x184 = Self::mul_add(-s_q7, x157, c_q7 * x173);
-        let x185 = Self::mul_add(c_q7, x157, s_q7 * x173);
-        let x186 = -x185;
-        let x187 = 0.75 * x160;
-        let x188 = 0.65 * x184;
-        let x189 = x187 + x188;
-        let x190 = Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x177, c_q7 * x175));
-        let x191 = Self::mul_add(
+        let x170 = x167 - (x160 - Self::mul_add(-x3, x159, x2 * x158) - x167);
+        let x171 = 48.0240000085309 + x154;
+        let x172 = -0.07309 + Self::mul_add(c_q8, x159, s_q8 * x158);
+        let x173 = -16.80768997608804 - x168;
+        let x174 = 130.43769025763282
+            - (x167 - (Self::mul_add(c_q8, x162, s_q8 * x161) - x167));
+        let x175 = 0.1132 - x169;
+        let x176 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x164, x166);
+        let x177 = s_q7 * s_q7;
+        let x178 = s_q7 * c_q7;
+        let x179 = x170 + x174;
+        let x180 = x172 + x172;
+        let x181 = Self::mul_add(-x178, x180, x177 * x179);
+        let x182 = Self::mul_add(-s_q7, x155, c_q7 * x171);
+        let x183 = Self::mul_add(c_q7, x155, s_q7 * x171);
+        let x184 = -x183;
+        let x185 = 0.75 * x157;
+        let x186 = 0.65 * x182;
+        let x187 = x185 - x186;
+        let x188 = Self::mul_add(-0.75, x182, Self::mul_add(-s_q7, x175, c_q7 * x173));
+        let x189 = Self::mul_add(
             -0.65,
-            x185,
-            x174 + Self::mul_add(-x179, x182, x180 * x181),
+            x183,
+            x172 - Self::mul_add(x177, x180, x178 * x179),
         );
-        let x192 = Self::mul_add(-0.75, x185, Self::mul_add(c_q7, x177, s_q7 * x175));
-        let x193 = x178 + x188;
-        let x194 = 110.5455 + x184;
-        let x195 = 180.9502499901501 + x160;
-        let x196 = 1394.5960312283303 + (x187 + (x172 - x183 + x187));
-        let x197 = -117.61766249359756 + Self::mul_add(-0.65, x160, x190);
-        let x198 = 1466.4506062283303 + (x189 + (x176 + x183 + x189));
-        let x199 = 1271.854575 + (x188 + x193);
-        let x200 = -x195;
-        let x201 = -x194;
-        let x202 = Self::mul_add(x3, x146, x2 * x147);
-        let x203 = x158 - x159;
-        let x204 = Self::mul_add(-0.35, x203, x163);
-        let x205 = Self::mul_add(0.35, x202, x166);
-        let x206 = Self::mul_add(-s_q7, x203, c_q7 * x202);
-        let x207 = Self::mul_add(c_q7, x203, s_q7 * x202);
-        let x208 = Self::mul_add(-0.75, x207, Self::mul_add(-s_q7, x205, c_q7 * x204));
-        let x209 = Self::mul_add(c_q7, x205, s_q7 * x204)
-            + Self::mul_add(-0.65, x157, 0.75 * x206);
-        let x210 = Self::mul_add(0.65, x207, x167);
-        let x211 = x8 * x101;
-        let x212 = Self::mul_add(x7, x108, x211);
-        let x213 = x128 + Self::mul_add(-0.275, x114, 0.4 * x212);
-        let x214 = Self::mul_add(0.4, x119, x131);
-        let x215 = Self::mul_add(-0.275, x119, x134);
-        let x216 = x114 + Self::mul_add(x3, x212, x2 * x119);
-        let x217 = Self::mul_add(-c_q8, x212, s_q8 * x119);
+        let x190 = Self::mul_add(-0.75, x183, Self::mul_add(c_q7, x175, s_q7 * x173));
+        let x191 = x176 + x186;
+        let x192 = 110.5455 + x182;
+        let x193 = 180.9502499901501 - x157;
+        let x194 = 1394.5960312283303 - (x185 + (x170 - x181 + x185));
+        let x195 = -117.61766249359756 + Self::mul_add(0.65, x157, x188);
+        let x196 = 1466.4506062283303 - (x187 - (x174 - x181 - x187));
+        let x197 = 1271.854575 + (x186 + x191);
+        let x198 = -x193;
+        let x199 = -x192;
+        let x200 = Self::mul_add(x3, x144, x2 * x145);
+        let x201 = Self::mul_add(-0.35, x156, x160);
+        let x202 = Self::mul_add(0.35, x200, x163);
+        let x203 = Self::mul_add(-s_q7, x156, c_q7 * x200);
+        let x204 = Self::mul_add(c_q7, x156, s_q7 * x200);
+        let x205 = Self::mul_add(-0.75, x204, Self::mul_add(-s_q7, x202, c_q7 * x201));
+        let x206 = Self::mul_add(c_q7, x202, s_q7 * x201)
+            + Self::mul_add(-0.65, x155, 0.75 * x203);
+        let x207 = -Self::mul_add(-0.65, x204, x164);
+        let x208 = x8 * x99;
+        let x209 = Self::mul_add(x7, x106, x208);
+        let x210 = x126 + Self::mul_add(-0.275, x112, 0.4 * x209);
+        let x211 = Self::mul_add(0.4, x117, x129);
+        let x212 = Self::mul_add(0.275, x117, x132);
+        let x213 = -x212;
+        let x214 = x112 + Self::mul_add(x3, x209, x2 * x117);
+        let x215 = Self::mul_add(-c_q8, x209, s_q8 * x117);
+        let x216 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x112,
+            Self::mul_add(s_q8, x209, c_q8 * x117),
+        );
+        let x217 = -x216;
         let x218 = Self::mul_add(
-            0.00000000020510342851533115,
-            x114,
-            -Self::mul_add(s_q8, x212, c_q8 * x119),
-        );
-        let x219 = Self::mul_add(
             -0.00000000020510342851533115,
-            x215,
-            Self::mul_add(-c_q8, x213, s_q8 * x214),
+            x212,
+            Self::mul_add(-s_q8, x211, c_q8 * x210),
         );
-        let x220 = Self::mul_add(
-            -0.35,
-            x217,
-            x215 + Self::mul_add(-x2, x213, x3 * x214),
-        );
-        let x221 = Self::mul_add(-0.35, x216, Self::mul_add(c_q8, x214, s_q8 * x213));
-        let x222 = Self::mul_add(s_q7, x217, c_q7 * x216);
+        let x219 = -x218;
+        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x3, x211, x2 * x210));
+        let x221 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x211, s_q8 * x210));
+        let x222 = Self::mul_add(s_q7, x215, c_q7 * x214);
         let x223 = -x222;
-        let x224 = Self::mul_add(-s_q7, x216, c_q7 * x217);
-        let x225 = Self::mul_add(-0.75, x224, Self::mul_add(-s_q7, x221, c_q7 * x220));
-        let x226 = Self::mul_add(c_q7, x221, s_q7 * x220)
-            - Self::mul_add(0.65, x218, 0.75 * x222);
-        let x227 = Self::mul_add(0.65, x224, x219);
-        let x228 = Self::mul_add(-s_q9, x103, x118);
-        let x229 = Self::mul_add(x7, x103, x211);
-        let x230 = Self::mul_add(c_q9, x103, x113);
-        let x231 = 0.00000000020510342851533115 * x106;
-        let x232 = Self::mul_add(c_q9, x99, s_q9 * x98) + x231
-            + Self::mul_add(-0.275, x230, 0.4 * x229);
-        let x233 = Self::mul_add(0.4, x228, x106 + Self::mul_add(-x8, x99, x7 * x98));
-        let x234 = Self::mul_add(
-            -0.275,
-            x228,
-            Self::mul_add(-s_q9, x99, c_q9 * x98) - x231,
+        let x224 = Self::mul_add(-c_q7, x215, s_q7 * x214);
+        let x225 = -x224;
+        let x226 = -Self::mul_add(-0.75, x224, Self::mul_add(s_q7, x221, c_q7 * x220));
+        let x227 = -(Self::mul_add(-c_q7, x221, s_q7 * x220)
+            + Self::mul_add(-0.65, x216, 0.75 * x222));
+        let x228 = -Self::mul_add(0.65, x224, x218);
+        let x229 = Self::mul_add(-s_q9, x101, x116);
+        let x230 = Self::mul_add(x7, x101, x208);
+        let x231 = Self::mul_add(c_q9, x101, x111);
+        let x232 = 0.00000000020510342851533115 * x104;
+        let x233 = Self::mul_add(c_q9, x97, s_q9 * x96) + x232
+            + Self::mul_add(-0.275, x231, 0.4 * x230);
+        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x8, x97, x7 * x96));
+        let x235 = Self::mul_add(
+            0.275,
+            x229,
+            x232 - Self::mul_add(-s_q9, x97, c_q9 * x96),
         );
-        let x235 = x230 + Self::mul_add(x3, x229, x2 * x228);
-        let x236 = Self::mul_add(-c_q8, x229, s_q8 * x228);
-        let x237 = Self::mul_add(
-            0.00000000020510342851533115,
-            x230,
-            -Self::mul_add(s_q8, x229, c_q8 * x228),
-        );
-        let x238 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x234,
-            Self::mul_add(-c_q8, x232, s_q8 * x233),
-        );
+        let x236 = -x235;
+        let x237 = x231 + Self::mul_add(x3, x230, x2 * x229);
+        let x238 = Self::mul_add(-c_q8, x230, s_q8 * x229);
         let x239 = Self::mul_add(
-            -0.35,
-            x236,
-            x234 + Self::mul_add(-x2, x232, x3 * x233),
+            -0.00000000020510342851533115,
+            x231,
+            Self::mul_add(s_q8, x230, c_q8 * x229),
         );
-        let x240 = Self::mul_add(-0.35, x235, Self::mul_add(c_q8, x233, s_q8 * x232));
-        let x241 = Self::mul_add(s_q7, x236, c_q7 * x235);
+        let x240 = -x239;
+        let x241 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x235,
+            Self::mul_add(-s_q8, x234, c_q8 * x233),
+        );
         let x242 = -x241;
-        let x243 = Self::mul_add(-s_q7, x235, c_q7 * x236);
-        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x240, c_q7 * x239));
-        let x245 = Self::mul_add(c_q7, x240, s_q7 * x239)
-            - Self::mul_add(0.65, x237, 0.75 * x241);
-        let x246 = Self::mul_add(0.65, x243, x238);
-        let x247 = Self::mul_add(c_q10, x79, x102);
-        let x248 = Self::mul_add(-s_q10, x79, x100);
-        let x249 = Self::mul_add(-s_q10, x85, c_q10 * x84);
-        let x250 = Self::mul_add(c_q10, x85, s_q10 * x84);
-        let x251 = Self::mul_add(-0.87, x247, x86);
-        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
-        let x253 = Self::mul_add(x8, x248, x7 * x247);
-        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
-        let x255 = 0.00000000020510342851533115 * x251;
-        let x256 = Self::mul_add(c_q9, x250, s_q9 * x249) + x255
-            + Self::mul_add(-0.275, x254, 0.4 * x253);
-        let x257 = Self::mul_add(0.4, x252, x251 + Self::mul_add(-x8, x250, x7 * x249));
-        let x258 = Self::mul_add(
-            -0.275,
-            x252,
-            Self::mul_add(-s_q9, x250, c_q9 * x249) - x255,
-        );
-        let x259 = x254 + Self::mul_add(x3, x253, x2 * x252);
-        let x260 = Self::mul_add(-c_q8, x253, s_q8 * x252);
-        let x261 = Self::mul_add(
-            0.00000000020510342851533115,
-            x254,
-            -Self::mul_add(s_q8, x253, c_q8 * x252),
-        );
-        let x262 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x258,
-            Self::mul_add(-c_q8, x256, s_q8 * x257),
-        );
+        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x3, x234, x2 * x233));
+        let x244 = Self::mul_add(-0.35, x237, Self::mul_add(c_q8, x234, s_q8 * x233));
+        let x245 = Self::mul_add(s_q7, x238, c_q7 * x237);
+        let x246 = -x245;
+        let x247 = Self::mul_add(-c_q7, x238, s_q7 * x237);
+        let x248 = -x247;
+        let x249 = -Self::mul_add(-0.75, x247, Self::mul_add(s_q7, x244, c_q7 * x243));
+        let x250 = -(Self::mul_add(-c_q7, x244, s_q7 * x243)
+            + Self::mul_add(-0.65, x239, 0.75 * x245));
+        let x251 = -Self::mul_add(0.65, x247, x241);
+        let x252 = Self::mul_add(c_q10, x77, x100);
+        let x253 = Self::mul_add(-s_q10, x77, x98);
+        let x254 = Self::mul_add(-s_q10, x83, c_q10 * x82);
+        let x255 = Self::mul_add(c_q10, x83, s_q10 * x82);
+        let x256 = Self::mul_add(-0.87, x252, x84);
+        let x257 = Self::mul_add(-c_q9, x253, s_q9 * x252);
+        let x258 = Self::mul_add(x8, x253, x7 * x252);
+        let x259 = Self::mul_add(s_q9, x253, c_q9 * x252);
+        let x260 = 0.00000000020510342851533115 * x256;
+        let x261 = Self::mul_add(c_q9, x255, s_q9 * x254) + x260
+            + Self::mul_add(-0.275, x259, 0.4 * x258);
+        let x262 = Self::mul_add(-0.4, x257, x256 + Self::mul_add(-x8, x255, x7 * x254));
         let x263 = Self::mul_add(
-            -0.35,
-            x260,
-            x258 + Self::mul_add(-x2, x256, x3 * x257),
-        );
-        let x264 = Self::mul_add(-0.35, x259, Self::mul_add(c_q8, x257, s_q8 * x256));
-        let x265 = Self::mul_add(s_q7, x260, c_q7 * x259);
-        let x266 = -x265;
-        let x267 = Self::mul_add(-s_q7, x259, c_q7 * x260);
-        let x268 = Self::mul_add(-0.75, x267, Self::mul_add(-s_q7, x264, c_q7 * x263));
-        let x269 = Self::mul_add(c_q7, x264, s_q7 * x263)
-            - Self::mul_add(0.65, x261, 0.75 * x265);
-        let x270 = Self::mul_add(0.65, x267, x262);
-        let x271 = Self::mul_add(-x13, x38, x12 * x39);
-        let x272 = x49 - x48;
-        let x273 = Self::mul_add(0.36, x271, x56);
-        let x274 = Self::mul_add(x52, 0.36, x59);
-        let x275 = Self::mul_add(s_q11, x271, c_q11 * x52);
-        let x276 = Self::mul_add(-s_q11, x52, c_q11 * x271);
-        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
-            + Self::mul_add(-0.63, x272, 0.275 * x276);
-        let x278 = Self::mul_add(0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
-        let x279 = Self::mul_add(0.63, x275, x60);
-        let x280 = -x279;
-        let x281 = Self::mul_add(s_q10, x276, c_q10 * x275);
-        let x282 = Self::mul_add(-s_q10, x275, c_q10 * x276);
-        let x283 = Self::mul_add(c_q10, x278, s_q10 * x277);
-        let x284 = Self::mul_add(-0.87, x272, Self::mul_add(-s_q10, x278, c_q10 * x277));
-        let x285 = Self::mul_add(0.87, x281, x279);
-        let x286 = -x285;
-        let x287 = 0.00000000020510342851533115 * x272;
-        let x288 = Self::mul_add(-s_q9, x281, c_q9 * x282) + x287;
-        let x289 = x272 - Self::mul_add(x8, x282, x7 * x281);
-        let x290 = x287 + Self::mul_add(s_q9, x282, c_q9 * x281);
-        let x291 = 0.00000000020510342851533115 * x285;
-        let x292 = Self::mul_add(c_q9, x283, s_q9 * x284) - x291
-            - Self::mul_add(0.275, x290, 0.4 * x289);
-        let x293 = Self::mul_add(0.4, x288, Self::mul_add(-x8, x283, x7 * x284) - x285);
-        let x294 = Self::mul_add(
             -0.275,
-            x288,
-            x291 + Self::mul_add(-s_q9, x283, c_q9 * x284),
+            x257,
+            x260 - Self::mul_add(-s_q9, x255, c_q9 * x254),
         );
-        let x295 = Self::mul_add(-x2, x288, x3 * x289) - x290;
-        let x296 = Self::mul_add(c_q8, x289, s_q8 * x288);
-        let x297 = Self::mul_add(
+        let x264 = -x263;
+        let x265 = x259 - Self::mul_add(-x3, x258, x2 * x257);
+        let x266 = Self::mul_add(c_q8, x258, s_q8 * x257);
+        let x267 = Self::mul_add(
             0.00000000020510342851533115,
-            x290,
-            Self::mul_add(-c_q8, x288, s_q8 * x289),
+            x259,
+            Self::mul_add(-s_q8, x258, c_q8 * x257),
         );
-        let x298 = Self::mul_add(
+        let x268 = Self::mul_add(
             -0.00000000020510342851533115,
-            x294,
-            Self::mul_add(-c_q8, x292, s_q8 * x293),
+            x263,
+            Self::mul_add(-s_q8, x262, c_q8 * x261),
         );
-        let x299 = Self::mul_add(
+        let x269 = -x268;
+        let x270 = Self::mul_add(
             -0.35,
-            x296,
-            x294 + Self::mul_add(-x2, x292, x3 * x293),
+            x266,
+            x263 + Self::mul_add(-x3, x262, x2 * x261),
         );
-        let x300 = Self::mul_add(0.35, x295, Self::mul_add(c_q8, x293, s_q8 * x292));
-        let x301 = Self::mul_add(-s_q7, x296, c_q7 * x295);
-        let x302 = Self::mul_add(c_q7, x296, s_q7 * x295);
-        let x303 = Self::mul_add(-0.75, x302, Self::mul_add(-s_q7, x300, c_q7 * x299));
-        let x304 = Self::mul_add(c_q7, x300, s_q7 * x299)
-            + Self::mul_add(-0.65, x297, 0.75 * x301);
-        let x305 = Self::mul_add(0.65, x302, x298);
-        let x306 = 4.806620000000001 * x15;
-        let x307 = x22 + x32;
-        let x308 = Self::mul_add(0.16, x306, -x26);
-        let x309 = Self::mul_add(-0.55, x306, x29);
-        let x310 = Self::mul_add(s_q12, x19, c_q12 * x306);
-        let x311 = x18 + Self::mul_add(-x12, x306, x13 * x19);
-        let x312 = Self::mul_add(
+        let x271 = Self::mul_add(-0.35, x265, Self::mul_add(c_q8, x262, s_q8 * x261));
+        let x272 = Self::mul_add(-s_q7, x266, c_q7 * x265);
+        let x273 = -x272;
+        let x274 = Self::mul_add(c_q7, x266, s_q7 * x265);
+        let x275 = -x274;
+        let x276 = -Self::mul_add(-0.75, x274, Self::mul_add(s_q7, x271, c_q7 * x270));
+        let x277 = -(Self::mul_add(-c_q7, x271, s_q7 * x270)
+            + Self::mul_add(0.65, x267, 0.75 * x272));
+        let x278 = -Self::mul_add(0.65, x274, x268);
+        let x279 = Self::mul_add(-x13, x38, x12 * x39);
+        let x280 = Self::mul_add(0.36, x279, x54);
+        let x281 = Self::mul_add(x50, 0.36, x57);
+        let x282 = Self::mul_add(s_q11, x279, c_q11 * x50);
+        let x283 = Self::mul_add(-c_q11, x279, s_q11 * x50);
+        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
+            - Self::mul_add(x48, -0.63, 0.275 * x283);
+        let x285 = Self::mul_add(0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
+        let x286 = Self::mul_add(0.63, x282, x58);
+        let x287 = -x286;
+        let x288 = Self::mul_add(-s_q10, x283, c_q10 * x282);
+        let x289 = Self::mul_add(c_q10, x283, s_q10 * x282);
+        let x290 = Self::mul_add(c_q10, x285, s_q10 * x284);
+        let x291 = Self::mul_add(x48, 0.87, Self::mul_add(-s_q10, x285, c_q10 * x284));
+        let x292 = Self::mul_add(0.87, x288, x286);
+        let x293 = -x292;
+        let x294 = 0.00000000020510342851533115 * x48;
+        let x295 = Self::mul_add(c_q9, x289, s_q9 * x288) + x294;
+        let x296 = x48 + Self::mul_add(-x8, x289, x7 * x288);
+        let x297 = x294 - Self::mul_add(-s_q9, x289, c_q9 * x288);
+        let x298 = 0.00000000020510342851533115 * x292;
+        let x299 = Self::mul_add(c_q9, x290, s_q9 * x291) - x298
+            + Self::mul_add(0.275, x297, 0.4 * x296);
+        let x300 = Self::mul_add(0.4, x295, x292 - Self::mul_add(-x8, x290, x7 * x291));
+        let x301 = Self::mul_add(
+            0.275,
+            x295,
+            x298 + Self::mul_add(-s_q9, x290, c_q9 * x291),
+        );
+        let x302 = x297 + Self::mul_add(-x3, x296, x2 * x295);
+        let x303 = Self::mul_add(c_q8, x296, s_q8 * x295);
+        let x304 = Self::mul_add(
             -0.00000000020510342851533115,
+            x297,
+            Self::mul_add(-s_q8, x296, c_q8 * x295),
+        );
+        let x305 = Self::mul_add(
+            0.00000000020510342851533115,
+            x301,
+            Self::mul_add(s_q8, x300, c_q8 * x299),
+        );
+        let x306 = -x305;
+        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x3, x300, x2 * x299));
+        let x308 = Self::mul_add(0.35, x302, Self::mul_add(-c_q8, x300, s_q8 * x299));
+        let x309 = Self::mul_add(s_q7, x303, c_q7 * x302);
+        let x310 = Self::mul_add(-c_q7, x303, s_q7 * x302);
+        let x311 = Self::mul_add(-0.75, x310, Self::mul_add(-s_q7, x308, c_q7 * x307));
+        let x312 = Self::mul_add(c_q7, x308, s_q7 * x307)
+            + Self::mul_add(-0.65, x304, 0.75 * x309);
+        let x313 = -Self::mul_add(-0.65, x310, x305);
+        let x314 = 4.806620000000001 * x15;
+        let x315 = x22 + x32;
+        let x316 = Self::mul_add(-0.16, x314, x26);
+        let x317 = Self::mul_add(-0.55, x314, x29);
+        let x318 = Self::mul_add(s_q12, x19, c_q12 * x314);
+        let x319 = x18 - Self::mul_add(-x13, x19, x12 * x314);
+        let x320 = Self::mul_add(
+            0.00000000020510342851533115,
             x18,
-            Self::mul_add(-s_q12, x306, c_q12 * x19),
+            Self::mul_add(-c_q12, x19, s_q12 * x314),
         );
-        let x313 = Self::mul_add(
+        let x321 = Self::mul_add(
             0.00000000020510342851533115,
-            x309,
-            Self::mul_add(c_q12, x308, s_q12 * x307),
+            x317,
+            Self::mul_add(-c_q12, x316, s_q12 * x315),
         );
-        let x314 = -x313;
-        let x315 = Self::mul_add(0.36, x311, Self::mul_add(-s_q12, x308, c_q12 * x307));
-        let x316 = Self::mul_add(
+        let x322 = -x321;
+        let x323 = Self::mul_add(0.36, x319, Self::mul_add(s_q12, x316, c_q12 * x315));
+        let x324 = Self::mul_add(
             -0.36,
-            x310,
-            x309 - Self::mul_add(x13, x308, x12 * x307),
+            x318,
+            x317 - Self::mul_add(-x13, x316, x12 * x315),
         );
-        let x317 = Self::mul_add(-s_q11, x311, c_q11 * x310);
-        let x318 = Self::mul_add(c_q11, x311, s_q11 * x310);
-        let x319 = Self::mul_add(-s_q11, x316, c_q11 * x315)
-            + Self::mul_add(-0.63, x312, 0.275 * x318);
-        let x320 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x316, s_q11 * x315));
-        let x321 = Self::mul_add(0.63, x317, -x313);
-        let x322 = Self::mul_add(-s_q10, x318, c_q10 * x317);
-        let x323 = Self::mul_add(c_q10, x318, s_q10 * x317);
-        let x324 = Self::mul_add(c_q10, x320, s_q10 * x319);
-        let x325 = Self::mul_add(-0.87, x312, Self::mul_add(-s_q10, x320, c_q10 * x319));
-        let x326 = Self::mul_add(0.87, x322, x321);
-        let x327 = 0.00000000020510342851533115 * x312;
-        let x328 = Self::mul_add(c_q9, x323, s_q9 * x322) + x327;
-        let x329 = x312 + Self::mul_add(-x8, x323, x7 * x322);
-        let x330 = Self::mul_add(-s_q9, x323, c_q9 * x322) - x327;
-        let x331 = 0.00000000020510342851533115 * x326;
-        let x332 = Self::mul_add(c_q9, x324, s_q9 * x325) + x331
-            + Self::mul_add(-0.4, x329, 0.275 * x330);
-        let x333 = Self::mul_add(0.4, x328, x326 + Self::mul_add(-x8, x324, x7 * x325));
-        let x334 = Self::mul_add(
+        let x325 = Self::mul_add(-s_q11, x319, c_q11 * x318);
+        let x326 = Self::mul_add(c_q11, x319, s_q11 * x318);
+        let x327 = Self::mul_add(-s_q11, x324, c_q11 * x323)
+            + Self::mul_add(0.63, x320, 0.275 * x326);
+        let x328 = Self::mul_add(-0.275, x325, Self::mul_add(c_q11, x324, s_q11 * x323));
+        let x329 = Self::mul_add(-0.63, x325, x321);
+        let x330 = -x329;
+        let x331 = Self::mul_add(-s_q10, x326, c_q10 * x325);
+        let x332 = Self::mul_add(c_q10, x326, s_q10 * x325);
+        let x333 = Self::mul_add(c_q10, x328, s_q10 * x327);
+        let x334 = Self::mul_add(0.87, x320, Self::mul_add(-s_q10, x328, c_q10 * x327));
+        let x335 = Self::mul_add(-0.87, x331, x329);
+        let x336 = -x335;
+        let x337 = 0.00000000020510342851533115 * x320;
+        let x338 = Self::mul_add(c_q9, x332, s_q9 * x331) - x337;
+        let x339 = x320 - Self::mul_add(-x8, x332, x7 * x331);
+        let x340 = x337 + Self::mul_add(-s_q9, x332, c_q9 * x331);
+        let x341 = 0.00000000020510342851533115 * x335;
+        let x342 = Self::mul_add(c_q9, x333, s_q9 * x334) - x341
+            + Self::mul_add(0.275, x340, 0.4 * x339);
+        let x343 = Self::mul_add(-0.4, x338, x335 - Self::mul_add(-x8, x333, x7 * x334));
+        let x344 = Self::mul_add(
             -0.275,
-            x328,
-            Self::mul_add(-s_q9, x324, c_q9 * x325) - x331,
+            x338,
+            x341 + Self::mul_add(-s_q9, x333, c_q9 * x334),
         );
-        let x335 = x330 + Self::mul_add(-x2, x328, x3 * x329);
-        let x336 = Self::mul_add(c_q8, x329, s_q8 * x328);
-        let x337 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x330,
-            Self::mul_add(-c_q8, x328, s_q8 * x329),
+        let x345 = x340 - Self::mul_add(x3, x339, x2 * x338);
+        let x346 = Self::mul_add(-c_q8, x339, s_q8 * x338);
+        let x347 = Self::mul_add(
+            0.00000000020510342851533115,
+            x340,
+            Self::mul_add(s_q8, x339, c_q8 * x338),
         );
-        let x338 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x334,
-            Self::mul_add(-c_q8, x332, s_q8 * x333),
+        let x348 = -x347;
+        let x349 = Self::mul_add(
+            0.00000000020510342851533115,
+            x344,
+            Self::mul_add(s_q8, x343, c_q8 * x342),
         );
-        let x339 = Self::mul_add(
-            -0.35,
-            x336,
-            x334 + Self::mul_add(-x2, x332, x3 * x333),
-        );
-        let x340 = Self::mul_add(0.35, x335, Self::mul_add(c_q8, x333, s_q8 * x332));
-        let x341 = Self::mul_add(-s_q7, x336, c_q7 * x335);
-        let x342 = Self::mul_add(c_q7, x336, s_q7 * x335);
-        let x343 = Self::mul_add(-0.75, x342, Self::mul_add(-s_q7, x340, c_q7 * x339));
-        let x344 = Self::mul_add(c_q7, x340, s_q7 * x339)
-            + Self::mul_add(-0.65, x337, 0.75 * x341);
-        let x345 = Self::mul_add(0.65, x342, x338);
+        let x350 = -x349;
+        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x3, x343, x2 * x342));
+        let x352 = Self::mul_add(0.35, x345, Self::mul_add(-c_q8, x343, s_q8 * x342));
+        let x353 = Self::mul_add(-s_q7, x346, c_q7 * x345);
+        let x354 = Self::mul_add(c_q7, x346, s_q7 * x345);
+        let x355 = Self::mul_add(-0.75, x354, Self::mul_add(-s_q7, x352, c_q7 * x351));
+        let x356 = Self::mul_add(c_q7, x352, s_q7 * x351)
+            + Self::mul_add(0.65, x347, 0.75 * x353);
+        let x357 = -Self::mul_add(-0.65, x354, x349);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x195,
-                x186,
-                x186,
-                x206,
-                x223,
-                x242,
-                x266,
-                x301,
-                x341,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x200,
-                0.0,
-                x194,
-                x184,
-                x207,
-                x224,
-                x243,
-                x267,
-                x302,
-                x342,
-            ],
-            [
-                0.0,
-                0.0,
-                1170.07,
-                x185,
-                x201,
-                0.0,
-                0.0,
-                x157,
-                x218,
-                x237,
-                x261,
-                x297,
-                x337,
-            ],
-            [
-                0.0,
-                x200,
-                x185,
-                x196,
-                x191,
-                x197,
-                x190,
-                x208,
-                x225,
-                x244,
-                x268,
-                x303,
-                x343,
-            ],
-            [
-                x195,
-                0.0,
-                x201,
-                x191,
-                x198,
-                x192,
-                x192,
-                x209,
-                x226,
-                x245,
-                x269,
-                x304,
-                x344,
-            ],
-            [
-                x186,
-                x194,
-                0.0,
-                x197,
-                x192,
-                x199,
                 x193,
-                x210,
-                x227,
+                x184,
+                x184,
+                x203,
+                x223,
                 x246,
-                x270,
-                x305,
-                x345,
+                x273,
+                x309,
+                x353,
             ],
             [
-                x186,
-                x184,
                 0.0,
-                x190,
+                1170.07,
+                0.0,
+                x198,
+                0.0,
                 x192,
-                x193,
-                x178,
-                x167,
-                x219,
-                x238,
-                x262,
-                x298,
-                x338,
+                x182,
+                x204,
+                x225,
+                x248,
+                x275,
+                x310,
+                x354,
             ],
             [
+                0.0,
+                0.0,
+                1170.07,
+                x183,
+                x199,
+                0.0,
+                0.0,
+                x155,
+                x217,
+                x240,
+                x267,
+                x304,
+                x348,
+            ],
+            [
+                0.0,
+                x198,
+                x183,
+                x194,
+                x189,
+                x195,
+                x188,
+                x205,
+                x226,
+                x249,
+                x276,
+                x311,
+                x355,
+            ],
+            [
+                x193,
+                0.0,
+                x199,
+                x189,
+                x196,
+                x190,
+                x190,
+                x206,
+                x227,
+                x250,
+                x277,
+                x312,
+                x356,
+            ],
+            [
+                x184,
+                x192,
+                0.0,
+                x195,
+                x190,
+                x197,
+                x191,
+                x207,
+                x228,
+                x251,
+                x278,
+                x313,
+                x357,
+            ],
+            [
+                x184,
+                x182,
+                0.0,
+                x188,
+                x190,
+                x191,
+                x176,
+                x165,
+                x219,
+                x242,
+                x269,
+                x306,
+                x350,
+            ],
+            [
+                x203,
+                x204,
+                x155,
+                x205,
                 x206,
                 x207,
-                x157,
-                x208,
-                x209,
-                x210,
-                x167,
-                x155,
-                x215,
-                x234,
-                x258,
-                x294,
-                x334,
+                x165,
+                x153,
+                x213,
+                x236,
+                x264,
+                x301,
+                x344,
             ],
             [
                 x223,
-                x224,
-                x218,
                 x225,
+                x217,
                 x226,
                 x227,
+                x228,
                 x219,
-                x215,
-                x112,
-                x106,
-                x251,
-                x286,
-                x326,
+                x213,
+                x110,
+                x104,
+                x256,
+                x293,
+                x336,
             ],
-            [x242, x243, x237, x244, x245, x246, x238, x234, x106, x92, x86, x280, x321],
-            [x266, x267, x261, x268, x269, x270, x262, x258, x251, x86, x72, x61, x314],
-            [x301, x302, x297, x303, x304, x305, x298, x294, x286, x280, x61, x47, x309],
+            [x246, x248, x240, x249, x250, x251, x242, x236, x104, x90, x84, x287, x330],
+            [x273, x275, x267, x276, x277, x278, x269, x264, x256, x84, x70, x59, x322],
+            [x309, x310, x304, x311, x312, x313, x306, x301, x293, x287, x59, x47, x317],
             [
-                x341,
-                x342,
-                x337,
-                x343,
+                x353,
+                x354,
+                x348,
+                x355,
+                x356,
+                x357,
+                x350,
                 x344,
-                x345,
-                x338,
-                x334,
-                x326,
-                x321,
-                x314,
-                x309,
+                x336,
+                x330,
+                x322,
+                x317,
                 1.4135609200000003,
             ],
         ]
@@ -1941,56 +1938,56 @@ impl FreeFloating7 {
     /// Methods: bias `newton-euler`: 528 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
-        let x0 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
+        let x0 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
         let x1 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x2 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
+        let x2 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x4 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x5 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x5 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
         let x6 = v[4] * v[4];
         let x7 = Self::mul_add(v[5], v[5], x6);
         let x8 = v[3] * v[4];
         let x9 = v[3] * v[5];
         let x10 = v[4] * v[5];
         let x11 = Self::mul_add(v[3], v[3], x6);
-        let x12 = x0 + Self::mul_add(-0.65, x7, 0.75 * x9);
+        let x12 = x0 + Self::mul_add(-0.75, x9, 0.65 * x7);
         let x13 = x1 + Self::mul_add(0.75, x10, 0.65 * x8);
-        let x14 = x2 + Self::mul_add(-0.75, x11, 0.65 * x9);
-        let x15 = Self::mul_add(-s_q7, x12, c_q7 * x13);
+        let x14 = x2 - Self::mul_add(-0.75, x11, 0.65 * x9);
+        let x15 = Self::mul_add(c_q7, x13, s_q7 * x12);
         let x16 = v[6] * x5;
         let x17 = v[6] * x4;
         let x18 = v[5] + v[6];
         let x19 = x5 * x5;
         let x20 = x4 * x18;
-        let x21 = Self::mul_add(x18, 16.80768997608804, x5 * 0.07309);
+        let x21 = Self::mul_add(x18, -16.80768997608804, x5 * 0.07309);
         let x22 = Self::mul_add(
-            0.1132,
+            -0.1132,
             x18,
-            Self::mul_add(x4, -0.07309, 130.43769025763282 * x5),
+            Self::mul_add(130.43769025763282, x5, x4 * 0.07309),
         );
         let x23 = Self::mul_add(
-            132.47349025763282,
+            -132.47349025763282,
             x18,
-            Self::mul_add(x4, -16.80768997608804, 0.1132 * x5),
+            Self::mul_add(0.1132, x5, x4 * 16.80768997608804),
         );
         let (s_q8, c_q8) = libm::sincos(q[8]);
         let x25 = 0.00000000020510342851533115 * c_q8;
         let x26 = 0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(-x4, x25, x5 * s_q8));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(x5, c_q8, x4 * x26));
-        let x29 = Self::mul_add(0.35, x20 - x17, Self::mul_add(s_q7, x13, c_q7 * x12));
-        let x30 = Self::mul_add(0.35, Self::mul_add(x5, x18, -x16), x15);
-        let x31 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x19), x14);
-        let x32 = Self::mul_add(-c_q8, x31, Self::mul_add(-x25, x29, s_q8 * x30));
-        let x33 = Self::mul_add(s_q8, x31, Self::mul_add(c_q8, x30, x26 * x29));
+        let x27 = Self::mul_add(x18, c_q8, Self::mul_add(x5, s_q8, x4 * x25));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x5, c_q8, x4 * x26));
+        let x29 = Self::mul_add(0.35, x17 - x20, Self::mul_add(-s_q7, x13, c_q7 * x12));
+        let x30 = Self::mul_add(0.35, Self::mul_add(-x5, x18, x16), x15);
+        let x31 = Self::mul_add(0.35, Self::mul_add(x4, x4, x19), x14);
+        let x32 = Self::mul_add(c_q8, x31, Self::mul_add(s_q8, x30, x25 * x29));
+        let x33 = Self::mul_add(s_q8, x31, Self::mul_add(-c_q8, x30, x26 * x29));
         let x34 = Self::mul_add(-0.00000000020510342851533115, x31, x29);
-        let x35 = Self::mul_add(v[7], x28, -Self::mul_add(x17, s_q8, x16 * x25));
-        let x36 = Self::mul_add(-v[7], x27, Self::mul_add(-x17, c_q8, x16 * x26));
+        let x35 = Self::mul_add(v[7], x28, Self::mul_add(-x17, s_q8, x16 * x25));
+        let x36 = Self::mul_add(-v[7], x27, Self::mul_add(x17, c_q8, x16 * x26));
         let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x4);
         let x38 = x28 * x28;
         let x39 = x37 * x37;
         let x40 = x27 * x28;
-        let x41 = x40 - x16;
+        let x41 = x16 - x40;
         let x42 = x27 * x37;
         let x43 = x27 * x27;
         let x44 = x39 + x43;
@@ -2004,12 +2001,12 @@ impl FreeFloating7 {
         let x48 = Self::mul_add(
             5.080660024070365,
             x37,
-            -Self::mul_add(x28, 111.7548902508081, x27 * 0.0000000234896432582596),
+            Self::mul_add(x28, -111.7548902508081, x27 * 0.0000000234896432582596),
         );
         let x49 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(x27, -0.002139996587640933, 5.080660024070366 * x28),
+            Self::mul_add(5.080660024070366, x28, x27 * 0.002139996587640933),
         );
         let x50 = Self::mul_add(
             x34,
@@ -2017,85 +2014,85 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x16,
-                -Self::mul_add(x36, 111.7548902508081, x35 * 0.0000000234896432582596),
-            ) - Self::mul_add(x27, x49, x37 * x47),
+                Self::mul_add(x36, -111.7548902508081, x35 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x27, x49, x37 * x47),
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
         let x52 = 0.00000000020510342851533115 * c_q9;
         let x53 = 0.00000000020510342851533115 * s_q9;
         let x54 = x52 - x53;
         let x55 = x52 + x53;
-        let x56 = Self::mul_add(x37, c_q9, Self::mul_add(x28, x54, x27 * s_q9));
-        let x57 = Self::mul_add(-x37, s_q9, Self::mul_add(-x28, x55, x27 * c_q9));
-        let x58 = x32 + Self::mul_add(0.4, x36 + x42, 0.275 * x41);
-        let x59 = x33 + Self::mul_add(-0.275, x44, 0.4 * (x45 - x35));
-        let x60 = x34 + Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
-        let x61 = Self::mul_add(c_q9, x60, Self::mul_add(x54, x59, s_q9 * x58));
+        let x56 = Self::mul_add(-x37, c_q9, Self::mul_add(-x28, x54, x27 * s_q9));
+        let x57 = Self::mul_add(x37, s_q9, Self::mul_add(x28, x55, x27 * c_q9));
+        let x58 = x32 + Self::mul_add(-0.4, x36 + x42, 0.275 * x41);
+        let x59 = x33 + Self::mul_add(0.4, x35 - x45, 0.275 * x44);
+        let x60 = x34 - Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
+        let x61 = Self::mul_add(-c_q9, x60, Self::mul_add(-x54, x59, s_q9 * x58));
         let x62 = Self::mul_add(
             -0.00000000020510342851533115,
             x60,
-            Self::mul_add(0.00000000020510342851533115, x58, x59),
+            Self::mul_add(-0.00000000020510342851533115, x58, x59),
         );
         let x63 = Self::mul_add(
             -0.00000000020510342851533115,
             x16,
-            Self::mul_add(0.00000000020510342851533115, x35, x36),
+            Self::mul_add(-0.00000000020510342851533115, x35, x36),
         );
         let x64 = Self::mul_add(
-            v[8],
+            -v[8],
             x57,
-            Self::mul_add(x16, c_q9, Self::mul_add(x36, x54, x35 * s_q9)),
+            Self::mul_add(-x16, c_q9, Self::mul_add(-x36, x54, x35 * s_q9)),
         );
         let x65 = Self::mul_add(
-            -v[8],
+            v[8],
             x56,
-            Self::mul_add(-x16, s_q9, Self::mul_add(-x36, x55, x35 * c_q9)),
+            Self::mul_add(x16, s_q9, Self::mul_add(x36, x55, x35 * c_q9)),
         );
         let x66 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
-                Self::mul_add(0.00000000020510342851533115, x27, x28),
+                Self::mul_add(-0.00000000020510342851533115, x27, x28),
             );
-        let x67 = Self::mul_add(x56, x57, -x63);
+        let x67 = Self::mul_add(x56, x57, x63);
         let x68 = Self::mul_add(x56, x56, x66 * x66);
-        let x69 = Self::mul_add(x57, x66, x64);
+        let x69 = Self::mul_add(-x57, x66, x64);
         let x70 = x66 * 0.00214;
-        let x71 = Self::mul_add(x66, 36.18604050126307, x57 * 63.36336825000001);
+        let x71 = Self::mul_add(x66, -36.18604050126307, x57 * 63.36336825000001);
         let x72 = Self::mul_add(
             69.99836825,
             x66,
-            -Self::mul_add(x57, 36.18604050126307, x56 * 0.00214),
+            Self::mul_add(x57, 36.18604050126307, x56 * 0.00214),
         );
         let x73 = Self::mul_add(
             x62,
-            -81.53205,
-            Self::mul_add(x63, -0.00214, Self::mul_add(x57, x72, x66 * x71)),
+            81.53205,
+            Self::mul_add(x63, 0.00214, -Self::mul_add(x57, x72, x66 * x71)),
         );
         let x74 = Self::mul_add(
             x61,
-            81.53205,
+            -81.53205,
             Self::mul_add(
                 69.99836825,
                 x63,
-                -Self::mul_add(x65, 36.18604050126307, x64 * 0.00214),
-            ) + Self::mul_add(-x56, x71, x57 * x70),
+                Self::mul_add(x65, 36.18604050126307, x64 * 0.00214),
+            ) + Self::mul_add(x56, x71, x57 * x70),
         );
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let x76 = Self::mul_add(x57, s_q10, x56 * c_q10);
-        let x77 = Self::mul_add(-x56, s_q10, x57 * c_q10);
+        let x77 = Self::mul_add(-x57, c_q10, x56 * s_q10);
         let x78 = Self::mul_add(x67, -0.87, x61);
         let x79 = Self::mul_add(
             x68,
             0.87,
-            Self::mul_add(-s_q9, x60, Self::mul_add(-x55, x59, c_q9 * x58)),
+            Self::mul_add(s_q9, x60, Self::mul_add(x55, x59, c_q9 * x58)),
         );
-        let x80 = Self::mul_add(x69, -0.87, x62);
+        let x80 = Self::mul_add(x69, 0.87, x62);
         let x81 = Self::mul_add(s_q10, x79, c_q10 * x78);
         let x82 = Self::mul_add(v[9], x77, Self::mul_add(x65, s_q10, x64 * c_q10));
-        let x83 = Self::mul_add(-v[9], x76, Self::mul_add(-x64, s_q10, x65 * c_q10));
+        let x83 = Self::mul_add(-v[9], x76, Self::mul_add(-x65, c_q10, x64 * s_q10));
         let x84 = v[9] + x66;
-        let x85 = Self::mul_add(x76, x77, -x63);
+        let x85 = Self::mul_add(-x76, x77, x63);
         let x86 = x76 * x76;
         let x87 = Self::mul_add(x84, x84, x86);
         let x88 = x77 * x84;
@@ -2105,102 +2102,102 @@ impl FreeFloating7 {
         let x92 = Self::mul_add(
             28.2393615,
             x84,
-            -Self::mul_add(x77, 24.351642000914637, x76 * 0.6328),
+            Self::mul_add(x77, -24.351642000914637, x76 * 0.6328),
         );
         let x93 = Self::mul_add(
             x80,
-            -45.1584,
-            Self::mul_add(x63, -0.6328, Self::mul_add(x77, x92, x84 * x91)),
+            45.1584,
+            Self::mul_add(x63, 0.6328, Self::mul_add(x77, x92, x84 * x91)),
         );
         let x94 = Self::mul_add(
             x81,
-            45.1584,
+            -45.1584,
             Self::mul_add(
                 28.2393615,
                 x63,
-                -Self::mul_add(x83, 24.351642000914637, x82 * 0.6328),
-            ) + Self::mul_add(-x76, x91, x77 * x90),
+                Self::mul_add(x83, -24.351642000914637, x82 * 0.6328),
+            ) - Self::mul_add(x76, x91, x77 * x90),
         );
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x96 = Self::mul_add(x77, s_q11, x76 * c_q11);
-        let x97 = Self::mul_add(-x76, s_q11, x77 * c_q11);
-        let x98 = x81 - Self::mul_add(0.275, Self::mul_add(x76, x84, x83), x85 * 0.63);
-        let x99 = Self::mul_add(-s_q10, x78, c_q10 * x79)
-            + Self::mul_add(-0.275, x88 - x82, x87 * 0.63);
-        let x100 = x80 + Self::mul_add(x89, -0.63, 0.275 * Self::mul_add(x77, x77, x86));
-        let x101 = Self::mul_add(s_q11, x99, c_q11 * x98);
-        let x102 = Self::mul_add(v[10], x97, Self::mul_add(x83, s_q11, x82 * c_q11));
-        let x103 = Self::mul_add(-v[10], x96, Self::mul_add(-x82, s_q11, x83 * c_q11));
+        let x96 = Self::mul_add(-x77, s_q11, x76 * c_q11);
+        let x97 = Self::mul_add(x77, c_q11, x76 * s_q11);
+        let x98 = x81 - Self::mul_add(-0.275, Self::mul_add(x76, x84, x83), x85 * 0.63);
+        let x99 = Self::mul_add(-c_q10, x79, s_q10 * x78)
+            - Self::mul_add(0.275, x82 - x88, x87 * 0.63);
+        let x100 = x80 + Self::mul_add(-0.275, Self::mul_add(x77, x77, x86), x89 * 0.63);
+        let x101 = Self::mul_add(-s_q11, x99, c_q11 * x98);
+        let x102 = Self::mul_add(v[10], x97, Self::mul_add(-x83, s_q11, x82 * c_q11));
+        let x103 = Self::mul_add(-v[10], x96, Self::mul_add(x83, c_q11, x82 * s_q11));
         let x104 = v[10] + x84;
         let x105 = x96 * x96;
         let x106 = x97 * x104;
         let x107 = 0.01675 * x104;
-        let x108 = Self::mul_add(x97, -9.142025249762803, 2.5482240016099564 * x104);
+        let x108 = Self::mul_add(-2.5482240016099564, x104, x97 * 9.142025249762803);
         let x109 = Self::mul_add(
-            9.223235249762805,
+            -9.223235249762805,
             x104,
-            Self::mul_add(2.5482240016099564, x97, 0.01675 * x96),
+            Self::mul_add(-2.5482240016099564, x97, 0.01675 * x96),
         );
         let x110 = Self::mul_add(
             7.078399999258757,
             x100,
-            Self::mul_add(0.01675, x63, Self::mul_add(-x104, x108, x97 * x109)),
+            Self::mul_add(0.01675, x63, -Self::mul_add(-x97, x109, x104 * x108)),
         );
         let x111 = Self::mul_add(
             -7.078399999258757,
             x101,
             Self::mul_add(
-                9.223235249762805,
+                -9.223235249762805,
                 x63,
-                Self::mul_add(2.5482240016099564, x103, 0.01675 * x102),
-            ) + Self::mul_add(-x97, x107, x96 * x108),
+                Self::mul_add(-2.5482240016099564, x103, 0.01675 * x102),
+            ) - Self::mul_add(-x96, x108, x97 * x107),
         );
         let (s_q12, c_q12) = libm::sincos(q[12]);
         let x113 = 0.00000000020510342851533115 * s_q12;
         let x114 = 0.00000000020510342851533115 * c_q12;
-        let x115 = Self::mul_add(-x104, s_q12, Self::mul_add(-x97, x113, x96 * c_q12));
-        let x116 = Self::mul_add(x104, c_q12, Self::mul_add(x97, x114, x96 * s_q12));
-        let x117 = Self::mul_add(Self::mul_add(x96, x104, x103), -0.36, x101);
+        let x115 = Self::mul_add(x104, s_q12, Self::mul_add(x97, x113, x96 * c_q12));
+        let x116 = Self::mul_add(-x104, c_q12, Self::mul_add(-x97, x114, x96 * s_q12));
+        let x117 = Self::mul_add(Self::mul_add(x96, x104, x103), 0.36, x101);
         let x118 = Self::mul_add(
-            x106 - x102,
+            x102 - x106,
             -0.36,
-            Self::mul_add(-s_q11, x98, c_q11 * x99),
+            Self::mul_add(c_q11, x99, s_q11 * x98),
         );
-        let x119 = Self::mul_add(Self::mul_add(x97, x97, x105), 0.36, x100);
-        let x120 = Self::mul_add(-s_q12, x119, Self::mul_add(-x113, x118, c_q12 * x117));
-        let x121 = Self::mul_add(c_q12, x119, Self::mul_add(x114, x118, s_q12 * x117));
+        let x119 = Self::mul_add(Self::mul_add(x97, x97, x105), -0.36, x100);
+        let x120 = Self::mul_add(s_q12, x119, Self::mul_add(x113, x118, c_q12 * x117));
+        let x121 = Self::mul_add(-c_q12, x119, Self::mul_add(-x114, x118, s_q12 * x117));
         let x122 = Self::mul_add(-0.00000000020510342851533115, x119, x118);
         let x123 = Self::mul_add(-0.00000000020510342851533115, x63, x103);
         let x124 = Self::mul_add(
-            -v[11],
+            v[11],
             x116,
-            Self::mul_add(-x63, s_q12, Self::mul_add(-x103, x113, x102 * c_q12)),
+            Self::mul_add(x63, s_q12, Self::mul_add(x103, x113, x102 * c_q12)),
         );
         let x125 = Self::mul_add(
-            v[11],
+            -v[11],
             x115,
-            Self::mul_add(x63, c_q12, Self::mul_add(x103, x114, x102 * s_q12)),
+            Self::mul_add(-x63, c_q12, Self::mul_add(-x103, x114, x102 * s_q12)),
         );
         let x126 = v[11] + Self::mul_add(-0.00000000020510342851533115, x104, x97);
         let x127 = x116 * x116;
         let x128 = x126 * x126;
         let x129 = x115 * x116;
-        let x130 = x123 + x129;
+        let x130 = x123 - x129;
         let x131 = x115 * x126;
         let x132 = x115 * x115;
         let x133 = x128 + x132;
         let x134 = x116 * x126;
-        let x135 = x124 - x134;
-        let x136 = Self::mul_add(x126, -0.809539999555672, x116 * 1.9877000000000002);
+        let x135 = x124 + x134;
+        let x136 = Self::mul_add(x126, 0.809539999555672, x116 * 1.9877000000000002);
         let x137 = Self::mul_add(
             x126,
             -2.741639999592316,
-            Self::mul_add(x115, -1.9877000000000002, x116 * 5.252920330000002),
+            Self::mul_add(x116, -5.252920330000002, x115 * 1.9877000000000002),
         );
         let x138 = Self::mul_add(
             9.740442170000001,
             x126,
-            Self::mul_add(x115, -0.809539999555672, x116 * 2.7416399995923166),
+            Self::mul_add(x116, -2.7416399995923166, x115 * 0.809539999555672),
         );
         let x139 = Self::mul_add(
             -3.6140000000000003,
@@ -2208,61 +2205,61 @@ impl FreeFloating7 {
             Self::mul_add(
                 x123,
                 -2.741639999592316,
-                Self::mul_add(x124, -1.9877000000000002, x125 * 5.252920330000002),
+                Self::mul_add(x125, -5.252920330000002, x124 * 1.9877000000000002),
             ) + Self::mul_add(-x115, x138, x126 * x136),
         );
         let (s_q13, c_q13) = libm::sincos(q[13]);
         let x141 = 0.00000000020510342851533115 * c_q13;
         let x142 = 0.00000000020510342851533115 * s_q13;
-        let x143 = Self::mul_add(x126, c_q13, Self::mul_add(x116, s_q13, x115 * x141));
-        let x144 = Self::mul_add(x126, s_q13, Self::mul_add(-x116, c_q13, x115 * x142));
-        let x145 = x120 + Self::mul_add(-0.55, x130, 0.16 * (x131 - x125));
-        let x146 = x122 + Self::mul_add(-0.16, x127 + x132, 0.55 * x135);
+        let x143 = Self::mul_add(-x126, c_q13, Self::mul_add(x116, s_q13, x115 * x141));
+        let x144 = Self::mul_add(-x126, s_q13, Self::mul_add(-x116, c_q13, x115 * x142));
+        let x145 = x120 + Self::mul_add(-0.16, x125 + x131, 0.55 * x130);
+        let x146 = x122 - Self::mul_add(-0.16, x127 + x132, 0.55 * x135);
         let x147 = Self::mul_add(
-            c_q13,
+            -c_q13,
             x146,
             Self::mul_add(
                 s_q13,
-                x121 + Self::mul_add(0.16, x124 + x134, 0.55 * x133),
+                x121 + Self::mul_add(0.16, x124 - x134, 0.55 * x133),
                 x141 * x145,
             ),
         );
-        let x148 = Self::mul_add(-0.00000000020510342851533115, x123, x124);
+        let x148 = Self::mul_add(0.00000000020510342851533115, x123, x124);
         let x149 = Self::mul_add(
             v[12],
             x144,
-            -Self::mul_add(x123, c_q13, Self::mul_add(x125, s_q13, x124 * x141)),
+            Self::mul_add(-x123, c_q13, Self::mul_add(x125, s_q13, x124 * x141)),
         );
         let x150 = Self::mul_add(
-            v[12],
+            -v[12],
             x143,
-            Self::mul_add(x123, s_q13, Self::mul_add(-x125, c_q13, x124 * x142)),
+            Self::mul_add(-x123, s_q13, Self::mul_add(-x125, c_q13, x124 * x142)),
         );
-        let x151 = v[12] + Self::mul_add(-0.00000000020510342851533115, x126, x115);
+        let x151 = v[12] - Self::mul_add(0.00000000020510342851533115, x126, x115);
         let x152 = 4.806620000000001 * Self::mul_add(x143, x144, x148);
         let x153 = 4.806620000000001 * Self::mul_add(x143, x143, x151 * x151);
         let x154 = 4.806620000000001 * Self::mul_add(x144, x151, x149);
-        let x155 = Self::mul_add(x151, -0.0145, 0.000781 * x144);
+        let x155 = Self::mul_add(x151, 0.0145, 0.000781 * x144);
         let x156 = Self::mul_add(
             x151,
-            0.9614610000000001,
+            -0.9614610000000001,
             Self::mul_add(x144, 1.2025609200000003, 0.000781 * x143),
         );
         let x157 = Self::mul_add(
-            1.4135609200000003,
+            -1.4135609200000003,
             x151,
             Self::mul_add(x144, -0.9614610000000001, x143 * 0.0145),
         );
         let x158 = Self::mul_add(
             x148,
-            -0.9614610000000001,
-            Self::mul_add(x150, -1.2025609200000003, 0.000781 * x149),
-        ) + Self::mul_add(x143, x157, x151 * x155);
+            0.9614610000000001,
+            Self::mul_add(x150, 1.2025609200000003, 0.000781 * x149),
+        ) + Self::mul_add(-x143, x157, x151 * x155);
         let x159 = Self::mul_add(
             4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x146, x145),
+            Self::mul_add(0.00000000020510342851533115, x146, x145),
             Self::mul_add(x148, -0.0145, 0.000781 * x150)
-                + Self::mul_add(x144, x157, x151 * x156),
+                - Self::mul_add(-x144, x157, x151 * x156),
         );
         let x160 = Self::mul_add(
             4.806620000000001,
@@ -2270,13 +2267,13 @@ impl FreeFloating7 {
             Self::mul_add(
                 1.4135609200000003,
                 x148,
-                -Self::mul_add(x150, 0.9614610000000001, x149 * 0.0145),
-            ) + Self::mul_add(-x144, x155, x143 * x156),
+                Self::mul_add(x150, -0.9614610000000001, x149 * 0.0145),
+            ) - Self::mul_add(-x143, x156, x144 * x155),
         );
-        let x161 = x154 + Self::mul_add(-x142, x153, x141 * x152);
+        let x161 = x154 - Self::mul_add(-x142, x153, x141 * x152);
         let x162 = Self::mul_add(c_q13, x153, s_q13 * x152);
         let x163 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x154,
             Self::mul_add(-s_q13, x153, c_q13 * x152),
         );
@@ -2284,303 +2281,300 @@ impl FreeFloating7 {
             -0.55,
             x161,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
                 x160,
-                Self::mul_add(-c_q13, x159, s_q13 * x158),
+                Self::mul_add(s_q13, x158, c_q13 * x159),
             ),
         );
-        let x165 = x161
-            - Self::mul_add(
-                17.135250000000003,
-                x130,
-                3.6140000000000003 * (x127 + x128),
-            );
-        let x166 = Self::mul_add(
+        let x165 = Self::mul_add(
             -17.135250000000003,
+            x130,
+            3.6140000000000003 * (x127 + x128),
+        ) + x161;
+        let x166 = Self::mul_add(
+            17.135250000000003,
             x133,
-            3.6140000000000003 * (x123 - x129),
-        ) - x162;
+            3.6140000000000003 * (x123 + x129),
+        ) + x162;
         let x167 = Self::mul_add(
             17.135250000000003,
             x135,
-            3.6140000000000003 * (x125 + x131),
+            3.6140000000000003 * (x125 - x131),
         ) + x163;
         let x168 = Self::mul_add(
-            17.135250000000003,
+            -17.135250000000003,
             x122,
-            Self::mul_add(x123, -0.809539999555672, x125 * 1.9877000000000002)
-                - Self::mul_add(x116, x138, x126 * x137),
+            Self::mul_add(x123, 0.809539999555672, x125 * 1.9877000000000002)
+                - Self::mul_add(-x116, x138, x126 * x137),
         )
-            + (x160 + Self::mul_add(-x141, x159, x142 * x158)
+            + (x160 - Self::mul_add(x142, x158, x141 * x159)
                 + Self::mul_add(0.55, x163, 0.16 * x162));
         let x169 = x139
-            + Self::mul_add(0.16, x161, Self::mul_add(c_q13, x158, s_q13 * x159));
+            - Self::mul_add(-0.16, x161, Self::mul_add(-c_q13, x158, s_q13 * x159));
         let x170 = Self::mul_add(
             9.740442170000001,
             x123,
-            Self::mul_add(x124, -0.809539999555672, x125 * 2.7416399995923166),
-        ) + Self::mul_add(x115, x137, x116 * x136)
-            - Self::mul_add(3.6140000000000003, x121, 17.135250000000003 * x120) + x164;
-        let x171 = Self::mul_add(-s_q12, x166, c_q12 * x165);
-        let x172 = x167 - Self::mul_add(x114, x166, x113 * x165);
-        let x173 = Self::mul_add(7.078399999258757, Self::mul_add(x96, x97, -x63), x171);
+            Self::mul_add(x125, -2.7416399995923166, x124 * 0.809539999555672),
+        ) - Self::mul_add(-x115, x137, x116 * x136)
+            + Self::mul_add(3.6140000000000003, x121, 17.135250000000003 * x120) + x164;
+        let x171 = -x170;
+        let x172 = Self::mul_add(-s_q12, x166, c_q12 * x165);
+        let x173 = x167 + Self::mul_add(x114, x166, x113 * x165);
         let x174 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x104, x104, x105),
-            x172,
+            7.078399999258757,
+            Self::mul_add(-x96, x97, x63),
+            -x172,
         );
         let x175 = Self::mul_add(
             7.078399999258757,
+            Self::mul_add(x104, x104, x105),
+            -x173,
+        );
+        let x176 = Self::mul_add(
+            7.078399999258757,
             x102 + x106,
-            -Self::mul_add(
-                0.00000000020510342851533115,
+            Self::mul_add(
+                -0.00000000020510342851533115,
                 x167,
                 Self::mul_add(c_q12, x166, s_q12 * x165),
             ),
         );
-        let x176 = x110
-            + Self::mul_add(0.36, x172, Self::mul_add(-s_q12, x169, c_q12 * x168));
-        let x177 = Self::mul_add(x103, -9.142025249762803, 2.5482240016099564 * x63)
+        let x177 = x110
+            - Self::mul_add(0.36, x173, Self::mul_add(s_q12, x169, c_q12 * x168));
+        let x178 = Self::mul_add(-2.5482240016099564, x63, x103 * 9.142025249762803)
             + Self::mul_add(-x96, x109, x104 * x107)
-            + Self::mul_add(-0.36, x171, x170 - Self::mul_add(x114, x169, x113 * x168));
-        let x178 = x111
+            - Self::mul_add(-0.36, x172, x170 + Self::mul_add(-x114, x169, x113 * x168));
+        let x179 = x111
             - Self::mul_add(
-                0.00000000020510342851533115,
+                -0.00000000020510342851533115,
                 x170,
-                Self::mul_add(c_q12, x169, s_q12 * x168),
+                Self::mul_add(-c_q12, x169, s_q12 * x168),
             );
-        let x179 = Self::mul_add(-s_q11, x174, c_q11 * x173);
-        let x180 = Self::mul_add(c_q11, x174, s_q11 * x173);
-        let x181 = Self::mul_add(x85, -45.1584, x179);
-        let x182 = Self::mul_add(45.1584, x87, x180);
-        let x183 = Self::mul_add(-45.1584, x89, x175);
-        let x184 = x93
-            + (Self::mul_add(-s_q11, x177, c_q11 * x176)
-                + Self::mul_add(-0.63, x175, 0.275 * x180));
-        let x185 = Self::mul_add(-0.275, x179, Self::mul_add(c_q11, x177, s_q11 * x176))
-            - (Self::mul_add(x63, 24.35164200091464, x83 * 24.4950615)
-                + Self::mul_add(x76, x92, x84 * x90));
-        let x186 = x94 + Self::mul_add(0.63, x179, x178);
-        let x187 = Self::mul_add(-s_q10, x182, c_q10 * x181);
-        let x188 = Self::mul_add(x67, -81.53205, x187);
-        let x189 = Self::mul_add(
+        let x180 = Self::mul_add(s_q11, x175, c_q11 * x174);
+        let x181 = Self::mul_add(-c_q11, x175, s_q11 * x174);
+        let x182 = Self::mul_add(x85, 45.1584, -x180);
+        let x183 = Self::mul_add(45.1584, x87, x181);
+        let x184 = Self::mul_add(45.1584, x89, -x176);
+        let x185 = x93
+            - (Self::mul_add(s_q11, x178, c_q11 * x177)
+                - Self::mul_add(-0.63, x176, 0.275 * x181));
+        let x186 = Self::mul_add(x63, 24.35164200091464, x83 * 24.4950615)
+            - Self::mul_add(-x76, x92, x84 * x90)
+            - Self::mul_add(0.275, x180, Self::mul_add(-c_q11, x178, s_q11 * x177));
+        let x187 = x94 - Self::mul_add(0.63, x180, x179);
+        let x188 = -x187;
+        let x189 = Self::mul_add(s_q10, x183, c_q10 * x182);
+        let x190 = Self::mul_add(x67, 81.53205, x189);
+        let x191 = Self::mul_add(
             81.53205,
             x68,
-            Self::mul_add(c_q10, x182, s_q10 * x181),
+            -Self::mul_add(-c_q10, x183, s_q10 * x182),
         );
-        let x190 = Self::mul_add(-81.53205, x69, x183);
-        let x191 = x73
-            + Self::mul_add(-0.87, x183, Self::mul_add(-s_q10, x185, c_q10 * x184));
-        let x192 = Self::mul_add(c_q10, x185, s_q10 * x184)
-            - (Self::mul_add(x63, 36.18604050126307, x65 * 63.36336825000001)
-                + Self::mul_add(x56, x72, x66 * x70));
-        let x193 = x74 + Self::mul_add(0.87, x187, x186);
-        let x194 = 0.00000000020510342851533115 * x190;
-        let x195 = Self::mul_add(c_q9, x189, s_q9 * x188) + x194;
-        let x196 = x190 + Self::mul_add(-x55, x189, x54 * x188);
-        let x197 = Self::mul_add(-s_q9, x189, c_q9 * x188) - x194;
-        let x198 = 0.00000000020510342851533115 * x193;
-        let x199 = Self::mul_add(
+        let x192 = Self::mul_add(81.53205, x69, x184);
+        let x193 = x73
+            + Self::mul_add(0.87, x184, Self::mul_add(-s_q10, x186, c_q10 * x185));
+        let x194 = Self::mul_add(x63, -36.18604050126307, x65 * 63.36336825000001)
+            + Self::mul_add(-x56, x72, x66 * x70)
+            - Self::mul_add(c_q10, x186, s_q10 * x185);
+        let x195 = x74 + Self::mul_add(0.87, x189, x187);
+        let x196 = -x195;
+        let x197 = 0.00000000020510342851533115 * x192;
+        let x198 = Self::mul_add(-c_q9, x191, s_q9 * x190) + x197;
+        let x199 = x192 + Self::mul_add(x55, x191, x54 * x190);
+        let x200 = x197 - Self::mul_add(s_q9, x191, c_q9 * x190);
+        let x201 = 0.00000000020510342851533115 * x195;
+        let x202 = Self::mul_add(
             x41,
             -12.701650001451807,
             (x38 + x39) * 0.000000008530897668050218,
-        ) + x195;
-        let x200 = Self::mul_add(
-            -0.000000008530897668050218,
-            x16 + x40,
-            12.701650001451807 * x44,
-        ) + x196;
-        let x201 = x197
-            - Self::mul_add(
-                12.701650001451807,
-                x46,
-                0.000000008530897668050218 * (x42 - x36),
-            );
-        let x202 = Self::mul_add(
-            x34,
-            -12.701650001451807,
-            Self::mul_add(-x37, x48, x28 * x49)
-                - Self::mul_add(
-                    x16,
-                    0.002139996587640933,
-                    x36 * 0.0000000234896432582596,
-                ),
-        )
-            + (Self::mul_add(c_q9, x192, s_q9 * x191) + x198
-                + Self::mul_add(-0.4, x196, 0.275 * x197));
-        let x203 = x50
-            + Self::mul_add(0.4, x195, x193 + Self::mul_add(-x55, x192, x54 * x191));
+        ) - x198;
+        let x203 = Self::mul_add(
+            12.701650001451807,
+            x44,
+            0.000000008530897668050218 * (x16 + x40),
+        ) - x199;
         let x204 = Self::mul_add(
+            12.701650001451807,
+            x46,
+            0.000000008530897668050218 * (x36 - x42),
+        ) - x200;
+        let x205 = Self::mul_add(
+            x34,
+            12.701650001451807,
+            Self::mul_add(x16, 0.002139996587640933, x36 * 0.0000000234896432582596)
+                - Self::mul_add(-x28, x49, x37 * x48),
+        )
+            + (Self::mul_add(-c_q9, x194, s_q9 * x193) - x201
+                + Self::mul_add(0.275, x200, 0.4 * x199));
+        let x206 = x50
+            + Self::mul_add(0.4, x198, x195 - Self::mul_add(x55, x194, x54 * x193));
+        let x207 = Self::mul_add(
             113.3918902508081,
             x16,
-            Self::mul_add(x35, -0.002139996587640933, 5.080660024070366 * x36),
-        ) + Self::mul_add(x27, x48, x28 * x47)
-            + Self::mul_add(x33, -0.000000008530897668050218, x32 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x195,
-                Self::mul_add(-s_q9, x192, c_q9 * x191) - x198,
-            );
-        let x205 = x201 + Self::mul_add(-x25, x199, x26 * x200);
-        let x206 = Self::mul_add(c_q8, x200, s_q8 * x199);
-        let x207 = Self::mul_add(-48.0240000085309, Self::mul_add(x18, x18, x19), x205);
-        let x208 = Self::mul_add(48.0240000085309, x4 * x5, x206);
-        let x209 = Self::mul_add(
+            Self::mul_add(5.080660024070366, x36, x35 * 0.002139996587640933),
+        ) - Self::mul_add(-x27, x48, x28 * x47)
+            - Self::mul_add(x33, 0.000000008530897668050218, x32 * 12.701650001451807)
+            - Self::mul_add(0.275, x198, x201 + Self::mul_add(s_q9, x194, c_q9 * x193));
+        let x208 = -x207;
+        let x209 = x204 + Self::mul_add(-x26, x203, x25 * x202);
+        let x210 = Self::mul_add(c_q8, x203, s_q8 * x202);
+        let x211 = Self::mul_add(48.0240000085309, Self::mul_add(x18, x18, x19), x209);
+        let x212 = Self::mul_add(48.0240000085309, x4 * x5, -x210);
+        let x213 = Self::mul_add(
             48.0240000085309,
             x17 + x20,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x201,
-                Self::mul_add(-c_q8, x199, s_q8 * x200),
-            ),
-        );
-        let x210 = Self::mul_add(x17, 0.07309, Self::mul_add(-x18, x22, x5 * x23))
-            + Self::mul_add(-0.35, x206, x204 + Self::mul_add(-x25, x202, x26 * x203));
-        let x211 = Self::mul_add(0.35, x205, Self::mul_add(c_q8, x203, s_q8 * x202))
-            - Self::mul_add(
-                48.0240000085309,
-                x14,
-                Self::mul_add(130.43769025763282, x17, x16 * 0.07309)
-                    + Self::mul_add(x4, x23, x18 * x21),
-            );
-        let x212 = Self::mul_add(
-            48.0240000085309,
-            x15,
-            Self::mul_add(x4, x22, x5 * x21)
-                - Self::mul_add(0.1132, x17, x16 * 16.80768997608804),
-        )
-            + Self::mul_add(
+            -Self::mul_add(
                 -0.00000000020510342851533115,
                 x204,
-                Self::mul_add(-c_q8, x202, s_q8 * x203),
+                Self::mul_add(-s_q8, x203, c_q8 * x202),
+            ),
+        );
+        let x214 = Self::mul_add(x17, 0.07309, Self::mul_add(x5, x23, x18 * x22))
+            - Self::mul_add(0.35, x210, x207 + Self::mul_add(x26, x206, x25 * x205));
+        let x215 = Self::mul_add(
+            48.0240000085309,
+            x14,
+            Self::mul_add(-130.43769025763282, x17, x16 * 0.07309)
+                + Self::mul_add(x4, x23, x18 * x21),
+        ) + Self::mul_add(-0.35, x209, Self::mul_add(-c_q8, x206, s_q8 * x205));
+        let x216 = Self::mul_add(
+            48.0240000085309,
+            x15,
+            Self::mul_add(-0.1132, x17, x16 * 16.80768997608804)
+                + Self::mul_add(-x4, x22, x5 * x21),
+        )
+            - Self::mul_add(
+                -0.00000000020510342851533115,
+                x207,
+                Self::mul_add(s_q8, x206, c_q8 * x205),
             );
-        let x213 = Self::mul_add(-s_q7, x208, c_q7 * x207);
-        let x214 = Self::mul_add(c_q7, x208, s_q7 * x207);
-        let x215 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x216 = 1466.4506062283303 * v[4];
-        let x217 = Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]);
-        let x218 = x213
+        let x217 = Self::mul_add(-s_q7, x212, c_q7 * x211);
+        let x218 = Self::mul_add(c_q7, x212, s_q7 * x211);
+        let x219 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x220 = 1466.4506062283303 * v[4];
+        let x221 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x222 = -(x217
             + Self::mul_add(
                 1170.07,
                 x0,
-                Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
-            );
-        let x219 = x214
-            + Self::mul_add(
+                Self::mul_add(-180.9502499901501, x9, 110.5455 * x7),
+            ));
+        let x223 = -(x218
+            - Self::mul_add(
                 1170.07,
                 x1,
                 Self::mul_add(180.9502499901501, x10, 110.5455 * x8),
-            );
-        let x220 = x209
-            + Self::mul_add(
+            ));
+        let x224 = x213
+            - Self::mul_add(
                 1170.07,
                 x2,
-                Self::mul_add(-180.9502499901501, x11, 110.5455 * x9),
+                -Self::mul_add(-180.9502499901501, x11, 110.5455 * x9),
             );
-        let x221 = Self::mul_add(-0.75, x214, Self::mul_add(-s_q7, x211, c_q7 * x210))
-            + Self::mul_add(
-                -180.9502499901501,
+        let x225 = Self::mul_add(0.75, x218, Self::mul_add(-s_q7, x215, c_q7 * x214))
+            - Self::mul_add(
+                180.9502499901501,
                 x1,
-                Self::mul_add(-v[5], x216, v[4] * x217),
+                Self::mul_add(v[4], x221, v[5] * x220),
             );
-        let x222 = Self::mul_add(c_q7, x211, s_q7 * x210)
-            + Self::mul_add(-0.65, x209, 0.75 * x213)
-            + (Self::mul_add(-v[3], x217, v[5] * x215)
-                + Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
-        let x223 = Self::mul_add(0.65, x214, x212)
-            + Self::mul_add(110.5455, x1, Self::mul_add(-v[4], x215, v[3] * x216));
-        [x218, x219, x220, x221, x222, x223, x212, x204, x193, x186, x178, x170, x160]
+        let x226 = Self::mul_add(c_q7, x215, s_q7 * x214)
+            - Self::mul_add(0.65, x213, 0.75 * x217)
+            + (Self::mul_add(v[3], x221, v[5] * x219)
+                - Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
+        let x227 = Self::mul_add(-0.65, x218, x216)
+            - Self::mul_add(-110.5455, x1, Self::mul_add(-v[3], x220, v[4] * x219));
+        [x222, x223, x224, x225, x226, x227, x216, x208, x196, x188, x179, x171, x160]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
     ///
     /// Methods: bias `newton-euler`: 543 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 332 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
-        let x0 = a[0] + Self::mul_add(-v[1], v[5], v[2] * v[4]);
+        let x0 = a[0] - Self::mul_add(-v[2], v[4], v[1] * v[5]);
         let x1 = a[1] + Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x2 = a[2] + Self::mul_add(-v[0], v[4], v[1] * v[3]);
+        let x2 = a[2] - Self::mul_add(-v[1], v[3], v[0] * v[4]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x4 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x5 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x5 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
         let x6 = v[4] * v[4];
         let x7 = Self::mul_add(v[5], v[5], x6);
         let x8 = v[3] * v[5];
         let x9 = a[4] + x8;
         let x10 = Self::mul_add(v[3], v[4], a[5]);
-        let x11 = Self::mul_add(v[4], v[5], -a[3]);
-        let x12 = x8 - a[4];
+        let x11 = Self::mul_add(-v[4], v[5], a[3]);
+        let x12 = a[4] - x8;
         let x13 = Self::mul_add(v[3], v[3], x6);
-        let x14 = x0 + Self::mul_add(-0.65, x7, 0.75 * x9);
-        let x15 = x1 + Self::mul_add(0.75, x11, 0.65 * x10);
-        let x16 = x2 + Self::mul_add(-0.75, x13, 0.65 * x12);
-        let x17 = Self::mul_add(-s_q7, x14, c_q7 * x15);
-        let x18 = Self::mul_add(v[6], x5, Self::mul_add(a[4], s_q7, a[3] * c_q7));
-        let x19 = Self::mul_add(-v[6], x4, Self::mul_add(-a[3], s_q7, a[4] * c_q7));
+        let x14 = x0 - Self::mul_add(-0.75, x9, 0.65 * x7);
+        let x15 = x1 + Self::mul_add(-0.75, x11, 0.65 * x10);
+        let x16 = x2 - Self::mul_add(0.75, x13, 0.65 * x12);
+        let x17 = Self::mul_add(-c_q7, x15, s_q7 * x14);
+        let x18 = Self::mul_add(-v[6], x5, Self::mul_add(a[4], s_q7, a[3] * c_q7));
+        let x19 = Self::mul_add(v[6], x4, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
         let x20 = a[5] + a[6];
         let x21 = v[5] + v[6];
         let x22 = x5 * x5;
         let x23 = x4 * x21;
-        let x24 = Self::mul_add(x21, 16.80768997608804, x5 * 0.07309);
+        let x24 = Self::mul_add(x21, -16.80768997608804, x5 * 0.07309);
         let x25 = Self::mul_add(
-            0.1132,
+            -0.1132,
             x21,
-            Self::mul_add(x4, -0.07309, 130.43769025763282 * x5),
+            Self::mul_add(130.43769025763282, x5, x4 * 0.07309),
         );
         let x26 = Self::mul_add(
-            132.47349025763282,
+            -132.47349025763282,
             x21,
-            Self::mul_add(x4, -16.80768997608804, 0.1132 * x5),
+            Self::mul_add(0.1132, x5, x4 * 16.80768997608804),
         );
         let x27 = Self::mul_add(
-            -48.0240000085309,
+            48.0240000085309,
             x16,
             Self::mul_add(
-                0.1132,
+                -0.1132,
                 x20,
-                Self::mul_add(x18, -0.07309, 130.43769025763282 * x19),
+                Self::mul_add(130.43769025763282, x19, x18 * 0.07309),
             ) - Self::mul_add(x4, x26, x21 * x24),
         );
         let x28 = Self::mul_add(
             48.0240000085309,
             x17,
             Self::mul_add(
-                132.47349025763282,
+                -132.47349025763282,
                 x20,
-                Self::mul_add(x18, -16.80768997608804, 0.1132 * x19),
-            ) + Self::mul_add(x4, x25, x5 * x24),
+                Self::mul_add(0.1132, x19, x18 * 16.80768997608804),
+            ) - Self::mul_add(-x4, x25, x5 * x24),
         );
         let (s_q8, c_q8) = libm::sincos(q[8]);
         let x30 = 0.00000000020510342851533115 * c_q8;
         let x31 = 0.00000000020510342851533115 * s_q8;
-        let x32 = Self::mul_add(-x21, c_q8, Self::mul_add(-x4, x30, x5 * s_q8));
-        let x33 = Self::mul_add(x21, s_q8, Self::mul_add(x5, c_q8, x4 * x31));
-        let x34 = Self::mul_add(0.35, x19 + x23, Self::mul_add(s_q7, x15, c_q7 * x14));
-        let x35 = Self::mul_add(0.35, Self::mul_add(x5, x21, -x18), x17);
+        let x32 = Self::mul_add(x21, c_q8, Self::mul_add(x5, s_q8, x4 * x30));
+        let x33 = Self::mul_add(x21, s_q8, Self::mul_add(-x5, c_q8, x4 * x31));
+        let x34 = Self::mul_add(-0.35, x19 - x23, Self::mul_add(s_q7, x15, c_q7 * x14));
+        let x35 = Self::mul_add(0.35, Self::mul_add(x5, x21, x18), x17);
         let x36 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x22), x16);
-        let x37 = Self::mul_add(-c_q8, x36, Self::mul_add(-x30, x34, s_q8 * x35));
-        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(c_q8, x35, x31 * x34));
+        let x37 = Self::mul_add(c_q8, x36, Self::mul_add(s_q8, x35, x30 * x34));
+        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(-c_q8, x35, x31 * x34));
         let x39 = Self::mul_add(-0.00000000020510342851533115, x36, x34);
         let x40 = Self::mul_add(
-            v[7],
+            -v[7],
             x33,
-            Self::mul_add(-x20, c_q8, Self::mul_add(-x18, x30, x19 * s_q8)),
+            Self::mul_add(x20, c_q8, Self::mul_add(x19, s_q8, x18 * x30)),
         );
         let x41 = Self::mul_add(
-            -v[7],
+            v[7],
             x32,
-            Self::mul_add(x20, s_q8, Self::mul_add(x19, c_q8, x18 * x31)),
+            Self::mul_add(x20, s_q8, Self::mul_add(-x19, c_q8, x18 * x31)),
         );
         let x42 = a[7] + Self::mul_add(-0.00000000020510342851533115, x20, x18);
         let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x21, x4);
         let x44 = x33 * x33;
         let x45 = x43 * x43;
         let x46 = x32 * x33;
-        let x47 = x46 - x42;
+        let x47 = x42 + x46;
         let x48 = x32 * x43;
         let x49 = x32 * x32;
         let x50 = x45 + x49;
         let x51 = x33 * x43;
-        let x52 = x40 + x51;
+        let x52 = x40 - x51;
         let x53 = Self::mul_add(
             x43,
             0.002139996587640933,
@@ -2589,12 +2583,12 @@ impl FreeFloating7 {
         let x54 = Self::mul_add(
             5.080660024070365,
             x43,
-            -Self::mul_add(x33, 111.7548902508081, x32 * 0.0000000234896432582596),
+            Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
         );
         let x55 = Self::mul_add(
             113.3918902508081,
             x43,
-            Self::mul_add(x32, -0.002139996587640933, 5.080660024070366 * x33),
+            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
         );
         let x56 = Self::mul_add(
             x39,
@@ -2602,171 +2596,172 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x42,
-                -Self::mul_add(x41, 111.7548902508081, x40 * 0.0000000234896432582596),
-            ) - Self::mul_add(x32, x55, x43 * x53),
+                Self::mul_add(x41, -111.7548902508081, x40 * 0.0000000234896432582596),
+            ) - Self::mul_add(-x32, x55, x43 * x53),
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
         let x58 = 0.00000000020510342851533115 * c_q9;
         let x59 = 0.00000000020510342851533115 * s_q9;
         let x60 = x58 - x59;
         let x61 = x58 + x59;
-        let x62 = Self::mul_add(x43, c_q9, Self::mul_add(x33, x60, x32 * s_q9));
-        let x63 = Self::mul_add(-x43, s_q9, Self::mul_add(-x33, x61, x32 * c_q9));
-        let x64 = x37 + Self::mul_add(0.4, x41 + x48, 0.275 * x47);
-        let x65 = x38 + Self::mul_add(-0.275, x50, 0.4 * (x51 - x40));
-        let x66 = x39 + Self::mul_add(-0.4, x44 + x49, 0.275 * x52);
-        let x67 = Self::mul_add(c_q9, x66, Self::mul_add(x60, x65, s_q9 * x64));
+        let x62 = Self::mul_add(-x43, c_q9, Self::mul_add(-x33, x60, x32 * s_q9));
+        let x63 = Self::mul_add(x43, s_q9, Self::mul_add(x33, x61, x32 * c_q9));
+        let x64 = x37 + Self::mul_add(-0.4, x41 - x48, 0.275 * x47);
+        let x65 = x38 - Self::mul_add(-0.4, x40 + x51, 0.275 * x50);
+        let x66 = x39 - Self::mul_add(0.4, x44 + x49, 0.275 * x52);
+        let x67 = Self::mul_add(-c_q9, x66, Self::mul_add(-x60, x65, s_q9 * x64));
         let x68 = Self::mul_add(
             -0.00000000020510342851533115,
             x66,
-            Self::mul_add(0.00000000020510342851533115, x64, x65),
+            Self::mul_add(-0.00000000020510342851533115, x64, x65),
         );
         let x69 = Self::mul_add(
             v[8],
             x63,
-            Self::mul_add(x42, c_q9, Self::mul_add(x41, x60, x40 * s_q9)),
+            Self::mul_add(-x42, c_q9, Self::mul_add(-x41, x60, x40 * s_q9)),
         );
         let x70 = Self::mul_add(
             -v[8],
             x62,
-            Self::mul_add(-x42, s_q9, Self::mul_add(-x41, x61, x40 * c_q9)),
+            Self::mul_add(x42, s_q9, Self::mul_add(x41, x61, x40 * c_q9)),
         );
         let x71 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x42,
-                Self::mul_add(0.00000000020510342851533115, x40, x41),
+                Self::mul_add(-0.00000000020510342851533115, x40, x41),
             );
         let x72 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x43,
-                Self::mul_add(0.00000000020510342851533115, x32, x33),
+                Self::mul_add(-0.00000000020510342851533115, x32, x33),
             );
-        let x73 = Self::mul_add(x62, x63, -x71);
+        let x73 = Self::mul_add(-x62, x63, x71);
         let x74 = Self::mul_add(x62, x62, x72 * x72);
         let x75 = Self::mul_add(x63, x72, x69);
         let x76 = x72 * 0.00214;
-        let x77 = Self::mul_add(x72, 36.18604050126307, x63 * 63.36336825000001);
+        let x77 = Self::mul_add(x72, -36.18604050126307, x63 * 63.36336825000001);
         let x78 = Self::mul_add(
             69.99836825,
             x72,
-            -Self::mul_add(x63, 36.18604050126307, x62 * 0.00214),
+            Self::mul_add(x63, 36.18604050126307, x62 * 0.00214),
         );
         let x79 = Self::mul_add(
             x68,
-            -81.53205,
-            Self::mul_add(x71, -0.00214, Self::mul_add(x63, x78, x72 * x77)),
+            81.53205,
+            Self::mul_add(x71, 0.00214, Self::mul_add(x63, x78, x72 * x77)),
         );
         let x80 = Self::mul_add(
             x67,
-            81.53205,
+            -81.53205,
             Self::mul_add(
                 69.99836825,
                 x71,
-                -Self::mul_add(x70, 36.18604050126307, x69 * 0.00214),
-            ) + Self::mul_add(-x62, x77, x63 * x76),
+                Self::mul_add(x70, 36.18604050126307, x69 * 0.00214),
+            ) - Self::mul_add(x62, x77, x63 * x76),
         );
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let x82 = Self::mul_add(x63, s_q10, x62 * c_q10);
-        let x83 = Self::mul_add(-x62, s_q10, x63 * c_q10);
+        let x83 = Self::mul_add(-x63, c_q10, x62 * s_q10);
         let x84 = Self::mul_add(x73, -0.87, x67);
         let x85 = Self::mul_add(
             x74,
-            0.87,
-            Self::mul_add(-s_q9, x66, Self::mul_add(-x61, x65, c_q9 * x64)),
+            -0.87,
+            Self::mul_add(s_q9, x66, Self::mul_add(x61, x65, c_q9 * x64)),
         );
-        let x86 = Self::mul_add(x75, -0.87, x68);
+        let x86 = Self::mul_add(x75, 0.87, x68);
         let x87 = Self::mul_add(s_q10, x85, c_q10 * x84);
-        let x88 = Self::mul_add(v[9], x83, Self::mul_add(x70, s_q10, x69 * c_q10));
-        let x89 = Self::mul_add(-v[9], x82, Self::mul_add(-x69, s_q10, x70 * c_q10));
+        let x88 = Self::mul_add(-v[9], x83, Self::mul_add(x70, s_q10, x69 * c_q10));
+        let x89 = Self::mul_add(v[9], x82, Self::mul_add(-x70, c_q10, x69 * s_q10));
         let x90 = a[9] + x71;
         let x91 = v[9] + x72;
-        let x92 = Self::mul_add(x82, x83, -x90);
+        let x92 = Self::mul_add(x82, x83, x90);
         let x93 = x82 * x82;
         let x94 = Self::mul_add(x91, x91, x93);
         let x95 = x83 * x91;
-        let x96 = x88 + x95;
+        let x96 = x88 - x95;
         let x97 = x91 * 0.6328;
         let x98 = Self::mul_add(x91, 24.35164200091464, x83 * 24.4950615);
         let x99 = Self::mul_add(
             28.2393615,
             x91,
-            -Self::mul_add(x83, 24.351642000914637, x82 * 0.6328),
+            Self::mul_add(x83, -24.351642000914637, x82 * 0.6328),
         );
         let x100 = Self::mul_add(
             x86,
-            -45.1584,
-            Self::mul_add(x90, -0.6328, Self::mul_add(x83, x99, x91 * x98)),
+            45.1584,
+            Self::mul_add(x90, 0.6328, -Self::mul_add(x83, x99, x91 * x98)),
         );
         let x101 = Self::mul_add(
             x87,
-            45.1584,
+            -45.1584,
             Self::mul_add(
                 28.2393615,
                 x90,
-                -Self::mul_add(x89, 24.351642000914637, x88 * 0.6328),
-            ) + Self::mul_add(-x82, x98, x83 * x97),
+                Self::mul_add(x89, -24.351642000914637, x88 * 0.6328),
+            ) + Self::mul_add(x82, x98, x83 * x97),
         );
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x103 = Self::mul_add(x83, s_q11, x82 * c_q11);
-        let x104 = Self::mul_add(-x82, s_q11, x83 * c_q11);
-        let x105 = x87 - Self::mul_add(0.275, Self::mul_add(x82, x91, x89), x92 * 0.63);
-        let x106 = Self::mul_add(-s_q10, x84, c_q10 * x85)
-            + Self::mul_add(-0.275, x95 - x88, x94 * 0.63);
-        let x107 = x86 + Self::mul_add(x96, -0.63, 0.275 * Self::mul_add(x83, x83, x93));
-        let x108 = Self::mul_add(s_q11, x106, c_q11 * x105);
-        let x109 = Self::mul_add(v[10], x104, Self::mul_add(x89, s_q11, x88 * c_q11));
-        let x110 = Self::mul_add(-v[10], x103, Self::mul_add(-x88, s_q11, x89 * c_q11));
+        let x103 = Self::mul_add(-x83, s_q11, x82 * c_q11);
+        let x104 = Self::mul_add(x83, c_q11, x82 * s_q11);
+        let x105 = x87
+            - Self::mul_add(-0.275, Self::mul_add(-x82, x91, x89), x92 * 0.63);
+        let x106 = Self::mul_add(-c_q10, x85, s_q10 * x84)
+            + Self::mul_add(-0.275, x88 + x95, x94 * 0.63);
+        let x107 = x86 + Self::mul_add(0.275, Self::mul_add(x83, x83, x93), x96 * 0.63);
+        let x108 = Self::mul_add(-s_q11, x106, c_q11 * x105);
+        let x109 = Self::mul_add(-v[10], x104, Self::mul_add(-x89, s_q11, x88 * c_q11));
+        let x110 = Self::mul_add(v[10], x103, Self::mul_add(x89, c_q11, x88 * s_q11));
         let x111 = a[10] + x90;
         let x112 = v[10] + x91;
         let x113 = x103 * x103;
         let x114 = x104 * x112;
         let x115 = 0.01675 * x112;
-        let x116 = Self::mul_add(x104, -9.142025249762803, 2.5482240016099564 * x112);
+        let x116 = Self::mul_add(-2.5482240016099564, x112, x104 * 9.142025249762803);
         let x117 = Self::mul_add(
-            9.223235249762805,
+            -9.223235249762805,
             x112,
-            Self::mul_add(2.5482240016099564, x104, 0.01675 * x103),
+            Self::mul_add(-2.5482240016099564, x104, 0.01675 * x103),
         );
         let x118 = Self::mul_add(
             7.078399999258757,
             x107,
-            Self::mul_add(0.01675, x111, Self::mul_add(-x112, x116, x104 * x117)),
+            Self::mul_add(0.01675, x111, Self::mul_add(-x104, x117, x112 * x116)),
         );
         let x119 = Self::mul_add(
             -7.078399999258757,
             x108,
             Self::mul_add(
-                9.223235249762805,
+                -9.223235249762805,
                 x111,
-                Self::mul_add(2.5482240016099564, x110, 0.01675 * x109),
-            ) + Self::mul_add(-x104, x115, x103 * x116),
+                Self::mul_add(-2.5482240016099564, x110, 0.01675 * x109),
+            ) + Self::mul_add(-x103, x116, x104 * x115),
         );
         let (s_q12, c_q12) = libm::sincos(q[12]);
         let x121 = 0.00000000020510342851533115 * s_q12;
         let x122 = 0.00000000020510342851533115 * c_q12;
-        let x123 = Self::mul_add(-x112, s_q12, Self::mul_add(-x104, x121, x103 * c_q12));
-        let x124 = Self::mul_add(x112, c_q12, Self::mul_add(x104, x122, x103 * s_q12));
-        let x125 = Self::mul_add(Self::mul_add(x103, x112, x110), -0.36, x108);
+        let x123 = Self::mul_add(x112, s_q12, Self::mul_add(x104, x121, x103 * c_q12));
+        let x124 = Self::mul_add(-x112, c_q12, Self::mul_add(-x104, x122, x103 * s_q12));
+        let x125 = Self::mul_add(Self::mul_add(-x103, x112, x110), 0.36, x108);
         let x126 = Self::mul_add(
-            x114 - x109,
+            x109 + x114,
             -0.36,
-            Self::mul_add(-s_q11, x105, c_q11 * x106),
+            Self::mul_add(c_q11, x106, s_q11 * x105),
         );
         let x127 = Self::mul_add(Self::mul_add(x104, x104, x113), 0.36, x107);
-        let x128 = Self::mul_add(-s_q12, x127, Self::mul_add(-x121, x126, c_q12 * x125));
-        let x129 = Self::mul_add(c_q12, x127, Self::mul_add(x122, x126, s_q12 * x125));
+        let x128 = Self::mul_add(s_q12, x127, Self::mul_add(x121, x126, c_q12 * x125));
+        let x129 = Self::mul_add(-c_q12, x127, Self::mul_add(-x122, x126, s_q12 * x125));
         let x130 = Self::mul_add(-0.00000000020510342851533115, x127, x126);
         let x131 = Self::mul_add(
             -v[11],
             x124,
-            Self::mul_add(-x111, s_q12, Self::mul_add(-x110, x121, x109 * c_q12)),
+            Self::mul_add(x111, s_q12, Self::mul_add(x110, x121, x109 * c_q12)),
         );
         let x132 = Self::mul_add(
             v[11],
             x123,
-            Self::mul_add(x111, c_q12, Self::mul_add(x110, x122, x109 * s_q12)),
+            Self::mul_add(-x111, c_q12, Self::mul_add(-x110, x122, x109 * s_q12)),
         );
         let x133 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x110);
         let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x112, x104);
@@ -2779,16 +2774,16 @@ impl FreeFloating7 {
         let x141 = x136 + x140;
         let x142 = x124 * x134;
         let x143 = x131 - x142;
-        let x144 = Self::mul_add(x134, -0.809539999555672, x124 * 1.9877000000000002);
+        let x144 = Self::mul_add(x134, 0.809539999555672, x124 * 1.9877000000000002);
         let x145 = Self::mul_add(
             x134,
             -2.741639999592316,
-            Self::mul_add(x123, -1.9877000000000002, x124 * 5.252920330000002),
+            Self::mul_add(x124, -5.252920330000002, x123 * 1.9877000000000002),
         );
         let x146 = Self::mul_add(
             9.740442170000001,
             x134,
-            Self::mul_add(x123, -0.809539999555672, x124 * 2.7416399995923166),
+            Self::mul_add(x124, -2.7416399995923166, x123 * 0.809539999555672),
         );
         let x147 = Self::mul_add(
             -3.6140000000000003,
@@ -2796,292 +2791,285 @@ impl FreeFloating7 {
             Self::mul_add(
                 x133,
                 -2.741639999592316,
-                Self::mul_add(x131, -1.9877000000000002, x132 * 5.252920330000002),
-            ) + Self::mul_add(-x123, x146, x134 * x144),
+                Self::mul_add(x132, -5.252920330000002, x131 * 1.9877000000000002),
+            ) - Self::mul_add(-x123, x146, x134 * x144),
         );
         let (s_q13, c_q13) = libm::sincos(q[13]);
         let x149 = 0.00000000020510342851533115 * c_q13;
         let x150 = 0.00000000020510342851533115 * s_q13;
-        let x151 = Self::mul_add(x134, c_q13, Self::mul_add(x124, s_q13, x123 * x149));
-        let x152 = Self::mul_add(x134, s_q13, Self::mul_add(-x124, c_q13, x123 * x150));
-        let x153 = x128 + Self::mul_add(-0.55, x138, 0.16 * (x139 - x132));
-        let x154 = x130 + Self::mul_add(-0.16, x135 + x140, 0.55 * x143);
+        let x151 = Self::mul_add(-x134, c_q13, Self::mul_add(x124, s_q13, x123 * x149));
+        let x152 = Self::mul_add(-x134, s_q13, Self::mul_add(-x124, c_q13, x123 * x150));
+        let x153 = x128 + Self::mul_add(-0.16, x132 - x139, 0.55 * x138);
+        let x154 = x130 - Self::mul_add(0.16, x135 + x140, 0.55 * x143);
         let x155 = Self::mul_add(
-            c_q13,
+            -c_q13,
             x154,
             Self::mul_add(
                 s_q13,
-                x129 + Self::mul_add(0.16, x131 + x142, 0.55 * x141),
+                x129 - Self::mul_add(-0.16, x131 + x142, 0.55 * x141),
                 x149 * x153,
             ),
         );
         let x156 = Self::mul_add(
-            v[12],
+            -v[12],
             x152,
-            -Self::mul_add(x133, c_q13, Self::mul_add(x132, s_q13, x131 * x149)),
+            Self::mul_add(-x133, c_q13, Self::mul_add(x132, s_q13, x131 * x149)),
         );
         let x157 = Self::mul_add(
             v[12],
             x151,
-            Self::mul_add(x133, s_q13, Self::mul_add(-x132, c_q13, x131 * x150)),
+            Self::mul_add(-x133, s_q13, Self::mul_add(-x132, c_q13, x131 * x150)),
         );
-        let x158 = a[12] + Self::mul_add(-0.00000000020510342851533115, x133, x131);
-        let x159 = v[12] + Self::mul_add(-0.00000000020510342851533115, x134, x123);
+        let x158 = a[12] - Self::mul_add(0.00000000020510342851533115, x133, x131);
+        let x159 = v[12] - Self::mul_add(0.00000000020510342851533115, x134, x123);
         let x160 = 4.806620000000001 * Self::mul_add(x151, x152, x158);
         let x161 = 4.806620000000001 * Self::mul_add(x151, x151, x159 * x159);
-        let x162 = 4.806620000000001 * Self::mul_add(x152, x159, x156);
-        let x163 = Self::mul_add(x159, -0.0145, 0.000781 * x152);
+        let x162 = 4.806620000000001 * Self::mul_add(-x152, x159, x156);
+        let x163 = Self::mul_add(x159, 0.0145, 0.000781 * x152);
         let x164 = Self::mul_add(
             x159,
-            0.9614610000000001,
+            -0.9614610000000001,
             Self::mul_add(x152, 1.2025609200000003, 0.000781 * x151),
         );
         let x165 = Self::mul_add(
-            1.4135609200000003,
+            -1.4135609200000003,
             x159,
             Self::mul_add(x152, -0.9614610000000001, x151 * 0.0145),
         );
         let x166 = Self::mul_add(
             x158,
             -0.9614610000000001,
-            Self::mul_add(x157, -1.2025609200000003, 0.000781 * x156),
-        ) + Self::mul_add(x151, x165, x159 * x163);
+            Self::mul_add(x157, 1.2025609200000003, 0.000781 * x156),
+        ) - Self::mul_add(-x151, x165, x159 * x163);
         let x167 = Self::mul_add(
             4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x154, x153),
-            Self::mul_add(x158, -0.0145, 0.000781 * x157)
-                + Self::mul_add(x152, x165, x159 * x164),
+            Self::mul_add(0.00000000020510342851533115, x154, x153),
+            Self::mul_add(x158, 0.0145, 0.000781 * x157)
+                + Self::mul_add(-x152, x165, x159 * x164),
         );
         let x168 = Self::mul_add(
             4.806620000000001,
             x155,
             Self::mul_add(
-                1.4135609200000003,
+                -1.4135609200000003,
                 x158,
-                -Self::mul_add(x157, 0.9614610000000001, x156 * 0.0145),
-            ) + Self::mul_add(-x152, x163, x151 * x164),
+                Self::mul_add(x157, -0.9614610000000001, x156 * 0.0145),
+            ) + Self::mul_add(-x151, x164, x152 * x163),
         );
-        let x169 = x162 + Self::mul_add(-x150, x161, x149 * x160);
-        let x170 = Self::mul_add(c_q13, x161, s_q13 * x160);
-        let x171 = Self::mul_add(
+        let x169 = -x168;
+        let x170 = x162 + Self::mul_add(-x150, x161, x149 * x160);
+        let x171 = Self::mul_add(c_q13, x161, s_q13 * x160);
+        let x172 = Self::mul_add(
             -0.00000000020510342851533115,
             x162,
             Self::mul_add(-s_q13, x161, c_q13 * x160),
         );
-        let x172 = Self::mul_add(
+        let x173 = Self::mul_add(
             -0.55,
-            x169,
+            x170,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
                 x168,
-                Self::mul_add(-c_q13, x167, s_q13 * x166),
+                Self::mul_add(s_q13, x166, c_q13 * x167),
             ),
         );
-        let x173 = x169
-            - Self::mul_add(
-                17.135250000000003,
-                x138,
-                3.6140000000000003 * (x135 + x136),
-            );
         let x174 = Self::mul_add(
+            17.135250000000003,
+            x138,
+            3.6140000000000003 * (x135 + x136),
+        ) - x170;
+        let x175 = Self::mul_add(
             -17.135250000000003,
             x141,
             3.6140000000000003 * (x133 - x137),
-        ) - x170;
-        let x175 = Self::mul_add(
+        ) - x171;
+        let x176 = Self::mul_add(
             17.135250000000003,
             x143,
             3.6140000000000003 * (x132 + x139),
-        ) + x171;
-        let x176 = Self::mul_add(
-            17.135250000000003,
+        ) - x172;
+        let x177 = Self::mul_add(
+            -17.135250000000003,
             x130,
-            Self::mul_add(x133, -0.809539999555672, x132 * 1.9877000000000002)
-                - Self::mul_add(x124, x146, x134 * x145),
+            Self::mul_add(x133, 0.809539999555672, x132 * 1.9877000000000002)
+                + Self::mul_add(-x124, x146, x134 * x145),
         )
-            + (x168 + Self::mul_add(-x149, x167, x150 * x166)
-                + Self::mul_add(0.55, x171, 0.16 * x170));
-        let x177 = x147
-            + Self::mul_add(0.16, x169, Self::mul_add(c_q13, x166, s_q13 * x167));
-        let x178 = Self::mul_add(
+            + (x168 - Self::mul_add(x150, x166, x149 * x167)
+                - Self::mul_add(0.55, x172, 0.16 * x171));
+        let x178 = x147
+            - Self::mul_add(-0.16, x170, Self::mul_add(-c_q13, x166, s_q13 * x167));
+        let x179 = Self::mul_add(
             9.740442170000001,
             x133,
-            Self::mul_add(x131, -0.809539999555672, x132 * 2.7416399995923166),
-        ) + Self::mul_add(x123, x145, x124 * x144)
-            - Self::mul_add(3.6140000000000003, x129, 17.135250000000003 * x128) + x172;
-        let x179 = Self::mul_add(-s_q12, x174, c_q12 * x173);
-        let x180 = x175 - Self::mul_add(x122, x174, x121 * x173);
-        let x181 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x103, x104, -x111),
-            x179,
-        );
+            Self::mul_add(x132, -2.7416399995923166, x131 * 0.809539999555672),
+        ) + Self::mul_add(-x123, x145, x124 * x144)
+            + Self::mul_add(3.6140000000000003, x129, 17.135250000000003 * x128) + x173;
+        let x180 = Self::mul_add(s_q12, x175, c_q12 * x174);
+        let x181 = x176 - Self::mul_add(-x122, x175, x121 * x174);
         let x182 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x112, x112, x113),
+            7.078399999258757,
+            Self::mul_add(x103, x104, x111),
             x180,
         );
         let x183 = Self::mul_add(
             7.078399999258757,
-            x109 + x114,
+            Self::mul_add(x112, x112, x113),
+            x181,
+        );
+        let x184 = Self::mul_add(
+            7.078399999258757,
+            x109 - x114,
             -Self::mul_add(
                 0.00000000020510342851533115,
-                x175,
-                Self::mul_add(c_q12, x174, s_q12 * x173),
+                x176,
+                Self::mul_add(-c_q12, x175, s_q12 * x174),
             ),
         );
-        let x184 = x118
-            + Self::mul_add(0.36, x180, Self::mul_add(-s_q12, x177, c_q12 * x176));
-        let x185 = Self::mul_add(x110, -9.142025249762803, 2.5482240016099564 * x111)
-            + Self::mul_add(-x103, x117, x112 * x115)
-            + Self::mul_add(-0.36, x179, x178 - Self::mul_add(x122, x177, x121 * x176));
-        let x186 = x119
+        let x185 = x118
+            - Self::mul_add(0.36, x181, Self::mul_add(s_q12, x178, c_q12 * x177));
+        let x186 = Self::mul_add(-2.5482240016099564, x111, x110 * 9.142025249762803)
+            - Self::mul_add(-x103, x117, x112 * x115)
+            - Self::mul_add(0.36, x180, x179 + Self::mul_add(-x122, x178, x121 * x177));
+        let x187 = x119
             - Self::mul_add(
-                0.00000000020510342851533115,
-                x178,
-                Self::mul_add(c_q12, x177, s_q12 * x176),
+                -0.00000000020510342851533115,
+                x179,
+                Self::mul_add(-c_q12, x178, s_q12 * x177),
             );
-        let x187 = Self::mul_add(-s_q11, x182, c_q11 * x181);
-        let x188 = Self::mul_add(c_q11, x182, s_q11 * x181);
-        let x189 = Self::mul_add(x92, -45.1584, x187);
-        let x190 = Self::mul_add(45.1584, x94, x188);
-        let x191 = Self::mul_add(-45.1584, x96, x183);
-        let x192 = x100
-            + (Self::mul_add(-s_q11, x185, c_q11 * x184)
-                + Self::mul_add(-0.63, x183, 0.275 * x188));
-        let x193 = Self::mul_add(-0.275, x187, Self::mul_add(c_q11, x185, s_q11 * x184))
-            - (Self::mul_add(x90, 24.35164200091464, x89 * 24.4950615)
-                + Self::mul_add(x82, x99, x91 * x97));
-        let x194 = x101 + Self::mul_add(0.63, x187, x186);
-        let x195 = Self::mul_add(-s_q10, x190, c_q10 * x189);
-        let x196 = Self::mul_add(x73, -81.53205, x195);
-        let x197 = Self::mul_add(
+        let x188 = -x187;
+        let x189 = Self::mul_add(-s_q11, x183, c_q11 * x182);
+        let x190 = Self::mul_add(c_q11, x183, s_q11 * x182);
+        let x191 = Self::mul_add(x92, 45.1584, -x189);
+        let x192 = Self::mul_add(45.1584, x94, -x190);
+        let x193 = Self::mul_add(45.1584, x96, -x184);
+        let x194 = x100
+            - (Self::mul_add(s_q11, x186, c_q11 * x185)
+                - Self::mul_add(-0.63, x184, 0.275 * x190));
+        let x195 = Self::mul_add(x90, 24.35164200091464, x89 * 24.4950615)
+            + Self::mul_add(-x82, x99, x91 * x97)
+            - Self::mul_add(0.275, x189, Self::mul_add(-c_q11, x186, s_q11 * x185));
+        let x196 = x101 - Self::mul_add(0.63, x189, x187);
+        let x197 = Self::mul_add(-s_q10, x192, c_q10 * x191);
+        let x198 = Self::mul_add(x73, 81.53205, x197);
+        let x199 = Self::mul_add(
             81.53205,
             x74,
-            Self::mul_add(c_q10, x190, s_q10 * x189),
+            Self::mul_add(c_q10, x192, s_q10 * x191),
         );
-        let x198 = Self::mul_add(-81.53205, x75, x191);
-        let x199 = x79
-            + Self::mul_add(-0.87, x191, Self::mul_add(-s_q10, x193, c_q10 * x192));
-        let x200 = Self::mul_add(c_q10, x193, s_q10 * x192)
-            - (Self::mul_add(x71, 36.18604050126307, x70 * 63.36336825000001)
-                + Self::mul_add(x62, x78, x72 * x76));
-        let x201 = x80 + Self::mul_add(0.87, x195, x194);
-        let x202 = 0.00000000020510342851533115 * x198;
-        let x203 = Self::mul_add(c_q9, x197, s_q9 * x196) + x202;
-        let x204 = x198 + Self::mul_add(-x61, x197, x60 * x196);
-        let x205 = Self::mul_add(-s_q9, x197, c_q9 * x196) - x202;
-        let x206 = 0.00000000020510342851533115 * x201;
-        let x207 = Self::mul_add(
+        let x200 = Self::mul_add(81.53205, x75, x193);
+        let x201 = x79
+            + Self::mul_add(0.87, x193, Self::mul_add(-s_q10, x195, c_q10 * x194));
+        let x202 = Self::mul_add(x71, -36.18604050126307, x70 * 63.36336825000001)
+            - Self::mul_add(-x62, x78, x72 * x76)
+            - Self::mul_add(c_q10, x195, s_q10 * x194);
+        let x203 = x80 + Self::mul_add(0.87, x197, x196);
+        let x204 = 0.00000000020510342851533115 * x200;
+        let x205 = Self::mul_add(c_q9, x199, s_q9 * x198) + x204;
+        let x206 = x200 + Self::mul_add(-x61, x199, x60 * x198);
+        let x207 = x204 - Self::mul_add(-s_q9, x199, c_q9 * x198);
+        let x208 = 0.00000000020510342851533115 * x203;
+        let x209 = Self::mul_add(
             x47,
-            -12.701650001451807,
+            12.701650001451807,
             (x44 + x45) * 0.000000008530897668050218,
-        ) + x203;
-        let x208 = Self::mul_add(
-            -0.000000008530897668050218,
-            x42 + x46,
-            12.701650001451807 * x50,
-        ) + x204;
-        let x209 = x205
-            - Self::mul_add(
-                12.701650001451807,
-                x52,
-                0.000000008530897668050218 * (x48 - x41),
-            );
+        ) + x205;
         let x210 = Self::mul_add(
-            x39,
             -12.701650001451807,
-            Self::mul_add(-x43, x54, x33 * x55)
-                - Self::mul_add(
-                    x42,
-                    0.002139996587640933,
-                    x41 * 0.0000000234896432582596,
-                ),
-        )
-            + (Self::mul_add(c_q9, x200, s_q9 * x199) + x206
-                + Self::mul_add(-0.4, x204, 0.275 * x205));
-        let x211 = x56
-            + Self::mul_add(0.4, x203, x201 + Self::mul_add(-x61, x200, x60 * x199));
+            x50,
+            0.000000008530897668050218 * (x42 - x46),
+        ) - x206;
+        let x211 = Self::mul_add(
+            12.701650001451807,
+            x52,
+            0.000000008530897668050218 * (x41 + x48),
+        ) - x207;
         let x212 = Self::mul_add(
+            x39,
+            12.701650001451807,
+            Self::mul_add(x42, 0.002139996587640933, x41 * 0.0000000234896432582596)
+                + Self::mul_add(-x33, x55, x43 * x54),
+        )
+            + (Self::mul_add(-c_q9, x202, s_q9 * x201) - x208
+                + Self::mul_add(0.275, x207, 0.4 * x206));
+        let x213 = x56
+            + Self::mul_add(0.4, x205, x203 - Self::mul_add(x61, x202, x60 * x201));
+        let x214 = Self::mul_add(
             113.3918902508081,
             x42,
-            Self::mul_add(x40, -0.002139996587640933, 5.080660024070366 * x41),
-        ) + Self::mul_add(x32, x54, x33 * x53)
-            + Self::mul_add(x38, -0.000000008530897668050218, x37 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x203,
-                Self::mul_add(-s_q9, x200, c_q9 * x199) - x206,
-            );
-        let x213 = x209 + Self::mul_add(-x30, x207, x31 * x208);
-        let x214 = Self::mul_add(c_q8, x208, s_q8 * x207);
-        let x215 = Self::mul_add(-48.0240000085309, Self::mul_add(x21, x21, x22), x213);
-        let x216 = Self::mul_add(48.0240000085309, Self::mul_add(x4, x5, x20), x214);
-        let x217 = Self::mul_add(
+            Self::mul_add(5.080660024070366, x41, x40 * 0.002139996587640933),
+        ) + Self::mul_add(-x32, x54, x33 * x53)
+            - Self::mul_add(x38, 0.000000008530897668050218, x37 * 12.701650001451807)
+            - Self::mul_add(0.275, x205, x208 + Self::mul_add(s_q9, x202, c_q9 * x201));
+        let x215 = x211 - Self::mul_add(x31, x210, x30 * x209);
+        let x216 = Self::mul_add(-c_q8, x210, s_q8 * x209);
+        let x217 = Self::mul_add(48.0240000085309, Self::mul_add(x21, x21, x22), -x215);
+        let x218 = Self::mul_add(48.0240000085309, Self::mul_add(-x4, x5, x20), x216);
+        let x219 = Self::mul_add(
             48.0240000085309,
-            x23 - x19,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x209,
-                Self::mul_add(-c_q8, x207, s_q8 * x208),
+            x19 + x23,
+            -Self::mul_add(
+                0.00000000020510342851533115,
+                x211,
+                Self::mul_add(s_q8, x210, c_q8 * x209),
             ),
         );
-        let x218 = Self::mul_add(-x21, x25, x5 * x26)
-            - Self::mul_add(x20, 16.80768997608804, x19 * 0.07309)
-            + Self::mul_add(-0.35, x214, x212 + Self::mul_add(-x30, x210, x31 * x211));
-        let x219 = x27
-            + Self::mul_add(0.35, x213, Self::mul_add(c_q8, x211, s_q8 * x210));
-        let x220 = x28
-            + Self::mul_add(
+        let x220 = Self::mul_add(x20, -16.80768997608804, x19 * 0.07309)
+            + Self::mul_add(x5, x26, x21 * x25)
+            + Self::mul_add(-0.35, x216, x214 + Self::mul_add(x31, x213, x30 * x212));
+        let x221 = x27
+            + Self::mul_add(-0.35, x215, Self::mul_add(-c_q8, x213, s_q8 * x212));
+        let x222 = x28
+            - Self::mul_add(
                 -0.00000000020510342851533115,
-                x212,
-                Self::mul_add(-c_q8, x210, s_q8 * x211),
+                x214,
+                Self::mul_add(s_q8, x213, c_q8 * x212),
             );
-        let x221 = Self::mul_add(-s_q7, x216, c_q7 * x215);
-        let x222 = Self::mul_add(c_q7, x216, s_q7 * x215);
-        let x223 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x224 = 1466.4506062283303 * v[4];
-        let x225 = Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]);
-        let x226 = x221
-            + Self::mul_add(
+        let x223 = -x222;
+        let x224 = Self::mul_add(s_q7, x218, c_q7 * x217);
+        let x225 = Self::mul_add(-c_q7, x218, s_q7 * x217);
+        let x226 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x227 = 1466.4506062283303 * v[4];
+        let x228 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x229 = -(x224
+            - Self::mul_add(
                 1170.07,
                 x0,
-                Self::mul_add(-110.5455, x7, 180.9502499901501 * x9),
-            );
-        let x227 = x222
-            + Self::mul_add(
+                -Self::mul_add(-180.9502499901501, x9, 110.5455 * x7),
+            ));
+        let x230 = -(x225
+            - Self::mul_add(
                 1170.07,
                 x1,
-                Self::mul_add(180.9502499901501, x11, 110.5455 * x10),
-            );
-        let x228 = x217
+                Self::mul_add(-180.9502499901501, x11, 110.5455 * x10),
+            ));
+        let x231 = x219
             + Self::mul_add(
                 1170.07,
                 x2,
-                Self::mul_add(-180.9502499901501, x13, 110.5455 * x12),
+                -Self::mul_add(180.9502499901501, x13, 110.5455 * x12),
             );
-        let x229 = Self::mul_add(-0.75, x222, Self::mul_add(-s_q7, x219, c_q7 * x218))
+        let x232 = Self::mul_add(0.75, x225, Self::mul_add(s_q7, x221, c_q7 * x220))
             + Self::mul_add(
                 -180.9502499901501,
                 x1,
                 Self::mul_add(a[5], -117.61766249359756, 1394.5960312283303 * a[3])
-                    + Self::mul_add(-v[5], x224, v[4] * x225),
+                    - Self::mul_add(v[4], x228, v[5] * x227),
             );
-        let x230 = Self::mul_add(c_q7, x219, s_q7 * x218)
-            + Self::mul_add(-0.65, x217, 0.75 * x221)
+        let x233 = Self::mul_add(-c_q7, x221, s_q7 * x220)
+            - Self::mul_add(0.65, x219, 0.75 * x224)
             + (Self::mul_add(
                 1466.4506062283303,
                 a[4],
-                Self::mul_add(-v[3], x225, v[5] * x223),
+                Self::mul_add(v[3], x228, v[5] * x226),
             ) + Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
-        let x231 = Self::mul_add(0.65, x222, x220)
+        let x234 = -(Self::mul_add(0.65, x225, x222)
             + Self::mul_add(
-                110.5455,
+                -110.5455,
                 x1,
-                Self::mul_add(a[3], -117.61766249359758, 1271.854575 * a[5])
-                    + Self::mul_add(-v[4], x223, v[3] * x224),
-            );
-        [x226, x227, x228, x229, x230, x231, x220, x212, x201, x194, x186, x178, x168]
+                Self::mul_add(-1271.854575, a[5], a[3] * 117.61766249359758)
+                    + Self::mul_add(-v[3], x227, v[4] * x226),
+            ));
+        [x229, x230, x231, x232, x233, x234, x223, x214, x203, x196, x188, x179, x169]
     }
     /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
     ///
@@ -3099,9 +3087,9 @@ impl FreeFloating7 {
             Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         );
         let x2 = Self::mul_add(
-            110.5455,
+            -110.5455,
             v[1],
-            Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]),
+            Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
         );
         let x3 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
         let x4 = Self::mul_add(
@@ -3112,34 +3100,34 @@ impl FreeFloating7 {
         let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x8 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
         let x9 = Self::mul_add(0.75, v[4], v[0]);
         let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x11 = Self::mul_add(-0.65, v[4], v[2]);
         let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
-        let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
+        let x13 = Self::mul_add(-c_q7, x10, s_q7 * x9);
         let x14 = v[6] * x8;
         let x15 = v[6] * x7;
         let x16 = v[6] * x13;
         let x17 = v[6] * x12;
         let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(x18, 16.80768997608804, x8 * 0.07309);
+        let x19 = Self::mul_add(x18, -16.80768997608804, x8 * 0.07309);
         let x20 = Self::mul_add(
-            -48.0240000085309,
+            48.0240000085309,
             x11,
             Self::mul_add(
-                0.1132,
+                -0.1132,
                 x18,
-                Self::mul_add(x7, -0.07309, 130.43769025763282 * x8),
+                Self::mul_add(130.43769025763282, x8, x7 * 0.07309),
             ),
         );
         let x21 = Self::mul_add(
             48.0240000085309,
             x13,
             Self::mul_add(
-                132.47349025763282,
+                -132.47349025763282,
                 x18,
-                Self::mul_add(x7, -16.80768997608804, 0.1132 * x8),
+                Self::mul_add(0.1132, x8, x7 * 16.80768997608804),
             ),
         );
         let x22 = 48.0240000085309 * x18;
@@ -3147,12 +3135,12 @@ impl FreeFloating7 {
         let (s_q8, c_q8) = libm::sincos(q[8]);
         let x25 = 0.00000000020510342851533115 * c_q8;
         let x26 = 0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(-x7, x25, x8 * s_q8));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(x8, c_q8, x7 * x26));
-        let x29 = Self::mul_add(0.35, x8, x12);
-        let x30 = Self::mul_add(-0.35, x7, x13);
-        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(-x25, x29, s_q8 * x30));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(c_q8, x30, x26 * x29));
+        let x27 = Self::mul_add(x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x8, c_q8, x7 * x26));
+        let x29 = Self::mul_add(-0.35, x8, x12);
+        let x30 = Self::mul_add(0.35, x7, x13);
+        let x31 = Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x30, x26 * x29));
         let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
         let x34 = v[7] * x28;
         let x35 = v[7] * x27;
@@ -3170,19 +3158,19 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x38,
-                -Self::mul_add(x28, 111.7548902508081, x27 * 0.0000000234896432582596),
+                Self::mul_add(x28, -111.7548902508081, x27 * 0.0000000234896432582596),
             ),
         );
         let x41 = Self::mul_add(
             113.3918902508081,
             x38,
-            Self::mul_add(x27, -0.002139996587640933, 5.080660024070366 * x28),
-        ) + Self::mul_add(x32, -0.000000008530897668050218, x31 * 12.701650001451807);
+            Self::mul_add(5.080660024070366, x28, x27 * 0.002139996587640933),
+        ) - Self::mul_add(x32, 0.000000008530897668050218, x31 * 12.701650001451807);
         let x42 = x38 * 12.701650001451807;
         let x43 = x38 * 0.000000008530897668050218;
         let x44 = Self::mul_add(
             x28,
-            -0.000000008530897668050218,
+            0.000000008530897668050218,
             x27 * 12.701650001451807,
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
@@ -3190,17 +3178,17 @@ impl FreeFloating7 {
         let x47 = 0.00000000020510342851533115 * s_q9;
         let x48 = x46 - x47;
         let x49 = x46 + x47;
-        let x50 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x48, x27 * s_q9));
-        let x51 = Self::mul_add(-x38, s_q9, Self::mul_add(-x28, x49, x27 * c_q9));
-        let x52 = x31 - Self::mul_add(-0.4, x28, 0.275 * x38);
-        let x53 = Self::mul_add(-0.4, x27, x32);
-        let x54 = Self::mul_add(0.275, x27, x33);
-        let x55 = Self::mul_add(c_q9, x54, Self::mul_add(x48, x53, s_q9 * x52));
-        let x56 = Self::mul_add(-s_q9, x54, Self::mul_add(-x49, x53, c_q9 * x52));
+        let x50 = Self::mul_add(-x38, c_q9, Self::mul_add(-x28, x48, x27 * s_q9));
+        let x51 = Self::mul_add(x38, s_q9, Self::mul_add(x28, x49, x27 * c_q9));
+        let x52 = x31 - Self::mul_add(-0.275, x38, 0.4 * x28);
+        let x53 = Self::mul_add(0.4, x27, x32);
+        let x54 = Self::mul_add(-0.275, x27, x33);
+        let x55 = Self::mul_add(-c_q9, x54, Self::mul_add(-x48, x53, s_q9 * x52));
+        let x56 = Self::mul_add(s_q9, x54, Self::mul_add(x49, x53, c_q9 * x52));
         let x57 = Self::mul_add(
             -0.00000000020510342851533115,
             x54,
-            Self::mul_add(0.00000000020510342851533115, x52, x53),
+            Self::mul_add(-0.00000000020510342851533115, x52, x53),
         );
         let x58 = v[8] * x51;
         let x59 = v[8] * x50;
@@ -3210,28 +3198,28 @@ impl FreeFloating7 {
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x38,
-                Self::mul_add(0.00000000020510342851533115, x27, x28),
+                Self::mul_add(-0.00000000020510342851533115, x27, x28),
             );
-        let x63 = Self::mul_add(x62, 36.18604050126307, x51 * 63.36336825000001);
+        let x63 = Self::mul_add(x62, -36.18604050126307, x51 * 63.36336825000001);
         let x64 = Self::mul_add(x57, 81.53205, x62 * 0.00214);
         let x65 = Self::mul_add(
             x55,
-            81.53205,
+            -81.53205,
             Self::mul_add(
                 69.99836825,
                 x62,
-                -Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
+                Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
             ),
         );
         let x66 = x62 * 81.53205;
         let x67 = x50 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
-        let x70 = Self::mul_add(-x50, s_q10, x51 * c_q10);
-        let x71 = Self::mul_add(x62, 0.87, x55);
-        let x72 = Self::mul_add(x50, -0.87, x57);
+        let x70 = Self::mul_add(-x51, c_q10, x50 * s_q10);
+        let x71 = Self::mul_add(x62, -0.87, x55);
+        let x72 = Self::mul_add(x50, 0.87, x57);
         let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
-        let x74 = Self::mul_add(-s_q10, x71, x56 * c_q10);
+        let x74 = Self::mul_add(-x56, c_q10, s_q10 * x71);
         let x75 = v[9] * x70;
         let x76 = v[9] * x69;
         let x77 = v[9] * x74;
@@ -3241,37 +3229,37 @@ impl FreeFloating7 {
         let x81 = Self::mul_add(x72, 45.1584, x79 * 0.6328);
         let x82 = Self::mul_add(
             x73,
-            45.1584,
+            -45.1584,
             Self::mul_add(
                 28.2393615,
                 x79,
-                -Self::mul_add(x70, 24.351642000914637, x69 * 0.6328),
+                Self::mul_add(x70, -24.351642000914637, x69 * 0.6328),
             ),
         );
         let x83 = x79 * 45.1584;
         let x84 = x69 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x86 = Self::mul_add(x70, s_q11, x69 * c_q11);
-        let x87 = Self::mul_add(-x69, s_q11, x70 * c_q11);
-        let x88 = x73 - Self::mul_add(x79, -0.63, 0.275 * x70);
-        let x89 = Self::mul_add(0.275, x69, x74);
-        let x90 = Self::mul_add(x69, -0.63, x72);
-        let x91 = Self::mul_add(s_q11, x89, c_q11 * x88);
-        let x92 = Self::mul_add(-s_q11, x88, c_q11 * x89);
+        let x86 = Self::mul_add(-x70, s_q11, x69 * c_q11);
+        let x87 = Self::mul_add(x70, c_q11, x69 * s_q11);
+        let x88 = x73 + Self::mul_add(x79, -0.63, 0.275 * x70);
+        let x89 = Self::mul_add(-0.275, x69, x74);
+        let x90 = Self::mul_add(x69, 0.63, x72);
+        let x91 = Self::mul_add(-s_q11, x89, c_q11 * x88);
+        let x92 = Self::mul_add(c_q11, x89, s_q11 * x88);
         let x93 = v[10] * x87;
         let x94 = v[10] * x86;
         let x95 = v[10] * x92;
         let x96 = v[10] * x91;
         let x97 = v[10] + x79;
-        let x98 = Self::mul_add(x87, -9.142025249762803, 2.5482240016099564 * x97);
+        let x98 = Self::mul_add(-2.5482240016099564, x97, x87 * 9.142025249762803);
         let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
         let x100 = Self::mul_add(
             -7.078399999258757,
             x91,
             Self::mul_add(
-                9.223235249762805,
+                -9.223235249762805,
                 x97,
-                Self::mul_add(2.5482240016099564, x87, 0.01675 * x86),
+                Self::mul_add(-2.5482240016099564, x87, 0.01675 * x86),
             ),
         );
         let x101 = 7.078399999258757 * x97;
@@ -3279,12 +3267,12 @@ impl FreeFloating7 {
         let (s_q12, c_q12) = libm::sincos(q[12]);
         let x104 = 0.00000000020510342851533115 * s_q12;
         let x105 = 0.00000000020510342851533115 * c_q12;
-        let x106 = Self::mul_add(-x97, s_q12, Self::mul_add(-x87, x104, x86 * c_q12));
-        let x107 = Self::mul_add(x97, c_q12, Self::mul_add(x87, x105, x86 * s_q12));
-        let x108 = Self::mul_add(x87, -0.36, x91);
-        let x109 = Self::mul_add(x86, 0.36, x92);
-        let x110 = Self::mul_add(-x90, s_q12, Self::mul_add(-x104, x109, c_q12 * x108));
-        let x111 = Self::mul_add(x90, c_q12, Self::mul_add(x105, x109, s_q12 * x108));
+        let x106 = Self::mul_add(x97, s_q12, Self::mul_add(x87, x104, x86 * c_q12));
+        let x107 = Self::mul_add(-x97, c_q12, Self::mul_add(-x87, x105, x86 * s_q12));
+        let x108 = Self::mul_add(x87, 0.36, x91);
+        let x109 = Self::mul_add(x86, -0.36, x92);
+        let x110 = Self::mul_add(x90, s_q12, Self::mul_add(x104, x109, c_q12 * x108));
+        let x111 = Self::mul_add(-x90, c_q12, Self::mul_add(-x105, x109, s_q12 * x108));
         let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
         let x113 = v[11] * x107;
         let x114 = v[11] * x106;
@@ -3292,9 +3280,9 @@ impl FreeFloating7 {
         let x116 = v[11] * x110;
         let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
         let x118 = Self::mul_add(
-            17.135250000000003,
+            -17.135250000000003,
             x112,
-            Self::mul_add(x117, -0.809539999555672, x107 * 1.9877000000000002),
+            Self::mul_add(x117, 0.809539999555672, x107 * 1.9877000000000002),
         );
         let x119 = Self::mul_add(
             -3.6140000000000003,
@@ -3302,60 +3290,60 @@ impl FreeFloating7 {
             Self::mul_add(
                 x117,
                 -2.741639999592316,
-                Self::mul_add(x106, -1.9877000000000002, x107 * 5.252920330000002),
+                Self::mul_add(x107, -5.252920330000002, x106 * 1.9877000000000002),
             ),
         );
         let x120 = Self::mul_add(
             9.740442170000001,
             x117,
-            Self::mul_add(x106, -0.809539999555672, x107 * 2.7416399995923166),
-        ) - Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
+            Self::mul_add(x107, -2.7416399995923166, x106 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
         let x121 = 17.135250000000003 * x117;
         let x122 = 3.6140000000000003 * x117;
         let x123 = Self::mul_add(3.6140000000000003, x107, 17.135250000000003 * x106);
         let (s_q13, c_q13) = libm::sincos(q[13]);
         let x125 = 0.00000000020510342851533115 * c_q13;
         let x126 = 0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
-        let x128 = Self::mul_add(x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
-        let x129 = x110 - Self::mul_add(0.55, x117, 0.16 * x107);
+        let x127 = Self::mul_add(-x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
+        let x128 = Self::mul_add(-x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
+        let x129 = x110 - Self::mul_add(-0.55, x117, 0.16 * x107);
         let x130 = Self::mul_add(0.16, x106, x111);
-        let x131 = Self::mul_add(0.55, x106, x112);
-        let x132 = Self::mul_add(c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
-        let x133 = Self::mul_add(s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
-        let x134 = Self::mul_add(-0.00000000020510342851533115, x131, x129);
+        let x131 = Self::mul_add(-0.55, x106, x112);
+        let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
+        let x133 = Self::mul_add(-s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
+        let x134 = Self::mul_add(0.00000000020510342851533115, x131, x129);
         let x135 = v[12] * x128;
         let x136 = v[12] * x127;
         let x137 = v[12] * x133;
-        let x138 = v[12] + Self::mul_add(-0.00000000020510342851533115, x117, x106);
+        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x117, x106);
         let x139 = Self::mul_add(
             x138,
-            0.9614610000000001,
+            -0.9614610000000001,
             Self::mul_add(x128, 1.2025609200000003, 0.000781 * x127),
         );
         let x140 = Self::mul_add(
             4.806620000000001,
             x134,
-            Self::mul_add(x138, -0.0145, 0.000781 * x128),
+            Self::mul_add(x138, 0.0145, 0.000781 * x128),
         );
         let x141 = Self::mul_add(
             4.806620000000001,
             x132,
             Self::mul_add(
-                1.4135609200000003,
+                -1.4135609200000003,
                 x138,
                 Self::mul_add(x128, -0.9614610000000001, x127 * 0.0145),
             ),
         );
         let x142 = 4.806620000000001 * x138;
         let x143 = 4.806620000000001 * x127;
-        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x128, x140, x127 * x139));
+        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x127, x139, x128 * x140));
         let x145 = Self::mul_add(x127, x143, x138 * x142);
-        let x146 = tau[6] - x144;
+        let x146 = tau[6] + x144;
         let x147 = Self::mul_add(
             x128,
             x143,
-            Self::mul_add(
+            -Self::mul_add(
                 x137,
                 16.344251950881606,
                 Self::mul_add(x136, 3.2693162398830324, x135 * 0.049305260929256585),
@@ -3364,8 +3352,8 @@ impl FreeFloating7 {
         let x148 = Self::mul_add(4.806620000000001, x135, x128 * x142);
         let x149 = Self::mul_add(
             x146,
-            -0.010257782169020348,
-            Self::mul_add(-x133, x143, Self::mul_add(x128, x141, x138 * x139))
+            0.010257782169020348,
+            Self::mul_add(x133, x143, Self::mul_add(-x128, x141, x138 * x139))
                 - Self::mul_add(
                     x137,
                     0.049305260929256585,
@@ -3378,16 +3366,16 @@ impl FreeFloating7 {
         );
         let x150 = Self::mul_add(
             x146,
-            -0.6801694828971361,
-            Self::mul_add(x127, x141, x138 * x140)
-                - Self::mul_add(x132, x143, x134 * x142)
+            0.6801694828971361,
+            Self::mul_add(-x127, x141, x138 * x140)
+                - Self::mul_add(-x132, x143, x134 * x142)
                 - Self::mul_add(
                     x137,
                     3.2693162398830324,
                     Self::mul_add(x136, 1.8565173511957638, x135 * 0.009081457502008472),
                 ),
         );
-        let x151 = x144 + x146;
+        let x151 = x144 - x146;
         let x152 = Self::mul_add(x146, 3.4003628227073506, x147);
         let x153 = c_q13 * 0.009081457502008472;
         let x154 = Self::mul_add(s_q13, 0.00014873784145079505, x153);
@@ -3405,11 +3393,11 @@ impl FreeFloating7 {
         let x162 = x125 * 3.2693162398830324;
         let x163 = s_q13 * 3.2693162398830324;
         let x164 = c_q13 * 3.2693162398830324;
-        let x165 = Self::mul_add(-x125, x159, x126 * x162);
+        let x165 = Self::mul_add(-x126, x162, x125 * x159);
         let x166 = Self::mul_add(-x126, x163, x125 * x160);
-        let x167 = Self::mul_add(-x125, x161, x126 * x164);
+        let x167 = Self::mul_add(-x126, x164, x125 * x161);
         let x168 = Self::mul_add(c_q13, x162, s_q13 * x159);
-        let x169 = Self::mul_add(-c_q13, x159, s_q13 * x162);
+        let x169 = Self::mul_add(-s_q13, x162, c_q13 * x159);
         let x170 = s_q13 * 16.344251950881606;
         let x171 = c_q13 * 16.344251950881606;
         let x172 = x125 * (x125 * 16.344251950881606);
@@ -3421,57 +3409,57 @@ impl FreeFloating7 {
         let x178 = 0.16 * x173;
         let x179 = 0.55 * x174;
         let x180 = x166 + Self::mul_add(0.55, x176, 0.16 * x175);
-        let x181 = x167 - Self::mul_add(0.55, x177, 0.16 * x176);
+        let x181 = x167 + Self::mul_add(0.55, x177, 0.16 * x176);
         let x182 = Self::mul_add(-0.16, x172, x168);
-        let x183 = x178 - Self::mul_add(c_q13, x163, s_q13 * x160);
+        let x183 = Self::mul_add(c_q13, x163, s_q13 * x160) - x178;
         let x184 = Self::mul_add(-0.16, x174, Self::mul_add(c_q13, x164, s_q13 * x161));
-        let x185 = Self::mul_add(0.55, x172, x169);
+        let x185 = Self::mul_add(-0.55, x172, x169);
         let x186 = Self::mul_add(-0.55, x173, Self::mul_add(-s_q13, x163, c_q13 * x160));
-        let x187 = Self::mul_add(-c_q13, x161, s_q13 * x164) + x179;
+        let x187 = Self::mul_add(-s_q13, x164, c_q13 * x161) - x179;
         let x188 = Self::mul_add(
             0.16,
             x168,
-            Self::mul_add(0.16, x182, -Self::mul_add(c_q13, x157, s_q13 * x154)),
+            -Self::mul_add(-0.16, x182, Self::mul_add(c_q13, x157, s_q13 * x154)),
         );
         let x189 = Self::mul_add(
-            -0.55,
+            0.55,
             x168,
-            Self::mul_add(0.16, x185, Self::mul_add(c_q13, x158, s_q13 * x156)),
+            -Self::mul_add(-0.16, x185, Self::mul_add(c_q13, x158, s_q13 * x156)),
         );
         let x190 = Self::mul_add(
-            -0.55,
+            0.55,
             x169,
-            Self::mul_add(-0.55, x185, Self::mul_add(-c_q13, x156, s_q13 * x158)),
+            -Self::mul_add(-0.55, x185, Self::mul_add(-s_q13, x158, c_q13 * x156)),
         );
-        let x191 = x148 + Self::mul_add(-x126, x145, x125 * x152);
+        let x191 = x148 - Self::mul_add(-x126, x145, x125 * x152);
         let x192 = Self::mul_add(c_q13, x145, s_q13 * x152);
         let x193 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x148,
             Self::mul_add(-s_q13, x145, c_q13 * x152),
         );
         let x194 = Self::mul_add(
-            -0.55,
+            0.55,
             x191,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
                 x151,
-                Self::mul_add(-c_q13, x149, s_q13 * x150),
+                Self::mul_add(-s_q13, x150, c_q13 * x149),
             ),
         );
         let x195 = -0.809539999555672
             + Self::mul_add(
-                -0.55,
+                0.55,
                 x165,
-                Self::mul_add(-x125, x156, x126 * x158)
-                    + Self::mul_add(-0.16, x186, 0.55 * x187),
+                -(Self::mul_add(-x126, x158, x125 * x156)
+                    + Self::mul_add(0.55, x187, 0.16 * x186)),
             );
-        let x196 = -2.741639999592316 + x189;
+        let x196 = -2.741639999592316 - x189;
         let x197 = 9.740442170000001 + x190;
-        let x198 = -17.135250000000003 + x185;
+        let x198 = -17.135250000000003 - x185;
         let x199 = 3.6140000000000003 + x186;
-        let x200 = Self::mul_add(x106, x119, x107 * x118)
-            + Self::mul_add(-x111, x121, x110 * x122) + x194;
+        let x200 = Self::mul_add(-x106, x119, x107 * x118)
+            + Self::mul_add(-x110, x122, x111 * x121) + x194;
         let x201 = 1.0 / x197;
         let x202 = tau[5] - x200;
         let x203 = x195 * x201;
@@ -3480,128 +3468,128 @@ impl FreeFloating7 {
         let x206 = x199 * x201;
         let x207 = x187 * x201;
         let x208 = Self::mul_add(
-            -x195,
+            x195,
             x203,
-            Self::mul_add(-0.16, x166, 0.55 * x167)
+            Self::mul_add(0.55, x167, 0.16 * x166)
                 + (Self::mul_add(
-                    -x125,
+                    -x126,
                     Self::mul_add(
                         x126,
-                        -0.009081457502008472,
-                        x125 * 0.00014873784145079505,
+                        -1.8565173511957638,
+                        x125 * 0.009081457502008472,
                     ),
-                    x126
+                    x125
                         * Self::mul_add(
                             x126,
-                            -1.8565173511957638,
-                            x125 * 0.009081457502008472,
+                            -0.009081457502008472,
+                            x125 * 0.00014873784145079505,
                         ),
-                ) + Self::mul_add(-0.16, x180, 0.55 * x181)),
+                ) + Self::mul_add(0.55, x181, 0.16 * x180)),
         );
         let x209 = Self::mul_add(
             -x195,
             x204,
             -1.9877000000000002
-                + Self::mul_add(
+                - Self::mul_add(
                     0.16,
                     x165,
-                    Self::mul_add(-x126, x157, x125 * x154)
-                        + Self::mul_add(-0.16, x183, 0.55 * x184),
+                    -(Self::mul_add(-x126, x157, x125 * x154)
+                        + Self::mul_add(0.55, x184, 0.16 * x183)),
                 ),
         );
         let x210 = Self::mul_add(-x196, x204, -5.252920330000002 + x188);
-        let x211 = Self::mul_add(-x195, x205, x165 - (x178 + x179));
+        let x211 = Self::mul_add(x195, x205, x165 + (x178 + x179));
         let x212 = Self::mul_add(-x195, x206, x180);
-        let x213 = Self::mul_add(-x195, x207, 17.135250000000003 + x181);
+        let x213 = Self::mul_add(x195, x207, 17.135250000000003 - x181);
         let x214 = Self::mul_add(-x196, x205, x182);
-        let x215 = Self::mul_add(-x196, x206, x183);
-        let x216 = Self::mul_add(-x196, x207, -3.6140000000000003 + x184);
+        let x215 = Self::mul_add(x196, x206, x183);
+        let x216 = Self::mul_add(x196, x207, -3.6140000000000003 + x184);
         let x217 = Self::mul_add(x198, x205, x172);
         let x218 = Self::mul_add(-x198, x206, x173);
-        let x219 = Self::mul_add(x198, x207, x174);
+        let x219 = Self::mul_add(-x198, x207, x174);
         let x220 = Self::mul_add(x199, x206, x175);
-        let x221 = Self::mul_add(-x199, x207, x176);
+        let x221 = Self::mul_add(x199, x207, x176);
         let x222 = Self::mul_add(x187, x207, x177);
         let x223 = Self::mul_add(
-            x202,
+            -x202,
             x203,
-            x151 + Self::mul_add(-x125, x149, x126 * x150)
-                + Self::mul_add(0.55, x193, 0.16 * x192)
-                - (Self::mul_add(x107, x120, x117 * x119)
-                    + Self::mul_add(x111, x123, x112 * x122))
-                - (Self::mul_add(x114, x209, x113 * x208)
-                    + Self::mul_add(x116, x212, x115 * x211)),
+            Self::mul_add(-x107, x120, x117 * x119)
+                + Self::mul_add(x111, x123, x112 * x122)
+                + (x151 - Self::mul_add(-x126, x150, x125 * x149)
+                    - Self::mul_add(0.55, x193, 0.16 * x192))
+                + (Self::mul_add(-x114, x209, x113 * x208)
+                    + Self::mul_add(-x116, x212, x115 * x211)),
         );
         let x224 = Self::mul_add(
-            x202,
+            -x202,
             x204,
             Self::mul_add(-x106, x120, x117 * x118)
-                - Self::mul_add(x110, x123, x112 * x121)
+                + Self::mul_add(x110, x123, x112 * x121)
                 + Self::mul_add(0.16, x191, Self::mul_add(c_q13, x150, s_q13 * x149))
                 - (Self::mul_add(x114, x210, x113 * x209)
-                    + Self::mul_add(x116, x215, x115 * x214)),
+                    + Self::mul_add(-x116, x215, x115 * x214)),
         );
         let x225 = Self::mul_add(x202, x197 * x201, x200);
         let x226 = Self::mul_add(
-            x202,
+            -x202,
             x205,
-            x191 - Self::mul_add(x107, x123, x117 * x122)
-                + (Self::mul_add(-x116, x218, x115 * x217)
-                    - Self::mul_add(x114, x214, x113 * x211)),
+            Self::mul_add(x107, x123, x117 * x122) + x191
+                + (Self::mul_add(-x114, x214, x113 * x211)
+                    + Self::mul_add(-x116, x218, x115 * x217)),
         );
         let x227 = Self::mul_add(
-            x202,
+            -x202,
             x206,
-            Self::mul_add(-x115, x218, x116 * x220)
-                - Self::mul_add(x114, x215, x113 * x212)
-                - (Self::mul_add(x106, x123, x117 * x121) + x192),
+            Self::mul_add(x106, x123, x117 * x121) + x192
+                - (Self::mul_add(-x114, x215, x113 * x212)
+                    + Self::mul_add(-x116, x220, x115 * x218)),
         );
         let x228 = Self::mul_add(
-            x202,
+            -x202,
             x207,
-            Self::mul_add(-x107, x121, x106 * x122) + x193
-                + (Self::mul_add(-x116, x221, x115 * x219)
-                    - Self::mul_add(x114, x216, x113 * x213)),
+            Self::mul_add(-x106, x122, x107 * x121) + x193
+                + (Self::mul_add(x114, x216, x113 * x213)
+                    - Self::mul_add(-x116, x221, x115 * x219)),
         );
         let x229 = s_q12 * x209;
-        let x230 = Self::mul_add(x105, x209, x104 * x208);
+        let x230 = Self::mul_add(-x105, x209, x104 * x208);
         let x231 = c_q12 * x209;
-        let x232 = Self::mul_add(s_q12, x208, x231);
+        let x232 = Self::mul_add(s_q12, x208, -x231);
         let x233 = Self::mul_add(x105, x210, x104 * x209);
         let x234 = Self::mul_add(c_q12, x210, x229);
-        let x235 = Self::mul_add(-s_q12, x212, c_q12 * x211);
-        let x236 = x213 - Self::mul_add(x105, x212, x104 * x211);
+        let x235 = Self::mul_add(s_q12, x212, c_q12 * x211);
+        let x236 = x213 + Self::mul_add(-x105, x212, x104 * x211);
         let x237 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.00000000020510342851533115,
             x213,
-            Self::mul_add(c_q12, x212, s_q12 * x211),
+            Self::mul_add(-c_q12, x212, s_q12 * x211),
         );
-        let x238 = Self::mul_add(-s_q12, x215, c_q12 * x214);
-        let x239 = x216 - Self::mul_add(x105, x215, x104 * x214);
+        let x238 = Self::mul_add(s_q12, x215, c_q12 * x214);
+        let x239 = x216 - Self::mul_add(-x105, x215, x104 * x214);
         let x240 = Self::mul_add(
             0.00000000020510342851533115,
             x216,
-            Self::mul_add(c_q12, x215, s_q12 * x214),
+            Self::mul_add(-c_q12, x215, s_q12 * x214),
         );
-        let x241 = Self::mul_add(-s_q12, x238, c_q12 * x235);
+        let x241 = Self::mul_add(s_q12, x238, c_q12 * x235);
         let x242 = Self::mul_add(-s_q12, x239, c_q12 * x236);
-        let x243 = Self::mul_add(x105, x238, x104 * x235);
-        let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
+        let x243 = Self::mul_add(-x105, x238, x104 * x235);
+        let x244 = Self::mul_add(-c_q12, x238, s_q12 * x235);
         let x245 = Self::mul_add(c_q12, x239, s_q12 * x236);
-        let x246 = Self::mul_add(c_q12, x240, s_q12 * x237);
+        let x246 = Self::mul_add(-c_q12, x240, s_q12 * x237);
         let x247 = s_q12 * x218;
-        let x248 = Self::mul_add(-x105, x218, x104 * x217) - x219;
+        let x248 = x219 - Self::mul_add(-x105, x218, x104 * x217);
         let x249 = c_q12 * x218;
         let x250 = Self::mul_add(
             0.00000000020510342851533115,
             x219,
             Self::mul_add(s_q12, x217, -x249),
         );
-        let x251 = x221 + Self::mul_add(-x104, x218, x105 * x220);
+        let x251 = x221 - Self::mul_add(-x105, x220, x104 * x218);
         let x252 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x221,
-            Self::mul_add(c_q12, x220, -x247),
+            Self::mul_add(-c_q12, x220, x247),
         );
         let x253 = Self::mul_add(
             0.00000000020510342851533115,
@@ -3613,159 +3601,159 @@ impl FreeFloating7 {
             Self::mul_add(s_q12, x220, x249),
             c_q12 * Self::mul_add(c_q12, x217, x247),
         );
-        let x255 = Self::mul_add(-s_q12, x251, c_q12 * x248);
-        let x256 = Self::mul_add(-s_q12, x252, c_q12 * x250);
-        let x257 = Self::mul_add(-x105, x221, x104 * x219) - x222
-            - Self::mul_add(x105, x251, x104 * x248);
-        let x258 = x253 - Self::mul_add(x105, x252, x104 * x250);
+        let x255 = Self::mul_add(s_q12, x251, c_q12 * x248);
+        let x256 = Self::mul_add(s_q12, x252, c_q12 * x250);
+        let x257 = x222 - Self::mul_add(-x105, x221, x104 * x219)
+            - Self::mul_add(-x105, x251, x104 * x248);
+        let x258 = x253 - Self::mul_add(-x105, x252, x104 * x250);
         let x259 = 0.36 * x255;
-        let x260 = Self::mul_add(0.36, x257, x242);
-        let x261 = Self::mul_add(0.36, x254, -x243);
-        let x262 = Self::mul_add(x105, x239, x104 * x236) + x259;
+        let x260 = Self::mul_add(-0.36, x257, x242);
+        let x261 = Self::mul_add(0.36, x254, x243);
+        let x262 = Self::mul_add(x105, x239, x104 * x236) - x259;
         let x263 = Self::mul_add(
-            0.36,
+            -0.36,
             x260,
             Self::mul_add(
-                -s_q12,
+                s_q12,
                 Self::mul_add(-s_q12, x210, x231),
-                c_q12 * Self::mul_add(c_q12, x208, -x229),
+                c_q12 * Self::mul_add(c_q12, x208, x229),
             ),
         );
         let x264 = Self::mul_add(
-            -0.36,
+            0.36,
             x241,
-            Self::mul_add(-0.36, x262, Self::mul_add(-c_q12, x230, s_q12 * x233)),
+            Self::mul_add(-0.36, x262, Self::mul_add(s_q12, x233, c_q12 * x230)),
         );
         let x265 = Self::mul_add(
             0.36,
             x243,
-            Self::mul_add(-0.36, x261, Self::mul_add(x105, x233, x104 * x230)),
+            Self::mul_add(0.36, x261, Self::mul_add(-x105, x233, x104 * x230)),
         );
         let x266 = Self::mul_add(-s_q12, x227, c_q12 * x226);
-        let x267 = x228 - Self::mul_add(x105, x227, x104 * x226);
+        let x267 = x228 + Self::mul_add(x105, x227, x104 * x226);
         let x268 = 0.01675
-            + Self::mul_add(-0.36, x245, Self::mul_add(-c_q12, x232, s_q12 * x234));
+            + Self::mul_add(-0.36, x245, Self::mul_add(s_q12, x234, c_q12 * x232));
         let x269 = 2.5482240016099564
-            + Self::mul_add(0.36, x244, Self::mul_add(x105, x234, x104 * x232));
-        let x270 = 9.223235249762805 + Self::mul_add(c_q12, x234, s_q12 * x232);
-        let x271 = -7.078399999258757 - x244;
-        let x272 = Self::mul_add(x92, x101, Self::mul_add(-x87, x99, x86 * x98))
+            - Self::mul_add(0.36, x244, Self::mul_add(-x105, x234, x104 * x232));
+        let x270 = 9.223235249762805 - Self::mul_add(-c_q12, x234, s_q12 * x232);
+        let x271 = -7.078399999258757 + x244;
+        let x272 = Self::mul_add(-x92, x101, Self::mul_add(-x86, x98, x87 * x99))
             - Self::mul_add(
-                0.00000000020510342851533115,
+                -0.00000000020510342851533115,
                 x225,
                 Self::mul_add(c_q12, x224, s_q12 * x223),
             );
         let x273 = Self::mul_add(
             x87,
             x101,
-            -Self::mul_add(
-                0.00000000020510342851533115,
+            Self::mul_add(
+                -0.00000000020510342851533115,
                 x228,
                 Self::mul_add(c_q12, x227, s_q12 * x226),
             ),
         );
         let x274 = 1.0 / x270;
-        let x275 = tau[4] - x272;
+        let x275 = tau[4] + x272;
         let x276 = x268 * x274;
         let x277 = x269 * x274;
         let x278 = x271 * x274;
         let x279 = x245 * x274;
         let x280 = x246 * x274;
-        let x281 = Self::mul_add(-x268, x276, Self::mul_add(0.36, x242, x263));
+        let x281 = Self::mul_add(-x268, x276, Self::mul_add(0.36, x242, -x263));
         let x282 = Self::mul_add(-x268, x277, x264);
-        let x283 = Self::mul_add(-x269, x277, -9.142025249762803 + x265);
-        let x284 = Self::mul_add(-x268, x278, x241 + x259);
+        let x283 = Self::mul_add(-x269, x277, -9.142025249762803 - x265);
+        let x284 = Self::mul_add(x268, x278, x241 + x259);
         let x285 = Self::mul_add(x268, x279, x260);
         let x286 = Self::mul_add(
-            -x268,
+            x268,
             x280,
             7.078399999258757
-                + Self::mul_add(0.36, x258, Self::mul_add(-c_q12, x237, s_q12 * x240)),
+                + Self::mul_add(0.36, x258, Self::mul_add(s_q12, x240, c_q12 * x237)),
         );
         let x287 = Self::mul_add(-x269, x278, x261);
-        let x288 = Self::mul_add(x269, x279, -x262);
+        let x288 = Self::mul_add(-x269, x279, x262);
         let x289 = Self::mul_add(
             -x269,
             x280,
-            Self::mul_add(-0.36, x256, Self::mul_add(x105, x240, x104 * x237)),
+            Self::mul_add(0.36, x256, Self::mul_add(-x105, x240, x104 * x237)),
         );
         let x290 = Self::mul_add(x271, x278, x254);
-        let x291 = Self::mul_add(x271, x279, x255);
-        let x292 = Self::mul_add(-x271, x280, x256);
-        let x293 = Self::mul_add(-x245, x279, x257);
-        let x294 = Self::mul_add(x245, x280, x258);
+        let x291 = Self::mul_add(-x271, x279, x255);
+        let x292 = Self::mul_add(x271, x280, x256);
+        let x293 = Self::mul_add(x245, x279, x257);
+        let x294 = Self::mul_add(-x245, x280, x258);
         let x295 = Self::mul_add(
             x246,
             x280,
             Self::mul_add(
                 0.00000000020510342851533115,
                 x253,
-                Self::mul_add(c_q12, x252, s_q12 * x250),
+                Self::mul_add(-c_q12, x252, s_q12 * x250),
             ),
         );
         let x296 = Self::mul_add(
             x275,
             x276,
-            Self::mul_add(x92, x102, Self::mul_add(-x97, x98, x87 * x100))
-                + Self::mul_add(0.36, x267, Self::mul_add(-s_q12, x224, c_q12 * x223))
-                + (Self::mul_add(-x94, x282, x93 * x281)
-                    + Self::mul_add(-x96, x285, x95 * x284)),
+            Self::mul_add(-x92, x102, Self::mul_add(-x87, x100, x97 * x98))
+                - Self::mul_add(-0.36, x267, Self::mul_add(-s_q12, x224, c_q12 * x223))
+                + (Self::mul_add(x94, x282, x93 * x281)
+                    - Self::mul_add(-x96, x285, x95 * x284)),
         );
         let x297 = Self::mul_add(
             x275,
             x277,
             Self::mul_add(-x86, x100, x97 * x99) - Self::mul_add(x91, x102, x90 * x101)
                 + Self::mul_add(
-                    -0.36,
+                    0.36,
                     x266,
-                    x225 - Self::mul_add(x105, x224, x104 * x223),
+                    x225 + Self::mul_add(x105, x224, x104 * x223),
                 )
-                + (Self::mul_add(-x94, x283, x93 * x282)
+                + (Self::mul_add(x94, x283, x93 * x282)
                     + Self::mul_add(-x96, x288, x95 * x287)),
         );
         let x298 = Self::mul_add(
-            x275,
+            -x275,
             x278,
             Self::mul_add(x87, x102, x266)
                 + (Self::mul_add(-x94, x287, x93 * x284)
-                    - Self::mul_add(x96, x291, x95 * x290)),
+                    + Self::mul_add(x96, x291, x95 * x290)),
         );
         let x299 = Self::mul_add(
-            -x275,
+            x275,
             x279,
-            x267 - Self::mul_add(x86, x102, x97 * x101)
-                + (Self::mul_add(-x94, x288, x93 * x285)
-                    + Self::mul_add(-x96, x293, x95 * x291)),
+            Self::mul_add(x86, x102, x97 * x101) - x267
+                - (Self::mul_add(-x94, x288, x93 * x285)
+                    - Self::mul_add(x96, x293, x95 * x291)),
         );
         let x300 = Self::mul_add(
-            x275,
+            -x275,
             x280,
             x273
                 + (Self::mul_add(-x94, x289, x93 * x286)
-                    + Self::mul_add(-x96, x294, x95 * x292)),
+                    + Self::mul_add(x96, x294, x95 * x292)),
         );
         let x301 = s_q11 * x282;
         let x302 = c_q11 * x282;
         let x303 = Self::mul_add(s_q11, x281, x302);
         let x304 = Self::mul_add(c_q11, x283, x301);
-        let x305 = Self::mul_add(-s_q11, x285, c_q11 * x284);
-        let x306 = Self::mul_add(c_q11, x285, s_q11 * x284);
-        let x307 = Self::mul_add(-s_q11, x288, c_q11 * x287);
-        let x308 = Self::mul_add(c_q11, x288, s_q11 * x287);
-        let x309 = Self::mul_add(-s_q11, x307, c_q11 * x305);
-        let x310 = Self::mul_add(-s_q11, x308, c_q11 * x306);
-        let x311 = Self::mul_add(-s_q11, x289, c_q11 * x286);
-        let x312 = Self::mul_add(c_q11, x307, s_q11 * x305);
+        let x305 = Self::mul_add(s_q11, x285, c_q11 * x284);
+        let x306 = Self::mul_add(-c_q11, x285, s_q11 * x284);
+        let x307 = Self::mul_add(s_q11, x288, c_q11 * x287);
+        let x308 = Self::mul_add(-c_q11, x288, s_q11 * x287);
+        let x309 = Self::mul_add(s_q11, x307, c_q11 * x305);
+        let x310 = Self::mul_add(s_q11, x308, c_q11 * x306);
+        let x311 = Self::mul_add(s_q11, x289, c_q11 * x286);
+        let x312 = Self::mul_add(-c_q11, x307, s_q11 * x305);
         let x313 = s_q11 * x291;
         let x314 = c_q11 * x291;
-        let x315 = Self::mul_add(-s_q11, x290, x314);
+        let x315 = Self::mul_add(s_q11, x290, x314);
         let x316 = Self::mul_add(c_q11, x293, x313);
         let x317 = Self::mul_add(-s_q11, x294, c_q11 * x292);
         let x318 = Self::mul_add(c_q11, x294, s_q11 * x292);
         let x319 = Self::mul_add(
-            s_q11,
+            -s_q11,
             Self::mul_add(-s_q11, x293, x314),
-            c_q11 * Self::mul_add(c_q11, x290, x313),
+            c_q11 * Self::mul_add(c_q11, x290, -x313),
         );
         let x320 = Self::mul_add(-s_q11, x316, c_q11 * x315);
         let x321 = Self::mul_add(c_q11, x316, s_q11 * x315);
@@ -3773,25 +3761,29 @@ impl FreeFloating7 {
         let x323 = 0.63 * x317;
         let x324 = 0.63 * x319;
         let x325 = 0.63 * x320;
-        let x326 = x310 + Self::mul_add(-0.63, x318, 0.275 * x321);
+        let x326 = x310 + Self::mul_add(0.63, x318, 0.275 * x321);
         let x327 = x311 + Self::mul_add(0.63, x295, 0.275 * x318);
-        let x328 = Self::mul_add(0.275, x319, x312);
-        let x329 = Self::mul_add(c_q11, x308, s_q11 * x306) - x322;
-        let x330 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x289, s_q11 * x286));
-        let x331 = Self::mul_add(
+        let x328 = Self::mul_add(-0.275, x319, x312);
+        let x329 = Self::mul_add(-c_q11, x308, s_q11 * x306) - x322;
+        let x330 = Self::mul_add(
             -0.275,
+            x317,
+            Self::mul_add(-c_q11, x289, s_q11 * x286),
+        );
+        let x331 = Self::mul_add(
+            0.275,
             x312,
-            Self::mul_add(-0.275, x328, Self::mul_add(c_q11, x304, s_q11 * x303)),
+            Self::mul_add(0.275, x328, Self::mul_add(c_q11, x304, s_q11 * x303)),
         );
         let x332 = Self::mul_add(-s_q11, x299, c_q11 * x298);
         let x333 = Self::mul_add(c_q11, x299, s_q11 * x298);
         let x334 = -0.6328
-            + Self::mul_add(0.63, x309, Self::mul_add(-0.63, x323, 0.275 * x325));
-        let x335 = -24.35164200091464 + Self::mul_add(0.63, x312, 0.275 * x324);
+            - Self::mul_add(0.63, x309, Self::mul_add(0.63, x323, 0.275 * x325));
+        let x335 = -24.35164200091464 + Self::mul_add(-0.63, x312, 0.275 * x324);
         let x336 = Self::mul_add(-0.63, x324, 28.2393615);
         let x337 = 45.1584 - x324;
-        let x338 = Self::mul_add(-x74, x83, Self::mul_add(-x69, x80, x70 * x81))
-            + Self::mul_add(0.63, x332, Self::mul_add(x275, x270 * x274, x272));
+        let x338 = Self::mul_add(-x74, x83, Self::mul_add(x69, x80, x70 * x81))
+            - Self::mul_add(0.63, x332, Self::mul_add(-x275, x270 * x274, x272));
         let x339 = 1.0 / x336;
         let x340 = tau[3] - x338;
         let x341 = x334 * x339;
@@ -3800,79 +3792,79 @@ impl FreeFloating7 {
         let x344 = x325 * x339;
         let x345 = x323 * x339;
         let x346 = Self::mul_add(
-            -x334,
+            x334,
             x341,
-            Self::mul_add(-0.63, x311, 0.275 * x310)
-                + (Self::mul_add(
+            Self::mul_add(0.63, x311, 0.275 * x310)
+                - (Self::mul_add(
                     -s_q11,
                     Self::mul_add(-s_q11, x283, x302),
                     c_q11 * Self::mul_add(c_q11, x281, -x301),
-                ) + Self::mul_add(-0.63, x327, 0.275 * x326)),
+                ) - Self::mul_add(0.63, x327, 0.275 * x326)),
         );
         let x347 = Self::mul_add(
             -x334,
             x342,
             Self::mul_add(
-                -0.275,
+                0.275,
                 x309,
                 Self::mul_add(-s_q11, x304, c_q11 * x303)
-                    + Self::mul_add(-0.63, x330, 0.275 * x329),
+                    - Self::mul_add(0.63, x330, 0.275 * x329),
             ),
         );
         let x348 = Self::mul_add(-x335, x342, -24.4950615 + x331);
-        let x349 = Self::mul_add(-x334, x343, x309 + (x322 - x323));
+        let x349 = Self::mul_add(x334, x343, x309 + (x322 + x323));
         let x350 = Self::mul_add(-x334, x344, x326);
         let x351 = Self::mul_add(-x334, x345, -45.1584 + x327);
-        let x352 = Self::mul_add(-x335, x343, x328);
+        let x352 = Self::mul_add(x335, x343, x328);
         let x353 = Self::mul_add(-x335, x344, x329);
         let x354 = Self::mul_add(-x335, x345, x330);
         let x355 = Self::mul_add(x337, x343, x319);
         let x356 = Self::mul_add(-x337, x344, x320);
         let x357 = Self::mul_add(-x337, x345, x317);
-        let x358 = Self::mul_add(-x325, x344, x321);
-        let x359 = Self::mul_add(-x325, x345, x318);
+        let x358 = Self::mul_add(x325, x344, x321);
+        let x359 = Self::mul_add(x325, x345, x318);
         let x360 = Self::mul_add(x323, x345, x295);
         let x361 = Self::mul_add(
             x340,
             x341,
-            Self::mul_add(-x74, x84, Self::mul_add(x70, x82, x79 * x80))
+            Self::mul_add(x74, x84, Self::mul_add(x70, x82, x79 * x80))
                 + (Self::mul_add(-s_q11, x297, c_q11 * x296)
-                    + Self::mul_add(-0.63, x300, 0.275 * x333))
-                + (Self::mul_add(-x76, x347, x75 * x346)
-                    + Self::mul_add(-x78, x350, x77 * x349)),
+                    - Self::mul_add(0.63, x300, 0.275 * x333))
+                - (Self::mul_add(-x76, x347, x75 * x346)
+                    + Self::mul_add(x78, x350, x77 * x349)),
         );
         let x362 = Self::mul_add(
-            x340,
+            -x340,
             x342,
-            Self::mul_add(x73, x84, x72 * x83) - Self::mul_add(x69, x82, x79 * x81)
-                + Self::mul_add(-0.275, x332, Self::mul_add(c_q11, x297, s_q11 * x296))
-                + (Self::mul_add(-x76, x348, x75 * x347)
-                    + Self::mul_add(-x78, x353, x77 * x352)),
+            Self::mul_add(-x69, x82, x79 * x81) - Self::mul_add(x73, x84, x72 * x83)
+                - Self::mul_add(0.275, x332, Self::mul_add(c_q11, x297, s_q11 * x296))
+                - (Self::mul_add(x76, x348, x75 * x347)
+                    - Self::mul_add(x78, x353, x77 * x352)),
         );
         let x363 = Self::mul_add(
             x340,
             x343,
-            Self::mul_add(-x70, x84, x332)
-                + (Self::mul_add(-x76, x352, x75 * x349)
-                    - Self::mul_add(x78, x356, x77 * x355)),
+            Self::mul_add(x70, x84, -x332)
+                - (Self::mul_add(x76, x352, x75 * x349)
+                    + Self::mul_add(x78, x356, x77 * x355)),
         );
         let x364 = Self::mul_add(
-            x340,
+            -x340,
             x344,
-            Self::mul_add(x69, x84, x79 * x83) + x333
-                + (Self::mul_add(-x76, x353, x75 * x350)
-                    + Self::mul_add(-x78, x358, x77 * x356)),
+            Self::mul_add(x69, x84, x79 * x83) - x333
+                - (Self::mul_add(x76, x353, x75 * x350)
+                    + Self::mul_add(x78, x358, x77 * x356)),
         );
         let x365 = Self::mul_add(
-            x340,
+            -x340,
             x345,
-            Self::mul_add(-x70, x83, x300)
-                + (Self::mul_add(-x76, x354, x75 * x351)
-                    + Self::mul_add(-x78, x359, x77 * x357)),
+            Self::mul_add(x70, x83, -x300)
+                - (Self::mul_add(x76, x354, x75 * x351)
+                    + Self::mul_add(x78, x359, x77 * x357)),
         );
         let x366 = s_q10 * x347;
         let x367 = c_q10 * x347;
-        let x368 = Self::mul_add(s_q10, x346, x367);
+        let x368 = Self::mul_add(s_q10, x346, -x367);
         let x369 = Self::mul_add(c_q10, x348, x366);
         let x370 = Self::mul_add(-s_q10, x350, c_q10 * x349);
         let x371 = Self::mul_add(c_q10, x350, s_q10 * x349);
@@ -3884,14 +3876,14 @@ impl FreeFloating7 {
         let x377 = Self::mul_add(c_q10, x354, s_q10 * x351);
         let x378 = s_q10 * x356;
         let x379 = c_q10 * x356;
-        let x380 = Self::mul_add(-s_q10, x355, x379);
+        let x380 = Self::mul_add(s_q10, x355, x379);
         let x381 = Self::mul_add(c_q10, x358, x378);
         let x382 = Self::mul_add(-s_q10, x359, c_q10 * x357);
         let x383 = Self::mul_add(c_q10, x359, s_q10 * x357);
         let x384 = Self::mul_add(
-            s_q10,
+            -s_q10,
             Self::mul_add(-s_q10, x358, x379),
-            c_q10 * Self::mul_add(c_q10, x355, x378),
+            c_q10 * Self::mul_add(c_q10, x355, -x378),
         );
         let x385 = Self::mul_add(-s_q10, x381, c_q10 * x380);
         let x386 = 0.87 * x382;
@@ -3899,81 +3891,81 @@ impl FreeFloating7 {
         let x388 = 0.87 * x385;
         let x389 = Self::mul_add(0.87, x360, x375);
         let x390 = Self::mul_add(
-            -0.87,
+            0.87,
             x389,
             Self::mul_add(
-                -s_q10,
+                s_q10,
                 Self::mul_add(-s_q10, x348, x367),
-                c_q10 * Self::mul_add(c_q10, x346, -x366),
+                c_q10 * Self::mul_add(c_q10, x346, x366),
             ),
         );
         let x391 = Self::mul_add(-s_q10, x364, c_q10 * x363);
-        let x392 = -0.00214 + Self::mul_add(-0.87, x386, 0.87 * x374);
-        let x393 = Self::mul_add(0.87, x376, -36.18604050126307);
+        let x392 = -0.00214 - Self::mul_add(0.87, x374, 0.87 * x386);
+        let x393 = Self::mul_add(-0.87, x376, -36.18604050126307);
         let x394 = Self::mul_add(-0.87, x387, 69.99836825);
         let x395 = 81.53205 - x387;
-        let x396 = Self::mul_add(-x56, x66, Self::mul_add(-x50, x63, x51 * x64))
-            + Self::mul_add(0.87, x391, Self::mul_add(x340, x336 * x339, x338));
+        let x396 = Self::mul_add(-x56, x66, Self::mul_add(x50, x63, x51 * x64))
+            - Self::mul_add(0.87, x391, Self::mul_add(x340, x336 * x339, x338));
         let x397 = 1.0 / x394;
-        let x398 = tau[2] - x396;
+        let x398 = tau[2] + x396;
         let x399 = x392 * x397;
         let x400 = x393 * x397;
         let x401 = x395 * x397;
         let x402 = x388 * x397;
         let x403 = x386 * x397;
-        let x404 = Self::mul_add(-x392, x399, Self::mul_add(-0.87, x375, x390));
+        let x404 = Self::mul_add(x392, x399, Self::mul_add(0.87, x375, x390));
         let x405 = Self::mul_add(
-            -x392,
+            x392,
             x400,
-            Self::mul_add(-0.87, x377, Self::mul_add(-s_q10, x369, c_q10 * x368)),
+            Self::mul_add(0.87, x377, Self::mul_add(s_q10, x369, c_q10 * x368)),
         );
         let x406 = Self::mul_add(
             -x393,
             x400,
-            -63.36336825000001 + Self::mul_add(c_q10, x369, s_q10 * x368),
+            -63.36336825000001 - Self::mul_add(-c_q10, x369, s_q10 * x368),
         );
-        let x407 = Self::mul_add(-x392, x401, x374 - x386);
+        let x407 = Self::mul_add(x392, x401, x374 + x386);
         let x408 = Self::mul_add(
             -x392,
             x402,
-            Self::mul_add(-0.87, x383, Self::mul_add(-s_q10, x373, c_q10 * x371)),
+            Self::mul_add(0.87, x383, Self::mul_add(-s_q10, x373, c_q10 * x371)),
         );
         let x409 = Self::mul_add(-x392, x403, -81.53205 + x389);
-        let x410 = Self::mul_add(-x393, x401, x376);
+        let x410 = Self::mul_add(x393, x401, x376);
         let x411 = Self::mul_add(-x393, x402, Self::mul_add(c_q10, x373, s_q10 * x371));
         let x412 = Self::mul_add(-x393, x403, x377);
         let x413 = Self::mul_add(x395, x401, x384);
         let x414 = Self::mul_add(-x395, x402, x385);
         let x415 = Self::mul_add(-x395, x403, x382);
-        let x416 = Self::mul_add(-x388, x402, Self::mul_add(c_q10, x381, s_q10 * x380));
-        let x417 = Self::mul_add(-x388, x403, x383);
+        let x416 = Self::mul_add(x388, x402, Self::mul_add(c_q10, x381, s_q10 * x380));
+        let x417 = Self::mul_add(x388, x403, x383);
         let x418 = Self::mul_add(x386, x403, x360);
         let x419 = Self::mul_add(
-            x398,
+            -x398,
             x399,
-            Self::mul_add(-x56, x67, Self::mul_add(x51, x65, x62 * x63))
-                + Self::mul_add(-0.87, x365, Self::mul_add(-s_q10, x362, c_q10 * x361))
-                + (Self::mul_add(-x59, x405, x58 * x404)
+            Self::mul_add(x56, x67, Self::mul_add(x51, x65, x62 * x63))
+                - Self::mul_add(0.87, x365, Self::mul_add(s_q10, x362, c_q10 * x361))
+                - (Self::mul_add(-x59, x405, x58 * x404)
                     + Self::mul_add(-x61, x408, x60 * x407)),
         );
         let x420 = Self::mul_add(
-            x398,
+            -x398,
             x400,
-            Self::mul_add(x55, x67, x57 * x66) - Self::mul_add(x50, x65, x62 * x64)
-                + Self::mul_add(c_q10, x362, s_q10 * x361)
-                + (Self::mul_add(-x59, x406, x58 * x405)
+            Self::mul_add(-x50, x65, x62 * x64) - Self::mul_add(x55, x67, x57 * x66)
+                - Self::mul_add(-c_q10, x362, s_q10 * x361)
+                - (Self::mul_add(x59, x406, x58 * x405)
                     + Self::mul_add(-x61, x411, x60 * x410)),
         );
-        let x421 = Self::mul_add(x398, x394 * x397, x396);
+        let x421 = Self::mul_add(-x398, x394 * x397, x396);
         let x422 = Self::mul_add(
-            x398,
+            -x398,
             x401,
-            Self::mul_add(-x51, x67, x391)
-                + (Self::mul_add(-x59, x410, x58 * x407)
-                    - Self::mul_add(x61, x414, x60 * x413)),
+            Self::mul_add(x51, x67, -x391)
+                - (Self::mul_add(-x59, x410, x58 * x407)
+                    + Self::mul_add(-x61, x414, x60 * x413)),
         );
         let x423 = Self::mul_add(
-            x398,
+            -x398,
             x402,
             Self::mul_add(x50, x67, x62 * x66) + Self::mul_add(c_q10, x364, s_q10 * x363)
                 + (Self::mul_add(-x59, x411, x58 * x408)
@@ -3982,24 +3974,24 @@ impl FreeFloating7 {
         let x424 = Self::mul_add(
             x398,
             x403,
-            Self::mul_add(-x51, x66, x365)
-                + (Self::mul_add(-x59, x412, x58 * x409)
+            Self::mul_add(x51, x66, -x365)
+                - (Self::mul_add(-x59, x412, x58 * x409)
                     + Self::mul_add(-x61, x417, x60 * x415)),
         );
         let x425 = c_q9 * x405;
         let x426 = Self::mul_add(-x49, x405, x48 * x404);
         let x427 = s_q9 * x405;
         let x428 = Self::mul_add(c_q9, x404, -x427);
-        let x429 = Self::mul_add(-x49, x406, x48 * x405);
-        let x430 = Self::mul_add(-s_q9, x406, x425);
+        let x429 = Self::mul_add(x49, x406, x48 * x405);
+        let x430 = Self::mul_add(s_q9, x406, x425);
         let x431 = 0.00000000020510342851533115 * x409;
-        let x432 = Self::mul_add(c_q9, x408, s_q9 * x407) + x431;
-        let x433 = x409 + Self::mul_add(-x49, x408, x48 * x407);
-        let x434 = Self::mul_add(-s_q9, x408, c_q9 * x407) - x431;
+        let x432 = Self::mul_add(c_q9, x408, s_q9 * x407) - x431;
+        let x433 = x409 - Self::mul_add(-x49, x408, x48 * x407);
+        let x434 = x431 + Self::mul_add(-s_q9, x408, c_q9 * x407);
         let x435 = 0.00000000020510342851533115 * x412;
-        let x436 = Self::mul_add(c_q9, x411, s_q9 * x410) + x435;
-        let x437 = x412 + Self::mul_add(-x49, x411, x48 * x410);
-        let x438 = Self::mul_add(-s_q9, x411, c_q9 * x410) - x435;
+        let x436 = Self::mul_add(c_q9, x411, s_q9 * x410) - x435;
+        let x437 = x412 - Self::mul_add(-x49, x411, x48 * x410);
+        let x438 = x435 + Self::mul_add(-s_q9, x411, c_q9 * x410);
         let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
         let x440 = Self::mul_add(c_q9, x437, s_q9 * x433);
         let x441 = Self::mul_add(c_q9, x438, s_q9 * x434);
@@ -4007,38 +3999,38 @@ impl FreeFloating7 {
         let x443 = Self::mul_add(-s_q9, x436, c_q9 * x432);
         let x444 = c_q9 * x414;
         let x445 = 0.00000000020510342851533115 * x415;
-        let x446 = x415 - Self::mul_add(x49, x414, x48 * x413);
+        let x446 = x415 - Self::mul_add(-x49, x414, x48 * x413);
         let x447 = s_q9 * x414;
-        let x448 = x445 + Self::mul_add(c_q9, x413, x447);
+        let x448 = x445 + Self::mul_add(c_q9, x413, -x447);
         let x449 = 0.00000000020510342851533115 * x417;
-        let x450 = x417 + Self::mul_add(-x49, x416, x48 * x414);
-        let x451 = Self::mul_add(-s_q9, x416, x444) - x449;
+        let x450 = x417 - Self::mul_add(-x49, x416, x48 * x414);
+        let x451 = x449 + Self::mul_add(-s_q9, x416, x444);
         let x452 = 0.00000000020510342851533115 * x418;
-        let x453 = Self::mul_add(-x49, x417, x48 * x415) - x418;
+        let x453 = x418 - Self::mul_add(-x49, x417, x48 * x415);
         let x454 = x452 + Self::mul_add(-s_q9, x417, c_q9 * x415);
         let x455 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.00000000020510342851533115,
             Self::mul_add(c_q9, x417, s_q9 * x415) - x452,
             Self::mul_add(
                 c_q9,
-                Self::mul_add(c_q9, x416, x447) + x449,
-                s_q9 * (Self::mul_add(-s_q9, x413, x444) + x445),
+                Self::mul_add(c_q9, x416, x447) - x449,
+                s_q9 * (Self::mul_add(s_q9, x413, x444) - x445),
             ),
         );
         let x456 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.00000000020510342851533115,
             x453,
             Self::mul_add(c_q9, x450, s_q9 * x446),
         );
         let x457 = 0.00000000020510342851533115 * x454;
-        let x458 = Self::mul_add(-s_q9, x448, c_q9 * x451) + x457;
-        let x459 = x453 + Self::mul_add(-x49, x450, x48 * x446);
-        let x460 = x454 - Self::mul_add(x49, x451, x48 * x448);
-        let x461 = x457 + Self::mul_add(s_q9, x451, c_q9 * x448);
+        let x458 = Self::mul_add(c_q9, x451, s_q9 * x448) - x457;
+        let x459 = x453 - Self::mul_add(-x49, x450, x48 * x446);
+        let x460 = x454 - Self::mul_add(-x49, x451, x48 * x448);
+        let x461 = x457 + Self::mul_add(-s_q9, x451, c_q9 * x448);
         let x462 = 0.4 * x456;
         let x463 = 0.275 * x458;
-        let x464 = x440 + Self::mul_add(-0.4, x459, 0.275 * x460);
-        let x465 = x441 - Self::mul_add(0.275, x461, 0.4 * x460);
+        let x464 = x440 + Self::mul_add(0.275, x460, 0.4 * x459);
+        let x465 = x441 + Self::mul_add(0.275, x461, 0.4 * x460);
         let x466 = Self::mul_add(0.4, x455, x442);
         let x467 = Self::mul_add(-x49, x437, x48 * x433) + x462;
         let x468 = Self::mul_add(0.4, x458, Self::mul_add(-x49, x438, x48 * x434));
@@ -4051,38 +4043,34 @@ impl FreeFloating7 {
             Self::mul_add(0.4, x466, Self::mul_add(-x49, x429, x48 * x426)),
         );
         let x473 = Self::mul_add(
-            -0.275,
+            0.275,
             x442,
-            Self::mul_add(0.4, x469, Self::mul_add(-x49, x430, x48 * x428)),
+            -Self::mul_add(0.4, x469, Self::mul_add(-x49, x430, x48 * x428)),
         );
         let x474 = Self::mul_add(
-            -0.275,
+            0.275,
             x443,
-            Self::mul_add(-0.275, x469, Self::mul_add(-s_q9, x430, c_q9 * x428)),
+            -Self::mul_add(-0.275, x469, Self::mul_add(-s_q9, x430, c_q9 * x428)),
         );
         let x475 = 0.00000000020510342851533115 * x424;
-        let x476 = Self::mul_add(c_q9, x423, s_q9 * x422) + x475;
-        let x477 = x424 + Self::mul_add(-x49, x423, x48 * x422);
-        let x478 = Self::mul_add(-s_q9, x423, c_q9 * x422) - x475;
+        let x476 = Self::mul_add(-c_q9, x423, s_q9 * x422) - x475;
+        let x477 = x424 - Self::mul_add(x49, x423, x48 * x422);
+        let x478 = x475 + Self::mul_add(s_q9, x423, c_q9 * x422);
         let x479 = 0.00000000020510342851533115 * x421;
         let x480 = -0.002139996587640933
             + Self::mul_add(
-                -0.275,
+                0.275,
                 x439,
-                Self::mul_add(c_q9, x430, s_q9 * x428)
-                    + Self::mul_add(-0.4, x470, 0.275 * x471),
+                -(Self::mul_add(c_q9, x430, s_q9 * x428)
+                    + Self::mul_add(0.275, x471, 0.4 * x470)),
             );
         let x481 = 5.080660024070365 + x473;
         let x482 = 113.3918902508081 + x474;
-        let x483 = 12.701650001451807 + x469;
+        let x483 = 12.701650001451807 - x469;
         let x484 = -0.000000008530897668050218 + x470;
-        let x485 = Self::mul_add(x27, x40, x28 * x39)
-            - Self::mul_add(x31, x43, x32 * x42)
-            + Self::mul_add(
-                -0.275,
-                x476,
-                Self::mul_add(-s_q9, x420, c_q9 * x419) - x479,
-            );
+        let x485 = Self::mul_add(-x27, x40, x28 * x39)
+            - Self::mul_add(-x31, x43, x32 * x42)
+            + Self::mul_add(0.275, x476, x479 - Self::mul_add(-s_q9, x420, c_q9 * x419));
         let x486 = 1.0 / x482;
         let x487 = tau[1] - x485;
         let x488 = x480 * x486;
@@ -4091,178 +4079,178 @@ impl FreeFloating7 {
         let x491 = x484 * x486;
         let x492 = x471 * x486;
         let x493 = Self::mul_add(
-            -x480,
+            x480,
             x488,
-            Self::mul_add(-0.4, x440, 0.275 * x441)
+            Self::mul_add(0.275, x441, 0.4 * x440)
                 + (Self::mul_add(
                     c_q9,
-                    Self::mul_add(c_q9, x406, x427),
+                    Self::mul_add(-c_q9, x406, x427),
                     s_q9 * Self::mul_add(s_q9, x404, x425),
-                ) + Self::mul_add(-0.4, x464, 0.275 * x465)),
+                ) + Self::mul_add(0.275, x465, 0.4 * x464)),
         );
         let x494 = Self::mul_add(
             -x480,
             x489,
             -0.0000000234896432582596
-                + Self::mul_add(
+                - Self::mul_add(
                     0.4,
                     x439,
                     Self::mul_add(c_q9, x429, s_q9 * x426)
-                        + Self::mul_add(-0.4, x467, 0.275 * x468),
+                        + Self::mul_add(0.275, x468, 0.4 * x467),
                 ),
         );
-        let x495 = Self::mul_add(-x481, x489, -111.7548902508081 + x472);
-        let x496 = Self::mul_add(-x480, x490, x439 + (x463 - x462));
+        let x495 = Self::mul_add(-x481, x489, -111.7548902508081 - x472);
+        let x496 = Self::mul_add(x480, x490, x439 + (x462 + x463));
         let x497 = Self::mul_add(-x480, x491, x464);
-        let x498 = Self::mul_add(-x480, x492, -12.701650001451807 + x465);
-        let x499 = Self::mul_add(-x481, x490, x466);
+        let x498 = Self::mul_add(x480, x492, -12.701650001451807 - x465);
+        let x499 = Self::mul_add(x481, x490, x466);
         let x500 = Self::mul_add(-x481, x491, x467);
-        let x501 = Self::mul_add(-x481, x492, 0.000000008530897668050218 + x468);
-        let x502 = Self::mul_add(-x483, x490, x455);
+        let x501 = Self::mul_add(x481, x492, 0.000000008530897668050218 - x468);
+        let x502 = Self::mul_add(x483, x490, x455);
         let x503 = Self::mul_add(-x483, x491, x456);
         let x504 = Self::mul_add(-x483, x492, x458);
-        let x505 = Self::mul_add(-x484, x491, x459);
-        let x506 = Self::mul_add(-x484, x492, x460);
+        let x505 = Self::mul_add(x484, x491, x459);
+        let x506 = Self::mul_add(x484, x492, x460);
         let x507 = Self::mul_add(x471, x492, x461);
         let x508 = Self::mul_add(
-            x487,
+            -x487,
             x488,
-            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
+            Self::mul_add(-x28, x41, x38 * x40) - Self::mul_add(x32, x44, x33 * x43)
                 + (Self::mul_add(c_q9, x420, s_q9 * x419) + x479
-                    + Self::mul_add(-0.4, x477, 0.275 * x478))
+                    + Self::mul_add(0.275, x478, 0.4 * x477))
                 + (Self::mul_add(-x35, x494, x34 * x493)
                     + Self::mul_add(-x37, x497, x36 * x496)),
         );
         let x509 = Self::mul_add(
-            x487,
+            -x487,
             x489,
-            Self::mul_add(x31, x44, x33 * x42) - Self::mul_add(x27, x41, x38 * x39)
+            Self::mul_add(-x27, x41, x38 * x39) - Self::mul_add(x31, x44, x33 * x42)
                 + Self::mul_add(0.4, x476, x421 + Self::mul_add(-x49, x420, x48 * x419))
-                + (Self::mul_add(-x35, x495, x34 * x494)
-                    + Self::mul_add(-x37, x500, x36 * x499)),
+                - (Self::mul_add(x35, x495, x34 * x494)
+                    - Self::mul_add(-x37, x500, x36 * x499)),
         );
         let x510 = Self::mul_add(x487, x482 * x486, x485);
         let x511 = Self::mul_add(
             x487,
             x490,
-            Self::mul_add(-x28, x44, x38 * x43) + x476
-                + (Self::mul_add(-x35, x499, x34 * x496)
+            Self::mul_add(x28, x44, x38 * x43) - x476
+                - (Self::mul_add(x35, x499, x34 * x496)
                     + Self::mul_add(-x37, x503, x36 * x502)),
         );
         let x512 = Self::mul_add(
             x487,
             x491,
             Self::mul_add(x27, x44, x38 * x42) + x477
-                + (Self::mul_add(-x35, x500, x34 * x497)
+                + (Self::mul_add(x35, x500, x34 * x497)
                     + Self::mul_add(-x37, x505, x36 * x503)),
         );
         let x513 = Self::mul_add(
             x487,
             x492,
-            x478 - Self::mul_add(x27, x43, x28 * x42)
-                + (Self::mul_add(-x35, x501, x34 * x498)
-                    + Self::mul_add(-x37, x506, x36 * x504)),
+            Self::mul_add(-x27, x43, x28 * x42) + x478
+                - (Self::mul_add(x35, x501, x34 * x498)
+                    - Self::mul_add(-x37, x506, x36 * x504)),
         );
         let x514 = c_q8 * x494;
-        let x515 = Self::mul_add(s_q8, x493, x514);
+        let x515 = Self::mul_add(s_q8, x493, -x514);
         let x516 = s_q8 * x494;
-        let x517 = Self::mul_add(-c_q8, x493, x516);
+        let x517 = Self::mul_add(c_q8, x493, x516);
         let x518 = Self::mul_add(c_q8, x495, x516);
-        let x519 = Self::mul_add(s_q8, x495, -x514);
-        let x520 = x498 + Self::mul_add(-x25, x496, x26 * x497);
-        let x521 = Self::mul_add(c_q8, x497, s_q8 * x496);
+        let x519 = Self::mul_add(-s_q8, x495, x514);
+        let x520 = x498 + Self::mul_add(x26, x497, x25 * x496);
+        let x521 = Self::mul_add(-c_q8, x497, s_q8 * x496);
         let x522 = Self::mul_add(
             -0.00000000020510342851533115,
             x498,
-            Self::mul_add(-c_q8, x496, s_q8 * x497),
+            Self::mul_add(s_q8, x497, c_q8 * x496),
         );
-        let x523 = x501 + Self::mul_add(-x25, x499, x26 * x500);
-        let x524 = Self::mul_add(c_q8, x500, s_q8 * x499);
+        let x523 = x501 + Self::mul_add(x26, x500, x25 * x499);
+        let x524 = Self::mul_add(-c_q8, x500, s_q8 * x499);
         let x525 = Self::mul_add(
             -0.00000000020510342851533115,
             x501,
-            Self::mul_add(-c_q8, x499, s_q8 * x500),
+            Self::mul_add(s_q8, x500, c_q8 * x499),
         );
-        let x526 = Self::mul_add(-x25, x520, x26 * x523);
-        let x527 = Self::mul_add(-x25, x521, x26 * x524);
+        let x526 = Self::mul_add(-x26, x523, x25 * x520);
+        let x527 = Self::mul_add(-x26, x524, x25 * x521);
         let x528 = Self::mul_add(c_q8, x523, s_q8 * x520);
-        let x529 = Self::mul_add(-c_q8, x520, s_q8 * x523);
-        let x530 = Self::mul_add(-c_q8, x521, s_q8 * x524);
-        let x531 = Self::mul_add(-c_q8, x522, s_q8 * x525);
+        let x529 = Self::mul_add(-s_q8, x523, c_q8 * x520);
+        let x530 = Self::mul_add(-s_q8, x524, c_q8 * x521);
+        let x531 = Self::mul_add(-s_q8, x525, c_q8 * x522);
         let x532 = c_q8 * x503;
-        let x533 = Self::mul_add(s_q8, x502, x532);
+        let x533 = Self::mul_add(s_q8, x502, -x532);
         let x534 = s_q8 * x503;
         let x535 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x504,
-            Self::mul_add(-c_q8, x502, x534),
+            Self::mul_add(c_q8, x502, x534),
         );
-        let x536 = Self::mul_add(c_q8, x505, x534);
+        let x536 = Self::mul_add(-c_q8, x505, x534);
         let x537 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x506,
-            Self::mul_add(s_q8, x505, -x532),
+            Self::mul_add(s_q8, x505, x532),
         );
         let x538 = Self::mul_add(
             0.00000000020510342851533115,
             x507,
-            Self::mul_add(-c_q8, x504, s_q8 * x506),
+            Self::mul_add(s_q8, x506, c_q8 * x504),
         );
-        let x539 = Self::mul_add(-x25, x504, x26 * x506) - x507
-            + Self::mul_add(
-                -x25,
-                x504 + Self::mul_add(-x25, x502, x26 * x503),
-                x26 * (x506 + Self::mul_add(-x25, x503, x26 * x505)),
+        let x539 = x507 - Self::mul_add(x26, x506, x25 * x504)
+            - Self::mul_add(
+                x26,
+                x506 - Self::mul_add(x26, x505, x25 * x503),
+                x25 * (x504 - Self::mul_add(x26, x503, x25 * x502)),
             );
-        let x540 = Self::mul_add(c_q8, x506, s_q8 * x504)
-            + Self::mul_add(-x25, x533, x26 * x536);
-        let x541 = x538 + Self::mul_add(-x25, x535, x26 * x537);
-        let x542 = Self::mul_add(c_q8, x536, s_q8 * x533);
-        let x543 = Self::mul_add(c_q8, x537, s_q8 * x535);
+        let x540 = Self::mul_add(-c_q8, x506, s_q8 * x504)
+            - Self::mul_add(x26, x536, x25 * x533);
+        let x541 = x538 - Self::mul_add(x26, x537, x25 * x535);
+        let x542 = Self::mul_add(-c_q8, x536, s_q8 * x533);
+        let x543 = Self::mul_add(-c_q8, x537, s_q8 * x535);
         let x544 = 0.35 * x540;
-        let x545 = Self::mul_add(-0.35, x542, x527);
-        let x546 = Self::mul_add(0.35, x539, x528);
+        let x545 = Self::mul_add(0.35, x542, x527);
+        let x546 = Self::mul_add(-0.35, x539, x528);
         let x547 = Self::mul_add(c_q8, x524, s_q8 * x521) + x544;
         let x548 = Self::mul_add(
-            -0.35,
+            0.35,
             x545,
             Self::mul_add(
-                -x25,
-                Self::mul_add(-x25, x493, x26 * x494),
-                x26 * Self::mul_add(-x25, x494, x26 * x495),
+                x26,
+                Self::mul_add(-x26, x495, x25 * x494),
+                x25 * Self::mul_add(x26, x494, x25 * x493),
             ),
         );
         let x549 = Self::mul_add(
             0.35,
             x526,
-            Self::mul_add(-0.35, x547, Self::mul_add(-x25, x515, x26 * x518)),
+            -Self::mul_add(0.35, x547, Self::mul_add(x26, x518, x25 * x515)),
         );
         let x550 = Self::mul_add(
             0.35,
             x528,
-            Self::mul_add(0.35, x546, Self::mul_add(c_q8, x518, s_q8 * x515)),
+            -Self::mul_add(-0.35, x546, Self::mul_add(-c_q8, x518, s_q8 * x515)),
         );
-        let x551 = x513 + Self::mul_add(-x25, x511, x26 * x512);
+        let x551 = x513 + Self::mul_add(-x26, x512, x25 * x511);
         let x552 = Self::mul_add(c_q8, x512, s_q8 * x511);
         let x553 = -16.80768997608804
-            + Self::mul_add(-0.35, x530, Self::mul_add(-x25, x517, x26 * x519));
+            - Self::mul_add(0.35, x530, Self::mul_add(x26, x519, x25 * x517));
         let x554 = 0.1132
-            + Self::mul_add(0.35, x529, Self::mul_add(c_q8, x519, s_q8 * x517));
-        let x555 = 132.47349025763282 + Self::mul_add(-c_q8, x517, s_q8 * x519);
+            + Self::mul_add(-0.35, x529, Self::mul_add(-c_q8, x519, s_q8 * x517));
+        let x555 = 132.47349025763282 - Self::mul_add(s_q8, x519, c_q8 * x517);
         let x556 = 48.0240000085309 + x530;
-        let x557 = Self::mul_add(x12, x22, Self::mul_add(x7, x20, x8 * x19))
+        let x557 = Self::mul_add(x12, x22, Self::mul_add(-x7, x20, x8 * x19))
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x510,
-                Self::mul_add(-c_q8, x508, s_q8 * x509),
+                Self::mul_add(-s_q8, x509, c_q8 * x508),
             );
         let x558 = Self::mul_add(
             x7,
             x22,
-            Self::mul_add(
+            -Self::mul_add(
                 -0.00000000020510342851533115,
                 x513,
-                Self::mul_add(-c_q8, x511, s_q8 * x512),
+                Self::mul_add(-s_q8, x512, c_q8 * x511),
             ),
         );
         let x559 = 1.0 / x555;
@@ -4272,46 +4260,46 @@ impl FreeFloating7 {
         let x563 = x529 * x559;
         let x564 = x556 * x559;
         let x565 = x531 * x559;
-        let x566 = Self::mul_add(-x553, x561, Self::mul_add(-0.35, x527, x548));
-        let x567 = Self::mul_add(-x553, x562, -0.07309 + x549);
+        let x566 = Self::mul_add(x553, x561, Self::mul_add(0.35, x527, x548));
+        let x567 = Self::mul_add(-x553, x562, -0.07309 - x549);
         let x568 = Self::mul_add(-x554, x562, 130.43769025763282 + x550);
         let x569 = Self::mul_add(-x553, x563, x526 - x544);
         let x570 = Self::mul_add(-x553, x564, x545);
         let x571 = Self::mul_add(
             -x553,
             x565,
-            Self::mul_add(-0.35, x543, Self::mul_add(-x25, x522, x26 * x525)),
+            Self::mul_add(0.35, x543, Self::mul_add(-x26, x525, x25 * x522)),
         );
-        let x572 = Self::mul_add(-x554, x563, x546);
-        let x573 = Self::mul_add(-x554, x564, x547);
+        let x572 = Self::mul_add(x554, x563, x546);
+        let x573 = Self::mul_add(x554, x564, x547);
         let x574 = Self::mul_add(
-            -x554,
+            x554,
             x565,
             -48.0240000085309
                 + Self::mul_add(0.35, x541, Self::mul_add(c_q8, x525, s_q8 * x522)),
         );
-        let x575 = Self::mul_add(-x529, x563, x539);
+        let x575 = Self::mul_add(x529, x563, x539);
         let x576 = Self::mul_add(-x529, x564, x540);
         let x577 = Self::mul_add(-x529, x565, x541);
-        let x578 = Self::mul_add(-x556, x564, x542);
-        let x579 = Self::mul_add(-x556, x565, x543);
+        let x578 = Self::mul_add(x556, x564, x542);
+        let x579 = Self::mul_add(x556, x565, x543);
         let x580 = Self::mul_add(
-            -x531,
+            x531,
             x565,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
                 x538,
-                Self::mul_add(-c_q8, x535, s_q8 * x537),
+                Self::mul_add(s_q8, x537, c_q8 * x535),
             ),
         );
         let x581 = Self::mul_add(
             x560,
             x561,
-            Self::mul_add(-x18, x20, x8 * x21) - Self::mul_add(x13, x23, x11 * x22)
+            Self::mul_add(x8, x21, x18 * x20) - Self::mul_add(x13, x23, x11 * x22)
                 + Self::mul_add(
                     -0.35,
                     x552,
-                    x510 + Self::mul_add(-x25, x508, x26 * x509),
+                    x510 + Self::mul_add(-x26, x509, x25 * x508),
                 )
                 + (Self::mul_add(-x15, x567, x14 * x566)
                     + Self::mul_add(-x17, x570, x16 * x569)),
@@ -4319,46 +4307,46 @@ impl FreeFloating7 {
         let x582 = Self::mul_add(
             x560,
             x562,
-            Self::mul_add(x12, x23, -Self::mul_add(x7, x21, x18 * x19))
-                + Self::mul_add(0.35, x551, Self::mul_add(c_q8, x509, s_q8 * x508))
-                + (Self::mul_add(-x15, x568, x14 * x567)
+            Self::mul_add(-x12, x23, Self::mul_add(x7, x21, x18 * x19))
+                - Self::mul_add(0.35, x551, Self::mul_add(c_q8, x509, s_q8 * x508))
+                - (Self::mul_add(x15, x568, x14 * x567)
                     + Self::mul_add(-x17, x573, x16 * x572)),
         );
         let x583 = Self::mul_add(
             x560,
             x563,
-            x551 - Self::mul_add(x8, x23, x18 * x22)
-                + (Self::mul_add(-x15, x572, x14 * x569)
-                    + Self::mul_add(-x17, x576, x16 * x575)),
+            Self::mul_add(x8, x23, x18 * x22) + x551
+                - (Self::mul_add(-x15, x572, x14 * x569)
+                    + Self::mul_add(x17, x576, x16 * x575)),
         );
         let x584 = Self::mul_add(
-            x560,
+            -x560,
             x564,
-            Self::mul_add(x7, x23, x552)
+            Self::mul_add(x7, x23, -x552)
                 + (Self::mul_add(-x15, x573, x14 * x570)
-                    + Self::mul_add(-x17, x578, x16 * x576)),
+                    - Self::mul_add(x17, x578, x16 * x576)),
         );
         let x585 = Self::mul_add(
-            x560,
+            -x560,
             x565,
             x558
                 + (Self::mul_add(-x15, x574, x14 * x571)
-                    + Self::mul_add(-x17, x579, x16 * x577)),
+                    - Self::mul_add(x17, x579, x16 * x577)),
         );
         let x586 = s_q7 * x567;
         let x587 = c_q7 * x567;
-        let x588 = Self::mul_add(s_q7, x566, x587);
+        let x588 = Self::mul_add(s_q7, x566, -x587);
         let x589 = Self::mul_add(c_q7, x568, x586);
-        let x590 = Self::mul_add(-s_q7, x570, c_q7 * x569);
-        let x591 = Self::mul_add(c_q7, x570, s_q7 * x569);
-        let x592 = Self::mul_add(-s_q7, x573, c_q7 * x572);
-        let x593 = Self::mul_add(c_q7, x573, s_q7 * x572);
-        let x594 = Self::mul_add(-s_q7, x592, c_q7 * x590);
-        let x595 = Self::mul_add(-s_q7, x593, c_q7 * x591);
-        let x596 = Self::mul_add(-s_q7, x574, c_q7 * x571);
-        let x597 = Self::mul_add(c_q7, x592, s_q7 * x590);
-        let x598 = Self::mul_add(c_q7, x593, s_q7 * x591);
-        let x599 = Self::mul_add(c_q7, x574, s_q7 * x571);
+        let x590 = Self::mul_add(s_q7, x570, c_q7 * x569);
+        let x591 = Self::mul_add(-c_q7, x570, s_q7 * x569);
+        let x592 = Self::mul_add(s_q7, x573, c_q7 * x572);
+        let x593 = Self::mul_add(-c_q7, x573, s_q7 * x572);
+        let x594 = Self::mul_add(s_q7, x592, c_q7 * x590);
+        let x595 = Self::mul_add(s_q7, x593, c_q7 * x591);
+        let x596 = Self::mul_add(s_q7, x574, c_q7 * x571);
+        let x597 = Self::mul_add(-c_q7, x592, s_q7 * x590);
+        let x598 = Self::mul_add(-c_q7, x593, s_q7 * x591);
+        let x599 = Self::mul_add(-c_q7, x574, s_q7 * x571);
         let x600 = s_q7 * x576;
         let x601 = c_q7 * x576;
         let x602 = Self::mul_add(s_q7, x575, x601);
@@ -4378,52 +4366,52 @@ impl FreeFloating7 {
         let x612 = 0.65 * x608;
         let x613 = x594 - x609;
         let x614 = Self::mul_add(-0.75, x608, x595);
-        let x615 = x597 + Self::mul_add(-0.65, x604, 0.75 * x606);
-        let x616 = x598 + (x609 - x611);
-        let x617 = x599 + Self::mul_add(-0.65, x580, 0.75 * x604);
+        let x615 = x597 + Self::mul_add(0.65, x604, 0.75 * x606);
+        let x616 = x598 + (x609 + x611);
+        let x617 = x599 - Self::mul_add(0.65, x580, 0.75 * x604);
         let x618 = Self::mul_add(
             -0.75,
             x614,
             Self::mul_add(
-                -s_q7,
+                s_q7,
                 Self::mul_add(-s_q7, x568, x587),
-                c_q7 * Self::mul_add(c_q7, x566, -x586),
+                c_q7 * Self::mul_add(c_q7, x566, x586),
             ),
         );
         let x619 = Self::mul_add(-s_q7, x584, c_q7 * x583);
         let x620 = Self::mul_add(c_q7, x584, s_q7 * x583);
-        let x621 = 180.9502499901501 + x615;
-        let x622 = Self::mul_add(-v[5], x4, v[4] * x5) + x619;
-        let x623 = 1.0 / (1170.07 + x606);
+        let x621 = 180.9502499901501 - x615;
+        let x622 = Self::mul_add(-v[4], x5, v[5] * x4) + x619;
+        let x623 = 1.0 / (1170.07 - x606);
         let x624 = x607 * x623;
         let x625 = x604 * x623;
         let x626 = x613 * x623;
         let x627 = x621 * x623;
         let x628 = x610 * x623;
-        let x629 = 1.0 / Self::mul_add(-x607, x624, 1170.07 + x608);
-        let x630 = Self::mul_add(-x607, x625, x605);
+        let x629 = 1.0 / Self::mul_add(-x607, x624, 1170.07 - x608);
+        let x630 = Self::mul_add(x607, x625, x605);
         let x631 = x629 * x630;
-        let x632 = Self::mul_add(-x607, x626, -180.9502499901501 + x614);
+        let x632 = Self::mul_add(-x607, x626, -180.9502499901501 - x614);
         let x633 = x629 * x632;
         let x634 = Self::mul_add(-x607, x627, x616);
         let x635 = x629 * x634;
-        let x636 = Self::mul_add(-x607, x628, 110.5455 + x612);
+        let x636 = Self::mul_add(-x607, x628, 110.5455 - x612);
         let x637 = x629 * x636;
         let x638 = 1.0
-            / Self::mul_add(-x630, x631, Self::mul_add(-x604, x625, 1170.07 + x580));
+            / Self::mul_add(-x630, x631, Self::mul_add(-x604, x625, 1170.07 - x580));
         let x639 = Self::mul_add(
-            -x630,
+            x630,
             x633,
-            Self::mul_add(-x604, x626, Self::mul_add(-0.75, x605, x596)),
+            Self::mul_add(-x604, x626, Self::mul_add(0.75, x605, x596)),
         );
         let x640 = x638 * x639;
         let x641 = Self::mul_add(
-            -x630,
+            x630,
             x635,
-            Self::mul_add(-x604, x627, -110.5455 + x617),
+            Self::mul_add(-x604, x627, -110.5455 - x617),
         );
         let x642 = x638 * x641;
-        let x643 = Self::mul_add(-x630, x637, Self::mul_add(-x604, x628, x611));
+        let x643 = Self::mul_add(-x630, x637, Self::mul_add(x604, x628, x611));
         let x644 = x638 * x643;
         let x645 = Self::mul_add(
             -x632,
@@ -4431,7 +4419,7 @@ impl FreeFloating7 {
             Self::mul_add(
                 -x613,
                 x626,
-                1394.5960312283303 + Self::mul_add(-0.75, x595, x618),
+                1394.5960312283303 + Self::mul_add(0.75, x595, -x618),
             ),
         );
         let x646 = 1.0 / Self::mul_add(-x639, x640, x645);
@@ -4439,7 +4427,7 @@ impl FreeFloating7 {
             -x613,
             x627,
             Self::mul_add(-0.65, x596, 0.75 * x594)
-                + Self::mul_add(-0.75, x616, Self::mul_add(-s_q7, x589, c_q7 * x588)),
+                + Self::mul_add(-0.75, x616, Self::mul_add(s_q7, x589, c_q7 * x588)),
         );
         let x648 = Self::mul_add(-x639, x642, Self::mul_add(-x632, x635, x647));
         let x649 = x646 * x648;
@@ -4449,10 +4437,10 @@ impl FreeFloating7 {
             Self::mul_add(
                 -x613,
                 x628,
-                -117.61766249359756 + Self::mul_add(-0.75, x612, 0.65 * x595),
+                -117.61766249359756 + Self::mul_add(-0.65, x595, 0.75 * x612),
             ),
         );
-        let x651 = Self::mul_add(-x639, x644, x650);
+        let x651 = Self::mul_add(x639, x644, x650);
         let x652 = x646 * x651;
         let x653 = Self::mul_add(
             -x634,
@@ -4461,8 +4449,8 @@ impl FreeFloating7 {
                 -x621,
                 x627,
                 1466.4506062283303
-                    + (Self::mul_add(-0.65, x599, 0.75 * x597)
-                        + (Self::mul_add(c_q7, x589, s_q7 * x588)
+                    - (Self::mul_add(-0.65, x599, 0.75 * x597)
+                        + (Self::mul_add(-c_q7, x589, s_q7 * x588)
                             + Self::mul_add(-0.65, x617, 0.75 * x615))),
             ),
         );
@@ -4470,18 +4458,18 @@ impl FreeFloating7 {
         let x655 = Self::mul_add(
             -x621,
             x628,
-            Self::mul_add(0.65, x598, Self::mul_add(-0.65, x611, 0.75 * x610)),
+            Self::mul_add(0.65, x598, Self::mul_add(0.65, x611, 0.75 * x610)),
         );
         let x656 = Self::mul_add(
             -x648,
             x652,
-            Self::mul_add(-x641, x644, Self::mul_add(-x634, x637, x655)),
+            Self::mul_add(x641, x644, Self::mul_add(-x634, x637, x655)),
         );
         let x657 = x654 * x656;
         let x658 = Self::mul_add(
             -x636,
             x637,
-            Self::mul_add(-x610, x628, Self::mul_add(0.65, x612, 1271.854575)),
+            Self::mul_add(-x610, x628, Self::mul_add(-0.65, x612, 1271.854575)),
         );
         let x659 = Self::mul_add(
             -x656,
@@ -4490,221 +4478,221 @@ impl FreeFloating7 {
         );
         let x660 = 1.0 / x659;
         let x661 = Self::mul_add(
-            x622,
+            -x622,
             x624,
-            -(Self::mul_add(-v[3], x5, v[5] * x3) + x620),
+            Self::mul_add(-v[3], x5, v[5] * x3) - x620,
         );
         let x662 = Self::mul_add(
-            -x631,
+            x631,
             x661,
-            Self::mul_add(x622, x625, -(Self::mul_add(-v[4], x3, v[3] * x4) + x585)),
+            Self::mul_add(-x622, x625, Self::mul_add(-v[3], x4, v[4] * x3) - x585),
         );
         let x663 = Self::mul_add(
             x622,
             x626,
-            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
-                + Self::mul_add(-0.75, x620, Self::mul_add(-s_q7, x582, c_q7 * x581))),
+            Self::mul_add(v[4], x2, v[5] * x1) + Self::mul_add(-v[1], x5, v[2] * x4)
+                - Self::mul_add(0.75, x620, Self::mul_add(-s_q7, x582, c_q7 * x581)),
         );
-        let x664 = Self::mul_add(-x640, x662, Self::mul_add(-x633, x661, x663));
+        let x664 = Self::mul_add(x640, x662, Self::mul_add(x633, x661, x663));
         let x665 = Self::mul_add(
-            -x635,
+            x635,
             x661,
             Self::mul_add(
                 x622,
                 x627,
-                -(Self::mul_add(-v[3], x2, v[5] * x0)
-                    + Self::mul_add(-v[0], x5, v[2] * x3)
+                Self::mul_add(v[3], x2, v[5] * x0) + Self::mul_add(-v[0], x5, v[2] * x3)
                     + (Self::mul_add(c_q7, x582, s_q7 * x581)
-                        + Self::mul_add(-0.65, x585, 0.75 * x619))),
+                        - Self::mul_add(0.65, x585, 0.75 * x619)),
             ),
         );
-        let x666 = Self::mul_add(-x649, x664, Self::mul_add(-x642, x662, x665));
+        let x666 = Self::mul_add(-x649, x664, Self::mul_add(x642, x662, x665));
         let x667 = Self::mul_add(
             x622,
             x628,
-            -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
-                + Self::mul_add(0.65, x620, Self::mul_add(x560, x555 * x559, x557))),
+            Self::mul_add(-v[3], x1, v[4] * x0) + Self::mul_add(-v[0], x4, v[1] * x3)
+                - Self::mul_add(-0.65, x620, Self::mul_add(x560, x555 * x559, x557)),
         );
         let x668 = Self::mul_add(
             -x652,
             x664,
-            Self::mul_add(-x644, x662, Self::mul_add(-x637, x661, x667)),
+            Self::mul_add(-x644, x662, Self::mul_add(x637, x661, x667)),
         );
         let x669 = x660 * Self::mul_add(-x657, x666, x668);
         let x670 = Self::mul_add(-x657, x669, x654 * x666);
-        let x671 = Self::mul_add(-x652, x669, Self::mul_add(-x649, x670, x646 * x664));
-        let x672 = Self::mul_add(
+        let x671 = -x670;
+        let x672 = Self::mul_add(-x652, x669, Self::mul_add(-x649, x670, x646 * x664));
+        let x673 = Self::mul_add(
             -x644,
             x669,
-            Self::mul_add(-x642, x670, Self::mul_add(-x640, x671, x638 * x662)),
+            Self::mul_add(x642, x670, Self::mul_add(x640, x672, x638 * x662)),
         );
-        let x673 = Self::mul_add(
-            -x635,
+        let x674 = Self::mul_add(
+            x635,
             x670,
-            Self::mul_add(-x633, x671, Self::mul_add(-x631, x672, x629 * x661)),
+            Self::mul_add(x633, x672, Self::mul_add(x631, x673, x629 * x661)),
         );
-        let x674 = Self::mul_add(-x637, x669, x673);
-        let x675 = Self::mul_add(
+        let x675 = Self::mul_add(x637, x669, x674);
+        let x676 = -x675;
+        let x677 = Self::mul_add(
             x626,
-            x671,
-            Self::mul_add(x625, x672, Self::mul_add(x624, x674, x622 * x623)),
+            x672,
+            Self::mul_add(-x625, x673, Self::mul_add(-x624, x675, x622 * x623)),
         );
-        let x676 = Self::mul_add(x628, x669, Self::mul_add(x627, x670, x675));
-        let x677 = -x676;
-        let x678 = Self::mul_add(0.75, x670, -x676);
-        let x679 = x674 - Self::mul_add(-0.65, x669, 0.75 * x671);
-        let x680 = Self::mul_add(-0.65, x670, x672);
-        let x681 = x14 + Self::mul_add(s_q7, x670, c_q7 * x671);
-        let x682 = Self::mul_add(-s_q7, x671, c_q7 * x670) - x15;
-        let x683 = x16 + Self::mul_add(s_q7, x679, c_q7 * x678);
-        let x684 = Self::mul_add(-s_q7, x678, c_q7 * x679) - x17;
-        let x685 = x559
+        let x678 = Self::mul_add(x628, x669, Self::mul_add(x627, x670, x677));
+        let x679 = Self::mul_add(-0.75, x670, x678);
+        let x680 = x675 + Self::mul_add(-0.65, x669, 0.75 * x672);
+        let x681 = Self::mul_add(0.65, x670, x673);
+        let x682 = x14 - Self::mul_add(-s_q7, x670, c_q7 * x672);
+        let x683 = x15 + Self::mul_add(c_q7, x670, s_q7 * x672);
+        let x684 = x16 - Self::mul_add(-s_q7, x680, c_q7 * x679);
+        let x685 = x17 + Self::mul_add(c_q7, x680, s_q7 * x679);
+        let x686 = x559
             * (x560
-                - (Self::mul_add(x555, x669, Self::mul_add(x554, x682, x553 * x681))
-                    + Self::mul_add(
-                        x531,
-                        x680,
-                        Self::mul_add(x556, x684, x529 * x683),
+                + (Self::mul_add(-x555, x669, Self::mul_add(x554, x683, x553 * x682))
+                    - Self::mul_add(
+                        -x531,
+                        x681,
+                        Self::mul_add(-x556, x685, x529 * x684),
                     )));
-        let x686 = x669 + x685;
-        let x687 = Self::mul_add(-0.00000000020510342851533115, x686, x681);
-        let x688 = Self::mul_add(0.35, x682, x683);
-        let x689 = Self::mul_add(-0.35, x681, x684);
-        let x690 = Self::mul_add(-0.00000000020510342851533115, x680, x688);
-        let x691 = x34
-            + Self::mul_add(-c_q8, x686, Self::mul_add(-x25, x681, s_q8 * x682));
-        let x692 = Self::mul_add(s_q8, x686, Self::mul_add(c_q8, x682, x26 * x681))
-            - x35;
-        let x693 = x36
-            + Self::mul_add(-c_q8, x680, Self::mul_add(-x25, x688, s_q8 * x689));
-        let x694 = Self::mul_add(s_q8, x680, Self::mul_add(c_q8, x689, x26 * x688))
-            - x37;
-        let x695 = x486
+        let x687 = x669 + x686;
+        let x688 = Self::mul_add(0.00000000020510342851533115, x687, x682);
+        let x689 = Self::mul_add(0.35, x683, x684);
+        let x690 = Self::mul_add(-0.35, x682, x685);
+        let x691 = Self::mul_add(0.00000000020510342851533115, x681, x689);
+        let x692 = x34
+            + Self::mul_add(-c_q8, x687, Self::mul_add(-s_q8, x683, x25 * x682));
+        let x693 = x35
+            - Self::mul_add(-s_q8, x687, Self::mul_add(c_q8, x683, x26 * x682));
+        let x694 = x36
+            + Self::mul_add(-c_q8, x681, Self::mul_add(-s_q8, x690, x25 * x689));
+        let x695 = x37
+            - Self::mul_add(-s_q8, x681, Self::mul_add(c_q8, x690, x26 * x689));
+        let x696 = x486
             * (x487
-                - (Self::mul_add(x482, x687, Self::mul_add(x481, x692, x480 * x691))
+                - (Self::mul_add(-x482, x688, Self::mul_add(x481, x693, x480 * x692))
                     + Self::mul_add(
                         x471,
-                        x690,
-                        Self::mul_add(x484, x694, x483 * x693),
+                        x691,
+                        Self::mul_add(x484, x695, x483 * x694),
                     )));
-        let x696 = x687 + x695;
-        let x697 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x696,
-            Self::mul_add(0.00000000020510342851533115, x691, x692),
+        let x697 = x688 - x696;
+        let x698 = Self::mul_add(
+            0.00000000020510342851533115,
+            x697,
+            Self::mul_add(0.00000000020510342851533115, x692, x693),
         );
-        let x698 = x693 - Self::mul_add(-0.4, x692, 0.275 * x696);
-        let x699 = Self::mul_add(-0.4, x691, x694);
-        let x700 = Self::mul_add(0.275, x691, x690);
-        let x701 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x700,
-            Self::mul_add(0.00000000020510342851533115, x698, x699),
+        let x699 = x694 + Self::mul_add(0.275, x697, 0.4 * x693);
+        let x700 = Self::mul_add(-0.4, x692, x695);
+        let x701 = Self::mul_add(-0.275, x692, x691);
+        let x702 = Self::mul_add(
+            0.00000000020510342851533115,
+            x701,
+            Self::mul_add(0.00000000020510342851533115, x699, x700),
         );
-        let x702 = x58
-            + Self::mul_add(c_q9, x696, Self::mul_add(x48, x692, s_q9 * x691));
-        let x703 = Self::mul_add(-s_q9, x696, Self::mul_add(-x49, x692, c_q9 * x691))
-            - x59;
-        let x704 = x60
-            + Self::mul_add(c_q9, x700, Self::mul_add(x48, x699, s_q9 * x698));
-        let x705 = Self::mul_add(-s_q9, x700, Self::mul_add(-x49, x699, c_q9 * x698))
-            - x61;
-        let x706 = x397
+        let x703 = x58
+            - Self::mul_add(-c_q9, x697, Self::mul_add(x48, x693, s_q9 * x692));
+        let x704 = x59
+            + Self::mul_add(s_q9, x697, Self::mul_add(-x49, x693, c_q9 * x692));
+        let x705 = x60
+            - Self::mul_add(-c_q9, x701, Self::mul_add(x48, x700, s_q9 * x699));
+        let x706 = x61
+            + Self::mul_add(s_q9, x701, Self::mul_add(-x49, x700, c_q9 * x699));
+        let x707 = x397
             * (x398
-                - (Self::mul_add(x394, x697, Self::mul_add(x393, x703, x392 * x702))
+                + (Self::mul_add(-x394, x698, Self::mul_add(-x393, x704, x392 * x703))
                     + Self::mul_add(
-                        x386,
-                        x701,
-                        Self::mul_add(x388, x705, x395 * x704),
+                        -x386,
+                        x702,
+                        Self::mul_add(x388, x706, x395 * x705),
                     )));
-        let x707 = x697 + x706;
-        let x708 = Self::mul_add(0.87, x707, x704);
-        let x709 = Self::mul_add(-0.87, x702, x701);
-        let x710 = x75 + Self::mul_add(s_q10, x703, c_q10 * x702);
-        let x711 = Self::mul_add(-s_q10, x702, c_q10 * x703) - x76;
-        let x712 = x77 + Self::mul_add(s_q10, x705, c_q10 * x708);
-        let x713 = Self::mul_add(-s_q10, x708, c_q10 * x705) - x78;
-        let x714 = x339
+        let x708 = x698 + x707;
+        let x709 = Self::mul_add(-0.87, x708, x705);
+        let x710 = Self::mul_add(0.87, x703, x702);
+        let x711 = x75 - Self::mul_add(-s_q10, x704, c_q10 * x703);
+        let x712 = x76 + Self::mul_add(c_q10, x704, s_q10 * x703);
+        let x713 = x77 - Self::mul_add(-s_q10, x706, c_q10 * x709);
+        let x714 = x78 + Self::mul_add(c_q10, x706, s_q10 * x709);
+        let x715 = x339
             * (x340
-                - (Self::mul_add(x336, x707, Self::mul_add(x335, x711, x334 * x710))
+                - (Self::mul_add(x336, x708, Self::mul_add(x335, x712, x334 * x711))
                     + Self::mul_add(
                         x323,
-                        x709,
-                        Self::mul_add(x325, x713, x337 * x712),
+                        x710,
+                        Self::mul_add(-x325, x714, x337 * x713),
                     )));
-        let x715 = x707 + x714;
-        let x716 = x712 - Self::mul_add(-0.63, x715, 0.275 * x711);
-        let x717 = Self::mul_add(0.275, x710, x713);
-        let x718 = Self::mul_add(-0.63, x710, x709);
-        let x719 = x93 + Self::mul_add(s_q11, x711, c_q11 * x710);
-        let x720 = Self::mul_add(-s_q11, x710, c_q11 * x711) - x94;
-        let x721 = x95 + Self::mul_add(s_q11, x717, c_q11 * x716);
-        let x722 = Self::mul_add(-s_q11, x716, c_q11 * x717) - x96;
-        let x723 = x274
+        let x716 = x708 + x715;
+        let x717 = x713 - Self::mul_add(-0.63, x716, 0.275 * x712);
+        let x718 = Self::mul_add(0.275, x711, x714);
+        let x719 = Self::mul_add(-0.63, x711, x710);
+        let x720 = x93 + Self::mul_add(s_q11, x712, c_q11 * x711);
+        let x721 = x94 - Self::mul_add(-c_q11, x712, s_q11 * x711);
+        let x722 = x95 + Self::mul_add(s_q11, x718, c_q11 * x717);
+        let x723 = x96 - Self::mul_add(-c_q11, x718, s_q11 * x717);
+        let x724 = x274
             * (x275
-                - (Self::mul_add(x270, x715, Self::mul_add(x269, x720, x268 * x719))
+                - (Self::mul_add(x270, x716, Self::mul_add(x269, x721, x268 * x720))
                     + Self::mul_add(
-                        x246,
-                        x718,
-                        Self::mul_add(-x245, x722, x271 * x721),
+                        -x246,
+                        x719,
+                        Self::mul_add(-x245, x723, x271 * x722),
                     )));
-        let x724 = x715 + x723;
-        let x725 = Self::mul_add(-0.00000000020510342851533115, x724, x720);
-        let x726 = Self::mul_add(-0.36, x720, x721);
-        let x727 = Self::mul_add(0.36, x719, x722);
-        let x728 = Self::mul_add(-0.00000000020510342851533115, x718, x727);
-        let x729 = Self::mul_add(-s_q12, x724, Self::mul_add(-x104, x720, c_q12 * x719))
-            - x113;
-        let x730 = x114
-            + Self::mul_add(c_q12, x724, Self::mul_add(x105, x720, s_q12 * x719));
-        let x731 = Self::mul_add(-s_q12, x718, Self::mul_add(-x104, x727, c_q12 * x726))
-            - x115;
-        let x732 = x116
-            + Self::mul_add(c_q12, x718, Self::mul_add(x105, x727, s_q12 * x726));
-        let x733 = x201
+        let x725 = x716 + x724;
+        let x726 = Self::mul_add(-0.00000000020510342851533115, x725, x721);
+        let x727 = Self::mul_add(-0.36, x721, x722);
+        let x728 = Self::mul_add(0.36, x720, x723);
+        let x729 = Self::mul_add(-0.00000000020510342851533115, x719, x728);
+        let x730 = x113
+            + Self::mul_add(-s_q12, x725, Self::mul_add(-x104, x721, c_q12 * x720));
+        let x731 = x114
+            - Self::mul_add(c_q12, x725, Self::mul_add(x105, x721, s_q12 * x720));
+        let x732 = x115
+            + Self::mul_add(-s_q12, x719, Self::mul_add(-x104, x728, c_q12 * x727));
+        let x733 = x116
+            - Self::mul_add(c_q12, x719, Self::mul_add(x105, x728, s_q12 * x727));
+        let x734 = x201
             * (x202
-                - (Self::mul_add(x197, x725, Self::mul_add(-x196, x730, x195 * x729))
+                - (Self::mul_add(x197, x726, Self::mul_add(x196, x731, x195 * x730))
                     + Self::mul_add(
-                        x187,
-                        x728,
-                        Self::mul_add(-x199, x732, x198 * x731),
+                        -x187,
+                        x729,
+                        Self::mul_add(x199, x733, x198 * x732),
                     )));
-        let x734 = x725 + x733;
-        let x735 = Self::mul_add(
-            c_q13,
-            Self::mul_add(0.55, x729, x728),
-            Self::mul_add(
-                s_q13,
-                Self::mul_add(0.16, x729, x732),
-                x125 * (x731 - Self::mul_add(0.55, x734, 0.16 * x730)),
-            ),
-        );
+        let x735 = x726 + x734;
         let x736 = Self::mul_add(
-            0.9614610000000001,
-            x136 + Self::mul_add(s_q13, x734, Self::mul_add(-c_q13, x730, x126 * x729)),
-            0.0145
-                * (x135
-                    - Self::mul_add(
-                        c_q13,
-                        x734,
-                        Self::mul_add(s_q13, x730, x125 * x729),
-                    )),
+            c_q13,
+            Self::mul_add(0.55, x730, x729),
+            Self::mul_add(
+                -s_q13,
+                Self::mul_add(-0.16, x730, x733),
+                x125 * (x732 + Self::mul_add(-0.55, x735, 0.16 * x731)),
+            ),
         );
         let x737 = Self::mul_add(
-            -4.806620000000001,
-            x137 - x735,
+            0.9614610000000001,
+            x136 - Self::mul_add(s_q13, x735, Self::mul_add(c_q13, x731, x126 * x730)),
+            0.0145
+                * (x135
+                    + Self::mul_add(
+                        c_q13,
+                        x735,
+                        Self::mul_add(-s_q13, x731, x125 * x730),
+                    )),
+        );
+        let x738 = Self::mul_add(
+            4.806620000000001,
+            x137 + x736,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x734, x729),
-                -x736,
+                Self::mul_add(-0.00000000020510342851533115, x735, x730),
+                x737,
             ),
         );
-        let x738 = 0.707433253035886 * (x146 - x737);
-        [x677, x674, x672, x671, x670, x669, x685, x695, x706, x714, x723, x733, x738]
+        let x739 = 0.707433253035886 * (x146 - x738);
+        [x678, x676, x673, x672, x671, x669, x686, x696, x707, x715, x724, x734, x739]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1076 mul, 935 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 618 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 1076 mul, 933 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 620 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -4740,8 +4728,8 @@ impl FreeFloating7 {
         let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
         let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
         let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = 0.00000000019719894748377882
-            - Self::mul_add(s_q13, 1.2025609200000003, x23);
+        let x28 = Self::mul_add(s_q13, 1.2025609200000003, x23)
+            - 0.00000000019719894748377882;
         let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
             + -0.0000000002899261911072858;
         let x30 = 0.16 * x19;
@@ -4751,56 +4739,55 @@ impl FreeFloating7 {
         let x34 = 0.16 * x17;
         let x35 = 0.16 * x18;
         let x36 = 0.55 * x19;
-        let x37 = x32 + (x22 + Self::mul_add(-x15, x20, x16 * x21) + x32);
+        let x37 = x32 + (x22 - Self::mul_add(-x16, x21, x15 * x20) + x32);
         let x38 = 3.6140000000000003 + x17;
         let x39 = 17.135250000000003 + x18;
         let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
         let x41 = -0.809539999555672
-            + (Self::mul_add(
-                -0.00000000020510342851533115,
+            - (Self::mul_add(
+                0.00000000020510342851533115,
                 x22,
-                Self::mul_add(-c_q13, x20, s_q13 * x21),
-            ) - x34);
+                Self::mul_add(-s_q13, x21, c_q13 * x20),
+            ) + x34);
         let x42 = -1.9877000000000002
-            + (Self::mul_add(-x15, x23, x16 * x25) - x26 - x33);
+            - (x26 + Self::mul_add(-x16, x25, x15 * x23) + x33);
         let x43 = -5.252920330000002
             + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
         let x44 = -2.741639999592316
-            + (Self::mul_add(
-                0.00000000020510342851533115,
-                x26,
-                Self::mul_add(-c_q13, x23, s_q13 * x25),
-            ) - x35 - x36);
-        let x45 = -0.809539999555672 + (x29 + Self::mul_add(-x15, x27, x16 * x28) - x34);
-        let x46 = -2.7416399995923166
-            + (Self::mul_add(c_q13, x28, s_q13 * x27) - x36 - x35);
-        let x47 = 9.740442170000001
-            + (x31
+            - (x36
                 + (Self::mul_add(
                     -0.00000000020510342851533115,
+                    x26,
+                    Self::mul_add(-s_q13, x25, c_q13 * x23),
+                ) + x35));
+        let x45 = -0.809539999555672 + (x29 - Self::mul_add(x16, x28, x15 * x27) - x34);
+        let x46 = -2.7416399995923166
+            - (x35 - (Self::mul_add(-c_q13, x28, s_q13 * x27) - x36));
+        let x47 = 9.740442170000001
+            + (x31
+                - (Self::mul_add(
+                    0.00000000020510342851533115,
                     x29,
-                    Self::mul_add(-c_q13, x27, s_q13 * x28),
-                ) + x31));
-        let x48 = c_q12 * x38;
-        let x49 = s_q12 * x39;
-        let x50 = x48 - x49;
-        let x51 = x19 - Self::mul_add(x13, x39, x12 * x38);
-        let x52 = Self::mul_add(c_q12, x39, s_q12 * x38);
-        let x53 = Self::mul_add(0.00000000020510342851533115, x19, x52);
-        let x54 = Self::mul_add(-s_q12, x42, c_q12 * x37);
-        let x55 = Self::mul_add(-s_q12, x43, c_q12 * x40);
-        let x56 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x57 = x45 - Self::mul_add(x13, x42, x12 * x37);
-        let x58 = x46 - Self::mul_add(x13, x43, x12 * x40);
-        let x59 = x47 - Self::mul_add(x13, x44, x12 * x41);
-        let x60 = Self::mul_add(
+                    Self::mul_add(s_q13, x28, c_q13 * x27),
+                ) - x31));
+        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
+        let x49 = x19 - Self::mul_add(x13, x39, x12 * x38);
+        let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
+        let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
+        let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
+        let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
+        let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
+        let x55 = x45 - Self::mul_add(x13, x42, x12 * x37);
+        let x56 = x46 - Self::mul_add(x13, x43, x12 * x40);
+        let x57 = x47 - Self::mul_add(x13, x44, x12 * x41);
+        let x58 = Self::mul_add(
             0.00000000020510342851533115,
             x47,
             Self::mul_add(c_q12, x44, s_q12 * x41),
         );
-        let x61 = -x60;
-        let x62 = x56 - Self::mul_add(x13, x55, x12 * x54);
-        let x63 = Self::mul_add(
+        let x59 = -x58;
+        let x60 = x54 - Self::mul_add(x13, x53, x12 * x52);
+        let x61 = Self::mul_add(
             c_q12,
             Self::mul_add(
                 0.00000000020510342851533115,
@@ -4814,1002 +4801,989 @@ impl FreeFloating7 {
                     Self::mul_add(c_q12, x42, s_q12 * x37),
                 ),
         );
-        let x64 = x53 * 0.36;
-        let x65 = Self::mul_add(
-            x50,
-            0.36,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x56,
-                Self::mul_add(c_q12, x55, s_q12 * x54),
-            ),
-        );
-        let x66 = Self::mul_add(
-            x51,
-            0.36,
-            -Self::mul_add(
-                0.00000000020510342851533115,
-                x59,
-                Self::mul_add(c_q12, x58, s_q12 * x57),
-            ),
-        );
-        let x67 = x64 + (Self::mul_add(-s_q12, x55, c_q12 * x54) + x64);
-        let x68 = 7.078399999258757 + x51;
-        let x69 = 0.01675 + x65;
-        let x70 = -9.142025249762803
-            + (x64 + (x59 - Self::mul_add(x13, x58, x12 * x57) + x64));
-        let x71 = 2.5482240016099564 + x66;
-        let x72 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x60, x63);
-        let x73 = s_q11 * s_q11;
-        let x74 = s_q11 * c_q11;
-        let x75 = x67 - x70;
-        let x76 = x62 + x62;
-        let x77 = Self::mul_add(x74, x76, x73 * x75);
-        let x78 = Self::mul_add(-s_q11, x68, c_q11 * x50);
-        let x79 = Self::mul_add(c_q11, x68, s_q11 * x50);
-        let x80 = 0.275 * x53;
-        let x81 = x79 * 0.63;
-        let x82 = x81 - x80;
-        let x83 = Self::mul_add(x78, 0.63, x62 + Self::mul_add(-x73, x76, x74 * x75));
-        let x84 = Self::mul_add(0.275, x78, Self::mul_add(-s_q11, x71, c_q11 * x69));
-        let x85 = Self::mul_add(0.275, x79, Self::mul_add(c_q11, x71, s_q11 * x69));
-        let x86 = x72 - x81;
-        let x87 = x67 - x77 - x82 - x82;
-        let x88 = -45.1584 + x79;
-        let x89 = -0.6328 + x84;
-        let x90 = -24.4950615 + (x80 + (x70 + x77 + x80));
-        let x91 = -24.35164200091464 + Self::mul_add(x53, -0.63, x85);
-        let x92 = 28.2393615 + (x86 - x81);
-        let x93 = s_q10 * s_q10;
-        let x94 = s_q10 * c_q10;
-        let x95 = x87 - x90;
-        let x96 = x83 + x83;
-        let x97 = Self::mul_add(x94, x96, x93 * x95);
-        let x98 = Self::mul_add(-s_q10, x91, c_q10 * x89);
-        let x99 = Self::mul_add(c_q10, x91, s_q10 * x89);
-        let x100 = c_q10 * x78;
-        let x101 = Self::mul_add(-s_q10, x88, x100);
-        let x102 = s_q10 * x78;
-        let x103 = Self::mul_add(c_q10, x88, x102);
-        let x104 = x103 * 0.87;
-        let x105 = Self::mul_add(x101, 0.87, x83 + Self::mul_add(-x93, x96, x94 * x95));
-        let x106 = x92 - x104;
-        let x107 = x87 - x97 - x104 - x104;
-        let x108 = -81.53205 + x103;
-        let x109 = -0.00214 + x98;
-        let x110 = -63.36336825000001 + (x90 + x97);
-        let x111 = -36.18604050126307 + Self::mul_add(x53, -0.87, x99);
-        let x112 = 69.99836825 + (x106 - x104);
-        let x113 = s_q9 * x101;
-        let x114 = Self::mul_add(c_q9, x108, x113);
-        let x115 = 0.00000000020510342851533115 * x53;
-        let x116 = x114 - x115;
-        let x117 = Self::mul_add(-x8, x108, x7 * x101) - x53;
-        let x118 = c_q9 * x101;
-        let x119 = Self::mul_add(-s_q9, x108, x118);
-        let x120 = x115 + x119;
-        let x121 = c_q9 * x105;
-        let x122 = 0.00000000020510342851533115 * x109;
-        let x123 = Self::mul_add(s_q9, x107, x121) + x122;
-        let x124 = s_q9 * x105;
-        let x125 = 0.00000000020510342851533115 * x111;
-        let x126 = Self::mul_add(c_q9, x110, x124) + x125;
-        let x127 = 0.00000000020510342851533115 * x112;
-        let x128 = Self::mul_add(c_q9, x111, s_q9 * x109) + x127;
-        let x129 = x109 + Self::mul_add(-x8, x105, x7 * x107);
-        let x130 = x111 + Self::mul_add(-x8, x110, x7 * x105);
-        let x131 = x112 + Self::mul_add(-x8, x111, x7 * x109);
-        let x132 = Self::mul_add(c_q9, x107, -x124) - x122;
-        let x133 = Self::mul_add(-s_q9, x110, x121) - x125;
-        let x134 = Self::mul_add(-s_q9, x111, c_q9 * x109) - x127;
-        let x135 = 0.00000000020510342851533115 * x128;
-        let x136 = 0.00000000020510342851533115 * x131;
-        let x137 = 0.00000000020510342851533115 * x134;
-        let x138 = 0.4 * x120;
-        let x139 = 0.275 * x117;
-        let x140 = x138 + x139;
-        let x141 = 0.275 * x116;
-        let x142 = 0.4 * x116;
-        let x143 = 0.4 * x117;
-        let x144 = 0.275 * x120;
-        let x145 = x140 + (Self::mul_add(c_q9, x126, s_q9 * x123) + x135 + x140);
-        let x146 = -0.000000008530897668050218 + x116;
-        let x147 = -12.701650001451807 + x117;
-        let x148 = -0.0000000234896432582596
-            + (x128 + Self::mul_add(-x8, x126, x7 * x123) - x141);
-        let x149 = -0.002139996587640933
-            + (Self::mul_add(-s_q9, x126, c_q9 * x123) - x135 - x142);
-        let x150 = -0.0000000234896432582596
-            + (Self::mul_add(c_q9, x130, s_q9 * x129) + x136 - x141);
-        let x151 = -111.7548902508081
-            + (x138 + (x131 + Self::mul_add(-x8, x130, x7 * x129) + x138));
-        let x152 = 5.080660024070365
-            + (Self::mul_add(-s_q9, x130, c_q9 * x129) - x136 - x143 - x144);
-        let x153 = -0.002139996587640933
-            + (Self::mul_add(c_q9, x133, s_q9 * x132) + x137 - x142);
-        let x154 = 5.080660024070366
-            + (x134 + Self::mul_add(-x8, x133, x7 * x132) - x144 - x143);
-        let x155 = 113.3918902508081
-            + (x139 + (Self::mul_add(-s_q9, x133, c_q9 * x132) - x137 + x139));
-        let x156 = x120 + Self::mul_add(-x2, x146, x3 * x147);
-        let x157 = Self::mul_add(c_q8, x147, s_q8 * x146);
-        let x158 = c_q8 * x146;
-        let x159 = s_q8 * x147;
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x120, x159 - x158);
-        let x161 = x153 + Self::mul_add(-x2, x145, x3 * x150);
-        let x162 = x154 + Self::mul_add(-x2, x148, x3 * x151);
-        let x163 = x155 + Self::mul_add(-x2, x149, x3 * x152);
-        let x164 = Self::mul_add(c_q8, x150, s_q8 * x145);
-        let x165 = Self::mul_add(c_q8, x151, s_q8 * x148);
-        let x166 = Self::mul_add(c_q8, x152, s_q8 * x149);
-        let x167 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x155,
-            Self::mul_add(-c_q8, x149, s_q8 * x152),
-        );
-        let x168 = Self::mul_add(
-            -c_q8,
+        let x62 = x51 * 0.36;
+        let x63 = Self::mul_add(
+            x48,
+            -0.36,
             Self::mul_add(
-                -0.00000000020510342851533115,
-                x153,
-                Self::mul_add(-c_q8, x145, s_q8 * x150),
+                0.00000000020510342851533115,
+                x54,
+                Self::mul_add(c_q12, x53, s_q12 * x52),
             ),
-            s_q8
+        );
+        let x64 = Self::mul_add(
+            x49,
+            -0.36,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x57,
+                Self::mul_add(c_q12, x56, s_q12 * x55),
+            ),
+        );
+        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) + x62);
+        let x66 = 7.078399999258757 + x49;
+        let x67 = 0.01675 - x63;
+        let x68 = -9.142025249762803
+            + (x62 + (x57 - Self::mul_add(x13, x56, x12 * x55) + x62));
+        let x69 = 2.5482240016099564 - x64;
+        let x70 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x58, x61);
+        let x71 = s_q11 * s_q11;
+        let x72 = s_q11 * c_q11;
+        let x73 = x65 - x68;
+        let x74 = x60 + x60;
+        let x75 = Self::mul_add(x72, x74, x71 * x73);
+        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
+        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
+        let x78 = 0.275 * x51;
+        let x79 = x77 * 0.63;
+        let x80 = x78 - x79;
+        let x81 = Self::mul_add(x76, 0.63, x60 + Self::mul_add(-x71, x74, x72 * x73));
+        let x82 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
+        let x83 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
+        let x84 = x70 - x79;
+        let x85 = x80 + (x65 - x75 + x80);
+        let x86 = -45.1584 + x77;
+        let x87 = -0.6328 + x82;
+        let x88 = -24.4950615 + (x78 + (x68 + x75 + x78));
+        let x89 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x83);
+        let x90 = 28.2393615 - (x79 - x84);
+        let x91 = s_q10 * s_q10;
+        let x92 = s_q10 * c_q10;
+        let x93 = x85 - x88;
+        let x94 = x81 + x81;
+        let x95 = Self::mul_add(x92, x94, x91 * x93);
+        let x96 = Self::mul_add(-s_q10, x89, c_q10 * x87);
+        let x97 = Self::mul_add(c_q10, x89, s_q10 * x87);
+        let x98 = c_q10 * x76;
+        let x99 = Self::mul_add(-s_q10, x86, x98);
+        let x100 = s_q10 * x76;
+        let x101 = Self::mul_add(c_q10, x86, x100);
+        let x102 = x101 * 0.87;
+        let x103 = Self::mul_add(x99, 0.87, x81 + Self::mul_add(-x91, x94, x92 * x93));
+        let x104 = x90 - x102;
+        let x105 = x102 - (x85 - x95 - x102);
+        let x106 = -81.53205 + x101;
+        let x107 = -0.00214 + x96;
+        let x108 = -63.36336825000001 + (x88 + x95);
+        let x109 = -36.18604050126307 + Self::mul_add(x51, -0.87, x97);
+        let x110 = 69.99836825 - (x102 - x104);
+        let x111 = s_q9 * x99;
+        let x112 = Self::mul_add(c_q9, x106, x111);
+        let x113 = 0.00000000020510342851533115 * x51;
+        let x114 = x112 - x113;
+        let x115 = x51 - Self::mul_add(-x8, x106, x7 * x99);
+        let x116 = c_q9 * x99;
+        let x117 = Self::mul_add(-s_q9, x106, x116);
+        let x118 = x113 + x117;
+        let x119 = c_q9 * x103;
+        let x120 = 0.00000000020510342851533115 * x107;
+        let x121 = Self::mul_add(s_q9, x105, -x119) - x120;
+        let x122 = s_q9 * x103;
+        let x123 = 0.00000000020510342851533115 * x109;
+        let x124 = Self::mul_add(c_q9, x108, x122) + x123;
+        let x125 = 0.00000000020510342851533115 * x110;
+        let x126 = Self::mul_add(c_q9, x109, s_q9 * x107) + x125;
+        let x127 = x107 - Self::mul_add(x8, x103, x7 * x105);
+        let x128 = x109 + Self::mul_add(-x8, x108, x7 * x103);
+        let x129 = x110 + Self::mul_add(-x8, x109, x7 * x107);
+        let x130 = x120 + Self::mul_add(c_q9, x105, x122);
+        let x131 = x123 - Self::mul_add(-s_q9, x108, x119);
+        let x132 = x125 - Self::mul_add(-s_q9, x109, c_q9 * x107);
+        let x133 = 0.00000000020510342851533115 * x126;
+        let x134 = 0.00000000020510342851533115 * x129;
+        let x135 = 0.00000000020510342851533115 * x132;
+        let x136 = 0.4 * x118;
+        let x137 = 0.275 * x115;
+        let x138 = x136 - x137;
+        let x139 = 0.275 * x114;
+        let x140 = 0.4 * x114;
+        let x141 = 0.4 * x115;
+        let x142 = 0.275 * x118;
+        let x143 = x138 - (Self::mul_add(-c_q9, x124, s_q9 * x121) - x133 - x138);
+        let x144 = -0.000000008530897668050218 + x114;
+        let x145 = -12.701650001451807 - x115;
+        let x146 = -0.0000000234896432582596
+            + (x126 - Self::mul_add(x8, x124, x7 * x121) - x139);
+        let x147 = -0.002139996587640933
+            - (x133 + Self::mul_add(s_q9, x124, c_q9 * x121) + x140);
+        let x148 = -0.0000000234896432582596
+            + (Self::mul_add(c_q9, x128, s_q9 * x127) + x134 - x139);
+        let x149 = -111.7548902508081
+            + (x136 + (x129 + Self::mul_add(-x8, x128, x7 * x127) + x136));
+        let x150 = 5.080660024070365
+            - (x142 + (x134 - Self::mul_add(-s_q9, x128, c_q9 * x127) - x141));
+        let x151 = -0.002139996587640933
+            - (Self::mul_add(c_q9, x131, s_q9 * x130) + x135 + x140);
+        let x152 = 5.080660024070366
+            + (x141 - (x132 + Self::mul_add(-x8, x131, x7 * x130) + x142));
+        let x153 = 113.3918902508081
+            - (x137 - (x135 - Self::mul_add(-s_q9, x131, c_q9 * x130) - x137));
+        let x154 = x118 - Self::mul_add(-x3, x145, x2 * x144);
+        let x155 = Self::mul_add(c_q8, x145, s_q8 * x144);
+        let x156 = Self::mul_add(-s_q8, x145, c_q8 * x144);
+        let x157 = Self::mul_add(0.00000000020510342851533115, x118, x156);
+        let x158 = x151 - Self::mul_add(-x3, x148, x2 * x143);
+        let x159 = x152 - Self::mul_add(-x3, x149, x2 * x146);
+        let x160 = x153 - Self::mul_add(-x3, x150, x2 * x147);
+        let x161 = Self::mul_add(c_q8, x148, s_q8 * x143);
+        let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
+        let x163 = Self::mul_add(c_q8, x150, s_q8 * x147);
+        let x164 = Self::mul_add(
+            0.00000000020510342851533115,
+            x153,
+            Self::mul_add(-s_q8, x150, c_q8 * x147),
+        );
+        let x165 = -x164;
+        let x166 = Self::mul_add(
+            -s_q8,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x152,
+                Self::mul_add(-s_q8, x149, c_q8 * x146),
+            ),
+            c_q8
                 * Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x154,
-                    Self::mul_add(-c_q8, x148, s_q8 * x151),
+                    0.00000000020510342851533115,
+                    x151,
+                    Self::mul_add(-s_q8, x148, c_q8 * x143),
                 ),
         );
-        let x169 = 0.35 * x160;
-        let x170 = Self::mul_add(
-            -0.35,
-            x156,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x163,
-                Self::mul_add(-c_q8, x161, s_q8 * x162),
-            ),
-        );
-        let x171 = Self::mul_add(
-            -0.35,
-            x157,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x166,
-                Self::mul_add(-c_q8, x164, s_q8 * x165),
-            ),
-        );
-        let x172 = x169 + (x163 + Self::mul_add(-x2, x161, x3 * x162) + x169);
-        let x173 = 48.0240000085309 + x156;
-        let x174 = -0.07309 + Self::mul_add(c_q8, x162, s_q8 * x161);
-        let x175 = -16.80768997608804 + x170;
-        let x176 = 130.43769025763282
-            + (x169 + (Self::mul_add(c_q8, x165, s_q8 * x164) + x169));
-        let x177 = 0.1132 + x171;
-        let x178 = 132.47349025763282
-            + Self::mul_add(-0.00000000020510342851533115, x167, x168);
-        let x179 = s_q7 * s_q7;
-        let x180 = s_q7 * c_q7;
-        let x181 = x172 - x176;
-        let x182 = x174 + x174;
-        let x183 = Self::mul_add(x180, x182, x179 * x181);
-        let x184 = Self::mul_add(-s_q7, x157, c_q7 * x173);
-        let x185 = Self::mul_add(c_q7, x157, s_q7 * x173);
-        let x186 = -x185;
-        let x187 = 0.75 * x160;
-        let x188 = 0.65 * x184;
-        let x189 = x187 + x188;
-        let x190 = Self::mul_add(-0.75, x184, Self::mul_add(-s_q7, x177, c_q7 * x175));
-        let x191 = Self::mul_add(
-            -0.65,
-            x185,
-            x174 + Self::mul_add(-x179, x182, x180 * x181),
-        );
-        let x192 = Self::mul_add(-0.75, x185, Self::mul_add(c_q7, x177, s_q7 * x175));
-        let x193 = x178 + x188;
-        let x194 = 110.5455 + x184;
-        let x195 = 180.9502499901501 + x160;
-        let x196 = 1394.5960312283303 + (x187 + (x172 - x183 + x187));
-        let x197 = -117.61766249359756 + Self::mul_add(-0.65, x160, x190);
-        let x198 = 1466.4506062283303 + (x189 + (x176 + x183 + x189));
-        let x199 = 1271.854575 + (x188 + x193);
-        let x200 = -x195;
-        let x201 = -x194;
-        let x202 = Self::mul_add(x3, x146, x2 * x147);
-        let x203 = x158 - x159;
-        let x204 = Self::mul_add(-0.35, x203, x163);
-        let x205 = Self::mul_add(0.35, x202, x166);
-        let x206 = Self::mul_add(-s_q7, x203, c_q7 * x202);
-        let x207 = Self::mul_add(c_q7, x203, s_q7 * x202);
-        let x208 = Self::mul_add(-0.75, x207, Self::mul_add(-s_q7, x205, c_q7 * x204));
-        let x209 = Self::mul_add(c_q7, x205, s_q7 * x204)
-            + Self::mul_add(-0.65, x157, 0.75 * x206);
-        let x210 = Self::mul_add(0.65, x207, x167);
-        let x211 = x8 * x101;
-        let x212 = Self::mul_add(x7, x108, x211);
-        let x213 = x128 + Self::mul_add(-0.275, x114, 0.4 * x212);
-        let x214 = Self::mul_add(0.4, x119, x131);
-        let x215 = Self::mul_add(-0.275, x119, x134);
-        let x216 = x114 + Self::mul_add(x3, x212, x2 * x119);
-        let x217 = Self::mul_add(-c_q8, x212, s_q8 * x119);
-        let x218 = Self::mul_add(
-            0.00000000020510342851533115,
-            x114,
-            -Self::mul_add(s_q8, x212, c_q8 * x119),
-        );
-        let x219 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x215,
-            Self::mul_add(-c_q8, x213, s_q8 * x214),
-        );
-        let x220 = Self::mul_add(
-            -0.35,
-            x217,
-            x215 + Self::mul_add(-x2, x213, x3 * x214),
-        );
-        let x221 = Self::mul_add(-0.35, x216, Self::mul_add(c_q8, x214, s_q8 * x213));
-        let x222 = Self::mul_add(s_q7, x217, c_q7 * x216);
-        let x223 = -x222;
-        let x224 = Self::mul_add(-s_q7, x216, c_q7 * x217);
-        let x225 = Self::mul_add(-0.75, x224, Self::mul_add(-s_q7, x221, c_q7 * x220));
-        let x226 = Self::mul_add(c_q7, x221, s_q7 * x220)
-            - Self::mul_add(0.65, x218, 0.75 * x222);
-        let x227 = Self::mul_add(0.65, x224, x219);
-        let x228 = Self::mul_add(-s_q9, x103, x118);
-        let x229 = Self::mul_add(x7, x103, x211);
-        let x230 = Self::mul_add(c_q9, x103, x113);
-        let x231 = 0.00000000020510342851533115 * x106;
-        let x232 = Self::mul_add(c_q9, x99, s_q9 * x98) + x231
-            + Self::mul_add(-0.275, x230, 0.4 * x229);
-        let x233 = Self::mul_add(0.4, x228, x106 + Self::mul_add(-x8, x99, x7 * x98));
-        let x234 = Self::mul_add(
-            -0.275,
-            x228,
-            Self::mul_add(-s_q9, x99, c_q9 * x98) - x231,
-        );
-        let x235 = x230 + Self::mul_add(x3, x229, x2 * x228);
-        let x236 = Self::mul_add(-c_q8, x229, s_q8 * x228);
-        let x237 = Self::mul_add(
-            0.00000000020510342851533115,
-            x230,
-            -Self::mul_add(s_q8, x229, c_q8 * x228),
-        );
-        let x238 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x234,
-            Self::mul_add(-c_q8, x232, s_q8 * x233),
-        );
-        let x239 = Self::mul_add(
-            -0.35,
-            x236,
-            x234 + Self::mul_add(-x2, x232, x3 * x233),
-        );
-        let x240 = Self::mul_add(-0.35, x235, Self::mul_add(c_q8, x233, s_q8 * x232));
-        let x241 = Self::mul_add(s_q7, x236, c_q7 * x235);
-        let x242 = -x241;
-        let x243 = Self::mul_add(-s_q7, x235, c_q7 * x236);
-        let x244 = Self::mul_add(-0.75, x243, Self::mul_add(-s_q7, x240, c_q7 * x239));
-        let x245 = Self::mul_add(c_q7, x240, s_q7 * x239)
-            - Self::mul_add(0.65, x237, 0.75 * x241);
-        let x246 = Self::mul_add(0.65, x243, x238);
-        let x247 = Self::mul_add(c_q10, x79, x102);
-        let x248 = Self::mul_add(-s_q10, x79, x100);
-        let x249 = Self::mul_add(-s_q10, x85, c_q10 * x84);
-        let x250 = Self::mul_add(c_q10, x85, s_q10 * x84);
-        let x251 = Self::mul_add(-0.87, x247, x86);
-        let x252 = Self::mul_add(-s_q9, x247, c_q9 * x248);
-        let x253 = Self::mul_add(x8, x248, x7 * x247);
-        let x254 = Self::mul_add(s_q9, x248, c_q9 * x247);
-        let x255 = 0.00000000020510342851533115 * x251;
-        let x256 = Self::mul_add(c_q9, x250, s_q9 * x249) + x255
-            + Self::mul_add(-0.275, x254, 0.4 * x253);
-        let x257 = Self::mul_add(0.4, x252, x251 + Self::mul_add(-x8, x250, x7 * x249));
-        let x258 = Self::mul_add(
-            -0.275,
-            x252,
-            Self::mul_add(-s_q9, x250, c_q9 * x249) - x255,
-        );
-        let x259 = x254 + Self::mul_add(x3, x253, x2 * x252);
-        let x260 = Self::mul_add(-c_q8, x253, s_q8 * x252);
-        let x261 = Self::mul_add(
-            0.00000000020510342851533115,
-            x254,
-            -Self::mul_add(s_q8, x253, c_q8 * x252),
-        );
-        let x262 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x258,
-            Self::mul_add(-c_q8, x256, s_q8 * x257),
-        );
-        let x263 = Self::mul_add(
-            -0.35,
-            x260,
-            x258 + Self::mul_add(-x2, x256, x3 * x257),
-        );
-        let x264 = Self::mul_add(-0.35, x259, Self::mul_add(c_q8, x257, s_q8 * x256));
-        let x265 = Self::mul_add(s_q7, x260, c_q7 * x259);
-        let x266 = -x265;
-        let x267 = Self::mul_add(-s_q7, x259, c_q7 * x260);
-        let x268 = Self::mul_add(-0.75, x267, Self::mul_add(-s_q7, x264, c_q7 * x263));
-        let x269 = Self::mul_add(c_q7, x264, s_q7 * x263)
-            - Self::mul_add(0.65, x261, 0.75 * x265);
-        let x270 = Self::mul_add(0.65, x267, x262);
-        let x271 = Self::mul_add(-x13, x38, x12 * x39);
-        let x272 = x49 - x48;
-        let x273 = Self::mul_add(0.36, x271, x56);
-        let x274 = Self::mul_add(x52, 0.36, x59);
-        let x275 = Self::mul_add(s_q11, x271, c_q11 * x52);
-        let x276 = Self::mul_add(-s_q11, x52, c_q11 * x271);
-        let x277 = Self::mul_add(-s_q11, x274, c_q11 * x273)
-            + Self::mul_add(-0.63, x272, 0.275 * x276);
-        let x278 = Self::mul_add(0.275, x275, Self::mul_add(c_q11, x274, s_q11 * x273));
-        let x279 = Self::mul_add(0.63, x275, x60);
-        let x280 = -x279;
-        let x281 = Self::mul_add(s_q10, x276, c_q10 * x275);
-        let x282 = Self::mul_add(-s_q10, x275, c_q10 * x276);
-        let x283 = Self::mul_add(c_q10, x278, s_q10 * x277);
-        let x284 = Self::mul_add(-0.87, x272, Self::mul_add(-s_q10, x278, c_q10 * x277));
-        let x285 = Self::mul_add(0.87, x281, x279);
-        let x286 = -x285;
-        let x287 = 0.00000000020510342851533115 * x272;
-        let x288 = Self::mul_add(-s_q9, x281, c_q9 * x282) + x287;
-        let x289 = x272 - Self::mul_add(x8, x282, x7 * x281);
-        let x290 = x287 + Self::mul_add(s_q9, x282, c_q9 * x281);
-        let x291 = 0.00000000020510342851533115 * x285;
-        let x292 = Self::mul_add(c_q9, x283, s_q9 * x284) - x291
-            - Self::mul_add(0.275, x290, 0.4 * x289);
-        let x293 = Self::mul_add(0.4, x288, Self::mul_add(-x8, x283, x7 * x284) - x285);
-        let x294 = Self::mul_add(
-            -0.275,
-            x288,
-            x291 + Self::mul_add(-s_q9, x283, c_q9 * x284),
-        );
-        let x295 = Self::mul_add(-x2, x288, x3 * x289) - x290;
-        let x296 = Self::mul_add(c_q8, x289, s_q8 * x288);
-        let x297 = Self::mul_add(
-            0.00000000020510342851533115,
-            x290,
-            Self::mul_add(-c_q8, x288, s_q8 * x289),
-        );
-        let x298 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x294,
-            Self::mul_add(-c_q8, x292, s_q8 * x293),
-        );
-        let x299 = Self::mul_add(
-            -0.35,
-            x296,
-            x294 + Self::mul_add(-x2, x292, x3 * x293),
-        );
-        let x300 = Self::mul_add(0.35, x295, Self::mul_add(c_q8, x293, s_q8 * x292));
-        let x301 = Self::mul_add(-s_q7, x296, c_q7 * x295);
-        let x302 = Self::mul_add(c_q7, x296, s_q7 * x295);
-        let x303 = Self::mul_add(-0.75, x302, Self::mul_add(-s_q7, x300, c_q7 * x299));
-        let x304 = Self::mul_add(c_q7, x300, s_q7 * x299)
-            + Self::mul_add(-0.65, x297, 0.75 * x301);
-        let x305 = Self::mul_add(0.65, x302, x298);
-        let x306 = 4.806620000000001 * x15;
-        let x307 = x22 + x32;
-        let x308 = Self::mul_add(0.16, x306, -x26);
-        let x309 = Self::mul_add(-0.55, x306, x29);
-        let x310 = Self::mul_add(s_q12, x19, c_q12 * x306);
-        let x311 = x18 + Self::mul_add(-x12, x306, x13 * x19);
-        let x312 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x18,
-            Self::mul_add(-s_q12, x306, c_q12 * x19),
-        );
-        let x313 = Self::mul_add(
-            0.00000000020510342851533115,
-            x309,
-            Self::mul_add(c_q12, x308, s_q12 * x307),
-        );
-        let x314 = -x313;
-        let x315 = Self::mul_add(0.36, x311, Self::mul_add(-s_q12, x308, c_q12 * x307));
-        let x316 = Self::mul_add(
-            -0.36,
-            x310,
-            x309 - Self::mul_add(x13, x308, x12 * x307),
-        );
-        let x317 = Self::mul_add(-s_q11, x311, c_q11 * x310);
-        let x318 = Self::mul_add(c_q11, x311, s_q11 * x310);
-        let x319 = Self::mul_add(-s_q11, x316, c_q11 * x315)
-            + Self::mul_add(-0.63, x312, 0.275 * x318);
-        let x320 = Self::mul_add(-0.275, x317, Self::mul_add(c_q11, x316, s_q11 * x315));
-        let x321 = Self::mul_add(0.63, x317, -x313);
-        let x322 = Self::mul_add(-s_q10, x318, c_q10 * x317);
-        let x323 = Self::mul_add(c_q10, x318, s_q10 * x317);
-        let x324 = Self::mul_add(c_q10, x320, s_q10 * x319);
-        let x325 = Self::mul_add(-0.87, x312, Self::mul_add(-s_q10, x320, c_q10 * x319));
-        let x326 = Self::mul_add(0.87, x322, x321);
-        let x327 = 0.00000000020510342851533115 * x312;
-        let x328 = Self::mul_add(c_q9, x323, s_q9 * x322) + x327;
-        let x329 = x312 + Self::mul_add(-x8, x323, x7 * x322);
-        let x330 = Self::mul_add(-s_q9, x323, c_q9 * x322) - x327;
-        let x331 = 0.00000000020510342851533115 * x326;
-        let x332 = Self::mul_add(c_q9, x324, s_q9 * x325) + x331
-            + Self::mul_add(-0.4, x329, 0.275 * x330);
-        let x333 = Self::mul_add(0.4, x328, x326 + Self::mul_add(-x8, x324, x7 * x325));
-        let x334 = Self::mul_add(
-            -0.275,
-            x328,
-            Self::mul_add(-s_q9, x324, c_q9 * x325) - x331,
-        );
-        let x335 = x330 + Self::mul_add(-x2, x328, x3 * x329);
-        let x336 = Self::mul_add(c_q8, x329, s_q8 * x328);
-        let x337 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x330,
-            Self::mul_add(-c_q8, x328, s_q8 * x329),
-        );
-        let x338 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x334,
-            Self::mul_add(-c_q8, x332, s_q8 * x333),
-        );
-        let x339 = Self::mul_add(
-            -0.35,
-            x336,
-            x334 + Self::mul_add(-x2, x332, x3 * x333),
-        );
-        let x340 = Self::mul_add(0.35, x335, Self::mul_add(c_q8, x333, s_q8 * x332));
-        let x341 = Self::mul_add(-s_q7, x336, c_q7 * x335);
-        let x342 = Self::mul_add(c_q7, x336, s_q7 * x335);
-        let x343 = Self::mul_add(-0.75, x342, Self::mul_add(-s_q7, x340, c_q7 * x339));
-        let x344 = Self::mul_add(c_q7, x340, s_q7 * x339)
-            + Self::mul_add(-0.65, x337, 0.75 * x341);
-        let x345 = Self::mul_add(0.65, x342, x338);
-        let x346 = Self::mul_add(-v[1], v[5], v[2] * v[4]);
-        let x347 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x348 = Self::mul_add(-v[0], v[4], v[1] * v[3]);
-        let x349 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x350 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
-        let x351 = v[4] * v[4];
-        let x352 = Self::mul_add(v[5], v[5], x351);
-        let x353 = v[3] * v[4];
-        let x354 = v[3] * v[5];
-        let x355 = v[4] * v[5];
-        let x356 = Self::mul_add(v[3], v[3], x351);
-        let x357 = x346 + Self::mul_add(-0.65, x352, 0.75 * x354);
-        let x358 = x347 + Self::mul_add(0.75, x355, 0.65 * x353);
-        let x359 = x348 + Self::mul_add(-0.75, x356, 0.65 * x354);
-        let x360 = Self::mul_add(-s_q7, x357, c_q7 * x358);
-        let x361 = v[6] * x350;
-        let x362 = v[6] * x349;
-        let x363 = v[5] + v[6];
-        let x364 = x350 * x350;
-        let x365 = x349 * x363;
-        let x366 = Self::mul_add(x363, 16.80768997608804, x350 * 0.07309);
-        let x367 = Self::mul_add(
-            0.1132,
-            x363,
-            Self::mul_add(x349, -0.07309, 130.43769025763282 * x350),
-        );
-        let x368 = Self::mul_add(
-            132.47349025763282,
-            x363,
-            Self::mul_add(x349, -16.80768997608804, 0.1132 * x350),
-        );
-        let x369 = Self::mul_add(-c_q8, x363, Self::mul_add(-x2, x349, s_q8 * x350));
-        let x370 = Self::mul_add(s_q8, x363, Self::mul_add(c_q8, x350, x3 * x349));
-        let x371 = Self::mul_add(
+        let x167 = 0.35 * x157;
+        let x168 = Self::mul_add(
             0.35,
-            x365 - x362,
-            Self::mul_add(s_q7, x358, c_q7 * x357),
+            x154,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x160,
+                Self::mul_add(-s_q8, x159, c_q8 * x158),
+            ),
         );
-        let x372 = Self::mul_add(0.35, Self::mul_add(x350, x363, -x361), x360);
-        let x373 = Self::mul_add(-0.35, Self::mul_add(x349, x349, x364), x359);
-        let x374 = Self::mul_add(-c_q8, x373, Self::mul_add(-x2, x371, s_q8 * x372));
-        let x375 = Self::mul_add(s_q8, x373, Self::mul_add(c_q8, x372, x3 * x371));
-        let x376 = Self::mul_add(-0.00000000020510342851533115, x373, x371);
-        let x377 = Self::mul_add(v[7], x370, -Self::mul_add(s_q8, x362, x2 * x361));
-        let x378 = Self::mul_add(-v[7], x369, Self::mul_add(-c_q8, x362, x3 * x361));
-        let x379 = v[7] + Self::mul_add(-0.00000000020510342851533115, x363, x349);
-        let x380 = x370 * x370;
-        let x381 = x379 * x379;
-        let x382 = x369 * x370;
-        let x383 = x382 - x361;
-        let x384 = x369 * x379;
-        let x385 = x369 * x369;
-        let x386 = x381 + x385;
-        let x387 = x370 * x379;
-        let x388 = x377 + x387;
-        let x389 = Self::mul_add(
-            x379,
+        let x169 = Self::mul_add(
+            0.35,
+            x155,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x163,
+                Self::mul_add(-s_q8, x162, c_q8 * x161),
+            ),
+        );
+        let x170 = x167 - (x160 - Self::mul_add(-x3, x159, x2 * x158) - x167);
+        let x171 = 48.0240000085309 + x154;
+        let x172 = -0.07309 + Self::mul_add(c_q8, x159, s_q8 * x158);
+        let x173 = -16.80768997608804 - x168;
+        let x174 = 130.43769025763282
+            - (x167 - (Self::mul_add(c_q8, x162, s_q8 * x161) - x167));
+        let x175 = 0.1132 - x169;
+        let x176 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x164, x166);
+        let x177 = s_q7 * s_q7;
+        let x178 = s_q7 * c_q7;
+        let x179 = x170 + x174;
+        let x180 = x172 + x172;
+        let x181 = Self::mul_add(-x178, x180, x177 * x179);
+        let x182 = Self::mul_add(-s_q7, x155, c_q7 * x171);
+        let x183 = Self::mul_add(c_q7, x155, s_q7 * x171);
+        let x184 = -x183;
+        let x185 = 0.75 * x157;
+        let x186 = 0.65 * x182;
+        let x187 = x185 - x186;
+        let x188 = Self::mul_add(-0.75, x182, Self::mul_add(-s_q7, x175, c_q7 * x173));
+        let x189 = Self::mul_add(
+            -0.65,
+            x183,
+            x172 - Self::mul_add(x177, x180, x178 * x179),
+        );
+        let x190 = Self::mul_add(-0.75, x183, Self::mul_add(c_q7, x175, s_q7 * x173));
+        let x191 = x176 + x186;
+        let x192 = 110.5455 + x182;
+        let x193 = 180.9502499901501 - x157;
+        let x194 = 1394.5960312283303 - (x185 + (x170 - x181 + x185));
+        let x195 = -117.61766249359756 + Self::mul_add(0.65, x157, x188);
+        let x196 = 1466.4506062283303 - (x187 - (x174 - x181 - x187));
+        let x197 = 1271.854575 + (x186 + x191);
+        let x198 = -x193;
+        let x199 = -x192;
+        let x200 = Self::mul_add(x3, x144, x2 * x145);
+        let x201 = Self::mul_add(-0.35, x156, x160);
+        let x202 = Self::mul_add(0.35, x200, x163);
+        let x203 = Self::mul_add(-s_q7, x156, c_q7 * x200);
+        let x204 = Self::mul_add(c_q7, x156, s_q7 * x200);
+        let x205 = Self::mul_add(-0.75, x204, Self::mul_add(-s_q7, x202, c_q7 * x201));
+        let x206 = Self::mul_add(c_q7, x202, s_q7 * x201)
+            + Self::mul_add(-0.65, x155, 0.75 * x203);
+        let x207 = -Self::mul_add(-0.65, x204, x164);
+        let x208 = x8 * x99;
+        let x209 = Self::mul_add(x7, x106, x208);
+        let x210 = x126 + Self::mul_add(-0.275, x112, 0.4 * x209);
+        let x211 = Self::mul_add(0.4, x117, x129);
+        let x212 = Self::mul_add(0.275, x117, x132);
+        let x213 = -x212;
+        let x214 = x112 + Self::mul_add(x3, x209, x2 * x117);
+        let x215 = Self::mul_add(-c_q8, x209, s_q8 * x117);
+        let x216 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x112,
+            Self::mul_add(s_q8, x209, c_q8 * x117),
+        );
+        let x217 = -x216;
+        let x218 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x212,
+            Self::mul_add(-s_q8, x211, c_q8 * x210),
+        );
+        let x219 = -x218;
+        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x3, x211, x2 * x210));
+        let x221 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x211, s_q8 * x210));
+        let x222 = Self::mul_add(s_q7, x215, c_q7 * x214);
+        let x223 = -x222;
+        let x224 = Self::mul_add(-c_q7, x215, s_q7 * x214);
+        let x225 = -x224;
+        let x226 = -Self::mul_add(-0.75, x224, Self::mul_add(s_q7, x221, c_q7 * x220));
+        let x227 = -(Self::mul_add(-c_q7, x221, s_q7 * x220)
+            + Self::mul_add(-0.65, x216, 0.75 * x222));
+        let x228 = -Self::mul_add(0.65, x224, x218);
+        let x229 = Self::mul_add(-s_q9, x101, x116);
+        let x230 = Self::mul_add(x7, x101, x208);
+        let x231 = Self::mul_add(c_q9, x101, x111);
+        let x232 = 0.00000000020510342851533115 * x104;
+        let x233 = Self::mul_add(c_q9, x97, s_q9 * x96) + x232
+            + Self::mul_add(-0.275, x231, 0.4 * x230);
+        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x8, x97, x7 * x96));
+        let x235 = Self::mul_add(
+            0.275,
+            x229,
+            x232 - Self::mul_add(-s_q9, x97, c_q9 * x96),
+        );
+        let x236 = -x235;
+        let x237 = x231 + Self::mul_add(x3, x230, x2 * x229);
+        let x238 = Self::mul_add(-c_q8, x230, s_q8 * x229);
+        let x239 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x231,
+            Self::mul_add(s_q8, x230, c_q8 * x229),
+        );
+        let x240 = -x239;
+        let x241 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x235,
+            Self::mul_add(-s_q8, x234, c_q8 * x233),
+        );
+        let x242 = -x241;
+        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x3, x234, x2 * x233));
+        let x244 = Self::mul_add(-0.35, x237, Self::mul_add(c_q8, x234, s_q8 * x233));
+        let x245 = Self::mul_add(s_q7, x238, c_q7 * x237);
+        let x246 = -x245;
+        let x247 = Self::mul_add(-c_q7, x238, s_q7 * x237);
+        let x248 = -x247;
+        let x249 = -Self::mul_add(-0.75, x247, Self::mul_add(s_q7, x244, c_q7 * x243));
+        let x250 = -(Self::mul_add(-c_q7, x244, s_q7 * x243)
+            + Self::mul_add(-0.65, x239, 0.75 * x245));
+        let x251 = -Self::mul_add(0.65, x247, x241);
+        let x252 = Self::mul_add(c_q10, x77, x100);
+        let x253 = Self::mul_add(-s_q10, x77, x98);
+        let x254 = Self::mul_add(-s_q10, x83, c_q10 * x82);
+        let x255 = Self::mul_add(c_q10, x83, s_q10 * x82);
+        let x256 = Self::mul_add(-0.87, x252, x84);
+        let x257 = Self::mul_add(-c_q9, x253, s_q9 * x252);
+        let x258 = Self::mul_add(x8, x253, x7 * x252);
+        let x259 = Self::mul_add(s_q9, x253, c_q9 * x252);
+        let x260 = 0.00000000020510342851533115 * x256;
+        let x261 = Self::mul_add(c_q9, x255, s_q9 * x254) + x260
+            + Self::mul_add(-0.275, x259, 0.4 * x258);
+        let x262 = Self::mul_add(-0.4, x257, x256 + Self::mul_add(-x8, x255, x7 * x254));
+        let x263 = Self::mul_add(
+            -0.275,
+            x257,
+            x260 - Self::mul_add(-s_q9, x255, c_q9 * x254),
+        );
+        let x264 = -x263;
+        let x265 = x259 - Self::mul_add(-x3, x258, x2 * x257);
+        let x266 = Self::mul_add(c_q8, x258, s_q8 * x257);
+        let x267 = Self::mul_add(
+            0.00000000020510342851533115,
+            x259,
+            Self::mul_add(-s_q8, x258, c_q8 * x257),
+        );
+        let x268 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x263,
+            Self::mul_add(-s_q8, x262, c_q8 * x261),
+        );
+        let x269 = -x268;
+        let x270 = Self::mul_add(
+            -0.35,
+            x266,
+            x263 + Self::mul_add(-x3, x262, x2 * x261),
+        );
+        let x271 = Self::mul_add(-0.35, x265, Self::mul_add(c_q8, x262, s_q8 * x261));
+        let x272 = Self::mul_add(-s_q7, x266, c_q7 * x265);
+        let x273 = -x272;
+        let x274 = Self::mul_add(c_q7, x266, s_q7 * x265);
+        let x275 = -x274;
+        let x276 = -Self::mul_add(-0.75, x274, Self::mul_add(s_q7, x271, c_q7 * x270));
+        let x277 = -(Self::mul_add(-c_q7, x271, s_q7 * x270)
+            + Self::mul_add(0.65, x267, 0.75 * x272));
+        let x278 = -Self::mul_add(0.65, x274, x268);
+        let x279 = Self::mul_add(-x13, x38, x12 * x39);
+        let x280 = Self::mul_add(0.36, x279, x54);
+        let x281 = Self::mul_add(x50, 0.36, x57);
+        let x282 = Self::mul_add(s_q11, x279, c_q11 * x50);
+        let x283 = Self::mul_add(-c_q11, x279, s_q11 * x50);
+        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
+            - Self::mul_add(x48, -0.63, 0.275 * x283);
+        let x285 = Self::mul_add(0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
+        let x286 = Self::mul_add(0.63, x282, x58);
+        let x287 = -x286;
+        let x288 = Self::mul_add(-s_q10, x283, c_q10 * x282);
+        let x289 = Self::mul_add(c_q10, x283, s_q10 * x282);
+        let x290 = Self::mul_add(c_q10, x285, s_q10 * x284);
+        let x291 = Self::mul_add(x48, 0.87, Self::mul_add(-s_q10, x285, c_q10 * x284));
+        let x292 = Self::mul_add(0.87, x288, x286);
+        let x293 = -x292;
+        let x294 = 0.00000000020510342851533115 * x48;
+        let x295 = Self::mul_add(c_q9, x289, s_q9 * x288) + x294;
+        let x296 = x48 + Self::mul_add(-x8, x289, x7 * x288);
+        let x297 = x294 - Self::mul_add(-s_q9, x289, c_q9 * x288);
+        let x298 = 0.00000000020510342851533115 * x292;
+        let x299 = Self::mul_add(c_q9, x290, s_q9 * x291) - x298
+            + Self::mul_add(0.275, x297, 0.4 * x296);
+        let x300 = Self::mul_add(0.4, x295, x292 - Self::mul_add(-x8, x290, x7 * x291));
+        let x301 = Self::mul_add(
+            0.275,
+            x295,
+            x298 + Self::mul_add(-s_q9, x290, c_q9 * x291),
+        );
+        let x302 = x297 + Self::mul_add(-x3, x296, x2 * x295);
+        let x303 = Self::mul_add(c_q8, x296, s_q8 * x295);
+        let x304 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x297,
+            Self::mul_add(-s_q8, x296, c_q8 * x295),
+        );
+        let x305 = Self::mul_add(
+            0.00000000020510342851533115,
+            x301,
+            Self::mul_add(s_q8, x300, c_q8 * x299),
+        );
+        let x306 = -x305;
+        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x3, x300, x2 * x299));
+        let x308 = Self::mul_add(0.35, x302, Self::mul_add(-c_q8, x300, s_q8 * x299));
+        let x309 = Self::mul_add(s_q7, x303, c_q7 * x302);
+        let x310 = Self::mul_add(-c_q7, x303, s_q7 * x302);
+        let x311 = Self::mul_add(-0.75, x310, Self::mul_add(-s_q7, x308, c_q7 * x307));
+        let x312 = Self::mul_add(c_q7, x308, s_q7 * x307)
+            + Self::mul_add(-0.65, x304, 0.75 * x309);
+        let x313 = -Self::mul_add(-0.65, x310, x305);
+        let x314 = 4.806620000000001 * x15;
+        let x315 = x22 + x32;
+        let x316 = Self::mul_add(-0.16, x314, x26);
+        let x317 = Self::mul_add(-0.55, x314, x29);
+        let x318 = Self::mul_add(s_q12, x19, c_q12 * x314);
+        let x319 = x18 - Self::mul_add(-x13, x19, x12 * x314);
+        let x320 = Self::mul_add(
+            0.00000000020510342851533115,
+            x18,
+            Self::mul_add(-c_q12, x19, s_q12 * x314),
+        );
+        let x321 = Self::mul_add(
+            0.00000000020510342851533115,
+            x317,
+            Self::mul_add(-c_q12, x316, s_q12 * x315),
+        );
+        let x322 = -x321;
+        let x323 = Self::mul_add(0.36, x319, Self::mul_add(s_q12, x316, c_q12 * x315));
+        let x324 = Self::mul_add(
+            -0.36,
+            x318,
+            x317 - Self::mul_add(-x13, x316, x12 * x315),
+        );
+        let x325 = Self::mul_add(-s_q11, x319, c_q11 * x318);
+        let x326 = Self::mul_add(c_q11, x319, s_q11 * x318);
+        let x327 = Self::mul_add(-s_q11, x324, c_q11 * x323)
+            + Self::mul_add(0.63, x320, 0.275 * x326);
+        let x328 = Self::mul_add(-0.275, x325, Self::mul_add(c_q11, x324, s_q11 * x323));
+        let x329 = Self::mul_add(-0.63, x325, x321);
+        let x330 = -x329;
+        let x331 = Self::mul_add(-s_q10, x326, c_q10 * x325);
+        let x332 = Self::mul_add(c_q10, x326, s_q10 * x325);
+        let x333 = Self::mul_add(c_q10, x328, s_q10 * x327);
+        let x334 = Self::mul_add(0.87, x320, Self::mul_add(-s_q10, x328, c_q10 * x327));
+        let x335 = Self::mul_add(-0.87, x331, x329);
+        let x336 = -x335;
+        let x337 = 0.00000000020510342851533115 * x320;
+        let x338 = Self::mul_add(c_q9, x332, s_q9 * x331) - x337;
+        let x339 = x320 - Self::mul_add(-x8, x332, x7 * x331);
+        let x340 = x337 + Self::mul_add(-s_q9, x332, c_q9 * x331);
+        let x341 = 0.00000000020510342851533115 * x335;
+        let x342 = Self::mul_add(c_q9, x333, s_q9 * x334) - x341
+            + Self::mul_add(0.275, x340, 0.4 * x339);
+        let x343 = Self::mul_add(-0.4, x338, x335 - Self::mul_add(-x8, x333, x7 * x334));
+        let x344 = Self::mul_add(
+            -0.275,
+            x338,
+            x341 + Self::mul_add(-s_q9, x333, c_q9 * x334),
+        );
+        let x345 = x340 - Self::mul_add(x3, x339, x2 * x338);
+        let x346 = Self::mul_add(-c_q8, x339, s_q8 * x338);
+        let x347 = Self::mul_add(
+            0.00000000020510342851533115,
+            x340,
+            Self::mul_add(s_q8, x339, c_q8 * x338),
+        );
+        let x348 = -x347;
+        let x349 = Self::mul_add(
+            0.00000000020510342851533115,
+            x344,
+            Self::mul_add(s_q8, x343, c_q8 * x342),
+        );
+        let x350 = -x349;
+        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x3, x343, x2 * x342));
+        let x352 = Self::mul_add(0.35, x345, Self::mul_add(-c_q8, x343, s_q8 * x342));
+        let x353 = Self::mul_add(-s_q7, x346, c_q7 * x345);
+        let x354 = Self::mul_add(c_q7, x346, s_q7 * x345);
+        let x355 = Self::mul_add(-0.75, x354, Self::mul_add(-s_q7, x352, c_q7 * x351));
+        let x356 = Self::mul_add(c_q7, x352, s_q7 * x351)
+            + Self::mul_add(0.65, x347, 0.75 * x353);
+        let x357 = -Self::mul_add(-0.65, x354, x349);
+        let x358 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x359 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x360 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x361 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x362 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x363 = v[4] * v[4];
+        let x364 = Self::mul_add(v[5], v[5], x363);
+        let x365 = v[3] * v[4];
+        let x366 = v[3] * v[5];
+        let x367 = v[4] * v[5];
+        let x368 = Self::mul_add(v[3], v[3], x363);
+        let x369 = x358 + Self::mul_add(-0.75, x366, 0.65 * x364);
+        let x370 = x359 + Self::mul_add(0.75, x367, 0.65 * x365);
+        let x371 = x360 - Self::mul_add(-0.75, x368, 0.65 * x366);
+        let x372 = Self::mul_add(c_q7, x370, s_q7 * x369);
+        let x373 = v[6] * x362;
+        let x374 = v[6] * x361;
+        let x375 = v[5] + v[6];
+        let x376 = x362 * x362;
+        let x377 = x361 * x375;
+        let x378 = Self::mul_add(x375, -16.80768997608804, x362 * 0.07309);
+        let x379 = Self::mul_add(
+            -0.1132,
+            x375,
+            Self::mul_add(130.43769025763282, x362, x361 * 0.07309),
+        );
+        let x380 = Self::mul_add(
+            -132.47349025763282,
+            x375,
+            Self::mul_add(0.1132, x362, x361 * 16.80768997608804),
+        );
+        let x381 = Self::mul_add(c_q8, x375, Self::mul_add(s_q8, x362, x2 * x361));
+        let x382 = Self::mul_add(s_q8, x375, Self::mul_add(-c_q8, x362, x3 * x361));
+        let x383 = Self::mul_add(
+            0.35,
+            x374 - x377,
+            Self::mul_add(-s_q7, x370, c_q7 * x369),
+        );
+        let x384 = Self::mul_add(0.35, Self::mul_add(-x362, x375, x373), x372);
+        let x385 = Self::mul_add(0.35, Self::mul_add(x361, x361, x376), x371);
+        let x386 = Self::mul_add(c_q8, x385, Self::mul_add(s_q8, x384, x2 * x383));
+        let x387 = Self::mul_add(s_q8, x385, Self::mul_add(-c_q8, x384, x3 * x383));
+        let x388 = Self::mul_add(-0.00000000020510342851533115, x385, x383);
+        let x389 = Self::mul_add(v[7], x382, Self::mul_add(-s_q8, x374, x2 * x373));
+        let x390 = Self::mul_add(-v[7], x381, Self::mul_add(c_q8, x374, x3 * x373));
+        let x391 = v[7] + Self::mul_add(-0.00000000020510342851533115, x375, x361);
+        let x392 = x382 * x382;
+        let x393 = x391 * x391;
+        let x394 = x381 * x382;
+        let x395 = x373 - x394;
+        let x396 = x381 * x391;
+        let x397 = x381 * x381;
+        let x398 = x393 + x397;
+        let x399 = x382 * x391;
+        let x400 = x389 + x399;
+        let x401 = Self::mul_add(
+            x391,
             0.002139996587640933,
-            x370 * 0.0000000234896432582596,
+            x382 * 0.0000000234896432582596,
         );
-        let x390 = Self::mul_add(
+        let x402 = Self::mul_add(
             5.080660024070365,
-            x379,
-            -Self::mul_add(x370, 111.7548902508081, x369 * 0.0000000234896432582596),
+            x391,
+            Self::mul_add(x382, -111.7548902508081, x381 * 0.0000000234896432582596),
         );
-        let x391 = Self::mul_add(
+        let x403 = Self::mul_add(
             113.3918902508081,
-            x379,
-            Self::mul_add(x369, -0.002139996587640933, 5.080660024070366 * x370),
+            x391,
+            Self::mul_add(5.080660024070366, x382, x381 * 0.002139996587640933),
         );
-        let x392 = Self::mul_add(
-            x376,
+        let x404 = Self::mul_add(
+            x388,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x361,
-                -Self::mul_add(x378, 111.7548902508081, x377 * 0.0000000234896432582596),
-            ) - Self::mul_add(x369, x391, x379 * x389),
+                x373,
+                Self::mul_add(x390, -111.7548902508081, x389 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x381, x403, x391 * x401),
         );
-        let x393 = Self::mul_add(c_q9, x379, Self::mul_add(x7, x370, s_q9 * x369));
-        let x394 = Self::mul_add(-s_q9, x379, Self::mul_add(-x8, x370, c_q9 * x369));
-        let x395 = x374 + Self::mul_add(0.4, x378 + x384, 0.275 * x383);
-        let x396 = x375 + Self::mul_add(-0.275, x386, 0.4 * (x387 - x377));
-        let x397 = x376 + Self::mul_add(-0.4, x380 + x385, 0.275 * x388);
-        let x398 = Self::mul_add(c_q9, x397, Self::mul_add(x7, x396, s_q9 * x395));
-        let x399 = Self::mul_add(
+        let x405 = Self::mul_add(-c_q9, x391, Self::mul_add(-x7, x382, s_q9 * x381));
+        let x406 = Self::mul_add(s_q9, x391, Self::mul_add(x8, x382, c_q9 * x381));
+        let x407 = x386 + Self::mul_add(-0.4, x390 + x396, 0.275 * x395);
+        let x408 = x387 + Self::mul_add(0.4, x389 - x399, 0.275 * x398);
+        let x409 = x388 - Self::mul_add(-0.4, x392 + x397, 0.275 * x400);
+        let x410 = Self::mul_add(-c_q9, x409, Self::mul_add(-x7, x408, s_q9 * x407));
+        let x411 = Self::mul_add(
             -0.00000000020510342851533115,
-            x397,
-            Self::mul_add(0.00000000020510342851533115, x395, x396),
+            x409,
+            Self::mul_add(-0.00000000020510342851533115, x407, x408),
         );
-        let x400 = Self::mul_add(
+        let x412 = Self::mul_add(
             -0.00000000020510342851533115,
-            x361,
-            Self::mul_add(0.00000000020510342851533115, x377, x378),
+            x373,
+            Self::mul_add(-0.00000000020510342851533115, x389, x390),
         );
-        let x401 = Self::mul_add(
-            v[8],
-            x394,
-            Self::mul_add(c_q9, x361, Self::mul_add(x7, x378, s_q9 * x377)),
-        );
-        let x402 = Self::mul_add(
+        let x413 = Self::mul_add(
             -v[8],
-            x393,
-            Self::mul_add(-s_q9, x361, Self::mul_add(-x8, x378, c_q9 * x377)),
+            x406,
+            Self::mul_add(-c_q9, x373, Self::mul_add(-x7, x390, s_q9 * x389)),
         );
-        let x403 = v[8]
+        let x414 = Self::mul_add(
+            v[8],
+            x405,
+            Self::mul_add(s_q9, x373, Self::mul_add(x8, x390, c_q9 * x389)),
+        );
+        let x415 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x379,
-                Self::mul_add(0.00000000020510342851533115, x369, x370),
+                x391,
+                Self::mul_add(-0.00000000020510342851533115, x381, x382),
             );
-        let x404 = Self::mul_add(x393, x394, -x400);
-        let x405 = Self::mul_add(x393, x393, x403 * x403);
-        let x406 = Self::mul_add(x394, x403, x401);
-        let x407 = x403 * 0.00214;
-        let x408 = Self::mul_add(x403, 36.18604050126307, x394 * 63.36336825000001);
-        let x409 = Self::mul_add(
+        let x416 = Self::mul_add(x405, x406, x412);
+        let x417 = Self::mul_add(x405, x405, x415 * x415);
+        let x418 = Self::mul_add(-x406, x415, x413);
+        let x419 = x415 * 0.00214;
+        let x420 = Self::mul_add(x415, -36.18604050126307, x406 * 63.36336825000001);
+        let x421 = Self::mul_add(
             69.99836825,
-            x403,
-            -Self::mul_add(x394, 36.18604050126307, x393 * 0.00214),
+            x415,
+            Self::mul_add(x406, 36.18604050126307, x405 * 0.00214),
         );
-        let x410 = Self::mul_add(
-            x399,
-            -81.53205,
-            Self::mul_add(x400, -0.00214, Self::mul_add(x394, x409, x403 * x408)),
-        );
-        let x411 = Self::mul_add(
-            x398,
+        let x422 = Self::mul_add(
+            x411,
             81.53205,
+            Self::mul_add(x412, 0.00214, -Self::mul_add(x406, x421, x415 * x420)),
+        );
+        let x423 = Self::mul_add(
+            x410,
+            -81.53205,
             Self::mul_add(
                 69.99836825,
-                x400,
-                -Self::mul_add(x402, 36.18604050126307, x401 * 0.00214),
-            ) + Self::mul_add(-x393, x408, x394 * x407),
+                x412,
+                Self::mul_add(x414, 36.18604050126307, x413 * 0.00214),
+            ) + Self::mul_add(x405, x420, x406 * x419),
         );
-        let x412 = Self::mul_add(s_q10, x394, c_q10 * x393);
-        let x413 = Self::mul_add(-s_q10, x393, c_q10 * x394);
-        let x414 = Self::mul_add(-0.87, x404, x398);
-        let x415 = Self::mul_add(
+        let x424 = Self::mul_add(s_q10, x406, c_q10 * x405);
+        let x425 = Self::mul_add(-c_q10, x406, s_q10 * x405);
+        let x426 = Self::mul_add(-0.87, x416, x410);
+        let x427 = Self::mul_add(
             0.87,
-            x405,
-            Self::mul_add(-s_q9, x397, Self::mul_add(-x8, x396, c_q9 * x395)),
-        );
-        let x416 = Self::mul_add(-0.87, x406, x399);
-        let x417 = Self::mul_add(s_q10, x415, c_q10 * x414);
-        let x418 = Self::mul_add(v[9], x413, Self::mul_add(s_q10, x402, c_q10 * x401));
-        let x419 = Self::mul_add(-v[9], x412, Self::mul_add(-s_q10, x401, c_q10 * x402));
-        let x420 = v[9] + x403;
-        let x421 = Self::mul_add(x412, x413, -x400);
-        let x422 = x412 * x412;
-        let x423 = Self::mul_add(x420, x420, x422);
-        let x424 = x413 * x420;
-        let x425 = x418 + x424;
-        let x426 = x420 * 0.6328;
-        let x427 = Self::mul_add(x420, 24.35164200091464, x413 * 24.4950615);
-        let x428 = Self::mul_add(
-            28.2393615,
-            x420,
-            -Self::mul_add(x413, 24.351642000914637, x412 * 0.6328),
-        );
-        let x429 = Self::mul_add(
-            x416,
-            -45.1584,
-            Self::mul_add(x400, -0.6328, Self::mul_add(x413, x428, x420 * x427)),
-        );
-        let x430 = Self::mul_add(
             x417,
+            Self::mul_add(s_q9, x409, Self::mul_add(x8, x408, c_q9 * x407)),
+        );
+        let x428 = Self::mul_add(0.87, x418, x411);
+        let x429 = Self::mul_add(s_q10, x427, c_q10 * x426);
+        let x430 = Self::mul_add(v[9], x425, Self::mul_add(s_q10, x414, c_q10 * x413));
+        let x431 = Self::mul_add(-v[9], x424, Self::mul_add(-c_q10, x414, s_q10 * x413));
+        let x432 = v[9] + x415;
+        let x433 = Self::mul_add(-x424, x425, x412);
+        let x434 = x424 * x424;
+        let x435 = Self::mul_add(x432, x432, x434);
+        let x436 = x425 * x432;
+        let x437 = x430 + x436;
+        let x438 = x432 * 0.6328;
+        let x439 = Self::mul_add(x432, 24.35164200091464, x425 * 24.4950615);
+        let x440 = Self::mul_add(
+            28.2393615,
+            x432,
+            Self::mul_add(x425, -24.351642000914637, x424 * 0.6328),
+        );
+        let x441 = Self::mul_add(
+            x428,
             45.1584,
+            Self::mul_add(x412, 0.6328, Self::mul_add(x425, x440, x432 * x439)),
+        );
+        let x442 = Self::mul_add(
+            x429,
+            -45.1584,
             Self::mul_add(
                 28.2393615,
-                x400,
-                -Self::mul_add(x419, 24.351642000914637, x418 * 0.6328),
-            ) + Self::mul_add(-x412, x427, x413 * x426),
+                x412,
+                Self::mul_add(x431, -24.351642000914637, x430 * 0.6328),
+            ) - Self::mul_add(x424, x439, x425 * x438),
         );
-        let x431 = Self::mul_add(s_q11, x413, c_q11 * x412);
-        let x432 = Self::mul_add(-s_q11, x412, c_q11 * x413);
-        let x433 = x417
-            - Self::mul_add(0.275, Self::mul_add(x412, x420, x419), 0.63 * x421);
-        let x434 = Self::mul_add(-s_q10, x414, c_q10 * x415)
-            + Self::mul_add(-0.275, x424 - x418, 0.63 * x423);
-        let x435 = x416
-            + Self::mul_add(-0.63, x425, 0.275 * Self::mul_add(x413, x413, x422));
-        let x436 = Self::mul_add(s_q11, x434, c_q11 * x433);
-        let x437 = Self::mul_add(v[10], x432, Self::mul_add(s_q11, x419, c_q11 * x418));
-        let x438 = Self::mul_add(
-            -v[10],
-            x431,
-            Self::mul_add(-s_q11, x418, c_q11 * x419),
-        );
-        let x439 = v[10] + x420;
-        let x440 = x431 * x431;
-        let x441 = x432 * x439;
-        let x442 = 0.01675 * x439;
-        let x443 = Self::mul_add(x432, -9.142025249762803, 2.5482240016099564 * x439);
-        let x444 = Self::mul_add(
-            9.223235249762805,
-            x439,
-            Self::mul_add(2.5482240016099564, x432, 0.01675 * x431),
-        );
-        let x445 = Self::mul_add(
-            7.078399999258757,
-            x435,
-            Self::mul_add(0.01675, x400, Self::mul_add(-x439, x443, x432 * x444)),
-        );
-        let x446 = Self::mul_add(
-            -7.078399999258757,
-            x436,
-            Self::mul_add(
-                9.223235249762805,
-                x400,
-                Self::mul_add(2.5482240016099564, x438, 0.01675 * x437),
-            ) + Self::mul_add(-x432, x442, x431 * x443),
-        );
-        let x447 = Self::mul_add(-s_q12, x439, Self::mul_add(-x12, x432, c_q12 * x431));
-        let x448 = Self::mul_add(c_q12, x439, Self::mul_add(x13, x432, s_q12 * x431));
-        let x449 = Self::mul_add(-0.36, Self::mul_add(x431, x439, x438), x436);
-        let x450 = Self::mul_add(
-            -0.36,
-            x441 - x437,
-            Self::mul_add(-s_q11, x433, c_q11 * x434),
-        );
-        let x451 = Self::mul_add(0.36, Self::mul_add(x432, x432, x440), x435);
-        let x452 = Self::mul_add(-s_q12, x451, Self::mul_add(-x12, x450, c_q12 * x449));
-        let x453 = Self::mul_add(c_q12, x451, Self::mul_add(x13, x450, s_q12 * x449));
-        let x454 = Self::mul_add(-0.00000000020510342851533115, x451, x450);
-        let x455 = Self::mul_add(-0.00000000020510342851533115, x400, x438);
+        let x443 = Self::mul_add(-s_q11, x425, c_q11 * x424);
+        let x444 = Self::mul_add(c_q11, x425, s_q11 * x424);
+        let x445 = x429
+            - Self::mul_add(-0.275, Self::mul_add(x424, x432, x431), 0.63 * x433);
+        let x446 = Self::mul_add(-c_q10, x427, s_q10 * x426)
+            - Self::mul_add(0.275, x430 - x436, 0.63 * x435);
+        let x447 = x428
+            + Self::mul_add(-0.275, Self::mul_add(x425, x425, x434), 0.63 * x437);
+        let x448 = Self::mul_add(-s_q11, x446, c_q11 * x445);
+        let x449 = Self::mul_add(v[10], x444, Self::mul_add(-s_q11, x431, c_q11 * x430));
+        let x450 = Self::mul_add(-v[10], x443, Self::mul_add(c_q11, x431, s_q11 * x430));
+        let x451 = v[10] + x432;
+        let x452 = x443 * x443;
+        let x453 = x444 * x451;
+        let x454 = 0.01675 * x451;
+        let x455 = Self::mul_add(-2.5482240016099564, x451, x444 * 9.142025249762803);
         let x456 = Self::mul_add(
-            -v[11],
-            x448,
-            Self::mul_add(-s_q12, x400, Self::mul_add(-x12, x438, c_q12 * x437)),
+            -9.223235249762805,
+            x451,
+            Self::mul_add(-2.5482240016099564, x444, 0.01675 * x443),
         );
         let x457 = Self::mul_add(
-            v[11],
+            7.078399999258757,
             x447,
-            Self::mul_add(c_q12, x400, Self::mul_add(x13, x438, s_q12 * x437)),
+            Self::mul_add(0.01675, x412, -Self::mul_add(-x444, x456, x451 * x455)),
         );
-        let x458 = v[11] + Self::mul_add(-0.00000000020510342851533115, x439, x432);
-        let x459 = x448 * x448;
-        let x460 = x458 * x458;
-        let x461 = x447 * x448;
-        let x462 = x455 + x461;
-        let x463 = x447 * x458;
-        let x464 = x447 * x447;
-        let x465 = x460 + x464;
-        let x466 = x448 * x458;
-        let x467 = x456 - x466;
-        let x468 = Self::mul_add(x458, -0.809539999555672, x448 * 1.9877000000000002);
-        let x469 = Self::mul_add(
-            x458,
-            -2.741639999592316,
-            Self::mul_add(x447, -1.9877000000000002, x448 * 5.252920330000002),
-        );
-        let x470 = Self::mul_add(
-            9.740442170000001,
-            x458,
-            Self::mul_add(x447, -0.809539999555672, x448 * 2.7416399995923166),
-        );
-        let x471 = Self::mul_add(
-            -3.6140000000000003,
-            x454,
+        let x458 = Self::mul_add(
+            -7.078399999258757,
+            x448,
             Self::mul_add(
-                x455,
-                -2.741639999592316,
-                Self::mul_add(x456, -1.9877000000000002, x457 * 5.252920330000002),
-            ) + Self::mul_add(-x447, x470, x458 * x468),
+                -9.223235249762805,
+                x412,
+                Self::mul_add(-2.5482240016099564, x450, 0.01675 * x449),
+            ) - Self::mul_add(-x443, x455, x444 * x454),
         );
-        let x472 = Self::mul_add(c_q13, x458, Self::mul_add(s_q13, x448, x15 * x447));
-        let x473 = Self::mul_add(s_q13, x458, Self::mul_add(-c_q13, x448, x16 * x447));
-        let x474 = x452 + Self::mul_add(-0.55, x462, 0.16 * (x463 - x457));
-        let x475 = x454 + Self::mul_add(-0.16, x459 + x464, 0.55 * x467);
-        let x476 = Self::mul_add(
-            c_q13,
-            x475,
+        let x459 = Self::mul_add(s_q12, x451, Self::mul_add(x12, x444, c_q12 * x443));
+        let x460 = Self::mul_add(-c_q12, x451, Self::mul_add(-x13, x444, s_q12 * x443));
+        let x461 = Self::mul_add(0.36, Self::mul_add(x443, x451, x450), x448);
+        let x462 = Self::mul_add(
+            -0.36,
+            x449 - x453,
+            Self::mul_add(c_q11, x446, s_q11 * x445),
+        );
+        let x463 = Self::mul_add(-0.36, Self::mul_add(x444, x444, x452), x447);
+        let x464 = Self::mul_add(s_q12, x463, Self::mul_add(x12, x462, c_q12 * x461));
+        let x465 = Self::mul_add(-c_q12, x463, Self::mul_add(-x13, x462, s_q12 * x461));
+        let x466 = Self::mul_add(-0.00000000020510342851533115, x463, x462);
+        let x467 = Self::mul_add(-0.00000000020510342851533115, x412, x450);
+        let x468 = Self::mul_add(
+            v[11],
+            x460,
+            Self::mul_add(s_q12, x412, Self::mul_add(x12, x450, c_q12 * x449)),
+        );
+        let x469 = Self::mul_add(
+            -v[11],
+            x459,
+            Self::mul_add(-c_q12, x412, Self::mul_add(-x13, x450, s_q12 * x449)),
+        );
+        let x470 = v[11] + Self::mul_add(-0.00000000020510342851533115, x451, x444);
+        let x471 = x460 * x460;
+        let x472 = x470 * x470;
+        let x473 = x459 * x460;
+        let x474 = x467 - x473;
+        let x475 = x459 * x470;
+        let x476 = x459 * x459;
+        let x477 = x472 + x476;
+        let x478 = x460 * x470;
+        let x479 = x468 + x478;
+        let x480 = Self::mul_add(x470, 0.809539999555672, x460 * 1.9877000000000002);
+        let x481 = Self::mul_add(
+            x470,
+            -2.741639999592316,
+            Self::mul_add(x460, -5.252920330000002, x459 * 1.9877000000000002),
+        );
+        let x482 = Self::mul_add(
+            9.740442170000001,
+            x470,
+            Self::mul_add(x460, -2.7416399995923166, x459 * 0.809539999555672),
+        );
+        let x483 = Self::mul_add(
+            -3.6140000000000003,
+            x466,
+            Self::mul_add(
+                x467,
+                -2.741639999592316,
+                Self::mul_add(x469, -5.252920330000002, x468 * 1.9877000000000002),
+            ) + Self::mul_add(-x459, x482, x470 * x480),
+        );
+        let x484 = Self::mul_add(-c_q13, x470, Self::mul_add(s_q13, x460, x15 * x459));
+        let x485 = Self::mul_add(-s_q13, x470, Self::mul_add(-c_q13, x460, x16 * x459));
+        let x486 = x464 + Self::mul_add(-0.16, x469 + x475, 0.55 * x474);
+        let x487 = x466 - Self::mul_add(-0.16, x471 + x476, 0.55 * x479);
+        let x488 = Self::mul_add(
+            -c_q13,
+            x487,
             Self::mul_add(
                 s_q13,
-                x453 + Self::mul_add(0.16, x456 + x466, 0.55 * x465),
-                x15 * x474,
+                x465 + Self::mul_add(0.16, x468 - x478, 0.55 * x477),
+                x15 * x486,
             ),
         );
-        let x477 = Self::mul_add(-0.00000000020510342851533115, x455, x456);
-        let x478 = Self::mul_add(
+        let x489 = Self::mul_add(0.00000000020510342851533115, x467, x468);
+        let x490 = Self::mul_add(
             v[12],
-            x473,
-            -Self::mul_add(c_q13, x455, Self::mul_add(s_q13, x457, x15 * x456)),
+            x485,
+            Self::mul_add(-c_q13, x467, Self::mul_add(s_q13, x469, x15 * x468)),
         );
-        let x479 = Self::mul_add(
-            v[12],
-            x472,
-            Self::mul_add(s_q13, x455, Self::mul_add(-c_q13, x457, x16 * x456)),
+        let x491 = Self::mul_add(
+            -v[12],
+            x484,
+            Self::mul_add(-s_q13, x467, Self::mul_add(-c_q13, x469, x16 * x468)),
         );
-        let x480 = v[12] + Self::mul_add(-0.00000000020510342851533115, x458, x447);
-        let x481 = 4.806620000000001 * Self::mul_add(x472, x473, x477);
-        let x482 = 4.806620000000001 * Self::mul_add(x472, x472, x480 * x480);
-        let x483 = 4.806620000000001 * Self::mul_add(x473, x480, x478);
-        let x484 = Self::mul_add(-0.0145, x480, 0.000781 * x473);
-        let x485 = Self::mul_add(
-            0.9614610000000001,
-            x480,
-            Self::mul_add(1.2025609200000003, x473, 0.000781 * x472),
-        );
-        let x486 = Self::mul_add(
-            1.4135609200000003,
-            x480,
-            Self::mul_add(-0.9614610000000001, x473, 0.0145 * x472),
-        );
-        let x487 = Self::mul_add(
+        let x492 = v[12] - Self::mul_add(0.00000000020510342851533115, x470, x459);
+        let x493 = 4.806620000000001 * Self::mul_add(x484, x485, x489);
+        let x494 = 4.806620000000001 * Self::mul_add(x484, x484, x492 * x492);
+        let x495 = 4.806620000000001 * Self::mul_add(x485, x492, x490);
+        let x496 = Self::mul_add(0.0145, x492, 0.000781 * x485);
+        let x497 = Self::mul_add(
             -0.9614610000000001,
-            x477,
-            Self::mul_add(-1.2025609200000003, x479, 0.000781 * x478),
-        ) + Self::mul_add(x472, x486, x480 * x484);
-        let x488 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x475, x474),
-            Self::mul_add(-0.0145, x477, 0.000781 * x479)
-                + Self::mul_add(x473, x486, x480 * x485),
+            x492,
+            Self::mul_add(1.2025609200000003, x485, 0.000781 * x484),
         );
-        let x489 = Self::mul_add(
+        let x498 = Self::mul_add(
+            -1.4135609200000003,
+            x492,
+            Self::mul_add(-0.9614610000000001, x485, 0.0145 * x484),
+        );
+        let x499 = Self::mul_add(
+            0.9614610000000001,
+            x489,
+            Self::mul_add(1.2025609200000003, x491, 0.000781 * x490),
+        ) + Self::mul_add(-x484, x498, x492 * x496);
+        let x500 = Self::mul_add(
             4.806620000000001,
-            x476,
+            Self::mul_add(0.00000000020510342851533115, x487, x486),
+            Self::mul_add(-0.0145, x489, 0.000781 * x491)
+                - Self::mul_add(-x485, x498, x492 * x497),
+        );
+        let x501 = Self::mul_add(
+            4.806620000000001,
+            x488,
             Self::mul_add(
                 1.4135609200000003,
-                x477,
-                -Self::mul_add(0.9614610000000001, x479, 0.0145 * x478),
-            ) + Self::mul_add(-x473, x484, x472 * x485),
-        );
-        let x490 = x483 + Self::mul_add(-x16, x482, x15 * x481);
-        let x491 = Self::mul_add(c_q13, x482, s_q13 * x481);
-        let x492 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x483,
-            Self::mul_add(-s_q13, x482, c_q13 * x481),
-        );
-        let x493 = Self::mul_add(
-            -0.55,
-            x490,
-            Self::mul_add(
-                -0.00000000020510342851533115,
                 x489,
-                Self::mul_add(-c_q13, x488, s_q13 * x487),
-            ),
+                Self::mul_add(-0.9614610000000001, x491, 0.0145 * x490),
+            ) - Self::mul_add(-x484, x497, x485 * x496),
         );
-        let x494 = x490
-            - Self::mul_add(
-                17.135250000000003,
-                x462,
-                3.6140000000000003 * (x459 + x460),
-            );
-        let x495 = Self::mul_add(
-            -17.135250000000003,
-            x465,
-            3.6140000000000003 * (x455 - x461),
-        ) - x491;
-        let x496 = Self::mul_add(
-            17.135250000000003,
-            x467,
-            3.6140000000000003 * (x457 + x463),
-        ) + x492;
-        let x497 = Self::mul_add(
-            17.135250000000003,
-            x454,
-            Self::mul_add(x455, -0.809539999555672, x457 * 1.9877000000000002)
-                - Self::mul_add(x448, x470, x458 * x469),
-        )
-            + (x489 + Self::mul_add(-x15, x488, x16 * x487)
-                + Self::mul_add(0.55, x492, 0.16 * x491));
-        let x498 = x471
-            + Self::mul_add(0.16, x490, Self::mul_add(c_q13, x487, s_q13 * x488));
-        let x499 = Self::mul_add(
-            9.740442170000001,
-            x455,
-            Self::mul_add(x456, -0.809539999555672, x457 * 2.7416399995923166),
-        ) + Self::mul_add(x447, x469, x448 * x468)
-            - Self::mul_add(3.6140000000000003, x453, 17.135250000000003 * x452) + x493;
-        let x500 = Self::mul_add(-s_q12, x495, c_q12 * x494);
-        let x501 = x496 - Self::mul_add(x13, x495, x12 * x494);
-        let x502 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x431, x432, -x400),
-            x500,
-        );
-        let x503 = Self::mul_add(
-            -7.078399999258757,
-            Self::mul_add(x439, x439, x440),
-            x501,
-        );
+        let x502 = x495 - Self::mul_add(-x16, x494, x15 * x493);
+        let x503 = Self::mul_add(c_q13, x494, s_q13 * x493);
         let x504 = Self::mul_add(
-            7.078399999258757,
-            x437 + x441,
-            -Self::mul_add(
+            0.00000000020510342851533115,
+            x495,
+            Self::mul_add(-s_q13, x494, c_q13 * x493),
+        );
+        let x505 = Self::mul_add(
+            -0.55,
+            x502,
+            Self::mul_add(
                 0.00000000020510342851533115,
-                x496,
-                Self::mul_add(c_q12, x495, s_q12 * x494),
+                x501,
+                Self::mul_add(s_q13, x499, c_q13 * x500),
             ),
         );
-        let x505 = x445
-            + Self::mul_add(0.36, x501, Self::mul_add(-s_q12, x498, c_q12 * x497));
-        let x506 = Self::mul_add(x438, -9.142025249762803, 2.5482240016099564 * x400)
-            + Self::mul_add(-x431, x444, x439 * x442)
-            + Self::mul_add(-0.36, x500, x499 - Self::mul_add(x13, x498, x12 * x497));
-        let x507 = x446
-            - Self::mul_add(
-                0.00000000020510342851533115,
-                x499,
-                Self::mul_add(c_q12, x498, s_q12 * x497),
-            );
-        let x508 = Self::mul_add(-s_q11, x503, c_q11 * x502);
-        let x509 = Self::mul_add(c_q11, x503, s_q11 * x502);
-        let x510 = Self::mul_add(x421, -45.1584, x508);
-        let x511 = Self::mul_add(45.1584, x423, x509);
-        let x512 = Self::mul_add(-45.1584, x425, x504);
-        let x513 = x429
-            + (Self::mul_add(-s_q11, x506, c_q11 * x505)
-                + Self::mul_add(-0.63, x504, 0.275 * x509));
-        let x514 = Self::mul_add(-0.275, x508, Self::mul_add(c_q11, x506, s_q11 * x505))
-            - (Self::mul_add(x400, 24.35164200091464, x419 * 24.4950615)
-                + Self::mul_add(x412, x428, x420 * x426));
-        let x515 = x430 + Self::mul_add(0.63, x508, x507);
-        let x516 = Self::mul_add(-s_q10, x511, c_q10 * x510);
-        let x517 = Self::mul_add(x404, -81.53205, x516);
-        let x518 = Self::mul_add(
-            81.53205,
-            x405,
-            Self::mul_add(c_q10, x511, s_q10 * x510),
-        );
-        let x519 = Self::mul_add(-81.53205, x406, x512);
-        let x520 = x410
-            + Self::mul_add(-0.87, x512, Self::mul_add(-s_q10, x514, c_q10 * x513));
-        let x521 = Self::mul_add(c_q10, x514, s_q10 * x513)
-            - (Self::mul_add(x400, 36.18604050126307, x402 * 63.36336825000001)
-                + Self::mul_add(x393, x409, x403 * x407));
-        let x522 = x411 + Self::mul_add(0.87, x516, x515);
-        let x523 = 0.00000000020510342851533115 * x519;
-        let x524 = Self::mul_add(c_q9, x518, s_q9 * x517) + x523;
-        let x525 = x519 + Self::mul_add(-x8, x518, x7 * x517);
-        let x526 = Self::mul_add(-s_q9, x518, c_q9 * x517) - x523;
-        let x527 = 0.00000000020510342851533115 * x522;
-        let x528 = Self::mul_add(
-            x383,
-            -12.701650001451807,
-            (x380 + x381) * 0.000000008530897668050218,
-        ) + x524;
-        let x529 = Self::mul_add(
-            -0.000000008530897668050218,
-            x361 + x382,
-            12.701650001451807 * x386,
-        ) + x525;
-        let x530 = x526
-            - Self::mul_add(
-                12.701650001451807,
-                x388,
-                0.000000008530897668050218 * (x384 - x378),
-            );
-        let x531 = Self::mul_add(
-            x376,
-            -12.701650001451807,
-            Self::mul_add(-x379, x390, x370 * x391)
-                - Self::mul_add(
-                    x361,
-                    0.002139996587640933,
-                    x378 * 0.0000000234896432582596,
-                ),
+        let x506 = Self::mul_add(
+            -17.135250000000003,
+            x474,
+            3.6140000000000003 * (x471 + x472),
+        ) + x502;
+        let x507 = Self::mul_add(
+            17.135250000000003,
+            x477,
+            3.6140000000000003 * (x467 + x473),
+        ) + x503;
+        let x508 = Self::mul_add(
+            17.135250000000003,
+            x479,
+            3.6140000000000003 * (x469 - x475),
+        ) + x504;
+        let x509 = Self::mul_add(
+            -17.135250000000003,
+            x466,
+            Self::mul_add(x467, 0.809539999555672, x469 * 1.9877000000000002)
+                - Self::mul_add(-x460, x482, x470 * x481),
         )
-            + (Self::mul_add(c_q9, x521, s_q9 * x520) + x527
-                + Self::mul_add(-0.4, x525, 0.275 * x526));
-        let x532 = x392
-            + Self::mul_add(0.4, x524, x522 + Self::mul_add(-x8, x521, x7 * x520));
-        let x533 = Self::mul_add(
-            113.3918902508081,
-            x361,
-            Self::mul_add(x377, -0.002139996587640933, 5.080660024070366 * x378),
-        ) + Self::mul_add(x369, x390, x370 * x389)
-            + Self::mul_add(x375, -0.000000008530897668050218, x374 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x524,
-                Self::mul_add(-s_q9, x521, c_q9 * x520) - x527,
-            );
-        let x534 = x530 + Self::mul_add(-x2, x528, x3 * x529);
-        let x535 = Self::mul_add(c_q8, x529, s_q8 * x528);
-        let x536 = Self::mul_add(
-            -48.0240000085309,
-            Self::mul_add(x363, x363, x364),
-            x534,
+            + (x501 - Self::mul_add(x16, x499, x15 * x500)
+                + Self::mul_add(0.55, x504, 0.16 * x503));
+        let x510 = x483
+            - Self::mul_add(-0.16, x502, Self::mul_add(-c_q13, x499, s_q13 * x500));
+        let x511 = Self::mul_add(
+            9.740442170000001,
+            x467,
+            Self::mul_add(x469, -2.7416399995923166, x468 * 0.809539999555672),
+        ) - Self::mul_add(-x459, x481, x460 * x480)
+            + Self::mul_add(3.6140000000000003, x465, 17.135250000000003 * x464) + x505;
+        let x512 = -x511;
+        let x513 = Self::mul_add(-s_q12, x507, c_q12 * x506);
+        let x514 = x508 + Self::mul_add(x13, x507, x12 * x506);
+        let x515 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(-x443, x444, x412),
+            -x513,
         );
-        let x537 = Self::mul_add(48.0240000085309, x349 * x350, x535);
-        let x538 = Self::mul_add(
-            48.0240000085309,
-            x362 + x365,
+        let x516 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x451, x451, x452),
+            -x514,
+        );
+        let x517 = Self::mul_add(
+            7.078399999258757,
+            x449 + x453,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x530,
-                Self::mul_add(-c_q8, x528, s_q8 * x529),
+                x508,
+                Self::mul_add(c_q12, x507, s_q12 * x506),
             ),
         );
-        let x539 = Self::mul_add(x362, 0.07309, Self::mul_add(-x363, x367, x350 * x368))
-            + Self::mul_add(-0.35, x535, x533 + Self::mul_add(-x2, x531, x3 * x532));
-        let x540 = Self::mul_add(0.35, x534, Self::mul_add(c_q8, x532, s_q8 * x531))
+        let x518 = x457
+            - Self::mul_add(0.36, x514, Self::mul_add(s_q12, x510, c_q12 * x509));
+        let x519 = Self::mul_add(-2.5482240016099564, x412, x450 * 9.142025249762803)
+            + Self::mul_add(-x443, x456, x451 * x454)
+            - Self::mul_add(-0.36, x513, x511 + Self::mul_add(-x13, x510, x12 * x509));
+        let x520 = x458
             - Self::mul_add(
-                48.0240000085309,
-                x359,
-                Self::mul_add(130.43769025763282, x362, x361 * 0.07309)
-                    + Self::mul_add(x349, x368, x363 * x366),
-            );
-        let x541 = Self::mul_add(
-            48.0240000085309,
-            x360,
-            Self::mul_add(x349, x367, x350 * x366)
-                - Self::mul_add(0.1132, x362, x361 * 16.80768997608804),
-        )
-            + Self::mul_add(
                 -0.00000000020510342851533115,
-                x533,
-                Self::mul_add(-c_q8, x531, s_q8 * x532),
+                x511,
+                Self::mul_add(-c_q12, x510, s_q12 * x509),
             );
-        let x542 = Self::mul_add(-s_q7, x537, c_q7 * x536);
-        let x543 = Self::mul_add(c_q7, x537, s_q7 * x536);
-        let x544 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x545 = 1466.4506062283303 * v[4];
-        let x546 = Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]);
-        let x547 = x542
+        let x521 = Self::mul_add(s_q11, x516, c_q11 * x515);
+        let x522 = Self::mul_add(-c_q11, x516, s_q11 * x515);
+        let x523 = Self::mul_add(x433, 45.1584, -x521);
+        let x524 = Self::mul_add(45.1584, x435, x522);
+        let x525 = Self::mul_add(45.1584, x437, -x517);
+        let x526 = x441
+            - (Self::mul_add(s_q11, x519, c_q11 * x518)
+                - Self::mul_add(-0.63, x517, 0.275 * x522));
+        let x527 = Self::mul_add(x412, 24.35164200091464, x431 * 24.4950615)
+            - Self::mul_add(-x424, x440, x432 * x438)
+            - Self::mul_add(0.275, x521, Self::mul_add(-c_q11, x519, s_q11 * x518));
+        let x528 = x442 - Self::mul_add(0.63, x521, x520);
+        let x529 = -x528;
+        let x530 = Self::mul_add(s_q10, x524, c_q10 * x523);
+        let x531 = Self::mul_add(x416, 81.53205, x530);
+        let x532 = Self::mul_add(
+            81.53205,
+            x417,
+            -Self::mul_add(-c_q10, x524, s_q10 * x523),
+        );
+        let x533 = Self::mul_add(81.53205, x418, x525);
+        let x534 = x422
+            + Self::mul_add(0.87, x525, Self::mul_add(-s_q10, x527, c_q10 * x526));
+        let x535 = Self::mul_add(x412, -36.18604050126307, x414 * 63.36336825000001)
+            + Self::mul_add(-x405, x421, x415 * x419)
+            - Self::mul_add(c_q10, x527, s_q10 * x526);
+        let x536 = x423 + Self::mul_add(0.87, x530, x528);
+        let x537 = -x536;
+        let x538 = 0.00000000020510342851533115 * x533;
+        let x539 = Self::mul_add(-c_q9, x532, s_q9 * x531) + x538;
+        let x540 = x533 + Self::mul_add(x8, x532, x7 * x531);
+        let x541 = x538 - Self::mul_add(s_q9, x532, c_q9 * x531);
+        let x542 = 0.00000000020510342851533115 * x536;
+        let x543 = Self::mul_add(
+            x395,
+            -12.701650001451807,
+            (x392 + x393) * 0.000000008530897668050218,
+        ) - x539;
+        let x544 = Self::mul_add(
+            12.701650001451807,
+            x398,
+            0.000000008530897668050218 * (x373 + x394),
+        ) - x540;
+        let x545 = Self::mul_add(
+            12.701650001451807,
+            x400,
+            0.000000008530897668050218 * (x390 - x396),
+        ) - x541;
+        let x546 = Self::mul_add(
+            x388,
+            12.701650001451807,
+            Self::mul_add(x373, 0.002139996587640933, x390 * 0.0000000234896432582596)
+                - Self::mul_add(-x382, x403, x391 * x402),
+        )
+            + (Self::mul_add(-c_q9, x535, s_q9 * x534) - x542
+                + Self::mul_add(0.275, x541, 0.4 * x540));
+        let x547 = x404
+            + Self::mul_add(0.4, x539, x536 - Self::mul_add(x8, x535, x7 * x534));
+        let x548 = Self::mul_add(
+            113.3918902508081,
+            x373,
+            Self::mul_add(5.080660024070366, x390, x389 * 0.002139996587640933),
+        ) - Self::mul_add(-x381, x402, x382 * x401)
+            - Self::mul_add(x387, 0.000000008530897668050218, x386 * 12.701650001451807)
+            - Self::mul_add(0.275, x539, x542 + Self::mul_add(s_q9, x535, c_q9 * x534));
+        let x549 = -x548;
+        let x550 = x545 + Self::mul_add(-x3, x544, x2 * x543);
+        let x551 = Self::mul_add(c_q8, x544, s_q8 * x543);
+        let x552 = Self::mul_add(
+            48.0240000085309,
+            Self::mul_add(x375, x375, x376),
+            x550,
+        );
+        let x553 = Self::mul_add(48.0240000085309, x361 * x362, -x551);
+        let x554 = Self::mul_add(
+            48.0240000085309,
+            x374 + x377,
+            -Self::mul_add(
+                -0.00000000020510342851533115,
+                x545,
+                Self::mul_add(-s_q8, x544, c_q8 * x543),
+            ),
+        );
+        let x555 = Self::mul_add(x374, 0.07309, Self::mul_add(x362, x380, x375 * x379))
+            - Self::mul_add(0.35, x551, x548 + Self::mul_add(x3, x547, x2 * x546));
+        let x556 = Self::mul_add(
+            48.0240000085309,
+            x371,
+            Self::mul_add(-130.43769025763282, x374, x373 * 0.07309)
+                + Self::mul_add(x361, x380, x375 * x378),
+        ) + Self::mul_add(-0.35, x550, Self::mul_add(-c_q8, x547, s_q8 * x546));
+        let x557 = Self::mul_add(
+            48.0240000085309,
+            x372,
+            Self::mul_add(-0.1132, x374, x373 * 16.80768997608804)
+                + Self::mul_add(-x361, x379, x362 * x378),
+        )
+            - Self::mul_add(
+                -0.00000000020510342851533115,
+                x548,
+                Self::mul_add(s_q8, x547, c_q8 * x546),
+            );
+        let x558 = Self::mul_add(-s_q7, x553, c_q7 * x552);
+        let x559 = Self::mul_add(c_q7, x553, s_q7 * x552);
+        let x560 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x561 = 1466.4506062283303 * v[4];
+        let x562 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x563 = -(x558
             + Self::mul_add(
                 1170.07,
-                x346,
-                Self::mul_add(-110.5455, x352, 180.9502499901501 * x354),
-            );
-        let x548 = x543
-            + Self::mul_add(
+                x358,
+                Self::mul_add(-180.9502499901501, x366, 110.5455 * x364),
+            ));
+        let x564 = -(x559
+            - Self::mul_add(
                 1170.07,
-                x347,
-                Self::mul_add(180.9502499901501, x355, 110.5455 * x353),
-            );
-        let x549 = x538
-            + Self::mul_add(
+                x359,
+                Self::mul_add(180.9502499901501, x367, 110.5455 * x365),
+            ));
+        let x565 = x554
+            - Self::mul_add(
                 1170.07,
-                x348,
-                Self::mul_add(-180.9502499901501, x356, 110.5455 * x354),
+                x360,
+                -Self::mul_add(-180.9502499901501, x368, 110.5455 * x366),
             );
-        let x550 = Self::mul_add(-0.75, x543, Self::mul_add(-s_q7, x540, c_q7 * x539))
-            + Self::mul_add(
-                -180.9502499901501,
-                x347,
-                Self::mul_add(-v[5], x545, v[4] * x546),
+        let x566 = Self::mul_add(0.75, x559, Self::mul_add(-s_q7, x556, c_q7 * x555))
+            - Self::mul_add(
+                180.9502499901501,
+                x359,
+                Self::mul_add(v[4], x562, v[5] * x561),
             );
-        let x551 = Self::mul_add(c_q7, x540, s_q7 * x539)
-            + Self::mul_add(-0.65, x538, 0.75 * x542)
-            + (Self::mul_add(-v[3], x546, v[5] * x544)
-                + Self::mul_add(-110.5455, x348, 180.9502499901501 * x346));
-        let x552 = Self::mul_add(0.65, x543, x541)
-            + Self::mul_add(110.5455, x347, Self::mul_add(-v[4], x544, v[3] * x545));
+        let x567 = Self::mul_add(c_q7, x556, s_q7 * x555)
+            - Self::mul_add(0.65, x554, 0.75 * x558)
+            + (Self::mul_add(v[3], x562, v[5] * x560)
+                - Self::mul_add(-110.5455, x360, 180.9502499901501 * x358));
+        let x568 = Self::mul_add(-0.65, x559, x557)
+            - Self::mul_add(-110.5455, x359, Self::mul_add(-v[3], x561, v[4] * x560));
         (
             [
                 [
@@ -5817,211 +5791,211 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x195,
-                    x186,
-                    x186,
-                    x206,
-                    x223,
-                    x242,
-                    x266,
-                    x301,
-                    x341,
-                ],
-                [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x200,
-                    0.0,
-                    x194,
+                    x193,
                     x184,
-                    x207,
-                    x224,
-                    x243,
-                    x267,
-                    x302,
-                    x342,
+                    x184,
+                    x203,
+                    x223,
+                    x246,
+                    x273,
+                    x309,
+                    x353,
                 ],
                 [
-                    0.0,
                     0.0,
                     1170.07,
-                    x185,
-                    x201,
                     0.0,
-                    0.0,
-                    x157,
-                    x218,
-                    x237,
-                    x261,
-                    x297,
-                    x337,
-                ],
-                [
-                    0.0,
-                    x200,
-                    x185,
-                    x196,
-                    x191,
-                    x197,
-                    x190,
-                    x208,
-                    x225,
-                    x244,
-                    x268,
-                    x303,
-                    x343,
-                ],
-                [
-                    x195,
-                    0.0,
-                    x201,
-                    x191,
                     x198,
+                    0.0,
                     x192,
-                    x192,
-                    x209,
-                    x226,
-                    x245,
-                    x269,
-                    x304,
-                    x344,
+                    x182,
+                    x204,
+                    x225,
+                    x248,
+                    x275,
+                    x310,
+                    x354,
                 ],
                 [
-                    x186,
-                    x194,
                     0.0,
-                    x197,
-                    x192,
+                    0.0,
+                    1170.07,
+                    x183,
                     x199,
-                    x193,
-                    x210,
-                    x227,
-                    x246,
-                    x270,
-                    x305,
-                    x345,
-                ],
-                [
-                    x186,
-                    x184,
                     0.0,
-                    x190,
-                    x192,
-                    x193,
-                    x178,
-                    x167,
-                    x219,
-                    x238,
-                    x262,
-                    x298,
-                    x338,
+                    0.0,
+                    x155,
+                    x217,
+                    x240,
+                    x267,
+                    x304,
+                    x348,
                 ],
                 [
+                    0.0,
+                    x198,
+                    x183,
+                    x194,
+                    x189,
+                    x195,
+                    x188,
+                    x205,
+                    x226,
+                    x249,
+                    x276,
+                    x311,
+                    x355,
+                ],
+                [
+                    x193,
+                    0.0,
+                    x199,
+                    x189,
+                    x196,
+                    x190,
+                    x190,
+                    x206,
+                    x227,
+                    x250,
+                    x277,
+                    x312,
+                    x356,
+                ],
+                [
+                    x184,
+                    x192,
+                    0.0,
+                    x195,
+                    x190,
+                    x197,
+                    x191,
+                    x207,
+                    x228,
+                    x251,
+                    x278,
+                    x313,
+                    x357,
+                ],
+                [
+                    x184,
+                    x182,
+                    0.0,
+                    x188,
+                    x190,
+                    x191,
+                    x176,
+                    x165,
+                    x219,
+                    x242,
+                    x269,
+                    x306,
+                    x350,
+                ],
+                [
+                    x203,
+                    x204,
+                    x155,
+                    x205,
                     x206,
                     x207,
-                    x157,
-                    x208,
-                    x209,
-                    x210,
-                    x167,
-                    x155,
-                    x215,
-                    x234,
-                    x258,
-                    x294,
-                    x334,
+                    x165,
+                    x153,
+                    x213,
+                    x236,
+                    x264,
+                    x301,
+                    x344,
                 ],
                 [
                     x223,
-                    x224,
-                    x218,
                     x225,
+                    x217,
                     x226,
                     x227,
+                    x228,
                     x219,
-                    x215,
-                    x112,
-                    x106,
-                    x251,
-                    x286,
-                    x326,
+                    x213,
+                    x110,
+                    x104,
+                    x256,
+                    x293,
+                    x336,
                 ],
                 [
-                    x242,
-                    x243,
-                    x237,
-                    x244,
-                    x245,
                     x246,
-                    x238,
-                    x234,
-                    x106,
-                    x92,
-                    x86,
-                    x280,
-                    x321,
-                ],
-                [
-                    x266,
-                    x267,
-                    x261,
-                    x268,
-                    x269,
-                    x270,
-                    x262,
-                    x258,
+                    x248,
+                    x240,
+                    x249,
+                    x250,
                     x251,
-                    x86,
-                    x72,
-                    x61,
-                    x314,
+                    x242,
+                    x236,
+                    x104,
+                    x90,
+                    x84,
+                    x287,
+                    x330,
                 ],
                 [
-                    x301,
-                    x302,
-                    x297,
-                    x303,
+                    x273,
+                    x275,
+                    x267,
+                    x276,
+                    x277,
+                    x278,
+                    x269,
+                    x264,
+                    x256,
+                    x84,
+                    x70,
+                    x59,
+                    x322,
+                ],
+                [
+                    x309,
+                    x310,
                     x304,
-                    x305,
-                    x298,
-                    x294,
-                    x286,
-                    x280,
-                    x61,
+                    x311,
+                    x312,
+                    x313,
+                    x306,
+                    x301,
+                    x293,
+                    x287,
+                    x59,
                     x47,
-                    x309,
+                    x317,
                 ],
                 [
-                    x341,
-                    x342,
-                    x337,
-                    x343,
+                    x353,
+                    x354,
+                    x348,
+                    x355,
+                    x356,
+                    x357,
+                    x350,
                     x344,
-                    x345,
-                    x338,
-                    x334,
-                    x326,
-                    x321,
-                    x314,
-                    x309,
+                    x336,
+                    x330,
+                    x322,
+                    x317,
                     1.4135609200000003,
                 ],
             ],
             [
-                x547,
-                x548,
+                x563,
+                x564,
+                x565,
+                x566,
+                x567,
+                x568,
+                x557,
                 x549,
-                x550,
-                x551,
-                x552,
-                x541,
-                x533,
-                x522,
-                x515,
-                x507,
-                x499,
-                x489,
+                x537,
+                x529,
+                x520,
+                x512,
+                x501,
             ],
         )
     }
@@ -6046,9 +6020,9 @@ impl FreeFloating7 {
             Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         );
         let x2 = Self::mul_add(
-            110.5455,
+            -110.5455,
             v[1],
-            Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]),
+            Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
         );
         let x3 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
         let x4 = Self::mul_add(
@@ -6059,34 +6033,34 @@ impl FreeFloating7 {
         let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x8 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x8 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
         let x9 = Self::mul_add(0.75, v[4], v[0]);
         let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x11 = Self::mul_add(-0.65, v[4], v[2]);
         let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
-        let x13 = Self::mul_add(-s_q7, x9, c_q7 * x10);
+        let x13 = Self::mul_add(-c_q7, x10, s_q7 * x9);
         let x14 = v[6] * x8;
         let x15 = v[6] * x7;
         let x16 = v[6] * x13;
         let x17 = v[6] * x12;
         let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(x18, 16.80768997608804, x8 * 0.07309);
+        let x19 = Self::mul_add(x18, -16.80768997608804, x8 * 0.07309);
         let x20 = Self::mul_add(
-            -48.0240000085309,
+            48.0240000085309,
             x11,
             Self::mul_add(
-                0.1132,
+                -0.1132,
                 x18,
-                Self::mul_add(x7, -0.07309, 130.43769025763282 * x8),
+                Self::mul_add(130.43769025763282, x8, x7 * 0.07309),
             ),
         );
         let x21 = Self::mul_add(
             48.0240000085309,
             x13,
             Self::mul_add(
-                132.47349025763282,
+                -132.47349025763282,
                 x18,
-                Self::mul_add(x7, -16.80768997608804, 0.1132 * x8),
+                Self::mul_add(0.1132, x8, x7 * 16.80768997608804),
             ),
         );
         let x22 = 48.0240000085309 * x18;
@@ -6094,12 +6068,12 @@ impl FreeFloating7 {
         let (s_q8, c_q8) = libm::sincos(q[8]);
         let x25 = 0.00000000020510342851533115 * c_q8;
         let x26 = 0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(-x18, c_q8, Self::mul_add(-x7, x25, x8 * s_q8));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(x8, c_q8, x7 * x26));
-        let x29 = Self::mul_add(0.35, x8, x12);
-        let x30 = Self::mul_add(-0.35, x7, x13);
-        let x31 = Self::mul_add(-x11, c_q8, Self::mul_add(-x25, x29, s_q8 * x30));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(c_q8, x30, x26 * x29));
+        let x27 = Self::mul_add(x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
+        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x8, c_q8, x7 * x26));
+        let x29 = Self::mul_add(-0.35, x8, x12);
+        let x30 = Self::mul_add(0.35, x7, x13);
+        let x31 = Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
+        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x30, x26 * x29));
         let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
         let x34 = v[7] * x28;
         let x35 = v[7] * x27;
@@ -6117,19 +6091,19 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x38,
-                -Self::mul_add(x28, 111.7548902508081, x27 * 0.0000000234896432582596),
+                Self::mul_add(x28, -111.7548902508081, x27 * 0.0000000234896432582596),
             ),
         );
         let x41 = Self::mul_add(
             113.3918902508081,
             x38,
-            Self::mul_add(x27, -0.002139996587640933, 5.080660024070366 * x28),
-        ) + Self::mul_add(x32, -0.000000008530897668050218, x31 * 12.701650001451807);
+            Self::mul_add(5.080660024070366, x28, x27 * 0.002139996587640933),
+        ) - Self::mul_add(x32, 0.000000008530897668050218, x31 * 12.701650001451807);
         let x42 = x38 * 12.701650001451807;
         let x43 = x38 * 0.000000008530897668050218;
         let x44 = Self::mul_add(
             x28,
-            -0.000000008530897668050218,
+            0.000000008530897668050218,
             x27 * 12.701650001451807,
         );
         let (s_q9, c_q9) = libm::sincos(q[9]);
@@ -6137,17 +6111,17 @@ impl FreeFloating7 {
         let x47 = 0.00000000020510342851533115 * s_q9;
         let x48 = x46 - x47;
         let x49 = x46 + x47;
-        let x50 = Self::mul_add(x38, c_q9, Self::mul_add(x28, x48, x27 * s_q9));
-        let x51 = Self::mul_add(-x38, s_q9, Self::mul_add(-x28, x49, x27 * c_q9));
-        let x52 = x31 - Self::mul_add(-0.4, x28, 0.275 * x38);
-        let x53 = Self::mul_add(-0.4, x27, x32);
-        let x54 = Self::mul_add(0.275, x27, x33);
-        let x55 = Self::mul_add(c_q9, x54, Self::mul_add(x48, x53, s_q9 * x52));
-        let x56 = Self::mul_add(-s_q9, x54, Self::mul_add(-x49, x53, c_q9 * x52));
+        let x50 = Self::mul_add(-x38, c_q9, Self::mul_add(-x28, x48, x27 * s_q9));
+        let x51 = Self::mul_add(x38, s_q9, Self::mul_add(x28, x49, x27 * c_q9));
+        let x52 = x31 - Self::mul_add(-0.275, x38, 0.4 * x28);
+        let x53 = Self::mul_add(0.4, x27, x32);
+        let x54 = Self::mul_add(-0.275, x27, x33);
+        let x55 = Self::mul_add(-c_q9, x54, Self::mul_add(-x48, x53, s_q9 * x52));
+        let x56 = Self::mul_add(s_q9, x54, Self::mul_add(x49, x53, c_q9 * x52));
         let x57 = Self::mul_add(
             -0.00000000020510342851533115,
             x54,
-            Self::mul_add(0.00000000020510342851533115, x52, x53),
+            Self::mul_add(-0.00000000020510342851533115, x52, x53),
         );
         let x58 = v[8] * x51;
         let x59 = v[8] * x50;
@@ -6157,28 +6131,28 @@ impl FreeFloating7 {
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x38,
-                Self::mul_add(0.00000000020510342851533115, x27, x28),
+                Self::mul_add(-0.00000000020510342851533115, x27, x28),
             );
-        let x63 = Self::mul_add(x62, 36.18604050126307, x51 * 63.36336825000001);
+        let x63 = Self::mul_add(x62, -36.18604050126307, x51 * 63.36336825000001);
         let x64 = Self::mul_add(x57, 81.53205, x62 * 0.00214);
         let x65 = Self::mul_add(
             x55,
-            81.53205,
+            -81.53205,
             Self::mul_add(
                 69.99836825,
                 x62,
-                -Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
+                Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
             ),
         );
         let x66 = x62 * 81.53205;
         let x67 = x50 * 81.53205;
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
-        let x70 = Self::mul_add(-x50, s_q10, x51 * c_q10);
-        let x71 = Self::mul_add(x62, 0.87, x55);
-        let x72 = Self::mul_add(x50, -0.87, x57);
+        let x70 = Self::mul_add(-x51, c_q10, x50 * s_q10);
+        let x71 = Self::mul_add(x62, -0.87, x55);
+        let x72 = Self::mul_add(x50, 0.87, x57);
         let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
-        let x74 = Self::mul_add(-s_q10, x71, x56 * c_q10);
+        let x74 = Self::mul_add(-x56, c_q10, s_q10 * x71);
         let x75 = v[9] * x70;
         let x76 = v[9] * x69;
         let x77 = v[9] * x74;
@@ -6188,37 +6162,37 @@ impl FreeFloating7 {
         let x81 = Self::mul_add(x72, 45.1584, x79 * 0.6328);
         let x82 = Self::mul_add(
             x73,
-            45.1584,
+            -45.1584,
             Self::mul_add(
                 28.2393615,
                 x79,
-                -Self::mul_add(x70, 24.351642000914637, x69 * 0.6328),
+                Self::mul_add(x70, -24.351642000914637, x69 * 0.6328),
             ),
         );
         let x83 = x79 * 45.1584;
         let x84 = x69 * 45.1584;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x86 = Self::mul_add(x70, s_q11, x69 * c_q11);
-        let x87 = Self::mul_add(-x69, s_q11, x70 * c_q11);
-        let x88 = x73 - Self::mul_add(x79, -0.63, 0.275 * x70);
-        let x89 = Self::mul_add(0.275, x69, x74);
-        let x90 = Self::mul_add(x69, -0.63, x72);
-        let x91 = Self::mul_add(s_q11, x89, c_q11 * x88);
-        let x92 = Self::mul_add(-s_q11, x88, c_q11 * x89);
+        let x86 = Self::mul_add(-x70, s_q11, x69 * c_q11);
+        let x87 = Self::mul_add(x70, c_q11, x69 * s_q11);
+        let x88 = x73 + Self::mul_add(x79, -0.63, 0.275 * x70);
+        let x89 = Self::mul_add(-0.275, x69, x74);
+        let x90 = Self::mul_add(x69, 0.63, x72);
+        let x91 = Self::mul_add(-s_q11, x89, c_q11 * x88);
+        let x92 = Self::mul_add(c_q11, x89, s_q11 * x88);
         let x93 = v[10] * x87;
         let x94 = v[10] * x86;
         let x95 = v[10] * x92;
         let x96 = v[10] * x91;
         let x97 = v[10] + x79;
-        let x98 = Self::mul_add(x87, -9.142025249762803, 2.5482240016099564 * x97);
+        let x98 = Self::mul_add(-2.5482240016099564, x97, x87 * 9.142025249762803);
         let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
         let x100 = Self::mul_add(
             -7.078399999258757,
             x91,
             Self::mul_add(
-                9.223235249762805,
+                -9.223235249762805,
                 x97,
-                Self::mul_add(2.5482240016099564, x87, 0.01675 * x86),
+                Self::mul_add(-2.5482240016099564, x87, 0.01675 * x86),
             ),
         );
         let x101 = 7.078399999258757 * x97;
@@ -6226,12 +6200,12 @@ impl FreeFloating7 {
         let (s_q12, c_q12) = libm::sincos(q[12]);
         let x104 = 0.00000000020510342851533115 * s_q12;
         let x105 = 0.00000000020510342851533115 * c_q12;
-        let x106 = Self::mul_add(-x97, s_q12, Self::mul_add(-x87, x104, x86 * c_q12));
-        let x107 = Self::mul_add(x97, c_q12, Self::mul_add(x87, x105, x86 * s_q12));
-        let x108 = Self::mul_add(x87, -0.36, x91);
-        let x109 = Self::mul_add(x86, 0.36, x92);
-        let x110 = Self::mul_add(-x90, s_q12, Self::mul_add(-x104, x109, c_q12 * x108));
-        let x111 = Self::mul_add(x90, c_q12, Self::mul_add(x105, x109, s_q12 * x108));
+        let x106 = Self::mul_add(x97, s_q12, Self::mul_add(x87, x104, x86 * c_q12));
+        let x107 = Self::mul_add(-x97, c_q12, Self::mul_add(-x87, x105, x86 * s_q12));
+        let x108 = Self::mul_add(x87, 0.36, x91);
+        let x109 = Self::mul_add(x86, -0.36, x92);
+        let x110 = Self::mul_add(x90, s_q12, Self::mul_add(x104, x109, c_q12 * x108));
+        let x111 = Self::mul_add(-x90, c_q12, Self::mul_add(-x105, x109, s_q12 * x108));
         let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
         let x113 = v[11] * x107;
         let x114 = v[11] * x106;
@@ -6239,9 +6213,9 @@ impl FreeFloating7 {
         let x116 = v[11] * x110;
         let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
         let x118 = Self::mul_add(
-            17.135250000000003,
+            -17.135250000000003,
             x112,
-            Self::mul_add(x117, -0.809539999555672, x107 * 1.9877000000000002),
+            Self::mul_add(x117, 0.809539999555672, x107 * 1.9877000000000002),
         );
         let x119 = Self::mul_add(
             -3.6140000000000003,
@@ -6249,67 +6223,67 @@ impl FreeFloating7 {
             Self::mul_add(
                 x117,
                 -2.741639999592316,
-                Self::mul_add(x106, -1.9877000000000002, x107 * 5.252920330000002),
+                Self::mul_add(x107, -5.252920330000002, x106 * 1.9877000000000002),
             ),
         );
         let x120 = Self::mul_add(
             9.740442170000001,
             x117,
-            Self::mul_add(x106, -0.809539999555672, x107 * 2.7416399995923166),
-        ) - Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
+            Self::mul_add(x107, -2.7416399995923166, x106 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
         let x121 = 17.135250000000003 * x117;
         let x122 = 3.6140000000000003 * x117;
         let x123 = Self::mul_add(3.6140000000000003, x107, 17.135250000000003 * x106);
         let (s_q13, c_q13) = libm::sincos(q[13]);
         let x125 = 0.00000000020510342851533115 * c_q13;
         let x126 = 0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
-        let x128 = Self::mul_add(x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
-        let x129 = x110 - Self::mul_add(0.55, x117, 0.16 * x107);
+        let x127 = Self::mul_add(-x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
+        let x128 = Self::mul_add(-x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
+        let x129 = x110 - Self::mul_add(-0.55, x117, 0.16 * x107);
         let x130 = Self::mul_add(0.16, x106, x111);
-        let x131 = Self::mul_add(0.55, x106, x112);
-        let x132 = Self::mul_add(c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
-        let x133 = Self::mul_add(s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
-        let x134 = Self::mul_add(-0.00000000020510342851533115, x131, x129);
+        let x131 = Self::mul_add(-0.55, x106, x112);
+        let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
+        let x133 = Self::mul_add(-s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
+        let x134 = Self::mul_add(0.00000000020510342851533115, x131, x129);
         let x135 = v[12] * x128;
         let x136 = v[12] * x127;
         let x137 = v[12] * x133;
-        let x138 = v[12] + Self::mul_add(-0.00000000020510342851533115, x117, x106);
+        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x117, x106);
         let x139 = Self::mul_add(
             x138,
-            0.9614610000000001,
+            -0.9614610000000001,
             Self::mul_add(x128, 1.2025609200000003, 0.000781 * x127),
         );
         let x140 = Self::mul_add(
             4.806620000000001,
             x134,
-            Self::mul_add(x138, -0.0145, 0.000781 * x128),
+            Self::mul_add(x138, 0.0145, 0.000781 * x128),
         );
         let x141 = Self::mul_add(
             4.806620000000001,
             x132,
             Self::mul_add(
-                1.4135609200000003,
+                -1.4135609200000003,
                 x138,
                 Self::mul_add(x128, -0.9614610000000001, x127 * 0.0145),
             ),
         );
         let x142 = 4.806620000000001 * x138;
         let x143 = 4.806620000000001 * x127;
-        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x128, x140, x127 * x139))
-            - f_ext[7][5];
+        let x144 = f_ext[7][5]
+            + Self::mul_add(x133, x142, Self::mul_add(-x127, x139, x128 * x140));
         let x145 = f_ext[7][1] + Self::mul_add(x127, x143, x138 * x142);
-        let x146 = tau[6] - x144;
+        let x146 = tau[6] + x144;
         let x147 = Self::mul_add(
             4.806620000000001,
             x135,
-            Self::mul_add(x128, x142, -f_ext[7][2]),
+            Self::mul_add(x128, x142, f_ext[7][2]),
         );
         let x148 = Self::mul_add(
             x146,
-            -0.010257782169020348,
-            Self::mul_add(-x133, x143, Self::mul_add(x128, x141, x138 * x139))
-                - f_ext[7][3]
+            0.010257782169020348,
+            f_ext[7][3]
+                + Self::mul_add(x133, x143, Self::mul_add(-x128, x141, x138 * x139))
                 - Self::mul_add(
                     x137,
                     0.049305260929256585,
@@ -6322,21 +6296,22 @@ impl FreeFloating7 {
         );
         let x149 = Self::mul_add(
             x146,
-            -0.6801694828971361,
-            Self::mul_add(x127, x141, x138 * x140)
-                - Self::mul_add(x132, x143, x134 * x142) - f_ext[7][4]
+            0.6801694828971361,
+            f_ext[7][4]
+                + (Self::mul_add(-x127, x141, x138 * x140)
+                    - Self::mul_add(-x132, x143, x134 * x142))
                 - Self::mul_add(
                     x137,
                     3.2693162398830324,
                     Self::mul_add(x136, 1.8565173511957638, x135 * 0.009081457502008472),
                 ),
         );
-        let x150 = x144 + x146;
+        let x150 = x144 - x146;
         let x151 = Self::mul_add(
             x146,
             3.4003628227073506,
             Self::mul_add(x128, x143, f_ext[7][0])
-                + Self::mul_add(
+                - Self::mul_add(
                     x137,
                     16.344251950881606,
                     Self::mul_add(x136, 3.2693162398830324, x135 * 0.049305260929256585),
@@ -6358,11 +6333,11 @@ impl FreeFloating7 {
         let x161 = x125 * 3.2693162398830324;
         let x162 = s_q13 * 3.2693162398830324;
         let x163 = c_q13 * 3.2693162398830324;
-        let x164 = Self::mul_add(-x125, x158, x126 * x161);
+        let x164 = Self::mul_add(-x126, x161, x125 * x158);
         let x165 = Self::mul_add(-x126, x162, x125 * x159);
-        let x166 = Self::mul_add(-x125, x160, x126 * x163);
+        let x166 = Self::mul_add(-x126, x163, x125 * x160);
         let x167 = Self::mul_add(c_q13, x161, s_q13 * x158);
-        let x168 = Self::mul_add(-c_q13, x158, s_q13 * x161);
+        let x168 = Self::mul_add(-s_q13, x161, c_q13 * x158);
         let x169 = s_q13 * 16.344251950881606;
         let x170 = c_q13 * 16.344251950881606;
         let x171 = x125 * (x125 * 16.344251950881606);
@@ -6374,188 +6349,190 @@ impl FreeFloating7 {
         let x177 = 0.16 * x172;
         let x178 = 0.55 * x173;
         let x179 = x165 + Self::mul_add(0.55, x175, 0.16 * x174);
-        let x180 = x166 - Self::mul_add(0.55, x176, 0.16 * x175);
+        let x180 = x166 + Self::mul_add(0.55, x176, 0.16 * x175);
         let x181 = Self::mul_add(-0.16, x171, x167);
-        let x182 = x177 - Self::mul_add(c_q13, x162, s_q13 * x159);
+        let x182 = Self::mul_add(c_q13, x162, s_q13 * x159) - x177;
         let x183 = Self::mul_add(-0.16, x173, Self::mul_add(c_q13, x163, s_q13 * x160));
-        let x184 = Self::mul_add(0.55, x171, x168);
+        let x184 = Self::mul_add(-0.55, x171, x168);
         let x185 = Self::mul_add(-0.55, x172, Self::mul_add(-s_q13, x162, c_q13 * x159));
-        let x186 = Self::mul_add(-c_q13, x160, s_q13 * x163) + x178;
+        let x186 = Self::mul_add(-s_q13, x163, c_q13 * x160) - x178;
         let x187 = Self::mul_add(
             0.16,
             x167,
-            Self::mul_add(0.16, x181, -Self::mul_add(c_q13, x156, s_q13 * x153)),
+            -Self::mul_add(-0.16, x181, Self::mul_add(c_q13, x156, s_q13 * x153)),
         );
         let x188 = Self::mul_add(
-            -0.55,
+            0.55,
             x167,
-            Self::mul_add(0.16, x184, Self::mul_add(c_q13, x157, s_q13 * x155)),
+            -Self::mul_add(-0.16, x184, Self::mul_add(c_q13, x157, s_q13 * x155)),
         );
         let x189 = Self::mul_add(
-            -0.55,
+            0.55,
             x168,
-            Self::mul_add(-0.55, x184, Self::mul_add(-c_q13, x155, s_q13 * x157)),
+            -Self::mul_add(-0.55, x184, Self::mul_add(-s_q13, x157, c_q13 * x155)),
         );
-        let x190 = x147 + Self::mul_add(-x126, x145, x125 * x151);
+        let x190 = x147 - Self::mul_add(-x126, x145, x125 * x151);
         let x191 = Self::mul_add(c_q13, x145, s_q13 * x151);
         let x192 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x147,
             Self::mul_add(-s_q13, x145, c_q13 * x151),
         );
         let x193 = Self::mul_add(
-            -0.55,
+            0.55,
             x190,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
                 x150,
-                Self::mul_add(-c_q13, x148, s_q13 * x149),
+                Self::mul_add(-s_q13, x149, c_q13 * x148),
             ),
         );
         let x194 = -0.809539999555672
             + Self::mul_add(
-                -0.55,
+                0.55,
                 x164,
-                Self::mul_add(-x125, x155, x126 * x157)
-                    + Self::mul_add(-0.16, x185, 0.55 * x186),
+                -(Self::mul_add(-x126, x157, x125 * x155)
+                    + Self::mul_add(0.55, x186, 0.16 * x185)),
             );
-        let x195 = -2.741639999592316 + x188;
+        let x195 = -2.741639999592316 - x188;
         let x196 = 9.740442170000001 + x189;
-        let x197 = -17.135250000000003 + x184;
+        let x197 = -17.135250000000003 - x184;
         let x198 = 3.6140000000000003 + x185;
-        let x199 = Self::mul_add(x106, x119, x107 * x118)
-            + Self::mul_add(-x111, x121, x110 * x122) - f_ext[6][5] + x193;
+        let x199 = f_ext[6][5]
+            - (Self::mul_add(-x106, x119, x107 * x118)
+                + Self::mul_add(-x110, x122, x111 * x121)) - x193;
         let x200 = 1.0 / x196;
-        let x201 = tau[5] - x199;
+        let x201 = tau[5] + x199;
         let x202 = x194 * x200;
         let x203 = x195 * x200;
         let x204 = x197 * x200;
         let x205 = x198 * x200;
         let x206 = x186 * x200;
         let x207 = Self::mul_add(
-            -x194,
+            x194,
             x202,
-            Self::mul_add(-0.16, x165, 0.55 * x166)
+            Self::mul_add(0.55, x166, 0.16 * x165)
                 + (Self::mul_add(
-                    -x125,
+                    -x126,
                     Self::mul_add(
                         x126,
-                        -0.009081457502008472,
-                        x125 * 0.00014873784145079505,
+                        -1.8565173511957638,
+                        x125 * 0.009081457502008472,
                     ),
-                    x126
+                    x125
                         * Self::mul_add(
                             x126,
-                            -1.8565173511957638,
-                            x125 * 0.009081457502008472,
+                            -0.009081457502008472,
+                            x125 * 0.00014873784145079505,
                         ),
-                ) + Self::mul_add(-0.16, x179, 0.55 * x180)),
+                ) + Self::mul_add(0.55, x180, 0.16 * x179)),
         );
         let x208 = Self::mul_add(
             -x194,
             x203,
             -1.9877000000000002
-                + Self::mul_add(
+                - Self::mul_add(
                     0.16,
                     x164,
-                    Self::mul_add(-x126, x156, x125 * x153)
-                        + Self::mul_add(-0.16, x182, 0.55 * x183),
+                    -(Self::mul_add(-x126, x156, x125 * x153)
+                        + Self::mul_add(0.55, x183, 0.16 * x182)),
                 ),
         );
         let x209 = Self::mul_add(-x195, x203, -5.252920330000002 + x187);
-        let x210 = Self::mul_add(-x194, x204, x164 - (x177 + x178));
+        let x210 = Self::mul_add(x194, x204, x164 + (x177 + x178));
         let x211 = Self::mul_add(-x194, x205, x179);
-        let x212 = Self::mul_add(-x194, x206, 17.135250000000003 + x180);
+        let x212 = Self::mul_add(x194, x206, 17.135250000000003 - x180);
         let x213 = Self::mul_add(-x195, x204, x181);
-        let x214 = Self::mul_add(-x195, x205, x182);
-        let x215 = Self::mul_add(-x195, x206, -3.6140000000000003 + x183);
+        let x214 = Self::mul_add(x195, x205, x182);
+        let x215 = Self::mul_add(x195, x206, -3.6140000000000003 + x183);
         let x216 = Self::mul_add(x197, x204, x171);
         let x217 = Self::mul_add(-x197, x205, x172);
-        let x218 = Self::mul_add(x197, x206, x173);
+        let x218 = Self::mul_add(-x197, x206, x173);
         let x219 = Self::mul_add(x198, x205, x174);
-        let x220 = Self::mul_add(-x198, x206, x175);
+        let x220 = Self::mul_add(x198, x206, x175);
         let x221 = Self::mul_add(x186, x206, x176);
         let x222 = Self::mul_add(
-            x201,
+            -x201,
             x202,
-            x150 + Self::mul_add(-x125, x148, x126 * x149)
-                + Self::mul_add(0.55, x192, 0.16 * x191)
-                - (f_ext[6][3]
-                    + (Self::mul_add(x107, x120, x117 * x119)
-                        + Self::mul_add(x111, x123, x112 * x122)))
-                - (Self::mul_add(x114, x208, x113 * x207)
-                    + Self::mul_add(x116, x211, x115 * x210)),
+            f_ext[6][3]
+                + (Self::mul_add(-x107, x120, x117 * x119)
+                    + Self::mul_add(x111, x123, x112 * x122))
+                + (x150 - Self::mul_add(-x126, x149, x125 * x148)
+                    - Self::mul_add(0.55, x192, 0.16 * x191))
+                + (Self::mul_add(-x114, x208, x113 * x207)
+                    + Self::mul_add(-x116, x211, x115 * x210)),
         );
         let x223 = Self::mul_add(
-            x201,
+            -x201,
             x203,
-            Self::mul_add(-x106, x120, x117 * x118)
-                - Self::mul_add(x110, x123, x112 * x121) - f_ext[6][4]
+            f_ext[6][4]
+                + (Self::mul_add(-x106, x120, x117 * x118)
+                    + Self::mul_add(x110, x123, x112 * x121))
                 + Self::mul_add(0.16, x190, Self::mul_add(c_q13, x149, s_q13 * x148))
                 - (Self::mul_add(x114, x209, x113 * x208)
-                    + Self::mul_add(x116, x214, x115 * x213)),
+                    + Self::mul_add(-x116, x214, x115 * x213)),
         );
-        let x224 = Self::mul_add(x201, x196 * x200, x199);
+        let x224 = Self::mul_add(-x201, x196 * x200, x199);
         let x225 = Self::mul_add(
-            x201,
+            -x201,
             x204,
-            x190 - (f_ext[6][0] + Self::mul_add(x107, x123, x117 * x122))
-                + (Self::mul_add(-x116, x217, x115 * x216)
-                    - Self::mul_add(x114, x213, x113 * x210)),
+            f_ext[6][0] + Self::mul_add(x107, x123, x117 * x122) + x190
+                + (Self::mul_add(-x114, x213, x113 * x210)
+                    + Self::mul_add(-x116, x217, x115 * x216)),
         );
         let x226 = Self::mul_add(
-            x201,
+            -x201,
             x205,
-            Self::mul_add(-x115, x217, x116 * x219)
-                - Self::mul_add(x114, x214, x113 * x211)
-                - (f_ext[6][1] + Self::mul_add(x106, x123, x117 * x121) + x191),
+            f_ext[6][1] + Self::mul_add(x106, x123, x117 * x121) + x191
+                - (Self::mul_add(-x114, x214, x113 * x211)
+                    + Self::mul_add(-x116, x219, x115 * x217)),
         );
         let x227 = Self::mul_add(
             x201,
             x206,
-            Self::mul_add(-x107, x121, x106 * x122) - f_ext[6][2] + x192
-                + (Self::mul_add(-x116, x220, x115 * x218)
-                    - Self::mul_add(x114, x215, x113 * x212)),
+            f_ext[6][2] - Self::mul_add(-x106, x122, x107 * x121) - x192
+                - (Self::mul_add(x114, x215, x113 * x212)
+                    - Self::mul_add(-x116, x220, x115 * x218)),
         );
         let x228 = s_q12 * x208;
-        let x229 = Self::mul_add(x105, x208, x104 * x207);
+        let x229 = Self::mul_add(-x105, x208, x104 * x207);
         let x230 = c_q12 * x208;
-        let x231 = Self::mul_add(s_q12, x207, x230);
+        let x231 = Self::mul_add(s_q12, x207, -x230);
         let x232 = Self::mul_add(x105, x209, x104 * x208);
         let x233 = Self::mul_add(c_q12, x209, x228);
-        let x234 = Self::mul_add(-s_q12, x211, c_q12 * x210);
-        let x235 = x212 - Self::mul_add(x105, x211, x104 * x210);
+        let x234 = Self::mul_add(s_q12, x211, c_q12 * x210);
+        let x235 = x212 + Self::mul_add(-x105, x211, x104 * x210);
         let x236 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.00000000020510342851533115,
             x212,
-            Self::mul_add(c_q12, x211, s_q12 * x210),
+            Self::mul_add(-c_q12, x211, s_q12 * x210),
         );
-        let x237 = Self::mul_add(-s_q12, x214, c_q12 * x213);
-        let x238 = x215 - Self::mul_add(x105, x214, x104 * x213);
+        let x237 = Self::mul_add(s_q12, x214, c_q12 * x213);
+        let x238 = x215 - Self::mul_add(-x105, x214, x104 * x213);
         let x239 = Self::mul_add(
             0.00000000020510342851533115,
             x215,
-            Self::mul_add(c_q12, x214, s_q12 * x213),
+            Self::mul_add(-c_q12, x214, s_q12 * x213),
         );
-        let x240 = Self::mul_add(-s_q12, x237, c_q12 * x234);
+        let x240 = Self::mul_add(s_q12, x237, c_q12 * x234);
         let x241 = Self::mul_add(-s_q12, x238, c_q12 * x235);
-        let x242 = Self::mul_add(x105, x237, x104 * x234);
-        let x243 = Self::mul_add(c_q12, x237, s_q12 * x234);
+        let x242 = Self::mul_add(-x105, x237, x104 * x234);
+        let x243 = Self::mul_add(-c_q12, x237, s_q12 * x234);
         let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
-        let x245 = Self::mul_add(c_q12, x239, s_q12 * x236);
+        let x245 = Self::mul_add(-c_q12, x239, s_q12 * x236);
         let x246 = s_q12 * x217;
-        let x247 = Self::mul_add(-x105, x217, x104 * x216) - x218;
+        let x247 = x218 - Self::mul_add(-x105, x217, x104 * x216);
         let x248 = c_q12 * x217;
         let x249 = Self::mul_add(
             0.00000000020510342851533115,
             x218,
             Self::mul_add(s_q12, x216, -x248),
         );
-        let x250 = x220 + Self::mul_add(-x104, x217, x105 * x219);
+        let x250 = x220 - Self::mul_add(-x105, x219, x104 * x217);
         let x251 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x220,
-            Self::mul_add(c_q12, x219, -x246),
+            Self::mul_add(-c_q12, x219, x246),
         );
         let x252 = Self::mul_add(
             0.00000000020510342851533115,
@@ -6567,157 +6544,158 @@ impl FreeFloating7 {
             Self::mul_add(s_q12, x219, x248),
             c_q12 * Self::mul_add(c_q12, x216, x246),
         );
-        let x254 = Self::mul_add(-s_q12, x250, c_q12 * x247);
-        let x255 = Self::mul_add(-s_q12, x251, c_q12 * x249);
-        let x256 = Self::mul_add(-x105, x220, x104 * x218) - x221
-            - Self::mul_add(x105, x250, x104 * x247);
-        let x257 = x252 - Self::mul_add(x105, x251, x104 * x249);
+        let x254 = Self::mul_add(s_q12, x250, c_q12 * x247);
+        let x255 = Self::mul_add(s_q12, x251, c_q12 * x249);
+        let x256 = x221 - Self::mul_add(-x105, x220, x104 * x218)
+            - Self::mul_add(-x105, x250, x104 * x247);
+        let x257 = x252 - Self::mul_add(-x105, x251, x104 * x249);
         let x258 = 0.36 * x254;
-        let x259 = Self::mul_add(0.36, x256, x241);
-        let x260 = Self::mul_add(0.36, x253, -x242);
-        let x261 = Self::mul_add(x105, x238, x104 * x235) + x258;
+        let x259 = Self::mul_add(-0.36, x256, x241);
+        let x260 = Self::mul_add(0.36, x253, x242);
+        let x261 = Self::mul_add(x105, x238, x104 * x235) - x258;
         let x262 = Self::mul_add(
-            0.36,
+            -0.36,
             x259,
             Self::mul_add(
-                -s_q12,
+                s_q12,
                 Self::mul_add(-s_q12, x209, x230),
-                c_q12 * Self::mul_add(c_q12, x207, -x228),
+                c_q12 * Self::mul_add(c_q12, x207, x228),
             ),
         );
         let x263 = Self::mul_add(
-            -0.36,
+            0.36,
             x240,
-            Self::mul_add(-0.36, x261, Self::mul_add(-c_q12, x229, s_q12 * x232)),
+            Self::mul_add(-0.36, x261, Self::mul_add(s_q12, x232, c_q12 * x229)),
         );
         let x264 = Self::mul_add(
             0.36,
             x242,
-            Self::mul_add(-0.36, x260, Self::mul_add(x105, x232, x104 * x229)),
+            Self::mul_add(0.36, x260, Self::mul_add(-x105, x232, x104 * x229)),
         );
         let x265 = Self::mul_add(-s_q12, x226, c_q12 * x225);
         let x266 = x227 - Self::mul_add(x105, x226, x104 * x225);
         let x267 = 0.01675
-            + Self::mul_add(-0.36, x244, Self::mul_add(-c_q12, x231, s_q12 * x233));
+            + Self::mul_add(-0.36, x244, Self::mul_add(s_q12, x233, c_q12 * x231));
         let x268 = 2.5482240016099564
-            + Self::mul_add(0.36, x243, Self::mul_add(x105, x233, x104 * x231));
-        let x269 = 9.223235249762805 + Self::mul_add(c_q12, x233, s_q12 * x231);
-        let x270 = -7.078399999258757 - x243;
-        let x271 = Self::mul_add(x92, x101, Self::mul_add(-x87, x99, x86 * x98))
-            - f_ext[5][5]
+            - Self::mul_add(0.36, x243, Self::mul_add(-x105, x233, x104 * x231));
+        let x269 = 9.223235249762805 - Self::mul_add(-c_q12, x233, s_q12 * x231);
+        let x270 = -7.078399999258757 + x243;
+        let x271 = f_ext[5][5]
+            + Self::mul_add(-x92, x101, Self::mul_add(-x86, x98, x87 * x99))
             - Self::mul_add(
                 0.00000000020510342851533115,
                 x224,
                 Self::mul_add(c_q12, x223, s_q12 * x222),
             );
         let x272 = 1.0 / x269;
-        let x273 = tau[4] - x271;
+        let x273 = tau[4] + x271;
         let x274 = x267 * x272;
         let x275 = x268 * x272;
         let x276 = x270 * x272;
         let x277 = x244 * x272;
         let x278 = x245 * x272;
-        let x279 = Self::mul_add(-x267, x274, Self::mul_add(0.36, x241, x262));
+        let x279 = Self::mul_add(-x267, x274, Self::mul_add(0.36, x241, -x262));
         let x280 = Self::mul_add(-x267, x275, x263);
-        let x281 = Self::mul_add(-x268, x275, -9.142025249762803 + x264);
-        let x282 = Self::mul_add(-x267, x276, x240 + x258);
+        let x281 = Self::mul_add(-x268, x275, -9.142025249762803 - x264);
+        let x282 = Self::mul_add(x267, x276, x240 + x258);
         let x283 = Self::mul_add(x267, x277, x259);
         let x284 = Self::mul_add(
-            -x267,
+            x267,
             x278,
             7.078399999258757
-                + Self::mul_add(0.36, x257, Self::mul_add(-c_q12, x236, s_q12 * x239)),
+                + Self::mul_add(0.36, x257, Self::mul_add(s_q12, x239, c_q12 * x236)),
         );
         let x285 = Self::mul_add(-x268, x276, x260);
-        let x286 = Self::mul_add(x268, x277, -x261);
+        let x286 = Self::mul_add(-x268, x277, x261);
         let x287 = Self::mul_add(
             -x268,
             x278,
-            Self::mul_add(-0.36, x255, Self::mul_add(x105, x239, x104 * x236)),
+            Self::mul_add(0.36, x255, Self::mul_add(-x105, x239, x104 * x236)),
         );
         let x288 = Self::mul_add(x270, x276, x253);
-        let x289 = Self::mul_add(x270, x277, x254);
-        let x290 = Self::mul_add(-x270, x278, x255);
-        let x291 = Self::mul_add(-x244, x277, x256);
-        let x292 = Self::mul_add(x244, x278, x257);
+        let x289 = Self::mul_add(-x270, x277, x254);
+        let x290 = Self::mul_add(x270, x278, x255);
+        let x291 = Self::mul_add(x244, x277, x256);
+        let x292 = Self::mul_add(-x244, x278, x257);
         let x293 = Self::mul_add(
             x245,
             x278,
             Self::mul_add(
                 0.00000000020510342851533115,
                 x252,
-                Self::mul_add(c_q12, x251, s_q12 * x249),
+                Self::mul_add(-c_q12, x251, s_q12 * x249),
             ),
         );
         let x294 = Self::mul_add(
-            x273,
+            -x273,
             x274,
-            Self::mul_add(x92, x102, Self::mul_add(-x97, x98, x87 * x100)) - f_ext[5][3]
+            f_ext[5][3] - Self::mul_add(-x92, x102, Self::mul_add(-x87, x100, x97 * x98))
                 + Self::mul_add(0.36, x266, Self::mul_add(-s_q12, x223, c_q12 * x222))
-                + (Self::mul_add(-x94, x280, x93 * x279)
-                    + Self::mul_add(-x96, x283, x95 * x282)),
+                - (Self::mul_add(x94, x280, x93 * x279)
+                    - Self::mul_add(-x96, x283, x95 * x282)),
         );
         let x295 = Self::mul_add(
-            x273,
+            -x273,
             x275,
-            Self::mul_add(-x86, x100, x97 * x99) - Self::mul_add(x91, x102, x90 * x101)
-                - f_ext[5][4]
+            f_ext[5][4]
+                - (Self::mul_add(-x86, x100, x97 * x99)
+                    - Self::mul_add(x91, x102, x90 * x101))
                 + Self::mul_add(
                     -0.36,
                     x265,
                     x224 - Self::mul_add(x105, x223, x104 * x222),
                 )
-                + (Self::mul_add(-x94, x281, x93 * x280)
+                - (Self::mul_add(x94, x281, x93 * x280)
                     + Self::mul_add(-x96, x286, x95 * x285)),
         );
         let x296 = Self::mul_add(
-            x273,
+            -x273,
             x276,
-            Self::mul_add(x87, x102, -f_ext[5][0]) + x265
+            Self::mul_add(x87, x102, f_ext[5][0]) + x265
                 + (Self::mul_add(-x94, x285, x93 * x282)
-                    - Self::mul_add(x96, x289, x95 * x288)),
+                    + Self::mul_add(x96, x289, x95 * x288)),
         );
         let x297 = Self::mul_add(
-            -x273,
+            x273,
             x277,
-            x266 - (f_ext[5][1] + Self::mul_add(x86, x102, x97 * x101))
-                + (Self::mul_add(-x94, x286, x93 * x283)
-                    + Self::mul_add(-x96, x291, x95 * x289)),
+            f_ext[5][1] + Self::mul_add(x86, x102, x97 * x101) + x266
+                - (Self::mul_add(-x94, x286, x93 * x283)
+                    - Self::mul_add(x96, x291, x95 * x289)),
         );
         let x298 = Self::mul_add(
             x273,
             x278,
-            Self::mul_add(x87, x101, -f_ext[5][2])
+            Self::mul_add(-x87, x101, f_ext[5][2])
                 - Self::mul_add(
                     0.00000000020510342851533115,
                     x227,
                     Self::mul_add(c_q12, x226, s_q12 * x225),
                 )
-                + (Self::mul_add(-x94, x287, x93 * x284)
-                    + Self::mul_add(-x96, x292, x95 * x290)),
+                - (Self::mul_add(-x94, x287, x93 * x284)
+                    + Self::mul_add(x96, x292, x95 * x290)),
         );
         let x299 = s_q11 * x280;
         let x300 = c_q11 * x280;
         let x301 = Self::mul_add(s_q11, x279, x300);
         let x302 = Self::mul_add(c_q11, x281, x299);
-        let x303 = Self::mul_add(-s_q11, x283, c_q11 * x282);
-        let x304 = Self::mul_add(c_q11, x283, s_q11 * x282);
-        let x305 = Self::mul_add(-s_q11, x286, c_q11 * x285);
-        let x306 = Self::mul_add(c_q11, x286, s_q11 * x285);
-        let x307 = Self::mul_add(-s_q11, x305, c_q11 * x303);
-        let x308 = Self::mul_add(-s_q11, x306, c_q11 * x304);
-        let x309 = Self::mul_add(-s_q11, x287, c_q11 * x284);
-        let x310 = Self::mul_add(c_q11, x305, s_q11 * x303);
+        let x303 = Self::mul_add(s_q11, x283, c_q11 * x282);
+        let x304 = Self::mul_add(-c_q11, x283, s_q11 * x282);
+        let x305 = Self::mul_add(s_q11, x286, c_q11 * x285);
+        let x306 = Self::mul_add(-c_q11, x286, s_q11 * x285);
+        let x307 = Self::mul_add(s_q11, x305, c_q11 * x303);
+        let x308 = Self::mul_add(s_q11, x306, c_q11 * x304);
+        let x309 = Self::mul_add(s_q11, x287, c_q11 * x284);
+        let x310 = Self::mul_add(-c_q11, x305, s_q11 * x303);
         let x311 = s_q11 * x289;
         let x312 = c_q11 * x289;
-        let x313 = Self::mul_add(-s_q11, x288, x312);
+        let x313 = Self::mul_add(s_q11, x288, x312);
         let x314 = Self::mul_add(c_q11, x291, x311);
         let x315 = Self::mul_add(-s_q11, x292, c_q11 * x290);
         let x316 = Self::mul_add(c_q11, x292, s_q11 * x290);
         let x317 = Self::mul_add(
-            s_q11,
+            -s_q11,
             Self::mul_add(-s_q11, x291, x312),
-            c_q11 * Self::mul_add(c_q11, x288, x311),
+            c_q11 * Self::mul_add(c_q11, x288, -x311),
         );
         let x318 = Self::mul_add(-s_q11, x314, c_q11 * x313);
         let x319 = Self::mul_add(c_q11, x314, s_q11 * x313);
@@ -6725,108 +6703,113 @@ impl FreeFloating7 {
         let x321 = 0.63 * x315;
         let x322 = 0.63 * x317;
         let x323 = 0.63 * x318;
-        let x324 = x308 + Self::mul_add(-0.63, x316, 0.275 * x319);
+        let x324 = x308 + Self::mul_add(0.63, x316, 0.275 * x319);
         let x325 = x309 + Self::mul_add(0.63, x293, 0.275 * x316);
-        let x326 = Self::mul_add(0.275, x317, x310);
-        let x327 = Self::mul_add(c_q11, x306, s_q11 * x304) - x320;
-        let x328 = Self::mul_add(-0.275, x315, Self::mul_add(c_q11, x287, s_q11 * x284));
-        let x329 = Self::mul_add(
+        let x326 = Self::mul_add(-0.275, x317, x310);
+        let x327 = Self::mul_add(-c_q11, x306, s_q11 * x304) - x320;
+        let x328 = Self::mul_add(
             -0.275,
+            x315,
+            Self::mul_add(-c_q11, x287, s_q11 * x284),
+        );
+        let x329 = Self::mul_add(
+            0.275,
             x310,
-            Self::mul_add(-0.275, x326, Self::mul_add(c_q11, x302, s_q11 * x301)),
+            Self::mul_add(0.275, x326, Self::mul_add(c_q11, x302, s_q11 * x301)),
         );
         let x330 = Self::mul_add(-s_q11, x297, c_q11 * x296);
         let x331 = Self::mul_add(c_q11, x297, s_q11 * x296);
         let x332 = -0.6328
-            + Self::mul_add(0.63, x307, Self::mul_add(-0.63, x321, 0.275 * x323));
-        let x333 = -24.35164200091464 + Self::mul_add(0.63, x310, 0.275 * x322);
+            - Self::mul_add(0.63, x307, Self::mul_add(0.63, x321, 0.275 * x323));
+        let x333 = -24.35164200091464 + Self::mul_add(-0.63, x310, 0.275 * x322);
         let x334 = Self::mul_add(-0.63, x322, 28.2393615);
         let x335 = 45.1584 - x322;
-        let x336 = Self::mul_add(-x74, x83, Self::mul_add(-x69, x80, x70 * x81))
-            - f_ext[4][5]
-            + Self::mul_add(0.63, x330, Self::mul_add(x273, x269 * x272, x271));
+        let x336 = f_ext[4][5]
+            - Self::mul_add(-x74, x83, Self::mul_add(x69, x80, x70 * x81))
+            + Self::mul_add(0.63, x330, Self::mul_add(-x273, x269 * x272, x271));
         let x337 = 1.0 / x334;
-        let x338 = tau[3] - x336;
+        let x338 = tau[3] + x336;
         let x339 = x332 * x337;
         let x340 = x333 * x337;
         let x341 = x335 * x337;
         let x342 = x323 * x337;
         let x343 = x321 * x337;
         let x344 = Self::mul_add(
-            -x332,
+            x332,
             x339,
-            Self::mul_add(-0.63, x309, 0.275 * x308)
-                + (Self::mul_add(
+            Self::mul_add(0.63, x309, 0.275 * x308)
+                - (Self::mul_add(
                     -s_q11,
                     Self::mul_add(-s_q11, x281, x300),
                     c_q11 * Self::mul_add(c_q11, x279, -x299),
-                ) + Self::mul_add(-0.63, x325, 0.275 * x324)),
+                ) - Self::mul_add(0.63, x325, 0.275 * x324)),
         );
         let x345 = Self::mul_add(
             -x332,
             x340,
             Self::mul_add(
-                -0.275,
+                0.275,
                 x307,
                 Self::mul_add(-s_q11, x302, c_q11 * x301)
-                    + Self::mul_add(-0.63, x328, 0.275 * x327),
+                    - Self::mul_add(0.63, x328, 0.275 * x327),
             ),
         );
         let x346 = Self::mul_add(-x333, x340, -24.4950615 + x329);
-        let x347 = Self::mul_add(-x332, x341, x307 + (x320 - x321));
+        let x347 = Self::mul_add(x332, x341, x307 + (x320 + x321));
         let x348 = Self::mul_add(-x332, x342, x324);
         let x349 = Self::mul_add(-x332, x343, -45.1584 + x325);
-        let x350 = Self::mul_add(-x333, x341, x326);
+        let x350 = Self::mul_add(x333, x341, x326);
         let x351 = Self::mul_add(-x333, x342, x327);
         let x352 = Self::mul_add(-x333, x343, x328);
         let x353 = Self::mul_add(x335, x341, x317);
         let x354 = Self::mul_add(-x335, x342, x318);
         let x355 = Self::mul_add(-x335, x343, x315);
-        let x356 = Self::mul_add(-x323, x342, x319);
-        let x357 = Self::mul_add(-x323, x343, x316);
+        let x356 = Self::mul_add(x323, x342, x319);
+        let x357 = Self::mul_add(x323, x343, x316);
         let x358 = Self::mul_add(x321, x343, x293);
         let x359 = Self::mul_add(
-            x338,
+            -x338,
             x339,
-            Self::mul_add(-x74, x84, Self::mul_add(x70, x82, x79 * x80)) - f_ext[4][3]
+            f_ext[4][3] - Self::mul_add(x74, x84, Self::mul_add(x70, x82, x79 * x80))
                 + (Self::mul_add(-s_q11, x295, c_q11 * x294)
                     + Self::mul_add(-0.63, x298, 0.275 * x331))
                 + (Self::mul_add(-x76, x345, x75 * x344)
-                    + Self::mul_add(-x78, x348, x77 * x347)),
+                    + Self::mul_add(x78, x348, x77 * x347)),
         );
         let x360 = Self::mul_add(
-            x338,
+            -x338,
             x340,
-            Self::mul_add(x73, x84, x72 * x83) - Self::mul_add(x69, x82, x79 * x81)
-                - f_ext[4][4]
+            f_ext[4][4]
+                + (Self::mul_add(-x69, x82, x79 * x81)
+                    - Self::mul_add(x73, x84, x72 * x83))
                 + Self::mul_add(-0.275, x330, Self::mul_add(c_q11, x295, s_q11 * x294))
-                + (Self::mul_add(-x76, x346, x75 * x345)
-                    + Self::mul_add(-x78, x351, x77 * x350)),
+                - (Self::mul_add(x76, x346, x75 * x345)
+                    - Self::mul_add(x78, x351, x77 * x350)),
         );
         let x361 = Self::mul_add(
-            x338,
+            -x338,
             x341,
-            x330 - Self::mul_add(x70, x84, f_ext[4][0])
-                + (Self::mul_add(-x76, x350, x75 * x347)
-                    - Self::mul_add(x78, x354, x77 * x353)),
+            Self::mul_add(-x70, x84, f_ext[4][0]) + x330
+                + (Self::mul_add(x76, x350, x75 * x347)
+                    + Self::mul_add(x78, x354, x77 * x353)),
         );
         let x362 = Self::mul_add(
             x338,
             x342,
-            Self::mul_add(x69, x84, x79 * x83) - f_ext[4][1] + x331
-                + (Self::mul_add(-x76, x351, x75 * x348)
-                    + Self::mul_add(-x78, x356, x77 * x354)),
+            f_ext[4][1] - Self::mul_add(x69, x84, x79 * x83) + x331
+                + (Self::mul_add(x76, x351, x75 * x348)
+                    + Self::mul_add(x78, x356, x77 * x354)),
         );
         let x363 = Self::mul_add(
-            x338,
+            -x338,
             x343,
-            x298 - Self::mul_add(x70, x83, f_ext[4][2])
-                + (Self::mul_add(-x76, x352, x75 * x349)
-                    + Self::mul_add(-x78, x357, x77 * x355)),
+            Self::mul_add(x70, x83, f_ext[4][2]) + x298
+                - (Self::mul_add(x76, x352, x75 * x349)
+                    + Self::mul_add(x78, x357, x77 * x355)),
         );
         let x364 = s_q10 * x345;
         let x365 = c_q10 * x345;
-        let x366 = Self::mul_add(s_q10, x344, x365);
+        let x366 = Self::mul_add(s_q10, x344, -x365);
         let x367 = Self::mul_add(c_q10, x346, x364);
         let x368 = Self::mul_add(-s_q10, x348, c_q10 * x347);
         let x369 = Self::mul_add(c_q10, x348, s_q10 * x347);
@@ -6838,14 +6821,14 @@ impl FreeFloating7 {
         let x375 = Self::mul_add(c_q10, x352, s_q10 * x349);
         let x376 = s_q10 * x354;
         let x377 = c_q10 * x354;
-        let x378 = Self::mul_add(-s_q10, x353, x377);
+        let x378 = Self::mul_add(s_q10, x353, x377);
         let x379 = Self::mul_add(c_q10, x356, x376);
         let x380 = Self::mul_add(-s_q10, x357, c_q10 * x355);
         let x381 = Self::mul_add(c_q10, x357, s_q10 * x355);
         let x382 = Self::mul_add(
-            s_q10,
+            -s_q10,
             Self::mul_add(-s_q10, x356, x377),
-            c_q10 * Self::mul_add(c_q10, x353, x376),
+            c_q10 * Self::mul_add(c_q10, x353, -x376),
         );
         let x383 = Self::mul_add(-s_q10, x379, c_q10 * x378);
         let x384 = 0.87 * x380;
@@ -6853,92 +6836,94 @@ impl FreeFloating7 {
         let x386 = 0.87 * x383;
         let x387 = Self::mul_add(0.87, x358, x373);
         let x388 = Self::mul_add(
-            -0.87,
+            0.87,
             x387,
             Self::mul_add(
-                -s_q10,
+                s_q10,
                 Self::mul_add(-s_q10, x346, x365),
-                c_q10 * Self::mul_add(c_q10, x344, -x364),
+                c_q10 * Self::mul_add(c_q10, x344, x364),
             ),
         );
         let x389 = Self::mul_add(-s_q10, x362, c_q10 * x361);
-        let x390 = -0.00214 + Self::mul_add(-0.87, x384, 0.87 * x372);
-        let x391 = Self::mul_add(0.87, x374, -36.18604050126307);
+        let x390 = -0.00214 - Self::mul_add(0.87, x372, 0.87 * x384);
+        let x391 = Self::mul_add(-0.87, x374, -36.18604050126307);
         let x392 = Self::mul_add(-0.87, x385, 69.99836825);
         let x393 = 81.53205 - x385;
-        let x394 = Self::mul_add(-x56, x66, Self::mul_add(-x50, x63, x51 * x64))
-            - f_ext[3][5]
-            + Self::mul_add(0.87, x389, Self::mul_add(x338, x334 * x337, x336));
+        let x394 = f_ext[3][5]
+            + Self::mul_add(-x56, x66, Self::mul_add(x50, x63, x51 * x64))
+            + Self::mul_add(0.87, x389, Self::mul_add(-x338, x334 * x337, x336));
         let x395 = 1.0 / x392;
-        let x396 = tau[2] - x394;
+        let x396 = tau[2] + x394;
         let x397 = x390 * x395;
         let x398 = x391 * x395;
         let x399 = x393 * x395;
         let x400 = x386 * x395;
         let x401 = x384 * x395;
-        let x402 = Self::mul_add(-x390, x397, Self::mul_add(-0.87, x373, x388));
+        let x402 = Self::mul_add(x390, x397, Self::mul_add(0.87, x373, x388));
         let x403 = Self::mul_add(
-            -x390,
+            x390,
             x398,
-            Self::mul_add(-0.87, x375, Self::mul_add(-s_q10, x367, c_q10 * x366)),
+            Self::mul_add(0.87, x375, Self::mul_add(s_q10, x367, c_q10 * x366)),
         );
         let x404 = Self::mul_add(
             -x391,
             x398,
-            -63.36336825000001 + Self::mul_add(c_q10, x367, s_q10 * x366),
+            -63.36336825000001 - Self::mul_add(-c_q10, x367, s_q10 * x366),
         );
-        let x405 = Self::mul_add(-x390, x399, x372 - x384);
+        let x405 = Self::mul_add(x390, x399, x372 + x384);
         let x406 = Self::mul_add(
             -x390,
             x400,
-            Self::mul_add(-0.87, x381, Self::mul_add(-s_q10, x371, c_q10 * x369)),
+            Self::mul_add(0.87, x381, Self::mul_add(-s_q10, x371, c_q10 * x369)),
         );
         let x407 = Self::mul_add(-x390, x401, -81.53205 + x387);
-        let x408 = Self::mul_add(-x391, x399, x374);
+        let x408 = Self::mul_add(x391, x399, x374);
         let x409 = Self::mul_add(-x391, x400, Self::mul_add(c_q10, x371, s_q10 * x369));
         let x410 = Self::mul_add(-x391, x401, x375);
         let x411 = Self::mul_add(x393, x399, x382);
         let x412 = Self::mul_add(-x393, x400, x383);
         let x413 = Self::mul_add(-x393, x401, x380);
-        let x414 = Self::mul_add(-x386, x400, Self::mul_add(c_q10, x379, s_q10 * x378));
-        let x415 = Self::mul_add(-x386, x401, x381);
+        let x414 = Self::mul_add(x386, x400, Self::mul_add(c_q10, x379, s_q10 * x378));
+        let x415 = Self::mul_add(x386, x401, x381);
         let x416 = Self::mul_add(x384, x401, x358);
         let x417 = Self::mul_add(
-            x396,
+            -x396,
             x397,
-            Self::mul_add(-x56, x67, Self::mul_add(x51, x65, x62 * x63)) - f_ext[3][3]
+            f_ext[3][3] + Self::mul_add(x56, x67, Self::mul_add(x51, x65, x62 * x63))
                 + Self::mul_add(-0.87, x363, Self::mul_add(-s_q10, x360, c_q10 * x359))
-                + (Self::mul_add(-x59, x403, x58 * x402)
+                - (Self::mul_add(-x59, x403, x58 * x402)
                     + Self::mul_add(-x61, x406, x60 * x405)),
         );
         let x418 = Self::mul_add(
-            x396,
+            -x396,
             x398,
-            Self::mul_add(x55, x67, x57 * x66) - Self::mul_add(x50, x65, x62 * x64)
-                - f_ext[3][4] + Self::mul_add(c_q10, x360, s_q10 * x359)
-                + (Self::mul_add(-x59, x404, x58 * x403)
+            f_ext[3][4]
+                + (Self::mul_add(-x50, x65, x62 * x64)
+                    - Self::mul_add(x55, x67, x57 * x66))
+                + Self::mul_add(c_q10, x360, s_q10 * x359)
+                - (Self::mul_add(x59, x404, x58 * x403)
                     + Self::mul_add(-x61, x409, x60 * x408)),
         );
-        let x419 = Self::mul_add(x396, x392 * x395, x394);
+        let x419 = Self::mul_add(-x396, x392 * x395, x394);
         let x420 = Self::mul_add(
-            x396,
+            -x396,
             x399,
-            x389 - Self::mul_add(x51, x67, f_ext[3][0])
-                + (Self::mul_add(-x59, x408, x58 * x405)
-                    - Self::mul_add(x61, x412, x60 * x411)),
+            Self::mul_add(x51, x67, f_ext[3][0]) + x389
+                - (Self::mul_add(-x59, x408, x58 * x405)
+                    + Self::mul_add(-x61, x412, x60 * x411)),
         );
         let x421 = Self::mul_add(
             x396,
             x400,
-            Self::mul_add(x50, x67, x62 * x66) - f_ext[3][1]
+            f_ext[3][1] - Self::mul_add(x50, x67, x62 * x66)
                 + Self::mul_add(c_q10, x362, s_q10 * x361)
-                + (Self::mul_add(-x59, x409, x58 * x406)
+                - (Self::mul_add(-x59, x409, x58 * x406)
                     + Self::mul_add(-x61, x414, x60 * x412)),
         );
         let x422 = Self::mul_add(
-            x396,
+            -x396,
             x401,
-            x363 - Self::mul_add(x51, x66, f_ext[3][2])
+            Self::mul_add(-x51, x66, f_ext[3][2]) + x363
                 + (Self::mul_add(-x59, x410, x58 * x407)
                     + Self::mul_add(-x61, x415, x60 * x413)),
         );
@@ -6946,16 +6931,16 @@ impl FreeFloating7 {
         let x424 = Self::mul_add(-x49, x403, x48 * x402);
         let x425 = s_q9 * x403;
         let x426 = Self::mul_add(c_q9, x402, -x425);
-        let x427 = Self::mul_add(-x49, x404, x48 * x403);
-        let x428 = Self::mul_add(-s_q9, x404, x423);
+        let x427 = Self::mul_add(x49, x404, x48 * x403);
+        let x428 = Self::mul_add(s_q9, x404, x423);
         let x429 = 0.00000000020510342851533115 * x407;
-        let x430 = Self::mul_add(c_q9, x406, s_q9 * x405) + x429;
-        let x431 = x407 + Self::mul_add(-x49, x406, x48 * x405);
-        let x432 = Self::mul_add(-s_q9, x406, c_q9 * x405) - x429;
+        let x430 = Self::mul_add(c_q9, x406, s_q9 * x405) - x429;
+        let x431 = x407 - Self::mul_add(-x49, x406, x48 * x405);
+        let x432 = x429 + Self::mul_add(-s_q9, x406, c_q9 * x405);
         let x433 = 0.00000000020510342851533115 * x410;
-        let x434 = Self::mul_add(c_q9, x409, s_q9 * x408) + x433;
-        let x435 = x410 + Self::mul_add(-x49, x409, x48 * x408);
-        let x436 = Self::mul_add(-s_q9, x409, c_q9 * x408) - x433;
+        let x434 = Self::mul_add(c_q9, x409, s_q9 * x408) - x433;
+        let x435 = x410 - Self::mul_add(-x49, x409, x48 * x408);
+        let x436 = x433 + Self::mul_add(-s_q9, x409, c_q9 * x408);
         let x437 = Self::mul_add(c_q9, x434, s_q9 * x430);
         let x438 = Self::mul_add(c_q9, x435, s_q9 * x431);
         let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
@@ -6963,38 +6948,38 @@ impl FreeFloating7 {
         let x441 = Self::mul_add(-s_q9, x434, c_q9 * x430);
         let x442 = c_q9 * x412;
         let x443 = 0.00000000020510342851533115 * x413;
-        let x444 = x413 - Self::mul_add(x49, x412, x48 * x411);
+        let x444 = x413 - Self::mul_add(-x49, x412, x48 * x411);
         let x445 = s_q9 * x412;
-        let x446 = x443 + Self::mul_add(c_q9, x411, x445);
+        let x446 = x443 + Self::mul_add(c_q9, x411, -x445);
         let x447 = 0.00000000020510342851533115 * x415;
-        let x448 = x415 + Self::mul_add(-x49, x414, x48 * x412);
-        let x449 = Self::mul_add(-s_q9, x414, x442) - x447;
+        let x448 = x415 - Self::mul_add(-x49, x414, x48 * x412);
+        let x449 = x447 + Self::mul_add(-s_q9, x414, x442);
         let x450 = 0.00000000020510342851533115 * x416;
-        let x451 = Self::mul_add(-x49, x415, x48 * x413) - x416;
+        let x451 = x416 - Self::mul_add(-x49, x415, x48 * x413);
         let x452 = x450 + Self::mul_add(-s_q9, x415, c_q9 * x413);
         let x453 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.00000000020510342851533115,
             Self::mul_add(c_q9, x415, s_q9 * x413) - x450,
             Self::mul_add(
                 c_q9,
-                Self::mul_add(c_q9, x414, x445) + x447,
-                s_q9 * (Self::mul_add(-s_q9, x411, x442) + x443),
+                Self::mul_add(c_q9, x414, x445) - x447,
+                s_q9 * (Self::mul_add(s_q9, x411, x442) - x443),
             ),
         );
         let x454 = Self::mul_add(
-            0.00000000020510342851533115,
+            -0.00000000020510342851533115,
             x451,
             Self::mul_add(c_q9, x448, s_q9 * x444),
         );
         let x455 = 0.00000000020510342851533115 * x452;
-        let x456 = Self::mul_add(-s_q9, x446, c_q9 * x449) + x455;
-        let x457 = x451 + Self::mul_add(-x49, x448, x48 * x444);
-        let x458 = x452 - Self::mul_add(x49, x449, x48 * x446);
-        let x459 = x455 + Self::mul_add(s_q9, x449, c_q9 * x446);
+        let x456 = Self::mul_add(c_q9, x449, s_q9 * x446) - x455;
+        let x457 = x451 - Self::mul_add(-x49, x448, x48 * x444);
+        let x458 = x452 - Self::mul_add(-x49, x449, x48 * x446);
+        let x459 = x455 + Self::mul_add(-s_q9, x449, c_q9 * x446);
         let x460 = 0.4 * x454;
         let x461 = 0.275 * x456;
-        let x462 = x438 + Self::mul_add(-0.4, x457, 0.275 * x458);
-        let x463 = x439 - Self::mul_add(0.275, x459, 0.4 * x458);
+        let x462 = x438 + Self::mul_add(0.275, x458, 0.4 * x457);
+        let x463 = x439 + Self::mul_add(0.275, x459, 0.4 * x458);
         let x464 = Self::mul_add(0.4, x453, x440);
         let x465 = Self::mul_add(-x49, x435, x48 * x431) + x460;
         let x466 = Self::mul_add(0.4, x456, Self::mul_add(-x49, x436, x48 * x432));
@@ -7007,314 +6992,313 @@ impl FreeFloating7 {
             Self::mul_add(0.4, x464, Self::mul_add(-x49, x427, x48 * x424)),
         );
         let x471 = Self::mul_add(
-            -0.275,
+            0.275,
             x440,
-            Self::mul_add(0.4, x467, Self::mul_add(-x49, x428, x48 * x426)),
+            -Self::mul_add(0.4, x467, Self::mul_add(-x49, x428, x48 * x426)),
         );
         let x472 = Self::mul_add(
-            -0.275,
+            0.275,
             x441,
-            Self::mul_add(-0.275, x467, Self::mul_add(-s_q9, x428, c_q9 * x426)),
+            -Self::mul_add(-0.275, x467, Self::mul_add(-s_q9, x428, c_q9 * x426)),
         );
         let x473 = 0.00000000020510342851533115 * x422;
         let x474 = Self::mul_add(c_q9, x421, s_q9 * x420) + x473;
         let x475 = x422 + Self::mul_add(-x49, x421, x48 * x420);
-        let x476 = Self::mul_add(-s_q9, x421, c_q9 * x420) - x473;
+        let x476 = x473 - Self::mul_add(-s_q9, x421, c_q9 * x420);
         let x477 = 0.00000000020510342851533115 * x419;
         let x478 = -0.002139996587640933
             + Self::mul_add(
-                -0.275,
+                0.275,
                 x437,
-                Self::mul_add(c_q9, x428, s_q9 * x426)
-                    + Self::mul_add(-0.4, x468, 0.275 * x469),
+                -(Self::mul_add(c_q9, x428, s_q9 * x426)
+                    + Self::mul_add(0.275, x469, 0.4 * x468)),
             );
         let x479 = 5.080660024070365 + x471;
         let x480 = 113.3918902508081 + x472;
-        let x481 = 12.701650001451807 + x467;
+        let x481 = 12.701650001451807 - x467;
         let x482 = -0.000000008530897668050218 + x468;
-        let x483 = Self::mul_add(x27, x40, x28 * x39)
-            - Self::mul_add(x31, x43, x32 * x42) - f_ext[2][5]
-            + Self::mul_add(
-                -0.275,
-                x474,
-                Self::mul_add(-s_q9, x418, c_q9 * x417) - x477,
-            );
+        let x483 = f_ext[2][5]
+            - (Self::mul_add(-x27, x40, x28 * x39) - Self::mul_add(-x31, x43, x32 * x42))
+            - Self::mul_add(0.275, x474, x477 - Self::mul_add(-s_q9, x418, c_q9 * x417));
         let x484 = 1.0 / x480;
-        let x485 = tau[1] - x483;
+        let x485 = tau[1] + x483;
         let x486 = x478 * x484;
         let x487 = x479 * x484;
         let x488 = x481 * x484;
         let x489 = x482 * x484;
         let x490 = x469 * x484;
         let x491 = Self::mul_add(
-            -x478,
+            x478,
             x486,
-            Self::mul_add(-0.4, x438, 0.275 * x439)
+            Self::mul_add(0.275, x439, 0.4 * x438)
                 + (Self::mul_add(
                     c_q9,
-                    Self::mul_add(c_q9, x404, x425),
+                    Self::mul_add(-c_q9, x404, x425),
                     s_q9 * Self::mul_add(s_q9, x402, x423),
-                ) + Self::mul_add(-0.4, x462, 0.275 * x463)),
+                ) + Self::mul_add(0.275, x463, 0.4 * x462)),
         );
         let x492 = Self::mul_add(
             -x478,
             x487,
             -0.0000000234896432582596
-                + Self::mul_add(
+                - Self::mul_add(
                     0.4,
                     x437,
                     Self::mul_add(c_q9, x427, s_q9 * x424)
-                        + Self::mul_add(-0.4, x465, 0.275 * x466),
+                        + Self::mul_add(0.275, x466, 0.4 * x465),
                 ),
         );
-        let x493 = Self::mul_add(-x479, x487, -111.7548902508081 + x470);
-        let x494 = Self::mul_add(-x478, x488, x437 + (x461 - x460));
+        let x493 = Self::mul_add(-x479, x487, -111.7548902508081 - x470);
+        let x494 = Self::mul_add(x478, x488, x437 + (x460 + x461));
         let x495 = Self::mul_add(-x478, x489, x462);
-        let x496 = Self::mul_add(-x478, x490, -12.701650001451807 + x463);
-        let x497 = Self::mul_add(-x479, x488, x464);
+        let x496 = Self::mul_add(x478, x490, -12.701650001451807 - x463);
+        let x497 = Self::mul_add(x479, x488, x464);
         let x498 = Self::mul_add(-x479, x489, x465);
-        let x499 = Self::mul_add(-x479, x490, 0.000000008530897668050218 + x466);
-        let x500 = Self::mul_add(-x481, x488, x453);
+        let x499 = Self::mul_add(x479, x490, 0.000000008530897668050218 - x466);
+        let x500 = Self::mul_add(x481, x488, x453);
         let x501 = Self::mul_add(-x481, x489, x454);
         let x502 = Self::mul_add(-x481, x490, x456);
-        let x503 = Self::mul_add(-x482, x489, x457);
-        let x504 = Self::mul_add(-x482, x490, x458);
+        let x503 = Self::mul_add(x482, x489, x457);
+        let x504 = Self::mul_add(x482, x490, x458);
         let x505 = Self::mul_add(x469, x490, x459);
         let x506 = Self::mul_add(
-            x485,
+            -x485,
             x486,
-            Self::mul_add(-x38, x40, x28 * x41) + Self::mul_add(-x32, x44, x33 * x43)
-                - f_ext[2][3]
+            f_ext[2][3]
+                + (Self::mul_add(-x28, x41, x38 * x40)
+                    - Self::mul_add(x32, x44, x33 * x43))
                 + (Self::mul_add(c_q9, x418, s_q9 * x417) + x477
-                    + Self::mul_add(-0.4, x475, 0.275 * x476))
+                    - Self::mul_add(0.275, x476, 0.4 * x475))
                 + (Self::mul_add(-x35, x492, x34 * x491)
                     + Self::mul_add(-x37, x495, x36 * x494)),
         );
         let x507 = Self::mul_add(
-            x485,
+            -x485,
             x487,
-            Self::mul_add(x31, x44, x33 * x42) - Self::mul_add(x27, x41, x38 * x39)
-                - f_ext[2][4]
+            f_ext[2][4]
+                + (Self::mul_add(-x27, x41, x38 * x39)
+                    - Self::mul_add(x31, x44, x33 * x42))
                 + Self::mul_add(0.4, x474, x419 + Self::mul_add(-x49, x418, x48 * x417))
-                + (Self::mul_add(-x35, x493, x34 * x492)
-                    + Self::mul_add(-x37, x498, x36 * x497)),
+                - (Self::mul_add(x35, x493, x34 * x492)
+                    - Self::mul_add(-x37, x498, x36 * x497)),
         );
-        let x508 = Self::mul_add(x485, x480 * x484, x483);
+        let x508 = Self::mul_add(-x485, x480 * x484, x483);
         let x509 = Self::mul_add(
-            x485,
+            -x485,
             x488,
-            Self::mul_add(-x28, x44, x38 * x43) - f_ext[2][0] + x474
-                + (Self::mul_add(-x35, x497, x34 * x494)
+            f_ext[2][0] - Self::mul_add(x28, x44, x38 * x43) + x474
+                + (Self::mul_add(x35, x497, x34 * x494)
                     + Self::mul_add(-x37, x501, x36 * x500)),
         );
         let x510 = Self::mul_add(
-            x485,
+            -x485,
             x489,
-            Self::mul_add(x27, x44, x38 * x42) - f_ext[2][1] + x475
-                + (Self::mul_add(-x35, x498, x34 * x495)
+            f_ext[2][1] - Self::mul_add(x27, x44, x38 * x42) + x475
+                - (Self::mul_add(x35, x498, x34 * x495)
                     + Self::mul_add(-x37, x503, x36 * x501)),
         );
         let x511 = Self::mul_add(
             x485,
             x490,
-            x476 - (f_ext[2][2] + Self::mul_add(x27, x43, x28 * x42))
-                + (Self::mul_add(-x35, x499, x34 * x496)
-                    + Self::mul_add(-x37, x504, x36 * x502)),
+            f_ext[2][2] + Self::mul_add(-x27, x43, x28 * x42) - x476
+                - (Self::mul_add(x35, x499, x34 * x496)
+                    - Self::mul_add(-x37, x504, x36 * x502)),
         );
         let x512 = c_q8 * x492;
-        let x513 = Self::mul_add(s_q8, x491, x512);
+        let x513 = Self::mul_add(s_q8, x491, -x512);
         let x514 = s_q8 * x492;
-        let x515 = Self::mul_add(-c_q8, x491, x514);
+        let x515 = Self::mul_add(c_q8, x491, x514);
         let x516 = Self::mul_add(c_q8, x493, x514);
-        let x517 = Self::mul_add(s_q8, x493, -x512);
-        let x518 = x496 + Self::mul_add(-x25, x494, x26 * x495);
-        let x519 = Self::mul_add(c_q8, x495, s_q8 * x494);
+        let x517 = Self::mul_add(-s_q8, x493, x512);
+        let x518 = x496 + Self::mul_add(x26, x495, x25 * x494);
+        let x519 = Self::mul_add(-c_q8, x495, s_q8 * x494);
         let x520 = Self::mul_add(
             -0.00000000020510342851533115,
             x496,
-            Self::mul_add(-c_q8, x494, s_q8 * x495),
+            Self::mul_add(s_q8, x495, c_q8 * x494),
         );
-        let x521 = x499 + Self::mul_add(-x25, x497, x26 * x498);
-        let x522 = Self::mul_add(c_q8, x498, s_q8 * x497);
+        let x521 = x499 + Self::mul_add(x26, x498, x25 * x497);
+        let x522 = Self::mul_add(-c_q8, x498, s_q8 * x497);
         let x523 = Self::mul_add(
             -0.00000000020510342851533115,
             x499,
-            Self::mul_add(-c_q8, x497, s_q8 * x498),
+            Self::mul_add(s_q8, x498, c_q8 * x497),
         );
-        let x524 = Self::mul_add(-x25, x518, x26 * x521);
-        let x525 = Self::mul_add(-x25, x519, x26 * x522);
+        let x524 = Self::mul_add(-x26, x521, x25 * x518);
+        let x525 = Self::mul_add(-x26, x522, x25 * x519);
         let x526 = Self::mul_add(c_q8, x521, s_q8 * x518);
-        let x527 = Self::mul_add(-c_q8, x518, s_q8 * x521);
-        let x528 = Self::mul_add(-c_q8, x519, s_q8 * x522);
-        let x529 = Self::mul_add(-c_q8, x520, s_q8 * x523);
+        let x527 = Self::mul_add(-s_q8, x521, c_q8 * x518);
+        let x528 = Self::mul_add(-s_q8, x522, c_q8 * x519);
+        let x529 = Self::mul_add(-s_q8, x523, c_q8 * x520);
         let x530 = c_q8 * x501;
-        let x531 = Self::mul_add(s_q8, x500, x530);
+        let x531 = Self::mul_add(s_q8, x500, -x530);
         let x532 = s_q8 * x501;
         let x533 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x502,
-            Self::mul_add(-c_q8, x500, x532),
+            Self::mul_add(c_q8, x500, x532),
         );
-        let x534 = Self::mul_add(c_q8, x503, x532);
+        let x534 = Self::mul_add(-c_q8, x503, x532);
         let x535 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x504,
-            Self::mul_add(s_q8, x503, -x530),
+            Self::mul_add(s_q8, x503, x530),
         );
         let x536 = Self::mul_add(
             0.00000000020510342851533115,
             x505,
-            Self::mul_add(-c_q8, x502, s_q8 * x504),
+            Self::mul_add(s_q8, x504, c_q8 * x502),
         );
-        let x537 = Self::mul_add(-x25, x502, x26 * x504) - x505
-            + Self::mul_add(
-                -x25,
-                x502 + Self::mul_add(-x25, x500, x26 * x501),
-                x26 * (x504 + Self::mul_add(-x25, x501, x26 * x503)),
+        let x537 = x505 - Self::mul_add(x26, x504, x25 * x502)
+            - Self::mul_add(
+                x26,
+                x504 - Self::mul_add(x26, x503, x25 * x501),
+                x25 * (x502 - Self::mul_add(x26, x501, x25 * x500)),
             );
-        let x538 = Self::mul_add(c_q8, x504, s_q8 * x502)
-            + Self::mul_add(-x25, x531, x26 * x534);
-        let x539 = x536 + Self::mul_add(-x25, x533, x26 * x535);
-        let x540 = Self::mul_add(c_q8, x534, s_q8 * x531);
-        let x541 = Self::mul_add(c_q8, x535, s_q8 * x533);
+        let x538 = Self::mul_add(-c_q8, x504, s_q8 * x502)
+            - Self::mul_add(x26, x534, x25 * x531);
+        let x539 = x536 - Self::mul_add(x26, x535, x25 * x533);
+        let x540 = Self::mul_add(-c_q8, x534, s_q8 * x531);
+        let x541 = Self::mul_add(-c_q8, x535, s_q8 * x533);
         let x542 = 0.35 * x538;
-        let x543 = Self::mul_add(-0.35, x540, x525);
-        let x544 = Self::mul_add(0.35, x537, x526);
+        let x543 = Self::mul_add(0.35, x540, x525);
+        let x544 = Self::mul_add(-0.35, x537, x526);
         let x545 = Self::mul_add(c_q8, x522, s_q8 * x519) + x542;
         let x546 = Self::mul_add(
-            -0.35,
+            0.35,
             x543,
             Self::mul_add(
-                -x25,
-                Self::mul_add(-x25, x491, x26 * x492),
-                x26 * Self::mul_add(-x25, x492, x26 * x493),
+                x26,
+                Self::mul_add(-x26, x493, x25 * x492),
+                x25 * Self::mul_add(x26, x492, x25 * x491),
             ),
         );
         let x547 = Self::mul_add(
             0.35,
             x524,
-            Self::mul_add(-0.35, x545, Self::mul_add(-x25, x513, x26 * x516)),
+            -Self::mul_add(0.35, x545, Self::mul_add(x26, x516, x25 * x513)),
         );
         let x548 = Self::mul_add(
             0.35,
             x526,
-            Self::mul_add(0.35, x544, Self::mul_add(c_q8, x516, s_q8 * x513)),
+            -Self::mul_add(-0.35, x544, Self::mul_add(-c_q8, x516, s_q8 * x513)),
         );
-        let x549 = x511 + Self::mul_add(-x25, x509, x26 * x510);
+        let x549 = x511 - Self::mul_add(-x26, x510, x25 * x509);
         let x550 = Self::mul_add(c_q8, x510, s_q8 * x509);
         let x551 = -16.80768997608804
-            + Self::mul_add(-0.35, x528, Self::mul_add(-x25, x515, x26 * x517));
+            - Self::mul_add(0.35, x528, Self::mul_add(x26, x517, x25 * x515));
         let x552 = 0.1132
-            + Self::mul_add(0.35, x527, Self::mul_add(c_q8, x517, s_q8 * x515));
-        let x553 = 132.47349025763282 + Self::mul_add(-c_q8, x515, s_q8 * x517);
+            + Self::mul_add(-0.35, x527, Self::mul_add(-c_q8, x517, s_q8 * x515));
+        let x553 = 132.47349025763282 - Self::mul_add(s_q8, x517, c_q8 * x515);
         let x554 = 48.0240000085309 + x528;
-        let x555 = Self::mul_add(x12, x22, Self::mul_add(x7, x20, x8 * x19))
-            - f_ext[1][5]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
+        let x555 = f_ext[1][5]
+            - Self::mul_add(x12, x22, Self::mul_add(-x7, x20, x8 * x19))
+            - Self::mul_add(
+                0.00000000020510342851533115,
                 x508,
-                Self::mul_add(-c_q8, x506, s_q8 * x507),
+                Self::mul_add(-s_q8, x507, c_q8 * x506),
             );
         let x556 = 1.0 / x553;
-        let x557 = tau[0] - x555;
+        let x557 = tau[0] + x555;
         let x558 = x551 * x556;
         let x559 = x552 * x556;
         let x560 = x527 * x556;
         let x561 = x554 * x556;
         let x562 = x529 * x556;
-        let x563 = Self::mul_add(-x551, x558, Self::mul_add(-0.35, x525, x546));
-        let x564 = Self::mul_add(-x551, x559, -0.07309 + x547);
+        let x563 = Self::mul_add(x551, x558, Self::mul_add(0.35, x525, x546));
+        let x564 = Self::mul_add(-x551, x559, -0.07309 - x547);
         let x565 = Self::mul_add(-x552, x559, 130.43769025763282 + x548);
         let x566 = Self::mul_add(-x551, x560, x524 - x542);
         let x567 = Self::mul_add(-x551, x561, x543);
         let x568 = Self::mul_add(
             -x551,
             x562,
-            Self::mul_add(-0.35, x541, Self::mul_add(-x25, x520, x26 * x523)),
+            Self::mul_add(0.35, x541, Self::mul_add(-x26, x523, x25 * x520)),
         );
-        let x569 = Self::mul_add(-x552, x560, x544);
-        let x570 = Self::mul_add(-x552, x561, x545);
+        let x569 = Self::mul_add(x552, x560, x544);
+        let x570 = Self::mul_add(x552, x561, x545);
         let x571 = Self::mul_add(
-            -x552,
+            x552,
             x562,
             -48.0240000085309
                 + Self::mul_add(0.35, x539, Self::mul_add(c_q8, x523, s_q8 * x520)),
         );
-        let x572 = Self::mul_add(-x527, x560, x537);
+        let x572 = Self::mul_add(x527, x560, x537);
         let x573 = Self::mul_add(-x527, x561, x538);
         let x574 = Self::mul_add(-x527, x562, x539);
-        let x575 = Self::mul_add(-x554, x561, x540);
-        let x576 = Self::mul_add(-x554, x562, x541);
+        let x575 = Self::mul_add(x554, x561, x540);
+        let x576 = Self::mul_add(x554, x562, x541);
         let x577 = Self::mul_add(
-            -x529,
+            x529,
             x562,
             Self::mul_add(
-                -0.00000000020510342851533115,
+                0.00000000020510342851533115,
                 x536,
-                Self::mul_add(-c_q8, x533, s_q8 * x535),
+                Self::mul_add(s_q8, x535, c_q8 * x533),
             ),
         );
         let x578 = Self::mul_add(
-            x557,
+            -x557,
             x558,
-            Self::mul_add(-x18, x20, x8 * x21) - Self::mul_add(x13, x23, x11 * x22)
-                - f_ext[1][3]
+            f_ext[1][3]
+                - (Self::mul_add(x8, x21, x18 * x20)
+                    - Self::mul_add(x13, x23, x11 * x22))
                 + Self::mul_add(
                     -0.35,
                     x550,
-                    x508 + Self::mul_add(-x25, x506, x26 * x507),
+                    x508 - Self::mul_add(-x26, x507, x25 * x506),
                 )
-                + (Self::mul_add(-x15, x564, x14 * x563)
+                - (Self::mul_add(-x15, x564, x14 * x563)
                     + Self::mul_add(-x17, x567, x16 * x566)),
         );
         let x579 = Self::mul_add(
-            x557,
+            -x557,
             x559,
-            Self::mul_add(x12, x23, -Self::mul_add(x7, x21, x18 * x19)) - f_ext[1][4]
+            f_ext[1][4] - Self::mul_add(-x12, x23, Self::mul_add(x7, x21, x18 * x19))
                 + Self::mul_add(0.35, x549, Self::mul_add(c_q8, x507, s_q8 * x506))
-                + (Self::mul_add(-x15, x565, x14 * x564)
+                + (Self::mul_add(x15, x565, x14 * x564)
                     + Self::mul_add(-x17, x570, x16 * x569)),
         );
         let x580 = Self::mul_add(
             x557,
             x560,
-            x549 - (f_ext[1][0] + Self::mul_add(x8, x23, x18 * x22))
-                + (Self::mul_add(-x15, x569, x14 * x566)
-                    + Self::mul_add(-x17, x573, x16 * x572)),
+            f_ext[1][0] + Self::mul_add(x8, x23, x18 * x22) + x549
+                - (Self::mul_add(-x15, x569, x14 * x566)
+                    + Self::mul_add(x17, x573, x16 * x572)),
         );
         let x581 = Self::mul_add(
-            x557,
+            -x557,
             x561,
-            Self::mul_add(x7, x23, -f_ext[1][1]) + x550
+            Self::mul_add(x7, x23, f_ext[1][1]) + x550
                 + (Self::mul_add(-x15, x570, x14 * x567)
-                    + Self::mul_add(-x17, x575, x16 * x573)),
+                    - Self::mul_add(x17, x575, x16 * x573)),
         );
         let x582 = Self::mul_add(
             x557,
             x562,
-            Self::mul_add(x7, x22, -f_ext[1][2])
-                + Self::mul_add(
-                    -0.00000000020510342851533115,
+            Self::mul_add(-x7, x22, f_ext[1][2])
+                - Self::mul_add(
+                    0.00000000020510342851533115,
                     x511,
-                    Self::mul_add(-c_q8, x509, s_q8 * x510),
+                    Self::mul_add(-s_q8, x510, c_q8 * x509),
                 )
-                + (Self::mul_add(-x15, x571, x14 * x568)
-                    + Self::mul_add(-x17, x576, x16 * x574)),
+                - (Self::mul_add(-x15, x571, x14 * x568)
+                    - Self::mul_add(x17, x576, x16 * x574)),
         );
         let x583 = s_q7 * x564;
         let x584 = c_q7 * x564;
-        let x585 = Self::mul_add(s_q7, x563, x584);
+        let x585 = Self::mul_add(s_q7, x563, -x584);
         let x586 = Self::mul_add(c_q7, x565, x583);
-        let x587 = Self::mul_add(-s_q7, x567, c_q7 * x566);
-        let x588 = Self::mul_add(c_q7, x567, s_q7 * x566);
-        let x589 = Self::mul_add(-s_q7, x570, c_q7 * x569);
-        let x590 = Self::mul_add(c_q7, x570, s_q7 * x569);
-        let x591 = Self::mul_add(-s_q7, x589, c_q7 * x587);
-        let x592 = Self::mul_add(-s_q7, x590, c_q7 * x588);
-        let x593 = Self::mul_add(-s_q7, x571, c_q7 * x568);
-        let x594 = Self::mul_add(c_q7, x589, s_q7 * x587);
-        let x595 = Self::mul_add(c_q7, x590, s_q7 * x588);
-        let x596 = Self::mul_add(c_q7, x571, s_q7 * x568);
+        let x587 = Self::mul_add(s_q7, x567, c_q7 * x566);
+        let x588 = Self::mul_add(-c_q7, x567, s_q7 * x566);
+        let x589 = Self::mul_add(s_q7, x570, c_q7 * x569);
+        let x590 = Self::mul_add(-c_q7, x570, s_q7 * x569);
+        let x591 = Self::mul_add(s_q7, x589, c_q7 * x587);
+        let x592 = Self::mul_add(s_q7, x590, c_q7 * x588);
+        let x593 = Self::mul_add(s_q7, x571, c_q7 * x568);
+        let x594 = Self::mul_add(-c_q7, x589, s_q7 * x587);
+        let x595 = Self::mul_add(-c_q7, x590, s_q7 * x588);
+        let x596 = Self::mul_add(-c_q7, x571, s_q7 * x568);
         let x597 = s_q7 * x573;
         let x598 = c_q7 * x573;
         let x599 = Self::mul_add(s_q7, x572, x598);
@@ -7334,52 +7318,52 @@ impl FreeFloating7 {
         let x609 = 0.65 * x605;
         let x610 = x591 - x606;
         let x611 = Self::mul_add(-0.75, x605, x592);
-        let x612 = x594 + Self::mul_add(-0.65, x601, 0.75 * x603);
-        let x613 = x595 + (x606 - x608);
-        let x614 = x596 + Self::mul_add(-0.65, x577, 0.75 * x601);
+        let x612 = x594 + Self::mul_add(0.65, x601, 0.75 * x603);
+        let x613 = x595 + (x606 + x608);
+        let x614 = x596 - Self::mul_add(0.65, x577, 0.75 * x601);
         let x615 = Self::mul_add(
             -0.75,
             x611,
             Self::mul_add(
-                -s_q7,
+                s_q7,
                 Self::mul_add(-s_q7, x565, x584),
-                c_q7 * Self::mul_add(c_q7, x563, -x583),
+                c_q7 * Self::mul_add(c_q7, x563, x583),
             ),
         );
         let x616 = Self::mul_add(-s_q7, x581, c_q7 * x580);
         let x617 = Self::mul_add(c_q7, x581, s_q7 * x580);
-        let x618 = 180.9502499901501 + x612;
-        let x619 = Self::mul_add(-v[5], x4, v[4] * x5) - f_ext[0][0] + x616;
-        let x620 = 1.0 / (1170.07 + x603);
+        let x618 = 180.9502499901501 - x612;
+        let x619 = f_ext[0][0] + Self::mul_add(-v[4], x5, v[5] * x4) + x616;
+        let x620 = 1.0 / (1170.07 - x603);
         let x621 = x604 * x620;
         let x622 = x601 * x620;
         let x623 = x610 * x620;
         let x624 = x618 * x620;
         let x625 = x607 * x620;
-        let x626 = 1.0 / Self::mul_add(-x604, x621, 1170.07 + x605);
-        let x627 = Self::mul_add(-x604, x622, x602);
+        let x626 = 1.0 / Self::mul_add(-x604, x621, 1170.07 - x605);
+        let x627 = Self::mul_add(x604, x622, x602);
         let x628 = x626 * x627;
-        let x629 = Self::mul_add(-x604, x623, -180.9502499901501 + x611);
+        let x629 = Self::mul_add(-x604, x623, -180.9502499901501 - x611);
         let x630 = x626 * x629;
         let x631 = Self::mul_add(-x604, x624, x613);
         let x632 = x626 * x631;
-        let x633 = Self::mul_add(-x604, x625, 110.5455 + x609);
+        let x633 = Self::mul_add(-x604, x625, 110.5455 - x609);
         let x634 = x626 * x633;
         let x635 = 1.0
-            / Self::mul_add(-x627, x628, Self::mul_add(-x601, x622, 1170.07 + x577));
+            / Self::mul_add(-x627, x628, Self::mul_add(-x601, x622, 1170.07 - x577));
         let x636 = Self::mul_add(
-            -x627,
+            x627,
             x630,
-            Self::mul_add(-x601, x623, Self::mul_add(-0.75, x602, x593)),
+            Self::mul_add(-x601, x623, Self::mul_add(0.75, x602, x593)),
         );
         let x637 = x635 * x636;
         let x638 = Self::mul_add(
-            -x627,
+            x627,
             x632,
-            Self::mul_add(-x601, x624, -110.5455 + x614),
+            Self::mul_add(-x601, x624, -110.5455 - x614),
         );
         let x639 = x635 * x638;
-        let x640 = Self::mul_add(-x627, x634, Self::mul_add(-x601, x625, x608));
+        let x640 = Self::mul_add(-x627, x634, Self::mul_add(x601, x625, x608));
         let x641 = x635 * x640;
         let x642 = Self::mul_add(
             -x629,
@@ -7387,7 +7371,7 @@ impl FreeFloating7 {
             Self::mul_add(
                 -x610,
                 x623,
-                1394.5960312283303 + Self::mul_add(-0.75, x592, x615),
+                1394.5960312283303 + Self::mul_add(0.75, x592, -x615),
             ),
         );
         let x643 = 1.0 / Self::mul_add(-x636, x637, x642);
@@ -7395,7 +7379,7 @@ impl FreeFloating7 {
             -x610,
             x624,
             Self::mul_add(-0.65, x593, 0.75 * x591)
-                + Self::mul_add(-0.75, x613, Self::mul_add(-s_q7, x586, c_q7 * x585)),
+                + Self::mul_add(-0.75, x613, Self::mul_add(s_q7, x586, c_q7 * x585)),
         );
         let x645 = Self::mul_add(-x636, x639, Self::mul_add(-x629, x632, x644));
         let x646 = x643 * x645;
@@ -7405,10 +7389,10 @@ impl FreeFloating7 {
             Self::mul_add(
                 -x610,
                 x625,
-                -117.61766249359756 + Self::mul_add(-0.75, x609, 0.65 * x592),
+                -117.61766249359756 + Self::mul_add(-0.65, x592, 0.75 * x609),
             ),
         );
-        let x648 = Self::mul_add(-x636, x641, x647);
+        let x648 = Self::mul_add(x636, x641, x647);
         let x649 = x643 * x648;
         let x650 = Self::mul_add(
             -x631,
@@ -7417,8 +7401,8 @@ impl FreeFloating7 {
                 -x618,
                 x624,
                 1466.4506062283303
-                    + (Self::mul_add(-0.65, x596, 0.75 * x594)
-                        + (Self::mul_add(c_q7, x586, s_q7 * x585)
+                    - (Self::mul_add(-0.65, x596, 0.75 * x594)
+                        + (Self::mul_add(-c_q7, x586, s_q7 * x585)
                             + Self::mul_add(-0.65, x614, 0.75 * x612))),
             ),
         );
@@ -7426,18 +7410,18 @@ impl FreeFloating7 {
         let x652 = Self::mul_add(
             -x618,
             x625,
-            Self::mul_add(0.65, x595, Self::mul_add(-0.65, x608, 0.75 * x607)),
+            Self::mul_add(0.65, x595, Self::mul_add(0.65, x608, 0.75 * x607)),
         );
         let x653 = Self::mul_add(
             -x645,
             x649,
-            Self::mul_add(-x638, x641, Self::mul_add(-x631, x634, x652)),
+            Self::mul_add(x638, x641, Self::mul_add(-x631, x634, x652)),
         );
         let x654 = x651 * x653;
         let x655 = Self::mul_add(
             -x633,
             x634,
-            Self::mul_add(-x607, x625, Self::mul_add(0.65, x609, 1271.854575)),
+            Self::mul_add(-x607, x625, Self::mul_add(-0.65, x609, 1271.854575)),
         );
         let x656 = Self::mul_add(
             -x653,
@@ -7448,60 +7432,63 @@ impl FreeFloating7 {
         let x658 = Self::mul_add(
             x619,
             x621,
-            -(Self::mul_add(-v[3], x5, v[5] * x3) - f_ext[0][1] + x617),
+            f_ext[0][1] - Self::mul_add(-v[3], x5, v[5] * x3) + x617,
         );
         let x659 = Self::mul_add(
             -x628,
             x658,
             Self::mul_add(
-                x619,
+                -x619,
                 x622,
-                -(Self::mul_add(-v[4], x3, v[3] * x4) - f_ext[0][2] + x582),
+                f_ext[0][2] + Self::mul_add(-v[3], x4, v[4] * x3) + x582,
             ),
         );
         let x660 = Self::mul_add(
             x619,
             x623,
-            -(Self::mul_add(-v[5], x1, v[4] * x2) + Self::mul_add(-v[2], x4, v[1] * x5)
-                - f_ext[0][3]
-                + Self::mul_add(-0.75, x617, Self::mul_add(-s_q7, x579, c_q7 * x578))),
+            f_ext[0][3]
+                + (Self::mul_add(v[4], x2, v[5] * x1)
+                    + Self::mul_add(-v[1], x5, v[2] * x4))
+                + Self::mul_add(-0.75, x617, Self::mul_add(-s_q7, x579, c_q7 * x578)),
         );
-        let x661 = Self::mul_add(-x637, x659, Self::mul_add(-x630, x658, x660));
+        let x661 = Self::mul_add(x637, x659, Self::mul_add(-x630, x658, x660));
         let x662 = Self::mul_add(
-            -x632,
+            x632,
             x658,
             Self::mul_add(
-                x619,
+                -x619,
                 x624,
-                -(Self::mul_add(-v[3], x2, v[5] * x0)
-                    + Self::mul_add(-v[0], x5, v[2] * x3) - f_ext[0][4]
+                f_ext[0][4]
+                    - (Self::mul_add(v[3], x2, v[5] * x0)
+                        + Self::mul_add(-v[0], x5, v[2] * x3))
                     + (Self::mul_add(c_q7, x579, s_q7 * x578)
-                        + Self::mul_add(-0.65, x582, 0.75 * x616))),
+                        + Self::mul_add(-0.65, x582, 0.75 * x616)),
             ),
         );
-        let x663 = Self::mul_add(-x646, x661, Self::mul_add(-x639, x659, x662));
+        let x663 = Self::mul_add(x646, x661, Self::mul_add(-x639, x659, x662));
         let x664 = Self::mul_add(
             x619,
             x625,
-            -(Self::mul_add(-v[4], x0, v[3] * x1) + Self::mul_add(-v[1], x3, v[0] * x4)
-                - f_ext[0][5]
-                + Self::mul_add(0.65, x617, Self::mul_add(x557, x553 * x556, x555))),
+            f_ext[0][5]
+                + (Self::mul_add(-v[3], x1, v[4] * x0)
+                    + Self::mul_add(-v[0], x4, v[1] * x3))
+                + Self::mul_add(0.65, x617, Self::mul_add(-x557, x553 * x556, x555)),
         );
         let x665 = Self::mul_add(
             -x649,
             x661,
             Self::mul_add(-x641, x659, Self::mul_add(-x634, x658, x664)),
         );
-        let x666 = x657 * Self::mul_add(-x654, x663, x665);
-        let x667 = Self::mul_add(-x654, x666, x651 * x663);
-        let x668 = Self::mul_add(-x649, x666, Self::mul_add(-x646, x667, x643 * x661));
+        let x666 = x657 * Self::mul_add(x654, x663, x665);
+        let x667 = Self::mul_add(x654, x666, x651 * x663);
+        let x668 = Self::mul_add(-x649, x666, Self::mul_add(x646, x667, x643 * x661));
         let x669 = Self::mul_add(
             -x641,
             x666,
-            Self::mul_add(-x639, x667, Self::mul_add(-x637, x668, x635 * x659)),
+            Self::mul_add(-x639, x667, Self::mul_add(x637, x668, x635 * x659)),
         );
         let x670 = Self::mul_add(
-            -x632,
+            x632,
             x667,
             Self::mul_add(-x630, x668, Self::mul_add(-x628, x669, x626 * x658)),
         );
@@ -7509,160 +7496,159 @@ impl FreeFloating7 {
         let x672 = Self::mul_add(
             x623,
             x668,
-            Self::mul_add(x622, x669, Self::mul_add(x621, x671, x619 * x620)),
+            Self::mul_add(-x622, x669, Self::mul_add(x621, x671, x619 * x620)),
         );
-        let x673 = Self::mul_add(x625, x666, Self::mul_add(x624, x667, x672));
-        let x674 = -x673;
-        let x675 = Self::mul_add(0.75, x667, -x673);
-        let x676 = x671 - Self::mul_add(-0.65, x666, 0.75 * x668);
-        let x677 = Self::mul_add(-0.65, x667, x669);
-        let x678 = x14 + Self::mul_add(s_q7, x667, c_q7 * x668);
-        let x679 = Self::mul_add(-s_q7, x668, c_q7 * x667) - x15;
-        let x680 = x16 + Self::mul_add(s_q7, x676, c_q7 * x675);
-        let x681 = Self::mul_add(-s_q7, x675, c_q7 * x676) - x17;
-        let x682 = x556
+        let x673 = Self::mul_add(x625, x666, Self::mul_add(-x624, x667, x672));
+        let x674 = Self::mul_add(0.75, x667, x673);
+        let x675 = x671 - Self::mul_add(-0.65, x666, 0.75 * x668);
+        let x676 = Self::mul_add(-0.65, x667, x669);
+        let x677 = x14 - Self::mul_add(s_q7, x667, c_q7 * x668);
+        let x678 = x15 + Self::mul_add(-c_q7, x667, s_q7 * x668);
+        let x679 = x16 - Self::mul_add(s_q7, x675, c_q7 * x674);
+        let x680 = x17 + Self::mul_add(-c_q7, x675, s_q7 * x674);
+        let x681 = x556
             * (x557
-                - (Self::mul_add(x553, x666, Self::mul_add(x552, x679, x551 * x678))
-                    + Self::mul_add(
-                        x529,
-                        x677,
-                        Self::mul_add(x554, x681, x527 * x680),
+                + (Self::mul_add(-x553, x666, Self::mul_add(x552, x678, x551 * x677))
+                    - Self::mul_add(
+                        -x529,
+                        x676,
+                        Self::mul_add(-x554, x680, x527 * x679),
                     )));
-        let x683 = x666 + x682;
-        let x684 = Self::mul_add(-0.00000000020510342851533115, x683, x678);
-        let x685 = Self::mul_add(0.35, x679, x680);
-        let x686 = Self::mul_add(-0.35, x678, x681);
-        let x687 = Self::mul_add(-0.00000000020510342851533115, x677, x685);
-        let x688 = x34
-            + Self::mul_add(-c_q8, x683, Self::mul_add(-x25, x678, s_q8 * x679));
-        let x689 = Self::mul_add(s_q8, x683, Self::mul_add(c_q8, x679, x26 * x678))
-            - x35;
-        let x690 = x36
-            + Self::mul_add(-c_q8, x677, Self::mul_add(-x25, x685, s_q8 * x686));
-        let x691 = Self::mul_add(s_q8, x677, Self::mul_add(c_q8, x686, x26 * x685))
-            - x37;
-        let x692 = x484
+        let x682 = x666 + x681;
+        let x683 = Self::mul_add(0.00000000020510342851533115, x682, x677);
+        let x684 = Self::mul_add(0.35, x678, x679);
+        let x685 = Self::mul_add(-0.35, x677, x680);
+        let x686 = Self::mul_add(0.00000000020510342851533115, x676, x684);
+        let x687 = x34
+            + Self::mul_add(-c_q8, x682, Self::mul_add(-s_q8, x678, x25 * x677));
+        let x688 = x35
+            - Self::mul_add(-s_q8, x682, Self::mul_add(c_q8, x678, x26 * x677));
+        let x689 = x36
+            + Self::mul_add(-c_q8, x676, Self::mul_add(-s_q8, x685, x25 * x684));
+        let x690 = x37
+            - Self::mul_add(-s_q8, x676, Self::mul_add(c_q8, x685, x26 * x684));
+        let x691 = x484
             * (x485
-                - (Self::mul_add(x480, x684, Self::mul_add(x479, x689, x478 * x688))
+                - (Self::mul_add(-x480, x683, Self::mul_add(x479, x688, x478 * x687))
                     + Self::mul_add(
                         x469,
-                        x687,
-                        Self::mul_add(x482, x691, x481 * x690),
+                        x686,
+                        Self::mul_add(x482, x690, x481 * x689),
                     )));
-        let x693 = x684 + x692;
-        let x694 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x693,
-            Self::mul_add(0.00000000020510342851533115, x688, x689),
+        let x692 = x683 - x691;
+        let x693 = Self::mul_add(
+            0.00000000020510342851533115,
+            x692,
+            Self::mul_add(0.00000000020510342851533115, x687, x688),
         );
-        let x695 = x690 - Self::mul_add(-0.4, x689, 0.275 * x693);
-        let x696 = Self::mul_add(-0.4, x688, x691);
-        let x697 = Self::mul_add(0.275, x688, x687);
-        let x698 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x697,
-            Self::mul_add(0.00000000020510342851533115, x695, x696),
+        let x694 = x689 + Self::mul_add(0.275, x692, 0.4 * x688);
+        let x695 = Self::mul_add(-0.4, x687, x690);
+        let x696 = Self::mul_add(-0.275, x687, x686);
+        let x697 = Self::mul_add(
+            0.00000000020510342851533115,
+            x696,
+            Self::mul_add(0.00000000020510342851533115, x694, x695),
         );
-        let x699 = x58
-            + Self::mul_add(c_q9, x693, Self::mul_add(x48, x689, s_q9 * x688));
-        let x700 = Self::mul_add(-s_q9, x693, Self::mul_add(-x49, x689, c_q9 * x688))
-            - x59;
-        let x701 = x60
-            + Self::mul_add(c_q9, x697, Self::mul_add(x48, x696, s_q9 * x695));
-        let x702 = Self::mul_add(-s_q9, x697, Self::mul_add(-x49, x696, c_q9 * x695))
-            - x61;
-        let x703 = x395
+        let x698 = x58
+            - Self::mul_add(-c_q9, x692, Self::mul_add(x48, x688, s_q9 * x687));
+        let x699 = x59
+            + Self::mul_add(s_q9, x692, Self::mul_add(-x49, x688, c_q9 * x687));
+        let x700 = x60
+            - Self::mul_add(-c_q9, x696, Self::mul_add(x48, x695, s_q9 * x694));
+        let x701 = x61
+            + Self::mul_add(s_q9, x696, Self::mul_add(-x49, x695, c_q9 * x694));
+        let x702 = x395
             * (x396
-                - (Self::mul_add(x392, x694, Self::mul_add(x391, x700, x390 * x699))
+                + (Self::mul_add(-x392, x693, Self::mul_add(-x391, x699, x390 * x698))
                     + Self::mul_add(
-                        x384,
-                        x698,
-                        Self::mul_add(x386, x702, x393 * x701),
+                        -x384,
+                        x697,
+                        Self::mul_add(x386, x701, x393 * x700),
                     )));
-        let x704 = x694 + x703;
-        let x705 = Self::mul_add(0.87, x704, x701);
-        let x706 = Self::mul_add(-0.87, x699, x698);
-        let x707 = x75 + Self::mul_add(s_q10, x700, c_q10 * x699);
-        let x708 = Self::mul_add(-s_q10, x699, c_q10 * x700) - x76;
-        let x709 = x77 + Self::mul_add(s_q10, x702, c_q10 * x705);
-        let x710 = Self::mul_add(-s_q10, x705, c_q10 * x702) - x78;
-        let x711 = x337
+        let x703 = x693 + x702;
+        let x704 = Self::mul_add(-0.87, x703, x700);
+        let x705 = Self::mul_add(0.87, x698, x697);
+        let x706 = x75 - Self::mul_add(-s_q10, x699, c_q10 * x698);
+        let x707 = x76 + Self::mul_add(c_q10, x699, s_q10 * x698);
+        let x708 = x77 - Self::mul_add(-s_q10, x701, c_q10 * x704);
+        let x709 = x78 + Self::mul_add(c_q10, x701, s_q10 * x704);
+        let x710 = x337
             * (x338
-                - (Self::mul_add(x334, x704, Self::mul_add(x333, x708, x332 * x707))
+                - (Self::mul_add(x334, x703, Self::mul_add(x333, x707, x332 * x706))
                     + Self::mul_add(
                         x321,
-                        x706,
-                        Self::mul_add(x323, x710, x335 * x709),
+                        x705,
+                        Self::mul_add(-x323, x709, x335 * x708),
                     )));
-        let x712 = x704 + x711;
-        let x713 = x709 - Self::mul_add(-0.63, x712, 0.275 * x708);
-        let x714 = Self::mul_add(0.275, x707, x710);
-        let x715 = Self::mul_add(-0.63, x707, x706);
-        let x716 = x93 + Self::mul_add(s_q11, x708, c_q11 * x707);
-        let x717 = Self::mul_add(-s_q11, x707, c_q11 * x708) - x94;
-        let x718 = x95 + Self::mul_add(s_q11, x714, c_q11 * x713);
-        let x719 = Self::mul_add(-s_q11, x713, c_q11 * x714) - x96;
-        let x720 = x272
+        let x711 = x703 + x710;
+        let x712 = x708 - Self::mul_add(-0.63, x711, 0.275 * x707);
+        let x713 = Self::mul_add(0.275, x706, x709);
+        let x714 = Self::mul_add(-0.63, x706, x705);
+        let x715 = x93 + Self::mul_add(s_q11, x707, c_q11 * x706);
+        let x716 = x94 - Self::mul_add(-c_q11, x707, s_q11 * x706);
+        let x717 = x95 + Self::mul_add(s_q11, x713, c_q11 * x712);
+        let x718 = x96 - Self::mul_add(-c_q11, x713, s_q11 * x712);
+        let x719 = x272
             * (x273
-                - (Self::mul_add(x269, x712, Self::mul_add(x268, x717, x267 * x716))
+                - (Self::mul_add(x269, x711, Self::mul_add(x268, x716, x267 * x715))
                     + Self::mul_add(
-                        x245,
-                        x715,
-                        Self::mul_add(-x244, x719, x270 * x718),
+                        -x245,
+                        x714,
+                        Self::mul_add(-x244, x718, x270 * x717),
                     )));
-        let x721 = x712 + x720;
-        let x722 = Self::mul_add(-0.00000000020510342851533115, x721, x717);
-        let x723 = Self::mul_add(-0.36, x717, x718);
-        let x724 = Self::mul_add(0.36, x716, x719);
-        let x725 = Self::mul_add(-0.00000000020510342851533115, x715, x724);
-        let x726 = Self::mul_add(-s_q12, x721, Self::mul_add(-x104, x717, c_q12 * x716))
-            - x113;
-        let x727 = x114
-            + Self::mul_add(c_q12, x721, Self::mul_add(x105, x717, s_q12 * x716));
-        let x728 = Self::mul_add(-s_q12, x715, Self::mul_add(-x104, x724, c_q12 * x723))
-            - x115;
-        let x729 = x116
-            + Self::mul_add(c_q12, x715, Self::mul_add(x105, x724, s_q12 * x723));
-        let x730 = x200
+        let x720 = x711 + x719;
+        let x721 = Self::mul_add(-0.00000000020510342851533115, x720, x716);
+        let x722 = Self::mul_add(-0.36, x716, x717);
+        let x723 = Self::mul_add(0.36, x715, x718);
+        let x724 = Self::mul_add(-0.00000000020510342851533115, x714, x723);
+        let x725 = x113
+            + Self::mul_add(-s_q12, x720, Self::mul_add(-x104, x716, c_q12 * x715));
+        let x726 = x114
+            - Self::mul_add(c_q12, x720, Self::mul_add(x105, x716, s_q12 * x715));
+        let x727 = x115
+            + Self::mul_add(-s_q12, x714, Self::mul_add(-x104, x723, c_q12 * x722));
+        let x728 = x116
+            - Self::mul_add(c_q12, x714, Self::mul_add(x105, x723, s_q12 * x722));
+        let x729 = x200
             * (x201
-                - (Self::mul_add(x196, x722, Self::mul_add(-x195, x727, x194 * x726))
+                - (Self::mul_add(x196, x721, Self::mul_add(x195, x726, x194 * x725))
                     + Self::mul_add(
-                        x186,
-                        x725,
-                        Self::mul_add(-x198, x729, x197 * x728),
+                        -x186,
+                        x724,
+                        Self::mul_add(x198, x728, x197 * x727),
                     )));
-        let x731 = x722 + x730;
-        let x732 = Self::mul_add(
+        let x730 = x721 + x729;
+        let x731 = Self::mul_add(
             c_q13,
-            Self::mul_add(0.55, x726, x725),
+            Self::mul_add(0.55, x725, x724),
             Self::mul_add(
-                s_q13,
-                Self::mul_add(0.16, x726, x729),
-                x125 * (x728 - Self::mul_add(0.55, x731, 0.16 * x727)),
+                -s_q13,
+                Self::mul_add(-0.16, x725, x728),
+                x125 * (x727 + Self::mul_add(-0.55, x730, 0.16 * x726)),
             ),
         );
-        let x733 = Self::mul_add(
+        let x732 = Self::mul_add(
             0.9614610000000001,
-            x136 + Self::mul_add(s_q13, x731, Self::mul_add(-c_q13, x727, x126 * x726)),
+            x136 - Self::mul_add(s_q13, x730, Self::mul_add(c_q13, x726, x126 * x725)),
             0.0145
                 * (x135
-                    - Self::mul_add(
+                    + Self::mul_add(
                         c_q13,
-                        x731,
-                        Self::mul_add(s_q13, x727, x125 * x726),
+                        x730,
+                        Self::mul_add(-s_q13, x726, x125 * x725),
                     )),
         );
-        let x734 = Self::mul_add(
-            -4.806620000000001,
-            x137 - x732,
+        let x733 = Self::mul_add(
+            4.806620000000001,
+            x137 + x731,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x731, x726),
-                -x733,
+                Self::mul_add(-0.00000000020510342851533115, x730, x725),
+                x732,
             ),
         );
-        let x735 = 0.707433253035886 * (x146 - x734);
-        [x674, x671, x669, x668, x667, x666, x682, x692, x703, x711, x720, x730, x735]
+        let x734 = 0.707433253035886 * (x146 - x733);
+        [x673, x671, x669, x668, x667, x666, x681, x691, x702, x710, x719, x729, x734]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///
@@ -7680,31 +7666,31 @@ impl FreeFloating7 {
         let x8 = 2.0 * (q[3] * q[5]);
         let x9 = 2.0 * (q[4] * q[5]);
         let x10 = Self::mul_add(-2.0, x4 + x5, 1.0);
-        let x11 = x7 - x1;
+        let x11 = x1 - x7;
         let x12 = x2 + x8;
         let x13 = x1 + x7;
         let x14 = Self::mul_add(-2.0, x4 + x6, 1.0);
-        let x15 = x9 - x3;
-        let x16 = x8 - x2;
+        let x15 = x3 - x9;
+        let x16 = x2 - x8;
         let x17 = x3 + x9;
         let x18 = Self::mul_add(-2.0, x5 + x6, 1.0);
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x20 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x21 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x21 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
         let x22 = Self::mul_add(0.75, v[4], v[0]);
         let x23 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x24 = Self::mul_add(-0.65, v[4], v[2]);
-        let x25 = Self::mul_add(-s_q7, x22, c_q7 * x23);
+        let x25 = Self::mul_add(-c_q7, x23, s_q7 * x22);
         let x26 = v[5] + v[6];
         let (s_q8, c_q8) = libm::sincos(q[8]);
         let x28 = 0.00000000020510342851533115 * c_q8;
         let x29 = 0.00000000020510342851533115 * s_q8;
-        let x30 = Self::mul_add(-x26, c_q8, Self::mul_add(-x20, x28, x21 * s_q8));
-        let x31 = Self::mul_add(x26, s_q8, Self::mul_add(x21, c_q8, x20 * x29));
-        let x32 = Self::mul_add(0.35, x21, Self::mul_add(s_q7, x23, c_q7 * x22));
-        let x33 = Self::mul_add(-0.35, x20, x25);
-        let x34 = Self::mul_add(-x24, c_q8, Self::mul_add(-x28, x32, s_q8 * x33));
-        let x35 = Self::mul_add(x24, s_q8, Self::mul_add(c_q8, x33, x29 * x32));
+        let x30 = Self::mul_add(x26, c_q8, Self::mul_add(x21, s_q8, x20 * x28));
+        let x31 = Self::mul_add(x26, s_q8, Self::mul_add(-x21, c_q8, x20 * x29));
+        let x32 = Self::mul_add(-0.35, x21, Self::mul_add(s_q7, x23, c_q7 * x22));
+        let x33 = Self::mul_add(0.35, x20, x25);
+        let x34 = Self::mul_add(x24, c_q8, Self::mul_add(s_q8, x33, x28 * x32));
+        let x35 = Self::mul_add(x24, s_q8, Self::mul_add(-c_q8, x33, x29 * x32));
         let x36 = Self::mul_add(-0.00000000020510342851533115, x24, x32);
         let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x26, x20);
         let (s_q9, c_q9) = libm::sincos(q[9]);
@@ -7712,79 +7698,79 @@ impl FreeFloating7 {
         let x40 = 0.00000000020510342851533115 * s_q9;
         let x41 = x39 - x40;
         let x42 = x39 + x40;
-        let x43 = Self::mul_add(x37, c_q9, Self::mul_add(x31, x41, x30 * s_q9));
-        let x44 = Self::mul_add(-x37, s_q9, Self::mul_add(-x31, x42, x30 * c_q9));
-        let x45 = x34 - Self::mul_add(-0.4, x31, 0.275 * x37);
-        let x46 = Self::mul_add(-0.4, x30, x35);
-        let x47 = Self::mul_add(0.275, x30, x36);
-        let x48 = Self::mul_add(c_q9, x47, Self::mul_add(x41, x46, s_q9 * x45));
-        let x49 = Self::mul_add(-s_q9, x47, Self::mul_add(-x42, x46, c_q9 * x45));
+        let x43 = Self::mul_add(-x37, c_q9, Self::mul_add(-x31, x41, x30 * s_q9));
+        let x44 = Self::mul_add(x37, s_q9, Self::mul_add(x31, x42, x30 * c_q9));
+        let x45 = x34 - Self::mul_add(-0.275, x37, 0.4 * x31);
+        let x46 = Self::mul_add(0.4, x30, x35);
+        let x47 = Self::mul_add(-0.275, x30, x36);
+        let x48 = Self::mul_add(-c_q9, x47, Self::mul_add(-x41, x46, s_q9 * x45));
+        let x49 = Self::mul_add(s_q9, x47, Self::mul_add(x42, x46, c_q9 * x45));
         let x50 = Self::mul_add(
             -0.00000000020510342851533115,
             x47,
-            Self::mul_add(0.00000000020510342851533115, x45, x46),
+            Self::mul_add(-0.00000000020510342851533115, x45, x46),
         );
         let x51 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x37,
-                Self::mul_add(0.00000000020510342851533115, x30, x31),
+                Self::mul_add(-0.00000000020510342851533115, x30, x31),
             );
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let x53 = Self::mul_add(x44, s_q10, x43 * c_q10);
-        let x54 = Self::mul_add(-x43, s_q10, x44 * c_q10);
-        let x55 = Self::mul_add(x51, 0.87, x48);
-        let x56 = Self::mul_add(x43, -0.87, x50);
+        let x54 = Self::mul_add(-x44, c_q10, x43 * s_q10);
+        let x55 = Self::mul_add(x51, -0.87, x48);
+        let x56 = Self::mul_add(x43, 0.87, x50);
         let x57 = Self::mul_add(x49, s_q10, c_q10 * x55);
         let x58 = v[9] + x51;
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x60 = Self::mul_add(x54, s_q11, x53 * c_q11);
-        let x61 = Self::mul_add(-x53, s_q11, x54 * c_q11);
-        let x62 = x57 - Self::mul_add(x58, -0.63, 0.275 * x54);
-        let x63 = Self::mul_add(0.275, x53, Self::mul_add(-s_q10, x55, x49 * c_q10));
-        let x64 = Self::mul_add(x53, -0.63, x56);
-        let x65 = Self::mul_add(s_q11, x63, c_q11 * x62);
+        let x60 = Self::mul_add(-x54, s_q11, x53 * c_q11);
+        let x61 = Self::mul_add(x54, c_q11, x53 * s_q11);
+        let x62 = x57 + Self::mul_add(x58, -0.63, 0.275 * x54);
+        let x63 = Self::mul_add(-0.275, x53, Self::mul_add(-x49, c_q10, s_q10 * x55));
+        let x64 = Self::mul_add(x53, 0.63, x56);
+        let x65 = Self::mul_add(-s_q11, x63, c_q11 * x62);
         let x66 = v[10] + x58;
         let (s_q12, c_q12) = libm::sincos(q[12]);
         let x68 = 0.00000000020510342851533115 * s_q12;
         let x69 = 0.00000000020510342851533115 * c_q12;
-        let x70 = Self::mul_add(-x66, s_q12, Self::mul_add(-x61, x68, x60 * c_q12));
-        let x71 = Self::mul_add(x66, c_q12, Self::mul_add(x61, x69, x60 * s_q12));
-        let x72 = Self::mul_add(x61, -0.36, x65);
-        let x73 = Self::mul_add(x60, 0.36, Self::mul_add(-s_q11, x62, c_q11 * x63));
-        let x74 = Self::mul_add(-x64, s_q12, Self::mul_add(-x68, x73, c_q12 * x72));
-        let x75 = Self::mul_add(x64, c_q12, Self::mul_add(x69, x73, s_q12 * x72));
+        let x70 = Self::mul_add(x66, s_q12, Self::mul_add(x61, x68, x60 * c_q12));
+        let x71 = Self::mul_add(-x66, c_q12, Self::mul_add(-x61, x69, x60 * s_q12));
+        let x72 = Self::mul_add(x61, 0.36, x65);
+        let x73 = Self::mul_add(x60, -0.36, Self::mul_add(c_q11, x63, s_q11 * x62));
+        let x74 = Self::mul_add(x64, s_q12, Self::mul_add(x68, x73, c_q12 * x72));
+        let x75 = Self::mul_add(-x64, c_q12, Self::mul_add(-x69, x73, s_q12 * x72));
         let x76 = Self::mul_add(-0.00000000020510342851533115, x64, x73);
         let x77 = v[11] + Self::mul_add(-0.00000000020510342851533115, x66, x61);
         let (s_q13, c_q13) = libm::sincos(q[13]);
         let x79 = 0.00000000020510342851533115 * c_q13;
         let x80 = 0.00000000020510342851533115 * s_q13;
-        let x81 = Self::mul_add(x77, c_q13, Self::mul_add(x71, s_q13, x70 * x79));
-        let x82 = Self::mul_add(x77, s_q13, Self::mul_add(-x71, c_q13, x70 * x80));
-        let x83 = x74 - Self::mul_add(0.55, x77, 0.16 * x71);
-        let x84 = Self::mul_add(0.55, x70, x76);
+        let x81 = Self::mul_add(-x77, c_q13, Self::mul_add(x71, s_q13, x70 * x79));
+        let x82 = Self::mul_add(-x77, s_q13, Self::mul_add(-x71, c_q13, x70 * x80));
+        let x83 = x74 - Self::mul_add(-0.55, x77, 0.16 * x71);
+        let x84 = Self::mul_add(-0.55, x70, x76);
         let x85 = Self::mul_add(
-            c_q13,
+            -c_q13,
             x84,
             Self::mul_add(s_q13, Self::mul_add(0.16, x70, x75), x79 * x83),
         );
-        let x86 = v[12] + Self::mul_add(-0.00000000020510342851533115, x77, x70);
+        let x86 = v[12] - Self::mul_add(0.00000000020510342851533115, x77, x70);
         let x87 = Self::mul_add(
-            -48.0240000085309,
+            48.0240000085309,
             x24,
             Self::mul_add(
-                0.1132,
+                -0.1132,
                 x26,
-                Self::mul_add(x20, -0.07309, 130.43769025763282 * x21),
+                Self::mul_add(130.43769025763282, x21, x20 * 0.07309),
             ),
         );
         let x88 = Self::mul_add(
             48.0240000085309,
             x25,
             Self::mul_add(
-                132.47349025763282,
+                -132.47349025763282,
                 x26,
-                Self::mul_add(x20, -16.80768997608804, 0.1132 * x21),
+                Self::mul_add(0.1132, x21, x20 * 16.80768997608804),
             ),
         );
         let x89 = Self::mul_add(
@@ -7793,34 +7779,34 @@ impl FreeFloating7 {
             Self::mul_add(
                 5.080660024070365,
                 x37,
-                -Self::mul_add(x31, 111.7548902508081, x30 * 0.0000000234896432582596),
+                Self::mul_add(x31, -111.7548902508081, x30 * 0.0000000234896432582596),
             ),
         );
         let x90 = Self::mul_add(
             x48,
-            81.53205,
+            -81.53205,
             Self::mul_add(
                 69.99836825,
                 x51,
-                -Self::mul_add(x44, 36.18604050126307, x43 * 0.00214),
+                Self::mul_add(x44, 36.18604050126307, x43 * 0.00214),
             ),
         );
         let x91 = Self::mul_add(
             x57,
-            45.1584,
+            -45.1584,
             Self::mul_add(
                 28.2393615,
                 x58,
-                -Self::mul_add(x54, 24.351642000914637, x53 * 0.6328),
+                Self::mul_add(x54, -24.351642000914637, x53 * 0.6328),
             ),
         );
         let x92 = Self::mul_add(
             -7.078399999258757,
             x65,
             Self::mul_add(
-                9.223235249762805,
+                -9.223235249762805,
                 x66,
-                Self::mul_add(2.5482240016099564, x61, 0.01675 * x60),
+                Self::mul_add(-2.5482240016099564, x61, 0.01675 * x60),
             ),
         );
         let x93 = Self::mul_add(
@@ -7829,35 +7815,35 @@ impl FreeFloating7 {
             Self::mul_add(
                 x77,
                 -2.741639999592316,
-                Self::mul_add(x70, -1.9877000000000002, x71 * 5.252920330000002),
+                Self::mul_add(x71, -5.252920330000002, x70 * 1.9877000000000002),
             ),
         );
         let x94 = Self::mul_add(
             x86,
-            0.9614610000000001,
+            -0.9614610000000001,
             Self::mul_add(x82, 1.2025609200000003, 0.000781 * x81),
         );
         let x95 = Self::mul_add(
             4.806620000000001,
-            Self::mul_add(-0.00000000020510342851533115, x84, x83),
-            Self::mul_add(x86, -0.0145, 0.000781 * x82),
+            Self::mul_add(0.00000000020510342851533115, x84, x83),
+            Self::mul_add(x86, 0.0145, 0.000781 * x82),
         );
         let x96 = Self::mul_add(
             4.806620000000001,
             x85,
             Self::mul_add(
-                1.4135609200000003,
+                -1.4135609200000003,
                 x86,
                 Self::mul_add(x82, -0.9614610000000001, x81 * 0.0145),
             ),
         );
         let x97 = 4.806620000000001 * x86;
         let x98 = 4.806620000000001 * x81;
-        let x99 = Self::mul_add(x79, x97, -x98);
+        let x99 = Self::mul_add(x79, x97, x98);
         let x100 = s_q13 * x97;
-        let x101 = Self::mul_add(0.00000000020510342851533115, x98, c_q13 * x97);
+        let x101 = Self::mul_add(-0.00000000020510342851533115, x98, c_q13 * x97);
         let x102 = Self::mul_add(
-            0.55,
+            -0.55,
             x99,
             Self::mul_add(
                 0.00000000020510342851533115,
@@ -7866,37 +7852,37 @@ impl FreeFloating7 {
             ),
         );
         let x103 = Self::mul_add(
-            17.135250000000003,
+            -17.135250000000003,
             x76,
-            Self::mul_add(x77, -0.809539999555672, x71 * 1.9877000000000002),
+            Self::mul_add(x77, 0.809539999555672, x71 * 1.9877000000000002),
         )
             + (x96 - Self::mul_add(x80, x94, x79 * x95)
-                + Self::mul_add(0.55, x101, 0.16 * x100));
+                - Self::mul_add(0.55, x101, 0.16 * x100));
         let x104 = x93
-            + Self::mul_add(0.16, x99, Self::mul_add(-c_q13, x94, s_q13 * x95));
+            - Self::mul_add(-0.16, x99, Self::mul_add(-c_q13, x94, s_q13 * x95));
         let x105 = Self::mul_add(
             9.740442170000001,
             x77,
-            Self::mul_add(x70, -0.809539999555672, x71 * 2.7416399995923166),
-        ) - Self::mul_add(3.6140000000000003, x75, 17.135250000000003 * x74) - x102;
-        let x106 = Self::mul_add(-17.135250000000003, x77, x99);
+            Self::mul_add(x71, -2.7416399995923166, x70 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x75, 17.135250000000003 * x74) + x102;
+        let x106 = Self::mul_add(17.135250000000003, x77, -x99);
         let x107 = Self::mul_add(3.6140000000000003, x77, -x100);
         let x108 = Self::mul_add(3.6140000000000003, x71, 17.135250000000003 * x70)
-            + x101;
-        let x109 = Self::mul_add(-s_q12, x107, c_q12 * x106);
-        let x110 = x108 - Self::mul_add(x69, x107, x68 * x106);
+            - x101;
+        let x109 = Self::mul_add(s_q12, x107, c_q12 * x106);
+        let x110 = x108 - Self::mul_add(-x69, x107, x68 * x106);
         let x111 = Self::mul_add(7.078399999258757, x64, 0.01675 * x66)
-            + Self::mul_add(0.36, x110, Self::mul_add(-s_q12, x104, c_q12 * x103));
-        let x112 = Self::mul_add(x61, -9.142025249762803, 2.5482240016099564 * x66)
-            + Self::mul_add(-0.36, x109, x105 - Self::mul_add(x69, x104, x68 * x103));
-        let x113 = Self::mul_add(-7.078399999258757, x66, x109);
+            - Self::mul_add(0.36, x110, Self::mul_add(s_q12, x104, c_q12 * x103));
+        let x112 = Self::mul_add(-2.5482240016099564, x66, x61 * 9.142025249762803)
+            - Self::mul_add(0.36, x109, x105 + Self::mul_add(-x69, x104, x68 * x103));
+        let x113 = Self::mul_add(7.078399999258757, x66, x109);
         let x114 = Self::mul_add(
             7.078399999258757,
             x60,
             -Self::mul_add(
                 0.00000000020510342851533115,
                 x108,
-                Self::mul_add(c_q12, x107, s_q12 * x106),
+                Self::mul_add(-c_q12, x107, s_q12 * x106),
             ),
         );
         let x115 = Self::mul_add(-s_q11, x110, c_q11 * x113);
@@ -7906,102 +7892,98 @@ impl FreeFloating7 {
             x115,
             x92
                 - Self::mul_add(
-                    0.00000000020510342851533115,
+                    -0.00000000020510342851533115,
                     x105,
-                    Self::mul_add(c_q12, x104, s_q12 * x103),
+                    Self::mul_add(-c_q12, x104, s_q12 * x103),
                 ),
         );
-        let x118 = Self::mul_add(-s_q11, x112, c_q11 * x111)
-            + Self::mul_add(-0.63, x114, 0.275 * x116)
-            - Self::mul_add(x56, 45.1584, x58 * 0.6328);
-        let x119 = Self::mul_add(-0.275, x115, Self::mul_add(c_q11, x112, s_q11 * x111))
-            - Self::mul_add(x58, 24.35164200091464, x54 * 24.4950615);
-        let x120 = Self::mul_add(x58, 45.1584, x115);
-        let x121 = Self::mul_add(x53, -45.1584, x114);
-        let x122 = Self::mul_add(-s_q10, x116, c_q10 * x120);
-        let x123 = Self::mul_add(c_q10, x116, s_q10 * x120);
-        let x124 = Self::mul_add(-0.87, x121, Self::mul_add(-s_q10, x119, c_q10 * x118))
-            - Self::mul_add(x50, 81.53205, x51 * 0.00214);
-        let x125 = Self::mul_add(c_q10, x119, s_q10 * x118)
-            - Self::mul_add(x51, 36.18604050126307, x44 * 63.36336825000001);
-        let x126 = x90 + Self::mul_add(0.87, x122, x91 + x117);
+        let x118 = Self::mul_add(x56, 45.1584, x58 * 0.6328)
+            - (Self::mul_add(s_q11, x112, c_q11 * x111)
+                - Self::mul_add(-0.63, x114, 0.275 * x116));
+        let x119 = Self::mul_add(x58, 24.35164200091464, x54 * 24.4950615)
+            - Self::mul_add(0.275, x115, Self::mul_add(-c_q11, x112, s_q11 * x111));
+        let x120 = Self::mul_add(x58, 45.1584, -x115);
+        let x121 = Self::mul_add(x53, 45.1584, -x114);
+        let x122 = Self::mul_add(s_q10, x116, c_q10 * x120);
+        let x123 = Self::mul_add(-c_q10, x116, s_q10 * x120);
+        let x124 = Self::mul_add(x50, 81.53205, x51 * 0.00214)
+            + Self::mul_add(0.87, x121, Self::mul_add(-s_q10, x119, c_q10 * x118));
+        let x125 = Self::mul_add(x51, -36.18604050126307, x44 * 63.36336825000001)
+            - Self::mul_add(c_q10, x119, s_q10 * x118);
+        let x126 = x90 + Self::mul_add(0.87, x122, x91 - x117);
         let x127 = Self::mul_add(x51, 81.53205, x122);
-        let x128 = Self::mul_add(x43, -81.53205, x121);
+        let x128 = Self::mul_add(x43, 81.53205, x121);
         let x129 = 0.00000000020510342851533115 * x128;
         let x130 = Self::mul_add(c_q9, x123, s_q9 * x127) + x129;
         let x131 = x128 + Self::mul_add(-x42, x123, x41 * x127);
-        let x132 = Self::mul_add(-s_q9, x123, c_q9 * x127) - x129;
+        let x132 = x129 - Self::mul_add(-s_q9, x123, c_q9 * x127);
         let x133 = 0.00000000020510342851533115 * x126;
-        let x134 = Self::mul_add(c_q9, x125, s_q9 * x124) + x133
-            + Self::mul_add(-0.4, x131, 0.275 * x132)
-            - Self::mul_add(
-                x36,
-                12.701650001451807,
-                Self::mul_add(x37, 0.002139996587640933, x31 * 0.0000000234896432582596),
-            );
+        let x134 = Self::mul_add(
+            x36,
+            12.701650001451807,
+            Self::mul_add(x37, 0.002139996587640933, x31 * 0.0000000234896432582596),
+        )
+            + (Self::mul_add(-c_q9, x125, s_q9 * x124) - x133
+                + Self::mul_add(0.275, x132, 0.4 * x131));
         let x135 = x89
-            + Self::mul_add(0.4, x130, x126 + Self::mul_add(-x42, x125, x41 * x124));
+            + Self::mul_add(0.4, x130, x126 - Self::mul_add(x42, x125, x41 * x124));
         let x136 = Self::mul_add(
             113.3918902508081,
             x37,
-            Self::mul_add(x30, -0.002139996587640933, 5.080660024070366 * x31),
-        ) + Self::mul_add(x35, -0.000000008530897668050218, x34 * 12.701650001451807)
-            + Self::mul_add(
-                -0.275,
-                x130,
-                Self::mul_add(-s_q9, x125, c_q9 * x124) - x133,
-            );
+            Self::mul_add(5.080660024070366, x31, x30 * 0.002139996587640933),
+        ) - Self::mul_add(x35, 0.000000008530897668050218, x34 * 12.701650001451807)
+            - Self::mul_add(0.275, x130, x133 + Self::mul_add(s_q9, x125, c_q9 * x124));
         let x137 = Self::mul_add(x37, 12.701650001451807, x130);
-        let x138 = Self::mul_add(x37, -0.000000008530897668050218, x131);
-        let x139 = x132
-            - Self::mul_add(x31, -0.000000008530897668050218, x30 * 12.701650001451807);
-        let x140 = x139 + Self::mul_add(-x28, x137, x29 * x138);
-        let x141 = Self::mul_add(c_q8, x138, s_q8 * x137);
-        let x142 = Self::mul_add(
-            -0.35,
-            x141,
-            x136 + Self::mul_add(-x28, x134, x29 * x135),
-        ) - Self::mul_add(x26, 16.80768997608804, x21 * 0.07309);
+        let x138 = Self::mul_add(x37, 0.000000008530897668050218, -x131);
+        let x139 = Self::mul_add(
+            x31,
+            0.000000008530897668050218,
+            x30 * 12.701650001451807,
+        ) - x132;
+        let x140 = x139 - Self::mul_add(x29, x138, x28 * x137);
+        let x141 = Self::mul_add(-c_q8, x138, s_q8 * x137);
+        let x142 = Self::mul_add(x26, -16.80768997608804, x21 * 0.07309)
+            + Self::mul_add(-0.35, x141, x136 + Self::mul_add(x29, x135, x28 * x134));
         let x143 = x87
-            + Self::mul_add(0.35, x140, Self::mul_add(c_q8, x135, s_q8 * x134));
+            + Self::mul_add(-0.35, x140, Self::mul_add(-c_q8, x135, s_q8 * x134));
         let x144 = Self::mul_add(48.0240000085309, x26, x141);
         let x145 = Self::mul_add(
-            -48.0240000085309,
+            48.0240000085309,
             x21,
-            Self::mul_add(
-                -0.00000000020510342851533115,
+            -Self::mul_add(
+                0.00000000020510342851533115,
                 x139,
-                Self::mul_add(-c_q8, x137, s_q8 * x138),
+                Self::mul_add(s_q8, x138, c_q8 * x137),
             ),
         );
         let x146 = Self::mul_add(-s_q7, x144, c_q7 * x140);
         let x147 = Self::mul_add(c_q7, x144, s_q7 * x140);
         let x148 = Self::mul_add(
-            0.65,
+            -0.65,
             x147,
             x88
-                + Self::mul_add(
+                - Self::mul_add(
                     -0.00000000020510342851533115,
                     x136,
-                    Self::mul_add(-c_q8, x134, s_q8 * x135),
+                    Self::mul_add(s_q8, x135, c_q8 * x134),
                 ),
         );
         let x149 = Self::mul_add(
             -180.9502499901501,
             v[1],
             Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
-        ) + Self::mul_add(-0.75, x147, Self::mul_add(-s_q7, x143, c_q7 * x142));
+        ) + Self::mul_add(-0.75, x147, Self::mul_add(s_q7, x143, c_q7 * x142));
         let x150 = Self::mul_add(
             1466.4506062283303,
             v[4],
             Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         )
-            + (Self::mul_add(c_q7, x143, s_q7 * x142)
+            + (Self::mul_add(-c_q7, x143, s_q7 * x142)
                 + Self::mul_add(-0.65, x145, 0.75 * x146));
         let x151 = Self::mul_add(
-            110.5455,
+            -110.5455,
             v[1],
-            Self::mul_add(v[3], -117.61766249359758, 1271.854575 * v[5]),
+            Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
         ) + x148;
         let x152 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]) + x146;
         let x153 = Self::mul_add(
@@ -8010,16 +7992,17 @@ impl FreeFloating7 {
             -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
         ) + x147;
         let x154 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x145;
-        let x155 = Self::mul_add(x12, x154, Self::mul_add(x11, x153, x10 * x152));
-        let x156 = Self::mul_add(x15, x154, Self::mul_add(x14, x153, x13 * x152));
-        let x157 = Self::mul_add(x18, x154, Self::mul_add(x17, x153, x16 * x152));
-        let x158 = Self::mul_add(x12, x151, Self::mul_add(x11, x150, x10 * x149))
-            + Self::mul_add(-q[2], x156, q[1] * x157);
-        let x159 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149))
-            + Self::mul_add(-q[0], x157, q[2] * x155);
-        let x160 = Self::mul_add(x18, x151, Self::mul_add(x17, x150, x16 * x149))
-            + Self::mul_add(-q[1], x155, q[0] * x156);
-        [x155, x156, x157, x158, x159, x160]
+        let x155 = Self::mul_add(x12, x154, Self::mul_add(-x11, x153, x10 * x152));
+        let x156 = Self::mul_add(-x15, x154, Self::mul_add(x14, x153, x13 * x152));
+        let x157 = Self::mul_add(-x18, x154, Self::mul_add(-x17, x153, x16 * x152));
+        let x158 = -x157;
+        let x159 = Self::mul_add(-x12, x151, Self::mul_add(-x11, x150, x10 * x149))
+            - Self::mul_add(q[1], x157, q[2] * x156);
+        let x160 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149))
+            + Self::mul_add(q[0], x157, q[2] * x155);
+        let x161 = -(Self::mul_add(x18, x151, Self::mul_add(-x17, x150, x16 * x149))
+            + Self::mul_add(-q[0], x156, q[1] * x155));
+        [x155, x156, x158, x159, x160, x161]
     }
     /// The wrench the arm exerts on the base (force, moment about the base origin, base coordinates) in the motion `(q, v, a)`.
     ///
@@ -8028,338 +8011,338 @@ impl FreeFloating7 {
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
         let (s_q7, c_q7) = libm::sincos(q[7]);
         let x1 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x2 = Self::mul_add(-v[3], s_q7, v[4] * c_q7);
+        let x2 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
         let x3 = Self::mul_add(0.75, v[4], v[0]);
         let x4 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
         let x5 = Self::mul_add(-0.65, v[4], v[2]);
         let x6 = Self::mul_add(s_q7, x4, c_q7 * x3);
-        let x7 = Self::mul_add(-s_q7, x3, c_q7 * x4);
+        let x7 = Self::mul_add(-c_q7, x4, s_q7 * x3);
         let x8 = v[5] + v[6];
         let x9 = Self::mul_add(0.75, a[4], a[0]);
         let x10 = a[1] - Self::mul_add(-0.65, a[5], 0.75 * a[3]);
         let x11 = Self::mul_add(-0.65, a[4], a[2]);
         let x12 = a[5] + a[6];
-        let x13 = Self::mul_add(v[6], x2, Self::mul_add(a[4], s_q7, a[3] * c_q7));
-        let x14 = Self::mul_add(-v[6], x1, Self::mul_add(-a[3], s_q7, a[4] * c_q7));
-        let x15 = Self::mul_add(v[6], x7, Self::mul_add(s_q7, x10, c_q7 * x9));
-        let x16 = Self::mul_add(-v[6], x6, Self::mul_add(-s_q7, x9, c_q7 * x10));
+        let x13 = Self::mul_add(-v[6], x2, Self::mul_add(a[4], s_q7, a[3] * c_q7));
+        let x14 = Self::mul_add(v[6], x1, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
+        let x15 = Self::mul_add(-v[6], x7, Self::mul_add(s_q7, x10, c_q7 * x9));
+        let x16 = Self::mul_add(v[6], x6, Self::mul_add(-c_q7, x10, s_q7 * x9));
         let x17 = Self::mul_add(
-            -6.1267499999999995,
+            6.1267499999999995,
             x16,
-            Self::mul_add(0.00071, x12, Self::mul_add(x14, -0.07309, 2.29018125 * x13)),
+            Self::mul_add(0.00071, x12, Self::mul_add(x14, 0.07309, 2.29018125 * x13)),
         );
         let x18 = Self::mul_add(
-            6.1267499999999995,
+            -6.1267499999999995,
             x15,
             Self::mul_add(
-                0.1132,
+                -0.1132,
                 x12,
-                Self::mul_add(x13, -0.07309, 1.5853812499999997 * x14),
+                Self::mul_add(1.5853812499999997, x14, x13 * 0.07309),
             ),
         );
-        let x19 = Self::mul_add(1.331, x8, Self::mul_add(0.1132, x2, 0.00071 * x1));
+        let x19 = Self::mul_add(1.331, x8, Self::mul_add(-0.1132, x2, 0.00071 * x1));
         let x20 = Self::mul_add(
-            -6.1267499999999995,
+            6.1267499999999995,
             x7,
-            Self::mul_add(0.00071, x8, Self::mul_add(x2, -0.07309, 2.29018125 * x1)),
+            Self::mul_add(0.00071, x8, Self::mul_add(x2, 0.07309, 2.29018125 * x1)),
         );
         let x21 = Self::mul_add(
-            6.1267499999999995,
+            -6.1267499999999995,
             x6,
             Self::mul_add(
-                0.1132,
+                -0.1132,
                 x8,
-                Self::mul_add(x1, -0.07309, 1.5853812499999997 * x2),
+                Self::mul_add(1.5853812499999997, x2, x1 * 0.07309),
             ),
         );
         let x22 = 35.01 * x5;
-        let x23 = Self::mul_add(6.1267499999999995, x2, 35.01 * x6);
-        let x24 = Self::mul_add(-6.1267499999999995, x1, 35.01 * x7);
+        let x23 = Self::mul_add(-6.1267499999999995, x2, 35.01 * x6);
+        let x24 = Self::mul_add(6.1267499999999995, x1, 35.01 * x7);
         let (s_q8, c_q8) = libm::sincos(q[8]);
         let x26 = 0.00000000020510342851533115 * c_q8;
         let x27 = 0.00000000020510342851533115 * s_q8;
-        let x28 = Self::mul_add(-x8, c_q8, Self::mul_add(-x1, x26, x2 * s_q8));
-        let x29 = Self::mul_add(x8, s_q8, Self::mul_add(x2, c_q8, x1 * x27));
-        let x30 = Self::mul_add(0.35, x2, x6);
-        let x31 = Self::mul_add(-0.35, x1, x7);
-        let x32 = Self::mul_add(-x5, c_q8, Self::mul_add(-x26, x30, s_q8 * x31));
-        let x33 = Self::mul_add(x5, s_q8, Self::mul_add(c_q8, x31, x27 * x30));
+        let x28 = Self::mul_add(x8, c_q8, Self::mul_add(x2, s_q8, x1 * x26));
+        let x29 = Self::mul_add(x8, s_q8, Self::mul_add(-x2, c_q8, x1 * x27));
+        let x30 = Self::mul_add(-0.35, x2, x6);
+        let x31 = Self::mul_add(0.35, x1, x7);
+        let x32 = Self::mul_add(x5, c_q8, Self::mul_add(s_q8, x31, x26 * x30));
+        let x33 = Self::mul_add(x5, s_q8, Self::mul_add(-c_q8, x31, x27 * x30));
         let x34 = Self::mul_add(-0.00000000020510342851533115, x5, x30);
         let x35 = v[7] + Self::mul_add(-0.00000000020510342851533115, x8, x1);
-        let x36 = Self::mul_add(0.35, x14, x15);
-        let x37 = Self::mul_add(-0.35, x13, x16);
+        let x36 = Self::mul_add(-0.35, x14, x15);
+        let x37 = Self::mul_add(0.35, x13, x16);
         let x38 = Self::mul_add(-0.00000000020510342851533115, x11, x36);
         let x39 = a[7] + Self::mul_add(-0.00000000020510342851533115, x12, x13);
         let x40 = Self::mul_add(
-            v[7],
+            -v[7],
             x29,
-            Self::mul_add(-x12, c_q8, Self::mul_add(-x13, x26, x14 * s_q8)),
+            Self::mul_add(x12, c_q8, Self::mul_add(x14, s_q8, x13 * x26)),
         );
         let x41 = Self::mul_add(
-            -v[7],
+            v[7],
             x28,
-            Self::mul_add(x12, s_q8, Self::mul_add(x14, c_q8, x13 * x27)),
+            Self::mul_add(x12, s_q8, Self::mul_add(-x14, c_q8, x13 * x27)),
         );
         let x42 = Self::mul_add(
-            v[7],
+            -v[7],
             x33,
-            Self::mul_add(-x11, c_q8, Self::mul_add(-x26, x36, s_q8 * x37)),
+            Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x37, x26 * x36)),
         );
         let x43 = Self::mul_add(
-            -v[7],
+            v[7],
             x32,
-            Self::mul_add(x11, s_q8, Self::mul_add(c_q8, x37, x27 * x36)),
+            Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x37, x27 * x36)),
         );
-        let x44 = Self::mul_add(x28, -0.00214, 2.359 * x35);
+        let x44 = Self::mul_add(2.359, x35, x28 * 0.00214);
         let x45 = Self::mul_add(
-            -6.0,
+            6.0,
             x33,
-            Self::mul_add(x35, -0.00214, 3.3000000000000003 * x28),
+            Self::mul_add(x35, 0.00214, 3.3000000000000003 * x28),
         );
-        let x46 = Self::mul_add(6.0, x32, 2.5780000000000003 * x29);
+        let x46 = Self::mul_add(-6.0, x32, 2.5780000000000003 * x29);
         let x47 = 30.0 * x34;
-        let x48 = Self::mul_add(6.0, x29, 30.0 * x32);
-        let x49 = Self::mul_add(-6.0, x28, 30.0 * x33);
+        let x48 = Self::mul_add(-6.0, x29, 30.0 * x32);
+        let x49 = Self::mul_add(6.0, x28, 30.0 * x33);
         let (s_q9, c_q9) = libm::sincos(q[9]);
         let x51 = 0.00000000020510342851533115 * c_q9;
         let x52 = 0.00000000020510342851533115 * s_q9;
         let x53 = x51 - x52;
         let x54 = x51 + x52;
-        let x55 = Self::mul_add(x35, c_q9, Self::mul_add(x29, x53, x28 * s_q9));
-        let x56 = Self::mul_add(-x35, s_q9, Self::mul_add(-x29, x54, x28 * c_q9));
-        let x57 = x32 - Self::mul_add(-0.4, x29, 0.275 * x35);
-        let x58 = Self::mul_add(-0.4, x28, x33);
-        let x59 = Self::mul_add(0.275, x28, x34);
-        let x60 = Self::mul_add(c_q9, x59, Self::mul_add(x53, x58, s_q9 * x57));
-        let x61 = Self::mul_add(-s_q9, x59, Self::mul_add(-x54, x58, c_q9 * x57));
+        let x55 = Self::mul_add(-x35, c_q9, Self::mul_add(-x29, x53, x28 * s_q9));
+        let x56 = Self::mul_add(x35, s_q9, Self::mul_add(x29, x54, x28 * c_q9));
+        let x57 = x32 - Self::mul_add(-0.275, x35, 0.4 * x29);
+        let x58 = Self::mul_add(0.4, x28, x33);
+        let x59 = Self::mul_add(-0.275, x28, x34);
+        let x60 = Self::mul_add(-c_q9, x59, Self::mul_add(-x53, x58, s_q9 * x57));
+        let x61 = Self::mul_add(s_q9, x59, Self::mul_add(x54, x58, c_q9 * x57));
         let x62 = Self::mul_add(
             -0.00000000020510342851533115,
             x59,
-            Self::mul_add(0.00000000020510342851533115, x57, x58),
+            Self::mul_add(-0.00000000020510342851533115, x57, x58),
         );
         let x63 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x35,
-                Self::mul_add(0.00000000020510342851533115, x28, x29),
+                Self::mul_add(-0.00000000020510342851533115, x28, x29),
             );
-        let x64 = x42 - Self::mul_add(-0.4, x41, 0.275 * x39);
-        let x65 = Self::mul_add(-0.4, x40, x43);
-        let x66 = Self::mul_add(0.275, x40, x38);
+        let x64 = x42 - Self::mul_add(-0.275, x39, 0.4 * x41);
+        let x65 = Self::mul_add(0.4, x40, x43);
+        let x66 = Self::mul_add(-0.275, x40, x38);
         let x67 = Self::mul_add(
             -0.00000000020510342851533115,
             x66,
-            Self::mul_add(0.00000000020510342851533115, x64, x65),
+            Self::mul_add(-0.00000000020510342851533115, x64, x65),
         );
         let x68 = a[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x39,
-                Self::mul_add(0.00000000020510342851533115, x40, x41),
+                Self::mul_add(-0.00000000020510342851533115, x40, x41),
             );
         let x69 = Self::mul_add(
             v[8],
             x56,
-            Self::mul_add(x39, c_q9, Self::mul_add(x41, x53, x40 * s_q9)),
+            Self::mul_add(-x39, c_q9, Self::mul_add(-x41, x53, x40 * s_q9)),
         );
         let x70 = Self::mul_add(
             -v[8],
             x55,
-            Self::mul_add(-x39, s_q9, Self::mul_add(-x41, x54, x40 * c_q9)),
+            Self::mul_add(x39, s_q9, Self::mul_add(x41, x54, x40 * c_q9)),
         );
         let x71 = Self::mul_add(
             v[8],
             x61,
-            Self::mul_add(c_q9, x66, Self::mul_add(x53, x65, s_q9 * x64)),
+            Self::mul_add(-c_q9, x66, Self::mul_add(-x53, x65, s_q9 * x64)),
         );
         let x72 = Self::mul_add(
             -v[8],
             x60,
-            Self::mul_add(-s_q9, x66, Self::mul_add(-x54, x65, c_q9 * x64)),
+            Self::mul_add(s_q9, x66, Self::mul_add(x54, x65, c_q9 * x64)),
         );
         let x73 = 3.378 * x56;
         let x74 = Self::mul_add(
             x62,
-            -9.87015,
-            Self::mul_add(-0.00214, x63, 4.395515250000001 * x55),
+            9.87015,
+            Self::mul_add(0.00214, x63, 4.395515250000001 * x55),
         );
         let x75 = Self::mul_add(
             x60,
-            9.87015,
-            Self::mul_add(-0.00214, x55, 7.65251525 * x63),
+            -9.87015,
+            Self::mul_add(7.65251525, x63, 0.00214 * x55),
         );
         let x76 = 22.69 * x61;
-        let x77 = Self::mul_add(x63, 9.87015, 22.69 * x60);
-        let x78 = Self::mul_add(x55, -9.87015, 22.69 * x62);
+        let x77 = Self::mul_add(x63, -9.87015, 22.69 * x60);
+        let x78 = Self::mul_add(x55, 9.87015, 22.69 * x62);
         let (s_q10, c_q10) = libm::sincos(q[10]);
         let x80 = Self::mul_add(x56, s_q10, x55 * c_q10);
-        let x81 = Self::mul_add(-x55, s_q10, x56 * c_q10);
-        let x82 = Self::mul_add(x63, 0.87, x60);
-        let x83 = Self::mul_add(x55, -0.87, x62);
+        let x81 = Self::mul_add(-x56, c_q10, x55 * s_q10);
+        let x82 = Self::mul_add(x63, -0.87, x60);
+        let x83 = Self::mul_add(x55, 0.87, x62);
         let x84 = Self::mul_add(x61, s_q10, c_q10 * x82);
-        let x85 = Self::mul_add(-s_q10, x82, x61 * c_q10);
+        let x85 = Self::mul_add(-x61, c_q10, s_q10 * x82);
         let x86 = v[9] + x63;
-        let x87 = Self::mul_add(x68, 0.87, x71);
-        let x88 = Self::mul_add(x69, -0.87, x67);
+        let x87 = Self::mul_add(x68, -0.87, x71);
+        let x88 = Self::mul_add(x69, 0.87, x67);
         let x89 = a[9] + x68;
-        let x90 = Self::mul_add(v[9], x81, Self::mul_add(x70, s_q10, x69 * c_q10));
-        let x91 = Self::mul_add(-v[9], x80, Self::mul_add(-x69, s_q10, x70 * c_q10));
-        let x92 = Self::mul_add(v[9], x85, Self::mul_add(x72, s_q10, c_q10 * x87));
-        let x93 = Self::mul_add(-v[9], x84, Self::mul_add(-s_q10, x87, x72 * c_q10));
+        let x90 = Self::mul_add(-v[9], x81, Self::mul_add(x70, s_q10, x69 * c_q10));
+        let x91 = Self::mul_add(v[9], x80, Self::mul_add(-x70, c_q10, x69 * s_q10));
+        let x92 = Self::mul_add(-v[9], x85, Self::mul_add(x72, s_q10, c_q10 * x87));
+        let x93 = Self::mul_add(v[9], x84, Self::mul_add(-x72, c_q10, s_q10 * x87));
         let x94 = Self::mul_add(
             x92,
-            6.7347,
-            Self::mul_add(4.0324305, x89, -Self::mul_add(x91, 1.8520425, x90 * 0.6328)),
+            -6.7347,
+            Self::mul_add(4.0324305, x89, Self::mul_add(x91, -1.8520425, x90 * 0.6328)),
         );
-        let x95 = Self::mul_add(x86, -0.6328, 4.170993 * x80)
-            + Self::mul_add(x83, -6.7347, x85 * 5.8795);
+        let x95 = Self::mul_add(x86, 0.6328, 4.170993 * x80)
+            - Self::mul_add(x83, -6.7347, x85 * 5.8795);
         let x96 = Self::mul_add(
             x84,
-            -5.8795,
+            5.8795,
             Self::mul_add(x86, -1.8520425, 3.8828625 * x81),
         );
         let x97 = Self::mul_add(
             x84,
-            6.7347,
-            Self::mul_add(4.0324305, x86, -Self::mul_add(x81, 1.8520425, x80 * 0.6328)),
+            -6.7347,
+            Self::mul_add(4.0324305, x86, Self::mul_add(x81, -1.8520425, x80 * 0.6328)),
         );
-        let x98 = Self::mul_add(21.38, x84, -Self::mul_add(x86, -6.7347, x81 * 5.8795));
-        let x99 = Self::mul_add(x80, 5.8795, 21.38 * x85);
-        let x100 = Self::mul_add(x80, -6.7347, 21.38 * x83);
+        let x98 = Self::mul_add(21.38, x84, Self::mul_add(x86, -6.7347, x81 * 5.8795));
+        let x99 = Self::mul_add(x80, -5.8795, 21.38 * x85);
+        let x100 = Self::mul_add(x80, 6.7347, 21.38 * x83);
         let (s_q11, c_q11) = libm::sincos(q[11]);
-        let x102 = Self::mul_add(x81, s_q11, x80 * c_q11);
-        let x103 = Self::mul_add(-x80, s_q11, x81 * c_q11);
-        let x104 = x84 - Self::mul_add(x86, -0.63, 0.275 * x81);
-        let x105 = Self::mul_add(0.275, x80, x85);
-        let x106 = Self::mul_add(x80, -0.63, x83);
-        let x107 = Self::mul_add(s_q11, x105, c_q11 * x104);
-        let x108 = Self::mul_add(-s_q11, x104, c_q11 * x105);
+        let x102 = Self::mul_add(-x81, s_q11, x80 * c_q11);
+        let x103 = Self::mul_add(x81, c_q11, x80 * s_q11);
+        let x104 = x84 + Self::mul_add(x86, -0.63, 0.275 * x81);
+        let x105 = Self::mul_add(-0.275, x80, x85);
+        let x106 = Self::mul_add(x80, 0.63, x83);
+        let x107 = Self::mul_add(-s_q11, x105, c_q11 * x104);
+        let x108 = Self::mul_add(c_q11, x105, s_q11 * x104);
         let x109 = v[10] + x86;
-        let x110 = x92 - Self::mul_add(x89, -0.63, 0.275 * x91);
-        let x111 = Self::mul_add(0.275, x90, x93);
-        let x112 = Self::mul_add(x90, -0.63, x88);
+        let x110 = x92 + Self::mul_add(x89, -0.63, 0.275 * x91);
+        let x111 = Self::mul_add(-0.275, x90, x93);
+        let x112 = Self::mul_add(x90, 0.63, x88);
         let x113 = a[10] + x89;
-        let x114 = Self::mul_add(v[10], x103, Self::mul_add(x91, s_q11, x90 * c_q11));
-        let x115 = Self::mul_add(-v[10], x102, Self::mul_add(-x90, s_q11, x91 * c_q11));
-        let x116 = Self::mul_add(v[10], x108, Self::mul_add(s_q11, x111, c_q11 * x110));
-        let x117 = Self::mul_add(
+        let x114 = Self::mul_add(-v[10], x103, Self::mul_add(-x91, s_q11, x90 * c_q11));
+        let x115 = Self::mul_add(v[10], x102, Self::mul_add(x91, c_q11, x90 * s_q11));
+        let x116 = Self::mul_add(
             -v[10],
-            x107,
-            Self::mul_add(-s_q11, x110, c_q11 * x111),
+            x108,
+            Self::mul_add(-s_q11, x111, c_q11 * x110),
         );
-        let x118 = Self::mul_add(0.07271, x109, 0.01675 * x102);
+        let x117 = Self::mul_add(v[10], x107, Self::mul_add(c_q11, x111, s_q11 * x110));
+        let x118 = Self::mul_add(-0.07271, x109, 0.01675 * x102);
         let x119 = Self::mul_add(
             x108,
-            3.0149999999999997,
-            Self::mul_add(0.01675, x109, 0.9304999999999999 * x102),
+            -3.0149999999999997,
+            Self::mul_add(-0.01675, x109, 0.9304999999999999 * x102),
         );
-        let x120 = Self::mul_add(x107, -3.0149999999999997, 0.939 * x103);
+        let x120 = Self::mul_add(x107, 3.0149999999999997, 0.939 * x103);
         let x121 = 16.75 * x106;
-        let x122 = Self::mul_add(x103, -3.0149999999999997, 16.75 * x107);
-        let x123 = Self::mul_add(x102, 3.0149999999999997, 16.75 * x108);
+        let x122 = Self::mul_add(x103, 3.0149999999999997, 16.75 * x107);
+        let x123 = Self::mul_add(x102, -3.0149999999999997, 16.75 * x108);
         let (s_q12, c_q12) = libm::sincos(q[12]);
         let x125 = 0.00000000020510342851533115 * s_q12;
         let x126 = 0.00000000020510342851533115 * c_q12;
-        let x127 = Self::mul_add(-x109, s_q12, Self::mul_add(-x103, x125, x102 * c_q12));
-        let x128 = Self::mul_add(x109, c_q12, Self::mul_add(x103, x126, x102 * s_q12));
-        let x129 = Self::mul_add(x103, -0.36, x107);
-        let x130 = Self::mul_add(x102, 0.36, x108);
-        let x131 = Self::mul_add(-x106, s_q12, Self::mul_add(-x125, x130, c_q12 * x129));
-        let x132 = Self::mul_add(x106, c_q12, Self::mul_add(x126, x130, s_q12 * x129));
+        let x127 = Self::mul_add(x109, s_q12, Self::mul_add(x103, x125, x102 * c_q12));
+        let x128 = Self::mul_add(-x109, c_q12, Self::mul_add(-x103, x126, x102 * s_q12));
+        let x129 = Self::mul_add(x103, 0.36, x107);
+        let x130 = Self::mul_add(x102, -0.36, x108);
+        let x131 = Self::mul_add(x106, s_q12, Self::mul_add(x125, x130, c_q12 * x129));
+        let x132 = Self::mul_add(-x106, c_q12, Self::mul_add(-x126, x130, s_q12 * x129));
         let x133 = Self::mul_add(-0.00000000020510342851533115, x106, x130);
         let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x109, x103);
-        let x135 = Self::mul_add(x115, -0.36, x116);
-        let x136 = Self::mul_add(x114, 0.36, x117);
+        let x135 = Self::mul_add(x115, 0.36, x116);
+        let x136 = Self::mul_add(x114, -0.36, x117);
         let x137 = Self::mul_add(-0.00000000020510342851533115, x112, x136);
         let x138 = a[11] + Self::mul_add(-0.00000000020510342851533115, x113, x115);
         let x139 = Self::mul_add(
             -v[11],
             x128,
-            Self::mul_add(-x113, s_q12, Self::mul_add(-x115, x125, x114 * c_q12)),
+            Self::mul_add(x113, s_q12, Self::mul_add(x115, x125, x114 * c_q12)),
         );
         let x140 = Self::mul_add(
             v[11],
             x127,
-            Self::mul_add(x113, c_q12, Self::mul_add(x115, x126, x114 * s_q12)),
+            Self::mul_add(-x113, c_q12, Self::mul_add(-x115, x126, x114 * s_q12)),
         );
         let x141 = Self::mul_add(
             -v[11],
             x132,
-            Self::mul_add(-x112, s_q12, Self::mul_add(-x125, x136, c_q12 * x135)),
+            Self::mul_add(x112, s_q12, Self::mul_add(x125, x136, c_q12 * x135)),
         );
         let x142 = Self::mul_add(
             v[11],
             x131,
-            Self::mul_add(x112, c_q12, Self::mul_add(x126, x136, s_q12 * x135)),
+            Self::mul_add(-x112, c_q12, Self::mul_add(-x126, x136, s_q12 * x135)),
         );
         let x143 = Self::mul_add(
-            -7.196750000000001,
+            7.196750000000001,
             x141,
             Self::mul_add(
                 2.1079062500000005,
                 x138,
-                Self::mul_add(x139, -0.2313, x140 * 1.1514800000000003),
+                Self::mul_add(x140, -1.1514800000000003, x139 * 0.2313),
             ),
         );
-        let x144 = Self::mul_add(x134, -0.2313, 3.2217582500000006 * x127)
-            + Self::mul_add(7.196750000000001, x133, 4.187200000000001 * x132);
+        let x144 = Self::mul_add(x134, 0.2313, 3.2217582500000006 * x127)
+            + Self::mul_add(-7.196750000000001, x133, 4.187200000000001 * x132);
         let x145 = Self::mul_add(
-            4.187200000000001,
+            -4.187200000000001,
             x131,
-            -Self::mul_add(x134, 1.1514800000000003, 1.2686520000000001 * x128),
+            Self::mul_add(x134, -1.1514800000000003, 1.2686520000000001 * x128),
         );
         let x146 = Self::mul_add(
-            -7.196750000000001,
+            7.196750000000001,
             x131,
             Self::mul_add(
                 2.1079062500000005,
                 x134,
-                Self::mul_add(x127, -0.2313, x128 * 1.1514800000000003),
+                Self::mul_add(x128, -1.1514800000000003, x127 * 0.2313),
             ),
         );
         let x147 = Self::mul_add(
             26.17,
             x131,
-            -Self::mul_add(7.196750000000001, x134, 4.187200000000001 * x128),
+            -Self::mul_add(-7.196750000000001, x134, 4.187200000000001 * x128),
         );
         let x148 = Self::mul_add(4.187200000000001, x127, 26.17 * x132);
-        let x149 = Self::mul_add(7.196750000000001, x127, 26.17 * x133);
+        let x149 = Self::mul_add(-7.196750000000001, x127, 26.17 * x133);
         let (s_q13, c_q13) = libm::sincos(q[13]);
         let x151 = 0.00000000020510342851533115 * c_q13;
         let x152 = 0.00000000020510342851533115 * s_q13;
-        let x153 = Self::mul_add(x134, c_q13, Self::mul_add(x128, s_q13, x127 * x151));
-        let x154 = Self::mul_add(x134, s_q13, Self::mul_add(-x128, c_q13, x127 * x152));
-        let x155 = x131 - Self::mul_add(0.55, x134, 0.16 * x128);
+        let x153 = Self::mul_add(-x134, c_q13, Self::mul_add(x128, s_q13, x127 * x151));
+        let x154 = Self::mul_add(-x134, s_q13, Self::mul_add(-x128, c_q13, x127 * x152));
+        let x155 = x131 - Self::mul_add(-0.55, x134, 0.16 * x128);
         let x156 = Self::mul_add(0.16, x127, x132);
-        let x157 = Self::mul_add(0.55, x127, x133);
-        let x158 = Self::mul_add(c_q13, x157, Self::mul_add(s_q13, x156, x151 * x155));
-        let x159 = Self::mul_add(s_q13, x157, Self::mul_add(-c_q13, x156, x152 * x155));
-        let x160 = Self::mul_add(-0.00000000020510342851533115, x157, x155);
-        let x161 = v[12] + Self::mul_add(-0.00000000020510342851533115, x134, x127);
-        let x162 = x141 - Self::mul_add(0.55, x138, 0.16 * x140);
+        let x157 = Self::mul_add(-0.55, x127, x133);
+        let x158 = Self::mul_add(-c_q13, x157, Self::mul_add(s_q13, x156, x151 * x155));
+        let x159 = Self::mul_add(-s_q13, x157, Self::mul_add(-c_q13, x156, x152 * x155));
+        let x160 = Self::mul_add(0.00000000020510342851533115, x157, x155);
+        let x161 = v[12] - Self::mul_add(0.00000000020510342851533115, x134, x127);
+        let x162 = x141 - Self::mul_add(-0.55, x138, 0.16 * x140);
         let x163 = Self::mul_add(0.16, x139, x142);
-        let x164 = Self::mul_add(0.55, x139, x137);
-        let x165 = Self::mul_add(-0.00000000020510342851533115, x164, x162);
-        let x166 = a[12] + Self::mul_add(-0.00000000020510342851533115, x138, x139);
+        let x164 = Self::mul_add(-0.55, x139, x137);
+        let x165 = Self::mul_add(0.00000000020510342851533115, x164, x162);
+        let x166 = a[12] - Self::mul_add(0.00000000020510342851533115, x138, x139);
         let x167 = Self::mul_add(
-            v[12],
+            -v[12],
             x154,
-            -Self::mul_add(x138, c_q13, Self::mul_add(x140, s_q13, x139 * x151)),
+            Self::mul_add(-x138, c_q13, Self::mul_add(x140, s_q13, x139 * x151)),
         );
         let x168 = Self::mul_add(
             v[12],
             x153,
-            Self::mul_add(x138, s_q13, Self::mul_add(-x140, c_q13, x139 * x152)),
+            Self::mul_add(-x138, s_q13, Self::mul_add(-x140, c_q13, x139 * x152)),
         );
         let x169 = Self::mul_add(
-            v[12],
+            -v[12],
             x159,
-            -Self::mul_add(c_q13, x164, Self::mul_add(s_q13, x163, x151 * x162)),
+            Self::mul_add(-c_q13, x164, Self::mul_add(s_q13, x163, x151 * x162)),
         );
         let x170 = Self::mul_add(
             v[12],
             x158,
-            Self::mul_add(s_q13, x164, Self::mul_add(-c_q13, x163, x152 * x162)),
+            Self::mul_add(-s_q13, x164, Self::mul_add(-c_q13, x163, x152 * x162)),
         );
         let x171 = Self::mul_add(
             3.6140000000000003,
@@ -8367,37 +8350,37 @@ impl FreeFloating7 {
             Self::mul_add(
                 x166,
                 -0.9614610000000001,
-                Self::mul_add(0.9638000000000001, x168, 0.000781 * x167),
+                Self::mul_add(-0.9638000000000001, x168, 0.000781 * x167),
             ),
         );
         let x172 = Self::mul_add(
-            -4.806620000000001,
+            4.806620000000001,
             x169,
             Self::mul_add(
-                1.4135609200000003,
+                -1.4135609200000003,
                 x166,
-                -Self::mul_add(x168, 0.9614610000000001, x167 * 0.0145),
+                Self::mul_add(x168, -0.9614610000000001, x167 * 0.0145),
             ),
         );
         let x173 = Self::mul_add(
             x161,
             -0.0145,
-            Self::mul_add(-2.1663609200000002, x153, 0.000781 * x154),
-        ) + Self::mul_add(-3.6140000000000003, x159, 4.806620000000001 * x160);
+            Self::mul_add(-0.000781, x154, 2.1663609200000002 * x153),
+        ) + Self::mul_add(-4.806620000000001, x160, 3.6140000000000003 * x159);
         let x174 = Self::mul_add(
-            -3.6140000000000003,
+            3.6140000000000003,
             x158,
             Self::mul_add(
                 x161,
                 -0.9614610000000001,
-                Self::mul_add(-0.000781, x153, 0.9638000000000001 * x154),
+                Self::mul_add(-0.9638000000000001, x154, 0.000781 * x153),
             ),
         );
         let x175 = Self::mul_add(
             4.806620000000001,
             x158,
             Self::mul_add(
-                1.4135609200000003,
+                -1.4135609200000003,
                 x161,
                 Self::mul_add(x154, -0.9614610000000001, x153 * 0.0145),
             ),
@@ -8405,38 +8388,38 @@ impl FreeFloating7 {
         let x176 = Self::mul_add(
             18.07,
             x158,
-            Self::mul_add(-3.6140000000000003, x154, 4.806620000000001 * x161),
+            -Self::mul_add(4.806620000000001, x161, 3.6140000000000003 * x154),
         );
         let x177 = Self::mul_add(3.6140000000000003, x153, 18.07 * x159);
         let x178 = Self::mul_add(-4.806620000000001, x153, 18.07 * x160);
         let x179 = Self::mul_add(
             x166,
             -0.0145,
-            Self::mul_add(0.000781, x168, 2.1663609200000002 * x167),
-        ) + Self::mul_add(-3.6140000000000003, x170, 4.806620000000001 * x165)
-            + (Self::mul_add(-x161, x174, x154 * x175)
-                + Self::mul_add(-x160, x177, x159 * x178));
+            Self::mul_add(-0.000781, x168, 2.1663609200000002 * x167),
+        ) + Self::mul_add(-4.806620000000001, x165, 3.6140000000000003 * x170)
+            - (Self::mul_add(-x154, x175, x161 * x174)
+                + Self::mul_add(-x159, x178, x160 * x177));
         let x180 = x171
             + (Self::mul_add(x153, x175, x161 * x173)
-                + Self::mul_add(-x160, x176, x158 * x178));
+                - Self::mul_add(-x158, x178, x160 * x176));
         let x181 = x172
-            + (Self::mul_add(-x158, x177, x159 * x176)
-                - Self::mul_add(x153, x174, x154 * x173));
+            - (Self::mul_add(x153, x174, x154 * x173)
+                + Self::mul_add(-x158, x177, x159 * x176));
         let x182 = Self::mul_add(
             18.07,
             x169,
-            -Self::mul_add(-3.6140000000000003, x168, 4.806620000000001 * x166),
-        ) + Self::mul_add(-x161, x177, x154 * x178);
-        let x183 = Self::mul_add(-3.6140000000000003, x167, 18.07 * x170)
-            + Self::mul_add(-x161, x176, x153 * x178);
-        let x184 = Self::mul_add(4.806620000000001, x167, 18.07 * x165)
-            + Self::mul_add(-x153, x177, x154 * x176);
-        let x185 = x184 + Self::mul_add(-x151, x182, x152 * x183);
-        let x186 = Self::mul_add(c_q13, x183, s_q13 * x182);
+            -Self::mul_add(4.806620000000001, x166, 3.6140000000000003 * x168),
+        ) + Self::mul_add(x154, x178, x161 * x177);
+        let x183 = Self::mul_add(3.6140000000000003, x167, 18.07 * x170)
+            - Self::mul_add(x153, x178, x161 * x176);
+        let x184 = Self::mul_add(-4.806620000000001, x167, 18.07 * x165)
+            - Self::mul_add(-x153, x177, x154 * x176);
+        let x185 = x184 + Self::mul_add(x152, x183, x151 * x182);
+        let x186 = Self::mul_add(-c_q13, x183, s_q13 * x182);
         let x187 = Self::mul_add(
             -0.00000000020510342851533115,
             x184,
-            Self::mul_add(-c_q13, x182, s_q13 * x183),
+            Self::mul_add(s_q13, x183, c_q13 * x182),
         );
         let x188 = Self::mul_add(
             -0.55,
@@ -8444,184 +8427,184 @@ impl FreeFloating7 {
             Self::mul_add(
                 -0.00000000020510342851533115,
                 x181,
-                Self::mul_add(-c_q13, x179, s_q13 * x180),
+                Self::mul_add(-s_q13, x180, c_q13 * x179),
             ),
         );
-        let x189 = Self::mul_add(x138, -0.2313, 3.2217582500000006 * x139)
-            + Self::mul_add(7.196750000000001, x137, 4.187200000000001 * x142)
-            + (Self::mul_add(-x132, x149, x133 * x148)
-                - Self::mul_add(x128, x146, x134 * x145))
-            + (x181 + Self::mul_add(-x151, x179, x152 * x180)
-                + Self::mul_add(-0.16, x186, 0.55 * x187));
+        let x189 = Self::mul_add(x138, 0.2313, 3.2217582500000006 * x139)
+            + Self::mul_add(-7.196750000000001, x137, 4.187200000000001 * x142)
+            + (Self::mul_add(-x128, x146, x134 * x145)
+                + Self::mul_add(-x132, x149, x133 * x148))
+            + (x181 + Self::mul_add(-x152, x180, x151 * x179)
+                + Self::mul_add(0.55, x187, 0.16 * x186));
         let x190 = Self::mul_add(
-            4.187200000000001,
+            -4.187200000000001,
             x141,
-            -Self::mul_add(x138, 1.1514800000000003, 1.2686520000000001 * x140),
+            Self::mul_add(x138, -1.1514800000000003, 1.2686520000000001 * x140),
         )
-            + (Self::mul_add(-x127, x146, x134 * x144)
+            - (Self::mul_add(-x127, x146, x134 * x144)
                 + Self::mul_add(-x131, x149, x133 * x147))
-            + Self::mul_add(0.16, x185, Self::mul_add(c_q13, x180, s_q13 * x179));
+            + Self::mul_add(-0.16, x185, Self::mul_add(c_q13, x180, s_q13 * x179));
         let x191 = x143
-            + (Self::mul_add(x127, x145, x128 * x144)
-                + Self::mul_add(-x131, x148, x132 * x147)) + x188;
+            + (Self::mul_add(-x127, x145, x128 * x144)
+                + Self::mul_add(-x131, x148, x132 * x147)) - x188;
         let x192 = Self::mul_add(
             26.17,
             x141,
-            -Self::mul_add(7.196750000000001, x138, 4.187200000000001 * x140),
+            -Self::mul_add(-7.196750000000001, x138, 4.187200000000001 * x140),
         ) + Self::mul_add(-x128, x149, x134 * x148) + x185;
-        let x193 = Self::mul_add(-x127, x149, x134 * x147)
-            - Self::mul_add(4.187200000000001, x139, 26.17 * x142) + x186;
-        let x194 = Self::mul_add(7.196750000000001, x139, 26.17 * x137)
-            + Self::mul_add(-x127, x148, x128 * x147) + x187;
-        let x195 = Self::mul_add(-s_q12, x193, c_q12 * x192);
-        let x196 = x194 - Self::mul_add(x126, x193, x125 * x192);
+        let x193 = Self::mul_add(4.187200000000001, x139, 26.17 * x142)
+            - Self::mul_add(-x127, x149, x134 * x147) + x186;
+        let x194 = Self::mul_add(-7.196750000000001, x139, 26.17 * x137)
+            + Self::mul_add(-x127, x148, x128 * x147) - x187;
+        let x195 = Self::mul_add(s_q12, x193, c_q12 * x192);
+        let x196 = x194 + Self::mul_add(-x126, x193, x125 * x192);
         let x197 = Self::mul_add(
             x117,
-            3.0149999999999997,
-            Self::mul_add(0.01675, x113, 0.9304999999999999 * x114),
+            -3.0149999999999997,
+            Self::mul_add(-0.01675, x113, 0.9304999999999999 * x114),
         )
-            + (Self::mul_add(-x109, x120, x103 * x118)
-                + Self::mul_add(-x106, x123, x108 * x121))
-            + Self::mul_add(0.36, x196, Self::mul_add(-s_q12, x190, c_q12 * x189));
-        let x198 = Self::mul_add(x116, -3.0149999999999997, 0.939 * x115)
-            + (Self::mul_add(-x102, x118, x109 * x119)
+            + (Self::mul_add(x103, x118, x109 * x120)
+                + Self::mul_add(-x108, x121, x106 * x123))
+            + Self::mul_add(-0.36, x196, Self::mul_add(s_q12, x190, c_q12 * x189));
+        let x198 = Self::mul_add(x116, 3.0149999999999997, 0.939 * x115)
+            - (Self::mul_add(x102, x118, x109 * x119)
                 + Self::mul_add(-x107, x121, x106 * x122))
-            + Self::mul_add(-0.36, x195, x191 - Self::mul_add(x126, x190, x125 * x189));
-        let x199 = Self::mul_add(x115, -3.0149999999999997, 16.75 * x116)
-            + Self::mul_add(-x109, x123, x103 * x121) + x195;
-        let x200 = Self::mul_add(x114, 3.0149999999999997, 16.75 * x117)
-            + Self::mul_add(-x102, x121, x109 * x122) + x196;
-        let x201 = Self::mul_add(16.75, x112, Self::mul_add(-x103, x122, x102 * x123))
-            - Self::mul_add(
-                0.00000000020510342851533115,
+            + Self::mul_add(0.36, x195, x191 + Self::mul_add(-x126, x190, x125 * x189));
+        let x199 = Self::mul_add(x115, 3.0149999999999997, 16.75 * x116)
+            + Self::mul_add(-x103, x121, x109 * x123) + x195;
+        let x200 = Self::mul_add(x114, -3.0149999999999997, 16.75 * x117)
+            - Self::mul_add(-x102, x121, x109 * x122) + x196;
+        let x201 = Self::mul_add(16.75, x112, Self::mul_add(-x102, x123, x103 * x122))
+            + Self::mul_add(
+                -0.00000000020510342851533115,
                 x194,
-                Self::mul_add(c_q12, x193, s_q12 * x192),
+                Self::mul_add(-c_q12, x193, s_q12 * x192),
             );
-        let x202 = Self::mul_add(-s_q11, x200, c_q11 * x199);
-        let x203 = Self::mul_add(c_q11, x200, s_q11 * x199);
+        let x202 = Self::mul_add(s_q11, x200, c_q11 * x199);
+        let x203 = Self::mul_add(-c_q11, x200, s_q11 * x199);
         let x204 = Self::mul_add(
             0.63,
             x202,
-            Self::mul_add(0.07271, x113, 0.01675 * x114)
-                + (Self::mul_add(-x103, x119, x102 * x120)
-                    + Self::mul_add(-x108, x122, x107 * x123))
+            Self::mul_add(-0.07271, x113, 0.01675 * x114)
+                - (Self::mul_add(-x102, x120, x103 * x119)
+                    + Self::mul_add(-x107, x123, x108 * x122))
                 - Self::mul_add(
-                    0.00000000020510342851533115,
+                    -0.00000000020510342851533115,
                     x191,
-                    Self::mul_add(c_q12, x190, s_q12 * x189),
+                    Self::mul_add(-c_q12, x190, s_q12 * x189),
                 ),
         );
-        let x205 = Self::mul_add(x89, -0.6328, 4.170993 * x90)
-            + Self::mul_add(x88, -6.7347, x93 * 5.8795)
-            + (Self::mul_add(-x86, x96, x81 * x97)
-                + Self::mul_add(-x83, x99, x85 * x100))
-            + (Self::mul_add(-s_q11, x198, c_q11 * x197)
-                + Self::mul_add(-0.63, x201, 0.275 * x203));
+        let x205 = Self::mul_add(x89, 0.6328, 4.170993 * x90)
+            - Self::mul_add(x88, -6.7347, x93 * 5.8795)
+            + (Self::mul_add(-x81, x97, x86 * x96)
+                + Self::mul_add(-x85, x100, x83 * x99))
+            + (Self::mul_add(s_q11, x198, c_q11 * x197)
+                + Self::mul_add(0.63, x201, 0.275 * x203));
         let x206 = Self::mul_add(
             x92,
-            -5.8795,
+            5.8795,
             Self::mul_add(x89, -1.8520425, 3.8828625 * x91),
-        ) + (Self::mul_add(-x80, x97, x86 * x95) + Self::mul_add(-x84, x100, x83 * x98))
-            + Self::mul_add(-0.275, x202, Self::mul_add(c_q11, x198, s_q11 * x197));
-        let x207 = Self::mul_add(21.38, x92, -Self::mul_add(x89, -6.7347, x91 * 5.8795))
-            + Self::mul_add(-x86, x99, x81 * x100) + x202;
-        let x208 = Self::mul_add(x90, 5.8795, 21.38 * x93)
-            + Self::mul_add(-x80, x100, x86 * x98) + x203;
-        let x209 = Self::mul_add(x90, -6.7347, 21.38 * x88)
-            + Self::mul_add(-x81, x98, x80 * x99) + x201;
-        let x210 = Self::mul_add(-s_q10, x208, c_q10 * x207);
+        ) - (Self::mul_add(-x80, x97, x86 * x95) + Self::mul_add(-x84, x100, x83 * x98))
+            - Self::mul_add(-0.275, x202, Self::mul_add(-c_q11, x198, s_q11 * x197));
+        let x207 = Self::mul_add(21.38, x92, Self::mul_add(x89, -6.7347, x91 * 5.8795))
+            + Self::mul_add(-x81, x100, x86 * x99) + x202;
+        let x208 = Self::mul_add(x90, -5.8795, 21.38 * x93)
+            - Self::mul_add(-x80, x100, x86 * x98) - x203;
+        let x209 = Self::mul_add(x90, 6.7347, 21.38 * x88)
+            + Self::mul_add(-x80, x99, x81 * x98) + x201;
+        let x210 = Self::mul_add(s_q10, x208, c_q10 * x207);
         let x211 = Self::mul_add(
             x67,
-            -9.87015,
-            Self::mul_add(-0.00214, x68, 4.395515250000001 * x69),
-        ) + (Self::mul_add(-x63, x73, x56 * x75) + Self::mul_add(-x62, x76, x61 * x78))
-            + Self::mul_add(-0.87, x209, Self::mul_add(-s_q10, x206, c_q10 * x205));
+            9.87015,
+            Self::mul_add(0.00214, x68, 4.395515250000001 * x69),
+        ) - (Self::mul_add(-x56, x75, x63 * x73) + Self::mul_add(-x61, x78, x62 * x76))
+            + Self::mul_add(0.87, x209, Self::mul_add(s_q10, x206, c_q10 * x205));
         let x212 = Self::mul_add(
             3.378,
             x70,
             Self::mul_add(-x55, x75, x63 * x74) + Self::mul_add(-x60, x78, x62 * x77),
-        ) + Self::mul_add(c_q10, x206, s_q10 * x205);
+        ) + Self::mul_add(-c_q10, x206, s_q10 * x205);
         let x213 = Self::mul_add(
             x71,
-            9.87015,
-            Self::mul_add(-0.00214, x69, 7.65251525 * x68),
-        ) + (Self::mul_add(-x56, x74, x55 * x73) + Self::mul_add(-x61, x77, x60 * x76))
+            -9.87015,
+            Self::mul_add(7.65251525, x68, 0.00214 * x69),
+        ) - (Self::mul_add(-x55, x73, x56 * x74) + Self::mul_add(-x60, x76, x61 * x77))
             + Self::mul_add(
-                0.87,
+                -0.87,
                 x210,
                 x94
-                    + (Self::mul_add(-x81, x95, x80 * x96)
-                        + Self::mul_add(-x85, x98, x84 * x99)) + x204,
+                    + (Self::mul_add(-x80, x96, x81 * x95)
+                        + Self::mul_add(-x84, x99, x85 * x98)) - x204,
             );
-        let x214 = Self::mul_add(x68, 9.87015, 22.69 * x71)
-            + Self::mul_add(-x63, x76, x56 * x78) + x210;
+        let x214 = Self::mul_add(x68, -9.87015, 22.69 * x71)
+            - Self::mul_add(-x56, x78, x63 * x76) + x210;
         let x215 = Self::mul_add(22.69, x72, Self::mul_add(-x55, x78, x63 * x77))
-            + Self::mul_add(c_q10, x208, s_q10 * x207);
-        let x216 = Self::mul_add(x69, -9.87015, 22.69 * x67)
-            + Self::mul_add(-x56, x77, x55 * x76) + x209;
+            + Self::mul_add(-c_q10, x208, s_q10 * x207);
+        let x216 = Self::mul_add(x69, 9.87015, 22.69 * x67)
+            - Self::mul_add(-x55, x76, x56 * x77) + x209;
         let x217 = 0.00000000020510342851533115 * x216;
-        let x218 = Self::mul_add(c_q9, x215, s_q9 * x214) + x217;
-        let x219 = x216 + Self::mul_add(-x54, x215, x53 * x214);
-        let x220 = Self::mul_add(-s_q9, x215, c_q9 * x214) - x217;
+        let x218 = Self::mul_add(c_q9, x215, s_q9 * x214) - x217;
+        let x219 = x216 - Self::mul_add(-x54, x215, x53 * x214);
+        let x220 = x217 + Self::mul_add(-s_q9, x215, c_q9 * x214);
         let x221 = 0.00000000020510342851533115 * x213;
         let x222 = Self::mul_add(
-            -6.0,
+            6.0,
             x43,
-            Self::mul_add(x39, -0.00214, 3.3000000000000003 * x40),
-        ) + (Self::mul_add(-x35, x46, x29 * x44) + Self::mul_add(-x34, x49, x33 * x47))
-            + (Self::mul_add(c_q9, x212, s_q9 * x211) + x221
-                + Self::mul_add(-0.4, x219, 0.275 * x220));
-        let x223 = Self::mul_add(6.0, x42, 2.5780000000000003 * x41)
-            + (Self::mul_add(-x28, x44, x35 * x45) + Self::mul_add(-x32, x47, x34 * x48))
-            + Self::mul_add(0.4, x218, x213 + Self::mul_add(-x54, x212, x53 * x211));
-        let x224 = Self::mul_add(x40, -0.00214, 2.359 * x39)
-            + (Self::mul_add(-x29, x45, x28 * x46) + Self::mul_add(-x33, x48, x32 * x49))
-            + Self::mul_add(
+            Self::mul_add(x39, 0.00214, 3.3000000000000003 * x40),
+        ) + (Self::mul_add(-x29, x44, x35 * x46) + Self::mul_add(-x33, x47, x34 * x49))
+            + (Self::mul_add(c_q9, x212, s_q9 * x211) - x221
+                + Self::mul_add(0.275, x220, 0.4 * x219));
+        let x223 = Self::mul_add(-6.0, x42, 2.5780000000000003 * x41)
+            - (Self::mul_add(-x28, x44, x35 * x45) + Self::mul_add(-x32, x47, x34 * x48))
+            + Self::mul_add(-0.4, x218, x213 - Self::mul_add(-x54, x212, x53 * x211));
+        let x224 = Self::mul_add(2.359, x39, x40 * 0.00214)
+            + (Self::mul_add(-x28, x46, x29 * x45) + Self::mul_add(-x32, x49, x33 * x48))
+            - Self::mul_add(
                 -0.275,
                 x218,
-                Self::mul_add(-s_q9, x212, c_q9 * x211) - x221,
+                x221 + Self::mul_add(-s_q9, x212, c_q9 * x211),
             );
-        let x225 = Self::mul_add(6.0, x41, 30.0 * x42)
-            + Self::mul_add(-x35, x49, x29 * x47) + x218;
-        let x226 = Self::mul_add(-6.0, x40, 30.0 * x43)
-            + Self::mul_add(-x28, x47, x35 * x48) + x219;
-        let x227 = Self::mul_add(30.0, x38, Self::mul_add(-x29, x48, x28 * x49)) + x220;
-        let x228 = x227 + Self::mul_add(-x26, x225, x27 * x226);
-        let x229 = Self::mul_add(c_q8, x226, s_q8 * x225);
+        let x225 = Self::mul_add(-6.0, x41, 30.0 * x42)
+            + Self::mul_add(-x29, x47, x35 * x49) + x218;
+        let x226 = Self::mul_add(6.0, x40, 30.0 * x43)
+            - Self::mul_add(-x28, x47, x35 * x48) + x219;
+        let x227 = Self::mul_add(30.0, x38, Self::mul_add(-x28, x49, x29 * x48)) - x220;
+        let x228 = x227 + Self::mul_add(x27, x226, x26 * x225);
+        let x229 = Self::mul_add(-c_q8, x226, s_q8 * x225);
         let x230 = x17
-            + (Self::mul_add(-x8, x21, x2 * x19) + Self::mul_add(-x5, x24, x7 * x22))
-            + Self::mul_add(-0.35, x229, x224 + Self::mul_add(-x26, x222, x27 * x223));
+            + (Self::mul_add(-x2, x19, x8 * x21) + Self::mul_add(-x7, x22, x5 * x24))
+            + Self::mul_add(0.35, x229, x224 + Self::mul_add(x27, x223, x26 * x222));
         let x231 = x18
-            + (Self::mul_add(-x1, x19, x8 * x20) + Self::mul_add(-x6, x22, x5 * x23))
-            + Self::mul_add(0.35, x228, Self::mul_add(c_q8, x223, s_q8 * x222));
-        let x232 = Self::mul_add(6.1267499999999995, x14, 35.01 * x15)
-            + Self::mul_add(-x8, x24, x2 * x22) + x228;
-        let x233 = Self::mul_add(-6.1267499999999995, x13, 35.01 * x16)
-            + Self::mul_add(-x1, x22, x8 * x23) + x229;
-        let x234 = Self::mul_add(35.01, x11, Self::mul_add(-x2, x23, x1 * x24))
+            - (Self::mul_add(-x1, x19, x8 * x20) + Self::mul_add(-x6, x22, x5 * x23))
+            + Self::mul_add(-0.35, x228, Self::mul_add(-c_q8, x223, s_q8 * x222));
+        let x232 = Self::mul_add(-6.1267499999999995, x14, 35.01 * x15)
+            + Self::mul_add(-x2, x22, x8 * x24) + x228;
+        let x233 = Self::mul_add(6.1267499999999995, x13, 35.01 * x16)
+            - Self::mul_add(-x1, x22, x8 * x23) + x229;
+        let x234 = Self::mul_add(35.01, x11, Self::mul_add(-x1, x24, x2 * x23))
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x227,
-                Self::mul_add(-c_q8, x225, s_q8 * x226),
+                Self::mul_add(s_q8, x226, c_q8 * x225),
             );
-        let x235 = Self::mul_add(-s_q7, x233, c_q7 * x232);
-        let x236 = Self::mul_add(c_q7, x233, s_q7 * x232);
+        let x235 = Self::mul_add(s_q7, x233, c_q7 * x232);
+        let x236 = Self::mul_add(-c_q7, x233, s_q7 * x232);
         let x237 = Self::mul_add(
             0.65,
             x236,
-            Self::mul_add(1.331, x12, Self::mul_add(0.1132, x14, 0.00071 * x13))
-                + (Self::mul_add(-x2, x20, x1 * x21) + Self::mul_add(-x7, x23, x6 * x24))
+            Self::mul_add(1.331, x12, Self::mul_add(-0.1132, x14, 0.00071 * x13))
+                + (Self::mul_add(-x1, x21, x2 * x20) + Self::mul_add(-x6, x24, x7 * x23))
                 + Self::mul_add(
                     -0.00000000020510342851533115,
                     x224,
-                    Self::mul_add(-c_q8, x222, s_q8 * x223),
+                    Self::mul_add(s_q8, x223, c_q8 * x222),
                 ),
         );
         let x238 = -x235;
         let x239 = -x236;
         let x240 = -x234;
-        let x241 = -Self::mul_add(-0.75, x236, Self::mul_add(-s_q7, x231, c_q7 * x230));
-        let x242 = -(Self::mul_add(c_q7, x231, s_q7 * x230)
+        let x241 = -Self::mul_add(-0.75, x236, Self::mul_add(s_q7, x231, c_q7 * x230));
+        let x242 = -(Self::mul_add(-c_q7, x231, s_q7 * x230)
             + Self::mul_add(-0.65, x234, 0.75 * x235));
         let x243 = -x237;
         [x238, x239, x240, x241, x242, x243]

@@ -9,8 +9,8 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 43 → 38 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 968 (`mass_matrix` 51, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 239, `mass_matrix_and_nonlinear_effects` 174, `forward_dynamics_with_wrenches` 247), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
-//! Form: unrolled straight-line code (auto: 610 emitted operations in M + c, within the 4000 limit).
+//! Fused multiply-adds where the target has them: 971 (`mass_matrix` 52, `nonlinear_effects` 123, `inverse_dynamics` 134, `forward_dynamics` 240, `mass_matrix_and_nonlinear_effects` 175, `forward_dynamics_with_wrenches` 247), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: 609 emitted operations in M + c, within the 4000 limit).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -24,8 +24,8 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 505 | 352 | 0 | 0 | 6 | 857 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 450 | 339 | 0 | 0 | 6 | 789 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 450 | 339 | 0 | 0 | 6 | 789 |
-//! | `mass_matrix` | `crba` | — | — | model | 118 | 117 | 0 | 0 | 5 | 235 |
-//! | `mass_matrix` * | `crba` | — | — | canonical | 118 | 115 | 0 | 0 | 5 | 233 |
+//! | `mass_matrix` | `crba` | — | — | model | 118 | 115 | 0 | 0 | 5 | 233 |
+//! | `mass_matrix` * | `crba` | — | — | canonical | 118 | 114 | 0 | 0 | 5 | 232 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 537 | 386 | 0 | 0 | 6 | 923 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 537 | 386 | 0 | 0 | 6 | 923 |
 //! | `nonlinear_effects` | — | `kane-direct` | — | model | 580 | 428 | 0 | 0 | 6 | 1008 |
@@ -34,22 +34,22 @@
 //! | `nonlinear_effects` | — | `rnea` | — | canonical | 254 | 181 | 0 | 0 | 5 | 435 |
 //! | `nonlinear_effects` * | — | `newton-euler` | — | model | 220 | 157 | 0 | 0 | 5 | 377 |
 //! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 220 | 157 | 0 | 0 | 5 | 377 |
-//! | `inverse_dynamics` | — | `recurrent` | — | model | 689 | 539 | 0 | 0 | 6 | 1228 |
-//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 689 | 537 | 0 | 0 | 6 | 1226 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | model | 732 | 581 | 0 | 0 | 6 | 1313 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 732 | 579 | 0 | 0 | 6 | 1311 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 689 | 537 | 0 | 0 | 6 | 1226 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 689 | 536 | 0 | 0 | 6 | 1225 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 732 | 579 | 0 | 0 | 6 | 1311 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 732 | 578 | 0 | 0 | 6 | 1310 |
 //! | `inverse_dynamics` | — | `rnea` | — | model | 278 | 207 | 0 | 0 | 5 | 485 |
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 278 | 207 | 0 | 0 | 5 | 485 |
 //! | `inverse_dynamics` * | — | `newton-euler` | — | model | 232 | 178 | 0 | 0 | 5 | 410 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 232 | 178 | 0 | 0 | 5 | 410 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 741 | 574 | 6 | 0 | 6 | 1315 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 741 | 572 | 6 | 0 | 6 | 1313 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 784 | 616 | 6 | 0 | 6 | 1400 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 784 | 614 | 6 | 0 | 6 | 1398 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 458 | 369 | 6 | 0 | 5 | 827 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 458 | 367 | 6 | 0 | 5 | 825 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 424 | 345 | 6 | 0 | 5 | 769 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 424 | 343 | 6 | 0 | 5 | 767 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 741 | 572 | 6 | 0 | 6 | 1313 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 741 | 571 | 6 | 0 | 6 | 1312 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 784 | 614 | 6 | 0 | 6 | 1398 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 784 | 613 | 6 | 0 | 6 | 1397 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 458 | 367 | 6 | 0 | 5 | 825 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 458 | 366 | 6 | 0 | 5 | 824 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 424 | 343 | 6 | 0 | 5 | 767 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 424 | 342 | 6 | 0 | 5 | 766 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 801 | 647 | 6 | 0 | 6 | 1448 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 801 | 647 | 6 | 0 | 6 | 1448 |
 //! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 844 | 689 | 6 | 0 | 6 | 1533 |
@@ -60,14 +60,14 @@
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 756 | 567 | 6 | 0 | 6 | 1323 |
 //! | `forward_dynamics` | — | — | `aba` | model | 567 | 411 | 5 | 0 | 5 | 978 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 574 | 414 | 5 | 0 | 5 | 988 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 655 | 503 | 0 | 0 | 6 | 1158 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 655 | 501 | 0 | 0 | 6 | 1156 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 698 | 545 | 0 | 0 | 6 | 1243 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 698 | 543 | 0 | 0 | 6 | 1241 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 372 | 298 | 0 | 0 | 5 | 670 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 372 | 296 | 0 | 0 | 5 | 668 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 338 | 274 | 0 | 0 | 5 | 612 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 338 | 272 | 0 | 0 | 5 | 610 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 655 | 501 | 0 | 0 | 6 | 1156 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 655 | 500 | 0 | 0 | 6 | 1155 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 698 | 543 | 0 | 0 | 6 | 1241 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 698 | 542 | 0 | 0 | 6 | 1240 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 372 | 296 | 0 | 0 | 5 | 668 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 372 | 295 | 0 | 0 | 5 | 667 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 338 | 272 | 0 | 0 | 5 | 610 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 338 | 271 | 0 | 0 | 5 | 609 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 715 | 576 | 0 | 0 | 6 | 1291 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 715 | 576 | 0 | 0 | 6 | 1291 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 758 | 618 | 0 | 0 | 6 | 1376 |
@@ -76,10 +76,10 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 704 | 520 | 0 | 0 | 6 | 1224 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 670 | 496 | 0 | 0 | 6 | 1166 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 670 | 496 | 0 | 0 | 6 | 1166 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 817 | 651 | 6 | 0 | 6 | 1468 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 860 | 693 | 6 | 0 | 6 | 1553 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 464 | 401 | 6 | 0 | 5 | 865 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 430 | 377 | 6 | 0 | 5 | 807 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 817 | 649 | 6 | 0 | 6 | 1466 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 860 | 691 | 6 | 0 | 6 | 1551 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 464 | 399 | 6 | 0 | 5 | 863 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 430 | 375 | 6 | 0 | 5 | 805 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 877 | 724 | 6 | 0 | 6 | 1601 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 920 | 766 | 6 | 0 | 6 | 1686 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 796 | 623 | 6 | 0 | 6 | 1419 |
@@ -151,11 +151,11 @@ impl Srms {
             forward_method: None,
             frames: "canonical",
             mul: 118u64,
-            add: 115u64,
+            add: 114u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 51u64,
+            fma: 52u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -190,11 +190,11 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 424u64,
-            add: 343u64,
+            add: 342u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 239u64,
+            fma: 240u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -203,11 +203,11 @@ impl Srms {
             forward_method: None,
             frames: "canonical",
             mul: 338u64,
-            add: 272u64,
+            add: 271u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 174u64,
+            fma: 175u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -216,7 +216,7 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 430u64,
-            add: 377u64,
+            add: 375u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -336,7 +336,7 @@ impl Srms {
             forward_method: None,
             frames: "model",
             mul: 118u64,
-            add: 117u64,
+            add: 115u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -349,7 +349,7 @@ impl Srms {
             forward_method: None,
             frames: "canonical",
             mul: 118u64,
-            add: 115u64,
+            add: 114u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -465,19 +465,6 @@ impl Srms {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 689u64,
-            add: 539u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("recurrent"),
-            forward_method: None,
-            frames: "canonical",
             mul: 689u64,
             add: 537u64,
             div: 0u64,
@@ -488,11 +475,11 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("kane-direct"),
+            bias_method: Some("recurrent"),
             forward_method: None,
-            frames: "model",
-            mul: 732u64,
-            add: 581u64,
+            frames: "canonical",
+            mul: 689u64,
+            add: 536u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -503,7 +490,7 @@ impl Srms {
             mass_matrix_method: None,
             bias_method: Some("kane-direct"),
             forward_method: None,
-            frames: "canonical",
+            frames: "model",
             mul: 732u64,
             add: 579u64,
             div: 0u64,
@@ -514,74 +501,74 @@ impl Srms {
         OpCount {
             function: "inverse_dynamics",
             mass_matrix_method: None,
-            bias_method: Some("rnea"),
-            forward_method: None,
-            frames: "model",
-            mul: 278u64,
-            add: 207u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("rnea"),
+            bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 278u64,
-            add: 207u64,
+            mul: 732u64,
+            add: 578u64,
             div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
-            forward_method: None,
-            frames: "model",
-            mul: 232u64,
-            add: 178u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "inverse_dynamics",
-            mass_matrix_method: None,
-            bias_method: Some("newton-euler"),
-            forward_method: None,
-            frames: "canonical",
-            mul: 232u64,
-            add: 178u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 5u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("recurrent"),
-            forward_method: Some("ldlt"),
-            frames: "model",
-            mul: 741u64,
-            add: 574u64,
-            div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
             fma: 0u64,
         },
         OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "model",
+            mul: 278u64,
+            add: 207u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 278u64,
+            add: 207u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "model",
+            mul: 232u64,
+            add: 178u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "inverse_dynamics",
+            mass_matrix_method: None,
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 232u64,
+            add: 178u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            frames: "canonical",
+            frames: "model",
             mul: 741u64,
             add: 572u64,
             div: 6u64,
@@ -592,11 +579,11 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
+            bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
-            frames: "model",
-            mul: 784u64,
-            add: 616u64,
+            frames: "canonical",
+            mul: 741u64,
+            add: 571u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -607,7 +594,7 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            frames: "canonical",
+            frames: "model",
             mul: 784u64,
             add: 614u64,
             div: 6u64,
@@ -618,14 +605,14 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
-            frames: "model",
-            mul: 458u64,
-            add: 369u64,
+            frames: "canonical",
+            mul: 784u64,
+            add: 613u64,
             div: 6u64,
             sqrt: 0u64,
-            sincos: 5u64,
+            sincos: 6u64,
             fma: 0u64,
         },
         OpCount {
@@ -633,7 +620,7 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
-            frames: "canonical",
+            frames: "model",
             mul: 458u64,
             add: 367u64,
             div: 6u64,
@@ -644,11 +631,24 @@ impl Srms {
         OpCount {
             function: "forward_dynamics",
             mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 458u64,
+            add: 366u64,
+            div: 6u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 424u64,
-            add: 345u64,
+            add: 343u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -661,7 +661,7 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "canonical",
             mul: 424u64,
-            add: 343u64,
+            add: 342u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -804,7 +804,7 @@ impl Srms {
             forward_method: None,
             frames: "model",
             mul: 655u64,
-            add: 503u64,
+            add: 501u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -817,7 +817,7 @@ impl Srms {
             forward_method: None,
             frames: "canonical",
             mul: 655u64,
-            add: 501u64,
+            add: 500u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -829,19 +829,6 @@ impl Srms {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 698u64,
-            add: 545u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("kane-direct"),
-            forward_method: None,
-            frames: "canonical",
             mul: 698u64,
             add: 543u64,
             div: 0u64,
@@ -852,14 +839,14 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
-            bias_method: Some("rnea"),
+            bias_method: Some("kane-direct"),
             forward_method: None,
-            frames: "model",
-            mul: 372u64,
-            add: 298u64,
+            frames: "canonical",
+            mul: 698u64,
+            add: 542u64,
             div: 0u64,
             sqrt: 0u64,
-            sincos: 5u64,
+            sincos: 6u64,
             fma: 0u64,
         },
         OpCount {
@@ -867,7 +854,7 @@ impl Srms {
             mass_matrix_method: Some("crba"),
             bias_method: Some("rnea"),
             forward_method: None,
-            frames: "canonical",
+            frames: "model",
             mul: 372u64,
             add: 296u64,
             div: 0u64,
@@ -878,11 +865,24 @@ impl Srms {
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
             mass_matrix_method: Some("crba"),
+            bias_method: Some("rnea"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 372u64,
+            add: 295u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 5u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
             mul: 338u64,
-            add: 274u64,
+            add: 272u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -895,7 +895,7 @@ impl Srms {
             forward_method: None,
             frames: "canonical",
             mul: 338u64,
-            add: 272u64,
+            add: 271u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -1012,7 +1012,7 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 817u64,
-            add: 651u64,
+            add: 649u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1025,7 +1025,7 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 860u64,
-            add: 693u64,
+            add: 691u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1038,7 +1038,7 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 464u64,
-            add: 401u64,
+            add: 399u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -1051,7 +1051,7 @@ impl Srms {
             forward_method: Some("ldlt"),
             frames: "model",
             mul: 430u64,
-            add: 377u64,
+            add: 375u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -1125,7 +1125,7 @@ impl Srms {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 118 mul, 115 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 51 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 118 mul, 114 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 52 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1147,124 +1147,121 @@ impl Srms {
         let x16 = Self::mul_add(x13, x15, x12 * x14);
         let x17 = -32.43591524 - x16;
         let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
-        let x19 = s_q4 * x8;
-        let x20 = c_q4 * x10;
-        let x21 = x19 - x20;
-        let x22 = s_q4 * 34.45002;
-        let x23 = c_q4 * 34.45002;
-        let x24 = 0.4572 * x23;
-        let x25 = x11 + x24;
-        let x26 = Self::mul_add(0.4572, x22, Self::mul_add(-x13, x14, x12 * x15) - x9);
-        let x27 = 41.67378 + x23;
-        let x28 = -15.380963024 + (x24 + x25);
-        let x29 = 54.202167456 + (x24 + (x16 - x7 + x24));
-        let x30 = s_q3 * s_q3;
-        let x31 = s_q3 * c_q3;
-        let x32 = x17 - x28;
-        let x33 = x21 + x21;
-        let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-c_q3, x26, s_q3 * x18);
-        let x36 = Self::mul_add(c_q3, x18, s_q3 * x26);
-        let x37 = c_q3 * x27;
-        let x38 = s_q3 * x27;
-        let x39 = 0.1524 * x38;
-        let x40 = 7.06 * x37;
-        let x41 = 0.1524 * x22;
-        let x42 = x39 + x40;
-        let x43 = x29 + x42;
-        let x44 = x39 + (x17 - x34 + x39);
-        let x45 = Self::mul_add(
-            -7.06,
-            x38,
-            Self::mul_add(-0.1524, x37, x21 + Self::mul_add(-x30, x33, x31 * x32)),
+        let x19 = Self::mul_add(-c_q4, x10, s_q4 * x8);
+        let x20 = s_q4 * 34.45002;
+        let x21 = c_q4 * 34.45002;
+        let x22 = 0.4572 * x21;
+        let x23 = x11 + x22;
+        let x24 = Self::mul_add(-0.4572, x20, x9 + Self::mul_add(-x12, x15, x13 * x14));
+        let x25 = 41.67378 + x21;
+        let x26 = -15.380963024 + (x22 + x23);
+        let x27 = 54.202167456 + (x22 - (x7 - x16 - x22));
+        let x28 = s_q3 * s_q3;
+        let x29 = s_q3 * c_q3;
+        let x30 = x17 - x26;
+        let x31 = x19 + x19;
+        let x32 = Self::mul_add(x29, x31, x28 * x30);
+        let x33 = Self::mul_add(s_q3, x18, c_q3 * x24);
+        let x34 = Self::mul_add(-c_q3, x18, s_q3 * x24);
+        let x35 = c_q3 * x25;
+        let x36 = s_q3 * x25;
+        let x37 = 0.1524 * x36;
+        let x38 = 7.06 * x35;
+        let x39 = 0.1524 * x20;
+        let x40 = x37 + x38;
+        let x41 = x27 + x40;
+        let x42 = x37 + (x17 - x32 + x37);
+        let x43 = Self::mul_add(
+            7.06,
+            x36,
+            -Self::mul_add(-0.1524, x35, x19 + Self::mul_add(-x28, x31, x29 * x30)),
         );
-        let x46 = 703.3878000000001 + x37;
-        let x47 = 15.183612000000002 + x38;
-        let x48 = -103.41030072000001 + x45;
-        let x49 = 0.8021 + Self::mul_add(-7.06, x22, x35);
-        let x50 = 5594.523885531201 + (x40 + (x28 + x34 + x40));
-        let x51 = 0.08 - (x36 + x41);
-        let x52 = 5601.1318504688 + (x42 + x43);
-        let x53 = s_q2 * s_q2;
-        let x54 = s_q2 * c_q2;
-        let x55 = x44 - x50;
-        let x56 = x48 + x48;
-        let x57 = Self::mul_add(x54, x56, x53 * x55);
-        let x58 = Self::mul_add(-s_q2, x51, c_q2 * x49);
-        let x59 = Self::mul_add(c_q2, x51, s_q2 * x49);
-        let x60 = Self::mul_add(-s_q2, x47, c_q2 * x46);
-        let x61 = Self::mul_add(c_q2, x47, s_q2 * x46);
-        let x62 = 0.1524 * x61;
-        let x63 = 6.377 * x60;
-        let x64 = x62 + x63;
-        let x65 = x52 + x64;
-        let x66 = Self::mul_add(
-            -6.377,
-            x61,
-            Self::mul_add(-0.1524, x60, x48 + Self::mul_add(-x53, x56, x54 * x55)),
+        let x44 = 703.3878000000001 + x35;
+        let x45 = 15.183612000000002 + x36;
+        let x46 = -103.41030072000001 - x43;
+        let x47 = 0.8021 + Self::mul_add(-7.06, x20, x33);
+        let x48 = 5594.523885531201 + (x38 + (x26 + x32 + x38));
+        let x49 = 0.08 + (x34 - x39);
+        let x50 = 5601.1318504688 + (x40 + x41);
+        let x51 = s_q2 * s_q2;
+        let x52 = s_q2 * c_q2;
+        let x53 = x42 - x48;
+        let x54 = x46 + x46;
+        let x55 = Self::mul_add(x52, x54, x51 * x53);
+        let x56 = Self::mul_add(-s_q2, x49, c_q2 * x47);
+        let x57 = Self::mul_add(c_q2, x49, s_q2 * x47);
+        let x58 = Self::mul_add(-s_q2, x45, c_q2 * x44);
+        let x59 = Self::mul_add(c_q2, x45, s_q2 * x44);
+        let x60 = 0.1524 * x59;
+        let x61 = 6.377 * x58;
+        let x62 = x60 + x61;
+        let x63 = x50 + x62;
+        let x64 = Self::mul_add(
+            6.377,
+            x59,
+            -Self::mul_add(-0.1524, x58, x46 + Self::mul_add(-x51, x54, x52 * x53)),
         );
-        let x67 = -190.97044034 + x66;
-        let x68 = 8596.210051042 + (x63 + (x50 + x57 + x63));
-        let x69 = 8609.573807858 + (x64 + x65);
-        let x70 = -Self::mul_add(
+        let x65 = -190.97044034 - x64;
+        let x66 = 8596.210051042 + (x61 + (x48 + x55 + x61));
+        let x67 = 8609.573807858 + (x62 + x63);
+        let x68 = -Self::mul_add(
             c_q1,
-            0.0302 + (x59 - x41),
-            s_q1 * (-1.928 + Self::mul_add(-6.377, x22, x58)),
+            0.0302 - (x39 - x57),
+            s_q1 * (-1.928 + Self::mul_add(-6.377, x20, x56)),
         );
-        let x71 = 46.90457611680001
-            + (x68
+        let x69 = 46.90457611680001
+            + (x66
                 + Self::mul_add(
                     s_q1 * c_q1,
-                    x67 + x67,
-                    s_q1 * s_q1 * (x62 + (x44 - x57 + x62) - x68),
+                    x65 + x65,
+                    s_q1 * s_q1 * (x60 + (x42 - x55 + x60) - x66),
                 ));
-        let x72 = -Self::mul_add(c_q1, x59, s_q1 * x58);
-        let x73 = x43
+        let x70 = -Self::mul_add(c_q1, x57, s_q1 * x56);
+        let x71 = x41
             + Self::mul_add(
-                6.377,
-                Self::mul_add(-s_q2, x38, c_q2 * x37),
-                0.1524 * Self::mul_add(s_q2, x37, c_q2 * x38),
+                -6.377,
+                Self::mul_add(-c_q2, x35, s_q2 * x36),
+                0.1524 * Self::mul_add(s_q2, x35, c_q2 * x36),
             );
-        let x74 = -Self::mul_add(
+        let x72 = -Self::mul_add(
             c_q1,
-            Self::mul_add(-c_q2, x36, s_q2 * x35),
-            s_q1 * Self::mul_add(s_q2, x36, c_q2 * x35),
+            Self::mul_add(c_q2, x34, s_q2 * x33),
+            s_q1 * Self::mul_add(-s_q2, x34, c_q2 * x33),
         );
-        let x75 = x20 - x19;
-        let x76 = c_q3 * x22;
-        let x77 = s_q3 * x22;
-        let x78 = 0.1524 * x23;
-        let x79 = Self::mul_add(s_q3, x25, c_q3 * x75) + x78;
-        let x80 = Self::mul_add(-7.06, x23, Self::mul_add(-c_q3, x25, s_q3 * x75));
-        let x81 = x18 + Self::mul_add(-7.06, x77, 0.1524 * x76);
-        let x82 = x81
-            - Self::mul_add(
-                6.377,
-                Self::mul_add(c_q2, x77, s_q2 * x76),
-                0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
+        let x73 = c_q3 * x20;
+        let x74 = s_q3 * x20;
+        let x75 = 0.1524 * x21;
+        let x76 = Self::mul_add(-s_q3, x23, c_q3 * x19) - x75;
+        let x77 = Self::mul_add(7.06, x21, Self::mul_add(c_q3, x23, s_q3 * x19));
+        let x78 = x18 + Self::mul_add(-7.06, x74, 0.1524 * x73);
+        let x79 = x78
+            + Self::mul_add(
+                -6.377,
+                Self::mul_add(c_q2, x74, s_q2 * x73),
+                0.1524 * Self::mul_add(-s_q2, x74, c_q2 * x73),
             );
-        let x83 = Self::mul_add(
-            c_q1,
-            Self::mul_add(-6.377, x23, Self::mul_add(c_q2, x80, s_q2 * x79)),
-            s_q1 * (x78 + Self::mul_add(-s_q2, x80, c_q2 * x79)),
+        let x80 = Self::mul_add(
+            -c_q1,
+            Self::mul_add(6.377, x21, Self::mul_add(c_q2, x77, s_q2 * x76)),
+            s_q1 * (x75 - Self::mul_add(-s_q2, x77, c_q2 * x76)),
         );
-        let x84 = -x83;
-        let x85 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x86 = Self::mul_add(1.903, s_q4, c_q4 * x9);
-        let x87 = Self::mul_add(s_q3, x10, c_q3 * x85);
-        let x88 = Self::mul_add(-c_q3, x10, s_q3 * x85);
-        let x89 = -Self::mul_add(
+        let x81 = -x80;
+        let x82 = Self::mul_add(-1.903, c_q4, s_q4 * x9);
+        let x83 = Self::mul_add(1.903, s_q4, c_q4 * x9);
+        let x84 = Self::mul_add(-s_q3, x10, c_q3 * x82);
+        let x85 = Self::mul_add(c_q3, x10, s_q3 * x82);
+        let x86 = Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x88, s_q2 * x87),
-            s_q1 * Self::mul_add(-s_q2, x88, c_q2 * x87),
+            Self::mul_add(c_q2, x85, s_q2 * x84),
+            s_q1 * Self::mul_add(-s_q2, x85, c_q2 * x84),
         );
         [
-            [x71, x70, x72, x74, x84, x89],
-            [x70, x69, x65, x73, x82, x86],
-            [x72, x65, x52, x43, x81, x86],
-            [x74, x73, x43, x29, x18, x86],
-            [x84, x82, x81, x18, x11, x10],
-            [x89, x86, x86, x86, x10, 1.903],
+            [x69, x68, x70, x72, x81, x86],
+            [x68, x67, x63, x71, x79, x83],
+            [x70, x63, x50, x41, x78, x83],
+            [x72, x71, x41, x27, x18, x83],
+            [x81, x79, x78, x18, x11, x10],
+            [x86, x83, x83, x83, x10, 1.903],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -1292,63 +1289,63 @@ impl Srms {
         let x9 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x1);
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x11 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x12 = Self::mul_add(-x1, s_q2, x2 * c_q2);
-        let x13 = Self::mul_add(-6.377, Self::mul_add(x2, x2, x5), x6 * 0.1524);
+        let x12 = Self::mul_add(-x2, c_q2, x1 * s_q2);
+        let x13 = Self::mul_add(x6, -0.1524, 6.377 * Self::mul_add(x2, x2, x5));
         let x14 = Self::mul_add(x3 + x3, 0.1524, 6.377 * (x4 + x4));
-        let x15 = Self::mul_add(-6.377, x6, Self::mul_add(x1, x1, x5) * 0.1524);
+        let x15 = Self::mul_add(Self::mul_add(x1, x1, x5), -0.1524, 6.377 * x6);
         let x16 = Self::mul_add(-s_q2, x15, c_q2 * x13);
         let x17 = Self::mul_add(c_q2, x15, s_q2 * x13);
-        let x18 = Self::mul_add(-qd[2], x12, Self::mul_add(-x3, c_q2, x4 * s_q2));
+        let x18 = Self::mul_add(-qd[2], x12, Self::mul_add(-x4, s_q2, x3 * c_q2));
         let x19 = Self::mul_add(qd[2], x11, Self::mul_add(x4, c_q2, x3 * s_q2));
         let x20 = qd[1] + qd[2];
         let x21 = x20 * x20;
         let x22 = Self::mul_add(x12, x12, x21);
         let x23 = x11 * x12;
         let x24 = Self::mul_add(x11, x20, x19);
-        let x25 = Self::mul_add(x12, x20, -x18);
+        let x25 = Self::mul_add(-x12, x20, x18);
         let x26 = Self::mul_add(x11, x11, x21);
         let x27 = Self::mul_add(
-            103.41030072000001,
+            -103.41030072000001,
             x12,
             Self::mul_add(0.8021, x20, x11 * 5594.523885531201),
         );
         let x28 = Self::mul_add(
             -0.08,
             x12,
-            Self::mul_add(-0.8021, x11, 5601.1318504688 * x20),
+            Self::mul_add(-5601.1318504688, x20, 0.8021 * x11),
         );
         let x29 = Self::mul_add(0.08, x20, 103.41030072000002 * x11);
         let x30 = Self::mul_add(
-            -703.3878000000001,
+            703.3878000000001,
             x14,
-            Self::mul_add(103.41030072000002, x18, -Self::mul_add(x11, x28, x20 * x27)),
+            Self::mul_add(103.41030072000002, x18, Self::mul_add(-x11, x28, x20 * x27)),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x32 = Self::mul_add(x12, s_q3, x11 * c_q3);
-        let x33 = Self::mul_add(-x11, s_q3, x12 * c_q3);
-        let x34 = x16 + Self::mul_add(-7.06, x22, 0.1524 * x23);
+        let x32 = Self::mul_add(-x12, s_q3, x11 * c_q3);
+        let x33 = Self::mul_add(x12, c_q3, x11 * s_q3);
+        let x34 = x16 + Self::mul_add(0.1524, x23, 7.06 * x22);
         let x35 = x14 + Self::mul_add(0.1524, x25, 7.06 * x24);
-        let x36 = x17 + Self::mul_add(-7.06, x23, 0.1524 * x26);
+        let x36 = x17 - Self::mul_add(0.1524, x26, 7.06 * x23);
         let x37 = Self::mul_add(c_q3, x36, s_q3 * x34);
-        let x38 = Self::mul_add(-qd[3], x33, Self::mul_add(x19, s_q3, x18 * c_q3));
-        let x39 = Self::mul_add(-qd[3], x32, Self::mul_add(-x19, c_q3, x18 * s_q3));
+        let x38 = Self::mul_add(-qd[3], x33, Self::mul_add(-x19, s_q3, x18 * c_q3));
+        let x39 = Self::mul_add(qd[3], x32, Self::mul_add(x19, c_q3, x18 * s_q3));
         let x40 = qd[3] + x20;
         let x41 = Self::mul_add(x33, x33, x40 * x40);
         let x42 = x32 * x33;
-        let x43 = Self::mul_add(-x32, x40, x39);
+        let x43 = Self::mul_add(x32, x40, x39);
         let x44 = x32 * 18.957952216000002;
         let x45 = 19.863252216000003 * x40;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x47 = Self::mul_add(-x32, c_q4, x40 * s_q4);
+        let x47 = Self::mul_add(-x40, s_q4, x32 * c_q4);
         let x48 = Self::mul_add(x40, c_q4, x32 * s_q4);
         let x49 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(-0.4572, x41, Self::mul_add(-s_q3, x36, c_q3 * x34)),
-            c_q4 * Self::mul_add(0.4572, x43, -x35),
+            -c_q4,
+            Self::mul_add(0.4572, x43, x35),
+            s_q4 * Self::mul_add(0.4572, x41, Self::mul_add(-s_q3, x36, c_q3 * x34)),
         );
-        let x50 = Self::mul_add(qd[4], x48, x38 * c_q4);
+        let x50 = Self::mul_add(-qd[4], x48, x38 * c_q4);
         let x51 = Self::mul_add(qd[4], x47, x38 * s_q4);
-        let x52 = qd[4] + x33;
+        let x52 = qd[4] - x33;
         let x53 = 34.45002 * Self::mul_add(x52, x52, x48 * x48);
         let x54 = 34.45002 * Self::mul_add(x47, x48, x39);
         let x55 = 34.45002 * Self::mul_add(x47, x52, x51);
@@ -1356,86 +1353,85 @@ impl Srms {
         let x57 = 34.74691524 * x52;
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x59 = Self::mul_add(x52, s_q5, x48 * c_q5);
-        let x60 = Self::mul_add(-x48, s_q5, x52 * c_q5);
-        let x61 = Self::mul_add(qd[5], x60, Self::mul_add(-x51, c_q5, x39 * s_q5));
-        let x62 = Self::mul_add(-qd[5], x59, Self::mul_add(x39, c_q5, x51 * s_q5));
-        let x63 = qd[5] + x47;
-        let x64 = Self::mul_add(0.966, x60, Self::mul_add(0.385, x59, 1.903 * x63));
-        let x65 = Self::mul_add(0.353, x60, 0.385 * x63);
+        let x60 = Self::mul_add(-x52, c_q5, x48 * s_q5);
+        let x61 = Self::mul_add(-qd[5], x60, Self::mul_add(-x39, s_q5, x51 * c_q5));
+        let x62 = Self::mul_add(qd[5], x59, Self::mul_add(x39, c_q5, x51 * s_q5));
+        let x63 = qd[5] - x47;
+        let x64 = Self::mul_add(-0.966, x60, Self::mul_add(0.385, x59, 1.903 * x63));
+        let x65 = Self::mul_add(-0.353, x60, 0.385 * x63);
         let x66 = Self::mul_add(
             x60,
-            -0.9929999999999999,
+            0.9929999999999999,
             Self::mul_add(0.353, x59, 0.966 * x63),
         );
-        let x67 = Self::mul_add(0.966, x62, Self::mul_add(0.385, x61, 1.903 * x50))
-            + Self::mul_add(-x60, x65, x59 * x66);
-        let x68 = Self::mul_add(0.353, x62, 0.385 * x50)
-            + Self::mul_add(-x63, x66, x60 * x64);
-        let x69 = Self::mul_add(
+        let x67 = Self::mul_add(0.966, x62, Self::mul_add(-0.385, x61, 1.903 * x50))
+            - Self::mul_add(x59, x66, x60 * x65);
+        let x68 = -x67;
+        let x69 = Self::mul_add(0.353, x62, 0.385 * x50)
+            + Self::mul_add(x63, x66, x60 * x64);
+        let x70 = Self::mul_add(
             x62,
             -0.9929999999999999,
-            Self::mul_add(0.353, x61, 0.966 * x50),
-        ) + Self::mul_add(-x59, x64, x63 * x65);
-        let x70 = Self::mul_add(-x52, x56, x48 * x57) + x67;
-        let x71 = Self::mul_add(-s_q5, x69, c_q5 * x68)
-            - Self::mul_add(
-                34.45002,
-                Self::mul_add(-0.4572, x42, x37),
-                Self::mul_add(x47, x57, 34.33891524 * x51),
-            );
+            Self::mul_add(-0.353, x61, 0.966 * x50),
+        ) + Self::mul_add(-x63, x65, x59 * x64);
+        let x71 = Self::mul_add(-x48, x57, x52 * x56) + x67;
         let x72 = Self::mul_add(
             34.45002,
+            Self::mul_add(-0.4572, x42, x37),
+            Self::mul_add(x47, x57, 34.33891524 * x51),
+        ) - Self::mul_add(-s_q5, x70, c_q5 * x69);
+        let x73 = Self::mul_add(
+            -34.45002,
             x49,
             Self::mul_add(x47, x56, 34.74691524 * x39),
-        ) + Self::mul_add(c_q5, x69, s_q5 * x68);
-        let x73 = Self::mul_add(-s_q4, x53, c_q4 * x54);
-        let x74 = Self::mul_add(41.67378, x41, Self::mul_add(s_q4, x54, c_q4 * x53));
-        let x75 = Self::mul_add(41.67378, x43, x73);
-        let x76 = Self::mul_add(-41.67378, x42, x55);
-        let x77 = Self::mul_add(-s_q4, x71, c_q4 * x70)
-            - Self::mul_add(x33, x45, x38 * 18.957952216000002);
-        let x78 = Self::mul_add(-41.67378, x37, x33 * x44)
-            + Self::mul_add(-0.4572, x55, Self::mul_add(c_q4, x71, s_q4 * x70));
-        let x79 = Self::mul_add(0.4572, x73, x72)
-            - Self::mul_add(41.67378, x35, Self::mul_add(x32, x45, x40 * x44));
-        let x80 = Self::mul_add(-c_q3, x74, s_q3 * x76);
-        let x81 = Self::mul_add(c_q3, x76, s_q3 * x74);
-        let x82 = Self::mul_add(-703.3878000000001, x22, x23 * 15.183612000000002) + x80;
-        let x83 = x75 - Self::mul_add(15.183612000000002, x25, 703.3878000000001 * x24);
-        let x84 = Self::mul_add(-703.3878000000001, x23, 15.183612000000002 * x26) + x81;
-        let x85 = Self::mul_add(0.1524, x75, Self::mul_add(s_q3, x79, c_q3 * x77))
-            - Self::mul_add(
-                x14,
-                15.183612000000002,
-                Self::mul_add(103.41030072000001, x19, x18 * 5594.523885531201)
-                    + Self::mul_add(x20, x29, x12 * x28),
-            );
-        let x86 = Self::mul_add(0.08, x19, 0.8021 * x18)
-            + Self::mul_add(-x11, x29, x12 * x27)
+        ) + Self::mul_add(c_q5, x70, s_q5 * x69);
+        let x74 = -x73;
+        let x75 = Self::mul_add(c_q4, x54, s_q4 * x53);
+        let x76 = Self::mul_add(41.67378, x41, Self::mul_add(-s_q4, x54, c_q4 * x53));
+        let x77 = Self::mul_add(41.67378, x43, x75);
+        let x78 = Self::mul_add(41.67378, x42, -x55);
+        let x79 = Self::mul_add(x33, x45, x38 * 18.957952216000002)
+            - Self::mul_add(s_q4, x72, c_q4 * x71);
+        let x80 = Self::mul_add(-41.67378, x37, x33 * x44)
+            + Self::mul_add(-0.4572, x55, Self::mul_add(-c_q4, x72, s_q4 * x71));
+        let x81 = -x80;
+        let x82 = Self::mul_add(41.67378, x35, Self::mul_add(x32, x45, x40 * x44))
+            + Self::mul_add(0.4572, x75, x73);
+        let x83 = Self::mul_add(-s_q3, x78, c_q3 * x76);
+        let x84 = Self::mul_add(c_q3, x78, s_q3 * x76);
+        let x85 = Self::mul_add(x23, 15.183612000000002, 703.3878000000001 * x22) + x83;
+        let x86 = Self::mul_add(15.183612000000002, x25, 703.3878000000001 * x24) + x77;
+        let x87 = Self::mul_add(15.183612000000002, x26, 703.3878000000001 * x23) + x84;
+        let x88 = Self::mul_add(
+            x14,
+            -15.183612000000002,
+            Self::mul_add(-103.41030072000001, x19, x18 * 5594.523885531201)
+                - Self::mul_add(x20, x29, x12 * x28),
+        ) + Self::mul_add(-0.1524, x77, Self::mul_add(-s_q3, x82, c_q3 * x79));
+        let x89 = Self::mul_add(-0.08, x19, 0.8021 * x18)
+            + Self::mul_add(x11, x29, x12 * x27)
             - Self::mul_add(703.3878000000001, x17, x16 * 15.183612000000002)
-            + (x78 - Self::mul_add(7.06, x81, 0.1524 * x80));
-        let x87 = x30 + Self::mul_add(7.06, x75, Self::mul_add(-s_q3, x77, c_q3 * x79));
-        let x88 = Self::mul_add(x4, 0.0302, x3 * 1.928) + Self::mul_add(-x1, x9, x2 * x7)
-            + (x86
+            + (x80 - Self::mul_add(-7.06, x84, 0.1524 * x83));
+        let x90 = -x89;
+        let x91 = x30 + Self::mul_add(7.06, x77, Self::mul_add(c_q3, x82, s_q3 * x79));
+        let x92 = Self::mul_add(x4, 0.0302, x3 * 1.928) + Self::mul_add(-x1, x9, x2 * x7)
+            - (x89
                 - Self::mul_add(
-                    6.377,
-                    Self::mul_add(-s_q2, x82, c_q2 * x84),
-                    0.1524 * Self::mul_add(s_q2, x84, c_q2 * x82),
+                    -6.377,
+                    Self::mul_add(c_q2, x87, s_q2 * x85),
+                    0.1524 * Self::mul_add(-s_q2, x87, c_q2 * x85),
                 ));
-        let x89 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-190.97044034, x4, x3 * 8596.210051042)
-                - Self::mul_add(qd[1], x9, x2 * x8)
-                + Self::mul_add(0.1524, x83, Self::mul_add(s_q2, x87, c_q2 * x85)),
-            c_q1
-                * (Self::mul_add(6.377, x83, Self::mul_add(-s_q2, x85, c_q2 * x87))
-                    - Self::mul_add(
-                        190.97044034000004,
-                        x3,
-                        Self::mul_add(x1, x8, qd[1] * x7),
-                    )),
+        let x93 = Self::mul_add(
+            c_q1,
+            Self::mul_add(190.97044034000004, x3, Self::mul_add(x1, x8, qd[1] * x7))
+                + Self::mul_add(6.377, x86, Self::mul_add(c_q2, x91, s_q2 * x88)),
+            s_q1
+                * (Self::mul_add(-190.97044034, x4, x3 * 8596.210051042)
+                    - Self::mul_add(qd[1], x9, x2 * x8)
+                    + Self::mul_add(-0.1524, x86, Self::mul_add(-s_q2, x91, c_q2 * x88))),
         );
-        [x89, x88, x86, x78, x72, x67]
+        let x94 = -x93;
+        [x94, x92, x90, x81, x74, x68]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1464,173 +1460,179 @@ impl Srms {
         let x11 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x1);
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x13 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x14 = Self::mul_add(-x1, s_q2, x2 * c_q2);
+        let x14 = Self::mul_add(-x2, c_q2, x1 * s_q2);
         let x15 = Self::mul_add(qdd[1] - x8, 0.1524, 6.377 * Self::mul_add(x2, x2, x7));
-        let x16 = Self::mul_add(x3 + x5, -0.1524, 6.377 * (x6 - x4));
-        let x17 = Self::mul_add(-6.377, qdd[1] + x8, Self::mul_add(x1, x1, x7) * 0.1524);
-        let x18 = Self::mul_add(s_q2, x17, c_q2 * x15);
-        let x19 = Self::mul_add(-s_q2, x15, c_q2 * x17);
-        let x20 = Self::mul_add(qd[2], x14, Self::mul_add(x6, s_q2, x5 * c_q2));
-        let x21 = Self::mul_add(-qd[2], x13, Self::mul_add(-x5, s_q2, x6 * c_q2));
+        let x16 = Self::mul_add(x3 + x5, 0.1524, 6.377 * (x4 - x6));
+        let x17 = Self::mul_add(
+            Self::mul_add(x1, x1, x7),
+            -0.1524,
+            6.377 * (qdd[1] + x8),
+        );
+        let x18 = Self::mul_add(-s_q2, x17, c_q2 * x15);
+        let x19 = Self::mul_add(c_q2, x17, s_q2 * x15);
+        let x20 = Self::mul_add(-qd[2], x14, Self::mul_add(x6, s_q2, x5 * c_q2));
+        let x21 = Self::mul_add(qd[2], x13, Self::mul_add(-x6, c_q2, x5 * s_q2));
         let x22 = qdd[1] + qdd[2];
         let x23 = qd[1] + qd[2];
         let x24 = x23 * x23;
         let x25 = Self::mul_add(x14, x14, x24);
         let x26 = x13 * x14;
-        let x27 = x22 - x26;
-        let x28 = Self::mul_add(-x13, x23, x21);
-        let x29 = Self::mul_add(x14, x23, x20);
-        let x30 = x22 + x26;
+        let x27 = x22 + x26;
+        let x28 = Self::mul_add(x13, x23, x21);
+        let x29 = Self::mul_add(-x14, x23, x20);
+        let x30 = x22 - x26;
         let x31 = Self::mul_add(x13, x13, x24);
         let x32 = Self::mul_add(
-            103.41030072000001,
+            -103.41030072000001,
             x14,
             Self::mul_add(0.8021, x23, x13 * 5594.523885531201),
         );
         let x33 = Self::mul_add(
             -0.08,
             x14,
-            Self::mul_add(-0.8021, x13, 5601.1318504688 * x23),
+            Self::mul_add(-5601.1318504688, x23, 0.8021 * x13),
         );
         let x34 = Self::mul_add(0.08, x23, 103.41030072000002 * x13);
         let x35 = Self::mul_add(
             x16,
-            15.183612000000002,
+            -15.183612000000002,
             Self::mul_add(
-                103.41030072000001,
+                -103.41030072000001,
                 x21,
                 Self::mul_add(0.8021, x22, x20 * 5594.523885531201),
             ) - Self::mul_add(x23, x34, x14 * x33),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x37 = Self::mul_add(x14, s_q3, x13 * c_q3);
-        let x38 = Self::mul_add(-x13, s_q3, x14 * c_q3);
+        let x37 = Self::mul_add(-x14, s_q3, x13 * c_q3);
+        let x38 = Self::mul_add(x14, c_q3, x13 * s_q3);
         let x39 = x18 + Self::mul_add(0.1524, x27, 7.06 * x25);
-        let x40 = x16 + Self::mul_add(-0.1524, x29, 7.06 * x28);
-        let x41 = x19 + Self::mul_add(-7.06, x30, 0.1524 * x31);
-        let x42 = Self::mul_add(-s_q3, x39, c_q3 * x41);
-        let x43 = Self::mul_add(qd[3], x38, Self::mul_add(x21, s_q3, x20 * c_q3));
-        let x44 = Self::mul_add(-qd[3], x37, Self::mul_add(-x20, s_q3, x21 * c_q3));
+        let x40 = x16 + Self::mul_add(0.1524, x29, 7.06 * x28);
+        let x41 = x19 + Self::mul_add(-0.1524, x31, 7.06 * x30);
+        let x42 = Self::mul_add(c_q3, x41, s_q3 * x39);
+        let x43 = Self::mul_add(-qd[3], x38, Self::mul_add(-x21, s_q3, x20 * c_q3));
+        let x44 = Self::mul_add(qd[3], x37, Self::mul_add(x21, c_q3, x20 * s_q3));
         let x45 = qdd[3] + x22;
         let x46 = qd[3] + x23;
         let x47 = Self::mul_add(x38, x38, x46 * x46);
-        let x48 = Self::mul_add(-x37, x46, x44);
-        let x49 = Self::mul_add(x37, x38, x45);
+        let x48 = Self::mul_add(x37, x46, x44);
+        let x49 = Self::mul_add(-x37, x38, x45);
         let x50 = x37 * 18.957952216000002;
         let x51 = 19.863252216000003 * x46;
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x53 = Self::mul_add(-x37, c_q4, x46 * s_q4);
+        let x53 = Self::mul_add(-x46, s_q4, x37 * c_q4);
         let x54 = Self::mul_add(x46, c_q4, x37 * s_q4);
         let x55 = Self::mul_add(
-            c_q4,
+            -c_q4,
             Self::mul_add(0.4572, x48, x40),
-            s_q4 * Self::mul_add(0.4572, x47, Self::mul_add(s_q3, x41, c_q3 * x39)),
+            s_q4 * Self::mul_add(0.4572, x47, Self::mul_add(-s_q3, x41, c_q3 * x39)),
         );
-        let x56 = Self::mul_add(-qd[4], x53, Self::mul_add(x45, c_q4, x43 * s_q4));
-        let x57 = qdd[4] + x44;
-        let x58 = qd[4] + x38;
+        let x56 = Self::mul_add(qd[4], x53, Self::mul_add(x45, c_q4, x43 * s_q4));
+        let x57 = qdd[4] - x44;
+        let x58 = qd[4] - x38;
         let x59 = 34.45002 * Self::mul_add(x58, x58, x54 * x54);
-        let x60 = 34.45002 * Self::mul_add(x53, x54, x57);
-        let x61 = 34.45002 * Self::mul_add(x53, x58, -x56);
+        let x60 = 34.45002 * Self::mul_add(-x53, x54, x57);
+        let x61 = 34.45002 * Self::mul_add(x53, x58, x56);
         let x62 = 34.33891524 * x54;
         let x63 = 34.74691524 * x58;
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x65 = Self::mul_add(x58, s_q5, x54 * c_q5);
-        let x66 = Self::mul_add(-x54, s_q5, x58 * c_q5);
-        let x67 = Self::mul_add(qd[5], x66, Self::mul_add(x57, s_q5, x56 * c_q5));
-        let x68 = Self::mul_add(-qd[5], x65, Self::mul_add(-x56, s_q5, x57 * c_q5));
+        let x66 = Self::mul_add(-x58, c_q5, x54 * s_q5);
+        let x67 = Self::mul_add(-qd[5], x66, Self::mul_add(x57, s_q5, x56 * c_q5));
+        let x68 = Self::mul_add(qd[5], x65, Self::mul_add(-x57, c_q5, x56 * s_q5));
         let x69 = qdd[5]
-            + Self::mul_add(qd[4], x54, Self::mul_add(-x43, c_q4, x45 * s_q4));
-        let x70 = qd[5] + x53;
-        let x71 = Self::mul_add(0.966, x66, Self::mul_add(0.385, x65, 1.903 * x70));
-        let x72 = Self::mul_add(0.353, x66, 0.385 * x70);
+            - Self::mul_add(-qd[4], x54, Self::mul_add(-x45, s_q4, x43 * c_q4));
+        let x70 = qd[5] - x53;
+        let x71 = Self::mul_add(-0.966, x66, Self::mul_add(0.385, x65, 1.903 * x70));
+        let x72 = Self::mul_add(-0.353, x66, 0.385 * x70);
         let x73 = Self::mul_add(
             x66,
-            -0.9929999999999999,
+            0.9929999999999999,
             Self::mul_add(0.353, x65, 0.966 * x70),
         );
-        let x74 = Self::mul_add(0.966, x68, Self::mul_add(0.385, x67, 1.903 * x69))
-            + Self::mul_add(-x66, x72, x65 * x73);
-        let x75 = Self::mul_add(0.353, x68, 0.385 * x69)
-            + Self::mul_add(-x70, x73, x66 * x71);
+        let x74 = Self::mul_add(-0.966, x68, Self::mul_add(0.385, x67, 1.903 * x69))
+            + Self::mul_add(x65, x73, x66 * x72);
+        let x75 = Self::mul_add(-0.353, x68, 0.385 * x69)
+            - Self::mul_add(x70, x73, x66 * x71);
         let x76 = Self::mul_add(
             x68,
-            -0.9929999999999999,
+            0.9929999999999999,
             Self::mul_add(0.353, x67, 0.966 * x69),
-        ) + Self::mul_add(-x65, x71, x70 * x72);
-        let x77 = Self::mul_add(-x58, x62, x54 * x63) + x74;
+        ) - Self::mul_add(-x70, x72, x65 * x71);
+        let x77 = Self::mul_add(-x54, x63, x58 * x62) - x74;
         let x78 = Self::mul_add(
-            -34.45002,
-            Self::mul_add(-0.4572, x49, x42),
-            Self::mul_add(-x53, x63, 34.33891524 * x56),
+            34.45002,
+            Self::mul_add(0.4572, x49, x42),
+            Self::mul_add(x53, x63, 34.33891524 * x56),
         ) + Self::mul_add(-s_q5, x76, c_q5 * x75);
         let x79 = Self::mul_add(
             34.45002,
             x55,
-            Self::mul_add(x53, x62, 34.74691524 * x57),
+            Self::mul_add(-x53, x62, 34.74691524 * x57),
         ) + Self::mul_add(c_q5, x76, s_q5 * x75);
-        let x80 = Self::mul_add(-s_q4, x59, c_q4 * x60);
+        let x80 = Self::mul_add(-c_q4, x60, s_q4 * x59);
         let x81 = Self::mul_add(41.67378, x47, Self::mul_add(s_q4, x60, c_q4 * x59));
         let x82 = Self::mul_add(41.67378, x48, x80);
-        let x83 = Self::mul_add(-41.67378, x49, x61);
-        let x84 = Self::mul_add(-x38, x51, x43 * 18.957952216000002)
-            + Self::mul_add(-s_q4, x78, c_q4 * x77);
+        let x83 = Self::mul_add(41.67378, x49, x61);
+        let x84 = Self::mul_add(x38, x51, x43 * 18.957952216000002)
+            - Self::mul_add(s_q4, x78, c_q4 * x77);
         let x85 = Self::mul_add(
-            -41.67378,
+            41.67378,
             x42,
-            Self::mul_add(x38, x50, 19.863252216000003 * x45),
-        ) + Self::mul_add(-0.4572, x61, Self::mul_add(c_q4, x78, s_q4 * x77));
-        let x86 = Self::mul_add(41.67378, x40, -Self::mul_add(x37, x51, x46 * x50))
-            + Self::mul_add(0.4572, x80, x79);
-        let x87 = Self::mul_add(-c_q3, x81, s_q3 * x83);
-        let x88 = Self::mul_add(c_q3, x83, s_q3 * x81);
-        let x89 = x87 - Self::mul_add(x27, 15.183612000000002, 703.3878000000001 * x25);
-        let x90 = Self::mul_add(-15.183612000000002, x29, 703.3878000000001 * x28) + x82;
-        let x91 = Self::mul_add(-703.3878000000001, x30, 15.183612000000002 * x31) + x88;
-        let x92 = x35 + Self::mul_add(0.1524, x82, Self::mul_add(s_q3, x86, c_q3 * x84));
+            Self::mul_add(-x38, x50, 19.863252216000003 * x45),
+        ) - Self::mul_add(-0.4572, x61, Self::mul_add(-c_q4, x78, s_q4 * x77));
+        let x86 = Self::mul_add(41.67378, x40, Self::mul_add(x37, x51, x46 * x50))
+            - Self::mul_add(-0.4572, x80, x79);
+        let x87 = Self::mul_add(s_q3, x83, c_q3 * x81);
+        let x88 = Self::mul_add(-c_q3, x83, s_q3 * x81);
+        let x89 = Self::mul_add(x27, 15.183612000000002, 703.3878000000001 * x25) + x87;
+        let x90 = Self::mul_add(15.183612000000002, x29, 703.3878000000001 * x28) + x82;
+        let x91 = Self::mul_add(-15.183612000000002, x31, 703.3878000000001 * x30) - x88;
+        let x92 = x35
+            + Self::mul_add(-0.1524, x82, Self::mul_add(-s_q3, x86, c_q3 * x84));
         let x93 = Self::mul_add(
             -0.08,
             x21,
-            Self::mul_add(-0.8021, x20, 5601.1318504688 * x22),
-        ) + Self::mul_add(-x13, x34, x14 * x32)
-            + Self::mul_add(-703.3878000000001, x19, x18 * 15.183612000000002)
-            + (x85 - Self::mul_add(7.06, x88, 0.1524 * x87));
-        let x94 = Self::mul_add(
+            Self::mul_add(-5601.1318504688, x22, 0.8021 * x20),
+        ) + Self::mul_add(x13, x34, x14 * x32)
+            - Self::mul_add(703.3878000000001, x19, x18 * 15.183612000000002)
+            - (x85 + Self::mul_add(-7.06, x88, 0.1524 * x87));
+        let x94 = -x93;
+        let x95 = Self::mul_add(
             703.3878000000001,
             x16,
-            -(Self::mul_add(0.08, x22, 103.41030072000002 * x20)
-                + Self::mul_add(x13, x33, x23 * x32)),
-        ) + Self::mul_add(7.06, x82, Self::mul_add(-s_q3, x84, c_q3 * x86));
-        let x95 = Self::mul_add(
+            Self::mul_add(0.08, x22, 103.41030072000002 * x20)
+                + Self::mul_add(-x13, x33, x23 * x32),
+        ) + Self::mul_add(7.06, x82, Self::mul_add(c_q3, x86, s_q3 * x84));
+        let x96 = Self::mul_add(
             x6,
             -0.0302,
             Self::mul_add(8609.573807858, qdd[1], x5 * 1.928),
         ) + Self::mul_add(-x1, x11, x2 * x9)
-            + (x93
+            - (x93
                 - Self::mul_add(
-                    6.377,
-                    Self::mul_add(-s_q2, x89, c_q2 * x91),
+                    -6.377,
+                    Self::mul_add(-c_q2, x91, s_q2 * x89),
                     0.1524 * Self::mul_add(s_q2, x91, c_q2 * x89),
                 ));
-        let x96 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                190.97044034,
-                x6,
-                Self::mul_add(qdd[1], -1.928, x5 * 8596.210051042),
-            ) - Self::mul_add(qd[1], x11, x2 * x10)
-                + Self::mul_add(0.1524, x90, Self::mul_add(s_q2, x94, c_q2 * x92)),
-            c_q1
-                * (Self::mul_add(6.377, x90, Self::mul_add(-s_q2, x92, c_q2 * x94))
-                    - (Self::mul_add(qdd[1], 0.0302, 190.97044034000004 * x5)
-                        + Self::mul_add(x1, x10, qd[1] * x9))),
+        let x97 = Self::mul_add(
+            c_q1,
+            Self::mul_add(qdd[1], 0.0302, 190.97044034000004 * x5)
+                + Self::mul_add(x1, x10, qd[1] * x9)
+                + Self::mul_add(6.377, x90, Self::mul_add(c_q2, x95, s_q2 * x92)),
+            s_q1
+                * (Self::mul_add(
+                    190.97044034,
+                    x6,
+                    Self::mul_add(qdd[1], -1.928, x5 * 8596.210051042),
+                ) - Self::mul_add(qd[1], x11, x2 * x10)
+                    + Self::mul_add(-0.1524, x90, Self::mul_add(-s_q2, x95, c_q2 * x92))),
         );
-        let x97 = Self::mul_add(14222.257549666001, qdd[0], x96);
-        [x97, x95, x93, x85, x79, x74]
+        let x98 = Self::mul_add(14222.257549666001, qdd[0], -x97);
+        [x98, x96, x94, x85, x79, x74]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 424 mul, 343 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 239 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 424 mul, 342 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
         let (s_q1, c_q1) = libm::sincos(q[1]);
@@ -1652,401 +1654,393 @@ impl Srms {
         let x16 = Self::mul_add(x13, x15, x12 * x14);
         let x17 = -32.43591524 - x16;
         let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
-        let x19 = s_q4 * x8;
-        let x20 = c_q4 * x10;
-        let x21 = x19 - x20;
-        let x22 = s_q4 * 34.45002;
-        let x23 = c_q4 * 34.45002;
-        let x24 = 0.4572 * x23;
-        let x25 = x11 + x24;
-        let x26 = Self::mul_add(0.4572, x22, Self::mul_add(-x13, x14, x12 * x15) - x9);
-        let x27 = 41.67378 + x23;
-        let x28 = -15.380963024 + (x24 + x25);
-        let x29 = 54.202167456 + (x24 + (x16 - x7 + x24));
-        let x30 = s_q3 * s_q3;
-        let x31 = s_q3 * c_q3;
-        let x32 = x17 - x28;
-        let x33 = x21 + x21;
-        let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-c_q3, x26, s_q3 * x18);
-        let x36 = Self::mul_add(c_q3, x18, s_q3 * x26);
-        let x37 = c_q3 * x27;
-        let x38 = s_q3 * x27;
-        let x39 = 0.1524 * x38;
-        let x40 = 7.06 * x37;
-        let x41 = 0.1524 * x22;
-        let x42 = x39 + x40;
-        let x43 = x29 + x42;
-        let x44 = x39 + (x17 - x34 + x39);
-        let x45 = Self::mul_add(
-            -7.06,
-            x38,
-            Self::mul_add(-0.1524, x37, x21 + Self::mul_add(-x30, x33, x31 * x32)),
+        let x19 = Self::mul_add(-c_q4, x10, s_q4 * x8);
+        let x20 = s_q4 * 34.45002;
+        let x21 = c_q4 * 34.45002;
+        let x22 = 0.4572 * x21;
+        let x23 = x11 + x22;
+        let x24 = Self::mul_add(-0.4572, x20, x9 + Self::mul_add(-x12, x15, x13 * x14));
+        let x25 = 41.67378 + x21;
+        let x26 = -15.380963024 + (x22 + x23);
+        let x27 = 54.202167456 + (x22 - (x7 - x16 - x22));
+        let x28 = s_q3 * s_q3;
+        let x29 = s_q3 * c_q3;
+        let x30 = x17 - x26;
+        let x31 = x19 + x19;
+        let x32 = Self::mul_add(x29, x31, x28 * x30);
+        let x33 = Self::mul_add(s_q3, x18, c_q3 * x24);
+        let x34 = Self::mul_add(-c_q3, x18, s_q3 * x24);
+        let x35 = c_q3 * x25;
+        let x36 = s_q3 * x25;
+        let x37 = 0.1524 * x36;
+        let x38 = 7.06 * x35;
+        let x39 = 0.1524 * x20;
+        let x40 = x37 + x38;
+        let x41 = x27 + x40;
+        let x42 = x37 + (x17 - x32 + x37);
+        let x43 = Self::mul_add(
+            7.06,
+            x36,
+            -Self::mul_add(-0.1524, x35, x19 + Self::mul_add(-x28, x31, x29 * x30)),
         );
-        let x46 = 703.3878000000001 + x37;
-        let x47 = 15.183612000000002 + x38;
-        let x48 = -103.41030072000001 + x45;
-        let x49 = 0.8021 + Self::mul_add(-7.06, x22, x35);
-        let x50 = 5594.523885531201 + (x40 + (x28 + x34 + x40));
-        let x51 = 0.08 - (x36 + x41);
-        let x52 = 5601.1318504688 + (x42 + x43);
-        let x53 = s_q2 * s_q2;
-        let x54 = s_q2 * c_q2;
-        let x55 = x44 - x50;
-        let x56 = x48 + x48;
-        let x57 = Self::mul_add(x54, x56, x53 * x55);
-        let x58 = Self::mul_add(-s_q2, x51, c_q2 * x49);
-        let x59 = Self::mul_add(c_q2, x51, s_q2 * x49);
-        let x60 = Self::mul_add(-s_q2, x47, c_q2 * x46);
-        let x61 = Self::mul_add(c_q2, x47, s_q2 * x46);
-        let x62 = 0.1524 * x61;
-        let x63 = 6.377 * x60;
-        let x64 = x62 + x63;
-        let x65 = x52 + x64;
-        let x66 = Self::mul_add(
-            -6.377,
-            x61,
-            Self::mul_add(-0.1524, x60, x48 + Self::mul_add(-x53, x56, x54 * x55)),
+        let x44 = 703.3878000000001 + x35;
+        let x45 = 15.183612000000002 + x36;
+        let x46 = -103.41030072000001 - x43;
+        let x47 = 0.8021 + Self::mul_add(-7.06, x20, x33);
+        let x48 = 5594.523885531201 + (x38 + (x26 + x32 + x38));
+        let x49 = 0.08 + (x34 - x39);
+        let x50 = 5601.1318504688 + (x40 + x41);
+        let x51 = s_q2 * s_q2;
+        let x52 = s_q2 * c_q2;
+        let x53 = x42 - x48;
+        let x54 = x46 + x46;
+        let x55 = Self::mul_add(x52, x54, x51 * x53);
+        let x56 = Self::mul_add(-s_q2, x49, c_q2 * x47);
+        let x57 = Self::mul_add(c_q2, x49, s_q2 * x47);
+        let x58 = Self::mul_add(-s_q2, x45, c_q2 * x44);
+        let x59 = Self::mul_add(c_q2, x45, s_q2 * x44);
+        let x60 = 0.1524 * x59;
+        let x61 = 6.377 * x58;
+        let x62 = x60 + x61;
+        let x63 = x50 + x62;
+        let x64 = Self::mul_add(
+            6.377,
+            x59,
+            -Self::mul_add(-0.1524, x58, x46 + Self::mul_add(-x51, x54, x52 * x53)),
         );
-        let x67 = -190.97044034 + x66;
-        let x68 = 8596.210051042 + (x63 + (x50 + x57 + x63));
+        let x65 = -190.97044034 - x64;
+        let x66 = 8596.210051042 + (x61 + (x48 + x55 + x61));
+        let x67 = Self::mul_add(
+            c_q1,
+            0.0302 - (x39 - x57),
+            s_q1 * (-1.928 + Self::mul_add(-6.377, x20, x56)),
+        );
+        let x68 = Self::mul_add(c_q1, x57, s_q1 * x56);
         let x69 = Self::mul_add(
             c_q1,
-            0.0302 + (x59 - x41),
-            s_q1 * (-1.928 + Self::mul_add(-6.377, x22, x58)),
+            Self::mul_add(c_q2, x34, s_q2 * x33),
+            s_q1 * Self::mul_add(-s_q2, x34, c_q2 * x33),
         );
-        let x70 = Self::mul_add(c_q1, x59, s_q1 * x58);
-        let x71 = Self::mul_add(
+        let x70 = c_q3 * x20;
+        let x71 = s_q3 * x20;
+        let x72 = 0.1524 * x21;
+        let x73 = Self::mul_add(-s_q3, x23, c_q3 * x19) - x72;
+        let x74 = Self::mul_add(7.06, x21, Self::mul_add(c_q3, x23, s_q3 * x19));
+        let x75 = x18 + Self::mul_add(-7.06, x71, 0.1524 * x70);
+        let x76 = Self::mul_add(
+            -c_q1,
+            Self::mul_add(6.377, x21, Self::mul_add(c_q2, x74, s_q2 * x73)),
+            s_q1 * (x72 - Self::mul_add(-s_q2, x74, c_q2 * x73)),
+        );
+        let x77 = Self::mul_add(-1.903, c_q4, s_q4 * x9);
+        let x78 = Self::mul_add(1.903, s_q4, c_q4 * x9);
+        let x79 = Self::mul_add(-s_q3, x10, c_q3 * x77);
+        let x80 = Self::mul_add(c_q3, x10, s_q3 * x77);
+        let x81 = Self::mul_add(
             c_q1,
-            Self::mul_add(-c_q2, x36, s_q2 * x35),
-            s_q1 * Self::mul_add(s_q2, x36, c_q2 * x35),
+            Self::mul_add(c_q2, x80, s_q2 * x79),
+            s_q1 * Self::mul_add(-s_q2, x80, c_q2 * x79),
         );
-        let x72 = x20 - x19;
-        let x73 = c_q3 * x22;
-        let x74 = s_q3 * x22;
-        let x75 = 0.1524 * x23;
-        let x76 = Self::mul_add(s_q3, x25, c_q3 * x72) + x75;
-        let x77 = Self::mul_add(-7.06, x23, Self::mul_add(-c_q3, x25, s_q3 * x72));
-        let x78 = x18 + Self::mul_add(-7.06, x74, 0.1524 * x73);
-        let x79 = Self::mul_add(
-            c_q1,
-            Self::mul_add(-6.377, x23, Self::mul_add(c_q2, x77, s_q2 * x76)),
-            s_q1 * (x75 + Self::mul_add(-s_q2, x77, c_q2 * x76)),
-        );
-        let x80 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x81 = Self::mul_add(1.903, s_q4, c_q4 * x9);
-        let x82 = Self::mul_add(s_q3, x10, c_q3 * x80);
-        let x83 = Self::mul_add(-c_q3, x10, s_q3 * x80);
-        let x84 = Self::mul_add(
-            c_q1,
-            Self::mul_add(c_q2, x83, s_q2 * x82),
-            s_q1 * Self::mul_add(-s_q2, x83, c_q2 * x82),
-        );
-        let x85 = qd[0] * s_q1;
-        let x86 = qd[0] * c_q1;
-        let x87 = qd[1] * x86;
-        let x88 = qd[1] * x85;
-        let x89 = qd[1] * qd[1];
-        let x90 = x85 * x86;
-        let x91 = Self::mul_add(qd[1], -1.928, x86 * 190.97044034);
-        let x92 = Self::mul_add(
+        let x82 = qd[0] * s_q1;
+        let x83 = qd[0] * c_q1;
+        let x84 = qd[1] * x83;
+        let x85 = qd[1] * x82;
+        let x86 = qd[1] * qd[1];
+        let x87 = x82 * x83;
+        let x88 = Self::mul_add(qd[1], -1.928, x83 * 190.97044034);
+        let x89 = Self::mul_add(
             0.0302,
             qd[1],
-            Self::mul_add(-8596.210051042, x86, x85 * 190.97044034000004),
+            Self::mul_add(-8596.210051042, x83, x82 * 190.97044034000004),
         );
-        let x93 = Self::mul_add(
+        let x90 = Self::mul_add(
             8609.573807858,
             qd[1],
-            Self::mul_add(-0.0302, x86, x85 * 1.928),
+            Self::mul_add(-0.0302, x83, x82 * 1.928),
         );
-        let x94 = Self::mul_add(s_q2, x86, c_q2 * x85);
-        let x95 = Self::mul_add(-c_q2, x86, s_q2 * x85);
-        let x96 = Self::mul_add(-6.377, Self::mul_add(x86, x86, x89), 0.1524 * x90);
-        let x97 = Self::mul_add(-0.1524, Self::mul_add(x85, x85, x89), 6.377 * x90);
-        let x98 = Self::mul_add(0.1524, x87 + x87, 6.377 * (x88 + x88));
-        let x99 = Self::mul_add(s_q2, x97, c_q2 * x96);
-        let x100 = Self::mul_add(-s_q2, x96, c_q2 * x97);
-        let x101 = Self::mul_add(qd[2], x95, Self::mul_add(-c_q2, x87, s_q2 * x88));
-        let x102 = Self::mul_add(qd[2], x94, Self::mul_add(c_q2, x88, s_q2 * x87));
-        let x103 = qd[1] + qd[2];
-        let x104 = x103 * x103;
-        let x105 = Self::mul_add(x95, x95, x104);
-        let x106 = x94 * x95;
-        let x107 = Self::mul_add(x94, x94, x104);
-        let x108 = Self::mul_add(x94, x103, x102);
-        let x109 = Self::mul_add(x95, x103, x101);
-        let x110 = Self::mul_add(x95, -103.41030072000001, 0.8021 * x103);
-        let x111 = Self::mul_add(
+        let x91 = Self::mul_add(s_q2, x83, c_q2 * x82);
+        let x92 = Self::mul_add(-c_q2, x83, s_q2 * x82);
+        let x93 = Self::mul_add(-0.1524, x87, 6.377 * Self::mul_add(x83, x83, x86));
+        let x94 = Self::mul_add(-0.1524, Self::mul_add(x82, x82, x86), 6.377 * x87);
+        let x95 = Self::mul_add(0.1524, x84 + x84, 6.377 * (x85 + x85));
+        let x96 = Self::mul_add(-s_q2, x94, c_q2 * x93);
+        let x97 = Self::mul_add(c_q2, x94, s_q2 * x93);
+        let x98 = Self::mul_add(-qd[2], x92, Self::mul_add(-s_q2, x85, c_q2 * x84));
+        let x99 = Self::mul_add(qd[2], x91, Self::mul_add(c_q2, x85, s_q2 * x84));
+        let x100 = qd[1] + qd[2];
+        let x101 = x100 * x100;
+        let x102 = Self::mul_add(x92, x92, x101);
+        let x103 = x91 * x92;
+        let x104 = Self::mul_add(x91, x91, x101);
+        let x105 = Self::mul_add(x91, x100, x99);
+        let x106 = Self::mul_add(-x92, x100, x98);
+        let x107 = Self::mul_add(-0.8021, x100, x92 * 103.41030072000001);
+        let x108 = Self::mul_add(
             0.08,
-            x103,
-            Self::mul_add(5594.523885531201, x95, x94 * 103.41030072000002),
+            x100,
+            Self::mul_add(5594.523885531201, x92, x91 * 103.41030072000002),
         );
-        let x112 = Self::mul_add(
-            5601.1318504688,
-            x103,
-            Self::mul_add(-0.8021, x94, 0.08 * x95),
+        let x109 = Self::mul_add(
+            -5601.1318504688,
+            x100,
+            Self::mul_add(-0.08, x92, 0.8021 * x91),
         );
-        let x113 = Self::mul_add(
-            -15.183612000000002,
-            x98,
-            Self::mul_add(
-                x102,
-                -103.41030072000001,
-                Self::mul_add(-x103, x111, x95 * x112),
-            ),
+        let x110 = Self::mul_add(
+            15.183612000000002,
+            x95,
+            Self::mul_add(x99, 103.41030072000001, Self::mul_add(x92, x109, x100 * x108)),
         );
-        let x114 = Self::mul_add(-c_q3, x94, s_q3 * x95);
-        let x115 = Self::mul_add(c_q3, x95, s_q3 * x94);
-        let x116 = x99 - Self::mul_add(0.1524, x106, 7.06 * x105);
-        let x117 = x100 - Self::mul_add(0.1524, x107, 7.06 * x106);
-        let x118 = Self::mul_add(-7.06, x108, 0.1524 * x109) - x98;
-        let x119 = Self::mul_add(-s_q3, x116, c_q3 * x117);
-        let x120 = Self::mul_add(qd[3], x115, Self::mul_add(s_q3, x102, c_q3 * x101));
-        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(-s_q3, x101, c_q3 * x102));
-        let x122 = qd[3] + x103;
-        let x123 = Self::mul_add(x122, x122, x115 * x115);
-        let x124 = x114 * x115;
-        let x125 = Self::mul_add(x114, x122, -x121);
-        let x126 = x115 * 15.380963024;
-        let x127 = 54.202167456 * x122;
-        let x128 = Self::mul_add(-s_q4, x114, c_q4 * x122);
-        let x129 = Self::mul_add(s_q4, x122, c_q4 * x114);
-        let x130 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(-0.4572, x123, Self::mul_add(s_q3, x117, c_q3 * x116)),
-            c_q4 * Self::mul_add(0.4572, x125, x118),
+        let x111 = Self::mul_add(-s_q3, x92, c_q3 * x91);
+        let x112 = Self::mul_add(c_q3, x92, s_q3 * x91);
+        let x113 = x96 + Self::mul_add(0.1524, x103, 7.06 * x102);
+        let x114 = x97 - Self::mul_add(0.1524, x104, 7.06 * x103);
+        let x115 = x95 + Self::mul_add(0.1524, x106, 7.06 * x105);
+        let x116 = Self::mul_add(c_q3, x114, s_q3 * x113);
+        let x117 = Self::mul_add(-qd[3], x112, Self::mul_add(-s_q3, x99, c_q3 * x98));
+        let x118 = Self::mul_add(qd[3], x111, Self::mul_add(c_q3, x99, s_q3 * x98));
+        let x119 = qd[3] + x100;
+        let x120 = Self::mul_add(x119, x119, x112 * x112);
+        let x121 = x111 * x112;
+        let x122 = Self::mul_add(x111, x119, x118);
+        let x123 = x112 * 15.380963024;
+        let x124 = 54.202167456 * x119;
+        let x125 = Self::mul_add(c_q4, x119, s_q4 * x111);
+        let x126 = Self::mul_add(-s_q4, x119, c_q4 * x111);
+        let x127 = Self::mul_add(
+            -c_q4,
+            Self::mul_add(0.4572, x122, x115),
+            s_q4 * Self::mul_add(0.4572, x120, Self::mul_add(-s_q3, x114, c_q3 * x113)),
         );
-        let x131 = Self::mul_add(qd[4], x129, s_q4 * x120);
-        let x132 = Self::mul_add(qd[4], x128, c_q4 * x120);
-        let x133 = qd[4] - x115;
-        let x134 = 34.45002 * Self::mul_add(-x128, x129, x121);
-        let x135 = 34.45002 * Self::mul_add(x128, x128, x133 * x133);
-        let x136 = 34.45002 * Self::mul_add(x129, x133, x131);
-        let x137 = x129 * 34.33891524;
-        let x138 = 34.74691524 * x133;
-        let x139 = Self::mul_add(s_q5, x133, c_q5 * x128);
-        let x140 = Self::mul_add(-s_q5, x128, c_q5 * x133);
-        let x141 = Self::mul_add(qd[5], x140, -Self::mul_add(s_q5, x121, c_q5 * x131));
-        let x142 = Self::mul_add(-qd[5], x139, Self::mul_add(-c_q5, x121, s_q5 * x131));
-        let x143 = qd[5] + x129;
-        let x144 = Self::mul_add(0.385, x143, 0.353 * x140);
+        let x128 = Self::mul_add(qd[4], x126, s_q4 * x117);
+        let x129 = Self::mul_add(-qd[4], x125, c_q4 * x117);
+        let x130 = qd[4] - x112;
+        let x131 = 34.45002 * Self::mul_add(x125, x126, x118);
+        let x132 = 34.45002 * Self::mul_add(x125, x125, x130 * x130);
+        let x133 = 34.45002 * Self::mul_add(x126, x130, x128);
+        let x134 = x126 * 34.33891524;
+        let x135 = 34.74691524 * x130;
+        let x136 = Self::mul_add(s_q5, x130, c_q5 * x125);
+        let x137 = Self::mul_add(-c_q5, x130, s_q5 * x125);
+        let x138 = Self::mul_add(-qd[5], x137, Self::mul_add(-s_q5, x118, c_q5 * x128));
+        let x139 = Self::mul_add(qd[5], x136, Self::mul_add(c_q5, x118, s_q5 * x128));
+        let x140 = qd[5] - x126;
+        let x141 = Self::mul_add(-0.385, x140, 0.353 * x137);
+        let x142 = Self::mul_add(
+            0.966,
+            x140,
+            Self::mul_add(0.9929999999999999, x137, 0.353 * x136),
+        );
+        let x143 = Self::mul_add(1.903, x140, Self::mul_add(-0.966, x137, 0.385 * x136));
+        let x144 = Self::mul_add(0.385, x129, 0.353 * x139)
+            + Self::mul_add(x137, x143, x140 * x142);
         let x145 = Self::mul_add(
-            0.966,
-            x143,
-            Self::mul_add(-0.9929999999999999, x140, 0.353 * x139),
+            -0.966,
+            x129,
+            Self::mul_add(0.9929999999999999, x139, 0.353 * x138),
+        ) - Self::mul_add(x136, x143, x140 * x141);
+        let x146 = Self::mul_add(-1.903, x129, Self::mul_add(-0.966, x139, 0.385 * x138))
+            - Self::mul_add(-x136, x142, x137 * x141);
+        let x147 = Self::mul_add(
+            34.45002,
+            Self::mul_add(-0.4572, x121, x116),
+            Self::mul_add(x126, x135, x130 * x134),
+        ) - Self::mul_add(s_q5, x145, c_q5 * x144);
+        let x148 = Self::mul_add(x125, x135, x129 * 34.33891524) + x146;
+        let x149 = Self::mul_add(
+            -34.45002,
+            x127,
+            Self::mul_add(x125, x134, 34.74691524 * x118),
+        ) + Self::mul_add(-c_q5, x145, s_q5 * x144);
+        let x150 = Self::mul_add(s_q4, x132, c_q4 * x131);
+        let x151 = Self::mul_add(
+            41.67378,
+            x120,
+            -Self::mul_add(-c_q4, x132, s_q4 * x131),
         );
-        let x146 = Self::mul_add(1.903, x143, Self::mul_add(0.966, x140, 0.385 * x139));
-        let x147 = Self::mul_add(0.385, x132, 0.353 * x142)
-            + Self::mul_add(-x143, x145, x140 * x146);
-        let x148 = Self::mul_add(
-            0.966,
-            x132,
-            Self::mul_add(-0.9929999999999999, x142, 0.353 * x141),
-        ) + Self::mul_add(-x139, x146, x143 * x144);
-        let x149 = Self::mul_add(1.903, x132, Self::mul_add(0.966, x142, 0.385 * x141))
-            + Self::mul_add(-x140, x144, x139 * x145);
-        let x150 = Self::mul_add(
-            34.45002,
-            Self::mul_add(0.4572, x124, x119),
-            -Self::mul_add(x129, x138, x133 * x137),
-        ) + Self::mul_add(-s_q5, x148, c_q5 * x147);
-        let x151 = Self::mul_add(-x128, x138, x132 * 34.33891524) - x149;
-        let x152 = Self::mul_add(
-            34.45002,
-            x130,
-            Self::mul_add(-34.74691524, x121, x128 * x137),
-        ) + Self::mul_add(c_q5, x148, s_q5 * x147);
-        let x153 = Self::mul_add(s_q4, x135, c_q4 * x134);
-        let x154 = Self::mul_add(
+        let x152 = Self::mul_add(41.67378, x121, -x133);
+        let x153 = Self::mul_add(41.67378, x122, x150);
+        let x154 = Self::mul_add(x112, x124, x119 * x123)
+            - Self::mul_add(-c_q4, x148, s_q4 * x147);
+        let x155 = Self::mul_add(
             -41.67378,
-            x123,
-            Self::mul_add(-c_q4, x135, s_q4 * x134),
-        );
-        let x155 = Self::mul_add(41.67378, x124, -x136);
-        let x156 = Self::mul_add(41.67378, x125, -x153);
-        let x157 = Self::mul_add(x115, x127, x122 * x126)
-            - Self::mul_add(c_q4, x151, s_q4 * x150);
-        let x158 = Self::mul_add(0.4572, x153, -x152)
-            - Self::mul_add(
-                41.67378,
-                x118,
-                Self::mul_add(x114, x127, x121 * 15.380963024),
-            );
-        let x159 = Self::mul_add(-x114, x126, 41.67378 * x119)
-            + Self::mul_add(-0.4572, x136, Self::mul_add(-s_q4, x151, c_q4 * x150));
-        let x160 = Self::mul_add(-s_q3, x155, c_q3 * x154);
-        let x161 = Self::mul_add(c_q3, x155, s_q3 * x154);
-        let x162 = x160
-            - Self::mul_add(15.183612000000002, x106, 703.3878000000001 * x105);
-        let x163 = x161
-            - Self::mul_add(15.183612000000002, x107, 703.3878000000001 * x106);
-        let x164 = Self::mul_add(-703.3878000000001, x108, 15.183612000000002 * x109)
-            + x156;
-        let x165 = x113
-            + Self::mul_add(0.1524, x156, Self::mul_add(-s_q3, x158, c_q3 * x157));
-        let x166 = Self::mul_add(
+            x115,
+            Self::mul_add(-x111, x124, x118 * 15.380963024),
+        ) - Self::mul_add(0.4572, x150, x149);
+        let x156 = Self::mul_add(41.67378, x116, x111 * x123)
+            + Self::mul_add(0.4572, x133, Self::mul_add(s_q4, x148, c_q4 * x147));
+        let x157 = Self::mul_add(-s_q3, x152, c_q3 * x151);
+        let x158 = Self::mul_add(c_q3, x152, s_q3 * x151);
+        let x159 = Self::mul_add(15.183612000000002, x103, 703.3878000000001 * x102)
+            + x157;
+        let x160 = Self::mul_add(15.183612000000002, x104, 703.3878000000001 * x103)
+            + x158;
+        let x161 = Self::mul_add(15.183612000000002, x106, 703.3878000000001 * x105)
+            + x153;
+        let x162 = x110
+            - Self::mul_add(-0.1524, x153, Self::mul_add(s_q3, x155, c_q3 * x154));
+        let x163 = Self::mul_add(
             703.3878000000001,
-            x98,
-            Self::mul_add(x101, -103.41030072000002, 5594.523885531201 * x102)
-                + Self::mul_add(x94, x112, x103 * x110),
-        ) + Self::mul_add(-7.06, x156, Self::mul_add(c_q3, x158, s_q3 * x157));
-        let x167 = Self::mul_add(0.08, x102, 0.8021 * x101)
-            - Self::mul_add(x94, x111, x95 * x110)
-            + Self::mul_add(-15.183612000000002, x99, 703.3878000000001 * x100)
-            + (x159 + Self::mul_add(-0.1524, x160, 7.06 * x161));
-        let x168 = Self::mul_add(
-            c_q1,
-            Self::mul_add(8596.210051042, x88, x87 * 190.97044034000004)
-                + Self::mul_add(x85, x93, qd[1] * x91)
-                + Self::mul_add(-6.377, x164, Self::mul_add(c_q2, x166, s_q2 * x165)),
+            x95,
+            Self::mul_add(5594.523885531201, x99, x98 * 103.41030072000002)
+                - Self::mul_add(x91, x109, x100 * x107),
+        ) + Self::mul_add(7.06, x153, Self::mul_add(-c_q3, x155, s_q3 * x154));
+        let x164 = Self::mul_add(-0.08, x99, 0.8021 * x98)
+            - Self::mul_add(-x91, x108, x92 * x107)
+            - Self::mul_add(703.3878000000001, x97, 15.183612000000002 * x96)
+            - (x156 + Self::mul_add(-7.06, x158, 0.1524 * x157));
+        let x165 = Self::mul_add(
+            -c_q1,
+            Self::mul_add(8596.210051042, x85, x84 * 190.97044034000004)
+                + Self::mul_add(x82, x90, qd[1] * x88)
+                - Self::mul_add(-6.377, x161, Self::mul_add(-c_q2, x163, s_q2 * x162)),
             s_q1
-                * (Self::mul_add(0.1524, x164, Self::mul_add(-s_q2, x166, c_q2 * x165))
-                    - Self::mul_add(
-                        x88,
-                        190.97044034,
-                        Self::mul_add(x86, x93, qd[1] * x92),
+                * (Self::mul_add(x85, 190.97044034, Self::mul_add(x83, x90, qd[1] * x89))
+                    + Self::mul_add(
+                        0.1524,
+                        x161,
+                        Self::mul_add(s_q2, x163, c_q2 * x162),
                     )),
         );
-        let x169 = tau[0] + x168;
-        let x170 = 1.0
+        let x166 = tau[0] - x165;
+        let x167 = 1.0
             / (46.90457611680001
-                + (x68
+                + (x66
                     + Self::mul_add(
                         s_q1 * c_q1,
-                        x67 + x67,
-                        s_q1 * s_q1 * (x62 + (x44 - x57 + x62) - x68),
+                        x65 + x65,
+                        s_q1 * s_q1 * (x60 + (x42 - x55 + x60) - x66),
                     )));
-        let x171 = x69 * x170;
-        let x172 = x70 * x170;
-        let x173 = x71 * x170;
-        let x174 = x79 * x170;
-        let x175 = x84 * x170;
-        let x176 = 1.0 / Self::mul_add(-x69, x171, 8609.573807858 + (x64 + x65));
-        let x177 = Self::mul_add(-x69, x172, x65);
-        let x178 = x176 * x177;
-        let x179 = Self::mul_add(
-            -x69,
-            x173,
-            x43
+        let x168 = x67 * x167;
+        let x169 = x68 * x167;
+        let x170 = x69 * x167;
+        let x171 = x76 * x167;
+        let x172 = x81 * x167;
+        let x173 = 1.0 / Self::mul_add(-x67, x168, 8609.573807858 + (x62 + x63));
+        let x174 = Self::mul_add(-x67, x169, x63);
+        let x175 = x173 * x174;
+        let x176 = Self::mul_add(
+            -x67,
+            x170,
+            x41
                 + Self::mul_add(
-                    6.377,
-                    Self::mul_add(-s_q2, x38, c_q2 * x37),
-                    0.1524 * Self::mul_add(s_q2, x37, c_q2 * x38),
+                    -6.377,
+                    Self::mul_add(-c_q2, x35, s_q2 * x36),
+                    0.1524 * Self::mul_add(s_q2, x35, c_q2 * x36),
                 ),
         );
-        let x180 = x176 * x179;
-        let x181 = Self::mul_add(
-            -x69,
-            x174,
-            x78
-                - Self::mul_add(
-                    6.377,
-                    Self::mul_add(c_q2, x74, s_q2 * x73),
-                    0.1524 * Self::mul_add(-c_q2, x73, s_q2 * x74),
-                ),
-        );
-        let x182 = x176 * x181;
-        let x183 = Self::mul_add(-x69, x175, x81);
-        let x184 = x176 * x183;
-        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x70, x172, x52));
-        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x70, x173, x43));
-        let x187 = x185 * x186;
-        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x70, x174, x78));
-        let x189 = x185 * x188;
-        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x70, x175, x81));
-        let x191 = x185 * x190;
-        let x192 = Self::mul_add(
-            -x186,
-            x187,
-            Self::mul_add(-x179, x180, Self::mul_add(-x71, x173, x29)),
-        );
-        let x193 = 1.0 / x192;
-        let x194 = Self::mul_add(
-            -x186,
-            x189,
-            Self::mul_add(-x179, x182, Self::mul_add(-x71, x174, x18)),
-        );
-        let x195 = x193 * x194;
-        let x196 = Self::mul_add(
-            -x186,
-            x191,
-            Self::mul_add(-x179, x184, Self::mul_add(-x71, x175, x81)),
-        );
-        let x197 = x193 * x196;
-        let x198 = Self::mul_add(
-            -x188,
-            x189,
-            Self::mul_add(-x181, x182, Self::mul_add(-x79, x174, x11)),
-        );
-        let x199 = 1.0 / Self::mul_add(-x194, x195, x198);
-        let x200 = Self::mul_add(
-            -x188,
-            x191,
-            Self::mul_add(-x181, x184, Self::mul_add(-x79, x175, x10)),
-        );
-        let x201 = Self::mul_add(-x194, x197, x200);
-        let x202 = x199 * x201;
-        let x203 = Self::mul_add(
-            -x190,
-            x191,
-            Self::mul_add(-x183, x184, Self::mul_add(-x84, x175, 1.903)),
-        );
-        let x204 = 1.0 / Self::mul_add(-x201, x202, Self::mul_add(-x196, x197, x203));
-        let x205 = Self::mul_add(
-            x169,
+        let x177 = x173 * x176;
+        let x178 = Self::mul_add(
+            -x67,
             x171,
+            x75
+                + Self::mul_add(
+                    -6.377,
+                    Self::mul_add(c_q2, x71, s_q2 * x70),
+                    0.1524 * Self::mul_add(-s_q2, x71, c_q2 * x70),
+                ),
+        );
+        let x179 = x173 * x178;
+        let x180 = Self::mul_add(x67, x172, x78);
+        let x181 = x173 * x180;
+        let x182 = 1.0 / Self::mul_add(-x174, x175, Self::mul_add(-x68, x169, x50));
+        let x183 = Self::mul_add(-x174, x177, Self::mul_add(-x68, x170, x41));
+        let x184 = x182 * x183;
+        let x185 = Self::mul_add(-x174, x179, Self::mul_add(-x68, x171, x75));
+        let x186 = x182 * x185;
+        let x187 = Self::mul_add(-x174, x181, Self::mul_add(x68, x172, x78));
+        let x188 = x182 * x187;
+        let x189 = Self::mul_add(
+            -x183,
+            x184,
+            Self::mul_add(-x176, x177, Self::mul_add(-x69, x170, x27)),
+        );
+        let x190 = 1.0 / x189;
+        let x191 = Self::mul_add(
+            -x183,
+            x186,
+            Self::mul_add(-x176, x179, Self::mul_add(-x69, x171, x18)),
+        );
+        let x192 = x190 * x191;
+        let x193 = Self::mul_add(
+            -x183,
+            x188,
+            Self::mul_add(-x176, x181, Self::mul_add(x69, x172, x78)),
+        );
+        let x194 = x190 * x193;
+        let x195 = Self::mul_add(
+            -x185,
+            x186,
+            Self::mul_add(-x178, x179, Self::mul_add(-x76, x171, x11)),
+        );
+        let x196 = 1.0 / Self::mul_add(-x191, x192, x195);
+        let x197 = Self::mul_add(
+            -x185,
+            x188,
+            Self::mul_add(-x178, x181, Self::mul_add(x76, x172, x10)),
+        );
+        let x198 = Self::mul_add(-x191, x194, x197);
+        let x199 = x196 * x198;
+        let x200 = Self::mul_add(
+            -x187,
+            x188,
+            Self::mul_add(-x180, x181, Self::mul_add(-x81, x172, 1.903)),
+        );
+        let x201 = 1.0 / Self::mul_add(-x198, x199, Self::mul_add(-x193, x194, x200));
+        let x202 = Self::mul_add(
+            x166,
+            x168,
             tau[1]
-                - (Self::mul_add(0.0302, x88, x87 * 1.928)
-                    + Self::mul_add(-x85, x92, x86 * x91)
-                    + (x167
-                        + Self::mul_add(
-                            -0.1524,
-                            Self::mul_add(-s_q2, x163, c_q2 * x162),
-                            6.377 * Self::mul_add(c_q2, x163, s_q2 * x162),
+                - (Self::mul_add(0.0302, x85, x84 * 1.928)
+                    + Self::mul_add(-x82, x89, x83 * x88)
+                    - (x164
+                        - Self::mul_add(
+                            -6.377,
+                            Self::mul_add(c_q2, x160, s_q2 * x159),
+                            0.1524 * Self::mul_add(-s_q2, x160, c_q2 * x159),
                         ))),
         );
-        let x206 = Self::mul_add(-x178, x205, Self::mul_add(x169, x172, tau[2] - x167));
+        let x203 = Self::mul_add(-x175, x202, Self::mul_add(x166, x169, tau[2] + x164));
+        let x204 = Self::mul_add(
+            -x184,
+            x203,
+            Self::mul_add(-x177, x202, Self::mul_add(x166, x170, tau[3] - x156)),
+        );
+        let x205 = Self::mul_add(
+            -x186,
+            x203,
+            Self::mul_add(-x179, x202, Self::mul_add(x166, x171, tau[4] + x149)),
+        );
+        let x206 = Self::mul_add(-x192, x204, x205);
         let x207 = Self::mul_add(
-            -x187,
-            x206,
-            Self::mul_add(-x180, x205, Self::mul_add(x169, x173, tau[3] - x159)),
+            -x188,
+            x203,
+            Self::mul_add(-x181, x202, Self::mul_add(-x166, x172, tau[5] - x146)),
         );
-        let x208 = Self::mul_add(
-            -x189,
-            x206,
-            Self::mul_add(-x182, x205, Self::mul_add(x169, x174, tau[4] - x152)),
+        let x208 = x201 * Self::mul_add(-x199, x206, Self::mul_add(-x194, x204, x207));
+        let x209 = Self::mul_add(-x199, x208, x196 * x206);
+        let x210 = Self::mul_add(-x194, x208, Self::mul_add(-x192, x209, x190 * x204));
+        let x211 = Self::mul_add(
+            -x188,
+            x208,
+            Self::mul_add(-x186, x209, Self::mul_add(-x184, x210, x182 * x203)),
         );
-        let x209 = Self::mul_add(-x195, x207, x208);
-        let x210 = Self::mul_add(
-            -x191,
-            x206,
-            Self::mul_add(-x184, x205, Self::mul_add(x169, x175, tau[5] - x149)),
+        let x212 = Self::mul_add(
+            -x179,
+            x209,
+            Self::mul_add(-x177, x210, Self::mul_add(-x175, x211, x173 * x202)),
         );
-        let x211 = x204 * Self::mul_add(-x202, x209, Self::mul_add(-x197, x207, x210));
-        let x212 = Self::mul_add(-x202, x211, x199 * x209);
-        let x213 = Self::mul_add(-x197, x211, Self::mul_add(-x195, x212, x193 * x207));
+        let x213 = Self::mul_add(-x181, x208, x212);
         let x214 = Self::mul_add(
-            -x191,
-            x211,
-            Self::mul_add(-x189, x212, Self::mul_add(-x187, x213, x185 * x206)),
+            x170,
+            x210,
+            Self::mul_add(x169, x211, Self::mul_add(x168, x213, x166 * x167)),
         );
-        let x215 = Self::mul_add(
-            -x182,
-            x212,
-            Self::mul_add(-x180, x213, Self::mul_add(-x178, x214, x176 * x205)),
-        );
-        let x216 = Self::mul_add(-x184, x211, x215);
-        let x217 = Self::mul_add(
-            x173,
-            x213,
-            Self::mul_add(x172, x214, Self::mul_add(x171, x216, x169 * x170)),
-        );
-        let x218 = Self::mul_add(x175, x211, Self::mul_add(x174, x212, x217));
-        [x218, x216, x214, x213, x212, x211]
+        let x215 = Self::mul_add(-x172, x208, Self::mul_add(x171, x209, x214));
+        [x215, x213, x211, x210, x209, x208]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 338 mul, 272 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 174 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 338 mul, 271 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 175 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 6],
@@ -2071,306 +2065,303 @@ impl Srms {
         let x16 = Self::mul_add(x13, x15, x12 * x14);
         let x17 = -32.43591524 - x16;
         let x18 = Self::mul_add(s_q4, x10, c_q4 * x8);
-        let x19 = s_q4 * x8;
-        let x20 = c_q4 * x10;
-        let x21 = x19 - x20;
-        let x22 = s_q4 * 34.45002;
-        let x23 = c_q4 * 34.45002;
-        let x24 = 0.4572 * x23;
-        let x25 = x11 + x24;
-        let x26 = Self::mul_add(0.4572, x22, Self::mul_add(-x13, x14, x12 * x15) - x9);
-        let x27 = 41.67378 + x23;
-        let x28 = -15.380963024 + (x24 + x25);
-        let x29 = 54.202167456 + (x24 + (x16 - x7 + x24));
-        let x30 = s_q3 * s_q3;
-        let x31 = s_q3 * c_q3;
-        let x32 = x17 - x28;
-        let x33 = x21 + x21;
-        let x34 = Self::mul_add(x31, x33, x30 * x32);
-        let x35 = Self::mul_add(-c_q3, x26, s_q3 * x18);
-        let x36 = Self::mul_add(c_q3, x18, s_q3 * x26);
-        let x37 = c_q3 * x27;
-        let x38 = s_q3 * x27;
-        let x39 = 0.1524 * x38;
-        let x40 = 7.06 * x37;
-        let x41 = 0.1524 * x22;
-        let x42 = x39 + x40;
-        let x43 = x29 + x42;
-        let x44 = x39 + (x17 - x34 + x39);
-        let x45 = Self::mul_add(
-            -7.06,
-            x38,
-            Self::mul_add(-0.1524, x37, x21 + Self::mul_add(-x30, x33, x31 * x32)),
+        let x19 = Self::mul_add(-c_q4, x10, s_q4 * x8);
+        let x20 = s_q4 * 34.45002;
+        let x21 = c_q4 * 34.45002;
+        let x22 = 0.4572 * x21;
+        let x23 = x11 + x22;
+        let x24 = Self::mul_add(-0.4572, x20, x9 + Self::mul_add(-x12, x15, x13 * x14));
+        let x25 = 41.67378 + x21;
+        let x26 = -15.380963024 + (x22 + x23);
+        let x27 = 54.202167456 + (x22 - (x7 - x16 - x22));
+        let x28 = s_q3 * s_q3;
+        let x29 = s_q3 * c_q3;
+        let x30 = x17 - x26;
+        let x31 = x19 + x19;
+        let x32 = Self::mul_add(x29, x31, x28 * x30);
+        let x33 = Self::mul_add(s_q3, x18, c_q3 * x24);
+        let x34 = Self::mul_add(-c_q3, x18, s_q3 * x24);
+        let x35 = c_q3 * x25;
+        let x36 = s_q3 * x25;
+        let x37 = 0.1524 * x36;
+        let x38 = 7.06 * x35;
+        let x39 = 0.1524 * x20;
+        let x40 = x37 + x38;
+        let x41 = x27 + x40;
+        let x42 = x37 + (x17 - x32 + x37);
+        let x43 = Self::mul_add(
+            7.06,
+            x36,
+            -Self::mul_add(-0.1524, x35, x19 + Self::mul_add(-x28, x31, x29 * x30)),
         );
-        let x46 = 703.3878000000001 + x37;
-        let x47 = 15.183612000000002 + x38;
-        let x48 = -103.41030072000001 + x45;
-        let x49 = 0.8021 + Self::mul_add(-7.06, x22, x35);
-        let x50 = 5594.523885531201 + (x40 + (x28 + x34 + x40));
-        let x51 = 0.08 - (x36 + x41);
-        let x52 = 5601.1318504688 + (x42 + x43);
-        let x53 = s_q2 * s_q2;
-        let x54 = s_q2 * c_q2;
-        let x55 = x44 - x50;
-        let x56 = x48 + x48;
-        let x57 = Self::mul_add(x54, x56, x53 * x55);
-        let x58 = Self::mul_add(-s_q2, x51, c_q2 * x49);
-        let x59 = Self::mul_add(c_q2, x51, s_q2 * x49);
-        let x60 = Self::mul_add(-s_q2, x47, c_q2 * x46);
-        let x61 = Self::mul_add(c_q2, x47, s_q2 * x46);
-        let x62 = 0.1524 * x61;
-        let x63 = 6.377 * x60;
-        let x64 = x62 + x63;
-        let x65 = x52 + x64;
-        let x66 = Self::mul_add(
-            -6.377,
-            x61,
-            Self::mul_add(-0.1524, x60, x48 + Self::mul_add(-x53, x56, x54 * x55)),
+        let x44 = 703.3878000000001 + x35;
+        let x45 = 15.183612000000002 + x36;
+        let x46 = -103.41030072000001 - x43;
+        let x47 = 0.8021 + Self::mul_add(-7.06, x20, x33);
+        let x48 = 5594.523885531201 + (x38 + (x26 + x32 + x38));
+        let x49 = 0.08 + (x34 - x39);
+        let x50 = 5601.1318504688 + (x40 + x41);
+        let x51 = s_q2 * s_q2;
+        let x52 = s_q2 * c_q2;
+        let x53 = x42 - x48;
+        let x54 = x46 + x46;
+        let x55 = Self::mul_add(x52, x54, x51 * x53);
+        let x56 = Self::mul_add(-s_q2, x49, c_q2 * x47);
+        let x57 = Self::mul_add(c_q2, x49, s_q2 * x47);
+        let x58 = Self::mul_add(-s_q2, x45, c_q2 * x44);
+        let x59 = Self::mul_add(c_q2, x45, s_q2 * x44);
+        let x60 = 0.1524 * x59;
+        let x61 = 6.377 * x58;
+        let x62 = x60 + x61;
+        let x63 = x50 + x62;
+        let x64 = Self::mul_add(
+            6.377,
+            x59,
+            -Self::mul_add(-0.1524, x58, x46 + Self::mul_add(-x51, x54, x52 * x53)),
         );
-        let x67 = -190.97044034 + x66;
-        let x68 = 8596.210051042 + (x63 + (x50 + x57 + x63));
-        let x69 = 8609.573807858 + (x64 + x65);
-        let x70 = -Self::mul_add(
+        let x65 = -190.97044034 - x64;
+        let x66 = 8596.210051042 + (x61 + (x48 + x55 + x61));
+        let x67 = 8609.573807858 + (x62 + x63);
+        let x68 = -Self::mul_add(
             c_q1,
-            0.0302 + (x59 - x41),
-            s_q1 * (-1.928 + Self::mul_add(-6.377, x22, x58)),
+            0.0302 - (x39 - x57),
+            s_q1 * (-1.928 + Self::mul_add(-6.377, x20, x56)),
         );
-        let x71 = 46.90457611680001
-            + (x68
+        let x69 = 46.90457611680001
+            + (x66
                 + Self::mul_add(
                     s_q1 * c_q1,
-                    x67 + x67,
-                    s_q1 * s_q1 * (x62 + (x44 - x57 + x62) - x68),
+                    x65 + x65,
+                    s_q1 * s_q1 * (x60 + (x42 - x55 + x60) - x66),
                 ));
-        let x72 = -Self::mul_add(c_q1, x59, s_q1 * x58);
-        let x73 = x43
+        let x70 = -Self::mul_add(c_q1, x57, s_q1 * x56);
+        let x71 = x41
             + Self::mul_add(
-                6.377,
-                Self::mul_add(-s_q2, x38, c_q2 * x37),
-                0.1524 * Self::mul_add(s_q2, x37, c_q2 * x38),
+                -6.377,
+                Self::mul_add(-c_q2, x35, s_q2 * x36),
+                0.1524 * Self::mul_add(s_q2, x35, c_q2 * x36),
             );
-        let x74 = -Self::mul_add(
+        let x72 = -Self::mul_add(
             c_q1,
-            Self::mul_add(-c_q2, x36, s_q2 * x35),
-            s_q1 * Self::mul_add(s_q2, x36, c_q2 * x35),
+            Self::mul_add(c_q2, x34, s_q2 * x33),
+            s_q1 * Self::mul_add(-s_q2, x34, c_q2 * x33),
         );
-        let x75 = x20 - x19;
-        let x76 = c_q3 * x22;
-        let x77 = s_q3 * x22;
-        let x78 = 0.1524 * x23;
-        let x79 = Self::mul_add(s_q3, x25, c_q3 * x75) + x78;
-        let x80 = Self::mul_add(-7.06, x23, Self::mul_add(-c_q3, x25, s_q3 * x75));
-        let x81 = x18 + Self::mul_add(-7.06, x77, 0.1524 * x76);
-        let x82 = x81
-            - Self::mul_add(
-                6.377,
-                Self::mul_add(c_q2, x77, s_q2 * x76),
-                0.1524 * Self::mul_add(-c_q2, x76, s_q2 * x77),
+        let x73 = c_q3 * x20;
+        let x74 = s_q3 * x20;
+        let x75 = 0.1524 * x21;
+        let x76 = Self::mul_add(-s_q3, x23, c_q3 * x19) - x75;
+        let x77 = Self::mul_add(7.06, x21, Self::mul_add(c_q3, x23, s_q3 * x19));
+        let x78 = x18 + Self::mul_add(-7.06, x74, 0.1524 * x73);
+        let x79 = x78
+            + Self::mul_add(
+                -6.377,
+                Self::mul_add(c_q2, x74, s_q2 * x73),
+                0.1524 * Self::mul_add(-s_q2, x74, c_q2 * x73),
             );
-        let x83 = Self::mul_add(
-            c_q1,
-            Self::mul_add(-6.377, x23, Self::mul_add(c_q2, x80, s_q2 * x79)),
-            s_q1 * (x78 + Self::mul_add(-s_q2, x80, c_q2 * x79)),
+        let x80 = Self::mul_add(
+            -c_q1,
+            Self::mul_add(6.377, x21, Self::mul_add(c_q2, x77, s_q2 * x76)),
+            s_q1 * (x75 - Self::mul_add(-s_q2, x77, c_q2 * x76)),
         );
-        let x84 = -x83;
-        let x85 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x86 = Self::mul_add(1.903, s_q4, c_q4 * x9);
-        let x87 = Self::mul_add(s_q3, x10, c_q3 * x85);
-        let x88 = Self::mul_add(-c_q3, x10, s_q3 * x85);
-        let x89 = -Self::mul_add(
+        let x81 = -x80;
+        let x82 = Self::mul_add(-1.903, c_q4, s_q4 * x9);
+        let x83 = Self::mul_add(1.903, s_q4, c_q4 * x9);
+        let x84 = Self::mul_add(-s_q3, x10, c_q3 * x82);
+        let x85 = Self::mul_add(c_q3, x10, s_q3 * x82);
+        let x86 = Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x88, s_q2 * x87),
-            s_q1 * Self::mul_add(-s_q2, x88, c_q2 * x87),
+            Self::mul_add(c_q2, x85, s_q2 * x84),
+            s_q1 * Self::mul_add(-s_q2, x85, c_q2 * x84),
         );
-        let x90 = qd[0] * s_q1;
-        let x91 = qd[0] * c_q1;
-        let x92 = qd[1] * x91;
-        let x93 = qd[1] * x90;
-        let x94 = qd[1] * qd[1];
-        let x95 = x90 * x91;
-        let x96 = Self::mul_add(qd[1], -1.928, x91 * 190.97044034);
-        let x97 = Self::mul_add(
+        let x87 = qd[0] * s_q1;
+        let x88 = qd[0] * c_q1;
+        let x89 = qd[1] * x88;
+        let x90 = qd[1] * x87;
+        let x91 = qd[1] * qd[1];
+        let x92 = x87 * x88;
+        let x93 = Self::mul_add(qd[1], -1.928, x88 * 190.97044034);
+        let x94 = Self::mul_add(
             0.0302,
             qd[1],
-            Self::mul_add(-8596.210051042, x91, x90 * 190.97044034000004),
+            Self::mul_add(-8596.210051042, x88, x87 * 190.97044034000004),
         );
-        let x98 = Self::mul_add(
+        let x95 = Self::mul_add(
             8609.573807858,
             qd[1],
-            Self::mul_add(-0.0302, x91, x90 * 1.928),
+            Self::mul_add(-0.0302, x88, x87 * 1.928),
         );
-        let x99 = Self::mul_add(s_q2, x91, c_q2 * x90);
-        let x100 = Self::mul_add(-c_q2, x91, s_q2 * x90);
-        let x101 = Self::mul_add(-6.377, Self::mul_add(x91, x91, x94), 0.1524 * x95);
-        let x102 = Self::mul_add(-0.1524, Self::mul_add(x90, x90, x94), 6.377 * x95);
-        let x103 = Self::mul_add(0.1524, x92 + x92, 6.377 * (x93 + x93));
-        let x104 = Self::mul_add(s_q2, x102, c_q2 * x101);
-        let x105 = Self::mul_add(-s_q2, x101, c_q2 * x102);
-        let x106 = Self::mul_add(qd[2], x100, Self::mul_add(-c_q2, x92, s_q2 * x93));
-        let x107 = Self::mul_add(qd[2], x99, Self::mul_add(c_q2, x93, s_q2 * x92));
-        let x108 = qd[1] + qd[2];
-        let x109 = x108 * x108;
-        let x110 = Self::mul_add(x100, x100, x109);
-        let x111 = x99 * x100;
-        let x112 = Self::mul_add(x99, x99, x109);
-        let x113 = Self::mul_add(x99, x108, x107);
-        let x114 = Self::mul_add(x100, x108, x106);
-        let x115 = Self::mul_add(x100, -103.41030072000001, 0.8021 * x108);
-        let x116 = Self::mul_add(
+        let x96 = Self::mul_add(s_q2, x88, c_q2 * x87);
+        let x97 = Self::mul_add(-c_q2, x88, s_q2 * x87);
+        let x98 = Self::mul_add(-0.1524, x92, 6.377 * Self::mul_add(x88, x88, x91));
+        let x99 = Self::mul_add(-0.1524, Self::mul_add(x87, x87, x91), 6.377 * x92);
+        let x100 = Self::mul_add(0.1524, x89 + x89, 6.377 * (x90 + x90));
+        let x101 = Self::mul_add(-s_q2, x99, c_q2 * x98);
+        let x102 = Self::mul_add(c_q2, x99, s_q2 * x98);
+        let x103 = Self::mul_add(-qd[2], x97, Self::mul_add(-s_q2, x90, c_q2 * x89));
+        let x104 = Self::mul_add(qd[2], x96, Self::mul_add(c_q2, x90, s_q2 * x89));
+        let x105 = qd[1] + qd[2];
+        let x106 = x105 * x105;
+        let x107 = Self::mul_add(x97, x97, x106);
+        let x108 = x96 * x97;
+        let x109 = Self::mul_add(x96, x96, x106);
+        let x110 = Self::mul_add(x96, x105, x104);
+        let x111 = Self::mul_add(-x97, x105, x103);
+        let x112 = Self::mul_add(-0.8021, x105, x97 * 103.41030072000001);
+        let x113 = Self::mul_add(
             0.08,
-            x108,
-            Self::mul_add(5594.523885531201, x100, x99 * 103.41030072000002),
+            x105,
+            Self::mul_add(5594.523885531201, x97, x96 * 103.41030072000002),
         );
-        let x117 = Self::mul_add(
-            5601.1318504688,
-            x108,
-            Self::mul_add(-0.8021, x99, 0.08 * x100),
+        let x114 = Self::mul_add(
+            -5601.1318504688,
+            x105,
+            Self::mul_add(-0.08, x97, 0.8021 * x96),
         );
-        let x118 = Self::mul_add(
-            -15.183612000000002,
-            x103,
+        let x115 = Self::mul_add(
+            15.183612000000002,
+            x100,
             Self::mul_add(
-                x107,
-                -103.41030072000001,
-                Self::mul_add(-x108, x116, x100 * x117),
+                x104,
+                103.41030072000001,
+                Self::mul_add(x97, x114, x105 * x113),
             ),
         );
-        let x119 = Self::mul_add(-c_q3, x99, s_q3 * x100);
-        let x120 = Self::mul_add(c_q3, x100, s_q3 * x99);
-        let x121 = x104 - Self::mul_add(0.1524, x111, 7.06 * x110);
-        let x122 = x105 - Self::mul_add(0.1524, x112, 7.06 * x111);
-        let x123 = Self::mul_add(-7.06, x113, 0.1524 * x114) - x103;
-        let x124 = Self::mul_add(-s_q3, x121, c_q3 * x122);
-        let x125 = Self::mul_add(qd[3], x120, Self::mul_add(s_q3, x107, c_q3 * x106));
-        let x126 = Self::mul_add(-qd[3], x119, Self::mul_add(-s_q3, x106, c_q3 * x107));
-        let x127 = qd[3] + x108;
-        let x128 = Self::mul_add(x127, x127, x120 * x120);
-        let x129 = x119 * x120;
-        let x130 = Self::mul_add(x119, x127, -x126);
-        let x131 = x120 * 15.380963024;
-        let x132 = 54.202167456 * x127;
-        let x133 = Self::mul_add(-s_q4, x119, c_q4 * x127);
-        let x134 = Self::mul_add(s_q4, x127, c_q4 * x119);
-        let x135 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(-0.4572, x128, Self::mul_add(s_q3, x122, c_q3 * x121)),
-            c_q4 * Self::mul_add(0.4572, x130, x123),
+        let x116 = Self::mul_add(-s_q3, x97, c_q3 * x96);
+        let x117 = Self::mul_add(c_q3, x97, s_q3 * x96);
+        let x118 = x101 + Self::mul_add(0.1524, x108, 7.06 * x107);
+        let x119 = x102 - Self::mul_add(0.1524, x109, 7.06 * x108);
+        let x120 = x100 + Self::mul_add(0.1524, x111, 7.06 * x110);
+        let x121 = Self::mul_add(c_q3, x119, s_q3 * x118);
+        let x122 = Self::mul_add(-qd[3], x117, Self::mul_add(-s_q3, x104, c_q3 * x103));
+        let x123 = Self::mul_add(qd[3], x116, Self::mul_add(c_q3, x104, s_q3 * x103));
+        let x124 = qd[3] + x105;
+        let x125 = Self::mul_add(x124, x124, x117 * x117);
+        let x126 = x116 * x117;
+        let x127 = Self::mul_add(x116, x124, x123);
+        let x128 = x117 * 15.380963024;
+        let x129 = 54.202167456 * x124;
+        let x130 = Self::mul_add(c_q4, x124, s_q4 * x116);
+        let x131 = Self::mul_add(-s_q4, x124, c_q4 * x116);
+        let x132 = Self::mul_add(
+            -c_q4,
+            Self::mul_add(0.4572, x127, x120),
+            s_q4 * Self::mul_add(0.4572, x125, Self::mul_add(-s_q3, x119, c_q3 * x118)),
         );
-        let x136 = Self::mul_add(qd[4], x134, s_q4 * x125);
-        let x137 = Self::mul_add(qd[4], x133, c_q4 * x125);
-        let x138 = qd[4] - x120;
-        let x139 = 34.45002 * Self::mul_add(-x133, x134, x126);
-        let x140 = 34.45002 * Self::mul_add(x133, x133, x138 * x138);
-        let x141 = 34.45002 * Self::mul_add(x134, x138, x136);
-        let x142 = x134 * 34.33891524;
-        let x143 = 34.74691524 * x138;
-        let x144 = Self::mul_add(s_q5, x138, c_q5 * x133);
-        let x145 = Self::mul_add(-s_q5, x133, c_q5 * x138);
-        let x146 = Self::mul_add(qd[5], x145, -Self::mul_add(s_q5, x126, c_q5 * x136));
-        let x147 = Self::mul_add(-qd[5], x144, Self::mul_add(-c_q5, x126, s_q5 * x136));
-        let x148 = qd[5] + x134;
-        let x149 = Self::mul_add(0.385, x148, 0.353 * x145);
+        let x133 = Self::mul_add(qd[4], x131, s_q4 * x122);
+        let x134 = Self::mul_add(-qd[4], x130, c_q4 * x122);
+        let x135 = qd[4] - x117;
+        let x136 = 34.45002 * Self::mul_add(x130, x131, x123);
+        let x137 = 34.45002 * Self::mul_add(x130, x130, x135 * x135);
+        let x138 = 34.45002 * Self::mul_add(x131, x135, x133);
+        let x139 = x131 * 34.33891524;
+        let x140 = 34.74691524 * x135;
+        let x141 = Self::mul_add(s_q5, x135, c_q5 * x130);
+        let x142 = Self::mul_add(-c_q5, x135, s_q5 * x130);
+        let x143 = Self::mul_add(-qd[5], x142, Self::mul_add(-s_q5, x123, c_q5 * x133));
+        let x144 = Self::mul_add(qd[5], x141, Self::mul_add(c_q5, x123, s_q5 * x133));
+        let x145 = qd[5] - x131;
+        let x146 = Self::mul_add(-0.385, x145, 0.353 * x142);
+        let x147 = Self::mul_add(
+            0.966,
+            x145,
+            Self::mul_add(0.9929999999999999, x142, 0.353 * x141),
+        );
+        let x148 = Self::mul_add(1.903, x145, Self::mul_add(-0.966, x142, 0.385 * x141));
+        let x149 = Self::mul_add(0.385, x134, 0.353 * x144)
+            + Self::mul_add(x142, x148, x145 * x147);
         let x150 = Self::mul_add(
-            0.966,
-            x148,
-            Self::mul_add(-0.9929999999999999, x145, 0.353 * x144),
-        );
-        let x151 = Self::mul_add(1.903, x148, Self::mul_add(0.966, x145, 0.385 * x144));
-        let x152 = Self::mul_add(0.385, x137, 0.353 * x147)
-            + Self::mul_add(-x148, x150, x145 * x151);
-        let x153 = Self::mul_add(
-            0.966,
-            x137,
-            Self::mul_add(-0.9929999999999999, x147, 0.353 * x146),
-        ) + Self::mul_add(-x144, x151, x148 * x149);
-        let x154 = Self::mul_add(1.903, x137, Self::mul_add(0.966, x147, 0.385 * x146))
-            + Self::mul_add(-x145, x149, x144 * x150);
-        let x155 = Self::mul_add(
+            -0.966,
+            x134,
+            Self::mul_add(0.9929999999999999, x144, 0.353 * x143),
+        ) - Self::mul_add(x141, x148, x145 * x146);
+        let x151 = Self::mul_add(-1.903, x134, Self::mul_add(-0.966, x144, 0.385 * x143))
+            - Self::mul_add(-x141, x147, x142 * x146);
+        let x152 = Self::mul_add(
             34.45002,
-            Self::mul_add(0.4572, x129, x124),
-            -Self::mul_add(x134, x143, x138 * x142),
-        ) + Self::mul_add(-s_q5, x153, c_q5 * x152);
-        let x156 = Self::mul_add(-x133, x143, x137 * 34.33891524) - x154;
+            Self::mul_add(-0.4572, x126, x121),
+            Self::mul_add(x131, x140, x135 * x139),
+        ) - Self::mul_add(s_q5, x150, c_q5 * x149);
+        let x153 = Self::mul_add(x130, x140, x134 * 34.33891524) + x151;
+        let x154 = Self::mul_add(
+            -34.45002,
+            x132,
+            Self::mul_add(x130, x139, 34.74691524 * x123),
+        ) + Self::mul_add(-c_q5, x150, s_q5 * x149);
+        let x155 = -x154;
+        let x156 = Self::mul_add(s_q4, x137, c_q4 * x136);
         let x157 = Self::mul_add(
-            34.45002,
-            x135,
-            Self::mul_add(-34.74691524, x126, x133 * x142),
-        ) + Self::mul_add(c_q5, x153, s_q5 * x152);
-        let x158 = Self::mul_add(s_q4, x140, c_q4 * x139);
-        let x159 = Self::mul_add(
-            -41.67378,
-            x128,
-            Self::mul_add(-c_q4, x140, s_q4 * x139),
+            41.67378,
+            x125,
+            -Self::mul_add(-c_q4, x137, s_q4 * x136),
         );
-        let x160 = Self::mul_add(41.67378, x129, -x141);
-        let x161 = Self::mul_add(41.67378, x130, -x158);
-        let x162 = Self::mul_add(x120, x132, x127 * x131)
-            - Self::mul_add(c_q4, x156, s_q4 * x155);
-        let x163 = Self::mul_add(0.4572, x158, -x157)
-            - Self::mul_add(
-                41.67378,
-                x123,
-                Self::mul_add(x119, x132, x126 * 15.380963024),
-            );
-        let x164 = Self::mul_add(-x119, x131, 41.67378 * x124)
-            + Self::mul_add(-0.4572, x141, Self::mul_add(-s_q4, x156, c_q4 * x155));
-        let x165 = Self::mul_add(-s_q3, x160, c_q3 * x159);
-        let x166 = Self::mul_add(c_q3, x160, s_q3 * x159);
-        let x167 = x165
-            - Self::mul_add(15.183612000000002, x111, 703.3878000000001 * x110);
-        let x168 = x166
-            - Self::mul_add(15.183612000000002, x112, 703.3878000000001 * x111);
-        let x169 = Self::mul_add(-703.3878000000001, x113, 15.183612000000002 * x114)
-            + x161;
-        let x170 = x118
-            + Self::mul_add(0.1524, x161, Self::mul_add(-s_q3, x163, c_q3 * x162));
-        let x171 = Self::mul_add(
+        let x158 = Self::mul_add(41.67378, x126, -x138);
+        let x159 = Self::mul_add(41.67378, x127, x156);
+        let x160 = Self::mul_add(x117, x129, x124 * x128)
+            - Self::mul_add(-c_q4, x153, s_q4 * x152);
+        let x161 = Self::mul_add(
+            -41.67378,
+            x120,
+            Self::mul_add(-x116, x129, x123 * 15.380963024),
+        ) - Self::mul_add(0.4572, x156, x154);
+        let x162 = Self::mul_add(41.67378, x121, x116 * x128)
+            + Self::mul_add(0.4572, x138, Self::mul_add(s_q4, x153, c_q4 * x152));
+        let x163 = Self::mul_add(-s_q3, x158, c_q3 * x157);
+        let x164 = Self::mul_add(c_q3, x158, s_q3 * x157);
+        let x165 = Self::mul_add(15.183612000000002, x108, 703.3878000000001 * x107)
+            + x163;
+        let x166 = Self::mul_add(15.183612000000002, x109, 703.3878000000001 * x108)
+            + x164;
+        let x167 = Self::mul_add(15.183612000000002, x111, 703.3878000000001 * x110)
+            + x159;
+        let x168 = x115
+            - Self::mul_add(-0.1524, x159, Self::mul_add(s_q3, x161, c_q3 * x160));
+        let x169 = Self::mul_add(
             703.3878000000001,
-            x103,
-            Self::mul_add(x106, -103.41030072000002, 5594.523885531201 * x107)
-                + Self::mul_add(x99, x117, x108 * x115),
-        ) + Self::mul_add(-7.06, x161, Self::mul_add(c_q3, x163, s_q3 * x162));
-        let x172 = Self::mul_add(0.08, x107, 0.8021 * x106)
-            - Self::mul_add(x99, x116, x100 * x115)
-            + Self::mul_add(-15.183612000000002, x104, 703.3878000000001 * x105)
-            + (x164 + Self::mul_add(-0.1524, x165, 7.06 * x166));
-        let x173 = Self::mul_add(0.0302, x93, x92 * 1.928)
-            + Self::mul_add(-x90, x97, x91 * x96)
-            + (x172
-                + Self::mul_add(
-                    -0.1524,
-                    Self::mul_add(-s_q2, x168, c_q2 * x167),
-                    6.377 * Self::mul_add(c_q2, x168, s_q2 * x167),
+            x100,
+            Self::mul_add(5594.523885531201, x104, x103 * 103.41030072000002)
+                - Self::mul_add(x96, x114, x105 * x112),
+        ) + Self::mul_add(7.06, x159, Self::mul_add(-c_q3, x161, s_q3 * x160));
+        let x170 = Self::mul_add(-0.08, x104, 0.8021 * x103)
+            - Self::mul_add(-x96, x113, x97 * x112)
+            - Self::mul_add(703.3878000000001, x102, 15.183612000000002 * x101)
+            - (x162 + Self::mul_add(-7.06, x164, 0.1524 * x163));
+        let x171 = -x170;
+        let x172 = Self::mul_add(0.0302, x90, x89 * 1.928)
+            + Self::mul_add(-x87, x94, x88 * x93)
+            - (x170
+                - Self::mul_add(
+                    -6.377,
+                    Self::mul_add(c_q2, x166, s_q2 * x165),
+                    0.1524 * Self::mul_add(-s_q2, x166, c_q2 * x165),
                 ));
-        let x174 = Self::mul_add(
-            c_q1,
-            Self::mul_add(8596.210051042, x93, x92 * 190.97044034000004)
-                + Self::mul_add(x90, x98, qd[1] * x96)
-                + Self::mul_add(-6.377, x169, Self::mul_add(c_q2, x171, s_q2 * x170)),
+        let x173 = Self::mul_add(
+            -c_q1,
+            Self::mul_add(8596.210051042, x90, x89 * 190.97044034000004)
+                + Self::mul_add(x87, x95, qd[1] * x93)
+                - Self::mul_add(-6.377, x167, Self::mul_add(-c_q2, x169, s_q2 * x168)),
             s_q1
-                * (Self::mul_add(0.1524, x169, Self::mul_add(-s_q2, x171, c_q2 * x170))
-                    - Self::mul_add(
-                        x93,
-                        190.97044034,
-                        Self::mul_add(x91, x98, qd[1] * x97),
+                * (Self::mul_add(x90, 190.97044034, Self::mul_add(x88, x95, qd[1] * x94))
+                    + Self::mul_add(
+                        0.1524,
+                        x167,
+                        Self::mul_add(s_q2, x169, c_q2 * x168),
                     )),
         );
-        let x175 = -x174;
         (
             [
-                [x71, x70, x72, x74, x84, x89],
-                [x70, x69, x65, x73, x82, x86],
-                [x72, x65, x52, x43, x81, x86],
-                [x74, x73, x43, x29, x18, x86],
-                [x84, x82, x81, x18, x11, x10],
-                [x89, x86, x86, x86, x10, 1.903],
+                [x69, x68, x70, x72, x81, x86],
+                [x68, x67, x63, x71, x79, x83],
+                [x70, x63, x50, x41, x78, x83],
+                [x72, x71, x41, x27, x18, x83],
+                [x81, x79, x78, x18, x11, x10],
+                [x86, x83, x83, x83, x10, 1.903],
             ],
-            [x175, x173, x172, x164, x157, x154],
+            [x173, x172, x171, x162, x155, x151],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 430 mul, 377 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 430 mul, 375 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 247 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -2446,239 +2437,246 @@ impl Srms {
         let x61 = 0.1524 * x59;
         let x62 = 6.377 * x60;
         let x63 = x61 - x62;
-        let x64 = Self::mul_add(
+        let x64 = x49 - x63;
+        let x65 = Self::mul_add(
             0.1524,
             x60,
             Self::mul_add(-6.377, x59, x51 + Self::mul_add(-x52, x55, x53 * x54)),
         );
-        let x65 = x62 + (x44 - x56 + x62);
-        let x66 = 190.97044034000004 + x64;
-        let x67 = Self::mul_add(
+        let x66 = x62 + (x44 - x56 + x62);
+        let x67 = 190.97044034000004 + x65;
+        let x68 = Self::mul_add(
             -s_q1,
             -1.928 + Self::mul_add(-6.377, x21, x58),
             c_q1 * (-0.0302 + (x41 + x57)),
         );
-        let x68 = Self::mul_add(-s_q1, x58, c_q1 * x57);
-        let x69 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x34, c_q2 * x35),
-            c_q1 * Self::mul_add(-s_q2, x35, c_q2 * x34),
+        let x69 = Self::mul_add(-c_q1, x57, s_q1 * x58);
+        let x70 = Self::mul_add(
+            c_q1,
+            Self::mul_add(-c_q2, x34, s_q2 * x35),
+            s_q1 * Self::mul_add(s_q2, x34, c_q2 * x35),
         );
-        let x70 = c_q3 * x21;
-        let x71 = s_q3 * x21;
-        let x72 = x20 * 0.1524;
-        let x73 = Self::mul_add(s_q3, x24, c_q3 * x18) + x72;
-        let x74 = x19 + Self::mul_add(-7.06, x71, 0.1524 * x70);
-        let x75 = Self::mul_add(7.06, x20, Self::mul_add(-s_q3, x18, c_q3 * x24));
-        let x76 = Self::mul_add(
-            -s_q1,
-            x72 + Self::mul_add(s_q2, x75, c_q2 * x73),
-            c_q1 * Self::mul_add(6.377, x20, Self::mul_add(-s_q2, x73, c_q2 * x75)),
+        let x71 = c_q3 * x21;
+        let x72 = s_q3 * x21;
+        let x73 = x20 * 0.1524;
+        let x74 = Self::mul_add(s_q3, x24, c_q3 * x18) + x73;
+        let x75 = x19 + Self::mul_add(-7.06, x72, 0.1524 * x71);
+        let x76 = Self::mul_add(-7.06, x20, Self::mul_add(-c_q3, x24, s_q3 * x18));
+        let x77 = Self::mul_add(
+            c_q1,
+            Self::mul_add(-6.377, x20, Self::mul_add(c_q2, x76, s_q2 * x74)),
+            s_q1 * (x73 + Self::mul_add(-s_q2, x76, c_q2 * x74)),
         );
-        let x77 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
-        let x78 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
-        let x79 = Self::mul_add(s_q3, x10, c_q3 * x77);
-        let x80 = Self::mul_add(-s_q3, x77, c_q3 * x10);
-        let x81 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x80, c_q2 * x79),
-            c_q1 * Self::mul_add(-s_q2, x79, c_q2 * x80),
+        let x78 = Self::mul_add(-s_q4, x9, 1.903 * c_q4);
+        let x79 = Self::mul_add(c_q4, x9, 1.903 * s_q4);
+        let x80 = Self::mul_add(s_q3, x10, c_q3 * x78);
+        let x81 = Self::mul_add(-c_q3, x10, s_q3 * x78);
+        let x82 = Self::mul_add(
+            c_q1,
+            Self::mul_add(c_q2, x81, s_q2 * x80),
+            s_q1 * Self::mul_add(-s_q2, x81, c_q2 * x80),
         );
-        let x82 = qd[0] * s_q1;
-        let x83 = qd[0] * c_q1;
-        let x84 = qd[1] * x83;
-        let x85 = qd[1] * x82;
-        let x86 = qd[1] * qd[1];
-        let x87 = x82 * x83;
-        let x88 = Self::mul_add(
-            190.97044034,
-            x83,
-            Self::mul_add(qd[1], -1.928, x82 * 8596.210051042),
-        );
+        let x83 = qd[0] * s_q1;
+        let x84 = qd[0] * c_q1;
+        let x85 = qd[1] * x84;
+        let x86 = qd[1] * x83;
+        let x87 = qd[1] * qd[1];
+        let x88 = x83 * x84;
         let x89 = Self::mul_add(
-            x83,
+            190.97044034,
+            x84,
+            Self::mul_add(qd[1], -1.928, x83 * 8596.210051042),
+        );
+        let x90 = Self::mul_add(
+            x84,
             -0.0302,
-            Self::mul_add(8609.573807858, qd[1], x82 * 1.928),
+            Self::mul_add(8609.573807858, qd[1], x83 * 1.928),
         );
-        let x90 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x82);
-        let x91 = Self::mul_add(s_q2, x83, c_q2 * x82);
-        let x92 = Self::mul_add(-s_q2, x82, c_q2 * x83);
-        let x93 = Self::mul_add(-6.377, Self::mul_add(x83, x83, x86), 0.1524 * x87);
-        let x94 = Self::mul_add(0.1524, x84 + x84, 6.377 * (x85 + x85));
-        let x95 = Self::mul_add(-6.377, x87, 0.1524 * Self::mul_add(x82, x82, x86));
-        let x96 = Self::mul_add(-s_q2, x95, c_q2 * x93);
-        let x97 = Self::mul_add(c_q2, x95, s_q2 * x93);
-        let x98 = Self::mul_add(-qd[2], x92, Self::mul_add(-c_q2, x84, s_q2 * x85));
-        let x99 = Self::mul_add(qd[2], x91, Self::mul_add(c_q2, x85, s_q2 * x84));
-        let x100 = qd[1] + qd[2];
-        let x101 = x100 * x100;
-        let x102 = Self::mul_add(x92, x92, x101);
-        let x103 = x91 * x92;
-        let x104 = Self::mul_add(x91, x100, x99);
-        let x105 = Self::mul_add(x92, x100, -x98);
-        let x106 = Self::mul_add(x91, x91, x101);
-        let x107 = Self::mul_add(
-            103.41030072000001,
-            x92,
-            Self::mul_add(0.8021, x100, x91 * 5594.523885531201),
-        );
+        let x91 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x83);
+        let x92 = Self::mul_add(s_q2, x84, c_q2 * x83);
+        let x93 = Self::mul_add(-c_q2, x84, s_q2 * x83);
+        let x94 = Self::mul_add(-0.1524, x88, 6.377 * Self::mul_add(x84, x84, x87));
+        let x95 = Self::mul_add(0.1524, x85 + x85, 6.377 * (x86 + x86));
+        let x96 = Self::mul_add(-0.1524, Self::mul_add(x83, x83, x87), 6.377 * x88);
+        let x97 = Self::mul_add(-s_q2, x96, c_q2 * x94);
+        let x98 = Self::mul_add(c_q2, x96, s_q2 * x94);
+        let x99 = Self::mul_add(-qd[2], x93, Self::mul_add(-s_q2, x86, c_q2 * x85));
+        let x100 = Self::mul_add(qd[2], x92, Self::mul_add(c_q2, x86, s_q2 * x85));
+        let x101 = qd[1] + qd[2];
+        let x102 = x101 * x101;
+        let x103 = Self::mul_add(x93, x93, x102);
+        let x104 = x92 * x93;
+        let x105 = Self::mul_add(x92, x101, x100);
+        let x106 = Self::mul_add(-x93, x101, x99);
+        let x107 = Self::mul_add(x92, x92, x102);
         let x108 = Self::mul_add(
-            -0.08,
-            x92,
-            Self::mul_add(-0.8021, x91, 5601.1318504688 * x100),
+            -103.41030072000001,
+            x93,
+            Self::mul_add(0.8021, x101, x92 * 5594.523885531201),
         );
-        let x109 = Self::mul_add(0.08, x100, 103.41030072000002 * x91);
-        let x110 = Self::mul_add(
-            -703.3878000000001,
-            x94,
+        let x109 = Self::mul_add(
+            -0.08,
+            x93,
+            Self::mul_add(-5601.1318504688, x101, 0.8021 * x92),
+        );
+        let x110 = Self::mul_add(0.08, x101, 103.41030072000002 * x92);
+        let x111 = Self::mul_add(
+            703.3878000000001,
+            x95,
             Self::mul_add(
                 103.41030072000002,
-                x98,
-                -Self::mul_add(x91, x108, x100 * x107),
+                x99,
+                Self::mul_add(-x92, x109, x101 * x108),
             ),
         );
-        let x111 = Self::mul_add(s_q3, x92, c_q3 * x91);
-        let x112 = Self::mul_add(-s_q3, x91, c_q3 * x92);
-        let x113 = x96 + Self::mul_add(-7.06, x102, 0.1524 * x103);
-        let x114 = x94 + Self::mul_add(0.1524, x105, 7.06 * x104);
-        let x115 = x97 + Self::mul_add(-7.06, x103, 0.1524 * x106);
-        let x116 = Self::mul_add(c_q3, x115, s_q3 * x113);
-        let x117 = Self::mul_add(-qd[3], x112, Self::mul_add(s_q3, x99, c_q3 * x98));
-        let x118 = Self::mul_add(-qd[3], x111, Self::mul_add(-c_q3, x99, s_q3 * x98));
-        let x119 = qd[3] + x100;
-        let x120 = Self::mul_add(x112, x112, x119 * x119);
-        let x121 = x111 * x112;
-        let x122 = Self::mul_add(-x111, x119, x118);
-        let x123 = x111 * 18.957952216000002;
-        let x124 = 19.863252216000003 * x119;
-        let x125 = Self::mul_add(-c_q4, x111, s_q4 * x119);
-        let x126 = Self::mul_add(c_q4, x119, s_q4 * x111);
-        let x127 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(-0.4572, x120, Self::mul_add(-s_q3, x115, c_q3 * x113)),
-            c_q4 * Self::mul_add(0.4572, x122, -x114),
+        let x112 = Self::mul_add(-s_q3, x93, c_q3 * x92);
+        let x113 = Self::mul_add(c_q3, x93, s_q3 * x92);
+        let x114 = x97 + Self::mul_add(0.1524, x104, 7.06 * x103);
+        let x115 = x95 + Self::mul_add(0.1524, x106, 7.06 * x105);
+        let x116 = x98 - Self::mul_add(0.1524, x107, 7.06 * x104);
+        let x117 = Self::mul_add(c_q3, x116, s_q3 * x114);
+        let x118 = Self::mul_add(-qd[3], x113, Self::mul_add(-s_q3, x100, c_q3 * x99));
+        let x119 = Self::mul_add(qd[3], x112, Self::mul_add(c_q3, x100, s_q3 * x99));
+        let x120 = qd[3] + x101;
+        let x121 = Self::mul_add(x113, x113, x120 * x120);
+        let x122 = x112 * x113;
+        let x123 = Self::mul_add(x112, x120, x119);
+        let x124 = x112 * 18.957952216000002;
+        let x125 = 19.863252216000003 * x120;
+        let x126 = Self::mul_add(-s_q4, x120, c_q4 * x112);
+        let x127 = Self::mul_add(c_q4, x120, s_q4 * x112);
+        let x128 = Self::mul_add(
+            -c_q4,
+            Self::mul_add(0.4572, x123, x115),
+            s_q4 * Self::mul_add(0.4572, x121, Self::mul_add(-s_q3, x116, c_q3 * x114)),
         );
-        let x128 = Self::mul_add(qd[4], x126, c_q4 * x117);
-        let x129 = Self::mul_add(qd[4], x125, s_q4 * x117);
-        let x130 = qd[4] + x112;
-        let x131 = 34.33891524 * x126;
-        let x132 = 34.74691524 * x130;
-        let x133 = Self::mul_add(s_q5, x130, c_q5 * x126);
-        let x134 = Self::mul_add(-s_q5, x126, c_q5 * x130);
-        let x135 = Self::mul_add(qd[5], x134, Self::mul_add(-c_q5, x129, s_q5 * x118));
-        let x136 = Self::mul_add(-qd[5], x133, Self::mul_add(c_q5, x118, s_q5 * x129));
-        let x137 = qd[5] + x125;
-        let x138 = Self::mul_add(0.966, x134, Self::mul_add(0.385, x133, 1.903 * x137));
-        let x139 = Self::mul_add(0.353, x134, 0.385 * x137);
-        let x140 = Self::mul_add(
-            -0.9929999999999999,
-            x134,
-            Self::mul_add(0.353, x133, 0.966 * x137),
+        let x129 = Self::mul_add(-qd[4], x127, c_q4 * x118);
+        let x130 = Self::mul_add(qd[4], x126, s_q4 * x118);
+        let x131 = qd[4] - x113;
+        let x132 = 34.33891524 * x127;
+        let x133 = 34.74691524 * x131;
+        let x134 = Self::mul_add(s_q5, x131, c_q5 * x127);
+        let x135 = Self::mul_add(-c_q5, x131, s_q5 * x127);
+        let x136 = Self::mul_add(-qd[5], x135, Self::mul_add(-s_q5, x119, c_q5 * x130));
+        let x137 = Self::mul_add(qd[5], x134, Self::mul_add(c_q5, x119, s_q5 * x130));
+        let x138 = qd[5] - x126;
+        let x139 = Self::mul_add(-0.966, x135, Self::mul_add(0.385, x134, 1.903 * x138));
+        let x140 = Self::mul_add(-0.353, x135, 0.385 * x138);
+        let x141 = Self::mul_add(
+            0.9929999999999999,
+            x135,
+            Self::mul_add(0.353, x134, 0.966 * x138),
         );
-        let x141 = Self::mul_add(0.966, x136, Self::mul_add(0.385, x135, 1.903 * x128))
-            + Self::mul_add(-x134, x139, x133 * x140) - f_ext[5][3];
-        let x142 = Self::mul_add(0.353, x136, 0.385 * x128)
-            + Self::mul_add(-x137, x140, x134 * x138) - f_ext[5][4];
-        let x143 = Self::mul_add(
-            -0.9929999999999999,
-            x136,
-            Self::mul_add(0.353, x135, 0.966 * x128),
-        ) + Self::mul_add(-x133, x138, x137 * x139) - f_ext[5][5];
-        let x144 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
-        let x145 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x146 = f_ext[5][0]
+        let x142 = f_ext[5][3]
+            + (Self::mul_add(0.966, x137, Self::mul_add(-0.385, x136, 1.903 * x129))
+                - Self::mul_add(x134, x141, x135 * x140));
+        let x143 = f_ext[5][4]
+            + (Self::mul_add(0.353, x137, 0.385 * x129)
+                + Self::mul_add(x138, x141, x135 * x139));
+        let x144 = f_ext[5][5]
+            + (Self::mul_add(
+                -0.9929999999999999,
+                x137,
+                Self::mul_add(-0.353, x136, 0.966 * x129),
+            ) + Self::mul_add(-x138, x140, x134 * x139));
+        let x145 = Self::mul_add(-f_ext[5][2], s_q5, f_ext[5][1] * c_q5);
+        let x146 = Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x147 = f_ext[5][0]
             + Self::mul_add(
                 34.45002,
-                Self::mul_add(x130, x130, x126 * x126),
+                Self::mul_add(x131, x131, x127 * x127),
                 f_ext[4][0],
             );
-        let x147 = Self::mul_add(34.45002, Self::mul_add(x125, x126, x118), -f_ext[4][1])
-            + x144;
-        let x148 = Self::mul_add(34.45002, Self::mul_add(x125, x130, x129), -f_ext[4][2])
-            - x145;
-        let x149 = Self::mul_add(-x130, x131, x126 * x132) - f_ext[4][3] + x141;
-        let x150 = Self::mul_add(0.762, x145, Self::mul_add(-s_q5, x143, c_q5 * x142))
-            - (f_ext[4][4]
+        let x148 = Self::mul_add(34.45002, Self::mul_add(x126, x127, x119), f_ext[4][1])
+            + x145;
+        let x149 = Self::mul_add(34.45002, Self::mul_add(x126, x131, x130), f_ext[4][2])
+            + x146;
+        let x150 = f_ext[4][3] + Self::mul_add(-x127, x133, x131 * x132) + x142;
+        let x151 = f_ext[4][4]
+            - Self::mul_add(
+                34.45002,
+                Self::mul_add(-0.4572, x122, x117),
+                Self::mul_add(x126, x133, 34.33891524 * x130),
+            ) + Self::mul_add(-0.762, x146, Self::mul_add(-s_q5, x144, c_q5 * x143));
+        let x152 = f_ext[4][5]
+            + Self::mul_add(
+                -34.45002,
+                x128,
+                Self::mul_add(x126, x132, 34.74691524 * x119),
+            ) + Self::mul_add(0.762, x145, Self::mul_add(c_q5, x144, s_q5 * x143));
+        let x153 = Self::mul_add(c_q4, x148, s_q4 * x147);
+        let x154 = Self::mul_add(41.67378, x121, f_ext[3][0])
+            + Self::mul_add(-s_q4, x148, c_q4 * x147);
+        let x155 = Self::mul_add(41.67378, x123, f_ext[3][1]) + x153;
+        let x156 = Self::mul_add(-41.67378, x122, f_ext[3][2]) + x149;
+        let x157 = f_ext[3][3] - Self::mul_add(x113, x125, x118 * 18.957952216000002)
+            + Self::mul_add(-s_q4, x151, c_q4 * x150);
+        let x158 = f_ext[3][4] + Self::mul_add(-41.67378, x117, x113 * x124)
+            + Self::mul_add(-0.4572, x149, Self::mul_add(c_q4, x151, s_q4 * x150));
+        let x159 = f_ext[3][5]
+            + Self::mul_add(41.67378, x115, Self::mul_add(x112, x125, x120 * x124))
+            + Self::mul_add(0.4572, x153, x152);
+        let x160 = Self::mul_add(s_q3, x156, c_q3 * x154);
+        let x161 = Self::mul_add(-c_q3, x156, s_q3 * x154);
+        let x162 = f_ext[2][0]
+            + Self::mul_add(x104, 15.183612000000002, 703.3878000000001 * x103) + x160;
+        let x163 = f_ext[2][1]
+            + Self::mul_add(15.183612000000002, x106, 703.3878000000001 * x105) + x155;
+        let x164 = f_ext[2][2]
+            - Self::mul_add(15.183612000000002, x107, 703.3878000000001 * x104) - x161;
+        let x165 = f_ext[2][3]
+            - Self::mul_add(
+                x95,
+                -15.183612000000002,
+                Self::mul_add(-103.41030072000001, x100, x99 * 5594.523885531201)
+                    - Self::mul_add(x101, x110, x93 * x109),
+            ) + Self::mul_add(0.1524, x155, Self::mul_add(s_q3, x159, c_q3 * x157));
+        let x166 = f_ext[2][4]
+            + (Self::mul_add(-0.08, x100, 0.8021 * x99)
+                + Self::mul_add(x92, x110, x93 * x108)
+                - Self::mul_add(703.3878000000001, x98, x97 * 15.183612000000002))
+            + (x158 - Self::mul_add(-7.06, x161, 0.1524 * x160));
+        let x167 = f_ext[2][5] + x111
+            - Self::mul_add(-7.06, x155, Self::mul_add(-c_q3, x159, s_q3 * x157));
+        let x168 = Self::mul_add(
+            -c_q1,
+            f_ext[1][5]
                 + Self::mul_add(
-                    34.45002,
-                    Self::mul_add(-0.4572, x121, x116),
-                    Self::mul_add(x125, x132, 34.33891524 * x129),
-                ));
-        let x151 = Self::mul_add(
-            34.45002,
-            x127,
-            Self::mul_add(x125, x131, 34.74691524 * x118),
-        ) - f_ext[4][5]
-            + Self::mul_add(0.762, x144, Self::mul_add(c_q5, x143, s_q5 * x142));
-        let x152 = Self::mul_add(-s_q4, x146, c_q4 * x147);
-        let x153 = Self::mul_add(41.67378, x120, f_ext[3][0])
-            + Self::mul_add(s_q4, x147, c_q4 * x146);
-        let x154 = Self::mul_add(41.67378, x122, -f_ext[3][1]) + x152;
-        let x155 = x148 - Self::mul_add(41.67378, x121, f_ext[3][2]);
-        let x156 = Self::mul_add(-s_q4, x150, c_q4 * x149)
-            - (f_ext[3][3] + Self::mul_add(x112, x124, x117 * 18.957952216000002));
-        let x157 = Self::mul_add(-41.67378, x116, x112 * x123) - f_ext[3][4]
-            + Self::mul_add(-0.4572, x148, Self::mul_add(c_q4, x150, s_q4 * x149));
-        let x158 = Self::mul_add(0.4572, x152, x151)
-            - (f_ext[3][5]
-                + Self::mul_add(41.67378, x114, Self::mul_add(x111, x124, x119 * x123)));
-        let x159 = Self::mul_add(-c_q3, x153, s_q3 * x155);
-        let x160 = Self::mul_add(c_q3, x155, s_q3 * x153);
-        let x161 = Self::mul_add(-703.3878000000001, x102, x103 * 15.183612000000002)
-            - f_ext[2][0] + x159;
-        let x162 = x154
-            - (f_ext[2][1]
-                + Self::mul_add(15.183612000000002, x105, 703.3878000000001 * x104));
-        let x163 = Self::mul_add(-703.3878000000001, x103, 15.183612000000002 * x106)
-            - f_ext[2][2] + x160;
-        let x164 = Self::mul_add(0.1524, x154, Self::mul_add(s_q3, x158, c_q3 * x156))
-            - (f_ext[2][3]
-                + Self::mul_add(
-                    x94,
-                    15.183612000000002,
-                    Self::mul_add(103.41030072000001, x99, x98 * 5594.523885531201)
-                        + Self::mul_add(x100, x109, x92 * x108),
-                ));
-        let x165 = Self::mul_add(0.08, x99, 0.8021 * x98)
-            + Self::mul_add(-x91, x109, x92 * x107)
-            - Self::mul_add(703.3878000000001, x97, x96 * 15.183612000000002)
-            - f_ext[2][4] + (x157 - Self::mul_add(7.06, x160, 0.1524 * x159));
-        let x166 = x110 - f_ext[2][5]
-            + Self::mul_add(7.06, x154, Self::mul_add(-s_q3, x156, c_q3 * x158));
-        let x167 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-190.97044034, x85, x84 * 8596.210051042)
-                - Self::mul_add(qd[1], x90, x83 * x89) - f_ext[1][3]
-                + Self::mul_add(0.1524, x162, Self::mul_add(s_q2, x166, c_q2 * x164)),
-            c_q1
-                * (Self::mul_add(6.377, x162, Self::mul_add(-s_q2, x164, c_q2 * x166))
-                    - (f_ext[1][5]
-                        + Self::mul_add(
-                            190.97044034000004,
-                            x84,
-                            Self::mul_add(x82, x89, qd[1] * x88),
-                        ))),
+                    190.97044034000004,
+                    x85,
+                    Self::mul_add(x83, x90, qd[1] * x89),
+                ) - Self::mul_add(-6.377, x163, Self::mul_add(-c_q2, x167, s_q2 * x165)),
+            s_q1
+                * (f_ext[1][3]
+                    - (Self::mul_add(-190.97044034, x86, x85 * 8596.210051042)
+                        - Self::mul_add(qd[1], x91, x84 * x90))
+                    + Self::mul_add(
+                        0.1524,
+                        x163,
+                        Self::mul_add(s_q2, x167, c_q2 * x165),
+                    )),
         );
-        let x168 = tau[0] - (x167 - f_ext[0][5]);
-        let x169 = 1.0
+        let x169 = tau[0] + (f_ext[0][5] - x168);
+        let x170 = 1.0
             / (14222.257549666001
-                + (x65
+                + (x66
                     - Self::mul_add(
                         s_q1 * c_q1,
-                        x66 + x66,
-                        s_q1 * s_q1 * (x65 - (-8596.210051042 + (x47 + x56 - x61 - x61))),
+                        x67 + x67,
+                        s_q1 * s_q1
+                            * (x66 - (-8596.210051042 - (x61 - (x47 + x56 - x61)))),
                     )));
-        let x170 = x67 * x169;
-        let x171 = x68 * x169;
-        let x172 = x69 * x169;
-        let x173 = x76 * x169;
-        let x174 = x81 * x169;
-        let x175 = 1.0 / Self::mul_add(-x67, x170, 8609.573807858 + (x49 - x63 - x63));
-        let x176 = Self::mul_add(-x67, x171, x49 + (x62 - x61));
-        let x177 = x175 * x176;
-        let x178 = Self::mul_add(
-            -x67,
-            x172,
+        let x171 = x68 * x170;
+        let x172 = x69 * x170;
+        let x173 = x70 * x170;
+        let x174 = x77 * x170;
+        let x175 = x82 * x170;
+        let x176 = 1.0 / Self::mul_add(-x68, x171, 8609.573807858 - (x63 - x64));
+        let x177 = Self::mul_add(x68, x172, x64);
+        let x178 = x176 * x177;
+        let x179 = Self::mul_add(
+            x68,
+            x173,
             x42
                 + Self::mul_add(
                     -6.377,
@@ -2686,115 +2684,116 @@ impl Srms {
                     0.1524 * Self::mul_add(s_q2, x37, c_q2 * x36),
                 ),
         );
-        let x179 = x175 * x178;
-        let x180 = Self::mul_add(
-            -x67,
-            x173,
-            x74
-                - Self::mul_add(
-                    6.377,
-                    Self::mul_add(c_q2, x71, s_q2 * x70),
-                    0.1524 * Self::mul_add(-c_q2, x70, s_q2 * x71),
+        let x180 = x176 * x179;
+        let x181 = Self::mul_add(
+            x68,
+            x174,
+            x75
+                + Self::mul_add(
+                    -6.377,
+                    Self::mul_add(c_q2, x72, s_q2 * x71),
+                    0.1524 * Self::mul_add(-s_q2, x72, c_q2 * x71),
                 ),
         );
-        let x181 = x175 * x180;
-        let x182 = Self::mul_add(-x67, x174, x78);
-        let x183 = x175 * x182;
-        let x184 = 1.0 / Self::mul_add(-x176, x177, Self::mul_add(-x68, x171, x49));
-        let x185 = Self::mul_add(-x176, x179, Self::mul_add(-x68, x172, x42));
-        let x186 = x184 * x185;
-        let x187 = Self::mul_add(-x176, x181, Self::mul_add(-x68, x173, x74));
-        let x188 = x184 * x187;
-        let x189 = Self::mul_add(-x176, x183, Self::mul_add(-x68, x174, x78));
-        let x190 = x184 * x189;
-        let x191 = Self::mul_add(
-            -x185,
-            x186,
-            Self::mul_add(-x178, x179, Self::mul_add(-x69, x172, x28)),
+        let x182 = x176 * x181;
+        let x183 = Self::mul_add(x68, x175, x79);
+        let x184 = x176 * x183;
+        let x185 = 1.0 / Self::mul_add(-x177, x178, Self::mul_add(-x69, x172, x49));
+        let x186 = Self::mul_add(-x177, x180, Self::mul_add(-x69, x173, x42));
+        let x187 = x185 * x186;
+        let x188 = Self::mul_add(-x177, x182, Self::mul_add(-x69, x174, x75));
+        let x189 = x185 * x188;
+        let x190 = Self::mul_add(-x177, x184, Self::mul_add(-x69, x175, x79));
+        let x191 = x185 * x190;
+        let x192 = Self::mul_add(
+            -x186,
+            x187,
+            Self::mul_add(-x179, x180, Self::mul_add(-x70, x173, x28)),
         );
-        let x192 = 1.0 / x191;
-        let x193 = Self::mul_add(
-            -x185,
-            x188,
-            Self::mul_add(-x178, x181, Self::mul_add(-x69, x173, x19)),
+        let x193 = 1.0 / x192;
+        let x194 = Self::mul_add(
+            -x186,
+            x189,
+            Self::mul_add(-x179, x182, Self::mul_add(-x70, x174, x19)),
         );
-        let x194 = x192 * x193;
-        let x195 = Self::mul_add(
-            -x185,
-            x190,
-            Self::mul_add(-x178, x183, Self::mul_add(-x69, x174, x78)),
+        let x195 = x193 * x194;
+        let x196 = Self::mul_add(
+            -x186,
+            x191,
+            Self::mul_add(-x179, x184, Self::mul_add(-x70, x175, x79)),
         );
-        let x196 = x192 * x195;
-        let x197 = Self::mul_add(
-            -x187,
-            x188,
-            Self::mul_add(-x180, x181, Self::mul_add(-x76, x173, x12)),
+        let x197 = x193 * x196;
+        let x198 = Self::mul_add(
+            -x188,
+            x189,
+            Self::mul_add(-x181, x182, Self::mul_add(-x77, x174, x12)),
         );
-        let x198 = 1.0 / Self::mul_add(-x193, x194, x197);
-        let x199 = Self::mul_add(
-            -x187,
-            x190,
-            Self::mul_add(-x180, x183, Self::mul_add(-x76, x174, x10)),
+        let x199 = 1.0 / Self::mul_add(-x194, x195, x198);
+        let x200 = Self::mul_add(
+            -x188,
+            x191,
+            Self::mul_add(-x181, x184, Self::mul_add(-x77, x175, x10)),
         );
-        let x200 = Self::mul_add(-x193, x196, x199);
-        let x201 = x198 * x200;
-        let x202 = Self::mul_add(
-            -x189,
-            x190,
-            Self::mul_add(-x182, x183, Self::mul_add(-x81, x174, 1.903)),
+        let x201 = Self::mul_add(-x194, x197, x200);
+        let x202 = x199 * x201;
+        let x203 = Self::mul_add(
+            -x190,
+            x191,
+            Self::mul_add(-x183, x184, Self::mul_add(-x82, x175, 1.903)),
         );
-        let x203 = 1.0 / Self::mul_add(-x200, x201, Self::mul_add(-x195, x196, x202));
-        let x204 = Self::mul_add(
-            -x168,
-            x170,
+        let x204 = 1.0 / Self::mul_add(-x201, x202, Self::mul_add(-x196, x197, x203));
+        let x205 = Self::mul_add(
+            -x169,
+            x171,
             tau[1]
-                - (Self::mul_add(x85, 0.0302, x84 * 1.928)
-                    + Self::mul_add(-x82, x90, x83 * x88) - f_ext[1][4]
-                    + (x165
+                + (f_ext[1][4]
+                    - (Self::mul_add(x86, 0.0302, x85 * 1.928)
+                        + Self::mul_add(-x83, x91, x84 * x89))
+                    + (x166
                         - Self::mul_add(
-                            6.377,
-                            Self::mul_add(-s_q2, x161, c_q2 * x163),
-                            0.1524 * Self::mul_add(s_q2, x163, c_q2 * x161),
+                            -6.377,
+                            Self::mul_add(-c_q2, x164, s_q2 * x162),
+                            0.1524 * Self::mul_add(s_q2, x164, c_q2 * x162),
                         ))),
         );
-        let x205 = Self::mul_add(-x177, x204, Self::mul_add(-x168, x171, tau[2] - x165));
-        let x206 = Self::mul_add(
-            -x186,
-            x205,
-            Self::mul_add(-x179, x204, Self::mul_add(-x168, x172, tau[3] - x157)),
-        );
+        let x206 = Self::mul_add(-x178, x205, Self::mul_add(x169, x172, tau[2] + x166));
         let x207 = Self::mul_add(
-            -x188,
-            x205,
-            Self::mul_add(-x181, x204, Self::mul_add(-x168, x173, tau[4] - x151)),
+            -x187,
+            x206,
+            Self::mul_add(-x180, x205, Self::mul_add(x169, x173, tau[3] + x158)),
         );
-        let x208 = Self::mul_add(-x194, x206, x207);
-        let x209 = Self::mul_add(
-            -x190,
-            x205,
-            Self::mul_add(-x183, x204, Self::mul_add(-x168, x174, tau[5] - x141)),
+        let x208 = Self::mul_add(
+            -x189,
+            x206,
+            Self::mul_add(-x182, x205, Self::mul_add(x169, x174, tau[4] + x152)),
         );
-        let x210 = x203 * Self::mul_add(-x201, x208, Self::mul_add(-x196, x206, x209));
-        let x211 = Self::mul_add(-x201, x210, x198 * x208);
-        let x212 = Self::mul_add(-x196, x210, Self::mul_add(-x194, x211, x192 * x206));
-        let x213 = Self::mul_add(
-            -x190,
-            x210,
-            Self::mul_add(-x188, x211, Self::mul_add(-x186, x212, x184 * x205)),
+        let x209 = Self::mul_add(-x195, x207, x208);
+        let x210 = Self::mul_add(
+            -x191,
+            x206,
+            Self::mul_add(-x184, x205, Self::mul_add(x169, x175, tau[5] + x142)),
         );
+        let x211 = x204 * Self::mul_add(-x202, x209, Self::mul_add(-x197, x207, x210));
+        let x212 = Self::mul_add(-x202, x211, x199 * x209);
+        let x213 = Self::mul_add(-x197, x211, Self::mul_add(-x195, x212, x193 * x207));
         let x214 = Self::mul_add(
-            -x181,
+            -x191,
             x211,
-            Self::mul_add(-x179, x212, Self::mul_add(-x177, x213, x175 * x204)),
+            Self::mul_add(-x189, x212, Self::mul_add(-x187, x213, x185 * x206)),
         );
-        let x215 = Self::mul_add(-x183, x210, x214);
-        let x216 = Self::mul_add(
-            -x172,
+        let x215 = Self::mul_add(
+            -x182,
             x212,
-            Self::mul_add(-x171, x213, Self::mul_add(-x170, x215, x168 * x169)),
+            Self::mul_add(-x180, x213, Self::mul_add(-x178, x214, x176 * x205)),
         );
-        let x217 = Self::mul_add(-x174, x210, Self::mul_add(-x173, x211, x216));
-        [x217, x215, x213, x212, x211, x210]
+        let x216 = Self::mul_add(-x184, x211, x215);
+        let x217 = Self::mul_add(
+            x173,
+            x213,
+            Self::mul_add(x172, x214, Self::mul_add(-x171, x216, x169 * x170)),
+        );
+        let x218 = Self::mul_add(x175, x211, Self::mul_add(x174, x212, x217));
+        [x218, x216, x214, x213, x212, x211]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

@@ -9,7 +9,7 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 6 of 6 bodies gave, 31 → 25 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
-//! Fused multiply-adds where the target has them: 692 (`mass_matrix` 35, `nonlinear_effects` 80, `inverse_dynamics` 95, `forward_dynamics` 176, `mass_matrix_and_nonlinear_effects` 115, `forward_dynamics_with_wrenches` 191), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 691 (`mass_matrix` 35, `nonlinear_effects` 80, `inverse_dynamics` 95, `forward_dynamics` 176, `mass_matrix_and_nonlinear_effects` 115, `forward_dynamics_with_wrenches` 190), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 395 emitted operations in M + c, within the 4000 limit).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -24,7 +24,7 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 442 | 295 | 0 | 0 | 6 | 737 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 412 | 299 | 0 | 0 | 6 | 711 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 412 | 299 | 0 | 0 | 6 | 711 |
-//! | `mass_matrix` | `crba` | — | — | model | 78 | 70 | 0 | 0 | 4 | 148 |
+//! | `mass_matrix` | `crba` | — | — | model | 76 | 67 | 0 | 0 | 4 | 143 |
 //! | `mass_matrix` * | `crba` | — | — | canonical | 76 | 65 | 0 | 0 | 4 | 141 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 493 | 340 | 0 | 0 | 6 | 833 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 493 | 340 | 0 | 0 | 6 | 833 |
@@ -34,21 +34,21 @@
 //! | `nonlinear_effects` | — | `rnea` | — | canonical | 189 | 124 | 0 | 0 | 5 | 313 |
 //! | `nonlinear_effects` * | — | `newton-euler` | — | model | 155 | 99 | 0 | 0 | 5 | 254 |
 //! | `nonlinear_effects` | — | `newton-euler` | — | canonical | 155 | 99 | 0 | 0 | 5 | 254 |
-//! | `inverse_dynamics` | — | `recurrent` | — | model | 597 | 438 | 0 | 0 | 6 | 1035 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 595 | 435 | 0 | 0 | 6 | 1030 |
 //! | `inverse_dynamics` | — | `recurrent` | — | canonical | 595 | 433 | 0 | 0 | 6 | 1028 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | model | 638 | 474 | 0 | 0 | 6 | 1112 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 636 | 471 | 0 | 0 | 6 | 1107 |
 //! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 636 | 469 | 0 | 0 | 6 | 1105 |
 //! | `inverse_dynamics` | — | `rnea` | — | model | 208 | 146 | 0 | 0 | 5 | 354 |
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 207 | 145 | 0 | 0 | 5 | 352 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | model | 172 | 124 | 0 | 0 | 5 | 296 |
 //! | `inverse_dynamics` * | — | `newton-euler` | — | canonical | 171 | 123 | 0 | 0 | 5 | 294 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 657 | 477 | 6 | 0 | 6 | 1134 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 655 | 474 | 6 | 0 | 6 | 1129 |
 //! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 655 | 472 | 6 | 0 | 6 | 1127 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 698 | 513 | 6 | 0 | 6 | 1211 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 696 | 510 | 6 | 0 | 6 | 1206 |
 //! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 696 | 508 | 6 | 0 | 6 | 1204 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 353 | 261 | 6 | 0 | 5 | 614 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 351 | 258 | 6 | 0 | 5 | 609 |
 //! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 351 | 256 | 6 | 0 | 5 | 607 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 319 | 236 | 6 | 0 | 5 | 555 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 317 | 233 | 6 | 0 | 5 | 550 |
 //! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 317 | 231 | 6 | 0 | 5 | 548 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 764 | 605 | 6 | 0 | 6 | 1369 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 764 | 605 | 6 | 0 | 6 | 1369 |
@@ -60,13 +60,13 @@
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 653 | 469 | 6 | 0 | 6 | 1122 |
 //! | `forward_dynamics` | — | — | `aba` | model | 421 | 292 | 4 | 0 | 5 | 713 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 423 | 294 | 4 | 0 | 5 | 717 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 571 | 410 | 0 | 0 | 6 | 981 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 569 | 407 | 0 | 0 | 6 | 976 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 569 | 405 | 0 | 0 | 6 | 974 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 612 | 446 | 0 | 0 | 6 | 1058 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 610 | 443 | 0 | 0 | 6 | 1053 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 610 | 441 | 0 | 0 | 6 | 1051 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 267 | 194 | 0 | 0 | 5 | 461 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 265 | 191 | 0 | 0 | 5 | 456 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 265 | 189 | 0 | 0 | 5 | 454 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 233 | 169 | 0 | 0 | 5 | 402 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 231 | 166 | 0 | 0 | 5 | 397 |
 //! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 231 | 164 | 0 | 0 | 5 | 395 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 678 | 534 | 0 | 0 | 6 | 1212 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 678 | 534 | 0 | 0 | 6 | 1212 |
@@ -76,10 +76,10 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 601 | 423 | 0 | 0 | 6 | 1024 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 567 | 398 | 0 | 0 | 6 | 965 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 567 | 398 | 0 | 0 | 6 | 965 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 739 | 560 | 6 | 0 | 6 | 1299 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 780 | 596 | 6 | 0 | 6 | 1376 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 365 | 299 | 6 | 0 | 5 | 664 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 331 | 274 | 6 | 0 | 5 | 605 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 737 | 557 | 6 | 0 | 6 | 1294 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 778 | 593 | 6 | 0 | 6 | 1371 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 363 | 296 | 6 | 0 | 5 | 659 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 329 | 271 | 6 | 0 | 5 | 600 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 846 | 688 | 6 | 0 | 6 | 1534 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 887 | 724 | 6 | 0 | 6 | 1611 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 699 | 532 | 6 | 0 | 6 | 1231 |
@@ -215,12 +215,12 @@ impl Ssrms6 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 331u64,
-            add: 274u64,
+            mul: 329u64,
+            add: 271u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 191u64,
+            fma: 190u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -335,8 +335,8 @@ impl Ssrms6 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 78u64,
-            add: 70u64,
+            mul: 76u64,
+            add: 67u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 4u64,
@@ -465,8 +465,8 @@ impl Ssrms6 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 597u64,
-            add: 438u64,
+            mul: 595u64,
+            add: 435u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -491,8 +491,8 @@ impl Ssrms6 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 638u64,
-            add: 474u64,
+            mul: 636u64,
+            add: 471u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -569,8 +569,8 @@ impl Ssrms6 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 657u64,
-            add: 477u64,
+            mul: 655u64,
+            add: 474u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -595,8 +595,8 @@ impl Ssrms6 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 698u64,
-            add: 513u64,
+            mul: 696u64,
+            add: 510u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -621,8 +621,8 @@ impl Ssrms6 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 353u64,
-            add: 261u64,
+            mul: 351u64,
+            add: 258u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -647,8 +647,8 @@ impl Ssrms6 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 319u64,
-            add: 236u64,
+            mul: 317u64,
+            add: 233u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -803,8 +803,8 @@ impl Ssrms6 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 571u64,
-            add: 410u64,
+            mul: 569u64,
+            add: 407u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -829,8 +829,8 @@ impl Ssrms6 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 612u64,
-            add: 446u64,
+            mul: 610u64,
+            add: 443u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -855,8 +855,8 @@ impl Ssrms6 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 267u64,
-            add: 194u64,
+            mul: 265u64,
+            add: 191u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -881,8 +881,8 @@ impl Ssrms6 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 233u64,
-            add: 169u64,
+            mul: 231u64,
+            add: 166u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -1011,8 +1011,8 @@ impl Ssrms6 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 739u64,
-            add: 560u64,
+            mul: 737u64,
+            add: 557u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1024,8 +1024,8 @@ impl Ssrms6 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 780u64,
-            add: 596u64,
+            mul: 778u64,
+            add: 593u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1037,8 +1037,8 @@ impl Ssrms6 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 365u64,
-            add: 299u64,
+            mul: 363u64,
+            add: 296u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -1050,8 +1050,8 @@ impl Ssrms6 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 331u64,
-            add: 274u64,
+            mul: 329u64,
+            add: 271u64,
             div: 6u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -1140,7 +1140,7 @@ impl Ssrms6 {
         let x9 = s_q3 * s_q3 * x8;
         let x10 = x5 - x9;
         let x11 = Self::mul_add(97.44448770720001, s_q3, c_q3 * x6);
-        let x12 = Self::mul_add(-s_q3, x6, 97.44448770720001 * c_q3);
+        let x12 = Self::mul_add(-97.44448770720001, c_q3, s_q3 * x6);
         let x13 = 171.195516 * s_q3;
         let x14 = 171.195516 * c_q3;
         let x15 = 7.11 * x13;
@@ -1148,8 +1148,8 @@ impl Ssrms6 {
         let x17 = x7 - x15;
         let x18 = 3239.4582 - x13;
         let x19 = 1375.0472756800002 - x11;
-        let x20 = 24989.305802 + (-129.6173695416 + x9 - x15 - x15);
-        let x21 = 24998.827802 + (x17 - x15);
+        let x20 = 24989.305802 - (x15 - (-129.6173695416 + x9 - x15));
+        let x21 = 24998.827802 - (x15 - x17);
         let x22 = s_q2 * s_q2;
         let x23 = s_q2 * c_q2;
         let x24 = x10 - x20;
@@ -1162,12 +1162,12 @@ impl Ssrms6 {
         let x31 = c_q2 * x14;
         let x32 = Self::mul_add(s_q2, x18, x31);
         let x33 = 7.11 * x30;
-        let x34 = Self::mul_add(x30, 0.475, Self::mul_add(c_q2, x19, -x27));
+        let x34 = Self::mul_add(x30, 0.475, Self::mul_add(c_q2, x19, x27));
         let x35 = Self::mul_add(-7.11, x32, x16 + Self::mul_add(-x22, x25, x23 * x24));
         let x36 = x21 + x33;
         let x37 = 39234.474122 + (x33 + (x20 + x26 + x33));
         let x38 = 39241.404122 + (x33 + x36);
-        let x39 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(s_q2, x19, x28));
+        let x39 = c_q1 * Self::mul_add(x32, 0.475, Self::mul_add(s_q2, x19, -x28));
         let x40 = c_q1 * x32;
         let x41 = 1650.6386721183999
             + (x37
@@ -1186,15 +1186,15 @@ impl Ssrms6 {
             Self::mul_add(s_q1, x30, x40),
             Self::mul_add(s_q1, x34, x39),
         );
-        let x44 = Self::mul_add(s_q2, x13, -x31);
+        let x44 = Self::mul_add(-s_q2, x13, x31);
         let x45 = Self::mul_add(c_q2, x13, x29);
         let x46 = Self::mul_add(-7.11, x45, x17);
         let x47 = Self::mul_add(
             -c_q1,
-            Self::mul_add(-0.475, x44, Self::mul_add(-s_q2, x11, x28)),
-            s_q1 * Self::mul_add(0.475, x45, Self::mul_add(c_q2, x11, x27)),
+            Self::mul_add(-0.475, x44, Self::mul_add(s_q2, x11, x28)),
+            s_q1 * Self::mul_add(-0.475, x45, Self::mul_add(-c_q2, x11, x27)),
         );
-        let x48 = Self::mul_add(0.5692, Self::mul_add(s_q1, x45, c_q1 * x44), x47);
+        let x48 = -Self::mul_add(0.5692, Self::mul_add(-s_q1, x45, c_q1 * x44), x47);
         let x49 = 47.471 * s_q3;
         let x50 = 47.471 * c_q3;
         let x51 = -Self::mul_add(
@@ -1235,107 +1235,112 @@ impl Ssrms6 {
         let x7 = Self::mul_add(qd[1], qd[1], x6);
         let x8 = x1 * x2;
         let x9 = Self::mul_add(3946.18812068, qd[1], x1 * 39234.47412200001);
-        let x10 = Self::mul_add(-3946.1881206800003, x1, 39241.404122 * qd[1]);
+        let x10 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x1);
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x12 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x13 = Self::mul_add(-x1, s_q2, x2 * c_q2);
+        let x13 = Self::mul_add(-x2, c_q2, x1 * s_q2);
         let x14 = 7.11 * x7;
         let x15 = 7.11 * x8;
-        let x16 = x3 + Self::mul_add(-7.11, x5 + x5, Self::mul_add(x1, x1, x6) * 0.475);
+        let x16 = x3
+            - Self::mul_add(Self::mul_add(x1, x1, x6), -0.475, 7.11 * (x5 + x5));
         let x17 = Self::mul_add(c_q2, x15, s_q2 * x14);
-        let x18 = Self::mul_add(-qd[2], x13, Self::mul_add(-x4, c_q2, x5 * s_q2));
+        let x18 = Self::mul_add(-qd[2], x13, Self::mul_add(-x5, s_q2, x4 * c_q2));
         let x19 = Self::mul_add(qd[2], x12, Self::mul_add(x5, c_q2, x4 * s_q2));
         let x20 = qd[1] + qd[2];
         let x21 = Self::mul_add(x13, x13, x20 * x20);
         let x22 = x12 * x13;
         let x23 = Self::mul_add(x12, x20, x19);
         let x24 = Self::mul_add(1375.0472756800002, x20, x12 * 24989.305802);
-        let x25 = Self::mul_add(-1375.0472756800002, x12, 24998.827802 * x20);
+        let x25 = Self::mul_add(-24998.827802, x20, 1375.0472756800002 * x12);
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x27 = Self::mul_add(x13, s_q3, x12 * c_q3);
-        let x28 = Self::mul_add(-x12, s_q3, x13 * c_q3);
+        let x27 = Self::mul_add(-x13, s_q3, x12 * c_q3);
+        let x28 = Self::mul_add(x13, c_q3, x12 * s_q3);
         let x29 = Self::mul_add(
-            s_q3,
-            Self::mul_add(7.11, x22, x17),
-            c_q3 * Self::mul_add(-7.11, x21, Self::mul_add(-c_q2, x14, s_q2 * x15)),
+            -s_q3,
+            Self::mul_add(-7.11, x22, x17),
+            c_q3 * Self::mul_add(7.11, x21, Self::mul_add(-s_q2, x15, c_q2 * x14)),
         );
-        let x30 = Self::mul_add(-qd[3], x28, Self::mul_add(x19, s_q3, x18 * c_q3));
-        let x31 = Self::mul_add(-qd[3], x27, Self::mul_add(-x19, c_q3, x18 * s_q3));
+        let x30 = Self::mul_add(-qd[3], x28, Self::mul_add(-x19, s_q3, x18 * c_q3));
+        let x31 = Self::mul_add(qd[3], x27, Self::mul_add(x19, c_q3, x18 * s_q3));
         let x32 = qd[3] + x20;
         let x33 = x27 * x28 * 171.195516;
-        let x34 = 171.195516 * Self::mul_add(x28, x32, -x30);
+        let x34 = 171.195516 * Self::mul_add(-x28, x32, x30);
         let x35 = 171.195516 * Self::mul_add(x27, x27, x32 * x32);
         let x36 = 132.6783695416 * x27;
-        let x37 = Self::mul_add(x28, -97.44448770720001, 135.4729695416 * x32);
+        let x37 = Self::mul_add(x28, 97.44448770720001, 135.4729695416 * x32);
         let x38 = x32 * 97.44448770720001;
         let x39 = Self::mul_add(
             Self::mul_add(-7.11, x23, x16),
-            171.195516,
-            Self::mul_add(132.6783695416, x30, -Self::mul_add(x32, x38, x28 * x37)),
+            -171.195516,
+            Self::mul_add(132.6783695416, x30, -Self::mul_add(-x32, x38, x28 * x37)),
         );
         let x40 = Self::mul_add(
             x29,
             171.195516,
-            Self::mul_add(x31, 97.44448770720001, Self::mul_add(x27, x38, x28 * x36)),
+            Self::mul_add(x31, 97.44448770720001, Self::mul_add(-x27, x38, x28 * x36)),
         );
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x42 = Self::mul_add(-x27, c_q4, x32 * s_q4);
+        let x42 = Self::mul_add(-x32, s_q4, x27 * c_q4);
         let x43 = Self::mul_add(x32, c_q4, x27 * s_q4);
-        let x44 = qd[4] + x28;
+        let x44 = qd[4] - x28;
         let x45 = 44.41 * x43;
         let x46 = 47.471 * x44;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x48 = 9.336 * Self::mul_add(qd[4], x43, x30 * c_q4);
-        let x49 = 9.336 * (qd[5] + x42);
-        let x50 = Self::mul_add(-x43, s_q5, x44 * c_q5) * x49;
-        let x51 = Self::mul_add(x44, s_q5, x43 * c_q5) * x49;
-        let x52 = Self::mul_add(-x44, x45, x43 * x46) + x48;
-        let x53 = Self::mul_add(s_q5, x51, c_q5 * x50)
-            - Self::mul_add(x42, x46, 44.41 * Self::mul_add(qd[4], x42, x30 * s_q4));
-        let x54 = Self::mul_add(x42, x45, 47.471 * x31)
-            + Self::mul_add(-c_q5, x51, s_q5 * x50);
-        let x55 = x39 + Self::mul_add(-s_q4, x53, c_q4 * x52);
-        let x56 = Self::mul_add(c_q4, x53, s_q4 * x52) - x40;
-        let x57 = Self::mul_add(-x27, x37, x32 * x36) + x54;
-        let x58 = Self::mul_add(-s_q3, x33, c_q3 * x35);
-        let x59 = Self::mul_add(-3239.4582, x21, Self::mul_add(s_q3, x35, c_q3 * x33));
-        let x60 = Self::mul_add(-3239.4582, x22, x58);
-        let x61 = Self::mul_add(s_q3, x57, c_q3 * x55)
-            - Self::mul_add(x13, x25, x18 * 24989.305802);
-        let x62 = Self::mul_add(
-            3239.4582,
+        let x48 = 9.336 * Self::mul_add(-qd[4], x43, x30 * c_q4);
+        let x49 = -x48;
+        let x50 = 9.336 * (qd[5] - x42);
+        let x51 = Self::mul_add(-x44, c_q5, x43 * s_q5) * x50;
+        let x52 = Self::mul_add(x44, s_q5, x43 * c_q5) * x50;
+        let x53 = Self::mul_add(-x43, x46, x44 * x45) + x48;
+        let x54 = Self::mul_add(x42, x46, 44.41 * Self::mul_add(qd[4], x42, x30 * s_q4))
+            - Self::mul_add(-s_q5, x52, c_q5 * x51);
+        let x55 = Self::mul_add(x42, x45, 47.471 * x31)
+            + Self::mul_add(c_q5, x52, s_q5 * x51);
+        let x56 = -x55;
+        let x57 = x39 + Self::mul_add(s_q4, x54, c_q4 * x53);
+        let x58 = x40 - Self::mul_add(-c_q4, x54, s_q4 * x53);
+        let x59 = Self::mul_add(-x27, x37, x32 * x36) - x55;
+        let x60 = Self::mul_add(c_q3, x35, s_q3 * x33);
+        let x61 = Self::mul_add(3239.4582, x21, Self::mul_add(-s_q3, x35, c_q3 * x33));
+        let x62 = Self::mul_add(3239.4582, x22, x60);
+        let x63 = Self::mul_add(-x13, x25, x18 * 24989.305802)
+            - Self::mul_add(-s_q3, x59, c_q3 * x57);
+        let x64 = Self::mul_add(
+            -3239.4582,
             x17,
             Self::mul_add(x13, x24, 1375.0472756800002 * x18),
-        ) + Self::mul_add(-7.11, x58, x56);
-        let x63 = Self::mul_add(3239.4582, x16, -Self::mul_add(x12, x25, x20 * x24))
-            + Self::mul_add(-7.11, x34, Self::mul_add(-s_q3, x55, c_q3 * x57));
-        let x64 = Self::mul_add(s_q2, x60, c_q2 * x59);
-        let x65 = Self::mul_add(-s_q2, x59, c_q2 * x60);
-        let x66 = Self::mul_add(-3946.1881206800003, x4, x2 * x9)
-            + Self::mul_add(-7.11, x65, x62);
-        let x67 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-x2, x10, x4 * 39234.47412200001)
-                + Self::mul_add(-0.475, x65, Self::mul_add(s_q2, x63, c_q2 * x61)),
-            c_q1
-                * (Self::mul_add(5224.5702, x3, -Self::mul_add(x1, x10, qd[1] * x9))
-                    + (Self::mul_add(-s_q2, x61, c_q2 * x63)
-                        + Self::mul_add(
-                            -7.11,
-                            Self::mul_add(3239.4582, x23, x34),
-                            0.475 * x64,
-                        ))),
+        ) - Self::mul_add(-7.11, x60, x58);
+        let x65 = -x64;
+        let x66 = Self::mul_add(-3239.4582, x16, Self::mul_add(-x12, x25, x20 * x24))
+            - Self::mul_add(-7.11, x34, Self::mul_add(c_q3, x59, s_q3 * x57));
+        let x67 = Self::mul_add(-s_q2, x62, c_q2 * x61);
+        let x68 = Self::mul_add(c_q2, x62, s_q2 * x61);
+        let x69 = -(Self::mul_add(-x2, x9, 3946.1881206800003 * x4)
+            + Self::mul_add(7.11, x68, x64));
+        let x70 = Self::mul_add(
+            c_q1,
+            Self::mul_add(-5224.5702, x3, Self::mul_add(-x1, x10, qd[1] * x9))
+                + (Self::mul_add(c_q2, x66, s_q2 * x63)
+                    + Self::mul_add(
+                        7.11,
+                        Self::mul_add(3239.4582, x23, x34),
+                        0.475 * x67,
+                    )),
+            s_q1
+                * (Self::mul_add(x2, x10, x4 * 39234.47412200001)
+                    + Self::mul_add(-0.475, x68, Self::mul_add(-s_q2, x66, c_q2 * x63))),
         );
-        let x68 = Self::mul_add(
+        let x71 = Self::mul_add(
             0.5692,
             Self::mul_add(
                 s_q1,
-                Self::mul_add(-5224.5702, x8, x65),
-                c_q1 * Self::mul_add(-5224.5702, x7, x64),
+                Self::mul_add(5224.5702, x8, -x68),
+                c_q1 * Self::mul_add(5224.5702, x7, x67),
             ),
-            x67,
+            x70,
         );
-        [x68, x66, x62, x56, x54, x48]
+        let x72 = -x71;
+        [x72, x69, x65, x58, x56, x49]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1351,27 +1356,28 @@ impl Ssrms6 {
         let x6 = qd[1] * x2;
         let x7 = qd[1] * x1;
         let x8 = Self::mul_add(qdd[0], s_q1, x6);
-        let x9 = Self::mul_add(-qdd[0], c_q1, x7);
+        let x9 = Self::mul_add(qdd[0], c_q1, -x7);
         let x10 = x2 * x2;
         let x11 = Self::mul_add(qd[1], qd[1], x10);
         let x12 = Self::mul_add(x1, x2, qdd[1]);
         let x13 = 3946.18812068 * qd[1];
         let x14 = 39234.474122 * x2;
-        let x15 = Self::mul_add(-3946.1881206800003, x1, 39241.404122 * qd[1]);
+        let x15 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x1);
         let x16 = Self::mul_add(
-            -5224.5702,
+            5224.5702,
             x4,
-            Self::mul_add(39234.474122, x9, Self::mul_add(x1, x15, qd[1] * x13)),
+            Self::mul_add(39234.474122, x9, -Self::mul_add(-x1, x15, qd[1] * x13)),
         );
         let (s_q2, c_q2) = libm::sincos(q[2]);
         let x18 = Self::mul_add(x2, s_q2, x1 * c_q2);
         let x19 = Self::mul_add(-x2, c_q2, x1 * s_q2);
-        let x20 = Self::mul_add(c_q1, x3, -Self::mul_add(x9 - x7, 0.475, 7.11 * x11));
-        let x21 = Self::mul_add(x8 - x6, -0.475, 7.11 * x12) - x5;
-        let x22 = x4 + Self::mul_add(-7.11, x7 + x9, Self::mul_add(x1, x1, x10) * 0.475);
-        let x23 = Self::mul_add(-s_q2, x20, c_q2 * x21);
-        let x24 = Self::mul_add(qd[2], x19, Self::mul_add(-x8, c_q2, x9 * s_q2));
-        let x25 = Self::mul_add(qd[2], x18, Self::mul_add(x9, c_q2, x8 * s_q2));
+        let x20 = Self::mul_add(c_q1, x3, -Self::mul_add(x7 + x9, -0.475, 7.11 * x11));
+        let x21 = x5 - Self::mul_add(x6 - x8, 0.475, 7.11 * x12);
+        let x22 = x4
+            - Self::mul_add(Self::mul_add(x1, x1, x10), -0.475, 7.11 * (x7 - x9));
+        let x23 = Self::mul_add(c_q2, x21, s_q2 * x20);
+        let x24 = Self::mul_add(-qd[2], x19, Self::mul_add(x9, s_q2, x8 * c_q2));
+        let x25 = Self::mul_add(qd[2], x18, Self::mul_add(-x9, c_q2, x8 * s_q2));
         let x26 = qdd[1] + qdd[2];
         let x27 = qd[1] + qd[2];
         let x28 = Self::mul_add(x27, x27, x19 * x19);
@@ -1379,28 +1385,28 @@ impl Ssrms6 {
         let x30 = Self::mul_add(x18, x27, x25);
         let x31 = 1375.0472756800002 * x27;
         let x32 = 24989.305802 * x19;
-        let x33 = Self::mul_add(-1375.0472756800002, x18, 24998.827802 * x27);
+        let x33 = Self::mul_add(-24998.827802, x27, 1375.0472756800002 * x18);
         let x34 = Self::mul_add(
             -3239.4582,
             x22,
-            Self::mul_add(24989.305802, x25, Self::mul_add(x18, x33, x27 * x31)),
+            Self::mul_add(24989.305802, x25, Self::mul_add(-x18, x33, x27 * x31)),
         );
         let (s_q3, c_q3) = libm::sincos(q[3]);
-        let x36 = Self::mul_add(-x18, c_q3, x19 * s_q3);
+        let x36 = Self::mul_add(-x19, s_q3, x18 * c_q3);
         let x37 = Self::mul_add(x19, c_q3, x18 * s_q3);
         let x38 = Self::mul_add(
-            s_q3,
-            Self::mul_add(7.11, x29, x23),
-            c_q3 * Self::mul_add(-7.11, x28, Self::mul_add(s_q2, x21, c_q2 * x20)),
+            -s_q3,
+            Self::mul_add(-7.11, x29, x23),
+            c_q3 * Self::mul_add(-7.11, x28, Self::mul_add(-s_q2, x21, c_q2 * x20)),
         );
-        let x39 = Self::mul_add(qd[3], x37, Self::mul_add(x25, s_q3, x24 * c_q3));
-        let x40 = Self::mul_add(-qd[3], x36, Self::mul_add(-x24, s_q3, x25 * c_q3));
+        let x39 = Self::mul_add(-qd[3], x37, Self::mul_add(-x25, s_q3, x24 * c_q3));
+        let x40 = Self::mul_add(qd[3], x36, Self::mul_add(x25, c_q3, x24 * s_q3));
         let x41 = qdd[3] + x26;
         let x42 = qd[3] + x27;
-        let x43 = 171.195516 * Self::mul_add(x36, x37, -x41);
+        let x43 = 171.195516 * Self::mul_add(x36, x37, x41);
         let x44 = 171.195516 * Self::mul_add(x36, x36, x42 * x42);
-        let x45 = 171.195516 * Self::mul_add(x37, x42, x39);
-        let x46 = Self::mul_add(x37, -177.0883695416, 97.44448770720001 * x42);
+        let x45 = 171.195516 * Self::mul_add(-x37, x42, x39);
+        let x46 = Self::mul_add(-97.44448770720001, x42, x37 * 177.0883695416);
         let x47 = Self::mul_add(179.8829695416, x42, 97.44448770720001 * x37);
         let x48 = Self::mul_add(
             -171.195516,
@@ -1412,83 +1418,84 @@ impl Ssrms6 {
             ),
         );
         let (s_q4, c_q4) = libm::sincos(q[4]);
-        let x50 = Self::mul_add(-x36, s_q4, x42 * c_q4);
-        let x51 = Self::mul_add(x42, s_q4, x36 * c_q4);
-        let x52 = Self::mul_add(qd[4], x50, Self::mul_add(x41, s_q4, x39 * c_q4));
+        let x50 = Self::mul_add(x42, c_q4, x36 * s_q4);
+        let x51 = Self::mul_add(-x42, s_q4, x36 * c_q4);
+        let x52 = Self::mul_add(-qd[4], x50, Self::mul_add(-x41, s_q4, x39 * c_q4));
         let x53 = qd[4] - x37;
         let x54 = 44.41 * x51;
         let x55 = 47.471 * x53;
         let (s_q5, c_q5) = libm::sincos(q[5]);
-        let x57 = 9.336 * (qdd[5] + x52);
-        let x58 = 9.336 * (qd[5] + x51);
-        let x59 = Self::mul_add(-x50, s_q5, x53 * c_q5) * x58;
+        let x57 = 9.336 * (qdd[5] - x52);
+        let x58 = 9.336 * (qd[5] - x51);
+        let x59 = Self::mul_add(-x53, c_q5, x50 * s_q5) * x58;
         let x60 = Self::mul_add(x53, s_q5, x50 * c_q5) * x58;
-        let x61 = Self::mul_add(s_q5, x60, c_q5 * x59)
-            - Self::mul_add(x51, x55, x53 * x54);
-        let x62 = Self::mul_add(-x50, x55, 44.41 * x52) - x57;
-        let x63 = Self::mul_add(x50, x54, 47.471 * (qdd[4] - x40))
-            + Self::mul_add(-c_q5, x60, s_q5 * x59);
+        let x61 = Self::mul_add(x51, x55, x53 * x54)
+            - Self::mul_add(-s_q5, x60, c_q5 * x59);
+        let x62 = Self::mul_add(x50, x55, 44.41 * x52) + x57;
+        let x63 = Self::mul_add(-x50, x54, 47.471 * (qdd[4] - x40))
+            - Self::mul_add(c_q5, x60, s_q5 * x59);
         let x64 = Self::mul_add(
             171.195516,
             Self::mul_add(-7.11, x30, x22),
-            Self::mul_add(-x42, x46, x37 * x47),
-        ) - Self::mul_add(c_q4, x62, s_q4 * x61);
+            Self::mul_add(x37, x47, x42 * x46),
+        ) - Self::mul_add(-c_q4, x62, s_q4 * x61);
         let x65 = Self::mul_add(
             -x36,
             x47,
-            Self::mul_add(x40, -177.0883695416, 97.44448770720001 * x41),
-        ) - x63;
-        let x66 = x48 + Self::mul_add(-s_q4, x62, c_q4 * x61);
-        let x67 = Self::mul_add(-c_q3, x44, s_q3 * x43);
-        let x68 = Self::mul_add(-3239.4582, x28, Self::mul_add(s_q3, x44, c_q3 * x43));
-        let x69 = Self::mul_add(3239.4582, x29, x67);
+            Self::mul_add(-97.44448770720001, x41, x40 * 177.0883695416),
+        ) + x63;
+        let x66 = x48 + Self::mul_add(s_q4, x62, c_q4 * x61);
+        let x67 = Self::mul_add(c_q3, x44, s_q3 * x43);
+        let x68 = Self::mul_add(3239.4582, x28, Self::mul_add(-s_q3, x44, c_q3 * x43));
+        let x69 = Self::mul_add(3239.4582, x29, -x67);
         let x70 = Self::mul_add(
             1375.0472756800002,
             x26,
-            Self::mul_add(-x27, x32, x19 * x33),
-        ) + Self::mul_add(-s_q3, x65, c_q3 * x64);
-        let x71 = x34 + Self::mul_add(-7.11, x45, Self::mul_add(c_q3, x65, s_q3 * x64));
+            -Self::mul_add(x19, x33, x27 * x32),
+        ) + Self::mul_add(s_q3, x65, c_q3 * x64);
+        let x71 = x34 + Self::mul_add(7.11, x45, Self::mul_add(-c_q3, x65, s_q3 * x64));
         let x72 = Self::mul_add(
             3239.4582,
             x23,
-            Self::mul_add(24998.827802, x26, 1375.0472756800002 * x24)
-                - Self::mul_add(x18, x32, x19 * x31),
-        ) + Self::mul_add(7.11, x67, x66);
-        let x73 = Self::mul_add(-s_q2, x69, c_q2 * x68);
-        let x74 = Self::mul_add(c_q2, x69, s_q2 * x68);
-        let x75 = Self::mul_add(
-            -5224.5702,
+            Self::mul_add(-24998.827802, x26, 1375.0472756800002 * x24)
+                + Self::mul_add(x18, x32, x19 * x31),
+        ) - Self::mul_add(-7.11, x67, x66);
+        let x73 = -x72;
+        let x74 = Self::mul_add(s_q2, x69, c_q2 * x68);
+        let x75 = Self::mul_add(-c_q2, x69, s_q2 * x68);
+        let x76 = -(Self::mul_add(
+            5224.5702,
             x5,
-            Self::mul_add(-3946.1881206800003, x8, 39241.404122 * qdd[1])
-                + Self::mul_add(x1, x14, x2 * x13),
-        ) + Self::mul_add(7.11, x74, x72);
-        let x76 = Self::mul_add(
-            c_q1,
+            Self::mul_add(-39241.404122, qdd[1], 3946.1881206800003 * x8)
+                - Self::mul_add(x1, x14, x2 * x13),
+        ) + Self::mul_add(7.11, x75, x72));
+        let x77 = Self::mul_add(
+            -c_q1,
             x16
-                + (Self::mul_add(c_q2, x71, s_q2 * x70)
-                    - Self::mul_add(
+                - (Self::mul_add(c_q2, x71, s_q2 * x70)
+                    + Self::mul_add(
                         7.11,
-                        Self::mul_add(-3239.4582, x30, x45),
-                        0.475 * x73,
+                        Self::mul_add(3239.4582, x30, x45),
+                        0.475 * x74,
                     )),
             s_q1
                 * (Self::mul_add(
                     3946.18812068,
                     qdd[1],
-                    Self::mul_add(-x2, x15, qd[1] * x14),
-                ) + Self::mul_add(0.475, x74, Self::mul_add(-s_q2, x71, c_q2 * x70))),
+                    Self::mul_add(x2, x15, qd[1] * x14),
+                ) + Self::mul_add(-0.475, x75, Self::mul_add(-s_q2, x71, c_q2 * x70))),
         );
-        let x77 = Self::mul_add(
+        let x78 = Self::mul_add(
             0.5692,
             Self::mul_add(
-                -c_q1,
-                Self::mul_add(-5224.5702, x11, x73),
-                s_q1 * Self::mul_add(5224.5702, x12, x74),
+                s_q1,
+                Self::mul_add(5224.5702, x12, -x75),
+                c_q1 * Self::mul_add(5224.5702, x11, x74),
             ),
-            x76,
+            x77,
         );
-        let x78 = Self::mul_add(1650.6386721183999, qdd[0], -x77);
-        [x78, x75, x72, x66, x63, x57]
+        let x79 = Self::mul_add(1650.6386721183999, qdd[0], -x78);
+        [x79, x76, x73, x66, x63, x57]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
@@ -1508,7 +1515,7 @@ impl Ssrms6 {
         let x10 = s_q3 * s_q3 * x9;
         let x11 = x6 - x10;
         let x12 = Self::mul_add(97.44448770720001, s_q3, c_q3 * x7);
-        let x13 = Self::mul_add(-s_q3, x7, 97.44448770720001 * c_q3);
+        let x13 = Self::mul_add(-97.44448770720001, c_q3, s_q3 * x7);
         let x14 = 171.195516 * s_q3;
         let x15 = 171.195516 * c_q3;
         let x16 = 7.11 * x14;
@@ -1516,8 +1523,8 @@ impl Ssrms6 {
         let x18 = x8 - x16;
         let x19 = 3239.4582 - x14;
         let x20 = 1375.0472756800002 - x12;
-        let x21 = 24989.305802 + (-129.6173695416 + x10 - x16 - x16);
-        let x22 = 24998.827802 + (x18 - x16);
+        let x21 = 24989.305802 - (x16 - (-129.6173695416 + x10 - x16));
+        let x22 = 24998.827802 - (x16 - x18);
         let x23 = s_q2 * s_q2;
         let x24 = s_q2 * c_q2;
         let x25 = x11 - x21;
@@ -1530,11 +1537,11 @@ impl Ssrms6 {
         let x32 = c_q2 * x15;
         let x33 = Self::mul_add(s_q2, x19, x32);
         let x34 = 7.11 * x31;
-        let x35 = Self::mul_add(x31, 0.475, Self::mul_add(c_q2, x20, -x28));
+        let x35 = Self::mul_add(x31, 0.475, Self::mul_add(c_q2, x20, x28));
         let x36 = Self::mul_add(-7.11, x33, x17 + Self::mul_add(-x23, x26, x24 * x25));
         let x37 = x22 + x34;
         let x38 = 39234.474122 + (x34 + (x21 + x27 + x34));
-        let x39 = c_q1 * Self::mul_add(x33, 0.475, Self::mul_add(s_q2, x20, x29));
+        let x39 = c_q1 * Self::mul_add(x33, 0.475, Self::mul_add(s_q2, x20, -x29));
         let x40 = c_q1 * x33;
         let x41 = Self::mul_add(
             0.5692,
@@ -1546,14 +1553,14 @@ impl Ssrms6 {
             Self::mul_add(s_q1, x31, x40),
             Self::mul_add(s_q1, x35, x39),
         );
-        let x43 = Self::mul_add(s_q2, x14, -x32);
+        let x43 = Self::mul_add(-s_q2, x14, x32);
         let x44 = Self::mul_add(c_q2, x14, x30);
         let x45 = Self::mul_add(
             -c_q1,
-            Self::mul_add(-0.475, x43, Self::mul_add(-s_q2, x12, x29)),
-            s_q1 * Self::mul_add(0.475, x44, Self::mul_add(c_q2, x12, x28)),
+            Self::mul_add(-0.475, x43, Self::mul_add(s_q2, x12, x29)),
+            s_q1 * Self::mul_add(-0.475, x44, Self::mul_add(-c_q2, x12, x28)),
         );
-        let x46 = Self::mul_add(0.5692, Self::mul_add(s_q1, x44, c_q1 * x43), x45);
+        let x46 = Self::mul_add(0.5692, Self::mul_add(-s_q1, x44, c_q1 * x43), x45);
         let x47 = 47.471 * s_q3;
         let x48 = 47.471 * c_q3;
         let x49 = Self::mul_add(
@@ -1580,20 +1587,20 @@ impl Ssrms6 {
         let x62 = x55 * x56;
         let x63 = 3946.18812068 * qd[1];
         let x64 = 39234.474122 * x56;
-        let x65 = Self::mul_add(-3946.1881206800003, x55, 39241.404122 * qd[1]);
+        let x65 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x55);
         let x66 = Self::mul_add(
             -5224.5702,
             x57,
-            Self::mul_add(39234.474122, x59, Self::mul_add(x55, x65, qd[1] * x63)),
+            Self::mul_add(39234.474122, x59, Self::mul_add(-x55, x65, qd[1] * x63)),
         );
         let x67 = Self::mul_add(s_q2, x56, c_q2 * x55);
         let x68 = Self::mul_add(-c_q2, x56, s_q2 * x55);
         let x69 = 7.11 * x61;
         let x70 = 7.11 * x62;
         let x71 = x57
-            + Self::mul_add(-7.11, x59 + x59, 0.475 * Self::mul_add(x55, x55, x60));
+            - Self::mul_add(-0.475, Self::mul_add(x55, x55, x60), 7.11 * (x59 + x59));
         let x72 = Self::mul_add(c_q2, x70, s_q2 * x69);
-        let x73 = Self::mul_add(qd[2], x68, Self::mul_add(-c_q2, x58, s_q2 * x59));
+        let x73 = Self::mul_add(-qd[2], x68, Self::mul_add(-s_q2, x59, c_q2 * x58));
         let x74 = Self::mul_add(qd[2], x67, Self::mul_add(c_q2, x59, s_q2 * x58));
         let x75 = qd[1] + qd[2];
         let x76 = Self::mul_add(x75, x75, x68 * x68);
@@ -1601,91 +1608,87 @@ impl Ssrms6 {
         let x78 = Self::mul_add(x67, x75, x74);
         let x79 = 1375.0472756800002 * x75;
         let x80 = 24989.305802 * x68;
-        let x81 = Self::mul_add(-1375.0472756800002, x67, 24998.827802 * x75);
+        let x81 = Self::mul_add(-24998.827802, x75, 1375.0472756800002 * x67);
         let x82 = Self::mul_add(
             -3239.4582,
             x71,
-            Self::mul_add(24989.305802, x74, Self::mul_add(x67, x81, x75 * x79)),
+            Self::mul_add(24989.305802, x74, Self::mul_add(-x67, x81, x75 * x79)),
         );
         let x83 = Self::mul_add(
-            3239.4582,
+            -3239.4582,
             x72,
-            Self::mul_add(1375.0472756800002, x73, -Self::mul_add(x67, x80, x68 * x79)),
+            Self::mul_add(1375.0472756800002, x73, Self::mul_add(x67, x80, x68 * x79)),
         );
-        let x84 = Self::mul_add(-c_q3, x67, s_q3 * x68);
+        let x84 = Self::mul_add(-s_q3, x68, c_q3 * x67);
         let x85 = Self::mul_add(c_q3, x68, s_q3 * x67);
         let x86 = Self::mul_add(
-            s_q3,
+            -s_q3,
             Self::mul_add(-7.11, x77, x72),
-            c_q3 * Self::mul_add(-7.11, x76, Self::mul_add(-c_q2, x69, s_q2 * x70)),
+            c_q3 * Self::mul_add(7.11, x76, Self::mul_add(-s_q2, x70, c_q2 * x69)),
         );
-        let x87 = Self::mul_add(qd[3], x85, Self::mul_add(s_q3, x74, c_q3 * x73));
-        let x88 = Self::mul_add(-qd[3], x84, Self::mul_add(-s_q3, x73, c_q3 * x74));
+        let x87 = Self::mul_add(-qd[3], x85, Self::mul_add(-s_q3, x74, c_q3 * x73));
+        let x88 = Self::mul_add(qd[3], x84, Self::mul_add(c_q3, x74, s_q3 * x73));
         let x89 = qd[3] + x75;
         let x90 = 171.195516 * (x84 * x85);
         let x91 = 171.195516 * Self::mul_add(x84, x84, x89 * x89);
-        let x92 = 171.195516 * Self::mul_add(x85, x89, x87);
-        let x93 = Self::mul_add(x85, -177.0883695416, 97.44448770720001 * x89);
+        let x92 = 171.195516 * Self::mul_add(-x85, x89, x87);
+        let x93 = Self::mul_add(-97.44448770720001, x89, x85 * 177.0883695416);
         let x94 = Self::mul_add(179.8829695416, x89, 97.44448770720001 * x85);
-        let x95 = Self::mul_add(-s_q4, x84, c_q4 * x89);
-        let x96 = Self::mul_add(s_q4, x89, c_q4 * x84);
-        let x97 = Self::mul_add(qd[4], x95, c_q4 * x87);
+        let x95 = Self::mul_add(c_q4, x89, s_q4 * x84);
+        let x96 = Self::mul_add(-s_q4, x89, c_q4 * x84);
+        let x97 = Self::mul_add(-qd[4], x95, c_q4 * x87);
         let x98 = qd[4] - x85;
         let x99 = 44.41 * x96;
         let x100 = 47.471 * x98;
         let x101 = 9.336 * x97;
-        let x102 = 9.336 * (qd[5] + x96);
-        let x103 = Self::mul_add(-s_q5, x95, c_q5 * x98) * x102;
+        let x102 = 9.336 * (qd[5] - x96);
+        let x103 = Self::mul_add(-c_q5, x98, s_q5 * x95) * x102;
         let x104 = Self::mul_add(s_q5, x98, c_q5 * x95) * x102;
-        let x105 = Self::mul_add(s_q5, x104, c_q5 * x103)
-            - Self::mul_add(x96, x100, x98 * x99);
-        let x106 = Self::mul_add(-x95, x100, 44.41 * x97) - x101;
-        let x107 = Self::mul_add(-47.471, x88, x95 * x99)
-            + Self::mul_add(-c_q5, x104, s_q5 * x103);
+        let x105 = Self::mul_add(x96, x100, x98 * x99)
+            - Self::mul_add(-s_q5, x104, c_q5 * x103);
+        let x106 = Self::mul_add(x95, x100, 44.41 * x97) - x101;
+        let x107 = Self::mul_add(x95, x99, 47.471 * x88)
+            + Self::mul_add(c_q5, x104, s_q5 * x103);
         let x108 = Self::mul_add(
             171.195516,
             Self::mul_add(-7.11, x78, x71),
-            Self::mul_add(-x89, x93, x85 * x94),
-        ) - Self::mul_add(c_q4, x106, s_q4 * x105);
-        let x109 = Self::mul_add(x84, x94, x88 * 177.0883695416) + x107;
+            Self::mul_add(x85, x94, x89 * x93),
+        ) - Self::mul_add(-c_q4, x106, s_q4 * x105);
+        let x109 = Self::mul_add(-x84, x94, x88 * 177.0883695416) - x107;
         let x110 = Self::mul_add(
-            -171.195516,
+            171.195516,
             x86,
             Self::mul_add(x84, x93, 97.44448770720001 * x88),
-        ) + Self::mul_add(-s_q4, x106, c_q4 * x105);
-        let x111 = Self::mul_add(-c_q3, x91, s_q3 * x90);
-        let x112 = Self::mul_add(-3239.4582, x76, Self::mul_add(s_q3, x91, c_q3 * x90));
-        let x113 = Self::mul_add(-3239.4582, x77, x111);
-        let x114 = Self::mul_add(-x75, x80, x68 * x81)
-            + Self::mul_add(s_q3, x109, c_q3 * x108);
+        ) + Self::mul_add(s_q4, x106, c_q4 * x105);
+        let x111 = Self::mul_add(c_q3, x91, s_q3 * x90);
+        let x112 = Self::mul_add(3239.4582, x76, Self::mul_add(-s_q3, x91, c_q3 * x90));
+        let x113 = Self::mul_add(3239.4582, x77, x111);
+        let x114 = Self::mul_add(x68, x81, x75 * x80)
+            - Self::mul_add(s_q3, x109, c_q3 * x108);
         let x115 = x82
-            + Self::mul_add(-7.11, x92, Self::mul_add(-c_q3, x109, s_q3 * x108));
-        let x116 = x83 + Self::mul_add(7.11, x111, x110);
+            + Self::mul_add(7.11, x92, Self::mul_add(-c_q3, x109, s_q3 * x108));
+        let x116 = x83 - Self::mul_add(-7.11, x111, x110);
         let x117 = Self::mul_add(-s_q2, x113, c_q2 * x112);
         let x118 = Self::mul_add(c_q2, x113, s_q2 * x112);
         let x119 = Self::mul_add(
             c_q1,
             x66
-                + (Self::mul_add(c_q2, x115, s_q2 * x114)
+                - (Self::mul_add(-c_q2, x115, s_q2 * x114)
                     - Self::mul_add(
                         7.11,
-                        Self::mul_add(-3239.4582, x78, x92),
+                        Self::mul_add(3239.4582, x78, x92),
                         0.475 * x117,
                     )),
             s_q1
-                * (Self::mul_add(-x56, x65, qd[1] * x64)
-                    + Self::mul_add(
-                        0.475,
-                        x118,
-                        Self::mul_add(-s_q2, x115, c_q2 * x114),
-                    )),
+                * (Self::mul_add(x56, x65, qd[1] * x64)
+                    - Self::mul_add(0.475, x118, Self::mul_add(s_q2, x115, c_q2 * x114))),
         );
         let x120 = Self::mul_add(
             0.5692,
             Self::mul_add(
-                -c_q1,
-                Self::mul_add(-5224.5702, x61, x117),
-                s_q1 * Self::mul_add(5224.5702, x62, x118),
+                s_q1,
+                Self::mul_add(5224.5702, x62, -x118),
+                c_q1 * Self::mul_add(5224.5702, x61, x117),
             ),
             x119,
         );
@@ -1706,16 +1709,16 @@ impl Ssrms6 {
         let x128 = 1.0 / Self::mul_add(-x41, x123, 39241.404122 + (x34 + x37));
         let x129 = Self::mul_add(-x41, x124, x37);
         let x130 = x128 * x129;
-        let x131 = Self::mul_add(x41, x125, Self::mul_add(-7.11, x44, x18));
+        let x131 = Self::mul_add(-x41, x125, Self::mul_add(-7.11, x44, x18));
         let x132 = x128 * x131;
         let x133 = x41 * x126;
         let x134 = x128 * x133;
         let x135 = Self::mul_add(-x41, x127, x51);
         let x136 = x128 * x135;
         let x137 = 1.0 / Self::mul_add(-x129, x130, Self::mul_add(-x42, x124, x22));
-        let x138 = Self::mul_add(-x129, x132, Self::mul_add(x42, x125, x18));
+        let x138 = Self::mul_add(-x129, x132, Self::mul_add(-x42, x125, x18));
         let x139 = x137 * x138;
-        let x140 = Self::mul_add(-x42, x126, x129 * x134);
+        let x140 = Self::mul_add(-x129, x134, x42 * x126);
         let x141 = x137 * x140;
         let x142 = Self::mul_add(-x129, x136, Self::mul_add(-x42, x127, x51));
         let x143 = x137 * x142;
@@ -1725,12 +1728,12 @@ impl Ssrms6 {
             Self::mul_add(-x131, x132, Self::mul_add(-x46, x125, x8)),
         );
         let x145 = 1.0 / x144;
-        let x146 = Self::mul_add(-x138, x141, Self::mul_add(x131, x134, x46 * x126));
+        let x146 = Self::mul_add(-x138, x141, Self::mul_add(-x131, x134, x46 * x126));
         let x147 = x145 * x146;
         let x148 = Self::mul_add(
             -x138,
             x143,
-            Self::mul_add(-x131, x136, Self::mul_add(x46, x127, x51)),
+            Self::mul_add(-x131, x136, Self::mul_add(-x46, x127, x51)),
         );
         let x149 = x145 * x148;
         let x150 = Self::mul_add(
@@ -1742,7 +1745,7 @@ impl Ssrms6 {
         let x152 = Self::mul_add(
             -x146,
             x149,
-            Self::mul_add(-x140, x143, Self::mul_add(-x49, x127, x133 * x136)),
+            Self::mul_add(-x140, x143, Self::mul_add(-x133, x136, x49 * x127)),
         );
         let x153 = x151 * x152;
         let x154 = Self::mul_add(
@@ -1755,36 +1758,36 @@ impl Ssrms6 {
             x121,
             x123,
             tau[1]
-                - (Self::mul_add(
-                    -3946.1881206800003,
+                + (Self::mul_add(
+                    3946.1881206800003,
                     x58,
-                    Self::mul_add(x55, x64, x56 * x63),
+                    -Self::mul_add(x55, x64, x56 * x63),
                 ) + Self::mul_add(7.11, x118, x116)),
         );
-        let x157 = Self::mul_add(-x130, x156, Self::mul_add(x121, x124, tau[2] - x116));
+        let x157 = Self::mul_add(-x130, x156, Self::mul_add(x121, x124, tau[2] + x116));
         let x158 = Self::mul_add(
             -x139,
             x157,
-            Self::mul_add(-x132, x156, Self::mul_add(-x121, x125, tau[3] - x110)),
+            Self::mul_add(-x132, x156, Self::mul_add(x121, x125, tau[3] - x110)),
         );
         let x159 = Self::mul_add(
-            -x141,
+            x141,
             x157,
-            Self::mul_add(x134, x156, Self::mul_add(x121, x126, tau[4] - x107)),
+            Self::mul_add(x134, x156, Self::mul_add(x121, x126, tau[4] + x107)),
         );
-        let x160 = Self::mul_add(-x147, x158, x159);
+        let x160 = Self::mul_add(x147, x158, x159);
         let x161 = Self::mul_add(
             -x143,
             x157,
-            Self::mul_add(-x136, x156, Self::mul_add(x121, x127, tau[5] - x101)),
+            Self::mul_add(-x136, x156, Self::mul_add(x121, x127, tau[5] + x101)),
         );
-        let x162 = x155 * Self::mul_add(-x153, x160, Self::mul_add(-x149, x158, x161));
-        let x163 = Self::mul_add(-x153, x162, x151 * x160);
-        let x164 = Self::mul_add(-x149, x162, Self::mul_add(-x147, x163, x145 * x158));
+        let x162 = x155 * Self::mul_add(x153, x160, Self::mul_add(-x149, x158, x161));
+        let x163 = Self::mul_add(x153, x162, x151 * x160);
+        let x164 = Self::mul_add(-x149, x162, Self::mul_add(x147, x163, x145 * x158));
         let x165 = Self::mul_add(
             -x143,
             x162,
-            Self::mul_add(-x141, x163, Self::mul_add(-x139, x164, x137 * x157)),
+            Self::mul_add(x141, x163, Self::mul_add(-x139, x164, x137 * x157)),
         );
         let x166 = Self::mul_add(
             x134,
@@ -1793,7 +1796,7 @@ impl Ssrms6 {
         );
         let x167 = Self::mul_add(-x136, x162, x166);
         let x168 = Self::mul_add(
-            -x125,
+            x125,
             x164,
             Self::mul_add(x124, x165, Self::mul_add(x123, x167, x121 * x122)),
         );
@@ -1821,7 +1824,7 @@ impl Ssrms6 {
         let x10 = s_q3 * s_q3 * x9;
         let x11 = x6 - x10;
         let x12 = Self::mul_add(97.44448770720001, s_q3, c_q3 * x7);
-        let x13 = Self::mul_add(-s_q3, x7, 97.44448770720001 * c_q3);
+        let x13 = Self::mul_add(-97.44448770720001, c_q3, s_q3 * x7);
         let x14 = 171.195516 * s_q3;
         let x15 = 171.195516 * c_q3;
         let x16 = 7.11 * x14;
@@ -1829,8 +1832,8 @@ impl Ssrms6 {
         let x18 = x8 - x16;
         let x19 = 3239.4582 - x14;
         let x20 = 1375.0472756800002 - x12;
-        let x21 = 24989.305802 + (-129.6173695416 + x10 - x16 - x16);
-        let x22 = 24998.827802 + (x18 - x16);
+        let x21 = 24989.305802 - (x16 - (-129.6173695416 + x10 - x16));
+        let x22 = 24998.827802 - (x16 - x18);
         let x23 = s_q2 * s_q2;
         let x24 = s_q2 * c_q2;
         let x25 = x11 - x21;
@@ -1843,12 +1846,12 @@ impl Ssrms6 {
         let x32 = c_q2 * x15;
         let x33 = Self::mul_add(s_q2, x19, x32);
         let x34 = 7.11 * x31;
-        let x35 = Self::mul_add(x31, 0.475, Self::mul_add(c_q2, x20, -x28));
+        let x35 = Self::mul_add(x31, 0.475, Self::mul_add(c_q2, x20, x28));
         let x36 = Self::mul_add(-7.11, x33, x17 + Self::mul_add(-x23, x26, x24 * x25));
         let x37 = x22 + x34;
         let x38 = 39234.474122 + (x34 + (x21 + x27 + x34));
         let x39 = 39241.404122 + (x34 + x37);
-        let x40 = c_q1 * Self::mul_add(x33, 0.475, Self::mul_add(s_q2, x20, x29));
+        let x40 = c_q1 * Self::mul_add(x33, 0.475, Self::mul_add(s_q2, x20, -x29));
         let x41 = c_q1 * x33;
         let x42 = 1650.6386721183999
             + (x38
@@ -1867,15 +1870,15 @@ impl Ssrms6 {
             Self::mul_add(s_q1, x31, x41),
             Self::mul_add(s_q1, x35, x40),
         );
-        let x45 = Self::mul_add(s_q2, x14, -x32);
+        let x45 = Self::mul_add(-s_q2, x14, x32);
         let x46 = Self::mul_add(c_q2, x14, x30);
         let x47 = Self::mul_add(-7.11, x46, x18);
         let x48 = Self::mul_add(
             -c_q1,
-            Self::mul_add(-0.475, x45, Self::mul_add(-s_q2, x12, x29)),
-            s_q1 * Self::mul_add(0.475, x46, Self::mul_add(c_q2, x12, x28)),
+            Self::mul_add(-0.475, x45, Self::mul_add(s_q2, x12, x29)),
+            s_q1 * Self::mul_add(-0.475, x46, Self::mul_add(-c_q2, x12, x28)),
         );
-        let x49 = Self::mul_add(0.5692, Self::mul_add(s_q1, x46, c_q1 * x45), x48);
+        let x49 = -Self::mul_add(0.5692, Self::mul_add(-s_q1, x46, c_q1 * x45), x48);
         let x50 = 47.471 * s_q3;
         let x51 = 47.471 * c_q3;
         let x52 = -Self::mul_add(
@@ -1902,20 +1905,20 @@ impl Ssrms6 {
         let x65 = x58 * x59;
         let x66 = 3946.18812068 * qd[1];
         let x67 = 39234.474122 * x59;
-        let x68 = Self::mul_add(-3946.1881206800003, x58, 39241.404122 * qd[1]);
+        let x68 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x58);
         let x69 = Self::mul_add(
             -5224.5702,
             x60,
-            Self::mul_add(39234.474122, x62, Self::mul_add(x58, x68, qd[1] * x66)),
+            Self::mul_add(39234.474122, x62, Self::mul_add(-x58, x68, qd[1] * x66)),
         );
         let x70 = Self::mul_add(s_q2, x59, c_q2 * x58);
         let x71 = Self::mul_add(-c_q2, x59, s_q2 * x58);
         let x72 = 7.11 * x64;
         let x73 = 7.11 * x65;
         let x74 = x60
-            + Self::mul_add(-7.11, x62 + x62, 0.475 * Self::mul_add(x58, x58, x63));
+            - Self::mul_add(-0.475, Self::mul_add(x58, x58, x63), 7.11 * (x62 + x62));
         let x75 = Self::mul_add(c_q2, x73, s_q2 * x72);
-        let x76 = Self::mul_add(qd[2], x71, Self::mul_add(-c_q2, x61, s_q2 * x62));
+        let x76 = Self::mul_add(-qd[2], x71, Self::mul_add(-s_q2, x62, c_q2 * x61));
         let x77 = Self::mul_add(qd[2], x70, Self::mul_add(c_q2, x62, s_q2 * x61));
         let x78 = qd[1] + qd[2];
         let x79 = Self::mul_add(x78, x78, x71 * x71);
@@ -1923,100 +1926,99 @@ impl Ssrms6 {
         let x81 = Self::mul_add(x70, x78, x77);
         let x82 = 1375.0472756800002 * x78;
         let x83 = 24989.305802 * x71;
-        let x84 = Self::mul_add(-1375.0472756800002, x70, 24998.827802 * x78);
+        let x84 = Self::mul_add(-24998.827802, x78, 1375.0472756800002 * x70);
         let x85 = Self::mul_add(
             -3239.4582,
             x74,
-            Self::mul_add(24989.305802, x77, Self::mul_add(x70, x84, x78 * x82)),
+            Self::mul_add(24989.305802, x77, Self::mul_add(-x70, x84, x78 * x82)),
         );
         let x86 = Self::mul_add(
-            3239.4582,
+            -3239.4582,
             x75,
-            Self::mul_add(1375.0472756800002, x76, -Self::mul_add(x70, x83, x71 * x82)),
+            Self::mul_add(1375.0472756800002, x76, Self::mul_add(x70, x83, x71 * x82)),
         );
-        let x87 = Self::mul_add(-c_q3, x70, s_q3 * x71);
+        let x87 = Self::mul_add(-s_q3, x71, c_q3 * x70);
         let x88 = Self::mul_add(c_q3, x71, s_q3 * x70);
         let x89 = Self::mul_add(
-            s_q3,
+            -s_q3,
             Self::mul_add(-7.11, x80, x75),
-            c_q3 * Self::mul_add(-7.11, x79, Self::mul_add(-c_q2, x72, s_q2 * x73)),
+            c_q3 * Self::mul_add(7.11, x79, Self::mul_add(-s_q2, x73, c_q2 * x72)),
         );
-        let x90 = Self::mul_add(qd[3], x88, Self::mul_add(s_q3, x77, c_q3 * x76));
-        let x91 = Self::mul_add(-qd[3], x87, Self::mul_add(-s_q3, x76, c_q3 * x77));
+        let x90 = Self::mul_add(-qd[3], x88, Self::mul_add(-s_q3, x77, c_q3 * x76));
+        let x91 = Self::mul_add(qd[3], x87, Self::mul_add(c_q3, x77, s_q3 * x76));
         let x92 = qd[3] + x78;
         let x93 = 171.195516 * (x87 * x88);
         let x94 = 171.195516 * Self::mul_add(x87, x87, x92 * x92);
-        let x95 = 171.195516 * Self::mul_add(x88, x92, x90);
-        let x96 = Self::mul_add(x88, -177.0883695416, 97.44448770720001 * x92);
+        let x95 = 171.195516 * Self::mul_add(-x88, x92, x90);
+        let x96 = Self::mul_add(-97.44448770720001, x92, x88 * 177.0883695416);
         let x97 = Self::mul_add(179.8829695416, x92, 97.44448770720001 * x88);
-        let x98 = Self::mul_add(-s_q4, x87, c_q4 * x92);
-        let x99 = Self::mul_add(s_q4, x92, c_q4 * x87);
-        let x100 = Self::mul_add(qd[4], x98, c_q4 * x90);
+        let x98 = Self::mul_add(c_q4, x92, s_q4 * x87);
+        let x99 = Self::mul_add(-s_q4, x92, c_q4 * x87);
+        let x100 = Self::mul_add(-qd[4], x98, c_q4 * x90);
         let x101 = qd[4] - x88;
         let x102 = 44.41 * x99;
         let x103 = 47.471 * x101;
         let x104 = 9.336 * x100;
-        let x105 = 9.336 * (qd[5] + x99);
-        let x106 = Self::mul_add(-s_q5, x98, c_q5 * x101) * x105;
-        let x107 = Self::mul_add(s_q5, x101, c_q5 * x98) * x105;
-        let x108 = Self::mul_add(s_q5, x107, c_q5 * x106)
-            - Self::mul_add(x99, x103, x101 * x102);
-        let x109 = Self::mul_add(-x98, x103, 44.41 * x100) - x104;
-        let x110 = Self::mul_add(-47.471, x91, x98 * x102)
-            + Self::mul_add(-c_q5, x107, s_q5 * x106);
-        let x111 = Self::mul_add(
+        let x105 = -x104;
+        let x106 = 9.336 * (qd[5] - x99);
+        let x107 = Self::mul_add(-c_q5, x101, s_q5 * x98) * x106;
+        let x108 = Self::mul_add(s_q5, x101, c_q5 * x98) * x106;
+        let x109 = Self::mul_add(x99, x103, x101 * x102)
+            - Self::mul_add(-s_q5, x108, c_q5 * x107);
+        let x110 = Self::mul_add(x98, x103, 44.41 * x100) - x104;
+        let x111 = Self::mul_add(x98, x102, 47.471 * x91)
+            + Self::mul_add(c_q5, x108, s_q5 * x107);
+        let x112 = -x111;
+        let x113 = Self::mul_add(
             171.195516,
             Self::mul_add(-7.11, x81, x74),
-            Self::mul_add(-x92, x96, x88 * x97),
-        ) - Self::mul_add(c_q4, x109, s_q4 * x108);
-        let x112 = Self::mul_add(x87, x97, x91 * 177.0883695416) + x110;
-        let x113 = Self::mul_add(
-            -171.195516,
+            Self::mul_add(x88, x97, x92 * x96),
+        ) - Self::mul_add(-c_q4, x110, s_q4 * x109);
+        let x114 = Self::mul_add(-x87, x97, x91 * 177.0883695416) - x111;
+        let x115 = Self::mul_add(
+            171.195516,
             x89,
             Self::mul_add(x87, x96, 97.44448770720001 * x91),
-        ) + Self::mul_add(-s_q4, x109, c_q4 * x108);
-        let x114 = Self::mul_add(-c_q3, x94, s_q3 * x93);
-        let x115 = Self::mul_add(-3239.4582, x79, Self::mul_add(s_q3, x94, c_q3 * x93));
-        let x116 = Self::mul_add(-3239.4582, x80, x114);
-        let x117 = Self::mul_add(-x78, x83, x71 * x84)
-            + Self::mul_add(s_q3, x112, c_q3 * x111);
-        let x118 = x85
-            + Self::mul_add(-7.11, x95, Self::mul_add(-c_q3, x112, s_q3 * x111));
-        let x119 = x86 + Self::mul_add(7.11, x114, x113);
-        let x120 = Self::mul_add(-s_q2, x116, c_q2 * x115);
-        let x121 = Self::mul_add(c_q2, x116, s_q2 * x115);
-        let x122 = Self::mul_add(
-            -3946.1881206800003,
+        ) + Self::mul_add(s_q4, x110, c_q4 * x109);
+        let x116 = Self::mul_add(c_q3, x94, s_q3 * x93);
+        let x117 = Self::mul_add(3239.4582, x79, Self::mul_add(-s_q3, x94, c_q3 * x93));
+        let x118 = Self::mul_add(3239.4582, x80, x116);
+        let x119 = Self::mul_add(x71, x84, x78 * x83)
+            - Self::mul_add(s_q3, x114, c_q3 * x113);
+        let x120 = x85
+            + Self::mul_add(7.11, x95, Self::mul_add(-c_q3, x114, s_q3 * x113));
+        let x121 = x86 - Self::mul_add(-7.11, x116, x115);
+        let x122 = -x121;
+        let x123 = Self::mul_add(-s_q2, x118, c_q2 * x117);
+        let x124 = Self::mul_add(c_q2, x118, s_q2 * x117);
+        let x125 = -(Self::mul_add(
+            3946.1881206800003,
             x61,
-            Self::mul_add(x58, x67, x59 * x66),
-        ) + Self::mul_add(7.11, x121, x119);
-        let x123 = Self::mul_add(
+            -Self::mul_add(x58, x67, x59 * x66),
+        ) + Self::mul_add(7.11, x124, x121));
+        let x126 = Self::mul_add(
             c_q1,
             x69
-                + (Self::mul_add(c_q2, x118, s_q2 * x117)
+                - (Self::mul_add(-c_q2, x120, s_q2 * x119)
                     - Self::mul_add(
                         7.11,
-                        Self::mul_add(-3239.4582, x81, x95),
-                        0.475 * x120,
+                        Self::mul_add(3239.4582, x81, x95),
+                        0.475 * x123,
                     )),
             s_q1
-                * (Self::mul_add(-x59, x68, qd[1] * x67)
-                    + Self::mul_add(
-                        0.475,
-                        x121,
-                        Self::mul_add(-s_q2, x118, c_q2 * x117),
-                    )),
+                * (Self::mul_add(x59, x68, qd[1] * x67)
+                    - Self::mul_add(0.475, x124, Self::mul_add(s_q2, x120, c_q2 * x119))),
         );
-        let x124 = Self::mul_add(
+        let x127 = Self::mul_add(
             0.5692,
             Self::mul_add(
-                -c_q1,
-                Self::mul_add(-5224.5702, x64, x120),
-                s_q1 * Self::mul_add(5224.5702, x65, x121),
+                s_q1,
+                Self::mul_add(5224.5702, x65, -x124),
+                c_q1 * Self::mul_add(5224.5702, x64, x123),
             ),
-            x123,
+            x126,
         );
-        let x125 = -x124;
+        let x128 = -x127;
         (
             [
                 [x42, x43, x44, x49, x52, x57],
@@ -2026,12 +2028,12 @@ impl Ssrms6 {
                 [x52, 0.0, 0.0, 0.0, 47.471, 0.0],
                 [x57, x54, x54, x54, 0.0, 9.336],
             ],
-            [x125, x122, x119, x113, x110, x104],
+            [x128, x125, x122, x115, x112, x105],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 331 mul, 274 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 191 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 329 mul, 271 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 190 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 6],
@@ -2050,315 +2052,303 @@ impl Ssrms6 {
         let x8 = 135.4729695416 + (44.41 - x5);
         let x9 = 47.471 - x7;
         let x10 = s_q3 * s_q3 * x9;
-        let x11 = Self::mul_add(c_q3, -97.44448770720001, s_q3 * x6);
+        let x11 = Self::mul_add(-s_q3, x6, c_q3 * 97.44448770720001);
         let x12 = Self::mul_add(c_q3, x6, s_q3 * 97.44448770720001);
         let x13 = c_q3 * 171.195516;
         let x14 = s_q3 * 171.195516;
         let x15 = 7.11 * x14;
         let x16 = x8 - x15;
         let x17 = Self::mul_add(7.11, x13, s_q3 * c_q3 * x9);
-        let x18 = 47.471 - x10 - x15 - x15;
+        let x18 = x15 - (47.471 - x10 - x15);
         let x19 = 3239.4582 - x14;
         let x20 = -24989.305802 + (x7 + x10);
         let x21 = 1375.0472756800002 - x12;
-        let x22 = 24998.827802 + (x16 - x15);
+        let x22 = 24998.827802 - (x15 - x16);
         let x23 = s_q2 * s_q2;
         let x24 = s_q2 * c_q2;
-        let x25 = x18 - x20;
+        let x25 = x18 + x20;
         let x26 = x17 + x17;
-        let x27 = Self::mul_add(x24, x26, x23 * x25);
+        let x27 = Self::mul_add(-x24, x26, x23 * x25);
         let x28 = c_q2 * x11;
         let x29 = s_q2 * x11;
-        let x30 = Self::mul_add(c_q2, x21, x29);
-        let x31 = c_q2 * x13;
-        let x32 = Self::mul_add(s_q2, x19, x31);
-        let x33 = s_q2 * x13;
-        let x34 = c_q2 * x19;
-        let x35 = x34 - x33;
-        let x36 = 7.11 * x35;
-        let x37 = Self::mul_add(7.11, x32, x17 + Self::mul_add(-x23, x26, x24 * x25));
-        let x38 = x36 + (x18 - x27 + x36);
-        let x39 = c_q1 * Self::mul_add(x32, -0.475, Self::mul_add(-s_q2, x21, x28));
-        let x40 = c_q1 * x32;
+        let x30 = c_q2 * x13;
+        let x31 = Self::mul_add(s_q2, x19, x30);
+        let x32 = s_q2 * x13;
+        let x33 = Self::mul_add(-c_q2, x19, x32);
+        let x34 = 7.11 * x33;
+        let x35 = Self::mul_add(x33, 0.475, Self::mul_add(-c_q2, x21, x29));
+        let x36 = x22 - x34;
+        let x37 = Self::mul_add(7.11, x31, x17 - Self::mul_add(x23, x26, x24 * x25));
+        let x38 = x34 + (x18 - x27 + x34);
+        let x39 = c_q1 * Self::mul_add(x31, 0.475, Self::mul_add(s_q2, x21, x28));
+        let x40 = c_q1 * x31;
         let x41 = Self::mul_add(
-            -0.5692,
-            Self::mul_add(s_q1, 5224.5702 + x35, x40),
-            Self::mul_add(-s_q1, 3946.18812068 + Self::mul_add(x35, 0.475, x30), x39),
-        );
-        let x42 = x33 - x34;
-        let x43 = Self::mul_add(
             0.5692,
-            Self::mul_add(s_q1, x42, -x40),
-            Self::mul_add(-s_q1, Self::mul_add(-0.475, x42, x30), x39),
+            Self::mul_add(s_q1, 5224.5702 - x33, x40),
+            Self::mul_add(s_q1, 3946.18812068 - x35, x39),
         );
-        let x44 = Self::mul_add(s_q2, x14, -x31);
-        let x45 = Self::mul_add(c_q2, x14, x33);
-        let x46 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-0.475, x45, Self::mul_add(-c_q2, x12, x29)),
-            c_q1 * Self::mul_add(0.475, x44, Self::mul_add(s_q2, x12, x28)),
+        let x42 = Self::mul_add(
+            0.5692,
+            Self::mul_add(-s_q1, x33, x40),
+            Self::mul_add(-s_q1, x35, x39),
         );
-        let x47 = Self::mul_add(0.5692, Self::mul_add(s_q1, x45, c_q1 * x44), x46);
-        let x48 = 47.471 * s_q3;
-        let x49 = 47.471 * c_q3;
-        let x50 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(s_q2, x49, c_q2 * x48),
-            c_q1 * Self::mul_add(-s_q2, x48, c_q2 * x49),
+        let x43 = Self::mul_add(-s_q2, x14, x30);
+        let x44 = Self::mul_add(c_q2, x14, x32);
+        let x45 = Self::mul_add(
+            -c_q1,
+            Self::mul_add(0.475, x43, Self::mul_add(-s_q2, x12, x28)),
+            s_q1 * Self::mul_add(0.475, x44, Self::mul_add(c_q2, x12, x29)),
         );
-        let x51 = 9.336 * c_q4;
-        let x52 = 9.336 * s_q4;
-        let x53 = c_q3 * x51;
-        let x54 = s_q3 * x51;
-        let x55 = Self::mul_add(
+        let x46 = Self::mul_add(-0.5692, Self::mul_add(-s_q1, x44, c_q1 * x43), x45);
+        let x47 = 47.471 * s_q3;
+        let x48 = 47.471 * c_q3;
+        let x49 = Self::mul_add(
             c_q1,
-            Self::mul_add(c_q2, x54, s_q2 * x53),
-            s_q1 * Self::mul_add(-s_q2, x54, c_q2 * x53),
+            Self::mul_add(-c_q2, x48, s_q2 * x47),
+            s_q1 * Self::mul_add(s_q2, x48, c_q2 * x47),
         );
-        let x56 = qd[0] * s_q1;
-        let x57 = qd[0] * c_q1;
-        let x58 = 0.5692 * (qd[0] * qd[0]);
-        let x59 = qd[1] * x57;
-        let x60 = qd[1] * x56;
-        let x61 = x57 * x57;
-        let x62 = Self::mul_add(qd[1], qd[1], x61);
-        let x63 = x56 * x57;
-        let x64 = Self::mul_add(3946.18812068, qd[1], x56 * 39234.47412200001);
-        let x65 = Self::mul_add(-3946.1881206800003, x56, 39241.404122 * qd[1]);
-        let x66 = Self::mul_add(s_q2, x57, c_q2 * x56);
-        let x67 = Self::mul_add(-s_q2, x56, c_q2 * x57);
+        let x50 = 9.336 * c_q4;
+        let x51 = 9.336 * s_q4;
+        let x52 = c_q3 * x50;
+        let x53 = s_q3 * x50;
+        let x54 = Self::mul_add(
+            c_q1,
+            Self::mul_add(c_q2, x53, s_q2 * x52),
+            s_q1 * Self::mul_add(-s_q2, x53, c_q2 * x52),
+        );
+        let x55 = qd[0] * s_q1;
+        let x56 = qd[0] * c_q1;
+        let x57 = 0.5692 * (qd[0] * qd[0]);
+        let x58 = qd[1] * x56;
+        let x59 = qd[1] * x55;
+        let x60 = x56 * x56;
+        let x61 = Self::mul_add(qd[1], qd[1], x60);
+        let x62 = x55 * x56;
+        let x63 = Self::mul_add(3946.18812068, qd[1], x55 * 39234.47412200001);
+        let x64 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x55);
+        let x65 = Self::mul_add(s_q2, x56, c_q2 * x55);
+        let x66 = Self::mul_add(-c_q2, x56, s_q2 * x55);
+        let x67 = 7.11 * x61;
         let x68 = 7.11 * x62;
-        let x69 = 7.11 * x63;
-        let x70 = x58
-            + Self::mul_add(-7.11, x60 + x60, 0.475 * Self::mul_add(x56, x56, x61));
-        let x71 = Self::mul_add(c_q2, x69, s_q2 * x68);
-        let x72 = Self::mul_add(-qd[2], x67, Self::mul_add(-c_q2, x59, s_q2 * x60));
-        let x73 = Self::mul_add(qd[2], x66, Self::mul_add(c_q2, x60, s_q2 * x59));
-        let x74 = qd[1] + qd[2];
-        let x75 = Self::mul_add(x67, x67, x74 * x74);
-        let x76 = x66 * x67;
-        let x77 = Self::mul_add(x66, x74, x73);
-        let x78 = Self::mul_add(1375.0472756800002, x74, x66 * 24989.305802);
-        let x79 = Self::mul_add(-1375.0472756800002, x66, 24998.827802 * x74);
-        let x80 = Self::mul_add(s_q3, x67, c_q3 * x66);
-        let x81 = Self::mul_add(-s_q3, x66, c_q3 * x67);
-        let x82 = Self::mul_add(
-            s_q3,
-            Self::mul_add(7.11, x76, x71),
-            c_q3 * Self::mul_add(-7.11, x75, Self::mul_add(-c_q2, x68, s_q2 * x69)),
+        let x69 = x57
+            - Self::mul_add(-0.475, Self::mul_add(x55, x55, x60), 7.11 * (x59 + x59));
+        let x70 = Self::mul_add(c_q2, x68, s_q2 * x67);
+        let x71 = Self::mul_add(-qd[2], x66, Self::mul_add(-s_q2, x59, c_q2 * x58));
+        let x72 = Self::mul_add(qd[2], x65, Self::mul_add(c_q2, x59, s_q2 * x58));
+        let x73 = qd[1] + qd[2];
+        let x74 = Self::mul_add(x66, x66, x73 * x73);
+        let x75 = x65 * x66;
+        let x76 = Self::mul_add(x65, x73, x72);
+        let x77 = Self::mul_add(1375.0472756800002, x73, x65 * 24989.305802);
+        let x78 = Self::mul_add(-24998.827802, x73, 1375.0472756800002 * x65);
+        let x79 = Self::mul_add(-s_q3, x66, c_q3 * x65);
+        let x80 = Self::mul_add(c_q3, x66, s_q3 * x65);
+        let x81 = Self::mul_add(
+            -s_q3,
+            Self::mul_add(-7.11, x75, x70),
+            c_q3 * Self::mul_add(7.11, x74, Self::mul_add(-s_q2, x68, c_q2 * x67)),
         );
-        let x83 = Self::mul_add(-qd[3], x81, Self::mul_add(s_q3, x73, c_q3 * x72));
-        let x84 = Self::mul_add(-qd[3], x80, Self::mul_add(-c_q3, x73, s_q3 * x72));
-        let x85 = qd[3] + x74;
-        let x86 = 132.6783695416 * x80;
-        let x87 = Self::mul_add(-97.44448770720001, x81, 135.4729695416 * x85);
-        let x88 = 97.44448770720001 * x85;
+        let x82 = Self::mul_add(-qd[3], x80, Self::mul_add(-s_q3, x72, c_q3 * x71));
+        let x83 = Self::mul_add(qd[3], x79, Self::mul_add(c_q3, x72, s_q3 * x71));
+        let x84 = qd[3] + x73;
+        let x85 = 132.6783695416 * x79;
+        let x86 = Self::mul_add(97.44448770720001, x80, 135.4729695416 * x84);
+        let x87 = 97.44448770720001 * x84;
+        let x88 = Self::mul_add(
+            -171.195516,
+            Self::mul_add(-7.11, x76, x69),
+            Self::mul_add(132.6783695416, x82, -Self::mul_add(-x84, x87, x80 * x86)),
+        );
         let x89 = Self::mul_add(
             171.195516,
-            Self::mul_add(-7.11, x77, x70),
-            Self::mul_add(132.6783695416, x83, -Self::mul_add(x85, x88, x81 * x87)),
+            x81,
+            Self::mul_add(97.44448770720001, x83, Self::mul_add(-x79, x87, x80 * x85)),
         );
-        let x90 = Self::mul_add(
-            171.195516,
-            x82,
-            Self::mul_add(97.44448770720001, x84, Self::mul_add(x80, x88, x81 * x86)),
-        );
-        let x91 = Self::mul_add(-c_q4, x80, s_q4 * x85);
-        let x92 = Self::mul_add(c_q4, x85, s_q4 * x80);
-        let x93 = qd[4] + x81;
-        let x94 = 44.41 * x92;
-        let x95 = 47.471 * x93;
-        let x96 = 9.336 * (qd[5] + x91);
-        let x97 = Self::mul_add(
+        let x90 = Self::mul_add(-s_q4, x84, c_q4 * x79);
+        let x91 = Self::mul_add(c_q4, x84, s_q4 * x79);
+        let x92 = qd[4] - x80;
+        let x93 = 44.41 * x91;
+        let x94 = 47.471 * x92;
+        let x95 = 9.336 * (qd[5] - x90);
+        let x96 = Self::mul_add(
             9.336,
-            Self::mul_add(qd[4], x92, c_q4 * x83),
-            -f_ext[5][3],
+            Self::mul_add(-qd[4], x91, c_q4 * x82),
+            f_ext[5][3],
         );
-        let x98 = Self::mul_add(
-            Self::mul_add(-s_q5, x92, c_q5 * x93),
-            x96,
-            -f_ext[5][4],
+        let x97 = Self::mul_add(Self::mul_add(-c_q5, x92, s_q5 * x91), x95, f_ext[5][4]);
+        let x98 = Self::mul_add(Self::mul_add(s_q5, x92, c_q5 * x91), x95, f_ext[5][5]);
+        let x99 = Self::mul_add(-f_ext[5][2], s_q5, f_ext[5][1] * c_q5);
+        let x100 = f_ext[4][0] + f_ext[5][0];
+        let x101 = f_ext[4][1] + x99;
+        let x102 = f_ext[4][2] + Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
+        let x103 = f_ext[4][3] + Self::mul_add(-x91, x94, x92 * x93)
+            + Self::mul_add(0.7026, x99, x96);
+        let x104 = f_ext[4][4]
+            - Self::mul_add(x90, x94, 44.41 * Self::mul_add(qd[4], x90, s_q4 * x82))
+            + Self::mul_add(-0.7026, f_ext[5][0], Self::mul_add(-s_q5, x98, c_q5 * x97));
+        let x105 = f_ext[4][5] + Self::mul_add(x90, x93, 47.471 * x83)
+            + Self::mul_add(c_q5, x98, s_q5 * x97);
+        let x106 = Self::mul_add(-s_q4, x101, c_q4 * x100);
+        let x107 = Self::mul_add(171.195516, x79 * x80, f_ext[3][0]) + x106;
+        let x108 = Self::mul_add(171.195516, Self::mul_add(-x80, x84, x82), f_ext[3][1])
+            + Self::mul_add(c_q4, x101, s_q4 * x100);
+        let x109 = Self::mul_add(
+            -171.195516,
+            Self::mul_add(x79, x79, x84 * x84),
+            f_ext[3][2],
+        ) + x102;
+        let x110 = f_ext[3][3] + x88
+            + Self::mul_add(-0.5692, x102, Self::mul_add(-s_q4, x104, c_q4 * x103));
+        let x111 = f_ext[3][4] - x89 + Self::mul_add(c_q4, x104, s_q4 * x103);
+        let x112 = f_ext[3][5] - Self::mul_add(-x79, x86, x84 * x85)
+            + Self::mul_add(0.5692, x106, x105);
+        let x113 = Self::mul_add(-c_q3, x109, s_q3 * x107);
+        let x114 = Self::mul_add(3239.4582, x74, f_ext[2][0])
+            + Self::mul_add(s_q3, x109, c_q3 * x107);
+        let x115 = Self::mul_add(-3239.4582, x75, f_ext[2][2]) - x113;
+        let x116 = f_ext[2][3] - Self::mul_add(-x66, x78, x71 * 24989.305802)
+            + Self::mul_add(s_q3, x112, c_q3 * x110);
+        let x117 = f_ext[2][4]
+            + Self::mul_add(
+                -3239.4582,
+                x70,
+                Self::mul_add(x66, x77, 1375.0472756800002 * x71),
+            ) + Self::mul_add(7.11, x113, x111);
+        let x118 = f_ext[2][5]
+            + Self::mul_add(-3239.4582, x69, Self::mul_add(-x65, x78, x73 * x77))
+            - Self::mul_add(-7.11, x108, Self::mul_add(-c_q3, x112, s_q3 * x110));
+        let x119 = Self::mul_add(s_q2, x115, c_q2 * x114);
+        let x120 = Self::mul_add(-c_q2, x115, s_q2 * x114);
+        let x121 = Self::mul_add(
+            -c_q1,
+            f_ext[1][5]
+                + Self::mul_add(-5224.5702, x57, Self::mul_add(-x55, x64, qd[1] * x63))
+                - (Self::mul_add(-c_q2, x118, s_q2 * x116)
+                    - Self::mul_add(
+                        7.11,
+                        Self::mul_add(3239.4582, x76, f_ext[2][1]) + x108,
+                        0.475 * x119,
+                    )),
+            s_q1
+                * (f_ext[1][3] - Self::mul_add(x56, x64, x58 * 39234.47412200001)
+                    + Self::mul_add(0.475, x120, Self::mul_add(s_q2, x118, c_q2 * x116))),
         );
-        let x99 = Self::mul_add(Self::mul_add(s_q5, x93, c_q5 * x92), x96, f_ext[5][5]);
-        let x100 = Self::mul_add(-f_ext[5][1], c_q5, f_ext[5][2] * s_q5);
-        let x101 = f_ext[4][0] + f_ext[5][0];
-        let x102 = x100 - f_ext[4][1];
-        let x103 = f_ext[4][2] + Self::mul_add(f_ext[5][2], c_q5, f_ext[5][1] * s_q5);
-        let x104 = Self::mul_add(-x93, x94, x92 * x95) - f_ext[4][3]
-            + Self::mul_add(0.7026, x100, x97);
-        let x105 = Self::mul_add(
-            0.7026,
-            f_ext[5][0],
-            Self::mul_add(s_q5, x99, c_q5 * x98),
-        )
-            - (f_ext[4][4]
-                + Self::mul_add(
-                    x91,
-                    x95,
-                    44.41 * Self::mul_add(qd[4], x91, s_q4 * x83),
-                ));
-        let x106 = Self::mul_add(x91, x94, 47.471 * x84) - f_ext[4][5]
-            + Self::mul_add(-c_q5, x99, s_q5 * x98);
-        let x107 = Self::mul_add(s_q4, x102, c_q4 * x101);
-        let x108 = Self::mul_add(171.195516, x80 * x81, -f_ext[3][0]) - x107;
-        let x109 = Self::mul_add(-s_q4, x101, c_q4 * x102)
-            - Self::mul_add(171.195516, Self::mul_add(x81, x85, -x83), f_ext[3][1]);
-        let x110 = Self::mul_add(
-            171.195516,
-            Self::mul_add(x80, x80, x85 * x85),
-            -f_ext[3][2],
-        ) - x103;
-        let x111 = x89 - f_ext[3][3]
-            + Self::mul_add(0.5692, x103, Self::mul_add(-s_q4, x105, c_q4 * x104));
-        let x112 = Self::mul_add(c_q4, x105, s_q4 * x104) - (f_ext[3][4] + x90);
-        let x113 = Self::mul_add(-x80, x87, x85 * x86) - f_ext[3][5]
-            + Self::mul_add(-0.5692, x107, x106);
-        let x114 = Self::mul_add(-s_q3, x108, c_q3 * x110);
-        let x115 = Self::mul_add(s_q3, x110, c_q3 * x108)
-            - Self::mul_add(3239.4582, x75, f_ext[2][0]);
-        let x116 = x114 - Self::mul_add(3239.4582, x76, f_ext[2][2]);
-        let x117 = Self::mul_add(s_q3, x113, c_q3 * x111)
-            - (f_ext[2][3] + Self::mul_add(x67, x79, x72 * 24989.305802));
-        let x118 = Self::mul_add(
-            3239.4582,
-            x71,
-            Self::mul_add(x67, x78, 1375.0472756800002 * x72),
-        ) - f_ext[2][4] + Self::mul_add(-7.11, x114, x112);
-        let x119 = Self::mul_add(3239.4582, x70, -Self::mul_add(x66, x79, x74 * x78))
-            - f_ext[2][5]
-            + Self::mul_add(7.11, x109, Self::mul_add(-s_q3, x111, c_q3 * x113));
-        let x120 = Self::mul_add(s_q2, x116, c_q2 * x115);
-        let x121 = Self::mul_add(-s_q2, x115, c_q2 * x116);
         let x122 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(-x57, x65, x59 * 39234.47412200001) - f_ext[1][3]
-                + Self::mul_add(-0.475, x121, Self::mul_add(s_q2, x119, c_q2 * x117)),
-            c_q1
-                * (Self::mul_add(5224.5702, x58, -Self::mul_add(x56, x65, qd[1] * x64))
-                    - f_ext[1][5]
-                    + (Self::mul_add(-s_q2, x117, c_q2 * x119)
-                        + Self::mul_add(
-                            7.11,
-                            x109 - Self::mul_add(3239.4582, x77, f_ext[2][1]),
-                            0.475 * x120,
-                        ))),
-        );
-        let x123 = Self::mul_add(
-            0.5692,
+            -0.5692,
             Self::mul_add(
                 s_q1,
-                x121 - Self::mul_add(5224.5702, x63, f_ext[1][2]),
-                c_q1 * (x120 - Self::mul_add(5224.5702, x62, f_ext[1][0])),
+                Self::mul_add(5224.5702, x62, f_ext[1][2]) - x120,
+                c_q1 * (Self::mul_add(5224.5702, x61, f_ext[1][0]) + x119),
             ),
-            x122,
+            x121,
         );
-        let x124 = tau[0] - (x123 - f_ext[0][5]);
-        let x125 = 1.0
+        let x123 = tau[0] + (f_ext[0][5] - x122);
+        let x124 = 1.0
             / (65697.3302265768
-                + (x38
+                - (x38
                     - Self::mul_add(
-                        s_q1 * c_q1,
+                        -(s_q1 * c_q1),
                         x37 + x37,
-                        s_q1 * s_q1 * (x38 - (-39234.47412200001 + (x20 + x27))),
+                        s_q1 * s_q1 * (x38 + (-39234.47412200001 + (x20 - x27))),
                     )));
-        let x126 = x41 * x125;
-        let x127 = x43 * x125;
-        let x128 = x47 * x125;
-        let x129 = x50 * x125;
-        let x130 = x55 * x125;
-        let x131 = 1.0 / Self::mul_add(-x41, x126, 39241.404122 + (x36 + (x22 + x36)));
-        let x132 = Self::mul_add(-x41, x127, Self::mul_add(-7.11, x42, x22));
-        let x133 = x131 * x132;
-        let x134 = Self::mul_add(-x41, x128, Self::mul_add(-7.11, x45, x16));
-        let x135 = x131 * x134;
-        let x136 = x41 * x129;
-        let x137 = x131 * x136;
-        let x138 = Self::mul_add(x41, x130, x52);
-        let x139 = x131 * x138;
-        let x140 = 1.0 / Self::mul_add(-x132, x133, Self::mul_add(-x43, x127, x22));
-        let x141 = Self::mul_add(-x132, x135, Self::mul_add(-x43, x128, x16));
-        let x142 = x140 * x141;
-        let x143 = Self::mul_add(-x43, x129, x132 * x137);
-        let x144 = x140 * x143;
-        let x145 = Self::mul_add(-x132, x139, Self::mul_add(x43, x130, x52));
-        let x146 = x140 * x145;
-        let x147 = Self::mul_add(
-            -x141,
-            x142,
-            Self::mul_add(-x134, x135, Self::mul_add(-x47, x128, x8)),
+        let x125 = x41 * x124;
+        let x126 = x42 * x124;
+        let x127 = x46 * x124;
+        let x128 = x49 * x124;
+        let x129 = x54 * x124;
+        let x130 = 1.0 / Self::mul_add(-x41, x125, 39241.404122 - (x34 - x36));
+        let x131 = Self::mul_add(-x41, x126, x36);
+        let x132 = x130 * x131;
+        let x133 = Self::mul_add(x41, x127, Self::mul_add(-7.11, x44, x16));
+        let x134 = x130 * x133;
+        let x135 = x41 * x128;
+        let x136 = x130 * x135;
+        let x137 = Self::mul_add(-x41, x129, x51);
+        let x138 = x130 * x137;
+        let x139 = 1.0 / Self::mul_add(-x131, x132, Self::mul_add(-x42, x126, x22));
+        let x140 = Self::mul_add(-x131, x134, Self::mul_add(x42, x127, x16));
+        let x141 = x139 * x140;
+        let x142 = Self::mul_add(-x131, x136, x42 * x128);
+        let x143 = x139 * x142;
+        let x144 = Self::mul_add(-x131, x138, Self::mul_add(-x42, x129, x51));
+        let x145 = x139 * x144;
+        let x146 = Self::mul_add(
+            -x140,
+            x141,
+            Self::mul_add(-x133, x134, Self::mul_add(-x46, x127, x8)),
         );
-        let x148 = 1.0 / x147;
-        let x149 = Self::mul_add(-x141, x144, Self::mul_add(-x47, x129, x134 * x137));
-        let x150 = x148 * x149;
-        let x151 = Self::mul_add(
-            -x141,
-            x146,
-            Self::mul_add(-x134, x139, Self::mul_add(x47, x130, x52)),
+        let x147 = 1.0 / x146;
+        let x148 = Self::mul_add(x140, x143, Self::mul_add(x133, x136, x46 * x128));
+        let x149 = x147 * x148;
+        let x150 = Self::mul_add(
+            -x140,
+            x145,
+            Self::mul_add(-x133, x138, Self::mul_add(x46, x129, x51)),
         );
-        let x152 = x148 * x151;
-        let x153 = Self::mul_add(
-            -x143,
-            x144,
-            Self::mul_add(-x136, x137, Self::mul_add(-x50, x129, 47.471)),
-        );
-        let x154 = 1.0 / Self::mul_add(-x149, x150, x153);
-        let x155 = Self::mul_add(
-            -x149,
-            x152,
-            Self::mul_add(-x143, x146, Self::mul_add(x136, x139, x50 * x130)),
-        );
-        let x156 = x154 * x155;
-        let x157 = Self::mul_add(
-            -x145,
-            x146,
-            Self::mul_add(-x138, x139, Self::mul_add(-x55, x130, 9.336)),
-        );
-        let x158 = 1.0 / Self::mul_add(-x155, x156, Self::mul_add(-x151, x152, x157));
-        let x159 = Self::mul_add(
-            -x124,
-            x126,
-            tau[1]
-                - (Self::mul_add(-3946.1881206800003, x59, x57 * x64) - f_ext[1][4]
-                    + Self::mul_add(-7.11, x121, x118)),
-        );
-        let x160 = Self::mul_add(-x133, x159, Self::mul_add(-x124, x127, tau[2] - x118));
-        let x161 = Self::mul_add(
+        let x151 = x147 * x150;
+        let x152 = Self::mul_add(
             -x142,
-            x160,
-            Self::mul_add(-x135, x159, Self::mul_add(-x124, x128, tau[3] - x112)),
+            x143,
+            Self::mul_add(-x135, x136, Self::mul_add(-x49, x128, 47.471)),
         );
-        let x162 = Self::mul_add(
+        let x153 = 1.0 / Self::mul_add(-x148, x149, x152);
+        let x154 = Self::mul_add(
+            x148,
+            x151,
+            Self::mul_add(-x142, x145, Self::mul_add(-x135, x138, x49 * x129)),
+        );
+        let x155 = x153 * x154;
+        let x156 = Self::mul_add(
             -x144,
-            x160,
-            Self::mul_add(x137, x159, Self::mul_add(-x124, x129, tau[4] - x106)),
+            x145,
+            Self::mul_add(-x137, x138, Self::mul_add(-x54, x129, 9.336)),
         );
-        let x163 = Self::mul_add(-x150, x161, x162);
-        let x164 = Self::mul_add(
-            -x146,
-            x160,
-            Self::mul_add(-x139, x159, Self::mul_add(x124, x130, tau[5] - x97)),
+        let x157 = 1.0 / Self::mul_add(-x154, x155, Self::mul_add(-x150, x151, x156));
+        let x158 = Self::mul_add(
+            x123,
+            x125,
+            tau[1]
+                + (f_ext[1][4] + Self::mul_add(-x56, x63, 3946.1881206800003 * x58)
+                    + Self::mul_add(7.11, x120, x117)),
         );
-        let x165 = x158 * Self::mul_add(-x156, x163, Self::mul_add(-x152, x161, x164));
-        let x166 = Self::mul_add(-x156, x165, x154 * x163);
-        let x167 = Self::mul_add(-x152, x165, Self::mul_add(-x150, x166, x148 * x161));
+        let x159 = Self::mul_add(-x132, x158, Self::mul_add(x123, x126, tau[2] + x117));
+        let x160 = Self::mul_add(
+            -x141,
+            x159,
+            Self::mul_add(-x134, x158, Self::mul_add(-x123, x127, tau[3] + x111)),
+        );
+        let x161 = Self::mul_add(
+            x143,
+            x159,
+            Self::mul_add(x136, x158, Self::mul_add(x123, x128, tau[4] + x105)),
+        );
+        let x162 = Self::mul_add(-x149, x160, x161);
+        let x163 = Self::mul_add(
+            -x145,
+            x159,
+            Self::mul_add(-x138, x158, Self::mul_add(x123, x129, tau[5] + x96)),
+        );
+        let x164 = x157 * Self::mul_add(x155, x162, Self::mul_add(-x151, x160, x163));
+        let x165 = Self::mul_add(x155, x164, x153 * x162);
+        let x166 = Self::mul_add(-x151, x164, Self::mul_add(-x149, x165, x147 * x160));
+        let x167 = Self::mul_add(
+            -x145,
+            x164,
+            Self::mul_add(x143, x165, Self::mul_add(-x141, x166, x139 * x159)),
+        );
         let x168 = Self::mul_add(
-            -x146,
+            x136,
             x165,
-            Self::mul_add(-x144, x166, Self::mul_add(-x142, x167, x140 * x160)),
+            Self::mul_add(-x134, x166, Self::mul_add(-x132, x167, x130 * x158)),
         );
-        let x169 = Self::mul_add(
-            x137,
+        let x169 = Self::mul_add(-x138, x164, x168);
+        let x170 = Self::mul_add(
+            -x127,
             x166,
-            Self::mul_add(-x135, x167, Self::mul_add(-x133, x168, x131 * x159)),
+            Self::mul_add(x126, x167, Self::mul_add(x125, x169, x123 * x124)),
         );
-        let x170 = Self::mul_add(-x139, x165, x169);
-        let x171 = Self::mul_add(
-            -x128,
-            x167,
-            Self::mul_add(-x127, x168, Self::mul_add(-x126, x170, x124 * x125)),
-        );
-        let x172 = Self::mul_add(x130, x165, Self::mul_add(-x129, x166, x171));
-        [x172, x170, x168, x167, x166, x165]
+        let x171 = Self::mul_add(x129, x164, Self::mul_add(x128, x165, x170));
+        [x171, x169, x167, x166, x165, x164]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

@@ -11,8 +11,8 @@
 //! Algorithm: per function the cheapest candidate (below).
 //! Precision: `f32`: inputs, outputs and every intermediate; the model's numbers rounded to `f32` constants; libm's `sincosf`, `sinf`, `cosf`, `sqrtf`.
 //! Fused multiply-adds: none.
-//! Fused multiply-adds where the target has them: 1008 (`mass_matrix` 57, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 264, `mass_matrix_and_nonlinear_effects` 170, `forward_dynamics_with_wrenches` 282), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
-//! Form: unrolled straight-line code (auto: 568 emitted operations in M + c, within the 4000 limit).
+//! Fused multiply-adds where the target has them: 1010 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Form: unrolled straight-line code (auto: 564 emitted operations in M + c, within the 4000 limit).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
 //!
@@ -26,8 +26,8 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 709 | 510 | 0 | 0 | 7 | 1219 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 577 | 454 | 0 | 0 | 7 | 1031 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 577 | 454 | 0 | 0 | 7 | 1031 |
-//! | `mass_matrix` | `crba` | — | — | model | 123 | 104 | 0 | 0 | 5 | 227 |
-//! | `mass_matrix` * | `crba` | — | — | canonical | 121 | 100 | 0 | 0 | 5 | 221 |
+//! | `mass_matrix` | `crba` | — | — | model | 120 | 99 | 0 | 0 | 5 | 219 |
+//! | `mass_matrix` * | `crba` | — | — | canonical | 120 | 97 | 0 | 0 | 5 | 217 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 618 | 450 | 0 | 0 | 7 | 1068 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 618 | 450 | 0 | 0 | 7 | 1068 |
 //! | `nonlinear_effects` | — | `kane-direct` | — | model | 708 | 536 | 0 | 0 | 7 | 1244 |
@@ -36,22 +36,22 @@
 //! | `nonlinear_effects` | — | `rnea` | — | canonical | 253 | 174 | 0 | 0 | 6 | 427 |
 //! | `nonlinear_effects` | — | `newton-euler` | — | model | 207 | 142 | 0 | 0 | 6 | 349 |
 //! | `nonlinear_effects` * | — | `newton-euler` | — | canonical | 206 | 141 | 0 | 0 | 6 | 347 |
-//! | `inverse_dynamics` | — | `recurrent` | — | model | 780 | 595 | 0 | 0 | 7 | 1375 |
-//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 778 | 591 | 0 | 0 | 7 | 1369 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | model | 870 | 681 | 0 | 0 | 7 | 1551 |
-//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 868 | 677 | 0 | 0 | 7 | 1545 |
+//! | `inverse_dynamics` | — | `recurrent` | — | model | 777 | 590 | 0 | 0 | 7 | 1367 |
+//! | `inverse_dynamics` | — | `recurrent` | — | canonical | 777 | 588 | 0 | 0 | 7 | 1365 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | model | 867 | 676 | 0 | 0 | 7 | 1543 |
+//! | `inverse_dynamics` | — | `kane-direct` | — | canonical | 867 | 674 | 0 | 0 | 7 | 1541 |
 //! | `inverse_dynamics` | — | `rnea` | — | model | 268 | 191 | 0 | 0 | 6 | 459 |
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 265 | 189 | 0 | 0 | 6 | 454 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | model | 217 | 157 | 0 | 0 | 6 | 374 |
 //! | `inverse_dynamics` * | — | `newton-euler` | — | canonical | 216 | 156 | 0 | 0 | 6 | 372 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 867 | 655 | 7 | 0 | 7 | 1522 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 865 | 651 | 7 | 0 | 7 | 1516 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 957 | 741 | 7 | 0 | 7 | 1698 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 955 | 737 | 7 | 0 | 7 | 1692 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 505 | 381 | 7 | 0 | 6 | 886 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 500 | 375 | 7 | 0 | 6 | 875 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 456 | 347 | 7 | 0 | 6 | 803 |
-//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 453 | 342 | 7 | 0 | 6 | 795 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 864 | 650 | 7 | 0 | 7 | 1514 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 864 | 648 | 7 | 0 | 7 | 1512 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 954 | 736 | 7 | 0 | 7 | 1690 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 954 | 734 | 7 | 0 | 7 | 1688 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 502 | 376 | 7 | 0 | 6 | 878 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 499 | 372 | 7 | 0 | 6 | 871 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 453 | 342 | 7 | 0 | 6 | 795 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | canonical | 452 | 339 | 7 | 0 | 6 | 791 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 1034 | 865 | 7 | 0 | 7 | 1899 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 1034 | 865 | 7 | 0 | 7 | 1899 |
 //! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 1124 | 951 | 7 | 0 | 7 | 2075 |
@@ -62,14 +62,14 @@
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 909 | 700 | 7 | 0 | 7 | 1609 |
 //! | `forward_dynamics` | — | — | `aba` | model | 554 | 388 | 5 | 0 | 6 | 942 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 554 | 389 | 5 | 0 | 6 | 943 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 741 | 554 | 0 | 0 | 7 | 1295 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 739 | 550 | 0 | 0 | 7 | 1289 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 831 | 640 | 0 | 0 | 7 | 1471 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 829 | 636 | 0 | 0 | 7 | 1465 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 379 | 280 | 0 | 0 | 6 | 659 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 374 | 274 | 0 | 0 | 6 | 648 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 330 | 246 | 0 | 0 | 6 | 576 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 327 | 241 | 0 | 0 | 6 | 568 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 738 | 549 | 0 | 0 | 7 | 1287 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 738 | 547 | 0 | 0 | 7 | 1285 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 828 | 635 | 0 | 0 | 7 | 1463 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 828 | 633 | 0 | 0 | 7 | 1461 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 376 | 275 | 0 | 0 | 6 | 651 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 373 | 271 | 0 | 0 | 6 | 644 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | model | 327 | 241 | 0 | 0 | 6 | 568 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | canonical | 326 | 238 | 0 | 0 | 6 | 564 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 908 | 760 | 0 | 0 | 7 | 1668 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 908 | 760 | 0 | 0 | 7 | 1668 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 998 | 846 | 0 | 0 | 7 | 1844 |
@@ -78,10 +78,10 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 830 | 628 | 0 | 0 | 7 | 1458 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 784 | 596 | 0 | 0 | 7 | 1380 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 783 | 595 | 0 | 0 | 7 | 1378 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 971 | 760 | 7 | 0 | 7 | 1731 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 1061 | 846 | 7 | 0 | 7 | 1907 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 517 | 425 | 7 | 0 | 6 | 942 |
-//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 468 | 391 | 7 | 0 | 6 | 859 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 968 | 755 | 7 | 0 | 7 | 1723 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 1058 | 841 | 7 | 0 | 7 | 1899 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 514 | 420 | 7 | 0 | 6 | 934 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 465 | 386 | 7 | 0 | 6 | 851 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 1138 | 970 | 7 | 0 | 7 | 2108 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 1228 | 1056 | 7 | 0 | 7 | 2284 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 971 | 779 | 7 | 0 | 7 | 1750 |
@@ -153,12 +153,12 @@ impl SsrmsF32 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 121u64,
-            add: 100u64,
+            mul: 120u64,
+            add: 97u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
-            fma: 57u64,
+            fma: 58u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -192,12 +192,12 @@ impl SsrmsF32 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 453u64,
-            add: 342u64,
+            mul: 452u64,
+            add: 339u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 264u64,
+            fma: 265u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -205,12 +205,12 @@ impl SsrmsF32 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 327u64,
-            add: 241u64,
+            mul: 326u64,
+            add: 238u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 170u64,
+            fma: 171u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
@@ -218,12 +218,12 @@ impl SsrmsF32 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 468u64,
-            add: 391u64,
+            mul: 465u64,
+            add: 386u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
-            fma: 282u64,
+            fma: 281u64,
         },
     ];
     /// Emitted operation counts of every candidate traced (the cheapest is emitted).
@@ -338,8 +338,8 @@ impl SsrmsF32 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 123u64,
-            add: 104u64,
+            mul: 120u64,
+            add: 99u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -351,8 +351,8 @@ impl SsrmsF32 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 121u64,
-            add: 100u64,
+            mul: 120u64,
+            add: 97u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 5u64,
@@ -468,8 +468,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 780u64,
-            add: 595u64,
+            mul: 777u64,
+            add: 590u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -481,8 +481,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 778u64,
-            add: 591u64,
+            mul: 777u64,
+            add: 588u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -494,8 +494,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 870u64,
-            add: 681u64,
+            mul: 867u64,
+            add: 676u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -507,8 +507,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 868u64,
-            add: 677u64,
+            mul: 867u64,
+            add: 674u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -572,8 +572,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 867u64,
-            add: 655u64,
+            mul: 864u64,
+            add: 650u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -585,8 +585,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 865u64,
-            add: 651u64,
+            mul: 864u64,
+            add: 648u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -598,8 +598,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 957u64,
-            add: 741u64,
+            mul: 954u64,
+            add: 736u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -611,8 +611,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 955u64,
-            add: 737u64,
+            mul: 954u64,
+            add: 734u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -624,8 +624,8 @@ impl SsrmsF32 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 505u64,
-            add: 381u64,
+            mul: 502u64,
+            add: 376u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -637,8 +637,8 @@ impl SsrmsF32 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 500u64,
-            add: 375u64,
+            mul: 499u64,
+            add: 372u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -650,21 +650,21 @@ impl SsrmsF32 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 456u64,
-            add: 347u64,
-            div: 7u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "forward_dynamics",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
-            forward_method: Some("ldlt"),
-            frames: "canonical",
             mul: 453u64,
             add: 342u64,
+            div: 7u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "forward_dynamics",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
+            frames: "canonical",
+            mul: 452u64,
+            add: 339u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -806,8 +806,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 741u64,
-            add: 554u64,
+            mul: 738u64,
+            add: 549u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -819,8 +819,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 739u64,
-            add: 550u64,
+            mul: 738u64,
+            add: 547u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -832,8 +832,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 831u64,
-            add: 640u64,
+            mul: 828u64,
+            add: 635u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -845,8 +845,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 829u64,
-            add: 636u64,
+            mul: 828u64,
+            add: 633u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -858,8 +858,8 @@ impl SsrmsF32 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 379u64,
-            add: 280u64,
+            mul: 376u64,
+            add: 275u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -871,8 +871,8 @@ impl SsrmsF32 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 374u64,
-            add: 274u64,
+            mul: 373u64,
+            add: 271u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -884,21 +884,21 @@ impl SsrmsF32 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 330u64,
-            add: 246u64,
-            div: 0u64,
-            sqrt: 0u64,
-            sincos: 6u64,
-            fma: 0u64,
-        },
-        OpCount {
-            function: "mass_matrix_and_nonlinear_effects",
-            mass_matrix_method: Some("crba"),
-            bias_method: Some("newton-euler"),
-            forward_method: None,
-            frames: "canonical",
             mul: 327u64,
             add: 241u64,
+            div: 0u64,
+            sqrt: 0u64,
+            sincos: 6u64,
+            fma: 0u64,
+        },
+        OpCount {
+            function: "mass_matrix_and_nonlinear_effects",
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: None,
+            frames: "canonical",
+            mul: 326u64,
+            add: 238u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1014,8 +1014,8 @@ impl SsrmsF32 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 971u64,
-            add: 760u64,
+            mul: 968u64,
+            add: 755u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1027,8 +1027,8 @@ impl SsrmsF32 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1061u64,
-            add: 846u64,
+            mul: 1058u64,
+            add: 841u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1040,8 +1040,8 @@ impl SsrmsF32 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 517u64,
-            add: 425u64,
+            mul: 514u64,
+            add: 420u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1053,8 +1053,8 @@ impl SsrmsF32 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 468u64,
-            add: 391u64,
+            mul: 465u64,
+            add: 386u64,
             div: 7u64,
             sqrt: 0u64,
             sincos: 6u64,
@@ -1128,7 +1128,7 @@ impl SsrmsF32 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 121 mul, 100 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 57 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 120 mul, 97 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 58 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f32; 7]) -> [[f32; 7]; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -1144,7 +1144,7 @@ impl SsrmsF32 {
         let x10 = s_q4 * s_q4 * x9;
         let x11 = x6 - x10;
         let x12 = Self::mul_add(97.44449, s_q4, c_q4 * x7);
-        let x13 = Self::mul_add(-s_q4, x7, 97.44449 * c_q4);
+        let x13 = Self::mul_add(-97.44449, c_q4, s_q4 * x7);
         let x14 = 171.19551 * s_q4;
         let x15 = 171.19551 * c_q4;
         let x16 = 7.11 * x14;
@@ -1152,8 +1152,8 @@ impl SsrmsF32 {
         let x18 = x8 - x16;
         let x19 = 3239.4583 - x14;
         let x20 = 1375.0472 - x12;
-        let x21 = 24989.307 + (-129.61737 + x10 - x16 - x16);
-        let x22 = 24998.828 + (x18 - x16);
+        let x21 = 24989.307 - (x16 - (-129.61737 + x10 - x16));
+        let x22 = 24998.828 - (x16 - x18);
         let x23 = s_q3 * s_q3;
         let x24 = s_q3 * c_q3;
         let x25 = x11 - x21;
@@ -1167,9 +1167,9 @@ impl SsrmsF32 {
         let x33 = c_q3 * x15;
         let x34 = Self::mul_add(s_q3, x19, x33);
         let x35 = 7.11 * x32;
-        let x36 = Self::mul_add(x32, 0.475, Self::mul_add(c_q3, x20, -x29));
+        let x36 = Self::mul_add(x32, 0.475, Self::mul_add(c_q3, x20, x29));
         let x37 = Self::mul_add(-7.11, x34, x17 + Self::mul_add(-x23, x26, x24 * x25));
-        let x38 = Self::mul_add(x34, 0.475, Self::mul_add(s_q3, x20, x30));
+        let x38 = Self::mul_add(x34, 0.475, Self::mul_add(s_q3, x20, -x30));
         let x39 = x22 + x35;
         let x40 = 5224.5703 + x32;
         let x41 = 3946.1882 + x36;
@@ -1181,93 +1181,93 @@ impl SsrmsF32 {
         let x47 = x37 + x37;
         let x48 = Self::mul_add(x45, x47, x44 * x46);
         let x49 = x28 - x48;
-        let x50 = c_q2 * x41;
-        let x51 = s_q2 * x38;
-        let x52 = c_q2 * x38;
-        let x53 = c_q2 * x40;
-        let x54 = s_q2 * x34;
-        let x55 = x53 - x54;
-        let x56 = c_q2 * x34;
-        let x57 = Self::mul_add(s_q2, x40, x56);
-        let x58 = Self::mul_add(0.5692, x55, x50 - x51);
-        let x59 = Self::mul_add(0.5692, x57, Self::mul_add(s_q2, x41, x52));
-        let x60 = 1650.6387 + (x42 + x48);
-        let x61 = 0.7026 * x57;
-        let x62 = 2232.9683
-            + (x49
-                - Self::mul_add(
-                    s_q1 * c_q1,
-                    x58 + x58,
-                    s_q1 * s_q1 * (x49 - (-1647.2197 + x43)),
-                ) - x61 - x61);
-        let x63 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(1145.5438, s_q1, c_q1 * x55),
-            Self::mul_add(-c_q1, x37 + Self::mul_add(-x44, x47, x45 * x46), s_q1 * x59),
-        );
-        let x64 = -x59;
-        let x65 = Self::mul_add(
+        let x50 = s_q2 * x38;
+        let x51 = c_q2 * x38;
+        let x52 = s_q2 * x34;
+        let x53 = Self::mul_add(c_q2, x40, -x52);
+        let x54 = c_q2 * x34;
+        let x55 = Self::mul_add(s_q2, x40, x54);
+        let x56 = Self::mul_add(0.5692, x53, Self::mul_add(c_q2, x41, -x50));
+        let x57 = Self::mul_add(0.5692, x55, Self::mul_add(s_q2, x41, x51));
+        let x58 = 1650.6387 + (x42 + x48);
+        let x59 = 0.7026 * x55;
+        let x60 = Self::mul_add(
             0.7026,
-            s_q1 * x57,
-            -Self::mul_add(s_q1, x43, c_q1 * Self::mul_add(0.5692, x54 - x53, x51 - x50)),
+            Self::mul_add(1145.5438, s_q1, c_q1 * x53),
+            Self::mul_add(-s_q1, x57, c_q1 * (x37 + Self::mul_add(-x44, x47, x45 * x46))),
         );
-        let x66 = Self::mul_add(s_q2, x32, x56);
-        let x67 = -Self::mul_add(0.5692, x66, Self::mul_add(s_q2, x36, x52));
-        let x68 = Self::mul_add(
+        let x61 = 2232.9683
+            - (x59
+                - (x49
+                    - Self::mul_add(
+                        s_q1 * c_q1,
+                        x56 + x56,
+                        s_q1 * s_q1 * (x49 - (-1647.2197 + x43)),
+                    ) - x59));
+        let x62 = -x60;
+        let x63 = -x57;
+        let x64 = Self::mul_add(
+            0.7026,
+            s_q1 * x55,
+            Self::mul_add(-s_q1, x43, c_q1 * x56),
+        );
+        let x65 = Self::mul_add(s_q2, x32, x54);
+        let x66 = -Self::mul_add(0.5692, x65, Self::mul_add(s_q2, x36, x51));
+        let x67 = Self::mul_add(
             s_q1,
             x39,
             c_q1
                 * Self::mul_add(
                     0.5692,
-                    Self::mul_add(-c_q2, x32, x54),
-                    Self::mul_add(-c_q2, x36, x51),
+                    Self::mul_add(-c_q2, x32, x52),
+                    Self::mul_add(-c_q2, x36, x50),
                 ),
         );
-        let x69 = Self::mul_add(0.7026, s_q1 * x66, -x68);
-        let x70 = Self::mul_add(s_q3, x14, -x33);
-        let x71 = Self::mul_add(c_q3, x14, x31);
-        let x72 = Self::mul_add(0.475, x71, Self::mul_add(c_q3, x12, x29));
-        let x73 = Self::mul_add(-0.475, x70, Self::mul_add(-s_q3, x12, x30));
-        let x74 = Self::mul_add(-7.11, x71, x18);
-        let x75 = Self::mul_add(s_q2, x71, c_q2 * x70);
-        let x76 = Self::mul_add(0.5692, x75, Self::mul_add(-c_q2, x73, s_q2 * x72));
-        let x77 = Self::mul_add(
-            s_q1,
-            x74,
+        let x68 = -Self::mul_add(-0.7026, s_q1 * x65, x67);
+        let x69 = Self::mul_add(-s_q3, x14, x33);
+        let x70 = Self::mul_add(c_q3, x14, x31);
+        let x71 = Self::mul_add(-0.475, x70, Self::mul_add(-c_q3, x12, x29));
+        let x72 = Self::mul_add(-0.475, x69, Self::mul_add(s_q3, x12, x30));
+        let x73 = Self::mul_add(-7.11, x70, x18);
+        let x74 = Self::mul_add(-s_q2, x70, c_q2 * x69);
+        let x75 = -Self::mul_add(0.5692, x74, Self::mul_add(-c_q2, x72, s_q2 * x71));
+        let x76 = Self::mul_add(
+            -s_q1,
+            x73,
             c_q1
                 * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-s_q2, x70, c_q2 * x71),
-                    Self::mul_add(s_q2, x73, c_q2 * x72),
+                    -0.5692,
+                    Self::mul_add(c_q2, x70, s_q2 * x69),
+                    Self::mul_add(s_q2, x72, c_q2 * x71),
                 ),
         );
-        let x78 = -Self::mul_add(0.7026, s_q1 * x75, x77);
-        let x79 = 47.471 * s_q4;
-        let x80 = 47.471 * c_q4;
-        let x81 = Self::mul_add(s_q3, x80, c_q3 * x79);
-        let x82 = Self::mul_add(-c_q3, x80, s_q3 * x79);
-        let x83 = -Self::mul_add(c_q2, x82, s_q2 * x81);
-        let x84 = -(c_q1 * Self::mul_add(-c_q2, x81, s_q2 * x82));
-        let x85 = 9.336 * c_q5;
-        let x86 = 9.336 * s_q5;
-        let x87 = c_q4 * x85;
-        let x88 = s_q4 * x85;
-        let x89 = Self::mul_add(-s_q3, x88, c_q3 * x87);
-        let x90 = Self::mul_add(c_q3, x88, s_q3 * x87);
-        let x91 = -Self::mul_add(c_q2, x90, s_q2 * x89);
-        let x92 = -Self::mul_add(
-            s_q1,
-            x86,
-            c_q1 * Self::mul_add(-c_q2, x89, s_q2 * x90),
+        let x77 = Self::mul_add(0.7026, s_q1 * x74, x76);
+        let x78 = 47.471 * s_q4;
+        let x79 = 47.471 * c_q4;
+        let x80 = Self::mul_add(s_q3, x79, c_q3 * x78);
+        let x81 = Self::mul_add(-c_q3, x79, s_q3 * x78);
+        let x82 = -Self::mul_add(c_q2, x81, s_q2 * x80);
+        let x83 = c_q1 * Self::mul_add(-s_q2, x81, c_q2 * x80);
+        let x84 = 9.336 * c_q5;
+        let x85 = 9.336 * s_q5;
+        let x86 = c_q4 * x84;
+        let x87 = s_q4 * x84;
+        let x88 = Self::mul_add(-s_q3, x87, c_q3 * x86);
+        let x89 = Self::mul_add(c_q3, x87, s_q3 * x86);
+        let x90 = -Self::mul_add(c_q2, x89, s_q2 * x88);
+        let x91 = Self::mul_add(
+            -s_q1,
+            x85,
+            c_q1 * Self::mul_add(-s_q2, x89, c_q2 * x88),
         );
         [
-            [x62, x63, x65, x69, x78, x84, x92],
-            [x63, x60, x64, x67, x76, x83, x91],
-            [x65, x64, x43, x39, x74, 0.0, x86],
-            [x69, x67, x39, x22, x18, 0.0, x86],
-            [x78, x76, x74, x18, x8, 0.0, x86],
-            [x84, x83, 0.0, 0.0, 0.0, 47.471, 0.0],
-            [x92, x91, x86, x86, x86, 0.0, 9.336],
+            [x61, x62, x64, x68, x77, x83, x91],
+            [x62, x58, x63, x66, x75, x82, x90],
+            [x64, x63, x43, x39, x73, 0.0, x85],
+            [x68, x66, x39, x22, x18, 0.0, x85],
+            [x77, x75, x73, x18, x8, 0.0, x85],
+            [x83, x82, 0.0, 0.0, 0.0, 47.471, 0.0],
+            [x91, x90, x85, x85, x85, 0.0, 9.336],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -1290,8 +1290,8 @@ impl SsrmsF32 {
         let x12 = Self::mul_add(qd[1], c_q2, x1 * s_q2);
         let x13 = 0.5692 * x6;
         let x14 = 0.5692 * x7;
-        let x15 = Self::mul_add(0.5692, x4 + x4, -x3);
-        let x16 = Self::mul_add(c_q2, x15, s_q2 * x13);
+        let x15 = Self::mul_add(-0.5692, x4 + x4, x3);
+        let x16 = Self::mul_add(-c_q2, x15, s_q2 * x13);
         let x17 = Self::mul_add(qd[2], x12, x4 * c_q2);
         let x18 = Self::mul_add(-qd[2], x11, x4 * s_q2);
         let x19 = qd[2] - x2;
@@ -1299,7 +1299,7 @@ impl SsrmsF32 {
         let x21 = Self::mul_add(x19, x19, x20);
         let x22 = x11 * x19;
         let x23 = Self::mul_add(x11, x12, x5);
-        let x24 = x22 - x18;
+        let x24 = x18 - x22;
         let x25 = 3946.1882 * x19;
         let x26 = 39234.473 * x12;
         let x27 = Self::mul_add(39241.402, x19, 3946.1882 * x11);
@@ -1311,17 +1311,17 @@ impl SsrmsF32 {
         let (s_q3, c_q3) = libm::sincosf(q[3]);
         let x30 = Self::mul_add(-x12, s_q3, x11 * c_q3);
         let x31 = Self::mul_add(x12, c_q3, x11 * s_q3);
-        let x32 = Self::mul_add(-s_q2, x15, c_q2 * x13)
+        let x32 = Self::mul_add(s_q2, x15, c_q2 * x13)
             - Self::mul_add(x18 + x22, 0.475, 7.11 * x21);
         let x33 = x16 + Self::mul_add(Self::mul_add(-x12, x19, x17), 0.475, 7.11 * x23);
-        let x34 = x14 + Self::mul_add(Self::mul_add(x11, x11, x20), 0.475, 7.11 * x24);
+        let x34 = x14 - Self::mul_add(Self::mul_add(x11, x11, x20), -0.475, 7.11 * x24);
         let x35 = Self::mul_add(c_q3, x33, s_q3 * x32);
-        let x36 = Self::mul_add(-qd[3], x31, Self::mul_add(-x17, c_q3, x18 * s_q3));
+        let x36 = Self::mul_add(qd[3], x31, Self::mul_add(-x18, s_q3, x17 * c_q3));
         let x37 = Self::mul_add(-qd[3], x30, Self::mul_add(x18, c_q3, x17 * s_q3));
         let x38 = qd[3] + x19;
         let x39 = Self::mul_add(x38, x38, x31 * x31);
         let x40 = Self::mul_add(x30, x31, x5);
-        let x41 = Self::mul_add(x30, x38, -x37);
+        let x41 = Self::mul_add(-x30, x38, x37);
         let x42 = 1375.0472 * x38;
         let x43 = 24989.307 * x31;
         let x44 = Self::mul_add(24998.828, x38, 1375.0472 * x30);
@@ -1338,23 +1338,23 @@ impl SsrmsF32 {
             Self::mul_add(7.11, x40, x35),
             c_q4 * Self::mul_add(-7.11, x39, Self::mul_add(-s_q3, x33, c_q3 * x32)),
         );
-        let x50 = Self::mul_add(-qd[4], x48, Self::mul_add(x37, s_q4, x36 * c_q4));
-        let x51 = Self::mul_add(-qd[4], x47, Self::mul_add(-x36, s_q4, x37 * c_q4));
+        let x50 = Self::mul_add(qd[4], x48, Self::mul_add(-x37, s_q4, x36 * c_q4));
+        let x51 = Self::mul_add(-qd[4], x47, Self::mul_add(x37, c_q4, x36 * s_q4));
         let x52 = qd[4] + x38;
         let x53 = 171.19551 * Self::mul_add(-x47, x48, x5);
         let x54 = 171.19551 * Self::mul_add(x47, x47, x52 * x52);
-        let x55 = 171.19551 * Self::mul_add(-x48, x52, x50);
+        let x55 = 171.19551 * Self::mul_add(x48, x52, x50);
         let x56 = Self::mul_add(97.44449, x52, x48 * 177.08836);
-        let x57 = Self::mul_add(-97.44449, x48, 179.88297 * x52);
+        let x57 = Self::mul_add(-179.88297, x52, 97.44449 * x48);
         let x58 = Self::mul_add(
             -171.19551,
             x49,
             Self::mul_add(x47, x56, Self::mul_add(-179.88297, x5, 97.44449 * x51)),
         );
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x60 = Self::mul_add(-x47, s_q5, x52 * c_q5);
+        let x60 = Self::mul_add(-x52, c_q5, x47 * s_q5);
         let x61 = Self::mul_add(x52, s_q5, x47 * c_q5);
-        let x62 = Self::mul_add(-qd[5], x60, Self::mul_add(-x50, c_q5, x5 * s_q5));
+        let x62 = Self::mul_add(qd[5], x60, Self::mul_add(x5, s_q5, x50 * c_q5));
         let x63 = qd[5] + x48;
         let x64 = 44.41 * x61;
         let x65 = 47.471 * x63;
@@ -1362,72 +1362,76 @@ impl SsrmsF32 {
         let x67 = 9.336 * x62;
         let x68 = -x67;
         let x69 = 9.336 * (qd[6] + x61);
-        let x70 = Self::mul_add(-x60, s_q6, x63 * c_q6) * x69;
-        let x71 = Self::mul_add(x63, s_q6, x60 * c_q6) * x69;
-        let x72 = Self::mul_add(s_q6, x71, c_q6 * x70)
-            - Self::mul_add(x61, x65, x63 * x64);
-        let x73 = x67 - Self::mul_add(x60, x65, 44.41 * x62);
-        let x74 = Self::mul_add(-47.471, x51, x60 * x64)
-            + Self::mul_add(-c_q6, x71, s_q6 * x70);
-        let x75 = Self::mul_add(
-            171.19551,
-            Self::mul_add(7.11, x41, x34),
-            -Self::mul_add(x48, x57, x52 * x56),
+        let x70 = Self::mul_add(x63, c_q6, x60 * s_q6) * x69;
+        let x71 = Self::mul_add(-x63, s_q6, x60 * c_q6) * x69;
+        let x72 = Self::mul_add(x61, x65, x63 * x64)
+            - Self::mul_add(-s_q6, x71, c_q6 * x70);
+        let x73 = Self::mul_add(-x60, x65, 44.41 * x62) - x67;
+        let x74 = Self::mul_add(x60, x64, 47.471 * x51)
+            - Self::mul_add(c_q6, x71, s_q6 * x70);
+        let x75 = -x74;
+        let x76 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(-7.11, x41, x34),
+            Self::mul_add(-x48, x57, x52 * x56),
         ) - Self::mul_add(c_q5, x73, s_q5 * x72);
-        let x76 = Self::mul_add(x47, x57, Self::mul_add(97.44449, x5, x51 * 177.08836))
-            + x74;
-        let x77 = x58 + Self::mul_add(-s_q5, x73, c_q5 * x72);
-        let x78 = Self::mul_add(-c_q4, x54, s_q4 * x53);
-        let x79 = Self::mul_add(-3239.4583, x39, Self::mul_add(s_q4, x54, c_q4 * x53));
-        let x80 = Self::mul_add(-3239.4583, x40, x78);
-        let x81 = Self::mul_add(3239.4583, x41, x55);
-        let x82 = Self::mul_add(-1375.0472, x5, Self::mul_add(-x31, x44, x38 * x43))
-            + Self::mul_add(s_q4, x76, c_q4 * x75);
-        let x83 = x45 + Self::mul_add(-7.11, x55, Self::mul_add(-c_q4, x76, s_q4 * x75));
-        let x84 = Self::mul_add(
-            -3239.4583,
+        let x77 = Self::mul_add(-x47, x57, Self::mul_add(97.44449, x5, x51 * 177.08836))
+            - x74;
+        let x78 = x58 - Self::mul_add(-s_q5, x73, c_q5 * x72);
+        let x79 = Self::mul_add(-c_q4, x54, s_q4 * x53);
+        let x80 = Self::mul_add(3239.4583, x39, -Self::mul_add(s_q4, x54, c_q4 * x53));
+        let x81 = Self::mul_add(3239.4583, x40, -x79);
+        let x82 = Self::mul_add(3239.4583, x41, x55);
+        let x83 = Self::mul_add(1375.0472, x5, -Self::mul_add(-x31, x44, x38 * x43))
+            + Self::mul_add(-s_q4, x77, c_q4 * x76);
+        let x84 = x45 - Self::mul_add(-7.11, x55, Self::mul_add(c_q4, x77, s_q4 * x76));
+        let x85 = Self::mul_add(
+            3239.4583,
             x35,
-            Self::mul_add(-24998.828, x5, 1375.0472 * x36)
-                + Self::mul_add(-x30, x43, x31 * x42),
-        ) + Self::mul_add(7.11, x78, x77);
-        let x85 = Self::mul_add(-s_q3, x80, c_q3 * x79);
-        let x86 = Self::mul_add(c_q3, x80, s_q3 * x79);
-        let x87 = Self::mul_add(-5224.5703, x21, x85);
-        let x88 = Self::mul_add(-5224.5703, x23, x86);
-        let x89 = Self::mul_add(-3946.1882, x5, Self::mul_add(-x12, x27, x19 * x26))
-            + Self::mul_add(0.475, x86, Self::mul_add(-s_q3, x83, c_q3 * x82));
-        let x90 = x28
-            + (Self::mul_add(c_q3, x83, s_q3 * x82)
-                - Self::mul_add(7.11, x81, 0.475 * x85));
-        let x91 = Self::mul_add(
-            -5224.5703,
-            x16,
-            Self::mul_add(-x11, x26, x12 * x25)
-                - Self::mul_add(39241.402, x5, 3946.1882 * x17),
-        ) + Self::mul_add(7.11, x86, x84);
-        let x92 = Self::mul_add(-c_q2, x87, s_q2 * x88);
+            Self::mul_add(24998.828, x5, 1375.0472 * x36)
+                - Self::mul_add(-x30, x43, x31 * x42),
+        ) - Self::mul_add(7.11, x79, x78);
+        let x86 = -x85;
+        let x87 = Self::mul_add(-s_q3, x81, c_q3 * x80);
+        let x88 = Self::mul_add(c_q3, x81, s_q3 * x80);
+        let x89 = Self::mul_add(5224.5703, x21, x87);
+        let x90 = Self::mul_add(5224.5703, x23, x88);
+        let x91 = Self::mul_add(3946.1882, x5, -Self::mul_add(-x12, x27, x19 * x26))
+            + Self::mul_add(0.475, x88, Self::mul_add(s_q3, x84, c_q3 * x83));
+        let x92 = x28
+            - (Self::mul_add(-c_q3, x84, s_q3 * x83)
+                - Self::mul_add(7.11, x82, 0.475 * x87));
         let x93 = Self::mul_add(
+            5224.5703,
+            x16,
+            Self::mul_add(39241.402, x5, 3946.1882 * x17)
+                - Self::mul_add(-x11, x26, x12 * x25),
+        ) + Self::mul_add(7.11, x88, x85);
+        let x94 = -x93;
+        let x95 = Self::mul_add(-s_q2, x90, c_q2 * x89);
+        let x96 = Self::mul_add(
             x1,
             x8,
-            -Self::mul_add(0.5692, x92, Self::mul_add(c_q2, x90, s_q2 * x89)),
+            Self::mul_add(-0.5692, x95, Self::mul_add(-c_q2, x92, s_q2 * x91)),
         );
-        let x94 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(1145.5438, x7, Self::mul_add(5224.5703, x24, x81)),
-            s_q1 * Self::mul_add(-1145.5438, x6, x92),
+        let x97 = Self::mul_add(
+            c_q1,
+            Self::mul_add(1145.5438, x7, -Self::mul_add(5224.5703, x24, x82)),
+            s_q1 * Self::mul_add(1145.5438, x6, -x95),
         );
-        let x95 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-1145.5438, x3, Self::mul_add(x2, x9, qd[1] * x8))
-                + Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x88, s_q2 * x87),
-                    Self::mul_add(-c_q2, x89, s_q2 * x90),
-                ),
-            s_q1 * (Self::mul_add(x5, -1647.2197, x1 * x9) - x91),
+        let x98 = Self::mul_add(
+            s_q1,
+            Self::mul_add(-x1, x9, x5 * 1647.2197) - x93,
+            c_q1
+                * (Self::mul_add(-1145.5438, x3, Self::mul_add(x2, x9, qd[1] * x8))
+                    + Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x90, s_q2 * x89),
+                        Self::mul_add(s_q2, x92, c_q2 * x91),
+                    )),
         );
-        let x96 = Self::mul_add(0.7026, x94, x95);
-        [x96, x93, x91, x84, x77, x74, x68]
+        let x99 = -Self::mul_add(0.7026, x97, x98);
+        [x99, x96, x94, x86, x78, x75, x68]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1441,7 +1445,7 @@ impl SsrmsF32 {
         let x4 = qd[0] * qd[0] * 0.7026;
         let x5 = s_q1 * x3;
         let x6 = qd[1] * x2;
-        let x7 = Self::mul_add(-qdd[0], c_q1, x6);
+        let x7 = Self::mul_add(qdd[0], c_q1, -x6);
         let x8 = Self::mul_add(qd[1], x1, qdd[0] * s_q1);
         let x9 = Self::mul_add(x1, x2, qdd[1]);
         let x10 = Self::mul_add(x1, x1, qd[1] * qd[1]);
@@ -1452,153 +1456,152 @@ impl SsrmsF32 {
         let x15 = Self::mul_add(qd[1], c_q2, x1 * s_q2);
         let x16 = Self::mul_add(-0.5692, x9, x5);
         let x17 = Self::mul_add(-0.5692, x10, c_q1 * x3);
-        let x18 = Self::mul_add(0.5692, x6 + x7, -x4);
-        let x19 = Self::mul_add(-c_q2, x18, s_q2 * x16);
-        let x20 = Self::mul_add(qd[2], x15, Self::mul_add(qdd[1], s_q2, x7 * c_q2));
-        let x21 = Self::mul_add(-qd[2], x14, Self::mul_add(-qdd[1], c_q2, x7 * s_q2));
+        let x18 = Self::mul_add(-0.5692, x6 - x7, x4);
+        let x19 = Self::mul_add(c_q2, x18, s_q2 * x16);
+        let x20 = Self::mul_add(-qd[2], x15, Self::mul_add(-qdd[1], s_q2, x7 * c_q2));
+        let x21 = Self::mul_add(qd[2], x14, Self::mul_add(qdd[1], c_q2, x7 * s_q2));
         let x22 = qdd[2] - x8;
         let x23 = qd[2] - x2;
         let x24 = x15 * x15;
         let x25 = Self::mul_add(x23, x23, x24);
         let x26 = x14 * x23;
         let x27 = Self::mul_add(-x14, x15, x22);
-        let x28 = x26 - x21;
+        let x28 = x21 + x26;
         let x29 = 3946.1882 * x23;
         let x30 = 39234.473 * x15;
         let x31 = Self::mul_add(39241.402, x23, 3946.1882 * x14);
         let x32 = Self::mul_add(
-            5224.5703,
+            -5224.5703,
             x17,
-            Self::mul_add(39234.473, x21, Self::mul_add(-x14, x31, x23 * x29)),
+            Self::mul_add(39234.473, x21, -Self::mul_add(-x14, x31, x23 * x29)),
         );
         let (s_q3, c_q3) = libm::sincosf(q[3]);
         let x34 = Self::mul_add(-x15, s_q3, x14 * c_q3);
         let x35 = Self::mul_add(x15, c_q3, x14 * s_q3);
-        let x36 = Self::mul_add(s_q2, x18, c_q2 * x16)
-            + Self::mul_add(x21 + x26, 0.475, 7.11 * x25);
-        let x37 = x19 + Self::mul_add(Self::mul_add(-x15, x23, x20), -0.475, 7.11 * x27);
-        let x38 = Self::mul_add(Self::mul_add(x14, x14, x24), 0.475, 7.11 * x28) - x17;
+        let x36 = Self::mul_add(-s_q2, x18, c_q2 * x16)
+            + Self::mul_add(x21 - x26, -0.475, 7.11 * x25);
+        let x37 = x19 + Self::mul_add(Self::mul_add(x15, x23, x20), 0.475, 7.11 * x27);
+        let x38 = x17 - Self::mul_add(Self::mul_add(x14, x14, x24), 0.475, 7.11 * x28);
         let x39 = Self::mul_add(c_q3, x37, s_q3 * x36);
-        let x40 = Self::mul_add(-qd[3], x35, Self::mul_add(-x20, c_q3, x21 * s_q3));
-        let x41 = Self::mul_add(-qd[3], x34, Self::mul_add(x21, c_q3, x20 * s_q3));
+        let x40 = Self::mul_add(-qd[3], x35, Self::mul_add(-x21, s_q3, x20 * c_q3));
+        let x41 = Self::mul_add(qd[3], x34, Self::mul_add(x21, c_q3, x20 * s_q3));
         let x42 = qdd[3] + x22;
         let x43 = qd[3] + x23;
         let x44 = Self::mul_add(x43, x43, x35 * x35);
         let x45 = Self::mul_add(-x34, x35, x42);
-        let x46 = Self::mul_add(x34, x43, -x41);
+        let x46 = Self::mul_add(x34, x43, x41);
         let x47 = 1375.0472 * x43;
         let x48 = 24989.307 * x35;
         let x49 = Self::mul_add(24998.828, x43, 1375.0472 * x34);
         let x50 = Self::mul_add(
             -3239.4583,
             x38,
-            Self::mul_add(24989.307, x41, Self::mul_add(-x34, x49, x43 * x47)),
+            Self::mul_add(24989.307, x41, -Self::mul_add(-x34, x49, x43 * x47)),
         );
         let (s_q4, c_q4) = libm::sincosf(q[4]);
         let x52 = Self::mul_add(-x35, s_q4, x34 * c_q4);
         let x53 = Self::mul_add(x35, c_q4, x34 * s_q4);
         let x54 = Self::mul_add(
-            s_q4,
+            -s_q4,
             Self::mul_add(7.11, x45, x39),
-            c_q4 * Self::mul_add(-7.11, x44, Self::mul_add(-c_q3, x36, s_q3 * x37)),
+            c_q4 * Self::mul_add(7.11, x44, Self::mul_add(-s_q3, x37, c_q3 * x36)),
         );
-        let x55 = Self::mul_add(-qd[4], x53, Self::mul_add(x41, s_q4, x40 * c_q4));
-        let x56 = Self::mul_add(-qd[4], x52, Self::mul_add(-x40, s_q4, x41 * c_q4));
+        let x55 = Self::mul_add(-qd[4], x53, Self::mul_add(-x41, s_q4, x40 * c_q4));
+        let x56 = Self::mul_add(qd[4], x52, Self::mul_add(x41, c_q4, x40 * s_q4));
         let x57 = qdd[4] + x42;
         let x58 = qd[4] + x43;
         let x59 = 171.19551 * Self::mul_add(x52, x53, x57);
         let x60 = 171.19551 * Self::mul_add(x52, x52, x58 * x58);
         let x61 = 171.19551 * Self::mul_add(-x53, x58, x55);
         let x62 = Self::mul_add(97.44449, x58, x53 * 177.08836);
-        let x63 = Self::mul_add(-97.44449, x53, 179.88297 * x58);
+        let x63 = Self::mul_add(-179.88297, x58, 97.44449 * x53);
         let x64 = Self::mul_add(
             -171.19551,
             x54,
-            Self::mul_add(x52, x62, Self::mul_add(179.88297, x57, 97.44449 * x56)),
+            Self::mul_add(-x52, x62, Self::mul_add(-179.88297, x57, 97.44449 * x56)),
         );
         let (s_q5, c_q5) = libm::sincosf(q[5]);
-        let x66 = Self::mul_add(-x52, s_q5, x58 * c_q5);
+        let x66 = Self::mul_add(-x58, c_q5, x52 * s_q5);
         let x67 = Self::mul_add(x58, s_q5, x52 * c_q5);
-        let x68 = Self::mul_add(qd[5], x66, Self::mul_add(x57, s_q5, x55 * c_q5));
+        let x68 = Self::mul_add(-qd[5], x66, Self::mul_add(x57, s_q5, x55 * c_q5));
         let x69 = qd[5] + x53;
         let x70 = 44.41 * x67;
         let x71 = 47.471 * x69;
         let (s_q6, c_q6) = libm::sincosf(q[6]);
         let x73 = 9.336 * (qdd[6] + x68);
         let x74 = 9.336 * (qd[6] + x67);
-        let x75 = Self::mul_add(-x66, s_q6, x69 * c_q6) * x74;
-        let x76 = Self::mul_add(x69, s_q6, x66 * c_q6) * x74;
-        let x77 = Self::mul_add(s_q6, x76, c_q6 * x75)
-            - Self::mul_add(x67, x71, x69 * x70);
-        let x78 = Self::mul_add(-x66, x71, 44.41 * x68) - x73;
-        let x79 = Self::mul_add(x66, x70, 47.471 * (qdd[5] - x56))
-            + Self::mul_add(-c_q6, x76, s_q6 * x75);
+        let x75 = Self::mul_add(x69, c_q6, x66 * s_q6) * x74;
+        let x76 = Self::mul_add(-x69, s_q6, x66 * c_q6) * x74;
+        let x77 = Self::mul_add(x67, x71, x69 * x70)
+            - Self::mul_add(-s_q6, x76, c_q6 * x75);
+        let x78 = Self::mul_add(x66, x71, 44.41 * x68) - x73;
+        let x79 = Self::mul_add(-x66, x70, 47.471 * (qdd[5] + x56))
+            + Self::mul_add(c_q6, x76, s_q6 * x75);
         let x80 = Self::mul_add(
             171.19551,
-            Self::mul_add(7.11, x46, x38),
-            -Self::mul_add(x53, x63, x58 * x62),
-        ) - Self::mul_add(c_q5, x78, s_q5 * x77);
-        let x81 = Self::mul_add(
-            -x52,
-            x63,
-            Self::mul_add(x56, -177.08836, 97.44449 * x57),
-        ) - x79;
-        let x82 = x64 + Self::mul_add(-s_q5, x78, c_q5 * x77);
-        let x83 = Self::mul_add(c_q4, x60, s_q4 * x59);
-        let x84 = Self::mul_add(-3239.4583, x44, Self::mul_add(-c_q4, x59, s_q4 * x60));
-        let x85 = Self::mul_add(3239.4583, x45, -x83);
-        let x86 = Self::mul_add(3239.4583, x46, x61);
-        let x87 = Self::mul_add(1375.0472, x42, Self::mul_add(-x35, x49, x43 * x48))
-            + Self::mul_add(-s_q4, x81, c_q4 * x80);
-        let x88 = x50 + Self::mul_add(-7.11, x61, Self::mul_add(c_q4, x81, s_q4 * x80));
-        let x89 = Self::mul_add(
+            Self::mul_add(-7.11, x46, x38),
+            Self::mul_add(-x53, x63, x58 * x62),
+        ) - Self::mul_add(-c_q5, x78, s_q5 * x77);
+        let x81 = Self::mul_add(x52, x63, Self::mul_add(97.44449, x57, x56 * 177.08836))
+            - x79;
+        let x82 = x64 + Self::mul_add(s_q5, x78, c_q5 * x77);
+        let x83 = -x82;
+        let x84 = Self::mul_add(c_q4, x60, s_q4 * x59);
+        let x85 = Self::mul_add(3239.4583, x44, Self::mul_add(-s_q4, x60, c_q4 * x59));
+        let x86 = Self::mul_add(3239.4583, x45, -x84);
+        let x87 = Self::mul_add(3239.4583, x46, x61);
+        let x88 = Self::mul_add(1375.0472, x42, Self::mul_add(-x35, x49, x43 * x48))
+            - Self::mul_add(s_q4, x81, c_q4 * x80);
+        let x89 = x50 + Self::mul_add(7.11, x61, Self::mul_add(-c_q4, x81, s_q4 * x80));
+        let x90 = Self::mul_add(
             3239.4583,
             x39,
             Self::mul_add(24998.828, x42, 1375.0472 * x40)
                 + Self::mul_add(-x34, x48, x35 * x47),
-        ) + Self::mul_add(-7.11, x83, x82);
-        let x90 = Self::mul_add(-s_q3, x85, c_q3 * x84);
-        let x91 = Self::mul_add(c_q3, x85, s_q3 * x84);
-        let x92 = Self::mul_add(-5224.5703, x25, x90);
-        let x93 = Self::mul_add(5224.5703, x27, x91);
-        let x94 = Self::mul_add(3946.1882, x22, Self::mul_add(-x15, x31, x23 * x30))
-            + Self::mul_add(0.475, x91, Self::mul_add(-s_q3, x88, c_q3 * x87));
-        let x95 = x32
-            + (Self::mul_add(c_q3, x88, s_q3 * x87)
-                - Self::mul_add(7.11, x86, 0.475 * x90));
-        let x96 = Self::mul_add(
+        ) - Self::mul_add(7.11, x84, x82);
+        let x91 = Self::mul_add(s_q3, x86, c_q3 * x85);
+        let x92 = Self::mul_add(-c_q3, x86, s_q3 * x85);
+        let x93 = Self::mul_add(5224.5703, x25, x91);
+        let x94 = Self::mul_add(5224.5703, x27, -x92);
+        let x95 = Self::mul_add(3946.1882, x22, Self::mul_add(-x15, x31, x23 * x30))
+            + Self::mul_add(-0.475, x92, Self::mul_add(s_q3, x89, c_q3 * x88));
+        let x96 = x32
+            - (Self::mul_add(-c_q3, x89, s_q3 * x88)
+                + Self::mul_add(-7.11, x87, 0.475 * x91));
+        let x97 = Self::mul_add(
             5224.5703,
             x19,
-            Self::mul_add(-3946.1882, x20, 39241.402 * x22)
+            Self::mul_add(39241.402, x22, 3946.1882 * x20)
                 + Self::mul_add(-x14, x30, x15 * x29),
-        ) + Self::mul_add(7.11, x91, x89);
-        let x97 = Self::mul_add(-c_q2, x92, s_q2 * x93);
-        let x98 = Self::mul_add(
+        ) + Self::mul_add(-7.11, x92, x90);
+        let x98 = Self::mul_add(s_q2, x94, c_q2 * x93);
+        let x99 = Self::mul_add(
             -1145.5438,
             x5,
             Self::mul_add(x1, x11, 1650.6387 * qdd[1]),
-        ) - Self::mul_add(0.5692, x97, Self::mul_add(c_q2, x95, s_q2 * x94));
-        let x99 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(1145.5438, x10, Self::mul_add(5224.5703, x28, x86)),
-            s_q1 * Self::mul_add(-1145.5438, x9, x97),
-        );
+        ) - Self::mul_add(0.5692, x98, Self::mul_add(-c_q2, x96, s_q2 * x95));
         let x100 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-1145.5438, x4, Self::mul_add(x2, x12, qd[1] * x11))
-                + Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x93, s_q2 * x92),
-                    Self::mul_add(-c_q2, x94, s_q2 * x95),
-                ),
-            s_q1 * (Self::mul_add(x8, -1647.2197, x1 * x12) - x96),
+            c_q1,
+            Self::mul_add(1145.5438, x10, Self::mul_add(5224.5703, x28, x87)),
+            s_q1 * Self::mul_add(1145.5438, x9, -x98),
         );
-        let x101 = Self::mul_add(2232.9683, qdd[0], Self::mul_add(0.7026, x99, x100));
-        [x101, x98, x96, x89, x82, x79, x73]
+        let x101 = Self::mul_add(
+            s_q1,
+            Self::mul_add(-x1, x12, x8 * 1647.2197) + x97,
+            c_q1
+                * (Self::mul_add(-1145.5438, x4, Self::mul_add(x2, x12, qd[1] * x11))
+                    - Self::mul_add(
+                        -0.5692,
+                        Self::mul_add(-c_q2, x94, s_q2 * x93),
+                        Self::mul_add(s_q2, x96, c_q2 * x95),
+                    )),
+        );
+        let x102 = Self::mul_add(2232.9683, qdd[0], -Self::mul_add(0.7026, x100, x101));
+        [x102, x99, x97, x90, x83, x79, x73]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 453 mul, 342 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 264 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f32; 7], qd: &[f32; 7], tau: &[f32; 7]) -> [f32; 7] {
         let (s_q1, c_q1) = libm::sincosf(q[1]);
@@ -1615,7 +1618,7 @@ impl SsrmsF32 {
         let x11 = s_q4 * s_q4 * x10;
         let x12 = x7 - x11;
         let x13 = Self::mul_add(97.44449, s_q4, c_q4 * x8);
-        let x14 = Self::mul_add(-s_q4, x8, 97.44449 * c_q4);
+        let x14 = Self::mul_add(-97.44449, c_q4, s_q4 * x8);
         let x15 = 171.19551 * s_q4;
         let x16 = 171.19551 * c_q4;
         let x17 = 7.11 * x15;
@@ -1623,8 +1626,8 @@ impl SsrmsF32 {
         let x19 = x9 - x17;
         let x20 = 3239.4583 - x15;
         let x21 = 1375.0472 - x13;
-        let x22 = 24989.307 + (-129.61737 + x11 - x17 - x17);
-        let x23 = 24998.828 + (x19 - x17);
+        let x22 = 24989.307 - (x17 - (-129.61737 + x11 - x17));
+        let x23 = 24998.828 - (x17 - x19);
         let x24 = s_q3 * s_q3;
         let x25 = s_q3 * c_q3;
         let x26 = x12 - x22;
@@ -1638,9 +1641,9 @@ impl SsrmsF32 {
         let x34 = c_q3 * x16;
         let x35 = Self::mul_add(s_q3, x20, x34);
         let x36 = 7.11 * x33;
-        let x37 = Self::mul_add(x33, 0.475, Self::mul_add(c_q3, x21, -x30));
+        let x37 = Self::mul_add(x33, 0.475, Self::mul_add(c_q3, x21, x30));
         let x38 = Self::mul_add(-7.11, x35, x18 + Self::mul_add(-x24, x27, x25 * x26));
-        let x39 = Self::mul_add(x35, 0.475, Self::mul_add(s_q3, x21, x31));
+        let x39 = Self::mul_add(x35, 0.475, Self::mul_add(s_q3, x21, -x31));
         let x40 = x23 + x36;
         let x41 = 5224.5703 + x33;
         let x42 = 3946.1882 + x37;
@@ -1652,395 +1655,399 @@ impl SsrmsF32 {
         let x48 = x38 + x38;
         let x49 = Self::mul_add(x46, x48, x45 * x47);
         let x50 = x29 - x49;
-        let x51 = c_q2 * x42;
-        let x52 = s_q2 * x39;
-        let x53 = c_q2 * x39;
-        let x54 = c_q2 * x41;
-        let x55 = s_q2 * x35;
-        let x56 = x54 - x55;
-        let x57 = c_q2 * x35;
-        let x58 = Self::mul_add(s_q2, x41, x57);
-        let x59 = Self::mul_add(0.5692, x56, x51 - x52);
-        let x60 = Self::mul_add(0.5692, x58, Self::mul_add(s_q2, x42, x53));
-        let x61 = 0.7026 * x58;
-        let x62 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(1145.5438, s_q1, c_q1 * x56),
-            Self::mul_add(-c_q1, x38 + Self::mul_add(-x45, x48, x46 * x47), s_q1 * x60),
-        );
-        let x63 = Self::mul_add(
+        let x51 = s_q2 * x39;
+        let x52 = c_q2 * x39;
+        let x53 = s_q2 * x35;
+        let x54 = Self::mul_add(c_q2, x41, -x53);
+        let x55 = c_q2 * x35;
+        let x56 = Self::mul_add(s_q2, x41, x55);
+        let x57 = Self::mul_add(0.5692, x54, Self::mul_add(c_q2, x42, -x51));
+        let x58 = Self::mul_add(0.5692, x56, Self::mul_add(s_q2, x42, x52));
+        let x59 = 0.7026 * x56;
+        let x60 = Self::mul_add(
             0.7026,
-            s_q1 * x58,
-            -Self::mul_add(s_q1, x44, c_q1 * Self::mul_add(0.5692, x55 - x54, x52 - x51)),
+            Self::mul_add(1145.5438, s_q1, c_q1 * x54),
+            Self::mul_add(-s_q1, x58, c_q1 * (x38 + Self::mul_add(-x45, x48, x46 * x47))),
         );
-        let x64 = Self::mul_add(s_q2, x33, x57);
-        let x65 = Self::mul_add(
+        let x61 = Self::mul_add(
+            0.7026,
+            s_q1 * x56,
+            Self::mul_add(-s_q1, x44, c_q1 * x57),
+        );
+        let x62 = Self::mul_add(s_q2, x33, x55);
+        let x63 = Self::mul_add(
             s_q1,
             x40,
             c_q1
                 * Self::mul_add(
                     0.5692,
-                    Self::mul_add(-c_q2, x33, x55),
-                    Self::mul_add(-c_q2, x37, x52),
+                    Self::mul_add(-c_q2, x33, x53),
+                    Self::mul_add(-c_q2, x37, x51),
                 ),
         );
-        let x66 = Self::mul_add(0.7026, s_q1 * x64, -x65);
-        let x67 = Self::mul_add(s_q3, x15, -x34);
-        let x68 = Self::mul_add(c_q3, x15, x32);
-        let x69 = Self::mul_add(0.475, x68, Self::mul_add(c_q3, x13, x30));
-        let x70 = Self::mul_add(-0.475, x67, Self::mul_add(-s_q3, x13, x31));
-        let x71 = Self::mul_add(-7.11, x68, x19);
-        let x72 = Self::mul_add(s_q2, x68, c_q2 * x67);
-        let x73 = Self::mul_add(
-            s_q1,
-            x71,
+        let x64 = Self::mul_add(-0.7026, s_q1 * x62, x63);
+        let x65 = Self::mul_add(-s_q3, x15, x34);
+        let x66 = Self::mul_add(c_q3, x15, x32);
+        let x67 = Self::mul_add(-0.475, x66, Self::mul_add(-c_q3, x13, x30));
+        let x68 = Self::mul_add(-0.475, x65, Self::mul_add(s_q3, x13, x31));
+        let x69 = Self::mul_add(-7.11, x66, x19);
+        let x70 = Self::mul_add(-s_q2, x66, c_q2 * x65);
+        let x71 = Self::mul_add(
+            -s_q1,
+            x69,
             c_q1
                 * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-s_q2, x67, c_q2 * x68),
-                    Self::mul_add(s_q2, x70, c_q2 * x69),
-                ),
-        );
-        let x74 = Self::mul_add(0.7026, s_q1 * x72, x73);
-        let x75 = 47.471 * s_q4;
-        let x76 = 47.471 * c_q4;
-        let x77 = Self::mul_add(s_q3, x76, c_q3 * x75);
-        let x78 = Self::mul_add(-c_q3, x76, s_q3 * x75);
-        let x79 = c_q1 * Self::mul_add(-c_q2, x77, s_q2 * x78);
-        let x80 = 9.336 * c_q5;
-        let x81 = 9.336 * s_q5;
-        let x82 = c_q4 * x80;
-        let x83 = s_q4 * x80;
-        let x84 = Self::mul_add(-s_q3, x83, c_q3 * x82);
-        let x85 = Self::mul_add(c_q3, x83, s_q3 * x82);
-        let x86 = Self::mul_add(s_q1, x81, c_q1 * Self::mul_add(-c_q2, x84, s_q2 * x85));
-        let x87 = qd[0] * c_q1;
-        let x88 = qd[0] * s_q1;
-        let x89 = 0.7026 * (qd[0] * qd[0]);
-        let x90 = qd[1] * x88;
-        let x91 = qd[1] * x87;
-        let x92 = x87 * x88;
-        let x93 = Self::mul_add(x87, x87, qd[1] * qd[1]);
-        let x94 = x88 * 1647.2197;
-        let x95 = 1650.6387 * qd[1];
-        let x96 = Self::mul_add(-qd[1], s_q2, c_q2 * x87);
-        let x97 = Self::mul_add(qd[1], c_q2, s_q2 * x87);
-        let x98 = 0.5692 * x92;
-        let x99 = 0.5692 * x93;
-        let x100 = Self::mul_add(0.5692, x90 + x90, -x89);
-        let x101 = Self::mul_add(c_q2, x100, s_q2 * x98);
-        let x102 = Self::mul_add(qd[2], x97, c_q2 * x90);
-        let x103 = Self::mul_add(-qd[2], x96, s_q2 * x90);
-        let x104 = qd[2] - x88;
-        let x105 = x97 * x97;
-        let x106 = Self::mul_add(x104, x104, x105);
-        let x107 = x96 * x104;
-        let x108 = Self::mul_add(x96, x97, x91);
-        let x109 = x107 - x103;
-        let x110 = 3946.1882 * x104;
-        let x111 = 39234.473 * x97;
-        let x112 = Self::mul_add(39241.402, x104, 3946.1882 * x96);
-        let x113 = Self::mul_add(
-            -5224.5703,
-            x99,
-            Self::mul_add(39234.473, x103, Self::mul_add(-x96, x112, x104 * x110)),
-        );
-        let x114 = Self::mul_add(-s_q3, x97, c_q3 * x96);
-        let x115 = Self::mul_add(c_q3, x97, s_q3 * x96);
-        let x116 = Self::mul_add(-s_q2, x100, c_q2 * x98)
-            - Self::mul_add(0.475, x103 + x107, 7.11 * x106);
-        let x117 = x101
-            + Self::mul_add(0.475, Self::mul_add(-x97, x104, x102), 7.11 * x108);
-        let x118 = x99
-            + Self::mul_add(0.475, Self::mul_add(x96, x96, x105), 7.11 * x109);
-        let x119 = Self::mul_add(c_q3, x117, s_q3 * x116);
-        let x120 = Self::mul_add(-qd[3], x115, Self::mul_add(-c_q3, x102, s_q3 * x103));
-        let x121 = Self::mul_add(-qd[3], x114, Self::mul_add(c_q3, x103, s_q3 * x102));
-        let x122 = qd[3] + x104;
-        let x123 = Self::mul_add(x122, x122, x115 * x115);
-        let x124 = Self::mul_add(x114, x115, x91);
-        let x125 = Self::mul_add(x114, x122, -x121);
-        let x126 = 1375.0472 * x122;
-        let x127 = 24989.307 * x115;
-        let x128 = Self::mul_add(24998.828, x122, 1375.0472 * x114);
-        let x129 = Self::mul_add(
-            -3239.4583,
-            x118,
-            Self::mul_add(24989.307, x121, Self::mul_add(-x114, x128, x122 * x126)),
-        );
-        let x130 = Self::mul_add(-s_q4, x115, c_q4 * x114);
-        let x131 = Self::mul_add(c_q4, x115, s_q4 * x114);
-        let x132 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x124, x119),
-            c_q4 * Self::mul_add(-7.11, x123, Self::mul_add(-s_q3, x117, c_q3 * x116)),
-        );
-        let x133 = Self::mul_add(-qd[4], x131, Self::mul_add(s_q4, x121, c_q4 * x120));
-        let x134 = Self::mul_add(-qd[4], x130, Self::mul_add(-s_q4, x120, c_q4 * x121));
-        let x135 = qd[4] + x122;
-        let x136 = 171.19551 * Self::mul_add(-x130, x131, x91);
-        let x137 = 171.19551 * Self::mul_add(x130, x130, x135 * x135);
-        let x138 = 171.19551 * Self::mul_add(-x131, x135, x133);
-        let x139 = Self::mul_add(97.44449, x135, x131 * 177.08836);
-        let x140 = Self::mul_add(-97.44449, x131, 179.88297 * x135);
-        let x141 = Self::mul_add(
-            -171.19551,
-            x132,
-            Self::mul_add(x130, x139, Self::mul_add(-179.88297, x91, 97.44449 * x134)),
-        );
-        let x142 = Self::mul_add(-s_q5, x130, c_q5 * x135);
-        let x143 = Self::mul_add(s_q5, x135, c_q5 * x130);
-        let x144 = Self::mul_add(-qd[5], x142, Self::mul_add(-c_q5, x133, s_q5 * x91));
-        let x145 = qd[5] + x131;
-        let x146 = 44.41 * x143;
-        let x147 = 47.471 * x145;
-        let x148 = 9.336 * x144;
-        let x149 = 9.336 * (qd[6] + x143);
-        let x150 = Self::mul_add(-s_q6, x142, c_q6 * x145) * x149;
-        let x151 = Self::mul_add(s_q6, x145, c_q6 * x142) * x149;
-        let x152 = Self::mul_add(s_q6, x151, c_q6 * x150)
-            - Self::mul_add(x143, x147, x145 * x146);
-        let x153 = x148 - Self::mul_add(x142, x147, 44.41 * x144);
-        let x154 = Self::mul_add(-47.471, x134, x142 * x146)
-            + Self::mul_add(-c_q6, x151, s_q6 * x150);
-        let x155 = Self::mul_add(
-            171.19551,
-            Self::mul_add(7.11, x125, x118),
-            -Self::mul_add(x131, x140, x135 * x139),
-        ) - Self::mul_add(c_q5, x153, s_q5 * x152);
-        let x156 = Self::mul_add(
-            x130,
-            x140,
-            Self::mul_add(97.44449, x91, x134 * 177.08836),
-        ) + x154;
-        let x157 = x141 + Self::mul_add(-s_q5, x153, c_q5 * x152);
-        let x158 = Self::mul_add(-c_q4, x137, s_q4 * x136);
-        let x159 = Self::mul_add(
-            -3239.4583,
-            x123,
-            Self::mul_add(s_q4, x137, c_q4 * x136),
-        );
-        let x160 = Self::mul_add(-3239.4583, x124, x158);
-        let x161 = Self::mul_add(3239.4583, x125, x138);
-        let x162 = Self::mul_add(
-            -1375.0472,
-            x91,
-            Self::mul_add(-x115, x128, x122 * x127),
-        ) + Self::mul_add(s_q4, x156, c_q4 * x155);
-        let x163 = x129
-            + Self::mul_add(-7.11, x138, Self::mul_add(-c_q4, x156, s_q4 * x155));
-        let x164 = Self::mul_add(
-            -3239.4583,
-            x119,
-            Self::mul_add(-24998.828, x91, 1375.0472 * x120)
-                + Self::mul_add(-x114, x127, x115 * x126),
-        ) + Self::mul_add(7.11, x158, x157);
-        let x165 = Self::mul_add(-s_q3, x160, c_q3 * x159);
-        let x166 = Self::mul_add(c_q3, x160, s_q3 * x159);
-        let x167 = Self::mul_add(-5224.5703, x106, x165);
-        let x168 = Self::mul_add(-5224.5703, x108, x166);
-        let x169 = Self::mul_add(-3946.1882, x91, Self::mul_add(-x97, x112, x104 * x111))
-            + Self::mul_add(0.475, x166, Self::mul_add(-s_q3, x163, c_q3 * x162));
-        let x170 = x113
-            + (Self::mul_add(c_q3, x163, s_q3 * x162)
-                - Self::mul_add(7.11, x161, 0.475 * x165));
-        let x171 = Self::mul_add(
-            -5224.5703,
-            x101,
-            Self::mul_add(-x96, x111, x97 * x110)
-                - Self::mul_add(39241.402, x91, 3946.1882 * x102),
-        ) + Self::mul_add(7.11, x166, x164);
-        let x172 = Self::mul_add(-c_q2, x167, s_q2 * x168);
-        let x173 = Self::mul_add(
-            x87,
-            x94,
-            -Self::mul_add(0.5692, x172, Self::mul_add(c_q2, x170, s_q2 * x169)),
-        );
-        let x174 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(1145.5438, x93, Self::mul_add(5224.5703, x109, x161)),
-            s_q1 * Self::mul_add(-1145.5438, x92, x172),
-        );
-        let x175 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-1145.5438, x89, Self::mul_add(x88, x95, qd[1] * x94))
-                + Self::mul_add(
                     -0.5692,
-                    Self::mul_add(c_q2, x168, s_q2 * x167),
-                    Self::mul_add(-c_q2, x169, s_q2 * x170),
+                    Self::mul_add(c_q2, x66, s_q2 * x65),
+                    Self::mul_add(s_q2, x68, c_q2 * x67),
                 ),
-            s_q1 * (Self::mul_add(x91, -1647.2197, x87 * x95) - x171),
         );
-        let x176 = tau[0] - Self::mul_add(0.7026, x174, x175);
-        let x177 = 1.0
+        let x72 = Self::mul_add(0.7026, s_q1 * x70, x71);
+        let x73 = 47.471 * s_q4;
+        let x74 = 47.471 * c_q4;
+        let x75 = Self::mul_add(s_q3, x74, c_q3 * x73);
+        let x76 = Self::mul_add(-c_q3, x74, s_q3 * x73);
+        let x77 = c_q1 * Self::mul_add(-s_q2, x76, c_q2 * x75);
+        let x78 = 9.336 * c_q5;
+        let x79 = 9.336 * s_q5;
+        let x80 = c_q4 * x78;
+        let x81 = s_q4 * x78;
+        let x82 = Self::mul_add(-s_q3, x81, c_q3 * x80);
+        let x83 = Self::mul_add(c_q3, x81, s_q3 * x80);
+        let x84 = Self::mul_add(
+            -s_q1,
+            x79,
+            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x82),
+        );
+        let x85 = qd[0] * c_q1;
+        let x86 = qd[0] * s_q1;
+        let x87 = 0.7026 * (qd[0] * qd[0]);
+        let x88 = qd[1] * x86;
+        let x89 = qd[1] * x85;
+        let x90 = x85 * x86;
+        let x91 = Self::mul_add(x85, x85, qd[1] * qd[1]);
+        let x92 = x86 * 1647.2197;
+        let x93 = 1650.6387 * qd[1];
+        let x94 = Self::mul_add(-qd[1], s_q2, c_q2 * x85);
+        let x95 = Self::mul_add(qd[1], c_q2, s_q2 * x85);
+        let x96 = 0.5692 * x90;
+        let x97 = 0.5692 * x91;
+        let x98 = Self::mul_add(-0.5692, x88 + x88, x87);
+        let x99 = Self::mul_add(-c_q2, x98, s_q2 * x96);
+        let x100 = Self::mul_add(qd[2], x95, c_q2 * x88);
+        let x101 = Self::mul_add(-qd[2], x94, s_q2 * x88);
+        let x102 = qd[2] - x86;
+        let x103 = x95 * x95;
+        let x104 = Self::mul_add(x102, x102, x103);
+        let x105 = x94 * x102;
+        let x106 = Self::mul_add(x94, x95, x89);
+        let x107 = x101 - x105;
+        let x108 = 3946.1882 * x102;
+        let x109 = 39234.473 * x95;
+        let x110 = Self::mul_add(39241.402, x102, 3946.1882 * x94);
+        let x111 = Self::mul_add(
+            -5224.5703,
+            x97,
+            Self::mul_add(39234.473, x101, Self::mul_add(-x94, x110, x102 * x108)),
+        );
+        let x112 = Self::mul_add(-s_q3, x95, c_q3 * x94);
+        let x113 = Self::mul_add(c_q3, x95, s_q3 * x94);
+        let x114 = Self::mul_add(s_q2, x98, c_q2 * x96)
+            - Self::mul_add(0.475, x101 + x105, 7.11 * x104);
+        let x115 = x99
+            + Self::mul_add(0.475, Self::mul_add(-x95, x102, x100), 7.11 * x106);
+        let x116 = x97
+            - Self::mul_add(-0.475, Self::mul_add(x94, x94, x103), 7.11 * x107);
+        let x117 = Self::mul_add(c_q3, x115, s_q3 * x114);
+        let x118 = Self::mul_add(qd[3], x113, Self::mul_add(-s_q3, x101, c_q3 * x100));
+        let x119 = Self::mul_add(-qd[3], x112, Self::mul_add(c_q3, x101, s_q3 * x100));
+        let x120 = qd[3] + x102;
+        let x121 = Self::mul_add(x120, x120, x113 * x113);
+        let x122 = Self::mul_add(x112, x113, x89);
+        let x123 = Self::mul_add(-x112, x120, x119);
+        let x124 = 1375.0472 * x120;
+        let x125 = 24989.307 * x113;
+        let x126 = Self::mul_add(24998.828, x120, 1375.0472 * x112);
+        let x127 = Self::mul_add(
+            -3239.4583,
+            x116,
+            Self::mul_add(24989.307, x119, Self::mul_add(-x112, x126, x120 * x124)),
+        );
+        let x128 = Self::mul_add(-s_q4, x113, c_q4 * x112);
+        let x129 = Self::mul_add(c_q4, x113, s_q4 * x112);
+        let x130 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(7.11, x122, x117),
+            c_q4 * Self::mul_add(-7.11, x121, Self::mul_add(-s_q3, x115, c_q3 * x114)),
+        );
+        let x131 = Self::mul_add(qd[4], x129, Self::mul_add(-s_q4, x119, c_q4 * x118));
+        let x132 = Self::mul_add(-qd[4], x128, Self::mul_add(c_q4, x119, s_q4 * x118));
+        let x133 = qd[4] + x120;
+        let x134 = 171.19551 * Self::mul_add(-x128, x129, x89);
+        let x135 = 171.19551 * Self::mul_add(x128, x128, x133 * x133);
+        let x136 = 171.19551 * Self::mul_add(x129, x133, x131);
+        let x137 = Self::mul_add(97.44449, x133, x129 * 177.08836);
+        let x138 = Self::mul_add(-179.88297, x133, 97.44449 * x129);
+        let x139 = Self::mul_add(
+            -171.19551,
+            x130,
+            Self::mul_add(x128, x137, Self::mul_add(-179.88297, x89, 97.44449 * x132)),
+        );
+        let x140 = Self::mul_add(-c_q5, x133, s_q5 * x128);
+        let x141 = Self::mul_add(s_q5, x133, c_q5 * x128);
+        let x142 = Self::mul_add(qd[5], x140, Self::mul_add(s_q5, x89, c_q5 * x131));
+        let x143 = qd[5] + x129;
+        let x144 = 44.41 * x141;
+        let x145 = 47.471 * x143;
+        let x146 = 9.336 * x142;
+        let x147 = 9.336 * (qd[6] + x141);
+        let x148 = Self::mul_add(c_q6, x143, s_q6 * x140) * x147;
+        let x149 = Self::mul_add(-s_q6, x143, c_q6 * x140) * x147;
+        let x150 = Self::mul_add(x141, x145, x143 * x144)
+            - Self::mul_add(-s_q6, x149, c_q6 * x148);
+        let x151 = Self::mul_add(-x140, x145, 44.41 * x142) - x146;
+        let x152 = Self::mul_add(x140, x144, 47.471 * x132)
+            - Self::mul_add(c_q6, x149, s_q6 * x148);
+        let x153 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(-7.11, x123, x116),
+            Self::mul_add(-x129, x138, x133 * x137),
+        ) - Self::mul_add(c_q5, x151, s_q5 * x150);
+        let x154 = Self::mul_add(
+            -x128,
+            x138,
+            Self::mul_add(97.44449, x89, x132 * 177.08836),
+        ) - x152;
+        let x155 = x139 - Self::mul_add(-s_q5, x151, c_q5 * x150);
+        let x156 = Self::mul_add(-c_q4, x135, s_q4 * x134);
+        let x157 = Self::mul_add(
+            3239.4583,
+            x121,
+            -Self::mul_add(s_q4, x135, c_q4 * x134),
+        );
+        let x158 = Self::mul_add(3239.4583, x122, -x156);
+        let x159 = Self::mul_add(3239.4583, x123, x136);
+        let x160 = Self::mul_add(
+            1375.0472,
+            x89,
+            -Self::mul_add(-x113, x126, x120 * x125),
+        ) + Self::mul_add(-s_q4, x154, c_q4 * x153);
+        let x161 = x127
+            - Self::mul_add(-7.11, x136, Self::mul_add(c_q4, x154, s_q4 * x153));
+        let x162 = Self::mul_add(
+            3239.4583,
+            x117,
+            Self::mul_add(24998.828, x89, 1375.0472 * x118)
+                - Self::mul_add(-x112, x125, x113 * x124),
+        ) - Self::mul_add(7.11, x156, x155);
+        let x163 = Self::mul_add(-s_q3, x158, c_q3 * x157);
+        let x164 = Self::mul_add(c_q3, x158, s_q3 * x157);
+        let x165 = Self::mul_add(5224.5703, x104, x163);
+        let x166 = Self::mul_add(5224.5703, x106, x164);
+        let x167 = Self::mul_add(3946.1882, x89, -Self::mul_add(-x95, x110, x102 * x109))
+            + Self::mul_add(0.475, x164, Self::mul_add(s_q3, x161, c_q3 * x160));
+        let x168 = x111
+            - (Self::mul_add(-c_q3, x161, s_q3 * x160)
+                - Self::mul_add(7.11, x159, 0.475 * x163));
+        let x169 = Self::mul_add(
+            5224.5703,
+            x99,
+            Self::mul_add(39241.402, x89, 3946.1882 * x100)
+                - Self::mul_add(-x94, x109, x95 * x108),
+        ) + Self::mul_add(7.11, x164, x162);
+        let x170 = Self::mul_add(-s_q2, x166, c_q2 * x165);
+        let x171 = Self::mul_add(
+            x85,
+            x92,
+            Self::mul_add(-0.5692, x170, Self::mul_add(-c_q2, x168, s_q2 * x167)),
+        );
+        let x172 = Self::mul_add(
+            c_q1,
+            Self::mul_add(1145.5438, x91, -Self::mul_add(5224.5703, x107, x159)),
+            s_q1 * Self::mul_add(1145.5438, x90, -x170),
+        );
+        let x173 = Self::mul_add(
+            s_q1,
+            Self::mul_add(-x85, x93, x89 * 1647.2197) - x169,
+            c_q1
+                * (Self::mul_add(-1145.5438, x87, Self::mul_add(x86, x93, qd[1] * x92))
+                    + Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x166, s_q2 * x165),
+                        Self::mul_add(s_q2, x168, c_q2 * x167),
+                    )),
+        );
+        let x174 = tau[0] + Self::mul_add(0.7026, x172, x173);
+        let x175 = 1.0
             / (2232.9683
-                + (x50
-                    - Self::mul_add(
-                        s_q1 * c_q1,
-                        x59 + x59,
-                        s_q1 * s_q1 * (x50 - (-1647.2197 + x44)),
-                    ) - x61 - x61));
-        let x178 = x62 * x177;
-        let x179 = x63 * x177;
-        let x180 = x66 * x177;
-        let x181 = x74 * x177;
-        let x182 = x79 * x177;
-        let x183 = x86 * x177;
-        let x184 = 1.0 / Self::mul_add(-x62, x178, 1650.6387 + (x43 + x49));
-        let x185 = Self::mul_add(x62, x179, x60);
-        let x186 = x184 * x185;
+                - (x59
+                    - (x50
+                        - Self::mul_add(
+                            s_q1 * c_q1,
+                            x57 + x57,
+                            s_q1 * s_q1 * (x50 - (-1647.2197 + x44)),
+                        ) - x59)));
+        let x176 = x60 * x175;
+        let x177 = x61 * x175;
+        let x178 = x64 * x175;
+        let x179 = x72 * x175;
+        let x180 = x77 * x175;
+        let x181 = x84 * x175;
+        let x182 = 1.0 / Self::mul_add(-x60, x176, 1650.6387 + (x43 + x49));
+        let x183 = Self::mul_add(-x60, x177, x58);
+        let x184 = x182 * x183;
+        let x185 = Self::mul_add(
+            x60,
+            x178,
+            Self::mul_add(0.5692, x62, Self::mul_add(s_q2, x37, x52)),
+        );
+        let x186 = x182 * x185;
         let x187 = Self::mul_add(
-            x62,
-            x180,
-            Self::mul_add(0.5692, x64, Self::mul_add(s_q2, x37, x53)),
+            -x60,
+            x179,
+            Self::mul_add(0.5692, x70, Self::mul_add(-c_q2, x68, s_q2 * x67)),
         );
-        let x188 = x184 * x187;
-        let x189 = Self::mul_add(
-            x62,
-            x181,
-            Self::mul_add(0.5692, x72, Self::mul_add(-c_q2, x70, s_q2 * x69)),
+        let x188 = x182 * x187;
+        let x189 = Self::mul_add(-x60, x180, Self::mul_add(c_q2, x76, s_q2 * x75));
+        let x190 = x182 * x189;
+        let x191 = Self::mul_add(-x60, x181, Self::mul_add(c_q2, x83, s_q2 * x82));
+        let x192 = x182 * x191;
+        let x193 = 1.0 / Self::mul_add(-x183, x184, Self::mul_add(-x61, x177, x44));
+        let x194 = Self::mul_add(-x183, x186, Self::mul_add(x61, x178, x40));
+        let x195 = x193 * x194;
+        let x196 = Self::mul_add(-x183, x188, Self::mul_add(-x61, x179, x69));
+        let x197 = x193 * x196;
+        let x198 = Self::mul_add(x183, x190, x61 * x180);
+        let x199 = x193 * x198;
+        let x200 = Self::mul_add(-x183, x192, Self::mul_add(-x61, x181, x79));
+        let x201 = x193 * x200;
+        let x202 = Self::mul_add(
+            -x194,
+            x195,
+            Self::mul_add(-x185, x186, Self::mul_add(-x64, x178, x23)),
         );
-        let x190 = x184 * x189;
-        let x191 = Self::mul_add(x62, x182, -Self::mul_add(c_q2, x78, s_q2 * x77));
-        let x192 = x184 * x191;
-        let x193 = Self::mul_add(x62, x183, -Self::mul_add(c_q2, x85, s_q2 * x84));
-        let x194 = x184 * x193;
-        let x195 = 1.0 / Self::mul_add(-x185, x186, Self::mul_add(-x63, x179, x44));
-        let x196 = Self::mul_add(-x185, x188, Self::mul_add(-x63, x180, x40));
-        let x197 = x195 * x196;
-        let x198 = Self::mul_add(x185, x190, Self::mul_add(x63, x181, x71));
-        let x199 = x195 * x198;
-        let x200 = Self::mul_add(x185, x192, x63 * x182);
-        let x201 = x195 * x200;
-        let x202 = Self::mul_add(x185, x194, Self::mul_add(x63, x183, x81));
-        let x203 = x195 * x202;
+        let x203 = 1.0 / x202;
         let x204 = Self::mul_add(
-            -x196,
+            -x194,
             x197,
-            Self::mul_add(-x187, x188, Self::mul_add(-x66, x180, x23)),
+            Self::mul_add(-x185, x188, Self::mul_add(x64, x179, x19)),
         );
-        let x205 = 1.0 / x204;
-        let x206 = Self::mul_add(
-            -x196,
-            x199,
-            Self::mul_add(x187, x190, Self::mul_add(x66, x181, x19)),
+        let x205 = x203 * x204;
+        let x206 = Self::mul_add(x194, x199, Self::mul_add(-x185, x190, x64 * x180));
+        let x207 = x203 * x206;
+        let x208 = Self::mul_add(
+            -x194,
+            x201,
+            Self::mul_add(-x185, x192, Self::mul_add(x64, x181, x79)),
         );
-        let x207 = x205 * x206;
-        let x208 = Self::mul_add(-x196, x201, Self::mul_add(x187, x192, x66 * x182));
-        let x209 = x205 * x208;
+        let x209 = x203 * x208;
         let x210 = Self::mul_add(
             -x196,
-            x203,
-            Self::mul_add(x187, x194, Self::mul_add(x66, x183, x81)),
+            x197,
+            Self::mul_add(-x187, x188, Self::mul_add(-x72, x179, x9)),
         );
-        let x211 = x205 * x210;
+        let x211 = 1.0 / Self::mul_add(-x204, x205, x210);
         let x212 = Self::mul_add(
+            x204,
+            x207,
+            Self::mul_add(-x196, x199, Self::mul_add(x187, x190, x72 * x180)),
+        );
+        let x213 = x211 * x212;
+        let x214 = Self::mul_add(
+            -x196,
+            x201,
+            Self::mul_add(-x187, x192, Self::mul_add(-x72, x181, x79)),
+        );
+        let x215 = Self::mul_add(-x204, x209, x214);
+        let x216 = x211 * x215;
+        let x217 = Self::mul_add(
             -x198,
             x199,
-            Self::mul_add(-x189, x190, Self::mul_add(-x74, x181, x9)),
+            Self::mul_add(-x189, x190, Self::mul_add(-x77, x180, 47.471)),
         );
-        let x213 = 1.0 / Self::mul_add(-x206, x207, x212);
-        let x214 = Self::mul_add(
+        let x218 = 1.0 / Self::mul_add(-x212, x213, Self::mul_add(-x206, x207, x217));
+        let x219 = Self::mul_add(
             x206,
             x209,
-            Self::mul_add(x198, x201, Self::mul_add(x189, x192, x74 * x182)),
+            Self::mul_add(-x198, x201, Self::mul_add(x189, x192, x77 * x181)),
         );
-        let x215 = x213 * x214;
-        let x216 = Self::mul_add(
-            -x198,
-            x203,
-            Self::mul_add(-x189, x194, Self::mul_add(-x74, x183, x81)),
-        );
-        let x217 = Self::mul_add(-x206, x211, x216);
-        let x218 = x213 * x217;
-        let x219 = Self::mul_add(
+        let x220 = Self::mul_add(-x212, x216, x219);
+        let x221 = x218 * x220;
+        let x222 = Self::mul_add(
             -x200,
             x201,
-            Self::mul_add(-x191, x192, Self::mul_add(-x79, x182, 47.471)),
+            Self::mul_add(-x191, x192, Self::mul_add(-x84, x181, 9.336)),
         );
-        let x220 = 1.0 / Self::mul_add(-x214, x215, Self::mul_add(-x208, x209, x219));
-        let x221 = Self::mul_add(
-            x208,
-            x211,
-            Self::mul_add(x200, x203, Self::mul_add(x191, x194, x79 * x183)),
+        let x223 = Self::mul_add(
+            -x220,
+            x221,
+            Self::mul_add(-x215, x216, Self::mul_add(-x208, x209, x222)),
         );
-        let x222 = Self::mul_add(x214, x218, -x221);
-        let x223 = x220 * x222;
-        let x224 = Self::mul_add(
-            -x202,
-            x203,
-            Self::mul_add(-x193, x194, Self::mul_add(-x86, x183, 9.336)),
+        let x224 = 1.0 / x223;
+        let x225 = Self::mul_add(x174, x176, tau[1] - x171);
+        let x226 = Self::mul_add(x184, x225, Self::mul_add(-x174, x177, tau[2] + x169));
+        let x227 = Self::mul_add(
+            -x195,
+            x226,
+            Self::mul_add(x186, x225, Self::mul_add(x174, x178, tau[3] + x162)),
         );
-        let x225 = Self::mul_add(
-            -x222,
-            x223,
-            Self::mul_add(-x217, x218, Self::mul_add(-x210, x211, x224)),
-        );
-        let x226 = 1.0 / x225;
-        let x227 = Self::mul_add(-x176, x178, tau[1] - x173);
-        let x228 = Self::mul_add(x186, x227, Self::mul_add(-x176, x179, tau[2] - x171));
-        let x229 = Self::mul_add(
+        let x228 = Self::mul_add(
             -x197,
-            x228,
-            Self::mul_add(x188, x227, Self::mul_add(-x176, x180, tau[3] - x164)),
+            x226,
+            Self::mul_add(x188, x225, Self::mul_add(-x174, x179, tau[4] - x155)),
         );
+        let x229 = Self::mul_add(-x205, x227, x228);
         let x230 = Self::mul_add(
-            -x199,
-            x228,
-            Self::mul_add(-x190, x227, Self::mul_add(x176, x181, tau[4] - x157)),
+            x199,
+            x226,
+            Self::mul_add(x190, x225, Self::mul_add(-x174, x180, tau[5] + x152)),
         );
-        let x231 = Self::mul_add(-x207, x229, x230);
+        let x231 = Self::mul_add(x213, x229, Self::mul_add(-x207, x227, x230));
         let x232 = Self::mul_add(
             -x201,
-            x228,
-            Self::mul_add(-x192, x227, Self::mul_add(x176, x182, tau[5] - x154)),
+            x226,
+            Self::mul_add(x192, x225, Self::mul_add(-x174, x181, tau[6] + x146)),
         );
-        let x233 = Self::mul_add(x215, x231, Self::mul_add(-x209, x229, x232));
-        let x234 = Self::mul_add(
-            -x203,
-            x228,
-            Self::mul_add(-x194, x227, Self::mul_add(x176, x183, tau[6] + x148)),
+        let x233 = Self::mul_add(
+            x221,
+            x231,
+            Self::mul_add(-x216, x229, Self::mul_add(-x209, x227, x232)),
         );
-        let x235 = Self::mul_add(
-            -x223,
-            x233,
-            Self::mul_add(-x218, x231, Self::mul_add(-x211, x229, x234)),
+        let x234 = x224 * x233;
+        let x235 = Self::mul_add(x221, x234, x218 * x231);
+        let x236 = Self::mul_add(-x216, x234, Self::mul_add(x213, x235, x211 * x229));
+        let x237 = Self::mul_add(
+            -x209,
+            x234,
+            Self::mul_add(-x207, x235, Self::mul_add(-x205, x236, x203 * x227)),
         );
-        let x236 = x226 * x235;
-        let x237 = Self::mul_add(-x223, x236, x220 * x233);
-        let x238 = Self::mul_add(-x218, x236, Self::mul_add(x215, x237, x213 * x231));
-        let x239 = Self::mul_add(
-            -x211,
-            x236,
-            Self::mul_add(-x209, x237, Self::mul_add(-x207, x238, x205 * x229)),
+        let x238 = Self::mul_add(
+            x199,
+            x235,
+            Self::mul_add(-x197, x236, Self::mul_add(-x195, x237, x193 * x226)),
         );
+        let x239 = Self::mul_add(-x201, x234, x238);
         let x240 = Self::mul_add(
-            -x201,
-            x237,
-            Self::mul_add(-x199, x238, Self::mul_add(-x197, x239, x195 * x228)),
-        );
-        let x241 = Self::mul_add(-x203, x236, x240);
-        let x242 = Self::mul_add(
-            -x190,
-            x238,
-            Self::mul_add(x188, x239, Self::mul_add(x186, x241, x184 * x227)),
-        );
-        let x243 = Self::mul_add(-x194, x236, Self::mul_add(-x192, x237, x242));
-        let x244 = Self::mul_add(
-            -x180,
-            x239,
-            Self::mul_add(-x179, x241, Self::mul_add(-x178, x243, x176 * x177)),
-        );
-        let x245 = Self::mul_add(
-            x183,
+            x188,
             x236,
-            Self::mul_add(x182, x237, Self::mul_add(x181, x238, x244)),
+            Self::mul_add(x186, x237, Self::mul_add(x184, x239, x182 * x225)),
         );
-        [x245, x243, x241, x239, x238, x237, x236]
+        let x241 = Self::mul_add(x192, x234, Self::mul_add(x190, x235, x240));
+        let x242 = Self::mul_add(
+            x178,
+            x237,
+            Self::mul_add(-x177, x239, Self::mul_add(x176, x241, x174 * x175)),
+        );
+        let x243 = Self::mul_add(
+            -x181,
+            x234,
+            Self::mul_add(-x180, x235, Self::mul_add(-x179, x236, x242)),
+        );
+        [x243, x241, x239, x237, x236, x235, x234]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 327 mul, 241 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 170 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 326 mul, 238 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 171 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f32; 7],
@@ -2060,7 +2067,7 @@ impl SsrmsF32 {
         let x11 = s_q4 * s_q4 * x10;
         let x12 = x7 - x11;
         let x13 = Self::mul_add(97.44449, s_q4, c_q4 * x8);
-        let x14 = Self::mul_add(-s_q4, x8, 97.44449 * c_q4);
+        let x14 = Self::mul_add(-97.44449, c_q4, s_q4 * x8);
         let x15 = 171.19551 * s_q4;
         let x16 = 171.19551 * c_q4;
         let x17 = 7.11 * x15;
@@ -2068,8 +2075,8 @@ impl SsrmsF32 {
         let x19 = x9 - x17;
         let x20 = 3239.4583 - x15;
         let x21 = 1375.0472 - x13;
-        let x22 = 24989.307 + (-129.61737 + x11 - x17 - x17);
-        let x23 = 24998.828 + (x19 - x17);
+        let x22 = 24989.307 - (x17 - (-129.61737 + x11 - x17));
+        let x23 = 24998.828 - (x17 - x19);
         let x24 = s_q3 * s_q3;
         let x25 = s_q3 * c_q3;
         let x26 = x12 - x22;
@@ -2083,9 +2090,9 @@ impl SsrmsF32 {
         let x34 = c_q3 * x16;
         let x35 = Self::mul_add(s_q3, x20, x34);
         let x36 = 7.11 * x33;
-        let x37 = Self::mul_add(x33, 0.475, Self::mul_add(c_q3, x21, -x30));
+        let x37 = Self::mul_add(x33, 0.475, Self::mul_add(c_q3, x21, x30));
         let x38 = Self::mul_add(-7.11, x35, x18 + Self::mul_add(-x24, x27, x25 * x26));
-        let x39 = Self::mul_add(x35, 0.475, Self::mul_add(s_q3, x21, x31));
+        let x39 = Self::mul_add(x35, 0.475, Self::mul_add(s_q3, x21, -x31));
         let x40 = x23 + x36;
         let x41 = 5224.5703 + x33;
         let x42 = 3946.1882 + x37;
@@ -2097,263 +2104,267 @@ impl SsrmsF32 {
         let x48 = x38 + x38;
         let x49 = Self::mul_add(x46, x48, x45 * x47);
         let x50 = x29 - x49;
-        let x51 = c_q2 * x42;
-        let x52 = s_q2 * x39;
-        let x53 = c_q2 * x39;
-        let x54 = c_q2 * x41;
-        let x55 = s_q2 * x35;
-        let x56 = x54 - x55;
-        let x57 = c_q2 * x35;
-        let x58 = Self::mul_add(s_q2, x41, x57);
-        let x59 = Self::mul_add(0.5692, x56, x51 - x52);
-        let x60 = Self::mul_add(0.5692, x58, Self::mul_add(s_q2, x42, x53));
-        let x61 = 1650.6387 + (x43 + x49);
-        let x62 = 0.7026 * x58;
-        let x63 = 2232.9683
-            + (x50
-                - Self::mul_add(
-                    s_q1 * c_q1,
-                    x59 + x59,
-                    s_q1 * s_q1 * (x50 - (-1647.2197 + x44)),
-                ) - x62 - x62);
-        let x64 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(1145.5438, s_q1, c_q1 * x56),
-            Self::mul_add(-c_q1, x38 + Self::mul_add(-x45, x48, x46 * x47), s_q1 * x60),
-        );
-        let x65 = -x60;
-        let x66 = Self::mul_add(
+        let x51 = s_q2 * x39;
+        let x52 = c_q2 * x39;
+        let x53 = s_q2 * x35;
+        let x54 = Self::mul_add(c_q2, x41, -x53);
+        let x55 = c_q2 * x35;
+        let x56 = Self::mul_add(s_q2, x41, x55);
+        let x57 = Self::mul_add(0.5692, x54, Self::mul_add(c_q2, x42, -x51));
+        let x58 = Self::mul_add(0.5692, x56, Self::mul_add(s_q2, x42, x52));
+        let x59 = 1650.6387 + (x43 + x49);
+        let x60 = 0.7026 * x56;
+        let x61 = Self::mul_add(
             0.7026,
-            s_q1 * x58,
-            -Self::mul_add(s_q1, x44, c_q1 * Self::mul_add(0.5692, x55 - x54, x52 - x51)),
+            Self::mul_add(1145.5438, s_q1, c_q1 * x54),
+            Self::mul_add(-s_q1, x58, c_q1 * (x38 + Self::mul_add(-x45, x48, x46 * x47))),
         );
-        let x67 = Self::mul_add(s_q2, x33, x57);
-        let x68 = -Self::mul_add(0.5692, x67, Self::mul_add(s_q2, x37, x53));
-        let x69 = Self::mul_add(
+        let x62 = 2232.9683
+            - (x60
+                - (x50
+                    - Self::mul_add(
+                        s_q1 * c_q1,
+                        x57 + x57,
+                        s_q1 * s_q1 * (x50 - (-1647.2197 + x44)),
+                    ) - x60));
+        let x63 = -x61;
+        let x64 = -x58;
+        let x65 = Self::mul_add(
+            0.7026,
+            s_q1 * x56,
+            Self::mul_add(-s_q1, x44, c_q1 * x57),
+        );
+        let x66 = Self::mul_add(s_q2, x33, x55);
+        let x67 = -Self::mul_add(0.5692, x66, Self::mul_add(s_q2, x37, x52));
+        let x68 = Self::mul_add(
             s_q1,
             x40,
             c_q1
                 * Self::mul_add(
                     0.5692,
-                    Self::mul_add(-c_q2, x33, x55),
-                    Self::mul_add(-c_q2, x37, x52),
+                    Self::mul_add(-c_q2, x33, x53),
+                    Self::mul_add(-c_q2, x37, x51),
                 ),
         );
-        let x70 = Self::mul_add(0.7026, s_q1 * x67, -x69);
-        let x71 = Self::mul_add(s_q3, x15, -x34);
-        let x72 = Self::mul_add(c_q3, x15, x32);
-        let x73 = Self::mul_add(0.475, x72, Self::mul_add(c_q3, x13, x30));
-        let x74 = Self::mul_add(-0.475, x71, Self::mul_add(-s_q3, x13, x31));
-        let x75 = Self::mul_add(-7.11, x72, x19);
-        let x76 = Self::mul_add(s_q2, x72, c_q2 * x71);
-        let x77 = Self::mul_add(0.5692, x76, Self::mul_add(-c_q2, x74, s_q2 * x73));
-        let x78 = Self::mul_add(
-            s_q1,
-            x75,
+        let x69 = -Self::mul_add(-0.7026, s_q1 * x66, x68);
+        let x70 = Self::mul_add(-s_q3, x15, x34);
+        let x71 = Self::mul_add(c_q3, x15, x32);
+        let x72 = Self::mul_add(-0.475, x71, Self::mul_add(-c_q3, x13, x30));
+        let x73 = Self::mul_add(-0.475, x70, Self::mul_add(s_q3, x13, x31));
+        let x74 = Self::mul_add(-7.11, x71, x19);
+        let x75 = Self::mul_add(-s_q2, x71, c_q2 * x70);
+        let x76 = -Self::mul_add(0.5692, x75, Self::mul_add(-c_q2, x73, s_q2 * x72));
+        let x77 = Self::mul_add(
+            -s_q1,
+            x74,
             c_q1
                 * Self::mul_add(
-                    0.5692,
-                    Self::mul_add(-s_q2, x71, c_q2 * x72),
-                    Self::mul_add(s_q2, x74, c_q2 * x73),
-                ),
-        );
-        let x79 = -Self::mul_add(0.7026, s_q1 * x76, x78);
-        let x80 = 47.471 * s_q4;
-        let x81 = 47.471 * c_q4;
-        let x82 = Self::mul_add(s_q3, x81, c_q3 * x80);
-        let x83 = Self::mul_add(-c_q3, x81, s_q3 * x80);
-        let x84 = -Self::mul_add(c_q2, x83, s_q2 * x82);
-        let x85 = -(c_q1 * Self::mul_add(-c_q2, x82, s_q2 * x83));
-        let x86 = 9.336 * c_q5;
-        let x87 = 9.336 * s_q5;
-        let x88 = c_q4 * x86;
-        let x89 = s_q4 * x86;
-        let x90 = Self::mul_add(-s_q3, x89, c_q3 * x88);
-        let x91 = Self::mul_add(c_q3, x89, s_q3 * x88);
-        let x92 = -Self::mul_add(c_q2, x91, s_q2 * x90);
-        let x93 = -Self::mul_add(
-            s_q1,
-            x87,
-            c_q1 * Self::mul_add(-c_q2, x90, s_q2 * x91),
-        );
-        let x94 = qd[0] * c_q1;
-        let x95 = qd[0] * s_q1;
-        let x96 = 0.7026 * (qd[0] * qd[0]);
-        let x97 = qd[1] * x95;
-        let x98 = qd[1] * x94;
-        let x99 = x94 * x95;
-        let x100 = Self::mul_add(x94, x94, qd[1] * qd[1]);
-        let x101 = x95 * 1647.2197;
-        let x102 = 1650.6387 * qd[1];
-        let x103 = Self::mul_add(-qd[1], s_q2, c_q2 * x94);
-        let x104 = Self::mul_add(qd[1], c_q2, s_q2 * x94);
-        let x105 = 0.5692 * x99;
-        let x106 = 0.5692 * x100;
-        let x107 = Self::mul_add(0.5692, x97 + x97, -x96);
-        let x108 = Self::mul_add(c_q2, x107, s_q2 * x105);
-        let x109 = Self::mul_add(qd[2], x104, c_q2 * x97);
-        let x110 = Self::mul_add(-qd[2], x103, s_q2 * x97);
-        let x111 = qd[2] - x95;
-        let x112 = x104 * x104;
-        let x113 = Self::mul_add(x111, x111, x112);
-        let x114 = x103 * x111;
-        let x115 = Self::mul_add(x103, x104, x98);
-        let x116 = x114 - x110;
-        let x117 = 3946.1882 * x111;
-        let x118 = 39234.473 * x104;
-        let x119 = Self::mul_add(39241.402, x111, 3946.1882 * x103);
-        let x120 = Self::mul_add(
-            -5224.5703,
-            x106,
-            Self::mul_add(39234.473, x110, Self::mul_add(-x103, x119, x111 * x117)),
-        );
-        let x121 = Self::mul_add(-s_q3, x104, c_q3 * x103);
-        let x122 = Self::mul_add(c_q3, x104, s_q3 * x103);
-        let x123 = Self::mul_add(-s_q2, x107, c_q2 * x105)
-            - Self::mul_add(0.475, x110 + x114, 7.11 * x113);
-        let x124 = x108
-            + Self::mul_add(0.475, Self::mul_add(-x104, x111, x109), 7.11 * x115);
-        let x125 = x106
-            + Self::mul_add(0.475, Self::mul_add(x103, x103, x112), 7.11 * x116);
-        let x126 = Self::mul_add(c_q3, x124, s_q3 * x123);
-        let x127 = Self::mul_add(-qd[3], x122, Self::mul_add(-c_q3, x109, s_q3 * x110));
-        let x128 = Self::mul_add(-qd[3], x121, Self::mul_add(c_q3, x110, s_q3 * x109));
-        let x129 = qd[3] + x111;
-        let x130 = Self::mul_add(x129, x129, x122 * x122);
-        let x131 = Self::mul_add(x121, x122, x98);
-        let x132 = Self::mul_add(x121, x129, -x128);
-        let x133 = 1375.0472 * x129;
-        let x134 = 24989.307 * x122;
-        let x135 = Self::mul_add(24998.828, x129, 1375.0472 * x121);
-        let x136 = Self::mul_add(
-            -3239.4583,
-            x125,
-            Self::mul_add(24989.307, x128, Self::mul_add(-x121, x135, x129 * x133)),
-        );
-        let x137 = Self::mul_add(-s_q4, x122, c_q4 * x121);
-        let x138 = Self::mul_add(c_q4, x122, s_q4 * x121);
-        let x139 = Self::mul_add(
-            -s_q4,
-            Self::mul_add(7.11, x131, x126),
-            c_q4 * Self::mul_add(-7.11, x130, Self::mul_add(-s_q3, x124, c_q3 * x123)),
-        );
-        let x140 = Self::mul_add(-qd[4], x138, Self::mul_add(s_q4, x128, c_q4 * x127));
-        let x141 = Self::mul_add(-qd[4], x137, Self::mul_add(-s_q4, x127, c_q4 * x128));
-        let x142 = qd[4] + x129;
-        let x143 = 171.19551 * Self::mul_add(-x137, x138, x98);
-        let x144 = 171.19551 * Self::mul_add(x137, x137, x142 * x142);
-        let x145 = 171.19551 * Self::mul_add(-x138, x142, x140);
-        let x146 = Self::mul_add(97.44449, x142, x138 * 177.08836);
-        let x147 = Self::mul_add(-97.44449, x138, 179.88297 * x142);
-        let x148 = Self::mul_add(
-            -171.19551,
-            x139,
-            Self::mul_add(x137, x146, Self::mul_add(-179.88297, x98, 97.44449 * x141)),
-        );
-        let x149 = Self::mul_add(-s_q5, x137, c_q5 * x142);
-        let x150 = Self::mul_add(s_q5, x142, c_q5 * x137);
-        let x151 = Self::mul_add(-qd[5], x149, Self::mul_add(-c_q5, x140, s_q5 * x98));
-        let x152 = qd[5] + x138;
-        let x153 = 44.41 * x150;
-        let x154 = 47.471 * x152;
-        let x155 = 9.336 * x151;
-        let x156 = -x155;
-        let x157 = 9.336 * (qd[6] + x150);
-        let x158 = Self::mul_add(-s_q6, x149, c_q6 * x152) * x157;
-        let x159 = Self::mul_add(s_q6, x152, c_q6 * x149) * x157;
-        let x160 = Self::mul_add(s_q6, x159, c_q6 * x158)
-            - Self::mul_add(x150, x154, x152 * x153);
-        let x161 = x155 - Self::mul_add(x149, x154, 44.41 * x151);
-        let x162 = Self::mul_add(-47.471, x141, x149 * x153)
-            + Self::mul_add(-c_q6, x159, s_q6 * x158);
-        let x163 = Self::mul_add(
-            171.19551,
-            Self::mul_add(7.11, x132, x125),
-            -Self::mul_add(x138, x147, x142 * x146),
-        ) - Self::mul_add(c_q5, x161, s_q5 * x160);
-        let x164 = Self::mul_add(
-            x137,
-            x147,
-            Self::mul_add(97.44449, x98, x141 * 177.08836),
-        ) + x162;
-        let x165 = x148 + Self::mul_add(-s_q5, x161, c_q5 * x160);
-        let x166 = Self::mul_add(-c_q4, x144, s_q4 * x143);
-        let x167 = Self::mul_add(
-            -3239.4583,
-            x130,
-            Self::mul_add(s_q4, x144, c_q4 * x143),
-        );
-        let x168 = Self::mul_add(-3239.4583, x131, x166);
-        let x169 = Self::mul_add(3239.4583, x132, x145);
-        let x170 = Self::mul_add(
-            -1375.0472,
-            x98,
-            Self::mul_add(-x122, x135, x129 * x134),
-        ) + Self::mul_add(s_q4, x164, c_q4 * x163);
-        let x171 = x136
-            + Self::mul_add(-7.11, x145, Self::mul_add(-c_q4, x164, s_q4 * x163));
-        let x172 = Self::mul_add(
-            -3239.4583,
-            x126,
-            Self::mul_add(-24998.828, x98, 1375.0472 * x127)
-                + Self::mul_add(-x121, x134, x122 * x133),
-        ) + Self::mul_add(7.11, x166, x165);
-        let x173 = Self::mul_add(-s_q3, x168, c_q3 * x167);
-        let x174 = Self::mul_add(c_q3, x168, s_q3 * x167);
-        let x175 = Self::mul_add(-5224.5703, x113, x173);
-        let x176 = Self::mul_add(-5224.5703, x115, x174);
-        let x177 = Self::mul_add(
-            -3946.1882,
-            x98,
-            Self::mul_add(-x104, x119, x111 * x118),
-        ) + Self::mul_add(0.475, x174, Self::mul_add(-s_q3, x171, c_q3 * x170));
-        let x178 = x120
-            + (Self::mul_add(c_q3, x171, s_q3 * x170)
-                - Self::mul_add(7.11, x169, 0.475 * x173));
-        let x179 = Self::mul_add(
-            -5224.5703,
-            x108,
-            Self::mul_add(-x103, x118, x104 * x117)
-                - Self::mul_add(39241.402, x98, 3946.1882 * x109),
-        ) + Self::mul_add(7.11, x174, x172);
-        let x180 = Self::mul_add(-c_q2, x175, s_q2 * x176);
-        let x181 = Self::mul_add(
-            x94,
-            x101,
-            -Self::mul_add(0.5692, x180, Self::mul_add(c_q2, x178, s_q2 * x177)),
-        );
-        let x182 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(1145.5438, x100, Self::mul_add(5224.5703, x116, x169)),
-            s_q1 * Self::mul_add(-1145.5438, x99, x180),
-        );
-        let x183 = Self::mul_add(
-            -c_q1,
-            Self::mul_add(-1145.5438, x96, Self::mul_add(x95, x102, qd[1] * x101))
-                + Self::mul_add(
                     -0.5692,
-                    Self::mul_add(c_q2, x176, s_q2 * x175),
-                    Self::mul_add(-c_q2, x177, s_q2 * x178),
+                    Self::mul_add(c_q2, x71, s_q2 * x70),
+                    Self::mul_add(s_q2, x73, c_q2 * x72),
                 ),
-            s_q1 * (Self::mul_add(x98, -1647.2197, x94 * x102) - x179),
         );
-        let x184 = Self::mul_add(0.7026, x182, x183);
+        let x78 = Self::mul_add(0.7026, s_q1 * x75, x77);
+        let x79 = 47.471 * s_q4;
+        let x80 = 47.471 * c_q4;
+        let x81 = Self::mul_add(s_q3, x80, c_q3 * x79);
+        let x82 = Self::mul_add(-c_q3, x80, s_q3 * x79);
+        let x83 = -Self::mul_add(c_q2, x82, s_q2 * x81);
+        let x84 = c_q1 * Self::mul_add(-s_q2, x82, c_q2 * x81);
+        let x85 = 9.336 * c_q5;
+        let x86 = 9.336 * s_q5;
+        let x87 = c_q4 * x85;
+        let x88 = s_q4 * x85;
+        let x89 = Self::mul_add(-s_q3, x88, c_q3 * x87);
+        let x90 = Self::mul_add(c_q3, x88, s_q3 * x87);
+        let x91 = -Self::mul_add(c_q2, x90, s_q2 * x89);
+        let x92 = Self::mul_add(
+            -s_q1,
+            x86,
+            c_q1 * Self::mul_add(-s_q2, x90, c_q2 * x89),
+        );
+        let x93 = qd[0] * c_q1;
+        let x94 = qd[0] * s_q1;
+        let x95 = 0.7026 * (qd[0] * qd[0]);
+        let x96 = qd[1] * x94;
+        let x97 = qd[1] * x93;
+        let x98 = x93 * x94;
+        let x99 = Self::mul_add(x93, x93, qd[1] * qd[1]);
+        let x100 = x94 * 1647.2197;
+        let x101 = 1650.6387 * qd[1];
+        let x102 = Self::mul_add(-qd[1], s_q2, c_q2 * x93);
+        let x103 = Self::mul_add(qd[1], c_q2, s_q2 * x93);
+        let x104 = 0.5692 * x98;
+        let x105 = 0.5692 * x99;
+        let x106 = Self::mul_add(-0.5692, x96 + x96, x95);
+        let x107 = Self::mul_add(-c_q2, x106, s_q2 * x104);
+        let x108 = Self::mul_add(qd[2], x103, c_q2 * x96);
+        let x109 = Self::mul_add(-qd[2], x102, s_q2 * x96);
+        let x110 = qd[2] - x94;
+        let x111 = x103 * x103;
+        let x112 = Self::mul_add(x110, x110, x111);
+        let x113 = x102 * x110;
+        let x114 = Self::mul_add(x102, x103, x97);
+        let x115 = x109 - x113;
+        let x116 = 3946.1882 * x110;
+        let x117 = 39234.473 * x103;
+        let x118 = Self::mul_add(39241.402, x110, 3946.1882 * x102);
+        let x119 = Self::mul_add(
+            -5224.5703,
+            x105,
+            Self::mul_add(39234.473, x109, Self::mul_add(-x102, x118, x110 * x116)),
+        );
+        let x120 = Self::mul_add(-s_q3, x103, c_q3 * x102);
+        let x121 = Self::mul_add(c_q3, x103, s_q3 * x102);
+        let x122 = Self::mul_add(s_q2, x106, c_q2 * x104)
+            - Self::mul_add(0.475, x109 + x113, 7.11 * x112);
+        let x123 = x107
+            + Self::mul_add(0.475, Self::mul_add(-x103, x110, x108), 7.11 * x114);
+        let x124 = x105
+            - Self::mul_add(-0.475, Self::mul_add(x102, x102, x111), 7.11 * x115);
+        let x125 = Self::mul_add(c_q3, x123, s_q3 * x122);
+        let x126 = Self::mul_add(qd[3], x121, Self::mul_add(-s_q3, x109, c_q3 * x108));
+        let x127 = Self::mul_add(-qd[3], x120, Self::mul_add(c_q3, x109, s_q3 * x108));
+        let x128 = qd[3] + x110;
+        let x129 = Self::mul_add(x128, x128, x121 * x121);
+        let x130 = Self::mul_add(x120, x121, x97);
+        let x131 = Self::mul_add(-x120, x128, x127);
+        let x132 = 1375.0472 * x128;
+        let x133 = 24989.307 * x121;
+        let x134 = Self::mul_add(24998.828, x128, 1375.0472 * x120);
+        let x135 = Self::mul_add(
+            -3239.4583,
+            x124,
+            Self::mul_add(24989.307, x127, Self::mul_add(-x120, x134, x128 * x132)),
+        );
+        let x136 = Self::mul_add(-s_q4, x121, c_q4 * x120);
+        let x137 = Self::mul_add(c_q4, x121, s_q4 * x120);
+        let x138 = Self::mul_add(
+            -s_q4,
+            Self::mul_add(7.11, x130, x125),
+            c_q4 * Self::mul_add(-7.11, x129, Self::mul_add(-s_q3, x123, c_q3 * x122)),
+        );
+        let x139 = Self::mul_add(qd[4], x137, Self::mul_add(-s_q4, x127, c_q4 * x126));
+        let x140 = Self::mul_add(-qd[4], x136, Self::mul_add(c_q4, x127, s_q4 * x126));
+        let x141 = qd[4] + x128;
+        let x142 = 171.19551 * Self::mul_add(-x136, x137, x97);
+        let x143 = 171.19551 * Self::mul_add(x136, x136, x141 * x141);
+        let x144 = 171.19551 * Self::mul_add(x137, x141, x139);
+        let x145 = Self::mul_add(97.44449, x141, x137 * 177.08836);
+        let x146 = Self::mul_add(-179.88297, x141, 97.44449 * x137);
+        let x147 = Self::mul_add(
+            -171.19551,
+            x138,
+            Self::mul_add(x136, x145, Self::mul_add(-179.88297, x97, 97.44449 * x140)),
+        );
+        let x148 = Self::mul_add(-c_q5, x141, s_q5 * x136);
+        let x149 = Self::mul_add(s_q5, x141, c_q5 * x136);
+        let x150 = Self::mul_add(qd[5], x148, Self::mul_add(s_q5, x97, c_q5 * x139));
+        let x151 = qd[5] + x137;
+        let x152 = 44.41 * x149;
+        let x153 = 47.471 * x151;
+        let x154 = 9.336 * x150;
+        let x155 = -x154;
+        let x156 = 9.336 * (qd[6] + x149);
+        let x157 = Self::mul_add(c_q6, x151, s_q6 * x148) * x156;
+        let x158 = Self::mul_add(-s_q6, x151, c_q6 * x148) * x156;
+        let x159 = Self::mul_add(x149, x153, x151 * x152)
+            - Self::mul_add(-s_q6, x158, c_q6 * x157);
+        let x160 = Self::mul_add(-x148, x153, 44.41 * x150) - x154;
+        let x161 = Self::mul_add(x148, x152, 47.471 * x140)
+            - Self::mul_add(c_q6, x158, s_q6 * x157);
+        let x162 = -x161;
+        let x163 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(-7.11, x131, x124),
+            Self::mul_add(-x137, x146, x141 * x145),
+        ) - Self::mul_add(c_q5, x160, s_q5 * x159);
+        let x164 = Self::mul_add(
+            -x136,
+            x146,
+            Self::mul_add(97.44449, x97, x140 * 177.08836),
+        ) - x161;
+        let x165 = x147 - Self::mul_add(-s_q5, x160, c_q5 * x159);
+        let x166 = Self::mul_add(-c_q4, x143, s_q4 * x142);
+        let x167 = Self::mul_add(
+            3239.4583,
+            x129,
+            -Self::mul_add(s_q4, x143, c_q4 * x142),
+        );
+        let x168 = Self::mul_add(3239.4583, x130, -x166);
+        let x169 = Self::mul_add(3239.4583, x131, x144);
+        let x170 = Self::mul_add(
+            1375.0472,
+            x97,
+            -Self::mul_add(-x121, x134, x128 * x133),
+        ) + Self::mul_add(-s_q4, x164, c_q4 * x163);
+        let x171 = x135
+            - Self::mul_add(-7.11, x144, Self::mul_add(c_q4, x164, s_q4 * x163));
+        let x172 = Self::mul_add(
+            3239.4583,
+            x125,
+            Self::mul_add(24998.828, x97, 1375.0472 * x126)
+                - Self::mul_add(-x120, x133, x121 * x132),
+        ) - Self::mul_add(7.11, x166, x165);
+        let x173 = -x172;
+        let x174 = Self::mul_add(-s_q3, x168, c_q3 * x167);
+        let x175 = Self::mul_add(c_q3, x168, s_q3 * x167);
+        let x176 = Self::mul_add(5224.5703, x112, x174);
+        let x177 = Self::mul_add(5224.5703, x114, x175);
+        let x178 = Self::mul_add(
+            3946.1882,
+            x97,
+            -Self::mul_add(-x103, x118, x110 * x117),
+        ) + Self::mul_add(0.475, x175, Self::mul_add(s_q3, x171, c_q3 * x170));
+        let x179 = x119
+            - (Self::mul_add(-c_q3, x171, s_q3 * x170)
+                - Self::mul_add(7.11, x169, 0.475 * x174));
+        let x180 = Self::mul_add(
+            5224.5703,
+            x107,
+            Self::mul_add(39241.402, x97, 3946.1882 * x108)
+                - Self::mul_add(-x102, x117, x103 * x116),
+        ) + Self::mul_add(7.11, x175, x172);
+        let x181 = -x180;
+        let x182 = Self::mul_add(-s_q2, x177, c_q2 * x176);
+        let x183 = Self::mul_add(
+            x93,
+            x100,
+            Self::mul_add(-0.5692, x182, Self::mul_add(-c_q2, x179, s_q2 * x178)),
+        );
+        let x184 = Self::mul_add(
+            c_q1,
+            Self::mul_add(1145.5438, x99, -Self::mul_add(5224.5703, x115, x169)),
+            s_q1 * Self::mul_add(1145.5438, x98, -x182),
+        );
+        let x185 = Self::mul_add(
+            s_q1,
+            Self::mul_add(-x93, x101, x97 * 1647.2197) - x180,
+            c_q1
+                * (Self::mul_add(-1145.5438, x95, Self::mul_add(x94, x101, qd[1] * x100))
+                    + Self::mul_add(
+                        0.5692,
+                        Self::mul_add(c_q2, x177, s_q2 * x176),
+                        Self::mul_add(s_q2, x179, c_q2 * x178),
+                    )),
+        );
+        let x186 = -Self::mul_add(0.7026, x184, x185);
         (
             [
-                [x63, x64, x66, x70, x79, x85, x93],
-                [x64, x61, x65, x68, x77, x84, x92],
-                [x66, x65, x44, x40, x75, 0.0, x87],
-                [x70, x68, x40, x23, x19, 0.0, x87],
-                [x79, x77, x75, x19, x9, 0.0, x87],
-                [x85, x84, 0.0, 0.0, 0.0, 47.471, 0.0],
-                [x93, x92, x87, x87, x87, 0.0, 9.336],
+                [x62, x63, x65, x69, x78, x84, x92],
+                [x63, x59, x64, x67, x76, x83, x91],
+                [x65, x64, x44, x40, x74, 0.0, x86],
+                [x69, x67, x40, x23, x19, 0.0, x86],
+                [x78, x76, x74, x19, x9, 0.0, x86],
+                [x84, x83, 0.0, 0.0, 0.0, 47.471, 0.0],
+                [x92, x91, x86, x86, x86, 0.0, 9.336],
             ],
-            [x184, x181, x179, x172, x165, x162, x156],
+            [x186, x183, x181, x173, x165, x162, x155],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 468 mul, 391 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 282 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 465 mul, 386 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 281 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f32; 7],
@@ -2373,471 +2384,475 @@ impl SsrmsF32 {
         let x9 = 135.47298 + (44.41 - x6);
         let x10 = 47.471 - x8;
         let x11 = s_q4 * s_q4 * x10;
-        let x12 = Self::mul_add(c_q4, -97.44449, s_q4 * x7);
+        let x12 = Self::mul_add(-s_q4, x7, c_q4 * 97.44449);
         let x13 = Self::mul_add(c_q4, x7, s_q4 * 97.44449);
         let x14 = c_q4 * 171.19551;
         let x15 = s_q4 * 171.19551;
         let x16 = 7.11 * x15;
         let x17 = x9 - x16;
         let x18 = Self::mul_add(7.11, x14, s_q4 * c_q4 * x10);
-        let x19 = 47.471 - x11 - x16 - x16;
+        let x19 = x16 - (47.471 - x11 - x16);
         let x20 = 3239.4583 - x15;
         let x21 = -24989.307 + (x8 + x11);
         let x22 = 1375.0472 - x13;
-        let x23 = 24998.828 + (x17 - x16);
+        let x23 = 24998.828 - (x16 - x17);
         let x24 = s_q3 * s_q3;
         let x25 = s_q3 * c_q3;
-        let x26 = x19 - x21;
+        let x26 = x19 + x21;
         let x27 = x18 + x18;
-        let x28 = Self::mul_add(x25, x27, x24 * x26);
+        let x28 = Self::mul_add(-x25, x27, x24 * x26);
         let x29 = c_q3 * x12;
         let x30 = s_q3 * x12;
-        let x31 = Self::mul_add(c_q3, x22, x30);
-        let x32 = c_q3 * x14;
-        let x33 = Self::mul_add(s_q3, x20, x32);
-        let x34 = s_q3 * x14;
-        let x35 = c_q3 * x20;
-        let x36 = x35 - x34;
-        let x37 = 7.11 * x36;
-        let x38 = Self::mul_add(7.11, x33, x18 + Self::mul_add(-x24, x27, x25 * x26));
-        let x39 = Self::mul_add(x33, -0.475, Self::mul_add(-s_q3, x22, x29));
-        let x40 = x37 + (x19 - x28 + x37);
-        let x41 = 5224.5703 + x36;
-        let x42 = -39234.473 + (x21 + x28);
-        let x43 = 3946.1882 + Self::mul_add(x36, 0.475, x31);
-        let x44 = 39241.402 + (x37 + (x23 + x37));
+        let x31 = c_q3 * x14;
+        let x32 = Self::mul_add(s_q3, x20, x31);
+        let x33 = s_q3 * x14;
+        let x34 = Self::mul_add(-c_q3, x20, x33);
+        let x35 = 7.11 * x34;
+        let x36 = Self::mul_add(x34, 0.475, Self::mul_add(-c_q3, x22, x30));
+        let x37 = x23 - x35;
+        let x38 = Self::mul_add(7.11, x32, x18 - Self::mul_add(x24, x27, x25 * x26));
+        let x39 = Self::mul_add(x32, 0.475, Self::mul_add(s_q3, x22, x29));
+        let x40 = x35 + (x19 - x28 + x35);
+        let x41 = 5224.5703 - x34;
+        let x42 = -39234.473 + (x21 - x28);
+        let x43 = 3946.1882 - x36;
+        let x44 = 39241.402 - (x35 - x37);
         let x45 = s_q2 * s_q2;
         let x46 = s_q2 * c_q2;
-        let x47 = x40 - x42;
+        let x47 = x40 + x42;
         let x48 = x38 + x38;
-        let x49 = Self::mul_add(x46, x48, x45 * x47);
-        let x50 = x42 + x49;
+        let x49 = Self::mul_add(-x46, x48, x45 * x47);
+        let x50 = x42 - x49;
         let x51 = c_q2 * x39;
         let x52 = s_q2 * x39;
-        let x53 = Self::mul_add(c_q2, x43, x52);
-        let x54 = c_q2 * x33;
-        let x55 = Self::mul_add(s_q2, x41, x54);
-        let x56 = s_q2 * x33;
-        let x57 = c_q2 * x41;
-        let x58 = x57 - x56;
-        let x59 = Self::mul_add(0.5692, x58, x53);
-        let x60 = Self::mul_add(-0.5692, x55, Self::mul_add(-s_q2, x43, x51));
-        let x61 = 0.7026 * x55;
-        let x62 = Self::mul_add(
-            -0.7026,
-            Self::mul_add(s_q1, 1145.5438, c_q1 * x58),
-            Self::mul_add(-s_q1, x60, c_q1 * (x38 + Self::mul_add(-x45, x48, x46 * x47))),
-        );
-        let x63 = Self::mul_add(
+        let x53 = c_q2 * x32;
+        let x54 = Self::mul_add(s_q2, x41, x53);
+        let x55 = s_q2 * x32;
+        let x56 = Self::mul_add(-c_q2, x41, x55);
+        let x57 = Self::mul_add(0.5692, x56, Self::mul_add(-c_q2, x43, x52));
+        let x58 = Self::mul_add(0.5692, x54, Self::mul_add(s_q2, x43, x51));
+        let x59 = 0.7026 * x54;
+        let x60 = Self::mul_add(
             0.7026,
-            s_q1 * x55,
-            Self::mul_add(-s_q1, x44, c_q1 * Self::mul_add(-0.5692, x56 - x57, x53)),
+            Self::mul_add(s_q1, -1145.5438, c_q1 * x56),
+            Self::mul_add(s_q1, x58, c_q1 * (x38 - Self::mul_add(x45, x48, x46 * x47))),
         );
-        let x64 = x34 - x35;
-        let x65 = Self::mul_add(-0.475, x64, x31);
-        let x66 = Self::mul_add(-7.11, x64, x23);
-        let x67 = Self::mul_add(s_q2, x64, -x54);
-        let x68 = Self::mul_add(
-            -s_q1,
-            x66,
+        let x61 = Self::mul_add(
+            -0.7026,
+            s_q1 * x54,
+            Self::mul_add(s_q1, x44, c_q1 * x57),
+        );
+        let x62 = Self::mul_add(-s_q2, x34, x53);
+        let x63 = Self::mul_add(
+            s_q1,
+            x37,
             c_q1
                 * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(c_q2, x64, x56),
-                    Self::mul_add(c_q2, x65, x52),
+                    0.5692,
+                    Self::mul_add(c_q2, x34, x55),
+                    Self::mul_add(c_q2, x36, x52),
                 ),
         );
-        let x69 = Self::mul_add(-0.7026, s_q1 * x67, x68);
-        let x70 = Self::mul_add(s_q3, x15, -x32);
-        let x71 = Self::mul_add(c_q3, x15, x34);
-        let x72 = Self::mul_add(-0.475, x71, Self::mul_add(-c_q3, x13, x30));
-        let x73 = Self::mul_add(-7.11, x71, x17);
-        let x74 = Self::mul_add(0.475, x70, Self::mul_add(s_q3, x13, x29));
-        let x75 = Self::mul_add(s_q2, x71, c_q2 * x70);
-        let x76 = Self::mul_add(
-            -s_q1,
-            x73,
+        let x64 = Self::mul_add(-0.7026, s_q1 * x62, x63);
+        let x65 = Self::mul_add(-s_q3, x15, x31);
+        let x66 = Self::mul_add(c_q3, x15, x33);
+        let x67 = Self::mul_add(0.475, x66, Self::mul_add(c_q3, x13, x30));
+        let x68 = Self::mul_add(-7.11, x66, x17);
+        let x69 = Self::mul_add(0.475, x65, Self::mul_add(-s_q3, x13, x29));
+        let x70 = Self::mul_add(-s_q2, x66, c_q2 * x65);
+        let x71 = Self::mul_add(
+            s_q1,
+            x68,
             c_q1
                 * Self::mul_add(
-                    -0.5692,
-                    Self::mul_add(-s_q2, x70, c_q2 * x71),
-                    Self::mul_add(s_q2, x74, c_q2 * x72),
+                    0.5692,
+                    Self::mul_add(c_q2, x66, s_q2 * x65),
+                    Self::mul_add(s_q2, x69, c_q2 * x67),
                 ),
         );
-        let x77 = Self::mul_add(-0.7026, s_q1 * x75, x76);
-        let x78 = 47.471 * s_q4;
-        let x79 = 47.471 * c_q4;
-        let x80 = Self::mul_add(s_q3, x79, c_q3 * x78);
-        let x81 = Self::mul_add(-s_q3, x78, c_q3 * x79);
-        let x82 = c_q1 * Self::mul_add(s_q2, x81, c_q2 * x80);
-        let x83 = 9.336 * c_q5;
-        let x84 = 9.336 * s_q5;
-        let x85 = c_q4 * x83;
-        let x86 = s_q4 * x83;
-        let x87 = Self::mul_add(-s_q3, x86, c_q3 * x85);
-        let x88 = Self::mul_add(c_q3, x86, s_q3 * x85);
-        let x89 = Self::mul_add(
+        let x72 = Self::mul_add(-0.7026, s_q1 * x70, x71);
+        let x73 = 47.471 * s_q4;
+        let x74 = 47.471 * c_q4;
+        let x75 = Self::mul_add(s_q3, x74, c_q3 * x73);
+        let x76 = Self::mul_add(-c_q3, x74, s_q3 * x73);
+        let x77 = c_q1 * Self::mul_add(-s_q2, x76, c_q2 * x75);
+        let x78 = 9.336 * c_q5;
+        let x79 = 9.336 * s_q5;
+        let x80 = c_q4 * x78;
+        let x81 = s_q4 * x78;
+        let x82 = Self::mul_add(-s_q3, x81, c_q3 * x80);
+        let x83 = Self::mul_add(c_q3, x81, s_q3 * x80);
+        let x84 = Self::mul_add(
             -s_q1,
-            x84,
-            c_q1 * Self::mul_add(-s_q2, x88, c_q2 * x87),
+            x79,
+            c_q1 * Self::mul_add(-s_q2, x83, c_q2 * x82),
         );
-        let x90 = qd[0] * c_q1;
-        let x91 = qd[0] * s_q1;
-        let x92 = 0.7026 * (qd[0] * qd[0]);
-        let x93 = qd[1] * x91;
-        let x94 = qd[1] * x90;
-        let x95 = x90 * x91;
-        let x96 = Self::mul_add(x90, x90, qd[1] * qd[1]);
-        let x97 = x91 * 65693.914;
-        let x98 = 65697.33 * qd[1];
-        let x99 = Self::mul_add(-qd[1], s_q2, c_q2 * x90);
-        let x100 = Self::mul_add(qd[1], c_q2, s_q2 * x90);
-        let x101 = 0.5692 * x95;
-        let x102 = 0.5692 * x96;
-        let x103 = Self::mul_add(0.5692, x93 + x93, -x92);
-        let x104 = Self::mul_add(c_q2, x103, s_q2 * x101);
-        let x105 = Self::mul_add(qd[2], x100, c_q2 * x93);
-        let x106 = Self::mul_add(-s_q2, x93, qd[2] * x99);
-        let x107 = qd[2] - x91;
-        let x108 = x100 * x100;
-        let x109 = Self::mul_add(x107, x107, x108);
-        let x110 = x99 * x107;
-        let x111 = x106 + x110;
-        let x112 = Self::mul_add(x99, x100, x94);
-        let x113 = Self::mul_add(x99, -39234.473, 3946.1882 * x107);
-        let x114 = Self::mul_add(39241.402, x107, 3946.1882 * x99);
-        let x115 = Self::mul_add(
-            -5224.5703,
-            x104,
-            Self::mul_add(x100, x113, -Self::mul_add(39241.402, x94, 3946.1882 * x105)),
+        let x85 = qd[0] * c_q1;
+        let x86 = qd[0] * s_q1;
+        let x87 = 0.7026 * (qd[0] * qd[0]);
+        let x88 = qd[1] * x86;
+        let x89 = qd[1] * x85;
+        let x90 = x85 * x86;
+        let x91 = Self::mul_add(x85, x85, qd[1] * qd[1]);
+        let x92 = x86 * 65693.914;
+        let x93 = 65697.33 * qd[1];
+        let x94 = Self::mul_add(-qd[1], s_q2, c_q2 * x85);
+        let x95 = Self::mul_add(qd[1], c_q2, s_q2 * x85);
+        let x96 = 0.5692 * x90;
+        let x97 = 0.5692 * x91;
+        let x98 = Self::mul_add(-0.5692, x88 + x88, x87);
+        let x99 = Self::mul_add(-c_q2, x98, s_q2 * x96);
+        let x100 = Self::mul_add(qd[2], x95, c_q2 * x88);
+        let x101 = Self::mul_add(-qd[2], x94, s_q2 * x88);
+        let x102 = qd[2] - x86;
+        let x103 = x95 * x95;
+        let x104 = Self::mul_add(x102, x102, x103);
+        let x105 = x94 * x102;
+        let x106 = x101 - x105;
+        let x107 = Self::mul_add(x94, x95, x89);
+        let x108 = Self::mul_add(-3946.1882, x102, x94 * 39234.473);
+        let x109 = Self::mul_add(39241.402, x102, 3946.1882 * x94);
+        let x110 = Self::mul_add(
+            5224.5703,
+            x99,
+            Self::mul_add(x95, x108, Self::mul_add(39241.402, x89, 3946.1882 * x100)),
         );
-        let x116 = Self::mul_add(-s_q3, x100, c_q3 * x99);
-        let x117 = Self::mul_add(c_q3, x100, s_q3 * x99);
-        let x118 = Self::mul_add(-s_q2, x103, c_q2 * x101)
-            - Self::mul_add(0.475, x110 - x106, 7.11 * x109);
-        let x119 = x102
-            + Self::mul_add(0.475, Self::mul_add(x99, x99, x108), 7.11 * x111);
-        let x120 = x104
-            + Self::mul_add(-0.475, Self::mul_add(x100, x107, -x105), 7.11 * x112);
-        let x121 = Self::mul_add(c_q3, x120, s_q3 * x118);
-        let x122 = Self::mul_add(qd[3], x117, Self::mul_add(s_q3, x106, c_q3 * x105));
-        let x123 = Self::mul_add(qd[3], x116, Self::mul_add(-s_q3, x105, c_q3 * x106));
-        let x124 = qd[3] + x107;
-        let x125 = Self::mul_add(x117, x117, x124 * x124);
-        let x126 = Self::mul_add(x116, x124, x123);
-        let x127 = Self::mul_add(x116, x117, x94);
-        let x128 = Self::mul_add(x116, -24989.307, 1375.0472 * x124);
-        let x129 = Self::mul_add(24998.828, x124, 1375.0472 * x116);
-        let x130 = Self::mul_add(
-            -3239.4583,
-            x121,
-            Self::mul_add(x117, x128, -Self::mul_add(24998.828, x94, 1375.0472 * x122)),
+        let x111 = Self::mul_add(-s_q3, x95, c_q3 * x94);
+        let x112 = Self::mul_add(c_q3, x95, s_q3 * x94);
+        let x113 = Self::mul_add(s_q2, x98, c_q2 * x96)
+            - Self::mul_add(0.475, x101 + x105, 7.11 * x104);
+        let x114 = x97
+            - Self::mul_add(-0.475, Self::mul_add(x94, x94, x103), 7.11 * x106);
+        let x115 = x99
+            + Self::mul_add(0.475, Self::mul_add(-x95, x102, x100), 7.11 * x107);
+        let x116 = Self::mul_add(c_q3, x115, s_q3 * x113);
+        let x117 = Self::mul_add(qd[3], x112, Self::mul_add(-s_q3, x101, c_q3 * x100));
+        let x118 = Self::mul_add(-qd[3], x111, Self::mul_add(c_q3, x101, s_q3 * x100));
+        let x119 = qd[3] + x102;
+        let x120 = Self::mul_add(x112, x112, x119 * x119);
+        let x121 = Self::mul_add(-x111, x119, x118);
+        let x122 = Self::mul_add(x111, x112, x89);
+        let x123 = Self::mul_add(-1375.0472, x119, x111 * 24989.307);
+        let x124 = Self::mul_add(24998.828, x119, 1375.0472 * x111);
+        let x125 = Self::mul_add(
+            3239.4583,
+            x116,
+            Self::mul_add(x112, x123, Self::mul_add(24998.828, x89, 1375.0472 * x117)),
         );
-        let x131 = Self::mul_add(-s_q4, x117, c_q4 * x116);
-        let x132 = Self::mul_add(c_q4, x117, s_q4 * x116);
-        let x133 = Self::mul_add(
+        let x126 = Self::mul_add(-s_q4, x112, c_q4 * x111);
+        let x127 = Self::mul_add(c_q4, x112, s_q4 * x111);
+        let x128 = Self::mul_add(
             -s_q4,
-            Self::mul_add(7.11, x127, x121),
-            c_q4 * Self::mul_add(-7.11, x125, Self::mul_add(-s_q3, x120, c_q3 * x118)),
+            Self::mul_add(7.11, x122, x116),
+            c_q4 * Self::mul_add(-7.11, x120, Self::mul_add(-s_q3, x115, c_q3 * x113)),
         );
-        let x134 = Self::mul_add(qd[4], x132, Self::mul_add(s_q4, x123, c_q4 * x122));
-        let x135 = Self::mul_add(qd[4], x131, Self::mul_add(-s_q4, x122, c_q4 * x123));
-        let x136 = qd[4] + x124;
-        let x137 = 132.67838 * x131;
-        let x138 = Self::mul_add(-97.44449, x132, 135.47298 * x136);
-        let x139 = 97.44449 * x136;
-        let x140 = Self::mul_add(
-            171.19551,
-            Self::mul_add(7.11, x126, x119),
-            -Self::mul_add(132.67838, x134, Self::mul_add(x136, x139, x132 * x138)),
+        let x129 = Self::mul_add(qd[4], x127, Self::mul_add(-s_q4, x118, c_q4 * x117));
+        let x130 = Self::mul_add(-qd[4], x126, Self::mul_add(c_q4, x118, s_q4 * x117));
+        let x131 = qd[4] + x119;
+        let x132 = 132.67838 * x126;
+        let x133 = Self::mul_add(-97.44449, x127, 135.47298 * x131);
+        let x134 = 97.44449 * x131;
+        let x135 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(-7.11, x121, x114),
+            Self::mul_add(132.67838, x129, Self::mul_add(x131, x134, x127 * x133)),
         );
-        let x141 = Self::mul_add(s_q5, x136, c_q5 * x131);
-        let x142 = Self::mul_add(-s_q5, x131, c_q5 * x136);
-        let x143 = qd[5] + x132;
-        let x144 = 44.41 * x142;
-        let x145 = 47.471 * x143;
-        let x146 = Self::mul_add(
-            -x141,
-            x145,
-            44.41 * Self::mul_add(-qd[5], x141, Self::mul_add(-c_q5, x94, s_q5 * x134)),
+        let x136 = Self::mul_add(s_q5, x131, c_q5 * x126);
+        let x137 = Self::mul_add(-c_q5, x131, s_q5 * x126);
+        let x138 = qd[5] + x127;
+        let x139 = 44.41 * x137;
+        let x140 = 47.471 * x138;
+        let x141 = Self::mul_add(
+            -x136,
+            x140,
+            44.41 * Self::mul_add(-qd[5], x136, Self::mul_add(-c_q5, x89, s_q5 * x129)),
         );
-        let x147 = 9.336 * (qd[6] + x141);
-        let x148 = Self::mul_add(
+        let x142 = 9.336 * (qd[6] + x136);
+        let x143 = Self::mul_add(
             9.336,
-            Self::mul_add(qd[5], x142, -Self::mul_add(s_q5, x94, c_q5 * x134)),
-            -f_ext[6][3],
+            Self::mul_add(qd[5], x137, Self::mul_add(s_q5, x89, c_q5 * x129)),
+            f_ext[6][3],
         );
-        let x149 = Self::mul_add(
-            Self::mul_add(-s_q6, x142, c_q6 * x143),
-            x147,
-            -f_ext[6][4],
+        let x144 = Self::mul_add(
+            -Self::mul_add(c_q6, x138, s_q6 * x137),
+            x142,
+            f_ext[6][4],
         );
-        let x150 = Self::mul_add(
-            Self::mul_add(s_q6, x143, c_q6 * x142),
-            x147,
+        let x145 = Self::mul_add(
+            -Self::mul_add(-s_q6, x138, c_q6 * x137),
+            x142,
             f_ext[6][5],
         );
-        let x151 = Self::mul_add(-f_ext[6][1], c_q6, f_ext[6][2] * s_q6);
-        let x152 = f_ext[5][0] + f_ext[6][0];
-        let x153 = x151 - f_ext[5][1];
-        let x154 = f_ext[5][2] + Self::mul_add(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
-        let x155 = Self::mul_add(-x143, x144, x142 * x145) - f_ext[5][3]
-            + Self::mul_add(0.7026, x151, x148);
-        let x156 = x146 - f_ext[5][4]
-            + Self::mul_add(0.7026, f_ext[6][0], Self::mul_add(s_q6, x150, c_q6 * x149));
-        let x157 = Self::mul_add(x141, x144, 47.471 * x135) - f_ext[5][5]
-            + Self::mul_add(-c_q6, x150, s_q6 * x149);
-        let x158 = Self::mul_add(s_q5, x153, c_q5 * x152);
-        let x159 = Self::mul_add(171.19551, Self::mul_add(x131, x132, -x94), f_ext[4][0])
-            + x158;
-        let x160 = Self::mul_add(-s_q5, x152, c_q5 * x153)
-            - Self::mul_add(171.19551, Self::mul_add(x132, x136, x134), f_ext[4][1]);
-        let x161 = Self::mul_add(
-            171.19551,
-            Self::mul_add(x131, x131, x136 * x136),
-            -f_ext[4][2],
-        ) - x154;
-        let x162 = x140 - f_ext[4][3]
-            + Self::mul_add(0.5692, x154, Self::mul_add(-s_q5, x156, c_q5 * x155));
-        let x163 = Self::mul_add(
+        let x146 = Self::mul_add(-f_ext[6][2], s_q6, f_ext[6][1] * c_q6);
+        let x147 = f_ext[5][0] + f_ext[6][0];
+        let x148 = f_ext[5][1] + x146;
+        let x149 = f_ext[5][2] + Self::mul_add(f_ext[6][2], c_q6, f_ext[6][1] * s_q6);
+        let x150 = f_ext[5][3] - Self::mul_add(-x137, x140, x138 * x139)
+            + Self::mul_add(0.7026, x146, x143);
+        let x151 = f_ext[5][4] - x141
+            + Self::mul_add(
+                -0.7026,
+                f_ext[6][0],
+                Self::mul_add(-s_q6, x145, c_q6 * x144),
+            );
+        let x152 = f_ext[5][5] + Self::mul_add(x136, x139, 47.471 * x130)
+            + Self::mul_add(c_q6, x145, s_q6 * x144);
+        let x153 = Self::mul_add(-s_q5, x148, c_q5 * x147);
+        let x154 = Self::mul_add(
             -171.19551,
-            x133,
-            Self::mul_add(x131, x139, x132 * x137)
-                - Self::mul_add(97.44449, x135, 135.47298 * x94),
-        ) - f_ext[4][4] + Self::mul_add(c_q5, x156, s_q5 * x155);
-        let x164 = Self::mul_add(97.44449, x94, Self::mul_add(-x136, x137, x131 * x138))
-            - f_ext[4][5] + Self::mul_add(-0.5692, x158, x157);
-        let x165 = Self::mul_add(c_q4, x161, s_q4 * x159);
-        let x166 = Self::mul_add(-c_q4, x159, s_q4 * x161)
-            - Self::mul_add(3239.4583, x125, f_ext[3][0]);
-        let x167 = Self::mul_add(3239.4583, x126, -f_ext[3][1]) + x160;
-        let x168 = Self::mul_add(3239.4583, x127, -f_ext[3][2]) + x165;
-        let x169 = Self::mul_add(
-            -x117,
-            x129,
-            Self::mul_add(-1375.0472, x94, x122 * 24989.307),
-        ) - f_ext[3][3] + Self::mul_add(s_q4, x164, c_q4 * x162);
-        let x170 = x130 - f_ext[3][4] + Self::mul_add(-7.11, x165, x163);
-        let x171 = Self::mul_add(
-            3239.4583,
-            x119,
-            Self::mul_add(-x124, x128, x116 * x129),
-        ) - f_ext[3][5]
-            + Self::mul_add(7.11, x160, Self::mul_add(-s_q4, x162, c_q4 * x164));
-        let x172 = Self::mul_add(s_q3, x168, c_q3 * x166);
-        let x173 = Self::mul_add(-s_q3, x166, c_q3 * x168);
-        let x174 = x172 - Self::mul_add(5224.5703, x109, f_ext[2][0]);
-        let x175 = Self::mul_add(5224.5703, x112, -f_ext[2][2]) + x173;
-        let x176 = Self::mul_add(
-            -x100,
-            x114,
-            Self::mul_add(-3946.1882, x94, x105 * 39234.473),
-        ) - f_ext[2][3]
-            + Self::mul_add(-0.475, x173, Self::mul_add(s_q3, x171, c_q3 * x169));
-        let x177 = x115 - f_ext[2][4] + Self::mul_add(-7.11, x173, x170);
-        let x178 = Self::mul_add(5224.5703, x102, Self::mul_add(-x107, x113, x99 * x114))
-            - f_ext[2][5]
-            + (Self::mul_add(-s_q3, x169, c_q3 * x171)
-                + Self::mul_add(7.11, x167, 0.475 * x172));
-        let x179 = Self::mul_add(s_q2, x175, c_q2 * x174);
-        let x180 = Self::mul_add(
+            Self::mul_add(-x126, x127, x89),
+            f_ext[4][0],
+        ) + x153;
+        let x155 = Self::mul_add(171.19551, Self::mul_add(x127, x131, x129), f_ext[4][1])
+            + Self::mul_add(c_q5, x148, s_q5 * x147);
+        let x156 = Self::mul_add(
+            -171.19551,
+            Self::mul_add(x126, x126, x131 * x131),
+            f_ext[4][2],
+        ) + x149;
+        let x157 = f_ext[4][3] + x135
+            + Self::mul_add(-0.5692, x149, Self::mul_add(-s_q5, x151, c_q5 * x150));
+        let x158 = f_ext[4][4]
+            + Self::mul_add(
+                171.19551,
+                x128,
+                Self::mul_add(-97.44449, x130, 135.47298 * x89)
+                    - Self::mul_add(x126, x134, x127 * x132),
+            ) + Self::mul_add(c_q5, x151, s_q5 * x150);
+        let x159 = f_ext[4][5]
+            - Self::mul_add(97.44449, x89, -Self::mul_add(-x126, x133, x131 * x132))
+            + Self::mul_add(0.5692, x153, x152);
+        let x160 = Self::mul_add(-c_q4, x156, s_q4 * x154);
+        let x161 = Self::mul_add(3239.4583, x120, f_ext[3][0])
+            + Self::mul_add(s_q4, x156, c_q4 * x154);
+        let x162 = Self::mul_add(3239.4583, x121, f_ext[3][1]) + x155;
+        let x163 = Self::mul_add(-3239.4583, x122, f_ext[3][2]) - x160;
+        let x164 = f_ext[3][3]
+            - Self::mul_add(
+                -x112,
+                x124,
+                Self::mul_add(-1375.0472, x89, x117 * 24989.307),
+            ) + Self::mul_add(s_q4, x159, c_q4 * x157);
+        let x165 = f_ext[3][4] + x125 + Self::mul_add(7.11, x160, x158);
+        let x166 = f_ext[3][5]
+            - Self::mul_add(3239.4583, x114, Self::mul_add(x111, x124, x119 * x123))
+            - Self::mul_add(-7.11, x155, Self::mul_add(-c_q4, x159, s_q4 * x157));
+        let x167 = Self::mul_add(s_q3, x163, c_q3 * x161);
+        let x168 = Self::mul_add(-c_q3, x163, s_q3 * x161);
+        let x169 = Self::mul_add(5224.5703, x104, f_ext[2][0]) + x167;
+        let x170 = Self::mul_add(-5224.5703, x107, f_ext[2][2]) - x168;
+        let x171 = f_ext[2][3]
+            - Self::mul_add(-x95, x109, Self::mul_add(-3946.1882, x89, x100 * 39234.473))
+            + Self::mul_add(0.475, x168, Self::mul_add(s_q3, x166, c_q3 * x164));
+        let x172 = f_ext[2][4] + x110 + Self::mul_add(7.11, x168, x165);
+        let x173 = f_ext[2][5]
+            - Self::mul_add(5224.5703, x97, Self::mul_add(x94, x109, x102 * x108))
+            - (Self::mul_add(-c_q3, x166, s_q3 * x164)
+                - Self::mul_add(7.11, x162, 0.475 * x167));
+        let x174 = Self::mul_add(s_q2, x170, c_q2 * x169);
+        let x175 = Self::mul_add(
             -s_q1,
-            Self::mul_add(-x90, x98, x94 * 65693.914) - f_ext[1][4] + x177,
+            f_ext[1][4] - Self::mul_add(-x85, x93, x89 * 65693.914) + x172,
             c_q1
-                * (Self::mul_add(1145.5438, x92, -Self::mul_add(x91, x98, qd[1] * x97))
-                    - f_ext[1][3]
+                * (f_ext[1][3]
                     + Self::mul_add(
-                        -0.5692,
-                        Self::mul_add(-s_q2, x174, c_q2 * x175),
-                        Self::mul_add(s_q2, x178, c_q2 * x176),
+                        -1145.5438,
+                        x87,
+                        Self::mul_add(x86, x93, qd[1] * x92),
+                    )
+                    + Self::mul_add(
+                        0.5692,
+                        Self::mul_add(-c_q2, x170, s_q2 * x169),
+                        Self::mul_add(s_q2, x173, c_q2 * x171),
                     )),
         );
-        let x181 = Self::mul_add(
+        let x176 = Self::mul_add(
             -0.7026,
             Self::mul_add(
                 c_q1,
-                Self::mul_add(1145.5438, x96, -f_ext[1][1])
-                    + (Self::mul_add(5224.5703, x111, -f_ext[2][1]) + x167),
-                s_q1 * (Self::mul_add(1145.5438, x95, -f_ext[1][0]) + x179),
+                Self::mul_add(-1145.5438, x91, f_ext[1][1])
+                    + (Self::mul_add(5224.5703, x106, f_ext[2][1]) + x162),
+                s_q1 * (Self::mul_add(-1145.5438, x90, f_ext[1][0]) + x174),
             ),
-            x180,
+            x175,
         );
-        let x182 = tau[0] - (x181 - f_ext[0][3]);
-        let x183 = 1.0
+        let x177 = tau[0] + (f_ext[0][3] + x176);
+        let x178 = 1.0
             / (66279.66
-                + (x50
-                    - Self::mul_add(
-                        s_q1 * c_q1,
-                        x59 + x59,
-                        s_q1 * s_q1 * (x50 - (-65693.914 + x44)),
-                    ) - x61 - x61));
-        let x184 = x62 * x183;
-        let x185 = x63 * x183;
-        let x186 = x69 * x183;
-        let x187 = x77 * x183;
-        let x188 = x82 * x183;
-        let x189 = x89 * x183;
-        let x190 = 1.0 / Self::mul_add(-x62, x184, 65697.33 + (x40 - x49));
-        let x191 = Self::mul_add(-x62, x185, x60);
-        let x192 = x190 * x191;
-        let x193 = Self::mul_add(
-            -x62,
-            x186,
-            Self::mul_add(0.5692, x67, Self::mul_add(-s_q2, x65, x51)),
+                - (x59
+                    - (x50
+                        - Self::mul_add(
+                            -(s_q1 * c_q1),
+                            x57 + x57,
+                            s_q1 * s_q1 * (x50 - (-65693.914 + x44)),
+                        ) - x59)));
+        let x179 = x60 * x178;
+        let x180 = x61 * x178;
+        let x181 = x64 * x178;
+        let x182 = x72 * x178;
+        let x183 = x77 * x178;
+        let x184 = x84 * x178;
+        let x185 = 1.0 / Self::mul_add(-x60, x179, 65697.33 - (x40 - x49));
+        let x186 = Self::mul_add(-x60, x180, x58);
+        let x187 = x185 * x186;
+        let x188 = Self::mul_add(
+            -x60,
+            x181,
+            Self::mul_add(0.5692, x62, Self::mul_add(-s_q2, x36, x51)),
         );
-        let x194 = x190 * x193;
-        let x195 = Self::mul_add(
-            -x62,
-            x187,
-            Self::mul_add(0.5692, x75, Self::mul_add(-s_q2, x72, c_q2 * x74)),
+        let x189 = x185 * x188;
+        let x190 = Self::mul_add(
+            x60,
+            x182,
+            Self::mul_add(-0.5692, x70, Self::mul_add(-c_q2, x69, s_q2 * x67)),
         );
-        let x196 = x190 * x195;
-        let x197 = Self::mul_add(-x62, x188, Self::mul_add(-s_q2, x80, c_q2 * x81));
-        let x198 = x190 * x197;
-        let x199 = Self::mul_add(x62, x189, Self::mul_add(c_q2, x88, s_q2 * x87));
-        let x200 = x190 * x199;
-        let x201 = 1.0 / Self::mul_add(-x191, x192, Self::mul_add(-x63, x185, x44));
-        let x202 = Self::mul_add(-x191, x194, Self::mul_add(-x63, x186, x66));
-        let x203 = x201 * x202;
-        let x204 = Self::mul_add(-x191, x196, Self::mul_add(-x63, x187, x73));
-        let x205 = x201 * x204;
-        let x206 = Self::mul_add(x191, x198, x63 * x188);
-        let x207 = x201 * x206;
-        let x208 = Self::mul_add(x191, x200, Self::mul_add(-x63, x189, x84));
-        let x209 = x201 * x208;
-        let x210 = Self::mul_add(
-            -x202,
-            x203,
-            Self::mul_add(-x193, x194, Self::mul_add(-x69, x186, x23)),
+        let x191 = x185 * x190;
+        let x192 = Self::mul_add(x60, x183, Self::mul_add(c_q2, x76, s_q2 * x75));
+        let x193 = x185 * x192;
+        let x194 = Self::mul_add(x60, x184, Self::mul_add(c_q2, x83, s_q2 * x82));
+        let x195 = x185 * x194;
+        let x196 = 1.0 / Self::mul_add(-x186, x187, Self::mul_add(-x61, x180, x44));
+        let x197 = Self::mul_add(-x186, x189, Self::mul_add(-x61, x181, x37));
+        let x198 = x196 * x197;
+        let x199 = Self::mul_add(x186, x191, Self::mul_add(-x61, x182, x68));
+        let x200 = x196 * x199;
+        let x201 = Self::mul_add(-x186, x193, x61 * x183);
+        let x202 = x196 * x201;
+        let x203 = Self::mul_add(-x186, x195, Self::mul_add(x61, x184, x79));
+        let x204 = x196 * x203;
+        let x205 = Self::mul_add(
+            -x197,
+            x198,
+            Self::mul_add(-x188, x189, Self::mul_add(-x64, x181, x23)),
         );
-        let x211 = 1.0 / x210;
-        let x212 = Self::mul_add(
-            -x202,
-            x205,
-            Self::mul_add(-x193, x196, Self::mul_add(-x69, x187, x17)),
+        let x206 = 1.0 / x205;
+        let x207 = Self::mul_add(
+            -x197,
+            x200,
+            Self::mul_add(x188, x191, Self::mul_add(-x64, x182, x17)),
         );
-        let x213 = x211 * x212;
-        let x214 = Self::mul_add(x202, x207, -Self::mul_add(x193, x198, x69 * x188));
-        let x215 = x211 * x214;
-        let x216 = Self::mul_add(
-            -x202,
-            x209,
-            Self::mul_add(x193, x200, Self::mul_add(-x69, x189, x84)),
+        let x208 = x206 * x207;
+        let x209 = Self::mul_add(-x197, x202, Self::mul_add(-x188, x193, x64 * x183));
+        let x210 = x206 * x209;
+        let x211 = Self::mul_add(
+            -x197,
+            x204,
+            Self::mul_add(-x188, x195, Self::mul_add(x64, x184, x79)),
         );
-        let x217 = x211 * x216;
-        let x218 = Self::mul_add(
-            -x204,
-            x205,
-            Self::mul_add(-x195, x196, Self::mul_add(-x77, x187, x9)),
+        let x212 = x206 * x211;
+        let x213 = Self::mul_add(
+            -x199,
+            x200,
+            Self::mul_add(-x190, x191, Self::mul_add(-x72, x182, x9)),
         );
-        let x219 = 1.0 / Self::mul_add(-x212, x213, x218);
+        let x214 = 1.0 / Self::mul_add(-x207, x208, x213);
+        let x215 = Self::mul_add(
+            -x207,
+            x210,
+            Self::mul_add(-x199, x202, Self::mul_add(x190, x193, x72 * x183)),
+        );
+        let x216 = x214 * x215;
+        let x217 = Self::mul_add(
+            -x199,
+            x204,
+            Self::mul_add(x190, x195, Self::mul_add(x72, x184, x79)),
+        );
+        let x218 = Self::mul_add(-x207, x212, x217);
+        let x219 = x214 * x218;
         let x220 = Self::mul_add(
-            -x212,
-            x215,
-            Self::mul_add(x204, x207, -Self::mul_add(x195, x198, x77 * x188)),
+            -x201,
+            x202,
+            Self::mul_add(-x192, x193, Self::mul_add(-x77, x183, 47.471)),
         );
-        let x221 = x219 * x220;
+        let x221 = 1.0 / Self::mul_add(-x215, x216, Self::mul_add(-x209, x210, x220));
         let x222 = Self::mul_add(
-            -x204,
             x209,
-            Self::mul_add(x195, x200, Self::mul_add(-x77, x189, x84)),
+            x212,
+            Self::mul_add(x201, x204, Self::mul_add(x192, x195, x77 * x184)),
         );
-        let x223 = Self::mul_add(-x212, x217, x222);
-        let x224 = x219 * x223;
+        let x223 = Self::mul_add(x215, x219, x222);
+        let x224 = x221 * x223;
         let x225 = Self::mul_add(
-            -x206,
-            x207,
-            Self::mul_add(-x197, x198, Self::mul_add(-x82, x188, 47.471)),
+            -x203,
+            x204,
+            Self::mul_add(-x194, x195, Self::mul_add(-x84, x184, 9.336)),
         );
-        let x226 = 1.0 / Self::mul_add(-x220, x221, Self::mul_add(-x214, x215, x225));
-        let x227 = Self::mul_add(
-            -x214,
-            x217,
-            Self::mul_add(x206, x209, Self::mul_add(-x82, x189, x197 * x200)),
+        let x226 = Self::mul_add(
+            -x223,
+            x224,
+            Self::mul_add(-x218, x219, Self::mul_add(-x211, x212, x225)),
         );
-        let x228 = Self::mul_add(-x220, x224, x227);
-        let x229 = x226 * x228;
-        let x230 = Self::mul_add(
-            -x208,
-            x209,
-            Self::mul_add(-x199, x200, Self::mul_add(-x89, x189, 9.336)),
-        );
-        let x231 = Self::mul_add(
-            -x228,
-            x229,
-            Self::mul_add(-x223, x224, Self::mul_add(-x216, x217, x230)),
-        );
-        let x232 = 1.0 / x231;
-        let x233 = Self::mul_add(
-            -x182,
-            x184,
+        let x227 = 1.0 / x226;
+        let x228 = Self::mul_add(
+            -x177,
+            x179,
             tau[1]
-                - (Self::mul_add(x90, x97, -f_ext[1][5])
-                    + Self::mul_add(
-                        0.5692,
-                        x179,
-                        Self::mul_add(-s_q2, x176, c_q2 * x178),
+                + (Self::mul_add(-x85, x92, f_ext[1][5])
+                    - Self::mul_add(
+                        -0.5692,
+                        x174,
+                        Self::mul_add(-c_q2, x173, s_q2 * x171),
                     )),
         );
-        let x234 = Self::mul_add(-x192, x233, Self::mul_add(-x182, x185, tau[2] - x177));
+        let x229 = Self::mul_add(x187, x228, Self::mul_add(x177, x180, tau[2] + x172));
+        let x230 = Self::mul_add(
+            -x198,
+            x229,
+            Self::mul_add(x189, x228, Self::mul_add(x177, x181, tau[3] + x165)),
+        );
+        let x231 = Self::mul_add(
+            -x200,
+            x229,
+            Self::mul_add(-x191, x228, Self::mul_add(x177, x182, tau[4] + x158)),
+        );
+        let x232 = Self::mul_add(-x208, x230, x231);
+        let x233 = Self::mul_add(
+            -x202,
+            x229,
+            Self::mul_add(x193, x228, Self::mul_add(-x177, x183, tau[5] + x152)),
+        );
+        let x234 = Self::mul_add(-x216, x232, Self::mul_add(-x210, x230, x233));
         let x235 = Self::mul_add(
-            -x203,
-            x234,
-            Self::mul_add(-x194, x233, Self::mul_add(-x182, x186, tau[3] - x170)),
+            -x204,
+            x229,
+            Self::mul_add(x195, x228, Self::mul_add(-x177, x184, tau[6] + x143)),
         );
         let x236 = Self::mul_add(
-            -x205,
+            x224,
             x234,
-            Self::mul_add(-x196, x233, Self::mul_add(-x182, x187, tau[4] - x163)),
+            Self::mul_add(-x219, x232, Self::mul_add(-x212, x230, x235)),
         );
-        let x237 = Self::mul_add(-x213, x235, x236);
-        let x238 = Self::mul_add(
-            x207,
-            x234,
-            Self::mul_add(-x198, x233, Self::mul_add(-x182, x188, tau[5] - x157)),
-        );
-        let x239 = Self::mul_add(-x221, x237, Self::mul_add(-x215, x235, x238));
+        let x237 = x227 * x236;
+        let x238 = Self::mul_add(x224, x237, x221 * x234);
+        let x239 = Self::mul_add(-x219, x237, Self::mul_add(-x216, x238, x214 * x232));
         let x240 = Self::mul_add(
-            -x209,
-            x234,
-            Self::mul_add(x200, x233, Self::mul_add(-x182, x189, tau[6] - x148)),
+            -x212,
+            x237,
+            Self::mul_add(-x210, x238, Self::mul_add(-x208, x239, x206 * x230)),
         );
         let x241 = Self::mul_add(
-            -x229,
-            x239,
-            Self::mul_add(-x224, x237, Self::mul_add(-x217, x235, x240)),
+            -x202,
+            x238,
+            Self::mul_add(-x200, x239, Self::mul_add(-x198, x240, x196 * x229)),
         );
-        let x242 = x232 * x241;
-        let x243 = Self::mul_add(-x229, x242, x226 * x239);
-        let x244 = Self::mul_add(-x224, x242, Self::mul_add(-x221, x243, x219 * x237));
+        let x242 = Self::mul_add(-x204, x237, x241);
+        let x243 = Self::mul_add(
+            -x191,
+            x239,
+            Self::mul_add(x189, x240, Self::mul_add(x187, x242, x185 * x228)),
+        );
+        let x244 = Self::mul_add(x195, x237, Self::mul_add(x193, x238, x243));
         let x245 = Self::mul_add(
-            -x217,
-            x242,
-            Self::mul_add(-x215, x243, Self::mul_add(-x213, x244, x211 * x235)),
+            x181,
+            x240,
+            Self::mul_add(x180, x242, Self::mul_add(-x179, x244, x177 * x178)),
         );
         let x246 = Self::mul_add(
-            x207,
-            x243,
-            Self::mul_add(-x205, x244, Self::mul_add(-x203, x245, x201 * x234)),
+            -x184,
+            x237,
+            Self::mul_add(-x183, x238, Self::mul_add(x182, x239, x245)),
         );
-        let x247 = Self::mul_add(-x209, x242, x246);
-        let x248 = Self::mul_add(
-            -x196,
-            x244,
-            Self::mul_add(-x194, x245, Self::mul_add(-x192, x247, x190 * x233)),
-        );
-        let x249 = Self::mul_add(x200, x242, Self::mul_add(-x198, x243, x248));
-        let x250 = Self::mul_add(
-            -x186,
-            x245,
-            Self::mul_add(-x185, x247, Self::mul_add(-x184, x249, x182 * x183)),
-        );
-        let x251 = Self::mul_add(
-            -x189,
-            x242,
-            Self::mul_add(-x188, x243, Self::mul_add(-x187, x244, x250)),
-        );
-        [x251, x249, x247, x245, x244, x243, x242]
+        [x246, x244, x242, x240, x239, x238, x237]
     }
     /// `a·b + c`: one fused multiply-add (one rounding) where the build targets it (x86-64
     /// with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), two operations

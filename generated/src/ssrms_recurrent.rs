@@ -303,10 +303,10 @@ impl SsrmsRecurrent {
         let x53 = Self::mul_add(1966.28, s_q1, x46 * 39.95);
         let x54 = 1966.28 * x47;
         let x55 = Self::mul_add(x5, -39.95, 9.522 * x48);
-        let x56 = Self::mul_add(x48, -39.95, 1966.28 * x5);
+        let x56 = Self::mul_add(-1966.28, x5, x48 * 39.95);
         let x57 = 1966.28 * x49;
         let x58 = Self::mul_add(x7, -39.95, 9.522 * x50);
-        let x59 = Self::mul_add(x50, -39.95, 1966.28 * x7);
+        let x59 = Self::mul_add(-1966.28, x7, x50 * 39.95);
         let x60 = 1966.28 * x51;
         let x61 = 7.11 * x46;
         let x62 = 7.11 * x48;
@@ -328,9 +328,9 @@ impl SsrmsRecurrent {
         let x78 = Self::mul_add(-s_q1, s_q5, x65 * c_q5);
         let x79 = Self::mul_add(s_q1, c_q5, x65 * s_q5);
         let x80 = Self::mul_add(x5, s_q5, x67 * c_q5);
-        let x81 = Self::mul_add(-x67, s_q5, x5 * c_q5);
+        let x81 = Self::mul_add(-x5, c_q5, x67 * s_q5);
         let x82 = Self::mul_add(x7, s_q5, x69 * c_q5);
-        let x83 = Self::mul_add(-x69, s_q5, x7 * c_q5);
+        let x83 = Self::mul_add(-x7, c_q5, x69 * s_q5);
         let x84 = 12.13 * x78;
         let x85 = 12.13 * x79;
         let x86 = 3.061 * x66;
@@ -344,12 +344,12 @@ impl SsrmsRecurrent {
         let x94 = 0.7026 * x68;
         let x95 = 0.7026 * x70;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x97 = Self::mul_add(-x79, c_q6, x66 * s_q6);
+        let x97 = Self::mul_add(-x66, s_q6, x79 * c_q6);
         let x98 = Self::mul_add(x66, c_q6, x79 * s_q6);
-        let x99 = Self::mul_add(x68, s_q6, x81 * c_q6);
-        let x100 = Self::mul_add(-x81, s_q6, x68 * c_q6);
-        let x101 = Self::mul_add(x70, s_q6, x83 * c_q6);
-        let x102 = Self::mul_add(-x83, s_q6, x70 * c_q6);
+        let x99 = Self::mul_add(-x68, s_q6, x81 * c_q6);
+        let x100 = Self::mul_add(x68, c_q6, x81 * s_q6);
+        let x101 = Self::mul_add(-x70, s_q6, x83 * c_q6);
+        let x102 = Self::mul_add(x70, c_q6, x83 * s_q6);
         let x103 = 9.336 * x78;
         let x104 = 44.41 * x97;
         let x105 = 44.41 * x98;
@@ -377,23 +377,23 @@ impl SsrmsRecurrent {
         let x127 = x42 + x124;
         let x128 = x43 + x125;
         let x129 = x44 + x126;
-        let x130 = x128 - x24;
-        let x131 = x129 - x25;
+        let x130 = x24 - x128;
+        let x131 = x25 - x129;
         let x132 = x23 + x61;
-        let x133 = x62 - x24;
-        let x134 = x63 - x25;
+        let x133 = x24 - x62;
+        let x134 = x25 - x63;
         let x135 = x42 + x132;
-        let x136 = x43 + x133;
-        let x137 = x44 + x134;
-        let x138 = x136 - x24;
-        let x139 = x137 - x25;
+        let x136 = x43 - x133;
+        let x137 = x44 - x134;
+        let x138 = x24 - x136;
+        let x139 = x25 - x137;
         let x140 = x42 + x61;
         let x141 = x43 + x62;
         let x142 = x44 + x63;
-        let x143 = x141 - x24;
-        let x144 = x142 - x25;
-        let x145 = x43 - x24;
-        let x146 = x44 - x25;
+        let x143 = x24 - x141;
+        let x144 = x25 - x142;
+        let x145 = x24 - x43;
+        let x146 = x25 - x44;
         let x147 = 243.66 * x93;
         let x148 = 243.66 * x94;
         let x149 = 243.66 * x95;
@@ -409,35 +409,35 @@ impl SsrmsRecurrent {
         let x159 = 243.66 * (x23 + x127);
         let x160 = 243.66 * x130;
         let x161 = 243.66 * x131;
-        let x162 = 243.66 * (x130 - x1);
-        let x163 = 243.66 * (x2 + x131);
+        let x162 = 243.66 * (x1 + x130);
+        let x163 = 243.66 * (x2 - x131);
         let x164 = Self::mul_add(x66, x86, Self::mul_add(x79, x85, x78 * x84)) + x112;
-        let x165 = Self::mul_add(x68, x86, Self::mul_add(-x81, x85, x80 * x84)) + x113;
-        let x166 = Self::mul_add(x70, x86, Self::mul_add(-x83, x85, x82 * x84)) + x114;
-        let x167 = Self::mul_add(x66, x89, Self::mul_add(-x79, x88, x78 * x87)) + x115;
+        let x165 = Self::mul_add(x68, x86, Self::mul_add(x81, x85, x80 * x84)) + x113;
+        let x166 = Self::mul_add(x70, x86, Self::mul_add(x83, x85, x82 * x84)) + x114;
+        let x167 = Self::mul_add(x66, x89, Self::mul_add(x79, x88, x78 * x87)) + x115;
         let x168 = Self::mul_add(x68, x89, Self::mul_add(x81, x88, x80 * x87)) + x116;
         let x169 = Self::mul_add(x70, x89, Self::mul_add(x83, x88, x82 * x87)) + x117;
-        let x170 = Self::mul_add(x66, x92, Self::mul_add(-x79, x91, x78 * x90)) + x118;
+        let x170 = Self::mul_add(x66, x92, Self::mul_add(x79, x91, x78 * x90)) + x118;
         let x171 = Self::mul_add(x68, x92, Self::mul_add(x81, x91, x80 * x90)) + x119;
         let x172 = Self::mul_add(x70, x92, Self::mul_add(x83, x91, x82 * x90)) + x120;
         let x173 = Self::mul_add(x66, x72, Self::mul_add(x65, x71, x16)) + x164;
-        let x174 = Self::mul_add(x68, x72, Self::mul_add(x67, x71, -x17)) + x165;
-        let x175 = Self::mul_add(x70, x72, Self::mul_add(x69, x71, -x18)) + x166;
-        let x176 = Self::mul_add(x66, x74, Self::mul_add(-s_q1, x11, x65 * x73)) + x167;
+        let x174 = Self::mul_add(-x68, x72, Self::mul_add(-x67, x71, x17)) - x165;
+        let x175 = Self::mul_add(-x70, x72, Self::mul_add(-x69, x71, x18)) - x166;
+        let x176 = Self::mul_add(-x66, x74, Self::mul_add(-x65, x73, s_q1 * x11)) - x167;
         let x177 = Self::mul_add(x68, x74, Self::mul_add(x67, x73, x19)) + x168;
         let x178 = Self::mul_add(x70, x74, Self::mul_add(x69, x73, x20)) + x169;
-        let x179 = Self::mul_add(x66, x76, Self::mul_add(-s_q1, x14, x65 * x75)) + x170;
+        let x179 = Self::mul_add(-x66, x76, Self::mul_add(-x65, x75, s_q1 * x14)) - x170;
         let x180 = Self::mul_add(x68, x76, Self::mul_add(x67, x75, x21)) + x171;
         let x181 = Self::mul_add(x70, x76, Self::mul_add(x69, x75, x22)) + x172;
         let x182 = Self::mul_add(x47, x54, Self::mul_add(s_q1, x53, x46 * x52)) + x173;
-        let x183 = Self::mul_add(x49, x54, Self::mul_add(-x5, x53, x48 * x52)) + x174;
-        let x184 = Self::mul_add(x51, x54, Self::mul_add(-x7, x53, x50 * x52)) + x175;
-        let x185 = Self::mul_add(x47, x57, Self::mul_add(-s_q1, x56, x46 * x55)) + x176;
-        let x186 = Self::mul_add(x49, x57, Self::mul_add(x5, x56, x48 * x55)) + x177;
-        let x187 = Self::mul_add(x51, x57, Self::mul_add(x7, x56, x50 * x55)) + x178;
-        let x188 = Self::mul_add(x47, x60, Self::mul_add(-s_q1, x59, x46 * x58)) + x179;
-        let x189 = Self::mul_add(x49, x60, Self::mul_add(x5, x59, x48 * x58)) + x180;
-        let x190 = Self::mul_add(x51, x60, Self::mul_add(x7, x59, x50 * x58)) + x181;
+        let x183 = Self::mul_add(x49, x54, Self::mul_add(-x5, x53, x48 * x52)) - x174;
+        let x184 = Self::mul_add(x51, x54, Self::mul_add(-x7, x53, x50 * x52)) - x175;
+        let x185 = Self::mul_add(x47, x57, Self::mul_add(s_q1, x56, x46 * x55)) - x176;
+        let x186 = Self::mul_add(x49, x57, Self::mul_add(-x5, x56, x48 * x55)) + x177;
+        let x187 = Self::mul_add(x51, x57, Self::mul_add(-x7, x56, x50 * x55)) + x178;
+        let x188 = Self::mul_add(x47, x60, Self::mul_add(s_q1, x59, x46 * x58)) - x179;
+        let x189 = Self::mul_add(x49, x60, Self::mul_add(-x5, x59, x48 * x58)) + x180;
+        let x190 = Self::mul_add(x51, x60, Self::mul_add(-x7, x59, x50 * x58)) + x181;
         let x191 = Self::mul_add(x28, x35, Self::mul_add(-s_q1, x34, x27 * x33)) + x182;
         let x192 = Self::mul_add(x30, x35, Self::mul_add(x5, x34, x29 * x33)) + x183;
         let x193 = Self::mul_add(x32, x35, Self::mul_add(x7, x34, x31 * x33)) + x184;
@@ -451,8 +451,8 @@ impl SsrmsRecurrent {
         let x201 = Self::mul_add(105.98, x24, x151);
         let x202 = Self::mul_add(105.98, x25, x152);
         let x203 = Self::mul_add(105.98, x132, x153);
-        let x204 = Self::mul_add(105.98, x133, x154);
-        let x205 = Self::mul_add(105.98, x134, x155);
+        let x204 = Self::mul_add(-105.98, x133, x154);
+        let x205 = Self::mul_add(-105.98, x134, x155);
         let x206 = Self::mul_add(105.98, x61, x203);
         let x207 = Self::mul_add(105.98, x62, x204);
         let x208 = Self::mul_add(105.98, x63, x205);
@@ -474,26 +474,26 @@ impl SsrmsRecurrent {
         let x224 = Self::mul_add(279.2, x23 + x42, x221);
         let x225 = Self::mul_add(279.2, x145, x222);
         let x226 = Self::mul_add(279.2, x146, x223);
-        let x227 = Self::mul_add(-314.88, x24, x225);
-        let x228 = Self::mul_add(-314.88, x25, x226);
-        let x229 = Self::mul_add(105.98, x138 - x1, x162);
-        let x230 = Self::mul_add(105.98, x2 + x139, x163);
-        let x231 = Self::mul_add(105.98, x143 - x1, x229);
-        let x232 = Self::mul_add(105.98, x2 + x144, x230);
-        let x233 = Self::mul_add(279.2, x145 - x1, x231);
-        let x234 = Self::mul_add(279.2, x2 + x146, x232);
-        let x235 = Self::mul_add(-314.88, x1 + x24, x233);
+        let x227 = Self::mul_add(314.88, x24, x225);
+        let x228 = Self::mul_add(314.88, x25, x226);
+        let x229 = Self::mul_add(105.98, x1 + x138, x162);
+        let x230 = Self::mul_add(105.98, x2 - x139, x163);
+        let x231 = Self::mul_add(105.98, x1 + x143, x229);
+        let x232 = Self::mul_add(105.98, x2 - x144, x230);
+        let x233 = Self::mul_add(279.2, x1 + x145, x231);
+        let x234 = Self::mul_add(279.2, x2 - x146, x232);
+        let x235 = Self::mul_add(314.88, x1 + x24, x233);
         let x236 = Self::mul_add(314.88, x2 - x25, x234);
-        let x237 = Self::mul_add(x94, x162, x95 * x163);
+        let x237 = Self::mul_add(-x94, x162, x95 * x163);
         let x238 = x93 * x162;
         let x239 = x93 * x163;
         let x240 = x94 * x159;
         let x241 = x93 * x159;
         let x242 = x95 * x159;
-        let x243 = Self::mul_add(x95, x161, x241);
+        let x243 = Self::mul_add(-x95, x161, x241);
         let x244 = x94 * x161;
         let x245 = x95 * x160;
-        let x246 = Self::mul_add(x94, x160, x241);
+        let x246 = Self::mul_add(-x94, x160, x241);
         let x247 = x95 * x158;
         let x248 = x94 * x157;
         let x249 = x247 + x248;
@@ -543,11 +543,11 @@ impl SsrmsRecurrent {
         let x293 = Self::mul_add(-x23, x204, x262);
         let x294 = Self::mul_add(-x23, x205, x263);
         let x295 = Self::mul_add(x24, x203, x264);
-        let x296 = x291 - x289 - x266;
+        let x296 = x266 + (x289 - x291);
         let x297 = Self::mul_add(x24, x205, x267);
         let x298 = Self::mul_add(x25, x203, x268);
         let x299 = Self::mul_add(x25, x204, x269);
-        let x300 = x291 - x290 - x270;
+        let x300 = x270 + (x290 - x291);
         let x301 = x63 * x208;
         let x302 = x62 * x207;
         let x303 = x61 * x206;
@@ -558,393 +558,398 @@ impl SsrmsRecurrent {
         let x308 = Self::mul_add(-x23, x210, x250);
         let x309 = Self::mul_add(-x23, x211, x251);
         let x310 = Self::mul_add(x24, x209, x252);
-        let x311 = x306 - x304 - x254;
+        let x311 = x254 + (x304 - x306);
         let x312 = Self::mul_add(x24, x211, x255);
         let x313 = Self::mul_add(x25, x209, x256);
         let x314 = Self::mul_add(x25, x210, x257);
-        let x315 = x306 - x305 - x258;
+        let x315 = x258 + (x305 - x306);
         let x316 = x63 * x214;
         let x317 = x62 * x213;
         let x318 = x61 * x212;
-        let x319 = x316 + x317 - x307;
+        let x319 = x307 - (x316 + x317);
         let x320 = Self::mul_add(-x61, x213, x308);
         let x321 = Self::mul_add(-x61, x214, x309);
         let x322 = Self::mul_add(-x62, x212, x310);
-        let x323 = x311 + (x316 + x318);
+        let x323 = x311 - (x316 + x318);
         let x324 = Self::mul_add(-x62, x214, x312);
         let x325 = Self::mul_add(-x63, x212, x313);
         let x326 = Self::mul_add(-x63, x213, x314);
-        let x327 = x315 + (x317 + x318);
+        let x327 = x315 - (x317 + x318);
         let x328 = x44 * x217;
         let x329 = x43 * x216;
         let x330 = x42 * x215;
         let x331 = x23 * x218;
         let x332 = Self::mul_add(x24, x218, x240);
-        let x333 = Self::mul_add(-x25, x220, x331) - x243;
+        let x333 = x243 - Self::mul_add(x25, x220, x331);
         let x334 = Self::mul_add(x24, x220, x244);
         let x335 = Self::mul_add(x25, x218, x242);
         let x336 = Self::mul_add(x25, x219, x245);
-        let x337 = Self::mul_add(-x24, x219, x331) - x246;
+        let x337 = x246 - Self::mul_add(x24, x219, x331);
         let x338 = x61 * x221;
         let x339 = Self::mul_add(-x62, x221, x332);
-        let x340 = x333 + Self::mul_add(x63, x223, x338);
+        let x340 = x333 + Self::mul_add(x63, x223, -x338);
         let x341 = Self::mul_add(-x62, x223, x334);
         let x342 = Self::mul_add(-x63, x221, x335);
         let x343 = Self::mul_add(-x63, x222, x336);
-        let x344 = x337 + Self::mul_add(x62, x222, x338);
+        let x344 = x337 + Self::mul_add(x62, x222, -x338);
         let x345 = x42 * x224;
-        let x346 = x340 + Self::mul_add(x44, x226, x345);
+        let x346 = x340 + Self::mul_add(x44, x226, -x345);
         let x347 = Self::mul_add(-x43, x226, x341);
         let x348 = Self::mul_add(-x44, x225, x343);
-        let x349 = x344 + Self::mul_add(x43, x225, x345);
+        let x349 = x344 + Self::mul_add(x43, x225, -x345);
         let x350 = x23 * Self::mul_add(314.88, x23, x224);
-        let x351 = x237 + Self::mul_add(x24, x229, x25 * x230);
+        let x351 = x237 + Self::mul_add(-x24, x229, x25 * x230);
         let x352 = Self::mul_add(-x23, x229, x238);
         let x353 = Self::mul_add(-x23, x230, x239);
-        let x354 = Self::mul_add(x62, x231, x63 * x232) - x351;
+        let x354 = x351 - Self::mul_add(-x62, x231, x63 * x232);
         let x355 = Self::mul_add(-x61, x231, x352);
         let x356 = Self::mul_add(-x61, x232, x353);
-        let x357 = x354 + Self::mul_add(x43, x233, x44 * x234);
+        let x357 = x354 - Self::mul_add(-x43, x233, x44 * x234);
         let x358 = Self::mul_add(-x42, x233, x355);
         let x359 = Self::mul_add(-x42, x234, x356);
         let x360 = 12.19 + (Self::mul_add(c_q1, x8, x16) + x191)
-            + (x357 - Self::mul_add(x24, x235, x25 * x236)
-                + Self::mul_add(
-                    -x1,
-                    Self::mul_add(-105.98, x1, x235),
+            - (x357 + Self::mul_add(-x24, x235, x25 * x236)
+                - Self::mul_add(
+                    x1,
+                    Self::mul_add(105.98, x1, x235),
                     x2 * Self::mul_add(105.98, x2, x236),
                 ));
-        let x361 = Self::mul_add(
-            -s_q0,
-            Self::mul_add(x4, x8, -x17) + x192 + Self::mul_add(-x23, x235, x358),
-            c_q0 * (Self::mul_add(x6, x8, -x18) + x193 + Self::mul_add(-x23, x236, x359)),
+        let x361 = -Self::mul_add(
+            -c_q0,
+            Self::mul_add(x6, x8, -x18) + x193 + Self::mul_add(-x23, x236, x359),
+            s_q0 * (Self::mul_add(x4, x8, -x17) + x192 - Self::mul_add(-x23, x235, x358)),
         );
-        let x362 = Self::mul_add(
-            x7,
+        let x362 = -Self::mul_add(
+            -x7,
             x193 + x359,
-            Self::mul_add(-s_q1, x191 + x357, x5 * (x192 + x358)),
+            Self::mul_add(-x5, x192 - x358, s_q1 * (x191 - x357)),
         );
-        let x363 = Self::mul_add(
-            x7,
+        let x363 = -Self::mul_add(
+            -x7,
             x184 + x356,
-            Self::mul_add(-s_q1, x182 + x354, x5 * (x183 + x355)),
+            Self::mul_add(-x5, x183 - x355, s_q1 * (x182 - x354)),
         );
-        let x364 = Self::mul_add(
+        let x364 = -Self::mul_add(
             x7,
-            x175 + x353,
-            Self::mul_add(-s_q1, x173 - x351, x5 * (x174 + x352)),
+            x175 - x353,
+            Self::mul_add(x5, x174 + x352, s_q1 * (x173 - x351)),
         );
         let x365 = Self::mul_add(
             x70,
             x166 + x239,
-            Self::mul_add(x68, x165 + x238, x66 * (x164 - x237)),
+            Self::mul_add(x68, x165 - x238, x66 * (x164 - x237)),
         );
         let x366 = Self::mul_add(x82, x114, Self::mul_add(x80, x113, x78 * x112));
         let x367 = Self::mul_add(x82, x117, Self::mul_add(x80, x116, x78 * x115));
         let x368 = Self::mul_add(x82, x120, Self::mul_add(x80, x119, x78 * x118));
         let x369 = Self::mul_add(
-            -s_q0,
-            Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x19)) + x195
-                + (x346 + Self::mul_add(-x25, x228, x350)),
-            c_q0
-                * (Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x20)) + x196
-                    + Self::mul_add(x24, x228, x347)),
+            -c_q0,
+            Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x20)) + x196
+                - Self::mul_add(x24, x228, x347),
+            s_q0
+                * (Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x19)) + x195
+                    - (x346 - Self::mul_add(x25, x228, x350))),
         );
         let x370 = Self::mul_add(
-            -s_q0,
-            Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x21)) + x198
-                + Self::mul_add(x25, x227, x348),
-            c_q0
-                * (Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x22)) + x199
-                    + (x349 + Self::mul_add(-x24, x227, x350))),
+            -c_q0,
+            Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x22)) + x199
+                - (x349 - Self::mul_add(x24, x227, x350)),
+            s_q0
+                * (Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x21)) + x198
+                    - Self::mul_add(x25, x227, x348)),
         );
-        let x371 = Self::mul_add(-s_q0, x369, c_q0 * x370);
+        let x371 = Self::mul_add(-c_q0, x370, s_q0 * x369);
         let x372 = Self::mul_add(
-            x7,
-            x196 + x347,
+            -x7,
+            x196 - x347,
             Self::mul_add(
-                -s_q1,
-                x194 + Self::mul_add(-x43, x224, x339),
-                x5 * (x195 + x346),
+                -x5,
+                x195 - x346,
+                s_q1 * (x194 + Self::mul_add(-x43, x224, x339)),
             ),
         );
         let x373 = Self::mul_add(
-            x7,
-            x199 + x349,
+            -x7,
+            x199 - x349,
             Self::mul_add(
-                -s_q1,
-                x197 + Self::mul_add(-x44, x224, x342),
-                x5 * (x198 + x348),
+                -x5,
+                x198 - x348,
+                s_q1 * (x197 + Self::mul_add(-x44, x224, x342)),
             ),
         );
-        let x374 = Self::mul_add(-s_q0, x372, c_q0 * x373);
+        let x374 = Self::mul_add(-c_q0, x373, s_q0 * x372);
         let x375 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                x7,
-                x187 + x341,
-                Self::mul_add(-s_q1, x185 + x339, x5 * (x186 + x340)),
+                -x7,
+                x190 - x344,
+                Self::mul_add(-x5, x189 - x343, s_q1 * (x188 + x342)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    x7,
-                    x190 + x344,
-                    Self::mul_add(-s_q1, x188 + x342, x5 * (x189 + x343)),
+                    -x7,
+                    x187 - x341,
+                    Self::mul_add(-x5, x186 - x340, s_q1 * (x185 + x339)),
                 ),
         );
         let x376 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x7,
-                x178 + x334,
-                Self::mul_add(-s_q1, x176 + x332, x5 * (x177 + x333)),
+                x181 - x337,
+                Self::mul_add(x5, x180 - x336, s_q1 * (x179 - x335)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x7,
-                    x181 + x337,
-                    Self::mul_add(-s_q1, x179 + x335, x5 * (x180 + x336)),
+                    x178 - x334,
+                    Self::mul_add(x5, x177 - x333, s_q1 * (x176 - x332)),
                 ),
         );
-        let x377 = Self::mul_add(
-            -s_q0,
+        let x377 = -x376;
+        let x378 = Self::mul_add(
+            -c_q0,
             Self::mul_add(
                 x70,
-                x169 + x244,
-                Self::mul_add(x68, x168 - x243, x66 * (x167 + x240)),
+                x172 - x246,
+                Self::mul_add(x68, x171 - x245, x66 * (x170 + x242)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x70,
-                    x172 - x246,
-                    Self::mul_add(x68, x171 + x245, x66 * (x170 + x242)),
+                    x169 - x244,
+                    Self::mul_add(x68, x168 - x243, x66 * (x167 + x240)),
                 ),
         );
-        let x378 = Self::mul_add(-s_q0, x367, c_q0 * x368);
-        let x379 = Self::mul_add(
-            x7,
+        let x379 = -x378;
+        let x380 = -Self::mul_add(-c_q0, x368, s_q0 * x367);
+        let x381 = Self::mul_add(
+            -x7,
             x193 + Self::mul_add(-x42, x217, x321),
             Self::mul_add(
-                -s_q1,
-                x191 + (x319 + (x328 + x329)),
-                x5 * (x192 + Self::mul_add(-x42, x216, x320)),
+                -x5,
+                x192 + Self::mul_add(-x42, x216, x320),
+                s_q1 * (x191 - (x319 - (x328 + x329))),
             ),
         );
-        let x380 = Self::mul_add(
-            x7,
+        let x382 = Self::mul_add(
+            -x7,
             x196 + Self::mul_add(-x43, x217, x324),
             Self::mul_add(
-                -s_q1,
-                x194 + Self::mul_add(-x43, x215, x322),
-                x5 * (x195 + (x323 + (x328 + x330))),
+                -x5,
+                x195 - (x323 - (x328 + x330)),
+                s_q1 * (x194 + Self::mul_add(-x43, x215, x322)),
             ),
         );
-        let x381 = Self::mul_add(
-            x7,
-            x199 + (x327 + (x329 + x330)),
-            Self::mul_add(
-                -s_q1,
-                x197 + Self::mul_add(-x44, x215, x325),
-                x5 * (x198 + Self::mul_add(-x44, x216, x326)),
-            ),
-        );
-        let x382 = Self::mul_add(x7, x381, Self::mul_add(-s_q1, x379, x5 * x380));
         let x383 = Self::mul_add(
-            -s_q1,
+            -x7,
+            x199 - (x327 - (x329 + x330)),
             Self::mul_add(
-                x7,
-                x184 + x321,
-                Self::mul_add(-s_q1, x182 + x319, x5 * (x183 + x320)),
+                -x5,
+                x198 + Self::mul_add(-x44, x216, x326),
+                s_q1 * (x197 + Self::mul_add(-x44, x215, x325)),
             ),
-            x5
-                * Self::mul_add(
-                    x7,
-                    x187 + x324,
-                    Self::mul_add(-s_q1, x185 + x322, x5 * (x186 + x323)),
-                ),
         );
-        let x384 = Self::mul_add(
-            x7,
-            Self::mul_add(
-                x7,
-                x190 + x327,
-                Self::mul_add(-s_q1, x188 + x325, x5 * (x189 + x326)),
-            ),
-            x383,
-        );
+        let x384 = Self::mul_add(-x7, x383, Self::mul_add(-x5, x382, s_q1 * x381));
         let x385 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
-                x7,
-                x175 + x309,
-                Self::mul_add(-s_q1, x173 - x307, x5 * (x174 + x308)),
+                -x7,
+                x187 + x324,
+                Self::mul_add(-x5, x186 - x323, s_q1 * (x185 + x322)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x7,
-                    x178 + x312,
-                    Self::mul_add(-s_q1, x176 + x310, x5 * (x177 + x311)),
+                    -x7,
+                    x184 + x321,
+                    Self::mul_add(-x5, x183 + x320, s_q1 * (x182 - x319)),
                 ),
         );
         let x386 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
-                x7,
-                x181 + x315,
-                Self::mul_add(-s_q1, x179 + x313, x5 * (x180 + x314)),
+                -x7,
+                x190 - x327,
+                Self::mul_add(-x5, x189 + x326, s_q1 * (x188 + x325)),
             ),
             x385,
         );
         let x387 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
-                x70,
-                x166 + x251,
-                Self::mul_add(x68, x165 + x250, x66 * (x164 - x249)),
+                x7,
+                x178 + x312,
+                Self::mul_add(x5, x177 - x311, s_q1 * (x176 - x310)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x70,
-                    x169 + x255,
-                    Self::mul_add(x68, x168 - x254, x66 * (x167 + x252)),
+                    x7,
+                    x175 - x309,
+                    Self::mul_add(x5, x174 - x308, s_q1 * (x173 - x307)),
                 ),
         );
         let x388 = Self::mul_add(
             x7,
             Self::mul_add(
+                x7,
+                x181 - x315,
+                Self::mul_add(x5, x180 + x314, s_q1 * (x179 - x313)),
+            ),
+            x387,
+        );
+        let x389 = Self::mul_add(
+            -x5,
+            Self::mul_add(
+                x70,
+                x169 + x255,
+                Self::mul_add(x68, x168 - x254, x66 * (x167 + x252)),
+            ),
+            s_q1
+                * Self::mul_add(
+                    x70,
+                    x166 + x251,
+                    Self::mul_add(x68, x165 + x250, x66 * (x164 - x249)),
+                ),
+        );
+        let x390 = Self::mul_add(
+            -x7,
+            Self::mul_add(
                 x70,
                 x172 - x258,
                 Self::mul_add(x68, x171 + x257, x66 * (x170 + x256)),
             ),
-            x387,
+            x389,
         );
-        let x389 = Self::mul_add(x7, x368, Self::mul_add(-s_q1, x366, x5 * x367));
-        let x390 = Self::mul_add(
-            x7,
+        let x391 = -x390;
+        let x392 = -Self::mul_add(-x7, x368, Self::mul_add(-x5, x367, s_q1 * x366));
+        let x393 = Self::mul_add(
+            -x7,
             x184 + Self::mul_add(-x61, x208, x294),
             Self::mul_add(
-                -s_q1,
-                x182 + (x301 + x302 - x292),
-                x5 * (x183 + Self::mul_add(-x61, x207, x293)),
+                -x5,
+                x183 + Self::mul_add(-x61, x207, x293),
+                s_q1 * (x182 - (x292 - (x301 + x302))),
             ),
         );
-        let x391 = Self::mul_add(
-            x7,
+        let x394 = Self::mul_add(
+            -x7,
             x187 + Self::mul_add(-x62, x208, x297),
             Self::mul_add(
-                -s_q1,
-                x185 + Self::mul_add(-x62, x206, x295),
-                x5 * (x186 + (x296 + (x301 + x303))),
+                -x5,
+                x186 - (x296 - (x301 + x303)),
+                s_q1 * (x185 + Self::mul_add(-x62, x206, x295)),
             ),
-        );
-        let x392 = Self::mul_add(
-            x7,
-            x190 + (x300 + (x302 + x303)),
-            Self::mul_add(
-                -s_q1,
-                x188 + Self::mul_add(-x63, x206, x298),
-                x5 * (x189 + Self::mul_add(-x63, x207, x299)),
-            ),
-        );
-        let x393 = Self::mul_add(x7, x392, Self::mul_add(-s_q1, x390, x5 * x391));
-        let x394 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                x7,
-                x175 + x294,
-                Self::mul_add(-s_q1, x173 - x292, x5 * (x174 + x293)),
-            ),
-            x5
-                * Self::mul_add(
-                    x7,
-                    x178 + x297,
-                    Self::mul_add(-s_q1, x176 + x295, x5 * (x177 + x296)),
-                ),
         );
         let x395 = Self::mul_add(
+            -x7,
+            x190 - (x300 - (x302 + x303)),
+            Self::mul_add(
+                -x5,
+                x189 + Self::mul_add(-x63, x207, x299),
+                s_q1 * (x188 + Self::mul_add(-x63, x206, x298)),
+            ),
+        );
+        let x396 = Self::mul_add(-x7, x395, Self::mul_add(-x5, x394, s_q1 * x393));
+        let x397 = Self::mul_add(
+            x5,
+            Self::mul_add(
+                x7,
+                x178 + x297,
+                Self::mul_add(x5, x177 - x296, s_q1 * (x176 - x295)),
+            ),
+            s_q1
+                * Self::mul_add(
+                    x7,
+                    x175 - x294,
+                    Self::mul_add(x5, x174 - x293, s_q1 * (x173 - x292)),
+                ),
+        );
+        let x398 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x181 + x300,
-                Self::mul_add(-s_q1, x179 + x298, x5 * (x180 + x299)),
+                x181 - x300,
+                Self::mul_add(x5, x180 + x299, s_q1 * (x179 - x298)),
             ),
-            x394,
+            x397,
         );
-        let x396 = Self::mul_add(
-            -s_q1,
+        let x399 = Self::mul_add(
+            -x5,
             Self::mul_add(
                 x70,
-                x166 + x263,
-                Self::mul_add(x68, x165 + x262, x66 * (x164 - x261)),
+                x169 + x267,
+                Self::mul_add(x68, x168 - x266, x66 * (x167 + x264)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x70,
-                    x169 + x267,
-                    Self::mul_add(x68, x168 - x266, x66 * (x167 + x264)),
+                    x166 + x263,
+                    Self::mul_add(x68, x165 + x262, x66 * (x164 - x261)),
                 ),
         );
-        let x397 = Self::mul_add(
-            x7,
+        let x400 = Self::mul_add(
+            -x7,
             Self::mul_add(
                 x70,
                 x172 - x270,
                 Self::mul_add(x68, x171 + x269, x66 * (x170 + x268)),
             ),
-            x396,
+            x399,
         );
-        let x398 = Self::mul_add(
-            x7,
-            x175 + Self::mul_add(x23, x202, -x275),
-            Self::mul_add(
-                -s_q1,
-                x173 + (x273 + (x286 + x287)),
-                x5 * (x174 + Self::mul_add(x23, x201, -x274)),
-            ),
-        );
-        let x399 = Self::mul_add(
-            x7,
-            x178 - Self::mul_add(x24, x202, x279),
-            Self::mul_add(
-                -s_q1,
-                x176 + Self::mul_add(x24, x200, x276),
-                x5 * (x177 + (x278 + (x286 + x288))),
-            ),
-        );
-        let x400 = Self::mul_add(
-            x7,
-            x181 + (x282 + (x287 + x288)),
-            Self::mul_add(
-                -s_q1,
-                x179 + Self::mul_add(x25, x200, x280),
-                x5 * (x180 - Self::mul_add(x25, x201, x281)),
-            ),
-        );
-        let x401 = Self::mul_add(x7, x400, Self::mul_add(-s_q1, x398, x5 * x399));
+        let x401 = -x400;
         let x402 = Self::mul_add(
-            -s_q1,
+            x7,
+            x175 + Self::mul_add(-x23, x202, x275),
             Self::mul_add(
-                x70,
-                x166 - x275,
-                Self::mul_add(x68, x165 - x274, x66 * (x164 + x273)),
+                x5,
+                x174 + Self::mul_add(-x23, x201, x274),
+                s_q1 * (x173 + (x273 + (x286 + x287))),
             ),
-            x5
-                * Self::mul_add(
-                    x70,
-                    x169 - x279,
-                    Self::mul_add(x68, x168 + x278, x66 * (x167 + x276)),
-                ),
         );
         let x403 = Self::mul_add(
             x7,
+            x178 - Self::mul_add(x24, x202, x279),
+            Self::mul_add(
+                x5,
+                x177 + (x278 + (x286 + x288)),
+                s_q1 * (x176 - Self::mul_add(x24, x200, x276)),
+            ),
+        );
+        let x404 = Self::mul_add(
+            x7,
+            x181 + (x282 + (x287 + x288)),
+            Self::mul_add(
+                x5,
+                x180 - Self::mul_add(x25, x201, x281),
+                s_q1 * (x179 - Self::mul_add(x25, x200, x280)),
+            ),
+        );
+        let x405 = Self::mul_add(x7, x404, Self::mul_add(x5, x403, s_q1 * x402));
+        let x406 = Self::mul_add(
+            -x5,
+            Self::mul_add(
+                x70,
+                x169 - x279,
+                Self::mul_add(x68, x168 + x278, x66 * (x167 + x276)),
+            ),
+            s_q1
+                * Self::mul_add(
+                    x70,
+                    x166 - x275,
+                    Self::mul_add(x68, x165 - x274, x66 * (x164 + x273)),
+                ),
+        );
+        let x407 = Self::mul_add(
+            -x7,
             Self::mul_add(
                 x70,
                 x172 + x282,
                 Self::mul_add(x68, x171 - x281, x66 * (x170 + x280)),
             ),
-            x402,
+            x406,
         );
-        let x404 = Self::mul_add(
+        let x408 = -x407;
+        let x409 = Self::mul_add(
             x70,
             Self::mul_add(-x93, x149, x166),
             Self::mul_add(
@@ -953,7 +958,7 @@ impl SsrmsRecurrent {
                 x66 * (x164 + (x283 + x284)),
             ),
         );
-        let x405 = Self::mul_add(
+        let x410 = Self::mul_add(
             x70,
             Self::mul_add(-x94, x149, x169),
             Self::mul_add(
@@ -962,7 +967,7 @@ impl SsrmsRecurrent {
                 x66 * Self::mul_add(-x94, x147, x167),
             ),
         );
-        let x406 = Self::mul_add(
+        let x411 = Self::mul_add(
             x70,
             x172 + (x284 + x285),
             Self::mul_add(
@@ -971,17 +976,17 @@ impl SsrmsRecurrent {
                 x66 * Self::mul_add(-x95, x147, x170),
             ),
         );
-        let x407 = Self::mul_add(x70, x406, Self::mul_add(x68, x405, x66 * x404));
-        let x408 = Self::mul_add(x70, x368, Self::mul_add(x68, x367, x66 * x366));
-        let x409 = Self::mul_add(x82, x368, Self::mul_add(x80, x367, x78 * x366));
+        let x412 = Self::mul_add(x70, x411, Self::mul_add(x68, x410, x66 * x409));
+        let x413 = Self::mul_add(x70, x368, Self::mul_add(x68, x367, x66 * x366));
+        let x414 = Self::mul_add(x82, x368, Self::mul_add(x80, x367, x78 * x366));
         [
             [x360, x361, x362, x363, x364, x365, x366],
-            [x361, x371, x374, x375, x376, x377, x378],
-            [x362, x374, x382, x384, x386, x388, x389],
-            [x363, x375, x384, x393, x395, x397, x389],
-            [x364, x376, x386, x395, x401, x403, x389],
-            [x365, x377, x388, x397, x403, x407, x408],
-            [x366, x378, x389, x389, x389, x408, x409],
+            [x361, x371, x374, x375, x377, x379, x380],
+            [x362, x374, x384, x386, x388, x391, x392],
+            [x363, x375, x386, x396, x398, x401, x392],
+            [x364, x377, x388, x398, x405, x408, x392],
+            [x365, x379, x391, x401, x408, x412, x413],
+            [x366, x380, x392, x392, x392, x413, x414],
         ]
     }
     /// The nonlinear effects `c(q, v)` of `M v̇ + c = τ`: velocity products, plus gravity when the model has it (Pinocchio's `nonLinearEffects`).
@@ -1062,20 +1067,20 @@ impl SsrmsRecurrent {
         let x70 = Self::mul_add(1966.28, s_q1, x63 * 39.95);
         let x71 = 1966.28 * x64;
         let x72 = Self::mul_add(x5, -39.95, 9.522 * x65);
-        let x73 = Self::mul_add(x65, -39.95, 1966.28 * x5);
+        let x73 = Self::mul_add(-1966.28, x5, x65 * 39.95);
         let x74 = 1966.28 * x66;
         let x75 = Self::mul_add(x7, -39.95, 9.522 * x67);
-        let x76 = Self::mul_add(x67, -39.95, 1966.28 * x7);
+        let x76 = Self::mul_add(-1966.28, x7, x67 * 39.95);
         let x77 = 1966.28 * x68;
         let x78 = Self::mul_add(x64, x71, Self::mul_add(s_q1, x70, x63 * x69));
         let x79 = Self::mul_add(x66, x71, Self::mul_add(-x5, x70, x65 * x69));
         let x80 = Self::mul_add(x68, x71, Self::mul_add(-x7, x70, x67 * x69));
-        let x81 = Self::mul_add(x64, x74, Self::mul_add(-s_q1, x73, x63 * x72));
-        let x82 = Self::mul_add(x66, x74, Self::mul_add(x5, x73, x65 * x72));
-        let x83 = Self::mul_add(x68, x74, Self::mul_add(x7, x73, x67 * x72));
-        let x84 = Self::mul_add(x64, x77, Self::mul_add(-s_q1, x76, x63 * x75));
-        let x85 = Self::mul_add(x66, x77, Self::mul_add(x5, x76, x65 * x75));
-        let x86 = Self::mul_add(x68, x77, Self::mul_add(x7, x76, x67 * x75));
+        let x81 = Self::mul_add(x64, x74, Self::mul_add(s_q1, x73, x63 * x72));
+        let x82 = Self::mul_add(x66, x74, Self::mul_add(-x5, x73, x65 * x72));
+        let x83 = Self::mul_add(x68, x74, Self::mul_add(-x7, x73, x67 * x72));
+        let x84 = Self::mul_add(x64, x77, Self::mul_add(s_q1, x76, x63 * x75));
+        let x85 = Self::mul_add(x66, x77, Self::mul_add(-x5, x76, x65 * x75));
+        let x86 = Self::mul_add(x68, x77, Self::mul_add(-x7, x76, x67 * x75));
         let x87 = 7.11 * x63;
         let x88 = 7.11 * x65;
         let x89 = 7.11 * x67;
@@ -1093,21 +1098,21 @@ impl SsrmsRecurrent {
         let x101 = 8.305 * x95;
         let x102 = 8.0386 * x96;
         let x103 = Self::mul_add(x92, x98, Self::mul_add(x91, x97, x16));
-        let x104 = Self::mul_add(x94, x98, Self::mul_add(x93, x97, -x17));
-        let x105 = Self::mul_add(x96, x98, Self::mul_add(x95, x97, -x19));
-        let x106 = Self::mul_add(x92, x100, Self::mul_add(x91, x99, -x21));
+        let x104 = Self::mul_add(-x94, x98, Self::mul_add(-x93, x97, x17));
+        let x105 = Self::mul_add(-x96, x98, Self::mul_add(-x95, x97, x19));
+        let x106 = Self::mul_add(-x92, x100, Self::mul_add(-x91, x99, x21));
         let x107 = Self::mul_add(x94, x100, Self::mul_add(x93, x99, x22));
         let x108 = Self::mul_add(x96, x100, Self::mul_add(x95, x99, x24));
-        let x109 = Self::mul_add(x92, x102, Self::mul_add(x91, x101, -x26));
+        let x109 = Self::mul_add(-x92, x102, Self::mul_add(-x91, x101, x26));
         let x110 = Self::mul_add(x94, x102, Self::mul_add(x93, x101, x27));
         let x111 = Self::mul_add(x96, x102, Self::mul_add(x95, x101, x29));
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x113 = Self::mul_add(-s_q1, s_q5, x91 * c_q5);
         let x114 = Self::mul_add(s_q1, c_q5, x91 * s_q5);
         let x115 = Self::mul_add(x5, s_q5, x93 * c_q5);
-        let x116 = Self::mul_add(-x93, s_q5, x5 * c_q5);
+        let x116 = Self::mul_add(-x5, c_q5, x93 * s_q5);
         let x117 = Self::mul_add(x7, s_q5, x95 * c_q5);
-        let x118 = Self::mul_add(-x95, s_q5, x7 * c_q5);
+        let x118 = Self::mul_add(-x7, c_q5, x95 * s_q5);
         let x119 = 12.13 * x113;
         let x120 = 12.13 * x114;
         let x121 = 3.061 * x92;
@@ -1118,24 +1123,24 @@ impl SsrmsRecurrent {
         let x126 = 12.13 * x118;
         let x127 = 3.061 * x96;
         let x128 = Self::mul_add(x92, x121, Self::mul_add(x114, x120, x113 * x119));
-        let x129 = Self::mul_add(x94, x121, Self::mul_add(-x116, x120, x115 * x119));
-        let x130 = Self::mul_add(x96, x121, Self::mul_add(-x118, x120, x117 * x119));
-        let x131 = Self::mul_add(x92, x124, Self::mul_add(-x114, x123, x113 * x122));
+        let x129 = Self::mul_add(x94, x121, Self::mul_add(x116, x120, x115 * x119));
+        let x130 = Self::mul_add(x96, x121, Self::mul_add(x118, x120, x117 * x119));
+        let x131 = Self::mul_add(x92, x124, Self::mul_add(x114, x123, x113 * x122));
         let x132 = Self::mul_add(x94, x124, Self::mul_add(x116, x123, x115 * x122));
         let x133 = Self::mul_add(x96, x124, Self::mul_add(x118, x123, x117 * x122));
-        let x134 = Self::mul_add(x92, x127, Self::mul_add(-x114, x126, x113 * x125));
+        let x134 = Self::mul_add(x92, x127, Self::mul_add(x114, x126, x113 * x125));
         let x135 = Self::mul_add(x94, x127, Self::mul_add(x116, x126, x115 * x125));
         let x136 = Self::mul_add(x96, x127, Self::mul_add(x118, x126, x117 * x125));
         let x137 = 0.7026 * x92;
         let x138 = 0.7026 * x94;
         let x139 = 0.7026 * x96;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x141 = Self::mul_add(-x114, c_q6, x92 * s_q6);
+        let x141 = Self::mul_add(-x92, s_q6, x114 * c_q6);
         let x142 = Self::mul_add(x92, c_q6, x114 * s_q6);
-        let x143 = Self::mul_add(x94, s_q6, x116 * c_q6);
-        let x144 = Self::mul_add(-x116, s_q6, x94 * c_q6);
-        let x145 = Self::mul_add(x96, s_q6, x118 * c_q6);
-        let x146 = Self::mul_add(-x118, s_q6, x96 * c_q6);
+        let x143 = Self::mul_add(-x94, s_q6, x116 * c_q6);
+        let x144 = Self::mul_add(x94, c_q6, x116 * s_q6);
+        let x145 = Self::mul_add(-x96, s_q6, x118 * c_q6);
+        let x146 = Self::mul_add(x96, c_q6, x118 * s_q6);
         let x147 = 9.336 * x113;
         let x148 = 44.41 * x141;
         let x149 = 44.41 * x142;
@@ -1169,22 +1174,23 @@ impl SsrmsRecurrent {
         let x177 = x165 * x166;
         let x178 = x31 * (x175 + x176);
         let x179 = x168
-            + Self::mul_add(
-                x33,
+            - Self::mul_add(
+                -x33,
                 x177,
-                Self::mul_add(-x31, x171 + x171, x32 * (x167 + x175)),
+                Self::mul_add(-x32, x167 + x175, x31 * (x171 + x171)),
             );
-        let x180 = Self::mul_add(
-            x33,
-            x167 + x176,
-            Self::mul_add(x32, x177, x31 * (x170 + x170)),
-        ) - x169;
+        let x180 = x169
+            - Self::mul_add(
+                x33,
+                x167 + x176,
+                Self::mul_add(x32, x177, x31 * (x170 + x170)),
+            );
         let x181 = qd[0] - x172;
-        let x182 = x173 - x165;
+        let x182 = x165 - x173;
         let x183 = x166 + x174;
         let x184 = Self::mul_add(x165, x174, x166 * x173);
         let x185 = x170 + Self::mul_add(qd[0], x174, x166 * x172);
-        let x186 = Self::mul_add(-x165, x172, qd[0] * x173) - x171;
+        let x186 = x171 + Self::mul_add(-qd[0], x173, x165 * x172);
         let x187 = qd[3] * s_q1;
         let x188 = qd[3] * x5;
         let x189 = qd[3] * x7;
@@ -1194,29 +1200,30 @@ impl SsrmsRecurrent {
         let x193 = x181 * x183;
         let x194 = x181 * x181;
         let x195 = x182 * x183;
-        let x196 = Self::mul_add(
-            x61,
-            x193 - x185,
-            Self::mul_add(-x59, x190 + x191, x60 * (x192 - x186)),
-        ) - x178;
-        let x197 = x179
+        let x196 = x178
             + Self::mul_add(
                 x61,
-                x184 + x195,
-                Self::mul_add(-x60, x190 + x194, x59 * (x186 + x192)),
+                x185 - x193,
+                Self::mul_add(-x60, x186 - x192, x59 * (x190 + x191)),
+            );
+        let x197 = x179
+            - Self::mul_add(
+                -x61,
+                x184 - x195,
+                Self::mul_add(x60, x190 + x194, x59 * (x186 + x192)),
             );
         let x198 = x180
-            + Self::mul_add(
+            - Self::mul_add(
                 -x61,
                 x191 + x194,
-                Self::mul_add(x60, x195 - x184, x59 * (x185 + x193)),
+                Self::mul_add(-x60, x184 + x195, x59 * (x185 + x193)),
             );
         let x199 = x181 - x187;
-        let x200 = x182 + x188;
+        let x200 = x182 - x188;
         let x201 = x183 + x189;
-        let x202 = Self::mul_add(-x183, x188, x182 * x189) - x184;
+        let x202 = x184 + Self::mul_add(x182, x189, x183 * x188);
         let x203 = x185 + Self::mul_add(x181, x189, x183 * x187);
-        let x204 = x186 + Self::mul_add(x181, x188, x182 * x187);
+        let x204 = x186 + Self::mul_add(-x181, x188, x182 * x187);
         let x205 = qd[4] * s_q1;
         let x206 = qd[4] * x5;
         let x207 = qd[4] * x7;
@@ -1229,27 +1236,27 @@ impl SsrmsRecurrent {
         let x214 = x196
             + Self::mul_add(
                 x89,
-                x211 - x203,
-                Self::mul_add(-x87, x208 + x209, x88 * (x210 - x204)),
+                x203 - x211,
+                Self::mul_add(-x88, x204 - x210, x87 * (x208 + x209)),
             );
         let x215 = x197
-            + Self::mul_add(
-                x89,
-                x213 - x202,
-                Self::mul_add(-x88, x208 + x212, x87 * (x204 + x210)),
+            - Self::mul_add(
+                -x89,
+                x202 - x213,
+                Self::mul_add(x88, x208 + x212, x87 * (x204 + x210)),
             );
         let x216 = x198
-            + Self::mul_add(
+            - Self::mul_add(
                 -x89,
                 x209 + x212,
-                Self::mul_add(x88, x202 + x213, x87 * (x203 + x211)),
+                Self::mul_add(-x88, x202 + x213, x87 * (x203 + x211)),
             );
         let x217 = x199 - x205;
-        let x218 = x200 + x206;
+        let x218 = x200 - x206;
         let x219 = x201 + x207;
-        let x220 = x202 + Self::mul_add(-x201, x206, x200 * x207);
+        let x220 = x202 + Self::mul_add(x200, x207, x201 * x206);
         let x221 = x203 + Self::mul_add(x199, x207, x201 * x205);
-        let x222 = x204 + Self::mul_add(x199, x206, x200 * x205);
+        let x222 = x204 + Self::mul_add(-x199, x206, x200 * x205);
         let x223 = qd[5] * x92;
         let x224 = qd[5] * x94;
         let x225 = qd[5] * x96;
@@ -1260,29 +1267,29 @@ impl SsrmsRecurrent {
         let x230 = x217 * x217;
         let x231 = x218 * x219;
         let x232 = x214
-            - Self::mul_add(
-                x33,
-                x229 - x221,
-                Self::mul_add(x32, x228 - x222, x31 * (x226 + x227)),
-            );
-        let x233 = x215
             + Self::mul_add(
                 -x33,
-                x231 - x220,
-                Self::mul_add(x32, x226 + x230, x31 * (x222 + x228)),
+                x221 - x229,
+                Self::mul_add(x32, x222 - x228, x31 * (x226 + x227)),
+            );
+        let x233 = x215
+            - Self::mul_add(
+                x33,
+                x220 - x231,
+                Self::mul_add(-x32, x226 + x230, x31 * (x222 + x228)),
             );
         let x234 = x216
-            + Self::mul_add(
+            - Self::mul_add(
                 x33,
                 x227 + x230,
-                Self::mul_add(-x32, x220 + x231, x31 * (x221 + x229)),
+                Self::mul_add(x32, x220 + x231, x31 * (x221 + x229)),
             );
         let x235 = x217 + x223;
-        let x236 = x218 + x224;
+        let x236 = x218 - x224;
         let x237 = x219 + x225;
-        let x238 = x220 + Self::mul_add(-x219, x224, x218 * x225);
-        let x239 = Self::mul_add(-x217, x225, x219 * x223) - x221;
-        let x240 = x222 + Self::mul_add(-x218, x223, x217 * x224);
+        let x238 = x220 + Self::mul_add(x218, x225, x219 * x224);
+        let x239 = x221 - Self::mul_add(-x217, x225, x219 * x223);
+        let x240 = x222 - Self::mul_add(x217, x224, x218 * x223);
         let x241 = qd[6] * x113;
         let x242 = qd[6] * x115;
         let x243 = qd[6] * x117;
@@ -1293,11 +1300,11 @@ impl SsrmsRecurrent {
         let x248 = x235 * x235;
         let x249 = x236 * x237;
         let x250 = x235 + x241;
-        let x251 = x236 + x242;
+        let x251 = x236 - x242;
         let x252 = x237 + x243;
-        let x253 = x238 + Self::mul_add(-x237, x242, x236 * x243);
-        let x254 = x239 + Self::mul_add(-x235, x243, x237 * x241);
-        let x255 = x240 + Self::mul_add(-x236, x241, x235 * x242);
+        let x253 = x238 + Self::mul_add(x236, x243, x237 * x242);
+        let x254 = x239 - Self::mul_add(-x235, x243, x237 * x241);
+        let x255 = x240 - Self::mul_add(x235, x242, x236 * x241);
         let x256 = Self::mul_add(
             x20,
             x166,
@@ -1313,48 +1320,48 @@ impl SsrmsRecurrent {
             x166,
             Self::mul_add(-x28, x165, qd[0] * Self::mul_add(c_q1, x13, -x26)),
         );
-        let x259 = Self::mul_add(x52, x183, Self::mul_add(x51, x182, x50 * x181));
-        let x260 = Self::mul_add(x55, x183, Self::mul_add(x54, x182, x53 * x181));
-        let x261 = Self::mul_add(x58, x183, Self::mul_add(x57, x182, x56 * x181));
-        let x262 = Self::mul_add(x80, x201, Self::mul_add(x79, x200, x78 * x199));
-        let x263 = Self::mul_add(x83, x201, Self::mul_add(x82, x200, x81 * x199));
-        let x264 = Self::mul_add(x86, x201, Self::mul_add(x85, x200, x84 * x199));
-        let x265 = Self::mul_add(x105, x219, Self::mul_add(x104, x218, x103 * x217));
-        let x266 = Self::mul_add(x108, x219, Self::mul_add(x107, x218, x106 * x217));
-        let x267 = Self::mul_add(x111, x219, Self::mul_add(x110, x218, x109 * x217));
-        let x268 = Self::mul_add(x130, x237, Self::mul_add(x129, x236, x128 * x235));
-        let x269 = Self::mul_add(x133, x237, Self::mul_add(x132, x236, x131 * x235));
-        let x270 = Self::mul_add(x136, x237, Self::mul_add(x135, x236, x134 * x235));
+        let x259 = Self::mul_add(x52, x183, Self::mul_add(-x51, x182, x50 * x181));
+        let x260 = Self::mul_add(x55, x183, Self::mul_add(-x54, x182, x53 * x181));
+        let x261 = Self::mul_add(x58, x183, Self::mul_add(-x57, x182, x56 * x181));
+        let x262 = Self::mul_add(x80, x201, Self::mul_add(-x79, x200, x78 * x199));
+        let x263 = Self::mul_add(x83, x201, Self::mul_add(-x82, x200, x81 * x199));
+        let x264 = Self::mul_add(x86, x201, Self::mul_add(-x85, x200, x84 * x199));
+        let x265 = Self::mul_add(-x105, x219, Self::mul_add(x104, x218, x103 * x217));
+        let x266 = Self::mul_add(-x108, x219, Self::mul_add(x107, x218, x106 * x217));
+        let x267 = Self::mul_add(-x111, x219, Self::mul_add(x110, x218, x109 * x217));
+        let x268 = Self::mul_add(x130, x237, Self::mul_add(-x129, x236, x128 * x235));
+        let x269 = Self::mul_add(x133, x237, Self::mul_add(-x132, x236, x131 * x235));
+        let x270 = Self::mul_add(x136, x237, Self::mul_add(-x135, x236, x134 * x235));
         let x271 = 243.66
             * (x232
-                + Self::mul_add(
-                    -x139,
-                    x239 + x247,
-                    Self::mul_add(-x138, x246 - x240, x137 * (x244 + x245)),
+                - Self::mul_add(
+                    x139,
+                    x239 - x247,
+                    Self::mul_add(-x138, x240 - x246, x137 * (x244 + x245)),
                 ));
         let x272 = 243.66
             * (x233
                 + Self::mul_add(
                     -x139,
-                    x249 - x238,
-                    Self::mul_add(-x137, x240 + x246, x138 * (x244 + x248)),
+                    x238 - x249,
+                    Self::mul_add(x138, x244 + x248, x137 * (x240 + x246)),
                 ));
         let x273 = 243.66
             * (x234
                 + Self::mul_add(
-                    x139,
+                    -x139,
                     x245 + x248,
-                    -Self::mul_add(x138, x238 + x249, x137 * (x247 - x239)),
+                    Self::mul_add(-x138, x238 + x249, x137 * (x239 + x247)),
                 ));
-        let x274 = Self::mul_add(x158, x252, Self::mul_add(x157, x251, x156 * x250));
-        let x275 = Self::mul_add(x161, x252, Self::mul_add(x160, x251, x159 * x250));
-        let x276 = Self::mul_add(x164, x252, Self::mul_add(x163, x251, x162 * x250));
+        let x274 = Self::mul_add(x158, x252, Self::mul_add(-x157, x251, x156 * x250));
+        let x275 = Self::mul_add(x161, x252, Self::mul_add(-x160, x251, x159 * x250));
+        let x276 = Self::mul_add(x164, x252, Self::mul_add(-x163, x251, x162 * x250));
         let x277 = Self::mul_add(x158, x255, Self::mul_add(x157, x254, x156 * x253))
-            + Self::mul_add(-x252, x275, x251 * x276);
+            + Self::mul_add(x251, x276, x252 * x275);
         let x278 = Self::mul_add(x161, x255, Self::mul_add(x160, x254, x159 * x253))
-            + Self::mul_add(-x250, x276, x252 * x274);
+            - Self::mul_add(-x250, x276, x252 * x274);
         let x279 = Self::mul_add(x164, x255, Self::mul_add(x163, x254, x162 * x253))
-            + Self::mul_add(-x251, x274, x250 * x275);
+            - Self::mul_add(x250, x275, x251 * x274);
         let x280 = Self::mul_add(105.98, x232, x271);
         let x281 = Self::mul_add(105.98, x233, x272);
         let x282 = Self::mul_add(105.98, x234, x273);
@@ -1364,80 +1371,69 @@ impl SsrmsRecurrent {
         let x286 = Self::mul_add(279.2, x196, x283);
         let x287 = Self::mul_add(279.2, x197, x284);
         let x288 = Self::mul_add(279.2, x198, x285);
-        let x289 = Self::mul_add(314.88, x178, -x286);
+        let x289 = Self::mul_add(314.88, x178, x286);
         let x290 = Self::mul_add(314.88, x179, x287);
         let x291 = Self::mul_add(314.88, x180, x288);
-        let x292 = Self::mul_add(-x139, x272, x138 * x273)
-            - (Self::mul_add(x130, x240, Self::mul_add(x129, x239, x128 * x238))
-                + Self::mul_add(-x237, x269, x236 * x270) + x277);
-        let x293 = Self::mul_add(-x137, x273, x139 * x271)
-            - (Self::mul_add(x133, x240, Self::mul_add(x132, x239, x131 * x238))
-                + Self::mul_add(-x235, x270, x237 * x268) + x278);
-        let x294 = Self::mul_add(-x138, x271, x137 * x272)
-            - (Self::mul_add(x136, x240, Self::mul_add(x135, x239, x134 * x238))
-                + Self::mul_add(-x236, x268, x235 * x269) + x279);
-        let x295 = x292
-            - (Self::mul_add(x105, x222, Self::mul_add(-x104, x221, x103 * x220))
-                + Self::mul_add(-x219, x266, x218 * x267))
-            + Self::mul_add(-x33, x281, x32 * x282);
-        let x296 = x293
-            - (Self::mul_add(x108, x222, Self::mul_add(-x107, x221, x106 * x220))
-                + Self::mul_add(-x217, x267, x219 * x265))
+        let x292 = Self::mul_add(x130, x240, Self::mul_add(x129, x239, x128 * x238))
+            + Self::mul_add(x236, x270, x237 * x269) + x277
+            - Self::mul_add(x138, x273, x139 * x272);
+        let x293 = Self::mul_add(x133, x240, Self::mul_add(x132, x239, x131 * x238))
+            - Self::mul_add(-x235, x270, x237 * x268) + x278
+            - Self::mul_add(-x137, x273, x139 * x271);
+        let x294 = Self::mul_add(x136, x240, Self::mul_add(x135, x239, x134 * x238))
+            - Self::mul_add(x235, x269, x236 * x268) + x279
+            + Self::mul_add(x137, x272, x138 * x271);
+        let x295 = Self::mul_add(-x105, x222, Self::mul_add(-x104, x221, x103 * x220))
+            - Self::mul_add(x218, x267, x219 * x266) + x292
+            - Self::mul_add(x32, x282, x33 * x281);
+        let x296 = Self::mul_add(-x108, x222, Self::mul_add(-x107, x221, x106 * x220))
+            + Self::mul_add(x217, x267, x219 * x265) - x293
             + Self::mul_add(x31, x282, x33 * x280);
-        let x297 = x294
-            - (Self::mul_add(x111, x222, Self::mul_add(-x110, x221, x109 * x220))
-                + Self::mul_add(-x218, x265, x217 * x266))
-            - Self::mul_add(x31, x281, x32 * x280);
-        let x298 = x295
-            - (Self::mul_add(x80, x204, Self::mul_add(-x79, x203, x78 * x202))
-                + Self::mul_add(-x201, x263, x200 * x264))
-            + Self::mul_add(-x88, x285, x89 * x284);
-        let x299 = x296
-            - (Self::mul_add(x83, x204, Self::mul_add(-x82, x203, x81 * x202))
-                + Self::mul_add(-x199, x264, x201 * x262))
-            + Self::mul_add(-x89, x283, x87 * x285);
-        let x300 = x297
-            - (Self::mul_add(x86, x204, Self::mul_add(-x85, x203, x84 * x202))
-                + Self::mul_add(-x200, x262, x199 * x263))
-            + Self::mul_add(-x87, x284, x88 * x283);
-        let x301 = x298
-            - (Self::mul_add(x52, x186, -Self::mul_add(x51, x185, x50 * x184))
-                + Self::mul_add(-x183, x260, x182 * x261))
-            + Self::mul_add(-x60, x288, x61 * x287);
-        let x302 = x299
-            - (Self::mul_add(x55, x186, -Self::mul_add(x54, x185, x53 * x184))
-                + Self::mul_add(-x181, x261, x183 * x259))
-            + Self::mul_add(-x61, x286, x59 * x288);
-        let x303 = x300
-            - (Self::mul_add(x58, x186, -Self::mul_add(x57, x185, x56 * x184))
-                + Self::mul_add(-x182, x259, x181 * x260))
-            + Self::mul_add(-x59, x287, x60 * x286);
-        let x304 = Self::mul_add(x117, x279, Self::mul_add(x115, x278, x113 * x277));
-        let x305 = -(Self::mul_add(x20, x171, x18 * x170)
+        let x297 = Self::mul_add(-x111, x222, Self::mul_add(-x110, x221, x109 * x220))
+            + Self::mul_add(-x217, x266, x218 * x265) - x294
+            - Self::mul_add(-x31, x281, x32 * x280);
+        let x298 = Self::mul_add(x80, x204, Self::mul_add(x79, x203, x78 * x202))
+            + Self::mul_add(x200, x264, x201 * x263) + x295
+            + Self::mul_add(x88, x285, x89 * x284);
+        let x299 = Self::mul_add(x83, x204, Self::mul_add(x82, x203, x81 * x202))
+            - Self::mul_add(-x199, x264, x201 * x262) - x296
+            + Self::mul_add(-x87, x285, x89 * x283);
+        let x300 = Self::mul_add(x86, x204, Self::mul_add(x85, x203, x84 * x202))
+            - Self::mul_add(x199, x263, x200 * x262) - x297
+            - Self::mul_add(x87, x284, x88 * x283);
+        let x301 = Self::mul_add(x52, x186, Self::mul_add(x51, x185, x50 * x184))
+            + Self::mul_add(x182, x261, x183 * x260) + x298
+            + Self::mul_add(x60, x288, x61 * x287);
+        let x302 = Self::mul_add(x55, x186, Self::mul_add(x54, x185, x53 * x184))
+            - Self::mul_add(-x181, x261, x183 * x259) + x299
+            + Self::mul_add(-x59, x288, x61 * x286);
+        let x303 = Self::mul_add(x58, x186, Self::mul_add(x57, x185, x56 * x184))
+            - Self::mul_add(x181, x260, x182 * x259) + x300
+            - Self::mul_add(x59, x287, x60 * x286);
+        let x304 = Self::mul_add(
+            -c_q0,
+            Self::mul_add(x30, x171, x28 * x170)
+                - Self::mul_add(qd[0], x257, x165 * x256) + x303
+                + Self::mul_add(-x31, x290, x32 * x289),
+            s_q0
+                * (Self::mul_add(x25, x171, x23 * x170)
+                    - Self::mul_add(-qd[0], x258, x166 * x256) + x302
+                    - Self::mul_add(x31, x291, x33 * x289)),
+        );
+        let x305 = Self::mul_add(-x7, x303, Self::mul_add(-x5, x302, s_q1 * x301));
+        let x306 = Self::mul_add(-x7, x300, Self::mul_add(-x5, x299, s_q1 * x298));
+        let x307 = Self::mul_add(x7, x297, Self::mul_add(x5, x296, s_q1 * x295));
+        let x308 = -(Self::mul_add(x20, x171, x18 * x170)
             + Self::mul_add(x165, x258, x166 * x257) + x301
-            + Self::mul_add(-x33, x290, x32 * x291)
+            - Self::mul_add(x32, x291, x33 * x290)
             + Self::mul_add(
                 -x1,
-                Self::mul_add(105.98, x169, -x291),
+                Self::mul_add(105.98, x169, x291),
                 x2 * Self::mul_add(105.98, x168, x290),
             ));
-        let x306 = -Self::mul_add(
-            -s_q0,
-            x302
-                - (Self::mul_add(-qd[0], x258, x166 * x256)
-                    - Self::mul_add(x25, x171, x23 * x170))
-                + Self::mul_add(-x33, x289, x31 * x291),
-            c_q0
-                * (x303
-                    - (Self::mul_add(qd[0], x257, x165 * x256)
-                        - Self::mul_add(x30, x171, x28 * x170))
-                    + Self::mul_add(-x31, x290, x32 * x289)),
-        );
-        let x307 = -Self::mul_add(x7, x303, Self::mul_add(-s_q1, x301, x5 * x302));
-        let x308 = -Self::mul_add(x7, x300, Self::mul_add(-s_q1, x298, x5 * x299));
-        let x309 = -Self::mul_add(x7, x297, Self::mul_add(-s_q1, x295, x5 * x296));
-        let x310 = -Self::mul_add(x96, x294, Self::mul_add(x94, x293, x92 * x292));
-        [x305, x306, x307, x308, x309, x310, x304]
+        let x309 = -Self::mul_add(x96, x294, Self::mul_add(x94, x293, x92 * x292));
+        let x310 = -Self::mul_add(x117, x279, Self::mul_add(x115, x278, x113 * x277));
+        [x308, x304, x305, x306, x307, x309, x310]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
     ///
@@ -1518,20 +1514,20 @@ impl SsrmsRecurrent {
         let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
         let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
+        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
         let x75 = 1966.28 * x67;
         let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
+        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
         let x78 = 1966.28 * x69;
         let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
         let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
         let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(-s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(x7, x77, x68 * x76));
+        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
+        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
+        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
+        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
+        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
+        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
         let x88 = 7.11 * x64;
         let x89 = 7.11 * x66;
         let x90 = 7.11 * x68;
@@ -1549,21 +1545,21 @@ impl SsrmsRecurrent {
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
         let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(x95, x99, Self::mul_add(x94, x98, -x18));
-        let x106 = Self::mul_add(x97, x99, Self::mul_add(x96, x98, -x20));
-        let x107 = Self::mul_add(x93, x101, Self::mul_add(x92, x100, -x22));
+        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
+        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
+        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
         let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
         let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(x93, x103, Self::mul_add(x92, x102, -x27));
+        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
         let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
         let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
         let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
         let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x94, s_q5, x5 * c_q5);
+        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
         let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x96, s_q5, x7 * c_q5);
+        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
         let x120 = 12.13 * x114;
         let x121 = 12.13 * x115;
         let x122 = 3.061 * x93;
@@ -1574,24 +1570,24 @@ impl SsrmsRecurrent {
         let x127 = 12.13 * x119;
         let x128 = 3.061 * x97;
         let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(-x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(-x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(-x115, x124, x114 * x123));
+        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
+        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
+        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
         let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
         let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
+        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
         let x138 = 0.7026 * x93;
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
+        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(-x117, s_q6, x95 * c_q6);
-        let x146 = Self::mul_add(x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(-x119, s_q6, x97 * c_q6);
+        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
+        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
+        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
+        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
         let x148 = 9.336 * x114;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
@@ -1619,23 +1615,23 @@ impl SsrmsRecurrent {
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x173 - x33;
-        let x176 = x174 - x34;
+        let x175 = x33 - x173;
+        let x176 = x34 - x174;
         let x177 = x32 + x88;
-        let x178 = x89 - x33;
-        let x179 = x90 - x34;
+        let x178 = x33 - x89;
+        let x179 = x34 - x90;
         let x180 = x60 + x177;
-        let x181 = x61 + x178;
-        let x182 = x62 + x179;
-        let x183 = x181 - x33;
-        let x184 = x182 - x34;
+        let x181 = x61 - x178;
+        let x182 = x62 - x179;
+        let x183 = x33 - x181;
+        let x184 = x34 - x182;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x186 - x33;
-        let x189 = x187 - x34;
-        let x190 = x61 - x33;
-        let x191 = x62 - x34;
+        let x188 = x33 - x186;
+        let x189 = x34 - x187;
+        let x190 = x33 - x61;
+        let x191 = x34 - x62;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -1651,8 +1647,8 @@ impl SsrmsRecurrent {
         let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x175 - x1);
-        let x208 = 243.66 * (x2 + x176);
+        let x207 = 243.66 * (x1 + x175);
+        let x208 = 243.66 * (x2 - x176);
         let x209 = x129 + x157;
         let x210 = x130 + x158;
         let x211 = x131 + x159;
@@ -1663,21 +1659,21 @@ impl SsrmsRecurrent {
         let x216 = x136 + x164;
         let x217 = x137 + x165;
         let x218 = x104 + x209;
-        let x219 = x105 + x210;
-        let x220 = x106 + x211;
-        let x221 = x107 + x212;
+        let x219 = x105 - x210;
+        let x220 = x106 - x211;
+        let x221 = x107 - x212;
         let x222 = x108 + x213;
         let x223 = x109 + x214;
-        let x224 = x110 + x215;
+        let x224 = x110 - x215;
         let x225 = x111 + x216;
         let x226 = x112 + x217;
         let x227 = x79 + x218;
-        let x228 = x80 + x219;
-        let x229 = x81 + x220;
-        let x230 = x82 + x221;
+        let x228 = x80 - x219;
+        let x229 = x81 - x220;
+        let x230 = x82 - x221;
         let x231 = x83 + x222;
         let x232 = x84 + x223;
-        let x233 = x85 + x224;
+        let x233 = x85 - x224;
         let x234 = x86 + x225;
         let x235 = x87 + x226;
         let x236 = x51 + x227;
@@ -1693,8 +1689,8 @@ impl SsrmsRecurrent {
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(105.98, x178, x199);
-        let x250 = Self::mul_add(105.98, x179, x200);
+        let x249 = Self::mul_add(-105.98, x178, x199);
+        let x250 = Self::mul_add(-105.98, x179, x200);
         let x251 = Self::mul_add(105.98, x88, x248);
         let x252 = Self::mul_add(105.98, x89, x249);
         let x253 = Self::mul_add(105.98, x90, x250);
@@ -1716,26 +1712,26 @@ impl SsrmsRecurrent {
         let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(-314.88, x33, x270);
-        let x273 = Self::mul_add(-314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x183 - x1, x207);
-        let x275 = Self::mul_add(105.98, x2 + x184, x208);
-        let x276 = Self::mul_add(105.98, x188 - x1, x274);
-        let x277 = Self::mul_add(105.98, x2 + x189, x275);
-        let x278 = Self::mul_add(279.2, x190 - x1, x276);
-        let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x272 = Self::mul_add(314.88, x33, x270);
+        let x273 = Self::mul_add(314.88, x34, x271);
+        let x274 = Self::mul_add(105.98, x1 + x183, x207);
+        let x275 = Self::mul_add(105.98, x2 - x184, x208);
+        let x276 = Self::mul_add(105.98, x1 + x188, x274);
+        let x277 = Self::mul_add(105.98, x2 - x189, x275);
+        let x278 = Self::mul_add(279.2, x1 + x190, x276);
+        let x279 = Self::mul_add(279.2, x2 - x191, x277);
+        let x280 = Self::mul_add(314.88, x1 + x33, x278);
         let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(x139, x207, x140 * x208);
+        let x282 = Self::mul_add(-x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
         let x285 = x139 * x204;
         let x286 = x138 * x204;
         let x287 = x140 * x204;
-        let x288 = Self::mul_add(x140, x206, x286);
+        let x288 = Self::mul_add(-x140, x206, x286);
         let x289 = x139 * x206;
         let x290 = x140 * x205;
-        let x291 = Self::mul_add(x139, x205, x286);
+        let x291 = Self::mul_add(-x139, x205, x286);
         let x292 = x140 * x203;
         let x293 = x139 * x202;
         let x294 = x292 + x293;
@@ -1785,11 +1781,11 @@ impl SsrmsRecurrent {
         let x338 = Self::mul_add(-x32, x249, x307);
         let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x336 - x334 - x311;
+        let x341 = x311 + (x334 - x336);
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x336 - x335 - x315;
+        let x345 = x315 + (x335 - x336);
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -1800,248 +1796,248 @@ impl SsrmsRecurrent {
         let x353 = Self::mul_add(-x32, x255, x295);
         let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x351 - x349 - x299;
+        let x356 = x299 + (x349 - x351);
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x351 - x350 - x303;
+        let x360 = x303 + (x350 - x351);
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x361 + x362 - x352;
+        let x364 = x352 - (x361 + x362);
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
         let x367 = Self::mul_add(-x89, x257, x355);
-        let x368 = x356 + (x361 + x363);
+        let x368 = x356 - (x361 + x363);
         let x369 = Self::mul_add(-x89, x259, x357);
         let x370 = Self::mul_add(-x90, x257, x358);
         let x371 = Self::mul_add(-x90, x258, x359);
-        let x372 = x360 + (x362 + x363);
+        let x372 = x360 - (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = Self::mul_add(-x34, x265, x376) - x288;
+        let x378 = x288 - Self::mul_add(x34, x265, x376);
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = Self::mul_add(-x33, x264, x376) - x291;
+        let x382 = x291 - Self::mul_add(x33, x264, x376);
         let x383 = x88 * x266;
         let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, x383);
+        let x385 = x378 + Self::mul_add(x90, x268, -x383);
         let x386 = Self::mul_add(-x89, x268, x379);
         let x387 = Self::mul_add(-x90, x266, x380);
         let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, x383);
+        let x389 = x382 + Self::mul_add(x89, x267, -x383);
         let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, x390);
+        let x391 = x385 + Self::mul_add(x62, x271, -x390);
         let x392 = Self::mul_add(-x61, x271, x386);
         let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, x390);
+        let x394 = x389 + Self::mul_add(x61, x270, -x390);
         let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
+        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
         let x397 = Self::mul_add(-x32, x274, x283);
         let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
+        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
+        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
         let x403 = Self::mul_add(-x60, x278, x400);
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = Self::mul_add(
-            -s_q0,
-            x19 + x237 + Self::mul_add(-x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
+            -c_q0,
+            x21 + x238 + Self::mul_add(-x32, x281, x404),
+            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
         );
         let x406 = Self::mul_add(
-            x7,
+            -x7,
             x238 + x404,
-            Self::mul_add(-s_q1, x236 + x402, x5 * (x237 + x403)),
+            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x407 = Self::mul_add(
-            x7,
+            -x7,
             x229 + x401,
-            Self::mul_add(-s_q1, x227 + x399, x5 * (x228 + x400)),
+            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x408 = Self::mul_add(
             x7,
-            x220 + x398,
-            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
+            x220 - x398,
+            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x409 = Self::mul_add(
             x97,
             x211 + x284,
-            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
+            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
         );
         let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
         let x412 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
         let x413 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
-                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
+                -c_q0,
+                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
+                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    -s_q0,
-                    x29 + x243 + Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
+                    -c_q0,
+                    x26 + x241 - Self::mul_add(x33, x273, x392),
+                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
                 ),
         );
         let x414 = Self::mul_add(
-            x7,
-            x241 + x392,
+            -x7,
+            x241 - x392,
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x269, x384),
-                x5 * (x240 + x391),
+                -x5,
+                x240 - x391,
+                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
             ),
         );
         let x415 = Self::mul_add(
-            x7,
-            x244 + x394,
+            -x7,
+            x244 - x394,
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x269, x387),
-                x5 * (x243 + x393),
+                -x5,
+                x243 - x393,
+                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
             ),
         );
-        let x416 = Self::mul_add(-s_q0, x414, c_q0 * x415);
+        let x416 = Self::mul_add(-c_q0, x415, s_q0 * x414);
         let x417 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                x7,
-                x232 + x386,
-                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
+                -x7,
+                x235 - x389,
+                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    x7,
-                    x235 + x389,
-                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
+                    -x7,
+                    x232 - x386,
+                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x418 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x7,
-                x223 + x379,
-                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
+                x226 - x382,
+                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x7,
-                    x226 + x382,
-                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
+                    x223 - x379,
+                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x419 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x97,
-                x214 + x289,
-                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                x217 - x291,
+                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x97,
-                    x217 - x291,
-                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
+                    x214 - x289,
+                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
                 ),
         );
-        let x420 = Self::mul_add(-s_q0, x411, c_q0 * x412);
+        let x420 = Self::mul_add(-c_q0, x412, s_q0 * x411);
         let x421 = Self::mul_add(
-            x7,
+            -x7,
             x238 + Self::mul_add(-x60, x262, x366),
             Self::mul_add(
-                -s_q1,
-                x236 + (x364 + (x373 + x374)),
-                x5 * (x237 + Self::mul_add(-x60, x261, x365)),
+                -x5,
+                x237 + Self::mul_add(-x60, x261, x365),
+                s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x422 = Self::mul_add(
-            x7,
+            -x7,
             x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x260, x367),
-                x5 * (x240 + (x368 + (x373 + x375))),
+                -x5,
+                x240 - (x368 - (x373 + x375)),
+                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
             ),
         );
         let x423 = Self::mul_add(
-            x7,
-            x244 + (x372 + (x374 + x375)),
+            -x7,
+            x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x260, x370),
-                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
+                -x5,
+                x243 + Self::mul_add(-x62, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
             ),
         );
         let x424 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
-                x7,
-                x229 + x366,
-                Self::mul_add(-s_q1, x227 + x364, x5 * (x228 + x365)),
+                -x7,
+                x232 + x369,
+                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x7,
-                    x232 + x369,
-                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
+                    -x7,
+                    x229 + x366,
+                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x425 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
-                x7,
-                x235 + x372,
-                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
+                -x7,
+                x235 - x372,
+                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x424,
         );
         let x426 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
                 x7,
-                x220 + x354,
-                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
+                x223 + x357,
+                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x7,
-                    x223 + x357,
-                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
+                    x220 - x354,
+                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x427 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x360,
-                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
+                x226 - x360,
+                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x426,
         );
         let x428 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x296,
-                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                x214 + x300,
+                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x300,
-                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                    x211 + x296,
+                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
                 ),
         );
         let x429 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x303,
@@ -2049,73 +2045,73 @@ impl SsrmsRecurrent {
             ),
             x428,
         );
-        let x430 = Self::mul_add(x7, x412, Self::mul_add(-s_q1, x410, x5 * x411));
+        let x430 = Self::mul_add(-x7, x412, Self::mul_add(-x5, x411, s_q1 * x410));
         let x431 = Self::mul_add(
-            x7,
+            -x7,
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
-                -s_q1,
-                x227 + (x346 + x347 - x337),
-                x5 * (x228 + Self::mul_add(-x88, x252, x338)),
+                -x5,
+                x228 + Self::mul_add(-x88, x252, x338),
+                s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x432 = Self::mul_add(
-            x7,
+            -x7,
             x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
-                -s_q1,
-                x230 + Self::mul_add(-x89, x251, x340),
-                x5 * (x231 + (x341 + (x346 + x348))),
+                -x5,
+                x231 - (x341 - (x346 + x348)),
+                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
             ),
         );
         let x433 = Self::mul_add(
-            x7,
-            x235 + (x345 + (x347 + x348)),
+            -x7,
+            x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -s_q1,
-                x233 + Self::mul_add(-x90, x251, x343),
-                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
+                -x5,
+                x234 + Self::mul_add(-x90, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
             ),
         );
         let x434 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
                 x7,
-                x220 + x339,
-                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
+                x223 + x342,
+                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x7,
-                    x223 + x342,
-                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
+                    x220 - x339,
+                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x435 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x345,
-                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
+                x226 - x345,
+                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x434,
         );
         let x436 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x308,
-                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                x214 + x312,
+                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x312,
-                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                    x211 + x308,
+                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
                 ),
         );
         let x437 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x315,
@@ -2125,47 +2121,47 @@ impl SsrmsRecurrent {
         );
         let x438 = Self::mul_add(
             x7,
-            x220 + Self::mul_add(x32, x247, -x320),
+            x220 + Self::mul_add(-x32, x247, x320),
             Self::mul_add(
-                -s_q1,
-                x218 + (x318 + (x331 + x332)),
-                x5 * (x219 + Self::mul_add(x32, x246, -x319)),
+                x5,
+                x219 + Self::mul_add(-x32, x246, x319),
+                s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x439 = Self::mul_add(
             x7,
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
-                -s_q1,
-                x221 + Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 + x333))),
+                x5,
+                x222 + (x323 + (x331 + x333)),
+                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
             ),
         );
         let x440 = Self::mul_add(
             x7,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                -s_q1,
-                x224 + Self::mul_add(x34, x245, x325),
-                x5 * (x225 - Self::mul_add(x34, x246, x326)),
+                x5,
+                x225 - Self::mul_add(x34, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
             ),
         );
         let x441 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 - x320,
-                Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                x214 - x324,
+                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                    x211 - x320,
+                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
                 ),
         );
         let x442 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 + x327,
@@ -2216,22 +2212,23 @@ impl SsrmsRecurrent {
         let x459 = x447 * x448;
         let x460 = x32 * (x457 + x458);
         let x461 = x450
-            + Self::mul_add(
-                x34,
+            - Self::mul_add(
+                -x34,
                 x459,
-                Self::mul_add(-x32, x453 + x453, x33 * (x449 + x457)),
+                Self::mul_add(-x33, x449 + x457, x32 * (x453 + x453)),
             );
-        let x462 = Self::mul_add(
-            x34,
-            x449 + x458,
-            Self::mul_add(x33, x459, x32 * (x452 + x452)),
-        ) - x451;
+        let x462 = x451
+            - Self::mul_add(
+                x34,
+                x449 + x458,
+                Self::mul_add(x33, x459, x32 * (x452 + x452)),
+            );
         let x463 = qd[0] - x454;
-        let x464 = x455 - x447;
+        let x464 = x447 - x455;
         let x465 = x448 + x456;
         let x466 = Self::mul_add(x447, x456, x448 * x455);
         let x467 = x452 + Self::mul_add(qd[0], x456, x448 * x454);
-        let x468 = Self::mul_add(-x447, x454, qd[0] * x455) - x453;
+        let x468 = x453 + Self::mul_add(-qd[0], x455, x447 * x454);
         let x469 = qd[3] * s_q1;
         let x470 = qd[3] * x5;
         let x471 = qd[3] * x7;
@@ -2241,29 +2238,30 @@ impl SsrmsRecurrent {
         let x475 = x463 * x465;
         let x476 = x463 * x463;
         let x477 = x464 * x465;
-        let x478 = Self::mul_add(
-            x62,
-            x475 - x467,
-            Self::mul_add(-x60, x472 + x473, x61 * (x474 - x468)),
-        ) - x460;
-        let x479 = x461
+        let x478 = x460
             + Self::mul_add(
                 x62,
-                x466 + x477,
-                Self::mul_add(-x61, x472 + x476, x60 * (x468 + x474)),
+                x467 - x475,
+                Self::mul_add(-x61, x468 - x474, x60 * (x472 + x473)),
+            );
+        let x479 = x461
+            - Self::mul_add(
+                -x62,
+                x466 - x477,
+                Self::mul_add(x61, x472 + x476, x60 * (x468 + x474)),
             );
         let x480 = x462
-            + Self::mul_add(
+            - Self::mul_add(
                 -x62,
                 x473 + x476,
-                Self::mul_add(x61, x477 - x466, x60 * (x467 + x475)),
+                Self::mul_add(-x61, x466 + x477, x60 * (x467 + x475)),
             );
         let x481 = x463 - x469;
-        let x482 = x464 + x470;
+        let x482 = x464 - x470;
         let x483 = x465 + x471;
-        let x484 = Self::mul_add(-x465, x470, x464 * x471) - x466;
+        let x484 = x466 + Self::mul_add(x464, x471, x465 * x470);
         let x485 = x467 + Self::mul_add(x463, x471, x465 * x469);
-        let x486 = x468 + Self::mul_add(x463, x470, x464 * x469);
+        let x486 = x468 + Self::mul_add(-x463, x470, x464 * x469);
         let x487 = qd[4] * s_q1;
         let x488 = qd[4] * x5;
         let x489 = qd[4] * x7;
@@ -2276,27 +2274,27 @@ impl SsrmsRecurrent {
         let x496 = x478
             + Self::mul_add(
                 x90,
-                x493 - x485,
-                Self::mul_add(-x88, x490 + x491, x89 * (x492 - x486)),
+                x485 - x493,
+                Self::mul_add(-x89, x486 - x492, x88 * (x490 + x491)),
             );
         let x497 = x479
-            + Self::mul_add(
-                x90,
-                x495 - x484,
-                Self::mul_add(-x89, x490 + x494, x88 * (x486 + x492)),
+            - Self::mul_add(
+                -x90,
+                x484 - x495,
+                Self::mul_add(x89, x490 + x494, x88 * (x486 + x492)),
             );
         let x498 = x480
-            + Self::mul_add(
+            - Self::mul_add(
                 -x90,
                 x491 + x494,
-                Self::mul_add(x89, x484 + x495, x88 * (x485 + x493)),
+                Self::mul_add(-x89, x484 + x495, x88 * (x485 + x493)),
             );
         let x499 = x481 - x487;
-        let x500 = x482 + x488;
+        let x500 = x482 - x488;
         let x501 = x483 + x489;
-        let x502 = x484 + Self::mul_add(-x483, x488, x482 * x489);
+        let x502 = x484 + Self::mul_add(x482, x489, x483 * x488);
         let x503 = x485 + Self::mul_add(x481, x489, x483 * x487);
-        let x504 = x486 + Self::mul_add(x481, x488, x482 * x487);
+        let x504 = x486 + Self::mul_add(-x481, x488, x482 * x487);
         let x505 = qd[5] * x93;
         let x506 = qd[5] * x95;
         let x507 = qd[5] * x97;
@@ -2307,29 +2305,29 @@ impl SsrmsRecurrent {
         let x512 = x499 * x499;
         let x513 = x500 * x501;
         let x514 = x496
-            - Self::mul_add(
-                x34,
-                x511 - x503,
-                Self::mul_add(x33, x510 - x504, x32 * (x508 + x509)),
-            );
-        let x515 = x497
             + Self::mul_add(
                 -x34,
-                x513 - x502,
-                Self::mul_add(x33, x508 + x512, x32 * (x504 + x510)),
+                x503 - x511,
+                Self::mul_add(x33, x504 - x510, x32 * (x508 + x509)),
+            );
+        let x515 = x497
+            - Self::mul_add(
+                x34,
+                x502 - x513,
+                Self::mul_add(-x33, x508 + x512, x32 * (x504 + x510)),
             );
         let x516 = x498
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x509 + x512,
-                Self::mul_add(-x33, x502 + x513, x32 * (x503 + x511)),
+                Self::mul_add(x33, x502 + x513, x32 * (x503 + x511)),
             );
         let x517 = x499 + x505;
-        let x518 = x500 + x506;
+        let x518 = x500 - x506;
         let x519 = x501 + x507;
-        let x520 = x502 + Self::mul_add(-x501, x506, x500 * x507);
-        let x521 = Self::mul_add(-x499, x507, x501 * x505) - x503;
-        let x522 = x504 + Self::mul_add(-x500, x505, x499 * x506);
+        let x520 = x502 + Self::mul_add(x500, x507, x501 * x506);
+        let x521 = x503 - Self::mul_add(-x499, x507, x501 * x505);
+        let x522 = x504 - Self::mul_add(x499, x506, x500 * x505);
         let x523 = qd[6] * x114;
         let x524 = qd[6] * x116;
         let x525 = qd[6] * x118;
@@ -2340,11 +2338,11 @@ impl SsrmsRecurrent {
         let x530 = x517 * x517;
         let x531 = x518 * x519;
         let x532 = x517 + x523;
-        let x533 = x518 + x524;
+        let x533 = x518 - x524;
         let x534 = x519 + x525;
-        let x535 = x520 + Self::mul_add(-x519, x524, x518 * x525);
-        let x536 = x521 + Self::mul_add(-x517, x525, x519 * x523);
-        let x537 = x522 + Self::mul_add(-x518, x523, x517 * x524);
+        let x535 = x520 + Self::mul_add(x518, x525, x519 * x524);
+        let x536 = x521 - Self::mul_add(-x517, x525, x519 * x523);
+        let x537 = x522 - Self::mul_add(x517, x524, x518 * x523);
         let x538 = Self::mul_add(x21, x448, Self::mul_add(-x19, x447, qd[0] * x17));
         let x539 = Self::mul_add(
             x26,
@@ -2356,48 +2354,48 @@ impl SsrmsRecurrent {
             x448,
             Self::mul_add(-x29, x447, qd[0] * Self::mul_add(c_q1, x13, -x27)),
         );
-        let x541 = Self::mul_add(x53, x465, Self::mul_add(x52, x464, x51 * x463));
-        let x542 = Self::mul_add(x56, x465, Self::mul_add(x55, x464, x54 * x463));
-        let x543 = Self::mul_add(x59, x465, Self::mul_add(x58, x464, x57 * x463));
-        let x544 = Self::mul_add(x81, x483, Self::mul_add(x80, x482, x79 * x481));
-        let x545 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481));
-        let x546 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481));
-        let x547 = Self::mul_add(x106, x501, Self::mul_add(x105, x500, x104 * x499));
-        let x548 = Self::mul_add(x109, x501, Self::mul_add(x108, x500, x107 * x499));
-        let x549 = Self::mul_add(x112, x501, Self::mul_add(x111, x500, x110 * x499));
-        let x550 = Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517));
-        let x551 = Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517));
-        let x552 = Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517));
+        let x541 = Self::mul_add(x53, x465, Self::mul_add(-x52, x464, x51 * x463));
+        let x542 = Self::mul_add(x56, x465, Self::mul_add(-x55, x464, x54 * x463));
+        let x543 = Self::mul_add(x59, x465, Self::mul_add(-x58, x464, x57 * x463));
+        let x544 = Self::mul_add(x81, x483, Self::mul_add(-x80, x482, x79 * x481));
+        let x545 = Self::mul_add(x84, x483, Self::mul_add(-x83, x482, x82 * x481));
+        let x546 = Self::mul_add(x87, x483, Self::mul_add(-x86, x482, x85 * x481));
+        let x547 = Self::mul_add(-x106, x501, Self::mul_add(x105, x500, x104 * x499));
+        let x548 = Self::mul_add(-x109, x501, Self::mul_add(x108, x500, x107 * x499));
+        let x549 = Self::mul_add(-x112, x501, Self::mul_add(x111, x500, x110 * x499));
+        let x550 = Self::mul_add(x131, x519, Self::mul_add(-x130, x518, x129 * x517));
+        let x551 = Self::mul_add(x134, x519, Self::mul_add(-x133, x518, x132 * x517));
+        let x552 = Self::mul_add(x137, x519, Self::mul_add(-x136, x518, x135 * x517));
         let x553 = 243.66
             * (x514
-                + Self::mul_add(
-                    -x140,
-                    x521 + x529,
-                    Self::mul_add(-x139, x528 - x522, x138 * (x526 + x527)),
+                - Self::mul_add(
+                    x140,
+                    x521 - x529,
+                    Self::mul_add(-x139, x522 - x528, x138 * (x526 + x527)),
                 ));
         let x554 = 243.66
             * (x515
                 + Self::mul_add(
                     -x140,
-                    x531 - x520,
-                    Self::mul_add(-x138, x522 + x528, x139 * (x526 + x530)),
+                    x520 - x531,
+                    Self::mul_add(x139, x526 + x530, x138 * (x522 + x528)),
                 ));
         let x555 = 243.66
             * (x516
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x527 + x530,
-                    -Self::mul_add(x139, x520 + x531, x138 * (x529 - x521)),
+                    Self::mul_add(-x139, x520 + x531, x138 * (x521 + x529)),
                 ));
-        let x556 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532));
-        let x557 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532));
-        let x558 = Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532));
+        let x556 = Self::mul_add(x159, x534, Self::mul_add(-x158, x533, x157 * x532));
+        let x557 = Self::mul_add(x162, x534, Self::mul_add(-x161, x533, x160 * x532));
+        let x558 = Self::mul_add(x165, x534, Self::mul_add(-x164, x533, x163 * x532));
         let x559 = Self::mul_add(x159, x537, Self::mul_add(x158, x536, x157 * x535))
-            + Self::mul_add(-x534, x557, x533 * x558);
+            + Self::mul_add(x533, x558, x534 * x557);
         let x560 = Self::mul_add(x162, x537, Self::mul_add(x161, x536, x160 * x535))
-            + Self::mul_add(-x532, x558, x534 * x556);
+            - Self::mul_add(-x532, x558, x534 * x556);
         let x561 = Self::mul_add(x165, x537, Self::mul_add(x164, x536, x163 * x535))
-            + Self::mul_add(-x533, x556, x532 * x557);
+            - Self::mul_add(x532, x557, x533 * x556);
         let x562 = Self::mul_add(105.98, x514, x553);
         let x563 = Self::mul_add(105.98, x515, x554);
         let x564 = Self::mul_add(105.98, x516, x555);
@@ -2407,159 +2405,146 @@ impl SsrmsRecurrent {
         let x568 = Self::mul_add(279.2, x478, x565);
         let x569 = Self::mul_add(279.2, x479, x566);
         let x570 = Self::mul_add(279.2, x480, x567);
-        let x571 = Self::mul_add(314.88, x460, -x568);
+        let x571 = Self::mul_add(314.88, x460, x568);
         let x572 = Self::mul_add(314.88, x461, x569);
         let x573 = Self::mul_add(314.88, x462, x570);
-        let x574 = Self::mul_add(-x140, x554, x139 * x555)
-            - (Self::mul_add(x131, x522, Self::mul_add(x130, x521, x129 * x520))
-                + Self::mul_add(-x519, x551, x518 * x552) + x559);
-        let x575 = Self::mul_add(-x138, x555, x140 * x553)
-            - (Self::mul_add(x134, x522, Self::mul_add(x133, x521, x132 * x520))
-                + Self::mul_add(-x517, x552, x519 * x550) + x560);
-        let x576 = Self::mul_add(-x139, x553, x138 * x554)
-            - (Self::mul_add(x137, x522, Self::mul_add(x136, x521, x135 * x520))
-                + Self::mul_add(-x518, x550, x517 * x551) + x561);
-        let x577 = x574
-            - (Self::mul_add(x106, x504, Self::mul_add(-x105, x503, x104 * x502))
-                + Self::mul_add(-x501, x548, x500 * x549))
-            + Self::mul_add(-x34, x563, x33 * x564);
-        let x578 = x575
-            - (Self::mul_add(x109, x504, Self::mul_add(-x108, x503, x107 * x502))
-                + Self::mul_add(-x499, x549, x501 * x547))
+        let x574 = Self::mul_add(x131, x522, Self::mul_add(x130, x521, x129 * x520))
+            + Self::mul_add(x518, x552, x519 * x551) + x559
+            - Self::mul_add(x139, x555, x140 * x554);
+        let x575 = Self::mul_add(x134, x522, Self::mul_add(x133, x521, x132 * x520))
+            - Self::mul_add(-x517, x552, x519 * x550) + x560
+            - Self::mul_add(-x138, x555, x140 * x553);
+        let x576 = Self::mul_add(x137, x522, Self::mul_add(x136, x521, x135 * x520))
+            - Self::mul_add(x517, x551, x518 * x550) + x561
+            + Self::mul_add(x138, x554, x139 * x553);
+        let x577 = Self::mul_add(-x106, x504, Self::mul_add(-x105, x503, x104 * x502))
+            - Self::mul_add(x500, x549, x501 * x548) + x574
+            - Self::mul_add(x33, x564, x34 * x563);
+        let x578 = Self::mul_add(-x109, x504, Self::mul_add(-x108, x503, x107 * x502))
+            + Self::mul_add(x499, x549, x501 * x547) - x575
             + Self::mul_add(x32, x564, x34 * x562);
-        let x579 = x576
-            - (Self::mul_add(x112, x504, Self::mul_add(-x111, x503, x110 * x502))
-                + Self::mul_add(-x500, x547, x499 * x548))
-            - Self::mul_add(x32, x563, x33 * x562);
-        let x580 = x577
-            - (Self::mul_add(x81, x486, Self::mul_add(-x80, x485, x79 * x484))
-                + Self::mul_add(-x483, x545, x482 * x546))
-            + Self::mul_add(-x89, x567, x90 * x566);
-        let x581 = x578
-            - (Self::mul_add(x84, x486, Self::mul_add(-x83, x485, x82 * x484))
-                + Self::mul_add(-x481, x546, x483 * x544))
-            + Self::mul_add(-x90, x565, x88 * x567);
-        let x582 = x579
-            - (Self::mul_add(x87, x486, Self::mul_add(-x86, x485, x85 * x484))
-                + Self::mul_add(-x482, x544, x481 * x545))
-            + Self::mul_add(-x88, x566, x89 * x565);
-        let x583 = x580
-            - (Self::mul_add(x53, x468, -Self::mul_add(x52, x467, x51 * x466))
-                + Self::mul_add(-x465, x542, x464 * x543))
-            + Self::mul_add(-x61, x570, x62 * x569);
-        let x584 = x581
-            - (Self::mul_add(x56, x468, -Self::mul_add(x55, x467, x54 * x466))
-                + Self::mul_add(-x463, x543, x465 * x541))
-            + Self::mul_add(-x62, x568, x60 * x570);
-        let x585 = x582
-            - (Self::mul_add(x59, x468, -Self::mul_add(x58, x467, x57 * x466))
-                + Self::mul_add(-x464, x541, x463 * x542))
-            + Self::mul_add(-x60, x569, x61 * x568);
+        let x579 = Self::mul_add(-x112, x504, Self::mul_add(-x111, x503, x110 * x502))
+            + Self::mul_add(-x499, x548, x500 * x547) - x576
+            - Self::mul_add(-x32, x563, x33 * x562);
+        let x580 = Self::mul_add(x81, x486, Self::mul_add(x80, x485, x79 * x484))
+            + Self::mul_add(x482, x546, x483 * x545) + x577
+            + Self::mul_add(x89, x567, x90 * x566);
+        let x581 = Self::mul_add(x84, x486, Self::mul_add(x83, x485, x82 * x484))
+            - Self::mul_add(-x481, x546, x483 * x544) - x578
+            + Self::mul_add(-x88, x567, x90 * x565);
+        let x582 = Self::mul_add(x87, x486, Self::mul_add(x86, x485, x85 * x484))
+            - Self::mul_add(x481, x545, x482 * x544) - x579
+            - Self::mul_add(x88, x566, x89 * x565);
+        let x583 = Self::mul_add(x53, x468, Self::mul_add(x52, x467, x51 * x466))
+            + Self::mul_add(x464, x543, x465 * x542) + x580
+            + Self::mul_add(x61, x570, x62 * x569);
+        let x584 = Self::mul_add(x56, x468, Self::mul_add(x55, x467, x54 * x466))
+            - Self::mul_add(-x463, x543, x465 * x541) + x581
+            + Self::mul_add(-x60, x570, x62 * x568);
+        let x585 = Self::mul_add(x59, x468, Self::mul_add(x58, x467, x57 * x466))
+            - Self::mul_add(x463, x542, x464 * x541) + x582
+            - Self::mul_add(x60, x569, x61 * x568);
         let x586 = Self::mul_add(
-            qdd[1],
+            -qdd[1],
             x405,
             qdd[0]
                 * (12.19 + (x17 + x236)
-                    + (x402 - Self::mul_add(x33, x280, x34 * x281)
-                        + Self::mul_add(
-                            -x1,
-                            Self::mul_add(-105.98, x1, x280),
+                    - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+                        - Self::mul_add(
+                            x1,
+                            Self::mul_add(105.98, x1, x280),
                             x2 * Self::mul_add(105.98, x2, x281),
                         ))),
         );
         let x587 = Self::mul_add(
-            qdd[4],
+            -qdd[4],
             x408,
-            Self::mul_add(qdd[3], x407, Self::mul_add(qdd[2], x406, x586)),
+            Self::mul_add(-qdd[3], x407, Self::mul_add(-qdd[2], x406, x586)),
         );
-        let x588 = Self::mul_add(qdd[6], x410, Self::mul_add(qdd[5], x409, x587))
-            - (Self::mul_add(x21, x453, x19 * x452)
-                + Self::mul_add(x447, x540, x448 * x539) + x583
-                + Self::mul_add(-x34, x572, x33 * x573)
-                + Self::mul_add(
-                    -x1,
-                    Self::mul_add(105.98, x451, -x573),
-                    x2 * Self::mul_add(105.98, x450, x572),
-                ));
+        let x588 = -(Self::mul_add(x21, x453, x19 * x452)
+            + Self::mul_add(x447, x540, x448 * x539) + x583
+            - Self::mul_add(x33, x573, x34 * x572)
+            + Self::mul_add(
+                -x1,
+                Self::mul_add(105.98, x451, x573),
+                x2 * Self::mul_add(105.98, x450, x572),
+            ) - Self::mul_add(qdd[6], x410, Self::mul_add(qdd[5], x409, x587)));
         let x589 = Self::mul_add(
-            qdd[3],
+            -qdd[3],
             x417,
-            Self::mul_add(qdd[2], x416, Self::mul_add(qdd[1], x413, qdd[0] * x405)),
+            Self::mul_add(-qdd[2], x416, Self::mul_add(-qdd[1], x413, qdd[0] * x405)),
         );
         let x590 = Self::mul_add(
             qdd[6],
             x420,
             Self::mul_add(qdd[5], x419, Self::mul_add(qdd[4], x418, x589)),
         );
-        let x591 = x590
-            - Self::mul_add(
-                -s_q0,
-                x584
-                    - (Self::mul_add(-qd[0], x540, x448 * x538)
-                        - Self::mul_add(x26, x453, x24 * x452))
-                    + Self::mul_add(-x34, x571, x32 * x573),
-                c_q0
-                    * (x585
-                        - (Self::mul_add(qd[0], x539, x447 * x538)
-                            - Self::mul_add(x31, x453, x29 * x452))
-                        + Self::mul_add(-x32, x572, x33 * x571)),
-            );
+        let x591 = Self::mul_add(
+            -c_q0,
+            Self::mul_add(x31, x453, x29 * x452)
+                - Self::mul_add(qd[0], x539, x447 * x538) + x585
+                + Self::mul_add(-x32, x572, x33 * x571),
+            s_q0
+                * (Self::mul_add(x26, x453, x24 * x452)
+                    - Self::mul_add(-qd[0], x540, x448 * x538) + x584
+                    - Self::mul_add(x32, x573, x34 * x571)),
+        ) - x590;
         let x592 = Self::mul_add(
-            qdd[2],
-            Self::mul_add(x7, x423, Self::mul_add(-s_q1, x421, x5 * x422)),
-            Self::mul_add(qdd[1], x416, qdd[0] * x406),
+            -qdd[2],
+            Self::mul_add(-x7, x423, Self::mul_add(-x5, x422, s_q1 * x421)),
+            Self::mul_add(-qdd[1], x416, qdd[0] * x406),
         );
         let x593 = Self::mul_add(
             qdd[5],
             x429,
-            Self::mul_add(qdd[4], x427, Self::mul_add(qdd[3], x425, x592)),
+            Self::mul_add(-qdd[4], x427, Self::mul_add(-qdd[3], x425, x592)),
         );
         let x594 = qdd[6] * x430;
-        let x595 = x593 + x594
-            - Self::mul_add(x7, x585, Self::mul_add(-s_q1, x583, x5 * x584));
+        let x595 = Self::mul_add(-x7, x585, Self::mul_add(-x5, x584, s_q1 * x583))
+            - (x593 + x594);
         let x596 = Self::mul_add(
-            qdd[3],
-            Self::mul_add(x7, x433, Self::mul_add(-s_q1, x431, x5 * x432)),
-            Self::mul_add(qdd[2], x425, Self::mul_add(qdd[1], x417, qdd[0] * x407)),
+            -qdd[3],
+            Self::mul_add(-x7, x433, Self::mul_add(-x5, x432, s_q1 * x431)),
+            Self::mul_add(-qdd[2], x425, Self::mul_add(-qdd[1], x417, qdd[0] * x407)),
         );
-        let x597 = x594 + Self::mul_add(qdd[5], x437, Self::mul_add(qdd[4], x435, x596))
-            - Self::mul_add(x7, x582, Self::mul_add(-s_q1, x580, x5 * x581));
+        let x597 = Self::mul_add(-x7, x582, Self::mul_add(-x5, x581, s_q1 * x580))
+            - (x594 + Self::mul_add(qdd[5], x437, Self::mul_add(-qdd[4], x435, x596)));
         let x598 = Self::mul_add(
-            qdd[3],
+            -qdd[3],
             x435,
-            Self::mul_add(qdd[2], x427, Self::mul_add(qdd[1], x418, qdd[0] * x408)),
+            Self::mul_add(-qdd[2], x427, Self::mul_add(qdd[1], x418, qdd[0] * x408)),
         );
         let x599 = Self::mul_add(
-            qdd[4],
-            Self::mul_add(x7, x440, Self::mul_add(-s_q1, x438, x5 * x439)),
+            -qdd[4],
+            Self::mul_add(x7, x440, Self::mul_add(x5, x439, s_q1 * x438)),
             x598,
         );
-        let x600 = x594 + Self::mul_add(qdd[5], x442, x599)
-            - Self::mul_add(x7, x579, Self::mul_add(-s_q1, x577, x5 * x578));
+        let x600 = Self::mul_add(x7, x579, Self::mul_add(x5, x578, s_q1 * x577))
+            - (x594 + Self::mul_add(qdd[5], x442, x599));
         let x601 = Self::mul_add(
-            qdd[3],
+            -qdd[3],
             x437,
-            Self::mul_add(qdd[2], x429, Self::mul_add(qdd[1], x419, qdd[0] * x409)),
+            Self::mul_add(-qdd[2], x429, Self::mul_add(-qdd[1], x419, qdd[0] * x409)),
         );
         let x602 = Self::mul_add(
             qdd[5],
             Self::mul_add(x97, x445, Self::mul_add(x95, x444, x93 * x443)),
-            Self::mul_add(qdd[4], x442, x601),
+            Self::mul_add(-qdd[4], x442, x601),
         );
-        let x603 = Self::mul_add(qdd[6], x446, x602)
-            - Self::mul_add(x97, x576, Self::mul_add(x95, x575, x93 * x574));
+        let x603 = -(Self::mul_add(x97, x576, Self::mul_add(x95, x575, x93 * x574))
+            - Self::mul_add(qdd[6], x446, x602));
         let x604 = Self::mul_add(
-            qdd[3],
+            -qdd[3],
             x430,
-            Self::mul_add(qdd[2], x430, Self::mul_add(qdd[1], x420, qdd[0] * x410)),
+            Self::mul_add(-qdd[2], x430, Self::mul_add(-qdd[1], x420, qdd[0] * x410)),
         );
         let x605 = Self::mul_add(
             qdd[6],
             Self::mul_add(x118, x412, Self::mul_add(x116, x411, x114 * x410)),
-            Self::mul_add(qdd[5], x446, Self::mul_add(qdd[4], x430, x604)),
+            Self::mul_add(qdd[5], x446, Self::mul_add(-qdd[4], x430, x604)),
         );
-        let x606 = Self::mul_add(x118, x561, Self::mul_add(x116, x560, x114 * x559))
-            + x605;
+        let x606 = -(Self::mul_add(x118, x561, Self::mul_add(x116, x560, x114 * x559))
+            - x605);
         [x588, x591, x595, x597, x600, x603, x606]
     }
     /// Forward dynamics: `q̈` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
@@ -2641,20 +2626,20 @@ impl SsrmsRecurrent {
         let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
         let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
+        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
         let x75 = 1966.28 * x67;
         let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
+        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
         let x78 = 1966.28 * x69;
         let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
         let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
         let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(-s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(x7, x77, x68 * x76));
+        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
+        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
+        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
+        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
+        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
+        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
         let x88 = 7.11 * x64;
         let x89 = 7.11 * x66;
         let x90 = 7.11 * x68;
@@ -2672,21 +2657,21 @@ impl SsrmsRecurrent {
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
         let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(x95, x99, Self::mul_add(x94, x98, -x18));
-        let x106 = Self::mul_add(x97, x99, Self::mul_add(x96, x98, -x20));
-        let x107 = Self::mul_add(x93, x101, Self::mul_add(x92, x100, -x22));
+        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
+        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
+        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
         let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
         let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(x93, x103, Self::mul_add(x92, x102, -x27));
+        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
         let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
         let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
         let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
         let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x94, s_q5, x5 * c_q5);
+        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
         let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x96, s_q5, x7 * c_q5);
+        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
         let x120 = 12.13 * x114;
         let x121 = 12.13 * x115;
         let x122 = 3.061 * x93;
@@ -2697,24 +2682,24 @@ impl SsrmsRecurrent {
         let x127 = 12.13 * x119;
         let x128 = 3.061 * x97;
         let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(-x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(-x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(-x115, x124, x114 * x123));
+        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
+        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
+        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
         let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
         let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
+        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
         let x138 = 0.7026 * x93;
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
+        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(-x117, s_q6, x95 * c_q6);
-        let x146 = Self::mul_add(x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(-x119, s_q6, x97 * c_q6);
+        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
+        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
+        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
+        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
         let x148 = 9.336 * x114;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
@@ -2742,23 +2727,23 @@ impl SsrmsRecurrent {
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x173 - x33;
-        let x176 = x174 - x34;
+        let x175 = x33 - x173;
+        let x176 = x34 - x174;
         let x177 = x32 + x88;
-        let x178 = x89 - x33;
-        let x179 = x90 - x34;
+        let x178 = x33 - x89;
+        let x179 = x34 - x90;
         let x180 = x60 + x177;
-        let x181 = x61 + x178;
-        let x182 = x62 + x179;
-        let x183 = x181 - x33;
-        let x184 = x182 - x34;
+        let x181 = x61 - x178;
+        let x182 = x62 - x179;
+        let x183 = x33 - x181;
+        let x184 = x34 - x182;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x186 - x33;
-        let x189 = x187 - x34;
-        let x190 = x61 - x33;
-        let x191 = x62 - x34;
+        let x188 = x33 - x186;
+        let x189 = x34 - x187;
+        let x190 = x33 - x61;
+        let x191 = x34 - x62;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -2774,8 +2759,8 @@ impl SsrmsRecurrent {
         let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x175 - x1);
-        let x208 = 243.66 * (x2 + x176);
+        let x207 = 243.66 * (x1 + x175);
+        let x208 = 243.66 * (x2 - x176);
         let x209 = x129 + x157;
         let x210 = x130 + x158;
         let x211 = x131 + x159;
@@ -2786,21 +2771,21 @@ impl SsrmsRecurrent {
         let x216 = x136 + x164;
         let x217 = x137 + x165;
         let x218 = x104 + x209;
-        let x219 = x105 + x210;
-        let x220 = x106 + x211;
-        let x221 = x107 + x212;
+        let x219 = x105 - x210;
+        let x220 = x106 - x211;
+        let x221 = x107 - x212;
         let x222 = x108 + x213;
         let x223 = x109 + x214;
-        let x224 = x110 + x215;
+        let x224 = x110 - x215;
         let x225 = x111 + x216;
         let x226 = x112 + x217;
         let x227 = x79 + x218;
-        let x228 = x80 + x219;
-        let x229 = x81 + x220;
-        let x230 = x82 + x221;
+        let x228 = x80 - x219;
+        let x229 = x81 - x220;
+        let x230 = x82 - x221;
         let x231 = x83 + x222;
         let x232 = x84 + x223;
-        let x233 = x85 + x224;
+        let x233 = x85 - x224;
         let x234 = x86 + x225;
         let x235 = x87 + x226;
         let x236 = x51 + x227;
@@ -2816,8 +2801,8 @@ impl SsrmsRecurrent {
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(105.98, x178, x199);
-        let x250 = Self::mul_add(105.98, x179, x200);
+        let x249 = Self::mul_add(-105.98, x178, x199);
+        let x250 = Self::mul_add(-105.98, x179, x200);
         let x251 = Self::mul_add(105.98, x88, x248);
         let x252 = Self::mul_add(105.98, x89, x249);
         let x253 = Self::mul_add(105.98, x90, x250);
@@ -2839,26 +2824,26 @@ impl SsrmsRecurrent {
         let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(-314.88, x33, x270);
-        let x273 = Self::mul_add(-314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x183 - x1, x207);
-        let x275 = Self::mul_add(105.98, x2 + x184, x208);
-        let x276 = Self::mul_add(105.98, x188 - x1, x274);
-        let x277 = Self::mul_add(105.98, x2 + x189, x275);
-        let x278 = Self::mul_add(279.2, x190 - x1, x276);
-        let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x272 = Self::mul_add(314.88, x33, x270);
+        let x273 = Self::mul_add(314.88, x34, x271);
+        let x274 = Self::mul_add(105.98, x1 + x183, x207);
+        let x275 = Self::mul_add(105.98, x2 - x184, x208);
+        let x276 = Self::mul_add(105.98, x1 + x188, x274);
+        let x277 = Self::mul_add(105.98, x2 - x189, x275);
+        let x278 = Self::mul_add(279.2, x1 + x190, x276);
+        let x279 = Self::mul_add(279.2, x2 - x191, x277);
+        let x280 = Self::mul_add(314.88, x1 + x33, x278);
         let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(x139, x207, x140 * x208);
+        let x282 = Self::mul_add(-x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
         let x285 = x139 * x204;
         let x286 = x138 * x204;
         let x287 = x140 * x204;
-        let x288 = Self::mul_add(x140, x206, x286);
+        let x288 = Self::mul_add(-x140, x206, x286);
         let x289 = x139 * x206;
         let x290 = x140 * x205;
-        let x291 = Self::mul_add(x139, x205, x286);
+        let x291 = Self::mul_add(-x139, x205, x286);
         let x292 = x140 * x203;
         let x293 = x139 * x202;
         let x294 = x292 + x293;
@@ -2908,11 +2893,11 @@ impl SsrmsRecurrent {
         let x338 = Self::mul_add(-x32, x249, x307);
         let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x336 - x334 - x311;
+        let x341 = x311 + (x334 - x336);
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x336 - x335 - x315;
+        let x345 = x315 + (x335 - x336);
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -2923,246 +2908,246 @@ impl SsrmsRecurrent {
         let x353 = Self::mul_add(-x32, x255, x295);
         let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x351 - x349 - x299;
+        let x356 = x299 + (x349 - x351);
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x351 - x350 - x303;
+        let x360 = x303 + (x350 - x351);
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x361 + x362 - x352;
+        let x364 = x352 - (x361 + x362);
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
         let x367 = Self::mul_add(-x89, x257, x355);
-        let x368 = x356 + (x361 + x363);
+        let x368 = x356 - (x361 + x363);
         let x369 = Self::mul_add(-x89, x259, x357);
         let x370 = Self::mul_add(-x90, x257, x358);
         let x371 = Self::mul_add(-x90, x258, x359);
-        let x372 = x360 + (x362 + x363);
+        let x372 = x360 - (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = Self::mul_add(-x34, x265, x376) - x288;
+        let x378 = x288 - Self::mul_add(x34, x265, x376);
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = Self::mul_add(-x33, x264, x376) - x291;
+        let x382 = x291 - Self::mul_add(x33, x264, x376);
         let x383 = x88 * x266;
         let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, x383);
+        let x385 = x378 + Self::mul_add(x90, x268, -x383);
         let x386 = Self::mul_add(-x89, x268, x379);
         let x387 = Self::mul_add(-x90, x266, x380);
         let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, x383);
+        let x389 = x382 + Self::mul_add(x89, x267, -x383);
         let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, x390);
+        let x391 = x385 + Self::mul_add(x62, x271, -x390);
         let x392 = Self::mul_add(-x61, x271, x386);
         let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, x390);
+        let x394 = x389 + Self::mul_add(x61, x270, -x390);
         let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
+        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
         let x397 = Self::mul_add(-x32, x274, x283);
         let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
+        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
+        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
         let x403 = Self::mul_add(-x60, x278, x400);
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = Self::mul_add(
-            -s_q0,
-            x19 + x237 + Self::mul_add(-x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
+            -c_q0,
+            x21 + x238 + Self::mul_add(-x32, x281, x404),
+            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
         );
         let x406 = Self::mul_add(
-            x7,
+            -x7,
             x238 + x404,
-            Self::mul_add(-s_q1, x236 + x402, x5 * (x237 + x403)),
+            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x407 = Self::mul_add(
-            x7,
+            -x7,
             x229 + x401,
-            Self::mul_add(-s_q1, x227 + x399, x5 * (x228 + x400)),
+            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x408 = Self::mul_add(
             x7,
-            x220 + x398,
-            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
+            x220 - x398,
+            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x409 = Self::mul_add(
             x97,
             x211 + x284,
-            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
+            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
         );
         let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
         let x412 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
         let x413 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
-                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
+                -c_q0,
+                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
+                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    -s_q0,
-                    x29 + x243 + Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
+                    -c_q0,
+                    x26 + x241 - Self::mul_add(x33, x273, x392),
+                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
                 ),
         );
         let x414 = Self::mul_add(
-            x7,
-            x241 + x392,
+            -x7,
+            x241 - x392,
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x269, x384),
-                x5 * (x240 + x391),
+                -x5,
+                x240 - x391,
+                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
             ),
         );
         let x415 = Self::mul_add(
-            x7,
-            x244 + x394,
+            -x7,
+            x244 - x394,
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x269, x387),
-                x5 * (x243 + x393),
+                -x5,
+                x243 - x393,
+                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
             ),
         );
         let x416 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                x7,
-                x232 + x386,
-                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
+                -x7,
+                x235 - x389,
+                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    x7,
-                    x235 + x389,
-                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
+                    -x7,
+                    x232 - x386,
+                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x417 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x7,
-                x223 + x379,
-                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
+                x226 - x382,
+                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x7,
-                    x226 + x382,
-                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
+                    x223 - x379,
+                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x418 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x97,
-                x214 + x289,
-                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                x217 - x291,
+                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x97,
-                    x217 - x291,
-                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
+                    x214 - x289,
+                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
                 ),
         );
         let x419 = Self::mul_add(
-            x7,
+            -x7,
             x238 + Self::mul_add(-x60, x262, x366),
             Self::mul_add(
-                -s_q1,
-                x236 + (x364 + (x373 + x374)),
-                x5 * (x237 + Self::mul_add(-x60, x261, x365)),
+                -x5,
+                x237 + Self::mul_add(-x60, x261, x365),
+                s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x420 = Self::mul_add(
-            x7,
+            -x7,
             x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x260, x367),
-                x5 * (x240 + (x368 + (x373 + x375))),
+                -x5,
+                x240 - (x368 - (x373 + x375)),
+                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
             ),
         );
         let x421 = Self::mul_add(
-            x7,
-            x244 + (x372 + (x374 + x375)),
+            -x7,
+            x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x260, x370),
-                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
+                -x5,
+                x243 + Self::mul_add(-x62, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
             ),
         );
         let x422 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
-                x7,
-                x229 + x366,
-                Self::mul_add(-s_q1, x227 + x364, x5 * (x228 + x365)),
+                -x7,
+                x232 + x369,
+                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x7,
-                    x232 + x369,
-                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
+                    -x7,
+                    x229 + x366,
+                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x423 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
-                x7,
-                x235 + x372,
-                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
+                -x7,
+                x235 - x372,
+                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x422,
         );
         let x424 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
                 x7,
-                x220 + x354,
-                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
+                x223 + x357,
+                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x7,
-                    x223 + x357,
-                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
+                    x220 - x354,
+                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x425 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x360,
-                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
+                x226 - x360,
+                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x424,
         );
         let x426 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x296,
-                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                x214 + x300,
+                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x300,
-                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                    x211 + x296,
+                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
                 ),
         );
         let x427 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x303,
@@ -3170,73 +3155,73 @@ impl SsrmsRecurrent {
             ),
             x426,
         );
-        let x428 = Self::mul_add(x7, x412, Self::mul_add(-s_q1, x410, x5 * x411));
+        let x428 = Self::mul_add(-x7, x412, Self::mul_add(-x5, x411, s_q1 * x410));
         let x429 = Self::mul_add(
-            x7,
+            -x7,
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
-                -s_q1,
-                x227 + (x346 + x347 - x337),
-                x5 * (x228 + Self::mul_add(-x88, x252, x338)),
+                -x5,
+                x228 + Self::mul_add(-x88, x252, x338),
+                s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x430 = Self::mul_add(
-            x7,
+            -x7,
             x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
-                -s_q1,
-                x230 + Self::mul_add(-x89, x251, x340),
-                x5 * (x231 + (x341 + (x346 + x348))),
+                -x5,
+                x231 - (x341 - (x346 + x348)),
+                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
             ),
         );
         let x431 = Self::mul_add(
-            x7,
-            x235 + (x345 + (x347 + x348)),
+            -x7,
+            x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -s_q1,
-                x233 + Self::mul_add(-x90, x251, x343),
-                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
+                -x5,
+                x234 + Self::mul_add(-x90, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
             ),
         );
         let x432 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
                 x7,
-                x220 + x339,
-                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
+                x223 + x342,
+                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x7,
-                    x223 + x342,
-                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
+                    x220 - x339,
+                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x433 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x345,
-                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
+                x226 - x345,
+                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x432,
         );
         let x434 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x308,
-                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                x214 + x312,
+                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x312,
-                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                    x211 + x308,
+                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
                 ),
         );
         let x435 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x315,
@@ -3246,47 +3231,47 @@ impl SsrmsRecurrent {
         );
         let x436 = Self::mul_add(
             x7,
-            x220 + Self::mul_add(x32, x247, -x320),
+            x220 + Self::mul_add(-x32, x247, x320),
             Self::mul_add(
-                -s_q1,
-                x218 + (x318 + (x331 + x332)),
-                x5 * (x219 + Self::mul_add(x32, x246, -x319)),
+                x5,
+                x219 + Self::mul_add(-x32, x246, x319),
+                s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x437 = Self::mul_add(
             x7,
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
-                -s_q1,
-                x221 + Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 + x333))),
+                x5,
+                x222 + (x323 + (x331 + x333)),
+                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
             ),
         );
         let x438 = Self::mul_add(
             x7,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                -s_q1,
-                x224 + Self::mul_add(x34, x245, x325),
-                x5 * (x225 - Self::mul_add(x34, x246, x326)),
+                x5,
+                x225 - Self::mul_add(x34, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
             ),
         );
         let x439 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 - x320,
-                Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                x214 - x324,
+                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                    x211 - x320,
+                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
                 ),
         );
         let x440 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 + x327,
@@ -3336,22 +3321,23 @@ impl SsrmsRecurrent {
         let x456 = x444 * x445;
         let x457 = x32 * (x454 + x455);
         let x458 = x447
-            + Self::mul_add(
-                x34,
+            - Self::mul_add(
+                -x34,
                 x456,
-                Self::mul_add(-x32, x450 + x450, x33 * (x446 + x454)),
+                Self::mul_add(-x33, x446 + x454, x32 * (x450 + x450)),
             );
-        let x459 = Self::mul_add(
-            x34,
-            x446 + x455,
-            Self::mul_add(x33, x456, x32 * (x449 + x449)),
-        ) - x448;
+        let x459 = x448
+            - Self::mul_add(
+                x34,
+                x446 + x455,
+                Self::mul_add(x33, x456, x32 * (x449 + x449)),
+            );
         let x460 = qd[0] - x451;
-        let x461 = x452 - x444;
+        let x461 = x444 - x452;
         let x462 = x445 + x453;
         let x463 = Self::mul_add(x444, x453, x445 * x452);
         let x464 = x449 + Self::mul_add(qd[0], x453, x445 * x451);
-        let x465 = Self::mul_add(-x444, x451, qd[0] * x452) - x450;
+        let x465 = x450 + Self::mul_add(-qd[0], x452, x444 * x451);
         let x466 = qd[3] * s_q1;
         let x467 = qd[3] * x5;
         let x468 = qd[3] * x7;
@@ -3361,29 +3347,30 @@ impl SsrmsRecurrent {
         let x472 = x460 * x462;
         let x473 = x460 * x460;
         let x474 = x461 * x462;
-        let x475 = Self::mul_add(
-            x62,
-            x472 - x464,
-            Self::mul_add(-x60, x469 + x470, x61 * (x471 - x465)),
-        ) - x457;
-        let x476 = x458
+        let x475 = x457
             + Self::mul_add(
                 x62,
-                x463 + x474,
-                Self::mul_add(-x61, x469 + x473, x60 * (x465 + x471)),
+                x464 - x472,
+                Self::mul_add(-x61, x465 - x471, x60 * (x469 + x470)),
+            );
+        let x476 = x458
+            - Self::mul_add(
+                -x62,
+                x463 - x474,
+                Self::mul_add(x61, x469 + x473, x60 * (x465 + x471)),
             );
         let x477 = x459
-            + Self::mul_add(
+            - Self::mul_add(
                 -x62,
                 x470 + x473,
-                Self::mul_add(x61, x474 - x463, x60 * (x464 + x472)),
+                Self::mul_add(-x61, x463 + x474, x60 * (x464 + x472)),
             );
         let x478 = x460 - x466;
-        let x479 = x461 + x467;
+        let x479 = x461 - x467;
         let x480 = x462 + x468;
-        let x481 = Self::mul_add(-x462, x467, x461 * x468) - x463;
+        let x481 = x463 + Self::mul_add(x461, x468, x462 * x467);
         let x482 = x464 + Self::mul_add(x460, x468, x462 * x466);
-        let x483 = x465 + Self::mul_add(x460, x467, x461 * x466);
+        let x483 = x465 + Self::mul_add(-x460, x467, x461 * x466);
         let x484 = qd[4] * s_q1;
         let x485 = qd[4] * x5;
         let x486 = qd[4] * x7;
@@ -3396,27 +3383,27 @@ impl SsrmsRecurrent {
         let x493 = x475
             + Self::mul_add(
                 x90,
-                x490 - x482,
-                Self::mul_add(-x88, x487 + x488, x89 * (x489 - x483)),
+                x482 - x490,
+                Self::mul_add(-x89, x483 - x489, x88 * (x487 + x488)),
             );
         let x494 = x476
-            + Self::mul_add(
-                x90,
-                x492 - x481,
-                Self::mul_add(-x89, x487 + x491, x88 * (x483 + x489)),
+            - Self::mul_add(
+                -x90,
+                x481 - x492,
+                Self::mul_add(x89, x487 + x491, x88 * (x483 + x489)),
             );
         let x495 = x477
-            + Self::mul_add(
+            - Self::mul_add(
                 -x90,
                 x488 + x491,
-                Self::mul_add(x89, x481 + x492, x88 * (x482 + x490)),
+                Self::mul_add(-x89, x481 + x492, x88 * (x482 + x490)),
             );
         let x496 = x478 - x484;
-        let x497 = x479 + x485;
+        let x497 = x479 - x485;
         let x498 = x480 + x486;
-        let x499 = x481 + Self::mul_add(-x480, x485, x479 * x486);
+        let x499 = x481 + Self::mul_add(x479, x486, x480 * x485);
         let x500 = x482 + Self::mul_add(x478, x486, x480 * x484);
-        let x501 = x483 + Self::mul_add(x478, x485, x479 * x484);
+        let x501 = x483 + Self::mul_add(-x478, x485, x479 * x484);
         let x502 = qd[5] * x93;
         let x503 = qd[5] * x95;
         let x504 = qd[5] * x97;
@@ -3427,29 +3414,29 @@ impl SsrmsRecurrent {
         let x509 = x496 * x496;
         let x510 = x497 * x498;
         let x511 = x493
-            - Self::mul_add(
-                x34,
-                x508 - x500,
-                Self::mul_add(x33, x507 - x501, x32 * (x505 + x506)),
-            );
-        let x512 = x494
             + Self::mul_add(
                 -x34,
-                x510 - x499,
-                Self::mul_add(x33, x505 + x509, x32 * (x501 + x507)),
+                x500 - x508,
+                Self::mul_add(x33, x501 - x507, x32 * (x505 + x506)),
+            );
+        let x512 = x494
+            - Self::mul_add(
+                x34,
+                x499 - x510,
+                Self::mul_add(-x33, x505 + x509, x32 * (x501 + x507)),
             );
         let x513 = x495
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x506 + x509,
-                Self::mul_add(-x33, x499 + x510, x32 * (x500 + x508)),
+                Self::mul_add(x33, x499 + x510, x32 * (x500 + x508)),
             );
         let x514 = x496 + x502;
-        let x515 = x497 + x503;
+        let x515 = x497 - x503;
         let x516 = x498 + x504;
-        let x517 = x499 + Self::mul_add(-x498, x503, x497 * x504);
-        let x518 = Self::mul_add(-x496, x504, x498 * x502) - x500;
-        let x519 = x501 + Self::mul_add(-x497, x502, x496 * x503);
+        let x517 = x499 + Self::mul_add(x497, x504, x498 * x503);
+        let x518 = x500 - Self::mul_add(-x496, x504, x498 * x502);
+        let x519 = x501 - Self::mul_add(x496, x503, x497 * x502);
         let x520 = qd[6] * x114;
         let x521 = qd[6] * x116;
         let x522 = qd[6] * x118;
@@ -3460,11 +3447,11 @@ impl SsrmsRecurrent {
         let x527 = x514 * x514;
         let x528 = x515 * x516;
         let x529 = x514 + x520;
-        let x530 = x515 + x521;
+        let x530 = x515 - x521;
         let x531 = x516 + x522;
-        let x532 = x517 + Self::mul_add(-x516, x521, x515 * x522);
-        let x533 = x518 + Self::mul_add(-x514, x522, x516 * x520);
-        let x534 = x519 + Self::mul_add(-x515, x520, x514 * x521);
+        let x532 = x517 + Self::mul_add(x515, x522, x516 * x521);
+        let x533 = x518 - Self::mul_add(-x514, x522, x516 * x520);
+        let x534 = x519 - Self::mul_add(x514, x521, x515 * x520);
         let x535 = Self::mul_add(x21, x445, Self::mul_add(-x19, x444, qd[0] * x17));
         let x536 = Self::mul_add(
             x26,
@@ -3476,48 +3463,48 @@ impl SsrmsRecurrent {
             x445,
             Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x13, -x27)),
         );
-        let x538 = Self::mul_add(x53, x462, Self::mul_add(x52, x461, x51 * x460));
-        let x539 = Self::mul_add(x56, x462, Self::mul_add(x55, x461, x54 * x460));
-        let x540 = Self::mul_add(x59, x462, Self::mul_add(x58, x461, x57 * x460));
-        let x541 = Self::mul_add(x81, x480, Self::mul_add(x80, x479, x79 * x478));
-        let x542 = Self::mul_add(x84, x480, Self::mul_add(x83, x479, x82 * x478));
-        let x543 = Self::mul_add(x87, x480, Self::mul_add(x86, x479, x85 * x478));
-        let x544 = Self::mul_add(x106, x498, Self::mul_add(x105, x497, x104 * x496));
-        let x545 = Self::mul_add(x109, x498, Self::mul_add(x108, x497, x107 * x496));
-        let x546 = Self::mul_add(x112, x498, Self::mul_add(x111, x497, x110 * x496));
-        let x547 = Self::mul_add(x131, x516, Self::mul_add(x130, x515, x129 * x514));
-        let x548 = Self::mul_add(x134, x516, Self::mul_add(x133, x515, x132 * x514));
-        let x549 = Self::mul_add(x137, x516, Self::mul_add(x136, x515, x135 * x514));
+        let x538 = Self::mul_add(x53, x462, Self::mul_add(-x52, x461, x51 * x460));
+        let x539 = Self::mul_add(x56, x462, Self::mul_add(-x55, x461, x54 * x460));
+        let x540 = Self::mul_add(x59, x462, Self::mul_add(-x58, x461, x57 * x460));
+        let x541 = Self::mul_add(x81, x480, Self::mul_add(-x80, x479, x79 * x478));
+        let x542 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
+        let x543 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
+        let x544 = Self::mul_add(-x106, x498, Self::mul_add(x105, x497, x104 * x496));
+        let x545 = Self::mul_add(-x109, x498, Self::mul_add(x108, x497, x107 * x496));
+        let x546 = Self::mul_add(-x112, x498, Self::mul_add(x111, x497, x110 * x496));
+        let x547 = Self::mul_add(x131, x516, Self::mul_add(-x130, x515, x129 * x514));
+        let x548 = Self::mul_add(x134, x516, Self::mul_add(-x133, x515, x132 * x514));
+        let x549 = Self::mul_add(x137, x516, Self::mul_add(-x136, x515, x135 * x514));
         let x550 = 243.66
             * (x511
-                + Self::mul_add(
-                    -x140,
-                    x518 + x526,
-                    Self::mul_add(-x139, x525 - x519, x138 * (x523 + x524)),
+                - Self::mul_add(
+                    x140,
+                    x518 - x526,
+                    Self::mul_add(-x139, x519 - x525, x138 * (x523 + x524)),
                 ));
         let x551 = 243.66
             * (x512
                 + Self::mul_add(
                     -x140,
-                    x528 - x517,
-                    Self::mul_add(-x138, x519 + x525, x139 * (x523 + x527)),
+                    x517 - x528,
+                    Self::mul_add(x139, x523 + x527, x138 * (x519 + x525)),
                 ));
         let x552 = 243.66
             * (x513
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x524 + x527,
-                    -Self::mul_add(x139, x517 + x528, x138 * (x526 - x518)),
+                    Self::mul_add(-x139, x517 + x528, x138 * (x518 + x526)),
                 ));
-        let x553 = Self::mul_add(x159, x531, Self::mul_add(x158, x530, x157 * x529));
-        let x554 = Self::mul_add(x162, x531, Self::mul_add(x161, x530, x160 * x529));
-        let x555 = Self::mul_add(x165, x531, Self::mul_add(x164, x530, x163 * x529));
+        let x553 = Self::mul_add(x159, x531, Self::mul_add(-x158, x530, x157 * x529));
+        let x554 = Self::mul_add(x162, x531, Self::mul_add(-x161, x530, x160 * x529));
+        let x555 = Self::mul_add(x165, x531, Self::mul_add(-x164, x530, x163 * x529));
         let x556 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532))
-            + Self::mul_add(-x531, x554, x530 * x555);
+            + Self::mul_add(x530, x555, x531 * x554);
         let x557 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532))
-            + Self::mul_add(-x529, x555, x531 * x553);
+            - Self::mul_add(-x529, x555, x531 * x553);
         let x558 = Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532))
-            + Self::mul_add(-x530, x553, x529 * x554);
+            - Self::mul_add(x529, x554, x530 * x553);
         let x559 = Self::mul_add(105.98, x511, x550);
         let x560 = Self::mul_add(105.98, x512, x551);
         let x561 = Self::mul_add(105.98, x513, x552);
@@ -3527,69 +3514,60 @@ impl SsrmsRecurrent {
         let x565 = Self::mul_add(279.2, x475, x562);
         let x566 = Self::mul_add(279.2, x476, x563);
         let x567 = Self::mul_add(279.2, x477, x564);
-        let x568 = Self::mul_add(314.88, x457, -x565);
+        let x568 = Self::mul_add(314.88, x457, x565);
         let x569 = Self::mul_add(314.88, x458, x566);
         let x570 = Self::mul_add(314.88, x459, x567);
-        let x571 = Self::mul_add(-x140, x551, x139 * x552)
-            - (Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
-                + Self::mul_add(-x516, x548, x515 * x549) + x556);
-        let x572 = Self::mul_add(-x138, x552, x140 * x550)
-            - (Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
-                + Self::mul_add(-x514, x549, x516 * x547) + x557);
-        let x573 = Self::mul_add(-x139, x550, x138 * x551)
-            - (Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
-                + Self::mul_add(-x515, x547, x514 * x548) + x558);
-        let x574 = x571
-            - (Self::mul_add(x106, x501, Self::mul_add(-x105, x500, x104 * x499))
-                + Self::mul_add(-x498, x545, x497 * x546))
-            + Self::mul_add(-x34, x560, x33 * x561);
-        let x575 = x572
-            - (Self::mul_add(x109, x501, Self::mul_add(-x108, x500, x107 * x499))
-                + Self::mul_add(-x496, x546, x498 * x544))
+        let x571 = Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
+            + Self::mul_add(x515, x549, x516 * x548) + x556
+            - Self::mul_add(x139, x552, x140 * x551);
+        let x572 = Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
+            - Self::mul_add(-x514, x549, x516 * x547) + x557
+            - Self::mul_add(-x138, x552, x140 * x550);
+        let x573 = Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
+            - Self::mul_add(x514, x548, x515 * x547) + x558
+            + Self::mul_add(x138, x551, x139 * x550);
+        let x574 = Self::mul_add(-x106, x501, Self::mul_add(-x105, x500, x104 * x499))
+            - Self::mul_add(x497, x546, x498 * x545) + x571
+            - Self::mul_add(x33, x561, x34 * x560);
+        let x575 = Self::mul_add(-x109, x501, Self::mul_add(-x108, x500, x107 * x499))
+            + Self::mul_add(x496, x546, x498 * x544) - x572
             + Self::mul_add(x32, x561, x34 * x559);
-        let x576 = x573
-            - (Self::mul_add(x112, x501, Self::mul_add(-x111, x500, x110 * x499))
-                + Self::mul_add(-x497, x544, x496 * x545))
-            - Self::mul_add(x32, x560, x33 * x559);
-        let x577 = x574
-            - (Self::mul_add(x81, x483, Self::mul_add(-x80, x482, x79 * x481))
-                + Self::mul_add(-x480, x542, x479 * x543))
-            + Self::mul_add(-x89, x564, x90 * x563);
-        let x578 = x575
-            - (Self::mul_add(x84, x483, Self::mul_add(-x83, x482, x82 * x481))
-                + Self::mul_add(-x478, x543, x480 * x541))
-            + Self::mul_add(-x90, x562, x88 * x564);
-        let x579 = x576
-            - (Self::mul_add(x87, x483, Self::mul_add(-x86, x482, x85 * x481))
-                + Self::mul_add(-x479, x541, x478 * x542))
-            + Self::mul_add(-x88, x563, x89 * x562);
-        let x580 = x577
-            - (Self::mul_add(x53, x465, -Self::mul_add(x52, x464, x51 * x463))
-                + Self::mul_add(-x462, x539, x461 * x540))
-            + Self::mul_add(-x61, x567, x62 * x566);
-        let x581 = x578
-            - (Self::mul_add(x56, x465, -Self::mul_add(x55, x464, x54 * x463))
-                + Self::mul_add(-x460, x540, x462 * x538))
-            + Self::mul_add(-x62, x565, x60 * x567);
-        let x582 = x579
-            - (Self::mul_add(x59, x465, -Self::mul_add(x58, x464, x57 * x463))
-                + Self::mul_add(-x461, x538, x460 * x539))
-            + Self::mul_add(-x60, x566, x61 * x565);
+        let x576 = Self::mul_add(-x112, x501, Self::mul_add(-x111, x500, x110 * x499))
+            + Self::mul_add(-x496, x545, x497 * x544) - x573
+            - Self::mul_add(-x32, x560, x33 * x559);
+        let x577 = Self::mul_add(x81, x483, Self::mul_add(x80, x482, x79 * x481))
+            + Self::mul_add(x479, x543, x480 * x542) + x574
+            + Self::mul_add(x89, x564, x90 * x563);
+        let x578 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
+            - Self::mul_add(-x478, x543, x480 * x541) - x575
+            + Self::mul_add(-x88, x564, x90 * x562);
+        let x579 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
+            - Self::mul_add(x478, x542, x479 * x541) - x576
+            - Self::mul_add(x88, x563, x89 * x562);
+        let x580 = Self::mul_add(x53, x465, Self::mul_add(x52, x464, x51 * x463))
+            + Self::mul_add(x461, x540, x462 * x539) + x577
+            + Self::mul_add(x61, x567, x62 * x566);
+        let x581 = Self::mul_add(x56, x465, Self::mul_add(x55, x464, x54 * x463))
+            - Self::mul_add(-x460, x540, x462 * x538) + x578
+            + Self::mul_add(-x60, x567, x62 * x565);
+        let x582 = Self::mul_add(x59, x465, Self::mul_add(x58, x464, x57 * x463))
+            - Self::mul_add(x460, x539, x461 * x538) + x579
+            - Self::mul_add(x60, x566, x61 * x565);
         let x583 = tau[0]
             + (Self::mul_add(x21, x450, x19 * x449)
                 + Self::mul_add(x444, x537, x445 * x536) + x580
-                + Self::mul_add(-x34, x569, x33 * x570)
+                - Self::mul_add(x33, x570, x34 * x569)
                 + Self::mul_add(
                     -x1,
-                    Self::mul_add(105.98, x448, -x570),
+                    Self::mul_add(105.98, x448, x570),
                     x2 * Self::mul_add(105.98, x447, x569),
                 ));
         let x584 = 1.0
             / (12.19 + (x17 + x236)
-                + (x402 - Self::mul_add(x33, x280, x34 * x281)
-                    + Self::mul_add(
-                        -x1,
-                        Self::mul_add(-105.98, x1, x280),
+                - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+                    - Self::mul_add(
+                        x1,
+                        Self::mul_add(105.98, x1, x280),
                         x2 * Self::mul_add(105.98, x2, x281),
                     )));
         let x585 = x405 * x584;
@@ -3599,25 +3577,25 @@ impl SsrmsRecurrent {
         let x589 = x409 * x584;
         let x590 = x410 * x584;
         let x591 = 1.0 / Self::mul_add(-x405, x585, x413);
-        let x592 = Self::mul_add(-x405, x586, Self::mul_add(-s_q0, x414, c_q0 * x415));
+        let x592 = Self::mul_add(-x405, x586, Self::mul_add(-c_q0, x415, s_q0 * x414));
         let x593 = x591 * x592;
         let x594 = Self::mul_add(-x405, x587, x416);
         let x595 = x591 * x594;
-        let x596 = Self::mul_add(-x405, x588, x417);
+        let x596 = Self::mul_add(x405, x588, x417);
         let x597 = x591 * x596;
         let x598 = Self::mul_add(-x405, x589, x418);
         let x599 = x591 * x598;
-        let x600 = Self::mul_add(-x405, x590, Self::mul_add(-s_q0, x411, c_q0 * x412));
+        let x600 = Self::mul_add(-x405, x590, Self::mul_add(-c_q0, x412, s_q0 * x411));
         let x601 = x591 * x600;
         let x602 = Self::mul_add(
             -x406,
             x586,
-            Self::mul_add(x7, x421, Self::mul_add(-s_q1, x419, x5 * x420)),
+            Self::mul_add(-x7, x421, Self::mul_add(-x5, x420, s_q1 * x419)),
         );
         let x603 = 1.0 / Self::mul_add(-x592, x593, x602);
         let x604 = Self::mul_add(-x592, x595, Self::mul_add(-x406, x587, x423));
         let x605 = x603 * x604;
-        let x606 = Self::mul_add(-x592, x597, Self::mul_add(-x406, x588, x425));
+        let x606 = Self::mul_add(x592, x597, Self::mul_add(-x406, x588, x425));
         let x607 = x603 * x606;
         let x608 = Self::mul_add(-x592, x599, Self::mul_add(-x406, x589, x427));
         let x609 = x603 * x608;
@@ -3626,13 +3604,13 @@ impl SsrmsRecurrent {
         let x612 = Self::mul_add(
             -x407,
             x587,
-            Self::mul_add(x7, x431, Self::mul_add(-s_q1, x429, x5 * x430)),
+            Self::mul_add(-x7, x431, Self::mul_add(-x5, x430, s_q1 * x429)),
         );
         let x613 = 1.0 / Self::mul_add(-x604, x605, Self::mul_add(-x594, x595, x612));
         let x614 = Self::mul_add(
             -x604,
             x607,
-            Self::mul_add(-x594, x597, Self::mul_add(-x407, x588, x433)),
+            Self::mul_add(x594, x597, Self::mul_add(-x407, x588, x433)),
         );
         let x615 = x613 * x614;
         let x616 = Self::mul_add(
@@ -3650,7 +3628,7 @@ impl SsrmsRecurrent {
         let x620 = Self::mul_add(
             -x408,
             x588,
-            Self::mul_add(x7, x438, Self::mul_add(-s_q1, x436, x5 * x437)),
+            Self::mul_add(x7, x438, Self::mul_add(x5, x437, s_q1 * x436)),
         );
         let x621 = Self::mul_add(
             -x614,
@@ -3661,14 +3639,14 @@ impl SsrmsRecurrent {
         let x623 = Self::mul_add(
             -x606,
             x609,
-            Self::mul_add(-x596, x599, Self::mul_add(-x408, x589, x440)),
+            Self::mul_add(x596, x599, Self::mul_add(-x408, x589, x440)),
         );
         let x624 = Self::mul_add(-x614, x617, x623);
         let x625 = x622 * x624;
         let x626 = Self::mul_add(
             -x606,
             x611,
-            Self::mul_add(-x596, x601, Self::mul_add(-x408, x590, x428)),
+            Self::mul_add(x596, x601, Self::mul_add(-x408, x590, x428)),
         );
         let x627 = Self::mul_add(-x614, x619, x626);
         let x628 = x622 * x627;
@@ -3707,43 +3685,41 @@ impl SsrmsRecurrent {
         );
         let x638 = 1.0 / Self::mul_add(-x634, x635, Self::mul_add(-x627, x628, x637));
         let x639 = Self::mul_add(
-            -x583,
+            x583,
             x585,
             tau[1]
-                + Self::mul_add(
-                    -s_q0,
-                    x581
-                        - (Self::mul_add(-qd[0], x537, x445 * x535)
-                            - Self::mul_add(x26, x450, x24 * x449))
-                        + Self::mul_add(-x34, x568, x32 * x570),
-                    c_q0
-                        * (x582
-                            - (Self::mul_add(qd[0], x536, x444 * x535)
-                                - Self::mul_add(x31, x450, x29 * x449))
-                            + Self::mul_add(-x32, x569, x33 * x568)),
+                - Self::mul_add(
+                    -c_q0,
+                    Self::mul_add(x31, x450, x29 * x449)
+                        - Self::mul_add(qd[0], x536, x444 * x535) + x582
+                        + Self::mul_add(-x32, x569, x33 * x568),
+                    s_q0
+                        * (Self::mul_add(x26, x450, x24 * x449)
+                            - Self::mul_add(-qd[0], x537, x445 * x535) + x581
+                            - Self::mul_add(x32, x570, x34 * x568)),
                 ),
         );
         let x640 = Self::mul_add(
-            -x583,
+            x583,
             x586,
-            tau[2] + Self::mul_add(x7, x582, Self::mul_add(-s_q1, x580, x5 * x581)),
+            tau[2] - Self::mul_add(-x7, x582, Self::mul_add(-x5, x581, s_q1 * x580)),
         );
         let x641 = Self::mul_add(-x593, x639, x640);
         let x642 = Self::mul_add(
-            -x583,
+            x583,
             x587,
-            tau[3] + Self::mul_add(x7, x579, Self::mul_add(-s_q1, x577, x5 * x578)),
+            tau[3] - Self::mul_add(-x7, x579, Self::mul_add(-x5, x578, s_q1 * x577)),
         );
         let x643 = Self::mul_add(-x605, x641, Self::mul_add(-x595, x639, x642));
         let x644 = Self::mul_add(
-            -x583,
+            x583,
             x588,
-            tau[4] + Self::mul_add(x7, x576, Self::mul_add(-s_q1, x574, x5 * x575)),
+            tau[4] - Self::mul_add(x7, x576, Self::mul_add(x5, x575, s_q1 * x574)),
         );
         let x645 = Self::mul_add(
             -x615,
             x643,
-            Self::mul_add(-x607, x641, Self::mul_add(-x597, x639, x644)),
+            Self::mul_add(-x607, x641, Self::mul_add(x597, x639, x644)),
         );
         let x646 = Self::mul_add(
             -x583,
@@ -3751,50 +3727,50 @@ impl SsrmsRecurrent {
             tau[5] + Self::mul_add(x97, x573, Self::mul_add(x95, x572, x93 * x571)),
         );
         let x647 = Self::mul_add(
-            -x617,
+            x617,
             x643,
-            Self::mul_add(-x609, x641, Self::mul_add(-x599, x639, x646)),
+            Self::mul_add(x609, x641, Self::mul_add(x599, x639, x646)),
         );
-        let x648 = Self::mul_add(-x625, x645, x647);
+        let x648 = Self::mul_add(x625, x645, x647);
         let x649 = Self::mul_add(
             -x583,
             x590,
-            tau[6] - Self::mul_add(x118, x558, Self::mul_add(x116, x557, x114 * x556)),
+            tau[6] + Self::mul_add(x118, x558, Self::mul_add(x116, x557, x114 * x556)),
         );
         let x650 = Self::mul_add(
-            -x619,
+            x619,
             x643,
-            Self::mul_add(-x611, x641, Self::mul_add(-x601, x639, x649)),
+            Self::mul_add(x611, x641, Self::mul_add(x601, x639, x649)),
         );
-        let x651 = x638 * Self::mul_add(-x635, x648, Self::mul_add(-x628, x645, x650));
+        let x651 = x638 * Self::mul_add(-x635, x648, Self::mul_add(x628, x645, x650));
         let x652 = Self::mul_add(-x635, x651, x631 * x648);
-        let x653 = Self::mul_add(-x628, x651, Self::mul_add(-x625, x652, x622 * x645));
+        let x653 = Self::mul_add(x628, x651, Self::mul_add(x625, x652, x622 * x645));
         let x654 = Self::mul_add(
-            -x619,
+            x619,
             x651,
-            Self::mul_add(-x617, x652, Self::mul_add(-x615, x653, x613 * x643)),
+            Self::mul_add(x617, x652, Self::mul_add(-x615, x653, x613 * x643)),
         );
         let x655 = Self::mul_add(
-            -x609,
+            x609,
             x652,
             Self::mul_add(-x607, x653, Self::mul_add(-x605, x654, x603 * x641)),
         );
-        let x656 = Self::mul_add(-x611, x651, x655);
+        let x656 = Self::mul_add(x611, x651, x655);
         let x657 = Self::mul_add(
-            -x597,
+            x597,
             x653,
             Self::mul_add(-x595, x654, Self::mul_add(-x593, x656, x591 * x639)),
         );
-        let x658 = Self::mul_add(-x601, x651, Self::mul_add(-x599, x652, x657));
+        let x658 = Self::mul_add(x601, x651, Self::mul_add(x599, x652, x657));
         let x659 = Self::mul_add(
-            -x587,
+            x587,
             x654,
-            Self::mul_add(-x586, x656, Self::mul_add(-x585, x658, x583 * x584)),
+            Self::mul_add(x586, x656, Self::mul_add(x585, x658, x583 * x584)),
         );
         let x660 = Self::mul_add(
             -x590,
             x651,
-            Self::mul_add(-x589, x652, Self::mul_add(-x588, x653, x659)),
+            Self::mul_add(-x589, x652, Self::mul_add(x588, x653, x659)),
         );
         [x660, x658, x656, x654, x653, x652, x651]
     }
@@ -3880,20 +3856,20 @@ impl SsrmsRecurrent {
         let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
         let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
+        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
         let x75 = 1966.28 * x67;
         let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
+        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
         let x78 = 1966.28 * x69;
         let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
         let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
         let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(-s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(x7, x77, x68 * x76));
+        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
+        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
+        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
+        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
+        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
+        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
         let x88 = 7.11 * x64;
         let x89 = 7.11 * x66;
         let x90 = 7.11 * x68;
@@ -3911,21 +3887,21 @@ impl SsrmsRecurrent {
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
         let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(x95, x99, Self::mul_add(x94, x98, -x18));
-        let x106 = Self::mul_add(x97, x99, Self::mul_add(x96, x98, -x20));
-        let x107 = Self::mul_add(x93, x101, Self::mul_add(x92, x100, -x22));
+        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
+        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
+        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
         let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
         let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(x93, x103, Self::mul_add(x92, x102, -x27));
+        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
         let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
         let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
         let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
         let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x94, s_q5, x5 * c_q5);
+        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
         let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x96, s_q5, x7 * c_q5);
+        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
         let x120 = 12.13 * x114;
         let x121 = 12.13 * x115;
         let x122 = 3.061 * x93;
@@ -3936,24 +3912,24 @@ impl SsrmsRecurrent {
         let x127 = 12.13 * x119;
         let x128 = 3.061 * x97;
         let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(-x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(-x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(-x115, x124, x114 * x123));
+        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
+        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
+        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
         let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
         let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
+        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
         let x138 = 0.7026 * x93;
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
+        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(-x117, s_q6, x95 * c_q6);
-        let x146 = Self::mul_add(x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(-x119, s_q6, x97 * c_q6);
+        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
+        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
+        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
+        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
         let x148 = 9.336 * x114;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
@@ -3981,23 +3957,23 @@ impl SsrmsRecurrent {
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x173 - x33;
-        let x176 = x174 - x34;
+        let x175 = x33 - x173;
+        let x176 = x34 - x174;
         let x177 = x32 + x88;
-        let x178 = x89 - x33;
-        let x179 = x90 - x34;
+        let x178 = x33 - x89;
+        let x179 = x34 - x90;
         let x180 = x60 + x177;
-        let x181 = x61 + x178;
-        let x182 = x62 + x179;
-        let x183 = x181 - x33;
-        let x184 = x182 - x34;
+        let x181 = x61 - x178;
+        let x182 = x62 - x179;
+        let x183 = x33 - x181;
+        let x184 = x34 - x182;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x186 - x33;
-        let x189 = x187 - x34;
-        let x190 = x61 - x33;
-        let x191 = x62 - x34;
+        let x188 = x33 - x186;
+        let x189 = x34 - x187;
+        let x190 = x33 - x61;
+        let x191 = x34 - x62;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -4013,8 +3989,8 @@ impl SsrmsRecurrent {
         let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x175 - x1);
-        let x208 = 243.66 * (x2 + x176);
+        let x207 = 243.66 * (x1 + x175);
+        let x208 = 243.66 * (x2 - x176);
         let x209 = x129 + x157;
         let x210 = x130 + x158;
         let x211 = x131 + x159;
@@ -4025,21 +4001,21 @@ impl SsrmsRecurrent {
         let x216 = x136 + x164;
         let x217 = x137 + x165;
         let x218 = x104 + x209;
-        let x219 = x105 + x210;
-        let x220 = x106 + x211;
-        let x221 = x107 + x212;
+        let x219 = x105 - x210;
+        let x220 = x106 - x211;
+        let x221 = x107 - x212;
         let x222 = x108 + x213;
         let x223 = x109 + x214;
-        let x224 = x110 + x215;
+        let x224 = x110 - x215;
         let x225 = x111 + x216;
         let x226 = x112 + x217;
         let x227 = x79 + x218;
-        let x228 = x80 + x219;
-        let x229 = x81 + x220;
-        let x230 = x82 + x221;
+        let x228 = x80 - x219;
+        let x229 = x81 - x220;
+        let x230 = x82 - x221;
         let x231 = x83 + x222;
         let x232 = x84 + x223;
-        let x233 = x85 + x224;
+        let x233 = x85 - x224;
         let x234 = x86 + x225;
         let x235 = x87 + x226;
         let x236 = x51 + x227;
@@ -4055,8 +4031,8 @@ impl SsrmsRecurrent {
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(105.98, x178, x199);
-        let x250 = Self::mul_add(105.98, x179, x200);
+        let x249 = Self::mul_add(-105.98, x178, x199);
+        let x250 = Self::mul_add(-105.98, x179, x200);
         let x251 = Self::mul_add(105.98, x88, x248);
         let x252 = Self::mul_add(105.98, x89, x249);
         let x253 = Self::mul_add(105.98, x90, x250);
@@ -4078,26 +4054,26 @@ impl SsrmsRecurrent {
         let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(-314.88, x33, x270);
-        let x273 = Self::mul_add(-314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x183 - x1, x207);
-        let x275 = Self::mul_add(105.98, x2 + x184, x208);
-        let x276 = Self::mul_add(105.98, x188 - x1, x274);
-        let x277 = Self::mul_add(105.98, x2 + x189, x275);
-        let x278 = Self::mul_add(279.2, x190 - x1, x276);
-        let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x272 = Self::mul_add(314.88, x33, x270);
+        let x273 = Self::mul_add(314.88, x34, x271);
+        let x274 = Self::mul_add(105.98, x1 + x183, x207);
+        let x275 = Self::mul_add(105.98, x2 - x184, x208);
+        let x276 = Self::mul_add(105.98, x1 + x188, x274);
+        let x277 = Self::mul_add(105.98, x2 - x189, x275);
+        let x278 = Self::mul_add(279.2, x1 + x190, x276);
+        let x279 = Self::mul_add(279.2, x2 - x191, x277);
+        let x280 = Self::mul_add(314.88, x1 + x33, x278);
         let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(x139, x207, x140 * x208);
+        let x282 = Self::mul_add(-x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
         let x285 = x139 * x204;
         let x286 = x138 * x204;
         let x287 = x140 * x204;
-        let x288 = Self::mul_add(x140, x206, x286);
+        let x288 = Self::mul_add(-x140, x206, x286);
         let x289 = x139 * x206;
         let x290 = x140 * x205;
-        let x291 = Self::mul_add(x139, x205, x286);
+        let x291 = Self::mul_add(-x139, x205, x286);
         let x292 = x140 * x203;
         let x293 = x139 * x202;
         let x294 = x292 + x293;
@@ -4147,11 +4123,11 @@ impl SsrmsRecurrent {
         let x338 = Self::mul_add(-x32, x249, x307);
         let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x336 - x334 - x311;
+        let x341 = x311 + (x334 - x336);
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x336 - x335 - x315;
+        let x345 = x315 + (x335 - x336);
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -4162,390 +4138,395 @@ impl SsrmsRecurrent {
         let x353 = Self::mul_add(-x32, x255, x295);
         let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x351 - x349 - x299;
+        let x356 = x299 + (x349 - x351);
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x351 - x350 - x303;
+        let x360 = x303 + (x350 - x351);
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x361 + x362 - x352;
+        let x364 = x352 - (x361 + x362);
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
         let x367 = Self::mul_add(-x89, x257, x355);
-        let x368 = x356 + (x361 + x363);
+        let x368 = x356 - (x361 + x363);
         let x369 = Self::mul_add(-x89, x259, x357);
         let x370 = Self::mul_add(-x90, x257, x358);
         let x371 = Self::mul_add(-x90, x258, x359);
-        let x372 = x360 + (x362 + x363);
+        let x372 = x360 - (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = Self::mul_add(-x34, x265, x376) - x288;
+        let x378 = x288 - Self::mul_add(x34, x265, x376);
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = Self::mul_add(-x33, x264, x376) - x291;
+        let x382 = x291 - Self::mul_add(x33, x264, x376);
         let x383 = x88 * x266;
         let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, x383);
+        let x385 = x378 + Self::mul_add(x90, x268, -x383);
         let x386 = Self::mul_add(-x89, x268, x379);
         let x387 = Self::mul_add(-x90, x266, x380);
         let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, x383);
+        let x389 = x382 + Self::mul_add(x89, x267, -x383);
         let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, x390);
+        let x391 = x385 + Self::mul_add(x62, x271, -x390);
         let x392 = Self::mul_add(-x61, x271, x386);
         let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, x390);
+        let x394 = x389 + Self::mul_add(x61, x270, -x390);
         let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
+        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
         let x397 = Self::mul_add(-x32, x274, x283);
         let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
+        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
+        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
         let x403 = Self::mul_add(-x60, x278, x400);
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = 12.19 + (x17 + x236)
-            + (x402 - Self::mul_add(x33, x280, x34 * x281)
-                + Self::mul_add(
-                    -x1,
-                    Self::mul_add(-105.98, x1, x280),
+            - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+                - Self::mul_add(
+                    x1,
+                    Self::mul_add(105.98, x1, x280),
                     x2 * Self::mul_add(105.98, x2, x281),
                 ));
-        let x406 = Self::mul_add(
-            -s_q0,
-            x19 + x237 + Self::mul_add(-x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
+        let x406 = -Self::mul_add(
+            -c_q0,
+            x21 + x238 + Self::mul_add(-x32, x281, x404),
+            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
         );
-        let x407 = Self::mul_add(
-            x7,
+        let x407 = -Self::mul_add(
+            -x7,
             x238 + x404,
-            Self::mul_add(-s_q1, x236 + x402, x5 * (x237 + x403)),
+            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
         );
-        let x408 = Self::mul_add(
-            x7,
+        let x408 = -Self::mul_add(
+            -x7,
             x229 + x401,
-            Self::mul_add(-s_q1, x227 + x399, x5 * (x228 + x400)),
+            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
         );
-        let x409 = Self::mul_add(
+        let x409 = -Self::mul_add(
             x7,
-            x220 + x398,
-            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
+            x220 - x398,
+            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x410 = Self::mul_add(
             x97,
             x211 + x284,
-            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
+            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
         );
         let x411 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x412 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
         let x413 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
         let x414 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
-                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
+                -c_q0,
+                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
+                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    -s_q0,
-                    x29 + x243 + Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
+                    -c_q0,
+                    x26 + x241 - Self::mul_add(x33, x273, x392),
+                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
                 ),
         );
         let x415 = Self::mul_add(
-            x7,
-            x241 + x392,
+            -x7,
+            x241 - x392,
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x269, x384),
-                x5 * (x240 + x391),
+                -x5,
+                x240 - x391,
+                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
             ),
         );
         let x416 = Self::mul_add(
-            x7,
-            x244 + x394,
+            -x7,
+            x244 - x394,
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x269, x387),
-                x5 * (x243 + x393),
+                -x5,
+                x243 - x393,
+                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
             ),
         );
-        let x417 = Self::mul_add(-s_q0, x415, c_q0 * x416);
+        let x417 = Self::mul_add(-c_q0, x416, s_q0 * x415);
         let x418 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                x7,
-                x232 + x386,
-                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
+                -x7,
+                x235 - x389,
+                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    x7,
-                    x235 + x389,
-                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
+                    -x7,
+                    x232 - x386,
+                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x419 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x7,
-                x223 + x379,
-                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
+                x226 - x382,
+                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x7,
-                    x226 + x382,
-                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
+                    x223 - x379,
+                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
-        let x420 = Self::mul_add(
-            -s_q0,
+        let x420 = -x419;
+        let x421 = Self::mul_add(
+            -c_q0,
             Self::mul_add(
                 x97,
-                x214 + x289,
-                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                x217 - x291,
+                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x97,
-                    x217 - x291,
-                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
+                    x214 - x289,
+                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
                 ),
         );
-        let x421 = Self::mul_add(-s_q0, x412, c_q0 * x413);
-        let x422 = Self::mul_add(
-            x7,
+        let x422 = -x421;
+        let x423 = -Self::mul_add(-c_q0, x413, s_q0 * x412);
+        let x424 = Self::mul_add(
+            -x7,
             x238 + Self::mul_add(-x60, x262, x366),
             Self::mul_add(
-                -s_q1,
-                x236 + (x364 + (x373 + x374)),
-                x5 * (x237 + Self::mul_add(-x60, x261, x365)),
+                -x5,
+                x237 + Self::mul_add(-x60, x261, x365),
+                s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
-        let x423 = Self::mul_add(
-            x7,
+        let x425 = Self::mul_add(
+            -x7,
             x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x260, x367),
-                x5 * (x240 + (x368 + (x373 + x375))),
+                -x5,
+                x240 - (x368 - (x373 + x375)),
+                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
             ),
         );
-        let x424 = Self::mul_add(
-            x7,
-            x244 + (x372 + (x374 + x375)),
-            Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x260, x370),
-                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
-            ),
-        );
-        let x425 = Self::mul_add(x7, x424, Self::mul_add(-s_q1, x422, x5 * x423));
         let x426 = Self::mul_add(
-            -s_q1,
+            -x7,
+            x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                x7,
-                x229 + x366,
-                Self::mul_add(-s_q1, x227 + x364, x5 * (x228 + x365)),
+                -x5,
+                x243 + Self::mul_add(-x62, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
             ),
-            x5
-                * Self::mul_add(
-                    x7,
-                    x232 + x369,
-                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
-                ),
         );
-        let x427 = Self::mul_add(
-            x7,
-            Self::mul_add(
-                x7,
-                x235 + x372,
-                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
-            ),
-            x426,
-        );
+        let x427 = Self::mul_add(-x7, x426, Self::mul_add(-x5, x425, s_q1 * x424));
         let x428 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
-                x7,
-                x220 + x354,
-                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
+                -x7,
+                x232 + x369,
+                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x7,
-                    x223 + x357,
-                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
+                    -x7,
+                    x229 + x366,
+                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x429 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
-                x7,
-                x226 + x360,
-                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
+                -x7,
+                x235 - x372,
+                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x428,
         );
         let x430 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
-                x97,
-                x211 + x296,
-                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                x7,
+                x223 + x357,
+                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x97,
-                    x214 + x300,
-                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                    x7,
+                    x220 - x354,
+                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x431 = Self::mul_add(
             x7,
             Self::mul_add(
+                x7,
+                x226 - x360,
+                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
+            ),
+            x430,
+        );
+        let x432 = Self::mul_add(
+            -x5,
+            Self::mul_add(
+                x97,
+                x214 + x300,
+                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+            ),
+            s_q1
+                * Self::mul_add(
+                    x97,
+                    x211 + x296,
+                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                ),
+        );
+        let x433 = Self::mul_add(
+            -x7,
+            Self::mul_add(
                 x97,
                 x217 - x303,
                 Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
             ),
-            x430,
+            x432,
         );
-        let x432 = Self::mul_add(x7, x413, Self::mul_add(-s_q1, x411, x5 * x412));
-        let x433 = Self::mul_add(
-            x7,
+        let x434 = -x433;
+        let x435 = -Self::mul_add(-x7, x413, Self::mul_add(-x5, x412, s_q1 * x411));
+        let x436 = Self::mul_add(
+            -x7,
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
-                -s_q1,
-                x227 + (x346 + x347 - x337),
-                x5 * (x228 + Self::mul_add(-x88, x252, x338)),
+                -x5,
+                x228 + Self::mul_add(-x88, x252, x338),
+                s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
-        let x434 = Self::mul_add(
-            x7,
+        let x437 = Self::mul_add(
+            -x7,
             x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
-                -s_q1,
-                x230 + Self::mul_add(-x89, x251, x340),
-                x5 * (x231 + (x341 + (x346 + x348))),
+                -x5,
+                x231 - (x341 - (x346 + x348)),
+                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
             ),
-        );
-        let x435 = Self::mul_add(
-            x7,
-            x235 + (x345 + (x347 + x348)),
-            Self::mul_add(
-                -s_q1,
-                x233 + Self::mul_add(-x90, x251, x343),
-                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
-            ),
-        );
-        let x436 = Self::mul_add(x7, x435, Self::mul_add(-s_q1, x433, x5 * x434));
-        let x437 = Self::mul_add(
-            -s_q1,
-            Self::mul_add(
-                x7,
-                x220 + x339,
-                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
-            ),
-            x5
-                * Self::mul_add(
-                    x7,
-                    x223 + x342,
-                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
-                ),
         );
         let x438 = Self::mul_add(
+            -x7,
+            x235 - (x345 - (x347 + x348)),
+            Self::mul_add(
+                -x5,
+                x234 + Self::mul_add(-x90, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
+            ),
+        );
+        let x439 = Self::mul_add(-x7, x438, Self::mul_add(-x5, x437, s_q1 * x436));
+        let x440 = Self::mul_add(
+            x5,
+            Self::mul_add(
+                x7,
+                x223 + x342,
+                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
+            ),
+            s_q1
+                * Self::mul_add(
+                    x7,
+                    x220 - x339,
+                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
+                ),
+        );
+        let x441 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x345,
-                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
+                x226 - x345,
+                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
             ),
-            x437,
+            x440,
         );
-        let x439 = Self::mul_add(
-            -s_q1,
+        let x442 = Self::mul_add(
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x308,
-                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                x214 + x312,
+                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x312,
-                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                    x211 + x308,
+                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
                 ),
         );
-        let x440 = Self::mul_add(
-            x7,
+        let x443 = Self::mul_add(
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x315,
                 Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
             ),
-            x439,
+            x442,
         );
-        let x441 = Self::mul_add(
-            x7,
-            x220 + Self::mul_add(x32, x247, -x320),
-            Self::mul_add(
-                -s_q1,
-                x218 + (x318 + (x331 + x332)),
-                x5 * (x219 + Self::mul_add(x32, x246, -x319)),
-            ),
-        );
-        let x442 = Self::mul_add(
-            x7,
-            x223 - Self::mul_add(x33, x247, x324),
-            Self::mul_add(
-                -s_q1,
-                x221 + Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 + x333))),
-            ),
-        );
-        let x443 = Self::mul_add(
-            x7,
-            x226 + (x327 + (x332 + x333)),
-            Self::mul_add(
-                -s_q1,
-                x224 + Self::mul_add(x34, x245, x325),
-                x5 * (x225 - Self::mul_add(x34, x246, x326)),
-            ),
-        );
-        let x444 = Self::mul_add(x7, x443, Self::mul_add(-s_q1, x441, x5 * x442));
+        let x444 = -x443;
         let x445 = Self::mul_add(
-            -s_q1,
+            x7,
+            x220 + Self::mul_add(-x32, x247, x320),
             Self::mul_add(
-                x97,
-                x211 - x320,
-                Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                x5,
+                x219 + Self::mul_add(-x32, x246, x319),
+                s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
-            x5
-                * Self::mul_add(
-                    x97,
-                    x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
-                ),
         );
         let x446 = Self::mul_add(
             x7,
+            x223 - Self::mul_add(x33, x247, x324),
+            Self::mul_add(
+                x5,
+                x222 + (x323 + (x331 + x333)),
+                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
+            ),
+        );
+        let x447 = Self::mul_add(
+            x7,
+            x226 + (x327 + (x332 + x333)),
+            Self::mul_add(
+                x5,
+                x225 - Self::mul_add(x34, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
+            ),
+        );
+        let x448 = Self::mul_add(x7, x447, Self::mul_add(x5, x446, s_q1 * x445));
+        let x449 = Self::mul_add(
+            -x5,
+            Self::mul_add(
+                x97,
+                x214 - x324,
+                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+            ),
+            s_q1
+                * Self::mul_add(
+                    x97,
+                    x211 - x320,
+                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                ),
+        );
+        let x450 = Self::mul_add(
+            -x7,
             Self::mul_add(
                 x97,
                 x217 + x327,
                 Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
             ),
-            x445,
+            x449,
         );
-        let x447 = Self::mul_add(
+        let x451 = -x450;
+        let x452 = Self::mul_add(
             x97,
             Self::mul_add(-x138, x194, x211),
             Self::mul_add(
@@ -4554,7 +4535,7 @@ impl SsrmsRecurrent {
                 x93 * (x209 + (x328 + x329)),
             ),
         );
-        let x448 = Self::mul_add(
+        let x453 = Self::mul_add(
             x97,
             Self::mul_add(-x139, x194, x214),
             Self::mul_add(
@@ -4563,7 +4544,7 @@ impl SsrmsRecurrent {
                 x93 * Self::mul_add(-x139, x192, x212),
             ),
         );
-        let x449 = Self::mul_add(
+        let x454 = Self::mul_add(
             x97,
             x217 + (x329 + x330),
             Self::mul_add(
@@ -4572,299 +4553,290 @@ impl SsrmsRecurrent {
                 x93 * Self::mul_add(-x140, x192, x215),
             ),
         );
-        let x450 = Self::mul_add(x97, x449, Self::mul_add(x95, x448, x93 * x447));
-        let x451 = Self::mul_add(x97, x413, Self::mul_add(x95, x412, x93 * x411));
-        let x452 = Self::mul_add(x118, x413, Self::mul_add(x116, x412, x114 * x411));
-        let x453 = qd[1] * s_q0;
-        let x454 = qd[1] * c_q0;
-        let x455 = qd[0] * qd[0];
-        let x456 = x1 * x455;
-        let x457 = x2 * x455;
-        let x458 = qd[0] * x454;
-        let x459 = qd[0] * x453;
-        let x460 = qd[2] * s_q1;
-        let x461 = qd[2] * x5;
-        let x462 = qd[2] * x7;
-        let x463 = x454 * x454;
-        let x464 = x453 * x453;
-        let x465 = x453 * x454;
-        let x466 = x32 * (x463 + x464);
-        let x467 = x456
-            + Self::mul_add(
-                x34,
-                x465,
-                Self::mul_add(-x32, x459 + x459, x33 * (x455 + x463)),
+        let x455 = Self::mul_add(x97, x454, Self::mul_add(x95, x453, x93 * x452));
+        let x456 = Self::mul_add(x97, x413, Self::mul_add(x95, x412, x93 * x411));
+        let x457 = Self::mul_add(x118, x413, Self::mul_add(x116, x412, x114 * x411));
+        let x458 = qd[1] * s_q0;
+        let x459 = qd[1] * c_q0;
+        let x460 = qd[0] * qd[0];
+        let x461 = x1 * x460;
+        let x462 = x2 * x460;
+        let x463 = qd[0] * x459;
+        let x464 = qd[0] * x458;
+        let x465 = qd[2] * s_q1;
+        let x466 = qd[2] * x5;
+        let x467 = qd[2] * x7;
+        let x468 = x459 * x459;
+        let x469 = x458 * x458;
+        let x470 = x458 * x459;
+        let x471 = x32 * (x468 + x469);
+        let x472 = x461
+            - Self::mul_add(
+                -x34,
+                x470,
+                Self::mul_add(-x33, x460 + x468, x32 * (x464 + x464)),
             );
-        let x468 = Self::mul_add(
-            x34,
-            x455 + x464,
-            Self::mul_add(x33, x465, x32 * (x458 + x458)),
-        ) - x457;
-        let x469 = qd[0] - x460;
-        let x470 = x461 - x453;
-        let x471 = x454 + x462;
-        let x472 = Self::mul_add(x453, x462, x454 * x461);
-        let x473 = x458 + Self::mul_add(qd[0], x462, x454 * x460);
-        let x474 = Self::mul_add(-x453, x460, qd[0] * x461) - x459;
-        let x475 = qd[3] * s_q1;
-        let x476 = qd[3] * x5;
-        let x477 = qd[3] * x7;
-        let x478 = x471 * x471;
-        let x479 = x470 * x470;
-        let x480 = x469 * x470;
-        let x481 = x469 * x471;
-        let x482 = x469 * x469;
-        let x483 = x470 * x471;
-        let x484 = Self::mul_add(
-            x62,
-            x481 - x473,
-            Self::mul_add(-x60, x478 + x479, x61 * (x480 - x474)),
-        ) - x466;
-        let x485 = x467
-            + Self::mul_add(
-                x62,
-                x472 + x483,
-                Self::mul_add(-x61, x478 + x482, x60 * (x474 + x480)),
-            );
-        let x486 = x468
-            + Self::mul_add(
-                -x62,
-                x479 + x482,
-                Self::mul_add(x61, x483 - x472, x60 * (x473 + x481)),
-            );
-        let x487 = x469 - x475;
-        let x488 = x470 + x476;
-        let x489 = x471 + x477;
-        let x490 = Self::mul_add(-x471, x476, x470 * x477) - x472;
-        let x491 = x473 + Self::mul_add(x469, x477, x471 * x475);
-        let x492 = x474 + Self::mul_add(x469, x476, x470 * x475);
-        let x493 = qd[4] * s_q1;
-        let x494 = qd[4] * x5;
-        let x495 = qd[4] * x7;
-        let x496 = x489 * x489;
-        let x497 = x488 * x488;
-        let x498 = x487 * x488;
-        let x499 = x487 * x489;
-        let x500 = x487 * x487;
-        let x501 = x488 * x489;
-        let x502 = x484
-            + Self::mul_add(
-                x90,
-                x499 - x491,
-                Self::mul_add(-x88, x496 + x497, x89 * (x498 - x492)),
-            );
-        let x503 = x485
-            + Self::mul_add(
-                x90,
-                x501 - x490,
-                Self::mul_add(-x89, x496 + x500, x88 * (x492 + x498)),
-            );
-        let x504 = x486
-            + Self::mul_add(
-                -x90,
-                x497 + x500,
-                Self::mul_add(x89, x490 + x501, x88 * (x491 + x499)),
-            );
-        let x505 = x487 - x493;
-        let x506 = x488 + x494;
-        let x507 = x489 + x495;
-        let x508 = x490 + Self::mul_add(-x489, x494, x488 * x495);
-        let x509 = x491 + Self::mul_add(x487, x495, x489 * x493);
-        let x510 = x492 + Self::mul_add(x487, x494, x488 * x493);
-        let x511 = qd[5] * x93;
-        let x512 = qd[5] * x95;
-        let x513 = qd[5] * x97;
-        let x514 = x507 * x507;
-        let x515 = x506 * x506;
-        let x516 = x505 * x506;
-        let x517 = x505 * x507;
-        let x518 = x505 * x505;
-        let x519 = x506 * x507;
-        let x520 = x502
+        let x473 = x462
             - Self::mul_add(
                 x34,
-                x517 - x509,
-                Self::mul_add(x33, x516 - x510, x32 * (x514 + x515)),
+                x460 + x469,
+                Self::mul_add(x33, x470, x32 * (x463 + x463)),
             );
-        let x521 = x503
+        let x474 = qd[0] - x465;
+        let x475 = x458 - x466;
+        let x476 = x459 + x467;
+        let x477 = Self::mul_add(x458, x467, x459 * x466);
+        let x478 = x463 + Self::mul_add(qd[0], x467, x459 * x465);
+        let x479 = x464 + Self::mul_add(-qd[0], x466, x458 * x465);
+        let x480 = qd[3] * s_q1;
+        let x481 = qd[3] * x5;
+        let x482 = qd[3] * x7;
+        let x483 = x476 * x476;
+        let x484 = x475 * x475;
+        let x485 = x474 * x475;
+        let x486 = x474 * x476;
+        let x487 = x474 * x474;
+        let x488 = x475 * x476;
+        let x489 = x471
+            + Self::mul_add(
+                x62,
+                x478 - x486,
+                Self::mul_add(-x61, x479 - x485, x60 * (x483 + x484)),
+            );
+        let x490 = x472
+            - Self::mul_add(
+                -x62,
+                x477 - x488,
+                Self::mul_add(x61, x483 + x487, x60 * (x479 + x485)),
+            );
+        let x491 = x473
+            - Self::mul_add(
+                -x62,
+                x484 + x487,
+                Self::mul_add(-x61, x477 + x488, x60 * (x478 + x486)),
+            );
+        let x492 = x474 - x480;
+        let x493 = x475 - x481;
+        let x494 = x476 + x482;
+        let x495 = x477 + Self::mul_add(x475, x482, x476 * x481);
+        let x496 = x478 + Self::mul_add(x474, x482, x476 * x480);
+        let x497 = x479 + Self::mul_add(-x474, x481, x475 * x480);
+        let x498 = qd[4] * s_q1;
+        let x499 = qd[4] * x5;
+        let x500 = qd[4] * x7;
+        let x501 = x494 * x494;
+        let x502 = x493 * x493;
+        let x503 = x492 * x493;
+        let x504 = x492 * x494;
+        let x505 = x492 * x492;
+        let x506 = x493 * x494;
+        let x507 = x489
+            + Self::mul_add(
+                x90,
+                x496 - x504,
+                Self::mul_add(-x89, x497 - x503, x88 * (x501 + x502)),
+            );
+        let x508 = x490
+            - Self::mul_add(
+                -x90,
+                x495 - x506,
+                Self::mul_add(x89, x501 + x505, x88 * (x497 + x503)),
+            );
+        let x509 = x491
+            - Self::mul_add(
+                -x90,
+                x502 + x505,
+                Self::mul_add(-x89, x495 + x506, x88 * (x496 + x504)),
+            );
+        let x510 = x492 - x498;
+        let x511 = x493 - x499;
+        let x512 = x494 + x500;
+        let x513 = x495 + Self::mul_add(x493, x500, x494 * x499);
+        let x514 = x496 + Self::mul_add(x492, x500, x494 * x498);
+        let x515 = x497 + Self::mul_add(-x492, x499, x493 * x498);
+        let x516 = qd[5] * x93;
+        let x517 = qd[5] * x95;
+        let x518 = qd[5] * x97;
+        let x519 = x512 * x512;
+        let x520 = x511 * x511;
+        let x521 = x510 * x511;
+        let x522 = x510 * x512;
+        let x523 = x510 * x510;
+        let x524 = x511 * x512;
+        let x525 = x507
             + Self::mul_add(
                 -x34,
-                x519 - x508,
-                Self::mul_add(x33, x514 + x518, x32 * (x510 + x516)),
+                x514 - x522,
+                Self::mul_add(x33, x515 - x521, x32 * (x519 + x520)),
             );
-        let x522 = x504
-            + Self::mul_add(
+        let x526 = x508
+            - Self::mul_add(
                 x34,
-                x515 + x518,
-                Self::mul_add(-x33, x508 + x519, x32 * (x509 + x517)),
+                x513 - x524,
+                Self::mul_add(-x33, x519 + x523, x32 * (x515 + x521)),
             );
-        let x523 = x505 + x511;
-        let x524 = x506 + x512;
-        let x525 = x507 + x513;
-        let x526 = x508 + Self::mul_add(-x507, x512, x506 * x513);
-        let x527 = Self::mul_add(-x505, x513, x507 * x511) - x509;
-        let x528 = x510 + Self::mul_add(-x506, x511, x505 * x512);
-        let x529 = qd[6] * x114;
-        let x530 = qd[6] * x116;
-        let x531 = qd[6] * x118;
-        let x532 = x525 * x525;
-        let x533 = x524 * x524;
-        let x534 = x523 * x524;
-        let x535 = x523 * x525;
-        let x536 = x523 * x523;
-        let x537 = x524 * x525;
-        let x538 = x523 + x529;
-        let x539 = x524 + x530;
-        let x540 = x525 + x531;
-        let x541 = x526 + Self::mul_add(-x525, x530, x524 * x531);
-        let x542 = x527 + Self::mul_add(-x523, x531, x525 * x529);
-        let x543 = x528 + Self::mul_add(-x524, x529, x523 * x530);
-        let x544 = Self::mul_add(x21, x454, Self::mul_add(-x19, x453, qd[0] * x17));
-        let x545 = Self::mul_add(
+        let x527 = x509
+            - Self::mul_add(
+                x34,
+                x520 + x523,
+                Self::mul_add(x33, x513 + x524, x32 * (x514 + x522)),
+            );
+        let x528 = x510 + x516;
+        let x529 = x511 - x517;
+        let x530 = x512 + x518;
+        let x531 = x513 + Self::mul_add(x511, x518, x512 * x517);
+        let x532 = x514 - Self::mul_add(-x510, x518, x512 * x516);
+        let x533 = x515 - Self::mul_add(x510, x517, x511 * x516);
+        let x534 = qd[6] * x114;
+        let x535 = qd[6] * x116;
+        let x536 = qd[6] * x118;
+        let x537 = x530 * x530;
+        let x538 = x529 * x529;
+        let x539 = x528 * x529;
+        let x540 = x528 * x530;
+        let x541 = x528 * x528;
+        let x542 = x529 * x530;
+        let x543 = x528 + x534;
+        let x544 = x529 - x535;
+        let x545 = x530 + x536;
+        let x546 = x531 + Self::mul_add(x529, x536, x530 * x535);
+        let x547 = x532 - Self::mul_add(-x528, x536, x530 * x534);
+        let x548 = x533 - Self::mul_add(x528, x535, x529 * x534);
+        let x549 = Self::mul_add(x21, x459, Self::mul_add(-x19, x458, qd[0] * x17));
+        let x550 = Self::mul_add(
             x26,
-            x454,
-            Self::mul_add(-x24, x453, qd[0] * Self::mul_add(c_q1, x10, -x22)),
+            x459,
+            Self::mul_add(-x24, x458, qd[0] * Self::mul_add(c_q1, x10, -x22)),
         );
-        let x546 = Self::mul_add(
+        let x551 = Self::mul_add(
             x31,
-            x454,
-            Self::mul_add(-x29, x453, qd[0] * Self::mul_add(c_q1, x13, -x27)),
+            x459,
+            Self::mul_add(-x29, x458, qd[0] * Self::mul_add(c_q1, x13, -x27)),
         );
-        let x547 = Self::mul_add(x53, x471, Self::mul_add(x52, x470, x51 * x469));
-        let x548 = Self::mul_add(x56, x471, Self::mul_add(x55, x470, x54 * x469));
-        let x549 = Self::mul_add(x59, x471, Self::mul_add(x58, x470, x57 * x469));
-        let x550 = Self::mul_add(x81, x489, Self::mul_add(x80, x488, x79 * x487));
-        let x551 = Self::mul_add(x84, x489, Self::mul_add(x83, x488, x82 * x487));
-        let x552 = Self::mul_add(x87, x489, Self::mul_add(x86, x488, x85 * x487));
-        let x553 = Self::mul_add(x106, x507, Self::mul_add(x105, x506, x104 * x505));
-        let x554 = Self::mul_add(x109, x507, Self::mul_add(x108, x506, x107 * x505));
-        let x555 = Self::mul_add(x112, x507, Self::mul_add(x111, x506, x110 * x505));
-        let x556 = Self::mul_add(x131, x525, Self::mul_add(x130, x524, x129 * x523));
-        let x557 = Self::mul_add(x134, x525, Self::mul_add(x133, x524, x132 * x523));
-        let x558 = Self::mul_add(x137, x525, Self::mul_add(x136, x524, x135 * x523));
-        let x559 = 243.66
-            * (x520
-                + Self::mul_add(
-                    -x140,
-                    x527 + x535,
-                    Self::mul_add(-x139, x534 - x528, x138 * (x532 + x533)),
-                ));
-        let x560 = 243.66
-            * (x521
-                + Self::mul_add(
-                    -x140,
-                    x537 - x526,
-                    Self::mul_add(-x138, x528 + x534, x139 * (x532 + x536)),
-                ));
-        let x561 = 243.66
-            * (x522
-                + Self::mul_add(
+        let x552 = Self::mul_add(x53, x476, Self::mul_add(-x52, x475, x51 * x474));
+        let x553 = Self::mul_add(x56, x476, Self::mul_add(-x55, x475, x54 * x474));
+        let x554 = Self::mul_add(x59, x476, Self::mul_add(-x58, x475, x57 * x474));
+        let x555 = Self::mul_add(x81, x494, Self::mul_add(-x80, x493, x79 * x492));
+        let x556 = Self::mul_add(x84, x494, Self::mul_add(-x83, x493, x82 * x492));
+        let x557 = Self::mul_add(x87, x494, Self::mul_add(-x86, x493, x85 * x492));
+        let x558 = Self::mul_add(-x106, x512, Self::mul_add(x105, x511, x104 * x510));
+        let x559 = Self::mul_add(-x109, x512, Self::mul_add(x108, x511, x107 * x510));
+        let x560 = Self::mul_add(-x112, x512, Self::mul_add(x111, x511, x110 * x510));
+        let x561 = Self::mul_add(x131, x530, Self::mul_add(-x130, x529, x129 * x528));
+        let x562 = Self::mul_add(x134, x530, Self::mul_add(-x133, x529, x132 * x528));
+        let x563 = Self::mul_add(x137, x530, Self::mul_add(-x136, x529, x135 * x528));
+        let x564 = 243.66
+            * (x525
+                - Self::mul_add(
                     x140,
-                    x533 + x536,
-                    -Self::mul_add(x139, x526 + x537, x138 * (x535 - x527)),
+                    x532 - x540,
+                    Self::mul_add(-x139, x533 - x539, x138 * (x537 + x538)),
                 ));
-        let x562 = Self::mul_add(x159, x540, Self::mul_add(x158, x539, x157 * x538));
-        let x563 = Self::mul_add(x162, x540, Self::mul_add(x161, x539, x160 * x538));
-        let x564 = Self::mul_add(x165, x540, Self::mul_add(x164, x539, x163 * x538));
-        let x565 = Self::mul_add(x159, x543, Self::mul_add(x158, x542, x157 * x541))
-            + Self::mul_add(-x540, x563, x539 * x564);
-        let x566 = Self::mul_add(x162, x543, Self::mul_add(x161, x542, x160 * x541))
-            + Self::mul_add(-x538, x564, x540 * x562);
-        let x567 = Self::mul_add(x165, x543, Self::mul_add(x164, x542, x163 * x541))
-            + Self::mul_add(-x539, x562, x538 * x563);
-        let x568 = Self::mul_add(105.98, x520, x559);
-        let x569 = Self::mul_add(105.98, x521, x560);
-        let x570 = Self::mul_add(105.98, x522, x561);
-        let x571 = Self::mul_add(105.98, x502, x568);
-        let x572 = Self::mul_add(105.98, x503, x569);
-        let x573 = Self::mul_add(105.98, x504, x570);
-        let x574 = Self::mul_add(279.2, x484, x571);
-        let x575 = Self::mul_add(279.2, x485, x572);
-        let x576 = Self::mul_add(279.2, x486, x573);
-        let x577 = Self::mul_add(314.88, x466, -x574);
-        let x578 = Self::mul_add(314.88, x467, x575);
-        let x579 = Self::mul_add(314.88, x468, x576);
-        let x580 = Self::mul_add(-x140, x560, x139 * x561)
-            - (Self::mul_add(x131, x528, Self::mul_add(x130, x527, x129 * x526))
-                + Self::mul_add(-x525, x557, x524 * x558) + x565);
-        let x581 = Self::mul_add(-x138, x561, x140 * x559)
-            - (Self::mul_add(x134, x528, Self::mul_add(x133, x527, x132 * x526))
-                + Self::mul_add(-x523, x558, x525 * x556) + x566);
-        let x582 = Self::mul_add(-x139, x559, x138 * x560)
-            - (Self::mul_add(x137, x528, Self::mul_add(x136, x527, x135 * x526))
-                + Self::mul_add(-x524, x556, x523 * x557) + x567);
-        let x583 = x580
-            - (Self::mul_add(x106, x510, Self::mul_add(-x105, x509, x104 * x508))
-                + Self::mul_add(-x507, x554, x506 * x555))
-            + Self::mul_add(-x34, x569, x33 * x570);
-        let x584 = x581
-            - (Self::mul_add(x109, x510, Self::mul_add(-x108, x509, x107 * x508))
-                + Self::mul_add(-x505, x555, x507 * x553))
-            + Self::mul_add(x32, x570, x34 * x568);
-        let x585 = x582
-            - (Self::mul_add(x112, x510, Self::mul_add(-x111, x509, x110 * x508))
-                + Self::mul_add(-x506, x553, x505 * x554))
-            - Self::mul_add(x32, x569, x33 * x568);
-        let x586 = x583
-            - (Self::mul_add(x81, x492, Self::mul_add(-x80, x491, x79 * x490))
-                + Self::mul_add(-x489, x551, x488 * x552))
-            + Self::mul_add(-x89, x573, x90 * x572);
-        let x587 = x584
-            - (Self::mul_add(x84, x492, Self::mul_add(-x83, x491, x82 * x490))
-                + Self::mul_add(-x487, x552, x489 * x550))
-            + Self::mul_add(-x90, x571, x88 * x573);
-        let x588 = x585
-            - (Self::mul_add(x87, x492, Self::mul_add(-x86, x491, x85 * x490))
-                + Self::mul_add(-x488, x550, x487 * x551))
-            + Self::mul_add(-x88, x572, x89 * x571);
-        let x589 = x586
-            - (Self::mul_add(x53, x474, -Self::mul_add(x52, x473, x51 * x472))
-                + Self::mul_add(-x471, x548, x470 * x549))
-            + Self::mul_add(-x61, x576, x62 * x575);
-        let x590 = x587
-            - (Self::mul_add(x56, x474, -Self::mul_add(x55, x473, x54 * x472))
-                + Self::mul_add(-x469, x549, x471 * x547))
-            + Self::mul_add(-x62, x574, x60 * x576);
-        let x591 = x588
-            - (Self::mul_add(x59, x474, -Self::mul_add(x58, x473, x57 * x472))
-                + Self::mul_add(-x470, x547, x469 * x548))
-            + Self::mul_add(-x60, x575, x61 * x574);
-        let x592 = Self::mul_add(x118, x567, Self::mul_add(x116, x566, x114 * x565));
-        let x593 = -(Self::mul_add(x21, x459, x19 * x458)
-            + Self::mul_add(x453, x546, x454 * x545) + x589
-            + Self::mul_add(-x34, x578, x33 * x579)
+        let x565 = 243.66
+            * (x526
+                + Self::mul_add(
+                    -x140,
+                    x531 - x542,
+                    Self::mul_add(x139, x537 + x541, x138 * (x533 + x539)),
+                ));
+        let x566 = 243.66
+            * (x527
+                + Self::mul_add(
+                    -x140,
+                    x538 + x541,
+                    Self::mul_add(-x139, x531 + x542, x138 * (x532 + x540)),
+                ));
+        let x567 = Self::mul_add(x159, x545, Self::mul_add(-x158, x544, x157 * x543));
+        let x568 = Self::mul_add(x162, x545, Self::mul_add(-x161, x544, x160 * x543));
+        let x569 = Self::mul_add(x165, x545, Self::mul_add(-x164, x544, x163 * x543));
+        let x570 = Self::mul_add(x159, x548, Self::mul_add(x158, x547, x157 * x546))
+            + Self::mul_add(x544, x569, x545 * x568);
+        let x571 = Self::mul_add(x162, x548, Self::mul_add(x161, x547, x160 * x546))
+            - Self::mul_add(-x543, x569, x545 * x567);
+        let x572 = Self::mul_add(x165, x548, Self::mul_add(x164, x547, x163 * x546))
+            - Self::mul_add(x543, x568, x544 * x567);
+        let x573 = Self::mul_add(105.98, x525, x564);
+        let x574 = Self::mul_add(105.98, x526, x565);
+        let x575 = Self::mul_add(105.98, x527, x566);
+        let x576 = Self::mul_add(105.98, x507, x573);
+        let x577 = Self::mul_add(105.98, x508, x574);
+        let x578 = Self::mul_add(105.98, x509, x575);
+        let x579 = Self::mul_add(279.2, x489, x576);
+        let x580 = Self::mul_add(279.2, x490, x577);
+        let x581 = Self::mul_add(279.2, x491, x578);
+        let x582 = Self::mul_add(314.88, x471, x579);
+        let x583 = Self::mul_add(314.88, x472, x580);
+        let x584 = Self::mul_add(314.88, x473, x581);
+        let x585 = Self::mul_add(x131, x533, Self::mul_add(x130, x532, x129 * x531))
+            + Self::mul_add(x529, x563, x530 * x562) + x570
+            - Self::mul_add(x139, x566, x140 * x565);
+        let x586 = Self::mul_add(x134, x533, Self::mul_add(x133, x532, x132 * x531))
+            - Self::mul_add(-x528, x563, x530 * x561) + x571
+            - Self::mul_add(-x138, x566, x140 * x564);
+        let x587 = Self::mul_add(x137, x533, Self::mul_add(x136, x532, x135 * x531))
+            - Self::mul_add(x528, x562, x529 * x561) + x572
+            + Self::mul_add(x138, x565, x139 * x564);
+        let x588 = Self::mul_add(-x106, x515, Self::mul_add(-x105, x514, x104 * x513))
+            - Self::mul_add(x511, x560, x512 * x559) + x585
+            - Self::mul_add(x33, x575, x34 * x574);
+        let x589 = Self::mul_add(-x109, x515, Self::mul_add(-x108, x514, x107 * x513))
+            + Self::mul_add(x510, x560, x512 * x558) - x586
+            + Self::mul_add(x32, x575, x34 * x573);
+        let x590 = Self::mul_add(-x112, x515, Self::mul_add(-x111, x514, x110 * x513))
+            + Self::mul_add(-x510, x559, x511 * x558) - x587
+            - Self::mul_add(-x32, x574, x33 * x573);
+        let x591 = Self::mul_add(x81, x497, Self::mul_add(x80, x496, x79 * x495))
+            + Self::mul_add(x493, x557, x494 * x556) + x588
+            + Self::mul_add(x89, x578, x90 * x577);
+        let x592 = Self::mul_add(x84, x497, Self::mul_add(x83, x496, x82 * x495))
+            - Self::mul_add(-x492, x557, x494 * x555) - x589
+            + Self::mul_add(-x88, x578, x90 * x576);
+        let x593 = Self::mul_add(x87, x497, Self::mul_add(x86, x496, x85 * x495))
+            - Self::mul_add(x492, x556, x493 * x555) - x590
+            - Self::mul_add(x88, x577, x89 * x576);
+        let x594 = Self::mul_add(x53, x479, Self::mul_add(x52, x478, x51 * x477))
+            + Self::mul_add(x475, x554, x476 * x553) + x591
+            + Self::mul_add(x61, x581, x62 * x580);
+        let x595 = Self::mul_add(x56, x479, Self::mul_add(x55, x478, x54 * x477))
+            - Self::mul_add(-x474, x554, x476 * x552) + x592
+            + Self::mul_add(-x60, x581, x62 * x579);
+        let x596 = Self::mul_add(x59, x479, Self::mul_add(x58, x478, x57 * x477))
+            - Self::mul_add(x474, x553, x475 * x552) + x593
+            - Self::mul_add(x60, x580, x61 * x579);
+        let x597 = Self::mul_add(
+            -c_q0,
+            Self::mul_add(x31, x464, x29 * x463)
+                - Self::mul_add(qd[0], x550, x458 * x549) + x596
+                + Self::mul_add(-x32, x583, x33 * x582),
+            s_q0
+                * (Self::mul_add(x26, x464, x24 * x463)
+                    - Self::mul_add(-qd[0], x551, x459 * x549) + x595
+                    - Self::mul_add(x32, x584, x34 * x582)),
+        );
+        let x598 = Self::mul_add(-x7, x596, Self::mul_add(-x5, x595, s_q1 * x594));
+        let x599 = Self::mul_add(-x7, x593, Self::mul_add(-x5, x592, s_q1 * x591));
+        let x600 = Self::mul_add(x7, x590, Self::mul_add(x5, x589, s_q1 * x588));
+        let x601 = -(Self::mul_add(x21, x464, x19 * x463)
+            + Self::mul_add(x458, x551, x459 * x550) + x594
+            - Self::mul_add(x33, x584, x34 * x583)
             + Self::mul_add(
                 -x1,
-                Self::mul_add(105.98, x457, -x579),
-                x2 * Self::mul_add(105.98, x456, x578),
+                Self::mul_add(105.98, x462, x584),
+                x2 * Self::mul_add(105.98, x461, x583),
             ));
-        let x594 = -Self::mul_add(
-            -s_q0,
-            x590
-                - (Self::mul_add(-qd[0], x546, x454 * x544)
-                    - Self::mul_add(x26, x459, x24 * x458))
-                + Self::mul_add(-x34, x577, x32 * x579),
-            c_q0
-                * (x591
-                    - (Self::mul_add(qd[0], x545, x453 * x544)
-                        - Self::mul_add(x31, x459, x29 * x458))
-                    + Self::mul_add(-x32, x578, x33 * x577)),
-        );
-        let x595 = -Self::mul_add(x7, x591, Self::mul_add(-s_q1, x589, x5 * x590));
-        let x596 = -Self::mul_add(x7, x588, Self::mul_add(-s_q1, x586, x5 * x587));
-        let x597 = -Self::mul_add(x7, x585, Self::mul_add(-s_q1, x583, x5 * x584));
-        let x598 = -Self::mul_add(x97, x582, Self::mul_add(x95, x581, x93 * x580));
+        let x602 = -Self::mul_add(x97, x587, Self::mul_add(x95, x586, x93 * x585));
+        let x603 = -Self::mul_add(x118, x572, Self::mul_add(x116, x571, x114 * x570));
         (
             [
                 [x405, x406, x407, x408, x409, x410, x411],
-                [x406, x414, x417, x418, x419, x420, x421],
-                [x407, x417, x425, x427, x429, x431, x432],
-                [x408, x418, x427, x436, x438, x440, x432],
-                [x409, x419, x429, x438, x444, x446, x432],
-                [x410, x420, x431, x440, x446, x450, x451],
-                [x411, x421, x432, x432, x432, x451, x452],
+                [x406, x414, x417, x418, x420, x422, x423],
+                [x407, x417, x427, x429, x431, x434, x435],
+                [x408, x418, x429, x439, x441, x444, x435],
+                [x409, x420, x431, x441, x448, x451, x435],
+                [x410, x422, x434, x444, x451, x455, x456],
+                [x411, x423, x435, x435, x435, x456, x457],
             ],
-            [x593, x594, x595, x596, x597, x598, x592],
+            [x601, x597, x598, x599, x600, x602, x603],
         )
     }
     /// Forward dynamics `q̈` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin.
@@ -4951,20 +4923,20 @@ impl SsrmsRecurrent {
         let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
         let x72 = 1966.28 * x65;
         let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(x66, -39.95, 1966.28 * x5);
+        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
         let x75 = 1966.28 * x67;
         let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(x68, -39.95, 1966.28 * x7);
+        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
         let x78 = 1966.28 * x69;
         let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
         let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
         let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(-s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(-s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(x7, x77, x68 * x76));
+        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
+        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
+        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
+        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
+        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
+        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
         let x88 = 7.11 * x64;
         let x89 = 7.11 * x66;
         let x90 = 7.11 * x68;
@@ -4982,21 +4954,21 @@ impl SsrmsRecurrent {
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
         let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(x95, x99, Self::mul_add(x94, x98, -x18));
-        let x106 = Self::mul_add(x97, x99, Self::mul_add(x96, x98, -x20));
-        let x107 = Self::mul_add(x93, x101, Self::mul_add(x92, x100, -x22));
+        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
+        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
+        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
         let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
         let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(x93, x103, Self::mul_add(x92, x102, -x27));
+        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
         let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
         let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
         let (s_q5, c_q5) = libm::sincos(q[5]);
         let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
         let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
         let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x94, s_q5, x5 * c_q5);
+        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
         let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x96, s_q5, x7 * c_q5);
+        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
         let x120 = 12.13 * x114;
         let x121 = 12.13 * x115;
         let x122 = 3.061 * x93;
@@ -5007,24 +4979,24 @@ impl SsrmsRecurrent {
         let x127 = 12.13 * x119;
         let x128 = 3.061 * x97;
         let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(-x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(-x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(-x115, x124, x114 * x123));
+        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
+        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
+        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
         let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
         let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(-x115, x127, x114 * x126));
+        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
         let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
         let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
         let x138 = 0.7026 * x93;
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
         let (s_q6, c_q6) = libm::sincos(q[6]);
-        let x142 = Self::mul_add(-x115, c_q6, x93 * s_q6);
+        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
         let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(-x117, s_q6, x95 * c_q6);
-        let x146 = Self::mul_add(x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(-x119, s_q6, x97 * c_q6);
+        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
+        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
+        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
+        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
         let x148 = 9.336 * x114;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
@@ -5052,23 +5024,23 @@ impl SsrmsRecurrent {
         let x172 = x60 + x169;
         let x173 = x61 + x170;
         let x174 = x62 + x171;
-        let x175 = x173 - x33;
-        let x176 = x174 - x34;
+        let x175 = x33 - x173;
+        let x176 = x34 - x174;
         let x177 = x32 + x88;
-        let x178 = x89 - x33;
-        let x179 = x90 - x34;
+        let x178 = x33 - x89;
+        let x179 = x34 - x90;
         let x180 = x60 + x177;
-        let x181 = x61 + x178;
-        let x182 = x62 + x179;
-        let x183 = x181 - x33;
-        let x184 = x182 - x34;
+        let x181 = x61 - x178;
+        let x182 = x62 - x179;
+        let x183 = x33 - x181;
+        let x184 = x34 - x182;
         let x185 = x60 + x88;
         let x186 = x61 + x89;
         let x187 = x62 + x90;
-        let x188 = x186 - x33;
-        let x189 = x187 - x34;
-        let x190 = x61 - x33;
-        let x191 = x62 - x34;
+        let x188 = x33 - x186;
+        let x189 = x34 - x187;
+        let x190 = x33 - x61;
+        let x191 = x34 - x62;
         let x192 = 243.66 * x138;
         let x193 = 243.66 * x139;
         let x194 = 243.66 * x140;
@@ -5084,8 +5056,8 @@ impl SsrmsRecurrent {
         let x204 = 243.66 * (x32 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x175 - x1);
-        let x208 = 243.66 * (x2 + x176);
+        let x207 = 243.66 * (x1 + x175);
+        let x208 = 243.66 * (x2 - x176);
         let x209 = x129 + x157;
         let x210 = x130 + x158;
         let x211 = x131 + x159;
@@ -5096,21 +5068,21 @@ impl SsrmsRecurrent {
         let x216 = x136 + x164;
         let x217 = x137 + x165;
         let x218 = x104 + x209;
-        let x219 = x105 + x210;
-        let x220 = x106 + x211;
-        let x221 = x107 + x212;
+        let x219 = x105 - x210;
+        let x220 = x106 - x211;
+        let x221 = x107 - x212;
         let x222 = x108 + x213;
         let x223 = x109 + x214;
-        let x224 = x110 + x215;
+        let x224 = x110 - x215;
         let x225 = x111 + x216;
         let x226 = x112 + x217;
         let x227 = x79 + x218;
-        let x228 = x80 + x219;
-        let x229 = x81 + x220;
-        let x230 = x82 + x221;
+        let x228 = x80 - x219;
+        let x229 = x81 - x220;
+        let x230 = x82 - x221;
         let x231 = x83 + x222;
         let x232 = x84 + x223;
-        let x233 = x85 + x224;
+        let x233 = x85 - x224;
         let x234 = x86 + x225;
         let x235 = x87 + x226;
         let x236 = x51 + x227;
@@ -5126,8 +5098,8 @@ impl SsrmsRecurrent {
         let x246 = Self::mul_add(105.98, x33, x196);
         let x247 = Self::mul_add(105.98, x34, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
-        let x249 = Self::mul_add(105.98, x178, x199);
-        let x250 = Self::mul_add(105.98, x179, x200);
+        let x249 = Self::mul_add(-105.98, x178, x199);
+        let x250 = Self::mul_add(-105.98, x179, x200);
         let x251 = Self::mul_add(105.98, x88, x248);
         let x252 = Self::mul_add(105.98, x89, x249);
         let x253 = Self::mul_add(105.98, x90, x250);
@@ -5149,26 +5121,26 @@ impl SsrmsRecurrent {
         let x269 = Self::mul_add(279.2, x32 + x60, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(-314.88, x33, x270);
-        let x273 = Self::mul_add(-314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x183 - x1, x207);
-        let x275 = Self::mul_add(105.98, x2 + x184, x208);
-        let x276 = Self::mul_add(105.98, x188 - x1, x274);
-        let x277 = Self::mul_add(105.98, x2 + x189, x275);
-        let x278 = Self::mul_add(279.2, x190 - x1, x276);
-        let x279 = Self::mul_add(279.2, x2 + x191, x277);
-        let x280 = Self::mul_add(-314.88, x1 + x33, x278);
+        let x272 = Self::mul_add(314.88, x33, x270);
+        let x273 = Self::mul_add(314.88, x34, x271);
+        let x274 = Self::mul_add(105.98, x1 + x183, x207);
+        let x275 = Self::mul_add(105.98, x2 - x184, x208);
+        let x276 = Self::mul_add(105.98, x1 + x188, x274);
+        let x277 = Self::mul_add(105.98, x2 - x189, x275);
+        let x278 = Self::mul_add(279.2, x1 + x190, x276);
+        let x279 = Self::mul_add(279.2, x2 - x191, x277);
+        let x280 = Self::mul_add(314.88, x1 + x33, x278);
         let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(x139, x207, x140 * x208);
+        let x282 = Self::mul_add(-x139, x207, x140 * x208);
         let x283 = x138 * x207;
         let x284 = x138 * x208;
         let x285 = x139 * x204;
         let x286 = x138 * x204;
         let x287 = x140 * x204;
-        let x288 = Self::mul_add(x140, x206, x286);
+        let x288 = Self::mul_add(-x140, x206, x286);
         let x289 = x139 * x206;
         let x290 = x140 * x205;
-        let x291 = Self::mul_add(x139, x205, x286);
+        let x291 = Self::mul_add(-x139, x205, x286);
         let x292 = x140 * x203;
         let x293 = x139 * x202;
         let x294 = x292 + x293;
@@ -5218,11 +5190,11 @@ impl SsrmsRecurrent {
         let x338 = Self::mul_add(-x32, x249, x307);
         let x339 = Self::mul_add(-x32, x250, x308);
         let x340 = Self::mul_add(x33, x248, x309);
-        let x341 = x336 - x334 - x311;
+        let x341 = x311 + (x334 - x336);
         let x342 = Self::mul_add(x33, x250, x312);
         let x343 = Self::mul_add(x34, x248, x313);
         let x344 = Self::mul_add(x34, x249, x314);
-        let x345 = x336 - x335 - x315;
+        let x345 = x315 + (x335 - x336);
         let x346 = x90 * x253;
         let x347 = x89 * x252;
         let x348 = x88 * x251;
@@ -5233,246 +5205,246 @@ impl SsrmsRecurrent {
         let x353 = Self::mul_add(-x32, x255, x295);
         let x354 = Self::mul_add(-x32, x256, x296);
         let x355 = Self::mul_add(x33, x254, x297);
-        let x356 = x351 - x349 - x299;
+        let x356 = x299 + (x349 - x351);
         let x357 = Self::mul_add(x33, x256, x300);
         let x358 = Self::mul_add(x34, x254, x301);
         let x359 = Self::mul_add(x34, x255, x302);
-        let x360 = x351 - x350 - x303;
+        let x360 = x303 + (x350 - x351);
         let x361 = x90 * x259;
         let x362 = x89 * x258;
         let x363 = x88 * x257;
-        let x364 = x361 + x362 - x352;
+        let x364 = x352 - (x361 + x362);
         let x365 = Self::mul_add(-x88, x258, x353);
         let x366 = Self::mul_add(-x88, x259, x354);
         let x367 = Self::mul_add(-x89, x257, x355);
-        let x368 = x356 + (x361 + x363);
+        let x368 = x356 - (x361 + x363);
         let x369 = Self::mul_add(-x89, x259, x357);
         let x370 = Self::mul_add(-x90, x257, x358);
         let x371 = Self::mul_add(-x90, x258, x359);
-        let x372 = x360 + (x362 + x363);
+        let x372 = x360 - (x362 + x363);
         let x373 = x62 * x262;
         let x374 = x61 * x261;
         let x375 = x60 * x260;
         let x376 = x32 * x263;
         let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = Self::mul_add(-x34, x265, x376) - x288;
+        let x378 = x288 - Self::mul_add(x34, x265, x376);
         let x379 = Self::mul_add(x33, x265, x289);
         let x380 = Self::mul_add(x34, x263, x287);
         let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = Self::mul_add(-x33, x264, x376) - x291;
+        let x382 = x291 - Self::mul_add(x33, x264, x376);
         let x383 = x88 * x266;
         let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, x383);
+        let x385 = x378 + Self::mul_add(x90, x268, -x383);
         let x386 = Self::mul_add(-x89, x268, x379);
         let x387 = Self::mul_add(-x90, x266, x380);
         let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, x383);
+        let x389 = x382 + Self::mul_add(x89, x267, -x383);
         let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, x390);
+        let x391 = x385 + Self::mul_add(x62, x271, -x390);
         let x392 = Self::mul_add(-x61, x271, x386);
         let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, x390);
+        let x394 = x389 + Self::mul_add(x61, x270, -x390);
         let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(x33, x274, x34 * x275);
+        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
         let x397 = Self::mul_add(-x32, x274, x283);
         let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = Self::mul_add(x89, x276, x90 * x277) - x396;
+        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
         let x400 = Self::mul_add(-x88, x276, x397);
         let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 + Self::mul_add(x61, x278, x62 * x279);
+        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
         let x403 = Self::mul_add(-x60, x278, x400);
         let x404 = Self::mul_add(-x60, x279, x401);
         let x405 = Self::mul_add(
-            -s_q0,
-            x19 + x237 + Self::mul_add(-x32, x280, x403),
-            c_q0 * (x21 + x238 + Self::mul_add(-x32, x281, x404)),
+            -c_q0,
+            x21 + x238 + Self::mul_add(-x32, x281, x404),
+            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
         );
         let x406 = Self::mul_add(
-            x7,
+            -x7,
             x238 + x404,
-            Self::mul_add(-s_q1, x236 + x402, x5 * (x237 + x403)),
+            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x407 = Self::mul_add(
-            x7,
+            -x7,
             x229 + x401,
-            Self::mul_add(-s_q1, x227 + x399, x5 * (x228 + x400)),
+            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x408 = Self::mul_add(
             x7,
-            x220 + x398,
-            Self::mul_add(-s_q1, x218 - x396, x5 * (x219 + x397)),
+            x220 - x398,
+            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x409 = Self::mul_add(
             x97,
             x211 + x284,
-            Self::mul_add(x95, x210 + x283, x93 * (x209 - x282)),
+            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
         );
         let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
         let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
         let x412 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
         let x413 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                -s_q0,
-                x24 + x240 + (x391 + Self::mul_add(-x34, x273, x395)),
-                c_q0 * (x26 + x241 + Self::mul_add(x33, x273, x392)),
+                -c_q0,
+                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
+                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    -s_q0,
-                    x29 + x243 + Self::mul_add(x34, x272, x393),
-                    c_q0 * (x31 + x244 + (x394 + Self::mul_add(-x33, x272, x395))),
+                    -c_q0,
+                    x26 + x241 - Self::mul_add(x33, x273, x392),
+                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
                 ),
         );
         let x414 = Self::mul_add(
-            x7,
-            x241 + x392,
+            -x7,
+            x241 - x392,
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x269, x384),
-                x5 * (x240 + x391),
+                -x5,
+                x240 - x391,
+                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
             ),
         );
         let x415 = Self::mul_add(
-            x7,
-            x244 + x394,
+            -x7,
+            x244 - x394,
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x269, x387),
-                x5 * (x243 + x393),
+                -x5,
+                x243 - x393,
+                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
             ),
         );
         let x416 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
-                x7,
-                x232 + x386,
-                Self::mul_add(-s_q1, x230 + x384, x5 * (x231 + x385)),
+                -x7,
+                x235 - x389,
+                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
-                    x7,
-                    x235 + x389,
-                    Self::mul_add(-s_q1, x233 + x387, x5 * (x234 + x388)),
+                    -x7,
+                    x232 - x386,
+                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x417 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x7,
-                x223 + x379,
-                Self::mul_add(-s_q1, x221 + x377, x5 * (x222 + x378)),
+                x226 - x382,
+                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x7,
-                    x226 + x382,
-                    Self::mul_add(-s_q1, x224 + x380, x5 * (x225 + x381)),
+                    x223 - x379,
+                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x418 = Self::mul_add(
-            -s_q0,
+            -c_q0,
             Self::mul_add(
                 x97,
-                x214 + x289,
-                Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                x217 - x291,
+                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
             ),
-            c_q0
+            s_q0
                 * Self::mul_add(
                     x97,
-                    x217 - x291,
-                    Self::mul_add(x95, x216 + x290, x93 * (x215 + x287)),
+                    x214 - x289,
+                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
                 ),
         );
         let x419 = Self::mul_add(
-            x7,
+            -x7,
             x238 + Self::mul_add(-x60, x262, x366),
             Self::mul_add(
-                -s_q1,
-                x236 + (x364 + (x373 + x374)),
-                x5 * (x237 + Self::mul_add(-x60, x261, x365)),
+                -x5,
+                x237 + Self::mul_add(-x60, x261, x365),
+                s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x420 = Self::mul_add(
-            x7,
+            -x7,
             x241 + Self::mul_add(-x61, x262, x369),
             Self::mul_add(
-                -s_q1,
-                x239 + Self::mul_add(-x61, x260, x367),
-                x5 * (x240 + (x368 + (x373 + x375))),
+                -x5,
+                x240 - (x368 - (x373 + x375)),
+                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
             ),
         );
         let x421 = Self::mul_add(
-            x7,
-            x244 + (x372 + (x374 + x375)),
+            -x7,
+            x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -s_q1,
-                x242 + Self::mul_add(-x62, x260, x370),
-                x5 * (x243 + Self::mul_add(-x62, x261, x371)),
+                -x5,
+                x243 + Self::mul_add(-x62, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
             ),
         );
         let x422 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
-                x7,
-                x229 + x366,
-                Self::mul_add(-s_q1, x227 + x364, x5 * (x228 + x365)),
+                -x7,
+                x232 + x369,
+                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
-                    x7,
-                    x232 + x369,
-                    Self::mul_add(-s_q1, x230 + x367, x5 * (x231 + x368)),
+                    -x7,
+                    x229 + x366,
+                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x423 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
-                x7,
-                x235 + x372,
-                Self::mul_add(-s_q1, x233 + x370, x5 * (x234 + x371)),
+                -x7,
+                x235 - x372,
+                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x422,
         );
         let x424 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
                 x7,
-                x220 + x354,
-                Self::mul_add(-s_q1, x218 - x352, x5 * (x219 + x353)),
+                x223 + x357,
+                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x7,
-                    x223 + x357,
-                    Self::mul_add(-s_q1, x221 + x355, x5 * (x222 + x356)),
+                    x220 - x354,
+                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x425 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x360,
-                Self::mul_add(-s_q1, x224 + x358, x5 * (x225 + x359)),
+                x226 - x360,
+                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x424,
         );
         let x426 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x296,
-                Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                x214 + x300,
+                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x300,
-                    Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                    x211 + x296,
+                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
                 ),
         );
         let x427 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x303,
@@ -5480,73 +5452,73 @@ impl SsrmsRecurrent {
             ),
             x426,
         );
-        let x428 = Self::mul_add(x7, x412, Self::mul_add(-s_q1, x410, x5 * x411));
+        let x428 = Self::mul_add(-x7, x412, Self::mul_add(-x5, x411, s_q1 * x410));
         let x429 = Self::mul_add(
-            x7,
+            -x7,
             x229 + Self::mul_add(-x88, x253, x339),
             Self::mul_add(
-                -s_q1,
-                x227 + (x346 + x347 - x337),
-                x5 * (x228 + Self::mul_add(-x88, x252, x338)),
+                -x5,
+                x228 + Self::mul_add(-x88, x252, x338),
+                s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x430 = Self::mul_add(
-            x7,
+            -x7,
             x232 + Self::mul_add(-x89, x253, x342),
             Self::mul_add(
-                -s_q1,
-                x230 + Self::mul_add(-x89, x251, x340),
-                x5 * (x231 + (x341 + (x346 + x348))),
+                -x5,
+                x231 - (x341 - (x346 + x348)),
+                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
             ),
         );
         let x431 = Self::mul_add(
-            x7,
-            x235 + (x345 + (x347 + x348)),
+            -x7,
+            x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -s_q1,
-                x233 + Self::mul_add(-x90, x251, x343),
-                x5 * (x234 + Self::mul_add(-x90, x252, x344)),
+                -x5,
+                x234 + Self::mul_add(-x90, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
             ),
         );
         let x432 = Self::mul_add(
-            -s_q1,
+            x5,
             Self::mul_add(
                 x7,
-                x220 + x339,
-                Self::mul_add(-s_q1, x218 - x337, x5 * (x219 + x338)),
+                x223 + x342,
+                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x7,
-                    x223 + x342,
-                    Self::mul_add(-s_q1, x221 + x340, x5 * (x222 + x341)),
+                    x220 - x339,
+                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x433 = Self::mul_add(
             x7,
             Self::mul_add(
                 x7,
-                x226 + x345,
-                Self::mul_add(-s_q1, x224 + x343, x5 * (x225 + x344)),
+                x226 - x345,
+                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x432,
         );
         let x434 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 + x308,
-                Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                x214 + x312,
+                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 + x312,
-                    Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                    x211 + x308,
+                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
                 ),
         );
         let x435 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 - x315,
@@ -5556,47 +5528,47 @@ impl SsrmsRecurrent {
         );
         let x436 = Self::mul_add(
             x7,
-            x220 + Self::mul_add(x32, x247, -x320),
+            x220 + Self::mul_add(-x32, x247, x320),
             Self::mul_add(
-                -s_q1,
-                x218 + (x318 + (x331 + x332)),
-                x5 * (x219 + Self::mul_add(x32, x246, -x319)),
+                x5,
+                x219 + Self::mul_add(-x32, x246, x319),
+                s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x437 = Self::mul_add(
             x7,
             x223 - Self::mul_add(x33, x247, x324),
             Self::mul_add(
-                -s_q1,
-                x221 + Self::mul_add(x33, x245, x321),
-                x5 * (x222 + (x323 + (x331 + x333))),
+                x5,
+                x222 + (x323 + (x331 + x333)),
+                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
             ),
         );
         let x438 = Self::mul_add(
             x7,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                -s_q1,
-                x224 + Self::mul_add(x34, x245, x325),
-                x5 * (x225 - Self::mul_add(x34, x246, x326)),
+                x5,
+                x225 - Self::mul_add(x34, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
             ),
         );
         let x439 = Self::mul_add(
-            -s_q1,
+            -x5,
             Self::mul_add(
                 x97,
-                x211 - x320,
-                Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                x214 - x324,
+                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
             ),
-            x5
+            s_q1
                 * Self::mul_add(
                     x97,
-                    x214 - x324,
-                    Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                    x211 - x320,
+                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
                 ),
         );
         let x440 = Self::mul_add(
-            x7,
+            -x7,
             Self::mul_add(
                 x97,
                 x217 + x327,
@@ -5646,22 +5618,23 @@ impl SsrmsRecurrent {
         let x456 = x444 * x445;
         let x457 = x32 * (x454 + x455);
         let x458 = x447
-            + Self::mul_add(
-                x34,
+            - Self::mul_add(
+                -x34,
                 x456,
-                Self::mul_add(-x32, x450 + x450, x33 * (x446 + x454)),
+                Self::mul_add(-x33, x446 + x454, x32 * (x450 + x450)),
             );
-        let x459 = Self::mul_add(
-            x34,
-            x446 + x455,
-            Self::mul_add(x33, x456, x32 * (x449 + x449)),
-        ) - x448;
+        let x459 = x448
+            - Self::mul_add(
+                x34,
+                x446 + x455,
+                Self::mul_add(x33, x456, x32 * (x449 + x449)),
+            );
         let x460 = qd[0] - x451;
-        let x461 = x452 - x444;
+        let x461 = x444 - x452;
         let x462 = x445 + x453;
         let x463 = Self::mul_add(x444, x453, x445 * x452);
         let x464 = x449 + Self::mul_add(qd[0], x453, x445 * x451);
-        let x465 = Self::mul_add(-x444, x451, qd[0] * x452) - x450;
+        let x465 = x450 + Self::mul_add(-qd[0], x452, x444 * x451);
         let x466 = qd[3] * s_q1;
         let x467 = qd[3] * x5;
         let x468 = qd[3] * x7;
@@ -5671,29 +5644,30 @@ impl SsrmsRecurrent {
         let x472 = x460 * x462;
         let x473 = x460 * x460;
         let x474 = x461 * x462;
-        let x475 = Self::mul_add(
-            x62,
-            x472 - x464,
-            Self::mul_add(-x60, x469 + x470, x61 * (x471 - x465)),
-        ) - x457;
-        let x476 = x458
+        let x475 = x457
             + Self::mul_add(
                 x62,
-                x463 + x474,
-                Self::mul_add(-x61, x469 + x473, x60 * (x465 + x471)),
+                x464 - x472,
+                Self::mul_add(-x61, x465 - x471, x60 * (x469 + x470)),
+            );
+        let x476 = x458
+            - Self::mul_add(
+                -x62,
+                x463 - x474,
+                Self::mul_add(x61, x469 + x473, x60 * (x465 + x471)),
             );
         let x477 = x459
-            + Self::mul_add(
+            - Self::mul_add(
                 -x62,
                 x470 + x473,
-                Self::mul_add(x61, x474 - x463, x60 * (x464 + x472)),
+                Self::mul_add(-x61, x463 + x474, x60 * (x464 + x472)),
             );
         let x478 = x460 - x466;
-        let x479 = x461 + x467;
+        let x479 = x461 - x467;
         let x480 = x462 + x468;
-        let x481 = Self::mul_add(-x462, x467, x461 * x468) - x463;
+        let x481 = x463 + Self::mul_add(x461, x468, x462 * x467);
         let x482 = x464 + Self::mul_add(x460, x468, x462 * x466);
-        let x483 = x465 + Self::mul_add(x460, x467, x461 * x466);
+        let x483 = x465 + Self::mul_add(-x460, x467, x461 * x466);
         let x484 = qd[4] * s_q1;
         let x485 = qd[4] * x5;
         let x486 = qd[4] * x7;
@@ -5706,27 +5680,27 @@ impl SsrmsRecurrent {
         let x493 = x475
             + Self::mul_add(
                 x90,
-                x490 - x482,
-                Self::mul_add(-x88, x487 + x488, x89 * (x489 - x483)),
+                x482 - x490,
+                Self::mul_add(-x89, x483 - x489, x88 * (x487 + x488)),
             );
         let x494 = x476
-            + Self::mul_add(
-                x90,
-                x492 - x481,
-                Self::mul_add(-x89, x487 + x491, x88 * (x483 + x489)),
+            - Self::mul_add(
+                -x90,
+                x481 - x492,
+                Self::mul_add(x89, x487 + x491, x88 * (x483 + x489)),
             );
         let x495 = x477
-            + Self::mul_add(
+            - Self::mul_add(
                 -x90,
                 x488 + x491,
-                Self::mul_add(x89, x481 + x492, x88 * (x482 + x490)),
+                Self::mul_add(-x89, x481 + x492, x88 * (x482 + x490)),
             );
         let x496 = x478 - x484;
-        let x497 = x479 + x485;
+        let x497 = x479 - x485;
         let x498 = x480 + x486;
-        let x499 = x481 + Self::mul_add(-x480, x485, x479 * x486);
+        let x499 = x481 + Self::mul_add(x479, x486, x480 * x485);
         let x500 = x482 + Self::mul_add(x478, x486, x480 * x484);
-        let x501 = x483 + Self::mul_add(x478, x485, x479 * x484);
+        let x501 = x483 + Self::mul_add(-x478, x485, x479 * x484);
         let x502 = qd[5] * x93;
         let x503 = qd[5] * x95;
         let x504 = qd[5] * x97;
@@ -5737,29 +5711,29 @@ impl SsrmsRecurrent {
         let x509 = x496 * x496;
         let x510 = x497 * x498;
         let x511 = x493
-            - Self::mul_add(
-                x34,
-                x508 - x500,
-                Self::mul_add(x33, x507 - x501, x32 * (x505 + x506)),
-            );
-        let x512 = x494
             + Self::mul_add(
                 -x34,
-                x510 - x499,
-                Self::mul_add(x33, x505 + x509, x32 * (x501 + x507)),
+                x500 - x508,
+                Self::mul_add(x33, x501 - x507, x32 * (x505 + x506)),
+            );
+        let x512 = x494
+            - Self::mul_add(
+                x34,
+                x499 - x510,
+                Self::mul_add(-x33, x505 + x509, x32 * (x501 + x507)),
             );
         let x513 = x495
-            + Self::mul_add(
+            - Self::mul_add(
                 x34,
                 x506 + x509,
-                Self::mul_add(-x33, x499 + x510, x32 * (x500 + x508)),
+                Self::mul_add(x33, x499 + x510, x32 * (x500 + x508)),
             );
         let x514 = x496 + x502;
-        let x515 = x497 + x503;
+        let x515 = x497 - x503;
         let x516 = x498 + x504;
-        let x517 = x499 + Self::mul_add(-x498, x503, x497 * x504);
-        let x518 = Self::mul_add(-x496, x504, x498 * x502) - x500;
-        let x519 = x501 + Self::mul_add(-x497, x502, x496 * x503);
+        let x517 = x499 + Self::mul_add(x497, x504, x498 * x503);
+        let x518 = x500 - Self::mul_add(-x496, x504, x498 * x502);
+        let x519 = x501 - Self::mul_add(x496, x503, x497 * x502);
         let x520 = qd[6] * x114;
         let x521 = qd[6] * x116;
         let x522 = qd[6] * x118;
@@ -5770,11 +5744,11 @@ impl SsrmsRecurrent {
         let x527 = x514 * x514;
         let x528 = x515 * x516;
         let x529 = x514 + x520;
-        let x530 = x515 + x521;
+        let x530 = x515 - x521;
         let x531 = x516 + x522;
-        let x532 = x517 + Self::mul_add(-x516, x521, x515 * x522);
-        let x533 = x518 + Self::mul_add(-x514, x522, x516 * x520);
-        let x534 = x519 + Self::mul_add(-x515, x520, x514 * x521);
+        let x532 = x517 + Self::mul_add(x515, x522, x516 * x521);
+        let x533 = x518 - Self::mul_add(-x514, x522, x516 * x520);
+        let x534 = x519 - Self::mul_add(x514, x521, x515 * x520);
         let x535 = Self::mul_add(x21, x445, Self::mul_add(-x19, x444, qd[0] * x17));
         let x536 = Self::mul_add(
             x26,
@@ -5787,9 +5761,9 @@ impl SsrmsRecurrent {
             Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x13, -x27)),
         );
         let x538 = Self::mul_add(
-            -105.98,
+            105.98,
             x447,
-            Self::mul_add(
+            -Self::mul_add(
                 -f_ext[1][2],
                 s_q0,
                 Self::mul_add(f_ext[1][1], x5, f_ext[1][0] * x4),
@@ -5804,9 +5778,9 @@ impl SsrmsRecurrent {
                 Self::mul_add(f_ext[1][1], x7, f_ext[1][0] * x6),
             ),
         );
-        let x540 = Self::mul_add(x53, x462, Self::mul_add(x52, x461, x51 * x460));
-        let x541 = Self::mul_add(x56, x462, Self::mul_add(x55, x461, x54 * x460));
-        let x542 = Self::mul_add(x59, x462, Self::mul_add(x58, x461, x57 * x460));
+        let x540 = Self::mul_add(x53, x462, Self::mul_add(-x52, x461, x51 * x460));
+        let x541 = Self::mul_add(x56, x462, Self::mul_add(-x55, x461, x54 * x460));
+        let x542 = Self::mul_add(x59, x462, Self::mul_add(-x58, x461, x57 * x460));
         let x543 = Self::mul_add(
             314.88,
             x457,
@@ -5817,16 +5791,16 @@ impl SsrmsRecurrent {
             ),
         );
         let x544 = Self::mul_add(
-            -314.88,
+            314.88,
             x458,
-            Self::mul_add(
+            -Self::mul_add(
                 f_ext[2][2],
                 x39,
                 Self::mul_add(f_ext[2][1], x5, f_ext[2][0] * x38),
             ),
         );
         let x545 = Self::mul_add(
-            -314.88,
+            314.88,
             x459,
             Self::mul_add(
                 f_ext[2][2],
@@ -5834,11 +5808,11 @@ impl SsrmsRecurrent {
                 Self::mul_add(f_ext[2][1], x7, f_ext[2][0] * x40),
             ),
         );
-        let x546 = Self::mul_add(x81, x480, Self::mul_add(x80, x479, x79 * x478));
-        let x547 = Self::mul_add(x84, x480, Self::mul_add(x83, x479, x82 * x478));
-        let x548 = Self::mul_add(x87, x480, Self::mul_add(x86, x479, x85 * x478));
+        let x546 = Self::mul_add(x81, x480, Self::mul_add(-x80, x479, x79 * x478));
+        let x547 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
+        let x548 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
         let x549 = Self::mul_add(
-            -279.2,
+            279.2,
             x475,
             Self::mul_add(
                 f_ext[3][2],
@@ -5847,16 +5821,16 @@ impl SsrmsRecurrent {
             ),
         );
         let x550 = Self::mul_add(
-            -279.2,
+            279.2,
             x476,
-            Self::mul_add(
+            -Self::mul_add(
                 f_ext[3][2],
                 x67,
                 Self::mul_add(f_ext[3][1], x5, f_ext[3][0] * x66),
             ),
         );
         let x551 = Self::mul_add(
-            -279.2,
+            279.2,
             x477,
             Self::mul_add(
                 f_ext[3][2],
@@ -5864,11 +5838,11 @@ impl SsrmsRecurrent {
                 Self::mul_add(f_ext[3][1], x7, f_ext[3][0] * x68),
             ),
         );
-        let x552 = Self::mul_add(x106, x498, Self::mul_add(x105, x497, x104 * x496));
-        let x553 = Self::mul_add(x109, x498, Self::mul_add(x108, x497, x107 * x496));
-        let x554 = Self::mul_add(x112, x498, Self::mul_add(x111, x497, x110 * x496));
+        let x552 = Self::mul_add(-x106, x498, Self::mul_add(x105, x497, x104 * x496));
+        let x553 = Self::mul_add(-x109, x498, Self::mul_add(x108, x497, x107 * x496));
+        let x554 = Self::mul_add(-x112, x498, Self::mul_add(x111, x497, x110 * x496));
         let x555 = Self::mul_add(
-            -105.98,
+            105.98,
             x493,
             Self::mul_add(
                 f_ext[4][2],
@@ -5877,16 +5851,16 @@ impl SsrmsRecurrent {
             ),
         );
         let x556 = Self::mul_add(
-            -105.98,
+            105.98,
             x494,
-            Self::mul_add(
+            -Self::mul_add(
                 f_ext[4][2],
                 x95,
                 Self::mul_add(f_ext[4][1], x5, f_ext[4][0] * x94),
             ),
         );
         let x557 = Self::mul_add(
-            -105.98,
+            105.98,
             x495,
             Self::mul_add(
                 f_ext[4][2],
@@ -5894,11 +5868,11 @@ impl SsrmsRecurrent {
                 Self::mul_add(f_ext[4][1], x7, f_ext[4][0] * x96),
             ),
         );
-        let x558 = Self::mul_add(x131, x516, Self::mul_add(x130, x515, x129 * x514));
-        let x559 = Self::mul_add(x134, x516, Self::mul_add(x133, x515, x132 * x514));
-        let x560 = Self::mul_add(x137, x516, Self::mul_add(x136, x515, x135 * x514));
+        let x558 = Self::mul_add(x131, x516, Self::mul_add(-x130, x515, x129 * x514));
+        let x559 = Self::mul_add(x134, x516, Self::mul_add(-x133, x515, x132 * x514));
+        let x560 = Self::mul_add(x137, x516, Self::mul_add(-x136, x515, x135 * x514));
         let x561 = Self::mul_add(
-            -105.98,
+            105.98,
             x511,
             Self::mul_add(
                 f_ext[5][2],
@@ -5907,89 +5881,89 @@ impl SsrmsRecurrent {
             ),
         );
         let x562 = Self::mul_add(
-            -105.98,
+            105.98,
             x512,
-            Self::mul_add(
+            -Self::mul_add(
                 f_ext[5][2],
                 x95,
-                Self::mul_add(f_ext[5][1], x117, f_ext[5][0] * x116),
+                Self::mul_add(-f_ext[5][1], x117, f_ext[5][0] * x116),
             ),
         );
         let x563 = Self::mul_add(
-            -105.98,
+            105.98,
             x513,
             Self::mul_add(
                 f_ext[5][2],
                 x97,
-                Self::mul_add(f_ext[5][1], x119, f_ext[5][0] * x118),
+                Self::mul_add(-f_ext[5][1], x119, f_ext[5][0] * x118),
             ),
         );
-        let x564 = Self::mul_add(x159, x531, Self::mul_add(x158, x530, x157 * x529));
-        let x565 = Self::mul_add(x162, x531, Self::mul_add(x161, x530, x160 * x529));
-        let x566 = Self::mul_add(x165, x531, Self::mul_add(x164, x530, x163 * x529));
+        let x564 = Self::mul_add(x159, x531, Self::mul_add(-x158, x530, x157 * x529));
+        let x565 = Self::mul_add(x162, x531, Self::mul_add(-x161, x530, x160 * x529));
+        let x566 = Self::mul_add(x165, x531, Self::mul_add(-x164, x530, x163 * x529));
         let x567 = Self::mul_add(
-            -243.66,
+            243.66,
             x511
-                + Self::mul_add(
-                    -x140,
-                    x518 + x526,
-                    Self::mul_add(-x139, x525 - x519, x138 * (x523 + x524)),
+                - Self::mul_add(
+                    x140,
+                    x518 - x526,
+                    Self::mul_add(-x139, x519 - x525, x138 * (x523 + x524)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
                 x143,
-                Self::mul_add(f_ext[6][1], x142, f_ext[6][0] * x114),
+                Self::mul_add(-f_ext[6][1], x142, f_ext[6][0] * x114),
             ),
         );
         let x568 = Self::mul_add(
-            -243.66,
+            243.66,
             x512
                 + Self::mul_add(
                     -x140,
-                    x528 - x517,
-                    Self::mul_add(-x138, x519 + x525, x139 * (x523 + x527)),
+                    x517 - x528,
+                    Self::mul_add(x139, x523 + x527, x138 * (x519 + x525)),
                 ),
-            Self::mul_add(
+            -Self::mul_add(
                 f_ext[6][2],
                 x145,
-                Self::mul_add(f_ext[6][1], x144, f_ext[6][0] * x116),
+                Self::mul_add(-f_ext[6][1], x144, f_ext[6][0] * x116),
             ),
         );
         let x569 = Self::mul_add(
-            -243.66,
+            243.66,
             x513
                 + Self::mul_add(
-                    x140,
+                    -x140,
                     x524 + x527,
-                    -Self::mul_add(x139, x517 + x528, x138 * (x526 - x518)),
+                    Self::mul_add(-x139, x517 + x528, x138 * (x518 + x526)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
                 x147,
-                Self::mul_add(f_ext[6][1], x146, f_ext[6][0] * x118),
+                Self::mul_add(-f_ext[6][1], x146, f_ext[6][0] * x118),
             ),
         );
-        let x570 = Self::mul_add(
-            f_ext[6][5],
-            x143,
-            Self::mul_add(f_ext[6][4], x142, f_ext[6][3] * x114),
-        )
-            - (Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532))
-                + Self::mul_add(-x531, x565, x530 * x566));
-        let x571 = Self::mul_add(
-            f_ext[6][5],
-            x145,
-            Self::mul_add(f_ext[6][4], x144, f_ext[6][3] * x116),
-        )
-            - (Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532))
-                + Self::mul_add(-x529, x566, x531 * x564));
-        let x572 = Self::mul_add(
-            f_ext[6][5],
-            x147,
-            Self::mul_add(f_ext[6][4], x146, f_ext[6][3] * x118),
-        )
-            - (Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532))
-                + Self::mul_add(-x530, x564, x529 * x565));
+        let x570 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532))
+            + Self::mul_add(x530, x566, x531 * x565)
+            + Self::mul_add(
+                f_ext[6][5],
+                x143,
+                Self::mul_add(-f_ext[6][4], x142, f_ext[6][3] * x114),
+            );
+        let x571 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532))
+            - Self::mul_add(-x529, x566, x531 * x564)
+            + Self::mul_add(
+                f_ext[6][5],
+                x145,
+                Self::mul_add(-f_ext[6][4], x144, f_ext[6][3] * x116),
+            );
+        let x572 = Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532))
+            - Self::mul_add(x529, x565, x530 * x564)
+            + Self::mul_add(
+                f_ext[6][5],
+                x147,
+                Self::mul_add(-f_ext[6][4], x146, f_ext[6][3] * x118),
+            );
         let x573 = x561 + x567;
         let x574 = x562 + x568;
         let x575 = x563 + x569;
@@ -6002,135 +5976,121 @@ impl SsrmsRecurrent {
         let x582 = x543 + x579;
         let x583 = x544 + x580;
         let x584 = x545 + x581;
-        let x585 = Self::mul_add(
-            f_ext[5][5],
-            x93,
-            Self::mul_add(-f_ext[5][4], x115, f_ext[5][3] * x114),
-        )
-            - (Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
-                + Self::mul_add(-x516, x559, x515 * x560)) + x570
-            + Self::mul_add(-x139, x569, x140 * x568);
-        let x586 = Self::mul_add(
-            f_ext[5][5],
-            x95,
-            Self::mul_add(f_ext[5][4], x117, f_ext[5][3] * x116),
-        )
-            - (Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
-                + Self::mul_add(-x514, x560, x516 * x558)) + x571
-            + Self::mul_add(-x140, x567, x138 * x569);
-        let x587 = Self::mul_add(
-            f_ext[5][5],
-            x97,
-            Self::mul_add(f_ext[5][4], x119, f_ext[5][3] * x118),
-        )
-            - (Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
-                + Self::mul_add(-x515, x558, x514 * x559)) + x572
-            + Self::mul_add(-x138, x568, x139 * x567);
-        let x588 = Self::mul_add(
-            f_ext[4][5],
-            x93,
-            Self::mul_add(-f_ext[4][4], s_q1, f_ext[4][3] * x92),
-        )
-            - (Self::mul_add(x106, x501, Self::mul_add(-x105, x500, x104 * x499))
-                + Self::mul_add(-x498, x553, x497 * x554)) + x585
-            + Self::mul_add(-x33, x575, x34 * x574);
-        let x589 = Self::mul_add(
-            f_ext[4][5],
-            x95,
-            Self::mul_add(f_ext[4][4], x5, f_ext[4][3] * x94),
-        )
-            - (Self::mul_add(x109, x501, Self::mul_add(-x108, x500, x107 * x499))
-                + Self::mul_add(-x496, x554, x498 * x552)) + x586
-            - Self::mul_add(x32, x575, x34 * x573);
-        let x590 = Self::mul_add(
-            f_ext[4][5],
-            x97,
-            Self::mul_add(f_ext[4][4], x7, f_ext[4][3] * x96),
-        )
-            - (Self::mul_add(x112, x501, Self::mul_add(-x111, x500, x110 * x499))
-                + Self::mul_add(-x497, x552, x496 * x553)) + x587
-            + Self::mul_add(x32, x574, x33 * x573);
-        let x591 = Self::mul_add(
-            f_ext[3][5],
-            x65,
-            Self::mul_add(-f_ext[3][4], s_q1, f_ext[3][3] * x64),
-        )
-            - (Self::mul_add(x81, x483, Self::mul_add(-x80, x482, x79 * x481))
-                + Self::mul_add(-x480, x547, x479 * x548)) + x588
-            + Self::mul_add(-x90, x577, x89 * x578);
-        let x592 = Self::mul_add(
-            f_ext[3][5],
-            x67,
-            Self::mul_add(f_ext[3][4], x5, f_ext[3][3] * x66),
-        )
-            - (Self::mul_add(x84, x483, Self::mul_add(-x83, x482, x82 * x481))
-                + Self::mul_add(-x478, x548, x480 * x546)) + x589
-            + Self::mul_add(-x88, x578, x90 * x576);
-        let x593 = Self::mul_add(
-            f_ext[3][5],
-            x69,
-            Self::mul_add(f_ext[3][4], x7, f_ext[3][3] * x68),
-        )
-            - (Self::mul_add(x87, x483, Self::mul_add(-x86, x482, x85 * x481))
-                + Self::mul_add(-x479, x546, x478 * x547)) + x590
-            + Self::mul_add(-x89, x576, x88 * x577);
-        let x594 = Self::mul_add(
-            f_ext[2][5],
-            x37,
-            Self::mul_add(-f_ext[2][4], s_q1, f_ext[2][3] * x36),
-        )
-            - (Self::mul_add(x53, x465, -Self::mul_add(x52, x464, x51 * x463))
-                + Self::mul_add(-x462, x541, x461 * x542)) + x591
-            + Self::mul_add(-x62, x580, x61 * x581);
-        let x595 = Self::mul_add(
-            f_ext[2][5],
-            x39,
-            Self::mul_add(f_ext[2][4], x5, f_ext[2][3] * x38),
-        )
-            - (Self::mul_add(x56, x465, -Self::mul_add(x55, x464, x54 * x463))
-                + Self::mul_add(-x460, x542, x462 * x540)) + x592
-            + Self::mul_add(-x60, x581, x62 * x579);
-        let x596 = Self::mul_add(
-            f_ext[2][5],
-            x41,
-            Self::mul_add(f_ext[2][4], x7, f_ext[2][3] * x40),
-        )
-            - (Self::mul_add(x59, x465, -Self::mul_add(x58, x464, x57 * x463))
-                + Self::mul_add(-x461, x540, x460 * x541)) + x593
-            + Self::mul_add(-x61, x579, x60 * x580);
+        let x585 = Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
+            + Self::mul_add(x515, x560, x516 * x559)
+            + Self::mul_add(
+                f_ext[5][5],
+                x93,
+                Self::mul_add(-f_ext[5][4], x115, f_ext[5][3] * x114),
+            ) + x570 - Self::mul_add(x139, x569, x140 * x568);
+        let x586 = Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
+            - Self::mul_add(-x514, x560, x516 * x558)
+            + Self::mul_add(
+                f_ext[5][5],
+                x95,
+                Self::mul_add(-f_ext[5][4], x117, f_ext[5][3] * x116),
+            ) + x571 - Self::mul_add(-x138, x569, x140 * x567);
+        let x587 = Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
+            - Self::mul_add(x514, x559, x515 * x558)
+            + Self::mul_add(
+                f_ext[5][5],
+                x97,
+                Self::mul_add(-f_ext[5][4], x119, f_ext[5][3] * x118),
+            ) + x572 + Self::mul_add(x138, x568, x139 * x567);
+        let x588 = Self::mul_add(-x106, x501, Self::mul_add(-x105, x500, x104 * x499))
+            - Self::mul_add(x497, x554, x498 * x553)
+            + Self::mul_add(
+                f_ext[4][5],
+                x93,
+                Self::mul_add(-f_ext[4][4], s_q1, f_ext[4][3] * x92),
+            ) + x585 - Self::mul_add(x33, x575, x34 * x574);
+        let x589 = Self::mul_add(-x109, x501, Self::mul_add(-x108, x500, x107 * x499))
+            + Self::mul_add(x496, x554, x498 * x552)
+            - Self::mul_add(
+                f_ext[4][5],
+                x95,
+                Self::mul_add(f_ext[4][4], x5, f_ext[4][3] * x94),
+            ) - x586 + Self::mul_add(x32, x575, x34 * x573);
+        let x590 = Self::mul_add(-x112, x501, Self::mul_add(-x111, x500, x110 * x499))
+            + Self::mul_add(-x496, x553, x497 * x552)
+            - Self::mul_add(
+                f_ext[4][5],
+                x97,
+                Self::mul_add(f_ext[4][4], x7, f_ext[4][3] * x96),
+            ) - x587 - Self::mul_add(-x32, x574, x33 * x573);
+        let x591 = Self::mul_add(x81, x483, Self::mul_add(x80, x482, x79 * x481))
+            + Self::mul_add(x479, x548, x480 * x547)
+            + Self::mul_add(
+                f_ext[3][5],
+                x65,
+                Self::mul_add(-f_ext[3][4], s_q1, f_ext[3][3] * x64),
+            ) + x588 + Self::mul_add(x89, x578, x90 * x577);
+        let x592 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
+            - Self::mul_add(-x478, x548, x480 * x546)
+            + Self::mul_add(
+                f_ext[3][5],
+                x67,
+                Self::mul_add(f_ext[3][4], x5, f_ext[3][3] * x66),
+            ) - x589 + Self::mul_add(-x88, x578, x90 * x576);
+        let x593 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
+            - Self::mul_add(x478, x547, x479 * x546)
+            + Self::mul_add(
+                f_ext[3][5],
+                x69,
+                Self::mul_add(f_ext[3][4], x7, f_ext[3][3] * x68),
+            ) - x590 - Self::mul_add(x88, x577, x89 * x576);
+        let x594 = Self::mul_add(x53, x465, Self::mul_add(x52, x464, x51 * x463))
+            + Self::mul_add(x461, x542, x462 * x541)
+            + Self::mul_add(
+                f_ext[2][5],
+                x37,
+                Self::mul_add(-f_ext[2][4], s_q1, f_ext[2][3] * x36),
+            ) + x591 + Self::mul_add(x61, x581, x62 * x580);
+        let x595 = Self::mul_add(x56, x465, Self::mul_add(x55, x464, x54 * x463))
+            - Self::mul_add(-x460, x542, x462 * x540)
+            + Self::mul_add(
+                f_ext[2][5],
+                x39,
+                Self::mul_add(f_ext[2][4], x5, f_ext[2][3] * x38),
+            ) + x592 + Self::mul_add(-x60, x581, x62 * x579);
+        let x596 = Self::mul_add(x59, x465, Self::mul_add(x58, x464, x57 * x463))
+            - Self::mul_add(x460, x541, x461 * x540)
+            + Self::mul_add(
+                f_ext[2][5],
+                x41,
+                Self::mul_add(f_ext[2][4], x7, f_ext[2][3] * x40),
+            ) + x593 - Self::mul_add(x60, x580, x61 * x579);
         let x597 = tau[0]
             + (f_ext[0][3]
                 + (Self::mul_add(x21, x450, x19 * x449)
                     + Self::mul_add(x444, x537, x445 * x536)
                     + Self::mul_add(-f_ext[1][4], s_q1, f_ext[1][3] * c_q1) + x594
-                    + Self::mul_add(-x33, x584, x34 * x583))
-                - Self::mul_add(x1, x539 + x584, x2 * (x538 + x583)));
+                    - Self::mul_add(x33, x584, x34 * x583))
+                + Self::mul_add(-x1, x539 + x584, x2 * (x538 + x583)));
         let x598 = Self::mul_add(
-            -s_q0,
-            Self::mul_add(
-                -f_ext[1][5],
-                s_q0,
-                Self::mul_add(f_ext[1][4], x5, f_ext[1][3] * x4),
-            )
-                - (Self::mul_add(-qd[0], x537, x445 * x535)
-                    - Self::mul_add(x26, x450, x24 * x449)) + x595
-                - Self::mul_add(x32, x584, x34 * x582),
-            c_q0
-                * (Self::mul_add(
+            -c_q0,
+            Self::mul_add(x31, x450, x29 * x449)
+                - Self::mul_add(qd[0], x536, x444 * x535)
+                + Self::mul_add(
                     f_ext[1][5],
                     c_q0,
                     Self::mul_add(f_ext[1][4], x7, f_ext[1][3] * x6),
-                )
-                    - (Self::mul_add(qd[0], x536, x444 * x535)
-                        - Self::mul_add(x31, x450, x29 * x449)) + x596
-                    + Self::mul_add(x32, x583, x33 * x582)),
+                ) + x596 + Self::mul_add(-x32, x583, x33 * x582),
+            s_q0
+                * (Self::mul_add(x26, x450, x24 * x449)
+                    - Self::mul_add(-qd[0], x537, x445 * x535)
+                    + Self::mul_add(
+                        -f_ext[1][5],
+                        s_q0,
+                        Self::mul_add(f_ext[1][4], x5, f_ext[1][3] * x4),
+                    ) + x595 - Self::mul_add(x32, x584, x34 * x582)),
         );
         let x599 = 1.0
             / (12.19 + (x17 + x236)
-                + (x402 - Self::mul_add(x33, x280, x34 * x281)
-                    + Self::mul_add(
-                        -x1,
-                        Self::mul_add(-105.98, x1, x280),
+                - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+                    - Self::mul_add(
+                        x1,
+                        Self::mul_add(105.98, x1, x280),
                         x2 * Self::mul_add(105.98, x2, x281),
                     )));
         let x600 = x405 * x599;
@@ -6140,25 +6100,25 @@ impl SsrmsRecurrent {
         let x604 = x409 * x599;
         let x605 = x410 * x599;
         let x606 = 1.0 / Self::mul_add(-x405, x600, x413);
-        let x607 = Self::mul_add(-x405, x601, Self::mul_add(-s_q0, x414, c_q0 * x415));
+        let x607 = Self::mul_add(-x405, x601, Self::mul_add(-c_q0, x415, s_q0 * x414));
         let x608 = x606 * x607;
         let x609 = Self::mul_add(-x405, x602, x416);
         let x610 = x606 * x609;
-        let x611 = Self::mul_add(-x405, x603, x417);
+        let x611 = Self::mul_add(x405, x603, x417);
         let x612 = x606 * x611;
         let x613 = Self::mul_add(-x405, x604, x418);
         let x614 = x606 * x613;
-        let x615 = Self::mul_add(-x405, x605, Self::mul_add(-s_q0, x411, c_q0 * x412));
+        let x615 = Self::mul_add(-x405, x605, Self::mul_add(-c_q0, x412, s_q0 * x411));
         let x616 = x606 * x615;
         let x617 = Self::mul_add(
             -x406,
             x601,
-            Self::mul_add(x7, x421, Self::mul_add(-s_q1, x419, x5 * x420)),
+            Self::mul_add(-x7, x421, Self::mul_add(-x5, x420, s_q1 * x419)),
         );
         let x618 = 1.0 / Self::mul_add(-x607, x608, x617);
         let x619 = Self::mul_add(-x607, x610, Self::mul_add(-x406, x602, x423));
         let x620 = x618 * x619;
-        let x621 = Self::mul_add(-x607, x612, Self::mul_add(-x406, x603, x425));
+        let x621 = Self::mul_add(x607, x612, Self::mul_add(-x406, x603, x425));
         let x622 = x618 * x621;
         let x623 = Self::mul_add(-x607, x614, Self::mul_add(-x406, x604, x427));
         let x624 = x618 * x623;
@@ -6167,13 +6127,13 @@ impl SsrmsRecurrent {
         let x627 = Self::mul_add(
             -x407,
             x602,
-            Self::mul_add(x7, x431, Self::mul_add(-s_q1, x429, x5 * x430)),
+            Self::mul_add(-x7, x431, Self::mul_add(-x5, x430, s_q1 * x429)),
         );
         let x628 = 1.0 / Self::mul_add(-x619, x620, Self::mul_add(-x609, x610, x627));
         let x629 = Self::mul_add(
             -x619,
             x622,
-            Self::mul_add(-x609, x612, Self::mul_add(-x407, x603, x433)),
+            Self::mul_add(x609, x612, Self::mul_add(-x407, x603, x433)),
         );
         let x630 = x628 * x629;
         let x631 = Self::mul_add(
@@ -6191,7 +6151,7 @@ impl SsrmsRecurrent {
         let x635 = Self::mul_add(
             -x408,
             x603,
-            Self::mul_add(x7, x438, Self::mul_add(-s_q1, x436, x5 * x437)),
+            Self::mul_add(x7, x438, Self::mul_add(x5, x437, s_q1 * x436)),
         );
         let x636 = Self::mul_add(
             -x629,
@@ -6202,14 +6162,14 @@ impl SsrmsRecurrent {
         let x638 = Self::mul_add(
             -x621,
             x624,
-            Self::mul_add(-x611, x614, Self::mul_add(-x408, x604, x440)),
+            Self::mul_add(x611, x614, Self::mul_add(-x408, x604, x440)),
         );
         let x639 = Self::mul_add(-x629, x632, x638);
         let x640 = x637 * x639;
         let x641 = Self::mul_add(
             -x621,
             x626,
-            Self::mul_add(-x611, x616, Self::mul_add(-x408, x605, x428)),
+            Self::mul_add(x611, x616, Self::mul_add(-x408, x605, x428)),
         );
         let x642 = Self::mul_add(-x629, x634, x641);
         let x643 = x637 * x642;
@@ -6247,28 +6207,28 @@ impl SsrmsRecurrent {
             Self::mul_add(-x625, x626, Self::mul_add(-x615, x616, x651)),
         );
         let x653 = 1.0 / Self::mul_add(-x649, x650, Self::mul_add(-x642, x643, x652));
-        let x654 = Self::mul_add(-x597, x600, tau[1] + x598);
+        let x654 = Self::mul_add(x597, x600, tau[1] - x598);
         let x655 = Self::mul_add(
-            -x597,
+            x597,
             x601,
-            tau[2] + Self::mul_add(x7, x596, Self::mul_add(-s_q1, x594, x5 * x595)),
+            tau[2] - Self::mul_add(-x7, x596, Self::mul_add(-x5, x595, s_q1 * x594)),
         );
         let x656 = Self::mul_add(-x608, x654, x655);
         let x657 = Self::mul_add(
-            -x597,
+            x597,
             x602,
-            tau[3] + Self::mul_add(x7, x593, Self::mul_add(-s_q1, x591, x5 * x592)),
+            tau[3] - Self::mul_add(-x7, x593, Self::mul_add(-x5, x592, s_q1 * x591)),
         );
         let x658 = Self::mul_add(-x620, x656, Self::mul_add(-x610, x654, x657));
         let x659 = Self::mul_add(
-            -x597,
+            x597,
             x603,
-            tau[4] + Self::mul_add(x7, x590, Self::mul_add(-s_q1, x588, x5 * x589)),
+            tau[4] - Self::mul_add(x7, x590, Self::mul_add(x5, x589, s_q1 * x588)),
         );
         let x660 = Self::mul_add(
             -x630,
             x658,
-            Self::mul_add(-x622, x656, Self::mul_add(-x612, x654, x659)),
+            Self::mul_add(-x622, x656, Self::mul_add(x612, x654, x659)),
         );
         let x661 = Self::mul_add(
             -x597,
@@ -6276,50 +6236,50 @@ impl SsrmsRecurrent {
             tau[5] + Self::mul_add(x97, x587, Self::mul_add(x95, x586, x93 * x585)),
         );
         let x662 = Self::mul_add(
-            -x632,
+            x632,
             x658,
-            Self::mul_add(-x624, x656, Self::mul_add(-x614, x654, x661)),
+            Self::mul_add(x624, x656, Self::mul_add(x614, x654, x661)),
         );
-        let x663 = Self::mul_add(-x640, x660, x662);
+        let x663 = Self::mul_add(x640, x660, x662);
         let x664 = Self::mul_add(
             -x597,
             x605,
             tau[6] + Self::mul_add(x118, x572, Self::mul_add(x116, x571, x114 * x570)),
         );
         let x665 = Self::mul_add(
-            -x634,
+            x634,
             x658,
-            Self::mul_add(-x626, x656, Self::mul_add(-x616, x654, x664)),
+            Self::mul_add(x626, x656, Self::mul_add(x616, x654, x664)),
         );
-        let x666 = x653 * Self::mul_add(-x650, x663, Self::mul_add(-x643, x660, x665));
+        let x666 = x653 * Self::mul_add(-x650, x663, Self::mul_add(x643, x660, x665));
         let x667 = Self::mul_add(-x650, x666, x646 * x663);
-        let x668 = Self::mul_add(-x643, x666, Self::mul_add(-x640, x667, x637 * x660));
+        let x668 = Self::mul_add(x643, x666, Self::mul_add(x640, x667, x637 * x660));
         let x669 = Self::mul_add(
-            -x634,
+            x634,
             x666,
-            Self::mul_add(-x632, x667, Self::mul_add(-x630, x668, x628 * x658)),
+            Self::mul_add(x632, x667, Self::mul_add(-x630, x668, x628 * x658)),
         );
         let x670 = Self::mul_add(
-            -x624,
+            x624,
             x667,
             Self::mul_add(-x622, x668, Self::mul_add(-x620, x669, x618 * x656)),
         );
-        let x671 = Self::mul_add(-x626, x666, x670);
+        let x671 = Self::mul_add(x626, x666, x670);
         let x672 = Self::mul_add(
-            -x612,
+            x612,
             x668,
             Self::mul_add(-x610, x669, Self::mul_add(-x608, x671, x606 * x654)),
         );
-        let x673 = Self::mul_add(-x616, x666, Self::mul_add(-x614, x667, x672));
+        let x673 = Self::mul_add(x616, x666, Self::mul_add(x614, x667, x672));
         let x674 = Self::mul_add(
-            -x602,
+            x602,
             x669,
-            Self::mul_add(-x601, x671, Self::mul_add(-x600, x673, x597 * x599)),
+            Self::mul_add(x601, x671, Self::mul_add(x600, x673, x597 * x599)),
         );
         let x675 = Self::mul_add(
             -x605,
             x666,
-            Self::mul_add(-x604, x667, Self::mul_add(-x603, x668, x674)),
+            Self::mul_add(-x604, x667, Self::mul_add(x603, x668, x674)),
         );
         [x675, x673, x671, x669, x668, x667, x666]
     }

@@ -16,7 +16,7 @@
 //! * [`Convention::Folded`] — the operations left after folding at construction: constants fold,
 //!   `0·x`, `1·x`, `−1·x`, `x ± 0`, `0 − x`, `x − x`, `x/1`, `0/x`, `−(−x)` vanish, and signs are
 //!   normalised (`(−a)·b → −(a·b)`, `a·(−k) → −(a·k)` for a constant `k`, `a + (−b) → a − b`,
-//!   `(−a) − b → −(a + b)`, …) so that negations
+//!   `(−a) − b → −(a + b)`, `b − a → −(a − b)` for the older `a`, …) so that negations
 //!   float to the top where they are free. Operations that then hit the hash-cons table are still
 //!   counted (no CSE yet).
 //! * [`Convention::Emitted`] — the unique non-leaf nodes reachable from the outputs: folding plus
@@ -414,6 +414,10 @@ impl Graph {
     fn sub_core(&mut self, a: u32, b: u32) -> u32 {
         if a == b {
             self.constant(0.0)
+        } else if a > b {
+            // `a − b = −(b − a)` exactly: one node for both orders.
+            let d = self.mk(Op::Sub(b, a));
+            self.neg(d)
         } else {
             self.mk(Op::Sub(a, b))
         }

@@ -52,7 +52,7 @@
 //!
 //! | model | N | LDLᵀ, CRBA + RNEA | LDLᵀ, cheapest | ABA | div (cheapest LDLᵀ / ABA) | emitted |
 //! |---|---:|---:|---:|---:|---:|---|
-//! | SSRMS (Nguyen & Hughes 1994) | 7 | 875 | 795 | 943 | 7 / 5 | LDLᵀ |
+//! | SSRMS (Nguyen & Hughes 1994) | 7 | 871 | 791 | 943 | 7 / 5 | LDLᵀ |
 //! | random chain | 4 | 1047 | 954 | 1322 | 4 / 3 | LDLᵀ |
 //! | random chain | 8 | 3461 | 3204 | 3502 | 8 / 7 | LDLᵀ |
 //! | random chain | 16 | 11249 | 10393 | 7863 | 16 / 15 | ABA |
@@ -64,12 +64,12 @@
 //! top of the mass matrix's `O(N²)`. **Crossovers** (every N from 4 to 24 measured): ABA is
 //! cheaper than LDLᵀ on the CRBA and the RNEA from **N = 9** (4047 against 4207), and than the
 //! generator's cheapest LDLᵀ from **N = 10** (4592 against 4675), which is where generated code
-//! switches to it; at N = 64 it needs 4.6× fewer operations. On SSRMS (N = 7) ABA costs 943 against 875 for LDLᵀ
-//! on the CRBA and the RNEA, and LDLᵀ with the classical Newton–Euler bias costs 795 and is
+//! switches to it; at N = 64 it needs 4.6× fewer operations. On SSRMS (N = 7) ABA costs 943 against 871 for LDLᵀ
+//! on the CRBA and the RNEA, and LDLᵀ with the classical Newton–Euler bias costs 791 and is
 //! emitted: its axes are coordinate axes (`I^a S = 0` gives zero rows and columns)
 //! and its joint placements signed permutations and offsets along one axis, which fold. A
 //! free-floating base makes LDLᵀ factor `6 + N` speeds while ABA adds one 6×6 solve: the 7-dof
-//! free-flyer of `kanegen-generated` emits ABA (2869 against 2950 for its cheapest LDLᵀ, its
+//! free-flyer of `kanegen-generated` emits ABA (2869 against 2948 for its cheapest LDLᵀ, its
 //! axes being coordinate axes too). The
 //! leaf's `D` is a constant of the model, hence `N − 1` divisions.
 //!
