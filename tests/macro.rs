@@ -13,6 +13,11 @@ use std::path::Path;
 kanegen::dynamics!(Random3, "tests/data/codegen/random3_prismatic.toml");
 kanegen::dynamics!(Random5, "tests/data/codegen/random5.toml");
 kanegen::dynamics!(
+    Random5OwnFrames,
+    "tests/data/codegen/random5.toml",
+    canonical = false
+);
+kanegen::dynamics!(
     Random5Gravity,
     "tests/data/codegen/random5.toml",
     gravity = [0.3, -1.2, -9.81],
@@ -121,6 +126,36 @@ fn random_models_through_the_macro_equal_interpreted() {
             .any(|c| c.mass_matrix_method == chosen.mass_matrix_method
                 && c.bias_method == chosen.bias_method));
     }
+}
+
+/// `canonical = false` traces in the model's own frames only: every candidate says so, the
+/// default's joint-space functions are canonical and cheaper, and both give the same `(M, c)`.
+#[test]
+fn canonical_frames_can_be_turned_off() {
+    assert!(Random5OwnFrames::CANDIDATES
+        .iter()
+        .all(|c| c.frames == "model"));
+    let canonical = |f: &str| Random5::OP_COUNTS.iter().find(|c| c.function == f).unwrap();
+    let own = |f: &str| {
+        Random5OwnFrames::OP_COUNTS
+            .iter()
+            .find(|c| c.function == f)
+            .unwrap()
+    };
+    for f in ["mass_matrix", "mass_matrix_and_nonlinear_effects"] {
+        assert_eq!(canonical(f).frames, "canonical", "{f}");
+        assert!(
+            canonical(f).mul + canonical(f).add < own(f).mul + own(f).add,
+            "{f}"
+        );
+    }
+    let q = [0.3, -1.1, 0.7, 2.0, -0.4];
+    let v = [0.5, 0.1, -0.9, 0.2, 1.3];
+    let (m1, c1) = Random5::mass_matrix_and_nonlinear_effects(&q, &v);
+    let (m2, c2) = Random5OwnFrames::mass_matrix_and_nonlinear_effects(&q, &v);
+    let a: Vec<f64> = m1.iter().flatten().chain(&c1).copied().collect();
+    let b: Vec<f64> = m2.iter().flatten().chain(&c2).copied().collect();
+    assert!(rel_err(&a, &b) < 1e-13);
 }
 
 /// The chain with its last body's mass properties replaced.

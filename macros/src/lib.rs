@@ -31,6 +31,7 @@ struct Input {
     fma_path: Option<syn::Path>,
     target_fma: bool,
     regroup: bool,
+    canonical: bool,
     snap: Option<f64>,
     algorithm: Option<kanegen_codegen::kanegen_dynamics::Methods>,
     form: kanegen_codegen::Form,
@@ -73,6 +74,7 @@ impl Parse for Input {
             fma_path: None,
             target_fma: true,
             regroup: true,
+            canonical: true,
             snap: None,
             algorithm: None,
             form: kanegen_codegen::Form::Auto,
@@ -124,6 +126,7 @@ impl Parse for Input {
                 }
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
+                "canonical" => out.canonical = input.parse::<LitBool>()?.value,
                 "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
                 "algorithm" => {
                     let name: LitStr = input.parse()?;
@@ -164,7 +167,8 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, snap, algorithm, form)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, canonical, snap, algorithm, \
+                             form)"
                         ),
                     ))
                 }
@@ -214,6 +218,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.float = input.float;
     opts.fma = input.fma;
     opts.regroup = input.regroup;
+    opts.canonical = input.canonical;
     opts.target_fma = input.target_fma;
     opts.algorithm = input.algorithm;
     if let Some(snap) = input.snap {
