@@ -39,21 +39,12 @@ impl BodyFrames {
 
     /// The frames `f` is traced in: canonical ones too when [`Options::canonical`] is on, no
     /// algorithm is forced ([`Options::algorithm`]: the paper's algorithm on the model as given),
-    /// `f` reads and writes joint-space quantities only (not a named frame, the base reaction,
-    /// the momentum or body-frame wrenches) and there is no runtime payload (given in its body's
+    /// `f` is [`Function::is_joint_space`] and there is no runtime payload (given in its body's
     /// own frame).
     #[must_use]
     pub fn for_function(f: Function, opts: &Options) -> &'static [BodyFrames] {
-        let joint_space = matches!(
-            f,
-            Function::MassMatrix
-                | Function::NonlinearEffects
-                | Function::Gravity
-                | Function::InverseDynamics
-                | Function::ForwardDynamics
-                | Function::MassMatrixAndNonlinearEffects
-        );
-        if opts.canonical && opts.algorithm.is_none() && joint_space && !opts.runtime_payload {
+        if opts.canonical && opts.algorithm.is_none() && f.is_joint_space() && !opts.runtime_payload
+        {
             &[BodyFrames::Model, BodyFrames::Canonical]
         } else {
             &[BodyFrames::Model]
@@ -86,14 +77,16 @@ pub struct Choice {
 }
 
 impl Choice {
+    /// The chosen candidate (`None` only for a `Choice` built by hand without it).
+    #[must_use]
+    pub fn candidate(&self) -> Option<&Candidate> {
+        self.candidates.iter().find(|c| self.is_chosen(c))
+    }
+
     /// Emitted counts of the chosen candidate.
     #[must_use]
     pub fn counts(&self) -> Counts {
-        self.candidates
-            .iter()
-            .find(|c| c.methods == self.chosen && c.frames == self.frames)
-            .map(|c| c.counts)
-            .unwrap_or_default()
+        self.candidate().map(|c| c.counts).unwrap_or_default()
     }
 
     /// Whether `c` is the chosen candidate.

@@ -299,11 +299,7 @@ fn generate_items_with(
         })
     };
     let emitted = choices.iter().zip(&fmas).map(|(ch, k)| {
-        let chosen = ch
-            .candidates
-            .iter()
-            .find(|c| ch.is_chosen(c))
-            .expect("the chosen candidate was traced");
+        let chosen = ch.candidate().expect("the chosen candidate was traced");
         entry(ch, chosen, *k)
     });
     let all = choices

@@ -163,6 +163,23 @@ impl Function {
         )
     }
 
+    /// Whether it reads and writes joint-space quantities only (`q`, `q̇`, `q̈`, `τ`, `M`, `c`,
+    /// `g`; on a free-floating base also the base's, in base coordinates), so it can be computed
+    /// in any body frames. Not: named frames, body-frame wrenches, and the base reaction and the
+    /// momentum, which code generation reads from the model as given.
+    #[must_use]
+    pub fn is_joint_space(self) -> bool {
+        matches!(
+            self,
+            Function::MassMatrix
+                | Function::NonlinearEffects
+                | Function::Gravity
+                | Function::InverseDynamics
+                | Function::ForwardDynamics
+                | Function::MassMatrixAndNonlinearEffects
+        )
+    }
+
     /// Whether its result involves the mass matrix (and so a mass-matrix method; with LDLᵀ for
     /// forward dynamics).
     #[must_use]
