@@ -85,7 +85,7 @@ fn random_trees_keep_their_dynamics() {
             ..Default::default()
         };
         let m = random_tree(&spec, 70 + n as u64);
-        let c = m.canonical();
+        let c = m.canonical().unwrap();
         assert!(c.model.joints().iter().all(|j| j.axis == [0.0, 0.0, 1.0]));
         assert_eq!(c.report.turned, n, "random axes: every body turns");
         worst = worst.max(compare(&m, &c.model, n as u64));
@@ -109,7 +109,7 @@ fn pinocchio_robots_keep_their_dynamics_and_lose_their_noise() {
         let m = load_model(path).unwrap();
         // A loose tolerance also takes `rpy = 1.570796325`'s 4.9e-12 residues, and changes the
         // robot by about as much.
-        let loose = m.canonical_with(1e-9);
+        let loose = m.canonical_with(1e-9).unwrap();
         assert!(loose.report.largest_snap <= 1e-9);
         let d = compare(&m, &loose.model, i as u64);
         assert!(
@@ -119,7 +119,7 @@ fn pinocchio_robots_keep_their_dynamics_and_lose_their_noise() {
             loose.report.largest_snap
         );
         loose_snapped += loose.report.snapped;
-        let c = m.canonical();
+        let c = m.canonical().unwrap();
         assert!(c.report.largest_snap <= DEFAULT_SNAP);
         snapped += c.report.snapped;
         // Snapping alone (what the code generator applies): no frame turned, every joint's axis
@@ -144,7 +144,7 @@ fn pinocchio_robots_keep_their_dynamics_and_lose_their_noise() {
         assert!(d < TOL, "{}: {d:e}", path.display());
         if m.base_inertial().is_some() {
             let f = m.clone().with_base_kind(BaseKind::FreeFloating).unwrap();
-            let cf = f.canonical();
+            let cf = f.canonical().unwrap();
             assert_eq!(cf.model.base_kind(), BaseKind::FreeFloating);
             let d = compare(&f, &cf.model, 100 + i as u64);
             assert!(d < TOL, "{} free-floating: {d:e}", path.display());
@@ -182,7 +182,7 @@ fn coordinate_axes_turn_by_signed_permutations_exactly() {
         j.origin.rotation = kanegen::model::placement::I3;
     }
     let m = Model::new(m.name(), m.base(), None, joints).unwrap();
-    let c = m.canonical();
+    let c = m.canonical().unwrap();
     let originals: Vec<f64> = m
         .joints()
         .iter()
@@ -201,4 +201,43 @@ fn coordinate_axes_turn_by_signed_permutations_exactly() {
     }
     assert_eq!(c.report.snapped, 0);
     assert!(compare(&m, &c.model, 9) < TOL);
+}
+
+/// A model at its validation bounds (inertia exactly 1e18 kg·m², found by `tests/fuzz.rs`):
+/// turning its frames may round a number past the bound, so `canonical` says so instead of
+/// panicking, and the generator keeps to the model's own frames.
+#[test]
+fn a_model_at_its_bounds_keeps_its_own_frames() {
+    let text = r#"
+name = "at_bounds"
+[[joint]]
+name = "j0"
+type = "revolute"
+xyz = [0.0, 0.0, 0.0]
+rpy = [0.0, 0.0, 0.0]
+axis = [0.0, 1.6692606987310081, -1.7946724189125696]
+[joint.body]
+mass = 0.26554066897078704
+com = [0.0, 0.0, 0.0]
+inertia = { ixx = 0.5, iyy = 0.6, izz = 0.7 }
+[[joint]]
+name = "j1"
+type = "revolute"
+xyz = [0.0, 0.0, 0.0]
+rpy = [0.0, 0.0, 0.0]
+axis = [0.6183691575941561, 0.0, 0.28166316518857754]
+[joint.body]
+mass = 1.2051721939607931
+com = [0.0, 0.0, 0.0]
+inertia = { ixx = 1e18, iyy = 1e18, izz = 1e18 }
+"#;
+    let m = kanegen::model::io::parse_toml(text).unwrap();
+    let err = m.canonical().unwrap_err();
+    assert!(err.to_string().contains("inertia"), "{err}");
+    let g =
+        kanegen::codegen::generate_items(&m, &kanegen::codegen::Options::new("AtBounds")).unwrap();
+    assert!(g
+        .choices
+        .iter()
+        .all(|ch| ch.candidates.iter().all(|c| c.frames.name() == "model")));
 }

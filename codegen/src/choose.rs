@@ -246,9 +246,13 @@ pub fn choose(
     let mut best: Option<(u64, Methods, BodyFrames, Traced)> = None;
     let mut traced = Vec::new();
     let frames = BodyFrames::for_function(f, opts);
+    // None also where the turned model fails validation (numbers at its bounds): then only
+    // the model's own frames are traced.
     let canonical = frames
         .contains(&BodyFrames::Canonical)
-        .then(|| model.canonical_with(opts.snap).model);
+        .then(|| model.canonical_with(opts.snap).ok())
+        .flatten()
+        .map(|c| c.model);
     let all = match opts.algorithm {
         // Forced: the one algorithm for whatever it computes, the others as usual.
         Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
@@ -260,7 +264,8 @@ pub fn choose(
         for &fr in frames {
             let subject = match (fr, &canonical) {
                 (BodyFrames::Canonical, Some(c)) => c,
-                _ => model,
+                (BodyFrames::Canonical, None) => continue,
+                (BodyFrames::Model, _) => model,
             };
             let t = trace(Subject::Model(subject), f, m, &spec)?;
             let c = t.trace.counts(Convention::Emitted);

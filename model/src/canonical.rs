@@ -25,7 +25,7 @@
 //! ```
 //! use kanegen_model::random::{random_chain, ChainSpec};
 //! let model = random_chain(&ChainSpec { n: 4, ..Default::default() }, 3);
-//! let c = model.canonical();
+//! let c = model.canonical().unwrap();
 //! assert!(c.model.joints().iter().all(|j| j.axis == [0.0, 0.0, 1.0]));
 //! assert_eq!(c.report.turned, 4);
 //! ```
@@ -136,8 +136,10 @@ impl Model {
     /// The same robot in canonical frames ([module docs](crate::canonical)): representation
     /// residues snapped ([`DEFAULT_SNAP`]), every joint axis `z`, each body's `x` along the
     /// common normal to its first child's axis.
-    #[must_use]
-    pub fn canonical(&self) -> Canonical {
+    ///
+    /// # Errors
+    /// As [`Model::canonical_with`].
+    pub fn canonical(&self) -> Result<Canonical, crate::ModelError> {
         self.canonical_with(DEFAULT_SNAP)
     }
 
@@ -206,8 +208,12 @@ impl Model {
     }
 
     /// [`Model::canonical`] with the snap tolerance `tol` (0 snaps nothing).
-    #[must_use]
-    pub fn canonical_with(&self, tol: f64) -> Canonical {
+    ///
+    /// # Errors
+    /// When turning the frames moves a number of a model at its validation bounds past them
+    /// (an inertia of exactly 1e18 kg·m² may come out 1.0000000000000001e18): the model in its
+    /// own frames is the one to use.
+    pub fn canonical_with(&self, tol: f64) -> Result<Canonical, crate::ModelError> {
         let mut rep = CanonicalReport::default();
         let (mut joints, frames, base_inertial) = self.snap_parts(tol, &mut rep);
         // R_j for every body: z along the axis, x along the common normal to the first child's
@@ -259,9 +265,7 @@ impl Model {
                 }
             })
             .collect();
-        let model = self
-            .rebuilt(joints, frames, base_inertial)
-            .expect("turning body frames keeps a valid model valid");
-        Canonical { model, report: rep }
+        let model = self.rebuilt(joints, frames, base_inertial)?;
+        Ok(Canonical { model, report: rep })
     }
 }
