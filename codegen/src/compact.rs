@@ -168,17 +168,6 @@ pub fn has_body(f: Function) -> bool {
     )
 }
 
-fn libm(opts: &Options) -> Result<TokenStream, Error> {
-    Ok(match &opts.libm_tokens {
-        Some(t) => t.clone(),
-        None => {
-            let p: syn::Path = syn::parse_str(&opts.libm_path)
-                .map_err(|e| Error(format!("libm path `{}`: {e}", opts.libm_path)))?;
-            quote!(#p)
-        }
-    })
-}
-
 type M3 = [[f64; 3]; 3];
 
 fn mat(float: Float, m: &M3) -> TokenStream {
@@ -211,8 +200,13 @@ fn mul(a: &M3, b: &M3) -> M3 {
 pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
     let fl = opts.float.ty();
     let float = opts.float;
-    let libm = libm(opts)?;
-    let sincos = float.libm_fn("sincos");
+    let libm = opts.libm()?;
+    let sincos = if opts.table_sincos() {
+        quote!(Self::sincos)
+    } else {
+        let f = float.libm_fn("sincos");
+        quote!(#libm::#f)
+    };
     let n = model.dof();
     let nl = Literal::usize_unsuffixed(n);
     // The payload body neither gives nor receives (its inertia is a runtime input).
@@ -351,7 +345,7 @@ pub fn items(model: &Model, opts: &Options) -> Result<TokenStream, Error> {
             let mut x = [([[0.0; 3]; 3], [0.0; 3]); #nl];
             for (j, xj) in x.iter_mut().enumerate() {
                 let (s, c, d) = if Self::CX_REVOLUTE[j] {
-                    let (s, c) = #libm::#sincos(q[j]);
+                    let (s, c) = #sincos(q[j]);
                     (s, c, 0.0)
                 } else {
                     (0.0, 0.0, q[j])

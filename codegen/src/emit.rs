@@ -78,6 +78,8 @@ pub struct Emitter {
     libm: TokenStream,
     float: Float,
     fma: Option<TokenStream>,
+    /// Sines and cosines by the type's `Self::sincos` ([`Options::table_sincos`]), not libm.
+    table_sincos: bool,
 }
 
 impl Emitter {
@@ -86,14 +88,7 @@ impl Emitter {
     /// # Errors
     /// If [`Options::libm_path`] or [`Options::fma_path`] is not a Rust path.
     pub fn new(opts: &Options) -> Result<Self, Error> {
-        let libm = match &opts.libm_tokens {
-            Some(t) => t.clone(),
-            None => {
-                let libm: syn::Path = syn::parse_str(&opts.libm_path)
-                    .map_err(|e| Error(format!("libm path `{}`: {e}", opts.libm_path)))?;
-                quote!(#libm)
-            }
-        };
+        let libm = opts.libm()?;
         let fma = if opts.fma {
             Some(match &opts.fma_path {
                 Some(p) => {
@@ -115,6 +110,7 @@ impl Emitter {
             libm,
             float: opts.float,
             fma,
+            table_sincos: opts.table_sincos(),
         })
     }
 }
@@ -202,7 +198,12 @@ pub fn emit_body_streamed(
     stmt: &mut dyn FnMut(TokenStream),
 ) -> Body {
     let inputs: Vec<TokenStream> = t.inputs.iter().map(input_tokens).collect();
-    let Emitter { libm, float, fma } = emitter;
+    let Emitter {
+        libm,
+        float,
+        fma,
+        table_sincos,
+    } = emitter;
     let float = *float;
     let trace = &t.trace;
     let sched = trace.schedule();
@@ -338,24 +339,41 @@ pub fn emit_body_streamed(
                 let arg = get(*a).tokens;
                 let base = trig_base(a.id(), counter);
                 counter += 1;
+                // The type's own `sincos` (a table and short polynomials) takes both at the
+                // price of one; libm has `sin` and `cos` apart.
+                let (sin_call, cos_call, sincos_call) = if *table_sincos {
+                    (
+                        quote!(Self::sincos(#arg).0),
+                        quote!(Self::sincos(#arg).1),
+                        quote!(Self::sincos(#arg)),
+                    )
+                } else {
+                    let (s, c, sc) = (
+                        float.libm_fn("sin"),
+                        float.libm_fn("cos"),
+                        float.libm_fn("sincos"),
+                    );
+                    (
+                        quote!(#libm::#s(#arg)),
+                        quote!(#libm::#c(#arg)),
+                        quote!(#libm::#sc(#arg)),
+                    )
+                };
                 match trig[&a.id()] {
                     (Some(s), Some(c)) => {
                         let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
-                        let f = float.libm_fn("sincos");
-                        stmt(quote!(let (#sn, #cn) = #libm::#f(#arg);));
+                        stmt(quote!(let (#sn, #cn) = #sincos_call;));
                         exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
                         exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (Some(s), None) => {
                         let sn = format_ident!("s_{}", base);
-                        let f = float.libm_fn("sin");
-                        stmt(quote!(let #sn = #libm::#f(#arg);));
+                        stmt(quote!(let #sn = #sin_call;));
                         exprs.borrow_mut().insert(s, Expr::atom(quote!(#sn)));
                     }
                     (None, Some(c)) => {
                         let cn = format_ident!("c_{}", base);
-                        let f = float.libm_fn("cos");
-                        stmt(quote!(let #cn = #libm::#f(#arg);));
+                        stmt(quote!(let #cn = #cos_call;));
                         exprs.borrow_mut().insert(c, Expr::atom(quote!(#cn)));
                     }
                     (None, None) => unreachable!("trig node without entry"),

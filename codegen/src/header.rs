@@ -115,6 +115,18 @@ pub fn lines(
             ),
         },
     ];
+    if opts.table_sincos()
+        && choices
+            .iter()
+            .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0))
+    {
+        h.push(
+            "Sines and cosines: `Self::sincos`, inlined and branch-free for |x| < 32768 (a table \
+             of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), \
+             `libm::sincos` beyond; within 2 ulp of libm's (`kanegen accuracy` measures it)."
+                .into(),
+        );
+    }
     let total: u64 = fmas.iter().sum();
     let per = choices
         .iter()

@@ -34,6 +34,7 @@ pub mod compact;
 pub mod emit;
 pub mod header;
 mod options;
+pub mod sincos;
 
 pub use choose::Choice;
 pub use emit::{Body, Emitter, Shape};
@@ -365,8 +366,21 @@ fn generate_items_with(
     } else {
         quote!()
     };
-    let mul_add_item = if !opts.fma && opts.target_fma && fmas.iter().any(|k| *k > 0) {
+    // The type's own sine–cosine, where a function takes one (its products fused through
+    // `Self::mul_add` like the functions').
+    let sincos_item = opts.table_sincos()
+        && (compact
+            || choices
+                .iter()
+                .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0)));
+    let target_mul_add = !opts.fma && opts.target_fma;
+    let mul_add_item = if target_mul_add && (sincos_item || fmas.iter().any(|k| *k > 0)) {
         mul_add_fn(opts.float)
+    } else {
+        quote!()
+    };
+    let sincos_item = if sincos_item {
+        sincos::item(&opts.libm()?, target_mul_add)
     } else {
         quote!()
     };
@@ -434,6 +448,8 @@ fn generate_items_with(
             #(#fns)*
 
             #mul_add_item
+
+            #sincos_item
 
             #compact_items
         }
@@ -752,8 +768,9 @@ mod tests {
             opts.form = Form::Unrolled;
             let g = generate_items(&chain, &opts).unwrap();
             let mut fns = count_ops(g.items);
-            // The private `Self::mul_add` helper is not a generated function.
+            // The helpers `Self::mul_add` and `Self::sincos` are not generated functions.
             fns.remove("mul_add");
+            fns.remove("sincos");
             assert_eq!(fns.len(), 7, "all functions, gravity included");
             if fuse != Fuse::None {
                 assert!(fns.values().all(|c| c.fma > 0), "every function fuses");

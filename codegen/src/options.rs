@@ -64,6 +64,10 @@ pub struct Options {
     /// Trace the joint-space functions in the model's canonical frames too
     /// ([`crate::choose::BodyFrames`]) and emit whichever is cheaper. Default `true`.
     pub canonical: bool,
+    /// Take sines and cosines from libm (`sincos`, `sin`, `cos`) instead of the emitted
+    /// `Self::sincos` ([`crate::sincos`]: a table and short polynomials, branch-free, within
+    /// 2 ulp of libm's). Default `false`; `f32` code always uses libm's `sincosf`.
+    pub libm_trig: bool,
     /// Force one algorithm for every function that has a mass-matrix, bias or forward method
     /// instead of the cheapest candidate: a preset of [`Methods::PRESETS`] (`recurrent`, the
     /// paper's; `recurrent-r1`, `kane-direct`, `crba-base`, `spatial`) or [`Methods::ABA`]
@@ -181,6 +185,29 @@ impl Float {
 }
 
 impl Options {
+    /// The path of libm in the emitted code: [`Options::libm_tokens`], else
+    /// [`Options::libm_path`] parsed.
+    ///
+    /// # Errors
+    /// If [`Options::libm_path`] is not a Rust path.
+    pub(crate) fn libm(&self) -> Result<TokenStream, Error> {
+        Ok(match &self.libm_tokens {
+            Some(t) => t.clone(),
+            None => {
+                let p: syn::Path = syn::parse_str(&self.libm_path)
+                    .map_err(|e| Error(format!("libm path `{}`: {e}", self.libm_path)))?;
+                quote!(#p)
+            }
+        })
+    }
+
+    /// Whether the emitted code takes sines and cosines from its own `Self::sincos`
+    /// ([`crate::sincos`]): `f64` code without [`Options::libm_trig`].
+    #[must_use]
+    pub fn table_sincos(&self) -> bool {
+        self.float == Float::F64 && !self.libm_trig
+    }
+
     /// Defaults: space (no gravity), constant payload, `libm` path `libm`, structs `Payload` and
     /// `OpCount`, `f64`, products fused where the target has FMA ([`Options::target_fma`]), regrouped
     /// inertial parameters.
@@ -201,6 +228,7 @@ impl Options {
             regroup: true,
             snap: kanegen_model::canonical::DEFAULT_SNAP,
             canonical: true,
+            libm_trig: false,
             algorithm: None,
             form: Form::Auto,
         }

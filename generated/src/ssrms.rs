@@ -9,6 +9,7 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: per function the cheapest candidate (below).
+//! Sines and cosines: `Self::sincos`, inlined and branch-free for |x| < 32768 (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 2 ulp of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 1010 (`mass_matrix` 58, `nonlinear_effects` 113, `inverse_dynamics` 122, `forward_dynamics` 265, `mass_matrix_and_nonlinear_effects` 171, `forward_dynamics_with_wrenches` 281), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: 564 emitted operations in M + c, within the 4000 limit).
 //!
@@ -1129,11 +1130,11 @@ impl Ssrms {
     /// Methods: mass matrix `crba`: 120 mul, 97 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 58 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let (s_q1, c_q1) = Self::sincos(q[1]);
+        let (s_q2, c_q2) = Self::sincos(q[2]);
+        let (s_q3, c_q3) = Self::sincos(q[3]);
+        let (s_q4, c_q4) = Self::sincos(q[4]);
+        let (s_q5, c_q5) = Self::sincos(q[5]);
         let x5 = s_q5 * s_q5 * 35.074;
         let x6 = -35.074 + x5;
         let x7 = s_q5 * c_q5 * 35.074;
@@ -1273,7 +1274,7 @@ impl Ssrms {
     /// Methods: bias `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q1, c_q1) = Self::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
         let x3 = qd[0] * qd[0] * 0.7026;
@@ -1283,7 +1284,7 @@ impl Ssrms {
         let x7 = Self::mul_add(x1, x1, qd[1] * qd[1]);
         let x8 = x2 * 1647.2196721184;
         let x9 = 1650.6386721183999 * qd[1];
-        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let (s_q2, c_q2) = Self::sincos(q[2]);
         let x11 = Self::mul_add(-qd[1], s_q2, x1 * c_q2);
         let x12 = Self::mul_add(qd[1], c_q2, x1 * s_q2);
         let x13 = 0.5692 * x6;
@@ -1306,7 +1307,7 @@ impl Ssrms {
             x14,
             Self::mul_add(39234.474122, x18, Self::mul_add(-x11, x27, x19 * x25)),
         );
-        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let (s_q3, c_q3) = Self::sincos(q[3]);
         let x30 = Self::mul_add(-x12, s_q3, x11 * c_q3);
         let x31 = Self::mul_add(x12, c_q3, x11 * s_q3);
         let x32 = Self::mul_add(s_q2, x15, c_q2 * x13)
@@ -1328,7 +1329,7 @@ impl Ssrms {
             x34,
             Self::mul_add(24989.305802, x37, Self::mul_add(-x30, x44, x38 * x42)),
         );
-        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let (s_q4, c_q4) = Self::sincos(q[4]);
         let x47 = Self::mul_add(-x31, s_q4, x30 * c_q4);
         let x48 = Self::mul_add(x31, c_q4, x30 * s_q4);
         let x49 = Self::mul_add(
@@ -1353,14 +1354,14 @@ impl Ssrms {
                 Self::mul_add(-179.8829695416, x5, 97.44448770720001 * x51),
             ),
         );
-        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let (s_q5, c_q5) = Self::sincos(q[5]);
         let x60 = Self::mul_add(-x52, c_q5, x47 * s_q5);
         let x61 = Self::mul_add(x52, s_q5, x47 * c_q5);
         let x62 = Self::mul_add(qd[5], x60, Self::mul_add(x5, s_q5, x50 * c_q5));
         let x63 = qd[5] + x48;
         let x64 = 44.41 * x61;
         let x65 = 47.471 * x63;
-        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let (s_q6, c_q6) = Self::sincos(q[6]);
         let x67 = 9.336 * x62;
         let x68 = -x67;
         let x69 = 9.336 * (qd[6] + x61);
@@ -1450,7 +1451,7 @@ impl Ssrms {
     /// Methods: bias `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
+        let (s_q1, c_q1) = Self::sincos(q[1]);
         let x1 = qd[0] * c_q1;
         let x2 = qd[0] * s_q1;
         let x3 = qdd[0] * 0.7026;
@@ -1463,7 +1464,7 @@ impl Ssrms {
         let x10 = Self::mul_add(x1, x1, qd[1] * qd[1]);
         let x11 = x2 * 1647.2196721184;
         let x12 = 1650.6386721183999 * qd[1];
-        let (s_q2, c_q2) = libm::sincos(q[2]);
+        let (s_q2, c_q2) = Self::sincos(q[2]);
         let x14 = Self::mul_add(-qd[1], s_q2, x1 * c_q2);
         let x15 = Self::mul_add(qd[1], c_q2, x1 * s_q2);
         let x16 = Self::mul_add(-0.5692, x9, x5);
@@ -1487,7 +1488,7 @@ impl Ssrms {
             x17,
             Self::mul_add(39234.474122, x21, -Self::mul_add(-x14, x31, x23 * x29)),
         );
-        let (s_q3, c_q3) = libm::sincos(q[3]);
+        let (s_q3, c_q3) = Self::sincos(q[3]);
         let x34 = Self::mul_add(-x15, s_q3, x14 * c_q3);
         let x35 = Self::mul_add(x15, c_q3, x14 * s_q3);
         let x36 = Self::mul_add(-s_q2, x18, c_q2 * x16)
@@ -1510,7 +1511,7 @@ impl Ssrms {
             x38,
             Self::mul_add(24989.305802, x41, -Self::mul_add(-x34, x49, x43 * x47)),
         );
-        let (s_q4, c_q4) = libm::sincos(q[4]);
+        let (s_q4, c_q4) = Self::sincos(q[4]);
         let x52 = Self::mul_add(-x35, s_q4, x34 * c_q4);
         let x53 = Self::mul_add(x35, c_q4, x34 * s_q4);
         let x54 = Self::mul_add(
@@ -1536,14 +1537,14 @@ impl Ssrms {
                 Self::mul_add(-179.8829695416, x57, 97.44448770720001 * x56),
             ),
         );
-        let (s_q5, c_q5) = libm::sincos(q[5]);
+        let (s_q5, c_q5) = Self::sincos(q[5]);
         let x66 = Self::mul_add(-x58, c_q5, x52 * s_q5);
         let x67 = Self::mul_add(x58, s_q5, x52 * c_q5);
         let x68 = Self::mul_add(-qd[5], x66, Self::mul_add(x57, s_q5, x55 * c_q5));
         let x69 = qd[5] + x53;
         let x70 = 44.41 * x67;
         let x71 = 47.471 * x69;
-        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let (s_q6, c_q6) = Self::sincos(q[6]);
         let x73 = 9.336 * (qdd[6] + x68);
         let x74 = 9.336 * (qd[6] + x67);
         let x75 = Self::mul_add(x69, c_q6, x66 * s_q6) * x74;
@@ -1634,12 +1635,12 @@ impl Ssrms {
     /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let (s_q1, c_q1) = Self::sincos(q[1]);
+        let (s_q2, c_q2) = Self::sincos(q[2]);
+        let (s_q3, c_q3) = Self::sincos(q[3]);
+        let (s_q4, c_q4) = Self::sincos(q[4]);
+        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let (s_q6, c_q6) = Self::sincos(q[6]);
         let x6 = s_q5 * s_q5 * 35.074;
         let x7 = -35.074 + x6;
         let x8 = s_q5 * c_q5 * 35.074;
@@ -2098,12 +2099,12 @@ impl Ssrms {
         q: &[f64; 7],
         qd: &[f64; 7],
     ) -> ([[f64; 7]; 7], [f64; 7]) {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let (s_q1, c_q1) = Self::sincos(q[1]);
+        let (s_q2, c_q2) = Self::sincos(q[2]);
+        let (s_q3, c_q3) = Self::sincos(q[3]);
+        let (s_q4, c_q4) = Self::sincos(q[4]);
+        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let (s_q6, c_q6) = Self::sincos(q[6]);
         let x6 = s_q5 * s_q5 * 35.074;
         let x7 = -35.074 + x6;
         let x8 = s_q5 * c_q5 * 35.074;
@@ -2429,12 +2430,12 @@ impl Ssrms {
         tau: &[f64; 7],
         f_ext: &[[f64; 6]; 7],
     ) -> [f64; 7] {
-        let (s_q1, c_q1) = libm::sincos(q[1]);
-        let (s_q2, c_q2) = libm::sincos(q[2]);
-        let (s_q3, c_q3) = libm::sincos(q[3]);
-        let (s_q4, c_q4) = libm::sincos(q[4]);
-        let (s_q5, c_q5) = libm::sincos(q[5]);
-        let (s_q6, c_q6) = libm::sincos(q[6]);
+        let (s_q1, c_q1) = Self::sincos(q[1]);
+        let (s_q2, c_q2) = Self::sincos(q[2]);
+        let (s_q3, c_q3) = Self::sincos(q[3]);
+        let (s_q4, c_q4) = Self::sincos(q[4]);
+        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let (s_q6, c_q6) = Self::sincos(q[6]);
         let x6 = s_q5 * s_q5 * 35.074;
         let x7 = s_q5 * c_q5 * 35.074;
         let x8 = 132.6783695416 + (9.336 + x6);
@@ -2957,5 +2958,172 @@ impl Ssrms {
                 )
             )
         )] { a * b + c }
+    }
+    /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
+    /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
+    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 2 ulp of libm's
+    /// (`kanegen accuracy` measures it).
+    #[inline(always)]
+    #[must_use]
+    pub fn sincos(x: f64) -> (f64, f64) {
+        /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
+        const SIN_TABLE: [f64; 128] = [
+            0.0,
+            0.024541228522912288,
+            0.049067674327418015,
+            0.07356456359966743,
+            0.0980171403295606,
+            0.1224106751992162,
+            0.14673047445536175,
+            0.17096188876030122,
+            0.19509032201612828,
+            0.2191012401568698,
+            0.2429801799032639,
+            0.26671275747489837,
+            0.2902846772544624,
+            0.31368174039889146,
+            0.33688985339222005,
+            0.35989503653498817,
+            0.3826834323650898,
+            0.40524131400498986,
+            0.4275550934302821,
+            0.4496113296546066,
+            0.47139673682599764,
+            0.49289819222978404,
+            0.5141027441932218,
+            0.5349976198870973,
+            0.5555702330196022,
+            0.5758081914178453,
+            0.5956993044924334,
+            0.6152315905806268,
+            0.6343932841636455,
+            0.6531728429537768,
+            0.6715589548470184,
+            0.6895405447370669,
+            0.7071067811865476,
+            0.7242470829514669,
+            0.7409511253549591,
+            0.7572088465064846,
+            0.773010453362737,
+            0.7883464276266062,
+            0.8032075314806449,
+            0.8175848131515837,
+            0.8314696123025452,
+            0.8448535652497071,
+            0.8577286100002721,
+            0.8700869911087115,
+            0.881921264348355,
+            0.8932243011955153,
+            0.9039892931234433,
+            0.9142097557035307,
+            0.9238795325112867,
+            0.9329927988347388,
+            0.9415440651830208,
+            0.9495281805930367,
+            0.9569403357322088,
+            0.9637760657954398,
+            0.970031253194544,
+            0.9757021300385286,
+            0.9807852804032304,
+            0.9852776423889412,
+            0.989176509964781,
+            0.99247953459871,
+            0.9951847266721969,
+            0.9972904566786902,
+            0.9987954562051724,
+            0.9996988186962042,
+            1.0,
+            0.9996988186962042,
+            0.9987954562051724,
+            0.9972904566786902,
+            0.9951847266721969,
+            0.99247953459871,
+            0.989176509964781,
+            0.9852776423889412,
+            0.9807852804032304,
+            0.9757021300385286,
+            0.970031253194544,
+            0.9637760657954398,
+            0.9569403357322088,
+            0.9495281805930367,
+            0.9415440651830208,
+            0.9329927988347388,
+            0.9238795325112867,
+            0.9142097557035307,
+            0.9039892931234433,
+            0.8932243011955153,
+            0.881921264348355,
+            0.8700869911087115,
+            0.8577286100002721,
+            0.8448535652497071,
+            0.8314696123025452,
+            0.8175848131515837,
+            0.8032075314806449,
+            0.7883464276266062,
+            0.773010453362737,
+            0.7572088465064846,
+            0.7409511253549591,
+            0.7242470829514669,
+            0.7071067811865476,
+            0.6895405447370669,
+            0.6715589548470184,
+            0.6531728429537768,
+            0.6343932841636455,
+            0.6152315905806268,
+            0.5956993044924334,
+            0.5758081914178453,
+            0.5555702330196022,
+            0.5349976198870973,
+            0.5141027441932218,
+            0.49289819222978404,
+            0.47139673682599764,
+            0.4496113296546066,
+            0.4275550934302821,
+            0.40524131400498986,
+            0.3826834323650898,
+            0.35989503653498817,
+            0.33688985339222005,
+            0.31368174039889146,
+            0.2902846772544624,
+            0.26671275747489837,
+            0.2429801799032639,
+            0.2191012401568698,
+            0.19509032201612828,
+            0.17096188876030122,
+            0.14673047445536175,
+            0.1224106751992162,
+            0.0980171403295606,
+            0.07356456359966743,
+            0.049067674327418015,
+            0.024541228522912288,
+        ];
+        const S3: f64 = -1.0 / 6.0;
+        const S5: f64 = 1.0 / 120.0;
+        const C2: f64 = -0.5;
+        const C4: f64 = 1.0 / 24.0;
+        const C6: f64 = -1.0 / 720.0;
+        if !(x > -32768.0 && x < 32768.0) {
+            return libm::sincos(x);
+        }
+        let t = Self::mul_add(x, 40.74366543152521, 6755399441055744.0);
+        let k = t - 6755399441055744.0;
+        let i = (t.to_bits() & 255) as usize;
+        let r_hi = Self::mul_add(-k, 0.024543692605220713, x);
+        let r = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
+        let r2 = r * r;
+        let r3 = r * r2;
+        let p_s = Self::mul_add(r2, S5, S3);
+        let sin_r = Self::mul_add(r3, p_s, r);
+        let p_c6 = Self::mul_add(r2, C6, C4);
+        let p_c = Self::mul_add(r2, p_c6, C2);
+        let cos_r = Self::mul_add(r2, p_c, 1.0);
+        let table = |j: usize| {
+            f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
+        };
+        let (sin_a, cos_a) = (table(i), table(i + 64));
+        (
+            Self::mul_add(sin_a, cos_r, cos_a * sin_r),
+            Self::mul_add(cos_a, cos_r, -(sin_a * sin_r)),
+        )
     }
 }

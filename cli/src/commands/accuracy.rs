@@ -167,6 +167,12 @@ pub fn render_markdown(reports: &[AccuracyReport], timing: bool) -> Result<Strin
     let mut ctx = tera::Context::new();
     ctx.insert("version", env!("CARGO_PKG_VERSION"));
     ctx.insert("states", &crate::reports::accuracy::STATES);
+    let sc = crate::reports::accuracy::generated::sincos_error();
+    ctx.insert(
+        "sincos",
+        &serde_json::json!({"points": sc.points, "abs": format!("{:.2}", sc.abs_ulps),
+            "ulps": format!("{:.2}", sc.ulps)}),
+    );
     let time = |s: String| if timing { s } else { "—".into() };
     let subjects: Vec<serde_json::Value> = reports
         .iter()
