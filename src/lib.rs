@@ -23,7 +23,7 @@ extern crate std;
 /// `dynamics!(Name, "path/to/model.urdf" [, base = "free-floating"] [, gravity = [x, y, z]]
 /// [, allow_nonphysical = true] [, runtime_payload = true] [, scalar = f32] [, fma = true]
 /// [, fma_path = f64::mul_add] [, target_fma = false] [, regroup = false] [, canonical = false]
-/// [, snap = 1e-9] [, algorithm = "recurrent"] [, form = "compact"])` defines `pub struct Name;` with the associated constants `N`,
+/// [, libm_trig = true] [, snap = 1e-9] [, algorithm = "recurrent"] [, form = "compact"])` defines `pub struct Name;` with the associated constants `N`,
 /// `JOINTS`, `FRAMES`, `OP_COUNTS`, `CANDIDATES` and, on `&[f64; N]` arrays, the functions of
 /// `M(q) q̈ + c(q, q̇) = τ`: `mass_matrix(q)`, `nonlinear_effects(q, qd)`,
 /// `inverse_dynamics(q, qd, qdd)`, `forward_dynamics(q, qd, tau)`,
@@ -50,7 +50,10 @@ extern crate std;
 /// Kleinfinger's base parameters: the same `M`, `c` and `τ` in fewer operations; the header says
 /// what moved). `canonical = false` traces every function in the model's own body frames only
 /// (by default the joint-space functions are also traced in canonical frames, every joint axis
-/// z, and the cheaper is emitted; the header's table says which). `snap = TOL` (default 1e-15, `0.0` off) snaps float noise in the model before
+/// z, and the cheaper is emitted; the header's table says which). `f64` code takes sines and
+/// cosines from its own `Name::sincos` (a table of 128 sines and short polynomials, branch-free,
+/// within 1 ulp of 1 of libm's: `docs/accuracy.md`); `libm_trig = true` calls libm's instead.
+/// `snap = TOL` (default 1e-15, `0.0` off) snaps float noise in the model before
 /// tracing: rotations within `TOL` of a signed permutation become it, smaller offsets and
 /// inertia entries 0 (Panda's `cos(π/2) = 6.1e-17` residues: (M, c) in 1455 operations instead
 /// of 2122 before canonical frames); the header says how many numbers moved and by how much. `algorithm = NAME` forces

@@ -18,6 +18,11 @@ kanegen::dynamics!(
     canonical = false
 );
 kanegen::dynamics!(
+    Random5Libm,
+    "tests/data/codegen/random5.toml",
+    libm_trig = true
+);
+kanegen::dynamics!(
     Random5Gravity,
     "tests/data/codegen/random5.toml",
     gravity = [0.3, -1.2, -9.81],
@@ -530,4 +535,29 @@ fn regrouping_keeps_the_dynamics_and_saves_operations() {
     }
     println!("regrouped vs own inertias: worst {worst:.1e}");
     assert!(worst < 1e-12, "{worst:e}");
+}
+
+/// `libm_trig = true` takes libm's sines and cosines instead of the type's own `sincos`: the
+/// same emitted operations, the same forward dynamics to rounding, and `Random5::sincos` is
+/// libm's to 1 ulp of 1.
+#[test]
+fn libm_trig_gives_the_same_dynamics() {
+    assert_eq!(
+        Random5::OP_COUNTS.map(|c| (c.function, c.mul, c.add, c.sincos)),
+        Random5Libm::OP_COUNTS.map(|c| (c.function, c.mul, c.add, c.sincos))
+    );
+    let mut r = rng(17);
+    for _ in 0..20 {
+        let q: [f64; 5] = random_vec(&mut r, 5, 3.0).try_into().unwrap();
+        let v: [f64; 5] = random_vec(&mut r, 5, 1.0).try_into().unwrap();
+        let tau: [f64; 5] = random_vec(&mut r, 5, 10.0).try_into().unwrap();
+        let a = Random5::forward_dynamics(&q, &v, &tau);
+        let b = Random5Libm::forward_dynamics(&q, &v, &tau);
+        assert!(rel_err(&a, &b) < 1e-12, "{a:?} {b:?}");
+        for x in q {
+            let (s, c) = Random5::sincos(x);
+            let (s0, c0) = libm::sincos(x);
+            assert!((s - s0).abs() <= f64::EPSILON && (c - c0).abs() <= f64::EPSILON);
+        }
+    }
 }

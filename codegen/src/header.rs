@@ -123,7 +123,7 @@ pub fn lines(
         h.push(
             "Sines and cosines: `Self::sincos`, inlined and branch-free for |x| < 32768 (a table \
              of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), \
-             `libm::sincos` beyond; within 2 ulp of libm's (`kanegen accuracy` measures it)."
+             `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it)."
                 .into(),
         );
     }

@@ -66,7 +66,7 @@ pub struct Options {
     pub canonical: bool,
     /// Take sines and cosines from libm (`sincos`, `sin`, `cos`) instead of the emitted
     /// `Self::sincos` ([`crate::sincos`]: a table and short polynomials, branch-free, within
-    /// 2 ulp of libm's). Default `false`; `f32` code always uses libm's `sincosf`.
+    /// 1 ulp of 1 of libm's). Default `false`; `f32` code always uses libm's `sincosf`.
     pub libm_trig: bool,
     /// Force one algorithm for every function that has a mass-matrix, bias or forward method
     /// instead of the cheapest candidate: a preset of [`Methods::PRESETS`] (`recurrent`, the

@@ -9,7 +9,7 @@
 //! Inertial parameters: regrouped for the local-frame algorithms (the base parameters of Khalil and Kleinfinger: what a joint cannot move is carried by its parent): 7 of 7 bodies gave, 34 → 26 non-zero numbers in the spatial inertias; what reaches the fixed base is dropped. The same joint-space dynamics; `base_reaction`, where generated, reads the model's own numbers.
 //! Float noise: nothing within 1e-15 of 0 or ±1 to snap.
 //! Algorithm: forced to `recurrent` (`algorithm` option) for every function with a mass-matrix, bias or forward method; without it each takes the cheapest candidate.
-//! Sines and cosines: `Self::sincos`, inlined and branch-free for |x| < 32768 (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 2 ulp of libm's (`kanegen accuracy` measures it).
+//! Sines and cosines: `Self::sincos`, inlined and branch-free for |x| < 32768 (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
 //! Fused multiply-adds where the target has them: 3261 (`mass_matrix` 389, `nonlinear_effects` 317, `inverse_dynamics` 601, `forward_dynamics` 660, `mass_matrix_and_nonlinear_effects` 562, `forward_dynamics_with_wrenches` 732), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a forced algorithm yet).
 //!
@@ -6316,8 +6316,8 @@ impl SsrmsRecurrent {
     }
     /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
     /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
-    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 2 ulp of libm's
-    /// (`kanegen accuracy` measures it).
+    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 1 ulp of 1 of
+    /// libm's (`kanegen accuracy` measures it).
     #[inline(always)]
     #[must_use]
     pub fn sincos(x: f64) -> (f64, f64) {

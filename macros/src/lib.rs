@@ -32,6 +32,7 @@ struct Input {
     target_fma: bool,
     regroup: bool,
     canonical: bool,
+    libm_trig: bool,
     snap: Option<f64>,
     algorithm: Option<kanegen_codegen::kanegen_dynamics::Methods>,
     form: kanegen_codegen::Form,
@@ -75,6 +76,7 @@ impl Parse for Input {
             target_fma: true,
             regroup: true,
             canonical: true,
+            libm_trig: false,
             snap: None,
             algorithm: None,
             form: kanegen_codegen::Form::Auto,
@@ -127,6 +129,7 @@ impl Parse for Input {
                 "fma" => out.fma = input.parse::<LitBool>()?.value,
                 "regroup" => out.regroup = input.parse::<LitBool>()?.value,
                 "canonical" => out.canonical = input.parse::<LitBool>()?.value,
+                "libm_trig" => out.libm_trig = input.parse::<LitBool>()?.value,
                 "target_fma" => out.target_fma = input.parse::<LitBool>()?.value,
                 "algorithm" => {
                     let name: LitStr = input.parse()?;
@@ -167,8 +170,8 @@ impl Parse for Input {
                         key.span(),
                         format!(
                             "unknown option `{other}` (expected gravity, base, allow_nonphysical, \
-                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, canonical, snap, algorithm, \
-                             form)"
+                             runtime_payload, scalar, fma, fma_path, target_fma, regroup, canonical, libm_trig, snap, \
+                             algorithm, form)"
                         ),
                     ))
                 }
@@ -219,6 +222,7 @@ fn expand(input: &Input) -> Result<proc_macro2::TokenStream, String> {
     opts.fma = input.fma;
     opts.regroup = input.regroup;
     opts.canonical = input.canonical;
+    opts.libm_trig = input.libm_trig;
     opts.target_fma = input.target_fma;
     opts.algorithm = input.algorithm;
     if let Some(snap) = input.snap {
