@@ -262,6 +262,41 @@ pub fn emit_body_streamed(
             _ => format!("{counter}"),
         }
     };
+    // With the type's own `sincos`: the sines and cosines of the inputs (joint angles) in one
+    // `Self::sincos_n` at the top, so their polynomials run side by side in vector registers.
+    if *table_sincos {
+        let mut args: Vec<u32> = trig
+            .keys()
+            .copied()
+            .filter(|a| matches!(nodes[a], Node::Input(_)))
+            .collect();
+        args.sort_unstable();
+        if args.len() > 1 {
+            let mut pats = Vec::new();
+            let mut xs = Vec::new();
+            for a in args {
+                let base = trig_base(a, counter);
+                counter += 1;
+                let (sn, cn) = (format_ident!("s_{}", base), format_ident!("c_{}", base));
+                let (s, c) = trig[&a];
+                let bind = |node: Option<u32>, name: &proc_macro2::Ident| match node {
+                    Some(n) => {
+                        exprs.borrow_mut().insert(n, Expr::atom(quote!(#name)));
+                        quote!(#name)
+                    }
+                    None => quote!(_),
+                };
+                let (ps, pc) = (bind(s, &sn), bind(c, &cn));
+                pats.push(quote!((#ps, #pc)));
+                let x = &inputs[match nodes[&a] {
+                    Node::Input(i) => i as usize,
+                    _ => unreachable!("filtered to inputs"),
+                }];
+                xs.push(x.clone());
+            }
+            stmt(quote!(let [#(#pats),*] = Self::sincos_n([#(#xs),*]);));
+        }
+    }
     for (id, node) in &sched {
         let id = *id;
         let see_through = match node {

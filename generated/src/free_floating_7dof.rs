@@ -1230,21 +1230,24 @@ impl FreeFloating7 {
     /// Methods: mass matrix `crba`: 556 mul, 507 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 303 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x2 = 0.00000000020510342851533115 * c_q8;
-        let x3 = 0.00000000020510342851533115 * s_q8;
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x5 = 0.00000000020510342851533115 * c_q9;
-        let x6 = 0.00000000020510342851533115 * s_q9;
-        let x7 = x5 - x6;
-        let x8 = x5 + x6;
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x12 = 0.00000000020510342851533115 * s_q12;
-        let x13 = 0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = 0.00000000020510342851533115 * c_q8;
+        let x8 = 0.00000000020510342851533115 * s_q8;
+        let x9 = 0.00000000020510342851533115 * c_q9;
+        let x10 = 0.00000000020510342851533115 * s_q9;
+        let x11 = x9 - x10;
+        let x12 = x9 + x10;
+        let x13 = 0.00000000020510342851533115 * s_q12;
+        let x14 = 0.00000000020510342851533115 * c_q12;
         let x15 = 0.00000000020510342851533115 * c_q13;
         let x16 = 0.00000000020510342851533115 * s_q13;
         let x17 = 4.806620000000001 * x16;
@@ -1303,22 +1306,22 @@ impl FreeFloating7 {
                     Self::mul_add(s_q13, x28, c_q13 * x27),
                 ) - x31));
         let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
-        let x49 = x19 - Self::mul_add(x13, x39, x12 * x38);
+        let x49 = x19 - Self::mul_add(x14, x39, x13 * x38);
         let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
         let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
         let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
         let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
         let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x55 = x45 - Self::mul_add(x13, x42, x12 * x37);
-        let x56 = x46 - Self::mul_add(x13, x43, x12 * x40);
-        let x57 = x47 - Self::mul_add(x13, x44, x12 * x41);
+        let x55 = x45 - Self::mul_add(x14, x42, x13 * x37);
+        let x56 = x46 - Self::mul_add(x14, x43, x13 * x40);
+        let x57 = x47 - Self::mul_add(x14, x44, x13 * x41);
         let x58 = Self::mul_add(
             0.00000000020510342851533115,
             x47,
             Self::mul_add(c_q12, x44, s_q12 * x41),
         );
         let x59 = -x58;
-        let x60 = x54 - Self::mul_add(x13, x53, x12 * x52);
+        let x60 = x54 - Self::mul_add(x14, x53, x13 * x52);
         let x61 = Self::mul_add(
             c_q12,
             Self::mul_add(
@@ -1356,7 +1359,7 @@ impl FreeFloating7 {
         let x66 = 7.078399999258757 + x49;
         let x67 = 0.01675 - x63;
         let x68 = -9.142025249762803
-            + (x62 + (x57 - Self::mul_add(x13, x56, x12 * x55) + x62));
+            + (x62 + (x57 - Self::mul_add(x14, x56, x13 * x55) + x62));
         let x69 = 2.5482240016099564 - x64;
         let x70 = 9.223235249762805
             + Self::mul_add(0.00000000020510342851533115, x58, x61);
@@ -1404,7 +1407,7 @@ impl FreeFloating7 {
         let x112 = Self::mul_add(c_q9, x106, x111);
         let x113 = 0.00000000020510342851533115 * x51;
         let x114 = x112 - x113;
-        let x115 = x51 - Self::mul_add(-x8, x106, x7 * x99);
+        let x115 = x51 - Self::mul_add(-x12, x106, x11 * x99);
         let x116 = c_q9 * x99;
         let x117 = Self::mul_add(-s_q9, x106, x116);
         let x118 = x113 + x117;
@@ -1416,9 +1419,9 @@ impl FreeFloating7 {
         let x124 = Self::mul_add(c_q9, x108, x122) + x123;
         let x125 = 0.00000000020510342851533115 * x110;
         let x126 = Self::mul_add(c_q9, x109, s_q9 * x107) + x125;
-        let x127 = x107 - Self::mul_add(x8, x103, x7 * x105);
-        let x128 = x109 + Self::mul_add(-x8, x108, x7 * x103);
-        let x129 = x110 + Self::mul_add(-x8, x109, x7 * x107);
+        let x127 = x107 - Self::mul_add(x12, x103, x11 * x105);
+        let x128 = x109 + Self::mul_add(-x12, x108, x11 * x103);
+        let x129 = x110 + Self::mul_add(-x12, x109, x11 * x107);
         let x130 = x120 + Self::mul_add(c_q9, x105, x122);
         let x131 = x123 - Self::mul_add(-s_q9, x108, x119);
         let x132 = x125 - Self::mul_add(-s_q9, x109, c_q9 * x107);
@@ -1436,28 +1439,28 @@ impl FreeFloating7 {
         let x144 = -0.000000008530897668050218 + x114;
         let x145 = -12.701650001451807 - x115;
         let x146 = -0.0000000234896432582596
-            + (x126 - Self::mul_add(x8, x124, x7 * x121) - x139);
+            + (x126 - Self::mul_add(x12, x124, x11 * x121) - x139);
         let x147 = -0.002139996587640933
             - (x133 + Self::mul_add(s_q9, x124, c_q9 * x121) + x140);
         let x148 = -0.0000000234896432582596
             + (Self::mul_add(c_q9, x128, s_q9 * x127) + x134 - x139);
         let x149 = -111.7548902508081
-            + (x136 + (x129 + Self::mul_add(-x8, x128, x7 * x127) + x136));
+            + (x136 + (x129 + Self::mul_add(-x12, x128, x11 * x127) + x136));
         let x150 = 5.080660024070365
             - (x142 + (x134 - Self::mul_add(-s_q9, x128, c_q9 * x127) - x141));
         let x151 = -0.002139996587640933
             - (Self::mul_add(c_q9, x131, s_q9 * x130) + x135 + x140);
         let x152 = 5.080660024070366
-            + (x141 - (x132 + Self::mul_add(-x8, x131, x7 * x130) + x142));
+            + (x141 - (x132 + Self::mul_add(-x12, x131, x11 * x130) + x142));
         let x153 = 113.3918902508081
             - (x137 - (x135 - Self::mul_add(-s_q9, x131, c_q9 * x130) - x137));
-        let x154 = x118 - Self::mul_add(-x3, x145, x2 * x144);
+        let x154 = x118 - Self::mul_add(-x8, x145, x7 * x144);
         let x155 = Self::mul_add(c_q8, x145, s_q8 * x144);
         let x156 = Self::mul_add(-s_q8, x145, c_q8 * x144);
         let x157 = Self::mul_add(0.00000000020510342851533115, x118, x156);
-        let x158 = x151 - Self::mul_add(-x3, x148, x2 * x143);
-        let x159 = x152 - Self::mul_add(-x3, x149, x2 * x146);
-        let x160 = x153 - Self::mul_add(-x3, x150, x2 * x147);
+        let x158 = x151 - Self::mul_add(-x8, x148, x7 * x143);
+        let x159 = x152 - Self::mul_add(-x8, x149, x7 * x146);
+        let x160 = x153 - Self::mul_add(-x8, x150, x7 * x147);
         let x161 = Self::mul_add(c_q8, x148, s_q8 * x143);
         let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
         let x163 = Self::mul_add(c_q8, x150, s_q8 * x147);
@@ -1500,7 +1503,7 @@ impl FreeFloating7 {
                 Self::mul_add(-s_q8, x162, c_q8 * x161),
             ),
         );
-        let x170 = x167 - (x160 - Self::mul_add(-x3, x159, x2 * x158) - x167);
+        let x170 = x167 - (x160 - Self::mul_add(-x8, x159, x7 * x158) - x167);
         let x171 = 48.0240000085309 + x154;
         let x172 = -0.07309 + Self::mul_add(c_q8, x159, s_q8 * x158);
         let x173 = -16.80768997608804 - x168;
@@ -1536,7 +1539,7 @@ impl FreeFloating7 {
         let x197 = 1271.854575 + (x186 + x191);
         let x198 = -x193;
         let x199 = -x192;
-        let x200 = Self::mul_add(x3, x144, x2 * x145);
+        let x200 = Self::mul_add(x8, x144, x7 * x145);
         let x201 = Self::mul_add(-0.35, x156, x160);
         let x202 = Self::mul_add(0.35, x200, x163);
         let x203 = Self::mul_add(-s_q7, x156, c_q7 * x200);
@@ -1545,13 +1548,13 @@ impl FreeFloating7 {
         let x206 = Self::mul_add(c_q7, x202, s_q7 * x201)
             + Self::mul_add(-0.65, x155, 0.75 * x203);
         let x207 = -Self::mul_add(-0.65, x204, x164);
-        let x208 = x8 * x99;
-        let x209 = Self::mul_add(x7, x106, x208);
+        let x208 = x12 * x99;
+        let x209 = Self::mul_add(x11, x106, x208);
         let x210 = x126 + Self::mul_add(-0.275, x112, 0.4 * x209);
         let x211 = Self::mul_add(0.4, x117, x129);
         let x212 = Self::mul_add(0.275, x117, x132);
         let x213 = -x212;
-        let x214 = x112 + Self::mul_add(x3, x209, x2 * x117);
+        let x214 = x112 + Self::mul_add(x8, x209, x7 * x117);
         let x215 = Self::mul_add(-c_q8, x209, s_q8 * x117);
         let x216 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -1565,7 +1568,7 @@ impl FreeFloating7 {
             Self::mul_add(-s_q8, x211, c_q8 * x210),
         );
         let x219 = -x218;
-        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x3, x211, x2 * x210));
+        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x8, x211, x7 * x210));
         let x221 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x211, s_q8 * x210));
         let x222 = Self::mul_add(s_q7, x215, c_q7 * x214);
         let x223 = -x222;
@@ -1576,19 +1579,19 @@ impl FreeFloating7 {
             + Self::mul_add(-0.65, x216, 0.75 * x222));
         let x228 = -Self::mul_add(0.65, x224, x218);
         let x229 = Self::mul_add(-s_q9, x101, x116);
-        let x230 = Self::mul_add(x7, x101, x208);
+        let x230 = Self::mul_add(x11, x101, x208);
         let x231 = Self::mul_add(c_q9, x101, x111);
         let x232 = 0.00000000020510342851533115 * x104;
         let x233 = Self::mul_add(c_q9, x97, s_q9 * x96) + x232
             + Self::mul_add(-0.275, x231, 0.4 * x230);
-        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x8, x97, x7 * x96));
+        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x12, x97, x11 * x96));
         let x235 = Self::mul_add(
             0.275,
             x229,
             x232 - Self::mul_add(-s_q9, x97, c_q9 * x96),
         );
         let x236 = -x235;
-        let x237 = x231 + Self::mul_add(x3, x230, x2 * x229);
+        let x237 = x231 + Self::mul_add(x8, x230, x7 * x229);
         let x238 = Self::mul_add(-c_q8, x230, s_q8 * x229);
         let x239 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -1602,7 +1605,7 @@ impl FreeFloating7 {
             Self::mul_add(-s_q8, x234, c_q8 * x233),
         );
         let x242 = -x241;
-        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x3, x234, x2 * x233));
+        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x8, x234, x7 * x233));
         let x244 = Self::mul_add(-0.35, x237, Self::mul_add(c_q8, x234, s_q8 * x233));
         let x245 = Self::mul_add(s_q7, x238, c_q7 * x237);
         let x246 = -x245;
@@ -1618,19 +1621,23 @@ impl FreeFloating7 {
         let x255 = Self::mul_add(c_q10, x83, s_q10 * x82);
         let x256 = Self::mul_add(-0.87, x252, x84);
         let x257 = Self::mul_add(-c_q9, x253, s_q9 * x252);
-        let x258 = Self::mul_add(x8, x253, x7 * x252);
+        let x258 = Self::mul_add(x12, x253, x11 * x252);
         let x259 = Self::mul_add(s_q9, x253, c_q9 * x252);
         let x260 = 0.00000000020510342851533115 * x256;
         let x261 = Self::mul_add(c_q9, x255, s_q9 * x254) + x260
             + Self::mul_add(-0.275, x259, 0.4 * x258);
-        let x262 = Self::mul_add(-0.4, x257, x256 + Self::mul_add(-x8, x255, x7 * x254));
+        let x262 = Self::mul_add(
+            -0.4,
+            x257,
+            x256 + Self::mul_add(-x12, x255, x11 * x254),
+        );
         let x263 = Self::mul_add(
             -0.275,
             x257,
             x260 - Self::mul_add(-s_q9, x255, c_q9 * x254),
         );
         let x264 = -x263;
-        let x265 = x259 - Self::mul_add(-x3, x258, x2 * x257);
+        let x265 = x259 - Self::mul_add(-x8, x258, x7 * x257);
         let x266 = Self::mul_add(c_q8, x258, s_q8 * x257);
         let x267 = Self::mul_add(
             0.00000000020510342851533115,
@@ -1646,7 +1653,7 @@ impl FreeFloating7 {
         let x270 = Self::mul_add(
             -0.35,
             x266,
-            x263 + Self::mul_add(-x3, x262, x2 * x261),
+            x263 + Self::mul_add(-x8, x262, x7 * x261),
         );
         let x271 = Self::mul_add(-0.35, x265, Self::mul_add(c_q8, x262, s_q8 * x261));
         let x272 = Self::mul_add(-s_q7, x266, c_q7 * x265);
@@ -1657,7 +1664,7 @@ impl FreeFloating7 {
         let x277 = -(Self::mul_add(-c_q7, x271, s_q7 * x270)
             + Self::mul_add(0.65, x267, 0.75 * x272));
         let x278 = -Self::mul_add(0.65, x274, x268);
-        let x279 = Self::mul_add(-x13, x38, x12 * x39);
+        let x279 = Self::mul_add(-x14, x38, x13 * x39);
         let x280 = Self::mul_add(0.36, x279, x54);
         let x281 = Self::mul_add(x50, 0.36, x57);
         let x282 = Self::mul_add(s_q11, x279, c_q11 * x50);
@@ -1675,18 +1682,22 @@ impl FreeFloating7 {
         let x293 = -x292;
         let x294 = 0.00000000020510342851533115 * x48;
         let x295 = Self::mul_add(c_q9, x289, s_q9 * x288) + x294;
-        let x296 = x48 + Self::mul_add(-x8, x289, x7 * x288);
+        let x296 = x48 + Self::mul_add(-x12, x289, x11 * x288);
         let x297 = x294 - Self::mul_add(-s_q9, x289, c_q9 * x288);
         let x298 = 0.00000000020510342851533115 * x292;
         let x299 = Self::mul_add(c_q9, x290, s_q9 * x291) - x298
             + Self::mul_add(0.275, x297, 0.4 * x296);
-        let x300 = Self::mul_add(0.4, x295, x292 - Self::mul_add(-x8, x290, x7 * x291));
+        let x300 = Self::mul_add(
+            0.4,
+            x295,
+            x292 - Self::mul_add(-x12, x290, x11 * x291),
+        );
         let x301 = Self::mul_add(
             0.275,
             x295,
             x298 + Self::mul_add(-s_q9, x290, c_q9 * x291),
         );
-        let x302 = x297 + Self::mul_add(-x3, x296, x2 * x295);
+        let x302 = x297 + Self::mul_add(-x8, x296, x7 * x295);
         let x303 = Self::mul_add(c_q8, x296, s_q8 * x295);
         let x304 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -1699,7 +1710,7 @@ impl FreeFloating7 {
             Self::mul_add(s_q8, x300, c_q8 * x299),
         );
         let x306 = -x305;
-        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x3, x300, x2 * x299));
+        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x8, x300, x7 * x299));
         let x308 = Self::mul_add(0.35, x302, Self::mul_add(-c_q8, x300, s_q8 * x299));
         let x309 = Self::mul_add(s_q7, x303, c_q7 * x302);
         let x310 = Self::mul_add(-c_q7, x303, s_q7 * x302);
@@ -1712,7 +1723,7 @@ impl FreeFloating7 {
         let x316 = Self::mul_add(-0.16, x314, x26);
         let x317 = Self::mul_add(-0.55, x314, x29);
         let x318 = Self::mul_add(s_q12, x19, c_q12 * x314);
-        let x319 = x18 - Self::mul_add(-x13, x19, x12 * x314);
+        let x319 = x18 - Self::mul_add(-x14, x19, x13 * x314);
         let x320 = Self::mul_add(
             0.00000000020510342851533115,
             x18,
@@ -1728,7 +1739,7 @@ impl FreeFloating7 {
         let x324 = Self::mul_add(
             -0.36,
             x318,
-            x317 - Self::mul_add(-x13, x316, x12 * x315),
+            x317 - Self::mul_add(-x14, x316, x13 * x315),
         );
         let x325 = Self::mul_add(-s_q11, x319, c_q11 * x318);
         let x326 = Self::mul_add(c_q11, x319, s_q11 * x318);
@@ -1745,18 +1756,22 @@ impl FreeFloating7 {
         let x336 = -x335;
         let x337 = 0.00000000020510342851533115 * x320;
         let x338 = Self::mul_add(c_q9, x332, s_q9 * x331) - x337;
-        let x339 = x320 - Self::mul_add(-x8, x332, x7 * x331);
+        let x339 = x320 - Self::mul_add(-x12, x332, x11 * x331);
         let x340 = x337 + Self::mul_add(-s_q9, x332, c_q9 * x331);
         let x341 = 0.00000000020510342851533115 * x335;
         let x342 = Self::mul_add(c_q9, x333, s_q9 * x334) - x341
             + Self::mul_add(0.275, x340, 0.4 * x339);
-        let x343 = Self::mul_add(-0.4, x338, x335 - Self::mul_add(-x8, x333, x7 * x334));
+        let x343 = Self::mul_add(
+            -0.4,
+            x338,
+            x335 - Self::mul_add(-x12, x333, x11 * x334),
+        );
         let x344 = Self::mul_add(
             -0.275,
             x338,
             x341 + Self::mul_add(-s_q9, x333, c_q9 * x334),
         );
-        let x345 = x340 - Self::mul_add(x3, x339, x2 * x338);
+        let x345 = x340 - Self::mul_add(x8, x339, x7 * x338);
         let x346 = Self::mul_add(-c_q8, x339, s_q8 * x338);
         let x347 = Self::mul_add(
             0.00000000020510342851533115,
@@ -1770,7 +1785,7 @@ impl FreeFloating7 {
             Self::mul_add(s_q8, x343, c_q8 * x342),
         );
         let x350 = -x349;
-        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x3, x343, x2 * x342));
+        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x8, x343, x7 * x342));
         let x352 = Self::mul_add(0.35, x345, Self::mul_add(-c_q8, x343, s_q8 * x342));
         let x353 = Self::mul_add(-s_q7, x346, c_q7 * x345);
         let x354 = Self::mul_add(c_q7, x346, s_q7 * x345);
@@ -1939,304 +1954,307 @@ impl FreeFloating7 {
     /// Methods: bias `newton-euler`: 528 mul, 428 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 14], v: &[f64; 13]) -> [f64; 13] {
-        let x0 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x1 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x2 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let x4 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x5 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x6 = v[4] * v[4];
-        let x7 = Self::mul_add(v[5], v[5], x6);
-        let x8 = v[3] * v[4];
-        let x9 = v[3] * v[5];
-        let x10 = v[4] * v[5];
-        let x11 = Self::mul_add(v[3], v[3], x6);
-        let x12 = x0 + Self::mul_add(-0.75, x9, 0.65 * x7);
-        let x13 = x1 + Self::mul_add(0.75, x10, 0.65 * x8);
-        let x14 = x2 - Self::mul_add(-0.75, x11, 0.65 * x9);
-        let x15 = Self::mul_add(c_q7, x13, s_q7 * x12);
-        let x16 = v[6] * x5;
-        let x17 = v[6] * x4;
-        let x18 = v[5] + v[6];
-        let x19 = x5 * x5;
-        let x20 = x4 * x18;
-        let x21 = Self::mul_add(x18, -16.80768997608804, x5 * 0.07309);
-        let x22 = Self::mul_add(
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x8 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x9 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x10 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x11 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x12 = v[4] * v[4];
+        let x13 = Self::mul_add(v[5], v[5], x12);
+        let x14 = v[3] * v[4];
+        let x15 = v[3] * v[5];
+        let x16 = v[4] * v[5];
+        let x17 = Self::mul_add(v[3], v[3], x12);
+        let x18 = x7 + Self::mul_add(-0.75, x15, 0.65 * x13);
+        let x19 = x8 + Self::mul_add(0.75, x16, 0.65 * x14);
+        let x20 = x9 - Self::mul_add(-0.75, x17, 0.65 * x15);
+        let x21 = Self::mul_add(c_q7, x19, s_q7 * x18);
+        let x22 = v[6] * x11;
+        let x23 = v[6] * x10;
+        let x24 = v[5] + v[6];
+        let x25 = x11 * x11;
+        let x26 = x10 * x24;
+        let x27 = Self::mul_add(x24, -16.80768997608804, x11 * 0.07309);
+        let x28 = Self::mul_add(
             -0.1132,
-            x18,
-            Self::mul_add(130.43769025763282, x5, x4 * 0.07309),
+            x24,
+            Self::mul_add(130.43769025763282, x11, x10 * 0.07309),
         );
-        let x23 = Self::mul_add(
+        let x29 = Self::mul_add(
             -132.47349025763282,
-            x18,
-            Self::mul_add(0.1132, x5, x4 * 16.80768997608804),
+            x24,
+            Self::mul_add(0.1132, x11, x10 * 16.80768997608804),
         );
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x25 = 0.00000000020510342851533115 * c_q8;
-        let x26 = 0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(x18, c_q8, Self::mul_add(x5, s_q8, x4 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x5, c_q8, x4 * x26));
-        let x29 = Self::mul_add(0.35, x17 - x20, Self::mul_add(-s_q7, x13, c_q7 * x12));
-        let x30 = Self::mul_add(0.35, Self::mul_add(-x5, x18, x16), x15);
-        let x31 = Self::mul_add(0.35, Self::mul_add(x4, x4, x19), x14);
-        let x32 = Self::mul_add(c_q8, x31, Self::mul_add(s_q8, x30, x25 * x29));
-        let x33 = Self::mul_add(s_q8, x31, Self::mul_add(-c_q8, x30, x26 * x29));
-        let x34 = Self::mul_add(-0.00000000020510342851533115, x31, x29);
-        let x35 = Self::mul_add(v[7], x28, Self::mul_add(-x17, s_q8, x16 * x25));
-        let x36 = Self::mul_add(-v[7], x27, Self::mul_add(x17, c_q8, x16 * x26));
-        let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x4);
-        let x38 = x28 * x28;
-        let x39 = x37 * x37;
-        let x40 = x27 * x28;
-        let x41 = x16 - x40;
-        let x42 = x27 * x37;
-        let x43 = x27 * x27;
-        let x44 = x39 + x43;
-        let x45 = x28 * x37;
-        let x46 = x35 + x45;
-        let x47 = Self::mul_add(
-            x37,
+        let x30 = 0.00000000020510342851533115 * c_q8;
+        let x31 = 0.00000000020510342851533115 * s_q8;
+        let x32 = Self::mul_add(x24, c_q8, Self::mul_add(x11, s_q8, x10 * x30));
+        let x33 = Self::mul_add(x24, s_q8, Self::mul_add(-x11, c_q8, x10 * x31));
+        let x34 = Self::mul_add(0.35, x23 - x26, Self::mul_add(-s_q7, x19, c_q7 * x18));
+        let x35 = Self::mul_add(0.35, Self::mul_add(-x11, x24, x22), x21);
+        let x36 = Self::mul_add(0.35, Self::mul_add(x10, x10, x25), x20);
+        let x37 = Self::mul_add(c_q8, x36, Self::mul_add(s_q8, x35, x30 * x34));
+        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(-c_q8, x35, x31 * x34));
+        let x39 = Self::mul_add(-0.00000000020510342851533115, x36, x34);
+        let x40 = Self::mul_add(v[7], x33, Self::mul_add(-x23, s_q8, x22 * x30));
+        let x41 = Self::mul_add(-v[7], x32, Self::mul_add(x23, c_q8, x22 * x31));
+        let x42 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x10);
+        let x43 = x33 * x33;
+        let x44 = x42 * x42;
+        let x45 = x32 * x33;
+        let x46 = x22 - x45;
+        let x47 = x32 * x42;
+        let x48 = x32 * x32;
+        let x49 = x44 + x48;
+        let x50 = x33 * x42;
+        let x51 = x40 + x50;
+        let x52 = Self::mul_add(
+            x42,
             0.002139996587640933,
-            x28 * 0.0000000234896432582596,
+            x33 * 0.0000000234896432582596,
         );
-        let x48 = Self::mul_add(
+        let x53 = Self::mul_add(
             5.080660024070365,
-            x37,
-            Self::mul_add(x28, -111.7548902508081, x27 * 0.0000000234896432582596),
+            x42,
+            Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
         );
-        let x49 = Self::mul_add(
+        let x54 = Self::mul_add(
             113.3918902508081,
-            x37,
-            Self::mul_add(5.080660024070366, x28, x27 * 0.002139996587640933),
+            x42,
+            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
         );
-        let x50 = Self::mul_add(
-            x34,
+        let x55 = Self::mul_add(
+            x39,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x16,
-                Self::mul_add(x36, -111.7548902508081, x35 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x27, x49, x37 * x47),
+                x22,
+                Self::mul_add(x41, -111.7548902508081, x40 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x32, x54, x42 * x52),
         );
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x52 = 0.00000000020510342851533115 * c_q9;
-        let x53 = 0.00000000020510342851533115 * s_q9;
-        let x54 = x52 - x53;
-        let x55 = x52 + x53;
-        let x56 = Self::mul_add(-x37, c_q9, Self::mul_add(-x28, x54, x27 * s_q9));
-        let x57 = Self::mul_add(x37, s_q9, Self::mul_add(x28, x55, x27 * c_q9));
-        let x58 = x32 + Self::mul_add(-0.4, x36 + x42, 0.275 * x41);
-        let x59 = x33 + Self::mul_add(0.4, x35 - x45, 0.275 * x44);
-        let x60 = x34 - Self::mul_add(-0.4, x38 + x43, 0.275 * x46);
-        let x61 = Self::mul_add(-c_q9, x60, Self::mul_add(-x54, x59, s_q9 * x58));
-        let x62 = Self::mul_add(
+        let x56 = 0.00000000020510342851533115 * c_q9;
+        let x57 = 0.00000000020510342851533115 * s_q9;
+        let x58 = x56 - x57;
+        let x59 = x56 + x57;
+        let x60 = Self::mul_add(-x42, c_q9, Self::mul_add(-x33, x58, x32 * s_q9));
+        let x61 = Self::mul_add(x42, s_q9, Self::mul_add(x33, x59, x32 * c_q9));
+        let x62 = x37 + Self::mul_add(-0.4, x41 + x47, 0.275 * x46);
+        let x63 = x38 + Self::mul_add(0.4, x40 - x50, 0.275 * x49);
+        let x64 = x39 - Self::mul_add(-0.4, x43 + x48, 0.275 * x51);
+        let x65 = Self::mul_add(-c_q9, x64, Self::mul_add(-x58, x63, s_q9 * x62));
+        let x66 = Self::mul_add(
             -0.00000000020510342851533115,
-            x60,
-            Self::mul_add(-0.00000000020510342851533115, x58, x59),
+            x64,
+            Self::mul_add(-0.00000000020510342851533115, x62, x63),
         );
-        let x63 = Self::mul_add(
+        let x67 = Self::mul_add(
             -0.00000000020510342851533115,
-            x16,
-            Self::mul_add(-0.00000000020510342851533115, x35, x36),
+            x22,
+            Self::mul_add(-0.00000000020510342851533115, x40, x41),
         );
-        let x64 = Self::mul_add(
+        let x68 = Self::mul_add(
             -v[8],
-            x57,
-            Self::mul_add(-x16, c_q9, Self::mul_add(-x36, x54, x35 * s_q9)),
+            x61,
+            Self::mul_add(-x22, c_q9, Self::mul_add(-x41, x58, x40 * s_q9)),
         );
-        let x65 = Self::mul_add(
+        let x69 = Self::mul_add(
             v[8],
-            x56,
-            Self::mul_add(x16, s_q9, Self::mul_add(x36, x55, x35 * c_q9)),
+            x60,
+            Self::mul_add(x22, s_q9, Self::mul_add(x41, x59, x40 * c_q9)),
         );
-        let x66 = v[8]
+        let x70 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x37,
-                Self::mul_add(-0.00000000020510342851533115, x27, x28),
+                x42,
+                Self::mul_add(-0.00000000020510342851533115, x32, x33),
             );
-        let x67 = Self::mul_add(x56, x57, x63);
-        let x68 = Self::mul_add(x56, x56, x66 * x66);
-        let x69 = Self::mul_add(-x57, x66, x64);
-        let x70 = x66 * 0.00214;
-        let x71 = Self::mul_add(x66, -36.18604050126307, x57 * 63.36336825000001);
-        let x72 = Self::mul_add(
+        let x71 = Self::mul_add(x60, x61, x67);
+        let x72 = Self::mul_add(x60, x60, x70 * x70);
+        let x73 = Self::mul_add(-x61, x70, x68);
+        let x74 = x70 * 0.00214;
+        let x75 = Self::mul_add(x70, -36.18604050126307, x61 * 63.36336825000001);
+        let x76 = Self::mul_add(
             69.99836825,
+            x70,
+            Self::mul_add(x61, 36.18604050126307, x60 * 0.00214),
+        );
+        let x77 = Self::mul_add(
             x66,
-            Self::mul_add(x57, 36.18604050126307, x56 * 0.00214),
-        );
-        let x73 = Self::mul_add(
-            x62,
             81.53205,
-            Self::mul_add(x63, 0.00214, -Self::mul_add(x57, x72, x66 * x71)),
+            Self::mul_add(x67, 0.00214, -Self::mul_add(x61, x76, x70 * x75)),
         );
-        let x74 = Self::mul_add(
-            x61,
+        let x78 = Self::mul_add(
+            x65,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x63,
-                Self::mul_add(x65, 36.18604050126307, x64 * 0.00214),
-            ) + Self::mul_add(x56, x71, x57 * x70),
+                x67,
+                Self::mul_add(x69, 36.18604050126307, x68 * 0.00214),
+            ) + Self::mul_add(x60, x75, x61 * x74),
         );
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let x76 = Self::mul_add(x57, s_q10, x56 * c_q10);
-        let x77 = Self::mul_add(-x57, c_q10, x56 * s_q10);
-        let x78 = Self::mul_add(x67, -0.87, x61);
-        let x79 = Self::mul_add(
-            x68,
+        let x79 = Self::mul_add(x61, s_q10, x60 * c_q10);
+        let x80 = Self::mul_add(-x61, c_q10, x60 * s_q10);
+        let x81 = Self::mul_add(x71, -0.87, x65);
+        let x82 = Self::mul_add(
+            x72,
             0.87,
-            Self::mul_add(s_q9, x60, Self::mul_add(x55, x59, c_q9 * x58)),
+            Self::mul_add(s_q9, x64, Self::mul_add(x59, x63, c_q9 * x62)),
         );
-        let x80 = Self::mul_add(x69, 0.87, x62);
-        let x81 = Self::mul_add(s_q10, x79, c_q10 * x78);
-        let x82 = Self::mul_add(v[9], x77, Self::mul_add(x65, s_q10, x64 * c_q10));
-        let x83 = Self::mul_add(-v[9], x76, Self::mul_add(-x65, c_q10, x64 * s_q10));
-        let x84 = v[9] + x66;
-        let x85 = Self::mul_add(-x76, x77, x63);
-        let x86 = x76 * x76;
-        let x87 = Self::mul_add(x84, x84, x86);
-        let x88 = x77 * x84;
-        let x89 = x82 + x88;
-        let x90 = x84 * 0.6328;
-        let x91 = Self::mul_add(x84, 24.35164200091464, x77 * 24.4950615);
-        let x92 = Self::mul_add(
+        let x83 = Self::mul_add(x73, 0.87, x66);
+        let x84 = Self::mul_add(s_q10, x82, c_q10 * x81);
+        let x85 = Self::mul_add(v[9], x80, Self::mul_add(x69, s_q10, x68 * c_q10));
+        let x86 = Self::mul_add(-v[9], x79, Self::mul_add(-x69, c_q10, x68 * s_q10));
+        let x87 = v[9] + x70;
+        let x88 = Self::mul_add(-x79, x80, x67);
+        let x89 = x79 * x79;
+        let x90 = Self::mul_add(x87, x87, x89);
+        let x91 = x80 * x87;
+        let x92 = x85 + x91;
+        let x93 = x87 * 0.6328;
+        let x94 = Self::mul_add(x87, 24.35164200091464, x80 * 24.4950615);
+        let x95 = Self::mul_add(
             28.2393615,
-            x84,
-            Self::mul_add(x77, -24.351642000914637, x76 * 0.6328),
+            x87,
+            Self::mul_add(x80, -24.351642000914637, x79 * 0.6328),
         );
-        let x93 = Self::mul_add(
-            x80,
+        let x96 = Self::mul_add(
+            x83,
             45.1584,
-            Self::mul_add(x63, 0.6328, Self::mul_add(x77, x92, x84 * x91)),
+            Self::mul_add(x67, 0.6328, Self::mul_add(x80, x95, x87 * x94)),
         );
-        let x94 = Self::mul_add(
-            x81,
+        let x97 = Self::mul_add(
+            x84,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x63,
-                Self::mul_add(x83, -24.351642000914637, x82 * 0.6328),
-            ) - Self::mul_add(x76, x91, x77 * x90),
+                x67,
+                Self::mul_add(x86, -24.351642000914637, x85 * 0.6328),
+            ) - Self::mul_add(x79, x94, x80 * x93),
         );
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let x96 = Self::mul_add(-x77, s_q11, x76 * c_q11);
-        let x97 = Self::mul_add(x77, c_q11, x76 * s_q11);
-        let x98 = x81 - Self::mul_add(-0.275, Self::mul_add(x76, x84, x83), x85 * 0.63);
-        let x99 = Self::mul_add(-c_q10, x79, s_q10 * x78)
-            - Self::mul_add(0.275, x82 - x88, x87 * 0.63);
-        let x100 = x80 + Self::mul_add(-0.275, Self::mul_add(x77, x77, x86), x89 * 0.63);
-        let x101 = Self::mul_add(-s_q11, x99, c_q11 * x98);
-        let x102 = Self::mul_add(v[10], x97, Self::mul_add(-x83, s_q11, x82 * c_q11));
-        let x103 = Self::mul_add(-v[10], x96, Self::mul_add(x83, c_q11, x82 * s_q11));
-        let x104 = v[10] + x84;
-        let x105 = x96 * x96;
-        let x106 = x97 * x104;
-        let x107 = 0.01675 * x104;
-        let x108 = Self::mul_add(-2.5482240016099564, x104, x97 * 9.142025249762803);
-        let x109 = Self::mul_add(
-            -9.223235249762805,
-            x104,
-            Self::mul_add(-2.5482240016099564, x97, 0.01675 * x96),
-        );
-        let x110 = Self::mul_add(
-            7.078399999258757,
-            x100,
-            Self::mul_add(0.01675, x63, -Self::mul_add(-x97, x109, x104 * x108)),
-        );
+        let x98 = Self::mul_add(-x80, s_q11, x79 * c_q11);
+        let x99 = Self::mul_add(x80, c_q11, x79 * s_q11);
+        let x100 = x84 - Self::mul_add(-0.275, Self::mul_add(x79, x87, x86), x88 * 0.63);
+        let x101 = Self::mul_add(-c_q10, x82, s_q10 * x81)
+            - Self::mul_add(0.275, x85 - x91, x90 * 0.63);
+        let x102 = x83 + Self::mul_add(-0.275, Self::mul_add(x80, x80, x89), x92 * 0.63);
+        let x103 = Self::mul_add(-s_q11, x101, c_q11 * x100);
+        let x104 = Self::mul_add(v[10], x99, Self::mul_add(-x86, s_q11, x85 * c_q11));
+        let x105 = Self::mul_add(-v[10], x98, Self::mul_add(x86, c_q11, x85 * s_q11));
+        let x106 = v[10] + x87;
+        let x107 = x98 * x98;
+        let x108 = x99 * x106;
+        let x109 = 0.01675 * x106;
+        let x110 = Self::mul_add(-2.5482240016099564, x106, x99 * 9.142025249762803);
         let x111 = Self::mul_add(
+            -9.223235249762805,
+            x106,
+            Self::mul_add(-2.5482240016099564, x99, 0.01675 * x98),
+        );
+        let x112 = Self::mul_add(
+            7.078399999258757,
+            x102,
+            Self::mul_add(0.01675, x67, -Self::mul_add(-x99, x111, x106 * x110)),
+        );
+        let x113 = Self::mul_add(
             -7.078399999258757,
-            x101,
+            x103,
             Self::mul_add(
                 -9.223235249762805,
-                x63,
-                Self::mul_add(-2.5482240016099564, x103, 0.01675 * x102),
-            ) - Self::mul_add(-x96, x108, x97 * x107),
+                x67,
+                Self::mul_add(-2.5482240016099564, x105, 0.01675 * x104),
+            ) - Self::mul_add(-x98, x110, x99 * x109),
         );
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x113 = 0.00000000020510342851533115 * s_q12;
-        let x114 = 0.00000000020510342851533115 * c_q12;
-        let x115 = Self::mul_add(x104, s_q12, Self::mul_add(x97, x113, x96 * c_q12));
-        let x116 = Self::mul_add(-x104, c_q12, Self::mul_add(-x97, x114, x96 * s_q12));
-        let x117 = Self::mul_add(Self::mul_add(x96, x104, x103), 0.36, x101);
-        let x118 = Self::mul_add(
-            x102 - x106,
+        let x114 = 0.00000000020510342851533115 * s_q12;
+        let x115 = 0.00000000020510342851533115 * c_q12;
+        let x116 = Self::mul_add(x106, s_q12, Self::mul_add(x99, x114, x98 * c_q12));
+        let x117 = Self::mul_add(-x106, c_q12, Self::mul_add(-x99, x115, x98 * s_q12));
+        let x118 = Self::mul_add(Self::mul_add(x98, x106, x105), 0.36, x103);
+        let x119 = Self::mul_add(
+            x104 - x108,
             -0.36,
-            Self::mul_add(c_q11, x99, s_q11 * x98),
+            Self::mul_add(c_q11, x101, s_q11 * x100),
         );
-        let x119 = Self::mul_add(Self::mul_add(x97, x97, x105), -0.36, x100);
-        let x120 = Self::mul_add(s_q12, x119, Self::mul_add(x113, x118, c_q12 * x117));
-        let x121 = Self::mul_add(-c_q12, x119, Self::mul_add(-x114, x118, s_q12 * x117));
-        let x122 = Self::mul_add(-0.00000000020510342851533115, x119, x118);
-        let x123 = Self::mul_add(-0.00000000020510342851533115, x63, x103);
-        let x124 = Self::mul_add(
-            v[11],
-            x116,
-            Self::mul_add(x63, s_q12, Self::mul_add(x103, x113, x102 * c_q12)),
-        );
+        let x120 = Self::mul_add(Self::mul_add(x99, x99, x107), -0.36, x102);
+        let x121 = Self::mul_add(s_q12, x120, Self::mul_add(x114, x119, c_q12 * x118));
+        let x122 = Self::mul_add(-c_q12, x120, Self::mul_add(-x115, x119, s_q12 * x118));
+        let x123 = Self::mul_add(-0.00000000020510342851533115, x120, x119);
+        let x124 = Self::mul_add(-0.00000000020510342851533115, x67, x105);
         let x125 = Self::mul_add(
+            v[11],
+            x117,
+            Self::mul_add(x67, s_q12, Self::mul_add(x105, x114, x104 * c_q12)),
+        );
+        let x126 = Self::mul_add(
             -v[11],
-            x115,
-            Self::mul_add(-x63, c_q12, Self::mul_add(-x103, x114, x102 * s_q12)),
+            x116,
+            Self::mul_add(-x67, c_q12, Self::mul_add(-x105, x115, x104 * s_q12)),
         );
-        let x126 = v[11] + Self::mul_add(-0.00000000020510342851533115, x104, x97);
-        let x127 = x116 * x116;
-        let x128 = x126 * x126;
-        let x129 = x115 * x116;
-        let x130 = x123 - x129;
-        let x131 = x115 * x126;
-        let x132 = x115 * x115;
-        let x133 = x128 + x132;
-        let x134 = x116 * x126;
-        let x135 = x124 + x134;
-        let x136 = Self::mul_add(x126, 0.809539999555672, x116 * 1.9877000000000002);
-        let x137 = Self::mul_add(
-            x126,
-            -2.741639999592316,
-            Self::mul_add(x116, -5.252920330000002, x115 * 1.9877000000000002),
-        );
+        let x127 = v[11] + Self::mul_add(-0.00000000020510342851533115, x106, x99);
+        let x128 = x117 * x117;
+        let x129 = x127 * x127;
+        let x130 = x116 * x117;
+        let x131 = x124 - x130;
+        let x132 = x116 * x127;
+        let x133 = x116 * x116;
+        let x134 = x129 + x133;
+        let x135 = x117 * x127;
+        let x136 = x125 + x135;
+        let x137 = Self::mul_add(x127, 0.809539999555672, x117 * 1.9877000000000002);
         let x138 = Self::mul_add(
-            9.740442170000001,
-            x126,
-            Self::mul_add(x116, -2.7416399995923166, x115 * 0.809539999555672),
+            x127,
+            -2.741639999592316,
+            Self::mul_add(x117, -5.252920330000002, x116 * 1.9877000000000002),
         );
         let x139 = Self::mul_add(
-            -3.6140000000000003,
-            x122,
-            Self::mul_add(
-                x123,
-                -2.741639999592316,
-                Self::mul_add(x125, -5.252920330000002, x124 * 1.9877000000000002),
-            ) + Self::mul_add(-x115, x138, x126 * x136),
+            9.740442170000001,
+            x127,
+            Self::mul_add(x117, -2.7416399995923166, x116 * 0.809539999555672),
         );
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+        let x140 = Self::mul_add(
+            -3.6140000000000003,
+            x123,
+            Self::mul_add(
+                x124,
+                -2.741639999592316,
+                Self::mul_add(x126, -5.252920330000002, x125 * 1.9877000000000002),
+            ) + Self::mul_add(-x116, x139, x127 * x137),
+        );
         let x141 = 0.00000000020510342851533115 * c_q13;
         let x142 = 0.00000000020510342851533115 * s_q13;
-        let x143 = Self::mul_add(-x126, c_q13, Self::mul_add(x116, s_q13, x115 * x141));
-        let x144 = Self::mul_add(-x126, s_q13, Self::mul_add(-x116, c_q13, x115 * x142));
-        let x145 = x120 + Self::mul_add(-0.16, x125 + x131, 0.55 * x130);
-        let x146 = x122 - Self::mul_add(-0.16, x127 + x132, 0.55 * x135);
+        let x143 = Self::mul_add(-x127, c_q13, Self::mul_add(x117, s_q13, x116 * x141));
+        let x144 = Self::mul_add(-x127, s_q13, Self::mul_add(-x117, c_q13, x116 * x142));
+        let x145 = x121 + Self::mul_add(-0.16, x126 + x132, 0.55 * x131);
+        let x146 = x123 - Self::mul_add(-0.16, x128 + x133, 0.55 * x136);
         let x147 = Self::mul_add(
             -c_q13,
             x146,
             Self::mul_add(
                 s_q13,
-                x121 + Self::mul_add(0.16, x124 - x134, 0.55 * x133),
+                x122 + Self::mul_add(0.16, x125 - x135, 0.55 * x134),
                 x141 * x145,
             ),
         );
-        let x148 = Self::mul_add(0.00000000020510342851533115, x123, x124);
+        let x148 = Self::mul_add(0.00000000020510342851533115, x124, x125);
         let x149 = Self::mul_add(
             v[12],
             x144,
-            Self::mul_add(-x123, c_q13, Self::mul_add(x125, s_q13, x124 * x141)),
+            Self::mul_add(-x124, c_q13, Self::mul_add(x126, s_q13, x125 * x141)),
         );
         let x150 = Self::mul_add(
             -v[12],
             x143,
-            Self::mul_add(-x123, s_q13, Self::mul_add(-x125, c_q13, x124 * x142)),
+            Self::mul_add(-x124, s_q13, Self::mul_add(-x126, c_q13, x125 * x142)),
         );
-        let x151 = v[12] - Self::mul_add(0.00000000020510342851533115, x126, x115);
+        let x151 = v[12] - Self::mul_add(0.00000000020510342851533115, x127, x116);
         let x152 = 4.806620000000001 * Self::mul_add(x143, x144, x148);
         let x153 = 4.806620000000001 * Self::mul_add(x143, x143, x151 * x151);
         let x154 = 4.806620000000001 * Self::mul_add(x144, x151, x149);
@@ -2289,63 +2307,63 @@ impl FreeFloating7 {
         );
         let x165 = Self::mul_add(
             -17.135250000000003,
-            x130,
-            3.6140000000000003 * (x127 + x128),
+            x131,
+            3.6140000000000003 * (x128 + x129),
         ) + x161;
         let x166 = Self::mul_add(
             17.135250000000003,
-            x133,
-            3.6140000000000003 * (x123 + x129),
+            x134,
+            3.6140000000000003 * (x124 + x130),
         ) + x162;
         let x167 = Self::mul_add(
             17.135250000000003,
-            x135,
-            3.6140000000000003 * (x125 - x131),
+            x136,
+            3.6140000000000003 * (x126 - x132),
         ) + x163;
         let x168 = Self::mul_add(
             -17.135250000000003,
-            x122,
-            Self::mul_add(x123, 0.809539999555672, x125 * 1.9877000000000002)
-                - Self::mul_add(-x116, x138, x126 * x137),
+            x123,
+            Self::mul_add(x124, 0.809539999555672, x126 * 1.9877000000000002)
+                - Self::mul_add(-x117, x139, x127 * x138),
         )
             + (x160 - Self::mul_add(x142, x158, x141 * x159)
                 + Self::mul_add(0.55, x163, 0.16 * x162));
-        let x169 = x139
+        let x169 = x140
             - Self::mul_add(-0.16, x161, Self::mul_add(-c_q13, x158, s_q13 * x159));
         let x170 = Self::mul_add(
             9.740442170000001,
-            x123,
-            Self::mul_add(x125, -2.7416399995923166, x124 * 0.809539999555672),
-        ) - Self::mul_add(-x115, x137, x116 * x136)
-            + Self::mul_add(3.6140000000000003, x121, 17.135250000000003 * x120) + x164;
+            x124,
+            Self::mul_add(x126, -2.7416399995923166, x125 * 0.809539999555672),
+        ) - Self::mul_add(-x116, x138, x117 * x137)
+            + Self::mul_add(3.6140000000000003, x122, 17.135250000000003 * x121) + x164;
         let x171 = -x170;
         let x172 = Self::mul_add(-s_q12, x166, c_q12 * x165);
-        let x173 = x167 + Self::mul_add(x114, x166, x113 * x165);
+        let x173 = x167 + Self::mul_add(x115, x166, x114 * x165);
         let x174 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(-x96, x97, x63),
+            Self::mul_add(-x98, x99, x67),
             -x172,
         );
         let x175 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x104, x104, x105),
+            Self::mul_add(x106, x106, x107),
             -x173,
         );
         let x176 = Self::mul_add(
             7.078399999258757,
-            x102 + x106,
+            x104 + x108,
             Self::mul_add(
                 -0.00000000020510342851533115,
                 x167,
                 Self::mul_add(c_q12, x166, s_q12 * x165),
             ),
         );
-        let x177 = x110
+        let x177 = x112
             - Self::mul_add(0.36, x173, Self::mul_add(s_q12, x169, c_q12 * x168));
-        let x178 = Self::mul_add(-2.5482240016099564, x63, x103 * 9.142025249762803)
-            + Self::mul_add(-x96, x109, x104 * x107)
-            - Self::mul_add(-0.36, x172, x170 + Self::mul_add(-x114, x169, x113 * x168));
-        let x179 = x111
+        let x178 = Self::mul_add(-2.5482240016099564, x67, x105 * 9.142025249762803)
+            + Self::mul_add(-x98, x111, x106 * x109)
+            - Self::mul_add(-0.36, x172, x170 + Self::mul_add(-x115, x169, x114 * x168));
+        let x179 = x113
             - Self::mul_add(
                 -0.00000000020510342851533115,
                 x170,
@@ -2353,96 +2371,96 @@ impl FreeFloating7 {
             );
         let x180 = Self::mul_add(s_q11, x175, c_q11 * x174);
         let x181 = Self::mul_add(-c_q11, x175, s_q11 * x174);
-        let x182 = Self::mul_add(x85, 45.1584, -x180);
-        let x183 = Self::mul_add(45.1584, x87, x181);
-        let x184 = Self::mul_add(45.1584, x89, -x176);
-        let x185 = x93
+        let x182 = Self::mul_add(x88, 45.1584, -x180);
+        let x183 = Self::mul_add(45.1584, x90, x181);
+        let x184 = Self::mul_add(45.1584, x92, -x176);
+        let x185 = x96
             - (Self::mul_add(s_q11, x178, c_q11 * x177)
                 - Self::mul_add(-0.63, x176, 0.275 * x181));
-        let x186 = Self::mul_add(x63, 24.35164200091464, x83 * 24.4950615)
-            - Self::mul_add(-x76, x92, x84 * x90)
+        let x186 = Self::mul_add(x67, 24.35164200091464, x86 * 24.4950615)
+            - Self::mul_add(-x79, x95, x87 * x93)
             - Self::mul_add(0.275, x180, Self::mul_add(-c_q11, x178, s_q11 * x177));
-        let x187 = x94 - Self::mul_add(0.63, x180, x179);
+        let x187 = x97 - Self::mul_add(0.63, x180, x179);
         let x188 = -x187;
         let x189 = Self::mul_add(s_q10, x183, c_q10 * x182);
-        let x190 = Self::mul_add(x67, 81.53205, x189);
+        let x190 = Self::mul_add(x71, 81.53205, x189);
         let x191 = Self::mul_add(
             81.53205,
-            x68,
+            x72,
             -Self::mul_add(-c_q10, x183, s_q10 * x182),
         );
-        let x192 = Self::mul_add(81.53205, x69, x184);
-        let x193 = x73
+        let x192 = Self::mul_add(81.53205, x73, x184);
+        let x193 = x77
             + Self::mul_add(0.87, x184, Self::mul_add(-s_q10, x186, c_q10 * x185));
-        let x194 = Self::mul_add(x63, -36.18604050126307, x65 * 63.36336825000001)
-            + Self::mul_add(-x56, x72, x66 * x70)
+        let x194 = Self::mul_add(x67, -36.18604050126307, x69 * 63.36336825000001)
+            + Self::mul_add(-x60, x76, x70 * x74)
             - Self::mul_add(c_q10, x186, s_q10 * x185);
-        let x195 = x74 + Self::mul_add(0.87, x189, x187);
+        let x195 = x78 + Self::mul_add(0.87, x189, x187);
         let x196 = -x195;
         let x197 = 0.00000000020510342851533115 * x192;
         let x198 = Self::mul_add(-c_q9, x191, s_q9 * x190) + x197;
-        let x199 = x192 + Self::mul_add(x55, x191, x54 * x190);
+        let x199 = x192 + Self::mul_add(x59, x191, x58 * x190);
         let x200 = x197 - Self::mul_add(s_q9, x191, c_q9 * x190);
         let x201 = 0.00000000020510342851533115 * x195;
         let x202 = Self::mul_add(
-            x41,
+            x46,
             -12.701650001451807,
-            (x38 + x39) * 0.000000008530897668050218,
+            (x43 + x44) * 0.000000008530897668050218,
         ) - x198;
         let x203 = Self::mul_add(
             12.701650001451807,
-            x44,
-            0.000000008530897668050218 * (x16 + x40),
+            x49,
+            0.000000008530897668050218 * (x22 + x45),
         ) - x199;
         let x204 = Self::mul_add(
             12.701650001451807,
-            x46,
-            0.000000008530897668050218 * (x36 - x42),
+            x51,
+            0.000000008530897668050218 * (x41 - x47),
         ) - x200;
         let x205 = Self::mul_add(
-            x34,
+            x39,
             12.701650001451807,
-            Self::mul_add(x16, 0.002139996587640933, x36 * 0.0000000234896432582596)
-                - Self::mul_add(-x28, x49, x37 * x48),
+            Self::mul_add(x22, 0.002139996587640933, x41 * 0.0000000234896432582596)
+                - Self::mul_add(-x33, x54, x42 * x53),
         )
             + (Self::mul_add(-c_q9, x194, s_q9 * x193) - x201
                 + Self::mul_add(0.275, x200, 0.4 * x199));
-        let x206 = x50
-            + Self::mul_add(0.4, x198, x195 - Self::mul_add(x55, x194, x54 * x193));
+        let x206 = x55
+            + Self::mul_add(0.4, x198, x195 - Self::mul_add(x59, x194, x58 * x193));
         let x207 = Self::mul_add(
             113.3918902508081,
-            x16,
-            Self::mul_add(5.080660024070366, x36, x35 * 0.002139996587640933),
-        ) - Self::mul_add(-x27, x48, x28 * x47)
-            - Self::mul_add(x33, 0.000000008530897668050218, x32 * 12.701650001451807)
+            x22,
+            Self::mul_add(5.080660024070366, x41, x40 * 0.002139996587640933),
+        ) - Self::mul_add(-x32, x53, x33 * x52)
+            - Self::mul_add(x38, 0.000000008530897668050218, x37 * 12.701650001451807)
             - Self::mul_add(0.275, x198, x201 + Self::mul_add(s_q9, x194, c_q9 * x193));
         let x208 = -x207;
-        let x209 = x204 + Self::mul_add(-x26, x203, x25 * x202);
+        let x209 = x204 + Self::mul_add(-x31, x203, x30 * x202);
         let x210 = Self::mul_add(c_q8, x203, s_q8 * x202);
-        let x211 = Self::mul_add(48.0240000085309, Self::mul_add(x18, x18, x19), x209);
-        let x212 = Self::mul_add(48.0240000085309, x4 * x5, -x210);
+        let x211 = Self::mul_add(48.0240000085309, Self::mul_add(x24, x24, x25), x209);
+        let x212 = Self::mul_add(48.0240000085309, x10 * x11, -x210);
         let x213 = Self::mul_add(
             48.0240000085309,
-            x17 + x20,
+            x23 + x26,
             -Self::mul_add(
                 -0.00000000020510342851533115,
                 x204,
                 Self::mul_add(-s_q8, x203, c_q8 * x202),
             ),
         );
-        let x214 = Self::mul_add(x17, 0.07309, Self::mul_add(x5, x23, x18 * x22))
-            - Self::mul_add(0.35, x210, x207 + Self::mul_add(x26, x206, x25 * x205));
+        let x214 = Self::mul_add(x23, 0.07309, Self::mul_add(x11, x29, x24 * x28))
+            - Self::mul_add(0.35, x210, x207 + Self::mul_add(x31, x206, x30 * x205));
         let x215 = Self::mul_add(
             48.0240000085309,
-            x14,
-            Self::mul_add(-130.43769025763282, x17, x16 * 0.07309)
-                + Self::mul_add(x4, x23, x18 * x21),
+            x20,
+            Self::mul_add(-130.43769025763282, x23, x22 * 0.07309)
+                + Self::mul_add(x10, x29, x24 * x27),
         ) + Self::mul_add(-0.35, x209, Self::mul_add(-c_q8, x206, s_q8 * x205));
         let x216 = Self::mul_add(
             48.0240000085309,
-            x15,
-            Self::mul_add(-0.1132, x17, x16 * 16.80768997608804)
-                + Self::mul_add(-x4, x22, x5 * x21),
+            x21,
+            Self::mul_add(-0.1132, x23, x22 * 16.80768997608804)
+                + Self::mul_add(-x10, x28, x11 * x27),
         )
             - Self::mul_add(
                 -0.00000000020510342851533115,
@@ -2457,33 +2475,33 @@ impl FreeFloating7 {
         let x222 = -(x217
             + Self::mul_add(
                 1170.07,
-                x0,
-                Self::mul_add(-180.9502499901501, x9, 110.5455 * x7),
+                x7,
+                Self::mul_add(-180.9502499901501, x15, 110.5455 * x13),
             ));
         let x223 = -(x218
             - Self::mul_add(
                 1170.07,
-                x1,
-                Self::mul_add(180.9502499901501, x10, 110.5455 * x8),
+                x8,
+                Self::mul_add(180.9502499901501, x16, 110.5455 * x14),
             ));
         let x224 = x213
             - Self::mul_add(
                 1170.07,
-                x2,
-                -Self::mul_add(-180.9502499901501, x11, 110.5455 * x9),
+                x9,
+                -Self::mul_add(-180.9502499901501, x17, 110.5455 * x15),
             );
         let x225 = Self::mul_add(0.75, x218, Self::mul_add(-s_q7, x215, c_q7 * x214))
             - Self::mul_add(
                 180.9502499901501,
-                x1,
+                x8,
                 Self::mul_add(v[4], x221, v[5] * x220),
             );
         let x226 = Self::mul_add(c_q7, x215, s_q7 * x214)
             - Self::mul_add(0.65, x213, 0.75 * x217)
             + (Self::mul_add(v[3], x221, v[5] * x219)
-                - Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
+                - Self::mul_add(-110.5455, x9, 180.9502499901501 * x7));
         let x227 = Self::mul_add(-0.65, x218, x216)
-            - Self::mul_add(-110.5455, x1, Self::mul_add(-v[3], x220, v[4] * x219));
+            - Self::mul_add(-110.5455, x8, Self::mul_add(-v[3], x220, v[4] * x219));
         [x222, x223, x224, x225, x226, x227, x216, x208, x196, x188, x179, x171, x160]
     }
     /// Inverse dynamics: the external wrench on the base (force, moment about its origin, base coordinates) and the joint drives that produce `a`, i.e. `M a + c`.
@@ -2491,338 +2509,341 @@ impl FreeFloating7 {
     /// Methods: bias `newton-euler`: 543 mul, 458 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 332 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 13] {
-        let x0 = a[0] - Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x1 = a[1] + Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x2 = a[2] - Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let x4 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x5 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x6 = v[4] * v[4];
-        let x7 = Self::mul_add(v[5], v[5], x6);
-        let x8 = v[3] * v[5];
-        let x9 = a[4] + x8;
-        let x10 = Self::mul_add(v[3], v[4], a[5]);
-        let x11 = Self::mul_add(-v[4], v[5], a[3]);
-        let x12 = a[4] - x8;
-        let x13 = Self::mul_add(v[3], v[3], x6);
-        let x14 = x0 - Self::mul_add(-0.75, x9, 0.65 * x7);
-        let x15 = x1 + Self::mul_add(-0.75, x11, 0.65 * x10);
-        let x16 = x2 - Self::mul_add(0.75, x13, 0.65 * x12);
-        let x17 = Self::mul_add(-c_q7, x15, s_q7 * x14);
-        let x18 = Self::mul_add(-v[6], x5, Self::mul_add(a[4], s_q7, a[3] * c_q7));
-        let x19 = Self::mul_add(v[6], x4, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
-        let x20 = a[5] + a[6];
-        let x21 = v[5] + v[6];
-        let x22 = x5 * x5;
-        let x23 = x4 * x21;
-        let x24 = Self::mul_add(x21, -16.80768997608804, x5 * 0.07309);
-        let x25 = Self::mul_add(
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = a[0] - Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x8 = a[1] + Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x9 = a[2] - Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x10 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x11 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x12 = v[4] * v[4];
+        let x13 = Self::mul_add(v[5], v[5], x12);
+        let x14 = v[3] * v[5];
+        let x15 = a[4] + x14;
+        let x16 = Self::mul_add(v[3], v[4], a[5]);
+        let x17 = Self::mul_add(-v[4], v[5], a[3]);
+        let x18 = a[4] - x14;
+        let x19 = Self::mul_add(v[3], v[3], x12);
+        let x20 = x7 - Self::mul_add(-0.75, x15, 0.65 * x13);
+        let x21 = x8 + Self::mul_add(-0.75, x17, 0.65 * x16);
+        let x22 = x9 - Self::mul_add(0.75, x19, 0.65 * x18);
+        let x23 = Self::mul_add(-c_q7, x21, s_q7 * x20);
+        let x24 = Self::mul_add(-v[6], x11, Self::mul_add(a[4], s_q7, a[3] * c_q7));
+        let x25 = Self::mul_add(v[6], x10, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
+        let x26 = a[5] + a[6];
+        let x27 = v[5] + v[6];
+        let x28 = x11 * x11;
+        let x29 = x10 * x27;
+        let x30 = Self::mul_add(x27, -16.80768997608804, x11 * 0.07309);
+        let x31 = Self::mul_add(
             -0.1132,
-            x21,
-            Self::mul_add(130.43769025763282, x5, x4 * 0.07309),
+            x27,
+            Self::mul_add(130.43769025763282, x11, x10 * 0.07309),
         );
-        let x26 = Self::mul_add(
+        let x32 = Self::mul_add(
             -132.47349025763282,
-            x21,
-            Self::mul_add(0.1132, x5, x4 * 16.80768997608804),
+            x27,
+            Self::mul_add(0.1132, x11, x10 * 16.80768997608804),
         );
-        let x27 = Self::mul_add(
+        let x33 = Self::mul_add(
             48.0240000085309,
-            x16,
+            x22,
             Self::mul_add(
                 -0.1132,
-                x20,
-                Self::mul_add(130.43769025763282, x19, x18 * 0.07309),
-            ) - Self::mul_add(x4, x26, x21 * x24),
+                x26,
+                Self::mul_add(130.43769025763282, x25, x24 * 0.07309),
+            ) - Self::mul_add(x10, x32, x27 * x30),
         );
-        let x28 = Self::mul_add(
+        let x34 = Self::mul_add(
             48.0240000085309,
-            x17,
+            x23,
             Self::mul_add(
                 -132.47349025763282,
-                x20,
-                Self::mul_add(0.1132, x19, x18 * 16.80768997608804),
-            ) - Self::mul_add(-x4, x25, x5 * x24),
+                x26,
+                Self::mul_add(0.1132, x25, x24 * 16.80768997608804),
+            ) - Self::mul_add(-x10, x31, x11 * x30),
         );
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x30 = 0.00000000020510342851533115 * c_q8;
-        let x31 = 0.00000000020510342851533115 * s_q8;
-        let x32 = Self::mul_add(x21, c_q8, Self::mul_add(x5, s_q8, x4 * x30));
-        let x33 = Self::mul_add(x21, s_q8, Self::mul_add(-x5, c_q8, x4 * x31));
-        let x34 = Self::mul_add(-0.35, x19 - x23, Self::mul_add(s_q7, x15, c_q7 * x14));
-        let x35 = Self::mul_add(0.35, Self::mul_add(x5, x21, x18), x17);
-        let x36 = Self::mul_add(-0.35, Self::mul_add(x4, x4, x22), x16);
-        let x37 = Self::mul_add(c_q8, x36, Self::mul_add(s_q8, x35, x30 * x34));
-        let x38 = Self::mul_add(s_q8, x36, Self::mul_add(-c_q8, x35, x31 * x34));
-        let x39 = Self::mul_add(-0.00000000020510342851533115, x36, x34);
-        let x40 = Self::mul_add(
+        let x35 = 0.00000000020510342851533115 * c_q8;
+        let x36 = 0.00000000020510342851533115 * s_q8;
+        let x37 = Self::mul_add(x27, c_q8, Self::mul_add(x11, s_q8, x10 * x35));
+        let x38 = Self::mul_add(x27, s_q8, Self::mul_add(-x11, c_q8, x10 * x36));
+        let x39 = Self::mul_add(-0.35, x25 - x29, Self::mul_add(s_q7, x21, c_q7 * x20));
+        let x40 = Self::mul_add(0.35, Self::mul_add(x11, x27, x24), x23);
+        let x41 = Self::mul_add(-0.35, Self::mul_add(x10, x10, x28), x22);
+        let x42 = Self::mul_add(c_q8, x41, Self::mul_add(s_q8, x40, x35 * x39));
+        let x43 = Self::mul_add(s_q8, x41, Self::mul_add(-c_q8, x40, x36 * x39));
+        let x44 = Self::mul_add(-0.00000000020510342851533115, x41, x39);
+        let x45 = Self::mul_add(
             -v[7],
-            x33,
-            Self::mul_add(x20, c_q8, Self::mul_add(x19, s_q8, x18 * x30)),
+            x38,
+            Self::mul_add(x26, c_q8, Self::mul_add(x25, s_q8, x24 * x35)),
         );
-        let x41 = Self::mul_add(
+        let x46 = Self::mul_add(
             v[7],
-            x32,
-            Self::mul_add(x20, s_q8, Self::mul_add(-x19, c_q8, x18 * x31)),
+            x37,
+            Self::mul_add(x26, s_q8, Self::mul_add(-x25, c_q8, x24 * x36)),
         );
-        let x42 = a[7] + Self::mul_add(-0.00000000020510342851533115, x20, x18);
-        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x21, x4);
-        let x44 = x33 * x33;
-        let x45 = x43 * x43;
-        let x46 = x32 * x33;
-        let x47 = x42 + x46;
-        let x48 = x32 * x43;
-        let x49 = x32 * x32;
-        let x50 = x45 + x49;
-        let x51 = x33 * x43;
-        let x52 = x40 - x51;
-        let x53 = Self::mul_add(
-            x43,
+        let x47 = a[7] + Self::mul_add(-0.00000000020510342851533115, x26, x24);
+        let x48 = v[7] + Self::mul_add(-0.00000000020510342851533115, x27, x10);
+        let x49 = x38 * x38;
+        let x50 = x48 * x48;
+        let x51 = x37 * x38;
+        let x52 = x47 + x51;
+        let x53 = x37 * x48;
+        let x54 = x37 * x37;
+        let x55 = x50 + x54;
+        let x56 = x38 * x48;
+        let x57 = x45 - x56;
+        let x58 = Self::mul_add(
+            x48,
             0.002139996587640933,
-            x33 * 0.0000000234896432582596,
+            x38 * 0.0000000234896432582596,
         );
-        let x54 = Self::mul_add(
+        let x59 = Self::mul_add(
             5.080660024070365,
-            x43,
-            Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
+            x48,
+            Self::mul_add(x38, -111.7548902508081, x37 * 0.0000000234896432582596),
         );
-        let x55 = Self::mul_add(
+        let x60 = Self::mul_add(
             113.3918902508081,
-            x43,
-            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
+            x48,
+            Self::mul_add(5.080660024070366, x38, x37 * 0.002139996587640933),
         );
-        let x56 = Self::mul_add(
-            x39,
+        let x61 = Self::mul_add(
+            x44,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x42,
-                Self::mul_add(x41, -111.7548902508081, x40 * 0.0000000234896432582596),
-            ) - Self::mul_add(-x32, x55, x43 * x53),
+                x47,
+                Self::mul_add(x46, -111.7548902508081, x45 * 0.0000000234896432582596),
+            ) - Self::mul_add(-x37, x60, x48 * x58),
         );
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x58 = 0.00000000020510342851533115 * c_q9;
-        let x59 = 0.00000000020510342851533115 * s_q9;
-        let x60 = x58 - x59;
-        let x61 = x58 + x59;
-        let x62 = Self::mul_add(-x43, c_q9, Self::mul_add(-x33, x60, x32 * s_q9));
-        let x63 = Self::mul_add(x43, s_q9, Self::mul_add(x33, x61, x32 * c_q9));
-        let x64 = x37 + Self::mul_add(-0.4, x41 - x48, 0.275 * x47);
-        let x65 = x38 - Self::mul_add(-0.4, x40 + x51, 0.275 * x50);
-        let x66 = x39 - Self::mul_add(0.4, x44 + x49, 0.275 * x52);
-        let x67 = Self::mul_add(-c_q9, x66, Self::mul_add(-x60, x65, s_q9 * x64));
-        let x68 = Self::mul_add(
+        let x62 = 0.00000000020510342851533115 * c_q9;
+        let x63 = 0.00000000020510342851533115 * s_q9;
+        let x64 = x62 - x63;
+        let x65 = x62 + x63;
+        let x66 = Self::mul_add(-x48, c_q9, Self::mul_add(-x38, x64, x37 * s_q9));
+        let x67 = Self::mul_add(x48, s_q9, Self::mul_add(x38, x65, x37 * c_q9));
+        let x68 = x42 + Self::mul_add(-0.4, x46 - x53, 0.275 * x52);
+        let x69 = x43 - Self::mul_add(-0.4, x45 + x56, 0.275 * x55);
+        let x70 = x44 - Self::mul_add(0.4, x49 + x54, 0.275 * x57);
+        let x71 = Self::mul_add(-c_q9, x70, Self::mul_add(-x64, x69, s_q9 * x68));
+        let x72 = Self::mul_add(
             -0.00000000020510342851533115,
-            x66,
-            Self::mul_add(-0.00000000020510342851533115, x64, x65),
+            x70,
+            Self::mul_add(-0.00000000020510342851533115, x68, x69),
         );
-        let x69 = Self::mul_add(
+        let x73 = Self::mul_add(
             v[8],
-            x63,
-            Self::mul_add(-x42, c_q9, Self::mul_add(-x41, x60, x40 * s_q9)),
-        );
-        let x70 = Self::mul_add(
-            -v[8],
-            x62,
-            Self::mul_add(x42, s_q9, Self::mul_add(x41, x61, x40 * c_q9)),
-        );
-        let x71 = a[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x42,
-                Self::mul_add(-0.00000000020510342851533115, x40, x41),
-            );
-        let x72 = v[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x43,
-                Self::mul_add(-0.00000000020510342851533115, x32, x33),
-            );
-        let x73 = Self::mul_add(-x62, x63, x71);
-        let x74 = Self::mul_add(x62, x62, x72 * x72);
-        let x75 = Self::mul_add(x63, x72, x69);
-        let x76 = x72 * 0.00214;
-        let x77 = Self::mul_add(x72, -36.18604050126307, x63 * 63.36336825000001);
-        let x78 = Self::mul_add(
-            69.99836825,
-            x72,
-            Self::mul_add(x63, 36.18604050126307, x62 * 0.00214),
-        );
-        let x79 = Self::mul_add(
-            x68,
-            81.53205,
-            Self::mul_add(x71, 0.00214, Self::mul_add(x63, x78, x72 * x77)),
-        );
-        let x80 = Self::mul_add(
             x67,
+            Self::mul_add(-x47, c_q9, Self::mul_add(-x46, x64, x45 * s_q9)),
+        );
+        let x74 = Self::mul_add(
+            -v[8],
+            x66,
+            Self::mul_add(x47, s_q9, Self::mul_add(x46, x65, x45 * c_q9)),
+        );
+        let x75 = a[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x47,
+                Self::mul_add(-0.00000000020510342851533115, x45, x46),
+            );
+        let x76 = v[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x48,
+                Self::mul_add(-0.00000000020510342851533115, x37, x38),
+            );
+        let x77 = Self::mul_add(-x66, x67, x75);
+        let x78 = Self::mul_add(x66, x66, x76 * x76);
+        let x79 = Self::mul_add(x67, x76, x73);
+        let x80 = x76 * 0.00214;
+        let x81 = Self::mul_add(x76, -36.18604050126307, x67 * 63.36336825000001);
+        let x82 = Self::mul_add(
+            69.99836825,
+            x76,
+            Self::mul_add(x67, 36.18604050126307, x66 * 0.00214),
+        );
+        let x83 = Self::mul_add(
+            x72,
+            81.53205,
+            Self::mul_add(x75, 0.00214, Self::mul_add(x67, x82, x76 * x81)),
+        );
+        let x84 = Self::mul_add(
+            x71,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x71,
-                Self::mul_add(x70, 36.18604050126307, x69 * 0.00214),
-            ) - Self::mul_add(x62, x77, x63 * x76),
+                x75,
+                Self::mul_add(x74, 36.18604050126307, x73 * 0.00214),
+            ) - Self::mul_add(x66, x81, x67 * x80),
         );
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let x82 = Self::mul_add(x63, s_q10, x62 * c_q10);
-        let x83 = Self::mul_add(-x63, c_q10, x62 * s_q10);
-        let x84 = Self::mul_add(x73, -0.87, x67);
-        let x85 = Self::mul_add(
-            x74,
+        let x85 = Self::mul_add(x67, s_q10, x66 * c_q10);
+        let x86 = Self::mul_add(-x67, c_q10, x66 * s_q10);
+        let x87 = Self::mul_add(x77, -0.87, x71);
+        let x88 = Self::mul_add(
+            x78,
             -0.87,
-            Self::mul_add(s_q9, x66, Self::mul_add(x61, x65, c_q9 * x64)),
+            Self::mul_add(s_q9, x70, Self::mul_add(x65, x69, c_q9 * x68)),
         );
-        let x86 = Self::mul_add(x75, 0.87, x68);
-        let x87 = Self::mul_add(s_q10, x85, c_q10 * x84);
-        let x88 = Self::mul_add(-v[9], x83, Self::mul_add(x70, s_q10, x69 * c_q10));
-        let x89 = Self::mul_add(v[9], x82, Self::mul_add(-x70, c_q10, x69 * s_q10));
-        let x90 = a[9] + x71;
-        let x91 = v[9] + x72;
-        let x92 = Self::mul_add(x82, x83, x90);
-        let x93 = x82 * x82;
-        let x94 = Self::mul_add(x91, x91, x93);
-        let x95 = x83 * x91;
-        let x96 = x88 - x95;
-        let x97 = x91 * 0.6328;
-        let x98 = Self::mul_add(x91, 24.35164200091464, x83 * 24.4950615);
-        let x99 = Self::mul_add(
+        let x89 = Self::mul_add(x79, 0.87, x72);
+        let x90 = Self::mul_add(s_q10, x88, c_q10 * x87);
+        let x91 = Self::mul_add(-v[9], x86, Self::mul_add(x74, s_q10, x73 * c_q10));
+        let x92 = Self::mul_add(v[9], x85, Self::mul_add(-x74, c_q10, x73 * s_q10));
+        let x93 = a[9] + x75;
+        let x94 = v[9] + x76;
+        let x95 = Self::mul_add(x85, x86, x93);
+        let x96 = x85 * x85;
+        let x97 = Self::mul_add(x94, x94, x96);
+        let x98 = x86 * x94;
+        let x99 = x91 - x98;
+        let x100 = x94 * 0.6328;
+        let x101 = Self::mul_add(x94, 24.35164200091464, x86 * 24.4950615);
+        let x102 = Self::mul_add(
             28.2393615,
-            x91,
-            Self::mul_add(x83, -24.351642000914637, x82 * 0.6328),
+            x94,
+            Self::mul_add(x86, -24.351642000914637, x85 * 0.6328),
         );
-        let x100 = Self::mul_add(
-            x86,
+        let x103 = Self::mul_add(
+            x89,
             45.1584,
-            Self::mul_add(x90, 0.6328, -Self::mul_add(x83, x99, x91 * x98)),
+            Self::mul_add(x93, 0.6328, -Self::mul_add(x86, x102, x94 * x101)),
         );
-        let x101 = Self::mul_add(
-            x87,
+        let x104 = Self::mul_add(
+            x90,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x90,
-                Self::mul_add(x89, -24.351642000914637, x88 * 0.6328),
-            ) + Self::mul_add(x82, x98, x83 * x97),
+                x93,
+                Self::mul_add(x92, -24.351642000914637, x91 * 0.6328),
+            ) + Self::mul_add(x85, x101, x86 * x100),
         );
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let x103 = Self::mul_add(-x83, s_q11, x82 * c_q11);
-        let x104 = Self::mul_add(x83, c_q11, x82 * s_q11);
-        let x105 = x87
-            - Self::mul_add(-0.275, Self::mul_add(-x82, x91, x89), x92 * 0.63);
-        let x106 = Self::mul_add(-c_q10, x85, s_q10 * x84)
-            + Self::mul_add(-0.275, x88 + x95, x94 * 0.63);
-        let x107 = x86 + Self::mul_add(0.275, Self::mul_add(x83, x83, x93), x96 * 0.63);
-        let x108 = Self::mul_add(-s_q11, x106, c_q11 * x105);
-        let x109 = Self::mul_add(-v[10], x104, Self::mul_add(-x89, s_q11, x88 * c_q11));
-        let x110 = Self::mul_add(v[10], x103, Self::mul_add(x89, c_q11, x88 * s_q11));
-        let x111 = a[10] + x90;
-        let x112 = v[10] + x91;
-        let x113 = x103 * x103;
-        let x114 = x104 * x112;
-        let x115 = 0.01675 * x112;
-        let x116 = Self::mul_add(-2.5482240016099564, x112, x104 * 9.142025249762803);
-        let x117 = Self::mul_add(
-            -9.223235249762805,
-            x112,
-            Self::mul_add(-2.5482240016099564, x104, 0.01675 * x103),
-        );
-        let x118 = Self::mul_add(
-            7.078399999258757,
-            x107,
-            Self::mul_add(0.01675, x111, Self::mul_add(-x104, x117, x112 * x116)),
-        );
+        let x105 = Self::mul_add(-x86, s_q11, x85 * c_q11);
+        let x106 = Self::mul_add(x86, c_q11, x85 * s_q11);
+        let x107 = x90
+            - Self::mul_add(-0.275, Self::mul_add(-x85, x94, x92), x95 * 0.63);
+        let x108 = Self::mul_add(-c_q10, x88, s_q10 * x87)
+            + Self::mul_add(-0.275, x91 + x98, x97 * 0.63);
+        let x109 = x89 + Self::mul_add(0.275, Self::mul_add(x86, x86, x96), x99 * 0.63);
+        let x110 = Self::mul_add(-s_q11, x108, c_q11 * x107);
+        let x111 = Self::mul_add(-v[10], x106, Self::mul_add(-x92, s_q11, x91 * c_q11));
+        let x112 = Self::mul_add(v[10], x105, Self::mul_add(x92, c_q11, x91 * s_q11));
+        let x113 = a[10] + x93;
+        let x114 = v[10] + x94;
+        let x115 = x105 * x105;
+        let x116 = x106 * x114;
+        let x117 = 0.01675 * x114;
+        let x118 = Self::mul_add(-2.5482240016099564, x114, x106 * 9.142025249762803);
         let x119 = Self::mul_add(
+            -9.223235249762805,
+            x114,
+            Self::mul_add(-2.5482240016099564, x106, 0.01675 * x105),
+        );
+        let x120 = Self::mul_add(
+            7.078399999258757,
+            x109,
+            Self::mul_add(0.01675, x113, Self::mul_add(-x106, x119, x114 * x118)),
+        );
+        let x121 = Self::mul_add(
             -7.078399999258757,
-            x108,
+            x110,
             Self::mul_add(
                 -9.223235249762805,
-                x111,
-                Self::mul_add(-2.5482240016099564, x110, 0.01675 * x109),
-            ) + Self::mul_add(-x103, x116, x104 * x115),
+                x113,
+                Self::mul_add(-2.5482240016099564, x112, 0.01675 * x111),
+            ) + Self::mul_add(-x105, x118, x106 * x117),
         );
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x121 = 0.00000000020510342851533115 * s_q12;
-        let x122 = 0.00000000020510342851533115 * c_q12;
-        let x123 = Self::mul_add(x112, s_q12, Self::mul_add(x104, x121, x103 * c_q12));
-        let x124 = Self::mul_add(-x112, c_q12, Self::mul_add(-x104, x122, x103 * s_q12));
-        let x125 = Self::mul_add(Self::mul_add(-x103, x112, x110), 0.36, x108);
-        let x126 = Self::mul_add(
-            x109 + x114,
+        let x122 = 0.00000000020510342851533115 * s_q12;
+        let x123 = 0.00000000020510342851533115 * c_q12;
+        let x124 = Self::mul_add(x114, s_q12, Self::mul_add(x106, x122, x105 * c_q12));
+        let x125 = Self::mul_add(-x114, c_q12, Self::mul_add(-x106, x123, x105 * s_q12));
+        let x126 = Self::mul_add(Self::mul_add(-x105, x114, x112), 0.36, x110);
+        let x127 = Self::mul_add(
+            x111 + x116,
             -0.36,
-            Self::mul_add(c_q11, x106, s_q11 * x105),
+            Self::mul_add(c_q11, x108, s_q11 * x107),
         );
-        let x127 = Self::mul_add(Self::mul_add(x104, x104, x113), 0.36, x107);
-        let x128 = Self::mul_add(s_q12, x127, Self::mul_add(x121, x126, c_q12 * x125));
-        let x129 = Self::mul_add(-c_q12, x127, Self::mul_add(-x122, x126, s_q12 * x125));
-        let x130 = Self::mul_add(-0.00000000020510342851533115, x127, x126);
-        let x131 = Self::mul_add(
-            -v[11],
-            x124,
-            Self::mul_add(x111, s_q12, Self::mul_add(x110, x121, x109 * c_q12)),
-        );
+        let x128 = Self::mul_add(Self::mul_add(x106, x106, x115), 0.36, x109);
+        let x129 = Self::mul_add(s_q12, x128, Self::mul_add(x122, x127, c_q12 * x126));
+        let x130 = Self::mul_add(-c_q12, x128, Self::mul_add(-x123, x127, s_q12 * x126));
+        let x131 = Self::mul_add(-0.00000000020510342851533115, x128, x127);
         let x132 = Self::mul_add(
+            -v[11],
+            x125,
+            Self::mul_add(x113, s_q12, Self::mul_add(x112, x122, x111 * c_q12)),
+        );
+        let x133 = Self::mul_add(
             v[11],
-            x123,
-            Self::mul_add(-x111, c_q12, Self::mul_add(-x110, x122, x109 * s_q12)),
+            x124,
+            Self::mul_add(-x113, c_q12, Self::mul_add(-x112, x123, x111 * s_q12)),
         );
-        let x133 = a[11] + Self::mul_add(-0.00000000020510342851533115, x111, x110);
-        let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x112, x104);
-        let x135 = x124 * x124;
-        let x136 = x134 * x134;
-        let x137 = x123 * x124;
-        let x138 = x133 + x137;
-        let x139 = x123 * x134;
-        let x140 = x123 * x123;
-        let x141 = x136 + x140;
-        let x142 = x124 * x134;
-        let x143 = x131 - x142;
-        let x144 = Self::mul_add(x134, 0.809539999555672, x124 * 1.9877000000000002);
-        let x145 = Self::mul_add(
-            x134,
-            -2.741639999592316,
-            Self::mul_add(x124, -5.252920330000002, x123 * 1.9877000000000002),
-        );
+        let x134 = a[11] + Self::mul_add(-0.00000000020510342851533115, x113, x112);
+        let x135 = v[11] + Self::mul_add(-0.00000000020510342851533115, x114, x106);
+        let x136 = x125 * x125;
+        let x137 = x135 * x135;
+        let x138 = x124 * x125;
+        let x139 = x134 + x138;
+        let x140 = x124 * x135;
+        let x141 = x124 * x124;
+        let x142 = x137 + x141;
+        let x143 = x125 * x135;
+        let x144 = x132 - x143;
+        let x145 = Self::mul_add(x135, 0.809539999555672, x125 * 1.9877000000000002);
         let x146 = Self::mul_add(
-            9.740442170000001,
-            x134,
-            Self::mul_add(x124, -2.7416399995923166, x123 * 0.809539999555672),
+            x135,
+            -2.741639999592316,
+            Self::mul_add(x125, -5.252920330000002, x124 * 1.9877000000000002),
         );
         let x147 = Self::mul_add(
-            -3.6140000000000003,
-            x130,
-            Self::mul_add(
-                x133,
-                -2.741639999592316,
-                Self::mul_add(x132, -5.252920330000002, x131 * 1.9877000000000002),
-            ) - Self::mul_add(-x123, x146, x134 * x144),
+            9.740442170000001,
+            x135,
+            Self::mul_add(x125, -2.7416399995923166, x124 * 0.809539999555672),
         );
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+        let x148 = Self::mul_add(
+            -3.6140000000000003,
+            x131,
+            Self::mul_add(
+                x134,
+                -2.741639999592316,
+                Self::mul_add(x133, -5.252920330000002, x132 * 1.9877000000000002),
+            ) - Self::mul_add(-x124, x147, x135 * x145),
+        );
         let x149 = 0.00000000020510342851533115 * c_q13;
         let x150 = 0.00000000020510342851533115 * s_q13;
-        let x151 = Self::mul_add(-x134, c_q13, Self::mul_add(x124, s_q13, x123 * x149));
-        let x152 = Self::mul_add(-x134, s_q13, Self::mul_add(-x124, c_q13, x123 * x150));
-        let x153 = x128 + Self::mul_add(-0.16, x132 - x139, 0.55 * x138);
-        let x154 = x130 - Self::mul_add(0.16, x135 + x140, 0.55 * x143);
+        let x151 = Self::mul_add(-x135, c_q13, Self::mul_add(x125, s_q13, x124 * x149));
+        let x152 = Self::mul_add(-x135, s_q13, Self::mul_add(-x125, c_q13, x124 * x150));
+        let x153 = x129 + Self::mul_add(-0.16, x133 - x140, 0.55 * x139);
+        let x154 = x131 - Self::mul_add(0.16, x136 + x141, 0.55 * x144);
         let x155 = Self::mul_add(
             -c_q13,
             x154,
             Self::mul_add(
                 s_q13,
-                x129 - Self::mul_add(-0.16, x131 + x142, 0.55 * x141),
+                x130 - Self::mul_add(-0.16, x132 + x143, 0.55 * x142),
                 x149 * x153,
             ),
         );
         let x156 = Self::mul_add(
             -v[12],
             x152,
-            Self::mul_add(-x133, c_q13, Self::mul_add(x132, s_q13, x131 * x149)),
+            Self::mul_add(-x134, c_q13, Self::mul_add(x133, s_q13, x132 * x149)),
         );
         let x157 = Self::mul_add(
             v[12],
             x151,
-            Self::mul_add(-x133, s_q13, Self::mul_add(-x132, c_q13, x131 * x150)),
+            Self::mul_add(-x134, s_q13, Self::mul_add(-x133, c_q13, x132 * x150)),
         );
-        let x158 = a[12] - Self::mul_add(0.00000000020510342851533115, x133, x131);
-        let x159 = v[12] - Self::mul_add(0.00000000020510342851533115, x134, x123);
+        let x158 = a[12] - Self::mul_add(0.00000000020510342851533115, x134, x132);
+        let x159 = v[12] - Self::mul_add(0.00000000020510342851533115, x135, x124);
         let x160 = 4.806620000000001 * Self::mul_add(x151, x152, x158);
         let x161 = 4.806620000000001 * Self::mul_add(x151, x151, x159 * x159);
         let x162 = 4.806620000000001 * Self::mul_add(-x152, x159, x156);
@@ -2876,62 +2897,62 @@ impl FreeFloating7 {
         );
         let x174 = Self::mul_add(
             17.135250000000003,
-            x138,
-            3.6140000000000003 * (x135 + x136),
+            x139,
+            3.6140000000000003 * (x136 + x137),
         ) - x170;
         let x175 = Self::mul_add(
             -17.135250000000003,
-            x141,
-            3.6140000000000003 * (x133 - x137),
+            x142,
+            3.6140000000000003 * (x134 - x138),
         ) - x171;
         let x176 = Self::mul_add(
             17.135250000000003,
-            x143,
-            3.6140000000000003 * (x132 + x139),
+            x144,
+            3.6140000000000003 * (x133 + x140),
         ) - x172;
         let x177 = Self::mul_add(
             -17.135250000000003,
-            x130,
-            Self::mul_add(x133, 0.809539999555672, x132 * 1.9877000000000002)
-                + Self::mul_add(-x124, x146, x134 * x145),
+            x131,
+            Self::mul_add(x134, 0.809539999555672, x133 * 1.9877000000000002)
+                + Self::mul_add(-x125, x147, x135 * x146),
         )
             + (x168 - Self::mul_add(x150, x166, x149 * x167)
                 - Self::mul_add(0.55, x172, 0.16 * x171));
-        let x178 = x147
+        let x178 = x148
             - Self::mul_add(-0.16, x170, Self::mul_add(-c_q13, x166, s_q13 * x167));
         let x179 = Self::mul_add(
             9.740442170000001,
-            x133,
-            Self::mul_add(x132, -2.7416399995923166, x131 * 0.809539999555672),
-        ) + Self::mul_add(-x123, x145, x124 * x144)
-            + Self::mul_add(3.6140000000000003, x129, 17.135250000000003 * x128) + x173;
+            x134,
+            Self::mul_add(x133, -2.7416399995923166, x132 * 0.809539999555672),
+        ) + Self::mul_add(-x124, x146, x125 * x145)
+            + Self::mul_add(3.6140000000000003, x130, 17.135250000000003 * x129) + x173;
         let x180 = Self::mul_add(s_q12, x175, c_q12 * x174);
-        let x181 = x176 - Self::mul_add(-x122, x175, x121 * x174);
+        let x181 = x176 - Self::mul_add(-x123, x175, x122 * x174);
         let x182 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x103, x104, x111),
+            Self::mul_add(x105, x106, x113),
             x180,
         );
         let x183 = Self::mul_add(
             7.078399999258757,
-            Self::mul_add(x112, x112, x113),
+            Self::mul_add(x114, x114, x115),
             x181,
         );
         let x184 = Self::mul_add(
             7.078399999258757,
-            x109 - x114,
+            x111 - x116,
             -Self::mul_add(
                 0.00000000020510342851533115,
                 x176,
                 Self::mul_add(-c_q12, x175, s_q12 * x174),
             ),
         );
-        let x185 = x118
+        let x185 = x120
             - Self::mul_add(0.36, x181, Self::mul_add(s_q12, x178, c_q12 * x177));
-        let x186 = Self::mul_add(-2.5482240016099564, x111, x110 * 9.142025249762803)
-            - Self::mul_add(-x103, x117, x112 * x115)
-            - Self::mul_add(0.36, x180, x179 + Self::mul_add(-x122, x178, x121 * x177));
-        let x187 = x119
+        let x186 = Self::mul_add(-2.5482240016099564, x113, x112 * 9.142025249762803)
+            - Self::mul_add(-x105, x119, x114 * x117)
+            - Self::mul_add(0.36, x180, x179 + Self::mul_add(-x123, x178, x122 * x177));
+        let x187 = x121
             - Self::mul_add(
                 -0.00000000020510342851533115,
                 x179,
@@ -2940,86 +2961,86 @@ impl FreeFloating7 {
         let x188 = -x187;
         let x189 = Self::mul_add(-s_q11, x183, c_q11 * x182);
         let x190 = Self::mul_add(c_q11, x183, s_q11 * x182);
-        let x191 = Self::mul_add(x92, 45.1584, -x189);
-        let x192 = Self::mul_add(45.1584, x94, -x190);
-        let x193 = Self::mul_add(45.1584, x96, -x184);
-        let x194 = x100
+        let x191 = Self::mul_add(x95, 45.1584, -x189);
+        let x192 = Self::mul_add(45.1584, x97, -x190);
+        let x193 = Self::mul_add(45.1584, x99, -x184);
+        let x194 = x103
             - (Self::mul_add(s_q11, x186, c_q11 * x185)
                 - Self::mul_add(-0.63, x184, 0.275 * x190));
-        let x195 = Self::mul_add(x90, 24.35164200091464, x89 * 24.4950615)
-            + Self::mul_add(-x82, x99, x91 * x97)
+        let x195 = Self::mul_add(x93, 24.35164200091464, x92 * 24.4950615)
+            + Self::mul_add(-x85, x102, x94 * x100)
             - Self::mul_add(0.275, x189, Self::mul_add(-c_q11, x186, s_q11 * x185));
-        let x196 = x101 - Self::mul_add(0.63, x189, x187);
+        let x196 = x104 - Self::mul_add(0.63, x189, x187);
         let x197 = Self::mul_add(-s_q10, x192, c_q10 * x191);
-        let x198 = Self::mul_add(x73, 81.53205, x197);
+        let x198 = Self::mul_add(x77, 81.53205, x197);
         let x199 = Self::mul_add(
             81.53205,
-            x74,
+            x78,
             Self::mul_add(c_q10, x192, s_q10 * x191),
         );
-        let x200 = Self::mul_add(81.53205, x75, x193);
-        let x201 = x79
+        let x200 = Self::mul_add(81.53205, x79, x193);
+        let x201 = x83
             + Self::mul_add(0.87, x193, Self::mul_add(-s_q10, x195, c_q10 * x194));
-        let x202 = Self::mul_add(x71, -36.18604050126307, x70 * 63.36336825000001)
-            - Self::mul_add(-x62, x78, x72 * x76)
+        let x202 = Self::mul_add(x75, -36.18604050126307, x74 * 63.36336825000001)
+            - Self::mul_add(-x66, x82, x76 * x80)
             - Self::mul_add(c_q10, x195, s_q10 * x194);
-        let x203 = x80 + Self::mul_add(0.87, x197, x196);
+        let x203 = x84 + Self::mul_add(0.87, x197, x196);
         let x204 = 0.00000000020510342851533115 * x200;
         let x205 = Self::mul_add(c_q9, x199, s_q9 * x198) + x204;
-        let x206 = x200 + Self::mul_add(-x61, x199, x60 * x198);
+        let x206 = x200 + Self::mul_add(-x65, x199, x64 * x198);
         let x207 = x204 - Self::mul_add(-s_q9, x199, c_q9 * x198);
         let x208 = 0.00000000020510342851533115 * x203;
         let x209 = Self::mul_add(
-            x47,
+            x52,
             12.701650001451807,
-            (x44 + x45) * 0.000000008530897668050218,
+            (x49 + x50) * 0.000000008530897668050218,
         ) + x205;
         let x210 = Self::mul_add(
             -12.701650001451807,
-            x50,
-            0.000000008530897668050218 * (x42 - x46),
+            x55,
+            0.000000008530897668050218 * (x47 - x51),
         ) - x206;
         let x211 = Self::mul_add(
             12.701650001451807,
-            x52,
-            0.000000008530897668050218 * (x41 + x48),
+            x57,
+            0.000000008530897668050218 * (x46 + x53),
         ) - x207;
         let x212 = Self::mul_add(
-            x39,
+            x44,
             12.701650001451807,
-            Self::mul_add(x42, 0.002139996587640933, x41 * 0.0000000234896432582596)
-                + Self::mul_add(-x33, x55, x43 * x54),
+            Self::mul_add(x47, 0.002139996587640933, x46 * 0.0000000234896432582596)
+                + Self::mul_add(-x38, x60, x48 * x59),
         )
             + (Self::mul_add(-c_q9, x202, s_q9 * x201) - x208
                 + Self::mul_add(0.275, x207, 0.4 * x206));
-        let x213 = x56
-            + Self::mul_add(0.4, x205, x203 - Self::mul_add(x61, x202, x60 * x201));
+        let x213 = x61
+            + Self::mul_add(0.4, x205, x203 - Self::mul_add(x65, x202, x64 * x201));
         let x214 = Self::mul_add(
             113.3918902508081,
-            x42,
-            Self::mul_add(5.080660024070366, x41, x40 * 0.002139996587640933),
-        ) + Self::mul_add(-x32, x54, x33 * x53)
-            - Self::mul_add(x38, 0.000000008530897668050218, x37 * 12.701650001451807)
+            x47,
+            Self::mul_add(5.080660024070366, x46, x45 * 0.002139996587640933),
+        ) + Self::mul_add(-x37, x59, x38 * x58)
+            - Self::mul_add(x43, 0.000000008530897668050218, x42 * 12.701650001451807)
             - Self::mul_add(0.275, x205, x208 + Self::mul_add(s_q9, x202, c_q9 * x201));
-        let x215 = x211 - Self::mul_add(x31, x210, x30 * x209);
+        let x215 = x211 - Self::mul_add(x36, x210, x35 * x209);
         let x216 = Self::mul_add(-c_q8, x210, s_q8 * x209);
-        let x217 = Self::mul_add(48.0240000085309, Self::mul_add(x21, x21, x22), -x215);
-        let x218 = Self::mul_add(48.0240000085309, Self::mul_add(-x4, x5, x20), x216);
+        let x217 = Self::mul_add(48.0240000085309, Self::mul_add(x27, x27, x28), -x215);
+        let x218 = Self::mul_add(48.0240000085309, Self::mul_add(-x10, x11, x26), x216);
         let x219 = Self::mul_add(
             48.0240000085309,
-            x19 + x23,
+            x25 + x29,
             -Self::mul_add(
                 0.00000000020510342851533115,
                 x211,
                 Self::mul_add(s_q8, x210, c_q8 * x209),
             ),
         );
-        let x220 = Self::mul_add(x20, -16.80768997608804, x19 * 0.07309)
-            + Self::mul_add(x5, x26, x21 * x25)
-            + Self::mul_add(-0.35, x216, x214 + Self::mul_add(x31, x213, x30 * x212));
-        let x221 = x27
+        let x220 = Self::mul_add(x26, -16.80768997608804, x25 * 0.07309)
+            + Self::mul_add(x11, x32, x27 * x31)
+            + Self::mul_add(-0.35, x216, x214 + Self::mul_add(x36, x213, x35 * x212));
+        let x221 = x33
             + Self::mul_add(-0.35, x215, Self::mul_add(-c_q8, x213, s_q8 * x212));
-        let x222 = x28
+        let x222 = x34
             - Self::mul_add(
                 -0.00000000020510342851533115,
                 x214,
@@ -3034,25 +3055,25 @@ impl FreeFloating7 {
         let x229 = -(x224
             - Self::mul_add(
                 1170.07,
-                x0,
-                -Self::mul_add(-180.9502499901501, x9, 110.5455 * x7),
+                x7,
+                -Self::mul_add(-180.9502499901501, x15, 110.5455 * x13),
             ));
         let x230 = -(x225
             - Self::mul_add(
                 1170.07,
-                x1,
-                Self::mul_add(-180.9502499901501, x11, 110.5455 * x10),
+                x8,
+                Self::mul_add(-180.9502499901501, x17, 110.5455 * x16),
             ));
         let x231 = x219
             + Self::mul_add(
                 1170.07,
-                x2,
-                -Self::mul_add(180.9502499901501, x13, 110.5455 * x12),
+                x9,
+                -Self::mul_add(180.9502499901501, x19, 110.5455 * x18),
             );
         let x232 = Self::mul_add(0.75, x225, Self::mul_add(s_q7, x221, c_q7 * x220))
             + Self::mul_add(
                 -180.9502499901501,
-                x1,
+                x8,
                 Self::mul_add(a[5], -117.61766249359756, 1394.5960312283303 * a[3])
                     - Self::mul_add(v[4], x228, v[5] * x227),
             );
@@ -3062,11 +3083,11 @@ impl FreeFloating7 {
                 1466.4506062283303,
                 a[4],
                 Self::mul_add(v[3], x228, v[5] * x226),
-            ) + Self::mul_add(-110.5455, x2, 180.9502499901501 * x0));
+            ) + Self::mul_add(-110.5455, x9, 180.9502499901501 * x7));
         let x234 = -(Self::mul_add(0.65, x225, x222)
             + Self::mul_add(
                 -110.5455,
-                x1,
+                x8,
                 Self::mul_add(-1271.854575, a[5], a[3] * 117.61766249359758)
                     + Self::mul_add(-v[3], x227, v[4] * x226),
             ));
@@ -3077,246 +3098,249 @@ impl FreeFloating7 {
     /// Methods: forward `aba`: 1592 mul, 1277 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 953 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
-        let x0 = Self::mul_add(
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = Self::mul_add(
             -180.9502499901501,
             v[1],
             Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
         );
-        let x1 = Self::mul_add(
+        let x8 = Self::mul_add(
             1466.4506062283303,
             v[4],
             Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         );
-        let x2 = Self::mul_add(
+        let x9 = Self::mul_add(
             -110.5455,
             v[1],
             Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
         );
-        let x3 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
-        let x4 = Self::mul_add(
+        let x10 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
+        let x11 = Self::mul_add(
             1170.07,
             v[1],
             -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
         );
-        let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x8 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x9 = Self::mul_add(0.75, v[4], v[0]);
-        let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x11 = Self::mul_add(-0.65, v[4], v[2]);
-        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
-        let x13 = Self::mul_add(-c_q7, x10, s_q7 * x9);
-        let x14 = v[6] * x8;
-        let x15 = v[6] * x7;
-        let x16 = v[6] * x13;
-        let x17 = v[6] * x12;
-        let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(x18, -16.80768997608804, x8 * 0.07309);
-        let x20 = Self::mul_add(
+        let x12 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
+        let x13 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x14 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x15 = Self::mul_add(0.75, v[4], v[0]);
+        let x16 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
+        let x17 = Self::mul_add(-0.65, v[4], v[2]);
+        let x18 = Self::mul_add(s_q7, x16, c_q7 * x15);
+        let x19 = Self::mul_add(-c_q7, x16, s_q7 * x15);
+        let x20 = v[6] * x14;
+        let x21 = v[6] * x13;
+        let x22 = v[6] * x19;
+        let x23 = v[6] * x18;
+        let x24 = v[5] + v[6];
+        let x25 = Self::mul_add(x24, -16.80768997608804, x14 * 0.07309);
+        let x26 = Self::mul_add(
             48.0240000085309,
-            x11,
+            x17,
             Self::mul_add(
                 -0.1132,
-                x18,
-                Self::mul_add(130.43769025763282, x8, x7 * 0.07309),
+                x24,
+                Self::mul_add(130.43769025763282, x14, x13 * 0.07309),
             ),
         );
-        let x21 = Self::mul_add(
+        let x27 = Self::mul_add(
             48.0240000085309,
-            x13,
+            x19,
             Self::mul_add(
                 -132.47349025763282,
-                x18,
-                Self::mul_add(0.1132, x8, x7 * 16.80768997608804),
+                x24,
+                Self::mul_add(0.1132, x14, x13 * 16.80768997608804),
             ),
         );
-        let x22 = 48.0240000085309 * x18;
-        let x23 = 48.0240000085309 * x8;
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x25 = 0.00000000020510342851533115 * c_q8;
-        let x26 = 0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x8, c_q8, x7 * x26));
-        let x29 = Self::mul_add(-0.35, x8, x12);
-        let x30 = Self::mul_add(0.35, x7, x13);
-        let x31 = Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x30, x26 * x29));
-        let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
-        let x34 = v[7] * x28;
-        let x35 = v[7] * x27;
-        let x36 = v[7] * x32;
-        let x37 = v[7] * x31;
-        let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
-        let x39 = Self::mul_add(
-            x33,
+        let x28 = 48.0240000085309 * x24;
+        let x29 = 48.0240000085309 * x14;
+        let x30 = 0.00000000020510342851533115 * c_q8;
+        let x31 = 0.00000000020510342851533115 * s_q8;
+        let x32 = Self::mul_add(x24, c_q8, Self::mul_add(x14, s_q8, x13 * x30));
+        let x33 = Self::mul_add(x24, s_q8, Self::mul_add(-x14, c_q8, x13 * x31));
+        let x34 = Self::mul_add(-0.35, x14, x18);
+        let x35 = Self::mul_add(0.35, x13, x19);
+        let x36 = Self::mul_add(x17, c_q8, Self::mul_add(s_q8, x35, x30 * x34));
+        let x37 = Self::mul_add(x17, s_q8, Self::mul_add(-c_q8, x35, x31 * x34));
+        let x38 = Self::mul_add(-0.00000000020510342851533115, x17, x34);
+        let x39 = v[7] * x33;
+        let x40 = v[7] * x32;
+        let x41 = v[7] * x37;
+        let x42 = v[7] * x36;
+        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x13);
+        let x44 = Self::mul_add(
+            x38,
             12.701650001451807,
-            Self::mul_add(x38, 0.002139996587640933, x28 * 0.0000000234896432582596),
+            Self::mul_add(x43, 0.002139996587640933, x33 * 0.0000000234896432582596),
         );
-        let x40 = Self::mul_add(
-            x33,
+        let x45 = Self::mul_add(
+            x38,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x38,
-                Self::mul_add(x28, -111.7548902508081, x27 * 0.0000000234896432582596),
+                x43,
+                Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
             ),
         );
-        let x41 = Self::mul_add(
+        let x46 = Self::mul_add(
             113.3918902508081,
-            x38,
-            Self::mul_add(5.080660024070366, x28, x27 * 0.002139996587640933),
-        ) - Self::mul_add(x32, 0.000000008530897668050218, x31 * 12.701650001451807);
-        let x42 = x38 * 12.701650001451807;
-        let x43 = x38 * 0.000000008530897668050218;
-        let x44 = Self::mul_add(
-            x28,
+            x43,
+            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
+        ) - Self::mul_add(x37, 0.000000008530897668050218, x36 * 12.701650001451807);
+        let x47 = x43 * 12.701650001451807;
+        let x48 = x43 * 0.000000008530897668050218;
+        let x49 = Self::mul_add(
+            x33,
             0.000000008530897668050218,
-            x27 * 12.701650001451807,
+            x32 * 12.701650001451807,
         );
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x46 = 0.00000000020510342851533115 * c_q9;
-        let x47 = 0.00000000020510342851533115 * s_q9;
-        let x48 = x46 - x47;
-        let x49 = x46 + x47;
-        let x50 = Self::mul_add(-x38, c_q9, Self::mul_add(-x28, x48, x27 * s_q9));
-        let x51 = Self::mul_add(x38, s_q9, Self::mul_add(x28, x49, x27 * c_q9));
-        let x52 = x31 - Self::mul_add(-0.275, x38, 0.4 * x28);
-        let x53 = Self::mul_add(0.4, x27, x32);
-        let x54 = Self::mul_add(-0.275, x27, x33);
-        let x55 = Self::mul_add(-c_q9, x54, Self::mul_add(-x48, x53, s_q9 * x52));
-        let x56 = Self::mul_add(s_q9, x54, Self::mul_add(x49, x53, c_q9 * x52));
-        let x57 = Self::mul_add(
+        let x50 = 0.00000000020510342851533115 * c_q9;
+        let x51 = 0.00000000020510342851533115 * s_q9;
+        let x52 = x50 - x51;
+        let x53 = x50 + x51;
+        let x54 = Self::mul_add(-x43, c_q9, Self::mul_add(-x33, x52, x32 * s_q9));
+        let x55 = Self::mul_add(x43, s_q9, Self::mul_add(x33, x53, x32 * c_q9));
+        let x56 = x36 - Self::mul_add(-0.275, x43, 0.4 * x33);
+        let x57 = Self::mul_add(0.4, x32, x37);
+        let x58 = Self::mul_add(-0.275, x32, x38);
+        let x59 = Self::mul_add(-c_q9, x58, Self::mul_add(-x52, x57, s_q9 * x56));
+        let x60 = Self::mul_add(s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56));
+        let x61 = Self::mul_add(
             -0.00000000020510342851533115,
-            x54,
-            Self::mul_add(-0.00000000020510342851533115, x52, x53),
+            x58,
+            Self::mul_add(-0.00000000020510342851533115, x56, x57),
         );
-        let x58 = v[8] * x51;
-        let x59 = v[8] * x50;
-        let x60 = v[8] * x56;
-        let x61 = v[8] * x55;
-        let x62 = v[8]
+        let x62 = v[8] * x55;
+        let x63 = v[8] * x54;
+        let x64 = v[8] * x60;
+        let x65 = v[8] * x59;
+        let x66 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x38,
-                Self::mul_add(-0.00000000020510342851533115, x27, x28),
+                x43,
+                Self::mul_add(-0.00000000020510342851533115, x32, x33),
             );
-        let x63 = Self::mul_add(x62, -36.18604050126307, x51 * 63.36336825000001);
-        let x64 = Self::mul_add(x57, 81.53205, x62 * 0.00214);
-        let x65 = Self::mul_add(
-            x55,
+        let x67 = Self::mul_add(x66, -36.18604050126307, x55 * 63.36336825000001);
+        let x68 = Self::mul_add(x61, 81.53205, x66 * 0.00214);
+        let x69 = Self::mul_add(
+            x59,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x62,
-                Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
+                x66,
+                Self::mul_add(x55, 36.18604050126307, x54 * 0.00214),
             ),
         );
-        let x66 = x62 * 81.53205;
-        let x67 = x50 * 81.53205;
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
-        let x70 = Self::mul_add(-x51, c_q10, x50 * s_q10);
-        let x71 = Self::mul_add(x62, -0.87, x55);
-        let x72 = Self::mul_add(x50, 0.87, x57);
-        let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
-        let x74 = Self::mul_add(-x56, c_q10, s_q10 * x71);
-        let x75 = v[9] * x70;
-        let x76 = v[9] * x69;
-        let x77 = v[9] * x74;
+        let x70 = x66 * 81.53205;
+        let x71 = x54 * 81.53205;
+        let x72 = Self::mul_add(x55, s_q10, x54 * c_q10);
+        let x73 = Self::mul_add(-x55, c_q10, x54 * s_q10);
+        let x74 = Self::mul_add(x66, -0.87, x59);
+        let x75 = Self::mul_add(x54, 0.87, x61);
+        let x76 = Self::mul_add(x60, s_q10, c_q10 * x74);
+        let x77 = Self::mul_add(-x60, c_q10, s_q10 * x74);
         let x78 = v[9] * x73;
-        let x79 = v[9] + x62;
-        let x80 = Self::mul_add(x79, 24.35164200091464, x70 * 24.4950615);
-        let x81 = Self::mul_add(x72, 45.1584, x79 * 0.6328);
-        let x82 = Self::mul_add(
-            x73,
+        let x79 = v[9] * x72;
+        let x80 = v[9] * x77;
+        let x81 = v[9] * x76;
+        let x82 = v[9] + x66;
+        let x83 = Self::mul_add(x82, 24.35164200091464, x73 * 24.4950615);
+        let x84 = Self::mul_add(x75, 45.1584, x82 * 0.6328);
+        let x85 = Self::mul_add(
+            x76,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x79,
-                Self::mul_add(x70, -24.351642000914637, x69 * 0.6328),
+                x82,
+                Self::mul_add(x73, -24.351642000914637, x72 * 0.6328),
             ),
         );
-        let x83 = x79 * 45.1584;
-        let x84 = x69 * 45.1584;
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let x86 = Self::mul_add(-x70, s_q11, x69 * c_q11);
-        let x87 = Self::mul_add(x70, c_q11, x69 * s_q11);
-        let x88 = x73 + Self::mul_add(x79, -0.63, 0.275 * x70);
-        let x89 = Self::mul_add(-0.275, x69, x74);
-        let x90 = Self::mul_add(x69, 0.63, x72);
-        let x91 = Self::mul_add(-s_q11, x89, c_q11 * x88);
-        let x92 = Self::mul_add(c_q11, x89, s_q11 * x88);
-        let x93 = v[10] * x87;
-        let x94 = v[10] * x86;
-        let x95 = v[10] * x92;
-        let x96 = v[10] * x91;
-        let x97 = v[10] + x79;
-        let x98 = Self::mul_add(-2.5482240016099564, x97, x87 * 9.142025249762803);
-        let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
-        let x100 = Self::mul_add(
+        let x86 = x82 * 45.1584;
+        let x87 = x72 * 45.1584;
+        let x88 = Self::mul_add(-x73, s_q11, x72 * c_q11);
+        let x89 = Self::mul_add(x73, c_q11, x72 * s_q11);
+        let x90 = x76 + Self::mul_add(x82, -0.63, 0.275 * x73);
+        let x91 = Self::mul_add(-0.275, x72, x77);
+        let x92 = Self::mul_add(x72, 0.63, x75);
+        let x93 = Self::mul_add(-s_q11, x91, c_q11 * x90);
+        let x94 = Self::mul_add(c_q11, x91, s_q11 * x90);
+        let x95 = v[10] * x89;
+        let x96 = v[10] * x88;
+        let x97 = v[10] * x94;
+        let x98 = v[10] * x93;
+        let x99 = v[10] + x82;
+        let x100 = Self::mul_add(-2.5482240016099564, x99, x89 * 9.142025249762803);
+        let x101 = Self::mul_add(7.078399999258757, x92, 0.01675 * x99);
+        let x102 = Self::mul_add(
             -7.078399999258757,
-            x91,
+            x93,
             Self::mul_add(
                 -9.223235249762805,
-                x97,
-                Self::mul_add(-2.5482240016099564, x87, 0.01675 * x86),
+                x99,
+                Self::mul_add(-2.5482240016099564, x89, 0.01675 * x88),
             ),
         );
-        let x101 = 7.078399999258757 * x97;
-        let x102 = 7.078399999258757 * x86;
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x104 = 0.00000000020510342851533115 * s_q12;
-        let x105 = 0.00000000020510342851533115 * c_q12;
-        let x106 = Self::mul_add(x97, s_q12, Self::mul_add(x87, x104, x86 * c_q12));
-        let x107 = Self::mul_add(-x97, c_q12, Self::mul_add(-x87, x105, x86 * s_q12));
-        let x108 = Self::mul_add(x87, 0.36, x91);
-        let x109 = Self::mul_add(x86, -0.36, x92);
-        let x110 = Self::mul_add(x90, s_q12, Self::mul_add(x104, x109, c_q12 * x108));
-        let x111 = Self::mul_add(-x90, c_q12, Self::mul_add(-x105, x109, s_q12 * x108));
-        let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
-        let x113 = v[11] * x107;
-        let x114 = v[11] * x106;
-        let x115 = v[11] * x111;
-        let x116 = v[11] * x110;
-        let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
-        let x118 = Self::mul_add(
-            -17.135250000000003,
-            x112,
-            Self::mul_add(x117, 0.809539999555672, x107 * 1.9877000000000002),
-        );
+        let x103 = 7.078399999258757 * x99;
+        let x104 = 7.078399999258757 * x88;
+        let x105 = 0.00000000020510342851533115 * s_q12;
+        let x106 = 0.00000000020510342851533115 * c_q12;
+        let x107 = Self::mul_add(x99, s_q12, Self::mul_add(x89, x105, x88 * c_q12));
+        let x108 = Self::mul_add(-x99, c_q12, Self::mul_add(-x89, x106, x88 * s_q12));
+        let x109 = Self::mul_add(x89, 0.36, x93);
+        let x110 = Self::mul_add(x88, -0.36, x94);
+        let x111 = Self::mul_add(x92, s_q12, Self::mul_add(x105, x110, c_q12 * x109));
+        let x112 = Self::mul_add(-x92, c_q12, Self::mul_add(-x106, x110, s_q12 * x109));
+        let x113 = Self::mul_add(-0.00000000020510342851533115, x92, x110);
+        let x114 = v[11] * x108;
+        let x115 = v[11] * x107;
+        let x116 = v[11] * x112;
+        let x117 = v[11] * x111;
+        let x118 = v[11] + Self::mul_add(-0.00000000020510342851533115, x99, x89);
         let x119 = Self::mul_add(
-            -3.6140000000000003,
-            x112,
-            Self::mul_add(
-                x117,
-                -2.741639999592316,
-                Self::mul_add(x107, -5.252920330000002, x106 * 1.9877000000000002),
-            ),
+            -17.135250000000003,
+            x113,
+            Self::mul_add(x118, 0.809539999555672, x108 * 1.9877000000000002),
         );
         let x120 = Self::mul_add(
+            -3.6140000000000003,
+            x113,
+            Self::mul_add(
+                x118,
+                -2.741639999592316,
+                Self::mul_add(x108, -5.252920330000002, x107 * 1.9877000000000002),
+            ),
+        );
+        let x121 = Self::mul_add(
             9.740442170000001,
-            x117,
-            Self::mul_add(x107, -2.7416399995923166, x106 * 0.809539999555672),
-        ) + Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
-        let x121 = 17.135250000000003 * x117;
-        let x122 = 3.6140000000000003 * x117;
-        let x123 = Self::mul_add(3.6140000000000003, x107, 17.135250000000003 * x106);
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+            x118,
+            Self::mul_add(x108, -2.7416399995923166, x107 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x112, 17.135250000000003 * x111);
+        let x122 = 17.135250000000003 * x118;
+        let x123 = 3.6140000000000003 * x118;
+        let x124 = Self::mul_add(3.6140000000000003, x108, 17.135250000000003 * x107);
         let x125 = 0.00000000020510342851533115 * c_q13;
         let x126 = 0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(-x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
-        let x128 = Self::mul_add(-x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
-        let x129 = x110 - Self::mul_add(-0.55, x117, 0.16 * x107);
-        let x130 = Self::mul_add(0.16, x106, x111);
-        let x131 = Self::mul_add(-0.55, x106, x112);
+        let x127 = Self::mul_add(-x118, c_q13, Self::mul_add(x108, s_q13, x107 * x125));
+        let x128 = Self::mul_add(-x118, s_q13, Self::mul_add(-x108, c_q13, x107 * x126));
+        let x129 = x111 - Self::mul_add(-0.55, x118, 0.16 * x108);
+        let x130 = Self::mul_add(0.16, x107, x112);
+        let x131 = Self::mul_add(-0.55, x107, x113);
         let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
         let x133 = Self::mul_add(-s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
         let x134 = Self::mul_add(0.00000000020510342851533115, x131, x129);
         let x135 = v[12] * x128;
         let x136 = v[12] * x127;
         let x137 = v[12] * x133;
-        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x117, x106);
+        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x118, x107);
         let x139 = Self::mul_add(
             x138,
             -0.9614610000000001,
@@ -3459,8 +3483,8 @@ impl FreeFloating7 {
         let x197 = 9.740442170000001 + x190;
         let x198 = -17.135250000000003 - x185;
         let x199 = 3.6140000000000003 + x186;
-        let x200 = Self::mul_add(-x106, x119, x107 * x118)
-            + Self::mul_add(-x110, x122, x111 * x121) + x194;
+        let x200 = Self::mul_add(-x107, x120, x108 * x119)
+            + Self::mul_add(-x111, x123, x112 * x122) + x194;
         let x201 = 1.0 / x197;
         let x202 = tau[5] - x200;
         let x203 = x195 * x201;
@@ -3514,59 +3538,59 @@ impl FreeFloating7 {
         let x223 = Self::mul_add(
             -x202,
             x203,
-            Self::mul_add(-x107, x120, x117 * x119)
-                + Self::mul_add(x111, x123, x112 * x122)
+            Self::mul_add(-x108, x121, x118 * x120)
+                + Self::mul_add(x112, x124, x113 * x123)
                 + (x151 - Self::mul_add(-x126, x150, x125 * x149)
                     - Self::mul_add(0.55, x193, 0.16 * x192))
-                + (Self::mul_add(-x114, x209, x113 * x208)
-                    + Self::mul_add(-x116, x212, x115 * x211)),
+                + (Self::mul_add(-x115, x209, x114 * x208)
+                    + Self::mul_add(-x117, x212, x116 * x211)),
         );
         let x224 = Self::mul_add(
             -x202,
             x204,
-            Self::mul_add(-x106, x120, x117 * x118)
-                + Self::mul_add(x110, x123, x112 * x121)
+            Self::mul_add(-x107, x121, x118 * x119)
+                + Self::mul_add(x111, x124, x113 * x122)
                 + Self::mul_add(0.16, x191, Self::mul_add(c_q13, x150, s_q13 * x149))
-                - (Self::mul_add(x114, x210, x113 * x209)
-                    + Self::mul_add(-x116, x215, x115 * x214)),
+                - (Self::mul_add(x115, x210, x114 * x209)
+                    + Self::mul_add(-x117, x215, x116 * x214)),
         );
         let x225 = Self::mul_add(x202, x197 * x201, x200);
         let x226 = Self::mul_add(
             -x202,
             x205,
-            Self::mul_add(x107, x123, x117 * x122) + x191
-                + (Self::mul_add(-x114, x214, x113 * x211)
-                    + Self::mul_add(-x116, x218, x115 * x217)),
+            Self::mul_add(x108, x124, x118 * x123) + x191
+                + (Self::mul_add(-x115, x214, x114 * x211)
+                    + Self::mul_add(-x117, x218, x116 * x217)),
         );
         let x227 = Self::mul_add(
             -x202,
             x206,
-            Self::mul_add(x106, x123, x117 * x121) + x192
-                - (Self::mul_add(-x114, x215, x113 * x212)
-                    + Self::mul_add(-x116, x220, x115 * x218)),
+            Self::mul_add(x107, x124, x118 * x122) + x192
+                - (Self::mul_add(-x115, x215, x114 * x212)
+                    + Self::mul_add(-x117, x220, x116 * x218)),
         );
         let x228 = Self::mul_add(
             -x202,
             x207,
-            Self::mul_add(-x106, x122, x107 * x121) + x193
-                + (Self::mul_add(x114, x216, x113 * x213)
-                    - Self::mul_add(-x116, x221, x115 * x219)),
+            Self::mul_add(-x107, x123, x108 * x122) + x193
+                + (Self::mul_add(x115, x216, x114 * x213)
+                    - Self::mul_add(-x117, x221, x116 * x219)),
         );
         let x229 = s_q12 * x209;
-        let x230 = Self::mul_add(-x105, x209, x104 * x208);
+        let x230 = Self::mul_add(-x106, x209, x105 * x208);
         let x231 = c_q12 * x209;
         let x232 = Self::mul_add(s_q12, x208, -x231);
-        let x233 = Self::mul_add(x105, x210, x104 * x209);
+        let x233 = Self::mul_add(x106, x210, x105 * x209);
         let x234 = Self::mul_add(c_q12, x210, x229);
         let x235 = Self::mul_add(s_q12, x212, c_q12 * x211);
-        let x236 = x213 + Self::mul_add(-x105, x212, x104 * x211);
+        let x236 = x213 + Self::mul_add(-x106, x212, x105 * x211);
         let x237 = Self::mul_add(
             -0.00000000020510342851533115,
             x213,
             Self::mul_add(-c_q12, x212, s_q12 * x211),
         );
         let x238 = Self::mul_add(s_q12, x215, c_q12 * x214);
-        let x239 = x216 - Self::mul_add(-x105, x215, x104 * x214);
+        let x239 = x216 - Self::mul_add(-x106, x215, x105 * x214);
         let x240 = Self::mul_add(
             0.00000000020510342851533115,
             x216,
@@ -3574,19 +3598,19 @@ impl FreeFloating7 {
         );
         let x241 = Self::mul_add(s_q12, x238, c_q12 * x235);
         let x242 = Self::mul_add(-s_q12, x239, c_q12 * x236);
-        let x243 = Self::mul_add(-x105, x238, x104 * x235);
+        let x243 = Self::mul_add(-x106, x238, x105 * x235);
         let x244 = Self::mul_add(-c_q12, x238, s_q12 * x235);
         let x245 = Self::mul_add(c_q12, x239, s_q12 * x236);
         let x246 = Self::mul_add(-c_q12, x240, s_q12 * x237);
         let x247 = s_q12 * x218;
-        let x248 = x219 - Self::mul_add(-x105, x218, x104 * x217);
+        let x248 = x219 - Self::mul_add(-x106, x218, x105 * x217);
         let x249 = c_q12 * x218;
         let x250 = Self::mul_add(
             0.00000000020510342851533115,
             x219,
             Self::mul_add(s_q12, x217, -x249),
         );
-        let x251 = x221 - Self::mul_add(-x105, x220, x104 * x218);
+        let x251 = x221 - Self::mul_add(-x106, x220, x105 * x218);
         let x252 = Self::mul_add(
             0.00000000020510342851533115,
             x221,
@@ -3604,13 +3628,13 @@ impl FreeFloating7 {
         );
         let x255 = Self::mul_add(s_q12, x251, c_q12 * x248);
         let x256 = Self::mul_add(s_q12, x252, c_q12 * x250);
-        let x257 = x222 - Self::mul_add(-x105, x221, x104 * x219)
-            - Self::mul_add(-x105, x251, x104 * x248);
-        let x258 = x253 - Self::mul_add(-x105, x252, x104 * x250);
+        let x257 = x222 - Self::mul_add(-x106, x221, x105 * x219)
+            - Self::mul_add(-x106, x251, x105 * x248);
+        let x258 = x253 - Self::mul_add(-x106, x252, x105 * x250);
         let x259 = 0.36 * x255;
         let x260 = Self::mul_add(-0.36, x257, x242);
         let x261 = Self::mul_add(0.36, x254, x243);
-        let x262 = Self::mul_add(x105, x239, x104 * x236) - x259;
+        let x262 = Self::mul_add(x106, x239, x105 * x236) - x259;
         let x263 = Self::mul_add(
             -0.36,
             x260,
@@ -3628,25 +3652,25 @@ impl FreeFloating7 {
         let x265 = Self::mul_add(
             0.36,
             x243,
-            Self::mul_add(0.36, x261, Self::mul_add(-x105, x233, x104 * x230)),
+            Self::mul_add(0.36, x261, Self::mul_add(-x106, x233, x105 * x230)),
         );
         let x266 = Self::mul_add(-s_q12, x227, c_q12 * x226);
-        let x267 = x228 + Self::mul_add(x105, x227, x104 * x226);
+        let x267 = x228 + Self::mul_add(x106, x227, x105 * x226);
         let x268 = 0.01675
             + Self::mul_add(-0.36, x245, Self::mul_add(s_q12, x234, c_q12 * x232));
         let x269 = 2.5482240016099564
-            - Self::mul_add(0.36, x244, Self::mul_add(-x105, x234, x104 * x232));
+            - Self::mul_add(0.36, x244, Self::mul_add(-x106, x234, x105 * x232));
         let x270 = 9.223235249762805 - Self::mul_add(-c_q12, x234, s_q12 * x232);
         let x271 = -7.078399999258757 + x244;
-        let x272 = Self::mul_add(-x92, x101, Self::mul_add(-x86, x98, x87 * x99))
+        let x272 = Self::mul_add(-x94, x103, Self::mul_add(-x88, x100, x89 * x101))
             - Self::mul_add(
                 -0.00000000020510342851533115,
                 x225,
                 Self::mul_add(c_q12, x224, s_q12 * x223),
             );
         let x273 = Self::mul_add(
-            x87,
-            x101,
+            x89,
+            x103,
             Self::mul_add(
                 -0.00000000020510342851533115,
                 x228,
@@ -3676,7 +3700,7 @@ impl FreeFloating7 {
         let x289 = Self::mul_add(
             -x269,
             x280,
-            Self::mul_add(0.36, x256, Self::mul_add(-x105, x240, x104 * x237)),
+            Self::mul_add(0.36, x256, Self::mul_add(-x106, x240, x105 * x237)),
         );
         let x290 = Self::mul_add(x271, x278, x254);
         let x291 = Self::mul_add(-x271, x279, x255);
@@ -3695,43 +3719,43 @@ impl FreeFloating7 {
         let x296 = Self::mul_add(
             x275,
             x276,
-            Self::mul_add(-x92, x102, Self::mul_add(-x87, x100, x97 * x98))
+            Self::mul_add(-x94, x104, Self::mul_add(-x89, x102, x99 * x100))
                 - Self::mul_add(-0.36, x267, Self::mul_add(-s_q12, x224, c_q12 * x223))
-                + (Self::mul_add(x94, x282, x93 * x281)
-                    - Self::mul_add(-x96, x285, x95 * x284)),
+                + (Self::mul_add(x96, x282, x95 * x281)
+                    - Self::mul_add(-x98, x285, x97 * x284)),
         );
         let x297 = Self::mul_add(
             x275,
             x277,
-            Self::mul_add(-x86, x100, x97 * x99) - Self::mul_add(x91, x102, x90 * x101)
+            Self::mul_add(-x88, x102, x99 * x101) - Self::mul_add(x93, x104, x92 * x103)
                 + Self::mul_add(
                     0.36,
                     x266,
-                    x225 + Self::mul_add(x105, x224, x104 * x223),
+                    x225 + Self::mul_add(x106, x224, x105 * x223),
                 )
-                + (Self::mul_add(x94, x283, x93 * x282)
-                    + Self::mul_add(-x96, x288, x95 * x287)),
+                + (Self::mul_add(x96, x283, x95 * x282)
+                    + Self::mul_add(-x98, x288, x97 * x287)),
         );
         let x298 = Self::mul_add(
             -x275,
             x278,
-            Self::mul_add(x87, x102, x266)
-                + (Self::mul_add(-x94, x287, x93 * x284)
-                    + Self::mul_add(x96, x291, x95 * x290)),
+            Self::mul_add(x89, x104, x266)
+                + (Self::mul_add(-x96, x287, x95 * x284)
+                    + Self::mul_add(x98, x291, x97 * x290)),
         );
         let x299 = Self::mul_add(
             x275,
             x279,
-            Self::mul_add(x86, x102, x97 * x101) - x267
-                - (Self::mul_add(-x94, x288, x93 * x285)
-                    - Self::mul_add(x96, x293, x95 * x291)),
+            Self::mul_add(x88, x104, x99 * x103) - x267
+                - (Self::mul_add(-x96, x288, x95 * x285)
+                    - Self::mul_add(x98, x293, x97 * x291)),
         );
         let x300 = Self::mul_add(
             -x275,
             x280,
             x273
-                + (Self::mul_add(-x94, x289, x93 * x286)
-                    + Self::mul_add(x96, x294, x95 * x292)),
+                + (Self::mul_add(-x96, x289, x95 * x286)
+                    + Self::mul_add(x98, x294, x97 * x292)),
         );
         let x301 = s_q11 * x282;
         let x302 = c_q11 * x282;
@@ -3783,7 +3807,7 @@ impl FreeFloating7 {
         let x335 = -24.35164200091464 + Self::mul_add(-0.63, x312, 0.275 * x324);
         let x336 = Self::mul_add(-0.63, x324, 28.2393615);
         let x337 = 45.1584 - x324;
-        let x338 = Self::mul_add(-x74, x83, Self::mul_add(x69, x80, x70 * x81))
+        let x338 = Self::mul_add(-x77, x86, Self::mul_add(x72, x83, x73 * x84))
             - Self::mul_add(0.63, x332, Self::mul_add(-x275, x270 * x274, x272));
         let x339 = 1.0 / x336;
         let x340 = tau[3] - x338;
@@ -3828,40 +3852,40 @@ impl FreeFloating7 {
         let x361 = Self::mul_add(
             x340,
             x341,
-            Self::mul_add(x74, x84, Self::mul_add(x70, x82, x79 * x80))
+            Self::mul_add(x77, x87, Self::mul_add(x73, x85, x82 * x83))
                 + (Self::mul_add(-s_q11, x297, c_q11 * x296)
                     - Self::mul_add(0.63, x300, 0.275 * x333))
-                - (Self::mul_add(-x76, x347, x75 * x346)
-                    + Self::mul_add(x78, x350, x77 * x349)),
+                - (Self::mul_add(-x79, x347, x78 * x346)
+                    + Self::mul_add(x81, x350, x80 * x349)),
         );
         let x362 = Self::mul_add(
             -x340,
             x342,
-            Self::mul_add(-x69, x82, x79 * x81) - Self::mul_add(x73, x84, x72 * x83)
+            Self::mul_add(-x72, x85, x82 * x84) - Self::mul_add(x76, x87, x75 * x86)
                 - Self::mul_add(0.275, x332, Self::mul_add(c_q11, x297, s_q11 * x296))
-                - (Self::mul_add(x76, x348, x75 * x347)
-                    - Self::mul_add(x78, x353, x77 * x352)),
+                - (Self::mul_add(x79, x348, x78 * x347)
+                    - Self::mul_add(x81, x353, x80 * x352)),
         );
         let x363 = Self::mul_add(
             x340,
             x343,
-            Self::mul_add(x70, x84, -x332)
-                - (Self::mul_add(x76, x352, x75 * x349)
-                    + Self::mul_add(x78, x356, x77 * x355)),
+            Self::mul_add(x73, x87, -x332)
+                - (Self::mul_add(x79, x352, x78 * x349)
+                    + Self::mul_add(x81, x356, x80 * x355)),
         );
         let x364 = Self::mul_add(
             -x340,
             x344,
-            Self::mul_add(x69, x84, x79 * x83) - x333
-                - (Self::mul_add(x76, x353, x75 * x350)
-                    + Self::mul_add(x78, x358, x77 * x356)),
+            Self::mul_add(x72, x87, x82 * x86) - x333
+                - (Self::mul_add(x79, x353, x78 * x350)
+                    + Self::mul_add(x81, x358, x80 * x356)),
         );
         let x365 = Self::mul_add(
             -x340,
             x345,
-            Self::mul_add(x70, x83, -x300)
-                - (Self::mul_add(x76, x354, x75 * x351)
-                    + Self::mul_add(x78, x359, x77 * x357)),
+            Self::mul_add(x73, x86, -x300)
+                - (Self::mul_add(x79, x354, x78 * x351)
+                    + Self::mul_add(x81, x359, x80 * x357)),
         );
         let x366 = s_q10 * x347;
         let x367 = c_q10 * x347;
@@ -3905,7 +3929,7 @@ impl FreeFloating7 {
         let x393 = Self::mul_add(-0.87, x376, -36.18604050126307);
         let x394 = Self::mul_add(-0.87, x387, 69.99836825);
         let x395 = 81.53205 - x387;
-        let x396 = Self::mul_add(-x56, x66, Self::mul_add(x50, x63, x51 * x64))
+        let x396 = Self::mul_add(-x60, x70, Self::mul_add(x54, x67, x55 * x68))
             - Self::mul_add(0.87, x391, Self::mul_add(x340, x336 * x339, x338));
         let x397 = 1.0 / x394;
         let x398 = tau[2] + x396;
@@ -3944,70 +3968,70 @@ impl FreeFloating7 {
         let x419 = Self::mul_add(
             -x398,
             x399,
-            Self::mul_add(x56, x67, Self::mul_add(x51, x65, x62 * x63))
+            Self::mul_add(x60, x71, Self::mul_add(x55, x69, x66 * x67))
                 - Self::mul_add(0.87, x365, Self::mul_add(s_q10, x362, c_q10 * x361))
-                - (Self::mul_add(-x59, x405, x58 * x404)
-                    + Self::mul_add(-x61, x408, x60 * x407)),
+                - (Self::mul_add(-x63, x405, x62 * x404)
+                    + Self::mul_add(-x65, x408, x64 * x407)),
         );
         let x420 = Self::mul_add(
             -x398,
             x400,
-            Self::mul_add(-x50, x65, x62 * x64) - Self::mul_add(x55, x67, x57 * x66)
+            Self::mul_add(-x54, x69, x66 * x68) - Self::mul_add(x59, x71, x61 * x70)
                 - Self::mul_add(-c_q10, x362, s_q10 * x361)
-                - (Self::mul_add(x59, x406, x58 * x405)
-                    + Self::mul_add(-x61, x411, x60 * x410)),
+                - (Self::mul_add(x63, x406, x62 * x405)
+                    + Self::mul_add(-x65, x411, x64 * x410)),
         );
         let x421 = Self::mul_add(-x398, x394 * x397, x396);
         let x422 = Self::mul_add(
             -x398,
             x401,
-            Self::mul_add(x51, x67, -x391)
-                - (Self::mul_add(-x59, x410, x58 * x407)
-                    + Self::mul_add(-x61, x414, x60 * x413)),
+            Self::mul_add(x55, x71, -x391)
+                - (Self::mul_add(-x63, x410, x62 * x407)
+                    + Self::mul_add(-x65, x414, x64 * x413)),
         );
         let x423 = Self::mul_add(
             -x398,
             x402,
-            Self::mul_add(x50, x67, x62 * x66) + Self::mul_add(c_q10, x364, s_q10 * x363)
-                + (Self::mul_add(-x59, x411, x58 * x408)
-                    + Self::mul_add(-x61, x416, x60 * x414)),
+            Self::mul_add(x54, x71, x66 * x70) + Self::mul_add(c_q10, x364, s_q10 * x363)
+                + (Self::mul_add(-x63, x411, x62 * x408)
+                    + Self::mul_add(-x65, x416, x64 * x414)),
         );
         let x424 = Self::mul_add(
             x398,
             x403,
-            Self::mul_add(x51, x66, -x365)
-                - (Self::mul_add(-x59, x412, x58 * x409)
-                    + Self::mul_add(-x61, x417, x60 * x415)),
+            Self::mul_add(x55, x70, -x365)
+                - (Self::mul_add(-x63, x412, x62 * x409)
+                    + Self::mul_add(-x65, x417, x64 * x415)),
         );
         let x425 = c_q9 * x405;
-        let x426 = Self::mul_add(-x49, x405, x48 * x404);
+        let x426 = Self::mul_add(-x53, x405, x52 * x404);
         let x427 = s_q9 * x405;
         let x428 = Self::mul_add(c_q9, x404, -x427);
-        let x429 = Self::mul_add(x49, x406, x48 * x405);
+        let x429 = Self::mul_add(x53, x406, x52 * x405);
         let x430 = Self::mul_add(s_q9, x406, x425);
         let x431 = 0.00000000020510342851533115 * x409;
         let x432 = Self::mul_add(c_q9, x408, s_q9 * x407) - x431;
-        let x433 = x409 - Self::mul_add(-x49, x408, x48 * x407);
+        let x433 = x409 - Self::mul_add(-x53, x408, x52 * x407);
         let x434 = x431 + Self::mul_add(-s_q9, x408, c_q9 * x407);
         let x435 = 0.00000000020510342851533115 * x412;
         let x436 = Self::mul_add(c_q9, x411, s_q9 * x410) - x435;
-        let x437 = x412 - Self::mul_add(-x49, x411, x48 * x410);
+        let x437 = x412 - Self::mul_add(-x53, x411, x52 * x410);
         let x438 = x435 + Self::mul_add(-s_q9, x411, c_q9 * x410);
         let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
         let x440 = Self::mul_add(c_q9, x437, s_q9 * x433);
         let x441 = Self::mul_add(c_q9, x438, s_q9 * x434);
-        let x442 = Self::mul_add(-x49, x436, x48 * x432);
+        let x442 = Self::mul_add(-x53, x436, x52 * x432);
         let x443 = Self::mul_add(-s_q9, x436, c_q9 * x432);
         let x444 = c_q9 * x414;
         let x445 = 0.00000000020510342851533115 * x415;
-        let x446 = x415 - Self::mul_add(-x49, x414, x48 * x413);
+        let x446 = x415 - Self::mul_add(-x53, x414, x52 * x413);
         let x447 = s_q9 * x414;
         let x448 = x445 + Self::mul_add(c_q9, x413, -x447);
         let x449 = 0.00000000020510342851533115 * x417;
-        let x450 = x417 - Self::mul_add(-x49, x416, x48 * x414);
+        let x450 = x417 - Self::mul_add(-x53, x416, x52 * x414);
         let x451 = x449 + Self::mul_add(-s_q9, x416, x444);
         let x452 = 0.00000000020510342851533115 * x418;
-        let x453 = x418 - Self::mul_add(-x49, x417, x48 * x415);
+        let x453 = x418 - Self::mul_add(-x53, x417, x52 * x415);
         let x454 = x452 + Self::mul_add(-s_q9, x417, c_q9 * x415);
         let x455 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -4025,28 +4049,28 @@ impl FreeFloating7 {
         );
         let x457 = 0.00000000020510342851533115 * x454;
         let x458 = Self::mul_add(c_q9, x451, s_q9 * x448) - x457;
-        let x459 = x453 - Self::mul_add(-x49, x450, x48 * x446);
-        let x460 = x454 - Self::mul_add(-x49, x451, x48 * x448);
+        let x459 = x453 - Self::mul_add(-x53, x450, x52 * x446);
+        let x460 = x454 - Self::mul_add(-x53, x451, x52 * x448);
         let x461 = x457 + Self::mul_add(-s_q9, x451, c_q9 * x448);
         let x462 = 0.4 * x456;
         let x463 = 0.275 * x458;
         let x464 = x440 + Self::mul_add(0.275, x460, 0.4 * x459);
         let x465 = x441 + Self::mul_add(0.275, x461, 0.4 * x460);
         let x466 = Self::mul_add(0.4, x455, x442);
-        let x467 = Self::mul_add(-x49, x437, x48 * x433) + x462;
-        let x468 = Self::mul_add(0.4, x458, Self::mul_add(-x49, x438, x48 * x434));
+        let x467 = Self::mul_add(-x53, x437, x52 * x433) + x462;
+        let x468 = Self::mul_add(0.4, x458, Self::mul_add(-x53, x438, x52 * x434));
         let x469 = Self::mul_add(-0.275, x455, x443);
         let x470 = Self::mul_add(-0.275, x456, Self::mul_add(-s_q9, x437, c_q9 * x433));
         let x471 = Self::mul_add(-s_q9, x438, c_q9 * x434) - x463;
         let x472 = Self::mul_add(
             0.4,
             x442,
-            Self::mul_add(0.4, x466, Self::mul_add(-x49, x429, x48 * x426)),
+            Self::mul_add(0.4, x466, Self::mul_add(-x53, x429, x52 * x426)),
         );
         let x473 = Self::mul_add(
             0.275,
             x442,
-            -Self::mul_add(0.4, x469, Self::mul_add(-x49, x430, x48 * x428)),
+            -Self::mul_add(0.4, x469, Self::mul_add(-x53, x430, x52 * x428)),
         );
         let x474 = Self::mul_add(
             0.275,
@@ -4055,7 +4079,7 @@ impl FreeFloating7 {
         );
         let x475 = 0.00000000020510342851533115 * x424;
         let x476 = Self::mul_add(-c_q9, x423, s_q9 * x422) - x475;
-        let x477 = x424 - Self::mul_add(x49, x423, x48 * x422);
+        let x477 = x424 - Self::mul_add(x53, x423, x52 * x422);
         let x478 = x475 + Self::mul_add(s_q9, x423, c_q9 * x422);
         let x479 = 0.00000000020510342851533115 * x421;
         let x480 = -0.002139996587640933
@@ -4069,8 +4093,8 @@ impl FreeFloating7 {
         let x482 = 113.3918902508081 + x474;
         let x483 = 12.701650001451807 - x469;
         let x484 = -0.000000008530897668050218 + x470;
-        let x485 = Self::mul_add(-x27, x40, x28 * x39)
-            - Self::mul_add(-x31, x43, x32 * x42)
+        let x485 = Self::mul_add(-x32, x45, x33 * x44)
+            - Self::mul_add(-x36, x48, x37 * x47)
             + Self::mul_add(0.275, x476, x479 - Self::mul_add(-s_q9, x420, c_q9 * x419));
         let x486 = 1.0 / x482;
         let x487 = tau[1] - x485;
@@ -4116,41 +4140,41 @@ impl FreeFloating7 {
         let x508 = Self::mul_add(
             -x487,
             x488,
-            Self::mul_add(-x28, x41, x38 * x40) - Self::mul_add(x32, x44, x33 * x43)
+            Self::mul_add(-x33, x46, x43 * x45) - Self::mul_add(x37, x49, x38 * x48)
                 + (Self::mul_add(c_q9, x420, s_q9 * x419) + x479
                     + Self::mul_add(0.275, x478, 0.4 * x477))
-                + (Self::mul_add(-x35, x494, x34 * x493)
-                    + Self::mul_add(-x37, x497, x36 * x496)),
+                + (Self::mul_add(-x40, x494, x39 * x493)
+                    + Self::mul_add(-x42, x497, x41 * x496)),
         );
         let x509 = Self::mul_add(
             -x487,
             x489,
-            Self::mul_add(-x27, x41, x38 * x39) - Self::mul_add(x31, x44, x33 * x42)
-                + Self::mul_add(0.4, x476, x421 + Self::mul_add(-x49, x420, x48 * x419))
-                - (Self::mul_add(x35, x495, x34 * x494)
-                    - Self::mul_add(-x37, x500, x36 * x499)),
+            Self::mul_add(-x32, x46, x43 * x44) - Self::mul_add(x36, x49, x38 * x47)
+                + Self::mul_add(0.4, x476, x421 + Self::mul_add(-x53, x420, x52 * x419))
+                - (Self::mul_add(x40, x495, x39 * x494)
+                    - Self::mul_add(-x42, x500, x41 * x499)),
         );
         let x510 = Self::mul_add(x487, x482 * x486, x485);
         let x511 = Self::mul_add(
             x487,
             x490,
-            Self::mul_add(x28, x44, x38 * x43) - x476
-                - (Self::mul_add(x35, x499, x34 * x496)
-                    + Self::mul_add(-x37, x503, x36 * x502)),
+            Self::mul_add(x33, x49, x43 * x48) - x476
+                - (Self::mul_add(x40, x499, x39 * x496)
+                    + Self::mul_add(-x42, x503, x41 * x502)),
         );
         let x512 = Self::mul_add(
             x487,
             x491,
-            Self::mul_add(x27, x44, x38 * x42) + x477
-                + (Self::mul_add(x35, x500, x34 * x497)
-                    + Self::mul_add(-x37, x505, x36 * x503)),
+            Self::mul_add(x32, x49, x43 * x47) + x477
+                + (Self::mul_add(x40, x500, x39 * x497)
+                    + Self::mul_add(-x42, x505, x41 * x503)),
         );
         let x513 = Self::mul_add(
             x487,
             x492,
-            Self::mul_add(-x27, x43, x28 * x42) + x478
-                - (Self::mul_add(x35, x501, x34 * x498)
-                    - Self::mul_add(-x37, x506, x36 * x504)),
+            Self::mul_add(-x32, x48, x33 * x47) + x478
+                - (Self::mul_add(x40, x501, x39 * x498)
+                    - Self::mul_add(-x42, x506, x41 * x504)),
         );
         let x514 = c_q8 * x494;
         let x515 = Self::mul_add(s_q8, x493, -x514);
@@ -4158,22 +4182,22 @@ impl FreeFloating7 {
         let x517 = Self::mul_add(c_q8, x493, x516);
         let x518 = Self::mul_add(c_q8, x495, x516);
         let x519 = Self::mul_add(-s_q8, x495, x514);
-        let x520 = x498 + Self::mul_add(x26, x497, x25 * x496);
+        let x520 = x498 + Self::mul_add(x31, x497, x30 * x496);
         let x521 = Self::mul_add(-c_q8, x497, s_q8 * x496);
         let x522 = Self::mul_add(
             -0.00000000020510342851533115,
             x498,
             Self::mul_add(s_q8, x497, c_q8 * x496),
         );
-        let x523 = x501 + Self::mul_add(x26, x500, x25 * x499);
+        let x523 = x501 + Self::mul_add(x31, x500, x30 * x499);
         let x524 = Self::mul_add(-c_q8, x500, s_q8 * x499);
         let x525 = Self::mul_add(
             -0.00000000020510342851533115,
             x501,
             Self::mul_add(s_q8, x500, c_q8 * x499),
         );
-        let x526 = Self::mul_add(-x26, x523, x25 * x520);
-        let x527 = Self::mul_add(-x26, x524, x25 * x521);
+        let x526 = Self::mul_add(-x31, x523, x30 * x520);
+        let x527 = Self::mul_add(-x31, x524, x30 * x521);
         let x528 = Self::mul_add(c_q8, x523, s_q8 * x520);
         let x529 = Self::mul_add(-s_q8, x523, c_q8 * x520);
         let x530 = Self::mul_add(-s_q8, x524, c_q8 * x521);
@@ -4197,15 +4221,15 @@ impl FreeFloating7 {
             x507,
             Self::mul_add(s_q8, x506, c_q8 * x504),
         );
-        let x539 = x507 - Self::mul_add(x26, x506, x25 * x504)
+        let x539 = x507 - Self::mul_add(x31, x506, x30 * x504)
             - Self::mul_add(
-                x26,
-                x506 - Self::mul_add(x26, x505, x25 * x503),
-                x25 * (x504 - Self::mul_add(x26, x503, x25 * x502)),
+                x31,
+                x506 - Self::mul_add(x31, x505, x30 * x503),
+                x30 * (x504 - Self::mul_add(x31, x503, x30 * x502)),
             );
         let x540 = Self::mul_add(-c_q8, x506, s_q8 * x504)
-            - Self::mul_add(x26, x536, x25 * x533);
-        let x541 = x538 - Self::mul_add(x26, x537, x25 * x535);
+            - Self::mul_add(x31, x536, x30 * x533);
+        let x541 = x538 - Self::mul_add(x31, x537, x30 * x535);
         let x542 = Self::mul_add(-c_q8, x536, s_q8 * x533);
         let x543 = Self::mul_add(-c_q8, x537, s_q8 * x535);
         let x544 = 0.35 * x540;
@@ -4216,38 +4240,38 @@ impl FreeFloating7 {
             0.35,
             x545,
             Self::mul_add(
-                x26,
-                Self::mul_add(-x26, x495, x25 * x494),
-                x25 * Self::mul_add(x26, x494, x25 * x493),
+                x31,
+                Self::mul_add(-x31, x495, x30 * x494),
+                x30 * Self::mul_add(x31, x494, x30 * x493),
             ),
         );
         let x549 = Self::mul_add(
             0.35,
             x526,
-            -Self::mul_add(0.35, x547, Self::mul_add(x26, x518, x25 * x515)),
+            -Self::mul_add(0.35, x547, Self::mul_add(x31, x518, x30 * x515)),
         );
         let x550 = Self::mul_add(
             0.35,
             x528,
             -Self::mul_add(-0.35, x546, Self::mul_add(-c_q8, x518, s_q8 * x515)),
         );
-        let x551 = x513 + Self::mul_add(-x26, x512, x25 * x511);
+        let x551 = x513 + Self::mul_add(-x31, x512, x30 * x511);
         let x552 = Self::mul_add(c_q8, x512, s_q8 * x511);
         let x553 = -16.80768997608804
-            - Self::mul_add(0.35, x530, Self::mul_add(x26, x519, x25 * x517));
+            - Self::mul_add(0.35, x530, Self::mul_add(x31, x519, x30 * x517));
         let x554 = 0.1132
             + Self::mul_add(-0.35, x529, Self::mul_add(-c_q8, x519, s_q8 * x517));
         let x555 = 132.47349025763282 - Self::mul_add(s_q8, x519, c_q8 * x517);
         let x556 = 48.0240000085309 + x530;
-        let x557 = Self::mul_add(x12, x22, Self::mul_add(-x7, x20, x8 * x19))
+        let x557 = Self::mul_add(x18, x28, Self::mul_add(-x13, x26, x14 * x25))
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x510,
                 Self::mul_add(-s_q8, x509, c_q8 * x508),
             );
         let x558 = Self::mul_add(
-            x7,
-            x22,
+            x13,
+            x28,
             -Self::mul_add(
                 -0.00000000020510342851533115,
                 x513,
@@ -4269,7 +4293,7 @@ impl FreeFloating7 {
         let x571 = Self::mul_add(
             -x553,
             x565,
-            Self::mul_add(0.35, x543, Self::mul_add(-x26, x525, x25 * x522)),
+            Self::mul_add(0.35, x543, Self::mul_add(-x31, x525, x30 * x522)),
         );
         let x572 = Self::mul_add(x554, x563, x546);
         let x573 = Self::mul_add(x554, x564, x547);
@@ -4296,43 +4320,43 @@ impl FreeFloating7 {
         let x581 = Self::mul_add(
             x560,
             x561,
-            Self::mul_add(x8, x21, x18 * x20) - Self::mul_add(x13, x23, x11 * x22)
+            Self::mul_add(x14, x27, x24 * x26) - Self::mul_add(x19, x29, x17 * x28)
                 + Self::mul_add(
                     -0.35,
                     x552,
-                    x510 + Self::mul_add(-x26, x509, x25 * x508),
+                    x510 + Self::mul_add(-x31, x509, x30 * x508),
                 )
-                + (Self::mul_add(-x15, x567, x14 * x566)
-                    + Self::mul_add(-x17, x570, x16 * x569)),
+                + (Self::mul_add(-x21, x567, x20 * x566)
+                    + Self::mul_add(-x23, x570, x22 * x569)),
         );
         let x582 = Self::mul_add(
             x560,
             x562,
-            Self::mul_add(-x12, x23, Self::mul_add(x7, x21, x18 * x19))
+            Self::mul_add(-x18, x29, Self::mul_add(x13, x27, x24 * x25))
                 - Self::mul_add(0.35, x551, Self::mul_add(c_q8, x509, s_q8 * x508))
-                - (Self::mul_add(x15, x568, x14 * x567)
-                    + Self::mul_add(-x17, x573, x16 * x572)),
+                - (Self::mul_add(x21, x568, x20 * x567)
+                    + Self::mul_add(-x23, x573, x22 * x572)),
         );
         let x583 = Self::mul_add(
             x560,
             x563,
-            Self::mul_add(x8, x23, x18 * x22) + x551
-                - (Self::mul_add(-x15, x572, x14 * x569)
-                    + Self::mul_add(x17, x576, x16 * x575)),
+            Self::mul_add(x14, x29, x24 * x28) + x551
+                - (Self::mul_add(-x21, x572, x20 * x569)
+                    + Self::mul_add(x23, x576, x22 * x575)),
         );
         let x584 = Self::mul_add(
             -x560,
             x564,
-            Self::mul_add(x7, x23, -x552)
-                + (Self::mul_add(-x15, x573, x14 * x570)
-                    - Self::mul_add(x17, x578, x16 * x576)),
+            Self::mul_add(x13, x29, -x552)
+                + (Self::mul_add(-x21, x573, x20 * x570)
+                    - Self::mul_add(x23, x578, x22 * x576)),
         );
         let x585 = Self::mul_add(
             -x560,
             x565,
             x558
-                + (Self::mul_add(-x15, x574, x14 * x571)
-                    - Self::mul_add(x17, x579, x16 * x577)),
+                + (Self::mul_add(-x21, x574, x20 * x571)
+                    - Self::mul_add(x23, x579, x22 * x577)),
         );
         let x586 = s_q7 * x567;
         let x587 = c_q7 * x567;
@@ -4382,7 +4406,7 @@ impl FreeFloating7 {
         let x619 = Self::mul_add(-s_q7, x584, c_q7 * x583);
         let x620 = Self::mul_add(c_q7, x584, s_q7 * x583);
         let x621 = 180.9502499901501 - x615;
-        let x622 = Self::mul_add(-v[4], x5, v[5] * x4) + x619;
+        let x622 = Self::mul_add(-v[4], x12, v[5] * x11) + x619;
         let x623 = 1.0 / (1170.07 - x606);
         let x624 = x607 * x623;
         let x625 = x604 * x623;
@@ -4481,17 +4505,17 @@ impl FreeFloating7 {
         let x661 = Self::mul_add(
             -x622,
             x624,
-            Self::mul_add(-v[3], x5, v[5] * x3) - x620,
+            Self::mul_add(-v[3], x12, v[5] * x10) - x620,
         );
         let x662 = Self::mul_add(
             x631,
             x661,
-            Self::mul_add(-x622, x625, Self::mul_add(-v[3], x4, v[4] * x3) - x585),
+            Self::mul_add(-x622, x625, Self::mul_add(-v[3], x11, v[4] * x10) - x585),
         );
         let x663 = Self::mul_add(
             x622,
             x626,
-            Self::mul_add(v[4], x2, v[5] * x1) + Self::mul_add(-v[1], x5, v[2] * x4)
+            Self::mul_add(v[4], x9, v[5] * x8) + Self::mul_add(-v[1], x12, v[2] * x11)
                 - Self::mul_add(0.75, x620, Self::mul_add(-s_q7, x582, c_q7 * x581)),
         );
         let x664 = Self::mul_add(x640, x662, Self::mul_add(x633, x661, x663));
@@ -4501,7 +4525,8 @@ impl FreeFloating7 {
             Self::mul_add(
                 x622,
                 x627,
-                Self::mul_add(v[3], x2, v[5] * x0) + Self::mul_add(-v[0], x5, v[2] * x3)
+                Self::mul_add(v[3], x9, v[5] * x7)
+                    + Self::mul_add(-v[0], x12, v[2] * x10)
                     + (Self::mul_add(c_q7, x582, s_q7 * x581)
                         - Self::mul_add(0.65, x585, 0.75 * x619)),
             ),
@@ -4510,7 +4535,7 @@ impl FreeFloating7 {
         let x667 = Self::mul_add(
             x622,
             x628,
-            Self::mul_add(-v[3], x1, v[4] * x0) + Self::mul_add(-v[0], x4, v[1] * x3)
+            Self::mul_add(-v[3], x8, v[4] * x7) + Self::mul_add(-v[0], x11, v[1] * x10)
                 - Self::mul_add(-0.65, x620, Self::mul_add(x560, x555 * x559, x557)),
         );
         let x668 = Self::mul_add(
@@ -4543,10 +4568,10 @@ impl FreeFloating7 {
         let x679 = Self::mul_add(-0.75, x670, x678);
         let x680 = x675 + Self::mul_add(-0.65, x669, 0.75 * x672);
         let x681 = Self::mul_add(0.65, x670, x673);
-        let x682 = x14 - Self::mul_add(-s_q7, x670, c_q7 * x672);
-        let x683 = x15 + Self::mul_add(c_q7, x670, s_q7 * x672);
-        let x684 = x16 - Self::mul_add(-s_q7, x680, c_q7 * x679);
-        let x685 = x17 + Self::mul_add(c_q7, x680, s_q7 * x679);
+        let x682 = x20 - Self::mul_add(-s_q7, x670, c_q7 * x672);
+        let x683 = x21 + Self::mul_add(c_q7, x670, s_q7 * x672);
+        let x684 = x22 - Self::mul_add(-s_q7, x680, c_q7 * x679);
+        let x685 = x23 + Self::mul_add(c_q7, x680, s_q7 * x679);
         let x686 = x559
             * (x560
                 + (Self::mul_add(-x555, x669, Self::mul_add(x554, x683, x553 * x682))
@@ -4560,14 +4585,14 @@ impl FreeFloating7 {
         let x689 = Self::mul_add(0.35, x683, x684);
         let x690 = Self::mul_add(-0.35, x682, x685);
         let x691 = Self::mul_add(0.00000000020510342851533115, x681, x689);
-        let x692 = x34
-            + Self::mul_add(-c_q8, x687, Self::mul_add(-s_q8, x683, x25 * x682));
-        let x693 = x35
-            - Self::mul_add(-s_q8, x687, Self::mul_add(c_q8, x683, x26 * x682));
-        let x694 = x36
-            + Self::mul_add(-c_q8, x681, Self::mul_add(-s_q8, x690, x25 * x689));
-        let x695 = x37
-            - Self::mul_add(-s_q8, x681, Self::mul_add(c_q8, x690, x26 * x689));
+        let x692 = x39
+            + Self::mul_add(-c_q8, x687, Self::mul_add(-s_q8, x683, x30 * x682));
+        let x693 = x40
+            - Self::mul_add(-s_q8, x687, Self::mul_add(c_q8, x683, x31 * x682));
+        let x694 = x41
+            + Self::mul_add(-c_q8, x681, Self::mul_add(-s_q8, x690, x30 * x689));
+        let x695 = x42
+            - Self::mul_add(-s_q8, x681, Self::mul_add(c_q8, x690, x31 * x689));
         let x696 = x486
             * (x487
                 - (Self::mul_add(-x482, x688, Self::mul_add(x481, x693, x480 * x692))
@@ -4590,14 +4615,14 @@ impl FreeFloating7 {
             x701,
             Self::mul_add(0.00000000020510342851533115, x699, x700),
         );
-        let x703 = x58
-            - Self::mul_add(-c_q9, x697, Self::mul_add(x48, x693, s_q9 * x692));
-        let x704 = x59
-            + Self::mul_add(s_q9, x697, Self::mul_add(-x49, x693, c_q9 * x692));
-        let x705 = x60
-            - Self::mul_add(-c_q9, x701, Self::mul_add(x48, x700, s_q9 * x699));
-        let x706 = x61
-            + Self::mul_add(s_q9, x701, Self::mul_add(-x49, x700, c_q9 * x699));
+        let x703 = x62
+            - Self::mul_add(-c_q9, x697, Self::mul_add(x52, x693, s_q9 * x692));
+        let x704 = x63
+            + Self::mul_add(s_q9, x697, Self::mul_add(-x53, x693, c_q9 * x692));
+        let x705 = x64
+            - Self::mul_add(-c_q9, x701, Self::mul_add(x52, x700, s_q9 * x699));
+        let x706 = x65
+            + Self::mul_add(s_q9, x701, Self::mul_add(-x53, x700, c_q9 * x699));
         let x707 = x397
             * (x398
                 + (Self::mul_add(-x394, x698, Self::mul_add(-x393, x704, x392 * x703))
@@ -4609,10 +4634,10 @@ impl FreeFloating7 {
         let x708 = x698 + x707;
         let x709 = Self::mul_add(-0.87, x708, x705);
         let x710 = Self::mul_add(0.87, x703, x702);
-        let x711 = x75 - Self::mul_add(-s_q10, x704, c_q10 * x703);
-        let x712 = x76 + Self::mul_add(c_q10, x704, s_q10 * x703);
-        let x713 = x77 - Self::mul_add(-s_q10, x706, c_q10 * x709);
-        let x714 = x78 + Self::mul_add(c_q10, x706, s_q10 * x709);
+        let x711 = x78 - Self::mul_add(-s_q10, x704, c_q10 * x703);
+        let x712 = x79 + Self::mul_add(c_q10, x704, s_q10 * x703);
+        let x713 = x80 - Self::mul_add(-s_q10, x706, c_q10 * x709);
+        let x714 = x81 + Self::mul_add(c_q10, x706, s_q10 * x709);
         let x715 = x339
             * (x340
                 - (Self::mul_add(x336, x708, Self::mul_add(x335, x712, x334 * x711))
@@ -4625,10 +4650,10 @@ impl FreeFloating7 {
         let x717 = x713 - Self::mul_add(-0.63, x716, 0.275 * x712);
         let x718 = Self::mul_add(0.275, x711, x714);
         let x719 = Self::mul_add(-0.63, x711, x710);
-        let x720 = x93 + Self::mul_add(s_q11, x712, c_q11 * x711);
-        let x721 = x94 - Self::mul_add(-c_q11, x712, s_q11 * x711);
-        let x722 = x95 + Self::mul_add(s_q11, x718, c_q11 * x717);
-        let x723 = x96 - Self::mul_add(-c_q11, x718, s_q11 * x717);
+        let x720 = x95 + Self::mul_add(s_q11, x712, c_q11 * x711);
+        let x721 = x96 - Self::mul_add(-c_q11, x712, s_q11 * x711);
+        let x722 = x97 + Self::mul_add(s_q11, x718, c_q11 * x717);
+        let x723 = x98 - Self::mul_add(-c_q11, x718, s_q11 * x717);
         let x724 = x274
             * (x275
                 - (Self::mul_add(x270, x716, Self::mul_add(x269, x721, x268 * x720))
@@ -4642,14 +4667,14 @@ impl FreeFloating7 {
         let x727 = Self::mul_add(-0.36, x721, x722);
         let x728 = Self::mul_add(0.36, x720, x723);
         let x729 = Self::mul_add(-0.00000000020510342851533115, x719, x728);
-        let x730 = x113
-            + Self::mul_add(-s_q12, x725, Self::mul_add(-x104, x721, c_q12 * x720));
-        let x731 = x114
-            - Self::mul_add(c_q12, x725, Self::mul_add(x105, x721, s_q12 * x720));
-        let x732 = x115
-            + Self::mul_add(-s_q12, x719, Self::mul_add(-x104, x728, c_q12 * x727));
-        let x733 = x116
-            - Self::mul_add(c_q12, x719, Self::mul_add(x105, x728, s_q12 * x727));
+        let x730 = x114
+            + Self::mul_add(-s_q12, x725, Self::mul_add(-x105, x721, c_q12 * x720));
+        let x731 = x115
+            - Self::mul_add(c_q12, x725, Self::mul_add(x106, x721, s_q12 * x720));
+        let x732 = x116
+            + Self::mul_add(-s_q12, x719, Self::mul_add(-x105, x728, c_q12 * x727));
+        let x733 = x117
+            - Self::mul_add(c_q12, x719, Self::mul_add(x106, x728, s_q12 * x727));
         let x734 = x201
             * (x202
                 - (Self::mul_add(x197, x726, Self::mul_add(x196, x731, x195 * x730))
@@ -4699,21 +4724,24 @@ impl FreeFloating7 {
         q: &[f64; 14],
         v: &[f64; 13],
     ) -> ([[f64; 13]; 13], [f64; 13]) {
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x2 = 0.00000000020510342851533115 * c_q8;
-        let x3 = 0.00000000020510342851533115 * s_q8;
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x5 = 0.00000000020510342851533115 * c_q9;
-        let x6 = 0.00000000020510342851533115 * s_q9;
-        let x7 = x5 - x6;
-        let x8 = x5 + x6;
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x12 = 0.00000000020510342851533115 * s_q12;
-        let x13 = 0.00000000020510342851533115 * c_q12;
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = 0.00000000020510342851533115 * c_q8;
+        let x8 = 0.00000000020510342851533115 * s_q8;
+        let x9 = 0.00000000020510342851533115 * c_q9;
+        let x10 = 0.00000000020510342851533115 * s_q9;
+        let x11 = x9 - x10;
+        let x12 = x9 + x10;
+        let x13 = 0.00000000020510342851533115 * s_q12;
+        let x14 = 0.00000000020510342851533115 * c_q12;
         let x15 = 0.00000000020510342851533115 * c_q13;
         let x16 = 0.00000000020510342851533115 * s_q13;
         let x17 = 4.806620000000001 * x16;
@@ -4772,22 +4800,22 @@ impl FreeFloating7 {
                     Self::mul_add(s_q13, x28, c_q13 * x27),
                 ) - x31));
         let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
-        let x49 = x19 - Self::mul_add(x13, x39, x12 * x38);
+        let x49 = x19 - Self::mul_add(x14, x39, x13 * x38);
         let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
         let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
         let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
         let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
         let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x55 = x45 - Self::mul_add(x13, x42, x12 * x37);
-        let x56 = x46 - Self::mul_add(x13, x43, x12 * x40);
-        let x57 = x47 - Self::mul_add(x13, x44, x12 * x41);
+        let x55 = x45 - Self::mul_add(x14, x42, x13 * x37);
+        let x56 = x46 - Self::mul_add(x14, x43, x13 * x40);
+        let x57 = x47 - Self::mul_add(x14, x44, x13 * x41);
         let x58 = Self::mul_add(
             0.00000000020510342851533115,
             x47,
             Self::mul_add(c_q12, x44, s_q12 * x41),
         );
         let x59 = -x58;
-        let x60 = x54 - Self::mul_add(x13, x53, x12 * x52);
+        let x60 = x54 - Self::mul_add(x14, x53, x13 * x52);
         let x61 = Self::mul_add(
             c_q12,
             Self::mul_add(
@@ -4825,7 +4853,7 @@ impl FreeFloating7 {
         let x66 = 7.078399999258757 + x49;
         let x67 = 0.01675 - x63;
         let x68 = -9.142025249762803
-            + (x62 + (x57 - Self::mul_add(x13, x56, x12 * x55) + x62));
+            + (x62 + (x57 - Self::mul_add(x14, x56, x13 * x55) + x62));
         let x69 = 2.5482240016099564 - x64;
         let x70 = 9.223235249762805
             + Self::mul_add(0.00000000020510342851533115, x58, x61);
@@ -4873,7 +4901,7 @@ impl FreeFloating7 {
         let x112 = Self::mul_add(c_q9, x106, x111);
         let x113 = 0.00000000020510342851533115 * x51;
         let x114 = x112 - x113;
-        let x115 = x51 - Self::mul_add(-x8, x106, x7 * x99);
+        let x115 = x51 - Self::mul_add(-x12, x106, x11 * x99);
         let x116 = c_q9 * x99;
         let x117 = Self::mul_add(-s_q9, x106, x116);
         let x118 = x113 + x117;
@@ -4885,9 +4913,9 @@ impl FreeFloating7 {
         let x124 = Self::mul_add(c_q9, x108, x122) + x123;
         let x125 = 0.00000000020510342851533115 * x110;
         let x126 = Self::mul_add(c_q9, x109, s_q9 * x107) + x125;
-        let x127 = x107 - Self::mul_add(x8, x103, x7 * x105);
-        let x128 = x109 + Self::mul_add(-x8, x108, x7 * x103);
-        let x129 = x110 + Self::mul_add(-x8, x109, x7 * x107);
+        let x127 = x107 - Self::mul_add(x12, x103, x11 * x105);
+        let x128 = x109 + Self::mul_add(-x12, x108, x11 * x103);
+        let x129 = x110 + Self::mul_add(-x12, x109, x11 * x107);
         let x130 = x120 + Self::mul_add(c_q9, x105, x122);
         let x131 = x123 - Self::mul_add(-s_q9, x108, x119);
         let x132 = x125 - Self::mul_add(-s_q9, x109, c_q9 * x107);
@@ -4905,28 +4933,28 @@ impl FreeFloating7 {
         let x144 = -0.000000008530897668050218 + x114;
         let x145 = -12.701650001451807 - x115;
         let x146 = -0.0000000234896432582596
-            + (x126 - Self::mul_add(x8, x124, x7 * x121) - x139);
+            + (x126 - Self::mul_add(x12, x124, x11 * x121) - x139);
         let x147 = -0.002139996587640933
             - (x133 + Self::mul_add(s_q9, x124, c_q9 * x121) + x140);
         let x148 = -0.0000000234896432582596
             + (Self::mul_add(c_q9, x128, s_q9 * x127) + x134 - x139);
         let x149 = -111.7548902508081
-            + (x136 + (x129 + Self::mul_add(-x8, x128, x7 * x127) + x136));
+            + (x136 + (x129 + Self::mul_add(-x12, x128, x11 * x127) + x136));
         let x150 = 5.080660024070365
             - (x142 + (x134 - Self::mul_add(-s_q9, x128, c_q9 * x127) - x141));
         let x151 = -0.002139996587640933
             - (Self::mul_add(c_q9, x131, s_q9 * x130) + x135 + x140);
         let x152 = 5.080660024070366
-            + (x141 - (x132 + Self::mul_add(-x8, x131, x7 * x130) + x142));
+            + (x141 - (x132 + Self::mul_add(-x12, x131, x11 * x130) + x142));
         let x153 = 113.3918902508081
             - (x137 - (x135 - Self::mul_add(-s_q9, x131, c_q9 * x130) - x137));
-        let x154 = x118 - Self::mul_add(-x3, x145, x2 * x144);
+        let x154 = x118 - Self::mul_add(-x8, x145, x7 * x144);
         let x155 = Self::mul_add(c_q8, x145, s_q8 * x144);
         let x156 = Self::mul_add(-s_q8, x145, c_q8 * x144);
         let x157 = Self::mul_add(0.00000000020510342851533115, x118, x156);
-        let x158 = x151 - Self::mul_add(-x3, x148, x2 * x143);
-        let x159 = x152 - Self::mul_add(-x3, x149, x2 * x146);
-        let x160 = x153 - Self::mul_add(-x3, x150, x2 * x147);
+        let x158 = x151 - Self::mul_add(-x8, x148, x7 * x143);
+        let x159 = x152 - Self::mul_add(-x8, x149, x7 * x146);
+        let x160 = x153 - Self::mul_add(-x8, x150, x7 * x147);
         let x161 = Self::mul_add(c_q8, x148, s_q8 * x143);
         let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
         let x163 = Self::mul_add(c_q8, x150, s_q8 * x147);
@@ -4969,7 +4997,7 @@ impl FreeFloating7 {
                 Self::mul_add(-s_q8, x162, c_q8 * x161),
             ),
         );
-        let x170 = x167 - (x160 - Self::mul_add(-x3, x159, x2 * x158) - x167);
+        let x170 = x167 - (x160 - Self::mul_add(-x8, x159, x7 * x158) - x167);
         let x171 = 48.0240000085309 + x154;
         let x172 = -0.07309 + Self::mul_add(c_q8, x159, s_q8 * x158);
         let x173 = -16.80768997608804 - x168;
@@ -5005,7 +5033,7 @@ impl FreeFloating7 {
         let x197 = 1271.854575 + (x186 + x191);
         let x198 = -x193;
         let x199 = -x192;
-        let x200 = Self::mul_add(x3, x144, x2 * x145);
+        let x200 = Self::mul_add(x8, x144, x7 * x145);
         let x201 = Self::mul_add(-0.35, x156, x160);
         let x202 = Self::mul_add(0.35, x200, x163);
         let x203 = Self::mul_add(-s_q7, x156, c_q7 * x200);
@@ -5014,13 +5042,13 @@ impl FreeFloating7 {
         let x206 = Self::mul_add(c_q7, x202, s_q7 * x201)
             + Self::mul_add(-0.65, x155, 0.75 * x203);
         let x207 = -Self::mul_add(-0.65, x204, x164);
-        let x208 = x8 * x99;
-        let x209 = Self::mul_add(x7, x106, x208);
+        let x208 = x12 * x99;
+        let x209 = Self::mul_add(x11, x106, x208);
         let x210 = x126 + Self::mul_add(-0.275, x112, 0.4 * x209);
         let x211 = Self::mul_add(0.4, x117, x129);
         let x212 = Self::mul_add(0.275, x117, x132);
         let x213 = -x212;
-        let x214 = x112 + Self::mul_add(x3, x209, x2 * x117);
+        let x214 = x112 + Self::mul_add(x8, x209, x7 * x117);
         let x215 = Self::mul_add(-c_q8, x209, s_q8 * x117);
         let x216 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -5034,7 +5062,7 @@ impl FreeFloating7 {
             Self::mul_add(-s_q8, x211, c_q8 * x210),
         );
         let x219 = -x218;
-        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x3, x211, x2 * x210));
+        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x8, x211, x7 * x210));
         let x221 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x211, s_q8 * x210));
         let x222 = Self::mul_add(s_q7, x215, c_q7 * x214);
         let x223 = -x222;
@@ -5045,19 +5073,19 @@ impl FreeFloating7 {
             + Self::mul_add(-0.65, x216, 0.75 * x222));
         let x228 = -Self::mul_add(0.65, x224, x218);
         let x229 = Self::mul_add(-s_q9, x101, x116);
-        let x230 = Self::mul_add(x7, x101, x208);
+        let x230 = Self::mul_add(x11, x101, x208);
         let x231 = Self::mul_add(c_q9, x101, x111);
         let x232 = 0.00000000020510342851533115 * x104;
         let x233 = Self::mul_add(c_q9, x97, s_q9 * x96) + x232
             + Self::mul_add(-0.275, x231, 0.4 * x230);
-        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x8, x97, x7 * x96));
+        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x12, x97, x11 * x96));
         let x235 = Self::mul_add(
             0.275,
             x229,
             x232 - Self::mul_add(-s_q9, x97, c_q9 * x96),
         );
         let x236 = -x235;
-        let x237 = x231 + Self::mul_add(x3, x230, x2 * x229);
+        let x237 = x231 + Self::mul_add(x8, x230, x7 * x229);
         let x238 = Self::mul_add(-c_q8, x230, s_q8 * x229);
         let x239 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -5071,7 +5099,7 @@ impl FreeFloating7 {
             Self::mul_add(-s_q8, x234, c_q8 * x233),
         );
         let x242 = -x241;
-        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x3, x234, x2 * x233));
+        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x8, x234, x7 * x233));
         let x244 = Self::mul_add(-0.35, x237, Self::mul_add(c_q8, x234, s_q8 * x233));
         let x245 = Self::mul_add(s_q7, x238, c_q7 * x237);
         let x246 = -x245;
@@ -5087,19 +5115,23 @@ impl FreeFloating7 {
         let x255 = Self::mul_add(c_q10, x83, s_q10 * x82);
         let x256 = Self::mul_add(-0.87, x252, x84);
         let x257 = Self::mul_add(-c_q9, x253, s_q9 * x252);
-        let x258 = Self::mul_add(x8, x253, x7 * x252);
+        let x258 = Self::mul_add(x12, x253, x11 * x252);
         let x259 = Self::mul_add(s_q9, x253, c_q9 * x252);
         let x260 = 0.00000000020510342851533115 * x256;
         let x261 = Self::mul_add(c_q9, x255, s_q9 * x254) + x260
             + Self::mul_add(-0.275, x259, 0.4 * x258);
-        let x262 = Self::mul_add(-0.4, x257, x256 + Self::mul_add(-x8, x255, x7 * x254));
+        let x262 = Self::mul_add(
+            -0.4,
+            x257,
+            x256 + Self::mul_add(-x12, x255, x11 * x254),
+        );
         let x263 = Self::mul_add(
             -0.275,
             x257,
             x260 - Self::mul_add(-s_q9, x255, c_q9 * x254),
         );
         let x264 = -x263;
-        let x265 = x259 - Self::mul_add(-x3, x258, x2 * x257);
+        let x265 = x259 - Self::mul_add(-x8, x258, x7 * x257);
         let x266 = Self::mul_add(c_q8, x258, s_q8 * x257);
         let x267 = Self::mul_add(
             0.00000000020510342851533115,
@@ -5115,7 +5147,7 @@ impl FreeFloating7 {
         let x270 = Self::mul_add(
             -0.35,
             x266,
-            x263 + Self::mul_add(-x3, x262, x2 * x261),
+            x263 + Self::mul_add(-x8, x262, x7 * x261),
         );
         let x271 = Self::mul_add(-0.35, x265, Self::mul_add(c_q8, x262, s_q8 * x261));
         let x272 = Self::mul_add(-s_q7, x266, c_q7 * x265);
@@ -5126,7 +5158,7 @@ impl FreeFloating7 {
         let x277 = -(Self::mul_add(-c_q7, x271, s_q7 * x270)
             + Self::mul_add(0.65, x267, 0.75 * x272));
         let x278 = -Self::mul_add(0.65, x274, x268);
-        let x279 = Self::mul_add(-x13, x38, x12 * x39);
+        let x279 = Self::mul_add(-x14, x38, x13 * x39);
         let x280 = Self::mul_add(0.36, x279, x54);
         let x281 = Self::mul_add(x50, 0.36, x57);
         let x282 = Self::mul_add(s_q11, x279, c_q11 * x50);
@@ -5144,18 +5176,22 @@ impl FreeFloating7 {
         let x293 = -x292;
         let x294 = 0.00000000020510342851533115 * x48;
         let x295 = Self::mul_add(c_q9, x289, s_q9 * x288) + x294;
-        let x296 = x48 + Self::mul_add(-x8, x289, x7 * x288);
+        let x296 = x48 + Self::mul_add(-x12, x289, x11 * x288);
         let x297 = x294 - Self::mul_add(-s_q9, x289, c_q9 * x288);
         let x298 = 0.00000000020510342851533115 * x292;
         let x299 = Self::mul_add(c_q9, x290, s_q9 * x291) - x298
             + Self::mul_add(0.275, x297, 0.4 * x296);
-        let x300 = Self::mul_add(0.4, x295, x292 - Self::mul_add(-x8, x290, x7 * x291));
+        let x300 = Self::mul_add(
+            0.4,
+            x295,
+            x292 - Self::mul_add(-x12, x290, x11 * x291),
+        );
         let x301 = Self::mul_add(
             0.275,
             x295,
             x298 + Self::mul_add(-s_q9, x290, c_q9 * x291),
         );
-        let x302 = x297 + Self::mul_add(-x3, x296, x2 * x295);
+        let x302 = x297 + Self::mul_add(-x8, x296, x7 * x295);
         let x303 = Self::mul_add(c_q8, x296, s_q8 * x295);
         let x304 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -5168,7 +5204,7 @@ impl FreeFloating7 {
             Self::mul_add(s_q8, x300, c_q8 * x299),
         );
         let x306 = -x305;
-        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x3, x300, x2 * x299));
+        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x8, x300, x7 * x299));
         let x308 = Self::mul_add(0.35, x302, Self::mul_add(-c_q8, x300, s_q8 * x299));
         let x309 = Self::mul_add(s_q7, x303, c_q7 * x302);
         let x310 = Self::mul_add(-c_q7, x303, s_q7 * x302);
@@ -5181,7 +5217,7 @@ impl FreeFloating7 {
         let x316 = Self::mul_add(-0.16, x314, x26);
         let x317 = Self::mul_add(-0.55, x314, x29);
         let x318 = Self::mul_add(s_q12, x19, c_q12 * x314);
-        let x319 = x18 - Self::mul_add(-x13, x19, x12 * x314);
+        let x319 = x18 - Self::mul_add(-x14, x19, x13 * x314);
         let x320 = Self::mul_add(
             0.00000000020510342851533115,
             x18,
@@ -5197,7 +5233,7 @@ impl FreeFloating7 {
         let x324 = Self::mul_add(
             -0.36,
             x318,
-            x317 - Self::mul_add(-x13, x316, x12 * x315),
+            x317 - Self::mul_add(-x14, x316, x13 * x315),
         );
         let x325 = Self::mul_add(-s_q11, x319, c_q11 * x318);
         let x326 = Self::mul_add(c_q11, x319, s_q11 * x318);
@@ -5214,18 +5250,22 @@ impl FreeFloating7 {
         let x336 = -x335;
         let x337 = 0.00000000020510342851533115 * x320;
         let x338 = Self::mul_add(c_q9, x332, s_q9 * x331) - x337;
-        let x339 = x320 - Self::mul_add(-x8, x332, x7 * x331);
+        let x339 = x320 - Self::mul_add(-x12, x332, x11 * x331);
         let x340 = x337 + Self::mul_add(-s_q9, x332, c_q9 * x331);
         let x341 = 0.00000000020510342851533115 * x335;
         let x342 = Self::mul_add(c_q9, x333, s_q9 * x334) - x341
             + Self::mul_add(0.275, x340, 0.4 * x339);
-        let x343 = Self::mul_add(-0.4, x338, x335 - Self::mul_add(-x8, x333, x7 * x334));
+        let x343 = Self::mul_add(
+            -0.4,
+            x338,
+            x335 - Self::mul_add(-x12, x333, x11 * x334),
+        );
         let x344 = Self::mul_add(
             -0.275,
             x338,
             x341 + Self::mul_add(-s_q9, x333, c_q9 * x334),
         );
-        let x345 = x340 - Self::mul_add(x3, x339, x2 * x338);
+        let x345 = x340 - Self::mul_add(x8, x339, x7 * x338);
         let x346 = Self::mul_add(-c_q8, x339, s_q8 * x338);
         let x347 = Self::mul_add(
             0.00000000020510342851533115,
@@ -5239,7 +5279,7 @@ impl FreeFloating7 {
             Self::mul_add(s_q8, x343, c_q8 * x342),
         );
         let x350 = -x349;
-        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x3, x343, x2 * x342));
+        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x8, x343, x7 * x342));
         let x352 = Self::mul_add(0.35, x345, Self::mul_add(-c_q8, x343, s_q8 * x342));
         let x353 = Self::mul_add(-s_q7, x346, c_q7 * x345);
         let x354 = Self::mul_add(c_q7, x346, s_q7 * x345);
@@ -5278,8 +5318,8 @@ impl FreeFloating7 {
             x375,
             Self::mul_add(0.1132, x362, x361 * 16.80768997608804),
         );
-        let x381 = Self::mul_add(c_q8, x375, Self::mul_add(s_q8, x362, x2 * x361));
-        let x382 = Self::mul_add(s_q8, x375, Self::mul_add(-c_q8, x362, x3 * x361));
+        let x381 = Self::mul_add(c_q8, x375, Self::mul_add(s_q8, x362, x7 * x361));
+        let x382 = Self::mul_add(s_q8, x375, Self::mul_add(-c_q8, x362, x8 * x361));
         let x383 = Self::mul_add(
             0.35,
             x374 - x377,
@@ -5287,11 +5327,11 @@ impl FreeFloating7 {
         );
         let x384 = Self::mul_add(0.35, Self::mul_add(-x362, x375, x373), x372);
         let x385 = Self::mul_add(0.35, Self::mul_add(x361, x361, x376), x371);
-        let x386 = Self::mul_add(c_q8, x385, Self::mul_add(s_q8, x384, x2 * x383));
-        let x387 = Self::mul_add(s_q8, x385, Self::mul_add(-c_q8, x384, x3 * x383));
+        let x386 = Self::mul_add(c_q8, x385, Self::mul_add(s_q8, x384, x7 * x383));
+        let x387 = Self::mul_add(s_q8, x385, Self::mul_add(-c_q8, x384, x8 * x383));
         let x388 = Self::mul_add(-0.00000000020510342851533115, x385, x383);
-        let x389 = Self::mul_add(v[7], x382, Self::mul_add(-s_q8, x374, x2 * x373));
-        let x390 = Self::mul_add(-v[7], x381, Self::mul_add(c_q8, x374, x3 * x373));
+        let x389 = Self::mul_add(v[7], x382, Self::mul_add(-s_q8, x374, x7 * x373));
+        let x390 = Self::mul_add(-v[7], x381, Self::mul_add(c_q8, x374, x8 * x373));
         let x391 = v[7] + Self::mul_add(-0.00000000020510342851533115, x375, x361);
         let x392 = x382 * x382;
         let x393 = x391 * x391;
@@ -5326,12 +5366,12 @@ impl FreeFloating7 {
                 Self::mul_add(x390, -111.7548902508081, x389 * 0.0000000234896432582596),
             ) + Self::mul_add(-x381, x403, x391 * x401),
         );
-        let x405 = Self::mul_add(-c_q9, x391, Self::mul_add(-x7, x382, s_q9 * x381));
-        let x406 = Self::mul_add(s_q9, x391, Self::mul_add(x8, x382, c_q9 * x381));
+        let x405 = Self::mul_add(-c_q9, x391, Self::mul_add(-x11, x382, s_q9 * x381));
+        let x406 = Self::mul_add(s_q9, x391, Self::mul_add(x12, x382, c_q9 * x381));
         let x407 = x386 + Self::mul_add(-0.4, x390 + x396, 0.275 * x395);
         let x408 = x387 + Self::mul_add(0.4, x389 - x399, 0.275 * x398);
         let x409 = x388 - Self::mul_add(-0.4, x392 + x397, 0.275 * x400);
-        let x410 = Self::mul_add(-c_q9, x409, Self::mul_add(-x7, x408, s_q9 * x407));
+        let x410 = Self::mul_add(-c_q9, x409, Self::mul_add(-x11, x408, s_q9 * x407));
         let x411 = Self::mul_add(
             -0.00000000020510342851533115,
             x409,
@@ -5345,12 +5385,12 @@ impl FreeFloating7 {
         let x413 = Self::mul_add(
             -v[8],
             x406,
-            Self::mul_add(-c_q9, x373, Self::mul_add(-x7, x390, s_q9 * x389)),
+            Self::mul_add(-c_q9, x373, Self::mul_add(-x11, x390, s_q9 * x389)),
         );
         let x414 = Self::mul_add(
             v[8],
             x405,
-            Self::mul_add(s_q9, x373, Self::mul_add(x8, x390, c_q9 * x389)),
+            Self::mul_add(s_q9, x373, Self::mul_add(x12, x390, c_q9 * x389)),
         );
         let x415 = v[8]
             + Self::mul_add(
@@ -5388,7 +5428,7 @@ impl FreeFloating7 {
         let x427 = Self::mul_add(
             0.87,
             x417,
-            Self::mul_add(s_q9, x409, Self::mul_add(x8, x408, c_q9 * x407)),
+            Self::mul_add(s_q9, x409, Self::mul_add(x12, x408, c_q9 * x407)),
         );
         let x428 = Self::mul_add(0.87, x418, x411);
         let x429 = Self::mul_add(s_q10, x427, c_q10 * x426);
@@ -5456,8 +5496,8 @@ impl FreeFloating7 {
                 Self::mul_add(-2.5482240016099564, x450, 0.01675 * x449),
             ) - Self::mul_add(-x443, x455, x444 * x454),
         );
-        let x459 = Self::mul_add(s_q12, x451, Self::mul_add(x12, x444, c_q12 * x443));
-        let x460 = Self::mul_add(-c_q12, x451, Self::mul_add(-x13, x444, s_q12 * x443));
+        let x459 = Self::mul_add(s_q12, x451, Self::mul_add(x13, x444, c_q12 * x443));
+        let x460 = Self::mul_add(-c_q12, x451, Self::mul_add(-x14, x444, s_q12 * x443));
         let x461 = Self::mul_add(0.36, Self::mul_add(x443, x451, x450), x448);
         let x462 = Self::mul_add(
             -0.36,
@@ -5465,19 +5505,19 @@ impl FreeFloating7 {
             Self::mul_add(c_q11, x446, s_q11 * x445),
         );
         let x463 = Self::mul_add(-0.36, Self::mul_add(x444, x444, x452), x447);
-        let x464 = Self::mul_add(s_q12, x463, Self::mul_add(x12, x462, c_q12 * x461));
-        let x465 = Self::mul_add(-c_q12, x463, Self::mul_add(-x13, x462, s_q12 * x461));
+        let x464 = Self::mul_add(s_q12, x463, Self::mul_add(x13, x462, c_q12 * x461));
+        let x465 = Self::mul_add(-c_q12, x463, Self::mul_add(-x14, x462, s_q12 * x461));
         let x466 = Self::mul_add(-0.00000000020510342851533115, x463, x462);
         let x467 = Self::mul_add(-0.00000000020510342851533115, x412, x450);
         let x468 = Self::mul_add(
             v[11],
             x460,
-            Self::mul_add(s_q12, x412, Self::mul_add(x12, x450, c_q12 * x449)),
+            Self::mul_add(s_q12, x412, Self::mul_add(x13, x450, c_q12 * x449)),
         );
         let x469 = Self::mul_add(
             -v[11],
             x459,
-            Self::mul_add(-c_q12, x412, Self::mul_add(-x13, x450, s_q12 * x449)),
+            Self::mul_add(-c_q12, x412, Self::mul_add(-x14, x450, s_q12 * x449)),
         );
         let x470 = v[11] + Self::mul_add(-0.00000000020510342851533115, x451, x444);
         let x471 = x460 * x460;
@@ -5617,7 +5657,7 @@ impl FreeFloating7 {
             + Self::mul_add(3.6140000000000003, x465, 17.135250000000003 * x464) + x505;
         let x512 = -x511;
         let x513 = Self::mul_add(-s_q12, x507, c_q12 * x506);
-        let x514 = x508 + Self::mul_add(x13, x507, x12 * x506);
+        let x514 = x508 + Self::mul_add(x14, x507, x13 * x506);
         let x515 = Self::mul_add(
             7.078399999258757,
             Self::mul_add(-x443, x444, x412),
@@ -5641,7 +5681,7 @@ impl FreeFloating7 {
             - Self::mul_add(0.36, x514, Self::mul_add(s_q12, x510, c_q12 * x509));
         let x519 = Self::mul_add(-2.5482240016099564, x412, x450 * 9.142025249762803)
             + Self::mul_add(-x443, x456, x451 * x454)
-            - Self::mul_add(-0.36, x513, x511 + Self::mul_add(-x13, x510, x12 * x509));
+            - Self::mul_add(-0.36, x513, x511 + Self::mul_add(-x14, x510, x13 * x509));
         let x520 = x458
             - Self::mul_add(
                 -0.00000000020510342851533115,
@@ -5678,7 +5718,7 @@ impl FreeFloating7 {
         let x537 = -x536;
         let x538 = 0.00000000020510342851533115 * x533;
         let x539 = Self::mul_add(-c_q9, x532, s_q9 * x531) + x538;
-        let x540 = x533 + Self::mul_add(x8, x532, x7 * x531);
+        let x540 = x533 + Self::mul_add(x12, x532, x11 * x531);
         let x541 = x538 - Self::mul_add(s_q9, x532, c_q9 * x531);
         let x542 = 0.00000000020510342851533115 * x536;
         let x543 = Self::mul_add(
@@ -5705,7 +5745,7 @@ impl FreeFloating7 {
             + (Self::mul_add(-c_q9, x535, s_q9 * x534) - x542
                 + Self::mul_add(0.275, x541, 0.4 * x540));
         let x547 = x404
-            + Self::mul_add(0.4, x539, x536 - Self::mul_add(x8, x535, x7 * x534));
+            + Self::mul_add(0.4, x539, x536 - Self::mul_add(x12, x535, x11 * x534));
         let x548 = Self::mul_add(
             113.3918902508081,
             x373,
@@ -5714,7 +5754,7 @@ impl FreeFloating7 {
             - Self::mul_add(x387, 0.000000008530897668050218, x386 * 12.701650001451807)
             - Self::mul_add(0.275, x539, x542 + Self::mul_add(s_q9, x535, c_q9 * x534));
         let x549 = -x548;
-        let x550 = x545 + Self::mul_add(-x3, x544, x2 * x543);
+        let x550 = x545 + Self::mul_add(-x8, x544, x7 * x543);
         let x551 = Self::mul_add(c_q8, x544, s_q8 * x543);
         let x552 = Self::mul_add(
             48.0240000085309,
@@ -5732,7 +5772,7 @@ impl FreeFloating7 {
             ),
         );
         let x555 = Self::mul_add(x374, 0.07309, Self::mul_add(x362, x380, x375 * x379))
-            - Self::mul_add(0.35, x551, x548 + Self::mul_add(x3, x547, x2 * x546));
+            - Self::mul_add(0.35, x551, x548 + Self::mul_add(x8, x547, x7 * x546));
         let x556 = Self::mul_add(
             48.0240000085309,
             x371,
@@ -6010,246 +6050,249 @@ impl FreeFloating7 {
         tau: &[f64; 7],
         f_ext: &[[f64; 6]; 8],
     ) -> [f64; 13] {
-        let x0 = Self::mul_add(
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = Self::mul_add(
             -180.9502499901501,
             v[1],
             Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
         );
-        let x1 = Self::mul_add(
+        let x8 = Self::mul_add(
             1466.4506062283303,
             v[4],
             Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
         );
-        let x2 = Self::mul_add(
+        let x9 = Self::mul_add(
             -110.5455,
             v[1],
             Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
         );
-        let x3 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
-        let x4 = Self::mul_add(
+        let x10 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
+        let x11 = Self::mul_add(
             1170.07,
             v[1],
             -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
         );
-        let x5 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x8 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x9 = Self::mul_add(0.75, v[4], v[0]);
-        let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x11 = Self::mul_add(-0.65, v[4], v[2]);
-        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
-        let x13 = Self::mul_add(-c_q7, x10, s_q7 * x9);
-        let x14 = v[6] * x8;
-        let x15 = v[6] * x7;
-        let x16 = v[6] * x13;
-        let x17 = v[6] * x12;
-        let x18 = v[5] + v[6];
-        let x19 = Self::mul_add(x18, -16.80768997608804, x8 * 0.07309);
-        let x20 = Self::mul_add(
+        let x12 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
+        let x13 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x14 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x15 = Self::mul_add(0.75, v[4], v[0]);
+        let x16 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
+        let x17 = Self::mul_add(-0.65, v[4], v[2]);
+        let x18 = Self::mul_add(s_q7, x16, c_q7 * x15);
+        let x19 = Self::mul_add(-c_q7, x16, s_q7 * x15);
+        let x20 = v[6] * x14;
+        let x21 = v[6] * x13;
+        let x22 = v[6] * x19;
+        let x23 = v[6] * x18;
+        let x24 = v[5] + v[6];
+        let x25 = Self::mul_add(x24, -16.80768997608804, x14 * 0.07309);
+        let x26 = Self::mul_add(
             48.0240000085309,
-            x11,
+            x17,
             Self::mul_add(
                 -0.1132,
-                x18,
-                Self::mul_add(130.43769025763282, x8, x7 * 0.07309),
+                x24,
+                Self::mul_add(130.43769025763282, x14, x13 * 0.07309),
             ),
         );
-        let x21 = Self::mul_add(
+        let x27 = Self::mul_add(
             48.0240000085309,
-            x13,
+            x19,
             Self::mul_add(
                 -132.47349025763282,
-                x18,
-                Self::mul_add(0.1132, x8, x7 * 16.80768997608804),
+                x24,
+                Self::mul_add(0.1132, x14, x13 * 16.80768997608804),
             ),
         );
-        let x22 = 48.0240000085309 * x18;
-        let x23 = 48.0240000085309 * x8;
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x25 = 0.00000000020510342851533115 * c_q8;
-        let x26 = 0.00000000020510342851533115 * s_q8;
-        let x27 = Self::mul_add(x18, c_q8, Self::mul_add(x8, s_q8, x7 * x25));
-        let x28 = Self::mul_add(x18, s_q8, Self::mul_add(-x8, c_q8, x7 * x26));
-        let x29 = Self::mul_add(-0.35, x8, x12);
-        let x30 = Self::mul_add(0.35, x7, x13);
-        let x31 = Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x30, x25 * x29));
-        let x32 = Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x30, x26 * x29));
-        let x33 = Self::mul_add(-0.00000000020510342851533115, x11, x29);
-        let x34 = v[7] * x28;
-        let x35 = v[7] * x27;
-        let x36 = v[7] * x32;
-        let x37 = v[7] * x31;
-        let x38 = v[7] + Self::mul_add(-0.00000000020510342851533115, x18, x7);
-        let x39 = Self::mul_add(
-            x33,
+        let x28 = 48.0240000085309 * x24;
+        let x29 = 48.0240000085309 * x14;
+        let x30 = 0.00000000020510342851533115 * c_q8;
+        let x31 = 0.00000000020510342851533115 * s_q8;
+        let x32 = Self::mul_add(x24, c_q8, Self::mul_add(x14, s_q8, x13 * x30));
+        let x33 = Self::mul_add(x24, s_q8, Self::mul_add(-x14, c_q8, x13 * x31));
+        let x34 = Self::mul_add(-0.35, x14, x18);
+        let x35 = Self::mul_add(0.35, x13, x19);
+        let x36 = Self::mul_add(x17, c_q8, Self::mul_add(s_q8, x35, x30 * x34));
+        let x37 = Self::mul_add(x17, s_q8, Self::mul_add(-c_q8, x35, x31 * x34));
+        let x38 = Self::mul_add(-0.00000000020510342851533115, x17, x34);
+        let x39 = v[7] * x33;
+        let x40 = v[7] * x32;
+        let x41 = v[7] * x37;
+        let x42 = v[7] * x36;
+        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x13);
+        let x44 = Self::mul_add(
+            x38,
             12.701650001451807,
-            Self::mul_add(x38, 0.002139996587640933, x28 * 0.0000000234896432582596),
+            Self::mul_add(x43, 0.002139996587640933, x33 * 0.0000000234896432582596),
         );
-        let x40 = Self::mul_add(
-            x33,
+        let x45 = Self::mul_add(
+            x38,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x38,
-                Self::mul_add(x28, -111.7548902508081, x27 * 0.0000000234896432582596),
+                x43,
+                Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
             ),
         );
-        let x41 = Self::mul_add(
+        let x46 = Self::mul_add(
             113.3918902508081,
-            x38,
-            Self::mul_add(5.080660024070366, x28, x27 * 0.002139996587640933),
-        ) - Self::mul_add(x32, 0.000000008530897668050218, x31 * 12.701650001451807);
-        let x42 = x38 * 12.701650001451807;
-        let x43 = x38 * 0.000000008530897668050218;
-        let x44 = Self::mul_add(
-            x28,
+            x43,
+            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
+        ) - Self::mul_add(x37, 0.000000008530897668050218, x36 * 12.701650001451807);
+        let x47 = x43 * 12.701650001451807;
+        let x48 = x43 * 0.000000008530897668050218;
+        let x49 = Self::mul_add(
+            x33,
             0.000000008530897668050218,
-            x27 * 12.701650001451807,
+            x32 * 12.701650001451807,
         );
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x46 = 0.00000000020510342851533115 * c_q9;
-        let x47 = 0.00000000020510342851533115 * s_q9;
-        let x48 = x46 - x47;
-        let x49 = x46 + x47;
-        let x50 = Self::mul_add(-x38, c_q9, Self::mul_add(-x28, x48, x27 * s_q9));
-        let x51 = Self::mul_add(x38, s_q9, Self::mul_add(x28, x49, x27 * c_q9));
-        let x52 = x31 - Self::mul_add(-0.275, x38, 0.4 * x28);
-        let x53 = Self::mul_add(0.4, x27, x32);
-        let x54 = Self::mul_add(-0.275, x27, x33);
-        let x55 = Self::mul_add(-c_q9, x54, Self::mul_add(-x48, x53, s_q9 * x52));
-        let x56 = Self::mul_add(s_q9, x54, Self::mul_add(x49, x53, c_q9 * x52));
-        let x57 = Self::mul_add(
+        let x50 = 0.00000000020510342851533115 * c_q9;
+        let x51 = 0.00000000020510342851533115 * s_q9;
+        let x52 = x50 - x51;
+        let x53 = x50 + x51;
+        let x54 = Self::mul_add(-x43, c_q9, Self::mul_add(-x33, x52, x32 * s_q9));
+        let x55 = Self::mul_add(x43, s_q9, Self::mul_add(x33, x53, x32 * c_q9));
+        let x56 = x36 - Self::mul_add(-0.275, x43, 0.4 * x33);
+        let x57 = Self::mul_add(0.4, x32, x37);
+        let x58 = Self::mul_add(-0.275, x32, x38);
+        let x59 = Self::mul_add(-c_q9, x58, Self::mul_add(-x52, x57, s_q9 * x56));
+        let x60 = Self::mul_add(s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56));
+        let x61 = Self::mul_add(
             -0.00000000020510342851533115,
-            x54,
-            Self::mul_add(-0.00000000020510342851533115, x52, x53),
+            x58,
+            Self::mul_add(-0.00000000020510342851533115, x56, x57),
         );
-        let x58 = v[8] * x51;
-        let x59 = v[8] * x50;
-        let x60 = v[8] * x56;
-        let x61 = v[8] * x55;
-        let x62 = v[8]
+        let x62 = v[8] * x55;
+        let x63 = v[8] * x54;
+        let x64 = v[8] * x60;
+        let x65 = v[8] * x59;
+        let x66 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x38,
-                Self::mul_add(-0.00000000020510342851533115, x27, x28),
+                x43,
+                Self::mul_add(-0.00000000020510342851533115, x32, x33),
             );
-        let x63 = Self::mul_add(x62, -36.18604050126307, x51 * 63.36336825000001);
-        let x64 = Self::mul_add(x57, 81.53205, x62 * 0.00214);
-        let x65 = Self::mul_add(
-            x55,
+        let x67 = Self::mul_add(x66, -36.18604050126307, x55 * 63.36336825000001);
+        let x68 = Self::mul_add(x61, 81.53205, x66 * 0.00214);
+        let x69 = Self::mul_add(
+            x59,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x62,
-                Self::mul_add(x51, 36.18604050126307, x50 * 0.00214),
+                x66,
+                Self::mul_add(x55, 36.18604050126307, x54 * 0.00214),
             ),
         );
-        let x66 = x62 * 81.53205;
-        let x67 = x50 * 81.53205;
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let x69 = Self::mul_add(x51, s_q10, x50 * c_q10);
-        let x70 = Self::mul_add(-x51, c_q10, x50 * s_q10);
-        let x71 = Self::mul_add(x62, -0.87, x55);
-        let x72 = Self::mul_add(x50, 0.87, x57);
-        let x73 = Self::mul_add(x56, s_q10, c_q10 * x71);
-        let x74 = Self::mul_add(-x56, c_q10, s_q10 * x71);
-        let x75 = v[9] * x70;
-        let x76 = v[9] * x69;
-        let x77 = v[9] * x74;
+        let x70 = x66 * 81.53205;
+        let x71 = x54 * 81.53205;
+        let x72 = Self::mul_add(x55, s_q10, x54 * c_q10);
+        let x73 = Self::mul_add(-x55, c_q10, x54 * s_q10);
+        let x74 = Self::mul_add(x66, -0.87, x59);
+        let x75 = Self::mul_add(x54, 0.87, x61);
+        let x76 = Self::mul_add(x60, s_q10, c_q10 * x74);
+        let x77 = Self::mul_add(-x60, c_q10, s_q10 * x74);
         let x78 = v[9] * x73;
-        let x79 = v[9] + x62;
-        let x80 = Self::mul_add(x79, 24.35164200091464, x70 * 24.4950615);
-        let x81 = Self::mul_add(x72, 45.1584, x79 * 0.6328);
-        let x82 = Self::mul_add(
-            x73,
+        let x79 = v[9] * x72;
+        let x80 = v[9] * x77;
+        let x81 = v[9] * x76;
+        let x82 = v[9] + x66;
+        let x83 = Self::mul_add(x82, 24.35164200091464, x73 * 24.4950615);
+        let x84 = Self::mul_add(x75, 45.1584, x82 * 0.6328);
+        let x85 = Self::mul_add(
+            x76,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x79,
-                Self::mul_add(x70, -24.351642000914637, x69 * 0.6328),
+                x82,
+                Self::mul_add(x73, -24.351642000914637, x72 * 0.6328),
             ),
         );
-        let x83 = x79 * 45.1584;
-        let x84 = x69 * 45.1584;
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let x86 = Self::mul_add(-x70, s_q11, x69 * c_q11);
-        let x87 = Self::mul_add(x70, c_q11, x69 * s_q11);
-        let x88 = x73 + Self::mul_add(x79, -0.63, 0.275 * x70);
-        let x89 = Self::mul_add(-0.275, x69, x74);
-        let x90 = Self::mul_add(x69, 0.63, x72);
-        let x91 = Self::mul_add(-s_q11, x89, c_q11 * x88);
-        let x92 = Self::mul_add(c_q11, x89, s_q11 * x88);
-        let x93 = v[10] * x87;
-        let x94 = v[10] * x86;
-        let x95 = v[10] * x92;
-        let x96 = v[10] * x91;
-        let x97 = v[10] + x79;
-        let x98 = Self::mul_add(-2.5482240016099564, x97, x87 * 9.142025249762803);
-        let x99 = Self::mul_add(7.078399999258757, x90, 0.01675 * x97);
-        let x100 = Self::mul_add(
+        let x86 = x82 * 45.1584;
+        let x87 = x72 * 45.1584;
+        let x88 = Self::mul_add(-x73, s_q11, x72 * c_q11);
+        let x89 = Self::mul_add(x73, c_q11, x72 * s_q11);
+        let x90 = x76 + Self::mul_add(x82, -0.63, 0.275 * x73);
+        let x91 = Self::mul_add(-0.275, x72, x77);
+        let x92 = Self::mul_add(x72, 0.63, x75);
+        let x93 = Self::mul_add(-s_q11, x91, c_q11 * x90);
+        let x94 = Self::mul_add(c_q11, x91, s_q11 * x90);
+        let x95 = v[10] * x89;
+        let x96 = v[10] * x88;
+        let x97 = v[10] * x94;
+        let x98 = v[10] * x93;
+        let x99 = v[10] + x82;
+        let x100 = Self::mul_add(-2.5482240016099564, x99, x89 * 9.142025249762803);
+        let x101 = Self::mul_add(7.078399999258757, x92, 0.01675 * x99);
+        let x102 = Self::mul_add(
             -7.078399999258757,
-            x91,
+            x93,
             Self::mul_add(
                 -9.223235249762805,
-                x97,
-                Self::mul_add(-2.5482240016099564, x87, 0.01675 * x86),
+                x99,
+                Self::mul_add(-2.5482240016099564, x89, 0.01675 * x88),
             ),
         );
-        let x101 = 7.078399999258757 * x97;
-        let x102 = 7.078399999258757 * x86;
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x104 = 0.00000000020510342851533115 * s_q12;
-        let x105 = 0.00000000020510342851533115 * c_q12;
-        let x106 = Self::mul_add(x97, s_q12, Self::mul_add(x87, x104, x86 * c_q12));
-        let x107 = Self::mul_add(-x97, c_q12, Self::mul_add(-x87, x105, x86 * s_q12));
-        let x108 = Self::mul_add(x87, 0.36, x91);
-        let x109 = Self::mul_add(x86, -0.36, x92);
-        let x110 = Self::mul_add(x90, s_q12, Self::mul_add(x104, x109, c_q12 * x108));
-        let x111 = Self::mul_add(-x90, c_q12, Self::mul_add(-x105, x109, s_q12 * x108));
-        let x112 = Self::mul_add(-0.00000000020510342851533115, x90, x109);
-        let x113 = v[11] * x107;
-        let x114 = v[11] * x106;
-        let x115 = v[11] * x111;
-        let x116 = v[11] * x110;
-        let x117 = v[11] + Self::mul_add(-0.00000000020510342851533115, x97, x87);
-        let x118 = Self::mul_add(
-            -17.135250000000003,
-            x112,
-            Self::mul_add(x117, 0.809539999555672, x107 * 1.9877000000000002),
-        );
+        let x103 = 7.078399999258757 * x99;
+        let x104 = 7.078399999258757 * x88;
+        let x105 = 0.00000000020510342851533115 * s_q12;
+        let x106 = 0.00000000020510342851533115 * c_q12;
+        let x107 = Self::mul_add(x99, s_q12, Self::mul_add(x89, x105, x88 * c_q12));
+        let x108 = Self::mul_add(-x99, c_q12, Self::mul_add(-x89, x106, x88 * s_q12));
+        let x109 = Self::mul_add(x89, 0.36, x93);
+        let x110 = Self::mul_add(x88, -0.36, x94);
+        let x111 = Self::mul_add(x92, s_q12, Self::mul_add(x105, x110, c_q12 * x109));
+        let x112 = Self::mul_add(-x92, c_q12, Self::mul_add(-x106, x110, s_q12 * x109));
+        let x113 = Self::mul_add(-0.00000000020510342851533115, x92, x110);
+        let x114 = v[11] * x108;
+        let x115 = v[11] * x107;
+        let x116 = v[11] * x112;
+        let x117 = v[11] * x111;
+        let x118 = v[11] + Self::mul_add(-0.00000000020510342851533115, x99, x89);
         let x119 = Self::mul_add(
-            -3.6140000000000003,
-            x112,
-            Self::mul_add(
-                x117,
-                -2.741639999592316,
-                Self::mul_add(x107, -5.252920330000002, x106 * 1.9877000000000002),
-            ),
+            -17.135250000000003,
+            x113,
+            Self::mul_add(x118, 0.809539999555672, x108 * 1.9877000000000002),
         );
         let x120 = Self::mul_add(
+            -3.6140000000000003,
+            x113,
+            Self::mul_add(
+                x118,
+                -2.741639999592316,
+                Self::mul_add(x108, -5.252920330000002, x107 * 1.9877000000000002),
+            ),
+        );
+        let x121 = Self::mul_add(
             9.740442170000001,
-            x117,
-            Self::mul_add(x107, -2.7416399995923166, x106 * 0.809539999555672),
-        ) + Self::mul_add(3.6140000000000003, x111, 17.135250000000003 * x110);
-        let x121 = 17.135250000000003 * x117;
-        let x122 = 3.6140000000000003 * x117;
-        let x123 = Self::mul_add(3.6140000000000003, x107, 17.135250000000003 * x106);
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+            x118,
+            Self::mul_add(x108, -2.7416399995923166, x107 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x112, 17.135250000000003 * x111);
+        let x122 = 17.135250000000003 * x118;
+        let x123 = 3.6140000000000003 * x118;
+        let x124 = Self::mul_add(3.6140000000000003, x108, 17.135250000000003 * x107);
         let x125 = 0.00000000020510342851533115 * c_q13;
         let x126 = 0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(-x117, c_q13, Self::mul_add(x107, s_q13, x106 * x125));
-        let x128 = Self::mul_add(-x117, s_q13, Self::mul_add(-x107, c_q13, x106 * x126));
-        let x129 = x110 - Self::mul_add(-0.55, x117, 0.16 * x107);
-        let x130 = Self::mul_add(0.16, x106, x111);
-        let x131 = Self::mul_add(-0.55, x106, x112);
+        let x127 = Self::mul_add(-x118, c_q13, Self::mul_add(x108, s_q13, x107 * x125));
+        let x128 = Self::mul_add(-x118, s_q13, Self::mul_add(-x108, c_q13, x107 * x126));
+        let x129 = x111 - Self::mul_add(-0.55, x118, 0.16 * x108);
+        let x130 = Self::mul_add(0.16, x107, x112);
+        let x131 = Self::mul_add(-0.55, x107, x113);
         let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
         let x133 = Self::mul_add(-s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
         let x134 = Self::mul_add(0.00000000020510342851533115, x131, x129);
         let x135 = v[12] * x128;
         let x136 = v[12] * x127;
         let x137 = v[12] * x133;
-        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x117, x106);
+        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x118, x107);
         let x139 = Self::mul_add(
             x138,
             -0.9614610000000001,
@@ -6400,8 +6443,8 @@ impl FreeFloating7 {
         let x197 = -17.135250000000003 - x184;
         let x198 = 3.6140000000000003 + x185;
         let x199 = f_ext[6][5]
-            - (Self::mul_add(-x106, x119, x107 * x118)
-                + Self::mul_add(-x110, x122, x111 * x121)) - x193;
+            - (Self::mul_add(-x107, x120, x108 * x119)
+                + Self::mul_add(-x111, x123, x112 * x122)) - x193;
         let x200 = 1.0 / x196;
         let x201 = tau[5] + x199;
         let x202 = x194 * x200;
@@ -6456,60 +6499,60 @@ impl FreeFloating7 {
             -x201,
             x202,
             f_ext[6][3]
-                + (Self::mul_add(-x107, x120, x117 * x119)
-                    + Self::mul_add(x111, x123, x112 * x122))
+                + (Self::mul_add(-x108, x121, x118 * x120)
+                    + Self::mul_add(x112, x124, x113 * x123))
                 + (x150 - Self::mul_add(-x126, x149, x125 * x148)
                     - Self::mul_add(0.55, x192, 0.16 * x191))
-                + (Self::mul_add(-x114, x208, x113 * x207)
-                    + Self::mul_add(-x116, x211, x115 * x210)),
+                + (Self::mul_add(-x115, x208, x114 * x207)
+                    + Self::mul_add(-x117, x211, x116 * x210)),
         );
         let x223 = Self::mul_add(
             -x201,
             x203,
             f_ext[6][4]
-                + (Self::mul_add(-x106, x120, x117 * x118)
-                    + Self::mul_add(x110, x123, x112 * x121))
+                + (Self::mul_add(-x107, x121, x118 * x119)
+                    + Self::mul_add(x111, x124, x113 * x122))
                 + Self::mul_add(0.16, x190, Self::mul_add(c_q13, x149, s_q13 * x148))
-                - (Self::mul_add(x114, x209, x113 * x208)
-                    + Self::mul_add(-x116, x214, x115 * x213)),
+                - (Self::mul_add(x115, x209, x114 * x208)
+                    + Self::mul_add(-x117, x214, x116 * x213)),
         );
         let x224 = Self::mul_add(-x201, x196 * x200, x199);
         let x225 = Self::mul_add(
             -x201,
             x204,
-            f_ext[6][0] + Self::mul_add(x107, x123, x117 * x122) + x190
-                + (Self::mul_add(-x114, x213, x113 * x210)
-                    + Self::mul_add(-x116, x217, x115 * x216)),
+            f_ext[6][0] + Self::mul_add(x108, x124, x118 * x123) + x190
+                + (Self::mul_add(-x115, x213, x114 * x210)
+                    + Self::mul_add(-x117, x217, x116 * x216)),
         );
         let x226 = Self::mul_add(
             -x201,
             x205,
-            f_ext[6][1] + Self::mul_add(x106, x123, x117 * x121) + x191
-                - (Self::mul_add(-x114, x214, x113 * x211)
-                    + Self::mul_add(-x116, x219, x115 * x217)),
+            f_ext[6][1] + Self::mul_add(x107, x124, x118 * x122) + x191
+                - (Self::mul_add(-x115, x214, x114 * x211)
+                    + Self::mul_add(-x117, x219, x116 * x217)),
         );
         let x227 = Self::mul_add(
             x201,
             x206,
-            f_ext[6][2] - Self::mul_add(-x106, x122, x107 * x121) - x192
-                - (Self::mul_add(x114, x215, x113 * x212)
-                    - Self::mul_add(-x116, x220, x115 * x218)),
+            f_ext[6][2] - Self::mul_add(-x107, x123, x108 * x122) - x192
+                - (Self::mul_add(x115, x215, x114 * x212)
+                    - Self::mul_add(-x117, x220, x116 * x218)),
         );
         let x228 = s_q12 * x208;
-        let x229 = Self::mul_add(-x105, x208, x104 * x207);
+        let x229 = Self::mul_add(-x106, x208, x105 * x207);
         let x230 = c_q12 * x208;
         let x231 = Self::mul_add(s_q12, x207, -x230);
-        let x232 = Self::mul_add(x105, x209, x104 * x208);
+        let x232 = Self::mul_add(x106, x209, x105 * x208);
         let x233 = Self::mul_add(c_q12, x209, x228);
         let x234 = Self::mul_add(s_q12, x211, c_q12 * x210);
-        let x235 = x212 + Self::mul_add(-x105, x211, x104 * x210);
+        let x235 = x212 + Self::mul_add(-x106, x211, x105 * x210);
         let x236 = Self::mul_add(
             -0.00000000020510342851533115,
             x212,
             Self::mul_add(-c_q12, x211, s_q12 * x210),
         );
         let x237 = Self::mul_add(s_q12, x214, c_q12 * x213);
-        let x238 = x215 - Self::mul_add(-x105, x214, x104 * x213);
+        let x238 = x215 - Self::mul_add(-x106, x214, x105 * x213);
         let x239 = Self::mul_add(
             0.00000000020510342851533115,
             x215,
@@ -6517,19 +6560,19 @@ impl FreeFloating7 {
         );
         let x240 = Self::mul_add(s_q12, x237, c_q12 * x234);
         let x241 = Self::mul_add(-s_q12, x238, c_q12 * x235);
-        let x242 = Self::mul_add(-x105, x237, x104 * x234);
+        let x242 = Self::mul_add(-x106, x237, x105 * x234);
         let x243 = Self::mul_add(-c_q12, x237, s_q12 * x234);
         let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
         let x245 = Self::mul_add(-c_q12, x239, s_q12 * x236);
         let x246 = s_q12 * x217;
-        let x247 = x218 - Self::mul_add(-x105, x217, x104 * x216);
+        let x247 = x218 - Self::mul_add(-x106, x217, x105 * x216);
         let x248 = c_q12 * x217;
         let x249 = Self::mul_add(
             0.00000000020510342851533115,
             x218,
             Self::mul_add(s_q12, x216, -x248),
         );
-        let x250 = x220 - Self::mul_add(-x105, x219, x104 * x217);
+        let x250 = x220 - Self::mul_add(-x106, x219, x105 * x217);
         let x251 = Self::mul_add(
             0.00000000020510342851533115,
             x220,
@@ -6547,13 +6590,13 @@ impl FreeFloating7 {
         );
         let x254 = Self::mul_add(s_q12, x250, c_q12 * x247);
         let x255 = Self::mul_add(s_q12, x251, c_q12 * x249);
-        let x256 = x221 - Self::mul_add(-x105, x220, x104 * x218)
-            - Self::mul_add(-x105, x250, x104 * x247);
-        let x257 = x252 - Self::mul_add(-x105, x251, x104 * x249);
+        let x256 = x221 - Self::mul_add(-x106, x220, x105 * x218)
+            - Self::mul_add(-x106, x250, x105 * x247);
+        let x257 = x252 - Self::mul_add(-x106, x251, x105 * x249);
         let x258 = 0.36 * x254;
         let x259 = Self::mul_add(-0.36, x256, x241);
         let x260 = Self::mul_add(0.36, x253, x242);
-        let x261 = Self::mul_add(x105, x238, x104 * x235) - x258;
+        let x261 = Self::mul_add(x106, x238, x105 * x235) - x258;
         let x262 = Self::mul_add(
             -0.36,
             x259,
@@ -6571,18 +6614,18 @@ impl FreeFloating7 {
         let x264 = Self::mul_add(
             0.36,
             x242,
-            Self::mul_add(0.36, x260, Self::mul_add(-x105, x232, x104 * x229)),
+            Self::mul_add(0.36, x260, Self::mul_add(-x106, x232, x105 * x229)),
         );
         let x265 = Self::mul_add(-s_q12, x226, c_q12 * x225);
-        let x266 = x227 - Self::mul_add(x105, x226, x104 * x225);
+        let x266 = x227 - Self::mul_add(x106, x226, x105 * x225);
         let x267 = 0.01675
             + Self::mul_add(-0.36, x244, Self::mul_add(s_q12, x233, c_q12 * x231));
         let x268 = 2.5482240016099564
-            - Self::mul_add(0.36, x243, Self::mul_add(-x105, x233, x104 * x231));
+            - Self::mul_add(0.36, x243, Self::mul_add(-x106, x233, x105 * x231));
         let x269 = 9.223235249762805 - Self::mul_add(-c_q12, x233, s_q12 * x231);
         let x270 = -7.078399999258757 + x243;
         let x271 = f_ext[5][5]
-            + Self::mul_add(-x92, x101, Self::mul_add(-x86, x98, x87 * x99))
+            + Self::mul_add(-x94, x103, Self::mul_add(-x88, x100, x89 * x101))
             - Self::mul_add(
                 0.00000000020510342851533115,
                 x224,
@@ -6611,7 +6654,7 @@ impl FreeFloating7 {
         let x287 = Self::mul_add(
             -x268,
             x278,
-            Self::mul_add(0.36, x255, Self::mul_add(-x105, x239, x104 * x236)),
+            Self::mul_add(0.36, x255, Self::mul_add(-x106, x239, x105 * x236)),
         );
         let x288 = Self::mul_add(x270, x276, x253);
         let x289 = Self::mul_add(-x270, x277, x254);
@@ -6630,50 +6673,51 @@ impl FreeFloating7 {
         let x294 = Self::mul_add(
             -x273,
             x274,
-            f_ext[5][3] - Self::mul_add(-x92, x102, Self::mul_add(-x87, x100, x97 * x98))
+            f_ext[5][3]
+                - Self::mul_add(-x94, x104, Self::mul_add(-x89, x102, x99 * x100))
                 + Self::mul_add(0.36, x266, Self::mul_add(-s_q12, x223, c_q12 * x222))
-                - (Self::mul_add(x94, x280, x93 * x279)
-                    - Self::mul_add(-x96, x283, x95 * x282)),
+                - (Self::mul_add(x96, x280, x95 * x279)
+                    - Self::mul_add(-x98, x283, x97 * x282)),
         );
         let x295 = Self::mul_add(
             -x273,
             x275,
             f_ext[5][4]
-                - (Self::mul_add(-x86, x100, x97 * x99)
-                    - Self::mul_add(x91, x102, x90 * x101))
+                - (Self::mul_add(-x88, x102, x99 * x101)
+                    - Self::mul_add(x93, x104, x92 * x103))
                 + Self::mul_add(
                     -0.36,
                     x265,
-                    x224 - Self::mul_add(x105, x223, x104 * x222),
+                    x224 - Self::mul_add(x106, x223, x105 * x222),
                 )
-                - (Self::mul_add(x94, x281, x93 * x280)
-                    + Self::mul_add(-x96, x286, x95 * x285)),
+                - (Self::mul_add(x96, x281, x95 * x280)
+                    + Self::mul_add(-x98, x286, x97 * x285)),
         );
         let x296 = Self::mul_add(
             -x273,
             x276,
-            Self::mul_add(x87, x102, f_ext[5][0]) + x265
-                + (Self::mul_add(-x94, x285, x93 * x282)
-                    + Self::mul_add(x96, x289, x95 * x288)),
+            Self::mul_add(x89, x104, f_ext[5][0]) + x265
+                + (Self::mul_add(-x96, x285, x95 * x282)
+                    + Self::mul_add(x98, x289, x97 * x288)),
         );
         let x297 = Self::mul_add(
             x273,
             x277,
-            f_ext[5][1] + Self::mul_add(x86, x102, x97 * x101) + x266
-                - (Self::mul_add(-x94, x286, x93 * x283)
-                    - Self::mul_add(x96, x291, x95 * x289)),
+            f_ext[5][1] + Self::mul_add(x88, x104, x99 * x103) + x266
+                - (Self::mul_add(-x96, x286, x95 * x283)
+                    - Self::mul_add(x98, x291, x97 * x289)),
         );
         let x298 = Self::mul_add(
             x273,
             x278,
-            Self::mul_add(-x87, x101, f_ext[5][2])
+            Self::mul_add(-x89, x103, f_ext[5][2])
                 - Self::mul_add(
                     0.00000000020510342851533115,
                     x227,
                     Self::mul_add(c_q12, x226, s_q12 * x225),
                 )
-                - (Self::mul_add(-x94, x287, x93 * x284)
-                    + Self::mul_add(x96, x292, x95 * x290)),
+                - (Self::mul_add(-x96, x287, x95 * x284)
+                    + Self::mul_add(x98, x292, x97 * x290)),
         );
         let x299 = s_q11 * x280;
         let x300 = c_q11 * x280;
@@ -6726,7 +6770,7 @@ impl FreeFloating7 {
         let x334 = Self::mul_add(-0.63, x322, 28.2393615);
         let x335 = 45.1584 - x322;
         let x336 = f_ext[4][5]
-            - Self::mul_add(-x74, x83, Self::mul_add(x69, x80, x70 * x81))
+            - Self::mul_add(-x77, x86, Self::mul_add(x72, x83, x73 * x84))
             + Self::mul_add(0.63, x330, Self::mul_add(-x273, x269 * x272, x271));
         let x337 = 1.0 / x334;
         let x338 = tau[3] + x336;
@@ -6771,42 +6815,42 @@ impl FreeFloating7 {
         let x359 = Self::mul_add(
             -x338,
             x339,
-            f_ext[4][3] - Self::mul_add(x74, x84, Self::mul_add(x70, x82, x79 * x80))
+            f_ext[4][3] - Self::mul_add(x77, x87, Self::mul_add(x73, x85, x82 * x83))
                 + (Self::mul_add(-s_q11, x295, c_q11 * x294)
                     + Self::mul_add(-0.63, x298, 0.275 * x331))
-                + (Self::mul_add(-x76, x345, x75 * x344)
-                    + Self::mul_add(x78, x348, x77 * x347)),
+                + (Self::mul_add(-x79, x345, x78 * x344)
+                    + Self::mul_add(x81, x348, x80 * x347)),
         );
         let x360 = Self::mul_add(
             -x338,
             x340,
             f_ext[4][4]
-                + (Self::mul_add(-x69, x82, x79 * x81)
-                    - Self::mul_add(x73, x84, x72 * x83))
+                + (Self::mul_add(-x72, x85, x82 * x84)
+                    - Self::mul_add(x76, x87, x75 * x86))
                 + Self::mul_add(-0.275, x330, Self::mul_add(c_q11, x295, s_q11 * x294))
-                - (Self::mul_add(x76, x346, x75 * x345)
-                    - Self::mul_add(x78, x351, x77 * x350)),
+                - (Self::mul_add(x79, x346, x78 * x345)
+                    - Self::mul_add(x81, x351, x80 * x350)),
         );
         let x361 = Self::mul_add(
             -x338,
             x341,
-            Self::mul_add(-x70, x84, f_ext[4][0]) + x330
-                + (Self::mul_add(x76, x350, x75 * x347)
-                    + Self::mul_add(x78, x354, x77 * x353)),
+            Self::mul_add(-x73, x87, f_ext[4][0]) + x330
+                + (Self::mul_add(x79, x350, x78 * x347)
+                    + Self::mul_add(x81, x354, x80 * x353)),
         );
         let x362 = Self::mul_add(
             x338,
             x342,
-            f_ext[4][1] - Self::mul_add(x69, x84, x79 * x83) + x331
-                + (Self::mul_add(x76, x351, x75 * x348)
-                    + Self::mul_add(x78, x356, x77 * x354)),
+            f_ext[4][1] - Self::mul_add(x72, x87, x82 * x86) + x331
+                + (Self::mul_add(x79, x351, x78 * x348)
+                    + Self::mul_add(x81, x356, x80 * x354)),
         );
         let x363 = Self::mul_add(
             -x338,
             x343,
-            Self::mul_add(x70, x83, f_ext[4][2]) + x298
-                - (Self::mul_add(x76, x352, x75 * x349)
-                    + Self::mul_add(x78, x357, x77 * x355)),
+            Self::mul_add(x73, x86, f_ext[4][2]) + x298
+                - (Self::mul_add(x79, x352, x78 * x349)
+                    + Self::mul_add(x81, x357, x80 * x355)),
         );
         let x364 = s_q10 * x345;
         let x365 = c_q10 * x345;
@@ -6851,7 +6895,7 @@ impl FreeFloating7 {
         let x392 = Self::mul_add(-0.87, x385, 69.99836825);
         let x393 = 81.53205 - x385;
         let x394 = f_ext[3][5]
-            + Self::mul_add(-x56, x66, Self::mul_add(x50, x63, x51 * x64))
+            + Self::mul_add(-x60, x70, Self::mul_add(x54, x67, x55 * x68))
             + Self::mul_add(0.87, x389, Self::mul_add(-x338, x334 * x337, x336));
         let x395 = 1.0 / x392;
         let x396 = tau[2] + x394;
@@ -6890,73 +6934,73 @@ impl FreeFloating7 {
         let x417 = Self::mul_add(
             -x396,
             x397,
-            f_ext[3][3] + Self::mul_add(x56, x67, Self::mul_add(x51, x65, x62 * x63))
+            f_ext[3][3] + Self::mul_add(x60, x71, Self::mul_add(x55, x69, x66 * x67))
                 + Self::mul_add(-0.87, x363, Self::mul_add(-s_q10, x360, c_q10 * x359))
-                - (Self::mul_add(-x59, x403, x58 * x402)
-                    + Self::mul_add(-x61, x406, x60 * x405)),
+                - (Self::mul_add(-x63, x403, x62 * x402)
+                    + Self::mul_add(-x65, x406, x64 * x405)),
         );
         let x418 = Self::mul_add(
             -x396,
             x398,
             f_ext[3][4]
-                + (Self::mul_add(-x50, x65, x62 * x64)
-                    - Self::mul_add(x55, x67, x57 * x66))
+                + (Self::mul_add(-x54, x69, x66 * x68)
+                    - Self::mul_add(x59, x71, x61 * x70))
                 + Self::mul_add(c_q10, x360, s_q10 * x359)
-                - (Self::mul_add(x59, x404, x58 * x403)
-                    + Self::mul_add(-x61, x409, x60 * x408)),
+                - (Self::mul_add(x63, x404, x62 * x403)
+                    + Self::mul_add(-x65, x409, x64 * x408)),
         );
         let x419 = Self::mul_add(-x396, x392 * x395, x394);
         let x420 = Self::mul_add(
             -x396,
             x399,
-            Self::mul_add(x51, x67, f_ext[3][0]) + x389
-                - (Self::mul_add(-x59, x408, x58 * x405)
-                    + Self::mul_add(-x61, x412, x60 * x411)),
+            Self::mul_add(x55, x71, f_ext[3][0]) + x389
+                - (Self::mul_add(-x63, x408, x62 * x405)
+                    + Self::mul_add(-x65, x412, x64 * x411)),
         );
         let x421 = Self::mul_add(
             x396,
             x400,
-            f_ext[3][1] - Self::mul_add(x50, x67, x62 * x66)
+            f_ext[3][1] - Self::mul_add(x54, x71, x66 * x70)
                 + Self::mul_add(c_q10, x362, s_q10 * x361)
-                - (Self::mul_add(-x59, x409, x58 * x406)
-                    + Self::mul_add(-x61, x414, x60 * x412)),
+                - (Self::mul_add(-x63, x409, x62 * x406)
+                    + Self::mul_add(-x65, x414, x64 * x412)),
         );
         let x422 = Self::mul_add(
             -x396,
             x401,
-            Self::mul_add(-x51, x66, f_ext[3][2]) + x363
-                + (Self::mul_add(-x59, x410, x58 * x407)
-                    + Self::mul_add(-x61, x415, x60 * x413)),
+            Self::mul_add(-x55, x70, f_ext[3][2]) + x363
+                + (Self::mul_add(-x63, x410, x62 * x407)
+                    + Self::mul_add(-x65, x415, x64 * x413)),
         );
         let x423 = c_q9 * x403;
-        let x424 = Self::mul_add(-x49, x403, x48 * x402);
+        let x424 = Self::mul_add(-x53, x403, x52 * x402);
         let x425 = s_q9 * x403;
         let x426 = Self::mul_add(c_q9, x402, -x425);
-        let x427 = Self::mul_add(x49, x404, x48 * x403);
+        let x427 = Self::mul_add(x53, x404, x52 * x403);
         let x428 = Self::mul_add(s_q9, x404, x423);
         let x429 = 0.00000000020510342851533115 * x407;
         let x430 = Self::mul_add(c_q9, x406, s_q9 * x405) - x429;
-        let x431 = x407 - Self::mul_add(-x49, x406, x48 * x405);
+        let x431 = x407 - Self::mul_add(-x53, x406, x52 * x405);
         let x432 = x429 + Self::mul_add(-s_q9, x406, c_q9 * x405);
         let x433 = 0.00000000020510342851533115 * x410;
         let x434 = Self::mul_add(c_q9, x409, s_q9 * x408) - x433;
-        let x435 = x410 - Self::mul_add(-x49, x409, x48 * x408);
+        let x435 = x410 - Self::mul_add(-x53, x409, x52 * x408);
         let x436 = x433 + Self::mul_add(-s_q9, x409, c_q9 * x408);
         let x437 = Self::mul_add(c_q9, x434, s_q9 * x430);
         let x438 = Self::mul_add(c_q9, x435, s_q9 * x431);
         let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
-        let x440 = Self::mul_add(-x49, x434, x48 * x430);
+        let x440 = Self::mul_add(-x53, x434, x52 * x430);
         let x441 = Self::mul_add(-s_q9, x434, c_q9 * x430);
         let x442 = c_q9 * x412;
         let x443 = 0.00000000020510342851533115 * x413;
-        let x444 = x413 - Self::mul_add(-x49, x412, x48 * x411);
+        let x444 = x413 - Self::mul_add(-x53, x412, x52 * x411);
         let x445 = s_q9 * x412;
         let x446 = x443 + Self::mul_add(c_q9, x411, -x445);
         let x447 = 0.00000000020510342851533115 * x415;
-        let x448 = x415 - Self::mul_add(-x49, x414, x48 * x412);
+        let x448 = x415 - Self::mul_add(-x53, x414, x52 * x412);
         let x449 = x447 + Self::mul_add(-s_q9, x414, x442);
         let x450 = 0.00000000020510342851533115 * x416;
-        let x451 = x416 - Self::mul_add(-x49, x415, x48 * x413);
+        let x451 = x416 - Self::mul_add(-x53, x415, x52 * x413);
         let x452 = x450 + Self::mul_add(-s_q9, x415, c_q9 * x413);
         let x453 = Self::mul_add(
             -0.00000000020510342851533115,
@@ -6974,28 +7018,28 @@ impl FreeFloating7 {
         );
         let x455 = 0.00000000020510342851533115 * x452;
         let x456 = Self::mul_add(c_q9, x449, s_q9 * x446) - x455;
-        let x457 = x451 - Self::mul_add(-x49, x448, x48 * x444);
-        let x458 = x452 - Self::mul_add(-x49, x449, x48 * x446);
+        let x457 = x451 - Self::mul_add(-x53, x448, x52 * x444);
+        let x458 = x452 - Self::mul_add(-x53, x449, x52 * x446);
         let x459 = x455 + Self::mul_add(-s_q9, x449, c_q9 * x446);
         let x460 = 0.4 * x454;
         let x461 = 0.275 * x456;
         let x462 = x438 + Self::mul_add(0.275, x458, 0.4 * x457);
         let x463 = x439 + Self::mul_add(0.275, x459, 0.4 * x458);
         let x464 = Self::mul_add(0.4, x453, x440);
-        let x465 = Self::mul_add(-x49, x435, x48 * x431) + x460;
-        let x466 = Self::mul_add(0.4, x456, Self::mul_add(-x49, x436, x48 * x432));
+        let x465 = Self::mul_add(-x53, x435, x52 * x431) + x460;
+        let x466 = Self::mul_add(0.4, x456, Self::mul_add(-x53, x436, x52 * x432));
         let x467 = Self::mul_add(-0.275, x453, x441);
         let x468 = Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x435, c_q9 * x431));
         let x469 = Self::mul_add(-s_q9, x436, c_q9 * x432) - x461;
         let x470 = Self::mul_add(
             0.4,
             x440,
-            Self::mul_add(0.4, x464, Self::mul_add(-x49, x427, x48 * x424)),
+            Self::mul_add(0.4, x464, Self::mul_add(-x53, x427, x52 * x424)),
         );
         let x471 = Self::mul_add(
             0.275,
             x440,
-            -Self::mul_add(0.4, x467, Self::mul_add(-x49, x428, x48 * x426)),
+            -Self::mul_add(0.4, x467, Self::mul_add(-x53, x428, x52 * x426)),
         );
         let x472 = Self::mul_add(
             0.275,
@@ -7004,7 +7048,7 @@ impl FreeFloating7 {
         );
         let x473 = 0.00000000020510342851533115 * x422;
         let x474 = Self::mul_add(c_q9, x421, s_q9 * x420) + x473;
-        let x475 = x422 + Self::mul_add(-x49, x421, x48 * x420);
+        let x475 = x422 + Self::mul_add(-x53, x421, x52 * x420);
         let x476 = x473 - Self::mul_add(-s_q9, x421, c_q9 * x420);
         let x477 = 0.00000000020510342851533115 * x419;
         let x478 = -0.002139996587640933
@@ -7019,7 +7063,7 @@ impl FreeFloating7 {
         let x481 = 12.701650001451807 - x467;
         let x482 = -0.000000008530897668050218 + x468;
         let x483 = f_ext[2][5]
-            - (Self::mul_add(-x27, x40, x28 * x39) - Self::mul_add(-x31, x43, x32 * x42))
+            - (Self::mul_add(-x32, x45, x33 * x44) - Self::mul_add(-x36, x48, x37 * x47))
             - Self::mul_add(0.275, x474, x477 - Self::mul_add(-s_q9, x418, c_q9 * x417));
         let x484 = 1.0 / x480;
         let x485 = tau[1] + x483;
@@ -7066,44 +7110,44 @@ impl FreeFloating7 {
             -x485,
             x486,
             f_ext[2][3]
-                + (Self::mul_add(-x28, x41, x38 * x40)
-                    - Self::mul_add(x32, x44, x33 * x43))
+                + (Self::mul_add(-x33, x46, x43 * x45)
+                    - Self::mul_add(x37, x49, x38 * x48))
                 + (Self::mul_add(c_q9, x418, s_q9 * x417) + x477
                     - Self::mul_add(0.275, x476, 0.4 * x475))
-                + (Self::mul_add(-x35, x492, x34 * x491)
-                    + Self::mul_add(-x37, x495, x36 * x494)),
+                + (Self::mul_add(-x40, x492, x39 * x491)
+                    + Self::mul_add(-x42, x495, x41 * x494)),
         );
         let x507 = Self::mul_add(
             -x485,
             x487,
             f_ext[2][4]
-                + (Self::mul_add(-x27, x41, x38 * x39)
-                    - Self::mul_add(x31, x44, x33 * x42))
-                + Self::mul_add(0.4, x474, x419 + Self::mul_add(-x49, x418, x48 * x417))
-                - (Self::mul_add(x35, x493, x34 * x492)
-                    - Self::mul_add(-x37, x498, x36 * x497)),
+                + (Self::mul_add(-x32, x46, x43 * x44)
+                    - Self::mul_add(x36, x49, x38 * x47))
+                + Self::mul_add(0.4, x474, x419 + Self::mul_add(-x53, x418, x52 * x417))
+                - (Self::mul_add(x40, x493, x39 * x492)
+                    - Self::mul_add(-x42, x498, x41 * x497)),
         );
         let x508 = Self::mul_add(-x485, x480 * x484, x483);
         let x509 = Self::mul_add(
             -x485,
             x488,
-            f_ext[2][0] - Self::mul_add(x28, x44, x38 * x43) + x474
-                + (Self::mul_add(x35, x497, x34 * x494)
-                    + Self::mul_add(-x37, x501, x36 * x500)),
+            f_ext[2][0] - Self::mul_add(x33, x49, x43 * x48) + x474
+                + (Self::mul_add(x40, x497, x39 * x494)
+                    + Self::mul_add(-x42, x501, x41 * x500)),
         );
         let x510 = Self::mul_add(
             -x485,
             x489,
-            f_ext[2][1] - Self::mul_add(x27, x44, x38 * x42) + x475
-                - (Self::mul_add(x35, x498, x34 * x495)
-                    + Self::mul_add(-x37, x503, x36 * x501)),
+            f_ext[2][1] - Self::mul_add(x32, x49, x43 * x47) + x475
+                - (Self::mul_add(x40, x498, x39 * x495)
+                    + Self::mul_add(-x42, x503, x41 * x501)),
         );
         let x511 = Self::mul_add(
             x485,
             x490,
-            f_ext[2][2] + Self::mul_add(-x27, x43, x28 * x42) - x476
-                - (Self::mul_add(x35, x499, x34 * x496)
-                    - Self::mul_add(-x37, x504, x36 * x502)),
+            f_ext[2][2] + Self::mul_add(-x32, x48, x33 * x47) - x476
+                - (Self::mul_add(x40, x499, x39 * x496)
+                    - Self::mul_add(-x42, x504, x41 * x502)),
         );
         let x512 = c_q8 * x492;
         let x513 = Self::mul_add(s_q8, x491, -x512);
@@ -7111,22 +7155,22 @@ impl FreeFloating7 {
         let x515 = Self::mul_add(c_q8, x491, x514);
         let x516 = Self::mul_add(c_q8, x493, x514);
         let x517 = Self::mul_add(-s_q8, x493, x512);
-        let x518 = x496 + Self::mul_add(x26, x495, x25 * x494);
+        let x518 = x496 + Self::mul_add(x31, x495, x30 * x494);
         let x519 = Self::mul_add(-c_q8, x495, s_q8 * x494);
         let x520 = Self::mul_add(
             -0.00000000020510342851533115,
             x496,
             Self::mul_add(s_q8, x495, c_q8 * x494),
         );
-        let x521 = x499 + Self::mul_add(x26, x498, x25 * x497);
+        let x521 = x499 + Self::mul_add(x31, x498, x30 * x497);
         let x522 = Self::mul_add(-c_q8, x498, s_q8 * x497);
         let x523 = Self::mul_add(
             -0.00000000020510342851533115,
             x499,
             Self::mul_add(s_q8, x498, c_q8 * x497),
         );
-        let x524 = Self::mul_add(-x26, x521, x25 * x518);
-        let x525 = Self::mul_add(-x26, x522, x25 * x519);
+        let x524 = Self::mul_add(-x31, x521, x30 * x518);
+        let x525 = Self::mul_add(-x31, x522, x30 * x519);
         let x526 = Self::mul_add(c_q8, x521, s_q8 * x518);
         let x527 = Self::mul_add(-s_q8, x521, c_q8 * x518);
         let x528 = Self::mul_add(-s_q8, x522, c_q8 * x519);
@@ -7150,15 +7194,15 @@ impl FreeFloating7 {
             x505,
             Self::mul_add(s_q8, x504, c_q8 * x502),
         );
-        let x537 = x505 - Self::mul_add(x26, x504, x25 * x502)
+        let x537 = x505 - Self::mul_add(x31, x504, x30 * x502)
             - Self::mul_add(
-                x26,
-                x504 - Self::mul_add(x26, x503, x25 * x501),
-                x25 * (x502 - Self::mul_add(x26, x501, x25 * x500)),
+                x31,
+                x504 - Self::mul_add(x31, x503, x30 * x501),
+                x30 * (x502 - Self::mul_add(x31, x501, x30 * x500)),
             );
         let x538 = Self::mul_add(-c_q8, x504, s_q8 * x502)
-            - Self::mul_add(x26, x534, x25 * x531);
-        let x539 = x536 - Self::mul_add(x26, x535, x25 * x533);
+            - Self::mul_add(x31, x534, x30 * x531);
+        let x539 = x536 - Self::mul_add(x31, x535, x30 * x533);
         let x540 = Self::mul_add(-c_q8, x534, s_q8 * x531);
         let x541 = Self::mul_add(-c_q8, x535, s_q8 * x533);
         let x542 = 0.35 * x538;
@@ -7169,31 +7213,31 @@ impl FreeFloating7 {
             0.35,
             x543,
             Self::mul_add(
-                x26,
-                Self::mul_add(-x26, x493, x25 * x492),
-                x25 * Self::mul_add(x26, x492, x25 * x491),
+                x31,
+                Self::mul_add(-x31, x493, x30 * x492),
+                x30 * Self::mul_add(x31, x492, x30 * x491),
             ),
         );
         let x547 = Self::mul_add(
             0.35,
             x524,
-            -Self::mul_add(0.35, x545, Self::mul_add(x26, x516, x25 * x513)),
+            -Self::mul_add(0.35, x545, Self::mul_add(x31, x516, x30 * x513)),
         );
         let x548 = Self::mul_add(
             0.35,
             x526,
             -Self::mul_add(-0.35, x544, Self::mul_add(-c_q8, x516, s_q8 * x513)),
         );
-        let x549 = x511 - Self::mul_add(-x26, x510, x25 * x509);
+        let x549 = x511 - Self::mul_add(-x31, x510, x30 * x509);
         let x550 = Self::mul_add(c_q8, x510, s_q8 * x509);
         let x551 = -16.80768997608804
-            - Self::mul_add(0.35, x528, Self::mul_add(x26, x517, x25 * x515));
+            - Self::mul_add(0.35, x528, Self::mul_add(x31, x517, x30 * x515));
         let x552 = 0.1132
             + Self::mul_add(-0.35, x527, Self::mul_add(-c_q8, x517, s_q8 * x515));
         let x553 = 132.47349025763282 - Self::mul_add(s_q8, x517, c_q8 * x515);
         let x554 = 48.0240000085309 + x528;
         let x555 = f_ext[1][5]
-            - Self::mul_add(x12, x22, Self::mul_add(-x7, x20, x8 * x19))
+            - Self::mul_add(x18, x28, Self::mul_add(-x13, x26, x14 * x25))
             - Self::mul_add(
                 0.00000000020510342851533115,
                 x508,
@@ -7214,7 +7258,7 @@ impl FreeFloating7 {
         let x568 = Self::mul_add(
             -x551,
             x562,
-            Self::mul_add(0.35, x541, Self::mul_add(-x26, x523, x25 * x520)),
+            Self::mul_add(0.35, x541, Self::mul_add(-x31, x523, x30 * x520)),
         );
         let x569 = Self::mul_add(x552, x560, x544);
         let x570 = Self::mul_add(x552, x561, x545);
@@ -7242,49 +7286,49 @@ impl FreeFloating7 {
             -x557,
             x558,
             f_ext[1][3]
-                - (Self::mul_add(x8, x21, x18 * x20)
-                    - Self::mul_add(x13, x23, x11 * x22))
+                - (Self::mul_add(x14, x27, x24 * x26)
+                    - Self::mul_add(x19, x29, x17 * x28))
                 + Self::mul_add(
                     -0.35,
                     x550,
-                    x508 - Self::mul_add(-x26, x507, x25 * x506),
+                    x508 - Self::mul_add(-x31, x507, x30 * x506),
                 )
-                - (Self::mul_add(-x15, x564, x14 * x563)
-                    + Self::mul_add(-x17, x567, x16 * x566)),
+                - (Self::mul_add(-x21, x564, x20 * x563)
+                    + Self::mul_add(-x23, x567, x22 * x566)),
         );
         let x579 = Self::mul_add(
             -x557,
             x559,
-            f_ext[1][4] - Self::mul_add(-x12, x23, Self::mul_add(x7, x21, x18 * x19))
+            f_ext[1][4] - Self::mul_add(-x18, x29, Self::mul_add(x13, x27, x24 * x25))
                 + Self::mul_add(0.35, x549, Self::mul_add(c_q8, x507, s_q8 * x506))
-                + (Self::mul_add(x15, x565, x14 * x564)
-                    + Self::mul_add(-x17, x570, x16 * x569)),
+                + (Self::mul_add(x21, x565, x20 * x564)
+                    + Self::mul_add(-x23, x570, x22 * x569)),
         );
         let x580 = Self::mul_add(
             x557,
             x560,
-            f_ext[1][0] + Self::mul_add(x8, x23, x18 * x22) + x549
-                - (Self::mul_add(-x15, x569, x14 * x566)
-                    + Self::mul_add(x17, x573, x16 * x572)),
+            f_ext[1][0] + Self::mul_add(x14, x29, x24 * x28) + x549
+                - (Self::mul_add(-x21, x569, x20 * x566)
+                    + Self::mul_add(x23, x573, x22 * x572)),
         );
         let x581 = Self::mul_add(
             -x557,
             x561,
-            Self::mul_add(x7, x23, f_ext[1][1]) + x550
-                + (Self::mul_add(-x15, x570, x14 * x567)
-                    - Self::mul_add(x17, x575, x16 * x573)),
+            Self::mul_add(x13, x29, f_ext[1][1]) + x550
+                + (Self::mul_add(-x21, x570, x20 * x567)
+                    - Self::mul_add(x23, x575, x22 * x573)),
         );
         let x582 = Self::mul_add(
             x557,
             x562,
-            Self::mul_add(-x7, x22, f_ext[1][2])
+            Self::mul_add(-x13, x28, f_ext[1][2])
                 - Self::mul_add(
                     0.00000000020510342851533115,
                     x511,
                     Self::mul_add(-s_q8, x510, c_q8 * x509),
                 )
-                - (Self::mul_add(-x15, x571, x14 * x568)
-                    - Self::mul_add(x17, x576, x16 * x574)),
+                - (Self::mul_add(-x21, x571, x20 * x568)
+                    - Self::mul_add(x23, x576, x22 * x574)),
         );
         let x583 = s_q7 * x564;
         let x584 = c_q7 * x564;
@@ -7334,7 +7378,7 @@ impl FreeFloating7 {
         let x616 = Self::mul_add(-s_q7, x581, c_q7 * x580);
         let x617 = Self::mul_add(c_q7, x581, s_q7 * x580);
         let x618 = 180.9502499901501 - x612;
-        let x619 = f_ext[0][0] + Self::mul_add(-v[4], x5, v[5] * x4) + x616;
+        let x619 = f_ext[0][0] + Self::mul_add(-v[4], x12, v[5] * x11) + x616;
         let x620 = 1.0 / (1170.07 - x603);
         let x621 = x604 * x620;
         let x622 = x601 * x620;
@@ -7433,7 +7477,7 @@ impl FreeFloating7 {
         let x658 = Self::mul_add(
             x619,
             x621,
-            f_ext[0][1] - Self::mul_add(-v[3], x5, v[5] * x3) + x617,
+            f_ext[0][1] - Self::mul_add(-v[3], x12, v[5] * x10) + x617,
         );
         let x659 = Self::mul_add(
             -x628,
@@ -7441,15 +7485,15 @@ impl FreeFloating7 {
             Self::mul_add(
                 -x619,
                 x622,
-                f_ext[0][2] + Self::mul_add(-v[3], x4, v[4] * x3) + x582,
+                f_ext[0][2] + Self::mul_add(-v[3], x11, v[4] * x10) + x582,
             ),
         );
         let x660 = Self::mul_add(
             x619,
             x623,
             f_ext[0][3]
-                + (Self::mul_add(v[4], x2, v[5] * x1)
-                    + Self::mul_add(-v[1], x5, v[2] * x4))
+                + (Self::mul_add(v[4], x9, v[5] * x8)
+                    + Self::mul_add(-v[1], x12, v[2] * x11))
                 + Self::mul_add(-0.75, x617, Self::mul_add(-s_q7, x579, c_q7 * x578)),
         );
         let x661 = Self::mul_add(x637, x659, Self::mul_add(-x630, x658, x660));
@@ -7460,8 +7504,8 @@ impl FreeFloating7 {
                 -x619,
                 x624,
                 f_ext[0][4]
-                    - (Self::mul_add(v[3], x2, v[5] * x0)
-                        + Self::mul_add(-v[0], x5, v[2] * x3))
+                    - (Self::mul_add(v[3], x9, v[5] * x7)
+                        + Self::mul_add(-v[0], x12, v[2] * x10))
                     + (Self::mul_add(c_q7, x579, s_q7 * x578)
                         + Self::mul_add(-0.65, x582, 0.75 * x616)),
             ),
@@ -7471,8 +7515,8 @@ impl FreeFloating7 {
             x619,
             x625,
             f_ext[0][5]
-                + (Self::mul_add(-v[3], x1, v[4] * x0)
-                    + Self::mul_add(-v[0], x4, v[1] * x3))
+                + (Self::mul_add(-v[3], x8, v[4] * x7)
+                    + Self::mul_add(-v[0], x11, v[1] * x10))
                 + Self::mul_add(0.65, x617, Self::mul_add(-x557, x553 * x556, x555)),
         );
         let x665 = Self::mul_add(
@@ -7503,10 +7547,10 @@ impl FreeFloating7 {
         let x674 = Self::mul_add(0.75, x667, x673);
         let x675 = x671 - Self::mul_add(-0.65, x666, 0.75 * x668);
         let x676 = Self::mul_add(-0.65, x667, x669);
-        let x677 = x14 - Self::mul_add(s_q7, x667, c_q7 * x668);
-        let x678 = x15 + Self::mul_add(-c_q7, x667, s_q7 * x668);
-        let x679 = x16 - Self::mul_add(s_q7, x675, c_q7 * x674);
-        let x680 = x17 + Self::mul_add(-c_q7, x675, s_q7 * x674);
+        let x677 = x20 - Self::mul_add(s_q7, x667, c_q7 * x668);
+        let x678 = x21 + Self::mul_add(-c_q7, x667, s_q7 * x668);
+        let x679 = x22 - Self::mul_add(s_q7, x675, c_q7 * x674);
+        let x680 = x23 + Self::mul_add(-c_q7, x675, s_q7 * x674);
         let x681 = x556
             * (x557
                 + (Self::mul_add(-x553, x666, Self::mul_add(x552, x678, x551 * x677))
@@ -7520,14 +7564,14 @@ impl FreeFloating7 {
         let x684 = Self::mul_add(0.35, x678, x679);
         let x685 = Self::mul_add(-0.35, x677, x680);
         let x686 = Self::mul_add(0.00000000020510342851533115, x676, x684);
-        let x687 = x34
-            + Self::mul_add(-c_q8, x682, Self::mul_add(-s_q8, x678, x25 * x677));
-        let x688 = x35
-            - Self::mul_add(-s_q8, x682, Self::mul_add(c_q8, x678, x26 * x677));
-        let x689 = x36
-            + Self::mul_add(-c_q8, x676, Self::mul_add(-s_q8, x685, x25 * x684));
-        let x690 = x37
-            - Self::mul_add(-s_q8, x676, Self::mul_add(c_q8, x685, x26 * x684));
+        let x687 = x39
+            + Self::mul_add(-c_q8, x682, Self::mul_add(-s_q8, x678, x30 * x677));
+        let x688 = x40
+            - Self::mul_add(-s_q8, x682, Self::mul_add(c_q8, x678, x31 * x677));
+        let x689 = x41
+            + Self::mul_add(-c_q8, x676, Self::mul_add(-s_q8, x685, x30 * x684));
+        let x690 = x42
+            - Self::mul_add(-s_q8, x676, Self::mul_add(c_q8, x685, x31 * x684));
         let x691 = x484
             * (x485
                 - (Self::mul_add(-x480, x683, Self::mul_add(x479, x688, x478 * x687))
@@ -7550,14 +7594,14 @@ impl FreeFloating7 {
             x696,
             Self::mul_add(0.00000000020510342851533115, x694, x695),
         );
-        let x698 = x58
-            - Self::mul_add(-c_q9, x692, Self::mul_add(x48, x688, s_q9 * x687));
-        let x699 = x59
-            + Self::mul_add(s_q9, x692, Self::mul_add(-x49, x688, c_q9 * x687));
-        let x700 = x60
-            - Self::mul_add(-c_q9, x696, Self::mul_add(x48, x695, s_q9 * x694));
-        let x701 = x61
-            + Self::mul_add(s_q9, x696, Self::mul_add(-x49, x695, c_q9 * x694));
+        let x698 = x62
+            - Self::mul_add(-c_q9, x692, Self::mul_add(x52, x688, s_q9 * x687));
+        let x699 = x63
+            + Self::mul_add(s_q9, x692, Self::mul_add(-x53, x688, c_q9 * x687));
+        let x700 = x64
+            - Self::mul_add(-c_q9, x696, Self::mul_add(x52, x695, s_q9 * x694));
+        let x701 = x65
+            + Self::mul_add(s_q9, x696, Self::mul_add(-x53, x695, c_q9 * x694));
         let x702 = x395
             * (x396
                 + (Self::mul_add(-x392, x693, Self::mul_add(-x391, x699, x390 * x698))
@@ -7569,10 +7613,10 @@ impl FreeFloating7 {
         let x703 = x693 + x702;
         let x704 = Self::mul_add(-0.87, x703, x700);
         let x705 = Self::mul_add(0.87, x698, x697);
-        let x706 = x75 - Self::mul_add(-s_q10, x699, c_q10 * x698);
-        let x707 = x76 + Self::mul_add(c_q10, x699, s_q10 * x698);
-        let x708 = x77 - Self::mul_add(-s_q10, x701, c_q10 * x704);
-        let x709 = x78 + Self::mul_add(c_q10, x701, s_q10 * x704);
+        let x706 = x78 - Self::mul_add(-s_q10, x699, c_q10 * x698);
+        let x707 = x79 + Self::mul_add(c_q10, x699, s_q10 * x698);
+        let x708 = x80 - Self::mul_add(-s_q10, x701, c_q10 * x704);
+        let x709 = x81 + Self::mul_add(c_q10, x701, s_q10 * x704);
         let x710 = x337
             * (x338
                 - (Self::mul_add(x334, x703, Self::mul_add(x333, x707, x332 * x706))
@@ -7585,10 +7629,10 @@ impl FreeFloating7 {
         let x712 = x708 - Self::mul_add(-0.63, x711, 0.275 * x707);
         let x713 = Self::mul_add(0.275, x706, x709);
         let x714 = Self::mul_add(-0.63, x706, x705);
-        let x715 = x93 + Self::mul_add(s_q11, x707, c_q11 * x706);
-        let x716 = x94 - Self::mul_add(-c_q11, x707, s_q11 * x706);
-        let x717 = x95 + Self::mul_add(s_q11, x713, c_q11 * x712);
-        let x718 = x96 - Self::mul_add(-c_q11, x713, s_q11 * x712);
+        let x715 = x95 + Self::mul_add(s_q11, x707, c_q11 * x706);
+        let x716 = x96 - Self::mul_add(-c_q11, x707, s_q11 * x706);
+        let x717 = x97 + Self::mul_add(s_q11, x713, c_q11 * x712);
+        let x718 = x98 - Self::mul_add(-c_q11, x713, s_q11 * x712);
         let x719 = x272
             * (x273
                 - (Self::mul_add(x269, x711, Self::mul_add(x268, x716, x267 * x715))
@@ -7602,14 +7646,14 @@ impl FreeFloating7 {
         let x722 = Self::mul_add(-0.36, x716, x717);
         let x723 = Self::mul_add(0.36, x715, x718);
         let x724 = Self::mul_add(-0.00000000020510342851533115, x714, x723);
-        let x725 = x113
-            + Self::mul_add(-s_q12, x720, Self::mul_add(-x104, x716, c_q12 * x715));
-        let x726 = x114
-            - Self::mul_add(c_q12, x720, Self::mul_add(x105, x716, s_q12 * x715));
-        let x727 = x115
-            + Self::mul_add(-s_q12, x714, Self::mul_add(-x104, x723, c_q12 * x722));
-        let x728 = x116
-            - Self::mul_add(c_q12, x714, Self::mul_add(x105, x723, s_q12 * x722));
+        let x725 = x114
+            + Self::mul_add(-s_q12, x720, Self::mul_add(-x105, x716, c_q12 * x715));
+        let x726 = x115
+            - Self::mul_add(c_q12, x720, Self::mul_add(x106, x716, s_q12 * x715));
+        let x727 = x116
+            + Self::mul_add(-s_q12, x714, Self::mul_add(-x105, x723, c_q12 * x722));
+        let x728 = x117
+            - Self::mul_add(c_q12, x714, Self::mul_add(x106, x723, s_q12 * x722));
         let x729 = x200
             * (x201
                 - (Self::mul_add(x196, x721, Self::mul_add(x195, x726, x194 * x725))
@@ -7656,167 +7700,170 @@ impl FreeFloating7 {
     /// : 350 mul, 283 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 215 fused where the target has FMA.
     #[must_use]
     pub fn momentum(q: &[f64; 14], v: &[f64; 13]) -> [f64; 6] {
-        let x0 = q[6] * 2.0;
-        let x1 = q[5] * x0;
-        let x2 = q[4] * x0;
-        let x3 = q[3] * x0;
-        let x4 = q[5] * q[5];
-        let x5 = q[4] * q[4];
-        let x6 = q[3] * q[3];
-        let x7 = 2.0 * (q[3] * q[4]);
-        let x8 = 2.0 * (q[3] * q[5]);
-        let x9 = 2.0 * (q[4] * q[5]);
-        let x10 = Self::mul_add(-2.0, x4 + x5, 1.0);
-        let x11 = x1 - x7;
-        let x12 = x2 + x8;
-        let x13 = x1 + x7;
-        let x14 = Self::mul_add(-2.0, x4 + x6, 1.0);
-        let x15 = x3 - x9;
-        let x16 = x2 - x8;
-        let x17 = x3 + x9;
-        let x18 = Self::mul_add(-2.0, x5 + x6, 1.0);
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let x20 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x21 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x22 = Self::mul_add(0.75, v[4], v[0]);
-        let x23 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x24 = Self::mul_add(-0.65, v[4], v[2]);
-        let x25 = Self::mul_add(-c_q7, x23, s_q7 * x22);
-        let x26 = v[5] + v[6];
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x28 = 0.00000000020510342851533115 * c_q8;
-        let x29 = 0.00000000020510342851533115 * s_q8;
-        let x30 = Self::mul_add(x26, c_q8, Self::mul_add(x21, s_q8, x20 * x28));
-        let x31 = Self::mul_add(x26, s_q8, Self::mul_add(-x21, c_q8, x20 * x29));
-        let x32 = Self::mul_add(-0.35, x21, Self::mul_add(s_q7, x23, c_q7 * x22));
-        let x33 = Self::mul_add(0.35, x20, x25);
-        let x34 = Self::mul_add(x24, c_q8, Self::mul_add(s_q8, x33, x28 * x32));
-        let x35 = Self::mul_add(x24, s_q8, Self::mul_add(-c_q8, x33, x29 * x32));
-        let x36 = Self::mul_add(-0.00000000020510342851533115, x24, x32);
-        let x37 = v[7] + Self::mul_add(-0.00000000020510342851533115, x26, x20);
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x39 = 0.00000000020510342851533115 * c_q9;
-        let x40 = 0.00000000020510342851533115 * s_q9;
-        let x41 = x39 - x40;
-        let x42 = x39 + x40;
-        let x43 = Self::mul_add(-x37, c_q9, Self::mul_add(-x31, x41, x30 * s_q9));
-        let x44 = Self::mul_add(x37, s_q9, Self::mul_add(x31, x42, x30 * c_q9));
-        let x45 = x34 - Self::mul_add(-0.275, x37, 0.4 * x31);
-        let x46 = Self::mul_add(0.4, x30, x35);
-        let x47 = Self::mul_add(-0.275, x30, x36);
-        let x48 = Self::mul_add(-c_q9, x47, Self::mul_add(-x41, x46, s_q9 * x45));
-        let x49 = Self::mul_add(s_q9, x47, Self::mul_add(x42, x46, c_q9 * x45));
-        let x50 = Self::mul_add(
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = q[6] * 2.0;
+        let x8 = q[5] * x7;
+        let x9 = q[4] * x7;
+        let x10 = q[3] * x7;
+        let x11 = q[5] * q[5];
+        let x12 = q[4] * q[4];
+        let x13 = q[3] * q[3];
+        let x14 = 2.0 * (q[3] * q[4]);
+        let x15 = 2.0 * (q[3] * q[5]);
+        let x16 = 2.0 * (q[4] * q[5]);
+        let x17 = Self::mul_add(-2.0, x11 + x12, 1.0);
+        let x18 = x8 - x14;
+        let x19 = x9 + x15;
+        let x20 = x8 + x14;
+        let x21 = Self::mul_add(-2.0, x11 + x13, 1.0);
+        let x22 = x10 - x16;
+        let x23 = x9 - x15;
+        let x24 = x10 + x16;
+        let x25 = Self::mul_add(-2.0, x12 + x13, 1.0);
+        let x26 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x27 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x28 = Self::mul_add(0.75, v[4], v[0]);
+        let x29 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
+        let x30 = Self::mul_add(-0.65, v[4], v[2]);
+        let x31 = Self::mul_add(-c_q7, x29, s_q7 * x28);
+        let x32 = v[5] + v[6];
+        let x33 = 0.00000000020510342851533115 * c_q8;
+        let x34 = 0.00000000020510342851533115 * s_q8;
+        let x35 = Self::mul_add(x32, c_q8, Self::mul_add(x27, s_q8, x26 * x33));
+        let x36 = Self::mul_add(x32, s_q8, Self::mul_add(-x27, c_q8, x26 * x34));
+        let x37 = Self::mul_add(-0.35, x27, Self::mul_add(s_q7, x29, c_q7 * x28));
+        let x38 = Self::mul_add(0.35, x26, x31);
+        let x39 = Self::mul_add(x30, c_q8, Self::mul_add(s_q8, x38, x33 * x37));
+        let x40 = Self::mul_add(x30, s_q8, Self::mul_add(-c_q8, x38, x34 * x37));
+        let x41 = Self::mul_add(-0.00000000020510342851533115, x30, x37);
+        let x42 = v[7] + Self::mul_add(-0.00000000020510342851533115, x32, x26);
+        let x43 = 0.00000000020510342851533115 * c_q9;
+        let x44 = 0.00000000020510342851533115 * s_q9;
+        let x45 = x43 - x44;
+        let x46 = x43 + x44;
+        let x47 = Self::mul_add(-x42, c_q9, Self::mul_add(-x36, x45, x35 * s_q9));
+        let x48 = Self::mul_add(x42, s_q9, Self::mul_add(x36, x46, x35 * c_q9));
+        let x49 = x39 - Self::mul_add(-0.275, x42, 0.4 * x36);
+        let x50 = Self::mul_add(0.4, x35, x40);
+        let x51 = Self::mul_add(-0.275, x35, x41);
+        let x52 = Self::mul_add(-c_q9, x51, Self::mul_add(-x45, x50, s_q9 * x49));
+        let x53 = Self::mul_add(s_q9, x51, Self::mul_add(x46, x50, c_q9 * x49));
+        let x54 = Self::mul_add(
             -0.00000000020510342851533115,
-            x47,
-            Self::mul_add(-0.00000000020510342851533115, x45, x46),
+            x51,
+            Self::mul_add(-0.00000000020510342851533115, x49, x50),
         );
-        let x51 = v[8]
+        let x55 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x37,
-                Self::mul_add(-0.00000000020510342851533115, x30, x31),
+                x42,
+                Self::mul_add(-0.00000000020510342851533115, x35, x36),
             );
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let x53 = Self::mul_add(x44, s_q10, x43 * c_q10);
-        let x54 = Self::mul_add(-x44, c_q10, x43 * s_q10);
-        let x55 = Self::mul_add(x51, -0.87, x48);
-        let x56 = Self::mul_add(x43, 0.87, x50);
-        let x57 = Self::mul_add(x49, s_q10, c_q10 * x55);
-        let x58 = v[9] + x51;
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let x60 = Self::mul_add(-x54, s_q11, x53 * c_q11);
-        let x61 = Self::mul_add(x54, c_q11, x53 * s_q11);
-        let x62 = x57 + Self::mul_add(x58, -0.63, 0.275 * x54);
-        let x63 = Self::mul_add(-0.275, x53, Self::mul_add(-x49, c_q10, s_q10 * x55));
-        let x64 = Self::mul_add(x53, 0.63, x56);
-        let x65 = Self::mul_add(-s_q11, x63, c_q11 * x62);
-        let x66 = v[10] + x58;
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x68 = 0.00000000020510342851533115 * s_q12;
-        let x69 = 0.00000000020510342851533115 * c_q12;
-        let x70 = Self::mul_add(x66, s_q12, Self::mul_add(x61, x68, x60 * c_q12));
-        let x71 = Self::mul_add(-x66, c_q12, Self::mul_add(-x61, x69, x60 * s_q12));
-        let x72 = Self::mul_add(x61, 0.36, x65);
-        let x73 = Self::mul_add(x60, -0.36, Self::mul_add(c_q11, x63, s_q11 * x62));
-        let x74 = Self::mul_add(x64, s_q12, Self::mul_add(x68, x73, c_q12 * x72));
-        let x75 = Self::mul_add(-x64, c_q12, Self::mul_add(-x69, x73, s_q12 * x72));
-        let x76 = Self::mul_add(-0.00000000020510342851533115, x64, x73);
-        let x77 = v[11] + Self::mul_add(-0.00000000020510342851533115, x66, x61);
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+        let x56 = Self::mul_add(x48, s_q10, x47 * c_q10);
+        let x57 = Self::mul_add(-x48, c_q10, x47 * s_q10);
+        let x58 = Self::mul_add(x55, -0.87, x52);
+        let x59 = Self::mul_add(x47, 0.87, x54);
+        let x60 = Self::mul_add(x53, s_q10, c_q10 * x58);
+        let x61 = v[9] + x55;
+        let x62 = Self::mul_add(-x57, s_q11, x56 * c_q11);
+        let x63 = Self::mul_add(x57, c_q11, x56 * s_q11);
+        let x64 = x60 + Self::mul_add(x61, -0.63, 0.275 * x57);
+        let x65 = Self::mul_add(-0.275, x56, Self::mul_add(-x53, c_q10, s_q10 * x58));
+        let x66 = Self::mul_add(x56, 0.63, x59);
+        let x67 = Self::mul_add(-s_q11, x65, c_q11 * x64);
+        let x68 = v[10] + x61;
+        let x69 = 0.00000000020510342851533115 * s_q12;
+        let x70 = 0.00000000020510342851533115 * c_q12;
+        let x71 = Self::mul_add(x68, s_q12, Self::mul_add(x63, x69, x62 * c_q12));
+        let x72 = Self::mul_add(-x68, c_q12, Self::mul_add(-x63, x70, x62 * s_q12));
+        let x73 = Self::mul_add(x63, 0.36, x67);
+        let x74 = Self::mul_add(x62, -0.36, Self::mul_add(c_q11, x65, s_q11 * x64));
+        let x75 = Self::mul_add(x66, s_q12, Self::mul_add(x69, x74, c_q12 * x73));
+        let x76 = Self::mul_add(-x66, c_q12, Self::mul_add(-x70, x74, s_q12 * x73));
+        let x77 = Self::mul_add(-0.00000000020510342851533115, x66, x74);
+        let x78 = v[11] + Self::mul_add(-0.00000000020510342851533115, x68, x63);
         let x79 = 0.00000000020510342851533115 * c_q13;
         let x80 = 0.00000000020510342851533115 * s_q13;
-        let x81 = Self::mul_add(-x77, c_q13, Self::mul_add(x71, s_q13, x70 * x79));
-        let x82 = Self::mul_add(-x77, s_q13, Self::mul_add(-x71, c_q13, x70 * x80));
-        let x83 = x74 - Self::mul_add(-0.55, x77, 0.16 * x71);
-        let x84 = Self::mul_add(-0.55, x70, x76);
+        let x81 = Self::mul_add(-x78, c_q13, Self::mul_add(x72, s_q13, x71 * x79));
+        let x82 = Self::mul_add(-x78, s_q13, Self::mul_add(-x72, c_q13, x71 * x80));
+        let x83 = x75 - Self::mul_add(-0.55, x78, 0.16 * x72);
+        let x84 = Self::mul_add(-0.55, x71, x77);
         let x85 = Self::mul_add(
             -c_q13,
             x84,
-            Self::mul_add(s_q13, Self::mul_add(0.16, x70, x75), x79 * x83),
+            Self::mul_add(s_q13, Self::mul_add(0.16, x71, x76), x79 * x83),
         );
-        let x86 = v[12] - Self::mul_add(0.00000000020510342851533115, x77, x70);
+        let x86 = v[12] - Self::mul_add(0.00000000020510342851533115, x78, x71);
         let x87 = Self::mul_add(
             48.0240000085309,
-            x24,
+            x30,
             Self::mul_add(
                 -0.1132,
-                x26,
-                Self::mul_add(130.43769025763282, x21, x20 * 0.07309),
+                x32,
+                Self::mul_add(130.43769025763282, x27, x26 * 0.07309),
             ),
         );
         let x88 = Self::mul_add(
             48.0240000085309,
-            x25,
+            x31,
             Self::mul_add(
                 -132.47349025763282,
-                x26,
-                Self::mul_add(0.1132, x21, x20 * 16.80768997608804),
+                x32,
+                Self::mul_add(0.1132, x27, x26 * 16.80768997608804),
             ),
         );
         let x89 = Self::mul_add(
-            x36,
+            x41,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x37,
-                Self::mul_add(x31, -111.7548902508081, x30 * 0.0000000234896432582596),
+                x42,
+                Self::mul_add(x36, -111.7548902508081, x35 * 0.0000000234896432582596),
             ),
         );
         let x90 = Self::mul_add(
-            x48,
+            x52,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x51,
-                Self::mul_add(x44, 36.18604050126307, x43 * 0.00214),
+                x55,
+                Self::mul_add(x48, 36.18604050126307, x47 * 0.00214),
             ),
         );
         let x91 = Self::mul_add(
-            x57,
+            x60,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x58,
-                Self::mul_add(x54, -24.351642000914637, x53 * 0.6328),
+                x61,
+                Self::mul_add(x57, -24.351642000914637, x56 * 0.6328),
             ),
         );
         let x92 = Self::mul_add(
             -7.078399999258757,
-            x65,
+            x67,
             Self::mul_add(
                 -9.223235249762805,
-                x66,
-                Self::mul_add(-2.5482240016099564, x61, 0.01675 * x60),
+                x68,
+                Self::mul_add(-2.5482240016099564, x63, 0.01675 * x62),
             ),
         );
         let x93 = Self::mul_add(
             -3.6140000000000003,
-            x76,
+            x77,
             Self::mul_add(
-                x77,
+                x78,
                 -2.741639999592316,
-                Self::mul_add(x71, -5.252920330000002, x70 * 1.9877000000000002),
+                Self::mul_add(x72, -5.252920330000002, x71 * 1.9877000000000002),
             ),
         );
         let x94 = Self::mul_add(
@@ -7854,8 +7901,8 @@ impl FreeFloating7 {
         );
         let x103 = Self::mul_add(
             -17.135250000000003,
-            x76,
-            Self::mul_add(x77, 0.809539999555672, x71 * 1.9877000000000002),
+            x77,
+            Self::mul_add(x78, 0.809539999555672, x72 * 1.9877000000000002),
         )
             + (x96 - Self::mul_add(x80, x94, x79 * x95)
                 - Self::mul_add(0.55, x101, 0.16 * x100));
@@ -7863,23 +7910,23 @@ impl FreeFloating7 {
             - Self::mul_add(-0.16, x99, Self::mul_add(-c_q13, x94, s_q13 * x95));
         let x105 = Self::mul_add(
             9.740442170000001,
-            x77,
-            Self::mul_add(x71, -2.7416399995923166, x70 * 0.809539999555672),
-        ) + Self::mul_add(3.6140000000000003, x75, 17.135250000000003 * x74) + x102;
-        let x106 = Self::mul_add(17.135250000000003, x77, -x99);
-        let x107 = Self::mul_add(3.6140000000000003, x77, -x100);
-        let x108 = Self::mul_add(3.6140000000000003, x71, 17.135250000000003 * x70)
+            x78,
+            Self::mul_add(x72, -2.7416399995923166, x71 * 0.809539999555672),
+        ) + Self::mul_add(3.6140000000000003, x76, 17.135250000000003 * x75) + x102;
+        let x106 = Self::mul_add(17.135250000000003, x78, -x99);
+        let x107 = Self::mul_add(3.6140000000000003, x78, -x100);
+        let x108 = Self::mul_add(3.6140000000000003, x72, 17.135250000000003 * x71)
             - x101;
         let x109 = Self::mul_add(s_q12, x107, c_q12 * x106);
-        let x110 = x108 - Self::mul_add(-x69, x107, x68 * x106);
-        let x111 = Self::mul_add(7.078399999258757, x64, 0.01675 * x66)
+        let x110 = x108 - Self::mul_add(-x70, x107, x69 * x106);
+        let x111 = Self::mul_add(7.078399999258757, x66, 0.01675 * x68)
             - Self::mul_add(0.36, x110, Self::mul_add(s_q12, x104, c_q12 * x103));
-        let x112 = Self::mul_add(-2.5482240016099564, x66, x61 * 9.142025249762803)
-            - Self::mul_add(0.36, x109, x105 + Self::mul_add(-x69, x104, x68 * x103));
-        let x113 = Self::mul_add(7.078399999258757, x66, x109);
+        let x112 = Self::mul_add(-2.5482240016099564, x68, x63 * 9.142025249762803)
+            - Self::mul_add(0.36, x109, x105 + Self::mul_add(-x70, x104, x69 * x103));
+        let x113 = Self::mul_add(7.078399999258757, x68, x109);
         let x114 = Self::mul_add(
             7.078399999258757,
-            x60,
+            x62,
             -Self::mul_add(
                 0.00000000020510342851533115,
                 x108,
@@ -7898,59 +7945,59 @@ impl FreeFloating7 {
                     Self::mul_add(-c_q12, x104, s_q12 * x103),
                 ),
         );
-        let x118 = Self::mul_add(x56, 45.1584, x58 * 0.6328)
+        let x118 = Self::mul_add(x59, 45.1584, x61 * 0.6328)
             - (Self::mul_add(s_q11, x112, c_q11 * x111)
                 - Self::mul_add(-0.63, x114, 0.275 * x116));
-        let x119 = Self::mul_add(x58, 24.35164200091464, x54 * 24.4950615)
+        let x119 = Self::mul_add(x61, 24.35164200091464, x57 * 24.4950615)
             - Self::mul_add(0.275, x115, Self::mul_add(-c_q11, x112, s_q11 * x111));
-        let x120 = Self::mul_add(x58, 45.1584, -x115);
-        let x121 = Self::mul_add(x53, 45.1584, -x114);
+        let x120 = Self::mul_add(x61, 45.1584, -x115);
+        let x121 = Self::mul_add(x56, 45.1584, -x114);
         let x122 = Self::mul_add(s_q10, x116, c_q10 * x120);
         let x123 = Self::mul_add(-c_q10, x116, s_q10 * x120);
-        let x124 = Self::mul_add(x50, 81.53205, x51 * 0.00214)
+        let x124 = Self::mul_add(x54, 81.53205, x55 * 0.00214)
             + Self::mul_add(0.87, x121, Self::mul_add(-s_q10, x119, c_q10 * x118));
-        let x125 = Self::mul_add(x51, -36.18604050126307, x44 * 63.36336825000001)
+        let x125 = Self::mul_add(x55, -36.18604050126307, x48 * 63.36336825000001)
             - Self::mul_add(c_q10, x119, s_q10 * x118);
         let x126 = x90 + Self::mul_add(0.87, x122, x91 - x117);
-        let x127 = Self::mul_add(x51, 81.53205, x122);
-        let x128 = Self::mul_add(x43, 81.53205, x121);
+        let x127 = Self::mul_add(x55, 81.53205, x122);
+        let x128 = Self::mul_add(x47, 81.53205, x121);
         let x129 = 0.00000000020510342851533115 * x128;
         let x130 = Self::mul_add(c_q9, x123, s_q9 * x127) + x129;
-        let x131 = x128 + Self::mul_add(-x42, x123, x41 * x127);
+        let x131 = x128 + Self::mul_add(-x46, x123, x45 * x127);
         let x132 = x129 - Self::mul_add(-s_q9, x123, c_q9 * x127);
         let x133 = 0.00000000020510342851533115 * x126;
         let x134 = Self::mul_add(
-            x36,
+            x41,
             12.701650001451807,
-            Self::mul_add(x37, 0.002139996587640933, x31 * 0.0000000234896432582596),
+            Self::mul_add(x42, 0.002139996587640933, x36 * 0.0000000234896432582596),
         )
             + (Self::mul_add(-c_q9, x125, s_q9 * x124) - x133
                 + Self::mul_add(0.275, x132, 0.4 * x131));
         let x135 = x89
-            + Self::mul_add(0.4, x130, x126 - Self::mul_add(x42, x125, x41 * x124));
+            + Self::mul_add(0.4, x130, x126 - Self::mul_add(x46, x125, x45 * x124));
         let x136 = Self::mul_add(
             113.3918902508081,
-            x37,
-            Self::mul_add(5.080660024070366, x31, x30 * 0.002139996587640933),
-        ) - Self::mul_add(x35, 0.000000008530897668050218, x34 * 12.701650001451807)
+            x42,
+            Self::mul_add(5.080660024070366, x36, x35 * 0.002139996587640933),
+        ) - Self::mul_add(x40, 0.000000008530897668050218, x39 * 12.701650001451807)
             - Self::mul_add(0.275, x130, x133 + Self::mul_add(s_q9, x125, c_q9 * x124));
-        let x137 = Self::mul_add(x37, 12.701650001451807, x130);
-        let x138 = Self::mul_add(x37, 0.000000008530897668050218, -x131);
+        let x137 = Self::mul_add(x42, 12.701650001451807, x130);
+        let x138 = Self::mul_add(x42, 0.000000008530897668050218, -x131);
         let x139 = Self::mul_add(
-            x31,
+            x36,
             0.000000008530897668050218,
-            x30 * 12.701650001451807,
+            x35 * 12.701650001451807,
         ) - x132;
-        let x140 = x139 - Self::mul_add(x29, x138, x28 * x137);
+        let x140 = x139 - Self::mul_add(x34, x138, x33 * x137);
         let x141 = Self::mul_add(-c_q8, x138, s_q8 * x137);
-        let x142 = Self::mul_add(x26, -16.80768997608804, x21 * 0.07309)
-            + Self::mul_add(-0.35, x141, x136 + Self::mul_add(x29, x135, x28 * x134));
+        let x142 = Self::mul_add(x32, -16.80768997608804, x27 * 0.07309)
+            + Self::mul_add(-0.35, x141, x136 + Self::mul_add(x34, x135, x33 * x134));
         let x143 = x87
             + Self::mul_add(-0.35, x140, Self::mul_add(-c_q8, x135, s_q8 * x134));
-        let x144 = Self::mul_add(48.0240000085309, x26, x141);
+        let x144 = Self::mul_add(48.0240000085309, x32, x141);
         let x145 = Self::mul_add(
             48.0240000085309,
-            x21,
+            x27,
             -Self::mul_add(
                 0.00000000020510342851533115,
                 x139,
@@ -7993,15 +8040,15 @@ impl FreeFloating7 {
             -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
         ) + x147;
         let x154 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]) + x145;
-        let x155 = Self::mul_add(x12, x154, Self::mul_add(-x11, x153, x10 * x152));
-        let x156 = Self::mul_add(-x15, x154, Self::mul_add(x14, x153, x13 * x152));
-        let x157 = Self::mul_add(-x18, x154, Self::mul_add(-x17, x153, x16 * x152));
+        let x155 = Self::mul_add(x19, x154, Self::mul_add(-x18, x153, x17 * x152));
+        let x156 = Self::mul_add(-x22, x154, Self::mul_add(x21, x153, x20 * x152));
+        let x157 = Self::mul_add(-x25, x154, Self::mul_add(-x24, x153, x23 * x152));
         let x158 = -x157;
-        let x159 = Self::mul_add(-x12, x151, Self::mul_add(-x11, x150, x10 * x149))
+        let x159 = Self::mul_add(-x19, x151, Self::mul_add(-x18, x150, x17 * x149))
             - Self::mul_add(q[1], x157, q[2] * x156);
-        let x160 = Self::mul_add(x15, x151, Self::mul_add(x14, x150, x13 * x149))
+        let x160 = Self::mul_add(x22, x151, Self::mul_add(x21, x150, x20 * x149))
             + Self::mul_add(q[0], x157, q[2] * x155);
-        let x161 = -(Self::mul_add(x18, x151, Self::mul_add(-x17, x150, x16 * x149))
+        let x161 = -(Self::mul_add(x25, x151, Self::mul_add(-x24, x150, x23 * x149))
             + Self::mul_add(-q[0], x156, q[1] * x155));
         [x155, x156, x158, x159, x160, x161]
     }
@@ -8010,330 +8057,333 @@ impl FreeFloating7 {
     /// Methods: bias `recurrent`: 688 mul, 566 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 426 fused where the target has FMA.
     #[must_use]
     pub fn base_reaction(q: &[f64; 14], v: &[f64; 13], a: &[f64; 13]) -> [f64; 6] {
-        let (s_q7, c_q7) = Self::sincos(q[7]);
-        let x1 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x2 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x3 = Self::mul_add(0.75, v[4], v[0]);
-        let x4 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x5 = Self::mul_add(-0.65, v[4], v[2]);
-        let x6 = Self::mul_add(s_q7, x4, c_q7 * x3);
-        let x7 = Self::mul_add(-c_q7, x4, s_q7 * x3);
-        let x8 = v[5] + v[6];
-        let x9 = Self::mul_add(0.75, a[4], a[0]);
-        let x10 = a[1] - Self::mul_add(-0.65, a[5], 0.75 * a[3]);
-        let x11 = Self::mul_add(-0.65, a[4], a[2]);
-        let x12 = a[5] + a[6];
-        let x13 = Self::mul_add(-v[6], x2, Self::mul_add(a[4], s_q7, a[3] * c_q7));
-        let x14 = Self::mul_add(v[6], x1, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
-        let x15 = Self::mul_add(-v[6], x7, Self::mul_add(s_q7, x10, c_q7 * x9));
-        let x16 = Self::mul_add(v[6], x6, Self::mul_add(-c_q7, x10, s_q7 * x9));
-        let x17 = Self::mul_add(
+        let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
+        (s_q12, c_q12), (s_q13, c_q13)] = Self::sincos_n([
+            q[7],
+            q[8],
+            q[9],
+            q[10],
+            q[11],
+            q[12],
+            q[13],
+        ]);
+        let x7 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x8 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x9 = Self::mul_add(0.75, v[4], v[0]);
+        let x10 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
+        let x11 = Self::mul_add(-0.65, v[4], v[2]);
+        let x12 = Self::mul_add(s_q7, x10, c_q7 * x9);
+        let x13 = Self::mul_add(-c_q7, x10, s_q7 * x9);
+        let x14 = v[5] + v[6];
+        let x15 = Self::mul_add(0.75, a[4], a[0]);
+        let x16 = a[1] - Self::mul_add(-0.65, a[5], 0.75 * a[3]);
+        let x17 = Self::mul_add(-0.65, a[4], a[2]);
+        let x18 = a[5] + a[6];
+        let x19 = Self::mul_add(-v[6], x8, Self::mul_add(a[4], s_q7, a[3] * c_q7));
+        let x20 = Self::mul_add(v[6], x7, Self::mul_add(-a[4], c_q7, a[3] * s_q7));
+        let x21 = Self::mul_add(-v[6], x13, Self::mul_add(s_q7, x16, c_q7 * x15));
+        let x22 = Self::mul_add(v[6], x12, Self::mul_add(-c_q7, x16, s_q7 * x15));
+        let x23 = Self::mul_add(
             6.1267499999999995,
-            x16,
-            Self::mul_add(0.00071, x12, Self::mul_add(x14, 0.07309, 2.29018125 * x13)),
+            x22,
+            Self::mul_add(0.00071, x18, Self::mul_add(x20, 0.07309, 2.29018125 * x19)),
         );
-        let x18 = Self::mul_add(
+        let x24 = Self::mul_add(
             -6.1267499999999995,
-            x15,
+            x21,
             Self::mul_add(
                 -0.1132,
-                x12,
-                Self::mul_add(1.5853812499999997, x14, x13 * 0.07309),
+                x18,
+                Self::mul_add(1.5853812499999997, x20, x19 * 0.07309),
             ),
         );
-        let x19 = Self::mul_add(1.331, x8, Self::mul_add(-0.1132, x2, 0.00071 * x1));
-        let x20 = Self::mul_add(
+        let x25 = Self::mul_add(1.331, x14, Self::mul_add(-0.1132, x8, 0.00071 * x7));
+        let x26 = Self::mul_add(
             6.1267499999999995,
-            x7,
-            Self::mul_add(0.00071, x8, Self::mul_add(x2, 0.07309, 2.29018125 * x1)),
+            x13,
+            Self::mul_add(0.00071, x14, Self::mul_add(x8, 0.07309, 2.29018125 * x7)),
         );
-        let x21 = Self::mul_add(
+        let x27 = Self::mul_add(
             -6.1267499999999995,
-            x6,
+            x12,
             Self::mul_add(
                 -0.1132,
-                x8,
-                Self::mul_add(1.5853812499999997, x2, x1 * 0.07309),
+                x14,
+                Self::mul_add(1.5853812499999997, x8, x7 * 0.07309),
             ),
         );
-        let x22 = 35.01 * x5;
-        let x23 = Self::mul_add(-6.1267499999999995, x2, 35.01 * x6);
-        let x24 = Self::mul_add(6.1267499999999995, x1, 35.01 * x7);
-        let (s_q8, c_q8) = Self::sincos(q[8]);
-        let x26 = 0.00000000020510342851533115 * c_q8;
-        let x27 = 0.00000000020510342851533115 * s_q8;
-        let x28 = Self::mul_add(x8, c_q8, Self::mul_add(x2, s_q8, x1 * x26));
-        let x29 = Self::mul_add(x8, s_q8, Self::mul_add(-x2, c_q8, x1 * x27));
-        let x30 = Self::mul_add(-0.35, x2, x6);
-        let x31 = Self::mul_add(0.35, x1, x7);
-        let x32 = Self::mul_add(x5, c_q8, Self::mul_add(s_q8, x31, x26 * x30));
-        let x33 = Self::mul_add(x5, s_q8, Self::mul_add(-c_q8, x31, x27 * x30));
-        let x34 = Self::mul_add(-0.00000000020510342851533115, x5, x30);
-        let x35 = v[7] + Self::mul_add(-0.00000000020510342851533115, x8, x1);
-        let x36 = Self::mul_add(-0.35, x14, x15);
-        let x37 = Self::mul_add(0.35, x13, x16);
-        let x38 = Self::mul_add(-0.00000000020510342851533115, x11, x36);
-        let x39 = a[7] + Self::mul_add(-0.00000000020510342851533115, x12, x13);
-        let x40 = Self::mul_add(
-            -v[7],
-            x29,
-            Self::mul_add(x12, c_q8, Self::mul_add(x14, s_q8, x13 * x26)),
-        );
-        let x41 = Self::mul_add(
-            v[7],
-            x28,
-            Self::mul_add(x12, s_q8, Self::mul_add(-x14, c_q8, x13 * x27)),
-        );
-        let x42 = Self::mul_add(
-            -v[7],
-            x33,
-            Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x37, x26 * x36)),
-        );
-        let x43 = Self::mul_add(
-            v[7],
-            x32,
-            Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x37, x27 * x36)),
-        );
-        let x44 = Self::mul_add(2.359, x35, x28 * 0.00214);
+        let x28 = 35.01 * x11;
+        let x29 = Self::mul_add(-6.1267499999999995, x8, 35.01 * x12);
+        let x30 = Self::mul_add(6.1267499999999995, x7, 35.01 * x13);
+        let x31 = 0.00000000020510342851533115 * c_q8;
+        let x32 = 0.00000000020510342851533115 * s_q8;
+        let x33 = Self::mul_add(x14, c_q8, Self::mul_add(x8, s_q8, x7 * x31));
+        let x34 = Self::mul_add(x14, s_q8, Self::mul_add(-x8, c_q8, x7 * x32));
+        let x35 = Self::mul_add(-0.35, x8, x12);
+        let x36 = Self::mul_add(0.35, x7, x13);
+        let x37 = Self::mul_add(x11, c_q8, Self::mul_add(s_q8, x36, x31 * x35));
+        let x38 = Self::mul_add(x11, s_q8, Self::mul_add(-c_q8, x36, x32 * x35));
+        let x39 = Self::mul_add(-0.00000000020510342851533115, x11, x35);
+        let x40 = v[7] + Self::mul_add(-0.00000000020510342851533115, x14, x7);
+        let x41 = Self::mul_add(-0.35, x20, x21);
+        let x42 = Self::mul_add(0.35, x19, x22);
+        let x43 = Self::mul_add(-0.00000000020510342851533115, x17, x41);
+        let x44 = a[7] + Self::mul_add(-0.00000000020510342851533115, x18, x19);
         let x45 = Self::mul_add(
-            6.0,
+            -v[7],
+            x34,
+            Self::mul_add(x18, c_q8, Self::mul_add(x20, s_q8, x19 * x31)),
+        );
+        let x46 = Self::mul_add(
+            v[7],
             x33,
-            Self::mul_add(x35, 0.00214, 3.3000000000000003 * x28),
+            Self::mul_add(x18, s_q8, Self::mul_add(-x20, c_q8, x19 * x32)),
         );
-        let x46 = Self::mul_add(-6.0, x32, 2.5780000000000003 * x29);
-        let x47 = 30.0 * x34;
-        let x48 = Self::mul_add(-6.0, x29, 30.0 * x32);
-        let x49 = Self::mul_add(6.0, x28, 30.0 * x33);
-        let (s_q9, c_q9) = Self::sincos(q[9]);
-        let x51 = 0.00000000020510342851533115 * c_q9;
-        let x52 = 0.00000000020510342851533115 * s_q9;
-        let x53 = x51 - x52;
-        let x54 = x51 + x52;
-        let x55 = Self::mul_add(-x35, c_q9, Self::mul_add(-x29, x53, x28 * s_q9));
-        let x56 = Self::mul_add(x35, s_q9, Self::mul_add(x29, x54, x28 * c_q9));
-        let x57 = x32 - Self::mul_add(-0.275, x35, 0.4 * x29);
-        let x58 = Self::mul_add(0.4, x28, x33);
-        let x59 = Self::mul_add(-0.275, x28, x34);
-        let x60 = Self::mul_add(-c_q9, x59, Self::mul_add(-x53, x58, s_q9 * x57));
-        let x61 = Self::mul_add(s_q9, x59, Self::mul_add(x54, x58, c_q9 * x57));
-        let x62 = Self::mul_add(
+        let x47 = Self::mul_add(
+            -v[7],
+            x38,
+            Self::mul_add(x17, c_q8, Self::mul_add(s_q8, x42, x31 * x41)),
+        );
+        let x48 = Self::mul_add(
+            v[7],
+            x37,
+            Self::mul_add(x17, s_q8, Self::mul_add(-c_q8, x42, x32 * x41)),
+        );
+        let x49 = Self::mul_add(2.359, x40, x33 * 0.00214);
+        let x50 = Self::mul_add(
+            6.0,
+            x38,
+            Self::mul_add(x40, 0.00214, 3.3000000000000003 * x33),
+        );
+        let x51 = Self::mul_add(-6.0, x37, 2.5780000000000003 * x34);
+        let x52 = 30.0 * x39;
+        let x53 = Self::mul_add(-6.0, x34, 30.0 * x37);
+        let x54 = Self::mul_add(6.0, x33, 30.0 * x38);
+        let x55 = 0.00000000020510342851533115 * c_q9;
+        let x56 = 0.00000000020510342851533115 * s_q9;
+        let x57 = x55 - x56;
+        let x58 = x55 + x56;
+        let x59 = Self::mul_add(-x40, c_q9, Self::mul_add(-x34, x57, x33 * s_q9));
+        let x60 = Self::mul_add(x40, s_q9, Self::mul_add(x34, x58, x33 * c_q9));
+        let x61 = x37 - Self::mul_add(-0.275, x40, 0.4 * x34);
+        let x62 = Self::mul_add(0.4, x33, x38);
+        let x63 = Self::mul_add(-0.275, x33, x39);
+        let x64 = Self::mul_add(-c_q9, x63, Self::mul_add(-x57, x62, s_q9 * x61));
+        let x65 = Self::mul_add(s_q9, x63, Self::mul_add(x58, x62, c_q9 * x61));
+        let x66 = Self::mul_add(
             -0.00000000020510342851533115,
-            x59,
-            Self::mul_add(-0.00000000020510342851533115, x57, x58),
+            x63,
+            Self::mul_add(-0.00000000020510342851533115, x61, x62),
         );
-        let x63 = v[8]
+        let x67 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x35,
-                Self::mul_add(-0.00000000020510342851533115, x28, x29),
+                x40,
+                Self::mul_add(-0.00000000020510342851533115, x33, x34),
             );
-        let x64 = x42 - Self::mul_add(-0.275, x39, 0.4 * x41);
-        let x65 = Self::mul_add(0.4, x40, x43);
-        let x66 = Self::mul_add(-0.275, x40, x38);
-        let x67 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x66,
-            Self::mul_add(-0.00000000020510342851533115, x64, x65),
-        );
-        let x68 = a[8]
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x39,
-                Self::mul_add(-0.00000000020510342851533115, x40, x41),
-            );
-        let x69 = Self::mul_add(
-            v[8],
-            x56,
-            Self::mul_add(-x39, c_q9, Self::mul_add(-x41, x53, x40 * s_q9)),
-        );
-        let x70 = Self::mul_add(
-            -v[8],
-            x55,
-            Self::mul_add(x39, s_q9, Self::mul_add(x41, x54, x40 * c_q9)),
-        );
+        let x68 = x47 - Self::mul_add(-0.275, x44, 0.4 * x46);
+        let x69 = Self::mul_add(0.4, x45, x48);
+        let x70 = Self::mul_add(-0.275, x45, x43);
         let x71 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x70,
+            Self::mul_add(-0.00000000020510342851533115, x68, x69),
+        );
+        let x72 = a[8]
+            + Self::mul_add(
+                -0.00000000020510342851533115,
+                x44,
+                Self::mul_add(-0.00000000020510342851533115, x45, x46),
+            );
+        let x73 = Self::mul_add(
             v[8],
-            x61,
-            Self::mul_add(-c_q9, x66, Self::mul_add(-x53, x65, s_q9 * x64)),
-        );
-        let x72 = Self::mul_add(
-            -v[8],
             x60,
-            Self::mul_add(s_q9, x66, Self::mul_add(x54, x65, c_q9 * x64)),
+            Self::mul_add(-x44, c_q9, Self::mul_add(-x46, x57, x45 * s_q9)),
         );
-        let x73 = 3.378 * x56;
         let x74 = Self::mul_add(
-            x62,
-            9.87015,
-            Self::mul_add(0.00214, x63, 4.395515250000001 * x55),
+            -v[8],
+            x59,
+            Self::mul_add(x44, s_q9, Self::mul_add(x46, x58, x45 * c_q9)),
         );
         let x75 = Self::mul_add(
-            x60,
+            v[8],
+            x65,
+            Self::mul_add(-c_q9, x70, Self::mul_add(-x57, x69, s_q9 * x68)),
+        );
+        let x76 = Self::mul_add(
+            -v[8],
+            x64,
+            Self::mul_add(s_q9, x70, Self::mul_add(x58, x69, c_q9 * x68)),
+        );
+        let x77 = 3.378 * x60;
+        let x78 = Self::mul_add(
+            x66,
+            9.87015,
+            Self::mul_add(0.00214, x67, 4.395515250000001 * x59),
+        );
+        let x79 = Self::mul_add(
+            x64,
             -9.87015,
-            Self::mul_add(7.65251525, x63, 0.00214 * x55),
+            Self::mul_add(7.65251525, x67, 0.00214 * x59),
         );
-        let x76 = 22.69 * x61;
-        let x77 = Self::mul_add(x63, -9.87015, 22.69 * x60);
-        let x78 = Self::mul_add(x55, 9.87015, 22.69 * x62);
-        let (s_q10, c_q10) = Self::sincos(q[10]);
-        let x80 = Self::mul_add(x56, s_q10, x55 * c_q10);
-        let x81 = Self::mul_add(-x56, c_q10, x55 * s_q10);
-        let x82 = Self::mul_add(x63, -0.87, x60);
-        let x83 = Self::mul_add(x55, 0.87, x62);
-        let x84 = Self::mul_add(x61, s_q10, c_q10 * x82);
-        let x85 = Self::mul_add(-x61, c_q10, s_q10 * x82);
-        let x86 = v[9] + x63;
-        let x87 = Self::mul_add(x68, -0.87, x71);
-        let x88 = Self::mul_add(x69, 0.87, x67);
-        let x89 = a[9] + x68;
-        let x90 = Self::mul_add(-v[9], x81, Self::mul_add(x70, s_q10, x69 * c_q10));
-        let x91 = Self::mul_add(v[9], x80, Self::mul_add(-x70, c_q10, x69 * s_q10));
-        let x92 = Self::mul_add(-v[9], x85, Self::mul_add(x72, s_q10, c_q10 * x87));
-        let x93 = Self::mul_add(v[9], x84, Self::mul_add(-x72, c_q10, s_q10 * x87));
-        let x94 = Self::mul_add(
-            x92,
-            -6.7347,
-            Self::mul_add(4.0324305, x89, Self::mul_add(x91, -1.8520425, x90 * 0.6328)),
-        );
-        let x95 = Self::mul_add(x86, 0.6328, 4.170993 * x80)
-            - Self::mul_add(x83, -6.7347, x85 * 5.8795);
-        let x96 = Self::mul_add(
-            x84,
-            5.8795,
-            Self::mul_add(x86, -1.8520425, 3.8828625 * x81),
-        );
+        let x80 = 22.69 * x65;
+        let x81 = Self::mul_add(x67, -9.87015, 22.69 * x64);
+        let x82 = Self::mul_add(x59, 9.87015, 22.69 * x66);
+        let x83 = Self::mul_add(x60, s_q10, x59 * c_q10);
+        let x84 = Self::mul_add(-x60, c_q10, x59 * s_q10);
+        let x85 = Self::mul_add(x67, -0.87, x64);
+        let x86 = Self::mul_add(x59, 0.87, x66);
+        let x87 = Self::mul_add(x65, s_q10, c_q10 * x85);
+        let x88 = Self::mul_add(-x65, c_q10, s_q10 * x85);
+        let x89 = v[9] + x67;
+        let x90 = Self::mul_add(x72, -0.87, x75);
+        let x91 = Self::mul_add(x73, 0.87, x71);
+        let x92 = a[9] + x72;
+        let x93 = Self::mul_add(-v[9], x84, Self::mul_add(x74, s_q10, x73 * c_q10));
+        let x94 = Self::mul_add(v[9], x83, Self::mul_add(-x74, c_q10, x73 * s_q10));
+        let x95 = Self::mul_add(-v[9], x88, Self::mul_add(x76, s_q10, c_q10 * x90));
+        let x96 = Self::mul_add(v[9], x87, Self::mul_add(-x76, c_q10, s_q10 * x90));
         let x97 = Self::mul_add(
-            x84,
+            x95,
             -6.7347,
-            Self::mul_add(4.0324305, x86, Self::mul_add(x81, -1.8520425, x80 * 0.6328)),
+            Self::mul_add(4.0324305, x92, Self::mul_add(x94, -1.8520425, x93 * 0.6328)),
         );
-        let x98 = Self::mul_add(21.38, x84, Self::mul_add(x86, -6.7347, x81 * 5.8795));
-        let x99 = Self::mul_add(x80, -5.8795, 21.38 * x85);
-        let x100 = Self::mul_add(x80, 6.7347, 21.38 * x83);
-        let (s_q11, c_q11) = Self::sincos(q[11]);
-        let x102 = Self::mul_add(-x81, s_q11, x80 * c_q11);
-        let x103 = Self::mul_add(x81, c_q11, x80 * s_q11);
-        let x104 = x84 + Self::mul_add(x86, -0.63, 0.275 * x81);
-        let x105 = Self::mul_add(-0.275, x80, x85);
-        let x106 = Self::mul_add(x80, 0.63, x83);
-        let x107 = Self::mul_add(-s_q11, x105, c_q11 * x104);
-        let x108 = Self::mul_add(c_q11, x105, s_q11 * x104);
-        let x109 = v[10] + x86;
-        let x110 = x92 + Self::mul_add(x89, -0.63, 0.275 * x91);
-        let x111 = Self::mul_add(-0.275, x90, x93);
-        let x112 = Self::mul_add(x90, 0.63, x88);
-        let x113 = a[10] + x89;
-        let x114 = Self::mul_add(-v[10], x103, Self::mul_add(-x91, s_q11, x90 * c_q11));
-        let x115 = Self::mul_add(v[10], x102, Self::mul_add(x91, c_q11, x90 * s_q11));
-        let x116 = Self::mul_add(
+        let x98 = Self::mul_add(x89, 0.6328, 4.170993 * x83)
+            - Self::mul_add(x86, -6.7347, x88 * 5.8795);
+        let x99 = Self::mul_add(
+            x87,
+            5.8795,
+            Self::mul_add(x89, -1.8520425, 3.8828625 * x84),
+        );
+        let x100 = Self::mul_add(
+            x87,
+            -6.7347,
+            Self::mul_add(4.0324305, x89, Self::mul_add(x84, -1.8520425, x83 * 0.6328)),
+        );
+        let x101 = Self::mul_add(21.38, x87, Self::mul_add(x89, -6.7347, x84 * 5.8795));
+        let x102 = Self::mul_add(x83, -5.8795, 21.38 * x88);
+        let x103 = Self::mul_add(x83, 6.7347, 21.38 * x86);
+        let x104 = Self::mul_add(-x84, s_q11, x83 * c_q11);
+        let x105 = Self::mul_add(x84, c_q11, x83 * s_q11);
+        let x106 = x87 + Self::mul_add(x89, -0.63, 0.275 * x84);
+        let x107 = Self::mul_add(-0.275, x83, x88);
+        let x108 = Self::mul_add(x83, 0.63, x86);
+        let x109 = Self::mul_add(-s_q11, x107, c_q11 * x106);
+        let x110 = Self::mul_add(c_q11, x107, s_q11 * x106);
+        let x111 = v[10] + x89;
+        let x112 = x95 + Self::mul_add(x92, -0.63, 0.275 * x94);
+        let x113 = Self::mul_add(-0.275, x93, x96);
+        let x114 = Self::mul_add(x93, 0.63, x91);
+        let x115 = a[10] + x92;
+        let x116 = Self::mul_add(-v[10], x105, Self::mul_add(-x94, s_q11, x93 * c_q11));
+        let x117 = Self::mul_add(v[10], x104, Self::mul_add(x94, c_q11, x93 * s_q11));
+        let x118 = Self::mul_add(
             -v[10],
-            x108,
-            Self::mul_add(-s_q11, x111, c_q11 * x110),
+            x110,
+            Self::mul_add(-s_q11, x113, c_q11 * x112),
         );
-        let x117 = Self::mul_add(v[10], x107, Self::mul_add(c_q11, x111, s_q11 * x110));
-        let x118 = Self::mul_add(-0.07271, x109, 0.01675 * x102);
-        let x119 = Self::mul_add(
-            x108,
+        let x119 = Self::mul_add(v[10], x109, Self::mul_add(c_q11, x113, s_q11 * x112));
+        let x120 = Self::mul_add(-0.07271, x111, 0.01675 * x104);
+        let x121 = Self::mul_add(
+            x110,
             -3.0149999999999997,
-            Self::mul_add(-0.01675, x109, 0.9304999999999999 * x102),
+            Self::mul_add(-0.01675, x111, 0.9304999999999999 * x104),
         );
-        let x120 = Self::mul_add(x107, 3.0149999999999997, 0.939 * x103);
-        let x121 = 16.75 * x106;
-        let x122 = Self::mul_add(x103, 3.0149999999999997, 16.75 * x107);
-        let x123 = Self::mul_add(x102, -3.0149999999999997, 16.75 * x108);
-        let (s_q12, c_q12) = Self::sincos(q[12]);
-        let x125 = 0.00000000020510342851533115 * s_q12;
-        let x126 = 0.00000000020510342851533115 * c_q12;
-        let x127 = Self::mul_add(x109, s_q12, Self::mul_add(x103, x125, x102 * c_q12));
-        let x128 = Self::mul_add(-x109, c_q12, Self::mul_add(-x103, x126, x102 * s_q12));
-        let x129 = Self::mul_add(x103, 0.36, x107);
-        let x130 = Self::mul_add(x102, -0.36, x108);
-        let x131 = Self::mul_add(x106, s_q12, Self::mul_add(x125, x130, c_q12 * x129));
-        let x132 = Self::mul_add(-x106, c_q12, Self::mul_add(-x126, x130, s_q12 * x129));
-        let x133 = Self::mul_add(-0.00000000020510342851533115, x106, x130);
-        let x134 = v[11] + Self::mul_add(-0.00000000020510342851533115, x109, x103);
-        let x135 = Self::mul_add(x115, 0.36, x116);
-        let x136 = Self::mul_add(x114, -0.36, x117);
-        let x137 = Self::mul_add(-0.00000000020510342851533115, x112, x136);
-        let x138 = a[11] + Self::mul_add(-0.00000000020510342851533115, x113, x115);
-        let x139 = Self::mul_add(
-            -v[11],
-            x128,
-            Self::mul_add(x113, s_q12, Self::mul_add(x115, x125, x114 * c_q12)),
-        );
+        let x122 = Self::mul_add(x109, 3.0149999999999997, 0.939 * x105);
+        let x123 = 16.75 * x108;
+        let x124 = Self::mul_add(x105, 3.0149999999999997, 16.75 * x109);
+        let x125 = Self::mul_add(x104, -3.0149999999999997, 16.75 * x110);
+        let x126 = 0.00000000020510342851533115 * s_q12;
+        let x127 = 0.00000000020510342851533115 * c_q12;
+        let x128 = Self::mul_add(x111, s_q12, Self::mul_add(x105, x126, x104 * c_q12));
+        let x129 = Self::mul_add(-x111, c_q12, Self::mul_add(-x105, x127, x104 * s_q12));
+        let x130 = Self::mul_add(x105, 0.36, x109);
+        let x131 = Self::mul_add(x104, -0.36, x110);
+        let x132 = Self::mul_add(x108, s_q12, Self::mul_add(x126, x131, c_q12 * x130));
+        let x133 = Self::mul_add(-x108, c_q12, Self::mul_add(-x127, x131, s_q12 * x130));
+        let x134 = Self::mul_add(-0.00000000020510342851533115, x108, x131);
+        let x135 = v[11] + Self::mul_add(-0.00000000020510342851533115, x111, x105);
+        let x136 = Self::mul_add(x117, 0.36, x118);
+        let x137 = Self::mul_add(x116, -0.36, x119);
+        let x138 = Self::mul_add(-0.00000000020510342851533115, x114, x137);
+        let x139 = a[11] + Self::mul_add(-0.00000000020510342851533115, x115, x117);
         let x140 = Self::mul_add(
-            v[11],
-            x127,
-            Self::mul_add(-x113, c_q12, Self::mul_add(-x115, x126, x114 * s_q12)),
+            -v[11],
+            x129,
+            Self::mul_add(x115, s_q12, Self::mul_add(x117, x126, x116 * c_q12)),
         );
         let x141 = Self::mul_add(
-            -v[11],
-            x132,
-            Self::mul_add(x112, s_q12, Self::mul_add(x125, x136, c_q12 * x135)),
+            v[11],
+            x128,
+            Self::mul_add(-x115, c_q12, Self::mul_add(-x117, x127, x116 * s_q12)),
         );
         let x142 = Self::mul_add(
-            v[11],
-            x131,
-            Self::mul_add(-x112, c_q12, Self::mul_add(-x126, x136, s_q12 * x135)),
+            -v[11],
+            x133,
+            Self::mul_add(x114, s_q12, Self::mul_add(x126, x137, c_q12 * x136)),
         );
         let x143 = Self::mul_add(
+            v[11],
+            x132,
+            Self::mul_add(-x114, c_q12, Self::mul_add(-x127, x137, s_q12 * x136)),
+        );
+        let x144 = Self::mul_add(
             7.196750000000001,
-            x141,
+            x142,
             Self::mul_add(
                 2.1079062500000005,
-                x138,
-                Self::mul_add(x140, -1.1514800000000003, x139 * 0.2313),
+                x139,
+                Self::mul_add(x141, -1.1514800000000003, x140 * 0.2313),
             ),
         );
-        let x144 = Self::mul_add(x134, 0.2313, 3.2217582500000006 * x127)
-            + Self::mul_add(-7.196750000000001, x133, 4.187200000000001 * x132);
-        let x145 = Self::mul_add(
-            -4.187200000000001,
-            x131,
-            Self::mul_add(x134, -1.1514800000000003, 1.2686520000000001 * x128),
-        );
+        let x145 = Self::mul_add(x135, 0.2313, 3.2217582500000006 * x128)
+            + Self::mul_add(-7.196750000000001, x134, 4.187200000000001 * x133);
         let x146 = Self::mul_add(
-            7.196750000000001,
-            x131,
-            Self::mul_add(
-                2.1079062500000005,
-                x134,
-                Self::mul_add(x128, -1.1514800000000003, x127 * 0.2313),
-            ),
+            -4.187200000000001,
+            x132,
+            Self::mul_add(x135, -1.1514800000000003, 1.2686520000000001 * x129),
         );
         let x147 = Self::mul_add(
-            26.17,
-            x131,
-            -Self::mul_add(-7.196750000000001, x134, 4.187200000000001 * x128),
+            7.196750000000001,
+            x132,
+            Self::mul_add(
+                2.1079062500000005,
+                x135,
+                Self::mul_add(x129, -1.1514800000000003, x128 * 0.2313),
+            ),
         );
-        let x148 = Self::mul_add(4.187200000000001, x127, 26.17 * x132);
-        let x149 = Self::mul_add(-7.196750000000001, x127, 26.17 * x133);
-        let (s_q13, c_q13) = Self::sincos(q[13]);
+        let x148 = Self::mul_add(
+            26.17,
+            x132,
+            -Self::mul_add(-7.196750000000001, x135, 4.187200000000001 * x129),
+        );
+        let x149 = Self::mul_add(4.187200000000001, x128, 26.17 * x133);
+        let x150 = Self::mul_add(-7.196750000000001, x128, 26.17 * x134);
         let x151 = 0.00000000020510342851533115 * c_q13;
         let x152 = 0.00000000020510342851533115 * s_q13;
-        let x153 = Self::mul_add(-x134, c_q13, Self::mul_add(x128, s_q13, x127 * x151));
-        let x154 = Self::mul_add(-x134, s_q13, Self::mul_add(-x128, c_q13, x127 * x152));
-        let x155 = x131 - Self::mul_add(-0.55, x134, 0.16 * x128);
-        let x156 = Self::mul_add(0.16, x127, x132);
-        let x157 = Self::mul_add(-0.55, x127, x133);
+        let x153 = Self::mul_add(-x135, c_q13, Self::mul_add(x129, s_q13, x128 * x151));
+        let x154 = Self::mul_add(-x135, s_q13, Self::mul_add(-x129, c_q13, x128 * x152));
+        let x155 = x132 - Self::mul_add(-0.55, x135, 0.16 * x129);
+        let x156 = Self::mul_add(0.16, x128, x133);
+        let x157 = Self::mul_add(-0.55, x128, x134);
         let x158 = Self::mul_add(-c_q13, x157, Self::mul_add(s_q13, x156, x151 * x155));
         let x159 = Self::mul_add(-s_q13, x157, Self::mul_add(-c_q13, x156, x152 * x155));
         let x160 = Self::mul_add(0.00000000020510342851533115, x157, x155);
-        let x161 = v[12] - Self::mul_add(0.00000000020510342851533115, x134, x127);
-        let x162 = x141 - Self::mul_add(-0.55, x138, 0.16 * x140);
-        let x163 = Self::mul_add(0.16, x139, x142);
-        let x164 = Self::mul_add(-0.55, x139, x137);
+        let x161 = v[12] - Self::mul_add(0.00000000020510342851533115, x135, x128);
+        let x162 = x142 - Self::mul_add(-0.55, x139, 0.16 * x141);
+        let x163 = Self::mul_add(0.16, x140, x143);
+        let x164 = Self::mul_add(-0.55, x140, x138);
         let x165 = Self::mul_add(0.00000000020510342851533115, x164, x162);
-        let x166 = a[12] - Self::mul_add(0.00000000020510342851533115, x138, x139);
+        let x166 = a[12] - Self::mul_add(0.00000000020510342851533115, x139, x140);
         let x167 = Self::mul_add(
             -v[12],
             x154,
-            Self::mul_add(-x138, c_q13, Self::mul_add(x140, s_q13, x139 * x151)),
+            Self::mul_add(-x139, c_q13, Self::mul_add(x141, s_q13, x140 * x151)),
         );
         let x168 = Self::mul_add(
             v[12],
             x153,
-            Self::mul_add(-x138, s_q13, Self::mul_add(-x140, c_q13, x139 * x152)),
+            Self::mul_add(-x139, s_q13, Self::mul_add(-x141, c_q13, x140 * x152)),
         );
         let x169 = Self::mul_add(
             -v[12],
@@ -8431,51 +8481,51 @@ impl FreeFloating7 {
                 Self::mul_add(-s_q13, x180, c_q13 * x179),
             ),
         );
-        let x189 = Self::mul_add(x138, 0.2313, 3.2217582500000006 * x139)
-            + Self::mul_add(-7.196750000000001, x137, 4.187200000000001 * x142)
-            + (Self::mul_add(-x128, x146, x134 * x145)
-                + Self::mul_add(-x132, x149, x133 * x148))
+        let x189 = Self::mul_add(x139, 0.2313, 3.2217582500000006 * x140)
+            + Self::mul_add(-7.196750000000001, x138, 4.187200000000001 * x143)
+            + (Self::mul_add(-x129, x147, x135 * x146)
+                + Self::mul_add(-x133, x150, x134 * x149))
             + (x181 + Self::mul_add(-x152, x180, x151 * x179)
                 + Self::mul_add(0.55, x187, 0.16 * x186));
         let x190 = Self::mul_add(
             -4.187200000000001,
-            x141,
-            Self::mul_add(x138, -1.1514800000000003, 1.2686520000000001 * x140),
+            x142,
+            Self::mul_add(x139, -1.1514800000000003, 1.2686520000000001 * x141),
         )
-            - (Self::mul_add(-x127, x146, x134 * x144)
-                + Self::mul_add(-x131, x149, x133 * x147))
+            - (Self::mul_add(-x128, x147, x135 * x145)
+                + Self::mul_add(-x132, x150, x134 * x148))
             + Self::mul_add(-0.16, x185, Self::mul_add(c_q13, x180, s_q13 * x179));
-        let x191 = x143
-            + (Self::mul_add(-x127, x145, x128 * x144)
-                + Self::mul_add(-x131, x148, x132 * x147)) - x188;
+        let x191 = x144
+            + (Self::mul_add(-x128, x146, x129 * x145)
+                + Self::mul_add(-x132, x149, x133 * x148)) - x188;
         let x192 = Self::mul_add(
             26.17,
-            x141,
-            -Self::mul_add(-7.196750000000001, x138, 4.187200000000001 * x140),
-        ) + Self::mul_add(-x128, x149, x134 * x148) + x185;
-        let x193 = Self::mul_add(4.187200000000001, x139, 26.17 * x142)
-            - Self::mul_add(-x127, x149, x134 * x147) + x186;
-        let x194 = Self::mul_add(-7.196750000000001, x139, 26.17 * x137)
-            + Self::mul_add(-x127, x148, x128 * x147) - x187;
+            x142,
+            -Self::mul_add(-7.196750000000001, x139, 4.187200000000001 * x141),
+        ) + Self::mul_add(-x129, x150, x135 * x149) + x185;
+        let x193 = Self::mul_add(4.187200000000001, x140, 26.17 * x143)
+            - Self::mul_add(-x128, x150, x135 * x148) + x186;
+        let x194 = Self::mul_add(-7.196750000000001, x140, 26.17 * x138)
+            + Self::mul_add(-x128, x149, x129 * x148) - x187;
         let x195 = Self::mul_add(s_q12, x193, c_q12 * x192);
-        let x196 = x194 + Self::mul_add(-x126, x193, x125 * x192);
+        let x196 = x194 + Self::mul_add(-x127, x193, x126 * x192);
         let x197 = Self::mul_add(
-            x117,
+            x119,
             -3.0149999999999997,
-            Self::mul_add(-0.01675, x113, 0.9304999999999999 * x114),
+            Self::mul_add(-0.01675, x115, 0.9304999999999999 * x116),
         )
-            + (Self::mul_add(x103, x118, x109 * x120)
-                + Self::mul_add(-x108, x121, x106 * x123))
+            + (Self::mul_add(x105, x120, x111 * x122)
+                + Self::mul_add(-x110, x123, x108 * x125))
             + Self::mul_add(-0.36, x196, Self::mul_add(s_q12, x190, c_q12 * x189));
-        let x198 = Self::mul_add(x116, 3.0149999999999997, 0.939 * x115)
-            - (Self::mul_add(x102, x118, x109 * x119)
-                + Self::mul_add(-x107, x121, x106 * x122))
-            + Self::mul_add(0.36, x195, x191 + Self::mul_add(-x126, x190, x125 * x189));
-        let x199 = Self::mul_add(x115, 3.0149999999999997, 16.75 * x116)
-            + Self::mul_add(-x103, x121, x109 * x123) + x195;
-        let x200 = Self::mul_add(x114, -3.0149999999999997, 16.75 * x117)
-            - Self::mul_add(-x102, x121, x109 * x122) + x196;
-        let x201 = Self::mul_add(16.75, x112, Self::mul_add(-x102, x123, x103 * x122))
+        let x198 = Self::mul_add(x118, 3.0149999999999997, 0.939 * x117)
+            - (Self::mul_add(x104, x120, x111 * x121)
+                + Self::mul_add(-x109, x123, x108 * x124))
+            + Self::mul_add(0.36, x195, x191 + Self::mul_add(-x127, x190, x126 * x189));
+        let x199 = Self::mul_add(x117, 3.0149999999999997, 16.75 * x118)
+            + Self::mul_add(-x105, x123, x111 * x125) + x195;
+        let x200 = Self::mul_add(x116, -3.0149999999999997, 16.75 * x119)
+            - Self::mul_add(-x104, x123, x111 * x124) + x196;
+        let x201 = Self::mul_add(16.75, x114, Self::mul_add(-x104, x125, x105 * x124))
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x194,
@@ -8486,103 +8536,105 @@ impl FreeFloating7 {
         let x204 = Self::mul_add(
             0.63,
             x202,
-            Self::mul_add(-0.07271, x113, 0.01675 * x114)
-                - (Self::mul_add(-x102, x120, x103 * x119)
-                    + Self::mul_add(-x107, x123, x108 * x122))
+            Self::mul_add(-0.07271, x115, 0.01675 * x116)
+                - (Self::mul_add(-x104, x122, x105 * x121)
+                    + Self::mul_add(-x109, x125, x110 * x124))
                 - Self::mul_add(
                     -0.00000000020510342851533115,
                     x191,
                     Self::mul_add(-c_q12, x190, s_q12 * x189),
                 ),
         );
-        let x205 = Self::mul_add(x89, 0.6328, 4.170993 * x90)
-            - Self::mul_add(x88, -6.7347, x93 * 5.8795)
-            + (Self::mul_add(-x81, x97, x86 * x96)
-                + Self::mul_add(-x85, x100, x83 * x99))
+        let x205 = Self::mul_add(x92, 0.6328, 4.170993 * x93)
+            - Self::mul_add(x91, -6.7347, x96 * 5.8795)
+            + (Self::mul_add(-x84, x100, x89 * x99)
+                + Self::mul_add(-x88, x103, x86 * x102))
             + (Self::mul_add(s_q11, x198, c_q11 * x197)
                 + Self::mul_add(0.63, x201, 0.275 * x203));
         let x206 = Self::mul_add(
-            x92,
+            x95,
             5.8795,
-            Self::mul_add(x89, -1.8520425, 3.8828625 * x91),
-        ) - (Self::mul_add(-x80, x97, x86 * x95) + Self::mul_add(-x84, x100, x83 * x98))
+            Self::mul_add(x92, -1.8520425, 3.8828625 * x94),
+        )
+            - (Self::mul_add(-x83, x100, x89 * x98)
+                + Self::mul_add(-x87, x103, x86 * x101))
             - Self::mul_add(-0.275, x202, Self::mul_add(-c_q11, x198, s_q11 * x197));
-        let x207 = Self::mul_add(21.38, x92, Self::mul_add(x89, -6.7347, x91 * 5.8795))
-            + Self::mul_add(-x81, x100, x86 * x99) + x202;
-        let x208 = Self::mul_add(x90, -5.8795, 21.38 * x93)
-            - Self::mul_add(-x80, x100, x86 * x98) - x203;
-        let x209 = Self::mul_add(x90, 6.7347, 21.38 * x88)
-            + Self::mul_add(-x80, x99, x81 * x98) + x201;
+        let x207 = Self::mul_add(21.38, x95, Self::mul_add(x92, -6.7347, x94 * 5.8795))
+            + Self::mul_add(-x84, x103, x89 * x102) + x202;
+        let x208 = Self::mul_add(x93, -5.8795, 21.38 * x96)
+            - Self::mul_add(-x83, x103, x89 * x101) - x203;
+        let x209 = Self::mul_add(x93, 6.7347, 21.38 * x91)
+            + Self::mul_add(-x83, x102, x84 * x101) + x201;
         let x210 = Self::mul_add(s_q10, x208, c_q10 * x207);
         let x211 = Self::mul_add(
-            x67,
+            x71,
             9.87015,
-            Self::mul_add(0.00214, x68, 4.395515250000001 * x69),
-        ) - (Self::mul_add(-x56, x75, x63 * x73) + Self::mul_add(-x61, x78, x62 * x76))
+            Self::mul_add(0.00214, x72, 4.395515250000001 * x73),
+        ) - (Self::mul_add(-x60, x79, x67 * x77) + Self::mul_add(-x65, x82, x66 * x80))
             + Self::mul_add(0.87, x209, Self::mul_add(s_q10, x206, c_q10 * x205));
         let x212 = Self::mul_add(
             3.378,
-            x70,
-            Self::mul_add(-x55, x75, x63 * x74) + Self::mul_add(-x60, x78, x62 * x77),
+            x74,
+            Self::mul_add(-x59, x79, x67 * x78) + Self::mul_add(-x64, x82, x66 * x81),
         ) + Self::mul_add(-c_q10, x206, s_q10 * x205);
         let x213 = Self::mul_add(
-            x71,
+            x75,
             -9.87015,
-            Self::mul_add(7.65251525, x68, 0.00214 * x69),
-        ) - (Self::mul_add(-x55, x73, x56 * x74) + Self::mul_add(-x60, x76, x61 * x77))
+            Self::mul_add(7.65251525, x72, 0.00214 * x73),
+        ) - (Self::mul_add(-x59, x77, x60 * x78) + Self::mul_add(-x64, x80, x65 * x81))
             + Self::mul_add(
                 -0.87,
                 x210,
-                x94
-                    + (Self::mul_add(-x80, x96, x81 * x95)
-                        + Self::mul_add(-x84, x99, x85 * x98)) - x204,
+                x97
+                    + (Self::mul_add(-x83, x99, x84 * x98)
+                        + Self::mul_add(-x87, x102, x88 * x101)) - x204,
             );
-        let x214 = Self::mul_add(x68, -9.87015, 22.69 * x71)
-            - Self::mul_add(-x56, x78, x63 * x76) + x210;
-        let x215 = Self::mul_add(22.69, x72, Self::mul_add(-x55, x78, x63 * x77))
+        let x214 = Self::mul_add(x72, -9.87015, 22.69 * x75)
+            - Self::mul_add(-x60, x82, x67 * x80) + x210;
+        let x215 = Self::mul_add(22.69, x76, Self::mul_add(-x59, x82, x67 * x81))
             + Self::mul_add(-c_q10, x208, s_q10 * x207);
-        let x216 = Self::mul_add(x69, 9.87015, 22.69 * x67)
-            - Self::mul_add(-x55, x76, x56 * x77) + x209;
+        let x216 = Self::mul_add(x73, 9.87015, 22.69 * x71)
+            - Self::mul_add(-x59, x80, x60 * x81) + x209;
         let x217 = 0.00000000020510342851533115 * x216;
         let x218 = Self::mul_add(c_q9, x215, s_q9 * x214) - x217;
-        let x219 = x216 - Self::mul_add(-x54, x215, x53 * x214);
+        let x219 = x216 - Self::mul_add(-x58, x215, x57 * x214);
         let x220 = x217 + Self::mul_add(-s_q9, x215, c_q9 * x214);
         let x221 = 0.00000000020510342851533115 * x213;
         let x222 = Self::mul_add(
             6.0,
-            x43,
-            Self::mul_add(x39, 0.00214, 3.3000000000000003 * x40),
-        ) + (Self::mul_add(-x29, x44, x35 * x46) + Self::mul_add(-x33, x47, x34 * x49))
+            x48,
+            Self::mul_add(x44, 0.00214, 3.3000000000000003 * x45),
+        ) + (Self::mul_add(-x34, x49, x40 * x51) + Self::mul_add(-x38, x52, x39 * x54))
             + (Self::mul_add(c_q9, x212, s_q9 * x211) - x221
                 + Self::mul_add(0.275, x220, 0.4 * x219));
-        let x223 = Self::mul_add(-6.0, x42, 2.5780000000000003 * x41)
-            - (Self::mul_add(-x28, x44, x35 * x45) + Self::mul_add(-x32, x47, x34 * x48))
-            + Self::mul_add(-0.4, x218, x213 - Self::mul_add(-x54, x212, x53 * x211));
-        let x224 = Self::mul_add(2.359, x39, x40 * 0.00214)
-            + (Self::mul_add(-x28, x46, x29 * x45) + Self::mul_add(-x32, x49, x33 * x48))
+        let x223 = Self::mul_add(-6.0, x47, 2.5780000000000003 * x46)
+            - (Self::mul_add(-x33, x49, x40 * x50) + Self::mul_add(-x37, x52, x39 * x53))
+            + Self::mul_add(-0.4, x218, x213 - Self::mul_add(-x58, x212, x57 * x211));
+        let x224 = Self::mul_add(2.359, x44, x45 * 0.00214)
+            + (Self::mul_add(-x33, x51, x34 * x50) + Self::mul_add(-x37, x54, x38 * x53))
             - Self::mul_add(
                 -0.275,
                 x218,
                 x221 + Self::mul_add(-s_q9, x212, c_q9 * x211),
             );
-        let x225 = Self::mul_add(-6.0, x41, 30.0 * x42)
-            + Self::mul_add(-x29, x47, x35 * x49) + x218;
-        let x226 = Self::mul_add(6.0, x40, 30.0 * x43)
-            - Self::mul_add(-x28, x47, x35 * x48) + x219;
-        let x227 = Self::mul_add(30.0, x38, Self::mul_add(-x28, x49, x29 * x48)) - x220;
-        let x228 = x227 + Self::mul_add(x27, x226, x26 * x225);
+        let x225 = Self::mul_add(-6.0, x46, 30.0 * x47)
+            + Self::mul_add(-x34, x52, x40 * x54) + x218;
+        let x226 = Self::mul_add(6.0, x45, 30.0 * x48)
+            - Self::mul_add(-x33, x52, x40 * x53) + x219;
+        let x227 = Self::mul_add(30.0, x43, Self::mul_add(-x33, x54, x34 * x53)) - x220;
+        let x228 = x227 + Self::mul_add(x32, x226, x31 * x225);
         let x229 = Self::mul_add(-c_q8, x226, s_q8 * x225);
-        let x230 = x17
-            + (Self::mul_add(-x2, x19, x8 * x21) + Self::mul_add(-x7, x22, x5 * x24))
-            + Self::mul_add(0.35, x229, x224 + Self::mul_add(x27, x223, x26 * x222));
-        let x231 = x18
-            - (Self::mul_add(-x1, x19, x8 * x20) + Self::mul_add(-x6, x22, x5 * x23))
+        let x230 = x23
+            + (Self::mul_add(-x8, x25, x14 * x27) + Self::mul_add(-x13, x28, x11 * x30))
+            + Self::mul_add(0.35, x229, x224 + Self::mul_add(x32, x223, x31 * x222));
+        let x231 = x24
+            - (Self::mul_add(-x7, x25, x14 * x26) + Self::mul_add(-x12, x28, x11 * x29))
             + Self::mul_add(-0.35, x228, Self::mul_add(-c_q8, x223, s_q8 * x222));
-        let x232 = Self::mul_add(-6.1267499999999995, x14, 35.01 * x15)
-            + Self::mul_add(-x2, x22, x8 * x24) + x228;
-        let x233 = Self::mul_add(6.1267499999999995, x13, 35.01 * x16)
-            - Self::mul_add(-x1, x22, x8 * x23) + x229;
-        let x234 = Self::mul_add(35.01, x11, Self::mul_add(-x1, x24, x2 * x23))
+        let x232 = Self::mul_add(-6.1267499999999995, x20, 35.01 * x21)
+            + Self::mul_add(-x8, x28, x14 * x30) + x228;
+        let x233 = Self::mul_add(6.1267499999999995, x19, 35.01 * x22)
+            - Self::mul_add(-x7, x28, x14 * x29) + x229;
+        let x234 = Self::mul_add(35.01, x17, Self::mul_add(-x7, x30, x8 * x29))
             + Self::mul_add(
                 -0.00000000020510342851533115,
                 x227,
@@ -8593,8 +8645,9 @@ impl FreeFloating7 {
         let x237 = Self::mul_add(
             0.65,
             x236,
-            Self::mul_add(1.331, x12, Self::mul_add(-0.1132, x14, 0.00071 * x13))
-                + (Self::mul_add(-x1, x21, x2 * x20) + Self::mul_add(-x6, x24, x7 * x23))
+            Self::mul_add(1.331, x18, Self::mul_add(-0.1132, x20, 0.00071 * x19))
+                + (Self::mul_add(-x7, x27, x8 * x26)
+                    + Self::mul_add(-x12, x30, x13 * x29))
                 + Self::mul_add(
                     -0.00000000020510342851533115,
                     x224,
@@ -8640,13 +8693,21 @@ impl FreeFloating7 {
             )
         )] { a * b + c }
     }
-    /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
-    /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
-    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 1 ulp of 1 of
-    /// libm's (`kanegen accuracy` measures it).
+    /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
     pub fn sincos(x: f64) -> (f64, f64) {
+        let [sc] = Self::sincos_n([x]);
+        sc
+    }
+    /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
+    /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
+    /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
+    /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
+    /// (`kanegen accuracy` measures it).
+    #[inline(always)]
+    #[must_use]
+    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
         /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
         const SIN_TABLE: [f64; 128] = [
             0.0,
@@ -8783,28 +8844,42 @@ impl FreeFloating7 {
         const C2: f64 = -0.5;
         const C4: f64 = 1.0 / 24.0;
         const C6: f64 = -1.0 / 720.0;
-        if !(x > -32768.0 && x < 32768.0) {
-            return libm::sincos(x);
+        let mut fast = true;
+        for v in x {
+            fast &= v > -32768.0 && v < 32768.0;
         }
-        let t = Self::mul_add(x, 40.74366543152521, 6755399441055744.0);
-        let k = t - 6755399441055744.0;
-        let i = (t.to_bits() & 255) as usize;
-        let r_hi = Self::mul_add(-k, 0.024543692605220713, x);
-        let r = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
-        let r2 = r * r;
-        let r3 = r * r2;
-        let p_s = Self::mul_add(r2, S5, S3);
-        let sin_r = Self::mul_add(r3, p_s, r);
-        let p_c6 = Self::mul_add(r2, C6, C4);
-        let p_c = Self::mul_add(r2, p_c6, C2);
-        let cos_r = Self::mul_add(r2, p_c, 1.0);
+        if !fast {
+            return x.map(libm::sincos);
+        }
+        let (mut t, mut r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            t[i] = Self::mul_add(x[i], 40.74366543152521, 6755399441055744.0);
+            let k = t[i] - 6755399441055744.0;
+            let r_hi = Self::mul_add(-k, 0.024543692605220713, x[i]);
+            r[i] = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
+        }
+        let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            let r2 = r[i] * r[i];
+            let r3 = r[i] * r2;
+            let p_s = Self::mul_add(r2, S5, S3);
+            sin_r[i] = Self::mul_add(r3, p_s, r[i]);
+            let p_c6 = Self::mul_add(r2, C6, C4);
+            let p_c = Self::mul_add(r2, p_c6, C2);
+            cos_r[i] = Self::mul_add(r2, p_c, 1.0);
+        }
         let table = |j: usize| {
             f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
         };
-        let (sin_a, cos_a) = (table(i), table(i + 64));
-        (
-            Self::mul_add(sin_a, cos_r, cos_a * sin_r),
-            Self::mul_add(cos_a, cos_r, -(sin_a * sin_r)),
-        )
+        let mut out = [(0.0, 0.0); N];
+        for i in 0..N {
+            let j = (t[i].to_bits() & 255) as usize;
+            let (sin_a, cos_a) = (table(j), table(j + 64));
+            out[i] = (
+                Self::mul_add(sin_a, cos_r[i], cos_a * sin_r[i]),
+                Self::mul_add(cos_a, cos_r[i], -(sin_a * sin_r[i])),
+            );
+        }
+        out
     }
 }

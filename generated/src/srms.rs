@@ -1129,11 +1129,13 @@ impl Srms {
     /// Methods: mass matrix `crba`: 118 mul, 114 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 52 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
         let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
@@ -1270,94 +1272,96 @@ impl Srms {
     /// Methods: bias `newton-euler`: 220 mul, 157 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 123 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x1 = qd[0] * s_q1;
-        let x2 = qd[0] * c_q1;
-        let x3 = qd[1] * x2;
-        let x4 = qd[1] * x1;
-        let x5 = qd[1] * qd[1];
-        let x6 = x1 * x2;
-        let x7 = Self::mul_add(
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
+        let x5 = qd[0] * s_q1;
+        let x6 = qd[0] * c_q1;
+        let x7 = qd[1] * x6;
+        let x8 = qd[1] * x5;
+        let x9 = qd[1] * qd[1];
+        let x10 = x5 * x6;
+        let x11 = Self::mul_add(
             190.97044034,
-            x2,
-            Self::mul_add(qd[1], -1.928, x1 * 8596.210051042),
+            x6,
+            Self::mul_add(qd[1], -1.928, x5 * 8596.210051042),
         );
-        let x8 = Self::mul_add(
-            x2,
+        let x12 = Self::mul_add(
+            x6,
             -0.0302,
-            Self::mul_add(8609.573807858, qd[1], x1 * 1.928),
+            Self::mul_add(8609.573807858, qd[1], x5 * 1.928),
         );
-        let x9 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x1);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x11 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x12 = Self::mul_add(-x2, c_q2, x1 * s_q2);
-        let x13 = Self::mul_add(x6, -0.1524, 6.377 * Self::mul_add(x2, x2, x5));
-        let x14 = Self::mul_add(x3 + x3, 0.1524, 6.377 * (x4 + x4));
-        let x15 = Self::mul_add(Self::mul_add(x1, x1, x5), -0.1524, 6.377 * x6);
-        let x16 = Self::mul_add(-s_q2, x15, c_q2 * x13);
-        let x17 = Self::mul_add(c_q2, x15, s_q2 * x13);
-        let x18 = Self::mul_add(-qd[2], x12, Self::mul_add(-x4, s_q2, x3 * c_q2));
-        let x19 = Self::mul_add(qd[2], x11, Self::mul_add(x4, c_q2, x3 * s_q2));
-        let x20 = qd[1] + qd[2];
-        let x21 = x20 * x20;
-        let x22 = Self::mul_add(x12, x12, x21);
-        let x23 = x11 * x12;
-        let x24 = Self::mul_add(x11, x20, x19);
-        let x25 = Self::mul_add(-x12, x20, x18);
-        let x26 = Self::mul_add(x11, x11, x21);
-        let x27 = Self::mul_add(
-            -103.41030072000001,
-            x12,
-            Self::mul_add(0.8021, x20, x11 * 5594.523885531201),
-        );
-        let x28 = Self::mul_add(
-            -0.08,
-            x12,
-            Self::mul_add(-5601.1318504688, x20, 0.8021 * x11),
-        );
-        let x29 = Self::mul_add(0.08, x20, 103.41030072000002 * x11);
+        let x13 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x5);
+        let x14 = Self::mul_add(x6, s_q2, x5 * c_q2);
+        let x15 = Self::mul_add(-x6, c_q2, x5 * s_q2);
+        let x16 = Self::mul_add(x10, -0.1524, 6.377 * Self::mul_add(x6, x6, x9));
+        let x17 = Self::mul_add(x7 + x7, 0.1524, 6.377 * (x8 + x8));
+        let x18 = Self::mul_add(Self::mul_add(x5, x5, x9), -0.1524, 6.377 * x10);
+        let x19 = Self::mul_add(-s_q2, x18, c_q2 * x16);
+        let x20 = Self::mul_add(c_q2, x18, s_q2 * x16);
+        let x21 = Self::mul_add(-qd[2], x15, Self::mul_add(-x8, s_q2, x7 * c_q2));
+        let x22 = Self::mul_add(qd[2], x14, Self::mul_add(x8, c_q2, x7 * s_q2));
+        let x23 = qd[1] + qd[2];
+        let x24 = x23 * x23;
+        let x25 = Self::mul_add(x15, x15, x24);
+        let x26 = x14 * x15;
+        let x27 = Self::mul_add(x14, x23, x22);
+        let x28 = Self::mul_add(-x15, x23, x21);
+        let x29 = Self::mul_add(x14, x14, x24);
         let x30 = Self::mul_add(
+            -103.41030072000001,
+            x15,
+            Self::mul_add(0.8021, x23, x14 * 5594.523885531201),
+        );
+        let x31 = Self::mul_add(
+            -0.08,
+            x15,
+            Self::mul_add(-5601.1318504688, x23, 0.8021 * x14),
+        );
+        let x32 = Self::mul_add(0.08, x23, 103.41030072000002 * x14);
+        let x33 = Self::mul_add(
             703.3878000000001,
-            x14,
-            Self::mul_add(103.41030072000002, x18, Self::mul_add(-x11, x28, x20 * x27)),
+            x17,
+            Self::mul_add(103.41030072000002, x21, Self::mul_add(-x14, x31, x23 * x30)),
         );
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x32 = Self::mul_add(-x12, s_q3, x11 * c_q3);
-        let x33 = Self::mul_add(x12, c_q3, x11 * s_q3);
-        let x34 = x16 + Self::mul_add(0.1524, x23, 7.06 * x22);
-        let x35 = x14 + Self::mul_add(0.1524, x25, 7.06 * x24);
-        let x36 = x17 - Self::mul_add(0.1524, x26, 7.06 * x23);
-        let x37 = Self::mul_add(c_q3, x36, s_q3 * x34);
-        let x38 = Self::mul_add(-qd[3], x33, Self::mul_add(-x19, s_q3, x18 * c_q3));
-        let x39 = Self::mul_add(qd[3], x32, Self::mul_add(x19, c_q3, x18 * s_q3));
-        let x40 = qd[3] + x20;
-        let x41 = Self::mul_add(x33, x33, x40 * x40);
-        let x42 = x32 * x33;
-        let x43 = Self::mul_add(x32, x40, x39);
-        let x44 = x32 * 18.957952216000002;
-        let x45 = 19.863252216000003 * x40;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x47 = Self::mul_add(-x40, s_q4, x32 * c_q4);
-        let x48 = Self::mul_add(x40, c_q4, x32 * s_q4);
-        let x49 = Self::mul_add(
+        let x34 = Self::mul_add(-x15, s_q3, x14 * c_q3);
+        let x35 = Self::mul_add(x15, c_q3, x14 * s_q3);
+        let x36 = x19 + Self::mul_add(0.1524, x26, 7.06 * x25);
+        let x37 = x17 + Self::mul_add(0.1524, x28, 7.06 * x27);
+        let x38 = x20 - Self::mul_add(0.1524, x29, 7.06 * x26);
+        let x39 = Self::mul_add(c_q3, x38, s_q3 * x36);
+        let x40 = Self::mul_add(-qd[3], x35, Self::mul_add(-x22, s_q3, x21 * c_q3));
+        let x41 = Self::mul_add(qd[3], x34, Self::mul_add(x22, c_q3, x21 * s_q3));
+        let x42 = qd[3] + x23;
+        let x43 = Self::mul_add(x35, x35, x42 * x42);
+        let x44 = x34 * x35;
+        let x45 = Self::mul_add(x34, x42, x41);
+        let x46 = x34 * 18.957952216000002;
+        let x47 = 19.863252216000003 * x42;
+        let x48 = Self::mul_add(-x42, s_q4, x34 * c_q4);
+        let x49 = Self::mul_add(x42, c_q4, x34 * s_q4);
+        let x50 = Self::mul_add(
             -c_q4,
-            Self::mul_add(0.4572, x43, x35),
-            s_q4 * Self::mul_add(0.4572, x41, Self::mul_add(-s_q3, x36, c_q3 * x34)),
+            Self::mul_add(0.4572, x45, x37),
+            s_q4 * Self::mul_add(0.4572, x43, Self::mul_add(-s_q3, x38, c_q3 * x36)),
         );
-        let x50 = Self::mul_add(-qd[4], x48, x38 * c_q4);
-        let x51 = Self::mul_add(qd[4], x47, x38 * s_q4);
-        let x52 = qd[4] - x33;
-        let x53 = 34.45002 * Self::mul_add(x52, x52, x48 * x48);
-        let x54 = 34.45002 * Self::mul_add(x47, x48, x39);
-        let x55 = 34.45002 * Self::mul_add(x47, x52, x51);
-        let x56 = 34.33891524 * x48;
-        let x57 = 34.74691524 * x52;
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x59 = Self::mul_add(x52, s_q5, x48 * c_q5);
-        let x60 = Self::mul_add(-x52, c_q5, x48 * s_q5);
-        let x61 = Self::mul_add(-qd[5], x60, Self::mul_add(-x39, s_q5, x51 * c_q5));
-        let x62 = Self::mul_add(qd[5], x59, Self::mul_add(x39, c_q5, x51 * s_q5));
-        let x63 = qd[5] - x47;
+        let x51 = Self::mul_add(-qd[4], x49, x40 * c_q4);
+        let x52 = Self::mul_add(qd[4], x48, x40 * s_q4);
+        let x53 = qd[4] - x35;
+        let x54 = 34.45002 * Self::mul_add(x53, x53, x49 * x49);
+        let x55 = 34.45002 * Self::mul_add(x48, x49, x41);
+        let x56 = 34.45002 * Self::mul_add(x48, x53, x52);
+        let x57 = 34.33891524 * x49;
+        let x58 = 34.74691524 * x53;
+        let x59 = Self::mul_add(x53, s_q5, x49 * c_q5);
+        let x60 = Self::mul_add(-x53, c_q5, x49 * s_q5);
+        let x61 = Self::mul_add(-qd[5], x60, Self::mul_add(-x41, s_q5, x52 * c_q5));
+        let x62 = Self::mul_add(qd[5], x59, Self::mul_add(x41, c_q5, x52 * s_q5));
+        let x63 = qd[5] - x48;
         let x64 = Self::mul_add(-0.966, x60, Self::mul_add(0.385, x59, 1.903 * x63));
         let x65 = Self::mul_add(-0.353, x60, 0.385 * x63);
         let x66 = Self::mul_add(
@@ -1365,57 +1369,58 @@ impl Srms {
             0.9929999999999999,
             Self::mul_add(0.353, x59, 0.966 * x63),
         );
-        let x67 = Self::mul_add(0.966, x62, Self::mul_add(-0.385, x61, 1.903 * x50))
+        let x67 = Self::mul_add(0.966, x62, Self::mul_add(-0.385, x61, 1.903 * x51))
             - Self::mul_add(x59, x66, x60 * x65);
         let x68 = -x67;
-        let x69 = Self::mul_add(0.353, x62, 0.385 * x50)
+        let x69 = Self::mul_add(0.353, x62, 0.385 * x51)
             + Self::mul_add(x63, x66, x60 * x64);
         let x70 = Self::mul_add(
             x62,
             -0.9929999999999999,
-            Self::mul_add(-0.353, x61, 0.966 * x50),
+            Self::mul_add(-0.353, x61, 0.966 * x51),
         ) + Self::mul_add(-x63, x65, x59 * x64);
-        let x71 = Self::mul_add(-x48, x57, x52 * x56) + x67;
+        let x71 = Self::mul_add(-x49, x58, x53 * x57) + x67;
         let x72 = Self::mul_add(
             34.45002,
-            Self::mul_add(-0.4572, x42, x37),
-            Self::mul_add(x47, x57, 34.33891524 * x51),
+            Self::mul_add(-0.4572, x44, x39),
+            Self::mul_add(x48, x58, 34.33891524 * x52),
         ) - Self::mul_add(-s_q5, x70, c_q5 * x69);
         let x73 = Self::mul_add(
             -34.45002,
-            x49,
-            Self::mul_add(x47, x56, 34.74691524 * x39),
+            x50,
+            Self::mul_add(x48, x57, 34.74691524 * x41),
         ) + Self::mul_add(c_q5, x70, s_q5 * x69);
         let x74 = -x73;
-        let x75 = Self::mul_add(c_q4, x54, s_q4 * x53);
-        let x76 = Self::mul_add(41.67378, x41, Self::mul_add(-s_q4, x54, c_q4 * x53));
-        let x77 = Self::mul_add(41.67378, x43, x75);
-        let x78 = Self::mul_add(41.67378, x42, -x55);
-        let x79 = Self::mul_add(x33, x45, x38 * 18.957952216000002)
+        let x75 = Self::mul_add(c_q4, x55, s_q4 * x54);
+        let x76 = Self::mul_add(41.67378, x43, Self::mul_add(-s_q4, x55, c_q4 * x54));
+        let x77 = Self::mul_add(41.67378, x45, x75);
+        let x78 = Self::mul_add(41.67378, x44, -x56);
+        let x79 = Self::mul_add(x35, x47, x40 * 18.957952216000002)
             - Self::mul_add(s_q4, x72, c_q4 * x71);
-        let x80 = Self::mul_add(-41.67378, x37, x33 * x44)
-            + Self::mul_add(-0.4572, x55, Self::mul_add(-c_q4, x72, s_q4 * x71));
+        let x80 = Self::mul_add(-41.67378, x39, x35 * x46)
+            + Self::mul_add(-0.4572, x56, Self::mul_add(-c_q4, x72, s_q4 * x71));
         let x81 = -x80;
-        let x82 = Self::mul_add(41.67378, x35, Self::mul_add(x32, x45, x40 * x44))
+        let x82 = Self::mul_add(41.67378, x37, Self::mul_add(x34, x47, x42 * x46))
             + Self::mul_add(0.4572, x75, x73);
         let x83 = Self::mul_add(-s_q3, x78, c_q3 * x76);
         let x84 = Self::mul_add(c_q3, x78, s_q3 * x76);
-        let x85 = Self::mul_add(x23, 15.183612000000002, 703.3878000000001 * x22) + x83;
-        let x86 = Self::mul_add(15.183612000000002, x25, 703.3878000000001 * x24) + x77;
-        let x87 = Self::mul_add(15.183612000000002, x26, 703.3878000000001 * x23) + x84;
+        let x85 = Self::mul_add(x26, 15.183612000000002, 703.3878000000001 * x25) + x83;
+        let x86 = Self::mul_add(15.183612000000002, x28, 703.3878000000001 * x27) + x77;
+        let x87 = Self::mul_add(15.183612000000002, x29, 703.3878000000001 * x26) + x84;
         let x88 = Self::mul_add(
-            x14,
+            x17,
             -15.183612000000002,
-            Self::mul_add(-103.41030072000001, x19, x18 * 5594.523885531201)
-                - Self::mul_add(x20, x29, x12 * x28),
+            Self::mul_add(-103.41030072000001, x22, x21 * 5594.523885531201)
+                - Self::mul_add(x23, x32, x15 * x31),
         ) + Self::mul_add(-0.1524, x77, Self::mul_add(-s_q3, x82, c_q3 * x79));
-        let x89 = Self::mul_add(-0.08, x19, 0.8021 * x18)
-            + Self::mul_add(x11, x29, x12 * x27)
-            - Self::mul_add(703.3878000000001, x17, x16 * 15.183612000000002)
+        let x89 = Self::mul_add(-0.08, x22, 0.8021 * x21)
+            + Self::mul_add(x14, x32, x15 * x30)
+            - Self::mul_add(703.3878000000001, x20, x19 * 15.183612000000002)
             + (x80 - Self::mul_add(-7.06, x84, 0.1524 * x83));
         let x90 = -x89;
-        let x91 = x30 + Self::mul_add(7.06, x77, Self::mul_add(c_q3, x82, s_q3 * x79));
-        let x92 = Self::mul_add(x4, 0.0302, x3 * 1.928) + Self::mul_add(-x1, x9, x2 * x7)
+        let x91 = x33 + Self::mul_add(7.06, x77, Self::mul_add(c_q3, x82, s_q3 * x79));
+        let x92 = Self::mul_add(x8, 0.0302, x7 * 1.928)
+            + Self::mul_add(-x5, x13, x6 * x11)
             - (x89
                 - Self::mul_add(
                     -6.377,
@@ -1424,11 +1429,11 @@ impl Srms {
                 ));
         let x93 = Self::mul_add(
             c_q1,
-            Self::mul_add(190.97044034000004, x3, Self::mul_add(x1, x8, qd[1] * x7))
+            Self::mul_add(190.97044034000004, x7, Self::mul_add(x5, x12, qd[1] * x11))
                 + Self::mul_add(6.377, x86, Self::mul_add(c_q2, x91, s_q2 * x88)),
             s_q1
-                * (Self::mul_add(-190.97044034, x4, x3 * 8596.210051042)
-                    - Self::mul_add(qd[1], x9, x2 * x8)
+                * (Self::mul_add(-190.97044034, x8, x7 * 8596.210051042)
+                    - Self::mul_add(qd[1], x13, x6 * x12)
                     + Self::mul_add(-0.1524, x86, Self::mul_add(-s_q2, x91, c_q2 * x88))),
         );
         let x94 = -x93;
@@ -1439,110 +1444,116 @@ impl Srms {
     /// Methods: bias `newton-euler`: 232 mul, 178 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 134 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x1 = qd[0] * s_q1;
-        let x2 = qd[0] * c_q1;
-        let x3 = qd[1] * x2;
-        let x4 = qd[1] * x1;
-        let x5 = Self::mul_add(qdd[0], s_q1, x3);
-        let x6 = Self::mul_add(qdd[0], c_q1, -x4);
-        let x7 = qd[1] * qd[1];
-        let x8 = x1 * x2;
-        let x9 = Self::mul_add(
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
+        let x5 = qd[0] * s_q1;
+        let x6 = qd[0] * c_q1;
+        let x7 = qd[1] * x6;
+        let x8 = qd[1] * x5;
+        let x9 = Self::mul_add(qdd[0], s_q1, x7);
+        let x10 = Self::mul_add(qdd[0], c_q1, -x8);
+        let x11 = qd[1] * qd[1];
+        let x12 = x5 * x6;
+        let x13 = Self::mul_add(
             190.97044034,
-            x2,
-            Self::mul_add(qd[1], -1.928, x1 * 8596.210051042),
+            x6,
+            Self::mul_add(qd[1], -1.928, x5 * 8596.210051042),
         );
-        let x10 = Self::mul_add(
-            x2,
+        let x14 = Self::mul_add(
+            x6,
             -0.0302,
-            Self::mul_add(8609.573807858, qd[1], x1 * 1.928),
+            Self::mul_add(8609.573807858, qd[1], x5 * 1.928),
         );
-        let x11 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x1);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x13 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x14 = Self::mul_add(-x2, c_q2, x1 * s_q2);
-        let x15 = Self::mul_add(qdd[1] - x8, 0.1524, 6.377 * Self::mul_add(x2, x2, x7));
-        let x16 = Self::mul_add(x3 + x5, 0.1524, 6.377 * (x4 - x6));
-        let x17 = Self::mul_add(
-            Self::mul_add(x1, x1, x7),
+        let x15 = Self::mul_add(qd[1], 0.0302, 190.97044034000004 * x5);
+        let x16 = Self::mul_add(x6, s_q2, x5 * c_q2);
+        let x17 = Self::mul_add(-x6, c_q2, x5 * s_q2);
+        let x18 = Self::mul_add(
+            qdd[1] - x12,
+            0.1524,
+            6.377 * Self::mul_add(x6, x6, x11),
+        );
+        let x19 = Self::mul_add(x7 + x9, 0.1524, 6.377 * (x8 - x10));
+        let x20 = Self::mul_add(
+            Self::mul_add(x5, x5, x11),
             -0.1524,
-            6.377 * (qdd[1] + x8),
+            6.377 * (qdd[1] + x12),
         );
-        let x18 = Self::mul_add(-s_q2, x17, c_q2 * x15);
-        let x19 = Self::mul_add(c_q2, x17, s_q2 * x15);
-        let x20 = Self::mul_add(-qd[2], x14, Self::mul_add(x6, s_q2, x5 * c_q2));
-        let x21 = Self::mul_add(qd[2], x13, Self::mul_add(-x6, c_q2, x5 * s_q2));
-        let x22 = qdd[1] + qdd[2];
-        let x23 = qd[1] + qd[2];
-        let x24 = x23 * x23;
-        let x25 = Self::mul_add(x14, x14, x24);
-        let x26 = x13 * x14;
-        let x27 = x22 + x26;
-        let x28 = Self::mul_add(x13, x23, x21);
-        let x29 = Self::mul_add(-x14, x23, x20);
-        let x30 = x22 - x26;
-        let x31 = Self::mul_add(x13, x13, x24);
-        let x32 = Self::mul_add(
-            -103.41030072000001,
-            x14,
-            Self::mul_add(0.8021, x23, x13 * 5594.523885531201),
-        );
-        let x33 = Self::mul_add(
-            -0.08,
-            x14,
-            Self::mul_add(-5601.1318504688, x23, 0.8021 * x13),
-        );
-        let x34 = Self::mul_add(0.08, x23, 103.41030072000002 * x13);
+        let x21 = Self::mul_add(-s_q2, x20, c_q2 * x18);
+        let x22 = Self::mul_add(c_q2, x20, s_q2 * x18);
+        let x23 = Self::mul_add(-qd[2], x17, Self::mul_add(x10, s_q2, x9 * c_q2));
+        let x24 = Self::mul_add(qd[2], x16, Self::mul_add(-x10, c_q2, x9 * s_q2));
+        let x25 = qdd[1] + qdd[2];
+        let x26 = qd[1] + qd[2];
+        let x27 = x26 * x26;
+        let x28 = Self::mul_add(x17, x17, x27);
+        let x29 = x16 * x17;
+        let x30 = x25 + x29;
+        let x31 = Self::mul_add(x16, x26, x24);
+        let x32 = Self::mul_add(-x17, x26, x23);
+        let x33 = x25 - x29;
+        let x34 = Self::mul_add(x16, x16, x27);
         let x35 = Self::mul_add(
-            x16,
+            -103.41030072000001,
+            x17,
+            Self::mul_add(0.8021, x26, x16 * 5594.523885531201),
+        );
+        let x36 = Self::mul_add(
+            -0.08,
+            x17,
+            Self::mul_add(-5601.1318504688, x26, 0.8021 * x16),
+        );
+        let x37 = Self::mul_add(0.08, x26, 103.41030072000002 * x16);
+        let x38 = Self::mul_add(
+            x19,
             -15.183612000000002,
             Self::mul_add(
                 -103.41030072000001,
-                x21,
-                Self::mul_add(0.8021, x22, x20 * 5594.523885531201),
-            ) - Self::mul_add(x23, x34, x14 * x33),
+                x24,
+                Self::mul_add(0.8021, x25, x23 * 5594.523885531201),
+            ) - Self::mul_add(x26, x37, x17 * x36),
         );
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x37 = Self::mul_add(-x14, s_q3, x13 * c_q3);
-        let x38 = Self::mul_add(x14, c_q3, x13 * s_q3);
-        let x39 = x18 + Self::mul_add(0.1524, x27, 7.06 * x25);
-        let x40 = x16 + Self::mul_add(0.1524, x29, 7.06 * x28);
-        let x41 = x19 + Self::mul_add(-0.1524, x31, 7.06 * x30);
-        let x42 = Self::mul_add(c_q3, x41, s_q3 * x39);
-        let x43 = Self::mul_add(-qd[3], x38, Self::mul_add(-x21, s_q3, x20 * c_q3));
-        let x44 = Self::mul_add(qd[3], x37, Self::mul_add(x21, c_q3, x20 * s_q3));
-        let x45 = qdd[3] + x22;
-        let x46 = qd[3] + x23;
-        let x47 = Self::mul_add(x38, x38, x46 * x46);
-        let x48 = Self::mul_add(x37, x46, x44);
-        let x49 = Self::mul_add(-x37, x38, x45);
-        let x50 = x37 * 18.957952216000002;
-        let x51 = 19.863252216000003 * x46;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x53 = Self::mul_add(-x46, s_q4, x37 * c_q4);
-        let x54 = Self::mul_add(x46, c_q4, x37 * s_q4);
-        let x55 = Self::mul_add(
+        let x39 = Self::mul_add(-x17, s_q3, x16 * c_q3);
+        let x40 = Self::mul_add(x17, c_q3, x16 * s_q3);
+        let x41 = x21 + Self::mul_add(0.1524, x30, 7.06 * x28);
+        let x42 = x19 + Self::mul_add(0.1524, x32, 7.06 * x31);
+        let x43 = x22 + Self::mul_add(-0.1524, x34, 7.06 * x33);
+        let x44 = Self::mul_add(c_q3, x43, s_q3 * x41);
+        let x45 = Self::mul_add(-qd[3], x40, Self::mul_add(-x24, s_q3, x23 * c_q3));
+        let x46 = Self::mul_add(qd[3], x39, Self::mul_add(x24, c_q3, x23 * s_q3));
+        let x47 = qdd[3] + x25;
+        let x48 = qd[3] + x26;
+        let x49 = Self::mul_add(x40, x40, x48 * x48);
+        let x50 = Self::mul_add(x39, x48, x46);
+        let x51 = Self::mul_add(-x39, x40, x47);
+        let x52 = x39 * 18.957952216000002;
+        let x53 = 19.863252216000003 * x48;
+        let x54 = Self::mul_add(-x48, s_q4, x39 * c_q4);
+        let x55 = Self::mul_add(x48, c_q4, x39 * s_q4);
+        let x56 = Self::mul_add(
             -c_q4,
-            Self::mul_add(0.4572, x48, x40),
-            s_q4 * Self::mul_add(0.4572, x47, Self::mul_add(-s_q3, x41, c_q3 * x39)),
+            Self::mul_add(0.4572, x50, x42),
+            s_q4 * Self::mul_add(0.4572, x49, Self::mul_add(-s_q3, x43, c_q3 * x41)),
         );
-        let x56 = Self::mul_add(qd[4], x53, Self::mul_add(x45, c_q4, x43 * s_q4));
-        let x57 = qdd[4] - x44;
-        let x58 = qd[4] - x38;
-        let x59 = 34.45002 * Self::mul_add(x58, x58, x54 * x54);
-        let x60 = 34.45002 * Self::mul_add(-x53, x54, x57);
-        let x61 = 34.45002 * Self::mul_add(x53, x58, x56);
-        let x62 = 34.33891524 * x54;
-        let x63 = 34.74691524 * x58;
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x65 = Self::mul_add(x58, s_q5, x54 * c_q5);
-        let x66 = Self::mul_add(-x58, c_q5, x54 * s_q5);
-        let x67 = Self::mul_add(-qd[5], x66, Self::mul_add(x57, s_q5, x56 * c_q5));
-        let x68 = Self::mul_add(qd[5], x65, Self::mul_add(-x57, c_q5, x56 * s_q5));
+        let x57 = Self::mul_add(qd[4], x54, Self::mul_add(x47, c_q4, x45 * s_q4));
+        let x58 = qdd[4] - x46;
+        let x59 = qd[4] - x40;
+        let x60 = 34.45002 * Self::mul_add(x59, x59, x55 * x55);
+        let x61 = 34.45002 * Self::mul_add(-x54, x55, x58);
+        let x62 = 34.45002 * Self::mul_add(x54, x59, x57);
+        let x63 = 34.33891524 * x55;
+        let x64 = 34.74691524 * x59;
+        let x65 = Self::mul_add(x59, s_q5, x55 * c_q5);
+        let x66 = Self::mul_add(-x59, c_q5, x55 * s_q5);
+        let x67 = Self::mul_add(-qd[5], x66, Self::mul_add(x58, s_q5, x57 * c_q5));
+        let x68 = Self::mul_add(qd[5], x65, Self::mul_add(-x58, c_q5, x57 * s_q5));
         let x69 = qdd[5]
-            - Self::mul_add(-qd[4], x54, Self::mul_add(-x45, s_q4, x43 * c_q4));
-        let x70 = qd[5] - x53;
+            - Self::mul_add(-qd[4], x55, Self::mul_add(-x47, s_q4, x45 * c_q4));
+        let x70 = qd[5] - x54;
         let x71 = Self::mul_add(-0.966, x66, Self::mul_add(0.385, x65, 1.903 * x70));
         let x72 = Self::mul_add(-0.353, x66, 0.385 * x70);
         let x73 = Self::mul_add(
@@ -1559,56 +1570,56 @@ impl Srms {
             0.9929999999999999,
             Self::mul_add(0.353, x67, 0.966 * x69),
         ) - Self::mul_add(-x70, x72, x65 * x71);
-        let x77 = Self::mul_add(-x54, x63, x58 * x62) - x74;
+        let x77 = Self::mul_add(-x55, x64, x59 * x63) - x74;
         let x78 = Self::mul_add(
             34.45002,
-            Self::mul_add(0.4572, x49, x42),
-            Self::mul_add(x53, x63, 34.33891524 * x56),
+            Self::mul_add(0.4572, x51, x44),
+            Self::mul_add(x54, x64, 34.33891524 * x57),
         ) + Self::mul_add(-s_q5, x76, c_q5 * x75);
         let x79 = Self::mul_add(
             34.45002,
-            x55,
-            Self::mul_add(-x53, x62, 34.74691524 * x57),
+            x56,
+            Self::mul_add(-x54, x63, 34.74691524 * x58),
         ) + Self::mul_add(c_q5, x76, s_q5 * x75);
-        let x80 = Self::mul_add(-c_q4, x60, s_q4 * x59);
-        let x81 = Self::mul_add(41.67378, x47, Self::mul_add(s_q4, x60, c_q4 * x59));
-        let x82 = Self::mul_add(41.67378, x48, x80);
-        let x83 = Self::mul_add(41.67378, x49, x61);
-        let x84 = Self::mul_add(x38, x51, x43 * 18.957952216000002)
+        let x80 = Self::mul_add(-c_q4, x61, s_q4 * x60);
+        let x81 = Self::mul_add(41.67378, x49, Self::mul_add(s_q4, x61, c_q4 * x60));
+        let x82 = Self::mul_add(41.67378, x50, x80);
+        let x83 = Self::mul_add(41.67378, x51, x62);
+        let x84 = Self::mul_add(x40, x53, x45 * 18.957952216000002)
             - Self::mul_add(s_q4, x78, c_q4 * x77);
         let x85 = Self::mul_add(
             41.67378,
-            x42,
-            Self::mul_add(-x38, x50, 19.863252216000003 * x45),
-        ) - Self::mul_add(-0.4572, x61, Self::mul_add(-c_q4, x78, s_q4 * x77));
-        let x86 = Self::mul_add(41.67378, x40, Self::mul_add(x37, x51, x46 * x50))
+            x44,
+            Self::mul_add(-x40, x52, 19.863252216000003 * x47),
+        ) - Self::mul_add(-0.4572, x62, Self::mul_add(-c_q4, x78, s_q4 * x77));
+        let x86 = Self::mul_add(41.67378, x42, Self::mul_add(x39, x53, x48 * x52))
             - Self::mul_add(-0.4572, x80, x79);
         let x87 = Self::mul_add(s_q3, x83, c_q3 * x81);
         let x88 = Self::mul_add(-c_q3, x83, s_q3 * x81);
-        let x89 = Self::mul_add(x27, 15.183612000000002, 703.3878000000001 * x25) + x87;
-        let x90 = Self::mul_add(15.183612000000002, x29, 703.3878000000001 * x28) + x82;
-        let x91 = Self::mul_add(-15.183612000000002, x31, 703.3878000000001 * x30) - x88;
-        let x92 = x35
+        let x89 = Self::mul_add(x30, 15.183612000000002, 703.3878000000001 * x28) + x87;
+        let x90 = Self::mul_add(15.183612000000002, x32, 703.3878000000001 * x31) + x82;
+        let x91 = Self::mul_add(-15.183612000000002, x34, 703.3878000000001 * x33) - x88;
+        let x92 = x38
             + Self::mul_add(-0.1524, x82, Self::mul_add(-s_q3, x86, c_q3 * x84));
         let x93 = Self::mul_add(
             -0.08,
-            x21,
-            Self::mul_add(-5601.1318504688, x22, 0.8021 * x20),
-        ) + Self::mul_add(x13, x34, x14 * x32)
-            - Self::mul_add(703.3878000000001, x19, x18 * 15.183612000000002)
+            x24,
+            Self::mul_add(-5601.1318504688, x25, 0.8021 * x23),
+        ) + Self::mul_add(x16, x37, x17 * x35)
+            - Self::mul_add(703.3878000000001, x22, x21 * 15.183612000000002)
             - (x85 + Self::mul_add(-7.06, x88, 0.1524 * x87));
         let x94 = -x93;
         let x95 = Self::mul_add(
             703.3878000000001,
-            x16,
-            Self::mul_add(0.08, x22, 103.41030072000002 * x20)
-                + Self::mul_add(-x13, x33, x23 * x32),
+            x19,
+            Self::mul_add(0.08, x25, 103.41030072000002 * x23)
+                + Self::mul_add(-x16, x36, x26 * x35),
         ) + Self::mul_add(7.06, x82, Self::mul_add(c_q3, x86, s_q3 * x84));
         let x96 = Self::mul_add(
-            x6,
+            x10,
             -0.0302,
-            Self::mul_add(8609.573807858, qdd[1], x5 * 1.928),
-        ) + Self::mul_add(-x1, x11, x2 * x9)
+            Self::mul_add(8609.573807858, qdd[1], x9 * 1.928),
+        ) + Self::mul_add(-x5, x15, x6 * x13)
             - (x93
                 - Self::mul_add(
                     -6.377,
@@ -1617,15 +1628,15 @@ impl Srms {
                 ));
         let x97 = Self::mul_add(
             c_q1,
-            Self::mul_add(qdd[1], 0.0302, 190.97044034000004 * x5)
-                + Self::mul_add(x1, x10, qd[1] * x9)
+            Self::mul_add(qdd[1], 0.0302, 190.97044034000004 * x9)
+                + Self::mul_add(x5, x14, qd[1] * x13)
                 + Self::mul_add(6.377, x90, Self::mul_add(c_q2, x95, s_q2 * x92)),
             s_q1
                 * (Self::mul_add(
                     190.97044034,
-                    x6,
-                    Self::mul_add(qdd[1], -1.928, x5 * 8596.210051042),
-                ) - Self::mul_add(qd[1], x11, x2 * x10)
+                    x10,
+                    Self::mul_add(qdd[1], -1.928, x9 * 8596.210051042),
+                ) - Self::mul_add(qd[1], x15, x6 * x14)
                     + Self::mul_add(-0.1524, x90, Self::mul_add(-s_q2, x95, c_q2 * x92))),
         );
         let x98 = Self::mul_add(14222.257549666001, qdd[0], -x97);
@@ -1636,11 +1647,13 @@ impl Srms {
     /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 424 mul, 342 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 240 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
         let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
@@ -2047,11 +2060,13 @@ impl Srms {
         q: &[f64; 6],
         qd: &[f64; 6],
     ) -> ([[f64; 6]; 6], [f64; 6]) {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
         let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
@@ -2370,11 +2385,13 @@ impl Srms {
         tau: &[f64; 6],
         f_ext: &[[f64; 6]; 6],
     ) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q5 * s_q5;
         let x6 = s_q5 * c_q5;
         let x7 = Self::mul_add(x6, 0.706, x5 * 0.9929999999999999);
@@ -2826,13 +2843,21 @@ impl Srms {
             )
         )] { a * b + c }
     }
-    /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
-    /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
-    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 1 ulp of 1 of
-    /// libm's (`kanegen accuracy` measures it).
+    /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
     pub fn sincos(x: f64) -> (f64, f64) {
+        let [sc] = Self::sincos_n([x]);
+        sc
+    }
+    /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
+    /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
+    /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
+    /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
+    /// (`kanegen accuracy` measures it).
+    #[inline(always)]
+    #[must_use]
+    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
         /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
         const SIN_TABLE: [f64; 128] = [
             0.0,
@@ -2969,28 +2994,42 @@ impl Srms {
         const C2: f64 = -0.5;
         const C4: f64 = 1.0 / 24.0;
         const C6: f64 = -1.0 / 720.0;
-        if !(x > -32768.0 && x < 32768.0) {
-            return libm::sincos(x);
+        let mut fast = true;
+        for v in x {
+            fast &= v > -32768.0 && v < 32768.0;
         }
-        let t = Self::mul_add(x, 40.74366543152521, 6755399441055744.0);
-        let k = t - 6755399441055744.0;
-        let i = (t.to_bits() & 255) as usize;
-        let r_hi = Self::mul_add(-k, 0.024543692605220713, x);
-        let r = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
-        let r2 = r * r;
-        let r3 = r * r2;
-        let p_s = Self::mul_add(r2, S5, S3);
-        let sin_r = Self::mul_add(r3, p_s, r);
-        let p_c6 = Self::mul_add(r2, C6, C4);
-        let p_c = Self::mul_add(r2, p_c6, C2);
-        let cos_r = Self::mul_add(r2, p_c, 1.0);
+        if !fast {
+            return x.map(libm::sincos);
+        }
+        let (mut t, mut r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            t[i] = Self::mul_add(x[i], 40.74366543152521, 6755399441055744.0);
+            let k = t[i] - 6755399441055744.0;
+            let r_hi = Self::mul_add(-k, 0.024543692605220713, x[i]);
+            r[i] = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
+        }
+        let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            let r2 = r[i] * r[i];
+            let r3 = r[i] * r2;
+            let p_s = Self::mul_add(r2, S5, S3);
+            sin_r[i] = Self::mul_add(r3, p_s, r[i]);
+            let p_c6 = Self::mul_add(r2, C6, C4);
+            let p_c = Self::mul_add(r2, p_c6, C2);
+            cos_r[i] = Self::mul_add(r2, p_c, 1.0);
+        }
         let table = |j: usize| {
             f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
         };
-        let (sin_a, cos_a) = (table(i), table(i + 64));
-        (
-            Self::mul_add(sin_a, cos_r, cos_a * sin_r),
-            Self::mul_add(cos_a, cos_r, -(sin_a * sin_r)),
-        )
+        let mut out = [(0.0, 0.0); N];
+        for i in 0..N {
+            let j = (t[i].to_bits() & 255) as usize;
+            let (sin_a, cos_a) = (table(j), table(j + 64));
+            out[i] = (
+                Self::mul_add(sin_a, cos_r[i], cos_a * sin_r[i]),
+                Self::mul_add(cos_a, cos_r[i], -(sin_a * sin_r[i])),
+            );
+        }
+        out
     }
 }

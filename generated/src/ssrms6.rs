@@ -1129,10 +1129,12 @@ impl Ssrms6 {
     /// Methods: mass matrix `crba`: 76 mul, 65 add, 0 div, 0 sqrt, 4 sincos (emitted), of which 35 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 6]) -> [[f64; 6]; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+        ]);
         let x4 = s_q4 * s_q4 * 35.074;
         let x5 = -35.074 + x4;
         let x6 = s_q4 * c_q4 * 35.074;
@@ -1226,117 +1228,119 @@ impl Ssrms6 {
     /// Methods: bias `newton-euler`: 155 mul, 99 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 80 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 6], qd: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x1 = qd[0] * s_q1;
-        let x2 = qd[0] * c_q1;
-        let x3 = qd[0] * qd[0] * 0.5692;
-        let x4 = qd[1] * x2;
-        let x5 = qd[1] * x1;
-        let x6 = x2 * x2;
-        let x7 = Self::mul_add(qd[1], qd[1], x6);
-        let x8 = x1 * x2;
-        let x9 = Self::mul_add(3946.18812068, qd[1], x1 * 39234.47412200001);
-        let x10 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x1);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x12 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x13 = Self::mul_add(-x2, c_q2, x1 * s_q2);
-        let x14 = 7.11 * x7;
-        let x15 = 7.11 * x8;
-        let x16 = x3
-            - Self::mul_add(Self::mul_add(x1, x1, x6), -0.475, 7.11 * (x5 + x5));
-        let x17 = Self::mul_add(c_q2, x15, s_q2 * x14);
-        let x18 = Self::mul_add(-qd[2], x13, Self::mul_add(-x5, s_q2, x4 * c_q2));
-        let x19 = Self::mul_add(qd[2], x12, Self::mul_add(x5, c_q2, x4 * s_q2));
-        let x20 = qd[1] + qd[2];
-        let x21 = Self::mul_add(x13, x13, x20 * x20);
-        let x22 = x12 * x13;
-        let x23 = Self::mul_add(x12, x20, x19);
-        let x24 = Self::mul_add(1375.0472756800002, x20, x12 * 24989.305802);
-        let x25 = Self::mul_add(-24998.827802, x20, 1375.0472756800002 * x12);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x27 = Self::mul_add(-x13, s_q3, x12 * c_q3);
-        let x28 = Self::mul_add(x13, c_q3, x12 * s_q3);
-        let x29 = Self::mul_add(
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
+        let x5 = qd[0] * s_q1;
+        let x6 = qd[0] * c_q1;
+        let x7 = qd[0] * qd[0] * 0.5692;
+        let x8 = qd[1] * x6;
+        let x9 = qd[1] * x5;
+        let x10 = x6 * x6;
+        let x11 = Self::mul_add(qd[1], qd[1], x10);
+        let x12 = x5 * x6;
+        let x13 = Self::mul_add(3946.18812068, qd[1], x5 * 39234.47412200001);
+        let x14 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x5);
+        let x15 = Self::mul_add(x6, s_q2, x5 * c_q2);
+        let x16 = Self::mul_add(-x6, c_q2, x5 * s_q2);
+        let x17 = 7.11 * x11;
+        let x18 = 7.11 * x12;
+        let x19 = x7
+            - Self::mul_add(Self::mul_add(x5, x5, x10), -0.475, 7.11 * (x9 + x9));
+        let x20 = Self::mul_add(c_q2, x18, s_q2 * x17);
+        let x21 = Self::mul_add(-qd[2], x16, Self::mul_add(-x9, s_q2, x8 * c_q2));
+        let x22 = Self::mul_add(qd[2], x15, Self::mul_add(x9, c_q2, x8 * s_q2));
+        let x23 = qd[1] + qd[2];
+        let x24 = Self::mul_add(x16, x16, x23 * x23);
+        let x25 = x15 * x16;
+        let x26 = Self::mul_add(x15, x23, x22);
+        let x27 = Self::mul_add(1375.0472756800002, x23, x15 * 24989.305802);
+        let x28 = Self::mul_add(-24998.827802, x23, 1375.0472756800002 * x15);
+        let x29 = Self::mul_add(-x16, s_q3, x15 * c_q3);
+        let x30 = Self::mul_add(x16, c_q3, x15 * s_q3);
+        let x31 = Self::mul_add(
             -s_q3,
-            Self::mul_add(-7.11, x22, x17),
-            c_q3 * Self::mul_add(7.11, x21, Self::mul_add(-s_q2, x15, c_q2 * x14)),
+            Self::mul_add(-7.11, x25, x20),
+            c_q3 * Self::mul_add(7.11, x24, Self::mul_add(-s_q2, x18, c_q2 * x17)),
         );
-        let x30 = Self::mul_add(-qd[3], x28, Self::mul_add(-x19, s_q3, x18 * c_q3));
-        let x31 = Self::mul_add(qd[3], x27, Self::mul_add(x19, c_q3, x18 * s_q3));
-        let x32 = qd[3] + x20;
-        let x33 = x27 * x28 * 171.195516;
-        let x34 = 171.195516 * Self::mul_add(-x28, x32, x30);
-        let x35 = 171.195516 * Self::mul_add(x27, x27, x32 * x32);
-        let x36 = 132.6783695416 * x27;
-        let x37 = Self::mul_add(x28, 97.44448770720001, 135.4729695416 * x32);
-        let x38 = x32 * 97.44448770720001;
-        let x39 = Self::mul_add(
-            Self::mul_add(-7.11, x23, x16),
+        let x32 = Self::mul_add(-qd[3], x30, Self::mul_add(-x22, s_q3, x21 * c_q3));
+        let x33 = Self::mul_add(qd[3], x29, Self::mul_add(x22, c_q3, x21 * s_q3));
+        let x34 = qd[3] + x23;
+        let x35 = x29 * x30 * 171.195516;
+        let x36 = 171.195516 * Self::mul_add(-x30, x34, x32);
+        let x37 = 171.195516 * Self::mul_add(x29, x29, x34 * x34);
+        let x38 = 132.6783695416 * x29;
+        let x39 = Self::mul_add(x30, 97.44448770720001, 135.4729695416 * x34);
+        let x40 = x34 * 97.44448770720001;
+        let x41 = Self::mul_add(
+            Self::mul_add(-7.11, x26, x19),
             -171.195516,
-            Self::mul_add(132.6783695416, x30, -Self::mul_add(-x32, x38, x28 * x37)),
+            Self::mul_add(132.6783695416, x32, -Self::mul_add(-x34, x40, x30 * x39)),
         );
-        let x40 = Self::mul_add(
-            x29,
+        let x42 = Self::mul_add(
+            x31,
             171.195516,
-            Self::mul_add(x31, 97.44448770720001, Self::mul_add(-x27, x38, x28 * x36)),
+            Self::mul_add(x33, 97.44448770720001, Self::mul_add(-x29, x40, x30 * x38)),
         );
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x42 = Self::mul_add(-x32, s_q4, x27 * c_q4);
-        let x43 = Self::mul_add(x32, c_q4, x27 * s_q4);
-        let x44 = qd[4] - x28;
-        let x45 = 44.41 * x43;
-        let x46 = 47.471 * x44;
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x48 = 9.336 * Self::mul_add(-qd[4], x43, x30 * c_q4);
+        let x43 = Self::mul_add(-x34, s_q4, x29 * c_q4);
+        let x44 = Self::mul_add(x34, c_q4, x29 * s_q4);
+        let x45 = qd[4] - x30;
+        let x46 = 44.41 * x44;
+        let x47 = 47.471 * x45;
+        let x48 = 9.336 * Self::mul_add(-qd[4], x44, x32 * c_q4);
         let x49 = -x48;
-        let x50 = 9.336 * (qd[5] - x42);
-        let x51 = Self::mul_add(-x44, c_q5, x43 * s_q5) * x50;
-        let x52 = Self::mul_add(x44, s_q5, x43 * c_q5) * x50;
-        let x53 = Self::mul_add(-x43, x46, x44 * x45) + x48;
-        let x54 = Self::mul_add(x42, x46, 44.41 * Self::mul_add(qd[4], x42, x30 * s_q4))
+        let x50 = 9.336 * (qd[5] - x43);
+        let x51 = Self::mul_add(-x45, c_q5, x44 * s_q5) * x50;
+        let x52 = Self::mul_add(x45, s_q5, x44 * c_q5) * x50;
+        let x53 = Self::mul_add(-x44, x47, x45 * x46) + x48;
+        let x54 = Self::mul_add(x43, x47, 44.41 * Self::mul_add(qd[4], x43, x32 * s_q4))
             - Self::mul_add(-s_q5, x52, c_q5 * x51);
-        let x55 = Self::mul_add(x42, x45, 47.471 * x31)
+        let x55 = Self::mul_add(x43, x46, 47.471 * x33)
             + Self::mul_add(c_q5, x52, s_q5 * x51);
         let x56 = -x55;
-        let x57 = x39 + Self::mul_add(s_q4, x54, c_q4 * x53);
-        let x58 = x40 - Self::mul_add(-c_q4, x54, s_q4 * x53);
-        let x59 = Self::mul_add(-x27, x37, x32 * x36) - x55;
-        let x60 = Self::mul_add(c_q3, x35, s_q3 * x33);
-        let x61 = Self::mul_add(3239.4582, x21, Self::mul_add(-s_q3, x35, c_q3 * x33));
-        let x62 = Self::mul_add(3239.4582, x22, x60);
-        let x63 = Self::mul_add(-x13, x25, x18 * 24989.305802)
+        let x57 = x41 + Self::mul_add(s_q4, x54, c_q4 * x53);
+        let x58 = x42 - Self::mul_add(-c_q4, x54, s_q4 * x53);
+        let x59 = Self::mul_add(-x29, x39, x34 * x38) - x55;
+        let x60 = Self::mul_add(c_q3, x37, s_q3 * x35);
+        let x61 = Self::mul_add(3239.4582, x24, Self::mul_add(-s_q3, x37, c_q3 * x35));
+        let x62 = Self::mul_add(3239.4582, x25, x60);
+        let x63 = Self::mul_add(-x16, x28, x21 * 24989.305802)
             - Self::mul_add(-s_q3, x59, c_q3 * x57);
         let x64 = Self::mul_add(
             -3239.4582,
-            x17,
-            Self::mul_add(x13, x24, 1375.0472756800002 * x18),
+            x20,
+            Self::mul_add(x16, x27, 1375.0472756800002 * x21),
         ) - Self::mul_add(-7.11, x60, x58);
         let x65 = -x64;
-        let x66 = Self::mul_add(-3239.4582, x16, Self::mul_add(-x12, x25, x20 * x24))
-            - Self::mul_add(-7.11, x34, Self::mul_add(c_q3, x59, s_q3 * x57));
+        let x66 = Self::mul_add(-3239.4582, x19, Self::mul_add(-x15, x28, x23 * x27))
+            - Self::mul_add(-7.11, x36, Self::mul_add(c_q3, x59, s_q3 * x57));
         let x67 = Self::mul_add(-s_q2, x62, c_q2 * x61);
         let x68 = Self::mul_add(c_q2, x62, s_q2 * x61);
-        let x69 = -(Self::mul_add(-x2, x9, 3946.1881206800003 * x4)
+        let x69 = -(Self::mul_add(-x6, x13, 3946.1881206800003 * x8)
             + Self::mul_add(7.11, x68, x64));
         let x70 = Self::mul_add(
             c_q1,
-            Self::mul_add(-5224.5702, x3, Self::mul_add(-x1, x10, qd[1] * x9))
+            Self::mul_add(-5224.5702, x7, Self::mul_add(-x5, x14, qd[1] * x13))
                 + (Self::mul_add(c_q2, x66, s_q2 * x63)
                     + Self::mul_add(
                         7.11,
-                        Self::mul_add(3239.4582, x23, x34),
+                        Self::mul_add(3239.4582, x26, x36),
                         0.475 * x67,
                     )),
             s_q1
-                * (Self::mul_add(x2, x10, x4 * 39234.47412200001)
+                * (Self::mul_add(x6, x14, x8 * 39234.47412200001)
                     + Self::mul_add(-0.475, x68, Self::mul_add(-s_q2, x66, c_q2 * x63))),
         );
         let x71 = Self::mul_add(
             0.5692,
             Self::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x8, -x68),
-                c_q1 * Self::mul_add(5224.5702, x7, x67),
+                Self::mul_add(5224.5702, x12, -x68),
+                c_q1 * Self::mul_add(5224.5702, x11, x67),
             ),
             x70,
         );
@@ -1348,150 +1352,152 @@ impl Ssrms6 {
     /// Methods: bias `newton-euler`: 171 mul, 123 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 95 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 6], qd: &[f64; 6], qdd: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x1 = qd[0] * s_q1;
-        let x2 = qd[0] * c_q1;
-        let x3 = 0.5692 * qdd[0];
-        let x4 = 0.5692 * (qd[0] * qd[0]);
-        let x5 = s_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = qd[1] * x1;
-        let x8 = Self::mul_add(qdd[0], s_q1, x6);
-        let x9 = Self::mul_add(qdd[0], c_q1, -x7);
-        let x10 = x2 * x2;
-        let x11 = Self::mul_add(qd[1], qd[1], x10);
-        let x12 = Self::mul_add(x1, x2, qdd[1]);
-        let x13 = 3946.18812068 * qd[1];
-        let x14 = 39234.474122 * x2;
-        let x15 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x1);
-        let x16 = Self::mul_add(
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
+        let x5 = qd[0] * s_q1;
+        let x6 = qd[0] * c_q1;
+        let x7 = 0.5692 * qdd[0];
+        let x8 = 0.5692 * (qd[0] * qd[0]);
+        let x9 = s_q1 * x7;
+        let x10 = qd[1] * x6;
+        let x11 = qd[1] * x5;
+        let x12 = Self::mul_add(qdd[0], s_q1, x10);
+        let x13 = Self::mul_add(qdd[0], c_q1, -x11);
+        let x14 = x6 * x6;
+        let x15 = Self::mul_add(qd[1], qd[1], x14);
+        let x16 = Self::mul_add(x5, x6, qdd[1]);
+        let x17 = 3946.18812068 * qd[1];
+        let x18 = 39234.474122 * x6;
+        let x19 = Self::mul_add(-39241.404122, qd[1], 3946.1881206800003 * x5);
+        let x20 = Self::mul_add(
             5224.5702,
-            x4,
-            Self::mul_add(39234.474122, x9, -Self::mul_add(-x1, x15, qd[1] * x13)),
+            x8,
+            Self::mul_add(39234.474122, x13, -Self::mul_add(-x5, x19, qd[1] * x17)),
         );
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x18 = Self::mul_add(x2, s_q2, x1 * c_q2);
-        let x19 = Self::mul_add(-x2, c_q2, x1 * s_q2);
-        let x20 = Self::mul_add(c_q1, x3, -Self::mul_add(x7 + x9, -0.475, 7.11 * x11));
-        let x21 = x5 - Self::mul_add(x6 - x8, 0.475, 7.11 * x12);
-        let x22 = x4
-            - Self::mul_add(Self::mul_add(x1, x1, x10), -0.475, 7.11 * (x7 - x9));
-        let x23 = Self::mul_add(c_q2, x21, s_q2 * x20);
-        let x24 = Self::mul_add(-qd[2], x19, Self::mul_add(x9, s_q2, x8 * c_q2));
-        let x25 = Self::mul_add(qd[2], x18, Self::mul_add(-x9, c_q2, x8 * s_q2));
-        let x26 = qdd[1] + qdd[2];
-        let x27 = qd[1] + qd[2];
-        let x28 = Self::mul_add(x27, x27, x19 * x19);
-        let x29 = Self::mul_add(-x18, x19, x26);
-        let x30 = Self::mul_add(x18, x27, x25);
-        let x31 = 1375.0472756800002 * x27;
-        let x32 = 24989.305802 * x19;
-        let x33 = Self::mul_add(-24998.827802, x27, 1375.0472756800002 * x18);
-        let x34 = Self::mul_add(
+        let x21 = Self::mul_add(x6, s_q2, x5 * c_q2);
+        let x22 = Self::mul_add(-x6, c_q2, x5 * s_q2);
+        let x23 = Self::mul_add(c_q1, x7, -Self::mul_add(x11 + x13, -0.475, 7.11 * x15));
+        let x24 = x9 - Self::mul_add(x10 - x12, 0.475, 7.11 * x16);
+        let x25 = x8
+            - Self::mul_add(Self::mul_add(x5, x5, x14), -0.475, 7.11 * (x11 - x13));
+        let x26 = Self::mul_add(c_q2, x24, s_q2 * x23);
+        let x27 = Self::mul_add(-qd[2], x22, Self::mul_add(x13, s_q2, x12 * c_q2));
+        let x28 = Self::mul_add(qd[2], x21, Self::mul_add(-x13, c_q2, x12 * s_q2));
+        let x29 = qdd[1] + qdd[2];
+        let x30 = qd[1] + qd[2];
+        let x31 = Self::mul_add(x30, x30, x22 * x22);
+        let x32 = Self::mul_add(-x21, x22, x29);
+        let x33 = Self::mul_add(x21, x30, x28);
+        let x34 = 1375.0472756800002 * x30;
+        let x35 = 24989.305802 * x22;
+        let x36 = Self::mul_add(-24998.827802, x30, 1375.0472756800002 * x21);
+        let x37 = Self::mul_add(
             -3239.4582,
-            x22,
-            Self::mul_add(24989.305802, x25, Self::mul_add(-x18, x33, x27 * x31)),
+            x25,
+            Self::mul_add(24989.305802, x28, Self::mul_add(-x21, x36, x30 * x34)),
         );
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x36 = Self::mul_add(-x19, s_q3, x18 * c_q3);
-        let x37 = Self::mul_add(x19, c_q3, x18 * s_q3);
-        let x38 = Self::mul_add(
+        let x38 = Self::mul_add(-x22, s_q3, x21 * c_q3);
+        let x39 = Self::mul_add(x22, c_q3, x21 * s_q3);
+        let x40 = Self::mul_add(
             -s_q3,
-            Self::mul_add(-7.11, x29, x23),
-            c_q3 * Self::mul_add(-7.11, x28, Self::mul_add(-s_q2, x21, c_q2 * x20)),
+            Self::mul_add(-7.11, x32, x26),
+            c_q3 * Self::mul_add(-7.11, x31, Self::mul_add(-s_q2, x24, c_q2 * x23)),
         );
-        let x39 = Self::mul_add(-qd[3], x37, Self::mul_add(-x25, s_q3, x24 * c_q3));
-        let x40 = Self::mul_add(qd[3], x36, Self::mul_add(x25, c_q3, x24 * s_q3));
-        let x41 = qdd[3] + x26;
-        let x42 = qd[3] + x27;
-        let x43 = 171.195516 * Self::mul_add(x36, x37, x41);
-        let x44 = 171.195516 * Self::mul_add(x36, x36, x42 * x42);
-        let x45 = 171.195516 * Self::mul_add(-x37, x42, x39);
-        let x46 = Self::mul_add(-97.44448770720001, x42, x37 * 177.0883695416);
-        let x47 = Self::mul_add(179.8829695416, x42, 97.44448770720001 * x37);
-        let x48 = Self::mul_add(
+        let x41 = Self::mul_add(-qd[3], x39, Self::mul_add(-x28, s_q3, x27 * c_q3));
+        let x42 = Self::mul_add(qd[3], x38, Self::mul_add(x28, c_q3, x27 * s_q3));
+        let x43 = qdd[3] + x29;
+        let x44 = qd[3] + x30;
+        let x45 = 171.195516 * Self::mul_add(x38, x39, x43);
+        let x46 = 171.195516 * Self::mul_add(x38, x38, x44 * x44);
+        let x47 = 171.195516 * Self::mul_add(-x39, x44, x41);
+        let x48 = Self::mul_add(-97.44448770720001, x44, x39 * 177.0883695416);
+        let x49 = Self::mul_add(179.8829695416, x44, 97.44448770720001 * x39);
+        let x50 = Self::mul_add(
             -171.195516,
-            x38,
+            x40,
             Self::mul_add(
-                x36,
-                x46,
-                Self::mul_add(179.8829695416, x41, 97.44448770720001 * x40),
+                x38,
+                x48,
+                Self::mul_add(179.8829695416, x43, 97.44448770720001 * x42),
             ),
         );
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x50 = Self::mul_add(x42, c_q4, x36 * s_q4);
-        let x51 = Self::mul_add(-x42, s_q4, x36 * c_q4);
-        let x52 = Self::mul_add(-qd[4], x50, Self::mul_add(-x41, s_q4, x39 * c_q4));
-        let x53 = qd[4] - x37;
-        let x54 = 44.41 * x51;
-        let x55 = 47.471 * x53;
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x57 = 9.336 * (qdd[5] - x52);
-        let x58 = 9.336 * (qd[5] - x51);
-        let x59 = Self::mul_add(-x53, c_q5, x50 * s_q5) * x58;
-        let x60 = Self::mul_add(x53, s_q5, x50 * c_q5) * x58;
-        let x61 = Self::mul_add(x51, x55, x53 * x54)
+        let x51 = Self::mul_add(x44, c_q4, x38 * s_q4);
+        let x52 = Self::mul_add(-x44, s_q4, x38 * c_q4);
+        let x53 = Self::mul_add(-qd[4], x51, Self::mul_add(-x43, s_q4, x41 * c_q4));
+        let x54 = qd[4] - x39;
+        let x55 = 44.41 * x52;
+        let x56 = 47.471 * x54;
+        let x57 = 9.336 * (qdd[5] - x53);
+        let x58 = 9.336 * (qd[5] - x52);
+        let x59 = Self::mul_add(-x54, c_q5, x51 * s_q5) * x58;
+        let x60 = Self::mul_add(x54, s_q5, x51 * c_q5) * x58;
+        let x61 = Self::mul_add(x52, x56, x54 * x55)
             - Self::mul_add(-s_q5, x60, c_q5 * x59);
-        let x62 = Self::mul_add(x50, x55, 44.41 * x52) + x57;
-        let x63 = Self::mul_add(-x50, x54, 47.471 * (qdd[4] - x40))
+        let x62 = Self::mul_add(x51, x56, 44.41 * x53) + x57;
+        let x63 = Self::mul_add(-x51, x55, 47.471 * (qdd[4] - x42))
             - Self::mul_add(c_q5, x60, s_q5 * x59);
         let x64 = Self::mul_add(
             171.195516,
-            Self::mul_add(-7.11, x30, x22),
-            Self::mul_add(x37, x47, x42 * x46),
+            Self::mul_add(-7.11, x33, x25),
+            Self::mul_add(x39, x49, x44 * x48),
         ) - Self::mul_add(-c_q4, x62, s_q4 * x61);
         let x65 = Self::mul_add(
-            -x36,
-            x47,
-            Self::mul_add(-97.44448770720001, x41, x40 * 177.0883695416),
+            -x38,
+            x49,
+            Self::mul_add(-97.44448770720001, x43, x42 * 177.0883695416),
         ) + x63;
-        let x66 = x48 + Self::mul_add(s_q4, x62, c_q4 * x61);
-        let x67 = Self::mul_add(c_q3, x44, s_q3 * x43);
-        let x68 = Self::mul_add(3239.4582, x28, Self::mul_add(-s_q3, x44, c_q3 * x43));
-        let x69 = Self::mul_add(3239.4582, x29, -x67);
+        let x66 = x50 + Self::mul_add(s_q4, x62, c_q4 * x61);
+        let x67 = Self::mul_add(c_q3, x46, s_q3 * x45);
+        let x68 = Self::mul_add(3239.4582, x31, Self::mul_add(-s_q3, x46, c_q3 * x45));
+        let x69 = Self::mul_add(3239.4582, x32, -x67);
         let x70 = Self::mul_add(
             1375.0472756800002,
-            x26,
-            -Self::mul_add(x19, x33, x27 * x32),
+            x29,
+            -Self::mul_add(x22, x36, x30 * x35),
         ) + Self::mul_add(s_q3, x65, c_q3 * x64);
-        let x71 = x34 + Self::mul_add(7.11, x45, Self::mul_add(-c_q3, x65, s_q3 * x64));
+        let x71 = x37 + Self::mul_add(7.11, x47, Self::mul_add(-c_q3, x65, s_q3 * x64));
         let x72 = Self::mul_add(
             3239.4582,
-            x23,
-            Self::mul_add(-24998.827802, x26, 1375.0472756800002 * x24)
-                + Self::mul_add(x18, x32, x19 * x31),
+            x26,
+            Self::mul_add(-24998.827802, x29, 1375.0472756800002 * x27)
+                + Self::mul_add(x21, x35, x22 * x34),
         ) - Self::mul_add(-7.11, x67, x66);
         let x73 = -x72;
         let x74 = Self::mul_add(s_q2, x69, c_q2 * x68);
         let x75 = Self::mul_add(-c_q2, x69, s_q2 * x68);
         let x76 = -(Self::mul_add(
             5224.5702,
-            x5,
-            Self::mul_add(-39241.404122, qdd[1], 3946.1881206800003 * x8)
-                - Self::mul_add(x1, x14, x2 * x13),
+            x9,
+            Self::mul_add(-39241.404122, qdd[1], 3946.1881206800003 * x12)
+                - Self::mul_add(x5, x18, x6 * x17),
         ) + Self::mul_add(7.11, x75, x72));
         let x77 = Self::mul_add(
             -c_q1,
-            x16
+            x20
                 - (Self::mul_add(c_q2, x71, s_q2 * x70)
                     + Self::mul_add(
                         7.11,
-                        Self::mul_add(3239.4582, x30, x45),
+                        Self::mul_add(3239.4582, x33, x47),
                         0.475 * x74,
                     )),
             s_q1
                 * (Self::mul_add(
                     3946.18812068,
                     qdd[1],
-                    Self::mul_add(x2, x15, qd[1] * x14),
+                    Self::mul_add(x6, x19, qd[1] * x18),
                 ) + Self::mul_add(-0.475, x75, Self::mul_add(-s_q2, x71, c_q2 * x70))),
         );
         let x78 = Self::mul_add(
             0.5692,
             Self::mul_add(
                 s_q1,
-                Self::mul_add(5224.5702, x12, -x75),
-                c_q1 * Self::mul_add(5224.5702, x11, x74),
+                Self::mul_add(5224.5702, x16, -x75),
+                c_q1 * Self::mul_add(5224.5702, x15, x74),
             ),
             x77,
         );
@@ -1503,11 +1509,13 @@ impl Ssrms6 {
     /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 317 mul, 231 add, 6 div, 0 sqrt, 5 sincos (emitted), of which 176 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 6], qd: &[f64; 6], tau: &[f64; 6]) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q4 * s_q4 * 35.074;
         let x6 = -35.074 + x5;
         let x7 = s_q4 * c_q4 * 35.074;
@@ -1812,11 +1820,13 @@ impl Ssrms6 {
         q: &[f64; 6],
         qd: &[f64; 6],
     ) -> ([[f64; 6]; 6], [f64; 6]) {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q4 * s_q4 * 35.074;
         let x6 = -35.074 + x5;
         let x7 = s_q4 * c_q4 * 35.074;
@@ -2042,11 +2052,13 @@ impl Ssrms6 {
         tau: &[f64; 6],
         f_ext: &[[f64; 6]; 6],
     ) -> [f64; 6] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q4 * s_q4 * 35.074;
         let x6 = s_q4 * c_q4 * 35.074;
         let x7 = 132.6783695416 + (9.336 + x5);
@@ -2381,13 +2393,21 @@ impl Ssrms6 {
             )
         )] { a * b + c }
     }
-    /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
-    /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
-    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 1 ulp of 1 of
-    /// libm's (`kanegen accuracy` measures it).
+    /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
     pub fn sincos(x: f64) -> (f64, f64) {
+        let [sc] = Self::sincos_n([x]);
+        sc
+    }
+    /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
+    /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
+    /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
+    /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
+    /// (`kanegen accuracy` measures it).
+    #[inline(always)]
+    #[must_use]
+    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
         /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
         const SIN_TABLE: [f64; 128] = [
             0.0,
@@ -2524,28 +2544,42 @@ impl Ssrms6 {
         const C2: f64 = -0.5;
         const C4: f64 = 1.0 / 24.0;
         const C6: f64 = -1.0 / 720.0;
-        if !(x > -32768.0 && x < 32768.0) {
-            return libm::sincos(x);
+        let mut fast = true;
+        for v in x {
+            fast &= v > -32768.0 && v < 32768.0;
         }
-        let t = Self::mul_add(x, 40.74366543152521, 6755399441055744.0);
-        let k = t - 6755399441055744.0;
-        let i = (t.to_bits() & 255) as usize;
-        let r_hi = Self::mul_add(-k, 0.024543692605220713, x);
-        let r = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
-        let r2 = r * r;
-        let r3 = r * r2;
-        let p_s = Self::mul_add(r2, S5, S3);
-        let sin_r = Self::mul_add(r3, p_s, r);
-        let p_c6 = Self::mul_add(r2, C6, C4);
-        let p_c = Self::mul_add(r2, p_c6, C2);
-        let cos_r = Self::mul_add(r2, p_c, 1.0);
+        if !fast {
+            return x.map(libm::sincos);
+        }
+        let (mut t, mut r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            t[i] = Self::mul_add(x[i], 40.74366543152521, 6755399441055744.0);
+            let k = t[i] - 6755399441055744.0;
+            let r_hi = Self::mul_add(-k, 0.024543692605220713, x[i]);
+            r[i] = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
+        }
+        let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            let r2 = r[i] * r[i];
+            let r3 = r[i] * r2;
+            let p_s = Self::mul_add(r2, S5, S3);
+            sin_r[i] = Self::mul_add(r3, p_s, r[i]);
+            let p_c6 = Self::mul_add(r2, C6, C4);
+            let p_c = Self::mul_add(r2, p_c6, C2);
+            cos_r[i] = Self::mul_add(r2, p_c, 1.0);
+        }
         let table = |j: usize| {
             f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
         };
-        let (sin_a, cos_a) = (table(i), table(i + 64));
-        (
-            Self::mul_add(sin_a, cos_r, cos_a * sin_r),
-            Self::mul_add(cos_a, cos_r, -(sin_a * sin_r)),
-        )
+        let mut out = [(0.0, 0.0); N];
+        for i in 0..N {
+            let j = (t[i].to_bits() & 255) as usize;
+            let (sin_a, cos_a) = (table(j), table(j + 64));
+            out[i] = (
+                Self::mul_add(sin_a, cos_r[i], cos_a * sin_r[i]),
+                Self::mul_add(cos_a, cos_r[i], -(sin_a * sin_r[i])),
+            );
+        }
+        out
     }
 }

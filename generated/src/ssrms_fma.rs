@@ -1131,11 +1131,13 @@ impl SsrmsFma {
     /// Methods: mass matrix `crba`: 120 mul, 97 add, 0 div, 0 sqrt, 5 sincos (emitted), of which 58 fused multiply-adds.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5)] = Self::sincos_n([
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+        ]);
         let x5 = s_q5 * s_q5 * 35.074;
         let x6 = -35.074 + x5;
         let x7 = s_q5 * c_q5 * 35.074;
@@ -1267,155 +1269,151 @@ impl SsrmsFma {
     /// Methods: bias `newton-euler`: 206 mul, 141 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 113 fused multiply-adds.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x1 = qd[0] * c_q1;
-        let x2 = qd[0] * s_q1;
-        let x3 = qd[0] * qd[0] * 0.7026;
-        let x4 = qd[1] * x2;
-        let x5 = qd[1] * x1;
-        let x6 = x1 * x2;
-        let x7 = libm::fma(x1, x1, qd[1] * qd[1]);
-        let x8 = x2 * 1647.2196721184;
-        let x9 = 1650.6386721183999 * qd[1];
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x11 = libm::fma(-qd[1], s_q2, x1 * c_q2);
-        let x12 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x13 = 0.5692 * x6;
-        let x14 = 0.5692 * x7;
-        let x15 = libm::fma(-0.5692, x4 + x4, x3);
-        let x16 = libm::fma(-c_q2, x15, s_q2 * x13);
-        let x17 = libm::fma(qd[2], x12, x4 * c_q2);
-        let x18 = libm::fma(-qd[2], x11, x4 * s_q2);
-        let x19 = qd[2] - x2;
-        let x20 = x12 * x12;
-        let x21 = libm::fma(x19, x19, x20);
-        let x22 = x11 * x19;
-        let x23 = libm::fma(x11, x12, x5);
-        let x24 = x18 - x22;
-        let x25 = 3946.18812068 * x19;
-        let x26 = 39234.474122 * x12;
-        let x27 = libm::fma(39241.404122, x19, 3946.1881206800003 * x11);
-        let x28 = libm::fma(
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
+        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        let x6 = qd[0] * c_q1;
+        let x7 = qd[0] * s_q1;
+        let x8 = qd[0] * qd[0] * 0.7026;
+        let x9 = qd[1] * x7;
+        let x10 = qd[1] * x6;
+        let x11 = x6 * x7;
+        let x12 = libm::fma(x6, x6, qd[1] * qd[1]);
+        let x13 = x7 * 1647.2196721184;
+        let x14 = 1650.6386721183999 * qd[1];
+        let x15 = libm::fma(-qd[1], s_q2, x6 * c_q2);
+        let x16 = libm::fma(qd[1], c_q2, x6 * s_q2);
+        let x17 = 0.5692 * x11;
+        let x18 = 0.5692 * x12;
+        let x19 = libm::fma(-0.5692, x9 + x9, x8);
+        let x20 = libm::fma(-c_q2, x19, s_q2 * x17);
+        let x21 = libm::fma(qd[2], x16, x9 * c_q2);
+        let x22 = libm::fma(-qd[2], x15, x9 * s_q2);
+        let x23 = qd[2] - x7;
+        let x24 = x16 * x16;
+        let x25 = libm::fma(x23, x23, x24);
+        let x26 = x15 * x23;
+        let x27 = libm::fma(x15, x16, x10);
+        let x28 = x22 - x26;
+        let x29 = 3946.18812068 * x23;
+        let x30 = 39234.474122 * x16;
+        let x31 = libm::fma(39241.404122, x23, 3946.1881206800003 * x15);
+        let x32 = libm::fma(
             -5224.5702,
-            x14,
-            libm::fma(39234.474122, x18, libm::fma(-x11, x27, x19 * x25)),
+            x18,
+            libm::fma(39234.474122, x22, libm::fma(-x15, x31, x23 * x29)),
         );
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x30 = libm::fma(-x12, s_q3, x11 * c_q3);
-        let x31 = libm::fma(x12, c_q3, x11 * s_q3);
-        let x32 = libm::fma(s_q2, x15, c_q2 * x13)
-            - libm::fma(x18 + x22, 0.475, 7.11 * x21);
-        let x33 = x16 + libm::fma(libm::fma(-x12, x19, x17), 0.475, 7.11 * x23);
-        let x34 = x14 - libm::fma(libm::fma(x11, x11, x20), -0.475, 7.11 * x24);
-        let x35 = libm::fma(c_q3, x33, s_q3 * x32);
-        let x36 = libm::fma(qd[3], x31, libm::fma(-x18, s_q3, x17 * c_q3));
-        let x37 = libm::fma(-qd[3], x30, libm::fma(x18, c_q3, x17 * s_q3));
-        let x38 = qd[3] + x19;
-        let x39 = libm::fma(x38, x38, x31 * x31);
-        let x40 = libm::fma(x30, x31, x5);
-        let x41 = libm::fma(-x30, x38, x37);
-        let x42 = 1375.0472756800002 * x38;
-        let x43 = 24989.305802 * x31;
-        let x44 = libm::fma(24998.827802, x38, 1375.0472756800002 * x30);
-        let x45 = libm::fma(
+        let x33 = libm::fma(-x16, s_q3, x15 * c_q3);
+        let x34 = libm::fma(x16, c_q3, x15 * s_q3);
+        let x35 = libm::fma(s_q2, x19, c_q2 * x17)
+            - libm::fma(x22 + x26, 0.475, 7.11 * x25);
+        let x36 = x20 + libm::fma(libm::fma(-x16, x23, x21), 0.475, 7.11 * x27);
+        let x37 = x18 - libm::fma(libm::fma(x15, x15, x24), -0.475, 7.11 * x28);
+        let x38 = libm::fma(c_q3, x36, s_q3 * x35);
+        let x39 = libm::fma(qd[3], x34, libm::fma(-x22, s_q3, x21 * c_q3));
+        let x40 = libm::fma(-qd[3], x33, libm::fma(x22, c_q3, x21 * s_q3));
+        let x41 = qd[3] + x23;
+        let x42 = libm::fma(x41, x41, x34 * x34);
+        let x43 = libm::fma(x33, x34, x10);
+        let x44 = libm::fma(-x33, x41, x40);
+        let x45 = 1375.0472756800002 * x41;
+        let x46 = 24989.305802 * x34;
+        let x47 = libm::fma(24998.827802, x41, 1375.0472756800002 * x33);
+        let x48 = libm::fma(
             -3239.4582,
-            x34,
-            libm::fma(24989.305802, x37, libm::fma(-x30, x44, x38 * x42)),
+            x37,
+            libm::fma(24989.305802, x40, libm::fma(-x33, x47, x41 * x45)),
         );
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x47 = libm::fma(-x31, s_q4, x30 * c_q4);
-        let x48 = libm::fma(x31, c_q4, x30 * s_q4);
-        let x49 = libm::fma(
+        let x49 = libm::fma(-x34, s_q4, x33 * c_q4);
+        let x50 = libm::fma(x34, c_q4, x33 * s_q4);
+        let x51 = libm::fma(
             -s_q4,
-            libm::fma(7.11, x40, x35),
-            c_q4 * libm::fma(-7.11, x39, libm::fma(-s_q3, x33, c_q3 * x32)),
+            libm::fma(7.11, x43, x38),
+            c_q4 * libm::fma(-7.11, x42, libm::fma(-s_q3, x36, c_q3 * x35)),
         );
-        let x50 = libm::fma(qd[4], x48, libm::fma(-x37, s_q4, x36 * c_q4));
-        let x51 = libm::fma(-qd[4], x47, libm::fma(x37, c_q4, x36 * s_q4));
-        let x52 = qd[4] + x38;
-        let x53 = 171.195516 * libm::fma(-x47, x48, x5);
-        let x54 = 171.195516 * libm::fma(x47, x47, x52 * x52);
-        let x55 = 171.195516 * libm::fma(x48, x52, x50);
-        let x56 = libm::fma(97.44448770720001, x52, x48 * 177.0883695416);
-        let x57 = libm::fma(-179.8829695416, x52, 97.44448770720001 * x48);
-        let x58 = libm::fma(
+        let x52 = libm::fma(qd[4], x50, libm::fma(-x40, s_q4, x39 * c_q4));
+        let x53 = libm::fma(-qd[4], x49, libm::fma(x40, c_q4, x39 * s_q4));
+        let x54 = qd[4] + x41;
+        let x55 = 171.195516 * libm::fma(-x49, x50, x10);
+        let x56 = 171.195516 * libm::fma(x49, x49, x54 * x54);
+        let x57 = 171.195516 * libm::fma(x50, x54, x52);
+        let x58 = libm::fma(97.44448770720001, x54, x50 * 177.0883695416);
+        let x59 = libm::fma(-179.8829695416, x54, 97.44448770720001 * x50);
+        let x60 = libm::fma(
             -171.195516,
-            x49,
-            libm::fma(x47, x56, libm::fma(-179.8829695416, x5, 97.44448770720001 * x51)),
+            x51,
+            libm::fma(x49, x58, libm::fma(-179.8829695416, x10, 97.44448770720001 * x53)),
         );
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x60 = libm::fma(-x52, c_q5, x47 * s_q5);
-        let x61 = libm::fma(x52, s_q5, x47 * c_q5);
-        let x62 = libm::fma(qd[5], x60, libm::fma(x5, s_q5, x50 * c_q5));
-        let x63 = qd[5] + x48;
-        let x64 = 44.41 * x61;
-        let x65 = 47.471 * x63;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x67 = 9.336 * x62;
+        let x61 = libm::fma(-x54, c_q5, x49 * s_q5);
+        let x62 = libm::fma(x54, s_q5, x49 * c_q5);
+        let x63 = libm::fma(qd[5], x61, libm::fma(x10, s_q5, x52 * c_q5));
+        let x64 = qd[5] + x50;
+        let x65 = 44.41 * x62;
+        let x66 = 47.471 * x64;
+        let x67 = 9.336 * x63;
         let x68 = -x67;
-        let x69 = 9.336 * (qd[6] + x61);
-        let x70 = libm::fma(x63, c_q6, x60 * s_q6) * x69;
-        let x71 = libm::fma(-x63, s_q6, x60 * c_q6) * x69;
-        let x72 = libm::fma(x61, x65, x63 * x64) - libm::fma(-s_q6, x71, c_q6 * x70);
-        let x73 = libm::fma(-x60, x65, 44.41 * x62) - x67;
-        let x74 = libm::fma(x60, x64, 47.471 * x51) - libm::fma(c_q6, x71, s_q6 * x70);
+        let x69 = 9.336 * (qd[6] + x62);
+        let x70 = libm::fma(x64, c_q6, x61 * s_q6) * x69;
+        let x71 = libm::fma(-x64, s_q6, x61 * c_q6) * x69;
+        let x72 = libm::fma(x62, x66, x64 * x65) - libm::fma(-s_q6, x71, c_q6 * x70);
+        let x73 = libm::fma(-x61, x66, 44.41 * x63) - x67;
+        let x74 = libm::fma(x61, x65, 47.471 * x53) - libm::fma(c_q6, x71, s_q6 * x70);
         let x75 = -x74;
         let x76 = libm::fma(
             -171.195516,
-            libm::fma(-7.11, x41, x34),
-            libm::fma(-x48, x57, x52 * x56),
+            libm::fma(-7.11, x44, x37),
+            libm::fma(-x50, x59, x54 * x58),
         ) - libm::fma(c_q5, x73, s_q5 * x72);
         let x77 = libm::fma(
-            -x47,
-            x57,
-            libm::fma(97.44448770720001, x5, x51 * 177.0883695416),
+            -x49,
+            x59,
+            libm::fma(97.44448770720001, x10, x53 * 177.0883695416),
         ) - x74;
-        let x78 = x58 - libm::fma(-s_q5, x73, c_q5 * x72);
-        let x79 = libm::fma(-c_q4, x54, s_q4 * x53);
-        let x80 = libm::fma(3239.4582, x39, -libm::fma(s_q4, x54, c_q4 * x53));
-        let x81 = libm::fma(3239.4582, x40, -x79);
-        let x82 = libm::fma(3239.4582, x41, x55);
-        let x83 = libm::fma(1375.0472756800002, x5, -libm::fma(-x31, x44, x38 * x43))
+        let x78 = x60 - libm::fma(-s_q5, x73, c_q5 * x72);
+        let x79 = libm::fma(-c_q4, x56, s_q4 * x55);
+        let x80 = libm::fma(3239.4582, x42, -libm::fma(s_q4, x56, c_q4 * x55));
+        let x81 = libm::fma(3239.4582, x43, -x79);
+        let x82 = libm::fma(3239.4582, x44, x57);
+        let x83 = libm::fma(1375.0472756800002, x10, -libm::fma(-x34, x47, x41 * x46))
             + libm::fma(-s_q4, x77, c_q4 * x76);
-        let x84 = x45 - libm::fma(-7.11, x55, libm::fma(c_q4, x77, s_q4 * x76));
+        let x84 = x48 - libm::fma(-7.11, x57, libm::fma(c_q4, x77, s_q4 * x76));
         let x85 = libm::fma(
             3239.4582,
-            x35,
-            libm::fma(24998.827802, x5, 1375.0472756800002 * x36)
-                - libm::fma(-x30, x43, x31 * x42),
+            x38,
+            libm::fma(24998.827802, x10, 1375.0472756800002 * x39)
+                - libm::fma(-x33, x46, x34 * x45),
         ) - libm::fma(7.11, x79, x78);
         let x86 = -x85;
         let x87 = libm::fma(-s_q3, x81, c_q3 * x80);
         let x88 = libm::fma(c_q3, x81, s_q3 * x80);
-        let x89 = libm::fma(5224.5702, x21, x87);
-        let x90 = libm::fma(5224.5702, x23, x88);
-        let x91 = libm::fma(3946.18812068, x5, -libm::fma(-x12, x27, x19 * x26))
+        let x89 = libm::fma(5224.5702, x25, x87);
+        let x90 = libm::fma(5224.5702, x27, x88);
+        let x91 = libm::fma(3946.18812068, x10, -libm::fma(-x16, x31, x23 * x30))
             + libm::fma(0.475, x88, libm::fma(s_q3, x84, c_q3 * x83));
-        let x92 = x28
+        let x92 = x32
             - (libm::fma(-c_q3, x84, s_q3 * x83) - libm::fma(7.11, x82, 0.475 * x87));
         let x93 = libm::fma(
             5224.5702,
-            x16,
-            libm::fma(39241.404122, x5, 3946.1881206800003 * x17)
-                - libm::fma(-x11, x26, x12 * x25),
+            x20,
+            libm::fma(39241.404122, x10, 3946.1881206800003 * x21)
+                - libm::fma(-x15, x30, x16 * x29),
         ) + libm::fma(7.11, x88, x85);
         let x94 = -x93;
         let x95 = libm::fma(-s_q2, x90, c_q2 * x89);
         let x96 = libm::fma(
-            x1,
-            x8,
+            x6,
+            x13,
             libm::fma(-0.5692, x95, libm::fma(-c_q2, x92, s_q2 * x91)),
         );
         let x97 = libm::fma(
             c_q1,
-            libm::fma(1145.5438279999998, x7, -libm::fma(5224.5702, x24, x82)),
-            s_q1 * libm::fma(1145.5438279999998, x6, -x95),
+            libm::fma(1145.5438279999998, x12, -libm::fma(5224.5702, x28, x82)),
+            s_q1 * libm::fma(1145.5438279999998, x11, -x95),
         );
         let x98 = libm::fma(
             s_q1,
-            libm::fma(-x1, x9, x5 * 1647.2196721184) - x93,
+            libm::fma(-x6, x14, x10 * 1647.2196721184) - x93,
             c_q1
-                * (libm::fma(-1145.5438279999998, x3, libm::fma(x2, x9, qd[1] * x8))
+                * (libm::fma(-1145.5438279999998, x8, libm::fma(x7, x14, qd[1] * x13))
                     + libm::fma(
                         0.5692,
                         libm::fma(c_q2, x90, s_q2 * x89),
@@ -1430,163 +1428,159 @@ impl SsrmsFma {
     /// Methods: bias `newton-euler`: 216 mul, 156 add, 0 div, 0 sqrt, 6 sincos (emitted), of which 122 fused multiply-adds.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x1 = qd[0] * c_q1;
-        let x2 = qd[0] * s_q1;
-        let x3 = qdd[0] * 0.7026;
-        let x4 = qd[0] * qd[0] * 0.7026;
-        let x5 = s_q1 * x3;
-        let x6 = qd[1] * x2;
-        let x7 = libm::fma(qdd[0], c_q1, -x6);
-        let x8 = libm::fma(qd[1], x1, qdd[0] * s_q1);
-        let x9 = libm::fma(x1, x2, qdd[1]);
-        let x10 = libm::fma(x1, x1, qd[1] * qd[1]);
-        let x11 = x2 * 1647.2196721184;
-        let x12 = 1650.6386721183999 * qd[1];
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x14 = libm::fma(-qd[1], s_q2, x1 * c_q2);
-        let x15 = libm::fma(qd[1], c_q2, x1 * s_q2);
-        let x16 = libm::fma(-0.5692, x9, x5);
-        let x17 = libm::fma(-0.5692, x10, c_q1 * x3);
-        let x18 = libm::fma(-0.5692, x6 - x7, x4);
-        let x19 = libm::fma(c_q2, x18, s_q2 * x16);
-        let x20 = libm::fma(-qd[2], x15, libm::fma(-qdd[1], s_q2, x7 * c_q2));
-        let x21 = libm::fma(qd[2], x14, libm::fma(qdd[1], c_q2, x7 * s_q2));
-        let x22 = qdd[2] - x8;
-        let x23 = qd[2] - x2;
-        let x24 = x15 * x15;
-        let x25 = libm::fma(x23, x23, x24);
-        let x26 = x14 * x23;
-        let x27 = libm::fma(-x14, x15, x22);
-        let x28 = x21 + x26;
-        let x29 = 3946.18812068 * x23;
-        let x30 = 39234.474122 * x15;
-        let x31 = libm::fma(39241.404122, x23, 3946.1881206800003 * x14);
-        let x32 = libm::fma(
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
+        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
+        let x6 = qd[0] * c_q1;
+        let x7 = qd[0] * s_q1;
+        let x8 = qdd[0] * 0.7026;
+        let x9 = qd[0] * qd[0] * 0.7026;
+        let x10 = s_q1 * x8;
+        let x11 = qd[1] * x7;
+        let x12 = libm::fma(qdd[0], c_q1, -x11);
+        let x13 = libm::fma(qd[1], x6, qdd[0] * s_q1);
+        let x14 = libm::fma(x6, x7, qdd[1]);
+        let x15 = libm::fma(x6, x6, qd[1] * qd[1]);
+        let x16 = x7 * 1647.2196721184;
+        let x17 = 1650.6386721183999 * qd[1];
+        let x18 = libm::fma(-qd[1], s_q2, x6 * c_q2);
+        let x19 = libm::fma(qd[1], c_q2, x6 * s_q2);
+        let x20 = libm::fma(-0.5692, x14, x10);
+        let x21 = libm::fma(-0.5692, x15, c_q1 * x8);
+        let x22 = libm::fma(-0.5692, x11 - x12, x9);
+        let x23 = libm::fma(c_q2, x22, s_q2 * x20);
+        let x24 = libm::fma(-qd[2], x19, libm::fma(-qdd[1], s_q2, x12 * c_q2));
+        let x25 = libm::fma(qd[2], x18, libm::fma(qdd[1], c_q2, x12 * s_q2));
+        let x26 = qdd[2] - x13;
+        let x27 = qd[2] - x7;
+        let x28 = x19 * x19;
+        let x29 = libm::fma(x27, x27, x28);
+        let x30 = x18 * x27;
+        let x31 = libm::fma(-x18, x19, x26);
+        let x32 = x25 + x30;
+        let x33 = 3946.18812068 * x27;
+        let x34 = 39234.474122 * x19;
+        let x35 = libm::fma(39241.404122, x27, 3946.1881206800003 * x18);
+        let x36 = libm::fma(
             -5224.5702,
-            x17,
-            libm::fma(39234.474122, x21, -libm::fma(-x14, x31, x23 * x29)),
+            x21,
+            libm::fma(39234.474122, x25, -libm::fma(-x18, x35, x27 * x33)),
         );
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x34 = libm::fma(-x15, s_q3, x14 * c_q3);
-        let x35 = libm::fma(x15, c_q3, x14 * s_q3);
-        let x36 = libm::fma(-s_q2, x18, c_q2 * x16)
-            + libm::fma(x21 - x26, -0.475, 7.11 * x25);
-        let x37 = x19 + libm::fma(libm::fma(x15, x23, x20), 0.475, 7.11 * x27);
-        let x38 = x17 - libm::fma(libm::fma(x14, x14, x24), 0.475, 7.11 * x28);
-        let x39 = libm::fma(c_q3, x37, s_q3 * x36);
-        let x40 = libm::fma(-qd[3], x35, libm::fma(-x21, s_q3, x20 * c_q3));
-        let x41 = libm::fma(qd[3], x34, libm::fma(x21, c_q3, x20 * s_q3));
-        let x42 = qdd[3] + x22;
-        let x43 = qd[3] + x23;
-        let x44 = libm::fma(x43, x43, x35 * x35);
-        let x45 = libm::fma(-x34, x35, x42);
-        let x46 = libm::fma(x34, x43, x41);
-        let x47 = 1375.0472756800002 * x43;
-        let x48 = 24989.305802 * x35;
-        let x49 = libm::fma(24998.827802, x43, 1375.0472756800002 * x34);
-        let x50 = libm::fma(
+        let x37 = libm::fma(-x19, s_q3, x18 * c_q3);
+        let x38 = libm::fma(x19, c_q3, x18 * s_q3);
+        let x39 = libm::fma(-s_q2, x22, c_q2 * x20)
+            + libm::fma(x25 - x30, -0.475, 7.11 * x29);
+        let x40 = x23 + libm::fma(libm::fma(x19, x27, x24), 0.475, 7.11 * x31);
+        let x41 = x21 - libm::fma(libm::fma(x18, x18, x28), 0.475, 7.11 * x32);
+        let x42 = libm::fma(c_q3, x40, s_q3 * x39);
+        let x43 = libm::fma(-qd[3], x38, libm::fma(-x25, s_q3, x24 * c_q3));
+        let x44 = libm::fma(qd[3], x37, libm::fma(x25, c_q3, x24 * s_q3));
+        let x45 = qdd[3] + x26;
+        let x46 = qd[3] + x27;
+        let x47 = libm::fma(x46, x46, x38 * x38);
+        let x48 = libm::fma(-x37, x38, x45);
+        let x49 = libm::fma(x37, x46, x44);
+        let x50 = 1375.0472756800002 * x46;
+        let x51 = 24989.305802 * x38;
+        let x52 = libm::fma(24998.827802, x46, 1375.0472756800002 * x37);
+        let x53 = libm::fma(
             -3239.4582,
-            x38,
-            libm::fma(24989.305802, x41, -libm::fma(-x34, x49, x43 * x47)),
+            x41,
+            libm::fma(24989.305802, x44, -libm::fma(-x37, x52, x46 * x50)),
         );
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x52 = libm::fma(-x35, s_q4, x34 * c_q4);
-        let x53 = libm::fma(x35, c_q4, x34 * s_q4);
-        let x54 = libm::fma(
+        let x54 = libm::fma(-x38, s_q4, x37 * c_q4);
+        let x55 = libm::fma(x38, c_q4, x37 * s_q4);
+        let x56 = libm::fma(
             -s_q4,
-            libm::fma(7.11, x45, x39),
-            c_q4 * libm::fma(7.11, x44, libm::fma(-s_q3, x37, c_q3 * x36)),
+            libm::fma(7.11, x48, x42),
+            c_q4 * libm::fma(7.11, x47, libm::fma(-s_q3, x40, c_q3 * x39)),
         );
-        let x55 = libm::fma(-qd[4], x53, libm::fma(-x41, s_q4, x40 * c_q4));
-        let x56 = libm::fma(qd[4], x52, libm::fma(x41, c_q4, x40 * s_q4));
-        let x57 = qdd[4] + x42;
-        let x58 = qd[4] + x43;
-        let x59 = 171.195516 * libm::fma(x52, x53, x57);
-        let x60 = 171.195516 * libm::fma(x52, x52, x58 * x58);
-        let x61 = 171.195516 * libm::fma(-x53, x58, x55);
-        let x62 = libm::fma(97.44448770720001, x58, x53 * 177.0883695416);
-        let x63 = libm::fma(-179.8829695416, x58, 97.44448770720001 * x53);
-        let x64 = libm::fma(
+        let x57 = libm::fma(-qd[4], x55, libm::fma(-x44, s_q4, x43 * c_q4));
+        let x58 = libm::fma(qd[4], x54, libm::fma(x44, c_q4, x43 * s_q4));
+        let x59 = qdd[4] + x45;
+        let x60 = qd[4] + x46;
+        let x61 = 171.195516 * libm::fma(x54, x55, x59);
+        let x62 = 171.195516 * libm::fma(x54, x54, x60 * x60);
+        let x63 = 171.195516 * libm::fma(-x55, x60, x57);
+        let x64 = libm::fma(97.44448770720001, x60, x55 * 177.0883695416);
+        let x65 = libm::fma(-179.8829695416, x60, 97.44448770720001 * x55);
+        let x66 = libm::fma(
             -171.195516,
-            x54,
+            x56,
             libm::fma(
-                -x52,
-                x62,
-                libm::fma(-179.8829695416, x57, 97.44448770720001 * x56),
+                -x54,
+                x64,
+                libm::fma(-179.8829695416, x59, 97.44448770720001 * x58),
             ),
         );
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x66 = libm::fma(-x58, c_q5, x52 * s_q5);
-        let x67 = libm::fma(x58, s_q5, x52 * c_q5);
-        let x68 = libm::fma(-qd[5], x66, libm::fma(x57, s_q5, x55 * c_q5));
-        let x69 = qd[5] + x53;
-        let x70 = 44.41 * x67;
-        let x71 = 47.471 * x69;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x73 = 9.336 * (qdd[6] + x68);
-        let x74 = 9.336 * (qd[6] + x67);
-        let x75 = libm::fma(x69, c_q6, x66 * s_q6) * x74;
-        let x76 = libm::fma(-x69, s_q6, x66 * c_q6) * x74;
-        let x77 = libm::fma(x67, x71, x69 * x70) - libm::fma(-s_q6, x76, c_q6 * x75);
-        let x78 = libm::fma(x66, x71, 44.41 * x68) - x73;
-        let x79 = libm::fma(-x66, x70, 47.471 * (qdd[5] + x56))
+        let x67 = libm::fma(-x60, c_q5, x54 * s_q5);
+        let x68 = libm::fma(x60, s_q5, x54 * c_q5);
+        let x69 = libm::fma(-qd[5], x67, libm::fma(x59, s_q5, x57 * c_q5));
+        let x70 = qd[5] + x55;
+        let x71 = 44.41 * x68;
+        let x72 = 47.471 * x70;
+        let x73 = 9.336 * (qdd[6] + x69);
+        let x74 = 9.336 * (qd[6] + x68);
+        let x75 = libm::fma(x70, c_q6, x67 * s_q6) * x74;
+        let x76 = libm::fma(-x70, s_q6, x67 * c_q6) * x74;
+        let x77 = libm::fma(x68, x72, x70 * x71) - libm::fma(-s_q6, x76, c_q6 * x75);
+        let x78 = libm::fma(x67, x72, 44.41 * x69) - x73;
+        let x79 = libm::fma(-x67, x71, 47.471 * (qdd[5] + x58))
             + libm::fma(c_q6, x76, s_q6 * x75);
         let x80 = libm::fma(
             171.195516,
-            libm::fma(-7.11, x46, x38),
-            libm::fma(-x53, x63, x58 * x62),
+            libm::fma(-7.11, x49, x41),
+            libm::fma(-x55, x65, x60 * x64),
         ) - libm::fma(-c_q5, x78, s_q5 * x77);
         let x81 = libm::fma(
-            x52,
-            x63,
-            libm::fma(97.44448770720001, x57, x56 * 177.0883695416),
+            x54,
+            x65,
+            libm::fma(97.44448770720001, x59, x58 * 177.0883695416),
         ) - x79;
-        let x82 = x64 + libm::fma(s_q5, x78, c_q5 * x77);
+        let x82 = x66 + libm::fma(s_q5, x78, c_q5 * x77);
         let x83 = -x82;
-        let x84 = libm::fma(c_q4, x60, s_q4 * x59);
-        let x85 = libm::fma(3239.4582, x44, libm::fma(-s_q4, x60, c_q4 * x59));
-        let x86 = libm::fma(3239.4582, x45, -x84);
-        let x87 = libm::fma(3239.4582, x46, x61);
-        let x88 = libm::fma(1375.0472756800002, x42, libm::fma(-x35, x49, x43 * x48))
+        let x84 = libm::fma(c_q4, x62, s_q4 * x61);
+        let x85 = libm::fma(3239.4582, x47, libm::fma(-s_q4, x62, c_q4 * x61));
+        let x86 = libm::fma(3239.4582, x48, -x84);
+        let x87 = libm::fma(3239.4582, x49, x63);
+        let x88 = libm::fma(1375.0472756800002, x45, libm::fma(-x38, x52, x46 * x51))
             - libm::fma(s_q4, x81, c_q4 * x80);
-        let x89 = x50 + libm::fma(7.11, x61, libm::fma(-c_q4, x81, s_q4 * x80));
+        let x89 = x53 + libm::fma(7.11, x63, libm::fma(-c_q4, x81, s_q4 * x80));
         let x90 = libm::fma(
             3239.4582,
-            x39,
-            libm::fma(24998.827802, x42, 1375.0472756800002 * x40)
-                + libm::fma(-x34, x48, x35 * x47),
+            x42,
+            libm::fma(24998.827802, x45, 1375.0472756800002 * x43)
+                + libm::fma(-x37, x51, x38 * x50),
         ) - libm::fma(7.11, x84, x82);
         let x91 = libm::fma(s_q3, x86, c_q3 * x85);
         let x92 = libm::fma(-c_q3, x86, s_q3 * x85);
-        let x93 = libm::fma(5224.5702, x25, x91);
-        let x94 = libm::fma(5224.5702, x27, -x92);
-        let x95 = libm::fma(3946.18812068, x22, libm::fma(-x15, x31, x23 * x30))
+        let x93 = libm::fma(5224.5702, x29, x91);
+        let x94 = libm::fma(5224.5702, x31, -x92);
+        let x95 = libm::fma(3946.18812068, x26, libm::fma(-x19, x35, x27 * x34))
             + libm::fma(-0.475, x92, libm::fma(s_q3, x89, c_q3 * x88));
-        let x96 = x32
+        let x96 = x36
             - (libm::fma(-c_q3, x89, s_q3 * x88) + libm::fma(-7.11, x87, 0.475 * x91));
         let x97 = libm::fma(
             5224.5702,
-            x19,
-            libm::fma(39241.404122, x22, 3946.1881206800003 * x20)
-                + libm::fma(-x14, x30, x15 * x29),
+            x23,
+            libm::fma(39241.404122, x26, 3946.1881206800003 * x24)
+                + libm::fma(-x18, x34, x19 * x33),
         ) + libm::fma(-7.11, x92, x90);
         let x98 = libm::fma(s_q2, x94, c_q2 * x93);
         let x99 = libm::fma(
             -1145.5438279999998,
-            x5,
-            libm::fma(x1, x11, 1650.6386721183999 * qdd[1]),
+            x10,
+            libm::fma(x6, x16, 1650.6386721183999 * qdd[1]),
         ) - libm::fma(0.5692, x98, libm::fma(-c_q2, x96, s_q2 * x95));
         let x100 = libm::fma(
             c_q1,
-            libm::fma(1145.5438279999998, x10, libm::fma(5224.5702, x28, x87)),
-            s_q1 * libm::fma(1145.5438279999998, x9, -x98),
+            libm::fma(1145.5438279999998, x15, libm::fma(5224.5702, x32, x87)),
+            s_q1 * libm::fma(1145.5438279999998, x14, -x98),
         );
         let x101 = libm::fma(
             s_q1,
-            libm::fma(-x1, x12, x8 * 1647.2196721184) + x97,
+            libm::fma(-x6, x17, x13 * 1647.2196721184) + x97,
             c_q1
-                * (libm::fma(-1145.5438279999998, x4, libm::fma(x2, x12, qd[1] * x11))
+                * (libm::fma(-1145.5438279999998, x9, libm::fma(x7, x17, qd[1] * x16))
                     - libm::fma(
                         -0.5692,
                         libm::fma(-c_q2, x94, s_q2 * x93),
@@ -1601,12 +1595,8 @@ impl SsrmsFma {
     /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 452 mul, 339 add, 7 div, 0 sqrt, 6 sincos (emitted), of which 265 fused multiply-adds.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let (s_q6, c_q6) = Self::sincos(q[6]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
+        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
         let x7 = -35.074 + x6;
         let x8 = s_q5 * c_q5 * 35.074;
@@ -2039,12 +2029,8 @@ impl SsrmsFma {
         q: &[f64; 7],
         qd: &[f64; 7],
     ) -> ([[f64; 7]; 7], [f64; 7]) {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let (s_q6, c_q6) = Self::sincos(q[6]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
+        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
         let x7 = -35.074 + x6;
         let x8 = s_q5 * c_q5 * 35.074;
@@ -2348,12 +2334,8 @@ impl SsrmsFma {
         tau: &[f64; 7],
         f_ext: &[[f64; 6]; 7],
     ) -> [f64; 7] {
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let (s_q6, c_q6) = Self::sincos(q[6]);
+        let [(s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4), (s_q5, c_q5),
+        (s_q6, c_q6)] = Self::sincos_n([q[1], q[2], q[3], q[4], q[5], q[6]]);
         let x6 = s_q5 * s_q5 * 35.074;
         let x7 = s_q5 * c_q5 * 35.074;
         let x8 = 132.6783695416 + (9.336 + x6);
@@ -2804,13 +2786,21 @@ impl SsrmsFma {
         );
         [x246, x244, x242, x240, x239, x238, x237]
     }
-    /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
-    /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
-    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 1 ulp of 1 of
-    /// libm's (`kanegen accuracy` measures it).
+    /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
     pub fn sincos(x: f64) -> (f64, f64) {
+        let [sc] = Self::sincos_n([x]);
+        sc
+    }
+    /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
+    /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
+    /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
+    /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
+    /// (`kanegen accuracy` measures it).
+    #[inline(always)]
+    #[must_use]
+    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
         /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
         const SIN_TABLE: [f64; 128] = [
             0.0,
@@ -2947,25 +2937,42 @@ impl SsrmsFma {
         const C2: f64 = -0.5;
         const C4: f64 = 1.0 / 24.0;
         const C6: f64 = -1.0 / 720.0;
-        if !(x > -32768.0 && x < 32768.0) {
-            return libm::sincos(x);
+        let mut fast = true;
+        for v in x {
+            fast &= v > -32768.0 && v < 32768.0;
         }
-        let t = x * 40.74366543152521 + 6755399441055744.0;
-        let k = t - 6755399441055744.0;
-        let i = (t.to_bits() & 255) as usize;
-        let r_hi = -k * 0.024543692605220713 + x;
-        let r = -k * 9.495469541415925e-13 + r_hi;
-        let r2 = r * r;
-        let r3 = r * r2;
-        let p_s = r2 * S5 + S3;
-        let sin_r = r3 * p_s + r;
-        let p_c6 = r2 * C6 + C4;
-        let p_c = r2 * p_c6 + C2;
-        let cos_r = r2 * p_c + 1.0;
+        if !fast {
+            return x.map(libm::sincos);
+        }
+        let (mut t, mut r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            t[i] = x[i] * 40.74366543152521 + 6755399441055744.0;
+            let k = t[i] - 6755399441055744.0;
+            let r_hi = -k * 0.024543692605220713 + x[i];
+            r[i] = -k * 9.495469541415925e-13 + r_hi;
+        }
+        let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            let r2 = r[i] * r[i];
+            let r3 = r[i] * r2;
+            let p_s = r2 * S5 + S3;
+            sin_r[i] = r3 * p_s + r[i];
+            let p_c6 = r2 * C6 + C4;
+            let p_c = r2 * p_c6 + C2;
+            cos_r[i] = r2 * p_c + 1.0;
+        }
         let table = |j: usize| {
             f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
         };
-        let (sin_a, cos_a) = (table(i), table(i + 64));
-        (sin_a * cos_r + cos_a * sin_r, cos_a * cos_r + -(sin_a * sin_r))
+        let mut out = [(0.0, 0.0); N];
+        for i in 0..N {
+            let j = (t[i].to_bits() & 255) as usize;
+            let (sin_a, cos_a) = (table(j), table(j + 64));
+            out[i] = (
+                sin_a * cos_r[i] + cos_a * sin_r[i],
+                cos_a * cos_r[i] + -(sin_a * sin_r[i]),
+            );
+        }
+        out
     }
 }

@@ -248,156 +248,159 @@ impl SsrmsRecurrent {
     /// Methods: mass matrix `recurrent`: 681 mul, 661 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 389 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 7]) -> [[f64; 7]; 7] {
-        let (s_q0, c_q0) = Self::sincos(q[0]);
-        let x1 = 0.7026 * s_q0;
-        let x2 = 0.7026 * c_q0;
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x4 = c_q0 * s_q1;
-        let x5 = c_q0 * c_q1;
-        let x6 = s_q0 * s_q1;
-        let x7 = s_q0 * c_q1;
-        let x8 = 8.088 * c_q1;
-        let x9 = 3.061 * s_q1;
-        let x10 = 8.088 * x4;
-        let x11 = 3.061 * x5;
-        let x12 = 8.446 * s_q0;
-        let x13 = 8.088 * x6;
-        let x14 = 3.061 * x7;
-        let x15 = 8.446 * c_q0;
-        let x16 = s_q1 * x9;
-        let x17 = x5 * x9;
-        let x18 = x7 * x9;
-        let x19 = x5 * x11;
-        let x20 = x7 * x11;
-        let x21 = x5 * x14;
-        let x22 = x7 * x14;
-        let x23 = s_q1 * 0.5692;
-        let x24 = x5 * 0.5692;
-        let x25 = x7 * 0.5692;
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x27 = c_q1 * c_q2;
-        let x28 = c_q1 * s_q2;
-        let x29 = Self::mul_add(s_q0, s_q2, x4 * c_q2);
-        let x30 = Self::mul_add(-s_q0, c_q2, x4 * s_q2);
-        let x31 = Self::mul_add(-c_q0, s_q2, x6 * c_q2);
-        let x32 = Self::mul_add(c_q0, c_q2, x6 * s_q2);
-        let x33 = Self::mul_add(-49.52, s_q1, 15.41 * x27);
-        let x34 = Self::mul_add(-2094.71, s_q1, 49.52 * x27);
-        let x35 = 2103.19 * x28;
-        let x36 = Self::mul_add(49.52, x5, 15.41 * x29);
-        let x37 = Self::mul_add(2094.71, x5, 49.52 * x29);
-        let x38 = 2103.19 * x30;
-        let x39 = Self::mul_add(49.52, x7, 15.41 * x31);
-        let x40 = Self::mul_add(2094.71, x7, 49.52 * x31);
-        let x41 = 2103.19 * x32;
-        let x42 = Self::mul_add(s_q1, 0.475, 7.11 * x27);
-        let x43 = Self::mul_add(x5, -0.475, 7.11 * x29);
-        let x44 = Self::mul_add(x7, -0.475, 7.11 * x31);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x46 = Self::mul_add(-x28, s_q3, x27 * c_q3);
-        let x47 = Self::mul_add(x28, c_q3, x27 * s_q3);
-        let x48 = Self::mul_add(-x30, s_q3, x29 * c_q3);
-        let x49 = Self::mul_add(x30, c_q3, x29 * s_q3);
-        let x50 = Self::mul_add(-x32, s_q3, x31 * c_q3);
-        let x51 = Self::mul_add(x32, c_q3, x31 * s_q3);
-        let x52 = Self::mul_add(s_q1, 39.95, 9.522 * x46);
-        let x53 = Self::mul_add(1966.28, s_q1, x46 * 39.95);
-        let x54 = 1966.28 * x47;
-        let x55 = Self::mul_add(x5, -39.95, 9.522 * x48);
-        let x56 = Self::mul_add(-1966.28, x5, x48 * 39.95);
-        let x57 = 1966.28 * x49;
-        let x58 = Self::mul_add(x7, -39.95, 9.522 * x50);
-        let x59 = Self::mul_add(-1966.28, x7, x50 * 39.95);
-        let x60 = 1966.28 * x51;
-        let x61 = 7.11 * x46;
-        let x62 = 7.11 * x48;
-        let x63 = 7.11 * x50;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x65 = Self::mul_add(-x47, s_q4, x46 * c_q4);
-        let x66 = Self::mul_add(x47, c_q4, x46 * s_q4);
-        let x67 = Self::mul_add(-x49, s_q4, x48 * c_q4);
-        let x68 = Self::mul_add(x49, c_q4, x48 * s_q4);
-        let x69 = Self::mul_add(-x51, s_q4, x50 * c_q4);
-        let x70 = Self::mul_add(x51, c_q4, x50 * s_q4);
-        let x71 = 8.305 * x65;
-        let x72 = 8.0386 * x66;
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = 0.7026 * s_q0;
+        let x8 = 0.7026 * c_q0;
+        let x9 = c_q0 * s_q1;
+        let x10 = c_q0 * c_q1;
+        let x11 = s_q0 * s_q1;
+        let x12 = s_q0 * c_q1;
+        let x13 = 8.088 * c_q1;
+        let x14 = 3.061 * s_q1;
+        let x15 = 8.088 * x9;
+        let x16 = 3.061 * x10;
+        let x17 = 8.446 * s_q0;
+        let x18 = 8.088 * x11;
+        let x19 = 3.061 * x12;
+        let x20 = 8.446 * c_q0;
+        let x21 = s_q1 * x14;
+        let x22 = x10 * x14;
+        let x23 = x12 * x14;
+        let x24 = x10 * x16;
+        let x25 = x12 * x16;
+        let x26 = x10 * x19;
+        let x27 = x12 * x19;
+        let x28 = s_q1 * 0.5692;
+        let x29 = x10 * 0.5692;
+        let x30 = x12 * 0.5692;
+        let x31 = c_q1 * c_q2;
+        let x32 = c_q1 * s_q2;
+        let x33 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x34 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
+        let x35 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
+        let x36 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x37 = Self::mul_add(-49.52, s_q1, 15.41 * x31);
+        let x38 = Self::mul_add(-2094.71, s_q1, 49.52 * x31);
+        let x39 = 2103.19 * x32;
+        let x40 = Self::mul_add(49.52, x10, 15.41 * x33);
+        let x41 = Self::mul_add(2094.71, x10, 49.52 * x33);
+        let x42 = 2103.19 * x34;
+        let x43 = Self::mul_add(49.52, x12, 15.41 * x35);
+        let x44 = Self::mul_add(2094.71, x12, 49.52 * x35);
+        let x45 = 2103.19 * x36;
+        let x46 = Self::mul_add(s_q1, 0.475, 7.11 * x31);
+        let x47 = Self::mul_add(x10, -0.475, 7.11 * x33);
+        let x48 = Self::mul_add(x12, -0.475, 7.11 * x35);
+        let x49 = Self::mul_add(-x32, s_q3, x31 * c_q3);
+        let x50 = Self::mul_add(x32, c_q3, x31 * s_q3);
+        let x51 = Self::mul_add(-x34, s_q3, x33 * c_q3);
+        let x52 = Self::mul_add(x34, c_q3, x33 * s_q3);
+        let x53 = Self::mul_add(-x36, s_q3, x35 * c_q3);
+        let x54 = Self::mul_add(x36, c_q3, x35 * s_q3);
+        let x55 = Self::mul_add(s_q1, 39.95, 9.522 * x49);
+        let x56 = Self::mul_add(1966.28, s_q1, x49 * 39.95);
+        let x57 = 1966.28 * x50;
+        let x58 = Self::mul_add(x10, -39.95, 9.522 * x51);
+        let x59 = Self::mul_add(-1966.28, x10, x51 * 39.95);
+        let x60 = 1966.28 * x52;
+        let x61 = Self::mul_add(x12, -39.95, 9.522 * x53);
+        let x62 = Self::mul_add(-1966.28, x12, x53 * 39.95);
+        let x63 = 1966.28 * x54;
+        let x64 = 7.11 * x49;
+        let x65 = 7.11 * x51;
+        let x66 = 7.11 * x53;
+        let x67 = Self::mul_add(-x50, s_q4, x49 * c_q4);
+        let x68 = Self::mul_add(x50, c_q4, x49 * s_q4);
+        let x69 = Self::mul_add(-x52, s_q4, x51 * c_q4);
+        let x70 = Self::mul_add(x52, c_q4, x51 * s_q4);
+        let x71 = Self::mul_add(-x54, s_q4, x53 * c_q4);
+        let x72 = Self::mul_add(x54, c_q4, x53 * s_q4);
         let x73 = 8.305 * x67;
         let x74 = 8.0386 * x68;
         let x75 = 8.305 * x69;
         let x76 = 8.0386 * x70;
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x78 = Self::mul_add(-s_q1, s_q5, x65 * c_q5);
-        let x79 = Self::mul_add(s_q1, c_q5, x65 * s_q5);
-        let x80 = Self::mul_add(x5, s_q5, x67 * c_q5);
-        let x81 = Self::mul_add(-x5, c_q5, x67 * s_q5);
-        let x82 = Self::mul_add(x7, s_q5, x69 * c_q5);
-        let x83 = Self::mul_add(-x7, c_q5, x69 * s_q5);
-        let x84 = 12.13 * x78;
+        let x77 = 8.305 * x71;
+        let x78 = 8.0386 * x72;
+        let x79 = Self::mul_add(-s_q1, s_q5, x67 * c_q5);
+        let x80 = Self::mul_add(s_q1, c_q5, x67 * s_q5);
+        let x81 = Self::mul_add(x10, s_q5, x69 * c_q5);
+        let x82 = Self::mul_add(-x10, c_q5, x69 * s_q5);
+        let x83 = Self::mul_add(x12, s_q5, x71 * c_q5);
+        let x84 = Self::mul_add(-x12, c_q5, x71 * s_q5);
         let x85 = 12.13 * x79;
-        let x86 = 3.061 * x66;
-        let x87 = 12.13 * x80;
+        let x86 = 12.13 * x80;
+        let x87 = 3.061 * x68;
         let x88 = 12.13 * x81;
-        let x89 = 3.061 * x68;
-        let x90 = 12.13 * x82;
+        let x89 = 12.13 * x82;
+        let x90 = 3.061 * x70;
         let x91 = 12.13 * x83;
-        let x92 = 3.061 * x70;
-        let x93 = 0.7026 * x66;
+        let x92 = 12.13 * x84;
+        let x93 = 3.061 * x72;
         let x94 = 0.7026 * x68;
         let x95 = 0.7026 * x70;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x97 = Self::mul_add(-x66, s_q6, x79 * c_q6);
-        let x98 = Self::mul_add(x66, c_q6, x79 * s_q6);
-        let x99 = Self::mul_add(-x68, s_q6, x81 * c_q6);
-        let x100 = Self::mul_add(x68, c_q6, x81 * s_q6);
-        let x101 = Self::mul_add(-x70, s_q6, x83 * c_q6);
-        let x102 = Self::mul_add(x70, c_q6, x83 * s_q6);
-        let x103 = 9.336 * x78;
+        let x96 = 0.7026 * x72;
+        let x97 = Self::mul_add(-x68, s_q6, x80 * c_q6);
+        let x98 = Self::mul_add(x68, c_q6, x80 * s_q6);
+        let x99 = Self::mul_add(-x70, s_q6, x82 * c_q6);
+        let x100 = Self::mul_add(x70, c_q6, x82 * s_q6);
+        let x101 = Self::mul_add(-x72, s_q6, x84 * c_q6);
+        let x102 = Self::mul_add(x72, c_q6, x84 * s_q6);
+        let x103 = 9.336 * x79;
         let x104 = 44.41 * x97;
         let x105 = 44.41 * x98;
-        let x106 = 9.336 * x80;
+        let x106 = 9.336 * x81;
         let x107 = 44.41 * x99;
         let x108 = 44.41 * x100;
-        let x109 = 9.336 * x82;
+        let x109 = 9.336 * x83;
         let x110 = 44.41 * x101;
         let x111 = 44.41 * x102;
-        let x112 = Self::mul_add(x98, x105, Self::mul_add(x97, x104, x78 * x103));
-        let x113 = Self::mul_add(x100, x105, Self::mul_add(x99, x104, x80 * x103));
-        let x114 = Self::mul_add(x102, x105, Self::mul_add(x101, x104, x82 * x103));
-        let x115 = Self::mul_add(x98, x108, Self::mul_add(x97, x107, x78 * x106));
-        let x116 = Self::mul_add(x100, x108, Self::mul_add(x99, x107, x80 * x106));
-        let x117 = Self::mul_add(x102, x108, Self::mul_add(x101, x107, x82 * x106));
-        let x118 = Self::mul_add(x98, x111, Self::mul_add(x97, x110, x78 * x109));
-        let x119 = Self::mul_add(x100, x111, Self::mul_add(x99, x110, x80 * x109));
-        let x120 = Self::mul_add(x102, x111, Self::mul_add(x101, x110, x82 * x109));
-        let x121 = x23 - x93;
-        let x122 = x24 + x94;
-        let x123 = x25 + x95;
-        let x124 = x61 + x121;
-        let x125 = x62 - x122;
-        let x126 = x63 - x123;
-        let x127 = x42 + x124;
-        let x128 = x43 + x125;
-        let x129 = x44 + x126;
-        let x130 = x24 - x128;
-        let x131 = x25 - x129;
-        let x132 = x23 + x61;
-        let x133 = x24 - x62;
-        let x134 = x25 - x63;
-        let x135 = x42 + x132;
-        let x136 = x43 - x133;
-        let x137 = x44 - x134;
-        let x138 = x24 - x136;
-        let x139 = x25 - x137;
-        let x140 = x42 + x61;
-        let x141 = x43 + x62;
-        let x142 = x44 + x63;
-        let x143 = x24 - x141;
-        let x144 = x25 - x142;
-        let x145 = x24 - x43;
-        let x146 = x25 - x44;
-        let x147 = 243.66 * x93;
-        let x148 = 243.66 * x94;
-        let x149 = 243.66 * x95;
+        let x112 = Self::mul_add(x98, x105, Self::mul_add(x97, x104, x79 * x103));
+        let x113 = Self::mul_add(x100, x105, Self::mul_add(x99, x104, x81 * x103));
+        let x114 = Self::mul_add(x102, x105, Self::mul_add(x101, x104, x83 * x103));
+        let x115 = Self::mul_add(x98, x108, Self::mul_add(x97, x107, x79 * x106));
+        let x116 = Self::mul_add(x100, x108, Self::mul_add(x99, x107, x81 * x106));
+        let x117 = Self::mul_add(x102, x108, Self::mul_add(x101, x107, x83 * x106));
+        let x118 = Self::mul_add(x98, x111, Self::mul_add(x97, x110, x79 * x109));
+        let x119 = Self::mul_add(x100, x111, Self::mul_add(x99, x110, x81 * x109));
+        let x120 = Self::mul_add(x102, x111, Self::mul_add(x101, x110, x83 * x109));
+        let x121 = x28 - x94;
+        let x122 = x29 + x95;
+        let x123 = x30 + x96;
+        let x124 = x64 + x121;
+        let x125 = x65 - x122;
+        let x126 = x66 - x123;
+        let x127 = x46 + x124;
+        let x128 = x47 + x125;
+        let x129 = x48 + x126;
+        let x130 = x29 - x128;
+        let x131 = x30 - x129;
+        let x132 = x28 + x64;
+        let x133 = x29 - x65;
+        let x134 = x30 - x66;
+        let x135 = x46 + x132;
+        let x136 = x47 - x133;
+        let x137 = x48 - x134;
+        let x138 = x29 - x136;
+        let x139 = x30 - x137;
+        let x140 = x46 + x64;
+        let x141 = x47 + x65;
+        let x142 = x48 + x66;
+        let x143 = x29 - x141;
+        let x144 = x30 - x142;
+        let x145 = x29 - x47;
+        let x146 = x30 - x48;
+        let x147 = 243.66 * x94;
+        let x148 = 243.66 * x95;
+        let x149 = 243.66 * x96;
         let x150 = 243.66 * x121;
         let x151 = 243.66 * x122;
         let x152 = 243.66 * x123;
@@ -407,579 +410,580 @@ impl SsrmsRecurrent {
         let x156 = 243.66 * x127;
         let x157 = 243.66 * x128;
         let x158 = 243.66 * x129;
-        let x159 = 243.66 * (x23 + x127);
+        let x159 = 243.66 * (x28 + x127);
         let x160 = 243.66 * x130;
         let x161 = 243.66 * x131;
-        let x162 = 243.66 * (x1 + x130);
-        let x163 = 243.66 * (x2 - x131);
-        let x164 = Self::mul_add(x66, x86, Self::mul_add(x79, x85, x78 * x84)) + x112;
-        let x165 = Self::mul_add(x68, x86, Self::mul_add(x81, x85, x80 * x84)) + x113;
-        let x166 = Self::mul_add(x70, x86, Self::mul_add(x83, x85, x82 * x84)) + x114;
-        let x167 = Self::mul_add(x66, x89, Self::mul_add(x79, x88, x78 * x87)) + x115;
-        let x168 = Self::mul_add(x68, x89, Self::mul_add(x81, x88, x80 * x87)) + x116;
-        let x169 = Self::mul_add(x70, x89, Self::mul_add(x83, x88, x82 * x87)) + x117;
-        let x170 = Self::mul_add(x66, x92, Self::mul_add(x79, x91, x78 * x90)) + x118;
-        let x171 = Self::mul_add(x68, x92, Self::mul_add(x81, x91, x80 * x90)) + x119;
-        let x172 = Self::mul_add(x70, x92, Self::mul_add(x83, x91, x82 * x90)) + x120;
-        let x173 = Self::mul_add(x66, x72, Self::mul_add(x65, x71, x16)) + x164;
-        let x174 = Self::mul_add(-x68, x72, Self::mul_add(-x67, x71, x17)) - x165;
-        let x175 = Self::mul_add(-x70, x72, Self::mul_add(-x69, x71, x18)) - x166;
-        let x176 = Self::mul_add(-x66, x74, Self::mul_add(-x65, x73, s_q1 * x11)) - x167;
-        let x177 = Self::mul_add(x68, x74, Self::mul_add(x67, x73, x19)) + x168;
-        let x178 = Self::mul_add(x70, x74, Self::mul_add(x69, x73, x20)) + x169;
-        let x179 = Self::mul_add(-x66, x76, Self::mul_add(-x65, x75, s_q1 * x14)) - x170;
-        let x180 = Self::mul_add(x68, x76, Self::mul_add(x67, x75, x21)) + x171;
-        let x181 = Self::mul_add(x70, x76, Self::mul_add(x69, x75, x22)) + x172;
-        let x182 = Self::mul_add(x47, x54, Self::mul_add(s_q1, x53, x46 * x52)) + x173;
-        let x183 = Self::mul_add(x49, x54, Self::mul_add(-x5, x53, x48 * x52)) - x174;
-        let x184 = Self::mul_add(x51, x54, Self::mul_add(-x7, x53, x50 * x52)) - x175;
-        let x185 = Self::mul_add(x47, x57, Self::mul_add(s_q1, x56, x46 * x55)) - x176;
-        let x186 = Self::mul_add(x49, x57, Self::mul_add(-x5, x56, x48 * x55)) + x177;
-        let x187 = Self::mul_add(x51, x57, Self::mul_add(-x7, x56, x50 * x55)) + x178;
-        let x188 = Self::mul_add(x47, x60, Self::mul_add(s_q1, x59, x46 * x58)) - x179;
-        let x189 = Self::mul_add(x49, x60, Self::mul_add(-x5, x59, x48 * x58)) + x180;
-        let x190 = Self::mul_add(x51, x60, Self::mul_add(-x7, x59, x50 * x58)) + x181;
-        let x191 = Self::mul_add(x28, x35, Self::mul_add(-s_q1, x34, x27 * x33)) + x182;
-        let x192 = Self::mul_add(x30, x35, Self::mul_add(x5, x34, x29 * x33)) + x183;
-        let x193 = Self::mul_add(x32, x35, Self::mul_add(x7, x34, x31 * x33)) + x184;
-        let x194 = Self::mul_add(x28, x38, Self::mul_add(-s_q1, x37, x27 * x36)) + x185;
-        let x195 = Self::mul_add(x30, x38, Self::mul_add(x5, x37, x29 * x36)) + x186;
-        let x196 = Self::mul_add(x32, x38, Self::mul_add(x7, x37, x31 * x36)) + x187;
-        let x197 = Self::mul_add(x28, x41, Self::mul_add(-s_q1, x40, x27 * x39)) + x188;
-        let x198 = Self::mul_add(x30, x41, Self::mul_add(x5, x40, x29 * x39)) + x189;
-        let x199 = Self::mul_add(x32, x41, Self::mul_add(x7, x40, x31 * x39)) + x190;
-        let x200 = Self::mul_add(105.98, x23, x150);
-        let x201 = Self::mul_add(105.98, x24, x151);
-        let x202 = Self::mul_add(105.98, x25, x152);
+        let x162 = 243.66 * (x7 + x130);
+        let x163 = 243.66 * (x8 - x131);
+        let x164 = Self::mul_add(x68, x87, Self::mul_add(x80, x86, x79 * x85)) + x112;
+        let x165 = Self::mul_add(x70, x87, Self::mul_add(x82, x86, x81 * x85)) + x113;
+        let x166 = Self::mul_add(x72, x87, Self::mul_add(x84, x86, x83 * x85)) + x114;
+        let x167 = Self::mul_add(x68, x90, Self::mul_add(x80, x89, x79 * x88)) + x115;
+        let x168 = Self::mul_add(x70, x90, Self::mul_add(x82, x89, x81 * x88)) + x116;
+        let x169 = Self::mul_add(x72, x90, Self::mul_add(x84, x89, x83 * x88)) + x117;
+        let x170 = Self::mul_add(x68, x93, Self::mul_add(x80, x92, x79 * x91)) + x118;
+        let x171 = Self::mul_add(x70, x93, Self::mul_add(x82, x92, x81 * x91)) + x119;
+        let x172 = Self::mul_add(x72, x93, Self::mul_add(x84, x92, x83 * x91)) + x120;
+        let x173 = Self::mul_add(x68, x74, Self::mul_add(x67, x73, x21)) + x164;
+        let x174 = Self::mul_add(-x70, x74, Self::mul_add(-x69, x73, x22)) - x165;
+        let x175 = Self::mul_add(-x72, x74, Self::mul_add(-x71, x73, x23)) - x166;
+        let x176 = Self::mul_add(-x68, x76, Self::mul_add(-x67, x75, s_q1 * x16)) - x167;
+        let x177 = Self::mul_add(x70, x76, Self::mul_add(x69, x75, x24)) + x168;
+        let x178 = Self::mul_add(x72, x76, Self::mul_add(x71, x75, x25)) + x169;
+        let x179 = Self::mul_add(-x68, x78, Self::mul_add(-x67, x77, s_q1 * x19)) - x170;
+        let x180 = Self::mul_add(x70, x78, Self::mul_add(x69, x77, x26)) + x171;
+        let x181 = Self::mul_add(x72, x78, Self::mul_add(x71, x77, x27)) + x172;
+        let x182 = Self::mul_add(x50, x57, Self::mul_add(s_q1, x56, x49 * x55)) + x173;
+        let x183 = Self::mul_add(x52, x57, Self::mul_add(-x10, x56, x51 * x55)) - x174;
+        let x184 = Self::mul_add(x54, x57, Self::mul_add(-x12, x56, x53 * x55)) - x175;
+        let x185 = Self::mul_add(x50, x60, Self::mul_add(s_q1, x59, x49 * x58)) - x176;
+        let x186 = Self::mul_add(x52, x60, Self::mul_add(-x10, x59, x51 * x58)) + x177;
+        let x187 = Self::mul_add(x54, x60, Self::mul_add(-x12, x59, x53 * x58)) + x178;
+        let x188 = Self::mul_add(x50, x63, Self::mul_add(s_q1, x62, x49 * x61)) - x179;
+        let x189 = Self::mul_add(x52, x63, Self::mul_add(-x10, x62, x51 * x61)) + x180;
+        let x190 = Self::mul_add(x54, x63, Self::mul_add(-x12, x62, x53 * x61)) + x181;
+        let x191 = Self::mul_add(x32, x39, Self::mul_add(-s_q1, x38, x31 * x37)) + x182;
+        let x192 = Self::mul_add(x34, x39, Self::mul_add(x10, x38, x33 * x37)) + x183;
+        let x193 = Self::mul_add(x36, x39, Self::mul_add(x12, x38, x35 * x37)) + x184;
+        let x194 = Self::mul_add(x32, x42, Self::mul_add(-s_q1, x41, x31 * x40)) + x185;
+        let x195 = Self::mul_add(x34, x42, Self::mul_add(x10, x41, x33 * x40)) + x186;
+        let x196 = Self::mul_add(x36, x42, Self::mul_add(x12, x41, x35 * x40)) + x187;
+        let x197 = Self::mul_add(x32, x45, Self::mul_add(-s_q1, x44, x31 * x43)) + x188;
+        let x198 = Self::mul_add(x34, x45, Self::mul_add(x10, x44, x33 * x43)) + x189;
+        let x199 = Self::mul_add(x36, x45, Self::mul_add(x12, x44, x35 * x43)) + x190;
+        let x200 = Self::mul_add(105.98, x28, x150);
+        let x201 = Self::mul_add(105.98, x29, x151);
+        let x202 = Self::mul_add(105.98, x30, x152);
         let x203 = Self::mul_add(105.98, x132, x153);
         let x204 = Self::mul_add(-105.98, x133, x154);
         let x205 = Self::mul_add(-105.98, x134, x155);
-        let x206 = Self::mul_add(105.98, x61, x203);
-        let x207 = Self::mul_add(105.98, x62, x204);
-        let x208 = Self::mul_add(105.98, x63, x205);
+        let x206 = Self::mul_add(105.98, x64, x203);
+        let x207 = Self::mul_add(105.98, x65, x204);
+        let x208 = Self::mul_add(105.98, x66, x205);
         let x209 = Self::mul_add(105.98, x135, x156);
         let x210 = Self::mul_add(105.98, x136, x157);
         let x211 = Self::mul_add(105.98, x137, x158);
         let x212 = Self::mul_add(105.98, x140, x209);
         let x213 = Self::mul_add(105.98, x141, x210);
         let x214 = Self::mul_add(105.98, x142, x211);
-        let x215 = Self::mul_add(279.2, x42, x212);
-        let x216 = Self::mul_add(279.2, x43, x213);
-        let x217 = Self::mul_add(279.2, x44, x214);
-        let x218 = Self::mul_add(105.98, x23 + x135, x159);
+        let x215 = Self::mul_add(279.2, x46, x212);
+        let x216 = Self::mul_add(279.2, x47, x213);
+        let x217 = Self::mul_add(279.2, x48, x214);
+        let x218 = Self::mul_add(105.98, x28 + x135, x159);
         let x219 = Self::mul_add(105.98, x138, x160);
         let x220 = Self::mul_add(105.98, x139, x161);
-        let x221 = Self::mul_add(105.98, x23 + x140, x218);
+        let x221 = Self::mul_add(105.98, x28 + x140, x218);
         let x222 = Self::mul_add(105.98, x143, x219);
         let x223 = Self::mul_add(105.98, x144, x220);
-        let x224 = Self::mul_add(279.2, x23 + x42, x221);
+        let x224 = Self::mul_add(279.2, x28 + x46, x221);
         let x225 = Self::mul_add(279.2, x145, x222);
         let x226 = Self::mul_add(279.2, x146, x223);
-        let x227 = Self::mul_add(314.88, x24, x225);
-        let x228 = Self::mul_add(314.88, x25, x226);
-        let x229 = Self::mul_add(105.98, x1 + x138, x162);
-        let x230 = Self::mul_add(105.98, x2 - x139, x163);
-        let x231 = Self::mul_add(105.98, x1 + x143, x229);
-        let x232 = Self::mul_add(105.98, x2 - x144, x230);
-        let x233 = Self::mul_add(279.2, x1 + x145, x231);
-        let x234 = Self::mul_add(279.2, x2 - x146, x232);
-        let x235 = Self::mul_add(314.88, x1 + x24, x233);
-        let x236 = Self::mul_add(314.88, x2 - x25, x234);
-        let x237 = Self::mul_add(-x94, x162, x95 * x163);
-        let x238 = x93 * x162;
-        let x239 = x93 * x163;
-        let x240 = x94 * x159;
-        let x241 = x93 * x159;
-        let x242 = x95 * x159;
-        let x243 = Self::mul_add(-x95, x161, x241);
-        let x244 = x94 * x161;
-        let x245 = x95 * x160;
-        let x246 = Self::mul_add(-x94, x160, x241);
-        let x247 = x95 * x158;
-        let x248 = x94 * x157;
+        let x227 = Self::mul_add(314.88, x29, x225);
+        let x228 = Self::mul_add(314.88, x30, x226);
+        let x229 = Self::mul_add(105.98, x7 + x138, x162);
+        let x230 = Self::mul_add(105.98, x8 - x139, x163);
+        let x231 = Self::mul_add(105.98, x7 + x143, x229);
+        let x232 = Self::mul_add(105.98, x8 - x144, x230);
+        let x233 = Self::mul_add(279.2, x7 + x145, x231);
+        let x234 = Self::mul_add(279.2, x8 - x146, x232);
+        let x235 = Self::mul_add(314.88, x7 + x29, x233);
+        let x236 = Self::mul_add(314.88, x8 - x30, x234);
+        let x237 = Self::mul_add(-x95, x162, x96 * x163);
+        let x238 = x94 * x162;
+        let x239 = x94 * x163;
+        let x240 = x95 * x159;
+        let x241 = x94 * x159;
+        let x242 = x96 * x159;
+        let x243 = Self::mul_add(-x96, x161, x241);
+        let x244 = x95 * x161;
+        let x245 = x96 * x160;
+        let x246 = Self::mul_add(-x95, x160, x241);
+        let x247 = x96 * x158;
+        let x248 = x95 * x157;
         let x249 = x247 + x248;
-        let x250 = x93 * x157;
-        let x251 = x93 * x158;
-        let x252 = x94 * x156;
-        let x253 = x93 * x156;
+        let x250 = x94 * x157;
+        let x251 = x94 * x158;
+        let x252 = x95 * x156;
+        let x253 = x94 * x156;
         let x254 = x247 + x253;
-        let x255 = x94 * x158;
-        let x256 = x95 * x156;
-        let x257 = x95 * x157;
+        let x255 = x95 * x158;
+        let x256 = x96 * x156;
+        let x257 = x96 * x157;
         let x258 = x248 + x253;
-        let x259 = x95 * x155;
-        let x260 = x94 * x154;
+        let x259 = x96 * x155;
+        let x260 = x95 * x154;
         let x261 = x259 + x260;
-        let x262 = x93 * x154;
-        let x263 = x93 * x155;
-        let x264 = x94 * x153;
-        let x265 = x93 * x153;
+        let x262 = x94 * x154;
+        let x263 = x94 * x155;
+        let x264 = x95 * x153;
+        let x265 = x94 * x153;
         let x266 = x259 + x265;
-        let x267 = x94 * x155;
-        let x268 = x95 * x153;
-        let x269 = x95 * x154;
+        let x267 = x95 * x155;
+        let x268 = x96 * x153;
+        let x269 = x96 * x154;
         let x270 = x260 + x265;
-        let x271 = x95 * x152;
-        let x272 = x94 * x151;
+        let x271 = x96 * x152;
+        let x272 = x95 * x151;
         let x273 = x271 + x272;
-        let x274 = x93 * x151;
-        let x275 = x93 * x152;
-        let x276 = x94 * x150;
-        let x277 = x93 * x150;
+        let x274 = x94 * x151;
+        let x275 = x94 * x152;
+        let x276 = x95 * x150;
+        let x277 = x94 * x150;
         let x278 = x271 - x277;
-        let x279 = x94 * x152;
-        let x280 = x95 * x150;
-        let x281 = x95 * x151;
+        let x279 = x95 * x152;
+        let x280 = x96 * x150;
+        let x281 = x96 * x151;
         let x282 = x272 - x277;
-        let x283 = x95 * x149;
-        let x284 = x94 * x148;
-        let x285 = x93 * x147;
-        let x286 = x25 * x202;
-        let x287 = x24 * x201;
-        let x288 = x23 * x200;
-        let x289 = x25 * x205;
-        let x290 = x24 * x204;
-        let x291 = x23 * x203;
+        let x283 = x96 * x149;
+        let x284 = x95 * x148;
+        let x285 = x94 * x147;
+        let x286 = x30 * x202;
+        let x287 = x29 * x201;
+        let x288 = x28 * x200;
+        let x289 = x30 * x205;
+        let x290 = x29 * x204;
+        let x291 = x28 * x203;
         let x292 = x261 + (x289 + x290);
-        let x293 = Self::mul_add(-x23, x204, x262);
-        let x294 = Self::mul_add(-x23, x205, x263);
-        let x295 = Self::mul_add(x24, x203, x264);
+        let x293 = Self::mul_add(-x28, x204, x262);
+        let x294 = Self::mul_add(-x28, x205, x263);
+        let x295 = Self::mul_add(x29, x203, x264);
         let x296 = x266 + (x289 - x291);
-        let x297 = Self::mul_add(x24, x205, x267);
-        let x298 = Self::mul_add(x25, x203, x268);
-        let x299 = Self::mul_add(x25, x204, x269);
+        let x297 = Self::mul_add(x29, x205, x267);
+        let x298 = Self::mul_add(x30, x203, x268);
+        let x299 = Self::mul_add(x30, x204, x269);
         let x300 = x270 + (x290 - x291);
-        let x301 = x63 * x208;
-        let x302 = x62 * x207;
-        let x303 = x61 * x206;
-        let x304 = x25 * x211;
-        let x305 = x24 * x210;
-        let x306 = x23 * x209;
+        let x301 = x66 * x208;
+        let x302 = x65 * x207;
+        let x303 = x64 * x206;
+        let x304 = x30 * x211;
+        let x305 = x29 * x210;
+        let x306 = x28 * x209;
         let x307 = x249 + (x304 + x305);
-        let x308 = Self::mul_add(-x23, x210, x250);
-        let x309 = Self::mul_add(-x23, x211, x251);
-        let x310 = Self::mul_add(x24, x209, x252);
+        let x308 = Self::mul_add(-x28, x210, x250);
+        let x309 = Self::mul_add(-x28, x211, x251);
+        let x310 = Self::mul_add(x29, x209, x252);
         let x311 = x254 + (x304 - x306);
-        let x312 = Self::mul_add(x24, x211, x255);
-        let x313 = Self::mul_add(x25, x209, x256);
-        let x314 = Self::mul_add(x25, x210, x257);
+        let x312 = Self::mul_add(x29, x211, x255);
+        let x313 = Self::mul_add(x30, x209, x256);
+        let x314 = Self::mul_add(x30, x210, x257);
         let x315 = x258 + (x305 - x306);
-        let x316 = x63 * x214;
-        let x317 = x62 * x213;
-        let x318 = x61 * x212;
+        let x316 = x66 * x214;
+        let x317 = x65 * x213;
+        let x318 = x64 * x212;
         let x319 = x307 - (x316 + x317);
-        let x320 = Self::mul_add(-x61, x213, x308);
-        let x321 = Self::mul_add(-x61, x214, x309);
-        let x322 = Self::mul_add(-x62, x212, x310);
+        let x320 = Self::mul_add(-x64, x213, x308);
+        let x321 = Self::mul_add(-x64, x214, x309);
+        let x322 = Self::mul_add(-x65, x212, x310);
         let x323 = x311 - (x316 + x318);
-        let x324 = Self::mul_add(-x62, x214, x312);
-        let x325 = Self::mul_add(-x63, x212, x313);
-        let x326 = Self::mul_add(-x63, x213, x314);
+        let x324 = Self::mul_add(-x65, x214, x312);
+        let x325 = Self::mul_add(-x66, x212, x313);
+        let x326 = Self::mul_add(-x66, x213, x314);
         let x327 = x315 - (x317 + x318);
-        let x328 = x44 * x217;
-        let x329 = x43 * x216;
-        let x330 = x42 * x215;
-        let x331 = x23 * x218;
-        let x332 = Self::mul_add(x24, x218, x240);
-        let x333 = x243 - Self::mul_add(x25, x220, x331);
-        let x334 = Self::mul_add(x24, x220, x244);
-        let x335 = Self::mul_add(x25, x218, x242);
-        let x336 = Self::mul_add(x25, x219, x245);
-        let x337 = x246 - Self::mul_add(x24, x219, x331);
-        let x338 = x61 * x221;
-        let x339 = Self::mul_add(-x62, x221, x332);
-        let x340 = x333 + Self::mul_add(x63, x223, -x338);
-        let x341 = Self::mul_add(-x62, x223, x334);
-        let x342 = Self::mul_add(-x63, x221, x335);
-        let x343 = Self::mul_add(-x63, x222, x336);
-        let x344 = x337 + Self::mul_add(x62, x222, -x338);
-        let x345 = x42 * x224;
-        let x346 = x340 + Self::mul_add(x44, x226, -x345);
-        let x347 = Self::mul_add(-x43, x226, x341);
-        let x348 = Self::mul_add(-x44, x225, x343);
-        let x349 = x344 + Self::mul_add(x43, x225, -x345);
-        let x350 = x23 * Self::mul_add(314.88, x23, x224);
-        let x351 = x237 + Self::mul_add(-x24, x229, x25 * x230);
-        let x352 = Self::mul_add(-x23, x229, x238);
-        let x353 = Self::mul_add(-x23, x230, x239);
-        let x354 = x351 - Self::mul_add(-x62, x231, x63 * x232);
-        let x355 = Self::mul_add(-x61, x231, x352);
-        let x356 = Self::mul_add(-x61, x232, x353);
-        let x357 = x354 - Self::mul_add(-x43, x233, x44 * x234);
-        let x358 = Self::mul_add(-x42, x233, x355);
-        let x359 = Self::mul_add(-x42, x234, x356);
-        let x360 = 12.19 + (Self::mul_add(c_q1, x8, x16) + x191)
-            - (x357 + Self::mul_add(-x24, x235, x25 * x236)
+        let x328 = x48 * x217;
+        let x329 = x47 * x216;
+        let x330 = x46 * x215;
+        let x331 = x28 * x218;
+        let x332 = Self::mul_add(x29, x218, x240);
+        let x333 = x243 - Self::mul_add(x30, x220, x331);
+        let x334 = Self::mul_add(x29, x220, x244);
+        let x335 = Self::mul_add(x30, x218, x242);
+        let x336 = Self::mul_add(x30, x219, x245);
+        let x337 = x246 - Self::mul_add(x29, x219, x331);
+        let x338 = x64 * x221;
+        let x339 = Self::mul_add(-x65, x221, x332);
+        let x340 = x333 + Self::mul_add(x66, x223, -x338);
+        let x341 = Self::mul_add(-x65, x223, x334);
+        let x342 = Self::mul_add(-x66, x221, x335);
+        let x343 = Self::mul_add(-x66, x222, x336);
+        let x344 = x337 + Self::mul_add(x65, x222, -x338);
+        let x345 = x46 * x224;
+        let x346 = x340 + Self::mul_add(x48, x226, -x345);
+        let x347 = Self::mul_add(-x47, x226, x341);
+        let x348 = Self::mul_add(-x48, x225, x343);
+        let x349 = x344 + Self::mul_add(x47, x225, -x345);
+        let x350 = x28 * Self::mul_add(314.88, x28, x224);
+        let x351 = x237 + Self::mul_add(-x29, x229, x30 * x230);
+        let x352 = Self::mul_add(-x28, x229, x238);
+        let x353 = Self::mul_add(-x28, x230, x239);
+        let x354 = x351 - Self::mul_add(-x65, x231, x66 * x232);
+        let x355 = Self::mul_add(-x64, x231, x352);
+        let x356 = Self::mul_add(-x64, x232, x353);
+        let x357 = x354 - Self::mul_add(-x47, x233, x48 * x234);
+        let x358 = Self::mul_add(-x46, x233, x355);
+        let x359 = Self::mul_add(-x46, x234, x356);
+        let x360 = 12.19 + (Self::mul_add(c_q1, x13, x21) + x191)
+            - (x357 + Self::mul_add(-x29, x235, x30 * x236)
                 - Self::mul_add(
-                    x1,
-                    Self::mul_add(105.98, x1, x235),
-                    x2 * Self::mul_add(105.98, x2, x236),
+                    x7,
+                    Self::mul_add(105.98, x7, x235),
+                    x8 * Self::mul_add(105.98, x8, x236),
                 ));
         let x361 = -Self::mul_add(
             -c_q0,
-            Self::mul_add(x6, x8, -x18) + x193 + Self::mul_add(-x23, x236, x359),
-            s_q0 * (Self::mul_add(x4, x8, -x17) + x192 - Self::mul_add(-x23, x235, x358)),
+            Self::mul_add(x11, x13, -x23) + x193 + Self::mul_add(-x28, x236, x359),
+            s_q0
+                * (Self::mul_add(x9, x13, -x22) + x192 - Self::mul_add(-x28, x235, x358)),
         );
         let x362 = -Self::mul_add(
-            -x7,
+            -x12,
             x193 + x359,
-            Self::mul_add(-x5, x192 - x358, s_q1 * (x191 - x357)),
+            Self::mul_add(-x10, x192 - x358, s_q1 * (x191 - x357)),
         );
         let x363 = -Self::mul_add(
-            -x7,
+            -x12,
             x184 + x356,
-            Self::mul_add(-x5, x183 - x355, s_q1 * (x182 - x354)),
+            Self::mul_add(-x10, x183 - x355, s_q1 * (x182 - x354)),
         );
         let x364 = -Self::mul_add(
-            x7,
+            x12,
             x175 - x353,
-            Self::mul_add(x5, x174 + x352, s_q1 * (x173 - x351)),
+            Self::mul_add(x10, x174 + x352, s_q1 * (x173 - x351)),
         );
         let x365 = Self::mul_add(
-            x70,
+            x72,
             x166 + x239,
-            Self::mul_add(x68, x165 - x238, x66 * (x164 - x237)),
+            Self::mul_add(x70, x165 - x238, x68 * (x164 - x237)),
         );
-        let x366 = Self::mul_add(x82, x114, Self::mul_add(x80, x113, x78 * x112));
-        let x367 = Self::mul_add(x82, x117, Self::mul_add(x80, x116, x78 * x115));
-        let x368 = Self::mul_add(x82, x120, Self::mul_add(x80, x119, x78 * x118));
+        let x366 = Self::mul_add(x83, x114, Self::mul_add(x81, x113, x79 * x112));
+        let x367 = Self::mul_add(x83, x117, Self::mul_add(x81, x116, x79 * x115));
+        let x368 = Self::mul_add(x83, x120, Self::mul_add(x81, x119, x79 * x118));
         let x369 = Self::mul_add(
             -c_q0,
-            Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x20)) + x196
-                - Self::mul_add(x24, x228, x347),
+            Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x25)) + x196
+                - Self::mul_add(x29, x228, x347),
             s_q0
-                * (Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x19)) + x195
-                    - (x346 - Self::mul_add(x25, x228, x350))),
+                * (Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x24)) + x195
+                    - (x346 - Self::mul_add(x30, x228, x350))),
         );
         let x370 = Self::mul_add(
             -c_q0,
-            Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x22)) + x199
-                - (x349 - Self::mul_add(x24, x227, x350)),
+            Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x27)) + x199
+                - (x349 - Self::mul_add(x29, x227, x350)),
             s_q0
-                * (Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x21)) + x198
-                    - Self::mul_add(x25, x227, x348)),
+                * (Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x26)) + x198
+                    - Self::mul_add(x30, x227, x348)),
         );
         let x371 = Self::mul_add(-c_q0, x370, s_q0 * x369);
         let x372 = Self::mul_add(
-            -x7,
+            -x12,
             x196 - x347,
             Self::mul_add(
-                -x5,
+                -x10,
                 x195 - x346,
-                s_q1 * (x194 + Self::mul_add(-x43, x224, x339)),
+                s_q1 * (x194 + Self::mul_add(-x47, x224, x339)),
             ),
         );
         let x373 = Self::mul_add(
-            -x7,
+            -x12,
             x199 - x349,
             Self::mul_add(
-                -x5,
+                -x10,
                 x198 - x348,
-                s_q1 * (x197 + Self::mul_add(-x44, x224, x342)),
+                s_q1 * (x197 + Self::mul_add(-x48, x224, x342)),
             ),
         );
         let x374 = Self::mul_add(-c_q0, x373, s_q0 * x372);
         let x375 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                -x7,
+                -x12,
                 x190 - x344,
-                Self::mul_add(-x5, x189 - x343, s_q1 * (x188 + x342)),
+                Self::mul_add(-x10, x189 - x343, s_q1 * (x188 + x342)),
             ),
             s_q0
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x187 - x341,
-                    Self::mul_add(-x5, x186 - x340, s_q1 * (x185 + x339)),
+                    Self::mul_add(-x10, x186 - x340, s_q1 * (x185 + x339)),
                 ),
         );
         let x376 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x7,
+                x12,
                 x181 - x337,
-                Self::mul_add(x5, x180 - x336, s_q1 * (x179 - x335)),
+                Self::mul_add(x10, x180 - x336, s_q1 * (x179 - x335)),
             ),
             s_q0
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x178 - x334,
-                    Self::mul_add(x5, x177 - x333, s_q1 * (x176 - x332)),
+                    Self::mul_add(x10, x177 - x333, s_q1 * (x176 - x332)),
                 ),
         );
         let x377 = -x376;
         let x378 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x70,
+                x72,
                 x172 - x246,
-                Self::mul_add(x68, x171 - x245, x66 * (x170 + x242)),
+                Self::mul_add(x70, x171 - x245, x68 * (x170 + x242)),
             ),
             s_q0
                 * Self::mul_add(
-                    x70,
+                    x72,
                     x169 - x244,
-                    Self::mul_add(x68, x168 - x243, x66 * (x167 + x240)),
+                    Self::mul_add(x70, x168 - x243, x68 * (x167 + x240)),
                 ),
         );
         let x379 = -x378;
         let x380 = -Self::mul_add(-c_q0, x368, s_q0 * x367);
         let x381 = Self::mul_add(
-            -x7,
-            x193 + Self::mul_add(-x42, x217, x321),
+            -x12,
+            x193 + Self::mul_add(-x46, x217, x321),
             Self::mul_add(
-                -x5,
-                x192 + Self::mul_add(-x42, x216, x320),
+                -x10,
+                x192 + Self::mul_add(-x46, x216, x320),
                 s_q1 * (x191 - (x319 - (x328 + x329))),
             ),
         );
         let x382 = Self::mul_add(
-            -x7,
-            x196 + Self::mul_add(-x43, x217, x324),
+            -x12,
+            x196 + Self::mul_add(-x47, x217, x324),
             Self::mul_add(
-                -x5,
+                -x10,
                 x195 - (x323 - (x328 + x330)),
-                s_q1 * (x194 + Self::mul_add(-x43, x215, x322)),
+                s_q1 * (x194 + Self::mul_add(-x47, x215, x322)),
             ),
         );
         let x383 = Self::mul_add(
-            -x7,
+            -x12,
             x199 - (x327 - (x329 + x330)),
             Self::mul_add(
-                -x5,
-                x198 + Self::mul_add(-x44, x216, x326),
-                s_q1 * (x197 + Self::mul_add(-x44, x215, x325)),
+                -x10,
+                x198 + Self::mul_add(-x48, x216, x326),
+                s_q1 * (x197 + Self::mul_add(-x48, x215, x325)),
             ),
         );
-        let x384 = Self::mul_add(-x7, x383, Self::mul_add(-x5, x382, s_q1 * x381));
+        let x384 = Self::mul_add(-x12, x383, Self::mul_add(-x10, x382, s_q1 * x381));
         let x385 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                -x7,
+                -x12,
                 x187 + x324,
-                Self::mul_add(-x5, x186 - x323, s_q1 * (x185 + x322)),
+                Self::mul_add(-x10, x186 - x323, s_q1 * (x185 + x322)),
             ),
             s_q1
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x184 + x321,
-                    Self::mul_add(-x5, x183 + x320, s_q1 * (x182 - x319)),
+                    Self::mul_add(-x10, x183 + x320, s_q1 * (x182 - x319)),
                 ),
         );
         let x386 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                -x7,
+                -x12,
                 x190 - x327,
-                Self::mul_add(-x5, x189 + x326, s_q1 * (x188 + x325)),
+                Self::mul_add(-x10, x189 + x326, s_q1 * (x188 + x325)),
             ),
             x385,
         );
         let x387 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x178 + x312,
-                Self::mul_add(x5, x177 - x311, s_q1 * (x176 - x310)),
+                Self::mul_add(x10, x177 - x311, s_q1 * (x176 - x310)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x175 - x309,
-                    Self::mul_add(x5, x174 - x308, s_q1 * (x173 - x307)),
+                    Self::mul_add(x10, x174 - x308, s_q1 * (x173 - x307)),
                 ),
         );
         let x388 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x181 - x315,
-                Self::mul_add(x5, x180 + x314, s_q1 * (x179 - x313)),
+                Self::mul_add(x10, x180 + x314, s_q1 * (x179 - x313)),
             ),
             x387,
         );
         let x389 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x70,
+                x72,
                 x169 + x255,
-                Self::mul_add(x68, x168 - x254, x66 * (x167 + x252)),
+                Self::mul_add(x70, x168 - x254, x68 * (x167 + x252)),
             ),
             s_q1
                 * Self::mul_add(
-                    x70,
+                    x72,
                     x166 + x251,
-                    Self::mul_add(x68, x165 + x250, x66 * (x164 - x249)),
+                    Self::mul_add(x70, x165 + x250, x68 * (x164 - x249)),
                 ),
         );
         let x390 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x70,
+                x72,
                 x172 - x258,
-                Self::mul_add(x68, x171 + x257, x66 * (x170 + x256)),
+                Self::mul_add(x70, x171 + x257, x68 * (x170 + x256)),
             ),
             x389,
         );
         let x391 = -x390;
-        let x392 = -Self::mul_add(-x7, x368, Self::mul_add(-x5, x367, s_q1 * x366));
+        let x392 = -Self::mul_add(-x12, x368, Self::mul_add(-x10, x367, s_q1 * x366));
         let x393 = Self::mul_add(
-            -x7,
-            x184 + Self::mul_add(-x61, x208, x294),
+            -x12,
+            x184 + Self::mul_add(-x64, x208, x294),
             Self::mul_add(
-                -x5,
-                x183 + Self::mul_add(-x61, x207, x293),
+                -x10,
+                x183 + Self::mul_add(-x64, x207, x293),
                 s_q1 * (x182 - (x292 - (x301 + x302))),
             ),
         );
         let x394 = Self::mul_add(
-            -x7,
-            x187 + Self::mul_add(-x62, x208, x297),
+            -x12,
+            x187 + Self::mul_add(-x65, x208, x297),
             Self::mul_add(
-                -x5,
+                -x10,
                 x186 - (x296 - (x301 + x303)),
-                s_q1 * (x185 + Self::mul_add(-x62, x206, x295)),
+                s_q1 * (x185 + Self::mul_add(-x65, x206, x295)),
             ),
         );
         let x395 = Self::mul_add(
-            -x7,
+            -x12,
             x190 - (x300 - (x302 + x303)),
             Self::mul_add(
-                -x5,
-                x189 + Self::mul_add(-x63, x207, x299),
-                s_q1 * (x188 + Self::mul_add(-x63, x206, x298)),
+                -x10,
+                x189 + Self::mul_add(-x66, x207, x299),
+                s_q1 * (x188 + Self::mul_add(-x66, x206, x298)),
             ),
         );
-        let x396 = Self::mul_add(-x7, x395, Self::mul_add(-x5, x394, s_q1 * x393));
+        let x396 = Self::mul_add(-x12, x395, Self::mul_add(-x10, x394, s_q1 * x393));
         let x397 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x178 + x297,
-                Self::mul_add(x5, x177 - x296, s_q1 * (x176 - x295)),
+                Self::mul_add(x10, x177 - x296, s_q1 * (x176 - x295)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x175 - x294,
-                    Self::mul_add(x5, x174 - x293, s_q1 * (x173 - x292)),
+                    Self::mul_add(x10, x174 - x293, s_q1 * (x173 - x292)),
                 ),
         );
         let x398 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x181 - x300,
-                Self::mul_add(x5, x180 + x299, s_q1 * (x179 - x298)),
+                Self::mul_add(x10, x180 + x299, s_q1 * (x179 - x298)),
             ),
             x397,
         );
         let x399 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x70,
+                x72,
                 x169 + x267,
-                Self::mul_add(x68, x168 - x266, x66 * (x167 + x264)),
+                Self::mul_add(x70, x168 - x266, x68 * (x167 + x264)),
             ),
             s_q1
                 * Self::mul_add(
-                    x70,
+                    x72,
                     x166 + x263,
-                    Self::mul_add(x68, x165 + x262, x66 * (x164 - x261)),
+                    Self::mul_add(x70, x165 + x262, x68 * (x164 - x261)),
                 ),
         );
         let x400 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x70,
+                x72,
                 x172 - x270,
-                Self::mul_add(x68, x171 + x269, x66 * (x170 + x268)),
+                Self::mul_add(x70, x171 + x269, x68 * (x170 + x268)),
             ),
             x399,
         );
         let x401 = -x400;
         let x402 = Self::mul_add(
-            x7,
-            x175 + Self::mul_add(-x23, x202, x275),
+            x12,
+            x175 + Self::mul_add(-x28, x202, x275),
             Self::mul_add(
-                x5,
-                x174 + Self::mul_add(-x23, x201, x274),
+                x10,
+                x174 + Self::mul_add(-x28, x201, x274),
                 s_q1 * (x173 + (x273 + (x286 + x287))),
             ),
         );
         let x403 = Self::mul_add(
-            x7,
-            x178 - Self::mul_add(x24, x202, x279),
+            x12,
+            x178 - Self::mul_add(x29, x202, x279),
             Self::mul_add(
-                x5,
+                x10,
                 x177 + (x278 + (x286 + x288)),
-                s_q1 * (x176 - Self::mul_add(x24, x200, x276)),
+                s_q1 * (x176 - Self::mul_add(x29, x200, x276)),
             ),
         );
         let x404 = Self::mul_add(
-            x7,
+            x12,
             x181 + (x282 + (x287 + x288)),
             Self::mul_add(
-                x5,
-                x180 - Self::mul_add(x25, x201, x281),
-                s_q1 * (x179 - Self::mul_add(x25, x200, x280)),
+                x10,
+                x180 - Self::mul_add(x30, x201, x281),
+                s_q1 * (x179 - Self::mul_add(x30, x200, x280)),
             ),
         );
-        let x405 = Self::mul_add(x7, x404, Self::mul_add(x5, x403, s_q1 * x402));
+        let x405 = Self::mul_add(x12, x404, Self::mul_add(x10, x403, s_q1 * x402));
         let x406 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x70,
+                x72,
                 x169 - x279,
-                Self::mul_add(x68, x168 + x278, x66 * (x167 + x276)),
+                Self::mul_add(x70, x168 + x278, x68 * (x167 + x276)),
             ),
             s_q1
                 * Self::mul_add(
-                    x70,
+                    x72,
                     x166 - x275,
-                    Self::mul_add(x68, x165 - x274, x66 * (x164 + x273)),
+                    Self::mul_add(x70, x165 - x274, x68 * (x164 + x273)),
                 ),
         );
         let x407 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x70,
+                x72,
                 x172 + x282,
-                Self::mul_add(x68, x171 - x281, x66 * (x170 + x280)),
+                Self::mul_add(x70, x171 - x281, x68 * (x170 + x280)),
             ),
             x406,
         );
         let x408 = -x407;
         let x409 = Self::mul_add(
-            x70,
-            Self::mul_add(-x93, x149, x166),
+            x72,
+            Self::mul_add(-x94, x149, x166),
             Self::mul_add(
-                x68,
-                Self::mul_add(-x93, x148, x165),
-                x66 * (x164 + (x283 + x284)),
+                x70,
+                Self::mul_add(-x94, x148, x165),
+                x68 * (x164 + (x283 + x284)),
             ),
         );
         let x410 = Self::mul_add(
-            x70,
-            Self::mul_add(-x94, x149, x169),
+            x72,
+            Self::mul_add(-x95, x149, x169),
             Self::mul_add(
-                x68,
+                x70,
                 x168 + (x283 + x285),
-                x66 * Self::mul_add(-x94, x147, x167),
+                x68 * Self::mul_add(-x95, x147, x167),
             ),
         );
         let x411 = Self::mul_add(
-            x70,
+            x72,
             x172 + (x284 + x285),
             Self::mul_add(
-                x68,
-                Self::mul_add(-x95, x148, x171),
-                x66 * Self::mul_add(-x95, x147, x170),
+                x70,
+                Self::mul_add(-x96, x148, x171),
+                x68 * Self::mul_add(-x96, x147, x170),
             ),
         );
-        let x412 = Self::mul_add(x70, x411, Self::mul_add(x68, x410, x66 * x409));
-        let x413 = Self::mul_add(x70, x368, Self::mul_add(x68, x367, x66 * x366));
-        let x414 = Self::mul_add(x82, x368, Self::mul_add(x80, x367, x78 * x366));
+        let x412 = Self::mul_add(x72, x411, Self::mul_add(x70, x410, x68 * x409));
+        let x413 = Self::mul_add(x72, x368, Self::mul_add(x70, x367, x68 * x366));
+        let x414 = Self::mul_add(x83, x368, Self::mul_add(x81, x367, x79 * x366));
         [
             [x360, x361, x362, x363, x364, x365, x366],
             [x361, x371, x374, x375, x377, x379, x380],
@@ -995,196 +999,199 @@ impl SsrmsRecurrent {
     /// Methods: bias `recurrent`: 618 mul, 450 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 317 fused where the target has FMA.
     #[must_use]
     pub fn nonlinear_effects(q: &[f64; 7], qd: &[f64; 7]) -> [f64; 7] {
-        let (s_q0, c_q0) = Self::sincos(q[0]);
-        let x1 = 0.7026 * s_q0;
-        let x2 = 0.7026 * c_q0;
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x4 = c_q0 * s_q1;
-        let x5 = c_q0 * c_q1;
-        let x6 = s_q0 * s_q1;
-        let x7 = s_q0 * c_q1;
-        let x8 = 8.088 * c_q1;
-        let x9 = 3.061 * s_q1;
-        let x10 = 8.088 * x4;
-        let x11 = 3.061 * x5;
-        let x12 = 8.446 * s_q0;
-        let x13 = 8.088 * x6;
-        let x14 = 3.061 * x7;
-        let x15 = 8.446 * c_q0;
-        let x16 = s_q1 * x9;
-        let x17 = x5 * x9;
-        let x18 = Self::mul_add(x4, x8, -x17);
-        let x19 = x7 * x9;
-        let x20 = Self::mul_add(x6, x8, -x19);
-        let x21 = s_q1 * x11;
-        let x22 = x5 * x11;
-        let x23 = Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x22));
-        let x24 = x7 * x11;
-        let x25 = Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x24));
-        let x26 = s_q1 * x14;
-        let x27 = x5 * x14;
-        let x28 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x27));
-        let x29 = x7 * x14;
-        let x30 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x29));
-        let x31 = s_q1 * 0.5692;
-        let x32 = x5 * 0.5692;
-        let x33 = x7 * 0.5692;
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x35 = c_q1 * c_q2;
-        let x36 = c_q1 * s_q2;
-        let x37 = Self::mul_add(s_q0, s_q2, x4 * c_q2);
-        let x38 = Self::mul_add(-s_q0, c_q2, x4 * s_q2);
-        let x39 = Self::mul_add(-c_q0, s_q2, x6 * c_q2);
-        let x40 = Self::mul_add(c_q0, c_q2, x6 * s_q2);
-        let x41 = Self::mul_add(-49.52, s_q1, 15.41 * x35);
-        let x42 = Self::mul_add(-2094.71, s_q1, 49.52 * x35);
-        let x43 = 2103.19 * x36;
-        let x44 = Self::mul_add(49.52, x5, 15.41 * x37);
-        let x45 = Self::mul_add(2094.71, x5, 49.52 * x37);
-        let x46 = 2103.19 * x38;
-        let x47 = Self::mul_add(49.52, x7, 15.41 * x39);
-        let x48 = Self::mul_add(2094.71, x7, 49.52 * x39);
-        let x49 = 2103.19 * x40;
-        let x50 = Self::mul_add(x36, x43, Self::mul_add(-s_q1, x42, x35 * x41));
-        let x51 = Self::mul_add(x38, x43, Self::mul_add(x5, x42, x37 * x41));
-        let x52 = Self::mul_add(x40, x43, Self::mul_add(x7, x42, x39 * x41));
-        let x53 = Self::mul_add(x36, x46, Self::mul_add(-s_q1, x45, x35 * x44));
-        let x54 = Self::mul_add(x38, x46, Self::mul_add(x5, x45, x37 * x44));
-        let x55 = Self::mul_add(x40, x46, Self::mul_add(x7, x45, x39 * x44));
-        let x56 = Self::mul_add(x36, x49, Self::mul_add(-s_q1, x48, x35 * x47));
-        let x57 = Self::mul_add(x38, x49, Self::mul_add(x5, x48, x37 * x47));
-        let x58 = Self::mul_add(x40, x49, Self::mul_add(x7, x48, x39 * x47));
-        let x59 = Self::mul_add(s_q1, 0.475, 7.11 * x35);
-        let x60 = Self::mul_add(x5, -0.475, 7.11 * x37);
-        let x61 = Self::mul_add(x7, -0.475, 7.11 * x39);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x63 = Self::mul_add(-x36, s_q3, x35 * c_q3);
-        let x64 = Self::mul_add(x36, c_q3, x35 * s_q3);
-        let x65 = Self::mul_add(-x38, s_q3, x37 * c_q3);
-        let x66 = Self::mul_add(x38, c_q3, x37 * s_q3);
-        let x67 = Self::mul_add(-x40, s_q3, x39 * c_q3);
-        let x68 = Self::mul_add(x40, c_q3, x39 * s_q3);
-        let x69 = Self::mul_add(s_q1, 39.95, 9.522 * x63);
-        let x70 = Self::mul_add(1966.28, s_q1, x63 * 39.95);
-        let x71 = 1966.28 * x64;
-        let x72 = Self::mul_add(x5, -39.95, 9.522 * x65);
-        let x73 = Self::mul_add(-1966.28, x5, x65 * 39.95);
-        let x74 = 1966.28 * x66;
-        let x75 = Self::mul_add(x7, -39.95, 9.522 * x67);
-        let x76 = Self::mul_add(-1966.28, x7, x67 * 39.95);
-        let x77 = 1966.28 * x68;
-        let x78 = Self::mul_add(x64, x71, Self::mul_add(s_q1, x70, x63 * x69));
-        let x79 = Self::mul_add(x66, x71, Self::mul_add(-x5, x70, x65 * x69));
-        let x80 = Self::mul_add(x68, x71, Self::mul_add(-x7, x70, x67 * x69));
-        let x81 = Self::mul_add(x64, x74, Self::mul_add(s_q1, x73, x63 * x72));
-        let x82 = Self::mul_add(x66, x74, Self::mul_add(-x5, x73, x65 * x72));
-        let x83 = Self::mul_add(x68, x74, Self::mul_add(-x7, x73, x67 * x72));
-        let x84 = Self::mul_add(x64, x77, Self::mul_add(s_q1, x76, x63 * x75));
-        let x85 = Self::mul_add(x66, x77, Self::mul_add(-x5, x76, x65 * x75));
-        let x86 = Self::mul_add(x68, x77, Self::mul_add(-x7, x76, x67 * x75));
-        let x87 = 7.11 * x63;
-        let x88 = 7.11 * x65;
-        let x89 = 7.11 * x67;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x91 = Self::mul_add(-x64, s_q4, x63 * c_q4);
-        let x92 = Self::mul_add(x64, c_q4, x63 * s_q4);
-        let x93 = Self::mul_add(-x66, s_q4, x65 * c_q4);
-        let x94 = Self::mul_add(x66, c_q4, x65 * s_q4);
-        let x95 = Self::mul_add(-x68, s_q4, x67 * c_q4);
-        let x96 = Self::mul_add(x68, c_q4, x67 * s_q4);
-        let x97 = 8.305 * x91;
-        let x98 = 8.0386 * x92;
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = 0.7026 * s_q0;
+        let x8 = 0.7026 * c_q0;
+        let x9 = c_q0 * s_q1;
+        let x10 = c_q0 * c_q1;
+        let x11 = s_q0 * s_q1;
+        let x12 = s_q0 * c_q1;
+        let x13 = 8.088 * c_q1;
+        let x14 = 3.061 * s_q1;
+        let x15 = 8.088 * x9;
+        let x16 = 3.061 * x10;
+        let x17 = 8.446 * s_q0;
+        let x18 = 8.088 * x11;
+        let x19 = 3.061 * x12;
+        let x20 = 8.446 * c_q0;
+        let x21 = s_q1 * x14;
+        let x22 = x10 * x14;
+        let x23 = Self::mul_add(x9, x13, -x22);
+        let x24 = x12 * x14;
+        let x25 = Self::mul_add(x11, x13, -x24);
+        let x26 = s_q1 * x16;
+        let x27 = x10 * x16;
+        let x28 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x27));
+        let x29 = x12 * x16;
+        let x30 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x29));
+        let x31 = s_q1 * x19;
+        let x32 = x10 * x19;
+        let x33 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x32));
+        let x34 = x12 * x19;
+        let x35 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x34));
+        let x36 = s_q1 * 0.5692;
+        let x37 = x10 * 0.5692;
+        let x38 = x12 * 0.5692;
+        let x39 = c_q1 * c_q2;
+        let x40 = c_q1 * s_q2;
+        let x41 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x42 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
+        let x43 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
+        let x44 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x45 = Self::mul_add(-49.52, s_q1, 15.41 * x39);
+        let x46 = Self::mul_add(-2094.71, s_q1, 49.52 * x39);
+        let x47 = 2103.19 * x40;
+        let x48 = Self::mul_add(49.52, x10, 15.41 * x41);
+        let x49 = Self::mul_add(2094.71, x10, 49.52 * x41);
+        let x50 = 2103.19 * x42;
+        let x51 = Self::mul_add(49.52, x12, 15.41 * x43);
+        let x52 = Self::mul_add(2094.71, x12, 49.52 * x43);
+        let x53 = 2103.19 * x44;
+        let x54 = Self::mul_add(x40, x47, Self::mul_add(-s_q1, x46, x39 * x45));
+        let x55 = Self::mul_add(x42, x47, Self::mul_add(x10, x46, x41 * x45));
+        let x56 = Self::mul_add(x44, x47, Self::mul_add(x12, x46, x43 * x45));
+        let x57 = Self::mul_add(x40, x50, Self::mul_add(-s_q1, x49, x39 * x48));
+        let x58 = Self::mul_add(x42, x50, Self::mul_add(x10, x49, x41 * x48));
+        let x59 = Self::mul_add(x44, x50, Self::mul_add(x12, x49, x43 * x48));
+        let x60 = Self::mul_add(x40, x53, Self::mul_add(-s_q1, x52, x39 * x51));
+        let x61 = Self::mul_add(x42, x53, Self::mul_add(x10, x52, x41 * x51));
+        let x62 = Self::mul_add(x44, x53, Self::mul_add(x12, x52, x43 * x51));
+        let x63 = Self::mul_add(s_q1, 0.475, 7.11 * x39);
+        let x64 = Self::mul_add(x10, -0.475, 7.11 * x41);
+        let x65 = Self::mul_add(x12, -0.475, 7.11 * x43);
+        let x66 = Self::mul_add(-x40, s_q3, x39 * c_q3);
+        let x67 = Self::mul_add(x40, c_q3, x39 * s_q3);
+        let x68 = Self::mul_add(-x42, s_q3, x41 * c_q3);
+        let x69 = Self::mul_add(x42, c_q3, x41 * s_q3);
+        let x70 = Self::mul_add(-x44, s_q3, x43 * c_q3);
+        let x71 = Self::mul_add(x44, c_q3, x43 * s_q3);
+        let x72 = Self::mul_add(s_q1, 39.95, 9.522 * x66);
+        let x73 = Self::mul_add(1966.28, s_q1, x66 * 39.95);
+        let x74 = 1966.28 * x67;
+        let x75 = Self::mul_add(x10, -39.95, 9.522 * x68);
+        let x76 = Self::mul_add(-1966.28, x10, x68 * 39.95);
+        let x77 = 1966.28 * x69;
+        let x78 = Self::mul_add(x12, -39.95, 9.522 * x70);
+        let x79 = Self::mul_add(-1966.28, x12, x70 * 39.95);
+        let x80 = 1966.28 * x71;
+        let x81 = Self::mul_add(x67, x74, Self::mul_add(s_q1, x73, x66 * x72));
+        let x82 = Self::mul_add(x69, x74, Self::mul_add(-x10, x73, x68 * x72));
+        let x83 = Self::mul_add(x71, x74, Self::mul_add(-x12, x73, x70 * x72));
+        let x84 = Self::mul_add(x67, x77, Self::mul_add(s_q1, x76, x66 * x75));
+        let x85 = Self::mul_add(x69, x77, Self::mul_add(-x10, x76, x68 * x75));
+        let x86 = Self::mul_add(x71, x77, Self::mul_add(-x12, x76, x70 * x75));
+        let x87 = Self::mul_add(x67, x80, Self::mul_add(s_q1, x79, x66 * x78));
+        let x88 = Self::mul_add(x69, x80, Self::mul_add(-x10, x79, x68 * x78));
+        let x89 = Self::mul_add(x71, x80, Self::mul_add(-x12, x79, x70 * x78));
+        let x90 = 7.11 * x66;
+        let x91 = 7.11 * x68;
+        let x92 = 7.11 * x70;
+        let x93 = Self::mul_add(-x67, s_q4, x66 * c_q4);
+        let x94 = Self::mul_add(x67, c_q4, x66 * s_q4);
+        let x95 = Self::mul_add(-x69, s_q4, x68 * c_q4);
+        let x96 = Self::mul_add(x69, c_q4, x68 * s_q4);
+        let x97 = Self::mul_add(-x71, s_q4, x70 * c_q4);
+        let x98 = Self::mul_add(x71, c_q4, x70 * s_q4);
         let x99 = 8.305 * x93;
         let x100 = 8.0386 * x94;
         let x101 = 8.305 * x95;
         let x102 = 8.0386 * x96;
-        let x103 = Self::mul_add(x92, x98, Self::mul_add(x91, x97, x16));
-        let x104 = Self::mul_add(-x94, x98, Self::mul_add(-x93, x97, x17));
-        let x105 = Self::mul_add(-x96, x98, Self::mul_add(-x95, x97, x19));
-        let x106 = Self::mul_add(-x92, x100, Self::mul_add(-x91, x99, x21));
-        let x107 = Self::mul_add(x94, x100, Self::mul_add(x93, x99, x22));
-        let x108 = Self::mul_add(x96, x100, Self::mul_add(x95, x99, x24));
-        let x109 = Self::mul_add(-x92, x102, Self::mul_add(-x91, x101, x26));
-        let x110 = Self::mul_add(x94, x102, Self::mul_add(x93, x101, x27));
-        let x111 = Self::mul_add(x96, x102, Self::mul_add(x95, x101, x29));
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x113 = Self::mul_add(-s_q1, s_q5, x91 * c_q5);
-        let x114 = Self::mul_add(s_q1, c_q5, x91 * s_q5);
-        let x115 = Self::mul_add(x5, s_q5, x93 * c_q5);
-        let x116 = Self::mul_add(-x5, c_q5, x93 * s_q5);
-        let x117 = Self::mul_add(x7, s_q5, x95 * c_q5);
-        let x118 = Self::mul_add(-x7, c_q5, x95 * s_q5);
-        let x119 = 12.13 * x113;
+        let x103 = 8.305 * x97;
+        let x104 = 8.0386 * x98;
+        let x105 = Self::mul_add(x94, x100, Self::mul_add(x93, x99, x21));
+        let x106 = Self::mul_add(-x96, x100, Self::mul_add(-x95, x99, x22));
+        let x107 = Self::mul_add(-x98, x100, Self::mul_add(-x97, x99, x24));
+        let x108 = Self::mul_add(-x94, x102, Self::mul_add(-x93, x101, x26));
+        let x109 = Self::mul_add(x96, x102, Self::mul_add(x95, x101, x27));
+        let x110 = Self::mul_add(x98, x102, Self::mul_add(x97, x101, x29));
+        let x111 = Self::mul_add(-x94, x104, Self::mul_add(-x93, x103, x31));
+        let x112 = Self::mul_add(x96, x104, Self::mul_add(x95, x103, x32));
+        let x113 = Self::mul_add(x98, x104, Self::mul_add(x97, x103, x34));
+        let x114 = Self::mul_add(-s_q1, s_q5, x93 * c_q5);
+        let x115 = Self::mul_add(s_q1, c_q5, x93 * s_q5);
+        let x116 = Self::mul_add(x10, s_q5, x95 * c_q5);
+        let x117 = Self::mul_add(-x10, c_q5, x95 * s_q5);
+        let x118 = Self::mul_add(x12, s_q5, x97 * c_q5);
+        let x119 = Self::mul_add(-x12, c_q5, x97 * s_q5);
         let x120 = 12.13 * x114;
-        let x121 = 3.061 * x92;
-        let x122 = 12.13 * x115;
+        let x121 = 12.13 * x115;
+        let x122 = 3.061 * x94;
         let x123 = 12.13 * x116;
-        let x124 = 3.061 * x94;
-        let x125 = 12.13 * x117;
+        let x124 = 12.13 * x117;
+        let x125 = 3.061 * x96;
         let x126 = 12.13 * x118;
-        let x127 = 3.061 * x96;
-        let x128 = Self::mul_add(x92, x121, Self::mul_add(x114, x120, x113 * x119));
-        let x129 = Self::mul_add(x94, x121, Self::mul_add(x116, x120, x115 * x119));
-        let x130 = Self::mul_add(x96, x121, Self::mul_add(x118, x120, x117 * x119));
-        let x131 = Self::mul_add(x92, x124, Self::mul_add(x114, x123, x113 * x122));
-        let x132 = Self::mul_add(x94, x124, Self::mul_add(x116, x123, x115 * x122));
-        let x133 = Self::mul_add(x96, x124, Self::mul_add(x118, x123, x117 * x122));
-        let x134 = Self::mul_add(x92, x127, Self::mul_add(x114, x126, x113 * x125));
-        let x135 = Self::mul_add(x94, x127, Self::mul_add(x116, x126, x115 * x125));
-        let x136 = Self::mul_add(x96, x127, Self::mul_add(x118, x126, x117 * x125));
-        let x137 = 0.7026 * x92;
+        let x127 = 12.13 * x119;
+        let x128 = 3.061 * x98;
+        let x129 = Self::mul_add(x94, x122, Self::mul_add(x115, x121, x114 * x120));
+        let x130 = Self::mul_add(x96, x122, Self::mul_add(x117, x121, x116 * x120));
+        let x131 = Self::mul_add(x98, x122, Self::mul_add(x119, x121, x118 * x120));
+        let x132 = Self::mul_add(x94, x125, Self::mul_add(x115, x124, x114 * x123));
+        let x133 = Self::mul_add(x96, x125, Self::mul_add(x117, x124, x116 * x123));
+        let x134 = Self::mul_add(x98, x125, Self::mul_add(x119, x124, x118 * x123));
+        let x135 = Self::mul_add(x94, x128, Self::mul_add(x115, x127, x114 * x126));
+        let x136 = Self::mul_add(x96, x128, Self::mul_add(x117, x127, x116 * x126));
+        let x137 = Self::mul_add(x98, x128, Self::mul_add(x119, x127, x118 * x126));
         let x138 = 0.7026 * x94;
         let x139 = 0.7026 * x96;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x141 = Self::mul_add(-x92, s_q6, x114 * c_q6);
-        let x142 = Self::mul_add(x92, c_q6, x114 * s_q6);
-        let x143 = Self::mul_add(-x94, s_q6, x116 * c_q6);
-        let x144 = Self::mul_add(x94, c_q6, x116 * s_q6);
-        let x145 = Self::mul_add(-x96, s_q6, x118 * c_q6);
-        let x146 = Self::mul_add(x96, c_q6, x118 * s_q6);
-        let x147 = 9.336 * x113;
+        let x140 = 0.7026 * x98;
+        let x141 = Self::mul_add(-x94, s_q6, x115 * c_q6);
+        let x142 = Self::mul_add(x94, c_q6, x115 * s_q6);
+        let x143 = Self::mul_add(-x96, s_q6, x117 * c_q6);
+        let x144 = Self::mul_add(x96, c_q6, x117 * s_q6);
+        let x145 = Self::mul_add(-x98, s_q6, x119 * c_q6);
+        let x146 = Self::mul_add(x98, c_q6, x119 * s_q6);
+        let x147 = 9.336 * x114;
         let x148 = 44.41 * x141;
         let x149 = 44.41 * x142;
-        let x150 = 9.336 * x115;
+        let x150 = 9.336 * x116;
         let x151 = 44.41 * x143;
         let x152 = 44.41 * x144;
-        let x153 = 9.336 * x117;
+        let x153 = 9.336 * x118;
         let x154 = 44.41 * x145;
         let x155 = 44.41 * x146;
-        let x156 = Self::mul_add(x142, x149, Self::mul_add(x141, x148, x113 * x147));
-        let x157 = Self::mul_add(x144, x149, Self::mul_add(x143, x148, x115 * x147));
-        let x158 = Self::mul_add(x146, x149, Self::mul_add(x145, x148, x117 * x147));
-        let x159 = Self::mul_add(x142, x152, Self::mul_add(x141, x151, x113 * x150));
-        let x160 = Self::mul_add(x144, x152, Self::mul_add(x143, x151, x115 * x150));
-        let x161 = Self::mul_add(x146, x152, Self::mul_add(x145, x151, x117 * x150));
-        let x162 = Self::mul_add(x142, x155, Self::mul_add(x141, x154, x113 * x153));
-        let x163 = Self::mul_add(x144, x155, Self::mul_add(x143, x154, x115 * x153));
-        let x164 = Self::mul_add(x146, x155, Self::mul_add(x145, x154, x117 * x153));
+        let x156 = Self::mul_add(x142, x149, Self::mul_add(x141, x148, x114 * x147));
+        let x157 = Self::mul_add(x144, x149, Self::mul_add(x143, x148, x116 * x147));
+        let x158 = Self::mul_add(x146, x149, Self::mul_add(x145, x148, x118 * x147));
+        let x159 = Self::mul_add(x142, x152, Self::mul_add(x141, x151, x114 * x150));
+        let x160 = Self::mul_add(x144, x152, Self::mul_add(x143, x151, x116 * x150));
+        let x161 = Self::mul_add(x146, x152, Self::mul_add(x145, x151, x118 * x150));
+        let x162 = Self::mul_add(x142, x155, Self::mul_add(x141, x154, x114 * x153));
+        let x163 = Self::mul_add(x144, x155, Self::mul_add(x143, x154, x116 * x153));
+        let x164 = Self::mul_add(x146, x155, Self::mul_add(x145, x154, x118 * x153));
         let x165 = qd[1] * s_q0;
         let x166 = qd[1] * c_q0;
         let x167 = qd[0] * qd[0];
-        let x168 = x1 * x167;
-        let x169 = x2 * x167;
+        let x168 = x7 * x167;
+        let x169 = x8 * x167;
         let x170 = qd[0] * x166;
         let x171 = qd[0] * x165;
         let x172 = qd[2] * s_q1;
-        let x173 = qd[2] * x5;
-        let x174 = qd[2] * x7;
+        let x173 = qd[2] * x10;
+        let x174 = qd[2] * x12;
         let x175 = x166 * x166;
         let x176 = x165 * x165;
         let x177 = x165 * x166;
-        let x178 = x31 * (x175 + x176);
+        let x178 = x36 * (x175 + x176);
         let x179 = x168
             - Self::mul_add(
-                -x33,
+                -x38,
                 x177,
-                Self::mul_add(-x32, x167 + x175, x31 * (x171 + x171)),
+                Self::mul_add(-x37, x167 + x175, x36 * (x171 + x171)),
             );
         let x180 = x169
             - Self::mul_add(
-                x33,
+                x38,
                 x167 + x176,
-                Self::mul_add(x32, x177, x31 * (x170 + x170)),
+                Self::mul_add(x37, x177, x36 * (x170 + x170)),
             );
         let x181 = qd[0] - x172;
         let x182 = x165 - x173;
@@ -1193,8 +1200,8 @@ impl SsrmsRecurrent {
         let x185 = x170 + Self::mul_add(qd[0], x174, x166 * x172);
         let x186 = x171 + Self::mul_add(-qd[0], x173, x165 * x172);
         let x187 = qd[3] * s_q1;
-        let x188 = qd[3] * x5;
-        let x189 = qd[3] * x7;
+        let x188 = qd[3] * x10;
+        let x189 = qd[3] * x12;
         let x190 = x183 * x183;
         let x191 = x182 * x182;
         let x192 = x181 * x182;
@@ -1203,21 +1210,21 @@ impl SsrmsRecurrent {
         let x195 = x182 * x183;
         let x196 = x178
             + Self::mul_add(
-                x61,
+                x65,
                 x185 - x193,
-                Self::mul_add(-x60, x186 - x192, x59 * (x190 + x191)),
+                Self::mul_add(-x64, x186 - x192, x63 * (x190 + x191)),
             );
         let x197 = x179
             - Self::mul_add(
-                -x61,
+                -x65,
                 x184 - x195,
-                Self::mul_add(x60, x190 + x194, x59 * (x186 + x192)),
+                Self::mul_add(x64, x190 + x194, x63 * (x186 + x192)),
             );
         let x198 = x180
             - Self::mul_add(
-                -x61,
+                -x65,
                 x191 + x194,
-                Self::mul_add(-x60, x184 + x195, x59 * (x185 + x193)),
+                Self::mul_add(-x64, x184 + x195, x63 * (x185 + x193)),
             );
         let x199 = x181 - x187;
         let x200 = x182 - x188;
@@ -1226,8 +1233,8 @@ impl SsrmsRecurrent {
         let x203 = x185 + Self::mul_add(x181, x189, x183 * x187);
         let x204 = x186 + Self::mul_add(-x181, x188, x182 * x187);
         let x205 = qd[4] * s_q1;
-        let x206 = qd[4] * x5;
-        let x207 = qd[4] * x7;
+        let x206 = qd[4] * x10;
+        let x207 = qd[4] * x12;
         let x208 = x201 * x201;
         let x209 = x200 * x200;
         let x210 = x199 * x200;
@@ -1236,21 +1243,21 @@ impl SsrmsRecurrent {
         let x213 = x200 * x201;
         let x214 = x196
             + Self::mul_add(
-                x89,
+                x92,
                 x203 - x211,
-                Self::mul_add(-x88, x204 - x210, x87 * (x208 + x209)),
+                Self::mul_add(-x91, x204 - x210, x90 * (x208 + x209)),
             );
         let x215 = x197
             - Self::mul_add(
-                -x89,
+                -x92,
                 x202 - x213,
-                Self::mul_add(x88, x208 + x212, x87 * (x204 + x210)),
+                Self::mul_add(x91, x208 + x212, x90 * (x204 + x210)),
             );
         let x216 = x198
             - Self::mul_add(
-                -x89,
+                -x92,
                 x209 + x212,
-                Self::mul_add(-x88, x202 + x213, x87 * (x203 + x211)),
+                Self::mul_add(-x91, x202 + x213, x90 * (x203 + x211)),
             );
         let x217 = x199 - x205;
         let x218 = x200 - x206;
@@ -1258,9 +1265,9 @@ impl SsrmsRecurrent {
         let x220 = x202 + Self::mul_add(x200, x207, x201 * x206);
         let x221 = x203 + Self::mul_add(x199, x207, x201 * x205);
         let x222 = x204 + Self::mul_add(-x199, x206, x200 * x205);
-        let x223 = qd[5] * x92;
-        let x224 = qd[5] * x94;
-        let x225 = qd[5] * x96;
+        let x223 = qd[5] * x94;
+        let x224 = qd[5] * x96;
+        let x225 = qd[5] * x98;
         let x226 = x219 * x219;
         let x227 = x218 * x218;
         let x228 = x217 * x218;
@@ -1269,21 +1276,21 @@ impl SsrmsRecurrent {
         let x231 = x218 * x219;
         let x232 = x214
             + Self::mul_add(
-                -x33,
+                -x38,
                 x221 - x229,
-                Self::mul_add(x32, x222 - x228, x31 * (x226 + x227)),
+                Self::mul_add(x37, x222 - x228, x36 * (x226 + x227)),
             );
         let x233 = x215
             - Self::mul_add(
-                x33,
+                x38,
                 x220 - x231,
-                Self::mul_add(-x32, x226 + x230, x31 * (x222 + x228)),
+                Self::mul_add(-x37, x226 + x230, x36 * (x222 + x228)),
             );
         let x234 = x216
             - Self::mul_add(
-                x33,
+                x38,
                 x227 + x230,
-                Self::mul_add(x32, x220 + x231, x31 * (x221 + x229)),
+                Self::mul_add(x37, x220 + x231, x36 * (x221 + x229)),
             );
         let x235 = x217 + x223;
         let x236 = x218 - x224;
@@ -1291,9 +1298,9 @@ impl SsrmsRecurrent {
         let x238 = x220 + Self::mul_add(x218, x225, x219 * x224);
         let x239 = x221 - Self::mul_add(-x217, x225, x219 * x223);
         let x240 = x222 - Self::mul_add(x217, x224, x218 * x223);
-        let x241 = qd[6] * x113;
-        let x242 = qd[6] * x115;
-        let x243 = qd[6] * x117;
+        let x241 = qd[6] * x114;
+        let x242 = qd[6] * x116;
+        let x243 = qd[6] * x118;
         let x244 = x237 * x237;
         let x245 = x236 * x236;
         let x246 = x235 * x236;
@@ -1307,52 +1314,52 @@ impl SsrmsRecurrent {
         let x254 = x239 - Self::mul_add(-x235, x243, x237 * x241);
         let x255 = x240 - Self::mul_add(x235, x242, x236 * x241);
         let x256 = Self::mul_add(
-            x20,
-            x166,
-            Self::mul_add(-x18, x165, qd[0] * Self::mul_add(c_q1, x8, x16)),
-        );
-        let x257 = Self::mul_add(
             x25,
             x166,
-            Self::mul_add(-x23, x165, qd[0] * Self::mul_add(c_q1, x10, -x21)),
+            Self::mul_add(-x23, x165, qd[0] * Self::mul_add(c_q1, x13, x21)),
         );
-        let x258 = Self::mul_add(
+        let x257 = Self::mul_add(
             x30,
             x166,
-            Self::mul_add(-x28, x165, qd[0] * Self::mul_add(c_q1, x13, -x26)),
+            Self::mul_add(-x28, x165, qd[0] * Self::mul_add(c_q1, x15, -x26)),
         );
-        let x259 = Self::mul_add(x52, x183, Self::mul_add(-x51, x182, x50 * x181));
-        let x260 = Self::mul_add(x55, x183, Self::mul_add(-x54, x182, x53 * x181));
-        let x261 = Self::mul_add(x58, x183, Self::mul_add(-x57, x182, x56 * x181));
-        let x262 = Self::mul_add(x80, x201, Self::mul_add(-x79, x200, x78 * x199));
-        let x263 = Self::mul_add(x83, x201, Self::mul_add(-x82, x200, x81 * x199));
-        let x264 = Self::mul_add(x86, x201, Self::mul_add(-x85, x200, x84 * x199));
-        let x265 = Self::mul_add(-x105, x219, Self::mul_add(x104, x218, x103 * x217));
-        let x266 = Self::mul_add(-x108, x219, Self::mul_add(x107, x218, x106 * x217));
-        let x267 = Self::mul_add(-x111, x219, Self::mul_add(x110, x218, x109 * x217));
-        let x268 = Self::mul_add(x130, x237, Self::mul_add(-x129, x236, x128 * x235));
-        let x269 = Self::mul_add(x133, x237, Self::mul_add(-x132, x236, x131 * x235));
-        let x270 = Self::mul_add(x136, x237, Self::mul_add(-x135, x236, x134 * x235));
+        let x258 = Self::mul_add(
+            x35,
+            x166,
+            Self::mul_add(-x33, x165, qd[0] * Self::mul_add(c_q1, x18, -x31)),
+        );
+        let x259 = Self::mul_add(x56, x183, Self::mul_add(-x55, x182, x54 * x181));
+        let x260 = Self::mul_add(x59, x183, Self::mul_add(-x58, x182, x57 * x181));
+        let x261 = Self::mul_add(x62, x183, Self::mul_add(-x61, x182, x60 * x181));
+        let x262 = Self::mul_add(x83, x201, Self::mul_add(-x82, x200, x81 * x199));
+        let x263 = Self::mul_add(x86, x201, Self::mul_add(-x85, x200, x84 * x199));
+        let x264 = Self::mul_add(x89, x201, Self::mul_add(-x88, x200, x87 * x199));
+        let x265 = Self::mul_add(-x107, x219, Self::mul_add(x106, x218, x105 * x217));
+        let x266 = Self::mul_add(-x110, x219, Self::mul_add(x109, x218, x108 * x217));
+        let x267 = Self::mul_add(-x113, x219, Self::mul_add(x112, x218, x111 * x217));
+        let x268 = Self::mul_add(x131, x237, Self::mul_add(-x130, x236, x129 * x235));
+        let x269 = Self::mul_add(x134, x237, Self::mul_add(-x133, x236, x132 * x235));
+        let x270 = Self::mul_add(x137, x237, Self::mul_add(-x136, x236, x135 * x235));
         let x271 = 243.66
             * (x232
                 - Self::mul_add(
-                    x139,
+                    x140,
                     x239 - x247,
-                    Self::mul_add(-x138, x240 - x246, x137 * (x244 + x245)),
+                    Self::mul_add(-x139, x240 - x246, x138 * (x244 + x245)),
                 ));
         let x272 = 243.66
             * (x233
                 + Self::mul_add(
-                    -x139,
+                    -x140,
                     x238 - x249,
-                    Self::mul_add(x138, x244 + x248, x137 * (x240 + x246)),
+                    Self::mul_add(x139, x244 + x248, x138 * (x240 + x246)),
                 ));
         let x273 = 243.66
             * (x234
                 + Self::mul_add(
-                    -x139,
+                    -x140,
                     x245 + x248,
-                    Self::mul_add(-x138, x238 + x249, x137 * (x239 + x247)),
+                    Self::mul_add(-x139, x238 + x249, x138 * (x239 + x247)),
                 ));
         let x274 = Self::mul_add(x158, x252, Self::mul_add(-x157, x251, x156 * x250));
         let x275 = Self::mul_add(x161, x252, Self::mul_add(-x160, x251, x159 * x250));
@@ -1375,65 +1382,65 @@ impl SsrmsRecurrent {
         let x289 = Self::mul_add(314.88, x178, x286);
         let x290 = Self::mul_add(314.88, x179, x287);
         let x291 = Self::mul_add(314.88, x180, x288);
-        let x292 = Self::mul_add(x130, x240, Self::mul_add(x129, x239, x128 * x238))
+        let x292 = Self::mul_add(x131, x240, Self::mul_add(x130, x239, x129 * x238))
             + Self::mul_add(x236, x270, x237 * x269) + x277
-            - Self::mul_add(x138, x273, x139 * x272);
-        let x293 = Self::mul_add(x133, x240, Self::mul_add(x132, x239, x131 * x238))
+            - Self::mul_add(x139, x273, x140 * x272);
+        let x293 = Self::mul_add(x134, x240, Self::mul_add(x133, x239, x132 * x238))
             - Self::mul_add(-x235, x270, x237 * x268) + x278
-            - Self::mul_add(-x137, x273, x139 * x271);
-        let x294 = Self::mul_add(x136, x240, Self::mul_add(x135, x239, x134 * x238))
+            - Self::mul_add(-x138, x273, x140 * x271);
+        let x294 = Self::mul_add(x137, x240, Self::mul_add(x136, x239, x135 * x238))
             - Self::mul_add(x235, x269, x236 * x268) + x279
-            + Self::mul_add(x137, x272, x138 * x271);
-        let x295 = Self::mul_add(-x105, x222, Self::mul_add(-x104, x221, x103 * x220))
+            + Self::mul_add(x138, x272, x139 * x271);
+        let x295 = Self::mul_add(-x107, x222, Self::mul_add(-x106, x221, x105 * x220))
             - Self::mul_add(x218, x267, x219 * x266) + x292
-            - Self::mul_add(x32, x282, x33 * x281);
-        let x296 = Self::mul_add(-x108, x222, Self::mul_add(-x107, x221, x106 * x220))
+            - Self::mul_add(x37, x282, x38 * x281);
+        let x296 = Self::mul_add(-x110, x222, Self::mul_add(-x109, x221, x108 * x220))
             + Self::mul_add(x217, x267, x219 * x265) - x293
-            + Self::mul_add(x31, x282, x33 * x280);
-        let x297 = Self::mul_add(-x111, x222, Self::mul_add(-x110, x221, x109 * x220))
+            + Self::mul_add(x36, x282, x38 * x280);
+        let x297 = Self::mul_add(-x113, x222, Self::mul_add(-x112, x221, x111 * x220))
             + Self::mul_add(-x217, x266, x218 * x265) - x294
-            - Self::mul_add(-x31, x281, x32 * x280);
-        let x298 = Self::mul_add(x80, x204, Self::mul_add(x79, x203, x78 * x202))
+            - Self::mul_add(-x36, x281, x37 * x280);
+        let x298 = Self::mul_add(x83, x204, Self::mul_add(x82, x203, x81 * x202))
             + Self::mul_add(x200, x264, x201 * x263) + x295
-            + Self::mul_add(x88, x285, x89 * x284);
-        let x299 = Self::mul_add(x83, x204, Self::mul_add(x82, x203, x81 * x202))
+            + Self::mul_add(x91, x285, x92 * x284);
+        let x299 = Self::mul_add(x86, x204, Self::mul_add(x85, x203, x84 * x202))
             - Self::mul_add(-x199, x264, x201 * x262) - x296
-            + Self::mul_add(-x87, x285, x89 * x283);
-        let x300 = Self::mul_add(x86, x204, Self::mul_add(x85, x203, x84 * x202))
+            + Self::mul_add(-x90, x285, x92 * x283);
+        let x300 = Self::mul_add(x89, x204, Self::mul_add(x88, x203, x87 * x202))
             - Self::mul_add(x199, x263, x200 * x262) - x297
-            - Self::mul_add(x87, x284, x88 * x283);
-        let x301 = Self::mul_add(x52, x186, Self::mul_add(x51, x185, x50 * x184))
+            - Self::mul_add(x90, x284, x91 * x283);
+        let x301 = Self::mul_add(x56, x186, Self::mul_add(x55, x185, x54 * x184))
             + Self::mul_add(x182, x261, x183 * x260) + x298
-            + Self::mul_add(x60, x288, x61 * x287);
-        let x302 = Self::mul_add(x55, x186, Self::mul_add(x54, x185, x53 * x184))
+            + Self::mul_add(x64, x288, x65 * x287);
+        let x302 = Self::mul_add(x59, x186, Self::mul_add(x58, x185, x57 * x184))
             - Self::mul_add(-x181, x261, x183 * x259) + x299
-            + Self::mul_add(-x59, x288, x61 * x286);
-        let x303 = Self::mul_add(x58, x186, Self::mul_add(x57, x185, x56 * x184))
+            + Self::mul_add(-x63, x288, x65 * x286);
+        let x303 = Self::mul_add(x62, x186, Self::mul_add(x61, x185, x60 * x184))
             - Self::mul_add(x181, x260, x182 * x259) + x300
-            - Self::mul_add(x59, x287, x60 * x286);
+            - Self::mul_add(x63, x287, x64 * x286);
         let x304 = Self::mul_add(
             -c_q0,
-            Self::mul_add(x30, x171, x28 * x170)
+            Self::mul_add(x35, x171, x33 * x170)
                 - Self::mul_add(qd[0], x257, x165 * x256) + x303
-                + Self::mul_add(-x31, x290, x32 * x289),
+                + Self::mul_add(-x36, x290, x37 * x289),
             s_q0
-                * (Self::mul_add(x25, x171, x23 * x170)
+                * (Self::mul_add(x30, x171, x28 * x170)
                     - Self::mul_add(-qd[0], x258, x166 * x256) + x302
-                    - Self::mul_add(x31, x291, x33 * x289)),
+                    - Self::mul_add(x36, x291, x38 * x289)),
         );
-        let x305 = Self::mul_add(-x7, x303, Self::mul_add(-x5, x302, s_q1 * x301));
-        let x306 = Self::mul_add(-x7, x300, Self::mul_add(-x5, x299, s_q1 * x298));
-        let x307 = Self::mul_add(x7, x297, Self::mul_add(x5, x296, s_q1 * x295));
-        let x308 = -(Self::mul_add(x20, x171, x18 * x170)
+        let x305 = Self::mul_add(-x12, x303, Self::mul_add(-x10, x302, s_q1 * x301));
+        let x306 = Self::mul_add(-x12, x300, Self::mul_add(-x10, x299, s_q1 * x298));
+        let x307 = Self::mul_add(x12, x297, Self::mul_add(x10, x296, s_q1 * x295));
+        let x308 = -(Self::mul_add(x25, x171, x23 * x170)
             + Self::mul_add(x165, x258, x166 * x257) + x301
-            - Self::mul_add(x32, x291, x33 * x290)
+            - Self::mul_add(x37, x291, x38 * x290)
             + Self::mul_add(
-                -x1,
+                -x7,
                 Self::mul_add(105.98, x169, x291),
-                x2 * Self::mul_add(105.98, x168, x290),
+                x8 * Self::mul_add(105.98, x168, x290),
             ));
-        let x309 = -Self::mul_add(x96, x294, Self::mul_add(x94, x293, x92 * x292));
-        let x310 = -Self::mul_add(x117, x279, Self::mul_add(x115, x278, x113 * x277));
+        let x309 = -Self::mul_add(x98, x294, Self::mul_add(x96, x293, x94 * x292));
+        let x310 = -Self::mul_add(x118, x279, Self::mul_add(x116, x278, x114 * x277));
         [x308, x304, x305, x306, x307, x309, x310]
     }
     /// Inverse dynamics: the drives `τ = M q̈ + c` that produce `q̈`.
@@ -1441,201 +1448,204 @@ impl SsrmsRecurrent {
     /// Methods: bias `recurrent`: 1059 mul, 1016 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 601 fused where the target has FMA.
     #[must_use]
     pub fn inverse_dynamics(q: &[f64; 7], qd: &[f64; 7], qdd: &[f64; 7]) -> [f64; 7] {
-        let (s_q0, c_q0) = Self::sincos(q[0]);
-        let x1 = 0.7026 * s_q0;
-        let x2 = 0.7026 * c_q0;
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x4 = c_q0 * s_q1;
-        let x5 = c_q0 * c_q1;
-        let x6 = s_q0 * s_q1;
-        let x7 = s_q0 * c_q1;
-        let x8 = 8.088 * c_q1;
-        let x9 = 3.061 * s_q1;
-        let x10 = 8.088 * x4;
-        let x11 = 3.061 * x5;
-        let x12 = 8.446 * s_q0;
-        let x13 = 8.088 * x6;
-        let x14 = 3.061 * x7;
-        let x15 = 8.446 * c_q0;
-        let x16 = s_q1 * x9;
-        let x17 = Self::mul_add(c_q1, x8, x16);
-        let x18 = x5 * x9;
-        let x19 = Self::mul_add(x4, x8, -x18);
-        let x20 = x7 * x9;
-        let x21 = Self::mul_add(x6, x8, -x20);
-        let x22 = s_q1 * x11;
-        let x23 = x5 * x11;
-        let x24 = Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x23));
-        let x25 = x7 * x11;
-        let x26 = Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x25));
-        let x27 = s_q1 * x14;
-        let x28 = x5 * x14;
-        let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
-        let x30 = x7 * x14;
-        let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = s_q1 * 0.5692;
-        let x33 = x5 * 0.5692;
-        let x34 = x7 * 0.5692;
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x36 = c_q1 * c_q2;
-        let x37 = c_q1 * s_q2;
-        let x38 = Self::mul_add(s_q0, s_q2, x4 * c_q2);
-        let x39 = Self::mul_add(-s_q0, c_q2, x4 * s_q2);
-        let x40 = Self::mul_add(-c_q0, s_q2, x6 * c_q2);
-        let x41 = Self::mul_add(c_q0, c_q2, x6 * s_q2);
-        let x42 = Self::mul_add(-49.52, s_q1, 15.41 * x36);
-        let x43 = Self::mul_add(-2094.71, s_q1, 49.52 * x36);
-        let x44 = 2103.19 * x37;
-        let x45 = Self::mul_add(49.52, x5, 15.41 * x38);
-        let x46 = Self::mul_add(2094.71, x5, 49.52 * x38);
-        let x47 = 2103.19 * x39;
-        let x48 = Self::mul_add(49.52, x7, 15.41 * x40);
-        let x49 = Self::mul_add(2094.71, x7, 49.52 * x40);
-        let x50 = 2103.19 * x41;
-        let x51 = Self::mul_add(x37, x44, Self::mul_add(-s_q1, x43, x36 * x42));
-        let x52 = Self::mul_add(x39, x44, Self::mul_add(x5, x43, x38 * x42));
-        let x53 = Self::mul_add(x41, x44, Self::mul_add(x7, x43, x40 * x42));
-        let x54 = Self::mul_add(x37, x47, Self::mul_add(-s_q1, x46, x36 * x45));
-        let x55 = Self::mul_add(x39, x47, Self::mul_add(x5, x46, x38 * x45));
-        let x56 = Self::mul_add(x41, x47, Self::mul_add(x7, x46, x40 * x45));
-        let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
-        let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
-        let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
-        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
-        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
-        let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
-        let x66 = Self::mul_add(-x39, s_q3, x38 * c_q3);
-        let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
-        let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
-        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
-        let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
-        let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
-        let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
-        let x88 = 7.11 * x64;
-        let x89 = 7.11 * x66;
-        let x90 = 7.11 * x68;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x92 = Self::mul_add(-x65, s_q4, x64 * c_q4);
-        let x93 = Self::mul_add(x65, c_q4, x64 * s_q4);
-        let x94 = Self::mul_add(-x67, s_q4, x66 * c_q4);
-        let x95 = Self::mul_add(x67, c_q4, x66 * s_q4);
-        let x96 = Self::mul_add(-x69, s_q4, x68 * c_q4);
-        let x97 = Self::mul_add(x69, c_q4, x68 * s_q4);
-        let x98 = 8.305 * x92;
-        let x99 = 8.0386 * x93;
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = 0.7026 * s_q0;
+        let x8 = 0.7026 * c_q0;
+        let x9 = c_q0 * s_q1;
+        let x10 = c_q0 * c_q1;
+        let x11 = s_q0 * s_q1;
+        let x12 = s_q0 * c_q1;
+        let x13 = 8.088 * c_q1;
+        let x14 = 3.061 * s_q1;
+        let x15 = 8.088 * x9;
+        let x16 = 3.061 * x10;
+        let x17 = 8.446 * s_q0;
+        let x18 = 8.088 * x11;
+        let x19 = 3.061 * x12;
+        let x20 = 8.446 * c_q0;
+        let x21 = s_q1 * x14;
+        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x23 = x10 * x14;
+        let x24 = Self::mul_add(x9, x13, -x23);
+        let x25 = x12 * x14;
+        let x26 = Self::mul_add(x11, x13, -x25);
+        let x27 = s_q1 * x16;
+        let x28 = x10 * x16;
+        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x30 = x12 * x16;
+        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x32 = s_q1 * x19;
+        let x33 = x10 * x19;
+        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x35 = x12 * x19;
+        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
+        let x37 = s_q1 * 0.5692;
+        let x38 = x10 * 0.5692;
+        let x39 = x12 * 0.5692;
+        let x40 = c_q1 * c_q2;
+        let x41 = c_q1 * s_q2;
+        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
+        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
+        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
+        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
+        let x48 = 2103.19 * x41;
+        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
+        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
+        let x51 = 2103.19 * x43;
+        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
+        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
+        let x54 = 2103.19 * x45;
+        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
+        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
+        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
+        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
+        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
+        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
+        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
+        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
+        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
+        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
+        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
+        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
+        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
+        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
+        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
+        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
+        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
+        let x75 = 1966.28 * x68;
+        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
+        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
+        let x78 = 1966.28 * x70;
+        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
+        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
+        let x81 = 1966.28 * x72;
+        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
+        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
+        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
+        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
+        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
+        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
+        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
+        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
+        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
+        let x91 = 7.11 * x67;
+        let x92 = 7.11 * x69;
+        let x93 = 7.11 * x71;
+        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
+        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
+        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
+        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
         let x100 = 8.305 * x94;
         let x101 = 8.0386 * x95;
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
-        let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
-        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
-        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
-        let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
-        let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
-        let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
-        let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
-        let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
-        let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
-        let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
-        let x120 = 12.13 * x114;
+        let x104 = 8.305 * x98;
+        let x105 = 8.0386 * x99;
+        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
+        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
+        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
+        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
+        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
+        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
+        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
+        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
+        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
+        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
+        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
+        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
         let x121 = 12.13 * x115;
-        let x122 = 3.061 * x93;
-        let x123 = 12.13 * x116;
+        let x122 = 12.13 * x116;
+        let x123 = 3.061 * x95;
         let x124 = 12.13 * x117;
-        let x125 = 3.061 * x95;
-        let x126 = 12.13 * x118;
+        let x125 = 12.13 * x118;
+        let x126 = 3.061 * x97;
         let x127 = 12.13 * x119;
-        let x128 = 3.061 * x97;
-        let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
-        let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
-        let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
-        let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
-        let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = 0.7026 * x93;
+        let x128 = 12.13 * x120;
+        let x129 = 3.061 * x99;
+        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
+        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
+        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
+        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
+        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
+        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
+        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
+        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
+        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
-        let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
-        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
-        let x148 = 9.336 * x114;
+        let x141 = 0.7026 * x99;
+        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
+        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
+        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
+        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = 9.336 * x115;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
-        let x151 = 9.336 * x116;
+        let x151 = 9.336 * x117;
         let x152 = 44.41 * x144;
         let x153 = 44.41 * x145;
-        let x154 = 9.336 * x118;
+        let x154 = 9.336 * x119;
         let x155 = 44.41 * x146;
         let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x114 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x116 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x118 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x114 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x116 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x118 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x32 - x138;
-        let x167 = x33 + x139;
-        let x168 = x34 + x140;
-        let x169 = x88 + x166;
-        let x170 = x89 - x167;
-        let x171 = x90 - x168;
-        let x172 = x60 + x169;
-        let x173 = x61 + x170;
-        let x174 = x62 + x171;
-        let x175 = x33 - x173;
-        let x176 = x34 - x174;
-        let x177 = x32 + x88;
-        let x178 = x33 - x89;
-        let x179 = x34 - x90;
-        let x180 = x60 + x177;
-        let x181 = x61 - x178;
-        let x182 = x62 - x179;
-        let x183 = x33 - x181;
-        let x184 = x34 - x182;
-        let x185 = x60 + x88;
-        let x186 = x61 + x89;
-        let x187 = x62 + x90;
-        let x188 = x33 - x186;
-        let x189 = x34 - x187;
-        let x190 = x33 - x61;
-        let x191 = x34 - x62;
-        let x192 = 243.66 * x138;
-        let x193 = 243.66 * x139;
-        let x194 = 243.66 * x140;
+        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
+        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
+        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
+        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
+        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
+        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
+        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
+        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
+        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x166 = x37 - x139;
+        let x167 = x38 + x140;
+        let x168 = x39 + x141;
+        let x169 = x91 + x166;
+        let x170 = x92 - x167;
+        let x171 = x93 - x168;
+        let x172 = x64 + x169;
+        let x173 = x65 + x170;
+        let x174 = x66 + x171;
+        let x175 = x38 - x173;
+        let x176 = x39 - x174;
+        let x177 = x37 + x91;
+        let x178 = x38 - x92;
+        let x179 = x39 - x93;
+        let x180 = x64 + x177;
+        let x181 = x65 - x178;
+        let x182 = x66 - x179;
+        let x183 = x38 - x181;
+        let x184 = x39 - x182;
+        let x185 = x64 + x91;
+        let x186 = x65 + x92;
+        let x187 = x66 + x93;
+        let x188 = x38 - x186;
+        let x189 = x39 - x187;
+        let x190 = x38 - x65;
+        let x191 = x39 - x66;
+        let x192 = 243.66 * x139;
+        let x193 = 243.66 * x140;
+        let x194 = 243.66 * x141;
         let x195 = 243.66 * x166;
         let x196 = 243.66 * x167;
         let x197 = 243.66 * x168;
@@ -1645,584 +1655,584 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x32 + x172);
+        let x204 = 243.66 * (x37 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x1 + x175);
-        let x208 = 243.66 * (x2 - x176);
-        let x209 = x129 + x157;
-        let x210 = x130 + x158;
-        let x211 = x131 + x159;
-        let x212 = x132 + x160;
-        let x213 = x133 + x161;
-        let x214 = x134 + x162;
-        let x215 = x135 + x163;
-        let x216 = x136 + x164;
-        let x217 = x137 + x165;
-        let x218 = x104 + x209;
-        let x219 = x105 - x210;
-        let x220 = x106 - x211;
-        let x221 = x107 - x212;
-        let x222 = x108 + x213;
-        let x223 = x109 + x214;
-        let x224 = x110 - x215;
-        let x225 = x111 + x216;
-        let x226 = x112 + x217;
-        let x227 = x79 + x218;
-        let x228 = x80 - x219;
-        let x229 = x81 - x220;
-        let x230 = x82 - x221;
-        let x231 = x83 + x222;
-        let x232 = x84 + x223;
-        let x233 = x85 - x224;
-        let x234 = x86 + x225;
-        let x235 = x87 + x226;
-        let x236 = x51 + x227;
-        let x237 = x52 + x228;
-        let x238 = x53 + x229;
-        let x239 = x54 + x230;
-        let x240 = x55 + x231;
-        let x241 = x56 + x232;
-        let x242 = x57 + x233;
-        let x243 = x58 + x234;
-        let x244 = x59 + x235;
-        let x245 = Self::mul_add(105.98, x32, x195);
-        let x246 = Self::mul_add(105.98, x33, x196);
-        let x247 = Self::mul_add(105.98, x34, x197);
+        let x207 = 243.66 * (x7 + x175);
+        let x208 = 243.66 * (x8 - x176);
+        let x209 = x130 + x157;
+        let x210 = x131 + x158;
+        let x211 = x132 + x159;
+        let x212 = x133 + x160;
+        let x213 = x134 + x161;
+        let x214 = x135 + x162;
+        let x215 = x136 + x163;
+        let x216 = x137 + x164;
+        let x217 = x138 + x165;
+        let x218 = x106 + x209;
+        let x219 = x107 - x210;
+        let x220 = x108 - x211;
+        let x221 = x109 - x212;
+        let x222 = x110 + x213;
+        let x223 = x111 + x214;
+        let x224 = x112 - x215;
+        let x225 = x113 + x216;
+        let x226 = x114 + x217;
+        let x227 = x82 + x218;
+        let x228 = x83 - x219;
+        let x229 = x84 - x220;
+        let x230 = x85 - x221;
+        let x231 = x86 + x222;
+        let x232 = x87 + x223;
+        let x233 = x88 - x224;
+        let x234 = x89 + x225;
+        let x235 = x90 + x226;
+        let x236 = x55 + x227;
+        let x237 = x56 + x228;
+        let x238 = x57 + x229;
+        let x239 = x58 + x230;
+        let x240 = x59 + x231;
+        let x241 = x60 + x232;
+        let x242 = x61 + x233;
+        let x243 = x62 + x234;
+        let x244 = x63 + x235;
+        let x245 = Self::mul_add(105.98, x37, x195);
+        let x246 = Self::mul_add(105.98, x38, x196);
+        let x247 = Self::mul_add(105.98, x39, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
         let x249 = Self::mul_add(-105.98, x178, x199);
         let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x88, x248);
-        let x252 = Self::mul_add(105.98, x89, x249);
-        let x253 = Self::mul_add(105.98, x90, x250);
+        let x251 = Self::mul_add(105.98, x91, x248);
+        let x252 = Self::mul_add(105.98, x92, x249);
+        let x253 = Self::mul_add(105.98, x93, x250);
         let x254 = Self::mul_add(105.98, x180, x201);
         let x255 = Self::mul_add(105.98, x181, x202);
         let x256 = Self::mul_add(105.98, x182, x203);
         let x257 = Self::mul_add(105.98, x185, x254);
         let x258 = Self::mul_add(105.98, x186, x255);
         let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x60, x257);
-        let x261 = Self::mul_add(279.2, x61, x258);
-        let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x32 + x180, x204);
+        let x260 = Self::mul_add(279.2, x64, x257);
+        let x261 = Self::mul_add(279.2, x65, x258);
+        let x262 = Self::mul_add(279.2, x66, x259);
+        let x263 = Self::mul_add(105.98, x37 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x32 + x185, x263);
+        let x266 = Self::mul_add(105.98, x37 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x32 + x60, x266);
+        let x269 = Self::mul_add(279.2, x37 + x64, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x1 + x183, x207);
-        let x275 = Self::mul_add(105.98, x2 - x184, x208);
-        let x276 = Self::mul_add(105.98, x1 + x188, x274);
-        let x277 = Self::mul_add(105.98, x2 - x189, x275);
-        let x278 = Self::mul_add(279.2, x1 + x190, x276);
-        let x279 = Self::mul_add(279.2, x2 - x191, x277);
-        let x280 = Self::mul_add(314.88, x1 + x33, x278);
-        let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(-x139, x207, x140 * x208);
-        let x283 = x138 * x207;
-        let x284 = x138 * x208;
-        let x285 = x139 * x204;
-        let x286 = x138 * x204;
-        let x287 = x140 * x204;
-        let x288 = Self::mul_add(-x140, x206, x286);
-        let x289 = x139 * x206;
-        let x290 = x140 * x205;
-        let x291 = Self::mul_add(-x139, x205, x286);
-        let x292 = x140 * x203;
-        let x293 = x139 * x202;
+        let x272 = Self::mul_add(314.88, x38, x270);
+        let x273 = Self::mul_add(314.88, x39, x271);
+        let x274 = Self::mul_add(105.98, x7 + x183, x207);
+        let x275 = Self::mul_add(105.98, x8 - x184, x208);
+        let x276 = Self::mul_add(105.98, x7 + x188, x274);
+        let x277 = Self::mul_add(105.98, x8 - x189, x275);
+        let x278 = Self::mul_add(279.2, x7 + x190, x276);
+        let x279 = Self::mul_add(279.2, x8 - x191, x277);
+        let x280 = Self::mul_add(314.88, x7 + x38, x278);
+        let x281 = Self::mul_add(314.88, x8 - x39, x279);
+        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x283 = x139 * x207;
+        let x284 = x139 * x208;
+        let x285 = x140 * x204;
+        let x286 = x139 * x204;
+        let x287 = x141 * x204;
+        let x288 = Self::mul_add(-x141, x206, x286);
+        let x289 = x140 * x206;
+        let x290 = x141 * x205;
+        let x291 = Self::mul_add(-x140, x205, x286);
+        let x292 = x141 * x203;
+        let x293 = x140 * x202;
         let x294 = x292 + x293;
-        let x295 = x138 * x202;
-        let x296 = x138 * x203;
-        let x297 = x139 * x201;
-        let x298 = x138 * x201;
+        let x295 = x139 * x202;
+        let x296 = x139 * x203;
+        let x297 = x140 * x201;
+        let x298 = x139 * x201;
         let x299 = x292 + x298;
-        let x300 = x139 * x203;
-        let x301 = x140 * x201;
-        let x302 = x140 * x202;
+        let x300 = x140 * x203;
+        let x301 = x141 * x201;
+        let x302 = x141 * x202;
         let x303 = x293 + x298;
-        let x304 = x140 * x200;
-        let x305 = x139 * x199;
+        let x304 = x141 * x200;
+        let x305 = x140 * x199;
         let x306 = x304 + x305;
-        let x307 = x138 * x199;
-        let x308 = x138 * x200;
-        let x309 = x139 * x198;
-        let x310 = x138 * x198;
+        let x307 = x139 * x199;
+        let x308 = x139 * x200;
+        let x309 = x140 * x198;
+        let x310 = x139 * x198;
         let x311 = x304 + x310;
-        let x312 = x139 * x200;
-        let x313 = x140 * x198;
-        let x314 = x140 * x199;
+        let x312 = x140 * x200;
+        let x313 = x141 * x198;
+        let x314 = x141 * x199;
         let x315 = x305 + x310;
-        let x316 = x140 * x197;
-        let x317 = x139 * x196;
+        let x316 = x141 * x197;
+        let x317 = x140 * x196;
         let x318 = x316 + x317;
-        let x319 = x138 * x196;
-        let x320 = x138 * x197;
-        let x321 = x139 * x195;
-        let x322 = x138 * x195;
+        let x319 = x139 * x196;
+        let x320 = x139 * x197;
+        let x321 = x140 * x195;
+        let x322 = x139 * x195;
         let x323 = x316 - x322;
-        let x324 = x139 * x197;
-        let x325 = x140 * x195;
-        let x326 = x140 * x196;
+        let x324 = x140 * x197;
+        let x325 = x141 * x195;
+        let x326 = x141 * x196;
         let x327 = x317 - x322;
-        let x328 = x140 * x194;
-        let x329 = x139 * x193;
-        let x330 = x138 * x192;
-        let x331 = x34 * x247;
-        let x332 = x33 * x246;
-        let x333 = x32 * x245;
-        let x334 = x34 * x250;
-        let x335 = x33 * x249;
-        let x336 = x32 * x248;
+        let x328 = x141 * x194;
+        let x329 = x140 * x193;
+        let x330 = x139 * x192;
+        let x331 = x39 * x247;
+        let x332 = x38 * x246;
+        let x333 = x37 * x245;
+        let x334 = x39 * x250;
+        let x335 = x38 * x249;
+        let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x32, x249, x307);
-        let x339 = Self::mul_add(-x32, x250, x308);
-        let x340 = Self::mul_add(x33, x248, x309);
+        let x338 = Self::mul_add(-x37, x249, x307);
+        let x339 = Self::mul_add(-x37, x250, x308);
+        let x340 = Self::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x33, x250, x312);
-        let x343 = Self::mul_add(x34, x248, x313);
-        let x344 = Self::mul_add(x34, x249, x314);
+        let x342 = Self::mul_add(x38, x250, x312);
+        let x343 = Self::mul_add(x39, x248, x313);
+        let x344 = Self::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
-        let x346 = x90 * x253;
-        let x347 = x89 * x252;
-        let x348 = x88 * x251;
-        let x349 = x34 * x256;
-        let x350 = x33 * x255;
-        let x351 = x32 * x254;
+        let x346 = x93 * x253;
+        let x347 = x92 * x252;
+        let x348 = x91 * x251;
+        let x349 = x39 * x256;
+        let x350 = x38 * x255;
+        let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x32, x255, x295);
-        let x354 = Self::mul_add(-x32, x256, x296);
-        let x355 = Self::mul_add(x33, x254, x297);
+        let x353 = Self::mul_add(-x37, x255, x295);
+        let x354 = Self::mul_add(-x37, x256, x296);
+        let x355 = Self::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x33, x256, x300);
-        let x358 = Self::mul_add(x34, x254, x301);
-        let x359 = Self::mul_add(x34, x255, x302);
+        let x357 = Self::mul_add(x38, x256, x300);
+        let x358 = Self::mul_add(x39, x254, x301);
+        let x359 = Self::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
-        let x361 = x90 * x259;
-        let x362 = x89 * x258;
-        let x363 = x88 * x257;
+        let x361 = x93 * x259;
+        let x362 = x92 * x258;
+        let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x88, x258, x353);
-        let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(-x89, x257, x355);
+        let x365 = Self::mul_add(-x91, x258, x353);
+        let x366 = Self::mul_add(-x91, x259, x354);
+        let x367 = Self::mul_add(-x92, x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x89, x259, x357);
-        let x370 = Self::mul_add(-x90, x257, x358);
-        let x371 = Self::mul_add(-x90, x258, x359);
+        let x369 = Self::mul_add(-x92, x259, x357);
+        let x370 = Self::mul_add(-x93, x257, x358);
+        let x371 = Self::mul_add(-x93, x258, x359);
         let x372 = x360 - (x362 + x363);
-        let x373 = x62 * x262;
-        let x374 = x61 * x261;
-        let x375 = x60 * x260;
-        let x376 = x32 * x263;
-        let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 - Self::mul_add(x34, x265, x376);
-        let x379 = Self::mul_add(x33, x265, x289);
-        let x380 = Self::mul_add(x34, x263, x287);
-        let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 - Self::mul_add(x33, x264, x376);
-        let x383 = x88 * x266;
-        let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, -x383);
-        let x386 = Self::mul_add(-x89, x268, x379);
-        let x387 = Self::mul_add(-x90, x266, x380);
-        let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, -x383);
-        let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, -x390);
-        let x392 = Self::mul_add(-x61, x271, x386);
-        let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, -x390);
-        let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
-        let x397 = Self::mul_add(-x32, x274, x283);
-        let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
-        let x400 = Self::mul_add(-x88, x276, x397);
-        let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
-        let x403 = Self::mul_add(-x60, x278, x400);
-        let x404 = Self::mul_add(-x60, x279, x401);
+        let x373 = x66 * x262;
+        let x374 = x65 * x261;
+        let x375 = x64 * x260;
+        let x376 = x37 * x263;
+        let x377 = Self::mul_add(x38, x263, x285);
+        let x378 = x288 - Self::mul_add(x39, x265, x376);
+        let x379 = Self::mul_add(x38, x265, x289);
+        let x380 = Self::mul_add(x39, x263, x287);
+        let x381 = Self::mul_add(x39, x264, x290);
+        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x383 = x91 * x266;
+        let x384 = Self::mul_add(-x92, x266, x377);
+        let x385 = x378 + Self::mul_add(x93, x268, -x383);
+        let x386 = Self::mul_add(-x92, x268, x379);
+        let x387 = Self::mul_add(-x93, x266, x380);
+        let x388 = Self::mul_add(-x93, x267, x381);
+        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x390 = x64 * x269;
+        let x391 = x385 + Self::mul_add(x66, x271, -x390);
+        let x392 = Self::mul_add(-x65, x271, x386);
+        let x393 = Self::mul_add(-x66, x270, x388);
+        let x394 = x389 + Self::mul_add(x65, x270, -x390);
+        let x395 = x37 * Self::mul_add(314.88, x37, x269);
+        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
+        let x397 = Self::mul_add(-x37, x274, x283);
+        let x398 = Self::mul_add(-x37, x275, x284);
+        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
+        let x400 = Self::mul_add(-x91, x276, x397);
+        let x401 = Self::mul_add(-x91, x277, x398);
+        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
+        let x403 = Self::mul_add(-x64, x278, x400);
+        let x404 = Self::mul_add(-x64, x279, x401);
         let x405 = Self::mul_add(
             -c_q0,
-            x21 + x238 + Self::mul_add(-x32, x281, x404),
-            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
+            x26 + x238 + Self::mul_add(-x37, x281, x404),
+            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
         );
         let x406 = Self::mul_add(
-            -x7,
+            -x12,
             x238 + x404,
-            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
+            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x407 = Self::mul_add(
-            -x7,
+            -x12,
             x229 + x401,
-            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
+            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x408 = Self::mul_add(
-            x7,
+            x12,
             x220 - x398,
-            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
+            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x409 = Self::mul_add(
-            x97,
+            x99,
             x211 + x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
+            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
-        let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
-        let x412 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
+        let x410 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
+        let x411 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
+        let x412 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
         let x413 = Self::mul_add(
             -c_q0,
             Self::mul_add(
                 -c_q0,
-                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
-                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
+                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
             ),
             s_q0
                 * Self::mul_add(
                     -c_q0,
-                    x26 + x241 - Self::mul_add(x33, x273, x392),
-                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
+                    x31 + x241 - Self::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
                 ),
         );
         let x414 = Self::mul_add(
-            -x7,
+            -x12,
             x241 - x392,
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
+                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
             ),
         );
         let x415 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - x394,
             Self::mul_add(
-                -x5,
+                -x10,
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
+                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
             ),
         );
         let x416 = Self::mul_add(-c_q0, x415, s_q0 * x414);
         let x417 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x389,
-                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
+                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x232 - x386,
-                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
+                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x418 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x382,
-                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
+                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x223 - x379,
-                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
+                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x419 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x291,
-                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
+                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x214 - x289,
-                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
         let x420 = Self::mul_add(-c_q0, x412, s_q0 * x411);
         let x421 = Self::mul_add(
-            -x7,
-            x238 + Self::mul_add(-x60, x262, x366),
+            -x12,
+            x238 + Self::mul_add(-x64, x262, x366),
             Self::mul_add(
-                -x5,
-                x237 + Self::mul_add(-x60, x261, x365),
+                -x10,
+                x237 + Self::mul_add(-x64, x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x422 = Self::mul_add(
-            -x7,
-            x241 + Self::mul_add(-x61, x262, x369),
+            -x12,
+            x241 + Self::mul_add(-x65, x262, x369),
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
+                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
             ),
         );
         let x423 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -x5,
-                x243 + Self::mul_add(-x62, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
+                -x10,
+                x243 + Self::mul_add(-x66, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
             ),
         );
         let x424 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                -x7,
+                -x12,
                 x232 + x369,
-                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
+                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x229 + x366,
-                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
+                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x425 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x372,
-                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
+                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x424,
         );
         let x426 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x357,
-                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
+                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x354,
-                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
+                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x427 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x360,
-                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
+                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x426,
         );
         let x428 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x300,
-                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x296,
-                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
         let x429 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x303,
-                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
+                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x428,
         );
-        let x430 = Self::mul_add(-x7, x412, Self::mul_add(-x5, x411, s_q1 * x410));
+        let x430 = Self::mul_add(-x12, x412, Self::mul_add(-x10, x411, s_q1 * x410));
         let x431 = Self::mul_add(
-            -x7,
-            x229 + Self::mul_add(-x88, x253, x339),
+            -x12,
+            x229 + Self::mul_add(-x91, x253, x339),
             Self::mul_add(
-                -x5,
-                x228 + Self::mul_add(-x88, x252, x338),
+                -x10,
+                x228 + Self::mul_add(-x91, x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x432 = Self::mul_add(
-            -x7,
-            x232 + Self::mul_add(-x89, x253, x342),
+            -x12,
+            x232 + Self::mul_add(-x92, x253, x342),
             Self::mul_add(
-                -x5,
+                -x10,
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
+                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
             ),
         );
         let x433 = Self::mul_add(
-            -x7,
+            -x12,
             x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -x5,
-                x234 + Self::mul_add(-x90, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
+                -x10,
+                x234 + Self::mul_add(-x93, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
             ),
         );
         let x434 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x342,
-                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
+                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x339,
-                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
+                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x435 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x345,
-                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
+                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x434,
         );
         let x436 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x312,
-                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x308,
-                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
         let x437 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x315,
-                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
+                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x436,
         );
         let x438 = Self::mul_add(
-            x7,
-            x220 + Self::mul_add(-x32, x247, x320),
+            x12,
+            x220 + Self::mul_add(-x37, x247, x320),
             Self::mul_add(
-                x5,
-                x219 + Self::mul_add(-x32, x246, x319),
+                x10,
+                x219 + Self::mul_add(-x37, x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x439 = Self::mul_add(
-            x7,
-            x223 - Self::mul_add(x33, x247, x324),
+            x12,
+            x223 - Self::mul_add(x38, x247, x324),
             Self::mul_add(
-                x5,
+                x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
+                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
             ),
         );
         let x440 = Self::mul_add(
-            x7,
+            x12,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                x5,
-                x225 - Self::mul_add(x34, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
+                x10,
+                x225 - Self::mul_add(x39, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
             ),
         );
         let x441 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 - x324,
-                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 - x320,
-                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
         let x442 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
+                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x441,
         );
         let x443 = Self::mul_add(
-            x97,
-            Self::mul_add(-x138, x194, x211),
+            x99,
+            Self::mul_add(-x139, x194, x211),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x138, x193, x210),
-                x93 * (x209 + (x328 + x329)),
+                x97,
+                Self::mul_add(-x139, x193, x210),
+                x95 * (x209 + (x328 + x329)),
             ),
         );
         let x444 = Self::mul_add(
-            x97,
-            Self::mul_add(-x139, x194, x214),
+            x99,
+            Self::mul_add(-x140, x194, x214),
             Self::mul_add(
-                x95,
+                x97,
                 x213 + (x328 + x330),
-                x93 * Self::mul_add(-x139, x192, x212),
+                x95 * Self::mul_add(-x140, x192, x212),
             ),
         );
         let x445 = Self::mul_add(
-            x97,
+            x99,
             x217 + (x329 + x330),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x140, x193, x216),
-                x93 * Self::mul_add(-x140, x192, x215),
+                x97,
+                Self::mul_add(-x141, x193, x216),
+                x95 * Self::mul_add(-x141, x192, x215),
             ),
         );
-        let x446 = Self::mul_add(x97, x412, Self::mul_add(x95, x411, x93 * x410));
+        let x446 = Self::mul_add(x99, x412, Self::mul_add(x97, x411, x95 * x410));
         let x447 = qd[1] * s_q0;
         let x448 = qd[1] * c_q0;
         let x449 = qd[0] * qd[0];
-        let x450 = x1 * x449;
-        let x451 = x2 * x449;
+        let x450 = x7 * x449;
+        let x451 = x8 * x449;
         let x452 = qd[0] * x448;
         let x453 = qd[0] * x447;
         let x454 = qd[2] * s_q1;
-        let x455 = qd[2] * x5;
-        let x456 = qd[2] * x7;
+        let x455 = qd[2] * x10;
+        let x456 = qd[2] * x12;
         let x457 = x448 * x448;
         let x458 = x447 * x447;
         let x459 = x447 * x448;
-        let x460 = x32 * (x457 + x458);
+        let x460 = x37 * (x457 + x458);
         let x461 = x450
             - Self::mul_add(
-                -x34,
+                -x39,
                 x459,
-                Self::mul_add(-x33, x449 + x457, x32 * (x453 + x453)),
+                Self::mul_add(-x38, x449 + x457, x37 * (x453 + x453)),
             );
         let x462 = x451
             - Self::mul_add(
-                x34,
+                x39,
                 x449 + x458,
-                Self::mul_add(x33, x459, x32 * (x452 + x452)),
+                Self::mul_add(x38, x459, x37 * (x452 + x452)),
             );
         let x463 = qd[0] - x454;
         let x464 = x447 - x455;
@@ -2231,8 +2241,8 @@ impl SsrmsRecurrent {
         let x467 = x452 + Self::mul_add(qd[0], x456, x448 * x454);
         let x468 = x453 + Self::mul_add(-qd[0], x455, x447 * x454);
         let x469 = qd[3] * s_q1;
-        let x470 = qd[3] * x5;
-        let x471 = qd[3] * x7;
+        let x470 = qd[3] * x10;
+        let x471 = qd[3] * x12;
         let x472 = x465 * x465;
         let x473 = x464 * x464;
         let x474 = x463 * x464;
@@ -2241,21 +2251,21 @@ impl SsrmsRecurrent {
         let x477 = x464 * x465;
         let x478 = x460
             + Self::mul_add(
-                x62,
+                x66,
                 x467 - x475,
-                Self::mul_add(-x61, x468 - x474, x60 * (x472 + x473)),
+                Self::mul_add(-x65, x468 - x474, x64 * (x472 + x473)),
             );
         let x479 = x461
             - Self::mul_add(
-                -x62,
+                -x66,
                 x466 - x477,
-                Self::mul_add(x61, x472 + x476, x60 * (x468 + x474)),
+                Self::mul_add(x65, x472 + x476, x64 * (x468 + x474)),
             );
         let x480 = x462
             - Self::mul_add(
-                -x62,
+                -x66,
                 x473 + x476,
-                Self::mul_add(-x61, x466 + x477, x60 * (x467 + x475)),
+                Self::mul_add(-x65, x466 + x477, x64 * (x467 + x475)),
             );
         let x481 = x463 - x469;
         let x482 = x464 - x470;
@@ -2264,8 +2274,8 @@ impl SsrmsRecurrent {
         let x485 = x467 + Self::mul_add(x463, x471, x465 * x469);
         let x486 = x468 + Self::mul_add(-x463, x470, x464 * x469);
         let x487 = qd[4] * s_q1;
-        let x488 = qd[4] * x5;
-        let x489 = qd[4] * x7;
+        let x488 = qd[4] * x10;
+        let x489 = qd[4] * x12;
         let x490 = x483 * x483;
         let x491 = x482 * x482;
         let x492 = x481 * x482;
@@ -2274,21 +2284,21 @@ impl SsrmsRecurrent {
         let x495 = x482 * x483;
         let x496 = x478
             + Self::mul_add(
-                x90,
+                x93,
                 x485 - x493,
-                Self::mul_add(-x89, x486 - x492, x88 * (x490 + x491)),
+                Self::mul_add(-x92, x486 - x492, x91 * (x490 + x491)),
             );
         let x497 = x479
             - Self::mul_add(
-                -x90,
+                -x93,
                 x484 - x495,
-                Self::mul_add(x89, x490 + x494, x88 * (x486 + x492)),
+                Self::mul_add(x92, x490 + x494, x91 * (x486 + x492)),
             );
         let x498 = x480
             - Self::mul_add(
-                -x90,
+                -x93,
                 x491 + x494,
-                Self::mul_add(-x89, x484 + x495, x88 * (x485 + x493)),
+                Self::mul_add(-x92, x484 + x495, x91 * (x485 + x493)),
             );
         let x499 = x481 - x487;
         let x500 = x482 - x488;
@@ -2296,9 +2306,9 @@ impl SsrmsRecurrent {
         let x502 = x484 + Self::mul_add(x482, x489, x483 * x488);
         let x503 = x485 + Self::mul_add(x481, x489, x483 * x487);
         let x504 = x486 + Self::mul_add(-x481, x488, x482 * x487);
-        let x505 = qd[5] * x93;
-        let x506 = qd[5] * x95;
-        let x507 = qd[5] * x97;
+        let x505 = qd[5] * x95;
+        let x506 = qd[5] * x97;
+        let x507 = qd[5] * x99;
         let x508 = x501 * x501;
         let x509 = x500 * x500;
         let x510 = x499 * x500;
@@ -2307,21 +2317,21 @@ impl SsrmsRecurrent {
         let x513 = x500 * x501;
         let x514 = x496
             + Self::mul_add(
-                -x34,
+                -x39,
                 x503 - x511,
-                Self::mul_add(x33, x504 - x510, x32 * (x508 + x509)),
+                Self::mul_add(x38, x504 - x510, x37 * (x508 + x509)),
             );
         let x515 = x497
             - Self::mul_add(
-                x34,
+                x39,
                 x502 - x513,
-                Self::mul_add(-x33, x508 + x512, x32 * (x504 + x510)),
+                Self::mul_add(-x38, x508 + x512, x37 * (x504 + x510)),
             );
         let x516 = x498
             - Self::mul_add(
-                x34,
+                x39,
                 x509 + x512,
-                Self::mul_add(x33, x502 + x513, x32 * (x503 + x511)),
+                Self::mul_add(x38, x502 + x513, x37 * (x503 + x511)),
             );
         let x517 = x499 + x505;
         let x518 = x500 - x506;
@@ -2329,9 +2339,9 @@ impl SsrmsRecurrent {
         let x520 = x502 + Self::mul_add(x500, x507, x501 * x506);
         let x521 = x503 - Self::mul_add(-x499, x507, x501 * x505);
         let x522 = x504 - Self::mul_add(x499, x506, x500 * x505);
-        let x523 = qd[6] * x114;
-        let x524 = qd[6] * x116;
-        let x525 = qd[6] * x118;
+        let x523 = qd[6] * x115;
+        let x524 = qd[6] * x117;
+        let x525 = qd[6] * x119;
         let x526 = x519 * x519;
         let x527 = x518 * x518;
         let x528 = x517 * x518;
@@ -2344,49 +2354,49 @@ impl SsrmsRecurrent {
         let x535 = x520 + Self::mul_add(x518, x525, x519 * x524);
         let x536 = x521 - Self::mul_add(-x517, x525, x519 * x523);
         let x537 = x522 - Self::mul_add(x517, x524, x518 * x523);
-        let x538 = Self::mul_add(x21, x448, Self::mul_add(-x19, x447, qd[0] * x17));
+        let x538 = Self::mul_add(x26, x448, Self::mul_add(-x24, x447, qd[0] * x22));
         let x539 = Self::mul_add(
-            x26,
-            x448,
-            Self::mul_add(-x24, x447, qd[0] * Self::mul_add(c_q1, x10, -x22)),
-        );
-        let x540 = Self::mul_add(
             x31,
             x448,
-            Self::mul_add(-x29, x447, qd[0] * Self::mul_add(c_q1, x13, -x27)),
+            Self::mul_add(-x29, x447, qd[0] * Self::mul_add(c_q1, x15, -x27)),
         );
-        let x541 = Self::mul_add(x53, x465, Self::mul_add(-x52, x464, x51 * x463));
-        let x542 = Self::mul_add(x56, x465, Self::mul_add(-x55, x464, x54 * x463));
-        let x543 = Self::mul_add(x59, x465, Self::mul_add(-x58, x464, x57 * x463));
-        let x544 = Self::mul_add(x81, x483, Self::mul_add(-x80, x482, x79 * x481));
-        let x545 = Self::mul_add(x84, x483, Self::mul_add(-x83, x482, x82 * x481));
-        let x546 = Self::mul_add(x87, x483, Self::mul_add(-x86, x482, x85 * x481));
-        let x547 = Self::mul_add(-x106, x501, Self::mul_add(x105, x500, x104 * x499));
-        let x548 = Self::mul_add(-x109, x501, Self::mul_add(x108, x500, x107 * x499));
-        let x549 = Self::mul_add(-x112, x501, Self::mul_add(x111, x500, x110 * x499));
-        let x550 = Self::mul_add(x131, x519, Self::mul_add(-x130, x518, x129 * x517));
-        let x551 = Self::mul_add(x134, x519, Self::mul_add(-x133, x518, x132 * x517));
-        let x552 = Self::mul_add(x137, x519, Self::mul_add(-x136, x518, x135 * x517));
+        let x540 = Self::mul_add(
+            x36,
+            x448,
+            Self::mul_add(-x34, x447, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+        );
+        let x541 = Self::mul_add(x57, x465, Self::mul_add(-x56, x464, x55 * x463));
+        let x542 = Self::mul_add(x60, x465, Self::mul_add(-x59, x464, x58 * x463));
+        let x543 = Self::mul_add(x63, x465, Self::mul_add(-x62, x464, x61 * x463));
+        let x544 = Self::mul_add(x84, x483, Self::mul_add(-x83, x482, x82 * x481));
+        let x545 = Self::mul_add(x87, x483, Self::mul_add(-x86, x482, x85 * x481));
+        let x546 = Self::mul_add(x90, x483, Self::mul_add(-x89, x482, x88 * x481));
+        let x547 = Self::mul_add(-x108, x501, Self::mul_add(x107, x500, x106 * x499));
+        let x548 = Self::mul_add(-x111, x501, Self::mul_add(x110, x500, x109 * x499));
+        let x549 = Self::mul_add(-x114, x501, Self::mul_add(x113, x500, x112 * x499));
+        let x550 = Self::mul_add(x132, x519, Self::mul_add(-x131, x518, x130 * x517));
+        let x551 = Self::mul_add(x135, x519, Self::mul_add(-x134, x518, x133 * x517));
+        let x552 = Self::mul_add(x138, x519, Self::mul_add(-x137, x518, x136 * x517));
         let x553 = 243.66
             * (x514
                 - Self::mul_add(
-                    x140,
+                    x141,
                     x521 - x529,
-                    Self::mul_add(-x139, x522 - x528, x138 * (x526 + x527)),
+                    Self::mul_add(-x140, x522 - x528, x139 * (x526 + x527)),
                 ));
         let x554 = 243.66
             * (x515
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x520 - x531,
-                    Self::mul_add(x139, x526 + x530, x138 * (x522 + x528)),
+                    Self::mul_add(x140, x526 + x530, x139 * (x522 + x528)),
                 ));
         let x555 = 243.66
             * (x516
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x527 + x530,
-                    Self::mul_add(-x139, x520 + x531, x138 * (x521 + x529)),
+                    Self::mul_add(-x140, x520 + x531, x139 * (x521 + x529)),
                 ));
         let x556 = Self::mul_add(x159, x534, Self::mul_add(-x158, x533, x157 * x532));
         let x557 = Self::mul_add(x162, x534, Self::mul_add(-x161, x533, x160 * x532));
@@ -2409,52 +2419,52 @@ impl SsrmsRecurrent {
         let x571 = Self::mul_add(314.88, x460, x568);
         let x572 = Self::mul_add(314.88, x461, x569);
         let x573 = Self::mul_add(314.88, x462, x570);
-        let x574 = Self::mul_add(x131, x522, Self::mul_add(x130, x521, x129 * x520))
+        let x574 = Self::mul_add(x132, x522, Self::mul_add(x131, x521, x130 * x520))
             + Self::mul_add(x518, x552, x519 * x551) + x559
-            - Self::mul_add(x139, x555, x140 * x554);
-        let x575 = Self::mul_add(x134, x522, Self::mul_add(x133, x521, x132 * x520))
+            - Self::mul_add(x140, x555, x141 * x554);
+        let x575 = Self::mul_add(x135, x522, Self::mul_add(x134, x521, x133 * x520))
             - Self::mul_add(-x517, x552, x519 * x550) + x560
-            - Self::mul_add(-x138, x555, x140 * x553);
-        let x576 = Self::mul_add(x137, x522, Self::mul_add(x136, x521, x135 * x520))
+            - Self::mul_add(-x139, x555, x141 * x553);
+        let x576 = Self::mul_add(x138, x522, Self::mul_add(x137, x521, x136 * x520))
             - Self::mul_add(x517, x551, x518 * x550) + x561
-            + Self::mul_add(x138, x554, x139 * x553);
-        let x577 = Self::mul_add(-x106, x504, Self::mul_add(-x105, x503, x104 * x502))
+            + Self::mul_add(x139, x554, x140 * x553);
+        let x577 = Self::mul_add(-x108, x504, Self::mul_add(-x107, x503, x106 * x502))
             - Self::mul_add(x500, x549, x501 * x548) + x574
-            - Self::mul_add(x33, x564, x34 * x563);
-        let x578 = Self::mul_add(-x109, x504, Self::mul_add(-x108, x503, x107 * x502))
+            - Self::mul_add(x38, x564, x39 * x563);
+        let x578 = Self::mul_add(-x111, x504, Self::mul_add(-x110, x503, x109 * x502))
             + Self::mul_add(x499, x549, x501 * x547) - x575
-            + Self::mul_add(x32, x564, x34 * x562);
-        let x579 = Self::mul_add(-x112, x504, Self::mul_add(-x111, x503, x110 * x502))
+            + Self::mul_add(x37, x564, x39 * x562);
+        let x579 = Self::mul_add(-x114, x504, Self::mul_add(-x113, x503, x112 * x502))
             + Self::mul_add(-x499, x548, x500 * x547) - x576
-            - Self::mul_add(-x32, x563, x33 * x562);
-        let x580 = Self::mul_add(x81, x486, Self::mul_add(x80, x485, x79 * x484))
+            - Self::mul_add(-x37, x563, x38 * x562);
+        let x580 = Self::mul_add(x84, x486, Self::mul_add(x83, x485, x82 * x484))
             + Self::mul_add(x482, x546, x483 * x545) + x577
-            + Self::mul_add(x89, x567, x90 * x566);
-        let x581 = Self::mul_add(x84, x486, Self::mul_add(x83, x485, x82 * x484))
+            + Self::mul_add(x92, x567, x93 * x566);
+        let x581 = Self::mul_add(x87, x486, Self::mul_add(x86, x485, x85 * x484))
             - Self::mul_add(-x481, x546, x483 * x544) - x578
-            + Self::mul_add(-x88, x567, x90 * x565);
-        let x582 = Self::mul_add(x87, x486, Self::mul_add(x86, x485, x85 * x484))
+            + Self::mul_add(-x91, x567, x93 * x565);
+        let x582 = Self::mul_add(x90, x486, Self::mul_add(x89, x485, x88 * x484))
             - Self::mul_add(x481, x545, x482 * x544) - x579
-            - Self::mul_add(x88, x566, x89 * x565);
-        let x583 = Self::mul_add(x53, x468, Self::mul_add(x52, x467, x51 * x466))
+            - Self::mul_add(x91, x566, x92 * x565);
+        let x583 = Self::mul_add(x57, x468, Self::mul_add(x56, x467, x55 * x466))
             + Self::mul_add(x464, x543, x465 * x542) + x580
-            + Self::mul_add(x61, x570, x62 * x569);
-        let x584 = Self::mul_add(x56, x468, Self::mul_add(x55, x467, x54 * x466))
+            + Self::mul_add(x65, x570, x66 * x569);
+        let x584 = Self::mul_add(x60, x468, Self::mul_add(x59, x467, x58 * x466))
             - Self::mul_add(-x463, x543, x465 * x541) + x581
-            + Self::mul_add(-x60, x570, x62 * x568);
-        let x585 = Self::mul_add(x59, x468, Self::mul_add(x58, x467, x57 * x466))
+            + Self::mul_add(-x64, x570, x66 * x568);
+        let x585 = Self::mul_add(x63, x468, Self::mul_add(x62, x467, x61 * x466))
             - Self::mul_add(x463, x542, x464 * x541) + x582
-            - Self::mul_add(x60, x569, x61 * x568);
+            - Self::mul_add(x64, x569, x65 * x568);
         let x586 = Self::mul_add(
             -qdd[1],
             x405,
             qdd[0]
-                * (12.19 + (x17 + x236)
-                    - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+                * (12.19 + (x22 + x236)
+                    - (x402 + Self::mul_add(-x38, x280, x39 * x281)
                         - Self::mul_add(
-                            x1,
-                            Self::mul_add(105.98, x1, x280),
-                            x2 * Self::mul_add(105.98, x2, x281),
+                            x7,
+                            Self::mul_add(105.98, x7, x280),
+                            x8 * Self::mul_add(105.98, x8, x281),
                         ))),
         );
         let x587 = Self::mul_add(
@@ -2462,13 +2472,13 @@ impl SsrmsRecurrent {
             x408,
             Self::mul_add(-qdd[3], x407, Self::mul_add(-qdd[2], x406, x586)),
         );
-        let x588 = -(Self::mul_add(x21, x453, x19 * x452)
+        let x588 = -(Self::mul_add(x26, x453, x24 * x452)
             + Self::mul_add(x447, x540, x448 * x539) + x583
-            - Self::mul_add(x33, x573, x34 * x572)
+            - Self::mul_add(x38, x573, x39 * x572)
             + Self::mul_add(
-                -x1,
+                -x7,
                 Self::mul_add(105.98, x451, x573),
-                x2 * Self::mul_add(105.98, x450, x572),
+                x8 * Self::mul_add(105.98, x450, x572),
             ) - Self::mul_add(qdd[6], x410, Self::mul_add(qdd[5], x409, x587)));
         let x589 = Self::mul_add(
             -qdd[3],
@@ -2482,17 +2492,17 @@ impl SsrmsRecurrent {
         );
         let x591 = Self::mul_add(
             -c_q0,
-            Self::mul_add(x31, x453, x29 * x452)
+            Self::mul_add(x36, x453, x34 * x452)
                 - Self::mul_add(qd[0], x539, x447 * x538) + x585
-                + Self::mul_add(-x32, x572, x33 * x571),
+                + Self::mul_add(-x37, x572, x38 * x571),
             s_q0
-                * (Self::mul_add(x26, x453, x24 * x452)
+                * (Self::mul_add(x31, x453, x29 * x452)
                     - Self::mul_add(-qd[0], x540, x448 * x538) + x584
-                    - Self::mul_add(x32, x573, x34 * x571)),
+                    - Self::mul_add(x37, x573, x39 * x571)),
         ) - x590;
         let x592 = Self::mul_add(
             -qdd[2],
-            Self::mul_add(-x7, x423, Self::mul_add(-x5, x422, s_q1 * x421)),
+            Self::mul_add(-x12, x423, Self::mul_add(-x10, x422, s_q1 * x421)),
             Self::mul_add(-qdd[1], x416, qdd[0] * x406),
         );
         let x593 = Self::mul_add(
@@ -2501,14 +2511,14 @@ impl SsrmsRecurrent {
             Self::mul_add(-qdd[4], x427, Self::mul_add(-qdd[3], x425, x592)),
         );
         let x594 = qdd[6] * x430;
-        let x595 = Self::mul_add(-x7, x585, Self::mul_add(-x5, x584, s_q1 * x583))
+        let x595 = Self::mul_add(-x12, x585, Self::mul_add(-x10, x584, s_q1 * x583))
             - (x593 + x594);
         let x596 = Self::mul_add(
             -qdd[3],
-            Self::mul_add(-x7, x433, Self::mul_add(-x5, x432, s_q1 * x431)),
+            Self::mul_add(-x12, x433, Self::mul_add(-x10, x432, s_q1 * x431)),
             Self::mul_add(-qdd[2], x425, Self::mul_add(-qdd[1], x417, qdd[0] * x407)),
         );
-        let x597 = Self::mul_add(-x7, x582, Self::mul_add(-x5, x581, s_q1 * x580))
+        let x597 = Self::mul_add(-x12, x582, Self::mul_add(-x10, x581, s_q1 * x580))
             - (x594 + Self::mul_add(qdd[5], x437, Self::mul_add(-qdd[4], x435, x596)));
         let x598 = Self::mul_add(
             -qdd[3],
@@ -2517,10 +2527,10 @@ impl SsrmsRecurrent {
         );
         let x599 = Self::mul_add(
             -qdd[4],
-            Self::mul_add(x7, x440, Self::mul_add(x5, x439, s_q1 * x438)),
+            Self::mul_add(x12, x440, Self::mul_add(x10, x439, s_q1 * x438)),
             x598,
         );
-        let x600 = Self::mul_add(x7, x579, Self::mul_add(x5, x578, s_q1 * x577))
+        let x600 = Self::mul_add(x12, x579, Self::mul_add(x10, x578, s_q1 * x577))
             - (x594 + Self::mul_add(qdd[5], x442, x599));
         let x601 = Self::mul_add(
             -qdd[3],
@@ -2529,10 +2539,10 @@ impl SsrmsRecurrent {
         );
         let x602 = Self::mul_add(
             qdd[5],
-            Self::mul_add(x97, x445, Self::mul_add(x95, x444, x93 * x443)),
+            Self::mul_add(x99, x445, Self::mul_add(x97, x444, x95 * x443)),
             Self::mul_add(-qdd[4], x442, x601),
         );
-        let x603 = -(Self::mul_add(x97, x576, Self::mul_add(x95, x575, x93 * x574))
+        let x603 = -(Self::mul_add(x99, x576, Self::mul_add(x97, x575, x95 * x574))
             - Self::mul_add(qdd[6], x446, x602));
         let x604 = Self::mul_add(
             -qdd[3],
@@ -2541,10 +2551,10 @@ impl SsrmsRecurrent {
         );
         let x605 = Self::mul_add(
             qdd[6],
-            Self::mul_add(x118, x412, Self::mul_add(x116, x411, x114 * x410)),
+            Self::mul_add(x119, x412, Self::mul_add(x117, x411, x115 * x410)),
             Self::mul_add(qdd[5], x446, Self::mul_add(-qdd[4], x430, x604)),
         );
-        let x606 = -(Self::mul_add(x118, x561, Self::mul_add(x116, x560, x114 * x559))
+        let x606 = -(Self::mul_add(x119, x561, Self::mul_add(x117, x560, x115 * x559))
             - x605);
         [x588, x591, x595, x597, x600, x603, x606]
     }
@@ -2553,201 +2563,204 @@ impl SsrmsRecurrent {
     /// Methods: mass matrix `recurrent`, bias `recurrent`, forward `ldlt`: 1138 mul, 1072 add, 7 div, 0 sqrt, 7 sincos (emitted), of which 660 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 7], qd: &[f64; 7], tau: &[f64; 7]) -> [f64; 7] {
-        let (s_q0, c_q0) = Self::sincos(q[0]);
-        let x1 = 0.7026 * s_q0;
-        let x2 = 0.7026 * c_q0;
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x4 = c_q0 * s_q1;
-        let x5 = c_q0 * c_q1;
-        let x6 = s_q0 * s_q1;
-        let x7 = s_q0 * c_q1;
-        let x8 = 8.088 * c_q1;
-        let x9 = 3.061 * s_q1;
-        let x10 = 8.088 * x4;
-        let x11 = 3.061 * x5;
-        let x12 = 8.446 * s_q0;
-        let x13 = 8.088 * x6;
-        let x14 = 3.061 * x7;
-        let x15 = 8.446 * c_q0;
-        let x16 = s_q1 * x9;
-        let x17 = Self::mul_add(c_q1, x8, x16);
-        let x18 = x5 * x9;
-        let x19 = Self::mul_add(x4, x8, -x18);
-        let x20 = x7 * x9;
-        let x21 = Self::mul_add(x6, x8, -x20);
-        let x22 = s_q1 * x11;
-        let x23 = x5 * x11;
-        let x24 = Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x23));
-        let x25 = x7 * x11;
-        let x26 = Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x25));
-        let x27 = s_q1 * x14;
-        let x28 = x5 * x14;
-        let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
-        let x30 = x7 * x14;
-        let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = s_q1 * 0.5692;
-        let x33 = x5 * 0.5692;
-        let x34 = x7 * 0.5692;
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x36 = c_q1 * c_q2;
-        let x37 = c_q1 * s_q2;
-        let x38 = Self::mul_add(s_q0, s_q2, x4 * c_q2);
-        let x39 = Self::mul_add(-s_q0, c_q2, x4 * s_q2);
-        let x40 = Self::mul_add(-c_q0, s_q2, x6 * c_q2);
-        let x41 = Self::mul_add(c_q0, c_q2, x6 * s_q2);
-        let x42 = Self::mul_add(-49.52, s_q1, 15.41 * x36);
-        let x43 = Self::mul_add(-2094.71, s_q1, 49.52 * x36);
-        let x44 = 2103.19 * x37;
-        let x45 = Self::mul_add(49.52, x5, 15.41 * x38);
-        let x46 = Self::mul_add(2094.71, x5, 49.52 * x38);
-        let x47 = 2103.19 * x39;
-        let x48 = Self::mul_add(49.52, x7, 15.41 * x40);
-        let x49 = Self::mul_add(2094.71, x7, 49.52 * x40);
-        let x50 = 2103.19 * x41;
-        let x51 = Self::mul_add(x37, x44, Self::mul_add(-s_q1, x43, x36 * x42));
-        let x52 = Self::mul_add(x39, x44, Self::mul_add(x5, x43, x38 * x42));
-        let x53 = Self::mul_add(x41, x44, Self::mul_add(x7, x43, x40 * x42));
-        let x54 = Self::mul_add(x37, x47, Self::mul_add(-s_q1, x46, x36 * x45));
-        let x55 = Self::mul_add(x39, x47, Self::mul_add(x5, x46, x38 * x45));
-        let x56 = Self::mul_add(x41, x47, Self::mul_add(x7, x46, x40 * x45));
-        let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
-        let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
-        let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
-        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
-        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
-        let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
-        let x66 = Self::mul_add(-x39, s_q3, x38 * c_q3);
-        let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
-        let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
-        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
-        let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
-        let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
-        let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
-        let x88 = 7.11 * x64;
-        let x89 = 7.11 * x66;
-        let x90 = 7.11 * x68;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x92 = Self::mul_add(-x65, s_q4, x64 * c_q4);
-        let x93 = Self::mul_add(x65, c_q4, x64 * s_q4);
-        let x94 = Self::mul_add(-x67, s_q4, x66 * c_q4);
-        let x95 = Self::mul_add(x67, c_q4, x66 * s_q4);
-        let x96 = Self::mul_add(-x69, s_q4, x68 * c_q4);
-        let x97 = Self::mul_add(x69, c_q4, x68 * s_q4);
-        let x98 = 8.305 * x92;
-        let x99 = 8.0386 * x93;
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = 0.7026 * s_q0;
+        let x8 = 0.7026 * c_q0;
+        let x9 = c_q0 * s_q1;
+        let x10 = c_q0 * c_q1;
+        let x11 = s_q0 * s_q1;
+        let x12 = s_q0 * c_q1;
+        let x13 = 8.088 * c_q1;
+        let x14 = 3.061 * s_q1;
+        let x15 = 8.088 * x9;
+        let x16 = 3.061 * x10;
+        let x17 = 8.446 * s_q0;
+        let x18 = 8.088 * x11;
+        let x19 = 3.061 * x12;
+        let x20 = 8.446 * c_q0;
+        let x21 = s_q1 * x14;
+        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x23 = x10 * x14;
+        let x24 = Self::mul_add(x9, x13, -x23);
+        let x25 = x12 * x14;
+        let x26 = Self::mul_add(x11, x13, -x25);
+        let x27 = s_q1 * x16;
+        let x28 = x10 * x16;
+        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x30 = x12 * x16;
+        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x32 = s_q1 * x19;
+        let x33 = x10 * x19;
+        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x35 = x12 * x19;
+        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
+        let x37 = s_q1 * 0.5692;
+        let x38 = x10 * 0.5692;
+        let x39 = x12 * 0.5692;
+        let x40 = c_q1 * c_q2;
+        let x41 = c_q1 * s_q2;
+        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
+        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
+        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
+        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
+        let x48 = 2103.19 * x41;
+        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
+        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
+        let x51 = 2103.19 * x43;
+        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
+        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
+        let x54 = 2103.19 * x45;
+        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
+        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
+        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
+        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
+        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
+        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
+        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
+        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
+        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
+        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
+        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
+        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
+        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
+        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
+        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
+        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
+        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
+        let x75 = 1966.28 * x68;
+        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
+        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
+        let x78 = 1966.28 * x70;
+        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
+        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
+        let x81 = 1966.28 * x72;
+        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
+        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
+        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
+        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
+        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
+        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
+        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
+        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
+        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
+        let x91 = 7.11 * x67;
+        let x92 = 7.11 * x69;
+        let x93 = 7.11 * x71;
+        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
+        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
+        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
+        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
         let x100 = 8.305 * x94;
         let x101 = 8.0386 * x95;
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
-        let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
-        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
-        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
-        let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
-        let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
-        let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
-        let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
-        let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
-        let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
-        let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
-        let x120 = 12.13 * x114;
+        let x104 = 8.305 * x98;
+        let x105 = 8.0386 * x99;
+        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
+        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
+        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
+        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
+        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
+        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
+        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
+        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
+        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
+        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
+        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
+        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
         let x121 = 12.13 * x115;
-        let x122 = 3.061 * x93;
-        let x123 = 12.13 * x116;
+        let x122 = 12.13 * x116;
+        let x123 = 3.061 * x95;
         let x124 = 12.13 * x117;
-        let x125 = 3.061 * x95;
-        let x126 = 12.13 * x118;
+        let x125 = 12.13 * x118;
+        let x126 = 3.061 * x97;
         let x127 = 12.13 * x119;
-        let x128 = 3.061 * x97;
-        let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
-        let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
-        let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
-        let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
-        let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = 0.7026 * x93;
+        let x128 = 12.13 * x120;
+        let x129 = 3.061 * x99;
+        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
+        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
+        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
+        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
+        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
+        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
+        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
+        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
+        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
-        let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
-        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
-        let x148 = 9.336 * x114;
+        let x141 = 0.7026 * x99;
+        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
+        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
+        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
+        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = 9.336 * x115;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
-        let x151 = 9.336 * x116;
+        let x151 = 9.336 * x117;
         let x152 = 44.41 * x144;
         let x153 = 44.41 * x145;
-        let x154 = 9.336 * x118;
+        let x154 = 9.336 * x119;
         let x155 = 44.41 * x146;
         let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x114 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x116 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x118 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x114 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x116 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x118 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x32 - x138;
-        let x167 = x33 + x139;
-        let x168 = x34 + x140;
-        let x169 = x88 + x166;
-        let x170 = x89 - x167;
-        let x171 = x90 - x168;
-        let x172 = x60 + x169;
-        let x173 = x61 + x170;
-        let x174 = x62 + x171;
-        let x175 = x33 - x173;
-        let x176 = x34 - x174;
-        let x177 = x32 + x88;
-        let x178 = x33 - x89;
-        let x179 = x34 - x90;
-        let x180 = x60 + x177;
-        let x181 = x61 - x178;
-        let x182 = x62 - x179;
-        let x183 = x33 - x181;
-        let x184 = x34 - x182;
-        let x185 = x60 + x88;
-        let x186 = x61 + x89;
-        let x187 = x62 + x90;
-        let x188 = x33 - x186;
-        let x189 = x34 - x187;
-        let x190 = x33 - x61;
-        let x191 = x34 - x62;
-        let x192 = 243.66 * x138;
-        let x193 = 243.66 * x139;
-        let x194 = 243.66 * x140;
+        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
+        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
+        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
+        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
+        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
+        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
+        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
+        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
+        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x166 = x37 - x139;
+        let x167 = x38 + x140;
+        let x168 = x39 + x141;
+        let x169 = x91 + x166;
+        let x170 = x92 - x167;
+        let x171 = x93 - x168;
+        let x172 = x64 + x169;
+        let x173 = x65 + x170;
+        let x174 = x66 + x171;
+        let x175 = x38 - x173;
+        let x176 = x39 - x174;
+        let x177 = x37 + x91;
+        let x178 = x38 - x92;
+        let x179 = x39 - x93;
+        let x180 = x64 + x177;
+        let x181 = x65 - x178;
+        let x182 = x66 - x179;
+        let x183 = x38 - x181;
+        let x184 = x39 - x182;
+        let x185 = x64 + x91;
+        let x186 = x65 + x92;
+        let x187 = x66 + x93;
+        let x188 = x38 - x186;
+        let x189 = x39 - x187;
+        let x190 = x38 - x65;
+        let x191 = x39 - x66;
+        let x192 = 243.66 * x139;
+        let x193 = 243.66 * x140;
+        let x194 = 243.66 * x141;
         let x195 = 243.66 * x166;
         let x196 = 243.66 * x167;
         let x197 = 243.66 * x168;
@@ -2757,581 +2770,581 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x32 + x172);
+        let x204 = 243.66 * (x37 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x1 + x175);
-        let x208 = 243.66 * (x2 - x176);
-        let x209 = x129 + x157;
-        let x210 = x130 + x158;
-        let x211 = x131 + x159;
-        let x212 = x132 + x160;
-        let x213 = x133 + x161;
-        let x214 = x134 + x162;
-        let x215 = x135 + x163;
-        let x216 = x136 + x164;
-        let x217 = x137 + x165;
-        let x218 = x104 + x209;
-        let x219 = x105 - x210;
-        let x220 = x106 - x211;
-        let x221 = x107 - x212;
-        let x222 = x108 + x213;
-        let x223 = x109 + x214;
-        let x224 = x110 - x215;
-        let x225 = x111 + x216;
-        let x226 = x112 + x217;
-        let x227 = x79 + x218;
-        let x228 = x80 - x219;
-        let x229 = x81 - x220;
-        let x230 = x82 - x221;
-        let x231 = x83 + x222;
-        let x232 = x84 + x223;
-        let x233 = x85 - x224;
-        let x234 = x86 + x225;
-        let x235 = x87 + x226;
-        let x236 = x51 + x227;
-        let x237 = x52 + x228;
-        let x238 = x53 + x229;
-        let x239 = x54 + x230;
-        let x240 = x55 + x231;
-        let x241 = x56 + x232;
-        let x242 = x57 + x233;
-        let x243 = x58 + x234;
-        let x244 = x59 + x235;
-        let x245 = Self::mul_add(105.98, x32, x195);
-        let x246 = Self::mul_add(105.98, x33, x196);
-        let x247 = Self::mul_add(105.98, x34, x197);
+        let x207 = 243.66 * (x7 + x175);
+        let x208 = 243.66 * (x8 - x176);
+        let x209 = x130 + x157;
+        let x210 = x131 + x158;
+        let x211 = x132 + x159;
+        let x212 = x133 + x160;
+        let x213 = x134 + x161;
+        let x214 = x135 + x162;
+        let x215 = x136 + x163;
+        let x216 = x137 + x164;
+        let x217 = x138 + x165;
+        let x218 = x106 + x209;
+        let x219 = x107 - x210;
+        let x220 = x108 - x211;
+        let x221 = x109 - x212;
+        let x222 = x110 + x213;
+        let x223 = x111 + x214;
+        let x224 = x112 - x215;
+        let x225 = x113 + x216;
+        let x226 = x114 + x217;
+        let x227 = x82 + x218;
+        let x228 = x83 - x219;
+        let x229 = x84 - x220;
+        let x230 = x85 - x221;
+        let x231 = x86 + x222;
+        let x232 = x87 + x223;
+        let x233 = x88 - x224;
+        let x234 = x89 + x225;
+        let x235 = x90 + x226;
+        let x236 = x55 + x227;
+        let x237 = x56 + x228;
+        let x238 = x57 + x229;
+        let x239 = x58 + x230;
+        let x240 = x59 + x231;
+        let x241 = x60 + x232;
+        let x242 = x61 + x233;
+        let x243 = x62 + x234;
+        let x244 = x63 + x235;
+        let x245 = Self::mul_add(105.98, x37, x195);
+        let x246 = Self::mul_add(105.98, x38, x196);
+        let x247 = Self::mul_add(105.98, x39, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
         let x249 = Self::mul_add(-105.98, x178, x199);
         let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x88, x248);
-        let x252 = Self::mul_add(105.98, x89, x249);
-        let x253 = Self::mul_add(105.98, x90, x250);
+        let x251 = Self::mul_add(105.98, x91, x248);
+        let x252 = Self::mul_add(105.98, x92, x249);
+        let x253 = Self::mul_add(105.98, x93, x250);
         let x254 = Self::mul_add(105.98, x180, x201);
         let x255 = Self::mul_add(105.98, x181, x202);
         let x256 = Self::mul_add(105.98, x182, x203);
         let x257 = Self::mul_add(105.98, x185, x254);
         let x258 = Self::mul_add(105.98, x186, x255);
         let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x60, x257);
-        let x261 = Self::mul_add(279.2, x61, x258);
-        let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x32 + x180, x204);
+        let x260 = Self::mul_add(279.2, x64, x257);
+        let x261 = Self::mul_add(279.2, x65, x258);
+        let x262 = Self::mul_add(279.2, x66, x259);
+        let x263 = Self::mul_add(105.98, x37 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x32 + x185, x263);
+        let x266 = Self::mul_add(105.98, x37 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x32 + x60, x266);
+        let x269 = Self::mul_add(279.2, x37 + x64, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x1 + x183, x207);
-        let x275 = Self::mul_add(105.98, x2 - x184, x208);
-        let x276 = Self::mul_add(105.98, x1 + x188, x274);
-        let x277 = Self::mul_add(105.98, x2 - x189, x275);
-        let x278 = Self::mul_add(279.2, x1 + x190, x276);
-        let x279 = Self::mul_add(279.2, x2 - x191, x277);
-        let x280 = Self::mul_add(314.88, x1 + x33, x278);
-        let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(-x139, x207, x140 * x208);
-        let x283 = x138 * x207;
-        let x284 = x138 * x208;
-        let x285 = x139 * x204;
-        let x286 = x138 * x204;
-        let x287 = x140 * x204;
-        let x288 = Self::mul_add(-x140, x206, x286);
-        let x289 = x139 * x206;
-        let x290 = x140 * x205;
-        let x291 = Self::mul_add(-x139, x205, x286);
-        let x292 = x140 * x203;
-        let x293 = x139 * x202;
+        let x272 = Self::mul_add(314.88, x38, x270);
+        let x273 = Self::mul_add(314.88, x39, x271);
+        let x274 = Self::mul_add(105.98, x7 + x183, x207);
+        let x275 = Self::mul_add(105.98, x8 - x184, x208);
+        let x276 = Self::mul_add(105.98, x7 + x188, x274);
+        let x277 = Self::mul_add(105.98, x8 - x189, x275);
+        let x278 = Self::mul_add(279.2, x7 + x190, x276);
+        let x279 = Self::mul_add(279.2, x8 - x191, x277);
+        let x280 = Self::mul_add(314.88, x7 + x38, x278);
+        let x281 = Self::mul_add(314.88, x8 - x39, x279);
+        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x283 = x139 * x207;
+        let x284 = x139 * x208;
+        let x285 = x140 * x204;
+        let x286 = x139 * x204;
+        let x287 = x141 * x204;
+        let x288 = Self::mul_add(-x141, x206, x286);
+        let x289 = x140 * x206;
+        let x290 = x141 * x205;
+        let x291 = Self::mul_add(-x140, x205, x286);
+        let x292 = x141 * x203;
+        let x293 = x140 * x202;
         let x294 = x292 + x293;
-        let x295 = x138 * x202;
-        let x296 = x138 * x203;
-        let x297 = x139 * x201;
-        let x298 = x138 * x201;
+        let x295 = x139 * x202;
+        let x296 = x139 * x203;
+        let x297 = x140 * x201;
+        let x298 = x139 * x201;
         let x299 = x292 + x298;
-        let x300 = x139 * x203;
-        let x301 = x140 * x201;
-        let x302 = x140 * x202;
+        let x300 = x140 * x203;
+        let x301 = x141 * x201;
+        let x302 = x141 * x202;
         let x303 = x293 + x298;
-        let x304 = x140 * x200;
-        let x305 = x139 * x199;
+        let x304 = x141 * x200;
+        let x305 = x140 * x199;
         let x306 = x304 + x305;
-        let x307 = x138 * x199;
-        let x308 = x138 * x200;
-        let x309 = x139 * x198;
-        let x310 = x138 * x198;
+        let x307 = x139 * x199;
+        let x308 = x139 * x200;
+        let x309 = x140 * x198;
+        let x310 = x139 * x198;
         let x311 = x304 + x310;
-        let x312 = x139 * x200;
-        let x313 = x140 * x198;
-        let x314 = x140 * x199;
+        let x312 = x140 * x200;
+        let x313 = x141 * x198;
+        let x314 = x141 * x199;
         let x315 = x305 + x310;
-        let x316 = x140 * x197;
-        let x317 = x139 * x196;
+        let x316 = x141 * x197;
+        let x317 = x140 * x196;
         let x318 = x316 + x317;
-        let x319 = x138 * x196;
-        let x320 = x138 * x197;
-        let x321 = x139 * x195;
-        let x322 = x138 * x195;
+        let x319 = x139 * x196;
+        let x320 = x139 * x197;
+        let x321 = x140 * x195;
+        let x322 = x139 * x195;
         let x323 = x316 - x322;
-        let x324 = x139 * x197;
-        let x325 = x140 * x195;
-        let x326 = x140 * x196;
+        let x324 = x140 * x197;
+        let x325 = x141 * x195;
+        let x326 = x141 * x196;
         let x327 = x317 - x322;
-        let x328 = x140 * x194;
-        let x329 = x139 * x193;
-        let x330 = x138 * x192;
-        let x331 = x34 * x247;
-        let x332 = x33 * x246;
-        let x333 = x32 * x245;
-        let x334 = x34 * x250;
-        let x335 = x33 * x249;
-        let x336 = x32 * x248;
+        let x328 = x141 * x194;
+        let x329 = x140 * x193;
+        let x330 = x139 * x192;
+        let x331 = x39 * x247;
+        let x332 = x38 * x246;
+        let x333 = x37 * x245;
+        let x334 = x39 * x250;
+        let x335 = x38 * x249;
+        let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x32, x249, x307);
-        let x339 = Self::mul_add(-x32, x250, x308);
-        let x340 = Self::mul_add(x33, x248, x309);
+        let x338 = Self::mul_add(-x37, x249, x307);
+        let x339 = Self::mul_add(-x37, x250, x308);
+        let x340 = Self::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x33, x250, x312);
-        let x343 = Self::mul_add(x34, x248, x313);
-        let x344 = Self::mul_add(x34, x249, x314);
+        let x342 = Self::mul_add(x38, x250, x312);
+        let x343 = Self::mul_add(x39, x248, x313);
+        let x344 = Self::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
-        let x346 = x90 * x253;
-        let x347 = x89 * x252;
-        let x348 = x88 * x251;
-        let x349 = x34 * x256;
-        let x350 = x33 * x255;
-        let x351 = x32 * x254;
+        let x346 = x93 * x253;
+        let x347 = x92 * x252;
+        let x348 = x91 * x251;
+        let x349 = x39 * x256;
+        let x350 = x38 * x255;
+        let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x32, x255, x295);
-        let x354 = Self::mul_add(-x32, x256, x296);
-        let x355 = Self::mul_add(x33, x254, x297);
+        let x353 = Self::mul_add(-x37, x255, x295);
+        let x354 = Self::mul_add(-x37, x256, x296);
+        let x355 = Self::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x33, x256, x300);
-        let x358 = Self::mul_add(x34, x254, x301);
-        let x359 = Self::mul_add(x34, x255, x302);
+        let x357 = Self::mul_add(x38, x256, x300);
+        let x358 = Self::mul_add(x39, x254, x301);
+        let x359 = Self::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
-        let x361 = x90 * x259;
-        let x362 = x89 * x258;
-        let x363 = x88 * x257;
+        let x361 = x93 * x259;
+        let x362 = x92 * x258;
+        let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x88, x258, x353);
-        let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(-x89, x257, x355);
+        let x365 = Self::mul_add(-x91, x258, x353);
+        let x366 = Self::mul_add(-x91, x259, x354);
+        let x367 = Self::mul_add(-x92, x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x89, x259, x357);
-        let x370 = Self::mul_add(-x90, x257, x358);
-        let x371 = Self::mul_add(-x90, x258, x359);
+        let x369 = Self::mul_add(-x92, x259, x357);
+        let x370 = Self::mul_add(-x93, x257, x358);
+        let x371 = Self::mul_add(-x93, x258, x359);
         let x372 = x360 - (x362 + x363);
-        let x373 = x62 * x262;
-        let x374 = x61 * x261;
-        let x375 = x60 * x260;
-        let x376 = x32 * x263;
-        let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 - Self::mul_add(x34, x265, x376);
-        let x379 = Self::mul_add(x33, x265, x289);
-        let x380 = Self::mul_add(x34, x263, x287);
-        let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 - Self::mul_add(x33, x264, x376);
-        let x383 = x88 * x266;
-        let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, -x383);
-        let x386 = Self::mul_add(-x89, x268, x379);
-        let x387 = Self::mul_add(-x90, x266, x380);
-        let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, -x383);
-        let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, -x390);
-        let x392 = Self::mul_add(-x61, x271, x386);
-        let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, -x390);
-        let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
-        let x397 = Self::mul_add(-x32, x274, x283);
-        let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
-        let x400 = Self::mul_add(-x88, x276, x397);
-        let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
-        let x403 = Self::mul_add(-x60, x278, x400);
-        let x404 = Self::mul_add(-x60, x279, x401);
+        let x373 = x66 * x262;
+        let x374 = x65 * x261;
+        let x375 = x64 * x260;
+        let x376 = x37 * x263;
+        let x377 = Self::mul_add(x38, x263, x285);
+        let x378 = x288 - Self::mul_add(x39, x265, x376);
+        let x379 = Self::mul_add(x38, x265, x289);
+        let x380 = Self::mul_add(x39, x263, x287);
+        let x381 = Self::mul_add(x39, x264, x290);
+        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x383 = x91 * x266;
+        let x384 = Self::mul_add(-x92, x266, x377);
+        let x385 = x378 + Self::mul_add(x93, x268, -x383);
+        let x386 = Self::mul_add(-x92, x268, x379);
+        let x387 = Self::mul_add(-x93, x266, x380);
+        let x388 = Self::mul_add(-x93, x267, x381);
+        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x390 = x64 * x269;
+        let x391 = x385 + Self::mul_add(x66, x271, -x390);
+        let x392 = Self::mul_add(-x65, x271, x386);
+        let x393 = Self::mul_add(-x66, x270, x388);
+        let x394 = x389 + Self::mul_add(x65, x270, -x390);
+        let x395 = x37 * Self::mul_add(314.88, x37, x269);
+        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
+        let x397 = Self::mul_add(-x37, x274, x283);
+        let x398 = Self::mul_add(-x37, x275, x284);
+        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
+        let x400 = Self::mul_add(-x91, x276, x397);
+        let x401 = Self::mul_add(-x91, x277, x398);
+        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
+        let x403 = Self::mul_add(-x64, x278, x400);
+        let x404 = Self::mul_add(-x64, x279, x401);
         let x405 = Self::mul_add(
             -c_q0,
-            x21 + x238 + Self::mul_add(-x32, x281, x404),
-            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
+            x26 + x238 + Self::mul_add(-x37, x281, x404),
+            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
         );
         let x406 = Self::mul_add(
-            -x7,
+            -x12,
             x238 + x404,
-            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
+            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x407 = Self::mul_add(
-            -x7,
+            -x12,
             x229 + x401,
-            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
+            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x408 = Self::mul_add(
-            x7,
+            x12,
             x220 - x398,
-            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
+            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x409 = Self::mul_add(
-            x97,
+            x99,
             x211 + x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
+            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
-        let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
-        let x412 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
+        let x410 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
+        let x411 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
+        let x412 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
         let x413 = Self::mul_add(
             -c_q0,
             Self::mul_add(
                 -c_q0,
-                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
-                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
+                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
             ),
             s_q0
                 * Self::mul_add(
                     -c_q0,
-                    x26 + x241 - Self::mul_add(x33, x273, x392),
-                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
+                    x31 + x241 - Self::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
                 ),
         );
         let x414 = Self::mul_add(
-            -x7,
+            -x12,
             x241 - x392,
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
+                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
             ),
         );
         let x415 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - x394,
             Self::mul_add(
-                -x5,
+                -x10,
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
+                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
             ),
         );
         let x416 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x389,
-                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
+                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x232 - x386,
-                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
+                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x417 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x382,
-                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
+                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x223 - x379,
-                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
+                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x418 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x291,
-                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
+                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x214 - x289,
-                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
         let x419 = Self::mul_add(
-            -x7,
-            x238 + Self::mul_add(-x60, x262, x366),
+            -x12,
+            x238 + Self::mul_add(-x64, x262, x366),
             Self::mul_add(
-                -x5,
-                x237 + Self::mul_add(-x60, x261, x365),
+                -x10,
+                x237 + Self::mul_add(-x64, x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x420 = Self::mul_add(
-            -x7,
-            x241 + Self::mul_add(-x61, x262, x369),
+            -x12,
+            x241 + Self::mul_add(-x65, x262, x369),
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
+                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
             ),
         );
         let x421 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -x5,
-                x243 + Self::mul_add(-x62, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
+                -x10,
+                x243 + Self::mul_add(-x66, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
             ),
         );
         let x422 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                -x7,
+                -x12,
                 x232 + x369,
-                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
+                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x229 + x366,
-                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
+                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x423 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x372,
-                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
+                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x422,
         );
         let x424 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x357,
-                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
+                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x354,
-                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
+                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x425 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x360,
-                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
+                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x424,
         );
         let x426 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x300,
-                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x296,
-                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
         let x427 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x303,
-                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
+                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x426,
         );
-        let x428 = Self::mul_add(-x7, x412, Self::mul_add(-x5, x411, s_q1 * x410));
+        let x428 = Self::mul_add(-x12, x412, Self::mul_add(-x10, x411, s_q1 * x410));
         let x429 = Self::mul_add(
-            -x7,
-            x229 + Self::mul_add(-x88, x253, x339),
+            -x12,
+            x229 + Self::mul_add(-x91, x253, x339),
             Self::mul_add(
-                -x5,
-                x228 + Self::mul_add(-x88, x252, x338),
+                -x10,
+                x228 + Self::mul_add(-x91, x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x430 = Self::mul_add(
-            -x7,
-            x232 + Self::mul_add(-x89, x253, x342),
+            -x12,
+            x232 + Self::mul_add(-x92, x253, x342),
             Self::mul_add(
-                -x5,
+                -x10,
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
+                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
             ),
         );
         let x431 = Self::mul_add(
-            -x7,
+            -x12,
             x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -x5,
-                x234 + Self::mul_add(-x90, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
+                -x10,
+                x234 + Self::mul_add(-x93, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
             ),
         );
         let x432 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x342,
-                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
+                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x339,
-                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
+                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x433 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x345,
-                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
+                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x432,
         );
         let x434 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x312,
-                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x308,
-                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
         let x435 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x315,
-                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
+                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x434,
         );
         let x436 = Self::mul_add(
-            x7,
-            x220 + Self::mul_add(-x32, x247, x320),
+            x12,
+            x220 + Self::mul_add(-x37, x247, x320),
             Self::mul_add(
-                x5,
-                x219 + Self::mul_add(-x32, x246, x319),
+                x10,
+                x219 + Self::mul_add(-x37, x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x437 = Self::mul_add(
-            x7,
-            x223 - Self::mul_add(x33, x247, x324),
+            x12,
+            x223 - Self::mul_add(x38, x247, x324),
             Self::mul_add(
-                x5,
+                x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
+                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
             ),
         );
         let x438 = Self::mul_add(
-            x7,
+            x12,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                x5,
-                x225 - Self::mul_add(x34, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
+                x10,
+                x225 - Self::mul_add(x39, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
             ),
         );
         let x439 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 - x324,
-                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 - x320,
-                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
         let x440 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
+                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x439,
         );
         let x441 = Self::mul_add(
-            x97,
-            Self::mul_add(-x138, x194, x211),
+            x99,
+            Self::mul_add(-x139, x194, x211),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x138, x193, x210),
-                x93 * (x209 + (x328 + x329)),
+                x97,
+                Self::mul_add(-x139, x193, x210),
+                x95 * (x209 + (x328 + x329)),
             ),
         );
         let x442 = Self::mul_add(
-            x97,
-            Self::mul_add(-x139, x194, x214),
+            x99,
+            Self::mul_add(-x140, x194, x214),
             Self::mul_add(
-                x95,
+                x97,
                 x213 + (x328 + x330),
-                x93 * Self::mul_add(-x139, x192, x212),
+                x95 * Self::mul_add(-x140, x192, x212),
             ),
         );
         let x443 = Self::mul_add(
-            x97,
+            x99,
             x217 + (x329 + x330),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x140, x193, x216),
-                x93 * Self::mul_add(-x140, x192, x215),
+                x97,
+                Self::mul_add(-x141, x193, x216),
+                x95 * Self::mul_add(-x141, x192, x215),
             ),
         );
         let x444 = qd[1] * s_q0;
         let x445 = qd[1] * c_q0;
         let x446 = qd[0] * qd[0];
-        let x447 = x1 * x446;
-        let x448 = x2 * x446;
+        let x447 = x7 * x446;
+        let x448 = x8 * x446;
         let x449 = qd[0] * x445;
         let x450 = qd[0] * x444;
         let x451 = qd[2] * s_q1;
-        let x452 = qd[2] * x5;
-        let x453 = qd[2] * x7;
+        let x452 = qd[2] * x10;
+        let x453 = qd[2] * x12;
         let x454 = x445 * x445;
         let x455 = x444 * x444;
         let x456 = x444 * x445;
-        let x457 = x32 * (x454 + x455);
+        let x457 = x37 * (x454 + x455);
         let x458 = x447
             - Self::mul_add(
-                -x34,
+                -x39,
                 x456,
-                Self::mul_add(-x33, x446 + x454, x32 * (x450 + x450)),
+                Self::mul_add(-x38, x446 + x454, x37 * (x450 + x450)),
             );
         let x459 = x448
             - Self::mul_add(
-                x34,
+                x39,
                 x446 + x455,
-                Self::mul_add(x33, x456, x32 * (x449 + x449)),
+                Self::mul_add(x38, x456, x37 * (x449 + x449)),
             );
         let x460 = qd[0] - x451;
         let x461 = x444 - x452;
@@ -3340,8 +3353,8 @@ impl SsrmsRecurrent {
         let x464 = x449 + Self::mul_add(qd[0], x453, x445 * x451);
         let x465 = x450 + Self::mul_add(-qd[0], x452, x444 * x451);
         let x466 = qd[3] * s_q1;
-        let x467 = qd[3] * x5;
-        let x468 = qd[3] * x7;
+        let x467 = qd[3] * x10;
+        let x468 = qd[3] * x12;
         let x469 = x462 * x462;
         let x470 = x461 * x461;
         let x471 = x460 * x461;
@@ -3350,21 +3363,21 @@ impl SsrmsRecurrent {
         let x474 = x461 * x462;
         let x475 = x457
             + Self::mul_add(
-                x62,
+                x66,
                 x464 - x472,
-                Self::mul_add(-x61, x465 - x471, x60 * (x469 + x470)),
+                Self::mul_add(-x65, x465 - x471, x64 * (x469 + x470)),
             );
         let x476 = x458
             - Self::mul_add(
-                -x62,
+                -x66,
                 x463 - x474,
-                Self::mul_add(x61, x469 + x473, x60 * (x465 + x471)),
+                Self::mul_add(x65, x469 + x473, x64 * (x465 + x471)),
             );
         let x477 = x459
             - Self::mul_add(
-                -x62,
+                -x66,
                 x470 + x473,
-                Self::mul_add(-x61, x463 + x474, x60 * (x464 + x472)),
+                Self::mul_add(-x65, x463 + x474, x64 * (x464 + x472)),
             );
         let x478 = x460 - x466;
         let x479 = x461 - x467;
@@ -3373,8 +3386,8 @@ impl SsrmsRecurrent {
         let x482 = x464 + Self::mul_add(x460, x468, x462 * x466);
         let x483 = x465 + Self::mul_add(-x460, x467, x461 * x466);
         let x484 = qd[4] * s_q1;
-        let x485 = qd[4] * x5;
-        let x486 = qd[4] * x7;
+        let x485 = qd[4] * x10;
+        let x486 = qd[4] * x12;
         let x487 = x480 * x480;
         let x488 = x479 * x479;
         let x489 = x478 * x479;
@@ -3383,21 +3396,21 @@ impl SsrmsRecurrent {
         let x492 = x479 * x480;
         let x493 = x475
             + Self::mul_add(
-                x90,
+                x93,
                 x482 - x490,
-                Self::mul_add(-x89, x483 - x489, x88 * (x487 + x488)),
+                Self::mul_add(-x92, x483 - x489, x91 * (x487 + x488)),
             );
         let x494 = x476
             - Self::mul_add(
-                -x90,
+                -x93,
                 x481 - x492,
-                Self::mul_add(x89, x487 + x491, x88 * (x483 + x489)),
+                Self::mul_add(x92, x487 + x491, x91 * (x483 + x489)),
             );
         let x495 = x477
             - Self::mul_add(
-                -x90,
+                -x93,
                 x488 + x491,
-                Self::mul_add(-x89, x481 + x492, x88 * (x482 + x490)),
+                Self::mul_add(-x92, x481 + x492, x91 * (x482 + x490)),
             );
         let x496 = x478 - x484;
         let x497 = x479 - x485;
@@ -3405,9 +3418,9 @@ impl SsrmsRecurrent {
         let x499 = x481 + Self::mul_add(x479, x486, x480 * x485);
         let x500 = x482 + Self::mul_add(x478, x486, x480 * x484);
         let x501 = x483 + Self::mul_add(-x478, x485, x479 * x484);
-        let x502 = qd[5] * x93;
-        let x503 = qd[5] * x95;
-        let x504 = qd[5] * x97;
+        let x502 = qd[5] * x95;
+        let x503 = qd[5] * x97;
+        let x504 = qd[5] * x99;
         let x505 = x498 * x498;
         let x506 = x497 * x497;
         let x507 = x496 * x497;
@@ -3416,21 +3429,21 @@ impl SsrmsRecurrent {
         let x510 = x497 * x498;
         let x511 = x493
             + Self::mul_add(
-                -x34,
+                -x39,
                 x500 - x508,
-                Self::mul_add(x33, x501 - x507, x32 * (x505 + x506)),
+                Self::mul_add(x38, x501 - x507, x37 * (x505 + x506)),
             );
         let x512 = x494
             - Self::mul_add(
-                x34,
+                x39,
                 x499 - x510,
-                Self::mul_add(-x33, x505 + x509, x32 * (x501 + x507)),
+                Self::mul_add(-x38, x505 + x509, x37 * (x501 + x507)),
             );
         let x513 = x495
             - Self::mul_add(
-                x34,
+                x39,
                 x506 + x509,
-                Self::mul_add(x33, x499 + x510, x32 * (x500 + x508)),
+                Self::mul_add(x38, x499 + x510, x37 * (x500 + x508)),
             );
         let x514 = x496 + x502;
         let x515 = x497 - x503;
@@ -3438,9 +3451,9 @@ impl SsrmsRecurrent {
         let x517 = x499 + Self::mul_add(x497, x504, x498 * x503);
         let x518 = x500 - Self::mul_add(-x496, x504, x498 * x502);
         let x519 = x501 - Self::mul_add(x496, x503, x497 * x502);
-        let x520 = qd[6] * x114;
-        let x521 = qd[6] * x116;
-        let x522 = qd[6] * x118;
+        let x520 = qd[6] * x115;
+        let x521 = qd[6] * x117;
+        let x522 = qd[6] * x119;
         let x523 = x516 * x516;
         let x524 = x515 * x515;
         let x525 = x514 * x515;
@@ -3453,49 +3466,49 @@ impl SsrmsRecurrent {
         let x532 = x517 + Self::mul_add(x515, x522, x516 * x521);
         let x533 = x518 - Self::mul_add(-x514, x522, x516 * x520);
         let x534 = x519 - Self::mul_add(x514, x521, x515 * x520);
-        let x535 = Self::mul_add(x21, x445, Self::mul_add(-x19, x444, qd[0] * x17));
+        let x535 = Self::mul_add(x26, x445, Self::mul_add(-x24, x444, qd[0] * x22));
         let x536 = Self::mul_add(
-            x26,
-            x445,
-            Self::mul_add(-x24, x444, qd[0] * Self::mul_add(c_q1, x10, -x22)),
-        );
-        let x537 = Self::mul_add(
             x31,
             x445,
-            Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x13, -x27)),
+            Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x15, -x27)),
         );
-        let x538 = Self::mul_add(x53, x462, Self::mul_add(-x52, x461, x51 * x460));
-        let x539 = Self::mul_add(x56, x462, Self::mul_add(-x55, x461, x54 * x460));
-        let x540 = Self::mul_add(x59, x462, Self::mul_add(-x58, x461, x57 * x460));
-        let x541 = Self::mul_add(x81, x480, Self::mul_add(-x80, x479, x79 * x478));
-        let x542 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
-        let x543 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
-        let x544 = Self::mul_add(-x106, x498, Self::mul_add(x105, x497, x104 * x496));
-        let x545 = Self::mul_add(-x109, x498, Self::mul_add(x108, x497, x107 * x496));
-        let x546 = Self::mul_add(-x112, x498, Self::mul_add(x111, x497, x110 * x496));
-        let x547 = Self::mul_add(x131, x516, Self::mul_add(-x130, x515, x129 * x514));
-        let x548 = Self::mul_add(x134, x516, Self::mul_add(-x133, x515, x132 * x514));
-        let x549 = Self::mul_add(x137, x516, Self::mul_add(-x136, x515, x135 * x514));
+        let x537 = Self::mul_add(
+            x36,
+            x445,
+            Self::mul_add(-x34, x444, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+        );
+        let x538 = Self::mul_add(x57, x462, Self::mul_add(-x56, x461, x55 * x460));
+        let x539 = Self::mul_add(x60, x462, Self::mul_add(-x59, x461, x58 * x460));
+        let x540 = Self::mul_add(x63, x462, Self::mul_add(-x62, x461, x61 * x460));
+        let x541 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
+        let x542 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
+        let x543 = Self::mul_add(x90, x480, Self::mul_add(-x89, x479, x88 * x478));
+        let x544 = Self::mul_add(-x108, x498, Self::mul_add(x107, x497, x106 * x496));
+        let x545 = Self::mul_add(-x111, x498, Self::mul_add(x110, x497, x109 * x496));
+        let x546 = Self::mul_add(-x114, x498, Self::mul_add(x113, x497, x112 * x496));
+        let x547 = Self::mul_add(x132, x516, Self::mul_add(-x131, x515, x130 * x514));
+        let x548 = Self::mul_add(x135, x516, Self::mul_add(-x134, x515, x133 * x514));
+        let x549 = Self::mul_add(x138, x516, Self::mul_add(-x137, x515, x136 * x514));
         let x550 = 243.66
             * (x511
                 - Self::mul_add(
-                    x140,
+                    x141,
                     x518 - x526,
-                    Self::mul_add(-x139, x519 - x525, x138 * (x523 + x524)),
+                    Self::mul_add(-x140, x519 - x525, x139 * (x523 + x524)),
                 ));
         let x551 = 243.66
             * (x512
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x517 - x528,
-                    Self::mul_add(x139, x523 + x527, x138 * (x519 + x525)),
+                    Self::mul_add(x140, x523 + x527, x139 * (x519 + x525)),
                 ));
         let x552 = 243.66
             * (x513
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x524 + x527,
-                    Self::mul_add(-x139, x517 + x528, x138 * (x518 + x526)),
+                    Self::mul_add(-x140, x517 + x528, x139 * (x518 + x526)),
                 ));
         let x553 = Self::mul_add(x159, x531, Self::mul_add(-x158, x530, x157 * x529));
         let x554 = Self::mul_add(x162, x531, Self::mul_add(-x161, x530, x160 * x529));
@@ -3518,58 +3531,58 @@ impl SsrmsRecurrent {
         let x568 = Self::mul_add(314.88, x457, x565);
         let x569 = Self::mul_add(314.88, x458, x566);
         let x570 = Self::mul_add(314.88, x459, x567);
-        let x571 = Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
+        let x571 = Self::mul_add(x132, x519, Self::mul_add(x131, x518, x130 * x517))
             + Self::mul_add(x515, x549, x516 * x548) + x556
-            - Self::mul_add(x139, x552, x140 * x551);
-        let x572 = Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
+            - Self::mul_add(x140, x552, x141 * x551);
+        let x572 = Self::mul_add(x135, x519, Self::mul_add(x134, x518, x133 * x517))
             - Self::mul_add(-x514, x549, x516 * x547) + x557
-            - Self::mul_add(-x138, x552, x140 * x550);
-        let x573 = Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
+            - Self::mul_add(-x139, x552, x141 * x550);
+        let x573 = Self::mul_add(x138, x519, Self::mul_add(x137, x518, x136 * x517))
             - Self::mul_add(x514, x548, x515 * x547) + x558
-            + Self::mul_add(x138, x551, x139 * x550);
-        let x574 = Self::mul_add(-x106, x501, Self::mul_add(-x105, x500, x104 * x499))
+            + Self::mul_add(x139, x551, x140 * x550);
+        let x574 = Self::mul_add(-x108, x501, Self::mul_add(-x107, x500, x106 * x499))
             - Self::mul_add(x497, x546, x498 * x545) + x571
-            - Self::mul_add(x33, x561, x34 * x560);
-        let x575 = Self::mul_add(-x109, x501, Self::mul_add(-x108, x500, x107 * x499))
+            - Self::mul_add(x38, x561, x39 * x560);
+        let x575 = Self::mul_add(-x111, x501, Self::mul_add(-x110, x500, x109 * x499))
             + Self::mul_add(x496, x546, x498 * x544) - x572
-            + Self::mul_add(x32, x561, x34 * x559);
-        let x576 = Self::mul_add(-x112, x501, Self::mul_add(-x111, x500, x110 * x499))
+            + Self::mul_add(x37, x561, x39 * x559);
+        let x576 = Self::mul_add(-x114, x501, Self::mul_add(-x113, x500, x112 * x499))
             + Self::mul_add(-x496, x545, x497 * x544) - x573
-            - Self::mul_add(-x32, x560, x33 * x559);
-        let x577 = Self::mul_add(x81, x483, Self::mul_add(x80, x482, x79 * x481))
+            - Self::mul_add(-x37, x560, x38 * x559);
+        let x577 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
             + Self::mul_add(x479, x543, x480 * x542) + x574
-            + Self::mul_add(x89, x564, x90 * x563);
-        let x578 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
+            + Self::mul_add(x92, x564, x93 * x563);
+        let x578 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
             - Self::mul_add(-x478, x543, x480 * x541) - x575
-            + Self::mul_add(-x88, x564, x90 * x562);
-        let x579 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
+            + Self::mul_add(-x91, x564, x93 * x562);
+        let x579 = Self::mul_add(x90, x483, Self::mul_add(x89, x482, x88 * x481))
             - Self::mul_add(x478, x542, x479 * x541) - x576
-            - Self::mul_add(x88, x563, x89 * x562);
-        let x580 = Self::mul_add(x53, x465, Self::mul_add(x52, x464, x51 * x463))
+            - Self::mul_add(x91, x563, x92 * x562);
+        let x580 = Self::mul_add(x57, x465, Self::mul_add(x56, x464, x55 * x463))
             + Self::mul_add(x461, x540, x462 * x539) + x577
-            + Self::mul_add(x61, x567, x62 * x566);
-        let x581 = Self::mul_add(x56, x465, Self::mul_add(x55, x464, x54 * x463))
+            + Self::mul_add(x65, x567, x66 * x566);
+        let x581 = Self::mul_add(x60, x465, Self::mul_add(x59, x464, x58 * x463))
             - Self::mul_add(-x460, x540, x462 * x538) + x578
-            + Self::mul_add(-x60, x567, x62 * x565);
-        let x582 = Self::mul_add(x59, x465, Self::mul_add(x58, x464, x57 * x463))
+            + Self::mul_add(-x64, x567, x66 * x565);
+        let x582 = Self::mul_add(x63, x465, Self::mul_add(x62, x464, x61 * x463))
             - Self::mul_add(x460, x539, x461 * x538) + x579
-            - Self::mul_add(x60, x566, x61 * x565);
+            - Self::mul_add(x64, x566, x65 * x565);
         let x583 = tau[0]
-            + (Self::mul_add(x21, x450, x19 * x449)
+            + (Self::mul_add(x26, x450, x24 * x449)
                 + Self::mul_add(x444, x537, x445 * x536) + x580
-                - Self::mul_add(x33, x570, x34 * x569)
+                - Self::mul_add(x38, x570, x39 * x569)
                 + Self::mul_add(
-                    -x1,
+                    -x7,
                     Self::mul_add(105.98, x448, x570),
-                    x2 * Self::mul_add(105.98, x447, x569),
+                    x8 * Self::mul_add(105.98, x447, x569),
                 ));
         let x584 = 1.0
-            / (12.19 + (x17 + x236)
-                - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+            / (12.19 + (x22 + x236)
+                - (x402 + Self::mul_add(-x38, x280, x39 * x281)
                     - Self::mul_add(
-                        x1,
-                        Self::mul_add(105.98, x1, x280),
-                        x2 * Self::mul_add(105.98, x2, x281),
+                        x7,
+                        Self::mul_add(105.98, x7, x280),
+                        x8 * Self::mul_add(105.98, x8, x281),
                     )));
         let x585 = x405 * x584;
         let x586 = x406 * x584;
@@ -3591,7 +3604,7 @@ impl SsrmsRecurrent {
         let x602 = Self::mul_add(
             -x406,
             x586,
-            Self::mul_add(-x7, x421, Self::mul_add(-x5, x420, s_q1 * x419)),
+            Self::mul_add(-x12, x421, Self::mul_add(-x10, x420, s_q1 * x419)),
         );
         let x603 = 1.0 / Self::mul_add(-x592, x593, x602);
         let x604 = Self::mul_add(-x592, x595, Self::mul_add(-x406, x587, x423));
@@ -3605,7 +3618,7 @@ impl SsrmsRecurrent {
         let x612 = Self::mul_add(
             -x407,
             x587,
-            Self::mul_add(-x7, x431, Self::mul_add(-x5, x430, s_q1 * x429)),
+            Self::mul_add(-x12, x431, Self::mul_add(-x10, x430, s_q1 * x429)),
         );
         let x613 = 1.0 / Self::mul_add(-x604, x605, Self::mul_add(-x594, x595, x612));
         let x614 = Self::mul_add(
@@ -3629,7 +3642,7 @@ impl SsrmsRecurrent {
         let x620 = Self::mul_add(
             -x408,
             x588,
-            Self::mul_add(x7, x438, Self::mul_add(x5, x437, s_q1 * x436)),
+            Self::mul_add(x12, x438, Self::mul_add(x10, x437, s_q1 * x436)),
         );
         let x621 = Self::mul_add(
             -x614,
@@ -3654,7 +3667,7 @@ impl SsrmsRecurrent {
         let x629 = Self::mul_add(
             -x409,
             x589,
-            Self::mul_add(x97, x443, Self::mul_add(x95, x442, x93 * x441)),
+            Self::mul_add(x99, x443, Self::mul_add(x97, x442, x95 * x441)),
         );
         let x630 = Self::mul_add(
             -x616,
@@ -3665,7 +3678,7 @@ impl SsrmsRecurrent {
         let x632 = Self::mul_add(
             -x409,
             x590,
-            Self::mul_add(x97, x412, Self::mul_add(x95, x411, x93 * x410)),
+            Self::mul_add(x99, x412, Self::mul_add(x97, x411, x95 * x410)),
         );
         let x633 = Self::mul_add(
             -x616,
@@ -3677,7 +3690,7 @@ impl SsrmsRecurrent {
         let x636 = Self::mul_add(
             -x410,
             x590,
-            Self::mul_add(x118, x412, Self::mul_add(x116, x411, x114 * x410)),
+            Self::mul_add(x119, x412, Self::mul_add(x117, x411, x115 * x410)),
         );
         let x637 = Self::mul_add(
             -x618,
@@ -3691,31 +3704,31 @@ impl SsrmsRecurrent {
             tau[1]
                 - Self::mul_add(
                     -c_q0,
-                    Self::mul_add(x31, x450, x29 * x449)
+                    Self::mul_add(x36, x450, x34 * x449)
                         - Self::mul_add(qd[0], x536, x444 * x535) + x582
-                        + Self::mul_add(-x32, x569, x33 * x568),
+                        + Self::mul_add(-x37, x569, x38 * x568),
                     s_q0
-                        * (Self::mul_add(x26, x450, x24 * x449)
+                        * (Self::mul_add(x31, x450, x29 * x449)
                             - Self::mul_add(-qd[0], x537, x445 * x535) + x581
-                            - Self::mul_add(x32, x570, x34 * x568)),
+                            - Self::mul_add(x37, x570, x39 * x568)),
                 ),
         );
         let x640 = Self::mul_add(
             x583,
             x586,
-            tau[2] - Self::mul_add(-x7, x582, Self::mul_add(-x5, x581, s_q1 * x580)),
+            tau[2] - Self::mul_add(-x12, x582, Self::mul_add(-x10, x581, s_q1 * x580)),
         );
         let x641 = Self::mul_add(-x593, x639, x640);
         let x642 = Self::mul_add(
             x583,
             x587,
-            tau[3] - Self::mul_add(-x7, x579, Self::mul_add(-x5, x578, s_q1 * x577)),
+            tau[3] - Self::mul_add(-x12, x579, Self::mul_add(-x10, x578, s_q1 * x577)),
         );
         let x643 = Self::mul_add(-x605, x641, Self::mul_add(-x595, x639, x642));
         let x644 = Self::mul_add(
             x583,
             x588,
-            tau[4] - Self::mul_add(x7, x576, Self::mul_add(x5, x575, s_q1 * x574)),
+            tau[4] - Self::mul_add(x12, x576, Self::mul_add(x10, x575, s_q1 * x574)),
         );
         let x645 = Self::mul_add(
             -x615,
@@ -3725,7 +3738,7 @@ impl SsrmsRecurrent {
         let x646 = Self::mul_add(
             -x583,
             x589,
-            tau[5] + Self::mul_add(x97, x573, Self::mul_add(x95, x572, x93 * x571)),
+            tau[5] + Self::mul_add(x99, x573, Self::mul_add(x97, x572, x95 * x571)),
         );
         let x647 = Self::mul_add(
             x617,
@@ -3736,7 +3749,7 @@ impl SsrmsRecurrent {
         let x649 = Self::mul_add(
             -x583,
             x590,
-            tau[6] + Self::mul_add(x118, x558, Self::mul_add(x116, x557, x114 * x556)),
+            tau[6] + Self::mul_add(x119, x558, Self::mul_add(x117, x557, x115 * x556)),
         );
         let x650 = Self::mul_add(
             x619,
@@ -3783,201 +3796,204 @@ impl SsrmsRecurrent {
         q: &[f64; 7],
         qd: &[f64; 7],
     ) -> ([[f64; 7]; 7], [f64; 7]) {
-        let (s_q0, c_q0) = Self::sincos(q[0]);
-        let x1 = 0.7026 * s_q0;
-        let x2 = 0.7026 * c_q0;
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x4 = c_q0 * s_q1;
-        let x5 = c_q0 * c_q1;
-        let x6 = s_q0 * s_q1;
-        let x7 = s_q0 * c_q1;
-        let x8 = 8.088 * c_q1;
-        let x9 = 3.061 * s_q1;
-        let x10 = 8.088 * x4;
-        let x11 = 3.061 * x5;
-        let x12 = 8.446 * s_q0;
-        let x13 = 8.088 * x6;
-        let x14 = 3.061 * x7;
-        let x15 = 8.446 * c_q0;
-        let x16 = s_q1 * x9;
-        let x17 = Self::mul_add(c_q1, x8, x16);
-        let x18 = x5 * x9;
-        let x19 = Self::mul_add(x4, x8, -x18);
-        let x20 = x7 * x9;
-        let x21 = Self::mul_add(x6, x8, -x20);
-        let x22 = s_q1 * x11;
-        let x23 = x5 * x11;
-        let x24 = Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x23));
-        let x25 = x7 * x11;
-        let x26 = Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x25));
-        let x27 = s_q1 * x14;
-        let x28 = x5 * x14;
-        let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
-        let x30 = x7 * x14;
-        let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = s_q1 * 0.5692;
-        let x33 = x5 * 0.5692;
-        let x34 = x7 * 0.5692;
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x36 = c_q1 * c_q2;
-        let x37 = c_q1 * s_q2;
-        let x38 = Self::mul_add(s_q0, s_q2, x4 * c_q2);
-        let x39 = Self::mul_add(-s_q0, c_q2, x4 * s_q2);
-        let x40 = Self::mul_add(-c_q0, s_q2, x6 * c_q2);
-        let x41 = Self::mul_add(c_q0, c_q2, x6 * s_q2);
-        let x42 = Self::mul_add(-49.52, s_q1, 15.41 * x36);
-        let x43 = Self::mul_add(-2094.71, s_q1, 49.52 * x36);
-        let x44 = 2103.19 * x37;
-        let x45 = Self::mul_add(49.52, x5, 15.41 * x38);
-        let x46 = Self::mul_add(2094.71, x5, 49.52 * x38);
-        let x47 = 2103.19 * x39;
-        let x48 = Self::mul_add(49.52, x7, 15.41 * x40);
-        let x49 = Self::mul_add(2094.71, x7, 49.52 * x40);
-        let x50 = 2103.19 * x41;
-        let x51 = Self::mul_add(x37, x44, Self::mul_add(-s_q1, x43, x36 * x42));
-        let x52 = Self::mul_add(x39, x44, Self::mul_add(x5, x43, x38 * x42));
-        let x53 = Self::mul_add(x41, x44, Self::mul_add(x7, x43, x40 * x42));
-        let x54 = Self::mul_add(x37, x47, Self::mul_add(-s_q1, x46, x36 * x45));
-        let x55 = Self::mul_add(x39, x47, Self::mul_add(x5, x46, x38 * x45));
-        let x56 = Self::mul_add(x41, x47, Self::mul_add(x7, x46, x40 * x45));
-        let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
-        let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
-        let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
-        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
-        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
-        let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
-        let x66 = Self::mul_add(-x39, s_q3, x38 * c_q3);
-        let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
-        let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
-        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
-        let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
-        let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
-        let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
-        let x88 = 7.11 * x64;
-        let x89 = 7.11 * x66;
-        let x90 = 7.11 * x68;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x92 = Self::mul_add(-x65, s_q4, x64 * c_q4);
-        let x93 = Self::mul_add(x65, c_q4, x64 * s_q4);
-        let x94 = Self::mul_add(-x67, s_q4, x66 * c_q4);
-        let x95 = Self::mul_add(x67, c_q4, x66 * s_q4);
-        let x96 = Self::mul_add(-x69, s_q4, x68 * c_q4);
-        let x97 = Self::mul_add(x69, c_q4, x68 * s_q4);
-        let x98 = 8.305 * x92;
-        let x99 = 8.0386 * x93;
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = 0.7026 * s_q0;
+        let x8 = 0.7026 * c_q0;
+        let x9 = c_q0 * s_q1;
+        let x10 = c_q0 * c_q1;
+        let x11 = s_q0 * s_q1;
+        let x12 = s_q0 * c_q1;
+        let x13 = 8.088 * c_q1;
+        let x14 = 3.061 * s_q1;
+        let x15 = 8.088 * x9;
+        let x16 = 3.061 * x10;
+        let x17 = 8.446 * s_q0;
+        let x18 = 8.088 * x11;
+        let x19 = 3.061 * x12;
+        let x20 = 8.446 * c_q0;
+        let x21 = s_q1 * x14;
+        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x23 = x10 * x14;
+        let x24 = Self::mul_add(x9, x13, -x23);
+        let x25 = x12 * x14;
+        let x26 = Self::mul_add(x11, x13, -x25);
+        let x27 = s_q1 * x16;
+        let x28 = x10 * x16;
+        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x30 = x12 * x16;
+        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x32 = s_q1 * x19;
+        let x33 = x10 * x19;
+        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x35 = x12 * x19;
+        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
+        let x37 = s_q1 * 0.5692;
+        let x38 = x10 * 0.5692;
+        let x39 = x12 * 0.5692;
+        let x40 = c_q1 * c_q2;
+        let x41 = c_q1 * s_q2;
+        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
+        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
+        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
+        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
+        let x48 = 2103.19 * x41;
+        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
+        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
+        let x51 = 2103.19 * x43;
+        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
+        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
+        let x54 = 2103.19 * x45;
+        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
+        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
+        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
+        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
+        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
+        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
+        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
+        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
+        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
+        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
+        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
+        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
+        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
+        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
+        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
+        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
+        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
+        let x75 = 1966.28 * x68;
+        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
+        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
+        let x78 = 1966.28 * x70;
+        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
+        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
+        let x81 = 1966.28 * x72;
+        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
+        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
+        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
+        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
+        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
+        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
+        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
+        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
+        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
+        let x91 = 7.11 * x67;
+        let x92 = 7.11 * x69;
+        let x93 = 7.11 * x71;
+        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
+        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
+        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
+        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
         let x100 = 8.305 * x94;
         let x101 = 8.0386 * x95;
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
-        let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
-        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
-        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
-        let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
-        let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
-        let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
-        let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
-        let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
-        let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
-        let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
-        let x120 = 12.13 * x114;
+        let x104 = 8.305 * x98;
+        let x105 = 8.0386 * x99;
+        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
+        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
+        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
+        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
+        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
+        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
+        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
+        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
+        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
+        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
+        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
+        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
         let x121 = 12.13 * x115;
-        let x122 = 3.061 * x93;
-        let x123 = 12.13 * x116;
+        let x122 = 12.13 * x116;
+        let x123 = 3.061 * x95;
         let x124 = 12.13 * x117;
-        let x125 = 3.061 * x95;
-        let x126 = 12.13 * x118;
+        let x125 = 12.13 * x118;
+        let x126 = 3.061 * x97;
         let x127 = 12.13 * x119;
-        let x128 = 3.061 * x97;
-        let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
-        let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
-        let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
-        let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
-        let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = 0.7026 * x93;
+        let x128 = 12.13 * x120;
+        let x129 = 3.061 * x99;
+        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
+        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
+        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
+        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
+        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
+        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
+        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
+        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
+        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
-        let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
-        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
-        let x148 = 9.336 * x114;
+        let x141 = 0.7026 * x99;
+        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
+        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
+        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
+        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = 9.336 * x115;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
-        let x151 = 9.336 * x116;
+        let x151 = 9.336 * x117;
         let x152 = 44.41 * x144;
         let x153 = 44.41 * x145;
-        let x154 = 9.336 * x118;
+        let x154 = 9.336 * x119;
         let x155 = 44.41 * x146;
         let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x114 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x116 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x118 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x114 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x116 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x118 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x32 - x138;
-        let x167 = x33 + x139;
-        let x168 = x34 + x140;
-        let x169 = x88 + x166;
-        let x170 = x89 - x167;
-        let x171 = x90 - x168;
-        let x172 = x60 + x169;
-        let x173 = x61 + x170;
-        let x174 = x62 + x171;
-        let x175 = x33 - x173;
-        let x176 = x34 - x174;
-        let x177 = x32 + x88;
-        let x178 = x33 - x89;
-        let x179 = x34 - x90;
-        let x180 = x60 + x177;
-        let x181 = x61 - x178;
-        let x182 = x62 - x179;
-        let x183 = x33 - x181;
-        let x184 = x34 - x182;
-        let x185 = x60 + x88;
-        let x186 = x61 + x89;
-        let x187 = x62 + x90;
-        let x188 = x33 - x186;
-        let x189 = x34 - x187;
-        let x190 = x33 - x61;
-        let x191 = x34 - x62;
-        let x192 = 243.66 * x138;
-        let x193 = 243.66 * x139;
-        let x194 = 243.66 * x140;
+        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
+        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
+        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
+        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
+        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
+        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
+        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
+        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
+        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x166 = x37 - x139;
+        let x167 = x38 + x140;
+        let x168 = x39 + x141;
+        let x169 = x91 + x166;
+        let x170 = x92 - x167;
+        let x171 = x93 - x168;
+        let x172 = x64 + x169;
+        let x173 = x65 + x170;
+        let x174 = x66 + x171;
+        let x175 = x38 - x173;
+        let x176 = x39 - x174;
+        let x177 = x37 + x91;
+        let x178 = x38 - x92;
+        let x179 = x39 - x93;
+        let x180 = x64 + x177;
+        let x181 = x65 - x178;
+        let x182 = x66 - x179;
+        let x183 = x38 - x181;
+        let x184 = x39 - x182;
+        let x185 = x64 + x91;
+        let x186 = x65 + x92;
+        let x187 = x66 + x93;
+        let x188 = x38 - x186;
+        let x189 = x39 - x187;
+        let x190 = x38 - x65;
+        let x191 = x39 - x66;
+        let x192 = 243.66 * x139;
+        let x193 = 243.66 * x140;
+        let x194 = 243.66 * x141;
         let x195 = 243.66 * x166;
         let x196 = 243.66 * x167;
         let x197 = 243.66 * x168;
@@ -3987,601 +4003,601 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x32 + x172);
+        let x204 = 243.66 * (x37 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x1 + x175);
-        let x208 = 243.66 * (x2 - x176);
-        let x209 = x129 + x157;
-        let x210 = x130 + x158;
-        let x211 = x131 + x159;
-        let x212 = x132 + x160;
-        let x213 = x133 + x161;
-        let x214 = x134 + x162;
-        let x215 = x135 + x163;
-        let x216 = x136 + x164;
-        let x217 = x137 + x165;
-        let x218 = x104 + x209;
-        let x219 = x105 - x210;
-        let x220 = x106 - x211;
-        let x221 = x107 - x212;
-        let x222 = x108 + x213;
-        let x223 = x109 + x214;
-        let x224 = x110 - x215;
-        let x225 = x111 + x216;
-        let x226 = x112 + x217;
-        let x227 = x79 + x218;
-        let x228 = x80 - x219;
-        let x229 = x81 - x220;
-        let x230 = x82 - x221;
-        let x231 = x83 + x222;
-        let x232 = x84 + x223;
-        let x233 = x85 - x224;
-        let x234 = x86 + x225;
-        let x235 = x87 + x226;
-        let x236 = x51 + x227;
-        let x237 = x52 + x228;
-        let x238 = x53 + x229;
-        let x239 = x54 + x230;
-        let x240 = x55 + x231;
-        let x241 = x56 + x232;
-        let x242 = x57 + x233;
-        let x243 = x58 + x234;
-        let x244 = x59 + x235;
-        let x245 = Self::mul_add(105.98, x32, x195);
-        let x246 = Self::mul_add(105.98, x33, x196);
-        let x247 = Self::mul_add(105.98, x34, x197);
+        let x207 = 243.66 * (x7 + x175);
+        let x208 = 243.66 * (x8 - x176);
+        let x209 = x130 + x157;
+        let x210 = x131 + x158;
+        let x211 = x132 + x159;
+        let x212 = x133 + x160;
+        let x213 = x134 + x161;
+        let x214 = x135 + x162;
+        let x215 = x136 + x163;
+        let x216 = x137 + x164;
+        let x217 = x138 + x165;
+        let x218 = x106 + x209;
+        let x219 = x107 - x210;
+        let x220 = x108 - x211;
+        let x221 = x109 - x212;
+        let x222 = x110 + x213;
+        let x223 = x111 + x214;
+        let x224 = x112 - x215;
+        let x225 = x113 + x216;
+        let x226 = x114 + x217;
+        let x227 = x82 + x218;
+        let x228 = x83 - x219;
+        let x229 = x84 - x220;
+        let x230 = x85 - x221;
+        let x231 = x86 + x222;
+        let x232 = x87 + x223;
+        let x233 = x88 - x224;
+        let x234 = x89 + x225;
+        let x235 = x90 + x226;
+        let x236 = x55 + x227;
+        let x237 = x56 + x228;
+        let x238 = x57 + x229;
+        let x239 = x58 + x230;
+        let x240 = x59 + x231;
+        let x241 = x60 + x232;
+        let x242 = x61 + x233;
+        let x243 = x62 + x234;
+        let x244 = x63 + x235;
+        let x245 = Self::mul_add(105.98, x37, x195);
+        let x246 = Self::mul_add(105.98, x38, x196);
+        let x247 = Self::mul_add(105.98, x39, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
         let x249 = Self::mul_add(-105.98, x178, x199);
         let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x88, x248);
-        let x252 = Self::mul_add(105.98, x89, x249);
-        let x253 = Self::mul_add(105.98, x90, x250);
+        let x251 = Self::mul_add(105.98, x91, x248);
+        let x252 = Self::mul_add(105.98, x92, x249);
+        let x253 = Self::mul_add(105.98, x93, x250);
         let x254 = Self::mul_add(105.98, x180, x201);
         let x255 = Self::mul_add(105.98, x181, x202);
         let x256 = Self::mul_add(105.98, x182, x203);
         let x257 = Self::mul_add(105.98, x185, x254);
         let x258 = Self::mul_add(105.98, x186, x255);
         let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x60, x257);
-        let x261 = Self::mul_add(279.2, x61, x258);
-        let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x32 + x180, x204);
+        let x260 = Self::mul_add(279.2, x64, x257);
+        let x261 = Self::mul_add(279.2, x65, x258);
+        let x262 = Self::mul_add(279.2, x66, x259);
+        let x263 = Self::mul_add(105.98, x37 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x32 + x185, x263);
+        let x266 = Self::mul_add(105.98, x37 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x32 + x60, x266);
+        let x269 = Self::mul_add(279.2, x37 + x64, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x1 + x183, x207);
-        let x275 = Self::mul_add(105.98, x2 - x184, x208);
-        let x276 = Self::mul_add(105.98, x1 + x188, x274);
-        let x277 = Self::mul_add(105.98, x2 - x189, x275);
-        let x278 = Self::mul_add(279.2, x1 + x190, x276);
-        let x279 = Self::mul_add(279.2, x2 - x191, x277);
-        let x280 = Self::mul_add(314.88, x1 + x33, x278);
-        let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(-x139, x207, x140 * x208);
-        let x283 = x138 * x207;
-        let x284 = x138 * x208;
-        let x285 = x139 * x204;
-        let x286 = x138 * x204;
-        let x287 = x140 * x204;
-        let x288 = Self::mul_add(-x140, x206, x286);
-        let x289 = x139 * x206;
-        let x290 = x140 * x205;
-        let x291 = Self::mul_add(-x139, x205, x286);
-        let x292 = x140 * x203;
-        let x293 = x139 * x202;
+        let x272 = Self::mul_add(314.88, x38, x270);
+        let x273 = Self::mul_add(314.88, x39, x271);
+        let x274 = Self::mul_add(105.98, x7 + x183, x207);
+        let x275 = Self::mul_add(105.98, x8 - x184, x208);
+        let x276 = Self::mul_add(105.98, x7 + x188, x274);
+        let x277 = Self::mul_add(105.98, x8 - x189, x275);
+        let x278 = Self::mul_add(279.2, x7 + x190, x276);
+        let x279 = Self::mul_add(279.2, x8 - x191, x277);
+        let x280 = Self::mul_add(314.88, x7 + x38, x278);
+        let x281 = Self::mul_add(314.88, x8 - x39, x279);
+        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x283 = x139 * x207;
+        let x284 = x139 * x208;
+        let x285 = x140 * x204;
+        let x286 = x139 * x204;
+        let x287 = x141 * x204;
+        let x288 = Self::mul_add(-x141, x206, x286);
+        let x289 = x140 * x206;
+        let x290 = x141 * x205;
+        let x291 = Self::mul_add(-x140, x205, x286);
+        let x292 = x141 * x203;
+        let x293 = x140 * x202;
         let x294 = x292 + x293;
-        let x295 = x138 * x202;
-        let x296 = x138 * x203;
-        let x297 = x139 * x201;
-        let x298 = x138 * x201;
+        let x295 = x139 * x202;
+        let x296 = x139 * x203;
+        let x297 = x140 * x201;
+        let x298 = x139 * x201;
         let x299 = x292 + x298;
-        let x300 = x139 * x203;
-        let x301 = x140 * x201;
-        let x302 = x140 * x202;
+        let x300 = x140 * x203;
+        let x301 = x141 * x201;
+        let x302 = x141 * x202;
         let x303 = x293 + x298;
-        let x304 = x140 * x200;
-        let x305 = x139 * x199;
+        let x304 = x141 * x200;
+        let x305 = x140 * x199;
         let x306 = x304 + x305;
-        let x307 = x138 * x199;
-        let x308 = x138 * x200;
-        let x309 = x139 * x198;
-        let x310 = x138 * x198;
+        let x307 = x139 * x199;
+        let x308 = x139 * x200;
+        let x309 = x140 * x198;
+        let x310 = x139 * x198;
         let x311 = x304 + x310;
-        let x312 = x139 * x200;
-        let x313 = x140 * x198;
-        let x314 = x140 * x199;
+        let x312 = x140 * x200;
+        let x313 = x141 * x198;
+        let x314 = x141 * x199;
         let x315 = x305 + x310;
-        let x316 = x140 * x197;
-        let x317 = x139 * x196;
+        let x316 = x141 * x197;
+        let x317 = x140 * x196;
         let x318 = x316 + x317;
-        let x319 = x138 * x196;
-        let x320 = x138 * x197;
-        let x321 = x139 * x195;
-        let x322 = x138 * x195;
+        let x319 = x139 * x196;
+        let x320 = x139 * x197;
+        let x321 = x140 * x195;
+        let x322 = x139 * x195;
         let x323 = x316 - x322;
-        let x324 = x139 * x197;
-        let x325 = x140 * x195;
-        let x326 = x140 * x196;
+        let x324 = x140 * x197;
+        let x325 = x141 * x195;
+        let x326 = x141 * x196;
         let x327 = x317 - x322;
-        let x328 = x140 * x194;
-        let x329 = x139 * x193;
-        let x330 = x138 * x192;
-        let x331 = x34 * x247;
-        let x332 = x33 * x246;
-        let x333 = x32 * x245;
-        let x334 = x34 * x250;
-        let x335 = x33 * x249;
-        let x336 = x32 * x248;
+        let x328 = x141 * x194;
+        let x329 = x140 * x193;
+        let x330 = x139 * x192;
+        let x331 = x39 * x247;
+        let x332 = x38 * x246;
+        let x333 = x37 * x245;
+        let x334 = x39 * x250;
+        let x335 = x38 * x249;
+        let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x32, x249, x307);
-        let x339 = Self::mul_add(-x32, x250, x308);
-        let x340 = Self::mul_add(x33, x248, x309);
+        let x338 = Self::mul_add(-x37, x249, x307);
+        let x339 = Self::mul_add(-x37, x250, x308);
+        let x340 = Self::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x33, x250, x312);
-        let x343 = Self::mul_add(x34, x248, x313);
-        let x344 = Self::mul_add(x34, x249, x314);
+        let x342 = Self::mul_add(x38, x250, x312);
+        let x343 = Self::mul_add(x39, x248, x313);
+        let x344 = Self::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
-        let x346 = x90 * x253;
-        let x347 = x89 * x252;
-        let x348 = x88 * x251;
-        let x349 = x34 * x256;
-        let x350 = x33 * x255;
-        let x351 = x32 * x254;
+        let x346 = x93 * x253;
+        let x347 = x92 * x252;
+        let x348 = x91 * x251;
+        let x349 = x39 * x256;
+        let x350 = x38 * x255;
+        let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x32, x255, x295);
-        let x354 = Self::mul_add(-x32, x256, x296);
-        let x355 = Self::mul_add(x33, x254, x297);
+        let x353 = Self::mul_add(-x37, x255, x295);
+        let x354 = Self::mul_add(-x37, x256, x296);
+        let x355 = Self::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x33, x256, x300);
-        let x358 = Self::mul_add(x34, x254, x301);
-        let x359 = Self::mul_add(x34, x255, x302);
+        let x357 = Self::mul_add(x38, x256, x300);
+        let x358 = Self::mul_add(x39, x254, x301);
+        let x359 = Self::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
-        let x361 = x90 * x259;
-        let x362 = x89 * x258;
-        let x363 = x88 * x257;
+        let x361 = x93 * x259;
+        let x362 = x92 * x258;
+        let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x88, x258, x353);
-        let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(-x89, x257, x355);
+        let x365 = Self::mul_add(-x91, x258, x353);
+        let x366 = Self::mul_add(-x91, x259, x354);
+        let x367 = Self::mul_add(-x92, x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x89, x259, x357);
-        let x370 = Self::mul_add(-x90, x257, x358);
-        let x371 = Self::mul_add(-x90, x258, x359);
+        let x369 = Self::mul_add(-x92, x259, x357);
+        let x370 = Self::mul_add(-x93, x257, x358);
+        let x371 = Self::mul_add(-x93, x258, x359);
         let x372 = x360 - (x362 + x363);
-        let x373 = x62 * x262;
-        let x374 = x61 * x261;
-        let x375 = x60 * x260;
-        let x376 = x32 * x263;
-        let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 - Self::mul_add(x34, x265, x376);
-        let x379 = Self::mul_add(x33, x265, x289);
-        let x380 = Self::mul_add(x34, x263, x287);
-        let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 - Self::mul_add(x33, x264, x376);
-        let x383 = x88 * x266;
-        let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, -x383);
-        let x386 = Self::mul_add(-x89, x268, x379);
-        let x387 = Self::mul_add(-x90, x266, x380);
-        let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, -x383);
-        let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, -x390);
-        let x392 = Self::mul_add(-x61, x271, x386);
-        let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, -x390);
-        let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
-        let x397 = Self::mul_add(-x32, x274, x283);
-        let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
-        let x400 = Self::mul_add(-x88, x276, x397);
-        let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
-        let x403 = Self::mul_add(-x60, x278, x400);
-        let x404 = Self::mul_add(-x60, x279, x401);
-        let x405 = 12.19 + (x17 + x236)
-            - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+        let x373 = x66 * x262;
+        let x374 = x65 * x261;
+        let x375 = x64 * x260;
+        let x376 = x37 * x263;
+        let x377 = Self::mul_add(x38, x263, x285);
+        let x378 = x288 - Self::mul_add(x39, x265, x376);
+        let x379 = Self::mul_add(x38, x265, x289);
+        let x380 = Self::mul_add(x39, x263, x287);
+        let x381 = Self::mul_add(x39, x264, x290);
+        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x383 = x91 * x266;
+        let x384 = Self::mul_add(-x92, x266, x377);
+        let x385 = x378 + Self::mul_add(x93, x268, -x383);
+        let x386 = Self::mul_add(-x92, x268, x379);
+        let x387 = Self::mul_add(-x93, x266, x380);
+        let x388 = Self::mul_add(-x93, x267, x381);
+        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x390 = x64 * x269;
+        let x391 = x385 + Self::mul_add(x66, x271, -x390);
+        let x392 = Self::mul_add(-x65, x271, x386);
+        let x393 = Self::mul_add(-x66, x270, x388);
+        let x394 = x389 + Self::mul_add(x65, x270, -x390);
+        let x395 = x37 * Self::mul_add(314.88, x37, x269);
+        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
+        let x397 = Self::mul_add(-x37, x274, x283);
+        let x398 = Self::mul_add(-x37, x275, x284);
+        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
+        let x400 = Self::mul_add(-x91, x276, x397);
+        let x401 = Self::mul_add(-x91, x277, x398);
+        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
+        let x403 = Self::mul_add(-x64, x278, x400);
+        let x404 = Self::mul_add(-x64, x279, x401);
+        let x405 = 12.19 + (x22 + x236)
+            - (x402 + Self::mul_add(-x38, x280, x39 * x281)
                 - Self::mul_add(
-                    x1,
-                    Self::mul_add(105.98, x1, x280),
-                    x2 * Self::mul_add(105.98, x2, x281),
+                    x7,
+                    Self::mul_add(105.98, x7, x280),
+                    x8 * Self::mul_add(105.98, x8, x281),
                 ));
         let x406 = -Self::mul_add(
             -c_q0,
-            x21 + x238 + Self::mul_add(-x32, x281, x404),
-            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
+            x26 + x238 + Self::mul_add(-x37, x281, x404),
+            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
         );
         let x407 = -Self::mul_add(
-            -x7,
+            -x12,
             x238 + x404,
-            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
+            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x408 = -Self::mul_add(
-            -x7,
+            -x12,
             x229 + x401,
-            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
+            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x409 = -Self::mul_add(
-            x7,
+            x12,
             x220 - x398,
-            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
+            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x410 = Self::mul_add(
-            x97,
+            x99,
             x211 + x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
+            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x411 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
-        let x412 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
-        let x413 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
+        let x411 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
+        let x412 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
+        let x413 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
         let x414 = Self::mul_add(
             -c_q0,
             Self::mul_add(
                 -c_q0,
-                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
-                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
+                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
             ),
             s_q0
                 * Self::mul_add(
                     -c_q0,
-                    x26 + x241 - Self::mul_add(x33, x273, x392),
-                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
+                    x31 + x241 - Self::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
                 ),
         );
         let x415 = Self::mul_add(
-            -x7,
+            -x12,
             x241 - x392,
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
+                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
             ),
         );
         let x416 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - x394,
             Self::mul_add(
-                -x5,
+                -x10,
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
+                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
             ),
         );
         let x417 = Self::mul_add(-c_q0, x416, s_q0 * x415);
         let x418 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x389,
-                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
+                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x232 - x386,
-                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
+                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x419 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x382,
-                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
+                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x223 - x379,
-                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
+                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x420 = -x419;
         let x421 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x291,
-                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
+                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x214 - x289,
-                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
         let x422 = -x421;
         let x423 = -Self::mul_add(-c_q0, x413, s_q0 * x412);
         let x424 = Self::mul_add(
-            -x7,
-            x238 + Self::mul_add(-x60, x262, x366),
+            -x12,
+            x238 + Self::mul_add(-x64, x262, x366),
             Self::mul_add(
-                -x5,
-                x237 + Self::mul_add(-x60, x261, x365),
+                -x10,
+                x237 + Self::mul_add(-x64, x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x425 = Self::mul_add(
-            -x7,
-            x241 + Self::mul_add(-x61, x262, x369),
+            -x12,
+            x241 + Self::mul_add(-x65, x262, x369),
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
+                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
             ),
         );
         let x426 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -x5,
-                x243 + Self::mul_add(-x62, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
+                -x10,
+                x243 + Self::mul_add(-x66, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
             ),
         );
-        let x427 = Self::mul_add(-x7, x426, Self::mul_add(-x5, x425, s_q1 * x424));
+        let x427 = Self::mul_add(-x12, x426, Self::mul_add(-x10, x425, s_q1 * x424));
         let x428 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                -x7,
+                -x12,
                 x232 + x369,
-                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
+                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x229 + x366,
-                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
+                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x429 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x372,
-                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
+                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x428,
         );
         let x430 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x357,
-                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
+                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x354,
-                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
+                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x431 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x360,
-                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
+                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x430,
         );
         let x432 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x300,
-                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x296,
-                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
         let x433 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x303,
-                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
+                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x432,
         );
         let x434 = -x433;
-        let x435 = -Self::mul_add(-x7, x413, Self::mul_add(-x5, x412, s_q1 * x411));
+        let x435 = -Self::mul_add(-x12, x413, Self::mul_add(-x10, x412, s_q1 * x411));
         let x436 = Self::mul_add(
-            -x7,
-            x229 + Self::mul_add(-x88, x253, x339),
+            -x12,
+            x229 + Self::mul_add(-x91, x253, x339),
             Self::mul_add(
-                -x5,
-                x228 + Self::mul_add(-x88, x252, x338),
+                -x10,
+                x228 + Self::mul_add(-x91, x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x437 = Self::mul_add(
-            -x7,
-            x232 + Self::mul_add(-x89, x253, x342),
+            -x12,
+            x232 + Self::mul_add(-x92, x253, x342),
             Self::mul_add(
-                -x5,
+                -x10,
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
+                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
             ),
         );
         let x438 = Self::mul_add(
-            -x7,
+            -x12,
             x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -x5,
-                x234 + Self::mul_add(-x90, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
+                -x10,
+                x234 + Self::mul_add(-x93, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
             ),
         );
-        let x439 = Self::mul_add(-x7, x438, Self::mul_add(-x5, x437, s_q1 * x436));
+        let x439 = Self::mul_add(-x12, x438, Self::mul_add(-x10, x437, s_q1 * x436));
         let x440 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x342,
-                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
+                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x339,
-                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
+                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x441 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x345,
-                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
+                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x440,
         );
         let x442 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x312,
-                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x308,
-                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
         let x443 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x315,
-                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
+                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x442,
         );
         let x444 = -x443;
         let x445 = Self::mul_add(
-            x7,
-            x220 + Self::mul_add(-x32, x247, x320),
+            x12,
+            x220 + Self::mul_add(-x37, x247, x320),
             Self::mul_add(
-                x5,
-                x219 + Self::mul_add(-x32, x246, x319),
+                x10,
+                x219 + Self::mul_add(-x37, x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x446 = Self::mul_add(
-            x7,
-            x223 - Self::mul_add(x33, x247, x324),
+            x12,
+            x223 - Self::mul_add(x38, x247, x324),
             Self::mul_add(
-                x5,
+                x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
+                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
             ),
         );
         let x447 = Self::mul_add(
-            x7,
+            x12,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                x5,
-                x225 - Self::mul_add(x34, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
+                x10,
+                x225 - Self::mul_add(x39, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
             ),
         );
-        let x448 = Self::mul_add(x7, x447, Self::mul_add(x5, x446, s_q1 * x445));
+        let x448 = Self::mul_add(x12, x447, Self::mul_add(x10, x446, s_q1 * x445));
         let x449 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 - x324,
-                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 - x320,
-                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
         let x450 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
+                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x449,
         );
         let x451 = -x450;
         let x452 = Self::mul_add(
-            x97,
-            Self::mul_add(-x138, x194, x211),
+            x99,
+            Self::mul_add(-x139, x194, x211),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x138, x193, x210),
-                x93 * (x209 + (x328 + x329)),
+                x97,
+                Self::mul_add(-x139, x193, x210),
+                x95 * (x209 + (x328 + x329)),
             ),
         );
         let x453 = Self::mul_add(
-            x97,
-            Self::mul_add(-x139, x194, x214),
+            x99,
+            Self::mul_add(-x140, x194, x214),
             Self::mul_add(
-                x95,
+                x97,
                 x213 + (x328 + x330),
-                x93 * Self::mul_add(-x139, x192, x212),
+                x95 * Self::mul_add(-x140, x192, x212),
             ),
         );
         let x454 = Self::mul_add(
-            x97,
+            x99,
             x217 + (x329 + x330),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x140, x193, x216),
-                x93 * Self::mul_add(-x140, x192, x215),
+                x97,
+                Self::mul_add(-x141, x193, x216),
+                x95 * Self::mul_add(-x141, x192, x215),
             ),
         );
-        let x455 = Self::mul_add(x97, x454, Self::mul_add(x95, x453, x93 * x452));
-        let x456 = Self::mul_add(x97, x413, Self::mul_add(x95, x412, x93 * x411));
-        let x457 = Self::mul_add(x118, x413, Self::mul_add(x116, x412, x114 * x411));
+        let x455 = Self::mul_add(x99, x454, Self::mul_add(x97, x453, x95 * x452));
+        let x456 = Self::mul_add(x99, x413, Self::mul_add(x97, x412, x95 * x411));
+        let x457 = Self::mul_add(x119, x413, Self::mul_add(x117, x412, x115 * x411));
         let x458 = qd[1] * s_q0;
         let x459 = qd[1] * c_q0;
         let x460 = qd[0] * qd[0];
-        let x461 = x1 * x460;
-        let x462 = x2 * x460;
+        let x461 = x7 * x460;
+        let x462 = x8 * x460;
         let x463 = qd[0] * x459;
         let x464 = qd[0] * x458;
         let x465 = qd[2] * s_q1;
-        let x466 = qd[2] * x5;
-        let x467 = qd[2] * x7;
+        let x466 = qd[2] * x10;
+        let x467 = qd[2] * x12;
         let x468 = x459 * x459;
         let x469 = x458 * x458;
         let x470 = x458 * x459;
-        let x471 = x32 * (x468 + x469);
+        let x471 = x37 * (x468 + x469);
         let x472 = x461
             - Self::mul_add(
-                -x34,
+                -x39,
                 x470,
-                Self::mul_add(-x33, x460 + x468, x32 * (x464 + x464)),
+                Self::mul_add(-x38, x460 + x468, x37 * (x464 + x464)),
             );
         let x473 = x462
             - Self::mul_add(
-                x34,
+                x39,
                 x460 + x469,
-                Self::mul_add(x33, x470, x32 * (x463 + x463)),
+                Self::mul_add(x38, x470, x37 * (x463 + x463)),
             );
         let x474 = qd[0] - x465;
         let x475 = x458 - x466;
@@ -4590,8 +4606,8 @@ impl SsrmsRecurrent {
         let x478 = x463 + Self::mul_add(qd[0], x467, x459 * x465);
         let x479 = x464 + Self::mul_add(-qd[0], x466, x458 * x465);
         let x480 = qd[3] * s_q1;
-        let x481 = qd[3] * x5;
-        let x482 = qd[3] * x7;
+        let x481 = qd[3] * x10;
+        let x482 = qd[3] * x12;
         let x483 = x476 * x476;
         let x484 = x475 * x475;
         let x485 = x474 * x475;
@@ -4600,21 +4616,21 @@ impl SsrmsRecurrent {
         let x488 = x475 * x476;
         let x489 = x471
             + Self::mul_add(
-                x62,
+                x66,
                 x478 - x486,
-                Self::mul_add(-x61, x479 - x485, x60 * (x483 + x484)),
+                Self::mul_add(-x65, x479 - x485, x64 * (x483 + x484)),
             );
         let x490 = x472
             - Self::mul_add(
-                -x62,
+                -x66,
                 x477 - x488,
-                Self::mul_add(x61, x483 + x487, x60 * (x479 + x485)),
+                Self::mul_add(x65, x483 + x487, x64 * (x479 + x485)),
             );
         let x491 = x473
             - Self::mul_add(
-                -x62,
+                -x66,
                 x484 + x487,
-                Self::mul_add(-x61, x477 + x488, x60 * (x478 + x486)),
+                Self::mul_add(-x65, x477 + x488, x64 * (x478 + x486)),
             );
         let x492 = x474 - x480;
         let x493 = x475 - x481;
@@ -4623,8 +4639,8 @@ impl SsrmsRecurrent {
         let x496 = x478 + Self::mul_add(x474, x482, x476 * x480);
         let x497 = x479 + Self::mul_add(-x474, x481, x475 * x480);
         let x498 = qd[4] * s_q1;
-        let x499 = qd[4] * x5;
-        let x500 = qd[4] * x7;
+        let x499 = qd[4] * x10;
+        let x500 = qd[4] * x12;
         let x501 = x494 * x494;
         let x502 = x493 * x493;
         let x503 = x492 * x493;
@@ -4633,21 +4649,21 @@ impl SsrmsRecurrent {
         let x506 = x493 * x494;
         let x507 = x489
             + Self::mul_add(
-                x90,
+                x93,
                 x496 - x504,
-                Self::mul_add(-x89, x497 - x503, x88 * (x501 + x502)),
+                Self::mul_add(-x92, x497 - x503, x91 * (x501 + x502)),
             );
         let x508 = x490
             - Self::mul_add(
-                -x90,
+                -x93,
                 x495 - x506,
-                Self::mul_add(x89, x501 + x505, x88 * (x497 + x503)),
+                Self::mul_add(x92, x501 + x505, x91 * (x497 + x503)),
             );
         let x509 = x491
             - Self::mul_add(
-                -x90,
+                -x93,
                 x502 + x505,
-                Self::mul_add(-x89, x495 + x506, x88 * (x496 + x504)),
+                Self::mul_add(-x92, x495 + x506, x91 * (x496 + x504)),
             );
         let x510 = x492 - x498;
         let x511 = x493 - x499;
@@ -4655,9 +4671,9 @@ impl SsrmsRecurrent {
         let x513 = x495 + Self::mul_add(x493, x500, x494 * x499);
         let x514 = x496 + Self::mul_add(x492, x500, x494 * x498);
         let x515 = x497 + Self::mul_add(-x492, x499, x493 * x498);
-        let x516 = qd[5] * x93;
-        let x517 = qd[5] * x95;
-        let x518 = qd[5] * x97;
+        let x516 = qd[5] * x95;
+        let x517 = qd[5] * x97;
+        let x518 = qd[5] * x99;
         let x519 = x512 * x512;
         let x520 = x511 * x511;
         let x521 = x510 * x511;
@@ -4666,21 +4682,21 @@ impl SsrmsRecurrent {
         let x524 = x511 * x512;
         let x525 = x507
             + Self::mul_add(
-                -x34,
+                -x39,
                 x514 - x522,
-                Self::mul_add(x33, x515 - x521, x32 * (x519 + x520)),
+                Self::mul_add(x38, x515 - x521, x37 * (x519 + x520)),
             );
         let x526 = x508
             - Self::mul_add(
-                x34,
+                x39,
                 x513 - x524,
-                Self::mul_add(-x33, x519 + x523, x32 * (x515 + x521)),
+                Self::mul_add(-x38, x519 + x523, x37 * (x515 + x521)),
             );
         let x527 = x509
             - Self::mul_add(
-                x34,
+                x39,
                 x520 + x523,
-                Self::mul_add(x33, x513 + x524, x32 * (x514 + x522)),
+                Self::mul_add(x38, x513 + x524, x37 * (x514 + x522)),
             );
         let x528 = x510 + x516;
         let x529 = x511 - x517;
@@ -4688,9 +4704,9 @@ impl SsrmsRecurrent {
         let x531 = x513 + Self::mul_add(x511, x518, x512 * x517);
         let x532 = x514 - Self::mul_add(-x510, x518, x512 * x516);
         let x533 = x515 - Self::mul_add(x510, x517, x511 * x516);
-        let x534 = qd[6] * x114;
-        let x535 = qd[6] * x116;
-        let x536 = qd[6] * x118;
+        let x534 = qd[6] * x115;
+        let x535 = qd[6] * x117;
+        let x536 = qd[6] * x119;
         let x537 = x530 * x530;
         let x538 = x529 * x529;
         let x539 = x528 * x529;
@@ -4703,49 +4719,49 @@ impl SsrmsRecurrent {
         let x546 = x531 + Self::mul_add(x529, x536, x530 * x535);
         let x547 = x532 - Self::mul_add(-x528, x536, x530 * x534);
         let x548 = x533 - Self::mul_add(x528, x535, x529 * x534);
-        let x549 = Self::mul_add(x21, x459, Self::mul_add(-x19, x458, qd[0] * x17));
+        let x549 = Self::mul_add(x26, x459, Self::mul_add(-x24, x458, qd[0] * x22));
         let x550 = Self::mul_add(
-            x26,
-            x459,
-            Self::mul_add(-x24, x458, qd[0] * Self::mul_add(c_q1, x10, -x22)),
-        );
-        let x551 = Self::mul_add(
             x31,
             x459,
-            Self::mul_add(-x29, x458, qd[0] * Self::mul_add(c_q1, x13, -x27)),
+            Self::mul_add(-x29, x458, qd[0] * Self::mul_add(c_q1, x15, -x27)),
         );
-        let x552 = Self::mul_add(x53, x476, Self::mul_add(-x52, x475, x51 * x474));
-        let x553 = Self::mul_add(x56, x476, Self::mul_add(-x55, x475, x54 * x474));
-        let x554 = Self::mul_add(x59, x476, Self::mul_add(-x58, x475, x57 * x474));
-        let x555 = Self::mul_add(x81, x494, Self::mul_add(-x80, x493, x79 * x492));
-        let x556 = Self::mul_add(x84, x494, Self::mul_add(-x83, x493, x82 * x492));
-        let x557 = Self::mul_add(x87, x494, Self::mul_add(-x86, x493, x85 * x492));
-        let x558 = Self::mul_add(-x106, x512, Self::mul_add(x105, x511, x104 * x510));
-        let x559 = Self::mul_add(-x109, x512, Self::mul_add(x108, x511, x107 * x510));
-        let x560 = Self::mul_add(-x112, x512, Self::mul_add(x111, x511, x110 * x510));
-        let x561 = Self::mul_add(x131, x530, Self::mul_add(-x130, x529, x129 * x528));
-        let x562 = Self::mul_add(x134, x530, Self::mul_add(-x133, x529, x132 * x528));
-        let x563 = Self::mul_add(x137, x530, Self::mul_add(-x136, x529, x135 * x528));
+        let x551 = Self::mul_add(
+            x36,
+            x459,
+            Self::mul_add(-x34, x458, qd[0] * Self::mul_add(c_q1, x18, -x32)),
+        );
+        let x552 = Self::mul_add(x57, x476, Self::mul_add(-x56, x475, x55 * x474));
+        let x553 = Self::mul_add(x60, x476, Self::mul_add(-x59, x475, x58 * x474));
+        let x554 = Self::mul_add(x63, x476, Self::mul_add(-x62, x475, x61 * x474));
+        let x555 = Self::mul_add(x84, x494, Self::mul_add(-x83, x493, x82 * x492));
+        let x556 = Self::mul_add(x87, x494, Self::mul_add(-x86, x493, x85 * x492));
+        let x557 = Self::mul_add(x90, x494, Self::mul_add(-x89, x493, x88 * x492));
+        let x558 = Self::mul_add(-x108, x512, Self::mul_add(x107, x511, x106 * x510));
+        let x559 = Self::mul_add(-x111, x512, Self::mul_add(x110, x511, x109 * x510));
+        let x560 = Self::mul_add(-x114, x512, Self::mul_add(x113, x511, x112 * x510));
+        let x561 = Self::mul_add(x132, x530, Self::mul_add(-x131, x529, x130 * x528));
+        let x562 = Self::mul_add(x135, x530, Self::mul_add(-x134, x529, x133 * x528));
+        let x563 = Self::mul_add(x138, x530, Self::mul_add(-x137, x529, x136 * x528));
         let x564 = 243.66
             * (x525
                 - Self::mul_add(
-                    x140,
+                    x141,
                     x532 - x540,
-                    Self::mul_add(-x139, x533 - x539, x138 * (x537 + x538)),
+                    Self::mul_add(-x140, x533 - x539, x139 * (x537 + x538)),
                 ));
         let x565 = 243.66
             * (x526
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x531 - x542,
-                    Self::mul_add(x139, x537 + x541, x138 * (x533 + x539)),
+                    Self::mul_add(x140, x537 + x541, x139 * (x533 + x539)),
                 ));
         let x566 = 243.66
             * (x527
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x538 + x541,
-                    Self::mul_add(-x139, x531 + x542, x138 * (x532 + x540)),
+                    Self::mul_add(-x140, x531 + x542, x139 * (x532 + x540)),
                 ));
         let x567 = Self::mul_add(x159, x545, Self::mul_add(-x158, x544, x157 * x543));
         let x568 = Self::mul_add(x162, x545, Self::mul_add(-x161, x544, x160 * x543));
@@ -4768,65 +4784,65 @@ impl SsrmsRecurrent {
         let x582 = Self::mul_add(314.88, x471, x579);
         let x583 = Self::mul_add(314.88, x472, x580);
         let x584 = Self::mul_add(314.88, x473, x581);
-        let x585 = Self::mul_add(x131, x533, Self::mul_add(x130, x532, x129 * x531))
+        let x585 = Self::mul_add(x132, x533, Self::mul_add(x131, x532, x130 * x531))
             + Self::mul_add(x529, x563, x530 * x562) + x570
-            - Self::mul_add(x139, x566, x140 * x565);
-        let x586 = Self::mul_add(x134, x533, Self::mul_add(x133, x532, x132 * x531))
+            - Self::mul_add(x140, x566, x141 * x565);
+        let x586 = Self::mul_add(x135, x533, Self::mul_add(x134, x532, x133 * x531))
             - Self::mul_add(-x528, x563, x530 * x561) + x571
-            - Self::mul_add(-x138, x566, x140 * x564);
-        let x587 = Self::mul_add(x137, x533, Self::mul_add(x136, x532, x135 * x531))
+            - Self::mul_add(-x139, x566, x141 * x564);
+        let x587 = Self::mul_add(x138, x533, Self::mul_add(x137, x532, x136 * x531))
             - Self::mul_add(x528, x562, x529 * x561) + x572
-            + Self::mul_add(x138, x565, x139 * x564);
-        let x588 = Self::mul_add(-x106, x515, Self::mul_add(-x105, x514, x104 * x513))
+            + Self::mul_add(x139, x565, x140 * x564);
+        let x588 = Self::mul_add(-x108, x515, Self::mul_add(-x107, x514, x106 * x513))
             - Self::mul_add(x511, x560, x512 * x559) + x585
-            - Self::mul_add(x33, x575, x34 * x574);
-        let x589 = Self::mul_add(-x109, x515, Self::mul_add(-x108, x514, x107 * x513))
+            - Self::mul_add(x38, x575, x39 * x574);
+        let x589 = Self::mul_add(-x111, x515, Self::mul_add(-x110, x514, x109 * x513))
             + Self::mul_add(x510, x560, x512 * x558) - x586
-            + Self::mul_add(x32, x575, x34 * x573);
-        let x590 = Self::mul_add(-x112, x515, Self::mul_add(-x111, x514, x110 * x513))
+            + Self::mul_add(x37, x575, x39 * x573);
+        let x590 = Self::mul_add(-x114, x515, Self::mul_add(-x113, x514, x112 * x513))
             + Self::mul_add(-x510, x559, x511 * x558) - x587
-            - Self::mul_add(-x32, x574, x33 * x573);
-        let x591 = Self::mul_add(x81, x497, Self::mul_add(x80, x496, x79 * x495))
+            - Self::mul_add(-x37, x574, x38 * x573);
+        let x591 = Self::mul_add(x84, x497, Self::mul_add(x83, x496, x82 * x495))
             + Self::mul_add(x493, x557, x494 * x556) + x588
-            + Self::mul_add(x89, x578, x90 * x577);
-        let x592 = Self::mul_add(x84, x497, Self::mul_add(x83, x496, x82 * x495))
+            + Self::mul_add(x92, x578, x93 * x577);
+        let x592 = Self::mul_add(x87, x497, Self::mul_add(x86, x496, x85 * x495))
             - Self::mul_add(-x492, x557, x494 * x555) - x589
-            + Self::mul_add(-x88, x578, x90 * x576);
-        let x593 = Self::mul_add(x87, x497, Self::mul_add(x86, x496, x85 * x495))
+            + Self::mul_add(-x91, x578, x93 * x576);
+        let x593 = Self::mul_add(x90, x497, Self::mul_add(x89, x496, x88 * x495))
             - Self::mul_add(x492, x556, x493 * x555) - x590
-            - Self::mul_add(x88, x577, x89 * x576);
-        let x594 = Self::mul_add(x53, x479, Self::mul_add(x52, x478, x51 * x477))
+            - Self::mul_add(x91, x577, x92 * x576);
+        let x594 = Self::mul_add(x57, x479, Self::mul_add(x56, x478, x55 * x477))
             + Self::mul_add(x475, x554, x476 * x553) + x591
-            + Self::mul_add(x61, x581, x62 * x580);
-        let x595 = Self::mul_add(x56, x479, Self::mul_add(x55, x478, x54 * x477))
+            + Self::mul_add(x65, x581, x66 * x580);
+        let x595 = Self::mul_add(x60, x479, Self::mul_add(x59, x478, x58 * x477))
             - Self::mul_add(-x474, x554, x476 * x552) + x592
-            + Self::mul_add(-x60, x581, x62 * x579);
-        let x596 = Self::mul_add(x59, x479, Self::mul_add(x58, x478, x57 * x477))
+            + Self::mul_add(-x64, x581, x66 * x579);
+        let x596 = Self::mul_add(x63, x479, Self::mul_add(x62, x478, x61 * x477))
             - Self::mul_add(x474, x553, x475 * x552) + x593
-            - Self::mul_add(x60, x580, x61 * x579);
+            - Self::mul_add(x64, x580, x65 * x579);
         let x597 = Self::mul_add(
             -c_q0,
-            Self::mul_add(x31, x464, x29 * x463)
+            Self::mul_add(x36, x464, x34 * x463)
                 - Self::mul_add(qd[0], x550, x458 * x549) + x596
-                + Self::mul_add(-x32, x583, x33 * x582),
+                + Self::mul_add(-x37, x583, x38 * x582),
             s_q0
-                * (Self::mul_add(x26, x464, x24 * x463)
+                * (Self::mul_add(x31, x464, x29 * x463)
                     - Self::mul_add(-qd[0], x551, x459 * x549) + x595
-                    - Self::mul_add(x32, x584, x34 * x582)),
+                    - Self::mul_add(x37, x584, x39 * x582)),
         );
-        let x598 = Self::mul_add(-x7, x596, Self::mul_add(-x5, x595, s_q1 * x594));
-        let x599 = Self::mul_add(-x7, x593, Self::mul_add(-x5, x592, s_q1 * x591));
-        let x600 = Self::mul_add(x7, x590, Self::mul_add(x5, x589, s_q1 * x588));
-        let x601 = -(Self::mul_add(x21, x464, x19 * x463)
+        let x598 = Self::mul_add(-x12, x596, Self::mul_add(-x10, x595, s_q1 * x594));
+        let x599 = Self::mul_add(-x12, x593, Self::mul_add(-x10, x592, s_q1 * x591));
+        let x600 = Self::mul_add(x12, x590, Self::mul_add(x10, x589, s_q1 * x588));
+        let x601 = -(Self::mul_add(x26, x464, x24 * x463)
             + Self::mul_add(x458, x551, x459 * x550) + x594
-            - Self::mul_add(x33, x584, x34 * x583)
+            - Self::mul_add(x38, x584, x39 * x583)
             + Self::mul_add(
-                -x1,
+                -x7,
                 Self::mul_add(105.98, x462, x584),
-                x2 * Self::mul_add(105.98, x461, x583),
+                x8 * Self::mul_add(105.98, x461, x583),
             ));
-        let x602 = -Self::mul_add(x97, x587, Self::mul_add(x95, x586, x93 * x585));
-        let x603 = -Self::mul_add(x118, x572, Self::mul_add(x116, x571, x114 * x570));
+        let x602 = -Self::mul_add(x99, x587, Self::mul_add(x97, x586, x95 * x585));
+        let x603 = -Self::mul_add(x119, x572, Self::mul_add(x117, x571, x115 * x570));
         (
             [
                 [x405, x406, x407, x408, x409, x410, x411],
@@ -4850,201 +4866,204 @@ impl SsrmsRecurrent {
         tau: &[f64; 7],
         f_ext: &[[f64; 6]; 7],
     ) -> [f64; 7] {
-        let (s_q0, c_q0) = Self::sincos(q[0]);
-        let x1 = 0.7026 * s_q0;
-        let x2 = 0.7026 * c_q0;
-        let (s_q1, c_q1) = Self::sincos(q[1]);
-        let x4 = c_q0 * s_q1;
-        let x5 = c_q0 * c_q1;
-        let x6 = s_q0 * s_q1;
-        let x7 = s_q0 * c_q1;
-        let x8 = 8.088 * c_q1;
-        let x9 = 3.061 * s_q1;
-        let x10 = 8.088 * x4;
-        let x11 = 3.061 * x5;
-        let x12 = 8.446 * s_q0;
-        let x13 = 8.088 * x6;
-        let x14 = 3.061 * x7;
-        let x15 = 8.446 * c_q0;
-        let x16 = s_q1 * x9;
-        let x17 = Self::mul_add(c_q1, x8, x16);
-        let x18 = x5 * x9;
-        let x19 = Self::mul_add(x4, x8, -x18);
-        let x20 = x7 * x9;
-        let x21 = Self::mul_add(x6, x8, -x20);
-        let x22 = s_q1 * x11;
-        let x23 = x5 * x11;
-        let x24 = Self::mul_add(s_q0, x12, Self::mul_add(x4, x10, x23));
-        let x25 = x7 * x11;
-        let x26 = Self::mul_add(-c_q0, x12, Self::mul_add(x6, x10, x25));
-        let x27 = s_q1 * x14;
-        let x28 = x5 * x14;
-        let x29 = Self::mul_add(-s_q0, x15, Self::mul_add(x4, x13, x28));
-        let x30 = x7 * x14;
-        let x31 = Self::mul_add(c_q0, x15, Self::mul_add(x6, x13, x30));
-        let x32 = s_q1 * 0.5692;
-        let x33 = x5 * 0.5692;
-        let x34 = x7 * 0.5692;
-        let (s_q2, c_q2) = Self::sincos(q[2]);
-        let x36 = c_q1 * c_q2;
-        let x37 = c_q1 * s_q2;
-        let x38 = Self::mul_add(s_q0, s_q2, x4 * c_q2);
-        let x39 = Self::mul_add(-s_q0, c_q2, x4 * s_q2);
-        let x40 = Self::mul_add(-c_q0, s_q2, x6 * c_q2);
-        let x41 = Self::mul_add(c_q0, c_q2, x6 * s_q2);
-        let x42 = Self::mul_add(-49.52, s_q1, 15.41 * x36);
-        let x43 = Self::mul_add(-2094.71, s_q1, 49.52 * x36);
-        let x44 = 2103.19 * x37;
-        let x45 = Self::mul_add(49.52, x5, 15.41 * x38);
-        let x46 = Self::mul_add(2094.71, x5, 49.52 * x38);
-        let x47 = 2103.19 * x39;
-        let x48 = Self::mul_add(49.52, x7, 15.41 * x40);
-        let x49 = Self::mul_add(2094.71, x7, 49.52 * x40);
-        let x50 = 2103.19 * x41;
-        let x51 = Self::mul_add(x37, x44, Self::mul_add(-s_q1, x43, x36 * x42));
-        let x52 = Self::mul_add(x39, x44, Self::mul_add(x5, x43, x38 * x42));
-        let x53 = Self::mul_add(x41, x44, Self::mul_add(x7, x43, x40 * x42));
-        let x54 = Self::mul_add(x37, x47, Self::mul_add(-s_q1, x46, x36 * x45));
-        let x55 = Self::mul_add(x39, x47, Self::mul_add(x5, x46, x38 * x45));
-        let x56 = Self::mul_add(x41, x47, Self::mul_add(x7, x46, x40 * x45));
-        let x57 = Self::mul_add(x37, x50, Self::mul_add(-s_q1, x49, x36 * x48));
-        let x58 = Self::mul_add(x39, x50, Self::mul_add(x5, x49, x38 * x48));
-        let x59 = Self::mul_add(x41, x50, Self::mul_add(x7, x49, x40 * x48));
-        let x60 = Self::mul_add(s_q1, 0.475, 7.11 * x36);
-        let x61 = Self::mul_add(x5, -0.475, 7.11 * x38);
-        let x62 = Self::mul_add(x7, -0.475, 7.11 * x40);
-        let (s_q3, c_q3) = Self::sincos(q[3]);
-        let x64 = Self::mul_add(-x37, s_q3, x36 * c_q3);
-        let x65 = Self::mul_add(x37, c_q3, x36 * s_q3);
-        let x66 = Self::mul_add(-x39, s_q3, x38 * c_q3);
-        let x67 = Self::mul_add(x39, c_q3, x38 * s_q3);
-        let x68 = Self::mul_add(-x41, s_q3, x40 * c_q3);
-        let x69 = Self::mul_add(x41, c_q3, x40 * s_q3);
-        let x70 = Self::mul_add(s_q1, 39.95, 9.522 * x64);
-        let x71 = Self::mul_add(1966.28, s_q1, x64 * 39.95);
-        let x72 = 1966.28 * x65;
-        let x73 = Self::mul_add(x5, -39.95, 9.522 * x66);
-        let x74 = Self::mul_add(-1966.28, x5, x66 * 39.95);
-        let x75 = 1966.28 * x67;
-        let x76 = Self::mul_add(x7, -39.95, 9.522 * x68);
-        let x77 = Self::mul_add(-1966.28, x7, x68 * 39.95);
-        let x78 = 1966.28 * x69;
-        let x79 = Self::mul_add(x65, x72, Self::mul_add(s_q1, x71, x64 * x70));
-        let x80 = Self::mul_add(x67, x72, Self::mul_add(-x5, x71, x66 * x70));
-        let x81 = Self::mul_add(x69, x72, Self::mul_add(-x7, x71, x68 * x70));
-        let x82 = Self::mul_add(x65, x75, Self::mul_add(s_q1, x74, x64 * x73));
-        let x83 = Self::mul_add(x67, x75, Self::mul_add(-x5, x74, x66 * x73));
-        let x84 = Self::mul_add(x69, x75, Self::mul_add(-x7, x74, x68 * x73));
-        let x85 = Self::mul_add(x65, x78, Self::mul_add(s_q1, x77, x64 * x76));
-        let x86 = Self::mul_add(x67, x78, Self::mul_add(-x5, x77, x66 * x76));
-        let x87 = Self::mul_add(x69, x78, Self::mul_add(-x7, x77, x68 * x76));
-        let x88 = 7.11 * x64;
-        let x89 = 7.11 * x66;
-        let x90 = 7.11 * x68;
-        let (s_q4, c_q4) = Self::sincos(q[4]);
-        let x92 = Self::mul_add(-x65, s_q4, x64 * c_q4);
-        let x93 = Self::mul_add(x65, c_q4, x64 * s_q4);
-        let x94 = Self::mul_add(-x67, s_q4, x66 * c_q4);
-        let x95 = Self::mul_add(x67, c_q4, x66 * s_q4);
-        let x96 = Self::mul_add(-x69, s_q4, x68 * c_q4);
-        let x97 = Self::mul_add(x69, c_q4, x68 * s_q4);
-        let x98 = 8.305 * x92;
-        let x99 = 8.0386 * x93;
+        let [(s_q0, c_q0), (s_q1, c_q1), (s_q2, c_q2), (s_q3, c_q3), (s_q4, c_q4),
+        (s_q5, c_q5), (s_q6, c_q6)] = Self::sincos_n([
+            q[0],
+            q[1],
+            q[2],
+            q[3],
+            q[4],
+            q[5],
+            q[6],
+        ]);
+        let x7 = 0.7026 * s_q0;
+        let x8 = 0.7026 * c_q0;
+        let x9 = c_q0 * s_q1;
+        let x10 = c_q0 * c_q1;
+        let x11 = s_q0 * s_q1;
+        let x12 = s_q0 * c_q1;
+        let x13 = 8.088 * c_q1;
+        let x14 = 3.061 * s_q1;
+        let x15 = 8.088 * x9;
+        let x16 = 3.061 * x10;
+        let x17 = 8.446 * s_q0;
+        let x18 = 8.088 * x11;
+        let x19 = 3.061 * x12;
+        let x20 = 8.446 * c_q0;
+        let x21 = s_q1 * x14;
+        let x22 = Self::mul_add(c_q1, x13, x21);
+        let x23 = x10 * x14;
+        let x24 = Self::mul_add(x9, x13, -x23);
+        let x25 = x12 * x14;
+        let x26 = Self::mul_add(x11, x13, -x25);
+        let x27 = s_q1 * x16;
+        let x28 = x10 * x16;
+        let x29 = Self::mul_add(s_q0, x17, Self::mul_add(x9, x15, x28));
+        let x30 = x12 * x16;
+        let x31 = Self::mul_add(-c_q0, x17, Self::mul_add(x11, x15, x30));
+        let x32 = s_q1 * x19;
+        let x33 = x10 * x19;
+        let x34 = Self::mul_add(-s_q0, x20, Self::mul_add(x9, x18, x33));
+        let x35 = x12 * x19;
+        let x36 = Self::mul_add(c_q0, x20, Self::mul_add(x11, x18, x35));
+        let x37 = s_q1 * 0.5692;
+        let x38 = x10 * 0.5692;
+        let x39 = x12 * 0.5692;
+        let x40 = c_q1 * c_q2;
+        let x41 = c_q1 * s_q2;
+        let x42 = Self::mul_add(s_q0, s_q2, x9 * c_q2);
+        let x43 = Self::mul_add(-s_q0, c_q2, x9 * s_q2);
+        let x44 = Self::mul_add(-c_q0, s_q2, x11 * c_q2);
+        let x45 = Self::mul_add(c_q0, c_q2, x11 * s_q2);
+        let x46 = Self::mul_add(-49.52, s_q1, 15.41 * x40);
+        let x47 = Self::mul_add(-2094.71, s_q1, 49.52 * x40);
+        let x48 = 2103.19 * x41;
+        let x49 = Self::mul_add(49.52, x10, 15.41 * x42);
+        let x50 = Self::mul_add(2094.71, x10, 49.52 * x42);
+        let x51 = 2103.19 * x43;
+        let x52 = Self::mul_add(49.52, x12, 15.41 * x44);
+        let x53 = Self::mul_add(2094.71, x12, 49.52 * x44);
+        let x54 = 2103.19 * x45;
+        let x55 = Self::mul_add(x41, x48, Self::mul_add(-s_q1, x47, x40 * x46));
+        let x56 = Self::mul_add(x43, x48, Self::mul_add(x10, x47, x42 * x46));
+        let x57 = Self::mul_add(x45, x48, Self::mul_add(x12, x47, x44 * x46));
+        let x58 = Self::mul_add(x41, x51, Self::mul_add(-s_q1, x50, x40 * x49));
+        let x59 = Self::mul_add(x43, x51, Self::mul_add(x10, x50, x42 * x49));
+        let x60 = Self::mul_add(x45, x51, Self::mul_add(x12, x50, x44 * x49));
+        let x61 = Self::mul_add(x41, x54, Self::mul_add(-s_q1, x53, x40 * x52));
+        let x62 = Self::mul_add(x43, x54, Self::mul_add(x10, x53, x42 * x52));
+        let x63 = Self::mul_add(x45, x54, Self::mul_add(x12, x53, x44 * x52));
+        let x64 = Self::mul_add(s_q1, 0.475, 7.11 * x40);
+        let x65 = Self::mul_add(x10, -0.475, 7.11 * x42);
+        let x66 = Self::mul_add(x12, -0.475, 7.11 * x44);
+        let x67 = Self::mul_add(-x41, s_q3, x40 * c_q3);
+        let x68 = Self::mul_add(x41, c_q3, x40 * s_q3);
+        let x69 = Self::mul_add(-x43, s_q3, x42 * c_q3);
+        let x70 = Self::mul_add(x43, c_q3, x42 * s_q3);
+        let x71 = Self::mul_add(-x45, s_q3, x44 * c_q3);
+        let x72 = Self::mul_add(x45, c_q3, x44 * s_q3);
+        let x73 = Self::mul_add(s_q1, 39.95, 9.522 * x67);
+        let x74 = Self::mul_add(1966.28, s_q1, x67 * 39.95);
+        let x75 = 1966.28 * x68;
+        let x76 = Self::mul_add(x10, -39.95, 9.522 * x69);
+        let x77 = Self::mul_add(-1966.28, x10, x69 * 39.95);
+        let x78 = 1966.28 * x70;
+        let x79 = Self::mul_add(x12, -39.95, 9.522 * x71);
+        let x80 = Self::mul_add(-1966.28, x12, x71 * 39.95);
+        let x81 = 1966.28 * x72;
+        let x82 = Self::mul_add(x68, x75, Self::mul_add(s_q1, x74, x67 * x73));
+        let x83 = Self::mul_add(x70, x75, Self::mul_add(-x10, x74, x69 * x73));
+        let x84 = Self::mul_add(x72, x75, Self::mul_add(-x12, x74, x71 * x73));
+        let x85 = Self::mul_add(x68, x78, Self::mul_add(s_q1, x77, x67 * x76));
+        let x86 = Self::mul_add(x70, x78, Self::mul_add(-x10, x77, x69 * x76));
+        let x87 = Self::mul_add(x72, x78, Self::mul_add(-x12, x77, x71 * x76));
+        let x88 = Self::mul_add(x68, x81, Self::mul_add(s_q1, x80, x67 * x79));
+        let x89 = Self::mul_add(x70, x81, Self::mul_add(-x10, x80, x69 * x79));
+        let x90 = Self::mul_add(x72, x81, Self::mul_add(-x12, x80, x71 * x79));
+        let x91 = 7.11 * x67;
+        let x92 = 7.11 * x69;
+        let x93 = 7.11 * x71;
+        let x94 = Self::mul_add(-x68, s_q4, x67 * c_q4);
+        let x95 = Self::mul_add(x68, c_q4, x67 * s_q4);
+        let x96 = Self::mul_add(-x70, s_q4, x69 * c_q4);
+        let x97 = Self::mul_add(x70, c_q4, x69 * s_q4);
+        let x98 = Self::mul_add(-x72, s_q4, x71 * c_q4);
+        let x99 = Self::mul_add(x72, c_q4, x71 * s_q4);
         let x100 = 8.305 * x94;
         let x101 = 8.0386 * x95;
         let x102 = 8.305 * x96;
         let x103 = 8.0386 * x97;
-        let x104 = Self::mul_add(x93, x99, Self::mul_add(x92, x98, x16));
-        let x105 = Self::mul_add(-x95, x99, Self::mul_add(-x94, x98, x18));
-        let x106 = Self::mul_add(-x97, x99, Self::mul_add(-x96, x98, x20));
-        let x107 = Self::mul_add(-x93, x101, Self::mul_add(-x92, x100, x22));
-        let x108 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x23));
-        let x109 = Self::mul_add(x97, x101, Self::mul_add(x96, x100, x25));
-        let x110 = Self::mul_add(-x93, x103, Self::mul_add(-x92, x102, x27));
-        let x111 = Self::mul_add(x95, x103, Self::mul_add(x94, x102, x28));
-        let x112 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x30));
-        let (s_q5, c_q5) = Self::sincos(q[5]);
-        let x114 = Self::mul_add(-s_q1, s_q5, x92 * c_q5);
-        let x115 = Self::mul_add(s_q1, c_q5, x92 * s_q5);
-        let x116 = Self::mul_add(x5, s_q5, x94 * c_q5);
-        let x117 = Self::mul_add(-x5, c_q5, x94 * s_q5);
-        let x118 = Self::mul_add(x7, s_q5, x96 * c_q5);
-        let x119 = Self::mul_add(-x7, c_q5, x96 * s_q5);
-        let x120 = 12.13 * x114;
+        let x104 = 8.305 * x98;
+        let x105 = 8.0386 * x99;
+        let x106 = Self::mul_add(x95, x101, Self::mul_add(x94, x100, x21));
+        let x107 = Self::mul_add(-x97, x101, Self::mul_add(-x96, x100, x23));
+        let x108 = Self::mul_add(-x99, x101, Self::mul_add(-x98, x100, x25));
+        let x109 = Self::mul_add(-x95, x103, Self::mul_add(-x94, x102, x27));
+        let x110 = Self::mul_add(x97, x103, Self::mul_add(x96, x102, x28));
+        let x111 = Self::mul_add(x99, x103, Self::mul_add(x98, x102, x30));
+        let x112 = Self::mul_add(-x95, x105, Self::mul_add(-x94, x104, x32));
+        let x113 = Self::mul_add(x97, x105, Self::mul_add(x96, x104, x33));
+        let x114 = Self::mul_add(x99, x105, Self::mul_add(x98, x104, x35));
+        let x115 = Self::mul_add(-s_q1, s_q5, x94 * c_q5);
+        let x116 = Self::mul_add(s_q1, c_q5, x94 * s_q5);
+        let x117 = Self::mul_add(x10, s_q5, x96 * c_q5);
+        let x118 = Self::mul_add(-x10, c_q5, x96 * s_q5);
+        let x119 = Self::mul_add(x12, s_q5, x98 * c_q5);
+        let x120 = Self::mul_add(-x12, c_q5, x98 * s_q5);
         let x121 = 12.13 * x115;
-        let x122 = 3.061 * x93;
-        let x123 = 12.13 * x116;
+        let x122 = 12.13 * x116;
+        let x123 = 3.061 * x95;
         let x124 = 12.13 * x117;
-        let x125 = 3.061 * x95;
-        let x126 = 12.13 * x118;
+        let x125 = 12.13 * x118;
+        let x126 = 3.061 * x97;
         let x127 = 12.13 * x119;
-        let x128 = 3.061 * x97;
-        let x129 = Self::mul_add(x93, x122, Self::mul_add(x115, x121, x114 * x120));
-        let x130 = Self::mul_add(x95, x122, Self::mul_add(x117, x121, x116 * x120));
-        let x131 = Self::mul_add(x97, x122, Self::mul_add(x119, x121, x118 * x120));
-        let x132 = Self::mul_add(x93, x125, Self::mul_add(x115, x124, x114 * x123));
-        let x133 = Self::mul_add(x95, x125, Self::mul_add(x117, x124, x116 * x123));
-        let x134 = Self::mul_add(x97, x125, Self::mul_add(x119, x124, x118 * x123));
-        let x135 = Self::mul_add(x93, x128, Self::mul_add(x115, x127, x114 * x126));
-        let x136 = Self::mul_add(x95, x128, Self::mul_add(x117, x127, x116 * x126));
-        let x137 = Self::mul_add(x97, x128, Self::mul_add(x119, x127, x118 * x126));
-        let x138 = 0.7026 * x93;
+        let x128 = 12.13 * x120;
+        let x129 = 3.061 * x99;
+        let x130 = Self::mul_add(x95, x123, Self::mul_add(x116, x122, x115 * x121));
+        let x131 = Self::mul_add(x97, x123, Self::mul_add(x118, x122, x117 * x121));
+        let x132 = Self::mul_add(x99, x123, Self::mul_add(x120, x122, x119 * x121));
+        let x133 = Self::mul_add(x95, x126, Self::mul_add(x116, x125, x115 * x124));
+        let x134 = Self::mul_add(x97, x126, Self::mul_add(x118, x125, x117 * x124));
+        let x135 = Self::mul_add(x99, x126, Self::mul_add(x120, x125, x119 * x124));
+        let x136 = Self::mul_add(x95, x129, Self::mul_add(x116, x128, x115 * x127));
+        let x137 = Self::mul_add(x97, x129, Self::mul_add(x118, x128, x117 * x127));
+        let x138 = Self::mul_add(x99, x129, Self::mul_add(x120, x128, x119 * x127));
         let x139 = 0.7026 * x95;
         let x140 = 0.7026 * x97;
-        let (s_q6, c_q6) = Self::sincos(q[6]);
-        let x142 = Self::mul_add(-x93, s_q6, x115 * c_q6);
-        let x143 = Self::mul_add(x93, c_q6, x115 * s_q6);
-        let x144 = Self::mul_add(-x95, s_q6, x117 * c_q6);
-        let x145 = Self::mul_add(x95, c_q6, x117 * s_q6);
-        let x146 = Self::mul_add(-x97, s_q6, x119 * c_q6);
-        let x147 = Self::mul_add(x97, c_q6, x119 * s_q6);
-        let x148 = 9.336 * x114;
+        let x141 = 0.7026 * x99;
+        let x142 = Self::mul_add(-x95, s_q6, x116 * c_q6);
+        let x143 = Self::mul_add(x95, c_q6, x116 * s_q6);
+        let x144 = Self::mul_add(-x97, s_q6, x118 * c_q6);
+        let x145 = Self::mul_add(x97, c_q6, x118 * s_q6);
+        let x146 = Self::mul_add(-x99, s_q6, x120 * c_q6);
+        let x147 = Self::mul_add(x99, c_q6, x120 * s_q6);
+        let x148 = 9.336 * x115;
         let x149 = 44.41 * x142;
         let x150 = 44.41 * x143;
-        let x151 = 9.336 * x116;
+        let x151 = 9.336 * x117;
         let x152 = 44.41 * x144;
         let x153 = 44.41 * x145;
-        let x154 = 9.336 * x118;
+        let x154 = 9.336 * x119;
         let x155 = 44.41 * x146;
         let x156 = 44.41 * x147;
-        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x114 * x148));
-        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x116 * x148));
-        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x118 * x148));
-        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x114 * x151));
-        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x116 * x151));
-        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x118 * x151));
-        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x114 * x154));
-        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x116 * x154));
-        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x118 * x154));
-        let x166 = x32 - x138;
-        let x167 = x33 + x139;
-        let x168 = x34 + x140;
-        let x169 = x88 + x166;
-        let x170 = x89 - x167;
-        let x171 = x90 - x168;
-        let x172 = x60 + x169;
-        let x173 = x61 + x170;
-        let x174 = x62 + x171;
-        let x175 = x33 - x173;
-        let x176 = x34 - x174;
-        let x177 = x32 + x88;
-        let x178 = x33 - x89;
-        let x179 = x34 - x90;
-        let x180 = x60 + x177;
-        let x181 = x61 - x178;
-        let x182 = x62 - x179;
-        let x183 = x33 - x181;
-        let x184 = x34 - x182;
-        let x185 = x60 + x88;
-        let x186 = x61 + x89;
-        let x187 = x62 + x90;
-        let x188 = x33 - x186;
-        let x189 = x34 - x187;
-        let x190 = x33 - x61;
-        let x191 = x34 - x62;
-        let x192 = 243.66 * x138;
-        let x193 = 243.66 * x139;
-        let x194 = 243.66 * x140;
+        let x157 = Self::mul_add(x143, x150, Self::mul_add(x142, x149, x115 * x148));
+        let x158 = Self::mul_add(x145, x150, Self::mul_add(x144, x149, x117 * x148));
+        let x159 = Self::mul_add(x147, x150, Self::mul_add(x146, x149, x119 * x148));
+        let x160 = Self::mul_add(x143, x153, Self::mul_add(x142, x152, x115 * x151));
+        let x161 = Self::mul_add(x145, x153, Self::mul_add(x144, x152, x117 * x151));
+        let x162 = Self::mul_add(x147, x153, Self::mul_add(x146, x152, x119 * x151));
+        let x163 = Self::mul_add(x143, x156, Self::mul_add(x142, x155, x115 * x154));
+        let x164 = Self::mul_add(x145, x156, Self::mul_add(x144, x155, x117 * x154));
+        let x165 = Self::mul_add(x147, x156, Self::mul_add(x146, x155, x119 * x154));
+        let x166 = x37 - x139;
+        let x167 = x38 + x140;
+        let x168 = x39 + x141;
+        let x169 = x91 + x166;
+        let x170 = x92 - x167;
+        let x171 = x93 - x168;
+        let x172 = x64 + x169;
+        let x173 = x65 + x170;
+        let x174 = x66 + x171;
+        let x175 = x38 - x173;
+        let x176 = x39 - x174;
+        let x177 = x37 + x91;
+        let x178 = x38 - x92;
+        let x179 = x39 - x93;
+        let x180 = x64 + x177;
+        let x181 = x65 - x178;
+        let x182 = x66 - x179;
+        let x183 = x38 - x181;
+        let x184 = x39 - x182;
+        let x185 = x64 + x91;
+        let x186 = x65 + x92;
+        let x187 = x66 + x93;
+        let x188 = x38 - x186;
+        let x189 = x39 - x187;
+        let x190 = x38 - x65;
+        let x191 = x39 - x66;
+        let x192 = 243.66 * x139;
+        let x193 = 243.66 * x140;
+        let x194 = 243.66 * x141;
         let x195 = 243.66 * x166;
         let x196 = 243.66 * x167;
         let x197 = 243.66 * x168;
@@ -5054,581 +5073,581 @@ impl SsrmsRecurrent {
         let x201 = 243.66 * x172;
         let x202 = 243.66 * x173;
         let x203 = 243.66 * x174;
-        let x204 = 243.66 * (x32 + x172);
+        let x204 = 243.66 * (x37 + x172);
         let x205 = 243.66 * x175;
         let x206 = 243.66 * x176;
-        let x207 = 243.66 * (x1 + x175);
-        let x208 = 243.66 * (x2 - x176);
-        let x209 = x129 + x157;
-        let x210 = x130 + x158;
-        let x211 = x131 + x159;
-        let x212 = x132 + x160;
-        let x213 = x133 + x161;
-        let x214 = x134 + x162;
-        let x215 = x135 + x163;
-        let x216 = x136 + x164;
-        let x217 = x137 + x165;
-        let x218 = x104 + x209;
-        let x219 = x105 - x210;
-        let x220 = x106 - x211;
-        let x221 = x107 - x212;
-        let x222 = x108 + x213;
-        let x223 = x109 + x214;
-        let x224 = x110 - x215;
-        let x225 = x111 + x216;
-        let x226 = x112 + x217;
-        let x227 = x79 + x218;
-        let x228 = x80 - x219;
-        let x229 = x81 - x220;
-        let x230 = x82 - x221;
-        let x231 = x83 + x222;
-        let x232 = x84 + x223;
-        let x233 = x85 - x224;
-        let x234 = x86 + x225;
-        let x235 = x87 + x226;
-        let x236 = x51 + x227;
-        let x237 = x52 + x228;
-        let x238 = x53 + x229;
-        let x239 = x54 + x230;
-        let x240 = x55 + x231;
-        let x241 = x56 + x232;
-        let x242 = x57 + x233;
-        let x243 = x58 + x234;
-        let x244 = x59 + x235;
-        let x245 = Self::mul_add(105.98, x32, x195);
-        let x246 = Self::mul_add(105.98, x33, x196);
-        let x247 = Self::mul_add(105.98, x34, x197);
+        let x207 = 243.66 * (x7 + x175);
+        let x208 = 243.66 * (x8 - x176);
+        let x209 = x130 + x157;
+        let x210 = x131 + x158;
+        let x211 = x132 + x159;
+        let x212 = x133 + x160;
+        let x213 = x134 + x161;
+        let x214 = x135 + x162;
+        let x215 = x136 + x163;
+        let x216 = x137 + x164;
+        let x217 = x138 + x165;
+        let x218 = x106 + x209;
+        let x219 = x107 - x210;
+        let x220 = x108 - x211;
+        let x221 = x109 - x212;
+        let x222 = x110 + x213;
+        let x223 = x111 + x214;
+        let x224 = x112 - x215;
+        let x225 = x113 + x216;
+        let x226 = x114 + x217;
+        let x227 = x82 + x218;
+        let x228 = x83 - x219;
+        let x229 = x84 - x220;
+        let x230 = x85 - x221;
+        let x231 = x86 + x222;
+        let x232 = x87 + x223;
+        let x233 = x88 - x224;
+        let x234 = x89 + x225;
+        let x235 = x90 + x226;
+        let x236 = x55 + x227;
+        let x237 = x56 + x228;
+        let x238 = x57 + x229;
+        let x239 = x58 + x230;
+        let x240 = x59 + x231;
+        let x241 = x60 + x232;
+        let x242 = x61 + x233;
+        let x243 = x62 + x234;
+        let x244 = x63 + x235;
+        let x245 = Self::mul_add(105.98, x37, x195);
+        let x246 = Self::mul_add(105.98, x38, x196);
+        let x247 = Self::mul_add(105.98, x39, x197);
         let x248 = Self::mul_add(105.98, x177, x198);
         let x249 = Self::mul_add(-105.98, x178, x199);
         let x250 = Self::mul_add(-105.98, x179, x200);
-        let x251 = Self::mul_add(105.98, x88, x248);
-        let x252 = Self::mul_add(105.98, x89, x249);
-        let x253 = Self::mul_add(105.98, x90, x250);
+        let x251 = Self::mul_add(105.98, x91, x248);
+        let x252 = Self::mul_add(105.98, x92, x249);
+        let x253 = Self::mul_add(105.98, x93, x250);
         let x254 = Self::mul_add(105.98, x180, x201);
         let x255 = Self::mul_add(105.98, x181, x202);
         let x256 = Self::mul_add(105.98, x182, x203);
         let x257 = Self::mul_add(105.98, x185, x254);
         let x258 = Self::mul_add(105.98, x186, x255);
         let x259 = Self::mul_add(105.98, x187, x256);
-        let x260 = Self::mul_add(279.2, x60, x257);
-        let x261 = Self::mul_add(279.2, x61, x258);
-        let x262 = Self::mul_add(279.2, x62, x259);
-        let x263 = Self::mul_add(105.98, x32 + x180, x204);
+        let x260 = Self::mul_add(279.2, x64, x257);
+        let x261 = Self::mul_add(279.2, x65, x258);
+        let x262 = Self::mul_add(279.2, x66, x259);
+        let x263 = Self::mul_add(105.98, x37 + x180, x204);
         let x264 = Self::mul_add(105.98, x183, x205);
         let x265 = Self::mul_add(105.98, x184, x206);
-        let x266 = Self::mul_add(105.98, x32 + x185, x263);
+        let x266 = Self::mul_add(105.98, x37 + x185, x263);
         let x267 = Self::mul_add(105.98, x188, x264);
         let x268 = Self::mul_add(105.98, x189, x265);
-        let x269 = Self::mul_add(279.2, x32 + x60, x266);
+        let x269 = Self::mul_add(279.2, x37 + x64, x266);
         let x270 = Self::mul_add(279.2, x190, x267);
         let x271 = Self::mul_add(279.2, x191, x268);
-        let x272 = Self::mul_add(314.88, x33, x270);
-        let x273 = Self::mul_add(314.88, x34, x271);
-        let x274 = Self::mul_add(105.98, x1 + x183, x207);
-        let x275 = Self::mul_add(105.98, x2 - x184, x208);
-        let x276 = Self::mul_add(105.98, x1 + x188, x274);
-        let x277 = Self::mul_add(105.98, x2 - x189, x275);
-        let x278 = Self::mul_add(279.2, x1 + x190, x276);
-        let x279 = Self::mul_add(279.2, x2 - x191, x277);
-        let x280 = Self::mul_add(314.88, x1 + x33, x278);
-        let x281 = Self::mul_add(314.88, x2 - x34, x279);
-        let x282 = Self::mul_add(-x139, x207, x140 * x208);
-        let x283 = x138 * x207;
-        let x284 = x138 * x208;
-        let x285 = x139 * x204;
-        let x286 = x138 * x204;
-        let x287 = x140 * x204;
-        let x288 = Self::mul_add(-x140, x206, x286);
-        let x289 = x139 * x206;
-        let x290 = x140 * x205;
-        let x291 = Self::mul_add(-x139, x205, x286);
-        let x292 = x140 * x203;
-        let x293 = x139 * x202;
+        let x272 = Self::mul_add(314.88, x38, x270);
+        let x273 = Self::mul_add(314.88, x39, x271);
+        let x274 = Self::mul_add(105.98, x7 + x183, x207);
+        let x275 = Self::mul_add(105.98, x8 - x184, x208);
+        let x276 = Self::mul_add(105.98, x7 + x188, x274);
+        let x277 = Self::mul_add(105.98, x8 - x189, x275);
+        let x278 = Self::mul_add(279.2, x7 + x190, x276);
+        let x279 = Self::mul_add(279.2, x8 - x191, x277);
+        let x280 = Self::mul_add(314.88, x7 + x38, x278);
+        let x281 = Self::mul_add(314.88, x8 - x39, x279);
+        let x282 = Self::mul_add(-x140, x207, x141 * x208);
+        let x283 = x139 * x207;
+        let x284 = x139 * x208;
+        let x285 = x140 * x204;
+        let x286 = x139 * x204;
+        let x287 = x141 * x204;
+        let x288 = Self::mul_add(-x141, x206, x286);
+        let x289 = x140 * x206;
+        let x290 = x141 * x205;
+        let x291 = Self::mul_add(-x140, x205, x286);
+        let x292 = x141 * x203;
+        let x293 = x140 * x202;
         let x294 = x292 + x293;
-        let x295 = x138 * x202;
-        let x296 = x138 * x203;
-        let x297 = x139 * x201;
-        let x298 = x138 * x201;
+        let x295 = x139 * x202;
+        let x296 = x139 * x203;
+        let x297 = x140 * x201;
+        let x298 = x139 * x201;
         let x299 = x292 + x298;
-        let x300 = x139 * x203;
-        let x301 = x140 * x201;
-        let x302 = x140 * x202;
+        let x300 = x140 * x203;
+        let x301 = x141 * x201;
+        let x302 = x141 * x202;
         let x303 = x293 + x298;
-        let x304 = x140 * x200;
-        let x305 = x139 * x199;
+        let x304 = x141 * x200;
+        let x305 = x140 * x199;
         let x306 = x304 + x305;
-        let x307 = x138 * x199;
-        let x308 = x138 * x200;
-        let x309 = x139 * x198;
-        let x310 = x138 * x198;
+        let x307 = x139 * x199;
+        let x308 = x139 * x200;
+        let x309 = x140 * x198;
+        let x310 = x139 * x198;
         let x311 = x304 + x310;
-        let x312 = x139 * x200;
-        let x313 = x140 * x198;
-        let x314 = x140 * x199;
+        let x312 = x140 * x200;
+        let x313 = x141 * x198;
+        let x314 = x141 * x199;
         let x315 = x305 + x310;
-        let x316 = x140 * x197;
-        let x317 = x139 * x196;
+        let x316 = x141 * x197;
+        let x317 = x140 * x196;
         let x318 = x316 + x317;
-        let x319 = x138 * x196;
-        let x320 = x138 * x197;
-        let x321 = x139 * x195;
-        let x322 = x138 * x195;
+        let x319 = x139 * x196;
+        let x320 = x139 * x197;
+        let x321 = x140 * x195;
+        let x322 = x139 * x195;
         let x323 = x316 - x322;
-        let x324 = x139 * x197;
-        let x325 = x140 * x195;
-        let x326 = x140 * x196;
+        let x324 = x140 * x197;
+        let x325 = x141 * x195;
+        let x326 = x141 * x196;
         let x327 = x317 - x322;
-        let x328 = x140 * x194;
-        let x329 = x139 * x193;
-        let x330 = x138 * x192;
-        let x331 = x34 * x247;
-        let x332 = x33 * x246;
-        let x333 = x32 * x245;
-        let x334 = x34 * x250;
-        let x335 = x33 * x249;
-        let x336 = x32 * x248;
+        let x328 = x141 * x194;
+        let x329 = x140 * x193;
+        let x330 = x139 * x192;
+        let x331 = x39 * x247;
+        let x332 = x38 * x246;
+        let x333 = x37 * x245;
+        let x334 = x39 * x250;
+        let x335 = x38 * x249;
+        let x336 = x37 * x248;
         let x337 = x306 + (x334 + x335);
-        let x338 = Self::mul_add(-x32, x249, x307);
-        let x339 = Self::mul_add(-x32, x250, x308);
-        let x340 = Self::mul_add(x33, x248, x309);
+        let x338 = Self::mul_add(-x37, x249, x307);
+        let x339 = Self::mul_add(-x37, x250, x308);
+        let x340 = Self::mul_add(x38, x248, x309);
         let x341 = x311 + (x334 - x336);
-        let x342 = Self::mul_add(x33, x250, x312);
-        let x343 = Self::mul_add(x34, x248, x313);
-        let x344 = Self::mul_add(x34, x249, x314);
+        let x342 = Self::mul_add(x38, x250, x312);
+        let x343 = Self::mul_add(x39, x248, x313);
+        let x344 = Self::mul_add(x39, x249, x314);
         let x345 = x315 + (x335 - x336);
-        let x346 = x90 * x253;
-        let x347 = x89 * x252;
-        let x348 = x88 * x251;
-        let x349 = x34 * x256;
-        let x350 = x33 * x255;
-        let x351 = x32 * x254;
+        let x346 = x93 * x253;
+        let x347 = x92 * x252;
+        let x348 = x91 * x251;
+        let x349 = x39 * x256;
+        let x350 = x38 * x255;
+        let x351 = x37 * x254;
         let x352 = x294 + (x349 + x350);
-        let x353 = Self::mul_add(-x32, x255, x295);
-        let x354 = Self::mul_add(-x32, x256, x296);
-        let x355 = Self::mul_add(x33, x254, x297);
+        let x353 = Self::mul_add(-x37, x255, x295);
+        let x354 = Self::mul_add(-x37, x256, x296);
+        let x355 = Self::mul_add(x38, x254, x297);
         let x356 = x299 + (x349 - x351);
-        let x357 = Self::mul_add(x33, x256, x300);
-        let x358 = Self::mul_add(x34, x254, x301);
-        let x359 = Self::mul_add(x34, x255, x302);
+        let x357 = Self::mul_add(x38, x256, x300);
+        let x358 = Self::mul_add(x39, x254, x301);
+        let x359 = Self::mul_add(x39, x255, x302);
         let x360 = x303 + (x350 - x351);
-        let x361 = x90 * x259;
-        let x362 = x89 * x258;
-        let x363 = x88 * x257;
+        let x361 = x93 * x259;
+        let x362 = x92 * x258;
+        let x363 = x91 * x257;
         let x364 = x352 - (x361 + x362);
-        let x365 = Self::mul_add(-x88, x258, x353);
-        let x366 = Self::mul_add(-x88, x259, x354);
-        let x367 = Self::mul_add(-x89, x257, x355);
+        let x365 = Self::mul_add(-x91, x258, x353);
+        let x366 = Self::mul_add(-x91, x259, x354);
+        let x367 = Self::mul_add(-x92, x257, x355);
         let x368 = x356 - (x361 + x363);
-        let x369 = Self::mul_add(-x89, x259, x357);
-        let x370 = Self::mul_add(-x90, x257, x358);
-        let x371 = Self::mul_add(-x90, x258, x359);
+        let x369 = Self::mul_add(-x92, x259, x357);
+        let x370 = Self::mul_add(-x93, x257, x358);
+        let x371 = Self::mul_add(-x93, x258, x359);
         let x372 = x360 - (x362 + x363);
-        let x373 = x62 * x262;
-        let x374 = x61 * x261;
-        let x375 = x60 * x260;
-        let x376 = x32 * x263;
-        let x377 = Self::mul_add(x33, x263, x285);
-        let x378 = x288 - Self::mul_add(x34, x265, x376);
-        let x379 = Self::mul_add(x33, x265, x289);
-        let x380 = Self::mul_add(x34, x263, x287);
-        let x381 = Self::mul_add(x34, x264, x290);
-        let x382 = x291 - Self::mul_add(x33, x264, x376);
-        let x383 = x88 * x266;
-        let x384 = Self::mul_add(-x89, x266, x377);
-        let x385 = x378 + Self::mul_add(x90, x268, -x383);
-        let x386 = Self::mul_add(-x89, x268, x379);
-        let x387 = Self::mul_add(-x90, x266, x380);
-        let x388 = Self::mul_add(-x90, x267, x381);
-        let x389 = x382 + Self::mul_add(x89, x267, -x383);
-        let x390 = x60 * x269;
-        let x391 = x385 + Self::mul_add(x62, x271, -x390);
-        let x392 = Self::mul_add(-x61, x271, x386);
-        let x393 = Self::mul_add(-x62, x270, x388);
-        let x394 = x389 + Self::mul_add(x61, x270, -x390);
-        let x395 = x32 * Self::mul_add(314.88, x32, x269);
-        let x396 = x282 + Self::mul_add(-x33, x274, x34 * x275);
-        let x397 = Self::mul_add(-x32, x274, x283);
-        let x398 = Self::mul_add(-x32, x275, x284);
-        let x399 = x396 - Self::mul_add(-x89, x276, x90 * x277);
-        let x400 = Self::mul_add(-x88, x276, x397);
-        let x401 = Self::mul_add(-x88, x277, x398);
-        let x402 = x399 - Self::mul_add(-x61, x278, x62 * x279);
-        let x403 = Self::mul_add(-x60, x278, x400);
-        let x404 = Self::mul_add(-x60, x279, x401);
+        let x373 = x66 * x262;
+        let x374 = x65 * x261;
+        let x375 = x64 * x260;
+        let x376 = x37 * x263;
+        let x377 = Self::mul_add(x38, x263, x285);
+        let x378 = x288 - Self::mul_add(x39, x265, x376);
+        let x379 = Self::mul_add(x38, x265, x289);
+        let x380 = Self::mul_add(x39, x263, x287);
+        let x381 = Self::mul_add(x39, x264, x290);
+        let x382 = x291 - Self::mul_add(x38, x264, x376);
+        let x383 = x91 * x266;
+        let x384 = Self::mul_add(-x92, x266, x377);
+        let x385 = x378 + Self::mul_add(x93, x268, -x383);
+        let x386 = Self::mul_add(-x92, x268, x379);
+        let x387 = Self::mul_add(-x93, x266, x380);
+        let x388 = Self::mul_add(-x93, x267, x381);
+        let x389 = x382 + Self::mul_add(x92, x267, -x383);
+        let x390 = x64 * x269;
+        let x391 = x385 + Self::mul_add(x66, x271, -x390);
+        let x392 = Self::mul_add(-x65, x271, x386);
+        let x393 = Self::mul_add(-x66, x270, x388);
+        let x394 = x389 + Self::mul_add(x65, x270, -x390);
+        let x395 = x37 * Self::mul_add(314.88, x37, x269);
+        let x396 = x282 + Self::mul_add(-x38, x274, x39 * x275);
+        let x397 = Self::mul_add(-x37, x274, x283);
+        let x398 = Self::mul_add(-x37, x275, x284);
+        let x399 = x396 - Self::mul_add(-x92, x276, x93 * x277);
+        let x400 = Self::mul_add(-x91, x276, x397);
+        let x401 = Self::mul_add(-x91, x277, x398);
+        let x402 = x399 - Self::mul_add(-x65, x278, x66 * x279);
+        let x403 = Self::mul_add(-x64, x278, x400);
+        let x404 = Self::mul_add(-x64, x279, x401);
         let x405 = Self::mul_add(
             -c_q0,
-            x21 + x238 + Self::mul_add(-x32, x281, x404),
-            s_q0 * (x19 + x237 - Self::mul_add(-x32, x280, x403)),
+            x26 + x238 + Self::mul_add(-x37, x281, x404),
+            s_q0 * (x24 + x237 - Self::mul_add(-x37, x280, x403)),
         );
         let x406 = Self::mul_add(
-            -x7,
+            -x12,
             x238 + x404,
-            Self::mul_add(-x5, x237 - x403, s_q1 * (x236 - x402)),
+            Self::mul_add(-x10, x237 - x403, s_q1 * (x236 - x402)),
         );
         let x407 = Self::mul_add(
-            -x7,
+            -x12,
             x229 + x401,
-            Self::mul_add(-x5, x228 - x400, s_q1 * (x227 - x399)),
+            Self::mul_add(-x10, x228 - x400, s_q1 * (x227 - x399)),
         );
         let x408 = Self::mul_add(
-            x7,
+            x12,
             x220 - x398,
-            Self::mul_add(x5, x219 + x397, s_q1 * (x218 - x396)),
+            Self::mul_add(x10, x219 + x397, s_q1 * (x218 - x396)),
         );
         let x409 = Self::mul_add(
-            x97,
+            x99,
             x211 + x284,
-            Self::mul_add(x95, x210 - x283, x93 * (x209 - x282)),
+            Self::mul_add(x97, x210 - x283, x95 * (x209 - x282)),
         );
-        let x410 = Self::mul_add(x118, x159, Self::mul_add(x116, x158, x114 * x157));
-        let x411 = Self::mul_add(x118, x162, Self::mul_add(x116, x161, x114 * x160));
-        let x412 = Self::mul_add(x118, x165, Self::mul_add(x116, x164, x114 * x163));
+        let x410 = Self::mul_add(x119, x159, Self::mul_add(x117, x158, x115 * x157));
+        let x411 = Self::mul_add(x119, x162, Self::mul_add(x117, x161, x115 * x160));
+        let x412 = Self::mul_add(x119, x165, Self::mul_add(x117, x164, x115 * x163));
         let x413 = Self::mul_add(
             -c_q0,
             Self::mul_add(
                 -c_q0,
-                x31 + x244 - (x394 - Self::mul_add(x33, x272, x395)),
-                s_q0 * (x29 + x243 - Self::mul_add(x34, x272, x393)),
+                x36 + x244 - (x394 - Self::mul_add(x38, x272, x395)),
+                s_q0 * (x34 + x243 - Self::mul_add(x39, x272, x393)),
             ),
             s_q0
                 * Self::mul_add(
                     -c_q0,
-                    x26 + x241 - Self::mul_add(x33, x273, x392),
-                    s_q0 * (x24 + x240 - (x391 - Self::mul_add(x34, x273, x395))),
+                    x31 + x241 - Self::mul_add(x38, x273, x392),
+                    s_q0 * (x29 + x240 - (x391 - Self::mul_add(x39, x273, x395))),
                 ),
         );
         let x414 = Self::mul_add(
-            -x7,
+            -x12,
             x241 - x392,
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - x391,
-                s_q1 * (x239 + Self::mul_add(-x61, x269, x384)),
+                s_q1 * (x239 + Self::mul_add(-x65, x269, x384)),
             ),
         );
         let x415 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - x394,
             Self::mul_add(
-                -x5,
+                -x10,
                 x243 - x393,
-                s_q1 * (x242 + Self::mul_add(-x62, x269, x387)),
+                s_q1 * (x242 + Self::mul_add(-x66, x269, x387)),
             ),
         );
         let x416 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x389,
-                Self::mul_add(-x5, x234 - x388, s_q1 * (x233 + x387)),
+                Self::mul_add(-x10, x234 - x388, s_q1 * (x233 + x387)),
             ),
             s_q0
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x232 - x386,
-                    Self::mul_add(-x5, x231 - x385, s_q1 * (x230 + x384)),
+                    Self::mul_add(-x10, x231 - x385, s_q1 * (x230 + x384)),
                 ),
         );
         let x417 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x382,
-                Self::mul_add(x5, x225 - x381, s_q1 * (x224 - x380)),
+                Self::mul_add(x10, x225 - x381, s_q1 * (x224 - x380)),
             ),
             s_q0
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x223 - x379,
-                    Self::mul_add(x5, x222 - x378, s_q1 * (x221 - x377)),
+                    Self::mul_add(x10, x222 - x378, s_q1 * (x221 - x377)),
                 ),
         );
         let x418 = Self::mul_add(
             -c_q0,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x291,
-                Self::mul_add(x95, x216 - x290, x93 * (x215 + x287)),
+                Self::mul_add(x97, x216 - x290, x95 * (x215 + x287)),
             ),
             s_q0
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x214 - x289,
-                    Self::mul_add(x95, x213 - x288, x93 * (x212 + x285)),
+                    Self::mul_add(x97, x213 - x288, x95 * (x212 + x285)),
                 ),
         );
         let x419 = Self::mul_add(
-            -x7,
-            x238 + Self::mul_add(-x60, x262, x366),
+            -x12,
+            x238 + Self::mul_add(-x64, x262, x366),
             Self::mul_add(
-                -x5,
-                x237 + Self::mul_add(-x60, x261, x365),
+                -x10,
+                x237 + Self::mul_add(-x64, x261, x365),
                 s_q1 * (x236 - (x364 - (x373 + x374))),
             ),
         );
         let x420 = Self::mul_add(
-            -x7,
-            x241 + Self::mul_add(-x61, x262, x369),
+            -x12,
+            x241 + Self::mul_add(-x65, x262, x369),
             Self::mul_add(
-                -x5,
+                -x10,
                 x240 - (x368 - (x373 + x375)),
-                s_q1 * (x239 + Self::mul_add(-x61, x260, x367)),
+                s_q1 * (x239 + Self::mul_add(-x65, x260, x367)),
             ),
         );
         let x421 = Self::mul_add(
-            -x7,
+            -x12,
             x244 - (x372 - (x374 + x375)),
             Self::mul_add(
-                -x5,
-                x243 + Self::mul_add(-x62, x261, x371),
-                s_q1 * (x242 + Self::mul_add(-x62, x260, x370)),
+                -x10,
+                x243 + Self::mul_add(-x66, x261, x371),
+                s_q1 * (x242 + Self::mul_add(-x66, x260, x370)),
             ),
         );
         let x422 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                -x7,
+                -x12,
                 x232 + x369,
-                Self::mul_add(-x5, x231 - x368, s_q1 * (x230 + x367)),
+                Self::mul_add(-x10, x231 - x368, s_q1 * (x230 + x367)),
             ),
             s_q1
                 * Self::mul_add(
-                    -x7,
+                    -x12,
                     x229 + x366,
-                    Self::mul_add(-x5, x228 + x365, s_q1 * (x227 - x364)),
+                    Self::mul_add(-x10, x228 + x365, s_q1 * (x227 - x364)),
                 ),
         );
         let x423 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                -x7,
+                -x12,
                 x235 - x372,
-                Self::mul_add(-x5, x234 + x371, s_q1 * (x233 + x370)),
+                Self::mul_add(-x10, x234 + x371, s_q1 * (x233 + x370)),
             ),
             x422,
         );
         let x424 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x357,
-                Self::mul_add(x5, x222 - x356, s_q1 * (x221 - x355)),
+                Self::mul_add(x10, x222 - x356, s_q1 * (x221 - x355)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x354,
-                    Self::mul_add(x5, x219 - x353, s_q1 * (x218 - x352)),
+                    Self::mul_add(x10, x219 - x353, s_q1 * (x218 - x352)),
                 ),
         );
         let x425 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x360,
-                Self::mul_add(x5, x225 + x359, s_q1 * (x224 - x358)),
+                Self::mul_add(x10, x225 + x359, s_q1 * (x224 - x358)),
             ),
             x424,
         );
         let x426 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x300,
-                Self::mul_add(x95, x213 - x299, x93 * (x212 + x297)),
+                Self::mul_add(x97, x213 - x299, x95 * (x212 + x297)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x296,
-                    Self::mul_add(x95, x210 + x295, x93 * (x209 - x294)),
+                    Self::mul_add(x97, x210 + x295, x95 * (x209 - x294)),
                 ),
         );
         let x427 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x303,
-                Self::mul_add(x95, x216 + x302, x93 * (x215 + x301)),
+                Self::mul_add(x97, x216 + x302, x95 * (x215 + x301)),
             ),
             x426,
         );
-        let x428 = Self::mul_add(-x7, x412, Self::mul_add(-x5, x411, s_q1 * x410));
+        let x428 = Self::mul_add(-x12, x412, Self::mul_add(-x10, x411, s_q1 * x410));
         let x429 = Self::mul_add(
-            -x7,
-            x229 + Self::mul_add(-x88, x253, x339),
+            -x12,
+            x229 + Self::mul_add(-x91, x253, x339),
             Self::mul_add(
-                -x5,
-                x228 + Self::mul_add(-x88, x252, x338),
+                -x10,
+                x228 + Self::mul_add(-x91, x252, x338),
                 s_q1 * (x227 - (x337 - (x346 + x347))),
             ),
         );
         let x430 = Self::mul_add(
-            -x7,
-            x232 + Self::mul_add(-x89, x253, x342),
+            -x12,
+            x232 + Self::mul_add(-x92, x253, x342),
             Self::mul_add(
-                -x5,
+                -x10,
                 x231 - (x341 - (x346 + x348)),
-                s_q1 * (x230 + Self::mul_add(-x89, x251, x340)),
+                s_q1 * (x230 + Self::mul_add(-x92, x251, x340)),
             ),
         );
         let x431 = Self::mul_add(
-            -x7,
+            -x12,
             x235 - (x345 - (x347 + x348)),
             Self::mul_add(
-                -x5,
-                x234 + Self::mul_add(-x90, x252, x344),
-                s_q1 * (x233 + Self::mul_add(-x90, x251, x343)),
+                -x10,
+                x234 + Self::mul_add(-x93, x252, x344),
+                s_q1 * (x233 + Self::mul_add(-x93, x251, x343)),
             ),
         );
         let x432 = Self::mul_add(
-            x5,
+            x10,
             Self::mul_add(
-                x7,
+                x12,
                 x223 + x342,
-                Self::mul_add(x5, x222 - x341, s_q1 * (x221 - x340)),
+                Self::mul_add(x10, x222 - x341, s_q1 * (x221 - x340)),
             ),
             s_q1
                 * Self::mul_add(
-                    x7,
+                    x12,
                     x220 - x339,
-                    Self::mul_add(x5, x219 - x338, s_q1 * (x218 - x337)),
+                    Self::mul_add(x10, x219 - x338, s_q1 * (x218 - x337)),
                 ),
         );
         let x433 = Self::mul_add(
-            x7,
+            x12,
             Self::mul_add(
-                x7,
+                x12,
                 x226 - x345,
-                Self::mul_add(x5, x225 + x344, s_q1 * (x224 - x343)),
+                Self::mul_add(x10, x225 + x344, s_q1 * (x224 - x343)),
             ),
             x432,
         );
         let x434 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 + x312,
-                Self::mul_add(x95, x213 - x311, x93 * (x212 + x309)),
+                Self::mul_add(x97, x213 - x311, x95 * (x212 + x309)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 + x308,
-                    Self::mul_add(x95, x210 + x307, x93 * (x209 - x306)),
+                    Self::mul_add(x97, x210 + x307, x95 * (x209 - x306)),
                 ),
         );
         let x435 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 - x315,
-                Self::mul_add(x95, x216 + x314, x93 * (x215 + x313)),
+                Self::mul_add(x97, x216 + x314, x95 * (x215 + x313)),
             ),
             x434,
         );
         let x436 = Self::mul_add(
-            x7,
-            x220 + Self::mul_add(-x32, x247, x320),
+            x12,
+            x220 + Self::mul_add(-x37, x247, x320),
             Self::mul_add(
-                x5,
-                x219 + Self::mul_add(-x32, x246, x319),
+                x10,
+                x219 + Self::mul_add(-x37, x246, x319),
                 s_q1 * (x218 + (x318 + (x331 + x332))),
             ),
         );
         let x437 = Self::mul_add(
-            x7,
-            x223 - Self::mul_add(x33, x247, x324),
+            x12,
+            x223 - Self::mul_add(x38, x247, x324),
             Self::mul_add(
-                x5,
+                x10,
                 x222 + (x323 + (x331 + x333)),
-                s_q1 * (x221 - Self::mul_add(x33, x245, x321)),
+                s_q1 * (x221 - Self::mul_add(x38, x245, x321)),
             ),
         );
         let x438 = Self::mul_add(
-            x7,
+            x12,
             x226 + (x327 + (x332 + x333)),
             Self::mul_add(
-                x5,
-                x225 - Self::mul_add(x34, x246, x326),
-                s_q1 * (x224 - Self::mul_add(x34, x245, x325)),
+                x10,
+                x225 - Self::mul_add(x39, x246, x326),
+                s_q1 * (x224 - Self::mul_add(x39, x245, x325)),
             ),
         );
         let x439 = Self::mul_add(
-            -x5,
+            -x10,
             Self::mul_add(
-                x97,
+                x99,
                 x214 - x324,
-                Self::mul_add(x95, x213 + x323, x93 * (x212 + x321)),
+                Self::mul_add(x97, x213 + x323, x95 * (x212 + x321)),
             ),
             s_q1
                 * Self::mul_add(
-                    x97,
+                    x99,
                     x211 - x320,
-                    Self::mul_add(x95, x210 - x319, x93 * (x209 + x318)),
+                    Self::mul_add(x97, x210 - x319, x95 * (x209 + x318)),
                 ),
         );
         let x440 = Self::mul_add(
-            -x7,
+            -x12,
             Self::mul_add(
-                x97,
+                x99,
                 x217 + x327,
-                Self::mul_add(x95, x216 - x326, x93 * (x215 + x325)),
+                Self::mul_add(x97, x216 - x326, x95 * (x215 + x325)),
             ),
             x439,
         );
         let x441 = Self::mul_add(
-            x97,
-            Self::mul_add(-x138, x194, x211),
+            x99,
+            Self::mul_add(-x139, x194, x211),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x138, x193, x210),
-                x93 * (x209 + (x328 + x329)),
+                x97,
+                Self::mul_add(-x139, x193, x210),
+                x95 * (x209 + (x328 + x329)),
             ),
         );
         let x442 = Self::mul_add(
-            x97,
-            Self::mul_add(-x139, x194, x214),
+            x99,
+            Self::mul_add(-x140, x194, x214),
             Self::mul_add(
-                x95,
+                x97,
                 x213 + (x328 + x330),
-                x93 * Self::mul_add(-x139, x192, x212),
+                x95 * Self::mul_add(-x140, x192, x212),
             ),
         );
         let x443 = Self::mul_add(
-            x97,
+            x99,
             x217 + (x329 + x330),
             Self::mul_add(
-                x95,
-                Self::mul_add(-x140, x193, x216),
-                x93 * Self::mul_add(-x140, x192, x215),
+                x97,
+                Self::mul_add(-x141, x193, x216),
+                x95 * Self::mul_add(-x141, x192, x215),
             ),
         );
         let x444 = qd[1] * s_q0;
         let x445 = qd[1] * c_q0;
         let x446 = qd[0] * qd[0];
-        let x447 = x1 * x446;
-        let x448 = x2 * x446;
+        let x447 = x7 * x446;
+        let x448 = x8 * x446;
         let x449 = qd[0] * x445;
         let x450 = qd[0] * x444;
         let x451 = qd[2] * s_q1;
-        let x452 = qd[2] * x5;
-        let x453 = qd[2] * x7;
+        let x452 = qd[2] * x10;
+        let x453 = qd[2] * x12;
         let x454 = x445 * x445;
         let x455 = x444 * x444;
         let x456 = x444 * x445;
-        let x457 = x32 * (x454 + x455);
+        let x457 = x37 * (x454 + x455);
         let x458 = x447
             - Self::mul_add(
-                -x34,
+                -x39,
                 x456,
-                Self::mul_add(-x33, x446 + x454, x32 * (x450 + x450)),
+                Self::mul_add(-x38, x446 + x454, x37 * (x450 + x450)),
             );
         let x459 = x448
             - Self::mul_add(
-                x34,
+                x39,
                 x446 + x455,
-                Self::mul_add(x33, x456, x32 * (x449 + x449)),
+                Self::mul_add(x38, x456, x37 * (x449 + x449)),
             );
         let x460 = qd[0] - x451;
         let x461 = x444 - x452;
@@ -5637,8 +5656,8 @@ impl SsrmsRecurrent {
         let x464 = x449 + Self::mul_add(qd[0], x453, x445 * x451);
         let x465 = x450 + Self::mul_add(-qd[0], x452, x444 * x451);
         let x466 = qd[3] * s_q1;
-        let x467 = qd[3] * x5;
-        let x468 = qd[3] * x7;
+        let x467 = qd[3] * x10;
+        let x468 = qd[3] * x12;
         let x469 = x462 * x462;
         let x470 = x461 * x461;
         let x471 = x460 * x461;
@@ -5647,21 +5666,21 @@ impl SsrmsRecurrent {
         let x474 = x461 * x462;
         let x475 = x457
             + Self::mul_add(
-                x62,
+                x66,
                 x464 - x472,
-                Self::mul_add(-x61, x465 - x471, x60 * (x469 + x470)),
+                Self::mul_add(-x65, x465 - x471, x64 * (x469 + x470)),
             );
         let x476 = x458
             - Self::mul_add(
-                -x62,
+                -x66,
                 x463 - x474,
-                Self::mul_add(x61, x469 + x473, x60 * (x465 + x471)),
+                Self::mul_add(x65, x469 + x473, x64 * (x465 + x471)),
             );
         let x477 = x459
             - Self::mul_add(
-                -x62,
+                -x66,
                 x470 + x473,
-                Self::mul_add(-x61, x463 + x474, x60 * (x464 + x472)),
+                Self::mul_add(-x65, x463 + x474, x64 * (x464 + x472)),
             );
         let x478 = x460 - x466;
         let x479 = x461 - x467;
@@ -5670,8 +5689,8 @@ impl SsrmsRecurrent {
         let x482 = x464 + Self::mul_add(x460, x468, x462 * x466);
         let x483 = x465 + Self::mul_add(-x460, x467, x461 * x466);
         let x484 = qd[4] * s_q1;
-        let x485 = qd[4] * x5;
-        let x486 = qd[4] * x7;
+        let x485 = qd[4] * x10;
+        let x486 = qd[4] * x12;
         let x487 = x480 * x480;
         let x488 = x479 * x479;
         let x489 = x478 * x479;
@@ -5680,21 +5699,21 @@ impl SsrmsRecurrent {
         let x492 = x479 * x480;
         let x493 = x475
             + Self::mul_add(
-                x90,
+                x93,
                 x482 - x490,
-                Self::mul_add(-x89, x483 - x489, x88 * (x487 + x488)),
+                Self::mul_add(-x92, x483 - x489, x91 * (x487 + x488)),
             );
         let x494 = x476
             - Self::mul_add(
-                -x90,
+                -x93,
                 x481 - x492,
-                Self::mul_add(x89, x487 + x491, x88 * (x483 + x489)),
+                Self::mul_add(x92, x487 + x491, x91 * (x483 + x489)),
             );
         let x495 = x477
             - Self::mul_add(
-                -x90,
+                -x93,
                 x488 + x491,
-                Self::mul_add(-x89, x481 + x492, x88 * (x482 + x490)),
+                Self::mul_add(-x92, x481 + x492, x91 * (x482 + x490)),
             );
         let x496 = x478 - x484;
         let x497 = x479 - x485;
@@ -5702,9 +5721,9 @@ impl SsrmsRecurrent {
         let x499 = x481 + Self::mul_add(x479, x486, x480 * x485);
         let x500 = x482 + Self::mul_add(x478, x486, x480 * x484);
         let x501 = x483 + Self::mul_add(-x478, x485, x479 * x484);
-        let x502 = qd[5] * x93;
-        let x503 = qd[5] * x95;
-        let x504 = qd[5] * x97;
+        let x502 = qd[5] * x95;
+        let x503 = qd[5] * x97;
+        let x504 = qd[5] * x99;
         let x505 = x498 * x498;
         let x506 = x497 * x497;
         let x507 = x496 * x497;
@@ -5713,21 +5732,21 @@ impl SsrmsRecurrent {
         let x510 = x497 * x498;
         let x511 = x493
             + Self::mul_add(
-                -x34,
+                -x39,
                 x500 - x508,
-                Self::mul_add(x33, x501 - x507, x32 * (x505 + x506)),
+                Self::mul_add(x38, x501 - x507, x37 * (x505 + x506)),
             );
         let x512 = x494
             - Self::mul_add(
-                x34,
+                x39,
                 x499 - x510,
-                Self::mul_add(-x33, x505 + x509, x32 * (x501 + x507)),
+                Self::mul_add(-x38, x505 + x509, x37 * (x501 + x507)),
             );
         let x513 = x495
             - Self::mul_add(
-                x34,
+                x39,
                 x506 + x509,
-                Self::mul_add(x33, x499 + x510, x32 * (x500 + x508)),
+                Self::mul_add(x38, x499 + x510, x37 * (x500 + x508)),
             );
         let x514 = x496 + x502;
         let x515 = x497 - x503;
@@ -5735,9 +5754,9 @@ impl SsrmsRecurrent {
         let x517 = x499 + Self::mul_add(x497, x504, x498 * x503);
         let x518 = x500 - Self::mul_add(-x496, x504, x498 * x502);
         let x519 = x501 - Self::mul_add(x496, x503, x497 * x502);
-        let x520 = qd[6] * x114;
-        let x521 = qd[6] * x116;
-        let x522 = qd[6] * x118;
+        let x520 = qd[6] * x115;
+        let x521 = qd[6] * x117;
+        let x522 = qd[6] * x119;
         let x523 = x516 * x516;
         let x524 = x515 * x515;
         let x525 = x514 * x515;
@@ -5750,16 +5769,16 @@ impl SsrmsRecurrent {
         let x532 = x517 + Self::mul_add(x515, x522, x516 * x521);
         let x533 = x518 - Self::mul_add(-x514, x522, x516 * x520);
         let x534 = x519 - Self::mul_add(x514, x521, x515 * x520);
-        let x535 = Self::mul_add(x21, x445, Self::mul_add(-x19, x444, qd[0] * x17));
+        let x535 = Self::mul_add(x26, x445, Self::mul_add(-x24, x444, qd[0] * x22));
         let x536 = Self::mul_add(
-            x26,
-            x445,
-            Self::mul_add(-x24, x444, qd[0] * Self::mul_add(c_q1, x10, -x22)),
-        );
-        let x537 = Self::mul_add(
             x31,
             x445,
-            Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x13, -x27)),
+            Self::mul_add(-x29, x444, qd[0] * Self::mul_add(c_q1, x15, -x27)),
+        );
+        let x537 = Self::mul_add(
+            x36,
+            x445,
+            Self::mul_add(-x34, x444, qd[0] * Self::mul_add(c_q1, x18, -x32)),
         );
         let x538 = Self::mul_add(
             105.98,
@@ -5767,7 +5786,7 @@ impl SsrmsRecurrent {
             -Self::mul_add(
                 -f_ext[1][2],
                 s_q0,
-                Self::mul_add(f_ext[1][1], x5, f_ext[1][0] * x4),
+                Self::mul_add(f_ext[1][1], x10, f_ext[1][0] * x9),
             ),
         );
         let x539 = Self::mul_add(
@@ -5776,19 +5795,19 @@ impl SsrmsRecurrent {
             Self::mul_add(
                 f_ext[1][2],
                 c_q0,
-                Self::mul_add(f_ext[1][1], x7, f_ext[1][0] * x6),
+                Self::mul_add(f_ext[1][1], x12, f_ext[1][0] * x11),
             ),
         );
-        let x540 = Self::mul_add(x53, x462, Self::mul_add(-x52, x461, x51 * x460));
-        let x541 = Self::mul_add(x56, x462, Self::mul_add(-x55, x461, x54 * x460));
-        let x542 = Self::mul_add(x59, x462, Self::mul_add(-x58, x461, x57 * x460));
+        let x540 = Self::mul_add(x57, x462, Self::mul_add(-x56, x461, x55 * x460));
+        let x541 = Self::mul_add(x60, x462, Self::mul_add(-x59, x461, x58 * x460));
+        let x542 = Self::mul_add(x63, x462, Self::mul_add(-x62, x461, x61 * x460));
         let x543 = Self::mul_add(
             314.88,
             x457,
             Self::mul_add(
                 f_ext[2][2],
-                x37,
-                Self::mul_add(-f_ext[2][1], s_q1, f_ext[2][0] * x36),
+                x41,
+                Self::mul_add(-f_ext[2][1], s_q1, f_ext[2][0] * x40),
             ),
         );
         let x544 = Self::mul_add(
@@ -5796,8 +5815,8 @@ impl SsrmsRecurrent {
             x458,
             -Self::mul_add(
                 f_ext[2][2],
-                x39,
-                Self::mul_add(f_ext[2][1], x5, f_ext[2][0] * x38),
+                x43,
+                Self::mul_add(f_ext[2][1], x10, f_ext[2][0] * x42),
             ),
         );
         let x545 = Self::mul_add(
@@ -5805,20 +5824,20 @@ impl SsrmsRecurrent {
             x459,
             Self::mul_add(
                 f_ext[2][2],
-                x41,
-                Self::mul_add(f_ext[2][1], x7, f_ext[2][0] * x40),
+                x45,
+                Self::mul_add(f_ext[2][1], x12, f_ext[2][0] * x44),
             ),
         );
-        let x546 = Self::mul_add(x81, x480, Self::mul_add(-x80, x479, x79 * x478));
-        let x547 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
-        let x548 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
+        let x546 = Self::mul_add(x84, x480, Self::mul_add(-x83, x479, x82 * x478));
+        let x547 = Self::mul_add(x87, x480, Self::mul_add(-x86, x479, x85 * x478));
+        let x548 = Self::mul_add(x90, x480, Self::mul_add(-x89, x479, x88 * x478));
         let x549 = Self::mul_add(
             279.2,
             x475,
             Self::mul_add(
                 f_ext[3][2],
-                x65,
-                Self::mul_add(-f_ext[3][1], s_q1, f_ext[3][0] * x64),
+                x68,
+                Self::mul_add(-f_ext[3][1], s_q1, f_ext[3][0] * x67),
             ),
         );
         let x550 = Self::mul_add(
@@ -5826,8 +5845,8 @@ impl SsrmsRecurrent {
             x476,
             -Self::mul_add(
                 f_ext[3][2],
-                x67,
-                Self::mul_add(f_ext[3][1], x5, f_ext[3][0] * x66),
+                x70,
+                Self::mul_add(f_ext[3][1], x10, f_ext[3][0] * x69),
             ),
         );
         let x551 = Self::mul_add(
@@ -5835,20 +5854,20 @@ impl SsrmsRecurrent {
             x477,
             Self::mul_add(
                 f_ext[3][2],
-                x69,
-                Self::mul_add(f_ext[3][1], x7, f_ext[3][0] * x68),
+                x72,
+                Self::mul_add(f_ext[3][1], x12, f_ext[3][0] * x71),
             ),
         );
-        let x552 = Self::mul_add(-x106, x498, Self::mul_add(x105, x497, x104 * x496));
-        let x553 = Self::mul_add(-x109, x498, Self::mul_add(x108, x497, x107 * x496));
-        let x554 = Self::mul_add(-x112, x498, Self::mul_add(x111, x497, x110 * x496));
+        let x552 = Self::mul_add(-x108, x498, Self::mul_add(x107, x497, x106 * x496));
+        let x553 = Self::mul_add(-x111, x498, Self::mul_add(x110, x497, x109 * x496));
+        let x554 = Self::mul_add(-x114, x498, Self::mul_add(x113, x497, x112 * x496));
         let x555 = Self::mul_add(
             105.98,
             x493,
             Self::mul_add(
                 f_ext[4][2],
-                x93,
-                Self::mul_add(-f_ext[4][1], s_q1, f_ext[4][0] * x92),
+                x95,
+                Self::mul_add(-f_ext[4][1], s_q1, f_ext[4][0] * x94),
             ),
         );
         let x556 = Self::mul_add(
@@ -5856,8 +5875,8 @@ impl SsrmsRecurrent {
             x494,
             -Self::mul_add(
                 f_ext[4][2],
-                x95,
-                Self::mul_add(f_ext[4][1], x5, f_ext[4][0] * x94),
+                x97,
+                Self::mul_add(f_ext[4][1], x10, f_ext[4][0] * x96),
             ),
         );
         let x557 = Self::mul_add(
@@ -5865,20 +5884,20 @@ impl SsrmsRecurrent {
             x495,
             Self::mul_add(
                 f_ext[4][2],
-                x97,
-                Self::mul_add(f_ext[4][1], x7, f_ext[4][0] * x96),
+                x99,
+                Self::mul_add(f_ext[4][1], x12, f_ext[4][0] * x98),
             ),
         );
-        let x558 = Self::mul_add(x131, x516, Self::mul_add(-x130, x515, x129 * x514));
-        let x559 = Self::mul_add(x134, x516, Self::mul_add(-x133, x515, x132 * x514));
-        let x560 = Self::mul_add(x137, x516, Self::mul_add(-x136, x515, x135 * x514));
+        let x558 = Self::mul_add(x132, x516, Self::mul_add(-x131, x515, x130 * x514));
+        let x559 = Self::mul_add(x135, x516, Self::mul_add(-x134, x515, x133 * x514));
+        let x560 = Self::mul_add(x138, x516, Self::mul_add(-x137, x515, x136 * x514));
         let x561 = Self::mul_add(
             105.98,
             x511,
             Self::mul_add(
                 f_ext[5][2],
-                x93,
-                Self::mul_add(-f_ext[5][1], x115, f_ext[5][0] * x114),
+                x95,
+                Self::mul_add(-f_ext[5][1], x116, f_ext[5][0] * x115),
             ),
         );
         let x562 = Self::mul_add(
@@ -5886,8 +5905,8 @@ impl SsrmsRecurrent {
             x512,
             -Self::mul_add(
                 f_ext[5][2],
-                x95,
-                Self::mul_add(-f_ext[5][1], x117, f_ext[5][0] * x116),
+                x97,
+                Self::mul_add(-f_ext[5][1], x118, f_ext[5][0] * x117),
             ),
         );
         let x563 = Self::mul_add(
@@ -5895,8 +5914,8 @@ impl SsrmsRecurrent {
             x513,
             Self::mul_add(
                 f_ext[5][2],
-                x97,
-                Self::mul_add(-f_ext[5][1], x119, f_ext[5][0] * x118),
+                x99,
+                Self::mul_add(-f_ext[5][1], x120, f_ext[5][0] * x119),
             ),
         );
         let x564 = Self::mul_add(x159, x531, Self::mul_add(-x158, x530, x157 * x529));
@@ -5906,42 +5925,42 @@ impl SsrmsRecurrent {
             243.66,
             x511
                 - Self::mul_add(
-                    x140,
+                    x141,
                     x518 - x526,
-                    Self::mul_add(-x139, x519 - x525, x138 * (x523 + x524)),
+                    Self::mul_add(-x140, x519 - x525, x139 * (x523 + x524)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
                 x143,
-                Self::mul_add(-f_ext[6][1], x142, f_ext[6][0] * x114),
+                Self::mul_add(-f_ext[6][1], x142, f_ext[6][0] * x115),
             ),
         );
         let x568 = Self::mul_add(
             243.66,
             x512
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x517 - x528,
-                    Self::mul_add(x139, x523 + x527, x138 * (x519 + x525)),
+                    Self::mul_add(x140, x523 + x527, x139 * (x519 + x525)),
                 ),
             -Self::mul_add(
                 f_ext[6][2],
                 x145,
-                Self::mul_add(-f_ext[6][1], x144, f_ext[6][0] * x116),
+                Self::mul_add(-f_ext[6][1], x144, f_ext[6][0] * x117),
             ),
         );
         let x569 = Self::mul_add(
             243.66,
             x513
                 + Self::mul_add(
-                    -x140,
+                    -x141,
                     x524 + x527,
-                    Self::mul_add(-x139, x517 + x528, x138 * (x518 + x526)),
+                    Self::mul_add(-x140, x517 + x528, x139 * (x518 + x526)),
                 ),
             Self::mul_add(
                 f_ext[6][2],
                 x147,
-                Self::mul_add(-f_ext[6][1], x146, f_ext[6][0] * x118),
+                Self::mul_add(-f_ext[6][1], x146, f_ext[6][0] * x119),
             ),
         );
         let x570 = Self::mul_add(x159, x534, Self::mul_add(x158, x533, x157 * x532))
@@ -5949,21 +5968,21 @@ impl SsrmsRecurrent {
             + Self::mul_add(
                 f_ext[6][5],
                 x143,
-                Self::mul_add(-f_ext[6][4], x142, f_ext[6][3] * x114),
+                Self::mul_add(-f_ext[6][4], x142, f_ext[6][3] * x115),
             );
         let x571 = Self::mul_add(x162, x534, Self::mul_add(x161, x533, x160 * x532))
             - Self::mul_add(-x529, x566, x531 * x564)
             + Self::mul_add(
                 f_ext[6][5],
                 x145,
-                Self::mul_add(-f_ext[6][4], x144, f_ext[6][3] * x116),
+                Self::mul_add(-f_ext[6][4], x144, f_ext[6][3] * x117),
             );
         let x572 = Self::mul_add(x165, x534, Self::mul_add(x164, x533, x163 * x532))
             - Self::mul_add(x529, x565, x530 * x564)
             + Self::mul_add(
                 f_ext[6][5],
                 x147,
-                Self::mul_add(-f_ext[6][4], x146, f_ext[6][3] * x118),
+                Self::mul_add(-f_ext[6][4], x146, f_ext[6][3] * x119),
             );
         let x573 = x561 + x567;
         let x574 = x562 + x568;
@@ -5977,122 +5996,122 @@ impl SsrmsRecurrent {
         let x582 = x543 + x579;
         let x583 = x544 + x580;
         let x584 = x545 + x581;
-        let x585 = Self::mul_add(x131, x519, Self::mul_add(x130, x518, x129 * x517))
+        let x585 = Self::mul_add(x132, x519, Self::mul_add(x131, x518, x130 * x517))
             + Self::mul_add(x515, x560, x516 * x559)
             + Self::mul_add(
                 f_ext[5][5],
-                x93,
-                Self::mul_add(-f_ext[5][4], x115, f_ext[5][3] * x114),
-            ) + x570 - Self::mul_add(x139, x569, x140 * x568);
-        let x586 = Self::mul_add(x134, x519, Self::mul_add(x133, x518, x132 * x517))
+                x95,
+                Self::mul_add(-f_ext[5][4], x116, f_ext[5][3] * x115),
+            ) + x570 - Self::mul_add(x140, x569, x141 * x568);
+        let x586 = Self::mul_add(x135, x519, Self::mul_add(x134, x518, x133 * x517))
             - Self::mul_add(-x514, x560, x516 * x558)
             + Self::mul_add(
                 f_ext[5][5],
-                x95,
-                Self::mul_add(-f_ext[5][4], x117, f_ext[5][3] * x116),
-            ) + x571 - Self::mul_add(-x138, x569, x140 * x567);
-        let x587 = Self::mul_add(x137, x519, Self::mul_add(x136, x518, x135 * x517))
+                x97,
+                Self::mul_add(-f_ext[5][4], x118, f_ext[5][3] * x117),
+            ) + x571 - Self::mul_add(-x139, x569, x141 * x567);
+        let x587 = Self::mul_add(x138, x519, Self::mul_add(x137, x518, x136 * x517))
             - Self::mul_add(x514, x559, x515 * x558)
             + Self::mul_add(
                 f_ext[5][5],
-                x97,
-                Self::mul_add(-f_ext[5][4], x119, f_ext[5][3] * x118),
-            ) + x572 + Self::mul_add(x138, x568, x139 * x567);
-        let x588 = Self::mul_add(-x106, x501, Self::mul_add(-x105, x500, x104 * x499))
+                x99,
+                Self::mul_add(-f_ext[5][4], x120, f_ext[5][3] * x119),
+            ) + x572 + Self::mul_add(x139, x568, x140 * x567);
+        let x588 = Self::mul_add(-x108, x501, Self::mul_add(-x107, x500, x106 * x499))
             - Self::mul_add(x497, x554, x498 * x553)
             + Self::mul_add(
                 f_ext[4][5],
-                x93,
-                Self::mul_add(-f_ext[4][4], s_q1, f_ext[4][3] * x92),
-            ) + x585 - Self::mul_add(x33, x575, x34 * x574);
-        let x589 = Self::mul_add(-x109, x501, Self::mul_add(-x108, x500, x107 * x499))
+                x95,
+                Self::mul_add(-f_ext[4][4], s_q1, f_ext[4][3] * x94),
+            ) + x585 - Self::mul_add(x38, x575, x39 * x574);
+        let x589 = Self::mul_add(-x111, x501, Self::mul_add(-x110, x500, x109 * x499))
             + Self::mul_add(x496, x554, x498 * x552)
             - Self::mul_add(
                 f_ext[4][5],
-                x95,
-                Self::mul_add(f_ext[4][4], x5, f_ext[4][3] * x94),
-            ) - x586 + Self::mul_add(x32, x575, x34 * x573);
-        let x590 = Self::mul_add(-x112, x501, Self::mul_add(-x111, x500, x110 * x499))
+                x97,
+                Self::mul_add(f_ext[4][4], x10, f_ext[4][3] * x96),
+            ) - x586 + Self::mul_add(x37, x575, x39 * x573);
+        let x590 = Self::mul_add(-x114, x501, Self::mul_add(-x113, x500, x112 * x499))
             + Self::mul_add(-x496, x553, x497 * x552)
             - Self::mul_add(
                 f_ext[4][5],
-                x97,
-                Self::mul_add(f_ext[4][4], x7, f_ext[4][3] * x96),
-            ) - x587 - Self::mul_add(-x32, x574, x33 * x573);
-        let x591 = Self::mul_add(x81, x483, Self::mul_add(x80, x482, x79 * x481))
+                x99,
+                Self::mul_add(f_ext[4][4], x12, f_ext[4][3] * x98),
+            ) - x587 - Self::mul_add(-x37, x574, x38 * x573);
+        let x591 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
             + Self::mul_add(x479, x548, x480 * x547)
             + Self::mul_add(
                 f_ext[3][5],
-                x65,
-                Self::mul_add(-f_ext[3][4], s_q1, f_ext[3][3] * x64),
-            ) + x588 + Self::mul_add(x89, x578, x90 * x577);
-        let x592 = Self::mul_add(x84, x483, Self::mul_add(x83, x482, x82 * x481))
+                x68,
+                Self::mul_add(-f_ext[3][4], s_q1, f_ext[3][3] * x67),
+            ) + x588 + Self::mul_add(x92, x578, x93 * x577);
+        let x592 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
             - Self::mul_add(-x478, x548, x480 * x546)
             + Self::mul_add(
                 f_ext[3][5],
-                x67,
-                Self::mul_add(f_ext[3][4], x5, f_ext[3][3] * x66),
-            ) - x589 + Self::mul_add(-x88, x578, x90 * x576);
-        let x593 = Self::mul_add(x87, x483, Self::mul_add(x86, x482, x85 * x481))
+                x70,
+                Self::mul_add(f_ext[3][4], x10, f_ext[3][3] * x69),
+            ) - x589 + Self::mul_add(-x91, x578, x93 * x576);
+        let x593 = Self::mul_add(x90, x483, Self::mul_add(x89, x482, x88 * x481))
             - Self::mul_add(x478, x547, x479 * x546)
             + Self::mul_add(
                 f_ext[3][5],
-                x69,
-                Self::mul_add(f_ext[3][4], x7, f_ext[3][3] * x68),
-            ) - x590 - Self::mul_add(x88, x577, x89 * x576);
-        let x594 = Self::mul_add(x53, x465, Self::mul_add(x52, x464, x51 * x463))
+                x72,
+                Self::mul_add(f_ext[3][4], x12, f_ext[3][3] * x71),
+            ) - x590 - Self::mul_add(x91, x577, x92 * x576);
+        let x594 = Self::mul_add(x57, x465, Self::mul_add(x56, x464, x55 * x463))
             + Self::mul_add(x461, x542, x462 * x541)
             + Self::mul_add(
                 f_ext[2][5],
-                x37,
-                Self::mul_add(-f_ext[2][4], s_q1, f_ext[2][3] * x36),
-            ) + x591 + Self::mul_add(x61, x581, x62 * x580);
-        let x595 = Self::mul_add(x56, x465, Self::mul_add(x55, x464, x54 * x463))
+                x41,
+                Self::mul_add(-f_ext[2][4], s_q1, f_ext[2][3] * x40),
+            ) + x591 + Self::mul_add(x65, x581, x66 * x580);
+        let x595 = Self::mul_add(x60, x465, Self::mul_add(x59, x464, x58 * x463))
             - Self::mul_add(-x460, x542, x462 * x540)
             + Self::mul_add(
                 f_ext[2][5],
-                x39,
-                Self::mul_add(f_ext[2][4], x5, f_ext[2][3] * x38),
-            ) + x592 + Self::mul_add(-x60, x581, x62 * x579);
-        let x596 = Self::mul_add(x59, x465, Self::mul_add(x58, x464, x57 * x463))
+                x43,
+                Self::mul_add(f_ext[2][4], x10, f_ext[2][3] * x42),
+            ) + x592 + Self::mul_add(-x64, x581, x66 * x579);
+        let x596 = Self::mul_add(x63, x465, Self::mul_add(x62, x464, x61 * x463))
             - Self::mul_add(x460, x541, x461 * x540)
             + Self::mul_add(
                 f_ext[2][5],
-                x41,
-                Self::mul_add(f_ext[2][4], x7, f_ext[2][3] * x40),
-            ) + x593 - Self::mul_add(x60, x580, x61 * x579);
+                x45,
+                Self::mul_add(f_ext[2][4], x12, f_ext[2][3] * x44),
+            ) + x593 - Self::mul_add(x64, x580, x65 * x579);
         let x597 = tau[0]
             + (f_ext[0][3]
-                + (Self::mul_add(x21, x450, x19 * x449)
+                + (Self::mul_add(x26, x450, x24 * x449)
                     + Self::mul_add(x444, x537, x445 * x536)
                     + Self::mul_add(-f_ext[1][4], s_q1, f_ext[1][3] * c_q1) + x594
-                    - Self::mul_add(x33, x584, x34 * x583))
-                + Self::mul_add(-x1, x539 + x584, x2 * (x538 + x583)));
+                    - Self::mul_add(x38, x584, x39 * x583))
+                + Self::mul_add(-x7, x539 + x584, x8 * (x538 + x583)));
         let x598 = Self::mul_add(
             -c_q0,
-            Self::mul_add(x31, x450, x29 * x449)
+            Self::mul_add(x36, x450, x34 * x449)
                 - Self::mul_add(qd[0], x536, x444 * x535)
                 + Self::mul_add(
                     f_ext[1][5],
                     c_q0,
-                    Self::mul_add(f_ext[1][4], x7, f_ext[1][3] * x6),
-                ) + x596 + Self::mul_add(-x32, x583, x33 * x582),
+                    Self::mul_add(f_ext[1][4], x12, f_ext[1][3] * x11),
+                ) + x596 + Self::mul_add(-x37, x583, x38 * x582),
             s_q0
-                * (Self::mul_add(x26, x450, x24 * x449)
+                * (Self::mul_add(x31, x450, x29 * x449)
                     - Self::mul_add(-qd[0], x537, x445 * x535)
                     + Self::mul_add(
                         -f_ext[1][5],
                         s_q0,
-                        Self::mul_add(f_ext[1][4], x5, f_ext[1][3] * x4),
-                    ) + x595 - Self::mul_add(x32, x584, x34 * x582)),
+                        Self::mul_add(f_ext[1][4], x10, f_ext[1][3] * x9),
+                    ) + x595 - Self::mul_add(x37, x584, x39 * x582)),
         );
         let x599 = 1.0
-            / (12.19 + (x17 + x236)
-                - (x402 + Self::mul_add(-x33, x280, x34 * x281)
+            / (12.19 + (x22 + x236)
+                - (x402 + Self::mul_add(-x38, x280, x39 * x281)
                     - Self::mul_add(
-                        x1,
-                        Self::mul_add(105.98, x1, x280),
-                        x2 * Self::mul_add(105.98, x2, x281),
+                        x7,
+                        Self::mul_add(105.98, x7, x280),
+                        x8 * Self::mul_add(105.98, x8, x281),
                     )));
         let x600 = x405 * x599;
         let x601 = x406 * x599;
@@ -6114,7 +6133,7 @@ impl SsrmsRecurrent {
         let x617 = Self::mul_add(
             -x406,
             x601,
-            Self::mul_add(-x7, x421, Self::mul_add(-x5, x420, s_q1 * x419)),
+            Self::mul_add(-x12, x421, Self::mul_add(-x10, x420, s_q1 * x419)),
         );
         let x618 = 1.0 / Self::mul_add(-x607, x608, x617);
         let x619 = Self::mul_add(-x607, x610, Self::mul_add(-x406, x602, x423));
@@ -6128,7 +6147,7 @@ impl SsrmsRecurrent {
         let x627 = Self::mul_add(
             -x407,
             x602,
-            Self::mul_add(-x7, x431, Self::mul_add(-x5, x430, s_q1 * x429)),
+            Self::mul_add(-x12, x431, Self::mul_add(-x10, x430, s_q1 * x429)),
         );
         let x628 = 1.0 / Self::mul_add(-x619, x620, Self::mul_add(-x609, x610, x627));
         let x629 = Self::mul_add(
@@ -6152,7 +6171,7 @@ impl SsrmsRecurrent {
         let x635 = Self::mul_add(
             -x408,
             x603,
-            Self::mul_add(x7, x438, Self::mul_add(x5, x437, s_q1 * x436)),
+            Self::mul_add(x12, x438, Self::mul_add(x10, x437, s_q1 * x436)),
         );
         let x636 = Self::mul_add(
             -x629,
@@ -6177,7 +6196,7 @@ impl SsrmsRecurrent {
         let x644 = Self::mul_add(
             -x409,
             x604,
-            Self::mul_add(x97, x443, Self::mul_add(x95, x442, x93 * x441)),
+            Self::mul_add(x99, x443, Self::mul_add(x97, x442, x95 * x441)),
         );
         let x645 = Self::mul_add(
             -x631,
@@ -6188,7 +6207,7 @@ impl SsrmsRecurrent {
         let x647 = Self::mul_add(
             -x409,
             x605,
-            Self::mul_add(x97, x412, Self::mul_add(x95, x411, x93 * x410)),
+            Self::mul_add(x99, x412, Self::mul_add(x97, x411, x95 * x410)),
         );
         let x648 = Self::mul_add(
             -x631,
@@ -6200,7 +6219,7 @@ impl SsrmsRecurrent {
         let x651 = Self::mul_add(
             -x410,
             x605,
-            Self::mul_add(x118, x412, Self::mul_add(x116, x411, x114 * x410)),
+            Self::mul_add(x119, x412, Self::mul_add(x117, x411, x115 * x410)),
         );
         let x652 = Self::mul_add(
             -x633,
@@ -6212,19 +6231,19 @@ impl SsrmsRecurrent {
         let x655 = Self::mul_add(
             x597,
             x601,
-            tau[2] - Self::mul_add(-x7, x596, Self::mul_add(-x5, x595, s_q1 * x594)),
+            tau[2] - Self::mul_add(-x12, x596, Self::mul_add(-x10, x595, s_q1 * x594)),
         );
         let x656 = Self::mul_add(-x608, x654, x655);
         let x657 = Self::mul_add(
             x597,
             x602,
-            tau[3] - Self::mul_add(-x7, x593, Self::mul_add(-x5, x592, s_q1 * x591)),
+            tau[3] - Self::mul_add(-x12, x593, Self::mul_add(-x10, x592, s_q1 * x591)),
         );
         let x658 = Self::mul_add(-x620, x656, Self::mul_add(-x610, x654, x657));
         let x659 = Self::mul_add(
             x597,
             x603,
-            tau[4] - Self::mul_add(x7, x590, Self::mul_add(x5, x589, s_q1 * x588)),
+            tau[4] - Self::mul_add(x12, x590, Self::mul_add(x10, x589, s_q1 * x588)),
         );
         let x660 = Self::mul_add(
             -x630,
@@ -6234,7 +6253,7 @@ impl SsrmsRecurrent {
         let x661 = Self::mul_add(
             -x597,
             x604,
-            tau[5] + Self::mul_add(x97, x587, Self::mul_add(x95, x586, x93 * x585)),
+            tau[5] + Self::mul_add(x99, x587, Self::mul_add(x97, x586, x95 * x585)),
         );
         let x662 = Self::mul_add(
             x632,
@@ -6245,7 +6264,7 @@ impl SsrmsRecurrent {
         let x664 = Self::mul_add(
             -x597,
             x605,
-            tau[6] + Self::mul_add(x118, x572, Self::mul_add(x116, x571, x114 * x570)),
+            tau[6] + Self::mul_add(x119, x572, Self::mul_add(x117, x571, x115 * x570)),
         );
         let x665 = Self::mul_add(
             x634,
@@ -6314,13 +6333,21 @@ impl SsrmsRecurrent {
             )
         )] { a * b + c }
     }
-    /// `(sin x, cos x)`, as this type's functions take them: branch-free and inlined for
-    /// `|x| < 32768` (`x = kπ/128 + r`; a table of 128 sines for `kπ/128`, Taylor polynomials
-    /// to `r⁵` and `r⁶` for `|r| ≤ π/256`), `libm::sincos` beyond. Within 1 ulp of 1 of
-    /// libm's (`kanegen accuracy` measures it).
+    /// `(sin x, cos x)`, as this type's functions take them: [`Self::sincos_n`] of one angle.
     #[inline(always)]
     #[must_use]
     pub fn sincos(x: f64) -> (f64, f64) {
+        let [sc] = Self::sincos_n([x]);
+        sc
+    }
+    /// `(sin x, cos x)` of `N` angles at once (the functions take every joint angle's in one
+    /// call): branch-free and inlined for `|x| < 32768` (`x = kπ/128 + r`; a table of 128
+    /// sines for `kπ/128`, Taylor polynomials to `r⁵` and `r⁶` for `|r| ≤ π/256`),
+    /// `libm::sincos` for all `N` if one is beyond. Within 1 ulp of 1 of libm's
+    /// (`kanegen accuracy` measures it).
+    #[inline(always)]
+    #[must_use]
+    pub fn sincos_n<const N: usize>(x: [f64; N]) -> [(f64, f64); N] {
         /// `sin(kπ/128)`, `k = 0, …, 127`, correctly rounded.
         const SIN_TABLE: [f64; 128] = [
             0.0,
@@ -6457,28 +6484,42 @@ impl SsrmsRecurrent {
         const C2: f64 = -0.5;
         const C4: f64 = 1.0 / 24.0;
         const C6: f64 = -1.0 / 720.0;
-        if !(x > -32768.0 && x < 32768.0) {
-            return libm::sincos(x);
+        let mut fast = true;
+        for v in x {
+            fast &= v > -32768.0 && v < 32768.0;
         }
-        let t = Self::mul_add(x, 40.74366543152521, 6755399441055744.0);
-        let k = t - 6755399441055744.0;
-        let i = (t.to_bits() & 255) as usize;
-        let r_hi = Self::mul_add(-k, 0.024543692605220713, x);
-        let r = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
-        let r2 = r * r;
-        let r3 = r * r2;
-        let p_s = Self::mul_add(r2, S5, S3);
-        let sin_r = Self::mul_add(r3, p_s, r);
-        let p_c6 = Self::mul_add(r2, C6, C4);
-        let p_c = Self::mul_add(r2, p_c6, C2);
-        let cos_r = Self::mul_add(r2, p_c, 1.0);
+        if !fast {
+            return x.map(libm::sincos);
+        }
+        let (mut t, mut r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            t[i] = Self::mul_add(x[i], 40.74366543152521, 6755399441055744.0);
+            let k = t[i] - 6755399441055744.0;
+            let r_hi = Self::mul_add(-k, 0.024543692605220713, x[i]);
+            r[i] = Self::mul_add(-k, 9.495469541415925e-13, r_hi);
+        }
+        let (mut sin_r, mut cos_r) = ([0.0; N], [0.0; N]);
+        for i in 0..N {
+            let r2 = r[i] * r[i];
+            let r3 = r[i] * r2;
+            let p_s = Self::mul_add(r2, S5, S3);
+            sin_r[i] = Self::mul_add(r3, p_s, r[i]);
+            let p_c6 = Self::mul_add(r2, C6, C4);
+            let p_c = Self::mul_add(r2, p_c6, C2);
+            cos_r[i] = Self::mul_add(r2, p_c, 1.0);
+        }
         let table = |j: usize| {
             f64::from_bits(SIN_TABLE[j & 127].to_bits() ^ (((j & 128) as u64) << 56))
         };
-        let (sin_a, cos_a) = (table(i), table(i + 64));
-        (
-            Self::mul_add(sin_a, cos_r, cos_a * sin_r),
-            Self::mul_add(cos_a, cos_r, -(sin_a * sin_r)),
-        )
+        let mut out = [(0.0, 0.0); N];
+        for i in 0..N {
+            let j = (t[i].to_bits() & 255) as usize;
+            let (sin_a, cos_a) = (table(j), table(j + 64));
+            out[i] = (
+                Self::mul_add(sin_a, cos_r[i], cos_a * sin_r[i]),
+                Self::mul_add(cos_a, cos_r[i], -(sin_a * sin_r[i])),
+            );
+        }
+        out
     }
 }
