@@ -290,3 +290,12 @@ pub fn choose(
         winner,
     ))
 }
+
+/// Whether any chosen candidate takes a sine or a cosine (then the generated type carries its
+/// own `sincos`, [`crate::sincos`], and the header says so).
+#[must_use]
+pub fn takes_trig(choices: &[Choice]) -> bool {
+    choices
+        .iter()
+        .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0))
+}

@@ -115,14 +115,11 @@ pub fn lines(
             ),
         },
     ];
-    if opts.table_sincos()
-        && choices
-            .iter()
-            .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0))
-    {
+    if opts.table_sincos() && crate::choose::takes_trig(choices) {
         h.push(
-            "Sines and cosines: `Self::sincos`, inlined and branch-free for |x| < 32768 (a table \
-             of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), \
+            "Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each \
+             function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a \
+             table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), \
              `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it)."
                 .into(),
         );

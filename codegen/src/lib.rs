@@ -368,11 +368,7 @@ fn generate_items_with(
     };
     // The type's own sine–cosine, where a function takes one (its products fused through
     // `Self::mul_add` like the functions').
-    let sincos_item = opts.table_sincos()
-        && (compact
-            || choices
-                .iter()
-                .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0)));
+    let sincos_item = opts.table_sincos() && (compact || choose::takes_trig(&choices));
     let target_mul_add = !opts.fma && opts.target_fma;
     let mul_add_item = if target_mul_add && (sincos_item || fmas.iter().any(|k| *k > 0)) {
         mul_add_fn(opts.float)
