@@ -1,9 +1,10 @@
 //! Generated forward dynamics by the articulated-body algorithm, where it is the cheaper: a
 //! random chain of 32 joints with gravity (`benches/data/random_n32.toml`: general geometry,
 //! ABA 25462 operations against 37129 for the cheapest LDLᵀ) through `kanegen::dynamics!`, and
-//! the free-floating 7-dof arm of `kanegen-generated`: the emitted code chose ABA, says so in
-//! `OP_COUNTS`, and equals the interpreted ABA to 1e-12 (8e-14 measured), and LDLᵀ to 1e-12 on
-//! the free-flyer, to 1e-10 on the 32-joint chain (cond(M) up to 1e5 there; 8e-13 measured).
+//! the free-floating 7-dof arm of `kanegen-generated` with ABA forced (its checked-in file takes
+//! LDLᵀ, 2839 operations against ABA's 2869): the emitted code says so in `OP_COUNTS`, and
+//! equals the interpreted ABA to 1e-12 (8e-14 measured), and LDLᵀ to 1e-12 on the free-flyer,
+//! to 1e-10 on the 32-joint chain (cond(M) up to 1e5 there; 8e-13 measured).
 //! SSRMS (coordinate axes) keeps LDLᵀ, the cheaper there, and equals both to 1e-12.
 
 use kanegen::dynamics::algorithms::{aba, floating};
@@ -17,6 +18,16 @@ use kanegen::model::Model;
 use kanegen_generated::free_floating_7dof::FreeFloating7;
 use kanegen_generated::ssrms::Ssrms;
 use std::path::Path;
+
+// The free-floating arm of `kanegen-generated` with ABA forced: its checked-in file takes LDLᵀ,
+// the cheaper since the two-step inertia carry through near-permutation placements.
+kanegen::dynamics!(
+    FreeFloating7Aba,
+    "tests/data/reference/bmsd_7dof_free_floating.urdf",
+    base = "free-floating",
+    allow_nonphysical = true,
+    algorithm = "aba",
+);
 
 kanegen::dynamics!(
     RandomN32,
@@ -147,14 +158,17 @@ fn generated_aba_equals_interpreted_forward_dynamics() {
     );
 }
 
-/// The checked-in free-floating 7-dof arm chose ABA: its `forward_dynamics` equals the
-/// interpreted floating ABA and LDLᵀ, the model's own and regrouped parameters alike.
+/// The free-floating 7-dof arm, generated with ABA forced and checked in with the cheapest
+/// method (LDLᵀ): both `forward_dynamics` equal the interpreted floating ABA and LDLᵀ, the
+/// model's own and regrouped parameters alike.
 #[test]
-fn generated_floating_aba_equals_interpreted() {
-    assert_aba_chosen!(
-        FreeFloating7,
-        ["forward_dynamics", "forward_dynamics_with_wrenches"]
-    );
+fn generated_floating_fd_equals_interpreted() {
+    for f in ["forward_dynamics", "forward_dynamics_with_wrenches"] {
+        let forced = FreeFloating7Aba::OP_COUNTS.iter().find(|c| c.function == f);
+        assert_eq!(forced.unwrap().forward_method, Some("aba"), "{f}");
+        let chosen = FreeFloating7::OP_COUNTS.iter().find(|c| c.function == f);
+        assert_eq!(chosen.unwrap().forward_method, Some("ldlt"), "{f}");
+    }
     let g = kanegen::cli::commands::generate::GENERATED
         .iter()
         .find(|g| g.type_name == "FreeFloating7")
@@ -195,7 +209,15 @@ fn generated_floating_aba_equals_interpreted() {
                 false,
             ),
             (
+                FreeFloating7Aba::forward_dynamics(&q, &v, &tau).to_vec(),
+                false,
+            ),
+            (
                 FreeFloating7::forward_dynamics_with_wrenches(&q, &v, &tau, &f_ext).to_vec(),
+                true,
+            ),
+            (
+                FreeFloating7Aba::forward_dynamics_with_wrenches(&q, &v, &tau, &f_ext).to_vec(),
                 true,
             ),
         ];

@@ -17,6 +17,8 @@ kanegen::dynamics!(
     "tests/data/codegen/random5.toml",
     canonical = false
 );
+// xArm7 writes `rpy = 1.5708` for π/2: every placement 3.7e-6 off a signed permutation.
+kanegen::dynamics!(XArm7, "tests/data/erd/xarm7.urdf");
 kanegen::dynamics!(
     Random5Libm,
     "tests/data/codegen/random5.toml",
@@ -560,4 +562,38 @@ fn libm_trig_gives_the_same_dynamics() {
             assert!((s - s0).abs() <= f64::EPSILON && (c - c0).abs() <= f64::EPSILON);
         }
     }
+}
+
+/// xArm7's placements are 3.7e-6 off signed permutations: the generator also traces the
+/// two-step inertia carry through them (`NEAR_PERMUTATION`) and emits it where cheaper — its
+/// mass matrix in fewer operations than any candidate with exact permutations only — and every
+/// function still equals every interpreted algorithm.
+#[test]
+fn near_permutation_placements_take_the_two_step_carry() {
+    use kanegen::dynamics::params::NEAR_PERMUTATION;
+    use kanegen::trace::{trace, Convention, Function, Spec, Subject};
+    let m = load("tests/data/erd/xarm7.urdf");
+    let ops = |tol: f64| {
+        let spec = Spec {
+            regroup: true,
+            two_step_placement: tol,
+            ..Spec::default()
+        };
+        let t = trace(
+            Subject::Model(&m),
+            Function::MassMatrix,
+            Methods::SPATIAL,
+            &spec,
+        )
+        .unwrap();
+        t.trace.counts(Convention::Emitted).total()
+    };
+    let (exact, near) = (ops(0.0), ops(NEAR_PERMUTATION));
+    let emitted = XArm7::OP_COUNTS
+        .iter()
+        .find(|c| c.function == "mass_matrix")
+        .unwrap();
+    assert!(near < exact, "{near} against {exact}");
+    assert_eq!(emitted.mul + emitted.add, near);
+    check_constant_model!(XArm7, 7, "tests/data/erd/xarm7.urdf");
 }

@@ -6,8 +6,9 @@
 //! frames ([`BodyFrames`]).
 
 use crate::options::Options;
+use kanegen_dynamics::params::{coordinate_axis, is_near_signed_permutation, NEAR_PERMUTATION};
 use kanegen_dynamics::{BiasMethod, ForwardMethod, MassMatrixMethod, Methods};
-use kanegen_model::{BaseKind, Model};
+use kanegen_model::{BaseKind, JointKind, Model};
 use kanegen_trace::{trace, Base, Convention, Counts, Function, Spec, Subject, TraceError, Traced};
 
 /// The body frames a candidate is traced in.
@@ -267,8 +268,21 @@ pub fn choose(
                 (BodyFrames::Canonical, None) => continue,
                 (BodyFrames::Model, _) => model,
             };
-            let t = trace(Subject::Model(subject), f, m, &spec)?;
-            let c = t.trace.counts(Convention::Emitted);
+            let mut t = trace(Subject::Model(subject), f, m, &spec)?;
+            let mut c = t.trace.counts(Convention::Emitted);
+            // Placements near a signed permutation: the two-step inertia carry through them
+            // too, kept where it is cheaper (`kanegen_dynamics::params::NEAR_PERMUTATION`).
+            if f.uses_mass_matrix() && has_near_permutation(subject) {
+                let near = Spec {
+                    two_step_placement: NEAR_PERMUTATION,
+                    ..spec.clone()
+                };
+                let t2 = trace(Subject::Model(subject), f, m, &near)?;
+                let c2 = t2.trace.counts(Convention::Emitted);
+                if c2.total() < c.total() {
+                    (t, c) = (t2, c2);
+                }
+            }
             traced.push(Candidate {
                 methods: m,
                 frames: fr,
@@ -298,4 +312,16 @@ pub fn takes_trig(choices: &[Choice]) -> bool {
     choices
         .iter()
         .any(|ch| ch.candidate().is_some_and(|c| c.counts.sincos > 0))
+}
+
+/// Whether a revolute joint about a coordinate axis of `model` is placed near a signed
+/// permutation ([`NEAR_PERMUTATION`]) but not exactly on one: the two-step inertia carry is then
+/// worth a second trace.
+fn has_near_permutation(model: &Model) -> bool {
+    model.joints().iter().any(|j| {
+        j.kind == JointKind::Revolute
+            && coordinate_axis(j.axis).is_some()
+            && is_near_signed_permutation(&j.origin.rotation, NEAR_PERMUTATION)
+            && !is_near_signed_permutation(&j.origin.rotation, 0.0)
+    })
 }

@@ -47,12 +47,12 @@ pub fn xup_trig<S: Scalar>(jp: &JointParams<S>, q: &S) -> XupTrig<S> {
 /// `Xup_jᵀ I Xup_j`: the inertia `i` of body `j` (its frame) carried to its parent's frame
 /// (RBDA Table 2.5, the backward loop of Table 6.2). `(x, trig)` is [`xup_trig`] of `q_j`. A
 /// revolute joint about a coordinate axis ([`JointParams::coordinate_axis`]) placed by a signed
-/// permutation ([`JointParams::placement_permutation`]) goes in two steps,
-/// `Xtreeᵀ (XJᵀ I XJ) Xtree`: the joint's own turn in double-angle form
-/// ([`RbInertia::turned_about_axis`], sharing `q`'s sine and cosine with `x`), then the
-/// placement, which only permutes axes; any other joint through `x` at once (measured: after a
-/// dense placement the two steps cost more, as the products of the double-angle terms with the
-/// placement's numbers are not shared).
+/// permutation, or within [`crate::params::NEAR_PERMUTATION`] of one
+/// ([`JointParams::placement_permutation`]), goes in two steps, `Xtreeᵀ (XJᵀ I XJ) Xtree`: the
+/// joint's own turn in double-angle form ([`RbInertia::turned_about_axis`], sharing `q`'s sine
+/// and cosine with `x`), then the placement (its true rotation); any other joint through `x` at
+/// once (measured: after a dense placement the two steps cost more, as the products of the
+/// double-angle terms with the placement's numbers are not shared).
 pub fn carry_inertia<S: Scalar>(
     jp: &JointParams<S>,
     (x, trig): &XupTrig<S>,

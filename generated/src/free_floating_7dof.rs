@@ -10,7 +10,7 @@
 //! Float noise: 1 number snapped to exact 0 or ±1 (tolerance 1e-15, the largest change 4.2e-20).
 //! Algorithm: per function the cheapest candidate (below).
 //! Sines and cosines: every joint angle's in one `Self::sincos_n` at the top of each function, inlined, branch-free for |x| < 32768 and vectorized across the angles (a table of 128 sines and Taylor polynomials to r⁶ for the remainder, |r| ≤ π/256), `libm::sincos` beyond; within 1 ulp of 1 of libm's (`kanegen accuracy` measures it).
-//! Fused multiply-adds where the target has them: 4120 (`mass_matrix` 303, `nonlinear_effects` 317, `inverse_dynamics` 332, `forward_dynamics` 953, `mass_matrix_and_nonlinear_effects` 620, `forward_dynamics_with_wrenches` 954, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
+//! Fused multiply-adds where the target has them: 4168 (`mass_matrix` 276, `nonlinear_effects` 317, `inverse_dynamics` 332, `forward_dynamics` 1003, `mass_matrix_and_nonlinear_effects` 593, `forward_dynamics_with_wrenches` 1006, `momentum` 215, `base_reaction` 426), each `Self::mul_add(a, b, c)`: one instruction, rounded once, when the build targets FMA (x86-64 with `target_feature = "fma"`, e.g. `-C target-cpu=native`; AArch64), and `a·b + c` otherwise, where the code is bit-identical to unfused code. The counts below count each as 1 mul + 1 add.
 //! Form: unrolled straight-line code (auto: the compact form does not support a free-floating base yet).
 //!
 //! Emitted operation counts per candidate (the cheapest in mul + add is emitted, *; forward dynamics by `ldlt` on `M` and `c`, or by `aba`, the articulated-body algorithm, which uses neither; frames: the model's own body frames, or its canonical ones, every joint axis z and modified-DH x, `Model::canonical`, which give the same joint-space results):
@@ -25,8 +25,8 @@
 //! | `mass_matrix` | `kane-direct` | — | — | canonical | 3469 | 2908 | 0 | 0 | 7 | 6377 |
 //! | `mass_matrix` | `crba-base` | — | — | model | 1303 | 1037 | 0 | 0 | 7 | 2340 |
 //! | `mass_matrix` | `crba-base` | — | — | canonical | 1318 | 1052 | 0 | 0 | 7 | 2370 |
-//! | `mass_matrix` * | `crba` | — | — | model | 556 | 507 | 0 | 0 | 7 | 1063 |
-//! | `mass_matrix` | `crba` | — | — | canonical | 567 | 511 | 0 | 0 | 7 | 1078 |
+//! | `mass_matrix` * | `crba` | — | — | model | 490 | 464 | 0 | 0 | 7 | 954 |
+//! | `mass_matrix` | `crba` | — | — | canonical | 511 | 479 | 0 | 0 | 7 | 990 |
 //! | `nonlinear_effects` | — | `recurrent` | — | model | 1147 | 881 | 0 | 0 | 7 | 2028 |
 //! | `nonlinear_effects` | — | `recurrent` | — | canonical | 1162 | 896 | 0 | 0 | 7 | 2058 |
 //! | `nonlinear_effects` | — | `kane-direct` | — | model | 1564 | 1276 | 0 | 0 | 7 | 2840 |
@@ -43,14 +43,14 @@
 //! | `inverse_dynamics` | — | `rnea` | — | canonical | 672 | 548 | 0 | 0 | 7 | 1220 |
 //! | `inverse_dynamics` * | — | `newton-euler` | — | model | 543 | 458 | 0 | 0 | 7 | 1001 |
 //! | `inverse_dynamics` | — | `newton-euler` | — | canonical | 545 | 458 | 0 | 0 | 7 | 1003 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2203 | 1827 | 10 | 0 | 7 | 4030 |
-//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2229 | 1846 | 10 | 0 | 7 | 4075 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2620 | 2222 | 10 | 0 | 7 | 4842 |
-//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2646 | 2241 | 10 | 0 | 7 | 4887 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1679 | 1446 | 10 | 0 | 7 | 3125 |
-//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1692 | 1450 | 10 | 0 | 7 | 3142 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1372 | 10 | 0 | 7 | 2948 |
-//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1589 | 1376 | 10 | 0 | 7 | 2965 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | model | 2137 | 1784 | 10 | 0 | 7 | 3921 |
+//! | `forward_dynamics` | `crba` | `recurrent` | `ldlt` | canonical | 2173 | 1814 | 10 | 0 | 7 | 3987 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | model | 2554 | 2179 | 10 | 0 | 7 | 4733 |
+//! | `forward_dynamics` | `crba` | `kane-direct` | `ldlt` | canonical | 2590 | 2209 | 10 | 0 | 7 | 4799 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | model | 1613 | 1403 | 10 | 0 | 7 | 3016 |
+//! | `forward_dynamics` | `crba` | `rnea` | `ldlt` | canonical | 1636 | 1418 | 10 | 0 | 7 | 3054 |
+//! | `forward_dynamics` * | `crba` | `newton-euler` | `ldlt` | model | 1510 | 1329 | 10 | 0 | 7 | 2839 |
+//! | `forward_dynamics` | `crba` | `newton-euler` | `ldlt` | canonical | 1533 | 1344 | 10 | 0 | 7 | 2877 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | model | 2505 | 2118 | 13 | 0 | 7 | 4623 |
 //! | `forward_dynamics` | `crba-base` | `recurrent` | `ldlt` | canonical | 2520 | 2133 | 13 | 0 | 7 | 4653 |
 //! | `forward_dynamics` | `crba-base` | `kane-direct` | `ldlt` | model | 2922 | 2513 | 13 | 0 | 7 | 5435 |
@@ -59,16 +59,16 @@
 //! | `forward_dynamics` | `crba-base` | `rnea` | `ldlt` | canonical | 2562 | 2081 | 13 | 0 | 7 | 4643 |
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | model | 2442 | 1992 | 13 | 0 | 7 | 4434 |
 //! | `forward_dynamics` | `crba-base` | `newton-euler` | `ldlt` | canonical | 2459 | 2007 | 13 | 0 | 7 | 4466 |
-//! | `forward_dynamics` * | — | — | `aba` | model | 1592 | 1277 | 12 | 0 | 7 | 2869 |
+//! | `forward_dynamics` | — | — | `aba` | model | 1592 | 1277 | 12 | 0 | 7 | 2869 |
 //! | `forward_dynamics` | — | — | `aba` | canonical | 1601 | 1280 | 12 | 0 | 7 | 2881 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1703 | 1388 | 0 | 0 | 7 | 3091 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1729 | 1407 | 0 | 0 | 7 | 3136 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2120 | 1783 | 0 | 0 | 7 | 3903 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2146 | 1802 | 0 | 0 | 7 | 3948 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1179 | 1007 | 0 | 0 | 7 | 2186 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1192 | 1011 | 0 | 0 | 7 | 2203 |
-//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1076 | 933 | 0 | 0 | 7 | 2009 |
-//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1089 | 937 | 0 | 0 | 7 | 2026 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | model | 1637 | 1345 | 0 | 0 | 7 | 2982 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `recurrent` | — | canonical | 1673 | 1375 | 0 | 0 | 7 | 3048 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | model | 2054 | 1740 | 0 | 0 | 7 | 3794 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `kane-direct` | — | canonical | 2090 | 1770 | 0 | 0 | 7 | 3860 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | model | 1113 | 964 | 0 | 0 | 7 | 2077 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `rnea` | — | canonical | 1136 | 979 | 0 | 0 | 7 | 2115 |
+//! | `mass_matrix_and_nonlinear_effects` * | `crba` | `newton-euler` | — | model | 1010 | 890 | 0 | 0 | 7 | 1900 |
+//! | `mass_matrix_and_nonlinear_effects` | `crba` | `newton-euler` | — | canonical | 1033 | 905 | 0 | 0 | 7 | 1938 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | model | 1894 | 1591 | 0 | 0 | 7 | 3485 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `recurrent` | — | canonical | 1909 | 1606 | 0 | 0 | 7 | 3515 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `kane-direct` | — | model | 2311 | 1986 | 0 | 0 | 7 | 4297 |
@@ -77,15 +77,15 @@
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `rnea` | — | canonical | 1951 | 1554 | 0 | 0 | 7 | 3505 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | model | 1831 | 1465 | 0 | 0 | 7 | 3296 |
 //! | `mass_matrix_and_nonlinear_effects` | `crba-base` | `newton-euler` | — | canonical | 1848 | 1480 | 0 | 0 | 7 | 3328 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2347 | 1971 | 10 | 0 | 7 | 4318 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2764 | 2366 | 10 | 0 | 7 | 5130 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1679 | 1494 | 10 | 0 | 7 | 3173 |
-//! | `forward_dynamics_with_wrenches` | `crba` | `newton-euler` | `ldlt` | model | 1576 | 1420 | 10 | 0 | 7 | 2996 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `recurrent` | `ldlt` | model | 2281 | 1928 | 10 | 0 | 7 | 4209 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `kane-direct` | `ldlt` | model | 2698 | 2323 | 10 | 0 | 7 | 5021 |
+//! | `forward_dynamics_with_wrenches` | `crba` | `rnea` | `ldlt` | model | 1613 | 1451 | 10 | 0 | 7 | 3064 |
+//! | `forward_dynamics_with_wrenches` * | `crba` | `newton-euler` | `ldlt` | model | 1510 | 1377 | 10 | 0 | 7 | 2887 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `recurrent` | `ldlt` | model | 2649 | 2262 | 13 | 0 | 7 | 4911 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `kane-direct` | `ldlt` | model | 3066 | 2657 | 13 | 0 | 7 | 5723 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `rnea` | `ldlt` | model | 2545 | 2114 | 13 | 0 | 7 | 4659 |
 //! | `forward_dynamics_with_wrenches` | `crba-base` | `newton-euler` | `ldlt` | model | 2442 | 2040 | 13 | 0 | 7 | 4482 |
-//! | `forward_dynamics_with_wrenches` * | — | — | `aba` | model | 1592 | 1325 | 12 | 0 | 7 | 2917 |
+//! | `forward_dynamics_with_wrenches` | — | — | `aba` | model | 1592 | 1325 | 12 | 0 | 7 | 2917 |
 //! | `momentum` * | — | — | — | model | 350 | 283 | 0 | 0 | 7 | 633 |
 //! | `base_reaction` * | — | `recurrent` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
 //! | `base_reaction` | — | `kane-direct` | — | model | 688 | 566 | 0 | 0 | 7 | 1254 |
@@ -161,12 +161,12 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 556u64,
-            add: 507u64,
+            mul: 490u64,
+            add: 464u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 303u64,
+            fma: 276u64,
         },
         OpCount {
             function: "nonlinear_effects",
@@ -196,16 +196,16 @@ impl FreeFloating7 {
         },
         OpCount {
             function: "forward_dynamics",
-            mass_matrix_method: None,
-            bias_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1592u64,
-            add: 1277u64,
-            div: 12u64,
+            mul: 1510u64,
+            add: 1329u64,
+            div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 953u64,
+            fma: 1003u64,
         },
         OpCount {
             function: "mass_matrix_and_nonlinear_effects",
@@ -213,25 +213,25 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1076u64,
-            add: 933u64,
+            mul: 1010u64,
+            add: 890u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 620u64,
+            fma: 593u64,
         },
         OpCount {
             function: "forward_dynamics_with_wrenches",
-            mass_matrix_method: None,
-            bias_method: None,
-            forward_method: Some("aba"),
+            mass_matrix_method: Some("crba"),
+            bias_method: Some("newton-euler"),
+            forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1592u64,
-            add: 1325u64,
-            div: 12u64,
+            mul: 1510u64,
+            add: 1377u64,
+            div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
-            fma: 954u64,
+            fma: 1006u64,
         },
         OpCount {
             function: "momentum",
@@ -372,8 +372,8 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "model",
-            mul: 556u64,
-            add: 507u64,
+            mul: 490u64,
+            add: 464u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -385,8 +385,8 @@ impl FreeFloating7 {
             bias_method: None,
             forward_method: None,
             frames: "canonical",
-            mul: 567u64,
-            add: 511u64,
+            mul: 511u64,
+            add: 479u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -606,8 +606,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2203u64,
-            add: 1827u64,
+            mul: 2137u64,
+            add: 1784u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -619,8 +619,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 2229u64,
-            add: 1846u64,
+            mul: 2173u64,
+            add: 1814u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -632,8 +632,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2620u64,
-            add: 2222u64,
+            mul: 2554u64,
+            add: 2179u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -645,8 +645,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 2646u64,
-            add: 2241u64,
+            mul: 2590u64,
+            add: 2209u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -658,8 +658,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1679u64,
-            add: 1446u64,
+            mul: 1613u64,
+            add: 1403u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -671,8 +671,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 1692u64,
-            add: 1450u64,
+            mul: 1636u64,
+            add: 1418u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -684,8 +684,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1576u64,
-            add: 1372u64,
+            mul: 1510u64,
+            add: 1329u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -697,8 +697,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "canonical",
-            mul: 1589u64,
-            add: 1376u64,
+            mul: 1533u64,
+            add: 1344u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -840,8 +840,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "model",
-            mul: 1703u64,
-            add: 1388u64,
+            mul: 1637u64,
+            add: 1345u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -853,8 +853,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: None,
             frames: "canonical",
-            mul: 1729u64,
-            add: 1407u64,
+            mul: 1673u64,
+            add: 1375u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -866,8 +866,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "model",
-            mul: 2120u64,
-            add: 1783u64,
+            mul: 2054u64,
+            add: 1740u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -879,8 +879,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: None,
             frames: "canonical",
-            mul: 2146u64,
-            add: 1802u64,
+            mul: 2090u64,
+            add: 1770u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -892,8 +892,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "model",
-            mul: 1179u64,
-            add: 1007u64,
+            mul: 1113u64,
+            add: 964u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -905,8 +905,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: None,
             frames: "canonical",
-            mul: 1192u64,
-            add: 1011u64,
+            mul: 1136u64,
+            add: 979u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -918,8 +918,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "model",
-            mul: 1076u64,
-            add: 933u64,
+            mul: 1010u64,
+            add: 890u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -931,8 +931,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: None,
             frames: "canonical",
-            mul: 1089u64,
-            add: 937u64,
+            mul: 1033u64,
+            add: 905u64,
             div: 0u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1048,8 +1048,8 @@ impl FreeFloating7 {
             bias_method: Some("recurrent"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2347u64,
-            add: 1971u64,
+            mul: 2281u64,
+            add: 1928u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1061,8 +1061,8 @@ impl FreeFloating7 {
             bias_method: Some("kane-direct"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 2764u64,
-            add: 2366u64,
+            mul: 2698u64,
+            add: 2323u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1074,8 +1074,8 @@ impl FreeFloating7 {
             bias_method: Some("rnea"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1679u64,
-            add: 1494u64,
+            mul: 1613u64,
+            add: 1451u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1087,8 +1087,8 @@ impl FreeFloating7 {
             bias_method: Some("newton-euler"),
             forward_method: Some("ldlt"),
             frames: "model",
-            mul: 1576u64,
-            add: 1420u64,
+            mul: 1510u64,
+            add: 1377u64,
             div: 10u64,
             sqrt: 0u64,
             sincos: 7u64,
@@ -1227,7 +1227,7 @@ impl FreeFloating7 {
     ];
     /// The joint-space inertia matrix `M(q)` (symmetric, both triangles written).
     ///
-    /// Methods: mass matrix `crba`: 556 mul, 507 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 303 fused where the target has FMA.
+    /// Methods: mass matrix `crba`: 490 mul, 464 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 276 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix(q: &[f64; 14]) -> [[f64; 13]; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -1249,702 +1249,682 @@ impl FreeFloating7 {
         let x13 = 0.00000000020510342851533115 * s_q12;
         let x14 = 0.00000000020510342851533115 * c_q12;
         let x15 = 0.00000000020510342851533115 * c_q13;
-        let x16 = 0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            - Self::mul_add(x16, 1.2025609200000003, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
-        let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(s_q13, 1.2025609200000003, x23)
-            - 0.00000000019719894748377882;
-        let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
-            + -0.0000000002899261911072858;
-        let x30 = 0.16 * x19;
-        let x31 = 0.55 * x18;
-        let x32 = x30 + x31;
-        let x33 = 0.55 * x17;
-        let x34 = 0.16 * x17;
-        let x35 = 0.16 * x18;
-        let x36 = 0.55 * x19;
-        let x37 = x32 + (x22 - Self::mul_add(-x16, x21, x15 * x20) + x32);
-        let x38 = 3.6140000000000003 + x17;
-        let x39 = 17.135250000000003 + x18;
-        let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
-        let x41 = -0.809539999555672
-            - (Self::mul_add(
-                0.00000000020510342851533115,
-                x22,
-                Self::mul_add(-s_q13, x21, c_q13 * x20),
-            ) + x34);
-        let x42 = -1.9877000000000002
-            - (x26 + Self::mul_add(-x16, x25, x15 * x23) + x33);
-        let x43 = -5.252920330000002
-            + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
-        let x44 = -2.741639999592316
-            - (x36
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x26,
-                    Self::mul_add(-s_q13, x25, c_q13 * x23),
-                ) + x35));
-        let x45 = -0.809539999555672 + (x29 - Self::mul_add(x16, x28, x15 * x27) - x34);
-        let x46 = -2.7416399995923166
-            - (x35 - (Self::mul_add(-c_q13, x28, s_q13 * x27) - x36));
-        let x47 = 9.740442170000001
-            + (x31
-                - (Self::mul_add(
-                    0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(s_q13, x28, c_q13 * x27),
-                ) - x31));
-        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
-        let x49 = x19 - Self::mul_add(x14, x39, x13 * x38);
-        let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
-        let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
-        let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
-        let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
-        let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x55 = x45 - Self::mul_add(x14, x42, x13 * x37);
-        let x56 = x46 - Self::mul_add(x14, x43, x13 * x40);
-        let x57 = x47 - Self::mul_add(x14, x44, x13 * x41);
-        let x58 = Self::mul_add(
-            0.00000000020510342851533115,
-            x47,
-            Self::mul_add(c_q12, x44, s_q12 * x41),
+        let x16 = s_q13 * s_q13;
+        let x17 = s_q13 * c_q13;
+        let x18 = Self::mul_add(x17, 0.001562, x16 * 1.2025609200000003);
+        let x19 = 0.000781 + Self::mul_add(x16, -0.001562, x17 * 1.2025609200000003);
+        let x20 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x21 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x22 = 4.806620000000001 * s_q13;
+        let x23 = 4.806620000000001 * c_q13;
+        let x24 = 0.00000000020510342851533115 * x22;
+        let x25 = Self::mul_add(-0.00000000020510342851533115, x18, x20);
+        let x26 = 0.00000000020510342851533115 * x20;
+        let x27 = 1.4135609200000003 + x26;
+        let x28 = x20 + -0.0000000002899261911072858;
+        let x29 = 0.16 * x22;
+        let x30 = 0.55 * x23;
+        let x31 = x29 + x30;
+        let x32 = x31 + (Self::mul_add(0.00000000020510342851533115, x25, x27) + x31);
+        let x33 = Self::mul_add(
+            0.55,
+            x22,
+            Self::mul_add(
+                0.16,
+                x23,
+                Self::mul_add(-0.00000000020510342851533115, x21, x19),
+            ),
         );
+        let x34 = 3.6140000000000003 + x24;
+        let x35 = 17.135250000000003 + x23;
+        let x36 = -1.9877000000000002
+            - Self::mul_add(
+                0.55,
+                x24,
+                Self::mul_add(0.00000000020510342851533115, x19, x21),
+            );
+        let x37 = -0.809539999555672
+            + Self::mul_add(
+                -0.16,
+                x24,
+                Self::mul_add(-0.00000000020510342851533115, x27, x25),
+            );
+        let x38 = -5.252920330000002 + (x29 + (-1.2025609200000003 + x18 + x29));
+        let x39 = -2.741639999592316 - x33;
+        let x40 = 9.740442170000001
+            + (x30
+                - (Self::mul_add(0.00000000020510342851533115, x28, x18 + x26) - x30));
+        let x41 = s_q12 * s_q12;
+        let x42 = s_q12 * c_q12;
+        let x43 = x32 - x38;
+        let x44 = x36 + x36;
+        let x45 = Self::mul_add(x42, x44, x41 * x43);
+        let x46 = x38 + x45;
+        let x47 = x36 + Self::mul_add(-x41, x44, x42 * x43);
+        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x37);
+        let x49 = Self::mul_add(c_q12, x39, s_q12 * x37);
+        let x50 = Self::mul_add(-s_q12, x35, c_q12 * x34);
+        let x51 = Self::mul_add(c_q12, x35, s_q12 * x34);
+        let x52 = Self::mul_add(-0.00000000020510342851533115, x51, x22);
+        let x53 = x24 + x51;
+        let x54 = Self::mul_add(-0.00000000020510342851533115, x47, x48);
+        let x55 = Self::mul_add(-0.00000000020510342851533115, x46, x49);
+        let x56 = 0.00000000020510342851533115 * x49;
+        let x57 = x40 - x56;
+        let x58 = Self::mul_add(0.00000000020510342851533115, x40, x49);
         let x59 = -x58;
-        let x60 = x54 - Self::mul_add(x14, x53, x13 * x52);
-        let x61 = Self::mul_add(
-            c_q12,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x46,
-                Self::mul_add(c_q12, x43, s_q12 * x40),
-            ),
-            s_q12
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x45,
-                    Self::mul_add(c_q12, x42, s_q12 * x37),
-                ),
-        );
-        let x62 = x51 * 0.36;
-        let x63 = Self::mul_add(
-            x48,
-            -0.36,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x54,
-                Self::mul_add(c_q12, x53, s_q12 * x52),
-            ),
-        );
-        let x64 = Self::mul_add(
-            x49,
-            -0.36,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x57,
-                Self::mul_add(c_q12, x56, s_q12 * x55),
-            ),
-        );
-        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) + x62);
-        let x66 = 7.078399999258757 + x49;
-        let x67 = 0.01675 - x63;
-        let x68 = -9.142025249762803
-            + (x62 + (x57 - Self::mul_add(x14, x56, x13 * x55) + x62));
-        let x69 = 2.5482240016099564 - x64;
-        let x70 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x58, x61);
-        let x71 = s_q11 * s_q11;
-        let x72 = s_q11 * c_q11;
-        let x73 = x65 - x68;
-        let x74 = x60 + x60;
-        let x75 = Self::mul_add(x72, x74, x71 * x73);
-        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
-        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
-        let x78 = 0.275 * x51;
-        let x79 = x77 * 0.63;
-        let x80 = x78 - x79;
-        let x81 = Self::mul_add(x76, 0.63, x60 + Self::mul_add(-x71, x74, x72 * x73));
-        let x82 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
-        let x83 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
-        let x84 = x70 - x79;
-        let x85 = x80 + (x65 - x75 + x80);
-        let x86 = -45.1584 + x77;
-        let x87 = -0.6328 + x82;
-        let x88 = -24.4950615 + (x78 + (x68 + x75 + x78));
-        let x89 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x83);
-        let x90 = 28.2393615 - (x79 - x84);
-        let x91 = s_q10 * s_q10;
-        let x92 = s_q10 * c_q10;
-        let x93 = x85 - x88;
-        let x94 = x81 + x81;
-        let x95 = Self::mul_add(x92, x94, x91 * x93);
-        let x96 = Self::mul_add(-s_q10, x89, c_q10 * x87);
-        let x97 = Self::mul_add(c_q10, x89, s_q10 * x87);
-        let x98 = c_q10 * x76;
-        let x99 = Self::mul_add(-s_q10, x86, x98);
-        let x100 = s_q10 * x76;
-        let x101 = Self::mul_add(c_q10, x86, x100);
-        let x102 = x101 * 0.87;
-        let x103 = Self::mul_add(x99, 0.87, x81 + Self::mul_add(-x91, x94, x92 * x93));
-        let x104 = x90 - x102;
-        let x105 = x102 - (x85 - x95 - x102);
-        let x106 = -81.53205 + x101;
-        let x107 = -0.00214 + x96;
-        let x108 = -63.36336825000001 + (x88 + x95);
-        let x109 = -36.18604050126307 + Self::mul_add(x51, -0.87, x97);
-        let x110 = 69.99836825 - (x102 - x104);
-        let x111 = s_q9 * x99;
-        let x112 = Self::mul_add(c_q9, x106, x111);
-        let x113 = 0.00000000020510342851533115 * x51;
-        let x114 = x112 - x113;
-        let x115 = x51 - Self::mul_add(-x12, x106, x11 * x99);
-        let x116 = c_q9 * x99;
-        let x117 = Self::mul_add(-s_q9, x106, x116);
-        let x118 = x113 + x117;
-        let x119 = c_q9 * x103;
-        let x120 = 0.00000000020510342851533115 * x107;
-        let x121 = Self::mul_add(s_q9, x105, -x119) - x120;
-        let x122 = s_q9 * x103;
-        let x123 = 0.00000000020510342851533115 * x109;
-        let x124 = Self::mul_add(c_q9, x108, x122) + x123;
-        let x125 = 0.00000000020510342851533115 * x110;
-        let x126 = Self::mul_add(c_q9, x109, s_q9 * x107) + x125;
-        let x127 = x107 - Self::mul_add(x12, x103, x11 * x105);
-        let x128 = x109 + Self::mul_add(-x12, x108, x11 * x103);
-        let x129 = x110 + Self::mul_add(-x12, x109, x11 * x107);
-        let x130 = x120 + Self::mul_add(c_q9, x105, x122);
-        let x131 = x123 - Self::mul_add(-s_q9, x108, x119);
-        let x132 = x125 - Self::mul_add(-s_q9, x109, c_q9 * x107);
-        let x133 = 0.00000000020510342851533115 * x126;
-        let x134 = 0.00000000020510342851533115 * x129;
-        let x135 = 0.00000000020510342851533115 * x132;
-        let x136 = 0.4 * x118;
-        let x137 = 0.275 * x115;
-        let x138 = x136 - x137;
-        let x139 = 0.275 * x114;
-        let x140 = 0.4 * x114;
-        let x141 = 0.4 * x115;
-        let x142 = 0.275 * x118;
-        let x143 = x138 - (Self::mul_add(-c_q9, x124, s_q9 * x121) - x133 - x138);
-        let x144 = -0.000000008530897668050218 + x114;
-        let x145 = -12.701650001451807 - x115;
-        let x146 = -0.0000000234896432582596
-            + (x126 - Self::mul_add(x12, x124, x11 * x121) - x139);
-        let x147 = -0.002139996587640933
-            - (x133 + Self::mul_add(s_q9, x124, c_q9 * x121) + x140);
-        let x148 = -0.0000000234896432582596
-            + (Self::mul_add(c_q9, x128, s_q9 * x127) + x134 - x139);
-        let x149 = -111.7548902508081
-            + (x136 + (x129 + Self::mul_add(-x12, x128, x11 * x127) + x136));
-        let x150 = 5.080660024070365
-            - (x142 + (x134 - Self::mul_add(-s_q9, x128, c_q9 * x127) - x141));
-        let x151 = -0.002139996587640933
-            - (Self::mul_add(c_q9, x131, s_q9 * x130) + x135 + x140);
-        let x152 = 5.080660024070366
-            + (x141 - (x132 + Self::mul_add(-x12, x131, x11 * x130) + x142));
-        let x153 = 113.3918902508081
-            - (x137 - (x135 - Self::mul_add(-s_q9, x131, c_q9 * x130) - x137));
-        let x154 = x118 - Self::mul_add(-x8, x145, x7 * x144);
-        let x155 = Self::mul_add(c_q8, x145, s_q8 * x144);
-        let x156 = Self::mul_add(-s_q8, x145, c_q8 * x144);
-        let x157 = Self::mul_add(0.00000000020510342851533115, x118, x156);
-        let x158 = x151 - Self::mul_add(-x8, x148, x7 * x143);
-        let x159 = x152 - Self::mul_add(-x8, x149, x7 * x146);
-        let x160 = x153 - Self::mul_add(-x8, x150, x7 * x147);
-        let x161 = Self::mul_add(c_q8, x148, s_q8 * x143);
-        let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
-        let x163 = Self::mul_add(c_q8, x150, s_q8 * x147);
-        let x164 = Self::mul_add(
-            0.00000000020510342851533115,
-            x153,
-            Self::mul_add(-s_q8, x150, c_q8 * x147),
-        );
-        let x165 = -x164;
-        let x166 = Self::mul_add(
-            -s_q8,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x152,
-                Self::mul_add(-s_q8, x149, c_q8 * x146),
-            ),
-            c_q8
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x151,
-                    Self::mul_add(-s_q8, x148, c_q8 * x143),
-                ),
-        );
-        let x167 = 0.35 * x157;
-        let x168 = Self::mul_add(
-            0.35,
-            x154,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x160,
-                Self::mul_add(-s_q8, x159, c_q8 * x158),
-            ),
-        );
-        let x169 = Self::mul_add(
-            0.35,
-            x155,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x163,
-                Self::mul_add(-s_q8, x162, c_q8 * x161),
-            ),
-        );
-        let x170 = x167 - (x160 - Self::mul_add(-x8, x159, x7 * x158) - x167);
-        let x171 = 48.0240000085309 + x154;
-        let x172 = -0.07309 + Self::mul_add(c_q8, x159, s_q8 * x158);
-        let x173 = -16.80768997608804 - x168;
-        let x174 = 130.43769025763282
-            - (x167 - (Self::mul_add(c_q8, x162, s_q8 * x161) - x167));
-        let x175 = 0.1132 - x169;
-        let x176 = 132.47349025763282
-            + Self::mul_add(0.00000000020510342851533115, x164, x166);
-        let x177 = s_q7 * s_q7;
-        let x178 = s_q7 * c_q7;
-        let x179 = x170 + x174;
-        let x180 = x172 + x172;
-        let x181 = Self::mul_add(-x178, x180, x177 * x179);
-        let x182 = Self::mul_add(-s_q7, x155, c_q7 * x171);
-        let x183 = Self::mul_add(c_q7, x155, s_q7 * x171);
-        let x184 = -x183;
-        let x185 = 0.75 * x157;
-        let x186 = 0.65 * x182;
-        let x187 = x185 - x186;
-        let x188 = Self::mul_add(-0.75, x182, Self::mul_add(-s_q7, x175, c_q7 * x173));
-        let x189 = Self::mul_add(
-            -0.65,
-            x183,
-            x172 - Self::mul_add(x177, x180, x178 * x179),
-        );
-        let x190 = Self::mul_add(-0.75, x183, Self::mul_add(c_q7, x175, s_q7 * x173));
-        let x191 = x176 + x186;
-        let x192 = 110.5455 + x182;
-        let x193 = 180.9502499901501 - x157;
-        let x194 = 1394.5960312283303 - (x185 + (x170 - x181 + x185));
-        let x195 = -117.61766249359756 + Self::mul_add(0.65, x157, x188);
-        let x196 = 1466.4506062283303 - (x187 - (x174 - x181 - x187));
-        let x197 = 1271.854575 + (x186 + x191);
-        let x198 = -x193;
-        let x199 = -x192;
-        let x200 = Self::mul_add(x8, x144, x7 * x145);
-        let x201 = Self::mul_add(-0.35, x156, x160);
-        let x202 = Self::mul_add(0.35, x200, x163);
-        let x203 = Self::mul_add(-s_q7, x156, c_q7 * x200);
-        let x204 = Self::mul_add(c_q7, x156, s_q7 * x200);
-        let x205 = Self::mul_add(-0.75, x204, Self::mul_add(-s_q7, x202, c_q7 * x201));
-        let x206 = Self::mul_add(c_q7, x202, s_q7 * x201)
-            + Self::mul_add(-0.65, x155, 0.75 * x203);
-        let x207 = -Self::mul_add(-0.65, x204, x164);
-        let x208 = x12 * x99;
-        let x209 = Self::mul_add(x11, x106, x208);
-        let x210 = x126 + Self::mul_add(-0.275, x112, 0.4 * x209);
-        let x211 = Self::mul_add(0.4, x117, x129);
-        let x212 = Self::mul_add(0.275, x117, x132);
-        let x213 = -x212;
-        let x214 = x112 + Self::mul_add(x8, x209, x7 * x117);
-        let x215 = Self::mul_add(-c_q8, x209, s_q8 * x117);
-        let x216 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x112,
-            Self::mul_add(s_q8, x209, c_q8 * x117),
-        );
-        let x217 = -x216;
-        let x218 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x212,
-            Self::mul_add(-s_q8, x211, c_q8 * x210),
-        );
-        let x219 = -x218;
-        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x8, x211, x7 * x210));
-        let x221 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x211, s_q8 * x210));
-        let x222 = Self::mul_add(s_q7, x215, c_q7 * x214);
-        let x223 = -x222;
-        let x224 = Self::mul_add(-c_q7, x215, s_q7 * x214);
-        let x225 = -x224;
-        let x226 = -Self::mul_add(-0.75, x224, Self::mul_add(s_q7, x221, c_q7 * x220));
-        let x227 = -(Self::mul_add(-c_q7, x221, s_q7 * x220)
-            + Self::mul_add(-0.65, x216, 0.75 * x222));
-        let x228 = -Self::mul_add(0.65, x224, x218);
-        let x229 = Self::mul_add(-s_q9, x101, x116);
-        let x230 = Self::mul_add(x11, x101, x208);
-        let x231 = Self::mul_add(c_q9, x101, x111);
-        let x232 = 0.00000000020510342851533115 * x104;
-        let x233 = Self::mul_add(c_q9, x97, s_q9 * x96) + x232
-            + Self::mul_add(-0.275, x231, 0.4 * x230);
-        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x12, x97, x11 * x96));
-        let x235 = Self::mul_add(
+        let x60 = x53 * 0.36;
+        let x61 = x60 + (x32 - x45 + x60);
+        let x62 = 7.078399999258757 + x52;
+        let x63 = 0.01675
+            - Self::mul_add(
+                x50,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x48, x47),
+            );
+        let x64 = -9.142025249762803
+            + (x60 + (Self::mul_add(-0.00000000020510342851533115, x55, x57) + x60));
+        let x65 = 2.5482240016099564
+            - Self::mul_add(
+                x52,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x57, x55),
+            );
+        let x66 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x58, x46 + x56);
+        let x67 = s_q11 * s_q11;
+        let x68 = s_q11 * c_q11;
+        let x69 = x61 - x64;
+        let x70 = x54 + x54;
+        let x71 = Self::mul_add(x68, x70, x67 * x69);
+        let x72 = Self::mul_add(-s_q11, x62, c_q11 * x50);
+        let x73 = Self::mul_add(c_q11, x62, s_q11 * x50);
+        let x74 = 0.275 * x53;
+        let x75 = x73 * 0.63;
+        let x76 = x74 - x75;
+        let x77 = Self::mul_add(x72, 0.63, x54 + Self::mul_add(-x67, x70, x68 * x69));
+        let x78 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x65, c_q11 * x63));
+        let x79 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x65, s_q11 * x63));
+        let x80 = x66 - x75;
+        let x81 = x76 + (x61 - x71 + x76);
+        let x82 = -45.1584 + x73;
+        let x83 = -0.6328 + x78;
+        let x84 = -24.4950615 + (x74 + (x64 + x71 + x74));
+        let x85 = -24.35164200091464 - Self::mul_add(x53, 0.63, -x79);
+        let x86 = 28.2393615 - (x75 - x80);
+        let x87 = s_q10 * s_q10;
+        let x88 = s_q10 * c_q10;
+        let x89 = x81 - x84;
+        let x90 = x77 + x77;
+        let x91 = Self::mul_add(x88, x90, x87 * x89);
+        let x92 = Self::mul_add(-s_q10, x85, c_q10 * x83);
+        let x93 = Self::mul_add(c_q10, x85, s_q10 * x83);
+        let x94 = c_q10 * x72;
+        let x95 = Self::mul_add(-s_q10, x82, x94);
+        let x96 = s_q10 * x72;
+        let x97 = Self::mul_add(c_q10, x82, x96);
+        let x98 = x97 * 0.87;
+        let x99 = Self::mul_add(x95, 0.87, x77 + Self::mul_add(-x87, x90, x88 * x89));
+        let x100 = x86 - x98;
+        let x101 = x98 - (x81 - x91 - x98);
+        let x102 = -81.53205 + x97;
+        let x103 = -0.00214 + x92;
+        let x104 = -63.36336825000001 + (x84 + x91);
+        let x105 = -36.18604050126307 + Self::mul_add(x53, -0.87, x93);
+        let x106 = 69.99836825 - (x98 - x100);
+        let x107 = s_q9 * s_q9;
+        let x108 = s_q9 * c_q9;
+        let x109 = x101 + x104;
+        let x110 = x99 + x99;
+        let x111 = Self::mul_add(-x108, x110, x107 * x109);
+        let x112 = x101 - x111;
+        let x113 = x104 - x111;
+        let x114 = x99 - Self::mul_add(x107, x110, x108 * x109);
+        let x115 = Self::mul_add(-s_q9, x105, c_q9 * x103);
+        let x116 = Self::mul_add(c_q9, x105, s_q9 * x103);
+        let x117 = c_q9 * x95;
+        let x118 = Self::mul_add(-s_q9, x102, x117);
+        let x119 = s_q9 * x95;
+        let x120 = Self::mul_add(c_q9, x102, x119);
+        let x121 = 0.00000000020510342851533115 * x53;
+        let x122 = x120 - x121;
+        let x123 = 0.00000000020510342851533115 * x120;
+        let x124 = x53 - Self::mul_add(0.00000000020510342851533115, x118, -x123);
+        let x125 = x118 + x121;
+        let x126 = 0.00000000020510342851533115 * x115;
+        let x127 = x114 + x126;
+        let x128 = 0.00000000020510342851533115 * x116;
+        let x129 = x113 + x128;
+        let x130 = 0.00000000020510342851533115 * x106;
+        let x131 = x116 + x130;
+        let x132 = 0.00000000020510342851533115 * x114;
+        let x133 = x115 - Self::mul_add(0.00000000020510342851533115, x112, x132);
+        let x134 = x106 + (x126 - x128);
+        let x135 = x115 - x130;
+        let x136 = 0.00000000020510342851533115 * x131;
+        let x137 = 0.4 * x125;
+        let x138 = 0.275 * x124;
+        let x139 = x137 - x138;
+        let x140 = x139 + (x129 + x136 + x139);
+        let x141 = Self::mul_add(
             0.275,
-            x229,
-            x232 - Self::mul_add(-s_q9, x97, c_q9 * x96),
+            x125,
+            -Self::mul_add(
+                0.4,
+                x124,
+                Self::mul_add(-0.00000000020510342851533115, x134, x133),
+            ),
+        );
+        let x142 = -0.000000008530897668050218 + x122;
+        let x143 = -12.701650001451807 - x124;
+        let x144 = -0.0000000234896432582596
+            + Self::mul_add(
+                -0.275,
+                x122,
+                x131
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x129,
+                        0.00000000020510342851533115 * x127,
+                    ),
+            );
+        let x145 = -0.002139996587640933 + Self::mul_add(-0.4, x122, x127 - x136);
+        let x146 = -111.7548902508081
+            + (x137
+                + (x134
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x116 + Self::mul_add(-0.00000000020510342851533115, x113, x132),
+                        0.00000000020510342851533115 * x133,
+                    ) + x137));
+        let x147 = 5.080660024070365 - x141;
+        let x148 = 113.3918902508081
+            - (x138
+                + (Self::mul_add(0.00000000020510342851533115, x135, x112 + x126)
+                    + x138));
+        let x149 = s_q8 * s_q8;
+        let x150 = s_q8 * c_q8;
+        let x151 = x140 - x146;
+        let x152 = x144 + x144;
+        let x153 = Self::mul_add(x150, x152, x149 * x151);
+        let x154 = x140 - x153;
+        let x155 = x144 + Self::mul_add(-x149, x152, x150 * x151);
+        let x156 = Self::mul_add(-s_q8, x147, c_q8 * x145);
+        let x157 = Self::mul_add(c_q8, x147, s_q8 * x145);
+        let x158 = Self::mul_add(-s_q8, x143, c_q8 * x142);
+        let x159 = Self::mul_add(c_q8, x143, s_q8 * x142);
+        let x160 = Self::mul_add(-0.00000000020510342851533115, x158, x125);
+        let x161 = Self::mul_add(0.00000000020510342851533115, x125, x158);
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x154, x156);
+        let x163 = 0.00000000020510342851533115 * x156;
+        let x164 = x148 - x163;
+        let x165 = Self::mul_add(0.00000000020510342851533115, x148, x156);
+        let x166 = -x165;
+        let x167 = 0.35 * x161;
+        let x168 = x167
+            - (Self::mul_add(-0.00000000020510342851533115, x162, x164) - x167);
+        let x169 = 48.0240000085309 + x160;
+        let x170 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x155, x157);
+        let x171 = -16.80768997608804
+            - Self::mul_add(
+                0.35,
+                x160,
+                Self::mul_add(0.00000000020510342851533115, x164, x162),
+            );
+        let x172 = 130.43769025763282 - (x167 - (x146 + x153 - x167));
+        let x173 = 0.1132
+            - Self::mul_add(
+                0.35,
+                x159,
+                Self::mul_add(0.00000000020510342851533115, x157, x155),
+            );
+        let x174 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x165, x154 + x163);
+        let x175 = s_q7 * s_q7;
+        let x176 = s_q7 * c_q7;
+        let x177 = x168 + x172;
+        let x178 = x170 + x170;
+        let x179 = Self::mul_add(-x176, x178, x175 * x177);
+        let x180 = Self::mul_add(-s_q7, x159, c_q7 * x169);
+        let x181 = Self::mul_add(c_q7, x159, s_q7 * x169);
+        let x182 = -x181;
+        let x183 = 0.75 * x161;
+        let x184 = 0.65 * x180;
+        let x185 = x183 - x184;
+        let x186 = Self::mul_add(-0.75, x180, Self::mul_add(-s_q7, x173, c_q7 * x171));
+        let x187 = Self::mul_add(
+            -0.65,
+            x181,
+            x170 - Self::mul_add(x175, x178, x176 * x177),
+        );
+        let x188 = Self::mul_add(-0.75, x181, Self::mul_add(c_q7, x173, s_q7 * x171));
+        let x189 = x174 + x184;
+        let x190 = 110.5455 + x180;
+        let x191 = 180.9502499901501 - x161;
+        let x192 = 1394.5960312283303 - (x183 + (x168 - x179 + x183));
+        let x193 = -117.61766249359756 + Self::mul_add(0.65, x161, x186);
+        let x194 = 1466.4506062283303 - (x185 - (x172 - x179 - x185));
+        let x195 = 1271.854575 + (x184 + x189);
+        let x196 = -x191;
+        let x197 = -x190;
+        let x198 = Self::mul_add(x8, x142, x7 * x143);
+        let x199 = Self::mul_add(
+            -0.35,
+            x158,
+            x148 - Self::mul_add(-x8, x147, x7 * x145),
+        );
+        let x200 = Self::mul_add(0.35, x198, x157);
+        let x201 = Self::mul_add(-s_q7, x158, c_q7 * x198);
+        let x202 = Self::mul_add(c_q7, x158, s_q7 * x198);
+        let x203 = Self::mul_add(-0.75, x202, Self::mul_add(-s_q7, x200, c_q7 * x199));
+        let x204 = Self::mul_add(c_q7, x200, s_q7 * x199)
+            + Self::mul_add(-0.65, x159, 0.75 * x201);
+        let x205 = -Self::mul_add(-0.65, x202, x165);
+        let x206 = x12 * x95;
+        let x207 = Self::mul_add(x11, x102, x206);
+        let x208 = x131 + Self::mul_add(-0.275, x120, 0.4 * x207);
+        let x209 = Self::mul_add(
+            0.4,
+            x118,
+            x106 + Self::mul_add(-x12, x105, x11 * x103),
+        );
+        let x210 = Self::mul_add(-0.275, x118, x135);
+        let x211 = x120 + Self::mul_add(x8, x207, x7 * x118);
+        let x212 = Self::mul_add(-c_q8, x207, s_q8 * x118);
+        let x213 = x123 - Self::mul_add(s_q8, x207, c_q8 * x118);
+        let x214 = Self::mul_add(
+            0.00000000020510342851533115,
+            x210,
+            Self::mul_add(-s_q8, x209, c_q8 * x208),
+        );
+        let x215 = -x214;
+        let x216 = Self::mul_add(
+            -0.35,
+            x212,
+            x210 - Self::mul_add(-x8, x209, x7 * x208),
+        );
+        let x217 = Self::mul_add(-0.35, x211, Self::mul_add(c_q8, x209, s_q8 * x208));
+        let x218 = Self::mul_add(s_q7, x212, c_q7 * x211);
+        let x219 = -x218;
+        let x220 = Self::mul_add(-c_q7, x212, s_q7 * x211);
+        let x221 = -x220;
+        let x222 = Self::mul_add(0.75, x220, Self::mul_add(-s_q7, x217, c_q7 * x216));
+        let x223 = Self::mul_add(c_q7, x217, s_q7 * x216)
+            - Self::mul_add(0.65, x213, 0.75 * x218);
+        let x224 = -Self::mul_add(0.65, x220, x214);
+        let x225 = Self::mul_add(-s_q9, x97, x117);
+        let x226 = Self::mul_add(x11, x97, x206);
+        let x227 = Self::mul_add(c_q9, x97, x119);
+        let x228 = 0.00000000020510342851533115 * x100;
+        let x229 = Self::mul_add(c_q9, x93, s_q9 * x92) + x228
+            + Self::mul_add(-0.275, x227, 0.4 * x226);
+        let x230 = Self::mul_add(0.4, x225, x100 + Self::mul_add(-x12, x93, x11 * x92));
+        let x231 = Self::mul_add(
+            0.275,
+            x225,
+            x228 - Self::mul_add(-s_q9, x93, c_q9 * x92),
+        );
+        let x232 = -x231;
+        let x233 = x227 + Self::mul_add(x8, x226, x7 * x225);
+        let x234 = Self::mul_add(-c_q8, x226, s_q8 * x225);
+        let x235 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x227,
+            Self::mul_add(s_q8, x226, c_q8 * x225),
         );
         let x236 = -x235;
-        let x237 = x231 + Self::mul_add(x8, x230, x7 * x229);
-        let x238 = Self::mul_add(-c_q8, x230, s_q8 * x229);
-        let x239 = Self::mul_add(
+        let x237 = Self::mul_add(
             -0.00000000020510342851533115,
             x231,
-            Self::mul_add(s_q8, x230, c_q8 * x229),
+            Self::mul_add(-s_q8, x230, c_q8 * x229),
         );
-        let x240 = -x239;
-        let x241 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x235,
-            Self::mul_add(-s_q8, x234, c_q8 * x233),
-        );
+        let x238 = -x237;
+        let x239 = Self::mul_add(0.35, x234, x231 + Self::mul_add(-x8, x230, x7 * x229));
+        let x240 = Self::mul_add(-0.35, x233, Self::mul_add(c_q8, x230, s_q8 * x229));
+        let x241 = Self::mul_add(s_q7, x234, c_q7 * x233);
         let x242 = -x241;
-        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x8, x234, x7 * x233));
-        let x244 = Self::mul_add(-0.35, x237, Self::mul_add(c_q8, x234, s_q8 * x233));
-        let x245 = Self::mul_add(s_q7, x238, c_q7 * x237);
-        let x246 = -x245;
-        let x247 = Self::mul_add(-c_q7, x238, s_q7 * x237);
-        let x248 = -x247;
-        let x249 = -Self::mul_add(-0.75, x247, Self::mul_add(s_q7, x244, c_q7 * x243));
-        let x250 = -(Self::mul_add(-c_q7, x244, s_q7 * x243)
-            + Self::mul_add(-0.65, x239, 0.75 * x245));
-        let x251 = -Self::mul_add(0.65, x247, x241);
-        let x252 = Self::mul_add(c_q10, x77, x100);
-        let x253 = Self::mul_add(-s_q10, x77, x98);
-        let x254 = Self::mul_add(-s_q10, x83, c_q10 * x82);
-        let x255 = Self::mul_add(c_q10, x83, s_q10 * x82);
-        let x256 = Self::mul_add(-0.87, x252, x84);
-        let x257 = Self::mul_add(-c_q9, x253, s_q9 * x252);
-        let x258 = Self::mul_add(x12, x253, x11 * x252);
-        let x259 = Self::mul_add(s_q9, x253, c_q9 * x252);
-        let x260 = 0.00000000020510342851533115 * x256;
-        let x261 = Self::mul_add(c_q9, x255, s_q9 * x254) + x260
-            + Self::mul_add(-0.275, x259, 0.4 * x258);
-        let x262 = Self::mul_add(
+        let x243 = Self::mul_add(-c_q7, x234, s_q7 * x233);
+        let x244 = -x243;
+        let x245 = -Self::mul_add(-0.75, x243, Self::mul_add(s_q7, x240, c_q7 * x239));
+        let x246 = -(Self::mul_add(-c_q7, x240, s_q7 * x239)
+            + Self::mul_add(-0.65, x235, 0.75 * x241));
+        let x247 = -Self::mul_add(0.65, x243, x237);
+        let x248 = Self::mul_add(c_q10, x73, x96);
+        let x249 = Self::mul_add(-s_q10, x73, x94);
+        let x250 = Self::mul_add(-s_q10, x79, c_q10 * x78);
+        let x251 = Self::mul_add(c_q10, x79, s_q10 * x78);
+        let x252 = Self::mul_add(-0.87, x248, x80);
+        let x253 = Self::mul_add(-c_q9, x249, s_q9 * x248);
+        let x254 = Self::mul_add(x12, x249, x11 * x248);
+        let x255 = Self::mul_add(s_q9, x249, c_q9 * x248);
+        let x256 = 0.00000000020510342851533115 * x252;
+        let x257 = Self::mul_add(c_q9, x251, s_q9 * x250) + x256
+            + Self::mul_add(-0.275, x255, 0.4 * x254);
+        let x258 = Self::mul_add(
             -0.4,
-            x257,
-            x256 + Self::mul_add(-x12, x255, x11 * x254),
+            x253,
+            x252 + Self::mul_add(-x12, x251, x11 * x250),
         );
-        let x263 = Self::mul_add(
+        let x259 = Self::mul_add(
             -0.275,
-            x257,
-            x260 - Self::mul_add(-s_q9, x255, c_q9 * x254),
+            x253,
+            x256 - Self::mul_add(-s_q9, x251, c_q9 * x250),
         );
-        let x264 = -x263;
-        let x265 = x259 - Self::mul_add(-x8, x258, x7 * x257);
-        let x266 = Self::mul_add(c_q8, x258, s_q8 * x257);
-        let x267 = Self::mul_add(
+        let x260 = -x259;
+        let x261 = x255 - Self::mul_add(-x8, x254, x7 * x253);
+        let x262 = Self::mul_add(c_q8, x254, s_q8 * x253);
+        let x263 = Self::mul_add(
             0.00000000020510342851533115,
+            x255,
+            Self::mul_add(-s_q8, x254, c_q8 * x253),
+        );
+        let x264 = Self::mul_add(
+            -0.00000000020510342851533115,
             x259,
             Self::mul_add(-s_q8, x258, c_q8 * x257),
         );
-        let x268 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x263,
-            Self::mul_add(-s_q8, x262, c_q8 * x261),
-        );
-        let x269 = -x268;
-        let x270 = Self::mul_add(
+        let x265 = -x264;
+        let x266 = Self::mul_add(
             -0.35,
-            x266,
-            x263 + Self::mul_add(-x8, x262, x7 * x261),
+            x262,
+            x259 + Self::mul_add(-x8, x258, x7 * x257),
         );
-        let x271 = Self::mul_add(-0.35, x265, Self::mul_add(c_q8, x262, s_q8 * x261));
-        let x272 = Self::mul_add(-s_q7, x266, c_q7 * x265);
-        let x273 = -x272;
-        let x274 = Self::mul_add(c_q7, x266, s_q7 * x265);
-        let x275 = -x274;
-        let x276 = -Self::mul_add(-0.75, x274, Self::mul_add(s_q7, x271, c_q7 * x270));
-        let x277 = -(Self::mul_add(-c_q7, x271, s_q7 * x270)
-            + Self::mul_add(0.65, x267, 0.75 * x272));
-        let x278 = -Self::mul_add(0.65, x274, x268);
-        let x279 = Self::mul_add(-x14, x38, x13 * x39);
-        let x280 = Self::mul_add(0.36, x279, x54);
-        let x281 = Self::mul_add(x50, 0.36, x57);
-        let x282 = Self::mul_add(s_q11, x279, c_q11 * x50);
-        let x283 = Self::mul_add(-c_q11, x279, s_q11 * x50);
-        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
-            - Self::mul_add(x48, -0.63, 0.275 * x283);
-        let x285 = Self::mul_add(0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
-        let x286 = Self::mul_add(0.63, x282, x58);
-        let x287 = -x286;
-        let x288 = Self::mul_add(-s_q10, x283, c_q10 * x282);
-        let x289 = Self::mul_add(c_q10, x283, s_q10 * x282);
-        let x290 = Self::mul_add(c_q10, x285, s_q10 * x284);
-        let x291 = Self::mul_add(x48, 0.87, Self::mul_add(-s_q10, x285, c_q10 * x284));
-        let x292 = Self::mul_add(0.87, x288, x286);
-        let x293 = -x292;
-        let x294 = 0.00000000020510342851533115 * x48;
-        let x295 = Self::mul_add(c_q9, x289, s_q9 * x288) + x294;
-        let x296 = x48 + Self::mul_add(-x12, x289, x11 * x288);
-        let x297 = x294 - Self::mul_add(-s_q9, x289, c_q9 * x288);
-        let x298 = 0.00000000020510342851533115 * x292;
-        let x299 = Self::mul_add(c_q9, x290, s_q9 * x291) - x298
-            + Self::mul_add(0.275, x297, 0.4 * x296);
-        let x300 = Self::mul_add(
+        let x267 = Self::mul_add(-0.35, x261, Self::mul_add(c_q8, x258, s_q8 * x257));
+        let x268 = Self::mul_add(-s_q7, x262, c_q7 * x261);
+        let x269 = -x268;
+        let x270 = Self::mul_add(c_q7, x262, s_q7 * x261);
+        let x271 = -x270;
+        let x272 = -Self::mul_add(-0.75, x270, Self::mul_add(s_q7, x267, c_q7 * x266));
+        let x273 = -(Self::mul_add(-c_q7, x267, s_q7 * x266)
+            + Self::mul_add(0.65, x263, 0.75 * x268));
+        let x274 = -Self::mul_add(0.65, x270, x264);
+        let x275 = Self::mul_add(-x14, x34, x13 * x35);
+        let x276 = Self::mul_add(0.36, x275, x48);
+        let x277 = Self::mul_add(x51, 0.36, x40 - Self::mul_add(x14, x39, x13 * x37));
+        let x278 = Self::mul_add(s_q11, x275, c_q11 * x51);
+        let x279 = Self::mul_add(-c_q11, x275, s_q11 * x51);
+        let x280 = Self::mul_add(-s_q11, x277, c_q11 * x276)
+            - Self::mul_add(x50, -0.63, 0.275 * x279);
+        let x281 = Self::mul_add(0.275, x278, Self::mul_add(c_q11, x277, s_q11 * x276));
+        let x282 = Self::mul_add(0.63, x278, x58);
+        let x283 = -x282;
+        let x284 = Self::mul_add(-s_q10, x279, c_q10 * x278);
+        let x285 = Self::mul_add(c_q10, x279, s_q10 * x278);
+        let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
+        let x287 = Self::mul_add(x50, 0.87, Self::mul_add(-s_q10, x281, c_q10 * x280));
+        let x288 = Self::mul_add(0.87, x284, x282);
+        let x289 = -x288;
+        let x290 = 0.00000000020510342851533115 * x50;
+        let x291 = Self::mul_add(c_q9, x285, s_q9 * x284) + x290;
+        let x292 = x50 + Self::mul_add(-x12, x285, x11 * x284);
+        let x293 = x290 - Self::mul_add(-s_q9, x285, c_q9 * x284);
+        let x294 = 0.00000000020510342851533115 * x288;
+        let x295 = Self::mul_add(c_q9, x286, s_q9 * x287) - x294
+            + Self::mul_add(0.275, x293, 0.4 * x292);
+        let x296 = Self::mul_add(
             0.4,
-            x295,
-            x292 - Self::mul_add(-x12, x290, x11 * x291),
+            x291,
+            x288 - Self::mul_add(-x12, x286, x11 * x287),
+        );
+        let x297 = Self::mul_add(
+            0.275,
+            x291,
+            x294 + Self::mul_add(-s_q9, x286, c_q9 * x287),
+        );
+        let x298 = x293 + Self::mul_add(-x8, x292, x7 * x291);
+        let x299 = Self::mul_add(c_q8, x292, s_q8 * x291);
+        let x300 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x293,
+            Self::mul_add(-s_q8, x292, c_q8 * x291),
         );
         let x301 = Self::mul_add(
-            0.275,
-            x295,
-            x298 + Self::mul_add(-s_q9, x290, c_q9 * x291),
-        );
-        let x302 = x297 + Self::mul_add(-x8, x296, x7 * x295);
-        let x303 = Self::mul_add(c_q8, x296, s_q8 * x295);
-        let x304 = Self::mul_add(
-            -0.00000000020510342851533115,
+            0.00000000020510342851533115,
             x297,
-            Self::mul_add(-s_q8, x296, c_q8 * x295),
+            Self::mul_add(s_q8, x296, c_q8 * x295),
         );
-        let x305 = Self::mul_add(
+        let x302 = -x301;
+        let x303 = Self::mul_add(0.35, x299, x297 - Self::mul_add(x8, x296, x7 * x295));
+        let x304 = Self::mul_add(0.35, x298, Self::mul_add(-c_q8, x296, s_q8 * x295));
+        let x305 = Self::mul_add(s_q7, x299, c_q7 * x298);
+        let x306 = Self::mul_add(-c_q7, x299, s_q7 * x298);
+        let x307 = Self::mul_add(-0.75, x306, Self::mul_add(-s_q7, x304, c_q7 * x303));
+        let x308 = Self::mul_add(c_q7, x304, s_q7 * x303)
+            + Self::mul_add(-0.65, x300, 0.75 * x305);
+        let x309 = -Self::mul_add(-0.65, x306, x301);
+        let x310 = 4.806620000000001 * x15;
+        let x311 = x31
+            + (1.4135609200000003
+                + Self::mul_add(
+                    0.00000000020510342851533115 * s_q13,
+                    -0.9614610000000001,
+                    x15 * 0.0145,
+                ));
+        let x312 = Self::mul_add(-0.16, x310, x21);
+        let x313 = Self::mul_add(-0.55, x310, x28);
+        let x314 = Self::mul_add(s_q12, x22, c_q12 * x310);
+        let x315 = x23 - Self::mul_add(-x14, x22, x13 * x310);
+        let x316 = Self::mul_add(
             0.00000000020510342851533115,
-            x301,
-            Self::mul_add(s_q8, x300, c_q8 * x299),
+            x23,
+            Self::mul_add(-c_q12, x22, s_q12 * x310),
         );
-        let x306 = -x305;
-        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x8, x300, x7 * x299));
-        let x308 = Self::mul_add(0.35, x302, Self::mul_add(-c_q8, x300, s_q8 * x299));
-        let x309 = Self::mul_add(s_q7, x303, c_q7 * x302);
-        let x310 = Self::mul_add(-c_q7, x303, s_q7 * x302);
-        let x311 = Self::mul_add(-0.75, x310, Self::mul_add(-s_q7, x308, c_q7 * x307));
-        let x312 = Self::mul_add(c_q7, x308, s_q7 * x307)
-            + Self::mul_add(-0.65, x304, 0.75 * x309);
-        let x313 = -Self::mul_add(-0.65, x310, x305);
-        let x314 = 4.806620000000001 * x15;
-        let x315 = x22 + x32;
-        let x316 = Self::mul_add(-0.16, x314, x26);
-        let x317 = Self::mul_add(-0.55, x314, x29);
-        let x318 = Self::mul_add(s_q12, x19, c_q12 * x314);
-        let x319 = x18 - Self::mul_add(-x14, x19, x13 * x314);
+        let x317 = Self::mul_add(
+            0.00000000020510342851533115,
+            x313,
+            Self::mul_add(-c_q12, x312, s_q12 * x311),
+        );
+        let x318 = -x317;
+        let x319 = Self::mul_add(0.36, x315, Self::mul_add(s_q12, x312, c_q12 * x311));
         let x320 = Self::mul_add(
-            0.00000000020510342851533115,
-            x18,
-            Self::mul_add(-c_q12, x19, s_q12 * x314),
-        );
-        let x321 = Self::mul_add(
-            0.00000000020510342851533115,
-            x317,
-            Self::mul_add(-c_q12, x316, s_q12 * x315),
-        );
-        let x322 = -x321;
-        let x323 = Self::mul_add(0.36, x319, Self::mul_add(s_q12, x316, c_q12 * x315));
-        let x324 = Self::mul_add(
             -0.36,
-            x318,
-            x317 - Self::mul_add(-x14, x316, x13 * x315),
+            x314,
+            x313 - Self::mul_add(-x14, x312, x13 * x311),
         );
-        let x325 = Self::mul_add(-s_q11, x319, c_q11 * x318);
-        let x326 = Self::mul_add(c_q11, x319, s_q11 * x318);
-        let x327 = Self::mul_add(-s_q11, x324, c_q11 * x323)
-            + Self::mul_add(0.63, x320, 0.275 * x326);
-        let x328 = Self::mul_add(-0.275, x325, Self::mul_add(c_q11, x324, s_q11 * x323));
-        let x329 = Self::mul_add(-0.63, x325, x321);
-        let x330 = -x329;
-        let x331 = Self::mul_add(-s_q10, x326, c_q10 * x325);
-        let x332 = Self::mul_add(c_q10, x326, s_q10 * x325);
-        let x333 = Self::mul_add(c_q10, x328, s_q10 * x327);
-        let x334 = Self::mul_add(0.87, x320, Self::mul_add(-s_q10, x328, c_q10 * x327));
-        let x335 = Self::mul_add(-0.87, x331, x329);
-        let x336 = -x335;
-        let x337 = 0.00000000020510342851533115 * x320;
-        let x338 = Self::mul_add(c_q9, x332, s_q9 * x331) - x337;
-        let x339 = x320 - Self::mul_add(-x12, x332, x11 * x331);
-        let x340 = x337 + Self::mul_add(-s_q9, x332, c_q9 * x331);
-        let x341 = 0.00000000020510342851533115 * x335;
-        let x342 = Self::mul_add(c_q9, x333, s_q9 * x334) - x341
-            + Self::mul_add(0.275, x340, 0.4 * x339);
-        let x343 = Self::mul_add(
+        let x321 = Self::mul_add(-s_q11, x315, c_q11 * x314);
+        let x322 = Self::mul_add(c_q11, x315, s_q11 * x314);
+        let x323 = Self::mul_add(-s_q11, x320, c_q11 * x319)
+            + Self::mul_add(0.63, x316, 0.275 * x322);
+        let x324 = Self::mul_add(-0.275, x321, Self::mul_add(c_q11, x320, s_q11 * x319));
+        let x325 = Self::mul_add(-0.63, x321, x317);
+        let x326 = -x325;
+        let x327 = Self::mul_add(-s_q10, x322, c_q10 * x321);
+        let x328 = Self::mul_add(c_q10, x322, s_q10 * x321);
+        let x329 = Self::mul_add(c_q10, x324, s_q10 * x323);
+        let x330 = Self::mul_add(0.87, x316, Self::mul_add(-s_q10, x324, c_q10 * x323));
+        let x331 = Self::mul_add(-0.87, x327, x325);
+        let x332 = -x331;
+        let x333 = 0.00000000020510342851533115 * x316;
+        let x334 = Self::mul_add(c_q9, x328, s_q9 * x327) - x333;
+        let x335 = x316 - Self::mul_add(-x12, x328, x11 * x327);
+        let x336 = x333 + Self::mul_add(-s_q9, x328, c_q9 * x327);
+        let x337 = 0.00000000020510342851533115 * x331;
+        let x338 = Self::mul_add(c_q9, x329, s_q9 * x330) - x337
+            + Self::mul_add(0.275, x336, 0.4 * x335);
+        let x339 = Self::mul_add(
             -0.4,
-            x338,
-            x335 - Self::mul_add(-x12, x333, x11 * x334),
+            x334,
+            x331 - Self::mul_add(-x12, x329, x11 * x330),
         );
-        let x344 = Self::mul_add(
+        let x340 = Self::mul_add(
             -0.275,
-            x338,
-            x341 + Self::mul_add(-s_q9, x333, c_q9 * x334),
+            x334,
+            x337 + Self::mul_add(-s_q9, x329, c_q9 * x330),
         );
-        let x345 = x340 - Self::mul_add(x8, x339, x7 * x338);
-        let x346 = Self::mul_add(-c_q8, x339, s_q8 * x338);
-        let x347 = Self::mul_add(
+        let x341 = x336 - Self::mul_add(x8, x335, x7 * x334);
+        let x342 = Self::mul_add(-c_q8, x335, s_q8 * x334);
+        let x343 = Self::mul_add(
+            0.00000000020510342851533115,
+            x336,
+            Self::mul_add(s_q8, x335, c_q8 * x334),
+        );
+        let x344 = -x343;
+        let x345 = Self::mul_add(
             0.00000000020510342851533115,
             x340,
             Self::mul_add(s_q8, x339, c_q8 * x338),
         );
-        let x348 = -x347;
-        let x349 = Self::mul_add(
-            0.00000000020510342851533115,
-            x344,
-            Self::mul_add(s_q8, x343, c_q8 * x342),
-        );
-        let x350 = -x349;
-        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x8, x343, x7 * x342));
-        let x352 = Self::mul_add(0.35, x345, Self::mul_add(-c_q8, x343, s_q8 * x342));
-        let x353 = Self::mul_add(-s_q7, x346, c_q7 * x345);
-        let x354 = Self::mul_add(c_q7, x346, s_q7 * x345);
-        let x355 = Self::mul_add(-0.75, x354, Self::mul_add(-s_q7, x352, c_q7 * x351));
-        let x356 = Self::mul_add(c_q7, x352, s_q7 * x351)
-            + Self::mul_add(0.65, x347, 0.75 * x353);
-        let x357 = -Self::mul_add(-0.65, x354, x349);
+        let x346 = -x345;
+        let x347 = Self::mul_add(-0.35, x342, x340 - Self::mul_add(x8, x339, x7 * x338));
+        let x348 = Self::mul_add(0.35, x341, Self::mul_add(-c_q8, x339, s_q8 * x338));
+        let x349 = Self::mul_add(-s_q7, x342, c_q7 * x341);
+        let x350 = Self::mul_add(c_q7, x342, s_q7 * x341);
+        let x351 = Self::mul_add(-0.75, x350, Self::mul_add(-s_q7, x348, c_q7 * x347));
+        let x352 = Self::mul_add(c_q7, x348, s_q7 * x347)
+            + Self::mul_add(0.65, x343, 0.75 * x349);
+        let x353 = -Self::mul_add(-0.65, x350, x345);
         [
             [
                 1170.07,
                 0.0,
                 0.0,
                 0.0,
-                x193,
-                x184,
-                x184,
-                x203,
-                x223,
-                x246,
-                x273,
-                x309,
-                x353,
-            ],
-            [
-                0.0,
-                1170.07,
-                0.0,
-                x198,
-                0.0,
-                x192,
-                x182,
-                x204,
-                x225,
-                x248,
-                x275,
-                x310,
-                x354,
-            ],
-            [
-                0.0,
-                0.0,
-                1170.07,
-                x183,
-                x199,
-                0.0,
-                0.0,
-                x155,
-                x217,
-                x240,
-                x267,
-                x304,
-                x348,
-            ],
-            [
-                0.0,
-                x198,
-                x183,
-                x194,
-                x189,
-                x195,
-                x188,
-                x205,
-                x226,
-                x249,
-                x276,
-                x311,
-                x355,
-            ],
-            [
-                x193,
-                0.0,
-                x199,
-                x189,
-                x196,
-                x190,
-                x190,
-                x206,
-                x227,
-                x250,
-                x277,
-                x312,
-                x356,
-            ],
-            [
-                x184,
-                x192,
-                0.0,
-                x195,
-                x190,
-                x197,
                 x191,
-                x207,
-                x228,
-                x251,
-                x278,
-                x313,
-                x357,
-            ],
-            [
-                x184,
                 x182,
-                0.0,
-                x188,
-                x190,
-                x191,
-                x176,
-                x165,
+                x182,
+                x201,
                 x219,
                 x242,
                 x269,
+                x305,
+                x349,
+            ],
+            [
+                0.0,
+                1170.07,
+                0.0,
+                x196,
+                0.0,
+                x190,
+                x180,
+                x202,
+                x221,
+                x244,
+                x271,
                 x306,
                 x350,
             ],
             [
-                x203,
-                x204,
-                x155,
-                x205,
-                x206,
-                x207,
-                x165,
-                x153,
+                0.0,
+                0.0,
+                1170.07,
+                x181,
+                x197,
+                0.0,
+                0.0,
+                x159,
                 x213,
                 x236,
-                x264,
-                x301,
+                x263,
+                x300,
                 x344,
             ],
             [
-                x223,
-                x225,
-                x217,
-                x226,
-                x227,
-                x228,
-                x219,
-                x213,
-                x110,
-                x104,
-                x256,
-                x293,
-                x336,
+                0.0,
+                x196,
+                x181,
+                x192,
+                x187,
+                x193,
+                x186,
+                x203,
+                x222,
+                x245,
+                x272,
+                x307,
+                x351,
             ],
-            [x246, x248, x240, x249, x250, x251, x242, x236, x104, x90, x84, x287, x330],
-            [x273, x275, x267, x276, x277, x278, x269, x264, x256, x84, x70, x59, x322],
-            [x309, x310, x304, x311, x312, x313, x306, x301, x293, x287, x59, x47, x317],
             [
+                x191,
+                0.0,
+                x197,
+                x187,
+                x194,
+                x188,
+                x188,
+                x204,
+                x223,
+                x246,
+                x273,
+                x308,
+                x352,
+            ],
+            [
+                x182,
+                x190,
+                0.0,
+                x193,
+                x188,
+                x195,
+                x189,
+                x205,
+                x224,
+                x247,
+                x274,
+                x309,
                 x353,
-                x354,
-                x348,
-                x355,
-                x356,
-                x357,
+            ],
+            [
+                x182,
+                x180,
+                0.0,
+                x186,
+                x188,
+                x189,
+                x174,
+                x166,
+                x215,
+                x238,
+                x265,
+                x302,
+                x346,
+            ],
+            [
+                x201,
+                x202,
+                x159,
+                x203,
+                x204,
+                x205,
+                x166,
+                x148,
+                x210,
+                x232,
+                x260,
+                x297,
+                x340,
+            ],
+            [
+                x219,
+                x221,
+                x213,
+                x222,
+                x223,
+                x224,
+                x215,
+                x210,
+                x106,
+                x100,
+                x252,
+                x289,
+                x332,
+            ],
+            [x242, x244, x236, x245, x246, x247, x238, x232, x100, x86, x80, x283, x326],
+            [x269, x271, x263, x272, x273, x274, x265, x260, x252, x80, x66, x59, x318],
+            [x305, x306, x300, x307, x308, x309, x302, x297, x289, x283, x59, x40, x313],
+            [
+                x349,
                 x350,
                 x344,
-                x336,
-                x330,
-                x322,
-                x317,
+                x351,
+                x352,
+                x353,
+                x346,
+                x340,
+                x332,
+                x326,
+                x318,
+                x313,
                 1.4135609200000003,
             ],
         ]
@@ -3093,9 +3073,9 @@ impl FreeFloating7 {
             ));
         [x229, x230, x231, x232, x233, x234, x223, x214, x203, x196, x188, x179, x169]
     }
-    /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled articulated-body algorithm (no `M` is formed).
+    /// Forward dynamics: `v̇ = [v̇_b, ω̇_b, q̈]` from the joint drives, `M⁻¹ (τ − c)`, by an unrolled branch-free LDLᵀ.
     ///
-    /// Methods: forward `aba`: 1592 mul, 1277 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 953 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1510 mul, 1329 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1003 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics(q: &[f64; 14], v: &[f64; 13], tau: &[f64; 7]) -> [f64; 13] {
         let [(s_q7, c_q7), (s_q8, c_q8), (s_q9, c_q9), (s_q10, c_q10), (s_q11, c_q11),
@@ -3108,1617 +3088,1830 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = Self::mul_add(
-            -180.9502499901501,
-            v[1],
-            Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
-        );
-        let x8 = Self::mul_add(
-            1466.4506062283303,
-            v[4],
-            Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
-        );
-        let x9 = Self::mul_add(
-            -110.5455,
-            v[1],
-            Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
-        );
-        let x10 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
-        let x11 = Self::mul_add(
-            1170.07,
-            v[1],
-            -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
-        );
-        let x12 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
-        let x13 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x14 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x15 = Self::mul_add(0.75, v[4], v[0]);
-        let x16 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x17 = Self::mul_add(-0.65, v[4], v[2]);
-        let x18 = Self::mul_add(s_q7, x16, c_q7 * x15);
-        let x19 = Self::mul_add(-c_q7, x16, s_q7 * x15);
-        let x20 = v[6] * x14;
-        let x21 = v[6] * x13;
-        let x22 = v[6] * x19;
-        let x23 = v[6] * x18;
-        let x24 = v[5] + v[6];
-        let x25 = Self::mul_add(x24, -16.80768997608804, x14 * 0.07309);
-        let x26 = Self::mul_add(
-            48.0240000085309,
-            x17,
+        let x7 = 0.00000000020510342851533115 * c_q8;
+        let x8 = 0.00000000020510342851533115 * s_q8;
+        let x9 = 0.00000000020510342851533115 * c_q9;
+        let x10 = 0.00000000020510342851533115 * s_q9;
+        let x11 = x9 - x10;
+        let x12 = x9 + x10;
+        let x13 = 0.00000000020510342851533115 * s_q12;
+        let x14 = 0.00000000020510342851533115 * c_q12;
+        let x15 = 0.00000000020510342851533115 * c_q13;
+        let x16 = 0.00000000020510342851533115 * s_q13;
+        let x17 = s_q13 * s_q13;
+        let x18 = s_q13 * c_q13;
+        let x19 = Self::mul_add(x18, 0.001562, x17 * 1.2025609200000003);
+        let x20 = 0.000781 + Self::mul_add(x17, -0.001562, x18 * 1.2025609200000003);
+        let x21 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x22 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x23 = 4.806620000000001 * s_q13;
+        let x24 = 4.806620000000001 * c_q13;
+        let x25 = 0.00000000020510342851533115 * x23;
+        let x26 = Self::mul_add(-0.00000000020510342851533115, x19, x21);
+        let x27 = 0.00000000020510342851533115 * x21;
+        let x28 = 1.4135609200000003 + x27;
+        let x29 = x21 + -0.0000000002899261911072858;
+        let x30 = 0.16 * x23;
+        let x31 = 0.55 * x24;
+        let x32 = x30 + x31;
+        let x33 = x32 + (Self::mul_add(0.00000000020510342851533115, x26, x28) + x32);
+        let x34 = Self::mul_add(
+            0.55,
+            x23,
             Self::mul_add(
-                -0.1132,
+                0.16,
                 x24,
-                Self::mul_add(130.43769025763282, x14, x13 * 0.07309),
+                Self::mul_add(-0.00000000020510342851533115, x22, x20),
             ),
         );
-        let x27 = Self::mul_add(
-            48.0240000085309,
-            x19,
-            Self::mul_add(
-                -132.47349025763282,
-                x24,
-                Self::mul_add(0.1132, x14, x13 * 16.80768997608804),
+        let x35 = 3.6140000000000003 + x25;
+        let x36 = 17.135250000000003 + x24;
+        let x37 = -1.9877000000000002
+            - Self::mul_add(
+                0.55,
+                x25,
+                Self::mul_add(0.00000000020510342851533115, x20, x22),
+            );
+        let x38 = -0.809539999555672
+            + Self::mul_add(
+                -0.16,
+                x25,
+                Self::mul_add(-0.00000000020510342851533115, x28, x26),
+            );
+        let x39 = -5.252920330000002 + (x30 + (-1.2025609200000003 + x19 + x30));
+        let x40 = -2.741639999592316 - x34;
+        let x41 = 9.740442170000001
+            + (x31
+                - (Self::mul_add(0.00000000020510342851533115, x29, x19 + x27) - x31));
+        let x42 = s_q12 * s_q12;
+        let x43 = s_q12 * c_q12;
+        let x44 = x33 - x39;
+        let x45 = x37 + x37;
+        let x46 = Self::mul_add(x43, x45, x42 * x44);
+        let x47 = x39 + x46;
+        let x48 = x37 + Self::mul_add(-x42, x45, x43 * x44);
+        let x49 = Self::mul_add(-s_q12, x40, c_q12 * x38);
+        let x50 = Self::mul_add(c_q12, x40, s_q12 * x38);
+        let x51 = Self::mul_add(-s_q12, x36, c_q12 * x35);
+        let x52 = Self::mul_add(c_q12, x36, s_q12 * x35);
+        let x53 = Self::mul_add(-0.00000000020510342851533115, x52, x23);
+        let x54 = x25 + x52;
+        let x55 = Self::mul_add(-0.00000000020510342851533115, x48, x49);
+        let x56 = Self::mul_add(-0.00000000020510342851533115, x47, x50);
+        let x57 = 0.00000000020510342851533115 * x50;
+        let x58 = x41 - x57;
+        let x59 = Self::mul_add(0.00000000020510342851533115, x41, x50);
+        let x60 = x54 * 0.36;
+        let x61 = x60 + (x33 - x46 + x60);
+        let x62 = 7.078399999258757 + x53;
+        let x63 = 0.01675
+            - Self::mul_add(
+                x51,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x49, x48),
+            );
+        let x64 = -9.142025249762803
+            + (x60 + (Self::mul_add(-0.00000000020510342851533115, x56, x58) + x60));
+        let x65 = 2.5482240016099564
+            - Self::mul_add(
+                x53,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x58, x56),
+            );
+        let x66 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x59, x47 + x57);
+        let x67 = s_q11 * s_q11;
+        let x68 = s_q11 * c_q11;
+        let x69 = x61 - x64;
+        let x70 = x55 + x55;
+        let x71 = Self::mul_add(x68, x70, x67 * x69);
+        let x72 = Self::mul_add(-s_q11, x62, c_q11 * x51);
+        let x73 = Self::mul_add(c_q11, x62, s_q11 * x51);
+        let x74 = 0.275 * x54;
+        let x75 = x73 * 0.63;
+        let x76 = x74 - x75;
+        let x77 = Self::mul_add(x72, 0.63, x55 + Self::mul_add(-x67, x70, x68 * x69));
+        let x78 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x65, c_q11 * x63));
+        let x79 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x65, s_q11 * x63));
+        let x80 = x66 - x75;
+        let x81 = x76 + (x61 - x71 + x76);
+        let x82 = -45.1584 + x73;
+        let x83 = -0.6328 + x78;
+        let x84 = -24.4950615 + (x74 + (x64 + x71 + x74));
+        let x85 = -24.35164200091464 - Self::mul_add(x54, 0.63, -x79);
+        let x86 = 28.2393615 - (x75 - x80);
+        let x87 = s_q10 * s_q10;
+        let x88 = s_q10 * c_q10;
+        let x89 = x81 - x84;
+        let x90 = x77 + x77;
+        let x91 = Self::mul_add(x88, x90, x87 * x89);
+        let x92 = Self::mul_add(-s_q10, x85, c_q10 * x83);
+        let x93 = Self::mul_add(c_q10, x85, s_q10 * x83);
+        let x94 = c_q10 * x72;
+        let x95 = Self::mul_add(-s_q10, x82, x94);
+        let x96 = s_q10 * x72;
+        let x97 = Self::mul_add(c_q10, x82, x96);
+        let x98 = x97 * 0.87;
+        let x99 = Self::mul_add(x95, 0.87, x77 + Self::mul_add(-x87, x90, x88 * x89));
+        let x100 = x86 - x98;
+        let x101 = x98 - (x81 - x91 - x98);
+        let x102 = -81.53205 + x97;
+        let x103 = -0.00214 + x92;
+        let x104 = -63.36336825000001 + (x84 + x91);
+        let x105 = -36.18604050126307 + Self::mul_add(x54, -0.87, x93);
+        let x106 = 69.99836825 - (x98 - x100);
+        let x107 = s_q9 * s_q9;
+        let x108 = s_q9 * c_q9;
+        let x109 = x101 + x104;
+        let x110 = x99 + x99;
+        let x111 = Self::mul_add(-x108, x110, x107 * x109);
+        let x112 = x101 - x111;
+        let x113 = x104 - x111;
+        let x114 = x99 - Self::mul_add(x107, x110, x108 * x109);
+        let x115 = Self::mul_add(-s_q9, x105, c_q9 * x103);
+        let x116 = Self::mul_add(c_q9, x105, s_q9 * x103);
+        let x117 = c_q9 * x95;
+        let x118 = Self::mul_add(-s_q9, x102, x117);
+        let x119 = s_q9 * x95;
+        let x120 = Self::mul_add(c_q9, x102, x119);
+        let x121 = 0.00000000020510342851533115 * x54;
+        let x122 = x120 - x121;
+        let x123 = 0.00000000020510342851533115 * x120;
+        let x124 = x54 - Self::mul_add(0.00000000020510342851533115, x118, -x123);
+        let x125 = x118 + x121;
+        let x126 = 0.00000000020510342851533115 * x115;
+        let x127 = x114 + x126;
+        let x128 = 0.00000000020510342851533115 * x116;
+        let x129 = x113 + x128;
+        let x130 = 0.00000000020510342851533115 * x106;
+        let x131 = x116 + x130;
+        let x132 = 0.00000000020510342851533115 * x114;
+        let x133 = x115 - Self::mul_add(0.00000000020510342851533115, x112, x132);
+        let x134 = x106 + (x126 - x128);
+        let x135 = x115 - x130;
+        let x136 = 0.00000000020510342851533115 * x131;
+        let x137 = 0.4 * x125;
+        let x138 = 0.275 * x124;
+        let x139 = x137 - x138;
+        let x140 = x139 + (x129 + x136 + x139);
+        let x141 = Self::mul_add(
+            0.275,
+            x125,
+            -Self::mul_add(
+                0.4,
+                x124,
+                Self::mul_add(-0.00000000020510342851533115, x134, x133),
             ),
         );
-        let x28 = 48.0240000085309 * x24;
-        let x29 = 48.0240000085309 * x14;
-        let x30 = 0.00000000020510342851533115 * c_q8;
-        let x31 = 0.00000000020510342851533115 * s_q8;
-        let x32 = Self::mul_add(x24, c_q8, Self::mul_add(x14, s_q8, x13 * x30));
-        let x33 = Self::mul_add(x24, s_q8, Self::mul_add(-x14, c_q8, x13 * x31));
-        let x34 = Self::mul_add(-0.35, x14, x18);
-        let x35 = Self::mul_add(0.35, x13, x19);
-        let x36 = Self::mul_add(x17, c_q8, Self::mul_add(s_q8, x35, x30 * x34));
-        let x37 = Self::mul_add(x17, s_q8, Self::mul_add(-c_q8, x35, x31 * x34));
-        let x38 = Self::mul_add(-0.00000000020510342851533115, x17, x34);
-        let x39 = v[7] * x33;
-        let x40 = v[7] * x32;
-        let x41 = v[7] * x37;
-        let x42 = v[7] * x36;
-        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x13);
-        let x44 = Self::mul_add(
-            x38,
-            12.701650001451807,
-            Self::mul_add(x43, 0.002139996587640933, x33 * 0.0000000234896432582596),
+        let x142 = -0.000000008530897668050218 + x122;
+        let x143 = -12.701650001451807 - x124;
+        let x144 = -0.0000000234896432582596
+            + Self::mul_add(
+                -0.275,
+                x122,
+                x131
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x129,
+                        0.00000000020510342851533115 * x127,
+                    ),
+            );
+        let x145 = -0.002139996587640933 + Self::mul_add(-0.4, x122, x127 - x136);
+        let x146 = -111.7548902508081
+            + (x137
+                + (x134
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x116 + Self::mul_add(-0.00000000020510342851533115, x113, x132),
+                        0.00000000020510342851533115 * x133,
+                    ) + x137));
+        let x147 = 5.080660024070365 - x141;
+        let x148 = 113.3918902508081
+            - (x138
+                + (Self::mul_add(0.00000000020510342851533115, x135, x112 + x126)
+                    + x138));
+        let x149 = s_q8 * s_q8;
+        let x150 = s_q8 * c_q8;
+        let x151 = x140 - x146;
+        let x152 = x144 + x144;
+        let x153 = Self::mul_add(x150, x152, x149 * x151);
+        let x154 = x140 - x153;
+        let x155 = x144 + Self::mul_add(-x149, x152, x150 * x151);
+        let x156 = Self::mul_add(-s_q8, x147, c_q8 * x145);
+        let x157 = Self::mul_add(c_q8, x147, s_q8 * x145);
+        let x158 = Self::mul_add(-s_q8, x143, c_q8 * x142);
+        let x159 = Self::mul_add(c_q8, x143, s_q8 * x142);
+        let x160 = Self::mul_add(-0.00000000020510342851533115, x158, x125);
+        let x161 = Self::mul_add(0.00000000020510342851533115, x125, x158);
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x154, x156);
+        let x163 = 0.00000000020510342851533115 * x156;
+        let x164 = x148 - x163;
+        let x165 = Self::mul_add(0.00000000020510342851533115, x148, x156);
+        let x166 = 0.35 * x161;
+        let x167 = x166
+            - (Self::mul_add(-0.00000000020510342851533115, x162, x164) - x166);
+        let x168 = 48.0240000085309 + x160;
+        let x169 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x155, x157);
+        let x170 = -16.80768997608804
+            - Self::mul_add(
+                0.35,
+                x160,
+                Self::mul_add(0.00000000020510342851533115, x164, x162),
+            );
+        let x171 = 130.43769025763282 - (x166 - (x146 + x153 - x166));
+        let x172 = 0.1132
+            - Self::mul_add(
+                0.35,
+                x159,
+                Self::mul_add(0.00000000020510342851533115, x157, x155),
+            );
+        let x173 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x165, x154 + x163);
+        let x174 = s_q7 * s_q7;
+        let x175 = s_q7 * c_q7;
+        let x176 = x167 + x171;
+        let x177 = x169 + x169;
+        let x178 = Self::mul_add(-x175, x177, x174 * x176);
+        let x179 = Self::mul_add(-s_q7, x159, c_q7 * x168);
+        let x180 = Self::mul_add(c_q7, x159, s_q7 * x168);
+        let x181 = 0.75 * x161;
+        let x182 = 0.65 * x179;
+        let x183 = x181 - x182;
+        let x184 = Self::mul_add(-0.75, x179, Self::mul_add(-s_q7, x172, c_q7 * x170));
+        let x185 = x173 + x182;
+        let x186 = 110.5455 + x179;
+        let x187 = 180.9502499901501 - x161;
+        let x188 = Self::mul_add(x8, x142, x7 * x143);
+        let x189 = Self::mul_add(
+            -0.35,
+            x158,
+            x148 - Self::mul_add(-x8, x147, x7 * x145),
         );
-        let x45 = Self::mul_add(
-            x38,
+        let x190 = Self::mul_add(0.35, x188, x157);
+        let x191 = Self::mul_add(-s_q7, x158, c_q7 * x188);
+        let x192 = Self::mul_add(c_q7, x158, s_q7 * x188);
+        let x193 = x12 * x95;
+        let x194 = Self::mul_add(x11, x102, x193);
+        let x195 = x131 + Self::mul_add(-0.275, x120, 0.4 * x194);
+        let x196 = Self::mul_add(
+            0.4,
+            x118,
+            x106 + Self::mul_add(-x12, x105, x11 * x103),
+        );
+        let x197 = Self::mul_add(-0.275, x118, x135);
+        let x198 = x120 + Self::mul_add(x8, x194, x7 * x118);
+        let x199 = Self::mul_add(-c_q8, x194, s_q8 * x118);
+        let x200 = x123 - Self::mul_add(s_q8, x194, c_q8 * x118);
+        let x201 = Self::mul_add(
+            0.00000000020510342851533115,
+            x197,
+            Self::mul_add(-s_q8, x196, c_q8 * x195),
+        );
+        let x202 = Self::mul_add(
+            -0.35,
+            x199,
+            x197 - Self::mul_add(-x8, x196, x7 * x195),
+        );
+        let x203 = Self::mul_add(-0.35, x198, Self::mul_add(c_q8, x196, s_q8 * x195));
+        let x204 = Self::mul_add(s_q7, x199, c_q7 * x198);
+        let x205 = Self::mul_add(-c_q7, x199, s_q7 * x198);
+        let x206 = Self::mul_add(-s_q9, x97, x117);
+        let x207 = Self::mul_add(x11, x97, x193);
+        let x208 = Self::mul_add(c_q9, x97, x119);
+        let x209 = 0.00000000020510342851533115 * x100;
+        let x210 = Self::mul_add(c_q9, x93, s_q9 * x92) + x209
+            + Self::mul_add(-0.275, x208, 0.4 * x207);
+        let x211 = Self::mul_add(0.4, x206, x100 + Self::mul_add(-x12, x93, x11 * x92));
+        let x212 = Self::mul_add(
+            0.275,
+            x206,
+            x209 - Self::mul_add(-s_q9, x93, c_q9 * x92),
+        );
+        let x213 = x208 + Self::mul_add(x8, x207, x7 * x206);
+        let x214 = Self::mul_add(-c_q8, x207, s_q8 * x206);
+        let x215 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x208,
+            Self::mul_add(s_q8, x207, c_q8 * x206),
+        );
+        let x216 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x212,
+            Self::mul_add(-s_q8, x211, c_q8 * x210),
+        );
+        let x217 = Self::mul_add(0.35, x214, x212 + Self::mul_add(-x8, x211, x7 * x210));
+        let x218 = Self::mul_add(-0.35, x213, Self::mul_add(c_q8, x211, s_q8 * x210));
+        let x219 = Self::mul_add(s_q7, x214, c_q7 * x213);
+        let x220 = Self::mul_add(-c_q7, x214, s_q7 * x213);
+        let x221 = Self::mul_add(c_q10, x73, x96);
+        let x222 = Self::mul_add(-s_q10, x73, x94);
+        let x223 = Self::mul_add(-s_q10, x79, c_q10 * x78);
+        let x224 = Self::mul_add(c_q10, x79, s_q10 * x78);
+        let x225 = Self::mul_add(-0.87, x221, x80);
+        let x226 = Self::mul_add(-c_q9, x222, s_q9 * x221);
+        let x227 = Self::mul_add(x12, x222, x11 * x221);
+        let x228 = Self::mul_add(s_q9, x222, c_q9 * x221);
+        let x229 = 0.00000000020510342851533115 * x225;
+        let x230 = Self::mul_add(c_q9, x224, s_q9 * x223) + x229
+            + Self::mul_add(-0.275, x228, 0.4 * x227);
+        let x231 = Self::mul_add(
+            -0.4,
+            x226,
+            x225 + Self::mul_add(-x12, x224, x11 * x223),
+        );
+        let x232 = Self::mul_add(
+            -0.275,
+            x226,
+            x229 - Self::mul_add(-s_q9, x224, c_q9 * x223),
+        );
+        let x233 = x228 - Self::mul_add(-x8, x227, x7 * x226);
+        let x234 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x235 = Self::mul_add(
+            0.00000000020510342851533115,
+            x228,
+            Self::mul_add(-s_q8, x227, c_q8 * x226),
+        );
+        let x236 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x232,
+            Self::mul_add(-s_q8, x231, c_q8 * x230),
+        );
+        let x237 = Self::mul_add(
+            -0.35,
+            x234,
+            x232 + Self::mul_add(-x8, x231, x7 * x230),
+        );
+        let x238 = Self::mul_add(-0.35, x233, Self::mul_add(c_q8, x231, s_q8 * x230));
+        let x239 = Self::mul_add(-s_q7, x234, c_q7 * x233);
+        let x240 = Self::mul_add(c_q7, x234, s_q7 * x233);
+        let x241 = Self::mul_add(-x14, x35, x13 * x36);
+        let x242 = Self::mul_add(0.36, x241, x49);
+        let x243 = Self::mul_add(x52, 0.36, x41 - Self::mul_add(x14, x40, x13 * x38));
+        let x244 = Self::mul_add(s_q11, x241, c_q11 * x52);
+        let x245 = Self::mul_add(-c_q11, x241, s_q11 * x52);
+        let x246 = Self::mul_add(-s_q11, x243, c_q11 * x242)
+            - Self::mul_add(x51, -0.63, 0.275 * x245);
+        let x247 = Self::mul_add(0.275, x244, Self::mul_add(c_q11, x243, s_q11 * x242));
+        let x248 = Self::mul_add(0.63, x244, x59);
+        let x249 = Self::mul_add(-s_q10, x245, c_q10 * x244);
+        let x250 = Self::mul_add(c_q10, x245, s_q10 * x244);
+        let x251 = Self::mul_add(c_q10, x247, s_q10 * x246);
+        let x252 = Self::mul_add(x51, 0.87, Self::mul_add(-s_q10, x247, c_q10 * x246));
+        let x253 = Self::mul_add(0.87, x249, x248);
+        let x254 = 0.00000000020510342851533115 * x51;
+        let x255 = Self::mul_add(c_q9, x250, s_q9 * x249) + x254;
+        let x256 = x51 + Self::mul_add(-x12, x250, x11 * x249);
+        let x257 = x254 - Self::mul_add(-s_q9, x250, c_q9 * x249);
+        let x258 = 0.00000000020510342851533115 * x253;
+        let x259 = Self::mul_add(c_q9, x251, s_q9 * x252) - x258
+            + Self::mul_add(0.275, x257, 0.4 * x256);
+        let x260 = Self::mul_add(
+            0.4,
+            x255,
+            x253 - Self::mul_add(-x12, x251, x11 * x252),
+        );
+        let x261 = Self::mul_add(
+            0.275,
+            x255,
+            x258 + Self::mul_add(-s_q9, x251, c_q9 * x252),
+        );
+        let x262 = x257 + Self::mul_add(-x8, x256, x7 * x255);
+        let x263 = Self::mul_add(c_q8, x256, s_q8 * x255);
+        let x264 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x257,
+            Self::mul_add(-s_q8, x256, c_q8 * x255),
+        );
+        let x265 = Self::mul_add(
+            0.00000000020510342851533115,
+            x261,
+            Self::mul_add(s_q8, x260, c_q8 * x259),
+        );
+        let x266 = Self::mul_add(0.35, x263, x261 - Self::mul_add(x8, x260, x7 * x259));
+        let x267 = Self::mul_add(0.35, x262, Self::mul_add(-c_q8, x260, s_q8 * x259));
+        let x268 = Self::mul_add(s_q7, x263, c_q7 * x262);
+        let x269 = Self::mul_add(-c_q7, x263, s_q7 * x262);
+        let x270 = 4.806620000000001 * x15;
+        let x271 = x32
+            + (1.4135609200000003
+                + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145));
+        let x272 = Self::mul_add(-0.16, x270, x22);
+        let x273 = Self::mul_add(-0.55, x270, x29);
+        let x274 = Self::mul_add(s_q12, x23, c_q12 * x270);
+        let x275 = x24 - Self::mul_add(-x14, x23, x13 * x270);
+        let x276 = Self::mul_add(
+            0.00000000020510342851533115,
+            x24,
+            Self::mul_add(-c_q12, x23, s_q12 * x270),
+        );
+        let x277 = Self::mul_add(
+            0.00000000020510342851533115,
+            x273,
+            Self::mul_add(-c_q12, x272, s_q12 * x271),
+        );
+        let x278 = Self::mul_add(0.36, x275, Self::mul_add(s_q12, x272, c_q12 * x271));
+        let x279 = Self::mul_add(
+            -0.36,
+            x274,
+            x273 - Self::mul_add(-x14, x272, x13 * x271),
+        );
+        let x280 = Self::mul_add(-s_q11, x275, c_q11 * x274);
+        let x281 = Self::mul_add(c_q11, x275, s_q11 * x274);
+        let x282 = Self::mul_add(-s_q11, x279, c_q11 * x278)
+            + Self::mul_add(0.63, x276, 0.275 * x281);
+        let x283 = Self::mul_add(-0.275, x280, Self::mul_add(c_q11, x279, s_q11 * x278));
+        let x284 = Self::mul_add(-0.63, x280, x277);
+        let x285 = Self::mul_add(-s_q10, x281, c_q10 * x280);
+        let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
+        let x287 = Self::mul_add(c_q10, x283, s_q10 * x282);
+        let x288 = Self::mul_add(0.87, x276, Self::mul_add(-s_q10, x283, c_q10 * x282));
+        let x289 = Self::mul_add(-0.87, x285, x284);
+        let x290 = 0.00000000020510342851533115 * x276;
+        let x291 = Self::mul_add(c_q9, x286, s_q9 * x285) - x290;
+        let x292 = x276 - Self::mul_add(-x12, x286, x11 * x285);
+        let x293 = x290 + Self::mul_add(-s_q9, x286, c_q9 * x285);
+        let x294 = 0.00000000020510342851533115 * x289;
+        let x295 = Self::mul_add(c_q9, x287, s_q9 * x288) - x294
+            + Self::mul_add(0.275, x293, 0.4 * x292);
+        let x296 = Self::mul_add(
+            -0.4,
+            x291,
+            x289 - Self::mul_add(-x12, x287, x11 * x288),
+        );
+        let x297 = Self::mul_add(
+            -0.275,
+            x291,
+            x294 + Self::mul_add(-s_q9, x287, c_q9 * x288),
+        );
+        let x298 = x293 - Self::mul_add(x8, x292, x7 * x291);
+        let x299 = Self::mul_add(-c_q8, x292, s_q8 * x291);
+        let x300 = Self::mul_add(
+            0.00000000020510342851533115,
+            x293,
+            Self::mul_add(s_q8, x292, c_q8 * x291),
+        );
+        let x301 = Self::mul_add(
+            0.00000000020510342851533115,
+            x297,
+            Self::mul_add(s_q8, x296, c_q8 * x295),
+        );
+        let x302 = Self::mul_add(-0.35, x299, x297 - Self::mul_add(x8, x296, x7 * x295));
+        let x303 = Self::mul_add(0.35, x298, Self::mul_add(-c_q8, x296, s_q8 * x295));
+        let x304 = Self::mul_add(-s_q7, x299, c_q7 * x298);
+        let x305 = Self::mul_add(c_q7, x299, s_q7 * x298);
+        let x306 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x307 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x308 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x309 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x310 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x311 = v[4] * v[4];
+        let x312 = Self::mul_add(v[5], v[5], x311);
+        let x313 = v[3] * v[4];
+        let x314 = v[3] * v[5];
+        let x315 = v[4] * v[5];
+        let x316 = Self::mul_add(v[3], v[3], x311);
+        let x317 = x306 + Self::mul_add(-0.75, x314, 0.65 * x312);
+        let x318 = x307 + Self::mul_add(0.75, x315, 0.65 * x313);
+        let x319 = x308 - Self::mul_add(-0.75, x316, 0.65 * x314);
+        let x320 = Self::mul_add(c_q7, x318, s_q7 * x317);
+        let x321 = v[6] * x310;
+        let x322 = v[6] * x309;
+        let x323 = v[5] + v[6];
+        let x324 = x310 * x310;
+        let x325 = x309 * x323;
+        let x326 = Self::mul_add(x323, -16.80768997608804, x310 * 0.07309);
+        let x327 = Self::mul_add(
+            -0.1132,
+            x323,
+            Self::mul_add(130.43769025763282, x310, x309 * 0.07309),
+        );
+        let x328 = Self::mul_add(
+            -132.47349025763282,
+            x323,
+            Self::mul_add(0.1132, x310, x309 * 16.80768997608804),
+        );
+        let x329 = Self::mul_add(c_q8, x323, Self::mul_add(s_q8, x310, x7 * x309));
+        let x330 = Self::mul_add(s_q8, x323, Self::mul_add(-c_q8, x310, x8 * x309));
+        let x331 = Self::mul_add(
+            0.35,
+            x322 - x325,
+            Self::mul_add(-s_q7, x318, c_q7 * x317),
+        );
+        let x332 = Self::mul_add(0.35, Self::mul_add(-x310, x323, x321), x320);
+        let x333 = Self::mul_add(0.35, Self::mul_add(x309, x309, x324), x319);
+        let x334 = Self::mul_add(c_q8, x333, Self::mul_add(s_q8, x332, x7 * x331));
+        let x335 = Self::mul_add(s_q8, x333, Self::mul_add(-c_q8, x332, x8 * x331));
+        let x336 = Self::mul_add(-0.00000000020510342851533115, x333, x331);
+        let x337 = Self::mul_add(v[7], x330, Self::mul_add(-s_q8, x322, x7 * x321));
+        let x338 = Self::mul_add(-v[7], x329, Self::mul_add(c_q8, x322, x8 * x321));
+        let x339 = v[7] + Self::mul_add(-0.00000000020510342851533115, x323, x309);
+        let x340 = x330 * x330;
+        let x341 = x339 * x339;
+        let x342 = x329 * x330;
+        let x343 = x321 - x342;
+        let x344 = x329 * x339;
+        let x345 = x329 * x329;
+        let x346 = x341 + x345;
+        let x347 = x330 * x339;
+        let x348 = x337 + x347;
+        let x349 = Self::mul_add(
+            x339,
+            0.002139996587640933,
+            x330 * 0.0000000234896432582596,
+        );
+        let x350 = Self::mul_add(
+            5.080660024070365,
+            x339,
+            Self::mul_add(x330, -111.7548902508081, x329 * 0.0000000234896432582596),
+        );
+        let x351 = Self::mul_add(
+            113.3918902508081,
+            x339,
+            Self::mul_add(5.080660024070366, x330, x329 * 0.002139996587640933),
+        );
+        let x352 = Self::mul_add(
+            x336,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x43,
-                Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
-            ),
+                x321,
+                Self::mul_add(x338, -111.7548902508081, x337 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x329, x351, x339 * x349),
         );
-        let x46 = Self::mul_add(
-            113.3918902508081,
-            x43,
-            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
-        ) - Self::mul_add(x37, 0.000000008530897668050218, x36 * 12.701650001451807);
-        let x47 = x43 * 12.701650001451807;
-        let x48 = x43 * 0.000000008530897668050218;
-        let x49 = Self::mul_add(
-            x33,
-            0.000000008530897668050218,
-            x32 * 12.701650001451807,
-        );
-        let x50 = 0.00000000020510342851533115 * c_q9;
-        let x51 = 0.00000000020510342851533115 * s_q9;
-        let x52 = x50 - x51;
-        let x53 = x50 + x51;
-        let x54 = Self::mul_add(-x43, c_q9, Self::mul_add(-x33, x52, x32 * s_q9));
-        let x55 = Self::mul_add(x43, s_q9, Self::mul_add(x33, x53, x32 * c_q9));
-        let x56 = x36 - Self::mul_add(-0.275, x43, 0.4 * x33);
-        let x57 = Self::mul_add(0.4, x32, x37);
-        let x58 = Self::mul_add(-0.275, x32, x38);
-        let x59 = Self::mul_add(-c_q9, x58, Self::mul_add(-x52, x57, s_q9 * x56));
-        let x60 = Self::mul_add(s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56));
-        let x61 = Self::mul_add(
+        let x353 = Self::mul_add(-c_q9, x339, Self::mul_add(-x11, x330, s_q9 * x329));
+        let x354 = Self::mul_add(s_q9, x339, Self::mul_add(x12, x330, c_q9 * x329));
+        let x355 = x334 + Self::mul_add(-0.4, x338 + x344, 0.275 * x343);
+        let x356 = x335 + Self::mul_add(0.4, x337 - x347, 0.275 * x346);
+        let x357 = x336 - Self::mul_add(-0.4, x340 + x345, 0.275 * x348);
+        let x358 = Self::mul_add(-c_q9, x357, Self::mul_add(-x11, x356, s_q9 * x355));
+        let x359 = Self::mul_add(
             -0.00000000020510342851533115,
-            x58,
-            Self::mul_add(-0.00000000020510342851533115, x56, x57),
+            x357,
+            Self::mul_add(-0.00000000020510342851533115, x355, x356),
         );
-        let x62 = v[8] * x55;
-        let x63 = v[8] * x54;
-        let x64 = v[8] * x60;
-        let x65 = v[8] * x59;
-        let x66 = v[8]
+        let x360 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x321,
+            Self::mul_add(-0.00000000020510342851533115, x337, x338),
+        );
+        let x361 = Self::mul_add(
+            -v[8],
+            x354,
+            Self::mul_add(-c_q9, x321, Self::mul_add(-x11, x338, s_q9 * x337)),
+        );
+        let x362 = Self::mul_add(
+            v[8],
+            x353,
+            Self::mul_add(s_q9, x321, Self::mul_add(x12, x338, c_q9 * x337)),
+        );
+        let x363 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x43,
-                Self::mul_add(-0.00000000020510342851533115, x32, x33),
+                x339,
+                Self::mul_add(-0.00000000020510342851533115, x329, x330),
             );
-        let x67 = Self::mul_add(x66, -36.18604050126307, x55 * 63.36336825000001);
-        let x68 = Self::mul_add(x61, 81.53205, x66 * 0.00214);
-        let x69 = Self::mul_add(
-            x59,
+        let x364 = Self::mul_add(x353, x354, x360);
+        let x365 = Self::mul_add(x353, x353, x363 * x363);
+        let x366 = Self::mul_add(-x354, x363, x361);
+        let x367 = x363 * 0.00214;
+        let x368 = Self::mul_add(x363, -36.18604050126307, x354 * 63.36336825000001);
+        let x369 = Self::mul_add(
+            69.99836825,
+            x363,
+            Self::mul_add(x354, 36.18604050126307, x353 * 0.00214),
+        );
+        let x370 = Self::mul_add(
+            x359,
+            81.53205,
+            Self::mul_add(x360, 0.00214, -Self::mul_add(x354, x369, x363 * x368)),
+        );
+        let x371 = Self::mul_add(
+            x358,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x66,
-                Self::mul_add(x55, 36.18604050126307, x54 * 0.00214),
-            ),
+                x360,
+                Self::mul_add(x362, 36.18604050126307, x361 * 0.00214),
+            ) + Self::mul_add(x353, x368, x354 * x367),
         );
-        let x70 = x66 * 81.53205;
-        let x71 = x54 * 81.53205;
-        let x72 = Self::mul_add(x55, s_q10, x54 * c_q10);
-        let x73 = Self::mul_add(-x55, c_q10, x54 * s_q10);
-        let x74 = Self::mul_add(x66, -0.87, x59);
-        let x75 = Self::mul_add(x54, 0.87, x61);
-        let x76 = Self::mul_add(x60, s_q10, c_q10 * x74);
-        let x77 = Self::mul_add(-x60, c_q10, s_q10 * x74);
-        let x78 = v[9] * x73;
-        let x79 = v[9] * x72;
-        let x80 = v[9] * x77;
-        let x81 = v[9] * x76;
-        let x82 = v[9] + x66;
-        let x83 = Self::mul_add(x82, 24.35164200091464, x73 * 24.4950615);
-        let x84 = Self::mul_add(x75, 45.1584, x82 * 0.6328);
-        let x85 = Self::mul_add(
-            x76,
+        let x372 = Self::mul_add(s_q10, x354, c_q10 * x353);
+        let x373 = Self::mul_add(-c_q10, x354, s_q10 * x353);
+        let x374 = Self::mul_add(-0.87, x364, x358);
+        let x375 = Self::mul_add(
+            0.87,
+            x365,
+            Self::mul_add(s_q9, x357, Self::mul_add(x12, x356, c_q9 * x355)),
+        );
+        let x376 = Self::mul_add(0.87, x366, x359);
+        let x377 = Self::mul_add(s_q10, x375, c_q10 * x374);
+        let x378 = Self::mul_add(v[9], x373, Self::mul_add(s_q10, x362, c_q10 * x361));
+        let x379 = Self::mul_add(-v[9], x372, Self::mul_add(-c_q10, x362, s_q10 * x361));
+        let x380 = v[9] + x363;
+        let x381 = Self::mul_add(-x372, x373, x360);
+        let x382 = x372 * x372;
+        let x383 = Self::mul_add(x380, x380, x382);
+        let x384 = x373 * x380;
+        let x385 = x378 + x384;
+        let x386 = x380 * 0.6328;
+        let x387 = Self::mul_add(x380, 24.35164200091464, x373 * 24.4950615);
+        let x388 = Self::mul_add(
+            28.2393615,
+            x380,
+            Self::mul_add(x373, -24.351642000914637, x372 * 0.6328),
+        );
+        let x389 = Self::mul_add(
+            x376,
+            45.1584,
+            Self::mul_add(x360, 0.6328, Self::mul_add(x373, x388, x380 * x387)),
+        );
+        let x390 = Self::mul_add(
+            x377,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x82,
-                Self::mul_add(x73, -24.351642000914637, x72 * 0.6328),
-            ),
+                x360,
+                Self::mul_add(x379, -24.351642000914637, x378 * 0.6328),
+            ) - Self::mul_add(x372, x387, x373 * x386),
         );
-        let x86 = x82 * 45.1584;
-        let x87 = x72 * 45.1584;
-        let x88 = Self::mul_add(-x73, s_q11, x72 * c_q11);
-        let x89 = Self::mul_add(x73, c_q11, x72 * s_q11);
-        let x90 = x76 + Self::mul_add(x82, -0.63, 0.275 * x73);
-        let x91 = Self::mul_add(-0.275, x72, x77);
-        let x92 = Self::mul_add(x72, 0.63, x75);
-        let x93 = Self::mul_add(-s_q11, x91, c_q11 * x90);
-        let x94 = Self::mul_add(c_q11, x91, s_q11 * x90);
-        let x95 = v[10] * x89;
-        let x96 = v[10] * x88;
-        let x97 = v[10] * x94;
-        let x98 = v[10] * x93;
-        let x99 = v[10] + x82;
-        let x100 = Self::mul_add(-2.5482240016099564, x99, x89 * 9.142025249762803);
-        let x101 = Self::mul_add(7.078399999258757, x92, 0.01675 * x99);
-        let x102 = Self::mul_add(
-            -7.078399999258757,
-            x93,
-            Self::mul_add(
-                -9.223235249762805,
-                x99,
-                Self::mul_add(-2.5482240016099564, x89, 0.01675 * x88),
-            ),
+        let x391 = Self::mul_add(-s_q11, x373, c_q11 * x372);
+        let x392 = Self::mul_add(c_q11, x373, s_q11 * x372);
+        let x393 = x377
+            - Self::mul_add(-0.275, Self::mul_add(x372, x380, x379), 0.63 * x381);
+        let x394 = Self::mul_add(-c_q10, x375, s_q10 * x374)
+            - Self::mul_add(0.275, x378 - x384, 0.63 * x383);
+        let x395 = x376
+            + Self::mul_add(-0.275, Self::mul_add(x373, x373, x382), 0.63 * x385);
+        let x396 = Self::mul_add(-s_q11, x394, c_q11 * x393);
+        let x397 = Self::mul_add(v[10], x392, Self::mul_add(-s_q11, x379, c_q11 * x378));
+        let x398 = Self::mul_add(-v[10], x391, Self::mul_add(c_q11, x379, s_q11 * x378));
+        let x399 = v[10] + x380;
+        let x400 = x391 * x391;
+        let x401 = x392 * x399;
+        let x402 = 0.01675 * x399;
+        let x403 = Self::mul_add(-2.5482240016099564, x399, x392 * 9.142025249762803);
+        let x404 = Self::mul_add(
+            -9.223235249762805,
+            x399,
+            Self::mul_add(-2.5482240016099564, x392, 0.01675 * x391),
         );
-        let x103 = 7.078399999258757 * x99;
-        let x104 = 7.078399999258757 * x88;
-        let x105 = 0.00000000020510342851533115 * s_q12;
-        let x106 = 0.00000000020510342851533115 * c_q12;
-        let x107 = Self::mul_add(x99, s_q12, Self::mul_add(x89, x105, x88 * c_q12));
-        let x108 = Self::mul_add(-x99, c_q12, Self::mul_add(-x89, x106, x88 * s_q12));
-        let x109 = Self::mul_add(x89, 0.36, x93);
-        let x110 = Self::mul_add(x88, -0.36, x94);
-        let x111 = Self::mul_add(x92, s_q12, Self::mul_add(x105, x110, c_q12 * x109));
-        let x112 = Self::mul_add(-x92, c_q12, Self::mul_add(-x106, x110, s_q12 * x109));
-        let x113 = Self::mul_add(-0.00000000020510342851533115, x92, x110);
-        let x114 = v[11] * x108;
-        let x115 = v[11] * x107;
-        let x116 = v[11] * x112;
-        let x117 = v[11] * x111;
-        let x118 = v[11] + Self::mul_add(-0.00000000020510342851533115, x99, x89);
-        let x119 = Self::mul_add(
-            -17.135250000000003,
-            x113,
-            Self::mul_add(x118, 0.809539999555672, x108 * 1.9877000000000002),
-        );
-        let x120 = Self::mul_add(
-            -3.6140000000000003,
-            x113,
-            Self::mul_add(
-                x118,
-                -2.741639999592316,
-                Self::mul_add(x108, -5.252920330000002, x107 * 1.9877000000000002),
-            ),
-        );
-        let x121 = Self::mul_add(
-            9.740442170000001,
-            x118,
-            Self::mul_add(x108, -2.7416399995923166, x107 * 0.809539999555672),
-        ) + Self::mul_add(3.6140000000000003, x112, 17.135250000000003 * x111);
-        let x122 = 17.135250000000003 * x118;
-        let x123 = 3.6140000000000003 * x118;
-        let x124 = Self::mul_add(3.6140000000000003, x108, 17.135250000000003 * x107);
-        let x125 = 0.00000000020510342851533115 * c_q13;
-        let x126 = 0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(-x118, c_q13, Self::mul_add(x108, s_q13, x107 * x125));
-        let x128 = Self::mul_add(-x118, s_q13, Self::mul_add(-x108, c_q13, x107 * x126));
-        let x129 = x111 - Self::mul_add(-0.55, x118, 0.16 * x108);
-        let x130 = Self::mul_add(0.16, x107, x112);
-        let x131 = Self::mul_add(-0.55, x107, x113);
-        let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
-        let x133 = Self::mul_add(-s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
-        let x134 = Self::mul_add(0.00000000020510342851533115, x131, x129);
-        let x135 = v[12] * x128;
-        let x136 = v[12] * x127;
-        let x137 = v[12] * x133;
-        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x118, x107);
-        let x139 = Self::mul_add(
-            x138,
-            -0.9614610000000001,
-            Self::mul_add(x128, 1.2025609200000003, 0.000781 * x127),
-        );
-        let x140 = Self::mul_add(
-            4.806620000000001,
-            x134,
-            Self::mul_add(x138, 0.0145, 0.000781 * x128),
-        );
-        let x141 = Self::mul_add(
-            4.806620000000001,
-            x132,
-            Self::mul_add(
-                -1.4135609200000003,
-                x138,
-                Self::mul_add(x128, -0.9614610000000001, x127 * 0.0145),
-            ),
-        );
-        let x142 = 4.806620000000001 * x138;
-        let x143 = 4.806620000000001 * x127;
-        let x144 = Self::mul_add(x133, x142, Self::mul_add(-x127, x139, x128 * x140));
-        let x145 = Self::mul_add(x127, x143, x138 * x142);
-        let x146 = tau[6] + x144;
-        let x147 = Self::mul_add(
-            x128,
-            x143,
-            -Self::mul_add(
-                x137,
-                16.344251950881606,
-                Self::mul_add(x136, 3.2693162398830324, x135 * 0.049305260929256585),
-            ),
-        );
-        let x148 = Self::mul_add(4.806620000000001, x135, x128 * x142);
-        let x149 = Self::mul_add(
-            x146,
-            0.010257782169020348,
-            Self::mul_add(x133, x143, Self::mul_add(-x128, x141, x138 * x139))
-                - Self::mul_add(
-                    x137,
-                    0.049305260929256585,
-                    Self::mul_add(
-                        x136,
-                        0.009081457502008472,
-                        x135 * 0.00014873784145079505,
-                    ),
-                ),
-        );
-        let x150 = Self::mul_add(
-            x146,
-            0.6801694828971361,
-            Self::mul_add(-x127, x141, x138 * x140)
-                - Self::mul_add(-x132, x143, x134 * x142)
-                - Self::mul_add(
-                    x137,
-                    3.2693162398830324,
-                    Self::mul_add(x136, 1.8565173511957638, x135 * 0.009081457502008472),
-                ),
-        );
-        let x151 = x144 - x146;
-        let x152 = Self::mul_add(x146, 3.4003628227073506, x147);
-        let x153 = c_q13 * 0.009081457502008472;
-        let x154 = Self::mul_add(s_q13, 0.00014873784145079505, x153);
-        let x155 = s_q13 * 0.009081457502008472;
-        let x156 = Self::mul_add(c_q13, 0.00014873784145079505, -x155);
-        let x157 = Self::mul_add(c_q13, 1.8565173511957638, x155);
-        let x158 = Self::mul_add(s_q13, -1.8565173511957638, x153);
-        let x159 = Self::mul_add(x125, 0.049305260929256585, 4.806620000000001);
-        let x160 = s_q13 * 0.049305260929256585;
-        let x161 = Self::mul_add(
-            c_q13,
-            0.049305260929256585,
-            -0.0000000009858542415703612,
-        );
-        let x162 = x125 * 3.2693162398830324;
-        let x163 = s_q13 * 3.2693162398830324;
-        let x164 = c_q13 * 3.2693162398830324;
-        let x165 = Self::mul_add(-x126, x162, x125 * x159);
-        let x166 = Self::mul_add(-x126, x163, x125 * x160);
-        let x167 = Self::mul_add(-x126, x164, x125 * x161);
-        let x168 = Self::mul_add(c_q13, x162, s_q13 * x159);
-        let x169 = Self::mul_add(-s_q13, x162, c_q13 * x159);
-        let x170 = s_q13 * 16.344251950881606;
-        let x171 = c_q13 * 16.344251950881606;
-        let x172 = x125 * (x125 * 16.344251950881606);
-        let x173 = x125 * x170;
-        let x174 = x125 * x171;
-        let x175 = s_q13 * x170;
-        let x176 = s_q13 * x171;
-        let x177 = c_q13 * x171;
-        let x178 = 0.16 * x173;
-        let x179 = 0.55 * x174;
-        let x180 = x166 + Self::mul_add(0.55, x176, 0.16 * x175);
-        let x181 = x167 + Self::mul_add(0.55, x177, 0.16 * x176);
-        let x182 = Self::mul_add(-0.16, x172, x168);
-        let x183 = Self::mul_add(c_q13, x163, s_q13 * x160) - x178;
-        let x184 = Self::mul_add(-0.16, x174, Self::mul_add(c_q13, x164, s_q13 * x161));
-        let x185 = Self::mul_add(-0.55, x172, x169);
-        let x186 = Self::mul_add(-0.55, x173, Self::mul_add(-s_q13, x163, c_q13 * x160));
-        let x187 = Self::mul_add(-s_q13, x164, c_q13 * x161) - x179;
-        let x188 = Self::mul_add(
-            0.16,
-            x168,
-            -Self::mul_add(-0.16, x182, Self::mul_add(c_q13, x157, s_q13 * x154)),
-        );
-        let x189 = Self::mul_add(
-            0.55,
-            x168,
-            -Self::mul_add(-0.16, x185, Self::mul_add(c_q13, x158, s_q13 * x156)),
-        );
-        let x190 = Self::mul_add(
-            0.55,
-            x169,
-            -Self::mul_add(-0.55, x185, Self::mul_add(-s_q13, x158, c_q13 * x156)),
-        );
-        let x191 = x148 - Self::mul_add(-x126, x145, x125 * x152);
-        let x192 = Self::mul_add(c_q13, x145, s_q13 * x152);
-        let x193 = Self::mul_add(
-            0.00000000020510342851533115,
-            x148,
-            Self::mul_add(-s_q13, x145, c_q13 * x152),
-        );
-        let x194 = Self::mul_add(
-            0.55,
-            x191,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x151,
-                Self::mul_add(-s_q13, x150, c_q13 * x149),
-            ),
-        );
-        let x195 = -0.809539999555672
-            + Self::mul_add(
-                0.55,
-                x165,
-                -(Self::mul_add(-x126, x158, x125 * x156)
-                    + Self::mul_add(0.55, x187, 0.16 * x186)),
-            );
-        let x196 = -2.741639999592316 - x189;
-        let x197 = 9.740442170000001 + x190;
-        let x198 = -17.135250000000003 - x185;
-        let x199 = 3.6140000000000003 + x186;
-        let x200 = Self::mul_add(-x107, x120, x108 * x119)
-            + Self::mul_add(-x111, x123, x112 * x122) + x194;
-        let x201 = 1.0 / x197;
-        let x202 = tau[5] - x200;
-        let x203 = x195 * x201;
-        let x204 = x196 * x201;
-        let x205 = x198 * x201;
-        let x206 = x199 * x201;
-        let x207 = x187 * x201;
-        let x208 = Self::mul_add(
-            x195,
-            x203,
-            Self::mul_add(0.55, x167, 0.16 * x166)
-                + (Self::mul_add(
-                    -x126,
-                    Self::mul_add(
-                        x126,
-                        -1.8565173511957638,
-                        x125 * 0.009081457502008472,
-                    ),
-                    x125
-                        * Self::mul_add(
-                            x126,
-                            -0.009081457502008472,
-                            x125 * 0.00014873784145079505,
-                        ),
-                ) + Self::mul_add(0.55, x181, 0.16 * x180)),
-        );
-        let x209 = Self::mul_add(
-            -x195,
-            x204,
-            -1.9877000000000002
-                - Self::mul_add(
-                    0.16,
-                    x165,
-                    -(Self::mul_add(-x126, x157, x125 * x154)
-                        + Self::mul_add(0.55, x184, 0.16 * x183)),
-                ),
-        );
-        let x210 = Self::mul_add(-x196, x204, -5.252920330000002 + x188);
-        let x211 = Self::mul_add(x195, x205, x165 + (x178 + x179));
-        let x212 = Self::mul_add(-x195, x206, x180);
-        let x213 = Self::mul_add(x195, x207, 17.135250000000003 - x181);
-        let x214 = Self::mul_add(-x196, x205, x182);
-        let x215 = Self::mul_add(x196, x206, x183);
-        let x216 = Self::mul_add(x196, x207, -3.6140000000000003 + x184);
-        let x217 = Self::mul_add(x198, x205, x172);
-        let x218 = Self::mul_add(-x198, x206, x173);
-        let x219 = Self::mul_add(-x198, x207, x174);
-        let x220 = Self::mul_add(x199, x206, x175);
-        let x221 = Self::mul_add(x199, x207, x176);
-        let x222 = Self::mul_add(x187, x207, x177);
-        let x223 = Self::mul_add(
-            -x202,
-            x203,
-            Self::mul_add(-x108, x121, x118 * x120)
-                + Self::mul_add(x112, x124, x113 * x123)
-                + (x151 - Self::mul_add(-x126, x150, x125 * x149)
-                    - Self::mul_add(0.55, x193, 0.16 * x192))
-                + (Self::mul_add(-x115, x209, x114 * x208)
-                    + Self::mul_add(-x117, x212, x116 * x211)),
-        );
-        let x224 = Self::mul_add(
-            -x202,
-            x204,
-            Self::mul_add(-x107, x121, x118 * x119)
-                + Self::mul_add(x111, x124, x113 * x122)
-                + Self::mul_add(0.16, x191, Self::mul_add(c_q13, x150, s_q13 * x149))
-                - (Self::mul_add(x115, x210, x114 * x209)
-                    + Self::mul_add(-x117, x215, x116 * x214)),
-        );
-        let x225 = Self::mul_add(x202, x197 * x201, x200);
-        let x226 = Self::mul_add(
-            -x202,
-            x205,
-            Self::mul_add(x108, x124, x118 * x123) + x191
-                + (Self::mul_add(-x115, x214, x114 * x211)
-                    + Self::mul_add(-x117, x218, x116 * x217)),
-        );
-        let x227 = Self::mul_add(
-            -x202,
-            x206,
-            Self::mul_add(x107, x124, x118 * x122) + x192
-                - (Self::mul_add(-x115, x215, x114 * x212)
-                    + Self::mul_add(-x117, x220, x116 * x218)),
-        );
-        let x228 = Self::mul_add(
-            -x202,
-            x207,
-            Self::mul_add(-x107, x123, x108 * x122) + x193
-                + (Self::mul_add(x115, x216, x114 * x213)
-                    - Self::mul_add(-x117, x221, x116 * x219)),
-        );
-        let x229 = s_q12 * x209;
-        let x230 = Self::mul_add(-x106, x209, x105 * x208);
-        let x231 = c_q12 * x209;
-        let x232 = Self::mul_add(s_q12, x208, -x231);
-        let x233 = Self::mul_add(x106, x210, x105 * x209);
-        let x234 = Self::mul_add(c_q12, x210, x229);
-        let x235 = Self::mul_add(s_q12, x212, c_q12 * x211);
-        let x236 = x213 + Self::mul_add(-x106, x212, x105 * x211);
-        let x237 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x213,
-            Self::mul_add(-c_q12, x212, s_q12 * x211),
-        );
-        let x238 = Self::mul_add(s_q12, x215, c_q12 * x214);
-        let x239 = x216 - Self::mul_add(-x106, x215, x105 * x214);
-        let x240 = Self::mul_add(
-            0.00000000020510342851533115,
-            x216,
-            Self::mul_add(-c_q12, x215, s_q12 * x214),
-        );
-        let x241 = Self::mul_add(s_q12, x238, c_q12 * x235);
-        let x242 = Self::mul_add(-s_q12, x239, c_q12 * x236);
-        let x243 = Self::mul_add(-x106, x238, x105 * x235);
-        let x244 = Self::mul_add(-c_q12, x238, s_q12 * x235);
-        let x245 = Self::mul_add(c_q12, x239, s_q12 * x236);
-        let x246 = Self::mul_add(-c_q12, x240, s_q12 * x237);
-        let x247 = s_q12 * x218;
-        let x248 = x219 - Self::mul_add(-x106, x218, x105 * x217);
-        let x249 = c_q12 * x218;
-        let x250 = Self::mul_add(
-            0.00000000020510342851533115,
-            x219,
-            Self::mul_add(s_q12, x217, -x249),
-        );
-        let x251 = x221 - Self::mul_add(-x106, x220, x105 * x218);
-        let x252 = Self::mul_add(
-            0.00000000020510342851533115,
-            x221,
-            Self::mul_add(-c_q12, x220, x247),
-        );
-        let x253 = Self::mul_add(
-            0.00000000020510342851533115,
-            x222,
-            Self::mul_add(-c_q12, x221, s_q12 * x219),
-        );
-        let x254 = Self::mul_add(
-            s_q12,
-            Self::mul_add(s_q12, x220, x249),
-            c_q12 * Self::mul_add(c_q12, x217, x247),
-        );
-        let x255 = Self::mul_add(s_q12, x251, c_q12 * x248);
-        let x256 = Self::mul_add(s_q12, x252, c_q12 * x250);
-        let x257 = x222 - Self::mul_add(-x106, x221, x105 * x219)
-            - Self::mul_add(-x106, x251, x105 * x248);
-        let x258 = x253 - Self::mul_add(-x106, x252, x105 * x250);
-        let x259 = 0.36 * x255;
-        let x260 = Self::mul_add(-0.36, x257, x242);
-        let x261 = Self::mul_add(0.36, x254, x243);
-        let x262 = Self::mul_add(x106, x239, x105 * x236) - x259;
-        let x263 = Self::mul_add(
-            -0.36,
-            x260,
-            Self::mul_add(
-                s_q12,
-                Self::mul_add(-s_q12, x210, x231),
-                c_q12 * Self::mul_add(c_q12, x208, x229),
-            ),
-        );
-        let x264 = Self::mul_add(
-            0.36,
-            x241,
-            Self::mul_add(-0.36, x262, Self::mul_add(s_q12, x233, c_q12 * x230)),
-        );
-        let x265 = Self::mul_add(
-            0.36,
-            x243,
-            Self::mul_add(0.36, x261, Self::mul_add(-x106, x233, x105 * x230)),
-        );
-        let x266 = Self::mul_add(-s_q12, x227, c_q12 * x226);
-        let x267 = x228 + Self::mul_add(x106, x227, x105 * x226);
-        let x268 = 0.01675
-            + Self::mul_add(-0.36, x245, Self::mul_add(s_q12, x234, c_q12 * x232));
-        let x269 = 2.5482240016099564
-            - Self::mul_add(0.36, x244, Self::mul_add(-x106, x234, x105 * x232));
-        let x270 = 9.223235249762805 - Self::mul_add(-c_q12, x234, s_q12 * x232);
-        let x271 = -7.078399999258757 + x244;
-        let x272 = Self::mul_add(-x94, x103, Self::mul_add(-x88, x100, x89 * x101))
-            - Self::mul_add(
-                -0.00000000020510342851533115,
-                x225,
-                Self::mul_add(c_q12, x224, s_q12 * x223),
-            );
-        let x273 = Self::mul_add(
-            x89,
-            x103,
-            Self::mul_add(
-                -0.00000000020510342851533115,
-                x228,
-                Self::mul_add(c_q12, x227, s_q12 * x226),
-            ),
-        );
-        let x274 = 1.0 / x270;
-        let x275 = tau[4] + x272;
-        let x276 = x268 * x274;
-        let x277 = x269 * x274;
-        let x278 = x271 * x274;
-        let x279 = x245 * x274;
-        let x280 = x246 * x274;
-        let x281 = Self::mul_add(-x268, x276, Self::mul_add(0.36, x242, -x263));
-        let x282 = Self::mul_add(-x268, x277, x264);
-        let x283 = Self::mul_add(-x269, x277, -9.142025249762803 - x265);
-        let x284 = Self::mul_add(x268, x278, x241 + x259);
-        let x285 = Self::mul_add(x268, x279, x260);
-        let x286 = Self::mul_add(
-            x268,
-            x280,
-            7.078399999258757
-                + Self::mul_add(0.36, x258, Self::mul_add(s_q12, x240, c_q12 * x237)),
-        );
-        let x287 = Self::mul_add(-x269, x278, x261);
-        let x288 = Self::mul_add(-x269, x279, x262);
-        let x289 = Self::mul_add(
-            -x269,
-            x280,
-            Self::mul_add(0.36, x256, Self::mul_add(-x106, x240, x105 * x237)),
-        );
-        let x290 = Self::mul_add(x271, x278, x254);
-        let x291 = Self::mul_add(-x271, x279, x255);
-        let x292 = Self::mul_add(x271, x280, x256);
-        let x293 = Self::mul_add(x245, x279, x257);
-        let x294 = Self::mul_add(-x245, x280, x258);
-        let x295 = Self::mul_add(
-            x246,
-            x280,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x253,
-                Self::mul_add(-c_q12, x252, s_q12 * x250),
-            ),
-        );
-        let x296 = Self::mul_add(
-            x275,
-            x276,
-            Self::mul_add(-x94, x104, Self::mul_add(-x89, x102, x99 * x100))
-                - Self::mul_add(-0.36, x267, Self::mul_add(-s_q12, x224, c_q12 * x223))
-                + (Self::mul_add(x96, x282, x95 * x281)
-                    - Self::mul_add(-x98, x285, x97 * x284)),
-        );
-        let x297 = Self::mul_add(
-            x275,
-            x277,
-            Self::mul_add(-x88, x102, x99 * x101) - Self::mul_add(x93, x104, x92 * x103)
-                + Self::mul_add(
-                    0.36,
-                    x266,
-                    x225 + Self::mul_add(x106, x224, x105 * x223),
-                )
-                + (Self::mul_add(x96, x283, x95 * x282)
-                    + Self::mul_add(-x98, x288, x97 * x287)),
-        );
-        let x298 = Self::mul_add(
-            -x275,
-            x278,
-            Self::mul_add(x89, x104, x266)
-                + (Self::mul_add(-x96, x287, x95 * x284)
-                    + Self::mul_add(x98, x291, x97 * x290)),
-        );
-        let x299 = Self::mul_add(
-            x275,
-            x279,
-            Self::mul_add(x88, x104, x99 * x103) - x267
-                - (Self::mul_add(-x96, x288, x95 * x285)
-                    - Self::mul_add(x98, x293, x97 * x291)),
-        );
-        let x300 = Self::mul_add(
-            -x275,
-            x280,
-            x273
-                + (Self::mul_add(-x96, x289, x95 * x286)
-                    + Self::mul_add(x98, x294, x97 * x292)),
-        );
-        let x301 = s_q11 * x282;
-        let x302 = c_q11 * x282;
-        let x303 = Self::mul_add(s_q11, x281, x302);
-        let x304 = Self::mul_add(c_q11, x283, x301);
-        let x305 = Self::mul_add(s_q11, x285, c_q11 * x284);
-        let x306 = Self::mul_add(-c_q11, x285, s_q11 * x284);
-        let x307 = Self::mul_add(s_q11, x288, c_q11 * x287);
-        let x308 = Self::mul_add(-c_q11, x288, s_q11 * x287);
-        let x309 = Self::mul_add(s_q11, x307, c_q11 * x305);
-        let x310 = Self::mul_add(s_q11, x308, c_q11 * x306);
-        let x311 = Self::mul_add(s_q11, x289, c_q11 * x286);
-        let x312 = Self::mul_add(-c_q11, x307, s_q11 * x305);
-        let x313 = s_q11 * x291;
-        let x314 = c_q11 * x291;
-        let x315 = Self::mul_add(s_q11, x290, x314);
-        let x316 = Self::mul_add(c_q11, x293, x313);
-        let x317 = Self::mul_add(-s_q11, x294, c_q11 * x292);
-        let x318 = Self::mul_add(c_q11, x294, s_q11 * x292);
-        let x319 = Self::mul_add(
-            -s_q11,
-            Self::mul_add(-s_q11, x293, x314),
-            c_q11 * Self::mul_add(c_q11, x290, -x313),
-        );
-        let x320 = Self::mul_add(-s_q11, x316, c_q11 * x315);
-        let x321 = Self::mul_add(c_q11, x316, s_q11 * x315);
-        let x322 = 0.275 * x320;
-        let x323 = 0.63 * x317;
-        let x324 = 0.63 * x319;
-        let x325 = 0.63 * x320;
-        let x326 = x310 + Self::mul_add(0.63, x318, 0.275 * x321);
-        let x327 = x311 + Self::mul_add(0.63, x295, 0.275 * x318);
-        let x328 = Self::mul_add(-0.275, x319, x312);
-        let x329 = Self::mul_add(-c_q11, x308, s_q11 * x306) - x322;
-        let x330 = Self::mul_add(
-            -0.275,
-            x317,
-            Self::mul_add(-c_q11, x289, s_q11 * x286),
-        );
-        let x331 = Self::mul_add(
-            0.275,
-            x312,
-            Self::mul_add(0.275, x328, Self::mul_add(c_q11, x304, s_q11 * x303)),
-        );
-        let x332 = Self::mul_add(-s_q11, x299, c_q11 * x298);
-        let x333 = Self::mul_add(c_q11, x299, s_q11 * x298);
-        let x334 = -0.6328
-            - Self::mul_add(0.63, x309, Self::mul_add(0.63, x323, 0.275 * x325));
-        let x335 = -24.35164200091464 + Self::mul_add(-0.63, x312, 0.275 * x324);
-        let x336 = Self::mul_add(-0.63, x324, 28.2393615);
-        let x337 = 45.1584 - x324;
-        let x338 = Self::mul_add(-x77, x86, Self::mul_add(x72, x83, x73 * x84))
-            - Self::mul_add(0.63, x332, Self::mul_add(-x275, x270 * x274, x272));
-        let x339 = 1.0 / x336;
-        let x340 = tau[3] - x338;
-        let x341 = x334 * x339;
-        let x342 = x335 * x339;
-        let x343 = x337 * x339;
-        let x344 = x325 * x339;
-        let x345 = x323 * x339;
-        let x346 = Self::mul_add(
-            x334,
-            x341,
-            Self::mul_add(0.63, x311, 0.275 * x310)
-                - (Self::mul_add(
-                    -s_q11,
-                    Self::mul_add(-s_q11, x283, x302),
-                    c_q11 * Self::mul_add(c_q11, x281, -x301),
-                ) - Self::mul_add(0.63, x327, 0.275 * x326)),
-        );
-        let x347 = Self::mul_add(
-            -x334,
-            x342,
-            Self::mul_add(
-                0.275,
-                x309,
-                Self::mul_add(-s_q11, x304, c_q11 * x303)
-                    - Self::mul_add(0.63, x330, 0.275 * x329),
-            ),
-        );
-        let x348 = Self::mul_add(-x335, x342, -24.4950615 + x331);
-        let x349 = Self::mul_add(x334, x343, x309 + (x322 + x323));
-        let x350 = Self::mul_add(-x334, x344, x326);
-        let x351 = Self::mul_add(-x334, x345, -45.1584 + x327);
-        let x352 = Self::mul_add(x335, x343, x328);
-        let x353 = Self::mul_add(-x335, x344, x329);
-        let x354 = Self::mul_add(-x335, x345, x330);
-        let x355 = Self::mul_add(x337, x343, x319);
-        let x356 = Self::mul_add(-x337, x344, x320);
-        let x357 = Self::mul_add(-x337, x345, x317);
-        let x358 = Self::mul_add(x325, x344, x321);
-        let x359 = Self::mul_add(x325, x345, x318);
-        let x360 = Self::mul_add(x323, x345, x295);
-        let x361 = Self::mul_add(
-            x340,
-            x341,
-            Self::mul_add(x77, x87, Self::mul_add(x73, x85, x82 * x83))
-                + (Self::mul_add(-s_q11, x297, c_q11 * x296)
-                    - Self::mul_add(0.63, x300, 0.275 * x333))
-                - (Self::mul_add(-x79, x347, x78 * x346)
-                    + Self::mul_add(x81, x350, x80 * x349)),
-        );
-        let x362 = Self::mul_add(
-            -x340,
-            x342,
-            Self::mul_add(-x72, x85, x82 * x84) - Self::mul_add(x76, x87, x75 * x86)
-                - Self::mul_add(0.275, x332, Self::mul_add(c_q11, x297, s_q11 * x296))
-                - (Self::mul_add(x79, x348, x78 * x347)
-                    - Self::mul_add(x81, x353, x80 * x352)),
-        );
-        let x363 = Self::mul_add(
-            x340,
-            x343,
-            Self::mul_add(x73, x87, -x332)
-                - (Self::mul_add(x79, x352, x78 * x349)
-                    + Self::mul_add(x81, x356, x80 * x355)),
-        );
-        let x364 = Self::mul_add(
-            -x340,
-            x344,
-            Self::mul_add(x72, x87, x82 * x86) - x333
-                - (Self::mul_add(x79, x353, x78 * x350)
-                    + Self::mul_add(x81, x358, x80 * x356)),
-        );
-        let x365 = Self::mul_add(
-            -x340,
-            x345,
-            Self::mul_add(x73, x86, -x300)
-                - (Self::mul_add(x79, x354, x78 * x351)
-                    + Self::mul_add(x81, x359, x80 * x357)),
-        );
-        let x366 = s_q10 * x347;
-        let x367 = c_q10 * x347;
-        let x368 = Self::mul_add(s_q10, x346, -x367);
-        let x369 = Self::mul_add(c_q10, x348, x366);
-        let x370 = Self::mul_add(-s_q10, x350, c_q10 * x349);
-        let x371 = Self::mul_add(c_q10, x350, s_q10 * x349);
-        let x372 = Self::mul_add(-s_q10, x353, c_q10 * x352);
-        let x373 = Self::mul_add(c_q10, x353, s_q10 * x352);
-        let x374 = Self::mul_add(-s_q10, x372, c_q10 * x370);
-        let x375 = Self::mul_add(-s_q10, x354, c_q10 * x351);
-        let x376 = Self::mul_add(c_q10, x372, s_q10 * x370);
-        let x377 = Self::mul_add(c_q10, x354, s_q10 * x351);
-        let x378 = s_q10 * x356;
-        let x379 = c_q10 * x356;
-        let x380 = Self::mul_add(s_q10, x355, x379);
-        let x381 = Self::mul_add(c_q10, x358, x378);
-        let x382 = Self::mul_add(-s_q10, x359, c_q10 * x357);
-        let x383 = Self::mul_add(c_q10, x359, s_q10 * x357);
-        let x384 = Self::mul_add(
-            -s_q10,
-            Self::mul_add(-s_q10, x358, x379),
-            c_q10 * Self::mul_add(c_q10, x355, -x378),
-        );
-        let x385 = Self::mul_add(-s_q10, x381, c_q10 * x380);
-        let x386 = 0.87 * x382;
-        let x387 = 0.87 * x384;
-        let x388 = 0.87 * x385;
-        let x389 = Self::mul_add(0.87, x360, x375);
-        let x390 = Self::mul_add(
-            0.87,
-            x389,
-            Self::mul_add(
-                s_q10,
-                Self::mul_add(-s_q10, x348, x367),
-                c_q10 * Self::mul_add(c_q10, x346, x366),
-            ),
-        );
-        let x391 = Self::mul_add(-s_q10, x364, c_q10 * x363);
-        let x392 = -0.00214 - Self::mul_add(0.87, x374, 0.87 * x386);
-        let x393 = Self::mul_add(-0.87, x376, -36.18604050126307);
-        let x394 = Self::mul_add(-0.87, x387, 69.99836825);
-        let x395 = 81.53205 - x387;
-        let x396 = Self::mul_add(-x60, x70, Self::mul_add(x54, x67, x55 * x68))
-            - Self::mul_add(0.87, x391, Self::mul_add(x340, x336 * x339, x338));
-        let x397 = 1.0 / x394;
-        let x398 = tau[2] + x396;
-        let x399 = x392 * x397;
-        let x400 = x393 * x397;
-        let x401 = x395 * x397;
-        let x402 = x388 * x397;
-        let x403 = x386 * x397;
-        let x404 = Self::mul_add(x392, x399, Self::mul_add(0.87, x375, x390));
         let x405 = Self::mul_add(
-            x392,
-            x400,
-            Self::mul_add(0.87, x377, Self::mul_add(s_q10, x369, c_q10 * x368)),
+            7.078399999258757,
+            x395,
+            Self::mul_add(0.01675, x360, -Self::mul_add(-x392, x404, x399 * x403)),
         );
         let x406 = Self::mul_add(
-            -x393,
-            x400,
-            -63.36336825000001 - Self::mul_add(-c_q10, x369, s_q10 * x368),
-        );
-        let x407 = Self::mul_add(x392, x401, x374 + x386);
-        let x408 = Self::mul_add(
-            -x392,
-            x402,
-            Self::mul_add(0.87, x383, Self::mul_add(-s_q10, x373, c_q10 * x371)),
-        );
-        let x409 = Self::mul_add(-x392, x403, -81.53205 + x389);
-        let x410 = Self::mul_add(x393, x401, x376);
-        let x411 = Self::mul_add(-x393, x402, Self::mul_add(c_q10, x373, s_q10 * x371));
-        let x412 = Self::mul_add(-x393, x403, x377);
-        let x413 = Self::mul_add(x395, x401, x384);
-        let x414 = Self::mul_add(-x395, x402, x385);
-        let x415 = Self::mul_add(-x395, x403, x382);
-        let x416 = Self::mul_add(x388, x402, Self::mul_add(c_q10, x381, s_q10 * x380));
-        let x417 = Self::mul_add(x388, x403, x383);
-        let x418 = Self::mul_add(x386, x403, x360);
-        let x419 = Self::mul_add(
-            -x398,
-            x399,
-            Self::mul_add(x60, x71, Self::mul_add(x55, x69, x66 * x67))
-                - Self::mul_add(0.87, x365, Self::mul_add(s_q10, x362, c_q10 * x361))
-                - (Self::mul_add(-x63, x405, x62 * x404)
-                    + Self::mul_add(-x65, x408, x64 * x407)),
-        );
-        let x420 = Self::mul_add(
-            -x398,
-            x400,
-            Self::mul_add(-x54, x69, x66 * x68) - Self::mul_add(x59, x71, x61 * x70)
-                - Self::mul_add(-c_q10, x362, s_q10 * x361)
-                - (Self::mul_add(x63, x406, x62 * x405)
-                    + Self::mul_add(-x65, x411, x64 * x410)),
-        );
-        let x421 = Self::mul_add(-x398, x394 * x397, x396);
-        let x422 = Self::mul_add(
-            -x398,
-            x401,
-            Self::mul_add(x55, x71, -x391)
-                - (Self::mul_add(-x63, x410, x62 * x407)
-                    + Self::mul_add(-x65, x414, x64 * x413)),
-        );
-        let x423 = Self::mul_add(
-            -x398,
-            x402,
-            Self::mul_add(x54, x71, x66 * x70) + Self::mul_add(c_q10, x364, s_q10 * x363)
-                + (Self::mul_add(-x63, x411, x62 * x408)
-                    + Self::mul_add(-x65, x416, x64 * x414)),
-        );
-        let x424 = Self::mul_add(
-            x398,
-            x403,
-            Self::mul_add(x55, x70, -x365)
-                - (Self::mul_add(-x63, x412, x62 * x409)
-                    + Self::mul_add(-x65, x417, x64 * x415)),
-        );
-        let x425 = c_q9 * x405;
-        let x426 = Self::mul_add(-x53, x405, x52 * x404);
-        let x427 = s_q9 * x405;
-        let x428 = Self::mul_add(c_q9, x404, -x427);
-        let x429 = Self::mul_add(x53, x406, x52 * x405);
-        let x430 = Self::mul_add(s_q9, x406, x425);
-        let x431 = 0.00000000020510342851533115 * x409;
-        let x432 = Self::mul_add(c_q9, x408, s_q9 * x407) - x431;
-        let x433 = x409 - Self::mul_add(-x53, x408, x52 * x407);
-        let x434 = x431 + Self::mul_add(-s_q9, x408, c_q9 * x407);
-        let x435 = 0.00000000020510342851533115 * x412;
-        let x436 = Self::mul_add(c_q9, x411, s_q9 * x410) - x435;
-        let x437 = x412 - Self::mul_add(-x53, x411, x52 * x410);
-        let x438 = x435 + Self::mul_add(-s_q9, x411, c_q9 * x410);
-        let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
-        let x440 = Self::mul_add(c_q9, x437, s_q9 * x433);
-        let x441 = Self::mul_add(c_q9, x438, s_q9 * x434);
-        let x442 = Self::mul_add(-x53, x436, x52 * x432);
-        let x443 = Self::mul_add(-s_q9, x436, c_q9 * x432);
-        let x444 = c_q9 * x414;
-        let x445 = 0.00000000020510342851533115 * x415;
-        let x446 = x415 - Self::mul_add(-x53, x414, x52 * x413);
-        let x447 = s_q9 * x414;
-        let x448 = x445 + Self::mul_add(c_q9, x413, -x447);
-        let x449 = 0.00000000020510342851533115 * x417;
-        let x450 = x417 - Self::mul_add(-x53, x416, x52 * x414);
-        let x451 = x449 + Self::mul_add(-s_q9, x416, x444);
-        let x452 = 0.00000000020510342851533115 * x418;
-        let x453 = x418 - Self::mul_add(-x53, x417, x52 * x415);
-        let x454 = x452 + Self::mul_add(-s_q9, x417, c_q9 * x415);
-        let x455 = Self::mul_add(
-            -0.00000000020510342851533115,
-            Self::mul_add(c_q9, x417, s_q9 * x415) - x452,
+            -7.078399999258757,
+            x396,
             Self::mul_add(
-                c_q9,
-                Self::mul_add(c_q9, x416, x447) - x449,
-                s_q9 * (Self::mul_add(s_q9, x413, x444) - x445),
-            ),
+                -9.223235249762805,
+                x360,
+                Self::mul_add(-2.5482240016099564, x398, 0.01675 * x397),
+            ) - Self::mul_add(-x391, x403, x392 * x402),
         );
-        let x456 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x453,
-            Self::mul_add(c_q9, x450, s_q9 * x446),
+        let x407 = Self::mul_add(s_q12, x399, Self::mul_add(x13, x392, c_q12 * x391));
+        let x408 = Self::mul_add(-c_q12, x399, Self::mul_add(-x14, x392, s_q12 * x391));
+        let x409 = Self::mul_add(0.36, Self::mul_add(x391, x399, x398), x396);
+        let x410 = Self::mul_add(
+            -0.36,
+            x397 - x401,
+            Self::mul_add(c_q11, x394, s_q11 * x393),
         );
-        let x457 = 0.00000000020510342851533115 * x454;
-        let x458 = Self::mul_add(c_q9, x451, s_q9 * x448) - x457;
-        let x459 = x453 - Self::mul_add(-x53, x450, x52 * x446);
-        let x460 = x454 - Self::mul_add(-x53, x451, x52 * x448);
-        let x461 = x457 + Self::mul_add(-s_q9, x451, c_q9 * x448);
-        let x462 = 0.4 * x456;
-        let x463 = 0.275 * x458;
-        let x464 = x440 + Self::mul_add(0.275, x460, 0.4 * x459);
-        let x465 = x441 + Self::mul_add(0.275, x461, 0.4 * x460);
-        let x466 = Self::mul_add(0.4, x455, x442);
-        let x467 = Self::mul_add(-x53, x437, x52 * x433) + x462;
-        let x468 = Self::mul_add(0.4, x458, Self::mul_add(-x53, x438, x52 * x434));
-        let x469 = Self::mul_add(-0.275, x455, x443);
-        let x470 = Self::mul_add(-0.275, x456, Self::mul_add(-s_q9, x437, c_q9 * x433));
-        let x471 = Self::mul_add(-s_q9, x438, c_q9 * x434) - x463;
-        let x472 = Self::mul_add(
-            0.4,
-            x442,
-            Self::mul_add(0.4, x466, Self::mul_add(-x53, x429, x52 * x426)),
+        let x411 = Self::mul_add(-0.36, Self::mul_add(x392, x392, x400), x395);
+        let x412 = Self::mul_add(s_q12, x411, Self::mul_add(x13, x410, c_q12 * x409));
+        let x413 = Self::mul_add(-c_q12, x411, Self::mul_add(-x14, x410, s_q12 * x409));
+        let x414 = Self::mul_add(-0.00000000020510342851533115, x411, x410);
+        let x415 = Self::mul_add(-0.00000000020510342851533115, x360, x398);
+        let x416 = Self::mul_add(
+            v[11],
+            x408,
+            Self::mul_add(s_q12, x360, Self::mul_add(x13, x398, c_q12 * x397)),
         );
-        let x473 = Self::mul_add(
-            0.275,
-            x442,
-            -Self::mul_add(0.4, x469, Self::mul_add(-x53, x430, x52 * x428)),
+        let x417 = Self::mul_add(
+            -v[11],
+            x407,
+            Self::mul_add(-c_q12, x360, Self::mul_add(-x14, x398, s_q12 * x397)),
         );
-        let x474 = Self::mul_add(
-            0.275,
-            x443,
-            -Self::mul_add(-0.275, x469, Self::mul_add(-s_q9, x430, c_q9 * x428)),
+        let x418 = v[11] + Self::mul_add(-0.00000000020510342851533115, x399, x392);
+        let x419 = x408 * x408;
+        let x420 = x418 * x418;
+        let x421 = x407 * x408;
+        let x422 = x415 - x421;
+        let x423 = x407 * x418;
+        let x424 = x407 * x407;
+        let x425 = x420 + x424;
+        let x426 = x408 * x418;
+        let x427 = x416 + x426;
+        let x428 = Self::mul_add(x418, 0.809539999555672, x408 * 1.9877000000000002);
+        let x429 = Self::mul_add(
+            x418,
+            -2.741639999592316,
+            Self::mul_add(x408, -5.252920330000002, x407 * 1.9877000000000002),
         );
-        let x475 = 0.00000000020510342851533115 * x424;
-        let x476 = Self::mul_add(-c_q9, x423, s_q9 * x422) - x475;
-        let x477 = x424 - Self::mul_add(x53, x423, x52 * x422);
-        let x478 = x475 + Self::mul_add(s_q9, x423, c_q9 * x422);
-        let x479 = 0.00000000020510342851533115 * x421;
-        let x480 = -0.002139996587640933
-            + Self::mul_add(
-                0.275,
-                x439,
-                -(Self::mul_add(c_q9, x430, s_q9 * x428)
-                    + Self::mul_add(0.275, x471, 0.4 * x470)),
-            );
-        let x481 = 5.080660024070365 + x473;
-        let x482 = 113.3918902508081 + x474;
-        let x483 = 12.701650001451807 - x469;
-        let x484 = -0.000000008530897668050218 + x470;
-        let x485 = Self::mul_add(-x32, x45, x33 * x44)
-            - Self::mul_add(-x36, x48, x37 * x47)
-            + Self::mul_add(0.275, x476, x479 - Self::mul_add(-s_q9, x420, c_q9 * x419));
-        let x486 = 1.0 / x482;
-        let x487 = tau[1] - x485;
-        let x488 = x480 * x486;
-        let x489 = x481 * x486;
-        let x490 = x483 * x486;
-        let x491 = x484 * x486;
-        let x492 = x471 * x486;
-        let x493 = Self::mul_add(
-            x480,
-            x488,
-            Self::mul_add(0.275, x441, 0.4 * x440)
-                + (Self::mul_add(
-                    c_q9,
-                    Self::mul_add(-c_q9, x406, x427),
-                    s_q9 * Self::mul_add(s_q9, x404, x425),
-                ) + Self::mul_add(0.275, x465, 0.4 * x464)),
+        let x430 = Self::mul_add(
+            9.740442170000001,
+            x418,
+            Self::mul_add(x408, -2.7416399995923166, x407 * 0.809539999555672),
         );
-        let x494 = Self::mul_add(
-            -x480,
-            x489,
-            -0.0000000234896432582596
-                - Self::mul_add(
-                    0.4,
-                    x439,
-                    Self::mul_add(c_q9, x429, s_q9 * x426)
-                        + Self::mul_add(0.275, x468, 0.4 * x467),
-                ),
-        );
-        let x495 = Self::mul_add(-x481, x489, -111.7548902508081 - x472);
-        let x496 = Self::mul_add(x480, x490, x439 + (x462 + x463));
-        let x497 = Self::mul_add(-x480, x491, x464);
-        let x498 = Self::mul_add(x480, x492, -12.701650001451807 - x465);
-        let x499 = Self::mul_add(x481, x490, x466);
-        let x500 = Self::mul_add(-x481, x491, x467);
-        let x501 = Self::mul_add(x481, x492, 0.000000008530897668050218 - x468);
-        let x502 = Self::mul_add(x483, x490, x455);
-        let x503 = Self::mul_add(-x483, x491, x456);
-        let x504 = Self::mul_add(-x483, x492, x458);
-        let x505 = Self::mul_add(x484, x491, x459);
-        let x506 = Self::mul_add(x484, x492, x460);
-        let x507 = Self::mul_add(x471, x492, x461);
-        let x508 = Self::mul_add(
-            -x487,
-            x488,
-            Self::mul_add(-x33, x46, x43 * x45) - Self::mul_add(x37, x49, x38 * x48)
-                + (Self::mul_add(c_q9, x420, s_q9 * x419) + x479
-                    + Self::mul_add(0.275, x478, 0.4 * x477))
-                + (Self::mul_add(-x40, x494, x39 * x493)
-                    + Self::mul_add(-x42, x497, x41 * x496)),
-        );
-        let x509 = Self::mul_add(
-            -x487,
-            x489,
-            Self::mul_add(-x32, x46, x43 * x44) - Self::mul_add(x36, x49, x38 * x47)
-                + Self::mul_add(0.4, x476, x421 + Self::mul_add(-x53, x420, x52 * x419))
-                - (Self::mul_add(x40, x495, x39 * x494)
-                    - Self::mul_add(-x42, x500, x41 * x499)),
-        );
-        let x510 = Self::mul_add(x487, x482 * x486, x485);
-        let x511 = Self::mul_add(
-            x487,
-            x490,
-            Self::mul_add(x33, x49, x43 * x48) - x476
-                - (Self::mul_add(x40, x499, x39 * x496)
-                    + Self::mul_add(-x42, x503, x41 * x502)),
-        );
-        let x512 = Self::mul_add(
-            x487,
-            x491,
-            Self::mul_add(x32, x49, x43 * x47) + x477
-                + (Self::mul_add(x40, x500, x39 * x497)
-                    + Self::mul_add(-x42, x505, x41 * x503)),
-        );
-        let x513 = Self::mul_add(
-            x487,
-            x492,
-            Self::mul_add(-x32, x48, x33 * x47) + x478
-                - (Self::mul_add(x40, x501, x39 * x498)
-                    - Self::mul_add(-x42, x506, x41 * x504)),
-        );
-        let x514 = c_q8 * x494;
-        let x515 = Self::mul_add(s_q8, x493, -x514);
-        let x516 = s_q8 * x494;
-        let x517 = Self::mul_add(c_q8, x493, x516);
-        let x518 = Self::mul_add(c_q8, x495, x516);
-        let x519 = Self::mul_add(-s_q8, x495, x514);
-        let x520 = x498 + Self::mul_add(x31, x497, x30 * x496);
-        let x521 = Self::mul_add(-c_q8, x497, s_q8 * x496);
-        let x522 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x498,
-            Self::mul_add(s_q8, x497, c_q8 * x496),
-        );
-        let x523 = x501 + Self::mul_add(x31, x500, x30 * x499);
-        let x524 = Self::mul_add(-c_q8, x500, s_q8 * x499);
-        let x525 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x501,
-            Self::mul_add(s_q8, x500, c_q8 * x499),
-        );
-        let x526 = Self::mul_add(-x31, x523, x30 * x520);
-        let x527 = Self::mul_add(-x31, x524, x30 * x521);
-        let x528 = Self::mul_add(c_q8, x523, s_q8 * x520);
-        let x529 = Self::mul_add(-s_q8, x523, c_q8 * x520);
-        let x530 = Self::mul_add(-s_q8, x524, c_q8 * x521);
-        let x531 = Self::mul_add(-s_q8, x525, c_q8 * x522);
-        let x532 = c_q8 * x503;
-        let x533 = Self::mul_add(s_q8, x502, -x532);
-        let x534 = s_q8 * x503;
-        let x535 = Self::mul_add(
-            0.00000000020510342851533115,
-            x504,
-            Self::mul_add(c_q8, x502, x534),
-        );
-        let x536 = Self::mul_add(-c_q8, x505, x534);
-        let x537 = Self::mul_add(
-            0.00000000020510342851533115,
-            x506,
-            Self::mul_add(s_q8, x505, x532),
-        );
-        let x538 = Self::mul_add(
-            0.00000000020510342851533115,
-            x507,
-            Self::mul_add(s_q8, x506, c_q8 * x504),
-        );
-        let x539 = x507 - Self::mul_add(x31, x506, x30 * x504)
-            - Self::mul_add(
-                x31,
-                x506 - Self::mul_add(x31, x505, x30 * x503),
-                x30 * (x504 - Self::mul_add(x31, x503, x30 * x502)),
-            );
-        let x540 = Self::mul_add(-c_q8, x506, s_q8 * x504)
-            - Self::mul_add(x31, x536, x30 * x533);
-        let x541 = x538 - Self::mul_add(x31, x537, x30 * x535);
-        let x542 = Self::mul_add(-c_q8, x536, s_q8 * x533);
-        let x543 = Self::mul_add(-c_q8, x537, s_q8 * x535);
-        let x544 = 0.35 * x540;
-        let x545 = Self::mul_add(0.35, x542, x527);
-        let x546 = Self::mul_add(-0.35, x539, x528);
-        let x547 = Self::mul_add(c_q8, x524, s_q8 * x521) + x544;
-        let x548 = Self::mul_add(
-            0.35,
-            x545,
+        let x431 = Self::mul_add(
+            -3.6140000000000003,
+            x414,
             Self::mul_add(
-                x31,
-                Self::mul_add(-x31, x495, x30 * x494),
-                x30 * Self::mul_add(x31, x494, x30 * x493),
-            ),
+                x415,
+                -2.741639999592316,
+                Self::mul_add(x417, -5.252920330000002, x416 * 1.9877000000000002),
+            ) + Self::mul_add(-x407, x430, x418 * x428),
         );
-        let x549 = Self::mul_add(
-            0.35,
-            x526,
-            -Self::mul_add(0.35, x547, Self::mul_add(x31, x518, x30 * x515)),
-        );
-        let x550 = Self::mul_add(
-            0.35,
-            x528,
-            -Self::mul_add(-0.35, x546, Self::mul_add(-c_q8, x518, s_q8 * x515)),
-        );
-        let x551 = x513 + Self::mul_add(-x31, x512, x30 * x511);
-        let x552 = Self::mul_add(c_q8, x512, s_q8 * x511);
-        let x553 = -16.80768997608804
-            - Self::mul_add(0.35, x530, Self::mul_add(x31, x519, x30 * x517));
-        let x554 = 0.1132
-            + Self::mul_add(-0.35, x529, Self::mul_add(-c_q8, x519, s_q8 * x517));
-        let x555 = 132.47349025763282 - Self::mul_add(s_q8, x519, c_q8 * x517);
-        let x556 = 48.0240000085309 + x530;
-        let x557 = Self::mul_add(x18, x28, Self::mul_add(-x13, x26, x14 * x25))
-            + Self::mul_add(
-                -0.00000000020510342851533115,
-                x510,
-                Self::mul_add(-s_q8, x509, c_q8 * x508),
-            );
-        let x558 = Self::mul_add(
-            x13,
-            x28,
-            -Self::mul_add(
-                -0.00000000020510342851533115,
-                x513,
-                Self::mul_add(-s_q8, x512, c_q8 * x511),
-            ),
-        );
-        let x559 = 1.0 / x555;
-        let x560 = tau[0] - x557;
-        let x561 = x553 * x559;
-        let x562 = x554 * x559;
-        let x563 = x529 * x559;
-        let x564 = x556 * x559;
-        let x565 = x531 * x559;
-        let x566 = Self::mul_add(x553, x561, Self::mul_add(0.35, x527, x548));
-        let x567 = Self::mul_add(-x553, x562, -0.07309 - x549);
-        let x568 = Self::mul_add(-x554, x562, 130.43769025763282 + x550);
-        let x569 = Self::mul_add(-x553, x563, x526 - x544);
-        let x570 = Self::mul_add(-x553, x564, x545);
-        let x571 = Self::mul_add(
-            -x553,
-            x565,
-            Self::mul_add(0.35, x543, Self::mul_add(-x31, x525, x30 * x522)),
-        );
-        let x572 = Self::mul_add(x554, x563, x546);
-        let x573 = Self::mul_add(x554, x564, x547);
-        let x574 = Self::mul_add(
-            x554,
-            x565,
-            -48.0240000085309
-                + Self::mul_add(0.35, x541, Self::mul_add(c_q8, x525, s_q8 * x522)),
-        );
-        let x575 = Self::mul_add(x529, x563, x539);
-        let x576 = Self::mul_add(-x529, x564, x540);
-        let x577 = Self::mul_add(-x529, x565, x541);
-        let x578 = Self::mul_add(x556, x564, x542);
-        let x579 = Self::mul_add(x556, x565, x543);
-        let x580 = Self::mul_add(
-            x531,
-            x565,
+        let x432 = Self::mul_add(-c_q13, x418, Self::mul_add(s_q13, x408, x15 * x407));
+        let x433 = Self::mul_add(-s_q13, x418, Self::mul_add(-c_q13, x408, x16 * x407));
+        let x434 = x412 + Self::mul_add(-0.16, x417 + x423, 0.55 * x422);
+        let x435 = x414 - Self::mul_add(-0.16, x419 + x424, 0.55 * x427);
+        let x436 = Self::mul_add(
+            -c_q13,
+            x435,
             Self::mul_add(
-                0.00000000020510342851533115,
-                x538,
-                Self::mul_add(s_q8, x537, c_q8 * x535),
+                s_q13,
+                x413 + Self::mul_add(0.16, x416 - x426, 0.55 * x425),
+                x15 * x434,
             ),
         );
-        let x581 = Self::mul_add(
-            x560,
-            x561,
-            Self::mul_add(x14, x27, x24 * x26) - Self::mul_add(x19, x29, x17 * x28)
-                + Self::mul_add(
-                    -0.35,
-                    x552,
-                    x510 + Self::mul_add(-x31, x509, x30 * x508),
-                )
-                + (Self::mul_add(-x21, x567, x20 * x566)
-                    + Self::mul_add(-x23, x570, x22 * x569)),
+        let x437 = Self::mul_add(0.00000000020510342851533115, x415, x416);
+        let x438 = Self::mul_add(
+            v[12],
+            x433,
+            Self::mul_add(-c_q13, x415, Self::mul_add(s_q13, x417, x15 * x416)),
         );
-        let x582 = Self::mul_add(
-            x560,
-            x562,
-            Self::mul_add(-x18, x29, Self::mul_add(x13, x27, x24 * x25))
-                - Self::mul_add(0.35, x551, Self::mul_add(c_q8, x509, s_q8 * x508))
-                - (Self::mul_add(x21, x568, x20 * x567)
-                    + Self::mul_add(-x23, x573, x22 * x572)),
+        let x439 = Self::mul_add(
+            -v[12],
+            x432,
+            Self::mul_add(-s_q13, x415, Self::mul_add(-c_q13, x417, x16 * x416)),
         );
-        let x583 = Self::mul_add(
-            x560,
-            x563,
-            Self::mul_add(x14, x29, x24 * x28) + x551
-                - (Self::mul_add(-x21, x572, x20 * x569)
-                    + Self::mul_add(x23, x576, x22 * x575)),
+        let x440 = v[12] - Self::mul_add(0.00000000020510342851533115, x418, x407);
+        let x441 = 4.806620000000001 * Self::mul_add(x432, x433, x437);
+        let x442 = 4.806620000000001 * Self::mul_add(x432, x432, x440 * x440);
+        let x443 = 4.806620000000001 * Self::mul_add(x433, x440, x438);
+        let x444 = Self::mul_add(0.0145, x440, 0.000781 * x433);
+        let x445 = Self::mul_add(
+            -0.9614610000000001,
+            x440,
+            Self::mul_add(1.2025609200000003, x433, 0.000781 * x432),
         );
-        let x584 = Self::mul_add(
-            -x560,
-            x564,
-            Self::mul_add(x13, x29, -x552)
-                + (Self::mul_add(-x21, x573, x20 * x570)
-                    - Self::mul_add(x23, x578, x22 * x576)),
+        let x446 = Self::mul_add(
+            -1.4135609200000003,
+            x440,
+            Self::mul_add(-0.9614610000000001, x433, 0.0145 * x432),
         );
-        let x585 = Self::mul_add(
-            -x560,
-            x565,
-            x558
-                + (Self::mul_add(-x21, x574, x20 * x571)
-                    - Self::mul_add(x23, x579, x22 * x577)),
-        );
-        let x586 = s_q7 * x567;
-        let x587 = c_q7 * x567;
-        let x588 = Self::mul_add(s_q7, x566, -x587);
-        let x589 = Self::mul_add(c_q7, x568, x586);
-        let x590 = Self::mul_add(s_q7, x570, c_q7 * x569);
-        let x591 = Self::mul_add(-c_q7, x570, s_q7 * x569);
-        let x592 = Self::mul_add(s_q7, x573, c_q7 * x572);
-        let x593 = Self::mul_add(-c_q7, x573, s_q7 * x572);
-        let x594 = Self::mul_add(s_q7, x592, c_q7 * x590);
-        let x595 = Self::mul_add(s_q7, x593, c_q7 * x591);
-        let x596 = Self::mul_add(s_q7, x574, c_q7 * x571);
-        let x597 = Self::mul_add(-c_q7, x592, s_q7 * x590);
-        let x598 = Self::mul_add(-c_q7, x593, s_q7 * x591);
-        let x599 = Self::mul_add(-c_q7, x574, s_q7 * x571);
-        let x600 = s_q7 * x576;
-        let x601 = c_q7 * x576;
-        let x602 = Self::mul_add(s_q7, x575, x601);
-        let x603 = Self::mul_add(c_q7, x578, x600);
-        let x604 = Self::mul_add(-s_q7, x579, c_q7 * x577);
-        let x605 = Self::mul_add(c_q7, x579, s_q7 * x577);
-        let x606 = Self::mul_add(
-            -s_q7,
-            Self::mul_add(-s_q7, x578, x601),
-            c_q7 * Self::mul_add(c_q7, x575, -x600),
-        );
-        let x607 = Self::mul_add(-s_q7, x603, c_q7 * x602);
-        let x608 = Self::mul_add(c_q7, x603, s_q7 * x602);
-        let x609 = 0.75 * x607;
-        let x610 = 0.65 * x607;
-        let x611 = 0.65 * x605;
-        let x612 = 0.65 * x608;
-        let x613 = x594 - x609;
-        let x614 = Self::mul_add(-0.75, x608, x595);
-        let x615 = x597 + Self::mul_add(0.65, x604, 0.75 * x606);
-        let x616 = x598 + (x609 + x611);
-        let x617 = x599 - Self::mul_add(0.65, x580, 0.75 * x604);
-        let x618 = Self::mul_add(
-            -0.75,
-            x614,
-            Self::mul_add(
-                s_q7,
-                Self::mul_add(-s_q7, x568, x587),
-                c_q7 * Self::mul_add(c_q7, x566, x586),
-            ),
-        );
-        let x619 = Self::mul_add(-s_q7, x584, c_q7 * x583);
-        let x620 = Self::mul_add(c_q7, x584, s_q7 * x583);
-        let x621 = 180.9502499901501 - x615;
-        let x622 = Self::mul_add(-v[4], x12, v[5] * x11) + x619;
-        let x623 = 1.0 / (1170.07 - x606);
-        let x624 = x607 * x623;
-        let x625 = x604 * x623;
-        let x626 = x613 * x623;
-        let x627 = x621 * x623;
-        let x628 = x610 * x623;
-        let x629 = 1.0 / Self::mul_add(-x607, x624, 1170.07 - x608);
-        let x630 = Self::mul_add(x607, x625, x605);
-        let x631 = x629 * x630;
-        let x632 = Self::mul_add(-x607, x626, -180.9502499901501 - x614);
-        let x633 = x629 * x632;
-        let x634 = Self::mul_add(-x607, x627, x616);
-        let x635 = x629 * x634;
-        let x636 = Self::mul_add(-x607, x628, 110.5455 - x612);
-        let x637 = x629 * x636;
-        let x638 = 1.0
-            / Self::mul_add(-x630, x631, Self::mul_add(-x604, x625, 1170.07 - x580));
-        let x639 = Self::mul_add(
-            x630,
-            x633,
-            Self::mul_add(-x604, x626, Self::mul_add(0.75, x605, x596)),
-        );
-        let x640 = x638 * x639;
-        let x641 = Self::mul_add(
-            x630,
-            x635,
-            Self::mul_add(-x604, x627, -110.5455 - x617),
-        );
-        let x642 = x638 * x641;
-        let x643 = Self::mul_add(-x630, x637, Self::mul_add(x604, x628, x611));
-        let x644 = x638 * x643;
-        let x645 = Self::mul_add(
-            -x632,
-            x633,
-            Self::mul_add(
-                -x613,
-                x626,
-                1394.5960312283303 + Self::mul_add(0.75, x595, -x618),
-            ),
-        );
-        let x646 = 1.0 / Self::mul_add(-x639, x640, x645);
-        let x647 = Self::mul_add(
-            -x613,
-            x627,
-            Self::mul_add(-0.65, x596, 0.75 * x594)
-                + Self::mul_add(-0.75, x616, Self::mul_add(s_q7, x589, c_q7 * x588)),
-        );
-        let x648 = Self::mul_add(-x639, x642, Self::mul_add(-x632, x635, x647));
-        let x649 = x646 * x648;
-        let x650 = Self::mul_add(
-            -x632,
-            x637,
-            Self::mul_add(
-                -x613,
-                x628,
-                -117.61766249359756 + Self::mul_add(-0.65, x595, 0.75 * x612),
-            ),
-        );
-        let x651 = Self::mul_add(x639, x644, x650);
-        let x652 = x646 * x651;
-        let x653 = Self::mul_add(
-            -x634,
-            x635,
-            Self::mul_add(
-                -x621,
-                x627,
-                1466.4506062283303
-                    - (Self::mul_add(-0.65, x599, 0.75 * x597)
-                        + (Self::mul_add(-c_q7, x589, s_q7 * x588)
-                            + Self::mul_add(-0.65, x617, 0.75 * x615))),
-            ),
-        );
-        let x654 = 1.0 / Self::mul_add(-x648, x649, Self::mul_add(-x641, x642, x653));
-        let x655 = Self::mul_add(
-            -x621,
-            x628,
-            Self::mul_add(0.65, x598, Self::mul_add(0.65, x611, 0.75 * x610)),
-        );
-        let x656 = Self::mul_add(
-            -x648,
-            x652,
-            Self::mul_add(x641, x644, Self::mul_add(-x634, x637, x655)),
-        );
-        let x657 = x654 * x656;
-        let x658 = Self::mul_add(
-            -x636,
-            x637,
-            Self::mul_add(-x610, x628, Self::mul_add(-0.65, x612, 1271.854575)),
-        );
-        let x659 = Self::mul_add(
-            -x656,
-            x657,
-            Self::mul_add(-x651, x652, Self::mul_add(-x643, x644, x658)),
-        );
-        let x660 = 1.0 / x659;
-        let x661 = Self::mul_add(
-            -x622,
-            x624,
-            Self::mul_add(-v[3], x12, v[5] * x10) - x620,
-        );
-        let x662 = Self::mul_add(
-            x631,
-            x661,
-            Self::mul_add(-x622, x625, Self::mul_add(-v[3], x11, v[4] * x10) - x585),
-        );
-        let x663 = Self::mul_add(
-            x622,
-            x626,
-            Self::mul_add(v[4], x9, v[5] * x8) + Self::mul_add(-v[1], x12, v[2] * x11)
-                - Self::mul_add(0.75, x620, Self::mul_add(-s_q7, x582, c_q7 * x581)),
-        );
-        let x664 = Self::mul_add(x640, x662, Self::mul_add(x633, x661, x663));
-        let x665 = Self::mul_add(
-            x635,
-            x661,
-            Self::mul_add(
-                x622,
-                x627,
-                Self::mul_add(v[3], x9, v[5] * x7)
-                    + Self::mul_add(-v[0], x12, v[2] * x10)
-                    + (Self::mul_add(c_q7, x582, s_q7 * x581)
-                        - Self::mul_add(0.65, x585, 0.75 * x619)),
-            ),
-        );
-        let x666 = Self::mul_add(-x649, x664, Self::mul_add(x642, x662, x665));
-        let x667 = Self::mul_add(
-            x622,
-            x628,
-            Self::mul_add(-v[3], x8, v[4] * x7) + Self::mul_add(-v[0], x11, v[1] * x10)
-                - Self::mul_add(-0.65, x620, Self::mul_add(x560, x555 * x559, x557)),
-        );
-        let x668 = Self::mul_add(
-            -x652,
-            x664,
-            Self::mul_add(-x644, x662, Self::mul_add(x637, x661, x667)),
-        );
-        let x669 = x660 * Self::mul_add(-x657, x666, x668);
-        let x670 = Self::mul_add(-x657, x669, x654 * x666);
-        let x671 = -x670;
-        let x672 = Self::mul_add(-x652, x669, Self::mul_add(-x649, x670, x646 * x664));
-        let x673 = Self::mul_add(
-            -x644,
-            x669,
-            Self::mul_add(x642, x670, Self::mul_add(x640, x672, x638 * x662)),
-        );
-        let x674 = Self::mul_add(
-            x635,
-            x670,
-            Self::mul_add(x633, x672, Self::mul_add(x631, x673, x629 * x661)),
-        );
-        let x675 = Self::mul_add(x637, x669, x674);
-        let x676 = -x675;
-        let x677 = Self::mul_add(
-            x626,
-            x672,
-            Self::mul_add(-x625, x673, Self::mul_add(-x624, x675, x622 * x623)),
-        );
-        let x678 = Self::mul_add(x628, x669, Self::mul_add(x627, x670, x677));
-        let x679 = Self::mul_add(-0.75, x670, x678);
-        let x680 = x675 + Self::mul_add(-0.65, x669, 0.75 * x672);
-        let x681 = Self::mul_add(0.65, x670, x673);
-        let x682 = x20 - Self::mul_add(-s_q7, x670, c_q7 * x672);
-        let x683 = x21 + Self::mul_add(c_q7, x670, s_q7 * x672);
-        let x684 = x22 - Self::mul_add(-s_q7, x680, c_q7 * x679);
-        let x685 = x23 + Self::mul_add(c_q7, x680, s_q7 * x679);
-        let x686 = x559
-            * (x560
-                + (Self::mul_add(-x555, x669, Self::mul_add(x554, x683, x553 * x682))
-                    - Self::mul_add(
-                        -x531,
-                        x681,
-                        Self::mul_add(-x556, x685, x529 * x684),
-                    )));
-        let x687 = x669 + x686;
-        let x688 = Self::mul_add(0.00000000020510342851533115, x687, x682);
-        let x689 = Self::mul_add(0.35, x683, x684);
-        let x690 = Self::mul_add(-0.35, x682, x685);
-        let x691 = Self::mul_add(0.00000000020510342851533115, x681, x689);
-        let x692 = x39
-            + Self::mul_add(-c_q8, x687, Self::mul_add(-s_q8, x683, x30 * x682));
-        let x693 = x40
-            - Self::mul_add(-s_q8, x687, Self::mul_add(c_q8, x683, x31 * x682));
-        let x694 = x41
-            + Self::mul_add(-c_q8, x681, Self::mul_add(-s_q8, x690, x30 * x689));
-        let x695 = x42
-            - Self::mul_add(-s_q8, x681, Self::mul_add(c_q8, x690, x31 * x689));
-        let x696 = x486
-            * (x487
-                - (Self::mul_add(-x482, x688, Self::mul_add(x481, x693, x480 * x692))
-                    + Self::mul_add(
-                        x471,
-                        x691,
-                        Self::mul_add(x484, x695, x483 * x694),
-                    )));
-        let x697 = x688 - x696;
-        let x698 = Self::mul_add(
-            0.00000000020510342851533115,
-            x697,
-            Self::mul_add(0.00000000020510342851533115, x692, x693),
-        );
-        let x699 = x694 + Self::mul_add(0.275, x697, 0.4 * x693);
-        let x700 = Self::mul_add(-0.4, x692, x695);
-        let x701 = Self::mul_add(-0.275, x692, x691);
-        let x702 = Self::mul_add(
-            0.00000000020510342851533115,
-            x701,
-            Self::mul_add(0.00000000020510342851533115, x699, x700),
-        );
-        let x703 = x62
-            - Self::mul_add(-c_q9, x697, Self::mul_add(x52, x693, s_q9 * x692));
-        let x704 = x63
-            + Self::mul_add(s_q9, x697, Self::mul_add(-x53, x693, c_q9 * x692));
-        let x705 = x64
-            - Self::mul_add(-c_q9, x701, Self::mul_add(x52, x700, s_q9 * x699));
-        let x706 = x65
-            + Self::mul_add(s_q9, x701, Self::mul_add(-x53, x700, c_q9 * x699));
-        let x707 = x397
-            * (x398
-                + (Self::mul_add(-x394, x698, Self::mul_add(-x393, x704, x392 * x703))
-                    + Self::mul_add(
-                        -x386,
-                        x702,
-                        Self::mul_add(x388, x706, x395 * x705),
-                    )));
-        let x708 = x698 + x707;
-        let x709 = Self::mul_add(-0.87, x708, x705);
-        let x710 = Self::mul_add(0.87, x703, x702);
-        let x711 = x78 - Self::mul_add(-s_q10, x704, c_q10 * x703);
-        let x712 = x79 + Self::mul_add(c_q10, x704, s_q10 * x703);
-        let x713 = x80 - Self::mul_add(-s_q10, x706, c_q10 * x709);
-        let x714 = x81 + Self::mul_add(c_q10, x706, s_q10 * x709);
-        let x715 = x339
-            * (x340
-                - (Self::mul_add(x336, x708, Self::mul_add(x335, x712, x334 * x711))
-                    + Self::mul_add(
-                        x323,
-                        x710,
-                        Self::mul_add(-x325, x714, x337 * x713),
-                    )));
-        let x716 = x708 + x715;
-        let x717 = x713 - Self::mul_add(-0.63, x716, 0.275 * x712);
-        let x718 = Self::mul_add(0.275, x711, x714);
-        let x719 = Self::mul_add(-0.63, x711, x710);
-        let x720 = x95 + Self::mul_add(s_q11, x712, c_q11 * x711);
-        let x721 = x96 - Self::mul_add(-c_q11, x712, s_q11 * x711);
-        let x722 = x97 + Self::mul_add(s_q11, x718, c_q11 * x717);
-        let x723 = x98 - Self::mul_add(-c_q11, x718, s_q11 * x717);
-        let x724 = x274
-            * (x275
-                - (Self::mul_add(x270, x716, Self::mul_add(x269, x721, x268 * x720))
-                    + Self::mul_add(
-                        -x246,
-                        x719,
-                        Self::mul_add(-x245, x723, x271 * x722),
-                    )));
-        let x725 = x716 + x724;
-        let x726 = Self::mul_add(-0.00000000020510342851533115, x725, x721);
-        let x727 = Self::mul_add(-0.36, x721, x722);
-        let x728 = Self::mul_add(0.36, x720, x723);
-        let x729 = Self::mul_add(-0.00000000020510342851533115, x719, x728);
-        let x730 = x114
-            + Self::mul_add(-s_q12, x725, Self::mul_add(-x105, x721, c_q12 * x720));
-        let x731 = x115
-            - Self::mul_add(c_q12, x725, Self::mul_add(x106, x721, s_q12 * x720));
-        let x732 = x116
-            + Self::mul_add(-s_q12, x719, Self::mul_add(-x105, x728, c_q12 * x727));
-        let x733 = x117
-            - Self::mul_add(c_q12, x719, Self::mul_add(x106, x728, s_q12 * x727));
-        let x734 = x201
-            * (x202
-                - (Self::mul_add(x197, x726, Self::mul_add(x196, x731, x195 * x730))
-                    + Self::mul_add(
-                        -x187,
-                        x729,
-                        Self::mul_add(x199, x733, x198 * x732),
-                    )));
-        let x735 = x726 + x734;
-        let x736 = Self::mul_add(
-            c_q13,
-            Self::mul_add(0.55, x730, x729),
-            Self::mul_add(
-                -s_q13,
-                Self::mul_add(-0.16, x730, x733),
-                x125 * (x732 + Self::mul_add(-0.55, x735, 0.16 * x731)),
-            ),
-        );
-        let x737 = Self::mul_add(
+        let x447 = Self::mul_add(
             0.9614610000000001,
-            x136 - Self::mul_add(s_q13, x735, Self::mul_add(c_q13, x731, x126 * x730)),
-            0.0145
-                * (x135
-                    + Self::mul_add(
-                        c_q13,
-                        x735,
-                        Self::mul_add(-s_q13, x731, x125 * x730),
-                    )),
-        );
-        let x738 = Self::mul_add(
+            x437,
+            Self::mul_add(1.2025609200000003, x439, 0.000781 * x438),
+        ) + Self::mul_add(-x432, x446, x440 * x444);
+        let x448 = Self::mul_add(
             4.806620000000001,
-            x137 + x736,
+            Self::mul_add(0.00000000020510342851533115, x435, x434),
+            Self::mul_add(-0.0145, x437, 0.000781 * x439)
+                - Self::mul_add(-x433, x446, x440 * x445),
+        );
+        let x449 = Self::mul_add(
+            4.806620000000001,
+            x436,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x735, x730),
-                x737,
+                x437,
+                Self::mul_add(-0.9614610000000001, x439, 0.0145 * x438),
+            ) - Self::mul_add(-x432, x445, x433 * x444),
+        );
+        let x450 = x443 - Self::mul_add(-x16, x442, x15 * x441);
+        let x451 = Self::mul_add(c_q13, x442, s_q13 * x441);
+        let x452 = Self::mul_add(
+            0.00000000020510342851533115,
+            x443,
+            Self::mul_add(-s_q13, x442, c_q13 * x441),
+        );
+        let x453 = Self::mul_add(
+            -0.55,
+            x450,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x449,
+                Self::mul_add(s_q13, x447, c_q13 * x448),
             ),
         );
-        let x739 = 0.707433253035886 * (x146 - x738);
-        [x678, x676, x673, x672, x671, x669, x686, x696, x707, x715, x724, x734, x739]
+        let x454 = Self::mul_add(
+            -17.135250000000003,
+            x422,
+            3.6140000000000003 * (x419 + x420),
+        ) + x450;
+        let x455 = Self::mul_add(
+            17.135250000000003,
+            x425,
+            3.6140000000000003 * (x415 + x421),
+        ) + x451;
+        let x456 = Self::mul_add(
+            17.135250000000003,
+            x427,
+            3.6140000000000003 * (x417 - x423),
+        ) + x452;
+        let x457 = Self::mul_add(
+            -17.135250000000003,
+            x414,
+            Self::mul_add(x415, 0.809539999555672, x417 * 1.9877000000000002)
+                - Self::mul_add(-x408, x430, x418 * x429),
+        )
+            + (x449 - Self::mul_add(x16, x447, x15 * x448)
+                + Self::mul_add(0.55, x452, 0.16 * x451));
+        let x458 = x431
+            - Self::mul_add(-0.16, x450, Self::mul_add(-c_q13, x447, s_q13 * x448));
+        let x459 = Self::mul_add(
+            9.740442170000001,
+            x415,
+            Self::mul_add(x417, -2.7416399995923166, x416 * 0.809539999555672),
+        ) - Self::mul_add(-x407, x429, x408 * x428)
+            + Self::mul_add(3.6140000000000003, x413, 17.135250000000003 * x412) + x453;
+        let x460 = Self::mul_add(-s_q12, x455, c_q12 * x454);
+        let x461 = x456 + Self::mul_add(x14, x455, x13 * x454);
+        let x462 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(-x391, x392, x360),
+            -x460,
+        );
+        let x463 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x399, x399, x400),
+            -x461,
+        );
+        let x464 = Self::mul_add(
+            7.078399999258757,
+            x397 + x401,
+            Self::mul_add(
+                -0.00000000020510342851533115,
+                x456,
+                Self::mul_add(c_q12, x455, s_q12 * x454),
+            ),
+        );
+        let x465 = x405
+            - Self::mul_add(0.36, x461, Self::mul_add(s_q12, x458, c_q12 * x457));
+        let x466 = Self::mul_add(-2.5482240016099564, x360, x398 * 9.142025249762803)
+            + Self::mul_add(-x391, x404, x399 * x402)
+            - Self::mul_add(-0.36, x460, x459 + Self::mul_add(-x14, x458, x13 * x457));
+        let x467 = x406
+            - Self::mul_add(
+                -0.00000000020510342851533115,
+                x459,
+                Self::mul_add(-c_q12, x458, s_q12 * x457),
+            );
+        let x468 = Self::mul_add(s_q11, x463, c_q11 * x462);
+        let x469 = Self::mul_add(-c_q11, x463, s_q11 * x462);
+        let x470 = Self::mul_add(x381, 45.1584, -x468);
+        let x471 = Self::mul_add(45.1584, x383, x469);
+        let x472 = Self::mul_add(45.1584, x385, -x464);
+        let x473 = x389
+            - (Self::mul_add(s_q11, x466, c_q11 * x465)
+                - Self::mul_add(-0.63, x464, 0.275 * x469));
+        let x474 = Self::mul_add(x360, 24.35164200091464, x379 * 24.4950615)
+            - Self::mul_add(-x372, x388, x380 * x386)
+            - Self::mul_add(0.275, x468, Self::mul_add(-c_q11, x466, s_q11 * x465));
+        let x475 = x390 - Self::mul_add(0.63, x468, x467);
+        let x476 = Self::mul_add(s_q10, x471, c_q10 * x470);
+        let x477 = Self::mul_add(x364, 81.53205, x476);
+        let x478 = Self::mul_add(
+            81.53205,
+            x365,
+            -Self::mul_add(-c_q10, x471, s_q10 * x470),
+        );
+        let x479 = Self::mul_add(81.53205, x366, x472);
+        let x480 = x370
+            + Self::mul_add(0.87, x472, Self::mul_add(-s_q10, x474, c_q10 * x473));
+        let x481 = Self::mul_add(x360, -36.18604050126307, x362 * 63.36336825000001)
+            + Self::mul_add(-x353, x369, x363 * x367)
+            - Self::mul_add(c_q10, x474, s_q10 * x473);
+        let x482 = x371 + Self::mul_add(0.87, x476, x475);
+        let x483 = 0.00000000020510342851533115 * x479;
+        let x484 = Self::mul_add(-c_q9, x478, s_q9 * x477) + x483;
+        let x485 = x479 + Self::mul_add(x12, x478, x11 * x477);
+        let x486 = x483 - Self::mul_add(s_q9, x478, c_q9 * x477);
+        let x487 = 0.00000000020510342851533115 * x482;
+        let x488 = Self::mul_add(
+            x343,
+            -12.701650001451807,
+            (x340 + x341) * 0.000000008530897668050218,
+        ) - x484;
+        let x489 = Self::mul_add(
+            12.701650001451807,
+            x346,
+            0.000000008530897668050218 * (x321 + x342),
+        ) - x485;
+        let x490 = Self::mul_add(
+            12.701650001451807,
+            x348,
+            0.000000008530897668050218 * (x338 - x344),
+        ) - x486;
+        let x491 = Self::mul_add(
+            x336,
+            12.701650001451807,
+            Self::mul_add(x321, 0.002139996587640933, x338 * 0.0000000234896432582596)
+                - Self::mul_add(-x330, x351, x339 * x350),
+        )
+            + (Self::mul_add(-c_q9, x481, s_q9 * x480) - x487
+                + Self::mul_add(0.275, x486, 0.4 * x485));
+        let x492 = x352
+            + Self::mul_add(0.4, x484, x482 - Self::mul_add(x12, x481, x11 * x480));
+        let x493 = Self::mul_add(
+            113.3918902508081,
+            x321,
+            Self::mul_add(5.080660024070366, x338, x337 * 0.002139996587640933),
+        ) - Self::mul_add(-x329, x350, x330 * x349)
+            - Self::mul_add(x335, 0.000000008530897668050218, x334 * 12.701650001451807)
+            - Self::mul_add(0.275, x484, x487 + Self::mul_add(s_q9, x481, c_q9 * x480));
+        let x494 = x490 + Self::mul_add(-x8, x489, x7 * x488);
+        let x495 = Self::mul_add(c_q8, x489, s_q8 * x488);
+        let x496 = Self::mul_add(
+            48.0240000085309,
+            Self::mul_add(x323, x323, x324),
+            x494,
+        );
+        let x497 = Self::mul_add(48.0240000085309, x309 * x310, -x495);
+        let x498 = Self::mul_add(
+            48.0240000085309,
+            x322 + x325,
+            -Self::mul_add(
+                -0.00000000020510342851533115,
+                x490,
+                Self::mul_add(-s_q8, x489, c_q8 * x488),
+            ),
+        );
+        let x499 = Self::mul_add(x322, 0.07309, Self::mul_add(x310, x328, x323 * x327))
+            - Self::mul_add(0.35, x495, x493 + Self::mul_add(x8, x492, x7 * x491));
+        let x500 = Self::mul_add(
+            48.0240000085309,
+            x319,
+            Self::mul_add(-130.43769025763282, x322, x321 * 0.07309)
+                + Self::mul_add(x309, x328, x323 * x326),
+        ) + Self::mul_add(-0.35, x494, Self::mul_add(-c_q8, x492, s_q8 * x491));
+        let x501 = Self::mul_add(
+            48.0240000085309,
+            x320,
+            Self::mul_add(-0.1132, x322, x321 * 16.80768997608804)
+                + Self::mul_add(-x309, x327, x310 * x326),
+        )
+            - Self::mul_add(
+                -0.00000000020510342851533115,
+                x493,
+                Self::mul_add(s_q8, x492, c_q8 * x491),
+            );
+        let x502 = Self::mul_add(-s_q7, x497, c_q7 * x496);
+        let x503 = Self::mul_add(c_q7, x497, s_q7 * x496);
+        let x504 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x505 = 1466.4506062283303 * v[4];
+        let x506 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x507 = x502
+            + Self::mul_add(
+                1170.07,
+                x306,
+                Self::mul_add(-180.9502499901501, x314, 110.5455 * x312),
+            );
+        let x508 = x503
+            - Self::mul_add(
+                1170.07,
+                x307,
+                Self::mul_add(180.9502499901501, x315, 110.5455 * x313),
+            );
+        let x509 = x498
+            - Self::mul_add(
+                1170.07,
+                x308,
+                -Self::mul_add(-180.9502499901501, x316, 110.5455 * x314),
+            );
+        let x510 = x187 * 0.0008546497218115156;
+        let x511 = x180 * 0.0008546497218115156;
+        let x512 = x191 * 0.0008546497218115156;
+        let x513 = x204 * 0.0008546497218115156;
+        let x514 = x219 * 0.0008546497218115156;
+        let x515 = x239 * 0.0008546497218115156;
+        let x516 = x268 * 0.0008546497218115156;
+        let x517 = x304 * 0.0008546497218115156;
+        let x518 = x186 * 0.0008546497218115156;
+        let x519 = x179 * 0.0008546497218115156;
+        let x520 = x192 * 0.0008546497218115156;
+        let x521 = x205 * 0.0008546497218115156;
+        let x522 = x220 * 0.0008546497218115156;
+        let x523 = x240 * 0.0008546497218115156;
+        let x524 = x269 * 0.0008546497218115156;
+        let x525 = x305 * 0.0008546497218115156;
+        let x526 = x159 * 0.0008546497218115156;
+        let x527 = x200 * 0.0008546497218115156;
+        let x528 = x215 * 0.0008546497218115156;
+        let x529 = x235 * 0.0008546497218115156;
+        let x530 = x264 * 0.0008546497218115156;
+        let x531 = x300 * 0.0008546497218115156;
+        let x532 = x187 * x510;
+        let x533 = x180 * x511;
+        let x534 = 1.0
+            / (1394.5960312283303 - (x181 + (x167 - x178 + x181)) - x532 - x533);
+        let x535 = Self::mul_add(
+            x180,
+            x518,
+            Self::mul_add(-0.65, x180, x169 - Self::mul_add(x174, x177, x175 * x176)),
+        );
+        let x536 = x534 * x535;
+        let x537 = Self::mul_add(
+            x187,
+            x518,
+            -117.61766249359756 + Self::mul_add(0.65, x161, x184),
+        );
+        let x538 = x534 * x537;
+        let x539 = Self::mul_add(x187, x519, x184);
+        let x540 = x534 * x539;
+        let x541 = Self::mul_add(
+            x187,
+            x520,
+            Self::mul_add(-0.75, x192, Self::mul_add(-s_q7, x190, c_q7 * x189)),
+        );
+        let x542 = Self::mul_add(-x180, x526, x541);
+        let x543 = x534 * x542;
+        let x544 = Self::mul_add(
+            -x187,
+            x521,
+            Self::mul_add(0.75, x205, Self::mul_add(-s_q7, x203, c_q7 * x202)),
+        );
+        let x545 = Self::mul_add(-x180, x527, x544);
+        let x546 = x534 * x545;
+        let x547 = Self::mul_add(
+            x187,
+            x522,
+            Self::mul_add(-0.75, x220, Self::mul_add(s_q7, x218, c_q7 * x217)),
+        );
+        let x548 = Self::mul_add(-x180, x528, x547);
+        let x549 = x534 * x548;
+        let x550 = Self::mul_add(
+            x187,
+            x523,
+            Self::mul_add(-0.75, x240, Self::mul_add(s_q7, x238, c_q7 * x237)),
+        );
+        let x551 = Self::mul_add(x180, x529, x550);
+        let x552 = x534 * x551;
+        let x553 = Self::mul_add(
+            x187,
+            x524,
+            Self::mul_add(-0.75, x269, Self::mul_add(-s_q7, x267, c_q7 * x266)),
+        );
+        let x554 = Self::mul_add(-x180, x530, x553);
+        let x555 = x534 * x554;
+        let x556 = Self::mul_add(
+            x187,
+            x525,
+            Self::mul_add(-0.75, x305, Self::mul_add(-s_q7, x303, c_q7 * x302)),
+        );
+        let x557 = Self::mul_add(x180, x531, x556);
+        let x558 = x534 * x557;
+        let x559 = x186 * x518;
+        let x560 = 1.0
+            / Self::mul_add(
+                -x535,
+                x536,
+                1466.4506062283303 - (x183 - (x171 - x178 - x183)) - x532 - x559,
+            );
+        let x561 = Self::mul_add(
+            x187,
+            x511,
+            Self::mul_add(-0.75, x180, Self::mul_add(c_q7, x172, s_q7 * x170)),
+        );
+        let x562 = Self::mul_add(-x535, x538, x561);
+        let x563 = x560 * x562;
+        let x564 = Self::mul_add(-x535, x540, x561);
+        let x565 = x560 * x564;
+        let x566 = Self::mul_add(
+            x186,
+            x526,
+            Self::mul_add(
+                -x187,
+                x512,
+                Self::mul_add(c_q7, x190, s_q7 * x189)
+                    + Self::mul_add(-0.65, x159, 0.75 * x191),
+            ),
+        );
+        let x567 = Self::mul_add(-x535, x543, x566);
+        let x568 = x560 * x567;
+        let x569 = Self::mul_add(
+            x186,
+            x527,
+            Self::mul_add(
+                x187,
+                x513,
+                Self::mul_add(c_q7, x203, s_q7 * x202)
+                    - Self::mul_add(0.65, x200, 0.75 * x204),
+            ),
+        );
+        let x570 = Self::mul_add(-x535, x546, x569);
+        let x571 = x560 * x570;
+        let x572 = Self::mul_add(
+            x186,
+            x528,
+            Self::mul_add(
+                -x187,
+                x514,
+                Self::mul_add(-c_q7, x218, s_q7 * x217)
+                    + Self::mul_add(-0.65, x215, 0.75 * x219),
+            ),
+        );
+        let x573 = Self::mul_add(-x535, x549, x572);
+        let x574 = x560 * x573;
+        let x575 = Self::mul_add(
+            -x186,
+            x529,
+            Self::mul_add(
+                -x187,
+                x515,
+                Self::mul_add(-c_q7, x238, s_q7 * x237)
+                    + Self::mul_add(0.65, x235, 0.75 * x239),
+            ),
+        );
+        let x576 = Self::mul_add(-x535, x552, x575);
+        let x577 = x560 * x576;
+        let x578 = Self::mul_add(
+            x186,
+            x530,
+            Self::mul_add(
+                -x187,
+                x516,
+                Self::mul_add(c_q7, x267, s_q7 * x266)
+                    + Self::mul_add(-0.65, x264, 0.75 * x268),
+            ),
+        );
+        let x579 = Self::mul_add(-x535, x555, x578);
+        let x580 = x560 * x579;
+        let x581 = Self::mul_add(
+            -x186,
+            x531,
+            Self::mul_add(
+                -x187,
+                x517,
+                Self::mul_add(c_q7, x303, s_q7 * x302)
+                    + Self::mul_add(0.65, x300, 0.75 * x304),
+            ),
+        );
+        let x582 = Self::mul_add(-x535, x558, x581);
+        let x583 = x560 * x582;
+        let x584 = 1.0
+            / Self::mul_add(
+                x562,
+                x563,
+                Self::mul_add(x537, x538, x559 - (1271.854575 + (x182 + x185) - x533)),
+            );
+        let x585 = Self::mul_add(
+            -x562,
+            x565,
+            Self::mul_add(-x537, x540, Self::mul_add(-x186, x519, x185 - x533)),
+        );
+        let x586 = x584 * x585;
+        let x587 = x180 * x512;
+        let x588 = Self::mul_add(
+            x537,
+            x543,
+            Self::mul_add(x186, x520, Self::mul_add(-0.65, x192, x165) - x587),
+        );
+        let x589 = Self::mul_add(x562, x568, x588);
+        let x590 = x584 * x589;
+        let x591 = x180 * x513;
+        let x592 = Self::mul_add(
+            x537,
+            x546,
+            Self::mul_add(-x186, x521, Self::mul_add(0.65, x205, x201) + x591),
+        );
+        let x593 = Self::mul_add(x562, x571, x592);
+        let x594 = x584 * x593;
+        let x595 = x180 * x514;
+        let x596 = Self::mul_add(
+            -x537,
+            x549,
+            Self::mul_add(-x186, x522, Self::mul_add(0.65, x220, x216) + x595),
+        );
+        let x597 = Self::mul_add(-x562, x574, x596);
+        let x598 = x584 * x597;
+        let x599 = x180 * x515;
+        let x600 = Self::mul_add(
+            -x537,
+            x552,
+            Self::mul_add(-x186, x523, Self::mul_add(0.65, x240, x236) + x599),
+        );
+        let x601 = Self::mul_add(-x562, x577, x600);
+        let x602 = x584 * x601;
+        let x603 = x180 * x516;
+        let x604 = Self::mul_add(
+            x537,
+            x555,
+            Self::mul_add(x186, x524, Self::mul_add(-0.65, x269, x265) - x603),
+        );
+        let x605 = Self::mul_add(x562, x580, x604);
+        let x606 = x584 * x605;
+        let x607 = x180 * x517;
+        let x608 = Self::mul_add(
+            x537,
+            x558,
+            Self::mul_add(x186, x525, Self::mul_add(-0.65, x305, x301) - x607),
+        );
+        let x609 = Self::mul_add(x562, x583, x608);
+        let x610 = x584 * x609;
+        let x611 = Self::mul_add(
+            -x564,
+            x565,
+            Self::mul_add(-x539, x540, Self::mul_add(-x179, x519, x173 - x533)),
+        );
+        let x612 = 1.0 / Self::mul_add(x585, x586, x611);
+        let x613 = Self::mul_add(
+            x564,
+            x568,
+            Self::mul_add(x539, x543, Self::mul_add(x179, x520, x165 - x587)),
+        );
+        let x614 = Self::mul_add(x585, x590, x613);
+        let x615 = x612 * x614;
+        let x616 = Self::mul_add(
+            x564,
+            x571,
+            Self::mul_add(x539, x546, Self::mul_add(-x179, x521, x201 + x591)),
+        );
+        let x617 = Self::mul_add(x585, x594, x616);
+        let x618 = x612 * x617;
+        let x619 = Self::mul_add(
+            -x564,
+            x574,
+            Self::mul_add(-x539, x549, Self::mul_add(-x179, x522, x216 + x595)),
+        );
+        let x620 = Self::mul_add(x585, x598, x619);
+        let x621 = x612 * x620;
+        let x622 = Self::mul_add(
+            -x564,
+            x577,
+            Self::mul_add(-x539, x552, Self::mul_add(-x179, x523, x236 + x599)),
+        );
+        let x623 = Self::mul_add(x585, x602, x622);
+        let x624 = x612 * x623;
+        let x625 = Self::mul_add(
+            x564,
+            x580,
+            Self::mul_add(x539, x555, Self::mul_add(x179, x524, x265 - x603)),
+        );
+        let x626 = Self::mul_add(x585, x606, x625);
+        let x627 = x612 * x626;
+        let x628 = Self::mul_add(
+            x564,
+            x583,
+            Self::mul_add(x539, x558, Self::mul_add(x179, x525, x301 - x607)),
+        );
+        let x629 = Self::mul_add(x585, x610, x628);
+        let x630 = x612 * x629;
+        let x631 = Self::mul_add(
+            -x159,
+            x526,
+            Self::mul_add(-x192, x520, Self::mul_add(-x191, x512, x148)),
+        );
+        let x632 = Self::mul_add(
+            x589,
+            x590,
+            Self::mul_add(-x567, x568, Self::mul_add(-x542, x543, x631)),
+        );
+        let x633 = 1.0 / Self::mul_add(-x614, x615, x632);
+        let x634 = Self::mul_add(
+            -x159,
+            x527,
+            Self::mul_add(x192, x521, Self::mul_add(x191, x513, x197)),
+        );
+        let x635 = Self::mul_add(
+            x589,
+            x594,
+            Self::mul_add(-x567, x571, Self::mul_add(-x542, x546, x634)),
+        );
+        let x636 = Self::mul_add(-x614, x618, x635);
+        let x637 = x633 * x636;
+        let x638 = Self::mul_add(
+            -x159,
+            x528,
+            Self::mul_add(-x192, x522, Self::mul_add(-x191, x514, x212)),
+        );
+        let x639 = Self::mul_add(
+            -x589,
+            x598,
+            Self::mul_add(-x567, x574, Self::mul_add(-x542, x549, x638)),
+        );
+        let x640 = Self::mul_add(x614, x621, x639);
+        let x641 = x633 * x640;
+        let x642 = Self::mul_add(
+            x159,
+            x529,
+            Self::mul_add(-x192, x523, Self::mul_add(-x191, x515, x232)),
+        );
+        let x643 = Self::mul_add(
+            -x589,
+            x602,
+            Self::mul_add(-x567, x577, Self::mul_add(-x542, x552, x642)),
+        );
+        let x644 = Self::mul_add(x614, x624, x643);
+        let x645 = x633 * x644;
+        let x646 = Self::mul_add(
+            -x159,
+            x530,
+            Self::mul_add(-x192, x524, Self::mul_add(-x191, x516, x261)),
+        );
+        let x647 = Self::mul_add(
+            x589,
+            x606,
+            Self::mul_add(-x567, x580, Self::mul_add(-x542, x555, x646)),
+        );
+        let x648 = Self::mul_add(-x614, x627, x647);
+        let x649 = x633 * x648;
+        let x650 = Self::mul_add(
+            x159,
+            x531,
+            Self::mul_add(-x192, x525, Self::mul_add(-x191, x517, x297)),
+        );
+        let x651 = Self::mul_add(
+            x589,
+            x610,
+            Self::mul_add(-x567, x583, Self::mul_add(-x542, x558, x650)),
+        );
+        let x652 = Self::mul_add(-x614, x630, x651);
+        let x653 = x633 * x652;
+        let x654 = Self::mul_add(
+            -x200,
+            x527,
+            Self::mul_add(-x205, x521, Self::mul_add(-x204, x513, x106)),
+        );
+        let x655 = Self::mul_add(
+            x593,
+            x594,
+            Self::mul_add(-x570, x571, Self::mul_add(-x545, x546, x654)),
+        );
+        let x656 = 1.0 / Self::mul_add(-x636, x637, Self::mul_add(-x617, x618, x655));
+        let x657 = Self::mul_add(
+            x200,
+            x528,
+            Self::mul_add(-x205, x522, Self::mul_add(-x204, x514, x100)),
+        );
+        let x658 = Self::mul_add(
+            x593,
+            x598,
+            Self::mul_add(x570, x574, Self::mul_add(x545, x549, x657)),
+        );
+        let x659 = Self::mul_add(x636, x641, Self::mul_add(-x617, x621, x658));
+        let x660 = x656 * x659;
+        let x661 = Self::mul_add(
+            -x200,
+            x529,
+            Self::mul_add(-x205, x523, Self::mul_add(-x204, x515, x225)),
+        );
+        let x662 = Self::mul_add(
+            x593,
+            x602,
+            Self::mul_add(x570, x577, Self::mul_add(x545, x552, x661)),
+        );
+        let x663 = Self::mul_add(x636, x645, Self::mul_add(-x617, x624, x662));
+        let x664 = x656 * x663;
+        let x665 = Self::mul_add(
+            x200,
+            x530,
+            Self::mul_add(-x205, x524, Self::mul_add(-x204, x516, x253)),
+        );
+        let x666 = Self::mul_add(
+            -x593,
+            x606,
+            Self::mul_add(x570, x580, Self::mul_add(x545, x555, x665)),
+        );
+        let x667 = Self::mul_add(x636, x649, Self::mul_add(x617, x627, x666));
+        let x668 = x656 * x667;
+        let x669 = Self::mul_add(
+            -x200,
+            x531,
+            Self::mul_add(-x205, x525, Self::mul_add(-x204, x517, x289)),
+        );
+        let x670 = Self::mul_add(
+            -x593,
+            x610,
+            Self::mul_add(x570, x583, Self::mul_add(x545, x558, x669)),
+        );
+        let x671 = Self::mul_add(x636, x653, Self::mul_add(x617, x630, x670));
+        let x672 = x656 * x671;
+        let x673 = Self::mul_add(
+            -x215,
+            x528,
+            Self::mul_add(-x220, x522, Self::mul_add(-x219, x514, x86)),
+        );
+        let x674 = Self::mul_add(
+            x597,
+            x598,
+            Self::mul_add(-x573, x574, Self::mul_add(-x548, x549, x673)),
+        );
+        let x675 = Self::mul_add(
+            -x659,
+            x660,
+            Self::mul_add(-x640, x641, Self::mul_add(-x620, x621, x674)),
+        );
+        let x676 = 1.0 / x675;
+        let x677 = Self::mul_add(
+            x215,
+            x529,
+            Self::mul_add(-x220, x523, Self::mul_add(-x219, x515, x80)),
+        );
+        let x678 = Self::mul_add(
+            x597,
+            x602,
+            Self::mul_add(-x573, x577, Self::mul_add(-x548, x552, x677)),
+        );
+        let x679 = Self::mul_add(
+            -x659,
+            x664,
+            Self::mul_add(-x640, x645, Self::mul_add(-x620, x624, x678)),
+        );
+        let x680 = x676 * x679;
+        let x681 = Self::mul_add(
+            -x215,
+            x530,
+            Self::mul_add(-x220, x524, Self::mul_add(-x219, x516, x248)),
+        );
+        let x682 = Self::mul_add(
+            -x597,
+            x606,
+            Self::mul_add(-x573, x580, Self::mul_add(-x548, x555, x681)),
+        );
+        let x683 = Self::mul_add(
+            -x659,
+            x668,
+            Self::mul_add(-x640, x649, Self::mul_add(x620, x627, x682)),
+        );
+        let x684 = x676 * x683;
+        let x685 = Self::mul_add(
+            x215,
+            x531,
+            Self::mul_add(-x220, x525, Self::mul_add(-x219, x517, x284)),
+        );
+        let x686 = Self::mul_add(
+            -x597,
+            x610,
+            Self::mul_add(-x573, x583, Self::mul_add(-x548, x558, x685)),
+        );
+        let x687 = Self::mul_add(
+            -x659,
+            x672,
+            Self::mul_add(-x640, x653, Self::mul_add(x620, x630, x686)),
+        );
+        let x688 = x676 * x687;
+        let x689 = Self::mul_add(
+            -x235,
+            x529,
+            Self::mul_add(-x240, x523, Self::mul_add(-x239, x515, x66)),
+        );
+        let x690 = Self::mul_add(
+            x601,
+            x602,
+            Self::mul_add(-x576, x577, Self::mul_add(-x551, x552, x689)),
+        );
+        let x691 = Self::mul_add(
+            -x663,
+            x664,
+            Self::mul_add(-x644, x645, Self::mul_add(-x623, x624, x690)),
+        );
+        let x692 = 1.0 / Self::mul_add(-x679, x680, x691);
+        let x693 = Self::mul_add(
+            x235,
+            x530,
+            Self::mul_add(-x240, x524, Self::mul_add(-x239, x516, x59)),
+        );
+        let x694 = Self::mul_add(
+            -x601,
+            x606,
+            Self::mul_add(-x576, x580, Self::mul_add(-x551, x555, x693)),
+        );
+        let x695 = Self::mul_add(
+            -x663,
+            x668,
+            Self::mul_add(-x644, x649, Self::mul_add(x623, x627, x694)),
+        );
+        let x696 = Self::mul_add(-x679, x684, x695);
+        let x697 = x692 * x696;
+        let x698 = Self::mul_add(
+            -x235,
+            x531,
+            Self::mul_add(-x240, x525, Self::mul_add(-x239, x517, x277)),
+        );
+        let x699 = Self::mul_add(
+            -x601,
+            x610,
+            Self::mul_add(-x576, x583, Self::mul_add(-x551, x558, x698)),
+        );
+        let x700 = Self::mul_add(
+            -x663,
+            x672,
+            Self::mul_add(-x644, x653, Self::mul_add(x623, x630, x699)),
+        );
+        let x701 = Self::mul_add(-x679, x688, x700);
+        let x702 = x692 * x701;
+        let x703 = Self::mul_add(
+            -x264,
+            x530,
+            Self::mul_add(-x269, x524, Self::mul_add(-x268, x516, x41)),
+        );
+        let x704 = Self::mul_add(
+            x605,
+            x606,
+            Self::mul_add(-x579, x580, Self::mul_add(-x554, x555, x703)),
+        );
+        let x705 = Self::mul_add(
+            -x667,
+            x668,
+            Self::mul_add(-x648, x649, Self::mul_add(-x626, x627, x704)),
+        );
+        let x706 = 1.0 / Self::mul_add(-x696, x697, Self::mul_add(-x683, x684, x705));
+        let x707 = Self::mul_add(
+            x264,
+            x531,
+            Self::mul_add(-x269, x525, Self::mul_add(-x268, x517, x273)),
+        );
+        let x708 = Self::mul_add(
+            x605,
+            x610,
+            Self::mul_add(-x579, x583, Self::mul_add(-x554, x558, x707)),
+        );
+        let x709 = Self::mul_add(
+            -x667,
+            x672,
+            Self::mul_add(-x648, x653, Self::mul_add(-x626, x630, x708)),
+        );
+        let x710 = Self::mul_add(-x696, x702, Self::mul_add(-x683, x688, x709));
+        let x711 = x706 * x710;
+        let x712 = Self::mul_add(
+            -x300,
+            x531,
+            Self::mul_add(-x305, x525, Self::mul_add(-x304, x517, 1.4135609200000003)),
+        );
+        let x713 = Self::mul_add(
+            x609,
+            x610,
+            Self::mul_add(-x582, x583, Self::mul_add(-x557, x558, x712)),
+        );
+        let x714 = Self::mul_add(
+            -x671,
+            x672,
+            Self::mul_add(-x652, x653, Self::mul_add(-x629, x630, x713)),
+        );
+        let x715 = Self::mul_add(
+            -x710,
+            x711,
+            Self::mul_add(-x701, x702, Self::mul_add(-x687, x688, x714)),
+        );
+        let x716 = 1.0 / x715;
+        let x717 = Self::mul_add(
+            -x508,
+            x510,
+            Self::mul_add(0.75, x503, Self::mul_add(-s_q7, x500, c_q7 * x499))
+                - Self::mul_add(
+                    180.9502499901501,
+                    x307,
+                    Self::mul_add(v[4], x506, v[5] * x505),
+                ),
+        );
+        let x718 = Self::mul_add(-x509, x511, x717);
+        let x719 = Self::mul_add(
+            x509,
+            x518,
+            Self::mul_add(
+                x507,
+                x510,
+                Self::mul_add(c_q7, x500, s_q7 * x499)
+                    - Self::mul_add(0.65, x498, 0.75 * x502)
+                    + (Self::mul_add(v[3], x506, v[5] * x504)
+                        - Self::mul_add(-110.5455, x308, 180.9502499901501 * x306)),
+            ),
+        );
+        let x720 = Self::mul_add(-x536, x718, x719);
+        let x721 = x507 * x511;
+        let x722 = Self::mul_add(
+            x508,
+            x518,
+            Self::mul_add(-0.65, x503, x501)
+                - Self::mul_add(-110.5455, x307, Self::mul_add(-v[3], x505, v[4] * x504))
+                - x721,
+        );
+        let x723 = Self::mul_add(-x563, x720, Self::mul_add(-x538, x718, x722));
+        let x724 = Self::mul_add(
+            x565,
+            x720,
+            Self::mul_add(x540, x718, Self::mul_add(-x508, x519, tau[0] - x501 + x721)),
+        );
+        let x725 = Self::mul_add(-x586, x723, x724);
+        let x726 = Self::mul_add(
+            x509,
+            x526,
+            Self::mul_add(-x508, x520, Self::mul_add(-x507, x512, tau[1] + x493)),
+        );
+        let x727 = Self::mul_add(
+            x590,
+            x723,
+            Self::mul_add(x568, x720, Self::mul_add(x543, x718, x726)),
+        );
+        let x728 = Self::mul_add(x615, x725, x727);
+        let x729 = Self::mul_add(
+            x509,
+            x527,
+            Self::mul_add(x508, x521, Self::mul_add(x507, x513, tau[2] + x482)),
+        );
+        let x730 = Self::mul_add(
+            x594,
+            x723,
+            Self::mul_add(x571, x720, Self::mul_add(x546, x718, x729)),
+        );
+        let x731 = Self::mul_add(-x637, x728, Self::mul_add(x618, x725, x730));
+        let x732 = Self::mul_add(
+            -x509,
+            x528,
+            Self::mul_add(x508, x522, Self::mul_add(x507, x514, tau[3] + x475)),
+        );
+        let x733 = Self::mul_add(
+            x598,
+            x723,
+            Self::mul_add(-x574, x720, Self::mul_add(-x549, x718, x732)),
+        );
+        let x734 = Self::mul_add(
+            -x660,
+            x731,
+            Self::mul_add(x641, x728, Self::mul_add(x621, x725, x733)),
+        );
+        let x735 = Self::mul_add(
+            x509,
+            x529,
+            Self::mul_add(x508, x523, Self::mul_add(x507, x515, tau[4] - x467)),
+        );
+        let x736 = Self::mul_add(
+            x602,
+            x723,
+            Self::mul_add(-x577, x720, Self::mul_add(-x552, x718, x735)),
+        );
+        let x737 = Self::mul_add(
+            -x664,
+            x731,
+            Self::mul_add(x645, x728, Self::mul_add(x624, x725, x736)),
+        );
+        let x738 = Self::mul_add(-x680, x734, x737);
+        let x739 = Self::mul_add(
+            x509,
+            x530,
+            Self::mul_add(-x508, x524, Self::mul_add(-x507, x516, tau[5] + x459)),
+        );
+        let x740 = Self::mul_add(
+            x606,
+            x723,
+            Self::mul_add(x580, x720, Self::mul_add(x555, x718, x739)),
+        );
+        let x741 = Self::mul_add(
+            x668,
+            x731,
+            Self::mul_add(-x649, x728, Self::mul_add(x627, x725, x740)),
+        );
+        let x742 = Self::mul_add(x697, x738, Self::mul_add(x684, x734, x741));
+        let x743 = Self::mul_add(
+            -x509,
+            x531,
+            Self::mul_add(-x508, x525, Self::mul_add(-x507, x517, tau[6] - x449)),
+        );
+        let x744 = Self::mul_add(
+            x610,
+            x723,
+            Self::mul_add(x583, x720, Self::mul_add(x558, x718, x743)),
+        );
+        let x745 = Self::mul_add(
+            x672,
+            x731,
+            Self::mul_add(-x653, x728, Self::mul_add(x630, x725, x744)),
+        );
+        let x746 = Self::mul_add(
+            -x711,
+            x742,
+            Self::mul_add(x702, x738, Self::mul_add(x688, x734, x745)),
+        );
+        let x747 = x716 * x746;
+        let x748 = Self::mul_add(-x711, x747, x706 * x742);
+        let x749 = Self::mul_add(x702, x747, Self::mul_add(x697, x748, x692 * x738));
+        let x750 = Self::mul_add(
+            x688,
+            x747,
+            Self::mul_add(x684, x748, Self::mul_add(-x680, x749, x676 * x734)),
+        );
+        let x751 = Self::mul_add(
+            x668,
+            x748,
+            Self::mul_add(-x664, x749, Self::mul_add(-x660, x750, x656 * x731)),
+        );
+        let x752 = Self::mul_add(x672, x747, x751);
+        let x753 = Self::mul_add(
+            x645,
+            x749,
+            Self::mul_add(x641, x750, Self::mul_add(-x637, x752, x633 * x728)),
+        );
+        let x754 = Self::mul_add(-x653, x747, Self::mul_add(-x649, x748, x753));
+        let x755 = Self::mul_add(
+            x621,
+            x750,
+            Self::mul_add(x618, x752, Self::mul_add(x615, x754, x612 * x725)),
+        );
+        let x756 = Self::mul_add(
+            x630,
+            x747,
+            Self::mul_add(x627, x748, Self::mul_add(x624, x749, x755)),
+        );
+        let x757 = Self::mul_add(
+            -x594,
+            x752,
+            Self::mul_add(-x590, x754, Self::mul_add(x586, x756, x584 * x723)),
+        );
+        let x758 = Self::mul_add(
+            -x606,
+            x748,
+            Self::mul_add(-x602, x749, Self::mul_add(-x598, x750, x757)),
+        );
+        let x759 = Self::mul_add(-x610, x747, x758);
+        let x760 = Self::mul_add(
+            x568,
+            x754,
+            Self::mul_add(x565, x756, Self::mul_add(x563, x759, x560 * x720)),
+        );
+        let x761 = Self::mul_add(
+            -x577,
+            x749,
+            Self::mul_add(-x574, x750, Self::mul_add(x571, x752, x760)),
+        );
+        let x762 = Self::mul_add(x583, x747, Self::mul_add(x580, x748, x761));
+        let x763 = -x762;
+        let x764 = Self::mul_add(
+            x540,
+            x756,
+            Self::mul_add(x538, x759, Self::mul_add(-x536, x762, x534 * x718)),
+        );
+        let x765 = Self::mul_add(
+            -x549,
+            x750,
+            Self::mul_add(x546, x752, Self::mul_add(x543, x754, x764)),
+        );
+        let x766 = Self::mul_add(
+            x558,
+            x747,
+            Self::mul_add(x555, x748, Self::mul_add(-x552, x749, x765)),
+        );
+        let x767 = -x766;
+        let x768 = Self::mul_add(
+            x526,
+            x754,
+            Self::mul_add(
+                x518,
+                x762,
+                Self::mul_add(-x511, x766, x509 * 0.0008546497218115156),
+            ),
+        );
+        let x769 = Self::mul_add(
+            x529,
+            x749,
+            Self::mul_add(-x528, x750, Self::mul_add(x527, x752, x768)),
+        );
+        let x770 = -Self::mul_add(-x531, x747, Self::mul_add(x530, x748, x769));
+        let x771 = Self::mul_add(
+            -x519,
+            x756,
+            Self::mul_add(
+                -x518,
+                x759,
+                Self::mul_add(-x510, x766, x508 * 0.0008546497218115156),
+            ),
+        );
+        let x772 = Self::mul_add(
+            x522,
+            x750,
+            Self::mul_add(x521, x752, Self::mul_add(-x520, x754, x771)),
+        );
+        let x773 = Self::mul_add(
+            -x525,
+            x747,
+            Self::mul_add(-x524, x748, Self::mul_add(x523, x749, x772)),
+        );
+        let x774 = Self::mul_add(
+            x511,
+            x756,
+            Self::mul_add(
+                x511,
+                x759,
+                Self::mul_add(x510, x762, x507 * 0.0008546497218115156),
+            ),
+        );
+        let x775 = Self::mul_add(
+            x514,
+            x750,
+            Self::mul_add(x513, x752, Self::mul_add(-x512, x754, x774)),
+        );
+        let x776 = Self::mul_add(
+            -x517,
+            x747,
+            Self::mul_add(-x516, x748, Self::mul_add(x515, x749, x775)),
+        );
+        [x776, x773, x770, x767, x763, x759, x756, x754, x752, x750, x749, x748, x747]
     }
     /// `(M(q), c(q, v))` in one call, sharing sines, cosines and kinematics.
     ///
-    /// Methods: mass matrix `crba`, bias `newton-euler`: 1076 mul, 933 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 620 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`: 1010 mul, 890 add, 0 div, 0 sqrt, 7 sincos (emitted), of which 593 fused where the target has FMA.
     #[must_use]
     pub fn mass_matrix_and_nonlinear_effects(
         q: &[f64; 14],
@@ -4744,1087 +4937,1064 @@ impl FreeFloating7 {
         let x14 = 0.00000000020510342851533115 * c_q12;
         let x15 = 0.00000000020510342851533115 * c_q13;
         let x16 = 0.00000000020510342851533115 * s_q13;
-        let x17 = 4.806620000000001 * x16;
-        let x18 = 4.806620000000001 * c_q13;
-        let x19 = 4.806620000000001 * s_q13;
-        let x20 = Self::mul_add(0.000781, x16, -0.0145);
-        let x21 = -0.9614610000000001
-            - Self::mul_add(x16, 1.2025609200000003, 0.000781 * x15);
-        let x22 = 1.4135609200000003
-            + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145);
-        let x23 = 0.000781 * c_q13;
-        let x24 = 0.000781 * s_q13;
-        let x25 = Self::mul_add(c_q13, -1.2025609200000003, x24);
-        let x26 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
-        let x27 = x24 + 0.000000000002973999713472302;
-        let x28 = Self::mul_add(s_q13, 1.2025609200000003, x23)
-            - 0.00000000019719894748377882;
-        let x29 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145)
-            + -0.0000000002899261911072858;
-        let x30 = 0.16 * x19;
-        let x31 = 0.55 * x18;
+        let x17 = s_q13 * s_q13;
+        let x18 = s_q13 * c_q13;
+        let x19 = Self::mul_add(x18, 0.001562, x17 * 1.2025609200000003);
+        let x20 = 0.000781 + Self::mul_add(x17, -0.001562, x18 * 1.2025609200000003);
+        let x21 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x22 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x23 = 4.806620000000001 * s_q13;
+        let x24 = 4.806620000000001 * c_q13;
+        let x25 = 0.00000000020510342851533115 * x23;
+        let x26 = Self::mul_add(-0.00000000020510342851533115, x19, x21);
+        let x27 = 0.00000000020510342851533115 * x21;
+        let x28 = 1.4135609200000003 + x27;
+        let x29 = x21 + -0.0000000002899261911072858;
+        let x30 = 0.16 * x23;
+        let x31 = 0.55 * x24;
         let x32 = x30 + x31;
-        let x33 = 0.55 * x17;
-        let x34 = 0.16 * x17;
-        let x35 = 0.16 * x18;
-        let x36 = 0.55 * x19;
-        let x37 = x32 + (x22 - Self::mul_add(-x16, x21, x15 * x20) + x32);
-        let x38 = 3.6140000000000003 + x17;
-        let x39 = 17.135250000000003 + x18;
-        let x40 = -1.9877000000000002 + (Self::mul_add(c_q13, x21, s_q13 * x20) - x33);
-        let x41 = -0.809539999555672
-            - (Self::mul_add(
-                0.00000000020510342851533115,
-                x22,
-                Self::mul_add(-s_q13, x21, c_q13 * x20),
-            ) + x34);
-        let x42 = -1.9877000000000002
-            - (x26 + Self::mul_add(-x16, x25, x15 * x23) + x33);
-        let x43 = -5.252920330000002
-            + (x30 + (Self::mul_add(c_q13, x25, s_q13 * x23) + x30));
-        let x44 = -2.741639999592316
-            - (x36
-                + (Self::mul_add(
-                    -0.00000000020510342851533115,
-                    x26,
-                    Self::mul_add(-s_q13, x25, c_q13 * x23),
-                ) + x35));
-        let x45 = -0.809539999555672 + (x29 - Self::mul_add(x16, x28, x15 * x27) - x34);
-        let x46 = -2.7416399995923166
-            - (x35 - (Self::mul_add(-c_q13, x28, s_q13 * x27) - x36));
-        let x47 = 9.740442170000001
+        let x33 = x32 + (Self::mul_add(0.00000000020510342851533115, x26, x28) + x32);
+        let x34 = Self::mul_add(
+            0.55,
+            x23,
+            Self::mul_add(
+                0.16,
+                x24,
+                Self::mul_add(-0.00000000020510342851533115, x22, x20),
+            ),
+        );
+        let x35 = 3.6140000000000003 + x25;
+        let x36 = 17.135250000000003 + x24;
+        let x37 = -1.9877000000000002
+            - Self::mul_add(
+                0.55,
+                x25,
+                Self::mul_add(0.00000000020510342851533115, x20, x22),
+            );
+        let x38 = -0.809539999555672
+            + Self::mul_add(
+                -0.16,
+                x25,
+                Self::mul_add(-0.00000000020510342851533115, x28, x26),
+            );
+        let x39 = -5.252920330000002 + (x30 + (-1.2025609200000003 + x19 + x30));
+        let x40 = -2.741639999592316 - x34;
+        let x41 = 9.740442170000001
             + (x31
-                - (Self::mul_add(
-                    0.00000000020510342851533115,
-                    x29,
-                    Self::mul_add(s_q13, x28, c_q13 * x27),
-                ) - x31));
-        let x48 = Self::mul_add(-s_q12, x39, c_q12 * x38);
-        let x49 = x19 - Self::mul_add(x14, x39, x13 * x38);
-        let x50 = Self::mul_add(c_q12, x39, s_q12 * x38);
-        let x51 = Self::mul_add(0.00000000020510342851533115, x19, x50);
-        let x52 = Self::mul_add(-s_q12, x42, c_q12 * x37);
-        let x53 = Self::mul_add(-s_q12, x43, c_q12 * x40);
-        let x54 = Self::mul_add(-s_q12, x44, c_q12 * x41);
-        let x55 = x45 - Self::mul_add(x14, x42, x13 * x37);
-        let x56 = x46 - Self::mul_add(x14, x43, x13 * x40);
-        let x57 = x47 - Self::mul_add(x14, x44, x13 * x41);
-        let x58 = Self::mul_add(
-            0.00000000020510342851533115,
-            x47,
-            Self::mul_add(c_q12, x44, s_q12 * x41),
-        );
-        let x59 = -x58;
-        let x60 = x54 - Self::mul_add(x14, x53, x13 * x52);
-        let x61 = Self::mul_add(
-            c_q12,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x46,
-                Self::mul_add(c_q12, x43, s_q12 * x40),
+                - (Self::mul_add(0.00000000020510342851533115, x29, x19 + x27) - x31));
+        let x42 = s_q12 * s_q12;
+        let x43 = s_q12 * c_q12;
+        let x44 = x33 - x39;
+        let x45 = x37 + x37;
+        let x46 = Self::mul_add(x43, x45, x42 * x44);
+        let x47 = x39 + x46;
+        let x48 = x37 + Self::mul_add(-x42, x45, x43 * x44);
+        let x49 = Self::mul_add(-s_q12, x40, c_q12 * x38);
+        let x50 = Self::mul_add(c_q12, x40, s_q12 * x38);
+        let x51 = Self::mul_add(-s_q12, x36, c_q12 * x35);
+        let x52 = Self::mul_add(c_q12, x36, s_q12 * x35);
+        let x53 = Self::mul_add(-0.00000000020510342851533115, x52, x23);
+        let x54 = x25 + x52;
+        let x55 = Self::mul_add(-0.00000000020510342851533115, x48, x49);
+        let x56 = Self::mul_add(-0.00000000020510342851533115, x47, x50);
+        let x57 = 0.00000000020510342851533115 * x50;
+        let x58 = x41 - x57;
+        let x59 = Self::mul_add(0.00000000020510342851533115, x41, x50);
+        let x60 = -x59;
+        let x61 = x54 * 0.36;
+        let x62 = x61 + (x33 - x46 + x61);
+        let x63 = 7.078399999258757 + x53;
+        let x64 = 0.01675
+            - Self::mul_add(
+                x51,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x49, x48),
+            );
+        let x65 = -9.142025249762803
+            + (x61 + (Self::mul_add(-0.00000000020510342851533115, x56, x58) + x61));
+        let x66 = 2.5482240016099564
+            - Self::mul_add(
+                x53,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x58, x56),
+            );
+        let x67 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x59, x47 + x57);
+        let x68 = s_q11 * s_q11;
+        let x69 = s_q11 * c_q11;
+        let x70 = x62 - x65;
+        let x71 = x55 + x55;
+        let x72 = Self::mul_add(x69, x71, x68 * x70);
+        let x73 = Self::mul_add(-s_q11, x63, c_q11 * x51);
+        let x74 = Self::mul_add(c_q11, x63, s_q11 * x51);
+        let x75 = 0.275 * x54;
+        let x76 = x74 * 0.63;
+        let x77 = x75 - x76;
+        let x78 = Self::mul_add(x73, 0.63, x55 + Self::mul_add(-x68, x71, x69 * x70));
+        let x79 = Self::mul_add(0.275, x73, Self::mul_add(-s_q11, x66, c_q11 * x64));
+        let x80 = Self::mul_add(0.275, x74, Self::mul_add(c_q11, x66, s_q11 * x64));
+        let x81 = x67 - x76;
+        let x82 = x77 + (x62 - x72 + x77);
+        let x83 = -45.1584 + x74;
+        let x84 = -0.6328 + x79;
+        let x85 = -24.4950615 + (x75 + (x65 + x72 + x75));
+        let x86 = -24.35164200091464 - Self::mul_add(x54, 0.63, -x80);
+        let x87 = 28.2393615 - (x76 - x81);
+        let x88 = s_q10 * s_q10;
+        let x89 = s_q10 * c_q10;
+        let x90 = x82 - x85;
+        let x91 = x78 + x78;
+        let x92 = Self::mul_add(x89, x91, x88 * x90);
+        let x93 = Self::mul_add(-s_q10, x86, c_q10 * x84);
+        let x94 = Self::mul_add(c_q10, x86, s_q10 * x84);
+        let x95 = c_q10 * x73;
+        let x96 = Self::mul_add(-s_q10, x83, x95);
+        let x97 = s_q10 * x73;
+        let x98 = Self::mul_add(c_q10, x83, x97);
+        let x99 = x98 * 0.87;
+        let x100 = Self::mul_add(x96, 0.87, x78 + Self::mul_add(-x88, x91, x89 * x90));
+        let x101 = x87 - x99;
+        let x102 = x99 - (x82 - x92 - x99);
+        let x103 = -81.53205 + x98;
+        let x104 = -0.00214 + x93;
+        let x105 = -63.36336825000001 + (x85 + x92);
+        let x106 = -36.18604050126307 + Self::mul_add(x54, -0.87, x94);
+        let x107 = 69.99836825 - (x99 - x101);
+        let x108 = s_q9 * s_q9;
+        let x109 = s_q9 * c_q9;
+        let x110 = x102 + x105;
+        let x111 = x100 + x100;
+        let x112 = Self::mul_add(-x109, x111, x108 * x110);
+        let x113 = x102 - x112;
+        let x114 = x105 - x112;
+        let x115 = x100 - Self::mul_add(x108, x111, x109 * x110);
+        let x116 = Self::mul_add(-s_q9, x106, c_q9 * x104);
+        let x117 = Self::mul_add(c_q9, x106, s_q9 * x104);
+        let x118 = c_q9 * x96;
+        let x119 = Self::mul_add(-s_q9, x103, x118);
+        let x120 = s_q9 * x96;
+        let x121 = Self::mul_add(c_q9, x103, x120);
+        let x122 = 0.00000000020510342851533115 * x54;
+        let x123 = x121 - x122;
+        let x124 = 0.00000000020510342851533115 * x121;
+        let x125 = x54 - Self::mul_add(0.00000000020510342851533115, x119, -x124);
+        let x126 = x119 + x122;
+        let x127 = 0.00000000020510342851533115 * x116;
+        let x128 = x115 + x127;
+        let x129 = 0.00000000020510342851533115 * x117;
+        let x130 = x114 + x129;
+        let x131 = 0.00000000020510342851533115 * x107;
+        let x132 = x117 + x131;
+        let x133 = 0.00000000020510342851533115 * x115;
+        let x134 = x116 - Self::mul_add(0.00000000020510342851533115, x113, x133);
+        let x135 = x107 + (x127 - x129);
+        let x136 = x116 - x131;
+        let x137 = 0.00000000020510342851533115 * x132;
+        let x138 = 0.4 * x126;
+        let x139 = 0.275 * x125;
+        let x140 = x138 - x139;
+        let x141 = x140 + (x130 + x137 + x140);
+        let x142 = Self::mul_add(
+            0.275,
+            x126,
+            -Self::mul_add(
+                0.4,
+                x125,
+                Self::mul_add(-0.00000000020510342851533115, x135, x134),
             ),
-            s_q12
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x45,
-                    Self::mul_add(c_q12, x42, s_q12 * x37),
-                ),
         );
-        let x62 = x51 * 0.36;
-        let x63 = Self::mul_add(
-            x48,
-            -0.36,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x54,
-                Self::mul_add(c_q12, x53, s_q12 * x52),
-            ),
-        );
-        let x64 = Self::mul_add(
-            x49,
-            -0.36,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x57,
-                Self::mul_add(c_q12, x56, s_q12 * x55),
-            ),
-        );
-        let x65 = x62 + (Self::mul_add(-s_q12, x53, c_q12 * x52) + x62);
-        let x66 = 7.078399999258757 + x49;
-        let x67 = 0.01675 - x63;
-        let x68 = -9.142025249762803
-            + (x62 + (x57 - Self::mul_add(x14, x56, x13 * x55) + x62));
-        let x69 = 2.5482240016099564 - x64;
-        let x70 = 9.223235249762805
-            + Self::mul_add(0.00000000020510342851533115, x58, x61);
-        let x71 = s_q11 * s_q11;
-        let x72 = s_q11 * c_q11;
-        let x73 = x65 - x68;
-        let x74 = x60 + x60;
-        let x75 = Self::mul_add(x72, x74, x71 * x73);
-        let x76 = Self::mul_add(-s_q11, x66, c_q11 * x48);
-        let x77 = Self::mul_add(c_q11, x66, s_q11 * x48);
-        let x78 = 0.275 * x51;
-        let x79 = x77 * 0.63;
-        let x80 = x78 - x79;
-        let x81 = Self::mul_add(x76, 0.63, x60 + Self::mul_add(-x71, x74, x72 * x73));
-        let x82 = Self::mul_add(0.275, x76, Self::mul_add(-s_q11, x69, c_q11 * x67));
-        let x83 = Self::mul_add(0.275, x77, Self::mul_add(c_q11, x69, s_q11 * x67));
-        let x84 = x70 - x79;
-        let x85 = x80 + (x65 - x75 + x80);
-        let x86 = -45.1584 + x77;
-        let x87 = -0.6328 + x82;
-        let x88 = -24.4950615 + (x78 + (x68 + x75 + x78));
-        let x89 = -24.35164200091464 - Self::mul_add(x51, 0.63, -x83);
-        let x90 = 28.2393615 - (x79 - x84);
-        let x91 = s_q10 * s_q10;
-        let x92 = s_q10 * c_q10;
-        let x93 = x85 - x88;
-        let x94 = x81 + x81;
-        let x95 = Self::mul_add(x92, x94, x91 * x93);
-        let x96 = Self::mul_add(-s_q10, x89, c_q10 * x87);
-        let x97 = Self::mul_add(c_q10, x89, s_q10 * x87);
-        let x98 = c_q10 * x76;
-        let x99 = Self::mul_add(-s_q10, x86, x98);
-        let x100 = s_q10 * x76;
-        let x101 = Self::mul_add(c_q10, x86, x100);
-        let x102 = x101 * 0.87;
-        let x103 = Self::mul_add(x99, 0.87, x81 + Self::mul_add(-x91, x94, x92 * x93));
-        let x104 = x90 - x102;
-        let x105 = x102 - (x85 - x95 - x102);
-        let x106 = -81.53205 + x101;
-        let x107 = -0.00214 + x96;
-        let x108 = -63.36336825000001 + (x88 + x95);
-        let x109 = -36.18604050126307 + Self::mul_add(x51, -0.87, x97);
-        let x110 = 69.99836825 - (x102 - x104);
-        let x111 = s_q9 * x99;
-        let x112 = Self::mul_add(c_q9, x106, x111);
-        let x113 = 0.00000000020510342851533115 * x51;
-        let x114 = x112 - x113;
-        let x115 = x51 - Self::mul_add(-x12, x106, x11 * x99);
-        let x116 = c_q9 * x99;
-        let x117 = Self::mul_add(-s_q9, x106, x116);
-        let x118 = x113 + x117;
-        let x119 = c_q9 * x103;
-        let x120 = 0.00000000020510342851533115 * x107;
-        let x121 = Self::mul_add(s_q9, x105, -x119) - x120;
-        let x122 = s_q9 * x103;
-        let x123 = 0.00000000020510342851533115 * x109;
-        let x124 = Self::mul_add(c_q9, x108, x122) + x123;
-        let x125 = 0.00000000020510342851533115 * x110;
-        let x126 = Self::mul_add(c_q9, x109, s_q9 * x107) + x125;
-        let x127 = x107 - Self::mul_add(x12, x103, x11 * x105);
-        let x128 = x109 + Self::mul_add(-x12, x108, x11 * x103);
-        let x129 = x110 + Self::mul_add(-x12, x109, x11 * x107);
-        let x130 = x120 + Self::mul_add(c_q9, x105, x122);
-        let x131 = x123 - Self::mul_add(-s_q9, x108, x119);
-        let x132 = x125 - Self::mul_add(-s_q9, x109, c_q9 * x107);
-        let x133 = 0.00000000020510342851533115 * x126;
-        let x134 = 0.00000000020510342851533115 * x129;
-        let x135 = 0.00000000020510342851533115 * x132;
-        let x136 = 0.4 * x118;
-        let x137 = 0.275 * x115;
-        let x138 = x136 - x137;
-        let x139 = 0.275 * x114;
-        let x140 = 0.4 * x114;
-        let x141 = 0.4 * x115;
-        let x142 = 0.275 * x118;
-        let x143 = x138 - (Self::mul_add(-c_q9, x124, s_q9 * x121) - x133 - x138);
-        let x144 = -0.000000008530897668050218 + x114;
-        let x145 = -12.701650001451807 - x115;
-        let x146 = -0.0000000234896432582596
-            + (x126 - Self::mul_add(x12, x124, x11 * x121) - x139);
-        let x147 = -0.002139996587640933
-            - (x133 + Self::mul_add(s_q9, x124, c_q9 * x121) + x140);
-        let x148 = -0.0000000234896432582596
-            + (Self::mul_add(c_q9, x128, s_q9 * x127) + x134 - x139);
-        let x149 = -111.7548902508081
-            + (x136 + (x129 + Self::mul_add(-x12, x128, x11 * x127) + x136));
-        let x150 = 5.080660024070365
-            - (x142 + (x134 - Self::mul_add(-s_q9, x128, c_q9 * x127) - x141));
-        let x151 = -0.002139996587640933
-            - (Self::mul_add(c_q9, x131, s_q9 * x130) + x135 + x140);
-        let x152 = 5.080660024070366
-            + (x141 - (x132 + Self::mul_add(-x12, x131, x11 * x130) + x142));
-        let x153 = 113.3918902508081
-            - (x137 - (x135 - Self::mul_add(-s_q9, x131, c_q9 * x130) - x137));
-        let x154 = x118 - Self::mul_add(-x8, x145, x7 * x144);
-        let x155 = Self::mul_add(c_q8, x145, s_q8 * x144);
-        let x156 = Self::mul_add(-s_q8, x145, c_q8 * x144);
-        let x157 = Self::mul_add(0.00000000020510342851533115, x118, x156);
-        let x158 = x151 - Self::mul_add(-x8, x148, x7 * x143);
-        let x159 = x152 - Self::mul_add(-x8, x149, x7 * x146);
-        let x160 = x153 - Self::mul_add(-x8, x150, x7 * x147);
-        let x161 = Self::mul_add(c_q8, x148, s_q8 * x143);
-        let x162 = Self::mul_add(c_q8, x149, s_q8 * x146);
-        let x163 = Self::mul_add(c_q8, x150, s_q8 * x147);
-        let x164 = Self::mul_add(
-            0.00000000020510342851533115,
-            x153,
-            Self::mul_add(-s_q8, x150, c_q8 * x147),
-        );
-        let x165 = -x164;
-        let x166 = Self::mul_add(
-            -s_q8,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x152,
-                Self::mul_add(-s_q8, x149, c_q8 * x146),
-            ),
-            c_q8
-                * Self::mul_add(
-                    0.00000000020510342851533115,
-                    x151,
-                    Self::mul_add(-s_q8, x148, c_q8 * x143),
-                ),
-        );
-        let x167 = 0.35 * x157;
-        let x168 = Self::mul_add(
-            0.35,
-            x154,
-            Self::mul_add(
-                0.00000000020510342851533115,
+        let x143 = -0.000000008530897668050218 + x123;
+        let x144 = -12.701650001451807 - x125;
+        let x145 = -0.0000000234896432582596
+            + Self::mul_add(
+                -0.275,
+                x123,
+                x132
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x130,
+                        0.00000000020510342851533115 * x128,
+                    ),
+            );
+        let x146 = -0.002139996587640933 + Self::mul_add(-0.4, x123, x128 - x137);
+        let x147 = -111.7548902508081
+            + (x138
+                + (x135
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x117 + Self::mul_add(-0.00000000020510342851533115, x114, x133),
+                        0.00000000020510342851533115 * x134,
+                    ) + x138));
+        let x148 = 5.080660024070365 - x142;
+        let x149 = 113.3918902508081
+            - (x139
+                + (Self::mul_add(0.00000000020510342851533115, x136, x113 + x127)
+                    + x139));
+        let x150 = s_q8 * s_q8;
+        let x151 = s_q8 * c_q8;
+        let x152 = x141 - x147;
+        let x153 = x145 + x145;
+        let x154 = Self::mul_add(x151, x153, x150 * x152);
+        let x155 = x141 - x154;
+        let x156 = x145 + Self::mul_add(-x150, x153, x151 * x152);
+        let x157 = Self::mul_add(-s_q8, x148, c_q8 * x146);
+        let x158 = Self::mul_add(c_q8, x148, s_q8 * x146);
+        let x159 = Self::mul_add(-s_q8, x144, c_q8 * x143);
+        let x160 = Self::mul_add(c_q8, x144, s_q8 * x143);
+        let x161 = Self::mul_add(-0.00000000020510342851533115, x159, x126);
+        let x162 = Self::mul_add(0.00000000020510342851533115, x126, x159);
+        let x163 = Self::mul_add(-0.00000000020510342851533115, x155, x157);
+        let x164 = 0.00000000020510342851533115 * x157;
+        let x165 = x149 - x164;
+        let x166 = Self::mul_add(0.00000000020510342851533115, x149, x157);
+        let x167 = -x166;
+        let x168 = 0.35 * x162;
+        let x169 = x168
+            - (Self::mul_add(-0.00000000020510342851533115, x163, x165) - x168);
+        let x170 = 48.0240000085309 + x161;
+        let x171 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x156, x158);
+        let x172 = -16.80768997608804
+            - Self::mul_add(
+                0.35,
+                x161,
+                Self::mul_add(0.00000000020510342851533115, x165, x163),
+            );
+        let x173 = 130.43769025763282 - (x168 - (x147 + x154 - x168));
+        let x174 = 0.1132
+            - Self::mul_add(
+                0.35,
                 x160,
-                Self::mul_add(-s_q8, x159, c_q8 * x158),
-            ),
-        );
-        let x169 = Self::mul_add(
-            0.35,
-            x155,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x163,
-                Self::mul_add(-s_q8, x162, c_q8 * x161),
-            ),
-        );
-        let x170 = x167 - (x160 - Self::mul_add(-x8, x159, x7 * x158) - x167);
-        let x171 = 48.0240000085309 + x154;
-        let x172 = -0.07309 + Self::mul_add(c_q8, x159, s_q8 * x158);
-        let x173 = -16.80768997608804 - x168;
-        let x174 = 130.43769025763282
-            - (x167 - (Self::mul_add(c_q8, x162, s_q8 * x161) - x167));
-        let x175 = 0.1132 - x169;
-        let x176 = 132.47349025763282
-            + Self::mul_add(0.00000000020510342851533115, x164, x166);
-        let x177 = s_q7 * s_q7;
-        let x178 = s_q7 * c_q7;
-        let x179 = x170 + x174;
-        let x180 = x172 + x172;
-        let x181 = Self::mul_add(-x178, x180, x177 * x179);
-        let x182 = Self::mul_add(-s_q7, x155, c_q7 * x171);
-        let x183 = Self::mul_add(c_q7, x155, s_q7 * x171);
-        let x184 = -x183;
-        let x185 = 0.75 * x157;
-        let x186 = 0.65 * x182;
-        let x187 = x185 - x186;
-        let x188 = Self::mul_add(-0.75, x182, Self::mul_add(-s_q7, x175, c_q7 * x173));
-        let x189 = Self::mul_add(
+                Self::mul_add(0.00000000020510342851533115, x158, x156),
+            );
+        let x175 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x166, x155 + x164);
+        let x176 = s_q7 * s_q7;
+        let x177 = s_q7 * c_q7;
+        let x178 = x169 + x173;
+        let x179 = x171 + x171;
+        let x180 = Self::mul_add(-x177, x179, x176 * x178);
+        let x181 = Self::mul_add(-s_q7, x160, c_q7 * x170);
+        let x182 = Self::mul_add(c_q7, x160, s_q7 * x170);
+        let x183 = -x182;
+        let x184 = 0.75 * x162;
+        let x185 = 0.65 * x181;
+        let x186 = x184 - x185;
+        let x187 = Self::mul_add(-0.75, x181, Self::mul_add(-s_q7, x174, c_q7 * x172));
+        let x188 = Self::mul_add(
             -0.65,
-            x183,
-            x172 - Self::mul_add(x177, x180, x178 * x179),
+            x182,
+            x171 - Self::mul_add(x176, x179, x177 * x178),
         );
-        let x190 = Self::mul_add(-0.75, x183, Self::mul_add(c_q7, x175, s_q7 * x173));
-        let x191 = x176 + x186;
-        let x192 = 110.5455 + x182;
-        let x193 = 180.9502499901501 - x157;
-        let x194 = 1394.5960312283303 - (x185 + (x170 - x181 + x185));
-        let x195 = -117.61766249359756 + Self::mul_add(0.65, x157, x188);
-        let x196 = 1466.4506062283303 - (x187 - (x174 - x181 - x187));
-        let x197 = 1271.854575 + (x186 + x191);
-        let x198 = -x193;
-        let x199 = -x192;
-        let x200 = Self::mul_add(x8, x144, x7 * x145);
-        let x201 = Self::mul_add(-0.35, x156, x160);
-        let x202 = Self::mul_add(0.35, x200, x163);
-        let x203 = Self::mul_add(-s_q7, x156, c_q7 * x200);
-        let x204 = Self::mul_add(c_q7, x156, s_q7 * x200);
-        let x205 = Self::mul_add(-0.75, x204, Self::mul_add(-s_q7, x202, c_q7 * x201));
-        let x206 = Self::mul_add(c_q7, x202, s_q7 * x201)
-            + Self::mul_add(-0.65, x155, 0.75 * x203);
-        let x207 = -Self::mul_add(-0.65, x204, x164);
-        let x208 = x12 * x99;
-        let x209 = Self::mul_add(x11, x106, x208);
-        let x210 = x126 + Self::mul_add(-0.275, x112, 0.4 * x209);
-        let x211 = Self::mul_add(0.4, x117, x129);
-        let x212 = Self::mul_add(0.275, x117, x132);
-        let x213 = -x212;
-        let x214 = x112 + Self::mul_add(x8, x209, x7 * x117);
-        let x215 = Self::mul_add(-c_q8, x209, s_q8 * x117);
-        let x216 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x112,
-            Self::mul_add(s_q8, x209, c_q8 * x117),
-        );
-        let x217 = -x216;
-        let x218 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x212,
-            Self::mul_add(-s_q8, x211, c_q8 * x210),
-        );
-        let x219 = -x218;
-        let x220 = Self::mul_add(0.35, x215, x212 + Self::mul_add(-x8, x211, x7 * x210));
-        let x221 = Self::mul_add(-0.35, x214, Self::mul_add(c_q8, x211, s_q8 * x210));
-        let x222 = Self::mul_add(s_q7, x215, c_q7 * x214);
-        let x223 = -x222;
-        let x224 = Self::mul_add(-c_q7, x215, s_q7 * x214);
-        let x225 = -x224;
-        let x226 = -Self::mul_add(-0.75, x224, Self::mul_add(s_q7, x221, c_q7 * x220));
-        let x227 = -(Self::mul_add(-c_q7, x221, s_q7 * x220)
-            + Self::mul_add(-0.65, x216, 0.75 * x222));
-        let x228 = -Self::mul_add(0.65, x224, x218);
-        let x229 = Self::mul_add(-s_q9, x101, x116);
-        let x230 = Self::mul_add(x11, x101, x208);
-        let x231 = Self::mul_add(c_q9, x101, x111);
-        let x232 = 0.00000000020510342851533115 * x104;
-        let x233 = Self::mul_add(c_q9, x97, s_q9 * x96) + x232
-            + Self::mul_add(-0.275, x231, 0.4 * x230);
-        let x234 = Self::mul_add(0.4, x229, x104 + Self::mul_add(-x12, x97, x11 * x96));
-        let x235 = Self::mul_add(
-            0.275,
-            x229,
-            x232 - Self::mul_add(-s_q9, x97, c_q9 * x96),
-        );
-        let x236 = -x235;
-        let x237 = x231 + Self::mul_add(x8, x230, x7 * x229);
-        let x238 = Self::mul_add(-c_q8, x230, s_q8 * x229);
-        let x239 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x231,
-            Self::mul_add(s_q8, x230, c_q8 * x229),
-        );
-        let x240 = -x239;
-        let x241 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x235,
-            Self::mul_add(-s_q8, x234, c_q8 * x233),
-        );
-        let x242 = -x241;
-        let x243 = Self::mul_add(0.35, x238, x235 + Self::mul_add(-x8, x234, x7 * x233));
-        let x244 = Self::mul_add(-0.35, x237, Self::mul_add(c_q8, x234, s_q8 * x233));
-        let x245 = Self::mul_add(s_q7, x238, c_q7 * x237);
-        let x246 = -x245;
-        let x247 = Self::mul_add(-c_q7, x238, s_q7 * x237);
-        let x248 = -x247;
-        let x249 = -Self::mul_add(-0.75, x247, Self::mul_add(s_q7, x244, c_q7 * x243));
-        let x250 = -(Self::mul_add(-c_q7, x244, s_q7 * x243)
-            + Self::mul_add(-0.65, x239, 0.75 * x245));
-        let x251 = -Self::mul_add(0.65, x247, x241);
-        let x252 = Self::mul_add(c_q10, x77, x100);
-        let x253 = Self::mul_add(-s_q10, x77, x98);
-        let x254 = Self::mul_add(-s_q10, x83, c_q10 * x82);
-        let x255 = Self::mul_add(c_q10, x83, s_q10 * x82);
-        let x256 = Self::mul_add(-0.87, x252, x84);
-        let x257 = Self::mul_add(-c_q9, x253, s_q9 * x252);
-        let x258 = Self::mul_add(x12, x253, x11 * x252);
-        let x259 = Self::mul_add(s_q9, x253, c_q9 * x252);
-        let x260 = 0.00000000020510342851533115 * x256;
-        let x261 = Self::mul_add(c_q9, x255, s_q9 * x254) + x260
-            + Self::mul_add(-0.275, x259, 0.4 * x258);
-        let x262 = Self::mul_add(
-            -0.4,
-            x257,
-            x256 + Self::mul_add(-x12, x255, x11 * x254),
-        );
-        let x263 = Self::mul_add(
-            -0.275,
-            x257,
-            x260 - Self::mul_add(-s_q9, x255, c_q9 * x254),
-        );
-        let x264 = -x263;
-        let x265 = x259 - Self::mul_add(-x8, x258, x7 * x257);
-        let x266 = Self::mul_add(c_q8, x258, s_q8 * x257);
-        let x267 = Self::mul_add(
-            0.00000000020510342851533115,
-            x259,
-            Self::mul_add(-s_q8, x258, c_q8 * x257),
-        );
-        let x268 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x263,
-            Self::mul_add(-s_q8, x262, c_q8 * x261),
-        );
-        let x269 = -x268;
-        let x270 = Self::mul_add(
+        let x189 = Self::mul_add(-0.75, x182, Self::mul_add(c_q7, x174, s_q7 * x172));
+        let x190 = x175 + x185;
+        let x191 = 110.5455 + x181;
+        let x192 = 180.9502499901501 - x162;
+        let x193 = 1394.5960312283303 - (x184 + (x169 - x180 + x184));
+        let x194 = -117.61766249359756 + Self::mul_add(0.65, x162, x187);
+        let x195 = 1466.4506062283303 - (x186 - (x173 - x180 - x186));
+        let x196 = 1271.854575 + (x185 + x190);
+        let x197 = -x192;
+        let x198 = -x191;
+        let x199 = Self::mul_add(x8, x143, x7 * x144);
+        let x200 = Self::mul_add(
             -0.35,
-            x266,
-            x263 + Self::mul_add(-x8, x262, x7 * x261),
+            x159,
+            x149 - Self::mul_add(-x8, x148, x7 * x146),
         );
-        let x271 = Self::mul_add(-0.35, x265, Self::mul_add(c_q8, x262, s_q8 * x261));
-        let x272 = Self::mul_add(-s_q7, x266, c_q7 * x265);
-        let x273 = -x272;
-        let x274 = Self::mul_add(c_q7, x266, s_q7 * x265);
-        let x275 = -x274;
-        let x276 = -Self::mul_add(-0.75, x274, Self::mul_add(s_q7, x271, c_q7 * x270));
-        let x277 = -(Self::mul_add(-c_q7, x271, s_q7 * x270)
-            + Self::mul_add(0.65, x267, 0.75 * x272));
-        let x278 = -Self::mul_add(0.65, x274, x268);
-        let x279 = Self::mul_add(-x14, x38, x13 * x39);
-        let x280 = Self::mul_add(0.36, x279, x54);
-        let x281 = Self::mul_add(x50, 0.36, x57);
-        let x282 = Self::mul_add(s_q11, x279, c_q11 * x50);
-        let x283 = Self::mul_add(-c_q11, x279, s_q11 * x50);
-        let x284 = Self::mul_add(-s_q11, x281, c_q11 * x280)
-            - Self::mul_add(x48, -0.63, 0.275 * x283);
-        let x285 = Self::mul_add(0.275, x282, Self::mul_add(c_q11, x281, s_q11 * x280));
-        let x286 = Self::mul_add(0.63, x282, x58);
-        let x287 = -x286;
-        let x288 = Self::mul_add(-s_q10, x283, c_q10 * x282);
-        let x289 = Self::mul_add(c_q10, x283, s_q10 * x282);
-        let x290 = Self::mul_add(c_q10, x285, s_q10 * x284);
-        let x291 = Self::mul_add(x48, 0.87, Self::mul_add(-s_q10, x285, c_q10 * x284));
-        let x292 = Self::mul_add(0.87, x288, x286);
-        let x293 = -x292;
-        let x294 = 0.00000000020510342851533115 * x48;
-        let x295 = Self::mul_add(c_q9, x289, s_q9 * x288) + x294;
-        let x296 = x48 + Self::mul_add(-x12, x289, x11 * x288);
-        let x297 = x294 - Self::mul_add(-s_q9, x289, c_q9 * x288);
-        let x298 = 0.00000000020510342851533115 * x292;
-        let x299 = Self::mul_add(c_q9, x290, s_q9 * x291) - x298
-            + Self::mul_add(0.275, x297, 0.4 * x296);
-        let x300 = Self::mul_add(
+        let x201 = Self::mul_add(0.35, x199, x158);
+        let x202 = Self::mul_add(-s_q7, x159, c_q7 * x199);
+        let x203 = Self::mul_add(c_q7, x159, s_q7 * x199);
+        let x204 = Self::mul_add(-0.75, x203, Self::mul_add(-s_q7, x201, c_q7 * x200));
+        let x205 = Self::mul_add(c_q7, x201, s_q7 * x200)
+            + Self::mul_add(-0.65, x160, 0.75 * x202);
+        let x206 = -Self::mul_add(-0.65, x203, x166);
+        let x207 = x12 * x96;
+        let x208 = Self::mul_add(x11, x103, x207);
+        let x209 = x132 + Self::mul_add(-0.275, x121, 0.4 * x208);
+        let x210 = Self::mul_add(
             0.4,
-            x295,
-            x292 - Self::mul_add(-x12, x290, x11 * x291),
+            x119,
+            x107 + Self::mul_add(-x12, x106, x11 * x104),
         );
-        let x301 = Self::mul_add(
+        let x211 = Self::mul_add(-0.275, x119, x136);
+        let x212 = x121 + Self::mul_add(x8, x208, x7 * x119);
+        let x213 = Self::mul_add(-c_q8, x208, s_q8 * x119);
+        let x214 = x124 - Self::mul_add(s_q8, x208, c_q8 * x119);
+        let x215 = Self::mul_add(
+            0.00000000020510342851533115,
+            x211,
+            Self::mul_add(-s_q8, x210, c_q8 * x209),
+        );
+        let x216 = -x215;
+        let x217 = Self::mul_add(
+            -0.35,
+            x213,
+            x211 - Self::mul_add(-x8, x210, x7 * x209),
+        );
+        let x218 = Self::mul_add(-0.35, x212, Self::mul_add(c_q8, x210, s_q8 * x209));
+        let x219 = Self::mul_add(s_q7, x213, c_q7 * x212);
+        let x220 = -x219;
+        let x221 = Self::mul_add(-c_q7, x213, s_q7 * x212);
+        let x222 = -x221;
+        let x223 = Self::mul_add(0.75, x221, Self::mul_add(-s_q7, x218, c_q7 * x217));
+        let x224 = Self::mul_add(c_q7, x218, s_q7 * x217)
+            - Self::mul_add(0.65, x214, 0.75 * x219);
+        let x225 = -Self::mul_add(0.65, x221, x215);
+        let x226 = Self::mul_add(-s_q9, x98, x118);
+        let x227 = Self::mul_add(x11, x98, x207);
+        let x228 = Self::mul_add(c_q9, x98, x120);
+        let x229 = 0.00000000020510342851533115 * x101;
+        let x230 = Self::mul_add(c_q9, x94, s_q9 * x93) + x229
+            + Self::mul_add(-0.275, x228, 0.4 * x227);
+        let x231 = Self::mul_add(0.4, x226, x101 + Self::mul_add(-x12, x94, x11 * x93));
+        let x232 = Self::mul_add(
             0.275,
-            x295,
-            x298 + Self::mul_add(-s_q9, x290, c_q9 * x291),
+            x226,
+            x229 - Self::mul_add(-s_q9, x94, c_q9 * x93),
         );
-        let x302 = x297 + Self::mul_add(-x8, x296, x7 * x295);
-        let x303 = Self::mul_add(c_q8, x296, s_q8 * x295);
-        let x304 = Self::mul_add(
+        let x233 = -x232;
+        let x234 = x228 + Self::mul_add(x8, x227, x7 * x226);
+        let x235 = Self::mul_add(-c_q8, x227, s_q8 * x226);
+        let x236 = Self::mul_add(
             -0.00000000020510342851533115,
-            x297,
-            Self::mul_add(-s_q8, x296, c_q8 * x295),
+            x228,
+            Self::mul_add(s_q8, x227, c_q8 * x226),
         );
-        let x305 = Self::mul_add(
-            0.00000000020510342851533115,
-            x301,
-            Self::mul_add(s_q8, x300, c_q8 * x299),
+        let x237 = -x236;
+        let x238 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x232,
+            Self::mul_add(-s_q8, x231, c_q8 * x230),
         );
-        let x306 = -x305;
-        let x307 = Self::mul_add(0.35, x303, x301 - Self::mul_add(x8, x300, x7 * x299));
-        let x308 = Self::mul_add(0.35, x302, Self::mul_add(-c_q8, x300, s_q8 * x299));
-        let x309 = Self::mul_add(s_q7, x303, c_q7 * x302);
-        let x310 = Self::mul_add(-c_q7, x303, s_q7 * x302);
-        let x311 = Self::mul_add(-0.75, x310, Self::mul_add(-s_q7, x308, c_q7 * x307));
-        let x312 = Self::mul_add(c_q7, x308, s_q7 * x307)
-            + Self::mul_add(-0.65, x304, 0.75 * x309);
-        let x313 = -Self::mul_add(-0.65, x310, x305);
-        let x314 = 4.806620000000001 * x15;
-        let x315 = x22 + x32;
-        let x316 = Self::mul_add(-0.16, x314, x26);
-        let x317 = Self::mul_add(-0.55, x314, x29);
-        let x318 = Self::mul_add(s_q12, x19, c_q12 * x314);
-        let x319 = x18 - Self::mul_add(-x14, x19, x13 * x314);
-        let x320 = Self::mul_add(
-            0.00000000020510342851533115,
-            x18,
-            Self::mul_add(-c_q12, x19, s_q12 * x314),
-        );
-        let x321 = Self::mul_add(
-            0.00000000020510342851533115,
-            x317,
-            Self::mul_add(-c_q12, x316, s_q12 * x315),
-        );
-        let x322 = -x321;
-        let x323 = Self::mul_add(0.36, x319, Self::mul_add(s_q12, x316, c_q12 * x315));
-        let x324 = Self::mul_add(
-            -0.36,
-            x318,
-            x317 - Self::mul_add(-x14, x316, x13 * x315),
-        );
-        let x325 = Self::mul_add(-s_q11, x319, c_q11 * x318);
-        let x326 = Self::mul_add(c_q11, x319, s_q11 * x318);
-        let x327 = Self::mul_add(-s_q11, x324, c_q11 * x323)
-            + Self::mul_add(0.63, x320, 0.275 * x326);
-        let x328 = Self::mul_add(-0.275, x325, Self::mul_add(c_q11, x324, s_q11 * x323));
-        let x329 = Self::mul_add(-0.63, x325, x321);
-        let x330 = -x329;
-        let x331 = Self::mul_add(-s_q10, x326, c_q10 * x325);
-        let x332 = Self::mul_add(c_q10, x326, s_q10 * x325);
-        let x333 = Self::mul_add(c_q10, x328, s_q10 * x327);
-        let x334 = Self::mul_add(0.87, x320, Self::mul_add(-s_q10, x328, c_q10 * x327));
-        let x335 = Self::mul_add(-0.87, x331, x329);
-        let x336 = -x335;
-        let x337 = 0.00000000020510342851533115 * x320;
-        let x338 = Self::mul_add(c_q9, x332, s_q9 * x331) - x337;
-        let x339 = x320 - Self::mul_add(-x12, x332, x11 * x331);
-        let x340 = x337 + Self::mul_add(-s_q9, x332, c_q9 * x331);
-        let x341 = 0.00000000020510342851533115 * x335;
-        let x342 = Self::mul_add(c_q9, x333, s_q9 * x334) - x341
-            + Self::mul_add(0.275, x340, 0.4 * x339);
-        let x343 = Self::mul_add(
+        let x239 = -x238;
+        let x240 = Self::mul_add(0.35, x235, x232 + Self::mul_add(-x8, x231, x7 * x230));
+        let x241 = Self::mul_add(-0.35, x234, Self::mul_add(c_q8, x231, s_q8 * x230));
+        let x242 = Self::mul_add(s_q7, x235, c_q7 * x234);
+        let x243 = -x242;
+        let x244 = Self::mul_add(-c_q7, x235, s_q7 * x234);
+        let x245 = -x244;
+        let x246 = -Self::mul_add(-0.75, x244, Self::mul_add(s_q7, x241, c_q7 * x240));
+        let x247 = -(Self::mul_add(-c_q7, x241, s_q7 * x240)
+            + Self::mul_add(-0.65, x236, 0.75 * x242));
+        let x248 = -Self::mul_add(0.65, x244, x238);
+        let x249 = Self::mul_add(c_q10, x74, x97);
+        let x250 = Self::mul_add(-s_q10, x74, x95);
+        let x251 = Self::mul_add(-s_q10, x80, c_q10 * x79);
+        let x252 = Self::mul_add(c_q10, x80, s_q10 * x79);
+        let x253 = Self::mul_add(-0.87, x249, x81);
+        let x254 = Self::mul_add(-c_q9, x250, s_q9 * x249);
+        let x255 = Self::mul_add(x12, x250, x11 * x249);
+        let x256 = Self::mul_add(s_q9, x250, c_q9 * x249);
+        let x257 = 0.00000000020510342851533115 * x253;
+        let x258 = Self::mul_add(c_q9, x252, s_q9 * x251) + x257
+            + Self::mul_add(-0.275, x256, 0.4 * x255);
+        let x259 = Self::mul_add(
             -0.4,
-            x338,
-            x335 - Self::mul_add(-x12, x333, x11 * x334),
+            x254,
+            x253 + Self::mul_add(-x12, x252, x11 * x251),
         );
-        let x344 = Self::mul_add(
+        let x260 = Self::mul_add(
             -0.275,
-            x338,
-            x341 + Self::mul_add(-s_q9, x333, c_q9 * x334),
+            x254,
+            x257 - Self::mul_add(-s_q9, x252, c_q9 * x251),
         );
-        let x345 = x340 - Self::mul_add(x8, x339, x7 * x338);
-        let x346 = Self::mul_add(-c_q8, x339, s_q8 * x338);
-        let x347 = Self::mul_add(
+        let x261 = -x260;
+        let x262 = x256 - Self::mul_add(-x8, x255, x7 * x254);
+        let x263 = Self::mul_add(c_q8, x255, s_q8 * x254);
+        let x264 = Self::mul_add(
             0.00000000020510342851533115,
-            x340,
-            Self::mul_add(s_q8, x339, c_q8 * x338),
+            x256,
+            Self::mul_add(-s_q8, x255, c_q8 * x254),
         );
-        let x348 = -x347;
-        let x349 = Self::mul_add(
+        let x265 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x260,
+            Self::mul_add(-s_q8, x259, c_q8 * x258),
+        );
+        let x266 = -x265;
+        let x267 = Self::mul_add(
+            -0.35,
+            x263,
+            x260 + Self::mul_add(-x8, x259, x7 * x258),
+        );
+        let x268 = Self::mul_add(-0.35, x262, Self::mul_add(c_q8, x259, s_q8 * x258));
+        let x269 = Self::mul_add(-s_q7, x263, c_q7 * x262);
+        let x270 = -x269;
+        let x271 = Self::mul_add(c_q7, x263, s_q7 * x262);
+        let x272 = -x271;
+        let x273 = -Self::mul_add(-0.75, x271, Self::mul_add(s_q7, x268, c_q7 * x267));
+        let x274 = -(Self::mul_add(-c_q7, x268, s_q7 * x267)
+            + Self::mul_add(0.65, x264, 0.75 * x269));
+        let x275 = -Self::mul_add(0.65, x271, x265);
+        let x276 = Self::mul_add(-x14, x35, x13 * x36);
+        let x277 = Self::mul_add(0.36, x276, x49);
+        let x278 = Self::mul_add(x52, 0.36, x41 - Self::mul_add(x14, x40, x13 * x38));
+        let x279 = Self::mul_add(s_q11, x276, c_q11 * x52);
+        let x280 = Self::mul_add(-c_q11, x276, s_q11 * x52);
+        let x281 = Self::mul_add(-s_q11, x278, c_q11 * x277)
+            - Self::mul_add(x51, -0.63, 0.275 * x280);
+        let x282 = Self::mul_add(0.275, x279, Self::mul_add(c_q11, x278, s_q11 * x277));
+        let x283 = Self::mul_add(0.63, x279, x59);
+        let x284 = -x283;
+        let x285 = Self::mul_add(-s_q10, x280, c_q10 * x279);
+        let x286 = Self::mul_add(c_q10, x280, s_q10 * x279);
+        let x287 = Self::mul_add(c_q10, x282, s_q10 * x281);
+        let x288 = Self::mul_add(x51, 0.87, Self::mul_add(-s_q10, x282, c_q10 * x281));
+        let x289 = Self::mul_add(0.87, x285, x283);
+        let x290 = -x289;
+        let x291 = 0.00000000020510342851533115 * x51;
+        let x292 = Self::mul_add(c_q9, x286, s_q9 * x285) + x291;
+        let x293 = x51 + Self::mul_add(-x12, x286, x11 * x285);
+        let x294 = x291 - Self::mul_add(-s_q9, x286, c_q9 * x285);
+        let x295 = 0.00000000020510342851533115 * x289;
+        let x296 = Self::mul_add(c_q9, x287, s_q9 * x288) - x295
+            + Self::mul_add(0.275, x294, 0.4 * x293);
+        let x297 = Self::mul_add(
+            0.4,
+            x292,
+            x289 - Self::mul_add(-x12, x287, x11 * x288),
+        );
+        let x298 = Self::mul_add(
+            0.275,
+            x292,
+            x295 + Self::mul_add(-s_q9, x287, c_q9 * x288),
+        );
+        let x299 = x294 + Self::mul_add(-x8, x293, x7 * x292);
+        let x300 = Self::mul_add(c_q8, x293, s_q8 * x292);
+        let x301 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x294,
+            Self::mul_add(-s_q8, x293, c_q8 * x292),
+        );
+        let x302 = Self::mul_add(
             0.00000000020510342851533115,
-            x344,
-            Self::mul_add(s_q8, x343, c_q8 * x342),
+            x298,
+            Self::mul_add(s_q8, x297, c_q8 * x296),
         );
-        let x350 = -x349;
-        let x351 = Self::mul_add(-0.35, x346, x344 - Self::mul_add(x8, x343, x7 * x342));
-        let x352 = Self::mul_add(0.35, x345, Self::mul_add(-c_q8, x343, s_q8 * x342));
-        let x353 = Self::mul_add(-s_q7, x346, c_q7 * x345);
-        let x354 = Self::mul_add(c_q7, x346, s_q7 * x345);
-        let x355 = Self::mul_add(-0.75, x354, Self::mul_add(-s_q7, x352, c_q7 * x351));
-        let x356 = Self::mul_add(c_q7, x352, s_q7 * x351)
-            + Self::mul_add(0.65, x347, 0.75 * x353);
-        let x357 = -Self::mul_add(-0.65, x354, x349);
-        let x358 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
-        let x359 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
-        let x360 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
-        let x361 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x362 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x363 = v[4] * v[4];
-        let x364 = Self::mul_add(v[5], v[5], x363);
-        let x365 = v[3] * v[4];
-        let x366 = v[3] * v[5];
-        let x367 = v[4] * v[5];
-        let x368 = Self::mul_add(v[3], v[3], x363);
-        let x369 = x358 + Self::mul_add(-0.75, x366, 0.65 * x364);
-        let x370 = x359 + Self::mul_add(0.75, x367, 0.65 * x365);
-        let x371 = x360 - Self::mul_add(-0.75, x368, 0.65 * x366);
-        let x372 = Self::mul_add(c_q7, x370, s_q7 * x369);
-        let x373 = v[6] * x362;
-        let x374 = v[6] * x361;
-        let x375 = v[5] + v[6];
-        let x376 = x362 * x362;
-        let x377 = x361 * x375;
-        let x378 = Self::mul_add(x375, -16.80768997608804, x362 * 0.07309);
-        let x379 = Self::mul_add(
+        let x303 = -x302;
+        let x304 = Self::mul_add(0.35, x300, x298 - Self::mul_add(x8, x297, x7 * x296));
+        let x305 = Self::mul_add(0.35, x299, Self::mul_add(-c_q8, x297, s_q8 * x296));
+        let x306 = Self::mul_add(s_q7, x300, c_q7 * x299);
+        let x307 = Self::mul_add(-c_q7, x300, s_q7 * x299);
+        let x308 = Self::mul_add(-0.75, x307, Self::mul_add(-s_q7, x305, c_q7 * x304));
+        let x309 = Self::mul_add(c_q7, x305, s_q7 * x304)
+            + Self::mul_add(-0.65, x301, 0.75 * x306);
+        let x310 = -Self::mul_add(-0.65, x307, x302);
+        let x311 = 4.806620000000001 * x15;
+        let x312 = x32
+            + (1.4135609200000003
+                + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145));
+        let x313 = Self::mul_add(-0.16, x311, x22);
+        let x314 = Self::mul_add(-0.55, x311, x29);
+        let x315 = Self::mul_add(s_q12, x23, c_q12 * x311);
+        let x316 = x24 - Self::mul_add(-x14, x23, x13 * x311);
+        let x317 = Self::mul_add(
+            0.00000000020510342851533115,
+            x24,
+            Self::mul_add(-c_q12, x23, s_q12 * x311),
+        );
+        let x318 = Self::mul_add(
+            0.00000000020510342851533115,
+            x314,
+            Self::mul_add(-c_q12, x313, s_q12 * x312),
+        );
+        let x319 = -x318;
+        let x320 = Self::mul_add(0.36, x316, Self::mul_add(s_q12, x313, c_q12 * x312));
+        let x321 = Self::mul_add(
+            -0.36,
+            x315,
+            x314 - Self::mul_add(-x14, x313, x13 * x312),
+        );
+        let x322 = Self::mul_add(-s_q11, x316, c_q11 * x315);
+        let x323 = Self::mul_add(c_q11, x316, s_q11 * x315);
+        let x324 = Self::mul_add(-s_q11, x321, c_q11 * x320)
+            + Self::mul_add(0.63, x317, 0.275 * x323);
+        let x325 = Self::mul_add(-0.275, x322, Self::mul_add(c_q11, x321, s_q11 * x320));
+        let x326 = Self::mul_add(-0.63, x322, x318);
+        let x327 = -x326;
+        let x328 = Self::mul_add(-s_q10, x323, c_q10 * x322);
+        let x329 = Self::mul_add(c_q10, x323, s_q10 * x322);
+        let x330 = Self::mul_add(c_q10, x325, s_q10 * x324);
+        let x331 = Self::mul_add(0.87, x317, Self::mul_add(-s_q10, x325, c_q10 * x324));
+        let x332 = Self::mul_add(-0.87, x328, x326);
+        let x333 = -x332;
+        let x334 = 0.00000000020510342851533115 * x317;
+        let x335 = Self::mul_add(c_q9, x329, s_q9 * x328) - x334;
+        let x336 = x317 - Self::mul_add(-x12, x329, x11 * x328);
+        let x337 = x334 + Self::mul_add(-s_q9, x329, c_q9 * x328);
+        let x338 = 0.00000000020510342851533115 * x332;
+        let x339 = Self::mul_add(c_q9, x330, s_q9 * x331) - x338
+            + Self::mul_add(0.275, x337, 0.4 * x336);
+        let x340 = Self::mul_add(
+            -0.4,
+            x335,
+            x332 - Self::mul_add(-x12, x330, x11 * x331),
+        );
+        let x341 = Self::mul_add(
+            -0.275,
+            x335,
+            x338 + Self::mul_add(-s_q9, x330, c_q9 * x331),
+        );
+        let x342 = x337 - Self::mul_add(x8, x336, x7 * x335);
+        let x343 = Self::mul_add(-c_q8, x336, s_q8 * x335);
+        let x344 = Self::mul_add(
+            0.00000000020510342851533115,
+            x337,
+            Self::mul_add(s_q8, x336, c_q8 * x335),
+        );
+        let x345 = -x344;
+        let x346 = Self::mul_add(
+            0.00000000020510342851533115,
+            x341,
+            Self::mul_add(s_q8, x340, c_q8 * x339),
+        );
+        let x347 = -x346;
+        let x348 = Self::mul_add(-0.35, x343, x341 - Self::mul_add(x8, x340, x7 * x339));
+        let x349 = Self::mul_add(0.35, x342, Self::mul_add(-c_q8, x340, s_q8 * x339));
+        let x350 = Self::mul_add(-s_q7, x343, c_q7 * x342);
+        let x351 = Self::mul_add(c_q7, x343, s_q7 * x342);
+        let x352 = Self::mul_add(-0.75, x351, Self::mul_add(-s_q7, x349, c_q7 * x348));
+        let x353 = Self::mul_add(c_q7, x349, s_q7 * x348)
+            + Self::mul_add(0.65, x344, 0.75 * x350);
+        let x354 = -Self::mul_add(-0.65, x351, x346);
+        let x355 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x356 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x357 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x358 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x359 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x360 = v[4] * v[4];
+        let x361 = Self::mul_add(v[5], v[5], x360);
+        let x362 = v[3] * v[4];
+        let x363 = v[3] * v[5];
+        let x364 = v[4] * v[5];
+        let x365 = Self::mul_add(v[3], v[3], x360);
+        let x366 = x355 + Self::mul_add(-0.75, x363, 0.65 * x361);
+        let x367 = x356 + Self::mul_add(0.75, x364, 0.65 * x362);
+        let x368 = x357 - Self::mul_add(-0.75, x365, 0.65 * x363);
+        let x369 = Self::mul_add(c_q7, x367, s_q7 * x366);
+        let x370 = v[6] * x359;
+        let x371 = v[6] * x358;
+        let x372 = v[5] + v[6];
+        let x373 = x359 * x359;
+        let x374 = x358 * x372;
+        let x375 = Self::mul_add(x372, -16.80768997608804, x359 * 0.07309);
+        let x376 = Self::mul_add(
             -0.1132,
-            x375,
-            Self::mul_add(130.43769025763282, x362, x361 * 0.07309),
+            x372,
+            Self::mul_add(130.43769025763282, x359, x358 * 0.07309),
         );
-        let x380 = Self::mul_add(
+        let x377 = Self::mul_add(
             -132.47349025763282,
-            x375,
-            Self::mul_add(0.1132, x362, x361 * 16.80768997608804),
+            x372,
+            Self::mul_add(0.1132, x359, x358 * 16.80768997608804),
         );
-        let x381 = Self::mul_add(c_q8, x375, Self::mul_add(s_q8, x362, x7 * x361));
-        let x382 = Self::mul_add(s_q8, x375, Self::mul_add(-c_q8, x362, x8 * x361));
-        let x383 = Self::mul_add(
+        let x378 = Self::mul_add(c_q8, x372, Self::mul_add(s_q8, x359, x7 * x358));
+        let x379 = Self::mul_add(s_q8, x372, Self::mul_add(-c_q8, x359, x8 * x358));
+        let x380 = Self::mul_add(
             0.35,
-            x374 - x377,
-            Self::mul_add(-s_q7, x370, c_q7 * x369),
+            x371 - x374,
+            Self::mul_add(-s_q7, x367, c_q7 * x366),
         );
-        let x384 = Self::mul_add(0.35, Self::mul_add(-x362, x375, x373), x372);
-        let x385 = Self::mul_add(0.35, Self::mul_add(x361, x361, x376), x371);
-        let x386 = Self::mul_add(c_q8, x385, Self::mul_add(s_q8, x384, x7 * x383));
-        let x387 = Self::mul_add(s_q8, x385, Self::mul_add(-c_q8, x384, x8 * x383));
-        let x388 = Self::mul_add(-0.00000000020510342851533115, x385, x383);
-        let x389 = Self::mul_add(v[7], x382, Self::mul_add(-s_q8, x374, x7 * x373));
-        let x390 = Self::mul_add(-v[7], x381, Self::mul_add(c_q8, x374, x8 * x373));
-        let x391 = v[7] + Self::mul_add(-0.00000000020510342851533115, x375, x361);
-        let x392 = x382 * x382;
-        let x393 = x391 * x391;
-        let x394 = x381 * x382;
-        let x395 = x373 - x394;
-        let x396 = x381 * x391;
-        let x397 = x381 * x381;
-        let x398 = x393 + x397;
-        let x399 = x382 * x391;
-        let x400 = x389 + x399;
-        let x401 = Self::mul_add(
-            x391,
-            0.002139996587640933,
-            x382 * 0.0000000234896432582596,
-        );
-        let x402 = Self::mul_add(
-            5.080660024070365,
-            x391,
-            Self::mul_add(x382, -111.7548902508081, x381 * 0.0000000234896432582596),
-        );
-        let x403 = Self::mul_add(
-            113.3918902508081,
-            x391,
-            Self::mul_add(5.080660024070366, x382, x381 * 0.002139996587640933),
-        );
-        let x404 = Self::mul_add(
+        let x381 = Self::mul_add(0.35, Self::mul_add(-x359, x372, x370), x369);
+        let x382 = Self::mul_add(0.35, Self::mul_add(x358, x358, x373), x368);
+        let x383 = Self::mul_add(c_q8, x382, Self::mul_add(s_q8, x381, x7 * x380));
+        let x384 = Self::mul_add(s_q8, x382, Self::mul_add(-c_q8, x381, x8 * x380));
+        let x385 = Self::mul_add(-0.00000000020510342851533115, x382, x380);
+        let x386 = Self::mul_add(v[7], x379, Self::mul_add(-s_q8, x371, x7 * x370));
+        let x387 = Self::mul_add(-v[7], x378, Self::mul_add(c_q8, x371, x8 * x370));
+        let x388 = v[7] + Self::mul_add(-0.00000000020510342851533115, x372, x358);
+        let x389 = x379 * x379;
+        let x390 = x388 * x388;
+        let x391 = x378 * x379;
+        let x392 = x370 - x391;
+        let x393 = x378 * x388;
+        let x394 = x378 * x378;
+        let x395 = x390 + x394;
+        let x396 = x379 * x388;
+        let x397 = x386 + x396;
+        let x398 = Self::mul_add(
             x388,
+            0.002139996587640933,
+            x379 * 0.0000000234896432582596,
+        );
+        let x399 = Self::mul_add(
+            5.080660024070365,
+            x388,
+            Self::mul_add(x379, -111.7548902508081, x378 * 0.0000000234896432582596),
+        );
+        let x400 = Self::mul_add(
+            113.3918902508081,
+            x388,
+            Self::mul_add(5.080660024070366, x379, x378 * 0.002139996587640933),
+        );
+        let x401 = Self::mul_add(
+            x385,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x373,
-                Self::mul_add(x390, -111.7548902508081, x389 * 0.0000000234896432582596),
-            ) + Self::mul_add(-x381, x403, x391 * x401),
+                x370,
+                Self::mul_add(x387, -111.7548902508081, x386 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x378, x400, x388 * x398),
         );
-        let x405 = Self::mul_add(-c_q9, x391, Self::mul_add(-x11, x382, s_q9 * x381));
-        let x406 = Self::mul_add(s_q9, x391, Self::mul_add(x12, x382, c_q9 * x381));
-        let x407 = x386 + Self::mul_add(-0.4, x390 + x396, 0.275 * x395);
-        let x408 = x387 + Self::mul_add(0.4, x389 - x399, 0.275 * x398);
-        let x409 = x388 - Self::mul_add(-0.4, x392 + x397, 0.275 * x400);
-        let x410 = Self::mul_add(-c_q9, x409, Self::mul_add(-x11, x408, s_q9 * x407));
-        let x411 = Self::mul_add(
+        let x402 = Self::mul_add(-c_q9, x388, Self::mul_add(-x11, x379, s_q9 * x378));
+        let x403 = Self::mul_add(s_q9, x388, Self::mul_add(x12, x379, c_q9 * x378));
+        let x404 = x383 + Self::mul_add(-0.4, x387 + x393, 0.275 * x392);
+        let x405 = x384 + Self::mul_add(0.4, x386 - x396, 0.275 * x395);
+        let x406 = x385 - Self::mul_add(-0.4, x389 + x394, 0.275 * x397);
+        let x407 = Self::mul_add(-c_q9, x406, Self::mul_add(-x11, x405, s_q9 * x404));
+        let x408 = Self::mul_add(
             -0.00000000020510342851533115,
-            x409,
-            Self::mul_add(-0.00000000020510342851533115, x407, x408),
-        );
-        let x412 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x373,
-            Self::mul_add(-0.00000000020510342851533115, x389, x390),
-        );
-        let x413 = Self::mul_add(
-            -v[8],
             x406,
-            Self::mul_add(-c_q9, x373, Self::mul_add(-x11, x390, s_q9 * x389)),
+            Self::mul_add(-0.00000000020510342851533115, x404, x405),
         );
-        let x414 = Self::mul_add(
+        let x409 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x370,
+            Self::mul_add(-0.00000000020510342851533115, x386, x387),
+        );
+        let x410 = Self::mul_add(
+            -v[8],
+            x403,
+            Self::mul_add(-c_q9, x370, Self::mul_add(-x11, x387, s_q9 * x386)),
+        );
+        let x411 = Self::mul_add(
             v[8],
-            x405,
-            Self::mul_add(s_q9, x373, Self::mul_add(x12, x390, c_q9 * x389)),
+            x402,
+            Self::mul_add(s_q9, x370, Self::mul_add(x12, x387, c_q9 * x386)),
         );
-        let x415 = v[8]
+        let x412 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x391,
-                Self::mul_add(-0.00000000020510342851533115, x381, x382),
+                x388,
+                Self::mul_add(-0.00000000020510342851533115, x378, x379),
             );
-        let x416 = Self::mul_add(x405, x406, x412);
-        let x417 = Self::mul_add(x405, x405, x415 * x415);
-        let x418 = Self::mul_add(-x406, x415, x413);
-        let x419 = x415 * 0.00214;
-        let x420 = Self::mul_add(x415, -36.18604050126307, x406 * 63.36336825000001);
-        let x421 = Self::mul_add(
+        let x413 = Self::mul_add(x402, x403, x409);
+        let x414 = Self::mul_add(x402, x402, x412 * x412);
+        let x415 = Self::mul_add(-x403, x412, x410);
+        let x416 = x412 * 0.00214;
+        let x417 = Self::mul_add(x412, -36.18604050126307, x403 * 63.36336825000001);
+        let x418 = Self::mul_add(
             69.99836825,
-            x415,
-            Self::mul_add(x406, 36.18604050126307, x405 * 0.00214),
+            x412,
+            Self::mul_add(x403, 36.18604050126307, x402 * 0.00214),
         );
-        let x422 = Self::mul_add(
-            x411,
+        let x419 = Self::mul_add(
+            x408,
             81.53205,
-            Self::mul_add(x412, 0.00214, -Self::mul_add(x406, x421, x415 * x420)),
+            Self::mul_add(x409, 0.00214, -Self::mul_add(x403, x418, x412 * x417)),
         );
-        let x423 = Self::mul_add(
-            x410,
+        let x420 = Self::mul_add(
+            x407,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x412,
-                Self::mul_add(x414, 36.18604050126307, x413 * 0.00214),
-            ) + Self::mul_add(x405, x420, x406 * x419),
+                x409,
+                Self::mul_add(x411, 36.18604050126307, x410 * 0.00214),
+            ) + Self::mul_add(x402, x417, x403 * x416),
         );
-        let x424 = Self::mul_add(s_q10, x406, c_q10 * x405);
-        let x425 = Self::mul_add(-c_q10, x406, s_q10 * x405);
-        let x426 = Self::mul_add(-0.87, x416, x410);
-        let x427 = Self::mul_add(
+        let x421 = Self::mul_add(s_q10, x403, c_q10 * x402);
+        let x422 = Self::mul_add(-c_q10, x403, s_q10 * x402);
+        let x423 = Self::mul_add(-0.87, x413, x407);
+        let x424 = Self::mul_add(
             0.87,
-            x417,
-            Self::mul_add(s_q9, x409, Self::mul_add(x12, x408, c_q9 * x407)),
+            x414,
+            Self::mul_add(s_q9, x406, Self::mul_add(x12, x405, c_q9 * x404)),
         );
-        let x428 = Self::mul_add(0.87, x418, x411);
-        let x429 = Self::mul_add(s_q10, x427, c_q10 * x426);
-        let x430 = Self::mul_add(v[9], x425, Self::mul_add(s_q10, x414, c_q10 * x413));
-        let x431 = Self::mul_add(-v[9], x424, Self::mul_add(-c_q10, x414, s_q10 * x413));
-        let x432 = v[9] + x415;
-        let x433 = Self::mul_add(-x424, x425, x412);
-        let x434 = x424 * x424;
-        let x435 = Self::mul_add(x432, x432, x434);
-        let x436 = x425 * x432;
-        let x437 = x430 + x436;
-        let x438 = x432 * 0.6328;
-        let x439 = Self::mul_add(x432, 24.35164200091464, x425 * 24.4950615);
-        let x440 = Self::mul_add(
+        let x425 = Self::mul_add(0.87, x415, x408);
+        let x426 = Self::mul_add(s_q10, x424, c_q10 * x423);
+        let x427 = Self::mul_add(v[9], x422, Self::mul_add(s_q10, x411, c_q10 * x410));
+        let x428 = Self::mul_add(-v[9], x421, Self::mul_add(-c_q10, x411, s_q10 * x410));
+        let x429 = v[9] + x412;
+        let x430 = Self::mul_add(-x421, x422, x409);
+        let x431 = x421 * x421;
+        let x432 = Self::mul_add(x429, x429, x431);
+        let x433 = x422 * x429;
+        let x434 = x427 + x433;
+        let x435 = x429 * 0.6328;
+        let x436 = Self::mul_add(x429, 24.35164200091464, x422 * 24.4950615);
+        let x437 = Self::mul_add(
             28.2393615,
-            x432,
-            Self::mul_add(x425, -24.351642000914637, x424 * 0.6328),
-        );
-        let x441 = Self::mul_add(
-            x428,
-            45.1584,
-            Self::mul_add(x412, 0.6328, Self::mul_add(x425, x440, x432 * x439)),
-        );
-        let x442 = Self::mul_add(
             x429,
+            Self::mul_add(x422, -24.351642000914637, x421 * 0.6328),
+        );
+        let x438 = Self::mul_add(
+            x425,
+            45.1584,
+            Self::mul_add(x409, 0.6328, Self::mul_add(x422, x437, x429 * x436)),
+        );
+        let x439 = Self::mul_add(
+            x426,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x412,
-                Self::mul_add(x431, -24.351642000914637, x430 * 0.6328),
-            ) - Self::mul_add(x424, x439, x425 * x438),
+                x409,
+                Self::mul_add(x428, -24.351642000914637, x427 * 0.6328),
+            ) - Self::mul_add(x421, x436, x422 * x435),
         );
-        let x443 = Self::mul_add(-s_q11, x425, c_q11 * x424);
-        let x444 = Self::mul_add(c_q11, x425, s_q11 * x424);
-        let x445 = x429
-            - Self::mul_add(-0.275, Self::mul_add(x424, x432, x431), 0.63 * x433);
-        let x446 = Self::mul_add(-c_q10, x427, s_q10 * x426)
-            - Self::mul_add(0.275, x430 - x436, 0.63 * x435);
-        let x447 = x428
-            + Self::mul_add(-0.275, Self::mul_add(x425, x425, x434), 0.63 * x437);
-        let x448 = Self::mul_add(-s_q11, x446, c_q11 * x445);
-        let x449 = Self::mul_add(v[10], x444, Self::mul_add(-s_q11, x431, c_q11 * x430));
-        let x450 = Self::mul_add(-v[10], x443, Self::mul_add(c_q11, x431, s_q11 * x430));
-        let x451 = v[10] + x432;
-        let x452 = x443 * x443;
-        let x453 = x444 * x451;
-        let x454 = 0.01675 * x451;
-        let x455 = Self::mul_add(-2.5482240016099564, x451, x444 * 9.142025249762803);
-        let x456 = Self::mul_add(
+        let x440 = Self::mul_add(-s_q11, x422, c_q11 * x421);
+        let x441 = Self::mul_add(c_q11, x422, s_q11 * x421);
+        let x442 = x426
+            - Self::mul_add(-0.275, Self::mul_add(x421, x429, x428), 0.63 * x430);
+        let x443 = Self::mul_add(-c_q10, x424, s_q10 * x423)
+            - Self::mul_add(0.275, x427 - x433, 0.63 * x432);
+        let x444 = x425
+            + Self::mul_add(-0.275, Self::mul_add(x422, x422, x431), 0.63 * x434);
+        let x445 = Self::mul_add(-s_q11, x443, c_q11 * x442);
+        let x446 = Self::mul_add(v[10], x441, Self::mul_add(-s_q11, x428, c_q11 * x427));
+        let x447 = Self::mul_add(-v[10], x440, Self::mul_add(c_q11, x428, s_q11 * x427));
+        let x448 = v[10] + x429;
+        let x449 = x440 * x440;
+        let x450 = x441 * x448;
+        let x451 = 0.01675 * x448;
+        let x452 = Self::mul_add(-2.5482240016099564, x448, x441 * 9.142025249762803);
+        let x453 = Self::mul_add(
             -9.223235249762805,
-            x451,
-            Self::mul_add(-2.5482240016099564, x444, 0.01675 * x443),
-        );
-        let x457 = Self::mul_add(
-            7.078399999258757,
-            x447,
-            Self::mul_add(0.01675, x412, -Self::mul_add(-x444, x456, x451 * x455)),
-        );
-        let x458 = Self::mul_add(
-            -7.078399999258757,
             x448,
+            Self::mul_add(-2.5482240016099564, x441, 0.01675 * x440),
+        );
+        let x454 = Self::mul_add(
+            7.078399999258757,
+            x444,
+            Self::mul_add(0.01675, x409, -Self::mul_add(-x441, x453, x448 * x452)),
+        );
+        let x455 = Self::mul_add(
+            -7.078399999258757,
+            x445,
             Self::mul_add(
                 -9.223235249762805,
-                x412,
-                Self::mul_add(-2.5482240016099564, x450, 0.01675 * x449),
-            ) - Self::mul_add(-x443, x455, x444 * x454),
+                x409,
+                Self::mul_add(-2.5482240016099564, x447, 0.01675 * x446),
+            ) - Self::mul_add(-x440, x452, x441 * x451),
         );
-        let x459 = Self::mul_add(s_q12, x451, Self::mul_add(x13, x444, c_q12 * x443));
-        let x460 = Self::mul_add(-c_q12, x451, Self::mul_add(-x14, x444, s_q12 * x443));
-        let x461 = Self::mul_add(0.36, Self::mul_add(x443, x451, x450), x448);
-        let x462 = Self::mul_add(
+        let x456 = Self::mul_add(s_q12, x448, Self::mul_add(x13, x441, c_q12 * x440));
+        let x457 = Self::mul_add(-c_q12, x448, Self::mul_add(-x14, x441, s_q12 * x440));
+        let x458 = Self::mul_add(0.36, Self::mul_add(x440, x448, x447), x445);
+        let x459 = Self::mul_add(
             -0.36,
-            x449 - x453,
-            Self::mul_add(c_q11, x446, s_q11 * x445),
+            x446 - x450,
+            Self::mul_add(c_q11, x443, s_q11 * x442),
         );
-        let x463 = Self::mul_add(-0.36, Self::mul_add(x444, x444, x452), x447);
-        let x464 = Self::mul_add(s_q12, x463, Self::mul_add(x13, x462, c_q12 * x461));
-        let x465 = Self::mul_add(-c_q12, x463, Self::mul_add(-x14, x462, s_q12 * x461));
-        let x466 = Self::mul_add(-0.00000000020510342851533115, x463, x462);
-        let x467 = Self::mul_add(-0.00000000020510342851533115, x412, x450);
-        let x468 = Self::mul_add(
+        let x460 = Self::mul_add(-0.36, Self::mul_add(x441, x441, x449), x444);
+        let x461 = Self::mul_add(s_q12, x460, Self::mul_add(x13, x459, c_q12 * x458));
+        let x462 = Self::mul_add(-c_q12, x460, Self::mul_add(-x14, x459, s_q12 * x458));
+        let x463 = Self::mul_add(-0.00000000020510342851533115, x460, x459);
+        let x464 = Self::mul_add(-0.00000000020510342851533115, x409, x447);
+        let x465 = Self::mul_add(
             v[11],
-            x460,
-            Self::mul_add(s_q12, x412, Self::mul_add(x13, x450, c_q12 * x449)),
+            x457,
+            Self::mul_add(s_q12, x409, Self::mul_add(x13, x447, c_q12 * x446)),
         );
-        let x469 = Self::mul_add(
+        let x466 = Self::mul_add(
             -v[11],
-            x459,
-            Self::mul_add(-c_q12, x412, Self::mul_add(-x14, x450, s_q12 * x449)),
+            x456,
+            Self::mul_add(-c_q12, x409, Self::mul_add(-x14, x447, s_q12 * x446)),
         );
-        let x470 = v[11] + Self::mul_add(-0.00000000020510342851533115, x451, x444);
-        let x471 = x460 * x460;
-        let x472 = x470 * x470;
-        let x473 = x459 * x460;
-        let x474 = x467 - x473;
-        let x475 = x459 * x470;
-        let x476 = x459 * x459;
-        let x477 = x472 + x476;
-        let x478 = x460 * x470;
-        let x479 = x468 + x478;
-        let x480 = Self::mul_add(x470, 0.809539999555672, x460 * 1.9877000000000002);
-        let x481 = Self::mul_add(
-            x470,
+        let x467 = v[11] + Self::mul_add(-0.00000000020510342851533115, x448, x441);
+        let x468 = x457 * x457;
+        let x469 = x467 * x467;
+        let x470 = x456 * x457;
+        let x471 = x464 - x470;
+        let x472 = x456 * x467;
+        let x473 = x456 * x456;
+        let x474 = x469 + x473;
+        let x475 = x457 * x467;
+        let x476 = x465 + x475;
+        let x477 = Self::mul_add(x467, 0.809539999555672, x457 * 1.9877000000000002);
+        let x478 = Self::mul_add(
+            x467,
             -2.741639999592316,
-            Self::mul_add(x460, -5.252920330000002, x459 * 1.9877000000000002),
+            Self::mul_add(x457, -5.252920330000002, x456 * 1.9877000000000002),
         );
-        let x482 = Self::mul_add(
-            9.740442170000001,
-            x470,
-            Self::mul_add(x460, -2.7416399995923166, x459 * 0.809539999555672),
-        );
-        let x483 = Self::mul_add(
-            -3.6140000000000003,
-            x466,
-            Self::mul_add(
-                x467,
-                -2.741639999592316,
-                Self::mul_add(x469, -5.252920330000002, x468 * 1.9877000000000002),
-            ) + Self::mul_add(-x459, x482, x470 * x480),
-        );
-        let x484 = Self::mul_add(-c_q13, x470, Self::mul_add(s_q13, x460, x15 * x459));
-        let x485 = Self::mul_add(-s_q13, x470, Self::mul_add(-c_q13, x460, x16 * x459));
-        let x486 = x464 + Self::mul_add(-0.16, x469 + x475, 0.55 * x474);
-        let x487 = x466 - Self::mul_add(-0.16, x471 + x476, 0.55 * x479);
-        let x488 = Self::mul_add(
-            -c_q13,
-            x487,
-            Self::mul_add(
-                s_q13,
-                x465 + Self::mul_add(0.16, x468 - x478, 0.55 * x477),
-                x15 * x486,
-            ),
-        );
-        let x489 = Self::mul_add(0.00000000020510342851533115, x467, x468);
-        let x490 = Self::mul_add(
-            v[12],
-            x485,
-            Self::mul_add(-c_q13, x467, Self::mul_add(s_q13, x469, x15 * x468)),
-        );
-        let x491 = Self::mul_add(
-            -v[12],
-            x484,
-            Self::mul_add(-s_q13, x467, Self::mul_add(-c_q13, x469, x16 * x468)),
-        );
-        let x492 = v[12] - Self::mul_add(0.00000000020510342851533115, x470, x459);
-        let x493 = 4.806620000000001 * Self::mul_add(x484, x485, x489);
-        let x494 = 4.806620000000001 * Self::mul_add(x484, x484, x492 * x492);
-        let x495 = 4.806620000000001 * Self::mul_add(x485, x492, x490);
-        let x496 = Self::mul_add(0.0145, x492, 0.000781 * x485);
-        let x497 = Self::mul_add(
-            -0.9614610000000001,
-            x492,
-            Self::mul_add(1.2025609200000003, x485, 0.000781 * x484),
-        );
-        let x498 = Self::mul_add(
-            -1.4135609200000003,
-            x492,
-            Self::mul_add(-0.9614610000000001, x485, 0.0145 * x484),
-        );
-        let x499 = Self::mul_add(
-            0.9614610000000001,
-            x489,
-            Self::mul_add(1.2025609200000003, x491, 0.000781 * x490),
-        ) + Self::mul_add(-x484, x498, x492 * x496);
-        let x500 = Self::mul_add(
-            4.806620000000001,
-            Self::mul_add(0.00000000020510342851533115, x487, x486),
-            Self::mul_add(-0.0145, x489, 0.000781 * x491)
-                - Self::mul_add(-x485, x498, x492 * x497),
-        );
-        let x501 = Self::mul_add(
-            4.806620000000001,
-            x488,
-            Self::mul_add(
-                1.4135609200000003,
-                x489,
-                Self::mul_add(-0.9614610000000001, x491, 0.0145 * x490),
-            ) - Self::mul_add(-x484, x497, x485 * x496),
-        );
-        let x502 = x495 - Self::mul_add(-x16, x494, x15 * x493);
-        let x503 = Self::mul_add(c_q13, x494, s_q13 * x493);
-        let x504 = Self::mul_add(
-            0.00000000020510342851533115,
-            x495,
-            Self::mul_add(-s_q13, x494, c_q13 * x493),
-        );
-        let x505 = Self::mul_add(
-            -0.55,
-            x502,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x501,
-                Self::mul_add(s_q13, x499, c_q13 * x500),
-            ),
-        );
-        let x506 = Self::mul_add(
-            -17.135250000000003,
-            x474,
-            3.6140000000000003 * (x471 + x472),
-        ) + x502;
-        let x507 = Self::mul_add(
-            17.135250000000003,
-            x477,
-            3.6140000000000003 * (x467 + x473),
-        ) + x503;
-        let x508 = Self::mul_add(
-            17.135250000000003,
-            x479,
-            3.6140000000000003 * (x469 - x475),
-        ) + x504;
-        let x509 = Self::mul_add(
-            -17.135250000000003,
-            x466,
-            Self::mul_add(x467, 0.809539999555672, x469 * 1.9877000000000002)
-                - Self::mul_add(-x460, x482, x470 * x481),
-        )
-            + (x501 - Self::mul_add(x16, x499, x15 * x500)
-                + Self::mul_add(0.55, x504, 0.16 * x503));
-        let x510 = x483
-            - Self::mul_add(-0.16, x502, Self::mul_add(-c_q13, x499, s_q13 * x500));
-        let x511 = Self::mul_add(
+        let x479 = Self::mul_add(
             9.740442170000001,
             x467,
-            Self::mul_add(x469, -2.7416399995923166, x468 * 0.809539999555672),
-        ) - Self::mul_add(-x459, x481, x460 * x480)
-            + Self::mul_add(3.6140000000000003, x465, 17.135250000000003 * x464) + x505;
-        let x512 = -x511;
-        let x513 = Self::mul_add(-s_q12, x507, c_q12 * x506);
-        let x514 = x508 + Self::mul_add(x14, x507, x13 * x506);
-        let x515 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(-x443, x444, x412),
-            -x513,
+            Self::mul_add(x457, -2.7416399995923166, x456 * 0.809539999555672),
         );
-        let x516 = Self::mul_add(
-            7.078399999258757,
-            Self::mul_add(x451, x451, x452),
-            -x514,
+        let x480 = Self::mul_add(
+            -3.6140000000000003,
+            x463,
+            Self::mul_add(
+                x464,
+                -2.741639999592316,
+                Self::mul_add(x466, -5.252920330000002, x465 * 1.9877000000000002),
+            ) + Self::mul_add(-x456, x479, x467 * x477),
         );
-        let x517 = Self::mul_add(
+        let x481 = Self::mul_add(-c_q13, x467, Self::mul_add(s_q13, x457, x15 * x456));
+        let x482 = Self::mul_add(-s_q13, x467, Self::mul_add(-c_q13, x457, x16 * x456));
+        let x483 = x461 + Self::mul_add(-0.16, x466 + x472, 0.55 * x471);
+        let x484 = x463 - Self::mul_add(-0.16, x468 + x473, 0.55 * x476);
+        let x485 = Self::mul_add(
+            -c_q13,
+            x484,
+            Self::mul_add(
+                s_q13,
+                x462 + Self::mul_add(0.16, x465 - x475, 0.55 * x474),
+                x15 * x483,
+            ),
+        );
+        let x486 = Self::mul_add(0.00000000020510342851533115, x464, x465);
+        let x487 = Self::mul_add(
+            v[12],
+            x482,
+            Self::mul_add(-c_q13, x464, Self::mul_add(s_q13, x466, x15 * x465)),
+        );
+        let x488 = Self::mul_add(
+            -v[12],
+            x481,
+            Self::mul_add(-s_q13, x464, Self::mul_add(-c_q13, x466, x16 * x465)),
+        );
+        let x489 = v[12] - Self::mul_add(0.00000000020510342851533115, x467, x456);
+        let x490 = 4.806620000000001 * Self::mul_add(x481, x482, x486);
+        let x491 = 4.806620000000001 * Self::mul_add(x481, x481, x489 * x489);
+        let x492 = 4.806620000000001 * Self::mul_add(x482, x489, x487);
+        let x493 = Self::mul_add(0.0145, x489, 0.000781 * x482);
+        let x494 = Self::mul_add(
+            -0.9614610000000001,
+            x489,
+            Self::mul_add(1.2025609200000003, x482, 0.000781 * x481),
+        );
+        let x495 = Self::mul_add(
+            -1.4135609200000003,
+            x489,
+            Self::mul_add(-0.9614610000000001, x482, 0.0145 * x481),
+        );
+        let x496 = Self::mul_add(
+            0.9614610000000001,
+            x486,
+            Self::mul_add(1.2025609200000003, x488, 0.000781 * x487),
+        ) + Self::mul_add(-x481, x495, x489 * x493);
+        let x497 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(0.00000000020510342851533115, x484, x483),
+            Self::mul_add(-0.0145, x486, 0.000781 * x488)
+                - Self::mul_add(-x482, x495, x489 * x494),
+        );
+        let x498 = Self::mul_add(
+            4.806620000000001,
+            x485,
+            Self::mul_add(
+                1.4135609200000003,
+                x486,
+                Self::mul_add(-0.9614610000000001, x488, 0.0145 * x487),
+            ) - Self::mul_add(-x481, x494, x482 * x493),
+        );
+        let x499 = x492 - Self::mul_add(-x16, x491, x15 * x490);
+        let x500 = Self::mul_add(c_q13, x491, s_q13 * x490);
+        let x501 = Self::mul_add(
+            0.00000000020510342851533115,
+            x492,
+            Self::mul_add(-s_q13, x491, c_q13 * x490),
+        );
+        let x502 = Self::mul_add(
+            -0.55,
+            x499,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x498,
+                Self::mul_add(s_q13, x496, c_q13 * x497),
+            ),
+        );
+        let x503 = Self::mul_add(
+            -17.135250000000003,
+            x471,
+            3.6140000000000003 * (x468 + x469),
+        ) + x499;
+        let x504 = Self::mul_add(
+            17.135250000000003,
+            x474,
+            3.6140000000000003 * (x464 + x470),
+        ) + x500;
+        let x505 = Self::mul_add(
+            17.135250000000003,
+            x476,
+            3.6140000000000003 * (x466 - x472),
+        ) + x501;
+        let x506 = Self::mul_add(
+            -17.135250000000003,
+            x463,
+            Self::mul_add(x464, 0.809539999555672, x466 * 1.9877000000000002)
+                - Self::mul_add(-x457, x479, x467 * x478),
+        )
+            + (x498 - Self::mul_add(x16, x496, x15 * x497)
+                + Self::mul_add(0.55, x501, 0.16 * x500));
+        let x507 = x480
+            - Self::mul_add(-0.16, x499, Self::mul_add(-c_q13, x496, s_q13 * x497));
+        let x508 = Self::mul_add(
+            9.740442170000001,
+            x464,
+            Self::mul_add(x466, -2.7416399995923166, x465 * 0.809539999555672),
+        ) - Self::mul_add(-x456, x478, x457 * x477)
+            + Self::mul_add(3.6140000000000003, x462, 17.135250000000003 * x461) + x502;
+        let x509 = -x508;
+        let x510 = Self::mul_add(-s_q12, x504, c_q12 * x503);
+        let x511 = x505 + Self::mul_add(x14, x504, x13 * x503);
+        let x512 = Self::mul_add(
             7.078399999258757,
-            x449 + x453,
+            Self::mul_add(-x440, x441, x409),
+            -x510,
+        );
+        let x513 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x448, x448, x449),
+            -x511,
+        );
+        let x514 = Self::mul_add(
+            7.078399999258757,
+            x446 + x450,
             Self::mul_add(
                 -0.00000000020510342851533115,
-                x508,
-                Self::mul_add(c_q12, x507, s_q12 * x506),
+                x505,
+                Self::mul_add(c_q12, x504, s_q12 * x503),
             ),
         );
-        let x518 = x457
-            - Self::mul_add(0.36, x514, Self::mul_add(s_q12, x510, c_q12 * x509));
-        let x519 = Self::mul_add(-2.5482240016099564, x412, x450 * 9.142025249762803)
-            + Self::mul_add(-x443, x456, x451 * x454)
-            - Self::mul_add(-0.36, x513, x511 + Self::mul_add(-x14, x510, x13 * x509));
-        let x520 = x458
+        let x515 = x454
+            - Self::mul_add(0.36, x511, Self::mul_add(s_q12, x507, c_q12 * x506));
+        let x516 = Self::mul_add(-2.5482240016099564, x409, x447 * 9.142025249762803)
+            + Self::mul_add(-x440, x453, x448 * x451)
+            - Self::mul_add(-0.36, x510, x508 + Self::mul_add(-x14, x507, x13 * x506));
+        let x517 = x455
             - Self::mul_add(
                 -0.00000000020510342851533115,
-                x511,
-                Self::mul_add(-c_q12, x510, s_q12 * x509),
+                x508,
+                Self::mul_add(-c_q12, x507, s_q12 * x506),
             );
-        let x521 = Self::mul_add(s_q11, x516, c_q11 * x515);
-        let x522 = Self::mul_add(-c_q11, x516, s_q11 * x515);
-        let x523 = Self::mul_add(x433, 45.1584, -x521);
-        let x524 = Self::mul_add(45.1584, x435, x522);
-        let x525 = Self::mul_add(45.1584, x437, -x517);
-        let x526 = x441
-            - (Self::mul_add(s_q11, x519, c_q11 * x518)
-                - Self::mul_add(-0.63, x517, 0.275 * x522));
-        let x527 = Self::mul_add(x412, 24.35164200091464, x431 * 24.4950615)
-            - Self::mul_add(-x424, x440, x432 * x438)
-            - Self::mul_add(0.275, x521, Self::mul_add(-c_q11, x519, s_q11 * x518));
-        let x528 = x442 - Self::mul_add(0.63, x521, x520);
-        let x529 = -x528;
-        let x530 = Self::mul_add(s_q10, x524, c_q10 * x523);
-        let x531 = Self::mul_add(x416, 81.53205, x530);
-        let x532 = Self::mul_add(
+        let x518 = Self::mul_add(s_q11, x513, c_q11 * x512);
+        let x519 = Self::mul_add(-c_q11, x513, s_q11 * x512);
+        let x520 = Self::mul_add(x430, 45.1584, -x518);
+        let x521 = Self::mul_add(45.1584, x432, x519);
+        let x522 = Self::mul_add(45.1584, x434, -x514);
+        let x523 = x438
+            - (Self::mul_add(s_q11, x516, c_q11 * x515)
+                - Self::mul_add(-0.63, x514, 0.275 * x519));
+        let x524 = Self::mul_add(x409, 24.35164200091464, x428 * 24.4950615)
+            - Self::mul_add(-x421, x437, x429 * x435)
+            - Self::mul_add(0.275, x518, Self::mul_add(-c_q11, x516, s_q11 * x515));
+        let x525 = x439 - Self::mul_add(0.63, x518, x517);
+        let x526 = -x525;
+        let x527 = Self::mul_add(s_q10, x521, c_q10 * x520);
+        let x528 = Self::mul_add(x413, 81.53205, x527);
+        let x529 = Self::mul_add(
             81.53205,
-            x417,
-            -Self::mul_add(-c_q10, x524, s_q10 * x523),
+            x414,
+            -Self::mul_add(-c_q10, x521, s_q10 * x520),
         );
-        let x533 = Self::mul_add(81.53205, x418, x525);
-        let x534 = x422
-            + Self::mul_add(0.87, x525, Self::mul_add(-s_q10, x527, c_q10 * x526));
-        let x535 = Self::mul_add(x412, -36.18604050126307, x414 * 63.36336825000001)
-            + Self::mul_add(-x405, x421, x415 * x419)
-            - Self::mul_add(c_q10, x527, s_q10 * x526);
-        let x536 = x423 + Self::mul_add(0.87, x530, x528);
-        let x537 = -x536;
-        let x538 = 0.00000000020510342851533115 * x533;
-        let x539 = Self::mul_add(-c_q9, x532, s_q9 * x531) + x538;
-        let x540 = x533 + Self::mul_add(x12, x532, x11 * x531);
-        let x541 = x538 - Self::mul_add(s_q9, x532, c_q9 * x531);
-        let x542 = 0.00000000020510342851533115 * x536;
-        let x543 = Self::mul_add(
-            x395,
+        let x530 = Self::mul_add(81.53205, x415, x522);
+        let x531 = x419
+            + Self::mul_add(0.87, x522, Self::mul_add(-s_q10, x524, c_q10 * x523));
+        let x532 = Self::mul_add(x409, -36.18604050126307, x411 * 63.36336825000001)
+            + Self::mul_add(-x402, x418, x412 * x416)
+            - Self::mul_add(c_q10, x524, s_q10 * x523);
+        let x533 = x420 + Self::mul_add(0.87, x527, x525);
+        let x534 = -x533;
+        let x535 = 0.00000000020510342851533115 * x530;
+        let x536 = Self::mul_add(-c_q9, x529, s_q9 * x528) + x535;
+        let x537 = x530 + Self::mul_add(x12, x529, x11 * x528);
+        let x538 = x535 - Self::mul_add(s_q9, x529, c_q9 * x528);
+        let x539 = 0.00000000020510342851533115 * x533;
+        let x540 = Self::mul_add(
+            x392,
             -12.701650001451807,
-            (x392 + x393) * 0.000000008530897668050218,
-        ) - x539;
-        let x544 = Self::mul_add(
+            (x389 + x390) * 0.000000008530897668050218,
+        ) - x536;
+        let x541 = Self::mul_add(
             12.701650001451807,
-            x398,
-            0.000000008530897668050218 * (x373 + x394),
-        ) - x540;
-        let x545 = Self::mul_add(
+            x395,
+            0.000000008530897668050218 * (x370 + x391),
+        ) - x537;
+        let x542 = Self::mul_add(
             12.701650001451807,
-            x400,
-            0.000000008530897668050218 * (x390 - x396),
-        ) - x541;
-        let x546 = Self::mul_add(
-            x388,
+            x397,
+            0.000000008530897668050218 * (x387 - x393),
+        ) - x538;
+        let x543 = Self::mul_add(
+            x385,
             12.701650001451807,
-            Self::mul_add(x373, 0.002139996587640933, x390 * 0.0000000234896432582596)
-                - Self::mul_add(-x382, x403, x391 * x402),
+            Self::mul_add(x370, 0.002139996587640933, x387 * 0.0000000234896432582596)
+                - Self::mul_add(-x379, x400, x388 * x399),
         )
-            + (Self::mul_add(-c_q9, x535, s_q9 * x534) - x542
-                + Self::mul_add(0.275, x541, 0.4 * x540));
-        let x547 = x404
-            + Self::mul_add(0.4, x539, x536 - Self::mul_add(x12, x535, x11 * x534));
-        let x548 = Self::mul_add(
+            + (Self::mul_add(-c_q9, x532, s_q9 * x531) - x539
+                + Self::mul_add(0.275, x538, 0.4 * x537));
+        let x544 = x401
+            + Self::mul_add(0.4, x536, x533 - Self::mul_add(x12, x532, x11 * x531));
+        let x545 = Self::mul_add(
             113.3918902508081,
-            x373,
-            Self::mul_add(5.080660024070366, x390, x389 * 0.002139996587640933),
-        ) - Self::mul_add(-x381, x402, x382 * x401)
-            - Self::mul_add(x387, 0.000000008530897668050218, x386 * 12.701650001451807)
-            - Self::mul_add(0.275, x539, x542 + Self::mul_add(s_q9, x535, c_q9 * x534));
-        let x549 = -x548;
-        let x550 = x545 + Self::mul_add(-x8, x544, x7 * x543);
-        let x551 = Self::mul_add(c_q8, x544, s_q8 * x543);
-        let x552 = Self::mul_add(
+            x370,
+            Self::mul_add(5.080660024070366, x387, x386 * 0.002139996587640933),
+        ) - Self::mul_add(-x378, x399, x379 * x398)
+            - Self::mul_add(x384, 0.000000008530897668050218, x383 * 12.701650001451807)
+            - Self::mul_add(0.275, x536, x539 + Self::mul_add(s_q9, x532, c_q9 * x531));
+        let x546 = -x545;
+        let x547 = x542 + Self::mul_add(-x8, x541, x7 * x540);
+        let x548 = Self::mul_add(c_q8, x541, s_q8 * x540);
+        let x549 = Self::mul_add(
             48.0240000085309,
-            Self::mul_add(x375, x375, x376),
-            x550,
+            Self::mul_add(x372, x372, x373),
+            x547,
         );
-        let x553 = Self::mul_add(48.0240000085309, x361 * x362, -x551);
-        let x554 = Self::mul_add(
+        let x550 = Self::mul_add(48.0240000085309, x358 * x359, -x548);
+        let x551 = Self::mul_add(
             48.0240000085309,
-            x374 + x377,
+            x371 + x374,
             -Self::mul_add(
                 -0.00000000020510342851533115,
-                x545,
-                Self::mul_add(-s_q8, x544, c_q8 * x543),
+                x542,
+                Self::mul_add(-s_q8, x541, c_q8 * x540),
             ),
         );
-        let x555 = Self::mul_add(x374, 0.07309, Self::mul_add(x362, x380, x375 * x379))
-            - Self::mul_add(0.35, x551, x548 + Self::mul_add(x8, x547, x7 * x546));
-        let x556 = Self::mul_add(
+        let x552 = Self::mul_add(x371, 0.07309, Self::mul_add(x359, x377, x372 * x376))
+            - Self::mul_add(0.35, x548, x545 + Self::mul_add(x8, x544, x7 * x543));
+        let x553 = Self::mul_add(
             48.0240000085309,
-            x371,
-            Self::mul_add(-130.43769025763282, x374, x373 * 0.07309)
-                + Self::mul_add(x361, x380, x375 * x378),
-        ) + Self::mul_add(-0.35, x550, Self::mul_add(-c_q8, x547, s_q8 * x546));
-        let x557 = Self::mul_add(
+            x368,
+            Self::mul_add(-130.43769025763282, x371, x370 * 0.07309)
+                + Self::mul_add(x358, x377, x372 * x375),
+        ) + Self::mul_add(-0.35, x547, Self::mul_add(-c_q8, x544, s_q8 * x543));
+        let x554 = Self::mul_add(
             48.0240000085309,
-            x372,
-            Self::mul_add(-0.1132, x374, x373 * 16.80768997608804)
-                + Self::mul_add(-x361, x379, x362 * x378),
+            x369,
+            Self::mul_add(-0.1132, x371, x370 * 16.80768997608804)
+                + Self::mul_add(-x358, x376, x359 * x375),
         )
             - Self::mul_add(
                 -0.00000000020510342851533115,
-                x548,
-                Self::mul_add(s_q8, x547, c_q8 * x546),
+                x545,
+                Self::mul_add(s_q8, x544, c_q8 * x543),
             );
-        let x558 = Self::mul_add(-s_q7, x553, c_q7 * x552);
-        let x559 = Self::mul_add(c_q7, x553, s_q7 * x552);
-        let x560 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
-        let x561 = 1466.4506062283303 * v[4];
-        let x562 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
-        let x563 = -(x558
+        let x555 = Self::mul_add(-s_q7, x550, c_q7 * x549);
+        let x556 = Self::mul_add(c_q7, x550, s_q7 * x549);
+        let x557 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x558 = 1466.4506062283303 * v[4];
+        let x559 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x560 = -(x555
             + Self::mul_add(
                 1170.07,
-                x358,
-                Self::mul_add(-180.9502499901501, x366, 110.5455 * x364),
+                x355,
+                Self::mul_add(-180.9502499901501, x363, 110.5455 * x361),
             ));
-        let x564 = -(x559
+        let x561 = -(x556
             - Self::mul_add(
                 1170.07,
-                x359,
-                Self::mul_add(180.9502499901501, x367, 110.5455 * x365),
+                x356,
+                Self::mul_add(180.9502499901501, x364, 110.5455 * x362),
             ));
-        let x565 = x554
+        let x562 = x551
             - Self::mul_add(
                 1170.07,
-                x360,
-                -Self::mul_add(-180.9502499901501, x368, 110.5455 * x366),
+                x357,
+                -Self::mul_add(-180.9502499901501, x365, 110.5455 * x363),
             );
-        let x566 = Self::mul_add(0.75, x559, Self::mul_add(-s_q7, x556, c_q7 * x555))
+        let x563 = Self::mul_add(0.75, x556, Self::mul_add(-s_q7, x553, c_q7 * x552))
             - Self::mul_add(
                 180.9502499901501,
-                x359,
-                Self::mul_add(v[4], x562, v[5] * x561),
+                x356,
+                Self::mul_add(v[4], x559, v[5] * x558),
             );
-        let x567 = Self::mul_add(c_q7, x556, s_q7 * x555)
-            - Self::mul_add(0.65, x554, 0.75 * x558)
-            + (Self::mul_add(v[3], x562, v[5] * x560)
-                - Self::mul_add(-110.5455, x360, 180.9502499901501 * x358));
-        let x568 = Self::mul_add(-0.65, x559, x557)
-            - Self::mul_add(-110.5455, x359, Self::mul_add(-v[3], x561, v[4] * x560));
+        let x564 = Self::mul_add(c_q7, x553, s_q7 * x552)
+            - Self::mul_add(0.65, x551, 0.75 * x555)
+            + (Self::mul_add(v[3], x559, v[5] * x557)
+                - Self::mul_add(-110.5455, x357, 180.9502499901501 * x355));
+        let x565 = Self::mul_add(-0.65, x556, x554)
+            - Self::mul_add(-110.5455, x356, Self::mul_add(-v[3], x558, v[4] * x557));
         (
             [
                 [
@@ -5832,217 +6002,217 @@ impl FreeFloating7 {
                     0.0,
                     0.0,
                     0.0,
-                    x193,
-                    x184,
-                    x184,
+                    x192,
+                    x183,
+                    x183,
+                    x202,
+                    x220,
+                    x243,
+                    x270,
+                    x306,
+                    x350,
+                ],
+                [
+                    0.0,
+                    1170.07,
+                    0.0,
+                    x197,
+                    0.0,
+                    x191,
+                    x181,
                     x203,
+                    x222,
+                    x245,
+                    x272,
+                    x307,
+                    x351,
+                ],
+                [
+                    0.0,
+                    0.0,
+                    1170.07,
+                    x182,
+                    x198,
+                    0.0,
+                    0.0,
+                    x160,
+                    x214,
+                    x237,
+                    x264,
+                    x301,
+                    x345,
+                ],
+                [
+                    0.0,
+                    x197,
+                    x182,
+                    x193,
+                    x188,
+                    x194,
+                    x187,
+                    x204,
                     x223,
                     x246,
                     x273,
+                    x308,
+                    x352,
+                ],
+                [
+                    x192,
+                    0.0,
+                    x198,
+                    x188,
+                    x195,
+                    x189,
+                    x189,
+                    x205,
+                    x224,
+                    x247,
+                    x274,
                     x309,
                     x353,
                 ],
                 [
-                    0.0,
-                    1170.07,
-                    0.0,
-                    x198,
-                    0.0,
-                    x192,
-                    x182,
-                    x204,
-                    x225,
-                    x248,
-                    x275,
-                    x310,
-                    x354,
-                ],
-                [
-                    0.0,
-                    0.0,
-                    1170.07,
                     x183,
-                    x199,
+                    x191,
                     0.0,
-                    0.0,
-                    x155,
-                    x217,
-                    x240,
-                    x267,
-                    x304,
-                    x348,
-                ],
-                [
-                    0.0,
-                    x198,
-                    x183,
                     x194,
-                    x189,
-                    x195,
-                    x188,
-                    x205,
-                    x226,
-                    x249,
-                    x276,
-                    x311,
-                    x355,
-                ],
-                [
-                    x193,
-                    0.0,
-                    x199,
                     x189,
                     x196,
                     x190,
-                    x190,
                     x206,
-                    x227,
-                    x250,
-                    x277,
-                    x312,
-                    x356,
+                    x225,
+                    x248,
+                    x275,
+                    x310,
+                    x354,
                 ],
                 [
-                    x184,
-                    x192,
+                    x183,
+                    x181,
                     0.0,
-                    x195,
+                    x187,
+                    x189,
                     x190,
-                    x197,
-                    x191,
-                    x207,
-                    x228,
-                    x251,
-                    x278,
-                    x313,
-                    x357,
+                    x175,
+                    x167,
+                    x216,
+                    x239,
+                    x266,
+                    x303,
+                    x347,
                 ],
                 [
-                    x184,
-                    x182,
-                    0.0,
-                    x188,
-                    x190,
-                    x191,
-                    x176,
-                    x165,
-                    x219,
-                    x242,
-                    x269,
-                    x306,
-                    x350,
-                ],
-                [
+                    x202,
                     x203,
+                    x160,
                     x204,
-                    x155,
                     x205,
                     x206,
-                    x207,
-                    x165,
-                    x153,
-                    x213,
-                    x236,
-                    x264,
-                    x301,
-                    x344,
+                    x167,
+                    x149,
+                    x211,
+                    x233,
+                    x261,
+                    x298,
+                    x341,
                 ],
                 [
+                    x220,
+                    x222,
+                    x214,
                     x223,
+                    x224,
                     x225,
-                    x217,
-                    x226,
-                    x227,
-                    x228,
-                    x219,
-                    x213,
-                    x110,
-                    x104,
-                    x256,
-                    x293,
-                    x336,
+                    x216,
+                    x211,
+                    x107,
+                    x101,
+                    x253,
+                    x290,
+                    x333,
                 ],
                 [
+                    x243,
+                    x245,
+                    x237,
                     x246,
+                    x247,
                     x248,
-                    x240,
-                    x249,
-                    x250,
-                    x251,
-                    x242,
-                    x236,
-                    x104,
-                    x90,
-                    x84,
-                    x287,
-                    x330,
+                    x239,
+                    x233,
+                    x101,
+                    x87,
+                    x81,
+                    x284,
+                    x327,
                 ],
                 [
-                    x273,
-                    x275,
-                    x267,
-                    x276,
-                    x277,
-                    x278,
-                    x269,
+                    x270,
+                    x272,
                     x264,
-                    x256,
-                    x84,
-                    x70,
-                    x59,
-                    x322,
+                    x273,
+                    x274,
+                    x275,
+                    x266,
+                    x261,
+                    x253,
+                    x81,
+                    x67,
+                    x60,
+                    x319,
                 ],
                 [
+                    x306,
+                    x307,
+                    x301,
+                    x308,
                     x309,
                     x310,
-                    x304,
-                    x311,
-                    x312,
-                    x313,
-                    x306,
-                    x301,
-                    x293,
-                    x287,
-                    x59,
-                    x47,
-                    x317,
+                    x303,
+                    x298,
+                    x290,
+                    x284,
+                    x60,
+                    x41,
+                    x314,
                 ],
                 [
+                    x350,
+                    x351,
+                    x345,
+                    x352,
                     x353,
                     x354,
-                    x348,
-                    x355,
-                    x356,
-                    x357,
-                    x350,
-                    x344,
-                    x336,
-                    x330,
-                    x322,
-                    x317,
+                    x347,
+                    x341,
+                    x333,
+                    x327,
+                    x319,
+                    x314,
                     1.4135609200000003,
                 ],
             ],
             [
+                x560,
+                x561,
+                x562,
                 x563,
                 x564,
                 x565,
-                x566,
-                x567,
-                x568,
-                x557,
-                x549,
-                x537,
-                x529,
-                x520,
-                x512,
-                x501,
+                x554,
+                x546,
+                x534,
+                x526,
+                x517,
+                x509,
+                x498,
             ],
         )
     }
     /// Forward dynamics `v̇ = [v̇_b, ω̇_b, q̈]` with an external wrench on every body: `f_ext[i]` = force (3) then moment (3), in the body's frame at its origin; `f_ext[0]` is the base's.
     ///
-    /// Methods: forward `aba`: 1592 mul, 1325 add, 12 div, 0 sqrt, 7 sincos (emitted), of which 954 fused where the target has FMA.
+    /// Methods: mass matrix `crba`, bias `newton-euler`, forward `ldlt`: 1510 mul, 1377 add, 10 div, 0 sqrt, 7 sincos (emitted), of which 1006 fused where the target has FMA.
     #[must_use]
     pub fn forward_dynamics_with_wrenches(
         q: &[f64; 14],
@@ -6060,1640 +6230,1858 @@ impl FreeFloating7 {
             q[12],
             q[13],
         ]);
-        let x7 = Self::mul_add(
-            -180.9502499901501,
-            v[1],
-            Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]),
-        );
-        let x8 = Self::mul_add(
-            1466.4506062283303,
-            v[4],
-            Self::mul_add(-110.5455, v[2], 180.9502499901501 * v[0]),
-        );
-        let x9 = Self::mul_add(
-            -110.5455,
-            v[1],
-            Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758),
-        );
-        let x10 = Self::mul_add(180.9502499901501, v[4], 1170.07 * v[0]);
-        let x11 = Self::mul_add(
-            1170.07,
-            v[1],
-            -Self::mul_add(-110.5455, v[5], 180.9502499901501 * v[3]),
-        );
-        let x12 = Self::mul_add(-110.5455, v[4], 1170.07 * v[2]);
-        let x13 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
-        let x14 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
-        let x15 = Self::mul_add(0.75, v[4], v[0]);
-        let x16 = v[1] - Self::mul_add(-0.65, v[5], 0.75 * v[3]);
-        let x17 = Self::mul_add(-0.65, v[4], v[2]);
-        let x18 = Self::mul_add(s_q7, x16, c_q7 * x15);
-        let x19 = Self::mul_add(-c_q7, x16, s_q7 * x15);
-        let x20 = v[6] * x14;
-        let x21 = v[6] * x13;
-        let x22 = v[6] * x19;
-        let x23 = v[6] * x18;
-        let x24 = v[5] + v[6];
-        let x25 = Self::mul_add(x24, -16.80768997608804, x14 * 0.07309);
-        let x26 = Self::mul_add(
-            48.0240000085309,
-            x17,
+        let x7 = 0.00000000020510342851533115 * c_q8;
+        let x8 = 0.00000000020510342851533115 * s_q8;
+        let x9 = 0.00000000020510342851533115 * c_q9;
+        let x10 = 0.00000000020510342851533115 * s_q9;
+        let x11 = x9 - x10;
+        let x12 = x9 + x10;
+        let x13 = 0.00000000020510342851533115 * s_q12;
+        let x14 = 0.00000000020510342851533115 * c_q12;
+        let x15 = 0.00000000020510342851533115 * c_q13;
+        let x16 = 0.00000000020510342851533115 * s_q13;
+        let x17 = s_q13 * s_q13;
+        let x18 = s_q13 * c_q13;
+        let x19 = Self::mul_add(x18, 0.001562, x17 * 1.2025609200000003);
+        let x20 = 0.000781 + Self::mul_add(x17, -0.001562, x18 * 1.2025609200000003);
+        let x21 = Self::mul_add(s_q13, -0.9614610000000001, c_q13 * 0.0145);
+        let x22 = Self::mul_add(c_q13, 0.9614610000000001, s_q13 * 0.0145);
+        let x23 = 4.806620000000001 * s_q13;
+        let x24 = 4.806620000000001 * c_q13;
+        let x25 = 0.00000000020510342851533115 * x23;
+        let x26 = Self::mul_add(-0.00000000020510342851533115, x19, x21);
+        let x27 = 0.00000000020510342851533115 * x21;
+        let x28 = 1.4135609200000003 + x27;
+        let x29 = x21 + -0.0000000002899261911072858;
+        let x30 = 0.16 * x23;
+        let x31 = 0.55 * x24;
+        let x32 = x30 + x31;
+        let x33 = x32 + (Self::mul_add(0.00000000020510342851533115, x26, x28) + x32);
+        let x34 = Self::mul_add(
+            0.55,
+            x23,
             Self::mul_add(
-                -0.1132,
+                0.16,
                 x24,
-                Self::mul_add(130.43769025763282, x14, x13 * 0.07309),
+                Self::mul_add(-0.00000000020510342851533115, x22, x20),
             ),
         );
-        let x27 = Self::mul_add(
-            48.0240000085309,
-            x19,
-            Self::mul_add(
-                -132.47349025763282,
-                x24,
-                Self::mul_add(0.1132, x14, x13 * 16.80768997608804),
+        let x35 = 3.6140000000000003 + x25;
+        let x36 = 17.135250000000003 + x24;
+        let x37 = -1.9877000000000002
+            - Self::mul_add(
+                0.55,
+                x25,
+                Self::mul_add(0.00000000020510342851533115, x20, x22),
+            );
+        let x38 = -0.809539999555672
+            + Self::mul_add(
+                -0.16,
+                x25,
+                Self::mul_add(-0.00000000020510342851533115, x28, x26),
+            );
+        let x39 = -5.252920330000002 + (x30 + (-1.2025609200000003 + x19 + x30));
+        let x40 = -2.741639999592316 - x34;
+        let x41 = 9.740442170000001
+            + (x31
+                - (Self::mul_add(0.00000000020510342851533115, x29, x19 + x27) - x31));
+        let x42 = s_q12 * s_q12;
+        let x43 = s_q12 * c_q12;
+        let x44 = x33 - x39;
+        let x45 = x37 + x37;
+        let x46 = Self::mul_add(x43, x45, x42 * x44);
+        let x47 = x39 + x46;
+        let x48 = x37 + Self::mul_add(-x42, x45, x43 * x44);
+        let x49 = Self::mul_add(-s_q12, x40, c_q12 * x38);
+        let x50 = Self::mul_add(c_q12, x40, s_q12 * x38);
+        let x51 = Self::mul_add(-s_q12, x36, c_q12 * x35);
+        let x52 = Self::mul_add(c_q12, x36, s_q12 * x35);
+        let x53 = Self::mul_add(-0.00000000020510342851533115, x52, x23);
+        let x54 = x25 + x52;
+        let x55 = Self::mul_add(-0.00000000020510342851533115, x48, x49);
+        let x56 = Self::mul_add(-0.00000000020510342851533115, x47, x50);
+        let x57 = 0.00000000020510342851533115 * x50;
+        let x58 = x41 - x57;
+        let x59 = Self::mul_add(0.00000000020510342851533115, x41, x50);
+        let x60 = x54 * 0.36;
+        let x61 = x60 + (x33 - x46 + x60);
+        let x62 = 7.078399999258757 + x53;
+        let x63 = 0.01675
+            - Self::mul_add(
+                x51,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x49, x48),
+            );
+        let x64 = -9.142025249762803
+            + (x60 + (Self::mul_add(-0.00000000020510342851533115, x56, x58) + x60));
+        let x65 = 2.5482240016099564
+            - Self::mul_add(
+                x53,
+                -0.36,
+                Self::mul_add(0.00000000020510342851533115, x58, x56),
+            );
+        let x66 = 9.223235249762805
+            + Self::mul_add(0.00000000020510342851533115, x59, x47 + x57);
+        let x67 = s_q11 * s_q11;
+        let x68 = s_q11 * c_q11;
+        let x69 = x61 - x64;
+        let x70 = x55 + x55;
+        let x71 = Self::mul_add(x68, x70, x67 * x69);
+        let x72 = Self::mul_add(-s_q11, x62, c_q11 * x51);
+        let x73 = Self::mul_add(c_q11, x62, s_q11 * x51);
+        let x74 = 0.275 * x54;
+        let x75 = x73 * 0.63;
+        let x76 = x74 - x75;
+        let x77 = Self::mul_add(x72, 0.63, x55 + Self::mul_add(-x67, x70, x68 * x69));
+        let x78 = Self::mul_add(0.275, x72, Self::mul_add(-s_q11, x65, c_q11 * x63));
+        let x79 = Self::mul_add(0.275, x73, Self::mul_add(c_q11, x65, s_q11 * x63));
+        let x80 = x66 - x75;
+        let x81 = x76 + (x61 - x71 + x76);
+        let x82 = -45.1584 + x73;
+        let x83 = -0.6328 + x78;
+        let x84 = -24.4950615 + (x74 + (x64 + x71 + x74));
+        let x85 = -24.35164200091464 - Self::mul_add(x54, 0.63, -x79);
+        let x86 = 28.2393615 - (x75 - x80);
+        let x87 = s_q10 * s_q10;
+        let x88 = s_q10 * c_q10;
+        let x89 = x81 - x84;
+        let x90 = x77 + x77;
+        let x91 = Self::mul_add(x88, x90, x87 * x89);
+        let x92 = Self::mul_add(-s_q10, x85, c_q10 * x83);
+        let x93 = Self::mul_add(c_q10, x85, s_q10 * x83);
+        let x94 = c_q10 * x72;
+        let x95 = Self::mul_add(-s_q10, x82, x94);
+        let x96 = s_q10 * x72;
+        let x97 = Self::mul_add(c_q10, x82, x96);
+        let x98 = x97 * 0.87;
+        let x99 = Self::mul_add(x95, 0.87, x77 + Self::mul_add(-x87, x90, x88 * x89));
+        let x100 = x86 - x98;
+        let x101 = x98 - (x81 - x91 - x98);
+        let x102 = -81.53205 + x97;
+        let x103 = -0.00214 + x92;
+        let x104 = -63.36336825000001 + (x84 + x91);
+        let x105 = -36.18604050126307 + Self::mul_add(x54, -0.87, x93);
+        let x106 = 69.99836825 - (x98 - x100);
+        let x107 = s_q9 * s_q9;
+        let x108 = s_q9 * c_q9;
+        let x109 = x101 + x104;
+        let x110 = x99 + x99;
+        let x111 = Self::mul_add(-x108, x110, x107 * x109);
+        let x112 = x101 - x111;
+        let x113 = x104 - x111;
+        let x114 = x99 - Self::mul_add(x107, x110, x108 * x109);
+        let x115 = Self::mul_add(-s_q9, x105, c_q9 * x103);
+        let x116 = Self::mul_add(c_q9, x105, s_q9 * x103);
+        let x117 = c_q9 * x95;
+        let x118 = Self::mul_add(-s_q9, x102, x117);
+        let x119 = s_q9 * x95;
+        let x120 = Self::mul_add(c_q9, x102, x119);
+        let x121 = 0.00000000020510342851533115 * x54;
+        let x122 = x120 - x121;
+        let x123 = 0.00000000020510342851533115 * x120;
+        let x124 = x54 - Self::mul_add(0.00000000020510342851533115, x118, -x123);
+        let x125 = x118 + x121;
+        let x126 = 0.00000000020510342851533115 * x115;
+        let x127 = x114 + x126;
+        let x128 = 0.00000000020510342851533115 * x116;
+        let x129 = x113 + x128;
+        let x130 = 0.00000000020510342851533115 * x106;
+        let x131 = x116 + x130;
+        let x132 = 0.00000000020510342851533115 * x114;
+        let x133 = x115 - Self::mul_add(0.00000000020510342851533115, x112, x132);
+        let x134 = x106 + (x126 - x128);
+        let x135 = x115 - x130;
+        let x136 = 0.00000000020510342851533115 * x131;
+        let x137 = 0.4 * x125;
+        let x138 = 0.275 * x124;
+        let x139 = x137 - x138;
+        let x140 = x139 + (x129 + x136 + x139);
+        let x141 = Self::mul_add(
+            0.275,
+            x125,
+            -Self::mul_add(
+                0.4,
+                x124,
+                Self::mul_add(-0.00000000020510342851533115, x134, x133),
             ),
         );
-        let x28 = 48.0240000085309 * x24;
-        let x29 = 48.0240000085309 * x14;
-        let x30 = 0.00000000020510342851533115 * c_q8;
-        let x31 = 0.00000000020510342851533115 * s_q8;
-        let x32 = Self::mul_add(x24, c_q8, Self::mul_add(x14, s_q8, x13 * x30));
-        let x33 = Self::mul_add(x24, s_q8, Self::mul_add(-x14, c_q8, x13 * x31));
-        let x34 = Self::mul_add(-0.35, x14, x18);
-        let x35 = Self::mul_add(0.35, x13, x19);
-        let x36 = Self::mul_add(x17, c_q8, Self::mul_add(s_q8, x35, x30 * x34));
-        let x37 = Self::mul_add(x17, s_q8, Self::mul_add(-c_q8, x35, x31 * x34));
-        let x38 = Self::mul_add(-0.00000000020510342851533115, x17, x34);
-        let x39 = v[7] * x33;
-        let x40 = v[7] * x32;
-        let x41 = v[7] * x37;
-        let x42 = v[7] * x36;
-        let x43 = v[7] + Self::mul_add(-0.00000000020510342851533115, x24, x13);
-        let x44 = Self::mul_add(
-            x38,
-            12.701650001451807,
-            Self::mul_add(x43, 0.002139996587640933, x33 * 0.0000000234896432582596),
+        let x142 = -0.000000008530897668050218 + x122;
+        let x143 = -12.701650001451807 - x124;
+        let x144 = -0.0000000234896432582596
+            + Self::mul_add(
+                -0.275,
+                x122,
+                x131
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x129,
+                        0.00000000020510342851533115 * x127,
+                    ),
+            );
+        let x145 = -0.002139996587640933 + Self::mul_add(-0.4, x122, x127 - x136);
+        let x146 = -111.7548902508081
+            + (x137
+                + (x134
+                    + Self::mul_add(
+                        -0.00000000020510342851533115,
+                        x116 + Self::mul_add(-0.00000000020510342851533115, x113, x132),
+                        0.00000000020510342851533115 * x133,
+                    ) + x137));
+        let x147 = 5.080660024070365 - x141;
+        let x148 = 113.3918902508081
+            - (x138
+                + (Self::mul_add(0.00000000020510342851533115, x135, x112 + x126)
+                    + x138));
+        let x149 = s_q8 * s_q8;
+        let x150 = s_q8 * c_q8;
+        let x151 = x140 - x146;
+        let x152 = x144 + x144;
+        let x153 = Self::mul_add(x150, x152, x149 * x151);
+        let x154 = x140 - x153;
+        let x155 = x144 + Self::mul_add(-x149, x152, x150 * x151);
+        let x156 = Self::mul_add(-s_q8, x147, c_q8 * x145);
+        let x157 = Self::mul_add(c_q8, x147, s_q8 * x145);
+        let x158 = Self::mul_add(-s_q8, x143, c_q8 * x142);
+        let x159 = Self::mul_add(c_q8, x143, s_q8 * x142);
+        let x160 = Self::mul_add(-0.00000000020510342851533115, x158, x125);
+        let x161 = Self::mul_add(0.00000000020510342851533115, x125, x158);
+        let x162 = Self::mul_add(-0.00000000020510342851533115, x154, x156);
+        let x163 = 0.00000000020510342851533115 * x156;
+        let x164 = x148 - x163;
+        let x165 = Self::mul_add(0.00000000020510342851533115, x148, x156);
+        let x166 = 0.35 * x161;
+        let x167 = x166
+            - (Self::mul_add(-0.00000000020510342851533115, x162, x164) - x166);
+        let x168 = 48.0240000085309 + x160;
+        let x169 = -0.07309 + Self::mul_add(-0.00000000020510342851533115, x155, x157);
+        let x170 = -16.80768997608804
+            - Self::mul_add(
+                0.35,
+                x160,
+                Self::mul_add(0.00000000020510342851533115, x164, x162),
+            );
+        let x171 = 130.43769025763282 - (x166 - (x146 + x153 - x166));
+        let x172 = 0.1132
+            - Self::mul_add(
+                0.35,
+                x159,
+                Self::mul_add(0.00000000020510342851533115, x157, x155),
+            );
+        let x173 = 132.47349025763282
+            + Self::mul_add(0.00000000020510342851533115, x165, x154 + x163);
+        let x174 = s_q7 * s_q7;
+        let x175 = s_q7 * c_q7;
+        let x176 = x167 + x171;
+        let x177 = x169 + x169;
+        let x178 = Self::mul_add(-x175, x177, x174 * x176);
+        let x179 = Self::mul_add(-s_q7, x159, c_q7 * x168);
+        let x180 = Self::mul_add(c_q7, x159, s_q7 * x168);
+        let x181 = 0.75 * x161;
+        let x182 = 0.65 * x179;
+        let x183 = x181 - x182;
+        let x184 = Self::mul_add(-0.75, x179, Self::mul_add(-s_q7, x172, c_q7 * x170));
+        let x185 = x173 + x182;
+        let x186 = 110.5455 + x179;
+        let x187 = 180.9502499901501 - x161;
+        let x188 = Self::mul_add(x8, x142, x7 * x143);
+        let x189 = Self::mul_add(
+            -0.35,
+            x158,
+            x148 - Self::mul_add(-x8, x147, x7 * x145),
         );
-        let x45 = Self::mul_add(
-            x38,
+        let x190 = Self::mul_add(0.35, x188, x157);
+        let x191 = Self::mul_add(-s_q7, x158, c_q7 * x188);
+        let x192 = Self::mul_add(c_q7, x158, s_q7 * x188);
+        let x193 = x12 * x95;
+        let x194 = Self::mul_add(x11, x102, x193);
+        let x195 = x131 + Self::mul_add(-0.275, x120, 0.4 * x194);
+        let x196 = Self::mul_add(
+            0.4,
+            x118,
+            x106 + Self::mul_add(-x12, x105, x11 * x103),
+        );
+        let x197 = Self::mul_add(-0.275, x118, x135);
+        let x198 = x120 + Self::mul_add(x8, x194, x7 * x118);
+        let x199 = Self::mul_add(-c_q8, x194, s_q8 * x118);
+        let x200 = x123 - Self::mul_add(s_q8, x194, c_q8 * x118);
+        let x201 = Self::mul_add(
+            0.00000000020510342851533115,
+            x197,
+            Self::mul_add(-s_q8, x196, c_q8 * x195),
+        );
+        let x202 = Self::mul_add(
+            -0.35,
+            x199,
+            x197 - Self::mul_add(-x8, x196, x7 * x195),
+        );
+        let x203 = Self::mul_add(-0.35, x198, Self::mul_add(c_q8, x196, s_q8 * x195));
+        let x204 = Self::mul_add(s_q7, x199, c_q7 * x198);
+        let x205 = Self::mul_add(-c_q7, x199, s_q7 * x198);
+        let x206 = Self::mul_add(-s_q9, x97, x117);
+        let x207 = Self::mul_add(x11, x97, x193);
+        let x208 = Self::mul_add(c_q9, x97, x119);
+        let x209 = 0.00000000020510342851533115 * x100;
+        let x210 = Self::mul_add(c_q9, x93, s_q9 * x92) + x209
+            + Self::mul_add(-0.275, x208, 0.4 * x207);
+        let x211 = Self::mul_add(0.4, x206, x100 + Self::mul_add(-x12, x93, x11 * x92));
+        let x212 = Self::mul_add(
+            0.275,
+            x206,
+            x209 - Self::mul_add(-s_q9, x93, c_q9 * x92),
+        );
+        let x213 = x208 + Self::mul_add(x8, x207, x7 * x206);
+        let x214 = Self::mul_add(-c_q8, x207, s_q8 * x206);
+        let x215 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x208,
+            Self::mul_add(s_q8, x207, c_q8 * x206),
+        );
+        let x216 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x212,
+            Self::mul_add(-s_q8, x211, c_q8 * x210),
+        );
+        let x217 = Self::mul_add(0.35, x214, x212 + Self::mul_add(-x8, x211, x7 * x210));
+        let x218 = Self::mul_add(-0.35, x213, Self::mul_add(c_q8, x211, s_q8 * x210));
+        let x219 = Self::mul_add(s_q7, x214, c_q7 * x213);
+        let x220 = Self::mul_add(-c_q7, x214, s_q7 * x213);
+        let x221 = Self::mul_add(c_q10, x73, x96);
+        let x222 = Self::mul_add(-s_q10, x73, x94);
+        let x223 = Self::mul_add(-s_q10, x79, c_q10 * x78);
+        let x224 = Self::mul_add(c_q10, x79, s_q10 * x78);
+        let x225 = Self::mul_add(-0.87, x221, x80);
+        let x226 = Self::mul_add(-c_q9, x222, s_q9 * x221);
+        let x227 = Self::mul_add(x12, x222, x11 * x221);
+        let x228 = Self::mul_add(s_q9, x222, c_q9 * x221);
+        let x229 = 0.00000000020510342851533115 * x225;
+        let x230 = Self::mul_add(c_q9, x224, s_q9 * x223) + x229
+            + Self::mul_add(-0.275, x228, 0.4 * x227);
+        let x231 = Self::mul_add(
+            -0.4,
+            x226,
+            x225 + Self::mul_add(-x12, x224, x11 * x223),
+        );
+        let x232 = Self::mul_add(
+            -0.275,
+            x226,
+            x229 - Self::mul_add(-s_q9, x224, c_q9 * x223),
+        );
+        let x233 = x228 - Self::mul_add(-x8, x227, x7 * x226);
+        let x234 = Self::mul_add(c_q8, x227, s_q8 * x226);
+        let x235 = Self::mul_add(
+            0.00000000020510342851533115,
+            x228,
+            Self::mul_add(-s_q8, x227, c_q8 * x226),
+        );
+        let x236 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x232,
+            Self::mul_add(-s_q8, x231, c_q8 * x230),
+        );
+        let x237 = Self::mul_add(
+            -0.35,
+            x234,
+            x232 + Self::mul_add(-x8, x231, x7 * x230),
+        );
+        let x238 = Self::mul_add(-0.35, x233, Self::mul_add(c_q8, x231, s_q8 * x230));
+        let x239 = Self::mul_add(-s_q7, x234, c_q7 * x233);
+        let x240 = Self::mul_add(c_q7, x234, s_q7 * x233);
+        let x241 = Self::mul_add(-x14, x35, x13 * x36);
+        let x242 = Self::mul_add(0.36, x241, x49);
+        let x243 = Self::mul_add(x52, 0.36, x41 - Self::mul_add(x14, x40, x13 * x38));
+        let x244 = Self::mul_add(s_q11, x241, c_q11 * x52);
+        let x245 = Self::mul_add(-c_q11, x241, s_q11 * x52);
+        let x246 = Self::mul_add(-s_q11, x243, c_q11 * x242)
+            - Self::mul_add(x51, -0.63, 0.275 * x245);
+        let x247 = Self::mul_add(0.275, x244, Self::mul_add(c_q11, x243, s_q11 * x242));
+        let x248 = Self::mul_add(0.63, x244, x59);
+        let x249 = Self::mul_add(-s_q10, x245, c_q10 * x244);
+        let x250 = Self::mul_add(c_q10, x245, s_q10 * x244);
+        let x251 = Self::mul_add(c_q10, x247, s_q10 * x246);
+        let x252 = Self::mul_add(x51, 0.87, Self::mul_add(-s_q10, x247, c_q10 * x246));
+        let x253 = Self::mul_add(0.87, x249, x248);
+        let x254 = 0.00000000020510342851533115 * x51;
+        let x255 = Self::mul_add(c_q9, x250, s_q9 * x249) + x254;
+        let x256 = x51 + Self::mul_add(-x12, x250, x11 * x249);
+        let x257 = x254 - Self::mul_add(-s_q9, x250, c_q9 * x249);
+        let x258 = 0.00000000020510342851533115 * x253;
+        let x259 = Self::mul_add(c_q9, x251, s_q9 * x252) - x258
+            + Self::mul_add(0.275, x257, 0.4 * x256);
+        let x260 = Self::mul_add(
+            0.4,
+            x255,
+            x253 - Self::mul_add(-x12, x251, x11 * x252),
+        );
+        let x261 = Self::mul_add(
+            0.275,
+            x255,
+            x258 + Self::mul_add(-s_q9, x251, c_q9 * x252),
+        );
+        let x262 = x257 + Self::mul_add(-x8, x256, x7 * x255);
+        let x263 = Self::mul_add(c_q8, x256, s_q8 * x255);
+        let x264 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x257,
+            Self::mul_add(-s_q8, x256, c_q8 * x255),
+        );
+        let x265 = Self::mul_add(
+            0.00000000020510342851533115,
+            x261,
+            Self::mul_add(s_q8, x260, c_q8 * x259),
+        );
+        let x266 = Self::mul_add(0.35, x263, x261 - Self::mul_add(x8, x260, x7 * x259));
+        let x267 = Self::mul_add(0.35, x262, Self::mul_add(-c_q8, x260, s_q8 * x259));
+        let x268 = Self::mul_add(s_q7, x263, c_q7 * x262);
+        let x269 = Self::mul_add(-c_q7, x263, s_q7 * x262);
+        let x270 = 4.806620000000001 * x15;
+        let x271 = x32
+            + (1.4135609200000003
+                + Self::mul_add(x16, -0.9614610000000001, x15 * 0.0145));
+        let x272 = Self::mul_add(-0.16, x270, x22);
+        let x273 = Self::mul_add(-0.55, x270, x29);
+        let x274 = Self::mul_add(s_q12, x23, c_q12 * x270);
+        let x275 = x24 - Self::mul_add(-x14, x23, x13 * x270);
+        let x276 = Self::mul_add(
+            0.00000000020510342851533115,
+            x24,
+            Self::mul_add(-c_q12, x23, s_q12 * x270),
+        );
+        let x277 = Self::mul_add(
+            0.00000000020510342851533115,
+            x273,
+            Self::mul_add(-c_q12, x272, s_q12 * x271),
+        );
+        let x278 = Self::mul_add(0.36, x275, Self::mul_add(s_q12, x272, c_q12 * x271));
+        let x279 = Self::mul_add(
+            -0.36,
+            x274,
+            x273 - Self::mul_add(-x14, x272, x13 * x271),
+        );
+        let x280 = Self::mul_add(-s_q11, x275, c_q11 * x274);
+        let x281 = Self::mul_add(c_q11, x275, s_q11 * x274);
+        let x282 = Self::mul_add(-s_q11, x279, c_q11 * x278)
+            + Self::mul_add(0.63, x276, 0.275 * x281);
+        let x283 = Self::mul_add(-0.275, x280, Self::mul_add(c_q11, x279, s_q11 * x278));
+        let x284 = Self::mul_add(-0.63, x280, x277);
+        let x285 = Self::mul_add(-s_q10, x281, c_q10 * x280);
+        let x286 = Self::mul_add(c_q10, x281, s_q10 * x280);
+        let x287 = Self::mul_add(c_q10, x283, s_q10 * x282);
+        let x288 = Self::mul_add(0.87, x276, Self::mul_add(-s_q10, x283, c_q10 * x282));
+        let x289 = Self::mul_add(-0.87, x285, x284);
+        let x290 = 0.00000000020510342851533115 * x276;
+        let x291 = Self::mul_add(c_q9, x286, s_q9 * x285) - x290;
+        let x292 = x276 - Self::mul_add(-x12, x286, x11 * x285);
+        let x293 = x290 + Self::mul_add(-s_q9, x286, c_q9 * x285);
+        let x294 = 0.00000000020510342851533115 * x289;
+        let x295 = Self::mul_add(c_q9, x287, s_q9 * x288) - x294
+            + Self::mul_add(0.275, x293, 0.4 * x292);
+        let x296 = Self::mul_add(
+            -0.4,
+            x291,
+            x289 - Self::mul_add(-x12, x287, x11 * x288),
+        );
+        let x297 = Self::mul_add(
+            -0.275,
+            x291,
+            x294 + Self::mul_add(-s_q9, x287, c_q9 * x288),
+        );
+        let x298 = x293 - Self::mul_add(x8, x292, x7 * x291);
+        let x299 = Self::mul_add(-c_q8, x292, s_q8 * x291);
+        let x300 = Self::mul_add(
+            0.00000000020510342851533115,
+            x293,
+            Self::mul_add(s_q8, x292, c_q8 * x291),
+        );
+        let x301 = Self::mul_add(
+            0.00000000020510342851533115,
+            x297,
+            Self::mul_add(s_q8, x296, c_q8 * x295),
+        );
+        let x302 = Self::mul_add(-0.35, x299, x297 - Self::mul_add(x8, x296, x7 * x295));
+        let x303 = Self::mul_add(0.35, x298, Self::mul_add(-c_q8, x296, s_q8 * x295));
+        let x304 = Self::mul_add(-s_q7, x299, c_q7 * x298);
+        let x305 = Self::mul_add(c_q7, x299, s_q7 * x298);
+        let x306 = Self::mul_add(-v[2], v[4], v[1] * v[5]);
+        let x307 = Self::mul_add(-v[2], v[3], v[0] * v[5]);
+        let x308 = Self::mul_add(-v[1], v[3], v[0] * v[4]);
+        let x309 = Self::mul_add(v[4], s_q7, v[3] * c_q7);
+        let x310 = Self::mul_add(-v[4], c_q7, v[3] * s_q7);
+        let x311 = v[4] * v[4];
+        let x312 = Self::mul_add(v[5], v[5], x311);
+        let x313 = v[3] * v[4];
+        let x314 = v[3] * v[5];
+        let x315 = v[4] * v[5];
+        let x316 = Self::mul_add(v[3], v[3], x311);
+        let x317 = x306 + Self::mul_add(-0.75, x314, 0.65 * x312);
+        let x318 = x307 + Self::mul_add(0.75, x315, 0.65 * x313);
+        let x319 = x308 - Self::mul_add(-0.75, x316, 0.65 * x314);
+        let x320 = Self::mul_add(c_q7, x318, s_q7 * x317);
+        let x321 = v[6] * x310;
+        let x322 = v[6] * x309;
+        let x323 = v[5] + v[6];
+        let x324 = x310 * x310;
+        let x325 = x309 * x323;
+        let x326 = Self::mul_add(x323, -16.80768997608804, x310 * 0.07309);
+        let x327 = Self::mul_add(
+            -0.1132,
+            x323,
+            Self::mul_add(130.43769025763282, x310, x309 * 0.07309),
+        );
+        let x328 = Self::mul_add(
+            -132.47349025763282,
+            x323,
+            Self::mul_add(0.1132, x310, x309 * 16.80768997608804),
+        );
+        let x329 = Self::mul_add(c_q8, x323, Self::mul_add(s_q8, x310, x7 * x309));
+        let x330 = Self::mul_add(s_q8, x323, Self::mul_add(-c_q8, x310, x8 * x309));
+        let x331 = Self::mul_add(
+            0.35,
+            x322 - x325,
+            Self::mul_add(-s_q7, x318, c_q7 * x317),
+        );
+        let x332 = Self::mul_add(0.35, Self::mul_add(-x310, x323, x321), x320);
+        let x333 = Self::mul_add(0.35, Self::mul_add(x309, x309, x324), x319);
+        let x334 = Self::mul_add(c_q8, x333, Self::mul_add(s_q8, x332, x7 * x331));
+        let x335 = Self::mul_add(s_q8, x333, Self::mul_add(-c_q8, x332, x8 * x331));
+        let x336 = Self::mul_add(-0.00000000020510342851533115, x333, x331);
+        let x337 = Self::mul_add(v[7], x330, Self::mul_add(-s_q8, x322, x7 * x321));
+        let x338 = Self::mul_add(-v[7], x329, Self::mul_add(c_q8, x322, x8 * x321));
+        let x339 = v[7] + Self::mul_add(-0.00000000020510342851533115, x323, x309);
+        let x340 = x330 * x330;
+        let x341 = x339 * x339;
+        let x342 = x329 * x330;
+        let x343 = x321 - x342;
+        let x344 = x329 * x339;
+        let x345 = x329 * x329;
+        let x346 = x341 + x345;
+        let x347 = x330 * x339;
+        let x348 = x337 + x347;
+        let x349 = Self::mul_add(
+            x339,
+            0.002139996587640933,
+            x330 * 0.0000000234896432582596,
+        );
+        let x350 = Self::mul_add(
+            5.080660024070365,
+            x339,
+            Self::mul_add(x330, -111.7548902508081, x329 * 0.0000000234896432582596),
+        );
+        let x351 = Self::mul_add(
+            113.3918902508081,
+            x339,
+            Self::mul_add(5.080660024070366, x330, x329 * 0.002139996587640933),
+        );
+        let x352 = Self::mul_add(
+            x336,
             0.000000008530897668050218,
             Self::mul_add(
                 5.080660024070365,
-                x43,
-                Self::mul_add(x33, -111.7548902508081, x32 * 0.0000000234896432582596),
-            ),
+                x321,
+                Self::mul_add(x338, -111.7548902508081, x337 * 0.0000000234896432582596),
+            ) + Self::mul_add(-x329, x351, x339 * x349),
         );
-        let x46 = Self::mul_add(
-            113.3918902508081,
-            x43,
-            Self::mul_add(5.080660024070366, x33, x32 * 0.002139996587640933),
-        ) - Self::mul_add(x37, 0.000000008530897668050218, x36 * 12.701650001451807);
-        let x47 = x43 * 12.701650001451807;
-        let x48 = x43 * 0.000000008530897668050218;
-        let x49 = Self::mul_add(
-            x33,
-            0.000000008530897668050218,
-            x32 * 12.701650001451807,
-        );
-        let x50 = 0.00000000020510342851533115 * c_q9;
-        let x51 = 0.00000000020510342851533115 * s_q9;
-        let x52 = x50 - x51;
-        let x53 = x50 + x51;
-        let x54 = Self::mul_add(-x43, c_q9, Self::mul_add(-x33, x52, x32 * s_q9));
-        let x55 = Self::mul_add(x43, s_q9, Self::mul_add(x33, x53, x32 * c_q9));
-        let x56 = x36 - Self::mul_add(-0.275, x43, 0.4 * x33);
-        let x57 = Self::mul_add(0.4, x32, x37);
-        let x58 = Self::mul_add(-0.275, x32, x38);
-        let x59 = Self::mul_add(-c_q9, x58, Self::mul_add(-x52, x57, s_q9 * x56));
-        let x60 = Self::mul_add(s_q9, x58, Self::mul_add(x53, x57, c_q9 * x56));
-        let x61 = Self::mul_add(
+        let x353 = Self::mul_add(-c_q9, x339, Self::mul_add(-x11, x330, s_q9 * x329));
+        let x354 = Self::mul_add(s_q9, x339, Self::mul_add(x12, x330, c_q9 * x329));
+        let x355 = x334 + Self::mul_add(-0.4, x338 + x344, 0.275 * x343);
+        let x356 = x335 + Self::mul_add(0.4, x337 - x347, 0.275 * x346);
+        let x357 = x336 - Self::mul_add(-0.4, x340 + x345, 0.275 * x348);
+        let x358 = Self::mul_add(-c_q9, x357, Self::mul_add(-x11, x356, s_q9 * x355));
+        let x359 = Self::mul_add(
             -0.00000000020510342851533115,
-            x58,
-            Self::mul_add(-0.00000000020510342851533115, x56, x57),
+            x357,
+            Self::mul_add(-0.00000000020510342851533115, x355, x356),
         );
-        let x62 = v[8] * x55;
-        let x63 = v[8] * x54;
-        let x64 = v[8] * x60;
-        let x65 = v[8] * x59;
-        let x66 = v[8]
+        let x360 = Self::mul_add(
+            -0.00000000020510342851533115,
+            x321,
+            Self::mul_add(-0.00000000020510342851533115, x337, x338),
+        );
+        let x361 = Self::mul_add(
+            -v[8],
+            x354,
+            Self::mul_add(-c_q9, x321, Self::mul_add(-x11, x338, s_q9 * x337)),
+        );
+        let x362 = Self::mul_add(
+            v[8],
+            x353,
+            Self::mul_add(s_q9, x321, Self::mul_add(x12, x338, c_q9 * x337)),
+        );
+        let x363 = v[8]
             + Self::mul_add(
                 -0.00000000020510342851533115,
-                x43,
-                Self::mul_add(-0.00000000020510342851533115, x32, x33),
+                x339,
+                Self::mul_add(-0.00000000020510342851533115, x329, x330),
             );
-        let x67 = Self::mul_add(x66, -36.18604050126307, x55 * 63.36336825000001);
-        let x68 = Self::mul_add(x61, 81.53205, x66 * 0.00214);
-        let x69 = Self::mul_add(
-            x59,
+        let x364 = Self::mul_add(x353, x354, x360);
+        let x365 = Self::mul_add(x353, x353, x363 * x363);
+        let x366 = Self::mul_add(-x354, x363, x361);
+        let x367 = x363 * 0.00214;
+        let x368 = Self::mul_add(x363, -36.18604050126307, x354 * 63.36336825000001);
+        let x369 = Self::mul_add(
+            69.99836825,
+            x363,
+            Self::mul_add(x354, 36.18604050126307, x353 * 0.00214),
+        );
+        let x370 = Self::mul_add(
+            x359,
+            81.53205,
+            Self::mul_add(x360, 0.00214, -Self::mul_add(x354, x369, x363 * x368)),
+        );
+        let x371 = Self::mul_add(
+            x358,
             -81.53205,
             Self::mul_add(
                 69.99836825,
-                x66,
-                Self::mul_add(x55, 36.18604050126307, x54 * 0.00214),
-            ),
+                x360,
+                Self::mul_add(x362, 36.18604050126307, x361 * 0.00214),
+            ) + Self::mul_add(x353, x368, x354 * x367),
         );
-        let x70 = x66 * 81.53205;
-        let x71 = x54 * 81.53205;
-        let x72 = Self::mul_add(x55, s_q10, x54 * c_q10);
-        let x73 = Self::mul_add(-x55, c_q10, x54 * s_q10);
-        let x74 = Self::mul_add(x66, -0.87, x59);
-        let x75 = Self::mul_add(x54, 0.87, x61);
-        let x76 = Self::mul_add(x60, s_q10, c_q10 * x74);
-        let x77 = Self::mul_add(-x60, c_q10, s_q10 * x74);
-        let x78 = v[9] * x73;
-        let x79 = v[9] * x72;
-        let x80 = v[9] * x77;
-        let x81 = v[9] * x76;
-        let x82 = v[9] + x66;
-        let x83 = Self::mul_add(x82, 24.35164200091464, x73 * 24.4950615);
-        let x84 = Self::mul_add(x75, 45.1584, x82 * 0.6328);
-        let x85 = Self::mul_add(
-            x76,
+        let x372 = Self::mul_add(s_q10, x354, c_q10 * x353);
+        let x373 = Self::mul_add(-c_q10, x354, s_q10 * x353);
+        let x374 = Self::mul_add(-0.87, x364, x358);
+        let x375 = Self::mul_add(
+            0.87,
+            x365,
+            Self::mul_add(s_q9, x357, Self::mul_add(x12, x356, c_q9 * x355)),
+        );
+        let x376 = Self::mul_add(0.87, x366, x359);
+        let x377 = Self::mul_add(s_q10, x375, c_q10 * x374);
+        let x378 = Self::mul_add(v[9], x373, Self::mul_add(s_q10, x362, c_q10 * x361));
+        let x379 = Self::mul_add(-v[9], x372, Self::mul_add(-c_q10, x362, s_q10 * x361));
+        let x380 = v[9] + x363;
+        let x381 = Self::mul_add(-x372, x373, x360);
+        let x382 = x372 * x372;
+        let x383 = Self::mul_add(x380, x380, x382);
+        let x384 = x373 * x380;
+        let x385 = x378 + x384;
+        let x386 = x380 * 0.6328;
+        let x387 = Self::mul_add(x380, 24.35164200091464, x373 * 24.4950615);
+        let x388 = Self::mul_add(
+            28.2393615,
+            x380,
+            Self::mul_add(x373, -24.351642000914637, x372 * 0.6328),
+        );
+        let x389 = Self::mul_add(
+            x376,
+            45.1584,
+            Self::mul_add(x360, 0.6328, Self::mul_add(x373, x388, x380 * x387)),
+        );
+        let x390 = Self::mul_add(
+            x377,
             -45.1584,
             Self::mul_add(
                 28.2393615,
-                x82,
-                Self::mul_add(x73, -24.351642000914637, x72 * 0.6328),
-            ),
+                x360,
+                Self::mul_add(x379, -24.351642000914637, x378 * 0.6328),
+            ) - Self::mul_add(x372, x387, x373 * x386),
         );
-        let x86 = x82 * 45.1584;
-        let x87 = x72 * 45.1584;
-        let x88 = Self::mul_add(-x73, s_q11, x72 * c_q11);
-        let x89 = Self::mul_add(x73, c_q11, x72 * s_q11);
-        let x90 = x76 + Self::mul_add(x82, -0.63, 0.275 * x73);
-        let x91 = Self::mul_add(-0.275, x72, x77);
-        let x92 = Self::mul_add(x72, 0.63, x75);
-        let x93 = Self::mul_add(-s_q11, x91, c_q11 * x90);
-        let x94 = Self::mul_add(c_q11, x91, s_q11 * x90);
-        let x95 = v[10] * x89;
-        let x96 = v[10] * x88;
-        let x97 = v[10] * x94;
-        let x98 = v[10] * x93;
-        let x99 = v[10] + x82;
-        let x100 = Self::mul_add(-2.5482240016099564, x99, x89 * 9.142025249762803);
-        let x101 = Self::mul_add(7.078399999258757, x92, 0.01675 * x99);
-        let x102 = Self::mul_add(
+        let x391 = Self::mul_add(-s_q11, x373, c_q11 * x372);
+        let x392 = Self::mul_add(c_q11, x373, s_q11 * x372);
+        let x393 = x377
+            - Self::mul_add(-0.275, Self::mul_add(x372, x380, x379), 0.63 * x381);
+        let x394 = Self::mul_add(-c_q10, x375, s_q10 * x374)
+            - Self::mul_add(0.275, x378 - x384, 0.63 * x383);
+        let x395 = x376
+            + Self::mul_add(-0.275, Self::mul_add(x373, x373, x382), 0.63 * x385);
+        let x396 = Self::mul_add(-s_q11, x394, c_q11 * x393);
+        let x397 = Self::mul_add(v[10], x392, Self::mul_add(-s_q11, x379, c_q11 * x378));
+        let x398 = Self::mul_add(-v[10], x391, Self::mul_add(c_q11, x379, s_q11 * x378));
+        let x399 = v[10] + x380;
+        let x400 = x391 * x391;
+        let x401 = x392 * x399;
+        let x402 = 0.01675 * x399;
+        let x403 = Self::mul_add(-2.5482240016099564, x399, x392 * 9.142025249762803);
+        let x404 = Self::mul_add(
+            -9.223235249762805,
+            x399,
+            Self::mul_add(-2.5482240016099564, x392, 0.01675 * x391),
+        );
+        let x405 = Self::mul_add(
+            7.078399999258757,
+            x395,
+            Self::mul_add(0.01675, x360, -Self::mul_add(-x392, x404, x399 * x403)),
+        );
+        let x406 = Self::mul_add(
             -7.078399999258757,
-            x93,
+            x396,
             Self::mul_add(
                 -9.223235249762805,
-                x99,
-                Self::mul_add(-2.5482240016099564, x89, 0.01675 * x88),
-            ),
+                x360,
+                Self::mul_add(-2.5482240016099564, x398, 0.01675 * x397),
+            ) - Self::mul_add(-x391, x403, x392 * x402),
         );
-        let x103 = 7.078399999258757 * x99;
-        let x104 = 7.078399999258757 * x88;
-        let x105 = 0.00000000020510342851533115 * s_q12;
-        let x106 = 0.00000000020510342851533115 * c_q12;
-        let x107 = Self::mul_add(x99, s_q12, Self::mul_add(x89, x105, x88 * c_q12));
-        let x108 = Self::mul_add(-x99, c_q12, Self::mul_add(-x89, x106, x88 * s_q12));
-        let x109 = Self::mul_add(x89, 0.36, x93);
-        let x110 = Self::mul_add(x88, -0.36, x94);
-        let x111 = Self::mul_add(x92, s_q12, Self::mul_add(x105, x110, c_q12 * x109));
-        let x112 = Self::mul_add(-x92, c_q12, Self::mul_add(-x106, x110, s_q12 * x109));
-        let x113 = Self::mul_add(-0.00000000020510342851533115, x92, x110);
-        let x114 = v[11] * x108;
-        let x115 = v[11] * x107;
-        let x116 = v[11] * x112;
-        let x117 = v[11] * x111;
-        let x118 = v[11] + Self::mul_add(-0.00000000020510342851533115, x99, x89);
-        let x119 = Self::mul_add(
-            -17.135250000000003,
-            x113,
-            Self::mul_add(x118, 0.809539999555672, x108 * 1.9877000000000002),
-        );
-        let x120 = Self::mul_add(
-            -3.6140000000000003,
-            x113,
-            Self::mul_add(
-                x118,
-                -2.741639999592316,
-                Self::mul_add(x108, -5.252920330000002, x107 * 1.9877000000000002),
-            ),
-        );
-        let x121 = Self::mul_add(
-            9.740442170000001,
-            x118,
-            Self::mul_add(x108, -2.7416399995923166, x107 * 0.809539999555672),
-        ) + Self::mul_add(3.6140000000000003, x112, 17.135250000000003 * x111);
-        let x122 = 17.135250000000003 * x118;
-        let x123 = 3.6140000000000003 * x118;
-        let x124 = Self::mul_add(3.6140000000000003, x108, 17.135250000000003 * x107);
-        let x125 = 0.00000000020510342851533115 * c_q13;
-        let x126 = 0.00000000020510342851533115 * s_q13;
-        let x127 = Self::mul_add(-x118, c_q13, Self::mul_add(x108, s_q13, x107 * x125));
-        let x128 = Self::mul_add(-x118, s_q13, Self::mul_add(-x108, c_q13, x107 * x126));
-        let x129 = x111 - Self::mul_add(-0.55, x118, 0.16 * x108);
-        let x130 = Self::mul_add(0.16, x107, x112);
-        let x131 = Self::mul_add(-0.55, x107, x113);
-        let x132 = Self::mul_add(-c_q13, x131, Self::mul_add(s_q13, x130, x125 * x129));
-        let x133 = Self::mul_add(-s_q13, x131, Self::mul_add(-c_q13, x130, x126 * x129));
-        let x134 = Self::mul_add(0.00000000020510342851533115, x131, x129);
-        let x135 = v[12] * x128;
-        let x136 = v[12] * x127;
-        let x137 = v[12] * x133;
-        let x138 = v[12] - Self::mul_add(0.00000000020510342851533115, x118, x107);
-        let x139 = Self::mul_add(
-            x138,
-            -0.9614610000000001,
-            Self::mul_add(x128, 1.2025609200000003, 0.000781 * x127),
-        );
-        let x140 = Self::mul_add(
-            4.806620000000001,
-            x134,
-            Self::mul_add(x138, 0.0145, 0.000781 * x128),
-        );
-        let x141 = Self::mul_add(
-            4.806620000000001,
-            x132,
-            Self::mul_add(
-                -1.4135609200000003,
-                x138,
-                Self::mul_add(x128, -0.9614610000000001, x127 * 0.0145),
-            ),
-        );
-        let x142 = 4.806620000000001 * x138;
-        let x143 = 4.806620000000001 * x127;
-        let x144 = f_ext[7][5]
-            + Self::mul_add(x133, x142, Self::mul_add(-x127, x139, x128 * x140));
-        let x145 = f_ext[7][1] + Self::mul_add(x127, x143, x138 * x142);
-        let x146 = tau[6] + x144;
-        let x147 = Self::mul_add(
-            4.806620000000001,
-            x135,
-            Self::mul_add(x128, x142, f_ext[7][2]),
-        );
-        let x148 = Self::mul_add(
-            x146,
-            0.010257782169020348,
-            f_ext[7][3]
-                + Self::mul_add(x133, x143, Self::mul_add(-x128, x141, x138 * x139))
-                - Self::mul_add(
-                    x137,
-                    0.049305260929256585,
-                    Self::mul_add(
-                        x136,
-                        0.009081457502008472,
-                        x135 * 0.00014873784145079505,
-                    ),
-                ),
-        );
-        let x149 = Self::mul_add(
-            x146,
-            0.6801694828971361,
-            f_ext[7][4]
-                + (Self::mul_add(-x127, x141, x138 * x140)
-                    - Self::mul_add(-x132, x143, x134 * x142))
-                - Self::mul_add(
-                    x137,
-                    3.2693162398830324,
-                    Self::mul_add(x136, 1.8565173511957638, x135 * 0.009081457502008472),
-                ),
-        );
-        let x150 = x144 - x146;
-        let x151 = Self::mul_add(
-            x146,
-            3.4003628227073506,
-            Self::mul_add(x128, x143, f_ext[7][0])
-                - Self::mul_add(
-                    x137,
-                    16.344251950881606,
-                    Self::mul_add(x136, 3.2693162398830324, x135 * 0.049305260929256585),
-                ),
-        );
-        let x152 = c_q13 * 0.009081457502008472;
-        let x153 = Self::mul_add(s_q13, 0.00014873784145079505, x152);
-        let x154 = s_q13 * 0.009081457502008472;
-        let x155 = Self::mul_add(c_q13, 0.00014873784145079505, -x154);
-        let x156 = Self::mul_add(c_q13, 1.8565173511957638, x154);
-        let x157 = Self::mul_add(s_q13, -1.8565173511957638, x152);
-        let x158 = Self::mul_add(x125, 0.049305260929256585, 4.806620000000001);
-        let x159 = s_q13 * 0.049305260929256585;
-        let x160 = Self::mul_add(
-            c_q13,
-            0.049305260929256585,
-            -0.0000000009858542415703612,
-        );
-        let x161 = x125 * 3.2693162398830324;
-        let x162 = s_q13 * 3.2693162398830324;
-        let x163 = c_q13 * 3.2693162398830324;
-        let x164 = Self::mul_add(-x126, x161, x125 * x158);
-        let x165 = Self::mul_add(-x126, x162, x125 * x159);
-        let x166 = Self::mul_add(-x126, x163, x125 * x160);
-        let x167 = Self::mul_add(c_q13, x161, s_q13 * x158);
-        let x168 = Self::mul_add(-s_q13, x161, c_q13 * x158);
-        let x169 = s_q13 * 16.344251950881606;
-        let x170 = c_q13 * 16.344251950881606;
-        let x171 = x125 * (x125 * 16.344251950881606);
-        let x172 = x125 * x169;
-        let x173 = x125 * x170;
-        let x174 = s_q13 * x169;
-        let x175 = s_q13 * x170;
-        let x176 = c_q13 * x170;
-        let x177 = 0.16 * x172;
-        let x178 = 0.55 * x173;
-        let x179 = x165 + Self::mul_add(0.55, x175, 0.16 * x174);
-        let x180 = x166 + Self::mul_add(0.55, x176, 0.16 * x175);
-        let x181 = Self::mul_add(-0.16, x171, x167);
-        let x182 = Self::mul_add(c_q13, x162, s_q13 * x159) - x177;
-        let x183 = Self::mul_add(-0.16, x173, Self::mul_add(c_q13, x163, s_q13 * x160));
-        let x184 = Self::mul_add(-0.55, x171, x168);
-        let x185 = Self::mul_add(-0.55, x172, Self::mul_add(-s_q13, x162, c_q13 * x159));
-        let x186 = Self::mul_add(-s_q13, x163, c_q13 * x160) - x178;
-        let x187 = Self::mul_add(
-            0.16,
-            x167,
-            -Self::mul_add(-0.16, x181, Self::mul_add(c_q13, x156, s_q13 * x153)),
-        );
-        let x188 = Self::mul_add(
-            0.55,
-            x167,
-            -Self::mul_add(-0.16, x184, Self::mul_add(c_q13, x157, s_q13 * x155)),
-        );
-        let x189 = Self::mul_add(
-            0.55,
-            x168,
-            -Self::mul_add(-0.55, x184, Self::mul_add(-s_q13, x157, c_q13 * x155)),
-        );
-        let x190 = x147 - Self::mul_add(-x126, x145, x125 * x151);
-        let x191 = Self::mul_add(c_q13, x145, s_q13 * x151);
-        let x192 = Self::mul_add(
-            0.00000000020510342851533115,
-            x147,
-            Self::mul_add(-s_q13, x145, c_q13 * x151),
-        );
-        let x193 = Self::mul_add(
-            0.55,
-            x190,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x150,
-                Self::mul_add(-s_q13, x149, c_q13 * x148),
-            ),
-        );
-        let x194 = -0.809539999555672
-            + Self::mul_add(
-                0.55,
-                x164,
-                -(Self::mul_add(-x126, x157, x125 * x155)
-                    + Self::mul_add(0.55, x186, 0.16 * x185)),
-            );
-        let x195 = -2.741639999592316 - x188;
-        let x196 = 9.740442170000001 + x189;
-        let x197 = -17.135250000000003 - x184;
-        let x198 = 3.6140000000000003 + x185;
-        let x199 = f_ext[6][5]
-            - (Self::mul_add(-x107, x120, x108 * x119)
-                + Self::mul_add(-x111, x123, x112 * x122)) - x193;
-        let x200 = 1.0 / x196;
-        let x201 = tau[5] + x199;
-        let x202 = x194 * x200;
-        let x203 = x195 * x200;
-        let x204 = x197 * x200;
-        let x205 = x198 * x200;
-        let x206 = x186 * x200;
-        let x207 = Self::mul_add(
-            x194,
-            x202,
-            Self::mul_add(0.55, x166, 0.16 * x165)
-                + (Self::mul_add(
-                    -x126,
-                    Self::mul_add(
-                        x126,
-                        -1.8565173511957638,
-                        x125 * 0.009081457502008472,
-                    ),
-                    x125
-                        * Self::mul_add(
-                            x126,
-                            -0.009081457502008472,
-                            x125 * 0.00014873784145079505,
-                        ),
-                ) + Self::mul_add(0.55, x180, 0.16 * x179)),
-        );
-        let x208 = Self::mul_add(
-            -x194,
-            x203,
-            -1.9877000000000002
-                - Self::mul_add(
-                    0.16,
-                    x164,
-                    -(Self::mul_add(-x126, x156, x125 * x153)
-                        + Self::mul_add(0.55, x183, 0.16 * x182)),
-                ),
-        );
-        let x209 = Self::mul_add(-x195, x203, -5.252920330000002 + x187);
-        let x210 = Self::mul_add(x194, x204, x164 + (x177 + x178));
-        let x211 = Self::mul_add(-x194, x205, x179);
-        let x212 = Self::mul_add(x194, x206, 17.135250000000003 - x180);
-        let x213 = Self::mul_add(-x195, x204, x181);
-        let x214 = Self::mul_add(x195, x205, x182);
-        let x215 = Self::mul_add(x195, x206, -3.6140000000000003 + x183);
-        let x216 = Self::mul_add(x197, x204, x171);
-        let x217 = Self::mul_add(-x197, x205, x172);
-        let x218 = Self::mul_add(-x197, x206, x173);
-        let x219 = Self::mul_add(x198, x205, x174);
-        let x220 = Self::mul_add(x198, x206, x175);
-        let x221 = Self::mul_add(x186, x206, x176);
-        let x222 = Self::mul_add(
-            -x201,
-            x202,
-            f_ext[6][3]
-                + (Self::mul_add(-x108, x121, x118 * x120)
-                    + Self::mul_add(x112, x124, x113 * x123))
-                + (x150 - Self::mul_add(-x126, x149, x125 * x148)
-                    - Self::mul_add(0.55, x192, 0.16 * x191))
-                + (Self::mul_add(-x115, x208, x114 * x207)
-                    + Self::mul_add(-x117, x211, x116 * x210)),
-        );
-        let x223 = Self::mul_add(
-            -x201,
-            x203,
-            f_ext[6][4]
-                + (Self::mul_add(-x107, x121, x118 * x119)
-                    + Self::mul_add(x111, x124, x113 * x122))
-                + Self::mul_add(0.16, x190, Self::mul_add(c_q13, x149, s_q13 * x148))
-                - (Self::mul_add(x115, x209, x114 * x208)
-                    + Self::mul_add(-x117, x214, x116 * x213)),
-        );
-        let x224 = Self::mul_add(-x201, x196 * x200, x199);
-        let x225 = Self::mul_add(
-            -x201,
-            x204,
-            f_ext[6][0] + Self::mul_add(x108, x124, x118 * x123) + x190
-                + (Self::mul_add(-x115, x213, x114 * x210)
-                    + Self::mul_add(-x117, x217, x116 * x216)),
-        );
-        let x226 = Self::mul_add(
-            -x201,
-            x205,
-            f_ext[6][1] + Self::mul_add(x107, x124, x118 * x122) + x191
-                - (Self::mul_add(-x115, x214, x114 * x211)
-                    + Self::mul_add(-x117, x219, x116 * x217)),
-        );
-        let x227 = Self::mul_add(
-            x201,
-            x206,
-            f_ext[6][2] - Self::mul_add(-x107, x123, x108 * x122) - x192
-                - (Self::mul_add(x115, x215, x114 * x212)
-                    - Self::mul_add(-x117, x220, x116 * x218)),
-        );
-        let x228 = s_q12 * x208;
-        let x229 = Self::mul_add(-x106, x208, x105 * x207);
-        let x230 = c_q12 * x208;
-        let x231 = Self::mul_add(s_q12, x207, -x230);
-        let x232 = Self::mul_add(x106, x209, x105 * x208);
-        let x233 = Self::mul_add(c_q12, x209, x228);
-        let x234 = Self::mul_add(s_q12, x211, c_q12 * x210);
-        let x235 = x212 + Self::mul_add(-x106, x211, x105 * x210);
-        let x236 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x212,
-            Self::mul_add(-c_q12, x211, s_q12 * x210),
-        );
-        let x237 = Self::mul_add(s_q12, x214, c_q12 * x213);
-        let x238 = x215 - Self::mul_add(-x106, x214, x105 * x213);
-        let x239 = Self::mul_add(
-            0.00000000020510342851533115,
-            x215,
-            Self::mul_add(-c_q12, x214, s_q12 * x213),
-        );
-        let x240 = Self::mul_add(s_q12, x237, c_q12 * x234);
-        let x241 = Self::mul_add(-s_q12, x238, c_q12 * x235);
-        let x242 = Self::mul_add(-x106, x237, x105 * x234);
-        let x243 = Self::mul_add(-c_q12, x237, s_q12 * x234);
-        let x244 = Self::mul_add(c_q12, x238, s_q12 * x235);
-        let x245 = Self::mul_add(-c_q12, x239, s_q12 * x236);
-        let x246 = s_q12 * x217;
-        let x247 = x218 - Self::mul_add(-x106, x217, x105 * x216);
-        let x248 = c_q12 * x217;
-        let x249 = Self::mul_add(
-            0.00000000020510342851533115,
-            x218,
-            Self::mul_add(s_q12, x216, -x248),
-        );
-        let x250 = x220 - Self::mul_add(-x106, x219, x105 * x217);
-        let x251 = Self::mul_add(
-            0.00000000020510342851533115,
-            x220,
-            Self::mul_add(-c_q12, x219, x246),
-        );
-        let x252 = Self::mul_add(
-            0.00000000020510342851533115,
-            x221,
-            Self::mul_add(-c_q12, x220, s_q12 * x218),
-        );
-        let x253 = Self::mul_add(
-            s_q12,
-            Self::mul_add(s_q12, x219, x248),
-            c_q12 * Self::mul_add(c_q12, x216, x246),
-        );
-        let x254 = Self::mul_add(s_q12, x250, c_q12 * x247);
-        let x255 = Self::mul_add(s_q12, x251, c_q12 * x249);
-        let x256 = x221 - Self::mul_add(-x106, x220, x105 * x218)
-            - Self::mul_add(-x106, x250, x105 * x247);
-        let x257 = x252 - Self::mul_add(-x106, x251, x105 * x249);
-        let x258 = 0.36 * x254;
-        let x259 = Self::mul_add(-0.36, x256, x241);
-        let x260 = Self::mul_add(0.36, x253, x242);
-        let x261 = Self::mul_add(x106, x238, x105 * x235) - x258;
-        let x262 = Self::mul_add(
+        let x407 = Self::mul_add(s_q12, x399, Self::mul_add(x13, x392, c_q12 * x391));
+        let x408 = Self::mul_add(-c_q12, x399, Self::mul_add(-x14, x392, s_q12 * x391));
+        let x409 = Self::mul_add(0.36, Self::mul_add(x391, x399, x398), x396);
+        let x410 = Self::mul_add(
             -0.36,
-            x259,
-            Self::mul_add(
-                s_q12,
-                Self::mul_add(-s_q12, x209, x230),
-                c_q12 * Self::mul_add(c_q12, x207, x228),
-            ),
+            x397 - x401,
+            Self::mul_add(c_q11, x394, s_q11 * x393),
         );
-        let x263 = Self::mul_add(
-            0.36,
-            x240,
-            Self::mul_add(-0.36, x261, Self::mul_add(s_q12, x232, c_q12 * x229)),
+        let x411 = Self::mul_add(-0.36, Self::mul_add(x392, x392, x400), x395);
+        let x412 = Self::mul_add(s_q12, x411, Self::mul_add(x13, x410, c_q12 * x409));
+        let x413 = Self::mul_add(-c_q12, x411, Self::mul_add(-x14, x410, s_q12 * x409));
+        let x414 = Self::mul_add(-0.00000000020510342851533115, x411, x410);
+        let x415 = Self::mul_add(-0.00000000020510342851533115, x360, x398);
+        let x416 = Self::mul_add(
+            v[11],
+            x408,
+            Self::mul_add(s_q12, x360, Self::mul_add(x13, x398, c_q12 * x397)),
         );
-        let x264 = Self::mul_add(
-            0.36,
-            x242,
-            Self::mul_add(0.36, x260, Self::mul_add(-x106, x232, x105 * x229)),
-        );
-        let x265 = Self::mul_add(-s_q12, x226, c_q12 * x225);
-        let x266 = x227 - Self::mul_add(x106, x226, x105 * x225);
-        let x267 = 0.01675
-            + Self::mul_add(-0.36, x244, Self::mul_add(s_q12, x233, c_q12 * x231));
-        let x268 = 2.5482240016099564
-            - Self::mul_add(0.36, x243, Self::mul_add(-x106, x233, x105 * x231));
-        let x269 = 9.223235249762805 - Self::mul_add(-c_q12, x233, s_q12 * x231);
-        let x270 = -7.078399999258757 + x243;
-        let x271 = f_ext[5][5]
-            + Self::mul_add(-x94, x103, Self::mul_add(-x88, x100, x89 * x101))
-            - Self::mul_add(
-                0.00000000020510342851533115,
-                x224,
-                Self::mul_add(c_q12, x223, s_q12 * x222),
-            );
-        let x272 = 1.0 / x269;
-        let x273 = tau[4] + x271;
-        let x274 = x267 * x272;
-        let x275 = x268 * x272;
-        let x276 = x270 * x272;
-        let x277 = x244 * x272;
-        let x278 = x245 * x272;
-        let x279 = Self::mul_add(-x267, x274, Self::mul_add(0.36, x241, -x262));
-        let x280 = Self::mul_add(-x267, x275, x263);
-        let x281 = Self::mul_add(-x268, x275, -9.142025249762803 - x264);
-        let x282 = Self::mul_add(x267, x276, x240 + x258);
-        let x283 = Self::mul_add(x267, x277, x259);
-        let x284 = Self::mul_add(
-            x267,
-            x278,
-            7.078399999258757
-                + Self::mul_add(0.36, x257, Self::mul_add(s_q12, x239, c_q12 * x236)),
-        );
-        let x285 = Self::mul_add(-x268, x276, x260);
-        let x286 = Self::mul_add(-x268, x277, x261);
-        let x287 = Self::mul_add(
-            -x268,
-            x278,
-            Self::mul_add(0.36, x255, Self::mul_add(-x106, x239, x105 * x236)),
-        );
-        let x288 = Self::mul_add(x270, x276, x253);
-        let x289 = Self::mul_add(-x270, x277, x254);
-        let x290 = Self::mul_add(x270, x278, x255);
-        let x291 = Self::mul_add(x244, x277, x256);
-        let x292 = Self::mul_add(-x244, x278, x257);
-        let x293 = Self::mul_add(
-            x245,
-            x278,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x252,
-                Self::mul_add(-c_q12, x251, s_q12 * x249),
-            ),
-        );
-        let x294 = Self::mul_add(
-            -x273,
-            x274,
-            f_ext[5][3]
-                - Self::mul_add(-x94, x104, Self::mul_add(-x89, x102, x99 * x100))
-                + Self::mul_add(0.36, x266, Self::mul_add(-s_q12, x223, c_q12 * x222))
-                - (Self::mul_add(x96, x280, x95 * x279)
-                    - Self::mul_add(-x98, x283, x97 * x282)),
-        );
-        let x295 = Self::mul_add(
-            -x273,
-            x275,
-            f_ext[5][4]
-                - (Self::mul_add(-x88, x102, x99 * x101)
-                    - Self::mul_add(x93, x104, x92 * x103))
-                + Self::mul_add(
-                    -0.36,
-                    x265,
-                    x224 - Self::mul_add(x106, x223, x105 * x222),
-                )
-                - (Self::mul_add(x96, x281, x95 * x280)
-                    + Self::mul_add(-x98, x286, x97 * x285)),
-        );
-        let x296 = Self::mul_add(
-            -x273,
-            x276,
-            Self::mul_add(x89, x104, f_ext[5][0]) + x265
-                + (Self::mul_add(-x96, x285, x95 * x282)
-                    + Self::mul_add(x98, x289, x97 * x288)),
-        );
-        let x297 = Self::mul_add(
-            x273,
-            x277,
-            f_ext[5][1] + Self::mul_add(x88, x104, x99 * x103) + x266
-                - (Self::mul_add(-x96, x286, x95 * x283)
-                    - Self::mul_add(x98, x291, x97 * x289)),
-        );
-        let x298 = Self::mul_add(
-            x273,
-            x278,
-            Self::mul_add(-x89, x103, f_ext[5][2])
-                - Self::mul_add(
-                    0.00000000020510342851533115,
-                    x227,
-                    Self::mul_add(c_q12, x226, s_q12 * x225),
-                )
-                - (Self::mul_add(-x96, x287, x95 * x284)
-                    + Self::mul_add(x98, x292, x97 * x290)),
-        );
-        let x299 = s_q11 * x280;
-        let x300 = c_q11 * x280;
-        let x301 = Self::mul_add(s_q11, x279, x300);
-        let x302 = Self::mul_add(c_q11, x281, x299);
-        let x303 = Self::mul_add(s_q11, x283, c_q11 * x282);
-        let x304 = Self::mul_add(-c_q11, x283, s_q11 * x282);
-        let x305 = Self::mul_add(s_q11, x286, c_q11 * x285);
-        let x306 = Self::mul_add(-c_q11, x286, s_q11 * x285);
-        let x307 = Self::mul_add(s_q11, x305, c_q11 * x303);
-        let x308 = Self::mul_add(s_q11, x306, c_q11 * x304);
-        let x309 = Self::mul_add(s_q11, x287, c_q11 * x284);
-        let x310 = Self::mul_add(-c_q11, x305, s_q11 * x303);
-        let x311 = s_q11 * x289;
-        let x312 = c_q11 * x289;
-        let x313 = Self::mul_add(s_q11, x288, x312);
-        let x314 = Self::mul_add(c_q11, x291, x311);
-        let x315 = Self::mul_add(-s_q11, x292, c_q11 * x290);
-        let x316 = Self::mul_add(c_q11, x292, s_q11 * x290);
-        let x317 = Self::mul_add(
-            -s_q11,
-            Self::mul_add(-s_q11, x291, x312),
-            c_q11 * Self::mul_add(c_q11, x288, -x311),
-        );
-        let x318 = Self::mul_add(-s_q11, x314, c_q11 * x313);
-        let x319 = Self::mul_add(c_q11, x314, s_q11 * x313);
-        let x320 = 0.275 * x318;
-        let x321 = 0.63 * x315;
-        let x322 = 0.63 * x317;
-        let x323 = 0.63 * x318;
-        let x324 = x308 + Self::mul_add(0.63, x316, 0.275 * x319);
-        let x325 = x309 + Self::mul_add(0.63, x293, 0.275 * x316);
-        let x326 = Self::mul_add(-0.275, x317, x310);
-        let x327 = Self::mul_add(-c_q11, x306, s_q11 * x304) - x320;
-        let x328 = Self::mul_add(
-            -0.275,
-            x315,
-            Self::mul_add(-c_q11, x287, s_q11 * x284),
-        );
-        let x329 = Self::mul_add(
-            0.275,
-            x310,
-            Self::mul_add(0.275, x326, Self::mul_add(c_q11, x302, s_q11 * x301)),
-        );
-        let x330 = Self::mul_add(-s_q11, x297, c_q11 * x296);
-        let x331 = Self::mul_add(c_q11, x297, s_q11 * x296);
-        let x332 = -0.6328
-            - Self::mul_add(0.63, x307, Self::mul_add(0.63, x321, 0.275 * x323));
-        let x333 = -24.35164200091464 + Self::mul_add(-0.63, x310, 0.275 * x322);
-        let x334 = Self::mul_add(-0.63, x322, 28.2393615);
-        let x335 = 45.1584 - x322;
-        let x336 = f_ext[4][5]
-            - Self::mul_add(-x77, x86, Self::mul_add(x72, x83, x73 * x84))
-            + Self::mul_add(0.63, x330, Self::mul_add(-x273, x269 * x272, x271));
-        let x337 = 1.0 / x334;
-        let x338 = tau[3] + x336;
-        let x339 = x332 * x337;
-        let x340 = x333 * x337;
-        let x341 = x335 * x337;
-        let x342 = x323 * x337;
-        let x343 = x321 * x337;
-        let x344 = Self::mul_add(
-            x332,
-            x339,
-            Self::mul_add(0.63, x309, 0.275 * x308)
-                - (Self::mul_add(
-                    -s_q11,
-                    Self::mul_add(-s_q11, x281, x300),
-                    c_q11 * Self::mul_add(c_q11, x279, -x299),
-                ) - Self::mul_add(0.63, x325, 0.275 * x324)),
-        );
-        let x345 = Self::mul_add(
-            -x332,
-            x340,
-            Self::mul_add(
-                0.275,
-                x307,
-                Self::mul_add(-s_q11, x302, c_q11 * x301)
-                    - Self::mul_add(0.63, x328, 0.275 * x327),
-            ),
-        );
-        let x346 = Self::mul_add(-x333, x340, -24.4950615 + x329);
-        let x347 = Self::mul_add(x332, x341, x307 + (x320 + x321));
-        let x348 = Self::mul_add(-x332, x342, x324);
-        let x349 = Self::mul_add(-x332, x343, -45.1584 + x325);
-        let x350 = Self::mul_add(x333, x341, x326);
-        let x351 = Self::mul_add(-x333, x342, x327);
-        let x352 = Self::mul_add(-x333, x343, x328);
-        let x353 = Self::mul_add(x335, x341, x317);
-        let x354 = Self::mul_add(-x335, x342, x318);
-        let x355 = Self::mul_add(-x335, x343, x315);
-        let x356 = Self::mul_add(x323, x342, x319);
-        let x357 = Self::mul_add(x323, x343, x316);
-        let x358 = Self::mul_add(x321, x343, x293);
-        let x359 = Self::mul_add(
-            -x338,
-            x339,
-            f_ext[4][3] - Self::mul_add(x77, x87, Self::mul_add(x73, x85, x82 * x83))
-                + (Self::mul_add(-s_q11, x295, c_q11 * x294)
-                    + Self::mul_add(-0.63, x298, 0.275 * x331))
-                + (Self::mul_add(-x79, x345, x78 * x344)
-                    + Self::mul_add(x81, x348, x80 * x347)),
-        );
-        let x360 = Self::mul_add(
-            -x338,
-            x340,
-            f_ext[4][4]
-                + (Self::mul_add(-x72, x85, x82 * x84)
-                    - Self::mul_add(x76, x87, x75 * x86))
-                + Self::mul_add(-0.275, x330, Self::mul_add(c_q11, x295, s_q11 * x294))
-                - (Self::mul_add(x79, x346, x78 * x345)
-                    - Self::mul_add(x81, x351, x80 * x350)),
-        );
-        let x361 = Self::mul_add(
-            -x338,
-            x341,
-            Self::mul_add(-x73, x87, f_ext[4][0]) + x330
-                + (Self::mul_add(x79, x350, x78 * x347)
-                    + Self::mul_add(x81, x354, x80 * x353)),
-        );
-        let x362 = Self::mul_add(
-            x338,
-            x342,
-            f_ext[4][1] - Self::mul_add(x72, x87, x82 * x86) + x331
-                + (Self::mul_add(x79, x351, x78 * x348)
-                    + Self::mul_add(x81, x356, x80 * x354)),
-        );
-        let x363 = Self::mul_add(
-            -x338,
-            x343,
-            Self::mul_add(x73, x86, f_ext[4][2]) + x298
-                - (Self::mul_add(x79, x352, x78 * x349)
-                    + Self::mul_add(x81, x357, x80 * x355)),
-        );
-        let x364 = s_q10 * x345;
-        let x365 = c_q10 * x345;
-        let x366 = Self::mul_add(s_q10, x344, -x365);
-        let x367 = Self::mul_add(c_q10, x346, x364);
-        let x368 = Self::mul_add(-s_q10, x348, c_q10 * x347);
-        let x369 = Self::mul_add(c_q10, x348, s_q10 * x347);
-        let x370 = Self::mul_add(-s_q10, x351, c_q10 * x350);
-        let x371 = Self::mul_add(c_q10, x351, s_q10 * x350);
-        let x372 = Self::mul_add(-s_q10, x370, c_q10 * x368);
-        let x373 = Self::mul_add(-s_q10, x352, c_q10 * x349);
-        let x374 = Self::mul_add(c_q10, x370, s_q10 * x368);
-        let x375 = Self::mul_add(c_q10, x352, s_q10 * x349);
-        let x376 = s_q10 * x354;
-        let x377 = c_q10 * x354;
-        let x378 = Self::mul_add(s_q10, x353, x377);
-        let x379 = Self::mul_add(c_q10, x356, x376);
-        let x380 = Self::mul_add(-s_q10, x357, c_q10 * x355);
-        let x381 = Self::mul_add(c_q10, x357, s_q10 * x355);
-        let x382 = Self::mul_add(
-            -s_q10,
-            Self::mul_add(-s_q10, x356, x377),
-            c_q10 * Self::mul_add(c_q10, x353, -x376),
-        );
-        let x383 = Self::mul_add(-s_q10, x379, c_q10 * x378);
-        let x384 = 0.87 * x380;
-        let x385 = 0.87 * x382;
-        let x386 = 0.87 * x383;
-        let x387 = Self::mul_add(0.87, x358, x373);
-        let x388 = Self::mul_add(
-            0.87,
-            x387,
-            Self::mul_add(
-                s_q10,
-                Self::mul_add(-s_q10, x346, x365),
-                c_q10 * Self::mul_add(c_q10, x344, x364),
-            ),
-        );
-        let x389 = Self::mul_add(-s_q10, x362, c_q10 * x361);
-        let x390 = -0.00214 - Self::mul_add(0.87, x372, 0.87 * x384);
-        let x391 = Self::mul_add(-0.87, x374, -36.18604050126307);
-        let x392 = Self::mul_add(-0.87, x385, 69.99836825);
-        let x393 = 81.53205 - x385;
-        let x394 = f_ext[3][5]
-            + Self::mul_add(-x60, x70, Self::mul_add(x54, x67, x55 * x68))
-            + Self::mul_add(0.87, x389, Self::mul_add(-x338, x334 * x337, x336));
-        let x395 = 1.0 / x392;
-        let x396 = tau[2] + x394;
-        let x397 = x390 * x395;
-        let x398 = x391 * x395;
-        let x399 = x393 * x395;
-        let x400 = x386 * x395;
-        let x401 = x384 * x395;
-        let x402 = Self::mul_add(x390, x397, Self::mul_add(0.87, x373, x388));
-        let x403 = Self::mul_add(
-            x390,
-            x398,
-            Self::mul_add(0.87, x375, Self::mul_add(s_q10, x367, c_q10 * x366)),
-        );
-        let x404 = Self::mul_add(
-            -x391,
-            x398,
-            -63.36336825000001 - Self::mul_add(-c_q10, x367, s_q10 * x366),
-        );
-        let x405 = Self::mul_add(x390, x399, x372 + x384);
-        let x406 = Self::mul_add(
-            -x390,
-            x400,
-            Self::mul_add(0.87, x381, Self::mul_add(-s_q10, x371, c_q10 * x369)),
-        );
-        let x407 = Self::mul_add(-x390, x401, -81.53205 + x387);
-        let x408 = Self::mul_add(x391, x399, x374);
-        let x409 = Self::mul_add(-x391, x400, Self::mul_add(c_q10, x371, s_q10 * x369));
-        let x410 = Self::mul_add(-x391, x401, x375);
-        let x411 = Self::mul_add(x393, x399, x382);
-        let x412 = Self::mul_add(-x393, x400, x383);
-        let x413 = Self::mul_add(-x393, x401, x380);
-        let x414 = Self::mul_add(x386, x400, Self::mul_add(c_q10, x379, s_q10 * x378));
-        let x415 = Self::mul_add(x386, x401, x381);
-        let x416 = Self::mul_add(x384, x401, x358);
         let x417 = Self::mul_add(
-            -x396,
-            x397,
-            f_ext[3][3] + Self::mul_add(x60, x71, Self::mul_add(x55, x69, x66 * x67))
-                + Self::mul_add(-0.87, x363, Self::mul_add(-s_q10, x360, c_q10 * x359))
-                - (Self::mul_add(-x63, x403, x62 * x402)
-                    + Self::mul_add(-x65, x406, x64 * x405)),
+            -v[11],
+            x407,
+            Self::mul_add(-c_q12, x360, Self::mul_add(-x14, x398, s_q12 * x397)),
         );
-        let x418 = Self::mul_add(
-            -x396,
-            x398,
-            f_ext[3][4]
-                + (Self::mul_add(-x54, x69, x66 * x68)
-                    - Self::mul_add(x59, x71, x61 * x70))
-                + Self::mul_add(c_q10, x360, s_q10 * x359)
-                - (Self::mul_add(x63, x404, x62 * x403)
-                    + Self::mul_add(-x65, x409, x64 * x408)),
+        let x418 = v[11] + Self::mul_add(-0.00000000020510342851533115, x399, x392);
+        let x419 = x408 * x408;
+        let x420 = x418 * x418;
+        let x421 = x407 * x408;
+        let x422 = x415 - x421;
+        let x423 = x407 * x418;
+        let x424 = x407 * x407;
+        let x425 = x420 + x424;
+        let x426 = x408 * x418;
+        let x427 = x416 + x426;
+        let x428 = Self::mul_add(x418, 0.809539999555672, x408 * 1.9877000000000002);
+        let x429 = Self::mul_add(
+            x418,
+            -2.741639999592316,
+            Self::mul_add(x408, -5.252920330000002, x407 * 1.9877000000000002),
         );
-        let x419 = Self::mul_add(-x396, x392 * x395, x394);
-        let x420 = Self::mul_add(
-            -x396,
-            x399,
-            Self::mul_add(x55, x71, f_ext[3][0]) + x389
-                - (Self::mul_add(-x63, x408, x62 * x405)
-                    + Self::mul_add(-x65, x412, x64 * x411)),
+        let x430 = Self::mul_add(
+            9.740442170000001,
+            x418,
+            Self::mul_add(x408, -2.7416399995923166, x407 * 0.809539999555672),
         );
-        let x421 = Self::mul_add(
-            x396,
-            x400,
-            f_ext[3][1] - Self::mul_add(x54, x71, x66 * x70)
-                + Self::mul_add(c_q10, x362, s_q10 * x361)
-                - (Self::mul_add(-x63, x409, x62 * x406)
-                    + Self::mul_add(-x65, x414, x64 * x412)),
-        );
-        let x422 = Self::mul_add(
-            -x396,
-            x401,
-            Self::mul_add(-x55, x70, f_ext[3][2]) + x363
-                + (Self::mul_add(-x63, x410, x62 * x407)
-                    + Self::mul_add(-x65, x415, x64 * x413)),
-        );
-        let x423 = c_q9 * x403;
-        let x424 = Self::mul_add(-x53, x403, x52 * x402);
-        let x425 = s_q9 * x403;
-        let x426 = Self::mul_add(c_q9, x402, -x425);
-        let x427 = Self::mul_add(x53, x404, x52 * x403);
-        let x428 = Self::mul_add(s_q9, x404, x423);
-        let x429 = 0.00000000020510342851533115 * x407;
-        let x430 = Self::mul_add(c_q9, x406, s_q9 * x405) - x429;
-        let x431 = x407 - Self::mul_add(-x53, x406, x52 * x405);
-        let x432 = x429 + Self::mul_add(-s_q9, x406, c_q9 * x405);
-        let x433 = 0.00000000020510342851533115 * x410;
-        let x434 = Self::mul_add(c_q9, x409, s_q9 * x408) - x433;
-        let x435 = x410 - Self::mul_add(-x53, x409, x52 * x408);
-        let x436 = x433 + Self::mul_add(-s_q9, x409, c_q9 * x408);
-        let x437 = Self::mul_add(c_q9, x434, s_q9 * x430);
-        let x438 = Self::mul_add(c_q9, x435, s_q9 * x431);
-        let x439 = Self::mul_add(c_q9, x436, s_q9 * x432);
-        let x440 = Self::mul_add(-x53, x434, x52 * x430);
-        let x441 = Self::mul_add(-s_q9, x434, c_q9 * x430);
-        let x442 = c_q9 * x412;
-        let x443 = 0.00000000020510342851533115 * x413;
-        let x444 = x413 - Self::mul_add(-x53, x412, x52 * x411);
-        let x445 = s_q9 * x412;
-        let x446 = x443 + Self::mul_add(c_q9, x411, -x445);
-        let x447 = 0.00000000020510342851533115 * x415;
-        let x448 = x415 - Self::mul_add(-x53, x414, x52 * x412);
-        let x449 = x447 + Self::mul_add(-s_q9, x414, x442);
-        let x450 = 0.00000000020510342851533115 * x416;
-        let x451 = x416 - Self::mul_add(-x53, x415, x52 * x413);
-        let x452 = x450 + Self::mul_add(-s_q9, x415, c_q9 * x413);
-        let x453 = Self::mul_add(
-            -0.00000000020510342851533115,
-            Self::mul_add(c_q9, x415, s_q9 * x413) - x450,
+        let x431 = Self::mul_add(
+            -3.6140000000000003,
+            x414,
             Self::mul_add(
-                c_q9,
-                Self::mul_add(c_q9, x414, x445) - x447,
-                s_q9 * (Self::mul_add(s_q9, x411, x442) - x443),
+                x415,
+                -2.741639999592316,
+                Self::mul_add(x417, -5.252920330000002, x416 * 1.9877000000000002),
+            ) + Self::mul_add(-x407, x430, x418 * x428),
+        );
+        let x432 = Self::mul_add(-c_q13, x418, Self::mul_add(s_q13, x408, x15 * x407));
+        let x433 = Self::mul_add(-s_q13, x418, Self::mul_add(-c_q13, x408, x16 * x407));
+        let x434 = x412 + Self::mul_add(-0.16, x417 + x423, 0.55 * x422);
+        let x435 = x414 - Self::mul_add(-0.16, x419 + x424, 0.55 * x427);
+        let x436 = Self::mul_add(
+            -c_q13,
+            x435,
+            Self::mul_add(
+                s_q13,
+                x413 + Self::mul_add(0.16, x416 - x426, 0.55 * x425),
+                x15 * x434,
             ),
         );
-        let x454 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x451,
-            Self::mul_add(c_q9, x448, s_q9 * x444),
+        let x437 = Self::mul_add(0.00000000020510342851533115, x415, x416);
+        let x438 = Self::mul_add(
+            v[12],
+            x433,
+            Self::mul_add(-c_q13, x415, Self::mul_add(s_q13, x417, x15 * x416)),
         );
-        let x455 = 0.00000000020510342851533115 * x452;
-        let x456 = Self::mul_add(c_q9, x449, s_q9 * x446) - x455;
-        let x457 = x451 - Self::mul_add(-x53, x448, x52 * x444);
-        let x458 = x452 - Self::mul_add(-x53, x449, x52 * x446);
-        let x459 = x455 + Self::mul_add(-s_q9, x449, c_q9 * x446);
-        let x460 = 0.4 * x454;
-        let x461 = 0.275 * x456;
-        let x462 = x438 + Self::mul_add(0.275, x458, 0.4 * x457);
-        let x463 = x439 + Self::mul_add(0.275, x459, 0.4 * x458);
-        let x464 = Self::mul_add(0.4, x453, x440);
-        let x465 = Self::mul_add(-x53, x435, x52 * x431) + x460;
-        let x466 = Self::mul_add(0.4, x456, Self::mul_add(-x53, x436, x52 * x432));
-        let x467 = Self::mul_add(-0.275, x453, x441);
-        let x468 = Self::mul_add(-0.275, x454, Self::mul_add(-s_q9, x435, c_q9 * x431));
-        let x469 = Self::mul_add(-s_q9, x436, c_q9 * x432) - x461;
-        let x470 = Self::mul_add(
-            0.4,
+        let x439 = Self::mul_add(
+            -v[12],
+            x432,
+            Self::mul_add(-s_q13, x415, Self::mul_add(-c_q13, x417, x16 * x416)),
+        );
+        let x440 = v[12] - Self::mul_add(0.00000000020510342851533115, x418, x407);
+        let x441 = Self::mul_add(0.0145, x440, 0.000781 * x433);
+        let x442 = Self::mul_add(
+            -0.9614610000000001,
             x440,
-            Self::mul_add(0.4, x464, Self::mul_add(-x53, x427, x52 * x424)),
+            Self::mul_add(1.2025609200000003, x433, 0.000781 * x432),
         );
-        let x471 = Self::mul_add(
-            0.275,
+        let x443 = Self::mul_add(
+            -1.4135609200000003,
             x440,
-            -Self::mul_add(0.4, x467, Self::mul_add(-x53, x428, x52 * x426)),
+            Self::mul_add(-0.9614610000000001, x433, 0.0145 * x432),
         );
-        let x472 = Self::mul_add(
-            0.275,
-            x441,
-            -Self::mul_add(-0.275, x467, Self::mul_add(-s_q9, x428, c_q9 * x426)),
-        );
-        let x473 = 0.00000000020510342851533115 * x422;
-        let x474 = Self::mul_add(c_q9, x421, s_q9 * x420) + x473;
-        let x475 = x422 + Self::mul_add(-x53, x421, x52 * x420);
-        let x476 = x473 - Self::mul_add(-s_q9, x421, c_q9 * x420);
-        let x477 = 0.00000000020510342851533115 * x419;
-        let x478 = -0.002139996587640933
-            + Self::mul_add(
-                0.275,
-                x437,
-                -(Self::mul_add(c_q9, x428, s_q9 * x426)
-                    + Self::mul_add(0.275, x469, 0.4 * x468)),
-            );
-        let x479 = 5.080660024070365 + x471;
-        let x480 = 113.3918902508081 + x472;
-        let x481 = 12.701650001451807 - x467;
-        let x482 = -0.000000008530897668050218 + x468;
-        let x483 = f_ext[2][5]
-            - (Self::mul_add(-x32, x45, x33 * x44) - Self::mul_add(-x36, x48, x37 * x47))
-            - Self::mul_add(0.275, x474, x477 - Self::mul_add(-s_q9, x418, c_q9 * x417));
-        let x484 = 1.0 / x480;
-        let x485 = tau[1] + x483;
-        let x486 = x478 * x484;
-        let x487 = x479 * x484;
-        let x488 = x481 * x484;
-        let x489 = x482 * x484;
-        let x490 = x469 * x484;
-        let x491 = Self::mul_add(
-            x478,
-            x486,
-            Self::mul_add(0.275, x439, 0.4 * x438)
-                + (Self::mul_add(
-                    c_q9,
-                    Self::mul_add(-c_q9, x404, x425),
-                    s_q9 * Self::mul_add(s_q9, x402, x423),
-                ) + Self::mul_add(0.275, x463, 0.4 * x462)),
-        );
-        let x492 = Self::mul_add(
-            -x478,
-            x487,
-            -0.0000000234896432582596
-                - Self::mul_add(
-                    0.4,
-                    x437,
-                    Self::mul_add(c_q9, x427, s_q9 * x424)
-                        + Self::mul_add(0.275, x466, 0.4 * x465),
-                ),
-        );
-        let x493 = Self::mul_add(-x479, x487, -111.7548902508081 - x470);
-        let x494 = Self::mul_add(x478, x488, x437 + (x460 + x461));
-        let x495 = Self::mul_add(-x478, x489, x462);
-        let x496 = Self::mul_add(x478, x490, -12.701650001451807 - x463);
-        let x497 = Self::mul_add(x479, x488, x464);
-        let x498 = Self::mul_add(-x479, x489, x465);
-        let x499 = Self::mul_add(x479, x490, 0.000000008530897668050218 - x466);
-        let x500 = Self::mul_add(x481, x488, x453);
-        let x501 = Self::mul_add(-x481, x489, x454);
-        let x502 = Self::mul_add(-x481, x490, x456);
-        let x503 = Self::mul_add(x482, x489, x457);
-        let x504 = Self::mul_add(x482, x490, x458);
-        let x505 = Self::mul_add(x469, x490, x459);
-        let x506 = Self::mul_add(
-            -x485,
-            x486,
-            f_ext[2][3]
-                + (Self::mul_add(-x33, x46, x43 * x45)
-                    - Self::mul_add(x37, x49, x38 * x48))
-                + (Self::mul_add(c_q9, x418, s_q9 * x417) + x477
-                    - Self::mul_add(0.275, x476, 0.4 * x475))
-                + (Self::mul_add(-x40, x492, x39 * x491)
-                    + Self::mul_add(-x42, x495, x41 * x494)),
-        );
-        let x507 = Self::mul_add(
-            -x485,
-            x487,
-            f_ext[2][4]
-                + (Self::mul_add(-x32, x46, x43 * x44)
-                    - Self::mul_add(x36, x49, x38 * x47))
-                + Self::mul_add(0.4, x474, x419 + Self::mul_add(-x53, x418, x52 * x417))
-                - (Self::mul_add(x40, x493, x39 * x492)
-                    - Self::mul_add(-x42, x498, x41 * x497)),
-        );
-        let x508 = Self::mul_add(-x485, x480 * x484, x483);
-        let x509 = Self::mul_add(
-            -x485,
-            x488,
-            f_ext[2][0] - Self::mul_add(x33, x49, x43 * x48) + x474
-                + (Self::mul_add(x40, x497, x39 * x494)
-                    + Self::mul_add(-x42, x501, x41 * x500)),
-        );
-        let x510 = Self::mul_add(
-            -x485,
-            x489,
-            f_ext[2][1] - Self::mul_add(x32, x49, x43 * x47) + x475
-                - (Self::mul_add(x40, x498, x39 * x495)
-                    + Self::mul_add(-x42, x503, x41 * x501)),
-        );
-        let x511 = Self::mul_add(
-            x485,
-            x490,
-            f_ext[2][2] + Self::mul_add(-x32, x48, x33 * x47) - x476
-                - (Self::mul_add(x40, x499, x39 * x496)
-                    - Self::mul_add(-x42, x504, x41 * x502)),
-        );
-        let x512 = c_q8 * x492;
-        let x513 = Self::mul_add(s_q8, x491, -x512);
-        let x514 = s_q8 * x492;
-        let x515 = Self::mul_add(c_q8, x491, x514);
-        let x516 = Self::mul_add(c_q8, x493, x514);
-        let x517 = Self::mul_add(-s_q8, x493, x512);
-        let x518 = x496 + Self::mul_add(x31, x495, x30 * x494);
-        let x519 = Self::mul_add(-c_q8, x495, s_q8 * x494);
-        let x520 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x496,
-            Self::mul_add(s_q8, x495, c_q8 * x494),
-        );
-        let x521 = x499 + Self::mul_add(x31, x498, x30 * x497);
-        let x522 = Self::mul_add(-c_q8, x498, s_q8 * x497);
-        let x523 = Self::mul_add(
-            -0.00000000020510342851533115,
-            x499,
-            Self::mul_add(s_q8, x498, c_q8 * x497),
-        );
-        let x524 = Self::mul_add(-x31, x521, x30 * x518);
-        let x525 = Self::mul_add(-x31, x522, x30 * x519);
-        let x526 = Self::mul_add(c_q8, x521, s_q8 * x518);
-        let x527 = Self::mul_add(-s_q8, x521, c_q8 * x518);
-        let x528 = Self::mul_add(-s_q8, x522, c_q8 * x519);
-        let x529 = Self::mul_add(-s_q8, x523, c_q8 * x520);
-        let x530 = c_q8 * x501;
-        let x531 = Self::mul_add(s_q8, x500, -x530);
-        let x532 = s_q8 * x501;
-        let x533 = Self::mul_add(
-            0.00000000020510342851533115,
-            x502,
-            Self::mul_add(c_q8, x500, x532),
-        );
-        let x534 = Self::mul_add(-c_q8, x503, x532);
-        let x535 = Self::mul_add(
-            0.00000000020510342851533115,
-            x504,
-            Self::mul_add(s_q8, x503, x530),
-        );
-        let x536 = Self::mul_add(
-            0.00000000020510342851533115,
-            x505,
-            Self::mul_add(s_q8, x504, c_q8 * x502),
-        );
-        let x537 = x505 - Self::mul_add(x31, x504, x30 * x502)
-            - Self::mul_add(
-                x31,
-                x504 - Self::mul_add(x31, x503, x30 * x501),
-                x30 * (x502 - Self::mul_add(x31, x501, x30 * x500)),
-            );
-        let x538 = Self::mul_add(-c_q8, x504, s_q8 * x502)
-            - Self::mul_add(x31, x534, x30 * x531);
-        let x539 = x536 - Self::mul_add(x31, x535, x30 * x533);
-        let x540 = Self::mul_add(-c_q8, x534, s_q8 * x531);
-        let x541 = Self::mul_add(-c_q8, x535, s_q8 * x533);
-        let x542 = 0.35 * x538;
-        let x543 = Self::mul_add(0.35, x540, x525);
-        let x544 = Self::mul_add(-0.35, x537, x526);
-        let x545 = Self::mul_add(c_q8, x522, s_q8 * x519) + x542;
-        let x546 = Self::mul_add(
-            0.35,
-            x543,
-            Self::mul_add(
-                x31,
-                Self::mul_add(-x31, x493, x30 * x492),
-                x30 * Self::mul_add(x31, x492, x30 * x491),
-            ),
-        );
-        let x547 = Self::mul_add(
-            0.35,
-            x524,
-            -Self::mul_add(0.35, x545, Self::mul_add(x31, x516, x30 * x513)),
-        );
-        let x548 = Self::mul_add(
-            0.35,
-            x526,
-            -Self::mul_add(-0.35, x544, Self::mul_add(-c_q8, x516, s_q8 * x513)),
-        );
-        let x549 = x511 - Self::mul_add(-x31, x510, x30 * x509);
-        let x550 = Self::mul_add(c_q8, x510, s_q8 * x509);
-        let x551 = -16.80768997608804
-            - Self::mul_add(0.35, x528, Self::mul_add(x31, x517, x30 * x515));
-        let x552 = 0.1132
-            + Self::mul_add(-0.35, x527, Self::mul_add(-c_q8, x517, s_q8 * x515));
-        let x553 = 132.47349025763282 - Self::mul_add(s_q8, x517, c_q8 * x515);
-        let x554 = 48.0240000085309 + x528;
-        let x555 = f_ext[1][5]
-            - Self::mul_add(x18, x28, Self::mul_add(-x13, x26, x14 * x25))
-            - Self::mul_add(
-                0.00000000020510342851533115,
-                x508,
-                Self::mul_add(-s_q8, x507, c_q8 * x506),
-            );
-        let x556 = 1.0 / x553;
-        let x557 = tau[0] + x555;
-        let x558 = x551 * x556;
-        let x559 = x552 * x556;
-        let x560 = x527 * x556;
-        let x561 = x554 * x556;
-        let x562 = x529 * x556;
-        let x563 = Self::mul_add(x551, x558, Self::mul_add(0.35, x525, x546));
-        let x564 = Self::mul_add(-x551, x559, -0.07309 - x547);
-        let x565 = Self::mul_add(-x552, x559, 130.43769025763282 + x548);
-        let x566 = Self::mul_add(-x551, x560, x524 - x542);
-        let x567 = Self::mul_add(-x551, x561, x543);
-        let x568 = Self::mul_add(
-            -x551,
-            x562,
-            Self::mul_add(0.35, x541, Self::mul_add(-x31, x523, x30 * x520)),
-        );
-        let x569 = Self::mul_add(x552, x560, x544);
-        let x570 = Self::mul_add(x552, x561, x545);
-        let x571 = Self::mul_add(
-            x552,
-            x562,
-            -48.0240000085309
-                + Self::mul_add(0.35, x539, Self::mul_add(c_q8, x523, s_q8 * x520)),
-        );
-        let x572 = Self::mul_add(x527, x560, x537);
-        let x573 = Self::mul_add(-x527, x561, x538);
-        let x574 = Self::mul_add(-x527, x562, x539);
-        let x575 = Self::mul_add(x554, x561, x540);
-        let x576 = Self::mul_add(x554, x562, x541);
-        let x577 = Self::mul_add(
-            x529,
-            x562,
-            Self::mul_add(
-                0.00000000020510342851533115,
-                x536,
-                Self::mul_add(s_q8, x535, c_q8 * x533),
-            ),
-        );
-        let x578 = Self::mul_add(
-            -x557,
-            x558,
-            f_ext[1][3]
-                - (Self::mul_add(x14, x27, x24 * x26)
-                    - Self::mul_add(x19, x29, x17 * x28))
-                + Self::mul_add(
-                    -0.35,
-                    x550,
-                    x508 - Self::mul_add(-x31, x507, x30 * x506),
-                )
-                - (Self::mul_add(-x21, x564, x20 * x563)
-                    + Self::mul_add(-x23, x567, x22 * x566)),
-        );
-        let x579 = Self::mul_add(
-            -x557,
-            x559,
-            f_ext[1][4] - Self::mul_add(-x18, x29, Self::mul_add(x13, x27, x24 * x25))
-                + Self::mul_add(0.35, x549, Self::mul_add(c_q8, x507, s_q8 * x506))
-                + (Self::mul_add(x21, x565, x20 * x564)
-                    + Self::mul_add(-x23, x570, x22 * x569)),
-        );
-        let x580 = Self::mul_add(
-            x557,
-            x560,
-            f_ext[1][0] + Self::mul_add(x14, x29, x24 * x28) + x549
-                - (Self::mul_add(-x21, x569, x20 * x566)
-                    + Self::mul_add(x23, x573, x22 * x572)),
-        );
-        let x581 = Self::mul_add(
-            -x557,
-            x561,
-            Self::mul_add(x13, x29, f_ext[1][1]) + x550
-                + (Self::mul_add(-x21, x570, x20 * x567)
-                    - Self::mul_add(x23, x575, x22 * x573)),
-        );
-        let x582 = Self::mul_add(
-            x557,
-            x562,
-            Self::mul_add(-x13, x28, f_ext[1][2])
-                - Self::mul_add(
-                    0.00000000020510342851533115,
-                    x511,
-                    Self::mul_add(-s_q8, x510, c_q8 * x509),
-                )
-                - (Self::mul_add(-x21, x571, x20 * x568)
-                    - Self::mul_add(x23, x576, x22 * x574)),
-        );
-        let x583 = s_q7 * x564;
-        let x584 = c_q7 * x564;
-        let x585 = Self::mul_add(s_q7, x563, -x584);
-        let x586 = Self::mul_add(c_q7, x565, x583);
-        let x587 = Self::mul_add(s_q7, x567, c_q7 * x566);
-        let x588 = Self::mul_add(-c_q7, x567, s_q7 * x566);
-        let x589 = Self::mul_add(s_q7, x570, c_q7 * x569);
-        let x590 = Self::mul_add(-c_q7, x570, s_q7 * x569);
-        let x591 = Self::mul_add(s_q7, x589, c_q7 * x587);
-        let x592 = Self::mul_add(s_q7, x590, c_q7 * x588);
-        let x593 = Self::mul_add(s_q7, x571, c_q7 * x568);
-        let x594 = Self::mul_add(-c_q7, x589, s_q7 * x587);
-        let x595 = Self::mul_add(-c_q7, x590, s_q7 * x588);
-        let x596 = Self::mul_add(-c_q7, x571, s_q7 * x568);
-        let x597 = s_q7 * x573;
-        let x598 = c_q7 * x573;
-        let x599 = Self::mul_add(s_q7, x572, x598);
-        let x600 = Self::mul_add(c_q7, x575, x597);
-        let x601 = Self::mul_add(-s_q7, x576, c_q7 * x574);
-        let x602 = Self::mul_add(c_q7, x576, s_q7 * x574);
-        let x603 = Self::mul_add(
-            -s_q7,
-            Self::mul_add(-s_q7, x575, x598),
-            c_q7 * Self::mul_add(c_q7, x572, -x597),
-        );
-        let x604 = Self::mul_add(-s_q7, x600, c_q7 * x599);
-        let x605 = Self::mul_add(c_q7, x600, s_q7 * x599);
-        let x606 = 0.75 * x604;
-        let x607 = 0.65 * x604;
-        let x608 = 0.65 * x602;
-        let x609 = 0.65 * x605;
-        let x610 = x591 - x606;
-        let x611 = Self::mul_add(-0.75, x605, x592);
-        let x612 = x594 + Self::mul_add(0.65, x601, 0.75 * x603);
-        let x613 = x595 + (x606 + x608);
-        let x614 = x596 - Self::mul_add(0.65, x577, 0.75 * x601);
-        let x615 = Self::mul_add(
-            -0.75,
-            x611,
-            Self::mul_add(
-                s_q7,
-                Self::mul_add(-s_q7, x565, x584),
-                c_q7 * Self::mul_add(c_q7, x563, x583),
-            ),
-        );
-        let x616 = Self::mul_add(-s_q7, x581, c_q7 * x580);
-        let x617 = Self::mul_add(c_q7, x581, s_q7 * x580);
-        let x618 = 180.9502499901501 - x612;
-        let x619 = f_ext[0][0] + Self::mul_add(-v[4], x12, v[5] * x11) + x616;
-        let x620 = 1.0 / (1170.07 - x603);
-        let x621 = x604 * x620;
-        let x622 = x601 * x620;
-        let x623 = x610 * x620;
-        let x624 = x618 * x620;
-        let x625 = x607 * x620;
-        let x626 = 1.0 / Self::mul_add(-x604, x621, 1170.07 - x605);
-        let x627 = Self::mul_add(x604, x622, x602);
-        let x628 = x626 * x627;
-        let x629 = Self::mul_add(-x604, x623, -180.9502499901501 - x611);
-        let x630 = x626 * x629;
-        let x631 = Self::mul_add(-x604, x624, x613);
-        let x632 = x626 * x631;
-        let x633 = Self::mul_add(-x604, x625, 110.5455 - x609);
-        let x634 = x626 * x633;
-        let x635 = 1.0
-            / Self::mul_add(-x627, x628, Self::mul_add(-x601, x622, 1170.07 - x577));
-        let x636 = Self::mul_add(
-            x627,
-            x630,
-            Self::mul_add(-x601, x623, Self::mul_add(0.75, x602, x593)),
-        );
-        let x637 = x635 * x636;
-        let x638 = Self::mul_add(
-            x627,
-            x632,
-            Self::mul_add(-x601, x624, -110.5455 - x614),
-        );
-        let x639 = x635 * x638;
-        let x640 = Self::mul_add(-x627, x634, Self::mul_add(x601, x625, x608));
-        let x641 = x635 * x640;
-        let x642 = Self::mul_add(
-            -x629,
-            x630,
-            Self::mul_add(
-                -x610,
-                x623,
-                1394.5960312283303 + Self::mul_add(0.75, x592, -x615),
-            ),
-        );
-        let x643 = 1.0 / Self::mul_add(-x636, x637, x642);
-        let x644 = Self::mul_add(
-            -x610,
-            x624,
-            Self::mul_add(-0.65, x593, 0.75 * x591)
-                + Self::mul_add(-0.75, x613, Self::mul_add(s_q7, x586, c_q7 * x585)),
-        );
-        let x645 = Self::mul_add(-x636, x639, Self::mul_add(-x629, x632, x644));
-        let x646 = x643 * x645;
-        let x647 = Self::mul_add(
-            -x629,
-            x634,
-            Self::mul_add(
-                -x610,
-                x625,
-                -117.61766249359756 + Self::mul_add(-0.65, x592, 0.75 * x609),
-            ),
-        );
-        let x648 = Self::mul_add(x636, x641, x647);
-        let x649 = x643 * x648;
-        let x650 = Self::mul_add(
-            -x631,
-            x632,
-            Self::mul_add(
-                -x618,
-                x624,
-                1466.4506062283303
-                    - (Self::mul_add(-0.65, x596, 0.75 * x594)
-                        + (Self::mul_add(-c_q7, x586, s_q7 * x585)
-                            + Self::mul_add(-0.65, x614, 0.75 * x612))),
-            ),
-        );
-        let x651 = 1.0 / Self::mul_add(-x645, x646, Self::mul_add(-x638, x639, x650));
-        let x652 = Self::mul_add(
-            -x618,
-            x625,
-            Self::mul_add(0.65, x595, Self::mul_add(0.65, x608, 0.75 * x607)),
-        );
-        let x653 = Self::mul_add(
-            -x645,
-            x649,
-            Self::mul_add(x638, x641, Self::mul_add(-x631, x634, x652)),
-        );
-        let x654 = x651 * x653;
-        let x655 = Self::mul_add(
-            -x633,
-            x634,
-            Self::mul_add(-x607, x625, Self::mul_add(-0.65, x609, 1271.854575)),
-        );
-        let x656 = Self::mul_add(
-            -x653,
-            x654,
-            Self::mul_add(-x648, x649, Self::mul_add(-x640, x641, x655)),
-        );
-        let x657 = 1.0 / x656;
-        let x658 = Self::mul_add(
-            x619,
-            x621,
-            f_ext[0][1] - Self::mul_add(-v[3], x12, v[5] * x10) + x617,
-        );
-        let x659 = Self::mul_add(
-            -x628,
-            x658,
-            Self::mul_add(
-                -x619,
-                x622,
-                f_ext[0][2] + Self::mul_add(-v[3], x11, v[4] * x10) + x582,
-            ),
-        );
-        let x660 = Self::mul_add(
-            x619,
-            x623,
-            f_ext[0][3]
-                + (Self::mul_add(v[4], x9, v[5] * x8)
-                    + Self::mul_add(-v[1], x12, v[2] * x11))
-                + Self::mul_add(-0.75, x617, Self::mul_add(-s_q7, x579, c_q7 * x578)),
-        );
-        let x661 = Self::mul_add(x637, x659, Self::mul_add(-x630, x658, x660));
-        let x662 = Self::mul_add(
-            x632,
-            x658,
-            Self::mul_add(
-                -x619,
-                x624,
-                f_ext[0][4]
-                    - (Self::mul_add(v[3], x9, v[5] * x7)
-                        + Self::mul_add(-v[0], x12, v[2] * x10))
-                    + (Self::mul_add(c_q7, x579, s_q7 * x578)
-                        + Self::mul_add(-0.65, x582, 0.75 * x616)),
-            ),
-        );
-        let x663 = Self::mul_add(x646, x661, Self::mul_add(-x639, x659, x662));
-        let x664 = Self::mul_add(
-            x619,
-            x625,
-            f_ext[0][5]
-                + (Self::mul_add(-v[3], x8, v[4] * x7)
-                    + Self::mul_add(-v[0], x11, v[1] * x10))
-                + Self::mul_add(0.65, x617, Self::mul_add(-x557, x553 * x556, x555)),
-        );
-        let x665 = Self::mul_add(
-            -x649,
-            x661,
-            Self::mul_add(-x641, x659, Self::mul_add(-x634, x658, x664)),
-        );
-        let x666 = x657 * Self::mul_add(x654, x663, x665);
-        let x667 = Self::mul_add(x654, x666, x651 * x663);
-        let x668 = Self::mul_add(-x649, x666, Self::mul_add(x646, x667, x643 * x661));
-        let x669 = Self::mul_add(
-            -x641,
-            x666,
-            Self::mul_add(-x639, x667, Self::mul_add(x637, x668, x635 * x659)),
-        );
-        let x670 = Self::mul_add(
-            x632,
-            x667,
-            Self::mul_add(-x630, x668, Self::mul_add(-x628, x669, x626 * x658)),
-        );
-        let x671 = Self::mul_add(-x634, x666, x670);
-        let x672 = Self::mul_add(
-            x623,
-            x668,
-            Self::mul_add(-x622, x669, Self::mul_add(x621, x671, x619 * x620)),
-        );
-        let x673 = Self::mul_add(x625, x666, Self::mul_add(-x624, x667, x672));
-        let x674 = Self::mul_add(0.75, x667, x673);
-        let x675 = x671 - Self::mul_add(-0.65, x666, 0.75 * x668);
-        let x676 = Self::mul_add(-0.65, x667, x669);
-        let x677 = x20 - Self::mul_add(s_q7, x667, c_q7 * x668);
-        let x678 = x21 + Self::mul_add(-c_q7, x667, s_q7 * x668);
-        let x679 = x22 - Self::mul_add(s_q7, x675, c_q7 * x674);
-        let x680 = x23 + Self::mul_add(-c_q7, x675, s_q7 * x674);
-        let x681 = x556
-            * (x557
-                + (Self::mul_add(-x553, x666, Self::mul_add(x552, x678, x551 * x677))
-                    - Self::mul_add(
-                        -x529,
-                        x676,
-                        Self::mul_add(-x554, x680, x527 * x679),
-                    )));
-        let x682 = x666 + x681;
-        let x683 = Self::mul_add(0.00000000020510342851533115, x682, x677);
-        let x684 = Self::mul_add(0.35, x678, x679);
-        let x685 = Self::mul_add(-0.35, x677, x680);
-        let x686 = Self::mul_add(0.00000000020510342851533115, x676, x684);
-        let x687 = x39
-            + Self::mul_add(-c_q8, x682, Self::mul_add(-s_q8, x678, x30 * x677));
-        let x688 = x40
-            - Self::mul_add(-s_q8, x682, Self::mul_add(c_q8, x678, x31 * x677));
-        let x689 = x41
-            + Self::mul_add(-c_q8, x676, Self::mul_add(-s_q8, x685, x30 * x684));
-        let x690 = x42
-            - Self::mul_add(-s_q8, x676, Self::mul_add(c_q8, x685, x31 * x684));
-        let x691 = x484
-            * (x485
-                - (Self::mul_add(-x480, x683, Self::mul_add(x479, x688, x478 * x687))
-                    + Self::mul_add(
-                        x469,
-                        x686,
-                        Self::mul_add(x482, x690, x481 * x689),
-                    )));
-        let x692 = x683 - x691;
-        let x693 = Self::mul_add(
-            0.00000000020510342851533115,
-            x692,
-            Self::mul_add(0.00000000020510342851533115, x687, x688),
-        );
-        let x694 = x689 + Self::mul_add(0.275, x692, 0.4 * x688);
-        let x695 = Self::mul_add(-0.4, x687, x690);
-        let x696 = Self::mul_add(-0.275, x687, x686);
-        let x697 = Self::mul_add(
-            0.00000000020510342851533115,
-            x696,
-            Self::mul_add(0.00000000020510342851533115, x694, x695),
-        );
-        let x698 = x62
-            - Self::mul_add(-c_q9, x692, Self::mul_add(x52, x688, s_q9 * x687));
-        let x699 = x63
-            + Self::mul_add(s_q9, x692, Self::mul_add(-x53, x688, c_q9 * x687));
-        let x700 = x64
-            - Self::mul_add(-c_q9, x696, Self::mul_add(x52, x695, s_q9 * x694));
-        let x701 = x65
-            + Self::mul_add(s_q9, x696, Self::mul_add(-x53, x695, c_q9 * x694));
-        let x702 = x395
-            * (x396
-                + (Self::mul_add(-x392, x693, Self::mul_add(-x391, x699, x390 * x698))
-                    + Self::mul_add(
-                        -x384,
-                        x697,
-                        Self::mul_add(x386, x701, x393 * x700),
-                    )));
-        let x703 = x693 + x702;
-        let x704 = Self::mul_add(-0.87, x703, x700);
-        let x705 = Self::mul_add(0.87, x698, x697);
-        let x706 = x78 - Self::mul_add(-s_q10, x699, c_q10 * x698);
-        let x707 = x79 + Self::mul_add(c_q10, x699, s_q10 * x698);
-        let x708 = x80 - Self::mul_add(-s_q10, x701, c_q10 * x704);
-        let x709 = x81 + Self::mul_add(c_q10, x701, s_q10 * x704);
-        let x710 = x337
-            * (x338
-                - (Self::mul_add(x334, x703, Self::mul_add(x333, x707, x332 * x706))
-                    + Self::mul_add(
-                        x321,
-                        x705,
-                        Self::mul_add(-x323, x709, x335 * x708),
-                    )));
-        let x711 = x703 + x710;
-        let x712 = x708 - Self::mul_add(-0.63, x711, 0.275 * x707);
-        let x713 = Self::mul_add(0.275, x706, x709);
-        let x714 = Self::mul_add(-0.63, x706, x705);
-        let x715 = x95 + Self::mul_add(s_q11, x707, c_q11 * x706);
-        let x716 = x96 - Self::mul_add(-c_q11, x707, s_q11 * x706);
-        let x717 = x97 + Self::mul_add(s_q11, x713, c_q11 * x712);
-        let x718 = x98 - Self::mul_add(-c_q11, x713, s_q11 * x712);
-        let x719 = x272
-            * (x273
-                - (Self::mul_add(x269, x711, Self::mul_add(x268, x716, x267 * x715))
-                    + Self::mul_add(
-                        -x245,
-                        x714,
-                        Self::mul_add(-x244, x718, x270 * x717),
-                    )));
-        let x720 = x711 + x719;
-        let x721 = Self::mul_add(-0.00000000020510342851533115, x720, x716);
-        let x722 = Self::mul_add(-0.36, x716, x717);
-        let x723 = Self::mul_add(0.36, x715, x718);
-        let x724 = Self::mul_add(-0.00000000020510342851533115, x714, x723);
-        let x725 = x114
-            + Self::mul_add(-s_q12, x720, Self::mul_add(-x105, x716, c_q12 * x715));
-        let x726 = x115
-            - Self::mul_add(c_q12, x720, Self::mul_add(x106, x716, s_q12 * x715));
-        let x727 = x116
-            + Self::mul_add(-s_q12, x714, Self::mul_add(-x105, x723, c_q12 * x722));
-        let x728 = x117
-            - Self::mul_add(c_q12, x714, Self::mul_add(x106, x723, s_q12 * x722));
-        let x729 = x200
-            * (x201
-                - (Self::mul_add(x196, x721, Self::mul_add(x195, x726, x194 * x725))
-                    + Self::mul_add(
-                        -x186,
-                        x724,
-                        Self::mul_add(x198, x728, x197 * x727),
-                    )));
-        let x730 = x721 + x729;
-        let x731 = Self::mul_add(
-            c_q13,
-            Self::mul_add(0.55, x725, x724),
-            Self::mul_add(
-                -s_q13,
-                Self::mul_add(-0.16, x725, x728),
-                x125 * (x727 + Self::mul_add(-0.55, x730, 0.16 * x726)),
-            ),
-        );
-        let x732 = Self::mul_add(
-            0.9614610000000001,
-            x136 - Self::mul_add(s_q13, x730, Self::mul_add(c_q13, x726, x126 * x725)),
-            0.0145
-                * (x135
-                    + Self::mul_add(
-                        c_q13,
-                        x730,
-                        Self::mul_add(-s_q13, x726, x125 * x725),
-                    )),
-        );
-        let x733 = Self::mul_add(
+        let x444 = Self::mul_add(
             4.806620000000001,
-            x137 + x731,
+            x436,
             Self::mul_add(
                 1.4135609200000003,
-                Self::mul_add(-0.00000000020510342851533115, x730, x725),
-                x732,
+                x437,
+                Self::mul_add(-0.9614610000000001, x439, 0.0145 * x438),
+            ) - Self::mul_add(-x432, x442, x433 * x441),
+        );
+        let x445 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(x432, x433, x437),
+            f_ext[7][0],
+        );
+        let x446 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(x432, x432, x440 * x440),
+            f_ext[7][1],
+        );
+        let x447 = Self::mul_add(
+            4.806620000000001,
+            Self::mul_add(x433, x440, x438),
+            f_ext[7][2],
+        );
+        let x448 = f_ext[7][3]
+            - Self::mul_add(
+                4.806620000000001,
+                Self::mul_add(0.00000000020510342851533115, x435, x434),
+                Self::mul_add(-0.0145, x437, 0.000781 * x439)
+                    - Self::mul_add(-x433, x443, x440 * x442),
+            );
+        let x449 = f_ext[7][4]
+            + (Self::mul_add(
+                0.9614610000000001,
+                x437,
+                Self::mul_add(1.2025609200000003, x439, 0.000781 * x438),
+            ) + Self::mul_add(-x432, x443, x440 * x441));
+        let x450 = f_ext[7][5] - x444;
+        let x451 = x447 - Self::mul_add(-x16, x446, x15 * x445);
+        let x452 = Self::mul_add(c_q13, x446, s_q13 * x445);
+        let x453 = Self::mul_add(
+            0.00000000020510342851533115,
+            x447,
+            Self::mul_add(-s_q13, x446, c_q13 * x445),
+        );
+        let x454 = Self::mul_add(
+            0.55,
+            x451,
+            Self::mul_add(
+                0.00000000020510342851533115,
+                x450,
+                Self::mul_add(-s_q13, x449, c_q13 * x448),
             ),
         );
-        let x734 = 0.707433253035886 * (x146 - x733);
-        [x673, x671, x669, x668, x667, x666, x681, x691, x702, x710, x719, x729, x734]
+        let x455 = f_ext[6][0]
+            + Self::mul_add(
+                -17.135250000000003,
+                x422,
+                3.6140000000000003 * (x419 + x420),
+            ) + x451;
+        let x456 = f_ext[6][1]
+            + Self::mul_add(17.135250000000003, x425, 3.6140000000000003 * (x415 + x421))
+            + x452;
+        let x457 = f_ext[6][2]
+            - Self::mul_add(17.135250000000003, x427, 3.6140000000000003 * (x417 - x423))
+            - x453;
+        let x458 = f_ext[6][3]
+            - Self::mul_add(
+                -17.135250000000003,
+                x414,
+                Self::mul_add(x415, 0.809539999555672, x417 * 1.9877000000000002)
+                    - Self::mul_add(-x408, x430, x418 * x429),
+            )
+            + (x450 - Self::mul_add(-x16, x449, x15 * x448)
+                - Self::mul_add(0.55, x453, 0.16 * x452));
+        let x459 = f_ext[6][4] + x431
+            + Self::mul_add(0.16, x451, Self::mul_add(c_q13, x449, s_q13 * x448));
+        let x460 = f_ext[6][5]
+            + (Self::mul_add(
+                9.740442170000001,
+                x415,
+                Self::mul_add(x417, -2.7416399995923166, x416 * 0.809539999555672),
+            ) - Self::mul_add(-x407, x429, x408 * x428)
+                + Self::mul_add(3.6140000000000003, x413, 17.135250000000003 * x412))
+            - x454;
+        let x461 = Self::mul_add(-s_q12, x456, c_q12 * x455);
+        let x462 = x457 - Self::mul_add(x14, x456, x13 * x455);
+        let x463 = Self::mul_add(
+            -7.078399999258757,
+            Self::mul_add(-x391, x392, x360),
+            f_ext[5][0],
+        ) + x461;
+        let x464 = Self::mul_add(
+            7.078399999258757,
+            Self::mul_add(x399, x399, x400),
+            f_ext[5][1],
+        ) + x462;
+        let x465 = Self::mul_add(-7.078399999258757, x397 + x401, f_ext[5][2])
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x457,
+                Self::mul_add(c_q12, x456, s_q12 * x455),
+            );
+        let x466 = f_ext[5][3] + x405
+            + Self::mul_add(0.36, x462, Self::mul_add(-s_q12, x459, c_q12 * x458));
+        let x467 = f_ext[5][4]
+            - (Self::mul_add(-2.5482240016099564, x360, x398 * 9.142025249762803)
+                + Self::mul_add(-x391, x404, x399 * x402))
+            + Self::mul_add(-0.36, x461, x460 - Self::mul_add(x14, x459, x13 * x458));
+        let x468 = f_ext[5][5] - x406
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x460,
+                Self::mul_add(c_q12, x459, s_q12 * x458),
+            );
+        let x469 = Self::mul_add(-s_q11, x464, c_q11 * x463);
+        let x470 = Self::mul_add(c_q11, x464, s_q11 * x463);
+        let x471 = Self::mul_add(x381, 45.1584, f_ext[4][0]) + x469;
+        let x472 = Self::mul_add(-45.1584, x383, f_ext[4][1]) + x470;
+        let x473 = Self::mul_add(45.1584, x385, f_ext[4][2]) + x465;
+        let x474 = f_ext[4][3] - x389
+            + (Self::mul_add(-s_q11, x467, c_q11 * x466)
+                + Self::mul_add(-0.63, x465, 0.275 * x470));
+        let x475 = f_ext[4][4]
+            - (Self::mul_add(x360, 24.35164200091464, x379 * 24.4950615)
+                - Self::mul_add(-x372, x388, x380 * x386))
+            + Self::mul_add(-0.275, x469, Self::mul_add(c_q11, x467, s_q11 * x466));
+        let x476 = f_ext[4][5] + x390 + Self::mul_add(0.63, x469, x468);
+        let x477 = Self::mul_add(-s_q10, x472, c_q10 * x471);
+        let x478 = Self::mul_add(x364, 81.53205, f_ext[3][0]) + x477;
+        let x479 = Self::mul_add(-81.53205, x365, f_ext[3][1])
+            + Self::mul_add(c_q10, x472, s_q10 * x471);
+        let x480 = Self::mul_add(81.53205, x366, f_ext[3][2]) + x473;
+        let x481 = f_ext[3][3] - x370
+            + Self::mul_add(-0.87, x473, Self::mul_add(-s_q10, x475, c_q10 * x474));
+        let x482 = f_ext[3][4]
+            + (Self::mul_add(x360, -36.18604050126307, x362 * 63.36336825000001)
+                + Self::mul_add(-x353, x369, x363 * x367))
+            + Self::mul_add(c_q10, x475, s_q10 * x474);
+        let x483 = f_ext[3][5] + x371 + Self::mul_add(0.87, x477, x476);
+        let x484 = 0.00000000020510342851533115 * x480;
+        let x485 = Self::mul_add(c_q9, x479, s_q9 * x478) + x484;
+        let x486 = x480 + Self::mul_add(-x12, x479, x11 * x478);
+        let x487 = x484 - Self::mul_add(-s_q9, x479, c_q9 * x478);
+        let x488 = 0.00000000020510342851533115 * x483;
+        let x489 = f_ext[2][0]
+            - Self::mul_add(
+                x343,
+                -12.701650001451807,
+                (x340 + x341) * 0.000000008530897668050218,
+            ) + x485;
+        let x490 = f_ext[2][1]
+            - Self::mul_add(
+                12.701650001451807,
+                x346,
+                0.000000008530897668050218 * (x321 + x342),
+            ) + x486;
+        let x491 = f_ext[2][2]
+            + Self::mul_add(
+                12.701650001451807,
+                x348,
+                0.000000008530897668050218 * (x338 - x344),
+            ) - x487;
+        let x492 = f_ext[2][3]
+            - Self::mul_add(
+                x336,
+                12.701650001451807,
+                Self::mul_add(
+                    x321,
+                    0.002139996587640933,
+                    x338 * 0.0000000234896432582596,
+                ) - Self::mul_add(-x330, x351, x339 * x350),
+            )
+            + (Self::mul_add(c_q9, x482, s_q9 * x481) + x488
+                - Self::mul_add(0.275, x487, 0.4 * x486));
+        let x493 = f_ext[2][4] + x352
+            + Self::mul_add(0.4, x485, x483 + Self::mul_add(-x12, x482, x11 * x481));
+        let x494 = f_ext[2][5]
+            + (Self::mul_add(
+                113.3918902508081,
+                x321,
+                Self::mul_add(5.080660024070366, x338, x337 * 0.002139996587640933),
+            ) - Self::mul_add(-x329, x350, x330 * x349)
+                - Self::mul_add(
+                    x335,
+                    0.000000008530897668050218,
+                    x334 * 12.701650001451807,
+                ))
+            - Self::mul_add(0.275, x485, x488 - Self::mul_add(-s_q9, x482, c_q9 * x481));
+        let x495 = x491 - Self::mul_add(-x8, x490, x7 * x489);
+        let x496 = Self::mul_add(c_q8, x490, s_q8 * x489);
+        let x497 = Self::mul_add(
+            48.0240000085309,
+            Self::mul_add(x323, x323, x324),
+            f_ext[1][0],
+        ) + x495;
+        let x498 = Self::mul_add(48.0240000085309, x309 * x310, f_ext[1][1]) + x496;
+        let x499 = Self::mul_add(-48.0240000085309, x322 + x325, f_ext[1][2])
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x491,
+                Self::mul_add(-s_q8, x490, c_q8 * x489),
+            );
+        let x500 = f_ext[1][3]
+            - Self::mul_add(x322, 0.07309, Self::mul_add(x310, x328, x323 * x327))
+            + Self::mul_add(-0.35, x496, x494 - Self::mul_add(-x8, x493, x7 * x492));
+        let x501 = f_ext[1][4]
+            - Self::mul_add(
+                48.0240000085309,
+                x319,
+                Self::mul_add(-130.43769025763282, x322, x321 * 0.07309)
+                    + Self::mul_add(x309, x328, x323 * x326),
+            ) + Self::mul_add(0.35, x495, Self::mul_add(c_q8, x493, s_q8 * x492));
+        let x502 = f_ext[1][5]
+            - Self::mul_add(
+                48.0240000085309,
+                x320,
+                Self::mul_add(-0.1132, x322, x321 * 16.80768997608804)
+                    + Self::mul_add(-x309, x327, x310 * x326),
+            )
+            - Self::mul_add(
+                0.00000000020510342851533115,
+                x494,
+                Self::mul_add(-s_q8, x493, c_q8 * x492),
+            );
+        let x503 = Self::mul_add(-s_q7, x498, c_q7 * x497);
+        let x504 = Self::mul_add(c_q7, x498, s_q7 * x497);
+        let x505 = Self::mul_add(v[5], -117.61766249359756, 1394.5960312283303 * v[3]);
+        let x506 = 1466.4506062283303 * v[4];
+        let x507 = Self::mul_add(-1271.854575, v[5], v[3] * 117.61766249359758);
+        let x508 = x503
+            + (f_ext[0][0]
+                + Self::mul_add(
+                    1170.07,
+                    x306,
+                    Self::mul_add(-180.9502499901501, x314, 110.5455 * x312),
+                ));
+        let x509 = x504
+            + (f_ext[0][1]
+                - Self::mul_add(
+                    1170.07,
+                    x307,
+                    Self::mul_add(180.9502499901501, x315, 110.5455 * x313),
+                ));
+        let x510 = x499
+            + (f_ext[0][2]
+                + Self::mul_add(
+                    1170.07,
+                    x308,
+                    -Self::mul_add(-180.9502499901501, x316, 110.5455 * x314),
+                ));
+        let x511 = x187 * 0.0008546497218115156;
+        let x512 = x180 * 0.0008546497218115156;
+        let x513 = x191 * 0.0008546497218115156;
+        let x514 = x204 * 0.0008546497218115156;
+        let x515 = x219 * 0.0008546497218115156;
+        let x516 = x239 * 0.0008546497218115156;
+        let x517 = x268 * 0.0008546497218115156;
+        let x518 = x304 * 0.0008546497218115156;
+        let x519 = x186 * 0.0008546497218115156;
+        let x520 = x179 * 0.0008546497218115156;
+        let x521 = x192 * 0.0008546497218115156;
+        let x522 = x205 * 0.0008546497218115156;
+        let x523 = x220 * 0.0008546497218115156;
+        let x524 = x240 * 0.0008546497218115156;
+        let x525 = x269 * 0.0008546497218115156;
+        let x526 = x305 * 0.0008546497218115156;
+        let x527 = x159 * 0.0008546497218115156;
+        let x528 = x200 * 0.0008546497218115156;
+        let x529 = x215 * 0.0008546497218115156;
+        let x530 = x235 * 0.0008546497218115156;
+        let x531 = x264 * 0.0008546497218115156;
+        let x532 = x300 * 0.0008546497218115156;
+        let x533 = x187 * x511;
+        let x534 = x180 * x512;
+        let x535 = 1.0
+            / (1394.5960312283303 - (x181 + (x167 - x178 + x181)) - x533 - x534);
+        let x536 = Self::mul_add(
+            x180,
+            x519,
+            Self::mul_add(-0.65, x180, x169 - Self::mul_add(x174, x177, x175 * x176)),
+        );
+        let x537 = x535 * x536;
+        let x538 = Self::mul_add(
+            x187,
+            x519,
+            -117.61766249359756 + Self::mul_add(0.65, x161, x184),
+        );
+        let x539 = x535 * x538;
+        let x540 = Self::mul_add(x187, x520, x184);
+        let x541 = x535 * x540;
+        let x542 = Self::mul_add(
+            x187,
+            x521,
+            Self::mul_add(-0.75, x192, Self::mul_add(-s_q7, x190, c_q7 * x189)),
+        );
+        let x543 = Self::mul_add(-x180, x527, x542);
+        let x544 = x535 * x543;
+        let x545 = Self::mul_add(
+            -x187,
+            x522,
+            Self::mul_add(0.75, x205, Self::mul_add(-s_q7, x203, c_q7 * x202)),
+        );
+        let x546 = Self::mul_add(-x180, x528, x545);
+        let x547 = x535 * x546;
+        let x548 = Self::mul_add(
+            x187,
+            x523,
+            Self::mul_add(-0.75, x220, Self::mul_add(s_q7, x218, c_q7 * x217)),
+        );
+        let x549 = Self::mul_add(-x180, x529, x548);
+        let x550 = x535 * x549;
+        let x551 = Self::mul_add(
+            x187,
+            x524,
+            Self::mul_add(-0.75, x240, Self::mul_add(s_q7, x238, c_q7 * x237)),
+        );
+        let x552 = Self::mul_add(x180, x530, x551);
+        let x553 = x535 * x552;
+        let x554 = Self::mul_add(
+            x187,
+            x525,
+            Self::mul_add(-0.75, x269, Self::mul_add(-s_q7, x267, c_q7 * x266)),
+        );
+        let x555 = Self::mul_add(-x180, x531, x554);
+        let x556 = x535 * x555;
+        let x557 = Self::mul_add(
+            x187,
+            x526,
+            Self::mul_add(-0.75, x305, Self::mul_add(-s_q7, x303, c_q7 * x302)),
+        );
+        let x558 = Self::mul_add(x180, x532, x557);
+        let x559 = x535 * x558;
+        let x560 = x186 * x519;
+        let x561 = 1.0
+            / Self::mul_add(
+                -x536,
+                x537,
+                1466.4506062283303 - (x183 - (x171 - x178 - x183)) - x533 - x560,
+            );
+        let x562 = Self::mul_add(
+            x187,
+            x512,
+            Self::mul_add(-0.75, x180, Self::mul_add(c_q7, x172, s_q7 * x170)),
+        );
+        let x563 = Self::mul_add(-x536, x539, x562);
+        let x564 = x561 * x563;
+        let x565 = Self::mul_add(-x536, x541, x562);
+        let x566 = x561 * x565;
+        let x567 = Self::mul_add(
+            x186,
+            x527,
+            Self::mul_add(
+                -x187,
+                x513,
+                Self::mul_add(c_q7, x190, s_q7 * x189)
+                    + Self::mul_add(-0.65, x159, 0.75 * x191),
+            ),
+        );
+        let x568 = Self::mul_add(-x536, x544, x567);
+        let x569 = x561 * x568;
+        let x570 = Self::mul_add(
+            x186,
+            x528,
+            Self::mul_add(
+                x187,
+                x514,
+                Self::mul_add(c_q7, x203, s_q7 * x202)
+                    - Self::mul_add(0.65, x200, 0.75 * x204),
+            ),
+        );
+        let x571 = Self::mul_add(-x536, x547, x570);
+        let x572 = x561 * x571;
+        let x573 = Self::mul_add(
+            x186,
+            x529,
+            Self::mul_add(
+                -x187,
+                x515,
+                Self::mul_add(-c_q7, x218, s_q7 * x217)
+                    + Self::mul_add(-0.65, x215, 0.75 * x219),
+            ),
+        );
+        let x574 = Self::mul_add(-x536, x550, x573);
+        let x575 = x561 * x574;
+        let x576 = Self::mul_add(
+            -x186,
+            x530,
+            Self::mul_add(
+                -x187,
+                x516,
+                Self::mul_add(-c_q7, x238, s_q7 * x237)
+                    + Self::mul_add(0.65, x235, 0.75 * x239),
+            ),
+        );
+        let x577 = Self::mul_add(-x536, x553, x576);
+        let x578 = x561 * x577;
+        let x579 = Self::mul_add(
+            x186,
+            x531,
+            Self::mul_add(
+                -x187,
+                x517,
+                Self::mul_add(c_q7, x267, s_q7 * x266)
+                    + Self::mul_add(-0.65, x264, 0.75 * x268),
+            ),
+        );
+        let x580 = Self::mul_add(-x536, x556, x579);
+        let x581 = x561 * x580;
+        let x582 = Self::mul_add(
+            -x186,
+            x532,
+            Self::mul_add(
+                -x187,
+                x518,
+                Self::mul_add(c_q7, x303, s_q7 * x302)
+                    + Self::mul_add(0.65, x300, 0.75 * x304),
+            ),
+        );
+        let x583 = Self::mul_add(-x536, x559, x582);
+        let x584 = x561 * x583;
+        let x585 = 1.0
+            / Self::mul_add(
+                x563,
+                x564,
+                Self::mul_add(x538, x539, x560 - (1271.854575 + (x182 + x185) - x534)),
+            );
+        let x586 = Self::mul_add(
+            -x563,
+            x566,
+            Self::mul_add(-x538, x541, Self::mul_add(-x186, x520, x185 - x534)),
+        );
+        let x587 = x585 * x586;
+        let x588 = x180 * x513;
+        let x589 = Self::mul_add(
+            x538,
+            x544,
+            Self::mul_add(x186, x521, Self::mul_add(-0.65, x192, x165) - x588),
+        );
+        let x590 = Self::mul_add(x563, x569, x589);
+        let x591 = x585 * x590;
+        let x592 = x180 * x514;
+        let x593 = Self::mul_add(
+            x538,
+            x547,
+            Self::mul_add(-x186, x522, Self::mul_add(0.65, x205, x201) + x592),
+        );
+        let x594 = Self::mul_add(x563, x572, x593);
+        let x595 = x585 * x594;
+        let x596 = x180 * x515;
+        let x597 = Self::mul_add(
+            -x538,
+            x550,
+            Self::mul_add(-x186, x523, Self::mul_add(0.65, x220, x216) + x596),
+        );
+        let x598 = Self::mul_add(-x563, x575, x597);
+        let x599 = x585 * x598;
+        let x600 = x180 * x516;
+        let x601 = Self::mul_add(
+            -x538,
+            x553,
+            Self::mul_add(-x186, x524, Self::mul_add(0.65, x240, x236) + x600),
+        );
+        let x602 = Self::mul_add(-x563, x578, x601);
+        let x603 = x585 * x602;
+        let x604 = x180 * x517;
+        let x605 = Self::mul_add(
+            x538,
+            x556,
+            Self::mul_add(x186, x525, Self::mul_add(-0.65, x269, x265) - x604),
+        );
+        let x606 = Self::mul_add(x563, x581, x605);
+        let x607 = x585 * x606;
+        let x608 = x180 * x518;
+        let x609 = Self::mul_add(
+            x538,
+            x559,
+            Self::mul_add(x186, x526, Self::mul_add(-0.65, x305, x301) - x608),
+        );
+        let x610 = Self::mul_add(x563, x584, x609);
+        let x611 = x585 * x610;
+        let x612 = Self::mul_add(
+            -x565,
+            x566,
+            Self::mul_add(-x540, x541, Self::mul_add(-x179, x520, x173 - x534)),
+        );
+        let x613 = 1.0 / Self::mul_add(x586, x587, x612);
+        let x614 = Self::mul_add(
+            x565,
+            x569,
+            Self::mul_add(x540, x544, Self::mul_add(x179, x521, x165 - x588)),
+        );
+        let x615 = Self::mul_add(x586, x591, x614);
+        let x616 = x613 * x615;
+        let x617 = Self::mul_add(
+            x565,
+            x572,
+            Self::mul_add(x540, x547, Self::mul_add(-x179, x522, x201 + x592)),
+        );
+        let x618 = Self::mul_add(x586, x595, x617);
+        let x619 = x613 * x618;
+        let x620 = Self::mul_add(
+            -x565,
+            x575,
+            Self::mul_add(-x540, x550, Self::mul_add(-x179, x523, x216 + x596)),
+        );
+        let x621 = Self::mul_add(x586, x599, x620);
+        let x622 = x613 * x621;
+        let x623 = Self::mul_add(
+            -x565,
+            x578,
+            Self::mul_add(-x540, x553, Self::mul_add(-x179, x524, x236 + x600)),
+        );
+        let x624 = Self::mul_add(x586, x603, x623);
+        let x625 = x613 * x624;
+        let x626 = Self::mul_add(
+            x565,
+            x581,
+            Self::mul_add(x540, x556, Self::mul_add(x179, x525, x265 - x604)),
+        );
+        let x627 = Self::mul_add(x586, x607, x626);
+        let x628 = x613 * x627;
+        let x629 = Self::mul_add(
+            x565,
+            x584,
+            Self::mul_add(x540, x559, Self::mul_add(x179, x526, x301 - x608)),
+        );
+        let x630 = Self::mul_add(x586, x611, x629);
+        let x631 = x613 * x630;
+        let x632 = Self::mul_add(
+            -x159,
+            x527,
+            Self::mul_add(-x192, x521, Self::mul_add(-x191, x513, x148)),
+        );
+        let x633 = Self::mul_add(
+            x590,
+            x591,
+            Self::mul_add(-x568, x569, Self::mul_add(-x543, x544, x632)),
+        );
+        let x634 = 1.0 / Self::mul_add(-x615, x616, x633);
+        let x635 = Self::mul_add(
+            -x159,
+            x528,
+            Self::mul_add(x192, x522, Self::mul_add(x191, x514, x197)),
+        );
+        let x636 = Self::mul_add(
+            x590,
+            x595,
+            Self::mul_add(-x568, x572, Self::mul_add(-x543, x547, x635)),
+        );
+        let x637 = Self::mul_add(-x615, x619, x636);
+        let x638 = x634 * x637;
+        let x639 = Self::mul_add(
+            -x159,
+            x529,
+            Self::mul_add(-x192, x523, Self::mul_add(-x191, x515, x212)),
+        );
+        let x640 = Self::mul_add(
+            -x590,
+            x599,
+            Self::mul_add(-x568, x575, Self::mul_add(-x543, x550, x639)),
+        );
+        let x641 = Self::mul_add(x615, x622, x640);
+        let x642 = x634 * x641;
+        let x643 = Self::mul_add(
+            x159,
+            x530,
+            Self::mul_add(-x192, x524, Self::mul_add(-x191, x516, x232)),
+        );
+        let x644 = Self::mul_add(
+            -x590,
+            x603,
+            Self::mul_add(-x568, x578, Self::mul_add(-x543, x553, x643)),
+        );
+        let x645 = Self::mul_add(x615, x625, x644);
+        let x646 = x634 * x645;
+        let x647 = Self::mul_add(
+            -x159,
+            x531,
+            Self::mul_add(-x192, x525, Self::mul_add(-x191, x517, x261)),
+        );
+        let x648 = Self::mul_add(
+            x590,
+            x607,
+            Self::mul_add(-x568, x581, Self::mul_add(-x543, x556, x647)),
+        );
+        let x649 = Self::mul_add(-x615, x628, x648);
+        let x650 = x634 * x649;
+        let x651 = Self::mul_add(
+            x159,
+            x532,
+            Self::mul_add(-x192, x526, Self::mul_add(-x191, x518, x297)),
+        );
+        let x652 = Self::mul_add(
+            x590,
+            x611,
+            Self::mul_add(-x568, x584, Self::mul_add(-x543, x559, x651)),
+        );
+        let x653 = Self::mul_add(-x615, x631, x652);
+        let x654 = x634 * x653;
+        let x655 = Self::mul_add(
+            -x200,
+            x528,
+            Self::mul_add(-x205, x522, Self::mul_add(-x204, x514, x106)),
+        );
+        let x656 = Self::mul_add(
+            x594,
+            x595,
+            Self::mul_add(-x571, x572, Self::mul_add(-x546, x547, x655)),
+        );
+        let x657 = 1.0 / Self::mul_add(-x637, x638, Self::mul_add(-x618, x619, x656));
+        let x658 = Self::mul_add(
+            x200,
+            x529,
+            Self::mul_add(-x205, x523, Self::mul_add(-x204, x515, x100)),
+        );
+        let x659 = Self::mul_add(
+            x594,
+            x599,
+            Self::mul_add(x571, x575, Self::mul_add(x546, x550, x658)),
+        );
+        let x660 = Self::mul_add(x637, x642, Self::mul_add(-x618, x622, x659));
+        let x661 = x657 * x660;
+        let x662 = Self::mul_add(
+            -x200,
+            x530,
+            Self::mul_add(-x205, x524, Self::mul_add(-x204, x516, x225)),
+        );
+        let x663 = Self::mul_add(
+            x594,
+            x603,
+            Self::mul_add(x571, x578, Self::mul_add(x546, x553, x662)),
+        );
+        let x664 = Self::mul_add(x637, x646, Self::mul_add(-x618, x625, x663));
+        let x665 = x657 * x664;
+        let x666 = Self::mul_add(
+            x200,
+            x531,
+            Self::mul_add(-x205, x525, Self::mul_add(-x204, x517, x253)),
+        );
+        let x667 = Self::mul_add(
+            -x594,
+            x607,
+            Self::mul_add(x571, x581, Self::mul_add(x546, x556, x666)),
+        );
+        let x668 = Self::mul_add(x637, x650, Self::mul_add(x618, x628, x667));
+        let x669 = x657 * x668;
+        let x670 = Self::mul_add(
+            -x200,
+            x532,
+            Self::mul_add(-x205, x526, Self::mul_add(-x204, x518, x289)),
+        );
+        let x671 = Self::mul_add(
+            -x594,
+            x611,
+            Self::mul_add(x571, x584, Self::mul_add(x546, x559, x670)),
+        );
+        let x672 = Self::mul_add(x637, x654, Self::mul_add(x618, x631, x671));
+        let x673 = x657 * x672;
+        let x674 = Self::mul_add(
+            -x215,
+            x529,
+            Self::mul_add(-x220, x523, Self::mul_add(-x219, x515, x86)),
+        );
+        let x675 = Self::mul_add(
+            x598,
+            x599,
+            Self::mul_add(-x574, x575, Self::mul_add(-x549, x550, x674)),
+        );
+        let x676 = Self::mul_add(
+            -x660,
+            x661,
+            Self::mul_add(-x641, x642, Self::mul_add(-x621, x622, x675)),
+        );
+        let x677 = 1.0 / x676;
+        let x678 = Self::mul_add(
+            x215,
+            x530,
+            Self::mul_add(-x220, x524, Self::mul_add(-x219, x516, x80)),
+        );
+        let x679 = Self::mul_add(
+            x598,
+            x603,
+            Self::mul_add(-x574, x578, Self::mul_add(-x549, x553, x678)),
+        );
+        let x680 = Self::mul_add(
+            -x660,
+            x665,
+            Self::mul_add(-x641, x646, Self::mul_add(-x621, x625, x679)),
+        );
+        let x681 = x677 * x680;
+        let x682 = Self::mul_add(
+            -x215,
+            x531,
+            Self::mul_add(-x220, x525, Self::mul_add(-x219, x517, x248)),
+        );
+        let x683 = Self::mul_add(
+            -x598,
+            x607,
+            Self::mul_add(-x574, x581, Self::mul_add(-x549, x556, x682)),
+        );
+        let x684 = Self::mul_add(
+            -x660,
+            x669,
+            Self::mul_add(-x641, x650, Self::mul_add(x621, x628, x683)),
+        );
+        let x685 = x677 * x684;
+        let x686 = Self::mul_add(
+            x215,
+            x532,
+            Self::mul_add(-x220, x526, Self::mul_add(-x219, x518, x284)),
+        );
+        let x687 = Self::mul_add(
+            -x598,
+            x611,
+            Self::mul_add(-x574, x584, Self::mul_add(-x549, x559, x686)),
+        );
+        let x688 = Self::mul_add(
+            -x660,
+            x673,
+            Self::mul_add(-x641, x654, Self::mul_add(x621, x631, x687)),
+        );
+        let x689 = x677 * x688;
+        let x690 = Self::mul_add(
+            -x235,
+            x530,
+            Self::mul_add(-x240, x524, Self::mul_add(-x239, x516, x66)),
+        );
+        let x691 = Self::mul_add(
+            x602,
+            x603,
+            Self::mul_add(-x577, x578, Self::mul_add(-x552, x553, x690)),
+        );
+        let x692 = Self::mul_add(
+            -x664,
+            x665,
+            Self::mul_add(-x645, x646, Self::mul_add(-x624, x625, x691)),
+        );
+        let x693 = 1.0 / Self::mul_add(-x680, x681, x692);
+        let x694 = Self::mul_add(
+            x235,
+            x531,
+            Self::mul_add(-x240, x525, Self::mul_add(-x239, x517, x59)),
+        );
+        let x695 = Self::mul_add(
+            -x602,
+            x607,
+            Self::mul_add(-x577, x581, Self::mul_add(-x552, x556, x694)),
+        );
+        let x696 = Self::mul_add(
+            -x664,
+            x669,
+            Self::mul_add(-x645, x650, Self::mul_add(x624, x628, x695)),
+        );
+        let x697 = Self::mul_add(-x680, x685, x696);
+        let x698 = x693 * x697;
+        let x699 = Self::mul_add(
+            -x235,
+            x532,
+            Self::mul_add(-x240, x526, Self::mul_add(-x239, x518, x277)),
+        );
+        let x700 = Self::mul_add(
+            -x602,
+            x611,
+            Self::mul_add(-x577, x584, Self::mul_add(-x552, x559, x699)),
+        );
+        let x701 = Self::mul_add(
+            -x664,
+            x673,
+            Self::mul_add(-x645, x654, Self::mul_add(x624, x631, x700)),
+        );
+        let x702 = Self::mul_add(-x680, x689, x701);
+        let x703 = x693 * x702;
+        let x704 = Self::mul_add(
+            -x264,
+            x531,
+            Self::mul_add(-x269, x525, Self::mul_add(-x268, x517, x41)),
+        );
+        let x705 = Self::mul_add(
+            x606,
+            x607,
+            Self::mul_add(-x580, x581, Self::mul_add(-x555, x556, x704)),
+        );
+        let x706 = Self::mul_add(
+            -x668,
+            x669,
+            Self::mul_add(-x649, x650, Self::mul_add(-x627, x628, x705)),
+        );
+        let x707 = 1.0 / Self::mul_add(-x697, x698, Self::mul_add(-x684, x685, x706));
+        let x708 = Self::mul_add(
+            x264,
+            x532,
+            Self::mul_add(-x269, x526, Self::mul_add(-x268, x518, x273)),
+        );
+        let x709 = Self::mul_add(
+            x606,
+            x611,
+            Self::mul_add(-x580, x584, Self::mul_add(-x555, x559, x708)),
+        );
+        let x710 = Self::mul_add(
+            -x668,
+            x673,
+            Self::mul_add(-x649, x654, Self::mul_add(-x627, x631, x709)),
+        );
+        let x711 = Self::mul_add(-x697, x703, Self::mul_add(-x684, x689, x710));
+        let x712 = x707 * x711;
+        let x713 = Self::mul_add(
+            -x300,
+            x532,
+            Self::mul_add(-x305, x526, Self::mul_add(-x304, x518, 1.4135609200000003)),
+        );
+        let x714 = Self::mul_add(
+            x610,
+            x611,
+            Self::mul_add(-x583, x584, Self::mul_add(-x558, x559, x713)),
+        );
+        let x715 = Self::mul_add(
+            -x672,
+            x673,
+            Self::mul_add(-x653, x654, Self::mul_add(-x630, x631, x714)),
+        );
+        let x716 = Self::mul_add(
+            -x711,
+            x712,
+            Self::mul_add(-x702, x703, Self::mul_add(-x688, x689, x715)),
+        );
+        let x717 = 1.0 / x716;
+        let x718 = Self::mul_add(
+            x509,
+            x511,
+            Self::mul_add(-0.75, x504, Self::mul_add(-s_q7, x501, c_q7 * x500))
+                + (f_ext[0][3]
+                    + Self::mul_add(
+                        180.9502499901501,
+                        x307,
+                        Self::mul_add(v[4], x507, v[5] * x506),
+                    )),
+        );
+        let x719 = Self::mul_add(-x510, x512, x718);
+        let x720 = Self::mul_add(
+            x510,
+            x519,
+            Self::mul_add(
+                -x508,
+                x511,
+                Self::mul_add(c_q7, x501, s_q7 * x500)
+                    + Self::mul_add(-0.65, x499, 0.75 * x503)
+                    + (f_ext[0][4]
+                        - (Self::mul_add(v[3], x507, v[5] * x505)
+                            - Self::mul_add(-110.5455, x308, 180.9502499901501 * x306))),
+            ),
+        );
+        let x721 = Self::mul_add(-x537, x719, x720);
+        let x722 = x508 * x512;
+        let x723 = Self::mul_add(
+            -x509,
+            x519,
+            Self::mul_add(0.65, x504, x502)
+                + (f_ext[0][5]
+                    + Self::mul_add(
+                        -110.5455,
+                        x307,
+                        Self::mul_add(-v[3], x506, v[4] * x505),
+                    )) + x722,
+        );
+        let x724 = Self::mul_add(-x564, x721, Self::mul_add(-x539, x719, x723));
+        let x725 = Self::mul_add(
+            -x566,
+            x721,
+            Self::mul_add(-x541, x719, Self::mul_add(-x509, x520, tau[0] + x502 + x722)),
+        );
+        let x726 = Self::mul_add(x587, x724, x725);
+        let x727 = Self::mul_add(
+            -x510,
+            x527,
+            Self::mul_add(-x509, x521, Self::mul_add(-x508, x513, tau[1] + x494)),
+        );
+        let x728 = Self::mul_add(
+            -x591,
+            x724,
+            Self::mul_add(-x569, x721, Self::mul_add(-x544, x719, x727)),
+        );
+        let x729 = Self::mul_add(x616, x726, x728);
+        let x730 = Self::mul_add(
+            -x510,
+            x528,
+            Self::mul_add(x509, x522, Self::mul_add(x508, x514, tau[2] + x483)),
+        );
+        let x731 = Self::mul_add(
+            -x595,
+            x724,
+            Self::mul_add(-x572, x721, Self::mul_add(-x547, x719, x730)),
+        );
+        let x732 = Self::mul_add(-x638, x729, Self::mul_add(x619, x726, x731));
+        let x733 = Self::mul_add(
+            x510,
+            x529,
+            Self::mul_add(x509, x523, Self::mul_add(x508, x515, tau[3] + x476)),
+        );
+        let x734 = Self::mul_add(
+            -x599,
+            x724,
+            Self::mul_add(x575, x721, Self::mul_add(x550, x719, x733)),
+        );
+        let x735 = Self::mul_add(
+            -x661,
+            x732,
+            Self::mul_add(x642, x729, Self::mul_add(x622, x726, x734)),
+        );
+        let x736 = Self::mul_add(
+            -x510,
+            x530,
+            Self::mul_add(x509, x524, Self::mul_add(x508, x516, tau[4] + x468)),
+        );
+        let x737 = Self::mul_add(
+            -x603,
+            x724,
+            Self::mul_add(x578, x721, Self::mul_add(x553, x719, x736)),
+        );
+        let x738 = Self::mul_add(
+            -x665,
+            x732,
+            Self::mul_add(x646, x729, Self::mul_add(x625, x726, x737)),
+        );
+        let x739 = Self::mul_add(-x681, x735, x738);
+        let x740 = Self::mul_add(
+            -x510,
+            x531,
+            Self::mul_add(-x509, x525, Self::mul_add(-x508, x517, tau[5] + x460)),
+        );
+        let x741 = Self::mul_add(
+            -x607,
+            x724,
+            Self::mul_add(-x581, x721, Self::mul_add(-x556, x719, x740)),
+        );
+        let x742 = Self::mul_add(
+            x669,
+            x732,
+            Self::mul_add(-x650, x729, Self::mul_add(x628, x726, x741)),
+        );
+        let x743 = Self::mul_add(x698, x739, Self::mul_add(x685, x735, x742));
+        let x744 = Self::mul_add(
+            x510,
+            x532,
+            Self::mul_add(-x509, x526, Self::mul_add(-x508, x518, tau[6] + x450)),
+        );
+        let x745 = Self::mul_add(
+            -x611,
+            x724,
+            Self::mul_add(-x584, x721, Self::mul_add(-x559, x719, x744)),
+        );
+        let x746 = Self::mul_add(
+            x673,
+            x732,
+            Self::mul_add(-x654, x729, Self::mul_add(x631, x726, x745)),
+        );
+        let x747 = Self::mul_add(
+            -x712,
+            x743,
+            Self::mul_add(x703, x739, Self::mul_add(x689, x735, x746)),
+        );
+        let x748 = x717 * x747;
+        let x749 = Self::mul_add(-x712, x748, x707 * x743);
+        let x750 = Self::mul_add(x703, x748, Self::mul_add(x698, x749, x693 * x739));
+        let x751 = Self::mul_add(
+            x689,
+            x748,
+            Self::mul_add(x685, x749, Self::mul_add(-x681, x750, x677 * x735)),
+        );
+        let x752 = Self::mul_add(
+            x669,
+            x749,
+            Self::mul_add(-x665, x750, Self::mul_add(-x661, x751, x657 * x732)),
+        );
+        let x753 = Self::mul_add(x673, x748, x752);
+        let x754 = Self::mul_add(
+            x646,
+            x750,
+            Self::mul_add(x642, x751, Self::mul_add(-x638, x753, x634 * x729)),
+        );
+        let x755 = Self::mul_add(-x654, x748, Self::mul_add(-x650, x749, x754));
+        let x756 = Self::mul_add(
+            x622,
+            x751,
+            Self::mul_add(x619, x753, Self::mul_add(x616, x755, x613 * x726)),
+        );
+        let x757 = Self::mul_add(
+            x631,
+            x748,
+            Self::mul_add(x628, x749, Self::mul_add(x625, x750, x756)),
+        );
+        let x758 = Self::mul_add(
+            x595,
+            x753,
+            Self::mul_add(x591, x755, Self::mul_add(-x587, x757, x585 * x724)),
+        );
+        let x759 = Self::mul_add(
+            x607,
+            x749,
+            Self::mul_add(x603, x750, Self::mul_add(x599, x751, x758)),
+        );
+        let x760 = Self::mul_add(x611, x748, x759);
+        let x761 = -x760;
+        let x762 = Self::mul_add(
+            -x569,
+            x755,
+            Self::mul_add(-x566, x757, Self::mul_add(x564, x760, x561 * x721)),
+        );
+        let x763 = Self::mul_add(
+            x578,
+            x750,
+            Self::mul_add(x575, x751, Self::mul_add(-x572, x753, x762)),
+        );
+        let x764 = Self::mul_add(-x584, x748, Self::mul_add(-x581, x749, x763));
+        let x765 = Self::mul_add(
+            -x541,
+            x757,
+            Self::mul_add(x539, x760, Self::mul_add(-x537, x764, x535 * x719)),
+        );
+        let x766 = Self::mul_add(
+            x550,
+            x751,
+            Self::mul_add(-x547, x753, Self::mul_add(-x544, x755, x765)),
+        );
+        let x767 = Self::mul_add(
+            -x559,
+            x748,
+            Self::mul_add(-x556, x749, Self::mul_add(x553, x750, x766)),
+        );
+        let x768 = Self::mul_add(
+            -x527,
+            x755,
+            Self::mul_add(
+                x519,
+                x764,
+                Self::mul_add(-x512, x767, x510 * 0.0008546497218115156),
+            ),
+        );
+        let x769 = Self::mul_add(
+            -x530,
+            x750,
+            Self::mul_add(x529, x751, Self::mul_add(-x528, x753, x768)),
+        );
+        let x770 = Self::mul_add(x532, x748, Self::mul_add(-x531, x749, x769));
+        let x771 = Self::mul_add(
+            -x520,
+            x757,
+            Self::mul_add(
+                x519,
+                x760,
+                Self::mul_add(x511, x767, x509 * 0.0008546497218115156),
+            ),
+        );
+        let x772 = Self::mul_add(
+            x523,
+            x751,
+            Self::mul_add(x522, x753, Self::mul_add(-x521, x755, x771)),
+        );
+        let x773 = Self::mul_add(
+            -x526,
+            x748,
+            Self::mul_add(-x525, x749, Self::mul_add(x524, x750, x772)),
+        );
+        let x774 = Self::mul_add(
+            x512,
+            x757,
+            Self::mul_add(
+                -x512,
+                x760,
+                Self::mul_add(-x511, x764, x508 * 0.0008546497218115156),
+            ),
+        );
+        let x775 = Self::mul_add(
+            x515,
+            x751,
+            Self::mul_add(x514, x753, Self::mul_add(-x513, x755, x774)),
+        );
+        let x776 = Self::mul_add(
+            -x518,
+            x748,
+            Self::mul_add(-x517, x749, Self::mul_add(x516, x750, x775)),
+        );
+        [x776, x773, x770, x767, x764, x761, x757, x755, x753, x751, x750, x749, x748]
     }
     /// The total momentum `[P (3), L (3)]` of base and arm: linear, and angular about the inertial origin, in inertial coordinates.
     ///

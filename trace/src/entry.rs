@@ -28,6 +28,7 @@ use kanegen_dynamics::algorithms::kinematics::BodyKinematics;
 use kanegen_dynamics::algorithms::{floating, frames, newton_euler, recurrent, rnea};
 use kanegen_dynamics::base::{quat_to_matrix, FloatingBase, FloatingState, BASE_BODY};
 use kanegen_dynamics::linalg::{Mat3, Vec3};
+use kanegen_dynamics::params::is_near_signed_permutation;
 use kanegen_dynamics::regroup::regrouped;
 use kanegen_dynamics::spatial::RbInertia;
 use kanegen_dynamics::{
@@ -108,6 +109,12 @@ pub fn trace(
             } else {
                 Params::<Sym>::new(model)
             };
+            if spec.two_step_placement > 0.0 {
+                for (jp, j) in p.joints.iter_mut().zip(model.joints()) {
+                    jp.placement_permutation =
+                        is_near_signed_permutation(&j.origin.rotation, spec.two_step_placement);
+                }
+            }
             if spec.runtime_payload {
                 payload_inputs(&mut p, &mut input);
             }

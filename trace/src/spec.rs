@@ -94,6 +94,10 @@ pub struct Spec {
     /// **inexact for N ≥ 3**; only with [`Subject::BaseFrame`] and the `recurrent-r1` mass-matrix
     /// method.
     pub paper_14b: bool,
+    /// Joint placements within this of a signed permutation, entry by entry, carry inertias in
+    /// two steps (`kanegen_dynamics::params::JointParams::placement_permutation`); only for a
+    /// model. 0 (default): exact permutations only. The same results, other operation counts.
+    pub two_step_placement: f64,
 }
 
 /// One effect of a [`Spec`], for reports of what each effect costs.
