@@ -259,20 +259,23 @@ pub fn choose(
         Some(m) if f.uses_mass_matrix() || f.uses_bias() => vec![m],
         _ => candidates(f, mass, model.is_chain()),
     };
+    // Placements near a signed permutation, per subject: the two-step inertia carry through
+    // them is traced as well (`kanegen_dynamics::params::NEAR_PERMUTATION`).
+    let near_model = has_near_permutation(model);
+    let near_canonical = canonical.as_ref().is_some_and(has_near_permutation);
     let n = model.dof();
     let kept: Vec<Methods> = all.iter().copied().filter(|m| can_win(f, *m, n)).collect();
     for m in if kept.is_empty() { all } else { kept } {
         for &fr in frames {
-            let subject = match (fr, &canonical) {
-                (BodyFrames::Canonical, Some(c)) => c,
+            let (subject, near) = match (fr, &canonical) {
+                (BodyFrames::Canonical, Some(c)) => (c, near_canonical),
                 (BodyFrames::Canonical, None) => continue,
-                (BodyFrames::Model, _) => model,
+                (BodyFrames::Model, _) => (model, near_model),
             };
             let mut t = trace(Subject::Model(subject), f, m, &spec)?;
             let mut c = t.trace.counts(Convention::Emitted);
-            // Placements near a signed permutation: the two-step inertia carry through them
-            // too, kept where it is cheaper (`kanegen_dynamics::params::NEAR_PERMUTATION`).
-            if f.uses_mass_matrix() && has_near_permutation(subject) {
+            // The CRBA's carry is the only one it changes (not ABA's), kept where cheaper.
+            if near && carries_inertia(f, m) {
                 let near = Spec {
                     two_step_placement: NEAR_PERMUTATION,
                     ..spec.clone()
@@ -324,4 +327,12 @@ fn has_near_permutation(model: &Model) -> bool {
             && is_near_signed_permutation(&j.origin.rotation, NEAR_PERMUTATION)
             && !is_near_signed_permutation(&j.origin.rotation, 0.0)
     })
+}
+
+/// Whether `f` by `m` runs the CRBA, whose inertia carry ([`NEAR_PERMUTATION`]) may go in two
+/// steps: a function of the mass matrix by `crba`, not forward dynamics by ABA.
+fn carries_inertia(f: Function, m: Methods) -> bool {
+    f.uses_mass_matrix()
+        && m.mass_matrix == MassMatrixMethod::Crba
+        && !(f.is_forward_dynamics() && m.forward == ForwardMethod::Aba)
 }
